@@ -1,0 +1,753 @@
+//! Constant evaluation of expressions, with type checking: every expression of a scene is
+//! evaluated at compile time. Function bodies are also checked on their own, with their
+//! parameters `Unknown` values of the declared types ("dry" evaluation: types only, no nodes).
+
+use super::builtins::{self, Build, Def, Range, P};
+use super::ops;
+use super::suggest::closest;
+use super::types::{Type, Value};
+use crate::diagnostics::Diagnostic;
+use crate::scene::{Graph, MaterialId, Node};
+use crate::span::Span;
+use crate::syntax::ast::*;
+use std::collections::HashMap;
+use std::rc::Rc;
+
+/// Limits that keep evaluation bounded on any input.
+pub const MAX_CALL_DEPTH: usize = 256;
+/// The most shape nodes a scene may build.
+pub const MAX_NODES: usize = 1_000_000;
+
+/// A user function and what checking its body found.
+#[derive(Debug)]
+pub struct FnInfo {
+    pub decl: Rc<FnDecl>,
+    /// The declared parameter types (`None` where the type name is unknown).
+    pub params: Vec<Option<Type>>,
+    /// The declared return type.
+    pub ret: Option<Type>,
+    /// False when the declaration or body had errors: calls then yield `Error` silently.
+    pub ok: bool,
+}
+
+/// The evaluation state of one compilation.
+#[derive(Debug, Default)]
+pub struct Ctx {
+    pub diags: Vec<Diagnostic>,
+    pub graph: Graph,
+    pub material_ids: HashMap<String, (MaterialId, Span)>,
+    pub globals: HashMap<String, (Value, Span)>,
+    /// Every global `let`, declared or not yet evaluated, for "used before its definition".
+    pub declared: HashMap<String, Span>,
+    pub fns: HashMap<String, FnInfo>,
+    locals: Vec<(String, Value)>,
+    dry: u32,
+    depth: usize,
+    reported_limit: bool,
+}
+
+/// An argument after evaluation.
+struct ArgVal {
+    name: Option<Ident>,
+    value: Value,
+    span: Span,
+}
+
+/// A parameter as the binder sees it (builtin or user).
+struct PView<'a> {
+    name: &'a str,
+    ty: Option<Type>,
+    has_default: bool,
+}
+
+impl Ctx {
+    pub fn error(&mut self, d: Diagnostic) {
+        if self.dry == 0 || d.code != "E0401" {
+            self.diags.push(d);
+        }
+    }
+
+    /// Evaluates `e`.
+    pub fn expr(&mut self, e: &Expr) -> Value {
+        match &e.kind {
+            ExprKind::Int(i) => Value::Int(*i),
+            ExprKind::Float(f) => self.finite(Value::Float(*f), e.span),
+            ExprKind::Angle(a) => self.finite(Value::Angle(*a), e.span),
+            ExprKind::Bool(b) => Value::Bool(*b),
+            ExprKind::Str(s) => Value::Str(s.as_str().into()),
+            ExprKind::Var(id) => self.var(id),
+            ExprKind::Tuple(items) => self.tuple(items, e.span),
+            ExprKind::Unary(op, x) => {
+                let v = self.expr(x);
+                self.result(ops::unary(*op, &v), e.span)
+            }
+            ExprKind::Binary(op, a, b) => {
+                let (va, vb) = (self.expr(a), self.expr(b));
+                match ops::binary(*op, &va, &vb) {
+                    Ok(v) => self.finite(v, e.span),
+                    Err(ops::OpError::DivZero) => {
+                        self.error(Diagnostic::error("E0401", "division by zero", b.span).with_label("this is zero"));
+                        Value::Error
+                    }
+                    Err(err) => self.op_error(err, *op, (&va, a.span), (&vb, b.span), e.span),
+                }
+            }
+            ExprKind::Call { callee, args } => {
+                let args = self.args(args);
+                self.call(callee, None, args, e.span)
+            }
+            ExprKind::Method { receiver, name, args } => {
+                let recv = self.expr(receiver);
+                let args = self.args(args);
+                self.call(name, Some((recv, receiver.span)), args, e.span)
+            }
+            ExprKind::Field(x, name) => {
+                let v = self.expr(x);
+                self.field(v, name)
+            }
+            ExprKind::If { cond, then, otherwise } => self.if_expr(cond, then, otherwise),
+            ExprKind::Material(x, m) => {
+                let v = self.expr(x);
+                self.paint(v, x.span, m, e.span)
+            }
+            ExprKind::Error => Value::Error,
+        }
+    }
+
+    fn finite(&mut self, v: Value, span: Span) -> Value {
+        if v.is_abstract() || v.components().iter().all(|c| c.is_finite()) {
+            return v;
+        }
+        self.error(
+            Diagnostic::error("E0402", "this value is not a finite number", span)
+                .with_label(format!("evaluates to {v}"))
+                .with_note("NaN and infinite values cannot be rendered"),
+        );
+        Value::Error
+    }
+
+    fn result(&mut self, r: Result<Value, ops::OpError>, span: Span) -> Value {
+        match r {
+            Ok(v) => self.finite(v, span),
+            Err(ops::OpError::Types(msg)) | Err(ops::OpError::Other(msg)) => {
+                self.error(Diagnostic::error("E0301", msg, span));
+                Value::Error
+            }
+            Err(ops::OpError::DivZero) => Value::Error,
+        }
+    }
+
+    fn op_error(&mut self, err: ops::OpError, op: BinOp, a: (&Value, Span), b: (&Value, Span), span: Span) -> Value {
+        let msg = match err {
+            ops::OpError::Types(m) | ops::OpError::Other(m) => m,
+            ops::OpError::DivZero => "division by zero".into(),
+        };
+        let mut d = Diagnostic::error("E0301", msg, span)
+            .with_secondary(a.1, format!("this is `{}`", a.0.ty().map_or("?".into(), |t| t.to_string())))
+            .with_secondary(b.1, format!("this is `{}`", b.0.ty().map_or("?".into(), |t| t.to_string())));
+        let tys = (a.0.ty(), b.0.ty());
+        if tys.0 == Some(Type::Shape) || tys.1 == Some(Type::Shape) {
+            d = d.with_help("shapes are combined with `union(a, b)`, `intersect(a, b)` or `subtract(a, b)`");
+        } else if matches!(tys, (Some(Type::Angle), Some(Type::Float | Type::Int)) | (Some(Type::Float | Type::Int), Some(Type::Angle)))
+            && matches!(op, BinOp::Add | BinOp::Sub)
+        {
+            d = d.with_help("give the number a unit: `30deg` or `0.5rad`");
+        }
+        self.error(d);
+        Value::Error
+    }
+
+    fn var(&mut self, id: &Ident) -> Value {
+        if let Some((_, v)) = self.locals.iter().rev().find(|(n, _)| *n == id.name) {
+            return v.clone();
+        }
+        if let Some((v, _)) = self.globals.get(&id.name) {
+            return v.clone();
+        }
+        if let Some(def) = self.declared.get(&id.name).copied() {
+            self.error(
+                Diagnostic::error("E0208", format!("`{}` is used before its definition", id.name), id.span)
+                    .with_label("used here")
+                    .with_secondary(def, "defined here, later")
+                    .with_help("move the `let` above its first use"),
+            );
+            return Value::Error;
+        }
+        let mut d = Diagnostic::error("E0200", format!("unknown name `{}`", id.name), id.span).with_label("not defined");
+        if self.fns.contains_key(&id.name) || builtins::builtin(&id.name).is_some() {
+            d = d.with_help(format!("`{}` is a function: call it as `{}(...)`", id.name, id.name));
+        } else if self.material_ids.contains_key(&id.name) {
+            d = d.with_help(format!("`{}` is a material: apply it with `shape @ {}`", id.name, id.name));
+        } else if let Some(s) = self.suggest_value(&id.name) {
+            d = d.with_help(format!("did you mean `{s}`?"));
+        }
+        self.error(d);
+        Value::Error
+    }
+
+    fn suggest_value(&self, name: &str) -> Option<String> {
+        let names: Vec<&str> = self
+            .locals
+            .iter()
+            .map(|(n, _)| n.as_str())
+            .chain(self.globals.keys().map(String::as_str))
+            .collect();
+        closest(name, names).map(str::to_string)
+    }
+
+    fn tuple(&mut self, items: &[Expr], span: Span) -> Value {
+        let vals: Vec<Value> = items.iter().map(|i| self.expr(i)).collect();
+        if !(2..=3).contains(&vals.len()) {
+            self.error(
+                Diagnostic::error("E0300", format!("a vector has 2 or 3 components, this has {}", vals.len()), span)
+                    .with_label("not a vec2 or vec3"),
+            );
+            return Value::Error;
+        }
+        let mut nums = Vec::new();
+        let mut abstract_ = false;
+        for (v, item) in vals.iter().zip(items) {
+            match v.clone().coerce(Type::Float) {
+                Some(Value::Float(f)) => nums.push(f),
+                Some(_) => abstract_ = true,
+                None => {
+                    self.error(
+                        Diagnostic::error("E0300", "vector components must be numbers", item.span)
+                            .with_label(format!("this is `{}`", v.ty().map_or("?".into(), |t| t.to_string()))),
+                    );
+                    return Value::Error;
+                }
+            }
+        }
+        let ty = if vals.len() == 2 { Type::Vec2 } else { Type::Vec3 };
+        if abstract_ {
+            return Value::Unknown(ty);
+        }
+        if nums.len() == 2 {
+            Value::Vec2([nums[0], nums[1]])
+        } else {
+            Value::Vec3([nums[0], nums[1], nums[2]])
+        }
+    }
+
+    fn field(&mut self, v: Value, name: &Ident) -> Value {
+        let idx = match name.name.as_str() {
+            "x" | "r" => 0,
+            "y" | "g" => 1,
+            "z" | "b" => 2,
+            _ => 3,
+        };
+        let dims = match v.ty() {
+            None => return Value::Error,
+            Some(Type::Vec2) => 2,
+            Some(Type::Vec3) => 3,
+            Some(t) => {
+                self.error(
+                    Diagnostic::error("E0210", format!("`{t}` has no component `{}`", name.name), name.span)
+                        .with_label("components exist only on vec2 and vec3"),
+                );
+                return Value::Error;
+            }
+        };
+        if idx >= dims {
+            self.error(
+                Diagnostic::error("E0210", format!("unknown vector component `{}`", name.name), name.span)
+                    .with_label(if dims == 2 { "a vec2 has `x` and `y`" } else { "a vec3 has `x`, `y` and `z`" }),
+            );
+            return Value::Error;
+        }
+        match v {
+            Value::Vec2(a) => Value::Float(a[idx]),
+            Value::Vec3(a) => Value::Float(a[idx]),
+            _ => Value::Unknown(Type::Float),
+        }
+    }
+
+    fn if_expr(&mut self, cond: &Expr, then: &Body, otherwise: &Body) -> Value {
+        let c = self.expr(cond);
+        let taken = match &c {
+            Value::Bool(b) => Some(*b),
+            Value::Error | Value::Unknown(Type::Bool) => None,
+            other => {
+                self.error(
+                    Diagnostic::error("E0303", "the condition of `if` must be a bool", cond.span)
+                        .with_label(format!("this is `{}`", other.ty().map_or("?".into(), |t| t.to_string()))),
+                );
+                None
+            }
+        };
+        // The branch not taken is still type-checked, without building anything.
+        let (a, b) = match taken {
+            Some(true) => (self.body(then), self.dry(|cx| cx.body(otherwise))),
+            Some(false) => (self.dry(|cx| cx.body(then)), self.body(otherwise)),
+            None => (self.dry(|cx| cx.body(then)), self.dry(|cx| cx.body(otherwise))),
+        };
+        let (ta, tb) = (a.ty(), b.ty());
+        if let (Some(x), Some(y)) = (ta, tb) {
+            if x != y && !(x.fits(y) || y.fits(x)) {
+                self.error(
+                    Diagnostic::error("E0302", "the branches of `if` have different types", then.value.span)
+                        .with_label(format!("this is `{x}`"))
+                        .with_secondary(otherwise.value.span, format!("this is `{y}`")),
+                );
+                return Value::Error;
+            }
+        }
+        match taken {
+            Some(true) => a,
+            Some(false) => b,
+            None => ta.or(tb).map_or(Value::Error, Value::Unknown),
+        }
+    }
+
+    /// Runs `f` in dry mode: types only, no nodes, no range errors.
+    pub fn dry<T>(&mut self, f: impl FnOnce(&mut Self) -> T) -> T {
+        self.dry += 1;
+        let out = f(self);
+        self.dry -= 1;
+        out
+    }
+
+    /// Evaluates a body's local bindings and value; the bindings end with it.
+    pub fn body(&mut self, b: &Body) -> Value {
+        let mark = self.locals.len();
+        for l in &b.lets {
+            let v = self.let_value(l);
+            self.locals.push((l.name.name.clone(), v));
+        }
+        let v = self.expr(&b.value);
+        self.locals.truncate(mark);
+        v
+    }
+
+    /// Evaluates the value of a `let`, checking its declared type.
+    pub fn let_value(&mut self, l: &Let) -> Value {
+        let v = self.expr(&l.value);
+        let Some(ty) = &l.ty else { return v };
+        let Some(want) = self.type_name(ty) else { return Value::Error };
+        match v.clone().coerce(want) {
+            Some(c) => c,
+            None => {
+                self.error(
+                    Diagnostic::error("E0300", format!("expected `{want}`, found `{}`", v.ty().map_or("?".into(), |t| t.to_string())), l.value.span)
+                        .with_label(format!("this is `{}`", v.ty().map_or("?".into(), |t| t.to_string())))
+                        .with_secondary(ty.span, "declared type"),
+                );
+                Value::Error
+            }
+        }
+    }
+
+    /// Binds a scene-level local (a `let` or loop variable of a `scene` block).
+    pub fn push_local(&mut self, name: &str, v: Value) {
+        self.locals.push((name.to_string(), v));
+    }
+
+    /// The number of locals, to truncate back to.
+    pub fn locals_mark(&self) -> usize {
+        self.locals.len()
+    }
+
+    /// Drops locals bound after `mark`.
+    pub fn truncate_locals(&mut self, mark: usize) {
+        self.locals.truncate(mark);
+    }
+
+    /// Resolves a type name, reporting an unknown one.
+    pub fn type_name(&mut self, id: &Ident) -> Option<Type> {
+        let t = Type::from_name(&id.name);
+        if t.is_none() {
+            let mut d = Diagnostic::error("E0209", format!("unknown type `{}`", id.name), id.span)
+                .with_label("not a type")
+                .with_note(format!("the types are {}", Type::NAMES.join(", ")));
+            if let Some(s) = closest(&id.name, Type::NAMES) {
+                d = d.with_help(format!("did you mean `{s}`?"));
+            }
+            self.error(d);
+        }
+        t
+    }
+
+    fn paint(&mut self, v: Value, vspan: Span, m: &Ident, span: Span) -> Value {
+        let mat = match self.material_ids.get(&m.name) {
+            Some((id, _)) => Some(*id),
+            None => {
+                let mut d = Diagnostic::error("E0212", format!("unknown material `{}`", m.name), m.span)
+                    .with_label("no material of this name");
+                if let Some(s) = closest(&m.name, self.material_ids.keys().map(String::as_str)) {
+                    d = d.with_help(format!("did you mean `{s}`?"));
+                } else {
+                    d = d.with_help(format!("declare it: `material {} = phong {{ color: (1, 0, 0) }}`", m.name));
+                }
+                self.error(d);
+                None
+            }
+        };
+        match (v, mat) {
+            (Value::Shape(child), Some(material)) => self.add_node(Node::Paint { material, child }, span),
+            (Value::Error, _) | (Value::Shape(_), None) => Value::Error,
+            (Value::Unknown(Type::Shape), _) => Value::Unknown(Type::Shape),
+            (other, _) => {
+                self.error(
+                    Diagnostic::error("E0300", "only shapes can be given a material", vspan)
+                        .with_label(format!("this is `{}`", other.ty().map_or("?".into(), |t| t.to_string()))),
+                );
+                Value::Error
+            }
+        }
+    }
+
+    /// Adds a node unless the node budget is spent.
+    pub fn add_node(&mut self, node: Node, span: Span) -> Value {
+        if self.graph.len() >= MAX_NODES {
+            self.limit(span, format!("the scene has more than {MAX_NODES} shape nodes"));
+            return Value::Error;
+        }
+        Value::Shape(self.graph.add(node, span))
+    }
+
+    /// Reports a resource limit once.
+    pub fn limit(&mut self, span: Span, msg: String) {
+        if !self.reported_limit {
+            self.reported_limit = true;
+            self.error(Diagnostic::error("E0507", msg, span).with_note("this limit keeps compilation bounded"));
+        }
+    }
+
+    fn args(&mut self, args: &[Arg]) -> Vec<ArgVal> {
+        args.iter()
+            .map(|a| ArgVal { name: a.name.clone(), value: self.expr(&a.value), span: a.value.span })
+            .collect()
+    }
+
+    fn call(&mut self, callee: &Ident, recv: Option<(Value, Span)>, args: Vec<ArgVal>, span: Span) -> Value {
+        if self.fns.contains_key(&callee.name) {
+            return self.call_user(callee, recv, args, span);
+        }
+        if let Some(b) = builtins::builtin(&callee.name) {
+            return self.call_builtin(b, callee, recv, args, span);
+        }
+        let mut d = Diagnostic::error("E0201", format!("unknown function `{}`", callee.name), callee.span)
+            .with_label("no function of this name");
+        let names = self.fns.keys().map(String::as_str).chain(builtins::BUILTINS.iter().map(|b| b.name));
+        if let Some(s) = closest(&callee.name, names) {
+            d = d.with_help(format!("did you mean `{s}`?"));
+        }
+        self.error(d);
+        Value::Error
+    }
+
+    fn call_builtin(&mut self, b: &'static builtins::Builtin, callee: &Ident, recv: Option<(Value, Span)>, args: Vec<ArgVal>, span: Span) -> Value {
+        // Overloads are tried in order; the first that binds cleanly wins. Otherwise the errors
+        // of the closest one are reported.
+        let mut best: Option<(usize, Vec<Diagnostic>)> = None;
+        for (i, sig) in b.sigs.iter().enumerate() {
+            let params: Vec<PView> = sig.params.iter().map(|p| PView { name: p.name, ty: Some(p.ty), has_default: p.def.value().is_some() }).collect();
+            match bind(&params, sig.rest, &recv, &args, callee, span) {
+                Ok(slots) => return self.run_builtin(b, sig, slots, callee, span),
+                Err(errs) => {
+                    if best.as_ref().is_none_or(|(_, e)| errs.len() < e.len()) {
+                        best = Some((i, errs));
+                    }
+                }
+            }
+        }
+        if let Some((i, errs)) = best {
+            let sig_note = if b.sigs.len() > 1 {
+                let all: Vec<String> = b.sigs.iter().map(|s| builtins::signature(b.name, s)).collect();
+                format!("the forms of `{}` are:\n  {}", b.name, all.join("\n  "))
+            } else {
+                format!("`{}`", builtins::signature(b.name, &b.sigs[i]))
+            };
+            for d in errs {
+                self.error(d.with_note(sig_note.clone()));
+            }
+        }
+        Value::Error
+    }
+
+    fn run_builtin(&mut self, b: &builtins::Builtin, sig: &builtins::Sig, slots: Bound, callee: &Ident, span: Span) -> Value {
+        let mut vals = Vec::new();
+        let mut ok = true;
+        let mut abstract_ = false;
+        for (i, slot) in slots.slots.into_iter().enumerate() {
+            let p: &P = &sig.params[i];
+            let (v, vspan) = match slot {
+                Some(s) => s,
+                None => (p.def.value().unwrap_or(Value::Error), span),
+            };
+            ok &= self.in_range(p, &v, vspan, callee);
+            abstract_ |= v.is_abstract();
+            vals.push(v);
+        }
+        let last = sig.params.last();
+        for (v, vspan) in slots.rest {
+            if let Some(p) = last {
+                ok &= self.in_range(p, &v, vspan, callee);
+            }
+            abstract_ |= v.is_abstract();
+            vals.push(v);
+        }
+        if !ok {
+            return Value::Error;
+        }
+        if abstract_ || self.dry > 0 {
+            return if vals.contains(&Value::Error) { Value::Error } else { Value::Unknown(sig.ret) };
+        }
+        if sig.ret == Type::Shape && self.graph.len() >= MAX_NODES {
+            self.limit(span, format!("the scene has more than {MAX_NODES} shape nodes"));
+            return Value::Error;
+        }
+        let mut build = Build { graph: &mut self.graph, span };
+        match (sig.imp)(&mut build, &vals) {
+            Ok(v) => self.finite(v, span),
+            Err(msg) => {
+                self.error(Diagnostic::error("E0400", msg, span).with_label(format!("in this call of `{}`", b.name)));
+                Value::Error
+            }
+        }
+    }
+
+    fn in_range(&mut self, p: &P, v: &Value, span: Span, callee: &Ident) -> bool {
+        if v.is_abstract() || p.range == Range::Any || self.dry > 0 {
+            return true;
+        }
+        match p.range.check(v) {
+            Ok(()) => true,
+            Err(why) => {
+                self.error(
+                    Diagnostic::error("E0400", format!("`{}` of `{}` {why}", p.name, callee.name), span)
+                        .with_label(format!("this is {v}")),
+                );
+                false
+            }
+        }
+    }
+
+    fn call_user(&mut self, callee: &Ident, recv: Option<(Value, Span)>, args: Vec<ArgVal>, span: Span) -> Value {
+        let info = &self.fns[&callee.name];
+        let decl = info.decl.clone();
+        let (ptys, ret, ok) = (info.params.clone(), info.ret, info.ok);
+        let params: Vec<PView> = decl
+            .params
+            .iter()
+            .zip(&ptys)
+            .map(|(p, t)| PView { name: &p.name.name, ty: *t, has_default: p.default.is_some() })
+            .collect();
+        let slots = match bind(&params, false, &recv, &args, callee, span) {
+            Ok(s) => s,
+            Err(errs) => {
+                for d in errs {
+                    self.error(d.with_secondary(decl.name.span, "declared here"));
+                }
+                return Value::Error;
+            }
+        };
+        let Some(ret) = ret else { return Value::Error };
+        if !ok {
+            return Value::Error;
+        }
+        if self.depth >= MAX_CALL_DEPTH {
+            self.limit(span, format!("calls nest deeper than {MAX_CALL_DEPTH}"));
+            return Value::Error;
+        }
+        // Defaults are evaluated in the global scope; the body sees only its parameters.
+        let saved = std::mem::take(&mut self.locals);
+        let mut frame = Vec::new();
+        for ((slot, p), ty) in slots.slots.into_iter().zip(&decl.params).zip(&ptys) {
+            let v = match slot {
+                Some((v, _)) => v,
+                None => {
+                    let d = p.default.as_ref().map_or(Value::Error, |d| self.expr(d));
+                    ty.and_then(|t| d.clone().coerce(t)).unwrap_or(Value::Error)
+                }
+            };
+            frame.push((p.name.name.clone(), v));
+        }
+        self.locals = frame;
+        self.depth += 1;
+        let v = self.body(&decl.body);
+        self.depth -= 1;
+        self.locals = saved;
+        v.coerce(ret).unwrap_or(Value::Error)
+    }
+}
+
+/// Arguments matched to parameters: one slot per parameter (`None`: use the default), then
+/// the extra arguments of a variadic last parameter.
+struct Bound {
+    slots: Vec<Option<(Value, Span)>>,
+    rest: Vec<(Value, Span)>,
+}
+
+/// Matches arguments to parameters and checks their types. A method receiver goes to the first
+/// parameter of its type. Returns every problem found.
+fn bind(params: &[PView], rest: bool, recv: &Option<(Value, Span)>, args: &[ArgVal], callee: &Ident, span: Span) -> Result<Bound, Vec<Diagnostic>> {
+    let mut errs = Vec::new();
+    let mut slots: Vec<Option<(Value, Span)>> = vec![None; params.len()];
+    let mut extra = Vec::new();
+    let mut filled = vec![false; params.len()];
+    if let Some((v, s)) = recv {
+        let idx = v.ty().and_then(|t| params.iter().position(|p| p.ty.is_some_and(|pt| t.fits(pt)))).unwrap_or(0);
+        if params.is_empty() {
+            errs.push(Diagnostic::error("E0205", format!("`{}` takes no arguments", callee.name), *s));
+        } else {
+            slots[idx] = Some((v.clone(), *s));
+            filled[idx] = true;
+        }
+    }
+    let mut next = 0;
+    let mut seen_named = false;
+    for a in args {
+        match &a.name {
+            None => {
+                if seen_named {
+                    errs.push(
+                        Diagnostic::error("E0206", "positional argument after a named argument", a.span)
+                            .with_help("give every argument after a named one by name too"),
+                    );
+                    continue;
+                }
+                while next < params.len() && filled[next] {
+                    next += 1;
+                }
+                if next < params.len() {
+                    slots[next] = Some((a.value.clone(), a.span));
+                    filled[next] = true;
+                } else if rest && !params.is_empty() {
+                    extra.push((a.value.clone(), a.span));
+                } else if !errs.iter().any(|d: &Diagnostic| d.code == "E0205") {
+                    errs.push(
+                        Diagnostic::error("E0205", format!("too many arguments to `{}`", callee.name), a.span)
+                            .with_label(format!("`{}` takes at most {} argument{}", callee.name, params.len(), if params.len() == 1 { "" } else { "s" })),
+                    );
+                }
+            }
+            Some(name) => {
+                seen_named = true;
+                match params.iter().position(|p| p.name == name.name) {
+                    Some(i) if filled[i] => errs.push(
+                        Diagnostic::error("E0203", format!("argument `{}` is given twice", name.name), name.span)
+                            .with_label("given again here"),
+                    ),
+                    Some(i) => {
+                        slots[i] = Some((a.value.clone(), a.span));
+                        filled[i] = true;
+                    }
+                    None => {
+                        let mut d = Diagnostic::error("E0202", format!("`{}` has no parameter `{}`", callee.name, name.name), name.span)
+                            .with_label("unknown parameter");
+                        if let Some(s) = closest(&name.name, params.iter().map(|p| p.name)) {
+                            d = d.with_help(format!("did you mean `{s}`?"));
+                        }
+                        errs.push(d);
+                    }
+                }
+            }
+        }
+    }
+    for (i, p) in params.iter().enumerate() {
+        if !filled[i] && !p.has_default {
+            errs.push(
+                Diagnostic::error("E0204", format!("missing argument `{}` of `{}`", p.name, callee.name), span)
+                    .with_label(format!("`{}` is required", p.name)),
+            );
+        }
+    }
+    for (i, slot) in slots.iter_mut().enumerate() {
+        if let (Some((v, s)), Some(want)) = (slot.as_mut(), params[i].ty) {
+            match v.clone().coerce(want) {
+                Some(c) => *v = c,
+                None => errs.push(type_mismatch(params[i].name, want, v, *s)),
+            }
+        }
+    }
+    if let Some(want) = params.last().and_then(|p| p.ty) {
+        for (v, s) in extra.iter_mut() {
+            match v.clone().coerce(want) {
+                Some(c) => *v = c,
+                None => errs.push(type_mismatch(params[params.len() - 1].name, want, v, *s)),
+            }
+        }
+    }
+    if errs.is_empty() {
+        Ok(Bound { slots, rest: extra })
+    } else {
+        Err(errs)
+    }
+}
+
+fn type_mismatch(param: &str, want: Type, v: &Value, span: Span) -> Diagnostic {
+    let found = v.ty().map_or("?".to_string(), |t| t.to_string());
+    let mut d = Diagnostic::error("E0300", format!("expected `{want}` for `{param}`, found `{found}`"), span)
+        .with_label(format!("this is `{found}`"));
+    match (want, v.ty()) {
+        (Type::Angle, Some(Type::Float | Type::Int)) => d = d.with_help("give the angle a unit: `90deg` or `1.57rad`"),
+        (Type::Int, Some(Type::Float)) => d = d.with_help("use a whole number, or `int(x)`"),
+        (Type::Vec3, Some(Type::Float | Type::Int)) => d = d.with_help("write a vector as `(x, y, z)`"),
+        _ => {}
+    }
+    d
+}
+
+/// Binds the fields of a record block (`phong { ... }`, `camera { ... }`) as named arguments,
+/// applying defaults and range checks. Returns the values by field name.
+pub fn record(cx: &mut Ctx, rec: &builtins::Record, fields: &[Field], head: &Ident) -> HashMap<&'static str, Value> {
+    let mut out: HashMap<&'static str, Value> = HashMap::new();
+    let mut spans: HashMap<&'static str, Span> = HashMap::new();
+    for f in fields {
+        let v = cx.expr(&f.value);
+        let Some(p) = rec.fields.iter().find(|p| p.name == f.name.name) else {
+            let mut d = Diagnostic::error("E0202", format!("`{}` has no field `{}`", rec.name, f.name.name), f.name.span)
+                .with_label("unknown field")
+                .with_note(format!("the fields of `{}` are {}", rec.name, rec.fields.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")));
+            if let Some(s) = closest(&f.name.name, rec.fields.iter().map(|p| p.name)) {
+                d = d.with_help(format!("did you mean `{s}`?"));
+            }
+            cx.error(d);
+            continue;
+        };
+        if let Some(prev) = spans.get(p.name) {
+            cx.error(
+                Diagnostic::error("E0203", format!("field `{}` is given twice", p.name), f.name.span)
+                    .with_label("given again here")
+                    .with_secondary(*prev, "first given here"),
+            );
+            continue;
+        }
+        spans.insert(p.name, f.name.span);
+        let v = match v.clone().coerce(p.ty) {
+            Some(c) => c,
+            None => {
+                cx.error(type_mismatch(p.name, p.ty, &v, f.value.span));
+                Value::Error
+            }
+        };
+        if !v.is_abstract() {
+            if let Err(why) = p.range.check(&v) {
+                cx.error(Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span).with_label(format!("this is {v}")));
+                out.insert(p.name, Value::Error);
+                continue;
+            }
+        }
+        out.insert(p.name, v);
+    }
+    for p in rec.fields {
+        if out.contains_key(p.name) || spans.contains_key(p.name) {
+            continue;
+        }
+        match p.def {
+            Def::Req => {
+                cx.error(
+                    Diagnostic::error("E0204", format!("missing field `{}` of `{}`", p.name, rec.name), head.span)
+                        .with_label(format!("`{}` is required", p.name)),
+                );
+                out.insert(p.name, Value::Error);
+            }
+            d => {
+                out.insert(p.name, d.value().unwrap_or(Value::Error));
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,155 @@
+//! Types and constant values of the language.
+
+use crate::scene::NodeId;
+use std::fmt;
+use std::rc::Rc;
+
+/// The types a value can have. `int` converts to `float` wherever a float is expected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Type {
+    Int,
+    Float,
+    Bool,
+    Vec2,
+    Vec3,
+    Angle,
+    Str,
+    Shape,
+}
+
+impl Type {
+    /// The type named `name` in a declaration.
+    pub fn from_name(name: &str) -> Option<Type> {
+        Some(match name {
+            "int" => Type::Int,
+            "float" => Type::Float,
+            "bool" => Type::Bool,
+            "vec2" => Type::Vec2,
+            "vec3" => Type::Vec3,
+            "angle" => Type::Angle,
+            "string" => Type::Str,
+            "shape" => Type::Shape,
+            _ => return None,
+        })
+    }
+
+    /// All type names, for suggestions.
+    pub const NAMES: [&'static str; 8] = ["int", "float", "bool", "vec2", "vec3", "angle", "string", "shape"];
+
+    /// True when a value of type `self` may be passed where `want` is expected.
+    pub fn fits(self, want: Type) -> bool {
+        self == want || (self == Type::Int && want == Type::Float)
+    }
+}
+
+impl fmt::Display for Type {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str(match self {
+            Type::Int => "int",
+            Type::Float => "float",
+            Type::Bool => "bool",
+            Type::Vec2 => "vec2",
+            Type::Vec3 => "vec3",
+            Type::Angle => "angle",
+            Type::Str => "string",
+            Type::Shape => "shape",
+        })
+    }
+}
+
+/// A constant value. `Unknown` is a value of a known type that is not computed (while a
+/// function body is checked on its own); `Error` is the result of an expression that was
+/// already reported, and is accepted everywhere so that one mistake is reported once.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    Int(i64),
+    Float(f64),
+    Bool(bool),
+    Vec2([f64; 2]),
+    Vec3([f64; 3]),
+    /// In radians.
+    Angle(f64),
+    Str(Rc<str>),
+    Shape(NodeId),
+    Unknown(Type),
+    Error,
+}
+
+impl Value {
+    /// The value's type; `None` for `Error`.
+    pub fn ty(&self) -> Option<Type> {
+        Some(match self {
+            Value::Int(_) => Type::Int,
+            Value::Float(_) => Type::Float,
+            Value::Bool(_) => Type::Bool,
+            Value::Vec2(_) => Type::Vec2,
+            Value::Vec3(_) => Type::Vec3,
+            Value::Angle(_) => Type::Angle,
+            Value::Str(_) => Type::Str,
+            Value::Shape(_) => Type::Shape,
+            Value::Unknown(t) => *t,
+            Value::Error => return None,
+        })
+    }
+
+    /// True for values that are not computed (unknown or error).
+    pub fn is_abstract(&self) -> bool {
+        matches!(self, Value::Unknown(_) | Value::Error)
+    }
+
+    /// Converts to `want` if the type fits (`int` to `float`); `None` if it does not.
+    pub fn coerce(self, want: Type) -> Option<Value> {
+        match (self, want) {
+            (Value::Error, _) => Some(Value::Error),
+            (Value::Int(i), Type::Float) => Some(Value::Float(i as f64)),
+            (Value::Unknown(t), w) if t.fits(w) => Some(Value::Unknown(w)),
+            (v, w) if v.ty() == Some(w) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// The number in an int or float (0 for others; callers check types first).
+    pub fn num(&self) -> f64 {
+        match self {
+            Value::Int(i) => *i as f64,
+            Value::Float(f) | Value::Angle(f) => *f,
+            _ => 0.0,
+        }
+    }
+
+    /// The components of a vec3 (zeros for others).
+    pub fn v3(&self) -> [f64; 3] {
+        match self {
+            Value::Vec3(v) => *v,
+            _ => [0.0; 3],
+        }
+    }
+
+    /// Every float component, for range and finiteness checks.
+    pub fn components(&self) -> Vec<f64> {
+        match self {
+            Value::Int(i) => vec![*i as f64],
+            Value::Float(f) | Value::Angle(f) => vec![*f],
+            Value::Vec2(v) => v.to_vec(),
+            Value::Vec3(v) => v.to_vec(),
+            _ => Vec::new(),
+        }
+    }
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self {
+            Value::Int(i) => write!(f, "{i}"),
+            Value::Float(x) => write!(f, "{x}"),
+            Value::Bool(b) => write!(f, "{b}"),
+            Value::Vec2(v) => write!(f, "({}, {})", v[0], v[1]),
+            Value::Vec3(v) => write!(f, "({}, {}, {})", v[0], v[1], v[2]),
+            Value::Angle(a) => write!(f, "{}deg", a.to_degrees()),
+            Value::Str(s) => write!(f, "{s:?}"),
+            Value::Shape(_) => write!(f, "<shape>"),
+            Value::Unknown(t) => write!(f, "<{t}>"),
+            Value::Error => write!(f, "<error>"),
+        }
+    }
+}

@@ -1,0 +1,26 @@
+//! sdfc: a compiler for scenes of signed distance fields.
+//!
+//! The stages are typed functions with one entry each:
+//!
+//! ```text
+//! syntax::parse   .sdf text            → ast::File + diagnostics   (logos, chumsky)
+//! check::check    files (via a Loader) → scene::Scene + diagnostics
+//! lower::lower    scene::Scene         → lower::Program             (flat scalar SSA)
+//! eval            lower::Program       → distances at batches of points (CPU, f32/f64)
+//! back::rust      lower::Program       → Rust source over glam
+//! ```
+//!
+//! The crate does no IO and never panics on user input: imports are read through the
+//! [`check::Loader`] the caller passes in, and every problem is a [`Diagnostic`].
+
+pub mod back;
+pub mod check;
+pub mod diagnostics;
+pub mod eval;
+pub mod lower;
+pub mod scene;
+pub mod span;
+pub mod syntax;
+
+pub use diagnostics::{Diagnostic, Severity};
+pub use span::{FileId, SourceMap, Span};

@@ -1,0 +1,166 @@
+//! A stable text dump of a scene (`sdfc compile --emit ir`, snapshot tests).
+
+use super::ir::*;
+use std::fmt::Write;
+
+/// Dumps a scene: settings, camera, lights, materials, then every node reachable from the root
+/// as `%n = op(args)`, children before parents.
+pub fn dump(scene: &Scene) -> String {
+    let mut out = String::new();
+    let s = &scene.settings;
+    let _ = writeln!(
+        out,
+        "render {}x{} aa={} max_steps={} epsilon={} max_depth={} max_dist={} relaxation={} background={}",
+        s.width, s.height, s.aa, s.max_steps, num(s.epsilon), s.max_depth, num(s.max_dist),
+        num(s.relaxation), v3(s.background)
+    );
+    let c = &scene.camera;
+    let _ = writeln!(
+        out,
+        "camera position={} look_at={} fov={}deg",
+        v3(c.position),
+        v3(c.look_at),
+        num(c.fov.to_degrees())
+    );
+    for l in &scene.lights {
+        let _ = match l {
+            Light::Point { position, color, intensity, radius, softness } => writeln!(
+                out,
+                "light point position={} color={} intensity={} radius={} softness={}",
+                v3(*position), v3(*color), num(*intensity), num(*radius), num(*softness)
+            ),
+            Light::Directional { direction, color, intensity, softness } => writeln!(
+                out,
+                "light directional direction={} color={} intensity={} softness={}",
+                v3(*direction), v3(*color), num(*intensity), num(*softness)
+            ),
+        };
+    }
+    for (i, m) in scene.materials.iter().enumerate() {
+        let pattern = match &m.pattern {
+            Pattern::Solid(c) => format!("color={}", v3(*c)),
+            Pattern::Checker { a, b, size } => format!("checker a={} b={} size={}", v3(*a), v3(*b), num(*size)),
+        };
+        let _ = writeln!(
+            out,
+            "material #{i} {} {pattern} ambient={} diffuse={} specular={} shininess={} reflect={} transparency={} ior={}",
+            m.name, num(m.ambient), num(m.diffuse), num(m.specular), num(m.shininess), num(m.reflect),
+            num(m.transparency), num(m.ior)
+        );
+    }
+    match scene.root {
+        None => out.push_str("root none\n"),
+        Some(root) => {
+            let mut order = Vec::new();
+            let mut seen = vec![false; scene.graph.len()];
+            postorder(&scene.graph, root, &mut seen, &mut order);
+            for id in order {
+                let _ = writeln!(out, "%{} = {}", id.0, node(scene.graph.node(id)));
+            }
+            let _ = writeln!(out, "root %{}", root.0);
+        }
+    }
+    out
+}
+
+fn postorder(g: &Graph, id: NodeId, seen: &mut [bool], order: &mut Vec<NodeId>) {
+    // Iterative, so that deep scenes cannot overflow the stack.
+    let mut stack = vec![(id, false)];
+    while let Some((n, expanded)) = stack.pop() {
+        if seen[n.0 as usize] {
+            continue;
+        }
+        if expanded {
+            seen[n.0 as usize] = true;
+            order.push(n);
+        } else {
+            stack.push((n, true));
+            for c in g.node(n).children().into_iter().rev() {
+                stack.push((c, false));
+            }
+        }
+    }
+}
+
+/// Formats a float the shortest way that reads back exactly.
+/// Formats a float for the dump: integers without a fraction, others to 10 significant
+/// digits, so that round-off noise (such as 59.99999999999999 for 60°) does not show.
+pub(crate) fn num(x: f64) -> String {
+    if x == 0.0 || x.abs() < 1e-13 {
+        return "0".to_string();
+    }
+    if x == x.trunc() && x.abs() < 1e15 {
+        return format!("{}", x as i64);
+    }
+    let digits = 9 - x.abs().log10().floor() as i32;
+    if !(0..=17).contains(&digits) {
+        return format!("{x:e}");
+    }
+    let s = format!("{:.*}", digits as usize, x);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".to_string() } else { s.to_string() }
+}
+
+fn v3(v: V3) -> String {
+    format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]))
+}
+
+fn ids(ids: &[NodeId]) -> String {
+    ids.iter().map(|i| format!("%{}", i.0)).collect::<Vec<_>>().join(", ")
+}
+
+fn node(n: &Node) -> String {
+    match n {
+        Node::Sphere { radius } => format!("sphere radius={}", num(*radius)),
+        Node::Box { half } => format!("box half={}", v3(*half)),
+        Node::RoundBox { half, radius } => format!("round_box half={} radius={}", v3(*half), num(*radius)),
+        Node::Plane { normal, height } => format!("plane normal={} height={}", v3(*normal), num(*height)),
+        Node::Torus { major, minor } => format!("torus major={} minor={}", num(*major), num(*minor)),
+        Node::Cylinder { radius, half_height } => {
+            format!("cylinder radius={} half_height={}", num(*radius), num(*half_height))
+        }
+        Node::Capsule { radius, half_height } => {
+            format!("capsule radius={} half_height={}", num(*radius), num(*half_height))
+        }
+        Node::Cone { radius, half_height } => format!("cone radius={} half_height={}", num(*radius), num(*half_height)),
+        Node::Ellipsoid { radii } => format!("ellipsoid radii={}", v3(*radii)),
+        Node::Mandelbulb { power, iterations } => format!("mandelbulb power={} iterations={iterations}", num(*power)),
+        Node::Combine { op, children } => format!("{} {}", combine(*op), ids(children)),
+        Node::SmoothCombine { op, k, variant, a, b } => {
+            let v = if *variant == Smooth::Poly { "poly" } else { "exp" };
+            format!("smooth_{} k={} {v} %{}, %{}", combine(*op), num(*k), a.0, b.0)
+        }
+        Node::Translate { offset, child } => format!("translate {} %{}", v3(*offset), child.0),
+        Node::Rotate { matrix, child } => format!(
+            "rotate [{}, {}, {}] %{}",
+            v3(matrix[0]),
+            v3(matrix[1]),
+            v3(matrix[2]),
+            child.0
+        ),
+        Node::Scale { factor, child } => format!("scale {} %{}", num(*factor), child.0),
+        Node::ScaleXyz { factors, child } => format!("scale_xyz {} %{}", v3(*factors), child.0),
+        Node::Repeat { period, count, child } => match count {
+            Some(c) => format!("repeat period={} count={} %{}", v3(*period), v3(*c), child.0),
+            None => format!("repeat period={} %{}", v3(*period), child.0),
+        },
+        Node::Mirror { axes, child } => {
+            let a: String = ["x", "y", "z"].iter().zip(axes).filter(|(_, on)| **on).map(|(n, _)| *n).collect();
+            format!("mirror {a} %{}", child.0)
+        }
+        Node::Twist { rate, child } => format!("twist {} %{}", num(*rate), child.0),
+        Node::Bend { rate, child } => format!("bend {} %{}", num(*rate), child.0),
+        Node::Round { radius, child } => format!("round {} %{}", num(*radius), child.0),
+        Node::Shell { thickness, child } => format!("shell {} %{}", num(*thickness), child.0),
+        Node::Elongate { half, child } => format!("elongate {} %{}", v3(*half), child.0),
+        Node::Paint { material, child } => format!("paint #{} %{}", material.0, child.0),
+    }
+}
+
+fn combine(op: Combine) -> &'static str {
+    match op {
+        Combine::Union => "union",
+        Combine::Intersect => "intersect",
+        Combine::Subtract => "subtract",
+    }
+}

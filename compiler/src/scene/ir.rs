@@ -1,0 +1,338 @@
+//! The scene IR: a hash-consed DAG of shape nodes plus materials, lights, camera and settings.
+//!
+//! Everything in it is constant: the checker has evaluated every expression. Nodes live in an
+//! arena ([`Graph`]) and are named by [`NodeId`]; structurally equal nodes are stored once, so
+//! a sub-shape used twice is one node. Computed facts (bounds, Lipschitz bound, exactness) are
+//! kept in side tables keyed by `NodeId` ([`Facts`]), next to the spans.
+
+use crate::span::Span;
+use std::collections::HashMap;
+
+/// A 3-vector of f64.
+pub type V3 = [f64; 3];
+
+/// Names a node of a [`Graph`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(pub u32);
+
+/// Names a material of a [`Scene`]; 0 is the default material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MaterialId(pub u32);
+
+/// The smooth-minimum variant of a smooth combinator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Smooth {
+    /// Polynomial (quadratic) smooth minimum: exact outside the blend region, a bound inside.
+    Poly,
+    /// Exponential smooth minimum: smoother, but not a bound for large k.
+    Exp,
+}
+
+/// The three boolean combinations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Combine {
+    /// min(a, b)
+    Union,
+    /// max(a, b)
+    Intersect,
+    /// max(a, -b)
+    Subtract,
+}
+
+/// A shape node. Primitives are centred on the origin; transforms wrap a child.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Node {
+    /// Sphere of a radius.
+    Sphere { radius: f64 },
+    /// Box of half-extents.
+    Box { half: V3 },
+    /// Box of half-extents with edges rounded by a radius (the radius is inside the extents).
+    RoundBox { half: V3, radius: f64 },
+    /// Half-space below the plane `dot(p, normal) = height` (normal is unit length).
+    Plane { normal: V3, height: f64 },
+    /// Torus in the xz plane.
+    Torus { major: f64, minor: f64 },
+    /// Capped cylinder along y.
+    Cylinder { radius: f64, half_height: f64 },
+    /// Capsule along y: a segment of half-length `half_height`, swept by a radius.
+    Capsule { radius: f64, half_height: f64 },
+    /// Capped cone along y with its tip at `height / 2` and its base radius `radius` at
+    /// `-height / 2`.
+    Cone { radius: f64, half_height: f64 },
+    /// Axis-aligned ellipsoid of radii (a bound, not exact).
+    Ellipsoid { radii: V3 },
+    /// Mandelbulb fractal (distance estimator, approximate).
+    Mandelbulb { power: f64, iterations: u32 },
+    /// n-ary union, or a binary intersection or subtraction.
+    Combine { op: Combine, children: Vec<NodeId> },
+    /// Smooth union, intersection or subtraction with blend radius `k`.
+    SmoothCombine { op: Combine, k: f64, variant: Smooth, a: NodeId, b: NodeId },
+    /// Child moved by an offset.
+    Translate { offset: V3, child: NodeId },
+    /// Child rotated by an orthonormal matrix (rows).
+    Rotate { matrix: [V3; 3], child: NodeId },
+    /// Child scaled uniformly.
+    Scale { factor: f64, child: NodeId },
+    /// Child scaled per axis (the field becomes a bound).
+    ScaleXyz { factors: V3, child: NodeId },
+    /// Domain repetition with a period per axis (0: no repetition on that axis), infinite or
+    /// limited to `count` copies per axis.
+    Repeat { period: V3, count: Option<V3>, child: NodeId },
+    /// Mirror across the planes x = 0, y = 0, z = 0 where set.
+    Mirror { axes: [bool; 3], child: NodeId },
+    /// Twist about y by `rate` radians per unit of height.
+    Twist { rate: f64, child: NodeId },
+    /// Bend in the xy plane by `rate` radians per unit of x.
+    Bend { rate: f64, child: NodeId },
+    /// Child's surface offset outwards by a radius.
+    Round { radius: f64, child: NodeId },
+    /// Hollow shell of a thickness around the child's surface (onion).
+    Shell { thickness: f64, child: NodeId },
+    /// Child stretched by inserting a box of half-extents `half` at the origin.
+    Elongate { half: V3, child: NodeId },
+    /// Child painted with a material (inner materials take precedence).
+    Paint { material: MaterialId, child: NodeId },
+}
+
+impl Node {
+    /// The node's children in order.
+    pub fn children(&self) -> Vec<NodeId> {
+        match self {
+            Node::Combine { children, .. } => children.clone(),
+            Node::SmoothCombine { a, b, .. } => vec![*a, *b],
+            Node::Translate { child, .. }
+            | Node::Rotate { child, .. }
+            | Node::Scale { child, .. }
+            | Node::ScaleXyz { child, .. }
+            | Node::Repeat { child, .. }
+            | Node::Mirror { child, .. }
+            | Node::Twist { child, .. }
+            | Node::Bend { child, .. }
+            | Node::Round { child, .. }
+            | Node::Shell { child, .. }
+            | Node::Elongate { child, .. }
+            | Node::Paint { child, .. } => vec![*child],
+            _ => Vec::new(),
+        }
+    }
+
+    /// A key that is equal for structurally equal nodes (floats compared by bits).
+    fn key(&self) -> String {
+        format!("{self:?}")
+    }
+}
+
+/// Facts an analysis computed for a node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Facts {
+    /// Whether the field is an exact distance, a bound, or neither.
+    pub exactness: Exactness,
+    /// An upper bound on the field's Lipschitz constant.
+    pub lipschitz: f64,
+}
+
+/// How a field relates to the true distance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Exactness {
+    /// The exact Euclidean distance (signed).
+    Exact,
+    /// Never above the true distance (safe for sphere tracing).
+    Bound,
+    /// May overstate the distance.
+    Approximate,
+}
+
+/// An arena of hash-consed nodes, with the span each node came from.
+#[derive(Debug, Default, Clone)]
+pub struct Graph {
+    nodes: Vec<Node>,
+    spans: Vec<Span>,
+    dedup: HashMap<String, NodeId>,
+}
+
+impl Graph {
+    /// Adds a node, or returns the id of an equal node added before.
+    pub fn add(&mut self, node: Node, span: Span) -> NodeId {
+        let key = node.key();
+        if let Some(&id) = self.dedup.get(&key) {
+            return id;
+        }
+        let id = NodeId(self.nodes.len() as u32);
+        self.nodes.push(node);
+        self.spans.push(span);
+        self.dedup.insert(key, id);
+        id
+    }
+
+    /// The node behind an id.
+    pub fn node(&self, id: NodeId) -> &Node {
+        &self.nodes[id.0 as usize]
+    }
+
+    /// The span of the expression that first built this node.
+    pub fn span(&self, id: NodeId) -> Span {
+        self.spans[id.0 as usize]
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// True when there are no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// All ids in creation order (children before parents).
+    pub fn ids(&self) -> impl Iterator<Item = NodeId> {
+        (0..self.nodes.len() as u32).map(NodeId)
+    }
+}
+
+/// The colour of a material at a point.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Pattern {
+    /// One colour.
+    Solid(V3),
+    /// A 3D checkerboard of two colours with cubes of edge `size`.
+    Checker { a: V3, b: V3, size: f64 },
+}
+
+/// A Phong material (RENDERER.md, "Shading at a hit").
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// The name it was declared with.
+    pub name: String,
+    /// Colour or pattern.
+    pub pattern: Pattern,
+    /// k_a
+    pub ambient: f64,
+    /// k_d
+    pub diffuse: f64,
+    /// k_s
+    pub specular: f64,
+    /// α
+    pub shininess: f64,
+    /// Weight of the reflected ray, in [0, 1].
+    pub reflect: f64,
+    /// Weight of the transmitted ray, in [0, 1]; reflect + transparency ≤ 1.
+    pub transparency: f64,
+    /// Index of refraction, ≥ 1.
+    pub ior: f64,
+}
+
+impl Material {
+    /// The material of shapes that were not painted.
+    pub fn default_material() -> Self {
+        Material {
+            name: "default".into(),
+            pattern: Pattern::Solid([0.8, 0.8, 0.8]),
+            ambient: 0.1,
+            diffuse: 0.9,
+            specular: 0.3,
+            shininess: 32.0,
+            reflect: 0.0,
+            transparency: 0.0,
+            ior: 1.5,
+        }
+    }
+}
+
+/// A light source.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Light {
+    /// A point light whose contribution falls to zero at `radius`.
+    Point { position: V3, color: V3, intensity: f64, radius: f64, softness: f64 },
+    /// A light from a direction (the direction light travels in), with no attenuation.
+    Directional { direction: V3, color: V3, intensity: f64, softness: f64 },
+}
+
+impl Light {
+    /// Soft-shadow sharpness k; 0 means hard shadows.
+    pub fn softness(&self) -> f64 {
+        match self {
+            Light::Point { softness, .. } | Light::Directional { softness, .. } => *softness,
+        }
+    }
+}
+
+/// A pinhole camera.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: V3,
+    /// The point looked at.
+    pub look_at: V3,
+    /// Vertical field of view in radians.
+    pub fov: f64,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera { position: [0.0, 1.0, -5.0], look_at: [0.0, 0.0, 0.0], fov: 60f64.to_radians() }
+    }
+}
+
+/// Render settings (RENDERER.md); `sdfc render --set key=value` overrides them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Supersampling grid edge (n×n samples per pixel).
+    pub aa: u32,
+    /// Sphere-tracing step budget per ray.
+    pub max_steps: u32,
+    /// Pixel-cone hit tolerance: hit when |d| < epsilon · t.
+    pub epsilon: f64,
+    /// Secondary-ray depth limit.
+    pub max_depth: u32,
+    /// Rays stop beyond this distance.
+    pub max_dist: f64,
+    /// Over-relaxation factor ω in [1, 2).
+    pub relaxation: f64,
+    /// Colour of rays that hit nothing.
+    pub background: V3,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            width: 640,
+            height: 480,
+            aa: 1,
+            max_steps: 256,
+            epsilon: 1e-4,
+            max_depth: 5,
+            max_dist: 100.0,
+            relaxation: 1.0,
+            background: [0.05, 0.06, 0.08],
+        }
+    }
+}
+
+/// A checked scene: everything a back end needs, nothing from the AST.
+#[derive(Debug, Clone, Default)]
+pub struct Scene {
+    /// The shape arena.
+    pub graph: Graph,
+    /// The union of all scene objects; `None` for a scene with no objects.
+    pub root: Option<NodeId>,
+    /// Materials; index 0 is the default material.
+    pub materials: Vec<Material>,
+    /// Lights in declaration order.
+    pub lights: Vec<Light>,
+    /// The camera.
+    pub camera: Camera,
+    /// Render settings.
+    pub settings: Settings,
+}
+
+impl Scene {
+    /// The material behind an id.
+    pub fn material(&self, id: MaterialId) -> &Material {
+        &self.materials[id.0 as usize]
+    }
+}

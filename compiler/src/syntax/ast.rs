@@ -1,0 +1,229 @@
+//! The abstract syntax tree of one `.sdf` file, with a span on every node.
+//!
+//! Node names follow the rules of `grammar/sdf.ebnf`. The tree is produced by
+//! [`super::parse`] even when there are syntax errors: broken parts become
+//! [`ExprKind::Error`] or [`Item::Error`].
+
+use crate::span::Span;
+
+/// A name and where it was written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ident {
+    /// The name.
+    pub name: String,
+    /// Its span.
+    pub span: Span,
+}
+
+/// One source file: `file = { item }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct File {
+    /// Items in source order.
+    pub items: Vec<Item>,
+}
+
+/// `item = import | let | fn | material | camera | light | render | scene`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Item {
+    /// `import "path";`
+    Import { path: String, span: Span },
+    /// `let name [: type] = expr;`
+    Let(Let),
+    /// `fn name(params) -> type { body }`
+    Fn(FnDecl),
+    /// `material name = kind { fields }`
+    Material { name: Ident, kind: Ident, fields: Vec<Field>, span: Span },
+    /// `camera { fields }`, `render { fields }`, `light kind { fields }`: a block of settings.
+    Block(Block),
+    /// `scene { statements }`
+    Scene { stmts: Vec<Stmt>, span: Span },
+    /// An item that did not parse (already reported).
+    Error(Span),
+}
+
+/// A settings block such as `camera { ... }` or `light point { ... }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Block {
+    /// `camera`, `render` or `light`.
+    pub keyword: Ident,
+    /// The light's kind (`point`, `directional`); `None` for camera and render.
+    pub kind: Option<Ident>,
+    /// The fields.
+    pub fields: Vec<Field>,
+    /// The whole block.
+    pub span: Span,
+}
+
+/// `name: expr` inside a block.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Field {
+    /// The field's name.
+    pub name: Ident,
+    /// Its value.
+    pub value: Expr,
+}
+
+/// `let name [: type] = value;`
+#[derive(Debug, Clone, PartialEq)]
+pub struct Let {
+    /// The bound name.
+    pub name: Ident,
+    /// The declared type, if any.
+    pub ty: Option<Ident>,
+    /// The value.
+    pub value: Expr,
+    /// The whole declaration.
+    pub span: Span,
+}
+
+/// A user function.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FnDecl {
+    /// Its name.
+    pub name: Ident,
+    /// Parameters in order.
+    pub params: Vec<Param>,
+    /// The declared return type.
+    pub ret: Ident,
+    /// The body.
+    pub body: Body,
+    /// The whole declaration.
+    pub span: Span,
+}
+
+/// `name: type [= default]`
+#[derive(Debug, Clone, PartialEq)]
+pub struct Param {
+    /// The parameter's name.
+    pub name: Ident,
+    /// Its type.
+    pub ty: Ident,
+    /// Its default value.
+    pub default: Option<Expr>,
+}
+
+/// `{ let ...; let ...; expr }`: local bindings, then the value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// Local bindings in order.
+    pub lets: Vec<Let>,
+    /// The value of the body.
+    pub value: Box<Expr>,
+    /// The braces and all inside.
+    pub span: Span,
+}
+
+/// A statement of a `scene` block.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stmt {
+    /// `let name = expr;`
+    Let(Let),
+    /// `expr;`: a shape added to the scene (usually `shape @ material`).
+    Object(Expr),
+    /// `for name in from..to { statements }`: statements repeated with `name` an int.
+    For { var: Ident, from: Expr, to: Expr, body: Vec<Stmt>, span: Span },
+    /// A statement that did not parse (already reported).
+    Error(Span),
+}
+
+/// An expression.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Expr {
+    /// What it is.
+    pub kind: ExprKind,
+    /// Where it is.
+    pub span: Span,
+}
+
+/// Binary operators, by precedence from loosest to tightest: `||`, `&&`, comparisons,
+/// `+ -`, `* / %`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BinOp {
+    Or,
+    And,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Rem,
+}
+
+impl BinOp {
+    /// The operator as written.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            BinOp::Or => "||",
+            BinOp::And => "&&",
+            BinOp::Eq => "==",
+            BinOp::Ne => "!=",
+            BinOp::Lt => "<",
+            BinOp::Le => "<=",
+            BinOp::Gt => ">",
+            BinOp::Ge => ">=",
+            BinOp::Add => "+",
+            BinOp::Sub => "-",
+            BinOp::Mul => "*",
+            BinOp::Div => "/",
+            BinOp::Rem => "%",
+        }
+    }
+}
+
+/// Unary operators.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UnOp {
+    /// `-x`
+    Neg,
+    /// `!x`
+    Not,
+}
+
+/// A call argument, positional or named.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Arg {
+    /// `name:` for a named argument.
+    pub name: Option<Ident>,
+    /// The value.
+    pub value: Expr,
+}
+
+/// The kinds of expression.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExprKind {
+    /// `42`
+    Int(i64),
+    /// `0.5`, `1e-4`
+    Float(f64),
+    /// `45deg`, `0.5rad` (stored in radians)
+    Angle(f64),
+    /// `true`, `false`
+    Bool(bool),
+    /// `"text"`
+    Str(String),
+    /// A name.
+    Var(Ident),
+    /// `(a, b)` or `(a, b, c)`: a vector.
+    Tuple(Vec<Expr>),
+    /// `-x`, `!x`
+    Unary(UnOp, Box<Expr>),
+    /// `a op b`
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// `f(args)`
+    Call { callee: Ident, args: Vec<Arg> },
+    /// `receiver.f(args)`: the receiver is passed as the first parameter of its type.
+    Method { receiver: Box<Expr>, name: Ident, args: Vec<Arg> },
+    /// `v.x`: a vector component.
+    Field(Box<Expr>, Ident),
+    /// `if cond { a } else { b }`
+    If { cond: Box<Expr>, then: Body, otherwise: Body },
+    /// `shape @ material`
+    Material(Box<Expr>, Ident),
+    /// An expression that did not parse (already reported).
+    Error,
+}

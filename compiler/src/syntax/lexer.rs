@@ -1,0 +1,234 @@
+//! The lexer: source text to tokens with spans (logos), and lexical diagnostics.
+//!
+//! Grammar rules: `token`, `number`, `string`, `comment` in `grammar/sdf.ebnf`.
+
+use crate::diagnostics::Diagnostic;
+use crate::span::{FileId, Span};
+use logos::Logos;
+use std::fmt;
+
+/// One token. Literals carry their parsed value; a number with a unit suffix is an angle in
+/// radians.
+#[derive(Logos, Debug, Clone, PartialEq)]
+#[logos(skip r"[ \t\r\n\f]+")]
+#[logos(skip(r"//[^\n]*", allow_greedy = true))]
+pub enum Token {
+    #[token("import")]
+    Import,
+    #[token("let")]
+    Let,
+    #[token("fn")]
+    Fn,
+    #[token("material")]
+    Material,
+    #[token("camera")]
+    Camera,
+    #[token("light")]
+    Light,
+    #[token("render")]
+    Render,
+    #[token("scene")]
+    Scene,
+    #[token("if")]
+    If,
+    #[token("else")]
+    Else,
+    #[token("for")]
+    For,
+    #[token("in")]
+    In,
+    #[token("true", |_| true)]
+    #[token("false", |_| false)]
+    Bool(bool),
+    /// An integer literal.
+    #[regex(r"[0-9]+", priority = 3, callback = |lex| lex.slice().parse::<i64>().ok())]
+    Int(i64),
+    /// A float literal (with a fraction or an exponent).
+    #[regex(r"[0-9]+\.[0-9]+([eE][+-]?[0-9]+)?|[0-9]+[eE][+-]?[0-9]+", |lex| lex.slice().parse::<f64>().ok())]
+    Float(f64),
+    /// An angle literal such as `45deg` or `0.5rad`, in radians.
+    #[regex(r"([0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?)(deg|rad)", angle)]
+    Angle(f64),
+    /// A string literal, without its quotes (no escapes other than `\"` and `\\`).
+    #[regex(r#""([^"\\\n]|\\["\\])*""#, |lex| { let s = lex.slice(); s[1..s.len() - 1].replace("\\\"", "\"").replace("\\\\", "\\") })]
+    Str(String),
+    /// A string literal missing its closing quote (reported, then skipped).
+    #[regex(r#""([^"\\\n]|\\["\\])*"#, priority = 1)]
+    UnterminatedStr,
+    #[regex(r"[A-Za-z_][A-Za-z0-9_]*", |lex| lex.slice().to_string())]
+    Ident(String),
+    #[token("(")]
+    LParen,
+    #[token(")")]
+    RParen,
+    #[token("{")]
+    LBrace,
+    #[token("}")]
+    RBrace,
+    #[token(",")]
+    Comma,
+    #[token(";")]
+    Semi,
+    #[token(":")]
+    Colon,
+    #[token(".")]
+    Dot,
+    #[token("..")]
+    DotDot,
+    #[token("@")]
+    At,
+    #[token("=")]
+    Eq,
+    #[token("->")]
+    Arrow,
+    #[token("+")]
+    Plus,
+    #[token("-")]
+    Minus,
+    #[token("*")]
+    Star,
+    #[token("/")]
+    Slash,
+    #[token("%")]
+    Percent,
+    #[token("<")]
+    Lt,
+    #[token("<=")]
+    Le,
+    #[token(">")]
+    Gt,
+    #[token(">=")]
+    Ge,
+    #[token("==")]
+    EqEq,
+    #[token("!=")]
+    Ne,
+    #[token("&&")]
+    AndAnd,
+    #[token("||")]
+    OrOr,
+    #[token("!")]
+    Bang,
+    /// The start of a block comment; the lexer driver skips to its end.
+    #[token("/*")]
+    BlockComment,
+}
+
+fn angle(lex: &mut logos::Lexer<Token>) -> Option<f64> {
+    let s = lex.slice();
+    let (num, unit) = s.split_at(s.len() - 3);
+    let v: f64 = num.parse().ok()?;
+    Some(if unit == "deg" { v.to_radians() } else { v })
+}
+
+impl fmt::Display for Token {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        let s = match self {
+            Token::Import => "import",
+            Token::Let => "let",
+            Token::Fn => "fn",
+            Token::Material => "material",
+            Token::Camera => "camera",
+            Token::Light => "light",
+            Token::Render => "render",
+            Token::Scene => "scene",
+            Token::If => "if",
+            Token::Else => "else",
+            Token::For => "for",
+            Token::In => "in",
+            Token::Bool(b) => return write!(f, "{b}"),
+            Token::Int(_) | Token::Float(_) => "number",
+            Token::Angle(_) => "angle",
+            Token::Str(_) | Token::UnterminatedStr => "string",
+            Token::Ident(name) => return write!(f, "identifier `{name}`"),
+            Token::LParen => "(",
+            Token::RParen => ")",
+            Token::LBrace => "{",
+            Token::RBrace => "}",
+            Token::Comma => ",",
+            Token::Semi => ";",
+            Token::Colon => ":",
+            Token::Dot => ".",
+            Token::DotDot => "..",
+            Token::At => "@",
+            Token::Eq => "=",
+            Token::Arrow => "->",
+            Token::Plus => "+",
+            Token::Minus => "-",
+            Token::Star => "*",
+            Token::Slash => "/",
+            Token::Percent => "%",
+            Token::Lt => "<",
+            Token::Le => "<=",
+            Token::Gt => ">",
+            Token::Ge => ">=",
+            Token::EqEq => "==",
+            Token::Ne => "!=",
+            Token::AndAnd => "&&",
+            Token::OrOr => "||",
+            Token::Bang => "!",
+            Token::BlockComment => "/*",
+        };
+        write!(f, "`{s}`")
+    }
+}
+
+/// Splits `text` into tokens. Lexical errors become diagnostics and the offending bytes are
+/// skipped, so the parser still sees every valid token.
+pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
+    let mut tokens = Vec::new();
+    let mut diags = Vec::new();
+    let mut lexer = Token::lexer(text);
+    while let Some(result) = lexer.next() {
+        let range = lexer.span();
+        let span = Span::new(file, range.clone());
+        match result {
+            Ok(Token::BlockComment) => {
+                let rest = &text[range.end..];
+                match rest.find("*/") {
+                    Some(end) => lexer.bump(end + 2),
+                    None => {
+                        diags.push(
+                            Diagnostic::error("E0003", "unterminated block comment", span)
+                                .with_label("this comment is never closed")
+                                .with_help("close it with `*/`"),
+                        );
+                        lexer.bump(rest.len());
+                    }
+                }
+            }
+            Ok(Token::UnterminatedStr) => diags.push(
+                Diagnostic::error("E0002", "unterminated string literal", span)
+                    .with_label("this string has no closing quote on its line")
+                    .with_help("strings end with `\"` on the same line"),
+            ),
+            Ok(tok) => tokens.push((tok, span)),
+            Err(()) => diags.push(lex_error(text, range, span)),
+        }
+    }
+    (tokens, diags)
+}
+
+fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnostic {
+    let slice = &text[range.clone()];
+    if slice.starts_with('"') {
+        return Diagnostic::error("E0002", "unterminated string literal", span)
+            .with_label("this string has no closing quote on its line")
+            .with_help("strings end with `\"` on the same line");
+    }
+    if slice.starts_with(|c: char| c.is_ascii_digit()) {
+        return Diagnostic::error("E0004", format!("invalid number literal `{slice}`"), span)
+            .with_label("not a valid number")
+            .with_note("integers must fit in 64 bits; floats look like `1.5`, `2e-3` or `.5` written as `0.5`");
+    }
+    let ch = slice.chars().next().unwrap_or('?');
+    let d = Diagnostic::error("E0001", format!("unexpected character `{}`", ch.escape_default()), span)
+        .with_label("not part of the language");
+    match ch {
+        '&' => d.with_help("logical and is written `&&`"),
+        '|' => d.with_help("logical or is written `||`"),
+        '#' => d.with_help("comments start with `//`"),
+        '[' | ']' => d.with_help("vectors are written `(x, y, z)` or `vec3(x, y, z)`"),
+        _ => d,
+    }
+}

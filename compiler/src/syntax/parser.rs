@@ -1,0 +1,379 @@
+//! The parser: tokens to [`ast::File`] (chumsky), with error recovery so that one run reports
+//! every syntax error.
+//!
+//! Each parser function names the rule of `grammar/sdf.ebnf` it implements.
+
+use super::ast::*;
+use super::lexer::Token;
+use crate::diagnostics::Diagnostic;
+use crate::span::{FileId, Span};
+use chumsky::{input::ValueInput, prelude::*};
+
+type Extra<'t> = extra::Err<Rich<'t, Token, SimpleSpan>>;
+
+/// Parses a token stream into a file. Always returns a tree (possibly with error nodes) and
+/// the syntax errors found.
+pub fn parse(file: FileId, tokens: &[(Token, Span)], eof: usize) -> (File, Vec<Diagnostic>) {
+    let simple: Vec<(Token, SimpleSpan)> =
+        tokens.iter().map(|(t, s)| (t.clone(), SimpleSpan::from(s.range()))).collect();
+    let input = simple.as_slice().map(SimpleSpan::from(eof..eof), |(t, s)| (t, s));
+    let (out, errors) = file_parser(file).parse(input).into_output_errors();
+    let diags = errors.into_iter().map(|e| syntax_error(file, e, tokens)).collect();
+    (out.unwrap_or(File { items: Vec::new() }), diags)
+}
+
+fn syntax_error(file: FileId, e: Rich<'_, Token, SimpleSpan>, tokens: &[(Token, Span)]) -> Diagnostic {
+    use chumsky::error::RichPattern;
+    let span = Span::new(file, e.span().into_range());
+    let found = match e.found() {
+        Some(t) => t.to_string(),
+        None => "end of file".to_string(),
+    };
+    let mut expected: Vec<String> = e
+        .expected()
+        .filter_map(|p| match p {
+            RichPattern::Token(t) => Some(t.to_string()),
+            RichPattern::Label(l) => Some(l.to_string()),
+            RichPattern::EndOfInput => Some("end of file".to_string()),
+            _ => None,
+        })
+        .collect();
+    expected.sort();
+    expected.dedup();
+    if let chumsky::error::RichReason::Custom(msg) = e.reason() {
+        return Diagnostic::error("E0100", msg.to_string(), span);
+    }
+    // A missing `;` or closing delimiter is reported just after the previous token, where it
+    // belongs, rather than at the next token.
+    for closer in ["`;`", "`)`", "`}`"] {
+        if expected.iter().any(|x| x == closer) && e.found().is_some() {
+            if let Some(prev) = tokens.iter().rev().find(|(_, s)| s.end <= span.start) {
+                let at = Span { file, start: prev.1.end, end: prev.1.end };
+                return Diagnostic::error("E0101", format!("expected {closer}, found {found}"), at)
+                    .with_label(format!("{closer} is missing here"))
+                    .with_secondary(span, format!("found {found}"));
+            }
+        }
+    }
+    let mut d = Diagnostic::error("E0100", format!("unexpected {found}"), span).with_label(format!("unexpected {found}"));
+    if !expected.is_empty() {
+        let list = if expected.len() > 8 {
+            format!("{}, …", expected[..8].join(", "))
+        } else {
+            expected.join(", ")
+        };
+        d = d.with_note(format!("expected {list}"));
+    }
+    d
+}
+
+fn sp(file: FileId, s: SimpleSpan) -> Span {
+    Span::new(file, s.into_range())
+}
+
+/// `ident`
+fn ident<'t, I>(file: FileId) -> impl Parser<'t, I, Ident, Extra<'t>> + Clone
+where
+    I: ValueInput<'t, Token = Token, Span = SimpleSpan>,
+{
+    select! { Token::Ident(name) => name }
+        .map_with(move |name, e| Ident { name, span: sp(file, e.span()) })
+        .labelled("name")
+}
+
+/// `expr` with all its precedence levels, and `body`.
+fn expr_parser<'t, I>(file: FileId) -> impl Parser<'t, I, Expr, Extra<'t>> + Clone
+where
+    I: ValueInput<'t, Token = Token, Span = SimpleSpan>,
+{
+    recursive(move |expr| {
+        let mk = move |kind: ExprKind, s: SimpleSpan| Expr { kind, span: sp(file, s) };
+
+        // `let_stmt = "let" ident [":" ident] "=" expr ";"`
+        let local_let = just(Token::Let)
+            .ignore_then(ident(file))
+            .then(just(Token::Colon).ignore_then(ident(file)).or_not())
+            .then_ignore(just(Token::Eq))
+            .then(expr.clone())
+            .then_ignore(just(Token::Semi))
+            .map_with(move |((name, ty), value), e| Let { name, ty, value, span: sp(file, e.span()) });
+
+        // `body = "{" { let_stmt } expr "}"`
+        let body = local_let
+            .repeated()
+            .collect::<Vec<_>>()
+            .then(expr.clone())
+            .delimited_by(just(Token::LBrace), just(Token::RBrace))
+            .map_with(move |(lets, value), e| Body { lets, value: Box::new(value), span: sp(file, e.span()) })
+            .boxed();
+
+        // `args = "(" [ arg { "," arg } [","] ] ")"`, `arg = [ident ":"] expr`
+        let arg = ident(file)
+            .then_ignore(just(Token::Colon))
+            .or_not()
+            .then(expr.clone())
+            .map(|(name, value)| Arg { name, value });
+        let args = arg
+            .separated_by(just(Token::Comma))
+            .allow_trailing()
+            .collect::<Vec<_>>()
+            .delimited_by(just(Token::LParen), just(Token::RParen))
+            .labelled("arguments")
+            .boxed();
+
+        let literal = select! {
+            Token::Int(v) => ExprKind::Int(v),
+            Token::Float(v) => ExprKind::Float(v),
+            Token::Angle(v) => ExprKind::Angle(v),
+            Token::Bool(v) => ExprKind::Bool(v),
+            Token::Str(v) => ExprKind::Str(v),
+        }
+        .map_with(move |k, e| mk(k, e.span()));
+
+        // `call = ident args`
+        let call = ident(file)
+            .then(args.clone())
+            .map_with(move |(callee, args), e| mk(ExprKind::Call { callee, args }, e.span()));
+
+        let var = ident(file).map(|id| {
+            let span = id.span;
+            Expr { kind: ExprKind::Var(id), span }
+        });
+
+        // `tuple = "(" expr { "," expr } [","] ")"`: one element without comma is parentheses.
+        let tuple = expr
+            .clone()
+            .separated_by(just(Token::Comma))
+            .at_least(1)
+            .collect::<Vec<_>>()
+            .then(just(Token::Comma).or_not())
+            .delimited_by(just(Token::LParen), just(Token::RParen))
+            .map_with(move |(mut items, trailing), e| {
+                if items.len() == 1 && trailing.is_none() {
+                    let mut inner = items.pop().expect("one item");
+                    inner.span = sp(file, e.span());
+                    inner
+                } else {
+                    mk(ExprKind::Tuple(items), e.span())
+                }
+            })
+            .recover_with(via_parser(nested_delimiters(
+                Token::LParen,
+                Token::RParen,
+                [(Token::LBrace, Token::RBrace)],
+                move |s| mk(ExprKind::Error, s),
+            )));
+
+        // `if = "if" expr body "else" (body | if)`
+        let if_expr = recursive(|if_expr| {
+            just(Token::If)
+                .ignore_then(expr.clone())
+                .then(body.clone())
+                .then_ignore(just(Token::Else))
+                .then(body.clone().or(if_expr.map(move |e: Expr| {
+                    let span = e.span;
+                    Body { lets: Vec::new(), value: Box::new(e), span }
+                })))
+                .map_with(move |((cond, then), otherwise), e| {
+                    mk(ExprKind::If { cond: Box::new(cond), then, otherwise }, e.span())
+                })
+        });
+
+        let atom = choice((literal, call, var, tuple, if_expr)).labelled("expression").boxed();
+
+        // `postfix = atom { "." ident [args] }`
+        let postfix = atom
+            .foldl_with(
+                just(Token::Dot).ignore_then(ident(file)).then(args.clone().or_not()).repeated(),
+                move |receiver, (name, args), e| {
+                    let kind = match args {
+                        Some(args) => ExprKind::Method { receiver: Box::new(receiver), name, args },
+                        None => ExprKind::Field(Box::new(receiver), name),
+                    };
+                    mk(kind, e.span())
+                },
+            )
+            .boxed();
+
+        // `unary = { "-" | "!" } postfix`
+        let unary = choice((just(Token::Minus).to(UnOp::Neg), just(Token::Bang).to(UnOp::Not)))
+            .map_with(move |op, e| (op, sp(file, e.span())))
+            .repeated()
+            .foldr(postfix, move |(op, op_span), rhs: Expr| {
+                let span = op_span.join(rhs.span);
+                Expr { kind: ExprKind::Unary(op, Box::new(rhs)), span }
+            })
+            .boxed();
+
+        let binary = move |lower: chumsky::Boxed<'t, 't, I, Expr, Extra<'t>>, ops: Vec<(Token, BinOp)>| {
+            let op = choice(ops.into_iter().map(|(t, o)| just(t).to(o)).collect::<Vec<_>>());
+            lower
+                .clone()
+                .foldl_with(op.then(lower).repeated(), move |a, (op, b), e| {
+                    mk(ExprKind::Binary(op, Box::new(a), Box::new(b)), e.span())
+                })
+                .boxed()
+        };
+        let product = binary(
+            unary,
+            vec![(Token::Star, BinOp::Mul), (Token::Slash, BinOp::Div), (Token::Percent, BinOp::Rem)],
+        );
+        let sum = binary(product, vec![(Token::Plus, BinOp::Add), (Token::Minus, BinOp::Sub)]);
+        let compare = binary(
+            sum,
+            vec![
+                (Token::EqEq, BinOp::Eq),
+                (Token::Ne, BinOp::Ne),
+                (Token::Le, BinOp::Le),
+                (Token::Ge, BinOp::Ge),
+                (Token::Lt, BinOp::Lt),
+                (Token::Gt, BinOp::Gt),
+            ],
+        );
+        let and = binary(compare, vec![(Token::AndAnd, BinOp::And)]);
+        let or = binary(and, vec![(Token::OrOr, BinOp::Or)]);
+
+        // `expr = logic { "@" ident }`
+        or.foldl_with(just(Token::At).ignore_then(ident(file)).repeated(), move |shape, mat, e| {
+            mk(ExprKind::Material(Box::new(shape), mat), e.span())
+        })
+        .labelled("expression")
+    })
+}
+
+/// `file = { item }`
+fn file_parser<'t, I>(file: FileId) -> impl Parser<'t, I, File, Extra<'t>>
+where
+    I: ValueInput<'t, Token = Token, Span = SimpleSpan>,
+{
+    let expr = expr_parser(file).boxed();
+
+    // `let = "let" ident [":" ident] "=" expr ";"`
+    let let_decl = just(Token::Let)
+        .ignore_then(ident(file))
+        .then(just(Token::Colon).ignore_then(ident(file)).or_not())
+        .then_ignore(just(Token::Eq))
+        .then(expr.clone())
+        .then_ignore(just(Token::Semi))
+        .map_with(move |((name, ty), value), e| Let { name, ty, value, span: sp(file, e.span()) })
+        .boxed();
+
+    // `field = ident ":" expr`, `fields = "{" [field {"," field} [","]] "}"`
+    let fields = ident(file)
+        .then_ignore(just(Token::Colon))
+        .then(expr.clone())
+        .map(|(name, value)| Field { name, value })
+        .separated_by(just(Token::Comma))
+        .allow_trailing()
+        .collect::<Vec<_>>()
+        .delimited_by(just(Token::LBrace), just(Token::RBrace))
+        .recover_with(via_parser(nested_delimiters(
+            Token::LBrace,
+            Token::RBrace,
+            [(Token::LParen, Token::RParen)],
+            |_| Vec::new(),
+        )))
+        .boxed();
+
+    let import = just(Token::Import)
+        .ignore_then(select! { Token::Str(s) => s }.labelled("a file name in quotes"))
+        .then_ignore(just(Token::Semi))
+        .map_with(move |path, e| Item::Import { path, span: sp(file, e.span()) });
+
+    // `param = ident ":" ident ["=" expr]`
+    let param = ident(file)
+        .then_ignore(just(Token::Colon))
+        .then(ident(file))
+        .then(just(Token::Eq).ignore_then(expr.clone()).or_not())
+        .map(|((name, ty), default)| Param { name, ty, default });
+
+    // `fn = "fn" ident "(" params ")" "->" ident body`
+    let local_let = let_decl.clone();
+    let body = local_let
+        .repeated()
+        .collect::<Vec<_>>()
+        .then(expr.clone())
+        .delimited_by(just(Token::LBrace), just(Token::RBrace))
+        .map_with(move |(lets, value), e| Body { lets, value: Box::new(value), span: sp(file, e.span()) })
+        .recover_with(via_parser(nested_delimiters(
+            Token::LBrace,
+            Token::RBrace,
+            [(Token::LParen, Token::RParen)],
+            move |s| Body {
+                lets: Vec::new(),
+                value: Box::new(Expr { kind: ExprKind::Error, span: sp(file, s) }),
+                span: sp(file, s),
+            },
+        )));
+    let function = just(Token::Fn)
+        .ignore_then(ident(file))
+        .then(
+            param
+                .separated_by(just(Token::Comma))
+                .allow_trailing()
+                .collect::<Vec<_>>()
+                .delimited_by(just(Token::LParen), just(Token::RParen)),
+        )
+        .then_ignore(just(Token::Arrow))
+        .then(ident(file))
+        .then(body)
+        .map_with(move |(((name, params), ret), body), e| {
+            Item::Fn(FnDecl { name, params, ret, body, span: sp(file, e.span()) })
+        });
+
+    // `material = "material" ident "=" ident fields [";"]`
+    let material = just(Token::Material)
+        .ignore_then(ident(file))
+        .then_ignore(just(Token::Eq))
+        .then(ident(file))
+        .then(fields.clone())
+        .then_ignore(just(Token::Semi).or_not())
+        .map_with(move |((name, kind), fields), e| Item::Material { name, kind, fields, span: sp(file, e.span()) });
+
+    // `block = ("camera" | "render" | "light" ident) fields [";"]`
+    let keyword = move |t: Token, name: &'static str| {
+        just(t).map_with(move |_, e| Ident { name: name.to_string(), span: sp(file, e.span()) })
+    };
+    let block = choice((
+        keyword(Token::Camera, "camera").then(empty().to(None)),
+        keyword(Token::Render, "render").then(empty().to(None)),
+        keyword(Token::Light, "light").then(ident(file).map(Some)),
+    ))
+    .then(fields.clone())
+    .then_ignore(just(Token::Semi).or_not())
+    .map_with(move |((keyword, kind), fields), e| Item::Block(Block { keyword, kind, fields, span: sp(file, e.span()) }));
+
+    // `stmt = let | for | expr ";"`
+    let stmt = recursive(|stmt| {
+        let for_stmt = just(Token::For)
+            .ignore_then(ident(file))
+            .then_ignore(just(Token::In))
+            .then(expr.clone())
+            .then_ignore(just(Token::DotDot))
+            .then(expr.clone())
+            .then(stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), just(Token::RBrace)))
+            .map_with(move |(((var, from), to), body), e| Stmt::For { var, from, to, body, span: sp(file, e.span()) });
+        choice((
+            let_decl.clone().map(Stmt::Let),
+            for_stmt,
+            expr.clone().then_ignore(just(Token::Semi)).map(Stmt::Object),
+        ))
+        .recover_with(skip_then_retry_until(
+            none_of([Token::RBrace]).ignored(),
+            just(Token::RBrace).ignored().or(end()),
+        ))
+        .boxed()
+    });
+
+    // `scene = "scene" "{" { stmt } "}"`
+    let scene = just(Token::Scene)
+        .ignore_then(stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), just(Token::RBrace)))
+        .then_ignore(just(Token::Semi).or_not())
+        .map_with(move |stmts, e| Item::Scene { stmts, span: sp(file, e.span()) });
+
+    let item = choice((import, let_decl.map(Item::Let), function, material, block, scene))
+        .labelled("item")
+        .recover_with(skip_then_retry_until(any().ignored(), end()));
+
+    item.repeated().collect::<Vec<_>>().then_ignore(end()).map(|items| File { items })
+}

@@ -1,0 +1,6 @@
+//! One module per `sdfc` subcommand: its clap arguments and its `run`.
+
+pub mod bench;
+pub mod check;
+pub mod compile;
+pub mod render;

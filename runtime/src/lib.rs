@@ -1,0 +1,8 @@
+//! The sdfc runtime: loading scenes from disk, the CPU renderer, image IO, and the commands of
+//! the `sdfc` binary.
+
+pub mod commands;
+pub mod cpu;
+pub mod frontend;
+pub mod image;
+pub mod output;

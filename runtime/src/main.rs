@@ -1,0 +1,43 @@
+//! The `sdfc` command-line tool: check, compile, render and benchmark `.sdf` scenes.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+use sdfc_runtime::commands;
+
+/// sdfc compiles scenes of signed distance fields to images, shaders and programs.
+#[derive(Debug, Parser)]
+#[command(name = "sdfc", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Check scenes for errors; exit 0 when clean, 1 on errors, 2 on usage or IO problems.
+    Check(commands::check::CheckArgs),
+    /// Compile a scene to one of the textual targets.
+    Compile(commands::compile::CompileArgs),
+    /// Render a scene to a PNG image.
+    Render(commands::render::RenderArgs),
+    /// Time the rendering of scenes.
+    Bench(commands::bench::BenchArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            // clap reports --help and --version as "errors" with exit code 0.
+            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+        }
+    };
+    match cli.command {
+        Command::Check(args) => commands::check::run(args),
+        Command::Compile(args) => commands::compile::run(args),
+        Command::Render(args) => commands::render::run(args),
+        Command::Bench(args) => commands::bench::run(args),
+    }
+}

@@ -4,5 +4,7 @@
 pub mod commands;
 pub mod cpu;
 pub mod frontend;
+pub mod gpu;
 pub mod image;
+pub mod metrics;
 pub mod output;

@@ -1,7 +1,8 @@
 //! `sdfc compile`: write a scene as one of the textual targets.
 
 use crate::frontend::{self, DiagnosticFormat};
-use sdfc_compiler::{scene, syntax};
+use sdfc_compiler::back::{self, shader::Lang};
+use sdfc_compiler::{lower, scene, syntax};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -12,6 +13,20 @@ pub enum Emit {
     Ast,
     /// The checked scene IR.
     Ir,
+    /// The distance program (flat scalar SSA).
+    Program,
+    /// The distance program as a Rust function over glam.
+    Rust,
+    /// The WGSL renderer kernel, specialised to the scene.
+    Wgsl,
+    /// The kernel as SPIR-V (binary).
+    Spirv,
+    /// The kernel as Metal Shading Language.
+    Msl,
+    /// The kernel as GLSL 4.50.
+    Glsl,
+    /// The kernel as HLSL.
+    Hlsl,
 }
 
 /// Arguments of `sdfc compile`.
@@ -51,22 +66,58 @@ pub fn run(args: CompileArgs) -> ExitCode {
             }
             syntax::dump(&ast)
         }
-        Emit::Ir => match &loaded.scene {
-            Some(s) => scene::dump(s),
-            None => return ExitCode::from(1),
-        },
+        other => {
+            let Some(scene) = &loaded.scene else { return ExitCode::from(1) };
+            match emit(scene, other) {
+                Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
+                Err(msg) => {
+                    eprintln!("{msg}");
+                    return ExitCode::from(1);
+                }
+            }
+        }
     };
     write_output(args.output.as_deref(), &text)
 }
 
+/// The bytes of a target that needs the checked scene.
+fn emit(scene: &scene::Scene, target: Emit) -> Result<Vec<u8>, String> {
+    let program = lower::lower(scene);
+    let lang = match target {
+        Emit::Ir => return Ok(scene::dump(scene).into_bytes()),
+        Emit::Program => return Ok(program.dump().into_bytes()),
+        Emit::Rust => return Ok(back::rust::write(&program).into_bytes()),
+        Emit::Ast => return Err("internal error: the AST is not emitted from a scene".into()),
+        Emit::Spirv => Some(Lang::SpirV),
+        Emit::Msl => Some(Lang::Msl),
+        Emit::Glsl => Some(Lang::Glsl),
+        Emit::Hlsl => Some(Lang::Hlsl),
+        Emit::Wgsl => None,
+    };
+    let kernel = back::wgsl::write(scene, &program).map_err(|e| e.to_string())?;
+    match lang {
+        None => Ok(kernel.source.into_bytes()),
+        Some(lang) => back::shader::write(&kernel, lang).map_err(|e| e.to_string()),
+    }
+}
+
 /// Writes `text` to a file (atomically) or to standard output.
 pub fn write_output(path: Option<&std::path::Path>, text: &str) -> ExitCode {
+    write_bytes(path, text.as_bytes())
+}
+
+/// Writes bytes to a file (atomically) or to standard output.
+pub fn write_bytes(path: Option<&std::path::Path>, bytes: &[u8]) -> ExitCode {
+    use std::io::Write;
     match path {
         None => {
-            print!("{text}");
+            let mut out = std::io::stdout().lock();
+            if out.write_all(bytes).and_then(|_| out.flush()).is_err() {
+                return ExitCode::from(2);
+            }
             ExitCode::SUCCESS
         }
-        Some(p) => match crate::output::write_atomic(p, text.as_bytes()) {
+        Some(p) => match crate::output::write_atomic(p, bytes) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: cannot write `{}`: {e}", p.display());

@@ -1,0 +1,5 @@
+//! Back ends that write a distance program as source text.
+
+pub mod rust;
+pub mod shader;
+pub mod wgsl;

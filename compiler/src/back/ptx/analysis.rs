@@ -1,0 +1,199 @@
+//! Facts about the module that the writer needs before it writes any function: which
+//! functions the entry point reaches, which of them are inlined, which variables live
+//! in local memory (those indexed with a run-time index) and which expressions the
+//! statements emit. Each is one linear pass over the IR.
+
+use super::types::{Resolved, Shape, Types};
+use super::Error;
+use naga::valid::{FunctionInfo, ModuleInfo};
+use naga::{AddressSpace, Block, Expression, Function, Handle, Module, Statement, TypeInner};
+
+/// What the writer knows about the module before writing it.
+#[derive(Debug)]
+pub(super) struct Analysis {
+    /// Per function: reached from the entry point.
+    pub reachable: Vec<bool>,
+    /// Per function: expanded at each call instead of written as a `.func` (it takes a
+    /// pointer or uses a `var<private>`, which live in the kernel's own registers).
+    pub inline: Vec<bool>,
+    /// Per function, per local variable: kept in `.local` memory.
+    pub mem_locals: Vec<Vec<bool>>,
+    /// Per local variable of the entry point: kept in `.local` memory.
+    pub entry_mem_locals: Vec<bool>,
+    /// Per global variable: a `var<private>` kept in `.local` memory.
+    pub mem_privates: Vec<bool>,
+}
+
+/// Where a pointer expression points: into which variable or argument.
+#[derive(Debug, Clone, Copy)]
+enum Root {
+    Local(usize),
+    Global(usize),
+    Arg(usize),
+}
+
+impl Analysis {
+    pub fn new(module: &Module, info: &ModuleInfo, types: &Types, entry: usize) -> Result<Self, Error> {
+        let ep = &module.entry_points[entry];
+        let nf = module.functions.len();
+        let mut a = Analysis {
+            reachable: vec![false; nf],
+            inline: vec![false; nf],
+            mem_locals: vec![Vec::new(); nf],
+            entry_mem_locals: Vec::new(),
+            mem_privates: vec![false; module.global_variables.len()],
+        };
+        a.mark_reachable(module, &ep.function);
+        // Callees come before their callers in naga's arena, so one forward pass sees
+        // each callee's facts before any call to it.
+        let mut arg_dyn: Vec<Vec<bool>> = vec![Vec::new(); nf];
+        for (h, f) in module.functions.iter() {
+            if !a.reachable[h.index()] {
+                continue;
+            }
+            let fi = &info[h];
+            a.inline[h.index()] = takes_pointer(module, f) || uses_private(module, fi);
+            let (locals, args) = a.memory(types, f, fi, &arg_dyn)?;
+            a.mem_locals[h.index()] = locals;
+            arg_dyn[h.index()] = args;
+        }
+        let (locals, _) = a.memory(types, &ep.function, info.get_entry_point(entry), &arg_dyn)?;
+        a.entry_mem_locals = locals;
+        Ok(a)
+    }
+
+    fn mark_reachable(&mut self, module: &Module, f: &Function) {
+        let mut stack = Vec::new();
+        calls(&f.body, &mut stack);
+        while let Some(h) = stack.pop() {
+            if !std::mem::replace(&mut self.reachable[h.index()], true) {
+                calls(&module.functions[h].body, &mut stack);
+            }
+        }
+    }
+
+    /// Marks the variables `f` indexes at run time; returns its own locals' marks and
+    /// which of its pointer arguments it indexes at run time.
+    fn memory(
+        &mut self,
+        types: &Types,
+        f: &Function,
+        fi: &FunctionInfo,
+        arg_dyn: &[Vec<bool>],
+    ) -> Result<(Vec<bool>, Vec<bool>), Error> {
+        let mut locals = vec![false; f.local_variables.len()];
+        let mut args = vec![false; f.arguments.len()];
+        let mut roots: Vec<Option<Root>> = Vec::with_capacity(f.expressions.len());
+        for (h, e) in f.expressions.iter() {
+            let root = |b: Handle<Expression>| roots.get(b.index()).copied().flatten();
+            let (r, dynamic) = match *e {
+                Expression::LocalVariable(l) => (Some(Root::Local(l.index())), false),
+                Expression::GlobalVariable(g) => (Some(Root::Global(g.index())), false),
+                Expression::FunctionArgument(i) => (Some(Root::Arg(i as usize)), false),
+                Expression::AccessIndex { base, .. } => (root(base), false),
+                Expression::Access { base, .. } => (root(base), indexes_memory(types, fi, base)?),
+                _ => (None, false),
+            };
+            if let (true, Some(r)) = (dynamic, r) {
+                self.mark(r, &mut locals, &mut args);
+            }
+            roots.push(r);
+            debug_assert_eq!(roots.len(), h.index() + 1);
+        }
+        let mut marks = Vec::new();
+        visit(&f.body, &mut |s| {
+            if let Statement::Call { function, arguments, .. } = s {
+                let callee = &arg_dyn[function.index()];
+                for (i, a) in arguments.iter().enumerate() {
+                    if callee.get(i).copied().unwrap_or(false) {
+                        marks.extend(roots.get(a.index()).copied().flatten());
+                    }
+                }
+            }
+        });
+        for r in marks {
+            self.mark(r, &mut locals, &mut args);
+        }
+        Ok((locals, args))
+    }
+
+    fn mark(&mut self, r: Root, locals: &mut [bool], args: &mut [bool]) {
+        let slot = match r {
+            Root::Local(i) => locals.get_mut(i),
+            Root::Global(i) => self.mem_privates.get_mut(i),
+            Root::Arg(i) => args.get_mut(i),
+        };
+        if let Some(s) = slot {
+            *s = true;
+        }
+    }
+}
+
+/// Whether `Access { base, .. }` indexes an array or matrix behind a pointer (a vector
+/// in registers is indexed by selection instead).
+fn indexes_memory(types: &Types, fi: &FunctionInfo, base: Handle<Expression>) -> Result<bool, Error> {
+    match types.resolve(&fi[base].ty)? {
+        Resolved::Pointer(ty) => Ok(matches!(types.shape(ty)?, Shape::Array { .. } | Shape::Matrix { .. })),
+        Resolved::Value(_) => Ok(false),
+    }
+}
+
+fn takes_pointer(module: &Module, f: &Function) -> bool {
+    f.arguments.iter().any(|a| matches!(module.types[a.ty].inner, TypeInner::Pointer { .. }))
+}
+
+fn uses_private(module: &Module, fi: &FunctionInfo) -> bool {
+    module
+        .global_variables
+        .iter()
+        .any(|(h, g)| g.space == AddressSpace::Private && !fi[h].is_empty())
+}
+
+/// Pushes every function `block` calls.
+fn calls(block: &Block, out: &mut Vec<Handle<Function>>) {
+    visit(block, &mut |s| {
+        if let Statement::Call { function, .. } = *s {
+            out.push(function);
+        }
+    });
+}
+
+/// Calls `f` on every statement of `block`, nested ones included.
+pub(super) fn visit(block: &Block, f: &mut impl FnMut(&Statement)) {
+    for s in block.iter() {
+        f(s);
+        match s {
+            Statement::Block(b) => visit(b, f),
+            Statement::If { accept, reject, .. } => {
+                visit(accept, f);
+                visit(reject, f);
+            }
+            Statement::Switch { cases, .. } => {
+                for c in cases {
+                    visit(&c.body, f);
+                }
+            }
+            Statement::Loop { body, continuing, .. } => {
+                visit(body, f);
+                visit(continuing, f);
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Per expression of `f`: evaluated by an `Emit` statement (the others are constants,
+/// arguments, variables and results of statements).
+pub(super) fn emitted(f: &Function) -> Vec<bool> {
+    let mut marks = vec![false; f.expressions.len()];
+    visit(&f.body, &mut |s| {
+        if let Statement::Emit(range) = s {
+            for h in range.clone() {
+                if let Some(m) = marks.get_mut(h.index()) {
+                    *m = true;
+                }
+            }
+        }
+    });
+    marks
+}

@@ -1,0 +1,423 @@
+// sdfc renderer kernel: RENDERER.md as a WGSL compute shader, one invocation per pixel.
+// This file is a template: `//#if FEATURE` blocks are kept only when the scene uses the
+// feature, and a double-brace placeholder is replaced by a value (see template.rs). The CPU renderer
+// (runtime/src/cpu) implements the same algorithm; docs/rendering.md fixes the constants.
+
+//#if POINT
+struct PointLight {
+    position: vec4<f32>, // xyz, w: radius (0: no falloff)
+    color: vec4<f32>,    // rgb = colour × intensity, w: softness k (0: hard shadows)
+}
+//#endif
+//#if DIRECTIONAL
+struct DirLight {
+    to_light: vec4<f32>, // unit vector towards the light
+    color: vec4<f32>,    // rgb = colour × intensity, w: softness k
+}
+//#endif
+struct Material {
+    color: vec4<f32>,   // rgb, w: 1 for a checker pattern
+    color_b: vec4<f32>, // checker's second colour, w: 1 / checker size
+    phong: vec4<f32>,   // ambient, diffuse, specular, shininess
+    optics: vec4<f32>,  // reflect, transparency, ior, unused
+}
+struct Params {
+    eye: vec4<f32>,        // camera position
+    cam_w: vec4<f32>,      // forward
+    cam_u: vec4<f32>,      // right
+    cam_v: vec4<f32>,      // up
+    view: vec4<f32>,       // tan(fov/2)·aspect, tan(fov/2), width, height
+    march: vec4<f32>,      // epsilon, max_dist, relaxation ω, 1/L
+    background: vec4<f32>,
+    counts: vec4<u32>,     // width, height, aa, max_steps
+    depth: vec4<u32>,      // max_depth
+//#if POINT
+    points: array<PointLight, {{POINTS}}>,
+//#endif
+//#if DIRECTIONAL
+    dirs: array<DirLight, {{DIRS}}>,
+//#endif
+    materials: array<Material, {{MATERIALS}}>,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<uniform> tile: vec4<u32>; // x0, y0, width, height
+@group(0) @binding(2) var<storage, read_write> image: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> stats: array<u32>;
+
+// Per-pixel statistics, written to `stats` (8 words per pixel).
+struct Counters {
+    steps: u32,
+    hits: u32,
+    misses: u32,
+    budget: u32,
+    overshoots: u32,
+    nans: u32,
+    secondary: u32,
+    shadow: u32,
+}
+var<private> counters: Counters;
+
+const STATUS_HIT: u32 = 0u;
+const STATUS_MISS: u32 = 1u;
+const STATUS_BUDGET: u32 = 2u;
+const STATUS_NAN: u32 = 3u;
+// The tetrahedron's corners for the 4-tap gradient.
+const TETRA = array<vec3<f32>, 4>(vec3<f32>(1.0, -1.0, -1.0), vec3<f32>(-1.0, -1.0, 1.0), vec3<f32>(-1.0, 1.0, -1.0), vec3<f32>(1.0, 1.0, 1.0));
+
+{{MAP}}
+
+fn is_nan(x: f32) -> bool {
+    // NaN is the only value not equal to itself; the bit test keeps drivers from folding it.
+    let b = bitcast<u32>(x);
+    return (b & 0x7f800000u) == 0x7f800000u && (b & 0x007fffffu) != 0u;
+}
+
+struct Traced {
+    t: f32,
+    status: u32,
+}
+
+// Sphere tracing (RENDERER.md, "Intersection"), with over-relaxation when ω > 1.
+fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
+    let eps = params.march.x;
+    let max_dist = params.march.y;
+    let inv_l = params.march.w;
+    var t = 0.0;
+    var steps = 0u;
+//#if RELAX
+    var omega = params.march.z;
+    var prev = 0.0;
+    var step = 0.0;
+//#endif
+    loop {
+        let f = sdf(o + d * t);
+        steps += 1u;
+        counters.steps += 1u;
+        if is_nan(f) {
+            counters.nans += 1u;
+            return Traced(t, STATUS_NAN);
+        }
+        let signed = sign * f * inv_l;
+        let r = abs(signed);
+        let tol = eps * (t0 + t);
+        if signed < -tol {
+            counters.overshoots += 1u;
+        }
+//#if RELAX
+        let fail = omega > 1.0 && r + prev < step;
+        if fail {
+            step = step - omega * step;
+            omega = 1.0;
+        } else {
+            step = signed * omega;
+        }
+        prev = r;
+        if !fail && r < tol {
+            return Traced(t, STATUS_HIT);
+        }
+        let next = max(t + step, 0.0);
+//#else
+        if r < tol {
+            return Traced(t, STATUS_HIT);
+        }
+        let next = max(t + signed, 0.0);
+//#endif
+        t = next;
+        if next > max_dist {
+            return Traced(next, STATUS_MISS);
+        }
+        if steps >= params.counts.w {
+            return Traced(next, STATUS_BUDGET);
+        }
+    }
+    return Traced(t, STATUS_BUDGET); // not reached: the loop returns
+}
+
+// The normal step h = max(ε·t, 64·ε_f32·(1 + |p|∞)).
+fn normal_step(tt: f32, p: vec3<f32>) -> f32 {
+    let a = abs(p);
+    let floor_h = 64.0 * 1.1920929e-7 * (1.0 + max(a.x, max(a.y, a.z)));
+    return max(params.march.x * tt, floor_h);
+}
+
+// N = normalize(Σ k_i f(p + h·k_i)); a degenerate gradient gives -D.
+fn normal(p: vec3<f32>, h: f32, d: vec3<f32>) -> vec3<f32> {
+    var g = vec3<f32>(0.0);
+    for (var i = 0u; i < 4u; i++) {
+        let k = TETRA[i];
+        g += k * sdf(p + k * h);
+    }
+    let l = length(g);
+    if l > 0.0 && !is_nan(l) {
+        return g * (1.0 / l);
+    }
+    return -d;
+}
+
+// The colour of material m at p (checker: parity of the cell, sampled just inside).
+fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> {
+//#if CHECKER
+    if m.color.w > 0.0 {
+        let q = (p - n * (2.0 * h)) * m.color_b.w;
+        let s = floor(q.x) + floor(q.y) + floor(q.z);
+        let odd = s - 2.0 * floor(s / 2.0);
+        return select(m.color.xyz, m.color_b.xyz, odd > 0.0);
+    }
+//#endif
+    return m.color.xyz;
+}
+
+// A shadow ray towards a light at distance tmax: the fraction of light that arrives.
+// Soft (k > 0): res = min(res, k·d/t). A transparent occluder passes its transparency and
+// the ray goes on through it; an opaque one blocks the light.
+fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
+    counters.shadow += 1u;
+    let eps = params.march.x;
+    let inv_l = params.march.w;
+    var t = 0.0;
+    var steps = 0u;
+    var res = 1.0;
+    var through = 1.0;
+    var sign = 1.0;
+    loop {
+        let p = o + d * t;
+//#if REFRACTION
+        let fm = map(p);
+        let f = fm.x;
+        let tau = params.materials[u32(fm.y)].optics.y;
+//#else
+        let f = sdf(p);
+        let tau = 0.0;
+//#endif
+        steps += 1u;
+        counters.steps += 1u;
+        if is_nan(f) {
+            counters.nans += 1u;
+            return through * res;
+        }
+        let signed = sign * f * inv_l;
+        let tt = t0 + t;
+        let tol = eps * tt;
+        if signed < -tol {
+            counters.overshoots += 1u;
+        }
+        let outside = sign > 0.0;
+//#if SOFT
+        if outside && k > 0.0 && t > 0.0 && tau <= 0.0 {
+            res = min(res, k * signed / t);
+        }
+//#endif
+        var next = t + signed;
+        if abs(signed) < tol {
+            if tau <= 0.0 {
+                return 0.0;
+            }
+            if outside {
+                through = through * tau;
+            }
+            sign = -sign;
+            next = t + 4.0 * normal_step(tt, p);
+        }
+        t = max(next, 0.0);
+        if t >= tmax || steps >= params.counts.w {
+            return through * clamp(res, 0.0, 1.0);
+        }
+    }
+    return through * clamp(res, 0.0, 1.0); // not reached: the loop returns
+}
+
+// One light's Phong term at a hit, shadow included.
+fn phong_term(c: vec3<f32>, m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32,
+              l: vec3<f32>, dist: f32, atten: f32, il: vec3<f32>, k: f32, is_point: bool) -> vec3<f32> {
+    let ndl = dot(n, l);
+    if ndl <= 0.0 || atten <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let r = n * (2.0 * ndl) - l;
+    let rv = max(dot(r, -d), 0.0);
+    let spec = m.phong.z * pow(rv, m.phong.w);
+    let contrib = (c * (m.phong.y * ndl) + vec3<f32>(spec)) * il * atten;
+    let off = 4.0 * h;
+    let tmax = select(dist, dist - off, is_point);
+    return contrib * shadow(p + n * off, l, tt, tmax, k);
+}
+
+// Ambient plus every light: I = k_a·C + Σ shadow·atten·(k_d·max(N·L,0)·C·I_l + k_s·max(R·V,0)^α·I_l).
+fn shade(m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32) -> vec3<f32> {
+    let c = surface_colour(m, p, n, h);
+    var sum = c * m.phong.x;
+//#if POINT
+    for (var i = 0u; i < {{POINTS}}u; i++) {
+        let light = params.points[i];
+        let v = light.position.xyz - p;
+        let dist = length(v);
+        var atten = 1.0;
+        if light.position.w > 0.0 {
+            let x = dist / light.position.w;
+            let f = clamp(1.0 - x * x, 0.0, 1.0);
+            atten = f * f;
+        }
+        sum += phong_term(c, m, p, n, d, tt, h, v * (1.0 / dist), dist, atten, light.color.xyz, light.color.w, true);
+    }
+//#endif
+//#if DIRECTIONAL
+    for (var i = 0u; i < {{DIRS}}u; i++) {
+        let light = params.dirs[i];
+        sum += phong_term(c, m, p, n, d, tt, h, light.to_light.xyz, params.march.y, 1.0, light.color.xyz, light.color.w, false);
+    }
+//#endif
+    return sum;
+}
+
+// A ray to trace, with the weight its colour is added with.
+struct Ray {
+    origin: vec3<f32>,
+    t0: f32, // path length of the pixel's ray before this segment
+    dir: vec3<f32>,
+    depth: u32,
+    weight: vec3<f32>,
+    inside: u32, // 1 while travelling inside a solid (marching -f)
+}
+
+//#if SECONDARY
+// The transmitted direction through a surface of normal n (facing the ray) with index
+// ratio eta; a zero vector on total internal reflection.
+fn refract_dir(d: vec3<f32>, n: vec3<f32>, eta: f32) -> vec3<f32> {
+    let cosi = -dot(d, n);
+    let k = 1.0 - eta * eta * (1.0 - cosi * cosi);
+    if k < 0.0 {
+        return vec3<f32>(0.0);
+    }
+    return normalize(d * eta + n * (eta * cosi - sqrt(k)));
+}
+
+fn reflect_dir(d: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return d - n * (2.0 * dot(d, n));
+}
+//#endif
+
+// The colour seen along one camera ray, with all its secondary rays.
+fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    var acc = vec3<f32>(0.0);
+    let first = Ray(eye, 0.0, dir, 0u, vec3<f32>(1.0), 0u);
+//#if SECONDARY
+    // Pending rays on an explicit stack: each hit pushes at most two, one of which is
+    // popped next, so max_depth + 2 entries suffice.
+    var stack: array<Ray, {{STACK}}>;
+    var top = 1u;
+    stack[0] = first;
+    while top > 0u {
+        top -= 1u;
+        let ray = stack[top];
+//#else
+    for (var once = 0u; once < 1u; once++) {
+        let ray = first;
+//#endif
+//#if REFRACTION
+        let inside = ray.inside != 0u;
+        let hit = trace(ray.origin, ray.dir, ray.t0, select(1.0, -1.0, inside));
+//#else
+        let inside = false;
+        let hit = trace(ray.origin, ray.dir, ray.t0, 1.0);
+//#endif
+        if hit.status != STATUS_HIT {
+            if hit.status == STATUS_MISS {
+                counters.misses += 1u;
+            } else if hit.status == STATUS_BUDGET {
+                counters.budget += 1u;
+            }
+            acc += ray.weight * params.background.xyz;
+            continue;
+        }
+        counters.hits += 1u;
+        let p = ray.origin + ray.dir * hit.t;
+        let tt = ray.t0 + hit.t;
+        let h = normal_step(tt, p);
+        let n = normal(p, h, ray.dir);
+//#if MATERIALS
+        let m = params.materials[u32(map(p).y)];
+//#else
+        let m = params.materials[0];
+//#endif
+        let w = 1.0 - m.optics.x - m.optics.y;
+        if !inside && w > 0.0 {
+            acc += shade(m, p, n, ray.dir, tt, h) * ray.weight * w;
+        }
+//#if SECONDARY
+        if ray.depth >= params.depth.x {
+            continue;
+        }
+        let off = n * (4.0 * h);
+//#if REFRACTION
+        if inside {
+            // Leaving the solid: refract out, or reflect back in on total internal reflection.
+            let tr = refract_dir(ray.dir, -n, m.optics.z);
+            if any(tr != vec3<f32>(0.0)) {
+                stack[top] = Ray(p + off, tt, tr, ray.depth + 1u, ray.weight, 0u);
+            } else {
+                stack[top] = Ray(p - off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight, 1u);
+            }
+            top += 1u;
+            counters.secondary += 1u;
+            continue;
+        }
+//#endif
+        if m.optics.x > 0.0 {
+            stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight * m.optics.x, 0u);
+            top += 1u;
+            counters.secondary += 1u;
+        }
+//#if REFRACTION
+        if m.optics.y > 0.0 {
+            let tr = refract_dir(ray.dir, n, 1.0 / m.optics.z);
+            if any(tr != vec3<f32>(0.0)) {
+                stack[top] = Ray(p - off, tt, tr, ray.depth + 1u, ray.weight * m.optics.y, 1u);
+            } else {
+                stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight * m.optics.y, 0u);
+            }
+            top += 1u;
+            counters.secondary += 1u;
+        }
+//#endif
+//#endif
+    }
+    return acc;
+}
+
+// The direction of sample (i, j) of pixel (x, y) (RENDERER.md, "Per pixel").
+fn camera_dir(x: u32, y: u32, i: u32, j: u32) -> vec3<f32> {
+    let n = f32(params.counts.z);
+    let ax = (f32(x) + (f32(i) + 0.5) / n) / params.view.z;
+    let ay = (f32(y) + (f32(j) + 0.5) / n) / params.view.w;
+    let bx = 2.0 * ax - 1.0;
+    let by = 1.0 - 2.0 * ay;
+    return normalize(params.cam_w.xyz + params.cam_u.xyz * (bx * params.view.x) + params.cam_v.xyz * (by * params.view.y));
+}
+
+@compute @workgroup_size({{WORKGROUP}}, {{WORKGROUP}}, 1)
+fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= tile.z || gid.y >= tile.w {
+        return;
+    }
+    let x = tile.x + gid.x;
+    let y = tile.y + gid.y;
+    let aa = params.counts.z;
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < aa; j++) {
+        for (var i = 0u; i < aa; i++) {
+            sum += radiance(params.eye.xyz, camera_dir(x, y, i, j));
+        }
+    }
+    let pixel = y * params.counts.x + x;
+    image[pixel] = vec4<f32>(sum / f32(aa * aa), 1.0);
+    let s = pixel * 8u;
+    stats[s] = counters.steps;
+    stats[s + 1u] = counters.hits;
+    stats[s + 2u] = counters.misses;
+    stats[s + 3u] = counters.budget;
+    stats[s + 4u] = counters.overshoots;
+    stats[s + 5u] = counters.nans;
+    stats[s + 6u] = counters.secondary;
+    stats[s + 7u] = counters.shadow;
+}

@@ -1,0 +1,240 @@
+//! The WGSL back end: the distance program written as `fn map` and `fn sdf`, joined to the
+//! renderer kernel (`kernel.wgsl`) specialised to the scene, then parsed and validated by
+//! naga. Also the bytes of the scene uniform the kernel reads.
+//!
+//! Entry: [`write`]. The kernel's bindings (group 0): 0 the scene uniform ([`uniforms`]),
+//! 1 the tile (x0, y0, width, height as a uniform `vec4<u32>`), 2 the image (`vec4<f32>`
+//! linear colour per pixel), 3 the statistics ([`STATS_WORDS`] `u32` per pixel).
+
+mod map;
+mod template;
+
+pub use map::{float, write_map};
+
+use crate::lower::{Program, Reg};
+use crate::scene::{Light, Pattern, Scene};
+use std::collections::HashMap;
+use std::fmt;
+
+/// The kernel's entry point.
+pub const ENTRY_POINT: &str = "main";
+/// The workgroup is `WORKGROUP × WORKGROUP` invocations.
+pub const WORKGROUP: u32 = 8;
+/// Statistics words per pixel: steps, hits, misses, budget misses, overshoots, NaNs,
+/// secondary rays, shadow rays.
+pub const STATS_WORDS: u32 = 8;
+
+const TEMPLATE: &str = include_str!("kernel.wgsl");
+
+/// A generated, validated kernel.
+#[derive(Debug, Clone)]
+pub struct Kernel {
+    /// The WGSL text.
+    pub source: String,
+    /// naga's IR of it (input of the PTX and other shader back ends).
+    pub module: naga::Module,
+    /// naga's validation info.
+    pub info: naga::valid::ModuleInfo,
+    /// The features the kernel was specialised for, by name.
+    pub features: Vec<(&'static str, bool)>,
+}
+
+/// A generated kernel that naga rejected: always a compiler bug, reported with the generated
+/// line and, where the line comes from the distance program, the scene node's span.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Error {
+    /// naga's message.
+    pub message: String,
+    /// The generated line, 1-based, and its text.
+    pub line: Option<(usize, String)>,
+    /// The span of the scene node the line was generated from.
+    pub node_span: Option<crate::Span>,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "internal compiler error: the generated WGSL is invalid: {}", self.message)?;
+        if let Some((n, text)) = &self.line {
+            write!(f, "\n  at generated line {n}: {}", text.trim())?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// What the scene uses, deciding which parts of the kernel are emitted.
+fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
+    let mats = &scene.materials;
+    let soft = scene.lights.iter().any(|l| l.softness() > 0.0);
+    let points = scene.lights.iter().any(|l| matches!(l, Light::Point { .. }));
+    let dirs = scene.lights.iter().any(|l| matches!(l, Light::Directional { .. }));
+    let refraction = mats.iter().any(|m| m.transparency > 0.0);
+    let secondary = scene.settings.max_depth > 0 && mats.iter().any(|m| m.reflect > 0.0 || m.transparency > 0.0);
+    vec![
+        ("POINT", points),
+        ("DIRECTIONAL", dirs),
+        ("SOFT", soft),
+        ("CHECKER", mats.iter().any(|m| matches!(m.pattern, Pattern::Checker { .. }))),
+        ("REFRACTION", refraction && secondary),
+        ("SECONDARY", secondary),
+        ("MATERIALS", mats.len() > 1),
+        ("RELAX", scene.settings.relaxation > 1.0),
+    ]
+}
+
+fn count(scene: &Scene, point: bool) -> usize {
+    scene.lights.iter().filter(|l| matches!(l, Light::Point { .. }) == point).count()
+}
+
+/// Writes and validates the kernel for `scene`, whose distance program is `program`.
+pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
+    let features = features(scene);
+    let on: HashMap<&str, bool> = features.iter().copied().collect();
+    let mut values: HashMap<&str, String> = HashMap::new();
+    values.insert("MAP", format!("{}\n{}", write_map(program), write_sdf(program)));
+    values.insert("POINTS", count(scene, true).to_string());
+    values.insert("DIRS", count(scene, false).to_string());
+    values.insert("MATERIALS", scene.materials.len().max(1).to_string());
+    values.insert("STACK", (scene.settings.max_depth + 2).to_string());
+    values.insert("WORKGROUP", WORKGROUP.to_string());
+    values.insert("ENTRY", ENTRY_POINT.to_string());
+    let source = template::expand(TEMPLATE, &on, &values)
+        .map_err(|e| Error { message: format!("kernel template: {e}"), line: None, node_span: None })?;
+    let (module, info) = validate(&source, scene)?;
+    Ok(Kernel { source, module, info, features })
+}
+
+/// Parses and validates WGSL with naga.
+fn validate(source: &str, scene: &Scene) -> Result<(naga::Module, naga::valid::ModuleInfo), Error> {
+    let located = |message: String, span: Option<naga::Span>| {
+        let line = span.map(|s| s.location(source).line_number as usize).filter(|&n| n > 0);
+        let line = line.map(|n| (n, source.lines().nth(n - 1).unwrap_or("").to_string()));
+        let node_span = line.as_ref().and_then(|(n, _)| node_of_line(source, *n, scene));
+        Error { message, line, node_span }
+    };
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|e| located(e.emit_to_string(source), e.labels().next().map(|(s, _)| s)))?;
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        .validate(&module)
+        .map_err(|e| located(e.emit_to_string(source), e.spans().next().map(|(s, _)| *s)))?;
+    Ok((module, info))
+}
+
+/// The scene node whose comment (`// node N ...`) precedes generated line `n`.
+fn node_of_line(source: &str, n: usize, scene: &Scene) -> Option<crate::Span> {
+    let comment = source.lines().take(n).collect::<Vec<_>>().into_iter().rev().find_map(|l| l.trim().strip_prefix("// node "))?;
+    let id: u32 = comment.split_whitespace().next()?.parse().ok()?;
+    (id < scene.graph.len() as u32).then(|| scene.graph.span(crate::scene::NodeId(id)))
+}
+
+/// `fn sdf(p) -> f32`: only the instructions the distance depends on (marching and normals
+/// do not need the material).
+fn write_sdf(program: &Program) -> String {
+    let ops = program.ops();
+    let mut needed = vec![false; ops.len()];
+    needed[program.distance().0 as usize] = true;
+    for i in (0..ops.len()).rev() {
+        if needed[i] {
+            for Reg(r) in ops[i].operands() {
+                needed[r as usize] = true;
+            }
+        }
+    }
+    let mut out = String::from("// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n");
+    let text = write_map(program);
+    // Reuse the map writer's lines: keep the `let` of each needed register.
+    for line in text.lines() {
+        let t = line.trim_start();
+        if let Some(rest) = t.strip_prefix("let r") {
+            let idx: usize = rest.split(' ').next().and_then(|s| s.parse().ok()).unwrap_or(usize::MAX);
+            if needed.get(idx).copied().unwrap_or(false) {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    out.push_str(&format!("    return r{};\n}}\n", program.distance().0));
+    out
+}
+
+/// The bytes of the scene uniform (binding 0), in the layout of `Params` in the kernel.
+pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
+    let mut w = Words::default();
+    let cam = &scene.camera;
+    let s = &scene.settings;
+    let eye = cam.position;
+    let fwd = normalize(sub(cam.look_at, eye));
+    let u = normalize(cross(fwd, [0.0, 1.0, 0.0]));
+    let v = cross(u, fwd);
+    let tan = (cam.fov * 0.5).tan();
+    let aspect = s.width.max(1) as f64 / s.height.max(1) as f64;
+    w.v4(eye, 0.0);
+    w.v4(fwd, 0.0);
+    w.v4(u, 0.0);
+    w.v4(v, 0.0);
+    w.f([tan * aspect, tan, s.width as f64, s.height as f64]);
+    w.f([s.epsilon, s.max_dist, s.relaxation.max(1.0), 1.0 / lipschitz.max(1.0)]);
+    w.v4(s.background, 0.0);
+    w.u([s.width, s.height, s.aa.max(1), s.max_steps.max(1)]);
+    w.u([s.max_depth, 0, 0, 0]);
+    for l in &scene.lights {
+        if let Light::Point { position, color, intensity, radius, softness } = l {
+            w.v4(*position, if radius.is_finite() { *radius } else { 0.0 });
+            w.v4(scale(*color, *intensity), *softness);
+        }
+    }
+    for l in &scene.lights {
+        if let Light::Directional { direction, color, intensity, softness } = l {
+            w.v4(normalize([-direction[0], -direction[1], -direction[2]]), 0.0);
+            w.v4(scale(*color, *intensity), *softness);
+        }
+    }
+    for m in &scene.materials {
+        let (a, b, checker, inv) = match &m.pattern {
+            Pattern::Solid(c) => (*c, [0.0; 3], 0.0, 0.0),
+            Pattern::Checker { a, b, size } => (*a, *b, 1.0, 1.0 / size),
+        };
+        w.v4(a, checker);
+        w.v4(b, inv);
+        w.f([m.ambient, m.diffuse, m.specular, m.shininess]);
+        w.f([m.reflect, m.transparency, m.ior.max(1e-6), 0.0]);
+    }
+    w.0
+}
+
+#[derive(Default)]
+struct Words(Vec<u8>);
+
+impl Words {
+    fn f(&mut self, v: [f64; 4]) {
+        for x in v {
+            self.0.extend_from_slice(&(x as f32).to_le_bytes());
+        }
+    }
+    fn v4(&mut self, v: [f64; 3], w: f64) {
+        self.f([v[0], v[1], v[2], w]);
+    }
+    fn u(&mut self, v: [u32; 4]) {
+        for x in v {
+            self.0.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if l > 0.0 { scale(a, 1.0 / l) } else { a }
+}

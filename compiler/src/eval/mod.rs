@@ -1,0 +1,125 @@
+//! The CPU interpreter of distance programs.
+//!
+//! A [`Tape`] is a program prepared for batch evaluation: instructions the requested outputs
+//! do not need are dropped, and registers are packed into a few reusable slots. An
+//! [`Evaluator`] runs a tape over batches of points given as separate x, y, z slices: each
+//! instruction is one tight loop over the batch, so the cost of decoding an instruction is
+//! shared by the whole batch and the compiler can vectorise the loops.
+//!
+//! Everything is generic over [`Float`] (f32 or f64). [`eval_point`] is the one-point
+//! reference evaluation used by tests.
+
+pub mod float;
+pub mod scalar;
+mod tape;
+
+pub use float::Float;
+pub use tape::{Outputs, Tape};
+
+use crate::lower::{Axis, Op, Program};
+
+/// The default number of points an evaluator processes per pass over the tape.
+pub const DEFAULT_CHUNK: usize = 256;
+
+/// Evaluates a program at one point, instruction by instruction (the reference semantics).
+/// The material id is the material register converted to an integer (negative and NaN
+/// become 0).
+pub fn eval_point<T: Float>(program: &Program, p: [T; 3]) -> (T, u32) {
+    let mut regs: Vec<T> = Vec::with_capacity(program.len());
+    for op in program.ops() {
+        let r = |i: crate::lower::Reg| regs[i.0 as usize];
+        let v = match *op {
+            Op::Const(c) => T::from_f64(c),
+            Op::Input(Axis::X) => p[0],
+            Op::Input(Axis::Y) => p[1],
+            Op::Input(Axis::Z) => p[2],
+            Op::Unary(u, a) => scalar::unary(u, r(a)),
+            Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
+            Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
+        };
+        regs.push(v);
+    }
+    let get = |i: crate::lower::Reg| regs.get(i.0 as usize).copied().unwrap_or_else(T::zero);
+    (get(program.distance()), material_id(get(program.material())))
+}
+
+/// A material register value as an id (saturating: negative and NaN give 0).
+#[inline(always)]
+pub fn material_id<T: Float>(m: T) -> u32 {
+    let v = m.to_f64();
+    if v >= 0.0 {
+        v as u32
+    } else {
+        0
+    }
+}
+
+/// Runs one tape over batches of points, with its own scratch registers.
+#[derive(Debug)]
+pub struct Evaluator<'t, T: Float> {
+    tape: &'t Tape,
+    slots: Vec<Vec<T>>,
+    chunk: usize,
+}
+
+impl<'t, T: Float> Evaluator<'t, T> {
+    /// An evaluator for `tape` processing up to `chunk` points per pass (at least 1).
+    pub fn new(tape: &'t Tape, chunk: usize) -> Self {
+        let chunk = chunk.max(1);
+        let mut slots = vec![vec![T::zero(); chunk]; tape.slot_count()];
+        for &(slot, c) in tape.constants() {
+            slots[slot as usize].fill(T::from_f64(c));
+        }
+        Evaluator { tape, slots, chunk }
+    }
+
+    /// The tape this evaluator runs.
+    pub fn tape(&self) -> &'t Tape {
+        self.tape
+    }
+
+    /// Evaluates the distance at every point `(x[i], y[i], z[i])` into `d[i]`, and the
+    /// material id into `m[i]` when asked for (and when the tape computes materials; 0
+    /// otherwise). All slices must have the same length; extra elements are ignored.
+    pub fn eval(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], mut m: Option<&mut [u32]>) {
+        let n = x.len().min(y.len()).min(z.len()).min(d.len());
+        let mut start = 0;
+        while start < n {
+            let end = (start + self.chunk).min(n);
+            self.run(&x[start..end], &y[start..end], &z[start..end]);
+            let len = end - start;
+            d[start..end].copy_from_slice(&self.slots[self.tape.distance_slot() as usize][..len]);
+            if let Some(m) = m.as_deref_mut() {
+                let stop = end.min(m.len());
+                self.write_materials(&mut m[start.min(stop)..stop]);
+            }
+            start = end;
+        }
+    }
+
+    fn write_materials(&self, out: &mut [u32]) {
+        match self.tape.material_slot() {
+            Some(s) => {
+                for (o, &v) in out.iter_mut().zip(&self.slots[s as usize]) {
+                    *o = material_id(v);
+                }
+            }
+            None => out.fill(0),
+        }
+    }
+
+    /// One pass over the tape for up to `chunk` points.
+    fn run(&mut self, x: &[T], y: &[T], z: &[T]) {
+        let n = x.len();
+        for (axis, src) in [(Axis::X, x), (Axis::Y, y), (Axis::Z, z)] {
+            if let Some(s) = self.tape.input_slot(axis) {
+                self.slots[s as usize][..n].copy_from_slice(src);
+            }
+        }
+        for step in self.tape.steps() {
+            let mut dst = std::mem::take(&mut self.slots[step.dst as usize]);
+            step.apply(&mut dst[..n], &self.slots, n);
+            self.slots[step.dst as usize] = dst;
+        }
+    }
+}

@@ -1,0 +1,248 @@
+//! Tapes: distance programs prepared for batch evaluation (dead instructions dropped,
+//! registers packed into reusable slots), and the loop that runs each instruction.
+
+use super::{scalar, Float};
+use crate::lower::{Axis, Binary, Op, Program, Reg, Unary};
+
+/// Which results a tape computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outputs {
+    /// The distance only (sphere tracing, shadows, normals).
+    Distance,
+    /// The distance and the material id (shading).
+    DistanceAndMaterial,
+}
+
+/// The operation of one step.
+#[derive(Debug, Clone, Copy)]
+enum Code {
+    Unary(Unary),
+    Binary(Binary),
+    Select,
+}
+
+/// One instruction over slots: `dst = code(a, b, c)`. `dst` never equals an operand.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Step {
+    code: Code,
+    pub(super) dst: u32,
+    a: u32,
+    b: u32,
+    c: u32,
+}
+
+/// A program prepared for an [`super::Evaluator`].
+#[derive(Debug, Clone)]
+pub struct Tape {
+    steps: Vec<Step>,
+    constants: Vec<(u32, f64)>,
+    inputs: [Option<u32>; 3],
+    slots: usize,
+    distance: u32,
+    material: Option<u32>,
+}
+
+/// Where each register lives, decided once per tape.
+#[derive(Debug, Default)]
+struct Allocator {
+    slot_of: Vec<Option<u32>>,
+    free: Vec<u32>,
+    count: u32,
+}
+
+impl Allocator {
+    fn fresh(&mut self) -> u32 {
+        self.free.pop().unwrap_or_else(|| {
+            self.count += 1;
+            self.count - 1
+        })
+    }
+}
+
+impl Tape {
+    /// Prepares `program` for evaluation of `outputs`.
+    pub fn new(program: &Program, outputs: Outputs) -> Tape {
+        let ops = program.ops();
+        let mut roots = vec![program.distance()];
+        if outputs == Outputs::DistanceAndMaterial {
+            roots.push(program.material());
+        }
+        let last_use = last_uses(ops, &roots);
+        let mut alloc = Allocator { slot_of: vec![None; ops.len()], ..Default::default() };
+        let mut tape = Tape { steps: Vec::new(), constants: Vec::new(), inputs: [None; 3], slots: 0, distance: 0, material: None };
+        // Constants and inputs keep their own slots for the evaluator's whole life.
+        for (i, op) in ops.iter().enumerate() {
+            if last_use[i].is_none() {
+                continue;
+            }
+            match *op {
+                Op::Const(c) => {
+                    let s = alloc.fresh();
+                    alloc.slot_of[i] = Some(s);
+                    tape.constants.push((s, c));
+                }
+                Op::Input(a) => {
+                    let s = alloc.fresh();
+                    alloc.slot_of[i] = Some(s);
+                    tape.inputs[axis_index(a)] = Some(s);
+                }
+                _ => {}
+            }
+        }
+        for (i, op) in ops.iter().enumerate() {
+            if last_use[i].is_some() && !matches!(op, Op::Const(_) | Op::Input(_)) {
+                tape.steps.push(step(i, op, &mut alloc, &last_use, ops));
+            }
+        }
+        let slot = |r: Reg| alloc.slot_of.get(r.0 as usize).copied().flatten().unwrap_or(0);
+        tape.distance = slot(program.distance());
+        if outputs == Outputs::DistanceAndMaterial {
+            tape.material = Some(slot(program.material()));
+        }
+        tape.slots = alloc.count.max(1) as usize;
+        tape
+    }
+
+    /// Number of instructions run per point.
+    pub fn len(&self) -> usize {
+        self.steps.len()
+    }
+
+    /// True when the tape runs no instruction (the result is a constant or an input).
+    pub fn is_empty(&self) -> bool {
+        self.steps.is_empty()
+    }
+
+    /// Number of scratch slots (of one chunk each) an evaluator needs.
+    pub fn slot_count(&self) -> usize {
+        self.slots
+    }
+
+    pub(super) fn steps(&self) -> &[Step] {
+        &self.steps
+    }
+
+    pub(super) fn constants(&self) -> &[(u32, f64)] {
+        &self.constants
+    }
+
+    pub(super) fn input_slot(&self, a: Axis) -> Option<u32> {
+        self.inputs[axis_index(a)]
+    }
+
+    pub(super) fn distance_slot(&self) -> u32 {
+        self.distance
+    }
+
+    pub(super) fn material_slot(&self) -> Option<u32> {
+        self.material
+    }
+}
+
+fn axis_index(a: Axis) -> usize {
+    match a {
+        Axis::X => 0,
+        Axis::Y => 1,
+        Axis::Z => 2,
+    }
+}
+
+/// For each register, the index of the last instruction reading it (`usize::MAX` for
+/// outputs), or `None` when no output needs it.
+fn last_uses(ops: &[Op], roots: &[Reg]) -> Vec<Option<usize>> {
+    let mut last = vec![None; ops.len()];
+    for r in roots {
+        last[r.0 as usize] = Some(usize::MAX);
+    }
+    for i in (0..ops.len()).rev() {
+        if last[i].is_none() {
+            continue;
+        }
+        for r in ops[i].operands() {
+            let l = &mut last[r.0 as usize];
+            *l = Some(l.map_or(i, |v: usize| v.max(i)));
+        }
+    }
+    last
+}
+
+/// Allocates the destination of instruction `i`, then frees operands read for the last time
+/// (after, so that the destination is never an operand).
+fn step(i: usize, op: &Op, alloc: &mut Allocator, last_use: &[Option<usize>], ops: &[Op]) -> Step {
+    let operands = op.operands();
+    let s: Vec<u32> = operands.iter().map(|r| alloc.slot_of[r.0 as usize].unwrap_or(0)).collect();
+    let at = |k: usize| s.get(k).copied().unwrap_or(0);
+    let code = match *op {
+        Op::Unary(u, _) => Code::Unary(u),
+        Op::Binary(b, _, _) => Code::Binary(b),
+        _ => Code::Select,
+    };
+    let dst = alloc.fresh();
+    alloc.slot_of[i] = Some(dst);
+    let mut freed: Vec<u32> = Vec::new();
+    for (r, &slot) in operands.iter().zip(&s) {
+        let permanent = matches!(ops[r.0 as usize], Op::Const(_) | Op::Input(_));
+        if !permanent && last_use[r.0 as usize] == Some(i) && !freed.contains(&slot) {
+            freed.push(slot);
+        }
+    }
+    alloc.free.extend(freed);
+    Step { code, dst, a: at(0), b: at(1), c: at(2) }
+}
+
+impl Step {
+    /// Runs this step on the first `n` points: `dst` is the destination slot's storage
+    /// (taken out of `slots`), the operands are read from `slots`.
+    #[inline]
+    pub(super) fn apply<T: Float>(&self, dst: &mut [T], slots: &[Vec<T>], n: usize) {
+        let a = &slots[self.a as usize][..n];
+        match self.code {
+            Code::Unary(u) => unary_loop(u, dst, a),
+            Code::Binary(b) => binary_loop(b, dst, a, &slots[self.b as usize][..n]),
+            Code::Select => {
+                let (x, y) = (&slots[self.b as usize][..n], &slots[self.c as usize][..n]);
+                for (((o, &c), &p), &q) in dst.iter_mut().zip(a).zip(x).zip(y) {
+                    *o = scalar::select(c, p, q);
+                }
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn map1<T: Float>(d: &mut [T], a: &[T], f: impl Fn(T) -> T) {
+    for (o, &x) in d.iter_mut().zip(a) {
+        *o = f(x);
+    }
+}
+
+#[inline(always)]
+fn map2<T: Float>(d: &mut [T], a: &[T], b: &[T], f: impl Fn(T, T) -> T) {
+    for ((o, &x), &y) in d.iter_mut().zip(a).zip(b) {
+        *o = f(x, y);
+    }
+}
+
+/// One loop per operation, each specialised by `scalar::unary` with a constant operation.
+fn unary_loop<T: Float>(u: Unary, d: &mut [T], a: &[T]) {
+    macro_rules! arms {
+        ($($v:ident),*) => {
+            match u {
+                $(Unary::$v => map1(d, a, |x| scalar::unary(Unary::$v, x)),)*
+            }
+        };
+    }
+    arms!(Neg, Abs, Sqrt, Sin, Cos, Acos, Exp, Log, Floor, Round)
+}
+
+/// One loop per operation, each specialised by `scalar::binary` with a constant operation.
+fn binary_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], y: &[T]) {
+    macro_rules! arms {
+        ($($v:ident),*) => {
+            match b {
+                $(Binary::$v => map2(d, x, y, |p, q| scalar::binary(Binary::$v, p, q)),)*
+            }
+        };
+    }
+    arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+}

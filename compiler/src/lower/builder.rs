@@ -1,0 +1,303 @@
+//! The program builder: emits instructions with constant folding and sharing of equal
+//! instructions, and offers the small vector helpers the lowering rules are written with.
+
+use super::{Axis, Binary, Note, Op, Program, Reg, Unary};
+use crate::eval::scalar;
+use std::collections::HashMap;
+
+/// A point or vector: three registers.
+pub(super) type P = [Reg; 3];
+
+/// The identity of an instruction for sharing (constants compared by bits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Key {
+    Const(u64),
+    Input(Axis),
+    Unary(Unary, Reg),
+    Binary(Binary, Reg, Reg),
+    Select(Reg, Reg, Reg),
+}
+
+/// Builds one program.
+#[derive(Debug, Default)]
+pub(super) struct Builder {
+    ops: Vec<Op>,
+    notes: Vec<Note>,
+    shared: HashMap<Key, Reg>,
+}
+
+impl Builder {
+    /// An empty builder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Starts a commented block at the next instruction.
+    pub fn note(&mut self, text: String) {
+        self.notes.push(Note { at: self.ops.len(), text });
+    }
+
+    /// The input point.
+    pub fn input_point(&mut self) -> P {
+        [self.emit(Op::Input(Axis::X)), self.emit(Op::Input(Axis::Y)), self.emit(Op::Input(Axis::Z))]
+    }
+
+    /// The constant `x`.
+    pub fn c(&mut self, x: f64) -> Reg {
+        self.emit(Op::Const(x))
+    }
+
+    /// The value of a register when it is a constant.
+    pub fn value(&self, r: Reg) -> Option<f64> {
+        match self.ops[r.0 as usize] {
+            Op::Const(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    fn is(&self, r: Reg, x: f64) -> bool {
+        self.value(r) == Some(x)
+    }
+
+    /// Emits an instruction, or returns an equal or simpler one emitted before.
+    pub fn emit(&mut self, op: Op) -> Reg {
+        if let Some(r) = self.fold(op) {
+            return r;
+        }
+        let key = match op {
+            Op::Const(c) => Key::Const(c.to_bits()),
+            Op::Input(a) => Key::Input(a),
+            Op::Unary(u, a) => Key::Unary(u, a),
+            Op::Binary(b, x, y) if commutes(b) && y < x => Key::Binary(b, y, x),
+            Op::Binary(b, x, y) => Key::Binary(b, x, y),
+            Op::Select(c, a, b) => Key::Select(c, a, b),
+        };
+        if let Some(&r) = self.shared.get(&key) {
+            return r;
+        }
+        let r = Reg(self.ops.len() as u32);
+        self.ops.push(op);
+        self.shared.insert(key, r);
+        r
+    }
+
+    /// Constant folding and algebraic identities; `None` when the instruction stays.
+    fn fold(&mut self, op: Op) -> Option<Reg> {
+        match op {
+            Op::Const(_) | Op::Input(_) => None,
+            Op::Unary(u, a) => self.fold_unary(u, a),
+            Op::Binary(b, x, y) => self.fold_binary(b, x, y),
+            Op::Select(c, a, b) => match self.value(c) {
+                Some(v) => Some(if v != 0.0 { a } else { b }),
+                None if a == b => Some(a),
+                None => None,
+            },
+        }
+    }
+
+    fn fold_unary(&mut self, u: Unary, a: Reg) -> Option<Reg> {
+        if let Some(v) = self.value(a) {
+            return Some(self.c(scalar::unary(u, v)));
+        }
+        match (u, self.ops[a.0 as usize]) {
+            (Unary::Neg, Op::Unary(Unary::Neg, inner)) => Some(inner),
+            (Unary::Abs, Op::Unary(Unary::Abs | Unary::Neg, inner)) => Some(self.abs(inner)),
+            _ => None,
+        }
+    }
+
+    fn fold_binary(&mut self, b: Binary, x: Reg, y: Reg) -> Option<Reg> {
+        if let (Some(u), Some(v)) = (self.value(x), self.value(y)) {
+            return Some(self.c(scalar::binary(b, u, v)));
+        }
+        match b {
+            Binary::Add if self.is(y, 0.0) => Some(x),
+            Binary::Add if self.is(x, 0.0) => Some(y),
+            Binary::Sub if self.is(y, 0.0) => Some(x),
+            Binary::Sub if self.is(x, 0.0) => Some(self.neg(y)),
+            Binary::Mul if self.is(y, 1.0) => Some(x),
+            Binary::Mul if self.is(x, 1.0) => Some(y),
+            Binary::Mul if self.is(x, 0.0) || self.is(y, 0.0) => Some(self.c(0.0)),
+            Binary::Mul if self.is(y, -1.0) => Some(self.neg(x)),
+            Binary::Mul if self.is(x, -1.0) => Some(self.neg(y)),
+            Binary::Div if self.is(y, 1.0) => Some(x),
+            Binary::Pow if self.is(y, 1.0) => Some(x),
+            Binary::Pow if self.is(y, 2.0) => Some(self.mul(x, x)),
+            Binary::Min | Binary::Max if x == y => Some(x),
+            Binary::Lt if x == y => Some(self.c(0.0)),
+            _ => None,
+        }
+    }
+
+    /// Ends the program: drops instructions the outputs do not need and renumbers the rest.
+    pub fn finish(self, d: Reg, m: Reg) -> Program {
+        let mut live = vec![false; self.ops.len()];
+        live[d.0 as usize] = true;
+        live[m.0 as usize] = true;
+        for i in (0..self.ops.len()).rev() {
+            if live[i] {
+                for r in self.ops[i].operands() {
+                    live[r.0 as usize] = true;
+                }
+            }
+        }
+        let mut new_index = vec![Reg(0); self.ops.len()];
+        let mut ops = Vec::new();
+        let mut first_at_or_after = vec![0usize; self.ops.len() + 1];
+        for (i, op) in self.ops.iter().enumerate() {
+            first_at_or_after[i] = ops.len();
+            if live[i] {
+                new_index[i] = Reg(ops.len() as u32);
+                ops.push(renumber(op, &new_index));
+            }
+        }
+        first_at_or_after[self.ops.len()] = ops.len();
+        let notes = self.notes.into_iter().map(|n| Note { at: first_at_or_after[n.at], text: n.text }).collect();
+        Program { ops, notes, distance: new_index[d.0 as usize], material: new_index[m.0 as usize] }
+    }
+}
+
+fn commutes(b: Binary) -> bool {
+    matches!(b, Binary::Add | Binary::Mul | Binary::Min | Binary::Max)
+}
+
+fn renumber(op: &Op, new_index: &[Reg]) -> Op {
+    let n = |r: Reg| new_index[r.0 as usize];
+    match *op {
+        Op::Const(_) | Op::Input(_) => *op,
+        Op::Unary(u, a) => Op::Unary(u, n(a)),
+        Op::Binary(b, x, y) => Op::Binary(b, n(x), n(y)),
+        Op::Select(c, a, b) => Op::Select(n(c), n(a), n(b)),
+    }
+}
+
+/// Scalar helpers, one per instruction.
+impl Builder {
+    pub fn un(&mut self, u: Unary, a: Reg) -> Reg {
+        self.emit(Op::Unary(u, a))
+    }
+    pub fn bin(&mut self, b: Binary, x: Reg, y: Reg) -> Reg {
+        self.emit(Op::Binary(b, x, y))
+    }
+    pub fn add(&mut self, x: Reg, y: Reg) -> Reg {
+        self.bin(Binary::Add, x, y)
+    }
+    pub fn sub(&mut self, x: Reg, y: Reg) -> Reg {
+        self.bin(Binary::Sub, x, y)
+    }
+    pub fn mul(&mut self, x: Reg, y: Reg) -> Reg {
+        self.bin(Binary::Mul, x, y)
+    }
+    pub fn div(&mut self, x: Reg, y: Reg) -> Reg {
+        self.bin(Binary::Div, x, y)
+    }
+    pub fn min(&mut self, x: Reg, y: Reg) -> Reg {
+        self.bin(Binary::Min, x, y)
+    }
+    pub fn max(&mut self, x: Reg, y: Reg) -> Reg {
+        self.bin(Binary::Max, x, y)
+    }
+    pub fn lt(&mut self, x: Reg, y: Reg) -> Reg {
+        self.bin(Binary::Lt, x, y)
+    }
+    pub fn select(&mut self, c: Reg, a: Reg, b: Reg) -> Reg {
+        self.emit(Op::Select(c, a, b))
+    }
+    pub fn neg(&mut self, a: Reg) -> Reg {
+        self.un(Unary::Neg, a)
+    }
+    pub fn abs(&mut self, a: Reg) -> Reg {
+        self.un(Unary::Abs, a)
+    }
+    pub fn sqrt(&mut self, a: Reg) -> Reg {
+        self.un(Unary::Sqrt, a)
+    }
+    /// x + k for a constant k.
+    pub fn addc(&mut self, x: Reg, k: f64) -> Reg {
+        let k = self.c(k);
+        self.add(x, k)
+    }
+    /// x - k for a constant k.
+    pub fn subc(&mut self, x: Reg, k: f64) -> Reg {
+        let k = self.c(k);
+        self.sub(x, k)
+    }
+    /// x * k for a constant k.
+    pub fn mulc(&mut self, x: Reg, k: f64) -> Reg {
+        let k = self.c(k);
+        self.mul(x, k)
+    }
+    /// max(x, k) for a constant k.
+    pub fn maxc(&mut self, x: Reg, k: f64) -> Reg {
+        let k = self.c(k);
+        self.max(x, k)
+    }
+    /// min(x, k) for a constant k.
+    pub fn minc(&mut self, x: Reg, k: f64) -> Reg {
+        let k = self.c(k);
+        self.min(x, k)
+    }
+    /// x limited to the constant range [lo, hi].
+    pub fn clampc(&mut self, x: Reg, lo: f64, hi: f64) -> Reg {
+        let m = self.maxc(x, lo);
+        self.minc(m, hi)
+    }
+    /// √(a² + b²).
+    pub fn len2(&mut self, a: Reg, b: Reg) -> Reg {
+        let d = self.dot2(a, b, a, b);
+        self.sqrt(d)
+    }
+    /// a·c + b·d.
+    pub fn dot2(&mut self, a: Reg, b: Reg, c: Reg, d: Reg) -> Reg {
+        let x = self.mul(a, c);
+        let y = self.mul(b, d);
+        self.add(x, y)
+    }
+    /// The material `m`, or the constant `id` where `m` is unpainted (negative).
+    pub fn paint(&mut self, m: Reg, id: f64) -> Reg {
+        let zero = self.c(0.0);
+        let unpainted = self.lt(m, zero);
+        let id = self.c(id);
+        self.select(unpainted, id, m)
+    }
+}
+
+/// Vector helpers over [`P`].
+impl Builder {
+    /// Componentwise `f`.
+    pub fn map3(&mut self, p: P, mut f: impl FnMut(&mut Self, Reg, usize) -> Reg) -> P {
+        [f(self, p[0], 0), f(self, p[1], 1), f(self, p[2], 2)]
+    }
+    /// The constant vector `v`.
+    pub fn c3(&mut self, v: [f64; 3]) -> P {
+        [self.c(v[0]), self.c(v[1]), self.c(v[2])]
+    }
+    /// p - v for a constant v.
+    pub fn sub3c(&mut self, p: P, v: [f64; 3]) -> P {
+        self.map3(p, |b, x, i| b.subc(x, v[i]))
+    }
+    /// |p| componentwise.
+    pub fn abs3(&mut self, p: P) -> P {
+        self.map3(p, |b, x, _| b.abs(x))
+    }
+    /// max(p, k) componentwise.
+    pub fn max3c(&mut self, p: P, k: f64) -> P {
+        self.map3(p, |b, x, _| b.maxc(x, k))
+    }
+    /// a · b.
+    pub fn dot3(&mut self, a: P, c: P) -> Reg {
+        let xy = self.dot2(a[0], a[1], c[0], c[1]);
+        let z = self.mul(a[2], c[2]);
+        self.add(xy, z)
+    }
+    /// |p|.
+    pub fn len3(&mut self, p: P) -> Reg {
+        let d = self.dot3(p, p);
+        self.sqrt(d)
+    }
+    /// The largest component.
+    pub fn max_comp(&mut self, p: P) -> Reg {
+        let yz = self.max(p[1], p[2]);
+        self.max(p[0], yz)
+    }
+}

@@ -1,0 +1,186 @@
+//! Lowering rules of the primitives: Quilez's distance functions written as scalar code.
+//! Every primitive is centred on the origin; `p` is the point in the primitive's frame.
+
+use super::builder::{Builder, P};
+use super::{Binary, Reg, Unary};
+use crate::scene::V3;
+
+/// |p| - r
+pub(super) fn sphere(b: &mut Builder, p: P, r: f64) -> Reg {
+    let l = b.len3(p);
+    b.subc(l, r)
+}
+
+/// q = |p| - h; |max(q, 0)| + min(maxcomp(q), 0)
+pub(super) fn boxed(b: &mut Builder, p: P, half: V3) -> Reg {
+    let a = b.abs3(p);
+    let q = b.sub3c(a, half);
+    box_from_q(b, q)
+}
+
+fn box_from_q(b: &mut Builder, q: P) -> Reg {
+    let outside = b.max3c(q, 0.0);
+    let outside = b.len3(outside);
+    let inside = b.max_comp(q);
+    let inside = b.minc(inside, 0.0);
+    b.add(outside, inside)
+}
+
+/// A box of half-extents `half` (the rounding inside them) with edges rounded by `r`.
+pub(super) fn round_box(b: &mut Builder, p: P, half: V3, r: f64) -> Reg {
+    let a = b.abs3(p);
+    let q = b.sub3c(a, [half[0] - r, half[1] - r, half[2] - r]);
+    let d = box_from_q(b, q);
+    b.subc(d, r)
+}
+
+/// dot(p, n) - h: the half-space below the plane.
+pub(super) fn plane(b: &mut Builder, p: P, n: V3, h: f64) -> Reg {
+    let n = b.c3(n);
+    let d = b.dot3(p, n);
+    b.subc(d, h)
+}
+
+/// |(|p.xz| - R, p.y)| - r
+pub(super) fn torus(b: &mut Builder, p: P, major: f64, minor: f64) -> Reg {
+    let xz = b.len2(p[0], p[2]);
+    let qx = b.subc(xz, major);
+    let l = b.len2(qx, p[1]);
+    b.subc(l, minor)
+}
+
+/// Capped cylinder along y: d = |(|p.xz|, p.y)| - (r, h);
+/// min(max(d.x, d.y), 0) + |max(d, 0)|
+pub(super) fn cylinder(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
+    let xz = b.len2(p[0], p[2]);
+    let dx = b.subc(xz, r);
+    let ay = b.abs(p[1]);
+    let dy = b.subc(ay, h);
+    let inside = b.max(dx, dy);
+    let inside = b.minc(inside, 0.0);
+    let ox = b.maxc(dx, 0.0);
+    let oy = b.maxc(dy, 0.0);
+    let outside = b.len2(ox, oy);
+    b.add(inside, outside)
+}
+
+/// Capsule along y: |p - (0, clamp(p.y, -h, h), 0)| - r
+pub(super) fn capsule(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
+    let cy = b.clampc(p[1], -h, h);
+    let y = b.sub(p[1], cy);
+    let l = b.len3([p[0], y, p[2]]);
+    b.subc(l, r)
+}
+
+/// Quilez's exact capped cone with radius `r` at y = -h and radius 0 at y = +h:
+/// q = (|p.xz|, p.y), k1 = (0, h), k2 = (-r, 2h),
+/// ca = (q.x - min(q.x, q.y < 0 ? r : 0), |q.y| - h),
+/// cb = q - k1 + k2·clamp(dot(k1 - q, k2) / dot(k2, k2), 0, 1),
+/// s = (cb.x < 0 and ca.y < 0) ? -1 : 1,  d = s·√min(|ca|², |cb|²).
+pub(super) fn cone(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
+    let qx = b.len2(p[0], p[2]);
+    let qy = p[1];
+    let zero = b.c(0.0);
+    let below = b.lt(qy, zero);
+    let rc = b.c(r);
+    let cap = b.select(below, rc, zero);
+    let cap = b.min(qx, cap);
+    let cax = b.sub(qx, cap);
+    let ay = b.abs(qy);
+    let cay = b.subc(ay, h);
+    // dot(k1 - q, k2) = (0 - qx)(-r) + (h - qy)(2h) = r·qx + 2h² - 2h·qy
+    let t1 = b.mulc(qx, r);
+    let t2 = b.mulc(qy, -2.0 * h);
+    let t = b.add(t1, t2);
+    let t = b.addc(t, 2.0 * h * h);
+    let t = b.mulc(t, 1.0 / (r * r + 4.0 * h * h));
+    let t = b.clampc(t, 0.0, 1.0);
+    let kx = b.mulc(t, -r);
+    let cbx = b.add(qx, kx);
+    let ky = b.mulc(t, 2.0 * h);
+    let cby = b.subc(qy, h);
+    let cby = b.add(cby, ky);
+    let inside_x = b.lt(cbx, zero);
+    let inside_y = b.lt(cay, zero);
+    let inside = b.mul(inside_x, inside_y);
+    let one = b.c(1.0);
+    let minus = b.c(-1.0);
+    let s = b.select(inside, minus, one);
+    let da = b.dot2(cax, cay, cax, cay);
+    let db = b.dot2(cbx, cby, cbx, cby);
+    let m = b.min(da, db);
+    let m = b.sqrt(m);
+    b.mul(s, m)
+}
+
+/// Quilez's ellipsoid bound: k0 = |p / r|, k1 = |p / r²|, d = k0 (k0 - 1) / k1.
+/// k1 is kept above a tiny floor so that the centre gives a finite value.
+pub(super) fn ellipsoid(b: &mut Builder, p: P, radii: V3) -> Reg {
+    let q0 = b.map3(p, |b, x, i| b.mulc(x, 1.0 / radii[i]));
+    let q1 = b.map3(p, |b, x, i| b.mulc(x, 1.0 / (radii[i] * radii[i])));
+    let k0 = b.len3(q0);
+    let k1 = b.len3(q1);
+    let k1 = b.maxc(k1, 1e-30);
+    let k = b.subc(k0, 1.0);
+    let n = b.mul(k0, k);
+    b.div(n, k1)
+}
+
+/// Escape radius of the Mandelbulb iteration.
+const BAILOUT: f64 = 2.0;
+
+/// The Mandelbulb distance estimator 0.5·ln(r)·r/dr, with `iterations` unrolled steps of
+/// z ← zⁿ + p in spherical coordinates (y up). A point escapes when r > 2; from then on
+/// `select` keeps its state. Beyond |p| > 4 the field is |p| - 2 (the set lies inside the
+/// ball of radius 2), which keeps the far field a bound where the estimator would overstate.
+pub(super) fn mandelbulb(b: &mut Builder, p: P, power: f64, iterations: u32) -> Reg {
+    let mut z = p;
+    let mut dr = b.c(1.0);
+    for _ in 0..iterations {
+        let r = b.len3(z);
+        let bailout = b.c(BAILOUT);
+        let escaped = b.lt(bailout, r);
+        let (nz, ndr) = bulb_step(b, p, z, r, dr, power);
+        z = [0, 1, 2].map(|i| b.select(escaped, z[i], nz[i]));
+        dr = b.select(escaped, dr, ndr);
+    }
+    let r = b.len3(z);
+    let r = b.maxc(r, 1e-30);
+    let lr = b.un(Unary::Log, r);
+    let d = b.mul(lr, r);
+    let d = b.mulc(d, 0.5);
+    let de = b.div(d, dr);
+    let r0 = b.len3(p);
+    let four = b.c(4.0);
+    let far = b.lt(four, r0);
+    let sphere = b.subc(r0, BAILOUT);
+    b.select(far, sphere, de)
+}
+
+/// One iteration: dr ← n·rⁿ⁻¹·dr + 1, z ← rⁿ·(sin θ cos φ, cos θ, sin θ sin φ) + p with
+/// θ = n·acos(z.y / r), φ = n·atan2(z.z, z.x).
+fn bulb_step(b: &mut Builder, p: P, z: P, r: Reg, dr: Reg, n: f64) -> (P, Reg) {
+    let safe_r = b.maxc(r, 1e-30);
+    let cos_t = b.div(z[1], safe_r);
+    let cos_t = b.clampc(cos_t, -1.0, 1.0);
+    let theta = b.un(Unary::Acos, cos_t);
+    let theta = b.mulc(theta, n);
+    let phi = b.bin(Binary::Atan2, z[2], z[0]);
+    let phi = b.mulc(phi, n);
+    let e = b.c(n - 1.0);
+    let rn1 = b.bin(Binary::Pow, r, e);
+    let ndr = b.mul(rn1, dr);
+    let ndr = b.mulc(ndr, n);
+    let ndr = b.addc(ndr, 1.0);
+    let rn = b.mul(rn1, r);
+    let (st, ct) = (b.un(Unary::Sin, theta), b.un(Unary::Cos, theta));
+    let (sp, cp) = (b.un(Unary::Sin, phi), b.un(Unary::Cos, phi));
+    let x = b.mul(st, cp);
+    let z2 = b.mul(st, sp);
+    let dir = [x, ct, z2];
+    let nz = [0, 1, 2].map(|i| {
+        let s = b.mul(rn, dir[i]);
+        b.add(s, p[i])
+    });
+    (nz, ndr)
+}

@@ -1,0 +1,215 @@
+//! `sdfc render`: render a scene to a PNG image, and the option handling `sdfc bench` shares
+//! (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread pools).
+
+use crate::cpu::{self, Options, Precision};
+use crate::frontend::{self, DiagnosticFormat};
+use indicatif::{ProgressBar, ProgressStyle};
+use sdfc_compiler::lower;
+use sdfc_compiler::scene::{Scene, Settings};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Where a scene is rendered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Backend {
+    /// The best backend available (today: the CPU).
+    #[default]
+    Auto,
+    /// The CPU renderer with the batch interpreter.
+    Cpu,
+}
+
+/// Arguments of `sdfc render`.
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// Scene file.
+    pub file: PathBuf,
+    /// Backend to render with.
+    #[arg(long, value_enum, default_value_t)]
+    pub backend: Backend,
+    /// Image size, as WIDTHxHEIGHT (overrides the scene's `render` block).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Supersampling: N×N samples per pixel.
+    #[arg(long, value_name = "N")]
+    pub aa: Option<u32>,
+    /// Override a render setting: width, height, aa, max_steps, epsilon, max_depth, max_dist,
+    /// relaxation or background (as r,g,b). May be repeated.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Output PNG (default: the scene file's name with .png, in the current directory).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Print render statistics.
+    #[arg(long)]
+    pub stats: bool,
+    /// Float type of the evaluation.
+    #[arg(long, value_enum, default_value_t)]
+    pub precision: Precision,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+}
+
+/// Runs `sdfc render`.
+pub fn run(args: RenderArgs) -> ExitCode {
+    let mut scene = match frontend::load_scene(&args.file, DiagnosticFormat::Human) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if let Err(msg) = override_settings(&mut scene.settings, args.size, args.aa, &args.set) {
+        eprintln!("error: {msg}");
+        return ExitCode::from(2);
+    }
+    let pool = match thread_pool(args.threads) {
+        Ok(p) => p,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            return ExitCode::from(2);
+        }
+    };
+    let options = Options { precision: args.precision, ..Options::default() };
+    let started = Instant::now();
+    let render = pool.install(|| render_with_progress(&scene, &options));
+    let seconds = started.elapsed().as_secs_f64();
+    let out = args.output.clone().unwrap_or_else(|| default_output(&args.file));
+    if let Err(e) = crate::image::write_png(&out, &render.image) {
+        eprintln!("error: cannot write `{}`: {e}", out.display());
+        return ExitCode::from(2);
+    }
+    let s = &scene.settings;
+    eprintln!("wrote {} ({}x{}, aa {}, {:.3} s)", out.display(), s.width, s.height, s.aa, seconds);
+    if args.stats {
+        println!("time            {:.3} s", seconds);
+        println!("{}", render.stats);
+    }
+    ExitCode::SUCCESS
+}
+
+/// Renders with a progress bar on stderr when stderr is a terminal.
+fn render_with_progress(scene: &Scene, options: &Options) -> cpu::Render {
+    let program = lower::lower(scene);
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(cpu::tile_count(&scene.settings, options));
+        if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}") {
+            bar.set_style(style);
+        }
+        Some(bar)
+    } else {
+        None
+    };
+    let render = cpu::render(scene, &program, options, &|| {
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    render
+}
+
+/// `scene.sdf` → `./scene.png`.
+fn default_output(file: &Path) -> PathBuf {
+    let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "render".into());
+    PathBuf::from(format!("{stem}.png"))
+}
+
+/// A rayon pool of `threads` workers (default: rayon's choice, one per core).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        if n == 0 {
+            return Err("--threads must be at least 1".into());
+        }
+        b = b.num_threads(n);
+    }
+    b.build().map_err(|e| format!("cannot start worker threads: {e}"))
+}
+
+/// Parses `WIDTHxHEIGHT`.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, like 640x480, not `{s}`"))?;
+    let w = parse_dimension(w.trim())?;
+    let h = parse_dimension(h.trim())?;
+    Ok((w, h))
+}
+
+/// Largest accepted image edge.
+const MAX_EDGE: u32 = 1 << 15;
+
+fn parse_dimension(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(v) if (1..=MAX_EDGE).contains(&v) => Ok(v),
+        _ => Err(format!("an image edge must be a whole number from 1 to {MAX_EDGE}, not `{s}`")),
+    }
+}
+
+/// Applies `--size`, `--aa` and then each `--set key=value`, in order.
+pub fn override_settings(s: &mut Settings, size: Option<(u32, u32)>, aa: Option<u32>, sets: &[String]) -> Result<(), String> {
+    if let Some((w, h)) = size {
+        s.width = w;
+        s.height = h;
+    }
+    if let Some(n) = aa {
+        set(s, "aa", &n.to_string())?;
+    }
+    for item in sets {
+        let (key, value) =
+            item.split_once('=').ok_or_else(|| format!("--set expects KEY=VALUE, like max_steps=512, not `{item}`"))?;
+        set(s, key.trim(), value.trim())?;
+    }
+    Ok(())
+}
+
+/// The keys `--set` accepts.
+pub const SETTING_KEYS: &[&str] =
+    &["width", "height", "aa", "max_steps", "epsilon", "max_depth", "max_dist", "relaxation", "background"];
+
+/// Sets one render setting from text, checking its range.
+pub fn set(s: &mut Settings, key: &str, value: &str) -> Result<(), String> {
+    match key {
+        "width" => s.width = parse_dimension(value).map_err(|e| format!("width: {e}"))?,
+        "height" => s.height = parse_dimension(value).map_err(|e| format!("height: {e}"))?,
+        "aa" => s.aa = int(key, value, 1, 16)?,
+        "max_steps" => s.max_steps = int(key, value, 1, 1_000_000)?,
+        "max_depth" => s.max_depth = int(key, value, 0, 64)?,
+        "epsilon" => s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?,
+        "max_dist" => s.max_dist = real(key, value, |v| v > 0.0, "a positive number")?,
+        "relaxation" => s.relaxation = real(key, value, |v| (1.0..2.0).contains(&v), "a number in [1, 2)")?,
+        "background" => s.background = colour(value)?,
+        _ => {
+            return Err(format!("unknown render setting `{key}`; the settings are {}", SETTING_KEYS.join(", ")));
+        }
+    }
+    Ok(())
+}
+
+fn int(key: &str, value: &str, lo: u32, hi: u32) -> Result<u32, String> {
+    match value.parse::<u32>() {
+        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
+        _ => Err(format!("{key} must be a whole number from {lo} to {hi}, not `{value}`")),
+    }
+}
+
+fn real(key: &str, value: &str, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
+    match value.parse::<f64>() {
+        Ok(v) if v.is_finite() && ok(v) => Ok(v),
+        _ => Err(format!("{key} must be {what}, not `{value}`")),
+    }
+}
+
+fn colour(value: &str) -> Result<[f64; 3], String> {
+    let err = || format!("background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{value}`");
+    let parts: Vec<f64> = value
+        .trim_matches(|c| c == '(' || c == ')')
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().map_err(|_| err()))
+        .collect::<Result<_, _>>()?;
+    match parts[..] {
+        [r, g, b] if parts.iter().all(|v| (0.0..=1.0).contains(v)) => Ok([r, g, b]),
+        _ => Err(err()),
+    }
+}

@@ -1,0 +1,129 @@
+//! Everything a tile needs, prepared once per render in the evaluation type: settings,
+//! camera, materials, lights and the two tapes (distance only, distance and material).
+
+use super::camera::Pinhole;
+use super::vec::V3;
+use sdfc_compiler::eval::{Float, Outputs, Tape};
+use sdfc_compiler::lower::Program;
+use sdfc_compiler::scene::{Light, Material, Pattern, Scene};
+
+/// The colour of a material at a point.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Paint<T> {
+    Solid(V3<T>),
+    Checker { a: V3<T>, b: V3<T>, inv_size: T },
+}
+
+/// A Phong material in the evaluation type.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Mat<T> {
+    pub paint: Paint<T>,
+    pub ambient: T,
+    pub diffuse: T,
+    pub specular: T,
+    pub shininess: T,
+    pub reflect: T,
+    pub transparency: T,
+    pub ior: T,
+}
+
+/// A light in the evaluation type; `color` is colour × intensity (I_l).
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Lamp<T> {
+    Point { position: V3<T>, color: V3<T>, radius: T, softness: T },
+    Directional { to_light: V3<T>, color: V3<T>, softness: T },
+}
+
+/// Render-wide constants.
+#[derive(Debug)]
+pub(super) struct Context<T: Float> {
+    pub camera: Pinhole<T>,
+    pub epsilon: T,
+    pub max_dist: T,
+    pub max_steps: u32,
+    pub max_depth: u32,
+    pub relaxation: T,
+    /// 1 / L, the step scale.
+    pub inv_lipschitz: T,
+    pub background: V3<T>,
+    pub materials: Vec<Mat<T>>,
+    pub lamps: Vec<Lamp<T>>,
+    /// Whether any material is transparent (shadow rays then look up materials).
+    pub transparent: bool,
+    pub distance_tape: Tape,
+    pub full_tape: Tape,
+}
+
+impl<T: Float> Context<T> {
+    pub fn new(scene: &Scene, program: &Program, lipschitz: f64) -> Self {
+        let s = &scene.settings;
+        let mut materials: Vec<Mat<T>> = scene.materials.iter().map(mat).collect();
+        if materials.is_empty() {
+            materials.push(mat(&Material::default_material()));
+        }
+        let transparent = materials.iter().any(|m| m.transparency > T::zero());
+        Context {
+            camera: Pinhole::new(&scene.camera, s),
+            epsilon: T::from_f64(s.epsilon),
+            max_dist: T::from_f64(s.max_dist),
+            max_steps: s.max_steps.max(1),
+            max_depth: s.max_depth,
+            relaxation: T::from_f64(s.relaxation.max(1.0)),
+            inv_lipschitz: T::from_f64(1.0 / lipschitz.max(1.0)),
+            background: V3::from_f64(s.background),
+            materials,
+            lamps: scene.lights.iter().map(lamp).collect(),
+            transparent,
+            distance_tape: Tape::new(program, Outputs::Distance),
+            full_tape: Tape::new(program, Outputs::DistanceAndMaterial),
+        }
+    }
+
+    /// The material of an id (unknown ids get material 0).
+    pub fn material(&self, id: u32) -> &Mat<T> {
+        self.materials.get(id as usize).unwrap_or(&self.materials[0])
+    }
+
+    /// The normal step at a hit: h = max(ε·t, 64·machine ε·(1 + |p|∞)), where t is the
+    /// path length; the floor keeps the differences above the rounding noise of `T`.
+    pub fn normal_step(&self, tt: T, p: V3<T>) -> T {
+        let floor = T::from_f64(64.0) * T::EPSILON * (T::one() + p.max_abs());
+        (self.epsilon * tt).max(floor)
+    }
+}
+
+fn mat<T: Float>(m: &Material) -> Mat<T> {
+    let f = T::from_f64;
+    let paint = match &m.pattern {
+        Pattern::Solid(c) => Paint::Solid(V3::from_f64(*c)),
+        Pattern::Checker { a, b, size } => {
+            Paint::Checker { a: V3::from_f64(*a), b: V3::from_f64(*b), inv_size: f(1.0 / size) }
+        }
+    };
+    Mat {
+        paint,
+        ambient: f(m.ambient),
+        diffuse: f(m.diffuse),
+        specular: f(m.specular),
+        shininess: f(m.shininess),
+        reflect: f(m.reflect),
+        transparency: f(m.transparency),
+        ior: f(m.ior.max(1e-6)),
+    }
+}
+
+fn lamp<T: Float>(l: &Light) -> Lamp<T> {
+    match l {
+        Light::Point { position, color, intensity, radius, softness } => Lamp::Point {
+            position: V3::from_f64(*position),
+            color: V3::from_f64(*color) * T::from_f64(*intensity),
+            radius: T::from_f64(*radius),
+            softness: T::from_f64(*softness),
+        },
+        Light::Directional { direction, color, intensity, softness } => Lamp::Directional {
+            to_light: -V3::<T>::from_f64(*direction).normalize(),
+            color: V3::from_f64(*color) * T::from_f64(*intensity),
+            softness: T::from_f64(*softness),
+        },
+    }
+}

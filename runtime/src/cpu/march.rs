@@ -1,0 +1,236 @@
+//! The two marches of RENDERER.md: sphere tracing to the nearest surface (camera and
+//! secondary rays, with optional over-relaxation) and shadow rays (hard or soft, through
+//! transparent occluders).
+
+use super::context::Context;
+use super::lanes::{Lanes, Rule, DONE};
+use super::stats::Counters;
+use sdfc_compiler::eval::Float;
+
+/// How a traced ray ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(super) enum Status {
+    /// |d| < ε·t at t.
+    #[default]
+    Hit,
+    /// t went past `max_dist`.
+    Miss,
+    /// The step budget ran out.
+    Budget,
+    /// The field was NaN.
+    Nan,
+}
+
+/// The result of tracing one ray.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Traced<T> {
+    /// Distance along the ray of the hit (or where the march stopped).
+    pub t: T,
+    pub status: Status,
+    pub steps: u32,
+}
+
+/// Sphere tracing with Keinert et al.'s over-relaxation: step ω·d, and when the new
+/// unbounding sphere does not overlap the previous one (|d| + |d_prev| < step), step back
+/// and continue with ω = 1.
+#[derive(Debug)]
+pub(super) struct Trace<'a, T: Float> {
+    pub ctx: &'a Context<T>,
+    pub out: &'a mut [Traced<T>],
+    pub counters: &'a mut Counters,
+}
+
+// Flag bits an advance sets per lane, read back by its scan.
+const HIT: u32 = 2;
+const MISS: u32 = 4;
+const BUDGET: u32 = 8;
+const NAN: u32 = 16;
+const OVERSHOOT: u32 = 32;
+
+impl<T: Float> Rule<T> for Trace<'_, T> {
+    /// One branch-free pass over the lanes, then a scan of the flags for finished rays.
+    fn advance(&mut self, l: &mut Lanes<T>) {
+        let n = l.len;
+        let c = self.ctx;
+        let (one, zero) = (T::one(), T::zero());
+        let (inv_l, eps, max_dist, max_steps) = (c.inv_lipschitz, c.epsilon, c.max_dist, c.max_steps);
+        let (dist, sign, t0) = (&l.dist[..n], &l.sign[..n], &l.t0[..n]);
+        let (t, steps, flags) = (&mut l.t[..n], &mut l.steps[..n], &mut l.flags[..n]);
+        let (omega, prev, step) = (&mut l.omega[..n], &mut l.prev[..n], &mut l.step[..n]);
+        for k in 0..n {
+            let f = dist[k];
+            let s = sign[k] * f * inv_l;
+            let r = s.abs();
+            let tol = eps * (t0[k] + t[k]);
+            let om = omega[k];
+            let fail = (om > one) & (r + prev[k] < step[k]);
+            let st = if fail { step[k] - om * step[k] } else { s * om };
+            step[k] = st;
+            omega[k] = if fail { one } else { om };
+            prev[k] = r;
+            let hit = !fail & (r < tol);
+            let next = (t[k] + st).max(zero);
+            let count = steps[k] + 1;
+            steps[k] = count;
+            t[k] = if hit { t[k] } else { next };
+            flags[k] = (hit as u32) * HIT
+                | ((next > max_dist) as u32) * MISS
+                | ((count >= max_steps) as u32) * BUDGET
+                | ((f != f) as u32) * NAN
+                | ((s < -tol) as u32) * OVERSHOOT;
+        }
+        for k in 0..n {
+            let fl = l.flags[k];
+            if fl == 0 {
+                continue;
+            }
+            self.counters.overshoots += (fl & OVERSHOOT != 0) as u64;
+            let status = if fl & NAN != 0 {
+                self.counters.nans += 1;
+                Status::Nan
+            } else if fl & HIT != 0 {
+                Status::Hit
+            } else if fl & MISS != 0 {
+                Status::Miss
+            } else if fl & BUDGET != 0 {
+                Status::Budget
+            } else {
+                l.flags[k] = 0;
+                continue;
+            };
+            self.out[l.id[k] as usize] = Traced { t: l.t[k], status, steps: l.steps[k] };
+            l.flags[k] = DONE;
+        }
+    }
+}
+
+/// The result of one shadow ray: the fraction of the light that arrives, in [0, 1].
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Shadowed<T> {
+    pub light: T,
+    pub steps: u32,
+}
+
+/// Shadow rays towards a light at distance `tmax`. Soft (k > 0): res = min(res, k·d/t) along
+/// the ray. Reaching a surface: an opaque one blocks the light; a transparent one multiplies
+/// what passes by its transparency, and the ray goes on through the solid (marching -f) and
+/// out of it. Transparent solids cast no penumbra. Running out of steps counts as lit.
+#[derive(Debug)]
+pub(super) struct Shadow<'a, T: Float> {
+    pub ctx: &'a Context<T>,
+    pub out: &'a mut [Shadowed<T>],
+    pub counters: &'a mut Counters,
+}
+
+impl<T: Float> Shadow<'_, T> {
+    fn finish(&mut self, l: &mut Lanes<T>, k: usize, light: T) {
+        self.out[l.id[k] as usize] = Shadowed { light, steps: l.steps[k] };
+        l.flags[k] = DONE;
+    }
+
+    /// The light arriving at the end of lane `k`'s march.
+    fn arrived(l: &Lanes<T>, k: usize) -> T {
+        l.through[k] * l.res[k].clamp(T::zero(), T::one())
+    }
+
+    /// Opaque scenes: one branch-free pass, then a scan for finished rays.
+    fn advance_opaque(&mut self, l: &mut Lanes<T>) {
+        let n = l.len;
+        let c = self.ctx;
+        let zero = T::zero();
+        let (inv_l, eps, max_steps) = (c.inv_lipschitz, c.epsilon, c.max_steps);
+        let (dist, t0, kk, tmax) = (&l.dist[..n], &l.t0[..n], &l.k[..n], &l.tmax[..n]);
+        let (t, steps, flags, res) = (&mut l.t[..n], &mut l.steps[..n], &mut l.flags[..n], &mut l.res[..n]);
+        for k in 0..n {
+            let f = dist[k];
+            let s = f * inv_l;
+            let tol = eps * (t0[k] + t[k]);
+            let soft = (kk[k] > zero) & (t[k] > zero);
+            let penumbra = res[k].min(kk[k] * s / t[k]);
+            res[k] = if soft { penumbra } else { res[k] };
+            let blocked = s.abs() < tol;
+            let next = (t[k] + s).max(zero);
+            t[k] = next;
+            let count = steps[k] + 1;
+            steps[k] = count;
+            flags[k] = (blocked as u32) * HIT
+                | ((next >= tmax[k]) as u32) * MISS
+                | ((count >= max_steps) as u32) * BUDGET
+                | ((f != f) as u32) * NAN
+                | ((s < -tol) as u32) * OVERSHOOT;
+        }
+        for k in 0..n {
+            let fl = l.flags[k];
+            if fl == 0 {
+                continue;
+            }
+            self.counters.overshoots += (fl & OVERSHOOT != 0) as u64;
+            if fl & NAN != 0 {
+                self.counters.nans += 1;
+                self.finish(l, k, Self::arrived(l, k));
+            } else if fl & HIT != 0 {
+                self.finish(l, k, T::zero());
+            } else if fl & (MISS | BUDGET) != 0 {
+                self.finish(l, k, Self::arrived(l, k));
+            } else {
+                l.flags[k] = 0;
+            }
+        }
+    }
+
+    /// Scenes with transparent materials: lane by lane, looking at the nearest material.
+    fn step_transparent(&mut self, l: &mut Lanes<T>, k: usize) {
+        let c = self.ctx;
+        let f = l.dist[k];
+        let t = l.t[k];
+        l.flags[k] = 0;
+        l.steps[k] += 1;
+        if f.is_nan() {
+            self.counters.nans += 1;
+            return self.finish(l, k, Self::arrived(l, k));
+        }
+        let signed = l.sign[k] * f * c.inv_lipschitz;
+        let tt = l.t0[k] + t;
+        let tol = c.epsilon * tt;
+        if signed < -tol {
+            self.counters.overshoots += 1;
+        }
+        let tau = c.material(l.mat[k]).transparency;
+        let outside = l.sign[k] > T::zero();
+        if outside && l.k[k] > T::zero() && t > T::zero() && tau <= T::zero() {
+            l.res[k] = l.res[k].min(l.k[k] * signed / t);
+        }
+        let mut next = t + signed;
+        if signed.abs() < tol {
+            if tau <= T::zero() {
+                return self.finish(l, k, T::zero());
+            }
+            if outside {
+                l.through[k] = l.through[k] * tau;
+            }
+            l.sign[k] = -l.sign[k];
+            let p = super::vec::V3::new(l.px[k], l.py[k], l.pz[k]);
+            next = t + T::from_f64(4.0) * c.normal_step(tt, p);
+        }
+        l.t[k] = next.max(T::zero());
+        if l.t[k] >= l.tmax[k] || l.steps[k] >= c.max_steps {
+            self.finish(l, k, Self::arrived(l, k));
+        }
+    }
+}
+
+impl<T: Float> Rule<T> for Shadow<'_, T> {
+    fn needs_materials(&self) -> bool {
+        self.ctx.transparent
+    }
+
+    fn advance(&mut self, l: &mut Lanes<T>) {
+        if self.ctx.transparent {
+            for k in 0..l.len {
+                self.step_transparent(l, k);
+            }
+        } else {
+            self.advance_opaque(l);
+        }
+    }
+}

@@ -1,0 +1,136 @@
+//! The CPU renderer of RENDERER.md: sphere tracing of a distance program, evaluated by the
+//! batch interpreter, with Phong shading, hard and soft shadows, reflection and refraction.
+//!
+//! The image is cut into tiles rendered in parallel (rayon). Within a tile, rays travel in
+//! waves: all camera rays, then all the rays their hits spawned, and so on (no recursion).
+//! Each wave is marched in lanes of up to `Options::lanes` rays that are evaluated as one
+//! batch per step. A tile's result depends only on the tile, so the image is bit-identical
+//! whatever the number of threads. The choices RENDERER.md leaves open are written in
+//! `docs/rendering.md`.
+
+mod camera;
+mod context;
+mod lanes;
+mod march;
+mod shade;
+mod stats;
+mod tile;
+mod vec;
+
+pub use stats::{Counters, Stats};
+
+use crate::image::Image;
+use context::Context;
+use rayon::prelude::*;
+use sdfc_compiler::eval::Float;
+use sdfc_compiler::lower::Program;
+use sdfc_compiler::scene::{Scene, Settings};
+use tile::{Rect, Workspace};
+
+/// The float type a render runs in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Precision {
+    /// Single precision (the default of every backend).
+    #[default]
+    F32,
+    /// Double precision (the reference for accuracy measurements).
+    F64,
+}
+
+/// How the renderer works (not what it renders: that is the scene's settings).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// The Lipschitz bound L ≥ 1 of the field: steps are d / L.
+    pub lipschitz: f64,
+    /// Edge of a square tile, in pixels.
+    pub tile: u32,
+    /// Rays marched together.
+    pub lanes: usize,
+    /// Points per pass of the interpreter over the program.
+    pub chunk: usize,
+    /// Float type.
+    pub precision: Precision,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            lipschitz: 1.0,
+            tile: 16,
+            lanes: 256,
+            chunk: sdfc_compiler::eval::DEFAULT_CHUNK,
+            precision: Precision::F32,
+        }
+    }
+}
+
+/// A rendered image and its statistics.
+#[derive(Debug, Clone)]
+pub struct Render {
+    /// The linear image.
+    pub image: Image,
+    /// What happened while rendering it.
+    pub stats: Stats,
+}
+
+/// The tiles of an image, row-major.
+fn tiles(settings: &Settings, edge: u32) -> Vec<Rect> {
+    let edge = edge.max(1);
+    let mut out = Vec::new();
+    for y in (0..settings.height).step_by(edge as usize) {
+        for x in (0..settings.width).step_by(edge as usize) {
+            out.push(Rect { x, y, w: edge.min(settings.width - x), h: edge.min(settings.height - y) });
+        }
+    }
+    out
+}
+
+/// Number of tiles a render of `settings` is cut into (for progress reporting).
+pub fn tile_count(settings: &Settings, options: &Options) -> u64 {
+    tiles(settings, options.tile).len() as u64
+}
+
+/// Renders `scene` (whose distance program is `program`) on the current rayon pool, calling
+/// `progress` once per finished tile, in `options.precision`.
+pub fn render(scene: &Scene, program: &Program, options: &Options, progress: &(dyn Fn() + Sync)) -> Render {
+    match options.precision {
+        Precision::F32 => render_in::<f32>(scene, program, options, progress),
+        Precision::F64 => render_in::<f64>(scene, program, options, progress),
+    }
+}
+
+/// [`render`] in the float type `T`.
+pub fn render_in<T: Float>(scene: &Scene, program: &Program, options: &Options, progress: &(dyn Fn() + Sync)) -> Render {
+    let ctx = Context::<T>::new(scene, program, options.lipschitz);
+    let rects = tiles(&scene.settings, options.tile);
+    let outs: Vec<tile::TileOut> = rects
+        .par_iter()
+        .map_init(
+            || Workspace::new(&ctx, options.lanes, options.chunk),
+            |ws, &rect| {
+                let out = tile::render(&ctx, ws, rect);
+                progress();
+                out
+            },
+        )
+        .collect();
+    assemble(&scene.settings, &rects, &outs)
+}
+
+/// Puts the tiles together into the image and the statistics.
+fn assemble(settings: &Settings, rects: &[Rect], outs: &[tile::TileOut]) -> Render {
+    let mut image = Image::new(settings.width, settings.height);
+    let mut steps = vec![0u32; image.linear.len()];
+    let mut counters = Counters::default();
+    for (rect, out) in rects.iter().zip(outs) {
+        counters.add(&out.counters);
+        for row in 0..rect.h {
+            let dst = ((rect.y + row) * settings.width + rect.x) as usize;
+            let src = (row * rect.w) as usize;
+            let n = rect.w as usize;
+            image.linear[dst..dst + n].copy_from_slice(&out.pixels[src..src + n]);
+            steps[dst..dst + n].copy_from_slice(&out.steps[src..src + n]);
+        }
+    }
+    Render { image, stats: Stats::new(counters, &steps) }
+}

@@ -1,0 +1,299 @@
+//! One wave of rays: trace them, take the normal and material at each hit, light the hits
+//! (Phong with shadow rays) and spawn the next wave of reflected and refracted rays.
+
+use super::context::{Context, Lamp, Mat, Paint};
+use super::lanes::{march, Launch};
+use super::march::{Shadow, Shadowed, Status, Trace, Traced};
+use super::stats::Counters;
+use super::tile::{Ray, Workspace};
+use super::vec::V3;
+use sdfc_compiler::eval::Float;
+
+/// A surface point reached by a ray of the wave.
+#[derive(Debug, Clone, Copy)]
+struct Hit<T> {
+    /// Index of the ray in the wave.
+    ray: usize,
+    p: V3<T>,
+    /// Unit outward normal (gradient of f).
+    n: V3<T>,
+    /// Path length of the pixel's ray up to `p`.
+    tt: T,
+    /// Normal step h; offsets from the surface are 4h.
+    h: T,
+    mat: u32,
+}
+
+/// Traces `wave`, adds what it sees to `acc` (per sample), and returns the next wave.
+pub(super) fn bounce<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    wave: &[Ray<T>],
+    acc: &mut [V3<T>],
+    steps: &mut [u32],
+    counters: &mut Counters,
+) -> Vec<Ray<T>> {
+    trace(ctx, ws, wave, counters);
+    let mut hits = Vec::new();
+    for (i, (ray, tr)) in wave.iter().zip(&ws.traced).enumerate() {
+        steps[ray.sample as usize] += tr.steps;
+        counters.steps += tr.steps as u64;
+        match tr.status {
+            Status::Hit => {
+                counters.hits += 1;
+                let p = ray.origin + ray.dir * tr.t;
+                let tt = ray.t0 + tr.t;
+                let h = ctx.normal_step(tt, p);
+                hits.push(Hit { ray: i, p, n: V3::zero(), tt, h, mat: 0 });
+                continue;
+            }
+            Status::Miss => counters.misses += 1,
+            Status::Budget => counters.budget_misses += 1,
+            Status::Nan => {}
+        }
+        let a = &mut acc[ray.sample as usize];
+        *a = *a + ray.weight.mul_v(ctx.background);
+    }
+    normals(ws, wave, &mut hits);
+    materials(ctx, ws, &mut hits);
+    light(ctx, ws, wave, &hits, acc, steps, counters);
+    let next = spawn(ctx, wave, &hits);
+    counters.secondary_rays += next.len() as u64;
+    next
+}
+
+/// Sphere-traces every ray of the wave into `ws.traced`.
+fn trace<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, wave: &[Ray<T>], counters: &mut Counters) {
+    ws.launches.clear();
+    ws.launches.extend(wave.iter().enumerate().map(|(i, r)| Launch {
+        id: i as u32,
+        origin: [r.origin.x, r.origin.y, r.origin.z],
+        dir: [r.dir.x, r.dir.y, r.dir.z],
+        t0: r.t0,
+        sign: if r.inside { -T::one() } else { T::one() },
+        tmax: ctx.max_dist,
+        k: T::zero(),
+        omega: ctx.relaxation,
+    }));
+    ws.traced.clear();
+    ws.traced.resize(wave.len(), Traced::default());
+    let mut rule = Trace { ctx, out: &mut ws.traced, counters };
+    march(&mut ws.lanes, &mut ws.dist, &mut ws.full, &ws.launches, &mut rule);
+}
+
+/// The tetrahedron's corners k_i for the 4-tap gradient.
+const TETRA: [[f64; 3]; 4] = [[1.0, -1.0, -1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, 1.0, 1.0]];
+
+/// N = normalize(Σ k_i f(p + h·k_i)); a degenerate gradient gives -D.
+fn normals<T: Float>(ws: &mut Workspace<'_, T>, wave: &[Ray<T>], hits: &mut [Hit<T>]) {
+    let n = hits.len() * 4;
+    for v in [&mut ws.x, &mut ws.y, &mut ws.z, &mut ws.d] {
+        v.clear();
+        v.resize(n, T::zero());
+    }
+    for (i, hit) in hits.iter().enumerate() {
+        for (j, k) in TETRA.iter().enumerate() {
+            let q = hit.p + V3::from_f64(*k) * hit.h;
+            (ws.x[4 * i + j], ws.y[4 * i + j], ws.z[4 * i + j]) = (q.x, q.y, q.z);
+        }
+    }
+    ws.dist.eval(&ws.x, &ws.y, &ws.z, &mut ws.d, None);
+    for (i, hit) in hits.iter_mut().enumerate() {
+        let g = TETRA.iter().enumerate().fold(V3::zero(), |g, (j, k)| g + V3::from_f64(*k) * ws.d[4 * i + j]);
+        let l = g.length();
+        hit.n = if l > T::zero() && !l.is_nan() { g * (T::one() / l) } else { -wave[hit.ray].dir };
+    }
+}
+
+/// The material id at each hit (all 0 when the scene has one material).
+fn materials<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, hits: &mut [Hit<T>]) {
+    if ctx.materials.len() <= 1 || hits.is_empty() {
+        return;
+    }
+    let n = hits.len();
+    for v in [&mut ws.x, &mut ws.y, &mut ws.z, &mut ws.d] {
+        v.clear();
+        v.resize(n, T::zero());
+    }
+    ws.m.clear();
+    ws.m.resize(n, 0);
+    for (i, hit) in hits.iter().enumerate() {
+        (ws.x[i], ws.y[i], ws.z[i]) = (hit.p.x, hit.p.y, hit.p.z);
+    }
+    ws.full.eval(&ws.x, &ws.y, &ws.z, &mut ws.d, Some(&mut ws.m));
+    for (hit, &m) in hits.iter_mut().zip(&ws.m) {
+        hit.mat = m;
+    }
+}
+
+/// The colour of a material at p. A checker is the parity of ⌊x/s⌋ + ⌊y/s⌋ + ⌊z/s⌋ (even:
+/// first colour), sampled at p - 2h·N, just inside the surface, so that a face lying on a
+/// checker boundary does not flicker between the two colours.
+fn colour<T: Float>(m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
+    match m.paint {
+        Paint::Solid(c) => c,
+        Paint::Checker { a, b, inv_size } => {
+            let q = (hit.p - hit.n * (T::from_f64(2.0) * hit.h)) * inv_size;
+            let s = q.x.floor() + q.y.floor() + q.z.floor();
+            let two = T::from_f64(2.0);
+            let odd = s - two * (s / two).floor();
+            if odd > T::zero() {
+                b
+            } else {
+                a
+            }
+        }
+    }
+}
+
+/// Direction to the light, its distance (max_dist for a directional light) and its
+/// attenuation. Point lights fall off as (1 - (d/r)²)² clamped to [0, 1], reaching 0 at the
+/// radius r (a radius ≤ 0 or infinite means no falloff).
+fn towards<T: Float>(ctx: &Context<T>, lamp: &Lamp<T>, p: V3<T>) -> (V3<T>, T, T) {
+    match *lamp {
+        Lamp::Point { position, radius, .. } => {
+            let v = position - p;
+            let d = v.length();
+            let atten = if radius > T::zero() {
+                let x = d / radius;
+                let f = (T::one() - x * x).clamp(T::zero(), T::one());
+                f * f
+            } else {
+                T::one()
+            };
+            (v * (T::one() / d), d, atten)
+        }
+        Lamp::Directional { to_light, .. } => (to_light, ctx.max_dist, T::one()),
+    }
+}
+
+fn lamp_colour<T: Float>(lamp: &Lamp<T>) -> (V3<T>, T) {
+    match *lamp {
+        Lamp::Point { color, softness, .. } | Lamp::Directional { color, softness, .. } => (color, softness),
+    }
+}
+
+/// Phong at every hit seen from outside, with one shadow ray per (hit, light) that can
+/// contribute: I = k_a·C + Σ shadow·atten·(k_d·max(N·L, 0)·C·I_l + k_s·max(R·V, 0)^α·I_l),
+/// added to the sample with the weight (1 - r - τ).
+fn light<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    wave: &[Ray<T>],
+    hits: &[Hit<T>],
+    acc: &mut [V3<T>],
+    steps: &mut [u32],
+    counters: &mut Counters,
+) {
+    let mut local: Vec<(usize, V3<T>)> = Vec::new();
+    let mut pending: Vec<(usize, V3<T>)> = Vec::new();
+    ws.launches.clear();
+    for (hi, hit) in hits.iter().enumerate() {
+        let ray = &wave[hit.ray];
+        let m = ctx.material(hit.mat);
+        let w = T::one() - m.reflect - m.transparency;
+        if ray.inside || w <= T::zero() {
+            continue;
+        }
+        let c = colour(m, hit);
+        local.push((hi, c * m.ambient));
+        for lamp in &ctx.lamps {
+            let (l, dist, atten) = towards(ctx, lamp, hit.p);
+            let ndl = hit.n.dot(l);
+            if ndl <= T::zero() || atten <= T::zero() {
+                continue;
+            }
+            let (il, k) = lamp_colour(lamp);
+            let r = hit.n * (T::from_f64(2.0) * ndl) - l;
+            let rv = r.dot(-ray.dir).max(T::zero());
+            let spec = m.specular * rv.powf(m.shininess);
+            let contrib = (c * (m.diffuse * ndl) + V3::splat(spec)).mul_v(il) * atten;
+            let off = T::from_f64(4.0) * hit.h;
+            let o = hit.p + hit.n * off;
+            let tmax = if matches!(lamp, Lamp::Point { .. }) { dist - off } else { dist };
+            ws.launches.push(Launch {
+                id: pending.len() as u32,
+                origin: [o.x, o.y, o.z],
+                dir: [l.x, l.y, l.z],
+                t0: hit.tt,
+                sign: T::one(),
+                tmax,
+                k,
+                omega: T::one(),
+            });
+            pending.push((hi, contrib));
+        }
+    }
+    counters.shadow_rays += pending.len() as u64;
+    ws.shadowed.clear();
+    ws.shadowed.resize(pending.len(), Shadowed::default());
+    let mut rule = Shadow { ctx, out: &mut ws.shadowed, counters };
+    march(&mut ws.lanes, &mut ws.dist, &mut ws.full, &ws.launches, &mut rule);
+    let mut lit: Vec<V3<T>> = vec![V3::zero(); hits.len()];
+    for (&(hi, contrib), s) in pending.iter().zip(&ws.shadowed) {
+        lit[hi] = lit[hi] + contrib * s.light;
+        steps[wave[hits[hi].ray].sample as usize] += s.steps;
+        counters.steps += s.steps as u64;
+    }
+    for (hi, ambient) in local {
+        let hit = &hits[hi];
+        let ray = &wave[hit.ray];
+        let m = ctx.material(hit.mat);
+        let w = T::one() - m.reflect - m.transparency;
+        let a = &mut acc[ray.sample as usize];
+        *a = *a + (ambient + lit[hi]).mul_v(ray.weight) * w;
+    }
+}
+
+/// The transmitted direction through a surface of normal `n` (facing the incoming ray) with
+/// ratio of indices `eta`, or `None` on total internal reflection.
+fn refract<T: Float>(d: V3<T>, n: V3<T>, eta: T) -> Option<V3<T>> {
+    let cosi = -d.dot(n);
+    let k = T::one() - eta * eta * (T::one() - cosi * cosi);
+    if k < T::zero() {
+        None
+    } else {
+        Some((d * eta + n * (eta * cosi - k.sqrt())).normalize())
+    }
+}
+
+/// The next wave. From outside: a reflection (weight r) and a refraction into the solid
+/// (weight τ). From inside (an exit): the refraction out, or on total internal reflection
+/// the reflection back inside, with the ray's whole weight. Only below `max_depth`.
+fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ray<T>> {
+    let mut next = Vec::new();
+    for hit in hits {
+        let ray = &wave[hit.ray];
+        if ray.depth >= ctx.max_depth {
+            continue;
+        }
+        let m = ctx.material(hit.mat);
+        let off = hit.n * (T::from_f64(4.0) * hit.h);
+        let child = |origin: V3<T>, dir: V3<T>, weight: V3<T>, inside: bool| Ray {
+            origin,
+            dir,
+            t0: hit.tt,
+            weight,
+            sample: ray.sample,
+            depth: ray.depth + 1,
+            inside,
+        };
+        if ray.inside {
+            match refract(ray.dir, -hit.n, m.ior) {
+                Some(t) => next.push(child(hit.p + off, t, ray.weight, false)),
+                None => next.push(child(hit.p - off, ray.dir.reflect(hit.n), ray.weight, true)),
+            }
+            continue;
+        }
+        if m.reflect > T::zero() {
+            next.push(child(hit.p + off, ray.dir.reflect(hit.n), ray.weight * m.reflect, false));
+        }
+        if m.transparency > T::zero() {
+            match refract(ray.dir, hit.n, T::one() / m.ior) {
+                Some(t) => next.push(child(hit.p - off, t, ray.weight * m.transparency, true)),
+                None => next.push(child(hit.p + off, ray.dir.reflect(hit.n), ray.weight * m.transparency, false)),
+            }
+        }
+    }
+    next
+}

@@ -1,0 +1,127 @@
+//! One tile of the image: its camera rays, the waves of secondary rays they spawn, and the
+//! per-thread workspace the waves run in.
+
+use super::context::Context;
+use super::lanes::{Lanes, Launch};
+use super::march::{Shadowed, Traced};
+use super::shade;
+use super::stats::Counters;
+use super::vec::V3;
+use sdfc_compiler::eval::{Evaluator, Float};
+
+/// A ray waiting to be traced, with what it contributes to.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Ray<T> {
+    pub origin: V3<T>,
+    pub dir: V3<T>,
+    /// Path length of the pixel's ray before this segment.
+    pub t0: T,
+    /// The colour weight this ray's result is added with.
+    pub weight: V3<T>,
+    /// The sample (index within the tile) it belongs to.
+    pub sample: u32,
+    /// 0 for camera rays, +1 per bounce.
+    pub depth: u32,
+    /// Whether it travels inside a solid (marching -f).
+    pub inside: bool,
+}
+
+/// A pixel rectangle.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Rect {
+    pub x: u32,
+    pub y: u32,
+    pub w: u32,
+    pub h: u32,
+}
+
+/// What a tile produces.
+#[derive(Debug)]
+pub(super) struct TileOut {
+    /// Linear colours, row-major within the tile.
+    pub pixels: Vec<[f32; 3]>,
+    /// Marching steps per pixel.
+    pub steps: Vec<u32>,
+    pub counters: Counters,
+}
+
+/// Scratch space of one thread: evaluators, lanes and buffers, reused from tile to tile.
+#[derive(Debug)]
+pub(super) struct Workspace<'t, T: Float> {
+    pub dist: Evaluator<'t, T>,
+    pub full: Evaluator<'t, T>,
+    pub lanes: Lanes<T>,
+    pub launches: Vec<Launch<T>>,
+    pub traced: Vec<Traced<T>>,
+    pub shadowed: Vec<Shadowed<T>>,
+    pub x: Vec<T>,
+    pub y: Vec<T>,
+    pub z: Vec<T>,
+    pub d: Vec<T>,
+    pub m: Vec<u32>,
+}
+
+impl<'t, T: Float> Workspace<'t, T> {
+    pub fn new(ctx: &'t Context<T>, lanes: usize, chunk: usize) -> Self {
+        Workspace {
+            dist: Evaluator::new(&ctx.distance_tape, chunk),
+            full: Evaluator::new(&ctx.full_tape, chunk),
+            lanes: Lanes::new(lanes.max(1)),
+            launches: Vec::new(),
+            traced: Vec::new(),
+            shadowed: Vec::new(),
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            d: Vec::new(),
+            m: Vec::new(),
+        }
+    }
+}
+
+/// Renders one tile.
+pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect: Rect) -> TileOut {
+    let spp = ctx.camera.samples_per_pixel();
+    let samples = (rect.w * rect.h * spp) as usize;
+    let mut acc = vec![V3::zero(); samples];
+    let mut steps = vec![0u32; samples];
+    let mut counters = Counters::default();
+    let mut wave = camera_rays(ctx, rect);
+    counters.camera_rays = wave.len() as u64;
+    while !wave.is_empty() {
+        wave = shade::bounce(ctx, ws, &wave, &mut acc, &mut steps, &mut counters);
+    }
+    let scale = T::one() / T::from_f64(spp as f64);
+    let chunk = spp as usize;
+    let pixels = acc
+        .chunks(chunk)
+        .map(|s| {
+            let sum = s.iter().fold(V3::zero(), |a, &c| a + c) * scale;
+            [sum.x.to_f64() as f32, sum.y.to_f64() as f32, sum.z.to_f64() as f32]
+        })
+        .collect();
+    let steps = steps.chunks(chunk).map(|s| s.iter().sum()).collect();
+    TileOut { pixels, steps, counters }
+}
+
+/// One ray per sample, pixels row-major, samples row-major within the pixel.
+fn camera_rays<T: Float>(ctx: &Context<T>, rect: Rect) -> Vec<Ray<T>> {
+    let spp = ctx.camera.samples_per_pixel();
+    let mut rays = Vec::with_capacity((rect.w * rect.h * spp) as usize);
+    for y in rect.y..rect.y + rect.h {
+        for x in rect.x..rect.x + rect.w {
+            for s in 0..spp {
+                rays.push(Ray {
+                    origin: ctx.camera.origin(),
+                    dir: ctx.camera.direction(x, y, s),
+                    t0: T::zero(),
+                    weight: V3::splat(T::one()),
+                    sample: rays.len() as u32,
+                    depth: 0,
+                    inside: false,
+                });
+            }
+        }
+    }
+    rays
+}

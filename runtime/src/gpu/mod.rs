@@ -1,0 +1,69 @@
+//! GPU targets: the WGSL kernel launched through wgpu. The result has the CPU renderer's
+//! shape (an image and the same statistics) so that every backend is compared the same way.
+
+pub mod wgpu;
+
+use crate::cpu::{Counters, Render, Stats};
+use crate::image::Image;
+use sdfc_compiler::back::wgsl::{self, Kernel, STATS_WORDS};
+use sdfc_compiler::scene::Scene;
+use std::time::Duration;
+
+pub use self::wgpu::{Error, Gpu};
+
+/// Tile edge in pixels for GPU launches: 256×256 pixels per dispatch keeps each dispatch
+/// short (well under a driver watchdog's limit) while filling a large GPU.
+pub const TILE: u32 = 256;
+
+/// A GPU render and how long the GPU spent on it.
+#[derive(Debug, Clone)]
+pub struct GpuRender {
+    /// Image and statistics.
+    pub render: Render,
+    /// Time of the dispatches (GPU timestamps where the adapter has them, else wall time).
+    pub time: Duration,
+    /// Whether `time` comes from GPU timestamps.
+    pub timestamps: bool,
+}
+
+/// Renders `scene` with an already generated kernel on `gpu`.
+pub fn render(gpu: &Gpu, scene: &Scene, kernel: &Kernel, lipschitz: f64, progress: &mut dyn FnMut(f64)) -> Result<GpuRender, Error> {
+    let s = &scene.settings;
+    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let launch = self::wgpu::Launch {
+        wgsl: &kernel.source,
+        entry: wgsl::ENTRY_POINT,
+        uniforms: &uniforms,
+        width: s.width,
+        height: s.height,
+        stats_words: STATS_WORDS,
+        workgroup: wgsl::WORKGROUP,
+        tile: TILE,
+    };
+    let frame = gpu.render(&launch, progress)?;
+    let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
+    let image = Image { width: s.width, height: s.height, linear: frame.linear };
+    Ok(GpuRender {
+        render: Render { image, stats },
+        time: frame.gpu_time.unwrap_or(frame.wall_time),
+        timestamps: frame.gpu_time.is_some(),
+    })
+}
+
+/// Sums the kernel's per-pixel statistics words into the CPU renderer's statistics.
+pub fn stats(words: &[u32], pixels: u64, aa: u32) -> Stats {
+    let mut c = Counters { camera_rays: pixels * (aa.max(1) as u64).pow(2), ..Counters::default() };
+    let mut steps = Vec::with_capacity(pixels as usize);
+    for w in words.chunks_exact(STATS_WORDS as usize) {
+        steps.push(w[0]);
+        c.steps += w[0] as u64;
+        c.hits += w[1] as u64;
+        c.misses += w[2] as u64;
+        c.budget_misses += w[3] as u64;
+        c.overshoots += w[4] as u64;
+        c.nans += w[5] as u64;
+        c.secondary_rays += w[6] as u64;
+        c.shadow_rays += w[7] as u64;
+    }
+    Stats::new(c, &steps)
+}

@@ -1,0 +1,335 @@
+//! The wgpu launcher: finds an adapter, builds the kernel's compute pipeline, and renders an
+//! image in tiles (one dispatch each, so that no dispatch runs long enough to trip a driver
+//! watchdog), reading back the linear colours and the per-pixel statistics.
+
+use std::time::{Duration, Instant};
+
+/// What can go wrong on the wgpu path.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// No adapter (or, when a GPU is required, no hardware adapter) was found.
+    #[error("no {what} adapter found by wgpu: install a Vulkan, Metal or DX12 driver (on Linux without a GPU, Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`)")]
+    NoAdapter {
+        /// "GPU" or "wgpu".
+        what: &'static str,
+    },
+    /// The adapter refused the device request.
+    #[error("the adapter `{adapter}` refused to open a device: {message}")]
+    Device { adapter: String, message: String },
+    /// wgpu rejected the shader or pipeline (a compiler bug: the kernel was validated by naga).
+    #[error("wgpu rejected the kernel: {0}")]
+    Pipeline(String),
+    /// The device reported an error while rendering (out of memory, device lost, …).
+    #[error("GPU error while rendering: {0}")]
+    Render(String),
+}
+
+/// Bytes between tile entries in the tile table (the largest uniform offset alignment).
+const TILE_STRIDE: u32 = 256;
+/// Tiles per queue submission.
+const TILES_PER_SUBMIT: usize = 8;
+
+/// An opened device.
+#[derive(Debug)]
+pub struct Gpu {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    timestamps: bool,
+}
+
+/// Per-pixel results of a render.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    /// Linear RGB per pixel, row-major.
+    pub linear: Vec<[f32; 3]>,
+    /// The kernel's statistics words per pixel, `stats_words` of them per pixel.
+    pub stats: Vec<u32>,
+    /// GPU time of the dispatches measured with timestamps, where the adapter has them.
+    pub gpu_time: Option<Duration>,
+    /// Wall time from the first submit to the last readback.
+    pub wall_time: Duration,
+}
+
+/// A compiled kernel ready to launch: its WGSL, entry point and uniform bytes.
+#[derive(Debug, Clone, Copy)]
+pub struct Launch<'a> {
+    /// WGSL source (validated by the compiler).
+    pub wgsl: &'a str,
+    /// Entry point name.
+    pub entry: &'a str,
+    /// Bytes of the scene uniform (binding 0).
+    pub uniforms: &'a [u8],
+    /// Image size.
+    pub width: u32,
+    pub height: u32,
+    /// Statistics words written per pixel (binding 3).
+    pub stats_words: u32,
+    /// Workgroup edge of the kernel (it is square).
+    pub workgroup: u32,
+    /// Tile edge in pixels.
+    pub tile: u32,
+}
+
+impl Gpu {
+    /// Opens the first adapter wgpu finds. With `require_hardware`, a CPU adapter (lavapipe)
+    /// does not count.
+    pub fn open(require_hardware: bool) -> Result<Gpu, Error> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
+            wgpu::DeviceType::DiscreteGpu => 0,
+            wgpu::DeviceType::IntegratedGpu => 1,
+            wgpu::DeviceType::VirtualGpu => 2,
+            wgpu::DeviceType::Other => 3,
+            wgpu::DeviceType::Cpu => 4,
+        };
+        let adapter = adapters
+            .into_iter()
+            .filter(|a| !require_hardware || a.get_info().device_type != wgpu::DeviceType::Cpu)
+            .min_by_key(rank)
+            .ok_or(Error::NoAdapter { what: if require_hardware { "GPU" } else { "wgpu" } })?;
+        let info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let features = if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+        let limits = wgpu::Limits { max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size, ..wgpu::Limits::default() }
+            .using_resolution(adapter.limits());
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("sdfc"),
+            required_features: features,
+            required_limits: limits,
+            ..Default::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
+            .map_err(|e| Error::Device { adapter: info.name.clone(), message: e.to_string() })?;
+        Ok(Gpu { device, queue, info, timestamps })
+    }
+
+    /// The adapter's name and backend, e.g. `NVIDIA H100 (Vulkan)`.
+    pub fn describe(&self) -> String {
+        format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
+    }
+
+    /// True for a software adapter such as lavapipe.
+    pub fn is_cpu(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Renders one frame. `progress` is called with the fraction done after each tile.
+    pub fn render(&self, l: &Launch, progress: &mut dyn FnMut(f64)) -> Result<Frame, Error> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let pipeline = self.pipeline(l);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Pipeline(e.to_string()));
+        }
+        let pixels = l.width as u64 * l.height as u64;
+        let tiles = tiles(l.width, l.height, l.tile);
+        let buffers = self.buffers(l, pixels, tiles.len() as u64);
+        let bind = self.bind_group(&pipeline.1, &buffers);
+        let pipeline = pipeline.0;
+        let queries = self.timestamps.then(|| {
+            self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("sdfc timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * tiles.len() as u32,
+            })
+        });
+        let mem_scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let table: Vec<u8> = tiles.iter().flat_map(|t| {
+            let mut entry = words(&[t.0, t.1, t.2, t.3]);
+            entry.resize(TILE_STRIDE as usize, 0);
+            entry
+        }).collect();
+        self.queue.write_buffer(&buffers.tile, 0, &table);
+        let start = Instant::now();
+        // Tiles are submitted in batches: each tile is its own dispatch, and the host waits
+        // after each batch (progress, and a bound on how much work is queued at once).
+        for (b, batch) in tiles.chunks(TILES_PER_SUBMIT).enumerate() {
+            let mut enc = self.device.create_command_encoder(&Default::default());
+            for (j, t) in batch.iter().enumerate() {
+                let i = (b * TILES_PER_SUBMIT + j) as u32;
+                let writes = queries.as_ref().map(|q| wgpu::ComputePassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(2 * i),
+                    end_of_pass_write_index: Some(2 * i + 1),
+                });
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: writes });
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &bind, &[i * TILE_STRIDE]);
+                pass.dispatch_workgroups(t.2.div_ceil(l.workgroup), t.3.div_ceil(l.workgroup), 1);
+            }
+            self.queue.submit([enc.finish()]);
+            self.wait()?;
+            progress(((b * TILES_PER_SUBMIT + batch.len()) as f64 / tiles.len() as f64).min(1.0));
+        }
+        let linear = self.read(&buffers.image, pixels * 16)?;
+        let stats = self.read(&buffers.stats, pixels * 4 * l.stats_words as u64)?;
+        let wall_time = start.elapsed();
+        if let Some(e) = pollster::block_on(mem_scope.pop()) {
+            return Err(Error::Render(e.to_string()));
+        }
+        let gpu_time = match &queries {
+            Some(q) => Some(self.gpu_time(q, tiles.len() as u32)?),
+            None => None,
+        };
+        let floats: Vec<f32> = linear.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        let linear = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
+        let stats = stats.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        Ok(Frame { linear, stats, gpu_time, wall_time })
+    }
+
+    /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
+    /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage).
+    fn pipeline(&self, l: &Launch) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("sdfc kernel"),
+            source: wgpu::ShaderSource::Wgsl(l.wgsl.into()),
+        });
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty,
+            count: None,
+        };
+        let uniform = |dynamic| wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: None,
+        };
+        let storage = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let layout = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sdfc bindings"),
+            entries: &[entry(0, uniform(false)), entry(1, uniform(true)), entry(2, storage), entry(3, storage)],
+        });
+        let pipeline_layout = self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("sdfc layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("sdfc render"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(l.entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        (pipeline, layout)
+    }
+
+    fn buffers(&self, l: &Launch, pixels: u64, tiles: u64) -> Buffers {
+        use wgpu::BufferUsages as U;
+        let make = |label, size: u64, usage| {
+            self.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
+        };
+        let uniforms = make("sdfc scene", l.uniforms.len() as u64, U::UNIFORM | U::COPY_DST);
+        self.queue.write_buffer(&uniforms, 0, l.uniforms);
+        Buffers {
+            uniforms,
+            tile: make("sdfc tiles", tiles * TILE_STRIDE as u64, U::UNIFORM | U::COPY_DST),
+            image: make("sdfc image", pixels * 16, U::STORAGE | U::COPY_SRC),
+            stats: make("sdfc stats", pixels * 4 * l.stats_words as u64, U::STORAGE | U::COPY_SRC),
+        }
+    }
+
+    fn bind_group(&self, layout: &wgpu::BindGroupLayout, b: &Buffers) -> wgpu::BindGroup {
+        let tile = wgpu::BufferBinding { buffer: &b.tile, offset: 0, size: std::num::NonZeroU64::new(16) };
+        let entries = [
+            wgpu::BindGroupEntry { binding: 0, resource: b.uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Buffer(tile) },
+            wgpu::BindGroupEntry { binding: 2, resource: b.image.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 3, resource: b.stats.as_entire_binding() },
+        ];
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sdfc bindings"),
+            layout,
+            entries: &entries,
+        })
+    }
+
+    fn wait(&self) -> Result<(), Error> {
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Render(e.to_string()))
+    }
+
+    fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sdfc readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        let slice = staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv()
+            .map_err(|e| Error::Render(e.to_string()))?
+            .map_err(|e| Error::Render(e.to_string()))?;
+        let bytes = slice.get_mapped_range().map_err(|e| Error::Render(e.to_string()))?.to_vec();
+        staging.unmap();
+        Ok(bytes)
+    }
+
+    fn gpu_time(&self, q: &wgpu::QuerySet, tiles: u32) -> Result<Duration, Error> {
+        let n = 2 * tiles as u64;
+        let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sdfc timestamps"),
+            size: n * 8,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.resolve_query_set(q, 0..n as u32, &resolve, 0);
+        self.queue.submit([enc.finish()]);
+        let bytes = self.read(&resolve, n * 8)?;
+        let ticks: Vec<u64> = bytes.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect();
+        let period = self.queue.get_timestamp_period() as f64;
+        let total: u64 = ticks.chunks_exact(2).map(|p| p[1].saturating_sub(p[0])).sum();
+        Ok(Duration::from_nanos((total as f64 * period) as u64))
+    }
+}
+
+struct Buffers {
+    uniforms: wgpu::Buffer,
+    tile: wgpu::Buffer,
+    image: wgpu::Buffer,
+    stats: wgpu::Buffer,
+}
+
+/// Splits the image into tiles (x, y, width, height) of at most `edge` pixels a side.
+pub fn tiles(width: u32, height: u32, edge: u32) -> Vec<(u32, u32, u32, u32)> {
+    let edge = edge.max(8);
+    let mut out = Vec::new();
+    for y in (0..height).step_by(edge as usize) {
+        for x in (0..width).step_by(edge as usize) {
+            out.push((x, y, edge.min(width - x), edge.min(height - y)));
+        }
+    }
+    out
+}
+
+fn words(w: &[u32]) -> Vec<u8> {
+    w.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tiles;
+
+    #[test]
+    fn tiles_cover_the_image_once() {
+        let t = tiles(100, 70, 32);
+        assert_eq!(t.len(), 4 * 3);
+        let area: u32 = t.iter().map(|t| t.2 * t.3).sum();
+        assert_eq!(area, 100 * 70);
+    }
+}

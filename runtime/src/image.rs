@@ -1,0 +1,118 @@
+//! Images: linear float buffers, sRGB encoding and atomic PNG output.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A linear-RGB image, row-major from the top-left pixel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear colour of each pixel (not clamped).
+    pub linear: Vec<[f32; 3]>,
+}
+
+/// Why an image could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    /// The PNG encoder refused the image.
+    #[error("PNG encoding failed: {0}")]
+    Encode(String),
+    /// Creating, writing or renaming the file failed.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+}
+
+impl Image {
+    /// A black image.
+    pub fn new(width: u32, height: u32) -> Self {
+        Image { width, height, linear: vec![[0.0; 3]; width as usize * height as usize] }
+    }
+
+    /// The linear colour of pixel (x, y).
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 3] {
+        self.linear[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Clamped, sRGB-encoded RGBA8 bytes (alpha 255).
+    pub fn to_rgba8(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.linear.len() * 4);
+        for c in &self.linear {
+            out.extend_from_slice(&[srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255]);
+        }
+        out
+    }
+
+    /// The image as PNG file bytes (RGBA8, sRGB).
+    pub fn encode_png(&self) -> Result<Vec<u8>, ImageError> {
+        let mut bytes = Vec::new();
+        let mut encoder = png::Encoder::new(&mut bytes, self.width, self.height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        let mut writer = encoder.write_header().map_err(|e| ImageError::Encode(e.to_string()))?;
+        writer.write_image_data(&self.to_rgba8()).map_err(|e| ImageError::Encode(e.to_string()))?;
+        writer.finish().map_err(|e| ImageError::Encode(e.to_string()))?;
+        Ok(bytes)
+    }
+}
+
+/// A linear value clamped to [0, 1] and encoded with the sRGB transfer function (NaN is 0).
+pub fn srgb_encode(c: f32) -> u8 {
+    let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
+    let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Writes `image` as a PNG file, atomically (see [`write_atomic`]).
+pub fn write_png(path: &Path, image: &Image) -> Result<(), ImageError> {
+    let bytes = image.encode_png()?;
+    write_atomic(path, &bytes)?;
+    Ok(())
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so
+/// that `path` is either untouched or complete; the temporary file is removed on failure.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let tmp = temp_path(path);
+    let result = write_then_rename(&tmp, path, bytes);
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+fn write_then_rename(tmp: &Path, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(tmp)?;
+    file.write_all(bytes)?;
+    file.sync_all()?;
+    drop(file);
+    std::fs::rename(tmp, path)
+}
+
+/// `.NAME.PID.tmp` beside `path`.
+fn temp_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let tmp = format!(".{name}.{}.tmp", std::process::id());
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp),
+        _ => PathBuf::from(tmp),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_endpoints() {
+        assert_eq!(srgb_encode(0.0), 0);
+        assert_eq!(srgb_encode(1.0), 255);
+        assert_eq!(srgb_encode(2.0), 255);
+        assert_eq!(srgb_encode(-1.0), 0);
+        assert_eq!(srgb_encode(f32::NAN), 0);
+        assert_eq!(srgb_encode(0.5), 188);
+    }
+}

@@ -1,0 +1,69 @@
+//! Cross-backend conformance: every example rendered small on wgpu and on the CPU agrees
+//! within a stated tolerance. On a machine without a wgpu adapter the test says it skipped,
+//! unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe): then it fails.
+
+use sdfc_compiler::{back::wgsl, lower};
+use sdfc_runtime::{cpu, frontend, gpu, metrics};
+use std::path::PathBuf;
+
+/// Minimum PSNR (dB) between the wgpu and CPU renders of an example.
+const MIN_PSNR: f64 = 30.0;
+/// Most pixels allowed to differ by more than [`THRESHOLD`] in some channel.
+const MAX_DIFFERING: f64 = 0.02;
+/// Per-channel difference that counts a pixel as differing.
+const THRESHOLD: f64 = 0.1;
+
+fn examples() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir("../examples")
+        .expect("examples/")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
+        .collect();
+    files.sort();
+    files
+}
+
+fn open_gpu() -> Option<gpu::Gpu> {
+    match gpu::Gpu::open(false) {
+        Ok(g) => Some(g),
+        Err(e) => {
+            assert!(
+                std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+                "SDFC_REQUIRE_DEVICES=1 but wgpu found no adapter: {e}"
+            );
+            println!("SKIPPED: wgpu conformance: {e}");
+            None
+        }
+    }
+}
+
+#[test]
+fn wgpu_matches_cpu_on_every_example() {
+    let Some(gpu) = open_gpu() else { return };
+    println!("adapter: {}", gpu.describe());
+    let mut failures = Vec::new();
+    for path in examples() {
+        let mut scene = frontend::load(&path).expect("readable").scene.expect("valid example");
+        scene.settings.width = 96;
+        scene.settings.height = 64;
+        scene.settings.aa = 1;
+        let program = lower::lower(&scene);
+        let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+        let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
+        let on_cpu = cpu::render(&scene, &program, &cpu::Options::default(), &|| {});
+        let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+        println!(
+            "{:<14} psnr {:6.1} dB  differing {:.4}  steps/px gpu {:.1} cpu {:.1}",
+            path.file_stem().unwrap_or_default().to_string_lossy(),
+            d.psnr,
+            d.differing,
+            on_gpu.render.stats.steps_mean,
+            on_cpu.stats.steps_mean
+        );
+        assert_eq!(on_gpu.render.stats.counters.nans, 0, "{}: NaN on the GPU", path.display());
+        if d.psnr < MIN_PSNR || d.differing > MAX_DIFFERING {
+            failures.push(format!("{}: psnr {:.1} dB, differing {:.4}", path.display(), d.psnr, d.differing));
+        }
+    }
+    assert!(failures.is_empty(), "backends disagree:\n{}", failures.join("\n"));
+}

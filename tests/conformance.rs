@@ -43,7 +43,10 @@ fn wgpu_matches_cpu_on_every_example() {
     println!("adapter: {}", gpu.describe());
     let mut failures = Vec::new();
     for path in examples() {
-        let mut scene = frontend::load(&path).expect("readable").scene.expect("valid example");
+        let mut scene = frontend::load(&path)
+            .expect("readable")
+            .scene
+            .expect("valid example");
         scene.settings.width = 96;
         scene.settings.height = 64;
         scene.settings.aa = 1;
@@ -51,7 +54,8 @@ fn wgpu_matches_cpu_on_every_example() {
         let kernel = wgsl::write(&scene, &program).expect("valid kernel");
         let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
         let on_cpu = cpu::render(&scene, &program, &cpu::Options::default(), &|| {});
-        let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+        let d =
+            metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
         println!(
             "{:<14} psnr {:6.1} dB  differing {:.4}  steps/px gpu {:.1} cpu {:.1}",
             path.file_stem().unwrap_or_default().to_string_lossy(),
@@ -60,10 +64,24 @@ fn wgpu_matches_cpu_on_every_example() {
             on_gpu.render.stats.steps_mean,
             on_cpu.stats.steps_mean
         );
-        assert_eq!(on_gpu.render.stats.counters.nans, 0, "{}: NaN on the GPU", path.display());
+        assert_eq!(
+            on_gpu.render.stats.counters.nans,
+            0,
+            "{}: NaN on the GPU",
+            path.display()
+        );
         if d.psnr < MIN_PSNR || d.differing > MAX_DIFFERING {
-            failures.push(format!("{}: psnr {:.1} dB, differing {:.4}", path.display(), d.psnr, d.differing));
+            failures.push(format!(
+                "{}: psnr {:.1} dB, differing {:.4}",
+                path.display(),
+                d.psnr,
+                d.differing
+            ));
         }
     }
-    assert!(failures.is_empty(), "backends disagree:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "backends disagree:\n{}",
+        failures.join("\n")
+    );
 }

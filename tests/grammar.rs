@@ -1,11 +1,14 @@
 //! The grammar test: `grammar/sdf.ebnf` is read, checked for undefined, unused and misspelt
 //! rules and terminals, and used as a recogniser over the lexer's tokens: every example and
-//! every file of `tests/in/ok/` must be a sentence of `file`, and broken inputs must not be.
+//! every file of `tests/in/ok/` must be a sentence of `file`, broken inputs must not be, and on
+//! `tests/in/err/` the grammar and the parser must agree. The editor grammar and the reference
+//! in `docs/` are checked against the compiler's built-ins, records and diagnostic codes.
 //!
 //! The recogniser is a memoised backtracking one that returns every position where a rule can
 //! end, so it accepts exactly the sentences of the EBNF read as a context-free grammar (which
-//! must not be left-recursive). The parser is checked against it on the same inputs.
+//! must not be left-recursive).
 
+use sdfc_compiler::check::builtins::{self, BUILTINS};
 use sdfc_compiler::span::FileId;
 use sdfc_compiler::syntax::lexer::{lex, Token};
 use std::collections::{BTreeSet, HashMap, HashSet};
@@ -80,10 +83,19 @@ fn meta_tokens(text: &str) -> Vec<(Meta, usize)> {
             out.push((Meta::Str(chars[i + 1..end].iter().collect()), line));
             i = end + 1;
         } else if c.is_ascii_alphabetic() || c == '_' {
-            let end = (i..chars.len()).find(|&j| !(chars[j].is_ascii_alphanumeric() || chars[j] == '_')).unwrap_or(chars.len());
+            let end = (i..chars.len())
+                .find(|&j| !(chars[j].is_ascii_alphanumeric() || chars[j] == '_'))
+                .unwrap_or(chars.len());
             let word: String = chars[i..end].iter().collect();
             let is_class = word.chars().all(|c| c.is_ascii_uppercase() || c == '_');
-            out.push((if is_class { Meta::Class(word) } else { Meta::Name(word) }, line));
+            out.push((
+                if is_class {
+                    Meta::Class(word)
+                } else {
+                    Meta::Name(word)
+                },
+                line,
+            ));
             i = end;
         } else if "=|;{}[]()".contains(c) {
             out.push((Meta::Punct(c), line));
@@ -107,12 +119,19 @@ impl Reader {
     }
 
     fn line(&self) -> usize {
-        self.toks.get(self.pos).or(self.toks.last()).map_or(0, |(_, l)| *l)
+        self.toks
+            .get(self.pos)
+            .or(self.toks.last())
+            .map_or(0, |(_, l)| *l)
     }
 
     fn expect(&mut self, c: char) {
         if self.peek() != Some(&Meta::Punct(c)) {
-            panic!("sdf.ebnf:{}: expected `{c}`, found {:?}", self.line(), self.peek());
+            panic!(
+                "sdf.ebnf:{}: expected `{c}`, found {:?}",
+                self.line(),
+                self.peek()
+            );
         }
         self.pos += 1;
     }
@@ -121,7 +140,10 @@ impl Reader {
     fn rule(&mut self) -> (String, Ebnf) {
         let name = match self.peek() {
             Some(Meta::Name(n)) => n.clone(),
-            other => panic!("sdf.ebnf:{}: expected a rule name, found {other:?}", self.line()),
+            other => panic!(
+                "sdf.ebnf:{}: expected a rule name, found {other:?}",
+                self.line()
+            ),
         };
         self.pos += 1;
         self.expect('=');
@@ -192,7 +214,10 @@ impl Reader {
 
 /// Reads EBNF text into a grammar; panics with the line on malformed input.
 fn read_grammar(text: &str) -> Grammar {
-    let mut r = Reader { toks: meta_tokens(text), pos: 0 };
+    let mut r = Reader {
+        toks: meta_tokens(text),
+        pos: 0,
+    };
     let mut rules = Vec::new();
     while r.peek().is_some() {
         rules.push(r.rule());
@@ -290,7 +315,13 @@ struct Recogniser<'g> {
 
 impl<'g> Recogniser<'g> {
     fn new(g: &'g Grammar, input: Vec<Sym>) -> Self {
-        Recogniser { g, input, memo: HashMap::new(), furthest: 0, expected: BTreeSet::new() }
+        Recogniser {
+            g,
+            input,
+            memo: HashMap::new(),
+            furthest: 0,
+            expected: BTreeSet::new(),
+        }
     }
 
     /// Matches one quoted terminal or token class at `pos`.
@@ -319,7 +350,10 @@ impl<'g> Recogniser<'g> {
     }
 
     fn rule(&mut self, name: &str, pos: usize) -> BTreeSet<usize> {
-        let idx = self.g.get(name).unwrap_or_else(|| panic!("undefined rule `{name}`"));
+        let idx = self
+            .g
+            .get(name)
+            .unwrap_or_else(|| panic!("undefined rule `{name}`"));
         match self.memo.get(&(idx, pos)) {
             Some(Some(ends)) => return ends.clone(),
             Some(None) => panic!("rule `{name}` is left-recursive"),
@@ -375,7 +409,10 @@ impl<'g> Recogniser<'g> {
 fn recognise(g: &Grammar, start: &str, text: &str) -> Result<(), String> {
     let (tokens, diags) = lex(FileId(0), text);
     if !diags.is_empty() {
-        return Err(format!("lexical errors: {:?}", diags.iter().map(|d| &d.message).collect::<Vec<_>>()));
+        return Err(format!(
+            "lexical errors: {:?}",
+            diags.iter().map(|d| &d.message).collect::<Vec<_>>()
+        ));
     }
     let input: Vec<Sym> = tokens.iter().map(|(t, _)| terminal(t)).collect();
     let n = input.len();
@@ -391,13 +428,21 @@ fn recognise(g: &Grammar, start: &str, text: &str) -> Result<(), String> {
         },
     );
     let expected: Vec<String> = r.expected.into_iter().collect();
-    Err(format!("not a `{start}`: stuck at {at}; expected one of {}", expected.join(" ")))
+    Err(format!(
+        "not a `{start}`: stuck at {at}; expected one of {}",
+        expected.join(" ")
+    ))
 }
 
 /// Runs `f` on a thread with a large stack: recognition recurses once per nesting level of
 /// every rule.
 fn with_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-    std::thread::Builder::new().stack_size(256 << 20).spawn(f).expect("thread").join().expect("no panic")
+    std::thread::Builder::new()
+        .stack_size(64 << 20)
+        .spawn(f)
+        .expect("thread")
+        .join()
+        .expect("no panic")
 }
 
 // ---- Collecting rule names ----
@@ -433,22 +478,35 @@ fn classes(e: &Ebnf, out: &mut Vec<String>) {
 /// each was found on (without its `//`, `///` or `//!`).
 fn cited(source: &str) -> Vec<(String, String)> {
     let mut out = Vec::new();
-    for line in source.lines().map(str::trim).filter(|l| l.starts_with("//")) {
+    for line in source
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("//"))
+    {
         let text = line.trim_start_matches(['/', '!']).trim();
         let parts: Vec<&str> = text.split('`').collect();
-        out.extend(parts.iter().skip(1).step_by(2).map(|s| (s.to_string(), text.to_string())));
+        out.extend(
+            parts
+                .iter()
+                .skip(1)
+                .step_by(2)
+                .map(|s| (s.to_string(), text.to_string())),
+        );
     }
     out
 }
 
 fn is_name(s: &str) -> bool {
-    s.chars().next().is_some_and(|c| c.is_ascii_lowercase()) && s.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+    s.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && s.chars().all(|c| c.is_ascii_lowercase() || c == '_')
 }
 
 /// The `.sdf` files under `dir`, recursively, in a stable order.
 fn sdf_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
-    let Ok(entries) = std::fs::read_dir(dir) else { return out };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return out;
+    };
     for entry in entries.flatten() {
         let path = entry.path();
         if path.is_dir() {
@@ -475,7 +533,10 @@ fn every_rule_used_is_defined_once_and_reachable() {
         let mut used = Vec::new();
         refs(rhs, &mut used);
         for u in used {
-            assert!(g.get(&u).is_some(), "rule `{name}` uses `{u}`, which is not defined");
+            assert!(
+                g.get(&u).is_some(),
+                "rule `{name}` uses `{u}`, which is not defined"
+            );
         }
     }
     // Every rule is reachable from `file`.
@@ -487,7 +548,10 @@ fn every_rule_used_is_defined_once_and_reachable() {
         stack.extend(used.into_iter().filter(|u| reached.insert(u.clone())));
     }
     for (name, _) in &g.rules {
-        assert!(reached.contains(name), "rule `{name}` is not reachable from `file`");
+        assert!(
+            reached.contains(name),
+            "rule `{name}` is not reachable from `file`"
+        );
     }
 }
 
@@ -499,14 +563,23 @@ fn every_terminal_is_one_token_of_the_lexer() {
         lits(rhs, &mut ts);
         for t in ts {
             let (tokens, diags) = lex(FileId(0), &t);
-            assert!(diags.is_empty() && tokens.len() == 1, "rule `{name}`: \"{t}\" is not one token");
+            assert!(
+                diags.is_empty() && tokens.len() == 1,
+                "rule `{name}`: \"{t}\" is not one token"
+            );
             let is_lit = matches!(terminal(&tokens[0].0), Sym::Lit(s) if s == t);
-            assert!(is_lit, "rule `{name}`: \"{t}\" is a token class, not a quoted terminal");
+            assert!(
+                is_lit,
+                "rule `{name}`: \"{t}\" is a token class, not a quoted terminal"
+            );
         }
         let mut cs = Vec::new();
         classes(rhs, &mut cs);
         for c in cs {
-            assert!(CLASSES.contains(&c.as_str()), "rule `{name}`: unknown token class {c}");
+            assert!(
+                CLASSES.contains(&c.as_str()),
+                "rule `{name}`: unknown token class {c}"
+            );
         }
     }
 }
@@ -527,18 +600,37 @@ fn rules_cited_by_the_parser_and_lexer_exist() {
         if !is_name(lhs) {
             continue;
         }
-        assert!(g.get(lhs).is_some(), "parser.rs cites rule `{lhs}`, which sdf.ebnf does not define");
+        assert!(
+            g.get(lhs).is_some(),
+            "parser.rs cites rule `{lhs}`, which sdf.ebnf does not define"
+        );
         // Every rule name on the right, outside quotes.
         let unquoted: String = rhs.split('"').step_by(2).collect::<Vec<_>>().join(" ");
-        for word in unquoted.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).filter(|w| is_name(w)) {
-            assert!(g.get(word).is_some(), "parser.rs cites `{snippet}`; `{word}` is not a rule of sdf.ebnf");
+        for word in unquoted
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .filter(|w| is_name(w))
+        {
+            assert!(
+                g.get(word).is_some(),
+                "parser.rs cites `{snippet}`; `{word}` is not a rule of sdf.ebnf"
+            );
         }
     }
     // The lexer cites the lexical rules, which live in the comment at the top of sdf.ebnf.
     let lexer = std::fs::read_to_string(src.join("lexer.rs")).expect("lexer.rs");
-    for (name, _) in cited(&lexer).iter().filter(|(s, line)| is_name(s) && line.starts_with("Grammar rules")) {
-        let defined = text.lines().any(|l| l.trim_start().strip_prefix(name.as_str()).is_some_and(|r| r.trim_start().starts_with('=')));
-        assert!(defined, "lexer.rs cites lexical rule `{name}`, which sdf.ebnf does not define");
+    for (name, _) in cited(&lexer)
+        .iter()
+        .filter(|(s, line)| is_name(s) && line.starts_with("Grammar rules"))
+    {
+        let defined = text.lines().any(|l| {
+            l.trim_start()
+                .strip_prefix(name.as_str())
+                .is_some_and(|r| r.trim_start().starts_with('='))
+        });
+        assert!(
+            defined,
+            "lexer.rs cites lexical rule `{name}`, which sdf.ebnf does not define"
+        );
     }
 }
 
@@ -559,7 +651,12 @@ fn examples_and_valid_files_are_sentences_of_the_grammar() {
             // The parser agrees: no lexical or syntax errors.
             let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), &text);
             if let Some(d) = diags.first() {
-                failures.push(format!("{}: the parser reports {} {}", path.display(), d.code, d.message));
+                failures.push(format!(
+                    "{}: the parser reports {} {}",
+                    path.display(),
+                    d.code,
+                    d.message
+                ));
             }
         }
         assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -588,45 +685,80 @@ fn small_valid_inputs_are_recognised() {
         let g = grammar();
         for text in inputs {
             assert_eq!(recognise(&g, "file", text), Ok(()), "{text}");
+            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), text);
+            assert!(diags.is_empty(), "the parser rejects {text:?}: {diags:?}");
         }
+    });
+}
+
+#[test]
+fn the_grammar_and_the_parser_agree_on_the_error_files() {
+    // A file of `tests/in/err` is a sentence of the grammar exactly when the lexer and the
+    // parser find nothing wrong with it (its mistake is found by the checker).
+    let files = sdf_files(&root().join("tests/in/err"));
+    assert!(!files.is_empty(), "tests/in/err has no .sdf files");
+    with_stack(move || {
+        let g = grammar();
+        let mut disagreements = Vec::new();
+        for path in &files {
+            let text = std::fs::read_to_string(path).expect("readable");
+            let grammar_ok = recognise(&g, "file", &text);
+            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), &text);
+            if grammar_ok.is_ok() != diags.is_empty() {
+                let parser = diags.first().map_or("nothing".to_string(), |d| {
+                    format!("{} {}", d.code, d.message)
+                });
+                disagreements.push(format!(
+                    "{}: grammar {grammar_ok:?}, parser reports {parser}",
+                    path.display()
+                ));
+            }
+        }
+        assert!(disagreements.is_empty(), "{}", disagreements.join("\n"));
     });
 }
 
 #[test]
 fn broken_inputs_are_rejected() {
     let inputs = [
-        "scene { sphere(1) }",                        // missing `;` after a statement
-        "let = 1;",                                   // missing name
-        "let x = 1",                                  // missing `;` at the end
-        "let x = 1 +;",                               // missing operand
-        "let x = (1, 2;",                             // unclosed tuple
-        "let x = (,);",                               // empty tuple
-        "let x = .5;",                                // a float needs a leading digit
-        "let x = if a { 1 };",                        // `if` without `else`
-        "let x = if a { 1 } else { let y = 2; };",    // body without a value
-        "let x = f(a: );",                            // named argument without a value
-        "let x = 1 @ ;",                              // `@` without a material
-        "let x = a..b;",                              // a range outside `for`
-        "fn f(a) -> shape { a }",                     // parameter without a type
-        "fn f(a: float) { a }",                       // missing return type
-        "fn f(a: float) -> shape a",                  // body without braces
-        "material m phong { }",                       // missing `=`
+        "scene { sphere(1) }",                     // missing `;` after a statement
+        "let = 1;",                                // missing name
+        "let x = 1",                               // missing `;` at the end
+        "let x = 1 +;",                            // missing operand
+        "let x = (1, 2;",                          // unclosed tuple
+        "let x = (,);",                            // empty tuple
+        "let x = .5;",                             // a float needs a leading digit
+        "let x = if a { 1 };",                     // `if` without `else`
+        "let x = if a { 1 } else { let y = 2; };", // body without a value
+        "let x = f(a: );",                         // named argument without a value
+        "let x = 1 @ ;",                           // `@` without a material
+        "let x = a..b;",                           // a range outside `for`
+        "fn f(a) -> shape { a }",                  // parameter without a type
+        "fn f(a: float) { a }",                    // missing return type
+        "fn f(a: float) -> shape a",               // body without braces
+        "material m phong { }",                    // missing `=`
         "material m = phong { color: (1, 0, 0) ior: 2 }", // missing `,` between fields
-        "light { position: (0, 1, 0) }",              // light without a kind
-        "camera ( fov: 45deg )",                      // fields in parentheses
-        "import shapes;",                             // import without quotes
-        "scene { for i in 0..3 sphere(); }",          // loop body without braces
-        "scene { for i 0..3 { sphere(); } }",         // missing `in`
-        "scene sphere();",                            // scene without braces
-        "sphere();",                                  // a statement outside `scene`
-        "scene { sphere(1); ",                        // unclosed scene
+        "light { position: (0, 1, 0) }",           // light without a kind
+        "camera ( fov: 45deg )",                   // fields in parentheses
+        "import shapes;",                          // import without quotes
+        "scene { for i in 0..3 sphere(); }",       // loop body without braces
+        "scene { for i 0..3 { sphere(); } }",      // missing `in`
+        "scene sphere();",                         // scene without braces
+        "sphere();",                               // a statement outside `scene`
+        "scene { sphere(1); ",                     // unclosed scene
     ];
     with_stack(move || {
         let g = grammar();
         for text in inputs {
-            assert!(recognise(&g, "file", text).is_err(), "the grammar accepts the broken input {text:?}");
+            assert!(
+                recognise(&g, "file", text).is_err(),
+                "the grammar accepts the broken input {text:?}"
+            );
             let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), text);
-            assert!(!diags.is_empty(), "the parser accepts the broken input {text:?}");
+            assert!(
+                !diags.is_empty(),
+                "the parser accepts the broken input {text:?}"
+            );
         }
     });
 }
@@ -639,8 +771,115 @@ fn the_ebnf_reader_reads_its_own_notation() {
         g.rules[0].1,
         Ebnf::Seq(vec![
             Ebnf::Lit("x".into()),
-            Ebnf::Rep(Box::new(Ebnf::Alt(vec![Ebnf::Rule("b".into()), Ebnf::Opt(Box::new(Ebnf::Class("C".into())))]))),
+            Ebnf::Rep(Box::new(Ebnf::Alt(vec![
+                Ebnf::Rule("b".into()),
+                Ebnf::Opt(Box::new(Ebnf::Class("C".into())))
+            ]))),
             Ebnf::Lit("y".into()),
         ])
     );
+}
+
+// ---- The editor grammar and the reference stay in step with the compiler ----
+
+fn read(rel: &str) -> String {
+    let path = root().join(rel);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+}
+
+#[test]
+fn the_editor_grammar_knows_every_builtin() {
+    let tm = read("grammar/sdf.tmLanguage.json");
+    assert!(
+        tm.contains("\"scopeName\": \"source.sdf\""),
+        "the scope name is source.sdf"
+    );
+    for b in BUILTINS {
+        let listed = [
+            format!("|{}|", b.name),
+            format!("({}|", b.name),
+            format!("|{})", b.name),
+        ];
+        assert!(
+            listed.iter().any(|l| tm.contains(l.as_str())),
+            "sdf.tmLanguage.json does not highlight the builtin `{}`",
+            b.name
+        );
+    }
+}
+
+#[test]
+fn the_language_reference_lists_every_signature_and_field() {
+    let doc = read("docs/language.md");
+    for b in BUILTINS {
+        for sig in b.sigs {
+            let text = format!("`{}`", builtins::signature(b.name, sig));
+            assert!(doc.contains(&text), "docs/language.md does not list {text}");
+        }
+    }
+    let records = builtins::MATERIALS
+        .iter()
+        .chain(builtins::LIGHTS)
+        .chain([&builtins::CAMERA, &builtins::RENDER]);
+    for rec in records {
+        assert!(
+            doc.contains(&format!("`{}`", rec.name)),
+            "docs/language.md does not mention `{}`",
+            rec.name
+        );
+        for f in rec.fields {
+            assert!(
+                doc.contains(&format!("| `{}` |", f.name)),
+                "docs/language.md has no row for the field `{}` of `{}`",
+                f.name,
+                rec.name
+            );
+        }
+    }
+}
+
+/// The diagnostic codes (`"E0123"`, `"W0001"`) written in the Rust sources under `dir`.
+fn codes_in(dir: &Path, out: &mut BTreeSet<String>) {
+    for entry in std::fs::read_dir(dir).expect("readable").flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            codes_in(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let text = std::fs::read_to_string(&path).expect("readable");
+            for (i, _) in text.match_indices('"') {
+                let code = text.get(i + 1..i + 6).unwrap_or("");
+                let closed = text.get(i + 6..i + 7) == Some("\"");
+                if closed
+                    && (code.starts_with('E') || code.starts_with('W'))
+                    && code[1..].chars().all(|c| c.is_ascii_digit())
+                {
+                    out.insert(code.to_string());
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn every_diagnostic_code_is_documented_with_an_example() {
+    let doc = read("docs/diagnostics.md");
+    let mut codes = BTreeSet::new();
+    codes_in(&root().join("compiler/src"), &mut codes);
+    assert!(codes.len() > 10, "no diagnostic codes found");
+    for code in codes {
+        let row = doc.lines().find(|l| l.starts_with(&format!("| {code} |")));
+        let row = row.unwrap_or_else(|| panic!("docs/diagnostics.md has no row for {code}"));
+        assert!(
+            row.contains(".sdf") || row.contains('`'),
+            "the row of {code} has no example"
+        );
+    }
+    // Every example file the table names exists.
+    for part in doc.split("](../").skip(1) {
+        let rel = part.split(')').next().expect("a link");
+        assert!(
+            root().join(rel).exists(),
+            "docs/diagnostics.md links to {rel}, which does not exist"
+        );
+    }
 }

@@ -1,7 +1,8 @@
-//! Snapshot tests of every textual output: the AST and IR of every example and
-//! `tests/in/ok` file, and the rendered diagnostics of every `tests/in/err` file.
+//! Snapshot tests of every textual output: the AST, IR, distance program and WGSL kernel of
+//! every example and `tests/in/ok` file, and the rendered diagnostics of every `tests/in/err`
+//! file. Every WGSL kernel is also validated by naga (inside `back::wgsl::write`).
 
-use sdfc_compiler::{diagnostics, scene, syntax, FileId};
+use sdfc_compiler::{back, diagnostics, lower, scene, syntax, FileId};
 use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};
 
@@ -18,7 +19,9 @@ fn sdf_files(dir: &str) -> Vec<PathBuf> {
 }
 
 fn stem(p: &Path) -> String {
-    p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+    p.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }
 
 fn snapshot(folder: &str, name: &str, text: &str) {
@@ -37,12 +40,19 @@ fn check_valid(dir: &str, prefix: &str) {
     for path in files {
         let loaded = frontend::load(&path).expect("readable");
         let rendered = diagnostics::render(&loaded.diagnostics, &loaded.sources, false);
-        let scene = loaded.scene.unwrap_or_else(|| panic!("{} has errors:\n{rendered}", path.display()));
+        let scene = loaded
+            .scene
+            .unwrap_or_else(|| panic!("{} has errors:\n{rendered}", path.display()));
         let (ast, diags) = syntax::parse(FileId(0), loaded.sources.text(FileId(0)));
         assert!(diags.is_empty(), "{}: {diags:?}", path.display());
         let name = format!("{prefix}{}", stem(&path));
         snapshot("ast", &name, &syntax::dump(&ast));
         snapshot("ir", &name, &scene::dump(&scene));
+        let program = lower::lower(&scene);
+        snapshot("program", &name, &program.dump());
+        let kernel = back::wgsl::write(&scene, &program)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        snapshot("wgsl", &name, &kernel.source);
     }
 }
 
@@ -59,23 +69,40 @@ fn ok_inputs() {
 #[test]
 fn error_inputs() {
     let files = sdf_files("tests/in/err");
-    assert!(files.len() >= 40, "expected at least 40 error cases, found {}", files.len());
+    assert!(
+        files.len() >= 40,
+        "expected at least 40 error cases, found {}",
+        files.len()
+    );
     let mut codes = std::collections::BTreeSet::new();
     for path in files {
         let loaded = frontend::load(&path).expect("readable");
-        assert!(loaded.scene.is_none(), "{} compiled without errors", path.display());
+        assert!(
+            loaded.scene.is_none(),
+            "{} compiled without errors",
+            path.display()
+        );
         assert!(diagnostics::has_errors(&loaded.diagnostics));
         codes.extend(loaded.diagnostics.iter().map(|d| d.code));
         let source = loaded.sources.text(FileId(0));
         let rendered = diagnostics::render(&loaded.diagnostics, &loaded.sources, false);
-        snapshot("err", &stem(&path), &format!("{source}\n----- diagnostics -----\n{rendered}"));
+        snapshot(
+            "err",
+            &stem(&path),
+            &format!("{source}\n----- diagnostics -----\n{rendered}"),
+        );
     }
-    assert!(codes.len() >= 30, "only {} distinct diagnostic codes are exercised: {codes:?}", codes.len());
+    assert!(
+        codes.len() >= 30,
+        "only {} distinct diagnostic codes are exercised: {codes:?}",
+        codes.len()
+    );
 }
 
 #[test]
 fn json_diagnostics_are_one_object_per_line() {
-    let (_, diags, sources) = sdfc_compiler::check::check_str("t.sdf", "scene { spher(1); sphere(-1); }");
+    let (_, diags, sources) =
+        sdfc_compiler::check::check_str("t.sdf", "scene { spher(1); sphere(-1); }");
     let json = diagnostics::to_json(&diags, &sources);
     let lines: Vec<&str> = json.lines().collect();
     assert_eq!(lines.len(), 2);

@@ -65,7 +65,10 @@ impl Diagnostic {
             severity,
             code,
             message: message.into(),
-            labels: vec![Label { span, message: String::new() }],
+            labels: vec![Label {
+                span,
+                message: String::new(),
+            }],
             notes: Vec::new(),
             help: None,
         }
@@ -79,7 +82,10 @@ impl Diagnostic {
 
     /// Adds a secondary label.
     pub fn with_secondary(mut self, span: Span, message: impl Into<String>) -> Self {
-        self.labels.push(Label { span, message: message.into() });
+        self.labels.push(Label {
+            span,
+            message: message.into(),
+        });
         self
     }
 
@@ -125,7 +131,11 @@ pub fn render(diags: &[Diagnostic], sources: &SourceMap, colour: bool) -> String
         };
         let primary = d.span();
         let mut report = Report::build(kind, (primary.file, primary.range()))
-            .with_config(Config::default().with_color(colour).with_index_type(ariadne::IndexType::Byte))
+            .with_config(
+                Config::default()
+                    .with_color(colour)
+                    .with_index_type(ariadne::IndexType::Byte),
+            )
             .with_code(d.code)
             .with_message(&d.message);
         for (i, l) in d.labels.iter().enumerate() {
@@ -144,7 +154,9 @@ pub fn render(diags: &[Diagnostic], sources: &SourceMap, colour: bool) -> String
         // Writing into a Vec cannot fail for IO reasons; a failure would be a span bug,
         // which falls back to the plain form below.
         if report.finish().write(&mut cache, &mut out).is_err() {
-            out.extend_from_slice(format!("{}[{}]: {}\n", kind_word(d.severity), d.code, d.message).as_bytes());
+            out.extend_from_slice(
+                format!("{}[{}]: {}\n", kind_word(d.severity), d.code, d.message).as_bytes(),
+            );
         }
     }
     String::from_utf8_lossy(&out).into_owned()
@@ -186,7 +198,10 @@ pub fn to_json(diags: &[Diagnostic], sources: &SourceMap) -> String {
     out
 }
 
-struct SourceCache<'a>(&'a SourceMap, Vec<(crate::span::FileId, ariadne::Source<String>)>);
+struct SourceCache<'a>(
+    &'a SourceMap,
+    Vec<(crate::span::FileId, ariadne::Source<String>)>,
+);
 
 impl ariadne::Cache<crate::span::FileId> for SourceCache<'_> {
     type Storage = String;
@@ -199,7 +214,11 @@ impl ariadne::Cache<crate::span::FileId> for SourceCache<'_> {
             let text = self.0.text(*id).to_string();
             self.1.push((*id, ariadne::Source::from(text)));
         }
-        self.1.iter().find(|(f, _)| f == id).map(|(_, s)| s).ok_or("unknown file")
+        self.1
+            .iter()
+            .find(|(f, _)| f == id)
+            .map(|(_, s)| s)
+            .ok_or("unknown file")
     }
 
     fn display<'b>(&self, id: &'b crate::span::FileId) -> Option<impl std::fmt::Display + 'b> {

@@ -20,7 +20,11 @@ pub struct Span {
 impl Span {
     /// A span in `file` over `range`.
     pub fn new(file: FileId, range: std::ops::Range<usize>) -> Self {
-        Span { file, start: range.start as u32, end: range.end as u32 }
+        Span {
+            file,
+            start: range.start as u32,
+            end: range.end as u32,
+        }
     }
 
     /// The byte range.
@@ -33,7 +37,11 @@ impl Span {
         if self.file != other.file {
             return self;
         }
-        Span { file: self.file, start: self.start.min(other.start), end: self.end.max(other.end) }
+        Span {
+            file: self.file,
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
     }
 }
 
@@ -57,7 +65,9 @@ impl SourceMap {
 
     /// The file's name as given.
     pub fn name(&self, id: FileId) -> &str {
-        self.files.get(id.0 as usize).map_or("<unknown>", |f| f.0.as_str())
+        self.files
+            .get(id.0 as usize)
+            .map_or("<unknown>", |f| f.0.as_str())
     }
 
     /// The file's text.
@@ -77,7 +87,10 @@ impl SourceMap {
 
     /// The id of a file already added under `name`.
     pub fn find(&self, name: &str) -> Option<FileId> {
-        self.files.iter().position(|f| f.0 == name).map(|i| FileId(i as u32))
+        self.files
+            .iter()
+            .position(|f| f.0 == name)
+            .map(|i| FileId(i as u32))
     }
 
     /// 1-based line and column (in characters) of a span's start.

@@ -27,8 +27,10 @@ impl Loader for FsLoader {
         let base = Path::new(from).parent().unwrap_or(Path::new("."));
         let full: PathBuf = base.join(path);
         let name = normalise(&full);
-        let bytes = std::fs::read(&full).map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
-        let text = String::from_utf8(bytes).map_err(|_| format!("`{}` is not valid UTF-8", full.display()))?;
+        let bytes =
+            std::fs::read(&full).map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
+        let text = String::from_utf8(bytes)
+            .map_err(|_| format!("`{}` is not valid UTF-8", full.display()))?;
         Ok((name, text))
     }
 }
@@ -65,14 +67,23 @@ pub struct Loaded {
 /// Reads `path` and checks it. `Err` is an IO or encoding problem with the entry file itself,
 /// already phrased for the user.
 pub fn load(path: &Path) -> Result<Loaded, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
     let text = String::from_utf8(bytes).map_err(|e| {
-        format!("`{}` is not valid UTF-8 (first bad byte at offset {})", path.display(), e.utf8_error().valid_up_to())
+        format!(
+            "`{}` is not valid UTF-8 (first bad byte at offset {})",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        )
     })?;
     let mut sources = SourceMap::new();
     let entry = sources.add(normalise(path), text);
     let (scene, diagnostics) = check::check(&mut sources, entry, &mut FsLoader);
-    Ok(Loaded { scene, diagnostics, sources })
+    Ok(Loaded {
+        scene,
+        diagnostics,
+        sources,
+    })
 }
 
 /// Prints diagnostics to stderr in the chosen format.
@@ -81,9 +92,11 @@ pub fn report(loaded: &Loaded, format: DiagnosticFormat) {
         return;
     }
     let text = match format {
-        DiagnosticFormat::Human => {
-            diagnostics::render(&loaded.diagnostics, &loaded.sources, std::io::stderr().is_terminal())
-        }
+        DiagnosticFormat::Human => diagnostics::render(
+            &loaded.diagnostics,
+            &loaded.sources,
+            std::io::stderr().is_terminal(),
+        ),
         DiagnosticFormat::Json => diagnostics::to_json(&loaded.diagnostics, &loaded.sources),
     };
     eprint!("{text}");

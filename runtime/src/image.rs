@@ -28,7 +28,11 @@ pub enum ImageError {
 impl Image {
     /// A black image.
     pub fn new(width: u32, height: u32) -> Self {
-        Image { width, height, linear: vec![[0.0; 3]; width as usize * height as usize] }
+        Image {
+            width,
+            height,
+            linear: vec![[0.0; 3]; width as usize * height as usize],
+        }
     }
 
     /// The linear colour of pixel (x, y).
@@ -52,9 +56,15 @@ impl Image {
         encoder.set_color(png::ColorType::Rgba);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let mut writer = encoder.write_header().map_err(|e| ImageError::Encode(e.to_string()))?;
-        writer.write_image_data(&self.to_rgba8()).map_err(|e| ImageError::Encode(e.to_string()))?;
-        writer.finish().map_err(|e| ImageError::Encode(e.to_string()))?;
+        let mut writer = encoder
+            .write_header()
+            .map_err(|e| ImageError::Encode(e.to_string()))?;
+        writer
+            .write_image_data(&self.to_rgba8())
+            .map_err(|e| ImageError::Encode(e.to_string()))?;
+        writer
+            .finish()
+            .map_err(|e| ImageError::Encode(e.to_string()))?;
         Ok(bytes)
     }
 }
@@ -62,7 +72,11 @@ impl Image {
 /// A linear value clamped to [0, 1] and encoded with the sRGB transfer function (NaN is 0).
 pub fn srgb_encode(c: f32) -> u8 {
     let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-    let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    let s = if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
     (s * 255.0 + 0.5) as u8
 }
 
@@ -85,7 +99,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 }
 
 fn write_then_rename(tmp: &Path, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(tmp)?;
+    let mut file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(tmp)?;
     file.write_all(bytes)?;
     file.sync_all()?;
     drop(file);
@@ -94,7 +111,10 @@ fn write_then_rename(tmp: &Path, path: &Path, bytes: &[u8]) -> std::io::Result<(
 
 /// `.NAME.PID.tmp` beside `path`.
 fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
     let tmp = format!(".{name}.{}.tmp", std::process::id());
     match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp),

@@ -36,12 +36,25 @@ pub fn compare(a: &Image, b: &Image, threshold: f64) -> Option<Difference> {
     }
     let n = a.linear.len().max(1) as f64;
     let mse = sum / (3.0 * n);
-    let psnr = if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() };
-    Some(Difference { rmse: mse.sqrt(), psnr, differing: differing as f64 / n, threshold })
+    let psnr = if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        -10.0 * mse.log10()
+    };
+    Some(Difference {
+        rmse: mse.sqrt(),
+        psnr,
+        differing: differing as f64 / n,
+        threshold,
+    })
 }
 
 fn clamp01(x: f32) -> f64 {
-    if x.is_nan() { 1.0 } else { (x as f64).clamp(0.0, 1.0) }
+    if x.is_nan() {
+        1.0
+    } else {
+        (x as f64).clamp(0.0, 1.0)
+    }
 }
 
 #[cfg(test)]
@@ -49,7 +62,11 @@ mod tests {
     use super::*;
 
     fn image(pixels: &[[f32; 3]]) -> Image {
-        Image { width: pixels.len() as u32, height: 1, linear: pixels.to_vec() }
+        Image {
+            width: pixels.len() as u32,
+            height: 1,
+            linear: pixels.to_vec(),
+        }
     }
 
     #[test]

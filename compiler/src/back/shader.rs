@@ -23,7 +23,11 @@ pub struct Error(pub String);
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "internal compiler error while writing the shader: {}", self.0)
+        write!(
+            f,
+            "internal compiler error while writing the shader: {}",
+            self.0
+        )
     }
 }
 
@@ -39,8 +43,13 @@ pub fn write(kernel: &Kernel, lang: Lang) -> Result<Vec<u8>, Error> {
                 shader_stage: naga::ShaderStage::Compute,
                 entry_point: super::wgsl::ENTRY_POINT.into(),
             };
-            let words = naga::back::spv::write_vec(module, info, &naga::back::spv::Options::default(), Some(&pipeline))
-                .map_err(|e| err(&e))?;
+            let words = naga::back::spv::write_vec(
+                module,
+                info,
+                &naga::back::spv::Options::default(),
+                Some(&pipeline),
+            )
+            .map_err(|e| err(&e))?;
             Ok(words.iter().flat_map(|w| w.to_le_bytes()).collect())
         }
         Lang::Msl => {

@@ -74,14 +74,25 @@ impl Range {
         }
         let vector = matches!(v, Value::Vec2(_) | Value::Vec3(_));
         let each = if vector { "every component " } else { "" };
+        // Angles are shown in degrees, as they are usually written.
+        let show = |x: f64| match v {
+            Value::Angle(_) => format!("{}deg", crate::scene::dump_num(x.to_degrees())),
+            _ => crate::scene::dump_num(x),
+        };
         Err(match self {
             Range::Any => String::new(),
             Range::Pos => format!("{each}must be greater than 0"),
             Range::NonNeg => format!("{each}must be 0 or more"),
             Range::Unit => format!("{each}must be between 0 and 1"),
-            Range::Within(lo, hi) => format!("{each}must be between {lo} and {hi}"),
+            Range::Within(lo, hi) => format!("{each}must be between {} and {}", show(lo), show(hi)),
             Range::NonZero => "must not be the zero vector".to_string(),
-            Range::OneOf(opts) => format!("must be one of {}", opts.iter().map(|o| format!("\"{o}\"")).collect::<Vec<_>>().join(", ")),
+            Range::OneOf(opts) => format!(
+                "must be one of {}",
+                opts.iter()
+                    .map(|o| format!("\"{o}\""))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         })
     }
 }
@@ -96,7 +107,12 @@ pub struct P {
 }
 
 const fn p(name: &'static str, ty: Type, def: Def, range: Range) -> P {
-    P { name, ty, def, range }
+    P {
+        name,
+        ty,
+        def,
+        range,
+    }
 }
 
 const fn shape(name: &'static str) -> P {
@@ -150,7 +166,11 @@ pub fn signature(name: &str, sig: &Sig) -> String {
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let rest = if sig.rest && i + 1 == sig.params.len() { "..." } else { "" };
+            let rest = if sig.rest && i + 1 == sig.params.len() {
+                "..."
+            } else {
+                ""
+            };
             match p.def.value() {
                 Some(v) => format!("{}{rest}: {} = {v}", p.name, p.ty),
                 None => format!("{}{rest}: {}", p.name, p.ty),
@@ -171,7 +191,13 @@ fn smooth(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
         Value::Str(s) if &**s == "exp" => Smooth::Exp,
         _ => Smooth::Poly,
     };
-    b.node(Node::SmoothCombine { op, k: a[0].num(), variant, a: sh(&a[1]), b: sh(&a[2]) })
+    b.node(Node::SmoothCombine {
+        op,
+        k: a[0].num(),
+        variant,
+        a: sh(&a[1]),
+        b: sh(&a[2]),
+    })
 }
 
 fn rotation(axis: V3, angle: f64) -> [V3; 3] {
@@ -186,15 +212,31 @@ fn rotation(axis: V3, angle: f64) -> [V3; 3] {
         [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
     ];
     // Snap round-off (cos 90° = 6e-17) so that quarter turns are exact permutations.
-    m.map(|row| row.map(|v| if v.abs() < 1e-15 { 0.0 } else if (v.abs() - 1.0).abs() < 1e-15 { v.signum() } else { v }))
+    m.map(|row| {
+        row.map(|v| {
+            if v.abs() < 1e-15 {
+                0.0
+            } else if (v.abs() - 1.0).abs() < 1e-15 {
+                v.signum()
+            } else {
+                v
+            }
+        })
+    })
 }
 
 fn rotate(b: &mut Build, child: &Value, axis: V3, angle: f64) -> Result<Value, String> {
-    b.node(Node::Rotate { matrix: rotation(axis, angle), child: sh(child) })
+    b.node(Node::Rotate {
+        matrix: rotation(axis, angle),
+        child: sh(child),
+    })
 }
 
 fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
-    b.node(Node::Combine { op, children: a.iter().map(sh).collect() })
+    b.node(Node::Combine {
+        op,
+        children: a.iter().map(sh).collect(),
+    })
 }
 
 fn f1(a: &[Value], f: fn(f64) -> f64) -> Result<Value, String> {
@@ -229,260 +271,437 @@ macro_rules! sigs {
 /// Every builtin function.
 pub static BUILTINS: &[Builtin] = &[
     // Primitives.
-    Builtin { name: "sphere", sigs: sigs![
-        [p("radius", F, Num(1.0), Pos)] -> S => |b, a| b.node(Node::Sphere { radius: a[0].num() });
-    ]},
-    Builtin { name: "box", sigs: sigs![
-        [p("half", V, Req, Pos)] -> S => |b, a| b.node(Node::Box { half: a[0].v3() });
-        [p("half", F, Num(0.5), Pos)] -> S => |b, a| { let h = a[0].num(); b.node(Node::Box { half: [h; 3] }) };
-    ]},
-    Builtin { name: "round_box", sigs: sigs![
-        [p("half", V, Req, Pos), p("radius", F, Num(0.05), NonNeg)] -> S => |b, a| {
-            let (half, radius) = (a[0].v3(), a[1].num());
-            if half.iter().any(|&h| h < radius) {
-                return Err(format!("the rounding radius {radius} is larger than a half-extent of the box"));
-            }
-            b.node(Node::RoundBox { half, radius })
-        };
-    ]},
-    Builtin { name: "plane", sigs: sigs![
-        [p("normal", V, V3([0.0, 1.0, 0.0]), NonZero), p("height", F, Num(0.0), Any)] -> S => |b, a| {
-            let n = a[0].v3();
-            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            b.node(Node::Plane { normal: [n[0] / len, n[1] / len, n[2] / len], height: a[1].num() })
-        };
-    ]},
-    Builtin { name: "torus", sigs: sigs![
-        [p("major", F, Num(1.0), Pos), p("minor", F, Num(0.25), Pos)] -> S => |b, a| {
-            b.node(Node::Torus { major: a[0].num(), minor: a[1].num() })
-        };
-    ]},
-    Builtin { name: "cylinder", sigs: sigs![
-        [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
-            b.node(Node::Cylinder { radius: a[0].num(), half_height: a[1].num() / 2.0 })
-        };
-    ]},
-    Builtin { name: "capsule", sigs: sigs![
-        [p("radius", F, Num(0.25), Pos), p("height", F, Num(1.0), NonNeg)] -> S => |b, a| {
-            b.node(Node::Capsule { radius: a[0].num(), half_height: a[1].num() / 2.0 })
-        };
-    ]},
-    Builtin { name: "cone", sigs: sigs![
-        [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
-            b.node(Node::Cone { radius: a[0].num(), half_height: a[1].num() / 2.0 })
-        };
-    ]},
-    Builtin { name: "ellipsoid", sigs: sigs![
-        [p("radii", V, Req, Pos)] -> S => |b, a| b.node(Node::Ellipsoid { radii: a[0].v3() });
-    ]},
-    Builtin { name: "mandelbulb", sigs: sigs![
-        [p("power", F, Num(8.0), Within(2.0, 16.0)), p("iterations", I, Int(8), Within(1.0, 64.0))] -> S => |b, a| {
-            b.node(Node::Mandelbulb { power: a[0].num(), iterations: a[1].num() as u32 })
-        };
-    ]},
+    Builtin {
+        name: "sphere",
+        sigs: sigs![
+            [p("radius", F, Num(1.0), Pos)] -> S => |b, a| b.node(Node::Sphere { radius: a[0].num() });
+        ],
+    },
+    Builtin {
+        name: "box",
+        sigs: sigs![
+            [p("half", V, Req, Pos)] -> S => |b, a| b.node(Node::Box { half: a[0].v3() });
+            [p("half", F, Num(0.5), Pos)] -> S => |b, a| { let h = a[0].num(); b.node(Node::Box { half: [h; 3] }) };
+        ],
+    },
+    Builtin {
+        name: "round_box",
+        sigs: sigs![
+            [p("half", V, Req, Pos), p("radius", F, Num(0.05), NonNeg)] -> S => |b, a| {
+                let (half, radius) = (a[0].v3(), a[1].num());
+                if half.iter().any(|&h| h < radius) {
+                    return Err(format!("the rounding radius {radius} is larger than a half-extent of the box"));
+                }
+                b.node(Node::RoundBox { half, radius })
+            };
+        ],
+    },
+    Builtin {
+        name: "plane",
+        sigs: sigs![
+            [p("normal", V, V3([0.0, 1.0, 0.0]), NonZero), p("height", F, Num(0.0), Any)] -> S => |b, a| {
+                let n = a[0].v3();
+                let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                b.node(Node::Plane { normal: [n[0] / len, n[1] / len, n[2] / len], height: a[1].num() })
+            };
+        ],
+    },
+    Builtin {
+        name: "torus",
+        sigs: sigs![
+            [p("major", F, Num(1.0), Pos), p("minor", F, Num(0.25), Pos)] -> S => |b, a| {
+                b.node(Node::Torus { major: a[0].num(), minor: a[1].num() })
+            };
+        ],
+    },
+    Builtin {
+        name: "cylinder",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
+                b.node(Node::Cylinder { radius: a[0].num(), half_height: a[1].num() / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "capsule",
+        sigs: sigs![
+            [p("radius", F, Num(0.25), Pos), p("height", F, Num(1.0), NonNeg)] -> S => |b, a| {
+                b.node(Node::Capsule { radius: a[0].num(), half_height: a[1].num() / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "cone",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
+                b.node(Node::Cone { radius: a[0].num(), half_height: a[1].num() / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "ellipsoid",
+        sigs: sigs![
+            [p("radii", V, Req, Pos)] -> S => |b, a| b.node(Node::Ellipsoid { radii: a[0].v3() });
+        ],
+    },
+    Builtin {
+        name: "mandelbulb",
+        sigs: sigs![
+            [p("power", F, Num(8.0), Within(2.0, 16.0)), p("iterations", I, Int(8), Within(1.0, 64.0))] -> S => |b, a| {
+                b.node(Node::Mandelbulb { power: a[0].num(), iterations: a[1].num() as u32 })
+            };
+        ],
+    },
     // Combinators.
-    Builtin { name: "union", sigs: sigs![
-        [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Union);
-    ]},
-    Builtin { name: "intersect", sigs: sigs![
-        [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Intersect);
-    ]},
-    Builtin { name: "subtract", sigs: sigs![
-        [shape("a"), shape("b")] -> S => |b, a| combine(b, a, Combine::Subtract);
-    ]},
-    Builtin { name: "smooth_union", sigs: sigs![
-        [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
-            => |b, a| smooth(b, a, Combine::Union);
-    ]},
-    Builtin { name: "smooth_intersect", sigs: sigs![
-        [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
-            => |b, a| smooth(b, a, Combine::Intersect);
-    ]},
-    Builtin { name: "smooth_subtract", sigs: sigs![
-        [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
-            => |b, a| smooth(b, a, Combine::Subtract);
-    ]},
+    Builtin {
+        name: "union",
+        sigs: sigs![
+            [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Union);
+        ],
+    },
+    Builtin {
+        name: "intersect",
+        sigs: sigs![
+            [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Intersect);
+        ],
+    },
+    Builtin {
+        name: "subtract",
+        sigs: sigs![
+            [shape("a"), shape("b")] -> S => |b, a| combine(b, a, Combine::Subtract);
+        ],
+    },
+    Builtin {
+        name: "smooth_union",
+        sigs: sigs![
+            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+                => |b, a| smooth(b, a, Combine::Union);
+        ],
+    },
+    Builtin {
+        name: "smooth_intersect",
+        sigs: sigs![
+            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+                => |b, a| smooth(b, a, Combine::Intersect);
+        ],
+    },
+    Builtin {
+        name: "smooth_subtract",
+        sigs: sigs![
+            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+                => |b, a| smooth(b, a, Combine::Subtract);
+        ],
+    },
     // Transforms.
-    Builtin { name: "translate", sigs: sigs![
-        [shape("shape"), p("offset", V, Req, Any)] -> S => |b, a| b.node(Node::Translate { offset: a[1].v3(), child: sh(&a[0]) });
-        [shape("shape"), p("x", F, Req, Any), p("y", F, Num(0.0), Any), p("z", F, Num(0.0), Any)] -> S => |b, a| {
-            b.node(Node::Translate { offset: [a[1].num(), a[2].num(), a[3].num()], child: sh(&a[0]) })
-        };
-    ]},
-    Builtin { name: "rotate_x", sigs: sigs![
-        [shape("shape"), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], [1.0, 0.0, 0.0], a[1].num());
-    ]},
-    Builtin { name: "rotate_y", sigs: sigs![
-        [shape("shape"), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], [0.0, 1.0, 0.0], a[1].num());
-    ]},
-    Builtin { name: "rotate_z", sigs: sigs![
-        [shape("shape"), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], [0.0, 0.0, 1.0], a[1].num());
-    ]},
-    Builtin { name: "rotate", sigs: sigs![
-        [shape("shape"), p("axis", V, Req, NonZero), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], a[1].v3(), a[2].num());
-    ]},
-    Builtin { name: "scale", sigs: sigs![
-        [shape("shape"), p("factor", F, Req, Pos)] -> S => |b, a| b.node(Node::Scale { factor: a[1].num(), child: sh(&a[0]) });
-        [shape("shape"), p("factors", V, Req, Pos)] -> S => |b, a| b.node(Node::ScaleXyz { factors: a[1].v3(), child: sh(&a[0]) });
-    ]},
+    Builtin {
+        name: "translate",
+        sigs: sigs![
+            [shape("shape"), p("offset", V, Req, Any)] -> S => |b, a| b.node(Node::Translate { offset: a[1].v3(), child: sh(&a[0]) });
+            [shape("shape"), p("x", F, Req, Any), p("y", F, Num(0.0), Any), p("z", F, Num(0.0), Any)] -> S => |b, a| {
+                b.node(Node::Translate { offset: [a[1].num(), a[2].num(), a[3].num()], child: sh(&a[0]) })
+            };
+        ],
+    },
+    Builtin {
+        name: "rotate_x",
+        sigs: sigs![
+            [shape("shape"), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], [1.0, 0.0, 0.0], a[1].num());
+        ],
+    },
+    Builtin {
+        name: "rotate_y",
+        sigs: sigs![
+            [shape("shape"), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], [0.0, 1.0, 0.0], a[1].num());
+        ],
+    },
+    Builtin {
+        name: "rotate_z",
+        sigs: sigs![
+            [shape("shape"), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], [0.0, 0.0, 1.0], a[1].num());
+        ],
+    },
+    Builtin {
+        name: "rotate",
+        sigs: sigs![
+            [shape("shape"), p("axis", V, Req, NonZero), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], a[1].v3(), a[2].num());
+        ],
+    },
+    Builtin {
+        name: "scale",
+        sigs: sigs![
+            [shape("shape"), p("factor", F, Req, Pos)] -> S => |b, a| b.node(Node::Scale { factor: a[1].num(), child: sh(&a[0]) });
+            [shape("shape"), p("factors", V, Req, Pos)] -> S => |b, a| b.node(Node::ScaleXyz { factors: a[1].v3(), child: sh(&a[0]) });
+        ],
+    },
     // Domain and shape operations.
-    Builtin { name: "repeat", sigs: sigs![
-        [shape("shape"), p("period", V, Req, NonNeg)] -> S => |b, a| {
-            b.node(Node::Repeat { period: a[1].v3(), count: None, child: sh(&a[0]) })
-        };
-        [shape("shape"), p("period", V, Req, NonNeg), p("count", V, Req, Within(1.0, 1e6))] -> S => |b, a| {
-            let count = a[2].v3();
-            if count.iter().any(|c| c.fract() != 0.0) {
-                return Err("`count` must be whole numbers of copies".to_string());
-            }
-            b.node(Node::Repeat { period: a[1].v3(), count: Some(count), child: sh(&a[0]) })
-        };
-    ]},
-    Builtin { name: "mirror", sigs: sigs![
-        [shape("shape"), p("x", B, Bool(true), Any), p("y", B, Bool(false), Any), p("z", B, Bool(false), Any)] -> S => |b, a| {
-            let axes = [a[1] == Value::Bool(true), a[2] == Value::Bool(true), a[3] == Value::Bool(true)];
-            b.node(Node::Mirror { axes, child: sh(&a[0]) })
-        };
-    ]},
-    Builtin { name: "twist", sigs: sigs![
-        [shape("shape"), p("rate", F, Req, Any)] -> S => |b, a| b.node(Node::Twist { rate: a[1].num(), child: sh(&a[0]) });
-    ]},
-    Builtin { name: "bend", sigs: sigs![
-        [shape("shape"), p("rate", F, Req, Any)] -> S => |b, a| b.node(Node::Bend { rate: a[1].num(), child: sh(&a[0]) });
-    ]},
-    Builtin { name: "round", sigs: sigs![
-        [shape("shape"), p("radius", F, Req, NonNeg)] -> S => |b, a| b.node(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
-    ]},
-    Builtin { name: "shell", sigs: sigs![
-        [shape("shape"), p("thickness", F, Req, Pos)] -> S => |b, a| b.node(Node::Shell { thickness: a[1].num(), child: sh(&a[0]) });
-    ]},
-    Builtin { name: "elongate", sigs: sigs![
-        [shape("shape"), p("half", V, Req, NonNeg)] -> S => |b, a| b.node(Node::Elongate { half: a[1].v3(), child: sh(&a[0]) });
-    ]},
+    Builtin {
+        name: "repeat",
+        sigs: sigs![
+            [shape("shape"), p("period", V, Req, NonNeg)] -> S => |b, a| {
+                b.node(Node::Repeat { period: a[1].v3(), count: None, child: sh(&a[0]) })
+            };
+            [shape("shape"), p("period", V, Req, NonNeg), p("count", V, Req, Within(1.0, 1e6))] -> S => |b, a| {
+                let count = a[2].v3();
+                if count.iter().any(|c| c.fract() != 0.0) {
+                    return Err("`count` must be whole numbers of copies".to_string());
+                }
+                b.node(Node::Repeat { period: a[1].v3(), count: Some(count), child: sh(&a[0]) })
+            };
+        ],
+    },
+    Builtin {
+        name: "mirror",
+        sigs: sigs![
+            [shape("shape"), p("x", B, Bool(true), Any), p("y", B, Bool(false), Any), p("z", B, Bool(false), Any)] -> S => |b, a| {
+                let axes = [a[1] == Value::Bool(true), a[2] == Value::Bool(true), a[3] == Value::Bool(true)];
+                b.node(Node::Mirror { axes, child: sh(&a[0]) })
+            };
+        ],
+    },
+    Builtin {
+        name: "twist",
+        sigs: sigs![
+            [shape("shape"), p("rate", F, Req, Any)] -> S => |b, a| b.node(Node::Twist { rate: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    Builtin {
+        name: "bend",
+        sigs: sigs![
+            [shape("shape"), p("rate", F, Req, Any)] -> S => |b, a| b.node(Node::Bend { rate: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    Builtin {
+        name: "round",
+        sigs: sigs![
+            [shape("shape"), p("radius", F, Req, NonNeg)] -> S => |b, a| b.node(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    Builtin {
+        name: "shell",
+        sigs: sigs![
+            [shape("shape"), p("thickness", F, Req, Pos)] -> S => |b, a| b.node(Node::Shell { thickness: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    Builtin {
+        name: "elongate",
+        sigs: sigs![
+            [shape("shape"), p("half", V, Req, NonNeg)] -> S => |b, a| b.node(Node::Elongate { half: a[1].v3(), child: sh(&a[0]) });
+        ],
+    },
     // Vectors.
-    Builtin { name: "vec2", sigs: sigs![
-        [p("x", F, Req, Any), p("y", F, Req, Any)] -> V2 => |_, a| Ok(Value::Vec2([a[0].num(), a[1].num()]));
-    ]},
-    Builtin { name: "vec3", sigs: sigs![
-        [p("x", F, Req, Any), p("y", F, Req, Any), p("z", F, Req, Any)] -> V => |_, a| Ok(Value::Vec3([a[0].num(), a[1].num(), a[2].num()]));
-        [p("all", F, Req, Any)] -> V => |_, a| Ok(Value::Vec3([a[0].num(); 3]));
-    ]},
-    Builtin { name: "length", sigs: sigs![
-        [p("v", V, Req, Any)] -> F => |_, a| { let v = a[0].v3(); Ok(Value::Float((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())) };
-        [p("v", V2, Req, Any)] -> F => |_, a| { let c = a[0].components(); Ok(Value::Float(c[0].hypot(c[1]))) };
-    ]},
-    Builtin { name: "normalize", sigs: sigs![
-        [p("v", V, Req, NonZero)] -> V => |_, a| {
-            let v = a[0].v3();
-            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            Ok(Value::Vec3([v[0] / l, v[1] / l, v[2] / l]))
-        };
-    ]},
-    Builtin { name: "dot", sigs: sigs![
-        [p("a", V, Req, Any), p("b", V, Req, Any)] -> F => |_, a| {
-            let (x, y) = (a[0].v3(), a[1].v3());
-            Ok(Value::Float(x[0] * y[0] + x[1] * y[1] + x[2] * y[2]))
-        };
-    ]},
-    Builtin { name: "cross", sigs: sigs![
-        [p("a", V, Req, Any), p("b", V, Req, Any)] -> V => |_, a| {
-            let (x, y) = (a[0].v3(), a[1].v3());
-            Ok(Value::Vec3([x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]))
-        };
-    ]},
-    Builtin { name: "mix", sigs: sigs![
-        [p("a", F, Req, Any), p("b", F, Req, Any), p("t", F, Req, Any)] -> F => |_, a| {
-            Ok(Value::Float(a[0].num() + (a[1].num() - a[0].num()) * a[2].num()))
-        };
-        [p("a", V, Req, Any), p("b", V, Req, Any), p("t", F, Req, Any)] -> V => |_, a| {
-            let (x, y, t) = (a[0].v3(), a[1].v3(), a[2].num());
-            Ok(Value::Vec3([x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t, x[2] + (y[2] - x[2]) * t]))
-        };
-    ]},
+    Builtin {
+        name: "vec2",
+        sigs: sigs![
+            [p("x", F, Req, Any), p("y", F, Req, Any)] -> V2 => |_, a| Ok(Value::Vec2([a[0].num(), a[1].num()]));
+        ],
+    },
+    Builtin {
+        name: "vec3",
+        sigs: sigs![
+            [p("x", F, Req, Any), p("y", F, Req, Any), p("z", F, Req, Any)] -> V => |_, a| Ok(Value::Vec3([a[0].num(), a[1].num(), a[2].num()]));
+            [p("all", F, Req, Any)] -> V => |_, a| Ok(Value::Vec3([a[0].num(); 3]));
+        ],
+    },
+    Builtin {
+        name: "length",
+        sigs: sigs![
+            [p("v", V, Req, Any)] -> F => |_, a| { let v = a[0].v3(); Ok(Value::Float((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())) };
+            [p("v", V2, Req, Any)] -> F => |_, a| { let c = a[0].components(); Ok(Value::Float(c[0].hypot(c[1]))) };
+        ],
+    },
+    Builtin {
+        name: "normalize",
+        sigs: sigs![
+            [p("v", V, Req, NonZero)] -> V => |_, a| {
+                let v = a[0].v3();
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                Ok(Value::Vec3([v[0] / l, v[1] / l, v[2] / l]))
+            };
+        ],
+    },
+    Builtin {
+        name: "dot",
+        sigs: sigs![
+            [p("a", V, Req, Any), p("b", V, Req, Any)] -> F => |_, a| {
+                let (x, y) = (a[0].v3(), a[1].v3());
+                Ok(Value::Float(x[0] * y[0] + x[1] * y[1] + x[2] * y[2]))
+            };
+        ],
+    },
+    Builtin {
+        name: "cross",
+        sigs: sigs![
+            [p("a", V, Req, Any), p("b", V, Req, Any)] -> V => |_, a| {
+                let (x, y) = (a[0].v3(), a[1].v3());
+                Ok(Value::Vec3([x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]))
+            };
+        ],
+    },
+    Builtin {
+        name: "mix",
+        sigs: sigs![
+            [p("a", F, Req, Any), p("b", F, Req, Any), p("t", F, Req, Any)] -> F => |_, a| {
+                Ok(Value::Float(a[0].num() + (a[1].num() - a[0].num()) * a[2].num()))
+            };
+            [p("a", V, Req, Any), p("b", V, Req, Any), p("t", F, Req, Any)] -> V => |_, a| {
+                let (x, y, t) = (a[0].v3(), a[1].v3(), a[2].num());
+                Ok(Value::Vec3([x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t, x[2] + (y[2] - x[2]) * t]))
+            };
+        ],
+    },
     // Scalar maths.
-    Builtin { name: "sin", sigs: sigs![
-        [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::sin);
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::sin);
-    ]},
-    Builtin { name: "cos", sigs: sigs![
-        [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::cos);
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::cos);
-    ]},
-    Builtin { name: "tan", sigs: sigs![
-        [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::tan);
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::tan);
-    ]},
-    Builtin { name: "asin", sigs: sigs![
-        [p("x", F, Req, Within(-1.0, 1.0))] -> A => |_, a| Ok(Value::Angle(a[0].num().asin()));
-    ]},
-    Builtin { name: "acos", sigs: sigs![
-        [p("x", F, Req, Within(-1.0, 1.0))] -> A => |_, a| Ok(Value::Angle(a[0].num().acos()));
-    ]},
-    Builtin { name: "atan", sigs: sigs![
-        [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num().atan()));
-    ]},
-    Builtin { name: "atan2", sigs: sigs![
-        [p("y", F, Req, Any), p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num().atan2(a[1].num())));
-    ]},
-    Builtin { name: "sqrt", sigs: sigs![
-        [p("x", F, Req, NonNeg)] -> F => |_, a| f1(a, f64::sqrt);
-    ]},
-    Builtin { name: "exp", sigs: sigs![
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::exp);
-    ]},
-    Builtin { name: "log", sigs: sigs![
-        [p("x", F, Req, Pos)] -> F => |_, a| f1(a, f64::ln);
-    ]},
-    Builtin { name: "pow", sigs: sigs![
-        [p("base", F, Req, Any), p("exponent", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().powf(a[1].num())));
-    ]},
-    Builtin { name: "abs", sigs: sigs![
-        [p("x", I, Req, Any)] -> I => |_, a| match &a[0] { Value::Int(i) => i.checked_abs().map(Value::Int).ok_or_else(|| "integer overflow".to_string()), _ => Ok(Value::Error) };
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::abs);
-        [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::abs));
-    ]},
-    Builtin { name: "floor", sigs: sigs![
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::floor);
-    ]},
-    Builtin { name: "ceil", sigs: sigs![
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::ceil);
-    ]},
-    Builtin { name: "fract", sigs: sigs![
-        [p("x", F, Req, Any)] -> F => |_, a| f1(a, |x| x - x.floor());
-    ]},
-    Builtin { name: "min", sigs: sigs![
-        [p("a", I, Req, Any), p("b", I, Req, Any)] -> I => |_, a| Ok(Value::Int(a[0].num().min(a[1].num()) as i64));
-        [p("a", F, Req, Any), p("b", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().min(a[1].num())));
-    ]},
-    Builtin { name: "max", sigs: sigs![
-        [p("a", I, Req, Any), p("b", I, Req, Any)] -> I => |_, a| Ok(Value::Int(a[0].num().max(a[1].num()) as i64));
-        [p("a", F, Req, Any), p("b", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().max(a[1].num())));
-    ]},
-    Builtin { name: "clamp", sigs: sigs![
-        [p("x", F, Req, Any), p("lo", F, Req, Any), p("hi", F, Req, Any)] -> F => |_, a| {
-            let (x, lo, hi) = (a[0].num(), a[1].num(), a[2].num());
-            if lo > hi {
-                return Err(format!("`lo` ({lo}) is greater than `hi` ({hi})"));
-            }
-            Ok(Value::Float(x.clamp(lo, hi)))
-        };
-    ]},
-    Builtin { name: "radians", sigs: sigs![
-        [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num()));
-    ]},
-    Builtin { name: "degrees", sigs: sigs![
-        [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num().to_radians()));
-    ]},
-    Builtin { name: "hash", sigs: sigs![
-        [p("seed", I, Req, Any)] -> F => |_, a| match &a[0] { Value::Int(i) => Ok(Value::Float(hash(*i))), _ => Ok(Value::Error) };
-    ]},
-    Builtin { name: "float", sigs: sigs![
-        [p("x", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num()));
-        [p("x", A, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num()));
-    ]},
-    Builtin { name: "int", sigs: sigs![
-        [p("x", F, Req, Within(-9.0e15, 9.0e15))] -> I => |_, a| Ok(Value::Int(a[0].num().floor() as i64));
-    ]},
+    Builtin {
+        name: "sin",
+        sigs: sigs![
+            [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::sin);
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::sin);
+        ],
+    },
+    Builtin {
+        name: "cos",
+        sigs: sigs![
+            [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::cos);
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::cos);
+        ],
+    },
+    Builtin {
+        name: "tan",
+        sigs: sigs![
+            [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::tan);
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::tan);
+        ],
+    },
+    Builtin {
+        name: "asin",
+        sigs: sigs![
+            [p("x", F, Req, Within(-1.0, 1.0))] -> A => |_, a| Ok(Value::Angle(a[0].num().asin()));
+        ],
+    },
+    Builtin {
+        name: "acos",
+        sigs: sigs![
+            [p("x", F, Req, Within(-1.0, 1.0))] -> A => |_, a| Ok(Value::Angle(a[0].num().acos()));
+        ],
+    },
+    Builtin {
+        name: "atan",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num().atan()));
+        ],
+    },
+    Builtin {
+        name: "atan2",
+        sigs: sigs![
+            [p("y", F, Req, Any), p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num().atan2(a[1].num())));
+        ],
+    },
+    Builtin {
+        name: "sqrt",
+        sigs: sigs![
+            [p("x", F, Req, NonNeg)] -> F => |_, a| f1(a, f64::sqrt);
+        ],
+    },
+    Builtin {
+        name: "exp",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::exp);
+        ],
+    },
+    Builtin {
+        name: "log",
+        sigs: sigs![
+            [p("x", F, Req, Pos)] -> F => |_, a| f1(a, f64::ln);
+        ],
+    },
+    Builtin {
+        name: "pow",
+        sigs: sigs![
+            [p("base", F, Req, Any), p("exponent", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().powf(a[1].num())));
+        ],
+    },
+    Builtin {
+        name: "abs",
+        sigs: sigs![
+            [p("x", I, Req, Any)] -> I => |_, a| match &a[0] { Value::Int(i) => i.checked_abs().map(Value::Int).ok_or_else(|| "integer overflow".to_string()), _ => Ok(Value::Error) };
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::abs);
+            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::abs));
+        ],
+    },
+    Builtin {
+        name: "floor",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::floor);
+        ],
+    },
+    Builtin {
+        name: "ceil",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::ceil);
+        ],
+    },
+    Builtin {
+        name: "fract",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> F => |_, a| f1(a, |x| x - x.floor());
+        ],
+    },
+    Builtin {
+        name: "min",
+        sigs: sigs![
+            [p("a", I, Req, Any), p("b", I, Req, Any)] -> I => |_, a| Ok(Value::Int(a[0].num().min(a[1].num()) as i64));
+            [p("a", F, Req, Any), p("b", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().min(a[1].num())));
+        ],
+    },
+    Builtin {
+        name: "max",
+        sigs: sigs![
+            [p("a", I, Req, Any), p("b", I, Req, Any)] -> I => |_, a| Ok(Value::Int(a[0].num().max(a[1].num()) as i64));
+            [p("a", F, Req, Any), p("b", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().max(a[1].num())));
+        ],
+    },
+    Builtin {
+        name: "clamp",
+        sigs: sigs![
+            [p("x", F, Req, Any), p("lo", F, Req, Any), p("hi", F, Req, Any)] -> F => |_, a| {
+                let (x, lo, hi) = (a[0].num(), a[1].num(), a[2].num());
+                if lo > hi {
+                    return Err(format!("`lo` ({lo}) is greater than `hi` ({hi})"));
+                }
+                Ok(Value::Float(x.clamp(lo, hi)))
+            };
+        ],
+    },
+    Builtin {
+        name: "radians",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num()));
+        ],
+    },
+    Builtin {
+        name: "degrees",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num().to_radians()));
+        ],
+    },
+    Builtin {
+        name: "hash",
+        sigs: sigs![
+            [p("seed", I, Req, Any)] -> F => |_, a| match &a[0] { Value::Int(i) => Ok(Value::Float(hash(*i))), _ => Ok(Value::Error) };
+        ],
+    },
+    Builtin {
+        name: "float",
+        sigs: sigs![
+            [p("x", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num()));
+            [p("x", A, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num()));
+        ],
+    },
+    Builtin {
+        name: "int",
+        sigs: sigs![
+            [p("x", F, Req, Within(-9.0e15, 9.0e15))] -> I => |_, a| Ok(Value::Int(a[0].num().floor() as i64));
+        ],
+    },
 ];
 
 /// Looks a builtin up by name.
@@ -523,12 +742,27 @@ const fn concat<const N: usize, const M: usize, const T: usize>(a: [P; N], b: [P
 }
 
 const CHECKER: [P; 10] = concat(
-    [SURFACE[0], SURFACE[1], SURFACE[2], SURFACE[3], SURFACE[4], SURFACE[5], SURFACE[6]],
-    [p("a", V, V3([0.9, 0.9, 0.9]), NonNeg), p("b", V, V3([0.1, 0.1, 0.1]), NonNeg), p("size", F, Num(1.0), Pos)],
+    [
+        SURFACE[0], SURFACE[1], SURFACE[2], SURFACE[3], SURFACE[4], SURFACE[5], SURFACE[6],
+    ],
+    [
+        p("a", V, V3([0.9, 0.9, 0.9]), NonNeg),
+        p("b", V, V3([0.1, 0.1, 0.1]), NonNeg),
+        p("size", F, Num(1.0), Pos),
+    ],
 );
 
 /// Material kinds.
-pub static MATERIALS: &[Record] = &[Record { name: "phong", fields: &SURFACE }, Record { name: "checker", fields: &CHECKER }];
+pub static MATERIALS: &[Record] = &[
+    Record {
+        name: "phong",
+        fields: &SURFACE,
+    },
+    Record {
+        name: "checker",
+        fields: &CHECKER,
+    },
+];
 
 const LIGHT_COMMON: [P; 3] = [
     p("color", V, V3([1.0, 1.0, 1.0]), NonNeg),
@@ -536,11 +770,23 @@ const LIGHT_COMMON: [P; 3] = [
     p("softness", F, Num(0.0), NonNeg),
 ];
 
-const POINT: [P; 5] = concat([p("position", V, Req, Any), p("radius", F, Num(100.0), Pos)], LIGHT_COMMON);
+const POINT: [P; 5] = concat(
+    [p("position", V, Req, Any), p("radius", F, Num(100.0), Pos)],
+    LIGHT_COMMON,
+);
 const DIRECTIONAL: [P; 4] = concat([p("direction", V, Req, NonZero)], LIGHT_COMMON);
 
 /// Light kinds.
-pub static LIGHTS: &[Record] = &[Record { name: "point", fields: &POINT }, Record { name: "directional", fields: &DIRECTIONAL }];
+pub static LIGHTS: &[Record] = &[
+    Record {
+        name: "point",
+        fields: &POINT,
+    },
+    Record {
+        name: "directional",
+        fields: &DIRECTIONAL,
+    },
+];
 
 /// `camera { ... }`
 pub static CAMERA: Record = Record {
@@ -548,7 +794,15 @@ pub static CAMERA: Record = Record {
     fields: &[
         p("position", V, V3([0.0, 1.0, -5.0]), Any),
         p("look_at", V, V3([0.0, 0.0, 0.0]), Any),
-        p("fov", A, Deg(60.0), Within(0.1f64 * std::f64::consts::PI / 180.0, 179.0 * std::f64::consts::PI / 180.0)),
+        p(
+            "fov",
+            A,
+            Deg(60.0),
+            Within(
+                0.1f64 * std::f64::consts::PI / 180.0,
+                179.0 * std::f64::consts::PI / 180.0,
+            ),
+        ),
     ],
 };
 

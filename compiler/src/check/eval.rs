@@ -17,6 +17,10 @@ use std::rc::Rc;
 pub const MAX_CALL_DEPTH: usize = 256;
 /// The most shape nodes a scene may build.
 pub const MAX_NODES: usize = 1_000_000;
+/// The deepest expression nesting evaluated (deeper is an error, not a crash).
+pub const MAX_NESTING: usize = 1_000;
+/// The most evaluation steps (expressions and loop iterations) one compilation may take.
+pub const MAX_FUEL: u64 = 50_000_000;
 
 /// A user function and what checking its body found.
 #[derive(Debug)]
@@ -28,6 +32,8 @@ pub struct FnInfo {
     pub ret: Option<Type>,
     /// False when the declaration or body had errors: calls then yield `Error` silently.
     pub ok: bool,
+    /// Whether the body has been checked on its own yet (at the first call, or at the end).
+    pub checked: bool,
 }
 
 /// The evaluation state of one compilation.
@@ -43,7 +49,13 @@ pub struct Ctx {
     locals: Vec<(String, Value)>,
     dry: u32,
     depth: usize,
+    nesting: usize,
+    /// Evaluation steps taken (bounded by [`MAX_FUEL`]).
+    pub fuel: u64,
     reported_limit: bool,
+    /// Results of calls of user functions on concrete arguments: functions are pure, so a
+    /// call repeated with the same arguments is evaluated once.
+    memo: HashMap<String, Value>,
 }
 
 /// An argument after evaluation.
@@ -67,8 +79,39 @@ impl Ctx {
         }
     }
 
-    /// Evaluates `e`.
+    /// Evaluates `e`, within the nesting and fuel limits.
     pub fn expr(&mut self, e: &Expr) -> Value {
+        if self.nesting >= MAX_NESTING {
+            self.limit(
+                e.span,
+                format!("expressions nest more than {MAX_NESTING} levels deep"),
+            );
+            return Value::Error;
+        }
+        if !self.burn(e.span) {
+            return Value::Error;
+        }
+        self.nesting += 1;
+        // Deep but legal nesting must not overflow the thread's stack.
+        let v = stacker::maybe_grow(64 * 1024, 1024 * 1024, || self.expr_kind(e));
+        self.nesting -= 1;
+        v
+    }
+
+    /// Spends one evaluation step; false (and a report) once the budget is spent.
+    pub fn burn(&mut self, span: Span) -> bool {
+        self.fuel += 1;
+        if self.fuel > MAX_FUEL {
+            self.limit(
+                span,
+                format!("evaluating the scene takes more than {MAX_FUEL} steps"),
+            );
+            return false;
+        }
+        true
+    }
+
+    fn expr_kind(&mut self, e: &Expr) -> Value {
         match &e.kind {
             ExprKind::Int(i) => Value::Int(*i),
             ExprKind::Float(f) => self.finite(Value::Float(*f), e.span),
@@ -85,8 +128,12 @@ impl Ctx {
                 let (va, vb) = (self.expr(a), self.expr(b));
                 match ops::binary(*op, &va, &vb) {
                     Ok(v) => self.finite(v, e.span),
+                    Err(ops::OpError::Overflow) => self.overflow(e.span),
                     Err(ops::OpError::DivZero) => {
-                        self.error(Diagnostic::error("E0401", "division by zero", b.span).with_label("this is zero"));
+                        self.error(
+                            Diagnostic::error("E0401", "division by zero", b.span)
+                                .with_label("this is zero"),
+                        );
                         Value::Error
                     }
                     Err(err) => self.op_error(err, *op, (&va, a.span), (&vb, b.span), e.span),
@@ -96,7 +143,11 @@ impl Ctx {
                 let args = self.args(args);
                 self.call(callee, None, args, e.span)
             }
-            ExprKind::Method { receiver, name, args } => {
+            ExprKind::Method {
+                receiver,
+                name,
+                args,
+            } => {
                 let recv = self.expr(receiver);
                 let args = self.args(args);
                 self.call(name, Some((recv, receiver.span)), args, e.span)
@@ -105,7 +156,11 @@ impl Ctx {
                 let v = self.expr(x);
                 self.field(v, name)
             }
-            ExprKind::If { cond, then, otherwise } => self.if_expr(cond, then, otherwise),
+            ExprKind::If {
+                cond,
+                then,
+                otherwise,
+            } => self.if_expr(cond, then, otherwise),
             ExprKind::Material(x, m) => {
                 let v = self.expr(x);
                 self.paint(v, x.span, m, e.span)
@@ -129,31 +184,66 @@ impl Ctx {
     fn result(&mut self, r: Result<Value, ops::OpError>, span: Span) -> Value {
         match r {
             Ok(v) => self.finite(v, span),
-            Err(ops::OpError::Types(msg)) | Err(ops::OpError::Other(msg)) => {
-                self.error(Diagnostic::error("E0301", msg, span));
+            Err(ops::OpError::Types(msg)) => {
+                self.error(Diagnostic::error("E0301", msg, span).with_label("here"));
                 Value::Error
             }
+            Err(ops::OpError::Overflow) => self.overflow(span),
             Err(ops::OpError::DivZero) => Value::Error,
         }
     }
 
-    fn op_error(&mut self, err: ops::OpError, op: BinOp, a: (&Value, Span), b: (&Value, Span), span: Span) -> Value {
+    fn op_error(
+        &mut self,
+        err: ops::OpError,
+        op: BinOp,
+        a: (&Value, Span),
+        b: (&Value, Span),
+        span: Span,
+    ) -> Value {
         let msg = match err {
-            ops::OpError::Types(m) | ops::OpError::Other(m) => m,
+            ops::OpError::Types(m) => m,
+            ops::OpError::Overflow => "integer overflow".into(),
             ops::OpError::DivZero => "division by zero".into(),
         };
         let mut d = Diagnostic::error("E0301", msg, span)
-            .with_secondary(a.1, format!("this is `{}`", a.0.ty().map_or("?".into(), |t| t.to_string())))
-            .with_secondary(b.1, format!("this is `{}`", b.0.ty().map_or("?".into(), |t| t.to_string())));
+            .with_secondary(
+                a.1,
+                format!(
+                    "this is `{}`",
+                    a.0.ty().map_or("?".into(), |t| t.to_string())
+                ),
+            )
+            .with_secondary(
+                b.1,
+                format!(
+                    "this is `{}`",
+                    b.0.ty().map_or("?".into(), |t| t.to_string())
+                ),
+            );
         let tys = (a.0.ty(), b.0.ty());
         if tys.0 == Some(Type::Shape) || tys.1 == Some(Type::Shape) {
-            d = d.with_help("shapes are combined with `union(a, b)`, `intersect(a, b)` or `subtract(a, b)`");
-        } else if matches!(tys, (Some(Type::Angle), Some(Type::Float | Type::Int)) | (Some(Type::Float | Type::Int), Some(Type::Angle)))
-            && matches!(op, BinOp::Add | BinOp::Sub)
+            d = d.with_help(
+                "shapes are combined with `union(a, b)`, `intersect(a, b)` or `subtract(a, b)`",
+            );
+        } else if matches!(
+            tys,
+            (Some(Type::Angle), Some(Type::Float | Type::Int))
+                | (Some(Type::Float | Type::Int), Some(Type::Angle))
+        ) && matches!(op, BinOp::Add | BinOp::Sub)
         {
             d = d.with_help("give the number a unit: `30deg` or `0.5rad`");
         }
         self.error(d);
+        Value::Error
+    }
+
+    fn overflow(&mut self, span: Span) -> Value {
+        self.error(
+            Diagnostic::error("E0404", "integer overflow", span)
+                .with_label("the result does not fit in a 64-bit integer")
+                .with_help("use a float (`1.0 * x`) for large values"),
+        );
         Value::Error
     }
 
@@ -166,18 +256,29 @@ impl Ctx {
         }
         if let Some(def) = self.declared.get(&id.name).copied() {
             self.error(
-                Diagnostic::error("E0208", format!("`{}` is used before its definition", id.name), id.span)
-                    .with_label("used here")
-                    .with_secondary(def, "defined here, later")
-                    .with_help("move the `let` above its first use"),
+                Diagnostic::error(
+                    "E0208",
+                    format!("`{}` is used before its definition", id.name),
+                    id.span,
+                )
+                .with_label("used here")
+                .with_secondary(def, "defined here, later")
+                .with_help("move the `let` above its first use"),
             );
             return Value::Error;
         }
-        let mut d = Diagnostic::error("E0200", format!("unknown name `{}`", id.name), id.span).with_label("not defined");
+        let mut d = Diagnostic::error("E0200", format!("unknown name `{}`", id.name), id.span)
+            .with_label("not defined");
         if self.fns.contains_key(&id.name) || builtins::builtin(&id.name).is_some() {
-            d = d.with_help(format!("`{}` is a function: call it as `{}(...)`", id.name, id.name));
+            d = d.with_help(format!(
+                "`{}` is a function: call it as `{}(...)`",
+                id.name, id.name
+            ));
         } else if self.material_ids.contains_key(&id.name) {
-            d = d.with_help(format!("`{}` is a material: apply it with `shape @ {}`", id.name, id.name));
+            d = d.with_help(format!(
+                "`{}` is a material: apply it with `shape @ {}`",
+                id.name, id.name
+            ));
         } else if let Some(s) = self.suggest_value(&id.name) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
@@ -199,8 +300,12 @@ impl Ctx {
         let vals: Vec<Value> = items.iter().map(|i| self.expr(i)).collect();
         if !(2..=3).contains(&vals.len()) {
             self.error(
-                Diagnostic::error("E0300", format!("a vector has 2 or 3 components, this has {}", vals.len()), span)
-                    .with_label("not a vec2 or vec3"),
+                Diagnostic::error(
+                    "E0300",
+                    format!("a vector has 2 or 3 components, this has {}", vals.len()),
+                    span,
+                )
+                .with_label("not a vec2 or vec3"),
             );
             return Value::Error;
         }
@@ -213,13 +318,20 @@ impl Ctx {
                 None => {
                     self.error(
                         Diagnostic::error("E0300", "vector components must be numbers", item.span)
-                            .with_label(format!("this is `{}`", v.ty().map_or("?".into(), |t| t.to_string()))),
+                            .with_label(format!(
+                                "this is `{}`",
+                                v.ty().map_or("?".into(), |t| t.to_string())
+                            )),
                     );
                     return Value::Error;
                 }
             }
         }
-        let ty = if vals.len() == 2 { Type::Vec2 } else { Type::Vec3 };
+        let ty = if vals.len() == 2 {
+            Type::Vec2
+        } else {
+            Type::Vec3
+        };
         if abstract_ {
             return Value::Unknown(ty);
         }
@@ -243,16 +355,28 @@ impl Ctx {
             Some(Type::Vec3) => 3,
             Some(t) => {
                 self.error(
-                    Diagnostic::error("E0210", format!("`{t}` has no component `{}`", name.name), name.span)
-                        .with_label("components exist only on vec2 and vec3"),
+                    Diagnostic::error(
+                        "E0210",
+                        format!("`{t}` has no component `{}`", name.name),
+                        name.span,
+                    )
+                    .with_label("components exist only on vec2 and vec3"),
                 );
                 return Value::Error;
             }
         };
         if idx >= dims {
             self.error(
-                Diagnostic::error("E0210", format!("unknown vector component `{}`", name.name), name.span)
-                    .with_label(if dims == 2 { "a vec2 has `x` and `y`" } else { "a vec3 has `x`, `y` and `z`" }),
+                Diagnostic::error(
+                    "E0210",
+                    format!("unknown vector component `{}`", name.name),
+                    name.span,
+                )
+                .with_label(if dims == 2 {
+                    "a vec2 has `x` and `y`"
+                } else {
+                    "a vec3 has `x`, `y` and `z`"
+                }),
             );
             return Value::Error;
         }
@@ -265,13 +389,18 @@ impl Ctx {
 
     fn if_expr(&mut self, cond: &Expr, then: &Body, otherwise: &Body) -> Value {
         let c = self.expr(cond);
+        let mut failed = c == Value::Error;
         let taken = match &c {
             Value::Bool(b) => Some(*b),
             Value::Error | Value::Unknown(Type::Bool) => None,
             other => {
+                failed = true;
                 self.error(
                     Diagnostic::error("E0303", "the condition of `if` must be a bool", cond.span)
-                        .with_label(format!("this is `{}`", other.ty().map_or("?".into(), |t| t.to_string()))),
+                        .with_label(format!(
+                            "this is `{}`",
+                            other.ty().map_or("?".into(), |t| t.to_string())
+                        )),
                 );
                 None
             }
@@ -280,15 +409,22 @@ impl Ctx {
         let (a, b) = match taken {
             Some(true) => (self.body(then), self.dry(|cx| cx.body(otherwise))),
             Some(false) => (self.dry(|cx| cx.body(then)), self.body(otherwise)),
-            None => (self.dry(|cx| cx.body(then)), self.dry(|cx| cx.body(otherwise))),
+            None => (
+                self.dry(|cx| cx.body(then)),
+                self.dry(|cx| cx.body(otherwise)),
+            ),
         };
         let (ta, tb) = (a.ty(), b.ty());
         if let (Some(x), Some(y)) = (ta, tb) {
             if x != y && !(x.fits(y) || y.fits(x)) {
                 self.error(
-                    Diagnostic::error("E0302", "the branches of `if` have different types", then.value.span)
-                        .with_label(format!("this is `{x}`"))
-                        .with_secondary(otherwise.value.span, format!("this is `{y}`")),
+                    Diagnostic::error(
+                        "E0302",
+                        "the branches of `if` have different types",
+                        then.value.span,
+                    )
+                    .with_label(format!("this is `{x}`"))
+                    .with_secondary(otherwise.value.span, format!("this is `{y}`")),
                 );
                 return Value::Error;
             }
@@ -296,6 +432,7 @@ impl Ctx {
         match taken {
             Some(true) => a,
             Some(false) => b,
+            None if failed => Value::Error,
             None => ta.or(tb).map_or(Value::Error, Value::Unknown),
         }
     }
@@ -324,15 +461,20 @@ impl Ctx {
     pub fn let_value(&mut self, l: &Let) -> Value {
         let v = self.expr(&l.value);
         let Some(ty) = &l.ty else { return v };
-        let Some(want) = self.type_name(ty) else { return Value::Error };
+        let Some(want) = self.type_name(ty) else {
+            return Value::Error;
+        };
         match v.clone().coerce(want) {
             Some(c) => c,
             None => {
-                self.error(
-                    Diagnostic::error("E0300", format!("expected `{want}`, found `{}`", v.ty().map_or("?".into(), |t| t.to_string())), l.value.span)
-                        .with_label(format!("this is `{}`", v.ty().map_or("?".into(), |t| t.to_string())))
-                        .with_secondary(ty.span, "declared type"),
-                );
+                let d = Diagnostic::error(
+                    "E0300",
+                    format!("expected `{want}`, found `{}`", type_name(&v)),
+                    l.value.span,
+                )
+                .with_label(format!("this is `{}`", type_name(&v)))
+                .with_secondary(ty.span, "declared type");
+                self.error(with_type_help(d, want, v.ty()));
                 Value::Error
             }
         }
@@ -372,25 +514,34 @@ impl Ctx {
         let mat = match self.material_ids.get(&m.name) {
             Some((id, _)) => Some(*id),
             None => {
-                let mut d = Diagnostic::error("E0212", format!("unknown material `{}`", m.name), m.span)
-                    .with_label("no material of this name");
+                let mut d =
+                    Diagnostic::error("E0212", format!("unknown material `{}`", m.name), m.span)
+                        .with_label("no material of this name");
                 if let Some(s) = closest(&m.name, self.material_ids.keys().map(String::as_str)) {
                     d = d.with_help(format!("did you mean `{s}`?"));
                 } else {
-                    d = d.with_help(format!("declare it: `material {} = phong {{ color: (1, 0, 0) }}`", m.name));
+                    d = d.with_help(format!(
+                        "declare it: `material {} = phong {{ color: (1, 0, 0) }}`",
+                        m.name
+                    ));
                 }
                 self.error(d);
                 None
             }
         };
         match (v, mat) {
-            (Value::Shape(child), Some(material)) => self.add_node(Node::Paint { material, child }, span),
+            (Value::Shape(child), Some(material)) => {
+                self.add_node(Node::Paint { material, child }, span)
+            }
             (Value::Error, _) | (Value::Shape(_), None) => Value::Error,
             (Value::Unknown(Type::Shape), _) => Value::Unknown(Type::Shape),
             (other, _) => {
                 self.error(
                     Diagnostic::error("E0300", "only shapes can be given a material", vspan)
-                        .with_label(format!("this is `{}`", other.ty().map_or("?".into(), |t| t.to_string()))),
+                        .with_label(format!(
+                            "this is `{}`",
+                            other.ty().map_or("?".into(), |t| t.to_string())
+                        )),
                 );
                 Value::Error
             }
@@ -400,7 +551,10 @@ impl Ctx {
     /// Adds a node unless the node budget is spent.
     pub fn add_node(&mut self, node: Node, span: Span) -> Value {
         if self.graph.len() >= MAX_NODES {
-            self.limit(span, format!("the scene has more than {MAX_NODES} shape nodes"));
+            self.limit(
+                span,
+                format!("the scene has more than {MAX_NODES} shape nodes"),
+            );
             return Value::Error;
         }
         Value::Shape(self.graph.add(node, span))
@@ -410,26 +564,47 @@ impl Ctx {
     pub fn limit(&mut self, span: Span, msg: String) {
         if !self.reported_limit {
             self.reported_limit = true;
-            self.error(Diagnostic::error("E0507", msg, span).with_note("this limit keeps compilation bounded"));
+            self.error(
+                Diagnostic::error("E0507", msg, span)
+                    .with_note("this limit keeps compilation bounded"),
+            );
         }
     }
 
     fn args(&mut self, args: &[Arg]) -> Vec<ArgVal> {
         args.iter()
-            .map(|a| ArgVal { name: a.name.clone(), value: self.expr(&a.value), span: a.value.span })
+            .map(|a| ArgVal {
+                name: a.name.clone(),
+                value: self.expr(&a.value),
+                span: a.value.span,
+            })
             .collect()
     }
 
-    fn call(&mut self, callee: &Ident, recv: Option<(Value, Span)>, args: Vec<ArgVal>, span: Span) -> Value {
+    fn call(
+        &mut self,
+        callee: &Ident,
+        recv: Option<(Value, Span)>,
+        args: Vec<ArgVal>,
+        span: Span,
+    ) -> Value {
         if self.fns.contains_key(&callee.name) {
             return self.call_user(callee, recv, args, span);
         }
         if let Some(b) = builtins::builtin(&callee.name) {
             return self.call_builtin(b, callee, recv, args, span);
         }
-        let mut d = Diagnostic::error("E0201", format!("unknown function `{}`", callee.name), callee.span)
-            .with_label("no function of this name");
-        let names = self.fns.keys().map(String::as_str).chain(builtins::BUILTINS.iter().map(|b| b.name));
+        let mut d = Diagnostic::error(
+            "E0201",
+            format!("unknown function `{}`", callee.name),
+            callee.span,
+        )
+        .with_label("no function of this name");
+        let names = self
+            .fns
+            .keys()
+            .map(String::as_str)
+            .chain(builtins::BUILTINS.iter().map(|b| b.name));
         if let Some(s) = closest(&callee.name, names) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
@@ -437,12 +612,27 @@ impl Ctx {
         Value::Error
     }
 
-    fn call_builtin(&mut self, b: &'static builtins::Builtin, callee: &Ident, recv: Option<(Value, Span)>, args: Vec<ArgVal>, span: Span) -> Value {
+    fn call_builtin(
+        &mut self,
+        b: &'static builtins::Builtin,
+        callee: &Ident,
+        recv: Option<(Value, Span)>,
+        args: Vec<ArgVal>,
+        span: Span,
+    ) -> Value {
         // Overloads are tried in order; the first that binds cleanly wins. Otherwise the errors
         // of the closest one are reported.
         let mut best: Option<(usize, Vec<Diagnostic>)> = None;
         for (i, sig) in b.sigs.iter().enumerate() {
-            let params: Vec<PView> = sig.params.iter().map(|p| PView { name: p.name, ty: Some(p.ty), has_default: p.def.value().is_some() }).collect();
+            let params: Vec<PView> = sig
+                .params
+                .iter()
+                .map(|p| PView {
+                    name: p.name,
+                    ty: Some(p.ty),
+                    has_default: p.def.value().is_some(),
+                })
+                .collect();
             match bind(&params, sig.rest, &recv, &args, callee, span) {
                 Ok(slots) => return self.run_builtin(b, sig, slots, callee, span),
                 Err(errs) => {
@@ -454,7 +644,11 @@ impl Ctx {
         }
         if let Some((i, errs)) = best {
             let sig_note = if b.sigs.len() > 1 {
-                let all: Vec<String> = b.sigs.iter().map(|s| builtins::signature(b.name, s)).collect();
+                let all: Vec<String> = b
+                    .sigs
+                    .iter()
+                    .map(|s| builtins::signature(b.name, s))
+                    .collect();
                 format!("the forms of `{}` are:\n  {}", b.name, all.join("\n  "))
             } else {
                 format!("`{}`", builtins::signature(b.name, &b.sigs[i]))
@@ -466,7 +660,14 @@ impl Ctx {
         Value::Error
     }
 
-    fn run_builtin(&mut self, b: &builtins::Builtin, sig: &builtins::Sig, slots: Bound, callee: &Ident, span: Span) -> Value {
+    fn run_builtin(
+        &mut self,
+        b: &builtins::Builtin,
+        sig: &builtins::Sig,
+        slots: Bound,
+        callee: &Ident,
+        span: Span,
+    ) -> Value {
         let mut vals = Vec::new();
         let mut ok = true;
         let mut abstract_ = false;
@@ -492,17 +693,30 @@ impl Ctx {
             return Value::Error;
         }
         if abstract_ || self.dry > 0 {
-            return if vals.contains(&Value::Error) { Value::Error } else { Value::Unknown(sig.ret) };
+            return if vals.contains(&Value::Error) {
+                Value::Error
+            } else {
+                Value::Unknown(sig.ret)
+            };
         }
         if sig.ret == Type::Shape && self.graph.len() >= MAX_NODES {
-            self.limit(span, format!("the scene has more than {MAX_NODES} shape nodes"));
+            self.limit(
+                span,
+                format!("the scene has more than {MAX_NODES} shape nodes"),
+            );
             return Value::Error;
         }
-        let mut build = Build { graph: &mut self.graph, span };
+        let mut build = Build {
+            graph: &mut self.graph,
+            span,
+        };
         match (sig.imp)(&mut build, &vals) {
             Ok(v) => self.finite(v, span),
             Err(msg) => {
-                self.error(Diagnostic::error("E0400", msg, span).with_label(format!("in this call of `{}`", b.name)));
+                self.error(
+                    Diagnostic::error("E0400", msg, span)
+                        .with_label(format!("in this call of `{}`", b.name)),
+                );
                 Value::Error
             }
         }
@@ -516,15 +730,28 @@ impl Ctx {
             Ok(()) => true,
             Err(why) => {
                 self.error(
-                    Diagnostic::error("E0400", format!("`{}` of `{}` {why}", p.name, callee.name), span)
-                        .with_label(format!("this is {v}")),
+                    Diagnostic::error(
+                        "E0400",
+                        format!("`{}` of `{}` {why}", p.name, callee.name),
+                        span,
+                    )
+                    .with_label(format!("this is {v}")),
                 );
                 false
             }
         }
     }
 
-    fn call_user(&mut self, callee: &Ident, recv: Option<(Value, Span)>, args: Vec<ArgVal>, span: Span) -> Value {
+    fn call_user(
+        &mut self,
+        callee: &Ident,
+        recv: Option<(Value, Span)>,
+        args: Vec<ArgVal>,
+        span: Span,
+    ) -> Value {
+        if !self.fns[&callee.name].checked {
+            self.check_function(&callee.name);
+        }
         let info = &self.fns[&callee.name];
         let decl = info.decl.clone();
         let (ptys, ret, ok) = (info.params.clone(), info.ret, info.ok);
@@ -532,7 +759,11 @@ impl Ctx {
             .params
             .iter()
             .zip(&ptys)
-            .map(|(p, t)| PView { name: &p.name.name, ty: *t, has_default: p.default.is_some() })
+            .map(|(p, t)| PView {
+                name: &p.name.name,
+                ty: *t,
+                has_default: p.default.is_some(),
+            })
             .collect();
         let slots = match bind(&params, false, &recv, &args, callee, span) {
             Ok(s) => s,
@@ -547,11 +778,16 @@ impl Ctx {
         if !ok {
             return Value::Error;
         }
+        // The body was checked on its own: a types-only call needs only the return type.
+        if self.dry > 0 {
+            return Value::Unknown(ret);
+        }
         if self.depth >= MAX_CALL_DEPTH {
             self.limit(span, format!("calls nest deeper than {MAX_CALL_DEPTH}"));
             return Value::Error;
         }
-        // Defaults are evaluated in the global scope; the body sees only its parameters.
+        // Defaults are evaluated in the global scope; the body sees its parameters and the
+        // global constants.
         let saved = std::mem::take(&mut self.locals);
         let mut frame = Vec::new();
         for ((slot, p), ty) in slots.slots.into_iter().zip(&decl.params).zip(&ptys) {
@@ -564,13 +800,80 @@ impl Ctx {
             };
             frame.push((p.name.name.clone(), v));
         }
+        let key = format!(
+            "{}{:?}",
+            callee.name,
+            frame.iter().map(|(_, v)| v).collect::<Vec<_>>()
+        );
+        if let Some(v) = self.memo.get(&key) {
+            self.locals = saved;
+            return v.clone();
+        }
         self.locals = frame;
         self.depth += 1;
         let v = self.body(&decl.body);
         self.depth -= 1;
         self.locals = saved;
-        v.coerce(ret).unwrap_or(Value::Error)
+        let v = v.coerce(ret).unwrap_or(Value::Error);
+        self.memo.insert(key, v.clone());
+        v
     }
+
+    /// Checks a function's body once with its parameters unknown, so that its type errors are
+    /// reported whether or not it is called, and once only. Globals evaluated so far are
+    /// visible (a function is checked at its first call, or after all items).
+    pub fn check_function(&mut self, name: &str) {
+        let Some(info) = self.fns.get_mut(name) else {
+            return;
+        };
+        info.checked = true;
+        let (decl, params, ret) = (info.decl.clone(), info.params.clone(), info.ret);
+        let before = self.diags.len();
+        let saved = std::mem::take(&mut self.locals);
+        self.dry(|cx| {
+            for (p, t) in decl.params.iter().zip(&params) {
+                if let (Some(d), Some(t)) = (&p.default, t) {
+                    let v = cx.expr(d);
+                    if v.clone().coerce(*t).is_none() {
+                        cx.error(
+                            Diagnostic::error(
+                                "E0300",
+                                format!("the default of `{}` is not a `{t}`", p.name.name),
+                                d.span,
+                            )
+                            .with_label(format!("this is `{}`", type_name(&v))),
+                        );
+                    }
+                }
+                cx.push_local(&p.name.name, t.map_or(Value::Error, Value::Unknown));
+            }
+            let v = cx.body(&decl.body);
+            if let (Some(want), Some(got)) = (ret, v.ty()) {
+                if !got.fits(want) {
+                    cx.error(
+                        Diagnostic::error(
+                            "E0300",
+                            format!("`{name}` returns `{got}`, but is declared to return `{want}`"),
+                            decl.body.value.span,
+                        )
+                        .with_label(format!("this is `{got}`"))
+                        .with_secondary(decl.ret.span, "declared here"),
+                    );
+                }
+            }
+        });
+        self.locals = saved;
+        if self.diags[before..].iter().any(Diagnostic::is_error) {
+            if let Some(info) = self.fns.get_mut(name) {
+                info.ok = false;
+            }
+        }
+    }
+}
+
+/// The name of a value's type for messages (`?` for an error value).
+pub fn type_name(v: &Value) -> String {
+    v.ty().map_or("?".into(), |t| t.to_string())
 }
 
 /// Arguments matched to parameters: one slot per parameter (`None`: use the default), then
@@ -582,15 +885,33 @@ struct Bound {
 
 /// Matches arguments to parameters and checks their types. A method receiver goes to the first
 /// parameter of its type. Returns every problem found.
-fn bind(params: &[PView], rest: bool, recv: &Option<(Value, Span)>, args: &[ArgVal], callee: &Ident, span: Span) -> Result<Bound, Vec<Diagnostic>> {
+fn bind(
+    params: &[PView],
+    rest: bool,
+    recv: &Option<(Value, Span)>,
+    args: &[ArgVal],
+    callee: &Ident,
+    span: Span,
+) -> Result<Bound, Vec<Diagnostic>> {
     let mut errs = Vec::new();
     let mut slots: Vec<Option<(Value, Span)>> = vec![None; params.len()];
     let mut extra = Vec::new();
     let mut filled = vec![false; params.len()];
     if let Some((v, s)) = recv {
-        let idx = v.ty().and_then(|t| params.iter().position(|p| p.ty.is_some_and(|pt| t.fits(pt)))).unwrap_or(0);
+        let idx = v
+            .ty()
+            .and_then(|t| {
+                params
+                    .iter()
+                    .position(|p| p.ty.is_some_and(|pt| t.fits(pt)))
+            })
+            .unwrap_or(0);
         if params.is_empty() {
-            errs.push(Diagnostic::error("E0205", format!("`{}` takes no arguments", callee.name), *s));
+            errs.push(Diagnostic::error(
+                "E0205",
+                format!("`{}` takes no arguments", callee.name),
+                *s,
+            ));
         } else {
             slots[idx] = Some((v.clone(), *s));
             filled[idx] = true;
@@ -603,8 +924,12 @@ fn bind(params: &[PView], rest: bool, recv: &Option<(Value, Span)>, args: &[ArgV
             None => {
                 if seen_named {
                     errs.push(
-                        Diagnostic::error("E0206", "positional argument after a named argument", a.span)
-                            .with_help("give every argument after a named one by name too"),
+                        Diagnostic::error(
+                            "E0206",
+                            "positional argument after a named argument",
+                            a.span,
+                        )
+                        .with_help("give every argument after a named one by name too"),
                     );
                     continue;
                 }
@@ -618,8 +943,17 @@ fn bind(params: &[PView], rest: bool, recv: &Option<(Value, Span)>, args: &[ArgV
                     extra.push((a.value.clone(), a.span));
                 } else if !errs.iter().any(|d: &Diagnostic| d.code == "E0205") {
                     errs.push(
-                        Diagnostic::error("E0205", format!("too many arguments to `{}`", callee.name), a.span)
-                            .with_label(format!("`{}` takes at most {} argument{}", callee.name, params.len(), if params.len() == 1 { "" } else { "s" })),
+                        Diagnostic::error(
+                            "E0205",
+                            format!("too many arguments to `{}`", callee.name),
+                            a.span,
+                        )
+                        .with_label(format!(
+                            "`{}` takes at most {} argument{}",
+                            callee.name,
+                            params.len(),
+                            if params.len() == 1 { "" } else { "s" }
+                        )),
                     );
                 }
             }
@@ -627,16 +961,24 @@ fn bind(params: &[PView], rest: bool, recv: &Option<(Value, Span)>, args: &[ArgV
                 seen_named = true;
                 match params.iter().position(|p| p.name == name.name) {
                     Some(i) if filled[i] => errs.push(
-                        Diagnostic::error("E0203", format!("argument `{}` is given twice", name.name), name.span)
-                            .with_label("given again here"),
+                        Diagnostic::error(
+                            "E0203",
+                            format!("argument `{}` is given twice", name.name),
+                            name.span,
+                        )
+                        .with_label("given again here"),
                     ),
                     Some(i) => {
                         slots[i] = Some((a.value.clone(), a.span));
                         filled[i] = true;
                     }
                     None => {
-                        let mut d = Diagnostic::error("E0202", format!("`{}` has no parameter `{}`", callee.name, name.name), name.span)
-                            .with_label("unknown parameter");
+                        let mut d = Diagnostic::error(
+                            "E0202",
+                            format!("`{}` has no parameter `{}`", callee.name, name.name),
+                            name.span,
+                        )
+                        .with_label("unknown parameter");
                         if let Some(s) = closest(&name.name, params.iter().map(|p| p.name)) {
                             d = d.with_help(format!("did you mean `{s}`?"));
                         }
@@ -649,8 +991,12 @@ fn bind(params: &[PView], rest: bool, recv: &Option<(Value, Span)>, args: &[ArgV
     for (i, p) in params.iter().enumerate() {
         if !filled[i] && !p.has_default {
             errs.push(
-                Diagnostic::error("E0204", format!("missing argument `{}` of `{}`", p.name, callee.name), span)
-                    .with_label(format!("`{}` is required", p.name)),
+                Diagnostic::error(
+                    "E0204",
+                    format!("missing argument `{}` of `{}`", p.name, callee.name),
+                    span,
+                )
+                .with_label(format!("`{}` is required", p.name)),
             );
         }
     }
@@ -679,12 +1025,26 @@ fn bind(params: &[PView], rest: bool, recv: &Option<(Value, Span)>, args: &[ArgV
 
 fn type_mismatch(param: &str, want: Type, v: &Value, span: Span) -> Diagnostic {
     let found = v.ty().map_or("?".to_string(), |t| t.to_string());
-    let mut d = Diagnostic::error("E0300", format!("expected `{want}` for `{param}`, found `{found}`"), span)
-        .with_label(format!("this is `{found}`"));
-    match (want, v.ty()) {
-        (Type::Angle, Some(Type::Float | Type::Int)) => d = d.with_help("give the angle a unit: `90deg` or `1.57rad`"),
+    let mut d = Diagnostic::error(
+        "E0300",
+        format!("`{param}` expects a `{want}`, found `{found}`"),
+        span,
+    )
+    .with_label(format!("this is `{found}`"));
+    d = with_type_help(d, want, v.ty());
+    d
+}
+
+/// Adds the hint for a common type mix-up (a number for an angle, a float for an int...).
+fn with_type_help(mut d: Diagnostic, want: Type, found: Option<Type>) -> Diagnostic {
+    match (want, found) {
+        (Type::Angle, Some(Type::Float | Type::Int)) => {
+            d = d.with_help("give the angle a unit: `90deg` or `1.57rad`")
+        }
         (Type::Int, Some(Type::Float)) => d = d.with_help("use a whole number, or `int(x)`"),
-        (Type::Vec3, Some(Type::Float | Type::Int)) => d = d.with_help("write a vector as `(x, y, z)`"),
+        (Type::Vec3, Some(Type::Float | Type::Int)) => {
+            d = d.with_help("write a vector as `(x, y, z)`")
+        }
         _ => {}
     }
     d
@@ -692,15 +1052,32 @@ fn type_mismatch(param: &str, want: Type, v: &Value, span: Span) -> Diagnostic {
 
 /// Binds the fields of a record block (`phong { ... }`, `camera { ... }`) as named arguments,
 /// applying defaults and range checks. Returns the values by field name.
-pub fn record(cx: &mut Ctx, rec: &builtins::Record, fields: &[Field], head: &Ident) -> HashMap<&'static str, Value> {
+pub fn record(
+    cx: &mut Ctx,
+    rec: &builtins::Record,
+    fields: &[Field],
+    head: &Ident,
+) -> HashMap<&'static str, Value> {
     let mut out: HashMap<&'static str, Value> = HashMap::new();
     let mut spans: HashMap<&'static str, Span> = HashMap::new();
     for f in fields {
         let v = cx.expr(&f.value);
         let Some(p) = rec.fields.iter().find(|p| p.name == f.name.name) else {
-            let mut d = Diagnostic::error("E0202", format!("`{}` has no field `{}`", rec.name, f.name.name), f.name.span)
-                .with_label("unknown field")
-                .with_note(format!("the fields of `{}` are {}", rec.name, rec.fields.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")));
+            let mut d = Diagnostic::error(
+                "E0202",
+                format!("`{}` has no field `{}`", rec.name, f.name.name),
+                f.name.span,
+            )
+            .with_label("unknown field")
+            .with_note(format!(
+                "the fields of `{}` are {}",
+                rec.name,
+                rec.fields
+                    .iter()
+                    .map(|p| p.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
             if let Some(s) = closest(&f.name.name, rec.fields.iter().map(|p| p.name)) {
                 d = d.with_help(format!("did you mean `{s}`?"));
             }
@@ -709,9 +1086,13 @@ pub fn record(cx: &mut Ctx, rec: &builtins::Record, fields: &[Field], head: &Ide
         };
         if let Some(prev) = spans.get(p.name) {
             cx.error(
-                Diagnostic::error("E0203", format!("field `{}` is given twice", p.name), f.name.span)
-                    .with_label("given again here")
-                    .with_secondary(*prev, "first given here"),
+                Diagnostic::error(
+                    "E0203",
+                    format!("field `{}` is given twice", p.name),
+                    f.name.span,
+                )
+                .with_label("given again here")
+                .with_secondary(*prev, "first given here"),
             );
             continue;
         }
@@ -725,7 +1106,10 @@ pub fn record(cx: &mut Ctx, rec: &builtins::Record, fields: &[Field], head: &Ide
         };
         if !v.is_abstract() {
             if let Err(why) = p.range.check(&v) {
-                cx.error(Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span).with_label(format!("this is {v}")));
+                cx.error(
+                    Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span)
+                        .with_label(format!("this is {v}")),
+                );
                 out.insert(p.name, Value::Error);
                 continue;
             }
@@ -739,8 +1123,12 @@ pub fn record(cx: &mut Ctx, rec: &builtins::Record, fields: &[Field], head: &Ide
         match p.def {
             Def::Req => {
                 cx.error(
-                    Diagnostic::error("E0204", format!("missing field `{}` of `{}`", p.name, rec.name), head.span)
-                        .with_label(format!("`{}` is required", p.name)),
+                    Diagnostic::error(
+                        "E0204",
+                        format!("missing field `{}` of `{}`", p.name, rec.name),
+                        head.span,
+                    )
+                    .with_label(format!("`{}` is required", p.name)),
                 );
                 out.insert(p.name, Value::Error);
             }

@@ -47,11 +47,21 @@ impl Loader for NoImports {
 
 /// Checks the file `entry` of `sources` and everything it imports (added to `sources`).
 /// Returns the scene when there are no errors, and all diagnostics.
-pub fn check(sources: &mut SourceMap, entry: FileId, loader: &mut dyn Loader) -> (Option<Scene>, Vec<Diagnostic>) {
+pub fn check(
+    sources: &mut SourceMap,
+    entry: FileId,
+    loader: &mut dyn Loader,
+) -> (Option<Scene>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut items = Vec::new();
     let mut stack = Vec::new();
     load_file(sources, entry, loader, &mut stack, &mut items, &mut diags);
+    if crate::diagnostics::has_errors(&diags) {
+        // After a lexical, syntax or import error, names and items may be missing: checking
+        // would report mistakes that are only echoes of the first ones.
+        diags.sort_by_key(|d| (d.span().file, d.span().start));
+        return (None, diags);
+    }
     let mut cx = Ctx::default();
     cx.diags = diags;
     let scene = check_items(&mut cx, &items, entry);
@@ -107,13 +117,19 @@ fn import(
     let (name, text) = match loader.load(&from_name, path) {
         Ok(x) => x,
         Err(msg) => {
-            diags.push(Diagnostic::error("E0501", format!("cannot import `{path}`"), span).with_label(msg));
+            diags.push(
+                Diagnostic::error("E0501", format!("cannot import `{path}`"), span).with_label(msg),
+            );
             return;
         }
     };
     if let Some(existing) = sources.find(&name) {
         if stack.contains(&existing) {
-            let chain: Vec<&str> = stack.iter().map(|f| sources.name(*f)).chain([name.as_str()]).collect();
+            let chain: Vec<&str> = stack
+                .iter()
+                .map(|f| sources.name(*f))
+                .chain([name.as_str()])
+                .collect();
             diags.push(
                 Diagnostic::error("E0500", "import cycle", span)
                     .with_label(format!("`{path}` is already being imported"))
@@ -124,7 +140,11 @@ fn import(
         return;
     }
     if sources.len() >= MAX_FILES {
-        diags.push(Diagnostic::error("E0507", format!("more than {MAX_FILES} files are imported"), span));
+        diags.push(Diagnostic::error(
+            "E0507",
+            format!("more than {MAX_FILES} files are imported"),
+            span,
+        ));
         return;
     }
     let id = sources.add(name, text);
@@ -133,16 +153,19 @@ fn import(
 
 fn dup(cx: &mut Ctx, what: &str, name: &ast::Ident, first: Span) {
     cx.error(
-        Diagnostic::error("E0207", format!("duplicate definition of {what} `{}`", name.name), name.span)
-            .with_label("defined again here")
-            .with_secondary(first, "first defined here"),
+        Diagnostic::error(
+            "E0207",
+            format!("duplicate definition of {what} `{}`", name.name),
+            name.span,
+        )
+        .with_label("defined again here")
+        .with_secondary(first, "first defined here"),
     );
 }
 
 fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     collect_functions(cx, items);
     reject_recursion(cx);
-    check_function_bodies(cx);
     for item in items {
         if let ast::Item::Let(l) = item {
             if let Some(first) = cx.declared.get(&l.name.name).copied() {
@@ -152,7 +175,10 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
             }
         }
     }
-    let mut scene = Scene { materials: vec![Material::default_material()], ..Scene::default() };
+    let mut scene = Scene {
+        materials: vec![Material::default_material()],
+        ..Scene::default()
+    };
     let mut seen_blocks: HashMap<&str, Span> = HashMap::new();
     let mut scene_item = None;
     for item in items {
@@ -164,41 +190,86 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
                 let v = cx.let_value(l);
                 cx.globals.insert(l.name.name.clone(), (v, l.name.span));
             }
-            ast::Item::Material { name, kind, fields, .. } => material(cx, &mut scene, name, kind, fields),
+            ast::Item::Material {
+                name, kind, fields, ..
+            } => material(cx, &mut scene, name, kind, fields),
             ast::Item::Block(b) => {
                 let once = b.keyword.name != "light";
                 if once {
                     if let Some(first) = seen_blocks.get(b.keyword.name.as_str()) {
                         cx.error(
-                            Diagnostic::error("E0504", format!("more than one `{}` block", b.keyword.name), b.keyword.span)
-                                .with_label("second block")
-                                .with_secondary(*first, "first block"),
+                            Diagnostic::error(
+                                "E0504",
+                                format!("more than one `{}` block", b.keyword.name),
+                                b.keyword.span,
+                            )
+                            .with_label("second block")
+                            .with_secondary(*first, "first block"),
                         );
                         continue;
                     }
-                    seen_blocks.insert(if b.keyword.name == "camera" { "camera" } else { "render" }, b.keyword.span);
+                    seen_blocks.insert(
+                        if b.keyword.name == "camera" {
+                            "camera"
+                        } else {
+                            "render"
+                        },
+                        b.keyword.span,
+                    );
                 }
                 block(cx, &mut scene, b);
             }
             ast::Item::Scene { span, .. } => {
                 if let Some((_, first)) = scene_item {
                     cx.error(
-                        Diagnostic::error("E0504", "more than one `scene` block", Span { end: span.start + 5, ..*span })
-                            .with_label("second scene")
-                            .with_secondary(first, "first scene"),
+                        Diagnostic::error(
+                            "E0504",
+                            "more than one `scene` block",
+                            Span {
+                                end: span.start + 5,
+                                ..*span
+                            },
+                        )
+                        .with_label("second scene")
+                        .with_secondary(first, "first scene"),
                     );
                 } else {
-                    scene_item = Some((item, Span { end: span.start + 5, ..*span }));
+                    scene_item = Some((
+                        item,
+                        Span {
+                            end: span.start + 5,
+                            ..*span
+                        },
+                    ));
                 }
             }
             ast::Item::Fn(_) | ast::Item::Import { .. } | ast::Item::Error(_) => {}
         }
     }
+    // Functions never called are still checked.
+    let mut unchecked: Vec<(u32, String)> = cx
+        .fns
+        .iter()
+        .filter(|(_, f)| !f.checked)
+        .map(|(n, f)| (f.decl.span.start, n.clone()))
+        .collect();
+    unchecked.sort();
+    for (_, name) in unchecked {
+        cx.check_function(&name);
+    }
     match scene_item {
         Some((ast::Item::Scene { stmts, span }, _)) => scene.root = objects(cx, stmts, *span),
         _ => cx.error(
-            Diagnostic::error("E0503", "no `scene` block", Span { file: entry, start: 0, end: 0 })
-                .with_help("add the objects to render: `scene { sphere(1) @ red; }`"),
+            Diagnostic::error(
+                "E0503",
+                "no `scene` block",
+                Span {
+                    file: entry,
+                    start: 0,
+                    end: 0,
+                },
+            )
+            .with_help("add the objects to render: `scene { sphere(1) @ red; }`"),
         ),
     }
     scene.graph = std::mem::take(&mut cx.graph);
@@ -215,9 +286,13 @@ fn collect_functions(cx: &mut Ctx, items: &[ast::Item]) {
         }
         if builtins::builtin(&f.name.name).is_some() {
             cx.error(
-                Diagnostic::error("E0207", format!("`{}` is a built-in function", f.name.name), f.name.span)
-                    .with_label("this would hide it")
-                    .with_help("choose another name"),
+                Diagnostic::error(
+                    "E0207",
+                    format!("`{}` is a built-in function", f.name.name),
+                    f.name.span,
+                )
+                .with_label("this would hide it")
+                .with_help("choose another name"),
             );
             continue;
         }
@@ -232,28 +307,52 @@ fn collect_functions(cx: &mut Ctx, items: &[ast::Item]) {
         let params: Vec<Option<Type>> = f.params.iter().map(|p| cx.type_name(&p.ty)).collect();
         let ret = cx.type_name(&f.ret);
         ok &= params.iter().all(Option::is_some) && ret.is_some();
-        cx.fns.insert(f.name.name.clone(), FnInfo { decl: Rc::new(f.clone()), params, ret, ok });
+        cx.fns.insert(
+            f.name.name.clone(),
+            FnInfo {
+                decl: Rc::new(f.clone()),
+                params,
+                ret,
+                ok,
+                checked: false,
+            },
+        );
     }
 }
 
 /// Calls made by a function body, by name, with their spans.
 fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
-    let mut stack: Vec<&ast::Expr> = body.lets.iter().map(|l| &l.value).chain([&*body.value]).collect();
+    let mut stack: Vec<&ast::Expr> = body
+        .lets
+        .iter()
+        .map(|l| &l.value)
+        .chain([&*body.value])
+        .collect();
     while let Some(e) = stack.pop() {
         match &e.kind {
             ast::ExprKind::Call { callee, args } => {
                 out.push((callee.name.clone(), callee.span));
                 stack.extend(args.iter().map(|a| &a.value));
             }
-            ast::ExprKind::Method { receiver, name, args } => {
+            ast::ExprKind::Method {
+                receiver,
+                name,
+                args,
+            } => {
                 out.push((name.name.clone(), name.span));
                 stack.push(receiver);
                 stack.extend(args.iter().map(|a| &a.value));
             }
             ast::ExprKind::Tuple(xs) => stack.extend(xs),
-            ast::ExprKind::Unary(_, x) | ast::ExprKind::Field(x, _) | ast::ExprKind::Material(x, _) => stack.push(x),
+            ast::ExprKind::Unary(_, x)
+            | ast::ExprKind::Field(x, _)
+            | ast::ExprKind::Material(x, _) => stack.push(x),
             ast::ExprKind::Binary(_, a, b) => stack.extend([&**a, &**b]),
-            ast::ExprKind::If { cond, then, otherwise } => {
+            ast::ExprKind::If {
+                cond,
+                then,
+                otherwise,
+            } => {
                 stack.push(cond);
                 for b in [then, otherwise] {
                     stack.extend(b.lets.iter().map(|l| &l.value));
@@ -273,7 +372,14 @@ fn reject_recursion(cx: &mut Ctx) {
         calls_in(&info.decl.body, &mut calls);
         for p in &info.decl.params {
             if let Some(d) = &p.default {
-                calls_in(&ast::Body { lets: Vec::new(), value: Box::new(d.clone()), span: d.span }, &mut calls);
+                calls_in(
+                    &ast::Body {
+                        lets: Vec::new(),
+                        value: Box::new(d.clone()),
+                        span: d.span,
+                    },
+                    &mut calls,
+                );
             }
         }
         calls.retain(|(c, _)| cx.fns.contains_key(c));
@@ -292,8 +398,10 @@ fn reject_recursion(cx: &mut Ctx) {
                 let mut p = path.clone();
                 p.push((callee.clone(), *span));
                 if callee == start {
+                    // One report per cycle: every function on it is marked.
                     if !bad.contains(start) {
                         bad.insert(start.clone());
+                        bad.extend(p.iter().map(|(n, _)| n.clone()));
                         reports.push((start.clone(), p.clone()));
                     }
                 } else if seen.insert(callee.clone()) {
@@ -302,8 +410,11 @@ fn reject_recursion(cx: &mut Ctx) {
             }
         }
     }
-    for (name, path) in reports {
-        let chain: Vec<&str> = std::iter::once(name.as_str()).chain(path.iter().map(|(n, _)| n.as_str())).collect();
+    for (name, path) in &reports {
+        let chain: Vec<&str> = std::iter::once(name.as_str())
+            .chain(path.iter().map(|(n, _)| n.as_str()))
+            .collect();
+        let name = name.clone();
         let span = path[0].1;
         cx.error(
             Diagnostic::error("E0502", format!("function `{name}` calls itself"), span)
@@ -311,58 +422,21 @@ fn reject_recursion(cx: &mut Ctx) {
                 .with_note(format!("the call chain is {}", chain.join(" → ")))
                 .with_note("scenes are evaluated at compile time, so functions cannot recurse; use a `for` loop in the scene"),
         );
-        if let Some(info) = cx.fns.get_mut(&name) {
+    }
+    for name in &bad {
+        if let Some(info) = cx.fns.get_mut(name) {
             info.ok = false;
         }
     }
 }
 
-/// Checks every function body once with its parameters unknown, so that a function's type
-/// errors are reported whether or not it is called.
-fn check_function_bodies(cx: &mut Ctx) {
-    let mut names: Vec<String> = cx.fns.keys().cloned().collect();
-    names.sort_by_key(|n| cx.fns[n].decl.span.start);
-    for name in names {
-        let (decl, params, ret) = {
-            let info = &cx.fns[&name];
-            (info.decl.clone(), info.params.clone(), info.ret)
-        };
-        let before = cx.diags.len();
-        let mark = cx.locals_mark();
-        cx.dry(|cx| {
-            for (p, t) in decl.params.iter().zip(&params) {
-                if let (Some(d), Some(t)) = (&p.default, t) {
-                    let v = cx.expr(d);
-                    if v.clone().coerce(*t).is_none() {
-                        cx.error(
-                            Diagnostic::error("E0300", format!("the default of `{}` is not a `{t}`", p.name.name), d.span)
-                                .with_label(format!("this is `{}`", v.ty().map_or("?".into(), |t| t.to_string()))),
-                        );
-                    }
-                }
-                cx.push_local(&p.name.name, t.map_or(Value::Error, Value::Unknown));
-            }
-            let v = cx.body(&decl.body);
-            if let (Some(want), Some(got)) = (ret, v.ty()) {
-                if !got.fits(want) {
-                    cx.error(
-                        Diagnostic::error("E0300", format!("`{name}` returns `{got}`, but is declared to return `{want}`"), decl.body.value.span)
-                            .with_label(format!("this is `{got}`"))
-                            .with_secondary(decl.ret.span, "declared here"),
-                    );
-                }
-            }
-        });
-        cx.truncate_locals(mark);
-        if cx.diags[before..].iter().any(Diagnostic::is_error) {
-            if let Some(info) = cx.fns.get_mut(&name) {
-                info.ok = false;
-            }
-        }
-    }
-}
-
-fn material(cx: &mut Ctx, scene: &mut Scene, name: &ast::Ident, kind: &ast::Ident, fields: &[ast::Field]) {
+fn material(
+    cx: &mut Ctx,
+    scene: &mut Scene,
+    name: &ast::Ident,
+    kind: &ast::Ident,
+    fields: &[ast::Field],
+) {
     let rec = builtins::MATERIALS.iter().find(|r| r.name == kind.name);
     if let Some((_, first)) = cx.material_ids.get(&name.name) {
         let first = *first;
@@ -370,9 +444,13 @@ fn material(cx: &mut Ctx, scene: &mut Scene, name: &ast::Ident, kind: &ast::Iden
         return;
     }
     let Some(rec) = rec else {
-        let mut d = Diagnostic::error("E0211", format!("unknown material kind `{}`", kind.name), kind.span)
-            .with_label("not a material kind")
-            .with_note("the material kinds are phong and checker");
+        let mut d = Diagnostic::error(
+            "E0211",
+            format!("unknown material kind `{}`", kind.name),
+            kind.span,
+        )
+        .with_label("not a material kind")
+        .with_note("the material kinds are phong and checker");
         if let Some(s) = suggest::closest(&kind.name, builtins::MATERIALS.iter().map(|r| r.name)) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
@@ -383,13 +461,24 @@ fn material(cx: &mut Ctx, scene: &mut Scene, name: &ast::Ident, kind: &ast::Iden
     let (reflect, transparency) = (f["reflect"].num(), f["transparency"].num());
     if reflect + transparency > 1.0 + 1e-12 {
         cx.error(
-            Diagnostic::error("E0506", "`reflect` and `transparency` add up to more than 1", name.span)
-                .with_label(format!("{reflect} + {transparency} = {}", reflect + transparency))
-                .with_note("the surface's own colour is weighted by 1 − reflect − transparency"),
+            Diagnostic::error(
+                "E0506",
+                "`reflect` and `transparency` add up to more than 1",
+                name.span,
+            )
+            .with_label(format!(
+                "{reflect} + {transparency} = {}",
+                reflect + transparency
+            ))
+            .with_note("the surface's own colour is weighted by 1 − reflect − transparency"),
         );
     }
     let pattern = if rec.name == "checker" {
-        Pattern::Checker { a: f["a"].v3(), b: f["b"].v3(), size: f["size"].num() }
+        Pattern::Checker {
+            a: f["a"].v3(),
+            b: f["b"].v3(),
+            size: f["size"].num(),
+        }
     } else {
         Pattern::Solid(f["color"].v3())
     };
@@ -412,11 +501,19 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
     match (b.keyword.name.as_str(), &b.kind) {
         ("camera", _) => {
             let f = eval::record(cx, &builtins::CAMERA, &b.fields, &b.keyword);
-            scene.camera = Camera { position: f["position"].v3(), look_at: f["look_at"].v3(), fov: f["fov"].num() };
+            scene.camera = Camera {
+                position: f["position"].v3(),
+                look_at: f["look_at"].v3(),
+                fov: f["fov"].num(),
+            };
             if scene.camera.position == scene.camera.look_at && !f["position"].is_abstract() {
                 cx.error(
-                    Diagnostic::error("E0400", "the camera looks at its own position", b.keyword.span)
-                        .with_label("`position` and `look_at` are equal"),
+                    Diagnostic::error(
+                        "E0400",
+                        "the camera looks at its own position",
+                        b.keyword.span,
+                    )
+                    .with_label("`position` and `look_at` are equal"),
                 );
             }
         }
@@ -437,23 +534,43 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
         }
         (_, Some(kind)) => {
             let Some(rec) = builtins::LIGHTS.iter().find(|r| r.name == kind.name) else {
-                let mut d = Diagnostic::error("E0211", format!("unknown light kind `{}`", kind.name), kind.span)
-                    .with_label("not a light kind")
-                    .with_note("the light kinds are point and directional");
-                if let Some(s) = suggest::closest(&kind.name, builtins::LIGHTS.iter().map(|r| r.name)) {
+                let mut d = Diagnostic::error(
+                    "E0211",
+                    format!("unknown light kind `{}`", kind.name),
+                    kind.span,
+                )
+                .with_label("not a light kind")
+                .with_note("the light kinds are point and directional");
+                if let Some(s) =
+                    suggest::closest(&kind.name, builtins::LIGHTS.iter().map(|r| r.name))
+                {
                     d = d.with_help(format!("did you mean `{s}`?"));
                 }
                 cx.error(d);
                 return;
             };
             let f = eval::record(cx, rec, &b.fields, kind);
-            let (color, intensity, softness) = (f["color"].v3(), f["intensity"].num(), f["softness"].num());
+            let (color, intensity, softness) =
+                (f["color"].v3(), f["intensity"].num(), f["softness"].num());
             scene.lights.push(if rec.name == "point" {
-                Light::Point { position: f["position"].v3(), color, intensity, radius: f["radius"].num(), softness }
+                Light::Point {
+                    position: f["position"].v3(),
+                    color,
+                    intensity,
+                    radius: f["radius"].num(),
+                    softness,
+                }
             } else {
                 let d = f["direction"].v3();
-                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(f64::MIN_POSITIVE);
-                Light::Directional { direction: [d[0] / len, d[1] / len, d[2] / len], color, intensity, softness }
+                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                    .sqrt()
+                    .max(f64::MIN_POSITIVE);
+                Light::Directional {
+                    direction: [d[0] / len, d[1] / len, d[2] / len],
+                    color,
+                    intensity,
+                    softness,
+                }
             });
         }
         _ => {}
@@ -467,15 +584,29 @@ fn objects(cx: &mut Ctx, stmts: &[ast::Stmt], span: Span) -> Option<crate::scene
     stmts_into(cx, stmts, &mut out);
     cx.truncate_locals(mark);
     match out.len() {
+        0 if crate::diagnostics::has_errors(&cx.diags) => None,
         0 => {
             cx.error(
-                Diagnostic::warning("W0001", "the scene has no objects", Span { end: span.start + 5, ..span })
-                    .with_label("renders only the background"),
+                Diagnostic::warning(
+                    "W0001",
+                    "the scene has no objects",
+                    Span {
+                        end: span.start + 5,
+                        ..span
+                    },
+                )
+                .with_label("renders only the background"),
             );
             None
         }
         1 => Some(out[0]),
-        _ => match cx.add_node(Node::Combine { op: Combine::Union, children: out }, span) {
+        _ => match cx.add_node(
+            Node::Combine {
+                op: Combine::Union,
+                children: out,
+            },
+            span,
+        ) {
             Value::Shape(id) => Some(id),
             _ => None,
         },
@@ -490,9 +621,14 @@ fn stmts_into(cx: &mut Ctx, stmts: &[ast::Stmt], out: &mut Vec<crate::scene::Nod
                 cx.push_local(&l.name.name, v);
             }
             ast::Stmt::Object(e) => match cx.expr(e) {
+                // Already reported, or unknown only because of an earlier error.
+                Value::Unknown(Type::Shape) => {}
                 Value::Shape(id) => {
                     if out.len() >= MAX_OBJECTS {
-                        cx.limit(e.span, format!("the scene has more than {MAX_OBJECTS} objects"));
+                        cx.limit(
+                            e.span,
+                            format!("the scene has more than {MAX_OBJECTS} objects"),
+                        );
                         return;
                     }
                     out.push(id)
@@ -500,33 +636,64 @@ fn stmts_into(cx: &mut Ctx, stmts: &[ast::Stmt], out: &mut Vec<crate::scene::Nod
                 Value::Error => {}
                 other => cx.error(
                     Diagnostic::error("E0300", "a scene statement must be a shape", e.span)
-                        .with_label(format!("this is `{}`", other.ty().map_or("?".into(), |t| t.to_string()))),
+                        .with_label(format!(
+                            "this is `{}`",
+                            other.ty().map_or("?".into(), |t| t.to_string())
+                        )),
                 ),
             },
-            ast::Stmt::For { var, from, to, body, .. } => for_loop(cx, var, from, to, body, out),
+            ast::Stmt::For {
+                var,
+                from,
+                to,
+                body,
+                ..
+            } => for_loop(cx, var, from, to, body, out),
             ast::Stmt::Error(_) => {}
         }
     }
 }
 
-fn for_loop(cx: &mut Ctx, var: &ast::Ident, from: &ast::Expr, to: &ast::Expr, body: &[ast::Stmt], out: &mut Vec<crate::scene::NodeId>) {
+fn for_loop(
+    cx: &mut Ctx,
+    var: &ast::Ident,
+    from: &ast::Expr,
+    to: &ast::Expr,
+    body: &[ast::Stmt],
+    out: &mut Vec<crate::scene::NodeId>,
+) {
     let bound = |e: &ast::Expr, cx: &mut Ctx| match cx.expr(e) {
         Value::Int(i) => Some(i),
         Value::Error => None,
         other => {
             cx.error(
-                Diagnostic::error("E0300", "loop bounds must be `int`", e.span)
-                    .with_label(format!("this is `{}`", other.ty().map_or("?".into(), |t| t.to_string()))),
+                Diagnostic::error("E0300", "loop bounds must be `int`", e.span).with_label(
+                    format!(
+                        "this is `{}`",
+                        other.ty().map_or("?".into(), |t| t.to_string())
+                    ),
+                ),
             );
             None
         }
     };
-    let (Some(a), Some(b)) = (bound(from, cx), bound(to, cx)) else { return };
+    let (Some(a), Some(b)) = (bound(from, cx), bound(to, cx)) else {
+        return;
+    };
     if b.saturating_sub(a) > MAX_OBJECTS as i64 {
-        cx.limit(to.span, format!("the loop runs {} times, more than {MAX_OBJECTS}", b.saturating_sub(a)));
+        cx.limit(
+            to.span,
+            format!(
+                "the loop runs {} times, more than {MAX_OBJECTS}",
+                b.saturating_sub(a)
+            ),
+        );
         return;
     }
     for i in a..b {
+        if !cx.burn(var.span) {
+            return;
+        }
         let mark = cx.locals_mark();
         cx.push_local(&var.name, Value::Int(i));
         let errors_before = cx.diags.len();

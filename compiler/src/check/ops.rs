@@ -10,8 +10,8 @@ pub enum OpError {
     Types(String),
     /// Integer division or remainder by zero.
     DivZero,
-    /// Anything else (integer overflow).
-    Other(String),
+    /// Integer overflow.
+    Overflow,
 }
 
 fn tname(v: &Value) -> String {
@@ -22,16 +22,26 @@ fn tname(v: &Value) -> String {
 pub fn unary(op: UnOp, v: &Value) -> Result<Value, OpError> {
     Ok(match (op, v) {
         (_, Value::Error) => Value::Error,
-        (UnOp::Neg, Value::Int(i)) => Value::Int(i.checked_neg().ok_or_else(|| OpError::Other("integer overflow".into()))?),
+        (UnOp::Neg, Value::Int(i)) => Value::Int(i.checked_neg().ok_or(OpError::Overflow)?),
         (UnOp::Neg, Value::Float(f)) => Value::Float(-f),
         (UnOp::Neg, Value::Angle(f)) => Value::Angle(-f),
         (UnOp::Neg, Value::Vec2(a)) => Value::Vec2([-a[0], -a[1]]),
         (UnOp::Neg, Value::Vec3(a)) => Value::Vec3([-a[0], -a[1], -a[2]]),
-        (UnOp::Neg, Value::Unknown(t @ (Type::Int | Type::Float | Type::Angle | Type::Vec2 | Type::Vec3))) => Value::Unknown(*t),
+        (
+            UnOp::Neg,
+            Value::Unknown(t @ (Type::Int | Type::Float | Type::Angle | Type::Vec2 | Type::Vec3)),
+        ) => Value::Unknown(*t),
         (UnOp::Not, Value::Bool(b)) => Value::Bool(!b),
         (UnOp::Not, Value::Unknown(Type::Bool)) => Value::Unknown(Type::Bool),
-        (UnOp::Neg, other) => return Err(OpError::Types(format!("cannot negate `{}`", tname(other)))),
-        (UnOp::Not, other) => return Err(OpError::Types(format!("`!` needs a bool, found `{}`", tname(other)))),
+        (UnOp::Neg, other) => {
+            return Err(OpError::Types(format!("cannot negate `{}`", tname(other))))
+        }
+        (UnOp::Not, other) => {
+            return Err(OpError::Types(format!(
+                "`!` needs a bool, found `{}`",
+                tname(other)
+            )))
+        }
     })
 }
 
@@ -43,7 +53,9 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
     let vec = |t: Type| matches!(t, Vec2 | Vec3);
     match op {
         Or | And => (a == Bool && b == Bool).then_some(Bool),
-        Eq | Ne => (a == b || (num(a) && num(b))).then_some(Bool).filter(|_| a != Shape),
+        Eq | Ne => (a == b || (num(a) && num(b)))
+            .then_some(Bool)
+            .filter(|_| a != Shape),
         Lt | Le | Gt | Ge => ((num(a) && num(b)) || (a == Angle && b == Angle)).then_some(Bool),
         Add | Sub => match (a, b) {
             (Int, Int) => Some(Int),
@@ -93,9 +105,14 @@ fn rebuild(like: Type, c: Vec<f64>) -> Value {
 
 /// Applies a binary operator.
 pub fn binary(op: BinOp, a: &Value, b: &Value) -> Result<Value, OpError> {
-    let (Some(ta), Some(tb)) = (a.ty(), b.ty()) else { return Ok(Value::Error) };
+    let (Some(ta), Some(tb)) = (a.ty(), b.ty()) else {
+        return Ok(Value::Error);
+    };
     let Some(ty) = binary_type(op, ta, tb) else {
-        return Err(OpError::Types(format!("`{}` cannot be applied to `{ta}` and `{tb}`", op.symbol())));
+        return Err(OpError::Types(format!(
+            "`{}` cannot be applied to `{ta}` and `{tb}`",
+            op.symbol()
+        )));
     };
     if a.is_abstract() || b.is_abstract() {
         return Ok(Value::Unknown(ty));
@@ -112,7 +129,11 @@ pub fn binary(op: BinOp, a: &Value, b: &Value) -> Result<Value, OpError> {
             Value::Bool(if op == Or { x || y } else { x && y })
         }
         Eq | Ne => {
-            let eq = if ta == Type::Str || ta == Type::Bool { a == b } else { comps(a) == comps(b) };
+            let eq = if ta == Type::Str || ta == Type::Bool {
+                a == b
+            } else {
+                comps(a) == comps(b)
+            };
             Value::Bool(eq == (op == Eq))
         }
         Lt | Le | Gt | Ge => {
@@ -141,7 +162,7 @@ pub fn binary(op: BinOp, a: &Value, b: &Value) -> Result<Value, OpError> {
 }
 
 fn int_op(op: BinOp, x: i64, y: i64) -> Result<i64, OpError> {
-    let overflow = || OpError::Other("integer overflow".into());
+    let overflow = || OpError::Overflow;
     match op {
         BinOp::Add => x.checked_add(y).ok_or_else(overflow),
         BinOp::Sub => x.checked_sub(y).ok_or_else(overflow),
@@ -159,25 +180,62 @@ mod tests {
 
     #[test]
     fn arithmetic_promotes_and_checks() {
-        assert_eq!(binary(BinOp::Add, &Value::Int(2), &Value::Int(3)), Ok(Value::Int(5)));
-        assert_eq!(binary(BinOp::Add, &Value::Int(2), &Value::Float(0.5)), Ok(Value::Float(2.5)));
-        assert_eq!(binary(BinOp::Div, &Value::Int(7), &Value::Int(2)), Ok(Value::Int(3)));
-        assert_eq!(binary(BinOp::Div, &Value::Int(7), &Value::Int(0)), Err(OpError::DivZero));
         assert_eq!(
-            binary(BinOp::Mul, &Value::Vec3([1.0, 2.0, 3.0]), &Value::Float(2.0)),
+            binary(BinOp::Add, &Value::Int(2), &Value::Int(3)),
+            Ok(Value::Int(5))
+        );
+        assert_eq!(
+            binary(BinOp::Add, &Value::Int(2), &Value::Float(0.5)),
+            Ok(Value::Float(2.5))
+        );
+        assert_eq!(
+            binary(BinOp::Div, &Value::Int(7), &Value::Int(2)),
+            Ok(Value::Int(3))
+        );
+        assert_eq!(
+            binary(BinOp::Div, &Value::Int(7), &Value::Int(0)),
+            Err(OpError::DivZero)
+        );
+        assert_eq!(
+            binary(
+                BinOp::Mul,
+                &Value::Vec3([1.0, 2.0, 3.0]),
+                &Value::Float(2.0)
+            ),
             Ok(Value::Vec3([2.0, 4.0, 6.0]))
         );
-        assert_eq!(binary(BinOp::Mul, &Value::Angle(1.0), &Value::Int(2)), Ok(Value::Angle(2.0)));
-        assert_eq!(binary(BinOp::Div, &Value::Angle(1.0), &Value::Angle(0.5)), Ok(Value::Float(2.0)));
-        assert!(matches!(binary(BinOp::Add, &Value::Angle(1.0), &Value::Float(1.0)), Err(OpError::Types(_))));
-        assert_eq!(binary(BinOp::Lt, &Value::Int(1), &Value::Float(1.5)), Ok(Value::Bool(true)));
-        assert_eq!(binary(BinOp::Mul, &Value::Int(i64::MAX), &Value::Int(2)), Err(OpError::Other("integer overflow".into())));
-        assert_eq!(binary(BinOp::Add, &Value::Unknown(Type::Float), &Value::Int(1)), Ok(Value::Unknown(Type::Float)));
+        assert_eq!(
+            binary(BinOp::Mul, &Value::Angle(1.0), &Value::Int(2)),
+            Ok(Value::Angle(2.0))
+        );
+        assert_eq!(
+            binary(BinOp::Div, &Value::Angle(1.0), &Value::Angle(0.5)),
+            Ok(Value::Float(2.0))
+        );
+        assert!(matches!(
+            binary(BinOp::Add, &Value::Angle(1.0), &Value::Float(1.0)),
+            Err(OpError::Types(_))
+        ));
+        assert_eq!(
+            binary(BinOp::Lt, &Value::Int(1), &Value::Float(1.5)),
+            Ok(Value::Bool(true))
+        );
+        assert_eq!(
+            binary(BinOp::Mul, &Value::Int(i64::MAX), &Value::Int(2)),
+            Err(OpError::Overflow)
+        );
+        assert_eq!(
+            binary(BinOp::Add, &Value::Unknown(Type::Float), &Value::Int(1)),
+            Ok(Value::Unknown(Type::Float))
+        );
     }
 
     #[test]
     fn unary_ops() {
-        assert_eq!(unary(UnOp::Neg, &Value::Vec2([1.0, -2.0])), Ok(Value::Vec2([-1.0, 2.0])));
+        assert_eq!(
+            unary(UnOp::Neg, &Value::Vec2([1.0, -2.0])),
+            Ok(Value::Vec2([-1.0, 2.0]))
+        );
         assert_eq!(unary(UnOp::Not, &Value::Bool(true)), Ok(Value::Bool(false)));
         assert!(unary(UnOp::Not, &Value::Int(1)).is_err());
     }

@@ -5,7 +5,10 @@ use crate::scene::{Light, Node};
 
 fn ok(src: &str) -> crate::scene::Scene {
     let (scene, diags, _) = check_str("t.sdf", src);
-    assert!(diags.iter().all(|d| !d.is_error()), "unexpected errors: {diags:#?}");
+    assert!(
+        diags.iter().all(|d| !d.is_error()),
+        "unexpected errors: {diags:#?}"
+    );
     scene.expect("scene")
 }
 
@@ -23,31 +26,53 @@ fn evaluates_constants_and_functions() {
 
 #[test]
 fn angles_and_vectors() {
-    let s = ok("let a = 90deg / 2;\nlet v = (1, 2, 3) * 2 - vec3(1);\nscene { box(v).rotate_y(a); }");
+    let s =
+        ok("let a = 90deg / 2;\nlet v = (1, 2, 3) * 2 - vec3(1);\nscene { box(v).rotate_y(a); }");
     let root = s.root.expect("root");
-    let Node::Rotate { matrix, child } = s.graph.node(root) else { panic!("not a rotation") };
+    let Node::Rotate { matrix, child } = s.graph.node(root) else {
+        panic!("not a rotation")
+    };
     assert!((matrix[0][0] - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-12);
-    assert_eq!(s.graph.node(*child), &Node::Box { half: [1.0, 3.0, 5.0] });
+    assert_eq!(
+        s.graph.node(*child),
+        &Node::Box {
+            half: [1.0, 3.0, 5.0]
+        }
+    );
 }
 
 #[test]
 fn loops_if_and_hash() {
     let s = ok("scene { for i in 0..4 { sphere(if i % 2 == 0 { 0.5 } else { 0.25 }).translate(i, 0, 0); } }");
-    let Node::Combine { children, .. } = s.graph.node(s.root.expect("root")) else { panic!() };
+    let Node::Combine { children, .. } = s.graph.node(s.root.expect("root")) else {
+        panic!()
+    };
     assert_eq!(children.len(), 4);
 }
 
 #[test]
 fn shared_shapes_are_one_node() {
     let s = ok("let b = sphere(1);\nscene { union(b.translate(1, 0, 0), b.translate(-1, 0, 0)); }");
-    let spheres = s.graph.ids().filter(|id| matches!(s.graph.node(*id), Node::Sphere { .. })).count();
+    let spheres = s
+        .graph
+        .ids()
+        .filter(|id| matches!(s.graph.node(*id), Node::Sphere { .. }))
+        .count();
     assert_eq!(spheres, 1);
 }
 
 #[test]
 fn lights_are_normalised() {
     let s = ok("light directional { direction: (0, -2, 0) }\nscene { sphere(); }");
-    assert_eq!(s.lights[0], Light::Directional { direction: [0.0, -1.0, 0.0], color: [1.0; 3], intensity: 1.0, softness: 0.0 });
+    assert_eq!(
+        s.lights[0],
+        Light::Directional {
+            direction: [0.0, -1.0, 0.0],
+            color: [1.0; 3],
+            intensity: 1.0,
+            softness: 0.0
+        }
+    );
 }
 
 #[test]
@@ -57,14 +82,29 @@ fn reports_mistakes() {
     assert_eq!(codes("scene { sphere(radius: 1, radius: 2); }"), ["E0203"]);
     assert_eq!(codes("scene { torus(1, 0.2).rotate_x(90); }"), ["E0300"]);
     assert_eq!(codes("let x = 1 / 0;\nscene { sphere(); }"), ["E0401"]);
-    assert_eq!(codes("fn f(a: float) -> shape { f(a) }\nscene { f(1); }"), ["E0502"]);
+    assert_eq!(
+        codes("fn f(a: float) -> shape { f(a) }\nscene { f(1); }"),
+        ["E0502"]
+    );
     assert_eq!(codes("let a = 1;"), ["E0503"]);
-    assert_eq!(codes("let a = b;\nlet b = 1;\nscene { sphere(); }"), ["E0208"]);
-    assert_eq!(codes("material m = phong { ior: 0.5 };\nscene { sphere() @ m; }"), ["E0400"]);
+    assert_eq!(
+        codes("let a = b;\nlet b = 1;\nscene { sphere(); }"),
+        ["E0208"]
+    );
+    assert_eq!(
+        codes("material m = phong { ior: 0.5 };\nscene { sphere() @ m; }"),
+        ["E0400"]
+    );
 }
 
 #[test]
 fn function_bodies_are_checked_without_calls() {
-    assert_eq!(codes("fn f(a: float) -> shape { a + true }\nscene { sphere(); }"), ["E0301"]);
-    assert_eq!(codes("fn f(a: float) -> float { sphere(a) }\nscene { sphere(); }"), ["E0300"]);
+    assert_eq!(
+        codes("fn f(a: float) -> shape { a + true }\nscene { sphere(); }"),
+        ["E0301"]
+    );
+    assert_eq!(
+        codes("fn f(a: float) -> float { sphere(a) }\nscene { sphere(); }"),
+        ["E0300"]
+    );
 }

@@ -34,7 +34,9 @@ impl Type {
     }
 
     /// All type names, for suggestions.
-    pub const NAMES: [&'static str; 8] = ["int", "float", "bool", "vec2", "vec3", "angle", "string", "shape"];
+    pub const NAMES: [&'static str; 8] = [
+        "int", "float", "bool", "vec2", "vec3", "angle", "string", "shape",
+    ];
 
     /// True when a value of type `self` may be passed where `want` is expected.
     pub fn fits(self, want: Type) -> bool {

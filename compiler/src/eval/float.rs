@@ -176,7 +176,9 @@ mod tests {
 
     #[test]
     fn floor_matches_std() {
-        for &x in &[-2.5f32, -2.0, -0.5, -0.0, 0.0, 0.3, 1.0, 1.7, 1e7, -1e7, 3e9, -3e9] {
+        for &x in &[
+            -2.5f32, -2.0, -0.5, -0.0, 0.0, 0.3, 1.0, 1.7, 1e7, -1e7, 3e9, -3e9,
+        ] {
             assert_eq!(Float::floor(x), x.floor(), "{x}");
         }
         for &x in &[-2.5f64, -1e15, 1e15 + 0.5, 7.0, -7.25, 1e300] {

@@ -40,7 +40,10 @@ pub fn eval_point<T: Float>(program: &Program, p: [T; 3]) -> (T, u32) {
         regs.push(v);
     }
     let get = |i: crate::lower::Reg| regs.get(i.0 as usize).copied().unwrap_or_else(T::zero);
-    (get(program.distance()), material_id(get(program.material())))
+    (
+        get(program.distance()),
+        material_id(get(program.material())),
+    )
 }
 
 /// A material register value as an id (saturating: negative and NaN give 0).
@@ -58,7 +61,8 @@ pub fn material_id<T: Float>(m: T) -> u32 {
 #[derive(Debug)]
 pub struct Evaluator<'t, T: Float> {
     tape: &'t Tape,
-    slots: Vec<Vec<T>>,
+    /// `slot_count` slots of `chunk` values each, back to back.
+    slots: Vec<T>,
     chunk: usize,
 }
 
@@ -66,9 +70,9 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// An evaluator for `tape` processing up to `chunk` points per pass (at least 1).
     pub fn new(tape: &'t Tape, chunk: usize) -> Self {
         let chunk = chunk.max(1);
-        let mut slots = vec![vec![T::zero(); chunk]; tape.slot_count()];
+        let mut slots = vec![T::zero(); chunk * tape.slot_count()];
         for &(slot, c) in tape.constants() {
-            slots[slot as usize].fill(T::from_f64(c));
+            slots[slot as usize * chunk..][..chunk].fill(T::from_f64(c));
         }
         Evaluator { tape, slots, chunk }
     }
@@ -88,7 +92,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
             let end = (start + self.chunk).min(n);
             self.run(&x[start..end], &y[start..end], &z[start..end]);
             let len = end - start;
-            d[start..end].copy_from_slice(&self.slots[self.tape.distance_slot() as usize][..len]);
+            d[start..end].copy_from_slice(self.slot(self.tape.distance_slot(), len));
             if let Some(m) = m.as_deref_mut() {
                 let stop = end.min(m.len());
                 self.write_materials(&mut m[start.min(stop)..stop]);
@@ -100,7 +104,8 @@ impl<'t, T: Float> Evaluator<'t, T> {
     fn write_materials(&self, out: &mut [u32]) {
         match self.tape.material_slot() {
             Some(s) => {
-                for (o, &v) in out.iter_mut().zip(&self.slots[s as usize]) {
+                let n = out.len();
+                for (o, &v) in out.iter_mut().zip(self.slot(s, n)) {
                     *o = material_id(v);
                 }
             }
@@ -108,18 +113,22 @@ impl<'t, T: Float> Evaluator<'t, T> {
         }
     }
 
+    /// The first `n` values of a slot.
+    fn slot(&self, s: u32, n: usize) -> &[T] {
+        &self.slots[s as usize * self.chunk..][..n]
+    }
+
     /// One pass over the tape for up to `chunk` points.
     fn run(&mut self, x: &[T], y: &[T], z: &[T]) {
         let n = x.len();
+        let chunk = self.chunk;
         for (axis, src) in [(Axis::X, x), (Axis::Y, y), (Axis::Z, z)] {
             if let Some(s) = self.tape.input_slot(axis) {
-                self.slots[s as usize][..n].copy_from_slice(src);
+                self.slots[s as usize * chunk..][..n].copy_from_slice(src);
             }
         }
         for step in self.tape.steps() {
-            let mut dst = std::mem::take(&mut self.slots[step.dst as usize]);
-            step.apply(&mut dst[..n], &self.slots, n);
-            self.slots[step.dst as usize] = dst;
+            step.apply(&mut self.slots, chunk, n);
         }
     }
 }

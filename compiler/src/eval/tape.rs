@@ -68,8 +68,18 @@ impl Tape {
             roots.push(program.material());
         }
         let last_use = last_uses(ops, &roots);
-        let mut alloc = Allocator { slot_of: vec![None; ops.len()], ..Default::default() };
-        let mut tape = Tape { steps: Vec::new(), constants: Vec::new(), inputs: [None; 3], slots: 0, distance: 0, material: None };
+        let mut alloc = Allocator {
+            slot_of: vec![None; ops.len()],
+            ..Default::default()
+        };
+        let mut tape = Tape {
+            steps: Vec::new(),
+            constants: Vec::new(),
+            inputs: [None; 3],
+            slots: 0,
+            distance: 0,
+            material: None,
+        };
         // Constants and inputs keep their own slots for the evaluator's whole life.
         for (i, op) in ops.iter().enumerate() {
             if last_use[i].is_none() {
@@ -94,7 +104,14 @@ impl Tape {
                 tape.steps.push(step(i, op, &mut alloc, &last_use, ops));
             }
         }
-        let slot = |r: Reg| alloc.slot_of.get(r.0 as usize).copied().flatten().unwrap_or(0);
+        let slot = |r: Reg| {
+            alloc
+                .slot_of
+                .get(r.0 as usize)
+                .copied()
+                .flatten()
+                .unwrap_or(0)
+        };
         tape.distance = slot(program.distance());
         if outputs == Outputs::DistanceAndMaterial {
             tape.material = Some(slot(program.material()));
@@ -170,7 +187,10 @@ fn last_uses(ops: &[Op], roots: &[Reg]) -> Vec<Option<usize>> {
 /// (after, so that the destination is never an operand).
 fn step(i: usize, op: &Op, alloc: &mut Allocator, last_use: &[Option<usize>], ops: &[Op]) -> Step {
     let operands = op.operands();
-    let s: Vec<u32> = operands.iter().map(|r| alloc.slot_of[r.0 as usize].unwrap_or(0)).collect();
+    let s: Vec<u32> = operands
+        .iter()
+        .map(|r| alloc.slot_of[r.0 as usize].unwrap_or(0))
+        .collect();
     let at = |k: usize| s.get(k).copied().unwrap_or(0);
     let code = match *op {
         Op::Unary(u, _) => Code::Unary(u),
@@ -187,21 +207,38 @@ fn step(i: usize, op: &Op, alloc: &mut Allocator, last_use: &[Option<usize>], op
         }
     }
     alloc.free.extend(freed);
-    Step { code, dst, a: at(0), b: at(1), c: at(2) }
+    Step {
+        code,
+        dst,
+        a: at(0),
+        b: at(1),
+        c: at(2),
+    }
 }
 
 impl Step {
-    /// Runs this step on the first `n` points: `dst` is the destination slot's storage
-    /// (taken out of `slots`), the operands are read from `slots`.
+    /// Runs this step on the first `n` points of `slots` (slots of `chunk` values, back to
+    /// back). The destination is split off the buffer; operands are read from both sides.
     #[inline]
-    pub(super) fn apply<T: Float>(&self, dst: &mut [T], slots: &[Vec<T>], n: usize) {
-        let a = &slots[self.a as usize][..n];
+    pub(super) fn apply<T: Float>(&self, slots: &mut [T], chunk: usize, n: usize) {
+        let dst = self.dst as usize;
+        let (lo, rest) = slots.split_at_mut(dst * chunk);
+        let (d, hi) = rest.split_at_mut(chunk);
+        let read = |s: u32| -> &[T] {
+            let s = s as usize;
+            if s < dst {
+                &lo[s * chunk..][..n]
+            } else {
+                &hi[(s - dst - 1) * chunk..][..n]
+            }
+        };
+        let d = &mut d[..n];
         match self.code {
-            Code::Unary(u) => unary_loop(u, dst, a),
-            Code::Binary(b) => binary_loop(b, dst, a, &slots[self.b as usize][..n]),
+            Code::Unary(u) => unary_loop(u, d, read(self.a)),
+            Code::Binary(b) => binary_loop(b, d, read(self.a), read(self.b)),
             Code::Select => {
-                let (x, y) = (&slots[self.b as usize][..n], &slots[self.c as usize][..n]);
-                for (((o, &c), &p), &q) in dst.iter_mut().zip(a).zip(x).zip(y) {
+                let (c, x, y) = (read(self.a), read(self.b), read(self.c));
+                for (((o, &c), &p), &q) in d.iter_mut().zip(c).zip(x).zip(y) {
                     *o = scalar::select(c, p, q);
                 }
             }

@@ -22,6 +22,8 @@ enum Key {
 #[derive(Debug, Default)]
 pub(super) struct Builder {
     ops: Vec<Op>,
+    /// Per register: known to be ≥ 0 (a constant ≥ 0, or a select between such registers).
+    nonneg: Vec<bool>,
     notes: Vec<Note>,
     shared: HashMap<Key, Reg>,
 }
@@ -34,12 +36,19 @@ impl Builder {
 
     /// Starts a commented block at the next instruction.
     pub fn note(&mut self, text: String) {
-        self.notes.push(Note { at: self.ops.len(), text });
+        self.notes.push(Note {
+            at: self.ops.len(),
+            text,
+        });
     }
 
     /// The input point.
     pub fn input_point(&mut self) -> P {
-        [self.emit(Op::Input(Axis::X)), self.emit(Op::Input(Axis::Y)), self.emit(Op::Input(Axis::Z))]
+        [
+            self.emit(Op::Input(Axis::X)),
+            self.emit(Op::Input(Axis::Y)),
+            self.emit(Op::Input(Axis::Z)),
+        ]
     }
 
     /// The constant `x`.
@@ -76,7 +85,13 @@ impl Builder {
             return r;
         }
         let r = Reg(self.ops.len() as u32);
+        let nonneg = match op {
+            Op::Const(c) => c >= 0.0,
+            Op::Select(_, a, b) => self.nonneg[a.0 as usize] && self.nonneg[b.0 as usize],
+            _ => false,
+        };
         self.ops.push(op);
+        self.nonneg.push(nonneg);
         self.shared.insert(key, r);
         r
     }
@@ -125,6 +140,7 @@ impl Builder {
             Binary::Pow if self.is(y, 2.0) => Some(self.mul(x, x)),
             Binary::Min | Binary::Max if x == y => Some(x),
             Binary::Lt if x == y => Some(self.c(0.0)),
+            Binary::Lt if self.is(y, 0.0) && self.nonneg[x.0 as usize] => Some(self.c(0.0)),
             _ => None,
         }
     }
@@ -152,8 +168,20 @@ impl Builder {
             }
         }
         first_at_or_after[self.ops.len()] = ops.len();
-        let notes = self.notes.into_iter().map(|n| Note { at: first_at_or_after[n.at], text: n.text }).collect();
-        Program { ops, notes, distance: new_index[d.0 as usize], material: new_index[m.0 as usize] }
+        let notes = self
+            .notes
+            .into_iter()
+            .map(|n| Note {
+                at: first_at_or_after[n.at],
+                text: n.text,
+            })
+            .collect();
+        Program {
+            ops,
+            notes,
+            distance: new_index[d.0 as usize],
+            material: new_index[m.0 as usize],
+        }
     }
 }
 

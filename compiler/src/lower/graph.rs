@@ -27,7 +27,11 @@ pub(super) struct Lowerer<'a> {
 
 impl<'a> Lowerer<'a> {
     pub fn new(graph: &'a Graph, b: &'a mut Builder) -> Self {
-        Lowerer { graph, b, memo: HashMap::new() }
+        Lowerer {
+            graph,
+            b,
+            memo: HashMap::new(),
+        }
     }
 
     /// Lowers node `id` evaluated at point `p`.
@@ -40,11 +44,20 @@ impl<'a> Lowerer<'a> {
         self.b.note(format!("node {} {}", id.0, kind(node)));
         let f = match node {
             Node::Combine { op, children } => self.combine(id, *op, children, p),
-            Node::SmoothCombine { op, k, variant, a, b } => self.smooth(id, *op, *k, *variant, [*a, *b], p),
+            Node::SmoothCombine {
+                op,
+                k,
+                variant,
+                a,
+                b,
+            } => self.smooth(id, *op, *k, *variant, [*a, *b], p),
             Node::Paint { material, child } => {
                 let f = self.node(*child, p);
                 self.resume(id, node);
-                Field { d: f.d, m: self.b.paint(f.m, material.0 as f64) }
+                Field {
+                    d: f.d,
+                    m: self.b.paint(f.m, material.0 as f64),
+                }
             }
             Node::Round { radius, child } => self.post(id, *child, p, |b, d| b.subc(d, *radius)),
             Node::Shell { thickness, child } => self.post(id, *child, p, |b, d| {
@@ -71,14 +84,24 @@ impl<'a> Lowerer<'a> {
 
     /// Notes that the instructions that follow belong to `id` again, after its children.
     fn resume(&mut self, id: NodeId, node: &Node) {
-        self.b.note(format!("node {} {} (after its children)", id.0, kind(node)));
+        self.b
+            .note(format!("node {} {} (after its children)", id.0, kind(node)));
     }
 
     /// Lowers `child` at `q`, then maps its distance with `f` (material unchanged).
-    fn post(&mut self, id: NodeId, child: NodeId, q: P, f: impl FnOnce(&mut Builder, Reg) -> Reg) -> Field {
+    fn post(
+        &mut self,
+        id: NodeId,
+        child: NodeId,
+        q: P,
+        f: impl FnOnce(&mut Builder, Reg) -> Reg,
+    ) -> Field {
         let c = self.node(child, q);
         self.resume(id, self.graph.node(id));
-        Field { d: f(self.b, c.d), m: c.m }
+        Field {
+            d: f(self.b, c.d),
+            m: c.m,
+        }
     }
 
     /// For a domain transform: its child and the transformed point.
@@ -87,8 +110,15 @@ impl<'a> Lowerer<'a> {
         let q = match node {
             Node::Translate { offset, child } => (*child, b.sub3c(p, *offset)),
             Node::Rotate { matrix, child } => (*child, rotate(b, p, matrix)),
-            Node::Repeat { period, count, child } => (*child, repeat(b, p, *period, *count)),
-            Node::Mirror { axes, child } => (*child, b.map3(p, |b, x, i| if axes[i] { b.abs(x) } else { x })),
+            Node::Repeat {
+                period,
+                count,
+                child,
+            } => (*child, repeat(b, p, *period, *count)),
+            Node::Mirror { axes, child } => (
+                *child,
+                b.map3(p, |b, x, i| if axes[i] { b.abs(x) } else { x }),
+            ),
             Node::Twist { rate, child } => (*child, twist(b, p, *rate)),
             Node::Bend { rate, child } => (*child, bend(b, p, *rate)),
             Node::Elongate { half, child } => (*child, elongate(b, p, *half)),
@@ -106,14 +136,26 @@ impl<'a> Lowerer<'a> {
             Node::RoundBox { half, radius } => shapes::round_box(b, p, half, radius),
             Node::Plane { normal, height } => shapes::plane(b, p, normal, height),
             Node::Torus { major, minor } => shapes::torus(b, p, major, minor),
-            Node::Cylinder { radius, half_height } => shapes::cylinder(b, p, radius, half_height),
-            Node::Capsule { radius, half_height } => shapes::capsule(b, p, radius, half_height),
-            Node::Cone { radius, half_height } => shapes::cone(b, p, radius, half_height),
+            Node::Cylinder {
+                radius,
+                half_height,
+            } => shapes::cylinder(b, p, radius, half_height),
+            Node::Capsule {
+                radius,
+                half_height,
+            } => shapes::capsule(b, p, radius, half_height),
+            Node::Cone {
+                radius,
+                half_height,
+            } => shapes::cone(b, p, radius, half_height),
             Node::Ellipsoid { radii } => shapes::ellipsoid(b, p, radii),
             Node::Mandelbulb { power, iterations } => shapes::mandelbulb(b, p, power, iterations),
             _ => b.c(EMPTY_DISTANCE),
         };
-        Field { d, m: b.c(UNPAINTED) }
+        Field {
+            d,
+            m: b.c(UNPAINTED),
+        }
     }
 
     /// Union, intersection or subtraction of any number of children, left to right.
@@ -121,7 +163,10 @@ impl<'a> Lowerer<'a> {
         let fields: Vec<Field> = children.iter().map(|&c| self.node(c, p)).collect();
         self.resume(id, self.graph.node(id));
         let Some((&first, rest)) = fields.split_first() else {
-            return Field { d: self.b.c(EMPTY_DISTANCE), m: self.b.c(UNPAINTED) };
+            return Field {
+                d: self.b.c(EMPTY_DISTANCE),
+                m: self.b.c(UNPAINTED),
+            };
         };
         rest.iter().fold(first, |acc, &f| {
             let d = match op {
@@ -132,7 +177,10 @@ impl<'a> Lowerer<'a> {
                     self.b.max(acc.d, nb)
                 }
             };
-            Field { d, m: self.material(op, acc, f) }
+            Field {
+                d,
+                m: self.material(op, acc, f),
+            }
         })
     }
 
@@ -154,7 +202,15 @@ impl<'a> Lowerer<'a> {
     }
 
     /// A smooth combination of two children.
-    fn smooth(&mut self, id: NodeId, op: Combine, k: f64, v: Smooth, ch: [NodeId; 2], p: P) -> Field {
+    fn smooth(
+        &mut self,
+        id: NodeId,
+        op: Combine,
+        k: f64,
+        v: Smooth,
+        ch: [NodeId; 2],
+        p: P,
+    ) -> Field {
         let fa = self.node(ch[0], p);
         let fb = self.node(ch[1], p);
         self.resume(id, self.graph.node(id));
@@ -167,7 +223,10 @@ impl<'a> Lowerer<'a> {
                 smax(b, fa.d, nb, k, v)
             }
         };
-        Field { d, m: self.material(op, fa, fb) }
+        Field {
+            d,
+            m: self.material(op, fa, fb),
+        }
     }
 }
 
@@ -311,12 +370,28 @@ fn kind(node: &Node) -> &'static str {
         Node::Cone { .. } => "cone",
         Node::Ellipsoid { .. } => "ellipsoid",
         Node::Mandelbulb { .. } => "mandelbulb",
-        Node::Combine { op: Combine::Union, .. } => "union",
-        Node::Combine { op: Combine::Intersect, .. } => "intersect",
-        Node::Combine { op: Combine::Subtract, .. } => "subtract",
-        Node::SmoothCombine { op: Combine::Union, .. } => "smooth_union",
-        Node::SmoothCombine { op: Combine::Intersect, .. } => "smooth_intersect",
-        Node::SmoothCombine { op: Combine::Subtract, .. } => "smooth_subtract",
+        Node::Combine {
+            op: Combine::Union, ..
+        } => "union",
+        Node::Combine {
+            op: Combine::Intersect,
+            ..
+        } => "intersect",
+        Node::Combine {
+            op: Combine::Subtract,
+            ..
+        } => "subtract",
+        Node::SmoothCombine {
+            op: Combine::Union, ..
+        } => "smooth_union",
+        Node::SmoothCombine {
+            op: Combine::Intersect,
+            ..
+        } => "smooth_intersect",
+        Node::SmoothCombine {
+            op: Combine::Subtract,
+            ..
+        } => "smooth_subtract",
         Node::Translate { .. } => "translate",
         Node::Rotate { .. } => "rotate",
         Node::Scale { .. } => "scale",

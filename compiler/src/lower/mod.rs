@@ -172,7 +172,11 @@ impl Program {
         for n in notes {
             let _ = writeln!(out, "; {}", n.text);
         }
-        let _ = writeln!(out, "return distance %{}, material %{}", self.distance.0, self.material.0);
+        let _ = writeln!(
+            out,
+            "return distance %{}, material %{}",
+            self.distance.0, self.material.0
+        );
         out
     }
 }
@@ -245,15 +249,4 @@ pub fn lower(scene: &Scene) -> Program {
     b.note("result: unpainted shapes get the default material 0".into());
     let m = b.paint(m, 0.0);
     b.finish(d, m)
-}
-
-#[cfg(test)]
-mod scratch_tests {
-    #[test]
-    fn scratch_dump() {
-        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/seed3.sdf")).unwrap();
-        let (scene, _d, _s) = crate::check::check_str("seed3.sdf", &text);
-        let p = super::lower(&scene.unwrap());
-        println!("{}", p.dump());
-    }
 }

@@ -24,22 +24,42 @@ pub fn dump(scene: &Scene) -> String {
     );
     for l in &scene.lights {
         let _ = match l {
-            Light::Point { position, color, intensity, radius, softness } => writeln!(
+            Light::Point {
+                position,
+                color,
+                intensity,
+                radius,
+                softness,
+            } => writeln!(
                 out,
                 "light point position={} color={} intensity={} radius={} softness={}",
-                v3(*position), v3(*color), num(*intensity), num(*radius), num(*softness)
+                v3(*position),
+                v3(*color),
+                num(*intensity),
+                num(*radius),
+                num(*softness)
             ),
-            Light::Directional { direction, color, intensity, softness } => writeln!(
+            Light::Directional {
+                direction,
+                color,
+                intensity,
+                softness,
+            } => writeln!(
                 out,
                 "light directional direction={} color={} intensity={} softness={}",
-                v3(*direction), v3(*color), num(*intensity), num(*softness)
+                v3(*direction),
+                v3(*color),
+                num(*intensity),
+                num(*softness)
             ),
         };
     }
     for (i, m) in scene.materials.iter().enumerate() {
         let pattern = match &m.pattern {
             Pattern::Solid(c) => format!("color={}", v3(*c)),
-            Pattern::Checker { a, b, size } => format!("checker a={} b={} size={}", v3(*a), v3(*b), num(*size)),
+            Pattern::Checker { a, b, size } => {
+                format!("checker a={} b={} size={}", v3(*a), v3(*b), num(*size))
+            }
         };
         let _ = writeln!(
             out,
@@ -85,7 +105,7 @@ fn postorder(g: &Graph, id: NodeId, seen: &mut [bool], order: &mut Vec<NodeId>) 
 /// Formats a float the shortest way that reads back exactly.
 /// Formats a float for the dump: integers without a fraction, others to 10 significant
 /// digits, so that round-off noise (such as 59.99999999999999 for 60°) does not show.
-pub(crate) fn num(x: f64) -> String {
+pub fn num(x: f64) -> String {
     if x == 0.0 || x.abs() < 1e-13 {
         return "0".to_string();
     }
@@ -98,7 +118,11 @@ pub(crate) fn num(x: f64) -> String {
     }
     let s = format!("{:.*}", digits as usize, x);
     let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".to_string() } else { s.to_string() }
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
 }
 
 fn v3(v: V3) -> String {
@@ -106,29 +130,77 @@ fn v3(v: V3) -> String {
 }
 
 fn ids(ids: &[NodeId]) -> String {
-    ids.iter().map(|i| format!("%{}", i.0)).collect::<Vec<_>>().join(", ")
+    ids.iter()
+        .map(|i| format!("%{}", i.0))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn node(n: &Node) -> String {
     match n {
         Node::Sphere { radius } => format!("sphere radius={}", num(*radius)),
         Node::Box { half } => format!("box half={}", v3(*half)),
-        Node::RoundBox { half, radius } => format!("round_box half={} radius={}", v3(*half), num(*radius)),
-        Node::Plane { normal, height } => format!("plane normal={} height={}", v3(*normal), num(*height)),
-        Node::Torus { major, minor } => format!("torus major={} minor={}", num(*major), num(*minor)),
-        Node::Cylinder { radius, half_height } => {
-            format!("cylinder radius={} half_height={}", num(*radius), num(*half_height))
+        Node::RoundBox { half, radius } => {
+            format!("round_box half={} radius={}", v3(*half), num(*radius))
         }
-        Node::Capsule { radius, half_height } => {
-            format!("capsule radius={} half_height={}", num(*radius), num(*half_height))
+        Node::Plane { normal, height } => {
+            format!("plane normal={} height={}", v3(*normal), num(*height))
         }
-        Node::Cone { radius, half_height } => format!("cone radius={} half_height={}", num(*radius), num(*half_height)),
+        Node::Torus { major, minor } => {
+            format!("torus major={} minor={}", num(*major), num(*minor))
+        }
+        Node::Cylinder {
+            radius,
+            half_height,
+        } => {
+            format!(
+                "cylinder radius={} half_height={}",
+                num(*radius),
+                num(*half_height)
+            )
+        }
+        Node::Capsule {
+            radius,
+            half_height,
+        } => {
+            format!(
+                "capsule radius={} half_height={}",
+                num(*radius),
+                num(*half_height)
+            )
+        }
+        Node::Cone {
+            radius,
+            half_height,
+        } => format!(
+            "cone radius={} half_height={}",
+            num(*radius),
+            num(*half_height)
+        ),
         Node::Ellipsoid { radii } => format!("ellipsoid radii={}", v3(*radii)),
-        Node::Mandelbulb { power, iterations } => format!("mandelbulb power={} iterations={iterations}", num(*power)),
+        Node::Mandelbulb { power, iterations } => {
+            format!("mandelbulb power={} iterations={iterations}", num(*power))
+        }
         Node::Combine { op, children } => format!("{} {}", combine(*op), ids(children)),
-        Node::SmoothCombine { op, k, variant, a, b } => {
-            let v = if *variant == Smooth::Poly { "poly" } else { "exp" };
-            format!("smooth_{} k={} {v} %{}, %{}", combine(*op), num(*k), a.0, b.0)
+        Node::SmoothCombine {
+            op,
+            k,
+            variant,
+            a,
+            b,
+        } => {
+            let v = if *variant == Smooth::Poly {
+                "poly"
+            } else {
+                "exp"
+            };
+            format!(
+                "smooth_{} k={} {v} %{}, %{}",
+                combine(*op),
+                num(*k),
+                a.0,
+                b.0
+            )
         }
         Node::Translate { offset, child } => format!("translate {} %{}", v3(*offset), child.0),
         Node::Rotate { matrix, child } => format!(
@@ -140,12 +212,26 @@ fn node(n: &Node) -> String {
         ),
         Node::Scale { factor, child } => format!("scale {} %{}", num(*factor), child.0),
         Node::ScaleXyz { factors, child } => format!("scale_xyz {} %{}", v3(*factors), child.0),
-        Node::Repeat { period, count, child } => match count {
-            Some(c) => format!("repeat period={} count={} %{}", v3(*period), v3(*c), child.0),
+        Node::Repeat {
+            period,
+            count,
+            child,
+        } => match count {
+            Some(c) => format!(
+                "repeat period={} count={} %{}",
+                v3(*period),
+                v3(*c),
+                child.0
+            ),
             None => format!("repeat period={} %{}", v3(*period), child.0),
         },
         Node::Mirror { axes, child } => {
-            let a: String = ["x", "y", "z"].iter().zip(axes).filter(|(_, on)| **on).map(|(n, _)| *n).collect();
+            let a: String = ["x", "y", "z"]
+                .iter()
+                .zip(axes)
+                .filter(|(_, on)| **on)
+                .map(|(n, _)| *n)
+                .collect();
             format!("mirror {a} %{}", child.0)
         }
         Node::Twist { rate, child } => format!("twist {} %{}", num(*rate), child.0),

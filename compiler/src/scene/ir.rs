@@ -66,7 +66,13 @@ pub enum Node {
     /// n-ary union, or a binary intersection or subtraction.
     Combine { op: Combine, children: Vec<NodeId> },
     /// Smooth union, intersection or subtraction with blend radius `k`.
-    SmoothCombine { op: Combine, k: f64, variant: Smooth, a: NodeId, b: NodeId },
+    SmoothCombine {
+        op: Combine,
+        k: f64,
+        variant: Smooth,
+        a: NodeId,
+        b: NodeId,
+    },
     /// Child moved by an offset.
     Translate { offset: V3, child: NodeId },
     /// Child rotated by an orthonormal matrix (rows).
@@ -77,7 +83,11 @@ pub enum Node {
     ScaleXyz { factors: V3, child: NodeId },
     /// Domain repetition with a period per axis (0: no repetition on that axis), infinite or
     /// limited to `count` copies per axis.
-    Repeat { period: V3, count: Option<V3>, child: NodeId },
+    Repeat {
+        period: V3,
+        count: Option<V3>,
+        child: NodeId,
+    },
     /// Mirror across the planes x = 0, y = 0, z = 0 where set.
     Mirror { axes: [bool; 3], child: NodeId },
     /// Twist about y by `rate` radians per unit of height.
@@ -243,9 +253,20 @@ impl Material {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Light {
     /// A point light whose contribution falls to zero at `radius`.
-    Point { position: V3, color: V3, intensity: f64, radius: f64, softness: f64 },
+    Point {
+        position: V3,
+        color: V3,
+        intensity: f64,
+        radius: f64,
+        softness: f64,
+    },
     /// A light from a direction (the direction light travels in), with no attenuation.
-    Directional { direction: V3, color: V3, intensity: f64, softness: f64 },
+    Directional {
+        direction: V3,
+        color: V3,
+        intensity: f64,
+        softness: f64,
+    },
 }
 
 impl Light {
@@ -270,7 +291,11 @@ pub struct Camera {
 
 impl Default for Camera {
     fn default() -> Self {
-        Camera { position: [0.0, 1.0, -5.0], look_at: [0.0, 0.0, 0.0], fov: 60f64.to_radians() }
+        Camera {
+            position: [0.0, 1.0, -5.0],
+            look_at: [0.0, 0.0, 0.0],
+            fov: 60f64.to_radians(),
+        }
     }
 }
 

@@ -3,5 +3,5 @@
 mod dump;
 pub mod ir;
 
-pub use dump::dump;
+pub use dump::{dump, num as dump_num};
 pub use ir::*;

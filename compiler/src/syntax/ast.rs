@@ -32,7 +32,12 @@ pub enum Item {
     /// `fn name(params) -> type { body }`
     Fn(FnDecl),
     /// `material name = kind { fields }`
-    Material { name: Ident, kind: Ident, fields: Vec<Field>, span: Span },
+    Material {
+        name: Ident,
+        kind: Ident,
+        fields: Vec<Field>,
+        span: Span,
+    },
     /// `camera { fields }`, `render { fields }`, `light kind { fields }`: a block of settings.
     Block(Block),
     /// `scene { statements }`
@@ -121,7 +126,13 @@ pub enum Stmt {
     /// `expr;`: a shape added to the scene (usually `shape @ material`).
     Object(Expr),
     /// `for name in from..to { statements }`: statements repeated with `name` an int.
-    For { var: Ident, from: Expr, to: Expr, body: Vec<Stmt>, span: Span },
+    For {
+        var: Ident,
+        from: Expr,
+        to: Expr,
+        body: Vec<Stmt>,
+        span: Span,
+    },
     /// A statement that did not parse (already reported).
     Error(Span),
 }
@@ -217,11 +228,19 @@ pub enum ExprKind {
     /// `f(args)`
     Call { callee: Ident, args: Vec<Arg> },
     /// `receiver.f(args)`: the receiver is passed as the first parameter of its type.
-    Method { receiver: Box<Expr>, name: Ident, args: Vec<Arg> },
+    Method {
+        receiver: Box<Expr>,
+        name: Ident,
+        args: Vec<Arg>,
+    },
     /// `v.x`: a vector component.
     Field(Box<Expr>, Ident),
     /// `if cond { a } else { b }`
-    If { cond: Box<Expr>, then: Body, otherwise: Body },
+    If {
+        cond: Box<Expr>,
+        then: Body,
+        otherwise: Body,
+    },
     /// `shape @ material`
     Material(Box<Expr>, Ident),
     /// An expression that did not parse (already reported).

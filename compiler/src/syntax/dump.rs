@@ -5,7 +5,10 @@ use super::ast::*;
 /// Dumps a file as one line per node, children indented by two spaces. Spans are left out
 /// so the dump is stable under edits that only move text.
 pub fn dump(file: &File) -> String {
-    let mut d = Dumper { out: String::new(), depth: 0 };
+    let mut d = Dumper {
+        out: String::new(),
+        depth: 0,
+    };
     for item in &file.items {
         d.item(item);
     }
@@ -40,15 +43,20 @@ impl Dumper {
             Item::Fn(f) => self.nested(format!("fn {} -> {}", f.name.name, f.ret.name), |d| {
                 for p in &f.params {
                     match &p.default {
-                        Some(def) => d.nested(format!("param {}: {} =", p.name.name, p.ty.name), |d| d.expr(def)),
+                        Some(def) => d
+                            .nested(format!("param {}: {} =", p.name.name, p.ty.name), |d| {
+                                d.expr(def)
+                            }),
                         None => d.line(format!("param {}: {}", p.name.name, p.ty.name)),
                     }
                 }
                 d.body(&f.body);
             }),
-            Item::Material { name, kind, fields, .. } => {
-                self.nested(format!("material {} = {}", name.name, kind.name), |d| d.fields(fields))
-            }
+            Item::Material {
+                name, kind, fields, ..
+            } => self.nested(format!("material {} = {}", name.name, kind.name), |d| {
+                d.fields(fields)
+            }),
             Item::Block(b) => {
                 let head = match &b.kind {
                     Some(k) => format!("{} {}", b.keyword.name, k.name),
@@ -89,7 +97,13 @@ impl Dumper {
             match s {
                 Stmt::Let(l) => self.let_(l),
                 Stmt::Object(e) => self.nested("object", |d| d.expr(e)),
-                Stmt::For { var, from, to, body, .. } => self.nested(format!("for {}", var.name), |d| {
+                Stmt::For {
+                    var,
+                    from,
+                    to,
+                    body,
+                    ..
+                } => self.nested(format!("for {}", var.name), |d| {
                     d.expr(from);
                     d.expr(to);
                     d.nested("do", |d| d.stmts(body));
@@ -116,7 +130,9 @@ impl Dumper {
             ExprKind::Bool(v) => self.line(format!("bool {v}")),
             ExprKind::Str(v) => self.line(format!("string {v:?}")),
             ExprKind::Var(id) => self.line(format!("var {}", id.name)),
-            ExprKind::Tuple(items) => self.nested("tuple", |d| items.iter().for_each(|i| d.expr(i))),
+            ExprKind::Tuple(items) => {
+                self.nested("tuple", |d| items.iter().for_each(|i| d.expr(i)))
+            }
             ExprKind::Unary(op, x) => {
                 let sym = if *op == UnOp::Neg { "-" } else { "!" };
                 self.nested(format!("unary {sym}"), |d| d.expr(x))
@@ -125,13 +141,23 @@ impl Dumper {
                 d.expr(a);
                 d.expr(b);
             }),
-            ExprKind::Call { callee, args } => self.nested(format!("call {}", callee.name), |d| d.args(args)),
-            ExprKind::Method { receiver, name, args } => self.nested(format!("method {}", name.name), |d| {
+            ExprKind::Call { callee, args } => {
+                self.nested(format!("call {}", callee.name), |d| d.args(args))
+            }
+            ExprKind::Method {
+                receiver,
+                name,
+                args,
+            } => self.nested(format!("method {}", name.name), |d| {
                 d.expr(receiver);
                 d.args(args);
             }),
             ExprKind::Field(x, name) => self.nested(format!("field {}", name.name), |d| d.expr(x)),
-            ExprKind::If { cond, then, otherwise } => self.nested("if", |d| {
+            ExprKind::If {
+                cond,
+                then,
+                otherwise,
+            } => self.nested("if", |d| {
                 d.expr(cond);
                 d.body(then);
                 d.body(otherwise);
@@ -141,4 +167,3 @@ impl Dumper {
         }
     }
 }
-

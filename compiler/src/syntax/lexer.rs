@@ -49,11 +49,11 @@ pub enum Token {
     /// An angle literal such as `45deg` or `0.5rad`, in radians.
     #[regex(r"([0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?)(deg|rad)", angle)]
     Angle(f64),
-    /// A string literal, without its quotes (no escapes other than `\"` and `\\`).
-    #[regex(r#""([^"\\\n]|\\["\\])*""#, |lex| { let s = lex.slice(); s[1..s.len() - 1].replace("\\\"", "\"").replace("\\\\", "\\") })]
+    /// A string literal, without its quotes; escapes are resolved by [`lex`].
+    #[regex(r#""([^"\\\n]|\\[^\n])*""#, |lex| { let s = lex.slice(); s[1..s.len() - 1].to_string() })]
     Str(String),
     /// A string literal missing its closing quote (reported, then skipped).
-    #[regex(r#""([^"\\\n]|\\["\\])*"#, priority = 1)]
+    #[regex(r#""([^"\\\n]|\\[^\n])*"#, priority = 1)]
     UnterminatedStr,
     #[regex(r"[A-Za-z_][A-Za-z0-9_]*", |lex| lex.slice().to_string())]
     Ident(String),
@@ -202,11 +202,51 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
                     .with_label("this string has no closing quote on its line")
                     .with_help("strings end with `\"` on the same line"),
             ),
+            Ok(Token::Str(raw)) => {
+                let (text, bad) = unescape(&raw, range.start + 1, file);
+                diags.extend(bad);
+                tokens.push((Token::Str(text), span));
+            }
             Ok(tok) => tokens.push((tok, span)),
             Err(()) => diags.push(lex_error(text, range, span)),
         }
     }
     (tokens, diags)
+}
+
+/// Resolves the escapes `\"`, `\\`, `\n` and `\t`; any other escape is an error (the
+/// character is kept, so nothing after it is misread).
+fn unescape(raw: &str, offset: usize, file: FileId) -> (String, Vec<Diagnostic>) {
+    let mut out = String::with_capacity(raw.len());
+    let mut diags = Vec::new();
+    let mut chars = raw.char_indices();
+    while let Some((i, c)) = chars.next() {
+        if c != '\\' {
+            out.push(c);
+            continue;
+        }
+        match chars.next() {
+            Some((_, '"')) => out.push('"'),
+            Some((_, '\\')) => out.push('\\'),
+            Some((_, 'n')) => out.push('\n'),
+            Some((_, 't')) => out.push('\t'),
+            Some((j, other)) => {
+                let span = Span::new(file, offset + i..offset + j + other.len_utf8());
+                diags.push(
+                    Diagnostic::error(
+                        "E0005",
+                        format!("unknown escape `\\{other}` in a string"),
+                        span,
+                    )
+                    .with_label("not an escape")
+                    .with_note("the escapes are \\\", \\\\, \\n and \\t"),
+                );
+                out.push(other);
+            }
+            None => out.push('\\'),
+        }
+    }
+    (out, diags)
 }
 
 fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnostic {
@@ -222,7 +262,12 @@ fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnosti
             .with_note("integers must fit in 64 bits; floats look like `1.5`, `2e-3` or `.5` written as `0.5`");
     }
     let ch = slice.chars().next().unwrap_or('?');
-    let d = Diagnostic::error("E0001", format!("unexpected character `{}`", ch.escape_default()), span)
+    let shown = if ch.is_control() || ch.is_whitespace() {
+        ch.escape_default().to_string()
+    } else {
+        ch.to_string()
+    };
+    let d = Diagnostic::error("E0001", format!("unexpected character `{shown}`"), span)
         .with_label("not part of the language");
     match ch {
         '&' => d.with_help("logical and is written `&&`"),

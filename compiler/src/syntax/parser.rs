@@ -14,15 +14,26 @@ type Extra<'t> = extra::Err<Rich<'t, Token, SimpleSpan>>;
 /// Parses a token stream into a file. Always returns a tree (possibly with error nodes) and
 /// the syntax errors found.
 pub fn parse(file: FileId, tokens: &[(Token, Span)], eof: usize) -> (File, Vec<Diagnostic>) {
-    let simple: Vec<(Token, SimpleSpan)> =
-        tokens.iter().map(|(t, s)| (t.clone(), SimpleSpan::from(s.range()))).collect();
-    let input = simple.as_slice().map(SimpleSpan::from(eof..eof), |(t, s)| (t, s));
+    let simple: Vec<(Token, SimpleSpan)> = tokens
+        .iter()
+        .map(|(t, s)| (t.clone(), SimpleSpan::from(s.range())))
+        .collect();
+    let input = simple
+        .as_slice()
+        .map(SimpleSpan::from(eof..eof), |(t, s)| (t, s));
     let (out, errors) = file_parser(file).parse(input).into_output_errors();
-    let diags = errors.into_iter().map(|e| syntax_error(file, e, tokens)).collect();
+    let diags = errors
+        .into_iter()
+        .map(|e| syntax_error(file, e, tokens))
+        .collect();
     (out.unwrap_or(File { items: Vec::new() }), diags)
 }
 
-fn syntax_error(file: FileId, e: Rich<'_, Token, SimpleSpan>, tokens: &[(Token, Span)]) -> Diagnostic {
+fn syntax_error(
+    file: FileId,
+    e: Rich<'_, Token, SimpleSpan>,
+    tokens: &[(Token, Span)],
+) -> Diagnostic {
     use chumsky::error::RichPattern;
     let span = Span::new(file, e.span().into_range());
     let found = match e.found() {
@@ -43,19 +54,31 @@ fn syntax_error(file: FileId, e: Rich<'_, Token, SimpleSpan>, tokens: &[(Token, 
     if let chumsky::error::RichReason::Custom(msg) = e.reason() {
         return Diagnostic::error("E0100", msg.to_string(), span);
     }
-    // A missing `;` or closing delimiter is reported just after the previous token, where it
-    // belongs, rather than at the next token.
-    for closer in ["`;`", "`)`", "`}`"] {
-        if expected.iter().any(|x| x == closer) && e.found().is_some() {
-            if let Some(prev) = tokens.iter().rev().find(|(_, s)| s.end <= span.start) {
-                let at = Span { file, start: prev.1.end, end: prev.1.end };
-                return Diagnostic::error("E0101", format!("expected {closer}, found {found}"), at)
-                    .with_label(format!("{closer} is missing here"))
-                    .with_secondary(span, format!("found {found}"));
+    // A missing `;`, `,` or closing delimiter is reported just after the previous token, where
+    // it belongs, rather than at the next token.
+    let closers: Vec<&str> = ["`;`", "`,`", "`)`", "`}`"]
+        .into_iter()
+        .filter(|c| expected.iter().any(|x| x == c))
+        .collect();
+    if !closers.is_empty() && e.found().is_some() {
+        if let Some(prev) = tokens.iter().rev().find(|(_, s)| s.end <= span.start) {
+            let at = Span {
+                file,
+                start: prev.1.end,
+                end: prev.1.end,
+            };
+            let list = closers.join(" or ");
+            let mut d = Diagnostic::error("E0101", format!("expected {list}, found {found}"), at)
+                .with_label("something is missing here")
+                .with_secondary(span, format!("found {found}"));
+            if matches!(e.found(), Some(Token::Ident(u)) if u == "deg" || u == "rad") {
+                d = d.with_help("write an angle's unit right after the number, as in `90deg`");
             }
+            return d;
         }
     }
-    let mut d = Diagnostic::error("E0100", format!("unexpected {found}"), span).with_label(format!("unexpected {found}"));
+    let mut d = Diagnostic::error("E0100", format!("unexpected {found}"), span)
+        .with_label(format!("unexpected {found}"));
     if !expected.is_empty() {
         let list = if expected.len() > 8 {
             format!("{}, …", expected[..8].join(", "))
@@ -77,7 +100,10 @@ where
     I: ValueInput<'t, Token = Token, Span = SimpleSpan>,
 {
     select! { Token::Ident(name) => name }
-        .map_with(move |name, e| Ident { name, span: sp(file, e.span()) })
+        .map_with(move |name, e| Ident {
+            name,
+            span: sp(file, e.span()),
+        })
         .labelled("name")
 }
 
@@ -87,7 +113,10 @@ where
     I: ValueInput<'t, Token = Token, Span = SimpleSpan>,
 {
     recursive(move |expr| {
-        let mk = move |kind: ExprKind, s: SimpleSpan| Expr { kind, span: sp(file, s) };
+        let mk = move |kind: ExprKind, s: SimpleSpan| Expr {
+            kind,
+            span: sp(file, s),
+        };
 
         // `let_stmt = "let" ident [":" ident] "=" expr ";"`
         let local_let = just(Token::Let)
@@ -96,7 +125,12 @@ where
             .then_ignore(just(Token::Eq))
             .then(expr.clone())
             .then_ignore(just(Token::Semi))
-            .map_with(move |((name, ty), value), e| Let { name, ty, value, span: sp(file, e.span()) });
+            .map_with(move |((name, ty), value), e| Let {
+                name,
+                ty,
+                value,
+                span: sp(file, e.span()),
+            });
 
         // `body = "{" { let_stmt } expr "}"`
         let body = local_let
@@ -104,7 +138,11 @@ where
             .collect::<Vec<_>>()
             .then(expr.clone())
             .delimited_by(just(Token::LBrace), just(Token::RBrace))
-            .map_with(move |(lets, value), e| Body { lets, value: Box::new(value), span: sp(file, e.span()) })
+            .map_with(move |(lets, value), e| Body {
+                lets,
+                value: Box::new(value),
+                span: sp(file, e.span()),
+            })
             .boxed();
 
         // `args = "(" [ arg { "," arg } [","] ] ")"`, `arg = [ident ":"] expr`
@@ -137,7 +175,10 @@ where
 
         let var = ident(file).map(|id| {
             let span = id.span;
-            Expr { kind: ExprKind::Var(id), span }
+            Expr {
+                kind: ExprKind::Var(id),
+                span,
+            }
         });
 
         // `tuple = "(" expr { "," expr } [","] ")"`: one element without comma is parentheses.
@@ -172,22 +213,42 @@ where
                 .then_ignore(just(Token::Else))
                 .then(body.clone().or(if_expr.map(move |e: Expr| {
                     let span = e.span;
-                    Body { lets: Vec::new(), value: Box::new(e), span }
+                    Body {
+                        lets: Vec::new(),
+                        value: Box::new(e),
+                        span,
+                    }
                 })))
                 .map_with(move |((cond, then), otherwise), e| {
-                    mk(ExprKind::If { cond: Box::new(cond), then, otherwise }, e.span())
+                    mk(
+                        ExprKind::If {
+                            cond: Box::new(cond),
+                            then,
+                            otherwise,
+                        },
+                        e.span(),
+                    )
                 })
         });
 
-        let atom = choice((literal, call, var, tuple, if_expr)).labelled("expression").boxed();
+        let atom = choice((literal, call, var, tuple, if_expr))
+            .labelled("expression")
+            .boxed();
 
         // `postfix = atom { "." ident [args] }`
         let postfix = atom
             .foldl_with(
-                just(Token::Dot).ignore_then(ident(file)).then(args.clone().or_not()).repeated(),
+                just(Token::Dot)
+                    .ignore_then(ident(file))
+                    .then(args.clone().or_not())
+                    .repeated(),
                 move |receiver, (name, args), e| {
                     let kind = match args {
-                        Some(args) => ExprKind::Method { receiver: Box::new(receiver), name, args },
+                        Some(args) => ExprKind::Method {
+                            receiver: Box::new(receiver),
+                            name,
+                            args,
+                        },
                         None => ExprKind::Field(Box::new(receiver), name),
                     };
                     mk(kind, e.span())
@@ -196,17 +257,28 @@ where
             .boxed();
 
         // `unary = { "-" | "!" } postfix`
-        let unary = choice((just(Token::Minus).to(UnOp::Neg), just(Token::Bang).to(UnOp::Not)))
-            .map_with(move |op, e| (op, sp(file, e.span())))
-            .repeated()
-            .foldr(postfix, move |(op, op_span), rhs: Expr| {
-                let span = op_span.join(rhs.span);
-                Expr { kind: ExprKind::Unary(op, Box::new(rhs)), span }
-            })
-            .boxed();
+        let unary = choice((
+            just(Token::Minus).to(UnOp::Neg),
+            just(Token::Bang).to(UnOp::Not),
+        ))
+        .map_with(move |op, e| (op, sp(file, e.span())))
+        .repeated()
+        .foldr(postfix, move |(op, op_span), rhs: Expr| {
+            let span = op_span.join(rhs.span);
+            Expr {
+                kind: ExprKind::Unary(op, Box::new(rhs)),
+                span,
+            }
+        })
+        .boxed();
 
-        let binary = move |lower: chumsky::Boxed<'t, 't, I, Expr, Extra<'t>>, ops: Vec<(Token, BinOp)>| {
-            let op = choice(ops.into_iter().map(|(t, o)| just(t).to(o)).collect::<Vec<_>>());
+        let binary = move |lower: chumsky::Boxed<'t, 't, I, Expr, Extra<'t>>,
+                           ops: Vec<(Token, BinOp)>| {
+            let op = choice(
+                ops.into_iter()
+                    .map(|(t, o)| just(t).to(o))
+                    .collect::<Vec<_>>(),
+            );
             lower
                 .clone()
                 .foldl_with(op.then(lower).repeated(), move |a, (op, b), e| {
@@ -216,9 +288,16 @@ where
         };
         let product = binary(
             unary,
-            vec![(Token::Star, BinOp::Mul), (Token::Slash, BinOp::Div), (Token::Percent, BinOp::Rem)],
+            vec![
+                (Token::Star, BinOp::Mul),
+                (Token::Slash, BinOp::Div),
+                (Token::Percent, BinOp::Rem),
+            ],
         );
-        let sum = binary(product, vec![(Token::Plus, BinOp::Add), (Token::Minus, BinOp::Sub)]);
+        let sum = binary(
+            product,
+            vec![(Token::Plus, BinOp::Add), (Token::Minus, BinOp::Sub)],
+        );
         let compare = binary(
             sum,
             vec![
@@ -234,9 +313,10 @@ where
         let or = binary(and, vec![(Token::OrOr, BinOp::Or)]);
 
         // `expr = logic { "@" ident }`
-        or.foldl_with(just(Token::At).ignore_then(ident(file)).repeated(), move |shape, mat, e| {
-            mk(ExprKind::Material(Box::new(shape), mat), e.span())
-        })
+        or.foldl_with(
+            just(Token::At).ignore_then(ident(file)).repeated(),
+            move |shape, mat, e| mk(ExprKind::Material(Box::new(shape), mat), e.span()),
+        )
         .labelled("expression")
     })
 }
@@ -255,7 +335,12 @@ where
         .then_ignore(just(Token::Eq))
         .then(expr.clone())
         .then_ignore(just(Token::Semi))
-        .map_with(move |((name, ty), value), e| Let { name, ty, value, span: sp(file, e.span()) })
+        .map_with(move |((name, ty), value), e| Let {
+            name,
+            ty,
+            value,
+            span: sp(file, e.span()),
+        })
         .boxed();
 
     // `field = ident ":" expr`, `fields = "{" [field {"," field} [","]] "}"`
@@ -278,7 +363,10 @@ where
     let import = just(Token::Import)
         .ignore_then(select! { Token::Str(s) => s }.labelled("a file name in quotes"))
         .then_ignore(just(Token::Semi))
-        .map_with(move |path, e| Item::Import { path, span: sp(file, e.span()) });
+        .map_with(move |path, e| Item::Import {
+            path,
+            span: sp(file, e.span()),
+        });
 
     // `param = ident ":" ident ["=" expr]`
     let param = ident(file)
@@ -294,14 +382,21 @@ where
         .collect::<Vec<_>>()
         .then(expr.clone())
         .delimited_by(just(Token::LBrace), just(Token::RBrace))
-        .map_with(move |(lets, value), e| Body { lets, value: Box::new(value), span: sp(file, e.span()) })
+        .map_with(move |(lets, value), e| Body {
+            lets,
+            value: Box::new(value),
+            span: sp(file, e.span()),
+        })
         .recover_with(via_parser(nested_delimiters(
             Token::LBrace,
             Token::RBrace,
             [(Token::LParen, Token::RParen)],
             move |s| Body {
                 lets: Vec::new(),
-                value: Box::new(Expr { kind: ExprKind::Error, span: sp(file, s) }),
+                value: Box::new(Expr {
+                    kind: ExprKind::Error,
+                    span: sp(file, s),
+                }),
                 span: sp(file, s),
             },
         )));
@@ -318,7 +413,13 @@ where
         .then(ident(file))
         .then(body)
         .map_with(move |(((name, params), ret), body), e| {
-            Item::Fn(FnDecl { name, params, ret, body, span: sp(file, e.span()) })
+            Item::Fn(FnDecl {
+                name,
+                params,
+                ret,
+                body,
+                span: sp(file, e.span()),
+            })
         });
 
     // `material = "material" ident "=" ident fields [";"]`
@@ -328,11 +429,19 @@ where
         .then(ident(file))
         .then(fields.clone())
         .then_ignore(just(Token::Semi).or_not())
-        .map_with(move |((name, kind), fields), e| Item::Material { name, kind, fields, span: sp(file, e.span()) });
+        .map_with(move |((name, kind), fields), e| Item::Material {
+            name,
+            kind,
+            fields,
+            span: sp(file, e.span()),
+        });
 
     // `block = ("camera" | "render" | "light" ident) fields [";"]`
     let keyword = move |t: Token, name: &'static str| {
-        just(t).map_with(move |_, e| Ident { name: name.to_string(), span: sp(file, e.span()) })
+        just(t).map_with(move |_, e| Ident {
+            name: name.to_string(),
+            span: sp(file, e.span()),
+        })
     };
     let block = choice((
         keyword(Token::Camera, "camera").then(empty().to(None)),
@@ -341,7 +450,14 @@ where
     ))
     .then(fields.clone())
     .then_ignore(just(Token::Semi).or_not())
-    .map_with(move |((keyword, kind), fields), e| Item::Block(Block { keyword, kind, fields, span: sp(file, e.span()) }));
+    .map_with(move |((keyword, kind), fields), e| {
+        Item::Block(Block {
+            keyword,
+            kind,
+            fields,
+            span: sp(file, e.span()),
+        })
+    });
 
     // `stmt = let | for | expr ";"`
     let stmt = recursive(|stmt| {
@@ -351,29 +467,75 @@ where
             .then(expr.clone())
             .then_ignore(just(Token::DotDot))
             .then(expr.clone())
-            .then(stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), just(Token::RBrace)))
-            .map_with(move |(((var, from), to), body), e| Stmt::For { var, from, to, body, span: sp(file, e.span()) });
+            .then(
+                stmt.repeated()
+                    .collect::<Vec<_>>()
+                    .delimited_by(just(Token::LBrace), just(Token::RBrace)),
+            )
+            .map_with(move |(((var, from), to), body), e| Stmt::For {
+                var,
+                from,
+                to,
+                body,
+                span: sp(file, e.span()),
+            });
+        // A broken statement is skipped to its `;` (or to the `}` closing the block).
+        let skip_stmt = none_of([Token::RBrace])
+            .then(none_of([Token::Semi, Token::RBrace]).repeated())
+            .then(just(Token::Semi).or_not())
+            .map_with(move |_, e| Stmt::Error(sp(file, e.span())));
         choice((
             let_decl.clone().map(Stmt::Let),
             for_stmt,
-            expr.clone().then_ignore(just(Token::Semi)).map(Stmt::Object),
+            expr.clone()
+                .then_ignore(just(Token::Semi))
+                .map(Stmt::Object),
         ))
-        .recover_with(skip_then_retry_until(
-            none_of([Token::RBrace]).ignored(),
-            just(Token::RBrace).ignored().or(end()),
-        ))
+        .recover_with(via_parser(skip_stmt))
         .boxed()
     });
 
     // `scene = "scene" "{" { stmt } "}"`
     let scene = just(Token::Scene)
-        .ignore_then(stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), just(Token::RBrace)))
+        .ignore_then(
+            stmt.repeated()
+                .collect::<Vec<_>>()
+                .delimited_by(just(Token::LBrace), just(Token::RBrace)),
+        )
         .then_ignore(just(Token::Semi).or_not())
-        .map_with(move |stmts, e| Item::Scene { stmts, span: sp(file, e.span()) });
+        .map_with(move |stmts, e| Item::Scene {
+            stmts,
+            span: sp(file, e.span()),
+        });
 
-    let item = choice((import, let_decl.map(Item::Let), function, material, block, scene))
-        .labelled("item")
-        .recover_with(skip_then_retry_until(any().ignored(), end()));
+    // A broken item is skipped up to the next item keyword, so the items after it are
+    // still parsed and their errors reported.
+    let item_start = [
+        Token::Import,
+        Token::Let,
+        Token::Fn,
+        Token::Material,
+        Token::Camera,
+        Token::Light,
+        Token::Render,
+        Token::Scene,
+    ];
+    let skip_item = any()
+        .then(none_of(item_start).repeated())
+        .map_with(move |_, e| Item::Error(sp(file, e.span())));
+    let item = choice((
+        import,
+        let_decl.map(Item::Let),
+        function,
+        material,
+        block,
+        scene,
+    ))
+    .labelled("item")
+    .recover_with(via_parser(skip_item));
 
-    item.repeated().collect::<Vec<_>>().then_ignore(end()).map(|items| File { items })
+    item.repeated()
+        .collect::<Vec<_>>()
+        .then_ignore(end())
+        .map(|items| File { items })
 }

@@ -1,16 +1,188 @@
-//! `sdfc bench`.
+//! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps).
 
+use super::render::{override_settings, parse_size, thread_pool, Backend};
+use crate::cpu::{self, Options, Precision, Stats};
+use crate::frontend::{self, DiagnosticFormat};
+use sdfc_compiler::lower;
+use sdfc_compiler::scene::Scene;
+use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Instant;
 
 /// Arguments of `sdfc bench`.
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
-    /// Scene file.
-    pub file: std::path::PathBuf,
+    /// Scene files.
+    #[arg(required = true)]
+    pub file: Vec<PathBuf>,
+    /// Backend to time.
+    #[arg(long, value_enum, default_value_t)]
+    pub backend: Backend,
+    /// Image size, as WIDTHxHEIGHT (default: each scene's own).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Frames timed per scene (after one untimed warm-up frame).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub frames: u32,
+    /// Override a render setting (as for `sdfc render`). May be repeated.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Float type of the evaluation.
+    #[arg(long, value_enum, default_value_t)]
+    pub precision: Precision,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON array instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The timing of one scene.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Timing {
+    /// The scene file.
+    pub scene: String,
+    /// Backend used.
+    pub backend: &'static str,
+    /// Float type.
+    pub precision: &'static str,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Samples per pixel edge.
+    pub aa: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// Frames timed.
+    pub frames: u32,
+    /// Median seconds per frame.
+    pub median_s: f64,
+    /// Fastest frame, seconds.
+    pub min_s: f64,
+    /// Camera rays per second, in millions (at the median).
+    pub mrays_per_s: f64,
+    /// All rays (camera, secondary, shadow) per second, in millions (at the median).
+    pub total_mrays_per_s: f64,
+    /// Instructions of the distance program.
+    pub program_len: usize,
+    /// Statistics of the last frame.
+    pub stats: Stats,
 }
 
 /// Runs `sdfc bench`.
-pub fn run(_args: BenchArgs) -> ExitCode {
-    eprintln!("error: not built yet");
-    ExitCode::from(2)
+pub fn run(args: BenchArgs) -> ExitCode {
+    let pool = match thread_pool(args.threads) {
+        Ok(p) => p,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut timings = Vec::new();
+    for file in &args.file {
+        let mut scene = match frontend::load_scene(file, DiagnosticFormat::Human) {
+            Ok(s) => s,
+            Err(code) => return code,
+        };
+        if let Err(msg) = override_settings(&mut scene.settings, args.size, None, &args.set) {
+            eprintln!("error: {msg}");
+            return ExitCode::from(2);
+        }
+        let t = pool.install(|| time_scene(&args, file.display().to_string(), &scene));
+        if !args.json {
+            if timings.is_empty() {
+                println!("{}", header());
+            }
+            println!("{}", row(&t));
+        }
+        timings.push(t);
+    }
+    if args.json {
+        match serde_json::to_string_pretty(&timings) {
+            Ok(s) => println!("{s}"),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// Renders one warm-up frame and `frames` timed frames.
+fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Timing {
+    let program = lower::lower(scene);
+    let options = Options {
+        precision: args.precision,
+        ..Options::default()
+    };
+    let mut last = cpu::render(scene, &program, &options, &|| {});
+    let mut times = Vec::new();
+    for _ in 0..args.frames {
+        let start = Instant::now();
+        last = cpu::render(scene, &program, &options, &|| {});
+        times.push(start.elapsed().as_secs_f64());
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let c = &last.stats.counters;
+    let s = &scene.settings;
+    Timing {
+        scene: name,
+        backend: match args.backend {
+            Backend::Auto | Backend::Cpu => "cpu",
+        },
+        precision: match args.precision {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        },
+        width: s.width,
+        height: s.height,
+        aa: s.aa,
+        threads: rayon::current_num_threads(),
+        frames: args.frames,
+        median_s: median,
+        min_s: times[0],
+        mrays_per_s: c.camera_rays as f64 / median / 1e6,
+        total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
+        program_len: program.len(),
+        stats: last.stats,
+    }
+}
+
+fn header() -> String {
+    format!(
+        "{:<28} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>9} {:>6} {:>6}",
+        "scene",
+        "size",
+        "aa",
+        "threads",
+        "median ms",
+        "min ms",
+        "Mrays/s",
+        "steps/px",
+        "p99",
+        "max"
+    )
+}
+
+fn row(t: &Timing) -> String {
+    let name = std::path::Path::new(&t.scene)
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned());
+    format!(
+        "{:<28} {:>9} {:>4} {:>7} {:>10.1} {:>10.1} {:>8.2} {:>9.1} {:>6} {:>6}",
+        name.unwrap_or_else(|| t.scene.clone()),
+        format!("{}x{}", t.width, t.height),
+        t.aa,
+        t.threads,
+        t.median_s * 1e3,
+        t.min_s * 1e3,
+        t.mrays_per_s,
+        t.stats.steps_mean,
+        t.stats.steps_p99,
+        t.stats.steps_max
+    )
 }

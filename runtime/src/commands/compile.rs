@@ -67,7 +67,9 @@ pub fn run(args: CompileArgs) -> ExitCode {
             syntax::dump(&ast)
         }
         other => {
-            let Some(scene) = &loaded.scene else { return ExitCode::from(1) };
+            let Some(scene) = &loaded.scene else {
+                return ExitCode::from(1);
+            };
             match emit(scene, other) {
                 Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
                 Err(msg) => {

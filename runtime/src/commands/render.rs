@@ -70,17 +70,40 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let options = Options { precision: args.precision, ..Options::default() };
+    let mut options = Options {
+        precision: args.precision,
+        ..Options::default()
+    };
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<usize>().ok());
+    if let Some(v) = env("SDFC_TILE") {
+        options.tile = v as u32;
+    }
+    if let Some(v) = env("SDFC_LANES") {
+        options.lanes = v;
+    }
+    if let Some(v) = env("SDFC_CHUNK") {
+        options.chunk = v;
+    }
     let started = Instant::now();
     let render = pool.install(|| render_with_progress(&scene, &options));
     let seconds = started.elapsed().as_secs_f64();
-    let out = args.output.clone().unwrap_or_else(|| default_output(&args.file));
+    let out = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.file));
     if let Err(e) = crate::image::write_png(&out, &render.image) {
         eprintln!("error: cannot write `{}`: {e}", out.display());
         return ExitCode::from(2);
     }
     let s = &scene.settings;
-    eprintln!("wrote {} ({}x{}, aa {}, {:.3} s)", out.display(), s.width, s.height, s.aa, seconds);
+    eprintln!(
+        "wrote {} ({}x{}, aa {}, {:.3} s)",
+        out.display(),
+        s.width,
+        s.height,
+        s.aa,
+        seconds
+    );
     if args.stats {
         println!("time            {:.3} s", seconds);
         println!("{}", render.stats);
@@ -93,7 +116,9 @@ fn render_with_progress(scene: &Scene, options: &Options) -> cpu::Render {
     let program = lower::lower(scene);
     let bar = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(cpu::tile_count(&scene.settings, options));
-        if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}") {
+        if let Ok(style) =
+            ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}")
+        {
             bar.set_style(style);
         }
         Some(bar)
@@ -113,7 +138,10 @@ fn render_with_progress(scene: &Scene, options: &Options) -> cpu::Render {
 
 /// `scene.sdf` → `./scene.png`.
 fn default_output(file: &Path) -> PathBuf {
-    let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "render".into());
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "render".into());
     PathBuf::from(format!("{stem}.png"))
 }
 
@@ -126,12 +154,15 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> 
         }
         b = b.num_threads(n);
     }
-    b.build().map_err(|e| format!("cannot start worker threads: {e}"))
+    b.build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))
 }
 
 /// Parses `WIDTHxHEIGHT`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, like 640x480, not `{s}`"))?;
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, like 640x480, not `{s}`"))?;
     let w = parse_dimension(w.trim())?;
     let h = parse_dimension(h.trim())?;
     Ok((w, h))
@@ -143,12 +174,19 @@ const MAX_EDGE: u32 = 1 << 15;
 fn parse_dimension(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
         Ok(v) if (1..=MAX_EDGE).contains(&v) => Ok(v),
-        _ => Err(format!("an image edge must be a whole number from 1 to {MAX_EDGE}, not `{s}`")),
+        _ => Err(format!(
+            "an image edge must be a whole number from 1 to {MAX_EDGE}, not `{s}`"
+        )),
     }
 }
 
 /// Applies `--size`, `--aa` and then each `--set key=value`, in order.
-pub fn override_settings(s: &mut Settings, size: Option<(u32, u32)>, aa: Option<u32>, sets: &[String]) -> Result<(), String> {
+pub fn override_settings(
+    s: &mut Settings,
+    size: Option<(u32, u32)>,
+    aa: Option<u32>,
+    sets: &[String],
+) -> Result<(), String> {
     if let Some((w, h)) = size {
         s.width = w;
         s.height = h;
@@ -157,16 +195,26 @@ pub fn override_settings(s: &mut Settings, size: Option<(u32, u32)>, aa: Option<
         set(s, "aa", &n.to_string())?;
     }
     for item in sets {
-        let (key, value) =
-            item.split_once('=').ok_or_else(|| format!("--set expects KEY=VALUE, like max_steps=512, not `{item}`"))?;
+        let (key, value) = item
+            .split_once('=')
+            .ok_or_else(|| format!("--set expects KEY=VALUE, like max_steps=512, not `{item}`"))?;
         set(s, key.trim(), value.trim())?;
     }
     Ok(())
 }
 
 /// The keys `--set` accepts.
-pub const SETTING_KEYS: &[&str] =
-    &["width", "height", "aa", "max_steps", "epsilon", "max_depth", "max_dist", "relaxation", "background"];
+pub const SETTING_KEYS: &[&str] = &[
+    "width",
+    "height",
+    "aa",
+    "max_steps",
+    "epsilon",
+    "max_depth",
+    "max_dist",
+    "relaxation",
+    "background",
+];
 
 /// Sets one render setting from text, checking its range.
 pub fn set(s: &mut Settings, key: &str, value: &str) -> Result<(), String> {
@@ -178,10 +226,20 @@ pub fn set(s: &mut Settings, key: &str, value: &str) -> Result<(), String> {
         "max_depth" => s.max_depth = int(key, value, 0, 64)?,
         "epsilon" => s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?,
         "max_dist" => s.max_dist = real(key, value, |v| v > 0.0, "a positive number")?,
-        "relaxation" => s.relaxation = real(key, value, |v| (1.0..2.0).contains(&v), "a number in [1, 2)")?,
+        "relaxation" => {
+            s.relaxation = real(
+                key,
+                value,
+                |v| (1.0..2.0).contains(&v),
+                "a number in [1, 2)",
+            )?
+        }
         "background" => s.background = colour(value)?,
         _ => {
-            return Err(format!("unknown render setting `{key}`; the settings are {}", SETTING_KEYS.join(", ")));
+            return Err(format!(
+                "unknown render setting `{key}`; the settings are {}",
+                SETTING_KEYS.join(", ")
+            ));
         }
     }
     Ok(())
@@ -190,7 +248,9 @@ pub fn set(s: &mut Settings, key: &str, value: &str) -> Result<(), String> {
 fn int(key: &str, value: &str, lo: u32, hi: u32) -> Result<u32, String> {
     match value.parse::<u32>() {
         Ok(v) if (lo..=hi).contains(&v) => Ok(v),
-        _ => Err(format!("{key} must be a whole number from {lo} to {hi}, not `{value}`")),
+        _ => Err(format!(
+            "{key} must be a whole number from {lo} to {hi}, not `{value}`"
+        )),
     }
 }
 
@@ -202,7 +262,11 @@ fn real(key: &str, value: &str, ok: impl Fn(f64) -> bool, what: &str) -> Result<
 }
 
 fn colour(value: &str) -> Result<[f64; 3], String> {
-    let err = || format!("background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{value}`");
+    let err = || {
+        format!(
+            "background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{value}`"
+        )
+    };
     let parts: Vec<f64> = value
         .trim_matches(|c| c == '(' || c == ')')
         .split(',')

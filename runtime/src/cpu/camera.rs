@@ -30,7 +30,15 @@ impl<T: Float> Pinhole<T> {
         let (width, height) = (settings.width.max(1) as f64, settings.height.max(1) as f64);
         let aspect = T::from_f64(width / height);
         let size = (T::from_f64(width), T::from_f64(height));
-        Pinhole { origin, w, u, v, scale: (tan * aspect, tan), size, aa: settings.aa.max(1) }
+        Pinhole {
+            origin,
+            w,
+            u,
+            v,
+            scale: (tan * aspect, tan),
+            size,
+            aa: settings.aa.max(1),
+        }
     }
 
     /// The eye position.
@@ -49,7 +57,10 @@ impl<T: Float> Pinhole<T> {
     pub fn direction(&self, x: u32, y: u32, s: u32) -> V3<T> {
         let n = T::from_f64(self.aa as f64);
         let half = T::from_f64(0.5);
-        let (i, j) = (T::from_f64((s % self.aa) as f64), T::from_f64((s / self.aa) as f64));
+        let (i, j) = (
+            T::from_f64((s % self.aa) as f64),
+            T::from_f64((s / self.aa) as f64),
+        );
         let ax = (T::from_f64(x as f64) + (i + half) / n) / self.size.0;
         let ay = (T::from_f64(y as f64) + (j + half) / n) / self.size.1;
         let two = T::from_f64(2.0);

@@ -30,8 +30,17 @@ pub(super) struct Mat<T> {
 /// A light in the evaluation type; `color` is colour × intensity (I_l).
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Lamp<T> {
-    Point { position: V3<T>, color: V3<T>, radius: T, softness: T },
-    Directional { to_light: V3<T>, color: V3<T>, softness: T },
+    Point {
+        position: V3<T>,
+        color: V3<T>,
+        radius: T,
+        softness: T,
+    },
+    Directional {
+        to_light: V3<T>,
+        color: V3<T>,
+        softness: T,
+    },
 }
 
 /// Render-wide constants.
@@ -81,7 +90,9 @@ impl<T: Float> Context<T> {
 
     /// The material of an id (unknown ids get material 0).
     pub fn material(&self, id: u32) -> &Mat<T> {
-        self.materials.get(id as usize).unwrap_or(&self.materials[0])
+        self.materials
+            .get(id as usize)
+            .unwrap_or(&self.materials[0])
     }
 
     /// The normal step at a hit: h = max(ε·t, 64·machine ε·(1 + |p|∞)), where t is the
@@ -96,9 +107,11 @@ fn mat<T: Float>(m: &Material) -> Mat<T> {
     let f = T::from_f64;
     let paint = match &m.pattern {
         Pattern::Solid(c) => Paint::Solid(V3::from_f64(*c)),
-        Pattern::Checker { a, b, size } => {
-            Paint::Checker { a: V3::from_f64(*a), b: V3::from_f64(*b), inv_size: f(1.0 / size) }
-        }
+        Pattern::Checker { a, b, size } => Paint::Checker {
+            a: V3::from_f64(*a),
+            b: V3::from_f64(*b),
+            inv_size: f(1.0 / size),
+        },
     };
     Mat {
         paint,
@@ -114,13 +127,24 @@ fn mat<T: Float>(m: &Material) -> Mat<T> {
 
 fn lamp<T: Float>(l: &Light) -> Lamp<T> {
     match l {
-        Light::Point { position, color, intensity, radius, softness } => Lamp::Point {
+        Light::Point {
+            position,
+            color,
+            intensity,
+            radius,
+            softness,
+        } => Lamp::Point {
             position: V3::from_f64(*position),
             color: V3::from_f64(*color) * T::from_f64(*intensity),
             radius: T::from_f64(*radius),
             softness: T::from_f64(*softness),
         },
-        Light::Directional { direction, color, intensity, softness } => Lamp::Directional {
+        Light::Directional {
+            direction,
+            color,
+            intensity,
+            softness,
+        } => Lamp::Directional {
             to_light: -V3::<T>::from_f64(*direction).normalize(),
             color: V3::from_f64(*color) * T::from_f64(*intensity),
             softness: T::from_f64(*softness),

@@ -94,13 +94,25 @@ impl<T: Float> Lanes<T> {
     /// p = o + t·d for every lane.
     pub fn points(&mut self) {
         let n = self.len;
-        for (axis, (o, d)) in [(&self.ox, &self.dx), (&self.oy, &self.dy), (&self.oz, &self.dz)].into_iter().enumerate() {
+        for (axis, (o, d)) in [
+            (&self.ox, &self.dx),
+            (&self.oy, &self.dy),
+            (&self.oz, &self.dz),
+        ]
+        .into_iter()
+        .enumerate()
+        {
             let p = match axis {
                 0 => &mut self.px,
                 1 => &mut self.py,
                 _ => &mut self.pz,
             };
-            for (((p, &o), &d), &t) in p[..n].iter_mut().zip(&o[..n]).zip(&d[..n]).zip(&self.t[..n]) {
+            for (((p, &o), &d), &t) in p[..n]
+                .iter_mut()
+                .zip(&o[..n])
+                .zip(&d[..n])
+                .zip(&self.t[..n])
+            {
                 *p = o + t * d;
             }
         }
@@ -110,8 +122,20 @@ impl<T: Float> Lanes<T> {
     pub fn evaluate(&mut self, dist: &mut Evaluator<'_, T>, full: Option<&mut Evaluator<'_, T>>) {
         let n = self.len;
         match full {
-            Some(ev) => ev.eval(&self.px[..n], &self.py[..n], &self.pz[..n], &mut self.dist[..n], Some(&mut self.mat[..n])),
-            None => dist.eval(&self.px[..n], &self.py[..n], &self.pz[..n], &mut self.dist[..n], None),
+            Some(ev) => ev.eval(
+                &self.px[..n],
+                &self.py[..n],
+                &self.pz[..n],
+                &mut self.dist[..n],
+                Some(&mut self.mat[..n]),
+            ),
+            None => dist.eval(
+                &self.px[..n],
+                &self.py[..n],
+                &self.pz[..n],
+                &mut self.dist[..n],
+                None,
+            ),
         }
     }
 
@@ -164,7 +188,14 @@ pub(super) fn march<T: Float, R: Rule<T>>(
             return;
         }
         lanes.points();
-        lanes.evaluate(dist, if rule.needs_materials() { Some(&mut *full) } else { None });
+        lanes.evaluate(
+            dist,
+            if rule.needs_materials() {
+                Some(&mut *full)
+            } else {
+                None
+            },
+        );
         rule.advance(lanes);
         lanes.remove_done();
     }

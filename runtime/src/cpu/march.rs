@@ -53,7 +53,8 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
         let n = l.len;
         let c = self.ctx;
         let (one, zero) = (T::one(), T::zero());
-        let (inv_l, eps, max_dist, max_steps) = (c.inv_lipschitz, c.epsilon, c.max_dist, c.max_steps);
+        let (inv_l, eps, max_dist, max_steps) =
+            (c.inv_lipschitz, c.epsilon, c.max_dist, c.max_steps);
         let (dist, sign, t0) = (&l.dist[..n], &l.sign[..n], &l.t0[..n]);
         let (t, steps, flags) = (&mut l.t[..n], &mut l.steps[..n], &mut l.flags[..n]);
         let (omega, prev, step) = (&mut l.omega[..n], &mut l.prev[..n], &mut l.step[..n]);
@@ -98,7 +99,11 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
                 l.flags[k] = 0;
                 continue;
             };
-            self.out[l.id[k] as usize] = Traced { t: l.t[k], status, steps: l.steps[k] };
+            self.out[l.id[k] as usize] = Traced {
+                t: l.t[k],
+                status,
+                steps: l.steps[k],
+            };
             l.flags[k] = DONE;
         }
     }
@@ -124,7 +129,10 @@ pub(super) struct Shadow<'a, T: Float> {
 
 impl<T: Float> Shadow<'_, T> {
     fn finish(&mut self, l: &mut Lanes<T>, k: usize, light: T) {
-        self.out[l.id[k] as usize] = Shadowed { light, steps: l.steps[k] };
+        self.out[l.id[k] as usize] = Shadowed {
+            light,
+            steps: l.steps[k],
+        };
         l.flags[k] = DONE;
     }
 
@@ -140,7 +148,12 @@ impl<T: Float> Shadow<'_, T> {
         let zero = T::zero();
         let (inv_l, eps, max_steps) = (c.inv_lipschitz, c.epsilon, c.max_steps);
         let (dist, t0, kk, tmax) = (&l.dist[..n], &l.t0[..n], &l.k[..n], &l.tmax[..n]);
-        let (t, steps, flags, res) = (&mut l.t[..n], &mut l.steps[..n], &mut l.flags[..n], &mut l.res[..n]);
+        let (t, steps, flags, res) = (
+            &mut l.t[..n],
+            &mut l.steps[..n],
+            &mut l.flags[..n],
+            &mut l.res[..n],
+        );
         for k in 0..n {
             let f = dist[k];
             let s = f * inv_l;

@@ -56,7 +56,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             lipschitz: 1.0,
-            tile: 16,
+            tile: 32,
             lanes: 256,
             chunk: sdfc_compiler::eval::DEFAULT_CHUNK,
             precision: Precision::F32,
@@ -79,7 +79,12 @@ fn tiles(settings: &Settings, edge: u32) -> Vec<Rect> {
     let mut out = Vec::new();
     for y in (0..settings.height).step_by(edge as usize) {
         for x in (0..settings.width).step_by(edge as usize) {
-            out.push(Rect { x, y, w: edge.min(settings.width - x), h: edge.min(settings.height - y) });
+            out.push(Rect {
+                x,
+                y,
+                w: edge.min(settings.width - x),
+                h: edge.min(settings.height - y),
+            });
         }
     }
     out
@@ -92,7 +97,12 @@ pub fn tile_count(settings: &Settings, options: &Options) -> u64 {
 
 /// Renders `scene` (whose distance program is `program`) on the current rayon pool, calling
 /// `progress` once per finished tile, in `options.precision`.
-pub fn render(scene: &Scene, program: &Program, options: &Options, progress: &(dyn Fn() + Sync)) -> Render {
+pub fn render(
+    scene: &Scene,
+    program: &Program,
+    options: &Options,
+    progress: &(dyn Fn() + Sync),
+) -> Render {
     match options.precision {
         Precision::F32 => render_in::<f32>(scene, program, options, progress),
         Precision::F64 => render_in::<f64>(scene, program, options, progress),
@@ -100,7 +110,12 @@ pub fn render(scene: &Scene, program: &Program, options: &Options, progress: &(d
 }
 
 /// [`render`] in the float type `T`.
-pub fn render_in<T: Float>(scene: &Scene, program: &Program, options: &Options, progress: &(dyn Fn() + Sync)) -> Render {
+pub fn render_in<T: Float>(
+    scene: &Scene,
+    program: &Program,
+    options: &Options,
+    progress: &(dyn Fn() + Sync),
+) -> Render {
     let ctx = Context::<T>::new(scene, program, options.lipschitz);
     let rects = tiles(&scene.settings, options.tile);
     let outs: Vec<tile::TileOut> = rects
@@ -132,5 +147,8 @@ fn assemble(settings: &Settings, rects: &[Rect], outs: &[tile::TileOut]) -> Rend
             steps[dst..dst + n].copy_from_slice(&out.steps[src..src + n]);
         }
     }
-    Render { image, stats: Stats::new(counters, &steps) }
+    Render {
+        image,
+        stats: Stats::new(counters, &steps),
+    }
 }

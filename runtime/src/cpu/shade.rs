@@ -44,7 +44,14 @@ pub(super) fn bounce<T: Float>(
                 let p = ray.origin + ray.dir * tr.t;
                 let tt = ray.t0 + tr.t;
                 let h = ctx.normal_step(tt, p);
-                hits.push(Hit { ray: i, p, n: V3::zero(), tt, h, mat: 0 });
+                hits.push(Hit {
+                    ray: i,
+                    p,
+                    n: V3::zero(),
+                    tt,
+                    h,
+                    mat: 0,
+                });
                 continue;
             }
             Status::Miss => counters.misses += 1,
@@ -63,26 +70,47 @@ pub(super) fn bounce<T: Float>(
 }
 
 /// Sphere-traces every ray of the wave into `ws.traced`.
-fn trace<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, wave: &[Ray<T>], counters: &mut Counters) {
+fn trace<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    wave: &[Ray<T>],
+    counters: &mut Counters,
+) {
     ws.launches.clear();
-    ws.launches.extend(wave.iter().enumerate().map(|(i, r)| Launch {
-        id: i as u32,
-        origin: [r.origin.x, r.origin.y, r.origin.z],
-        dir: [r.dir.x, r.dir.y, r.dir.z],
-        t0: r.t0,
-        sign: if r.inside { -T::one() } else { T::one() },
-        tmax: ctx.max_dist,
-        k: T::zero(),
-        omega: ctx.relaxation,
-    }));
+    ws.launches
+        .extend(wave.iter().enumerate().map(|(i, r)| Launch {
+            id: i as u32,
+            origin: [r.origin.x, r.origin.y, r.origin.z],
+            dir: [r.dir.x, r.dir.y, r.dir.z],
+            t0: r.t0,
+            sign: if r.inside { -T::one() } else { T::one() },
+            tmax: ctx.max_dist,
+            k: T::zero(),
+            omega: ctx.relaxation,
+        }));
     ws.traced.clear();
     ws.traced.resize(wave.len(), Traced::default());
-    let mut rule = Trace { ctx, out: &mut ws.traced, counters };
-    march(&mut ws.lanes, &mut ws.dist, &mut ws.full, &ws.launches, &mut rule);
+    let mut rule = Trace {
+        ctx,
+        out: &mut ws.traced,
+        counters,
+    };
+    march(
+        &mut ws.lanes,
+        &mut ws.dist,
+        &mut ws.full,
+        &ws.launches,
+        &mut rule,
+    );
 }
 
 /// The tetrahedron's corners k_i for the 4-tap gradient.
-const TETRA: [[f64; 3]; 4] = [[1.0, -1.0, -1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, 1.0, 1.0]];
+const TETRA: [[f64; 3]; 4] = [
+    [1.0, -1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [-1.0, 1.0, -1.0],
+    [1.0, 1.0, 1.0],
+];
 
 /// N = normalize(Σ k_i f(p + h·k_i)); a degenerate gradient gives -D.
 fn normals<T: Float>(ws: &mut Workspace<'_, T>, wave: &[Ray<T>], hits: &mut [Hit<T>]) {
@@ -99,9 +127,15 @@ fn normals<T: Float>(ws: &mut Workspace<'_, T>, wave: &[Ray<T>], hits: &mut [Hit
     }
     ws.dist.eval(&ws.x, &ws.y, &ws.z, &mut ws.d, None);
     for (i, hit) in hits.iter_mut().enumerate() {
-        let g = TETRA.iter().enumerate().fold(V3::zero(), |g, (j, k)| g + V3::from_f64(*k) * ws.d[4 * i + j]);
+        let g = TETRA.iter().enumerate().fold(V3::zero(), |g, (j, k)| {
+            g + V3::from_f64(*k) * ws.d[4 * i + j]
+        });
         let l = g.length();
-        hit.n = if l > T::zero() && !l.is_nan() { g * (T::one() / l) } else { -wave[hit.ray].dir };
+        hit.n = if l > T::zero() && !l.is_nan() {
+            g * (T::one() / l)
+        } else {
+            -wave[hit.ray].dir
+        };
     }
 }
 
@@ -120,7 +154,8 @@ fn materials<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, hits: &mut [
     for (i, hit) in hits.iter().enumerate() {
         (ws.x[i], ws.y[i], ws.z[i]) = (hit.p.x, hit.p.y, hit.p.z);
     }
-    ws.full.eval(&ws.x, &ws.y, &ws.z, &mut ws.d, Some(&mut ws.m));
+    ws.full
+        .eval(&ws.x, &ws.y, &ws.z, &mut ws.d, Some(&mut ws.m));
     for (hit, &m) in hits.iter_mut().zip(&ws.m) {
         hit.mat = m;
     }
@@ -151,7 +186,9 @@ fn colour<T: Float>(m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
 /// radius r (a radius ≤ 0 or infinite means no falloff).
 fn towards<T: Float>(ctx: &Context<T>, lamp: &Lamp<T>, p: V3<T>) -> (V3<T>, T, T) {
     match *lamp {
-        Lamp::Point { position, radius, .. } => {
+        Lamp::Point {
+            position, radius, ..
+        } => {
             let v = position - p;
             let d = v.length();
             let atten = if radius > T::zero() {
@@ -169,7 +206,12 @@ fn towards<T: Float>(ctx: &Context<T>, lamp: &Lamp<T>, p: V3<T>) -> (V3<T>, T, T
 
 fn lamp_colour<T: Float>(lamp: &Lamp<T>) -> (V3<T>, T) {
     match *lamp {
-        Lamp::Point { color, softness, .. } | Lamp::Directional { color, softness, .. } => (color, softness),
+        Lamp::Point {
+            color, softness, ..
+        }
+        | Lamp::Directional {
+            color, softness, ..
+        } => (color, softness),
     }
 }
 
@@ -210,7 +252,11 @@ fn light<T: Float>(
             let contrib = (c * (m.diffuse * ndl) + V3::splat(spec)).mul_v(il) * atten;
             let off = T::from_f64(4.0) * hit.h;
             let o = hit.p + hit.n * off;
-            let tmax = if matches!(lamp, Lamp::Point { .. }) { dist - off } else { dist };
+            let tmax = if matches!(lamp, Lamp::Point { .. }) {
+                dist - off
+            } else {
+                dist
+            };
             ws.launches.push(Launch {
                 id: pending.len() as u32,
                 origin: [o.x, o.y, o.z],
@@ -227,8 +273,18 @@ fn light<T: Float>(
     counters.shadow_rays += pending.len() as u64;
     ws.shadowed.clear();
     ws.shadowed.resize(pending.len(), Shadowed::default());
-    let mut rule = Shadow { ctx, out: &mut ws.shadowed, counters };
-    march(&mut ws.lanes, &mut ws.dist, &mut ws.full, &ws.launches, &mut rule);
+    let mut rule = Shadow {
+        ctx,
+        out: &mut ws.shadowed,
+        counters,
+    };
+    march(
+        &mut ws.lanes,
+        &mut ws.dist,
+        &mut ws.full,
+        &ws.launches,
+        &mut rule,
+    );
     let mut lit: Vec<V3<T>> = vec![V3::zero(); hits.len()];
     for (&(hi, contrib), s) in pending.iter().zip(&ws.shadowed) {
         lit[hi] = lit[hi] + contrib * s.light;
@@ -286,12 +342,22 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
             continue;
         }
         if m.reflect > T::zero() {
-            next.push(child(hit.p + off, ray.dir.reflect(hit.n), ray.weight * m.reflect, false));
+            next.push(child(
+                hit.p + off,
+                ray.dir.reflect(hit.n),
+                ray.weight * m.reflect,
+                false,
+            ));
         }
         if m.transparency > T::zero() {
             match refract(ray.dir, hit.n, T::one() / m.ior) {
                 Some(t) => next.push(child(hit.p - off, t, ray.weight * m.transparency, true)),
-                None => next.push(child(hit.p + off, ray.dir.reflect(hit.n), ray.weight * m.transparency, false)),
+                None => next.push(child(
+                    hit.p + off,
+                    ray.dir.reflect(hit.n),
+                    ray.weight * m.transparency,
+                    false,
+                )),
             }
         }
     }

@@ -64,7 +64,11 @@ impl Stats {
         sorted.sort_unstable();
         let n = sorted.len();
         let total: u64 = sorted.iter().map(|&s| s as u64).sum();
-        let p99 = if n == 0 { 0 } else { sorted[((n - 1) as f64 * 0.99).round() as usize] };
+        let p99 = if n == 0 {
+            0
+        } else {
+            sorted[((n - 1) as f64 * 0.99).round() as usize]
+        };
         Stats {
             counters,
             pixels: n as u64,
@@ -79,10 +83,22 @@ impl fmt::Display for Stats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let c = &self.counters;
         writeln!(f, "pixels          {}", self.pixels)?;
-        writeln!(f, "rays            {} camera, {} secondary, {} shadow", c.camera_rays, c.secondary_rays, c.shadow_rays)?;
-        writeln!(f, "steps/pixel     mean {:.1}, p99 {}, max {}", self.steps_mean, self.steps_p99, self.steps_max)?;
+        writeln!(
+            f,
+            "rays            {} camera, {} secondary, {} shadow",
+            c.camera_rays, c.secondary_rays, c.shadow_rays
+        )?;
+        writeln!(
+            f,
+            "steps/pixel     mean {:.1}, p99 {}, max {}",
+            self.steps_mean, self.steps_p99, self.steps_max
+        )?;
         writeln!(f, "hits            {}", c.hits)?;
-        writeln!(f, "misses          {} by distance, {} by step budget", c.misses, c.budget_misses)?;
+        writeln!(
+            f,
+            "misses          {} by distance, {} by step budget",
+            c.misses, c.budget_misses
+        )?;
         writeln!(f, "overshoots      {}", c.overshoots)?;
         write!(f, "NaNs            {}", c.nans)
     }

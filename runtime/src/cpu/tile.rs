@@ -97,11 +97,19 @@ pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect
         .chunks(chunk)
         .map(|s| {
             let sum = s.iter().fold(V3::zero(), |a, &c| a + c) * scale;
-            [sum.x.to_f64() as f32, sum.y.to_f64() as f32, sum.z.to_f64() as f32]
+            [
+                sum.x.to_f64() as f32,
+                sum.y.to_f64() as f32,
+                sum.z.to_f64() as f32,
+            ]
         })
         .collect();
     let steps = steps.chunks(chunk).map(|s| s.iter().sum()).collect();
-    TileOut { pixels, steps, counters }
+    TileOut {
+        pixels,
+        steps,
+        counters,
+    }
 }
 
 /// One ray per sample, pixels row-major, samples row-major within the pixel.

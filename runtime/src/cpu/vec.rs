@@ -47,7 +47,11 @@ impl<T: Float> V3<T> {
     /// Cross product.
     #[inline]
     pub fn cross(self, o: Self) -> Self {
-        V3::new(self.y * o.z - self.z * o.y, self.z * o.x - self.x * o.z, self.x * o.y - self.y * o.x)
+        V3::new(
+            self.y * o.z - self.z * o.y,
+            self.z * o.x - self.x * o.z,
+            self.x * o.y - self.y * o.x,
+        )
     }
 
     /// Euclidean length.

@@ -27,7 +27,13 @@ pub struct GpuRender {
 }
 
 /// Renders `scene` with an already generated kernel on `gpu`.
-pub fn render(gpu: &Gpu, scene: &Scene, kernel: &Kernel, lipschitz: f64, progress: &mut dyn FnMut(f64)) -> Result<GpuRender, Error> {
+pub fn render(
+    gpu: &Gpu,
+    scene: &Scene,
+    kernel: &Kernel,
+    lipschitz: f64,
+    progress: &mut dyn FnMut(f64),
+) -> Result<GpuRender, Error> {
     let s = &scene.settings;
     let uniforms = wgsl::uniforms(scene, lipschitz);
     let launch = self::wgpu::Launch {
@@ -42,7 +48,11 @@ pub fn render(gpu: &Gpu, scene: &Scene, kernel: &Kernel, lipschitz: f64, progres
     };
     let frame = gpu.render(&launch, progress)?;
     let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
-    let image = Image { width: s.width, height: s.height, linear: frame.linear };
+    let image = Image {
+        width: s.width,
+        height: s.height,
+        linear: frame.linear,
+    };
     Ok(GpuRender {
         render: Render { image, stats },
         time: frame.gpu_time.unwrap_or(frame.wall_time),
@@ -52,7 +62,10 @@ pub fn render(gpu: &Gpu, scene: &Scene, kernel: &Kernel, lipschitz: f64, progres
 
 /// Sums the kernel's per-pixel statistics words into the CPU renderer's statistics.
 pub fn stats(words: &[u32], pixels: u64, aa: u32) -> Stats {
-    let mut c = Counters { camera_rays: pixels * (aa.max(1) as u64).pow(2), ..Counters::default() };
+    let mut c = Counters {
+        camera_rays: pixels * (aa.max(1) as u64).pow(2),
+        ..Counters::default()
+    };
     let mut steps = Vec::with_capacity(pixels as usize);
     for w in words.chunks_exact(STATS_WORDS as usize) {
         steps.push(w[0]);

@@ -75,7 +75,8 @@ impl Gpu {
     /// Opens the first adapter wgpu finds. With `require_hardware`, a CPU adapter (lavapipe)
     /// does not count.
     pub fn open(require_hardware: bool) -> Result<Gpu, Error> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
             wgpu::DeviceType::DiscreteGpu => 0,
@@ -88,26 +89,46 @@ impl Gpu {
             .into_iter()
             .filter(|a| !require_hardware || a.get_info().device_type != wgpu::DeviceType::Cpu)
             .min_by_key(rank)
-            .ok_or(Error::NoAdapter { what: if require_hardware { "GPU" } else { "wgpu" } })?;
+            .ok_or(Error::NoAdapter {
+                what: if require_hardware { "GPU" } else { "wgpu" },
+            })?;
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let features = if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
-        let limits = wgpu::Limits { max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size, ..wgpu::Limits::default() }
-            .using_resolution(adapter.limits());
+        let features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
+            ..wgpu::Limits::default()
+        }
+        .using_resolution(adapter.limits());
         let desc = wgpu::DeviceDescriptor {
             label: Some("sdfc"),
             required_features: features,
             required_limits: limits,
             ..Default::default()
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
-            .map_err(|e| Error::Device { adapter: info.name.clone(), message: e.to_string() })?;
-        Ok(Gpu { device, queue, info, timestamps })
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&desc)).map_err(|e| Error::Device {
+                adapter: info.name.clone(),
+                message: e.to_string(),
+            })?;
+        Ok(Gpu {
+            device,
+            queue,
+            info,
+            timestamps,
+        })
     }
 
     /// The adapter's name and backend, e.g. `NVIDIA H100 (Vulkan)`.
     pub fn describe(&self) -> String {
-        format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
     }
 
     /// True for a software adapter such as lavapipe.
@@ -135,11 +156,14 @@ impl Gpu {
             })
         });
         let mem_scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let table: Vec<u8> = tiles.iter().flat_map(|t| {
-            let mut entry = words(&[t.0, t.1, t.2, t.3]);
-            entry.resize(TILE_STRIDE as usize, 0);
-            entry
-        }).collect();
+        let table: Vec<u8> = tiles
+            .iter()
+            .flat_map(|t| {
+                let mut entry = words(&[t.0, t.1, t.2, t.3]);
+                entry.resize(TILE_STRIDE as usize, 0);
+                entry
+            })
+            .collect();
         self.queue.write_buffer(&buffers.tile, 0, &table);
         let start = Instant::now();
         // Tiles are submitted in batches: each tile is its own dispatch, and the host waits
@@ -153,7 +177,10 @@ impl Gpu {
                     beginning_of_pass_write_index: Some(2 * i),
                     end_of_pass_write_index: Some(2 * i + 1),
                 });
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: writes });
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: None,
+                    timestamp_writes: writes,
+                });
                 pass.set_pipeline(&pipeline);
                 pass.set_bind_group(0, &bind, &[i * TILE_STRIDE]);
                 pass.dispatch_workgroups(t.2.div_ceil(l.workgroup), t.3.div_ceil(l.workgroup), 1);
@@ -172,19 +199,32 @@ impl Gpu {
             Some(q) => Some(self.gpu_time(q, tiles.len() as u32)?),
             None => None,
         };
-        let floats: Vec<f32> = linear.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        let floats: Vec<f32> = linear
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
         let linear = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
-        let stats = stats.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-        Ok(Frame { linear, stats, gpu_time, wall_time })
+        let stats = stats
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        Ok(Frame {
+            linear,
+            stats,
+            gpu_time,
+            wall_time,
+        })
     }
 
     /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
     /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage).
     fn pipeline(&self, l: &Launch) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
-        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("sdfc kernel"),
-            source: wgpu::ShaderSource::Wgsl(l.wgsl.into()),
-        });
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("sdfc kernel"),
+                source: wgpu::ShaderSource::Wgsl(l.wgsl.into()),
+            });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -201,48 +241,92 @@ impl Gpu {
             has_dynamic_offset: false,
             min_binding_size: None,
         };
-        let layout = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sdfc bindings"),
-            entries: &[entry(0, uniform(false)), entry(1, uniform(true)), entry(2, storage), entry(3, storage)],
-        });
-        let pipeline_layout = self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sdfc layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("sdfc render"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(l.entry),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let layout = self
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("sdfc bindings"),
+                entries: &[
+                    entry(0, uniform(false)),
+                    entry(1, uniform(true)),
+                    entry(2, storage),
+                    entry(3, storage),
+                ],
+            });
+        let pipeline_layout = self
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("sdfc layout"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("sdfc render"),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(l.entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
         (pipeline, layout)
     }
 
     fn buffers(&self, l: &Launch, pixels: u64, tiles: u64) -> Buffers {
         use wgpu::BufferUsages as U;
         let make = |label, size: u64, usage| {
-            self.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16),
+                usage,
+                mapped_at_creation: false,
+            })
         };
-        let uniforms = make("sdfc scene", l.uniforms.len() as u64, U::UNIFORM | U::COPY_DST);
+        let uniforms = make(
+            "sdfc scene",
+            l.uniforms.len() as u64,
+            U::UNIFORM | U::COPY_DST,
+        );
         self.queue.write_buffer(&uniforms, 0, l.uniforms);
         Buffers {
             uniforms,
-            tile: make("sdfc tiles", tiles * TILE_STRIDE as u64, U::UNIFORM | U::COPY_DST),
+            tile: make(
+                "sdfc tiles",
+                tiles * TILE_STRIDE as u64,
+                U::UNIFORM | U::COPY_DST,
+            ),
             image: make("sdfc image", pixels * 16, U::STORAGE | U::COPY_SRC),
-            stats: make("sdfc stats", pixels * 4 * l.stats_words as u64, U::STORAGE | U::COPY_SRC),
+            stats: make(
+                "sdfc stats",
+                pixels * 4 * l.stats_words as u64,
+                U::STORAGE | U::COPY_SRC,
+            ),
         }
     }
 
     fn bind_group(&self, layout: &wgpu::BindGroupLayout, b: &Buffers) -> wgpu::BindGroup {
-        let tile = wgpu::BufferBinding { buffer: &b.tile, offset: 0, size: std::num::NonZeroU64::new(16) };
+        let tile = wgpu::BufferBinding {
+            buffer: &b.tile,
+            offset: 0,
+            size: std::num::NonZeroU64::new(16),
+        };
         let entries = [
-            wgpu::BindGroupEntry { binding: 0, resource: b.uniforms.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Buffer(tile) },
-            wgpu::BindGroupEntry { binding: 2, resource: b.image.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: b.stats.as_entire_binding() },
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: b.uniforms.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Buffer(tile),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: b.image.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: b.stats.as_entire_binding(),
+            },
         ];
         self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sdfc bindings"),
@@ -252,7 +336,10 @@ impl Gpu {
     }
 
     fn wait(&self) -> Result<(), Error> {
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Render(e.to_string()))
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| Error::Render(e.to_string()))
     }
 
     fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
@@ -274,7 +361,10 @@ impl Gpu {
         rx.recv()
             .map_err(|e| Error::Render(e.to_string()))?
             .map_err(|e| Error::Render(e.to_string()))?;
-        let bytes = slice.get_mapped_range().map_err(|e| Error::Render(e.to_string()))?.to_vec();
+        let bytes = slice
+            .get_mapped_range()
+            .map_err(|e| Error::Render(e.to_string()))?
+            .to_vec();
         staging.unmap();
         Ok(bytes)
     }
@@ -291,9 +381,15 @@ impl Gpu {
         enc.resolve_query_set(q, 0..n as u32, &resolve, 0);
         self.queue.submit([enc.finish()]);
         let bytes = self.read(&resolve, n * 8)?;
-        let ticks: Vec<u64> = bytes.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect();
+        let ticks: Vec<u64> = bytes
+            .chunks_exact(8)
+            .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
+            .collect();
         let period = self.queue.get_timestamp_period() as f64;
-        let total: u64 = ticks.chunks_exact(2).map(|p| p[1].saturating_sub(p[0])).sum();
+        let total: u64 = ticks
+            .chunks_exact(2)
+            .map(|p| p[1].saturating_sub(p[0]))
+            .sum();
         Ok(Duration::from_nanos((total as f64 * period) as u64))
     }
 }

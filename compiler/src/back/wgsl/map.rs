@@ -16,7 +16,12 @@ pub fn write_map(program: &Program) -> String {
         }
         let _ = writeln!(out, "    let r{i} = {};", expr(op));
     }
-    let _ = writeln!(out, "    return vec2<f32>(r{}, r{});", program.distance().0, program.material().0);
+    let _ = writeln!(
+        out,
+        "    return vec2<f32>(r{}, r{});",
+        program.distance().0,
+        program.material().0
+    );
     out.push_str("}\n");
     out
 }
@@ -26,7 +31,11 @@ pub fn write_map(program: &Program) -> String {
 pub fn float(x: f64) -> String {
     let f = (x as f32).clamp(-f32::MAX, f32::MAX);
     let s = format!("{f:?}");
-    if s.contains('.') || s.contains('e') { s } else { format!("{s}.0") }
+    if s.contains('.') || s.contains('e') {
+        s
+    } else {
+        format!("{s}.0")
+    }
 }
 
 fn expr(op: &Op) -> String {

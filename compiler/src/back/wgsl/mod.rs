@@ -53,7 +53,11 @@ pub struct Error {
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "internal compiler error: the generated WGSL is invalid: {}", self.message)?;
+        write!(
+            f,
+            "internal compiler error: the generated WGSL is invalid: {}",
+            self.message
+        )?;
         if let Some((n, text)) = &self.line {
             write!(f, "\n  at generated line {n}: {}", text.trim())?;
         }
@@ -67,15 +71,26 @@ impl std::error::Error for Error {}
 fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
     let mats = &scene.materials;
     let soft = scene.lights.iter().any(|l| l.softness() > 0.0);
-    let points = scene.lights.iter().any(|l| matches!(l, Light::Point { .. }));
-    let dirs = scene.lights.iter().any(|l| matches!(l, Light::Directional { .. }));
+    let points = scene
+        .lights
+        .iter()
+        .any(|l| matches!(l, Light::Point { .. }));
+    let dirs = scene
+        .lights
+        .iter()
+        .any(|l| matches!(l, Light::Directional { .. }));
     let refraction = mats.iter().any(|m| m.transparency > 0.0);
-    let secondary = scene.settings.max_depth > 0 && mats.iter().any(|m| m.reflect > 0.0 || m.transparency > 0.0);
+    let secondary = scene.settings.max_depth > 0
+        && mats.iter().any(|m| m.reflect > 0.0 || m.transparency > 0.0);
     vec![
         ("POINT", points),
         ("DIRECTIONAL", dirs),
         ("SOFT", soft),
-        ("CHECKER", mats.iter().any(|m| matches!(m.pattern, Pattern::Checker { .. }))),
+        (
+            "CHECKER",
+            mats.iter()
+                .any(|m| matches!(m.pattern, Pattern::Checker { .. })),
+        ),
         ("REFRACTION", refraction && secondary),
         ("SECONDARY", secondary),
         ("MATERIALS", mats.len() > 1),
@@ -84,7 +99,11 @@ fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
 }
 
 fn count(scene: &Scene, point: bool) -> usize {
-    scene.lights.iter().filter(|l| matches!(l, Light::Point { .. }) == point).count()
+    scene
+        .lights
+        .iter()
+        .filter(|l| matches!(l, Light::Point { .. }) == point)
+        .count()
 }
 
 /// Writes and validates the kernel for `scene`, whose distance program is `program`.
@@ -92,38 +111,66 @@ pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
     let features = features(scene);
     let on: HashMap<&str, bool> = features.iter().copied().collect();
     let mut values: HashMap<&str, String> = HashMap::new();
-    values.insert("MAP", format!("{}\n{}", write_map(program), write_sdf(program)));
+    values.insert(
+        "MAP",
+        format!("{}\n{}", write_map(program), write_sdf(program)),
+    );
     values.insert("POINTS", count(scene, true).to_string());
     values.insert("DIRS", count(scene, false).to_string());
     values.insert("MATERIALS", scene.materials.len().max(1).to_string());
     values.insert("STACK", (scene.settings.max_depth + 2).to_string());
     values.insert("WORKGROUP", WORKGROUP.to_string());
     values.insert("ENTRY", ENTRY_POINT.to_string());
-    let source = template::expand(TEMPLATE, &on, &values)
-        .map_err(|e| Error { message: format!("kernel template: {e}"), line: None, node_span: None })?;
+    let source = template::expand(TEMPLATE, &on, &values).map_err(|e| Error {
+        message: format!("kernel template: {e}"),
+        line: None,
+        node_span: None,
+    })?;
     let (module, info) = validate(&source, scene)?;
-    Ok(Kernel { source, module, info, features })
+    Ok(Kernel {
+        source,
+        module,
+        info,
+        features,
+    })
 }
 
 /// Parses and validates WGSL with naga.
 fn validate(source: &str, scene: &Scene) -> Result<(naga::Module, naga::valid::ModuleInfo), Error> {
     let located = |message: String, span: Option<naga::Span>| {
-        let line = span.map(|s| s.location(source).line_number as usize).filter(|&n| n > 0);
+        let line = span
+            .map(|s| s.location(source).line_number as usize)
+            .filter(|&n| n > 0);
         let line = line.map(|n| (n, source.lines().nth(n - 1).unwrap_or("").to_string()));
-        let node_span = line.as_ref().and_then(|(n, _)| node_of_line(source, *n, scene));
-        Error { message, line, node_span }
+        let node_span = line
+            .as_ref()
+            .and_then(|(n, _)| node_of_line(source, *n, scene));
+        Error {
+            message,
+            line,
+            node_span,
+        }
     };
     let module = naga::front::wgsl::parse_str(source)
         .map_err(|e| located(e.emit_to_string(source), e.labels().next().map(|(s, _)| s)))?;
-    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
-        .validate(&module)
-        .map_err(|e| located(e.emit_to_string(source), e.spans().next().map(|(s, _)| *s)))?;
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .map_err(|e| located(e.emit_to_string(source), e.spans().next().map(|(s, _)| *s)))?;
     Ok((module, info))
 }
 
 /// The scene node whose comment (`// node N ...`) precedes generated line `n`.
 fn node_of_line(source: &str, n: usize, scene: &Scene) -> Option<crate::Span> {
-    let comment = source.lines().take(n).collect::<Vec<_>>().into_iter().rev().find_map(|l| l.trim().strip_prefix("// node "))?;
+    let comment = source
+        .lines()
+        .take(n)
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .find_map(|l| l.trim().strip_prefix("// node "))?;
     let id: u32 = comment.split_whitespace().next()?.parse().ok()?;
     (id < scene.graph.len() as u32).then(|| scene.graph.span(crate::scene::NodeId(id)))
 }
@@ -141,13 +188,19 @@ fn write_sdf(program: &Program) -> String {
             }
         }
     }
-    let mut out = String::from("// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n");
+    let mut out = String::from(
+        "// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n",
+    );
     let text = write_map(program);
     // Reuse the map writer's lines: keep the `let` of each needed register.
     for line in text.lines() {
         let t = line.trim_start();
         if let Some(rest) = t.strip_prefix("let r") {
-            let idx: usize = rest.split(' ').next().and_then(|s| s.parse().ok()).unwrap_or(usize::MAX);
+            let idx: usize = rest
+                .split(' ')
+                .next()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(usize::MAX);
             if needed.get(idx).copied().unwrap_or(false) {
                 out.push_str(line);
                 out.push('\n');
@@ -174,19 +227,40 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
     w.v4(u, 0.0);
     w.v4(v, 0.0);
     w.f([tan * aspect, tan, s.width as f64, s.height as f64]);
-    w.f([s.epsilon, s.max_dist, s.relaxation.max(1.0), 1.0 / lipschitz.max(1.0)]);
+    w.f([
+        s.epsilon,
+        s.max_dist,
+        s.relaxation.max(1.0),
+        1.0 / lipschitz.max(1.0),
+    ]);
     w.v4(s.background, 0.0);
     w.u([s.width, s.height, s.aa.max(1), s.max_steps.max(1)]);
     w.u([s.max_depth, 0, 0, 0]);
     for l in &scene.lights {
-        if let Light::Point { position, color, intensity, radius, softness } = l {
+        if let Light::Point {
+            position,
+            color,
+            intensity,
+            radius,
+            softness,
+        } = l
+        {
             w.v4(*position, if radius.is_finite() { *radius } else { 0.0 });
             w.v4(scale(*color, *intensity), *softness);
         }
     }
     for l in &scene.lights {
-        if let Light::Directional { direction, color, intensity, softness } = l {
-            w.v4(normalize([-direction[0], -direction[1], -direction[2]]), 0.0);
+        if let Light::Directional {
+            direction,
+            color,
+            intensity,
+            softness,
+        } = l
+        {
+            w.v4(
+                normalize([-direction[0], -direction[1], -direction[2]]),
+                0.0,
+            );
             w.v4(scale(*color, *intensity), *softness);
         }
     }
@@ -231,10 +305,18 @@ fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 fn normalize(a: [f64; 3]) -> [f64; 3] {
     let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    if l > 0.0 { scale(a, 1.0 / l) } else { a }
+    if l > 0.0 {
+        scale(a, 1.0 / l)
+    } else {
+        a
+    }
 }

@@ -6,7 +6,11 @@ use std::collections::HashMap;
 /// Expands `template`: a line `//#if NAME` (or `//#if !NAME`) opens a block kept only when
 /// the feature is on (off); `//#else` and `//#endif` close it. Directive lines are dropped.
 /// Returns an error naming the line of an unbalanced directive or an unknown placeholder.
-pub fn expand(template: &str, features: &HashMap<&str, bool>, values: &HashMap<&str, String>) -> Result<String, String> {
+pub fn expand(
+    template: &str,
+    features: &HashMap<&str, bool>,
+    values: &HashMap<&str, String>,
+) -> Result<String, String> {
     let mut out = String::with_capacity(template.len());
     // Each open block: (this branch is kept, the enclosing block is kept).
     let mut stack: Vec<(bool, bool)> = Vec::new();
@@ -19,13 +23,19 @@ pub fn expand(template: &str, features: &HashMap<&str, bool>, values: &HashMap<&
                 Some(name) => (true, name),
                 None => (false, cond),
             };
-            let on = *features.get(name).ok_or_else(|| format!("line {}: unknown feature `{name}`", n + 1))?;
+            let on = *features
+                .get(name)
+                .ok_or_else(|| format!("line {}: unknown feature `{name}`", n + 1))?;
             stack.push((on != negate, live));
         } else if trimmed.starts_with("//#else") {
-            let top = stack.last_mut().ok_or_else(|| format!("line {}: `//#else` without `//#if`", n + 1))?;
+            let top = stack
+                .last_mut()
+                .ok_or_else(|| format!("line {}: `//#else` without `//#if`", n + 1))?;
             top.0 = !top.0;
         } else if trimmed.starts_with("//#endif") {
-            stack.pop().ok_or_else(|| format!("line {}: `//#endif` without `//#if`", n + 1))?;
+            stack
+                .pop()
+                .ok_or_else(|| format!("line {}: `//#endif` without `//#if`", n + 1))?;
         } else if live {
             out.push_str(&substitute(line, values).map_err(|e| format!("line {}: {e}", n + 1))?);
             out.push('\n');
@@ -45,7 +55,11 @@ fn substitute(line: &str, values: &HashMap<&str, String>) -> Result<String, Stri
         let after = &rest[start + 2..];
         let end = after.find("}}").ok_or("unclosed `{{`")?;
         let name = &after[..end];
-        out.push_str(values.get(name).ok_or_else(|| format!("unknown placeholder `{name}`"))?);
+        out.push_str(
+            values
+                .get(name)
+                .ok_or_else(|| format!("unknown placeholder `{name}`"))?,
+        );
         rest = &after[end + 2..];
     }
     out.push_str(rest);

@@ -1,0 +1,345 @@
+//! Software sequences for the f32 functions the hardware does not approximate well
+//! enough: sin, cos and tan (Cody–Waite reduction, Payne–Hanek beyond |x| > 105615,
+//! minimax polynomials), atan, atan2, asin, acos, exp (ex2 with the rounding error of
+//! x·log2(e) put back), pow and the hyperbolic functions. docs/ptx.md states each error.
+
+use super::emit::{ins, Class, Op};
+use super::writer::Fw;
+
+/// The name of the large-argument reduction `.func`.
+pub(super) const TRIG_REDUCE: &str = "__sdfc_trig_reduce";
+
+const PI: f32 = std::f32::consts::PI;
+const FRAC_PI_2: f32 = std::f32::consts::FRAC_PI_2;
+const FRAC_PI_4: f32 = std::f32::consts::FRAC_PI_4;
+
+/// Which trigonometric function of a reduced argument.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Trig {
+    Sin,
+    Cos,
+    Tan,
+}
+
+impl Fw<'_, '_> {
+    fn f(&mut self, op: &str, a: Op, b: Op) -> Op {
+        self.bin(op, Class::F32, a, b)
+    }
+
+    fn fma(&mut self, a: Op, b: Op, c: Op) -> Op {
+        self.tri("fma.rn.f32", Class::F32, a, b, c)
+    }
+
+    /// A polynomial in `z` by Horner's rule, highest coefficient first.
+    fn horner(&mut self, z: Op, coefficients: &[f32]) -> Op {
+        let mut acc = Op::f32(coefficients[0]);
+        for &c in &coefficients[1..] {
+            acc = self.fma(acc, z, Op::f32(c));
+        }
+        acc
+    }
+
+    /// sin, cos or tan of `x`.
+    pub fn trig(&mut self, x: Op, which: Trig) -> Op {
+        let (r, q) = self.trig_reduce(x);
+        let z = self.f("mul.f32", r, r);
+        // sin r = r + r·z·P(z) and cos r = 1 − z/2 + z²·Q(z) on [−π/4, π/4] (Cephes).
+        let ps = self.horner(z, &[-1.951_529_6e-4, 8.332_161e-3, -1.666_665_5e-1]);
+        let ps = self.f("mul.f32", ps, z);
+        let s = self.fma(ps, r, r);
+        let pc = self.horner(z, &[2.443_315_7e-5, -1.388_731_6e-3, 4.166_664_6e-2, -0.5]);
+        let c = self.fma(pc, z, Op::f32(1.0));
+        let q = if which == Trig::Cos { self.bin("add.s32", Class::B32, q, Op::I32(1)) } else { q };
+        let odd_bit = self.bin("and.b32", Class::B32, q, Op::U32(1));
+        let odd = self.setp("ne.u32", odd_bit, Op::U32(0));
+        if which == Trig::Tan {
+            let nc = self.un("neg.f32", Class::F32, c);
+            let num = self.selp(super::types::Sc::F32, nc, s, odd);
+            let den = self.selp(super::types::Sc::F32, s, c, odd);
+            return self.f("div.rn.f32", num, den);
+        }
+        let v = self.selp(super::types::Sc::F32, c, s, odd);
+        let neg_bit = self.bin("and.b32", Class::B32, q, Op::U32(2));
+        let neg = self.setp("ne.u32", neg_bit, Op::U32(0));
+        let nv = self.un("neg.f32", Class::F32, v);
+        self.selp(super::types::Sc::F32, nv, v, neg)
+    }
+
+    /// x = r + q·π/2 with |r| ≤ π/4: three-part Cody–Waite up to |x| = 105615, the
+    /// exact Payne–Hanek reduction (a `.func`) beyond.
+    fn trig_reduce(&mut self, x: Op) -> (Op, Op) {
+        self.cx.trig_reduce.set(true);
+        let t = self.f("mul.f32", x, Op::f32(std::f32::consts::FRAC_2_PI));
+        let j = self.un("cvt.rni.f32.f32", Class::F32, t);
+        let q = self.un("cvt.rni.s32.f32", Class::B32, t);
+        let r = self.fma(j, Op::F32(0xBFC9_0FDA), x);
+        let r = self.fma(j, Op::F32(0xB3A2_2168), r);
+        let r = self.fma(j, Op::F32(0xA7C2_34C5), r);
+        let ax = self.un("abs.f32", Class::F32, x);
+        let big = self.setp("gt.f32", ax, Op::f32(105615.0));
+        let done = self.out.label("trig_reduced");
+        ins!(self.out, "@!{big} bra {done};");
+        self.out.raw("\t{\n");
+        ins!(self.out, ".param .f32 param0;");
+        ins!(self.out, "st.param.f32 [param0], {x};");
+        ins!(self.out, ".param .align 4 .b8 retval0[8];");
+        ins!(self.out, "call (retval0), {TRIG_REDUCE}, (param0);");
+        ins!(self.out, "ld.param.f32 {r}, [retval0];");
+        ins!(self.out, "ld.param.b32 {q}, [retval0+4];");
+        self.out.raw("\t}\n");
+        self.out.place(&done);
+        (r, q)
+    }
+
+    /// atan of `a` ≥ 0 (or NaN), by Cephes' reduction to |u| ≤ tan(π/8).
+    fn atan_kernel(&mut self, a: Op) -> Op {
+        use super::types::Sc::F32;
+        let big = self.setp("gt.f32", a, Op::F32(0x401A_827A));
+        let mid = self.setp("gt.f32", a, Op::F32(0x3ED4_13CD));
+        let am1 = self.f("sub.f32", a, Op::f32(1.0));
+        let ap1 = self.f("add.f32", a, Op::f32(1.0));
+        let num = self.selp(F32, am1, a, mid);
+        let num = self.selp(F32, Op::f32(-1.0), num, big);
+        let den = self.selp(F32, ap1, Op::f32(1.0), mid);
+        let den = self.selp(F32, a, den, big);
+        let u = self.f("div.rn.f32", num, den);
+        let y0 = self.selp(F32, Op::f32(FRAC_PI_4), Op::f32(0.0), mid);
+        let y0 = self.selp(F32, Op::f32(FRAC_PI_2), y0, big);
+        let z = self.f("mul.f32", u, u);
+        let p = self.horner(z, &[8.053_744_5e-2, -1.387_768_6e-1, 1.997_771_1e-1, -3.333_295e-1]);
+        let p = self.f("mul.f32", p, z);
+        let k = self.fma(p, u, u);
+        self.f("add.f32", y0, k)
+    }
+
+    pub fn atan(&mut self, x: Op) -> Op {
+        let a = self.un("abs.f32", Class::F32, x);
+        let r = self.atan_kernel(a);
+        self.f("copysign.f32", x, r)
+    }
+
+    /// atan2(y, x) with IEEE's quadrants and signed zeros; NaN if either is NaN.
+    pub fn atan2(&mut self, y: Op, x: Op) -> Op {
+        use super::types::Sc::F32;
+        let ax = self.un("abs.f32", Class::F32, x);
+        let ay = self.un("abs.f32", Class::F32, y);
+        let mx = self.f("max.f32", ax, ay);
+        let mn = self.f("min.f32", ax, ay);
+        let t = self.f("div.rn.f32", mn, mx);
+        let zero = self.setp("eq.f32", mx, Op::f32(0.0));
+        let t = self.selp(F32, Op::f32(0.0), t, zero);
+        let inf = self.setp("eq.f32", mn, Op::f32(f32::INFINITY));
+        let t = self.selp(F32, Op::f32(1.0), t, inf);
+        let a = self.atan_kernel(t);
+        let swap = self.setp("gt.f32", ay, ax);
+        let b = self.f("sub.f32", Op::f32(FRAC_PI_2), a);
+        let a = self.selp(F32, b, a, swap);
+        let xb = self.un("mov.b32", Class::B32, x);
+        let xneg = self.setp("lt.s32", xb, Op::I32(0));
+        let b = self.f("sub.f32", Op::f32(PI), a);
+        let a = self.selp(F32, b, a, xneg);
+        let r = self.f("copysign.f32", y, a);
+        let nan = self.setp("nan.f32", x, y);
+        let sum = self.f("add.f32", x, y);
+        self.selp(F32, sum, r, nan)
+    }
+
+    /// (asin |x|, acos |x|) pieces: the Cephes kernel `k` and whether |x| > 1/2, in
+    /// which case k = asin(sqrt((1 − |x|)/2)).
+    fn asin_kernel(&mut self, a: Op) -> (Op, Op) {
+        use super::types::Sc::F32;
+        let big = self.setp("gt.f32", a, Op::f32(0.5));
+        let zb = self.fma(Op::f32(-0.5), a, Op::f32(0.5));
+        let sb = self.un("sqrt.rn.f32", Class::F32, zb);
+        let a2 = self.f("mul.f32", a, a);
+        let z = self.selp(F32, zb, a2, big);
+        let s = self.selp(F32, sb, a, big);
+        let p = self.horner(z, &[4.216_32e-2, 2.418_131_1e-2, 4.547_002_6e-2, 7.495_300_3e-2, 1.666_675_2e-1]);
+        let p = self.f("mul.f32", p, z);
+        (self.fma(p, s, s), big)
+    }
+
+    pub fn asin(&mut self, x: Op) -> Op {
+        let a = self.un("abs.f32", Class::F32, x);
+        let (k, big) = self.asin_kernel(a);
+        let r = self.fma(Op::f32(-2.0), k, Op::f32(FRAC_PI_2));
+        let r = self.selp(super::types::Sc::F32, r, k, big);
+        self.f("copysign.f32", x, r)
+    }
+
+    pub fn acos(&mut self, x: Op) -> Op {
+        use super::types::Sc::F32;
+        let a = self.un("abs.f32", Class::F32, x);
+        let (k, big) = self.asin_kernel(a);
+        let two_k = self.f("add.f32", k, k);
+        let small = self.f("sub.f32", Op::f32(FRAC_PI_2), k);
+        let r = self.selp(F32, two_k, small, big);
+        let neg = self.setp("lt.f32", x, Op::f32(0.0));
+        let flipped = self.f("sub.f32", Op::f32(PI), r);
+        self.selp(F32, flipped, r, neg)
+    }
+
+    /// e^x: ex2 of t = x·log2(e), times 1 + ε·ln 2 where ε is what rounding t lost.
+    pub fn exp(&mut self, x: Op) -> Op {
+        let t = self.f("mul.f32", x, Op::F32(0x3FB8_AA3B));
+        let nt = self.un("neg.f32", Class::F32, t);
+        let e = self.fma(x, Op::F32(0x3FB8_AA3B), nt);
+        let e = self.fma(x, Op::F32(0x32A5_7060), e);
+        let c = self.fma(e, Op::f32(std::f32::consts::LN_2), Op::f32(1.0));
+        let bad = self.setp("nan.f32", c, c);
+        let c = self.selp(super::types::Sc::F32, Op::f32(1.0), c, bad);
+        let y = self.un("ex2.approx.f32", Class::F32, t);
+        self.f("mul.f32", y, c)
+    }
+
+    /// ln x = log2(x)·ln 2.
+    pub fn ln(&mut self, x: Op) -> Op {
+        let l = self.un("lg2.approx.f32", Class::F32, x);
+        self.f("mul.f32", l, Op::f32(std::f32::consts::LN_2))
+    }
+
+    /// x^y = 2^(y·log2 x), as WGSL defines it: NaN for x < 0; 1 when y = 0 or x = 1.
+    pub fn pow(&mut self, x: Op, y: Op) -> Op {
+        use super::types::Sc::F32;
+        let l = self.un("lg2.approx.f32", Class::F32, x);
+        let t = self.f("mul.f32", y, l);
+        let p = self.un("ex2.approx.f32", Class::F32, t);
+        let y0 = self.setp("eq.f32", y, Op::f32(0.0));
+        let x1 = self.setp("eq.f32", x, Op::f32(1.0));
+        let one = self.bin("or.pred", Class::Pred, y0, x1);
+        self.selp(F32, Op::f32(1.0), p, one)
+    }
+
+    /// sinh, cosh (half the difference or sum of e^x and e^−x).
+    pub fn sinh_cosh(&mut self, x: Op, cosh: bool) -> Op {
+        let a = self.exp(x);
+        let nx = self.un("neg.f32", Class::F32, x);
+        let b = self.exp(nx);
+        let s = self.f(if cosh { "add.f32" } else { "sub.f32" }, a, b);
+        self.f("mul.f32", s, Op::f32(0.5))
+    }
+
+    /// tanh x = sign(x)·(1 − 2/(e^{2|x|} + 1)), which tends to ±1 without overflow.
+    pub fn tanh(&mut self, x: Op) -> Op {
+        let a = self.un("abs.f32", Class::F32, x);
+        let a2 = self.f("add.f32", a, a);
+        let e = self.exp(a2);
+        let d = self.f("add.f32", e, Op::f32(1.0));
+        let q = self.f("div.rn.f32", Op::f32(2.0), d);
+        let r = self.f("sub.f32", Op::f32(1.0), q);
+        self.f("copysign.f32", x, r)
+    }
+
+    /// asinh x = sign(x)·ln(|x| + sqrt(x² + 1)).
+    pub fn asinh(&mut self, x: Op) -> Op {
+        let a = self.un("abs.f32", Class::F32, x);
+        let s = self.fma(a, a, Op::f32(1.0));
+        let s = self.un("sqrt.rn.f32", Class::F32, s);
+        let s = self.f("add.f32", a, s);
+        let r = self.ln(s);
+        self.f("copysign.f32", x, r)
+    }
+
+    /// acosh x = ln(x + sqrt(x² − 1)).
+    pub fn acosh(&mut self, x: Op) -> Op {
+        let s = self.fma(x, x, Op::f32(-1.0));
+        let s = self.un("sqrt.rn.f32", Class::F32, s);
+        let s = self.f("add.f32", x, s);
+        self.ln(s)
+    }
+
+    /// atanh x = ln((1 + x)/(1 − x))/2.
+    pub fn atanh(&mut self, x: Op) -> Op {
+        let n = self.f("add.f32", Op::f32(1.0), x);
+        let d = self.f("sub.f32", Op::f32(1.0), x);
+        let q = self.f("div.rn.f32", n, d);
+        let l = self.ln(q);
+        self.f("mul.f32", l, Op::f32(0.5))
+    }
+}
+
+/// The `.func` that reduces |x| > 105615 exactly (Payne–Hanek): the 24-bit mantissa
+/// times 192 bits of 2/π, the two integer bits and 62 fraction bits around the binary
+/// point, the fraction times π/2 in f64. Returns (r: f32 at 0, q: s32 at 4).
+pub(super) fn trig_reduce_func() -> String {
+    const TWO_OVER_PI: [u32; 6] = [0x3C43_9041, 0xDB62_9599, 0xF534_DDC0, 0xFC27_57D1, 0x4E44_1529, 0xA2F9_836E];
+    let mut s = String::new();
+    s.push_str(&format!(
+        "// x = r + q·π/2 for |x| > 105615 (Payne–Hanek, exact).\n\
+         .func (.param .align 4 .b8 {TRIG_REDUCE}_ret[8]) {TRIG_REDUCE}(.param .f32 {TRIG_REDUCE}_x)\n{{\n\
+         \t.reg .pred %p<4>;\n\t.reg .b32 %r<40>;\n\t.reg .f32 %f<4>;\n\t.reg .b64 %rd<24>;\n\t.reg .f64 %fd<4>;\n\
+         \tld.param.f32 %f1, [{TRIG_REDUCE}_x];\n\
+         \tmov.b32 %r1, %f1;\n\
+         \tand.b32 %r2, %r1, -2147483648;\n\
+         \tbfe.u32 %r3, %r1, 23, 8;\n\
+         \tadd.s32 %r4, %r3, -128;\n\
+         \tshl.b32 %r5, %r1, 8;\n\
+         \tor.b32 %r6, %r5, -2147483648;\n\
+         \t// the product of the mantissa and 2/π, words %r10 (lowest) to %r16\n\
+         \tmov.u64 %rd1, 0;\n"
+    ));
+    for (q, w) in TWO_OVER_PI.iter().enumerate() {
+        s.push_str(&format!(
+            "\tmad.wide.u32 %rd{a}, %r6, {w}, %rd{c};\n\tcvt.u32.u64 %r{d}, %rd{a};\n\tshr.u64 %rd{b}, %rd{a}, 32;\n",
+            a = 2 * q + 2,
+            b = 2 * q + 3,
+            c = 2 * q + 1,
+            d = 10 + q
+        ));
+    }
+    s.push_str(
+        "\tcvt.u32.u64 %r16, %rd13;\n\
+         \t// k = e / 32 picks the words around the binary point\n\
+         \tshr.s32 %r7, %r4, 5;\n\
+         \tand.b32 %r8, %r4, 31;\n\
+         \tsetp.eq.s32 %p1, %r7, 1;\n\
+         \tsetp.eq.s32 %p2, %r7, 2;\n\
+         \tsetp.eq.s32 %p3, %r7, 3;\n\
+         \tselp.b32 %r20, %r15, %r16, %p1;\n\
+         \tselp.b32 %r20, %r14, %r20, %p2;\n\
+         \tselp.b32 %r20, %r13, %r20, %p3;\n\
+         \tselp.b32 %r21, %r14, %r15, %p1;\n\
+         \tselp.b32 %r21, %r13, %r21, %p2;\n\
+         \tselp.b32 %r21, %r12, %r21, %p3;\n\
+         \tselp.b32 %r22, %r13, %r14, %p1;\n\
+         \tselp.b32 %r22, %r12, %r22, %p2;\n\
+         \tselp.b32 %r22, %r11, %r22, %p3;\n\
+         \t// W: 2 integer bits, then 62 fraction bits\n\
+         \tmov.b64 %rd14, {%r21, %r20};\n\
+         \tshl.b64 %rd14, %rd14, %r8;\n\
+         \tsub.s32 %r23, 32, %r8;\n\
+         \tshr.u32 %r24, %r22, %r23;\n\
+         \tcvt.u64.u32 %rd15, %r24;\n\
+         \tor.b64 %rd14, %rd14, %rd15;\n\
+         \tshr.u64 %rd16, %rd14, 62;\n\
+         \tcvt.u32.u64 %r25, %rd16;\n\
+         \tshl.b64 %rd17, %rd14, 2;\n\
+         \t// a fraction of one half or more rounds q up and r becomes negative\n\
+         \tshr.u64 %rd18, %rd17, 63;\n\
+         \tcvt.u32.u64 %r26, %rd18;\n\
+         \tadd.s32 %r25, %r25, %r26;\n\
+         \tsetp.ne.u32 %p1, %r26, 0;\n\
+         \tneg.s64 %rd19, %rd17;\n\
+         \tselp.b64 %rd17, %rd19, %rd17, %p1;\n\
+         \tshl.b32 %r27, %r26, 31;\n\
+         \txor.b32 %r28, %r2, %r27;\n\
+         \tsetp.ne.u32 %p2, %r2, 0;\n\
+         \tneg.s32 %r29, %r25;\n\
+         \tselp.b32 %r25, %r29, %r25, %p2;\n\
+         \t// r = fraction · π/2\n\
+         \tcvt.rn.f64.u64 %fd1, %rd17;\n\
+         \tmul.f64 %fd2, %fd1, 0d3BF921FB54442D18;\n\
+         \tcvt.rn.f32.f64 %f2, %fd2;\n\
+         \tmov.b32 %r30, %f2;\n\
+         \tor.b32 %r30, %r30, %r28;\n\
+         \tmov.b32 %f3, %r30;\n\
+         \t// infinities give NaN\n\
+         \tsetp.eq.u32 %p3, %r3, 255;\n\
+         \tmul.f32 %f2, %f1, 0f00000000;\n\
+         \tselp.f32 %f3, %f2, %f3, %p3;\n",
+    );
+    s.push_str(&format!(
+        "\tst.param.f32 [{TRIG_REDUCE}_ret], %f3;\n\tst.param.b32 [{TRIG_REDUCE}_ret+4], %r25;\n\tret;\n}}\n"
+    ));
+    s
+}

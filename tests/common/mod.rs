@@ -1,0 +1,116 @@
+//! Helpers shared by the integration tests: scenes built in code, random points, and a few
+//! reference formulas.
+#![allow(dead_code)]
+
+use sdfc_compiler::scene::{Camera, Graph, Light, Material, MaterialId, Node, NodeId, Pattern, Scene, Settings};
+use sdfc_compiler::{FileId, Span};
+
+/// A span for nodes made in code.
+pub fn span() -> Span {
+    Span::new(FileId(0), 0..0)
+}
+
+/// A scene under construction.
+#[derive(Debug, Default)]
+pub struct Build {
+    pub scene: Scene,
+}
+
+impl Build {
+    /// An empty scene with the default material, camera and settings.
+    pub fn new() -> Self {
+        let scene = Scene {
+            graph: Graph::default(),
+            root: None,
+            materials: vec![Material::default_material()],
+            lights: Vec::new(),
+            camera: Camera::default(),
+            settings: Settings::default(),
+        };
+        Build { scene }
+    }
+
+    /// Adds a node.
+    pub fn add(&mut self, node: Node) -> NodeId {
+        self.scene.graph.add(node, span())
+    }
+
+    /// Adds a solid-colour material and returns its id.
+    pub fn material(&mut self, color: [f64; 3], reflect: f64, transparency: f64) -> MaterialId {
+        let mut m = Material::default_material();
+        m.name = format!("m{}", self.scene.materials.len());
+        m.pattern = Pattern::Solid(color);
+        m.reflect = reflect;
+        m.transparency = transparency;
+        self.scene.materials.push(m);
+        MaterialId(self.scene.materials.len() as u32 - 1)
+    }
+
+    /// Paints a node.
+    pub fn paint(&mut self, child: NodeId, m: MaterialId) -> NodeId {
+        self.add(Node::Paint { material: m, child })
+    }
+
+    /// Translates a node.
+    pub fn at(&mut self, child: NodeId, offset: [f64; 3]) -> NodeId {
+        self.add(Node::Translate { offset, child })
+    }
+
+    /// Sets the root and returns the scene.
+    pub fn finish(mut self, root: NodeId) -> Scene {
+        self.scene.root = Some(root);
+        self.scene
+    }
+
+    /// Adds a point light.
+    pub fn point_light(&mut self, position: [f64; 3], softness: f64) {
+        self.scene.lights.push(Light::Point { position, color: [1.0; 3], intensity: 1.0, radius: 100.0, softness });
+    }
+}
+
+/// A scene of one node at the origin.
+pub fn single(node: Node) -> Scene {
+    let mut b = Build::new();
+    let id = b.add(node);
+    b.finish(id)
+}
+
+/// A small deterministic generator (xorshift64*).
+#[derive(Debug, Clone)]
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+
+    /// A point uniform in the cube [-s, s]³.
+    pub fn point(&mut self, s: f64) -> [f64; 3] {
+        [self.range(-s, s), self.range(-s, s), self.range(-s, s)]
+    }
+}
+
+pub fn len3(p: [f64; 3]) -> f64 {
+    (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt()
+}
+
+pub fn len2(a: f64, b: f64) -> f64 {
+    (a * a + b * b).sqrt()
+}
+
+pub fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}

@@ -1,6 +1,7 @@
 //! The sdfc runtime: loading scenes from disk, the CPU renderer, image IO, and the commands of
 //! the `sdfc` binary.
 
+pub mod backend;
 pub mod commands;
 pub mod cpu;
 pub mod frontend;

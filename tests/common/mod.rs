@@ -2,7 +2,9 @@
 //! reference formulas.
 #![allow(dead_code)]
 
-use sdfc_compiler::scene::{Camera, Graph, Light, Material, MaterialId, Node, NodeId, Pattern, Scene, Settings};
+use sdfc_compiler::scene::{
+    Camera, Graph, Light, Material, MaterialId, Node, NodeId, Pattern, Scene, Settings,
+};
 use sdfc_compiler::{FileId, Span};
 
 /// A span for nodes made in code.
@@ -64,7 +66,13 @@ impl Build {
 
     /// Adds a point light.
     pub fn point_light(&mut self, position: [f64; 3], softness: f64) {
-        self.scene.lights.push(Light::Point { position, color: [1.0; 3], intensity: 1.0, radius: 100.0, softness });
+        self.scene.lights.push(Light::Point {
+            position,
+            color: [1.0; 3],
+            intensity: 1.0,
+            radius: 100.0,
+            softness,
+        });
     }
 }
 

@@ -3,3 +3,4 @@
 pub mod rust;
 pub mod shader;
 pub mod wgsl;
+pub mod ptx;

@@ -1,5 +1,6 @@
 //! Tapes: distance programs prepared for batch evaluation (dead instructions dropped,
-//! registers packed into reusable slots), and the loop that runs each instruction.
+//! constant operands of two-operand instructions made immediate, registers packed into
+//! reusable slots), and the loop that runs each instruction.
 
 use super::{scalar, Float};
 use crate::lower::{Axis, Binary, Op, Program, Reg, Unary};
@@ -16,12 +17,20 @@ pub enum Outputs {
 /// The operation of one step.
 #[derive(Debug, Clone, Copy)]
 enum Code {
+    /// `op(a)`
     Unary(Unary),
+    /// `op(a, b)`
     Binary(Binary),
+    /// `op(a, k)`
+    BinaryK(Binary),
+    /// `op(k, a)`
+    KBinary(Binary),
+    /// `select(a, b, c)`
     Select,
 }
 
-/// One instruction over slots: `dst = code(a, b, c)`. `dst` never equals an operand.
+/// One instruction over slots: `dst = code(a, b, c)` with the immediate `k`. `dst` never
+/// equals an operand.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Step {
     code: Code,
@@ -29,6 +38,7 @@ pub(super) struct Step {
     a: u32,
     b: u32,
     c: u32,
+    k: f64,
 }
 
 /// A program prepared for an [`super::Evaluator`].
@@ -68,6 +78,7 @@ impl Tape {
             roots.push(program.material());
         }
         let last_use = last_uses(ops, &roots);
+        let in_slot = needs_slot(ops, &roots, &last_use);
         let mut alloc = Allocator {
             slot_of: vec![None; ops.len()],
             ..Default::default()
@@ -80,18 +91,15 @@ impl Tape {
             distance: 0,
             material: None,
         };
-        // Constants and inputs keep their own slots for the evaluator's whole life.
+        // Constants read from memory and inputs keep their slots for the evaluator's life.
         for (i, op) in ops.iter().enumerate() {
-            if last_use[i].is_none() {
-                continue;
-            }
             match *op {
-                Op::Const(c) => {
+                Op::Const(c) if in_slot[i] => {
                     let s = alloc.fresh();
                     alloc.slot_of[i] = Some(s);
                     tape.constants.push((s, c));
                 }
-                Op::Input(a) => {
+                Op::Input(a) if last_use[i].is_some() => {
                     let s = alloc.fresh();
                     alloc.slot_of[i] = Some(s);
                     tape.inputs[axis_index(a)] = Some(s);
@@ -183,20 +191,46 @@ fn last_uses(ops: &[Op], roots: &[Reg]) -> Vec<Option<usize>> {
     last
 }
 
+/// Which constants must live in a slot: outputs and operands of one-operand instructions
+/// and selects (two-operand instructions take them as immediates).
+fn needs_slot(ops: &[Op], roots: &[Reg], last_use: &[Option<usize>]) -> Vec<bool> {
+    let mut need = vec![false; ops.len()];
+    for r in roots {
+        need[r.0 as usize] = true;
+    }
+    for (i, op) in ops.iter().enumerate() {
+        if last_use[i].is_none() {
+            continue;
+        }
+        match *op {
+            Op::Unary(_, a) => need[a.0 as usize] = true,
+            Op::Select(c, a, b) => [c, a, b].iter().for_each(|r| need[r.0 as usize] = true),
+            _ => {}
+        }
+    }
+    need
+}
+
 /// Allocates the destination of instruction `i`, then frees operands read for the last time
 /// (after, so that the destination is never an operand).
 fn step(i: usize, op: &Op, alloc: &mut Allocator, last_use: &[Option<usize>], ops: &[Op]) -> Step {
-    let operands = op.operands();
-    let s: Vec<u32> = operands
-        .iter()
-        .map(|r| alloc.slot_of[r.0 as usize].unwrap_or(0))
-        .collect();
-    let at = |k: usize| s.get(k).copied().unwrap_or(0);
-    let code = match *op {
-        Op::Unary(u, _) => Code::Unary(u),
-        Op::Binary(b, _, _) => Code::Binary(b),
-        _ => Code::Select,
+    let constant = |r: Reg| match ops[r.0 as usize] {
+        Op::Const(c) => Some(c),
+        _ => None,
     };
+    let slot = |alloc: &Allocator, r: Reg| alloc.slot_of[r.0 as usize].unwrap_or(0);
+    let (code, operands, k) = match *op {
+        Op::Unary(u, a) => (Code::Unary(u), vec![a], 0.0),
+        Op::Binary(b, x, y) => match (constant(x), constant(y)) {
+            (_, Some(k)) => (Code::BinaryK(b), vec![x], k),
+            (Some(k), None) => (Code::KBinary(b), vec![y], k),
+            (None, None) => (Code::Binary(b), vec![x, y], 0.0),
+        },
+        Op::Select(c, a, b) => (Code::Select, vec![c, a, b], 0.0),
+        Op::Const(_) | Op::Input(_) => (Code::Select, Vec::new(), 0.0),
+    };
+    let s: Vec<u32> = operands.iter().map(|&r| slot(alloc, r)).collect();
+    let at = |n: usize| s.get(n).copied().unwrap_or(0);
     let dst = alloc.fresh();
     alloc.slot_of[i] = Some(dst);
     let mut freed: Vec<u32> = Vec::new();
@@ -213,6 +247,7 @@ fn step(i: usize, op: &Op, alloc: &mut Allocator, last_use: &[Option<usize>], op
         a: at(0),
         b: at(1),
         c: at(2),
+        k,
     }
 }
 
@@ -233,9 +268,12 @@ impl Step {
             }
         };
         let d = &mut d[..n];
+        let k = T::from_f64(self.k);
         match self.code {
             Code::Unary(u) => unary_loop(u, d, read(self.a)),
             Code::Binary(b) => binary_loop(b, d, read(self.a), read(self.b)),
+            Code::BinaryK(b) => binary_k_loop(b, d, read(self.a), k),
+            Code::KBinary(b) => k_binary_loop(b, d, k, read(self.a)),
             Code::Select => {
                 let (c, x, y) = (read(self.a), read(self.b), read(self.c));
                 for (((o, &c), &p), &q) in d.iter_mut().zip(c).zip(x).zip(y) {
@@ -278,6 +316,30 @@ fn binary_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], y: &[T]) {
         ($($v:ident),*) => {
             match b {
                 $(Binary::$v => map2(d, x, y, |p, q| scalar::binary(Binary::$v, p, q)),)*
+            }
+        };
+    }
+    arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+}
+
+/// `op(x, k)` for an immediate `k`.
+fn binary_k_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], k: T) {
+    macro_rules! arms {
+        ($($v:ident),*) => {
+            match b {
+                $(Binary::$v => map1(d, x, |p| scalar::binary(Binary::$v, p, k)),)*
+            }
+        };
+    }
+    arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+}
+
+/// `op(k, y)` for an immediate `k`.
+fn k_binary_loop<T: Float>(b: Binary, d: &mut [T], k: T, y: &[T]) {
+    macro_rules! arms {
+        ($($v:ident),*) => {
+            match b {
+                $(Binary::$v => map1(d, y, |q| scalar::binary(Binary::$v, k, q)),)*
             }
         };
     }

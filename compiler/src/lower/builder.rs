@@ -25,6 +25,9 @@ pub(super) struct Builder {
     /// Per register: known to be ≥ 0 (a constant ≥ 0, or a select between such registers).
     nonneg: Vec<bool>,
     notes: Vec<Note>,
+    /// Per note: whether it only resumes a node after its children (dropped when no
+    /// instruction follows it).
+    resumes: Vec<bool>,
     shared: HashMap<Key, Reg>,
 }
 
@@ -40,6 +43,15 @@ impl Builder {
             at: self.ops.len(),
             text,
         });
+        self.resumes.push(false);
+    }
+
+    /// Notes that the next instructions belong to a node again, after its children.
+    pub fn note_resume(&mut self, text: String) {
+        self.note(text);
+        if let Some(last) = self.resumes.last_mut() {
+            *last = true;
+        }
     }
 
     /// The input point.
@@ -130,6 +142,10 @@ impl Builder {
             Binary::Add if self.is(x, 0.0) => Some(y),
             Binary::Sub if self.is(y, 0.0) => Some(x),
             Binary::Sub if self.is(x, 0.0) => Some(self.neg(y)),
+            Binary::Sub if self.value(y).is_some_and(|v| v < 0.0) => {
+                let k = self.c(-self.value(y).unwrap_or(0.0));
+                Some(self.add(x, k))
+            }
             Binary::Mul if self.is(y, 1.0) => Some(x),
             Binary::Mul if self.is(x, 1.0) => Some(y),
             Binary::Mul if self.is(x, 0.0) || self.is(y, 0.0) => Some(self.c(0.0)),
@@ -168,7 +184,7 @@ impl Builder {
             }
         }
         first_at_or_after[self.ops.len()] = ops.len();
-        let notes = self
+        let moved: Vec<Note> = self
             .notes
             .into_iter()
             .map(|n| Note {
@@ -176,6 +192,7 @@ impl Builder {
                 text: n.text,
             })
             .collect();
+        let notes = useful_notes(moved, &self.resumes, ops.len());
         Program {
             ops,
             notes,
@@ -183,6 +200,19 @@ impl Builder {
             material: new_index[m.0 as usize],
         }
     }
+}
+
+/// Drops the resuming notes that no instruction follows before the next note or the end.
+fn useful_notes(notes: Vec<Note>, resumes: &[bool], end: usize) -> Vec<Note> {
+    let next_at: Vec<usize> = (0..notes.len())
+        .map(|i| notes.get(i + 1).map_or(end, |n| n.at))
+        .collect();
+    notes
+        .into_iter()
+        .enumerate()
+        .filter(|(i, n)| !resumes[*i] || n.at < next_at[*i])
+        .map(|(_, n)| n)
+        .collect()
 }
 
 fn commutes(b: Binary) -> bool {

@@ -85,7 +85,7 @@ impl<'a> Lowerer<'a> {
     /// Notes that the instructions that follow belong to `id` again, after its children.
     fn resume(&mut self, id: NodeId, node: &Node) {
         self.b
-            .note(format!("node {} {} (after its children)", id.0, kind(node)));
+            .note_resume(format!("node {} {} (after its children)", id.0, kind(node)));
     }
 
     /// Lowers `child` at `q`, then maps its distance with `f` (material unchanged).

@@ -1,13 +1,12 @@
 //! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps).
 
 use super::render::{override_settings, parse_size, thread_pool, Backend};
-use crate::cpu::{self, Options, Precision, Stats};
+use crate::backend::Prepared;
+use crate::cpu::{Precision, Stats};
 use crate::frontend::{self, DiagnosticFormat};
-use sdfc_compiler::lower;
 use sdfc_compiler::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
 
 /// Arguments of `sdfc bench`.
 #[derive(Debug, clap::Args)]
@@ -21,6 +20,9 @@ pub struct BenchArgs {
     /// Image size, as WIDTHxHEIGHT (default: each scene's own).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Supersampling: N×N samples per pixel (default: each scene's own).
+    #[arg(long, value_name = "N")]
+    pub aa: Option<u32>,
     /// Frames timed per scene (after one untimed warm-up frame).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub frames: u32,
@@ -45,6 +47,8 @@ pub struct Timing {
     pub scene: String,
     /// Backend used.
     pub backend: &'static str,
+    /// The device it ran on.
+    pub device: String,
     /// Float type.
     pub precision: &'static str,
     /// Image width.
@@ -86,11 +90,17 @@ pub fn run(args: BenchArgs) -> ExitCode {
             Ok(s) => s,
             Err(code) => return code,
         };
-        if let Err(msg) = override_settings(&mut scene.settings, args.size, None, &args.set) {
+        if let Err(msg) = override_settings(&mut scene.settings, args.size, args.aa, &args.set) {
             eprintln!("error: {msg}");
             return ExitCode::from(2);
         }
-        let t = pool.install(|| time_scene(&args, file.display().to_string(), &scene));
+        let t = match pool.install(|| time_scene(&args, file.display().to_string(), &scene)) {
+            Ok(t) => t,
+            Err(msg) => {
+                eprintln!("error: {}: {msg}", file.display());
+                return ExitCode::from(1);
+            }
+        };
         if !args.json {
             if timings.is_empty() {
                 println!("{}", header());
@@ -111,29 +121,25 @@ pub fn run(args: BenchArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// Renders one warm-up frame and `frames` timed frames.
-fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Timing {
-    let program = lower::lower(scene);
-    let options = Options {
-        precision: args.precision,
-        ..Options::default()
-    };
-    let mut last = cpu::render(scene, &program, &options, &|| {});
+/// Renders one warm-up frame and `frames` timed frames. GPU backends are timed on the device
+/// (timestamps or events); the CPU by the wall clock.
+fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, String> {
+    let prepared = Prepared::new(args.backend, scene, args.precision)?;
+    let mut last = prepared.render(scene, &|_| {})?.render;
     let mut times = Vec::new();
     for _ in 0..args.frames {
-        let start = Instant::now();
-        last = cpu::render(scene, &program, &options, &|| {});
-        times.push(start.elapsed().as_secs_f64());
+        let frame = prepared.render(scene, &|_| {})?;
+        times.push(frame.time.as_secs_f64());
+        last = frame.render;
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
     let c = &last.stats.counters;
     let s = &scene.settings;
-    Timing {
+    Ok(Timing {
         scene: name,
-        backend: match args.backend {
-            Backend::Auto | Backend::Cpu => "cpu",
-        },
+        backend: prepared.name(),
+        device: prepared.device(),
         precision: match args.precision {
             Precision::F32 => "f32",
             Precision::F64 => "f64",
@@ -147,15 +153,16 @@ fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Timing {
         min_s: times[0],
         mrays_per_s: c.camera_rays as f64 / median / 1e6,
         total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
-        program_len: program.len(),
+        program_len: prepared.program_len(scene),
         stats: last.stats,
-    }
+    })
 }
 
 fn header() -> String {
     format!(
-        "{:<28} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>9} {:>6} {:>6}",
+        "{:<28} {:>7} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>9} {:>6} {:>6}",
         "scene",
+        "backend",
         "size",
         "aa",
         "threads",
@@ -173,8 +180,9 @@ fn row(t: &Timing) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned());
     format!(
-        "{:<28} {:>9} {:>4} {:>7} {:>10.1} {:>10.1} {:>8.2} {:>9.1} {:>6} {:>6}",
+        "{:<28} {:>7} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>9.1} {:>6} {:>6}",
         name.unwrap_or_else(|| t.scene.clone()),
+        t.backend,
         format!("{}x{}", t.width, t.height),
         t.aa,
         t.threads,

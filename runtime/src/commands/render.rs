@@ -1,25 +1,17 @@
 //! `sdfc render`: render a scene to a PNG image, and the option handling `sdfc bench` shares
 //! (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread pools).
 
-use crate::cpu::{self, Options, Precision};
+use crate::backend::Prepared;
+use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::lower;
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::scene::Settings;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Where a scene is rendered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum Backend {
-    /// The best backend available (today: the CPU).
-    #[default]
-    Auto,
-    /// The CPU renderer with the batch interpreter.
-    Cpu,
-}
+pub use crate::backend::Backend;
 
 /// Arguments of `sdfc render`.
 #[derive(Debug, clap::Args)]
@@ -70,22 +62,22 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let mut options = Options {
-        precision: args.precision,
-        ..Options::default()
+    let prepared = match pool.install(|| Prepared::new(args.backend, &scene, args.precision)) {
+        Ok(p) => p,
+        Err(msg) => {
+            eprintln!("error: the {:?} backend is not available: {msg}", args.backend);
+            return ExitCode::from(1);
+        }
     };
-    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<usize>().ok());
-    if let Some(v) = env("SDFC_TILE") {
-        options.tile = v as u32;
-    }
-    if let Some(v) = env("SDFC_LANES") {
-        options.lanes = v;
-    }
-    if let Some(v) = env("SDFC_CHUNK") {
-        options.chunk = v;
-    }
     let started = Instant::now();
-    let render = pool.install(|| render_with_progress(&scene, &options));
+    let frame = match pool.install(|| render_with_progress(&prepared, &scene)) {
+        Ok(f) => f,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            return ExitCode::from(1);
+        }
+    };
+    let render = frame.render;
     let seconds = started.elapsed().as_secs_f64();
     let out = args
         .output
@@ -97,43 +89,41 @@ pub fn run(args: RenderArgs) -> ExitCode {
     }
     let s = &scene.settings;
     eprintln!(
-        "wrote {} ({}x{}, aa {}, {:.3} s)",
+        "wrote {} ({}x{}, aa {}, {} on {}, {:.3} s)",
         out.display(),
         s.width,
         s.height,
         s.aa,
+        prepared.name(),
+        prepared.device(),
         seconds
     );
     if args.stats {
-        println!("time            {:.3} s", seconds);
+        println!("backend         {} ({})", prepared.name(), prepared.device());
+        println!("time            {:.3} s (frame {:.3} s)", seconds, frame.time.as_secs_f64());
         println!("{}", render.stats);
     }
     ExitCode::SUCCESS
 }
 
 /// Renders with a progress bar on stderr when stderr is a terminal.
-fn render_with_progress(scene: &Scene, options: &Options) -> cpu::Render {
-    let program = lower::lower(scene);
-    let bar = if std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(cpu::tile_count(&scene.settings, options));
-        if let Ok(style) =
-            ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}")
-        {
+fn render_with_progress(prepared: &Prepared, scene: &sdfc_compiler::scene::Scene) -> Result<crate::backend::Frame, String> {
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = ProgressBar::new(1000);
+        if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}") {
             bar.set_style(style);
         }
-        Some(bar)
-    } else {
-        None
-    };
-    let render = cpu::render(scene, &program, options, &|| {
+        bar
+    });
+    let frame = prepared.render(scene, &|f| {
         if let Some(b) = &bar {
-            b.inc(1);
+            b.set_position((f * 1000.0) as u64);
         }
     });
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    render
+    frame
 }
 
 /// `scene.sdf` → `./scene.png`.

@@ -34,6 +34,8 @@ macro_rules! lanes {
         #[derive(Debug, Default)]
         pub(super) struct Lanes<T> {
             pub len: usize,
+            /// Lanes finished in the last step, in increasing order.
+            pub finished: Vec<usize>,
             $(pub $f: Vec<$t>,)*
             $(pub $g: Vec<$u>,)*
         }
@@ -41,7 +43,7 @@ macro_rules! lanes {
         impl<T: Float> Lanes<T> {
             /// Room for `capacity` lanes.
             pub fn new(capacity: usize) -> Self {
-                Lanes { len: 0, $($f: vec![Default::default(); capacity],)* $($g: vec![Default::default(); capacity],)* }
+                Lanes { len: 0, finished: Vec::with_capacity(capacity), $($f: vec![Default::default(); capacity],)* $($g: vec![Default::default(); capacity],)* }
             }
 
             /// Moves lane `from` into lane `to`.
@@ -139,29 +141,23 @@ impl<T: Float> Lanes<T> {
         }
     }
 
-    /// Removes the lanes whose flags have the `DONE` bit.
-    pub fn remove_done(&mut self) {
-        let mut k = self.len;
-        while k > 0 {
-            k -= 1;
-            if self.flags[k] & DONE != 0 {
-                let last = self.len - 1;
-                if k != last {
-                    self.move_lane(last, k);
-                }
-                self.len -= 1;
+    /// Removes the lanes listed in `finished`, from the last one down, each replaced by the
+    /// current last lane.
+    pub fn remove_finished(&mut self) {
+        while let Some(k) = self.finished.pop() {
+            let last = self.len - 1;
+            if k != last {
+                self.move_lane(last, k);
             }
+            self.len -= 1;
         }
     }
 }
 
-/// The flag bit of a lane whose ray is finished (its result written).
-pub(super) const DONE: u32 = 1;
-
 /// What a march does with the lanes after an evaluation.
 pub(super) trait Rule<T: Float> {
-    /// Advances every lane by one step, given their fresh distances, and sets the `DONE`
-    /// flag of the lanes whose ray is finished (after writing its result).
+    /// Advances every lane by one step, given their fresh distances, and lists in
+    /// `finished` the lanes whose ray is finished (after writing its result).
     fn advance(&mut self, lanes: &mut Lanes<T>);
     /// Whether the rule needs material ids at every step.
     fn needs_materials(&self) -> bool {
@@ -197,6 +193,6 @@ pub(super) fn march<T: Float, R: Rule<T>>(
             },
         );
         rule.advance(lanes);
-        lanes.remove_done();
+        lanes.remove_finished();
     }
 }

@@ -3,7 +3,7 @@
 //! transparent occluders).
 
 use super::context::Context;
-use super::lanes::{Lanes, Rule, DONE};
+use super::lanes::{Lanes, Rule};
 use super::stats::Counters;
 use sdfc_compiler::eval::Float;
 
@@ -47,6 +47,12 @@ const BUDGET: u32 = 8;
 const NAN: u32 = 16;
 const OVERSHOOT: u32 = 32;
 
+/// `flag` when `b` holds, else 0 (branch-free).
+#[inline(always)]
+fn bit(b: bool, flag: u32) -> u32 {
+    (b as u32) * flag
+}
+
 impl<T: Float> Rule<T> for Trace<'_, T> {
     /// One branch-free pass over the lanes, then a scan of the flags for finished rays.
     fn advance(&mut self, l: &mut Lanes<T>) {
@@ -58,6 +64,7 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
         let (dist, sign, t0) = (&l.dist[..n], &l.sign[..n], &l.t0[..n]);
         let (t, steps, flags) = (&mut l.t[..n], &mut l.steps[..n], &mut l.flags[..n]);
         let (omega, prev, step) = (&mut l.omega[..n], &mut l.prev[..n], &mut l.step[..n]);
+        let mut any = 0;
         for k in 0..n {
             let f = dist[k];
             let s = sign[k] * f * inv_l;
@@ -74,11 +81,16 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             let count = steps[k] + 1;
             steps[k] = count;
             t[k] = if hit { t[k] } else { next };
-            flags[k] = (hit as u32) * HIT
-                | ((next > max_dist) as u32) * MISS
-                | ((count >= max_steps) as u32) * BUDGET
-                | ((f != f) as u32) * NAN
-                | ((s < -tol) as u32) * OVERSHOOT;
+            let fl = bit(hit, HIT)
+                | bit(next > max_dist, MISS)
+                | bit(count >= max_steps, BUDGET)
+                | bit(f.is_nan(), NAN)
+                | bit(s < -tol, OVERSHOOT);
+            flags[k] = fl;
+            any |= fl;
+        }
+        if any == 0 {
+            return;
         }
         for k in 0..n {
             let fl = l.flags[k];
@@ -96,7 +108,6 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             } else if fl & BUDGET != 0 {
                 Status::Budget
             } else {
-                l.flags[k] = 0;
                 continue;
             };
             self.out[l.id[k] as usize] = Traced {
@@ -104,7 +115,7 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
                 status,
                 steps: l.steps[k],
             };
-            l.flags[k] = DONE;
+            l.finished.push(k);
         }
     }
 }
@@ -133,7 +144,7 @@ impl<T: Float> Shadow<'_, T> {
             light,
             steps: l.steps[k],
         };
-        l.flags[k] = DONE;
+        l.finished.push(k);
     }
 
     /// The light arriving at the end of lane `k`'s march.
@@ -154,6 +165,7 @@ impl<T: Float> Shadow<'_, T> {
             &mut l.flags[..n],
             &mut l.res[..n],
         );
+        let mut any = 0;
         for k in 0..n {
             let f = dist[k];
             let s = f * inv_l;
@@ -166,11 +178,16 @@ impl<T: Float> Shadow<'_, T> {
             t[k] = next;
             let count = steps[k] + 1;
             steps[k] = count;
-            flags[k] = (blocked as u32) * HIT
-                | ((next >= tmax[k]) as u32) * MISS
-                | ((count >= max_steps) as u32) * BUDGET
-                | ((f != f) as u32) * NAN
-                | ((s < -tol) as u32) * OVERSHOOT;
+            let fl = bit(blocked, HIT)
+                | bit(next >= tmax[k], MISS)
+                | bit(count >= max_steps, BUDGET)
+                | bit(f.is_nan(), NAN)
+                | bit(s < -tol, OVERSHOOT);
+            flags[k] = fl;
+            any |= fl;
+        }
+        if any == 0 {
+            return;
         }
         for k in 0..n {
             let fl = l.flags[k];
@@ -185,8 +202,6 @@ impl<T: Float> Shadow<'_, T> {
                 self.finish(l, k, T::zero());
             } else if fl & (MISS | BUDGET) != 0 {
                 self.finish(l, k, Self::arrived(l, k));
-            } else {
-                l.flags[k] = 0;
             }
         }
     }
@@ -196,7 +211,6 @@ impl<T: Float> Shadow<'_, T> {
         let c = self.ctx;
         let f = l.dist[k];
         let t = l.t[k];
-        l.flags[k] = 0;
         l.steps[k] += 1;
         if f.is_nan() {
             self.counters.nans += 1;

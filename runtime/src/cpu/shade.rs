@@ -215,6 +215,52 @@ fn lamp_colour<T: Float>(lamp: &Lamp<T>) -> (V3<T>, T) {
     }
 }
 
+/// The Phong terms of one light at a hit, before its shadow: the contribution
+/// atten·(k_d·(N·L)·C·I_l + k_s·max(R·V, 0)^α·I_l) and the shadow ray towards the light, or
+/// `None` when the light cannot contribute (N·L ≤ 0 or atten = 0).
+fn lamp_term<T: Float>(
+    ctx: &Context<T>,
+    lamp: &Lamp<T>,
+    hit: &Hit<T>,
+    m: &Mat<T>,
+    c: V3<T>,
+    dir: V3<T>,
+) -> Option<(V3<T>, Launch<T>)> {
+    let (l, dist, atten) = towards(ctx, lamp, hit.p);
+    let ndl = hit.n.dot(l);
+    if ndl <= T::zero() || atten <= T::zero() {
+        return None;
+    }
+    let (il, k) = lamp_colour(lamp);
+    let r = hit.n * (T::from_f64(2.0) * ndl) - l;
+    let rv = r.dot(-dir).max(T::zero());
+    let spec = m.specular * rv.powf(m.shininess);
+    let contrib = (c * (m.diffuse * ndl) + V3::splat(spec)).mul_v(il) * atten;
+    let off = T::from_f64(4.0) * hit.h;
+    let o = hit.p + hit.n * off;
+    let tmax = if matches!(lamp, Lamp::Point { .. }) {
+        dist - off
+    } else {
+        dist
+    };
+    let launch = Launch {
+        id: 0,
+        origin: [o.x, o.y, o.z],
+        dir: [l.x, l.y, l.z],
+        t0: hit.tt,
+        sign: T::one(),
+        tmax,
+        k,
+        omega: T::one(),
+    };
+    Some((contrib, launch))
+}
+
+/// The weight of a material's local colour: 1 - r - τ.
+fn local_weight<T: Float>(m: &Mat<T>) -> T {
+    T::one() - m.reflect - m.transparency
+}
+
 /// Phong at every hit seen from outside, with one shadow ray per (hit, light) that can
 /// contribute: I = k_a·C + Σ shadow·atten·(k_d·max(N·L, 0)·C·I_l + k_s·max(R·V, 0)^α·I_l),
 /// added to the sample with the weight (1 - r - τ).
@@ -227,52 +273,46 @@ fn light<T: Float>(
     steps: &mut [u32],
     counters: &mut Counters,
 ) {
-    let mut local: Vec<(usize, V3<T>)> = Vec::new();
+    let mut colour_at: Vec<V3<T>> = vec![V3::zero(); hits.len()];
     let mut pending: Vec<(usize, V3<T>)> = Vec::new();
     ws.launches.clear();
     for (hi, hit) in hits.iter().enumerate() {
-        let ray = &wave[hit.ray];
-        let m = ctx.material(hit.mat);
-        let w = T::one() - m.reflect - m.transparency;
-        if ray.inside || w <= T::zero() {
+        let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
+        if ray.inside || local_weight(m) <= T::zero() {
             continue;
         }
         let c = colour(m, hit);
-        local.push((hi, c * m.ambient));
+        colour_at[hi] = c * m.ambient;
         for lamp in &ctx.lamps {
-            let (l, dist, atten) = towards(ctx, lamp, hit.p);
-            let ndl = hit.n.dot(l);
-            if ndl <= T::zero() || atten <= T::zero() {
-                continue;
+            if let Some((contrib, launch)) = lamp_term(ctx, lamp, hit, m, c, ray.dir) {
+                ws.launches.push(Launch {
+                    id: pending.len() as u32,
+                    ..launch
+                });
+                pending.push((hi, contrib));
             }
-            let (il, k) = lamp_colour(lamp);
-            let r = hit.n * (T::from_f64(2.0) * ndl) - l;
-            let rv = r.dot(-ray.dir).max(T::zero());
-            let spec = m.specular * rv.powf(m.shininess);
-            let contrib = (c * (m.diffuse * ndl) + V3::splat(spec)).mul_v(il) * atten;
-            let off = T::from_f64(4.0) * hit.h;
-            let o = hit.p + hit.n * off;
-            let tmax = if matches!(lamp, Lamp::Point { .. }) {
-                dist - off
-            } else {
-                dist
-            };
-            ws.launches.push(Launch {
-                id: pending.len() as u32,
-                origin: [o.x, o.y, o.z],
-                dir: [l.x, l.y, l.z],
-                t0: hit.tt,
-                sign: T::one(),
-                tmax,
-                k,
-                omega: T::one(),
-            });
-            pending.push((hi, contrib));
         }
     }
-    counters.shadow_rays += pending.len() as u64;
+    shadows(ctx, ws, counters);
+    for (&(hi, contrib), s) in pending.iter().zip(&ws.shadowed) {
+        colour_at[hi] = colour_at[hi] + contrib * s.light;
+        steps[wave[hits[hi].ray].sample as usize] += s.steps;
+        counters.steps += s.steps as u64;
+    }
+    for (hit, c) in hits.iter().zip(colour_at) {
+        let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
+        if !ray.inside && local_weight(m) > T::zero() {
+            let a = &mut acc[ray.sample as usize];
+            *a = *a + c.mul_v(ray.weight) * local_weight(m);
+        }
+    }
+}
+
+/// Marches the shadow rays of `ws.launches` into `ws.shadowed`.
+fn shadows<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, counters: &mut Counters) {
+    counters.shadow_rays += ws.launches.len() as u64;
     ws.shadowed.clear();
-    ws.shadowed.resize(pending.len(), Shadowed::default());
+    ws.shadowed.resize(ws.launches.len(), Shadowed::default());
     let mut rule = Shadow {
         ctx,
         out: &mut ws.shadowed,
@@ -285,20 +325,6 @@ fn light<T: Float>(
         &ws.launches,
         &mut rule,
     );
-    let mut lit: Vec<V3<T>> = vec![V3::zero(); hits.len()];
-    for (&(hi, contrib), s) in pending.iter().zip(&ws.shadowed) {
-        lit[hi] = lit[hi] + contrib * s.light;
-        steps[wave[hits[hi].ray].sample as usize] += s.steps;
-        counters.steps += s.steps as u64;
-    }
-    for (hi, ambient) in local {
-        let hit = &hits[hi];
-        let ray = &wave[hit.ray];
-        let m = ctx.material(hit.mat);
-        let w = T::one() - m.reflect - m.transparency;
-        let a = &mut acc[ray.sample as usize];
-        *a = *a + (ambient + lit[hi]).mul_v(ray.weight) * w;
-    }
 }
 
 /// The transmitted direction through a surface of normal `n` (facing the incoming ray) with

@@ -1,6 +1,8 @@
-//! GPU targets: the WGSL kernel launched through wgpu. The result has the CPU renderer's
-//! shape (an image and the same statistics) so that every backend is compared the same way.
+//! GPU targets: the WGSL kernel launched through wgpu, and its PTX translation launched
+//! through the CUDA driver. Results have the CPU renderer's shape (an image and the same
+//! statistics) so that every backend is compared the same way.
 
+pub mod cuda;
 pub mod wgpu;
 
 use crate::cpu::{Counters, Render, Stats};
@@ -58,6 +60,16 @@ pub fn render(
         time: frame.gpu_time.unwrap_or(frame.wall_time),
         timestamps: frame.gpu_time.is_some(),
     })
+}
+
+/// Renders `scene` with a kernel already loaded on a CUDA device.
+pub fn render_cuda(cuda: &cuda::Cuda, scene: &Scene, loaded: &cuda::Loaded, lipschitz: f64) -> Result<GpuRender, cuda::Error> {
+    let s = &scene.settings;
+    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let frame = cuda.render(loaded, &uniforms, s.width, s.height, STATS_WORDS, wgsl::WORKGROUP, TILE)?;
+    let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
+    let image = Image { width: s.width, height: s.height, linear: frame.linear };
+    Ok(GpuRender { render: Render { image, stats }, time: frame.gpu_time, timestamps: true })
 }
 
 /// Sums the kernel's per-pixel statistics words into the CPU renderer's statistics.

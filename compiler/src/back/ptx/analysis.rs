@@ -13,8 +13,8 @@ use naga::{AddressSpace, Block, Expression, Function, Handle, Module, Statement,
 pub(super) struct Analysis {
     /// Per function: reached from the entry point.
     pub reachable: Vec<bool>,
-    /// Per function: expanded at each call instead of written as a `.func` (it takes a
-    /// pointer or uses a `var<private>`, which live in the kernel's own registers).
+    /// Per function: expanded at each call instead of written as a `.func` (see
+    /// [`inlining`]).
     pub inline: Vec<bool>,
     /// Per function, per local variable: kept in `.local` memory.
     pub mem_locals: Vec<Vec<bool>>,
@@ -52,13 +52,13 @@ impl Analysis {
                 continue;
             }
             let fi = &info[h];
-            a.inline[h.index()] = takes_pointer(module, f) || uses_private(module, fi);
             let (locals, args) = a.memory(types, f, fi, &arg_dyn)?;
             a.mem_locals[h.index()] = locals;
             arg_dyn[h.index()] = args;
         }
         let (locals, _) = a.memory(types, &ep.function, info.get_entry_point(entry), &arg_dyn)?;
         a.entry_mem_locals = locals;
+        a.inline = inlining(module, info, &a.reachable, &ep.function);
         Ok(a)
     }
 
@@ -127,6 +127,52 @@ impl Analysis {
             *s = true;
         }
     }
+}
+
+/// The most expressions inlining a function may duplicate (its size times the number of
+/// copies beyond the first): below it a call costs more than the copies (ptxas cannot
+/// optimise across a call, and saves registers around it); above it the copies cost
+/// more (code size, and register pressure that ptxas resolves by spilling).
+const DUPLICATION_BUDGET: u64 = 1500;
+
+/// Per function: inlined at each call. A function is inlined where it must be (it takes
+/// a pointer or uses a `var<private>`), where it is called once, or where the copies
+/// stay within [`DUPLICATION_BUDGET`]. Linear in the module's size.
+fn inlining(module: &Module, info: &ModuleInfo, reachable: &[bool], entry: &Function) -> Vec<bool> {
+    let nf = module.functions.len();
+    let mut callees: Vec<Vec<Handle<Function>>> = vec![Vec::new(); nf];
+    for (h, f) in module.functions.iter() {
+        if reachable[h.index()] {
+            calls(&f.body, &mut callees[h.index()]);
+        }
+    }
+    // Copies of each function if every caller were inlined: callers come after their
+    // callees in naga's arena, so a backward pass sees every caller's count first.
+    let mut copies = vec![0u64; nf];
+    let mut from_entry = Vec::new();
+    calls(&entry.body, &mut from_entry);
+    for c in from_entry {
+        copies[c.index()] = copies[c.index()].saturating_add(1);
+    }
+    for i in (0..nf).rev() {
+        for c in &callees[i] {
+            copies[c.index()] = copies[c.index()].saturating_add(copies[i]);
+        }
+    }
+    let mut size = vec![0u64; nf];
+    let mut inline = vec![false; nf];
+    for (h, f) in module.functions.iter() {
+        let i = h.index();
+        if !reachable[i] {
+            continue;
+        }
+        let inlined = callees[i].iter().filter(|c| inline[c.index()]).fold(0u64, |a, c| a.saturating_add(size[c.index()]));
+        size[i] = (f.expressions.len() as u64).saturating_add(inlined);
+        let forced = takes_pointer(module, f) || uses_private(module, &info[h]);
+        let copies = copies[i].max(1);
+        inline[i] = forced || size[i].saturating_mul(copies - 1) <= DUPLICATION_BUDGET;
+    }
+    inline
 }
 
 /// Whether `Access { base, .. }` indexes an array or matrix behind a pointer (a vector

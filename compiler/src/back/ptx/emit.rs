@@ -125,10 +125,16 @@ impl Out {
         self.text.push('\n');
     }
 
-    /// A comment line.
+    /// A comment line (PTX is ASCII: other characters become `?`).
     pub fn comment(&mut self, args: fmt::Arguments) {
         self.text.push_str("\t// ");
+        let start = self.text.len();
         let _ = self.text.write_fmt(args);
+        if !self.text[start..].is_ascii() {
+            let tail: String = self.text[start..].chars().map(|c| if c.is_ascii() { c } else { '?' }).collect();
+            self.text.truncate(start);
+            self.text.push_str(&tail);
+        }
         self.text.push('\n');
     }
 
@@ -143,11 +149,12 @@ impl Out {
         self.text.push_str(s);
     }
 
-    /// Declares a `.local` byte array of `size` bytes aligned to 16; returns its name.
+    /// Declares a `.local` byte array of `size` bytes (rounded up to 16) aligned to 16;
+    /// returns its name.
     pub fn local_array(&mut self, size: u32, what: &str) -> String {
         self.local_count += 1;
         let name = format!("__local{}_{what}", self.local_count);
-        let _ = writeln!(self.locals, "\t.local .align 16 .b8 {name}[{}];", size.max(1));
+        let _ = writeln!(self.locals, "\t.local .align 16 .b8 {name}[{}];", size.max(1).next_multiple_of(16));
         name
     }
 
@@ -164,6 +171,11 @@ impl Out {
         s.push_str(&self.text);
         s
     }
+}
+
+/// `s` with every character outside ASCII (which PTX forbids) replaced by `?`.
+pub(super) fn ascii(s: &str) -> String {
+    s.chars().map(|c| if c.is_ascii() { c } else { '?' }).collect()
 }
 
 /// Writes one instruction: `ins!(out, "add.f32 {}, {}, {};", d, a, b)`.

@@ -92,6 +92,31 @@ impl<'a> Fw<'_, 'a> {
         }
     }
 
+    /// A constant expression of `f` (a local variable's initializer), as immediates:
+    /// naga has folded it, though an `Emit` may cover it.
+    pub fn const_expr(&self, f: &Frame, h: Handle<Expression>) -> Result<Vec<Op>, Error> {
+        if let Some(Some(Val::Data(d))) = f.values.get(h.index()) {
+            return Ok(d.clone());
+        }
+        match f.func.expressions[h] {
+            Expression::Literal(l) => Ok(vec![literal(l)?]),
+            Expression::Constant(c) => self.global_expr(self.cx.module.constants[c].init),
+            Expression::ZeroValue(ty) => self.cx.types.zeros(Ty::H(ty)),
+            Expression::Compose { ref components, .. } => {
+                let mut out = Vec::new();
+                for &c in components {
+                    out.extend(self.const_expr(f, c)?);
+                }
+                Ok(out)
+            }
+            Expression::Splat { size, value } => match self.const_expr(f, value)?.as_slice() {
+                [x] => Ok(vec![*x; size as usize]),
+                _ => Err(Error::Invalid("a splat of a non-scalar".into())),
+            },
+            ref other => Err(Error::Unsupported(format!("the initializer {}", expression_name(other)))),
+        }
+    }
+
     /// A pointer to global variable `g`, where this PTX function keeps it.
     fn global_ptr(&self, g: Handle<GlobalVariable>) -> Result<Ptr, Error> {
         let gv = &self.cx.module.global_variables[g];

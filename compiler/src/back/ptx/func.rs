@@ -2,7 +2,7 @@
 //! `.func`s with scalarised parameters and an aggregate return value, inlined calls,
 //! and what every function does on entry (variables, constants, arguments).
 
-use super::emit::{ins, Class, Op};
+use super::emit::{ins, Class, Op, Reg};
 use super::types::{Sc, Ty};
 use super::writer::{Cx, Frame, Fw, Ret, Space, Store, Val};
 use super::Error;
@@ -26,6 +26,12 @@ fn param_ty(sc: Sc) -> &'static str {
 impl<'c, 'a> Fw<'c, 'a> {
     /// Translates `f`'s body: variables, entry-time expressions, then statements.
     pub fn run(&mut self, f: &mut Frame<'a>, mem_locals: &[bool]) -> Result<(), Error> {
+        let name = f.name.clone();
+        self.out.comment(format_args!("fn {name}"));
+        self.run_body(f, mem_locals).map_err(|e| e.in_function(&name))
+    }
+
+    fn run_body(&mut self, f: &mut Frame<'a>, mem_locals: &[bool]) -> Result<(), Error> {
         let func = f.func;
         for (h, lv) in func.local_variables.iter() {
             let name = lv.name.as_deref().unwrap_or("local");
@@ -40,7 +46,7 @@ impl<'c, 'a> Fw<'c, 'a> {
         }
         for (h, lv) in func.local_variables.iter() {
             let value = match lv.init {
-                Some(init) => self.data(f, init)?.to_vec(),
+                Some(init) => self.const_expr(f, init)?,
                 None => self.cx.types.zeros(Ty::H(lv.ty))?,
             };
             let store = f.locals[h.index()];
@@ -65,8 +71,36 @@ impl<'c, 'a> Fw<'c, 'a> {
 
     /// Gives a variable its first value.
     fn init(&mut self, store: Store, ty: Ty, value: &[Op]) -> Result<(), Error> {
+        if let Store::Mem(space, base) = store {
+            if value.iter().all(|o| matches!(o, Op::F32(0) | Op::I32(0) | Op::U32(0) | Op::Bool(false))) {
+                self.zero_fill(space, base, self.cx.types.size(ty));
+                return Ok(());
+            }
+        }
         let p = super::writer::Ptr { loc: super::expr::loc_of(store), ty };
         self.store(&p, value)
+    }
+
+    /// Zeroes `size` bytes (rounded up to 16, as `.local` arrays are) at `base`: by
+    /// 16-byte stores, in a loop where there are many.
+    fn zero_fill(&mut self, space: Space, base: Reg, size: u32) {
+        let words = size.div_ceil(16);
+        let sp = space.st();
+        if words <= 8 {
+            for i in 0..words {
+                ins!(self.out, "st.{sp}.v4.u32 [{base}+{}], {{0, 0, 0, 0}};", 16 * i);
+            }
+            return;
+        }
+        let (addr, end) = (self.out.reg(Class::B64), self.out.reg(Class::B64));
+        let top = self.out.label("zero_fill");
+        ins!(self.out, "mov.b64 {addr}, {base};");
+        ins!(self.out, "add.s64 {end}, {base}, {};", 16 * words);
+        self.out.place(&top);
+        ins!(self.out, "st.{sp}.v4.u32 [{addr}], {{0, 0, 0, 0}};");
+        ins!(self.out, "add.s64 {addr}, {addr}, 16;");
+        let more = self.setp("lt.u64", Op::Reg(addr), Op::Reg(end));
+        ins!(self.out, "@{more} bra {top};");
     }
 
     /// Stores leaf `x` at `offset` in the aggregate parameter `param`.
@@ -205,6 +239,10 @@ fn is_statement_result(e: &Expression) -> bool {
     )
 }
 
+fn ends_in_return(b: &naga::Block) -> bool {
+    matches!(b.last(), Some(naga::Statement::Return { .. }))
+}
+
 fn is_f32(x: Op) -> bool {
     matches!(x, Op::F32(_)) || matches!(x, Op::Reg(r) if r.class == Class::F32)
 }
@@ -251,9 +289,11 @@ pub(super) fn write_func(cx: &Cx, h: Handle<Function>) -> Result<String, Error> 
     let fname = func.name.clone().unwrap_or_default();
     let mut frame = Frame::new(func, &cx.info[h], fname.clone(), args, ret);
     let mem = cx.an.mem_locals.get(h.index()).cloned().unwrap_or_default();
-    fw.run(&mut frame, &mem).map_err(|e| e.in_function(&fname))?;
-    ins!(fw.out, "ret;");
-    let mut s = format!("// fn {fname}\n.func {ret_decl}{name}(");
+    fw.run(&mut frame, &mem)?;
+    if !ends_in_return(&func.body) {
+        ins!(fw.out, "ret;");
+    }
+    let mut s = format!("// fn {}\n.func {ret_decl}{name}(", super::emit::ascii(&fname));
     s.push_str(&params.join(", "));
     s.push_str(")\n{\n");
     s.push_str(&fw.out.finish());
@@ -283,15 +323,19 @@ pub(super) fn write_kernel(cx: &Cx, ep: &EntryPoint, index: usize) -> Result<Str
     fw.privates(info)?;
     let mut args = Vec::with_capacity(ep.function.arguments.len());
     for a in &ep.function.arguments {
-        args.push(Val::Data(fw.input(a.binding.as_ref(), a.ty, ep.workgroup_size)?));
+        args.push(Val::Data(fw.input(a.binding.as_ref(), a.ty)?));
     }
     let mut frame = Frame::new(&ep.function, info, name.clone(), args, Ret::Kernel);
-    fw.run(&mut frame, &cx.an.entry_mem_locals).map_err(|e| e.in_function(name))?;
-    ins!(fw.out, "ret;");
+    fw.run(&mut frame, &cx.an.entry_mem_locals)?;
+    if !ends_in_return(&ep.function.body) {
+        ins!(fw.out, "ret;");
+    }
     let [x, y, z] = ep.workgroup_size;
     let mut s = String::new();
-    let _ = writeln!(s, "// entry point {name}, workgroup size ({x}, {y}, {z})");
-    let _ = write!(s, ".visible .entry {name}(\n\t{}\n)\n.reqntid {x}, {y}, {z}\n{{\n", params.join(",\n\t"));
+    // No .reqntid: ptxas reads a small block as a call for many blocks per SM and caps
+    // the registers (spilling); the launch uses the workgroup size as the block.
+    let _ = writeln!(s, "// entry point {name}, workgroup size ({x}, {y}, {z}): launch with this block");
+    let _ = write!(s, ".visible .entry {name}(\n\t{}\n)\n{{\n", params.join(",\n\t"));
     s.push_str(&fw.out.finish());
     s.push_str("}\n");
     Ok(s)
@@ -319,15 +363,15 @@ impl Fw<'_, '_> {
     }
 
     /// The value of a kernel input: a built-in, or a struct of built-ins.
-    fn input(&mut self, binding: Option<&Binding>, ty: Handle<naga::Type>, wg: [u32; 3]) -> Result<Vec<Op>, Error> {
+    fn input(&mut self, binding: Option<&Binding>, ty: Handle<naga::Type>) -> Result<Vec<Op>, Error> {
         match binding {
-            Some(Binding::BuiltIn(b)) => self.builtin(*b, wg),
+            Some(Binding::BuiltIn(b)) => self.builtin(*b),
             Some(Binding::Location { .. }) => Err(Error::Unsupported("location inputs to a compute shader".into())),
             None => match &self.cx.module.types[ty].inner {
                 naga::TypeInner::Struct { members, .. } => {
                     let mut out = Vec::new();
                     for m in members {
-                        out.extend(self.input(m.binding.as_ref(), m.ty, wg)?);
+                        out.extend(self.input(m.binding.as_ref(), m.ty)?);
                     }
                     Ok(out)
                 }
@@ -342,7 +386,7 @@ impl Fw<'_, '_> {
         Op::Reg(d)
     }
 
-    fn builtin(&mut self, b: BuiltIn, wg: [u32; 3]) -> Result<Vec<Op>, Error> {
+    fn builtin(&mut self, b: BuiltIn) -> Result<Vec<Op>, Error> {
         let xyz = ["x", "y", "z"];
         Ok(match b {
             BuiltIn::LocalInvocationId => xyz.iter().map(|c| self.special(&format!("%tid.{c}"))).collect(),
@@ -350,17 +394,19 @@ impl Fw<'_, '_> {
             BuiltIn::NumWorkGroups => xyz.iter().map(|c| self.special(&format!("%nctaid.{c}"))).collect(),
             BuiltIn::GlobalInvocationId => {
                 let mut out = Vec::with_capacity(3);
-                for (c, &n) in xyz.iter().zip(&wg) {
+                for c in xyz {
                     let id = self.special(&format!("%ctaid.{c}"));
+                    let n = self.special(&format!("%ntid.{c}"));
                     let t = self.special(&format!("%tid.{c}"));
-                    out.push(self.tri("mad.lo.u32", Class::B32, id, Op::U32(n), t));
+                    out.push(self.tri("mad.lo.u32", Class::B32, id, n, t));
                 }
                 out
             }
             BuiltIn::LocalInvocationIndex => {
                 let (x, y, z) = (self.special("%tid.x"), self.special("%tid.y"), self.special("%tid.z"));
-                let zy = self.tri("mad.lo.u32", Class::B32, z, Op::U32(wg[1]), y);
-                vec![self.tri("mad.lo.u32", Class::B32, zy, Op::U32(wg[0]), x)]
+                let (nx, ny) = (self.special("%ntid.x"), self.special("%ntid.y"));
+                let zy = self.tri("mad.lo.u32", Class::B32, z, ny, y);
+                vec![self.tri("mad.lo.u32", Class::B32, zy, nx, x)]
             }
             BuiltIn::SubgroupInvocationId => vec![self.special("%laneid")],
             BuiltIn::SubgroupSize => vec![Op::U32(32)],

@@ -1,7 +1,8 @@
-//! Software sequences for the f32 functions the hardware does not approximate well
-//! enough: sin, cos and tan (Cody–Waite reduction, Payne–Hanek beyond |x| > 105615,
-//! minimax polynomials), atan, atan2, asin, acos, exp (ex2 with the rounding error of
-//! x·log2(e) put back), pow and the hyperbolic functions. docs/ptx.md states each error.
+//! f32 functions as instruction sequences: sin, cos and tan (the hardware approximations
+//! after a Cody–Waite reduction to [−π, π], exact Payne–Hanek reduction beyond
+//! |x| > 105615), atan, atan2, asin and acos (Cephes' minimax polynomials), exp (ex2 with
+//! the rounding error of x·log2(e) put back), pow and the hyperbolic functions.
+//! docs/ptx.md states each one's error.
 
 use super::emit::{ins, Class, Op};
 use super::writer::Fw;
@@ -39,56 +40,53 @@ impl Fw<'_, '_> {
         acc
     }
 
-    /// sin, cos or tan of `x`.
+    /// sin, cos or tan of `x`: the hardware approximations on x reduced to [−π, π].
     pub fn trig(&mut self, x: Op, which: Trig) -> Op {
-        let (r, q) = self.trig_reduce(x);
-        let z = self.f("mul.f32", r, r);
-        // sin r = r + r·z·P(z) and cos r = 1 − z/2 + z²·Q(z) on [−π/4, π/4] (Cephes).
-        let ps = self.horner(z, &[-1.951_529_6e-4, 8.332_161e-3, -1.666_665_5e-1]);
-        let ps = self.f("mul.f32", ps, z);
-        let s = self.fma(ps, r, r);
-        let pc = self.horner(z, &[2.443_315_7e-5, -1.388_731_6e-3, 4.166_664_6e-2, -0.5]);
-        let c = self.fma(pc, z, Op::f32(1.0));
-        let q = if which == Trig::Cos { self.bin("add.s32", Class::B32, q, Op::I32(1)) } else { q };
-        let odd_bit = self.bin("and.b32", Class::B32, q, Op::U32(1));
-        let odd = self.setp("ne.u32", odd_bit, Op::U32(0));
-        if which == Trig::Tan {
-            let nc = self.un("neg.f32", Class::F32, c);
-            let num = self.selp(super::types::Sc::F32, nc, s, odd);
-            let den = self.selp(super::types::Sc::F32, s, c, odd);
-            return self.f("div.rn.f32", num, den);
+        let r = self.reduce_2pi(x);
+        match which {
+            Trig::Sin => self.un("sin.approx.f32", Class::F32, r),
+            Trig::Cos => self.un("cos.approx.f32", Class::F32, r),
+            Trig::Tan => {
+                let s = self.un("sin.approx.f32", Class::F32, r);
+                let c = self.un("cos.approx.f32", Class::F32, r);
+                self.f(super::math::DIV, s, c)
+            }
         }
-        let v = self.selp(super::types::Sc::F32, c, s, odd);
-        let neg_bit = self.bin("and.b32", Class::B32, q, Op::U32(2));
-        let neg = self.setp("ne.u32", neg_bit, Op::U32(0));
-        let nv = self.un("neg.f32", Class::F32, v);
-        self.selp(super::types::Sc::F32, nv, v, neg)
     }
 
-    /// x = r + q·π/2 with |r| ≤ π/4: three-part Cody–Waite up to |x| = 105615, the
-    /// exact Payne–Hanek reduction (a `.func`) beyond.
-    fn trig_reduce(&mut self, x: Op) -> (Op, Op) {
+    /// r = x − k·2π with |r| ≤ π (a little more beyond |x| = 105615): three-part
+    /// Cody–Waite (2π = 4·(P1 + P2 + P3), each product exact) up to |x| = 105615, the
+    /// exact Payne–Hanek reduction (a `.func`, modulo π/2) beyond; NaN for ±∞.
+    fn reduce_2pi(&mut self, x: Op) -> Op {
         self.cx.trig_reduce.set(true);
-        let t = self.f("mul.f32", x, Op::f32(std::f32::consts::FRAC_2_PI));
-        let j = self.un("cvt.rni.f32.f32", Class::F32, t);
-        let q = self.un("cvt.rni.s32.f32", Class::B32, t);
-        let r = self.fma(j, Op::F32(0xBFC9_0FDA), x);
-        let r = self.fma(j, Op::F32(0xB3A2_2168), r);
-        let r = self.fma(j, Op::F32(0xA7C2_34C5), r);
+        let t = self.f("mul.f32", x, Op::f32(1.0 / std::f32::consts::TAU));
+        let k = self.un("cvt.rni.f32.f32", Class::F32, t);
+        let r = self.fma(k, Op::F32(0xC0C9_0FDA), x);
+        let r = self.fma(k, Op::F32(0xB4A2_2168), r);
+        let r = self.fma(k, Op::F32(0xA8C2_34C5), r);
         let ax = self.un("abs.f32", Class::F32, x);
         let big = self.setp("gt.f32", ax, Op::f32(105615.0));
         let done = self.out.label("trig_reduced");
         ins!(self.out, "@!{big} bra {done};");
+        let (rq, q) = (self.out.reg(Class::F32), self.out.reg(Class::B32));
         self.out.raw("\t{\n");
         ins!(self.out, ".param .f32 param0;");
         ins!(self.out, "st.param.f32 [param0], {x};");
         ins!(self.out, ".param .align 4 .b8 retval0[8];");
         ins!(self.out, "call (retval0), {TRIG_REDUCE}, (param0);");
-        ins!(self.out, "ld.param.f32 {r}, [retval0];");
+        ins!(self.out, "ld.param.f32 {rq}, [retval0];");
         ins!(self.out, "ld.param.b32 {q}, [retval0+4];");
         self.out.raw("\t}\n");
+        // x = rq + q·π/2: add back (q mod 4) quarter turns, as −1, 0, 1 or 2.
+        let q3 = self.bin("and.b32", Class::B32, Op::Reg(q), Op::U32(3));
+        let qf = self.un("cvt.rn.f32.u32", Class::F32, q3);
+        let wrap = self.setp("gt.f32", qf, Op::f32(2.5));
+        let qm = self.f("sub.f32", qf, Op::f32(4.0));
+        let qf = self.selp(super::types::Sc::F32, qm, qf, wrap);
+        let full = self.fma(qf, Op::f32(FRAC_PI_2), Op::Reg(rq));
+        let _ = self.mov_to(r, full);
         self.out.place(&done);
-        (r, q)
+        r
     }
 
     /// atan of `a` ≥ 0 (or NaN), by Cephes' reduction to |u| ≤ tan(π/8).
@@ -102,7 +100,7 @@ impl Fw<'_, '_> {
         let num = self.selp(F32, Op::f32(-1.0), num, big);
         let den = self.selp(F32, ap1, Op::f32(1.0), mid);
         let den = self.selp(F32, a, den, big);
-        let u = self.f("div.rn.f32", num, den);
+        let u = self.f(super::math::DIV, num, den);
         let y0 = self.selp(F32, Op::f32(FRAC_PI_4), Op::f32(0.0), mid);
         let y0 = self.selp(F32, Op::f32(FRAC_PI_2), y0, big);
         let z = self.f("mul.f32", u, u);
@@ -125,7 +123,7 @@ impl Fw<'_, '_> {
         let ay = self.un("abs.f32", Class::F32, y);
         let mx = self.f("max.f32", ax, ay);
         let mn = self.f("min.f32", ax, ay);
-        let t = self.f("div.rn.f32", mn, mx);
+        let t = self.f(super::math::DIV, mn, mx);
         let zero = self.setp("eq.f32", mx, Op::f32(0.0));
         let t = self.selp(F32, Op::f32(0.0), t, zero);
         let inf = self.setp("eq.f32", mn, Op::f32(f32::INFINITY));
@@ -150,7 +148,7 @@ impl Fw<'_, '_> {
         use super::types::Sc::F32;
         let big = self.setp("gt.f32", a, Op::f32(0.5));
         let zb = self.fma(Op::f32(-0.5), a, Op::f32(0.5));
-        let sb = self.un("sqrt.rn.f32", Class::F32, zb);
+        let sb = self.un(super::math::SQRT, Class::F32, zb);
         let a2 = self.f("mul.f32", a, a);
         let z = self.selp(F32, zb, a2, big);
         let s = self.selp(F32, sb, a, big);
@@ -225,7 +223,7 @@ impl Fw<'_, '_> {
         let a2 = self.f("add.f32", a, a);
         let e = self.exp(a2);
         let d = self.f("add.f32", e, Op::f32(1.0));
-        let q = self.f("div.rn.f32", Op::f32(2.0), d);
+        let q = self.f(super::math::DIV, Op::f32(2.0), d);
         let r = self.f("sub.f32", Op::f32(1.0), q);
         self.f("copysign.f32", x, r)
     }
@@ -234,7 +232,7 @@ impl Fw<'_, '_> {
     pub fn asinh(&mut self, x: Op) -> Op {
         let a = self.un("abs.f32", Class::F32, x);
         let s = self.fma(a, a, Op::f32(1.0));
-        let s = self.un("sqrt.rn.f32", Class::F32, s);
+        let s = self.un(super::math::SQRT, Class::F32, s);
         let s = self.f("add.f32", a, s);
         let r = self.ln(s);
         self.f("copysign.f32", x, r)
@@ -243,7 +241,7 @@ impl Fw<'_, '_> {
     /// acosh x = ln(x + sqrt(x² − 1)).
     pub fn acosh(&mut self, x: Op) -> Op {
         let s = self.fma(x, x, Op::f32(-1.0));
-        let s = self.un("sqrt.rn.f32", Class::F32, s);
+        let s = self.un(super::math::SQRT, Class::F32, s);
         let s = self.f("add.f32", x, s);
         self.ln(s)
     }
@@ -252,7 +250,7 @@ impl Fw<'_, '_> {
     pub fn atanh(&mut self, x: Op) -> Op {
         let n = self.f("add.f32", Op::f32(1.0), x);
         let d = self.f("sub.f32", Op::f32(1.0), x);
-        let q = self.f("div.rn.f32", n, d);
+        let q = self.f(super::math::DIV, n, d);
         let l = self.ln(q);
         self.f("mul.f32", l, Op::f32(0.5))
     }
@@ -265,7 +263,7 @@ pub(super) fn trig_reduce_func() -> String {
     const TWO_OVER_PI: [u32; 6] = [0x3C43_9041, 0xDB62_9599, 0xF534_DDC0, 0xFC27_57D1, 0x4E44_1529, 0xA2F9_836E];
     let mut s = String::new();
     s.push_str(&format!(
-        "// x = r + q·π/2 for |x| > 105615 (Payne–Hanek, exact).\n\
+        "// x = r + q*pi/2 for |x| > 105615 (Payne-Hanek, exact).\n\
          .func (.param .align 4 .b8 {TRIG_REDUCE}_ret[8]) {TRIG_REDUCE}(.param .f32 {TRIG_REDUCE}_x)\n{{\n\
          \t.reg .pred %p<4>;\n\t.reg .b32 %r<40>;\n\t.reg .f32 %f<4>;\n\t.reg .b64 %rd<24>;\n\t.reg .f64 %fd<4>;\n\
          \tld.param.f32 %f1, [{TRIG_REDUCE}_x];\n\
@@ -275,7 +273,7 @@ pub(super) fn trig_reduce_func() -> String {
          \tadd.s32 %r4, %r3, -128;\n\
          \tshl.b32 %r5, %r1, 8;\n\
          \tor.b32 %r6, %r5, -2147483648;\n\
-         \t// the product of the mantissa and 2/π, words %r10 (lowest) to %r16\n\
+         \t// the product of the mantissa and 2/pi, words %r10 (lowest) to %r16\n\
          \tmov.u64 %rd1, 0;\n"
     ));
     for (q, w) in TWO_OVER_PI.iter().enumerate() {
@@ -326,7 +324,7 @@ pub(super) fn trig_reduce_func() -> String {
          \tsetp.ne.u32 %p2, %r2, 0;\n\
          \tneg.s32 %r29, %r25;\n\
          \tselp.b32 %r25, %r29, %r25, %p2;\n\
-         \t// r = fraction · π/2\n\
+         \t// r = fraction * pi/2\n\
          \tcvt.rn.f64.u64 %fd1, %rd17;\n\
          \tmul.f64 %fd2, %fd1, 0d3BF921FB54442D18;\n\
          \tcvt.rn.f32.f64 %f2, %fd2;\n\

@@ -67,7 +67,7 @@ impl Fw<'_, '_> {
             (B::Subtract, Sc::F32 | Sc::I32 | Sc::U32) => self.bin(&format!("sub.{t}"), class, a, b),
             (B::Multiply, Sc::F32) => self.bin("mul.f32", class, a, b),
             (B::Multiply, Sc::I32 | Sc::U32) => self.bin(&format!("mul.lo.{t}"), class, a, b),
-            (B::Divide, Sc::F32) => self.bin("div.rn.f32", class, a, b),
+            (B::Divide, Sc::F32) => self.bin(super::math::DIV, class, a, b),
             (B::Divide, Sc::I32 | Sc::U32) => self.int_div("div", sc, a, b),
             (B::Modulo, Sc::F32) => self.fmod(a, b),
             (B::Modulo, Sc::I32 | Sc::U32) => self.int_div("rem", sc, a, b),
@@ -127,7 +127,7 @@ impl Fw<'_, '_> {
 
     /// WGSL's float `%`: `a - b * trunc(a / b)` (the product and difference fused).
     fn fmod(&mut self, a: Op, b: Op) -> Op {
-        let q = self.bin("div.rn.f32", Class::F32, a, b);
+        let q = self.bin(super::math::DIV, Class::F32, a, b);
         let t = self.un("cvt.rzi.f32.f32", Class::F32, q);
         let nt = self.un("neg.f32", Class::F32, t);
         self.tri("fma.rn.f32", Class::F32, nt, b, a)

@@ -1,0 +1,131 @@
+//! Backends behind one interface: a scene is prepared once for a backend (program lowered,
+//! kernel generated, device opened, module loaded) and then rendered any number of times.
+
+use crate::cpu::{self, Options, Precision, Render};
+use crate::gpu::{self, cuda::Cuda, Gpu};
+use sdfc_compiler::back::{ptx, wgsl};
+use sdfc_compiler::lower::{self, Program};
+use sdfc_compiler::scene::Scene;
+use std::time::{Duration, Instant};
+
+/// Where a scene is rendered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Backend {
+    /// CUDA if a driver and device are present, else a wgpu GPU adapter, else the CPU.
+    #[default]
+    Auto,
+    /// The CPU renderer with the batch interpreter.
+    Cpu,
+    /// The WGSL kernel through wgpu (a GPU, or lavapipe on a CPU).
+    Wgpu,
+    /// The PTX kernel through the CUDA driver.
+    Cuda,
+}
+
+/// A scene prepared for one backend.
+#[derive(Debug)]
+pub enum Prepared {
+    /// CPU: the distance program and the render options.
+    Cpu { program: Program, options: Options },
+    /// wgpu: the device and the validated kernel.
+    Wgpu { gpu: Box<Gpu>, kernel: Box<wgsl::Kernel> },
+    /// CUDA: the device and the loaded module.
+    Cuda { cuda: Box<Cuda>, loaded: Box<gpu::cuda::Loaded>, ptx_time: Duration },
+}
+
+/// A finished frame: the render and the time it took (GPU time for GPU backends).
+#[derive(Debug)]
+pub struct Frame {
+    /// Image and statistics.
+    pub render: Render,
+    /// Time of the frame.
+    pub time: Duration,
+}
+
+impl Prepared {
+    /// Prepares `scene` for `backend`. `Err` says why the backend cannot be used.
+    pub fn new(backend: Backend, scene: &Scene, precision: Precision) -> Result<Prepared, String> {
+        match backend {
+            Backend::Cpu => Ok(Self::cpu(scene, precision)),
+            Backend::Wgpu => Self::wgpu(scene, false),
+            Backend::Cuda => Self::cuda(scene),
+            Backend::Auto if precision == Precision::F64 => Ok(Self::cpu(scene, precision)),
+            Backend::Auto => Self::cuda(scene).or_else(|_| Self::wgpu(scene, true)).or_else(|_| Ok(Self::cpu(scene, precision))),
+        }
+    }
+
+    fn cpu(scene: &Scene, precision: Precision) -> Prepared {
+        Prepared::Cpu { program: lower::lower(scene), options: Options { precision, ..Options::default() } }
+    }
+
+    fn kernel(scene: &Scene) -> Result<wgsl::Kernel, String> {
+        wgsl::write(scene, &lower::lower(scene)).map_err(|e| e.to_string())
+    }
+
+    fn wgpu(scene: &Scene, require_hardware: bool) -> Result<Prepared, String> {
+        let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
+        Ok(Prepared::Wgpu { gpu: Box::new(gpu), kernel: Box::new(Self::kernel(scene)?) })
+    }
+
+    fn cuda(scene: &Scene) -> Result<Prepared, String> {
+        let cuda = Cuda::open().map_err(|e| e.to_string())?;
+        let kernel = Self::kernel(scene)?;
+        let start = Instant::now();
+        let options = ptx::Options { sm: cuda.sm, entry_point: wgsl::ENTRY_POINT.to_string() };
+        let text = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
+        let ptx_time = start.elapsed();
+        let loaded = cuda.load(&text, wgsl::ENTRY_POINT).map_err(|e| e.to_string())?;
+        Ok(Prepared::Cuda { cuda: Box::new(cuda), loaded: Box::new(loaded), ptx_time })
+    }
+
+    /// The backend's name, as in `--backend`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Prepared::Cpu { .. } => "cpu",
+            Prepared::Wgpu { .. } => "wgpu",
+            Prepared::Cuda { .. } => "cuda",
+        }
+    }
+
+    /// The device, for messages.
+    pub fn device(&self) -> String {
+        match self {
+            Prepared::Cpu { .. } => format!("CPU, {} threads", rayon::current_num_threads()),
+            Prepared::Wgpu { gpu, .. } => gpu.describe(),
+            Prepared::Cuda { cuda, .. } => cuda.describe(),
+        }
+    }
+
+    /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
+    pub fn program_len(&self, scene: &Scene) -> usize {
+        match self {
+            Prepared::Cpu { program, .. } => program.len(),
+            _ => lower::lower(scene).len(),
+        }
+    }
+
+    /// Renders one frame; `progress` gets the fraction done.
+    pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, String> {
+        match self {
+            Prepared::Cpu { program, options } => {
+                let tiles = cpu::tile_count(&scene.settings, options).max(1) as f64;
+                let done = std::sync::atomic::AtomicU64::new(0);
+                let start = Instant::now();
+                let render = cpu::render(scene, program, options, &|| {
+                    let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress(n as f64 / tiles);
+                });
+                Ok(Frame { render, time: start.elapsed() })
+            }
+            Prepared::Wgpu { gpu, kernel } => {
+                let r = gpu::render(gpu, scene, kernel, 1.0, &mut |f| progress(f)).map_err(|e| e.to_string())?;
+                Ok(Frame { render: r.render, time: r.time })
+            }
+            Prepared::Cuda { cuda, loaded, .. } => {
+                let r = gpu::render_cuda(cuda, scene, loaded, 1.0).map_err(|e| e.to_string())?;
+                progress(1.0);
+                Ok(Frame { render: r.render, time: r.time })
+            }
+        }
+    }
+}

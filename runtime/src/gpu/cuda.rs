@@ -1,0 +1,218 @@
+//! The CUDA launcher: loads the PTX of the kernel through the driver's JIT (the compiled
+//! module is cached on disk, keyed by a hash of the PTX and the device), renders in tiles
+//! (one launch each) and reads back the image and the statistics.
+//!
+//! The driver is loaded at run time (cudarc's dynamic loading), so sdfc builds and runs on
+//! machines without CUDA and says so when asked to use it.
+#![allow(unsafe_code)] // The driver API is C: its calls are wrapped here, each with its reason.
+
+use cudarc::driver::{sys, CudaContext, CudaFunction, CudaStream, LaunchConfig, PushKernelArg};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// What can go wrong on the CUDA path.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// libcuda could not be loaded.
+    #[error("no CUDA driver found (libcuda.so): install the NVIDIA driver, or choose another backend")]
+    NoDriver,
+    /// The driver has no device.
+    #[error("the CUDA driver found no device")]
+    NoDevice,
+    /// A driver call failed.
+    #[error("CUDA driver error during {during}: {message}")]
+    Driver { during: &'static str, message: String },
+    /// The JIT refused the PTX (a compiler bug: the PTX is checked by ptxas in CI).
+    #[error("the CUDA JIT rejected the PTX: {0}")]
+    Jit(String),
+}
+
+fn driver(during: &'static str) -> impl Fn(cudarc::driver::DriverError) -> Error {
+    move |e| Error::Driver { during, message: e.to_string() }
+}
+
+/// An opened CUDA device.
+#[derive(Debug)]
+pub struct Cuda {
+    ctx: Arc<CudaContext>,
+    stream: Arc<CudaStream>,
+    /// Compute capability as major·10 + minor (90 for an H100).
+    pub sm: u32,
+    name: String,
+}
+
+/// A kernel loaded into the device, with how it was loaded.
+#[derive(Debug)]
+pub struct Loaded {
+    function: CudaFunction,
+    /// Time to compile (or read from the cache) and load the module.
+    pub load_time: Duration,
+    /// Whether the compiled module came from the disk cache.
+    pub cached: bool,
+}
+
+/// Per-pixel results of a render (same layout as the wgpu path).
+#[derive(Debug, Clone)]
+pub struct Frame {
+    /// Linear RGB per pixel, row-major.
+    pub linear: Vec<[f32; 3]>,
+    /// Statistics words per pixel.
+    pub stats: Vec<u32>,
+    /// Time of the launches, measured with CUDA events.
+    pub gpu_time: Duration,
+}
+
+impl Cuda {
+    /// Opens device 0.
+    pub fn open() -> Result<Cuda, Error> {
+        // SAFETY: only tries to dlopen libcuda; no driver call is made.
+        if !unsafe { sys::is_culib_present() } {
+            return Err(Error::NoDriver);
+        }
+        let count = CudaContext::device_count().map_err(driver("counting devices"))?;
+        if count < 1 {
+            return Err(Error::NoDevice);
+        }
+        let ctx = CudaContext::new(0).map_err(driver("creating a context"))?;
+        let major = ctx
+            .attribute(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR)
+            .map_err(driver("reading the compute capability"))?;
+        let minor = ctx
+            .attribute(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR)
+            .map_err(driver("reading the compute capability"))?;
+        let name = ctx.name().map_err(driver("reading the device name"))?;
+        let stream = ctx.default_stream();
+        Ok(Cuda { ctx, stream, sm: (major * 10 + minor) as u32, name })
+    }
+
+    /// The device's name and compute capability.
+    pub fn describe(&self) -> String {
+        format!("{} (sm_{})", self.name, self.sm)
+    }
+
+    /// Compiles `ptx` for this device (or takes it from the cache) and loads `entry`.
+    pub fn load(&self, ptx: &str, entry: &str) -> Result<Loaded, Error> {
+        let start = Instant::now();
+        let path = cache_path(ptx, &self.name, self.sm);
+        let (cubin, cached) = match path.as_ref().and_then(|p| std::fs::read(p).ok()) {
+            Some(bytes) => (bytes, true),
+            None => {
+                let cubin = self.jit(ptx)?;
+                if let Some(p) = &path {
+                    // The cache is an optimisation: failing to write it is not an error.
+                    if let Some(dir) = p.parent() {
+                        let _ = std::fs::create_dir_all(dir);
+                    }
+                    let _ = crate::output::write_atomic(p, &cubin);
+                }
+                (cubin, false)
+            }
+        };
+        let module = self
+            .ctx
+            .load_module(cudarc::nvrtc::Ptx::from_binary(cubin))
+            .map_err(driver("loading the module"))?;
+        let function = module.load_function(entry).map_err(driver("finding the kernel"))?;
+        Ok(Loaded { function, load_time: start.elapsed(), cached })
+    }
+
+    /// PTX to a cubin through the driver's linker (the JIT).
+    fn jit(&self, ptx: &str) -> Result<Vec<u8>, Error> {
+        self.ctx.bind_to_thread().map_err(driver("binding the context"))?;
+        let mut text = ptx.as_bytes().to_vec();
+        text.push(0);
+        let mut log = vec![0u8; 8192];
+        let mut state: sys::CUlinkState = std::ptr::null_mut();
+        let mut options = [sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER, sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER_SIZE_BYTES];
+        let mut values = [log.as_mut_ptr() as *mut std::ffi::c_void, log.len() as *mut std::ffi::c_void];
+        let check = |r: sys::CUresult, during: &'static str, log: &[u8]| -> Result<(), Error> {
+            if r == sys::CUresult::CUDA_SUCCESS {
+                return Ok(());
+            }
+            let end = log.iter().position(|&b| b == 0).unwrap_or(log.len());
+            let msg = String::from_utf8_lossy(&log[..end]).into_owned();
+            Err(Error::Jit(format!("{during}: {r:?} {msg}")))
+        };
+        // SAFETY: the option arrays outlive the link state, which is destroyed below; the
+        // PTX buffer is NUL-terminated and outlives cuLinkAddData; the cubin returned by
+        // cuLinkComplete is copied before cuLinkDestroy frees it.
+        unsafe {
+            check(sys::cuLinkCreate_v2(2, options.as_mut_ptr(), values.as_mut_ptr(), &mut state), "cuLinkCreate", &log)?;
+            let added = sys::cuLinkAddData_v2(
+                state,
+                sys::CUjitInputType::CU_JIT_INPUT_PTX,
+                text.as_mut_ptr() as *mut std::ffi::c_void,
+                text.len(),
+                c"sdfc.ptx".as_ptr(),
+                0,
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+            );
+            if let Err(e) = check(added, "cuLinkAddData", &log) {
+                sys::cuLinkDestroy(state);
+                return Err(e);
+            }
+            let mut cubin: *mut std::ffi::c_void = std::ptr::null_mut();
+            let mut size = 0usize;
+            let done = sys::cuLinkComplete(state, &mut cubin, &mut size);
+            let out = check(done, "cuLinkComplete", &log)
+                .map(|_| std::slice::from_raw_parts(cubin as *const u8, size).to_vec());
+            sys::cuLinkDestroy(state);
+            out
+        }
+    }
+
+    /// Renders one frame: one launch per tile of `tile`×`tile` pixels.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(&self, k: &Loaded, uniforms: &[u8], width: u32, height: u32, stats_words: u32, workgroup: u32, tile: u32) -> Result<Frame, Error> {
+        let s = &self.stream;
+        let pixels = width as usize * height as usize;
+        let tiles = super::wgpu::tiles(width, height, tile);
+        let table: Vec<u32> = tiles.iter().flat_map(|t| [t.0, t.1, t.2, t.3]).collect();
+        let d_uniforms = s.clone_htod(uniforms).map_err(driver("uploading the scene"))?;
+        let d_tiles = s.clone_htod(&table).map_err(driver("uploading the tiles"))?;
+        let mut d_image = s.alloc_zeros::<f32>(pixels * 4).map_err(driver("allocating the image"))?;
+        let mut d_stats = s.alloc_zeros::<u32>(pixels * stats_words as usize).map_err(driver("allocating the statistics"))?;
+        let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
+        let start = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
+        let end = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
+        start.record(s).map_err(driver("recording an event"))?;
+        for (i, t) in tiles.iter().enumerate() {
+            let tile_view = d_tiles.slice(4 * i..4 * i + 4);
+            let cfg = LaunchConfig {
+                grid_dim: (t.2.div_ceil(workgroup), t.3.div_ceil(workgroup), 1),
+                block_dim: (workgroup, workgroup, 1),
+                shared_mem_bytes: 0,
+            };
+            let mut launch = s.launch_builder(&k.function);
+            launch.arg(&d_uniforms).arg(&tile_view).arg(&mut d_image).arg(&mut d_stats);
+            // SAFETY: the kernel's parameters are the four buffers in binding order, as the
+            // PTX back end declares them; each buffer is as large as the kernel indexes.
+            unsafe { launch.launch(cfg) }.map_err(driver("launching the kernel"))?;
+        }
+        end.record(s).map_err(driver("recording an event"))?;
+        s.synchronize().map_err(driver("running the kernel"))?;
+        let ms = start.elapsed_ms(&end).map_err(driver("reading the timer"))?;
+        let image = s.clone_dtoh(&d_image).map_err(driver("reading the image"))?;
+        let stats = s.clone_dtoh(&d_stats).map_err(driver("reading the statistics"))?;
+        let linear = image.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
+        Ok(Frame { linear, stats, gpu_time: Duration::from_secs_f64(ms as f64 / 1e3) })
+    }
+}
+
+/// Where the compiled module of `ptx` for a device is cached: `$SDFC_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/sdfc/cuda`, else `~/.cache/sdfc/cuda`. `None` when there is no home.
+fn cache_path(ptx: &str, device: &str, sm: u32) -> Option<PathBuf> {
+    use std::hash::{Hash, Hasher};
+    let dir = match std::env::var_os("SDFC_CACHE_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => match std::env::var_os("XDG_CACHE_HOME") {
+            Some(d) => PathBuf::from(d).join("sdfc").join("cuda"),
+            None => PathBuf::from(std::env::var_os("HOME")?).join(".cache").join("sdfc").join("cuda"),
+        },
+    };
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (ptx, device, sm, env!("CARGO_PKG_VERSION")).hash(&mut h);
+    Some(dir.join(format!("{:016x}.cubin", h.finish())))
+}

@@ -1,0 +1,182 @@
+//! The batch interpreter: f32 against f64, the batch path against the one-point reference
+//! path (bit for bit), batches of every length around the chunk size, and what a tape keeps.
+
+mod common;
+
+use common::*;
+use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
+use sdfc_compiler::lower::{lower, Program};
+use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
+
+/// A scene that uses most operations: smooth blends, repetition, twist, bend, rotation,
+/// painting.
+fn busy_scene() -> Scene {
+    let mut b = Build::new();
+    let (m1, m2) = (
+        b.material([1.0, 0.2, 0.2], 0.0, 0.0),
+        b.material([0.2, 0.2, 1.0], 0.3, 0.0),
+    );
+    let t = b.add(Node::Torus {
+        major: 1.0,
+        minor: 0.3,
+    });
+    let t = b.add(Node::Twist {
+        rate: 0.5,
+        child: t,
+    });
+    let t = b.paint(t, m1);
+    let bx = b.add(Node::RoundBox {
+        half: [0.6, 0.4, 0.5],
+        radius: 0.1,
+    });
+    let bx = b.add(Node::Bend {
+        rate: 0.3,
+        child: bx,
+    });
+    let bx = b.at(bx, [0.7, 0.2, 0.0]);
+    let blend = b.add(Node::SmoothCombine {
+        op: Combine::Union,
+        k: 0.3,
+        variant: Smooth::Exp,
+        a: t,
+        b: bx,
+    });
+    let c = b.add(Node::Cone {
+        radius: 0.4,
+        half_height: 0.5,
+    });
+    let th: f64 = 0.4;
+    let c = b.add(Node::Rotate {
+        matrix: [
+            [1.0, 0.0, 0.0],
+            [0.0, th.cos(), -th.sin()],
+            [0.0, th.sin(), th.cos()],
+        ],
+        child: c,
+    });
+    let c = b.add(Node::Repeat {
+        period: [3.0, 0.0, 3.0],
+        count: Some([4.0, 1.0, 4.0]),
+        child: c,
+    });
+    let c = b.paint(c, m2);
+    let e = b.add(Node::Ellipsoid {
+        radii: [0.3, 0.6, 0.4],
+    });
+    let e = b.add(Node::Shell {
+        thickness: 0.05,
+        child: e,
+    });
+    let e = b.at(e, [-2.0, 0.0, 1.0]);
+    let floor = b.add(Node::Plane {
+        normal: [0.0, 1.0, 0.0],
+        height: -1.0,
+    });
+    let root = b.add(Node::Combine {
+        op: Combine::Union,
+        children: vec![blend, c, e, floor],
+    });
+    b.finish(root)
+}
+
+fn run<T: Float>(
+    program: &Program,
+    outputs: Outputs,
+    chunk: usize,
+    pts: &[[f64; 3]],
+) -> (Vec<T>, Vec<u32>) {
+    let tape = Tape::new(program, outputs);
+    let mut ev = Evaluator::<T>::new(&tape, chunk);
+    let c = |i: usize| pts.iter().map(|p| T::from_f64(p[i])).collect::<Vec<T>>();
+    let mut d = vec![T::zero(); pts.len()];
+    let mut m = vec![0u32; pts.len()];
+    ev.eval(&c(0), &c(1), &c(2), &mut d, Some(&mut m));
+    (d, m)
+}
+
+fn points(n: usize) -> Vec<[f64; 3]> {
+    let mut rng = Rng::new(42);
+    (0..n).map(|_| rng.point(4.0)).collect()
+}
+
+#[test]
+fn f32_agrees_with_f64() {
+    let program = lower(&busy_scene());
+    let pts = points(2000);
+    let (d32, m32) = run::<f32>(&program, Outputs::DistanceAndMaterial, 256, &pts);
+    let (d64, m64) = run::<f64>(&program, Outputs::DistanceAndMaterial, 256, &pts);
+    let mut material_mismatch = 0;
+    for i in 0..pts.len() {
+        let tol = 2e-5 * (1.0 + d64[i].abs() + len3(pts[i]));
+        assert!(
+            (d32[i] as f64 - d64[i]).abs() <= tol,
+            "at {:?}: {} vs {}",
+            pts[i],
+            d32[i],
+            d64[i]
+        );
+        material_mismatch += (m32[i] != m64[i]) as usize;
+    }
+    // Materials may differ only where two children are equally near (none at random points).
+    assert_eq!(material_mismatch, 0);
+}
+
+fn batch_matches_reference<T: Float>() {
+    let program = lower(&busy_scene());
+    let pts = points(300);
+    for chunk in [1, 7, 64] {
+        for n in [0, 1, 63, 64, 65, 128, 300] {
+            let (d, m) = run::<T>(&program, Outputs::DistanceAndMaterial, chunk, &pts[..n]);
+            for i in 0..n {
+                let p = pts[i].map(T::from_f64);
+                let (rd, rm) = eval_point::<T>(&program, p);
+                assert!(
+                    rd.to_f64().to_bits() == d[i].to_f64().to_bits() && rm == m[i],
+                    "chunk {chunk}, n {n}, point {i}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn batch_matches_the_reference_path_bit_for_bit() {
+    batch_matches_reference::<f32>();
+    batch_matches_reference::<f64>();
+}
+
+#[test]
+fn distance_tape_drops_material_code() {
+    let program = lower(&busy_scene());
+    let full = Tape::new(&program, Outputs::DistanceAndMaterial);
+    let dist = Tape::new(&program, Outputs::Distance);
+    assert!(dist.len() < full.len(), "{} vs {}", dist.len(), full.len());
+    let pts = points(100);
+    let (a, _) = run::<f32>(&program, Outputs::Distance, 32, &pts);
+    let (b, _) = run::<f32>(&program, Outputs::DistanceAndMaterial, 32, &pts);
+    assert_eq!(a, b);
+}
+
+#[test]
+fn slots_are_reused() {
+    // A long chain of unions needs few live registers at a time.
+    let mut b = Build::new();
+    let kids: Vec<_> = (0..50)
+        .map(|i| {
+            let s = b.add(Node::Sphere { radius: 0.1 });
+            b.at(s, [i as f64, 0.0, 0.0])
+        })
+        .collect();
+    let root = b.add(Node::Combine {
+        op: Combine::Union,
+        children: kids,
+    });
+    let program = lower(&b.finish(root));
+    let tape = Tape::new(&program, Outputs::Distance);
+    assert!(
+        tape.slot_count() < program.len() / 2,
+        "{} slots for {} instructions",
+        tape.slot_count(),
+        program.len()
+    );
+}

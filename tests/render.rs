@@ -1,0 +1,371 @@
+//! Properties of CPU renders: coverage of a sphere seen head-on, shadows, mirrors, clear
+//! glass, light falloff, and bit-identical output whatever the number of threads.
+
+mod common;
+
+use common::*;
+use sdfc_compiler::lower::lower;
+use sdfc_compiler::scene::{Light, Node, Pattern, Scene};
+use sdfc_runtime::cpu::{self, Options, Precision, Render};
+
+fn render(scene: &Scene) -> Render {
+    cpu::render(scene, &lower(scene), &Options::default(), &|| {})
+}
+
+fn render_with(scene: &Scene, options: &Options, threads: usize) -> Render {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    pool.install(|| cpu::render(scene, &lower(scene), options, &|| {}))
+}
+
+/// The camera of RENDERER.md written again: (eye, u, v, w, tan(fov/2)).
+fn basis(scene: &Scene) -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3], f64) {
+    let c = &scene.camera;
+    let w = normalize(sub3(c.look_at, c.position));
+    let u = normalize(cross(w, [0.0, 1.0, 0.0]));
+    let v = cross(u, w);
+    (c.position, u, v, w, (c.fov / 2.0).tan())
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let l = len3(a);
+    a.map(|x| x / l)
+}
+
+/// The pixel whose centre ray passes through the world point `x`.
+fn project(scene: &Scene, x: [f64; 3]) -> (u32, u32) {
+    let (eye, u, v, w, tan) = basis(scene);
+    let (wd, ht) = (scene.settings.width as f64, scene.settings.height as f64);
+    let d = sub3(x, eye);
+    let bx = dot(d, u) / dot(d, w) / (tan * wd / ht);
+    let by = dot(d, v) / dot(d, w) / tan;
+    let (ax, ay) = ((bx + 1.0) / 2.0, (1.0 - by) / 2.0);
+    (
+        (ax * wd - 0.5).round() as u32,
+        (ay * ht - 0.5).round() as u32,
+    )
+}
+
+fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+fn small(scene: &mut Scene, w: u32, h: u32) {
+    scene.settings.width = w;
+    scene.settings.height = h;
+    scene.settings.background = [0.0, 0.0, 0.0];
+}
+
+#[test]
+fn a_sphere_seen_head_on_covers_the_predicted_pixels() {
+    let mut scene = single(Node::Sphere { radius: 1.0 });
+    scene.camera.position = [0.0, 0.0, -5.0];
+    scene.camera.look_at = [0.0, 0.0, 0.0];
+    small(&mut scene, 96, 72);
+    let r = render(&scene);
+    let covered = r.image.linear.iter().filter(|c| c[0] > 0.0).count() as i64;
+    // A pixel is covered when its centre ray passes within the radius of the centre.
+    let (eye, u, v, w, tan) = basis(&scene);
+    let (wd, ht) = (96.0, 72.0);
+    let mut predicted = 0i64;
+    for y in 0..72 {
+        for x in 0..96 {
+            let bx = 2.0 * (x as f64 + 0.5) / wd - 1.0;
+            let by = 1.0 - 2.0 * (y as f64 + 0.5) / ht;
+            let dir =
+                normalize([0, 1, 2].map(|i| w[i] + bx * tan * wd / ht * u[i] + by * tan * v[i]));
+            predicted += (len3(cross(eye, dir)) < 1.0) as i64;
+        }
+    }
+    assert!(predicted > 300, "{predicted}");
+    assert!(
+        (covered - predicted).abs() <= 3,
+        "covered {covered}, predicted {predicted}"
+    );
+    assert_eq!(r.stats.counters.hits as i64, covered);
+}
+
+/// A grey floor, a sphere above it, a light up and to the side.
+fn shadow_scene(softness: f64) -> Scene {
+    let mut b = Build::new();
+    let floor = b.add(Node::Plane {
+        normal: [0.0, 1.0, 0.0],
+        height: 0.0,
+    });
+    let s = b.add(Node::Sphere { radius: 0.5 });
+    let s = b.at(s, [0.0, 1.0, 0.0]);
+    let root = b.add(Node::Combine {
+        op: sdfc_compiler::scene::Combine::Union,
+        children: vec![floor, s],
+    });
+    b.point_light([2.0, 5.0, 0.0], softness);
+    let mut scene = b.finish(root);
+    scene.camera.position = [0.0, 4.0, -6.0];
+    scene.camera.look_at = [0.0, 0.0, 0.0];
+    small(&mut scene, 160, 120);
+    scene
+}
+
+#[test]
+fn a_shadowed_pixel_is_darker_than_its_lit_neighbour() {
+    for softness in [0.0, 8.0] {
+        let scene = shadow_scene(softness);
+        let r = render(&scene);
+        // The shadow's centre on the floor, on the line from the light through the sphere.
+        let (sx, sy) = project(&scene, [-0.5, 0.0, 0.0]);
+        let (lx, ly) = project(&scene, [-0.5, 0.0, -1.2]);
+        let (dark, lit) = (
+            luminance(r.image.pixel(sx, sy)),
+            luminance(r.image.pixel(lx, ly)),
+        );
+        assert!(
+            dark < 0.5 * lit,
+            "softness {softness}: shadow {dark}, lit {lit}"
+        );
+        // Hard shadows leave only the ambient term: k_a · C.
+        if softness == 0.0 {
+            assert!(
+                (r.image.pixel(sx, sy)[0] - 0.1 * 0.8).abs() < 1e-4,
+                "{:?}",
+                r.image.pixel(sx, sy)
+            );
+        }
+    }
+}
+
+/// A red ball above a floor whose reflectivity is `reflect`.
+fn mirror_scene(reflect: f64) -> Scene {
+    let mut b = Build::new();
+    let grey = b.material([0.5, 0.5, 0.5], reflect, 0.0);
+    let red = b.material([1.0, 0.0, 0.0], 0.0, 0.0);
+    let floor = b.add(Node::Plane {
+        normal: [0.0, 1.0, 0.0],
+        height: 0.0,
+    });
+    let floor = b.paint(floor, grey);
+    let s = b.add(Node::Sphere { radius: 0.5 });
+    let s = b.at(s, [0.0, 0.6, 2.0]);
+    let s = b.paint(s, red);
+    let root = b.add(Node::Combine {
+        op: sdfc_compiler::scene::Combine::Union,
+        children: vec![floor, s],
+    });
+    b.point_light([0.0, 5.0, -2.0], 0.0);
+    let mut scene = b.finish(root);
+    scene.camera.position = [0.0, 1.0, -4.0];
+    scene.camera.look_at = [0.0, 0.0, 2.0];
+    small(&mut scene, 120, 90);
+    scene
+}
+
+#[test]
+fn a_mirror_shows_the_reflected_object() {
+    // Where the camera sees the ball's mirror image (its centre reflected in y = 0).
+    let with = render(&mirror_scene(0.9));
+    let without = render(&mirror_scene(0.0));
+    let (x, y) = project(&mirror_scene(0.9), [0.0, -0.6, 2.0]);
+    let (m, plain) = (with.image.pixel(x, y), without.image.pixel(x, y));
+    assert!(m[0] > 2.0 * m[1] + 0.05, "mirror pixel not red: {m:?}");
+    assert!(
+        (plain[0] - plain[1]).abs() < 1e-4,
+        "plain floor pixel not grey: {plain:?}"
+    );
+    assert!(with.stats.counters.secondary_rays > 0 && without.stats.counters.secondary_rays == 0);
+}
+
+/// A checkerboard wall behind where a ball may stand.
+fn glass_scene(ball: Option<(f64, f64)>) -> Scene {
+    let mut b = Build::new();
+    let wall = b.add(Node::Plane {
+        normal: [0.0, 0.0, -1.0],
+        height: -3.0,
+    });
+    let mut root = wall;
+    if let Some((transparency, ior)) = ball {
+        let glass = b.material([1.0, 1.0, 1.0], 0.0, transparency);
+        b.scene.materials[glass.0 as usize].ior = ior;
+        b.scene.materials[glass.0 as usize].specular = 0.0;
+        let s = b.add(Node::Sphere { radius: 1.0 });
+        let s = b.paint(s, glass);
+        root = b.add(Node::Combine {
+            op: sdfc_compiler::scene::Combine::Union,
+            children: vec![wall, s],
+        });
+    }
+    b.scene.materials[0].pattern = Pattern::Checker {
+        a: [0.9, 0.9, 0.9],
+        b: [0.1, 0.1, 0.1],
+        size: 0.5,
+    };
+    b.point_light([0.0, 0.0, -6.0], 4.0);
+    let mut scene = b.finish(root);
+    scene.camera.position = [0.0, 0.0, -5.0];
+    scene.camera.look_at = [0.0, 0.0, 0.0];
+    small(&mut scene, 96, 72);
+    scene
+}
+
+#[test]
+fn clear_glass_of_index_one_is_invisible() {
+    let bare = render(&glass_scene(None));
+    let clear = render(&glass_scene(Some((1.0, 1.0))));
+    let differ = bare
+        .image
+        .linear
+        .iter()
+        .zip(&clear.image.linear)
+        .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
+        .count();
+    assert!(
+        differ * 50 < bare.image.linear.len(),
+        "{differ} pixels differ"
+    );
+    assert!(clear.stats.counters.secondary_rays > 0);
+    // Real glass bends the checkerboard: many pixels change, none is NaN.
+    let glass = render(&glass_scene(Some((0.9, 1.5))));
+    let changed = bare
+        .image
+        .linear
+        .iter()
+        .zip(&glass.image.linear)
+        .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
+        .count();
+    assert!(changed > 300, "{changed}");
+    assert!(glass
+        .image
+        .linear
+        .iter()
+        .all(|c| c.iter().all(|v| v.is_finite())));
+}
+
+#[test]
+fn a_point_light_does_not_reach_past_its_radius() {
+    let mut scene = shadow_scene(0.0);
+    if let Some(Light::Point { radius, .. }) = scene.lights.first_mut() {
+        *radius = 2.0;
+    }
+    let r = render(&scene);
+    let (x, y) = project(&scene, [1.5, 0.0, -1.5]);
+    assert!(
+        (r.image.pixel(x, y)[0] - 0.08).abs() < 1e-5,
+        "{:?}",
+        r.image.pixel(x, y)
+    );
+}
+
+fn busy() -> Scene {
+    let mut scene = mirror_scene(0.5);
+    let glass = {
+        let mut m = scene.materials[2].clone();
+        m.transparency = 0.6;
+        m.reflect = 0.2;
+        m
+    };
+    scene.materials[2] = glass;
+    if let Some(Light::Point { softness, .. }) = scene.lights.first_mut() {
+        *softness = 6.0;
+    }
+    scene.settings.aa = 2;
+    scene.settings.width = 72;
+    scene.settings.height = 40;
+    scene
+}
+
+#[test]
+fn output_is_bit_identical_whatever_the_thread_count() {
+    let scene = busy();
+    let options = Options {
+        tile: 8,
+        ..Options::default()
+    };
+    let one = render_with(&scene, &options, 1);
+    for threads in [2, 3] {
+        let other = render_with(&scene, &options, threads);
+        assert!(one.image == other.image, "{threads} threads");
+        assert_eq!(one.stats, other.stats);
+    }
+    assert_eq!(
+        render_with(&scene, &options, 2).image,
+        one.image,
+        "run to run"
+    );
+}
+
+#[test]
+fn f64_and_f32_renders_agree() {
+    let scene = busy();
+    let a = render(&scene);
+    let b = render_with(
+        &scene,
+        &Options {
+            precision: Precision::F64,
+            ..Options::default()
+        },
+        2,
+    );
+    let mean: f64 = a
+        .image
+        .linear
+        .iter()
+        .zip(&b.image.linear)
+        .map(|(x, y)| (x[0] - y[0]).abs() as f64)
+        .sum::<f64>()
+        / a.image.linear.len() as f64;
+    assert!(mean < 0.01, "{mean}");
+}
+
+#[test]
+fn over_relaxation_changes_little() {
+    let mut scene = shadow_scene(8.0);
+    let plain = render(&scene);
+    scene.settings.relaxation = 1.6;
+    let relaxed = render(&scene);
+    let differ = plain
+        .image
+        .linear
+        .iter()
+        .zip(&relaxed.image.linear)
+        .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
+        .count();
+    assert!(differ * 100 < plain.image.linear.len(), "{differ}");
+}
+
+#[test]
+fn statistics_add_up() {
+    let r = render(&busy());
+    let c = &r.stats.counters;
+    assert_eq!(c.camera_rays, 72 * 40 * 4);
+    assert_eq!(
+        c.hits + c.misses + c.budget_misses + c.nans,
+        c.camera_rays + c.secondary_rays
+    );
+    assert_eq!(r.stats.pixels, 72 * 40);
+    assert!(
+        r.stats.steps_max >= r.stats.steps_p99
+            && r.stats.steps_p99 as f64 >= r.stats.steps_mean * 0.5
+    );
+    assert_eq!(c.nans, 0);
+}
+
+#[test]
+fn a_tiny_step_budget_misses_by_budget() {
+    let mut scene = shadow_scene(0.0);
+    scene.settings.max_steps = 2;
+    let r = render(&scene);
+    assert!(r.stats.counters.budget_misses > 0);
+    assert_eq!(r.stats.steps_max, 2);
+}

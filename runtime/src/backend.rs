@@ -96,6 +96,19 @@ impl Prepared {
         }
     }
 
+    /// How the backend was prepared, for `--stats`: PTX generation and JIT times for CUDA.
+    pub fn preparation(&self) -> Option<String> {
+        match self {
+            Prepared::Cuda { loaded, ptx_time, .. } => Some(format!(
+                "PTX generated in {:.2} ms; module {} in {:.1} ms",
+                ptx_time.as_secs_f64() * 1e3,
+                if loaded.cached { "read from the JIT cache and loaded" } else { "compiled by the driver JIT and loaded" },
+                loaded.load_time.as_secs_f64() * 1e3
+            )),
+            _ => None,
+        }
+    }
+
     /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
     pub fn program_len(&self, scene: &Scene) -> usize {
         match self {

@@ -17,8 +17,8 @@ pub struct Image {
 /// Why an image could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
-    /// The PNG encoder refused the image.
-    #[error("PNG encoding failed: {0}")]
+    /// The PNG encoder or decoder refused the image.
+    #[error("PNG error: {0}")]
     Encode(String),
     /// Creating, writing or renaming the file failed.
     #[error(transparent)]
@@ -78,6 +78,37 @@ pub fn srgb_encode(c: f32) -> u8 {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     };
     (s * 255.0 + 0.5) as u8
+}
+
+/// The inverse of [`srgb_encode`]: an 8-bit sRGB value as linear colour.
+pub fn srgb_decode(v: u8) -> f32 {
+    let s = v as f32 / 255.0;
+    if s <= 0.040_45 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Reads a PNG file (8-bit grey, grey-alpha, RGB or RGBA; alpha ignored) as a linear image.
+pub fn read_png(path: &Path) -> Result<Image, ImageError> {
+    let file = std::fs::File::open(path)?;
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = decoder.read_info().map_err(|e| ImageError::Encode(e.to_string()))?;
+    let size = reader.output_buffer_size().ok_or_else(|| ImageError::Encode("image too large".into()))?;
+    let mut buf = vec![0; size];
+    let info = reader.next_frame(&mut buf).map_err(|e| ImageError::Encode(e.to_string()))?;
+    let channels = info.color_type.samples();
+    let bytes = &buf[..info.buffer_size()];
+    let linear = bytes
+        .chunks_exact(channels)
+        .map(|px| match channels {
+            1 | 2 => [srgb_decode(px[0]); 3],
+            _ => [srgb_decode(px[0]), srgb_decode(px[1]), srgb_decode(px[2])],
+        })
+        .collect();
+    Ok(Image { width: info.width, height: info.height, linear })
 }
 
 /// Writes `image` as a PNG file, atomically (see [`write_atomic`]).

@@ -8,4 +8,3 @@ pub mod frontend;
 pub mod gpu;
 pub mod image;
 pub mod metrics;
-pub mod output;

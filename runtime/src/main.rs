@@ -23,6 +23,8 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// Time the rendering of scenes.
     Bench(commands::bench::BenchArgs),
+    /// Compare two rendered images (RMSE, PSNR, differing pixels).
+    Compare(commands::compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
@@ -39,5 +41,6 @@ fn main() -> ExitCode {
         Command::Compile(args) => commands::compile::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Bench(args) => commands::bench::run(args),
+        Command::Compare(args) => commands::compare::run(args),
     }
 }

@@ -27,6 +27,8 @@ pub enum Emit {
     Glsl,
     /// The kernel as HLSL.
     Hlsl,
+    /// The kernel as PTX for the CUDA driver.
+    Ptx,
 }
 
 /// Arguments of `sdfc compile`.
@@ -43,6 +45,9 @@ pub struct CompileArgs {
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value_t)]
     pub diagnostics: DiagnosticFormat,
+    /// The PTX target architecture (`--emit ptx`): 70 for sm_70, 80, 90, ...
+    #[arg(long, default_value_t = 70, value_parser = clap::value_parser!(u32).range(50..=120))]
+    pub sm: u32,
 }
 
 /// Compiles and writes the requested target.
@@ -70,7 +75,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
             let Some(scene) = &loaded.scene else {
                 return ExitCode::from(1);
             };
-            match emit(scene, other) {
+            match emit(scene, other, args.sm) {
                 Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
                 Err(msg) => {
                     eprintln!("{msg}");
@@ -83,7 +88,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
 }
 
 /// The bytes of a target that needs the checked scene.
-fn emit(scene: &scene::Scene, target: Emit) -> Result<Vec<u8>, String> {
+fn emit(scene: &scene::Scene, target: Emit, sm: u32) -> Result<Vec<u8>, String> {
     let program = lower::lower(scene);
     let lang = match target {
         Emit::Ir => return Ok(scene::dump(scene).into_bytes()),
@@ -94,9 +99,13 @@ fn emit(scene: &scene::Scene, target: Emit) -> Result<Vec<u8>, String> {
         Emit::Msl => Some(Lang::Msl),
         Emit::Glsl => Some(Lang::Glsl),
         Emit::Hlsl => Some(Lang::Hlsl),
-        Emit::Wgsl => None,
+        Emit::Wgsl | Emit::Ptx => None,
     };
     let kernel = back::wgsl::write(scene, &program).map_err(|e| e.to_string())?;
+    if target == Emit::Ptx {
+        let options = back::ptx::Options { sm, entry_point: back::wgsl::ENTRY_POINT.to_string() };
+        return back::ptx::write(&kernel.module, &kernel.info, &options).map(String::into_bytes).map_err(|e| e.to_string());
+    }
     match lang {
         None => Ok(kernel.source.into_bytes()),
         Some(lang) => back::shader::write(&kernel, lang).map_err(|e| e.to_string()),
@@ -119,7 +128,7 @@ pub fn write_bytes(path: Option<&std::path::Path>, bytes: &[u8]) -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Some(p) => match crate::output::write_atomic(p, bytes) {
+        Some(p) => match crate::image::write_atomic(p, bytes) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: cannot write `{}`: {e}", p.display());

@@ -100,6 +100,9 @@ pub fn run(args: RenderArgs) -> ExitCode {
     );
     if args.stats {
         println!("backend         {} ({})", prepared.name(), prepared.device());
+        if let Some(p) = prepared.preparation() {
+            println!("prepared        {p}");
+        }
         println!("time            {:.3} s (frame {:.3} s)", seconds, frame.time.as_secs_f64());
         println!("{}", render.stats);
     }

@@ -104,7 +104,7 @@ impl Cuda {
                     if let Some(dir) = p.parent() {
                         let _ = std::fs::create_dir_all(dir);
                     }
-                    let _ = crate::output::write_atomic(p, &cubin);
+                    let _ = crate::image::write_atomic(p, &cubin);
                 }
                 (cubin, false)
             }

@@ -197,18 +197,29 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
                     }
                 }
             }
-            Ok(Token::UnterminatedStr) => diags.push(
-                Diagnostic::error("E0002", "unterminated string literal", span)
-                    .with_label("this string has no closing quote on its line")
-                    .with_help("strings end with `\"` on the same line"),
-            ),
+            Ok(Token::UnterminatedStr) => {
+                diags.push(
+                    Diagnostic::error("E0002", "unterminated string literal", span)
+                        .with_label("this string has no closing quote on its line")
+                        .with_help("strings end with `\"` on the same line"),
+                );
+                // The parser sees a string, so the rest of the line is not misread.
+                tokens.push((Token::Str(String::new()), span));
+            }
             Ok(Token::Str(raw)) => {
                 let (text, bad) = unescape(&raw, range.start + 1, file);
                 diags.extend(bad);
                 tokens.push((Token::Str(text), span));
             }
             Ok(tok) => tokens.push((tok, span)),
-            Err(()) => diags.push(lex_error(text, range, span)),
+            Err(()) => {
+                let d = lex_error(text, range.clone(), span);
+                // A malformed number still stands for a number to the parser.
+                if d.code == "E0004" {
+                    tokens.push((Token::Float(0.0), span));
+                }
+                diags.push(d);
+            }
         }
     }
     (tokens, diags)

@@ -43,13 +43,21 @@ impl Fw<'_, '_> {
     /// sin, cos or tan of `x`: the hardware approximations on x reduced to [−π, π].
     pub fn trig(&mut self, x: Op, which: Trig) -> Op {
         let r = self.reduce_2pi(x);
+        // Near 0 the hardware's error is absolute (about 2^-21), so sin and tan take the
+        // first terms of their series there.
         match which {
-            Trig::Sin => self.un("sin.approx.f32", Class::F32, r),
+            Trig::Sin => {
+                let s = self.un("sin.approx.f32", Class::F32, r);
+                let series = self.odd_series(x, &[-1.0 / 6.0, 1.0 / 120.0]);
+                self.near_zero(x, 0.03125, series, s)
+            }
             Trig::Cos => self.un("cos.approx.f32", Class::F32, r),
             Trig::Tan => {
                 let s = self.un("sin.approx.f32", Class::F32, r);
                 let c = self.un("cos.approx.f32", Class::F32, r);
-                self.f(super::math::DIV, s, c)
+                let t = self.f(super::math::DIV, s, c);
+                let series = self.odd_series(x, &[1.0 / 3.0, 2.0 / 15.0]);
+                self.near_zero(x, 0.03125, series, t)
             }
         }
     }
@@ -152,7 +160,7 @@ impl Fw<'_, '_> {
         let a2 = self.f("mul.f32", a, a);
         let z = self.selp(F32, zb, a2, big);
         let s = self.selp(F32, sb, a, big);
-        let p = self.horner(z, &[4.216_32e-2, 2.418_131_1e-2, 4.547_002_6e-2, 7.495_300_3e-2, 1.666_675_2e-1]);
+        let p = self.horner(z, &[4.216_32e-2, 2.418_131e-2, 4.547_002_6e-2, 7.495_300_3e-2, 1.666_675_2e-1]);
         let p = self.f("mul.f32", p, z);
         (self.fma(p, s, s), big)
     }
@@ -208,16 +216,46 @@ impl Fw<'_, '_> {
         self.selp(F32, Op::f32(1.0), p, one)
     }
 
-    /// sinh, cosh (half the difference or sum of e^x and e^−x).
-    pub fn sinh_cosh(&mut self, x: Op, cosh: bool) -> Op {
-        let a = self.exp(x);
-        let nx = self.un("neg.f32", Class::F32, x);
-        let b = self.exp(nx);
-        let s = self.f(if cosh { "add.f32" } else { "sub.f32" }, a, b);
-        self.f("mul.f32", s, Op::f32(0.5))
+    /// x + x³·(c₁ + c₂x² + c₃x⁴ …): the start of an odd series, for small |x|.
+    fn odd_series(&mut self, x: Op, c: &[f32]) -> Op {
+        let z = self.f("mul.f32", x, x);
+        let mut rev = c.iter().rev();
+        let mut p = Op::f32(rev.next().copied().unwrap_or(0.0));
+        for &k in rev {
+            p = self.fma(p, z, Op::f32(k));
+        }
+        let p = self.f("mul.f32", p, z);
+        self.fma(p, x, x)
     }
 
-    /// tanh x = sign(x)·(1 − 2/(e^{2|x|} + 1)), which tends to ±1 without overflow.
+    /// `series` where |x| < `limit`, else `other` (a formula that loses relative
+    /// accuracy near 0, where the first terms of the series are exact to f32).
+    fn near_zero(&mut self, x: Op, limit: f32, series: Op, other: Op) -> Op {
+        let a = self.un("abs.f32", Class::F32, x);
+        let small = self.setp("lt.f32", a, Op::f32(limit));
+        self.selp(super::types::Sc::F32, series, other, small)
+    }
+
+    /// sinh, cosh: E ± 1/(4E) with E = e^|x|/2 = e^(|x|/2)·e^(|x|/2)/2 (no overflow
+    /// before the result overflows); sinh by its series near 0.
+    pub fn sinh_cosh(&mut self, x: Op, cosh: bool) -> Op {
+        let a = self.un("abs.f32", Class::F32, x);
+        let h = self.f("mul.f32", a, Op::f32(0.5));
+        let e = self.exp(h);
+        let half = self.f("mul.f32", e, Op::f32(0.5));
+        let big = self.f("mul.f32", e, half);
+        let small = self.f(super::math::DIV, Op::f32(0.25), big);
+        if cosh {
+            return self.f("add.f32", big, small);
+        }
+        let d = self.f("sub.f32", big, small);
+        let r = self.f("copysign.f32", x, d);
+        let series = self.odd_series(x, &[1.0 / 6.0, 1.0 / 120.0, 1.0 / 5040.0]);
+        self.near_zero(x, 0.5, series, r)
+    }
+
+    /// tanh x = sign(x)·(1 − 2/(e^{2|x|} + 1)), which tends to ±1 without overflow;
+    /// its series near 0.
     pub fn tanh(&mut self, x: Op) -> Op {
         let a = self.un("abs.f32", Class::F32, x);
         let a2 = self.f("add.f32", a, a);
@@ -225,34 +263,51 @@ impl Fw<'_, '_> {
         let d = self.f("add.f32", e, Op::f32(1.0));
         let q = self.f(super::math::DIV, Op::f32(2.0), d);
         let r = self.f("sub.f32", Op::f32(1.0), q);
-        self.f("copysign.f32", x, r)
+        let r = self.f("copysign.f32", x, r);
+        let series = self.odd_series(x, &[-1.0 / 3.0, 2.0 / 15.0, -17.0 / 315.0]);
+        self.near_zero(x, 0.25, series, r)
     }
 
-    /// asinh x = sign(x)·ln(|x| + sqrt(x² + 1)).
+    /// asinh x = sign(x)·ln(|x| + sqrt(x² + 1)); ln|x| + ln 2 for |x| > 4096 (where x²
+    /// could overflow), the series near 0.
     pub fn asinh(&mut self, x: Op) -> Op {
         let a = self.un("abs.f32", Class::F32, x);
         let s = self.fma(a, a, Op::f32(1.0));
         let s = self.un(super::math::SQRT, Class::F32, s);
         let s = self.f("add.f32", a, s);
         let r = self.ln(s);
-        self.f("copysign.f32", x, r)
+        let r = self.log_of_double(a, r);
+        let r = self.f("copysign.f32", x, r);
+        let series = self.odd_series(x, &[-1.0 / 6.0, 3.0 / 40.0, -5.0 / 112.0]);
+        self.near_zero(x, 0.25, series, r)
     }
 
-    /// acosh x = ln(x + sqrt(x² − 1)).
+    /// ln(2a) = ln a + ln 2 where a > 4096, else `r`.
+    fn log_of_double(&mut self, a: Op, r: Op) -> Op {
+        let l = self.ln(a);
+        let l = self.f("add.f32", l, Op::f32(std::f32::consts::LN_2));
+        let big = self.setp("gt.f32", a, Op::f32(4096.0));
+        self.selp(super::types::Sc::F32, l, r, big)
+    }
+
+    /// acosh x = ln(x + sqrt(x² − 1)); ln x + ln 2 for x > 4096.
     pub fn acosh(&mut self, x: Op) -> Op {
         let s = self.fma(x, x, Op::f32(-1.0));
         let s = self.un(super::math::SQRT, Class::F32, s);
         let s = self.f("add.f32", x, s);
-        self.ln(s)
+        let r = self.ln(s);
+        self.log_of_double(x, r)
     }
 
-    /// atanh x = ln((1 + x)/(1 − x))/2.
+    /// atanh x = ln((1 + x)/(1 − x))/2; its series near 0.
     pub fn atanh(&mut self, x: Op) -> Op {
         let n = self.f("add.f32", Op::f32(1.0), x);
         let d = self.f("sub.f32", Op::f32(1.0), x);
         let q = self.f(super::math::DIV, n, d);
         let l = self.ln(q);
-        self.f("mul.f32", l, Op::f32(0.5))
+        let r = self.f("mul.f32", l, Op::f32(0.5));
+        let series = self.odd_series(x, &[1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0]);
+        self.near_zero(x, 0.15, series, r)
     }
 }
 

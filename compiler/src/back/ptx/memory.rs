@@ -82,7 +82,7 @@ impl Fw<'_, '_> {
             }
             Loc::VarElem { var, first, len, index } => {
                 let src = self.var_slice(var, first, len)?;
-                let sc = sc_of(src[0]);
+                let sc = src.first().map_or(Sc::F32, |&o| sc_of(o));
                 Ok(vec![self.select_index(sc, &src, index)])
             }
         }

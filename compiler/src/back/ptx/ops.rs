@@ -157,7 +157,7 @@ impl Fw<'_, '_> {
         let d = self.data(f, e)?;
         let fold = |s: &mut Self, ins: &str| {
             let mut acc = d.first().copied().unwrap_or(Op::Bool(false));
-            for &x in &d[1..] {
+            for &x in d.iter().skip(1) {
                 acc = s.bin(ins, Class::Pred, acc, x);
             }
             acc
@@ -242,7 +242,7 @@ impl Fw<'_, '_> {
     fn mat_vec(&mut self, m: &[Op], v: &[Op], cols: u32, rows: u32) -> Vec<Op> {
         (0..rows as usize)
             .map(|r| {
-                let terms: Vec<(Op, Op)> = (0..cols as usize).map(|c| (m[c * rows as usize + r], v[c])).collect();
+                let terms: Vec<(Op, Op)> = (0..cols as usize).map(|c| (at(m, c * rows as usize + r), at(v, c))).collect();
                 self.dot_terms(&terms)
             })
             .collect()
@@ -252,7 +252,7 @@ impl Fw<'_, '_> {
     fn vec_mat(&mut self, v: &[Op], m: &[Op], cols: u32, rows: u32) -> Vec<Op> {
         (0..cols as usize)
             .map(|c| {
-                let terms: Vec<(Op, Op)> = (0..rows as usize).map(|r| (v[r], m[c * rows as usize + r])).collect();
+                let terms: Vec<(Op, Op)> = (0..rows as usize).map(|r| (at(v, r), at(m, c * rows as usize + r))).collect();
                 self.dot_terms(&terms)
             })
             .collect()
@@ -264,7 +264,7 @@ impl Fw<'_, '_> {
         let mut out = Vec::with_capacity(cols as usize * rows);
         for c in 0..cols as usize {
             for r in 0..rows {
-                let terms: Vec<(Op, Op)> = (0..k).map(|i| (a[i * rows + r], b[c * k + i])).collect();
+                let terms: Vec<(Op, Op)> = (0..k).map(|i| (at(a, i * rows + r), at(b, c * k + i))).collect();
                 out.push(self.dot_terms(&terms));
             }
         }
@@ -280,6 +280,11 @@ impl Fw<'_, '_> {
         }
         acc
     }
+}
+
+/// Leaf `i` of a matrix or vector (zero past the end, which validation rules out).
+fn at(v: &[Op], i: usize) -> Op {
+    v.get(i).copied().unwrap_or(Op::F32(0))
 }
 
 fn one(sc: Sc) -> Op {

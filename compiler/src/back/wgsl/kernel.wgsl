@@ -1,7 +1,9 @@
-// sdfc renderer kernel: RENDERER.md as a WGSL compute shader, one invocation per pixel.
-// This file is a template: `//#if FEATURE` blocks are kept only when the scene uses the
-// feature, and a double-brace placeholder is replaced by a value (see template.rs). The CPU renderer
-// (runtime/src/cpu) implements the same algorithm; docs/rendering.md fixes the constants.
+//% sdfc renderer kernel template: RENDERER.md as a WGSL compute shader, one invocation per
+//% pixel. `//#if FEATURE` blocks are kept only when the scene uses the feature, a
+//% double-brace placeholder is replaced by a value, and `//%` lines (these) are dropped (see
+//% template.rs). The CPU renderer (runtime/src/cpu) implements the same algorithm;
+//% docs/rendering.md fixes the constants.
+{{HEADER}}
 
 //#if POINT
 struct PointLight {

@@ -4,7 +4,8 @@
 use std::collections::HashMap;
 
 /// Expands `template`: a line `//#if NAME` (or `//#if !NAME`) opens a block kept only when
-/// the feature is on (off); `//#else` and `//#endif` close it. Directive lines are dropped.
+/// the feature is on (off); `//#else` and `//#endif` close it. Directive lines and `//%`
+/// comments (about the template itself) are dropped.
 /// Returns an error naming the line of an unbalanced directive or an unknown placeholder.
 pub fn expand(
     template: &str,
@@ -36,7 +37,7 @@ pub fn expand(
             stack
                 .pop()
                 .ok_or_else(|| format!("line {}: `//#endif` without `//#if`", n + 1))?;
-        } else if live {
+        } else if live && !trimmed.starts_with("//%") {
             out.push_str(&substitute(line, values).map_err(|e| format!("line {}: {e}", n + 1))?);
             out.push('\n');
         }

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# Runs on the GPU machine (the `device` tool): renders every example at 1920x1080 with wgpu,
+# CUDA and the CPU, compares them, and times the report's six scenes on both GPU backends at
+# the report's resolutions with aa 1 and 4. Expects the sdfc binary at .dev/sdfc and the
+# Vulkan loader packages in .gl/. Writes logs and JSON under $OUT; prints a table last.
+set -u
+OUT=${OUT:-/tmp/out}
+mkdir -p "$OUT" /tmp/sdfc-img
+for f in .gl/*.deb; do dpkg -x "$f" /; done
+ldconfig
+if [ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]; then
+  export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+fi
+export SDFC_CACHE_DIR=/tmp/sdfc-jit
+B=./.dev/sdfc
+chmod +x "$B"
+nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv,noheader | tee "$OUT/gpu.txt"
+MODE=${1:-all}
+
+if [ "$MODE" = all ] || [ "$MODE" = check ]; then
+  echo "== conformance at 1920x1080 (psnr dB / differing %)" | tee "$OUT/conformance.txt"
+  for f in examples/*.sdf; do
+    n=$(basename "$f" .sdf)
+    for b in cpu wgpu cuda; do
+      "$B" render "$f" --backend "$b" --size 1920x1080 -o "/tmp/sdfc-img/$n-$b.png" --stats > "$OUT/render-$n-$b.txt" 2>&1 || echo "$n $b FAILED: $(tail -n 2 "$OUT/render-$n-$b.txt")"
+    done
+    wc=$("$B" compare "/tmp/sdfc-img/$n-wgpu.png" "/tmp/sdfc-img/$n-cpu.png" --json 2>&1)
+    cc=$("$B" compare "/tmp/sdfc-img/$n-cuda.png" "/tmp/sdfc-img/$n-cpu.png" --json 2>&1)
+    cw=$("$B" compare "/tmp/sdfc-img/$n-cuda.png" "/tmp/sdfc-img/$n-wgpu.png" --json 2>&1)
+    echo "$n wgpu-cpu $wc | cuda-cpu $cc | cuda-wgpu $cw" | tee -a "$OUT/conformance.txt"
+  done
+  cp /tmp/sdfc-img/seed3-cuda.png /tmp/sdfc-img/seed5-wgpu.png "$OUT/" 2>/dev/null
+  echo "== CUDA JIT: cold, then warm cache" | tee "$OUT/jit.txt"
+  rm -rf /tmp/sdfc-jit
+  for i in 1 2; do "$B" render examples/seed3.sdf --backend cuda --size 64x64 -o /tmp/j.png --stats 2>&1 | grep prepared | tee -a "$OUT/jit.txt"; done
+fi
+
+if [ "$MODE" = all ] || [ "$MODE" = bench ]; then
+  SEEDS="examples/seed1.sdf examples/seed2.sdf examples/seed3.sdf examples/seed4.sdf examples/seed5.sdf examples/seed6.sdf"
+  for size in 640x480 1024x768 1920x1080; do
+    for aa in 1 4; do
+      for b in wgpu cuda; do
+        "$B" bench $SEEDS --backend "$b" --size "$size" --aa "$aa" --frames 10 --json > "$OUT/bench-$b-$size-aa$aa.json" 2> "$OUT/bench-$b-$size-aa$aa.err" || echo "bench $b $size aa$aa FAILED: $(tail -n 3 "$OUT/bench-$b-$size-aa$aa.err")"
+      done
+    done
+  done
+  python3 - "$OUT" <<'PY'
+import json, sys, glob, os
+out = sys.argv[1]
+rows = {}
+for path in glob.glob(os.path.join(out, "bench-*.json")):
+    try:
+        data = json.load(open(path))
+    except Exception:
+        continue
+    for t in data:
+        key = (os.path.basename(t["scene"]), f'{t["width"]}x{t["height"]}', t["aa"])
+        rows.setdefault(key, {})[t["backend"]] = t["median_s"] * 1e3
+print(f'{"scene":<12}{"size":>10}{"aa":>4}{"wgpu ms":>10}{"cuda ms":>10}{"cuda/wgpu":>10}')
+for key in sorted(rows):
+    r = rows[key]
+    w, c = r.get("wgpu"), r.get("cuda")
+    ratio = f"{c / w:.2f}" if w and c else "-"
+    print(f'{key[0]:<12}{key[1]:>10}{key[2]:>4}{w if w is None else round(w, 2)!s:>10}{c if c is None else round(c, 2)!s:>10}{ratio:>10}')
+PY
+fi
+cat "$OUT/conformance.txt" 2>/dev/null | tail -n 12
+cat "$OUT/jit.txt" 2>/dev/null

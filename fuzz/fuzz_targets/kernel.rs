@@ -1,0 +1,20 @@
+//! Fuzz target: every scene the checker accepts must give a WGSL kernel that naga validates
+//! and PTX that the PTX writer produces without error.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use sdfc_compiler::back::{ptx, wgsl};
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let (Some(scene), _, _) = sdfc_compiler::check::check_str("fuzz.sdf", text) else { return };
+    let program = sdfc_compiler::lower::lower(&scene);
+    let kernel = match wgsl::write(&scene, &program) {
+        Ok(k) => k,
+        Err(e) => panic!("invalid kernel for an accepted scene: {e}"),
+    };
+    let options = ptx::Options { sm: 70, entry_point: wgsl::ENTRY_POINT.to_string() };
+    if let Err(e) = ptx::write(&kernel.module, &kernel.info, &options) {
+        panic!("PTX writer failed on a validated kernel: {e}");
+    }
+});

@@ -202,3 +202,98 @@ fn bench_prints_a_table_or_json() {
     assert!(runs[0]["stats"]["steps_mean"].as_f64().is_some());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+// ---- Failure paths (docs/failures.md lists each with its test) ----
+
+#[test]
+fn missing_unreadable_and_non_utf8_inputs_exit_2() {
+    let d = dir("inputs");
+    for args in [&["check", "nope.sdf"][..], &["render", "nope.sdf"], &["compile", "nope.sdf", "--emit", "ir"]] {
+        let out = sdfc(&d, args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read `nope.sdf`"));
+    }
+    std::fs::create_dir(d.join("folder.sdf")).expect("dir");
+    assert_eq!(sdfc(&d, &["check", "folder.sdf"]).status.code(), Some(2));
+    std::fs::write(d.join("latin1.sdf"), b"scene { sphere(); } // caf\xe9\n").expect("write");
+    let out = sdfc(&d, &["render", "latin1.sdf"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not valid UTF-8"));
+    assert_eq!(entries(&d), ["folder.sdf", "latin1.sdf"]);
+}
+
+#[test]
+fn an_unreadable_import_is_a_diagnostic() {
+    let d = dir("import");
+    std::fs::write(d.join("lib.sdf"), b"let r = 1; // caf\xe9\n").expect("write");
+    std::fs::write(d.join("main.sdf"), "import \"lib.sdf\";\nscene { sphere(r); }\n").expect("write");
+    let out = sdfc(&d, &["check", "main.sdf"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("E0501") && err.contains("not valid UTF-8"), "{err}");
+}
+
+#[test]
+fn a_missing_or_invalid_output_directory_leaves_nothing() {
+    let d = dir("outputs");
+    scene_file(&d);
+    std::fs::write(d.join("plain-file"), "x").expect("write");
+    for target in ["missing/out.png", "plain-file/out.png"] {
+        let out = sdfc(&d, &["render", "ball.sdf", "-o", target]);
+        assert_eq!(out.status.code(), Some(2), "{target}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("cannot write"), "{target}");
+    }
+    let out = sdfc(&d, &["compile", "ball.sdf", "--emit", "wgsl", "-o", "missing/k.wgsl"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(entries(&d), ["ball.sdf", "plain-file"]);
+}
+
+#[test]
+fn no_gpu_adapter_is_a_clear_error() {
+    let d = dir("adapter");
+    scene_file(&d);
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args(["render", "ball.sdf", "--backend", "wgpu"])
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .output()
+        .expect("run sdfc");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no wgpu adapter found") && err.contains("mesa-vulkan-drivers"), "{err}");
+    assert_eq!(entries(&d), ["ball.sdf"]);
+}
+
+#[test]
+fn no_cuda_driver_is_a_clear_error() {
+    let d = dir("cuda");
+    scene_file(&d);
+    let out = sdfc(&d, &["render", "ball.sdf", "--backend", "cuda"]);
+    if out.status.success() {
+        println!("SKIPPED: a CUDA driver and device are present here");
+        return;
+    }
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("CUDA"), "{err}");
+    assert_eq!(entries(&d), ["ball.sdf"]);
+}
+
+#[test]
+fn an_interrupt_stops_a_render_and_leaves_no_file() {
+    let d = dir("interrupt");
+    scene_file(&d);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args(["render", "ball.sdf", "--backend", "cpu", "--size", "4000x3000", "--aa", "4", "-o", "big.png"])
+        .spawn()
+        .expect("spawn");
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill");
+    assert!(killed.success());
+    let status = child.wait().expect("wait");
+    assert!(!status.success());
+    assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
+}

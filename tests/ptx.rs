@@ -3,12 +3,12 @@
 //! `ptxas` is on PATH, unless SDFC_REQUIRE_DEVICES=1). Set SDFC_PTX_OUT to a folder
 //! to keep the PTX files.
 
-use wgpu::naga;
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use sdfc_compiler::back::ptx::{self, Error, Options};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
+use wgpu::naga;
 
 /// A sphere tracer shaped like the project's renderer kernel.
 const SPHERE_TRACER: &str = r#"
@@ -420,7 +420,8 @@ fn parse(src: &str) -> (naga::Module, ModuleInfo) {
 }
 
 fn parse_strict(src: &str) -> (naga::Module, ModuleInfo) {
-    let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)));
+    let module =
+        naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)));
     let info = Validator::new(ValidationFlags::all(), Capabilities::empty())
         .validate(&module)
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)));
@@ -428,13 +429,19 @@ fn parse_strict(src: &str) -> (naga::Module, ModuleInfo) {
 }
 
 fn options(sm: u32) -> Options {
-    Options { sm, entry_point: "main".into() }
+    Options {
+        sm,
+        entry_point: "main".into(),
+    }
 }
 
 /// The `ptxas` on PATH, if any; a missing one fails the test under SDFC_REQUIRE_DEVICES=1.
 fn ptxas() -> Option<PathBuf> {
-    let found = std::env::var_os("PATH")
-        .and_then(|p| std::env::split_paths(&p).map(|d| d.join("ptxas")).find(|p| p.is_file()));
+    let found = std::env::var_os("PATH").and_then(|p| {
+        std::env::split_paths(&p)
+            .map(|d| d.join("ptxas"))
+            .find(|p| p.is_file())
+    });
     if found.is_none() {
         let required = std::env::var("SDFC_REQUIRE_DEVICES").is_ok_and(|v| v == "1");
         assert!(!required, "SDFC_REQUIRE_DEVICES=1 but no ptxas on PATH");
@@ -469,8 +476,13 @@ fn assemble(ptxas: &Path, text: &str, name: &str, sm: u32) -> String {
         .arg(&path)
         .output()
         .expect("ptxas runs");
-    let report = String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "ptxas rejected {name} for sm_{sm} ({}):\n{report}", path.display());
+    let report =
+        String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "ptxas rejected {name} for sm_{sm} ({}):\n{report}",
+        path.display()
+    );
     if std::env::var_os("SDFC_PTX_OUT").is_none() {
         let _ = std::fs::remove_file(&path);
     }
@@ -485,9 +497,17 @@ fn summary(report: &str) -> String {
     for line in report.lines().map(str::trim) {
         if let Some(f) = line.split("Function properties for ").nth(1) {
             function = f.to_string();
-        } else if line.contains("stack frame") && (function == "main" || !line.starts_with("0 bytes stack frame, 0 bytes spill stores, 0 bytes spill loads")) {
+        } else if line.contains("stack frame")
+            && (function == "main"
+                || !line
+                    .starts_with("0 bytes stack frame, 0 bytes spill stores, 0 bytes spill loads"))
+        {
             out.push(format!("{function}: {line}"));
-        } else if let Some(used) = line.split("info    : ").nth(1).filter(|l| l.starts_with("Used")) {
+        } else if let Some(used) = line
+            .split("info    : ")
+            .nth(1)
+            .filter(|l| l.starts_with("Used"))
+        {
             out.push(format!("{function}: {used}"));
         }
     }
@@ -500,11 +520,19 @@ fn check(name: &str, src: &str) {
     let ptxas = ptxas();
     for sm in [70, 80, 90] {
         let start = Instant::now();
-        let text = ptx::write(&module, &info, &options(sm)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let text =
+            ptx::write(&module, &info, &options(sm)).unwrap_or_else(|e| panic!("{name}: {e}"));
         let took = start.elapsed();
         assert!(text.contains(&format!(".target sm_{sm}")));
-        assert_eq!(text, ptx::write(&module, &info, &options(sm)).unwrap(), "{name}: output is not deterministic");
-        println!("{name} sm_{sm}: {} lines of PTX in {took:.2?}", text.lines().count());
+        assert_eq!(
+            text,
+            ptx::write(&module, &info, &options(sm)).unwrap(),
+            "{name}: output is not deterministic"
+        );
+        println!(
+            "{name} sm_{sm}: {} lines of PTX in {took:.2?}",
+            text.lines().count()
+        );
         if let Some(p) = &ptxas {
             println!("    {}", summary(&assemble(p, &text, name, sm)));
         }
@@ -534,9 +562,16 @@ fn sphere_tracer_shape() {
     assert!(text.contains(".address_size 64"));
     assert!(text.contains("workgroup size (8, 8, 1)"));
     // Three buffers, in binding order; `push` (it uses the private stack) is inlined.
-    assert!(text.contains("main_param_0") && text.contains("main_param_2") && !text.contains("main_param_3"));
+    assert!(
+        text.contains("main_param_0")
+            && text.contains("main_param_2")
+            && !text.contains("main_param_3")
+    );
     assert!(!text.contains("fn_push("));
-    assert!(text.contains(".local .align 16 .b8"), "the private stack lives in local memory");
+    assert!(
+        text.contains(".local .align 16 .b8"),
+        "the private stack lives in local memory"
+    );
     assert!(text.contains("__sdfc_trig_reduce"));
 }
 
@@ -554,14 +589,24 @@ fn unsupported_constructs_are_errors() {
 #[test]
 fn bad_options_are_errors() {
     let (module, info) = parse_strict(MATH);
-    let missing = Options { sm: 80, entry_point: "nope".into() };
-    assert_eq!(ptx::write(&module, &info, &missing), Err(Error::NoEntryPoint("nope".into())));
-    assert_eq!(ptx::write(&module, &info, &options(42)), Err(Error::Target(42)));
+    let missing = Options {
+        sm: 80,
+        entry_point: "nope".into(),
+    };
+    assert_eq!(
+        ptx::write(&module, &info, &missing),
+        Err(Error::NoEntryPoint("nope".into()))
+    );
+    assert_eq!(
+        ptx::write(&module, &info, &options(42)),
+        Err(Error::Target(42))
+    );
 }
 
 /// A `map` of a few thousand expressions, like a large scene's.
 fn big_kernel(n: usize) -> String {
-    let mut s = String::from("@group(0) @binding(0) var<storage, read_write> out: array<vec2<f32>>;\n");
+    let mut s =
+        String::from("@group(0) @binding(0) var<storage, read_write> out: array<vec2<f32>>;\n");
     s.push_str("fn map(p: vec3<f32>) -> vec2<f32> {\n    var d = length(p) - 1.0;\n");
     for i in 0..n {
         let c = i as f32 * 0.37;
@@ -572,7 +617,9 @@ fn big_kernel(n: usize) -> String {
         ));
     }
     s.push_str("    return vec2<f32>(d, 1.0);\n}\n");
-    s.push_str("@compute @workgroup_size(64)\nfn main(@builtin(global_invocation_id) g: vec3<u32>) {\n");
+    s.push_str(
+        "@compute @workgroup_size(64)\nfn main(@builtin(global_invocation_id) g: vec3<u32>) {\n",
+    );
     s.push_str("    out[g.x] = map(vec3<f32>(f32(g.x), 0.0, 1.0)) + map(vec3<f32>(0.0, f32(g.x), 1.0));\n}\n");
     s
 }
@@ -581,7 +628,11 @@ fn big_kernel(n: usize) -> String {
 fn generation_is_fast() {
     let src = big_kernel(300);
     let (module, info) = parse_strict(&src);
-    let exprs: usize = module.functions.iter().map(|(_, f)| f.expressions.len()).sum();
+    let exprs: usize = module
+        .functions
+        .iter()
+        .map(|(_, f)| f.expressions.len())
+        .sum();
     let mut best = std::time::Duration::MAX;
     let mut text = String::new();
     for _ in 0..5 {
@@ -589,7 +640,10 @@ fn generation_is_fast() {
         text = ptx::write(&module, &info, &options(80)).unwrap();
         best = best.min(start.elapsed());
     }
-    println!("{exprs} naga expressions -> {} lines of PTX in {best:.2?} (best of 5)", text.lines().count());
+    println!(
+        "{exprs} naga expressions -> {} lines of PTX in {best:.2?} (best of 5)",
+        text.lines().count()
+    );
     assert!(exprs > 3000, "the kernel has {exprs} expressions");
     // `map` is large and called twice: a .func, not two copies.
     assert!(text.contains(".func (.param .align 4 .b8 fn_map_retval[8]) fn_map("));
@@ -618,16 +672,29 @@ fn example_scenes_assemble() {
         let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         keep(&format!("scene_{name}.wgsl"), kernel.source.as_bytes());
-        keep(&format!("scene_{name}.uniforms"), &sdfc_compiler::back::wgsl::uniforms(&scene, 1.0));
+        keep(
+            &format!("scene_{name}.uniforms"),
+            &sdfc_compiler::back::wgsl::uniforms(&scene, 1.0),
+        );
         let start = Instant::now();
         let text = ptx::write(&kernel.module, &kernel.info, &options(80))
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let took = start.elapsed();
-        let exprs: usize = kernel.module.functions.iter().map(|(_, f)| f.expressions.len()).sum();
-        println!("{name}: {exprs} naga expressions, {} lines of PTX in {took:.2?}", text.lines().count());
+        let exprs: usize = kernel
+            .module
+            .functions
+            .iter()
+            .map(|(_, f)| f.expressions.len())
+            .sum();
+        println!(
+            "{name}: {exprs} naga expressions, {} lines of PTX in {took:.2?}",
+            text.lines().count()
+        );
         if let Some(p) = &ptxas {
-            println!("    {}", summary(&assemble(p, &text, &format!("scene_{name}"), 80)));
+            println!(
+                "    {}",
+                summary(&assemble(p, &text, &format!("scene_{name}"), 80))
+            );
         }
     }
 }
-

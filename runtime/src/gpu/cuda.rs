@@ -174,11 +174,13 @@ impl Cuda {
         let d_tiles = s.clone_htod(&table).map_err(driver("uploading the tiles"))?;
         let mut d_image = s.alloc_zeros::<f32>(pixels * 4).map_err(driver("allocating the image"))?;
         let mut d_stats = s.alloc_zeros::<u32>(pixels * stats_words as usize).map_err(driver("allocating the statistics"))?;
+        // Each launch is timed by its own pair of events, and the times are summed: the
+        // same measure as the wgpu path's per-pass timestamps (gaps between launches excluded).
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
-        let start = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
-        let end = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
-        start.record(s).map_err(driver("recording an event"))?;
+        let mut events = Vec::with_capacity(tiles.len());
         for (i, t) in tiles.iter().enumerate() {
+            let start = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
+            let end = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
             let tile_view = d_tiles.slice(4 * i..4 * i + 4);
             let cfg = LaunchConfig {
                 grid_dim: (t.2.div_ceil(workgroup), t.3.div_ceil(workgroup), 1),
@@ -187,17 +189,22 @@ impl Cuda {
             };
             let mut launch = s.launch_builder(&k.function);
             launch.arg(&d_uniforms).arg(&tile_view).arg(&mut d_image).arg(&mut d_stats);
+            start.record(s).map_err(driver("recording an event"))?;
             // SAFETY: the kernel's parameters are the four buffers in binding order, as the
             // PTX back end declares them; each buffer is as large as the kernel indexes.
             unsafe { launch.launch(cfg) }.map_err(driver("launching the kernel"))?;
+            end.record(s).map_err(driver("recording an event"))?;
+            events.push((start, end));
         }
-        end.record(s).map_err(driver("recording an event"))?;
         s.synchronize().map_err(driver("running the kernel"))?;
-        let ms = start.elapsed_ms(&end).map_err(driver("reading the timer"))?;
+        let mut ms = 0.0f64;
+        for (start, end) in &events {
+            ms += start.elapsed_ms(end).map_err(driver("reading the timer"))? as f64;
+        }
         let image = s.clone_dtoh(&d_image).map_err(driver("reading the image"))?;
         let stats = s.clone_dtoh(&d_stats).map_err(driver("reading the statistics"))?;
         let linear = image.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
-        Ok(Frame { linear, stats, gpu_time: Duration::from_secs_f64(ms as f64 / 1e3) })
+        Ok(Frame { linear, stats, gpu_time: Duration::from_secs_f64(ms / 1e3) })
     }
 }
 

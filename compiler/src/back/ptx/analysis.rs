@@ -33,7 +33,12 @@ enum Root {
 }
 
 impl Analysis {
-    pub fn new(module: &Module, info: &ModuleInfo, types: &Types, entry: usize) -> Result<Self, Error> {
+    pub fn new(
+        module: &Module,
+        info: &ModuleInfo,
+        types: &Types,
+        entry: usize,
+    ) -> Result<Self, Error> {
         let ep = &module.entry_points[entry];
         let nf = module.functions.len();
         let mut a = Analysis {
@@ -102,7 +107,12 @@ impl Analysis {
         }
         let mut marks = Vec::new();
         visit(&f.body, &mut |s| {
-            if let Statement::Call { function, arguments, .. } = s {
+            if let Statement::Call {
+                function,
+                arguments,
+                ..
+            } = s
+            {
                 let callee = &arg_dyn[function.index()];
                 for (i, a) in arguments.iter().enumerate() {
                     if callee.get(i).copied().unwrap_or(false) {
@@ -166,7 +176,10 @@ fn inlining(module: &Module, info: &ModuleInfo, reachable: &[bool], entry: &Func
         if !reachable[i] {
             continue;
         }
-        let inlined = callees[i].iter().filter(|c| inline[c.index()]).fold(0u64, |a, c| a.saturating_add(size[c.index()]));
+        let inlined = callees[i]
+            .iter()
+            .filter(|c| inline[c.index()])
+            .fold(0u64, |a, c| a.saturating_add(size[c.index()]));
         size[i] = (f.expressions.len() as u64).saturating_add(inlined);
         let forced = takes_pointer(module, f) || uses_private(module, &info[h]);
         let copies = copies[i].max(1);
@@ -177,15 +190,24 @@ fn inlining(module: &Module, info: &ModuleInfo, reachable: &[bool], entry: &Func
 
 /// Whether `Access { base, .. }` indexes an array or matrix behind a pointer (a vector
 /// in registers is indexed by selection instead).
-fn indexes_memory(types: &Types, fi: &FunctionInfo, base: Handle<Expression>) -> Result<bool, Error> {
+fn indexes_memory(
+    types: &Types,
+    fi: &FunctionInfo,
+    base: Handle<Expression>,
+) -> Result<bool, Error> {
     match types.resolve(&fi[base].ty)? {
-        Resolved::Pointer(ty) => Ok(matches!(types.shape(ty)?, Shape::Array { .. } | Shape::Matrix { .. })),
+        Resolved::Pointer(ty) => Ok(matches!(
+            types.shape(ty)?,
+            Shape::Array { .. } | Shape::Matrix { .. }
+        )),
         Resolved::Value(_) => Ok(false),
     }
 }
 
 fn takes_pointer(module: &Module, f: &Function) -> bool {
-    f.arguments.iter().any(|a| matches!(module.types[a.ty].inner, TypeInner::Pointer { .. }))
+    f.arguments
+        .iter()
+        .any(|a| matches!(module.types[a.ty].inner, TypeInner::Pointer { .. }))
 }
 
 fn uses_private(module: &Module, fi: &FunctionInfo) -> bool {
@@ -219,7 +241,9 @@ pub(super) fn visit(block: &Block, f: &mut impl FnMut(&Statement)) {
                     visit(&c.body, f);
                 }
             }
-            Statement::Loop { body, continuing, .. } => {
+            Statement::Loop {
+                body, continuing, ..
+            } => {
                 visit(body, f);
                 visit(continuing, f);
             }

@@ -131,7 +131,10 @@ impl Out {
         let start = self.text.len();
         let _ = self.text.write_fmt(args);
         if !self.text[start..].is_ascii() {
-            let tail: String = self.text[start..].chars().map(|c| if c.is_ascii() { c } else { '?' }).collect();
+            let tail: String = self.text[start..]
+                .chars()
+                .map(|c| if c.is_ascii() { c } else { '?' })
+                .collect();
             self.text.truncate(start);
             self.text.push_str(&tail);
         }
@@ -154,7 +157,11 @@ impl Out {
     pub fn local_array(&mut self, size: u32, what: &str) -> String {
         self.local_count += 1;
         let name = format!("__local{}_{what}", self.local_count);
-        let _ = writeln!(self.locals, "\t.local .align 16 .b8 {name}[{}];", size.max(1).next_multiple_of(16));
+        let _ = writeln!(
+            self.locals,
+            "\t.local .align 16 .b8 {name}[{}];",
+            size.max(1).next_multiple_of(16)
+        );
         name
     }
 
@@ -175,7 +182,9 @@ impl Out {
 
 /// `s` with every character outside ASCII (which PTX forbids) replaced by `?`.
 pub(super) fn ascii(s: &str) -> String {
-    s.chars().map(|c| if c.is_ascii() { c } else { '?' }).collect()
+    s.chars()
+        .map(|c| if c.is_ascii() { c } else { '?' })
+        .collect()
 }
 
 /// Writes one instruction: `ins!(out, "add.f32 {}, {}, {};", d, a, b)`.

@@ -32,18 +32,39 @@ impl<'a> Fw<'_, 'a> {
                 data(out)
             }
             E::Splat { size, value } => data(vec![self.scalar(f, value)?; size as usize]),
-            E::Swizzle { size, vector, pattern } => {
+            E::Swizzle {
+                size,
+                vector,
+                pattern,
+            } => {
                 let v = self.data(f, vector)?;
-                let pick = |c: &naga::SwizzleComponent| v.get(*c as usize).copied().ok_or_else(bad_swizzle);
-                data(pattern[..size as usize].iter().map(pick).collect::<Result<_, _>>()?)
+                let pick = |c: &naga::SwizzleComponent| {
+                    v.get(*c as usize).copied().ok_or_else(bad_swizzle)
+                };
+                data(
+                    pattern[..size as usize]
+                        .iter()
+                        .map(pick)
+                        .collect::<Result<_, _>>()?,
+                )
             }
             E::AccessIndex { base, index } => self.access_index(f, base, index),
             E::Access { base, index } => self.access(f, base, index),
-            E::FunctionArgument(i) => f.args.get(i as usize).cloned().ok_or_else(|| Error::Invalid("no such argument".into())),
+            E::FunctionArgument(i) => f
+                .args
+                .get(i as usize)
+                .cloned()
+                .ok_or_else(|| Error::Invalid("no such argument".into())),
             E::GlobalVariable(g) => self.global_ptr(g).map(Val::Ptr),
             E::LocalVariable(l) => {
-                let store = *f.locals.get(l.index()).ok_or_else(|| Error::Invalid("no such local".into()))?;
-                Ok(Val::Ptr(Ptr { loc: loc_of(store), ty: Ty::H(f.func.local_variables[l].ty) }))
+                let store = *f
+                    .locals
+                    .get(l.index())
+                    .ok_or_else(|| Error::Invalid("no such local".into()))?;
+                Ok(Val::Ptr(Ptr {
+                    loc: loc_of(store),
+                    ty: Ty::H(f.func.local_variables[l].ty),
+                }))
             }
             E::Load { pointer } => {
                 let p = self.ptr(f, pointer)?.clone();
@@ -51,10 +72,26 @@ impl<'a> Fw<'_, 'a> {
             }
             E::Unary { op, expr } => self.unary(f, op, expr).map(Val::Data),
             E::Binary { op, left, right } => self.binary(f, op, left, right).map(Val::Data),
-            E::Select { condition, accept, reject } => self.select(f, condition, accept, reject).map(Val::Data),
+            E::Select {
+                condition,
+                accept,
+                reject,
+            } => self.select(f, condition, accept, reject).map(Val::Data),
             E::Relational { fun, argument } => self.relational(f, fun, argument).map(Val::Data),
-            E::Math { fun, arg, arg1, arg2, arg3 } => self.math(f, fun, [Some(arg), arg1, arg2, arg3]).map(Val::Data),
-            E::As { expr, kind, convert } => self.convert(f, expr, kind, convert).map(Val::Data),
+            E::Math {
+                fun,
+                arg,
+                arg1,
+                arg2,
+                arg3,
+            } => self
+                .math(f, fun, [Some(arg), arg1, arg2, arg3])
+                .map(Val::Data),
+            E::As {
+                expr,
+                kind,
+                convert,
+            } => self.convert(f, expr, kind, convert).map(Val::Data),
             E::CallResult(_) => Err(Error::Invalid("a call result used before its call".into())),
             ref other => Err(Error::Unsupported(expression_name(other).into())),
         }
@@ -87,8 +124,13 @@ impl<'a> Fw<'_, 'a> {
                 [x] => Ok(vec![*x; size as usize]),
                 _ => Err(Error::Invalid("a splat of a non-scalar".into())),
             },
-            Expression::Override(_) => Err(Error::Unsupported("pipeline-overridable constants".into())),
-            ref other => Err(Error::Unsupported(format!("the constant expression {}", expression_name(other)))),
+            Expression::Override(_) => {
+                Err(Error::Unsupported("pipeline-overridable constants".into()))
+            }
+            ref other => Err(Error::Unsupported(format!(
+                "the constant expression {}",
+                expression_name(other)
+            ))),
         }
     }
 
@@ -113,7 +155,10 @@ impl<'a> Fw<'_, 'a> {
                 [x] => Ok(vec![*x; size as usize]),
                 _ => Err(Error::Invalid("a splat of a non-scalar".into())),
             },
-            ref other => Err(Error::Unsupported(format!("the initializer {}", expression_name(other)))),
+            ref other => Err(Error::Unsupported(format!(
+                "the initializer {}",
+                expression_name(other)
+            ))),
         }
     }
 
@@ -122,17 +167,33 @@ impl<'a> Fw<'_, 'a> {
         let gv = &self.cx.module.global_variables[g];
         let name = gv.name.as_deref().unwrap_or("?");
         match self.globals.get(g.index()).copied().flatten() {
-            Some(store) => Ok(Ptr { loc: loc_of(store), ty: Ty::H(gv.ty) }),
+            Some(store) => Ok(Ptr {
+                loc: loc_of(store),
+                ty: Ty::H(gv.ty),
+            }),
             None => Err(match gv.space {
-                AddressSpace::Handle => Error::Unsupported(format!("textures and samplers (global `{name}`)")),
-                AddressSpace::WorkGroup => Error::Unsupported(format!("var<workgroup> (global `{name}`)")),
-                AddressSpace::Immediate => Error::Unsupported(format!("immediate data (global `{name}`)")),
-                space => Error::Unsupported(format!("the address space {space:?} (global `{name}`)")),
+                AddressSpace::Handle => {
+                    Error::Unsupported(format!("textures and samplers (global `{name}`)"))
+                }
+                AddressSpace::WorkGroup => {
+                    Error::Unsupported(format!("var<workgroup> (global `{name}`)"))
+                }
+                AddressSpace::Immediate => {
+                    Error::Unsupported(format!("immediate data (global `{name}`)"))
+                }
+                space => {
+                    Error::Unsupported(format!("the address space {space:?} (global `{name}`)"))
+                }
             }),
         }
     }
 
-    fn access_index(&mut self, f: &Frame, base: Handle<Expression>, index: u32) -> Result<Val, Error> {
+    fn access_index(
+        &mut self,
+        f: &Frame,
+        base: Handle<Expression>,
+        index: u32,
+    ) -> Result<Val, Error> {
         if let Val::Ptr(p) = self.val(f, base)? {
             let p = p.clone();
             return self.ptr_index(&p, index).map(Val::Ptr);
@@ -150,20 +211,36 @@ impl<'a> Fw<'_, 'a> {
         let types = &self.cx.types;
         match types.shape(ty)? {
             Shape::Struct(h, members) => {
-                let m = members.get(i as usize).ok_or_else(|| Error::Invalid("no such member".into()))?;
-                Ok((types.member_first(h, i as usize), types.leaves(Ty::H(m.ty))?))
+                let m = members
+                    .get(i as usize)
+                    .ok_or_else(|| Error::Invalid("no such member".into()))?;
+                Ok((
+                    types.member_first(h, i as usize),
+                    types.leaves(Ty::H(m.ty))?,
+                ))
             }
-            Shape::Array { base, len: Some(len), .. } => {
+            Shape::Array {
+                base,
+                len: Some(len),
+                ..
+            } => {
                 let n = types.leaves(Ty::H(base))?;
                 Ok((i.min(len - 1) * n, n))
             }
             Shape::Vector(len, _) => Ok((i.min(len - 1), 1)),
             Shape::Matrix { cols, rows } => Ok((i.min(cols - 1) * rows, rows)),
-            _ => Err(Error::Invalid("an index into a scalar or runtime-sized value".into())),
+            _ => Err(Error::Invalid(
+                "an index into a scalar or runtime-sized value".into(),
+            )),
         }
     }
 
-    fn access(&mut self, f: &Frame, base: Handle<Expression>, index: Handle<Expression>) -> Result<Val, Error> {
+    fn access(
+        &mut self,
+        f: &Frame,
+        base: Handle<Expression>,
+        index: Handle<Expression>,
+    ) -> Result<Val, Error> {
         let i = self.scalar(f, index)?;
         if let Val::Ptr(p) = self.val(f, base)? {
             let p = p.clone();
@@ -176,10 +253,16 @@ impl<'a> Fw<'_, 'a> {
         }
         let ty = self.ty(f, base)?;
         let (elem, count) = match self.cx.types.shape(ty)? {
-            Shape::Array { base, len: Some(n), .. } => (Ty::H(base), n),
+            Shape::Array {
+                base, len: Some(n), ..
+            } => (Ty::H(base), n),
             Shape::Vector(n, sc) => (Ty::S(sc), n),
             Shape::Matrix { cols, rows } => (Ty::V(rows, Sc::F32), cols),
-            _ => return Err(Error::Invalid("a run-time index into a scalar or struct".into())),
+            _ => {
+                return Err(Error::Invalid(
+                    "a run-time index into a scalar or struct".into(),
+                ))
+            }
         };
         let mut scs = Vec::new();
         self.cx.types.scalars(elem, &mut scs)?;
@@ -187,7 +270,9 @@ impl<'a> Fw<'_, 'a> {
         let n = scs.len();
         let mut out = Vec::with_capacity(n);
         for (j, &sc) in scs.iter().enumerate() {
-            let column: Vec<Op> = (0..count as usize).filter_map(|k| d.get(k * n + j).copied()).collect();
+            let column: Vec<Op> = (0..count as usize)
+                .filter_map(|k| d.get(k * n + j).copied())
+                .collect();
             out.push(self.select_index(sc, &column, i));
         }
         Ok(Val::Data(out))
@@ -198,7 +283,11 @@ impl<'a> Fw<'_, 'a> {
 pub(super) fn loc_of(store: Store) -> Loc {
     match store {
         Store::Regs(var) => Loc::Var { var, first: 0 },
-        Store::Mem(space, base) => Loc::Mem { space, base, offset: 0 },
+        Store::Mem(space, base) => Loc::Mem {
+            space,
+            base,
+            offset: 0,
+        },
     }
 }
 
@@ -209,7 +298,9 @@ pub(super) fn literal(l: Literal) -> Result<Op, Error> {
         Literal::I32(x) => Ok(Op::I32(x)),
         Literal::U32(x) => Ok(Op::U32(x)),
         Literal::Bool(b) => Ok(Op::Bool(b)),
-        other => Err(Error::Unsupported(format!("the literal {other:?} (only f32, i32, u32 and bool)"))),
+        other => Err(Error::Unsupported(format!(
+            "the literal {other:?} (only f32, i32, u32 and bool)"
+        ))),
     }
 }
 
@@ -227,11 +318,13 @@ pub(super) fn expression_name(e: &Expression) -> &'static str {
         E::ImageQuery { .. } => "texture queries (Expression::ImageQuery)",
         E::Derivative { .. } => "derivatives (Expression::Derivative)",
         E::AtomicResult { .. } => "atomics (Expression::AtomicResult)",
-        E::WorkGroupUniformLoadResult { .. } => "workgroupUniformLoad (Expression::WorkGroupUniformLoadResult)",
-        E::ArrayLength(_) => "arrayLength (Expression::ArrayLength)",
-        E::RayQueryVertexPositions { .. } | E::RayQueryProceedResult | E::RayQueryGetIntersection { .. } => {
-            "ray queries"
+        E::WorkGroupUniformLoadResult { .. } => {
+            "workgroupUniformLoad (Expression::WorkGroupUniformLoadResult)"
         }
+        E::ArrayLength(_) => "arrayLength (Expression::ArrayLength)",
+        E::RayQueryVertexPositions { .. }
+        | E::RayQueryProceedResult
+        | E::RayQueryGetIntersection { .. } => "ray queries",
         E::SubgroupBallotResult | E::SubgroupOperationResult { .. } => "subgroup operations",
         E::CooperativeLoad { .. } | E::CooperativeMultiplyAdd { .. } => "cooperative matrices",
         _ => "this expression",

@@ -6,7 +6,9 @@ use super::emit::{ins, Class, Op, Reg};
 use super::types::{Sc, Ty};
 use super::writer::{Cx, Frame, Fw, Ret, Space, Store, Val};
 use super::Error;
-use naga::{AddressSpace, Binding, BuiltIn, EntryPoint, Expression, Function, GlobalVariable, Handle};
+use naga::{
+    AddressSpace, Binding, BuiltIn, EntryPoint, Expression, Function, GlobalVariable, Handle,
+};
 use std::fmt::Write;
 
 /// Whether a global variable is read-only for the whole kernel.
@@ -20,7 +22,11 @@ fn read_only(g: &GlobalVariable) -> bool {
 
 /// The PTX type of one leaf in a parameter (booleans travel as `b32`).
 fn param_ty(sc: Sc) -> &'static str {
-    if sc == Sc::F32 { "f32" } else { "b32" }
+    if sc == Sc::F32 {
+        "f32"
+    } else {
+        "b32"
+    }
 }
 
 impl<'c, 'a> Fw<'c, 'a> {
@@ -28,14 +34,19 @@ impl<'c, 'a> Fw<'c, 'a> {
     pub fn run(&mut self, f: &mut Frame<'a>, mem_locals: &[bool]) -> Result<(), Error> {
         let name = f.name.clone();
         self.out.comment(format_args!("fn {name}"));
-        self.run_body(f, mem_locals).map_err(|e| e.in_function(&name))
+        self.run_body(f, mem_locals)
+            .map_err(|e| e.in_function(&name))
     }
 
     fn run_body(&mut self, f: &mut Frame<'a>, mem_locals: &[bool]) -> Result<(), Error> {
         let func = f.func;
         for (h, lv) in func.local_variables.iter() {
             let name = lv.name.as_deref().unwrap_or("local");
-            let store = self.alloc(Ty::H(lv.ty), mem_locals.get(h.index()).copied().unwrap_or(false), name)?;
+            let store = self.alloc(
+                Ty::H(lv.ty),
+                mem_locals.get(h.index()).copied().unwrap_or(false),
+                name,
+            )?;
             f.locals.push(store);
         }
         let emitted = super::analysis::emitted(func);
@@ -72,12 +83,18 @@ impl<'c, 'a> Fw<'c, 'a> {
     /// Gives a variable its first value.
     fn init(&mut self, store: Store, ty: Ty, value: &[Op]) -> Result<(), Error> {
         if let Store::Mem(space, base) = store {
-            if value.iter().all(|o| matches!(o, Op::F32(0) | Op::I32(0) | Op::U32(0) | Op::Bool(false))) {
+            if value
+                .iter()
+                .all(|o| matches!(o, Op::F32(0) | Op::I32(0) | Op::U32(0) | Op::Bool(false)))
+            {
                 self.zero_fill(space, base, self.cx.types.size(ty));
                 return Ok(());
             }
         }
-        let p = super::writer::Ptr { loc: super::expr::loc_of(store), ty };
+        let p = super::writer::Ptr {
+            loc: super::expr::loc_of(store),
+            ty,
+        };
         self.store(&p, value)
     }
 
@@ -88,7 +105,11 @@ impl<'c, 'a> Fw<'c, 'a> {
         let sp = space.st();
         if words <= 8 {
             for i in 0..words {
-                ins!(self.out, "st.{sp}.v4.u32 [{base}+{}], {{0, 0, 0, 0}};", 16 * i);
+                ins!(
+                    self.out,
+                    "st.{sp}.v4.u32 [{base}+{}], {{0, 0, 0, 0}};",
+                    16 * i
+                );
             }
             return;
         }
@@ -121,7 +142,11 @@ impl<'c, 'a> Fw<'c, 'a> {
 
     /// Loads a leaf of `sc` from a parameter address (`[name+offset]`).
     fn load_param(&mut self, sc: Sc, addr: &str) -> Op {
-        let d = self.out.reg(if sc == Sc::F32 { Class::F32 } else { Class::B32 });
+        let d = self.out.reg(if sc == Sc::F32 {
+            Class::F32
+        } else {
+            Class::B32
+        });
         ins!(self.out, "ld.param.{} {d}, {addr};", param_ty(sc));
         if sc == Sc::Bool {
             return self.setp("ne.b32", Op::Reg(d), Op::U32(0));
@@ -137,9 +162,24 @@ impl<'c, 'a> Fw<'c, 'a> {
         args: &[Handle<Expression>],
         result: Option<Handle<Expression>>,
     ) -> Result<(), Error> {
-        let name = self.cx.names.get(callee.index()).cloned().unwrap_or_default();
-        let values: Vec<Val> = args.iter().map(|&a| self.val(f, a).cloned()).collect::<Result<_, _>>()?;
-        let v = if self.cx.an.inline.get(callee.index()).copied().unwrap_or(false) {
+        let name = self
+            .cx
+            .names
+            .get(callee.index())
+            .cloned()
+            .unwrap_or_default();
+        let values: Vec<Val> = args
+            .iter()
+            .map(|&a| self.val(f, a).cloned())
+            .collect::<Result<_, _>>()?;
+        let v = if self
+            .cx
+            .an
+            .inline
+            .get(callee.index())
+            .copied()
+            .unwrap_or(false)
+        {
             self.out.comment(format_args!("inlined call of {name}"));
             self.inline(callee, values)?
         } else {
@@ -154,7 +194,11 @@ impl<'c, 'a> Fw<'c, 'a> {
         Ok(())
     }
 
-    fn inline(&mut self, callee: Handle<Function>, args: Vec<Val>) -> Result<Option<Vec<Op>>, Error> {
+    fn inline(
+        &mut self,
+        callee: Handle<Function>,
+        args: Vec<Val>,
+    ) -> Result<Option<Vec<Op>>, Error> {
         let cx = self.cx;
         let func = &cx.module.functions[callee];
         let var = match &func.result {
@@ -167,14 +211,33 @@ impl<'c, 'a> Fw<'c, 'a> {
         };
         let end = self.out.label("inline_end");
         let name = func.name.clone().unwrap_or_default();
-        let mut frame = Frame::new(func, &cx.info[callee], name, args, Ret::Inline { var, end: end.clone() });
-        let mem = cx.an.mem_locals.get(callee.index()).cloned().unwrap_or_default();
+        let mut frame = Frame::new(
+            func,
+            &cx.info[callee],
+            name,
+            args,
+            Ret::Inline {
+                var,
+                end: end.clone(),
+            },
+        );
+        let mem = cx
+            .an
+            .mem_locals
+            .get(callee.index())
+            .cloned()
+            .unwrap_or_default();
         self.run(&mut frame, &mem)?;
         self.out.place(&end);
         Ok(var.and_then(|v| self.vars.get(v).cloned()))
     }
 
-    fn call_func(&mut self, callee: Handle<Function>, name: &str, args: &[Val]) -> Result<Option<Vec<Op>>, Error> {
+    fn call_func(
+        &mut self,
+        callee: Handle<Function>,
+        name: &str,
+        args: &[Val],
+    ) -> Result<Option<Vec<Op>>, Error> {
         let cx = self.cx;
         let func = &cx.module.functions[callee];
         self.out.raw("\t{\n");
@@ -190,7 +253,9 @@ impl<'c, 'a> Fw<'c, 'a> {
             params.push(p);
         }
         for a in args {
-            let Val::Data(d) = a else { return Err(Error::Invalid("a pointer argument to a .func".into())) };
+            let Val::Data(d) = a else {
+                return Err(Error::Invalid("a pointer argument to a .func".into()));
+            };
             for &x in d {
                 let x = self.param_leaf(x);
                 let p = format!("param{}", params.len());
@@ -205,7 +270,11 @@ impl<'c, 'a> Fw<'c, 'a> {
             Some(r) => {
                 let mut scs = Vec::new();
                 cx.types.scalars(Ty::H(r.ty), &mut scs)?;
-                ins!(self.out, ".param .align 4 .b8 retval0[{}];", 4 * scs.len().max(1));
+                ins!(
+                    self.out,
+                    ".param .align 4 .b8 retval0[{}];",
+                    4 * scs.len().max(1)
+                );
                 result = Some(scs);
                 "(retval0), "
             }
@@ -213,7 +282,10 @@ impl<'c, 'a> Fw<'c, 'a> {
         };
         ins!(self.out, "call {ret}{name}, ({});", params.join(", "));
         let v = result.map(|scs| {
-            scs.iter().enumerate().map(|(i, &sc)| self.load_param(sc, &format!("[retval0+{}]", 4 * i))).collect()
+            scs.iter()
+                .enumerate()
+                .map(|(i, &sc)| self.load_param(sc, &format!("[retval0+{}]", 4 * i)))
+                .collect()
         });
         self.out.raw("\t}\n");
         Ok(v)
@@ -223,7 +295,11 @@ impl<'c, 'a> Fw<'c, 'a> {
 /// The buffers a function reads or writes (its hidden leading parameters).
 fn buffers_used(cx: &Cx, h: Handle<Function>) -> Vec<Handle<GlobalVariable>> {
     let fi = &cx.info[h];
-    cx.buffers.iter().copied().filter(|&g| !fi[g].is_empty()).collect()
+    cx.buffers
+        .iter()
+        .copied()
+        .filter(|&g| !fi[g].is_empty())
+        .collect()
 }
 
 /// Results of statements, which get their values when the statement runs.
@@ -249,7 +325,15 @@ fn is_f32(x: Op) -> bool {
 
 /// `name` with every character PTX does not allow in an identifier replaced by `_`.
 pub(super) fn ident(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect()
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// A `.func` for naga function `h`.
@@ -262,7 +346,11 @@ pub(super) fn write_func(cx: &Cx, h: Handle<Function>) -> Result<String, Error> 
         let p = format!("{name}_param_{}", params.len());
         let base = fw.out.reg(Class::B64);
         ins!(fw.out, "ld.param.b64 {base}, [{p}];");
-        let space = if read_only(&cx.module.global_variables[g]) { Space::GlobalRo } else { Space::Global };
+        let space = if read_only(&cx.module.global_variables[g]) {
+            Space::GlobalRo
+        } else {
+            Space::Global
+        };
         fw.globals[g.index()] = Some(Store::Mem(space, base));
         params.push(format!(".param .b64 {p}"));
     }
@@ -282,9 +370,17 @@ pub(super) fn write_func(cx: &Cx, h: Handle<Function>) -> Result<String, Error> 
         Some(r) => {
             let param = format!("{name}_retval");
             let n = cx.types.leaves(Ty::H(r.ty))?;
-            (format!("(.param .align 4 .b8 {param}[{}]) ", 4 * n.max(1)), Ret::Func { param })
+            (
+                format!("(.param .align 4 .b8 {param}[{}]) ", 4 * n.max(1)),
+                Ret::Func { param },
+            )
         }
-        None => (String::new(), Ret::Func { param: String::new() }),
+        None => (
+            String::new(),
+            Ret::Func {
+                param: String::new(),
+            },
+        ),
     };
     let fname = func.name.clone().unwrap_or_default();
     let mut frame = Frame::new(func, &cx.info[h], fname.clone(), args, ret);
@@ -293,7 +389,10 @@ pub(super) fn write_func(cx: &Cx, h: Handle<Function>) -> Result<String, Error> 
     if !ends_in_return(&func.body) {
         ins!(fw.out, "ret;");
     }
-    let mut s = format!("// fn {}\n.func {ret_decl}{name}(", super::emit::ascii(&fname));
+    let mut s = format!(
+        "// fn {}\n.func {ret_decl}{name}(",
+        super::emit::ascii(&fname)
+    );
     s.push_str(&params.join(", "));
     s.push_str(")\n{\n");
     s.push_str(&fw.out.finish());
@@ -317,7 +416,11 @@ pub(super) fn write_kernel(cx: &Cx, ep: &EntryPoint, index: usize) -> Result<Str
         let base = fw.out.reg(Class::B64);
         ins!(fw.out, "ld.param.u64 {raw}, [{p}];");
         ins!(fw.out, "cvta.to.global.u64 {base}, {raw};");
-        let space = if read_only(&cx.module.global_variables[g]) { Space::GlobalRo } else { Space::Global };
+        let space = if read_only(&cx.module.global_variables[g]) {
+            Space::GlobalRo
+        } else {
+            Space::Global
+        };
         fw.globals[g.index()] = Some(Store::Mem(space, base));
     }
     fw.privates(info)?;
@@ -334,8 +437,15 @@ pub(super) fn write_kernel(cx: &Cx, ep: &EntryPoint, index: usize) -> Result<Str
     let mut s = String::new();
     // No .reqntid: ptxas reads a small block as a call for many blocks per SM and caps
     // the registers (spilling); the launch uses the workgroup size as the block.
-    let _ = writeln!(s, "// entry point {name}, workgroup size ({x}, {y}, {z}): launch with this block");
-    let _ = write!(s, ".visible .entry {name}(\n\t{}\n)\n{{\n", params.join(",\n\t"));
+    let _ = writeln!(
+        s,
+        "// entry point {name}, workgroup size ({x}, {y}, {z}): launch with this block"
+    );
+    let _ = write!(
+        s,
+        ".visible .entry {name}(\n\t{}\n)\n{{\n",
+        params.join(",\n\t")
+    );
     s.push_str(&fw.out.finish());
     s.push_str("}\n");
     Ok(s)
@@ -351,7 +461,11 @@ impl Fw<'_, '_> {
             }
             let ty = Ty::H(gv.ty);
             let name = gv.name.as_deref().unwrap_or("private");
-            let store = self.alloc(ty, cx.an.mem_privates.get(g.index()).copied().unwrap_or(false), name)?;
+            let store = self.alloc(
+                ty,
+                cx.an.mem_privates.get(g.index()).copied().unwrap_or(false),
+                name,
+            )?;
             let value = match gv.init {
                 Some(init) => self.global_expr(init)?,
                 None => cx.types.zeros(ty)?,
@@ -363,10 +477,16 @@ impl Fw<'_, '_> {
     }
 
     /// The value of a kernel input: a built-in, or a struct of built-ins.
-    fn input(&mut self, binding: Option<&Binding>, ty: Handle<naga::Type>) -> Result<Vec<Op>, Error> {
+    fn input(
+        &mut self,
+        binding: Option<&Binding>,
+        ty: Handle<naga::Type>,
+    ) -> Result<Vec<Op>, Error> {
         match binding {
             Some(Binding::BuiltIn(b)) => self.builtin(*b),
-            Some(Binding::Location { .. }) => Err(Error::Unsupported("location inputs to a compute shader".into())),
+            Some(Binding::Location { .. }) => Err(Error::Unsupported(
+                "location inputs to a compute shader".into(),
+            )),
             None => match &self.cx.module.types[ty].inner {
                 naga::TypeInner::Struct { members, .. } => {
                     let mut out = Vec::new();
@@ -389,9 +509,18 @@ impl Fw<'_, '_> {
     fn builtin(&mut self, b: BuiltIn) -> Result<Vec<Op>, Error> {
         let xyz = ["x", "y", "z"];
         Ok(match b {
-            BuiltIn::LocalInvocationId => xyz.iter().map(|c| self.special(&format!("%tid.{c}"))).collect(),
-            BuiltIn::WorkGroupId => xyz.iter().map(|c| self.special(&format!("%ctaid.{c}"))).collect(),
-            BuiltIn::NumWorkGroups => xyz.iter().map(|c| self.special(&format!("%nctaid.{c}"))).collect(),
+            BuiltIn::LocalInvocationId => xyz
+                .iter()
+                .map(|c| self.special(&format!("%tid.{c}")))
+                .collect(),
+            BuiltIn::WorkGroupId => xyz
+                .iter()
+                .map(|c| self.special(&format!("%ctaid.{c}")))
+                .collect(),
+            BuiltIn::NumWorkGroups => xyz
+                .iter()
+                .map(|c| self.special(&format!("%nctaid.{c}")))
+                .collect(),
             BuiltIn::GlobalInvocationId => {
                 let mut out = Vec::with_capacity(3);
                 for c in xyz {
@@ -403,7 +532,11 @@ impl Fw<'_, '_> {
                 out
             }
             BuiltIn::LocalInvocationIndex => {
-                let (x, y, z) = (self.special("%tid.x"), self.special("%tid.y"), self.special("%tid.z"));
+                let (x, y, z) = (
+                    self.special("%tid.x"),
+                    self.special("%tid.y"),
+                    self.special("%tid.z"),
+                );
                 let (nx, ny) = (self.special("%ntid.x"), self.special("%ntid.y"));
                 let zy = self.tri("mad.lo.u32", Class::B32, z, ny, y);
                 vec![self.tri("mad.lo.u32", Class::B32, zy, nx, x)]

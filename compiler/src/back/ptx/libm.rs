@@ -112,7 +112,15 @@ impl Fw<'_, '_> {
         let y0 = self.selp(F32, Op::f32(FRAC_PI_4), Op::f32(0.0), mid);
         let y0 = self.selp(F32, Op::f32(FRAC_PI_2), y0, big);
         let z = self.f("mul.f32", u, u);
-        let p = self.horner(z, &[8.053_744_5e-2, -1.387_768_6e-1, 1.997_771_1e-1, -3.333_295e-1]);
+        let p = self.horner(
+            z,
+            &[
+                8.053_744_5e-2,
+                -1.387_768_6e-1,
+                1.997_771_1e-1,
+                -3.333_295e-1,
+            ],
+        );
         let p = self.f("mul.f32", p, z);
         let k = self.fma(p, u, u);
         self.f("add.f32", y0, k)
@@ -160,7 +168,16 @@ impl Fw<'_, '_> {
         let a2 = self.f("mul.f32", a, a);
         let z = self.selp(F32, zb, a2, big);
         let s = self.selp(F32, sb, a, big);
-        let p = self.horner(z, &[4.216_32e-2, 2.418_131e-2, 4.547_002_6e-2, 7.495_300_3e-2, 1.666_675_2e-1]);
+        let p = self.horner(
+            z,
+            &[
+                4.216_32e-2,
+                2.418_131e-2,
+                4.547_002_6e-2,
+                7.495_300_3e-2,
+                1.666_675_2e-1,
+            ],
+        );
         let p = self.f("mul.f32", p, z);
         (self.fma(p, s, s), big)
     }
@@ -315,7 +332,14 @@ impl Fw<'_, '_> {
 /// times 192 bits of 2/π, the two integer bits and 62 fraction bits around the binary
 /// point, the fraction times π/2 in f64. Returns (r: f32 at 0, q: s32 at 4).
 pub(super) fn trig_reduce_func() -> String {
-    const TWO_OVER_PI: [u32; 6] = [0x3C43_9041, 0xDB62_9599, 0xF534_DDC0, 0xFC27_57D1, 0x4E44_1529, 0xA2F9_836E];
+    const TWO_OVER_PI: [u32; 6] = [
+        0x3C43_9041,
+        0xDB62_9599,
+        0xF534_DDC0,
+        0xFC27_57D1,
+        0x4E44_1529,
+        0xA2F9_836E,
+    ];
     let mut s = String::new();
     s.push_str(&format!(
         "// x = r + q*pi/2 for |x| > 105615 (Payne-Hanek, exact).\n\

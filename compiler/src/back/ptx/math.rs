@@ -17,8 +17,14 @@ pub(super) const DIV: &str = "div.full.f32";
 pub(super) const SQRT: &str = "sqrt.approx.f32";
 
 impl Fw<'_, '_> {
-    pub fn math(&mut self, f: &Frame, fun: M, args: [Option<Handle<Expression>>; 4]) -> Result<Vec<Op>, Error> {
-        let first = args[0].ok_or_else(|| Error::Invalid("a math function without arguments".into()))?;
+    pub fn math(
+        &mut self,
+        f: &Frame,
+        fun: M,
+        args: [Option<Handle<Expression>>; 4],
+    ) -> Result<Vec<Op>, Error> {
+        let first =
+            args[0].ok_or_else(|| Error::Invalid("a math function without arguments".into()))?;
         let ty = self.ty(f, first)?;
         if let Shape::Matrix { cols, rows } = self.cx.types.shape(ty)? {
             return self.matrix_math(f, fun, first, cols, rows);
@@ -29,9 +35,14 @@ impl Fw<'_, '_> {
             ops.push(self.data(f, *a)?.to_vec());
         }
         match fun {
-            M::Dot | M::Cross | M::Length | M::Distance | M::Normalize | M::FaceForward | M::Reflect | M::Refract => {
-                self.geometry(fun, sc, &ops)
-            }
+            M::Dot
+            | M::Cross
+            | M::Length
+            | M::Distance
+            | M::Normalize
+            | M::FaceForward
+            | M::Reflect
+            | M::Refract => self.geometry(fun, sc, &ops),
             _ => self.componentwise(fun, sc, &ops),
         }
     }
@@ -44,14 +55,27 @@ impl Fw<'_, '_> {
         let n = ops.iter().map(Vec::len).max().unwrap_or(0);
         let mut out = Vec::with_capacity(n);
         for i in 0..n {
-            let a: Vec<Op> = ops.iter().map(|v| if v.len() == 1 { v[0] } else { v.get(i).copied().unwrap_or(v[0]) }).collect();
+            let a: Vec<Op> = ops
+                .iter()
+                .map(|v| {
+                    if v.len() == 1 {
+                        v[0]
+                    } else {
+                        v.get(i).copied().unwrap_or(v[0])
+                    }
+                })
+                .collect();
             out.push(self.scalar_math(fun, sc, &a)?);
         }
         Ok(out)
     }
 
     fn scalar_math(&mut self, fun: M, sc: Sc, a: &[Op]) -> Result<Op, Error> {
-        let arg = |i: usize| a.get(i).copied().ok_or_else(|| Error::Invalid(format!("{fun:?} lacks an argument")));
+        let arg = |i: usize| {
+            a.get(i)
+                .copied()
+                .ok_or_else(|| Error::Invalid(format!("{fun:?} lacks an argument")))
+        };
         let x = arg(0)?;
         let fl = |s: &mut Self, op: &str| s.un(op, Class::F32, x);
         Ok(match (fun, sc) {
@@ -136,7 +160,11 @@ impl Fw<'_, '_> {
             }
             (M::FirstLeadingBit, Sc::I32) => self.un("bfind.s32", Class::B32, x),
             (M::FirstLeadingBit, Sc::U32) => self.un("bfind.u32", Class::B32, x),
-            _ => return Err(Error::Unsupported(format!("the math function {fun:?} on {sc:?}"))),
+            _ => {
+                return Err(Error::Unsupported(format!(
+                    "the math function {fun:?} on {sc:?}"
+                )))
+            }
         })
     }
 
@@ -161,20 +189,29 @@ impl Fw<'_, '_> {
 
     /// Functions of whole vectors.
     fn geometry(&mut self, fun: M, sc: Sc, ops: &[Vec<Op>]) -> Result<Vec<Op>, Error> {
-        let v = |i: usize| ops.get(i).ok_or_else(|| Error::Invalid(format!("{fun:?} lacks an argument")));
+        let v = |i: usize| {
+            ops.get(i)
+                .ok_or_else(|| Error::Invalid(format!("{fun:?} lacks an argument")))
+        };
         let a = v(0)?;
         Ok(match fun {
             M::Dot => vec![self.dot(sc, a, v(1)?)],
             M::Cross => self.cross(a, v(1)?)?,
             M::Length => vec![self.length(a)],
             M::Distance => {
-                let d: Vec<Op> = a.iter().zip(v(1)?).map(|(&x, &y)| self.bin("sub.f32", Class::F32, x, y)).collect();
+                let d: Vec<Op> = a
+                    .iter()
+                    .zip(v(1)?)
+                    .map(|(&x, &y)| self.bin("sub.f32", Class::F32, x, y))
+                    .collect();
                 vec![self.length(&d)]
             }
             M::Normalize => {
                 let d = self.dot(Sc::F32, a, a);
                 let r = self.un("rsqrt.approx.f32", Class::F32, d);
-                a.iter().map(|&x| self.bin("mul.f32", Class::F32, x, r)).collect()
+                a.iter()
+                    .map(|&x| self.bin("mul.f32", Class::F32, x, r))
+                    .collect()
             }
             M::FaceForward => {
                 let d = self.dot(Sc::F32, v(1)?, v(2)?);
@@ -191,7 +228,10 @@ impl Fw<'_, '_> {
                 let n = v(1)?;
                 let d = self.dot(Sc::F32, n, a);
                 let k = self.bin("mul.f32", Class::F32, d, Op::f32(-2.0));
-                a.iter().zip(n).map(|(&x, &y)| self.tri("fma.rn.f32", Class::F32, k, y, x)).collect()
+                a.iter()
+                    .zip(n)
+                    .map(|(&x, &y)| self.tri("fma.rn.f32", Class::F32, k, y, x))
+                    .collect()
             }
             M::Refract => self.refract(a, v(1)?, v(2)?)?,
             _ => return Err(Error::Unsupported(format!("the math function {fun:?}"))),
@@ -226,13 +266,19 @@ impl Fw<'_, '_> {
             let nm = self.un("neg.f32", Class::F32, m);
             self.tri("fma.rn.f32", Class::F32, p, q, nm)
         };
-        Ok(vec![c(ay, bz, az, by), c(az, bx, ax, bz), c(ax, by, ay, bx)])
+        Ok(vec![
+            c(ay, bz, az, by),
+            c(az, bx, ax, bz),
+            c(ax, by, ay, bx),
+        ])
     }
 
     /// refract(e1, e2, η): k = 1 − η²(1 − dot(e2, e1)²); 0 if k < 0, else
     /// η·e1 − (η·dot(e2, e1) + sqrt(k))·e2.
     fn refract(&mut self, e1: &[Op], e2: &[Op], eta: &[Op]) -> Result<Vec<Op>, Error> {
-        let eta = *eta.first().ok_or_else(|| Error::Invalid("refract lacks η".into()))?;
+        let eta = *eta
+            .first()
+            .ok_or_else(|| Error::Invalid("refract lacks η".into()))?;
         let d = self.dot(Sc::F32, e2, e1);
         let d2 = self.bin("mul.f32", Class::F32, d, d);
         let omd = self.bin("sub.f32", Class::F32, Op::f32(1.0), d2);
@@ -253,15 +299,31 @@ impl Fw<'_, '_> {
     }
 
     /// Functions of matrices: transpose (others are unsupported).
-    fn matrix_math(&mut self, f: &Frame, fun: M, m: Handle<Expression>, cols: u32, rows: u32) -> Result<Vec<Op>, Error> {
+    fn matrix_math(
+        &mut self,
+        f: &Frame,
+        fun: M,
+        m: Handle<Expression>,
+        cols: u32,
+        rows: u32,
+    ) -> Result<Vec<Op>, Error> {
         let d = self.data(f, m)?;
         match fun {
             M::Transpose => {
                 let (c, r) = (cols as usize, rows as usize);
-                let at = |i: usize| d.get(i).copied().ok_or_else(|| Error::Invalid("a short matrix".into()));
-                (0..r).flat_map(|i| (0..c).map(move |j| (i, j))).map(|(i, j)| at(j * r + i)).collect()
+                let at = |i: usize| {
+                    d.get(i)
+                        .copied()
+                        .ok_or_else(|| Error::Invalid("a short matrix".into()))
+                };
+                (0..r)
+                    .flat_map(|i| (0..c).map(move |j| (i, j)))
+                    .map(|(i, j)| at(j * r + i))
+                    .collect()
             }
-            _ => Err(Error::Unsupported(format!("the math function {fun:?} on matrices"))),
+            _ => Err(Error::Unsupported(format!(
+                "the math function {fun:?} on matrices"
+            ))),
         }
     }
 }
@@ -269,6 +331,8 @@ impl Fw<'_, '_> {
 fn three(v: &[Op]) -> Result<[Op; 3], Error> {
     match *v {
         [x, y, z] => Ok([x, y, z]),
-        _ => Err(Error::Invalid("cross() of a vector that is not 3-wide".into())),
+        _ => Err(Error::Invalid(
+            "cross() of a vector that is not 3-wide".into(),
+        )),
     }
 }

@@ -18,7 +18,11 @@ impl Fw<'_, '_> {
             }
             Shape::Array { base, len, stride } => {
                 let i = len.map_or(i, |n| i.min(n - 1));
-                let leaves = if matches!(p.loc, Loc::Mem { .. }) { 0 } else { i * types.leaves(Ty::H(base))? };
+                let leaves = if matches!(p.loc, Loc::Mem { .. }) {
+                    0
+                } else {
+                    i * types.leaves(Ty::H(base))?
+                };
                 (Ty::H(base), i * stride, leaves)
             }
             Shape::Vector(n, sc) => {
@@ -32,9 +36,22 @@ impl Fw<'_, '_> {
             Shape::Scalar(_) => return Err(Error::Invalid("an index into a scalar".into())),
         };
         let loc = match p.loc {
-            Loc::Mem { space, base, offset } => Loc::Mem { space, base, offset: offset + bytes },
-            Loc::Var { var, first } => Loc::Var { var, first: first + leaves },
-            Loc::VarElem { .. } => return Err(Error::Invalid("an index into a vector component".into())),
+            Loc::Mem {
+                space,
+                base,
+                offset,
+            } => Loc::Mem {
+                space,
+                base,
+                offset: offset + bytes,
+            },
+            Loc::Var { var, first } => Loc::Var {
+                var,
+                first: first + leaves,
+            },
+            Loc::VarElem { .. } => {
+                return Err(Error::Invalid("an index into a vector component".into()))
+            }
         };
         Ok(Ptr { loc, ty })
     }
@@ -51,22 +68,41 @@ impl Fw<'_, '_> {
             Shape::Array { base, len, stride } => (Ty::H(base), len, stride),
             Shape::Vector(n, sc) => (Ty::S(sc), Some(n), sc.bytes()),
             Shape::Matrix { cols, rows } => (Ty::V(rows, Sc::F32), Some(cols), col_stride(rows)),
-            _ => return Err(Error::Invalid("a run-time index into a scalar or struct".into())),
+            _ => {
+                return Err(Error::Invalid(
+                    "a run-time index into a scalar or struct".into(),
+                ))
+            }
         };
         let index = match len {
             Some(n) => self.bin("min.u32", Class::B32, index, Op::U32(n - 1)),
             None => index,
         };
         let loc = match p.loc {
-            Loc::Mem { space, base, offset } => {
+            Loc::Mem {
+                space,
+                base,
+                offset,
+            } => {
                 let b = self.out.reg(Class::B64);
                 ins!(self.out, "mad.wide.u32 {b}, {index}, {stride}, {base};");
-                Loc::Mem { space, base: b, offset }
+                Loc::Mem {
+                    space,
+                    base: b,
+                    offset,
+                }
             }
-            Loc::Var { var, first } if matches!(ty, Ty::S(_)) => {
-                Loc::VarElem { var, first, len: len.unwrap_or(1), index }
+            Loc::Var { var, first } if matches!(ty, Ty::S(_)) => Loc::VarElem {
+                var,
+                first,
+                len: len.unwrap_or(1),
+                index,
+            },
+            _ => {
+                return Err(Error::Invalid(
+                    "a run-time index into an array held in registers".into(),
+                ))
             }
-            _ => return Err(Error::Invalid("a run-time index into an array held in registers".into())),
         };
         Ok(Ptr { loc, ty })
     }
@@ -74,13 +110,22 @@ impl Fw<'_, '_> {
     /// The value `p` points to, leaf by leaf, in fresh registers.
     pub fn load(&mut self, p: &Ptr) -> Result<Vec<Op>, Error> {
         match p.loc {
-            Loc::Mem { space, base, offset } => self.load_mem(space, base, offset, p.ty),
+            Loc::Mem {
+                space,
+                base,
+                offset,
+            } => self.load_mem(space, base, offset, p.ty),
             Loc::Var { var, first } => {
                 let n = self.cx.types.leaves(p.ty)?;
                 let src = self.var_slice(var, first, n)?;
                 Ok(src.into_iter().map(|o| self.copy(o)).collect())
             }
-            Loc::VarElem { var, first, len, index } => {
+            Loc::VarElem {
+                var,
+                first,
+                len,
+                index,
+            } => {
                 let src = self.var_slice(var, first, len)?;
                 let sc = src.first().map_or(Sc::F32, |&o| sc_of(o));
                 Ok(vec![self.select_index(sc, &src, index)])
@@ -91,14 +136,25 @@ impl Fw<'_, '_> {
     /// Stores the value `v` where `p` points.
     pub fn store(&mut self, p: &Ptr, v: &[Op]) -> Result<(), Error> {
         match p.loc {
-            Loc::Mem { space, base, offset } => self.store_mem(space, base, offset, p.ty, v),
+            Loc::Mem {
+                space,
+                base,
+                offset,
+            } => self.store_mem(space, base, offset, p.ty, v),
             Loc::Var { var, first } => {
                 let dst = self.var_slice(var, first, v.len() as u32)?;
                 dst.iter().zip(v).try_for_each(|(&d, &s)| self.mov_to(d, s))
             }
-            Loc::VarElem { var, first, len, index } => {
+            Loc::VarElem {
+                var,
+                first,
+                len,
+                index,
+            } => {
                 let dst = self.var_slice(var, first, len)?;
-                let value = *v.first().ok_or_else(|| Error::Invalid("an empty store".into()))?;
+                let value = *v
+                    .first()
+                    .ok_or_else(|| Error::Invalid("an empty store".into()))?;
                 for (k, &d) in dst.iter().enumerate() {
                     let hit = self.setp("eq.u32", index, Op::U32(k as u32));
                     let sc = sc_of(d);
@@ -111,7 +167,10 @@ impl Fw<'_, '_> {
     }
 
     fn var_slice(&self, var: usize, first: u32, n: u32) -> Result<Vec<Op>, Error> {
-        let regs = self.vars.get(var).ok_or_else(|| Error::Invalid("an unknown variable".into()))?;
+        let regs = self
+            .vars
+            .get(var)
+            .ok_or_else(|| Error::Invalid("an unknown variable".into()))?;
         regs.get(first as usize..(first + n) as usize)
             .map(<[Op]>::to_vec)
             .ok_or_else(|| Error::Invalid("an access past the end of a variable".into()))
@@ -127,7 +186,9 @@ impl Fw<'_, '_> {
 
     /// `elems[index]`, by comparisons; an index past the end selects the last element.
     pub fn select_index(&mut self, sc: Sc, elems: &[Op], index: Op) -> Op {
-        let Some((&last, rest)) = elems.split_last() else { return sc.zero() };
+        let Some((&last, rest)) = elems.split_last() else {
+            return sc.zero();
+        };
         let mut acc = last;
         for (k, &e) in rest.iter().enumerate().rev() {
             let hit = self.setp("eq.u32", index, Op::U32(k as u32));
@@ -160,17 +221,31 @@ impl Fw<'_, '_> {
         if c.n == 1 {
             ins!(self.out, "ld.{sp}.{mem} {}, {addr};", regs[0]);
         } else {
-            ins!(self.out, "ld.{sp}.v{}.{mem} {{{}}}, {addr};", c.n, join(regs.iter().map(|r| Op::Reg(*r))));
+            ins!(
+                self.out,
+                "ld.{sp}.v{}.{mem} {{{}}}, {addr};",
+                c.n,
+                join(regs.iter().map(|r| Op::Reg(*r)))
+            );
         }
         out.extend(regs.into_iter().map(Op::Reg));
     }
 
-    fn store_mem(&mut self, space: Space, base: Reg, offset: u32, ty: Ty, v: &[Op]) -> Result<(), Error> {
+    fn store_mem(
+        &mut self,
+        space: Space,
+        base: Reg,
+        offset: u32,
+        ty: Ty,
+        v: &[Op],
+    ) -> Result<(), Error> {
         let mut chunks = Vec::new();
         self.cx.types.chunks(ty, offset, &mut chunks)?;
         let mut at = 0usize;
         for c in chunks {
-            let vals = v.get(at..at + c.n as usize).ok_or_else(|| Error::Invalid("a store of the wrong size".into()))?;
+            let vals = v
+                .get(at..at + c.n as usize)
+                .ok_or_else(|| Error::Invalid("a store of the wrong size".into()))?;
             at += c.n as usize;
             self.store_chunk(space, base, c, vals);
         }
@@ -196,19 +271,32 @@ impl Fw<'_, '_> {
         if c.n == 1 {
             ins!(self.out, "st.{sp}.{mem} {addr}, {};", vals[0]);
         } else {
-            ins!(self.out, "st.{sp}.v{}.{mem} {addr}, {{{}}};", c.n, join(vals.iter().copied()));
+            ins!(
+                self.out,
+                "st.{sp}.v{}.{mem} {addr}, {{{}}};",
+                c.n,
+                join(vals.iter().copied())
+            );
         }
     }
 }
 
 /// The column stride of a matrix with `rows` rows in memory.
 fn col_stride(rows: u32) -> u32 {
-    if rows == 2 { 8 } else { 16 }
+    if rows == 2 {
+        8
+    } else {
+        16
+    }
 }
 
 /// `[base+offset]`.
 fn address(base: Reg, offset: u32) -> String {
-    if offset == 0 { format!("[{base}]") } else { format!("[{base}+{offset}]") }
+    if offset == 0 {
+        format!("[{base}]")
+    } else {
+        format!("[{base}+{offset}]")
+    }
 }
 
 /// Operands separated by commas.

@@ -3,8 +3,9 @@
 //!
 //! The kernel's interface: one `.param .u64` global address per uniform or storage
 //! buffer of the module, in (group, binding) order, whether or not the entry point
-//! uses it; a block of exactly the entry point's workgroup size (`.reqntid`); the grid
-//! is the dispatch (`num_workgroups`).
+//! uses it. Launch it with the entry point's workgroup size as the block (the header
+//! says it; it is not declared with `.reqntid`, which makes ptxas cap the registers and
+//! spill) and the dispatch as the grid.
 //!
 //! How naga's IR maps to PTX:
 //! - every value is scalarised: one virtual register (or immediate) per scalar leaf of
@@ -15,12 +16,13 @@
 //!   array or matrix of which is indexed with a run-time index: they live in `.local`
 //!   memory with the WGSL layout;
 //! - structured control flow becomes labelled branches;
-//! - a function that takes a pointer or uses a `var<private>` is inlined at each call;
-//!   every other one is a `.func` whose parameters are the buffer addresses it uses
-//!   followed by its arguments' leaves, and whose return value is one aggregate;
+//! - a function is inlined at its calls where it must be (it takes a pointer, or uses a
+//!   `var<private>`, which lives in the kernel's registers) or where that duplicates
+//!   little code; the others are `.func`s whose parameters are the buffer addresses
+//!   they use followed by their arguments' leaves, with one aggregate return value;
 //! - run-time indices into fixed-size arrays and vectors are clamped to the last
 //!   element (naga's `Restrict` policy); indices into runtime-sized arrays are not;
-//! - maths: see `math.rs`, `libm.rs` and docs/ptx.md for each function's error.
+//! - maths: `math.rs` and `libm.rs`; docs/ptx.md gives each function's error.
 //!
 //! The output depends only on the module: registers, labels and functions are
 //! numbered in the order the IR lists them.
@@ -54,7 +56,10 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options { sm: 70, entry_point: "main".into() }
+        Options {
+            sm: 70,
+            entry_point: "main".into(),
+        }
     }
 }
 
@@ -89,7 +94,10 @@ impl fmt::Display for Error {
         match self {
             Error::NoEntryPoint(n) => write!(f, "the module has no entry point `{n}`"),
             Error::NotCompute(n) => write!(f, "the entry point `{n}` is not a compute shader"),
-            Error::Target(sm) => write!(f, "no PTX target for sm_{sm} (sm_50 to sm_90, sm_100, sm_120)"),
+            Error::Target(sm) => write!(
+                f,
+                "no PTX target for sm_{sm} (sm_50 to sm_90, sm_100, sm_120)"
+            ),
             Error::Unsupported(m) => write!(f, "the PTX back end does not support {m}"),
             Error::Invalid(m) => write!(f, "internal error in the PTX back end: {m}"),
         }
@@ -125,11 +133,18 @@ pub fn write(module: &Module, info: &ModuleInfo, options: &Options) -> Result<St
     if ep.stage != ShaderStage::Compute {
         return Err(Error::NotCompute(name.clone()));
     }
-    if func::ident(name) != *name || name.starts_with(|c: char| c.is_ascii_digit()) || name.starts_with("__") {
-        return Err(Error::Unsupported(format!("the entry point name `{name}` (not a PTX identifier)")));
+    if func::ident(name) != *name
+        || name.starts_with(|c: char| c.is_ascii_digit())
+        || name.starts_with("__")
+    {
+        return Err(Error::Unsupported(format!(
+            "the entry point name `{name}` (not a PTX identifier)"
+        )));
     }
     if ep.workgroup_size_overrides.is_some() {
-        return Err(Error::Unsupported("a workgroup size set by pipeline overrides".into()));
+        return Err(Error::Unsupported(
+            "a workgroup size set by pipeline overrides".into(),
+        ));
     }
     let version = isa_version(options.sm)?;
     let types = types::Types::new(module);
@@ -167,7 +182,12 @@ fn buffers(module: &Module) -> Vec<naga::Handle<naga::GlobalVariable>> {
     let mut b: Vec<_> = module
         .global_variables
         .iter()
-        .filter(|(_, g)| matches!(g.space, AddressSpace::Uniform | AddressSpace::Storage { .. }))
+        .filter(|(_, g)| {
+            matches!(
+                g.space,
+                AddressSpace::Uniform | AddressSpace::Storage { .. }
+            )
+        })
         .filter_map(|(h, g)| g.binding.as_ref().map(|rb| ((rb.group, rb.binding), h)))
         .collect();
     b.sort_by_key(|&(key, h)| (key, h.index()));
@@ -181,8 +201,15 @@ fn names(module: &Module, entry: &str) -> Vec<String> {
         .functions
         .iter()
         .map(|(h, f)| {
-            let base = format!("fn_{}", func::ident(f.name.as_deref().unwrap_or("anonymous")));
-            let name = if seen.contains(&base) { format!("{base}_{}", h.index()) } else { base };
+            let base = format!(
+                "fn_{}",
+                func::ident(f.name.as_deref().unwrap_or("anonymous"))
+            );
+            let name = if seen.contains(&base) {
+                format!("{base}_{}", h.index())
+            } else {
+                base
+            };
             seen.insert(name.clone());
             name
         })
@@ -197,19 +224,33 @@ fn libm_name() -> String {
 fn header(cx: &writer::Cx, entry: &str, sm: u32, version: &str) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let _ = writeln!(s, "//\n// Generated by sdfc's PTX back end from the WGSL entry point `{entry}`.");
-    let _ = writeln!(s, "// Kernel parameters: the global address of each buffer, in (group, binding) order:");
+    let _ = writeln!(
+        s,
+        "//\n// Generated by sdfc's PTX back end from the WGSL entry point `{entry}`."
+    );
+    let _ = writeln!(
+        s,
+        "// Kernel parameters: the global address of each buffer, in (group, binding) order:"
+    );
     for (i, &g) in cx.buffers.iter().enumerate() {
         let gv = &cx.module.global_variables[g];
         let (group, binding) = gv.binding.as_ref().map_or((0, 0), |b| (b.group, b.binding));
         let space = match gv.space {
             AddressSpace::Uniform => "uniform".to_string(),
-            AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) => "storage, read_write".into(),
+            AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) => {
+                "storage, read_write".into()
+            }
             _ => "storage, read".into(),
         };
         let name = emit::ascii(gv.name.as_deref().unwrap_or("?"));
-        let _ = writeln!(s, "//   {entry}_param_{i}: @group({group}) @binding({binding}) var<{space}> {name}");
+        let _ = writeln!(
+            s,
+            "//   {entry}_param_{i}: @group({group}) @binding({binding}) var<{space}> {name}"
+        );
     }
-    let _ = writeln!(s, "//\n\n.version {version}\n.target sm_{sm}\n.address_size 64\n");
+    let _ = writeln!(
+        s,
+        "//\n\n.version {version}\n.target sm_{sm}\n.address_size 64\n"
+    );
     s
 }

@@ -6,7 +6,9 @@ use super::emit::{Class, Op};
 use super::types::{Sc, Shape, Ty};
 use super::writer::{Frame, Fw};
 use super::Error;
-use naga::{BinaryOperator as B, Expression, Handle, RelationalFunction, ScalarKind, UnaryOperator};
+use naga::{
+    BinaryOperator as B, Expression, Handle, RelationalFunction, ScalarKind, UnaryOperator,
+};
 
 /// The largest f32 below 2^31 and below 2^32: the saturation bounds of WGSL's
 /// float-to-integer conversions.
@@ -14,12 +16,19 @@ const I32_MAX_F: f32 = 2147483520.0;
 const U32_MAX_F: f32 = 4294967040.0;
 
 impl Fw<'_, '_> {
-    pub fn unary(&mut self, f: &Frame, op: UnaryOperator, e: Handle<Expression>) -> Result<Vec<Op>, Error> {
+    pub fn unary(
+        &mut self,
+        f: &Frame,
+        op: UnaryOperator,
+        e: Handle<Expression>,
+    ) -> Result<Vec<Op>, Error> {
         let sc = self.leaf_sc(self.ty(f, e)?)?;
         let (ins, class) = match (op, sc) {
             (UnaryOperator::Negate, Sc::F32) => ("neg.f32", Class::F32),
             (UnaryOperator::Negate, Sc::I32 | Sc::U32) => ("neg.s32", Class::B32),
-            (UnaryOperator::LogicalNot, Sc::Bool) | (UnaryOperator::BitwiseNot, Sc::Bool) => ("not.pred", Class::Pred),
+            (UnaryOperator::LogicalNot, Sc::Bool) | (UnaryOperator::BitwiseNot, Sc::Bool) => {
+                ("not.pred", Class::Pred)
+            }
             (UnaryOperator::BitwiseNot, Sc::I32 | Sc::U32) => ("not.b32", Class::B32),
             _ => return Err(Error::Invalid(format!("{op:?} of {sc:?}"))),
         };
@@ -32,17 +41,30 @@ impl Fw<'_, '_> {
         match self.cx.types.shape(ty)? {
             Shape::Scalar(s) | Shape::Vector(_, s) => Ok(s),
             Shape::Matrix { .. } => Ok(Sc::F32),
-            _ => Err(Error::Invalid(format!("an operator on `{}`", self.cx.types.name(ty)))),
+            _ => Err(Error::Invalid(format!(
+                "an operator on `{}`",
+                self.cx.types.name(ty)
+            ))),
         }
     }
 
-    pub fn binary(&mut self, f: &Frame, op: B, l: Handle<Expression>, r: Handle<Expression>) -> Result<Vec<Op>, Error> {
+    pub fn binary(
+        &mut self,
+        f: &Frame,
+        op: B,
+        l: Handle<Expression>,
+        r: Handle<Expression>,
+    ) -> Result<Vec<Op>, Error> {
         let (lt, rt) = (self.ty(f, l)?, self.ty(f, r)?);
         let (ls, rs) = (self.cx.types.shape(lt)?, self.cx.types.shape(rt)?);
         let (a, b) = (self.data(f, l)?, self.data(f, r)?);
         match (op, ls, rs) {
-            (B::Multiply, Shape::Matrix { cols, rows }, Shape::Vector(..)) => return Ok(self.mat_vec(a, b, cols, rows)),
-            (B::Multiply, Shape::Vector(..), Shape::Matrix { cols, rows }) => return Ok(self.vec_mat(a, b, cols, rows)),
+            (B::Multiply, Shape::Matrix { cols, rows }, Shape::Vector(..)) => {
+                return Ok(self.mat_vec(a, b, cols, rows))
+            }
+            (B::Multiply, Shape::Vector(..), Shape::Matrix { cols, rows }) => {
+                return Ok(self.vec_mat(a, b, cols, rows))
+            }
             (B::Multiply, Shape::Matrix { cols: k, rows }, Shape::Matrix { cols, .. }) => {
                 return Ok(self.mat_mat(a, b, k, rows, cols))
             }
@@ -50,11 +72,19 @@ impl Fw<'_, '_> {
         }
         let sc = self.leaf_sc(lt)?;
         let n = a.len().max(b.len());
-        let pick = |v: &[Op], i: usize| if v.len() == 1 { v[0] } else { v.get(i).copied().unwrap_or(v[0]) };
+        let pick = |v: &[Op], i: usize| {
+            if v.len() == 1 {
+                v[0]
+            } else {
+                v.get(i).copied().unwrap_or(v[0])
+            }
+        };
         if a.is_empty() || b.is_empty() {
             return Err(Error::Invalid("an operator on an empty value".into()));
         }
-        (0..n).map(|i| self.bin_leaf(op, sc, pick(a, i), pick(b, i))).collect()
+        (0..n)
+            .map(|i| self.bin_leaf(op, sc, pick(a, i), pick(b, i)))
+            .collect()
     }
 
     /// One leaf of a binary operator on operands of scalar `sc`.
@@ -64,7 +94,9 @@ impl Fw<'_, '_> {
         let cmp = |s: &mut Self, c: &str| s.setp(&format!("{c}.{t}"), a, b);
         Ok(match (op, sc) {
             (B::Add, Sc::F32 | Sc::I32 | Sc::U32) => self.bin(&format!("add.{t}"), class, a, b),
-            (B::Subtract, Sc::F32 | Sc::I32 | Sc::U32) => self.bin(&format!("sub.{t}"), class, a, b),
+            (B::Subtract, Sc::F32 | Sc::I32 | Sc::U32) => {
+                self.bin(&format!("sub.{t}"), class, a, b)
+            }
             (B::Multiply, Sc::F32) => self.bin("mul.f32", class, a, b),
             (B::Multiply, Sc::I32 | Sc::U32) => self.bin(&format!("mul.lo.{t}"), class, a, b),
             (B::Divide, Sc::F32) => self.bin(super::math::DIV, class, a, b),
@@ -141,19 +173,32 @@ impl Fw<'_, '_> {
         reject: Handle<Expression>,
     ) -> Result<Vec<Op>, Error> {
         let sc = self.leaf_sc(self.ty(f, accept)?)?;
-        let (c, t, e) = (self.data(f, cond)?, self.data(f, accept)?, self.data(f, reject)?);
+        let (c, t, e) = (
+            self.data(f, cond)?,
+            self.data(f, accept)?,
+            self.data(f, reject)?,
+        );
         if c.is_empty() || t.len() != e.len() {
             return Err(Error::Invalid("a select of mismatched values".into()));
         }
         let mut out = Vec::with_capacity(t.len());
         for i in 0..t.len() {
-            let p = if c.len() == 1 { c[0] } else { c.get(i).copied().unwrap_or(c[0]) };
+            let p = if c.len() == 1 {
+                c[0]
+            } else {
+                c.get(i).copied().unwrap_or(c[0])
+            };
             out.push(self.selp(sc, t[i], e[i], p));
         }
         Ok(out)
     }
 
-    pub fn relational(&mut self, f: &Frame, fun: RelationalFunction, e: Handle<Expression>) -> Result<Vec<Op>, Error> {
+    pub fn relational(
+        &mut self,
+        f: &Frame,
+        fun: RelationalFunction,
+        e: Handle<Expression>,
+    ) -> Result<Vec<Op>, Error> {
         let d = self.data(f, e)?;
         let fold = |s: &mut Self, ins: &str| {
             let mut acc = d.first().copied().unwrap_or(Op::Bool(false));
@@ -185,7 +230,10 @@ impl Fw<'_, '_> {
         convert: Option<u8>,
     ) -> Result<Vec<Op>, Error> {
         let from = self.leaf_sc(self.ty(f, e)?)?;
-        let to = Sc::of(naga::Scalar { kind, width: convert.unwrap_or(4) })?;
+        let to = Sc::of(naga::Scalar {
+            kind,
+            width: convert.unwrap_or(4),
+        })?;
         let d = self.data(f, e)?;
         d.iter()
             .map(|&a| match convert {
@@ -234,7 +282,11 @@ impl Fw<'_, '_> {
             // bool(x) is x != 0; NaN is true.
             (Sc::F32, Sc::Bool) => self.setp("neu.f32", a, Op::f32(0.0)),
             (_, Sc::Bool) => self.setp("ne.b32", a, Op::U32(0)),
-            _ => return Err(Error::Invalid(format!("a conversion from {from:?} to {to:?}"))),
+            _ => {
+                return Err(Error::Invalid(format!(
+                    "a conversion from {from:?} to {to:?}"
+                )))
+            }
         })
     }
 
@@ -242,7 +294,9 @@ impl Fw<'_, '_> {
     fn mat_vec(&mut self, m: &[Op], v: &[Op], cols: u32, rows: u32) -> Vec<Op> {
         (0..rows as usize)
             .map(|r| {
-                let terms: Vec<(Op, Op)> = (0..cols as usize).map(|c| (at(m, c * rows as usize + r), at(v, c))).collect();
+                let terms: Vec<(Op, Op)> = (0..cols as usize)
+                    .map(|c| (at(m, c * rows as usize + r), at(v, c)))
+                    .collect();
                 self.dot_terms(&terms)
             })
             .collect()
@@ -252,7 +306,9 @@ impl Fw<'_, '_> {
     fn vec_mat(&mut self, v: &[Op], m: &[Op], cols: u32, rows: u32) -> Vec<Op> {
         (0..cols as usize)
             .map(|c| {
-                let terms: Vec<(Op, Op)> = (0..rows as usize).map(|r| (at(v, r), at(m, c * rows as usize + r))).collect();
+                let terms: Vec<(Op, Op)> = (0..rows as usize)
+                    .map(|r| (at(v, r), at(m, c * rows as usize + r)))
+                    .collect();
                 self.dot_terms(&terms)
             })
             .collect()
@@ -264,7 +320,9 @@ impl Fw<'_, '_> {
         let mut out = Vec::with_capacity(cols as usize * rows);
         for c in 0..cols as usize {
             for r in 0..rows {
-                let terms: Vec<(Op, Op)> = (0..k).map(|i| (at(a, i * rows + r), at(b, c * k + i))).collect();
+                let terms: Vec<(Op, Op)> = (0..k)
+                    .map(|i| (at(a, i * rows + r), at(b, c * k + i)))
+                    .collect();
                 out.push(self.dot_terms(&terms));
             }
         }
@@ -273,7 +331,9 @@ impl Fw<'_, '_> {
 
     /// Σ xᵢ·yᵢ as a multiply followed by fused multiply-adds.
     pub fn dot_terms(&mut self, terms: &[(Op, Op)]) -> Op {
-        let Some((&(x, y), rest)) = terms.split_first() else { return Op::f32(0.0) };
+        let Some((&(x, y), rest)) = terms.split_first() else {
+            return Op::f32(0.0);
+        };
         let mut acc = self.bin("mul.f32", Class::F32, x, y);
         for &(x, y) in rest {
             acc = self.tri("fma.rn.f32", Class::F32, x, y, acc);

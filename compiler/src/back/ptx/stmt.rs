@@ -16,9 +16,20 @@ impl<'a> Fw<'_, 'a> {
         match *s {
             Statement::Emit(ref range) => self.emit(f, range.clone()),
             Statement::Block(ref b) => self.block(f, b),
-            Statement::If { condition, ref accept, ref reject } => self.if_(f, condition, accept, reject),
-            Statement::Switch { selector, ref cases } => self.switch(f, selector, cases),
-            Statement::Loop { ref body, ref continuing, break_if } => self.loop_(f, body, continuing, break_if),
+            Statement::If {
+                condition,
+                ref accept,
+                ref reject,
+            } => self.if_(f, condition, accept, reject),
+            Statement::Switch {
+                selector,
+                ref cases,
+            } => self.switch(f, selector, cases),
+            Statement::Loop {
+                ref body,
+                ref continuing,
+                break_if,
+            } => self.loop_(f, body, continuing, break_if),
             Statement::Break => self.break_(f),
             Statement::Continue => self.continue_(f),
             Statement::Return { value } => self.return_(f, value),
@@ -27,14 +38,34 @@ impl<'a> Fw<'_, 'a> {
                 let v = self.data(f, value)?.to_vec();
                 self.store(&p, &v)
             }
-            Statement::Call { function, ref arguments, result } => self.call(f, function, arguments, result),
+            Statement::Call {
+                function,
+                ref arguments,
+                result,
+            } => self.call(f, function, arguments, result),
             Statement::ControlBarrier(b) => {
                 self.out.comment(format_args!("barrier {b:?}"));
-                ins!(self.out, "{};", if b == Barrier::SUB_GROUP { "bar.warp.sync -1" } else { "bar.sync 0" });
+                ins!(
+                    self.out,
+                    "{};",
+                    if b == Barrier::SUB_GROUP {
+                        "bar.warp.sync -1"
+                    } else {
+                        "bar.sync 0"
+                    }
+                );
                 Ok(())
             }
             Statement::MemoryBarrier(b) => {
-                ins!(self.out, "{};", if b.contains(Barrier::STORAGE) { "membar.gl" } else { "membar.cta" });
+                ins!(
+                    self.out,
+                    "{};",
+                    if b.contains(Barrier::STORAGE) {
+                        "membar.gl"
+                    } else {
+                        "membar.cta"
+                    }
+                );
                 Ok(())
             }
             ref other => Err(Error::Unsupported(statement_name(other).into())),
@@ -59,7 +90,13 @@ impl<'a> Fw<'_, 'a> {
         self.scalar(f, h)
     }
 
-    fn if_(&mut self, f: &mut Frame<'a>, c: Handle<Expression>, accept: &'a Block, reject: &'a Block) -> Result<(), Error> {
+    fn if_(
+        &mut self,
+        f: &mut Frame<'a>,
+        c: Handle<Expression>,
+        accept: &'a Block,
+        reject: &'a Block,
+    ) -> Result<(), Error> {
         let p = match self.cond(f, c)? {
             Op::Bool(true) => return self.block(f, accept),
             Op::Bool(false) => return self.block(f, reject),
@@ -68,7 +105,11 @@ impl<'a> Fw<'_, 'a> {
         let g = self.out.label_group();
         let (else_, end) = (format!("$L{g}_else"), format!("$L{g}_endif"));
         self.out.comment(format_args!("if"));
-        ins!(self.out, "@!{p} bra {};", if reject.is_empty() { &end } else { &else_ });
+        ins!(
+            self.out,
+            "@!{p} bra {};",
+            if reject.is_empty() { &end } else { &else_ }
+        );
         self.block(f, accept)?;
         if !reject.is_empty() {
             ins!(self.out, "bra {end};");
@@ -87,10 +128,17 @@ impl<'a> Fw<'_, 'a> {
         break_if: Option<Handle<Expression>>,
     ) -> Result<(), Error> {
         let g = self.out.label_group();
-        let (head, cont, end) = (format!("$L{g}_loop"), format!("$L{g}_continuing"), format!("$L{g}_loop_end"));
+        let (head, cont, end) = (
+            format!("$L{g}_loop"),
+            format!("$L{g}_continuing"),
+            format!("$L{g}_loop_end"),
+        );
         self.out.comment(format_args!("loop"));
         self.out.place(&head);
-        f.targets.push(Target::Loop { cont: cont.clone(), end: end.clone() });
+        f.targets.push(Target::Loop {
+            cont: cont.clone(),
+            end: end.clone(),
+        });
         let r = self.block(f, body);
         f.targets.pop();
         r?;
@@ -111,7 +159,12 @@ impl<'a> Fw<'_, 'a> {
         Ok(())
     }
 
-    fn switch(&mut self, f: &mut Frame<'a>, selector: Handle<Expression>, cases: &'a [SwitchCase]) -> Result<(), Error> {
+    fn switch(
+        &mut self,
+        f: &mut Frame<'a>,
+        selector: Handle<Expression>,
+        cases: &'a [SwitchCase],
+    ) -> Result<(), Error> {
         let (sc, _) = self.sv(f, selector)?;
         let sel = match self.scalar(f, selector)? {
             Op::Reg(r) => Op::Reg(r),
@@ -194,7 +247,9 @@ impl<'a> Fw<'_, 'a> {
                     if dst.len() != v.len() {
                         return Err(Error::Invalid("a return value of the wrong size".into()));
                     }
-                    dst.iter().zip(&v).try_for_each(|(&d, &s)| self.mov_to(d, s))?;
+                    dst.iter()
+                        .zip(&v)
+                        .try_for_each(|(&d, &s)| self.mov_to(d, s))?;
                 }
                 ins!(self.out, "bra {end};");
             }
@@ -210,7 +265,9 @@ fn statement_name(s: &Statement) -> &'static str {
         Statement::ImageStore { .. } => "texture stores (Statement::ImageStore)",
         Statement::Atomic { .. } => "atomics (Statement::Atomic)",
         Statement::ImageAtomic { .. } => "texture atomics (Statement::ImageAtomic)",
-        Statement::WorkGroupUniformLoad { .. } => "workgroupUniformLoad (Statement::WorkGroupUniformLoad)",
+        Statement::WorkGroupUniformLoad { .. } => {
+            "workgroupUniformLoad (Statement::WorkGroupUniformLoad)"
+        }
         Statement::RayQuery { .. } | Statement::RayPipelineFunction(_) => "ray tracing",
         Statement::SubgroupBallot { .. }
         | Statement::SubgroupGather { .. }

@@ -27,7 +27,9 @@ impl Sc {
             (ScalarKind::Sint, 4) => Ok(Sc::I32),
             (ScalarKind::Uint, 4) => Ok(Sc::U32),
             (ScalarKind::Bool, _) => Ok(Sc::Bool),
-            (kind, width) => Err(Error::Unsupported(format!("the scalar type {kind:?} of {width} bytes"))),
+            (kind, width) => Err(Error::Unsupported(format!(
+                "the scalar type {kind:?} of {width} bytes"
+            ))),
         }
     }
 
@@ -61,7 +63,11 @@ impl Sc {
 
     /// Its size in memory, in bytes.
     pub fn bytes(self) -> u32 {
-        if self == Sc::Bool { 1 } else { 4 }
+        if self == Sc::Bool {
+            1
+        } else {
+            4
+        }
     }
 
     /// Its zero.
@@ -91,10 +97,17 @@ pub(super) enum Shape<'a> {
     Scalar(Sc),
     Vector(u32, Sc),
     /// Columns of `rows` f32s.
-    Matrix { cols: u32, rows: u32 },
+    Matrix {
+        cols: u32,
+        rows: u32,
+    },
     Struct(Handle<Type>, &'a [StructMember]),
     /// `len` is `None` for a runtime-sized array.
-    Array { base: Handle<Type>, len: Option<u32>, stride: u32 },
+    Array {
+        base: Handle<Type>,
+        len: Option<u32>,
+        stride: u32,
+    },
 }
 
 /// An expression's type: a value, or a pointer to a value.
@@ -124,7 +137,11 @@ pub(super) struct Types<'a> {
 
 impl<'a> Types<'a> {
     pub fn new(module: &'a Module) -> Self {
-        let mut t = Types { module, leaves: Vec::with_capacity(module.types.len()), firsts: Vec::new() };
+        let mut t = Types {
+            module,
+            leaves: Vec::with_capacity(module.types.len()),
+            firsts: Vec::new(),
+        };
         for (_, ty) in module.types.iter() {
             let (n, firsts) = t.count(&ty.inner);
             t.leaves.push(n);
@@ -137,10 +154,14 @@ impl<'a> Types<'a> {
         let known = |h: Handle<Type>| self.leaves.get(h.index()).copied().flatten();
         match *inner {
             TypeInner::Scalar(s) => (Sc::of(s).ok().map(|_| 1), Vec::new()),
-            TypeInner::Vector { size, scalar } => (Sc::of(scalar).ok().map(|_| size as u32), Vec::new()),
-            TypeInner::Matrix { columns, rows, scalar } if Sc::of(scalar) == Ok(Sc::F32) => {
-                (Some(columns as u32 * rows as u32), Vec::new())
+            TypeInner::Vector { size, scalar } => {
+                (Sc::of(scalar).ok().map(|_| size as u32), Vec::new())
             }
+            TypeInner::Matrix {
+                columns,
+                rows,
+                scalar,
+            } if Sc::of(scalar) == Ok(Sc::F32) => (Some(columns as u32 * rows as u32), Vec::new()),
             TypeInner::Struct { ref members, .. } => {
                 let mut firsts = Vec::with_capacity(members.len());
                 let mut total = Some(0u32);
@@ -153,8 +174,14 @@ impl<'a> Types<'a> {
                 }
                 (total, firsts)
             }
-            TypeInner::Array { base, size: ArraySize::Constant(n), .. } => {
-                let total = known(base).and_then(|b| b.checked_mul(n.get())).filter(|&s| s <= MAX_LEAVES);
+            TypeInner::Array {
+                base,
+                size: ArraySize::Constant(n),
+                ..
+            } => {
+                let total = known(base)
+                    .and_then(|b| b.checked_mul(n.get()))
+                    .filter(|&s| s <= MAX_LEAVES);
                 (total, Vec::new())
             }
             _ => (None, Vec::new()),
@@ -184,9 +211,18 @@ impl<'a> Types<'a> {
         match module.types[h].inner {
             TypeInner::Scalar(s) => Ok(Shape::Scalar(Sc::of(s)?)),
             TypeInner::Vector { size, scalar } => Ok(Shape::Vector(size as u32, Sc::of(scalar)?)),
-            TypeInner::Matrix { columns, rows, scalar } => match Sc::of(scalar)? {
-                Sc::F32 => Ok(Shape::Matrix { cols: columns as u32, rows: rows as u32 }),
-                _ => Err(Error::Unsupported("matrices of other scalars than f32".into())),
+            TypeInner::Matrix {
+                columns,
+                rows,
+                scalar,
+            } => match Sc::of(scalar)? {
+                Sc::F32 => Ok(Shape::Matrix {
+                    cols: columns as u32,
+                    rows: rows as u32,
+                }),
+                _ => Err(Error::Unsupported(
+                    "matrices of other scalars than f32".into(),
+                )),
             },
             TypeInner::Struct { ref members, .. } => Ok(Shape::Struct(h, members)),
             TypeInner::Array { base, size, stride } => {
@@ -194,7 +230,9 @@ impl<'a> Types<'a> {
                     ArraySize::Constant(n) => Some(n.get()),
                     ArraySize::Dynamic => None,
                     ArraySize::Pending(_) => {
-                        return Err(Error::Unsupported("arrays sized by a pipeline override".into()))
+                        return Err(Error::Unsupported(
+                            "arrays sized by a pipeline override".into(),
+                        ))
                     }
                 };
                 Ok(Shape::Array { base, len, stride })
@@ -213,7 +251,10 @@ impl<'a> Types<'a> {
                 Some(n) => Ok(n),
                 None => {
                     self.shape(ty)?;
-                    Err(Error::Unsupported(format!("the type `{}` as a value", self.name(ty))))
+                    Err(Error::Unsupported(format!(
+                        "the type `{}` as a value",
+                        self.name(ty)
+                    )))
                 }
             },
         }
@@ -221,7 +262,11 @@ impl<'a> Types<'a> {
 
     /// The first leaf of member `i` of struct `h`.
     pub fn member_first(&self, h: Handle<Type>, i: usize) -> u32 {
-        self.firsts.get(h.index()).and_then(|f| f.get(i)).copied().unwrap_or(0)
+        self.firsts
+            .get(h.index())
+            .and_then(|f| f.get(i))
+            .copied()
+            .unwrap_or(0)
     }
 
     /// The scalar of each leaf of `ty`, in order.
@@ -235,14 +280,18 @@ impl<'a> Types<'a> {
                     self.scalars(Ty::H(m.ty), out)?;
                 }
             }
-            Shape::Array { base, len: Some(n), .. } => {
+            Shape::Array {
+                base, len: Some(n), ..
+            } => {
                 self.leaves(ty)?;
                 for _ in 0..n {
                     self.scalars(Ty::H(base), out)?;
                 }
             }
             Shape::Array { len: None, .. } => {
-                return Err(Error::Unsupported("a runtime-sized array as a value".into()))
+                return Err(Error::Unsupported(
+                    "a runtime-sized array as a value".into(),
+                ))
             }
         }
         Ok(())
@@ -272,14 +321,20 @@ impl<'a> Types<'a> {
                     self.chunks(Ty::H(m.ty), offset + m.offset, out)?;
                 }
             }
-            Shape::Array { base, len: Some(n), stride } => {
+            Shape::Array {
+                base,
+                len: Some(n),
+                stride,
+            } => {
                 self.leaves(ty)?;
                 for i in 0..n {
                     self.chunks(Ty::H(base), offset + i * stride, out)?;
                 }
             }
             Shape::Array { len: None, .. } => {
-                return Err(Error::Unsupported("a runtime-sized array as a value".into()))
+                return Err(Error::Unsupported(
+                    "a runtime-sized array as a value".into(),
+                ))
             }
         }
         Ok(())
@@ -306,15 +361,26 @@ impl<'a> Types<'a> {
         };
         match *inner {
             TypeInner::Scalar(s) => Ok(Resolved::Value(Ty::S(Sc::of(s)?))),
-            TypeInner::Vector { size, scalar } => Ok(Resolved::Value(Ty::V(size as u32, Sc::of(scalar)?))),
-            TypeInner::Matrix { columns, rows, scalar } if Sc::of(scalar)? == Sc::F32 => {
-                Ok(Resolved::Value(Ty::M { cols: columns as u32, rows: rows as u32 }))
+            TypeInner::Vector { size, scalar } => {
+                Ok(Resolved::Value(Ty::V(size as u32, Sc::of(scalar)?)))
             }
+            TypeInner::Matrix {
+                columns,
+                rows,
+                scalar,
+            } if Sc::of(scalar)? == Sc::F32 => Ok(Resolved::Value(Ty::M {
+                cols: columns as u32,
+                rows: rows as u32,
+            })),
             TypeInner::Pointer { base, .. } => Ok(Resolved::Pointer(Ty::H(base))),
-            TypeInner::ValuePointer { size: None, scalar, .. } => Ok(Resolved::Pointer(Ty::S(Sc::of(scalar)?))),
-            TypeInner::ValuePointer { size: Some(n), scalar, .. } => {
-                Ok(Resolved::Pointer(Ty::V(n as u32, Sc::of(scalar)?)))
-            }
+            TypeInner::ValuePointer {
+                size: None, scalar, ..
+            } => Ok(Resolved::Pointer(Ty::S(Sc::of(scalar)?))),
+            TypeInner::ValuePointer {
+                size: Some(n),
+                scalar,
+                ..
+            } => Ok(Resolved::Pointer(Ty::V(n as u32, Sc::of(scalar)?))),
             ref other => Err(Error::Unsupported(format!("the type {}", type_kind(other)))),
         }
     }
@@ -324,20 +390,35 @@ impl<'a> Types<'a> {
         match self.shape(ty)? {
             Shape::Scalar(s) => Ok((s, 1)),
             Shape::Vector(n, s) => Ok((s, n)),
-            _ => Err(Error::Invalid(format!("expected a scalar or vector, found `{}`", self.name(ty)))),
+            _ => Err(Error::Invalid(format!(
+                "expected a scalar or vector, found `{}`",
+                self.name(ty)
+            ))),
         }
     }
 }
 
 fn vector_chunks(n: u32, sc: Sc, offset: u32, out: &mut Vec<Chunk>) {
     match (n, sc) {
-        (_, Sc::Bool) => out.extend((0..n).map(|i| Chunk { offset: offset + i, sc, n: 1 })),
+        (_, Sc::Bool) => out.extend((0..n).map(|i| Chunk {
+            offset: offset + i,
+            sc,
+            n: 1,
+        })),
         (2 | 4, _) => out.push(Chunk { offset, sc, n }),
         (3, _) => {
             out.push(Chunk { offset, sc, n: 2 });
-            out.push(Chunk { offset: offset + 8, sc, n: 1 });
+            out.push(Chunk {
+                offset: offset + 8,
+                sc,
+                n: 1,
+            });
         }
-        _ => out.extend((0..n).map(|i| Chunk { offset: offset + 4 * i, sc, n: 1 })),
+        _ => out.extend((0..n).map(|i| Chunk {
+            offset: offset + 4 * i,
+            sc,
+            n: 1,
+        })),
     }
 }
 

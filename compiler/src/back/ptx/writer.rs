@@ -64,12 +64,21 @@ pub(super) enum Store {
 #[derive(Debug, Clone)]
 pub(super) enum Loc {
     /// `offset` bytes past the address in `base`.
-    Mem { space: Space, base: Reg, offset: u32 },
+    Mem {
+        space: Space,
+        base: Reg,
+        offset: u32,
+    },
     /// The leaves of a register variable from `first` on.
     Var { var: usize, first: u32 },
     /// The component `index` (a run-time value) of the vector of `len` leaves at `first`
     /// of a register variable.
-    VarElem { var: usize, first: u32, len: u32, index: Op },
+    VarElem {
+        var: usize,
+        first: u32,
+        len: u32,
+        index: Op,
+    },
 }
 
 /// A pointer: where, and to what.
@@ -120,7 +129,13 @@ pub(super) struct Frame<'a> {
 }
 
 impl<'a> Frame<'a> {
-    pub fn new(func: &'a Function, info: &'a FunctionInfo, name: String, args: Vec<Val>, ret: Ret) -> Self {
+    pub fn new(
+        func: &'a Function,
+        info: &'a FunctionInfo,
+        name: String,
+        args: Vec<Val>,
+        ret: Ret,
+    ) -> Self {
         Frame {
             func,
             info,
@@ -147,14 +162,21 @@ pub(super) struct Fw<'c, 'a> {
 
 impl<'c, 'a> Fw<'c, 'a> {
     pub fn new(cx: &'c Cx<'a>) -> Self {
-        Fw { cx, out: Out::default(), vars: Vec::new(), globals: vec![None; cx.module.global_variables.len()] }
+        Fw {
+            cx,
+            out: Out::default(),
+            vars: Vec::new(),
+            globals: vec![None; cx.module.global_variables.len()],
+        }
     }
 
     /// The value of an expression already evaluated.
     pub fn val<'f>(&self, f: &'f Frame, h: Handle<Expression>) -> Result<&'f Val, Error> {
         match f.values.get(h.index()) {
             Some(Some(v)) => Ok(v),
-            _ => Err(Error::Invalid(format!("expression {h:?} is used before it is evaluated"))),
+            _ => Err(Error::Invalid(format!(
+                "expression {h:?} is used before it is evaluated"
+            ))),
         }
     }
 
@@ -162,7 +184,9 @@ impl<'c, 'a> Fw<'c, 'a> {
     pub fn data<'f>(&self, f: &'f Frame, h: Handle<Expression>) -> Result<&'f [Op], Error> {
         match self.val(f, h)? {
             Val::Data(d) => Ok(d),
-            Val::Ptr(_) => Err(Error::Invalid(format!("expression {h:?} is a pointer, not a value"))),
+            Val::Ptr(_) => Err(Error::Invalid(format!(
+                "expression {h:?} is a pointer, not a value"
+            ))),
         }
     }
 
@@ -170,7 +194,9 @@ impl<'c, 'a> Fw<'c, 'a> {
     pub fn ptr<'f>(&self, f: &'f Frame, h: Handle<Expression>) -> Result<&'f Ptr, Error> {
         match self.val(f, h)? {
             Val::Ptr(p) => Ok(p),
-            Val::Data(_) => Err(Error::Invalid(format!("expression {h:?} is a value, not a pointer"))),
+            Val::Data(_) => Err(Error::Invalid(format!(
+                "expression {h:?} is a value, not a pointer"
+            ))),
         }
     }
 
@@ -178,7 +204,9 @@ impl<'c, 'a> Fw<'c, 'a> {
     pub fn ty(&self, f: &Frame, h: Handle<Expression>) -> Result<Ty, Error> {
         match self.cx.types.resolve(&f.info[h].ty)? {
             Resolved::Value(t) => Ok(t),
-            Resolved::Pointer(_) => Err(Error::Invalid(format!("expression {h:?} is a pointer, not a value"))),
+            Resolved::Pointer(_) => Err(Error::Invalid(format!(
+                "expression {h:?} is a pointer, not a value"
+            ))),
         }
     }
 
@@ -272,7 +300,9 @@ impl<'c, 'a> Fw<'c, 'a> {
         for (i, &sc) in scs.iter().enumerate() {
             let r = Op::Reg(self.fresh(sc));
             if let Some(v) = init {
-                let src = *v.get(i).ok_or_else(|| Error::Invalid("an initializer of the wrong size".into()))?;
+                let src = *v
+                    .get(i)
+                    .ok_or_else(|| Error::Invalid("an initializer of the wrong size".into()))?;
                 self.mov_to(r, src)?;
             }
             regs.push(r);

@@ -27,7 +27,8 @@ if [ "$MODE" = all ] || [ "$MODE" = check ]; then
     wc=$("$B" compare "/tmp/sdfc-img/$n-wgpu.png" "/tmp/sdfc-img/$n-cpu.png" --json 2>&1)
     cc=$("$B" compare "/tmp/sdfc-img/$n-cuda.png" "/tmp/sdfc-img/$n-cpu.png" --json 2>&1)
     cw=$("$B" compare "/tmp/sdfc-img/$n-cuda.png" "/tmp/sdfc-img/$n-wgpu.png" --json 2>&1)
-    echo "$n wgpu-cpu $wc | cuda-cpu $cc | cuda-wgpu $cw" | tee -a "$OUT/conformance.txt"
+    short() { python3 -c 'import json,sys; d=json.loads(sys.argv[1]); print(f"{d[\"psnr\"]:.1f} dB {100*d[\"differing\"]:.4f}%")' "$1" 2>/dev/null || echo "n/a"; }
+    echo "$n  wgpu-cpu $(short "$wc") | cuda-cpu $(short "$cc") | cuda-wgpu $(short "$cw")" | tee -a "$OUT/conformance.txt"
   done
   cp /tmp/sdfc-img/seed3-cuda.png /tmp/sdfc-img/seed5-wgpu.png "$OUT/" 2>/dev/null
   echo "== CUDA JIT: cold, then warm cache" | tee "$OUT/jit.txt"
@@ -40,22 +41,26 @@ if [ "$MODE" = all ] || [ "$MODE" = bench ]; then
   for size in 640x480 1024x768 1920x1080; do
     for aa in 1 4; do
       for b in wgpu cuda; do
-        "$B" bench $SEEDS --backend "$b" --size "$size" --aa "$aa" --frames 10 --json > "$OUT/bench-$b-$size-aa$aa.json" 2> "$OUT/bench-$b-$size-aa$aa.err" || echo "bench $b $size aa$aa FAILED: $(tail -n 3 "$OUT/bench-$b-$size-aa$aa.err")"
+        "$B" bench $SEEDS --backend "$b" --size "$size" --aa "$aa" --frames 10 --json > "/tmp/bench-$b-$size-aa$aa.json" 2> "/tmp/bench-$b-$size-aa$aa.err" || echo "bench $b $size aa$aa FAILED: $(tail -n 3 "/tmp/bench-$b-$size-aa$aa.err")"
       done
     done
   done
+  {
   python3 - "$OUT" <<'PY'
 import json, sys, glob, os
 out = sys.argv[1]
 rows = {}
-for path in glob.glob(os.path.join(out, "bench-*.json")):
+merged = []
+for path in sorted(glob.glob("/tmp/bench-*.json")):
     try:
         data = json.load(open(path))
     except Exception:
         continue
+    merged.extend(data)
     for t in data:
         key = (os.path.basename(t["scene"]), f'{t["width"]}x{t["height"]}', t["aa"])
         rows.setdefault(key, {})[t["backend"]] = t["median_s"] * 1e3
+json.dump(merged, open(os.path.join(out, "bench.json"), "w"), indent=1)
 print(f'{"scene":<12}{"size":>10}{"aa":>4}{"wgpu ms":>10}{"cuda ms":>10}{"cuda/wgpu":>10}')
 for key in sorted(rows):
     r = rows[key]
@@ -63,6 +68,16 @@ for key in sorted(rows):
     ratio = f"{c / w:.2f}" if w and c else "-"
     print(f'{key[0]:<12}{key[1]:>10}{key[2]:>4}{w if w is None else round(w, 2)!s:>10}{c if c is None else round(c, 2)!s:>10}{ratio:>10}')
 PY
+  } | tee "$OUT/table.txt"
 fi
 cat "$OUT/conformance.txt" 2>/dev/null | tail -n 12
 cat "$OUT/jit.txt" 2>/dev/null
+
+if [ "$MODE" = lattice ]; then
+  # The wgpu render of the 400-sphere lattice crashed once at exit on an H200: repeat it with
+  # backtraces to see where.
+  for i in 1 2; do
+    RUST_BACKTRACE=1 "$B" render examples/lattice.sdf --backend wgpu --size 1920x1080 -o /tmp/l.png --stats > "$OUT/lattice-$i.txt" 2>&1
+    echo "lattice wgpu run $i exit $?" | tee -a "$OUT/lattice.txt"
+  done
+fi

@@ -124,8 +124,13 @@ impl Cuda {
         text.push(0);
         let mut log = vec![0u8; 8192];
         let mut state: sys::CUlinkState = std::ptr::null_mut();
-        let mut options = [sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER, sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER_SIZE_BYTES];
-        let mut values = [log.as_mut_ptr() as *mut std::ffi::c_void, log.len() as *mut std::ffi::c_void];
+        let mut options = vec![sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER, sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER_SIZE_BYTES];
+        let mut values = vec![log.as_mut_ptr() as *mut std::ffi::c_void, log.len() as *mut std::ffi::c_void];
+        // A register cap trades spills for occupancy; the value is passed through to the JIT.
+        if let Some(n) = max_registers() {
+            options.push(sys::CUjit_option::CU_JIT_MAX_REGISTERS);
+            values.push(n as usize as *mut std::ffi::c_void);
+        }
         let check = |r: sys::CUresult, during: &'static str, log: &[u8]| -> Result<(), Error> {
             if r == sys::CUresult::CUDA_SUCCESS {
                 return Ok(());
@@ -138,7 +143,7 @@ impl Cuda {
         // PTX buffer is NUL-terminated and outlives cuLinkAddData; the cubin returned by
         // cuLinkComplete is copied before cuLinkDestroy frees it.
         unsafe {
-            check(sys::cuLinkCreate_v2(2, options.as_mut_ptr(), values.as_mut_ptr(), &mut state), "cuLinkCreate", &log)?;
+            check(sys::cuLinkCreate_v2(options.len() as u32, options.as_mut_ptr(), values.as_mut_ptr(), &mut state), "cuLinkCreate", &log)?;
             let added = sys::cuLinkAddData_v2(
                 state,
                 sys::CUjitInputType::CU_JIT_INPUT_PTX,
@@ -208,6 +213,11 @@ impl Cuda {
     }
 }
 
+/// The register cap for the JIT: `$SDFC_CUDA_MAX_REGISTERS` (0 or unset: the JIT's choice).
+fn max_registers() -> Option<u32> {
+    std::env::var("SDFC_CUDA_MAX_REGISTERS").ok()?.parse().ok().filter(|&n| n > 0)
+}
+
 /// Where the compiled module of `ptx` for a device is cached: `$SDFC_CACHE_DIR`, else
 /// `$XDG_CACHE_HOME/sdfc/cuda`, else `~/.cache/sdfc/cuda`. `None` when there is no home.
 fn cache_path(ptx: &str, device: &str, sm: u32) -> Option<PathBuf> {
@@ -220,6 +230,6 @@ fn cache_path(ptx: &str, device: &str, sm: u32) -> Option<PathBuf> {
         },
     };
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    (ptx, device, sm, env!("CARGO_PKG_VERSION")).hash(&mut h);
+    (ptx, device, sm, max_registers(), env!("CARGO_PKG_VERSION")).hash(&mut h);
     Some(dir.join(format!("{:016x}.cubin", h.finish())))
 }

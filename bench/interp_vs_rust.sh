@@ -7,12 +7,14 @@
 #   (a) the emitted Rust `map` (f32), called once per point, and
 #   (b) the sdfc batch interpreter (`eval::Tape` + `eval::Evaluator<f32>`, distance only,
 #       DEFAULT_CHUNK points per pass over the tape).
-# Each measurement is repeated (BENCH_REPS, default 7; Rust and interpreter alternate) and
-# the median is reported as ns/point, with the ratio interpreter / Rust and the largest
-# absolute difference between the two sets of distances. Output: a Markdown table.
+# Each measurement is repeated (BENCH_REPS, default 9; Rust and interpreter alternate) and
+# the median is reported as ns/point, from the thread's CPU time (CLOCK_THREAD_CPUTIME_ID,
+# which a busy shared machine disturbs less) and from the wall clock, with the ratio
+# interpreter / Rust of each and the largest absolute difference between the two sets of
+# distances. Output: a Markdown table.
 #
-# Usage: bench/interp_vs_rust.sh            (from anywhere; builds target/release/sdfc if absent)
-# Environment: BENCH_REPS (repetitions, default 7), BENCH_POINTS (default 1000000).
+# Usage: bench/interp_vs_rust.sh   (from anywhere; runs `cargo build --release` first)
+# Environment: BENCH_REPS (repetitions, default 9), BENCH_POINTS (default 1000000).
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -21,9 +23,10 @@ SDFC="$ROOT/target/release/sdfc"
 OUT="$ROOT/target/bench-rust"
 SCENES="seed1 seed2 seed3 seed4 seed5 seed6"
 
-if [ ! -x "$SDFC" ]; then
-    cargo build --release
-fi
+# Bring target/release/sdfc up to date with compiler/, so that the emitted Rust and the
+# interpreter come from the same compiler (the benchmark warns when they do not).
+cargo build --release --quiet || echo "warning: cargo build failed; using the existing $SDFC" >&2
+[ -x "$SDFC" ] || { echo "error: no $SDFC" >&2; exit 2; }
 
 mkdir -p "$OUT/src" "$OUT/scenes"
 
@@ -44,6 +47,7 @@ publish = false
 [dependencies]
 sdfc-compiler = { path = "$ROOT/compiler" }
 glam = "0.34"
+libc = "0.2"
 
 # The workspace's release profile, so the interpreter is built as in target/release/sdfc.
 [profile.release]
@@ -68,6 +72,23 @@ cp Cargo.lock "$OUT/Cargo.lock"
 use sdfc_compiler::eval::{Evaluator, Outputs, Tape, DEFAULT_CHUNK};
 use std::hint::black_box;
 use std::time::Instant;
+
+/// CPU time of the calling thread, in seconds (CLOCK_THREAD_CPUTIME_ID): unlike the wall
+/// clock, it does not count the time the thread waits while other processes use the core.
+fn thread_cpu_s() -> f64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: clock_gettime writes one timespec through a valid pointer.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    assert_eq!(rc, 0, "clock_gettime(CLOCK_THREAD_CPUTIME_ID) failed");
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// Wall and thread-CPU seconds taken by `f`.
+fn timed(f: impl FnOnce()) -> (f64, f64) {
+    let (w, c) = (Instant::now(), thread_cpu_s());
+    f();
+    (w.elapsed().as_secs_f64(), thread_cpu_s() - c)
+}
 
 /// SplitMix64: a fixed, dependency-free source of uniform points.
 struct Rng(u64);
@@ -102,7 +123,15 @@ fn env_usize(name: &str, default: usize) -> usize {
 }
 
 /// Times one scene: the emitted `map` against the interpreter, alternating.
-fn bench(name: &str, text: &str, map: fn(&[f32], &[f32], &[f32], &mut [f32]), pts: &[Vec<f32>; 3], reps: usize) {
+fn bench(
+    name: &str,
+    text: &str,
+    emitted: &str,
+    map: fn(&[f32], &[f32], &[f32], &mut [f32]),
+    pts: &[Vec<f32>; 3],
+    reps: usize,
+    notes: &mut Vec<String>,
+) {
     let (scene, diags, _) = sdfc_compiler::check::check_str(name, text);
     let scene = match scene {
         Some(s) => s,
@@ -112,6 +141,14 @@ fn bench(name: &str, text: &str, map: fn(&[f32], &[f32], &[f32], &mut [f32]), pt
         }
     };
     let program = sdfc_compiler::lower::lower(&scene);
+    // The emitted function came from target/release/sdfc; the interpreter is this build of
+    // compiler/. Say so when they are not the same compiler.
+    if sdfc_compiler::back::rust::write(&program) != emitted {
+        notes.push(format!(
+            "{name}: the emitted Rust differs from what this build of compiler/ emits \
+             (target/release/sdfc is older or newer than compiler/)"
+        ));
+    }
     let tape = Tape::new(&program, Outputs::Distance);
     let mut ev = Evaluator::<f32>::new(&tape, DEFAULT_CHUNK);
     let [xs, ys, zs] = pts;
@@ -134,27 +171,33 @@ fn bench(name: &str, text: &str, map: fn(&[f32], &[f32], &[f32], &mut [f32]), pt
         max_diff = max_diff.max((*a as f64 - *b as f64).abs());
     }
 
-    let mut t_rust = Vec::with_capacity(reps);
-    let mut t_interp = Vec::with_capacity(reps);
+    // [wall, cpu] seconds of each repetition.
+    let mut t_rust = [Vec::with_capacity(reps), Vec::with_capacity(reps)];
+    let mut t_interp = [Vec::with_capacity(reps), Vec::with_capacity(reps)];
     for _ in 0..reps {
-        let t = Instant::now();
-        map(black_box(xs), black_box(ys), black_box(zs), &mut d_rust);
-        black_box(&d_rust);
-        t_rust.push(t.elapsed().as_secs_f64());
-
-        let t = Instant::now();
-        ev.eval(black_box(xs), black_box(ys), black_box(zs), &mut d_interp, None);
-        black_box(&d_interp);
-        t_interp.push(t.elapsed().as_secs_f64());
+        let (w, c) = timed(|| {
+            map(black_box(xs), black_box(ys), black_box(zs), &mut d_rust);
+            black_box(&d_rust);
+        });
+        t_rust[0].push(w);
+        t_rust[1].push(c);
+        let (w, c) = timed(|| {
+            ev.eval(black_box(xs), black_box(ys), black_box(zs), &mut d_interp, None);
+            black_box(&d_interp);
+        });
+        t_interp[0].push(w);
+        t_interp[1].push(c);
     }
-    let rust_ns = median(t_rust) * 1e9 / n as f64;
-    let interp_ns = median(t_interp) * 1e9 / n as f64;
+    let ns = |t: &Vec<f64>| median(t.clone()) * 1e9 / n as f64;
+    let (rust_cpu, interp_cpu) = (ns(&t_rust[1]), ns(&t_interp[1]));
+    let (rust_wall, interp_wall) = (ns(&t_rust[0]), ns(&t_interp[0]));
     let nan_note = if nan_mismatch > 0 { format!(" ({nan_mismatch} NaN mismatches)") } else { String::new() };
     println!(
-        "| {name} | {} | {} | {rust_ns:.1} | {interp_ns:.1} | {:.2} | {max_diff:.3e}{nan_note} |",
+        "| {name} | {} | {} | {rust_cpu:.1} | {interp_cpu:.1} | **{:.2}** | {rust_wall:.1} | {interp_wall:.1} | {:.2} | {max_diff:.1e}{nan_note} |",
         program.len(),
         tape.len(),
-        interp_ns / rust_ns,
+        interp_cpu / rust_cpu,
+        interp_wall / rust_wall,
     );
 }
 
@@ -173,7 +216,7 @@ macro_rules! rust_loop {
 
 fn main() {
     let n = env_usize("BENCH_POINTS", 1_000_000);
-    let reps = env_usize("BENCH_REPS", 7).max(1);
+    let reps = env_usize("BENCH_REPS", 9).max(1);
     let mut rng = Rng(0x5DFC_2026);
     let mut pts = [Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n)];
     for _ in 0..n {
@@ -183,14 +226,27 @@ fn main() {
     }
     println!("{n} points uniform in [-4, 4]^3, median of {reps} runs, one thread, f32");
     println!();
-    println!("| scene | program ops | tape steps | Rust ns/point | interpreter ns/point | ratio | max abs diff |");
-    println!("|---|---:|---:|---:|---:|---:|---:|");
+    println!("ns/point: median over the repetitions of thread CPU time (and of wall time) / points");
+    println!();
+    println!("| scene | program ops | tape steps | Rust ns/pt (CPU) | interpreter ns/pt (CPU) | ratio (CPU) | Rust ns/pt (wall) | interpreter ns/pt (wall) | ratio (wall) | max abs diff |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let mut notes = Vec::new();
 EOF
     for s in $SCENES; do
-        echo "    bench(\"$s\", include_str!(\"../scenes/$s.sdf\"), rust_loop!($s), &pts, reps);"
+        echo "    bench(\"$s\", include_str!(\"../scenes/$s.sdf\"), include_str!(\"$s.rs\"), rust_loop!($s), &pts, reps, &mut notes);"
     done
-    echo "}"
+    cat <<'EOF'
+    if !notes.is_empty() {
+        println!();
+    }
+    for n in notes {
+        println!("warning: {n}");
+    }
+}
+EOF
 } > "$OUT/src/main.rs"
 
 CARGO_TARGET_DIR="$OUT/target" cargo build --release --quiet --manifest-path "$OUT/Cargo.toml"
+echo "date: $(date -u); $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')"
+echo "git HEAD $(git rev-parse --short HEAD 2>/dev/null || echo '?')$(git diff --quiet HEAD -- compiler 2>/dev/null || echo ' (compiler/ has uncommitted changes)')"
 "$OUT/target/release/sdfc-bench-rust"

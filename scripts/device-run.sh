@@ -60,13 +60,17 @@ for path in sorted(glob.glob("/tmp/bench-*.json")):
     for t in data:
         key = (os.path.basename(t["scene"]), f'{t["width"]}x{t["height"]}', t["aa"])
         rows.setdefault(key, {})[t["backend"]] = t["median_s"] * 1e3
+        rows[key][t["backend"] + "_wall"] = t.get("median_wall_s", 0) * 1e3
 json.dump(merged, open(os.path.join(out, "bench.json"), "w"), indent=1)
-print(f'{"scene":<12}{"size":>10}{"aa":>4}{"wgpu ms":>10}{"cuda ms":>10}{"cuda/wgpu":>10}')
-for key in sorted(rows):
+print(f'{"scene":<11}{"size":>10}{"aa":>3}  {"wgpu gpu":>9}{"cuda gpu":>9}{"ratio":>6}  {"wgpu wall":>9}{"cuda wall":>10}{"ratio":>6}')
+def f(x):
+    return "-" if not x else f"{x:.2f}"
+for key in sorted(rows, key=lambda k: (k[0], int(k[1].split("x")[0]), k[2])):
     r = rows[key]
-    w, c = r.get("wgpu"), r.get("cuda")
+    w, c, ww, cw = r.get("wgpu"), r.get("cuda"), r.get("wgpu_wall"), r.get("cuda_wall")
     ratio = f"{c / w:.2f}" if w and c else "-"
-    print(f'{key[0]:<12}{key[1]:>10}{key[2]:>4}{w if w is None else round(w, 2)!s:>10}{c if c is None else round(c, 2)!s:>10}{ratio:>10}')
+    wratio = f"{cw / ww:.2f}" if ww and cw else "-"
+    print(f'{key[0]:<11}{key[1]:>10}{key[2]:>3}  {f(w):>9}{f(c):>9}{ratio:>6}  {f(ww):>9}{f(cw):>10}{wratio:>6}')
 PY
   } | tee "$OUT/table.txt"
 fi

@@ -5,7 +5,7 @@ use crate::cpu::{self, Options, Precision, Render};
 use crate::gpu::{self, cuda::Cuda, Gpu};
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, Program};
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::scene::{analysis, Scene};
 use std::time::{Duration, Instant};
 
 /// Where a scene is rendered.
@@ -27,10 +27,10 @@ pub enum Backend {
 pub enum Prepared {
     /// CPU: the distance program and the render options.
     Cpu { program: Program, options: Options },
-    /// wgpu: the device and the validated kernel.
-    Wgpu { gpu: Box<Gpu>, kernel: Box<wgsl::Kernel> },
-    /// CUDA: the device and the loaded module.
-    Cuda { cuda: Box<Cuda>, loaded: Box<gpu::cuda::Loaded>, ptx_time: Duration },
+    /// wgpu: the device, the validated kernel and the scene's Lipschitz bound L.
+    Wgpu { gpu: Box<Gpu>, kernel: Box<wgsl::Kernel>, lipschitz: f64 },
+    /// CUDA: the device, the loaded module and the scene's Lipschitz bound L.
+    Cuda { cuda: Box<Cuda>, loaded: Box<gpu::cuda::Loaded>, ptx_time: Duration, lipschitz: f64 },
 }
 
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
@@ -38,8 +38,10 @@ pub enum Prepared {
 pub struct Frame {
     /// Image and statistics.
     pub render: Render,
-    /// Time of the frame.
+    /// Time of the frame (GPU time for GPU backends).
     pub time: Duration,
+    /// Wall time of the frame (the same as `time` on the CPU).
+    pub wall: Duration,
 }
 
 impl Prepared {
@@ -54,8 +56,14 @@ impl Prepared {
         }
     }
 
+    /// The L every backend steps with (`f / L`): derived by the analysis of the scene IR.
+    pub fn lipschitz(scene: &Scene) -> f64 {
+        analysis::analyse(scene).step_lipschitz()
+    }
+
     fn cpu(scene: &Scene, precision: Precision) -> Prepared {
-        Prepared::Cpu { program: lower::lower(scene), options: Options { precision, ..Options::default() } }
+        let options = Options { precision, lipschitz: Self::lipschitz(scene), ..Options::default() };
+        Prepared::Cpu { program: lower::lower(scene), options }
     }
 
     fn kernel(scene: &Scene) -> Result<wgsl::Kernel, String> {
@@ -64,7 +72,8 @@ impl Prepared {
 
     fn wgpu(scene: &Scene, require_hardware: bool) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
-        Ok(Prepared::Wgpu { gpu: Box::new(gpu), kernel: Box::new(Self::kernel(scene)?) })
+        let lipschitz = Self::lipschitz(scene);
+        Ok(Prepared::Wgpu { gpu: Box::new(gpu), kernel: Box::new(Self::kernel(scene)?), lipschitz })
     }
 
     fn cuda(scene: &Scene) -> Result<Prepared, String> {
@@ -75,7 +84,7 @@ impl Prepared {
         let text = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
         let ptx_time = start.elapsed();
         let loaded = cuda.load(&text, wgsl::ENTRY_POINT).map_err(|e| e.to_string())?;
-        Ok(Prepared::Cuda { cuda: Box::new(cuda), loaded: Box::new(loaded), ptx_time })
+        Ok(Prepared::Cuda { cuda: Box::new(cuda), loaded: Box::new(loaded), ptx_time, lipschitz: Self::lipschitz(scene) })
     }
 
     /// The backend's name, as in `--backend`.
@@ -128,16 +137,17 @@ impl Prepared {
                     let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     progress(n as f64 / tiles);
                 });
-                Ok(Frame { render, time: start.elapsed() })
+                let time = start.elapsed();
+                Ok(Frame { render, time, wall: time })
             }
-            Prepared::Wgpu { gpu, kernel } => {
-                let r = gpu::render(gpu, scene, kernel, 1.0, &mut |f| progress(f)).map_err(|e| e.to_string())?;
-                Ok(Frame { render: r.render, time: r.time })
+            Prepared::Wgpu { gpu, kernel, lipschitz } => {
+                let r = gpu::render(gpu, scene, kernel, *lipschitz, &mut |f| progress(f)).map_err(|e| e.to_string())?;
+                Ok(Frame { render: r.render, time: r.time, wall: r.wall })
             }
-            Prepared::Cuda { cuda, loaded, .. } => {
-                let r = gpu::render_cuda(cuda, scene, loaded, 1.0).map_err(|e| e.to_string())?;
+            Prepared::Cuda { cuda, loaded, lipschitz, .. } => {
+                let r = gpu::render_cuda(cuda, scene, loaded, *lipschitz).map_err(|e| e.to_string())?;
                 progress(1.0);
-                Ok(Frame { render: r.render, time: r.time })
+                Ok(Frame { render: r.render, time: r.time, wall: r.wall })
             }
         }
     }

@@ -2,8 +2,11 @@
 //! the `sdfc` binary.
 
 pub mod backend;
+pub mod chart;
 pub mod commands;
 pub mod cpu;
+pub mod depth;
+pub mod fp32;
 pub mod frontend;
 pub mod gpu;
 pub mod image;

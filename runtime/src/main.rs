@@ -1,4 +1,5 @@
-//! The `sdfc` command-line tool: check, compile, render and benchmark `.sdf` scenes.
+//! The `sdfc` command-line tool: check, compile, render, benchmark and compare `.sdf` scenes,
+//! and chart their speed against accuracy.
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -23,8 +24,11 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// Time the rendering of scenes.
     Bench(commands::bench::BenchArgs),
-    /// Compare two rendered images (RMSE, PSNR, differing pixels).
+    /// Compare two rendered images (RMSE, PSNR, differing pixels, and first hits when both
+    /// have a depth sidecar).
     Compare(commands::compare::CompareArgs),
+    /// Chart speed against accuracy over swept render settings, with the Pareto front.
+    Pareto(commands::pareto::ParetoArgs),
 }
 
 fn main() -> ExitCode {
@@ -42,5 +46,6 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(args),
         Command::Bench(args) => commands::bench::run(args),
         Command::Compare(args) => commands::compare::run(args),
+        Command::Pareto(args) => commands::pareto::run(args),
     }
 }

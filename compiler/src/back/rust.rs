@@ -1,8 +1,10 @@
 //! The Rust back end (`sdfc compile --emit rust`): a distance program written as two
 //! self-contained functions over glam, `map` in f32 and `map_f64` in f64, one statement per
-//! instruction, with the meaning of every operation as in [`crate::eval::scalar`].
+//! instruction, with the meaning of every operation as in [`crate::eval::scalar`]. A guarded
+//! block is an `if`/`else`; each of its results is declared before it and assigned in both
+//! branches.
 
-use crate::lower::{Axis, Binary, Op, Program, Reg, Unary};
+use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::fmt::Write;
 
 /// Writes `program` as Rust source.
@@ -29,11 +31,42 @@ fn function(out: &mut String, program: &Program, name: &str, vec: &str, ty: &str
     let _ = writeln!(out, "#[allow(unused_variables, clippy::all)]");
     let _ = writeln!(out, "pub fn {name}(p: {vec}) -> ({ty}, u32) {{");
     let mut notes = program.notes().iter().peekable();
-    for (i, op) in program.ops().iter().enumerate() {
-        while let Some(n) = notes.next_if(|n| n.at == i) {
-            let _ = writeln!(out, "    // {}", n.text);
+    let phi_of = program.phi_blocks();
+    let all = vec![true; program.len()];
+    let mut depth = 1;
+    let pad = |d: usize| "    ".repeat(d);
+    for item in program.items() {
+        match item {
+            Item::Op(i) if phi_of[i].is_none() => {
+                while let Some(n) = notes.next_if(|n| n.at <= i) {
+                    let _ = writeln!(out, "{}// {}", pad(depth), n.text);
+                }
+                let op = &program.ops()[i];
+                let _ = writeln!(out, "{}let r{i}: {ty} = {};", pad(depth), expr(op, ty));
+            }
+            Item::Op(_) => {}
+            Item::Open(b) => {
+                let block = &program.blocks()[b];
+                for (j, _, _) in crate::back::wgsl::results(program, b, &all) {
+                    let _ = writeln!(out, "{}let r{j}: {ty};", pad(depth));
+                }
+                let (x, y) = (block.bound.0, block.best.0);
+                let _ = writeln!(out, "{}if !(r{x} >= r{y}) {{", pad(depth));
+                depth += 1;
+            }
+            Item::Close(b) => {
+                let results = crate::back::wgsl::results(program, b, &all);
+                for &(j, then, _) in &results {
+                    let _ = writeln!(out, "{}r{j} = r{};", pad(depth), then.0);
+                }
+                let _ = writeln!(out, "{}}} else {{", pad(depth - 1));
+                for &(j, _, other) in &results {
+                    let _ = writeln!(out, "{}r{j} = r{};", pad(depth), other.0);
+                }
+                depth -= 1;
+                let _ = writeln!(out, "{}}}", pad(depth));
+            }
         }
-        let _ = writeln!(out, "    let r{i}: {ty} = {};", expr(op, ty));
     }
     let (d, m) = (program.distance().0, program.material().0);
     let _ = writeln!(
@@ -57,6 +90,7 @@ fn expr(op: &Op, ty: &str) -> String {
         Op::Unary(u, a) => unary(u, &r(a), ty),
         Op::Binary(b, x, y) => binary(b, &r(x), &r(y)),
         Op::Select(c, a, b) => format!("if {} != 0.0 {{ {} }} else {{ {} }}", r(c), r(a), r(b)),
+        Op::Phi(a, _) => r(a),
     }
 }
 

@@ -65,6 +65,11 @@ pub fn check(
     let mut cx = Ctx::default();
     cx.diags = diags;
     let scene = check_items(&mut cx, &items, entry);
+    if !crate::diagnostics::has_errors(&cx.diags) {
+        // Distance semantics: warnings where a construct makes the field unreliable.
+        let analysis = crate::scene::analysis::analyse(&scene);
+        cx.diags.extend_from_slice(analysis.diagnostics());
+    }
     // Diagnostics in source order, whatever stage found them.
     cx.diags.sort_by_key(|d| (d.span().file, d.span().start));
     let errors = crate::diagnostics::has_errors(&cx.diags);

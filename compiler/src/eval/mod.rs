@@ -16,19 +16,48 @@ mod tape;
 pub use float::Float;
 pub use tape::{Outputs, Tape};
 
+use tape::{Guard, Step};
+
 use crate::lower::{Axis, Op, Program};
+
+/// Temporary counters.
+pub static COUNT_STEPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+/// Temporary counters.
+pub static COUNT_LANES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+/// Temporary counters.
+pub static COUNT_EVALS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 /// The default number of points an evaluator processes per pass over the tape.
 pub const DEFAULT_CHUNK: usize = 256;
 
-/// Evaluates a program at one point, instruction by instruction (the reference semantics).
-/// The material id is the material register converted to an integer (negative and NaN
-/// become 0).
+/// Evaluates a program at one point, instruction by instruction (the reference semantics):
+/// a guarded block whose `bound >= best` is skipped, its results taking their values from
+/// before it. The material id is the material register converted to an integer (negative and
+/// NaN become 0).
 pub fn eval_point<T: Float>(program: &Program, p: [T; 3]) -> (T, u32) {
-    let mut regs: Vec<T> = Vec::with_capacity(program.len());
-    for op in program.ops() {
-        let r = |i: crate::lower::Reg| regs[i.0 as usize];
-        let v = match *op {
+    let ops = program.ops();
+    let blocks = program.blocks();
+    let mut regs: Vec<T> = vec![T::zero(); ops.len()];
+    let mut next = 0;
+    let mut i = 0;
+    'run: while i < ops.len() {
+        while let Some(b) = blocks.get(next).filter(|b| b.start == i) {
+            next += 1;
+            if regs[b.bound.0 as usize] >= regs[b.best.0 as usize] {
+                for j in b.end..b.end + b.results {
+                    if let Op::Phi(_, other) = ops[j] {
+                        regs[j] = regs[other.0 as usize];
+                    }
+                }
+                i = b.end + b.results;
+                while blocks.get(next).is_some_and(|n| n.start < i) {
+                    next += 1;
+                }
+                continue 'run;
+            }
+        }
+        let r = |x: crate::lower::Reg| regs[x.0 as usize];
+        regs[i] = match ops[i] {
             Op::Const(c) => T::from_f64(c),
             Op::Input(Axis::X) => p[0],
             Op::Input(Axis::Y) => p[1],
@@ -36,8 +65,9 @@ pub fn eval_point<T: Float>(program: &Program, p: [T; 3]) -> (T, u32) {
             Op::Unary(u, a) => scalar::unary(u, r(a)),
             Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
             Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
+            Op::Phi(a, _) => r(a),
         };
-        regs.push(v);
+        i += 1;
     }
     let get = |i: crate::lower::Reg| regs.get(i.0 as usize).copied().unwrap_or_else(T::zero);
     (
@@ -64,6 +94,9 @@ pub struct Evaluator<'t, T: Float> {
     /// `slot_count` slots of `chunk` values each, back to back.
     slots: Vec<T>,
     chunk: usize,
+    /// Per open guarded block: the points (of the enclosing block's packing) where it runs,
+    /// and how many points the enclosing block had.
+    frames: Vec<(Vec<u32>, usize)>,
 }
 
 impl<'t, T: Float> Evaluator<'t, T> {
@@ -74,7 +107,15 @@ impl<'t, T: Float> Evaluator<'t, T> {
         for &(slot, c) in tape.constants() {
             slots[slot as usize * chunk..][..chunk].fill(T::from_f64(c));
         }
-        Evaluator { tape, slots, chunk }
+        let frames = (0..tape.depth())
+            .map(|_| (Vec::with_capacity(chunk), 0))
+            .collect();
+        Evaluator {
+            tape,
+            slots,
+            chunk,
+            frames,
+        }
     }
 
     /// The tape this evaluator runs.
@@ -87,6 +128,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// otherwise). All slices must have the same length; extra elements are ignored.
     pub fn eval(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], mut m: Option<&mut [u32]>) {
         let n = x.len().min(y.len()).min(z.len()).min(d.len());
+        COUNT_EVALS.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed);
         let mut start = 0;
         while start < n {
             let end = (start + self.chunk).min(n);
@@ -118,17 +160,109 @@ impl<'t, T: Float> Evaluator<'t, T> {
         &self.slots[s as usize * self.chunk..][..n]
     }
 
+    /// Copies the first `n` values of slot `from` to slot `to`.
+    fn copy(&mut self, from: u32, to: u32, n: usize) {
+        let c = self.chunk;
+        let from = from as usize * c;
+        self.slots.copy_within(from..from + n, to as usize * c);
+    }
+
     /// One pass over the tape for up to `chunk` points.
     fn run(&mut self, x: &[T], y: &[T], z: &[T]) {
-        let n = x.len();
+        let mut n = x.len();
         let chunk = self.chunk;
         for (axis, src) in [(Axis::X, x), (Axis::Y, y), (Axis::Z, z)] {
             if let Some(s) = self.tape.input_slot(axis) {
                 self.slots[s as usize * chunk..][..n].copy_from_slice(src);
             }
         }
-        for step in self.tape.steps() {
-            step.apply(&mut self.slots, chunk, n);
+        let tape = self.tape;
+        let steps = tape.steps();
+        let mut depth = 0;
+        let mut s = 0;
+        while s < steps.len() {
+            match steps[s] {
+                Step::Inst(inst) => {
+                    COUNT_STEPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    COUNT_LANES.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed);
+                    inst.apply(&mut self.slots, chunk, n)
+                }
+                Step::Enter(g) => {
+                    let guard = tape.guard(g);
+                    match self.enter(guard, depth, n) {
+                        Some(m) => {
+                            depth += 1;
+                            n = m;
+                        }
+                        None => {
+                            s = guard.after;
+                            continue;
+                        }
+                    }
+                }
+                Step::Leave(g) => {
+                    depth -= 1;
+                    n = self.leave(tape.guard(g), depth, n);
+                }
+            }
+            s += 1;
         }
+    }
+
+    /// Starts a guarded block over `n` points: `None` when it runs nowhere (its results then
+    /// hold their values from before), else the number of points it runs on, whose values
+    /// from outside are gathered.
+    fn enter(&mut self, guard: &Guard, depth: usize, n: usize) -> Option<usize> {
+        let c = self.chunk;
+        let (mut idx, _) = std::mem::take(&mut self.frames[depth]);
+        idx.clear();
+        {
+            let bound = &self.slots[guard.bound as usize * c..][..n];
+            let best = &self.slots[guard.best as usize * c..][..n];
+            for (i, (b, d)) in bound.iter().zip(best).enumerate() {
+                if !(*b >= *d) {
+                    idx.push(i as u32);
+                }
+            }
+        }
+        let m = idx.len();
+        if m == 0 {
+            for &(dst, _, other) in &guard.phis {
+                self.copy(other, dst, n);
+            }
+        } else if m == n {
+            for &(from, to) in &guard.gathers {
+                self.copy(from, to, n);
+            }
+        } else {
+            for &(from, to) in &guard.gathers {
+                let (from, to) = (from as usize * c, to as usize * c);
+                for (j, &i) in idx.iter().enumerate() {
+                    self.slots[to + j] = self.slots[from + i as usize];
+                }
+            }
+        }
+        self.frames[depth] = (idx, n);
+        (m > 0).then_some(m)
+    }
+
+    /// Ends a guarded block that ran on `m` points: scatters its results into the enclosing
+    /// block's packing, whose number of points it returns.
+    fn leave(&mut self, guard: &Guard, depth: usize, m: usize) -> usize {
+        let c = self.chunk;
+        let (idx, n) = std::mem::take(&mut self.frames[depth]);
+        for &(dst, then, other) in &guard.phis {
+            if m == n {
+                self.copy(then, dst, n);
+            } else {
+                self.copy(other, dst, n);
+                let (then, dst) = (then as usize * c, dst as usize * c);
+                for (j, &i) in idx.iter().enumerate() {
+                    self.slots[dst + i as usize] = self.slots[then + j];
+                }
+            }
+        }
+        self.frames[depth] = (idx, n);
+        n
     }
 }

@@ -1,9 +1,17 @@
 //! Tapes: distance programs prepared for batch evaluation (dead instructions dropped,
 //! constant operands of two-operand instructions made immediate, registers packed into
 //! reusable slots), and the loop that runs each instruction.
+//!
+//! A guarded block becomes an `Enter` step, the block's steps and a `Leave` step. `Enter`
+//! finds the points of the batch where the block runs; where none does, it sets the block's
+//! results to their values from before and jumps past `Leave`. Otherwise it gathers the
+//! values the block reads from outside into slots of its own, packed for the running points
+//! only, so that the block's steps run over those points alone; `Leave` scatters the
+//! results back. Blocks nest, each packing relative to the one around it.
 
 use super::{scalar, Float};
-use crate::lower::{Axis, Binary, Op, Program, Reg, Unary};
+use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
+use std::collections::HashMap;
 
 /// Which results a tape computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -14,7 +22,7 @@ pub enum Outputs {
     DistanceAndMaterial,
 }
 
-/// The operation of one step.
+/// The operation of one instruction step.
 #[derive(Debug, Clone, Copy)]
 enum Code {
     /// `op(a)`
@@ -32,7 +40,7 @@ enum Code {
 /// One instruction over slots: `dst = code(a, b, c)` with the immediate `k`. `dst` never
 /// equals an operand.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Step {
+pub(super) struct Inst {
     code: Code,
     pub(super) dst: u32,
     a: u32,
@@ -41,13 +49,41 @@ pub(super) struct Step {
     k: f64,
 }
 
+/// A step of a tape.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Step {
+    /// An instruction.
+    Inst(Inst),
+    /// The start of a guarded block (index into the guards).
+    Enter(u32),
+    /// The end of a guarded block.
+    Leave(u32),
+}
+
+/// The slots of a guarded block.
+#[derive(Debug, Clone)]
+pub(super) struct Guard {
+    /// The block runs where `!(bound >= best)`.
+    pub bound: u32,
+    pub best: u32,
+    /// (outside slot, inside slot) of each value the block reads from outside.
+    pub gathers: Vec<(u32, u32)>,
+    /// (result slot outside, value inside, value from before) of each result.
+    pub phis: Vec<(u32, u32, u32)>,
+    /// The index of the step after the block's `Leave`.
+    pub after: usize,
+}
+
 /// A program prepared for an [`super::Evaluator`].
 #[derive(Debug, Clone)]
 pub struct Tape {
     steps: Vec<Step>,
+    guards: Vec<Guard>,
     constants: Vec<(u32, f64)>,
     inputs: [Option<u32>; 3],
     slots: usize,
+    depth: usize,
+    instructions: usize,
     distance: u32,
     material: Option<u32>,
 }
@@ -55,7 +91,6 @@ pub struct Tape {
 /// Where each register lives, decided once per tape.
 #[derive(Debug, Default)]
 struct Allocator {
-    slot_of: Vec<Option<u32>>,
     free: Vec<u32>,
     count: u32,
 }
@@ -69,73 +104,103 @@ impl Allocator {
     }
 }
 
+/// The nesting of a program: instructions and blocks (a block's `Phi`s belong to it).
+#[derive(Debug)]
+enum Entry {
+    Op(usize),
+    Block(usize, Vec<Entry>),
+}
+
+/// Builds the nesting from [`Program::items`].
+fn nest(program: &Program) -> Vec<Entry> {
+    let phi_of = program.phi_blocks();
+    let mut stack: Vec<(usize, Vec<Entry>)> = vec![(usize::MAX, Vec::new())];
+    for item in program.items() {
+        match item {
+            Item::Op(i) if phi_of[i].is_some() => {}
+            Item::Op(i) => {
+                if let Some(s) = stack.last_mut() {
+                    s.1.push(Entry::Op(i));
+                }
+            }
+            Item::Open(b) => stack.push((b, Vec::new())),
+            Item::Close(_) => {
+                if let Some((b, inner)) = stack.pop() {
+                    if let Some(s) = stack.last_mut() {
+                        s.1.push(Entry::Block(b, inner));
+                    }
+                }
+            }
+        }
+    }
+    stack.pop().map(|s| s.1).unwrap_or_default()
+}
+
+/// Compiles a program into a tape.
+#[derive(Debug)]
+struct Compiler<'p> {
+    program: &'p Program,
+    live: Vec<bool>,
+    live_blocks: Vec<bool>,
+    slot_of: Vec<Option<u32>>,
+    alloc: Allocator,
+    tape: Tape,
+    depth: usize,
+}
+
 impl Tape {
     /// Prepares `program` for evaluation of `outputs`.
     pub fn new(program: &Program, outputs: Outputs) -> Tape {
-        let ops = program.ops();
         let mut roots = vec![program.distance()];
         if outputs == Outputs::DistanceAndMaterial {
             roots.push(program.material());
         }
-        let last_use = last_uses(ops, &roots);
-        let in_slot = needs_slot(ops, &roots, &last_use);
-        let mut alloc = Allocator {
-            slot_of: vec![None; ops.len()],
-            ..Default::default()
+        let (live, live_blocks) = program.live(&roots);
+        let mut c = Compiler {
+            program,
+            live,
+            live_blocks,
+            slot_of: vec![None; program.len()],
+            alloc: Allocator::default(),
+            tape: Tape {
+                steps: Vec::new(),
+                guards: Vec::new(),
+                constants: Vec::new(),
+                inputs: [None; 3],
+                slots: 0,
+                depth: 0,
+                instructions: 0,
+                distance: 0,
+                material: None,
+            },
+            depth: 0,
         };
-        let mut tape = Tape {
-            steps: Vec::new(),
-            constants: Vec::new(),
-            inputs: [None; 3],
-            slots: 0,
-            distance: 0,
-            material: None,
-        };
-        // Constants read from memory and inputs keep their slots for the evaluator's life.
-        for (i, op) in ops.iter().enumerate() {
-            match *op {
-                Op::Const(c) if in_slot[i] => {
-                    let s = alloc.fresh();
-                    alloc.slot_of[i] = Some(s);
-                    tape.constants.push((s, c));
-                }
-                Op::Input(a) if last_use[i].is_some() => {
-                    let s = alloc.fresh();
-                    alloc.slot_of[i] = Some(s);
-                    tape.inputs[axis_index(a)] = Some(s);
-                }
-                _ => {}
-            }
-        }
-        for (i, op) in ops.iter().enumerate() {
-            if last_use[i].is_some() && !matches!(op, Op::Const(_) | Op::Input(_)) {
-                tape.steps.push(step(i, op, &mut alloc, &last_use, ops));
-            }
-        }
-        let slot = |r: Reg| {
-            alloc
-                .slot_of
-                .get(r.0 as usize)
-                .copied()
-                .flatten()
-                .unwrap_or(0)
-        };
-        tape.distance = slot(program.distance());
+        c.permanent(&roots);
+        let entries = nest(program);
+        c.scope(&entries, &roots);
+        let slot = |r: Reg| c.slot_of.get(r.0 as usize).copied().flatten().unwrap_or(0);
+        c.tape.distance = slot(program.distance());
         if outputs == Outputs::DistanceAndMaterial {
-            tape.material = Some(slot(program.material()));
+            c.tape.material = Some(slot(program.material()));
         }
-        tape.slots = alloc.count.max(1) as usize;
-        tape
+        c.tape.slots = c.alloc.count.max(1) as usize;
+        c.tape.instructions = c
+            .tape
+            .steps
+            .iter()
+            .filter(|s| matches!(s, Step::Inst(_)))
+            .count();
+        c.tape
     }
 
-    /// Number of instructions run per point.
+    /// Number of instructions run per point (when every guarded block runs).
     pub fn len(&self) -> usize {
-        self.steps.len()
+        self.instructions
     }
 
     /// True when the tape runs no instruction (the result is a constant or an input).
     pub fn is_empty(&self) -> bool {
-        self.steps.is_empty()
+        self.instructions == 0
     }
 
     /// Number of scratch slots (of one chunk each) an evaluator needs.
@@ -143,8 +208,17 @@ impl Tape {
         self.slots
     }
 
+    /// The deepest nesting of guarded blocks.
+    pub fn depth(&self) -> usize {
+        self.depth
+    }
+
     pub(super) fn steps(&self) -> &[Step] {
         &self.steps
+    }
+
+    pub(super) fn guard(&self, g: u32) -> &Guard {
+        &self.guards[g as usize]
     }
 
     pub(super) fn constants(&self) -> &[(u32, f64)] {
@@ -172,86 +246,280 @@ fn axis_index(a: Axis) -> usize {
     }
 }
 
-/// For each register, the index of the last instruction reading it (`usize::MAX` for
-/// outputs), or `None` when no output needs it.
-fn last_uses(ops: &[Op], roots: &[Reg]) -> Vec<Option<usize>> {
-    let mut last = vec![None; ops.len()];
-    for r in roots {
-        last[r.0 as usize] = Some(usize::MAX);
+impl Compiler<'_> {
+    fn ops(&self) -> &[Op] {
+        self.program.ops()
     }
-    for i in (0..ops.len()).rev() {
-        if last[i].is_none() {
-            continue;
-        }
-        for r in ops[i].operands() {
-            let l = &mut last[r.0 as usize];
-            *l = Some(l.map_or(i, |v: usize| v.max(i)));
+
+    fn constant(&self, r: Reg) -> Option<f64> {
+        match self.ops()[r.0 as usize] {
+            Op::Const(c) => Some(c),
+            _ => None,
         }
     }
-    last
+
+    fn is_const(&self, r: Reg) -> bool {
+        self.constant(r).is_some()
+    }
+
+    fn slot(&self, r: Reg) -> u32 {
+        self.slot_of[r.0 as usize].unwrap_or(0)
+    }
+
+    /// Slots for the constants read from memory and for the inputs, kept for the
+    /// evaluator's life (constants hold their value in every lane, so blocks read them
+    /// directly).
+    fn permanent(&mut self, roots: &[Reg]) {
+        let ops = self.program.ops();
+        let mut need = vec![false; ops.len()];
+        for r in roots {
+            need[r.0 as usize] = true;
+        }
+        for (i, op) in ops.iter().enumerate() {
+            if !self.live[i] {
+                continue;
+            }
+            match *op {
+                Op::Binary(_, x, y) if self.is_const(y) => need[x.0 as usize] = true,
+                Op::Binary(_, x, y) if self.is_const(x) => need[y.0 as usize] = true,
+                Op::Binary(..) | Op::Const(_) | Op::Input(_) => {}
+                _ => op.operands().iter().for_each(|r| need[r.0 as usize] = true),
+            }
+        }
+        for (b, block) in self.program.blocks().iter().enumerate() {
+            if self.live_blocks[b] {
+                need[block.bound.0 as usize] = true;
+                need[block.best.0 as usize] = true;
+            }
+        }
+        for (i, op) in ops.iter().enumerate() {
+            match *op {
+                Op::Const(c) if need[i] && self.live[i] => {
+                    let s = self.alloc.fresh();
+                    self.slot_of[i] = Some(s);
+                    self.tape.constants.push((s, c));
+                }
+                Op::Input(a) if self.live[i] => {
+                    let s = self.alloc.fresh();
+                    self.slot_of[i] = Some(s);
+                    self.tape.inputs[axis_index(a)] = Some(s);
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// The registers block `b` reads that are defined outside it (constants aside), the
+    /// values it must gather.
+    fn outside_reads(&self, b: usize) -> Vec<Reg> {
+        let block = self.program.blocks()[b];
+        let ops = self.ops();
+        let mut reads: Vec<Reg> = Vec::new();
+        let mut add = |r: Reg, me: &Self| {
+            if (r.0 as usize) < block.start && !me.is_const(r) {
+                reads.push(r);
+            }
+        };
+        for i in block.start..block.end {
+            if self.live[i] {
+                ops[i].operands().into_iter().for_each(|r| add(r, self));
+            }
+        }
+        for (nb, inner) in self.program.blocks().iter().enumerate() {
+            let within = inner.start >= block.start && inner.end <= block.end && nb != b;
+            if within && self.live_blocks[nb] {
+                add(inner.bound, self);
+                add(inner.best, self);
+            }
+        }
+        for i in block.end..block.end + block.results {
+            if let (true, Op::Phi(then, _)) = (self.live[i], ops[i]) {
+                add(then, self);
+            }
+        }
+        reads.sort();
+        reads.dedup();
+        reads
+    }
+
+    /// What the scope around block `b` sees it read: its outside reads, its test and the
+    /// values from before of its results.
+    fn block_reads(&self, b: usize) -> Vec<Reg> {
+        let block = self.program.blocks()[b];
+        let mut reads = self.outside_reads(b);
+        reads.push(block.bound);
+        reads.push(block.best);
+        for i in block.end..block.end + block.results {
+            if let (true, Op::Phi(_, other)) = (self.live[i], self.ops()[i]) {
+                reads.push(other);
+            }
+        }
+        reads
+    }
+
+    /// For the registers a scope reads, the position of the last entry reading them
+    /// (`entries.len()` for `at_end`: read when the scope ends).
+    fn last_uses(&self, entries: &[Entry], at_end: &[Reg]) -> HashMap<u32, usize> {
+        let mut last = HashMap::new();
+        for (k, e) in entries.iter().enumerate() {
+            match e {
+                Entry::Op(i) if self.live[*i] => {
+                    for r in self.ops()[*i].operands() {
+                        last.insert(r.0, k);
+                    }
+                }
+                Entry::Block(b, _) if self.live_blocks[*b] => {
+                    for r in self.block_reads(*b) {
+                        last.insert(r.0, k);
+                    }
+                }
+                _ => {}
+            }
+        }
+        for r in at_end {
+            last.insert(r.0, entries.len());
+        }
+        last
+    }
+
+    /// Whether a register's slot outlives every scope (constants, and inputs outside
+    /// blocks).
+    fn permanent_reg(&self, r: Reg) -> bool {
+        match self.ops()[r.0 as usize] {
+            Op::Const(_) => true,
+            Op::Input(_) => self.depth == 0,
+            _ => false,
+        }
+    }
+
+    /// Compiles one scope; `at_end` are the registers read when it ends.
+    fn scope(&mut self, entries: &[Entry], at_end: &[Reg]) {
+        let last = self.last_uses(entries, at_end);
+        for (k, e) in entries.iter().enumerate() {
+            let reads = match e {
+                Entry::Op(i) if self.live[*i] => {
+                    if !matches!(self.ops()[*i], Op::Const(_) | Op::Input(_)) {
+                        let inst = self.inst(*i);
+                        self.tape.steps.push(Step::Inst(inst));
+                    }
+                    self.ops()[*i].operands()
+                }
+                Entry::Block(b, inner) if self.live_blocks[*b] => {
+                    self.block(*b, inner);
+                    self.block_reads(*b)
+                }
+                _ => continue,
+            };
+            self.free_after(&reads, &last, k);
+        }
+    }
+
+    /// Frees the slots of the registers whose last read is entry `k`.
+    fn free_after(&mut self, reads: &[Reg], last: &HashMap<u32, usize>, k: usize) {
+        let mut freed: Vec<u32> = Vec::new();
+        for &r in reads {
+            if self.permanent_reg(r) || last.get(&r.0) != Some(&k) {
+                continue;
+            }
+            if let Some(s) = self.slot_of[r.0 as usize] {
+                if !freed.contains(&s) {
+                    freed.push(s);
+                }
+            }
+        }
+        self.alloc.free.extend(freed);
+    }
+
+    /// The step of instruction `i`: its destination is allocated before its operands are
+    /// freed, so that it is never one of them.
+    fn inst(&mut self, i: usize) -> Inst {
+        let op = self.ops()[i];
+        let (code, operands, k) = match op {
+            Op::Unary(u, a) => (Code::Unary(u), vec![a], 0.0),
+            Op::Binary(b, x, y) => match (self.constant(x), self.constant(y)) {
+                (_, Some(k)) => (Code::BinaryK(b), vec![x], k),
+                (Some(k), None) => (Code::KBinary(b), vec![y], k),
+                (None, None) => (Code::Binary(b), vec![x, y], 0.0),
+            },
+            Op::Select(c, a, b) => (Code::Select, vec![c, a, b], 0.0),
+            Op::Const(_) | Op::Input(_) | Op::Phi(..) => (Code::Select, Vec::new(), 0.0),
+        };
+        let s: Vec<u32> = operands.iter().map(|&r| self.slot(r)).collect();
+        let at = |n: usize| s.get(n).copied().unwrap_or(0);
+        let dst = self.alloc.fresh();
+        self.slot_of[i] = Some(dst);
+        Inst {
+            code,
+            dst,
+            a: at(0),
+            b: at(1),
+            c: at(2),
+            k,
+        }
+    }
+
+    /// Compiles guarded block `b`: gathers, its scope, the results.
+    fn block(&mut self, b: usize, inner: &[Entry]) {
+        let block = self.program.blocks()[b];
+        let reads = self.outside_reads(b);
+        let (bound, best) = (self.slot(block.bound), self.slot(block.best));
+        let mut saved = Vec::new();
+        let mut gathers = Vec::new();
+        for r in reads {
+            let outside = self.slot(r);
+            let copy = self.alloc.fresh();
+            saved.push((r, self.slot_of[r.0 as usize]));
+            self.slot_of[r.0 as usize] = Some(copy);
+            gathers.push((outside, copy));
+        }
+        let g = self.tape.guards.len() as u32;
+        self.tape.guards.push(Guard {
+            bound,
+            best,
+            gathers,
+            phis: Vec::new(),
+            after: 0,
+        });
+        self.tape.steps.push(Step::Enter(g));
+        let phis: Vec<(usize, Reg, Reg)> = (block.end..block.end + block.results)
+            .filter(|&i| self.live[i])
+            .filter_map(|i| match self.ops()[i] {
+                Op::Phi(then, other) => Some((i, then, other)),
+                _ => None,
+            })
+            .collect();
+        let thens: Vec<Reg> = phis.iter().map(|p| p.1).collect();
+        self.depth += 1;
+        self.tape.depth = self.tape.depth.max(self.depth);
+        self.scope(inner, &thens);
+        self.depth -= 1;
+        let then_slots: Vec<u32> = thens.iter().map(|&r| self.slot(r)).collect();
+        let held: Vec<u32> = thens
+            .iter()
+            .filter(|&&r| !self.is_const(r))
+            .map(|&r| self.slot(r))
+            .collect();
+        for (r, s) in saved {
+            self.slot_of[r.0 as usize] = s;
+        }
+        let mut results = Vec::new();
+        for (&(i, _, other), &then) in phis.iter().zip(&then_slots) {
+            let dst = self.alloc.fresh();
+            self.slot_of[i] = Some(dst);
+            results.push((dst, then, self.slot(other)));
+        }
+        let mut held = held;
+        held.sort_unstable();
+        held.dedup();
+        self.alloc.free.extend(held);
+        self.tape.steps.push(Step::Leave(g));
+        let guard = &mut self.tape.guards[g as usize];
+        guard.phis = results;
+        guard.after = self.tape.steps.len();
+    }
 }
 
-/// Which constants must live in a slot: outputs and operands of one-operand instructions
-/// and selects (two-operand instructions take them as immediates).
-fn needs_slot(ops: &[Op], roots: &[Reg], last_use: &[Option<usize>]) -> Vec<bool> {
-    let mut need = vec![false; ops.len()];
-    for r in roots {
-        need[r.0 as usize] = true;
-    }
-    for (i, op) in ops.iter().enumerate() {
-        if last_use[i].is_none() {
-            continue;
-        }
-        match *op {
-            Op::Unary(_, a) => need[a.0 as usize] = true,
-            Op::Select(c, a, b) => [c, a, b].iter().for_each(|r| need[r.0 as usize] = true),
-            _ => {}
-        }
-    }
-    need
-}
-
-/// Allocates the destination of instruction `i`, then frees operands read for the last time
-/// (after, so that the destination is never an operand).
-fn step(i: usize, op: &Op, alloc: &mut Allocator, last_use: &[Option<usize>], ops: &[Op]) -> Step {
-    let constant = |r: Reg| match ops[r.0 as usize] {
-        Op::Const(c) => Some(c),
-        _ => None,
-    };
-    let slot = |alloc: &Allocator, r: Reg| alloc.slot_of[r.0 as usize].unwrap_or(0);
-    let (code, operands, k) = match *op {
-        Op::Unary(u, a) => (Code::Unary(u), vec![a], 0.0),
-        Op::Binary(b, x, y) => match (constant(x), constant(y)) {
-            (_, Some(k)) => (Code::BinaryK(b), vec![x], k),
-            (Some(k), None) => (Code::KBinary(b), vec![y], k),
-            (None, None) => (Code::Binary(b), vec![x, y], 0.0),
-        },
-        Op::Select(c, a, b) => (Code::Select, vec![c, a, b], 0.0),
-        Op::Const(_) | Op::Input(_) => (Code::Select, Vec::new(), 0.0),
-    };
-    let s: Vec<u32> = operands.iter().map(|&r| slot(alloc, r)).collect();
-    let at = |n: usize| s.get(n).copied().unwrap_or(0);
-    let dst = alloc.fresh();
-    alloc.slot_of[i] = Some(dst);
-    let mut freed: Vec<u32> = Vec::new();
-    for (r, &slot) in operands.iter().zip(&s) {
-        let permanent = matches!(ops[r.0 as usize], Op::Const(_) | Op::Input(_));
-        if !permanent && last_use[r.0 as usize] == Some(i) && !freed.contains(&slot) {
-            freed.push(slot);
-        }
-    }
-    alloc.free.extend(freed);
-    Step {
-        code,
-        dst,
-        a: at(0),
-        b: at(1),
-        c: at(2),
-        k,
-    }
-}
-
-impl Step {
+impl Inst {
     /// Runs this step on the first `n` points of `slots` (slots of `chunk` values, back to
     /// back). The destination is split off the buffer; operands are read from both sides.
     #[inline]

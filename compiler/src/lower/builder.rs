@@ -1,7 +1,8 @@
-//! The program builder: emits instructions with constant folding and sharing of equal
-//! instructions, and offers the small vector helpers the lowering rules are written with.
+//! The program builder: emits instructions with constant folding, algebraic identities and
+//! sharing of equal instructions (when optimising), opens and closes guarded blocks, and
+//! offers the small vector helpers the lowering rules are written with.
 
-use super::{Axis, Binary, Note, Op, Program, Reg, Unary};
+use super::{Axis, Binary, Block, Note, Op, Program, Reg, Unary};
 use crate::eval::scalar;
 use std::collections::HashMap;
 
@@ -18,23 +19,36 @@ enum Key {
     Select(Reg, Reg, Reg),
 }
 
+/// The scope of registers defined outside every block.
+const TOP: u32 = u32::MAX;
+
 /// Builds one program.
 #[derive(Debug, Default)]
 pub(super) struct Builder {
+    /// Fold, share and drop dead instructions (optimisation level ≥ 1).
+    optimise: bool,
     ops: Vec<Op>,
     /// Per register: known to be ≥ 0 (a constant ≥ 0, or a select between such registers).
     nonneg: Vec<bool>,
+    /// Per register: the innermost block it was defined in, or [`TOP`].
+    scope: Vec<u32>,
     notes: Vec<Note>,
     /// Per note: whether it only resumes a node after its children (dropped when no
     /// instruction follows it).
     resumes: Vec<bool>,
     shared: HashMap<Key, Reg>,
+    blocks: Vec<Block>,
+    /// The blocks open now, innermost last.
+    open: Vec<u32>,
 }
 
 impl Builder {
-    /// An empty builder.
-    pub fn new() -> Self {
-        Self::default()
+    /// An empty builder; `optimise` turns on folding, sharing and dead-code removal.
+    pub fn new(optimise: bool) -> Self {
+        Builder {
+            optimise,
+            ..Self::default()
+        }
     }
 
     /// Starts a commented block at the next instruction.
@@ -80,8 +94,19 @@ impl Builder {
         self.value(r) == Some(x)
     }
 
-    /// Emits an instruction, or returns an equal or simpler one emitted before.
+    /// Whether register `r` may be read here: defined outside every block, or inside one
+    /// that is still open.
+    pub fn visible(&self, r: Reg) -> bool {
+        let s = self.scope[r.0 as usize];
+        s == TOP || self.open.contains(&s)
+    }
+
+    /// Emits an instruction, or (when optimising) returns an equal or simpler one emitted
+    /// before and visible here.
     pub fn emit(&mut self, op: Op) -> Reg {
+        if !self.optimise {
+            return self.push(op);
+        }
         if let Some(r) = self.fold(op) {
             return r;
         }
@@ -92,26 +117,65 @@ impl Builder {
             Op::Binary(b, x, y) if commutes(b) && y < x => Key::Binary(b, y, x),
             Op::Binary(b, x, y) => Key::Binary(b, x, y),
             Op::Select(c, a, b) => Key::Select(c, a, b),
+            Op::Phi(..) => return self.push(op),
         };
         if let Some(&r) = self.shared.get(&key) {
-            return r;
+            if self.visible(r) {
+                return r;
+            }
         }
+        let r = self.push(op);
+        self.shared.insert(key, r);
+        r
+    }
+
+    /// Appends an instruction in the current scope.
+    fn push(&mut self, op: Op) -> Reg {
         let r = Reg(self.ops.len() as u32);
         let nonneg = match op {
             Op::Const(c) => c >= 0.0,
-            Op::Select(_, a, b) => self.nonneg[a.0 as usize] && self.nonneg[b.0 as usize],
+            Op::Select(_, a, b) | Op::Phi(a, b) => {
+                self.nonneg[a.0 as usize] && self.nonneg[b.0 as usize]
+            }
             _ => false,
         };
         self.ops.push(op);
         self.nonneg.push(nonneg);
-        self.shared.insert(key, r);
+        self.scope.push(self.open.last().copied().unwrap_or(TOP));
         r
+    }
+
+    /// Opens a guarded block that runs where `!(bound >= best)`.
+    pub fn open_block(&mut self, bound: Reg, best: Reg) -> u32 {
+        let id = self.blocks.len() as u32;
+        self.blocks.push(Block {
+            bound,
+            best,
+            start: self.ops.len(),
+            end: self.ops.len(),
+            results: 0,
+        });
+        self.open.push(id);
+        id
+    }
+
+    /// Closes the innermost block, which must be `id`, and returns its results: for each
+    /// pair, the first register where the block ran, else the second.
+    pub fn close_block(&mut self, id: u32, results: &[(Reg, Reg)]) -> Vec<Reg> {
+        debug_assert_eq!(self.open.last(), Some(&id));
+        self.open.pop();
+        self.blocks[id as usize].end = self.ops.len();
+        self.blocks[id as usize].results = results.len();
+        results
+            .iter()
+            .map(|&(inner, other)| self.push(Op::Phi(inner, other)))
+            .collect()
     }
 
     /// Constant folding and algebraic identities; `None` when the instruction stays.
     fn fold(&mut self, op: Op) -> Option<Reg> {
         match op {
-            Op::Const(_) | Op::Input(_) => None,
+            Op::Const(_) | Op::Input(_) | Op::Phi(..) => None,
             Op::Unary(u, a) => self.fold_unary(u, a),
             Op::Binary(b, x, y) => self.fold_binary(b, x, y),
             Op::Select(c, a, b) => match self.value(c) {
@@ -128,6 +192,7 @@ impl Builder {
         }
         match (u, self.ops[a.0 as usize]) {
             (Unary::Neg, Op::Unary(Unary::Neg, inner)) => Some(inner),
+            (Unary::Neg, Op::Binary(Binary::Sub, x, y)) => Some(self.sub(y, x)),
             (Unary::Abs, Op::Unary(Unary::Abs | Unary::Neg, inner)) => Some(self.abs(inner)),
             _ => None,
         }
@@ -136,6 +201,9 @@ impl Builder {
     fn fold_binary(&mut self, b: Binary, x: Reg, y: Reg) -> Option<Reg> {
         if let (Some(u), Some(v)) = (self.value(x), self.value(y)) {
             return Some(self.c(scalar::binary(b, u, v)));
+        }
+        if let Some(r) = self.fold_chain(b, x, y) {
+            return Some(r);
         }
         match b {
             Binary::Add if self.is(y, 0.0) => Some(x),
@@ -161,29 +229,66 @@ impl Builder {
         }
     }
 
-    /// Ends the program: drops instructions the outputs do not need and renumbers the rest.
-    pub fn finish(self, d: Reg, m: Reg) -> Program {
-        let mut live = vec![false; self.ops.len()];
-        live[d.0 as usize] = true;
-        live[m.0 as usize] = true;
-        for i in (0..self.ops.len()).rev() {
-            if live[i] {
-                for r in self.ops[i].operands() {
-                    live[r.0 as usize] = true;
-                }
+    /// Chains of constant offsets and factors: (a ± k1) ± k2 becomes a ± (k1 ± k2), and
+    /// (a·k1)·k2 becomes a·(k1·k2) (one rounding instead of two).
+    fn fold_chain(&mut self, b: Binary, x: Reg, y: Reg) -> Option<Reg> {
+        let k2 = self.value(y)?;
+        let (inner, k1) = match self.ops[x.0 as usize] {
+            Op::Binary(ib, a, k) => (ib, (a, self.value(k)?)),
+            _ => return None,
+        };
+        let (a, k1) = k1;
+        match (b, inner) {
+            (Binary::Add | Binary::Sub, Binary::Add | Binary::Sub) => {
+                let sign = |op: Binary| if op == Binary::Add { 1.0 } else { -1.0 };
+                let k = sign(inner) * k1 + sign(b) * k2;
+                Some(self.addc(a, k))
             }
+            (Binary::Mul, Binary::Mul) => Some(self.mulc(a, k1 * k2)),
+            _ => None,
         }
-        let mut new_index = vec![Reg(0); self.ops.len()];
+    }
+
+    /// Ends the program: drops instructions the outputs do not need (when optimising) and
+    /// renumbers the rest.
+    pub fn finish(self, d: Reg, m: Reg) -> Program {
+        let raw = Program {
+            ops: self.ops,
+            notes: Vec::new(),
+            blocks: self.blocks,
+            distance: d,
+            material: m,
+        };
+        let (live, live_blocks) = if self.optimise {
+            raw.live(&[d, m])
+        } else {
+            (vec![true; raw.ops.len()], vec![true; raw.blocks.len()])
+        };
+        let n = raw.ops.len();
+        let mut new_index = vec![Reg(0); n];
         let mut ops = Vec::new();
-        let mut first_at_or_after = vec![0usize; self.ops.len() + 1];
-        for (i, op) in self.ops.iter().enumerate() {
+        let mut first_at_or_after = vec![0usize; n + 1];
+        for (i, op) in raw.ops.iter().enumerate() {
             first_at_or_after[i] = ops.len();
             if live[i] {
                 new_index[i] = Reg(ops.len() as u32);
                 ops.push(renumber(op, &new_index));
             }
         }
-        first_at_or_after[self.ops.len()] = ops.len();
+        first_at_or_after[n] = ops.len();
+        let blocks = raw
+            .blocks
+            .iter()
+            .zip(&live_blocks)
+            .filter(|(_, &l)| l)
+            .map(|(b, _)| Block {
+                bound: new_index[b.bound.0 as usize],
+                best: new_index[b.best.0 as usize],
+                start: first_at_or_after[b.start],
+                end: first_at_or_after[b.end],
+                results: (b.end..b.end + b.results).filter(|&i| live[i]).count(),
+            })
+            .collect();
         let moved: Vec<Note> = self
             .notes
             .into_iter()
@@ -196,6 +301,7 @@ impl Builder {
         Program {
             ops,
             notes,
+            blocks,
             distance: new_index[d.0 as usize],
             material: new_index[m.0 as usize],
         }
@@ -226,6 +332,7 @@ fn renumber(op: &Op, new_index: &[Reg]) -> Op {
         Op::Unary(u, a) => Op::Unary(u, n(a)),
         Op::Binary(b, x, y) => Op::Binary(b, n(x), n(y)),
         Op::Select(c, a, b) => Op::Select(n(c), n(a), n(b)),
+        Op::Phi(a, b) => Op::Phi(n(a), n(b)),
     }
 }
 

@@ -1,14 +1,29 @@
 //! Lowering of the node graph: point transforms are applied on the way down, distance and
 //! material combinations on the way up. A node reached again at the same point (a shared
-//! sub-shape) is lowered once.
+//! sub-shape) is lowered once where its registers are visible.
+//!
+//! When optimising, a union evaluates its unbounded children first, then its bounded ones
+//! in a bounding volume hierarchy ([`super::bvh`]) whose groups are guarded blocks: a group
+//! runs only where its bounding volume is nearer than the best distance so far (see
+//! `docs/optimisation.md` for why the result is the same).
 
+use super::bounds::{Bound, Bounds};
 use super::builder::{Builder, P};
+use super::bvh::{self, Kind, Tree};
 use super::{shapes, Reg, Unary, EMPTY_DISTANCE};
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
 use std::collections::HashMap;
 
 /// The material register value of a shape no `paint` has reached yet.
 pub(super) const UNPAINTED: f64 = -1.0;
+
+/// A subtree is guarded by a bound only when it costs at least this many instructions per
+/// point (a bound costs about a dozen, plus the block's bookkeeping).
+const GUARD_COST: f64 = 40.0;
+
+/// 1 - 2⁻¹²: bounds are shrunk by this factor, and padded, so that rounding can never make
+/// a bound exceed the field it bounds.
+const SHRINK: f64 = 1.0 - 1.0 / 4096.0;
 
 /// A lowered field: distance and material registers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -17,32 +32,63 @@ pub(super) struct Field {
     pub m: Reg,
 }
 
+/// How the graph is lowered.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Config<'a> {
+    /// Guard union groups by their bounds.
+    pub cull: bool,
+    /// The camera position (the hierarchy puts nearer groups first).
+    pub camera: V3,
+    /// For a simplified graph: the original node of each node (for comments).
+    pub origin: Option<&'a [NodeId]>,
+    /// Bounds and costs of the nodes (when optimising).
+    pub bounds: Option<&'a Bounds>,
+    /// Optimisation level ≥ 1: unions get a hierarchy, rotations are shared.
+    pub optimise: bool,
+}
+
 /// Walks the graph, emitting into a builder.
 #[derive(Debug)]
 pub(super) struct Lowerer<'a> {
     graph: &'a Graph,
     b: &'a mut Builder,
     memo: HashMap<(NodeId, P), Field>,
+    config: Config<'a>,
 }
 
 impl<'a> Lowerer<'a> {
-    pub fn new(graph: &'a Graph, b: &'a mut Builder) -> Self {
+    pub fn new(graph: &'a Graph, b: &'a mut Builder, config: Config<'a>) -> Self {
         Lowerer {
             graph,
             b,
             memo: HashMap::new(),
+            config,
         }
+    }
+
+    /// The number of a node in comments: its original node.
+    fn number(&self, id: NodeId) -> u32 {
+        self.config
+            .origin
+            .and_then(|o| o.get(id.0 as usize))
+            .map_or(id.0, |n| n.0)
     }
 
     /// Lowers node `id` evaluated at point `p`.
     pub fn node(&mut self, id: NodeId, p: P) -> Field {
         if let Some(&f) = self.memo.get(&(id, p)) {
-            return f;
+            if self.b.visible(f.d) && self.b.visible(f.m) {
+                return f;
+            }
         }
         let graph = self.graph;
         let node = graph.node(id);
-        self.b.note(format!("node {} {}", id.0, kind(node)));
+        self.b.note(format!("node {} {}", self.number(id), kind(node)));
         let f = match node {
+            Node::Combine {
+                op: Combine::Union,
+                children,
+            } if self.config.optimise => self.union(id, children, p),
             Node::Combine { op, children } => self.combine(id, *op, children, p),
             Node::SmoothCombine {
                 op,
@@ -106,8 +152,19 @@ impl<'a> Lowerer<'a> {
 
     /// For a domain transform: its child and the transformed point.
     fn domain(&mut self, node: &Node, p: P) -> Option<(NodeId, P)> {
+        let optimise = self.config.optimise;
+        let graph = self.graph;
         let b = &mut *self.b;
         let q = match node {
+            Node::Translate { offset, child } if optimise => match graph.node(*child) {
+                // Mᵀ(p - t) as Mᵀp - Mᵀt, so that children rotated alike share Mᵀp.
+                Node::Rotate { matrix, child } => {
+                    let r = rotate(b, p, matrix);
+                    let t = [0, 1, 2].map(|j| (0..3).map(|i| offset[i] * matrix[i][j]).sum());
+                    (*child, b.sub3c(r, t))
+                }
+                _ => (*child, b.sub3c(p, *offset)),
+            },
             Node::Translate { offset, child } => (*child, b.sub3c(p, *offset)),
             Node::Rotate { matrix, child } => (*child, rotate(b, p, matrix)),
             Node::Repeat {
@@ -184,6 +241,225 @@ impl<'a> Lowerer<'a> {
         })
     }
 
+    /// An optimised union: unbounded children first, then children bounded by a slab one by
+    /// one, then the hierarchy of the children with finite bounds, each group guarded by its
+    /// bound where culling is on.
+    fn union(&mut self, id: NodeId, children: &[NodeId], p: P) -> Field {
+        let Some(bounds) = self.config.bounds else {
+            return self.combine(id, Combine::Union, children, p);
+        };
+        self.share_rotations(children, p);
+        let (mut free, mut slabs, mut finite) = (Vec::new(), Vec::new(), Vec::new());
+        for (index, &c) in children.iter().enumerate() {
+            let item = |bound| bvh::Item {
+                id: c,
+                bound,
+                cost: bounds.cost(c),
+                index,
+            };
+            match bounds.get(c) {
+                None => free.push(c),
+                Some(b) if b.finite() => finite.push(item(b)),
+                Some(b) => slabs.push(item(b)),
+            }
+        }
+        let mut acc = None;
+        for c in free {
+            let f = self.node(c, p);
+            acc = Some(self.fold(acc, f));
+        }
+        let tree = (!finite.is_empty()).then(|| bvh::build(finite, self.config.camera));
+        let split = tree
+            .as_ref()
+            .is_some_and(|t| matches!(t.kind, Kind::Split(..)));
+        let upper = (self.config.cull && split && std::env::var("SDFC_NO_DESCEND").is_err())
+            .then(|| tree.as_ref().map(|t| self.descend(t, p)))
+            .flatten();
+        if acc.is_none() && (split || !slabs.is_empty()) {
+            // A starting value, so that every group can be guarded (the same with culling
+            // off, so that both programs compute the same).
+            acc = Some(Field {
+                d: self.b.c(EMPTY_DISTANCE),
+                m: self.b.c(UNPAINTED),
+            });
+        }
+        for item in slabs {
+            self.child(id, &item, p, &mut acc, true, upper);
+        }
+        if let Some(tree) = &tree {
+            self.tree(id, tree, p, &mut acc, upper);
+        }
+        acc.unwrap_or_else(|| Field {
+            d: self.b.c(EMPTY_DISTANCE),
+            m: self.b.c(UNPAINTED),
+        })
+    }
+
+    /// An upper bound of a hierarchy's union at `p`: the distance of the children of one
+    /// group, found by descending from the root into the half whose bound is nearer. Any
+    /// child's distance is at least the union's, so the guards may compare with it before
+    /// the nearest child is reached.
+    fn descend(&mut self, t: &Tree, p: P) -> Reg {
+        match &t.kind {
+            Kind::Leaf(items) => {
+                let mut upper: Option<Reg> = None;
+                for item in items {
+                    let f = self.node(item.id, p);
+                    upper = Some(match upper {
+                        None => f.d,
+                        Some(u) => self.b.min(u, f.d),
+                    });
+                }
+                upper.unwrap_or_else(|| self.b.c(f64::INFINITY))
+            }
+            Kind::Split(a, b) => {
+                let ba = bound_distance(self.b, &a.bound, p);
+                let bb = bound_distance(self.b, &b.bound, p);
+                let none = self.b.c(f64::INFINITY);
+                let first = self.b.open_block(ba, bb);
+                let ua = self.descend(a, p);
+                let ua = self.b.close_block(first, &[(ua, none)])[0];
+                let second = self.b.open_block(bb, ba);
+                let ub = self.descend(b, p);
+                self.b.close_block(second, &[(ub, ua)])[0]
+            }
+        }
+    }
+
+    /// Adds a field to a union's accumulated field.
+    fn fold(&mut self, acc: Option<Field>, f: Field) -> Field {
+        match acc {
+            None => f,
+            Some(a) => Field {
+                d: self.b.min(a.d, f.d),
+                m: self.material(Combine::Union, a, f),
+            },
+        }
+    }
+
+    /// Evaluates one child of a union into `acc`, guarded by its bound when `alone` (not
+    /// already inside a guard of its own) and worth it.
+    fn child(
+        &mut self,
+        id: NodeId,
+        item: &bvh::Item,
+        p: P,
+        acc: &mut Option<Field>,
+        alone: bool,
+        upper: Option<Reg>,
+    ) {
+        if alone && self.guards(acc, item.cost) {
+            let text = format!("node {} union: child culled by its bound", self.number(id));
+            self.guarded(text, &item.bound, p, acc, upper, |me, acc| {
+                me.child(id, item, p, acc, false, upper)
+            });
+            return;
+        }
+        let f = self.node(item.id, p);
+        *acc = Some(self.fold(*acc, f));
+    }
+
+    /// Whether a subtree of this cost gets a guard (there must be a best distance already).
+    fn guards(&self, acc: &Option<Field>, cost: f64) -> bool {
+        self.config.cull && acc.is_some() && cost >= GUARD_COST
+    }
+
+    /// Evaluates a node of a union's hierarchy into `acc`.
+    fn tree(&mut self, id: NodeId, t: &Tree, p: P, acc: &mut Option<Field>, upper: Option<Reg>) {
+        if self.guards(acc, t.cost) {
+            let n = leaves(t);
+            let text = format!(
+                "node {} union: group of {n} children culled by its bound",
+                self.number(id)
+            );
+            self.guarded(text, &t.bound, p, acc, upper, |me, acc| {
+                me.tree_body(id, t, p, acc, upper)
+            });
+        } else {
+            self.tree_body(id, t, p, acc, upper);
+        }
+    }
+
+    fn tree_body(
+        &mut self,
+        id: NodeId,
+        t: &Tree,
+        p: P,
+        acc: &mut Option<Field>,
+        upper: Option<Reg>,
+    ) {
+        match &t.kind {
+            Kind::Leaf(items) => {
+                for item in items {
+                    self.child(id, item, p, acc, items.len() > 1, upper);
+                }
+            }
+            Kind::Split(a, b) => {
+                self.tree(id, a, p, acc, upper);
+                self.tree(id, b, p, acc, upper);
+            }
+        }
+    }
+
+    /// Runs `body` in a block guarded by `bound`: where the bound is not nearer than the
+    /// accumulated distance (or the upper bound of the union, when known), the block is
+    /// skipped and `acc` keeps its value.
+    fn guarded(
+        &mut self,
+        text: String,
+        bound: &Bound,
+        p: P,
+        acc: &mut Option<Field>,
+        upper: Option<Reg>,
+        body: impl FnOnce(&mut Self, &mut Option<Field>),
+    ) {
+        let Some(outer) = *acc else {
+            return body(self, acc);
+        };
+        self.b.note(text);
+        let beta = bound_distance(self.b, bound, p);
+        let best = match upper {
+            Some(u) => self.b.min(outer.d, u),
+            None => outer.d,
+        };
+        let block = self.b.open_block(beta, best);
+        let mut inner = Some(outer);
+        body(self, &mut inner);
+        let inner = inner.unwrap_or(outer);
+        let r = self
+            .b
+            .close_block(block, &[(inner.d, outer.d), (inner.m, outer.m)]);
+        *acc = Some(Field { d: r[0], m: r[1] });
+    }
+
+    /// Computes, before the children of a union, the rotated point Mᵀp of every rotation
+    /// that two or more children start with, so that they share it.
+    fn share_rotations(&mut self, children: &[NodeId], p: P) {
+        let mut count: HashMap<[u64; 9], (usize, [V3; 3])> = HashMap::new();
+        for &c in children {
+            if let Some(m) = self.leading_rotation(c) {
+                let key = [0, 1, 2, 3, 4, 5, 6, 7, 8].map(|k| m[k / 3][k % 3].to_bits());
+                count.entry(key).or_insert((0, m)).0 += 1;
+            }
+        }
+        let mut shared: Vec<_> = count.into_iter().filter(|(_, (n, _))| *n >= 2).collect();
+        shared.sort_by_key(|(k, _)| *k);
+        for (_, (_, m)) in shared {
+            rotate(self.b, p, &m);
+        }
+    }
+
+    /// The rotation a node starts with, under paint and a translation.
+    fn leading_rotation(&self, mut id: NodeId) -> Option<[V3; 3]> {
+        loop {
+            match self.graph.node(id) {
+                Node::Paint { child, .. } | Node::Translate { child, .. } => id = *child,
+                Node::Rotate { matrix, .. } => return Some(*matrix),
+                _ => return None,
+            }
+        }
+    }
+
     /// The material of a combination: a union takes the nearer child's, an intersection the
     /// farther child's (the one whose surface it is), a subtraction keeps the first child's.
     fn material(&mut self, op: Combine, a: Field, f: Field) -> Reg {
@@ -228,6 +504,58 @@ impl<'a> Lowerer<'a> {
             m: self.material(op, fa, fb),
         }
     }
+}
+
+/// The number of children below a node of a hierarchy.
+fn leaves(t: &Tree) -> usize {
+    match &t.kind {
+        Kind::Leaf(items) => items.len(),
+        Kind::Split(a, b) => leaves(a) + leaves(b),
+    }
+}
+
+/// A lower bound of the field of a node with bound `b` at `p`: the signed distance `s` to the
+/// sphere, or a lower bound of it for the box (the largest of the per-axis distances, over
+/// its finite axes), with the volume padded by 10⁻³ of its size plus 10⁻⁴·(1 + |centre|),
+/// then `SHRINK·s` (scale 1) or `min(s, SHRINK·scale·s)`. The padding and the shrinking
+/// cover the rounding of both this value and the field (`docs/optimisation.md`).
+fn bound_distance(b: &mut Builder, bound: &Bound, p: P) -> Reg {
+    let (box_volume, sphere_volume) = bound.volumes();
+    let s = if bound.finite() && sphere_volume <= 1.5 * box_volume {
+        let sp = bound.sphere;
+        let pad = 1e-3 * sp.r + 1e-4 * (1.0 + norm(sp.c));
+        let q = b.sub3c(p, sp.c);
+        let l = b.len3(q);
+        b.subc(l, sp.r + pad)
+    } else {
+        let bx = bound.aabb;
+        let axes: Vec<usize> = (0..3).filter(|&i| bx.h[i].is_finite()).collect();
+        let size = axes.iter().map(|&i| bx.h[i] * bx.h[i]).sum::<f64>().sqrt();
+        let centre = axes.iter().map(|&i| bx.c[i] * bx.c[i]).sum::<f64>().sqrt();
+        let pad = 1e-3 * size + 1e-4 * (1.0 + centre);
+        let per_axis: Vec<Reg> = axes
+            .iter()
+            .map(|&i| {
+                let d = b.subc(p[i], bx.c[i]);
+                let d = b.abs(d);
+                b.subc(d, bx.h[i] + pad)
+            })
+            .collect();
+        per_axis
+            .into_iter()
+            .reduce(|x, y| b.max(x, y))
+            .unwrap_or_else(|| b.c(f64::NEG_INFINITY))
+    };
+    if bound.scale >= 1.0 {
+        b.mulc(s, SHRINK)
+    } else {
+        let t = b.mulc(s, SHRINK * bound.scale);
+        b.min(s, t)
+    }
+}
+
+fn norm(v: V3) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
 /// The smooth minimum. Poly: h = max(k - |a - b|, 0) / k, min(a, b) - h²·k/4 (Quilez's

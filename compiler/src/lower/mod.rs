@@ -1,18 +1,30 @@
 //! Lowering of the scene IR to the distance program: one flat scalar SSA program that maps a
 //! point (x, y, z) to (distance, material id).
 //!
-//! The program has no control flow. Every instruction defines one register, numbered by its
-//! position, over the evaluation's float type (f32 or f64). Material ids are registers too
-//! (small integers held as floats); a union picks the nearer child's material with `lt` and
-//! `select`. Loops (the Mandelbulb's iterations) are unrolled, with the escape test done by
-//! `select` so that the state freezes once a point has escaped.
+//! Every instruction defines one register, numbered by its position, over the evaluation's
+//! float type (f32 or f64). Material ids are registers too (small integers held as floats); a
+//! union picks the nearer child's material with `lt` and `select`. Loops (the Mandelbulb's
+//! iterations) are unrolled, with the escape test done by `select` so that the state freezes
+//! once a point has escaped.
 //!
-//! The builder folds constants and shares equal instructions, so a feature a scene does not
-//! use costs nothing, and a node reached twice at the same point is computed once.
+//! The only control flow is the guarded [`Block`]: a range of instructions that runs only
+//! where a bounding volume is nearer than the best distance found so far, followed by `phi`
+//! instructions that carry its results out (the block's value where it ran, the value from
+//! before it elsewhere). Blocks nest; a register defined inside a block is read only inside it.
+//!
+//! [`lower_with`] runs the optimisation passes of `docs/optimisation.md` at level 1 (the
+//! default, [`lower`]): the scene is simplified (composed transforms, flattened unions,
+//! primitives in their cheapest exact form), the builder folds constants, shares equal
+//! instructions and drops dead ones, and unions are grouped into a bounding volume hierarchy
+//! whose subtrees are skipped where they cannot be the nearest. Level 0 lowers the scene
+//! literally.
 
+mod bounds;
 mod builder;
+mod bvh;
 mod graph;
 mod shapes;
+mod simplify;
 
 use crate::scene::Scene;
 use std::fmt::Write;
@@ -93,6 +105,10 @@ pub enum Op {
     Binary(Binary, Reg, Reg),
     /// `a` where `c != 0`, else `b`.
     Select(Reg, Reg, Reg),
+    /// A result of the guarded block that ends just before this instruction (after the
+    /// block's other `Phi`s): `a` (defined inside the block) where the block ran, else `b`
+    /// (defined before it).
+    Phi(Reg, Reg),
 }
 
 impl Op {
@@ -103,6 +119,7 @@ impl Op {
             Op::Unary(_, a) => vec![a],
             Op::Binary(_, a, b) => vec![a, b],
             Op::Select(c, a, b) => vec![c, a, b],
+            Op::Phi(a, b) => vec![a, b],
         }
     }
 }
@@ -117,11 +134,43 @@ pub struct Note {
     pub text: String,
 }
 
+/// A guarded block: the instructions `start..end` run only where `!(bound >= best)` (where
+/// the bounding volume is nearer than the best distance so far, or either is NaN). The
+/// `results` instructions from `end` on are [`Op::Phi`]s that carry the block's results out.
+///
+/// Blocks nest properly: a block inside another lies, with its `Phi`s, within the other's
+/// range. `bound` and `best` are defined before `start`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Block {
+    /// The distance to the bounding volume of what the block computes (a lower bound of it).
+    pub bound: Reg,
+    /// The best distance before the block.
+    pub best: Reg,
+    /// Index of the first instruction inside.
+    pub start: usize,
+    /// One past the last instruction inside: the index of the first `Phi`.
+    pub end: usize,
+    /// Number of `Phi` instructions after `end`.
+    pub results: usize,
+}
+
+/// One step of a walk over a program's structure ([`Program::items`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Item {
+    /// The instruction at this index.
+    Op(usize),
+    /// A guarded block opens (by index into [`Program::blocks`]).
+    Open(usize),
+    /// A guarded block closes (its `Phi`s follow).
+    Close(usize),
+}
+
 /// A distance program: p ↦ (distance, material id).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Program {
     ops: Vec<Op>,
     notes: Vec<Note>,
+    blocks: Vec<Block>,
     distance: Reg,
     material: Reg,
 }
@@ -135,6 +184,11 @@ impl Program {
     /// The comments naming the IR node of each block.
     pub fn notes(&self) -> &[Note] {
         &self.notes
+    }
+
+    /// The guarded blocks, by increasing `start` (an enclosing block before the ones inside).
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
     }
 
     /// The register holding the signed distance.
@@ -157,17 +211,108 @@ impl Program {
         self.ops.is_empty()
     }
 
+    /// The program's structure in order: every instruction, with the opening and closing of
+    /// each guarded block around its instructions (the `Phi`s come after the close).
+    pub fn items(&self) -> Vec<Item> {
+        let mut out = Vec::with_capacity(self.ops.len() + 2 * self.blocks.len());
+        let mut open: Vec<usize> = Vec::new();
+        let mut next = 0;
+        for i in 0..=self.ops.len() {
+            loop {
+                if let Some(&b) = open.last() {
+                    if self.blocks[b].end == i {
+                        open.pop();
+                        out.push(Item::Close(b));
+                        continue;
+                    }
+                }
+                if next < self.blocks.len() && self.blocks[next].start == i {
+                    open.push(next);
+                    out.push(Item::Open(next));
+                    next += 1;
+                    continue;
+                }
+                break;
+            }
+            if i < self.ops.len() {
+                out.push(Item::Op(i));
+            }
+        }
+        out
+    }
+
+    /// Which instructions the registers `roots` depend on, and which blocks (a block is
+    /// needed when one of its `Phi`s is; then so are its `bound` and `best`).
+    pub fn live(&self, roots: &[Reg]) -> (Vec<bool>, Vec<bool>) {
+        let mut live = vec![false; self.ops.len()];
+        let mut blocks = vec![false; self.blocks.len()];
+        for r in roots {
+            if let Some(l) = live.get_mut(r.0 as usize) {
+                *l = true;
+            }
+        }
+        let phi_block = self.phi_blocks();
+        for i in (0..self.ops.len()).rev() {
+            if !live[i] {
+                continue;
+            }
+            for r in self.ops[i].operands() {
+                live[r.0 as usize] = true;
+            }
+            if let Some(b) = phi_block[i] {
+                if !blocks[b] {
+                    blocks[b] = true;
+                    live[self.blocks[b].bound.0 as usize] = true;
+                    live[self.blocks[b].best.0 as usize] = true;
+                }
+            }
+        }
+        (live, blocks)
+    }
+
+    /// For each instruction, the block it is a `Phi` of.
+    pub fn phi_blocks(&self) -> Vec<Option<usize>> {
+        let mut out = vec![None; self.ops.len()];
+        for (b, block) in self.blocks.iter().enumerate() {
+            for slot in &mut out[block.end..block.end + block.results] {
+                *slot = Some(b);
+            }
+        }
+        out
+    }
+
     /// The stable text form (`sdfc compile --emit program`): one instruction per line,
-    /// `%3 = add %1, %2`, with `;` comments naming the IR node of each block.
+    /// `%3 = add %1, %2`, with `;` comments naming the IR node of each block of
+    /// instructions. A guarded block reads `if !(%7 >= %5) {` … `}`, its instructions
+    /// indented, and is followed by its `phi` instructions.
     pub fn dump(&self) -> String {
         let mut out = String::new();
-        let _ = writeln!(out, "; distance program: {} instructions", self.ops.len());
+        let _ = write!(out, "; distance program: {} instructions", self.ops.len());
+        if !self.blocks.is_empty() {
+            let _ = write!(out, ", {} guarded blocks", self.blocks.len());
+        }
+        out.push('\n');
         let mut notes = self.notes.iter().peekable();
-        for (i, op) in self.ops.iter().enumerate() {
-            while let Some(n) = notes.next_if(|n| n.at == i) {
-                let _ = writeln!(out, "; {}", n.text);
+        let mut depth = 0;
+        for item in self.items() {
+            let pad = "  ".repeat(depth);
+            match item {
+                Item::Op(i) => {
+                    while let Some(n) = notes.next_if(|n| n.at == i) {
+                        let _ = writeln!(out, "{pad}; {}", n.text);
+                    }
+                    let _ = writeln!(out, "{pad}%{i} = {}", op_text(&self.ops[i]));
+                }
+                Item::Open(b) => {
+                    let b = &self.blocks[b];
+                    let _ = writeln!(out, "{pad}if !(%{} >= %{}) {{", b.bound.0, b.best.0);
+                    depth += 1;
+                }
+                Item::Close(_) => {
+                    depth -= 1;
+                    let _ = writeln!(out, "{}}}", "  ".repeat(depth));
+                }
             }
-            let _ = writeln!(out, "%{i} = {}", op_text(op));
         }
         for n in notes {
             let _ = writeln!(out, "; {}", n.text);
@@ -189,6 +334,7 @@ pub fn op_text(op: &Op) -> String {
         Op::Unary(u, a) => format!("{} %{}", unary_name(u), a.0),
         Op::Binary(b, x, y) => format!("{} %{}, %{}", binary_name(b), x.0, y.0),
         Op::Select(c, a, b) => format!("select %{}, %{}, %{}", c.0, a.0, b.0),
+        Op::Phi(a, b) => format!("phi %{}, %{}", a.0, b.0),
     }
 }
 
@@ -235,13 +381,70 @@ pub fn binary_name(b: Binary) -> &'static str {
 /// The distance a program reports for a scene with no objects: far beyond any `max_dist`.
 pub const EMPTY_DISTANCE: f64 = 1e30;
 
-/// Lowers a checked scene to its distance program.
+/// How a scene is lowered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LowerOptions {
+    /// Optimisation level: 0 lowers the scene literally (no folding, sharing, dead-code
+    /// removal, scene simplification or culling); 1 runs every pass.
+    pub level: u8,
+    /// At level 1: whether unions get bounding-volume culling (guarded blocks). Turning it
+    /// off keeps every other pass, and the same order of evaluation, so that the two
+    /// programs compute bit-identical results.
+    pub cull: bool,
+}
+
+impl Default for LowerOptions {
+    fn default() -> Self {
+        LowerOptions {
+            level: 1,
+            cull: true,
+        }
+    }
+}
+
+impl LowerOptions {
+    /// The options of an optimisation level (culling on at level 1).
+    pub fn level(level: u8) -> Self {
+        LowerOptions {
+            level,
+            cull: level > 0,
+        }
+    }
+}
+
+/// Lowers a checked scene to its distance program, with every optimisation pass.
 pub fn lower(scene: &Scene) -> Program {
-    let mut b = builder::Builder::new();
+    lower_with(scene, &LowerOptions::default())
+}
+
+/// Lowers a checked scene to its distance program with the given options.
+pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
+    let optimise = options.level > 0;
+    let mut b = builder::Builder::new(optimise);
     let p = b.input_point();
     let (d, m) = match scene.root {
+        Some(root) if optimise => {
+            let simple = simplify::simplify(&scene.graph, root);
+            let bounds = bounds::Bounds::new(&simple.graph);
+            let config = graph::Config {
+                cull: options.cull,
+                camera: scene.camera.position,
+                origin: Some(simple.origin.as_slice()),
+                bounds: Some(&bounds),
+                optimise: true,
+            };
+            let field = graph::Lowerer::new(&simple.graph, &mut b, config).node(simple.root, p);
+            (field.d, field.m)
+        }
         Some(root) => {
-            let field = graph::Lowerer::new(&scene.graph, &mut b).node(root, p);
+            let config = graph::Config {
+                cull: false,
+                camera: scene.camera.position,
+                origin: None,
+                bounds: None,
+                optimise: false,
+            };
+            let field = graph::Lowerer::new(&scene.graph, &mut b, config).node(root, p);
             (field.d, field.m)
         }
         None => (b.c(EMPTY_DISTANCE), b.c(graph::UNPAINTED)),

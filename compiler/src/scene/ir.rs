@@ -328,11 +328,11 @@ impl Default for Settings {
             width: 640,
             height: 480,
             aa: 1,
-            max_steps: 256,
-            epsilon: 1e-4,
+            max_steps: 512,
+            epsilon: 1e-5,
             max_depth: 5,
             max_dist: 100.0,
-            relaxation: 1.0,
+            relaxation: 1.4,
             background: [0.05, 0.06, 0.08],
         }
     }

@@ -1,5 +1,6 @@
 //! The scene IR and its text dump.
 
+pub mod analysis;
 mod dump;
 pub mod ir;
 

@@ -1,9 +1,12 @@
-//! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps).
+//! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps, and
+//! for GPU targets the achieved fraction of the FP32 floor).
 
 use super::render::{override_settings, parse_size, thread_pool, Backend};
 use crate::backend::Prepared;
 use crate::cpu::{Precision, Stats};
+use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
+use sdfc_compiler::lower;
 use sdfc_compiler::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -63,6 +66,9 @@ pub struct Timing {
     pub frames: u32,
     /// Median seconds per frame.
     pub median_s: f64,
+    /// Median wall time per frame, seconds: for GPU backends from the first submission until
+    /// the GPU finished (launch overheads included, readback excluded).
+    pub median_wall_s: f64,
     /// Fastest frame, seconds.
     pub min_s: f64,
     /// Camera rays per second, in millions (at the median).
@@ -71,6 +77,16 @@ pub struct Timing {
     pub total_mrays_per_s: f64,
     /// Instructions of the distance program.
     pub program_len: usize,
+    /// FP32 operations of one evaluation of the distance (`fp32::distance_ops`).
+    pub ops_per_eval: f64,
+    /// Evaluations of the distance in the last frame (marching steps and normal taps).
+    pub evaluations: u64,
+    /// GPU targets: the device's peak FP32 rate in TFLOP/s (null for the CPU and for a
+    /// device not in the table of `fp32::PEAKS`).
+    pub fp32_peak_tflops: Option<f64>,
+    /// GPU targets: ops_per_eval · evaluations / (median_s · peak), the fraction of the
+    /// FP32 floor achieved (null where the peak is).
+    pub fp32_fraction: Option<f64>,
     /// Statistics of the last frame.
     pub stats: Stats,
 }
@@ -127,15 +143,23 @@ fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, S
     let prepared = Prepared::new(args.backend, scene, args.precision)?;
     let mut last = prepared.render(scene, &|_| {})?.render;
     let mut times = Vec::new();
+    let mut walls = Vec::new();
     for _ in 0..args.frames {
         let frame = prepared.render(scene, &|_| {})?;
         times.push(frame.time.as_secs_f64());
+        walls.push(frame.wall.as_secs_f64());
         last = frame.render;
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
     let c = &last.stats.counters;
     let s = &scene.settings;
+    let ops_per_eval = fp32::distance_ops(&lower::lower(scene));
+    let evaluations = fp32::evaluations(c);
+    let peak = match prepared {
+        Prepared::Cpu { .. } => None,
+        _ => fp32::peak_flops(&prepared.device()),
+    };
     Ok(Timing {
         scene: name,
         backend: prepared.name(),
@@ -150,10 +174,18 @@ fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, S
         threads: rayon::current_num_threads(),
         frames: args.frames,
         median_s: median,
+        median_wall_s: {
+            walls.sort_by(f64::total_cmp);
+            walls[walls.len() / 2]
+        },
         min_s: times[0],
         mrays_per_s: c.camera_rays as f64 / median / 1e6,
         total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
         program_len: prepared.program_len(scene),
+        ops_per_eval,
+        evaluations,
+        fp32_peak_tflops: peak.map(|p| p / 1e12),
+        fp32_fraction: peak.map(|p| fp32::fraction(ops_per_eval, evaluations, median, p)),
         stats: last.stats,
     })
 }

@@ -1,6 +1,9 @@
-//! `sdfc check`: report every mistake in one or more scene files.
+//! `sdfc check`: report every mistake in one or more scene files, and what the analysis
+//! derived about each scene's distance field.
 
-use crate::frontend::{self, DiagnosticFormat};
+use crate::frontend::{self, DiagnosticFormat, Loaded};
+use sdfc_compiler::scene::analysis::{self, Analysis};
+use sdfc_compiler::scene::{Exactness, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -16,7 +19,8 @@ pub struct CheckArgs {
 }
 
 /// Checks every file; exit 0 when all are clean, 1 when any has errors, 2 when any could not
-/// be read.
+/// be read. For a clean file, the human format ends with one line: `FILE: ok` and what the
+/// field is (exact, a bound or approximate) with the L the renderers step with.
 pub fn run(args: CheckArgs) -> ExitCode {
     let mut code = 0u8;
     for file in &args.files {
@@ -27,13 +31,60 @@ pub fn run(args: CheckArgs) -> ExitCode {
             }
             Ok(loaded) => {
                 frontend::report(&loaded, args.diagnostics);
-                if loaded.scene.is_none() {
-                    code = code.max(1);
-                } else if args.diagnostics == DiagnosticFormat::Human {
-                    eprintln!("{}: ok", file.display());
+                match &loaded.scene {
+                    None => code = code.max(1),
+                    Some(scene) if args.diagnostics == DiagnosticFormat::Human => {
+                        eprintln!("{}: ok; {}", file.display(), summary(&loaded, scene));
+                    }
+                    Some(_) => {}
                 }
             }
         }
     }
     ExitCode::from(code)
+}
+
+/// What the analysis derived for the scene, in one clause: `distance field: bound (L = 1)`,
+/// or, when inexact, with the construct responsible.
+pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
+    let analysis = analysis::analyse(scene);
+    let Some(root) = analysis.root() else {
+        return "no objects".into();
+    };
+    let facts = root.facts;
+    let word = analysis::describe(facts.exactness);
+    let l = facts.lipschitz;
+    let cause = cause(loaded, scene, &analysis);
+    let step = analysis.step_lipschitz();
+    match facts.exactness {
+        Exactness::Exact | Exactness::Bound => format!("distance field: {word} (L = {})", num(l)),
+        Exactness::Approximate if !root.proven => format!(
+            "distance field: {word}, no bound proven{cause}; steps with L = {}",
+            num(step)
+        ),
+        Exactness::Approximate if step < l => format!(
+            "distance field: {word}, L = {}{cause}, clamped to {}",
+            num(l),
+            num(step)
+        ),
+        Exactness::Approximate => format!("distance field: {word}, L = {}{cause}", num(l)),
+    }
+}
+
+/// ` (the twist at FILE:LINE:COL)` for the node that made the field inexact, or nothing.
+fn cause(loaded: &Loaded, scene: &Scene, analysis: &Analysis) -> String {
+    let Some(id) = analysis.root().and_then(|r| r.cause) else {
+        return String::new();
+    };
+    let span = scene.graph.span(id);
+    let (line, col) = loaded.sources.line_col(span);
+    let file = loaded.sources.name(span.file);
+    let kind = analysis::kind(scene.graph.node(id));
+    format!(" (the {kind} at {file}:{line}:{col})")
+}
+
+/// A number with at most three decimals and no trailing zeros.
+fn num(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }

@@ -48,6 +48,10 @@ pub struct CompileArgs {
     /// The PTX target architecture (`--emit ptx`): 70 for sm_70, 80, 90, ...
     #[arg(long, default_value_t = 70, value_parser = clap::value_parser!(u32).range(50..=120))]
     pub sm: u32,
+    /// Optimisation level of the distance program: 0 lowers the scene literally, 1 runs every
+    /// pass (folding, sharing, dead code, scene simplification, bounding-volume culling).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(0..=1))]
+    pub opt: u8,
 }
 
 /// Compiles and writes the requested target.
@@ -75,7 +79,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
             let Some(scene) = &loaded.scene else {
                 return ExitCode::from(1);
             };
-            match emit(scene, other, args.sm) {
+            match emit(scene, other, args.sm, args.opt) {
                 Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
                 Err(msg) => {
                     eprintln!("{msg}");
@@ -88,8 +92,8 @@ pub fn run(args: CompileArgs) -> ExitCode {
 }
 
 /// The bytes of a target that needs the checked scene.
-fn emit(scene: &scene::Scene, target: Emit, sm: u32) -> Result<Vec<u8>, String> {
-    let program = lower::lower(scene);
+fn emit(scene: &scene::Scene, target: Emit, sm: u32, opt: u8) -> Result<Vec<u8>, String> {
+    let program = lower::lower_with(scene, &lower::LowerOptions::level(opt));
     let lang = match target {
         Emit::Ir => return Ok(scene::dump(scene).into_bytes()),
         Emit::Program => return Ok(program.dump().into_bytes()),

@@ -4,4 +4,5 @@ pub mod bench;
 pub mod check;
 pub mod compare;
 pub mod compile;
+pub mod pareto;
 pub mod render;

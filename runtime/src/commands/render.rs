@@ -1,11 +1,15 @@
-//! `sdfc render`: render a scene to a PNG image, and the option handling `sdfc bench` shares
-//! (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread pools).
+//! `sdfc render`: render a scene to a PNG image (optionally the reference render with its
+//! convergence check, and the depth sidecar), and the option handling `sdfc bench` and
+//! `sdfc pareto` share (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread
+//! pools).
 
-use crate::backend::Prepared;
+use crate::backend::{Frame, Prepared};
+use crate::cpu::reference::{self, Convergence};
 use crate::cpu::Precision;
+use crate::depth;
 use crate::frontend::{self, DiagnosticFormat};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::scene::Settings;
+use sdfc_compiler::scene::{Scene, Settings};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -43,6 +47,16 @@ pub struct RenderArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Render the reference: on the CPU in f64 with ε 1e-6, 100000 steps and no
+    /// over-relaxation (`--set` still applies on top), then check it against a render with ε
+    /// ten times smaller; `--stats` prints how well they agree, and a warning says when they
+    /// do not.
+    #[arg(long)]
+    pub reference: bool,
+    /// Also write the depth and hit buffers as a sidecar file beside the image (OUT.aux; see
+    /// docs/accuracy.md). Only the CPU backend has them.
+    #[arg(long)]
+    pub aux: bool,
 }
 
 /// Runs `sdfc render`.
@@ -51,6 +65,16 @@ pub fn run(args: RenderArgs) -> ExitCode {
         Ok(s) => s,
         Err(code) => return code,
     };
+    let (backend, precision) = match reference_mode(&args) {
+        Ok(b) => b,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            return ExitCode::from(2);
+        }
+    };
+    if args.reference {
+        scene.settings = reference::settings(&scene.settings);
+    }
     if let Err(msg) = override_settings(&mut scene.settings, args.size, args.aa, &args.set) {
         eprintln!("error: {msg}");
         return ExitCode::from(2);
@@ -62,10 +86,10 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let prepared = match pool.install(|| Prepared::new(args.backend, &scene, args.precision)) {
+    let prepared = match pool.install(|| Prepared::new(backend, &scene, precision)) {
         Ok(p) => p,
         Err(msg) => {
-            eprintln!("error: the {:?} backend is not available: {msg}", args.backend);
+            eprintln!("error: the {backend:?} backend is not available: {msg}");
             return ExitCode::from(1);
         }
     };
@@ -77,8 +101,19 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     };
-    let render = frame.render;
     let seconds = started.elapsed().as_secs_f64();
+    let check = if args.reference {
+        match pool.install(|| check_reference(&prepared, &scene, &frame)) {
+            Ok(c) => Some(c),
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                return ExitCode::from(1);
+            }
+        }
+    } else {
+        None
+    };
+    let render = frame.render;
     let out = args
         .output
         .clone()
@@ -86,6 +121,12 @@ pub fn run(args: RenderArgs) -> ExitCode {
     if let Err(e) = crate::image::write_png(&out, &render.image) {
         eprintln!("error: cannot write `{}`: {e}", out.display());
         return ExitCode::from(2);
+    }
+    if args.aux {
+        if let Err(msg) = write_sidecar(&out, render.depth.as_ref(), prepared.name()) {
+            eprintln!("error: {msg}");
+            return ExitCode::from(2);
+        }
     }
     let s = &scene.settings;
     eprintln!(
@@ -105,12 +146,74 @@ pub fn run(args: RenderArgs) -> ExitCode {
         }
         println!("time            {:.3} s (frame {:.3} s)", seconds, frame.time.as_secs_f64());
         println!("{}", render.stats);
+        if let Some(c) = &check {
+            println!("{c}");
+        }
+    }
+    if let Some(c) = check.as_ref().filter(|c| !c.converged) {
+        eprintln!("warning: {}", not_converged(c));
     }
     ExitCode::SUCCESS
 }
 
+/// The backend and precision of a render: `--reference` means the CPU in f64.
+fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
+    if !args.reference {
+        return Ok((args.backend, args.precision));
+    }
+    match args.backend {
+        Backend::Auto | Backend::Cpu => Ok((Backend::Cpu, Precision::F64)),
+        b => Err(format!(
+            "--reference renders on the CPU in f64; it cannot use --backend {}",
+            format!("{b:?}").to_lowercase()
+        )),
+    }
+}
+
+/// Renders the convergence check of a reference frame (ε divided by ten) and compares.
+pub fn check_reference(prepared: &Prepared, scene: &Scene, frame: &Frame) -> Result<Convergence, String> {
+    let mut finer = scene.clone();
+    finer.settings = reference::check_settings(&scene.settings);
+    let check = prepared.render(&finer, &|_| {})?;
+    Ok(reference::convergence(&scene.settings, &frame.render, &check.render))
+}
+
+/// The warning printed for a reference that did not converge.
+pub fn not_converged(c: &Convergence) -> String {
+    format!(
+        "the reference has not converged: against ε {:e} it reaches {:.1} dB (needs {} dB), max difference {:.3}, and {} rays ran out of {} steps; its error is not far below the errors it would measure",
+        c.check_epsilon,
+        c.difference.psnr,
+        reference::CONVERGED_PSNR,
+        c.difference.max,
+        c.budget_misses,
+        c.max_steps
+    )
+}
+
+/// Writes the depth sidecar beside `image`. A backend without depth buffers writes none,
+/// and a sidecar left there by an earlier render is removed so that it cannot be mistaken
+/// for this one's.
+fn write_sidecar(image: &Path, depth: Option<&depth::Depth>, backend: &str) -> Result<(), String> {
+    let path = depth::sidecar_path(image);
+    match depth {
+        Some(d) => d
+            .write(&path)
+            .map_err(|e| format!("cannot write `{}`: {e}", path.display())),
+        None => {
+            eprintln!("note: the {backend} backend has no depth buffers; no sidecar written");
+            match std::fs::remove_file(&path) {
+                Ok(()) => eprintln!("note: removed the stale sidecar `{}`", path.display()),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => return Err(format!("cannot remove the stale sidecar `{}`: {e}", path.display())),
+            }
+            Ok(())
+        }
+    }
+}
+
 /// Renders with a progress bar on stderr when stderr is a terminal.
-fn render_with_progress(prepared: &Prepared, scene: &sdfc_compiler::scene::Scene) -> Result<crate::backend::Frame, String> {
+fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame, String> {
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = ProgressBar::new(1000);
         if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}") {

@@ -12,6 +12,7 @@ mod camera;
 mod context;
 mod lanes;
 mod march;
+pub mod reference;
 mod shade;
 mod stats;
 mod tile;
@@ -19,6 +20,7 @@ mod vec;
 
 pub use stats::{Counters, Stats};
 
+use crate::depth::Depth;
 use crate::image::Image;
 use context::Context;
 use rayon::prelude::*;
@@ -71,6 +73,9 @@ pub struct Render {
     pub image: Image,
     /// What happened while rendering it.
     pub stats: Stats,
+    /// Where each pixel's camera rays first hit a surface (the CPU renderer always fills it
+    /// in; the GPU backends do not).
+    pub depth: Option<Depth>,
 }
 
 /// The tiles of an image, row-major.
@@ -136,19 +141,24 @@ pub fn render_in<T: Float>(
 fn assemble(settings: &Settings, rects: &[Rect], outs: &[tile::TileOut]) -> Render {
     let mut image = Image::new(settings.width, settings.height);
     let mut steps = vec![0u32; image.linear.len()];
+    let spp = settings.aa.max(1) * settings.aa.max(1);
+    let mut depth = Depth::empty(settings.width, settings.height, spp);
     let mut counters = Counters::default();
     for (rect, out) in rects.iter().zip(outs) {
         counters.add(&out.counters);
         for row in 0..rect.h {
             let dst = ((rect.y + row) * settings.width + rect.x) as usize;
             let src = (row * rect.w) as usize;
-            let n = rect.w as usize;
-            image.linear[dst..dst + n].copy_from_slice(&out.pixels[src..src + n]);
-            steps[dst..dst + n].copy_from_slice(&out.steps[src..src + n]);
+            let (d, s) = (dst..dst + rect.w as usize, src..src + rect.w as usize);
+            image.linear[d.clone()].copy_from_slice(&out.pixels[s.clone()]);
+            steps[d.clone()].copy_from_slice(&out.steps[s.clone()]);
+            depth.distance[d.clone()].copy_from_slice(&out.distance[s.clone()]);
+            depth.coverage[d].copy_from_slice(&out.coverage[s]);
         }
     }
     Render {
         image,
         stats: Stats::new(counters, &steps),
+        depth: Some(depth),
     }
 }

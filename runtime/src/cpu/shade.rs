@@ -24,7 +24,9 @@ struct Hit<T> {
     mat: u32,
 }
 
-/// Traces `wave`, adds what it sees to `acc` (per sample), and returns the next wave.
+/// Traces `wave`, adds what it sees to `acc` (per sample), and returns the next wave. On
+/// return `ws.traced[i]` still holds how ray `i` of `wave` ended (its first hit, for camera
+/// rays).
 pub(super) fn bounce<T: Float>(
     ctx: &Context<T>,
     ws: &mut Workspace<'_, T>,

@@ -3,7 +3,7 @@
 
 use super::context::Context;
 use super::lanes::{Lanes, Launch};
-use super::march::{Shadowed, Traced};
+use super::march::{Shadowed, Status, Traced};
 use super::shade;
 use super::stats::Counters;
 use super::vec::V3;
@@ -42,6 +42,10 @@ pub(super) struct TileOut {
     pub pixels: Vec<[f32; 3]>,
     /// Marching steps per pixel.
     pub steps: Vec<u32>,
+    /// Mean first-hit distance of the pixel's camera rays that hit (NaN where none hit).
+    pub distance: Vec<f32>,
+    /// Fraction of the pixel's camera rays that hit.
+    pub coverage: Vec<f32>,
     pub counters: Counters,
 }
 
@@ -86,8 +90,10 @@ pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect
     let mut acc = vec![V3::zero(); samples];
     let mut steps = vec![0u32; samples];
     let mut counters = Counters::default();
-    let mut wave = camera_rays(ctx, rect);
-    counters.camera_rays = wave.len() as u64;
+    let camera = camera_rays(ctx, rect);
+    counters.camera_rays = camera.len() as u64;
+    let mut wave = shade::bounce(ctx, ws, &camera, &mut acc, &mut steps, &mut counters);
+    let (distance, coverage) = first_hits(&ws.traced, spp as usize);
     while !wave.is_empty() {
         wave = shade::bounce(ctx, ws, &wave, &mut acc, &mut steps, &mut counters);
     }
@@ -108,8 +114,33 @@ pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect
     TileOut {
         pixels,
         steps,
+        distance,
+        coverage,
         counters,
     }
+}
+
+/// Per pixel, from the camera rays' results (`spp` consecutive samples per pixel): the mean
+/// distance to the first hit over the rays that hit (NaN where none did) and the fraction of
+/// rays that hit.
+fn first_hits<T: Float>(traced: &[Traced<T>], spp: usize) -> (Vec<f32>, Vec<f32>) {
+    let pixels = traced.len() / spp.max(1);
+    let mut distance = Vec::with_capacity(pixels);
+    let mut coverage = Vec::with_capacity(pixels);
+    for samples in traced.chunks(spp.max(1)) {
+        let (mut sum, mut hits) = (T::zero(), 0u32);
+        for s in samples.iter().filter(|s| s.status == Status::Hit) {
+            sum = sum + s.t;
+            hits += 1;
+        }
+        distance.push(if hits == 0 {
+            f32::NAN
+        } else {
+            (sum / T::from_f64(hits as f64)).to_f64() as f32
+        });
+        coverage.push(hits as f32 / samples.len() as f32);
+    }
+    (distance, coverage)
 }
 
 /// One ray per sample, pixels row-major, samples row-major within the pixel.

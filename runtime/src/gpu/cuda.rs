@@ -61,6 +61,8 @@ pub struct Frame {
     pub stats: Vec<u32>,
     /// Time of the launches, measured with CUDA events.
     pub gpu_time: Duration,
+    /// Wall time from the first launch until the last finished (readback excluded).
+    pub wall_time: Duration,
 }
 
 impl Cuda {
@@ -183,6 +185,7 @@ impl Cuda {
         // same measure as the wgpu path's per-pass timestamps (gaps between launches excluded).
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
         let mut events = Vec::with_capacity(tiles.len());
+        let wall = Instant::now();
         for (i, t) in tiles.iter().enumerate() {
             let start = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
             let end = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
@@ -202,6 +205,7 @@ impl Cuda {
             events.push((start, end));
         }
         s.synchronize().map_err(driver("running the kernel"))?;
+        let wall_time = wall.elapsed();
         let mut ms = 0.0f64;
         for (start, end) in &events {
             ms += start.elapsed_ms(end).map_err(driver("reading the timer"))? as f64;
@@ -209,7 +213,7 @@ impl Cuda {
         let image = s.clone_dtoh(&d_image).map_err(driver("reading the image"))?;
         let stats = s.clone_dtoh(&d_stats).map_err(driver("reading the statistics"))?;
         let linear = image.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
-        Ok(Frame { linear, stats, gpu_time: Duration::from_secs_f64(ms / 1e3) })
+        Ok(Frame { linear, stats, gpu_time: Duration::from_secs_f64(ms / 1e3), wall_time })
     }
 }
 

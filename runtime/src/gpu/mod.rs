@@ -13,9 +13,9 @@ use std::time::Duration;
 
 pub use self::wgpu::{Error, Gpu};
 
-/// Tile edge in pixels for GPU launches: 256×256 pixels per dispatch keeps each dispatch
+/// Tile edge in pixels for GPU launches: 512×512 pixels per dispatch keeps each dispatch
 /// short (well under a driver watchdog's limit) while filling a large GPU.
-pub const TILE: u32 = 256;
+pub const TILE: u32 = 512;
 
 /// A GPU render and how long the GPU spent on it.
 #[derive(Debug, Clone)]
@@ -26,6 +26,9 @@ pub struct GpuRender {
     pub time: Duration,
     /// Whether `time` comes from GPU timestamps.
     pub timestamps: bool,
+    /// Wall time from the first submission until the GPU finished (launch overheads
+    /// included, readback excluded).
+    pub wall: Duration,
 }
 
 /// Renders `scene` with an already generated kernel on `gpu`.
@@ -56,9 +59,10 @@ pub fn render(
         linear: frame.linear,
     };
     Ok(GpuRender {
-        render: Render { image, stats },
+        render: Render { image, stats, depth: None },
         time: frame.gpu_time.unwrap_or(frame.wall_time),
         timestamps: frame.gpu_time.is_some(),
+        wall: frame.wall_time,
     })
 }
 
@@ -69,7 +73,7 @@ pub fn render_cuda(cuda: &cuda::Cuda, scene: &Scene, loaded: &cuda::Loaded, lips
     let frame = cuda.render(loaded, &uniforms, s.width, s.height, STATS_WORDS, wgsl::WORKGROUP, TILE)?;
     let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
     let image = Image { width: s.width, height: s.height, linear: frame.linear };
-    Ok(GpuRender { render: Render { image, stats }, time: frame.gpu_time, timestamps: true })
+    Ok(GpuRender { render: Render { image, stats, depth: None }, time: frame.gpu_time, timestamps: true, wall: frame.wall_time })
 }
 
 /// Sums the kernel's per-pixel statistics words into the CPU renderer's statistics.

@@ -47,7 +47,7 @@ pub struct Frame {
     pub stats: Vec<u32>,
     /// GPU time of the dispatches measured with timestamps, where the adapter has them.
     pub gpu_time: Option<Duration>,
-    /// Wall time from the first submit to the last readback.
+    /// Wall time from the first submit until the last dispatch finished (readback excluded).
     pub wall_time: Duration,
 }
 
@@ -189,9 +189,9 @@ impl Gpu {
             self.wait()?;
             progress(((b * TILES_PER_SUBMIT + batch.len()) as f64 / tiles.len() as f64).min(1.0));
         }
+        let wall_time = start.elapsed();
         let linear = self.read(&buffers.image, pixels * 16)?;
         let stats = self.read(&buffers.stats, pixels * 4 * l.stats_words as u64)?;
-        let wall_time = start.elapsed();
         if let Some(e) = pollster::block_on(mem_scope.pop()) {
             return Err(Error::Render(e.to_string()));
         }

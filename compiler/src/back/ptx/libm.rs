@@ -1,10 +1,13 @@
 //! f32 functions as instruction sequences: sin, cos and tan (the hardware approximations
 //! after a Cody–Waite reduction to [−π, π], exact Payne–Hanek reduction beyond
-//! |x| > 105615), atan, atan2, asin and acos (Cephes' minimax polynomials), exp (ex2 with
-//! the rounding error of x·log2(e) put back), pow and the hyperbolic functions.
+//! |x| > 105615; `sin(a)` and `cos(a)` in straight-line code share one reduction), atan,
+//! atan2, asin and acos (Cephes' minimax polynomials), exp (ex2 of x·log2(e), as the
+//! Vulkan driver computes it), pow and the hyperbolic functions (on an exp with the
+//! rounding error of x·log2(e) put back).
 //! docs/ptx.md states each one's error.
 
 use super::emit::{ins, Class, Op};
+use super::math::{ADD, COS, DIV, DIV_FULL, EX2, FMA, LG2, MUL, SIN, SQRT, SUB};
 use super::writer::Fw;
 
 /// The name of the large-argument reduction `.func`.
@@ -28,7 +31,7 @@ impl Fw<'_, '_> {
     }
 
     fn fma(&mut self, a: Op, b: Op, c: Op) -> Op {
-        self.tri("fma.rn.f32", Class::F32, a, b, c)
+        self.tri(FMA, Class::F32, a, b, c)
     }
 
     /// A polynomial in `z` by Horner's rule, highest coefficient first.
@@ -42,20 +45,24 @@ impl Fw<'_, '_> {
 
     /// sin, cos or tan of `x`: the hardware approximations on x reduced to [−π, π].
     pub fn trig(&mut self, x: Op, which: Trig) -> Op {
-        let r = self.reduce_2pi(x);
-        // Near 0 the hardware's error is absolute (about 2^-21), so sin and tan take the
-        // first terms of their series there.
-        match which {
-            Trig::Sin => {
-                let s = self.un("sin.approx.f32", Class::F32, r);
-                let series = self.odd_series(x, &[-1.0 / 6.0, 1.0 / 120.0]);
-                self.near_zero(x, 0.03125, series, s)
+        let r = match self.reduced.iter().find(|&&(a, _)| a == x) {
+            Some(&(_, r)) => r,
+            None => {
+                let r = self.reduce_2pi(x);
+                self.reduced.push((x, r));
+                r
             }
-            Trig::Cos => self.un("cos.approx.f32", Class::F32, r),
+        };
+        // Near 0 the hardware's error is absolute (about 2^-21): within WGSL's absolute
+        // 2^-11 for sin and cos, as in NVIDIA's Vulkan driver; tan (rare, and whose error
+        // WGSL inherits from sin/cos) takes the first terms of its series there.
+        match which {
+            Trig::Sin => self.un(SIN, Class::F32, r),
+            Trig::Cos => self.un(COS, Class::F32, r),
             Trig::Tan => {
-                let s = self.un("sin.approx.f32", Class::F32, r);
-                let c = self.un("cos.approx.f32", Class::F32, r);
-                let t = self.f(super::math::DIV, s, c);
+                let s = self.un(SIN, Class::F32, r);
+                let c = self.un(COS, Class::F32, r);
+                let t = self.f(DIV, s, c);
                 let series = self.odd_series(x, &[1.0 / 3.0, 2.0 / 15.0]);
                 self.near_zero(x, 0.03125, series, t)
             }
@@ -67,7 +74,7 @@ impl Fw<'_, '_> {
     /// exact Payne–Hanek reduction (a `.func`, modulo π/2) beyond; NaN for ±∞.
     fn reduce_2pi(&mut self, x: Op) -> Op {
         self.cx.trig_reduce.set(true);
-        let t = self.f("mul.f32", x, Op::f32(1.0 / std::f32::consts::TAU));
+        let t = self.f(MUL, x, Op::f32(1.0 / std::f32::consts::TAU));
         let k = self.un("cvt.rni.f32.f32", Class::F32, t);
         let r = self.fma(k, Op::F32(0xC0C9_0FDA), x);
         let r = self.fma(k, Op::F32(0xB4A2_2168), r);
@@ -89,7 +96,7 @@ impl Fw<'_, '_> {
         let q3 = self.bin("and.b32", Class::B32, Op::Reg(q), Op::U32(3));
         let qf = self.un("cvt.rn.f32.u32", Class::F32, q3);
         let wrap = self.setp("gt.f32", qf, Op::f32(2.5));
-        let qm = self.f("sub.f32", qf, Op::f32(4.0));
+        let qm = self.f(SUB, qf, Op::f32(4.0));
         let qf = self.selp(super::types::Sc::F32, qm, qf, wrap);
         let full = self.fma(qf, Op::f32(FRAC_PI_2), Op::Reg(rq));
         let _ = self.mov_to(r, full);
@@ -102,16 +109,16 @@ impl Fw<'_, '_> {
         use super::types::Sc::F32;
         let big = self.setp("gt.f32", a, Op::F32(0x401A_827A));
         let mid = self.setp("gt.f32", a, Op::F32(0x3ED4_13CD));
-        let am1 = self.f("sub.f32", a, Op::f32(1.0));
-        let ap1 = self.f("add.f32", a, Op::f32(1.0));
+        let am1 = self.f(SUB, a, Op::f32(1.0));
+        let ap1 = self.f(ADD, a, Op::f32(1.0));
         let num = self.selp(F32, am1, a, mid);
         let num = self.selp(F32, Op::f32(-1.0), num, big);
         let den = self.selp(F32, ap1, Op::f32(1.0), mid);
         let den = self.selp(F32, a, den, big);
-        let u = self.f(super::math::DIV, num, den);
+        let u = self.f(DIV, num, den);
         let y0 = self.selp(F32, Op::f32(FRAC_PI_4), Op::f32(0.0), mid);
         let y0 = self.selp(F32, Op::f32(FRAC_PI_2), y0, big);
-        let z = self.f("mul.f32", u, u);
+        let z = self.f(MUL, u, u);
         let p = self.horner(
             z,
             &[
@@ -121,9 +128,9 @@ impl Fw<'_, '_> {
                 -3.333_295e-1,
             ],
         );
-        let p = self.f("mul.f32", p, z);
+        let p = self.f(MUL, p, z);
         let k = self.fma(p, u, u);
-        self.f("add.f32", y0, k)
+        self.f(ADD, y0, k)
     }
 
     pub fn atan(&mut self, x: Op) -> Op {
@@ -139,22 +146,22 @@ impl Fw<'_, '_> {
         let ay = self.un("abs.f32", Class::F32, y);
         let mx = self.f("max.f32", ax, ay);
         let mn = self.f("min.f32", ax, ay);
-        let t = self.f(super::math::DIV, mn, mx);
+        let t = self.f(DIV_FULL, mn, mx);
         let zero = self.setp("eq.f32", mx, Op::f32(0.0));
         let t = self.selp(F32, Op::f32(0.0), t, zero);
         let inf = self.setp("eq.f32", mn, Op::f32(f32::INFINITY));
         let t = self.selp(F32, Op::f32(1.0), t, inf);
         let a = self.atan_kernel(t);
         let swap = self.setp("gt.f32", ay, ax);
-        let b = self.f("sub.f32", Op::f32(FRAC_PI_2), a);
+        let b = self.f(SUB, Op::f32(FRAC_PI_2), a);
         let a = self.selp(F32, b, a, swap);
         let xb = self.un("mov.b32", Class::B32, x);
         let xneg = self.setp("lt.s32", xb, Op::I32(0));
-        let b = self.f("sub.f32", Op::f32(PI), a);
+        let b = self.f(SUB, Op::f32(PI), a);
         let a = self.selp(F32, b, a, xneg);
         let r = self.f("copysign.f32", y, a);
         let nan = self.setp("nan.f32", x, y);
-        let sum = self.f("add.f32", x, y);
+        let sum = self.f(ADD, x, y);
         self.selp(F32, sum, r, nan)
     }
 
@@ -164,8 +171,8 @@ impl Fw<'_, '_> {
         use super::types::Sc::F32;
         let big = self.setp("gt.f32", a, Op::f32(0.5));
         let zb = self.fma(Op::f32(-0.5), a, Op::f32(0.5));
-        let sb = self.un(super::math::SQRT, Class::F32, zb);
-        let a2 = self.f("mul.f32", a, a);
+        let sb = self.un(SQRT, Class::F32, zb);
+        let a2 = self.f(MUL, a, a);
         let z = self.selp(F32, zb, a2, big);
         let s = self.selp(F32, sb, a, big);
         let p = self.horner(
@@ -178,7 +185,7 @@ impl Fw<'_, '_> {
                 1.666_675_2e-1,
             ],
         );
-        let p = self.f("mul.f32", p, z);
+        let p = self.f(MUL, p, z);
         (self.fma(p, s, s), big)
     }
 
@@ -194,39 +201,48 @@ impl Fw<'_, '_> {
         use super::types::Sc::F32;
         let a = self.un("abs.f32", Class::F32, x);
         let (k, big) = self.asin_kernel(a);
-        let two_k = self.f("add.f32", k, k);
-        let small = self.f("sub.f32", Op::f32(FRAC_PI_2), k);
+        let two_k = self.f(ADD, k, k);
+        let small = self.f(SUB, Op::f32(FRAC_PI_2), k);
         let r = self.selp(F32, two_k, small, big);
         let neg = self.setp("lt.f32", x, Op::f32(0.0));
-        let flipped = self.f("sub.f32", Op::f32(PI), r);
+        let flipped = self.f(SUB, Op::f32(PI), r);
         self.selp(F32, flipped, r, neg)
     }
 
-    /// e^x: ex2 of t = x·log2(e), times 1 + ε·ln 2 where ε is what rounding t lost.
+    /// WGSL's exp: ex2 of x·log2(e), as NVIDIA's Vulkan driver computes it. Rounding
+    /// x·log2(e) adds up to |x|·2⁻²⁴ of relative error (|x| ulp at most), within WGSL's
+    /// 3 + 2·|x| ulp; the hyperbolic functions use [`Self::exp_precise`].
     pub fn exp(&mut self, x: Op) -> Op {
-        let t = self.f("mul.f32", x, Op::F32(0x3FB8_AA3B));
+        let t = self.f(MUL, x, Op::F32(0x3FB8_AA3B));
+        self.un(EX2, Class::F32, t)
+    }
+
+    /// e^x to 2.6 ulp: ex2 of t = x·log2(e), times 1 + ε·ln 2 where ε is what rounding t
+    /// lost.
+    pub fn exp_precise(&mut self, x: Op) -> Op {
+        let t = self.f(MUL, x, Op::F32(0x3FB8_AA3B));
         let nt = self.un("neg.f32", Class::F32, t);
         let e = self.fma(x, Op::F32(0x3FB8_AA3B), nt);
         let e = self.fma(x, Op::F32(0x32A5_7060), e);
         let c = self.fma(e, Op::f32(std::f32::consts::LN_2), Op::f32(1.0));
         let bad = self.setp("nan.f32", c, c);
         let c = self.selp(super::types::Sc::F32, Op::f32(1.0), c, bad);
-        let y = self.un("ex2.approx.f32", Class::F32, t);
-        self.f("mul.f32", y, c)
+        let y = self.un(EX2, Class::F32, t);
+        self.f(MUL, y, c)
     }
 
     /// ln x = log2(x)·ln 2.
     pub fn ln(&mut self, x: Op) -> Op {
-        let l = self.un("lg2.approx.f32", Class::F32, x);
-        self.f("mul.f32", l, Op::f32(std::f32::consts::LN_2))
+        let l = self.un(LG2, Class::F32, x);
+        self.f(MUL, l, Op::f32(std::f32::consts::LN_2))
     }
 
     /// x^y = 2^(y·log2 x), as WGSL defines it: NaN for x < 0; 1 when y = 0 or x = 1.
     pub fn pow(&mut self, x: Op, y: Op) -> Op {
         use super::types::Sc::F32;
-        let l = self.un("lg2.approx.f32", Class::F32, x);
-        let t = self.f("mul.f32", y, l);
-        let p = self.un("ex2.approx.f32", Class::F32, t);
+        let l = self.un(LG2, Class::F32, x);
+        let t = self.f(MUL, y, l);
+        let p = self.un(EX2, Class::F32, t);
         let y0 = self.setp("eq.f32", y, Op::f32(0.0));
         let x1 = self.setp("eq.f32", x, Op::f32(1.0));
         let one = self.bin("or.pred", Class::Pred, y0, x1);
@@ -235,13 +251,13 @@ impl Fw<'_, '_> {
 
     /// x + x³·(c₁ + c₂x² + c₃x⁴ …): the start of an odd series, for small |x|.
     fn odd_series(&mut self, x: Op, c: &[f32]) -> Op {
-        let z = self.f("mul.f32", x, x);
+        let z = self.f(MUL, x, x);
         let mut rev = c.iter().rev();
         let mut p = Op::f32(rev.next().copied().unwrap_or(0.0));
         for &k in rev {
             p = self.fma(p, z, Op::f32(k));
         }
-        let p = self.f("mul.f32", p, z);
+        let p = self.f(MUL, p, z);
         self.fma(p, x, x)
     }
 
@@ -257,15 +273,15 @@ impl Fw<'_, '_> {
     /// before the result overflows); sinh by its series near 0.
     pub fn sinh_cosh(&mut self, x: Op, cosh: bool) -> Op {
         let a = self.un("abs.f32", Class::F32, x);
-        let h = self.f("mul.f32", a, Op::f32(0.5));
-        let e = self.exp(h);
-        let half = self.f("mul.f32", e, Op::f32(0.5));
-        let big = self.f("mul.f32", e, half);
-        let small = self.f(super::math::DIV, Op::f32(0.25), big);
+        let h = self.f(MUL, a, Op::f32(0.5));
+        let e = self.exp_precise(h);
+        let half = self.f(MUL, e, Op::f32(0.5));
+        let big = self.f(MUL, e, half);
+        let small = self.f(DIV, Op::f32(0.25), big);
         if cosh {
-            return self.f("add.f32", big, small);
+            return self.f(ADD, big, small);
         }
-        let d = self.f("sub.f32", big, small);
+        let d = self.f(SUB, big, small);
         let r = self.f("copysign.f32", x, d);
         let series = self.odd_series(x, &[1.0 / 6.0, 1.0 / 120.0, 1.0 / 5040.0]);
         self.near_zero(x, 0.5, series, r)
@@ -275,11 +291,11 @@ impl Fw<'_, '_> {
     /// its series near 0.
     pub fn tanh(&mut self, x: Op) -> Op {
         let a = self.un("abs.f32", Class::F32, x);
-        let a2 = self.f("add.f32", a, a);
-        let e = self.exp(a2);
-        let d = self.f("add.f32", e, Op::f32(1.0));
-        let q = self.f(super::math::DIV, Op::f32(2.0), d);
-        let r = self.f("sub.f32", Op::f32(1.0), q);
+        let a2 = self.f(ADD, a, a);
+        let e = self.exp_precise(a2);
+        let d = self.f(ADD, e, Op::f32(1.0));
+        let q = self.f(DIV, Op::f32(2.0), d);
+        let r = self.f(SUB, Op::f32(1.0), q);
         let r = self.f("copysign.f32", x, r);
         let series = self.odd_series(x, &[-1.0 / 3.0, 2.0 / 15.0, -17.0 / 315.0]);
         self.near_zero(x, 0.25, series, r)
@@ -290,8 +306,8 @@ impl Fw<'_, '_> {
     pub fn asinh(&mut self, x: Op) -> Op {
         let a = self.un("abs.f32", Class::F32, x);
         let s = self.fma(a, a, Op::f32(1.0));
-        let s = self.un(super::math::SQRT, Class::F32, s);
-        let s = self.f("add.f32", a, s);
+        let s = self.un(SQRT, Class::F32, s);
+        let s = self.f(ADD, a, s);
         let r = self.ln(s);
         let r = self.log_of_double(a, r);
         let r = self.f("copysign.f32", x, r);
@@ -302,7 +318,7 @@ impl Fw<'_, '_> {
     /// ln(2a) = ln a + ln 2 where a > 4096, else `r`.
     fn log_of_double(&mut self, a: Op, r: Op) -> Op {
         let l = self.ln(a);
-        let l = self.f("add.f32", l, Op::f32(std::f32::consts::LN_2));
+        let l = self.f(ADD, l, Op::f32(std::f32::consts::LN_2));
         let big = self.setp("gt.f32", a, Op::f32(4096.0));
         self.selp(super::types::Sc::F32, l, r, big)
     }
@@ -310,19 +326,19 @@ impl Fw<'_, '_> {
     /// acosh x = ln(x + sqrt(x² − 1)); ln x + ln 2 for x > 4096.
     pub fn acosh(&mut self, x: Op) -> Op {
         let s = self.fma(x, x, Op::f32(-1.0));
-        let s = self.un(super::math::SQRT, Class::F32, s);
-        let s = self.f("add.f32", x, s);
+        let s = self.un(SQRT, Class::F32, s);
+        let s = self.f(ADD, x, s);
         let r = self.ln(s);
         self.log_of_double(x, r)
     }
 
     /// atanh x = ln((1 + x)/(1 − x))/2; its series near 0.
     pub fn atanh(&mut self, x: Op) -> Op {
-        let n = self.f("add.f32", Op::f32(1.0), x);
-        let d = self.f("sub.f32", Op::f32(1.0), x);
-        let q = self.f(super::math::DIV, n, d);
+        let n = self.f(ADD, Op::f32(1.0), x);
+        let d = self.f(SUB, Op::f32(1.0), x);
+        let q = self.f(DIV, n, d);
         let l = self.ln(q);
-        let r = self.f("mul.f32", l, Op::f32(0.5));
+        let r = self.f(MUL, l, Op::f32(0.5));
         let series = self.odd_series(x, &[1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0]);
         self.near_zero(x, 0.15, series, r)
     }

@@ -15,14 +15,16 @@
 //! - variables (function locals and `var<private>`) live in registers, except those an
 //!   array or matrix of which is indexed with a run-time index: they live in `.local`
 //!   memory with the WGSL layout;
-//! - structured control flow becomes labelled branches;
+//! - structured control flow becomes labelled branches; loads from uniform buffers at
+//!   fixed offsets in an innermost loop are made once before it;
 //! - a function is inlined at its calls where it must be (it takes a pointer, or uses a
 //!   `var<private>`, which lives in the kernel's registers) or where that duplicates
 //!   little code; the others are `.func`s whose parameters are the buffer addresses
 //!   they use followed by their arguments' leaves, with one aggregate return value;
 //! - run-time indices into fixed-size arrays and vectors are clamped to the last
 //!   element (naga's `Restrict` policy); indices into runtime-sized arrays are not;
-//! - maths: `math.rs` and `libm.rs`; docs/ptx.md gives each function's error.
+//! - f32 arithmetic flushes subnormals (`.ftz`), as WGSL allows and NVIDIA's Vulkan
+//!   driver does; maths: `math.rs` and `libm.rs`; docs/ptx.md gives each function's error.
 //!
 //! The output depends only on the module: registers, labels and functions are
 //! numbered in the order the IR lists them.

@@ -3,6 +3,7 @@
 //! other back ends do) and matrix products.
 
 use super::emit::{Class, Op};
+use super::math::{ADD, DIV, FMA, MUL, SUB};
 use super::types::{Sc, Shape, Ty};
 use super::writer::{Frame, Fw};
 use super::Error;
@@ -93,13 +94,13 @@ impl Fw<'_, '_> {
         let class = sc.class();
         let cmp = |s: &mut Self, c: &str| s.setp(&format!("{c}.{t}"), a, b);
         Ok(match (op, sc) {
-            (B::Add, Sc::F32 | Sc::I32 | Sc::U32) => self.bin(&format!("add.{t}"), class, a, b),
-            (B::Subtract, Sc::F32 | Sc::I32 | Sc::U32) => {
-                self.bin(&format!("sub.{t}"), class, a, b)
-            }
-            (B::Multiply, Sc::F32) => self.bin("mul.f32", class, a, b),
+            (B::Add, Sc::F32) => self.bin(ADD, class, a, b),
+            (B::Subtract, Sc::F32) => self.bin(SUB, class, a, b),
+            (B::Add, Sc::I32 | Sc::U32) => self.bin(&format!("add.{t}"), class, a, b),
+            (B::Subtract, Sc::I32 | Sc::U32) => self.bin(&format!("sub.{t}"), class, a, b),
+            (B::Multiply, Sc::F32) => self.bin(MUL, class, a, b),
             (B::Multiply, Sc::I32 | Sc::U32) => self.bin(&format!("mul.lo.{t}"), class, a, b),
-            (B::Divide, Sc::F32) => self.bin(super::math::DIV, class, a, b),
+            (B::Divide, Sc::F32) => self.bin(DIV, class, a, b),
             (B::Divide, Sc::I32 | Sc::U32) => self.int_div("div", sc, a, b),
             (B::Modulo, Sc::F32) => self.fmod(a, b),
             (B::Modulo, Sc::I32 | Sc::U32) => self.int_div("rem", sc, a, b),
@@ -159,10 +160,10 @@ impl Fw<'_, '_> {
 
     /// WGSL's float `%`: `a - b * trunc(a / b)` (the product and difference fused).
     fn fmod(&mut self, a: Op, b: Op) -> Op {
-        let q = self.bin(super::math::DIV, Class::F32, a, b);
+        let q = self.bin(DIV, Class::F32, a, b);
         let t = self.un("cvt.rzi.f32.f32", Class::F32, q);
         let nt = self.un("neg.f32", Class::F32, t);
-        self.tri("fma.rn.f32", Class::F32, nt, b, a)
+        self.tri(FMA, Class::F32, nt, b, a)
     }
 
     pub fn select(
@@ -334,9 +335,9 @@ impl Fw<'_, '_> {
         let Some((&(x, y), rest)) = terms.split_first() else {
             return Op::f32(0.0);
         };
-        let mut acc = self.bin("mul.f32", Class::F32, x, y);
+        let mut acc = self.bin(MUL, Class::F32, x, y);
         for &(x, y) in rest {
-            acc = self.tri("fma.rn.f32", Class::F32, x, y, acc);
+            acc = self.tri(FMA, Class::F32, x, y, acc);
         }
         acc
     }

@@ -1,11 +1,15 @@
 //! Statements: naga's structured control flow as labelled branches, stores, calls,
 //! barriers and returns.
 
+use super::analysis::{has_loop, visit};
 use super::emit::{ins, Op};
 use super::types::Sc;
 use super::writer::{Frame, Fw, Ret, Target};
 use super::Error;
 use naga::{Barrier, Block, Expression, Handle, Statement, SwitchCase, SwitchValue};
+
+/// The most values (scalar leaves) hoisted out of one loop.
+const HOIST_LEAVES: u32 = 8;
 
 impl<'a> Fw<'_, 'a> {
     pub fn block(&mut self, f: &mut Frame<'a>, b: &'a Block) -> Result<(), Error> {
@@ -13,6 +17,20 @@ impl<'a> Fw<'_, 'a> {
     }
 
     fn stmt(&mut self, f: &mut Frame<'a>, s: &'a Statement) -> Result<(), Error> {
+        // Values computed for sharing (trigonometric reductions) stay within straight-line
+        // code: control flow on either side ends their scope.
+        let straight = matches!(s, Statement::Emit(_) | Statement::Store { .. });
+        if !straight {
+            self.reduced.clear();
+        }
+        let r = self.stmt_inner(f, s);
+        if !straight {
+            self.reduced.clear();
+        }
+        r
+    }
+
+    fn stmt_inner(&mut self, f: &mut Frame<'a>, s: &'a Statement) -> Result<(), Error> {
         match *s {
             Statement::Emit(ref range) => self.emit(f, range.clone()),
             Statement::Block(ref b) => self.block(f, b),
@@ -74,7 +92,8 @@ impl<'a> Fw<'_, 'a> {
 
     fn emit(&mut self, f: &mut Frame<'a>, range: naga::Range<Expression>) -> Result<(), Error> {
         for h in range {
-            if f.info[h].ref_count == 0 {
+            // Unused, or evaluated early (a load hoisted out of its loop).
+            if f.info[h].ref_count == 0 || f.values.get(h.index()).is_some_and(Option::is_some) {
                 continue;
             }
             if let Some(name) = f.func.named_expressions.get(&h) {
@@ -133,6 +152,7 @@ impl<'a> Fw<'_, 'a> {
             format!("$L{g}_continuing"),
             format!("$L{g}_loop_end"),
         );
+        self.hoist_uniform_loads(f, body, continuing)?;
         self.out.comment(format_args!("loop"));
         self.out.place(&head);
         f.targets.push(Target::Loop {
@@ -157,6 +177,90 @@ impl<'a> Fw<'_, 'a> {
         ins!(self.out, "bra {head};");
         self.out.place(&end);
         Ok(())
+    }
+
+    /// Loads from uniform buffers at fixed offsets in an innermost loop (one that runs no
+    /// other loop, its own or in a function it calls), evaluated once before the loop
+    /// instead of at each iteration: `params.counts.w` in the sphere tracer's loop
+    /// condition. ptxas does not move `ld.global.nc` out of loops itself, and a load the
+    /// loop's branch waits for costs an L1 round trip per iteration (Vulkan reads the
+    /// same value as a constant-bank operand). Uniform buffers cover their whole type, so
+    /// loading early, even what only one branch of the body reads, stays in bounds. At
+    /// most [`HOIST_LEAVES`] values, to keep register pressure in the loop down.
+    fn hoist_uniform_loads(
+        &mut self,
+        f: &mut Frame<'a>,
+        body: &'a Block,
+        continuing: &'a Block,
+    ) -> Result<(), Error> {
+        let loops = &self.cx.an.loops;
+        if has_loop(body, loops) || has_loop(continuing, loops) {
+            return Ok(());
+        }
+        let mut found = Vec::new();
+        for b in [body, continuing] {
+            visit(b, &mut |s| {
+                if let Statement::Emit(range) = s {
+                    found.extend(range.clone().filter(|&h| f.info[h].ref_count > 0));
+                }
+            });
+        }
+        let mut budget = HOIST_LEAVES;
+        for h in found {
+            let Some(chain) = self.uniform_chain(f, h) else {
+                continue;
+            };
+            let Ok(super::types::Resolved::Value(ty)) = self.cx.types.resolve(&f.info[h].ty) else {
+                continue;
+            };
+            let n = self.cx.types.leaves(ty)?;
+            if n > budget {
+                continue;
+            }
+            budget -= n;
+            if budget == HOIST_LEAVES - n {
+                self.out
+                    .comment(format_args!("uniform loads hoisted out of the loop"));
+            }
+            for &c in chain.iter().rev() {
+                if f.values.get(c.index()).is_some_and(Option::is_none) {
+                    self.expr(f, c)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// For a `Load` from a uniform buffer through members and constant indices only: the
+    /// load and the pointer expressions it goes through, outermost first.
+    fn uniform_chain(&self, f: &Frame, h: Handle<Expression>) -> Option<Vec<Handle<Expression>>> {
+        let Expression::Load { pointer } = f.func.expressions[h] else {
+            return None;
+        };
+        let mut chain = vec![h];
+        let mut p = pointer;
+        loop {
+            match f.func.expressions[p] {
+                Expression::AccessIndex { base, .. } => {
+                    chain.push(p);
+                    p = base;
+                }
+                Expression::Access { base, index }
+                    if matches!(f.func.expressions[index], Expression::Literal(_)) =>
+                {
+                    chain.push(p);
+                    p = base;
+                }
+                Expression::GlobalVariable(g) => {
+                    let uniform =
+                        self.cx.module.global_variables[g].space == naga::AddressSpace::Uniform;
+                    // The global's pointer is evaluated on entry (it is not emitted).
+                    let ready = f.values.get(p.index()).is_some_and(Option::is_some);
+                    return (uniform && ready).then_some(chain);
+                }
+                _ => return None,
+            }
+        }
     }
 
     fn switch(

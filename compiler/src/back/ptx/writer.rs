@@ -158,6 +158,11 @@ pub(super) struct Fw<'c, 'a> {
     pub vars: Vec<Vec<Op>>,
     /// Per global variable: where it lives in this PTX function.
     pub globals: Vec<Option<Store>>,
+    /// Arguments of sin, cos and tan reduced to [−π, π] since the last control-flow
+    /// statement, with their reductions: `sin(a)` and `cos(a)` (a rotation, a twist)
+    /// share one. Only straight-line code shares, so each entry's definition dominates
+    /// its uses.
+    pub reduced: Vec<(Op, Op)>,
 }
 
 impl<'c, 'a> Fw<'c, 'a> {
@@ -167,6 +172,7 @@ impl<'c, 'a> Fw<'c, 'a> {
             out: Out::default(),
             vars: Vec::new(),
             globals: vec![None; cx.module.global_variables.len()],
+            reduced: Vec::new(),
         }
     }
 

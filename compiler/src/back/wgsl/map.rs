@@ -1,7 +1,9 @@
-//! Writes a distance program as the WGSL function `fn map(p: vec3<f32>) -> vec2<f32>`:
-//! one `let` per instruction, with comments naming the scene node each block comes from.
+//! Writes a distance program as the WGSL functions `fn map(p: vec3<f32>) -> vec2<f32>` and
+//! `fn sdf(p: vec3<f32>) -> f32`: one `let` per instruction, with comments naming the scene
+//! node each block comes from. A guarded block is an `if`; each of its results is a `var`
+//! holding the value from before the block, assigned the block's value inside it.
 
-use crate::lower::{Axis, Binary, Op, Program, Unary};
+use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::fmt::Write;
 
 /// The WGSL text of `map`, returning (distance, material id).
@@ -9,13 +11,7 @@ pub fn write_map(program: &Program) -> String {
     let mut out = String::new();
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
     out.push_str("fn map(p: vec3<f32>) -> vec2<f32> {\n");
-    let mut notes = program.notes().iter().peekable();
-    for (i, op) in program.ops().iter().enumerate() {
-        while let Some(n) = notes.next_if(|n| n.at == i) {
-            let _ = writeln!(out, "    // {}", n.text);
-        }
-        let _ = writeln!(out, "    let r{i} = {};", expr(op));
-    }
+    body(&mut out, program, &[program.distance(), program.material()], true);
     let _ = writeln!(
         out,
         "    return vec2<f32>(r{}, r{});",
@@ -24,6 +20,75 @@ pub fn write_map(program: &Program) -> String {
     );
     out.push_str("}\n");
     out
+}
+
+/// The WGSL text of `sdf`: only the instructions the distance depends on (marching and
+/// normals do not need the material).
+pub fn write_sdf(program: &Program) -> String {
+    let mut out = String::from(
+        "// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n",
+    );
+    body(&mut out, program, &[program.distance()], false);
+    let _ = writeln!(out, "    return r{};\n}}", program.distance().0);
+    out
+}
+
+/// The statements computing `roots`, with the program's comments when `comments`.
+fn body(out: &mut String, program: &Program, roots: &[Reg], comments: bool) {
+    let (live, live_blocks) = program.live(roots);
+    let ops = program.ops();
+    let blocks = program.blocks();
+    let phi_of = program.phi_blocks();
+    let mut notes = program.notes().iter().peekable();
+    let mut depth = 1;
+    let pad = |d: usize| "    ".repeat(d);
+    for item in program.items() {
+        match item {
+            Item::Op(i) if live[i] && phi_of[i].is_none() => {
+                while let Some(n) = notes.next_if(|n| n.at <= i) {
+                    if comments {
+                        let _ = writeln!(out, "{}// {}", pad(depth), n.text);
+                    }
+                }
+                let _ = writeln!(out, "{}let r{i} = {};", pad(depth), expr(&ops[i]));
+            }
+            Item::Op(_) => {}
+            Item::Open(b) if live_blocks[b] => {
+                let block = &blocks[b];
+                for (j, _, other) in results(program, b, &live) {
+                    let _ = writeln!(out, "{}var r{j} = r{};", pad(depth), other.0);
+                }
+                let _ = writeln!(
+                    out,
+                    "{}if !(r{} >= r{}) {{",
+                    pad(depth),
+                    block.bound.0,
+                    block.best.0
+                );
+                depth += 1;
+            }
+            Item::Close(b) if live_blocks[b] => {
+                for (j, then, _) in results(program, b, &live) {
+                    let _ = writeln!(out, "{}r{j} = r{};", pad(depth), then.0);
+                }
+                depth -= 1;
+                let _ = writeln!(out, "{}}}", pad(depth));
+            }
+            Item::Open(_) | Item::Close(_) => {}
+        }
+    }
+}
+
+/// The needed results of block `b`: (register, value inside, value from before).
+pub(crate) fn results(program: &Program, b: usize, live: &[bool]) -> Vec<(usize, Reg, Reg)> {
+    let block = &program.blocks()[b];
+    (block.end..block.end + block.results)
+        .filter(|&j| live[j])
+        .filter_map(|j| match program.ops()[j] {
+            Op::Phi(then, other) => Some((j, then, other)),
+            _ => None,
+        })
+        .collect()
 }
 
 /// A WGSL float literal for `x` rounded to f32 (finite values only reach here; others are
@@ -75,5 +140,6 @@ fn expr(op: &Op) -> String {
             }
         }
         Op::Select(c, a, b) => format!("select(r{}, r{}, r{} != 0.0)", b.0, a.0, c.0),
+        Op::Phi(a, _) => format!("r{}", a.0),
     }
 }

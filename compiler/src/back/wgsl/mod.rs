@@ -9,9 +9,11 @@
 mod map;
 mod template;
 
-pub use map::{float, write_map};
+pub use map::{float, write_map, write_sdf};
 
-use crate::lower::{Program, Reg};
+pub(crate) use map::results;
+
+use crate::lower::Program;
 use crate::scene::{Light, Pattern, Scene};
 use std::collections::HashMap;
 use std::fmt;
@@ -181,42 +183,6 @@ fn node_of_line(source: &str, n: usize, scene: &Scene) -> Option<crate::Span> {
         .find_map(|l| l.trim().strip_prefix("// node "))?;
     let id: u32 = comment.split_whitespace().next()?.parse().ok()?;
     (id < scene.graph.len() as u32).then(|| scene.graph.span(crate::scene::NodeId(id)))
-}
-
-/// `fn sdf(p) -> f32`: only the instructions the distance depends on (marching and normals
-/// do not need the material).
-fn write_sdf(program: &Program) -> String {
-    let ops = program.ops();
-    let mut needed = vec![false; ops.len()];
-    needed[program.distance().0 as usize] = true;
-    for i in (0..ops.len()).rev() {
-        if needed[i] {
-            for Reg(r) in ops[i].operands() {
-                needed[r as usize] = true;
-            }
-        }
-    }
-    let mut out = String::from(
-        "// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n",
-    );
-    let text = write_map(program);
-    // Reuse the map writer's lines: keep the `let` of each needed register.
-    for line in text.lines() {
-        let t = line.trim_start();
-        if let Some(rest) = t.strip_prefix("let r") {
-            let idx: usize = rest
-                .split(' ')
-                .next()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(usize::MAX);
-            if needed.get(idx).copied().unwrap_or(false) {
-                out.push_str(line);
-                out.push('\n');
-            }
-        }
-    }
-    out.push_str(&format!("    return r{};\n}}\n", program.distance().0));
-    out
 }
 
 /// The bytes of the scene uniform (binding 0), in the layout of `Params` in the kernel.

@@ -1,0 +1,468 @@
+//! Bounding volumes of the nodes of a scene graph, and a cost estimate of each node.
+//!
+//! A node's [`Bound`] is a sphere and an axis-aligned box, each with the guarantee that the
+//! culling of guarded blocks relies on (`docs/optimisation.md`): at every point p, the
+//! field `f` the lowering computes for the node satisfies `f(p) ≥ min(s, c·s)`, where `s` is
+//! the signed distance from p to the volume and `c ∈ (0, 1]` the bound's `scale`. For a field
+//! that is an exact distance, any volume containing the shape does (with `c = 1`); the rules
+//! below keep the guarantee through every operation, including those whose field is only a
+//! bound or an estimate. A box may be infinite along some axes (a slab); a node with no
+//! bound at all (a plane, infinite repetition in every direction) has `None`.
+
+use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
+
+/// A sphere: centre and radius.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Sphere {
+    pub c: V3,
+    pub r: f64,
+}
+
+/// An axis-aligned box: centre and half extents (infinite along an unbounded axis).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Aabb {
+    pub c: V3,
+    pub h: V3,
+}
+
+/// The bounding volumes of a node: `f(p) ≥ min(s, scale·s)` for `s` the signed distance to
+/// either volume. `sphere` is infinite (`r = ∞`) when the box is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Bound {
+    pub sphere: Sphere,
+    pub aabb: Aabb,
+    pub scale: f64,
+}
+
+impl Bound {
+    fn of_sphere(r: f64) -> Bound {
+        Bound {
+            sphere: Sphere { c: [0.0; 3], r },
+            aabb: Aabb {
+                c: [0.0; 3],
+                h: [r; 3],
+            },
+            scale: 1.0,
+        }
+    }
+
+    /// A shape centred on the origin inside the box of half extents `h` and the sphere of
+    /// radius `r`.
+    fn of_box(h: V3, r: f64) -> Bound {
+        Bound {
+            sphere: Sphere { c: [0.0; 3], r },
+            aabb: Aabb { c: [0.0; 3], h },
+            scale: 1.0,
+        }
+    }
+
+    /// Whether the box is finite along every axis.
+    pub fn finite(&self) -> bool {
+        self.aabb.h.iter().all(|h| h.is_finite())
+    }
+
+    /// Replaces each volume by the one around the other where that is smaller. (A volume
+    /// containing a valid volume is valid; the intersection of two valid volumes need not
+    /// be, so volumes are only ever replaced, never intersected.)
+    fn tight(mut self) -> Bound {
+        if !self.finite() {
+            self.sphere.r = f64::INFINITY;
+            return self;
+        }
+        let around_box = norm(self.aabb.h);
+        let old_sphere = self.sphere;
+        if around_box < self.sphere.r {
+            self.sphere = Sphere {
+                c: self.aabb.c,
+                r: around_box,
+            };
+        }
+        let r = old_sphere.r;
+        if 8.0 * r * r * r < 8.0 * self.aabb.h[0] * self.aabb.h[1] * self.aabb.h[2] {
+            self.aabb = Aabb {
+                c: old_sphere.c,
+                h: [r; 3],
+            };
+        }
+        self
+    }
+
+    /// Both volumes grown by `g / scale` (so that `f ≥ min(s, c·s) - g` becomes a bound of
+    /// the same form).
+    fn grow(mut self, g: f64) -> Bound {
+        let g = g.max(0.0) / self.scale;
+        self.sphere.r += g;
+        self.aabb.h = self.aabb.h.map(|h| h + g);
+        self
+    }
+
+    /// The bound of a point map p ↦ s·p + t with a uniform s (the field scaled by |s|).
+    fn similar(self, s: f64, t: V3) -> Bound {
+        Bound {
+            sphere: Sphere {
+                c: add(scale3(self.sphere.c, s), t),
+                r: self.sphere.r * s.abs(),
+            },
+            aabb: Aabb {
+                c: add(scale3(self.aabb.c, s), t),
+                h: self.aabb.h.map(|h| h * s.abs()),
+            },
+            scale: self.scale,
+        }
+    }
+
+    /// The volume of the box (∞ for a slab) and of the sphere, for choosing between them.
+    pub fn volumes(&self) -> (f64, f64) {
+        let b = 8.0 * self.aabb.h[0] * self.aabb.h[1] * self.aabb.h[2];
+        let r = self.sphere.r;
+        (b, 4.0 / 3.0 * std::f64::consts::PI * r * r * r)
+    }
+}
+
+/// Joins two bounds: volumes containing both, the smaller scale.
+pub(super) fn hull(a: &Bound, b: &Bound) -> Bound {
+    let mut aabb = a.aabb;
+    for i in 0..3 {
+        let lo = (a.aabb.c[i] - a.aabb.h[i]).min(b.aabb.c[i] - b.aabb.h[i]);
+        let hi = (a.aabb.c[i] + a.aabb.h[i]).max(b.aabb.c[i] + b.aabb.h[i]);
+        if lo.is_finite() && hi.is_finite() {
+            aabb.c[i] = (lo + hi) * 0.5;
+            aabb.h[i] = (hi - lo) * 0.5;
+        } else {
+            aabb.c[i] = 0.0;
+            aabb.h[i] = f64::INFINITY;
+        }
+    }
+    Bound {
+        sphere: sphere_hull(&a.sphere, &b.sphere),
+        aabb,
+        scale: a.scale.min(b.scale),
+    }
+    .tight()
+}
+
+/// The smallest sphere containing two spheres.
+fn sphere_hull(a: &Sphere, b: &Sphere) -> Sphere {
+    if !(a.r.is_finite() && b.r.is_finite()) {
+        return Sphere {
+            c: [0.0; 3],
+            r: f64::INFINITY,
+        };
+    }
+    let d = norm(sub(b.c, a.c));
+    if d + b.r <= a.r {
+        return *a;
+    }
+    if d + a.r <= b.r {
+        return *b;
+    }
+    let r = (d + a.r + b.r) * 0.5;
+    let t = (r - a.r) / d;
+    Sphere {
+        c: add(a.c, scale3(sub(b.c, a.c), t)),
+        r: r * (1.0 + 1e-12),
+    }
+}
+
+/// The bound and the estimated cost (instructions per point) of every node of a graph.
+#[derive(Debug)]
+pub(super) struct Bounds {
+    of: Vec<Option<Bound>>,
+    cost: Vec<f64>,
+}
+
+impl Bounds {
+    /// Computes every node's bound and cost (children come before parents in a graph).
+    pub fn new(graph: &Graph) -> Bounds {
+        let mut out = Bounds {
+            of: Vec::with_capacity(graph.len()),
+            cost: Vec::with_capacity(graph.len()),
+        };
+        for id in graph.ids() {
+            let node = graph.node(id);
+            let b = out.bound(node);
+            let c = own_cost(node) + node.children().iter().map(|&c| out.cost(c)).sum::<f64>();
+            out.of.push(b.map(Bound::tight));
+            out.cost.push(c);
+        }
+        out
+    }
+
+    /// The bound of a node, if it has one.
+    pub fn get(&self, id: NodeId) -> Option<Bound> {
+        self.of[id.0 as usize]
+    }
+
+    /// The estimated number of instructions a node costs per point.
+    pub fn cost(&self, id: NodeId) -> f64 {
+        self.cost[id.0 as usize]
+    }
+
+    fn bound(&self, node: &Node) -> Option<Bound> {
+        let get = |id: &NodeId| self.get(*id);
+        Some(match node {
+            Node::Sphere { radius } => Bound::of_sphere(*radius),
+            Node::Box { half } => Bound::of_box(*half, norm(*half)),
+            Node::RoundBox { half, radius } => {
+                Bound::of_box(*half, norm(half.map(|h| (h - radius).max(0.0))) + radius)
+            }
+            Node::Plane { .. } => return None,
+            Node::Torus { major, minor } => {
+                Bound::of_box([major + minor, *minor, major + minor], major + minor)
+            }
+            Node::Cylinder {
+                radius,
+                half_height,
+            }
+            | Node::Cone {
+                radius,
+                half_height,
+            } => Bound::of_box([*radius, *half_height, *radius], radius.hypot(*half_height)),
+            Node::Capsule {
+                radius,
+                half_height,
+            } => Bound::of_box([*radius, half_height + radius, *radius], half_height + radius),
+            Node::Ellipsoid { radii } => ellipsoid(*radii),
+            // f ≥ |p| - 2 beyond radius 2, and f ≥ -0.5/e everywhere (see the docs).
+            Node::Mandelbulb { .. } => Bound::of_sphere(2.2),
+            Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
+            Node::SmoothCombine {
+                op, k, variant, a, b, ..
+            } => smooth(*op, *k, *variant, get(a), get(b))?,
+            Node::Translate { offset, child } => get(child)?.similar(1.0, *offset),
+            Node::Rotate { matrix, child } => rotate(&get(child)?, matrix),
+            Node::Scale { factor, child } => get(child)?.similar(*factor, [0.0; 3]),
+            Node::ScaleXyz { factors, child } => scale_xyz(&get(child)?, factors),
+            Node::Repeat {
+                period,
+                count,
+                child,
+            } => repeat(&get(child)?, period, count.as_ref())?,
+            Node::Mirror { axes, child } => mirror(&get(child)?, axes),
+            Node::Twist { child, .. } => about_axis(&get(child)?, 1),
+            Node::Bend { child, .. } => about_axis(&get(child)?, 2),
+            Node::Elongate { half, child } => elongate(&get(child)?, half),
+            Node::Round { radius, child } => get(child)?.grow(*radius),
+            Node::Shell { thickness, child } => get(child)?.grow(*thickness),
+            Node::Paint { child, .. } => get(child)?,
+        })
+    }
+}
+
+/// Quilez's ellipsoid field k0·(k0 - 1)/k1 is at least (r_min/r_max)·(|p| - r_max) outside
+/// the sphere of radius r_max, and at least |p| - r_max inside it.
+fn ellipsoid(r: V3) -> Bound {
+    let (lo, hi) = (r[0].min(r[1]).min(r[2]), r[0].max(r[1]).max(r[2]));
+    Bound {
+        scale: if hi > 0.0 { (lo / hi).clamp(1e-6, 1.0) } else { 1.0 },
+        ..Bound::of_sphere(hi)
+    }
+}
+
+/// min over children is at least the bound of their hull; max at least each child's.
+fn combine(op: Combine, mut kids: impl Iterator<Item = Option<Bound>>) -> Option<Bound> {
+    match op {
+        Combine::Union => {
+            let first = kids.next()??;
+            kids.try_fold(first, |acc, b| Some(hull(&acc, &b?)))
+        }
+        Combine::Intersect => kids.flatten().min_by(|a, b| a.volumes().0.total_cmp(&b.volumes().0)),
+        Combine::Subtract => kids.next()?,
+    }
+}
+
+/// A smooth union is at least min(a, b) minus its largest correction (k/4 for the
+/// polynomial, k·ln 2 for the exponential); a smooth maximum is at least the maximum.
+fn smooth(op: Combine, k: f64, v: Smooth, a: Option<Bound>, b: Option<Bound>) -> Option<Bound> {
+    match op {
+        Combine::Union => {
+            let h = hull(&a?, &b?);
+            let g = match v {
+                _ if k <= 0.0 => 0.0,
+                Smooth::Poly => k * 0.25,
+                Smooth::Exp => k * std::f64::consts::LN_2,
+            };
+            Some(h.grow(g * (1.0 + 1e-9)))
+        }
+        Combine::Intersect => combine(op, [a, b].into_iter()),
+        Combine::Subtract => a,
+    }
+}
+
+/// The field f(Mᵀp): the sphere's centre rotated, the box around the rotated box.
+fn rotate(b: &Bound, m: &[V3; 3]) -> Bound {
+    let mut out = *b;
+    out.sphere.c = mat_vec(m, b.sphere.c);
+    if b.finite() {
+        out.aabb.c = mat_vec(m, b.aabb.c);
+        out.aabb.h = [0, 1, 2].map(|i| (0..3).map(|j| m[i][j].abs() * b.aabb.h[j]).sum());
+    } else {
+        // A slab stays a slab only when the rotation keeps every infinite axis on itself.
+        let keeps = (0..3).all(|i| {
+            (0..3).all(|j| b.aabb.h[j].is_finite() || i == j || m[i][j].abs() < 1e-12)
+        });
+        if !keeps {
+            return unbounded();
+        }
+        out.aabb.c = mat_vec(m, b.aabb.c.map(|c| if c.is_finite() { c } else { 0.0 }));
+        // Entries below 1e-12 next to an infinite axis are rounding noise of a quarter turn.
+        out.aabb.h = [0, 1, 2].map(|i| {
+            (0..3)
+                .filter(|&j| b.aabb.h[j].is_finite() || m[i][j].abs() >= 1e-12)
+                .map(|j| m[i][j].abs() * b.aabb.h[j])
+                .sum()
+        });
+    }
+    out
+}
+
+/// A bound with an infinite box: nothing is ever skipped by it.
+fn unbounded() -> Bound {
+    Bound {
+        sphere: Sphere {
+            c: [0.0; 3],
+            r: f64::INFINITY,
+        },
+        aabb: Aabb {
+            c: [0.0; 3],
+            h: [f64::INFINITY; 3],
+        },
+        scale: 1.0,
+    }
+}
+
+/// The field f(p/s)·min|s|: the volumes mapped by s, and the scale multiplied by
+/// min|s|/max|s| (the map stretches distances by at most max|s|).
+fn scale_xyz(b: &Bound, s: &V3) -> Bound {
+    let a = s.map(f64::abs);
+    let (lo, hi) = (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]));
+    Bound {
+        sphere: Sphere {
+            c: [0, 1, 2].map(|i| b.sphere.c[i] * s[i]),
+            r: b.sphere.r * hi,
+        },
+        aabb: Aabb {
+            c: [0, 1, 2].map(|i| b.aabb.c[i] * s[i]),
+            h: [0, 1, 2].map(|i| b.aabb.h[i] * a[i]),
+        },
+        scale: if hi > 0.0 { b.scale * lo / hi } else { b.scale },
+    }
+}
+
+/// Repetition: every copy's volume lies in the box stretched by the farthest cell offset
+/// (infinitely along an infinitely repeated axis).
+fn repeat(b: &Bound, period: &V3, count: Option<&V3>) -> Option<Bound> {
+    let mut out = *b;
+    let mut reach = [0.0; 3];
+    for i in 0..3 {
+        if period[i] == 0.0 {
+            continue;
+        }
+        reach[i] = match count {
+            Some(n) => period[i].abs() * (n[i] - 1.0).max(0.0) * 0.5,
+            None => f64::INFINITY,
+        };
+        out.aabb.h[i] += reach[i];
+        if reach[i].is_infinite() {
+            out.aabb.c[i] = 0.0;
+        }
+    }
+    out.sphere.r += norm(reach);
+    if out.aabb.h.iter().all(|h| h.is_infinite()) {
+        return None;
+    }
+    Some(out)
+}
+
+/// Mirroring: the volumes made symmetric about each mirrored plane.
+fn mirror(b: &Bound, axes: &[bool; 3]) -> Bound {
+    let mut out = *b;
+    let mut moved = [0.0; 3];
+    for i in (0..3).filter(|&i| axes[i]) {
+        let far = b.aabb.c[i].abs() + b.aabb.h[i];
+        out.aabb.c[i] = 0.0;
+        out.aabb.h[i] = far;
+        moved[i] = b.sphere.c[i];
+        out.sphere.c[i] = 0.0;
+    }
+    out.sphere.r += norm(moved);
+    out
+}
+
+/// Twist (about y, `axis` 1) and bend (about z, `axis` 2): the point is rotated about the
+/// axis, so the volumes become symmetric about it.
+fn about_axis(b: &Bound, axis: usize) -> Bound {
+    let plane: Vec<usize> = (0..3).filter(|&i| i != axis).collect();
+    let mut out = *b;
+    let rho = plane
+        .iter()
+        .map(|&i| (b.aabb.c[i].abs() + b.aabb.h[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let off = plane
+        .iter()
+        .map(|&i| b.sphere.c[i].powi(2))
+        .sum::<f64>()
+        .sqrt();
+    for &i in &plane {
+        out.aabb.c[i] = 0.0;
+        out.aabb.h[i] = rho;
+        out.sphere.c[i] = 0.0;
+    }
+    out.sphere.r += off;
+    out
+}
+
+/// Elongation: the child's field at p - clamp(p, -h, h), so the volumes grow by h.
+fn elongate(b: &Bound, h: &V3) -> Bound {
+    let mut out = *b;
+    out.aabb.h = [0, 1, 2].map(|i| b.aabb.h[i] + h[i].abs());
+    out.sphere.r += norm(*h);
+    out
+}
+
+/// The instructions a node costs per point, roughly, without its children.
+fn own_cost(node: &Node) -> f64 {
+    match node {
+        Node::Sphere { .. } => 8.0,
+        Node::Box { .. } | Node::RoundBox { .. } => 18.0,
+        Node::Plane { .. } => 6.0,
+        Node::Torus { .. } => 12.0,
+        Node::Cylinder { .. } => 17.0,
+        Node::Capsule { .. } => 11.0,
+        Node::Cone { .. } => 35.0,
+        Node::Ellipsoid { .. } => 20.0,
+        Node::Mandelbulb { iterations, .. } => 20.0 + 45.0 * f64::from(*iterations),
+        Node::Combine { children, .. } => 4.0 * children.len() as f64,
+        Node::SmoothCombine { .. } => 14.0,
+        Node::Translate { .. } => 3.0,
+        Node::Rotate { .. } => 12.0,
+        Node::Scale { .. } | Node::ScaleXyz { .. } => 5.0,
+        Node::Repeat { .. } => 12.0,
+        Node::Mirror { .. } => 3.0,
+        Node::Twist { .. } | Node::Bend { .. } => 10.0,
+        Node::Elongate { .. } => 9.0,
+        Node::Round { .. } | Node::Shell { .. } => 2.0,
+        Node::Paint { .. } => 3.0,
+    }
+}
+
+fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
+    [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+}
+
+fn norm(v: V3) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn scale3(a: V3, s: f64) -> V3 {
+    a.map(|x| x * s)
+}

@@ -1,0 +1,304 @@
+//! Charts of speed against accuracy (`sdfc pareto -o`): two panels, time per frame and
+//! marching steps per pixel (both on log axes) against PSNR, with the Pareto front and the
+//! default settings marked, drawn with plotters as SVG or PNG.
+//!
+//! SVG text is left to the viewer's fonts; PNG text is rasterised by ab_glyph from DejaVu
+//! Sans, bundled by the `dejavu` crate, so no system font library is needed.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+/// One measured point of a chart.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// Median time per frame, seconds.
+    pub seconds: f64,
+    /// Mean marching steps per pixel.
+    pub steps: f64,
+    /// PSNR against the reference, dB (may be infinite).
+    pub psnr: f64,
+    /// On the front of time against PSNR.
+    pub front_time: bool,
+    /// On the front of steps against PSNR.
+    pub front_steps: bool,
+    /// The scene's own settings.
+    pub default: bool,
+}
+
+/// What a chart shows.
+#[derive(Debug, Clone)]
+pub struct Chart {
+    /// The title above both panels.
+    pub title: String,
+    /// A second line under the title (reference, machine).
+    pub subtitle: String,
+    /// The legend entry of the default point.
+    pub default_label: String,
+    /// A PSNR drawn as a dashed line (the accuracy target), if any.
+    pub target_psnr: Option<f64>,
+    /// The points.
+    pub points: Vec<Point>,
+}
+
+/// Chart size in pixels (SVG user units).
+pub const SIZE: (u32, u32) = (1200, 540);
+
+const FONT: &str = "sans-serif";
+const GREY: RGBColor = RGBColor(110, 130, 170);
+const FRONT: RGBColor = RGBColor(200, 40, 40);
+const DEFAULT: RGBColor = RGBColor(20, 150, 60);
+
+/// Writes the chart to `path`: SVG for a `.svg` name, PNG for `.png`.
+pub fn write(chart: &Chart, path: &Path) -> Result<(), String> {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
+    let bytes = match ext.as_deref() {
+        Some("svg") => svg(chart)?.into_bytes(),
+        Some("png") => png(chart)?,
+        _ => {
+            return Err(format!(
+                "`{}`: the chart must be a .svg or .png file",
+                path.display()
+            ))
+        }
+    };
+    crate::image::write_atomic(path, &bytes)
+        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+}
+
+/// The chart as SVG text.
+pub fn svg(chart: &Chart) -> Result<String, String> {
+    register_font();
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, SIZE).into_drawing_area();
+        draw(&root, chart)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(out)
+}
+
+/// The chart as PNG file bytes.
+pub fn png(chart: &Chart) -> Result<Vec<u8>, String> {
+    register_font();
+    let (w, h) = SIZE;
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        draw(&root, chart)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    encode_rgb(&rgb, w, h)
+}
+
+fn encode_rgb(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::new();
+    let mut encoder = ::png::Encoder::new(&mut bytes, w, h);
+    encoder.set_color(::png::ColorType::Rgb);
+    encoder.set_depth(::png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(rgb).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// Makes DejaVu Sans the "sans-serif" of plotters' ab_glyph text (once per process).
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bytes are a valid TrueType font; a failure would only leave text undrawn.
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+    });
+}
+
+/// The y range: PSNR from a little below the worst point to a little above the best finite
+/// one (infinite PSNRs are drawn at the top).
+fn psnr_range(chart: &Chart) -> (f64, f64, f64) {
+    let finite: Vec<f64> = chart
+        .points
+        .iter()
+        .map(|p| p.psnr)
+        .filter(|v| v.is_finite())
+        .collect();
+    let lo = finite.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = if lo.is_finite() {
+        (lo, hi)
+    } else {
+        (0.0, 60.0)
+    };
+    let (lo, hi) = match chart.target_psnr {
+        Some(t) => (lo.min(t), hi.max(t)),
+        None => (lo, hi),
+    };
+    let top = hi + 3.0;
+    ((lo - 3.0).floor(), top.ceil(), top)
+}
+
+/// A positive range around `values` for a log axis.
+fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !lo.is_finite() {
+        return 0.1..10.0;
+    }
+    lo / 1.25..hi * 1.25
+}
+
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (head, body) = root.split_vertically(64);
+    head.draw(&Text::new(
+        chart.title.clone(),
+        (20, 10),
+        (FONT, 22).into_font(),
+    ))
+    .map_err(|e| e.to_string())?;
+    head.draw(&Text::new(
+        chart.subtitle.clone(),
+        (20, 38),
+        (FONT, 14).into_font().color(&RGBColor(80, 80, 80)),
+    ))
+    .map_err(|e| e.to_string())?;
+    let (left, right) = body.split_horizontally(SIZE.0 / 2);
+    panel(
+        &left,
+        chart,
+        "Time per frame against accuracy",
+        "median time per frame (ms, log scale)",
+        |p| p.seconds * 1e3,
+        |p| p.front_time,
+    )?;
+    panel(
+        &right,
+        chart,
+        "Marching work against accuracy",
+        "mean marching steps per pixel (log scale)",
+        |p| p.steps,
+        |p| p.front_steps,
+    )
+}
+
+/// One panel: `x(point)` on a log axis against PSNR, the front of `on_front` joined by a line.
+fn panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    chart: &Chart,
+    caption: &str,
+    x_label: &str,
+    x: impl Fn(&Point) -> f64,
+    on_front: impl Fn(&Point) -> bool,
+) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let (y_lo, y_hi, y_inf) = psnr_range(chart);
+    let y = |p: &Point| if p.psnr.is_finite() { p.psnr } else { y_inf };
+    let xs = log_range(chart.points.iter().map(&x));
+    let ticks = log_ticks(xs.start, xs.end);
+    let mut c = ChartBuilder::on(area)
+        .caption(caption, (FONT, 16))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(56)
+        .build_cartesian_2d(xs.clone().log_scale().with_key_points(ticks), y_lo..y_hi)
+        .map_err(err)?;
+    c.configure_mesh()
+        .x_desc(x_label)
+        .y_desc("PSNR against the reference (dB, higher is better)")
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
+        .x_label_formatter(&|v| short(*v))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(err)?;
+    if let Some(t) = chart.target_psnr {
+        c.draw_series(DashedLineSeries::new(
+            [(xs.start, t), (xs.end, t)],
+            6,
+            4,
+            BLACK.mix(0.6).stroke_width(1),
+        ))
+        .map_err(err)?
+        .label(format!("{t} dB target"))
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK.mix(0.6)));
+    }
+    c.draw_series(
+        chart
+            .points
+            .iter()
+            .map(|p| Circle::new((x(p), y(p)), 3, GREY.filled())),
+    )
+    .map_err(err)?
+    .label("settings tried")
+    .legend(|(x, y)| Circle::new((x + 8, y), 3, GREY.filled()));
+    let mut front: Vec<(f64, f64)> = chart
+        .points
+        .iter()
+        .filter(|p| on_front(p))
+        .map(|p| (x(p), y(p)))
+        .collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    c.draw_series(LineSeries::new(front.clone(), FRONT.stroke_width(2)))
+        .map_err(err)?
+        .label("Pareto front")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], FRONT.stroke_width(2)));
+    c.draw_series(
+        front
+            .iter()
+            .map(|&(a, b)| Circle::new((a, b), 3, FRONT.filled())),
+    )
+    .map_err(err)?;
+    c.draw_series(
+        chart
+            .points
+            .iter()
+            .filter(|p| p.default)
+            .map(|p| TriangleMarker::new((x(p), y(p)), 8, DEFAULT.filled())),
+    )
+    .map_err(err)?
+    .label(chart.default_label.clone())
+    .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, DEFAULT.filled()));
+    c.configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .label_font((FONT, 12))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(160, 160, 160))
+        .draw()
+        .map_err(err)
+}
+
+/// Tick values for a log axis from `lo` to `hi`: 1, 2 and 5 times powers of ten, or every
+/// digit times a power of ten when that gives fewer than four.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let mut out = Vec::new();
+        let mut decade = 10f64.powi(lo.log10().floor() as i32);
+        while decade <= hi {
+            out.extend(
+                mantissas
+                    .iter()
+                    .map(|m| m * decade)
+                    .filter(|v| (lo..=hi).contains(v)),
+            );
+            decade *= 10.0;
+        }
+        out
+    };
+    let coarse = within(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 4 {
+        coarse
+    } else {
+        within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
+
+/// A tick label: whole numbers plain, small values with few digits.
+fn short(v: f64) -> String {
+    if v >= 1.0 {
+        format!("{}", v.round())
+    } else {
+        format!("{v:.2}")
+    }
+}

@@ -1,0 +1,482 @@
+//! Speed against accuracy: the image and depth metrics on tiny hand-computed images, the depth
+//! buffers of CPU renders and their sidecar, the reference render, the sweep parser and the
+//! Pareto front of `sdfc pareto`, and its charts (valid SVG and PNG).
+
+mod common;
+
+use common::*;
+use sdfc_compiler::lower::lower;
+use sdfc_compiler::scene::{Node, Settings};
+use sdfc_runtime::chart::{self, Chart, Point};
+use sdfc_runtime::commands::pareto::{self, front, parse_sweep, Key};
+use sdfc_runtime::cpu::{self, reference, Options};
+use sdfc_runtime::depth::{self, Depth};
+use sdfc_runtime::fp32;
+use sdfc_runtime::image::Image;
+use sdfc_runtime::metrics::{compare, compare_depth};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn image(pixels: &[[f32; 3]]) -> Image {
+    Image {
+        width: pixels.len() as u32,
+        height: 1,
+        linear: pixels.to_vec(),
+    }
+}
+
+fn depth(distance: &[f32], coverage: &[f32]) -> Depth {
+    Depth {
+        width: distance.len() as u32,
+        height: 1,
+        samples: 1,
+        distance: distance.to_vec(),
+        coverage: coverage.to_vec(),
+    }
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() < 1e-9
+}
+
+#[test]
+fn colour_metrics_match_hand_computed_values() {
+    // Four pixels, twelve channels; differences 0.2 (one channel) and 0.5 (one channel).
+    let a = image(&[[0.0; 3], [1.0; 3], [0.5; 3], [0.25; 3]]);
+    let b = image(&[[0.2, 0.0, 0.0], [1.0; 3], [0.5, 0.5, 0.0], [0.25; 3]]);
+    let d = compare(&a, &b, 0.3).expect("same size");
+    let mse = (0.2f64 * 0.2 + 0.5 * 0.5) / 12.0;
+    assert!((d.rmse - mse.sqrt()).abs() < 1e-7, "{d:?}");
+    assert!((d.psnr - (-10.0 * mse.log10())).abs() < 1e-5, "{d:?}");
+    assert!((d.max - 0.5).abs() < 1e-7, "{d:?}");
+    assert!(close(d.differing, 0.25), "{d:?}");
+    assert_eq!(
+        compare(&a, &a, 0.0).map(|d| (d.psnr, d.max)),
+        Some((f64::INFINITY, 0.0))
+    );
+}
+
+#[test]
+fn depth_metrics_match_hand_computed_values() {
+    // Pixel 0: both hit, test 1% behind (beyond the 0.1% tolerance).
+    // Pixel 1: both hit, test 0.05% in front.   Pixel 2: reference hit, test missed.
+    // Pixel 3: test hit, reference missed.      Pixel 4: both missed.
+    // Pixel 5: half the rays hit in both (a hit), equal distances.
+    let nan = f32::NAN;
+    let r = depth(
+        &[2.0, 4.0, 1.0, nan, nan, 8.0],
+        &[1.0, 1.0, 1.0, 0.0, 0.0, 0.5],
+    );
+    let t = depth(
+        &[2.02, 3.998, nan, 5.0, nan, 8.0],
+        &[1.0, 1.0, 0.25, 1.0, 0.0, 0.5],
+    );
+    let d = compare_depth(&r, &t, 1e-3).expect("same size");
+    assert!(close(d.missed, 1.0 / 6.0), "{d:?}");
+    assert!(close(d.false_hit, 1.0 / 6.0), "{d:?}");
+    assert!(close(d.behind, 1.0 / 6.0), "{d:?}");
+    assert!(close(d.both_hit, 3.0 / 6.0), "{d:?}");
+    let mean = (0.02f64 / 2.0 + 0.002 / 4.0 + 0.0) / 3.0;
+    let got = d.mean_relative_error.expect("some pixels hit by both");
+    assert!((got - mean).abs() < 1e-6, "{got} against {mean}");
+    let none =
+        compare_depth(&depth(&[nan], &[0.0]), &depth(&[1.0], &[1.0]), 1e-3).expect("same size");
+    assert_eq!((none.false_hit, none.mean_relative_error), (1.0, None));
+    assert!(compare_depth(&r, &depth(&[1.0], &[1.0]), 1e-3).is_none());
+}
+
+fn sphere_scene(w: u32, h: u32) -> sdfc_compiler::scene::Scene {
+    let mut scene = single(Node::Sphere { radius: 1.0 });
+    scene.camera.position = [0.0, 0.0, -5.0];
+    scene.camera.look_at = [0.0, 0.0, 0.0];
+    scene.settings.width = w;
+    scene.settings.height = h;
+    scene
+}
+
+#[test]
+fn cpu_renders_carry_first_hit_depths() {
+    let scene = sphere_scene(33, 33);
+    let r = cpu::render(&scene, &lower(&scene), &Options::default(), &|| {});
+    let d = r.depth.expect("the CPU renderer fills in depth");
+    assert_eq!((d.width, d.height, d.samples), (33, 33, 1));
+    // The centre ray meets the sphere 4 units from the eye, within the hit tolerance ε·t.
+    let centre = 16 * 33 + 16;
+    assert!(d.hit(centre));
+    assert!(
+        (d.distance[centre] - 4.0).abs() < 1e-3,
+        "{}",
+        d.distance[centre]
+    );
+    // Corners see the background.
+    assert!(!d.hit(0) && d.distance[0].is_nan() && d.coverage[0] == 0.0);
+    // With 2×2 supersampling coverage is a fraction and the mean stays near 4 (the samples
+    // are a quarter pixel off centre, where the sphere is a little farther).
+    let mut aa = scene.clone();
+    aa.settings.aa = 2;
+    let r2 = cpu::render(&aa, &lower(&aa), &Options::default(), &|| {});
+    let d2 = r2.depth.expect("depth");
+    assert_eq!(d2.samples, 4);
+    assert!(d2
+        .coverage
+        .iter()
+        .all(|c| [0.0, 0.25, 0.5, 0.75, 1.0].contains(c)));
+    assert!(
+        d2.coverage.iter().any(|&c| c > 0.0 && c < 1.0),
+        "an edge pixel is partly covered"
+    );
+    assert!(
+        (d2.distance[centre] - 4.0).abs() < 1e-2,
+        "{}",
+        d2.distance[centre]
+    );
+}
+
+#[test]
+fn depth_buffers_are_identical_whatever_the_number_of_threads() {
+    let scene = sphere_scene(70, 45);
+    let render = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| cpu::render(&scene, &lower(&scene), &Options::default(), &|| {}))
+    };
+    let (a, b) = (render(1), render(3));
+    let (da, db) = (a.depth.expect("depth"), b.depth.expect("depth"));
+    let bits = |d: &Depth| {
+        d.distance
+            .iter()
+            .chain(&d.coverage)
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&da), bits(&db));
+}
+
+#[test]
+fn reference_settings() {
+    let s = Settings {
+        relaxation: 1.6,
+        aa: 2,
+        ..Settings::default()
+    };
+    let r = reference::settings(&s);
+    assert_eq!(
+        (r.epsilon, r.max_steps, r.relaxation, r.aa),
+        (1e-6, 100_000, 1.0, 2)
+    );
+    assert_eq!(reference::check_settings(&r).epsilon, 1e-7);
+}
+
+#[test]
+fn sweep_ranges_follow_the_documented_rule() {
+    let eps = parse_sweep("epsilon=1e-2..1e-6").expect("parses");
+    assert_eq!(eps.key, Key::Epsilon);
+    assert_eq!(
+        eps.values,
+        [1e-2, 3.16e-3, 1e-3, 3.16e-4, 1e-4, 3.16e-5, 1e-5, 3.16e-6, 1e-6]
+    );
+    let steps = parse_sweep("max_steps=32..1024").expect("parses");
+    assert_eq!(steps.values, [32.0, 64.0, 128.0, 256.0, 512.0, 1024.0]);
+    let omega = parse_sweep("relaxation=1..1.8").expect("parses");
+    assert_eq!(omega.values, [1.0, 1.2, 1.4, 1.6, 1.8]);
+    assert_eq!(
+        parse_sweep("aa=1..4").expect("parses").values,
+        [1.0, 2.0, 3.0, 4.0]
+    );
+    assert_eq!(
+        parse_sweep("epsilon=1e-2..1e-4:3").expect("parses").values,
+        [1e-2, 1e-3, 1e-4]
+    );
+    assert_eq!(
+        parse_sweep("max_steps=100..1000:3").expect("parses").values,
+        [100.0, 316.0, 1000.0]
+    );
+    assert_eq!(
+        parse_sweep("relaxation=1..1.5:3").expect("parses").values,
+        [1.0, 1.25, 1.5]
+    );
+    assert_eq!(
+        parse_sweep("epsilon=1e-3,1e-4, 1e-3")
+            .expect("parses")
+            .values,
+        [1e-3, 1e-4]
+    );
+    assert_eq!(parse_sweep("aa=2").expect("parses").values, [2.0]);
+}
+
+#[test]
+fn bad_sweeps_are_refused() {
+    for (spec, needle) in [
+        ("colour=1..2", "cannot sweep `colour`"),
+        ("epsilon", "KEY=LO..HI"),
+        ("epsilon=abc", "not a number"),
+        ("relaxation=1..2.5", "relaxation must be"),
+        ("epsilon=0..1e-3", "positive"),
+        ("max_steps=32..64:0", "count"),
+        ("aa=0,1", "aa must be"),
+    ] {
+        let e = parse_sweep(spec).expect_err(spec);
+        assert!(e.contains(needle), "{spec}: {e}");
+    }
+}
+
+#[test]
+fn combinations_vary_the_first_sweep_slowest() {
+    let sweeps = [
+        parse_sweep("epsilon=1e-3,1e-4").expect("parses"),
+        parse_sweep("relaxation=1,1.5").expect("parses"),
+    ];
+    let all = pareto::combinations(&Settings::default(), &sweeps).expect("valid");
+    let pairs: Vec<(f64, f64)> = all.iter().map(|s| (s.epsilon, s.relaxation)).collect();
+    assert_eq!(pairs, [(1e-3, 1.0), (1e-3, 1.5), (1e-4, 1.0), (1e-4, 1.5)]);
+    assert!(all
+        .iter()
+        .all(|s| s.max_steps == Settings::default().max_steps));
+}
+
+#[test]
+fn the_pareto_front() {
+    // (cost, PSNR). 1 dominates 2 (cheaper, better); 3 is the most accurate; 4 is worse than
+    // 0 in both, but only by less than the margins (1% of cost against 3%, 0.01 dB against
+    // PSNR_MARGIN), so it counts as a tie unless the cost margin is 0; NaN never counts.
+    let points = [
+        (1.0, 20.0),
+        (2.0, 30.0),
+        (3.0, 25.0),
+        (4.0, 40.0),
+        (1.01, 19.99),
+        (0.5, f64::NAN),
+    ];
+    assert_eq!(front(&points, 0.03), [true, true, false, true, true, false]);
+    assert_eq!(front(&points, 0.0), [true, true, false, true, false, false]);
+}
+
+fn sample_chart() -> Chart {
+    let point = |seconds: f64, steps: f64, psnr: f64, front: bool, default: bool| Point {
+        seconds,
+        steps,
+        psnr,
+        front_time: front,
+        front_steps: front,
+        default,
+    };
+    Chart {
+        title: "test chart".into(),
+        subtitle: "three points".into(),
+        default_label: "defaults".into(),
+        target_psnr: Some(40.0),
+        points: vec![
+            point(0.01, 20.0, 25.0, true, false),
+            point(0.02, 40.0, 42.0, true, true),
+            point(0.03, 35.0, f64::INFINITY, true, false),
+        ],
+    }
+}
+
+#[test]
+fn charts_are_valid_svg_and_png() {
+    let svg = chart::svg(&sample_chart()).expect("draws");
+    assert!(
+        svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+        "{}",
+        &svg[..80]
+    );
+    for text in ["test chart", "Pareto front", "defaults", "PSNR"] {
+        assert!(svg.contains(text), "{text}");
+    }
+    let png = chart::png(&sample_chart()).expect("draws");
+    let decoder = png::Decoder::new(std::io::Cursor::new(png));
+    let reader = decoder.read_info().expect("a PNG");
+    assert_eq!((reader.info().width, reader.info().height), chart::SIZE);
+}
+
+#[test]
+fn distance_ops_count_transcendentals() {
+    let scene = single(Node::Sphere { radius: 1.0 });
+    let ops = fp32::distance_ops(&lower(&scene));
+    // |p| - r needs a square root and at least five arithmetic operations.
+    assert!(ops >= fp32::TRANSCENDENTAL + 5.0, "{ops}");
+    let c = cpu::Counters {
+        steps: 10,
+        hits: 2,
+        ..Default::default()
+    };
+    assert_eq!(fp32::evaluations(&c), 18);
+    // 10 operations × 100 evaluations in 1 µs is 1 GFLOP/s, a thousandth of 1 TFLOP/s.
+    assert!(close(fp32::fraction(10.0, 100, 1e-6, 1e12), 1e-3));
+}
+
+// The command line: `render --reference/--aux`, `compare` with sidecars, `pareto`.
+
+const SCENE: &str = "material red = phong { color: (1, 0.2, 0.1) };
+camera { position: (0, 1, -5), look_at: (0, 0.5, 0), fov: 50deg }
+light point { position: (2, 4, -3), intensity: 1, radius: 50 }
+render { width: 24, height: 16 }
+scene {
+  plane();
+  sphere(1).translate(0, 1, 0) @ red;
+}
+";
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sdfc-accuracy-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    std::fs::write(d.join("ball.sdf"), SCENE).expect("write scene");
+    d
+}
+
+fn sdfc(cwd: &Path, args: &[&str]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(cwd)
+        .args(args)
+        .output()
+        .expect("run sdfc");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn reference_renders_with_sidecars_compare_by_depth() {
+    let d = dir("compare");
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--reference",
+            "--aux",
+            "--stats",
+            "-o",
+            "ref.png",
+        ],
+    );
+    let stats = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stats.contains("against ε 1e-7") && stats.contains("converged"),
+        "{stats}"
+    );
+    assert!(d.join("ref.aux").exists());
+    let reference = Depth::read(&d.join("ref.aux")).expect("a sidecar");
+    assert_eq!((reference.width, reference.height), (24, 16));
+    sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--set",
+            "epsilon=1e-2",
+            "--aux",
+            "-o",
+            "coarse.png",
+        ],
+    );
+    let out = sdfc(&d, &["compare", "ref.png", "coarse.png", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert!(v["psnr"].as_f64().is_some_and(|p| p > 10.0), "{v}");
+    assert!(v["max"].as_f64().is_some(), "{v}");
+    for key in [
+        "missed",
+        "false_hit",
+        "behind",
+        "both_hit",
+        "mean_relative_error",
+    ] {
+        assert!(v["depth"][key].as_f64().is_some(), "{key}: {v}");
+    }
+    // Without a sidecar the depth comparison is absent, and the report says why.
+    sdfc(
+        &d,
+        &["render", "ball.sdf", "--backend", "cpu", "-o", "plain.png"],
+    );
+    let out = sdfc(&d, &["compare", "ref.png", "plain.png"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("not compared")
+            && text.contains(
+                &depth::sidecar_path(Path::new("plain.png"))
+                    .display()
+                    .to_string()
+            ),
+        "{text}"
+    );
+    let out = sdfc(&d, &["compare", "ref.png", "plain.png", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert!(v["depth"].is_null() && v["depth_note"].is_string(), "{v}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn reference_needs_the_cpu() {
+    let d = dir("reference-gpu");
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args(["render", "ball.sdf", "--reference", "--backend", "wgpu"])
+        .output()
+        .expect("run sdfc");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--reference renders on the CPU"));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn pareto_measures_points_and_draws_charts() {
+    let d = dir("pareto");
+    let args = [
+        "pareto",
+        "ball.sdf",
+        "--backend",
+        "cpu",
+        "--frames",
+        "1",
+        "--sweep",
+        "epsilon=1e-2,1e-4",
+        "--sweep",
+        "max_steps=64,128",
+        "--json",
+        "-o",
+    ];
+    let mut svg_args = args.to_vec();
+    svg_args.push("chart.svg");
+    let out = sdfc(&d, &svg_args);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let points = v["points"].as_array().expect("points");
+    // Four combinations, plus the scene's own settings (the defaults) which the sweep lacks.
+    assert_eq!(points.len(), 5, "{v}");
+    assert_eq!(points.iter().filter(|p| p["default"] == true).count(), 1);
+    assert!(points.iter().any(|p| p["front_time"] == true));
+    assert!(points
+        .iter()
+        .all(|p| p["median_s"].as_f64().is_some_and(|s| s > 0.0)));
+    assert!(points
+        .iter()
+        .all(|p| p["depth"]["missed"].as_f64().is_some()));
+    assert_eq!(
+        v["reference"]["convergence"]["epsilon"].as_f64(),
+        Some(1e-6)
+    );
+    let svg = std::fs::read_to_string(d.join("chart.svg")).expect("chart written");
+    assert!(svg.starts_with("<svg") && svg.contains("ball.sdf"));
+    let mut png_args = args.to_vec();
+    png_args.push("chart.png");
+    sdfc(&d, &png_args);
+    let bytes = std::fs::read(d.join("chart.png")).expect("chart written");
+    assert!(png::Decoder::new(std::io::Cursor::new(bytes))
+        .read_info()
+        .is_ok());
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args(["pareto", "ball.sdf", "-o", "chart.txt", "--sweep", "aa=1"])
+        .output()
+        .expect("run sdfc");
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -5,9 +5,13 @@
 //! ```text
 //! syntax::parse   .sdf text            → ast::File + diagnostics   (logos, chumsky)
 //! check::check    files (via a Loader) → scene::Scene + diagnostics
+//! scene::analysis::analyse  scene::Scene → exactness and Lipschitz bound per node
 //! lower::lower    scene::Scene         → lower::Program             (flat scalar SSA)
 //! eval            lower::Program       → distances at batches of points (CPU, f32/f64)
 //! back::rust      lower::Program       → Rust source over glam
+//! back::wgsl      Scene + Program      → WGSL kernel, validated by naga
+//! back::shader    wgsl::Kernel         → SPIR-V, MSL, GLSL, HLSL (naga)
+//! back::ptx       naga::Module         → PTX
 //! ```
 //!
 //! The crate does no IO and never panics on user input: imports are read through the

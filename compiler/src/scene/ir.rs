@@ -137,7 +137,9 @@ impl Node {
 pub struct Facts {
     /// Whether the field is an exact distance, a bound, or neither.
     pub exactness: Exactness,
-    /// An upper bound on the field's Lipschitz constant.
+    /// The step divisor L: marching by f / L never crosses the surface. For a field with a
+    /// proven gradient bound it is that bound; for a bound such as the ellipsoid it is 1
+    /// (a lower bound on the distance is safe to step by, however steep the field).
     pub lipschitz: f64,
 }
 

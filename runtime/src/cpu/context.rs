@@ -95,11 +95,21 @@ impl<T: Float> Context<T> {
             .unwrap_or(&self.materials[0])
     }
 
-    /// The normal step at a hit: h = max(ε·t, 64·machine ε·(1 + |p|∞)), where t is the
-    /// path length; the floor keeps the differences above the rounding noise of `T`.
+    /// The normal step at a hit: h = max(L·ε·t, 64·machine ε·(1 + |p|∞)), where t is the
+    /// path length; a hit may lie up to L·ε·t from the surface, and the floor keeps the
+    /// differences above the rounding noise of `T`.
     pub fn normal_step(&self, tt: T, p: V3<T>) -> T {
         let floor = T::from_f64(64.0) * T::EPSILON * (T::one() + p.max_abs());
-        (self.epsilon * tt).max(floor)
+        (self.epsilon * tt / self.inv_lipschitz).max(floor)
+    }
+
+    /// The hit tolerance at a point: the pixel cone's `cone` (ε·t), but never below a few
+    /// units in the last place of the point's coordinates, where the field cannot resolve
+    /// anything finer (far from the origin).
+    #[inline(always)]
+    pub fn tolerance(&self, cone: T, x: T, y: T, z: T) -> T {
+        let m = x.abs().max(y.abs()).max(z.abs());
+        cone.max(T::from_f64(8.0) * T::EPSILON * m)
     }
 }
 

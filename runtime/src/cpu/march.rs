@@ -62,6 +62,7 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
         let (inv_l, eps, max_dist, max_steps) =
             (c.inv_lipschitz, c.epsilon, c.max_dist, c.max_steps);
         let (dist, sign, t0) = (&l.dist[..n], &l.sign[..n], &l.t0[..n]);
+        let (px, py, pz) = (&l.px[..n], &l.py[..n], &l.pz[..n]);
         let (t, steps, flags) = (&mut l.t[..n], &mut l.steps[..n], &mut l.flags[..n]);
         let (omega, prev, step) = (&mut l.omega[..n], &mut l.prev[..n], &mut l.step[..n]);
         let mut any = 0;
@@ -69,7 +70,7 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             let f = dist[k];
             let s = sign[k] * f * inv_l;
             let r = s.abs();
-            let tol = eps * (t0[k] + t[k]);
+            let tol = c.tolerance(eps * (t0[k] + t[k]), px[k], py[k], pz[k]);
             let om = omega[k];
             let fail = (om > one) & (r + prev[k] < step[k]);
             let st = if fail { step[k] - om * step[k] } else { s * om };
@@ -159,6 +160,7 @@ impl<T: Float> Shadow<'_, T> {
         let zero = T::zero();
         let (inv_l, eps, max_steps) = (c.inv_lipschitz, c.epsilon, c.max_steps);
         let (dist, t0, kk, tmax) = (&l.dist[..n], &l.t0[..n], &l.k[..n], &l.tmax[..n]);
+        let (px, py, pz) = (&l.px[..n], &l.py[..n], &l.pz[..n]);
         let (t, steps, flags, res) = (
             &mut l.t[..n],
             &mut l.steps[..n],
@@ -169,7 +171,7 @@ impl<T: Float> Shadow<'_, T> {
         for k in 0..n {
             let f = dist[k];
             let s = f * inv_l;
-            let tol = eps * (t0[k] + t[k]);
+            let tol = c.tolerance(eps * (t0[k] + t[k]), px[k], py[k], pz[k]);
             let soft = (kk[k] > zero) & (t[k] > zero);
             let penumbra = res[k].min(kk[k] * s / t[k]);
             res[k] = if soft { penumbra } else { res[k] };
@@ -218,7 +220,7 @@ impl<T: Float> Shadow<'_, T> {
         }
         let signed = l.sign[k] * f * c.inv_lipschitz;
         let tt = l.t0[k] + t;
-        let tol = c.epsilon * tt;
+        let tol = c.tolerance(c.epsilon * tt, l.px[k], l.py[k], l.pz[k]);
         if signed < -tol {
             self.counters.overshoots += 1;
         }

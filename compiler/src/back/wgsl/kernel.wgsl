@@ -93,7 +93,8 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
     var step = 0.0;
 //#endif
     loop {
-        let f = sdf(o + d * t);
+        let p = o + d * t;
+        let f = sdf(p);
         steps += 1u;
         counters.steps += 1u;
         if is_nan(f) {
@@ -102,7 +103,7 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
         }
         let signed = sign * f * inv_l;
         let r = abs(signed);
-        let tol = eps * (t0 + t);
+        let tol = tolerance(eps * (t0 + t), p);
         if signed < -tol {
             counters.overshoots += 1u;
         }
@@ -136,11 +137,17 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
     return Traced(t, STATUS_BUDGET); // not reached: the loop returns
 }
 
-// The normal step h = max(ε·t, 64·ε_f32·(1 + |p|∞)).
+// The normal step h = max(L·ε·t, 64·ε_f32·(1 + |p|∞)) (a hit may lie up to L·ε·t away).
 fn normal_step(tt: f32, p: vec3<f32>) -> f32 {
     let a = abs(p);
     let floor_h = 64.0 * 1.1920929e-7 * (1.0 + max(a.x, max(a.y, a.z)));
-    return max(params.march.x * tt, floor_h);
+    return max(params.march.x * tt / params.march.w, floor_h);
+}
+
+// The hit tolerance: the pixel cone, but never below 8 ulps of the point's coordinates.
+fn tolerance(cone: f32, p: vec3<f32>) -> f32 {
+    let a = abs(p);
+    return max(cone, 8.0 * 1.1920929e-7 * max(a.x, max(a.y, a.z)));
 }
 
 // N = normalize(Σ k_i f(p + h·k_i)); a degenerate gradient gives -D.
@@ -200,7 +207,7 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
         }
         let signed = sign * f * inv_l;
         let tt = t0 + t;
-        let tol = eps * tt;
+        let tol = tolerance(eps * tt, p);
         if signed < -tol {
             counters.overshoots += 1u;
         }

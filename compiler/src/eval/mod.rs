@@ -20,13 +20,6 @@ use tape::{Guard, Step};
 
 use crate::lower::{Axis, Op, Program};
 
-/// Temporary counters.
-pub static COUNT_STEPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-/// Temporary counters.
-pub static COUNT_LANES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-/// Temporary counters.
-pub static COUNT_EVALS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
 /// The default number of points an evaluator processes per pass over the tape.
 pub const DEFAULT_CHUNK: usize = 256;
 
@@ -128,7 +121,6 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// otherwise). All slices must have the same length; extra elements are ignored.
     pub fn eval(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], mut m: Option<&mut [u32]>) {
         let n = x.len().min(y.len()).min(z.len()).min(d.len());
-        COUNT_EVALS.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed);
         let mut start = 0;
         while start < n {
             let end = (start + self.chunk).min(n);
@@ -182,11 +174,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
         let mut s = 0;
         while s < steps.len() {
             match steps[s] {
-                Step::Inst(inst) => {
-                    COUNT_STEPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    COUNT_LANES.fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed);
-                    inst.apply(&mut self.slots, chunk, n)
-                }
+                Step::Inst(inst) => inst.apply(&mut self.slots, chunk, n),
                 Step::Enter(g) => {
                     let guard = tape.guard(g);
                     match self.enter(guard, depth, n) {

@@ -33,7 +33,17 @@ pub(super) enum Kind {
     /// Children evaluated one after the other.
     Leaf(Vec<Item>),
     /// Two halves, the first nearer the camera.
-    Split(Box<Tree>, Box<Tree>),
+    Split(Box<Tree>, Box<Tree>, Plane),
+}
+
+/// The plane between the two halves of a split: the children of the `low` half have their
+/// centres below `at` along `axis`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Plane {
+    pub axis: usize,
+    pub at: f64,
+    /// Whether the first half is the low one.
+    pub first_low: bool,
 }
 
 /// Builds the hierarchy of a non-empty list of children.
@@ -57,17 +67,21 @@ pub(super) fn build(mut items: Vec<Item>, eye: V3) -> Tree {
             kind: Kind::Leaf(items),
         };
     };
-    let rest = items.split_off(split);
+    let (axis, k) = split;
+    let at = (items[k - 1].bound.aabb.c[axis] + items[k].bound.aabb.c[axis]) * 0.5;
+    let rest = items.split_off(k);
     let (a, b) = (build(items, eye), build(rest, eye));
-    let (first, second) = if distance(&b.bound, eye) < distance(&a.bound, eye) {
-        (b, a)
-    } else {
-        (a, b)
+    let swap = distance(&b.bound, eye) < distance(&a.bound, eye);
+    let plane = Plane {
+        axis,
+        at,
+        first_low: !swap,
     };
+    let (first, second) = if swap { (b, a) } else { (a, b) };
     Tree {
         bound,
         cost,
-        kind: Kind::Split(Box::new(first), Box::new(second)),
+        kind: Kind::Split(Box::new(first), Box::new(second), plane),
     }
 }
 
@@ -75,13 +89,13 @@ pub(super) fn build(mut items: Vec<Item>, eye: V3) -> Tree {
 const MIN_SPLIT_COST: f64 = 48.0;
 
 /// The cost of a guard (its bound and bookkeeping), in instructions.
-const GUARD: f64 = 16.0;
+const GUARD: f64 = 48.0;
 
 /// The surface area heuristic: sorts the items along the best axis and returns where to
 /// split them, or `None` when splitting costs more than evaluating the group as it is. A
 /// split costs two guards plus each half's cost weighted by its share of the surface area
 /// (the chance that a point must evaluate it).
-fn best_split(items: &mut [Item], total_area: f64, cost: f64) -> Option<usize> {
+fn best_split(items: &mut [Item], total_area: f64, cost: f64) -> Option<(usize, usize)> {
     let mut best: Option<(f64, usize, usize)> = None;
     for axis in 0..3 {
         sort_along(items, axis);
@@ -112,7 +126,7 @@ fn best_split(items: &mut [Item], total_area: f64, cost: f64) -> Option<usize> {
         return None;
     }
     sort_along(items, axis);
-    Some(at)
+    Some((axis, at))
 }
 
 fn sort_along(items: &mut [Item], axis: usize) {

@@ -7,7 +7,7 @@
 //! runs only where its bounding volume is nearer than the best distance so far (see
 //! `docs/optimisation.md` for why the result is the same).
 
-use super::bounds::{Bound, Bounds};
+use super::bounds::{Aabb, Bound, Bounds};
 use super::builder::{Builder, P};
 use super::bvh::{self, Kind, Tree};
 use super::{shapes, Reg, Unary, EMPTY_DISTANCE};
@@ -272,7 +272,7 @@ impl<'a> Lowerer<'a> {
         let split = tree
             .as_ref()
             .is_some_and(|t| matches!(t.kind, Kind::Split(..)));
-        let upper = (self.config.cull && split && std::env::var("SDFC_NO_DESCEND").is_err())
+        let upper = (self.config.cull && split)
             .then(|| tree.as_ref().map(|t| self.descend(t, p)))
             .flatten();
         if acc.is_none() && (split || !slabs.is_empty()) {
@@ -287,7 +287,7 @@ impl<'a> Lowerer<'a> {
             self.child(id, &item, p, &mut acc, true, upper);
         }
         if let Some(tree) = &tree {
-            self.tree(id, tree, p, &mut acc, upper);
+            self.tree(id, tree, None, p, &mut acc, upper);
         }
         acc.unwrap_or_else(|| Field {
             d: self.b.c(EMPTY_DISTANCE),
@@ -295,31 +295,32 @@ impl<'a> Lowerer<'a> {
         })
     }
 
-    /// An upper bound of a hierarchy's union at `p`: the distance of the children of one
-    /// group, found by descending from the root into the half whose bound is nearer. Any
-    /// child's distance is at least the union's, so the guards may compare with it before
-    /// the nearest child is reached.
+    /// An upper bound of a hierarchy's union at `p`: the distance of one child of the group
+    /// found by descending from the root into the half on the point's side of each splitting
+    /// plane. Any child's distance is at least the union's, so the guards may compare with it
+    /// before the nearest child is reached.
     fn descend(&mut self, t: &Tree, p: P) -> Reg {
         match &t.kind {
             Kind::Leaf(items) => {
-                let mut upper: Option<Reg> = None;
-                for item in items {
-                    let f = self.node(item.id, p);
-                    upper = Some(match upper {
-                        None => f.d,
-                        Some(u) => self.b.min(u, f.d),
-                    });
+                // One child is enough for an upper bound: the cheapest.
+                let cheapest = items
+                    .iter()
+                    .min_by(|a, b| a.cost.total_cmp(&b.cost).then(a.index.cmp(&b.index)));
+                match cheapest {
+                    Some(item) => self.node(item.id, p).d,
+                    None => self.b.c(f64::INFINITY),
                 }
-                upper.unwrap_or_else(|| self.b.c(f64::INFINITY))
             }
-            Kind::Split(a, b) => {
-                let ba = bound_distance(self.b, &a.bound, p);
-                let bb = bound_distance(self.b, &b.bound, p);
+            Kind::Split(a, b, plane) => {
+                // The half on the point's side of the plane between the halves.
+                let at = self.b.c(plane.at);
+                let x = p[plane.axis];
+                let (a_side, b_side) = if plane.first_low { (x, at) } else { (at, x) };
                 let none = self.b.c(f64::INFINITY);
-                let first = self.b.open_block(ba, bb);
+                let first = self.b.open_block(a_side, b_side);
                 let ua = self.descend(a, p);
                 let ua = self.b.close_block(first, &[(ua, none)])[0];
-                let second = self.b.open_block(bb, ba);
+                let second = self.b.open_block(b_side, a_side);
                 let ub = self.descend(b, p);
                 self.b.close_block(second, &[(ub, ua)])[0]
             }
@@ -350,7 +351,9 @@ impl<'a> Lowerer<'a> {
     ) {
         if alone && self.guards(acc, item.cost) {
             let text = format!("node {} union: child culled by its bound", self.number(id));
-            self.guarded(text, &item.bound, p, acc, upper, |me, acc| {
+            self.b.note(text);
+            let beta = bound_distance(self.b, &item.bound, p);
+            self.guarded(beta, p, acc, upper, |me, acc| {
                 me.child(id, item, p, acc, false, upper)
             });
             return;
@@ -365,25 +368,37 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Evaluates a node of a union's hierarchy into `acc`.
-    fn tree(&mut self, id: NodeId, t: &Tree, p: P, acc: &mut Option<Field>, upper: Option<Reg>) {
-        if self.guards(acc, t.cost) {
-            let n = leaves(t);
-            let text = format!(
-                "node {} union: group of {n} children culled by its bound",
-                self.number(id)
-            );
-            self.guarded(text, &t.bound, p, acc, upper, |me, acc| {
-                me.tree_body(id, t, p, acc, upper)
-            });
-        } else {
-            self.tree_body(id, t, p, acc, upper);
+    /// Evaluates a node of a union's hierarchy into `acc`; `tested` is what the guards above
+    /// have computed already.
+    fn tree(
+        &mut self,
+        id: NodeId,
+        t: &Tree,
+        tested: Option<Tested>,
+        p: P,
+        acc: &mut Option<Field>,
+        upper: Option<Reg>,
+    ) {
+        if !self.guards(acc, t.cost) {
+            return self.tree_body(id, t, tested, p, acc, upper);
         }
+        let n = leaves(t);
+        let text = format!(
+            "node {} union: group of {n} children culled by its bound",
+            self.number(id)
+        );
+        self.b.note(text);
+        let (beta, tested) = slab_distance(self.b, &t.bound, tested.as_ref(), p);
+        self.guarded(beta, p, acc, upper, |me, acc| {
+            me.tree_body(id, t, Some(tested), p, acc, upper)
+        });
     }
 
     fn tree_body(
         &mut self,
         id: NodeId,
         t: &Tree,
+        tested: Option<Tested>,
         p: P,
         acc: &mut Option<Field>,
         upper: Option<Reg>,
@@ -394,30 +409,28 @@ impl<'a> Lowerer<'a> {
                     self.child(id, item, p, acc, items.len() > 1, upper);
                 }
             }
-            Kind::Split(a, b) => {
-                self.tree(id, a, p, acc, upper);
-                self.tree(id, b, p, acc, upper);
+            Kind::Split(a, b, _) => {
+                self.tree(id, a, tested, p, acc, upper);
+                self.tree(id, b, tested, p, acc, upper);
             }
         }
     }
 
-    /// Runs `body` in a block guarded by `bound`: where the bound is not nearer than the
-    /// accumulated distance (or the upper bound of the union, when known), the block is
-    /// skipped and `acc` keeps its value.
+    /// Runs `body` in a block guarded by the bound distance `beta`: where it is not nearer
+    /// than the accumulated distance (or the upper bound of the union, when known), the
+    /// block is skipped and `acc` keeps its value.
     fn guarded(
         &mut self,
-        text: String,
-        bound: &Bound,
+        beta: Reg,
         p: P,
         acc: &mut Option<Field>,
         upper: Option<Reg>,
         body: impl FnOnce(&mut Self, &mut Option<Field>),
     ) {
+        let _ = p;
         let Some(outer) = *acc else {
             return body(self, acc);
         };
-        self.b.note(text);
-        let beta = bound_distance(self.b, bound, p);
         let best = match upper {
             Some(u) => self.b.min(outer.d, u),
             None => outer.d,
@@ -506,11 +519,30 @@ impl<'a> Lowerer<'a> {
     }
 }
 
+/// For tests: a program computing node `id`'s field (as its distance) and the guard distance
+/// of its bound (as its material register).
+#[cfg(test)]
+pub(super) fn field_and_bound(graph: &Graph, bounds: &Bounds, id: NodeId) -> Option<super::Program> {
+    let bound = bounds.get(id)?;
+    let mut b = Builder::new(true);
+    let p = b.input_point();
+    let beta = bound_distance(&mut b, &bound, p);
+    let config = Config {
+        cull: false,
+        camera: [0.0; 3],
+        origin: None,
+        bounds: Some(bounds),
+        optimise: true,
+    };
+    let f = Lowerer::new(graph, &mut b, config).node(id, p);
+    Some(b.finish(f.d, beta))
+}
+
 /// The number of children below a node of a hierarchy.
 fn leaves(t: &Tree) -> usize {
     match &t.kind {
         Kind::Leaf(items) => items.len(),
-        Kind::Split(a, b) => leaves(a) + leaves(b),
+        Kind::Split(a, b, _) => leaves(a) + leaves(b),
     }
 }
 
@@ -521,35 +553,102 @@ fn leaves(t: &Tree) -> usize {
 /// cover the rounding of both this value and the field (`docs/optimisation.md`).
 fn bound_distance(b: &mut Builder, bound: &Bound, p: P) -> Reg {
     let (box_volume, sphere_volume) = bound.volumes();
-    let s = if bound.finite() && sphere_volume <= 1.5 * box_volume {
+    if bound.finite() && sphere_volume <= 1.5 * box_volume {
         let sp = bound.sphere;
         let pad = 1e-3 * sp.r + 1e-4 * (1.0 + norm(sp.c));
         let q = b.sub3c(p, sp.c);
         let l = b.len3(q);
-        b.subc(l, sp.r + pad)
-    } else {
-        let bx = bound.aabb;
-        let axes: Vec<usize> = (0..3).filter(|&i| bx.h[i].is_finite()).collect();
-        let size = axes.iter().map(|&i| bx.h[i] * bx.h[i]).sum::<f64>().sqrt();
-        let centre = axes.iter().map(|&i| bx.c[i] * bx.c[i]).sum::<f64>().sqrt();
-        let pad = 1e-3 * size + 1e-4 * (1.0 + centre);
-        let per_axis: Vec<Reg> = axes
-            .iter()
-            .map(|&i| {
-                let d = b.subc(p[i], bx.c[i]);
-                let d = b.abs(d);
-                b.subc(d, bx.h[i] + pad)
-            })
-            .collect();
-        per_axis
-            .into_iter()
-            .reduce(|x, y| b.max(x, y))
-            .unwrap_or_else(|| b.c(f64::NEG_INFINITY))
+        let s = b.subc(l, sp.r + pad);
+        return shrink(b, s, bound.scale);
+    }
+    let axes: Vec<usize> = (0..3).filter(|&i| bound.aabb.h[i].is_finite()).collect();
+    box_distance(b, bound, &axes, p)
+}
+
+/// What the guards on the path to a hierarchy node have computed: the box they narrowed the
+/// point to, and per axis the registers of the last per-axis distance computed (to a box
+/// containing the node's, so a lower bound of the distance to the node's box along that
+/// axis) and of its positive part squared.
+#[derive(Debug, Clone, Copy)]
+struct Tested {
+    region: Aabb,
+    terms: [Option<(Reg, Reg)>; 3],
+}
+
+/// The bound distance of a hierarchy node: the distance to its box, `|max(q, 0)| +
+/// min(max q_i, 0)` with `q_i` the per-axis distance, computed afresh along the axes where the
+/// box is narrower than the region tested above (by a tenth) and taken from the guards above
+/// along the others. The distance along an axis to a larger box is a lower bound of the one to
+/// this box, and the formula grows with every `q_i`, so the result is a lower bound of the
+/// distance to the box. Returns the distance and what the guards below will know.
+fn slab_distance(b: &mut Builder, bound: &Bound, tested: Option<&Tested>, p: P) -> (Reg, Tested) {
+    let (c, h) = (bound.aabb.c, bound.aabb.h);
+    let mut state = tested.copied().unwrap_or(Tested {
+        region: bound.aabb,
+        terms: [None; 3],
+    });
+    let fresh = |i: usize| match tested {
+        None => h[i].is_finite(),
+        Some(t) => {
+            let margin = 0.1 * t.region.h[i];
+            c[i] - h[i] > t.region.c[i] - t.region.h[i] + margin
+                || c[i] + h[i] < t.region.c[i] + t.region.h[i] - margin
+        }
     };
-    if bound.scale >= 1.0 {
+    let size = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+    let pad = 1e-3 * size + 1e-4 * (1.0 + norm(c));
+    for i in (0..3).filter(|&i| fresh(i)) {
+        let d = b.subc(p[i], c[i]);
+        let d = b.abs(d);
+        let q = b.subc(d, h[i] + pad);
+        let o = b.maxc(q, 0.0);
+        state.terms[i] = Some((q, b.mul(o, o)));
+        state.region.c[i] = c[i];
+        state.region.h[i] = h[i];
+    }
+    let terms: Vec<(Reg, Reg)> = state.terms.iter().flatten().copied().collect();
+    let s = match terms.split_first() {
+        None => b.c(f64::NEG_INFINITY),
+        Some((&(q0, o0), rest)) => {
+            let (q, o) = rest
+                .iter()
+                .fold((q0, o0), |(q, o), &(qi, oi)| (b.max(q, qi), b.add(o, oi)));
+            let outside = b.sqrt(o);
+            let inside = b.minc(q, 0.0);
+            b.add(outside, inside)
+        }
+    };
+    (shrink(b, s, bound.scale), state)
+}
+
+/// The largest per-axis distance to the box over `axes` (a lower bound of the distance to
+/// the box), padded and shrunk.
+fn box_distance(b: &mut Builder, bound: &Bound, axes: &[usize], p: P) -> Reg {
+    let bx = bound.aabb;
+    let size = axes.iter().map(|&i| bx.h[i] * bx.h[i]).sum::<f64>().sqrt();
+    let centre = axes.iter().map(|&i| bx.c[i] * bx.c[i]).sum::<f64>().sqrt();
+    let pad = 1e-3 * size + 1e-4 * (1.0 + centre);
+    let per_axis: Vec<Reg> = axes
+        .iter()
+        .map(|&i| {
+            let d = b.subc(p[i], bx.c[i]);
+            let d = b.abs(d);
+            b.subc(d, bx.h[i] + pad)
+        })
+        .collect();
+    let s = per_axis
+        .into_iter()
+        .reduce(|x, y| b.max(x, y))
+        .unwrap_or_else(|| b.c(f64::NEG_INFINITY));
+    shrink(b, s, bound.scale)
+}
+
+/// `SHRINK·s` for a bound of scale 1, else `min(s, SHRINK·scale·s)`.
+fn shrink(b: &mut Builder, s: Reg, scale: f64) -> Reg {
+    if scale >= 1.0 {
         b.mulc(s, SHRINK)
     } else {
-        let t = b.mulc(s, SHRINK * bound.scale);
+        let t = b.mulc(s, SHRINK * scale);
         b.min(s, t)
     }
 }

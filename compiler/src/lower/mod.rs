@@ -25,6 +25,8 @@ mod bvh;
 mod graph;
 mod shapes;
 mod simplify;
+#[cfg(test)]
+mod tests;
 
 use crate::scene::Scene;
 use std::fmt::Write;

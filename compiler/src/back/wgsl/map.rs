@@ -1,6 +1,6 @@
 //! Writes a distance program as the WGSL functions `fn map(p: vec3<f32>) -> vec2<f32>` and
-//! `fn sdf(p: vec3<f32>) -> f32`: one `let` per instruction, with comments naming the scene
-//! node each block comes from. A guarded block is an `if`; each of its results is a `var`
+//! `fn sdf(p: vec3<f32>) -> f32`: one `let` per instruction (constants written where they are
+//! read), with comments naming the scene node each block comes from. A guarded block is an `if`; each of its results is a `var`
 //! holding the value from before the block, assigned the block's value inside it.
 
 use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
@@ -12,12 +12,9 @@ pub fn write_map(program: &Program) -> String {
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
     out.push_str("fn map(p: vec3<f32>) -> vec2<f32> {\n");
     body(&mut out, program, &[program.distance(), program.material()], true);
-    let _ = writeln!(
-        out,
-        "    return vec2<f32>(r{}, r{});",
-        program.distance().0,
-        program.material().0
-    );
+    let names = Names::new(program);
+    let (d, m) = (names.get(program.distance()), names.get(program.material()));
+    let _ = writeln!(out, "    return vec2<f32>({d}, {m});");
     out.push_str("}\n");
     out
 }
@@ -29,7 +26,8 @@ pub fn write_sdf(program: &Program) -> String {
         "// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n",
     );
     body(&mut out, program, &[program.distance()], false);
-    let _ = writeln!(out, "    return r{};\n}}", program.distance().0);
+    let d = Names::new(program).get(program.distance());
+    let _ = writeln!(out, "    return {d};\n}}");
     out
 }
 
@@ -39,37 +37,33 @@ fn body(out: &mut String, program: &Program, roots: &[Reg], comments: bool) {
     let ops = program.ops();
     let blocks = program.blocks();
     let phi_of = program.phi_blocks();
+    let names = Names::new(program);
     let mut notes = program.notes().iter().peekable();
     let mut depth = 1;
     let pad = |d: usize| "    ".repeat(d);
     for item in program.items() {
         match item {
-            Item::Op(i) if live[i] && phi_of[i].is_none() => {
+            Item::Op(i) if live[i] && phi_of[i].is_none() && !names.inlined(i) => {
                 while let Some(n) = notes.next_if(|n| n.at <= i) {
                     if comments {
                         let _ = writeln!(out, "{}// {}", pad(depth), n.text);
                     }
                 }
-                let _ = writeln!(out, "{}let r{i} = {};", pad(depth), expr(&ops[i]));
+                let _ = writeln!(out, "{}let r{i} = {};", pad(depth), expr(&ops[i], &names));
             }
             Item::Op(_) => {}
             Item::Open(b) if live_blocks[b] => {
                 let block = &blocks[b];
                 for (j, _, other) in results(program, b, &live) {
-                    let _ = writeln!(out, "{}var r{j} = r{};", pad(depth), other.0);
+                    let _ = writeln!(out, "{}var r{j}: f32 = {};", pad(depth), names.get(other));
                 }
-                let _ = writeln!(
-                    out,
-                    "{}if !(r{} >= r{}) {{",
-                    pad(depth),
-                    block.bound.0,
-                    block.best.0
-                );
+                let (x, y) = (names.get(block.bound), names.get(block.best));
+                let _ = writeln!(out, "{}if !({x} >= {y}) {{", pad(depth));
                 depth += 1;
             }
             Item::Close(b) if live_blocks[b] => {
                 for (j, then, _) in results(program, b, &live) {
-                    let _ = writeln!(out, "{}r{j} = r{};", pad(depth), then.0);
+                    let _ = writeln!(out, "{}r{j} = {};", pad(depth), names.get(then));
                 }
                 depth -= 1;
                 let _ = writeln!(out, "{}}}", pad(depth));
@@ -103,14 +97,57 @@ pub fn float(x: f64) -> String {
     }
 }
 
-fn expr(op: &Op) -> String {
+/// How each register is read: `r{i}`, or the literal of a constant that is only read by
+/// instructions with another operand (so that no expression is all constants, which naga
+/// would evaluate when parsing).
+struct Names(Vec<Option<String>>);
+
+impl Names {
+    fn new(program: &Program) -> Names {
+        let ops = program.ops();
+        let is_const = |r: Reg| matches!(ops[r.0 as usize], Op::Const(_));
+        let mut inline: Vec<bool> = ops.iter().map(|op| matches!(op, Op::Const(_))).collect();
+        for op in ops {
+            let operands = op.operands();
+            if !operands.is_empty() && operands.iter().all(|&r| is_const(r)) {
+                operands.iter().for_each(|r| inline[r.0 as usize] = false);
+            }
+        }
+        Names(
+            ops.iter()
+                .zip(inline)
+                .map(|(op, i)| match (op, i) {
+                    (Op::Const(c), true) => {
+                        let lit = float(*c);
+                        Some(if lit.starts_with('-') { format!("({lit})") } else { lit })
+                    }
+                    _ => None,
+                })
+                .collect(),
+        )
+    }
+
+    /// Whether the register is written as a literal (and has no `let`).
+    fn inlined(&self, i: usize) -> bool {
+        self.0[i].is_some()
+    }
+
+    fn get(&self, r: Reg) -> String {
+        self.0[r.0 as usize]
+            .clone()
+            .unwrap_or_else(|| format!("r{}", r.0))
+    }
+}
+
+fn expr(op: &Op, names: &Names) -> String {
+    let n = |r: Reg| names.get(r);
     match *op {
         Op::Const(c) => float(c),
         Op::Input(Axis::X) => "p.x".into(),
         Op::Input(Axis::Y) => "p.y".into(),
         Op::Input(Axis::Z) => "p.z".into(),
         Op::Unary(u, a) => {
-            let a = format!("r{}", a.0);
+            let a = n(a);
             match u {
                 Unary::Neg => format!("-{a}"),
                 Unary::Abs => format!("abs({a})"),
@@ -126,7 +163,7 @@ fn expr(op: &Op) -> String {
             }
         }
         Op::Binary(b, x, y) => {
-            let (x, y) = (format!("r{}", x.0), format!("r{}", y.0));
+            let (x, y) = (n(x), n(y));
             match b {
                 Binary::Add => format!("{x} + {y}"),
                 Binary::Sub => format!("{x} - {y}"),
@@ -139,7 +176,7 @@ fn expr(op: &Op) -> String {
                 Binary::Lt => format!("select(0.0, 1.0, {x} < {y})"),
             }
         }
-        Op::Select(c, a, b) => format!("select(r{}, r{}, r{} != 0.0)", b.0, a.0, c.0),
-        Op::Phi(a, _) => format!("r{}", a.0),
+        Op::Select(c, a, b) => format!("select({}, {}, {} != 0.0)", n(b), n(a), n(c)),
+        Op::Phi(a, _) => n(a),
     }
 }

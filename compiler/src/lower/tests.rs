@@ -1,0 +1,255 @@
+//! Checks of the bounds the culling relies on: for every kind of node, alone and under other
+//! nodes, the field the lowering computes is never below the guard distance of the node's
+//! bound, at random points near and far (in f64 and in f32).
+
+use super::bounds::Bounds;
+use super::graph::field_and_bound;
+use super::{Op, Program};
+use crate::eval::{scalar, Float};
+use crate::lower::Axis;
+use crate::scene::{Combine, Graph, MaterialId, Node, NodeId, Smooth};
+use crate::{FileId, Span};
+
+/// Evaluates the distance and the material register (the bound, here) of a program without
+/// blocks.
+fn eval<T: Float>(program: &Program, p: [T; 3]) -> (T, T) {
+    let mut regs: Vec<T> = Vec::with_capacity(program.len());
+    for op in program.ops() {
+        let r = |x: super::Reg| regs[x.0 as usize];
+        let v = match *op {
+            Op::Const(c) => T::from_f64(c),
+            Op::Input(Axis::X) => p[0],
+            Op::Input(Axis::Y) => p[1],
+            Op::Input(Axis::Z) => p[2],
+            Op::Unary(u, a) => scalar::unary(u, r(a)),
+            Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
+            Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
+            Op::Phi(a, _) => r(a),
+        };
+        regs.push(v);
+    }
+    (
+        regs[program.distance().0 as usize],
+        regs[program.material().0 as usize],
+    )
+}
+
+/// A small deterministic generator (xorshift64*), uniform in [0, 1).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+    let l = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    let [x, y, z] = axis.map(|a| a / l);
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    [
+        [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+        [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+        [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
+    ]
+}
+
+/// A graph holding one of every kind of node, alone and nested.
+fn zoo() -> (Graph, Vec<NodeId>) {
+    let mut g = Graph::default();
+    let mut add = |g: &mut Graph, n: Node| g.add(n, Span::new(FileId(0), 0..0));
+    let mut ids = Vec::new();
+    let prims = [
+        Node::Sphere { radius: 0.7 },
+        Node::Box {
+            half: [0.5, 0.2, 0.9],
+        },
+        Node::RoundBox {
+            half: [0.5, 0.4, 0.3],
+            radius: 0.1,
+        },
+        Node::Torus {
+            major: 0.8,
+            minor: 0.2,
+        },
+        Node::Cylinder {
+            radius: 0.3,
+            half_height: 0.9,
+        },
+        Node::Capsule {
+            radius: 0.25,
+            half_height: 0.6,
+        },
+        Node::Cone {
+            radius: 0.6,
+            half_height: 0.5,
+        },
+        Node::Ellipsoid {
+            radii: [0.3, 0.9, 0.5],
+        },
+        Node::Mandelbulb {
+            power: 8.0,
+            iterations: 4,
+        },
+        Node::Mandelbulb {
+            power: 3.5,
+            iterations: 3,
+        },
+    ];
+    let prims: Vec<NodeId> = prims.into_iter().map(|n| add(&mut g, n)).collect();
+    ids.extend(&prims);
+    let (a, b) = (prims[1], prims[7]);
+    let moved = add(
+        &mut g,
+        Node::Translate {
+            offset: [0.6, -0.2, 0.3],
+            child: b,
+        },
+    );
+    for op in [Combine::Union, Combine::Intersect, Combine::Subtract] {
+        ids.push(add(
+            &mut g,
+            Node::Combine {
+                op,
+                children: vec![a, moved],
+            },
+        ));
+        for variant in [Smooth::Poly, Smooth::Exp] {
+            ids.push(add(
+                &mut g,
+                Node::SmoothCombine {
+                    op,
+                    k: 0.5,
+                    variant,
+                    a,
+                    b: moved,
+                },
+            ));
+        }
+    }
+    let wrappers = |c: NodeId| {
+        vec![
+            Node::Translate {
+                offset: [1.5, -0.5, 2.0],
+                child: c,
+            },
+            Node::Rotate {
+                matrix: rotation([1.0, 2.0, 0.5], 0.9),
+                child: c,
+            },
+            Node::Scale {
+                factor: 2.5,
+                child: c,
+            },
+            Node::Scale {
+                factor: 0.4,
+                child: c,
+            },
+            Node::ScaleXyz {
+                factors: [0.5, 2.0, 1.0],
+                child: c,
+            },
+            Node::Repeat {
+                period: [1.5, 0.0, 2.0],
+                count: Some([3.0, 1.0, 2.0]),
+                child: c,
+            },
+            Node::Repeat {
+                period: [2.5, 0.0, 0.0],
+                count: None,
+                child: c,
+            },
+            Node::Mirror {
+                axes: [true, false, true],
+                child: c,
+            },
+            Node::Twist {
+                rate: 1.3,
+                child: c,
+            },
+            Node::Bend {
+                rate: 0.7,
+                child: c,
+            },
+            Node::Elongate {
+                half: [0.3, 0.0, 0.5],
+                child: c,
+            },
+            Node::Round {
+                radius: 0.2,
+                child: c,
+            },
+            Node::Shell {
+                thickness: 0.1,
+                child: c,
+            },
+            Node::Paint {
+                material: MaterialId(1),
+                child: c,
+            },
+        ]
+    };
+    let bases: Vec<NodeId> = ids.clone();
+    for &c in &bases {
+        let shifted = add(
+            &mut g,
+            Node::Translate {
+                offset: [0.4, 0.7, -0.3],
+                child: c,
+            },
+        );
+        for w in wrappers(shifted) {
+            ids.push(add(&mut g, w));
+        }
+    }
+    // Two levels of wrapping on a few shapes.
+    for &c in &[prims[1], prims[3], prims[7]] {
+        for w in wrappers(c) {
+            let inner = add(&mut g, w);
+            for w2 in wrappers(inner).into_iter().step_by(3) {
+                ids.push(add(&mut g, w2));
+            }
+        }
+    }
+    (g, ids)
+}
+
+#[test]
+fn every_bound_is_below_its_field() {
+    let (graph, ids) = zoo();
+    let bounds = Bounds::new(&graph);
+    let mut rng = Rng(0x1234_5678_9ABC_DEF1);
+    let mut checked = 0;
+    for id in ids {
+        let Some(program) = field_and_bound(&graph, &bounds, id) else {
+            continue;
+        };
+        let b = bounds.get(id).expect("bounded");
+        let reach = if b.finite() { b.sphere.r } else { 4.0 };
+        let c = if b.finite() { b.sphere.c } else { [0.0; 3] };
+        for k in 0..3000 {
+            // Points from deep inside to far outside, denser near the volume.
+            let scale = [0.3, 1.0, 1.5, 4.0][k % 4] * reach + 0.5;
+            let p: [f64; 3] = [0, 1, 2].map(|i| c[i] + (2.0 * rng.next() - 1.0) * scale);
+            let (f, beta) = eval::<f64>(&program, p);
+            assert!(
+                f.is_nan() || beta <= f,
+                "node {:?}: bound {beta} above field {f} at {p:?}",
+                graph.node(id)
+            );
+            let q = p.map(|v| v as f32);
+            let (f, beta) = eval::<f32>(&program, q);
+            assert!(
+                f.is_nan() || beta <= f,
+                "node {:?} (f32): bound {beta} above field {f} at {q:?}",
+                graph.node(id)
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked > 300, "{checked} nodes checked");
+}

@@ -208,7 +208,11 @@ fn bench_prints_a_table_or_json() {
 #[test]
 fn missing_unreadable_and_non_utf8_inputs_exit_2() {
     let d = dir("inputs");
-    for args in [&["check", "nope.sdf"][..], &["render", "nope.sdf"], &["compile", "nope.sdf", "--emit", "ir"]] {
+    for args in [
+        &["check", "nope.sdf"][..],
+        &["render", "nope.sdf"],
+        &["compile", "nope.sdf", "--emit", "ir"],
+    ] {
         let out = sdfc(&d, args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read `nope.sdf`"));
@@ -226,11 +230,18 @@ fn missing_unreadable_and_non_utf8_inputs_exit_2() {
 fn an_unreadable_import_is_a_diagnostic() {
     let d = dir("import");
     std::fs::write(d.join("lib.sdf"), b"let r = 1; // caf\xe9\n").expect("write");
-    std::fs::write(d.join("main.sdf"), "import \"lib.sdf\";\nscene { sphere(r); }\n").expect("write");
+    std::fs::write(
+        d.join("main.sdf"),
+        "import \"lib.sdf\";\nscene { sphere(r); }\n",
+    )
+    .expect("write");
     let out = sdfc(&d, &["check", "main.sdf"]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("E0501") && err.contains("not valid UTF-8"), "{err}");
+    assert!(
+        err.contains("E0501") && err.contains("not valid UTF-8"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -241,9 +252,22 @@ fn a_missing_or_invalid_output_directory_leaves_nothing() {
     for target in ["missing/out.png", "plain-file/out.png"] {
         let out = sdfc(&d, &["render", "ball.sdf", "-o", target]);
         assert_eq!(out.status.code(), Some(2), "{target}");
-        assert!(String::from_utf8_lossy(&out.stderr).contains("cannot write"), "{target}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("cannot write"),
+            "{target}"
+        );
     }
-    let out = sdfc(&d, &["compile", "ball.sdf", "--emit", "wgsl", "-o", "missing/k.wgsl"]);
+    let out = sdfc(
+        &d,
+        &[
+            "compile",
+            "ball.sdf",
+            "--emit",
+            "wgsl",
+            "-o",
+            "missing/k.wgsl",
+        ],
+    );
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(entries(&d), ["ball.sdf", "plain-file"]);
 }
@@ -262,7 +286,10 @@ fn no_gpu_adapter_is_a_clear_error() {
         .expect("run sdfc");
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("no wgpu adapter found") && err.contains("mesa-vulkan-drivers"), "{err}");
+    assert!(
+        err.contains("no wgpu adapter found") && err.contains("mesa-vulkan-drivers"),
+        "{err}"
+    );
     assert_eq!(entries(&d), ["ball.sdf"]);
 }
 
@@ -287,11 +314,25 @@ fn an_interrupt_stops_a_render_and_leaves_no_file() {
     scene_file(&d);
     let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&d)
-        .args(["render", "ball.sdf", "--backend", "cpu", "--size", "4000x3000", "--aa", "4", "-o", "big.png"])
+        .args([
+            "render",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--size",
+            "4000x3000",
+            "--aa",
+            "4",
+            "-o",
+            "big.png",
+        ])
         .spawn()
         .expect("spawn");
     std::thread::sleep(std::time::Duration::from_millis(500));
-    let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill");
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
     assert!(killed.success());
     let status = child.wait().expect("wait");
     assert!(!status.success());

@@ -11,7 +11,12 @@ fn codes(text: &str) -> Vec<&'static str> {
 
 /// Runs `f` on a thread with a small stack, as a test harness or an editor might.
 fn on_small_stack(f: impl FnOnce() + Send + 'static) {
-    std::thread::Builder::new().stack_size(2 << 20).spawn(f).expect("thread").join().expect("no panic");
+    std::thread::Builder::new()
+        .stack_size(2 << 20)
+        .spawn(f)
+        .expect("thread")
+        .join()
+        .expect("no panic");
 }
 
 #[test]
@@ -19,11 +24,23 @@ fn deep_nesting_is_an_error_not_a_crash() {
     on_small_stack(|| {
         let depth = 10_000;
         // Parentheses leave no trace in the tree: deep ones are simply accepted.
-        let parens = format!("let x = {}1{};\nscene {{ sphere(); }}", "(".repeat(depth), ")".repeat(depth));
+        let parens = format!(
+            "let x = {}1{};\nscene {{ sphere(); }}",
+            "(".repeat(depth),
+            ")".repeat(depth)
+        );
         assert!(codes(&parens).is_empty(), "{:?}", codes(&parens));
-        let calls = format!("let x = {}1{};\nscene {{ sphere(); }}", "abs(".repeat(depth), ")".repeat(depth));
+        let calls = format!(
+            "let x = {}1{};\nscene {{ sphere(); }}",
+            "abs(".repeat(depth),
+            ")".repeat(depth)
+        );
         assert!(codes(&calls).contains(&"E0507"), "{:?}", codes(&calls));
-        let shapes = format!("scene {{ {}sphere(){}; }}", "union(sphere(), ".repeat(depth), ")".repeat(depth));
+        let shapes = format!(
+            "scene {{ {}sphere(){}; }}",
+            "union(sphere(), ".repeat(depth),
+            ")".repeat(depth)
+        );
         assert!(codes(&shapes).contains(&"E0507"), "{:?}", codes(&shapes));
     });
 }
@@ -46,7 +63,11 @@ fn endless_evaluation_is_bounded() {
     // Functions calling each other twice: memoised, so this is fast and correct.
     let mut chain = String::from("fn f0(x: float) -> float { x + 1 }\n");
     for i in 1..40 {
-        chain.push_str(&format!("fn f{i}(x: float) -> float {{ f{}(x) + f{}(x) }}\n", i - 1, i - 1));
+        chain.push_str(&format!(
+            "fn f{i}(x: float) -> float {{ f{}(x) + f{}(x) }}\n",
+            i - 1,
+            i - 1
+        ));
     }
     chain.push_str("let big = f39(1);\nscene { sphere(); }");
     assert!(codes(&chain).is_empty(), "{:?}", codes(&chain));
@@ -55,8 +76,15 @@ fn endless_evaluation_is_bounded() {
 
 fn corpus() -> Vec<String> {
     let mut out = Vec::new();
-    for dir in ["../examples", "../tests/in/ok", "../tests/in/err", "../tests/in/fuzz"] {
-        let Ok(entries) = std::fs::read_dir(dir) else { continue };
+    for dir in [
+        "../examples",
+        "../tests/in/ok",
+        "../tests/in/err",
+        "../tests/in/fuzz",
+    ] {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            continue;
+        };
         let mut paths: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
         paths.sort();
         for p in paths {
@@ -94,8 +122,32 @@ impl Rng {
 }
 
 const SNIPPETS: &[&str] = &[
-    "(", ")", "{", "}", ";", ",", "@", "..", "-", "/*", "\"", "1e309", "0", "-1", "deg", "sphere(", "let ", "fn ",
-    "scene {", "for i in 0..3 {", "if true {", "} else {", ".translate(1, 0, 0)", "union(", "\u{e9}", "\n",
+    "(",
+    ")",
+    "{",
+    "}",
+    ";",
+    ",",
+    "@",
+    "..",
+    "-",
+    "/*",
+    "\"",
+    "1e309",
+    "0",
+    "-1",
+    "deg",
+    "sphere(",
+    "let ",
+    "fn ",
+    "scene {",
+    "for i in 0..3 {",
+    "if true {",
+    "} else {",
+    ".translate(1, 0, 0)",
+    "union(",
+    "\u{e9}",
+    "\n",
 ];
 
 #[test]
@@ -126,7 +178,8 @@ fn fuzz_regressions_and_mutations_do_not_panic() {
                     let other = &corpus[rng.below(corpus.len())];
                     let chars: Vec<char> = other.chars().collect();
                     let from = rng.below(chars.len());
-                    let piece: Vec<char> = chars[from..(from + rng.below(40)).min(chars.len())].to_vec();
+                    let piece: Vec<char> =
+                        chars[from..(from + rng.below(40)).min(chars.len())].to_vec();
                     for (i, c) in piece.into_iter().enumerate() {
                         bytes.insert((at + i).min(bytes.len()), c);
                     }

@@ -28,9 +28,18 @@ pub enum Prepared {
     /// CPU: the distance program and the render options.
     Cpu { program: Program, options: Options },
     /// wgpu: the device, the validated kernel and the scene's Lipschitz bound L.
-    Wgpu { gpu: Box<Gpu>, kernel: Box<wgsl::Kernel>, lipschitz: f64 },
+    Wgpu {
+        gpu: Box<Gpu>,
+        kernel: Box<wgsl::Kernel>,
+        lipschitz: f64,
+    },
     /// CUDA: the device, the loaded module and the scene's Lipschitz bound L.
-    Cuda { cuda: Box<Cuda>, loaded: Box<gpu::cuda::Loaded>, ptx_time: Duration, lipschitz: f64 },
+    Cuda {
+        cuda: Box<Cuda>,
+        loaded: Box<gpu::cuda::Loaded>,
+        ptx_time: Duration,
+        lipschitz: f64,
+    },
 }
 
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
@@ -52,7 +61,9 @@ impl Prepared {
             Backend::Wgpu => Self::wgpu(scene, false),
             Backend::Cuda => Self::cuda(scene),
             Backend::Auto if precision == Precision::F64 => Ok(Self::cpu(scene, precision)),
-            Backend::Auto => Self::cuda(scene).or_else(|_| Self::wgpu(scene, true)).or_else(|_| Ok(Self::cpu(scene, precision))),
+            Backend::Auto => Self::cuda(scene)
+                .or_else(|_| Self::wgpu(scene, true))
+                .or_else(|_| Ok(Self::cpu(scene, precision))),
         }
     }
 
@@ -62,8 +73,15 @@ impl Prepared {
     }
 
     fn cpu(scene: &Scene, precision: Precision) -> Prepared {
-        let options = Options { precision, lipschitz: Self::lipschitz(scene), ..Options::default() };
-        Prepared::Cpu { program: lower::lower(scene), options }
+        let options = Options {
+            precision,
+            lipschitz: Self::lipschitz(scene),
+            ..Options::default()
+        };
+        Prepared::Cpu {
+            program: lower::lower(scene),
+            options,
+        }
     }
 
     fn kernel(scene: &Scene) -> Result<wgsl::Kernel, String> {
@@ -73,18 +91,32 @@ impl Prepared {
     fn wgpu(scene: &Scene, require_hardware: bool) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
         let lipschitz = Self::lipschitz(scene);
-        Ok(Prepared::Wgpu { gpu: Box::new(gpu), kernel: Box::new(Self::kernel(scene)?), lipschitz })
+        Ok(Prepared::Wgpu {
+            gpu: Box::new(gpu),
+            kernel: Box::new(Self::kernel(scene)?),
+            lipschitz,
+        })
     }
 
     fn cuda(scene: &Scene) -> Result<Prepared, String> {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
         let kernel = Self::kernel(scene)?;
         let start = Instant::now();
-        let options = ptx::Options { sm: cuda.sm, entry_point: wgsl::ENTRY_POINT.to_string() };
+        let options = ptx::Options {
+            sm: cuda.sm,
+            entry_point: wgsl::ENTRY_POINT.to_string(),
+        };
         let text = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
         let ptx_time = start.elapsed();
-        let loaded = cuda.load(&text, wgsl::ENTRY_POINT).map_err(|e| e.to_string())?;
-        Ok(Prepared::Cuda { cuda: Box::new(cuda), loaded: Box::new(loaded), ptx_time, lipschitz: Self::lipschitz(scene) })
+        let loaded = cuda
+            .load(&text, wgsl::ENTRY_POINT)
+            .map_err(|e| e.to_string())?;
+        Ok(Prepared::Cuda {
+            cuda: Box::new(cuda),
+            loaded: Box::new(loaded),
+            ptx_time,
+            lipschitz: Self::lipschitz(scene),
+        })
     }
 
     /// The backend's name, as in `--backend`.
@@ -108,10 +140,16 @@ impl Prepared {
     /// How the backend was prepared, for `--stats`: PTX generation and JIT times for CUDA.
     pub fn preparation(&self) -> Option<String> {
         match self {
-            Prepared::Cuda { loaded, ptx_time, .. } => Some(format!(
+            Prepared::Cuda {
+                loaded, ptx_time, ..
+            } => Some(format!(
                 "PTX generated in {:.2} ms; module {} in {:.1} ms",
                 ptx_time.as_secs_f64() * 1e3,
-                if loaded.cached { "read from the JIT cache and loaded" } else { "compiled by the driver JIT and loaded" },
+                if loaded.cached {
+                    "read from the JIT cache and loaded"
+                } else {
+                    "compiled by the driver JIT and loaded"
+                },
                 loaded.load_time.as_secs_f64() * 1e3
             )),
             _ => None,
@@ -138,16 +176,39 @@ impl Prepared {
                     progress(n as f64 / tiles);
                 });
                 let time = start.elapsed();
-                Ok(Frame { render, time, wall: time })
+                Ok(Frame {
+                    render,
+                    time,
+                    wall: time,
+                })
             }
-            Prepared::Wgpu { gpu, kernel, lipschitz } => {
-                let r = gpu::render(gpu, scene, kernel, *lipschitz, &mut |f| progress(f)).map_err(|e| e.to_string())?;
-                Ok(Frame { render: r.render, time: r.time, wall: r.wall })
+            Prepared::Wgpu {
+                gpu,
+                kernel,
+                lipschitz,
+            } => {
+                let r = gpu::render(gpu, scene, kernel, *lipschitz, &mut |f| progress(f))
+                    .map_err(|e| e.to_string())?;
+                Ok(Frame {
+                    render: r.render,
+                    time: r.time,
+                    wall: r.wall,
+                })
             }
-            Prepared::Cuda { cuda, loaded, lipschitz, .. } => {
-                let r = gpu::render_cuda(cuda, scene, loaded, *lipschitz).map_err(|e| e.to_string())?;
+            Prepared::Cuda {
+                cuda,
+                loaded,
+                lipschitz,
+                ..
+            } => {
+                let r =
+                    gpu::render_cuda(cuda, scene, loaded, *lipschitz).map_err(|e| e.to_string())?;
                 progress(1.0);
-                Ok(Frame { render: r.render, time: r.time, wall: r.wall })
+                Ok(Frame {
+                    render: r.render,
+                    time: r.time,
+                    wall: r.wall,
+                })
             }
         }
     }

@@ -95,10 +95,16 @@ pub fn read_png(path: &Path) -> Result<Image, ImageError> {
     let file = std::fs::File::open(path)?;
     let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
     decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = decoder.read_info().map_err(|e| ImageError::Encode(e.to_string()))?;
-    let size = reader.output_buffer_size().ok_or_else(|| ImageError::Encode("image too large".into()))?;
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| ImageError::Encode(e.to_string()))?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| ImageError::Encode("image too large".into()))?;
     let mut buf = vec![0; size];
-    let info = reader.next_frame(&mut buf).map_err(|e| ImageError::Encode(e.to_string()))?;
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| ImageError::Encode(e.to_string()))?;
     let channels = info.color_type.samples();
     let bytes = &buf[..info.buffer_size()];
     let linear = bytes
@@ -108,7 +114,11 @@ pub fn read_png(path: &Path) -> Result<Image, ImageError> {
             _ => [srgb_decode(px[0]), srgb_decode(px[1]), srgb_decode(px[2])],
         })
         .collect();
-    Ok(Image { width: info.width, height: info.height, linear })
+    Ok(Image {
+        width: info.width,
+        height: info.height,
+        linear,
+    })
 }
 
 /// Writes `image` as a PNG file, atomically (see [`write_atomic`]).

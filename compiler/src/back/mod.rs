@@ -1,6 +1,6 @@
 //! Back ends that write a distance program as source text.
 
+pub mod ptx;
 pub mod rust;
 pub mod shader;
 pub mod wgsl;
-pub mod ptx;

@@ -1027,7 +1027,14 @@ fn type_mismatch(param: &str, want: Type, v: &Value, span: Span) -> Diagnostic {
     let found = v.ty().map_or("?".to_string(), |t| t.to_string());
     let mut d = Diagnostic::error(
         "E0300",
-        format!("`{param}` expects {} `{want}`, found `{found}`", if matches!(want, Type::Int | Type::Angle) { "an" } else { "a" }),
+        format!(
+            "`{param}` expects {} `{want}`, found `{found}`",
+            if matches!(want, Type::Int | Type::Angle) {
+                "an"
+            } else {
+                "a"
+            }
+        ),
         span,
     )
     .with_label(format!("this is `{found}`"));

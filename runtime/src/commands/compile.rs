@@ -107,8 +107,13 @@ fn emit(scene: &scene::Scene, target: Emit, sm: u32, opt: u8) -> Result<Vec<u8>,
     };
     let kernel = back::wgsl::write(scene, &program).map_err(|e| e.to_string())?;
     if target == Emit::Ptx {
-        let options = back::ptx::Options { sm, entry_point: back::wgsl::ENTRY_POINT.to_string() };
-        return back::ptx::write(&kernel.module, &kernel.info, &options).map(String::into_bytes).map_err(|e| e.to_string());
+        let options = back::ptx::Options {
+            sm,
+            entry_point: back::wgsl::ENTRY_POINT.to_string(),
+        };
+        return back::ptx::write(&kernel.module, &kernel.info, &options)
+            .map(String::into_bytes)
+            .map_err(|e| e.to_string());
     }
     match lang {
         None => Ok(kernel.source.into_bytes()),

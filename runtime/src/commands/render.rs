@@ -140,11 +140,19 @@ pub fn run(args: RenderArgs) -> ExitCode {
         seconds
     );
     if args.stats {
-        println!("backend         {} ({})", prepared.name(), prepared.device());
+        println!(
+            "backend         {} ({})",
+            prepared.name(),
+            prepared.device()
+        );
         if let Some(p) = prepared.preparation() {
             println!("prepared        {p}");
         }
-        println!("time            {:.3} s (frame {:.3} s)", seconds, frame.time.as_secs_f64());
+        println!(
+            "time            {:.3} s (frame {:.3} s)",
+            seconds,
+            frame.time.as_secs_f64()
+        );
         println!("{}", render.stats);
         if let Some(c) = &check {
             println!("{c}");
@@ -171,11 +179,19 @@ fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
 }
 
 /// Renders the convergence check of a reference frame (ε divided by ten) and compares.
-pub fn check_reference(prepared: &Prepared, scene: &Scene, frame: &Frame) -> Result<Convergence, String> {
+pub fn check_reference(
+    prepared: &Prepared,
+    scene: &Scene,
+    frame: &Frame,
+) -> Result<Convergence, String> {
     let mut finer = scene.clone();
     finer.settings = reference::check_settings(&scene.settings);
     let check = prepared.render(&finer, &|_| {})?;
-    Ok(reference::convergence(&scene.settings, &frame.render, &check.render))
+    Ok(reference::convergence(
+        &scene.settings,
+        &frame.render,
+        &check.render,
+    ))
 }
 
 /// The warning printed for a reference that did not converge.
@@ -205,7 +221,12 @@ fn write_sidecar(image: &Path, depth: Option<&depth::Depth>, backend: &str) -> R
             match std::fs::remove_file(&path) {
                 Ok(()) => eprintln!("note: removed the stale sidecar `{}`", path.display()),
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(e) => return Err(format!("cannot remove the stale sidecar `{}`: {e}", path.display())),
+                Err(e) => {
+                    return Err(format!(
+                        "cannot remove the stale sidecar `{}`: {e}",
+                        path.display()
+                    ))
+                }
             }
             Ok(())
         }
@@ -216,7 +237,9 @@ fn write_sidecar(image: &Path, depth: Option<&depth::Depth>, backend: &str) -> R
 fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame, String> {
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = ProgressBar::new(1000);
-        if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}") {
+        if let Ok(style) =
+            ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}")
+        {
             bar.set_style(style);
         }
         bar

@@ -15,21 +15,29 @@ use std::time::{Duration, Instant};
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// libcuda could not be loaded.
-    #[error("no CUDA driver found (libcuda.so): install the NVIDIA driver, or choose another backend")]
+    #[error(
+        "no CUDA driver found (libcuda.so): install the NVIDIA driver, or choose another backend"
+    )]
     NoDriver,
     /// The driver has no device.
     #[error("the CUDA driver found no device")]
     NoDevice,
     /// A driver call failed.
     #[error("CUDA driver error during {during}: {message}")]
-    Driver { during: &'static str, message: String },
+    Driver {
+        during: &'static str,
+        message: String,
+    },
     /// The JIT refused the PTX (a compiler bug: the PTX is checked by ptxas in CI).
     #[error("the CUDA JIT rejected the PTX: {0}")]
     Jit(String),
 }
 
 fn driver(during: &'static str) -> impl Fn(cudarc::driver::DriverError) -> Error {
-    move |e| Error::Driver { during, message: e.to_string() }
+    move |e| Error::Driver {
+        during,
+        message: e.to_string(),
+    }
 }
 
 /// An opened CUDA device.
@@ -85,7 +93,12 @@ impl Cuda {
             .map_err(driver("reading the compute capability"))?;
         let name = ctx.name().map_err(driver("reading the device name"))?;
         let stream = ctx.default_stream();
-        Ok(Cuda { ctx, stream, sm: (major * 10 + minor) as u32, name })
+        Ok(Cuda {
+            ctx,
+            stream,
+            sm: (major * 10 + minor) as u32,
+            name,
+        })
     }
 
     /// The device's name and compute capability.
@@ -115,19 +128,33 @@ impl Cuda {
             .ctx
             .load_module(cudarc::nvrtc::Ptx::from_binary(cubin))
             .map_err(driver("loading the module"))?;
-        let function = module.load_function(entry).map_err(driver("finding the kernel"))?;
-        Ok(Loaded { function, load_time: start.elapsed(), cached })
+        let function = module
+            .load_function(entry)
+            .map_err(driver("finding the kernel"))?;
+        Ok(Loaded {
+            function,
+            load_time: start.elapsed(),
+            cached,
+        })
     }
 
     /// PTX to a cubin through the driver's linker (the JIT).
     fn jit(&self, ptx: &str) -> Result<Vec<u8>, Error> {
-        self.ctx.bind_to_thread().map_err(driver("binding the context"))?;
+        self.ctx
+            .bind_to_thread()
+            .map_err(driver("binding the context"))?;
         let mut text = ptx.as_bytes().to_vec();
         text.push(0);
         let mut log = vec![0u8; 8192];
         let mut state: sys::CUlinkState = std::ptr::null_mut();
-        let mut options = vec![sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER, sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER_SIZE_BYTES];
-        let mut values = vec![log.as_mut_ptr() as *mut std::ffi::c_void, log.len() as *mut std::ffi::c_void];
+        let mut options = vec![
+            sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER,
+            sys::CUjit_option::CU_JIT_ERROR_LOG_BUFFER_SIZE_BYTES,
+        ];
+        let mut values = vec![
+            log.as_mut_ptr() as *mut std::ffi::c_void,
+            log.len() as *mut std::ffi::c_void,
+        ];
         // A register cap trades spills for occupancy; the value is passed through to the JIT.
         if let Some(n) = max_registers() {
             options.push(sys::CUjit_option::CU_JIT_MAX_REGISTERS);
@@ -145,7 +172,16 @@ impl Cuda {
         // PTX buffer is NUL-terminated and outlives cuLinkAddData; the cubin returned by
         // cuLinkComplete is copied before cuLinkDestroy frees it.
         unsafe {
-            check(sys::cuLinkCreate_v2(options.len() as u32, options.as_mut_ptr(), values.as_mut_ptr(), &mut state), "cuLinkCreate", &log)?;
+            check(
+                sys::cuLinkCreate_v2(
+                    options.len() as u32,
+                    options.as_mut_ptr(),
+                    values.as_mut_ptr(),
+                    &mut state,
+                ),
+                "cuLinkCreate",
+                &log,
+            )?;
             let added = sys::cuLinkAddData_v2(
                 state,
                 sys::CUjitInputType::CU_JIT_INPUT_PTX,
@@ -172,23 +208,46 @@ impl Cuda {
 
     /// Renders one frame: one launch per tile of `tile`×`tile` pixels.
     #[allow(clippy::too_many_arguments)]
-    pub fn render(&self, k: &Loaded, uniforms: &[u8], width: u32, height: u32, stats_words: u32, workgroup: u32, tile: u32) -> Result<Frame, Error> {
+    pub fn render(
+        &self,
+        k: &Loaded,
+        uniforms: &[u8],
+        width: u32,
+        height: u32,
+        stats_words: u32,
+        workgroup: u32,
+        tile: u32,
+    ) -> Result<Frame, Error> {
         let s = &self.stream;
         let pixels = width as usize * height as usize;
         let tiles = super::wgpu::tiles(width, height, tile);
         let table: Vec<u32> = tiles.iter().flat_map(|t| [t.0, t.1, t.2, t.3]).collect();
-        let d_uniforms = s.clone_htod(uniforms).map_err(driver("uploading the scene"))?;
-        let d_tiles = s.clone_htod(&table).map_err(driver("uploading the tiles"))?;
-        let mut d_image = s.alloc_zeros::<f32>(pixels * 4).map_err(driver("allocating the image"))?;
-        let mut d_stats = s.alloc_zeros::<u32>(pixels * stats_words as usize).map_err(driver("allocating the statistics"))?;
+        let d_uniforms = s
+            .clone_htod(uniforms)
+            .map_err(driver("uploading the scene"))?;
+        let d_tiles = s
+            .clone_htod(&table)
+            .map_err(driver("uploading the tiles"))?;
+        let mut d_image = s
+            .alloc_zeros::<f32>(pixels * 4)
+            .map_err(driver("allocating the image"))?;
+        let mut d_stats = s
+            .alloc_zeros::<u32>(pixels * stats_words as usize)
+            .map_err(driver("allocating the statistics"))?;
         // Each launch is timed by its own pair of events, and the times are summed: the
         // same measure as the wgpu path's per-pass timestamps (gaps between launches excluded).
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
         let mut events = Vec::with_capacity(tiles.len());
         let wall = Instant::now();
         for (i, t) in tiles.iter().enumerate() {
-            let start = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
-            let end = self.ctx.new_event(flags).map_err(driver("creating an event"))?;
+            let start = self
+                .ctx
+                .new_event(flags)
+                .map_err(driver("creating an event"))?;
+            let end = self
+                .ctx
+                .new_event(flags)
+                .map_err(driver("creating an event"))?;
             let tile_view = d_tiles.slice(4 * i..4 * i + 4);
             let cfg = LaunchConfig {
                 grid_dim: (t.2.div_ceil(workgroup), t.3.div_ceil(workgroup), 1),
@@ -196,7 +255,11 @@ impl Cuda {
                 shared_mem_bytes: 0,
             };
             let mut launch = s.launch_builder(&k.function);
-            launch.arg(&d_uniforms).arg(&tile_view).arg(&mut d_image).arg(&mut d_stats);
+            launch
+                .arg(&d_uniforms)
+                .arg(&tile_view)
+                .arg(&mut d_image)
+                .arg(&mut d_stats);
             start.record(s).map_err(driver("recording an event"))?;
             // SAFETY: the kernel's parameters are the four buffers in binding order, as the
             // PTX back end declares them; each buffer is as large as the kernel indexes.
@@ -210,16 +273,29 @@ impl Cuda {
         for (start, end) in &events {
             ms += start.elapsed_ms(end).map_err(driver("reading the timer"))? as f64;
         }
-        let image = s.clone_dtoh(&d_image).map_err(driver("reading the image"))?;
-        let stats = s.clone_dtoh(&d_stats).map_err(driver("reading the statistics"))?;
+        let image = s
+            .clone_dtoh(&d_image)
+            .map_err(driver("reading the image"))?;
+        let stats = s
+            .clone_dtoh(&d_stats)
+            .map_err(driver("reading the statistics"))?;
         let linear = image.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
-        Ok(Frame { linear, stats, gpu_time: Duration::from_secs_f64(ms / 1e3), wall_time })
+        Ok(Frame {
+            linear,
+            stats,
+            gpu_time: Duration::from_secs_f64(ms / 1e3),
+            wall_time,
+        })
     }
 }
 
 /// The register cap for the JIT: `$SDFC_CUDA_MAX_REGISTERS` (0 or unset: the JIT's choice).
 fn max_registers() -> Option<u32> {
-    std::env::var("SDFC_CUDA_MAX_REGISTERS").ok()?.parse().ok().filter(|&n| n > 0)
+    std::env::var("SDFC_CUDA_MAX_REGISTERS")
+        .ok()?
+        .parse()
+        .ok()
+        .filter(|&n| n > 0)
 }
 
 /// Where the compiled module of `ptx` for a device is cached: `$SDFC_CACHE_DIR`, else
@@ -230,7 +306,10 @@ fn cache_path(ptx: &str, device: &str, sm: u32) -> Option<PathBuf> {
         Some(d) => PathBuf::from(d),
         None => match std::env::var_os("XDG_CACHE_HOME") {
             Some(d) => PathBuf::from(d).join("sdfc").join("cuda"),
-            None => PathBuf::from(std::env::var_os("HOME")?).join(".cache").join("sdfc").join("cuda"),
+            None => PathBuf::from(std::env::var_os("HOME")?)
+                .join(".cache")
+                .join("sdfc")
+                .join("cuda"),
         },
     };
     let mut h = std::collections::hash_map::DefaultHasher::new();

@@ -59,7 +59,11 @@ pub fn render(
         linear: frame.linear,
     };
     Ok(GpuRender {
-        render: Render { image, stats, depth: None },
+        render: Render {
+            image,
+            stats,
+            depth: None,
+        },
         time: frame.gpu_time.unwrap_or(frame.wall_time),
         timestamps: frame.gpu_time.is_some(),
         wall: frame.wall_time,
@@ -67,13 +71,39 @@ pub fn render(
 }
 
 /// Renders `scene` with a kernel already loaded on a CUDA device.
-pub fn render_cuda(cuda: &cuda::Cuda, scene: &Scene, loaded: &cuda::Loaded, lipschitz: f64) -> Result<GpuRender, cuda::Error> {
+pub fn render_cuda(
+    cuda: &cuda::Cuda,
+    scene: &Scene,
+    loaded: &cuda::Loaded,
+    lipschitz: f64,
+) -> Result<GpuRender, cuda::Error> {
     let s = &scene.settings;
     let uniforms = wgsl::uniforms(scene, lipschitz);
-    let frame = cuda.render(loaded, &uniforms, s.width, s.height, STATS_WORDS, wgsl::WORKGROUP, TILE)?;
+    let frame = cuda.render(
+        loaded,
+        &uniforms,
+        s.width,
+        s.height,
+        STATS_WORDS,
+        wgsl::WORKGROUP,
+        TILE,
+    )?;
     let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
-    let image = Image { width: s.width, height: s.height, linear: frame.linear };
-    Ok(GpuRender { render: Render { image, stats, depth: None }, time: frame.gpu_time, timestamps: true, wall: frame.wall_time })
+    let image = Image {
+        width: s.width,
+        height: s.height,
+        linear: frame.linear,
+    };
+    Ok(GpuRender {
+        render: Render {
+            image,
+            stats,
+            depth: None,
+        },
+        time: frame.gpu_time,
+        timestamps: true,
+        wall: frame.wall_time,
+    })
 }
 
 /// Sums the kernel's per-pixel statistics words into the CPU renderer's statistics.

@@ -117,7 +117,10 @@ pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
         "MAP",
         format!("{}\n{}", write_map(program), write_sdf(program)),
     );
-    let used: Vec<String> = features.iter().map(|(n, on)| format!("{}{n}", if *on { "+" } else { "-" })).collect();
+    let used: Vec<String> = features
+        .iter()
+        .map(|(n, on)| format!("{}{n}", if *on { "+" } else { "-" }))
+        .collect();
     values.insert(
         "HEADER",
         format!(

@@ -10,4 +10,4 @@ mkdir -p "$corpus"
 find examples tests/in -name '*.sdf' -exec cp {} "$corpus/" \;
 export RUSTC_BOOTSTRAP=1
 cd fuzz
-cargo fuzz run "$target" "corpus/$target" -- -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -max_len=8192
+cargo fuzz run "$target" "corpus/$target" -- -max_total_time="$seconds" -timeout=30 -rss_limit_mb=4096 -max_len=8192

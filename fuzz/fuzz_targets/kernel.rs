@@ -5,9 +5,16 @@
 use libfuzzer_sys::fuzz_target;
 use sdfc_compiler::back::{ptx, wgsl};
 
+/// Scenes larger than this (in IR nodes) are skipped: writing and validating the kernel of a
+/// scene of thousands of objects takes seconds under the fuzzer's instrumentation.
+const KERNEL_LIMIT: usize = 2_000;
+
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let (Some(scene), _, _) = sdfc_compiler::check::check_str("fuzz.sdf", text) else { return };
+    if scene.graph.len() > KERNEL_LIMIT {
+        return;
+    }
     let program = sdfc_compiler::lower::lower(&scene);
     let kernel = match wgsl::write(&scene, &program) {
         Ok(k) => k,

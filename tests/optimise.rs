@@ -220,44 +220,6 @@ fn executed(program: &Program, p: [f32; 3]) -> usize {
     count
 }
 
-fn trace(program: &Program, p: [f32; 3]) {
-    let ops = program.ops();
-    let blocks = program.blocks();
-    let mut regs = vec![0f32; ops.len()];
-    let (mut next, mut i) = (0, 0);
-    let mut open: Vec<usize> = vec![];
-    let mut entered = vec![0usize; 40];
-    let mut skipped = vec![0usize; 40];
-    'run: while i < ops.len() {
-        while open.last().is_some_and(|&b| blocks[b].end <= i) { open.pop(); }
-        while let Some(b) = blocks.get(next).filter(|b| b.start == i) {
-            let depth = open.len();
-            if regs[b.bound.0 as usize] >= regs[b.best.0 as usize] {
-                skipped[depth] += 1;
-                if depth < 4 { println!("{} skip depth {depth} bound {} best {}", "  ".repeat(depth), regs[b.bound.0 as usize], regs[b.best.0 as usize]); }
-                for j in b.end..b.end + b.results {
-                    if let Op::Phi(_, other) = ops[j] {
-                        regs[j] = regs[other.0 as usize];
-                    }
-                }
-                i = b.end + b.results;
-                next += 1;
-                while blocks.get(next).is_some_and(|n| n.start < i) {
-                    next += 1;
-                }
-                continue 'run;
-            }
-            entered[depth] += 1;
-            if depth < 4 { println!("{} enter depth {depth} bound {} best {}", "  ".repeat(depth), regs[b.bound.0 as usize], regs[b.best.0 as usize]); }
-            open.push(next);
-            next += 1;
-        }
-        regs[i] = step(program, &regs, i, p);
-        i += 1;
-    }
-    println!("entered {:?}\nskipped {:?}", entered, skipped);
-}
-
 fn step(program: &Program, regs: &[f32], i: usize, p: [f32; 3]) -> f32 {
     use sdfc_compiler::eval::scalar;
     use sdfc_compiler::lower::Axis;
@@ -381,28 +343,6 @@ fn time_frames(scene: &Scene, program: &Program, frames: usize) -> f64 {
 
 /// The tables of BENCHMARKS.md: instruction counts (static, WGSL, executed per evaluation
 /// along camera rays) and CPU frame times with the passes off and on.
-#[test]
-#[ignore]
-fn histogram() {
-    let file = std::env::var("SDFC_FILE").unwrap_or("../examples/scaling/random_10000.sdf".into());
-    let scene = load(Path::new(&file));
-    let plain = lower_with(&scene, &NO_CULL);
-    let culled = lower_with(&scene, &CULL);
-    let rays = ray_points(&scene, &plain, 24, 18);
-    let mut counts: Vec<usize> = rays.iter().map(|&p| executed(&culled, p)).collect();
-    counts.sort();
-    let n = counts.len();
-    println!("points {n}: p10 {} p25 {} p50 {} p75 {} p90 {} p99 {} mean {:.0}", counts[n/10], counts[n/4], counts[n/2], counts[3*n/4], counts[9*n/10], counts[99*n/100], counts.iter().sum::<usize>() as f64 / n as f64);
-    let worst = rays.iter().copied().max_by_key(|&p| executed(&culled, p)).unwrap();
-    let (d, _) = eval_point::<f32>(&plain, worst);
-    println!("worst point {worst:?} dist {d} ops {}", executed(&culled, worst));
-    trace(&culled, worst);
-    // by distance
-    let mut by: Vec<(f32, usize)> = rays.iter().map(|&p| (eval_point::<f32>(&plain, p).0, executed(&culled, p))).collect();
-    by.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for k in 0..10 { let sl = &by[k*n/10..(k+1)*n/10]; println!("decile {k}: dist {:.3}..{:.3} mean ops {:.0}", sl[0].0, sl[sl.len()-1].0, sl.iter().map(|x| x.1 as f64).sum::<f64>()/sl.len() as f64); }
-}
-
 #[test]
 #[ignore]
 fn report() {

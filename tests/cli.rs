@@ -338,3 +338,34 @@ fn an_interrupt_stops_a_render_and_leaves_no_file() {
     assert!(!status.success());
     assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
 }
+
+/// `sdfc check` says which intersection method a scene gets and why; `--set method=trace`
+/// on a scene that does not allow it is an error that writes nothing.
+#[test]
+fn the_method_setting_and_what_check_says_about_it() {
+    let d = dir("method");
+    scene_file(&d);
+    let out = sdfc(&d, &["check", "ball.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("method: march (light 1 casts soft shadows"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["render", "ball.sdf", "--set", "method=trace"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot be ray traced analytically"), "{err}");
+    let out = sdfc(&d, &["render", "ball.sdf", "--set", "method=fast"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("method must be one of"));
+    assert_eq!(entries(&d), ["ball.sdf"]);
+    std::fs::write(d.join("hard.sdf"), SCENE.replace("softness: 8", "softness: 0"))
+        .expect("write");
+    let out = sdfc(&d, &["check", "hard.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("method: trace (2 primitives"), "{err}");
+    let out = sdfc(&d, &["render", "hard.sdf", "--set", "method=trace", "--stats"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(d.join("hard.png").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -10,7 +10,7 @@ use common::*;
 use sdfc_compiler::back::{rust, wgsl};
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
 use sdfc_compiler::lower::{lower_with, LowerOptions, Op, Program};
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::scene::{Method, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision};
 use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};
@@ -40,11 +40,15 @@ fn sdf_files(dir: &str) -> Vec<PathBuf> {
     files
 }
 
+/// A scene, sphere traced (`method: "march"`) whatever it allows: these tests are about the
+/// distance program, which analytic tracing does not run.
 fn load(path: &Path) -> Scene {
-    frontend::load(path)
+    let mut scene = frontend::load(path)
         .expect("readable")
         .scene
-        .unwrap_or_else(|| panic!("{} has errors", path.display()))
+        .unwrap_or_else(|| panic!("{} has errors", path.display()));
+    scene.settings.method = Method::March;
+    scene
 }
 
 fn name(path: &Path) -> String {

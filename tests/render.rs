@@ -5,11 +5,23 @@ mod common;
 
 use common::*;
 use sdfc_compiler::lower::lower;
-use sdfc_compiler::scene::{Light, Node, Pattern, Scene};
+use sdfc_compiler::scene::{Light, Method, Node, Pattern, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision, Render};
 
+/// Renders `scene` sphere traced, whatever it allows (the step-related tests).
 fn render(scene: &Scene) -> Render {
-    cpu::render(scene, &lower(scene), &Options::default(), &|| {})
+    render_as(Method::March, scene)
+}
+
+/// Both intersection methods: the properties below hold for either (analytic tracing is
+/// chosen for these scenes only when it is allowed; otherwise both renders march).
+const METHODS: [Method; 2] = [Method::March, Method::Auto];
+
+/// Renders `scene` with the intersection `method`.
+fn render_as(method: Method, scene: &Scene) -> Render {
+    let mut scene = scene.clone();
+    scene.settings.method = method;
+    cpu::render(&scene, &lower(&scene), &Options::default(), &|| {})
 }
 
 fn render_with(scene: &Scene, options: &Options, threads: usize) -> Render {
@@ -72,31 +84,34 @@ fn small(scene: &mut Scene, w: u32, h: u32) {
 
 #[test]
 fn a_sphere_seen_head_on_covers_the_predicted_pixels() {
-    let mut scene = single(Node::Sphere { radius: 1.0 });
-    scene.camera.position = [0.0, 0.0, -5.0];
-    scene.camera.look_at = [0.0, 0.0, 0.0];
-    small(&mut scene, 96, 72);
-    let r = render(&scene);
-    let covered = r.image.linear.iter().filter(|c| c[0] > 0.0).count() as i64;
-    // A pixel is covered when its centre ray passes within the radius of the centre.
-    let (eye, u, v, w, tan) = basis(&scene);
-    let (wd, ht) = (96.0, 72.0);
-    let mut predicted = 0i64;
-    for y in 0..72 {
-        for x in 0..96 {
-            let bx = 2.0 * (x as f64 + 0.5) / wd - 1.0;
-            let by = 1.0 - 2.0 * (y as f64 + 0.5) / ht;
-            let dir =
-                normalize([0, 1, 2].map(|i| w[i] + bx * tan * wd / ht * u[i] + by * tan * v[i]));
-            predicted += (len3(cross(eye, dir)) < 1.0) as i64;
+    for method in METHODS {
+        let mut scene = single(Node::Sphere { radius: 1.0 });
+        scene.camera.position = [0.0, 0.0, -5.0];
+        scene.camera.look_at = [0.0, 0.0, 0.0];
+        small(&mut scene, 96, 72);
+        let r = render_as(method, &scene);
+        let covered = r.image.linear.iter().filter(|c| c[0] > 0.0).count() as i64;
+        // A pixel is covered when its centre ray passes within the radius of the centre.
+        let (eye, u, v, w, tan) = basis(&scene);
+        let (wd, ht) = (96.0, 72.0);
+        let mut predicted = 0i64;
+        for y in 0..72 {
+            for x in 0..96 {
+                let bx = 2.0 * (x as f64 + 0.5) / wd - 1.0;
+                let by = 1.0 - 2.0 * (y as f64 + 0.5) / ht;
+                let dir = normalize(
+                    [0, 1, 2].map(|i| w[i] + bx * tan * wd / ht * u[i] + by * tan * v[i]),
+                );
+                predicted += (len3(cross(eye, dir)) < 1.0) as i64;
+            }
         }
+        assert!(predicted > 300, "{predicted}");
+        assert!(
+            (covered - predicted).abs() <= 3,
+            "covered {covered}, predicted {predicted}"
+        );
+        assert_eq!(r.stats.counters.hits as i64, covered);
     }
-    assert!(predicted > 300, "{predicted}");
-    assert!(
-        (covered - predicted).abs() <= 3,
-        "covered {covered}, predicted {predicted}"
-    );
-    assert_eq!(r.stats.counters.hits as i64, covered);
 }
 
 /// A grey floor, a sphere above it, a light up and to the side.
@@ -122,27 +137,29 @@ fn shadow_scene(softness: f64) -> Scene {
 
 #[test]
 fn a_shadowed_pixel_is_darker_than_its_lit_neighbour() {
-    for softness in [0.0, 8.0] {
-        let scene = shadow_scene(softness);
-        let r = render(&scene);
-        // The shadow's centre on the floor, on the line from the light through the sphere.
-        let (sx, sy) = project(&scene, [-0.5, 0.0, 0.0]);
-        let (lx, ly) = project(&scene, [-0.5, 0.0, -1.2]);
-        let (dark, lit) = (
-            luminance(r.image.pixel(sx, sy)),
-            luminance(r.image.pixel(lx, ly)),
-        );
-        assert!(
-            dark < 0.5 * lit,
-            "softness {softness}: shadow {dark}, lit {lit}"
-        );
-        // Hard shadows leave only the ambient term: k_a · C.
-        if softness == 0.0 {
-            assert!(
-                (r.image.pixel(sx, sy)[0] - 0.1 * 0.8).abs() < 1e-4,
-                "{:?}",
-                r.image.pixel(sx, sy)
+    for method in METHODS {
+        for softness in [0.0, 8.0] {
+            let scene = shadow_scene(softness);
+            let r = render_as(method, &scene);
+            // The shadow's centre on the floor, on the line from the light through the sphere.
+            let (sx, sy) = project(&scene, [-0.5, 0.0, 0.0]);
+            let (lx, ly) = project(&scene, [-0.5, 0.0, -1.2]);
+            let (dark, lit) = (
+                luminance(r.image.pixel(sx, sy)),
+                luminance(r.image.pixel(lx, ly)),
             );
+            assert!(
+                dark < 0.5 * lit,
+                "softness {softness}: shadow {dark}, lit {lit}"
+            );
+            // Hard shadows leave only the ambient term: k_a · C.
+            if softness == 0.0 {
+                assert!(
+                    (r.image.pixel(sx, sy)[0] - 0.1 * 0.8).abs() < 1e-4,
+                    "{:?}",
+                    r.image.pixel(sx, sy)
+                );
+            }
         }
     }
 }
@@ -174,17 +191,21 @@ fn mirror_scene(reflect: f64) -> Scene {
 
 #[test]
 fn a_mirror_shows_the_reflected_object() {
-    // Where the camera sees the ball's mirror image (its centre reflected in y = 0).
-    let with = render(&mirror_scene(0.9));
-    let without = render(&mirror_scene(0.0));
-    let (x, y) = project(&mirror_scene(0.9), [0.0, -0.6, 2.0]);
-    let (m, plain) = (with.image.pixel(x, y), without.image.pixel(x, y));
-    assert!(m[0] > 2.0 * m[1] + 0.05, "mirror pixel not red: {m:?}");
-    assert!(
-        (plain[0] - plain[1]).abs() < 1e-4,
-        "plain floor pixel not grey: {plain:?}"
-    );
-    assert!(with.stats.counters.secondary_rays > 0 && without.stats.counters.secondary_rays == 0);
+    for method in METHODS {
+        // Where the camera sees the ball's mirror image (its centre reflected in y = 0).
+        let with = render_as(method, &mirror_scene(0.9));
+        let without = render_as(method, &mirror_scene(0.0));
+        let (x, y) = project(&mirror_scene(0.9), [0.0, -0.6, 2.0]);
+        let (m, plain) = (with.image.pixel(x, y), without.image.pixel(x, y));
+        assert!(m[0] > 2.0 * m[1] + 0.05, "mirror pixel not red: {m:?}");
+        assert!(
+            (plain[0] - plain[1]).abs() < 1e-4,
+            "plain floor pixel not grey: {plain:?}"
+        );
+        assert!(
+            with.stats.counters.secondary_rays > 0 && without.stats.counters.secondary_rays == 0
+        );
+    }
 }
 
 /// A checkerboard wall behind where a ball may stand.
@@ -221,50 +242,54 @@ fn glass_scene(ball: Option<(f64, f64)>) -> Scene {
 
 #[test]
 fn clear_glass_of_index_one_is_invisible() {
-    let bare = render(&glass_scene(None));
-    let clear = render(&glass_scene(Some((1.0, 1.0))));
-    let differ = bare
-        .image
-        .linear
-        .iter()
-        .zip(&clear.image.linear)
-        .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
-        .count();
-    assert!(
-        differ * 50 < bare.image.linear.len(),
-        "{differ} pixels differ"
-    );
-    assert!(clear.stats.counters.secondary_rays > 0);
-    // Real glass bends the checkerboard: many pixels change, none is NaN.
-    let glass = render(&glass_scene(Some((0.9, 1.5))));
-    let changed = bare
-        .image
-        .linear
-        .iter()
-        .zip(&glass.image.linear)
-        .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
-        .count();
-    assert!(changed > 300, "{changed}");
-    assert!(glass
-        .image
-        .linear
-        .iter()
-        .all(|c| c.iter().all(|v| v.is_finite())));
+    for method in METHODS {
+        let bare = render_as(method, &glass_scene(None));
+        let clear = render_as(method, &glass_scene(Some((1.0, 1.0))));
+        let differ = bare
+            .image
+            .linear
+            .iter()
+            .zip(&clear.image.linear)
+            .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
+            .count();
+        assert!(
+            differ * 50 < bare.image.linear.len(),
+            "{differ} pixels differ"
+        );
+        assert!(clear.stats.counters.secondary_rays > 0);
+        // Real glass bends the checkerboard: many pixels change, none is NaN.
+        let glass = render_as(method, &glass_scene(Some((0.9, 1.5))));
+        let changed = bare
+            .image
+            .linear
+            .iter()
+            .zip(&glass.image.linear)
+            .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
+            .count();
+        assert!(changed > 300, "{changed}");
+        assert!(glass
+            .image
+            .linear
+            .iter()
+            .all(|c| c.iter().all(|v| v.is_finite())));
+    }
 }
 
 #[test]
 fn a_point_light_does_not_reach_past_its_radius() {
-    let mut scene = shadow_scene(0.0);
-    if let Some(Light::Point { radius, .. }) = scene.lights.first_mut() {
-        *radius = 2.0;
+    for method in METHODS {
+        let mut scene = shadow_scene(0.0);
+        if let Some(Light::Point { radius, .. }) = scene.lights.first_mut() {
+            *radius = 2.0;
+        }
+        let r = render_as(method, &scene);
+        let (x, y) = project(&scene, [1.5, 0.0, -1.5]);
+        assert!(
+            (r.image.pixel(x, y)[0] - 0.08).abs() < 1e-5,
+            "{:?}",
+            r.image.pixel(x, y)
+        );
     }
-    let r = render(&scene);
-    let (x, y) = project(&scene, [1.5, 0.0, -1.5]);
-    assert!(
-        (r.image.pixel(x, y)[0] - 0.08).abs() < 1e-5,
-        "{:?}",
-        r.image.pixel(x, y)
-    );
 }
 
 fn busy() -> Scene {

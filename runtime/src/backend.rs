@@ -5,7 +5,8 @@ use crate::cpu::{self, Options, Precision, Render};
 use crate::gpu::{self, cuda::Cuda, Gpu};
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, Program};
-use sdfc_compiler::scene::{analysis, Scene};
+use sdfc_compiler::scene::analytic::{self, Choice};
+use sdfc_compiler::scene::{analysis, Method, Scene};
 use std::time::{Duration, Instant};
 
 /// Where a scene is rendered.
@@ -53,9 +54,24 @@ pub struct Frame {
     pub wall: Duration,
 }
 
+/// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
+/// does not allow it, saying why.
+pub fn method_allowed(scene: &Scene) -> Result<(), String> {
+    if scene.settings.method == Method::Trace {
+        if let Choice::March(reason) = analytic::choose(scene) {
+            return Err(format!(
+                "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
+                reason.describe()
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Prepared {
     /// Prepares `scene` for `backend`. `Err` says why the backend cannot be used.
     pub fn new(backend: Backend, scene: &Scene, precision: Precision) -> Result<Prepared, String> {
+        method_allowed(scene)?;
         match backend {
             Backend::Cpu => Ok(Self::cpu(scene, precision)),
             Backend::Wgpu => Self::wgpu(scene, false),

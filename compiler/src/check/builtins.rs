@@ -819,5 +819,11 @@ pub static RENDER: Record = Record {
         p("max_dist", F, Num(100.0), Within(1e-6, 1e9)),
         p("relaxation", F, Num(1.4), Within(1.0, 1.99)),
         p("background", V, V3([0.05, 0.06, 0.08]), NonNeg),
+        p(
+            "method",
+            Str,
+            Text("auto"),
+            OneOf(crate::scene::Method::NAMES),
+        ),
     ],
 };

@@ -46,6 +46,9 @@ pub struct Ctx {
     /// Every global `let`, declared or not yet evaluated, for "used before its definition".
     pub declared: HashMap<String, Span>,
     pub fns: HashMap<String, FnInfo>,
+    /// Where the render block sets `method`, for the error when analytic tracing is asked
+    /// of a scene that does not allow it.
+    pub method_span: Option<Span>,
     locals: Vec<(String, Value)>,
     dry: u32,
     depth: usize,

@@ -12,7 +12,9 @@ mod suggest;
 pub mod types;
 
 use crate::diagnostics::Diagnostic;
-use crate::scene::{Camera, Combine, Light, Material, MaterialId, Node, Pattern, Scene, Settings};
+use crate::scene::{
+    Camera, Combine, Light, Material, MaterialId, Method, Node, Pattern, Scene, Settings,
+};
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::{self, ast};
 use eval::{Ctx, FnInfo};
@@ -69,11 +71,35 @@ pub fn check(
         // Distance semantics: warnings where a construct makes the field unreliable.
         let analysis = crate::scene::analysis::analyse(&scene);
         cx.diags.extend_from_slice(analysis.diagnostics());
+        analytic_method(&mut cx, &scene);
     }
     // Diagnostics in source order, whatever stage found them.
     cx.diags.sort_by_key(|d| (d.span().file, d.span().start));
     let errors = crate::diagnostics::has_errors(&cx.diags);
     (if errors { None } else { Some(scene) }, cx.diags)
+}
+
+/// `method: "trace"` on a scene that cannot be ray traced analytically is an error at the
+/// setting, pointing at what prevents it.
+fn analytic_method(cx: &mut Ctx, scene: &Scene) {
+    use crate::scene::analytic::{choose, Choice, Reason};
+    let (Method::Trace, Some(at)) = (scene.settings.method, cx.method_span) else {
+        return;
+    };
+    let Choice::March(reason) = choose(scene) else {
+        return;
+    };
+    let mut d = Diagnostic::error("E0405", "this scene cannot be ray traced analytically", at)
+        .with_label("analytic tracing is asked for here")
+        .with_help("use `method: \"auto\"` to sphere trace such scenes");
+    d = match reason {
+        Reason::Node { span, what } => d.with_secondary(
+            span,
+            format!("`{what}` has no closed-form ray intersection"),
+        ),
+        other => d.with_note(other.describe()),
+    };
+    cx.error(d);
 }
 
 /// Checks a single source text that imports nothing (for tests and tools).
@@ -524,6 +550,11 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
         }
         ("render", _) => {
             let f = eval::record(cx, &builtins::RENDER, &b.fields, &b.keyword);
+            cx.method_span = b
+                .fields
+                .iter()
+                .find(|f| f.name.name == "method")
+                .map(|f| f.value.span);
             let int = |k: &str| f[k].num() as u32;
             scene.settings = Settings {
                 width: int("width"),
@@ -535,6 +566,10 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 max_dist: f["max_dist"].num(),
                 relaxation: f["relaxation"].num(),
                 background: f["background"].v3(),
+                method: match &f["method"] {
+                    Value::Str(s) => Method::from_name(s).unwrap_or_default(),
+                    _ => Method::Auto,
+                },
             };
         }
         (_, Some(kind)) => {

@@ -61,7 +61,7 @@ fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
 /// A graph holding one of every kind of node, alone and nested.
 fn zoo() -> (Graph, Vec<NodeId>) {
     let mut g = Graph::default();
-    let mut add = |g: &mut Graph, n: Node| g.add(n, Span::new(FileId(0), 0..0));
+    let add = |g: &mut Graph, n: Node| g.add(n, Span::new(FileId(0), 0..0));
     let mut ids = Vec::new();
     let prims = [
         Node::Sphere { radius: 0.7 },

@@ -322,6 +322,44 @@ pub struct Settings {
     pub relaxation: f64,
     /// Colour of rays that hit nothing.
     pub background: V3,
+    /// How rays find surfaces (see [`Method`]).
+    pub method: Method,
+}
+
+/// The intersection method of a render (RENDERER.md, "Intersection").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Analytic ray tracing when the scene allows it, sphere tracing otherwise.
+    #[default]
+    Auto,
+    /// Analytic ray tracing; an error for a scene that does not allow it.
+    Trace,
+    /// Sphere tracing, whatever the scene.
+    March,
+}
+
+impl Method {
+    /// The names of the methods, as the `method` setting spells them.
+    pub const NAMES: &'static [&'static str] = &["auto", "trace", "march"];
+
+    /// The method of a name in [`Method::NAMES`].
+    pub fn from_name(name: &str) -> Option<Method> {
+        match name {
+            "auto" => Some(Method::Auto),
+            "trace" => Some(Method::Trace),
+            "march" => Some(Method::March),
+            _ => None,
+        }
+    }
+
+    /// The method's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Auto => "auto",
+            Method::Trace => "trace",
+            Method::March => "march",
+        }
+    }
 }
 
 impl Default for Settings {
@@ -336,6 +374,7 @@ impl Default for Settings {
             max_dist: 100.0,
             relaxation: 1.4,
             background: [0.05, 0.06, 0.08],
+            method: Method::Auto,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The scene IR and its text dump.
 
 pub mod analysis;
+pub mod analytic;
 mod dump;
 pub mod ir;
 

@@ -7,7 +7,7 @@ use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
 use sdfc_compiler::lower;
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::scene::{analytic, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -75,11 +75,14 @@ pub struct Timing {
     pub mrays_per_s: f64,
     /// All rays (camera, secondary, shadow) per second, in millions (at the median).
     pub total_mrays_per_s: f64,
+    /// The intersection method the scene was rendered with: "trace" (analytic) or "march".
+    pub method: &'static str,
     /// Instructions of the distance program.
     pub program_len: usize,
     /// FP32 operations of one evaluation of the distance (`fp32::distance_ops`).
     pub ops_per_eval: f64,
-    /// Evaluations of the distance in the last frame (marching steps and normal taps).
+    /// Evaluations of the distance in the last frame (marching steps and normal taps; 0 under
+    /// analytic tracing, which evaluates no distance, and then the FP32 fields are null).
     pub evaluations: u64,
     /// GPU targets: the device's peak FP32 rate in TFLOP/s (null for the CPU and for a
     /// device not in the table of `fp32::PEAKS`).
@@ -155,9 +158,11 @@ fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, S
     let c = &last.stats.counters;
     let s = &scene.settings;
     let ops_per_eval = fp32::distance_ops(&lower::lower(scene));
-    let evaluations = fp32::evaluations(c);
+    let traced = analytic::choose(scene).primitives().is_some();
+    let evaluations = if traced { 0 } else { fp32::evaluations(c) };
     let peak = match prepared {
         Prepared::Cpu { .. } => None,
+        _ if traced => None,
         _ => fp32::peak_flops(&prepared.device()),
     };
     Ok(Timing {
@@ -181,6 +186,7 @@ fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, S
         min_s: times[0],
         mrays_per_s: c.camera_rays as f64 / median / 1e6,
         total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
+        method: if traced { "trace" } else { "march" },
         program_len: prepared.program_len(scene),
         ops_per_eval,
         evaluations,
@@ -192,9 +198,10 @@ fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, S
 
 fn header() -> String {
     format!(
-        "{:<28} {:>7} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>9} {:>6} {:>6}",
+        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>9} {:>6} {:>6}",
         "scene",
         "backend",
+        "method",
         "size",
         "aa",
         "threads",
@@ -212,9 +219,10 @@ fn row(t: &Timing) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned());
     format!(
-        "{:<28} {:>7} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>9.1} {:>6} {:>6}",
+        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>9.1} {:>6} {:>6}",
         name.unwrap_or_else(|| t.scene.clone()),
         t.backend,
+        t.method,
         format!("{}x{}", t.width, t.height),
         t.aa,
         t.threads,

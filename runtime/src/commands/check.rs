@@ -3,6 +3,7 @@
 
 use crate::frontend::{self, DiagnosticFormat, Loaded};
 use sdfc_compiler::scene::analysis::{self, Analysis};
+use sdfc_compiler::scene::analytic::{self, Choice, Reason};
 use sdfc_compiler::scene::{Exactness, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,7 +35,12 @@ pub fn run(args: CheckArgs) -> ExitCode {
                 match &loaded.scene {
                     None => code = code.max(1),
                     Some(scene) if args.diagnostics == DiagnosticFormat::Human => {
-                        eprintln!("{}: ok; {}", file.display(), summary(&loaded, scene));
+                        eprintln!(
+                            "{}: ok; {}; {}",
+                            file.display(),
+                            summary(&loaded, scene),
+                            method(&loaded, scene)
+                        );
                     }
                     Some(_) => {}
                 }
@@ -68,6 +74,19 @@ pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
             num(step)
         ),
         Exactness::Approximate => format!("distance field: {word}, L = {}{cause}", num(l)),
+    }
+}
+
+/// How the scene is rendered and why: `method: trace (...)` or `method: march (...)`, with
+/// the location of the node that rules out analytic tracing.
+pub fn method(loaded: &Loaded, scene: &Scene) -> String {
+    match analytic::choose(scene) {
+        Choice::March(Reason::Node { what, span }) => {
+            let (line, col) = loaded.sources.line_col(span);
+            let file = loaded.sources.name(span.file);
+            format!("method: march (the {what} at {file}:{line}:{col} has no closed-form ray intersection)")
+        }
+        choice => choice.describe(),
     }
 }
 

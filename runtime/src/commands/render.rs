@@ -9,7 +9,7 @@ use crate::cpu::Precision;
 use crate::depth;
 use crate::frontend::{self, DiagnosticFormat};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -78,6 +78,10 @@ pub fn run(args: RenderArgs) -> ExitCode {
     if let Err(msg) = override_settings(&mut scene.settings, args.size, args.aa, &args.set) {
         eprintln!("error: {msg}");
         return ExitCode::from(2);
+    }
+    if let Err(msg) = crate::backend::method_allowed(&scene) {
+        eprintln!("error: {msg}");
+        return ExitCode::from(1);
     }
     let pool = match thread_pool(args.threads) {
         Ok(p) => p,
@@ -333,6 +337,7 @@ pub const SETTING_KEYS: &[&str] = &[
     "max_dist",
     "relaxation",
     "background",
+    "method",
 ];
 
 /// Sets one render setting from text, checking its range.
@@ -354,6 +359,14 @@ pub fn set(s: &mut Settings, key: &str, value: &str) -> Result<(), String> {
             )?
         }
         "background" => s.background = colour(value)?,
+        "method" => {
+            s.method = Method::from_name(value).ok_or_else(|| {
+                format!(
+                    "method must be one of {}, not `{value}`",
+                    Method::NAMES.join(", ")
+                )
+            })?
+        }
         _ => {
             return Err(format!(
                 "unknown render setting `{key}`; the settings are {}",

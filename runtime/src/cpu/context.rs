@@ -1,6 +1,7 @@
 //! Everything a tile needs, prepared once per render in the evaluation type: settings,
 //! camera, materials, lights and the two tapes (distance only, distance and material).
 
+use super::analytic::Tracer;
 use super::camera::Pinhole;
 use super::vec::V3;
 use sdfc_compiler::eval::{Float, Outputs, Tape};
@@ -61,6 +62,8 @@ pub(super) struct Context<T: Float> {
     pub transparent: bool,
     pub distance_tape: Tape,
     pub full_tape: Tape,
+    /// The primitives, when the scene is ray traced analytically instead of sphere traced.
+    pub analytic: Option<Tracer<T>>,
 }
 
 impl<T: Float> Context<T> {
@@ -85,6 +88,9 @@ impl<T: Float> Context<T> {
             transparent,
             distance_tape: Tape::new(program, Outputs::Distance),
             full_tape: Tape::new(program, Outputs::DistanceAndMaterial),
+            analytic: sdfc_compiler::scene::analytic::choose(scene)
+                .primitives()
+                .map(Tracer::new),
         }
     }
 

@@ -8,6 +8,7 @@
 //! whatever the number of threads. The choices RENDERER.md leaves open are written in
 //! `docs/rendering.md`.
 
+mod analytic;
 mod camera;
 mod context;
 mod lanes;

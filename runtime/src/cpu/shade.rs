@@ -63,21 +63,55 @@ pub(super) fn bounce<T: Float>(
         let a = &mut acc[ray.sample as usize];
         *a = *a + ray.weight.mul_v(ctx.background);
     }
-    normals(ws, wave, &mut hits);
-    materials(ctx, ws, &mut hits);
+    if ctx.analytic.is_some() {
+        for hit in &mut hits {
+            (hit.n, hit.mat) = ws.surfaces[hit.ray];
+        }
+    } else {
+        normals(ws, wave, &mut hits);
+        materials(ctx, ws, &mut hits);
+    }
     light(ctx, ws, wave, &hits, acc, steps, counters);
     let next = spawn(ctx, wave, &hits);
     counters.secondary_rays += next.len() as u64;
     next
 }
 
-/// Sphere-traces every ray of the wave into `ws.traced`.
+/// Traces every ray of the wave into `ws.traced`: analytically (with each hit's normal and
+/// material in `ws.surfaces`) or by sphere tracing.
 fn trace<T: Float>(
     ctx: &Context<T>,
     ws: &mut Workspace<'_, T>,
     wave: &[Ray<T>],
     counters: &mut Counters,
 ) {
+    if let Some(tracer) = &ctx.analytic {
+        ws.traced.clear();
+        ws.surfaces.clear();
+        for ray in wave {
+            let (traced, surface) = match tracer.nearest(ray.origin, ray.dir, ctx.max_dist) {
+                Some(s) => (
+                    Traced {
+                        t: s.t,
+                        status: Status::Hit,
+                        steps: 0,
+                    },
+                    (s.normal, s.material),
+                ),
+                None => (
+                    Traced {
+                        t: ctx.max_dist,
+                        status: Status::Miss,
+                        steps: 0,
+                    },
+                    (V3::zero(), 0),
+                ),
+            };
+            ws.traced.push(traced);
+            ws.surfaces.push(surface);
+        }
+        return;
+    }
     ws.launches.clear();
     ws.launches
         .extend(wave.iter().enumerate().map(|(i, r)| Launch {
@@ -314,6 +348,17 @@ fn light<T: Float>(
 fn shadows<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, counters: &mut Counters) {
     counters.shadow_rays += ws.launches.len() as u64;
     ws.shadowed.clear();
+    if let Some(tracer) = &ctx.analytic {
+        for l in &ws.launches {
+            let (o, d) = (
+                V3::new(l.origin[0], l.origin[1], l.origin[2]),
+                V3::new(l.dir[0], l.dir[1], l.dir[2]),
+            );
+            let light = tracer.transmitted(o, d, l.tmax, |m| ctx.material(m).transparency);
+            ws.shadowed.push(Shadowed { light, steps: 0 });
+        }
+        return;
+    }
     ws.shadowed.resize(ws.launches.len(), Shadowed::default());
     let mut rule = Shadow {
         ctx,

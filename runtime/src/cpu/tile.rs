@@ -57,6 +57,8 @@ pub(super) struct Workspace<'t, T: Float> {
     pub lanes: Lanes<T>,
     pub launches: Vec<Launch<T>>,
     pub traced: Vec<Traced<T>>,
+    /// Normal and material of each traced ray's hit, under analytic tracing.
+    pub surfaces: Vec<(V3<T>, u32)>,
     pub shadowed: Vec<Shadowed<T>>,
     pub x: Vec<T>,
     pub y: Vec<T>,
@@ -73,6 +75,7 @@ impl<'t, T: Float> Workspace<'t, T> {
             lanes: Lanes::new(lanes.max(1)),
             launches: Vec::new(),
             traced: Vec::new(),
+            surfaces: Vec::new(),
             shadowed: Vec::new(),
             x: Vec::new(),
             y: Vec::new(),

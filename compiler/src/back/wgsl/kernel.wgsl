@@ -78,8 +78,166 @@ fn is_nan(x: f32) -> bool {
 struct Traced {
     t: f32,
     status: u32,
+//#if ANALYTIC
+    normal: vec3<f32>, // unit outward normal at the hit
+    material: u32,
+//#endif
 }
 
+//#if ANALYTIC
+// Analytic ray tracing (RENDERER.md, "Intersection"). Every primitive is convex (a plane
+// bounds a half-space), so a ray meets it in one interval [near, far], near > far for a miss,
+// with the outward normals in the primitive's frame at both ends. BIG stands for infinity.
+const BIG: f32 = 3.0e38;
+struct Interval {
+    near: f32,
+    far: f32,
+    n_near: vec3<f32>,
+    n_far: vec3<f32>,
+}
+
+fn missed() -> Interval {
+    return Interval(BIG, -BIG, vec3<f32>(0.0), vec3<f32>(0.0));
+}
+
+// Roots of |o + t·d|² = r².
+fn sphere_interval(o: vec3<f32>, d: vec3<f32>, r2: f32) -> Interval {
+    let a = dot(d, d);
+    let b = dot(o, d);
+    let c = dot(o, o) - r2;
+    let disc = b * b - a * c;
+    if !(disc >= 0.0) {
+        return missed();
+    }
+    let q = sqrt(disc);
+    let near = (-b - q) / a;
+    let far = (-b + q) / a;
+    return Interval(near, far, o + d * near, o + d * far);
+}
+
+// The slab |x| <= h: (entry, exit); a ray parallel to it is inside for every t or none.
+fn slab(o: f32, d: f32, h: f32) -> vec2<f32> {
+    if d == 0.0 {
+        return select(vec2<f32>(BIG, -BIG), vec2<f32>(-BIG, BIG), abs(o) <= h);
+    }
+    let inv = 1.0 / d;
+    let t1 = (-h - o) * inv;
+    let t2 = (h - o) * inv;
+    return vec2<f32>(min(t1, t2), max(t1, t2));
+}
+
+// Narrows s to one slab along the unit axis e: entering it last or leaving it first sets
+// that end's normal to the slab's face.
+fn clip(s: Interval, t: vec2<f32>, e: vec3<f32>, d: f32) -> Interval {
+    var r = s;
+    let face = e * select(1.0, -1.0, d < 0.0);
+    if t.x > r.near {
+        r.near = t.x;
+        r.n_near = -face;
+    }
+    if t.y < r.far {
+        r.far = t.y;
+        r.n_far = face;
+    }
+    return r;
+}
+
+// The box |x| <= half: the intersection of three slabs.
+fn box_interval(o: vec3<f32>, d: vec3<f32>, half: vec3<f32>) -> Interval {
+    var s = Interval(-BIG, BIG, vec3<f32>(0.0), vec3<f32>(0.0));
+    s = clip(s, slab(o.x, d.x, half.x), vec3<f32>(1.0, 0.0, 0.0), d.x);
+    s = clip(s, slab(o.y, d.y, half.y), vec3<f32>(0.0, 1.0, 0.0), d.y);
+    s = clip(s, slab(o.z, d.z, half.z), vec3<f32>(0.0, 0.0, 1.0), d.z);
+    return s;
+}
+
+// The capped cylinder x² + z² <= r², |y| <= h.
+fn cylinder_interval(o: vec3<f32>, d: vec3<f32>, r2: f32, h: f32) -> Interval {
+    let a = d.x * d.x + d.z * d.z;
+    let b = o.x * d.x + o.z * d.z;
+    let c = o.x * o.x + o.z * o.z - r2;
+    var s = Interval(-BIG, BIG, vec3<f32>(0.0), vec3<f32>(0.0));
+    if a == 0.0 {
+        if c > 0.0 {
+            return missed();
+        }
+    } else {
+        let disc = b * b - a * c;
+        if !(disc >= 0.0) {
+            return missed();
+        }
+        let q = sqrt(disc);
+        s.near = (-b - q) / a;
+        s.far = (-b + q) / a;
+        let pn = o + d * s.near;
+        let pf = o + d * s.far;
+        s.n_near = vec3<f32>(pn.x, 0.0, pn.z);
+        s.n_far = vec3<f32>(pf.x, 0.0, pf.z);
+    }
+    return clip(s, slab(o.y, d.y, h), vec3<f32>(0.0, 1.0, 0.0), d.y);
+}
+
+// The half-space dot(p, n) <= h.
+fn plane_interval(o: vec3<f32>, d: vec3<f32>, n: vec3<f32>, h: f32) -> Interval {
+    let dn = dot(n, d);
+    let above = dot(n, o) - h;
+    if dn == 0.0 {
+        if above <= 0.0 {
+            return Interval(-BIG, BIG, n, n);
+        }
+        return missed();
+    }
+    let t = -above / dn;
+    if dn > 0.0 {
+        return Interval(-BIG, t, n, n);
+    }
+    return Interval(t, BIG, n, n);
+}
+
+// A vector in a primitive's frame, given the rows of its world-to-local matrix.
+fn into(v: vec3<f32>, r0: vec3<f32>, r1: vec3<f32>, r2: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(r0, v), dot(r1, v), dot(r2, v));
+}
+
+// An interval's normals in world space: normals map by the transpose of the world-to-local
+// matrix.
+fn to_world(s: Interval, r0: vec3<f32>, r1: vec3<f32>, r2: vec3<f32>) -> Interval {
+    let a = r0 * s.n_near.x + r1 * s.n_near.y + r2 * s.n_near.z;
+    let b = r0 * s.n_far.x + r1 * s.n_far.y + r2 * s.n_far.z;
+    return Interval(s.near, s.far, a, b);
+}
+
+// The nearer of best and the first end of s beyond the ray's origin.
+fn nearest(best: Traced, s: Interval, material: u32) -> Traced {
+    if !(s.near <= s.far) {
+        return best;
+    }
+    var t = s.far;
+    var n = s.n_far;
+    if s.near > 0.0 {
+        t = s.near;
+        n = s.n_near;
+    }
+    if t > 0.0 && t < best.t {
+        return Traced(t, STATUS_HIT, normalize(n), material);
+    }
+    return best;
+}
+
+// A shadow ray's light after one primitive: blocked by an opaque one in (0, tmax), reduced
+// by the transparency of a transparent one it enters.
+fn occlude(through: f32, s: Interval, tmax: f32, tau: f32) -> f32 {
+    if !(s.near <= s.far) || s.far <= 0.0 || s.near >= tmax {
+        return through;
+    }
+    if tau <= 0.0 {
+        return 0.0;
+    }
+    return select(through, through * tau, s.near > 0.0);
+}
+
+{{ANALYTIC}}
+//#else
 // Sphere tracing (RENDERER.md, "Intersection"), with over-relaxation when ω > 1.
 fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
     let eps = params.march.x;
@@ -136,6 +294,7 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
     }
     return Traced(t, STATUS_BUDGET); // not reached: the loop returns
 }
+//#endif
 
 // The normal step h = max(L·ε·t, 64·ε_f32·(1 + |p|∞)) (a hit may lie up to L·ε·t away).
 fn normal_step(tt: f32, p: vec3<f32>) -> f32 {
@@ -144,6 +303,7 @@ fn normal_step(tt: f32, p: vec3<f32>) -> f32 {
     return max(params.march.x * tt / params.march.w, floor_h);
 }
 
+//#if !ANALYTIC
 // The hit tolerance: the pixel cone, but never below 8 ulps of the point's coordinates.
 fn tolerance(cone: f32, p: vec3<f32>) -> f32 {
     let a = abs(p);
@@ -163,6 +323,7 @@ fn normal(p: vec3<f32>, h: f32, d: vec3<f32>) -> vec3<f32> {
     }
     return -d;
 }
+//#endif
 
 // The colour of material m at p (checker: parity of the cell, sampled just inside).
 fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> {
@@ -177,6 +338,7 @@ fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> 
     return m.color.xyz;
 }
 
+//#if !ANALYTIC
 // A shadow ray towards a light at distance tmax: the fraction of light that arrives.
 // Soft (k > 0): res = min(res, k·d/t). A transparent occluder passes its transparency and
 // the ray goes on through it; an opaque one blocks the light.
@@ -235,6 +397,7 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
     }
     return through * clamp(res, 0.0, 1.0); // not reached: the loop returns
 }
+//#endif
 
 // One light's Phong term at a hit, shadow included.
 fn phong_term(c: vec3<f32>, m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32,
@@ -343,11 +506,16 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         let p = ray.origin + ray.dir * hit.t;
         let tt = ray.t0 + hit.t;
         let h = normal_step(tt, p);
+//#if ANALYTIC
+        let n = hit.normal;
+        let m = params.materials[hit.material];
+//#else
         let n = normal(p, h, ray.dir);
 //#if MATERIALS
         let m = params.materials[u32(map(p).y)];
 //#else
         let m = params.materials[0];
+//#endif
 //#endif
         let w = 1.0 - m.optics.x - m.optics.y;
         if !inside && w > 0.0 {

@@ -6,6 +6,7 @@
 //! 1 the tile (x0, y0, width, height as a uniform `vec4<u32>`), 2 the image (`vec4<f32>`
 //! linear colour per pixel), 3 the statistics ([`STATS_WORDS`] `u32` per pixel).
 
+mod analytic;
 mod map;
 mod template;
 
@@ -84,7 +85,9 @@ fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
     let refraction = mats.iter().any(|m| m.transparency > 0.0);
     let secondary = scene.settings.max_depth > 0
         && mats.iter().any(|m| m.reflect > 0.0 || m.transparency > 0.0);
+    let traced = crate::scene::analytic::choose(scene).primitives().is_some();
     vec![
+        ("ANALYTIC", traced),
         ("POINT", points),
         ("DIRECTIONAL", dirs),
         ("SOFT", soft),
@@ -96,7 +99,7 @@ fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
         ("REFRACTION", refraction && secondary),
         ("SECONDARY", secondary),
         ("MATERIALS", mats.len() > 1),
-        ("RELAX", scene.settings.relaxation > 1.0),
+        ("RELAX", !traced && scene.settings.relaxation > 1.0),
     ]
 }
 
@@ -113,10 +116,19 @@ pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
     let features = features(scene);
     let on: HashMap<&str, bool> = features.iter().copied().collect();
     let mut values: HashMap<&str, String> = HashMap::new();
-    values.insert(
-        "MAP",
-        format!("{}\n{}", write_map(program), write_sdf(program)),
-    );
+    match crate::scene::analytic::choose(scene).primitives() {
+        // An analytically traced scene needs no distance field.
+        Some(primitives) => {
+            values.insert("MAP", String::new());
+            values.insert("ANALYTIC", analytic::write(primitives));
+        }
+        None => {
+            values.insert(
+                "MAP",
+                format!("{}\n{}", write_map(program), write_sdf(program)),
+            );
+        }
+    }
     let used: Vec<String> = features
         .iter()
         .map(|(n, on)| format!("{}{n}", if *on { "+" } else { "-" }))

@@ -1,0 +1,123 @@
+//! The WGSL of an analytically traced scene: `fn trace` (nearest hit, its normal and
+//! material) and `fn shadow` (any-hit shadow rays) unrolled over the scene's primitives, on
+//! top of the interval functions of the kernel template's `ANALYTIC` block.
+
+use super::map::float;
+use crate::scene::analytic::{Primitive, Shape};
+use crate::scene::V3;
+use std::fmt::Write;
+
+/// The scene's frame constants, `fn trace` and `fn shadow`.
+pub fn write(primitives: &[Primitive]) -> String {
+    let mut out = String::new();
+    if primitives.iter().any(|p| !identity(&p.matrix)) {
+        out.push_str("// The world-to-local rows of the primitives that are rotated or scaled.\n");
+    }
+    for (i, p) in primitives.iter().enumerate() {
+        if !identity(&p.matrix) {
+            for (r, row) in p.matrix.iter().enumerate() {
+                let _ = writeln!(out, "const P{i}_R{r} = {};", vec3(*row));
+            }
+        }
+    }
+    if !out.is_empty() {
+        out.push('\n');
+    }
+    out.push_str(
+        "// The nearest surface along o + t·d, 0 < t < max_dist, with its normal and material.\n",
+    );
+    out.push_str("fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {\n");
+    out.push_str("    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u);\n");
+    for (i, p) in primitives.iter().enumerate() {
+        let _ = writeln!(out, "    // node {} {}", p.node.0, name(&p.shape));
+        let _ = writeln!(
+            out,
+            "    best = nearest(best, {}, {}u);",
+            interval(i, p),
+            p.material.0
+        );
+    }
+    out.push_str("    return best;\n}\n\n");
+    out.push_str(
+        "// The light arriving along o + t·d, 0 < t < tmax: 0 behind an opaque primitive, else the\n\
+         // product of the transparencies of the primitives the ray enters.\n",
+    );
+    out.push_str("fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {\n");
+    out.push_str("    counters.shadow += 1u;\n    var through = 1.0;\n");
+    for (i, p) in primitives.iter().enumerate() {
+        let _ = writeln!(out, "    // node {} {}", p.node.0, name(&p.shape));
+        let _ = writeln!(
+            out,
+            "    through = occlude(through, {}, tmax, params.materials[{}u].optics.y);",
+            interval(i, p),
+            p.material.0
+        );
+    }
+    out.push_str("    return through;\n}\n");
+    out
+}
+
+fn name(s: &Shape) -> &'static str {
+    match s {
+        Shape::Sphere { .. } => "sphere",
+        Shape::Box { .. } => "box",
+        Shape::Cylinder { .. } => "cylinder",
+        Shape::Plane { .. } => "plane",
+    }
+}
+
+fn identity(m: &[V3; 3]) -> bool {
+    (0..3).all(|i| (0..3).all(|j| m[i][j] == if i == j { 1.0 } else { 0.0 }))
+}
+
+fn vec3(v: V3) -> String {
+    format!(
+        "vec3<f32>({}, {}, {})",
+        float(v[0]),
+        float(v[1]),
+        float(v[2])
+    )
+}
+
+/// The expression of primitive `i`'s interval along the ray (o, d), normals in world space.
+fn interval(i: usize, p: &Primitive) -> String {
+    let plain = identity(&p.matrix);
+    let rows = format!("P{i}_R0, P{i}_R1, P{i}_R2");
+    let moved = |v: &str| {
+        if plain {
+            v.to_string()
+        } else {
+            format!("into({v}, {rows})")
+        }
+    };
+    let origin = if p.offset == [0.0; 3] {
+        moved("o")
+    } else {
+        format!("{} + {}", moved("o"), vec3(p.offset))
+    };
+    let dir = moved("d");
+    let call = match p.shape {
+        Shape::Sphere { radius } => {
+            format!("sphere_interval({origin}, {dir}, {})", float(radius * radius))
+        }
+        Shape::Box { half } => format!("box_interval({origin}, {dir}, {})", vec3(half)),
+        Shape::Cylinder {
+            radius,
+            half_height,
+        } => format!(
+            "cylinder_interval({origin}, {dir}, {}, {})",
+            float(radius * radius),
+            float(half_height)
+        ),
+        Shape::Plane { normal, height } => format!(
+            "plane_interval({origin}, {dir}, {}, {})",
+            vec3(normal),
+            float(height)
+        ),
+    };
+    if plain {
+        call
+    } else {
+        format!("to_world({call}, {rows})")
+    }
+}

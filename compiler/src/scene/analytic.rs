@@ -1,0 +1,270 @@
+//! Which scenes can be ray traced analytically, and their primitives in world space.
+//!
+//! A scene qualifies when its objects are only spheres, planes, boxes and capped cylinders
+//! under affine transforms (translate, rotate, uniform and per-axis scale), painted and
+//! combined by plain union, and no light asks for soft shadows (a penumbra estimate needs a
+//! distance field). Every ray then has closed-form roots: exact hits, exact normals, no step
+//! budget and no ε. The CPU renderer and the WGSL kernel (so also PTX) both trace the list of
+//! [`Primitive`]s this module produces (RENDERER.md, "Intersection"; docs/rendering.md).
+
+use super::ir::{Combine, Light, MaterialId, Method, Node, NodeId, Scene, V3};
+use crate::span::Span;
+
+/// A primitive with a closed-form ray intersection, in its local frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape {
+    /// Sphere of a radius about the origin.
+    Sphere { radius: f64 },
+    /// Box of half-extents about the origin.
+    Box { half: V3 },
+    /// Capped cylinder along y.
+    Cylinder { radius: f64, half_height: f64 },
+    /// Half-space `dot(p, normal) <= height` (unit normal).
+    Plane { normal: V3, height: f64 },
+}
+
+/// One primitive of an analytic scene: its shape, the affine map from world to its local
+/// frame (`local = matrix · world + offset`, rows of `matrix`), and its material.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Primitive {
+    pub shape: Shape,
+    pub matrix: [V3; 3],
+    pub offset: V3,
+    pub material: MaterialId,
+    /// The primitive's node (for comments in generated code).
+    pub node: NodeId,
+}
+
+/// The most primitives `method: "auto"` traces analytically. Tracing tests every primitive
+/// for every ray (no hierarchy), and the GPU kernel has one intersection per primitive,
+/// unrolled; sphere tracing culls by bounding volumes. On the CPU, tracing is the faster of
+/// the two up to 1 000 random spheres and the slower at 10 000; the kernel of 1 000 spheres is
+/// 4 400 lines of WGSL and 145 000 of PTX, which ptxas takes 10 s to compile (BENCHMARKS.md).
+/// `method: "trace"` has no limit.
+pub const MAX_AUTO_PRIMITIVES: usize = 256;
+
+/// What a scene is rendered with, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Choice {
+    /// Analytic ray tracing of these primitives.
+    Trace(Vec<Primitive>),
+    /// Sphere tracing, for the reason given.
+    March(Reason),
+}
+
+/// Why a scene is sphere traced.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reason {
+    /// The render asks for it (`method: "march"`).
+    Asked,
+    /// A node has no closed-form ray intersection.
+    Node { what: &'static str, span: Span },
+    /// A light casts soft shadows.
+    SoftLight { index: usize },
+    /// Too many primitives for `auto` to trace them one by one.
+    Many { count: usize },
+}
+
+impl Reason {
+    /// The reason in words.
+    pub fn describe(&self) -> String {
+        match self {
+            Reason::Asked => "the render sets `method: \"march\"`".into(),
+            Reason::Node { what, .. } => format!("`{what}` has no closed-form ray intersection"),
+            Reason::SoftLight { index } => {
+                format!(
+                    "light {} casts soft shadows, which need a distance field",
+                    index + 1
+                )
+            }
+            Reason::Many { count } => format!(
+                "{count} primitives: beyond {MAX_AUTO_PRIMITIVES}, sphere tracing with bounding-volume culling is used"
+            ),
+        }
+    }
+}
+
+impl Choice {
+    /// The primitives, when the scene is traced analytically.
+    pub fn primitives(&self) -> Option<&[Primitive]> {
+        match self {
+            Choice::Trace(p) => Some(p),
+            Choice::March(_) => None,
+        }
+    }
+
+    /// One line for `sdfc check`: the method and why.
+    pub fn describe(&self) -> String {
+        match self {
+            Choice::Trace(p) => format!(
+                "method: trace ({} primitive{} with closed-form intersections, in a plain union)",
+                p.len(),
+                if p.len() == 1 { "" } else { "s" }
+            ),
+            Choice::March(r) => format!("method: march ({})", r.describe()),
+        }
+    }
+}
+
+/// Decides how `scene` is rendered: its `method` setting, and for `auto` whether every node
+/// and light allows analytic tracing. For `method: "trace"` on a scene that does not allow
+/// it, the answer is `March` with the reason, and the checker reports it as an error.
+pub fn choose(scene: &Scene) -> Choice {
+    if scene.settings.method == Method::March {
+        return Choice::March(Reason::Asked);
+    }
+    if let Some(index) = scene.lights.iter().position(|l| softness(l) > 0.0) {
+        return Choice::March(Reason::SoftLight { index });
+    }
+    let mut out = Vec::new();
+    if let Some(root) = scene.root {
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let frame = Frame {
+            matrix: identity,
+            offset: [0.0; 3],
+            material: MaterialId(0),
+        };
+        if let Err(reason) = collect(scene, root, frame, &mut out) {
+            return Choice::March(reason);
+        }
+    }
+    if scene.settings.method == Method::Auto && out.len() > MAX_AUTO_PRIMITIVES {
+        return Choice::March(Reason::Many { count: out.len() });
+    }
+    Choice::Trace(out)
+}
+
+fn softness(l: &Light) -> f64 {
+    match l {
+        Light::Point { softness, .. } | Light::Directional { softness, .. } => *softness,
+    }
+}
+
+/// The world-to-local map and the material in force at a node.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    matrix: [V3; 3],
+    offset: V3,
+    material: MaterialId,
+}
+
+impl Frame {
+    /// The frame of a child whose local point is `m · (this frame's local point) + c`.
+    fn then(&self, m: [V3; 3], c: V3) -> Frame {
+        let mut matrix = [[0.0; 3]; 3];
+        let mut offset = c;
+        for i in 0..3 {
+            for j in 0..3 {
+                matrix[i][j] = (0..3).map(|k| m[i][k] * self.matrix[k][j]).sum();
+                offset[i] += m[i][j] * self.offset[j];
+            }
+        }
+        Frame {
+            matrix,
+            offset,
+            material: self.material,
+        }
+    }
+}
+
+fn diagonal(v: V3) -> [V3; 3] {
+    [[v[0], 0.0, 0.0], [0.0, v[1], 0.0], [0.0, 0.0, v[2]]]
+}
+
+fn collect(scene: &Scene, id: NodeId, f: Frame, out: &mut Vec<Primitive>) -> Result<(), Reason> {
+    let g = &scene.graph;
+    let mut leaf = |shape| {
+        out.push(Primitive {
+            shape,
+            matrix: f.matrix,
+            offset: f.offset,
+            material: f.material,
+            node: id,
+        });
+        Ok(())
+    };
+    match g.node(id) {
+        Node::Sphere { radius } => leaf(Shape::Sphere { radius: *radius }),
+        Node::Box { half } => leaf(Shape::Box { half: *half }),
+        Node::Cylinder {
+            radius,
+            half_height,
+        } => leaf(Shape::Cylinder {
+            radius: *radius,
+            half_height: *half_height,
+        }),
+        Node::Plane { normal, height } => leaf(Shape::Plane {
+            normal: *normal,
+            height: *height,
+        }),
+        Node::Combine {
+            op: Combine::Union,
+            children,
+        } => children.iter().try_for_each(|&c| collect(scene, c, f, out)),
+        Node::Translate { offset, child } => {
+            let back = offset.map(|x| -x);
+            collect(scene, *child, f.then(diagonal([1.0; 3]), back), out)
+        }
+        // The lowering evaluates a rotated child at Mᵀp.
+        Node::Rotate { matrix, child } => {
+            let t = [0, 1, 2].map(|i| [0, 1, 2].map(|j| matrix[j][i]));
+            collect(scene, *child, f.then(t, [0.0; 3]), out)
+        }
+        Node::Scale { factor, child } => {
+            let s = 1.0 / factor;
+            collect(scene, *child, f.then(diagonal([s; 3]), [0.0; 3]), out)
+        }
+        Node::ScaleXyz { factors, child } => {
+            let s = factors.map(|x| 1.0 / x);
+            collect(scene, *child, f.then(diagonal(s), [0.0; 3]), out)
+        }
+        // Inner materials take precedence: the nearest paint above a primitive wins.
+        Node::Paint { material, child } => {
+            let inner = Frame {
+                material: *material,
+                ..f
+            };
+            collect(scene, *child, inner, out)
+        }
+        other => Err(Reason::Node {
+            what: name(other),
+            span: g.span(id),
+        }),
+    }
+}
+
+/// The language's name for a node that blocks analytic tracing.
+fn name(n: &Node) -> &'static str {
+    match n {
+        Node::RoundBox { .. } => "round_box",
+        Node::Torus { .. } => "torus",
+        Node::Capsule { .. } => "capsule",
+        Node::Cone { .. } => "cone",
+        Node::Ellipsoid { .. } => "ellipsoid",
+        Node::Mandelbulb { .. } => "mandelbulb",
+        Node::Combine {
+            op: Combine::Intersect,
+            ..
+        } => "intersect",
+        Node::Combine {
+            op: Combine::Subtract,
+            ..
+        } => "subtract",
+        Node::SmoothCombine {
+            op: Combine::Union, ..
+        } => "smooth_union",
+        Node::SmoothCombine {
+            op: Combine::Intersect,
+            ..
+        } => "smooth_intersect",
+        Node::SmoothCombine { .. } => "smooth_subtract",
+        Node::Repeat { .. } => "repeat",
+        Node::Mirror { .. } => "mirror",
+        Node::Twist { .. } => "twist",
+        Node::Bend { .. } => "bend",
+        Node::Round { .. } => "round",
+        Node::Shell { .. } => "shell",
+        Node::Elongate { .. } => "elongate",
+        _ => "shape",
+    }
+}

@@ -5,7 +5,7 @@
 # report), once with `--set method=trace` and once with `--set method=march`, on one backend.
 # Every `sdfc bench` times its frames after one untimed warm-up frame and reports the median
 # (GPU time on GPU backends). Prints the machine, the date, then one Markdown row per
-# (scene, size, aa): median seconds traced, marched, and marched / traced.
+# (scene, size, aa): median milliseconds traced, marched, and marched / traced.
 #
 # Usage: bench/analytic.sh BACKEND [SDFC]   BACKEND: cpu, wgpu or cuda; SDFC: the binary
 #        (default target/release/sdfc).
@@ -31,23 +31,25 @@ echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'), backend $BACKEND, $FRAMES frames p
 
 median() {
     # The median frame time in seconds from `sdfc bench --json` output.
-    python3 -c 'import json,sys; d=json.load(sys.stdin); d=d[0] if isinstance(d,list) else d; print(f"{d[\"median_s\"]:.4f}")'
+    python3 -c 'import json,sys; d=json.load(sys.stdin); d=d[0] if isinstance(d,list) else d; print("%.3f" % (d["median_s"] * 1e3))'
 }
 
 time_one() {
     local file=$1 size=$2 aa=$3 method=$4
     local out
+    # A crash after the JSON is printed (seen with wgpu at process exit) still gives a
+    # figure; a command that printed none shows as "failed".
     out=$("$SDFC" bench "$file" --backend "$BACKEND" --size "$size" --aa "$aa" \
-        --set "method=$method" --frames "$FRAMES" --json)
+        --set "method=$method" --frames "$FRAMES" --json 2>/dev/null || true)
     if [ -n "$JSON_DIR" ]; then
         mkdir -p "$JSON_DIR"
         echo "$out" > "$JSON_DIR/$(basename "$file" .sdf)-$size-aa$aa-$method.json"
     fi
-    echo "$out" | median
+    echo "$out" | median 2>/dev/null || echo failed
 }
 
 echo
-echo "| scene | size | aa | traced (s) | marched (s) | marched / traced |"
+echo "| scene | size | aa | traced (ms) | marched (ms) | marched / traced |"
 echo "|---|---|---:|---:|---:|---:|"
 for scene in seed1 seed2; do
     for size in 640x480 1024x768 1920x1080; do
@@ -61,7 +63,7 @@ for scene in seed1 seed2; do
                 ratio=""
             else
                 marched=$(time_one "examples/$scene.sdf" "$size" "$aa" march)
-                ratio=$(python3 -c "print(f'{$marched / $traced:.1f}')")
+                ratio=$(python3 -c "print(f'{$marched / $traced:.1f}')" 2>/dev/null || echo "")
             fi
             echo "| $scene | $size | $aa | $traced | $marched | $ratio |"
         done

@@ -27,7 +27,7 @@ if [ "$MODE" = all ] || [ "$MODE" = check ]; then
     wc=$("$B" compare "/tmp/sdfc-img/$n-wgpu.png" "/tmp/sdfc-img/$n-cpu.png" --json 2>&1)
     cc=$("$B" compare "/tmp/sdfc-img/$n-cuda.png" "/tmp/sdfc-img/$n-cpu.png" --json 2>&1)
     cw=$("$B" compare "/tmp/sdfc-img/$n-cuda.png" "/tmp/sdfc-img/$n-wgpu.png" --json 2>&1)
-    short() { python3 -c 'import json,sys; d=json.loads(sys.argv[1]); print(f"{d[\"psnr\"]:.1f} dB {100*d[\"differing\"]:.4f}%")' "$1" 2>/dev/null || echo "n/a"; }
+    short() { python3 -c 'import json,sys; d=json.loads(sys.argv[1]); print("%.1f dB %.4f%%" % (d["psnr"], 100 * d["differing"]))' "$1" 2>/dev/null || echo "n/a"; }
     echo "$n  wgpu-cpu $(short "$wc") | cuda-cpu $(short "$cc") | cuda-wgpu $(short "$cw")" | tee -a "$OUT/conformance.txt"
   done
   cp /tmp/sdfc-img/seed3-cuda.png /tmp/sdfc-img/seed5-wgpu.png "$OUT/" 2>/dev/null

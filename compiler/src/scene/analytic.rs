@@ -35,13 +35,13 @@ pub struct Primitive {
     pub node: NodeId,
 }
 
-/// The most primitives `method: "auto"` traces analytically. Tracing tests every primitive
-/// for every ray (no hierarchy), and the GPU kernel has one intersection per primitive,
-/// unrolled; sphere tracing culls by bounding volumes. On the CPU, tracing is the faster of
-/// the two up to 1 000 random spheres and the slower at 10 000; the kernel of 1 000 spheres is
-/// 4 400 lines of WGSL and 145 000 of PTX, which ptxas takes 10 s to compile (BENCHMARKS.md).
-/// `method: "trace"` has no limit.
-pub const MAX_AUTO_PRIMITIVES: usize = 256;
+/// The most primitives `method: "auto"` traces analytically. Rays visit the primitives
+/// through a bounding-volume hierarchy ([`hierarchy`]), but the GPU kernel unrolls it: one
+/// intersection per primitive in the code. The kernel of 1 000 random spheres is 82 000 lines
+/// of PTX (ptxas: 3.3 s; the driver caches it); that of 10 000 takes 34 s to generate, where
+/// sphere tracing with culling is the better choice (BENCHMARKS.md). `method: "trace"` has
+/// no limit.
+pub const MAX_AUTO_PRIMITIVES: usize = 1024;
 
 /// What a scene is rendered with, and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -267,4 +267,143 @@ fn name(n: &Node) -> &'static str {
         Node::Elongate { .. } => "elongate",
         _ => "shape",
     }
+}
+
+/// Primitives per leaf of the hierarchy: below this, testing a group's box costs more than
+/// testing its primitives.
+const LEAF: usize = 4;
+
+/// A node of the bounding-volume hierarchy over a traced scene's primitives: a world-space
+/// box (centre and half-extents) around everything in it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Group {
+    pub centre: V3,
+    pub half: V3,
+    pub items: Vec<Item>,
+}
+
+/// What a group holds.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Item {
+    /// A primitive, by index.
+    Primitive(usize),
+    /// A nested group.
+    Group(Group),
+}
+
+/// The hierarchy of a traced scene: what every ray tests (unbounded primitives, such as
+/// planes, and the top groups), each group only when the ray meets its box before the
+/// nearest hit so far.
+pub fn hierarchy(primitives: &[Primitive]) -> Vec<Item> {
+    let mut top = Vec::new();
+    let mut bounded = Vec::new();
+    for (i, p) in primitives.iter().enumerate() {
+        match world_box(p) {
+            Some(b) => bounded.push((i, b)),
+            None => top.push(Item::Primitive(i)),
+        }
+    }
+    if bounded.len() <= LEAF {
+        top.extend(bounded.into_iter().map(|(i, _)| Item::Primitive(i)));
+    } else {
+        top.push(Item::Group(build(bounded)));
+    }
+    top
+}
+
+/// An axis-aligned box as (low, high) corners.
+type Aabb = (V3, V3);
+
+/// Splits at the median of the box centres along the axis where they spread most (a median
+/// split keeps the tree balanced: depth log₂(n / LEAF)).
+fn build(mut items: Vec<(usize, Aabb)>) -> Group {
+    let (lo, hi) = items.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), (_, (a, b))| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(a[k])),
+                [0, 1, 2].map(|k| hi[k].max(b[k])),
+            )
+        },
+    );
+    let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+    // Padded by a few f32 ulps of the box's size and place, so that the box written as f32
+    // still contains every primitive in it.
+    let pad = 1e-5 * (0..3).map(|k| centre[k].abs() + hi[k] - lo[k]).fold(0.0, f64::max);
+    let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]) + pad);
+    if items.len() <= LEAF {
+        let items = items.into_iter().map(|(i, _)| Item::Primitive(i)).collect();
+        return Group { centre, half, items };
+    }
+    let mid = |(a, b): &Aabb, k: usize| a[k] + b[k];
+    let spread = |k: usize| {
+        let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+        for (_, bx) in &items {
+            a = a.min(mid(bx, k));
+            b = b.max(mid(bx, k));
+        }
+        b - a
+    };
+    let axis = (0..3)
+        .max_by(|&a, &b| spread(a).total_cmp(&spread(b)))
+        .unwrap_or(0);
+    // Ties broken by index, so that the tree (and the generated code) is deterministic.
+    items.sort_by(|x, y| mid(&x.1, axis).total_cmp(&mid(&y.1, axis)).then(x.0.cmp(&y.0)));
+    let rest = items.split_off(items.len() / 2);
+    let halves = [items, rest].map(|h| {
+        if h.len() == 1 {
+            Item::Primitive(h[0].0)
+        } else {
+            Item::Group(build(h))
+        }
+    });
+    Group {
+        centre,
+        half,
+        items: halves.into(),
+    }
+}
+
+/// The world-space box around a primitive (`None` for a plane): the corners of its local box
+/// mapped back to the world.
+pub fn world_box(p: &Primitive) -> Option<Aabb> {
+    let h = match p.shape {
+        Shape::Sphere { radius } => [radius; 3],
+        Shape::Box { half } => half,
+        Shape::Cylinder {
+            radius,
+            half_height,
+        } => [radius, half_height, radius],
+        Shape::Plane { .. } => return None,
+    };
+    let inv = inverse(&p.matrix)?;
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for corner in 0..8 {
+        // local = M·world + c, so world = M⁻¹·(local − c).
+        let local = [0, 1, 2].map(|k| {
+            let s = if corner >> k & 1 == 1 { 1.0 } else { -1.0 };
+            s * h[k] - p.offset[k]
+        });
+        for k in 0..3 {
+            let w: f64 = (0..3).map(|j| inv[k][j] * local[j]).sum();
+            lo[k] = lo[k].min(w);
+            hi[k] = hi[k].max(w);
+        }
+    }
+    lo.iter().chain(&hi).all(|x| x.is_finite()).then_some((lo, hi))
+}
+
+/// The inverse of a 3×3 matrix (rows), or `None` when it is singular.
+fn inverse(m: &[V3; 3]) -> Option<[V3; 3]> {
+    let c = |i: usize, j: usize| {
+        let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+        let (x, y) = ((j + 1) % 3, (j + 2) % 3);
+        m[a][x] * m[b][y] - m[a][y] * m[b][x]
+    };
+    let det: f64 = (0..3).map(|j| m[0][j] * c(0, j)).sum();
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    // The inverse is the transposed cofactor matrix over the determinant.
+    Some([0, 1, 2].map(|i| [0, 1, 2].map(|j| c(j, i) / det)))
 }

@@ -8,7 +8,7 @@
 
 use super::vec::V3;
 use sdfc_compiler::eval::Float;
-use sdfc_compiler::scene::analytic::{Primitive, Shape};
+use sdfc_compiler::scene::analytic::{hierarchy, Item, Primitive, Shape};
 
 /// A primitive in the evaluation type.
 #[derive(Debug, Clone, Copy)]
@@ -46,10 +46,40 @@ pub(super) struct Surface<T> {
     pub material: u32,
 }
 
-/// The primitives of an analytically traced scene.
+/// An entry of the hierarchy (`sdfc_compiler::scene::analytic::hierarchy`).
+#[derive(Debug, Clone)]
+enum Node<T> {
+    Prim(usize),
+    /// A world-space box (centre, half-extents) around the nodes in it.
+    Group {
+        centre: V3<T>,
+        half: V3<T>,
+        items: Vec<Node<T>>,
+    },
+}
+
+fn node<T: Float>(item: &Item) -> Node<T> {
+    match item {
+        Item::Primitive(i) => Node::Prim(*i),
+        Item::Group(g) => Node::Group {
+            centre: V3::from_f64(g.centre),
+            half: V3::from_f64(g.half),
+            items: g.items.iter().map(node).collect(),
+        },
+    }
+}
+
+/// The primitives of an analytically traced scene and their hierarchy.
 #[derive(Debug, Clone)]
 pub(super) struct Tracer<T> {
     prims: Vec<Prim<T>>,
+    top: Vec<Node<T>>,
+}
+
+/// Whether a ray meets a group's box between 0 and `limit`.
+fn enters<T: Float>(o: V3<T>, d: V3<T>, centre: V3<T>, half: V3<T>, limit: T) -> bool {
+    boxed(o - centre, d, half)
+        .is_some_and(|s| s.near <= s.far && s.far > T::zero() && s.near < limit)
 }
 
 impl<T: Float> Tracer<T> {
@@ -82,25 +112,55 @@ impl<T: Float> Tracer<T> {
                 material: p.material.0,
             })
             .collect();
-        Tracer { prims }
+        let top = hierarchy(primitives).iter().map(node).collect();
+        Tracer { prims, top }
+    }
+
+    /// Visits the primitives of `nodes` whose groups the ray enters before `limit` (which
+    /// `f` may lower as it goes); stops when `f` returns false.
+    fn visit(
+        &self,
+        nodes: &[Node<T>],
+        o: V3<T>,
+        d: V3<T>,
+        limit: &mut T,
+        f: &mut impl FnMut(&Prim<T>, &mut T) -> bool,
+    ) -> bool {
+        for n in nodes {
+            let go_on = match n {
+                Node::Prim(i) => f(&self.prims[*i], limit),
+                Node::Group {
+                    centre,
+                    half,
+                    items,
+                } => !enters(o, d, *centre, *half, *limit) || self.visit(items, o, d, limit, f),
+            };
+            if !go_on {
+                return false;
+            }
+        }
+        true
     }
 
     /// The nearest surface along `o + t·d` with 0 < t < `tmax`.
     pub fn nearest(&self, o: V3<T>, d: V3<T>, tmax: T) -> Option<Surface<T>> {
-        let mut best: Option<(T, V3<T>, &Prim<T>)> = None;
+        let mut best: Option<(T, V3<T>, Prim<T>)> = None;
         let mut limit = tmax;
-        for p in &self.prims {
-            let Some(s) = p.interval(o, d) else { continue };
+        self.visit(&self.top, o, d, &mut limit, &mut |p, limit| {
+            let Some(s) = p.interval(o, d) else {
+                return true;
+            };
             let (t, n) = if s.near > T::zero() {
                 (s.near, s.n_near)
             } else {
                 (s.far, s.n_far)
             };
-            if t > T::zero() && t < limit {
-                limit = t;
-                best = Some((t, n, p));
+            if t > T::zero() && t < *limit {
+                *limit = t;
+                best = Some((t, n, *p));
             }
-        }
+            true
+        });
         best.map(|(t, n, p)| Surface {
             t,
             normal: p.to_world(n),
@@ -113,19 +173,24 @@ impl<T: Float> Tracer<T> {
     /// ray enters (`transparency` of a material id).
     pub fn transmitted(&self, o: V3<T>, d: V3<T>, tmax: T, transparency: impl Fn(u32) -> T) -> T {
         let mut through = T::one();
-        for p in &self.prims {
-            let Some(s) = p.interval(o, d) else { continue };
+        let mut limit = tmax;
+        self.visit(&self.top, o, d, &mut limit, &mut |p, _| {
+            let Some(s) = p.interval(o, d) else {
+                return true;
+            };
             if !(s.far > T::zero() && s.near < tmax) {
-                continue;
+                return true;
             }
             let tau = transparency(p.material);
             if tau <= T::zero() {
-                return T::zero();
+                through = T::zero();
+                return false;
             }
             if s.near > T::zero() {
                 through = through * tau;
             }
-        }
+            true
+        });
         through
     }
 }
@@ -401,5 +466,45 @@ mod tests {
         assert_eq!(tracer.transmitted(o, back, 10.0, tau), 0.5);
         let side = V3::new(1.0, 0.0, 0.0);
         assert_eq!(tracer.transmitted(o, side, 10.0, tau), 1.0);
+    }
+
+    /// The hierarchy skips only what cannot be hit: on a scene of 300 scattered primitives,
+    /// every ray finds the same nearest hit as testing every primitive, and the same light.
+    #[test]
+    fn the_hierarchy_finds_what_testing_everything_finds() {
+        let mut text = String::from("material glass = phong { transparency: 0.5, ior: 1.5 };\nscene {\n plane();\n");
+        let mut rng = Rng(0x2545f4914f6cdd1d);
+        for i in 0..300 {
+            let (x, y, z) = (rng.next() * 8.0, rng.next() * 3.0 + 3.0, rng.next() * 8.0);
+            let shape = match i % 3 {
+                0 => "sphere(0.3)",
+                1 => "box((0.3, 0.1, 0.2)).rotate_y(25deg)",
+                _ => "cylinder(0.2, 0.3).rotate_x(40deg)",
+            };
+            let paint = if i % 7 == 0 { " @ glass" } else { "" };
+            text.push_str(&format!(" {shape}.translate({x}, {y}, {z}){paint};\n"));
+        }
+        text.push_str("}\n");
+        let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
+        let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+        let prims = choose(&scene);
+        let tracer = Tracer::<f64>::new(prims.primitives().expect("traced"));
+        assert!(matches!(tracer.top.last(), Some(Node::Group { .. })));
+        let brute = Tracer::<f64> {
+            prims: tracer.prims.clone(),
+            top: (0..tracer.prims.len()).map(Node::Prim).collect(),
+        };
+        let tau = |m: u32| if m == 1 { 0.5 } else { 0.0 };
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let o = rng.v3() * 12.0 + V3::new(0.0, 6.0, 0.0);
+            let d = rng.v3().normalize();
+            let (a, b) = (tracer.nearest(o, d, 100.0), brute.nearest(o, d, 100.0));
+            assert_eq!(a.map(|s| (s.t, s.material)), b.map(|s| (s.t, s.material)));
+            hits += usize::from(a.is_some());
+            let (a, b) = (tracer.transmitted(o, d, 7.0, tau), brute.transmitted(o, d, 7.0, tau));
+            assert_eq!(a, b);
+        }
+        assert!(hits > 500, "{hits}");
     }
 }

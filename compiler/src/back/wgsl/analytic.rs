@@ -3,7 +3,7 @@
 //! top of the interval functions of the kernel template's `ANALYTIC` block.
 
 use super::map::float;
-use crate::scene::analytic::{Primitive, Shape};
+use crate::scene::analytic::{hierarchy, Item, Primitive, Shape};
 use crate::scene::V3;
 use std::fmt::Write;
 
@@ -26,17 +26,17 @@ pub fn write(primitives: &[Primitive]) -> String {
     out.push_str(
         "// The nearest surface along o + t·d, 0 < t < max_dist, with its normal and material.\n",
     );
+    let top = hierarchy(primitives);
     out.push_str("fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {\n");
     out.push_str("    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u);\n");
-    for (i, p) in primitives.iter().enumerate() {
-        let _ = writeln!(out, "    // node {} {}", p.node.0, name(&p.shape));
-        let _ = writeln!(
-            out,
-            "    best = nearest(best, {}, {}u);",
+    let nearest = |i: usize, p: &Primitive| {
+        format!(
+            "best = nearest(best, {}, {}u);",
             interval(i, p),
             p.material.0
-        );
-    }
+        )
+    };
+    items(&mut out, primitives, &top, 1, "best.t", &nearest);
     out.push_str("    return best;\n}\n\n");
     out.push_str(
         "// The light arriving along o + t·d, 0 < t < tmax: 0 behind an opaque primitive, else the\n\
@@ -44,17 +44,48 @@ pub fn write(primitives: &[Primitive]) -> String {
     );
     out.push_str("fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {\n");
     out.push_str("    counters.shadow += 1u;\n    var through = 1.0;\n");
-    for (i, p) in primitives.iter().enumerate() {
-        let _ = writeln!(out, "    // node {} {}", p.node.0, name(&p.shape));
-        let _ = writeln!(
-            out,
-            "    through = occlude(through, {}, tmax, params.materials[{}u].optics.y);",
+    let occlude = |i: usize, p: &Primitive| {
+        format!(
+            "through = occlude(through, {}, tmax, params.materials[{}u].optics.y);",
             interval(i, p),
             p.material.0
-        );
-    }
+        )
+    };
+    items(&mut out, primitives, &top, 1, "tmax", &occlude);
     out.push_str("    return through;\n}\n");
     out
+}
+
+/// Writes the statements of `items` at `depth`: one `test` per primitive, each group's items
+/// inside an `if` that the ray enters the group's box before `limit`.
+fn items(
+    out: &mut String,
+    primitives: &[Primitive],
+    items_here: &[Item],
+    depth: usize,
+    limit: &str,
+    test: &dyn Fn(usize, &Primitive) -> String,
+) {
+    let pad = "    ".repeat(depth);
+    for item in items_here {
+        match item {
+            Item::Primitive(i) => {
+                let p = &primitives[*i];
+                let _ = writeln!(out, "{pad}// node {} {}", p.node.0, name(&p.shape));
+                let _ = writeln!(out, "{pad}{}", test(*i, p));
+            }
+            Item::Group(g) => {
+                let _ = writeln!(
+                    out,
+                    "{pad}if enters(o - {}, d, {}, {limit}) {{",
+                    vec3(g.centre),
+                    vec3(g.half)
+                );
+                self::items(out, primitives, &g.items, depth + 1, limit, test);
+                let _ = writeln!(out, "{pad}}}");
+            }
+        }
+    }
 }
 
 fn name(s: &Shape) -> &'static str {

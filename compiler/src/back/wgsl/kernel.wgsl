@@ -194,6 +194,13 @@ fn plane_interval(o: vec3<f32>, d: vec3<f32>, n: vec3<f32>, h: f32) -> Interval 
     return Interval(t, BIG, n, n);
 }
 
+// Whether a ray (from the group's centre) meets a group's box of half-extents h between 0
+// and limit: groups of the bounding-volume hierarchy are skipped when it does not.
+fn enters(o: vec3<f32>, d: vec3<f32>, h: vec3<f32>, limit: f32) -> bool {
+    let s = box_interval(o, d, h);
+    return s.near <= s.far && s.far > 0.0 && s.near < limit;
+}
+
 // A vector in a primitive's frame, given the rows of its world-to-local matrix.
 fn into(v: vec3<f32>, r0: vec3<f32>, r1: vec3<f32>, r2: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(r0, v), dot(r1, v), dot(r2, v));

@@ -338,3 +338,111 @@ fn an_interrupt_stops_a_render_and_leaves_no_file() {
     assert!(!status.success());
     assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
 }
+
+#[test]
+fn a_render_announces_its_memory_and_stops_above_the_memory_limit() {
+    let d = dir("memory");
+    scene_file(&d);
+    let out = sdfc(
+        &d,
+        &["render", "ball.sdf", "--backend", "cpu", "-o", "a.png"],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("render: 40x30, aa 1, cpu: allocating at most ") && err.contains(" MiB"),
+        "{err}"
+    );
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--limit",
+            "memory=1",
+            "--size",
+            "2000x2000",
+            "-o",
+            "b.png",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("more than the memory limit of 1 MiB") && err.contains("--limit memory="),
+        "{err}"
+    );
+    assert_eq!(entries(&d), ["a.png", "ball.sdf"], "no file written");
+}
+
+#[test]
+fn limits_are_set_by_name_and_named_when_exceeded() {
+    let d = dir("limits");
+    scene_file(&d);
+    let out = sdfc(&d, &["render", "ball.sdf", "--limit", "speed=3"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("unknown limit `speed`") && err.contains("fuel"),
+        "{err}"
+    );
+    for bad in ["aa=0", "aa=x", "aa"] {
+        let out = sdfc(&d, &["check", "ball.sdf", "--limit", bad]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+    }
+    // A loop over the objects limit: E0507 naming the flag, and the flag raises it.
+    let many = "scene { for i in 0..50 { sphere(0.1).translate(i, 0, 0); } }\n";
+    std::fs::write(d.join("many.sdf"), many).expect("write");
+    let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=20"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("E0507") && err.contains("--limit objects=40"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=50"]);
+    assert!(out.status.success());
+    // The render settings' limits: in the scene (E0400) and on the command line (exit 2).
+    let out = sdfc(&d, &["render", "ball.sdf", "--aa", "20"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--limit aa=20"), "{err}");
+    let out = sdfc(
+        &d,
+        &[
+            "render", "ball.sdf", "--aa", "20", "--limit", "aa=20", "--size", "4x4",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The program limit, after lowering and before any output.
+    for args in [
+        &[
+            "compile",
+            "ball.sdf",
+            "--emit",
+            "wgsl",
+            "--limit",
+            "program=10",
+            "-o",
+            "k.wgsl",
+        ][..],
+        &["render", "ball.sdf", "--limit", "program=10", "-o", "p.png"],
+    ] {
+        let out = sdfc(&d, args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("E0507")
+                && err.contains("distance program has")
+                && err.contains("--limit program="),
+            "{err}"
+        );
+    }
+    assert_eq!(entries(&d), ["ball.png", "ball.sdf", "many.sdf"]);
+}

@@ -43,7 +43,7 @@ pub(super) struct Rect {
 }
 
 /// Secondary rays are traced in pieces of at most this many rays.
-pub(super) const WAVE: usize = 4096;
+pub(super) const WAVE: usize = 1024;
 
 /// What the rays of a tile add up to, per sample (index within the tile).
 #[derive(Debug)]

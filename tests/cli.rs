@@ -446,3 +446,30 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
     }
     assert_eq!(entries(&d), ["ball.png", "ball.sdf", "many.sdf"]);
 }
+
+#[test]
+fn debug_nan_paints_nan_pixels_magenta_in_the_written_image() {
+    let d = dir("debug-nan");
+    let scene = std::fs::canonicalize("../tests/in/ok/nan_at_run_time.sdf").expect("scene");
+    let scene = scene.to_string_lossy();
+    let magenta = |png: &str| {
+        let image = sdfc_runtime::image::read_png(&d.join(png)).expect("png");
+        image
+            .linear
+            .iter()
+            .filter(|c| c[0] > 0.99 && c[1] < 0.01 && c[2] > 0.99)
+            .count()
+    };
+    for (flag, png) in [(None, "plain.png"), (Some("--debug-nan"), "debug.png")] {
+        let mut args = vec!["render", &scene, "--backend", "cpu", "-o", png];
+        args.extend(flag);
+        let out = sdfc(&d, &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    assert_eq!(magenta("plain.png"), 0);
+    assert!(magenta("debug.png") > 100);
+}

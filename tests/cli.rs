@@ -473,3 +473,67 @@ fn debug_nan_paints_nan_pixels_magenta_in_the_written_image() {
     assert_eq!(magenta("plain.png"), 0);
     assert!(magenta("debug.png") > 100);
 }
+
+/// Whether `sdfc` finds a wgpu adapter here; if not, the caller skips (saying so) unless
+/// SDFC_REQUIRE_DEVICES=1 (set by CI, which installs lavapipe).
+fn wgpu_available(d: &Path) -> bool {
+    let out = sdfc(
+        d,
+        &[
+            "render",
+            "ball.sdf",
+            "--backend",
+            "wgpu",
+            "--size",
+            "8x8",
+            "-o",
+            "probe.png",
+        ],
+    );
+    let _ = std::fs::remove_file(d.join("probe.png"));
+    if out.status.success() {
+        return true;
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+        "SDFC_REQUIRE_DEVICES=1 but wgpu failed: {err}"
+    );
+    println!("SKIPPED: no wgpu adapter: {err}");
+    false
+}
+
+#[test]
+fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
+    let d = dir("gpu-fault");
+    scene_file(&d);
+    if !wgpu_available(&d) {
+        return;
+    }
+    // 1100x40 is three tiles of 512 pixels: the second fails after the first rendered.
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args([
+            "render",
+            "ball.sdf",
+            "--backend",
+            "wgpu",
+            "--size",
+            "1100x40",
+        ])
+        .args(["-o", "fault.png"])
+        .env("SDFC_FAULT_AFTER_TILES", "1")
+        // Mesa's window-system code complains on stderr without it.
+        .env("XDG_RUNTIME_DIR", &d)
+        .output()
+        .expect("run sdfc");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(
+        errors,
+        ["error: GPU error while rendering: device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1 (a testing aid)"],
+        "{err}"
+    );
+    assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
+}

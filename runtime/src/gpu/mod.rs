@@ -14,6 +14,27 @@ use std::time::Duration;
 
 pub use self::wgpu::{Error, Gpu};
 
+/// The testing aid `SDFC_FAULT_AFTER_TILES=N`: the GPU backends render N tiles, then report
+/// a device error for the next one through the path a real device error takes (wgpu:
+/// [`Error::Render`]; CUDA: a driver error), so that tests can check what a failure
+/// mid-render leaves behind. Unset (or not a number), nothing is injected.
+pub const FAULT_AFTER_TILES: &str = "SDFC_FAULT_AFTER_TILES";
+
+/// The number of tiles after which to inject a device error, from [`FAULT_AFTER_TILES`].
+pub(crate) fn fault_after_tiles() -> Option<usize> {
+    std::env::var(FAULT_AFTER_TILES).ok()?.trim().parse().ok()
+}
+
+/// The message of the device error injected at tile `tile` (0-based), if one is.
+pub(crate) fn injected_fault(after: Option<usize>, tile: usize) -> Option<String> {
+    (after == Some(tile)).then(|| {
+        format!(
+            "device error injected at tile {} by {FAULT_AFTER_TILES}={tile} (a testing aid)",
+            tile + 1
+        )
+    })
+}
+
 /// Tile edge in pixels for GPU launches: 512×512 pixels per dispatch keeps each dispatch
 /// short (well under a driver watchdog's limit) while filling a large GPU.
 pub const TILE: u32 = 512;

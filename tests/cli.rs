@@ -409,6 +409,16 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("--limit aa=20"), "{err}");
+    for (set, flag) in [
+        ("max_steps=2000000", "--limit max_steps=2000000"),
+        ("max_depth=100", "--limit max_depth=100"),
+        ("width=20000", "--limit edge=20000"),
+    ] {
+        let out = sdfc(&d, &["render", "ball.sdf", "--set", set]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(flag), "{set}: {err}");
+    }
     let out = sdfc(
         &d,
         &[

@@ -234,18 +234,15 @@ impl Limits {
         format!("the limits are {}", names.join(", "))
     }
 
-    /// One line per limit: name, default and what it bounds (for `--help`).
+    /// A heading and one line per limit: name, default and what it bounds (for `--help`).
     pub fn table() -> String {
-        Limit::ALL
+        let row =
+            |name: &str, default: &str, what: &str| format!("{name:<11} {default:>10}  {what}");
+        let rows = Limit::ALL
             .iter()
-            .map(|l| {
-                format!(
-                    "{:<11} {:>10}  {}",
-                    l.name(),
-                    l.default_value(),
-                    l.describe()
-                )
-            })
+            .map(|l| row(l.name(), &l.default_value().to_string(), l.describe()));
+        std::iter::once(row("NAME", "DEFAULT", "BOUNDS"))
+            .chain(rows)
             .collect::<Vec<_>>()
             .join("\n")
     }

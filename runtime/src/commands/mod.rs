@@ -38,8 +38,7 @@ impl LimitArgs {
 fn limits_help() -> String {
     format!(
         "Set a resource limit (may be repeated). An input or render that exceeds a limit \
-         stops before any work with a message naming the flag that raises it.\n\n\
-         NAME        DEFAULT     BOUNDS\n{}",
+         stops before any work with a message naming the flag that raises it.\n\n{}",
         Limits::table()
     )
 }

@@ -228,7 +228,8 @@ fn combinations_vary_the_first_sweep_slowest() {
         parse_sweep("epsilon=1e-3,1e-4").expect("parses"),
         parse_sweep("relaxation=1,1.5").expect("parses"),
     ];
-    let all = pareto::combinations(&Settings::default(), &sweeps).expect("valid");
+    let all =
+        pareto::combinations(&Settings::default(), &sweeps, &Default::default()).expect("valid");
     let pairs: Vec<(f64, f64)> = all.iter().map(|s| (s.epsilon, s.relaxation)).collect();
     assert_eq!(pairs, [(1e-3, 1.0), (1e-3, 1.5), (1e-4, 1.0), (1e-4, 1.5)]);
     assert!(all

@@ -369,3 +369,212 @@ fn the_method_setting_and_what_check_says_about_it() {
     assert!(d.join("hard.png").exists());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn a_render_announces_its_memory_and_stops_above_the_memory_limit() {
+    let d = dir("memory");
+    scene_file(&d);
+    let out = sdfc(
+        &d,
+        &["render", "ball.sdf", "--backend", "cpu", "-o", "a.png"],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("render: 40x30, aa 1, cpu: allocating at most ") && err.contains(" MiB"),
+        "{err}"
+    );
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--limit",
+            "memory=1",
+            "--size",
+            "2000x2000",
+            "-o",
+            "b.png",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("more than the memory limit of 1 MiB") && err.contains("--limit memory="),
+        "{err}"
+    );
+    assert_eq!(entries(&d), ["a.png", "ball.sdf"], "no file written");
+}
+
+#[test]
+fn limits_are_set_by_name_and_named_when_exceeded() {
+    let d = dir("limits");
+    scene_file(&d);
+    let out = sdfc(&d, &["render", "ball.sdf", "--limit", "speed=3"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("unknown limit `speed`") && err.contains("fuel"),
+        "{err}"
+    );
+    for bad in ["aa=0", "aa=x", "aa"] {
+        let out = sdfc(&d, &["check", "ball.sdf", "--limit", bad]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+    }
+    // A loop over the objects limit: E0507 naming the flag, and the flag raises it.
+    let many = "scene { for i in 0..50 { sphere(0.1).translate(i, 0, 0); } }\n";
+    std::fs::write(d.join("many.sdf"), many).expect("write");
+    let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=20"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("E0507") && err.contains("--limit objects=40"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=50"]);
+    assert!(out.status.success());
+    // The render settings' limits: in the scene (E0400) and on the command line (exit 2).
+    let out = sdfc(&d, &["render", "ball.sdf", "--aa", "20"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--limit aa=20"), "{err}");
+    for (set, flag) in [
+        ("max_steps=2000000", "--limit max_steps=2000000"),
+        ("max_depth=100", "--limit max_depth=100"),
+        ("width=20000", "--limit edge=20000"),
+    ] {
+        let out = sdfc(&d, &["render", "ball.sdf", "--set", set]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(flag), "{set}: {err}");
+    }
+    let out = sdfc(
+        &d,
+        &[
+            "render", "ball.sdf", "--aa", "20", "--limit", "aa=20", "--size", "4x4",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The program limit, after lowering and before any output.
+    for args in [
+        &[
+            "compile",
+            "ball.sdf",
+            "--emit",
+            "wgsl",
+            "--limit",
+            "program=10",
+            "-o",
+            "k.wgsl",
+        ][..],
+        &["render", "ball.sdf", "--limit", "program=10", "-o", "p.png"],
+    ] {
+        let out = sdfc(&d, args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("E0507")
+                && err.contains("distance program has")
+                && err.contains("--limit program="),
+            "{err}"
+        );
+    }
+    assert_eq!(entries(&d), ["ball.png", "ball.sdf", "many.sdf"]);
+}
+
+#[test]
+fn debug_nan_paints_nan_pixels_magenta_in_the_written_image() {
+    let d = dir("debug-nan");
+    let scene = std::fs::canonicalize("../tests/in/ok/nan_at_run_time.sdf").expect("scene");
+    let scene = scene.to_string_lossy();
+    let magenta = |png: &str| {
+        let image = sdfc_runtime::image::read_png(&d.join(png)).expect("png");
+        image
+            .linear
+            .iter()
+            .filter(|c| c[0] > 0.99 && c[1] < 0.01 && c[2] > 0.99)
+            .count()
+    };
+    for (flag, png) in [(None, "plain.png"), (Some("--debug-nan"), "debug.png")] {
+        let mut args = vec!["render", &scene, "--backend", "cpu", "-o", png];
+        args.extend(flag);
+        let out = sdfc(&d, &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    assert_eq!(magenta("plain.png"), 0);
+    assert!(magenta("debug.png") > 100);
+}
+
+/// Whether `sdfc` finds a wgpu adapter here; if not, the caller skips (saying so) unless
+/// SDFC_REQUIRE_DEVICES=1 (set by CI, which installs lavapipe).
+fn wgpu_available(d: &Path) -> bool {
+    let out = sdfc(
+        d,
+        &[
+            "render",
+            "ball.sdf",
+            "--backend",
+            "wgpu",
+            "--size",
+            "8x8",
+            "-o",
+            "probe.png",
+        ],
+    );
+    let _ = std::fs::remove_file(d.join("probe.png"));
+    if out.status.success() {
+        return true;
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+        "SDFC_REQUIRE_DEVICES=1 but wgpu failed: {err}"
+    );
+    println!("SKIPPED: no wgpu adapter: {err}");
+    false
+}
+
+#[test]
+fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
+    let d = dir("gpu-fault");
+    scene_file(&d);
+    if !wgpu_available(&d) {
+        return;
+    }
+    // 1100x40 is three tiles of 512 pixels: the second fails after the first rendered.
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args([
+            "render",
+            "ball.sdf",
+            "--backend",
+            "wgpu",
+            "--size",
+            "1100x40",
+        ])
+        .args(["-o", "fault.png"])
+        .env("SDFC_FAULT_AFTER_TILES", "1")
+        // Mesa's window-system code complains on stderr without it.
+        .env("XDG_RUNTIME_DIR", &d)
+        .output()
+        .expect("run sdfc");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(
+        errors,
+        ["error: GPU error while rendering: device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1 (a testing aid)"],
+        "{err}"
+    );
+    assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
+}

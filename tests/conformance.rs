@@ -85,3 +85,43 @@ fn wgpu_matches_cpu_on_every_example() {
         failures.join("\n")
     );
 }
+
+/// `--debug-nan` on wgpu: the kernel's `DEBUG_NAN` feature paints the same pixels magenta
+/// as the CPU renderer; without it the kernel is the default one and paints none.
+#[test]
+fn debug_nan_marks_the_same_pixels_on_wgpu() {
+    let Some(gpu) = open_gpu() else { return };
+    let path = PathBuf::from("../tests/in/ok/nan_at_run_time.sdf");
+    let scene = frontend::load(&path)
+        .expect("readable")
+        .scene
+        .expect("valid scene");
+    let program = lower::lower(&scene);
+    let magenta = |image: &sdfc_runtime::image::Image| -> Vec<bool> {
+        image.linear.iter().map(|&c| c == cpu::NAN_COLOUR).collect()
+    };
+    let plain_kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(!plain_kernel.source.contains("DEBUG_NAN"));
+    let plain = gpu::render(&gpu, &scene, &plain_kernel, 1.0, &mut |_| {}).expect("render");
+    assert!(plain.render.stats.counters.nans > 0, "no NaN on the GPU");
+    assert!(!magenta(&plain.render.image).contains(&true));
+    let options = wgsl::Options { debug_nan: true };
+    let kernel = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
+    assert!(kernel.source.contains("+DEBUG_NAN"));
+    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("render");
+    let cpu_options = cpu::Options {
+        debug_nan: true,
+        ..cpu::Options::default()
+    };
+    let on_cpu = cpu::render(&scene, &program, &cpu_options, &|| {});
+    let (g, c) = (magenta(&on_gpu.render.image), magenta(&on_cpu.image));
+    let differ = g.iter().zip(&c).filter(|(a, b)| a != b).count();
+    let marked = g.iter().filter(|&&m| m).count();
+    println!("debug-nan: {marked} magenta pixels on wgpu, {differ} differ from the CPU");
+    assert!(marked > 0);
+    assert!(
+        differ * 50 <= g.len(),
+        "{differ} of {} pixels differ",
+        g.len()
+    );
+}

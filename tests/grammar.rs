@@ -883,3 +883,19 @@ fn every_diagnostic_code_is_documented_with_an_example() {
         );
     }
 }
+
+#[test]
+fn the_failure_paths_list_every_limit_with_its_default() {
+    let doc = read("docs/failures.md");
+    for limit in sdfc_compiler::Limit::ALL {
+        let row = doc
+            .lines()
+            .find(|l| l.starts_with(&format!("| `{}` |", limit.name())))
+            .unwrap_or_else(|| panic!("docs/failures.md has no row for the limit {limit}"));
+        assert!(
+            row.contains(&format!("| {} |", limit.default_value())),
+            "docs/failures.md gives the limit {limit} another default than {}",
+            limit.default_value()
+        );
+    }
+}

@@ -752,3 +752,20 @@ fn example_scenes_assemble() {
         }
     }
 }
+
+/// `--debug-nan` reaches CUDA through the same kernel: its `DEBUG_NAN` feature translates.
+#[test]
+fn the_debug_nan_kernel_assembles() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/in/ok/nan_at_run_time.sdf");
+    let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+    let program = sdfc_compiler::lower::lower(&scene);
+    let debug = sdfc_compiler::back::wgsl::Options { debug_nan: true };
+    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &program, &debug).unwrap();
+    let plain = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+    let without = ptx::write(&plain.module, &plain.info, &options(80)).unwrap();
+    assert_ne!(text, without, "the feature changes the kernel");
+    if let Some(p) = ptxas() {
+        println!("    {}", summary(&assemble(&p, &text, "debug_nan", 80)));
+    }
+}

@@ -394,3 +394,75 @@ fn a_tiny_step_budget_misses_by_budget() {
     assert!(r.stats.counters.budget_misses > 0);
     assert_eq!(r.stats.steps_max, 2);
 }
+
+/// The scene of `tests/in/ok/nan_at_run_time.sdf`: NaN at run time in f32, beyond about 1.8
+/// from the origin, with finite constants.
+fn nan_scene() -> Scene {
+    let text = std::fs::read_to_string("../tests/in/ok/nan_at_run_time.sdf").expect("scene");
+    let (scene, diags, _) = sdfc_compiler::check::check_str("nan.sdf", &text);
+    scene.unwrap_or_else(|| panic!("{diags:?}"))
+}
+
+fn is_magenta(c: [f32; 3]) -> bool {
+    c == cpu::NAN_COLOUR
+}
+
+#[test]
+fn debug_nan_paints_the_pixels_whose_rays_met_nan_magenta() {
+    let scene = nan_scene();
+    let plain = render(&scene);
+    assert!(plain.stats.counters.nans > 0, "the scene meets no NaN");
+    assert!(!plain.image.linear.iter().any(|&c| is_magenta(c)));
+    let debug = cpu::render(
+        &scene,
+        &lower(&scene),
+        &Options {
+            debug_nan: true,
+            ..Options::default()
+        },
+        &|| {},
+    );
+    assert_eq!(debug.stats, plain.stats);
+    let background = scene.settings.background.map(|x| x as f32);
+    let mut magenta = 0;
+    for (&d, &p) in debug.image.linear.iter().zip(&plain.image.linear) {
+        if is_magenta(d) {
+            magenta += 1;
+            // Here the camera ray met the NaN: without the flag it shows the background.
+            assert_eq!(p, background);
+        } else {
+            assert_eq!(d, p, "a pixel without NaN changed");
+        }
+    }
+    let pixels = plain.image.linear.len();
+    assert!(
+        magenta > pixels / 10 && magenta < pixels / 2,
+        "{magenta} of {pixels} pixels are magenta"
+    );
+    // In f64 nothing overflows: no NaN, nothing painted.
+    let f64 = cpu::render(
+        &scene,
+        &lower(&scene),
+        &Options {
+            debug_nan: true,
+            precision: Precision::F64,
+            ..Options::default()
+        },
+        &|| {},
+    );
+    assert_eq!(f64.stats.counters.nans, 0);
+    assert!(!f64.image.linear.iter().any(|&c| is_magenta(c)));
+}
+
+#[test]
+fn debug_nan_leaves_an_image_without_nan_unchanged() {
+    let scene = busy();
+    let debug = Options {
+        debug_nan: true,
+        ..Options::default()
+    };
+    let with = render_with(&scene, &debug, 2);
+    let without = render_with(&scene, &Options::default(), 2);
+    assert_eq!(with.stats.counters.nans, 0);
+    assert!(with.image == without.image);
+}

@@ -21,10 +21,12 @@ pub mod back;
 pub mod check;
 pub mod diagnostics;
 pub mod eval;
+pub mod limits;
 pub mod lower;
 pub mod scene;
 pub mod span;
 pub mod syntax;
 
 pub use diagnostics::{Diagnostic, Severity};
+pub use limits::{Limit, Limits};
 pub use span::{FileId, SourceMap, Span};

@@ -1,12 +1,14 @@
 //! Backends behind one interface: a scene is prepared once for a backend (program lowered,
-//! kernel generated, device opened, module loaded) and then rendered any number of times.
+//! tapes or kernel generated, device opened, module loaded) and then rendered any number of
+//! times; what a render allocates is known before it starts ([`Prepared::memory`]).
 
-use crate::cpu::{self, Options, Precision, Render};
+use crate::cpu::{self, Options, Precision, Render, Tapes};
 use crate::gpu::{self, cuda::Cuda, Gpu};
+use crate::memory::Memory;
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, Program};
 use sdfc_compiler::scene::analytic::{self, Choice};
-use sdfc_compiler::scene::{analysis, Method, Scene};
+use sdfc_compiler::scene::{analysis, Method, Scene, Settings};
 use std::time::{Duration, Instant};
 
 /// Where a scene is rendered.
@@ -23,11 +25,24 @@ pub enum Backend {
     Cuda,
 }
 
+/// How a scene is prepared, besides the backend.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Setup {
+    /// Float type of the CPU renderer (the GPU backends are f32).
+    pub precision: Precision,
+    /// Paint pixels whose rays met a NaN magenta (`--debug-nan`).
+    pub debug_nan: bool,
+}
+
 /// A scene prepared for one backend.
 #[derive(Debug)]
 pub enum Prepared {
-    /// CPU: the distance program and the render options.
-    Cpu { program: Program, options: Options },
+    /// CPU: the distance program, its tapes and the render options.
+    Cpu {
+        program: Program,
+        tapes: Box<Tapes>,
+        options: Options,
+    },
     /// wgpu: the device, the validated kernel and the scene's Lipschitz bound L.
     Wgpu {
         gpu: Box<Gpu>,
@@ -71,15 +86,31 @@ pub fn method_allowed(scene: &Scene) -> Result<(), String> {
 impl Prepared {
     /// Prepares `scene` for `backend`. `Err` says why the backend cannot be used.
     pub fn new(backend: Backend, scene: &Scene, precision: Precision) -> Result<Prepared, String> {
+        let setup = Setup {
+            precision,
+            ..Setup::default()
+        };
+        Self::from_program(backend, scene, lower::lower(scene), &setup)
+    }
+
+    /// Prepares `scene`, whose distance program is `program`, for `backend`.
+    pub fn from_program(
+        backend: Backend,
+        scene: &Scene,
+        program: Program,
+        setup: &Setup,
+    ) -> Result<Prepared, String> {
         method_allowed(scene)?;
         match backend {
-            Backend::Cpu => Ok(Self::cpu(scene, precision)),
-            Backend::Wgpu => Self::wgpu(scene, false),
-            Backend::Cuda => Self::cuda(scene),
-            Backend::Auto if precision == Precision::F64 => Ok(Self::cpu(scene, precision)),
-            Backend::Auto => Self::cuda(scene)
-                .or_else(|_| Self::wgpu(scene, true))
-                .or_else(|_| Ok(Self::cpu(scene, precision))),
+            Backend::Cpu => Ok(Self::cpu(scene, program, setup)),
+            Backend::Wgpu => Self::wgpu(scene, &program, setup, false),
+            Backend::Cuda => Self::cuda(scene, &program, setup),
+            Backend::Auto if setup.precision == Precision::F64 => {
+                Ok(Self::cpu(scene, program, setup))
+            }
+            Backend::Auto => Self::cuda(scene, &program, setup)
+                .or_else(|_| Self::wgpu(scene, &program, setup, true))
+                .or_else(|_| Ok(Self::cpu(scene, program, setup))),
         }
     }
 
@@ -88,35 +119,45 @@ impl Prepared {
         analysis::analyse(scene).step_lipschitz()
     }
 
-    fn cpu(scene: &Scene, precision: Precision) -> Prepared {
+    fn cpu(scene: &Scene, program: Program, setup: &Setup) -> Prepared {
         let options = Options {
-            precision,
+            precision: setup.precision,
+            debug_nan: setup.debug_nan,
             lipschitz: Self::lipschitz(scene),
             ..Options::default()
         };
         Prepared::Cpu {
-            program: lower::lower(scene),
+            tapes: Box::new(Tapes::new(&program)),
+            program,
             options,
         }
     }
 
-    fn kernel(scene: &Scene) -> Result<wgsl::Kernel, String> {
-        wgsl::write(scene, &lower::lower(scene)).map_err(|e| e.to_string())
+    fn kernel(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Kernel, String> {
+        let options = wgsl::Options {
+            debug_nan: setup.debug_nan,
+        };
+        wgsl::write_with(scene, program, &options).map_err(|e| e.to_string())
     }
 
-    fn wgpu(scene: &Scene, require_hardware: bool) -> Result<Prepared, String> {
+    fn wgpu(
+        scene: &Scene,
+        program: &Program,
+        setup: &Setup,
+        require_hardware: bool,
+    ) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
         let lipschitz = Self::lipschitz(scene);
         Ok(Prepared::Wgpu {
             gpu: Box::new(gpu),
-            kernel: Box::new(Self::kernel(scene)?),
+            kernel: Box::new(Self::kernel(scene, program, setup)?),
             lipschitz,
         })
     }
 
-    fn cuda(scene: &Scene) -> Result<Prepared, String> {
+    fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
-        let kernel = Self::kernel(scene)?;
+        let kernel = Self::kernel(scene, program, setup)?;
         let start = Instant::now();
         let options = ptx::Options {
             sm: cuda.sm,
@@ -172,6 +213,29 @@ impl Prepared {
         }
     }
 
+    /// The most memory rendering `settings` allocates (with the current pool's threads on
+    /// the CPU), the finished frame included.
+    pub fn memory(&self, scene: &Scene, settings: &Settings) -> Memory {
+        let mut at = scene.clone();
+        at.settings = settings.clone();
+        match self {
+            Prepared::Cpu { tapes, options, .. } => Memory {
+                host: cpu::memory(&at, tapes, options, rayon::current_num_threads()),
+                device: 0,
+            },
+            Prepared::Wgpu { .. } => gpu::memory_wgpu(settings, uniforms(&at)),
+            Prepared::Cuda { .. } => gpu::memory_cuda(settings, uniforms(&at)),
+        }
+    }
+
+    /// The bytes a finished frame holds (its image and, on the CPU, its depth buffers).
+    pub fn retained(&self, settings: &Settings) -> u64 {
+        match self {
+            Prepared::Cpu { .. } => cpu::retained(settings),
+            _ => gpu::retained(settings),
+        }
+    }
+
     /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
     pub fn program_len(&self, scene: &Scene) -> usize {
         match self {
@@ -183,11 +247,11 @@ impl Prepared {
     /// Renders one frame; `progress` gets the fraction done.
     pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, String> {
         match self {
-            Prepared::Cpu { program, options } => {
+            Prepared::Cpu { tapes, options, .. } => {
                 let tiles = cpu::tile_count(&scene.settings, options).max(1) as f64;
                 let done = std::sync::atomic::AtomicU64::new(0);
                 let start = Instant::now();
-                let render = cpu::render(scene, program, options, &|| {
+                let render = cpu::render_tapes(scene, tapes, options, &|| {
                     let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     progress(n as f64 / tiles);
                 });
@@ -228,4 +292,9 @@ impl Prepared {
             }
         }
     }
+}
+
+/// Bytes of the scene uniform of the GPU kernels.
+fn uniforms(scene: &Scene) -> u64 {
+    wgsl::uniforms(scene, 1.0).len() as u64
 }

@@ -1,12 +1,14 @@
-//! Reading scenes from disk: the file-system import loader, and the shared "load, check and
-//! report" step of every subcommand.
+//! Reading scenes from disk: the file-system import loader, and the shared "load, check,
+//! report and lower" steps of every subcommand.
 
 use sdfc_compiler::check::{self, Loader};
 use sdfc_compiler::diagnostics::{self, Diagnostic};
+use sdfc_compiler::lower::{self, LowerOptions, Program};
 use sdfc_compiler::scene::Scene;
-use sdfc_compiler::SourceMap;
+use sdfc_compiler::{Limits, SourceMap};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 
 /// How diagnostics are printed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Default)]
@@ -64,9 +66,14 @@ pub struct Loaded {
     pub sources: SourceMap,
 }
 
-/// Reads `path` and checks it. `Err` is an IO or encoding problem with the entry file itself,
-/// already phrased for the user.
+/// Reads `path` and checks it within the default limits. `Err` is an IO or encoding problem
+/// with the entry file itself, already phrased for the user.
 pub fn load(path: &Path) -> Result<Loaded, String> {
+    load_with(path, &Limits::default())
+}
+
+/// [`load`] within the given limits.
+pub fn load_with(path: &Path, limits: &Limits) -> Result<Loaded, String> {
     let bytes =
         std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
     let text = String::from_utf8(bytes).map_err(|e| {
@@ -78,7 +85,7 @@ pub fn load(path: &Path) -> Result<Loaded, String> {
     })?;
     let mut sources = SourceMap::new();
     let entry = sources.add(normalise(path), text);
-    let (scene, diagnostics) = check::check(&mut sources, entry, &mut FsLoader);
+    let (scene, diagnostics) = check::check_with(&mut sources, entry, &mut FsLoader, limits);
     Ok(Loaded {
         scene,
         diagnostics,
@@ -88,30 +95,71 @@ pub fn load(path: &Path) -> Result<Loaded, String> {
 
 /// Prints diagnostics to stderr in the chosen format.
 pub fn report(loaded: &Loaded, format: DiagnosticFormat) {
-    if loaded.diagnostics.is_empty() {
+    print_diagnostics(&loaded.diagnostics, &loaded.sources, format);
+}
+
+/// Prints `diags` about `sources` to stderr in the chosen format.
+pub fn print_diagnostics(diags: &[Diagnostic], sources: &SourceMap, format: DiagnosticFormat) {
+    if diags.is_empty() {
         return;
     }
     let text = match format {
-        DiagnosticFormat::Human => diagnostics::render(
-            &loaded.diagnostics,
-            &loaded.sources,
-            std::io::stderr().is_terminal(),
-        ),
-        DiagnosticFormat::Json => diagnostics::to_json(&loaded.diagnostics, &loaded.sources),
+        DiagnosticFormat::Human => {
+            diagnostics::render(diags, sources, std::io::stderr().is_terminal())
+        }
+        DiagnosticFormat::Json => diagnostics::to_json(diags, sources),
     };
     eprint!("{text}");
 }
 
-/// Loads, checks and reports; returns the scene, or the exit code to stop with (1 for errors
-/// in the scene, 2 for IO problems).
-pub fn load_scene(path: &Path, format: DiagnosticFormat) -> Result<Scene, std::process::ExitCode> {
-    let loaded = match load(path) {
+/// A scene that checked without errors, with the files it was read from (for the
+/// diagnostics of later stages).
+#[derive(Debug)]
+pub struct Checked {
+    /// The scene.
+    pub scene: Scene,
+    /// The files it was read from.
+    pub sources: SourceMap,
+    /// How diagnostics are printed.
+    pub format: DiagnosticFormat,
+}
+
+impl Checked {
+    /// Lowers the scene. A program larger than the `program` limit is reported (E0507) and
+    /// gives exit code 1, before any back end or render starts.
+    pub fn lower(&self, options: &LowerOptions, limits: &Limits) -> Result<Program, ExitCode> {
+        let program = lower::lower_with(&self.scene, options);
+        match lower::check_size(&self.scene, &program, limits) {
+            Ok(()) => Ok(program),
+            Err(d) => {
+                print_diagnostics(&[d], &self.sources, self.format);
+                Err(ExitCode::from(1))
+            }
+        }
+    }
+}
+
+/// Loads, checks within `limits` and reports; returns the checked scene, or the exit code to
+/// stop with (1 for errors in the scene, 2 for IO problems).
+pub fn load_scene(
+    path: &Path,
+    format: DiagnosticFormat,
+    limits: &Limits,
+) -> Result<Checked, ExitCode> {
+    let loaded = match load_with(path, limits) {
         Ok(l) => l,
         Err(msg) => {
             eprintln!("error: {msg}");
-            return Err(std::process::ExitCode::from(2));
+            return Err(ExitCode::from(2));
         }
     };
     report(&loaded, format);
-    loaded.scene.ok_or(std::process::ExitCode::from(1))
+    match loaded.scene {
+        Some(scene) => Ok(Checked {
+            scene,
+            sources: loaded.sources,
+            format,
+        }),
+        None => Err(ExitCode::from(1)),
+    }
 }

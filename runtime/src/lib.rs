@@ -10,4 +10,5 @@ pub mod fp32;
 pub mod frontend;
 pub mod gpu;
 pub mod image;
+pub mod memory;
 pub mod metrics;

@@ -2,6 +2,7 @@
 //! their constant evaluation. Shape builtins add nodes to the scene graph.
 
 use super::types::{Type, Value};
+use crate::limits::{Limit, Limits};
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
 use crate::span::Span;
 
@@ -51,13 +52,35 @@ pub enum Range {
     NonZero,
     /// One of the listed strings.
     OneOf(&'static [&'static str]),
+    /// In [lo, the value of a resource limit] (the render settings bounded by `--limit`).
+    Limited(f64, Limit),
 }
 
 impl Range {
+    /// The range with its resource limit, if any, replaced by the limit's value.
+    pub fn resolve(self, limits: &Limits) -> Range {
+        match self {
+            Range::Limited(lo, l) => Range::Within(lo, limits.get(l) as f64),
+            other => other,
+        }
+    }
+
+    /// The resource limit a value beyond the top of this range exceeds.
+    pub fn limit(self, v: &Value, limits: &Limits) -> Option<Limit> {
+        match self {
+            Range::Limited(_, l) => {
+                let top = limits.get(l) as f64;
+                v.components().iter().any(|&x| x > top).then_some(l)
+            }
+            _ => None,
+        }
+    }
+
     /// Checks a concrete value; returns what was expected when it is out of range.
-    pub fn check(self, v: &Value) -> Result<(), String> {
+    pub fn check(self, v: &Value, limits: &Limits) -> Result<(), String> {
+        let range = self.resolve(limits);
         let c = v.components();
-        let ok = match self {
+        let ok = match range {
             Range::Any => true,
             Range::Pos => c.iter().all(|&x| x > 0.0),
             Range::NonNeg => c.iter().all(|&x| x >= 0.0),
@@ -68,6 +91,7 @@ impl Range {
                 Value::Str(s) => opts.contains(&&**s),
                 _ => true,
             },
+            Range::Limited(..) => true,
         };
         if ok {
             return Ok(());
@@ -79,8 +103,8 @@ impl Range {
             Value::Angle(_) => format!("{}deg", crate::scene::dump_num(x.to_degrees())),
             _ => crate::scene::dump_num(x),
         };
-        Err(match self {
-            Range::Any => String::new(),
+        Err(match range {
+            Range::Any | Range::Limited(..) => String::new(),
             Range::Pos => format!("{each}must be greater than 0"),
             Range::NonNeg => format!("{each}must be 0 or more"),
             Range::Unit => format!("{each}must be between 0 and 1"),
@@ -810,12 +834,12 @@ pub static CAMERA: Record = Record {
 pub static RENDER: Record = Record {
     name: "render",
     fields: &[
-        p("width", I, Int(640), Within(1.0, 16384.0)),
-        p("height", I, Int(480), Within(1.0, 16384.0)),
-        p("aa", I, Int(1), Within(1.0, 16.0)),
-        p("max_steps", I, Int(512), Within(1.0, 1_000_000.0)),
+        p("width", I, Int(640), Limited(1.0, Limit::Edge)),
+        p("height", I, Int(480), Limited(1.0, Limit::Edge)),
+        p("aa", I, Int(1), Limited(1.0, Limit::Aa)),
+        p("max_steps", I, Int(512), Limited(1.0, Limit::MaxSteps)),
         p("epsilon", F, Num(1e-5), Within(1e-9, 0.5)),
-        p("max_depth", I, Int(5), Within(0.0, 64.0)),
+        p("max_depth", I, Int(5), Limited(0.0, Limit::MaxDepth)),
         p("max_dist", F, Num(100.0), Within(1e-6, 1e9)),
         p("relaxation", F, Num(1.4), Within(1.0, 1.99)),
         p("background", V, V3([0.05, 0.06, 0.08]), NonNeg),

@@ -7,20 +7,12 @@ use super::ops;
 use super::suggest::closest;
 use super::types::{Type, Value};
 use crate::diagnostics::Diagnostic;
+use crate::limits::{Limit, Limits};
 use crate::scene::{Graph, MaterialId, Node};
 use crate::span::Span;
 use crate::syntax::ast::*;
 use std::collections::HashMap;
 use std::rc::Rc;
-
-/// Limits that keep evaluation bounded on any input.
-pub const MAX_CALL_DEPTH: usize = 256;
-/// The most shape nodes a scene may build.
-pub const MAX_NODES: usize = 1_000_000;
-/// The deepest expression nesting evaluated (deeper is an error, not a crash).
-pub const MAX_NESTING: usize = 1_000;
-/// The most evaluation steps (expressions and loop iterations) one compilation may take.
-pub const MAX_FUEL: u64 = 50_000_000;
 
 /// A user function and what checking its body found.
 #[derive(Debug)]
@@ -53,8 +45,10 @@ pub struct Ctx {
     dry: u32,
     depth: usize,
     nesting: usize,
-    /// Evaluation steps taken (bounded by [`MAX_FUEL`]).
+    /// Evaluation steps taken (bounded by the `fuel` limit).
     pub fuel: u64,
+    /// The resource limits of this compilation: evaluation stays within them on any input.
+    pub limits: Limits,
     reported_limit: bool,
     /// Results of calls of user functions on concrete arguments: functions are pure, so a
     /// call repeated with the same arguments is evaluated once.
@@ -84,10 +78,12 @@ impl Ctx {
 
     /// Evaluates `e`, within the nesting and fuel limits.
     pub fn expr(&mut self, e: &Expr) -> Value {
-        if self.nesting >= MAX_NESTING {
+        let max = self.limits.count(Limit::Nesting);
+        if self.nesting >= max {
             self.limit(
+                Limit::Nesting,
                 e.span,
-                format!("expressions nest more than {MAX_NESTING} levels deep"),
+                format!("expressions nest more than {max} levels deep"),
             );
             return Value::Error;
         }
@@ -104,10 +100,12 @@ impl Ctx {
     /// Spends one evaluation step; false (and a report) once the budget is spent.
     pub fn burn(&mut self, span: Span) -> bool {
         self.fuel += 1;
-        if self.fuel > MAX_FUEL {
+        let max = self.limits.get(Limit::Fuel);
+        if self.fuel > max {
             self.limit(
+                Limit::Fuel,
                 span,
-                format!("evaluating the scene takes more than {MAX_FUEL} steps"),
+                format!("evaluating the scene takes more than {max} steps"),
             );
             return false;
         }
@@ -553,24 +551,35 @@ impl Ctx {
 
     /// Adds a node unless the node budget is spent.
     pub fn add_node(&mut self, node: Node, span: Span) -> Value {
-        if self.graph.len() >= MAX_NODES {
-            self.limit(
-                span,
-                format!("the scene has more than {MAX_NODES} shape nodes"),
-            );
+        if self.nodes_exhausted(span) {
             return Value::Error;
         }
         Value::Shape(self.graph.add(node, span))
     }
 
-    /// Reports a resource limit once.
-    pub fn limit(&mut self, span: Span, msg: String) {
+    /// Whether the node budget is spent (reported once).
+    fn nodes_exhausted(&mut self, span: Span) -> bool {
+        let max = self.limits.count(Limit::Nodes);
+        if self.graph.len() < max {
+            return false;
+        }
+        self.limit(
+            Limit::Nodes,
+            span,
+            format!("the scene has more than {max} shape nodes"),
+        );
+        true
+    }
+
+    /// Reports an exceeded resource limit once, naming the flag that raises it.
+    pub fn limit(&mut self, limit: Limit, span: Span, msg: String) {
         if !self.reported_limit {
             self.reported_limit = true;
-            self.error(
-                Diagnostic::error("E0507", msg, span)
-                    .with_note("this limit keeps compilation bounded"),
+            let note = format!(
+                "this limit keeps compilation bounded; {}",
+                self.limits.raise(limit)
             );
+            self.error(Diagnostic::error("E0507", msg, span).with_note(note));
         }
     }
 
@@ -702,11 +711,7 @@ impl Ctx {
                 Value::Unknown(sig.ret)
             };
         }
-        if sig.ret == Type::Shape && self.graph.len() >= MAX_NODES {
-            self.limit(
-                span,
-                format!("the scene has more than {MAX_NODES} shape nodes"),
-            );
+        if sig.ret == Type::Shape && self.nodes_exhausted(span) {
             return Value::Error;
         }
         let mut build = Build {
@@ -729,7 +734,7 @@ impl Ctx {
         if v.is_abstract() || p.range == Range::Any || self.dry > 0 {
             return true;
         }
-        match p.range.check(v) {
+        match p.range.check(v, &self.limits) {
             Ok(()) => true,
             Err(why) => {
                 self.error(
@@ -785,8 +790,13 @@ impl Ctx {
         if self.dry > 0 {
             return Value::Unknown(ret);
         }
-        if self.depth >= MAX_CALL_DEPTH {
-            self.limit(span, format!("calls nest deeper than {MAX_CALL_DEPTH}"));
+        let max = self.limits.count(Limit::CallDepth);
+        if self.depth >= max {
+            self.limit(
+                Limit::CallDepth,
+                span,
+                format!("calls nest deeper than {max}"),
+            );
             return Value::Error;
         }
         // Defaults are evaluated in the global scope; the body sees its parameters and the
@@ -1115,11 +1125,17 @@ pub fn record(
             }
         };
         if !v.is_abstract() {
-            if let Err(why) = p.range.check(&v) {
-                cx.error(
-                    Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span)
-                        .with_label(format!("this is {v}")),
-                );
+            if let Err(why) = p.range.check(&v, &cx.limits) {
+                let mut d = Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span)
+                    .with_label(format!("this is {v}"));
+                if let Some(limit) = p.range.limit(&v, &cx.limits) {
+                    let needed = v.components().into_iter().fold(0.0, f64::max) as u64;
+                    d = d.with_note(format!(
+                        "this limit keeps rendering bounded; {}",
+                        cx.limits.raise_to(limit, needed)
+                    ));
+                }
+                cx.error(d);
                 out.insert(p.name, Value::Error);
                 continue;
             }

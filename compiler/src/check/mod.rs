@@ -12,6 +12,7 @@ mod suggest;
 pub mod types;
 
 use crate::diagnostics::Diagnostic;
+use crate::limits::{Limit, Limits};
 use crate::scene::{
     Camera, Combine, Light, Material, MaterialId, Method, Node, Pattern, Scene, Settings,
 };
@@ -21,13 +22,6 @@ use eval::{Ctx, FnInfo};
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 use types::{Type, Value};
-
-pub use eval::{MAX_CALL_DEPTH, MAX_NODES};
-
-/// The most files one compilation may import, in all.
-pub const MAX_FILES: usize = 256;
-/// The most objects a `scene` block may add (loops included).
-pub const MAX_OBJECTS: usize = 100_000;
 
 /// Reads imported files for the checker (the compiler itself does no IO).
 pub trait Loader {
@@ -47,17 +41,35 @@ impl Loader for NoImports {
     }
 }
 
-/// Checks the file `entry` of `sources` and everything it imports (added to `sources`).
-/// Returns the scene when there are no errors, and all diagnostics.
+/// Checks the file `entry` of `sources` and everything it imports (added to `sources`),
+/// within the default [`Limits`]. Returns the scene when there are no errors, and all
+/// diagnostics.
 pub fn check(
     sources: &mut SourceMap,
     entry: FileId,
     loader: &mut dyn Loader,
 ) -> (Option<Scene>, Vec<Diagnostic>) {
+    check_with(sources, entry, loader, &Limits::default())
+}
+
+/// [`check`] within the given limits (`--limit`).
+pub fn check_with(
+    sources: &mut SourceMap,
+    entry: FileId,
+    loader: &mut dyn Loader,
+    limits: &Limits,
+) -> (Option<Scene>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut items = Vec::new();
-    let mut stack = Vec::new();
-    load_file(sources, entry, loader, &mut stack, &mut items, &mut diags);
+    let mut load = Load {
+        sources,
+        loader,
+        limits,
+        stack: Vec::new(),
+        items: &mut items,
+        diags: &mut diags,
+    };
+    load.file(entry);
     if crate::diagnostics::has_errors(&diags) {
         // After a lexical, syntax or import error, names and items may be missing: checking
         // would report mistakes that are only echoes of the first ones.
@@ -66,6 +78,7 @@ pub fn check(
     }
     let mut cx = Ctx::default();
     cx.diags = diags;
+    cx.limits = limits.clone();
     let scene = check_items(&mut cx, &items, entry);
     if !crate::diagnostics::has_errors(&cx.diags) {
         // Distance semantics: warnings where a construct makes the field unreliable.
@@ -110,76 +123,78 @@ pub fn check_str(name: &str, text: &str) -> (Option<Scene>, Vec<Diagnostic>, Sou
     (scene, diags, sources)
 }
 
-/// Parses `file`, then its imports in place (depth first), appending items in order.
-fn load_file(
-    sources: &mut SourceMap,
-    file: FileId,
-    loader: &mut dyn Loader,
-    stack: &mut Vec<FileId>,
-    items: &mut Vec<ast::Item>,
-    diags: &mut Vec<Diagnostic>,
-) {
-    stack.push(file);
-    let text = sources.text(file).to_string();
-    let (ast, parse_diags) = syntax::parse(file, &text);
-    diags.extend(parse_diags);
-    for item in ast.items {
-        if let ast::Item::Import { path, span } = &item {
-            import(sources, file, path, *span, loader, stack, items, diags);
-        } else {
-            items.push(item);
-        }
-    }
-    stack.pop();
+/// The files of one compilation being read: parsed in place of their imports, depth
+/// first, with their items appended in order.
+struct Load<'a> {
+    sources: &'a mut SourceMap,
+    loader: &'a mut dyn Loader,
+    limits: &'a Limits,
+    /// The files being imported, outermost first (a file found here again is a cycle).
+    stack: Vec<FileId>,
+    items: &'a mut Vec<ast::Item>,
+    diags: &'a mut Vec<Diagnostic>,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn import(
-    sources: &mut SourceMap,
-    from: FileId,
-    path: &str,
-    span: Span,
-    loader: &mut dyn Loader,
-    stack: &mut Vec<FileId>,
-    items: &mut Vec<ast::Item>,
-    diags: &mut Vec<Diagnostic>,
-) {
-    let from_name = sources.name(from).to_string();
-    let (name, text) = match loader.load(&from_name, path) {
-        Ok(x) => x,
-        Err(msg) => {
-            diags.push(
-                Diagnostic::error("E0501", format!("cannot import `{path}`"), span).with_label(msg),
+impl Load<'_> {
+    /// Parses `file`, then its imports in place (depth first), appending items in order.
+    fn file(&mut self, file: FileId) {
+        self.stack.push(file);
+        let text = self.sources.text(file).to_string();
+        let (ast, parse_diags) = syntax::parse(file, &text);
+        self.diags.extend(parse_diags);
+        for item in ast.items {
+            if let ast::Item::Import { path, span } = &item {
+                self.import(file, path, *span);
+            } else {
+                self.items.push(item);
+            }
+        }
+        self.stack.pop();
+    }
+
+    fn import(&mut self, from: FileId, path: &str, span: Span) {
+        let from_name = self.sources.name(from).to_string();
+        let (name, text) = match self.loader.load(&from_name, path) {
+            Ok(x) => x,
+            Err(msg) => {
+                self.diags.push(
+                    Diagnostic::error("E0501", format!("cannot import `{path}`"), span)
+                        .with_label(msg),
+                );
+                return;
+            }
+        };
+        if let Some(existing) = self.sources.find(&name) {
+            if self.stack.contains(&existing) {
+                let chain: Vec<&str> = self
+                    .stack
+                    .iter()
+                    .map(|f| self.sources.name(*f))
+                    .chain([name.as_str()])
+                    .collect();
+                self.diags.push(
+                    Diagnostic::error("E0500", "import cycle", span)
+                        .with_label(format!("`{path}` is already being imported"))
+                        .with_note(format!("the cycle is {}", chain.join(" → "))),
+                );
+            }
+            // A file imported twice (not in a cycle) is read once.
+            return;
+        }
+        let max = self.limits.count(Limit::Files);
+        if self.sources.len() >= max {
+            self.diags.push(
+                Diagnostic::error("E0507", format!("more than {max} files are imported"), span)
+                    .with_note(format!(
+                        "this limit keeps compilation bounded; {}",
+                        self.limits.raise(Limit::Files)
+                    )),
             );
             return;
         }
-    };
-    if let Some(existing) = sources.find(&name) {
-        if stack.contains(&existing) {
-            let chain: Vec<&str> = stack
-                .iter()
-                .map(|f| sources.name(*f))
-                .chain([name.as_str()])
-                .collect();
-            diags.push(
-                Diagnostic::error("E0500", "import cycle", span)
-                    .with_label(format!("`{path}` is already being imported"))
-                    .with_note(format!("the cycle is {}", chain.join(" → "))),
-            );
-        }
-        // A file imported twice (not in a cycle) is read once.
-        return;
+        let id = self.sources.add(name, text);
+        self.file(id);
     }
-    if sources.len() >= MAX_FILES {
-        diags.push(Diagnostic::error(
-            "E0507",
-            format!("more than {MAX_FILES} files are imported"),
-            span,
-        ));
-        return;
-    }
-    let id = sources.add(name, text);
-    load_file(sources, id, loader, stack, items, diags);
 }
 
 fn dup(cx: &mut Ctx, what: &str, name: &ast::Ident, first: Span) {
@@ -664,10 +679,12 @@ fn stmts_into(cx: &mut Ctx, stmts: &[ast::Stmt], out: &mut Vec<crate::scene::Nod
                 // Already reported, or unknown only because of an earlier error.
                 Value::Unknown(Type::Shape) => {}
                 Value::Shape(id) => {
-                    if out.len() >= MAX_OBJECTS {
+                    let max = cx.limits.count(Limit::Objects);
+                    if out.len() >= max {
                         cx.limit(
+                            Limit::Objects,
                             e.span,
-                            format!("the scene has more than {MAX_OBJECTS} objects"),
+                            format!("the scene has more than {max} objects"),
                         );
                         return;
                     }
@@ -720,11 +737,13 @@ fn for_loop(
     let (Some(a), Some(b)) = (bound(from, cx), bound(to, cx)) else {
         return;
     };
-    if b.saturating_sub(a) > MAX_OBJECTS as i64 {
+    let max = cx.limits.get(Limit::Objects);
+    if b > a && b.saturating_sub(a) as u64 > max {
         cx.limit(
+            Limit::Objects,
             to.span,
             format!(
-                "the loop runs {} times, more than {MAX_OBJECTS}",
+                "the loop runs {} times, more than {max}",
                 b.saturating_sub(a)
             ),
         );

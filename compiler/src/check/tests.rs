@@ -108,3 +108,60 @@ fn function_bodies_are_checked_without_calls() {
         ["E0300"]
     );
 }
+
+/// Imports from a fixed set of texts.
+struct Files(&'static [(&'static str, &'static str)]);
+
+impl super::Loader for Files {
+    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), String> {
+        let (name, text) = self
+            .0
+            .iter()
+            .find(|(n, _)| *n == path)
+            .ok_or("no such file")?;
+        Ok((name.to_string(), text.to_string()))
+    }
+}
+
+/// Checks `src` (importing from `files`) within `limits`: the diagnostics.
+fn within(
+    src: &str,
+    files: &'static [(&'static str, &'static str)],
+    limits: &crate::Limits,
+) -> Vec<crate::Diagnostic> {
+    let mut sources = crate::SourceMap::new();
+    let entry = sources.add("t.sdf", src);
+    super::check_with(&mut sources, entry, &mut Files(files), limits).1
+}
+
+#[test]
+fn every_compilation_limit_is_reported_with_the_flag_that_raises_it() {
+    use crate::{Limit, Limits};
+    const IMPORTS: &[(&str, &str)] = &[("a.sdf", "import \"b.sdf\";"), ("b.sdf", "let r = 1;")];
+    let cases: [(Limit, u64, &str); 6] = [
+        (Limit::Nesting, 5, "let x = abs(abs(abs(abs(abs(abs(1))))));\nscene { sphere(); }"),
+        (Limit::Fuel, 100, "scene { for i in 0..50 { sphere(1).translate(i, 0, 0); } }"),
+        (
+            Limit::CallDepth,
+            2,
+            "fn a(x: float) -> float { x }\nfn b(x: float) -> float { a(x) }\nfn c(x: float) -> float { b(x) }\nlet y = c(1);\nscene { sphere(); }",
+        ),
+        (Limit::Nodes, 3, "scene { union(sphere(1), sphere(2), sphere(3), sphere(4)); }"),
+        (Limit::Objects, 3, "scene { sphere(1); sphere(2); sphere(3); sphere(4); }"),
+        (Limit::Files, 2, "import \"a.sdf\";\nscene { sphere(r); }"),
+    ];
+    for (limit, value, src) in cases {
+        let mut low = Limits::default();
+        low.set(limit, value).expect("valid");
+        let diags = within(src, IMPORTS, &low);
+        let flag = format!("`--limit {}={}`", limit.name(), 2 * value);
+        assert!(
+            diags
+                .iter()
+                .any(|d| d.code == "E0507" && d.notes.iter().any(|n| n.contains(&flag))),
+            "{limit}: {diags:#?}"
+        );
+        let diags = within(src, IMPORTS, &Limits::default());
+        assert!(diags.iter().all(|d| !d.is_error()), "{limit}: {diags:#?}");
+    }
+}

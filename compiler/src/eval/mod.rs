@@ -111,6 +111,14 @@ impl<'t, T: Float> Evaluator<'t, T> {
         }
     }
 
+    /// The bytes an evaluator of `tape` allocates for `chunk` points per pass (its slots and
+    /// the point lists of its guarded blocks); evaluating allocates nothing more.
+    pub fn heap_bytes(tape: &Tape, chunk: usize) -> usize {
+        let chunk = chunk.max(1);
+        let frame = chunk * std::mem::size_of::<u32>() + std::mem::size_of::<(Vec<u32>, usize)>();
+        chunk * tape.slot_count() * std::mem::size_of::<T>() + tape.depth() * frame
+    }
+
     /// The tape this evaluator runs.
     pub fn tape(&self) -> &'t Tape {
         self.tape

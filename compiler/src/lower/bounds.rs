@@ -221,13 +221,21 @@ impl Bounds {
             Node::Capsule {
                 radius,
                 half_height,
-            } => Bound::of_box([*radius, half_height + radius, *radius], half_height + radius),
+            } => Bound::of_box(
+                [*radius, half_height + radius, *radius],
+                half_height + radius,
+            ),
             Node::Ellipsoid { radii } => ellipsoid(*radii),
             // f ≥ |p| - 2 beyond radius 2, and f ≥ -0.5/e everywhere (see the docs).
             Node::Mandelbulb { .. } => Bound::of_sphere(2.2),
             Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
             Node::SmoothCombine {
-                op, k, variant, a, b, ..
+                op,
+                k,
+                variant,
+                a,
+                b,
+                ..
             } => smooth(*op, *k, *variant, get(a), get(b))?,
             Node::Translate { offset, child } => get(child)?.similar(1.0, *offset),
             Node::Rotate { matrix, child } => rotate(&get(child)?, matrix),
@@ -254,7 +262,11 @@ impl Bounds {
 fn ellipsoid(r: V3) -> Bound {
     let (lo, hi) = (r[0].min(r[1]).min(r[2]), r[0].max(r[1]).max(r[2]));
     Bound {
-        scale: if hi > 0.0 { (lo / hi).clamp(1e-6, 1.0) } else { 1.0 },
+        scale: if hi > 0.0 {
+            (lo / hi).clamp(1e-6, 1.0)
+        } else {
+            1.0
+        },
         ..Bound::of_sphere(hi)
     }
 }
@@ -266,7 +278,9 @@ fn combine(op: Combine, mut kids: impl Iterator<Item = Option<Bound>>) -> Option
             let first = kids.next()??;
             kids.try_fold(first, |acc, b| Some(hull(&acc, &b?)))
         }
-        Combine::Intersect => kids.flatten().min_by(|a, b| a.volumes().0.total_cmp(&b.volumes().0)),
+        Combine::Intersect => kids
+            .flatten()
+            .min_by(|a, b| a.volumes().0.total_cmp(&b.volumes().0)),
         Combine::Subtract => kids.next()?,
     }
 }
@@ -298,9 +312,8 @@ fn rotate(b: &Bound, m: &[V3; 3]) -> Bound {
         out.aabb.h = [0, 1, 2].map(|i| (0..3).map(|j| m[i][j].abs() * b.aabb.h[j]).sum());
     } else {
         // A slab stays a slab only when the rotation keeps every infinite axis on itself.
-        let keeps = (0..3).all(|i| {
-            (0..3).all(|j| b.aabb.h[j].is_finite() || i == j || m[i][j].abs() < 1e-12)
-        });
+        let keeps = (0..3)
+            .all(|i| (0..3).all(|j| b.aabb.h[j].is_finite() || i == j || m[i][j].abs() < 1e-12));
         if !keeps {
             return unbounded();
         }

@@ -83,7 +83,8 @@ impl<'a> Lowerer<'a> {
         }
         let graph = self.graph;
         let node = graph.node(id);
-        self.b.note(format!("node {} {}", self.number(id), kind(node)));
+        self.b
+            .note(format!("node {} {}", self.number(id), kind(node)));
         let f = match node {
             Node::Combine {
                 op: Combine::Union,
@@ -522,7 +523,11 @@ impl<'a> Lowerer<'a> {
 /// For tests: a program computing node `id`'s field (as its distance) and the guard distance
 /// of its bound (as its material register).
 #[cfg(test)]
-pub(super) fn field_and_bound(graph: &Graph, bounds: &Bounds, id: NodeId) -> Option<super::Program> {
+pub(super) fn field_and_bound(
+    graph: &Graph,
+    bounds: &Bounds,
+    id: NodeId,
+) -> Option<super::Program> {
     let bound = bounds.get(id)?;
     let mut b = Builder::new(true);
     let p = b.input_point();

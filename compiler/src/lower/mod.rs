@@ -28,6 +28,8 @@ mod simplify;
 #[cfg(test)]
 mod tests;
 
+use crate::diagnostics::Diagnostic;
+use crate::limits::{Limit, Limits};
 use crate::scene::Scene;
 use std::fmt::Write;
 
@@ -417,6 +419,29 @@ impl LowerOptions {
 /// Lowers a checked scene to its distance program, with every optimisation pass.
 pub fn lower(scene: &Scene) -> Program {
     lower_with(scene, &LowerOptions::default())
+}
+
+/// Checks `program`, lowered from `scene`, against the `program` limit: more operations is
+/// an E0507 error at the scene's objects. Run after lowering and before any back end or
+/// render starts.
+pub fn check_size(scene: &Scene, program: &Program, limits: &Limits) -> Result<(), Diagnostic> {
+    let max = limits.get(Limit::Program);
+    let (Some(root), true) = (scene.root, program.len() as u64 > max) else {
+        return Ok(());
+    };
+    Err(Diagnostic::error(
+        "E0507",
+        format!(
+            "the distance program has {} operations, more than {max}",
+            program.len()
+        ),
+        scene.graph.span(root),
+    )
+    .with_label("the scene's objects lower to it")
+    .with_note(format!(
+        "this limit keeps compilation and rendering bounded; {}",
+        limits.raise_to(Limit::Program, program.len() as u64)
+    )))
 }
 
 /// Lowers a checked scene to its distance program with the given options.

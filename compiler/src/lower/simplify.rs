@@ -155,7 +155,9 @@ impl Simplifier<'_> {
     /// `node` rebuilt over the simplified child `c`, or `c` where the node does nothing.
     fn unary_on(&mut self, node: Node, c: NodeId) -> NodeId {
         let node = match node {
-            Node::ScaleXyz { factors, .. } if factors[0] == factors[1] && factors[1] == factors[2] => {
+            Node::ScaleXyz { factors, .. }
+                if factors[0] == factors[1] && factors[1] == factors[2] =>
+            {
                 return self.scale(factors[0], c)
             }
             Node::Repeat { period, count, .. } => {
@@ -352,10 +354,16 @@ impl Simplifier<'_> {
             Node::Box { .. } | Node::RoundBox { .. } | Node::Ellipsoid { .. } => {
                 match permutation(&m) {
                     Some(perm) => self.add(permute(node, perm)),
-                    None => self.add(Node::Rotate { matrix: m, child: c }),
+                    None => self.add(Node::Rotate {
+                        matrix: m,
+                        child: c,
+                    }),
                 }
             }
-            _ => self.add(Node::Rotate { matrix: m, child: c }),
+            _ => self.add(Node::Rotate {
+                matrix: m,
+                child: c,
+            }),
         }
     }
 

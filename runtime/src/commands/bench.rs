@@ -2,12 +2,13 @@
 //! for GPU targets the achieved fraction of the FP32 floor).
 
 use super::render::{override_settings, parse_size, thread_pool, Backend};
-use crate::backend::Prepared;
+use crate::backend::{Prepared, Setup};
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
-use sdfc_compiler::lower;
+use sdfc_compiler::lower::{LowerOptions, Program};
 use sdfc_compiler::scene::{analytic, Scene};
+use sdfc_compiler::Limits;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -41,6 +42,8 @@ pub struct BenchArgs {
     /// Print one JSON array instead of a table.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// The timing of one scene.
@@ -103,17 +106,25 @@ pub fn run(args: BenchArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let limits = args.limits.limits();
     let mut timings = Vec::new();
     for file in &args.file {
-        let mut scene = match frontend::load_scene(file, DiagnosticFormat::Human) {
-            Ok(s) => s,
+        let mut checked = match frontend::load_scene(file, DiagnosticFormat::Human, &limits) {
+            Ok(c) => c,
             Err(code) => return code,
         };
-        if let Err(msg) = override_settings(&mut scene.settings, args.size, args.aa, &args.set) {
+        let settings = &mut checked.scene.settings;
+        if let Err(msg) = override_settings(settings, args.size, args.aa, &args.set, &limits) {
             eprintln!("error: {msg}");
             return ExitCode::from(2);
         }
-        let t = match pool.install(|| time_scene(&args, file.display().to_string(), &scene)) {
+        let program = match checked.lower(&LowerOptions::default(), &limits) {
+            Ok(p) => p,
+            Err(code) => return code,
+        };
+        let name = file.display().to_string();
+        let scene = &checked.scene;
+        let t = match pool.install(|| time_scene(&args, name, scene, program, &limits)) {
             Ok(t) => t,
             Err(msg) => {
                 eprintln!("error: {}: {msg}", file.display());
@@ -140,10 +151,27 @@ pub fn run(args: BenchArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// Renders one warm-up frame and `frames` timed frames. GPU backends are timed on the device
-/// (timestamps or events); the CPU by the wall clock.
-fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, String> {
-    let prepared = Prepared::new(args.backend, scene, args.precision)?;
+/// Renders one warm-up frame and `frames` timed frames, within the memory limit. GPU backends
+/// are timed on the device (timestamps or events); the CPU by the wall clock.
+fn time_scene(
+    args: &BenchArgs,
+    name: String,
+    scene: &Scene,
+    program: Program,
+    limits: &Limits,
+) -> Result<Timing, String> {
+    let ops_per_eval = fp32::distance_ops(&program);
+    let setup = Setup {
+        precision: args.precision,
+        debug_nan: false,
+    };
+    let prepared = Prepared::from_program(args.backend, scene, program, &setup)?;
+    // The last frame is held while the next one renders.
+    let mut frame = prepared.memory(scene, &scene.settings);
+    frame.host = frame
+        .host
+        .saturating_add(prepared.retained(&scene.settings));
+    frame.check(limits)?;
     let mut last = prepared.render(scene, &|_| {})?.render;
     let mut times = Vec::new();
     let mut walls = Vec::new();
@@ -157,7 +185,6 @@ fn time_scene(args: &BenchArgs, name: String, scene: &Scene) -> Result<Timing, S
     let median = times[times.len() / 2];
     let c = &last.stats.counters;
     let s = &scene.settings;
-    let ops_per_eval = fp32::distance_ops(&lower::lower(scene));
     let traced = analytic::choose(scene).primitives().is_some();
     let evaluations = if traced { 0 } else { fp32::evaluations(c) };
     let peak = match prepared {

@@ -17,6 +17,8 @@ pub struct CheckArgs {
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value_t)]
     pub diagnostics: DiagnosticFormat,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// Checks every file; exit 0 when all are clean, 1 when any has errors, 2 when any could not
@@ -24,8 +26,9 @@ pub struct CheckArgs {
 /// field is (exact, a bound or approximate) with the L the renderers step with.
 pub fn run(args: CheckArgs) -> ExitCode {
     let mut code = 0u8;
+    let limits = args.limits.limits();
     for file in &args.files {
-        match frontend::load(file) {
+        match frontend::load_with(file, &limits) {
             Err(msg) => {
                 eprintln!("error: {msg}");
                 code = 2;

@@ -52,11 +52,14 @@ pub struct CompileArgs {
     /// pass (folding, sharing, dead code, scene simplification, bounding-volume culling).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(0..=1))]
     pub opt: u8,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// Compiles and writes the requested target.
 pub fn run(args: CompileArgs) -> ExitCode {
-    let loaded = match frontend::load(&args.file) {
+    let limits = args.limits.limits();
+    let loaded = match frontend::load_with(&args.file, &limits) {
         Ok(l) => l,
         Err(msg) => {
             eprintln!("error: {msg}");
@@ -79,7 +82,15 @@ pub fn run(args: CompileArgs) -> ExitCode {
             let Some(scene) = &loaded.scene else {
                 return ExitCode::from(1);
             };
-            match emit(scene, other, args.sm, args.opt) {
+            if other == Emit::Ir {
+                return write_output(args.output.as_deref(), &scene::dump(scene));
+            }
+            let program = lower::lower_with(scene, &lower::LowerOptions::level(args.opt));
+            if let Err(d) = lower::check_size(scene, &program, &limits) {
+                frontend::print_diagnostics(&[d], &loaded.sources, args.diagnostics);
+                return ExitCode::from(1);
+            }
+            match emit(scene, &program, other, args.sm) {
                 Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
                 Err(msg) => {
                     eprintln!("{msg}");
@@ -91,21 +102,26 @@ pub fn run(args: CompileArgs) -> ExitCode {
     write_output(args.output.as_deref(), &text)
 }
 
-/// The bytes of a target that needs the checked scene.
-fn emit(scene: &scene::Scene, target: Emit, sm: u32, opt: u8) -> Result<Vec<u8>, String> {
-    let program = lower::lower_with(scene, &lower::LowerOptions::level(opt));
+/// The bytes of a target that needs the distance program.
+fn emit(
+    scene: &scene::Scene,
+    program: &lower::Program,
+    target: Emit,
+    sm: u32,
+) -> Result<Vec<u8>, String> {
     let lang = match target {
-        Emit::Ir => return Ok(scene::dump(scene).into_bytes()),
         Emit::Program => return Ok(program.dump().into_bytes()),
-        Emit::Rust => return Ok(back::rust::write(&program).into_bytes()),
-        Emit::Ast => return Err("internal error: the AST is not emitted from a scene".into()),
+        Emit::Rust => return Ok(back::rust::write(program).into_bytes()),
+        Emit::Ast | Emit::Ir => {
+            return Err("internal error: the AST and IR are not emitted from a program".into())
+        }
         Emit::Spirv => Some(Lang::SpirV),
         Emit::Msl => Some(Lang::Msl),
         Emit::Glsl => Some(Lang::Glsl),
         Emit::Hlsl => Some(Lang::Hlsl),
         Emit::Wgsl | Emit::Ptx => None,
     };
-    let kernel = back::wgsl::write(scene, &program).map_err(|e| e.to_string())?;
+    let kernel = back::wgsl::write(scene, program).map_err(|e| e.to_string())?;
     if target == Emit::Ptx {
         let options = back::ptx::Options {
             sm,

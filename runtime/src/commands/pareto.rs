@@ -4,13 +4,15 @@
 //! Pareto front and draws the chart (`crate::chart`).
 
 use super::render::{self, override_settings, parse_size, thread_pool, Backend};
-use crate::backend::Prepared;
+use crate::backend::{Prepared, Setup};
 use crate::chart::{self, Chart};
 use crate::cpu::reference::{self, Convergence};
 use crate::cpu::{Precision, Render};
 use crate::frontend::{self, DiagnosticFormat};
 use crate::metrics::{self, DepthDifference};
+use sdfc_compiler::lower::{LowerOptions, Program};
 use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::Limits;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -52,6 +54,8 @@ pub struct ParetoArgs {
     /// Print the measured points as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// A setting that can be swept.
@@ -101,8 +105,8 @@ impl Key {
     }
 
     /// Sets the value in `s`, checking its range as `--set` does.
-    pub fn set(self, s: &mut Settings, v: f64) -> Result<(), String> {
-        render::set(s, self.name(), &format!("{v}"))
+    pub fn set(self, s: &mut Settings, v: f64, limits: &Limits) -> Result<(), String> {
+        render::set(s, self.name(), &format!("{v}"), limits)
     }
 
     /// Whether the values are whole numbers.
@@ -135,8 +139,13 @@ pub const DEFAULT_SWEEPS: &[&str] = &[
 /// every whole number. `:N` asks for N values instead, with the same spacing (logarithmic
 /// for epsilon and max_steps, linear otherwise). Values are rounded to three significant
 /// digits (whole numbers for max_steps and aa), duplicates dropped, and each checked as
-/// `--set` checks it.
+/// `--set` checks it (within the default limits; see [`parse_sweep_within`]).
 pub fn parse_sweep(spec: &str) -> Result<Sweep, String> {
+    parse_sweep_within(spec, &Limits::default())
+}
+
+/// [`parse_sweep`] with the values checked within `limits`.
+pub fn parse_sweep_within(spec: &str, limits: &Limits) -> Result<Sweep, String> {
     let (key, rest) = spec.split_once('=').ok_or_else(|| {
         format!("--sweep expects KEY=LO..HI or KEY=V1,V2, like epsilon=1e-2..1e-6, not `{spec}`")
     })?;
@@ -151,7 +160,7 @@ pub fn parse_sweep(spec: &str) -> Result<Sweep, String> {
     };
     let mut values: Vec<f64> = Vec::new();
     for v in raw.into_iter().map(|v| round(key, v)) {
-        key.set(&mut Settings::default(), v)?;
+        key.set(&mut Settings::default(), v, limits)?;
         if !values.contains(&v) {
             values.push(v);
         }
@@ -229,15 +238,19 @@ fn round(key: Key, v: f64) -> f64 {
 }
 
 /// Every combination of the sweeps' values applied to `base`, the first sweep varying
-/// slowest.
-pub fn combinations(base: &Settings, sweeps: &[Sweep]) -> Result<Vec<Settings>, String> {
+/// slowest, each checked within `limits`.
+pub fn combinations(
+    base: &Settings,
+    sweeps: &[Sweep],
+    limits: &Limits,
+) -> Result<Vec<Settings>, String> {
     let mut out = vec![base.clone()];
     for sweep in sweeps {
         let mut next = Vec::with_capacity(out.len() * sweep.values.len());
         for s in &out {
             for &v in &sweep.values {
                 let mut t = s.clone();
-                sweep.key.set(&mut t, v)?;
+                sweep.key.set(&mut t, v, limits)?;
                 next.push(t);
             }
         }
@@ -348,8 +361,9 @@ pub struct Report {
 
 /// Runs `sdfc pareto`.
 pub fn run(args: ParetoArgs) -> ExitCode {
-    let mut scene = match frontend::load_scene(&args.file, DiagnosticFormat::Human) {
-        Ok(s) => s,
+    let limits = args.limits.limits();
+    let mut checked = match frontend::load_scene(&args.file, DiagnosticFormat::Human, &limits) {
+        Ok(c) => c,
         Err(code) => return code,
     };
     let specs: Vec<String> = if args.sweep.is_empty() {
@@ -357,15 +371,16 @@ pub fn run(args: ParetoArgs) -> ExitCode {
     } else {
         args.sweep.clone()
     };
+    let settings = &mut checked.scene.settings;
     let plan = check_output(args.output.as_deref())
-        .and_then(|()| override_settings(&mut scene.settings, args.size, None, &args.set))
+        .and_then(|()| override_settings(settings, args.size, None, &args.set, &limits))
         .and_then(|()| {
             specs
                 .iter()
-                .map(|s| parse_sweep(s))
+                .map(|s| parse_sweep_within(s, &limits))
                 .collect::<Result<Vec<_>, _>>()
         })
-        .and_then(|sweeps| combinations(&scene.settings, &sweeps))
+        .and_then(|sweeps| combinations(settings, &sweeps, &limits))
         .and_then(|points| thread_pool(args.threads).map(|pool| (points, pool)));
     let (points, pool) = match plan {
         Ok(p) => p,
@@ -374,7 +389,11 @@ pub fn run(args: ParetoArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let report = match pool.install(|| measure(&args, &scene, points)) {
+    let program = match checked.lower(&LowerOptions::default(), &limits) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let report = match pool.install(|| measure(&args, &checked.scene, program, points, &limits)) {
         Ok(r) => r,
         Err(msg) => {
             eprintln!("error: {msg}");
@@ -420,15 +439,37 @@ fn finish(args: &ParetoArgs, report: &Report) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// Renders the reference, then every point, and measures them.
-fn measure(args: &ParetoArgs, scene: &Scene, mut points: Vec<Settings>) -> Result<Report, String> {
+/// Renders the reference, then every point, and measures them. Every render is held to the
+/// memory limit before the first starts.
+fn measure(
+    args: &ParetoArgs,
+    scene: &Scene,
+    program: Program,
+    mut points: Vec<Settings>,
+    limits: &Limits,
+) -> Result<Report, String> {
     let default = scene.settings.clone();
     if !points.iter().any(|s| same(s, &default)) {
         points.push(default.clone());
     }
-    let (reference, info) = reference_render(scene, &points)?;
-    let prepared = Prepared::new(args.backend, scene, args.precision)
+    let setup = Setup {
+        precision: args.precision,
+        debug_nan: false,
+    };
+    let prepared = Prepared::from_program(args.backend, scene, program.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
+    let (reference_scene, reference_prepared) = reference_setup(scene, program, &points)?;
+    // The reference frame is held while each point renders.
+    let held = reference_prepared.retained(&reference_scene.settings);
+    let reference_memory =
+        crate::memory::render(&reference_prepared, &reference_scene, true, false);
+    reference_memory.check(limits)?;
+    for settings in &points {
+        let mut point = prepared.memory(scene, settings);
+        point.host = point.host.saturating_add(held);
+        point.check(limits)?;
+    }
+    let (reference, info) = reference_render(&reference_prepared, &reference_scene)?;
     prepared.render(scene, &|_| {})?;
     let mut measured = Vec::with_capacity(points.len());
     for (i, settings) in points.iter().enumerate() {
@@ -487,8 +528,13 @@ pub fn describe(s: &Settings) -> String {
     )
 }
 
-/// The reference render (at the largest supersampling of the points) and its check.
-fn reference_render(scene: &Scene, points: &[Settings]) -> Result<(Render, ReferenceInfo), String> {
+/// The scene of the reference render (at the largest supersampling of the points), prepared
+/// on the CPU in f64.
+fn reference_setup(
+    scene: &Scene,
+    program: Program,
+    points: &[Settings],
+) -> Result<(Scene, Prepared), String> {
     let aa = points
         .iter()
         .map(|s| s.aa)
@@ -499,10 +545,23 @@ fn reference_render(scene: &Scene, points: &[Settings]) -> Result<(Render, Refer
         aa,
         ..scene.settings.clone()
     });
+    let setup = Setup {
+        precision: Precision::F64,
+        debug_nan: false,
+    };
+    let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, program, &setup)?;
+    Ok((reference_scene, prepared))
+}
+
+/// The reference render and its check.
+fn reference_render(
+    prepared: &Prepared,
+    reference_scene: &Scene,
+) -> Result<(Render, ReferenceInfo), String> {
+    let aa = reference_scene.settings.aa;
     let start = std::time::Instant::now();
-    let prepared = Prepared::new(Backend::Cpu, &reference_scene, Precision::F64)?;
-    let frame = prepared.render(&reference_scene, &|_| {})?;
-    let convergence = render::check_reference(&prepared, &reference_scene, &frame)?;
+    let frame = prepared.render(reference_scene, &|_| {})?;
+    let convergence = render::check_reference(prepared, reference_scene, &frame)?;
     let seconds = start.elapsed().as_secs_f64();
     if !convergence.converged {
         eprintln!("warning: {}", render::not_converged(&convergence));

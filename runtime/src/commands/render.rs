@@ -3,13 +3,15 @@
 //! `sdfc pareto` share (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread
 //! pools).
 
-use crate::backend::{Frame, Prepared};
+use crate::backend::{Frame, Prepared, Setup};
 use crate::cpu::reference::{self, Convergence};
 use crate::cpu::Precision;
-use crate::depth;
 use crate::frontend::{self, DiagnosticFormat};
+use crate::{depth, memory};
 use indicatif::{ProgressBar, ProgressStyle};
+use sdfc_compiler::lower::LowerOptions;
 use sdfc_compiler::scene::{Method, Scene, Settings};
+use sdfc_compiler::{Limit, Limits};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -57,12 +59,19 @@ pub struct RenderArgs {
     /// docs/accuracy.md). Only the CPU backend has them.
     #[arg(long)]
     pub aux: bool,
+    /// Paint the pixels whose rays (camera, secondary or shadow) met a NaN distance magenta,
+    /// instead of what they would show. Without it, images are unchanged.
+    #[arg(long)]
+    pub debug_nan: bool,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// Runs `sdfc render`.
 pub fn run(args: RenderArgs) -> ExitCode {
-    let mut scene = match frontend::load_scene(&args.file, DiagnosticFormat::Human) {
-        Ok(s) => s,
+    let limits = args.limits.limits();
+    let mut checked = match frontend::load_scene(&args.file, DiagnosticFormat::Human, &limits) {
+        Ok(c) => c,
         Err(code) => return code,
     };
     let (backend, precision) = match reference_mode(&args) {
@@ -72,14 +81,15 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let settings = &mut checked.scene.settings;
     if args.reference {
-        scene.settings = reference::settings(&scene.settings);
+        *settings = reference::settings(settings);
     }
-    if let Err(msg) = override_settings(&mut scene.settings, args.size, args.aa, &args.set) {
+    if let Err(msg) = override_settings(settings, args.size, args.aa, &args.set, &limits) {
         eprintln!("error: {msg}");
         return ExitCode::from(2);
     }
-    if let Err(msg) = crate::backend::method_allowed(&scene) {
+    if let Err(msg) = crate::backend::method_allowed(&checked.scene) {
         eprintln!("error: {msg}");
         return ExitCode::from(1);
     }
@@ -90,13 +100,31 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let prepared = match pool.install(|| Prepared::new(backend, &scene, precision)) {
+    let program = match checked.lower(&LowerOptions::default(), &limits) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let scene = checked.scene;
+    let setup = Setup {
+        precision,
+        debug_nan: args.debug_nan,
+    };
+    let prepared = match pool.install(|| Prepared::from_program(backend, &scene, program, &setup)) {
         Ok(p) => p,
         Err(msg) => {
             eprintln!("error: the {backend:?} backend is not available: {msg}");
             return ExitCode::from(1);
         }
     };
+    let needed = pool.install(|| memory::render(&prepared, &scene, args.reference, args.aux));
+    eprintln!(
+        "{}",
+        memory::announce(&scene.settings, prepared.name(), &needed)
+    );
+    if let Err(msg) = needed.check(&limits) {
+        eprintln!("error: {msg}");
+        return ExitCode::from(1);
+    }
     let started = Instant::now();
     let frame = match pool.install(|| render_with_progress(&prepared, &scene)) {
         Ok(f) => f,
@@ -281,47 +309,37 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> 
         .map_err(|e| format!("cannot start worker threads: {e}"))
 }
 
-/// Parses `WIDTHxHEIGHT`.
+/// Parses `WIDTHxHEIGHT` (each edge is checked against the `edge` limit when applied).
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, like 640x480, not `{s}`"))?;
-    let w = parse_dimension(w.trim())?;
-    let h = parse_dimension(h.trim())?;
+    let ceiling = Limit::Edge.ceiling() as u32;
+    let w = int("width", w.trim(), 1, ceiling, None)?;
+    let h = int("height", h.trim(), 1, ceiling, None)?;
     Ok((w, h))
 }
 
-/// Largest accepted image edge.
-const MAX_EDGE: u32 = 1 << 15;
-
-fn parse_dimension(s: &str) -> Result<u32, String> {
-    match s.parse::<u32>() {
-        Ok(v) if (1..=MAX_EDGE).contains(&v) => Ok(v),
-        _ => Err(format!(
-            "an image edge must be a whole number from 1 to {MAX_EDGE}, not `{s}`"
-        )),
-    }
-}
-
-/// Applies `--size`, `--aa` and then each `--set key=value`, in order.
+/// Applies `--size`, `--aa` and then each `--set key=value`, in order, within `limits`.
 pub fn override_settings(
     s: &mut Settings,
     size: Option<(u32, u32)>,
     aa: Option<u32>,
     sets: &[String],
+    limits: &Limits,
 ) -> Result<(), String> {
     if let Some((w, h)) = size {
-        s.width = w;
-        s.height = h;
+        set(s, "width", &w.to_string(), limits)?;
+        set(s, "height", &h.to_string(), limits)?;
     }
     if let Some(n) = aa {
-        set(s, "aa", &n.to_string())?;
+        set(s, "aa", &n.to_string(), limits)?;
     }
     for item in sets {
         let (key, value) = item
             .split_once('=')
             .ok_or_else(|| format!("--set expects KEY=VALUE, like max_steps=512, not `{item}`"))?;
-        set(s, key.trim(), value.trim())?;
+        set(s, key.trim(), value.trim(), limits)?;
     }
     Ok(())
 }
@@ -340,14 +358,19 @@ pub const SETTING_KEYS: &[&str] = &[
     "method",
 ];
 
-/// Sets one render setting from text, checking its range.
-pub fn set(s: &mut Settings, key: &str, value: &str) -> Result<(), String> {
+/// Sets one render setting from text, checking its range (the top of the range of width,
+/// height, aa, max_steps and max_depth is a limit of `limits`).
+pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<(), String> {
+    let limited = |limit: Limit, lo: u32| {
+        let hi = limits.get(limit).min(u32::MAX as u64) as u32;
+        int(key, value, lo, hi, Some((limits, limit)))
+    };
     match key {
-        "width" => s.width = parse_dimension(value).map_err(|e| format!("width: {e}"))?,
-        "height" => s.height = parse_dimension(value).map_err(|e| format!("height: {e}"))?,
-        "aa" => s.aa = int(key, value, 1, 16)?,
-        "max_steps" => s.max_steps = int(key, value, 1, 1_000_000)?,
-        "max_depth" => s.max_depth = int(key, value, 0, 64)?,
+        "width" => s.width = limited(Limit::Edge, 1)?,
+        "height" => s.height = limited(Limit::Edge, 1)?,
+        "aa" => s.aa = limited(Limit::Aa, 1)?,
+        "max_steps" => s.max_steps = limited(Limit::MaxSteps, 1)?,
+        "max_depth" => s.max_depth = limited(Limit::MaxDepth, 0)?,
         "epsilon" => s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?,
         "max_dist" => s.max_dist = real(key, value, |v| v > 0.0, "a positive number")?,
         "relaxation" => {
@@ -377,12 +400,26 @@ pub fn set(s: &mut Settings, key: &str, value: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn int(key: &str, value: &str, lo: u32, hi: u32) -> Result<u32, String> {
-    match value.parse::<u32>() {
-        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
-        _ => Err(format!(
-            "{key} must be a whole number from {lo} to {hi}, not `{value}`"
-        )),
+/// A whole number from `lo` to `hi`; with `limit`, one above `hi` says how to raise it.
+fn int(
+    key: &str,
+    value: &str,
+    lo: u32,
+    hi: u32,
+    limit: Option<(&Limits, Limit)>,
+) -> Result<u32, String> {
+    let parsed = value.parse::<u64>();
+    match parsed {
+        Ok(v) if (lo as u64..=hi as u64).contains(&v) => Ok(v as u32),
+        _ => {
+            let mut msg = format!("{key} must be a whole number from {lo} to {hi}, not `{value}`");
+            if let (Some((limits, limit)), Ok(v)) = (limit, parsed) {
+                if v > hi as u64 {
+                    msg.push_str(&format!("; {}", limits.raise_to(limit, v)));
+                }
+            }
+            Err(msg)
+        }
     }
 }
 

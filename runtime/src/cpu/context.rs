@@ -1,11 +1,11 @@
 //! Everything a tile needs, prepared once per render in the evaluation type: settings,
-//! camera, materials, lights and the two tapes (distance only, distance and material).
+//! camera, materials and lights. (The two tapes, distance only and distance and material,
+//! are prepared once per scene: [`super::Tapes`].)
 
 use super::analytic::Tracer;
 use super::camera::Pinhole;
 use super::vec::V3;
-use sdfc_compiler::eval::{Float, Outputs, Tape};
-use sdfc_compiler::lower::Program;
+use sdfc_compiler::eval::Float;
 use sdfc_compiler::scene::{Light, Material, Pattern, Scene};
 
 /// The colour of a material at a point.
@@ -60,14 +60,16 @@ pub(super) struct Context<T: Float> {
     pub lamps: Vec<Lamp<T>>,
     /// Whether any material is transparent (shadow rays then look up materials).
     pub transparent: bool,
-    pub distance_tape: Tape,
-    pub full_tape: Tape,
+    /// The most rays one hit spawns (0, 1 or 2: a reflection and a refraction).
+    pub branching: usize,
+    /// `--debug-nan`: pixels whose rays met a NaN are painted [`super::NAN_COLOUR`].
+    pub debug_nan: bool,
     /// The primitives, when the scene is ray traced analytically instead of sphere traced.
     pub analytic: Option<Tracer<T>>,
 }
 
 impl<T: Float> Context<T> {
-    pub fn new(scene: &Scene, program: &Program, lipschitz: f64) -> Self {
+    pub fn new(scene: &Scene, lipschitz: f64, debug_nan: bool) -> Self {
         let s = &scene.settings;
         let mut materials: Vec<Mat<T>> = scene.materials.iter().map(mat).collect();
         if materials.is_empty() {
@@ -86,8 +88,8 @@ impl<T: Float> Context<T> {
             materials,
             lamps: scene.lights.iter().map(lamp).collect(),
             transparent,
-            distance_tape: Tape::new(program, Outputs::Distance),
-            full_tape: Tape::new(program, Outputs::DistanceAndMaterial),
+            branching: branching(scene),
+            debug_nan,
             analytic: sdfc_compiler::scene::analytic::choose(scene)
                 .primitives()
                 .map(Tracer::new),
@@ -117,6 +119,21 @@ impl<T: Float> Context<T> {
         let m = x.abs().max(y.abs()).max(z.abs());
         cone.max(T::from_f64(8.0) * T::EPSILON * m)
     }
+}
+
+/// The most rays one hit spawns: a reflection where `reflect` > 0 and a refraction (or, on
+/// total internal reflection, a reflection) where `transparency` > 0; an exit from a solid
+/// spawns one, and no hit spawns any at `max_depth` 0.
+pub(super) fn branching(scene: &Scene) -> usize {
+    if scene.settings.max_depth == 0 {
+        return 0;
+    }
+    scene
+        .materials
+        .iter()
+        .map(|m| (m.reflect > 0.0) as usize + (m.transparency > 0.0) as usize)
+        .max()
+        .unwrap_or(0)
 }
 
 fn mat<T: Float>(m: &Material) -> Mat<T> {

@@ -46,6 +46,11 @@ macro_rules! lanes {
                 Lanes { len: 0, finished: Vec::with_capacity(capacity), $($f: vec![Default::default(); capacity],)* $($g: vec![Default::default(); capacity],)* }
             }
 
+            /// The bytes [`Lanes::new`] allocates for `capacity` lanes (they never grow).
+            pub fn heap_bytes(capacity: usize) -> usize {
+                capacity * (std::mem::size_of::<usize>() $(+ std::mem::size_of::<$t>())* $(+ std::mem::size_of::<$u>())*)
+            }
+
             /// Moves lane `from` into lane `to`.
             fn move_lane(&mut self, from: usize, to: usize) {
                 $(self.$f[to] = self.$f[from];)*

@@ -126,6 +126,8 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
 pub(super) struct Shadowed<T> {
     pub light: T,
     pub steps: u32,
+    /// Whether the ray stopped at a NaN.
+    pub nan: bool,
 }
 
 /// Shadow rays towards a light at distance `tmax`. Soft (k > 0): res = min(res, k·d/t) along
@@ -144,8 +146,16 @@ impl<T: Float> Shadow<'_, T> {
         self.out[l.id[k] as usize] = Shadowed {
             light,
             steps: l.steps[k],
+            nan: false,
         };
         l.finished.push(k);
+    }
+
+    /// Finishes lane `k` at a NaN: counted, and the light that arrived so far is kept.
+    fn finish_nan(&mut self, l: &mut Lanes<T>, k: usize) {
+        self.counters.nans += 1;
+        self.finish(l, k, Self::arrived(l, k));
+        self.out[l.id[k] as usize].nan = true;
     }
 
     /// The light arriving at the end of lane `k`'s march.
@@ -198,8 +208,7 @@ impl<T: Float> Shadow<'_, T> {
             }
             self.counters.overshoots += (fl & OVERSHOOT != 0) as u64;
             if fl & NAN != 0 {
-                self.counters.nans += 1;
-                self.finish(l, k, Self::arrived(l, k));
+                self.finish_nan(l, k);
             } else if fl & HIT != 0 {
                 self.finish(l, k, T::zero());
             } else if fl & (MISS | BUDGET) != 0 {
@@ -215,8 +224,7 @@ impl<T: Float> Shadow<'_, T> {
         let t = l.t[k];
         l.steps[k] += 1;
         if f.is_nan() {
-            self.counters.nans += 1;
-            return self.finish(l, k, Self::arrived(l, k));
+            return self.finish_nan(l, k);
         }
         let signed = l.sign[k] * f * c.inv_lipschitz;
         let tt = l.t0[k] + t;

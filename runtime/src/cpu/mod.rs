@@ -13,19 +13,21 @@ mod camera;
 mod context;
 mod lanes;
 mod march;
+mod memory;
 pub mod reference;
 mod shade;
 mod stats;
 mod tile;
 mod vec;
 
+pub use memory::{memory, retained};
 pub use stats::{Counters, Stats};
 
 use crate::depth::Depth;
 use crate::image::Image;
 use context::Context;
 use rayon::prelude::*;
-use sdfc_compiler::eval::Float;
+use sdfc_compiler::eval::{Float, Outputs, Tape};
 use sdfc_compiler::lower::Program;
 use sdfc_compiler::scene::{Scene, Settings};
 use tile::{Rect, Workspace};
@@ -53,6 +55,9 @@ pub struct Options {
     pub chunk: usize,
     /// Float type.
     pub precision: Precision,
+    /// Paint the pixels whose rays met a NaN (camera, secondary or shadow rays) in
+    /// [`NAN_COLOUR`] instead of what they would show (`--debug-nan`).
+    pub debug_nan: bool,
 }
 
 impl Default for Options {
@@ -63,6 +68,29 @@ impl Default for Options {
             lanes: 256,
             chunk: sdfc_compiler::eval::DEFAULT_CHUNK,
             precision: Precision::F32,
+            debug_nan: false,
+        }
+    }
+}
+
+/// The linear colour of a pixel whose rays met a NaN, with `--debug-nan` (magenta, on every
+/// backend).
+pub const NAN_COLOUR: [f32; 3] = [1.0, 0.0, 1.0];
+
+/// A distance program prepared for the CPU renderer, once per scene: its tape for the
+/// distance alone (marching, normals, shadows) and its tape for distance and material.
+#[derive(Debug, Clone)]
+pub struct Tapes {
+    distance: Tape,
+    full: Tape,
+}
+
+impl Tapes {
+    /// Prepares `program`'s two tapes.
+    pub fn new(program: &Program) -> Self {
+        Tapes {
+            distance: Tape::new(program, Outputs::Distance),
+            full: Tape::new(program, Outputs::DistanceAndMaterial),
         }
     }
 }
@@ -109,25 +137,36 @@ pub fn render(
     options: &Options,
     progress: &(dyn Fn() + Sync),
 ) -> Render {
-    match options.precision {
-        Precision::F32 => render_in::<f32>(scene, program, options, progress),
-        Precision::F64 => render_in::<f64>(scene, program, options, progress),
-    }
+    render_tapes(scene, &Tapes::new(program), options, progress)
 }
 
-/// [`render`] in the float type `T`.
-pub fn render_in<T: Float>(
+/// [`render`] with the program's tapes already prepared. It allocates at most [`memory`]
+/// bytes (with the current pool's number of threads).
+pub fn render_tapes(
     scene: &Scene,
-    program: &Program,
+    tapes: &Tapes,
     options: &Options,
     progress: &(dyn Fn() + Sync),
 ) -> Render {
-    let ctx = Context::<T>::new(scene, program, options.lipschitz);
+    match options.precision {
+        Precision::F32 => render_in::<f32>(scene, tapes, options, progress),
+        Precision::F64 => render_in::<f64>(scene, tapes, options, progress),
+    }
+}
+
+/// [`render_tapes`] in the float type `T`.
+pub fn render_in<T: Float>(
+    scene: &Scene,
+    tapes: &Tapes,
+    options: &Options,
+    progress: &(dyn Fn() + Sync),
+) -> Render {
+    let ctx = Context::<T>::new(scene, options.lipschitz, options.debug_nan);
     let rects = tiles(&scene.settings, options.tile);
     let outs: Vec<tile::TileOut> = rects
         .par_iter()
         .map_init(
-            || Workspace::new(&ctx, options.lanes, options.chunk),
+            || Workspace::new(tapes, options.lanes, options.chunk),
             |ws, &rect| {
                 let out = tile::render(&ctx, ws, rect);
                 progress();

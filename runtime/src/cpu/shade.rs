@@ -5,13 +5,13 @@ use super::context::{Context, Lamp, Mat, Paint};
 use super::lanes::{march, Launch};
 use super::march::{Shadow, Shadowed, Status, Trace, Traced};
 use super::stats::Counters;
-use super::tile::{Ray, Workspace};
+use super::tile::{Ray, Samples, Workspace};
 use super::vec::V3;
 use sdfc_compiler::eval::Float;
 
 /// A surface point reached by a ray of the wave.
 #[derive(Debug, Clone, Copy)]
-struct Hit<T> {
+pub(super) struct Hit<T> {
     /// Index of the ray in the wave.
     ray: usize,
     p: V3<T>,
@@ -24,21 +24,19 @@ struct Hit<T> {
     mat: u32,
 }
 
-/// Traces `wave`, adds what it sees to `acc` (per sample), and returns the next wave. On
-/// return `ws.traced[i]` still holds how ray `i` of `wave` ended (its first hit, for camera
-/// rays).
+/// Traces `wave`, adds what it sees to its samples, and returns the next wave. On return
+/// `ws.traced[i]` still holds how ray `i` of `wave` ended (its first hit, for camera rays).
 pub(super) fn bounce<T: Float>(
     ctx: &Context<T>,
     ws: &mut Workspace<'_, T>,
     wave: &[Ray<T>],
-    acc: &mut [V3<T>],
-    steps: &mut [u32],
+    samples: &mut Samples<T>,
     counters: &mut Counters,
 ) -> Vec<Ray<T>> {
     trace(ctx, ws, wave, counters);
     let mut hits = Vec::new();
     for (i, (ray, tr)) in wave.iter().zip(&ws.traced).enumerate() {
-        steps[ray.sample as usize] += tr.steps;
+        samples.steps[ray.sample as usize] += tr.steps;
         counters.steps += tr.steps as u64;
         match tr.status {
             Status::Hit => {
@@ -58,9 +56,9 @@ pub(super) fn bounce<T: Float>(
             }
             Status::Miss => counters.misses += 1,
             Status::Budget => counters.budget_misses += 1,
-            Status::Nan => {}
+            Status::Nan => samples.met_nan(ray.sample),
         }
-        let a = &mut acc[ray.sample as usize];
+        let a = &mut samples.acc[ray.sample as usize];
         *a = *a + ray.weight.mul_v(ctx.background);
     }
     if ctx.analytic.is_some() {
@@ -71,7 +69,7 @@ pub(super) fn bounce<T: Float>(
         normals(ws, wave, &mut hits);
         materials(ctx, ws, &mut hits);
     }
-    light(ctx, ws, wave, &hits, acc, steps, counters);
+    light(ctx, ws, wave, &hits, samples, counters);
     let next = spawn(ctx, wave, &hits);
     counters.secondary_rays += next.len() as u64;
     next
@@ -305,8 +303,7 @@ fn light<T: Float>(
     ws: &mut Workspace<'_, T>,
     wave: &[Ray<T>],
     hits: &[Hit<T>],
-    acc: &mut [V3<T>],
-    steps: &mut [u32],
+    samples: &mut Samples<T>,
     counters: &mut Counters,
 ) {
     let mut colour_at: Vec<V3<T>> = vec![V3::zero(); hits.len()];
@@ -332,13 +329,17 @@ fn light<T: Float>(
     shadows(ctx, ws, counters);
     for (&(hi, contrib), s) in pending.iter().zip(&ws.shadowed) {
         colour_at[hi] = colour_at[hi] + contrib * s.light;
-        steps[wave[hits[hi].ray].sample as usize] += s.steps;
+        let sample = wave[hits[hi].ray].sample;
+        samples.steps[sample as usize] += s.steps;
         counters.steps += s.steps as u64;
+        if s.nan {
+            samples.met_nan(sample);
+        }
     }
     for (hit, c) in hits.iter().zip(colour_at) {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
         if !ray.inside && local_weight(m) > T::zero() {
-            let a = &mut acc[ray.sample as usize];
+            let a = &mut samples.acc[ray.sample as usize];
             *a = *a + c.mul_v(ray.weight) * local_weight(m);
         }
     }
@@ -355,7 +356,11 @@ fn shadows<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, counters: &mut
                 V3::new(l.dir[0], l.dir[1], l.dir[2]),
             );
             let light = tracer.transmitted(o, d, l.tmax, |m| ctx.material(m).transparency);
-            ws.shadowed.push(Shadowed { light, steps: 0 });
+            ws.shadowed.push(Shadowed {
+                light,
+                steps: 0,
+                nan: false,
+            });
         }
         return;
     }
@@ -390,7 +395,13 @@ fn refract<T: Float>(d: V3<T>, n: V3<T>, eta: T) -> Option<V3<T>> {
 /// (weight τ). From inside (an exit): the refraction out, or on total internal reflection
 /// the reflection back inside, with the ray's whole weight. Only below `max_depth`.
 fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ray<T>> {
-    let mut next = Vec::new();
+    // At most `branching` rays per hit below `max_depth`: the vector never grows past
+    // this, and allocates nothing at `max_depth` (`super::memory` counts on both).
+    let below = hits
+        .iter()
+        .filter(|h| wave[h.ray].depth < ctx.max_depth)
+        .count();
+    let mut next = Vec::with_capacity(below * ctx.branching);
     for hit in hits {
         let ray = &wave[hit.ray];
         if ray.depth >= ctx.max_depth {

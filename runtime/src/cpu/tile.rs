@@ -1,5 +1,11 @@
 //! One tile of the image: its camera rays, the waves of secondary rays they spawn, and the
 //! per-thread workspace the waves run in.
+//!
+//! Secondary rays are traced in waves of at most [`WAVE`] rays, depth first: the rays a
+//! piece of a wave spawns are traced (and theirs, and so on) before the next piece. A hit
+//! can spawn two rays (glass reflects and refracts), so tracing whole waves breadth first
+//! would hold up to 2^depth rays per sample; depth first, a tile holds at most
+//! `max_depth` pieces at once, which is what `super::memory` counts on.
 
 use super::context::Context;
 use super::lanes::{Lanes, Launch};
@@ -7,6 +13,7 @@ use super::march::{Shadowed, Status, Traced};
 use super::shade;
 use super::stats::Counters;
 use super::vec::V3;
+use super::Tapes;
 use sdfc_compiler::eval::{Evaluator, Float};
 
 /// A ray waiting to be traced, with what it contributes to.
@@ -33,6 +40,41 @@ pub(super) struct Rect {
     pub y: u32,
     pub w: u32,
     pub h: u32,
+}
+
+/// Secondary rays are traced in pieces of at most this many rays.
+pub(super) const WAVE: usize = 1024;
+
+/// What the rays of a tile add up to, per sample (index within the tile).
+#[derive(Debug)]
+pub(super) struct Samples<T> {
+    /// Colour gathered so far.
+    pub acc: Vec<V3<T>>,
+    /// Marching steps taken.
+    pub steps: Vec<u32>,
+    /// With `--debug-nan`: whether a ray of the sample met a NaN (else empty).
+    pub nan: Vec<bool>,
+}
+
+impl<T: Float> Samples<T> {
+    fn new(n: usize, debug_nan: bool) -> Self {
+        Samples {
+            acc: vec![V3::zero(); n],
+            steps: vec![0; n],
+            nan: if debug_nan {
+                vec![false; n]
+            } else {
+                Vec::new()
+            },
+        }
+    }
+
+    /// Records that a ray of `sample` met a NaN (kept only with `--debug-nan`).
+    pub fn met_nan(&mut self, sample: u32) {
+        if let Some(flag) = self.nan.get_mut(sample as usize) {
+            *flag = true;
+        }
+    }
 }
 
 /// What a tile produces.
@@ -68,10 +110,10 @@ pub(super) struct Workspace<'t, T: Float> {
 }
 
 impl<'t, T: Float> Workspace<'t, T> {
-    pub fn new(ctx: &'t Context<T>, lanes: usize, chunk: usize) -> Self {
+    pub fn new(tapes: &'t Tapes, lanes: usize, chunk: usize) -> Self {
         Workspace {
-            dist: Evaluator::new(&ctx.distance_tape, chunk),
-            full: Evaluator::new(&ctx.full_tape, chunk),
+            dist: Evaluator::new(&tapes.distance, chunk),
+            full: Evaluator::new(&tapes.full, chunk),
             lanes: Lanes::new(lanes.max(1)),
             launches: Vec::new(),
             traced: Vec::new(),
@@ -89,20 +131,18 @@ impl<'t, T: Float> Workspace<'t, T> {
 /// Renders one tile.
 pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect: Rect) -> TileOut {
     let spp = ctx.camera.samples_per_pixel();
-    let samples = (rect.w * rect.h * spp) as usize;
-    let mut acc = vec![V3::zero(); samples];
-    let mut steps = vec![0u32; samples];
+    let mut samples = Samples::new((rect.w * rect.h * spp) as usize, ctx.debug_nan);
     let mut counters = Counters::default();
     let camera = camera_rays(ctx, rect);
     counters.camera_rays = camera.len() as u64;
-    let mut wave = shade::bounce(ctx, ws, &camera, &mut acc, &mut steps, &mut counters);
+    let next = shade::bounce(ctx, ws, &camera, &mut samples, &mut counters);
     let (distance, coverage) = first_hits(&ws.traced, spp as usize);
-    while !wave.is_empty() {
-        wave = shade::bounce(ctx, ws, &wave, &mut acc, &mut steps, &mut counters);
-    }
+    drop(camera);
+    descend(ctx, ws, &next, &mut samples, &mut counters);
     let scale = T::one() / T::from_f64(spp as f64);
     let chunk = spp as usize;
-    let pixels = acc
+    let mut pixels: Vec<[f32; 3]> = samples
+        .acc
         .chunks(chunk)
         .map(|s| {
             let sum = s.iter().fold(V3::zero(), |a, &c| a + c) * scale;
@@ -113,13 +153,37 @@ pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect
             ]
         })
         .collect();
-    let steps = steps.chunks(chunk).map(|s| s.iter().sum()).collect();
+    for (pixel, nan) in pixels.iter_mut().zip(samples.nan.chunks(chunk)) {
+        if nan.contains(&true) {
+            *pixel = super::NAN_COLOUR;
+        }
+    }
+    let steps = samples
+        .steps
+        .chunks(chunk)
+        .map(|s| s.iter().sum())
+        .collect();
     TileOut {
         pixels,
         steps,
         distance,
         coverage,
         counters,
+    }
+}
+
+/// Traces `wave` and, depth first, every ray it spawns, in pieces of at most [`WAVE`] rays.
+/// The recursion is as deep as `max_depth`: rays at that depth spawn none.
+fn descend<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    wave: &[Ray<T>],
+    samples: &mut Samples<T>,
+    counters: &mut Counters,
+) {
+    for piece in wave.chunks(WAVE) {
+        let next = shade::bounce(ctx, ws, piece, samples, counters);
+        descend(ctx, ws, &next, samples, counters);
     }
 }
 

@@ -238,8 +238,15 @@ impl Cuda {
         // same measure as the wgpu path's per-pass timestamps (gaps between launches excluded).
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
         let mut events = Vec::with_capacity(tiles.len());
+        let fault = super::fault_after_tiles();
         let wall = Instant::now();
         for (i, t) in tiles.iter().enumerate() {
+            if let Some(message) = super::injected_fault(fault, i) {
+                return Err(Error::Driver {
+                    during: "running the kernel",
+                    message,
+                });
+            }
             let start = self
                 .ctx
                 .new_event(flags)

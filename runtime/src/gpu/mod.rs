@@ -7,11 +7,33 @@ pub mod wgpu;
 
 use crate::cpu::{Counters, Render, Stats};
 use crate::image::Image;
+use crate::memory::Memory;
 use sdfc_compiler::back::wgsl::{self, Kernel, STATS_WORDS};
 use sdfc_compiler::scene::Scene;
 use std::time::Duration;
 
 pub use self::wgpu::{Error, Gpu};
+
+/// The testing aid `SDFC_FAULT_AFTER_TILES=N`: the GPU backends render N tiles, then report
+/// a device error for the next one through the path a real device error takes (wgpu:
+/// [`Error::Render`]; CUDA: a driver error), so that tests can check what a failure
+/// mid-render leaves behind. Unset (or not a number), nothing is injected.
+pub const FAULT_AFTER_TILES: &str = "SDFC_FAULT_AFTER_TILES";
+
+/// The number of tiles after which to inject a device error, from [`FAULT_AFTER_TILES`].
+pub(crate) fn fault_after_tiles() -> Option<usize> {
+    std::env::var(FAULT_AFTER_TILES).ok()?.trim().parse().ok()
+}
+
+/// The message of the device error injected at tile `tile` (0-based), if one is.
+pub(crate) fn injected_fault(after: Option<usize>, tile: usize) -> Option<String> {
+    (after == Some(tile)).then(|| {
+        format!(
+            "device error injected at tile {} by {FAULT_AFTER_TILES}={tile} (a testing aid)",
+            tile + 1
+        )
+    })
+}
 
 /// Tile edge in pixels for GPU launches: 512×512 pixels per dispatch keeps each dispatch
 /// short (well under a driver watchdog's limit) while filling a large GPU.
@@ -104,6 +126,46 @@ pub fn render_cuda(
         timestamps: true,
         wall: frame.wall_time,
     })
+}
+
+/// The most a wgpu render of `settings` allocates, with a scene uniform of `uniforms` bytes.
+/// On the device: the uniform, the tile table, the image (16 bytes a pixel) and statistics
+/// buffers, their readback copies and the timestamp queries. On the host: the tile table (and
+/// wgpu's staging copy of it), the read-back bytes and their conversion to colours and
+/// statistics words, then the statistics' per-pixel steps and their sorted copy.
+pub fn memory_wgpu(settings: &sdfc_compiler::scene::Settings, uniforms: u64) -> Memory {
+    let (pixels, tiles) = pixels_and_tiles(settings);
+    let stats = 4 * STATS_WORDS as u64 * pixels;
+    let table = tiles * 256;
+    let queries = 2 * tiles * 8;
+    let device = uniforms.max(16) + table + 2 * (16 * pixels + stats) + 3 * queries;
+    // Read back: the image's bytes (16 a pixel), floats (16) and colours (12), and the
+    // statistics' bytes and words, all held at once (more than the colours, words, steps and
+    // sorted steps held afterwards).
+    let host = 2 * table + 2 * queries + 44 * pixels + 2 * stats;
+    Memory { host, device }
+}
+
+/// The most a CUDA render of `settings` allocates, with a scene uniform of `uniforms` bytes:
+/// on the device the uniform, tile table, image and statistics; on the host the tile table,
+/// the read-back floats (16 bytes a pixel), colours (12) and statistics, then the steps.
+pub fn memory_cuda(settings: &sdfc_compiler::scene::Settings, uniforms: u64) -> Memory {
+    let (pixels, tiles) = pixels_and_tiles(settings);
+    let stats = 4 * STATS_WORDS as u64 * pixels;
+    let device = uniforms + 16 * tiles + 16 * pixels + stats;
+    let host = 16 * tiles + 64 * tiles + 16 * pixels + 12 * pixels + stats + 8 * pixels;
+    Memory { host, device }
+}
+
+/// The bytes of a finished GPU frame: its image.
+pub fn retained(settings: &sdfc_compiler::scene::Settings) -> u64 {
+    12 * settings.width as u64 * settings.height as u64
+}
+
+fn pixels_and_tiles(settings: &sdfc_compiler::scene::Settings) -> (u64, u64) {
+    let (w, h) = (settings.width as u64, settings.height as u64);
+    let edge = TILE as u64;
+    (w * h, w.div_ceil(edge) * h.div_ceil(edge))
 }
 
 /// Sums the kernel's per-pixel statistics words into the CPU renderer's statistics.

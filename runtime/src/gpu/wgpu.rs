@@ -166,6 +166,7 @@ impl Gpu {
             .collect();
         self.queue.write_buffer(&buffers.tile, 0, &table);
         let start = Instant::now();
+        let fault = super::fault_after_tiles();
         // Tiles are submitted in batches: each tile is its own dispatch, and the host waits
         // after each batch (progress, and a bound on how much work is queued at once).
         for (b, batch) in tiles.chunks(TILES_PER_SUBMIT).enumerate() {
@@ -187,6 +188,12 @@ impl Gpu {
             }
             self.queue.submit([enc.finish()]);
             self.wait()?;
+            let first = b * TILES_PER_SUBMIT;
+            if let Some(msg) =
+                (first..first + batch.len()).find_map(|i| super::injected_fault(fault, i))
+            {
+                return Err(Error::Render(msg));
+            }
             progress(((b * TILES_PER_SUBMIT + batch.len()) as f64 / tiles.len() as f64).min(1.0));
         }
         let wall_time = start.elapsed();

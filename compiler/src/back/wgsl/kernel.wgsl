@@ -593,6 +593,12 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
             sum += radiance(params.eye.xyz, camera_dir(x, y, i, j));
         }
     }
+//#if DEBUG_NAN
+    // --debug-nan: a pixel any of whose rays met a NaN is magenta.
+    if counters.nans > 0u {
+        sum = vec3<f32>(1.0, 0.0, 1.0) * f32(aa * aa);
+    }
+//#endif
     let pixel = y * params.counts.x + x;
     image[pixel] = vec4<f32>(sum / f32(aa * aa), 1.0);
     let s = pixel * 8u;

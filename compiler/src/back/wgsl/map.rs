@@ -11,7 +11,12 @@ pub fn write_map(program: &Program) -> String {
     let mut out = String::new();
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
     out.push_str("fn map(p: vec3<f32>) -> vec2<f32> {\n");
-    body(&mut out, program, &[program.distance(), program.material()], true);
+    body(
+        &mut out,
+        program,
+        &[program.distance(), program.material()],
+        true,
+    );
     let names = Names::new(program);
     let (d, m) = (names.get(program.distance()), names.get(program.material()));
     let _ = writeln!(out, "    return vec2<f32>({d}, {m});");
@@ -119,7 +124,11 @@ impl Names {
                 .map(|(op, i)| match (op, i) {
                     (Op::Const(c), true) => {
                         let lit = float(*c);
-                        Some(if lit.starts_with('-') { format!("({lit})") } else { lit })
+                        Some(if lit.starts_with('-') {
+                            format!("({lit})")
+                        } else {
+                            lit
+                        })
                     }
                     _ => None,
                 })

@@ -111,10 +111,28 @@ fn count(scene: &Scene, point: bool) -> usize {
         .count()
 }
 
+/// Choices of a kernel that do not come from the scene.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Paint the pixels whose rays met a NaN magenta (`sdfc render --debug-nan`): the
+    /// `DEBUG_NAN` feature. Off, the kernel is the same as without the option.
+    pub debug_nan: bool,
+}
+
 /// Writes and validates the kernel for `scene`, whose distance program is `program`.
 pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
-    let features = features(scene);
-    let on: HashMap<&str, bool> = features.iter().copied().collect();
+    write_with(scene, program, &Options::default())
+}
+
+/// [`write`] with the given options.
+pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result<Kernel, Error> {
+    let mut features = features(scene);
+    let mut on: HashMap<&str, bool> = features.iter().copied().collect();
+    // Listed in the header only when on, so that the default kernel does not change.
+    on.insert("DEBUG_NAN", options.debug_nan);
+    if options.debug_nan {
+        features.push(("DEBUG_NAN", true));
+    }
     let mut values: HashMap<&str, String> = HashMap::new();
     match crate::scene::analytic::choose(scene).primitives() {
         // An analytically traced scene needs no distance field.

@@ -1,0 +1,296 @@
+//! Resource limits: every bound that keeps a compilation or a render finite, with its
+//! default, the name `--limit NAME=VALUE` sets it by, and what it bounds.
+//!
+//! The checker reads the compilation limits from the [`Limits`] it is given
+//! (`check::check_with`); the render limits are checked by the checker (the `render` block)
+//! and by the runtime (`--set`, the program size, the render's memory). A diagnostic or error
+//! for an exceeded limit names the flag that raises it ([`Limits::raise`]).
+
+use std::fmt;
+
+/// One resource limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Limit {
+    /// Levels of expression nesting evaluated.
+    Nesting,
+    /// Evaluation steps (expressions and loop iterations) of one compilation.
+    Fuel,
+    /// Depth of nested calls of user functions.
+    CallDepth,
+    /// Shape nodes a scene may build.
+    Nodes,
+    /// Objects a `scene` block may add, and iterations of one loop.
+    Objects,
+    /// Files one compilation may import, in all.
+    Files,
+    /// Width and height of an image, in pixels.
+    Edge,
+    /// Supersampling: samples per pixel edge.
+    Aa,
+    /// The render setting `max_steps`.
+    MaxSteps,
+    /// The render setting `max_depth`.
+    MaxDepth,
+    /// Operations of the distance program after lowering.
+    Program,
+    /// Memory a render may allocate, in MiB.
+    Memory,
+}
+
+/// What a limit is: its name, default, accepted values and a one-line description.
+struct Spec {
+    name: &'static str,
+    default: u64,
+    /// The largest value `--limit` accepts (beyond it the implementation's own bounds, such
+    /// as 32-bit pixel indices, would break).
+    ceiling: u64,
+    what: &'static str,
+}
+
+impl Limit {
+    /// Every limit, in the order they are listed.
+    pub const ALL: [Limit; 12] = [
+        Limit::Nesting,
+        Limit::Fuel,
+        Limit::CallDepth,
+        Limit::Nodes,
+        Limit::Objects,
+        Limit::Files,
+        Limit::Edge,
+        Limit::Aa,
+        Limit::MaxSteps,
+        Limit::MaxDepth,
+        Limit::Program,
+        Limit::Memory,
+    ];
+
+    fn spec(self) -> Spec {
+        let s = |name, default, ceiling, what| Spec {
+            name,
+            default,
+            ceiling,
+            what,
+        };
+        match self {
+            Limit::Nesting => s("nesting", 1_000, 1_000_000, "levels of expression nesting"),
+            Limit::Fuel => s(
+                "fuel",
+                50_000_000,
+                1 << 50,
+                "evaluation steps (expressions and loop iterations) of one compilation",
+            ),
+            Limit::CallDepth => s(
+                "call_depth",
+                256,
+                1_000_000,
+                "depth of nested calls of functions",
+            ),
+            Limit::Nodes => s(
+                "nodes",
+                1_000_000,
+                u32::MAX as u64 - 1,
+                "shape nodes a scene builds",
+            ),
+            Limit::Objects => s(
+                "objects",
+                100_000,
+                u32::MAX as u64 - 1,
+                "objects in a scene, and iterations of one loop",
+            ),
+            Limit::Files => s("files", 256, 1_000_000, "files imported by one compilation"),
+            Limit::Edge => s(
+                "edge",
+                16_384,
+                65_535,
+                "width and height of an image, in pixels",
+            ),
+            Limit::Aa => s("aa", 16, 256, "supersampling (samples per pixel edge)"),
+            Limit::MaxSteps => s(
+                "max_steps",
+                1_000_000,
+                u32::MAX as u64 - 1,
+                "the render setting max_steps",
+            ),
+            Limit::MaxDepth => s("max_depth", 64, 1_000, "the render setting max_depth"),
+            Limit::Program => s(
+                "program",
+                4_000_000,
+                u32::MAX as u64 - 1,
+                "operations of the distance program after lowering",
+            ),
+            Limit::Memory => s(
+                "memory",
+                4_096,
+                1 << 30,
+                "memory a render may allocate, in MiB (host and device together)",
+            ),
+        }
+    }
+
+    /// The name `--limit NAME=VALUE` uses.
+    pub fn name(self) -> &'static str {
+        self.spec().name
+    }
+
+    /// What the limit bounds, in a few words.
+    pub fn describe(self) -> &'static str {
+        self.spec().what
+    }
+
+    /// The default value.
+    pub fn default_value(self) -> u64 {
+        self.spec().default
+    }
+
+    /// The largest value the limit may be raised to.
+    pub fn ceiling(self) -> u64 {
+        self.spec().ceiling
+    }
+
+    /// The limit of a name, as `--limit` writes it.
+    pub fn named(name: &str) -> Option<Limit> {
+        Limit::ALL.into_iter().find(|l| l.name() == name)
+    }
+}
+
+impl fmt::Display for Limit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The value of every limit for one run.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Limits {
+    values: [u64; 12],
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            values: Limit::ALL.map(Limit::default_value),
+        }
+    }
+}
+
+impl Limits {
+    /// The value of `limit`.
+    pub fn get(&self, limit: Limit) -> u64 {
+        self.values[limit as usize]
+    }
+
+    /// The value of `limit` as a `usize` (saturating on 32-bit targets).
+    pub fn count(&self, limit: Limit) -> usize {
+        usize::try_from(self.get(limit)).unwrap_or(usize::MAX)
+    }
+
+    /// Sets `limit` to `value`, which must be from 1 to the limit's ceiling.
+    pub fn set(&mut self, limit: Limit, value: u64) -> Result<(), String> {
+        if !(1..=limit.ceiling()).contains(&value) {
+            return Err(format!(
+                "the limit {} must be a whole number from 1 to {}, not {value}",
+                limit.name(),
+                limit.ceiling()
+            ));
+        }
+        self.values[limit as usize] = value;
+        Ok(())
+    }
+
+    /// Parses one `NAME=VALUE` of `--limit` (underscores may group digits). The error names
+    /// the valid limits.
+    pub fn parse(setting: &str) -> Result<(Limit, u64), String> {
+        let (name, value) = setting.split_once('=').ok_or_else(|| {
+            format!(
+                "--limit expects NAME=VALUE, like fuel=100000000, not `{setting}`; {}",
+                Self::names()
+            )
+        })?;
+        let (name, value) = (name.trim(), value.trim());
+        let limit = Limit::named(name)
+            .ok_or_else(|| format!("unknown limit `{name}`; {}", Self::names()))?;
+        let bad = || {
+            format!(
+                "the limit {name} must be a whole number from 1 to {}, not `{value}`",
+                limit.ceiling()
+            )
+        };
+        let parsed = value.replace('_', "").parse::<u64>().map_err(|_| bad())?;
+        if !(1..=limit.ceiling()).contains(&parsed) {
+            return Err(bad());
+        }
+        Ok((limit, parsed))
+    }
+
+    /// Applies one `NAME=VALUE` of `--limit`.
+    pub fn apply(&mut self, setting: &str) -> Result<(), String> {
+        let (limit, value) = Self::parse(setting)?;
+        self.set(limit, value)
+    }
+
+    /// `the limits are nesting, fuel, …`, for usage errors.
+    pub fn names() -> String {
+        let names: Vec<&str> = Limit::ALL.iter().map(|l| l.name()).collect();
+        format!("the limits are {}", names.join(", "))
+    }
+
+    /// A heading and one line per limit: name, default and what it bounds (for `--help`).
+    pub fn table() -> String {
+        let row =
+            |name: &str, default: &str, what: &str| format!("{name:<11} {default:>10}  {what}");
+        let rows = Limit::ALL
+            .iter()
+            .map(|l| row(l.name(), &l.default_value().to_string(), l.describe()));
+        std::iter::once(row("NAME", "DEFAULT", "BOUNDS"))
+            .chain(rows)
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    /// How to raise `limit` past its current value: ``raise it with `--limit fuel=100000000` ``
+    /// (twice the current value, within the ceiling).
+    pub fn raise(&self, limit: Limit) -> String {
+        let doubled = self.get(limit).saturating_mul(2);
+        self.raise_to(limit, doubled.min(limit.ceiling().max(self.get(limit) + 1)))
+    }
+
+    /// How to raise `limit` to at least `needed`, or that it cannot be raised so far.
+    pub fn raise_to(&self, limit: Limit, needed: u64) -> String {
+        let (name, ceiling) = (limit.name(), limit.ceiling());
+        if needed > ceiling {
+            return format!("it cannot be raised above {ceiling} (`--limit {name}={ceiling}`)");
+        }
+        format!("raise it with `--limit {name}={}`", needed.max(1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_defaults_within_ceilings() {
+        for (i, a) in Limit::ALL.iter().enumerate() {
+            assert_eq!(*a as usize, i, "ALL is in declaration order");
+            assert!(a.default_value() >= 1 && a.default_value() <= a.ceiling());
+            for b in &Limit::ALL[i + 1..] {
+                assert_ne!(a.name(), b.name());
+            }
+        }
+    }
+
+    #[test]
+    fn settings_parse_and_errors_list_the_names() {
+        let mut l = Limits::default();
+        l.apply("fuel=100_000").expect("valid");
+        assert_eq!(l.get(Limit::Fuel), 100_000);
+        let unknown = l.apply("speed=3").expect_err("unknown");
+        assert!(unknown.contains("unknown limit `speed`") && unknown.contains("max_steps"));
+        assert!(l.apply("aa=0").is_err());
+        assert!(l.apply("aa=257").is_err());
+        assert!(l.apply("aa=x").is_err());
+        assert!(l.apply("aa").expect_err("no =").contains("the limits are"));
+        assert_eq!(l.raise(Limit::Fuel), "raise it with `--limit fuel=200000`");
+        assert_eq!(l.raise(Limit::Aa), "raise it with `--limit aa=32`");
+    }
+}

@@ -1,0 +1,94 @@
+//! What a render allocates: the bound announced before a render starts, held to the
+//! `memory` limit (`--limit memory=MIB`), and the allocations of writing its outputs.
+
+use crate::backend::Prepared;
+use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{Limit, Limits};
+use std::fmt;
+
+/// Bytes in a MiB.
+pub const MIB: u64 = 1 << 20;
+
+/// Bytes allocated at most, on the host and on the GPU.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Memory {
+    /// Host memory.
+    pub host: u64,
+    /// Device memory (buffers on the GPU, including readback buffers).
+    pub device: u64,
+}
+
+impl Memory {
+    /// Host and device together: what the `memory` limit bounds.
+    pub fn total(&self) -> u64 {
+        self.host.saturating_add(self.device)
+    }
+
+    /// `Err` naming the flag that raises the limit when `self` exceeds the `memory` limit.
+    pub fn check(&self, limits: &Limits) -> Result<(), String> {
+        let limit = limits.get(Limit::Memory);
+        let needed = mib(self.total());
+        if needed <= limit {
+            return Ok(());
+        }
+        Err(format!(
+            "the render would allocate up to {needed} MiB, more than the memory limit of {limit} MiB; {}",
+            limits.raise_to(Limit::Memory, needed)
+        ))
+    }
+}
+
+/// Bytes in whole MiB, rounded up.
+pub fn mib(bytes: u64) -> u64 {
+    bytes.div_ceil(MIB)
+}
+
+impl fmt::Display for Memory {
+    /// `allocating at most 96 MiB` (with the device's share on GPU backends).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "allocating at most {} MiB", mib(self.total()))?;
+        if self.device > 0 {
+            write!(f, " ({} MiB of it on the GPU)", mib(self.device))?;
+        }
+        Ok(())
+    }
+}
+
+/// The most bytes writing the outputs of a render of `settings` allocates: the RGBA8 image,
+/// the PNG bytes (at most the raw image with its filter bytes, in a vector that may double)
+/// and the encoder's state, and with `aux` the depth sidecar's bytes.
+pub fn output(settings: &Settings, aux: bool) -> u64 {
+    let (w, h) = (settings.width as u64, settings.height as u64);
+    let rgba = 4 * w * h;
+    let png = 2 * (rgba + h + 4096);
+    let encoder = 4 * MIB + 16 * (4 * w + 1);
+    let sidecar = if aux { 20 + 8 * w * h } else { 0 };
+    rgba + png + encoder + sidecar
+}
+
+/// The most a `sdfc render` of `scene` allocates on `prepared`: the render; with
+/// `reference`, the finished frame held while its convergence check renders; then the frame
+/// held while its outputs are written.
+pub fn render(prepared: &Prepared, scene: &Scene, reference: bool, aux: bool) -> Memory {
+    let s = &scene.settings;
+    let frame = prepared.memory(scene, s);
+    let held = prepared.retained(s);
+    let check = if reference {
+        frame.host.saturating_add(held)
+    } else {
+        0
+    };
+    let writing = held.saturating_add(output(s, aux));
+    Memory {
+        host: frame.host.max(check).max(writing),
+        device: frame.device,
+    }
+}
+
+/// The announcement before a render: `render: 1920x1080, aa 4, cpu: allocating at most 96 MiB`.
+pub fn announce(settings: &Settings, backend: &str, memory: &Memory) -> String {
+    format!(
+        "render: {}x{}, aa {}, {backend}: {memory}",
+        settings.width, settings.height, settings.aa
+    )
+}

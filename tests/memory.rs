@@ -1,0 +1,172 @@
+//! The memory a render announces is an upper bound: a counting global allocator records the
+//! peak of live heap bytes while CPU renders run through the library, which must stay
+//! within `cpu::memory` (the render) and `memory::render` (the render, the frame held and
+//! its outputs written, as `sdfc render` does), for several sizes, supersampling and
+//! precisions, on a scene whose glass spawns two rays per hit.
+//!
+//! One test only: the counter sees every thread of the process, so nothing else may run.
+#![allow(unsafe_code)] // A global allocator is an unsafe trait; it only forwards to `System`.
+
+use sdfc_compiler::check::check_str;
+use sdfc_compiler::lower;
+use sdfc_compiler::scene::Scene;
+use sdfc_runtime::backend::{Backend, Prepared, Setup};
+use sdfc_runtime::cpu::{self, Options, Precision, Tapes};
+use sdfc_runtime::memory;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Counts live heap bytes and their peak.
+struct Counting;
+
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+fn grew(bytes: usize) {
+    let now = LIVE.fetch_add(bytes, Ordering::SeqCst) + bytes;
+    PEAK.fetch_max(now, Ordering::SeqCst);
+}
+
+// SAFETY: every call is forwarded to `System` with the same arguments; the counters are
+// atomics and never allocate.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            grew(layout.size());
+        }
+        p
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc_zeroed(layout) };
+        if !p.is_null() {
+            grew(layout.size());
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) };
+        LIVE.fetch_sub(layout.size(), Ordering::SeqCst);
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let p = unsafe { System.realloc(ptr, layout, new_size) };
+        if !p.is_null() {
+            // Counted as the new block allocated before the old one is freed (a copying
+            // realloc holds both).
+            grew(new_size);
+            LIVE.fetch_sub(layout.size(), Ordering::SeqCst);
+        }
+        p
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Runs `f` and returns its result and the peak growth of live heap bytes while it ran.
+fn peak_of<R>(f: impl FnOnce() -> R) -> (R, u64) {
+    let base = LIVE.load(Ordering::SeqCst);
+    PEAK.store(base, Ordering::SeqCst);
+    let r = f();
+    let peak = PEAK.load(Ordering::SeqCst);
+    (r, peak.saturating_sub(base) as u64)
+}
+
+const SCENE: &str = "
+material glass = phong { color: (1, 1, 1), reflect: 0.1, transparency: 0.85, ior: 1.5 };
+material mirror = phong { color: (0.9, 0.9, 0.9), reflect: 0.6 };
+material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 1 };
+camera { position: (0, 2, -6), look_at: (0, 0.5, 0), fov: 60deg }
+light point { position: (4, 6, -4), intensity: 1, radius: 30, softness: 16 }
+light directional { direction: (-1, -1, 0.5), color: (0.4, 0.4, 0.4) }
+render { width: 64, height: 48, max_depth: 8 }
+scene {
+  plane((0, 1, 0), 0) @ floor;
+  sphere(1).translate(0, 1, 0) @ glass;
+  sphere(0.6).translate(1.6, 0.6, 0.5) @ mirror;
+  for i in 0..5 { box((0.2, 0.5, 0.2)).translate(i - 2, 0.5, 2) @ glass; }
+}
+";
+
+fn scene(width: u32, height: u32, aa: u32) -> Scene {
+    let (scene, diags, _) = check_str("memory.sdf", SCENE);
+    let mut scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene.settings.aa = aa;
+    scene
+}
+
+#[test]
+fn renders_stay_within_the_memory_they_announce() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .expect("thread pool");
+    // Warm the pool and its thread-local state before measuring.
+    let warm = scene(16, 16, 1);
+    pool.install(|| cpu::render(&warm, &lower::lower(&warm), &Options::default(), &|| {}));
+    for (width, height, aa, precision) in [
+        (64, 48, 1, Precision::F32),
+        (120, 90, 3, Precision::F32),
+        (80, 60, 2, Precision::F64),
+        (300, 200, 1, Precision::F32),
+    ] {
+        let scene = scene(width, height, aa);
+        let program = lower::lower(&scene);
+        let tapes = Tapes::new(&program);
+        let options = Options {
+            precision,
+            ..Options::default()
+        };
+        let bound = pool.install(|| cpu::memory(&scene, &tapes, &options, 3));
+        let (render, peak) =
+            peak_of(|| pool.install(|| cpu::render_tapes(&scene, &tapes, &options, &|| {})));
+        let case = format!("{width}x{height}, aa {aa}, {precision:?}");
+        println!(
+            "{case}: render peak {peak} bytes, bound {bound} ({:.1}x)",
+            bound as f64 / peak as f64
+        );
+        assert!(render.stats.counters.secondary_rays > 0, "{case}: no glass");
+        let image = 12 * (width * height) as u64;
+        assert!(peak >= image, "{case}: the counter missed the image");
+        assert!(peak <= bound, "{case}: peak {peak} > bound {bound}");
+        // A sanity check that the bound says something: within an order of magnitude.
+        assert!(
+            bound <= 12 * peak,
+            "{case}: bound {bound} is far above {peak}"
+        );
+
+        // The whole of `sdfc render`: prepare, render, hold the frame, write PNG and sidecar.
+        let setup = Setup {
+            precision,
+            debug_nan: false,
+        };
+        let prepared = pool.install(|| {
+            Prepared::from_program(Backend::Cpu, &scene, program.clone(), &setup).expect("cpu")
+        });
+        let announced = pool.install(|| memory::render(&prepared, &scene, false, true));
+        assert_eq!(announced.device, 0);
+        let (bytes, peak) = peak_of(|| {
+            let frame = pool
+                .install(|| prepared.render(&scene, &|_| {}))
+                .expect("render");
+            let png = frame.render.image.encode_png().expect("png");
+            let aux = frame.render.depth.as_ref().expect("depth").encode();
+            png.len() + aux.len()
+        });
+        println!(
+            "{case}: render and outputs peak {peak} bytes, announced {}",
+            announced.host
+        );
+        assert!(bytes > 0);
+        assert!(
+            peak <= announced.host,
+            "{case}: peak {peak} > announced {}",
+            announced.host
+        );
+    }
+}

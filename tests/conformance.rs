@@ -86,6 +86,38 @@ fn wgpu_matches_cpu_on_every_example() {
     );
 }
 
+/// A distance program large enough that `map` and `sdf` are cut into functions
+/// (examples/scaling/compound_100.sdf, about 15 000 instructions) renders on wgpu as on the
+/// CPU.
+#[test]
+fn a_kernel_with_outlined_blocks_matches_the_cpu() {
+    let Some(gpu) = open_gpu() else { return };
+    let path = PathBuf::from("../examples/scaling/compound_100.sdf");
+    let mut scene = frontend::load(&path)
+        .expect("readable")
+        .scene
+        .expect("valid scene");
+    scene.settings.width = 64;
+    scene.settings.height = 48;
+    scene.settings.aa = 1;
+    let program = lower::lower(&scene);
+    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
+    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
+    let on_cpu = cpu::render(&scene, &program, &cpu::Options::default(), &|| {});
+    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+    println!(
+        "compound_100: psnr {:.1} dB, differing {:.4}",
+        d.psnr, d.differing
+    );
+    assert!(
+        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
+        "psnr {:.1} dB, differing {:.4}",
+        d.psnr,
+        d.differing
+    );
+}
+
 /// `--debug-nan` on wgpu: the kernel's `DEBUG_NAN` feature paints the same pixels magenta
 /// as the CPU renderer; without it the kernel is the default one and paints none.
 #[test]

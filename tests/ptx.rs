@@ -769,3 +769,19 @@ fn the_debug_nan_kernel_assembles() {
         println!("    {}", summary(&assemble(&p, &text, "debug_nan", 80)));
     }
 }
+
+/// A distance program large enough that `map` and `sdf` are cut into functions (guarded
+/// blocks outlined) translates, and assembles.
+#[test]
+fn a_kernel_with_outlined_blocks_assembles() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/compound_100.sdf");
+    let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+    let program = sdfc_compiler::lower::lower(&scene);
+    let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+    assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+    assert!(text.contains(".entry"));
+    if let Some(p) = ptxas() {
+        println!("    {}", summary(&assemble(&p, &text, "outlined", 80)));
+    }
+}

@@ -1,24 +1,39 @@
 //! Writes a distance program as the WGSL functions `fn map(p: vec3<f32>) -> vec2<f32>` and
 //! `fn sdf(p: vec3<f32>) -> f32`: one `let` per instruction (constants written where they are
-//! read), with comments naming the scene node each block comes from. A guarded block is an `if`; each of its results is a `var`
-//! holding the value from before the block, assigned the block's value inside it.
+//! read), with comments naming the scene node each block comes from. A guarded block is an
+//! `if`; each of its results is a `var` holding the value from before the block, assigned the
+//! block's value inside it. In a large program, large blocks become functions of their own
+//! (`map_blockN`, `sdf_blockN`) that take the point and the values they read from outside.
 
 use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::fmt::Write;
 
-/// The WGSL text of `map`, returning (distance, material id).
+/// Programs with more live instructions than this have their large guarded blocks written as
+/// functions of their own. naga's WGSL front end takes time that grows with the square of a
+/// function's length: `sdfc compile --emit ptx` of examples/scaling/compound_1000.sdf (about
+/// 150 000 instructions) took 41 s with one `map`, and takes 2 s cut into functions; ptxas
+/// then inlines them again. Smaller programs are written as one function.
+const OUTLINE_PROGRAM: usize = 8_000;
+/// In such a program, a guarded block with at least this many live instructions becomes a
+/// function (nested blocks inside it may become functions in turn). Smaller pieces parse
+/// faster still but made ptxas slower (122 s against 47 s for compound_1000 at 256).
+const OUTLINE_BLOCK: usize = 2_000;
+/// A block that reads more values from outside than this stays inline.
+const OUTLINE_PARAMS: usize = 48;
+
+/// The WGSL text of `map`, returning (distance, material id), preceded by the functions
+/// of its outlined blocks, if any.
 pub fn write_map(program: &Program) -> String {
-    let mut out = String::new();
+    let roots = [program.distance(), program.material()];
+    let mut w = Writer::new(program, &roots, true, "map");
+    let mut main = String::new();
+    w.emit(0, w.items.len(), 1, &mut main);
+    let names = &w.names;
+    let (d, m) = (names.get(program.distance()), names.get(program.material()));
+    let mut out = std::mem::take(&mut w.functions);
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
     out.push_str("fn map(p: vec3<f32>) -> vec2<f32> {\n");
-    body(
-        &mut out,
-        program,
-        &[program.distance(), program.material()],
-        true,
-    );
-    let names = Names::new(program);
-    let (d, m) = (names.get(program.distance()), names.get(program.material()));
+    out.push_str(&main);
     let _ = writeln!(out, "    return vec2<f32>({d}, {m});");
     out.push_str("}\n");
     out
@@ -27,54 +42,214 @@ pub fn write_map(program: &Program) -> String {
 /// The WGSL text of `sdf`: only the instructions the distance depends on (marching and
 /// normals do not need the material).
 pub fn write_sdf(program: &Program) -> String {
-    let mut out = String::from(
+    let roots = [program.distance()];
+    let mut w = Writer::new(program, &roots, false, "sdf");
+    let mut main = String::new();
+    w.emit(0, w.items.len(), 1, &mut main);
+    let d = w.names.get(program.distance());
+    let mut out = std::mem::take(&mut w.functions);
+    out.push_str(
         "// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n",
     );
-    body(&mut out, program, &[program.distance()], false);
-    let d = Names::new(program).get(program.distance());
+    out.push_str(&main);
     let _ = writeln!(out, "    return {d};\n}}");
     out
 }
 
-/// The statements computing `roots`, with the program's comments when `comments`.
-fn body(out: &mut String, program: &Program, roots: &[Reg], comments: bool) {
-    let (live, live_blocks) = program.live(roots);
-    let ops = program.ops();
-    let blocks = program.blocks();
-    let phi_of = program.phi_blocks();
-    let names = Names::new(program);
-    let mut notes = program.notes().iter().peekable();
-    let mut depth = 1;
-    let pad = |d: usize| "    ".repeat(d);
-    for item in program.items() {
-        match item {
-            Item::Op(i) if live[i] && phi_of[i].is_none() && !names.inlined(i) => {
-                while let Some(n) = notes.next_if(|n| n.at <= i) {
-                    if comments {
-                        let _ = writeln!(out, "{}// {}", pad(depth), n.text);
+/// Writes the statements of a program's live instructions, outlining large blocks.
+struct Writer<'a> {
+    program: &'a Program,
+    live: Vec<bool>,
+    live_blocks: Vec<bool>,
+    phi_of: Vec<Option<usize>>,
+    names: Names,
+    items: Vec<Item>,
+    /// For each `Item::Open` position, the position of its `Item::Close`.
+    close: Vec<usize>,
+    /// Whether each block is written as a function.
+    outline: Vec<bool>,
+    comments: bool,
+    /// Next program note to write.
+    note: usize,
+    /// Prefix of the outlined functions' names.
+    prefix: &'static str,
+    /// The outlined functions written so far.
+    functions: String,
+}
+
+impl<'a> Writer<'a> {
+    fn new(program: &'a Program, roots: &[Reg], comments: bool, prefix: &'static str) -> Self {
+        let (live, live_blocks) = program.live(roots);
+        let items = program.items();
+        let mut close = vec![0; items.len()];
+        let mut open = Vec::new();
+        for (k, item) in items.iter().enumerate() {
+            match item {
+                Item::Open(_) => open.push(k),
+                Item::Close(_) => {
+                    if let Some(o) = open.pop() {
+                        close[o] = k;
                     }
                 }
-                let _ = writeln!(out, "{}let r{i} = {};", pad(depth), expr(&ops[i], &names));
+                Item::Op(_) => {}
             }
-            Item::Op(_) => {}
-            Item::Open(b) if live_blocks[b] => {
-                let block = &blocks[b];
-                for (j, _, other) in results(program, b, &live) {
-                    let _ = writeln!(out, "{}var r{j}: f32 = {};", pad(depth), names.get(other));
-                }
-                let (x, y) = (names.get(block.bound), names.get(block.best));
-                let _ = writeln!(out, "{}if !({x} >= {y}) {{", pad(depth));
-                depth += 1;
-            }
-            Item::Close(b) if live_blocks[b] => {
-                for (j, then, _) in results(program, b, &live) {
-                    let _ = writeln!(out, "{}r{j} = {};", pad(depth), names.get(then));
-                }
-                depth -= 1;
-                let _ = writeln!(out, "{}}}", pad(depth));
-            }
-            Item::Open(_) | Item::Close(_) => {}
         }
+        let count = |a: usize, b: usize| live[a..b].iter().filter(|&&l| l).count();
+        let big = count(0, live.len()) > OUTLINE_PROGRAM;
+        let outline = program
+            .blocks()
+            .iter()
+            .enumerate()
+            .map(|(b, block)| {
+                big && live_blocks[b] && count(block.start, block.end) >= OUTLINE_BLOCK
+            })
+            .collect();
+        Writer {
+            program,
+            names: Names::new(program),
+            phi_of: program.phi_blocks(),
+            live,
+            live_blocks,
+            items,
+            close,
+            outline,
+            comments,
+            note: 0,
+            prefix,
+            functions: String::new(),
+        }
+    }
+
+    /// Writes the items `lo..hi` (blocks whole) at `depth` into `out`.
+    fn emit(&mut self, lo: usize, hi: usize, depth: usize, out: &mut String) {
+        let pad = |d: usize| "    ".repeat(d);
+        let ops = self.program.ops();
+        let mut k = lo;
+        while k < hi {
+            match self.items[k] {
+                Item::Op(i)
+                    if self.live[i] && self.phi_of[i].is_none() && !self.names.inlined(i) =>
+                {
+                    let notes = self.program.notes();
+                    while self.note < notes.len() && notes[self.note].at <= i {
+                        if self.comments {
+                            let _ = writeln!(out, "{}// {}", pad(depth), notes[self.note].text);
+                        }
+                        self.note += 1;
+                    }
+                    let _ = writeln!(
+                        out,
+                        "{}let r{i} = {};",
+                        pad(depth),
+                        expr(&ops[i], &self.names)
+                    );
+                }
+                Item::Open(b) if self.live_blocks[b] => {
+                    let block = &self.program.blocks()[b];
+                    let results = results(self.program, b, &self.live);
+                    for &(j, _, other) in &results {
+                        let _ = writeln!(
+                            out,
+                            "{}var r{j}: f32 = {};",
+                            pad(depth),
+                            self.names.get(other)
+                        );
+                    }
+                    let (x, y) = (self.names.get(block.bound), self.names.get(block.best));
+                    let _ = writeln!(out, "{}if !({x} >= {y}) {{", pad(depth));
+                    let end = self.close[k];
+                    let arity = results.len();
+                    let params = if self.outline[b] && (1..=4).contains(&arity) {
+                        Some(self.outside_reads(b, &results)).filter(|p| p.len() <= OUTLINE_PARAMS)
+                    } else {
+                        None
+                    };
+                    if let Some(params) = params {
+                        let name = format!("{}_block{b}", self.prefix);
+                        let args: Vec<String> =
+                            params.iter().map(|r| format!(", r{}", r.0)).collect();
+                        let _ =
+                            writeln!(out, "{}let o = {name}(p{});", pad(depth + 1), args.concat());
+                        for (n, &(j, _, _)) in results.iter().enumerate() {
+                            let lane = if arity == 1 {
+                                ""
+                            } else {
+                                [".x", ".y", ".z", ".w"][n]
+                            };
+                            let _ = writeln!(out, "{}r{j} = o{lane};", pad(depth + 1));
+                        }
+                        self.function(&name, k + 1, end, &params, &results);
+                    } else {
+                        self.emit(k + 1, end, depth + 1, out);
+                        for &(j, then, _) in &results {
+                            let _ =
+                                writeln!(out, "{}r{j} = {};", pad(depth + 1), self.names.get(then));
+                        }
+                    }
+                    let _ = writeln!(out, "{}}}", pad(depth));
+                    k = end;
+                }
+                Item::Op(_) | Item::Open(_) | Item::Close(_) => {}
+            }
+            k += 1;
+        }
+    }
+
+    /// Writes the function of an outlined block: the point and the values it reads from
+    /// outside in, the block's results out.
+    fn function(
+        &mut self,
+        name: &str,
+        lo: usize,
+        hi: usize,
+        params: &[Reg],
+        results: &[(usize, Reg, Reg)],
+    ) {
+        let mut body = String::new();
+        self.emit(lo, hi, 1, &mut body);
+        let ty = match results.len() {
+            1 => "f32".to_string(),
+            n => format!("vec{n}<f32>"),
+        };
+        let list: Vec<String> = params.iter().map(|r| format!(", r{}: f32", r.0)).collect();
+        let values: Vec<String> = results
+            .iter()
+            .map(|&(_, then, _)| self.names.get(then))
+            .collect();
+        let value = if results.len() == 1 {
+            values[0].clone()
+        } else {
+            format!("{ty}({})", values.join(", "))
+        };
+        let f = &mut self.functions;
+        let _ = writeln!(f, "// A guarded block of `{}`, outlined.", self.prefix);
+        let _ = writeln!(f, "fn {name}(p: vec3<f32>{}) -> {ty} {{", list.concat());
+        f.push_str(&body);
+        let _ = writeln!(f, "    return {value};\n}}\n");
+    }
+
+    /// The registers that block `b` (its live instructions, nested blocks and results) reads
+    /// from before it, other than literals, in order.
+    fn outside_reads(&self, b: usize, results: &[(usize, Reg, Reg)]) -> Vec<Reg> {
+        let program = self.program;
+        let block = &program.blocks()[b];
+        let inside = |r: Reg| (block.start..block.end).contains(&(r.0 as usize));
+        let mut reads: Vec<Reg> = Vec::new();
+        for i in block.start..block.end {
+            if self.live[i] && !self.names.inlined(i) {
+                reads.extend(program.ops()[i].operands());
+            }
+        }
+        for (b2, inner) in program.blocks().iter().enumerate() {
+            if b2 != b && self.live_blocks[b2] && inside(Reg(inner.start as u32)) {
+                reads.extend([inner.bound, inner.best]);
+            }
+        }
+        reads.extend(results.iter().map(|&(_, then, _)| then));
+        reads.retain(|&r| !inside(r) && !self.names.inlined(r.0 as usize));
+        reads.sort_by_key(|r| r.0);
+        reads.dedup();
+        reads
     }
 }
 

@@ -11,7 +11,7 @@ use crate::cpu::{Precision, Render};
 use crate::frontend::{self, DiagnosticFormat};
 use crate::metrics::{self, DepthDifference};
 use sdfc_compiler::lower::{LowerOptions, Program};
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::scene::{Method, Scene, Settings};
 use sdfc_compiler::Limits;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -372,6 +372,11 @@ pub fn run(args: ParetoArgs) -> ExitCode {
         args.sweep.clone()
     };
     let settings = &mut checked.scene.settings;
+    // The swept settings are sphere tracing's: a scene that `auto` would trace analytically
+    // (no ε, no step budget) is marched, unless `--set method=trace` asks otherwise.
+    if settings.method == Method::Auto {
+        settings.method = Method::March;
+    }
     let plan = check_output(args.output.as_deref())
         .and_then(|()| override_settings(settings, args.size, None, &args.set, &limits))
         .and_then(|()| {
@@ -541,8 +546,10 @@ fn reference_setup(
         .max()
         .unwrap_or(scene.settings.aa);
     let mut reference_scene = scene.clone();
+    // The most exact render the scene allows: analytic tracing where it can be traced.
     reference_scene.settings = reference::settings(&Settings {
         aa,
+        method: Method::Auto,
         ..scene.settings.clone()
     });
     let setup = Setup {

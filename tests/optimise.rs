@@ -321,9 +321,8 @@ fn generated_code_handles_blocks() {
     let ifs = kernel.source.matches("if !(r").count();
     assert!(ifs >= program.blocks().len(), "{ifs} ifs");
     let text = rust::write(&program);
-    // Two functions (f32 and f64). Not every block becomes its own `if` in the Rust text
-    // (an open question of issue 8: see the closing note), but culling must be there.
-    assert!(text.matches("if !(r").count() >= program.blocks().len());
+    // Two functions (f32 and f64), one `if` per block in each.
+    assert_eq!(text.matches("if !(r").count(), 2 * program.blocks().len());
     let dump = program.dump();
     assert_eq!(dump.matches("if !(%").count(), program.blocks().len());
     let results: usize = program.blocks().iter().map(|b| b.results).sum();

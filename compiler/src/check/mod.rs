@@ -110,6 +110,10 @@ fn analytic_method(cx: &mut Ctx, scene: &Scene) {
             span,
             format!("`{what}` has no closed-form ray intersection"),
         ),
+        Reason::Overlap { span } => d.with_secondary(
+            span,
+            "this transparent shape overlaps or touches another one",
+        ),
         other => d.with_note(other.describe()),
     };
     cx.error(d);

@@ -63,6 +63,9 @@ pub enum Reason {
     SoftLight { index: usize },
     /// Too many primitives for `auto` to trace them one by one.
     Many { count: usize },
+    /// A transparent primitive overlaps or touches another one: a ray inside it must leave
+    /// through the boundary of the union, which tracing primitive by primitive does not find.
+    Overlap { span: Span },
 }
 
 impl Reason {
@@ -76,6 +79,9 @@ impl Reason {
                     "light {} casts soft shadows, which need a distance field",
                     index + 1
                 )
+            }
+            Reason::Overlap { .. } => {
+                "a transparent primitive overlaps or touches another, so rays inside it would need the boundary of their union".into()
             }
             Reason::Many { count } => format!(
                 "{count} primitives: beyond {MAX_AUTO_PRIMITIVES}, sphere tracing with bounding-volume culling is used"
@@ -131,7 +137,46 @@ pub fn choose(scene: &Scene) -> Choice {
     if scene.settings.method == Method::Auto && out.len() > MAX_AUTO_PRIMITIVES {
         return Choice::March(Reason::Many { count: out.len() });
     }
+    if let Some(p) = transparent_overlap(scene, &out) {
+        let span = scene.graph.span(p.node);
+        return Choice::March(Reason::Overlap { span });
+    }
     Choice::Trace(out)
+}
+
+/// A transparent primitive whose box meets another primitive's box or a plane's solid side
+/// (touching counts; boxes are conservative, so some disjoint pairs are reported too). Rays
+/// are traced primitive by primitive: a ray inside a solid leaves at that solid's far side,
+/// which is a surface of the union only when no other solid overlaps it. Only refracted rays
+/// travel inside solids, so only transparent primitives need the check.
+fn transparent_overlap<'a>(scene: &Scene, prims: &'a [Primitive]) -> Option<&'a Primitive> {
+    let boxes: Vec<Option<Aabb>> = prims.iter().map(world_box).collect();
+    let touches = |a: &Aabb, j: usize| match (&boxes[j], &prims[j].shape) {
+        (Some(b), _) => (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k]),
+        (None, Shape::Plane { normal, height }) => {
+            // local = M·p + c: the solid side n·local <= h is (Mᵀn)·p <= h − n·c in the world.
+            let m = &prims[j].matrix;
+            let n: V3 = [0, 1, 2].map(|k| (0..3).map(|i| m[i][k] * normal[i]).sum());
+            let h = height - (0..3).map(|i| normal[i] * prims[j].offset[i]).sum::<f64>();
+            let lowest: f64 = (0..3)
+                .map(|k| n[k] * if n[k] > 0.0 { a.0[k] } else { a.1[k] })
+                .sum();
+            lowest <= h
+        }
+        (None, _) => true,
+    };
+    prims.iter().enumerate().find_map(|(i, p)| {
+        if scene.material(p.material).transparency <= 0.0 {
+            return None;
+        }
+        // A transparent primitive without a finite box (a plane) overlaps everything.
+        let Some(a) = &boxes[i] else {
+            return (prims.len() > 1).then_some(p);
+        };
+        (0..prims.len())
+            .any(|j| j != i && touches(a, j))
+            .then_some(p)
+    })
 }
 
 fn softness(l: &Light) -> f64 {
@@ -329,11 +374,18 @@ fn build(mut items: Vec<(usize, Aabb)>) -> Group {
     let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
     // Padded by a few f32 ulps of the box's size and place, so that the box written as f32
     // still contains every primitive in it.
-    let pad = 1e-5 * (0..3).map(|k| centre[k].abs() + hi[k] - lo[k]).fold(0.0, f64::max);
+    let pad = 1e-5
+        * (0..3)
+            .map(|k| centre[k].abs() + hi[k] - lo[k])
+            .fold(0.0, f64::max);
     let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]) + pad);
     if items.len() <= LEAF {
         let items = items.into_iter().map(|(i, _)| Item::Primitive(i)).collect();
-        return Group { centre, half, items };
+        return Group {
+            centre,
+            half,
+            items,
+        };
     }
     let mid = |(a, b): &Aabb, k: usize| a[k] + b[k];
     let spread = |k: usize| {
@@ -348,7 +400,11 @@ fn build(mut items: Vec<(usize, Aabb)>) -> Group {
         .max_by(|&a, &b| spread(a).total_cmp(&spread(b)))
         .unwrap_or(0);
     // Ties broken by index, so that the tree (and the generated code) is deterministic.
-    items.sort_by(|x, y| mid(&x.1, axis).total_cmp(&mid(&y.1, axis)).then(x.0.cmp(&y.0)));
+    items.sort_by(|x, y| {
+        mid(&x.1, axis)
+            .total_cmp(&mid(&y.1, axis))
+            .then(x.0.cmp(&y.0))
+    });
     let rest = items.split_off(items.len() / 2);
     let halves = [items, rest].map(|h| {
         if h.len() == 1 {
@@ -390,7 +446,10 @@ pub fn world_box(p: &Primitive) -> Option<Aabb> {
             hi[k] = hi[k].max(w);
         }
     }
-    lo.iter().chain(&hi).all(|x| x.is_finite()).then_some((lo, hi))
+    lo.iter()
+        .chain(&hi)
+        .all(|x| x.is_finite())
+        .then_some((lo, hi))
 }
 
 /// The inverse of a 3×3 matrix (rows), or `None` when it is singular.

@@ -89,6 +89,11 @@ pub fn method(loaded: &Loaded, scene: &Scene) -> String {
             let file = loaded.sources.name(span.file);
             format!("method: march (the {what} at {file}:{line}:{col} has no closed-form ray intersection)")
         }
+        Choice::March(Reason::Overlap { span }) => {
+            let (line, col) = loaded.sources.line_col(span);
+            let file = loaded.sources.name(span.file);
+            format!("method: march (the transparent shape at {file}:{line}:{col} overlaps or touches another one)")
+        }
         choice => choice.describe(),
     }
 }

@@ -118,6 +118,37 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
     );
 }
 
+/// Shadow rays pass through glass on the GPU as on the CPU even when no refracted ray is
+/// traced (`max_depth: 0`, so the kernel has no refraction code).
+#[test]
+fn shadows_through_glass_match_without_secondary_rays() {
+    let Some(gpu) = open_gpu() else { return };
+    let text = "material glass = phong { transparency: 0.9, ior: 1.5 };\n\
+                camera { position: (0, 3, -4), look_at: (0, 0, 0), fov: 50deg }\n\
+                light point { position: (0, 6, 0), intensity: 1, radius: 50 }\n\
+                render { width: 64, height: 48, max_depth: 0, method: \"march\" }\n\
+                scene { plane(); sphere(0.8).translate(0, 1.2, 0) @ glass; }";
+    let (scene, diags, _) = sdfc_compiler::check::check_str("glass.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let program = lower::lower(&scene);
+    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(kernel.features.contains(&("TRANSPARENT", true)));
+    assert!(kernel.features.contains(&("REFRACTION", false)));
+    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
+    let on_cpu = cpu::render(&scene, &program, &cpu::Options::default(), &|| {});
+    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+    println!(
+        "glass shadow: psnr {:.1} dB, differing {:.4}",
+        d.psnr, d.differing
+    );
+    assert!(
+        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
+        "psnr {:.1} dB, differing {:.4}",
+        d.psnr,
+        d.differing
+    );
+}
+
 /// `--debug-nan` on wgpu: the kernel's `DEBUG_NAN` feature paints the same pixels magenta
 /// as the CPU renderer; without it the kernel is the default one and paints none.
 #[test]

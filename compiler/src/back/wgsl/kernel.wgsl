@@ -360,7 +360,7 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
     var sign = 1.0;
     loop {
         let p = o + d * t;
-//#if REFRACTION
+//#if TRANSPARENT
         let fm = map(p);
         let f = fm.x;
         let tau = params.materials[u32(fm.y)].optics.y;

@@ -96,6 +96,9 @@ fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
             mats.iter()
                 .any(|m| matches!(m.pattern, Pattern::Checker { .. })),
         ),
+        // Shadow rays pass through transparent solids even when no refracted ray is traced
+        // (`max_depth: 0`), as on the CPU.
+        ("TRANSPARENT", refraction),
         ("REFRACTION", refraction && secondary),
         ("SECONDARY", secondary),
         ("MATERIALS", mats.len() > 1),

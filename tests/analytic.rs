@@ -23,7 +23,7 @@ fn load(name: &str) -> Scene {
 
 #[test]
 fn the_report_scenes_1_and_2_are_traced_analytically() {
-    for (name, count) in [("seed1.sdf", 3), ("seed2.sdf", 5), ("primitives.sdf", 7)] {
+    for (name, count) in [("seed1.sdf", 3), ("seed2.sdf", 5), ("primitives.sdf", 8)] {
         match choose(&load(name)) {
             Choice::Trace(p) => assert_eq!(p.len(), count, "{name}"),
             other => panic!("{name}: {other:?}"),
@@ -85,9 +85,24 @@ fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     let src = &kernel.source;
     assert!(!src.contains("fn map(") && !src.contains("fn sdf("));
     assert!(!src.contains("fn tolerance("));
-    assert_eq!(src.matches("best = nearest(").count(), 7);
-    assert_eq!(src.matches("through = occlude(").count(), 7);
+    assert_eq!(src.matches("best = nearest(").count(), 8);
+    assert_eq!(src.matches("through = occlude(").count(), 8);
     assert!(kernel.features.contains(&("ANALYTIC", true)));
+    assert!(src.contains("fn capsule_interval(") && src.contains("fn enters("));
+    // Only the interval functions a scene uses: spheres and a plane in scene 1.
+    let seed1 = load("seed1.sdf");
+    let kernel = wgsl::write(&seed1, &lower(&seed1)).expect("naga accepts it");
+    let fns: Vec<&str> = kernel
+        .source
+        .lines()
+        .filter_map(|l| l.strip_prefix("fn "))
+        .filter_map(|l| l.split('(').next())
+        .filter(|name| {
+            name.ends_with("_interval")
+                || ["slab", "clip", "enters", "into", "to_world"].contains(name)
+        })
+        .collect();
+    assert_eq!(fns, ["sphere_interval", "plane_interval"]);
     let mut marched = scene.clone();
     marched.settings.method = Method::March;
     let kernel = wgsl::write(&marched, &lower(&marched)).expect("naga accepts it");

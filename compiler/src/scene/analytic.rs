@@ -1,9 +1,9 @@
 //! Which scenes can be ray traced analytically, and their primitives in world space.
 //!
-//! A scene qualifies when its objects are only spheres, planes, boxes and capped cylinders
-//! under affine transforms (translate, rotate, uniform and per-axis scale), painted and
-//! combined by plain union, and no light asks for soft shadows (a penumbra estimate needs a
-//! distance field). Every ray then has closed-form roots: exact hits, exact normals, no step
+//! A scene qualifies when its objects are only spheres, planes, boxes, capped cylinders and
+//! capsules under affine transforms (translate, rotate, uniform and per-axis scale), painted
+//! and combined by plain union, no light asks for soft shadows (a penumbra estimate needs a
+//! distance field) and no glass overlaps another solid. Every ray then has closed-form roots: exact hits, exact normals, no step
 //! budget and no ε. The CPU renderer and the WGSL kernel (so also PTX) both trace the list of
 //! [`Primitive`]s this module produces (RENDERER.md, "Intersection"; docs/rendering.md).
 
@@ -19,6 +19,8 @@ pub enum Shape {
     Box { half: V3 },
     /// Capped cylinder along y.
     Cylinder { radius: f64, half_height: f64 },
+    /// Capsule along y: the segment |y| <= half_height swept by a radius.
+    Capsule { radius: f64, half_height: f64 },
     /// Half-space `dot(p, normal) <= height` (unit normal).
     Plane { normal: V3, height: f64 },
 }
@@ -238,6 +240,13 @@ fn collect(scene: &Scene, id: NodeId, f: Frame, out: &mut Vec<Primitive>) -> Res
             radius: *radius,
             half_height: *half_height,
         }),
+        Node::Capsule {
+            radius,
+            half_height,
+        } => leaf(Shape::Capsule {
+            radius: *radius,
+            half_height: *half_height,
+        }),
         Node::Plane { normal, height } => leaf(Shape::Plane {
             normal: *normal,
             height: *height,
@@ -283,7 +292,6 @@ fn name(n: &Node) -> &'static str {
     match n {
         Node::RoundBox { .. } => "round_box",
         Node::Torus { .. } => "torus",
-        Node::Capsule { .. } => "capsule",
         Node::Cone { .. } => "cone",
         Node::Ellipsoid { .. } => "ellipsoid",
         Node::Mandelbulb { .. } => "mandelbulb",
@@ -430,6 +438,10 @@ pub fn world_box(p: &Primitive) -> Option<Aabb> {
             radius,
             half_height,
         } => [radius, half_height, radius],
+        Shape::Capsule {
+            radius,
+            half_height,
+        } => [radius, half_height + radius, radius],
         Shape::Plane { .. } => return None,
     };
     let inv = inverse(&p.matrix)?;

@@ -1,6 +1,6 @@
 //! Analytic ray tracing on the CPU: the closed-form intersections of the primitives that
-//! `sdfc_compiler::scene::analytic` found (spheres, planes, boxes, capped cylinders under
-//! affine maps), nearest hits with exact normals, and any-hit shadow rays.
+//! `sdfc_compiler::scene::analytic` found (spheres, planes, boxes, capped cylinders and
+//! capsules under affine maps), nearest hits with exact normals, and any-hit shadow rays.
 //!
 //! Every primitive is convex (a plane bounds a half-space), so a ray meets it in one interval
 //! [near, far]; the hit is the first end of an interval beyond the ray's origin. Rays start
@@ -16,6 +16,7 @@ enum Kind<T> {
     Sphere { r2: T },
     Box { half: V3<T> },
     Cylinder { r2: T, half_height: T },
+    Capsule { r2: T, half_height: T },
     Plane { normal: V3<T>, height: T },
 }
 
@@ -99,6 +100,13 @@ impl<T: Float> Tracer<T> {
                         radius,
                         half_height,
                     } => Kind::Cylinder {
+                        r2: f(radius * radius),
+                        half_height: f(half_height),
+                    },
+                    Shape::Capsule {
+                        radius,
+                        half_height,
+                    } => Kind::Capsule {
                         r2: f(radius * radius),
                         half_height: f(half_height),
                     },
@@ -217,6 +225,7 @@ impl<T: Float> Prim<T> {
             Kind::Sphere { r2 } => sphere(o, d, r2)?,
             Kind::Box { half } => boxed(o, d, half)?,
             Kind::Cylinder { r2, half_height } => cylinder(o, d, r2, half_height)?,
+            Kind::Capsule { r2, half_height } => capsule(o, d, r2, half_height)?,
             Kind::Plane { normal, height } => plane(o, d, normal, height)?,
         };
         (s.near <= s.far).then_some(s)
@@ -333,6 +342,36 @@ fn cylinder<T: Float>(o: V3<T>, d: V3<T>, r2: T, h: T) -> Option<Interval<T>> {
     })
 }
 
+/// The capsule: the convex hull of two spheres at y = ±h, which is the union of them and the
+/// capped cylinder between them, so the ray's interval is the hull of the three intervals.
+/// The normals point away from the nearest point of the segment.
+fn capsule<T: Float>(o: V3<T>, d: V3<T>, r2: T, h: T) -> Option<Interval<T>> {
+    let up = V3::new(T::zero(), h, T::zero());
+    let parts = [
+        sphere(o - up, d, r2),
+        sphere(o + up, d, r2),
+        cylinder(o, d, r2, h),
+    ];
+    let (mut near, mut far) = (inf::<T>(), -inf::<T>());
+    for s in parts.into_iter().flatten().filter(|s| s.near <= s.far) {
+        near = near.min(s.near);
+        far = far.max(s.far);
+    }
+    if !(near <= far) {
+        return None;
+    }
+    let normal = |t: T| {
+        let p = o + d * t;
+        V3::new(p.x, p.y - p.y.clamp(-h, h), p.z)
+    };
+    Some(Interval {
+        near,
+        far,
+        n_near: normal(near),
+        n_far: normal(far),
+    })
+}
+
 /// The half-space dot(p, n) <= h.
 fn plane<T: Float>(o: V3<T>, d: V3<T>, n: V3<T>, h: T) -> Option<Interval<T>> {
     let dn = n.dot(d);
@@ -395,6 +434,8 @@ mod tests {
             "cylinder(0.4, 0.6).rotate_z(70deg).scale(1.3).translate(-0.2, 0, 0.1)",
             "sphere(0.5).scale((1.6, 0.5, 1)).rotate_y(40deg)",
             "box((0.4, 0.4, 0.4)).scale((1, 2, 0.5)).rotate_x(15deg)",
+            "capsule(0.3, 0.8)",
+            "capsule(0.4, 1.2).rotate_z(60deg).scale((1.2, 0.8, 1)).translate(0.1, 0.2, 0)",
         ];
         for shape in shapes {
             let text = format!(

@@ -1,15 +1,50 @@
-//! The WGSL of an analytically traced scene: `fn trace` (nearest hit, its normal and
-//! material) and `fn shadow` (any-hit shadow rays) unrolled over the scene's primitives, on
-//! top of the interval functions of the kernel template's `ANALYTIC` block.
+//! The WGSL of an analytically traced scene: the interval functions of `intervals.wgsl` its
+//! primitives use, `fn trace` (nearest hit, its normal and material) and `fn shadow` (any-hit
+//! shadow rays) unrolled over the scene's primitives and their hierarchy, on top of the
+//! kernel template's `ANALYTIC` block.
 
 use super::map::float;
 use crate::scene::analytic::{hierarchy, Item, Primitive, Shape};
 use crate::scene::V3;
 use std::fmt::Write;
 
-/// The scene's frame constants, `fn trace` and `fn shadow`.
-pub fn write(primitives: &[Primitive]) -> String {
+/// The interval functions, in sections named by `//= NAME` lines.
+const INTERVALS: &str = include_str!("intervals.wgsl");
+
+/// The sections of [`INTERVALS`] that `primitives` and their hierarchy `top` use.
+fn sections(primitives: &[Primitive], top: &[Item]) -> String {
+    let has = |f: fn(&Shape) -> bool| primitives.iter().any(|p| f(&p.shape));
+    let capsule = has(|s| matches!(s, Shape::Capsule { .. }));
+    let groups = top.iter().any(|i| matches!(i, Item::Group(_)));
+    let boxes = groups || has(|s| matches!(s, Shape::Box { .. }));
+    let cylinders = capsule || has(|s| matches!(s, Shape::Cylinder { .. }));
+    let framed = primitives.iter().any(|p| !identity(&p.matrix));
+    let wanted = |name: &str| match name {
+        "sphere" => capsule || has(|s| matches!(s, Shape::Sphere { .. })),
+        "slab" | "clip" => boxes || cylinders,
+        "box" => boxes,
+        "cylinder" => cylinders,
+        "capsule" => capsule,
+        "plane" => has(|s| matches!(s, Shape::Plane { .. })),
+        "enters" => groups,
+        "into" | "to_world" => framed,
+        _ => false,
+    };
     let mut out = String::new();
+    for section in INTERVALS.split("//= ").skip(1) {
+        let (name, body) = section.split_once('\n').unwrap_or((section, ""));
+        if wanted(name.trim()) {
+            out.push_str(body.trim_end());
+            out.push_str("\n\n");
+        }
+    }
+    out
+}
+
+/// The interval functions the scene uses, its frame constants, `fn trace` and `fn shadow`.
+pub fn write(primitives: &[Primitive]) -> String {
+    let top = hierarchy(primitives);
+    let mut out = sections(primitives, &top);
     if primitives.iter().any(|p| !identity(&p.matrix)) {
         out.push_str("// The world-to-local rows of the primitives that are rotated or scaled.\n");
     }
@@ -20,13 +55,12 @@ pub fn write(primitives: &[Primitive]) -> String {
             }
         }
     }
-    if !out.is_empty() {
+    if primitives.iter().any(|p| !identity(&p.matrix)) {
         out.push('\n');
     }
     out.push_str(
         "// The nearest surface along o + t·d, 0 < t < max_dist, with its normal and material.\n",
     );
-    let top = hierarchy(primitives);
     out.push_str("fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {\n");
     out.push_str("    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u);\n");
     let nearest = |i: usize, p: &Primitive| {
@@ -93,6 +127,7 @@ fn name(s: &Shape) -> &'static str {
         Shape::Sphere { .. } => "sphere",
         Shape::Box { .. } => "box",
         Shape::Cylinder { .. } => "cylinder",
+        Shape::Capsule { .. } => "capsule",
         Shape::Plane { .. } => "plane",
     }
 }
@@ -129,7 +164,10 @@ fn interval(i: usize, p: &Primitive) -> String {
     let dir = moved("d");
     let call = match p.shape {
         Shape::Sphere { radius } => {
-            format!("sphere_interval({origin}, {dir}, {})", float(radius * radius))
+            format!(
+                "sphere_interval({origin}, {dir}, {})",
+                float(radius * radius)
+            )
         }
         Shape::Box { half } => format!("box_interval({origin}, {dir}, {})", vec3(half)),
         Shape::Cylinder {
@@ -137,6 +175,14 @@ fn interval(i: usize, p: &Primitive) -> String {
             half_height,
         } => format!(
             "cylinder_interval({origin}, {dir}, {}, {})",
+            float(radius * radius),
+            float(half_height)
+        ),
+        Shape::Capsule {
+            radius,
+            half_height,
+        } => format!(
+            "capsule_interval({origin}, {dir}, {}, {})",
             float(radius * radius),
             float(half_height)
         ),

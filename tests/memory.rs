@@ -91,8 +91,30 @@ scene {
 }
 ";
 
+/// The same kind of scene within what analytic tracing takes: hard lights, glass that touches
+/// nothing.
+const TRACED: &str = "
+material glass = phong { color: (1, 1, 1), reflect: 0.1, transparency: 0.85, ior: 1.5 };
+material mirror = phong { color: (0.9, 0.9, 0.9), reflect: 0.6 };
+material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 1 };
+camera { position: (0, 2, -6), look_at: (0, 0.5, 0), fov: 60deg }
+light point { position: (4, 6, -4), intensity: 1, radius: 30 }
+light directional { direction: (-1, -1, 0.5), color: (0.4, 0.4, 0.4) }
+render { width: 64, height: 48, max_depth: 8 }
+scene {
+  plane((0, 1, 0), 0) @ floor;
+  sphere(1).translate(0, 1.2, 0) @ glass;
+  sphere(0.6).translate(1.8, 0.6, 0.5) @ mirror;
+  for i in 0..5 { box((0.2, 0.5, 0.2)).translate(i - 2, 0.5, 2) @ mirror; }
+}
+";
+
 fn scene(width: u32, height: u32, aa: u32) -> Scene {
-    let (scene, diags, _) = check_str("memory.sdf", SCENE);
+    scene_of(SCENE, width, height, aa)
+}
+
+fn scene_of(text: &str, width: u32, height: u32, aa: u32) -> Scene {
+    let (scene, diags, _) = check_str("memory.sdf", text);
     let mut scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     scene.settings.width = width;
     scene.settings.height = height;
@@ -109,13 +131,19 @@ fn renders_stay_within_the_memory_they_announce() {
     // Warm the pool and its thread-local state before measuring.
     let warm = scene(16, 16, 1);
     pool.install(|| cpu::render(&warm, &lower::lower(&warm), &Options::default(), &|| {}));
-    for (width, height, aa, precision) in [
-        (64, 48, 1, Precision::F32),
-        (120, 90, 3, Precision::F32),
-        (80, 60, 2, Precision::F64),
-        (300, 200, 1, Precision::F32),
+    for (text, width, height, aa, precision) in [
+        (SCENE, 64, 48, 1, Precision::F32),
+        (SCENE, 120, 90, 3, Precision::F32),
+        (SCENE, 80, 60, 2, Precision::F64),
+        (SCENE, 300, 200, 1, Precision::F32),
+        (TRACED, 120, 90, 3, Precision::F32),
+        (TRACED, 300, 200, 1, Precision::F64),
     ] {
-        let scene = scene(width, height, aa);
+        let scene = scene_of(text, width, height, aa);
+        let traced = sdfc_compiler::scene::analytic::choose(&scene)
+            .primitives()
+            .is_some();
+        assert_eq!(traced, text == TRACED);
         let program = lower::lower(&scene);
         let tapes = Tapes::new(&program);
         let options = Options {
@@ -125,7 +153,7 @@ fn renders_stay_within_the_memory_they_announce() {
         let bound = pool.install(|| cpu::memory(&scene, &tapes, &options, 3));
         let (render, peak) =
             peak_of(|| pool.install(|| cpu::render_tapes(&scene, &tapes, &options, &|| {})));
-        let case = format!("{width}x{height}, aa {aa}, {precision:?}");
+        let case = format!("{width}x{height}, aa {aa}, {precision:?}, traced {traced}");
         println!(
             "{case}: render peak {peak} bytes, bound {bound} ({:.1}x)",
             bound as f64 / peak as f64

@@ -105,6 +105,7 @@ fn shared<T: Float>(shape: &Shape, scene: &Scene) -> u64 {
         bytes::<TileOut>(shape.tiles),
         bytes::<Mat<T>>(scene.materials.len() as u64 + 1),
         bytes::<Lamp<T>>(shape.lamps),
+        super::analytic::heap_bytes::<T>(scene),
     ]
     .into_iter()
     .fold(0, u64::saturating_add)
@@ -121,6 +122,8 @@ fn workspace<T: Float>(shape: &Shape, tapes: &Tapes, options: &Options) -> u64 {
         lanes as u64,
         grown::<Launch<T>>(w.saturating_mul(shape.lamps.max(1))),
         grown::<Traced<T>>(w),
+        // Under analytic tracing, the normal and material of each traced ray.
+        grown::<(V3<T>, u32)>(w),
         grown::<Shadowed<T>>(w.saturating_mul(shape.lamps)),
         // x, y, z and d hold four normal taps per hit; m one material per hit.
         4 * grown::<T>(w.saturating_mul(4)),

@@ -8,18 +8,7 @@
 # in .gl/. Writes logs under $OUT; prints tables.
 # Usage: scripts/device-analytic.sh [all|check|analytic|scaling]
 set -u
-OUT=${OUT:-/tmp/out}
-mkdir -p "$OUT" /tmp/sdfc-img
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-if [ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]; then
-  export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-fi
-export SDFC_CACHE_DIR=/tmp/sdfc-jit
-B=./.dev/sdfc
-chmod +x "$B"
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv,noheader | tee "$OUT/gpu.txt"
-date -u '+%Y-%m-%d %H:%M UTC' | tee -a "$OUT/gpu.txt"
+. "$(dirname "$0")/device-env.sh"
 MODE=${1:-all}
 
 short() {

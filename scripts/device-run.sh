@@ -4,17 +4,7 @@
 # the report's resolutions with aa 1 and 4. Expects the sdfc binary at .dev/sdfc and the
 # Vulkan loader packages in .gl/. Writes logs and JSON under $OUT; prints a table last.
 set -u
-OUT=${OUT:-/tmp/out}
-mkdir -p "$OUT" /tmp/sdfc-img
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-if [ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]; then
-  export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-fi
-export SDFC_CACHE_DIR=/tmp/sdfc-jit
-B=./.dev/sdfc
-chmod +x "$B"
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv,noheader | tee "$OUT/gpu.txt"
+. "$(dirname "$0")/device-env.sh"
 MODE=${1:-all}
 
 if [ "$MODE" = all ] || [ "$MODE" = check ]; then

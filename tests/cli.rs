@@ -359,12 +359,18 @@ fn the_method_setting_and_what_check_says_about_it() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("method must be one of"));
     assert_eq!(entries(&d), ["ball.sdf"]);
-    std::fs::write(d.join("hard.sdf"), SCENE.replace("softness: 8", "softness: 0"))
-        .expect("write");
+    std::fs::write(
+        d.join("hard.sdf"),
+        SCENE.replace("softness: 8", "softness: 0"),
+    )
+    .expect("write");
     let out = sdfc(&d, &["check", "hard.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("method: trace (2 primitives"), "{err}");
-    let out = sdfc(&d, &["render", "hard.sdf", "--set", "method=trace", "--stats"]);
+    let out = sdfc(
+        &d,
+        &["render", "hard.sdf", "--set", "method=trace", "--stats"],
+    );
     assert_eq!(out.status.code(), Some(0));
     assert!(d.join("hard.png").exists());
     let _ = std::fs::remove_dir_all(&d);

@@ -86,6 +86,29 @@ fn wgpu_matches_cpu_on_every_example() {
     );
 }
 
+/// Renders `scene` on wgpu and on the CPU and asserts that they agree within the tolerance.
+fn assert_agree(
+    gpu: &gpu::Gpu,
+    scene: &sdfc_compiler::scene::Scene,
+    program: &lower::Program,
+    kernel: &wgsl::Kernel,
+    label: &str,
+) {
+    let on_gpu = gpu::render(gpu, scene, kernel, 1.0, &mut |_| {}).expect("gpu render");
+    let on_cpu = cpu::render(scene, program, &cpu::Options::default(), &|| {});
+    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+    println!(
+        "{label}: psnr {:.1} dB, differing {:.4}",
+        d.psnr, d.differing
+    );
+    assert!(
+        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
+        "{label}: psnr {:.1} dB, differing {:.4}",
+        d.psnr,
+        d.differing
+    );
+}
+
 /// A distance program large enough that `map` and `sdf` are cut into functions
 /// (examples/scaling/compound_100.sdf, about 15 000 instructions) renders on wgpu as on the
 /// CPU.
@@ -103,19 +126,7 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
     let program = lower::lower(&scene);
     let kernel = wgsl::write(&scene, &program).expect("valid kernel");
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
-    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-    let on_cpu = cpu::render(&scene, &program, &cpu::Options::default(), &|| {});
-    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
-    println!(
-        "compound_100: psnr {:.1} dB, differing {:.4}",
-        d.psnr, d.differing
-    );
-    assert!(
-        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
-        "psnr {:.1} dB, differing {:.4}",
-        d.psnr,
-        d.differing
-    );
+    assert_agree(&gpu, &scene, &program, &kernel, "compound_100");
 }
 
 /// Shadow rays pass through glass on the GPU as on the CPU even when no refracted ray is
@@ -134,19 +145,7 @@ fn shadows_through_glass_match_without_secondary_rays() {
     let kernel = wgsl::write(&scene, &program).expect("valid kernel");
     assert!(kernel.features.contains(&("TRANSPARENT", true)));
     assert!(kernel.features.contains(&("REFRACTION", false)));
-    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-    let on_cpu = cpu::render(&scene, &program, &cpu::Options::default(), &|| {});
-    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
-    println!(
-        "glass shadow: psnr {:.1} dB, differing {:.4}",
-        d.psnr, d.differing
-    );
-    assert!(
-        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
-        "psnr {:.1} dB, differing {:.4}",
-        d.psnr,
-        d.differing
-    );
+    assert_agree(&gpu, &scene, &program, &kernel, "glass shadow");
 }
 
 /// `--debug-nan` on wgpu: the kernel's `DEBUG_NAN` feature paints the same pixels magenta

@@ -123,10 +123,18 @@ fn culling_gives_the_same_field_bit_for_bit() {
         let pts = points(&scene, 3, 3000);
         for p in &pts {
             let (a, b) = (eval_point::<f64>(&on, *p), eval_point::<f64>(&off, *p));
-            assert_eq!((a.0.to_bits(), a.1), (b.0.to_bits(), b.1), "{name} f64 at {p:?}");
+            assert_eq!(
+                (a.0.to_bits(), a.1),
+                (b.0.to_bits(), b.1),
+                "{name} f64 at {p:?}"
+            );
             let q = p.map(|v| v as f32);
             let (a, b) = (eval_point::<f32>(&on, q), eval_point::<f32>(&off, q));
-            assert_eq!((a.0.to_bits(), a.1), (b.0.to_bits(), b.1), "{name} f32 at {p:?}");
+            assert_eq!(
+                (a.0.to_bits(), a.1),
+                (b.0.to_bits(), b.1),
+                "{name} f32 at {p:?}"
+            );
         }
     }
 }
@@ -154,7 +162,11 @@ fn the_batch_interpreter_runs_blocks_like_the_reference_path() {
         let mut d = vec![0.0; pts.len()];
         ev.eval(&c(0), &c(1), &c(2), &mut d, None);
         for (i, p) in pts.iter().enumerate() {
-            assert_eq!(d[i].to_bits(), eval_point::<f64>(&program, *p).0.to_bits(), "{name}");
+            assert_eq!(
+                d[i].to_bits(),
+                eval_point::<f64>(&program, *p).0.to_bits(),
+                "{name}"
+            );
         }
     }
 }
@@ -169,7 +181,10 @@ fn the_passes_keep_the_distance_field() {
             let (a, ma) = eval_point::<f64>(&opt, *p);
             let (b, mb) = eval_point::<f64>(&literal, *p);
             let scale = 1.0 + len3(*p) + b.abs();
-            assert!((a - b).abs() <= 1e-9 * scale, "{name} f64 at {p:?}: {a} vs {b}");
+            assert!(
+                (a - b).abs() <= 1e-9 * scale,
+                "{name} f64 at {p:?}: {a} vs {b}"
+            );
             materials += usize::from(ma != mb);
         }
         // Materials can differ only where two children are exactly as near (none here).
@@ -179,7 +194,12 @@ fn the_passes_keep_the_distance_field() {
         for (i, p) in pts.iter().enumerate() {
             let scale = 1.0 + len3(*p) + (d0[i] as f64).abs();
             let diff = (d1[i] as f64 - d0[i] as f64).abs();
-            assert!(diff <= 4e-5 * scale, "{name} f32 at {p:?}: {} vs {}", d1[i], d0[i]);
+            assert!(
+                diff <= 4e-5 * scale,
+                "{name} f32 at {p:?}: {} vs {}",
+                d1[i],
+                d0[i]
+            );
         }
     }
 }
@@ -260,7 +280,9 @@ fn ray_points(scene: &Scene, program: &Program, w: u32, h: u32) -> Vec<[f32; 3]>
                 let p = [0, 1, 2].map(|k| (eye[k] + t * d[k]) as f32);
                 out.push(p);
                 let (dist, _) = eval_point::<f32>(program, p);
-                if (dist as f64).abs() < scene.settings.epsilon * t.max(1.0) || t > scene.settings.max_dist {
+                if (dist as f64).abs() < scene.settings.epsilon * t.max(1.0)
+                    || t > scene.settings.max_dist
+                {
                     break;
                 }
                 t += dist as f64;
@@ -286,7 +308,10 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// Mean operations executed per evaluation along camera rays.
 fn mean_executed(scene: &Scene, program: &Program, rays: &[[f32; 3]]) -> f64 {
     let _ = scene;
-    rays.iter().map(|&p| executed(program, p) as f64).sum::<f64>() / rays.len().max(1) as f64
+    rays.iter()
+        .map(|&p| executed(program, p) as f64)
+        .sum::<f64>()
+        / rays.len().max(1) as f64
 }
 
 #[test]
@@ -300,7 +325,10 @@ fn instruction_counts_drop() {
             operations(&literal)
         );
     }
-    for file in ["../examples/lattice.sdf", "../examples/scaling/random_100.sdf"] {
+    for file in [
+        "../examples/lattice.sdf",
+        "../examples/scaling/random_100.sdf",
+    ] {
         let scene = load(Path::new(file));
         let (culled, plain) = (lower_with(&scene, &CULL), lower_with(&scene, &NO_CULL));
         let rays = ray_points(&scene, &plain, 16, 12);
@@ -308,7 +336,10 @@ fn instruction_counts_drop() {
             mean_executed(&scene, &culled, &rays),
             mean_executed(&scene, &plain, &rays),
         );
-        assert!(a * 3.0 < b, "{file}: {a:.0} operations per point culled, {b:.0} not");
+        assert!(
+            a * 3.0 < b,
+            "{file}: {a:.0} operations per point culled, {b:.0} not"
+        );
     }
 }
 
@@ -370,16 +401,29 @@ fn report() {
         let literal = lower_with(&scene, &LITERAL);
         let plain = lower_with(&scene, &NO_CULL);
         let culled = lower_with(&scene, &CULL);
-        let size = |p: &Program| wgsl::write_map(p).lines().count() + wgsl::write_sdf(p).lines().count();
+        let size =
+            |p: &Program| wgsl::write_map(p).lines().count() + wgsl::write_sdf(p).lines().count();
         let rays = ray_points(&scene, &plain, 24, 18);
         let big = literal.len() > 30_000;
         let (e0, e1) = (
-            if big { f64::NAN } else { mean_executed(&scene, &literal, &rays) },
+            if big {
+                f64::NAN
+            } else {
+                mean_executed(&scene, &literal, &rays)
+            },
             mean_executed(&scene, &culled, &rays),
         );
         let slow = literal.len() > time_limit * 10;
-        let t0 = if slow { f64::NAN } else { time_frames(&scene, &literal, 3) };
-        let t1 = if std::env::var("SDFC_REPORT_NO_TIME").is_ok() { f64::NAN } else { time_frames(&scene, &culled, 3) };
+        let t0 = if slow {
+            f64::NAN
+        } else {
+            time_frames(&scene, &literal, 3)
+        };
+        let t1 = if std::env::var("SDFC_REPORT_NO_TIME").is_ok() {
+            f64::NAN
+        } else {
+            time_frames(&scene, &culled, 3)
+        };
 
         println!(
             "| {n} | {} | {} | {} | {} | {} | {e0:.0} | {e1:.0} | {} | {t0:.0} | {t1:.0} |",

@@ -281,44 +281,9 @@ fn collect(scene: &Scene, id: NodeId, f: Frame, out: &mut Vec<Primitive>) -> Res
             collect(scene, *child, inner, out)
         }
         other => Err(Reason::Node {
-            what: name(other),
+            what: super::analysis::kind(other),
             span: g.span(id),
         }),
-    }
-}
-
-/// The language's name for a node that blocks analytic tracing.
-fn name(n: &Node) -> &'static str {
-    match n {
-        Node::RoundBox { .. } => "round_box",
-        Node::Torus { .. } => "torus",
-        Node::Cone { .. } => "cone",
-        Node::Ellipsoid { .. } => "ellipsoid",
-        Node::Mandelbulb { .. } => "mandelbulb",
-        Node::Combine {
-            op: Combine::Intersect,
-            ..
-        } => "intersect",
-        Node::Combine {
-            op: Combine::Subtract,
-            ..
-        } => "subtract",
-        Node::SmoothCombine {
-            op: Combine::Union, ..
-        } => "smooth_union",
-        Node::SmoothCombine {
-            op: Combine::Intersect,
-            ..
-        } => "smooth_intersect",
-        Node::SmoothCombine { .. } => "smooth_subtract",
-        Node::Repeat { .. } => "repeat",
-        Node::Mirror { .. } => "mirror",
-        Node::Twist { .. } => "twist",
-        Node::Bend { .. } => "bend",
-        Node::Round { .. } => "round",
-        Node::Shell { .. } => "shell",
-        Node::Elongate { .. } => "elongate",
-        _ => "shape",
     }
 }
 

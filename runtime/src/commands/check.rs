@@ -5,6 +5,7 @@ use crate::frontend::{self, DiagnosticFormat, Loaded};
 use sdfc_compiler::scene::analysis::{self, Analysis};
 use sdfc_compiler::scene::analytic::{self, Choice, Reason};
 use sdfc_compiler::scene::{Exactness, Scene};
+use sdfc_compiler::Span;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -84,18 +85,22 @@ pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
 /// the location of the node that rules out analytic tracing.
 pub fn method(loaded: &Loaded, scene: &Scene) -> String {
     match analytic::choose(scene) {
-        Choice::March(Reason::Node { what, span }) => {
-            let (line, col) = loaded.sources.line_col(span);
-            let file = loaded.sources.name(span.file);
-            format!("method: march (the {what} at {file}:{line}:{col} has no closed-form ray intersection)")
-        }
-        Choice::March(Reason::Overlap { span }) => {
-            let (line, col) = loaded.sources.line_col(span);
-            let file = loaded.sources.name(span.file);
-            format!("method: march (the transparent shape at {file}:{line}:{col} overlaps or touches another one)")
-        }
+        Choice::March(Reason::Node { what, span }) => format!(
+            "method: march (the {what} at {} has no closed-form ray intersection)",
+            at(loaded, span)
+        ),
+        Choice::March(Reason::Overlap { span }) => format!(
+            "method: march (the transparent shape at {} overlaps or touches another one)",
+            at(loaded, span)
+        ),
         choice => choice.describe(),
     }
+}
+
+/// `FILE:LINE:COL` of a span.
+fn at(loaded: &Loaded, span: Span) -> String {
+    let (line, col) = loaded.sources.line_col(span);
+    format!("{}:{line}:{col}", loaded.sources.name(span.file))
 }
 
 /// ` (the twist at FILE:LINE:COL)` for the node that made the field inexact, or nothing.
@@ -103,11 +108,8 @@ fn cause(loaded: &Loaded, scene: &Scene, analysis: &Analysis) -> String {
     let Some(id) = analysis.root().and_then(|r| r.cause) else {
         return String::new();
     };
-    let span = scene.graph.span(id);
-    let (line, col) = loaded.sources.line_col(span);
-    let file = loaded.sources.name(span.file);
     let kind = analysis::kind(scene.graph.node(id));
-    format!(" (the {kind} at {file}:{line}:{col})")
+    format!(" (the {kind} at {})", at(loaded, scene.graph.span(id)))
 }
 
 /// A number with at most three decimals and no trailing zeros.

@@ -70,8 +70,9 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
-/// What the scene uses, deciding which parts of the kernel are emitted.
-fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
+/// What the scene uses, deciding which parts of the kernel are emitted; `traced` when it is
+/// ray traced analytically.
+fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
     let mats = &scene.materials;
     let soft = scene.lights.iter().any(|l| l.softness() > 0.0);
     let points = scene
@@ -85,7 +86,6 @@ fn features(scene: &Scene) -> Vec<(&'static str, bool)> {
     let refraction = mats.iter().any(|m| m.transparency > 0.0);
     let secondary = scene.settings.max_depth > 0
         && mats.iter().any(|m| m.reflect > 0.0 || m.transparency > 0.0);
-    let traced = crate::scene::analytic::choose(scene).primitives().is_some();
     vec![
         ("ANALYTIC", traced),
         ("POINT", points),
@@ -129,7 +129,8 @@ pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
 
 /// [`write`] with the given options.
 pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result<Kernel, Error> {
-    let mut features = features(scene);
+    let choice = crate::scene::analytic::choose(scene);
+    let mut features = features(scene, choice.primitives().is_some());
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
     // Listed in the header only when on, so that the default kernel does not change.
     on.insert("DEBUG_NAN", options.debug_nan);
@@ -137,7 +138,7 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         features.push(("DEBUG_NAN", true));
     }
     let mut values: HashMap<&str, String> = HashMap::new();
-    match crate::scene::analytic::choose(scene).primitives() {
+    match choice.primitives() {
         // An analytically traced scene needs no distance field.
         Some(primitives) => {
             values.insert("MAP", String::new());

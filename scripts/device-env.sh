@@ -1,0 +1,16 @@
+# Sourced by the scripts that run on the GPU machine (the `device` tool): makes $OUT and the
+# image folder, installs the Vulkan loader from .gl/, points Vulkan at the NVIDIA driver, sets
+# the CUDA JIT cache, sets B to the sdfc binary carried in .dev/, and records the GPU and the
+# date in $OUT/gpu.txt.
+OUT=${OUT:-/tmp/out}
+mkdir -p "$OUT" /tmp/sdfc-img
+for f in .gl/*.deb; do dpkg -x "$f" /; done
+ldconfig
+if [ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]; then
+  export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+fi
+export SDFC_CACHE_DIR=/tmp/sdfc-jit
+B=./.dev/sdfc
+chmod +x "$B"
+nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv,noheader | tee "$OUT/gpu.txt"
+date -u '+%Y-%m-%d %H:%M UTC' | tee -a "$OUT/gpu.txt"

@@ -19,14 +19,23 @@ use std::time::Instant;
 const CULL: LowerOptions = LowerOptions {
     level: 1,
     cull: true,
+    local: true,
 };
 const NO_CULL: LowerOptions = LowerOptions {
     level: 1,
     cull: false,
+    local: true,
+};
+/// Every pass, without local bounds: the field as written, for comparing values.
+const WRITTEN: LowerOptions = LowerOptions {
+    level: 1,
+    cull: true,
+    local: false,
 };
 const LITERAL: LowerOptions = LowerOptions {
     level: 0,
     cull: false,
+    local: false,
 };
 
 /// The `.sdf` files directly inside `dir` (relative to the workspace root), sorted.
@@ -174,7 +183,8 @@ fn the_batch_interpreter_runs_blocks_like_the_reference_path() {
 #[test]
 fn the_passes_keep_the_distance_field() {
     for (name, scene) in scenes() {
-        let (opt, literal) = (lower_with(&scene, &CULL), lower_with(&scene, &LITERAL));
+        let (opt, literal) = (lower_with(&scene, &WRITTEN), lower_with(&scene, &LITERAL));
+        let local = lower_with(&scene, &CULL);
         let pts = points(&scene, 9, 2000);
         let mut materials = 0;
         for p in &pts {
@@ -186,6 +196,12 @@ fn the_passes_keep_the_distance_field() {
                 "{name} f64 at {p:?}: {a} vs {b}"
             );
             materials += usize::from(ma != mb);
+            // Local bounds change the values, not the solid.
+            let (c, _) = eval_point::<f64>(&local, *p);
+            assert!(
+                b.abs() <= 1e-9 * scale || c.signum() == b.signum(),
+                "{name} with local bounds at {p:?}: {c} vs {b}"
+            );
         }
         // Materials can differ only where two children are exactly as near (none here).
         assert_eq!(materials, 0, "{name}");

@@ -1,5 +1,6 @@
 //! The stability suite: scenes where sphere tracing is known to struggle (`tests/stability/`),
-//! each swept over its stress parameter, rendered at their default settings on the CPU in f32
+//! each swept over its stress parameter, sphere traced (also those that could be traced
+//! analytically) at their default settings on the CPU in f32
 //! (through the backend, so stepping with the L the analysis derives) and measured against an
 //! f64 reference (ε = 1e-6, a budget of 100 000 steps, no over-relaxation; steps four times
 //! shorter where the analysis proves no bound).
@@ -9,17 +10,21 @@
 //! BENCHMARKS.md, "Stability") has, per scene and value, the percentage of pixels the render
 //! missed, hit falsely and hit behind the reference's surface, the percentage of rays that ran
 //! out of steps, the PSNR against the reference, the mean steps per pixel, and, where L > 1,
-//! what stepping with L = 1 instead would have missed and hit behind. With
-//! `SDFC_STABILITY_IMAGES=DIR` set, both images of every render are written to `DIR`.
+//! the steps per pixel of the field as written stepped with the scene's L everywhere (no local
+//! bounds) and what stepping it with L = 1 instead would have missed and hit behind. A file
+//! may name the value of its parameter at which the scene is an exact field of the same layout
+//! (`// exact layout: VALUE`); the table then gives the steps per pixel relative to that render.
+//! With `SDFC_STABILITY_IMAGES=DIR` set, both images of every render are written to `DIR`.
 //!
 //! What it asserts is what the analysis promises: no pixel is ever NaN; where the analysis
 //! proves that `f / L` is a bound, no pixel is hit behind the surface and fewer than 0.1 % are
 //! missed, except for the renderer's documented limits in [`LIMITS`] (each checked to be what
-//! it claims); where the analysis proves nothing, the numbers are only reported.
+//! it claims), and a proven scene with an exact layout takes at most [`MAX_STEP_RATIO`] times
+//! its steps; where the analysis proves nothing, the numbers are only reported.
 
 use sdfc_compiler::check::check_str;
-use sdfc_compiler::lower::lower;
-use sdfc_compiler::scene::{analysis, Scene, Settings};
+use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
+use sdfc_compiler::scene::{analysis, Method, Scene, Settings};
 use sdfc_runtime::backend::{Backend, Prepared};
 use sdfc_runtime::cpu::{self, reference, Options, Precision, Render};
 use sdfc_runtime::depth::Depth;
@@ -37,6 +42,9 @@ const REFERENCE_STEP_FACTOR: f64 = 4.0;
 /// Largest fraction of pixels a proven scene may miss.
 const MAX_MISSED: f64 = 0.001;
 
+/// Most steps per pixel a proven scene may take relative to the exact scene of its layout.
+const MAX_STEP_RATIO: f64 = 1.5;
+
 /// A budget limit is checked by rendering again with this many times the step budget.
 const BUDGET_FACTOR: u32 = 16;
 
@@ -52,30 +60,6 @@ enum Limit {
 /// Renders (file stem, stress value) the renderer gets wrong for a reason the field is not
 /// responsible for, with the reason.
 const LIMITS: &[(&str, &str, Limit, &str)] = &[
-    (
-        "twist",
-        "2",
-        Limit::Budget,
-        "one L for the whole scene: the floor's grazing rays step L times shorter",
-    ),
-    (
-        "twist",
-        "4",
-        Limit::Budget,
-        "one L for the whole scene: the floor's grazing rays step L times shorter",
-    ),
-    (
-        "twist",
-        "8",
-        Limit::Budget,
-        "one L for the whole scene: the floor's grazing rays step L times shorter",
-    ),
-    (
-        "bend",
-        "2",
-        Limit::Budget,
-        "one L for the whole scene: the floor's grazing rays step L times shorter",
-    ),
     (
         "horizon",
         "1000",
@@ -108,6 +92,8 @@ struct Sweep {
     stem: String,
     param: String,
     values: Vec<String>,
+    /// The value at which the scene is an exact field of the same layout.
+    exact: Option<String>,
     text: String,
 }
 
@@ -143,6 +129,10 @@ fn sweep(path: &Path) -> Sweep {
         stem,
         param: param.trim().to_string(),
         values: values.split(',').map(|v| v.trim().to_string()).collect(),
+        exact: text
+            .lines()
+            .find_map(|l| l.strip_prefix("// exact layout:"))
+            .map(|v| v.trim().to_string()),
         text,
     }
 }
@@ -185,8 +175,13 @@ struct Row {
     psnr: f64,
     steps: f64,
     reference_steps: f64,
+    /// Steps per pixel of the exact scene of the same layout, where the file names one.
+    exact_steps: Option<f64>,
+    /// Steps per pixel without local bounds, stepping with the scene's L (only where L > 1).
+    global_steps: Option<f64>,
     nan_pixels: usize,
-    /// Missed and behind fractions when stepping with L = 1 (only where L > 1).
+    /// Missed and behind fractions without local bounds, stepping with L = 1 (only where
+    /// L > 1).
     at_one: Option<DepthDifference>,
     /// Where the first hits differ: `m` missed, `f` false hit, `b` behind.
     map: String,
@@ -203,13 +198,30 @@ fn nan_pixels(r: &Render) -> usize {
         .count()
 }
 
-/// The f32 CPU render of `scene` stepping with `lipschitz`.
-fn render(scene: &Scene, lipschitz: f64) -> Render {
+/// The f32 CPU render of `scene` as the backends render it (with local bounds).
+fn render(scene: &Scene) -> Render {
+    let program = lower(scene);
+    let options = Options {
+        lipschitz: program.lipschitz(),
+        ..Options::default()
+    };
+    cpu::render(scene, &program, &options, &|| {})
+}
+
+/// The f32 CPU render of the field as written (no local bounds), stepping with `lipschitz`.
+fn render_global(scene: &Scene, lipschitz: f64) -> Render {
+    let program = lower_with(
+        scene,
+        &LowerOptions {
+            local: false,
+            ..LowerOptions::default()
+        },
+    );
     let options = Options {
         lipschitz,
         ..Options::default()
     };
-    cpu::render(scene, &lower(scene), &options, &|| {})
+    cpu::render(scene, &program, &options, &|| {})
 }
 
 /// The f64 reference: ε = 1e-6, 100 000 steps, no over-relaxation, steps of f / `lipschitz`.
@@ -236,7 +248,8 @@ fn compare_depth(reference: &Depth, test: &Render) -> DepthDifference {
         .expect("depth buffers of the same size")
 }
 
-fn measure(s: &Sweep, value: &str) -> Row {
+/// The scene of a sweep at one value, at the suite's image size, with its diagnostics.
+fn scene_at(s: &Sweep, value: &str) -> (Scene, Vec<sdfc_compiler::diagnostics::Diagnostic>) {
     let name = format!("{}.sdf", s.stem);
     let (scene, diags, _) = check_str(&name, &with_value(s, value));
     let mut scene: Scene = scene.unwrap_or_else(|| panic!("{name} with {value}: {diags:?}"));
@@ -245,6 +258,14 @@ fn measure(s: &Sweep, value: &str) -> Row {
         scene.settings.height,
         scene.settings.aa,
     ) = (SIZE.0, SIZE.1, 1);
+    // The suite is about sphere tracing: scenes that could be traced analytically are
+    // marched all the same.
+    scene.settings.method = Method::March;
+    (scene, diags)
+}
+
+fn measure(s: &Sweep, value: &str, exact_steps: Option<f64>) -> Row {
+    let (scene, diags) = scene_at(s, value);
     let a = analysis::analyse(&scene);
     let facts = *a.root().expect("objects");
     let test = Prepared::new(Backend::Cpu, &scene, Precision::F32)
@@ -263,8 +284,9 @@ fn measure(s: &Sweep, value: &str) -> Row {
         sdfc_runtime::image::write_png(&file("test"), &test.image).expect("writable");
         sdfc_runtime::image::write_png(&file("reference"), &reference.image).expect("writable");
     }
-    let at_one =
-        (a.step_lipschitz() > 1.0).then(|| compare_depth(depth(&reference), &render(&scene, 1.0)));
+    let global = a.step_lipschitz() > 1.0;
+    let at_one = global.then(|| compare_depth(depth(&reference), &render_global(&scene, 1.0)));
+    let global_steps = global.then(|| render_global(&scene, a.step_lipschitz()).stats.steps_mean);
     let c = &test.stats.counters;
     Row {
         scene: s.stem.clone(),
@@ -279,6 +301,8 @@ fn measure(s: &Sweep, value: &str) -> Row {
         psnr: metrics::compare(&reference.image, &test.image, 0.1).map_or(f64::NAN, |d| d.psnr),
         steps: test.stats.steps_mean,
         reference_steps: reference.stats.steps_mean,
+        exact_steps,
+        global_steps,
         nan_pixels: nan_pixels(&test) + nan_pixels(&reference),
         at_one,
         map: hit_map(depth(&reference), depth(&test)),
@@ -314,8 +338,8 @@ fn pct(x: f64) -> String {
 /// The table, as Markdown.
 fn table(rows: &[Row]) -> String {
     let mut out = String::from(
-        "| Scene | Stress | Field | L | Warnings | Missed % | False hits % | Behind % | Exhausted % | PSNR dB | Steps/px | Ref. steps/px | At L = 1: missed %, behind % |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| Scene | Stress | Field | L | Warnings | Missed % | False hits % | Behind % | Exhausted % | PSNR dB | Steps/px | × exact layout | Global 1/L: steps/px | Ref. steps/px | At L = 1: missed %, behind % |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let field = if r.proven {
@@ -331,8 +355,14 @@ fn table(rows: &[Row]) -> String {
         let at_one = r.at_one.map_or("–".to_string(), |d| {
             format!("{}, {}", pct(d.missed), pct(d.behind))
         });
+        let ratio = r
+            .exact_steps
+            .map_or("–".to_string(), |e| format!("{:.2}", r.steps / e));
+        let global = r
+            .global_steps
+            .map_or("–".to_string(), |g| format!("{g:.1}"));
         out += &format!(
-            "| {} | {} = {} | {field} | {:.3} | {warnings} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {at_one} |\n",
+            "| {} | {} = {} | {field} | {:.3} | {warnings} | {} | {} | {} | {} | {:.1} | {:.1} | {ratio} | {global} | {:.1} | {at_one} |\n",
             r.scene,
             r.param,
             r.value,
@@ -363,6 +393,15 @@ fn check(r: &Row) -> Vec<String> {
     if r.nan_pixels > 0 {
         failures.push(format!("{what}: {} NaN pixels", r.nan_pixels));
     }
+    if let (Some(exact), true) = (r.exact_steps, r.proven) {
+        if r.steps > MAX_STEP_RATIO * exact {
+            failures.push(format!(
+                "{what}: {:.1} steps per pixel, {:.2} times the exact layout's {exact:.1}",
+                r.steps,
+                r.steps / exact
+            ));
+        }
+    }
     let wrong = r.depth.behind > 0.0 || r.depth.missed >= MAX_MISSED;
     if !wrong || !r.proven {
         if wrong {
@@ -377,7 +416,7 @@ fn check(r: &Row) -> Vec<String> {
         Some((Limit::Budget, reason)) => {
             let mut scene = r.scene_ir.clone();
             scene.settings.max_steps *= BUDGET_FACTOR;
-            let again = compare_depth(&r.reference_depth, &render(&scene, analysis::analyse(&scene).step_lipschitz()));
+            let again = compare_depth(&r.reference_depth, &render(&scene));
             println!(
                 "{what}: known limit ({reason}); with {BUDGET_FACTOR}× the budget {}% missed, {}% behind\n{}",
                 pct(again.missed),
@@ -410,7 +449,13 @@ fn stability_suite() {
     );
     let rows: Vec<Row> = sweeps
         .iter()
-        .flat_map(|s| s.values.iter().map(move |v| measure(s, v)))
+        .flat_map(|s| {
+            let exact = s
+                .exact
+                .as_ref()
+                .map(|v| render(&scene_at(s, v).0).stats.steps_mean);
+            s.values.iter().map(move |v| measure(s, v, exact))
+        })
         .collect();
     println!("{}", table(&rows));
     let failures: Vec<String> = rows.iter().flat_map(check).collect();

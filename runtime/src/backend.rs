@@ -8,7 +8,7 @@ use crate::memory::Memory;
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, Program};
 use sdfc_compiler::scene::analytic::{self, Choice};
-use sdfc_compiler::scene::{analysis, Method, Scene, Settings};
+use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::time::{Duration, Instant};
 
 /// Where a scene is rendered.
@@ -102,28 +102,21 @@ impl Prepared {
     ) -> Result<Prepared, String> {
         method_allowed(scene)?;
         match backend {
-            Backend::Cpu => Ok(Self::cpu(scene, program, setup)),
+            Backend::Cpu => Ok(Self::cpu(program, setup)),
             Backend::Wgpu => Self::wgpu(scene, &program, setup, false),
             Backend::Cuda => Self::cuda(scene, &program, setup),
-            Backend::Auto if setup.precision == Precision::F64 => {
-                Ok(Self::cpu(scene, program, setup))
-            }
+            Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(program, setup)),
             Backend::Auto => Self::cuda(scene, &program, setup)
                 .or_else(|_| Self::wgpu(scene, &program, setup, true))
-                .or_else(|_| Ok(Self::cpu(scene, program, setup))),
+                .or_else(|_| Ok(Self::cpu(program, setup))),
         }
     }
 
-    /// The L every backend steps with (`f / L`): derived by the analysis of the scene IR.
-    pub fn lipschitz(scene: &Scene) -> f64 {
-        analysis::analyse(scene).step_lipschitz()
-    }
-
-    fn cpu(scene: &Scene, program: Program, setup: &Setup) -> Prepared {
+    fn cpu(program: Program, setup: &Setup) -> Prepared {
         let options = Options {
             precision: setup.precision,
             debug_nan: setup.debug_nan,
-            lipschitz: Self::lipschitz(scene),
+            lipschitz: program.lipschitz(),
             ..Options::default()
         };
         Prepared::Cpu {
@@ -147,7 +140,7 @@ impl Prepared {
         require_hardware: bool,
     ) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
-        let lipschitz = Self::lipschitz(scene);
+        let lipschitz = program.lipschitz();
         Ok(Prepared::Wgpu {
             gpu: Box::new(gpu),
             kernel: Box::new(Self::kernel(scene, program, setup)?),
@@ -172,7 +165,7 @@ impl Prepared {
             cuda: Box::new(cuda),
             loaded: Box::new(loaded),
             ptx_time,
-            lipschitz: Self::lipschitz(scene),
+            lipschitz: program.lipschitz(),
         })
     }
 

@@ -258,6 +258,7 @@ impl Builder {
             blocks: self.blocks,
             distance: d,
             material: m,
+            lipschitz: 1.0,
         };
         let (live, live_blocks) = if self.optimise {
             raw.live(&[d, m])
@@ -304,6 +305,7 @@ impl Builder {
             blocks,
             distance: new_index[d.0 as usize],
             material: new_index[m.0 as usize],
+            lipschitz: 1.0,
         }
     }
 }

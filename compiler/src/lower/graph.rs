@@ -45,6 +45,9 @@ pub(super) struct Config<'a> {
     pub bounds: Option<&'a Bounds>,
     /// Optimisation level ≥ 1: unions get a hierarchy, rotations are shared.
     pub optimise: bool,
+    /// Local bounds: for every node, the L its field is divided by where it is an operand
+    /// whose zero set is all that matters (see [`Lowerer::node`]).
+    pub divide: Option<&'a [f64]>,
 }
 
 /// Walks the graph, emitting into a builder.
@@ -52,8 +55,12 @@ pub(super) struct Config<'a> {
 pub(super) struct Lowerer<'a> {
     graph: &'a Graph,
     b: &'a mut Builder,
-    memo: HashMap<(NodeId, P), Field>,
+    memo: HashMap<(NodeId, P, bool), Field>,
     config: Config<'a>,
+    /// Whether only the zero set of the node being lowered matters (its ancestors are
+    /// plain combinations, paint and rigid or uniformly scaling transforms): where local
+    /// bounds are on, its operands may then be divided by their own L.
+    zero_set: bool,
 }
 
 impl<'a> Lowerer<'a> {
@@ -62,6 +69,7 @@ impl<'a> Lowerer<'a> {
             graph,
             b,
             memo: HashMap::new(),
+            zero_set: config.divide.is_some(),
             config,
         }
     }
@@ -75,17 +83,84 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Lowers node `id` evaluated at point `p`.
+    ///
+    /// With local bounds, an operand whose L exceeds 1 and whose zero set is all that matters
+    /// (see [`Lowerer::zero_set`]) is lowered as `max(f / L, β)`, β the distance to its
+    /// bounding volume: both are distance bounds, so their maximum is one, and it steps as far
+    /// as the volume allows away from the operand. A chain of paint and transforms over a
+    /// plain combination is not such an operand: the combination's own operands are.
     pub fn node(&mut self, id: NodeId, p: P) -> Field {
-        if let Some(&f) = self.memo.get(&(id, p)) {
+        let key = (id, p, self.zero_set);
+        if let Some(&f) = self.memo.get(&key) {
             if self.b.visible(f.d) && self.b.visible(f.m) {
                 return f;
             }
         }
+        let f = match self.config.divide {
+            Some(divide) if self.zero_set && divide[id.0 as usize] > 1.0 && !self.spine(id) => {
+                self.local_bound(id, divide[id.0 as usize], p)
+            }
+            _ => {
+                let zero_set = self.zero_set;
+                self.zero_set = zero_set && keeps_zero_set(self.graph.node(id));
+                let f = self.lower_node(id, p);
+                self.zero_set = zero_set;
+                f
+            }
+        };
+        self.memo.insert(key, f);
+        f
+    }
+
+    /// Whether paint and transforms below `id` lead to a plain combination.
+    fn spine(&self, mut id: NodeId) -> bool {
+        loop {
+            match self.graph.node(id) {
+                Node::Combine { .. } => return true,
+                Node::Paint { child, .. }
+                | Node::Translate { child, .. }
+                | Node::Rotate { child, .. }
+                | Node::Scale { child, .. } => id = *child,
+                _ => return false,
+            }
+        }
+    }
+
+    /// `max(f / l, β)` for node `id`'s field `f` and β the distance to its bound.
+    fn local_bound(&mut self, id: NodeId, l: f64, p: P) -> Field {
+        self.zero_set = false;
+        let f = self.node(id, p);
+        self.zero_set = true;
+        let text = format!(
+            "node {} local bound: the field divided by its L = {}, at least the distance to its bound",
+            self.number(id),
+            crate::scene::dump_num(l)
+        );
+        self.b.note(text);
+        let scaled = self.b.mulc(f.d, 1.0 / l);
+        let d = match self.config.bounds.and_then(|b| b.get(id)) {
+            Some(bound) => {
+                // Both the guard distance of the node's own bound and that of its box: a
+                // union's guards skip the node where either is not nearer than the best
+                // distance (its own guard, and the boxes of the groups around it), and the
+                // result must then not be nearer either, so that culling keeps the field.
+                let beta = bound_distance(self.b, &bound, p);
+                let (slab, _) = slab_distance(self.b, &bound, None, p);
+                let d = self.b.max(scaled, beta);
+                self.b.max(d, slab)
+            }
+            None => scaled,
+        };
+        Field { d, m: f.m }
+    }
+
+    /// Lowers node `id` at `p` (the body of [`Lowerer::node`]).
+    fn lower_node(&mut self, id: NodeId, p: P) -> Field {
         let graph = self.graph;
         let node = graph.node(id);
         self.b
             .note(format!("node {} {}", self.number(id), kind(node)));
-        let f = match node {
+        match node {
             Node::Combine {
                 op: Combine::Union,
                 children,
@@ -124,9 +199,7 @@ impl<'a> Lowerer<'a> {
                 Some((child, q)) => self.node(child, q),
                 None => self.primitive(node, p),
             },
-        };
-        self.memo.insert((id, p), f);
-        f
+        }
     }
 
     /// Notes that the instructions that follow belong to `id` again, after its children.
@@ -538,9 +611,25 @@ pub(super) fn field_and_bound(
         origin: None,
         bounds: Some(bounds),
         optimise: true,
+        divide: None,
     };
     let f = Lowerer::new(graph, &mut b, config).node(id, p);
     Some(b.finish(f.d, beta))
+}
+
+/// Whether only the zero set of a node's children matters when only its own does: true for
+/// plain combinations (a minimum or maximum of bounds is a bound), paint, translation,
+/// rotation and uniform scale; false where the children's values are read (offsets, smooth
+/// combinations) or the point map stretches (repetition, twist, bend, per-axis scale).
+fn keeps_zero_set(node: &Node) -> bool {
+    matches!(
+        node,
+        Node::Combine { .. }
+            | Node::Paint { .. }
+            | Node::Translate { .. }
+            | Node::Rotate { .. }
+            | Node::Scale { .. }
+    )
 }
 
 /// The number of children below a node of a hierarchy.

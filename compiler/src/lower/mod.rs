@@ -30,7 +30,7 @@ mod tests;
 
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
-use crate::scene::Scene;
+use crate::scene::{analysis, Graph, Scene};
 use std::fmt::Write;
 
 /// Names a register: the value defined by the instruction at this index.
@@ -177,9 +177,18 @@ pub struct Program {
     blocks: Vec<Block>,
     distance: Reg,
     material: Reg,
+    lipschitz: f64,
 }
 
 impl Program {
+    /// The L a renderer steps with (`f / L` is a distance bound): 1 for a program with local
+    /// bounds, else the scene's L ([`Analysis::step_lipschitz`]).
+    ///
+    /// [`Analysis::step_lipschitz`]: crate::scene::analysis::Analysis::step_lipschitz
+    pub fn lipschitz(&self) -> f64 {
+        self.lipschitz
+    }
+
     /// The instructions; register `i` is defined by `ops()[i]`.
     pub fn ops(&self) -> &[Op] {
         &self.ops
@@ -395,14 +404,17 @@ pub struct LowerOptions {
     /// off keeps every other pass, and the same order of evaluation, so that the two
     /// programs compute bit-identical results.
     pub cull: bool,
+    /// At level 1: local bounds. Each operand of the scene's unions, intersections and
+    /// subtractions (and the root) whose L exceeds 1 is divided by its own L and raised to
+    /// the distance to its bounding volume (`docs/analysis.md`, "Local bounds"), so that the
+    /// program is a bound with L = 1 and only rays near such an operand step shorter. Off,
+    /// the program is the field as written and renderers step by the scene's L everywhere.
+    pub local: bool,
 }
 
 impl Default for LowerOptions {
     fn default() -> Self {
-        LowerOptions {
-            level: 1,
-            cull: true,
-        }
+        LowerOptions::level(1)
     }
 }
 
@@ -412,6 +424,7 @@ impl LowerOptions {
         LowerOptions {
             level,
             cull: level > 0,
+            local: level > 0,
         }
     }
 }
@@ -449,27 +462,47 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
     let optimise = options.level > 0;
     let mut b = builder::Builder::new(optimise);
     let p = b.input_point();
+    let mut lipschitz = 1.0;
     let (d, m) = match scene.root {
         Some(root) if optimise => {
             let simple = simplify::simplify(&scene.graph, root);
-            let bounds = bounds::Bounds::new(&simple.graph);
+            // The analysis of the simplified graph, whose nodes the lowering walks.
+            let simple_scene = Scene {
+                graph: simple.graph,
+                root: Some(simple.root),
+                ..scene_without_graph(scene)
+            };
+            let analysis = analysis::analyse(&simple_scene);
+            let divide: Vec<f64> = simple_scene
+                .graph
+                .ids()
+                .map(|id| analysis.node(id).step())
+                .collect();
+            if !options.local {
+                lipschitz = analysis.step_lipschitz();
+            }
+            let bounds = bounds::Bounds::new(&simple_scene.graph);
             let config = graph::Config {
                 cull: options.cull,
                 camera: scene.camera.position,
                 origin: Some(simple.origin.as_slice()),
                 bounds: Some(&bounds),
                 optimise: true,
+                divide: options.local.then_some(divide.as_slice()),
             };
-            let field = graph::Lowerer::new(&simple.graph, &mut b, config).node(simple.root, p);
+            let field =
+                graph::Lowerer::new(&simple_scene.graph, &mut b, config).node(simple.root, p);
             (field.d, field.m)
         }
         Some(root) => {
+            lipschitz = analysis::analyse(scene).step_lipschitz();
             let config = graph::Config {
                 cull: false,
                 camera: scene.camera.position,
                 origin: None,
                 bounds: None,
                 optimise: false,
+                divide: None,
             };
             let field = graph::Lowerer::new(&scene.graph, &mut b, config).node(root, p);
             (field.d, field.m)
@@ -478,5 +511,20 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
     };
     b.note("result: unpainted shapes get the default material 0".into());
     let m = b.paint(m, 0.0);
-    b.finish(d, m)
+    Program {
+        lipschitz,
+        ..b.finish(d, m)
+    }
+}
+
+/// Everything of a scene but its shapes (for analysing a rewritten graph).
+fn scene_without_graph(scene: &Scene) -> Scene {
+    Scene {
+        graph: Graph::default(),
+        root: None,
+        materials: scene.materials.clone(),
+        lights: scene.lights.clone(),
+        camera: scene.camera.clone(),
+        settings: scene.settings.clone(),
+    }
 }

@@ -50,6 +50,19 @@ pub struct Derived {
     pub cause: Option<NodeId>,
 }
 
+impl Derived {
+    /// The L to divide this field by for sphere tracing: its L, at least 1 and at most
+    /// [`MAX_STEP_LIPSCHITZ`] (also for an L that is not a number).
+    pub fn step(&self) -> f64 {
+        let l = self.facts.lipschitz;
+        if l.is_nan() {
+            MAX_STEP_LIPSCHITZ
+        } else {
+            l.clamp(1.0, MAX_STEP_LIPSCHITZ)
+        }
+    }
+}
+
 /// The result of [`analyse`].
 #[derive(Debug, Clone)]
 pub struct Analysis {
@@ -77,11 +90,7 @@ impl Analysis {
     /// The L the renderers step with: the scene's L, at least 1 and at most
     /// [`MAX_STEP_LIPSCHITZ`].
     pub fn step_lipschitz(&self) -> f64 {
-        match self.root() {
-            Some(d) if d.facts.lipschitz.is_nan() => MAX_STEP_LIPSCHITZ,
-            Some(d) => d.facts.lipschitz.clamp(1.0, MAX_STEP_LIPSCHITZ),
-            None => 1.0,
-        }
+        self.root().map_or(1.0, Derived::step)
     }
 
     /// Warnings about constructs that make the field unreliable, in node order, one per code

@@ -55,7 +55,8 @@ pub fn run(args: CheckArgs) -> ExitCode {
 }
 
 /// What the analysis derived for the scene, in one clause: `distance field: bound (L = 1)`,
-/// or, when inexact, with the construct responsible.
+/// or, when inexact, with the construct responsible, and, where L > 1, that the lowering
+/// divides it out locally (each operand by its own L, `docs/analysis.md`).
 pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
     let analysis = analysis::analyse(scene);
     let Some(root) = analysis.root() else {
@@ -73,9 +74,13 @@ pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
             num(step)
         ),
         Exactness::Approximate if step < l => format!(
-            "distance field: {word}, L = {}{cause}, clamped to {}",
+            "distance field: {word}, L = {}{cause}, clamped to {}; divided out locally",
             num(l),
             num(step)
+        ),
+        Exactness::Approximate if l > 1.0 => format!(
+            "distance field: {word}, L = {}{cause}; divided out locally",
+            num(l)
         ),
         Exactness::Approximate => format!("distance field: {word}, L = {}{cause}", num(l)),
     }

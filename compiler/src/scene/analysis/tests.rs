@@ -6,7 +6,7 @@
 use super::*;
 use crate::check::check_str;
 use crate::eval::eval_point;
-use crate::lower::{lower, Program};
+use crate::lower::{lower, lower_with, LowerOptions, Program};
 
 fn scene(objects: &str) -> (Scene, Vec<Diagnostic>) {
     let text = format!("scene {{ {objects}; }}");
@@ -257,33 +257,61 @@ fn crossings(program: &Program, b: &Aabb, l: f64, rays: usize) -> usize {
     bad
 }
 
-/// The scene's program, its analysis and a box around it.
+/// The scene's program as written (no local bounds), its analysis and a box around it.
 fn traced(objects: &str) -> (Program, f64, bool, Aabb) {
     let (s, _) = scene(objects);
     let a = analyse(&s);
     let r = *a.root().expect("root");
-    (lower(&s), r.facts.lipschitz, r.proven, r.bounds.grow(0.1))
+    let written = LowerOptions {
+        local: false,
+        ..LowerOptions::default()
+    };
+    let program = lower_with(&s, &written);
+    assert_eq!(program.lipschitz(), a.step_lipschitz());
+    (program, r.facts.lipschitz, r.proven, r.bounds.grow(0.1))
 }
+
+/// Proven fields of every kind of rule.
+const PROVEN: &[&str] = &[
+    "box((0.5, 1.5, 0.2)).twist(2)",
+    "box((0.5, 1.5, 0.2)).twist(2).round(0.1)",
+    "box((1.5, 0.1, 0.4)).bend(1)",
+    "smooth_union(1.5, sphere(0.5), box(0.3).translate(1.2, 0, 0), variant: \"exp\")",
+    "smooth_subtract(0.8, box(0.8), sphere(0.5).translate(0.5, 0.5, 0), variant: \"exp\")",
+    "smooth_union(0.6, box((0.2, 1, 0.2)).twist(3), sphere(0.4))",
+    "sphere(1).scale((1, 0.1, 3))",
+    "box(0.3).translate(0.5, 0.4, 0).mirror(x: true, y: true)",
+    "cone(0.5, 1).elongate((0.3, 0.2, 0))",
+    "intersect(sphere(0.3).repeat((1, 1, 1)), box(2))",
+    "intersect(sphere(0.4).repeat((1, 0, 1)).round(0.2), box(2))",
+    "smooth_subtract(0.3, sphere(1), sphere(0.12).repeat((0.3, 0.3, 0.3)))",
+];
 
 #[test]
 fn steps_of_f_over_l_never_cross_a_proven_surface() {
-    for objects in [
-        "box((0.5, 1.5, 0.2)).twist(2)",
-        "box((0.5, 1.5, 0.2)).twist(2).round(0.1)",
-        "box((1.5, 0.1, 0.4)).bend(1)",
-        "smooth_union(1.5, sphere(0.5), box(0.3).translate(1.2, 0, 0), variant: \"exp\")",
-        "smooth_subtract(0.8, box(0.8), sphere(0.5).translate(0.5, 0.5, 0), variant: \"exp\")",
-        "smooth_union(0.6, box((0.2, 1, 0.2)).twist(3), sphere(0.4))",
-        "sphere(1).scale((1, 0.1, 3))",
-        "box(0.3).translate(0.5, 0.4, 0).mirror(x: true, y: true)",
-        "cone(0.5, 1).elongate((0.3, 0.2, 0))",
-        "intersect(sphere(0.3).repeat((1, 1, 1)), box(2))",
-        "intersect(sphere(0.4).repeat((1, 0, 1)).round(0.2), box(2))",
-        "smooth_subtract(0.3, sphere(1), sphere(0.12).repeat((0.3, 0.3, 0.3)))",
-    ] {
+    for objects in PROVEN {
         let (program, l, proven, b) = traced(objects);
         assert!(proven, "{objects}");
         assert_eq!(crossings(&program, &b, l, 400), 0, "{objects}: L = {l}");
+    }
+}
+
+#[test]
+fn with_local_bounds_steps_of_f_never_cross_a_proven_surface() {
+    // Each field alone, and beside a sphere and under a subtraction, so that the operands of
+    // combinations are divided by their own L.
+    for objects in PROVEN {
+        for scene_text in [
+            objects.to_string(),
+            format!("union({objects}, sphere(0.3).translate(2.5, 0, 0))"),
+            format!("subtract({objects}, sphere(0.3).translate(0, 0.4, 0))"),
+        ] {
+            let (s, _) = scene(&scene_text);
+            let program = lower(&s);
+            assert_eq!(program.lipschitz(), 1.0, "{scene_text}");
+            let b = analyse(&s).root().expect("root").bounds.grow(0.1);
+            assert_eq!(crossings(&program, &b, 1.0, 300), 0, "{scene_text}");
+        }
     }
 }
 

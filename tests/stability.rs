@@ -14,6 +14,8 @@
 //! bounds) and what stepping it with L = 1 instead would have missed and hit behind. A file
 //! may name the value of its parameter at which the scene is an exact field of the same layout
 //! (`// exact layout: VALUE`); the table then gives the steps per pixel relative to that render.
+//! It may also name the least PSNR against the reference that every render must reach
+//! (`// min psnr: DB`).
 //! With `SDFC_STABILITY_IMAGES=DIR` set, both images of every render are written to `DIR`.
 //!
 //! What it asserts is what the analysis promises: no pixel is ever NaN; where the analysis
@@ -53,38 +55,16 @@ const BUDGET_FACTOR: u32 = 16;
 enum Limit {
     /// Rays run out of steps: with [`BUDGET_FACTOR`] times the budget the render is right.
     Budget,
-    /// f32 cannot resolve the hit tolerance ε·t so far from the origin; only reported.
-    Precision,
 }
 
 /// Renders (file stem, stress value) the renderer gets wrong for a reason the field is not
 /// responsible for, with the reason.
-const LIMITS: &[(&str, &str, Limit, &str)] = &[
-    (
-        "horizon",
-        "1000",
-        Limit::Budget,
-        "rays grazing the ground near the horizon need more steps than the budget",
-    ),
-    (
-        "far",
-        "1000",
-        Limit::Precision,
-        "ε·t is below the spacing of f32 coordinates 1000 units out",
-    ),
-    (
-        "far",
-        "10000",
-        Limit::Precision,
-        "ε·t is below the spacing of f32 coordinates 10⁴ units out",
-    ),
-    (
-        "far",
-        "100000",
-        Limit::Precision,
-        "ε·t is below the spacing of f32 coordinates 10⁵ units out",
-    ),
-];
+const LIMITS: &[(&str, &str, Limit, &str)] = &[(
+    "horizon",
+    "1000",
+    Limit::Budget,
+    "rays grazing the ground near the horizon need more steps than the budget",
+)];
 
 /// One scene file and its sweep.
 #[derive(Debug)]
@@ -94,6 +74,8 @@ struct Sweep {
     values: Vec<String>,
     /// The value at which the scene is an exact field of the same layout.
     exact: Option<String>,
+    /// The least PSNR against the reference every render of the sweep must reach.
+    min_psnr: Option<f64>,
     text: String,
 }
 
@@ -133,6 +115,10 @@ fn sweep(path: &Path) -> Sweep {
             .lines()
             .find_map(|l| l.strip_prefix("// exact layout:"))
             .map(|v| v.trim().to_string()),
+        min_psnr: text
+            .lines()
+            .find_map(|l| l.strip_prefix("// min psnr:"))
+            .map(|v| v.trim().parse().expect("`// min psnr: DB`")),
         text,
     }
 }
@@ -173,6 +159,7 @@ struct Row {
     depth: DepthDifference,
     exhausted: f64,
     psnr: f64,
+    min_psnr: Option<f64>,
     steps: f64,
     reference_steps: f64,
     /// Steps per pixel of the exact scene of the same layout, where the file names one.
@@ -299,6 +286,7 @@ fn measure(s: &Sweep, value: &str, exact_steps: Option<f64>) -> Row {
         depth: compare_depth(depth(&reference), &test),
         exhausted: c.budget_misses as f64 / (c.camera_rays + c.secondary_rays).max(1) as f64,
         psnr: metrics::compare(&reference.image, &test.image, 0.1).map_or(f64::NAN, |d| d.psnr),
+        min_psnr: s.min_psnr,
         steps: test.stats.steps_mean,
         reference_steps: reference.stats.steps_mean,
         exact_steps,
@@ -393,6 +381,14 @@ fn check(r: &Row) -> Vec<String> {
     if r.nan_pixels > 0 {
         failures.push(format!("{what}: {} NaN pixels", r.nan_pixels));
     }
+    if let Some(min) = r.min_psnr {
+        if r.psnr.is_nan() || r.psnr < min {
+            failures.push(format!(
+                "{what}: {:.1} dB against the reference, below {min} dB",
+                r.psnr
+            ));
+        }
+    }
     if let (Some(exact), true) = (r.exact_steps, r.proven) {
         if r.steps > MAX_STEP_RATIO * exact {
             failures.push(format!(
@@ -427,7 +423,6 @@ fn check(r: &Row) -> Vec<String> {
                 failures.push(format!("{what}: listed as a budget limit, but more steps do not fix it"));
             }
         }
-        Some((Limit::Precision, reason)) => println!("{what}: known limit ({reason})\n{}", r.map),
         None => failures.push(format!(
             "{what}: the analysis proves L = {} but {}% of pixels are missed and {}% hit behind\n{}",
             r.lipschitz,

@@ -28,6 +28,7 @@ impl Build {
             lights: Vec::new(),
             camera: Camera::default(),
             settings: Settings::default(),
+            origin: [0.0; 3],
         };
         Build { scene }
     }

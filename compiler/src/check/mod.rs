@@ -323,6 +323,7 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
         ),
     }
     scene.graph = std::mem::take(&mut cx.graph);
+    crate::scene::recentre::recentre(&mut scene);
     scene
 }
 

@@ -526,5 +526,6 @@ fn scene_without_graph(scene: &Scene) -> Scene {
         lights: scene.lights.clone(),
         camera: scene.camera.clone(),
         settings: scene.settings.clone(),
+        origin: scene.origin,
     }
 }

@@ -17,6 +17,13 @@ pub fn dump(scene: &Scene) -> String {
     if s.method != Method::Auto {
         let _ = writeln!(out, "method {}", s.method.name());
     }
+    if scene.origin != [0.0; 3] {
+        let _ = writeln!(
+            out,
+            "origin {} (moved to put the camera at the origin)",
+            v3(scene.origin)
+        );
+    }
     let c = &scene.camera;
     let _ = writeln!(
         out,

@@ -394,9 +394,21 @@ pub struct Scene {
     pub camera: Camera,
     /// Render settings.
     pub settings: Settings,
+    /// Where the scene's origin lies in the coordinates it was written in: zero, unless the
+    /// scene was moved to put a far camera at the origin ([`super::recentre`]). Patterns are
+    /// laid out in the written coordinates, at p + origin.
+    pub origin: V3,
 }
 
 impl Scene {
+    /// Where a checker of cells of edge `size` starts at the scene's origin, in cells: the
+    /// written pattern at p + origin is the pattern at p / size + shift. The origin is
+    /// reduced modulo two cells (which keeps the parity) so that the shift stays small and
+    /// exact in f32.
+    pub fn checker_shift(&self, size: f64) -> V3 {
+        self.origin.map(|o| o.rem_euclid(2.0 * size) / size)
+    }
+
     /// The material behind an id.
     pub fn material(&self, id: MaterialId) -> &Material {
         &self.materials[id.0 as usize]

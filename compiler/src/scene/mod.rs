@@ -4,6 +4,7 @@ pub mod analysis;
 pub mod analytic;
 mod dump;
 pub mod ir;
+pub mod recentre;
 
 pub use dump::{dump, num as dump_num};
 pub use ir::*;

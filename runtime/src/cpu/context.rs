@@ -12,7 +12,13 @@ use sdfc_compiler::scene::{Light, Material, Pattern, Scene};
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Paint<T> {
     Solid(V3<T>),
-    Checker { a: V3<T>, b: V3<T>, inv_size: T },
+    /// `shift`: [`Scene::checker_shift`].
+    Checker {
+        a: V3<T>,
+        b: V3<T>,
+        inv_size: T,
+        shift: V3<T>,
+    },
 }
 
 /// A Phong material in the evaluation type.
@@ -71,9 +77,9 @@ pub(super) struct Context<T: Float> {
 impl<T: Float> Context<T> {
     pub fn new(scene: &Scene, lipschitz: f64, debug_nan: bool) -> Self {
         let s = &scene.settings;
-        let mut materials: Vec<Mat<T>> = scene.materials.iter().map(mat).collect();
+        let mut materials: Vec<Mat<T>> = scene.materials.iter().map(|m| mat(scene, m)).collect();
         if materials.is_empty() {
-            materials.push(mat(&Material::default_material()));
+            materials.push(mat(scene, &Material::default_material()));
         }
         let transparent = materials.iter().any(|m| m.transparency > T::zero());
         Context {
@@ -136,7 +142,7 @@ pub(super) fn branching(scene: &Scene) -> usize {
         .unwrap_or(0)
 }
 
-fn mat<T: Float>(m: &Material) -> Mat<T> {
+fn mat<T: Float>(scene: &Scene, m: &Material) -> Mat<T> {
     let f = T::from_f64;
     let paint = match &m.pattern {
         Pattern::Solid(c) => Paint::Solid(V3::from_f64(*c)),
@@ -144,6 +150,7 @@ fn mat<T: Float>(m: &Material) -> Mat<T> {
             a: V3::from_f64(*a),
             b: V3::from_f64(*b),
             inv_size: f(1.0 / size),
+            shift: V3::from_f64(scene.checker_shift(*size)),
         },
     };
     Mat {

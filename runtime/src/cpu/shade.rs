@@ -201,8 +201,13 @@ fn materials<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, hits: &mut [
 fn colour<T: Float>(m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
     match m.paint {
         Paint::Solid(c) => c,
-        Paint::Checker { a, b, inv_size } => {
-            let q = (hit.p - hit.n * (T::from_f64(2.0) * hit.h)) * inv_size;
+        Paint::Checker {
+            a,
+            b,
+            inv_size,
+            shift,
+        } => {
+            let q = (hit.p - hit.n * (T::from_f64(2.0) * hit.h)) * inv_size + shift;
             let s = q.x.floor() + q.y.floor() + q.z.floor();
             let two = T::from_f64(2.0);
             let odd = s - two * (s / two).floor();

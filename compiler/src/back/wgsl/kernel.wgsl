@@ -22,6 +22,7 @@ struct Material {
     color_b: vec4<f32>, // checker's second colour, w: 1 / checker size
     phong: vec4<f32>,   // ambient, diffuse, specular, shininess
     optics: vec4<f32>,  // reflect, transparency, ior, unused
+    shift: vec4<f32>,   // checker: the pattern's offset at the scene's origin, in cells
 }
 struct Params {
     eye: vec4<f32>,        // camera position
@@ -222,7 +223,7 @@ fn normal(p: vec3<f32>, h: f32, d: vec3<f32>) -> vec3<f32> {
 fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> {
 //#if CHECKER
     if m.color.w > 0.0 {
-        let q = (p - n * (2.0 * h)) * m.color_b.w;
+        let q = (p - n * (2.0 * h)) * m.color_b.w + m.shift.xyz;
         let s = floor(q.x) + floor(q.y) + floor(q.z);
         let odd = s - 2.0 * floor(s / 2.0);
         return select(m.color.xyz, m.color_b.xyz, odd > 0.0);

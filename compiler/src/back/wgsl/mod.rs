@@ -276,14 +276,17 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
         }
     }
     for m in &scene.materials {
-        let (a, b, checker, inv) = match &m.pattern {
-            Pattern::Solid(c) => (*c, [0.0; 3], 0.0, 0.0),
-            Pattern::Checker { a, b, size } => (*a, *b, 1.0, 1.0 / size),
+        let (a, b, checker, inv, shift) = match &m.pattern {
+            Pattern::Solid(c) => (*c, [0.0; 3], 0.0, 0.0, [0.0; 3]),
+            Pattern::Checker { a, b, size } => {
+                (*a, *b, 1.0, 1.0 / size, scene.checker_shift(*size))
+            }
         };
         w.v4(a, checker);
         w.v4(b, inv);
         w.f([m.ambient, m.diffuse, m.specular, m.shininess]);
         w.f([m.reflect, m.transparency, m.ior.max(1e-6), 0.0]);
+        w.v4(shift, 0.0);
     }
     w.0
 }

@@ -18,6 +18,9 @@
 //! (`// min psnr: DB`).
 //! With `SDFC_STABILITY_IMAGES=DIR` set, both images of every render are written to `DIR`.
 //!
+//! Scenes that `method: auto` (the default) traces analytically are also rendered so and
+//! must then miss nothing and hit nothing behind.
+//!
 //! What it asserts is what the analysis promises: no pixel is ever NaN; where the analysis
 //! proves that `f / L` is a bound, no pixel is hit behind the surface and fewer than 0.1 % are
 //! missed, except for the renderer's documented limits in [`LIMITS`] (each checked to be what
@@ -26,6 +29,7 @@
 
 use sdfc_compiler::check::check_str;
 use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
+use sdfc_compiler::scene::analytic::{self, Choice};
 use sdfc_compiler::scene::{analysis, Method, Scene, Settings};
 use sdfc_runtime::backend::{Backend, Prepared};
 use sdfc_runtime::cpu::{self, reference, Options, Precision, Render};
@@ -63,7 +67,8 @@ const LIMITS: &[(&str, &str, Limit, &str)] = &[(
     "horizon",
     "1000",
     Limit::Budget,
-    "rays grazing the ground near the horizon need more steps than the budget",
+    "sphere tracing: rays grazing the ground near the horizon need more steps than the budget; \
+     method auto, the default, traces this scene analytically (checked)",
 )];
 
 /// One scene file and its sweep.
@@ -170,6 +175,9 @@ struct Row {
     /// Missed and behind fractions without local bounds, stepping with L = 1 (only where
     /// L > 1).
     at_one: Option<DepthDifference>,
+    /// Where `method: auto` (the default) traces the scene analytically: that render
+    /// against the reference.
+    traced: Option<DepthDifference>,
     /// Where the first hits differ: `m` missed, `f` false hit, `b` behind.
     map: String,
     /// The scene as rendered (for re-rendering under a limit).
@@ -271,6 +279,15 @@ fn measure(s: &Sweep, value: &str, exact_steps: Option<f64>) -> Row {
         sdfc_runtime::image::write_png(&file("test"), &test.image).expect("writable");
         sdfc_runtime::image::write_png(&file("reference"), &reference.image).expect("writable");
     }
+    let mut auto = scene.clone();
+    auto.settings.method = Method::Auto;
+    let traced = matches!(analytic::choose(&auto), Choice::Trace(_)).then(|| {
+        let r = Prepared::new(Backend::Cpu, &auto, Precision::F32)
+            .and_then(|p| p.render(&auto, &|_| {}))
+            .expect("a CPU render")
+            .render;
+        compare_depth(depth(&reference), &r)
+    });
     let global = a.step_lipschitz() > 1.0;
     let at_one = global.then(|| compare_depth(depth(&reference), &render_global(&scene, 1.0)));
     let global_steps = global.then(|| render_global(&scene, a.step_lipschitz()).stats.steps_mean);
@@ -293,6 +310,7 @@ fn measure(s: &Sweep, value: &str, exact_steps: Option<f64>) -> Row {
         global_steps,
         nan_pixels: nan_pixels(&test) + nan_pixels(&reference),
         at_one,
+        traced,
         map: hit_map(depth(&reference), depth(&test)),
         scene_ir: scene,
         reference_depth: depth(&reference).clone(),
@@ -326,8 +344,8 @@ fn pct(x: f64) -> String {
 /// The table, as Markdown.
 fn table(rows: &[Row]) -> String {
     let mut out = String::from(
-        "| Scene | Stress | Field | L | Warnings | Missed % | False hits % | Behind % | Exhausted % | PSNR dB | Steps/px | × exact layout | Global 1/L: steps/px | Ref. steps/px | At L = 1: missed %, behind % |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| Scene | Stress | Field | L | Warnings | Missed % | False hits % | Behind % | Exhausted % | PSNR dB | Steps/px | × exact layout | Global 1/L: steps/px | Ref. steps/px | At L = 1: missed %, behind % | Traced (auto): missed %, behind % |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let field = if r.proven {
@@ -343,6 +361,9 @@ fn table(rows: &[Row]) -> String {
         let at_one = r.at_one.map_or("–".to_string(), |d| {
             format!("{}, {}", pct(d.missed), pct(d.behind))
         });
+        let traced = r.traced.map_or("–".to_string(), |d| {
+            format!("{}, {}", pct(d.missed), pct(d.behind))
+        });
         let ratio = r
             .exact_steps
             .map_or("–".to_string(), |e| format!("{:.2}", r.steps / e));
@@ -350,7 +371,7 @@ fn table(rows: &[Row]) -> String {
             .global_steps
             .map_or("–".to_string(), |g| format!("{g:.1}"));
         out += &format!(
-            "| {} | {} = {} | {field} | {:.3} | {warnings} | {} | {} | {} | {} | {:.1} | {:.1} | {ratio} | {global} | {:.1} | {at_one} |\n",
+            "| {} | {} = {} | {field} | {:.3} | {warnings} | {} | {} | {} | {} | {:.1} | {:.1} | {ratio} | {global} | {:.1} | {at_one} | {traced} |\n",
             r.scene,
             r.param,
             r.value,
@@ -380,6 +401,15 @@ fn check(r: &Row) -> Vec<String> {
     let mut failures = Vec::new();
     if r.nan_pixels > 0 {
         failures.push(format!("{what}: {} NaN pixels", r.nan_pixels));
+    }
+    if let Some(t) = r.traced {
+        if t.behind > 0.0 || t.missed >= MAX_MISSED {
+            failures.push(format!(
+                "{what}: traced analytically (the default method here), {}% missed and {}% hit behind",
+                pct(t.missed),
+                pct(t.behind)
+            ));
+        }
     }
     if let Some(min) = r.min_psnr {
         if r.psnr.is_nan() || r.psnr < min {

@@ -11,6 +11,7 @@ use super::bounds::{Aabb, Bound, Bounds};
 use super::builder::{Builder, P};
 use super::bvh::{self, Kind, Tree};
 use super::{shapes, Reg, Unary, EMPTY_DISTANCE};
+use crate::scene::analysis::{Analysis, Window};
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
 use std::collections::HashMap;
 
@@ -45,9 +46,12 @@ pub(super) struct Config<'a> {
     pub bounds: Option<&'a Bounds>,
     /// Optimisation level ≥ 1: unions get a hierarchy, rotations are shared.
     pub optimise: bool,
-    /// Local bounds: for every node, the L its field is divided by where it is an operand
-    /// whose zero set is all that matters (see [`Lowerer::node`]).
-    pub divide: Option<&'a [f64]>,
+    /// The analysis of the graph: the neighbouring cells of repetitions, and for local
+    /// bounds the L of each node.
+    pub analysis: Option<&'a Analysis>,
+    /// Local bounds: an operand whose zero set is all that matters is divided by its own L
+    /// (see [`Lowerer::node`]).
+    pub local: bool,
 }
 
 /// Walks the graph, emitting into a builder.
@@ -69,7 +73,7 @@ impl<'a> Lowerer<'a> {
             graph,
             b,
             memo: HashMap::new(),
-            zero_set: config.divide.is_some(),
+            zero_set: config.local && config.analysis.is_some(),
             config,
         }
     }
@@ -96,10 +100,12 @@ impl<'a> Lowerer<'a> {
                 return f;
             }
         }
-        let f = match self.config.divide {
-            Some(divide) if self.zero_set && divide[id.0 as usize] > 1.0 && !self.spine(id) => {
-                self.local_bound(id, divide[id.0 as usize], p)
-            }
+        let divide = match self.config.analysis {
+            Some(a) if self.zero_set => a.node(id).step(),
+            _ => 1.0,
+        };
+        let f = match () {
+            _ if divide > 1.0 && !self.spine(id) => self.local_bound(id, divide, p),
             _ => {
                 let zero_set = self.zero_set;
                 self.zero_set = zero_set && keeps_zero_set(self.graph.node(id));
@@ -110,6 +116,75 @@ impl<'a> Lowerer<'a> {
         };
         self.memo.insert(key, f);
         f
+    }
+
+    /// The neighbouring cells repetition `id` evaluates, if any.
+    fn window(&self, id: NodeId) -> Option<Window> {
+        self.config.analysis.and_then(|a| a.window(id))
+    }
+
+    /// A repetition whose copies reach out of their cells: the minimum over the copies of the
+    /// cells within `w.reach` of the point's own cell (clamped to those that exist), and
+    /// `w.beyond`, a lower bound of the distance to the others.
+    fn windowed(
+        &mut self,
+        id: NodeId,
+        child: NodeId,
+        period: V3,
+        count: Option<V3>,
+        w: Window,
+        p: P,
+    ) -> Field {
+        let b = &mut *self.b;
+        // The own cell's index per axis, centred (−(n−1)/2 … (n−1)/2 for n copies).
+        let cell: [Option<Reg>; 3] = [0, 1, 2].map(|i| {
+            (period[i] != 0.0).then(|| {
+                let u = b.mulc(p[i], 1.0 / period[i]);
+                match count {
+                    None => b.un(Unary::Round, u),
+                    Some(n) => {
+                        let half = (n[i] - 1.0) * 0.5;
+                        let u = b.addc(u, half);
+                        let id = b.un(Unary::Round, u);
+                        let id = b.clampc(id, 0.0, n[i] - 1.0);
+                        b.subc(id, half)
+                    }
+                }
+            })
+        });
+        let r = w.reach.map(|x| x as i64);
+        let mut acc: Option<Field> = None;
+        for i in -r[0]..=r[0] {
+            for j in -r[1]..=r[1] {
+                for k in -r[2]..=r[2] {
+                    let offset = [i, j, k];
+                    let b = &mut *self.b;
+                    let q = b.map3(p, |b, x, a| {
+                        let Some(c) = cell[a] else { return x };
+                        let mut c = b.addc(c, offset[a] as f64);
+                        if let Some(n) = count {
+                            let half = (n[a] - 1.0) * 0.5;
+                            c = b.clampc(c, -half, half);
+                        }
+                        let off = b.mulc(c, period[a]);
+                        b.sub(x, off)
+                    });
+                    let f = self.node(child, q);
+                    acc = Some(self.fold(acc, f));
+                }
+            }
+        }
+        self.resume(id, self.graph.node(id));
+        let f = acc.expect("a window holds the own cell");
+        if w.beyond.is_finite() {
+            let cap = self.b.c(w.beyond);
+            Field {
+                d: self.b.min(f.d, cap),
+                m: f.m,
+            }
+        } else {
+            f
+        }
     }
 
     /// Whether paint and transforms below `id` lead to a plain combination.
@@ -189,6 +264,14 @@ impl<'a> Lowerer<'a> {
             Node::Scale { factor, child } => {
                 let q = self.b.map3(p, |b, x, _| b.mulc(x, 1.0 / factor));
                 self.post(id, *child, q, |b, d| b.mulc(d, factor.abs()))
+            }
+            Node::Repeat {
+                period,
+                count,
+                child,
+            } if self.window(id).is_some() => {
+                let w = self.window(id).expect("checked");
+                self.windowed(id, *child, *period, *count, w, p)
             }
             Node::ScaleXyz { factors, child } => {
                 let q = self.b.map3(p, |b, x, i| b.mulc(x, 1.0 / factors[i]));
@@ -611,7 +694,8 @@ pub(super) fn field_and_bound(
         origin: None,
         bounds: Some(bounds),
         optimise: true,
-        divide: None,
+        analysis: None,
+        local: false,
     };
     let f = Lowerer::new(graph, &mut b, config).node(id, p);
     Some(b.finish(f.d, beta))

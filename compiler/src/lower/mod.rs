@@ -473,11 +473,6 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
                 ..scene_without_graph(scene)
             };
             let analysis = analysis::analyse(&simple_scene);
-            let divide: Vec<f64> = simple_scene
-                .graph
-                .ids()
-                .map(|id| analysis.node(id).step())
-                .collect();
             if !options.local {
                 lipschitz = analysis.step_lipschitz();
             }
@@ -488,21 +483,24 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
                 origin: Some(simple.origin.as_slice()),
                 bounds: Some(&bounds),
                 optimise: true,
-                divide: options.local.then_some(divide.as_slice()),
+                analysis: Some(&analysis),
+                local: options.local,
             };
             let field =
                 graph::Lowerer::new(&simple_scene.graph, &mut b, config).node(simple.root, p);
             (field.d, field.m)
         }
         Some(root) => {
-            lipschitz = analysis::analyse(scene).step_lipschitz();
+            let analysis = analysis::analyse(scene);
+            lipschitz = analysis.step_lipschitz();
             let config = graph::Config {
                 cull: false,
                 camera: scene.camera.position,
                 origin: None,
                 bounds: None,
                 optimise: false,
-                divide: None,
+                analysis: Some(&analysis),
+                local: false,
             };
             let field = graph::Lowerer::new(&scene.graph, &mut b, config).node(root, p);
             (field.d, field.m)

@@ -28,6 +28,11 @@ pub const WARN_STRETCH: f64 = 1.5;
 /// A per-axis scale whose largest factor is this many times its smallest is reported (W0007).
 pub const WARN_SCALE_RATIO: f64 = 10.0;
 
+/// A repetition whose copies reach out of their cells evaluates the neighbouring cells too,
+/// up to this many cells per point; beyond, it evaluates only the own cell and is reported
+/// (W0005, W0006).
+pub const MAX_WINDOW_CELLS: u32 = 27;
+
 /// Slack of the geometric tests (a shape touching its cell still fits).
 const TOLERANCE: f64 = 1e-9;
 
@@ -63,10 +68,22 @@ impl Derived {
     }
 }
 
+/// The cells a repetition evaluates around a point's own cell, when its copies reach out of
+/// their cells or are off-centre: `reach[i]` cells on each side along axis i (clamped to the
+/// copies that exist), and the minimum with `beyond`, a lower bound of the distance to every
+/// copy outside that window (infinite when the window holds every copy). `docs/analysis.md`,
+/// "Repetition", derives it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Window {
+    pub reach: [u32; 3],
+    pub beyond: f64,
+}
+
 /// The result of [`analyse`].
 #[derive(Debug, Clone)]
 pub struct Analysis {
     nodes: Vec<Derived>,
+    windows: Vec<Option<Window>>,
     root: Option<NodeId>,
     diagnostics: Vec<Diagnostic>,
 }
@@ -80,6 +97,11 @@ impl Analysis {
     /// The facts of a node.
     pub fn facts(&self, id: NodeId) -> Facts {
         self.node(id).facts
+    }
+
+    /// The neighbouring cells a repetition node evaluates (`None`: only the own cell).
+    pub fn window(&self, id: NodeId) -> Option<Window> {
+        self.windows.get(id.0 as usize).copied().flatten()
     }
 
     /// What was derived for the whole scene (`None` for a scene with no objects).
@@ -156,6 +178,7 @@ pub fn analyse(scene: &Scene) -> Analysis {
         scene,
         usage,
         nodes: Vec::with_capacity(scene.graph.len()),
+        windows: vec![None; scene.graph.len()],
         diagnostics: Vec::new(),
         reported: HashSet::new(),
     };
@@ -165,6 +188,7 @@ pub fn analyse(scene: &Scene) -> Analysis {
     }
     Analysis {
         nodes: pass.nodes,
+        windows: pass.windows,
         root: scene.root,
         diagnostics: pass.diagnostics,
     }
@@ -344,6 +368,7 @@ struct Pass<'a> {
     scene: &'a Scene,
     usage: Usage,
     nodes: Vec<Derived>,
+    windows: Vec<Option<Window>>,
     diagnostics: Vec<Diagnostic>,
     reported: HashSet<(&'static str, crate::span::Span)>,
 }
@@ -585,6 +610,14 @@ impl Pass<'_> {
             let reach = s * (n - 1.0) * 0.5;
             (d.bounds.min[i], d.bounds.max[i]) = (c.bounds.min[i] - reach, c.bounds.max[i] + reach);
         }
+        if overlap.is_some() || off_centre.is_some() {
+            // The neighbouring cells, far enough that the levels ancestors read stay right.
+            let margin = self.usage.margin[id.0 as usize];
+            if let Some(w) = window(&extent, c.symmetric, period, count, margin) {
+                self.windows[id.0 as usize] = Some(w);
+                return at_most_bound(d);
+            }
+        }
         if let Some(axis) = overlap {
             self.warn_overlap(id, axis, extent.min[axis], extent.max[axis], period[axis]);
             unproven(d, id)
@@ -682,6 +715,55 @@ impl Pass<'_> {
             d
         }
     }
+}
+
+/// The window of neighbouring cells that makes a repetition of a child with box `extent` a
+/// bound read up to level `margin`, or `None` when it would exceed [`MAX_WINDOW_CELLS`].
+///
+/// Along an axis of period s where the child fits and is symmetric, the own cell suffices
+/// (reach 0). Elsewhere, with h the child's farthest extent from its cell's centre, a copy r + 1
+/// or more cells away lies at least (r + ½)·s − h from the point along that axis (the point is
+/// within ½·s of its own cell's centre, or outside the array beyond it): the reach r is the
+/// least ≥ 1 that makes this exceed the margin, and `beyond` is its minimum over such axes.
+/// A finite repetition whose window holds every copy on an axis needs no bound there.
+pub fn window(
+    extent: &Aabb,
+    symmetric: [bool; 3],
+    period: V3,
+    count: Option<V3>,
+    margin: f64,
+) -> Option<Window> {
+    let mut w = Window {
+        reach: [0; 3],
+        beyond: f64::INFINITY,
+    };
+    let mut cells = 1.0;
+    for i in 0..3 {
+        let s = period[i];
+        let n = count.map_or(f64::INFINITY, |n| n[i]);
+        if s == 0.0 || n <= 1.0 || extent.is_empty() {
+            continue;
+        }
+        let (lo, hi, half) = (extent.min[i], extent.max[i], s * 0.5);
+        let fits = lo >= -half - TOLERANCE && hi <= half + TOLERANCE;
+        if fits && symmetric[i] {
+            continue;
+        }
+        let h = lo.abs().max(hi.abs());
+        let mut r = ((h + margin) / s - 0.5).floor() + 1.0;
+        r = r.max(1.0);
+        if r >= n - 1.0 {
+            r = n - 1.0;
+        } else {
+            w.beyond = w.beyond.min((r + 0.5) * s - h);
+        }
+        cells *= 2.0 * r + 1.0;
+        if !(cells <= MAX_WINDOW_CELLS as f64) {
+            return None;
+        }
+        w.reach[i] = r as u32;
+    }
+    Some(w)
 }
 
 /// The facts of a combination of several fields (before its own rule): the largest L and

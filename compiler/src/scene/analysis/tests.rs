@@ -154,7 +154,10 @@ fn warnings_name_the_unreliable_constructs() {
     assert_eq!(codes("box((0.5, 1, 0.5)).twist(4)"), ["W0003"]);
     assert_eq!(codes("box((0.5, 1, 0.5)).twist(0.5)"), Vec::<&str>::new());
     assert_eq!(codes("plane((0, 1, 0), 0).twist(0.1)"), ["W0004"]);
-    assert_eq!(codes("sphere(0.6).repeat((1, 0, 1))"), ["W0005"]);
+    // Copies reaching one cell out are evaluated with their neighbours; three cells out on
+    // every axis would need 343 cells.
+    assert_eq!(codes("sphere(0.6).repeat((1, 0, 1))"), Vec::<&str>::new());
+    assert_eq!(codes("sphere(2.5).repeat((1, 1, 1))"), ["W0005"]);
     // The repeated field is the exact distance to every copy, so offsetting it is safe.
     assert_eq!(
         codes("sphere(0.4).repeat((1, 0, 1)).round(0.2)"),
@@ -163,6 +166,11 @@ fn warnings_name_the_unreliable_constructs() {
     assert_eq!(codes("sphere(0.4).repeat((1, 0, 1))"), Vec::<&str>::new());
     assert_eq!(
         codes("sphere(0.2).translate(0.2, 0, 0).repeat((1, 0, 1))"),
+        Vec::<&str>::new()
+    );
+    // Rounded by 2, the copies must be bounded 2 units out: 125 cells.
+    assert_eq!(
+        codes("sphere(0.2).translate(0.2, 0.2, 0.2).repeat((1, 1, 1)).round(2)"),
         ["W0006"]
     );
     assert_eq!(
@@ -285,6 +293,9 @@ const PROVEN: &[&str] = &[
     "intersect(sphere(0.3).repeat((1, 1, 1)), box(2))",
     "intersect(sphere(0.4).repeat((1, 0, 1)).round(0.2), box(2))",
     "smooth_subtract(0.3, sphere(1), sphere(0.12).repeat((0.3, 0.3, 0.3)))",
+    "sphere(0.45).translate(0.3, 0, 0).repeat((1, 0, 0), (3, 1, 1))",
+    "intersect(sphere(0.7).repeat((1, 0, 1)), box(2))",
+    "intersect(sphere(0.4).translate(0.2, 0, 0).repeat((1, 0, 1)).round(0.3), box(2))",
 ];
 
 #[test]
@@ -321,11 +332,12 @@ fn the_bounds_are_needed() {
     let (program, l, _, b) = traced("box((0.5, 1.5, 0.1)).twist(4)");
     assert!(l > 2.0);
     assert!(crossings(&program, &b, 1.0, 150) > 0);
-    // So does a repetition whose copies overlap their cells, which no L repairs.
+    // So does a repetition whose copies reach too far out of their cells for the neighbours
+    // to be evaluated (45 cells), which no L repairs.
     let (program, _, proven, _) =
-        traced("sphere(0.45).translate(0.3, 0, 0).repeat((1, 0, 0), (3, 1, 1))");
+        traced("sphere(1.2).translate(0.3, 0, 0).repeat((1, 1, 1), (3, 3, 3))");
     assert!(!proven);
-    let b = Aabb::centred([1.6, 0.5, 0.5]);
+    let b = Aabb::centred([2.8, 2.5, 2.5]);
     assert!(crossings(&program, &b, 1.0, 300) > 0);
 }
 

@@ -29,8 +29,8 @@ pub const WARN_STRETCH: f64 = 1.5;
 pub const WARN_SCALE_RATIO: f64 = 10.0;
 
 /// A repetition whose copies reach out of their cells evaluates the neighbouring cells too,
-/// up to this many cells per point; beyond, it evaluates only the own cell and is reported
-/// (W0005, W0006).
+/// up to this many cells per point (counting the windows of repetitions nested in it, which
+/// multiply); beyond, it evaluates only the own cell and is reported (W0005, W0006).
 pub const MAX_WINDOW_CELLS: u32 = 27;
 
 /// Slack of the geometric tests (a shape touching its cell still fits).
@@ -77,6 +77,13 @@ impl Derived {
 pub struct Window {
     pub reach: [u32; 3],
     pub beyond: f64,
+}
+
+impl Window {
+    /// The number of cells evaluated per point.
+    pub fn cells(&self) -> u32 {
+        self.reach.iter().map(|r| 2 * r + 1).product()
+    }
 }
 
 /// The result of [`analyse`].
@@ -179,12 +186,23 @@ pub fn analyse(scene: &Scene) -> Analysis {
         usage,
         nodes: Vec::with_capacity(scene.graph.len()),
         windows: vec![None; scene.graph.len()],
+        copies: Vec::with_capacity(scene.graph.len()),
         diagnostics: Vec::new(),
         reported: HashSet::new(),
     };
     for id in scene.graph.ids() {
         let d = pass.derive(id);
         pass.nodes.push(d);
+        let below = scene
+            .graph
+            .node(id)
+            .children()
+            .iter()
+            .map(|c| pass.copies[c.0 as usize])
+            .max()
+            .unwrap_or(1);
+        let own = pass.windows[id.0 as usize].map_or(1, |w| w.cells());
+        pass.copies.push(below * own);
     }
     Analysis {
         nodes: pass.nodes,
@@ -369,6 +387,9 @@ struct Pass<'a> {
     usage: Usage,
     nodes: Vec<Derived>,
     windows: Vec<Option<Window>>,
+    /// Per node: how many times the windows of the repetitions below it make the lowering
+    /// evaluate a leaf, at most (the largest product along a path).
+    copies: Vec<u32>,
     diagnostics: Vec<Diagnostic>,
     reported: HashSet<(&'static str, crate::span::Span)>,
 }
@@ -612,10 +633,14 @@ impl Pass<'_> {
         }
         if overlap.is_some() || off_centre.is_some() {
             // The neighbouring cells, far enough that the levels ancestors read stay right.
+            // Windows nested in windows multiply: their product is bounded too.
             let margin = self.usage.margin[id.0 as usize];
+            let below = self.copies[child.0 as usize];
             if let Some(w) = window(&extent, c.symmetric, period, count, margin) {
-                self.windows[id.0 as usize] = Some(w);
-                return at_most_bound(d);
+                if w.cells() * below <= MAX_WINDOW_CELLS {
+                    self.windows[id.0 as usize] = Some(w);
+                    return at_most_bound(d);
+                }
             }
         }
         if let Some(axis) = overlap {

@@ -168,6 +168,16 @@ fn warnings_name_the_unreliable_constructs() {
         codes("sphere(0.2).translate(0.2, 0, 0).repeat((1, 0, 1))"),
         Vec::<&str>::new()
     );
+    // Windows nested in windows multiply (9 × 9 cells): the outer one keeps its own cell.
+    let inner = "sphere(0.6).repeat((1, 0, 1), (3, 1, 3))";
+    assert_eq!(
+        codes(&format!("{inner}.repeat((5, 0, 5))")),
+        Vec::<&str>::new()
+    );
+    assert_eq!(
+        codes(&format!("{inner}.translate(0.2, 0, 0.2).repeat((4, 0, 4))")),
+        ["W0006"]
+    );
     // Rounded by 2, the copies must be bounded 2 units out: 125 cells.
     assert_eq!(
         codes("sphere(0.2).translate(0.2, 0.2, 0.2).repeat((1, 1, 1)).round(2)"),

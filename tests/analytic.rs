@@ -142,3 +142,42 @@ fn glass_touching_another_solid_is_sphere_traced() {
         Choice::Trace(_)
     ));
 }
+
+/// Beyond `MAX_UNROLLED` primitives the kernel reads them from `scene_data` instead of
+/// holding them: the kernels of 1 000 and 10 000 random spheres are the same text, a few
+/// hundred lines whose PTX is small, while the scene data grows with the scene (32 bytes a
+/// sphere and 32 a group, fewer groups than spheres). `auto` traces both.
+#[test]
+fn the_kernel_of_ten_thousand_spheres_stays_small() {
+    let kernel = |name: &str| {
+        let scene = load(name);
+        let n = choose(&scene).primitives().map(<[_]>::len);
+        let kernel = wgsl::write(&scene, &lower(&scene)).expect("naga accepts it");
+        (n, kernel)
+    };
+    let (n, large) = kernel("scaling/random_10000.sdf");
+    assert_eq!(n, Some(10_001), "random_10000 is traced");
+    let (_, small) = kernel("scaling/random_1000.sdf");
+    assert!(wgsl::MAX_UNROLLED < 1000);
+    assert_eq!(large.source, small.source);
+    assert!(large.source.len() < 24_000, "{} bytes", large.source.len());
+    assert!(!large.source.contains("if enters(o - vec3"));
+    let data = large.data.as_ref().expect("scene data").len();
+    println!(
+        "random_10000: {} bytes of WGSL, {data} bytes of scene data",
+        large.source.len()
+    );
+    assert!((32 * 10_001..64 * 10_001).contains(&data), "{data} bytes");
+    let options = sdfc_compiler::back::ptx::Options::default();
+    let ptx =
+        sdfc_compiler::back::ptx::write(&large.module, &large.info, &options).expect("translates");
+    println!("random_10000: {} lines of PTX", ptx.lines().count());
+    assert!(
+        ptx.lines().count() < 4_000,
+        "{} lines of PTX",
+        ptx.lines().count()
+    );
+    // Up to the threshold the intersections stay unrolled, and there is no buffer.
+    let (_, seed2) = kernel("seed2.sdf");
+    assert!(seed2.data.is_none() && !seed2.source.contains("scene_data"));
+}

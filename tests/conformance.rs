@@ -167,7 +167,10 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
     let plain = gpu::render(&gpu, &scene, &plain_kernel, 1.0, &mut |_| {}).expect("render");
     assert!(plain.render.stats.counters.nans > 0, "no NaN on the GPU");
     assert!(!magenta(&plain.render.image).contains(&true));
-    let options = wgsl::Options { debug_nan: true };
+    let options = wgsl::Options {
+        debug_nan: true,
+        ..wgsl::Options::default()
+    };
     let kernel = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
     assert!(kernel.source.contains("+DEBUG_NAN"));
     let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("render");
@@ -186,4 +189,120 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
         "{differ} of {} pixels differ",
         g.len()
     );
+}
+
+/// A scene of `n` primitives above the unrolling threshold: spheres, boxes, cylinders and
+/// capsules turned and scaled at pseudo-random places on a checkered, reflective floor, with
+/// mirrors and a floating glass ball that touches nothing (so `auto` traces it).
+fn mixed_scene(n: usize) -> String {
+    let mut state = 0x2545_f491_u64;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 33) as f64 / (1u64 << 31) as f64
+    };
+    let mut text = String::from(
+        "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75, reflect: 0.1 };\n\
+         material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\
+         material mirror = phong { color: (0.9, 0.9, 0.95), diffuse: 0.2, specular: 1, shininess: 200, reflect: 0.6 };\n\
+         material teal = phong { color: (0.15, 0.6, 0.6), specular: 0.5, shininess: 64 };\n\
+         material glass = phong { color: (0.95, 1, 0.95), ambient: 0, diffuse: 0.05, specular: 1, shininess: 180, reflect: 0.05, transparency: 0.9, ior: 1.5 };\n\
+         camera { position: (0, 7, -15), look_at: (0, 1, 2), fov: 50deg }\n\
+         light point { position: (-4, 9, -6), intensity: 1.1, radius: 60 }\n\
+         light directional { direction: (1, -1, 0.6), color: (0.35, 0.35, 0.4) }\n\
+         render { width: 96, height: 64, max_depth: 3 }\n\
+         scene {\n  plane() @ floor;\n  sphere(0.9).translate(0, 5, -5) @ glass;\n",
+    );
+    for i in 0..n {
+        let (x, y, z) = (16.0 * next() - 8.0, 0.4 + 2.0 * next(), 10.0 * next() - 2.0);
+        let (a, b) = (360.0 * next(), 360.0 * next());
+        let shape = match i % 4 {
+            0 => format!(
+                "sphere({:.3}).scale(({:.3}, 1, 1))",
+                0.2 + 0.1 * next(),
+                0.6 + next()
+            ),
+            1 => format!("box((0.2, 0.15, 0.25)).rotate_y({a:.1}deg).rotate_x({b:.1}deg)"),
+            2 => format!(
+                "cylinder(0.15, 0.3).rotate_z({a:.1}deg).scale({:.3})",
+                0.8 + 0.4 * next()
+            ),
+            _ => format!("capsule(0.1, 0.25).rotate_x({a:.1}deg).rotate_y({b:.1}deg)"),
+        };
+        let material = ["clay", "mirror", "teal"][i % 3];
+        text.push_str(&format!(
+            "  {shape}.translate({x:.3}, {y:.3}, {z:.3}) @ {material};\n"
+        ));
+    }
+    text.push_str("}\n");
+    text
+}
+
+/// A traced scene of more primitives than the kernel unrolls reads them and their hierarchy
+/// from `scene_data` (binding 4) and renders on wgpu as on the CPU: every kind of primitive,
+/// rotated and scaled, a plane, mirrors and glass.
+#[test]
+fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
+    let text = mixed_scene(300);
+    let (scene, diags, _) = sdfc_compiler::check::check_str("mixed.sdf", &text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let traced = sdfc_compiler::scene::analytic::choose(&scene);
+    assert_eq!(traced.primitives().map(<[_]>::len), Some(302), "{traced:?}");
+    let program = lower::lower(&scene);
+    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(kernel.features.contains(&("SCENE_DATA", true)));
+    assert!(kernel.data.is_some() && !kernel.source.contains("P0_R0"));
+    let Some(gpu) = open_gpu() else { return };
+    assert_agree(&gpu, &scene, &program, &kernel, "302 mixed primitives");
+    let path = PathBuf::from("../examples/scaling/random_1000.sdf");
+    let mut scene = frontend::load(&path)
+        .expect("readable")
+        .scene
+        .expect("valid scene");
+    scene.settings.width = 96;
+    scene.settings.height = 64;
+    let program = lower::lower(&scene);
+    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(kernel.data.is_some());
+    assert_agree(&gpu, &scene, &program, &kernel, "random_1000");
+}
+
+/// The walk over `scene_data` tests the primitives and groups of the unrolled code in the same
+/// order with the same functions: on wgpu both kernels of one scene find the same hits (the
+/// same statistics) and the same colours up to rounding (lavapipe's compiler folds and
+/// contracts the unrolled code's constants: a few pixels differ in the last bits).
+#[test]
+fn the_buffer_walk_renders_what_the_unrolled_code_renders() {
+    let text = mixed_scene(40);
+    let (scene, diags, _) = sdfc_compiler::check::check_str("mixed.sdf", &text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let program = lower::lower(&scene);
+    let unrolled = wgsl::write(&scene, &program).expect("valid kernel");
+    let options = wgsl::Options {
+        max_unrolled: 0,
+        ..wgsl::Options::default()
+    };
+    let walked = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
+    assert!(unrolled.data.is_none() && walked.data.is_some());
+    let Some(gpu) = open_gpu() else { return };
+    let render = |k: &wgsl::Kernel| gpu::render(&gpu, &scene, k, 1.0, &mut |_| {}).expect("render");
+    let (a, b) = (render(&unrolled).render, render(&walked).render);
+    assert_eq!(a.stats.counters, b.stats.counters);
+    assert!(a.stats.counters.hits > 0 && a.stats.counters.shadow_rays > 0);
+    let (mut differ, mut largest) = (0, 0.0f32);
+    for (x, y) in a.image.linear.iter().zip(&b.image.linear) {
+        if x != y {
+            differ += 1;
+        }
+        for k in 0..3 {
+            largest = largest.max((x[k] - y[k]).abs());
+        }
+    }
+    println!("unrolled against walked: {differ} pixels differ, by at most {largest:e}");
+    assert!(
+        differ * 100 <= a.image.linear.len(),
+        "{differ} pixels differ"
+    );
+    assert!(largest <= 1e-5, "a colour differs by {largest}");
 }

@@ -760,7 +760,10 @@ fn the_debug_nan_kernel_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/in/ok/nan_at_run_time.sdf");
     let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
     let program = sdfc_compiler::lower::lower(&scene);
-    let debug = sdfc_compiler::back::wgsl::Options { debug_nan: true };
+    let debug = sdfc_compiler::back::wgsl::Options {
+        debug_nan: true,
+        ..Default::default()
+    };
     let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &program, &debug).unwrap();
     let plain = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
     let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
@@ -784,5 +787,50 @@ fn a_kernel_with_outlined_blocks_assembles() {
     assert!(text.contains(".entry"));
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "outlined", 80)));
+    }
+}
+
+/// The kernel of a traced scene beyond `MAX_UNROLLED` primitives (read from `scene_data`, a
+/// fifth kernel parameter, and walked in a loop) translates and assembles: 10 000 random
+/// spheres, and every kind of primitive, rotated and scaled, with glass and mirrors.
+#[test]
+fn kernels_reading_the_scene_from_a_buffer_assemble() {
+    let mixed = "material a = phong { color: (0.8, 0.4, 0.2), reflect: 0.3 };\n\
+                 material b = phong { color: (0.2, 0.5, 0.6) };\n\
+                 material g = phong { transparency: 0.9, ior: 1.5 };\n\
+                 render { max_depth: 2 }\n\
+                 scene {\n  plane() @ b;\n  sphere(0.5).translate(0, 9, 0) @ g;\n\
+                 for i in 0..80 {\n\
+                 let x = 10 * hash(3 * i) - 5;\n    let z = 10 * hash(3 * i + 1) - 5;\n\
+                 sphere(0.2).translate(x, 1, z) @ a;\n\
+                 box((0.2, 0.1, 0.2)).rotate_y(degrees(360 * hash(3 * i + 2))).translate(x, 2, z) @ b;\n\
+                 cylinder(0.1, 0.2).scale(1.5).translate(x, 3, z) @ a;\n\
+                 capsule(0.1, 0.2).rotate_x(30deg).translate(x, 4, z) @ b;\n  }\n}\n";
+    let (scene, diags, _) = sdfc_compiler::check::check_str("mixed.sdf", mixed);
+    let mixed = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/random_10000.sdf");
+    let random = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+    let ptxas = ptxas();
+    for (name, scene) in [("mixed", mixed), ("random_10000", random)] {
+        let program = sdfc_compiler::lower::lower(&scene);
+        let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+        let data = kernel.data.as_ref().expect("read from a buffer");
+        keep(&format!("buffer_{name}.data"), data);
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+        assert!(text.contains("@group(0) @binding(4) var<storage, read> scene_data"));
+        assert!(text.contains("main_param_4"));
+        assert!(
+            text.contains("ld.global.nc"),
+            "{name}: scene data read through the cache"
+        );
+        for sm in [70, 80, 90] {
+            let text = ptx::write(&kernel.module, &kernel.info, &options(sm)).unwrap();
+            if let Some(p) = &ptxas {
+                println!(
+                    "{name} sm_{sm}: {}",
+                    summary(&assemble(p, &text, &format!("buffer_{name}"), sm))
+                );
+            }
+        }
     }
 }

@@ -49,10 +49,12 @@ pub enum Prepared {
         kernel: Box<wgsl::Kernel>,
         lipschitz: f64,
     },
-    /// CUDA: the device, the loaded module and the scene's Lipschitz bound L.
+    /// CUDA: the device, the loaded module, the kernel's scene data and the scene's
+    /// Lipschitz bound L.
     Cuda {
         cuda: Box<Cuda>,
         loaded: Box<gpu::cuda::Loaded>,
+        data: Option<Vec<u8>>,
         ptx_time: Duration,
         lipschitz: f64,
     },
@@ -129,6 +131,7 @@ impl Prepared {
     fn kernel(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Kernel, String> {
         let options = wgsl::Options {
             debug_nan: setup.debug_nan,
+            ..wgsl::Options::default()
         };
         wgsl::write_with(scene, program, &options).map_err(|e| e.to_string())
     }
@@ -164,6 +167,7 @@ impl Prepared {
         Ok(Prepared::Cuda {
             cuda: Box::new(cuda),
             loaded: Box::new(loaded),
+            data: kernel.data,
             ptx_time,
             lipschitz: program.lipschitz(),
         })
@@ -216,8 +220,10 @@ impl Prepared {
                 host: cpu::memory(&at, tapes, options, rayon::current_num_threads()),
                 device: 0,
             },
-            Prepared::Wgpu { .. } => gpu::memory_wgpu(settings, uniforms(&at)),
-            Prepared::Cuda { .. } => gpu::memory_cuda(settings, uniforms(&at)),
+            Prepared::Wgpu { kernel, .. } => {
+                gpu::memory_wgpu(settings, uniforms(&at), bytes(&kernel.data))
+            }
+            Prepared::Cuda { data, .. } => gpu::memory_cuda(settings, uniforms(&at), bytes(data)),
         }
     }
 
@@ -271,11 +277,12 @@ impl Prepared {
             Prepared::Cuda {
                 cuda,
                 loaded,
+                data,
                 lipschitz,
                 ..
             } => {
-                let r =
-                    gpu::render_cuda(cuda, scene, loaded, *lipschitz).map_err(|e| e.to_string())?;
+                let r = gpu::render_cuda(cuda, scene, loaded, data.as_deref(), *lipschitz)
+                    .map_err(|e| e.to_string())?;
                 progress(1.0);
                 Ok(Frame {
                     render: r.render,
@@ -290,4 +297,9 @@ impl Prepared {
 /// Bytes of the scene uniform of the GPU kernels.
 fn uniforms(scene: &Scene) -> u64 {
     wgsl::uniforms(scene, 1.0).len() as u64
+}
+
+/// Bytes of a kernel's scene data.
+fn bytes(data: &Option<Vec<u8>>) -> u64 {
+    data.as_ref().map_or(0, |d| d.len() as u64)
 }

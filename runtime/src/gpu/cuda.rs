@@ -206,12 +206,14 @@ impl Cuda {
         }
     }
 
-    /// Renders one frame: one launch per tile of `tile`×`tile` pixels.
+    /// Renders one frame: one launch per tile of `tile`×`tile` pixels. `data` is the
+    /// kernel's read-only `scene_data` (binding 4), when it declares one.
     #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
         k: &Loaded,
         uniforms: &[u8],
+        data: Option<&[u8]>,
         width: u32,
         height: u32,
         stats_words: u32,
@@ -234,6 +236,13 @@ impl Cuda {
         let mut d_stats = s
             .alloc_zeros::<u32>(pixels * stats_words as usize)
             .map_err(driver("allocating the statistics"))?;
+        let d_data = match data {
+            Some(bytes) => Some(
+                s.clone_htod(bytes)
+                    .map_err(driver("uploading the scene data"))?,
+            ),
+            None => None,
+        };
         // Each launch is timed by its own pair of events, and the times are summed: the
         // same measure as the wgpu path's per-pass timestamps (gaps between launches excluded).
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
@@ -267,9 +276,13 @@ impl Cuda {
                 .arg(&tile_view)
                 .arg(&mut d_image)
                 .arg(&mut d_stats);
+            if let Some(d) = &d_data {
+                launch.arg(d);
+            }
             start.record(s).map_err(driver("recording an event"))?;
-            // SAFETY: the kernel's parameters are the four buffers in binding order, as the
-            // PTX back end declares them; each buffer is as large as the kernel indexes.
+            // SAFETY: the kernel's parameters are its buffers in binding order, as the PTX back
+            // end declares them: four, and the scene data when the kernel has it (the caller
+            // passes `data` exactly then); each buffer is as large as the kernel indexes.
             unsafe { launch.launch(cfg) }.map_err(driver("launching the kernel"))?;
             end.record(s).map_err(driver("recording an event"))?;
             events.push((start, end));

@@ -67,6 +67,7 @@ pub fn render(
         wgsl: &kernel.source,
         entry: wgsl::ENTRY_POINT,
         uniforms: &uniforms,
+        data: kernel.data.as_deref(),
         width: s.width,
         height: s.height,
         stats_words: STATS_WORDS,
@@ -92,11 +93,13 @@ pub fn render(
     })
 }
 
-/// Renders `scene` with a kernel already loaded on a CUDA device.
+/// Renders `scene` with a kernel already loaded on a CUDA device; `data` is the kernel's
+/// scene data ([`Kernel::data`]).
 pub fn render_cuda(
     cuda: &cuda::Cuda,
     scene: &Scene,
     loaded: &cuda::Loaded,
+    data: Option<&[u8]>,
     lipschitz: f64,
 ) -> Result<GpuRender, cuda::Error> {
     let s = &scene.settings;
@@ -104,6 +107,7 @@ pub fn render_cuda(
     let frame = cuda.render(
         loaded,
         &uniforms,
+        data,
         s.width,
         s.height,
         STATS_WORDS,
@@ -128,31 +132,33 @@ pub fn render_cuda(
     })
 }
 
-/// The most a wgpu render of `settings` allocates, with a scene uniform of `uniforms` bytes.
-/// On the device: the uniform, the tile table, the image (16 bytes a pixel) and statistics
-/// buffers, their readback copies and the timestamp queries. On the host: the tile table (and
-/// wgpu's staging copy of it), the read-back bytes and their conversion to colours and
-/// statistics words, then the statistics' per-pixel steps and their sorted copy.
-pub fn memory_wgpu(settings: &sdfc_compiler::scene::Settings, uniforms: u64) -> Memory {
+/// The most a wgpu render of `settings` allocates, with a scene uniform of `uniforms` bytes and
+/// scene data of `data` bytes. On the device: the uniform, the scene data, the tile table, the
+/// image (16 bytes a pixel) and statistics buffers, their readback copies and the timestamp
+/// queries. On the host: wgpu's staging copy of the scene data, the tile table (and its
+/// staging copy), the read-back bytes and their conversion to colours and statistics words,
+/// then the statistics' per-pixel steps and their sorted copy.
+pub fn memory_wgpu(settings: &sdfc_compiler::scene::Settings, uniforms: u64, data: u64) -> Memory {
     let (pixels, tiles) = pixels_and_tiles(settings);
     let stats = 4 * STATS_WORDS as u64 * pixels;
     let table = tiles * 256;
     let queries = 2 * tiles * 8;
-    let device = uniforms.max(16) + table + 2 * (16 * pixels + stats) + 3 * queries;
+    let device = uniforms.max(16) + data + table + 2 * (16 * pixels + stats) + 3 * queries;
     // Read back: the image's bytes (16 a pixel), floats (16) and colours (12), and the
     // statistics' bytes and words, all held at once (more than the colours, words, steps and
     // sorted steps held afterwards).
-    let host = 2 * table + 2 * queries + 44 * pixels + 2 * stats;
+    let host = data + 2 * table + 2 * queries + 44 * pixels + 2 * stats;
     Memory { host, device }
 }
 
-/// The most a CUDA render of `settings` allocates, with a scene uniform of `uniforms` bytes:
-/// on the device the uniform, tile table, image and statistics; on the host the tile table,
-/// the read-back floats (16 bytes a pixel), colours (12) and statistics, then the steps.
-pub fn memory_cuda(settings: &sdfc_compiler::scene::Settings, uniforms: u64) -> Memory {
+/// The most a CUDA render of `settings` allocates, with a scene uniform of `uniforms` bytes
+/// and scene data of `data` bytes: on the device the uniform, scene data, tile table, image and
+/// statistics; on the host the tile table, the read-back floats (16 bytes a pixel), colours
+/// (12) and statistics, then the steps.
+pub fn memory_cuda(settings: &sdfc_compiler::scene::Settings, uniforms: u64, data: u64) -> Memory {
     let (pixels, tiles) = pixels_and_tiles(settings);
     let stats = 4 * STATS_WORDS as u64 * pixels;
-    let device = uniforms + 16 * tiles + 16 * pixels + stats;
+    let device = uniforms + data + 16 * tiles + 16 * pixels + stats;
     let host = 16 * tiles + 64 * tiles + 16 * pixels + 12 * pixels + stats + 8 * pixels;
     Memory { host, device }
 }

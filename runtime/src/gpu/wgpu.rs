@@ -60,6 +60,8 @@ pub struct Launch<'a> {
     pub entry: &'a str,
     /// Bytes of the scene uniform (binding 0).
     pub uniforms: &'a [u8],
+    /// Bytes of the read-only `scene_data` (binding 4), when the kernel declares it.
+    pub data: Option<&'a [u8]>,
     /// Image size.
     pub width: u32,
     pub height: u32,
@@ -138,6 +140,13 @@ impl Gpu {
 
     /// Renders one frame. `progress` is called with the fraction done after each tile.
     pub fn render(&self, l: &Launch, progress: &mut dyn FnMut(f64)) -> Result<Frame, Error> {
+        let limit = self.device.limits().max_storage_buffer_binding_size as u64;
+        if let Some(data) = l.data.filter(|d| d.len() as u64 > limit) {
+            return Err(Error::Render(format!(
+                "the scene's primitives take {} bytes, more than the {limit} bytes a storage buffer of this adapter may bind",
+                data.len()
+            )));
+        }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let pipeline = self.pipeline(l);
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -224,7 +233,8 @@ impl Gpu {
     }
 
     /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
-    /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage).
+    /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage), and 4 the
+    /// scene data (read-only storage) when the kernel has it.
     fn pipeline(&self, l: &Launch) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
         let module = self
             .device
@@ -243,21 +253,25 @@ impl Gpu {
             has_dynamic_offset: dynamic,
             min_binding_size: None,
         };
-        let storage = wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: false },
+        let storage = |read_only| wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
             has_dynamic_offset: false,
             min_binding_size: None,
         };
+        let mut entries = vec![
+            entry(0, uniform(false)),
+            entry(1, uniform(true)),
+            entry(2, storage(false)),
+            entry(3, storage(false)),
+        ];
+        if l.data.is_some() {
+            entries.push(entry(4, storage(true)));
+        }
         let layout = self
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("sdfc bindings"),
-                entries: &[
-                    entry(0, uniform(false)),
-                    entry(1, uniform(true)),
-                    entry(2, storage),
-                    entry(3, storage),
-                ],
+                entries: &entries,
             });
         let pipeline_layout = self
             .device
@@ -295,8 +309,18 @@ impl Gpu {
             U::UNIFORM | U::COPY_DST,
         );
         self.queue.write_buffer(&uniforms, 0, l.uniforms);
+        let data = l.data.map(|bytes| {
+            let buffer = make(
+                "sdfc scene data",
+                bytes.len() as u64,
+                U::STORAGE | U::COPY_DST,
+            );
+            self.queue.write_buffer(&buffer, 0, bytes);
+            buffer
+        });
         Buffers {
             uniforms,
+            data,
             tile: make(
                 "sdfc tiles",
                 tiles * TILE_STRIDE as u64,
@@ -317,7 +341,7 @@ impl Gpu {
             offset: 0,
             size: std::num::NonZeroU64::new(16),
         };
-        let entries = [
+        let mut entries = vec![
             wgpu::BindGroupEntry {
                 binding: 0,
                 resource: b.uniforms.as_entire_binding(),
@@ -335,6 +359,12 @@ impl Gpu {
                 resource: b.stats.as_entire_binding(),
             },
         ];
+        if let Some(data) = &b.data {
+            entries.push(wgpu::BindGroupEntry {
+                binding: 4,
+                resource: data.as_entire_binding(),
+            });
+        }
         self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sdfc bindings"),
             layout,
@@ -403,6 +433,7 @@ impl Gpu {
 
 struct Buffers {
     uniforms: wgpu::Buffer,
+    data: Option<wgpu::Buffer>,
     tile: wgpu::Buffer,
     image: wgpu::Buffer,
     stats: wgpu::Buffer,

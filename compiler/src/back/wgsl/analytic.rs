@@ -1,8 +1,10 @@
 //! The WGSL of an analytically traced scene: the interval functions of `intervals.wgsl` its
 //! primitives use, `fn trace` (nearest hit, its normal and material) and `fn shadow` (any-hit
-//! shadow rays) unrolled over the scene's primitives and their hierarchy, on top of the
-//! kernel template's `ANALYTIC` block.
+//! shadow rays) on top of the kernel template's `ANALYTIC` block. Up to [`MAX_UNROLLED`]
+//! primitives, both are unrolled over the primitives and their hierarchy; beyond, they walk
+//! the primitives and hierarchy stored in the `scene_data` buffer (buffer.rs).
 
+use super::buffer;
 use super::map::float;
 use crate::scene::analytic::{hierarchy, Item, Primitive, Shape};
 use crate::scene::V3;
@@ -41,10 +43,30 @@ fn sections(primitives: &[Primitive], top: &[Item]) -> String {
     out
 }
 
-/// The interval functions the scene uses, its frame constants, `fn trace` and `fn shadow`.
-pub fn write(primitives: &[Primitive]) -> String {
+/// The most primitives whose intersections are unrolled into the kernel. Unrolled, every
+/// primitive's constants are immediates and nothing is read from memory, which keeps small
+/// scenes fast (BENCHMARKS.md), but the kernel grows by about 180 lines of PTX a primitive and
+/// the time to assemble it more than in proportion (random spheres, ptxas for sm_90 on the
+/// development machine: 100 in 20 000 lines and 1 s, 256 in 47 000 lines and 2.3 s, 1 000 in
+/// 180 000 lines and 22 s; 10 000 did not finish in the CUDA driver's JIT in minutes). Up to 256
+/// the one-time cost stays within seconds (and the driver caches the result), and every
+/// example and the benchmarked scenes of up to 101 primitives keep the unrolled code.
+/// Beyond, the walk over `scene_data` reads 32 bytes per unrotated primitive or group it
+/// visits and its kernel is 2 000 lines of PTX whatever the scene's size; how its GPU time
+/// compares with the unrolled code's near the threshold is still to be measured
+/// (`Options::max_unrolled` chooses either way for one scene).
+pub const MAX_UNROLLED: usize = 256;
+
+/// The interval functions the scene uses and `fn trace` and `fn shadow`: unrolled over the
+/// primitives (with their frame constants) up to `max_unrolled` of them ([`MAX_UNROLLED`] by
+/// default), else walking the buffer `scene_data`, whose bytes are returned too.
+pub fn write(primitives: &[Primitive], max_unrolled: usize) -> (String, Option<Vec<u8>>) {
     let top = hierarchy(primitives);
     let mut out = sections(primitives, &top);
+    if primitives.len() > max_unrolled && buffer::fits(primitives) {
+        out.push_str(&buffer::write(primitives, &top));
+        return (out, Some(buffer::data(primitives, &top)));
+    }
     if primitives.iter().any(|p| !identity(&p.matrix)) {
         out.push_str("// The world-to-local rows of the primitives that are rotated or scaled.\n");
     }
@@ -87,7 +109,7 @@ pub fn write(primitives: &[Primitive]) -> String {
     };
     items(&mut out, primitives, &top, 1, "tmax", &occlude);
     out.push_str("    return through;\n}\n");
-    out
+    (out, None)
 }
 
 /// Writes the statements of `items` at `depth`: one `test` per primitive, each group's items
@@ -132,7 +154,9 @@ fn name(s: &Shape) -> &'static str {
     }
 }
 
-fn identity(m: &[V3; 3]) -> bool {
+/// Whether a world-to-local matrix is the identity (the primitive is neither rotated nor
+/// scaled).
+pub(super) fn identity(m: &[V3; 3]) -> bool {
     (0..3).all(|i| (0..3).all(|j| m[i][j] == if i == j { 1.0 } else { 0.0 }))
 }
 

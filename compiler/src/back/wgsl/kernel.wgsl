@@ -47,6 +47,10 @@ struct Params {
 @group(0) @binding(1) var<uniform> tile: vec4<u32>; // x0, y0, width, height
 @group(0) @binding(2) var<storage, read_write> image: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> stats: array<u32>;
+//#if SCENE_DATA
+// The primitives and hierarchy of an analytically traced scene (layout: compiler/src/back/wgsl/buffer.rs).
+@group(0) @binding(4) var<storage, read> scene_data: array<vec4<f32>>;
+//#endif
 
 // Per-pixel statistics, written to `stats` (8 words per pixel).
 struct Counters {

@@ -4,12 +4,16 @@
 //!
 //! Entry: [`write`]. The kernel's bindings (group 0): 0 the scene uniform ([`uniforms`]),
 //! 1 the tile (x0, y0, width, height as a uniform `vec4<u32>`), 2 the image (`vec4<f32>`
-//! linear colour per pixel), 3 the statistics ([`STATS_WORDS`] `u32` per pixel).
+//! linear colour per pixel), 3 the statistics ([`STATS_WORDS`] `u32` per pixel), and, only in
+//! the kernel of an analytically traced scene of more than [`MAX_UNROLLED`] primitives, 4 the
+//! read-only `scene_data` (`array<vec4<f32>>`, [`Kernel::data`]; layout in buffer.rs).
 
 mod analytic;
+mod buffer;
 mod map;
 mod template;
 
+pub use analytic::MAX_UNROLLED;
 pub use map::{float, write_map, write_sdf};
 
 pub(crate) use map::results;
@@ -40,6 +44,9 @@ pub struct Kernel {
     pub info: naga::valid::ModuleInfo,
     /// The features the kernel was specialised for, by name.
     pub features: Vec<(&'static str, bool)>,
+    /// The bytes of binding 4, `scene_data`, when the kernel declares it (the `SCENE_DATA`
+    /// feature): the primitives and hierarchy of a large analytically traced scene.
+    pub data: Option<Vec<u8>>,
 }
 
 /// A generated kernel that naga rejected: always a compiler bug, reported with the generated
@@ -115,11 +122,24 @@ fn count(scene: &Scene, point: bool) -> usize {
 }
 
 /// Choices of a kernel that do not come from the scene.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Options {
     /// Paint the pixels whose rays met a NaN magenta (`sdfc render --debug-nan`): the
     /// `DEBUG_NAN` feature. Off, the kernel is the same as without the option.
     pub debug_nan: bool,
+    /// The most primitives of an analytically traced scene whose intersections are unrolled
+    /// into the kernel; a larger scene is read from `scene_data` ([`MAX_UNROLLED`] unless a
+    /// test or a measurement compares the two ways).
+    pub max_unrolled: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            debug_nan: false,
+            max_unrolled: MAX_UNROLLED,
+        }
+    }
 }
 
 /// Writes and validates the kernel for `scene`, whose distance program is `program`.
@@ -138,11 +158,14 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         features.push(("DEBUG_NAN", true));
     }
     let mut values: HashMap<&str, String> = HashMap::new();
+    let mut data = None;
     match choice.primitives() {
         // An analytically traced scene needs no distance field.
         Some(primitives) => {
+            let (text, bytes) = analytic::write(primitives, options.max_unrolled);
             values.insert("MAP", String::new());
-            values.insert("ANALYTIC", analytic::write(primitives));
+            values.insert("ANALYTIC", text);
+            data = bytes;
         }
         None => {
             values.insert(
@@ -150,6 +173,11 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
                 format!("{}\n{}", write_map(program), write_sdf(program)),
             );
         }
+    }
+    // Listed in the header only when on, so that the kernels without it do not change.
+    on.insert("SCENE_DATA", data.is_some());
+    if data.is_some() {
+        features.push(("SCENE_DATA", true));
     }
     let used: Vec<String> = features
         .iter()
@@ -179,6 +207,7 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         module,
         info,
         features,
+        data,
     })
 }
 

@@ -1,0 +1,339 @@
+//! The primitives and hierarchy of a large analytically traced scene as data: the contents of
+//! the read-only storage buffer `scene_data` (binding 4), and the `trace` and `shadow` that
+//! walk it in a loop, so that the kernel's size does not depend on the number of primitives.
+//!
+//! Layout: an array of `vec4<f32>`; integers are stored as their bits (`bitcast<u32>`).
+//!
+//! ```text
+//! [0]          (end, 0, 0, 0): the index one past the last entry
+//! [1 .. end)   the entries, in the order of a depth-first walk of the hierarchy (the order in
+//!              which the unrolled code tests them):
+//!   group      [i]     (centre.xyz, GROUP)
+//!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries,
+//!                      where a ray that does not enter the group's box goes on
+//!   primitive  [i]     (offset.xyz, kind | FRAMED if rotated or scaled | material << 4)
+//!              [i + 1] the shape: sphere (r², 0, 0, 0), box (half.xyz, 0), cylinder and
+//!                      capsule (r², half height, 0, 0), plane (normal.xyz, height)
+//!              [i + 2 .. i + 5] only when FRAMED: the rows of the world-to-local matrix
+//! ```
+//!
+//! A group's entries follow its two vectors, so a walk goes to `i + 2` into a group it enters
+//! and to `next` past one it does not, and `i` grows at every step: the walk needs no stack and
+//! ends after at most `end` steps. An unrotated primitive takes 32 bytes, a rotated one 80,
+//! a group 32.
+
+use crate::scene::analytic::{Item, Primitive, Shape};
+use crate::scene::V3;
+use std::fmt::Write;
+
+/// The kinds of entry, in the low three bits of an entry's tag.
+const SPHERE: u32 = 0;
+const BOX: u32 = 1;
+const CYLINDER: u32 = 2;
+const CAPSULE: u32 = 3;
+const PLANE: u32 = 4;
+const GROUP: u32 = 5;
+/// The tag bit of a primitive with a world-to-local matrix other than the identity.
+const FRAMED: u32 = 8;
+/// Materials are numbered in the tag's bits above these.
+const MATERIAL_SHIFT: u32 = 4;
+
+/// Whether every material of `primitives` fits in a tag.
+pub fn fits(primitives: &[Primitive]) -> bool {
+    primitives
+        .iter()
+        .all(|p| p.material.0 < 1 << (32 - MATERIAL_SHIFT))
+}
+
+fn kind(s: &Shape) -> u32 {
+    match s {
+        Shape::Sphere { .. } => SPHERE,
+        Shape::Box { .. } => BOX,
+        Shape::Cylinder { .. } => CYLINDER,
+        Shape::Capsule { .. } => CAPSULE,
+        Shape::Plane { .. } => PLANE,
+    }
+}
+
+/// The bits of `x` as the f32 the kernel reads (as the literals of the unrolled code are).
+fn bits(x: f64) -> u32 {
+    (x as f32).clamp(-f32::MAX, f32::MAX).to_bits()
+}
+
+fn vec(v: V3, w: u32) -> [u32; 4] {
+    [bits(v[0]), bits(v[1]), bits(v[2]), w]
+}
+
+/// The contents of `scene_data` for `primitives` and their hierarchy `top`, as little-endian
+/// bytes.
+pub fn data(primitives: &[Primitive], top: &[Item]) -> Vec<u8> {
+    let mut entries = vec![[0u32; 4]];
+    push(&mut entries, primitives, top);
+    entries[0][0] = entries.len() as u32;
+    entries
+        .iter()
+        .flatten()
+        .flat_map(|w| w.to_le_bytes())
+        .collect()
+}
+
+fn push(out: &mut Vec<[u32; 4]>, primitives: &[Primitive], items: &[Item]) {
+    for item in items {
+        match item {
+            Item::Primitive(i) => primitive(out, &primitives[*i]),
+            Item::Group(g) => {
+                let at = out.len();
+                out.push(vec(g.centre, GROUP));
+                out.push(vec(g.half, 0));
+                push(out, primitives, &g.items);
+                out[at + 1][3] = out.len() as u32;
+            }
+        }
+    }
+}
+
+fn primitive(out: &mut Vec<[u32; 4]>, p: &Primitive) {
+    let framed = !super::analytic::identity(&p.matrix);
+    let tag = kind(&p.shape) | if framed { FRAMED } else { 0 } | p.material.0 << MATERIAL_SHIFT;
+    out.push(vec(p.offset, tag));
+    out.push(match p.shape {
+        Shape::Sphere { radius } => [bits(radius * radius), 0, 0, 0],
+        Shape::Box { half } => vec(half, 0),
+        Shape::Cylinder {
+            radius,
+            half_height,
+        }
+        | Shape::Capsule {
+            radius,
+            half_height,
+        } => [bits(radius * radius), bits(half_height), 0, 0],
+        Shape::Plane { normal, height } => vec(normal, bits(height)),
+    });
+    if framed {
+        out.extend(p.matrix.iter().map(|row| vec(*row, 0)));
+    }
+}
+
+/// `fn trace` and `fn shadow` walking `scene_data`, and the interval of one of its
+/// primitives; only the kinds of `primitives` are tested for, and groups only when `top` has
+/// any.
+pub fn write(primitives: &[Primitive], top: &[Item]) -> String {
+    let framed = primitives
+        .iter()
+        .any(|p| !super::analytic::identity(&p.matrix));
+    let groups = top.iter().any(|i| matches!(i, Item::Group(_)));
+    let mut out = String::from(
+        "// The entries of scene_data (the layout is in compiler/src/back/wgsl/buffer.rs): the\n\
+         // kind of entry in a tag's low three bits, FRAMED for a rotated or scaled primitive,\n\
+         // its material above.\n",
+    );
+    let _ = writeln!(out, "const GROUP: u32 = {GROUP}u;");
+    if framed {
+        let _ = writeln!(out, "const FRAMED: u32 = {FRAMED}u;");
+    }
+    out.push('\n');
+    shape_interval(&mut out, primitives);
+    primitive_interval(&mut out, framed);
+    let step = if framed {
+        "select(2u, 5u, (tag & FRAMED) != 0u)"
+    } else {
+        "2u"
+    };
+    out.push_str(
+        "// The nearest surface along o + t·d, 0 < t < max_dist, with its normal and material: the\n\
+         // entries of scene_data in order, past each group whose box the ray does not enter\n\
+         // before the nearest hit so far.\n",
+    );
+    out.push_str("fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {\n");
+    out.push_str("    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u);\n");
+    walk(
+        &mut out,
+        groups,
+        "best.t",
+        &[
+            &format!("best = nearest(best, primitive_interval(i, head, o, d), tag >> {MATERIAL_SHIFT}u);"),
+            &format!("i += {step};"),
+        ],
+    );
+    out.push_str("    return best;\n}\n\n");
+    out.push_str(
+        "// The light arriving along o + t·d, 0 < t < tmax: 0 behind an opaque primitive, else the\n\
+         // product of the transparencies of the primitives the ray enters.\n",
+    );
+    out.push_str("fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {\n");
+    out.push_str("    counters.shadow += 1u;\n    var through = 1.0;\n");
+    walk(
+        &mut out,
+        groups,
+        "tmax",
+        &[
+            &format!("let tau = params.materials[tag >> {MATERIAL_SHIFT}u].optics.y;"),
+            "through = occlude(through, primitive_interval(i, head, o, d), tmax, tau);",
+            "if through == 0.0 {",
+            "    return 0.0;",
+            "}",
+            &format!("i += {step};"),
+        ],
+    );
+    out.push_str("    return through;\n}\n");
+    out
+}
+
+/// The loop over the entries: a group is entered when the ray meets its box before `limit`,
+/// a primitive is met by the statements `visit` (which step `i` past it).
+fn walk(out: &mut String, groups: bool, limit: &str, visit: &[&str]) {
+    out.push_str("    let end = bitcast<u32>(scene_data[0u].x);\n    var i = 1u;\n");
+    out.push_str("    while i < end {\n        let head = scene_data[i];\n");
+    out.push_str("        let tag = bitcast<u32>(head.w);\n");
+    if groups {
+        out.push_str("        if tag == GROUP {\n            let size = scene_data[i + 1u];\n");
+        let _ = writeln!(
+            out,
+            "            let inside = enters(o - head.xyz, d, size.xyz, {limit});"
+        );
+        out.push_str("            i = select(bitcast<u32>(size.w), i + 2u, inside);\n");
+        out.push_str("            continue;\n        }\n");
+    }
+    for line in visit {
+        let _ = writeln!(out, "        {line}");
+    }
+    out.push_str("    }\n");
+}
+
+/// `fn shape_interval`: the interval of a primitive of the tag's kind in its own frame, with
+/// a branch for each kind among `primitives`.
+fn shape_interval(out: &mut String, primitives: &[Primitive]) {
+    let mut kinds: Vec<u32> = primitives.iter().map(|p| kind(&p.shape)).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    out.push_str(
+        "// The interval along (o, d) of a primitive of the tag's kind in its own frame, its shape\n\
+         // given by s.\n",
+    );
+    out.push_str(
+        "fn shape_interval(tag: u32, o: vec3<f32>, d: vec3<f32>, s: vec4<f32>) -> Interval {\n",
+    );
+    if kinds.len() > 1 {
+        out.push_str("    let kind = tag & 7u;\n");
+    }
+    for (n, k) in kinds.iter().enumerate() {
+        let call = match *k {
+            SPHERE => "sphere_interval(o, d, s.x)",
+            BOX => "box_interval(o, d, s.xyz)",
+            CYLINDER => "cylinder_interval(o, d, s.x, s.y)",
+            CAPSULE => "capsule_interval(o, d, s.x, s.y)",
+            _ => "plane_interval(o, d, s.xyz, s.w)",
+        };
+        if n + 1 < kinds.len() {
+            let _ = writeln!(
+                out,
+                "    if kind == {k}u {{\n        return {call};\n    }}"
+            );
+        } else {
+            let _ = writeln!(out, "    return {call};");
+        }
+    }
+    if kinds.is_empty() {
+        out.push_str("    return missed();\n");
+    }
+    out.push_str("}\n\n");
+}
+
+/// `fn primitive_interval`: the interval of the primitive whose entry starts at `i`, with
+/// normals in world space (the frame's rows are read only for a FRAMED one).
+fn primitive_interval(out: &mut String, framed: bool) {
+    out.push_str(
+        "// The interval along (o, d) of the primitive whose entry starts at scene_data[i] with\n\
+         // head, with normals in world space.\n",
+    );
+    out.push_str(
+        "fn primitive_interval(i: u32, head: vec4<f32>, o: vec3<f32>, d: vec3<f32>) -> Interval {\n",
+    );
+    out.push_str("    let tag = bitcast<u32>(head.w);\n    let offset = head.xyz;\n");
+    out.push_str("    let s = scene_data[i + 1u];\n");
+    if framed {
+        out.push_str("    if (tag & FRAMED) != 0u {\n");
+        for r in 0..3 {
+            let _ = writeln!(out, "        let r{r} = scene_data[i + {}u].xyz;", r + 2);
+        }
+        out.push_str("        let local = shape_interval(tag, into(o, r0, r1, r2) + offset, into(d, r0, r1, r2), s);\n");
+        out.push_str("        return to_world(local, r0, r1, r2);\n    }\n");
+    }
+    out.push_str("    return shape_interval(tag, o + offset, d, s);\n}\n\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::analytic::hierarchy;
+    use crate::scene::{MaterialId, NodeId};
+
+    fn sphere(x: f64, material: u32) -> Primitive {
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        Primitive {
+            shape: Shape::Sphere { radius: 0.5 },
+            matrix: identity,
+            offset: [-x, 0.0, 0.0],
+            material: MaterialId(material),
+            node: NodeId(0),
+        }
+    }
+
+    fn words(bytes: &[u8]) -> Vec<[u32; 4]> {
+        let w: Vec<u32> = bytes
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        w.chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect()
+    }
+
+    /// Every primitive is written once, in the order of the hierarchy, and every group's
+    /// `next` lies past its own entries and within the data, so the walk ends.
+    #[test]
+    fn entries_follow_the_hierarchy_and_groups_skip_forward() {
+        let mut prims: Vec<Primitive> = (0..37).map(|i| sphere(i as f64 * 1.5, i % 3)).collect();
+        prims[5].matrix = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let top = hierarchy(&prims);
+        let e = words(&data(&prims, &top));
+        let end = e[0][0] as usize;
+        assert_eq!(end, e.len());
+        let (mut i, mut seen, mut groups, mut framed) = (1, Vec::new(), 0, Vec::new());
+        while i < end {
+            let tag = e[i][3];
+            if tag == GROUP {
+                let next = e[i + 1][3] as usize;
+                assert!(next > i + 2 && next <= end, "group at {i}: next {next}");
+                groups += 1;
+                i += 2;
+            } else {
+                seen.push((f32::from_bits(e[i][0]), tag >> MATERIAL_SHIFT));
+                assert_eq!(tag & 7, SPHERE);
+                if tag & FRAMED != 0 {
+                    framed.push(seen.len() - 1);
+                }
+                i += if tag & FRAMED != 0 { 5 } else { 2 };
+            }
+        }
+        assert_eq!(i, end);
+        assert!(groups >= 9, "{groups} groups");
+        let mut order = Vec::new();
+        fn flatten(items: &[Item], out: &mut Vec<usize>) {
+            for it in items {
+                match it {
+                    Item::Primitive(p) => out.push(*p),
+                    Item::Group(g) => flatten(&g.items, out),
+                }
+            }
+        }
+        flatten(&top, &mut order);
+        let expected: Vec<(f32, u32)> = order
+            .iter()
+            .map(|&p| (-(p as f64 * 1.5) as f32, p as u32 % 3))
+            .collect();
+        assert_eq!(seen, expected);
+        let rotated: Vec<usize> = framed.iter().map(|&k| order[k]).collect();
+        assert_eq!(rotated, [5]);
+    }
+}

@@ -2,9 +2,10 @@
 //! within a stated tolerance. On a machine without a wgpu adapter the test says it skipped,
 //! unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe): then it fails.
 
+use sdfc_compiler::scene::Scene;
 use sdfc_compiler::{back::wgsl, lower};
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Minimum PSNR (dB) between the wgpu and CPU renders of an example.
 const MIN_PSNR: f64 = 30.0;
@@ -37,19 +38,25 @@ fn open_gpu() -> Option<gpu::Gpu> {
     }
 }
 
+/// A scene file loaded and made small: `width`×`height`, one sample per pixel.
+fn load_small(path: &Path, width: u32, height: u32) -> Scene {
+    let mut scene = frontend::load(path)
+        .expect("readable")
+        .scene
+        .unwrap_or_else(|| panic!("{} is a valid scene", path.display()));
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene.settings.aa = 1;
+    scene
+}
+
 #[test]
 fn wgpu_matches_cpu_on_every_example() {
     let Some(gpu) = open_gpu() else { return };
     println!("adapter: {}", gpu.describe());
     let mut failures = Vec::new();
     for path in examples() {
-        let mut scene = frontend::load(&path)
-            .expect("readable")
-            .scene
-            .expect("valid example");
-        scene.settings.width = 96;
-        scene.settings.height = 64;
-        scene.settings.aa = 1;
+        let scene = load_small(&path, 96, 64);
         let program = lower::lower(&scene);
         let kernel = wgsl::write(&scene, &program).expect("valid kernel");
         let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
@@ -116,13 +123,7 @@ fn assert_agree(
 fn a_kernel_with_outlined_blocks_matches_the_cpu() {
     let Some(gpu) = open_gpu() else { return };
     let path = PathBuf::from("../examples/scaling/compound_100.sdf");
-    let mut scene = frontend::load(&path)
-        .expect("readable")
-        .scene
-        .expect("valid scene");
-    scene.settings.width = 64;
-    scene.settings.height = 48;
-    scene.settings.aa = 1;
+    let scene = load_small(&path, 64, 48);
     let program = lower::lower(&scene);
     let kernel = wgsl::write(&scene, &program).expect("valid kernel");
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
@@ -256,12 +257,7 @@ fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
     let Some(gpu) = open_gpu() else { return };
     assert_agree(&gpu, &scene, &program, &kernel, "302 mixed primitives");
     let path = PathBuf::from("../examples/scaling/random_1000.sdf");
-    let mut scene = frontend::load(&path)
-        .expect("readable")
-        .scene
-        .expect("valid scene");
-    scene.settings.width = 96;
-    scene.settings.height = 64;
+    let scene = load_small(&path, 96, 64);
     let program = lower::lower(&scene);
     let kernel = wgsl::write(&scene, &program).expect("valid kernel");
     assert!(kernel.data.is_some());

@@ -138,19 +138,7 @@ impl<'a> Lowerer<'a> {
         let b = &mut *self.b;
         // The own cell's index per axis, centred (−(n−1)/2 … (n−1)/2 for n copies).
         let cell: [Option<Reg>; 3] = [0, 1, 2].map(|i| {
-            (period[i] != 0.0).then(|| {
-                let u = b.mulc(p[i], 1.0 / period[i]);
-                match count {
-                    None => b.un(Unary::Round, u),
-                    Some(n) => {
-                        let half = (n[i] - 1.0) * 0.5;
-                        let u = b.addc(u, half);
-                        let id = b.un(Unary::Round, u);
-                        let id = b.clampc(id, 0.0, n[i] - 1.0);
-                        b.subc(id, half)
-                    }
-                }
-            })
+            (period[i] != 0.0).then(|| cell_index(b, p[i], period[i], count.map(|n| n[i])))
         });
         let r = w.reach.map(|x| x as i64);
         let mut acc: Option<Field> = None;
@@ -917,20 +905,26 @@ fn repeat(b: &mut Builder, p: P, period: V3, count: Option<V3>) -> P {
         if s == 0.0 {
             return x;
         }
-        let u = b.mulc(x, 1.0 / s);
-        let cell = match count {
-            None => b.un(Unary::Round, u),
-            Some(n) => {
-                let half = (n[i] - 1.0) * 0.5;
-                let u = b.addc(u, half);
-                let id = b.un(Unary::Round, u);
-                let id = b.clampc(id, 0.0, n[i] - 1.0);
-                b.subc(id, half)
-            }
-        };
+        let cell = cell_index(b, x, s, count.map(|n| n[i]));
         let off = b.mulc(cell, s);
         b.sub(x, off)
     })
+}
+
+/// The index of the cell holding coordinate `x` along an axis of period `s` ≠ 0, centred on
+/// the middle copy: −(n−1)/2 … (n−1)/2 for `n` copies, any integer for infinitely many.
+fn cell_index(b: &mut Builder, x: Reg, s: f64, n: Option<f64>) -> Reg {
+    let u = b.mulc(x, 1.0 / s);
+    match n {
+        None => b.un(Unary::Round, u),
+        Some(n) => {
+            let half = (n - 1.0) * 0.5;
+            let u = b.addc(u, half);
+            let id = b.un(Unary::Round, u);
+            let id = b.clampc(id, 0.0, n - 1.0);
+            b.subc(id, half)
+        }
+    }
 }
 
 /// Rotation of the xz plane by k·y: q = (c·x - s·z, y, s·x + c·z).

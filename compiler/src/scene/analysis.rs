@@ -615,12 +615,7 @@ impl Pass<'_> {
         let mut d = c;
         let mut strict = true;
         let (mut overlap, mut off_centre) = (None, None);
-        for i in 0..3 {
-            let s = period[i];
-            let n = count.map_or(f64::INFINITY, |n| n[i]);
-            if s == 0.0 || n <= 1.0 || extent.is_empty() {
-                continue;
-            }
+        for (i, s, n) in repeated_axes(&extent, period, count) {
             let (lo, hi, half) = (extent.min[i], extent.max[i], s * 0.5);
             strict &= lo > -half && hi < half;
             if lo < -half - TOLERANCE || hi > half + TOLERANCE {
@@ -763,12 +758,7 @@ pub fn window(
         beyond: f64::INFINITY,
     };
     let mut cells = 1.0;
-    for i in 0..3 {
-        let s = period[i];
-        let n = count.map_or(f64::INFINITY, |n| n[i]);
-        if s == 0.0 || n <= 1.0 || extent.is_empty() {
-            continue;
-        }
+    for (i, s, n) in repeated_axes(extent, period, count) {
         let (lo, hi, half) = (extent.min[i], extent.max[i], s * 0.5);
         let fits = lo >= -half - TOLERANCE && hi <= half + TOLERANCE;
         if fits && symmetric[i] {
@@ -789,6 +779,20 @@ pub fn window(
         w.reach[i] = r as u32;
     }
     Some(w)
+}
+
+/// The axes along which a repetition of a non-empty shape makes copies: (axis, period,
+/// number of copies, infinite for an infinite repetition).
+fn repeated_axes(
+    extent: &Aabb,
+    period: V3,
+    count: Option<V3>,
+) -> impl Iterator<Item = (usize, f64, f64)> {
+    let empty = extent.is_empty();
+    (0..3).filter_map(move |i| {
+        let n = count.map_or(f64::INFINITY, |n| n[i]);
+        (period[i] != 0.0 && n > 1.0 && !empty).then_some((i, period[i], n))
+    })
 }
 
 /// The facts of a combination of several fields (before its own rule): the largest L and

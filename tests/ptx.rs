@@ -816,6 +816,7 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
         let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());
+        keep(&format!("buffer_{name}.data"), data);
         let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
         println!(
             "{name}: {} bytes of WGSL, {} lines of PTX, {} bytes of scene data",

@@ -53,6 +53,11 @@ const SCALED: u32 = 16;
 /// Materials are numbered in the tag's bits above these.
 const MATERIAL_SHIFT: u32 = 5;
 
+/// The most bytes of instance data: what wgpu's default limits let a storage buffer bind
+/// (128 MiB: over a million instances, ten times the default `objects` limit); a scene with
+/// more keeps its instances as code.
+pub const MAX_BYTES: usize = 128 << 20;
+
 /// Whether every material of `instances` fits in a tag.
 pub fn fits(instances: &[Instance]) -> bool {
     instances
@@ -261,11 +266,13 @@ fn formula(kind: u32) -> &'static str {
 /// `fn instance_distance`: the field of the instance whose entry starts at `i` with `head`,
 /// and `fn instance_size`, its number of vectors.
 fn instance_distance(out: &mut String, rotated: bool, scaled: bool) {
-    out.push_str(
+    let _ = write!(
+        out,
         "// The distance at p of the instance whose entry starts at scene_data[i] with head.\n\
-         fn instance_distance(i: u32, head: vec4<f32>, p: vec3<f32>) -> f32 {\n\
+         fn instance_distance(i: u32, head: vec4<f32>, p: vec3<f32>) -> f32 {{\n\
          \x20   let tag = bitcast<u32>(head.w);\n\
-         \x20   var q = p - head.xyz;\n",
+         \x20   {} q = p - head.xyz;\n",
+        if rotated || scaled { "var" } else { "let" }
     );
     if rotated || scaled {
         out.push_str("    var at = i + 2u;\n");
@@ -322,7 +329,7 @@ fn walk(out: &mut String, material: bool) {
         "// The nearer of start and the instances at p{}.\n\
          fn {name}(p: vec3<f32>, start: {ty}) -> {ty} {{",
         if material {
-            ", with its material (start's on a tie, else the earlier instance's)"
+            ", with its material (start's on a tie,\n// else the earlier instance's)"
         } else {
             ""
         }
@@ -356,4 +363,62 @@ fn walk(out: &mut String, material: bool) {
         out.push_str("        best = min(best, d);\n");
     }
     out.push_str("        i += instance_size(tag);\n    }\n    return best;\n}\n\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::MaterialId;
+
+    fn sphere(x: f64, k: usize) -> Instance {
+        let quarter = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        Instance {
+            shape: Node::Sphere { radius: 0.5 },
+            offset: [x, 0.0, 0.0],
+            rotation: (k % 3 == 1).then_some(quarter),
+            scale: (k % 5 == 2).then_some(2.0),
+            material: (k % 2 == 0).then_some(MaterialId(k as u32)),
+            aabb: ([x - 0.5, -0.5, -0.5], [x + 0.5, 0.5, 0.5]),
+        }
+    }
+
+    /// Every instance is written once with its flags and material, every group's `next` lies
+    /// past its own entries and within the data, and stepping by each entry's size (as
+    /// `instance_size` does) ends exactly at `end`.
+    #[test]
+    fn entries_cover_every_instance_and_groups_skip_forward() {
+        let instances: Vec<Instance> = (0..41).map(|k| sphere(k as f64 * 1.5, k)).collect();
+        let bytes = data(&instances);
+        let w: Vec<u32> = bytes
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        let e: Vec<&[u32]> = w.chunks_exact(4).collect();
+        let end = e[0][0] as usize;
+        assert_eq!(end, e.len());
+        let (mut i, mut seen, mut groups) = (1, Vec::new(), 0);
+        while i < end {
+            let tag = e[i][3];
+            if tag == GROUP {
+                let next = e[i + 1][3] as usize;
+                assert!(next > i + 2 && next <= end, "group at {i}: next {next}");
+                groups += 1;
+                i += 2;
+                continue;
+            }
+            let x = f32::from_bits(e[i][0]);
+            let k = (x / 1.5).round() as usize;
+            assert_eq!(tag & 7, SPHERE);
+            assert_eq!(tag & ROTATED != 0, k % 3 == 1, "instance {k}");
+            assert_eq!(tag & SCALED != 0, k % 5 == 2, "instance {k}");
+            let material = if k % 2 == 0 { k as u32 } else { 0 };
+            assert_eq!(tag >> MATERIAL_SHIFT, material);
+            seen.push(k);
+            i += 2 + 3 * usize::from(tag & ROTATED != 0) + usize::from(tag & SCALED != 0);
+        }
+        assert_eq!(i, end);
+        assert!(groups >= 9, "{groups} groups");
+        seen.sort_unstable();
+        assert_eq!(seen, (0..41).collect::<Vec<_>>());
+    }
 }

@@ -56,7 +56,8 @@ pub struct Kernel {
     /// The features the kernel was specialised for, by name.
     pub features: Vec<(&'static str, bool)>,
     /// The bytes of binding 4, `scene_data`, when the kernel declares it (the `SCENE_DATA`
-    /// feature): the primitives and hierarchy of a large analytically traced scene.
+    /// feature): the primitives and hierarchy of a large analytically traced scene, or the
+    /// instances and their hierarchy of a large marched one.
     pub data: Option<Vec<u8>>,
 }
 
@@ -226,19 +227,24 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
 
 /// `fn map` and `fn sdf` of a marched scene: the program as code, or, when its root union has
 /// more than `max_instances` instances, the rest of it as code and the instances as
-/// `scene_data` (march.rs).
+/// `scene_data` (march.rs), unless their materials or their bytes do not fit.
 fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, Option<Vec<u8>>) {
     let split = crate::lower::split(scene, &program.options(), max_instances)
-        .filter(|s| march::fits(&s.instances));
+        .filter(|s| march::fits(&s.instances))
+        .map(|s| {
+            let data = march::data(&s.instances);
+            (s, data)
+        })
+        .filter(|(_, data)| data.len() <= march::MAX_BYTES);
     match split {
-        Some(s) => {
+        Some((s, data)) => {
             let text = format!(
                 "{}\n{}\n{}",
                 map::write_map_named(&s.rest, "rest_map"),
                 map::write_sdf_named(&s.rest, "rest_sdf"),
                 march::write(&s.instances)
             );
-            (text, Some(march::data(&s.instances)))
+            (text, Some(data))
         }
         None => (
             format!("{}\n{}", write_map(program), write_sdf(program)),

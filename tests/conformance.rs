@@ -135,9 +135,10 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
     assert_agree(&gpu, &scene, &program, &kernel, "compound_100 as code");
 }
 
-/// A marched scene of `n` instances of every kind with closed-form distances (rotated, scaled,
-/// painted or not) over a plane, with shapes that must stay in the rest of the program: a twisted box and
-/// ellipsoids (a bound, not an exact distance).
+/// A marched scene of `n` instances of every kind with closed-form distances (rotated, some
+/// scaled, which the simplification absorbs into their sizes, painted or not) over a plane,
+/// with shapes that must stay in the rest of the program: a twisted box and ellipsoids (a
+/// bound, not an exact distance).
 fn marched_scene(n: usize) -> String {
     let mut state = 0x9e37_79b9_u64;
     let mut next = move || {

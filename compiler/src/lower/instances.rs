@@ -2,20 +2,23 @@
 //! end that evaluates them as data (`back::wgsl::march`) instead of as code computes the same
 //! field as `min(rest, instances)`, with the nearer one's material.
 //!
-//! An instance is a child of the simplified root union that is paint ∘ translate ∘ rotate ∘
-//! uniform scale (any of them, in that order, as `simplify` leaves them) of a sphere, box,
-//! round box, torus, capped cylinder, capsule or cone, whose field the analysis proves an
-//! exact distance (L = 1): the lowering neither divides it by a local L nor raises it to a
-//! bound, so its value is the primitive's formula of `shapes.rs` at the transformed point,
-//! and it is at least the distance to any box around it (which exact culling needs). The
-//! ellipsoid's field is only a bound, so an ellipsoid stays in the rest.
+//! An instance is a child of the simplified root union that is paint ∘ translate ∘ rotate (any
+//! of them, in that order, as `simplify` leaves them) of a sphere, box, round box, torus,
+//! capped cylinder, capsule or cone, whose field the analysis proves an exact distance (L = 1).
+//! `simplify` absorbs every uniform scale of these primitives into their sizes (the checker
+//! allows only positive factors), so a scale node above one never reaches this; a child with
+//! one stays in the rest. With L = 1 the lowering neither divides an instance by a local L
+//! nor raises it to a bound, so its value is the primitive's formula of `shapes.rs` at the
+//! transformed point, and, exact, it is at least the signed distance to any box around it
+//! (which exact culling needs). The ellipsoid's field is only a bound, so an ellipsoid stays
+//! in the rest.
 
 use super::bounds::Bounds;
 use super::{lower_simple, simplify, LowerOptions, Program};
 use crate::scene::analysis::{self, Analysis};
 use crate::scene::{Combine, Exactness, Graph, MaterialId, Node, NodeId, Scene, V3};
 
-/// One instance: `shape` evaluated at `scale⁻¹ · (rotate(p) − offset)`, times `|scale|`.
+/// One instance: `shape` evaluated at `rotate(p) − offset`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Instance {
     /// The primitive (one of the kinds listed in the module's header), in its own frame.
@@ -25,8 +28,6 @@ pub struct Instance {
     pub offset: V3,
     /// The rotation's matrix `M` (rows), whose transpose maps the point: `q_j = Σ_i p_i·M_ij`.
     pub rotation: Option<[V3; 3]>,
-    /// The uniform scale factor.
-    pub scale: Option<f64>,
     /// The paint, if any (unpainted shapes get material 0, as in the program).
     pub material: Option<MaterialId>,
     /// A world-space box around the solid (low and high corners): the field is at least the
@@ -105,7 +106,6 @@ fn instance(graph: &Graph, analysis: &Analysis, bounds: &Bounds, id: NodeId) -> 
         shape: Node::Sphere { radius: 0.0 },
         offset: [0.0; 3],
         rotation: None,
-        scale: None,
         material: None,
         aabb: (
             [0, 1, 2].map(|k| c[k] - h[k]),
@@ -124,10 +124,6 @@ fn instance(graph: &Graph, analysis: &Analysis, bounds: &Bounds, id: NodeId) -> 
     }
     if let Node::Rotate { matrix, child } = graph.node(n) {
         out.rotation = Some(*matrix);
-        n = *child;
-    }
-    if let Node::Scale { factor, child } = graph.node(n) {
-        out.scale = Some(*factor);
         n = *child;
     }
     out.offset = match (translation, &out.rotation) {

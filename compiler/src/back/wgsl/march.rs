@@ -14,14 +14,13 @@
 //!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries,
 //!                      where a point whose signed distance to the group's box is not below
 //!                      the best distance so far goes on
-//!   instance   [i]     (offset.xyz, kind | ROTATED | SCALED | material << 5): the point in
-//!                      the shape's frame is q = rotate(p) − offset, then q / s
+//!   instance   [i]     (offset.xyz, kind | ROTATED | material << 4): the point in the
+//!                      shape's frame is q = rotate(p) − offset
 //!              [i + 1] the shape: sphere (r, 0, 0, 0), box (half.xyz, 0), round box
 //!                      (half.xyz − r, r), torus (R, r, 0, 0), cylinder and capsule
 //!                      (r, half height, 0, 0), cone (r, h, 2h², 1 / (r² + 4h²))
 //!              [+ 3]   only when ROTATED: the columns of the rotation's matrix M, as rows
 //!                      (q_j = Σ_i p_i·M_ij)
-//!              [+ 1]   only when SCALED: (1 / s, |s|, 0, 0); the distance is multiplied by |s|
 //! ```
 //!
 //! The constants are those of `lower/shapes.rs`, computed in f64 and rounded to f32 as the
@@ -29,8 +28,8 @@
 //! field equals the CPU's up to f32 rounding. Every instance is an exact distance, so its value
 //! is at least the signed distance to its box, and a group whose box is not nearer than the
 //! best distance so far cannot change the minimum: skipping it is exact. The walk needs no
-//! stack and ends after at most `end` steps, as in buffer.rs. An unrotated, unscaled instance
-//! takes 32 bytes, a rotated one 80, a group 32.
+//! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes
+//! 32 bytes, a rotated one 80, a group 32.
 
 use crate::lower::Instance;
 use crate::scene::analytic::{boxed, Item};
@@ -48,10 +47,8 @@ const CONE: u32 = 6;
 const GROUP: u32 = 7;
 /// The tag bit of an instance with a rotation.
 const ROTATED: u32 = 8;
-/// The tag bit of an instance with a uniform scale.
-const SCALED: u32 = 16;
 /// Materials are numbered in the tag's bits above these.
-const MATERIAL_SHIFT: u32 = 5;
+const MATERIAL_SHIFT: u32 = 4;
 
 /// The most bytes of instance data: what wgpu's default limits let a storage buffer bind
 /// (128 MiB: over a million instances, ten times the default `objects` limit); a scene with
@@ -122,15 +119,11 @@ fn push(out: &mut Vec<[u32; 4]>, instances: &[Instance], items: &[Item]) {
 fn instance(out: &mut Vec<[u32; 4]>, i: &Instance) {
     let tag = kind(&i.shape)
         | if i.rotation.is_some() { ROTATED } else { 0 }
-        | if i.scale.is_some() { SCALED } else { 0 }
         | i.material.map_or(0, |m| m.0) << MATERIAL_SHIFT;
     out.push(vec(i.offset, tag));
     out.push(shape(&i.shape));
     if let Some(m) = i.rotation {
         out.extend((0..3).map(|j| vec([m[0][j], m[1][j], m[2][j]], 0)));
-    }
-    if let Some(s) = i.scale {
-        out.push(quad([1.0 / s, s.abs(), 0.0, 0.0]));
     }
 }
 
@@ -163,22 +156,18 @@ fn shape(shape: &Node) -> [u32; 4] {
 /// over `scene_data`; only the kinds of `instances` are tested for.
 pub fn write(instances: &[Instance]) -> String {
     let rotated = instances.iter().any(|i| i.rotation.is_some());
-    let scaled = instances.iter().any(|i| i.scale.is_some());
     let mut out = String::from(
         "// The instances in scene_data (the layout is in compiler/src/back/wgsl/march.rs): the\n\
-         // kind of entry in a tag's low three bits, ROTATED and SCALED, the material above.\n",
+         // kind of entry in a tag's low three bits, ROTATED, the material above.\n",
     );
     let _ = writeln!(out, "const GROUP: u32 = {GROUP}u;");
     if rotated {
         let _ = writeln!(out, "const ROTATED: u32 = {ROTATED}u;");
     }
-    if scaled {
-        let _ = writeln!(out, "const SCALED: u32 = {SCALED}u;");
-    }
     out.push('\n');
     helpers(&mut out);
     shape_distance(&mut out, instances);
-    instance_distance(&mut out, rotated, scaled);
+    instance_distance(&mut out, rotated);
     walk(&mut out, true);
     walk(&mut out, false);
     out.push_str(
@@ -265,18 +254,15 @@ fn formula(kind: u32) -> &'static str {
 
 /// `fn instance_distance`: the field of the instance whose entry starts at `i` with `head`,
 /// and `fn instance_size`, its number of vectors.
-fn instance_distance(out: &mut String, rotated: bool, scaled: bool) {
+fn instance_distance(out: &mut String, rotated: bool) {
     let _ = write!(
         out,
         "// The distance at p of the instance whose entry starts at scene_data[i] with head.\n\
          fn instance_distance(i: u32, head: vec4<f32>, p: vec3<f32>) -> f32 {{\n\
          \x20   let tag = bitcast<u32>(head.w);\n\
          \x20   {} q = p - head.xyz;\n",
-        if rotated || scaled { "var" } else { "let" }
+        if rotated { "var" } else { "let" }
     );
-    if rotated || scaled {
-        out.push_str("    var at = i + 2u;\n");
-    }
     if rotated {
         out.push_str(
             "    if (tag & ROTATED) != 0u {\n\
@@ -289,29 +275,15 @@ fn instance_distance(out: &mut String, rotated: bool, scaled: bool) {
              \x20           (p.x * c2.x + p.y * c2.y) + p.z * c2.z,\n\
              \x20       );\n\
              \x20       q = r - head.xyz;\n\
-             \x20       at = i + 5u;\n\
              \x20   }\n",
         );
     }
     let shape = "shape_distance(tag & 7u, q, scene_data[i + 1u])";
-    if scaled {
-        let _ = write!(
-            out,
-            "    if (tag & SCALED) != 0u {{\n\
-             \x20       let s = scene_data[at];\n\
-             \x20       q = q * s.x;\n\
-             \x20       return {shape} * s.y;\n\
-             \x20   }}\n"
-        );
-    }
     let _ = writeln!(out, "    return {shape};\n}}\n");
     out.push_str("// The number of vectors of the instance whose tag this is.\n");
     out.push_str("fn instance_size(tag: u32) -> u32 {\n    return 2u");
     if rotated {
         out.push_str(" + select(0u, 3u, (tag & ROTATED) != 0u)");
-    }
-    if scaled {
-        out.push_str(" + select(0u, 1u, (tag & SCALED) != 0u)");
     }
     out.push_str(";\n}\n\n");
 }
@@ -376,7 +348,6 @@ mod tests {
             shape: Node::Sphere { radius: 0.5 },
             offset: [x, 0.0, 0.0],
             rotation: (k % 3 == 1).then_some(quarter),
-            scale: (k % 5 == 2).then_some(2.0),
             material: (k % 2 == 0).then_some(MaterialId(k as u32)),
             aabb: ([x - 0.5, -0.5, -0.5], [x + 0.5, 0.5, 0.5]),
         }
@@ -410,11 +381,10 @@ mod tests {
             let k = (x / 1.5).round() as usize;
             assert_eq!(tag & 7, SPHERE);
             assert_eq!(tag & ROTATED != 0, k % 3 == 1, "instance {k}");
-            assert_eq!(tag & SCALED != 0, k % 5 == 2, "instance {k}");
             let material = if k % 2 == 0 { k as u32 } else { 0 };
             assert_eq!(tag >> MATERIAL_SHIFT, material);
             seen.push(k);
-            i += 2 + 3 * usize::from(tag & ROTATED != 0) + usize::from(tag & SCALED != 0);
+            i += 2 + 3 * usize::from(tag & ROTATED != 0);
         }
         assert_eq!(i, end);
         assert!(groups >= 9, "{groups} groups");

@@ -144,3 +144,38 @@ fn instance(graph: &Graph, analysis: &Analysis, bounds: &Bounds, id: NodeId) -> 
     };
     Some(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(text: &str) -> Scene {
+        let (scene, diags, _) = crate::check::check_str("split.sdf", text);
+        scene.unwrap_or_else(|| panic!("{diags:?}"))
+    }
+
+    /// Exact primitives under paint, translation and rotation are instances; a plane, a
+    /// twisted shape and an ellipsoid (a bound) stay in the rest; too few instances, or a
+    /// program lowered as written, give no split.
+    #[test]
+    fn instances_are_exact_children_of_the_root_union() {
+        let s = scene(
+            "material red = phong { color: (1, 0, 0) };\n\
+             scene {\n  plane();\n  box((1, 1, 1)).twist(0.5);\n  ellipsoid((1, 2, 3));\n\
+             for i in 0..6 { sphere(0.5).translate(i * 3, 0, 0) @ red; }\n\
+             box((0.2, 0.3, 0.4)).rotate_y(30deg).translate(0, 2, 0);\n\
+             torus(1, 0.2).rotate_x(20deg) @ red;\n  cone(0.5, 1).translate(0, 0, 5);\n}\n",
+        );
+        let split = split(&s, &LowerOptions::default(), 3).expect("more than 3 instances");
+        assert_eq!(split.instances.len(), 9);
+        let rotated = split.instances.iter().filter(|i| i.rotation.is_some());
+        assert_eq!(rotated.count(), 2);
+        let painted = split.instances.iter().filter(|i| i.material.is_some());
+        assert_eq!(painted.count(), 7);
+        let text = split.rest.dump();
+        assert!(text.contains("plane") && text.contains("twist") && text.contains("ellipsoid"));
+        assert!(!text.contains("torus") && !text.contains("cone") && !text.contains("sphere"));
+        assert!(super::split(&s, &LowerOptions::default(), 9).is_none());
+        assert!(super::split(&s, &LowerOptions::level(0), 3).is_none());
+    }
+}

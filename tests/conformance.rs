@@ -117,16 +117,121 @@ fn assert_agree(
 }
 
 /// A distance program large enough that `map` and `sdf` are cut into functions
-/// (examples/scaling/compound_100.sdf, about 15 000 instructions) renders on wgpu as on the
-/// CPU.
+/// (examples/scaling/compound_100.sdf, about 15 000 instructions, its instances written as
+/// code) renders on wgpu as on the CPU.
 #[test]
 fn a_kernel_with_outlined_blocks_matches_the_cpu() {
     let Some(gpu) = open_gpu() else { return };
     let path = PathBuf::from("../examples/scaling/compound_100.sdf");
     let scene = load_small(&path, 64, 48);
     let program = lower::lower(&scene);
-    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let options = wgsl::Options {
+        max_instances: usize::MAX,
+        ..wgsl::Options::default()
+    };
+    let kernel = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
+    assert!(kernel.data.is_none());
+    assert_agree(&gpu, &scene, &program, &kernel, "compound_100 as code");
+}
+
+/// A marched scene of `n` instances of every kind with closed-form distances (rotated, some
+/// scaled, which the simplification absorbs into their sizes, painted or not) over a plane,
+/// with shapes that must stay in the rest of the program: a twisted box and ellipsoids (a
+/// bound, not an exact distance).
+fn marched_scene(n: usize) -> String {
+    let mut state = 0x9e37_79b9_u64;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 33) as f64 / (1u64 << 31) as f64
+    };
+    let mut text = String::from(
+        "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75 };\n\
+         material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\
+         material mirror = phong { color: (0.9, 0.9, 0.95), diffuse: 0.2, specular: 1, shininess: 200, reflect: 0.5 };\n\
+         material teal = phong { color: (0.15, 0.6, 0.6), specular: 0.5, shininess: 64 };\n\
+         camera { position: (0, 4, -7), look_at: (0, 1, 3), fov: 60deg }\n\
+         light point { position: (-4, 9, -6), intensity: 1.1, radius: 60, softness: 0.1 }\n\
+         render { width: 96, height: 64, max_depth: 2, method: \"march\" }\n\
+         scene {\n  plane() @ floor;\n  box((0.3, 1, 0.3)).twist(1.5).translate(0, 1, -3) @ teal;\n",
+    );
+    for i in 0..n {
+        let (x, y, z) = (16.0 * next() - 8.0, 0.4 + 2.0 * next(), 10.0 * next() - 2.0);
+        let (a, b) = (360.0 * next(), 360.0 * next());
+        let turn = format!("rotate_y({a:.1}deg).rotate_x({b:.1}deg)");
+        let shape = match i % 9 {
+            0 => format!("sphere({:.3})", 0.2 + 0.1 * next()),
+            1 => format!("box((0.2, 0.15, 0.25)).{turn}"),
+            2 => format!("round_box((0.2, 0.15, 0.25), 0.05).{turn}.scale(1.2)"),
+            3 => format!("torus(0.25, 0.06).{turn}"),
+            4 => format!("cylinder(0.15, 0.3).rotate_z({a:.1}deg).scale(0.9)"),
+            5 => format!("capsule(0.1, 0.25).{turn}"),
+            6 => format!("cone(0.2, 0.3).{turn}"),
+            7 => format!("cone(0.2, 0.3).scale(1.1).rotate_z({a:.1}deg)"),
+            _ => "ellipsoid((0.3, 0.15, 0.2))".to_string(),
+        };
+        let material = ["clay", "mirror", "teal", ""][i % 4];
+        let paint = if material.is_empty() {
+            String::new()
+        } else {
+            format!(" @ {material}")
+        };
+        text.push_str(&format!(
+            "  {shape}.scale(2).translate({x:.3}, {y:.3}, {z:.3}){paint};\n"
+        ));
+    }
+    text.push_str("}\n");
+    text
+}
+
+/// Marched scenes with more instances than the kernel writes as code read them and their
+/// hierarchy from `scene_data` and render on wgpu as on the CPU: the lamp posts of
+/// examples/scaling/compound_100.sdf (400 instances), and a scene of every kind of instance
+/// with shapes that stay in the rest of the program.
+#[test]
+fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
+    let text = marched_scene(360);
+    let (scene, diags, _) = sdfc_compiler::check::check_str("marched.sdf", &text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let program = lower::lower(&scene);
+    let split = lower::split(&scene, &program.options(), wgsl::MAX_INSTANCES).expect("split");
+    // Of 360 children, the 40 ellipsoids stay, with the plane and the twisted box.
+    assert_eq!(split.instances.len(), 320);
+    assert!(split.instances.iter().any(|i| i.material.is_none()));
+    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(kernel.features.contains(&("SCENE_DATA", true)));
+    assert!(kernel.source.contains("fn rest_map") && kernel.source.contains("const ROTATED"));
+    let Some(gpu) = open_gpu() else { return };
+    assert_agree(
+        &gpu,
+        &scene,
+        &program,
+        &kernel,
+        "320 instances and the rest",
+    );
+    // The same field as the program written as code: on one device the two kernels render
+    // alike up to rounding, far closer than the CPU tolerance.
+    let options = wgsl::Options {
+        max_instances: usize::MAX,
+        ..wgsl::Options::default()
+    };
+    let code = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
+    assert!(code.data.is_none());
+    let render = |k: &wgsl::Kernel| gpu::render(&gpu, &scene, k, 1.0, &mut |_| {}).expect("render");
+    let (walked, written) = (render(&kernel).render, render(&code).render);
+    let d = metrics::compare(&walked.image, &written.image, THRESHOLD).expect("same size");
+    println!(
+        "walked against written as code: psnr {:.1} dB, differing {:.4}",
+        d.psnr, d.differing
+    );
+    assert!(d.psnr >= 50.0 && d.differing <= 0.002, "{d:?}");
+    let path = PathBuf::from("../examples/scaling/compound_100.sdf");
+    let scene = load_small(&path, 96, 64);
+    let program = lower::lower(&scene);
+    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(kernel.data.is_some() && !kernel.source.contains("fn map_block"));
     assert_agree(&gpu, &scene, &program, &kernel, "compound_100");
 }
 

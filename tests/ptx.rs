@@ -781,12 +781,55 @@ fn a_kernel_with_outlined_blocks_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/compound_100.sdf");
     let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
     let program = sdfc_compiler::lower::lower(&scene);
-    let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+    // Its 400 instances written as code, not read from `scene_data`.
+    let code = sdfc_compiler::back::wgsl::Options {
+        max_instances: usize::MAX,
+        ..Default::default()
+    };
+    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &program, &code).unwrap();
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
     let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
     assert!(text.contains(".entry"));
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "outlined", 80)));
+    }
+}
+
+/// The most bytes of WGSL and lines of PTX of a marched kernel whose instances are read from
+/// `scene_data`, whatever their number (about 15 KB and 2 500 lines for the lamp posts; their
+/// kernels written as code are megabytes).
+const WALKED_WGSL_BYTES: usize = 24_000;
+const WALKED_PTX_LINES: usize = 4_000;
+
+/// The kernels of marched scenes beyond `MAX_INSTANCES` instances (1 000 and 10 000 lamp
+/// posts of examples/scaling, 4 000 and 40 000 instances) stay small, translate and
+/// assemble.
+#[test]
+fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
+    let ptxas = ptxas();
+    for n in [1000, 10000] {
+        let name = format!("compound_{n}");
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../examples/scaling/{name}.sdf"));
+        let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+        let program = sdfc_compiler::lower::lower(&scene);
+        let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+        let data = kernel.data.as_ref().expect("instances read from a buffer");
+        keep(&format!("{name}.wgsl"), kernel.source.as_bytes());
+        keep(&format!("buffer_{name}.data"), data);
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+        println!(
+            "{name}: {} bytes of WGSL, {} lines of PTX, {} bytes of scene data",
+            kernel.source.len(),
+            text.lines().count(),
+            data.len()
+        );
+        assert!(kernel.source.len() < WALKED_WGSL_BYTES, "{name}: WGSL");
+        assert!(text.lines().count() < WALKED_PTX_LINES, "{name}: PTX");
+        assert!(text.contains("main_param_4") && text.contains("ld.global.nc"));
+        if let Some(p) = &ptxas {
+            println!("    {}", summary(&assemble(p, &text, &name, 80)));
+        }
     }
 }
 

@@ -259,6 +259,7 @@ impl Builder {
             distance: d,
             material: m,
             lipschitz: 1.0,
+            options: super::LowerOptions::default(),
         };
         let (live, live_blocks) = if self.optimise {
             raw.live(&[d, m])
@@ -306,6 +307,7 @@ impl Builder {
             distance: new_index[d.0 as usize],
             material: new_index[m.0 as usize],
             lipschitz: 1.0,
+            options: super::LowerOptions::default(),
         }
     }
 }

@@ -23,14 +23,17 @@ mod bounds;
 mod builder;
 mod bvh;
 mod graph;
+mod instances;
 mod shapes;
 mod simplify;
 #[cfg(test)]
 mod tests;
 
+pub use instances::{split, Instance, Split};
+
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
-use crate::scene::{analysis, Graph, Scene};
+use crate::scene::{analysis, Graph, NodeId, Scene};
 use std::fmt::Write;
 
 /// Names a register: the value defined by the instruction at this index.
@@ -178,9 +181,16 @@ pub struct Program {
     distance: Reg,
     material: Reg,
     lipschitz: f64,
+    options: LowerOptions,
 }
 
 impl Program {
+    /// The options the program was lowered with (a back end that lowers part of the scene
+    /// again, [`split`], uses the same).
+    pub fn options(&self) -> LowerOptions {
+        self.options
+    }
+
     /// The L a renderer steps with (`f / L` is a distance bound): 1 for a program with local
     /// bounds, else the scene's L ([`Analysis::step_lipschitz`]).
     ///
@@ -459,17 +469,40 @@ pub fn check_size(scene: &Scene, program: &Program, limits: &Limits) -> Result<(
 
 /// Lowers a checked scene to its distance program with the given options.
 pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
-    let optimise = options.level > 0;
-    let mut b = builder::Builder::new(optimise);
+    match scene.root {
+        _ if options.level == 0 => lower_literal(scene, options),
+        Some(root) => {
+            let simple = simplify::simplify(&scene.graph, root);
+            lower_simple(
+                scene,
+                simple.graph,
+                Some(simple.root),
+                &simple.origin,
+                options,
+            )
+        }
+        None => lower_simple(scene, Graph::default(), None, &[], options),
+    }
+}
+
+/// Lowers the simplified graph `graph` below `root` (for the scene's camera and settings),
+/// `origin` naming the original node of each simplified one.
+fn lower_simple(
+    scene: &Scene,
+    graph: Graph,
+    root: Option<NodeId>,
+    origin: &[NodeId],
+    options: &LowerOptions,
+) -> Program {
+    let mut b = builder::Builder::new(true);
     let p = b.input_point();
     let mut lipschitz = 1.0;
-    let (d, m) = match scene.root {
-        Some(root) if optimise => {
-            let simple = simplify::simplify(&scene.graph, root);
+    let (d, m) = match root {
+        Some(root) => {
             // The analysis of the simplified graph, whose nodes the lowering walks.
             let simple_scene = Scene {
-                graph: simple.graph,
-                root: Some(simple.root),
+                graph,
+                root: Some(root),
                 ..scene_without_graph(scene)
             };
             let analysis = analysis::analyse(&simple_scene);
@@ -480,16 +513,26 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
             let config = graph::Config {
                 cull: options.cull,
                 camera: scene.camera.position,
-                origin: Some(simple.origin.as_slice()),
+                origin: Some(origin),
                 bounds: Some(&bounds),
                 optimise: true,
                 analysis: Some(&analysis),
                 local: options.local,
             };
-            let field =
-                graph::Lowerer::new(&simple_scene.graph, &mut b, config).node(simple.root, p);
+            let field = graph::Lowerer::new(&simple_scene.graph, &mut b, config).node(root, p);
             (field.d, field.m)
         }
+        None => (b.c(EMPTY_DISTANCE), b.c(graph::UNPAINTED)),
+    };
+    finish(b, d, m, lipschitz, options)
+}
+
+/// Lowers the scene as written (level 0).
+fn lower_literal(scene: &Scene, options: &LowerOptions) -> Program {
+    let mut b = builder::Builder::new(false);
+    let p = b.input_point();
+    let mut lipschitz = 1.0;
+    let (d, m) = match scene.root {
         Some(root) => {
             let analysis = analysis::analyse(scene);
             lipschitz = analysis.step_lipschitz();
@@ -507,10 +550,22 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
         }
         None => (b.c(EMPTY_DISTANCE), b.c(graph::UNPAINTED)),
     };
+    finish(b, d, m, lipschitz, options)
+}
+
+/// Paints what is unpainted with material 0 and ends the program.
+fn finish(
+    mut b: builder::Builder,
+    d: Reg,
+    m: Reg,
+    lipschitz: f64,
+    options: &LowerOptions,
+) -> Program {
     b.note("result: unpainted shapes get the default material 0".into());
     let m = b.paint(m, 0.0);
     Program {
         lipschitz,
+        options: *options,
         ..b.finish(d, m)
     }
 }

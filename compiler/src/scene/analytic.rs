@@ -324,16 +324,26 @@ pub fn hierarchy(primitives: &[Primitive]) -> Vec<Item> {
             None => top.push(Item::Primitive(i)),
         }
     }
-    if bounded.len() <= LEAF {
-        top.extend(bounded.into_iter().map(|(i, _)| Item::Primitive(i)));
-    } else {
-        top.push(Item::Group(build(bounded)));
-    }
+    top.extend(boxed(bounded));
     top
 }
 
+/// The hierarchy over items with boxes, by index: the items themselves when there are a few,
+/// else one group around them all, split at medians (the hierarchy of [`hierarchy`], and of
+/// any other list of bounded things).
+pub fn boxed(bounded: Vec<(usize, Aabb)>) -> Vec<Item> {
+    if bounded.len() <= LEAF {
+        bounded
+            .into_iter()
+            .map(|(i, _)| Item::Primitive(i))
+            .collect()
+    } else {
+        vec![Item::Group(build(bounded))]
+    }
+}
+
 /// An axis-aligned box as (low, high) corners.
-type Aabb = (V3, V3);
+pub type Aabb = (V3, V3);
 
 /// Splits at the median of the box centres along the axis where they spread most (a median
 /// split keeps the tree balanced: depth log₂(n / LEAF)).

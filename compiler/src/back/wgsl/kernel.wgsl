@@ -48,7 +48,8 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> image: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> stats: array<u32>;
 //#if SCENE_DATA
-// The primitives and hierarchy of an analytically traced scene (layout: compiler/src/back/wgsl/buffer.rs).
+// The primitives and hierarchy of a large analytically traced scene, or the instances of a large
+// marched one (layouts: compiler/src/back/wgsl/buffer.rs, march.rs).
 @group(0) @binding(4) var<storage, read> scene_data: array<vec4<f32>>;
 //#endif
 

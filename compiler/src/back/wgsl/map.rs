@@ -24,15 +24,20 @@ const OUTLINE_PARAMS: usize = 48;
 /// The WGSL text of `map`, returning (distance, material id), preceded by the functions
 /// of its outlined blocks, if any.
 pub fn write_map(program: &Program) -> String {
+    write_map_named(program, "map")
+}
+
+/// [`write_map`] as the function `name` (its outlined blocks prefixed by it).
+pub(super) fn write_map_named(program: &Program, name: &'static str) -> String {
     let roots = [program.distance(), program.material()];
-    let mut w = Writer::new(program, &roots, true, "map");
+    let mut w = Writer::new(program, &roots, true, name);
     let mut main = String::new();
     w.emit(0, w.items.len(), 1, &mut main);
     let names = &w.names;
     let (d, m) = (names.get(program.distance()), names.get(program.material()));
     let mut out = std::mem::take(&mut w.functions);
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
-    out.push_str("fn map(p: vec3<f32>) -> vec2<f32> {\n");
+    let _ = writeln!(out, "fn {name}(p: vec3<f32>) -> vec2<f32> {{");
     out.push_str(&main);
     let _ = writeln!(out, "    return vec2<f32>({d}, {m});");
     out.push_str("}\n");
@@ -42,14 +47,20 @@ pub fn write_map(program: &Program) -> String {
 /// The WGSL text of `sdf`: only the instructions the distance depends on (marching and
 /// normals do not need the material).
 pub fn write_sdf(program: &Program) -> String {
+    write_sdf_named(program, "sdf")
+}
+
+/// [`write_sdf`] as the function `name`.
+pub(super) fn write_sdf_named(program: &Program, name: &'static str) -> String {
     let roots = [program.distance()];
-    let mut w = Writer::new(program, &roots, false, "sdf");
+    let mut w = Writer::new(program, &roots, false, name);
     let mut main = String::new();
     w.emit(0, w.items.len(), 1, &mut main);
     let d = w.names.get(program.distance());
     let mut out = std::mem::take(&mut w.functions);
-    out.push_str(
-        "// The distance alone, for marching and normals.\nfn sdf(p: vec3<f32>) -> f32 {\n",
+    let _ = writeln!(
+        out,
+        "// The distance alone, for marching and normals.\nfn {name}(p: vec3<f32>) -> f32 {{"
     );
     out.push_str(&main);
     let _ = writeln!(out, "    return {d};\n}}");

@@ -5,12 +5,14 @@
 //! Entry: [`write`]. The kernel's bindings (group 0): 0 the scene uniform ([`uniforms`]),
 //! 1 the tile (x0, y0, width, height as a uniform `vec4<u32>`), 2 the image (`vec4<f32>`
 //! linear colour per pixel), 3 the statistics ([`STATS_WORDS`] `u32` per pixel), and, only in
-//! the kernel of an analytically traced scene of more than [`MAX_UNROLLED`] primitives, 4 the
-//! read-only `scene_data` (`array<vec4<f32>>`, [`Kernel::data`]; layout in buffer.rs).
+//! the kernel of an analytically traced scene of more than [`MAX_UNROLLED`] primitives or of a
+//! marched scene whose root union has more than [`MAX_INSTANCES`] instances, 4 the read-only
+//! `scene_data` (`array<vec4<f32>>`, [`Kernel::data`]; layouts in buffer.rs and march.rs).
 
 mod analytic;
 mod buffer;
 mod map;
+mod march;
 mod template;
 
 pub use analytic::MAX_UNROLLED;
@@ -33,6 +35,15 @@ pub const STATS_WORDS: u32 = 8;
 
 const TEMPLATE: &str = include_str!("kernel.wgsl");
 
+/// The most instances (`lower::split`) of a marched scene's root union written as code: beyond,
+/// they are read from `scene_data` and walked in a loop. The same bound as [`MAX_UNROLLED`],
+/// for the same reason: the unrolled code grows with the scene (the CUDA JIT of a marched
+/// kernel of 1 000 lamp posts' 4 000 instances takes minutes, and its frame time grows almost
+/// linearly with the count while the instructions executed per point grow only as log n),
+/// while up to a few hundred instances the code stays within seconds to compile and every
+/// example and benchmarked scene keeps the unrolled code that the snapshots show.
+pub const MAX_INSTANCES: usize = 256;
+
 /// A generated, validated kernel.
 #[derive(Debug, Clone)]
 pub struct Kernel {
@@ -45,7 +56,8 @@ pub struct Kernel {
     /// The features the kernel was specialised for, by name.
     pub features: Vec<(&'static str, bool)>,
     /// The bytes of binding 4, `scene_data`, when the kernel declares it (the `SCENE_DATA`
-    /// feature): the primitives and hierarchy of a large analytically traced scene.
+    /// feature): the primitives and hierarchy of a large analytically traced scene, or the
+    /// instances and their hierarchy of a large marched one.
     pub data: Option<Vec<u8>>,
 }
 
@@ -131,6 +143,9 @@ pub struct Options {
     /// into the kernel; a larger scene is read from `scene_data` ([`MAX_UNROLLED`] unless a
     /// test or a measurement compares the two ways).
     pub max_unrolled: usize,
+    /// The most instances of a marched scene's root union written as code; more are read
+    /// from `scene_data` ([`MAX_INSTANCES`] unless a test compares the two ways).
+    pub max_instances: usize,
 }
 
 impl Default for Options {
@@ -138,6 +153,7 @@ impl Default for Options {
         Options {
             debug_nan: false,
             max_unrolled: MAX_UNROLLED,
+            max_instances: MAX_INSTANCES,
         }
     }
 }
@@ -158,22 +174,20 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         features.push(("DEBUG_NAN", true));
     }
     let mut values: HashMap<&str, String> = HashMap::new();
-    let mut data = None;
-    match choice.primitives() {
+    let data = match choice.primitives() {
         // An analytically traced scene needs no distance field.
         Some(primitives) => {
             let (text, bytes) = analytic::write(primitives, options.max_unrolled);
             values.insert("MAP", String::new());
             values.insert("ANALYTIC", text);
-            data = bytes;
+            bytes
         }
         None => {
-            values.insert(
-                "MAP",
-                format!("{}\n{}", write_map(program), write_sdf(program)),
-            );
+            let (text, bytes) = marched(scene, program, options.max_instances);
+            values.insert("MAP", text);
+            bytes
         }
-    }
+    };
     // Listed in the header only when on, so that the kernels without it do not change.
     on.insert("SCENE_DATA", data.is_some());
     if data.is_some() {
@@ -209,6 +223,34 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         features,
         data,
     })
+}
+
+/// `fn map` and `fn sdf` of a marched scene: the program as code, or, when its root union has
+/// more than `max_instances` instances, the rest of it as code and the instances as
+/// `scene_data` (march.rs), unless their materials or their bytes do not fit.
+fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, Option<Vec<u8>>) {
+    let split = crate::lower::split(scene, &program.options(), max_instances)
+        .filter(|s| march::fits(&s.instances))
+        .map(|s| {
+            let data = march::data(&s.instances);
+            (s, data)
+        })
+        .filter(|(_, data)| data.len() <= march::MAX_BYTES);
+    match split {
+        Some((s, data)) => {
+            let text = format!(
+                "{}\n{}\n{}",
+                map::write_map_named(&s.rest, "rest_map"),
+                map::write_sdf_named(&s.rest, "rest_sdf"),
+                march::write(&s.instances)
+            );
+            (text, Some(data))
+        }
+        None => (
+            format!("{}\n{}", write_map(program), write_sdf(program)),
+            None,
+        ),
+    }
 }
 
 /// Parses and validates WGSL with naga.

@@ -1,0 +1,394 @@
+//! The instances of a large sphere-traced scene as data: the contents of the read-only storage
+//! buffer `scene_data` (binding 4) for a marched kernel, and the loop that walks it, so that
+//! the kernel's size does not grow with the number of instances (`lower::split` says which
+//! children of the root union are instances). `map(p)` is `min(rest(p), walk(p))` with the
+//! nearer one's material (the rest's on a tie, else the earlier instance's): the field of the
+//! whole program, evaluated in another order.
+//!
+//! Layout: an array of `vec4<f32>`; integers are stored as their bits (`bitcast<u32>`).
+//!
+//! ```text
+//! [0]          (end, 0, 0, 0): the index one past the last entry
+//! [1 .. end)   the entries, in the order of a depth-first walk of the hierarchy:
+//!   group      [i]     (centre.xyz, GROUP)
+//!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries,
+//!                      where a point whose signed distance to the group's box is not below
+//!                      the best distance so far goes on
+//!   instance   [i]     (offset.xyz, kind | ROTATED | material << 4): the point in the
+//!                      shape's frame is q = rotate(p) − offset
+//!              [i + 1] the shape: sphere (r, 0, 0, 0), box (half.xyz, 0), round box
+//!                      (half.xyz − r, r), torus (R, r, 0, 0), cylinder and capsule
+//!                      (r, half height, 0, 0), cone (r, h, 2h², 1 / (r² + 4h²))
+//!              [+ 3]   only when ROTATED: the columns of the rotation's matrix M, as rows
+//!                      (q_j = Σ_i p_i·M_ij)
+//! ```
+//!
+//! The constants are those of `lower/shapes.rs`, computed in f64 and rounded to f32 as the
+//! program's are, and the walk computes in the program's order of operations, so the GPU's
+//! field equals the CPU's up to f32 rounding. Every instance is an exact distance, so its value
+//! is at least the signed distance to its box, and a group whose box is not nearer than the
+//! best distance so far cannot change the minimum: skipping it is exact. The walk needs no
+//! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes
+//! 32 bytes, a rotated one 80, a group 32.
+
+use crate::lower::Instance;
+use crate::scene::analytic::{boxed, Item};
+use crate::scene::{Node, V3};
+use std::fmt::Write;
+
+/// The kinds of entry, in the low three bits of an entry's tag.
+const SPHERE: u32 = 0;
+const BOX: u32 = 1;
+const ROUND_BOX: u32 = 2;
+const TORUS: u32 = 3;
+const CYLINDER: u32 = 4;
+const CAPSULE: u32 = 5;
+const CONE: u32 = 6;
+const GROUP: u32 = 7;
+/// The tag bit of an instance with a rotation.
+const ROTATED: u32 = 8;
+/// Materials are numbered in the tag's bits above these.
+const MATERIAL_SHIFT: u32 = 4;
+
+/// The most bytes of instance data: what wgpu's default limits let a storage buffer bind
+/// (128 MiB: over a million instances, ten times the default `objects` limit); a scene with
+/// more keeps its instances as code.
+pub const MAX_BYTES: usize = 128 << 20;
+
+/// Whether every material of `instances` fits in a tag.
+pub fn fits(instances: &[Instance]) -> bool {
+    instances
+        .iter()
+        .all(|i| i.material.map_or(0, |m| m.0) < 1 << (32 - MATERIAL_SHIFT))
+}
+
+fn kind(shape: &Node) -> u32 {
+    match shape {
+        Node::Sphere { .. } => SPHERE,
+        Node::Box { .. } => BOX,
+        Node::RoundBox { .. } => ROUND_BOX,
+        Node::Torus { .. } => TORUS,
+        Node::Cylinder { .. } => CYLINDER,
+        Node::Capsule { .. } => CAPSULE,
+        _ => CONE,
+    }
+}
+
+/// The bits of `x` as the f32 the kernel reads (as the program's constants are rounded).
+fn bits(x: f64) -> u32 {
+    (x as f32).clamp(-f32::MAX, f32::MAX).to_bits()
+}
+
+fn vec(v: V3, w: u32) -> [u32; 4] {
+    [bits(v[0]), bits(v[1]), bits(v[2]), w]
+}
+
+fn quad(v: [f64; 4]) -> [u32; 4] {
+    v.map(bits)
+}
+
+/// The contents of `scene_data` for `instances`, as little-endian bytes, their hierarchy
+/// built over their boxes.
+pub fn data(instances: &[Instance]) -> Vec<u8> {
+    let top = boxed(instances.iter().map(|i| i.aabb).enumerate().collect());
+    let mut entries = vec![[0u32; 4]];
+    push(&mut entries, instances, &top);
+    entries[0][0] = entries.len() as u32;
+    entries
+        .iter()
+        .flatten()
+        .flat_map(|w| w.to_le_bytes())
+        .collect()
+}
+
+fn push(out: &mut Vec<[u32; 4]>, instances: &[Instance], items: &[Item]) {
+    for item in items {
+        match item {
+            Item::Primitive(i) => instance(out, &instances[*i]),
+            Item::Group(g) => {
+                let at = out.len();
+                out.push(vec(g.centre, GROUP));
+                out.push(vec(g.half, 0));
+                push(out, instances, &g.items);
+                out[at + 1][3] = out.len() as u32;
+            }
+        }
+    }
+}
+
+fn instance(out: &mut Vec<[u32; 4]>, i: &Instance) {
+    let tag = kind(&i.shape)
+        | if i.rotation.is_some() { ROTATED } else { 0 }
+        | i.material.map_or(0, |m| m.0) << MATERIAL_SHIFT;
+    out.push(vec(i.offset, tag));
+    out.push(shape(&i.shape));
+    if let Some(m) = i.rotation {
+        out.extend((0..3).map(|j| vec([m[0][j], m[1][j], m[2][j]], 0)));
+    }
+}
+
+/// The shape's constants, as `shapes.rs` computes them.
+fn shape(shape: &Node) -> [u32; 4] {
+    match *shape {
+        Node::Sphere { radius } => quad([radius, 0.0, 0.0, 0.0]),
+        Node::Box { half } => vec(half, 0),
+        Node::RoundBox { half, radius } => {
+            quad([half[0] - radius, half[1] - radius, half[2] - radius, radius])
+        }
+        Node::Torus { major, minor } => quad([major, minor, 0.0, 0.0]),
+        Node::Cylinder {
+            radius,
+            half_height,
+        }
+        | Node::Capsule {
+            radius,
+            half_height,
+        } => quad([radius, half_height, 0.0, 0.0]),
+        Node::Cone {
+            radius: r,
+            half_height: h,
+        } => quad([r, h, 2.0 * h * h, 1.0 / (r * r + 4.0 * h * h)]),
+        _ => [0; 4],
+    }
+}
+
+/// `fn map` and `fn sdf` of the scene: the rest's, `rest_map` and `rest_sdf`, then the walk
+/// over `scene_data`; only the kinds of `instances` are tested for.
+pub fn write(instances: &[Instance]) -> String {
+    let rotated = instances.iter().any(|i| i.rotation.is_some());
+    let mut out = String::from(
+        "// The instances in scene_data (the layout is in compiler/src/back/wgsl/march.rs): the\n\
+         // kind of entry in a tag's low three bits, ROTATED, the material above.\n",
+    );
+    let _ = writeln!(out, "const GROUP: u32 = {GROUP}u;");
+    if rotated {
+        let _ = writeln!(out, "const ROTATED: u32 = {ROTATED}u;");
+    }
+    out.push('\n');
+    helpers(&mut out);
+    shape_distance(&mut out, instances);
+    instance_distance(&mut out, rotated);
+    walk(&mut out, true);
+    walk(&mut out, false);
+    out.push_str(
+        "// The scene's distance field: (signed distance, material id) at p, the nearer of the\n\
+         // rest of the scene and its instances.\n\
+         fn map(p: vec3<f32>) -> vec2<f32> {\n    return walk_map(p, rest_map(p));\n}\n\n\
+         // The distance alone, for marching and normals.\n\
+         fn sdf(p: vec3<f32>) -> f32 {\n    return walk_sdf(p, rest_sdf(p));\n}\n",
+    );
+    out
+}
+
+/// The lengths and the box distance, in the program's order of operations.
+fn helpers(out: &mut String) {
+    out.push_str(
+        "fn len2(a: f32, b: f32) -> f32 {\n    return sqrt(a * a + b * b);\n}\n\n\
+         fn len3(q: vec3<f32>) -> f32 {\n    return sqrt((q.x * q.x + q.y * q.y) + q.z * q.z);\n}\n\n\
+         // The signed distance of a box of half-extents h about the origin, given |q| - h.\n\
+         fn box_of(a: vec3<f32>) -> f32 {\n    \
+         return len3(max(a, vec3<f32>(0.0))) + min(max(a.x, max(a.y, a.z)), 0.0);\n}\n\n",
+    );
+}
+
+/// `fn shape_distance`: the distance of a shape of the tag's kind at q in its own frame, with
+/// a branch for each kind among `instances`.
+fn shape_distance(out: &mut String, instances: &[Instance]) {
+    let mut kinds: Vec<u32> = instances.iter().map(|i| kind(&i.shape)).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    out.push_str(
+        "// The distance at q of an instance's shape of the tag's kind in its own frame, its\n\
+         // constants s (lower/shapes.rs).\n\
+         fn shape_distance(kind: u32, q: vec3<f32>, s: vec4<f32>) -> f32 {\n",
+    );
+    for (n, k) in kinds.iter().enumerate() {
+        let body = formula(*k);
+        if n + 1 < kinds.len() {
+            let _ = writeln!(out, "    if kind == {k}u {{");
+            for line in body.lines() {
+                let _ = writeln!(out, "        {line}");
+            }
+            out.push_str("    }\n");
+        } else {
+            for line in body.lines() {
+                let _ = writeln!(out, "    {line}");
+            }
+        }
+    }
+    if kinds.is_empty() {
+        out.push_str("    return 1e30;\n");
+    }
+    out.push_str("}\n\n");
+}
+
+/// The statements of one kind's distance (ending in `return`).
+fn formula(kind: u32) -> &'static str {
+    match kind {
+        SPHERE => "return len3(q) - s.x;",
+        BOX => "return box_of(abs(q) - s.xyz);",
+        ROUND_BOX => "return box_of(abs(q) - s.xyz) - s.w;",
+        TORUS => "return len2(len2(q.x, q.z) - s.x, q.y) - s.y;",
+        CYLINDER => {
+            "let dx = len2(q.x, q.z) - s.x;\n\
+             let dy = abs(q.y) - s.y;\n\
+             return min(max(dx, dy), 0.0) + len2(max(dx, 0.0), max(dy, 0.0));"
+        }
+        CAPSULE => {
+            "let y = q.y - min(max(q.y, -s.y), s.y);\n\
+             return len3(vec3<f32>(q.x, y, q.z)) - s.x;"
+        }
+        _ => {
+            "let qx = len2(q.x, q.z);\n\
+             let cap = min(qx, select(0.0, s.x, q.y < 0.0));\n\
+             let cax = qx - cap;\n\
+             let cay = abs(q.y) - s.y;\n\
+             let t = min(max(((qx * s.x + q.y * (-2.0 * s.y)) + s.z) * s.w, 0.0), 1.0);\n\
+             let cbx = qx + t * (-s.x);\n\
+             let cby = (q.y - s.y) + t * (2.0 * s.y);\n\
+             let inside = select(1.0, -1.0, cbx < 0.0 && cay < 0.0);\n\
+             return inside * sqrt(min(cax * cax + cay * cay, cbx * cbx + cby * cby));"
+        }
+    }
+}
+
+/// `fn instance_distance`: the field of the instance whose entry starts at `i` with `head`,
+/// and `fn instance_size`, its number of vectors.
+fn instance_distance(out: &mut String, rotated: bool) {
+    let _ = write!(
+        out,
+        "// The distance at p of the instance whose entry starts at scene_data[i] with head.\n\
+         fn instance_distance(i: u32, head: vec4<f32>, p: vec3<f32>) -> f32 {{\n\
+         \x20   let tag = bitcast<u32>(head.w);\n\
+         \x20   {} q = p - head.xyz;\n",
+        if rotated { "var" } else { "let" }
+    );
+    if rotated {
+        out.push_str(
+            "    if (tag & ROTATED) != 0u {\n\
+             \x20       let c0 = scene_data[i + 2u].xyz;\n\
+             \x20       let c1 = scene_data[i + 3u].xyz;\n\
+             \x20       let c2 = scene_data[i + 4u].xyz;\n\
+             \x20       let r = vec3<f32>(\n\
+             \x20           (p.x * c0.x + p.y * c0.y) + p.z * c0.z,\n\
+             \x20           (p.x * c1.x + p.y * c1.y) + p.z * c1.z,\n\
+             \x20           (p.x * c2.x + p.y * c2.y) + p.z * c2.z,\n\
+             \x20       );\n\
+             \x20       q = r - head.xyz;\n\
+             \x20   }\n",
+        );
+    }
+    let shape = "shape_distance(tag & 7u, q, scene_data[i + 1u])";
+    let _ = writeln!(out, "    return {shape};\n}}\n");
+    out.push_str("// The number of vectors of the instance whose tag this is.\n");
+    out.push_str("fn instance_size(tag: u32) -> u32 {\n    return 2u");
+    if rotated {
+        out.push_str(" + select(0u, 3u, (tag & ROTATED) != 0u)");
+    }
+    out.push_str(";\n}\n\n");
+}
+
+/// `fn walk_map` (`material`) or `fn walk_sdf`: the minimum of `start` and the instances,
+/// past each group whose box is not nearer than the best distance so far.
+fn walk(out: &mut String, material: bool) {
+    let (name, ty, d) = if material {
+        ("walk_map", "vec2<f32>", "best.x")
+    } else {
+        ("walk_sdf", "f32", "best")
+    };
+    let _ = writeln!(
+        out,
+        "// The nearer of start and the instances at p{}.\n\
+         fn {name}(p: vec3<f32>, start: {ty}) -> {ty} {{",
+        if material {
+            ", with its material (start's on a tie,\n// else the earlier instance's)"
+        } else {
+            ""
+        }
+    );
+    out.push_str(
+        "    var best = start;\n\
+         \x20   let end = bitcast<u32>(scene_data[0u].x);\n\
+         \x20   var i = 1u;\n\
+         \x20   while i < end {\n\
+         \x20       let head = scene_data[i];\n\
+         \x20       let tag = bitcast<u32>(head.w);\n\
+         \x20       if tag == GROUP {\n\
+         \x20           let size = scene_data[i + 1u];\n",
+    );
+    let _ = writeln!(
+        out,
+        "            let near = box_of(abs(p - head.xyz) - size.xyz) < {d};"
+    );
+    out.push_str(
+        "            i = select(bitcast<u32>(size.w), i + 2u, near);\n\
+         \x20           continue;\n\
+         \x20       }\n\
+         \x20       let d = instance_distance(i, head, p);\n",
+    );
+    if material {
+        let _ = writeln!(
+            out,
+            "        if d < best.x {{\n            best = vec2<f32>(d, f32(tag >> {MATERIAL_SHIFT}u));\n        }}"
+        );
+    } else {
+        out.push_str("        best = min(best, d);\n");
+    }
+    out.push_str("        i += instance_size(tag);\n    }\n    return best;\n}\n\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::MaterialId;
+
+    fn sphere(x: f64, k: usize) -> Instance {
+        let quarter = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        Instance {
+            shape: Node::Sphere { radius: 0.5 },
+            offset: [x, 0.0, 0.0],
+            rotation: (k % 3 == 1).then_some(quarter),
+            material: (k % 2 == 0).then_some(MaterialId(k as u32)),
+            aabb: ([x - 0.5, -0.5, -0.5], [x + 0.5, 0.5, 0.5]),
+        }
+    }
+
+    /// Every instance is written once with its flags and material, every group's `next` lies
+    /// past its own entries and within the data, and stepping by each entry's size (as
+    /// `instance_size` does) ends exactly at `end`.
+    #[test]
+    fn entries_cover_every_instance_and_groups_skip_forward() {
+        let instances: Vec<Instance> = (0..41).map(|k| sphere(k as f64 * 1.5, k)).collect();
+        let bytes = data(&instances);
+        let w: Vec<u32> = bytes
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        let e: Vec<&[u32]> = w.chunks_exact(4).collect();
+        let end = e[0][0] as usize;
+        assert_eq!(end, e.len());
+        let (mut i, mut seen, mut groups) = (1, Vec::new(), 0);
+        while i < end {
+            let tag = e[i][3];
+            if tag == GROUP {
+                let next = e[i + 1][3] as usize;
+                assert!(next > i + 2 && next <= end, "group at {i}: next {next}");
+                groups += 1;
+                i += 2;
+                continue;
+            }
+            let x = f32::from_bits(e[i][0]);
+            let k = (x / 1.5).round() as usize;
+            assert_eq!(tag & 7, SPHERE);
+            assert_eq!(tag & ROTATED != 0, k % 3 == 1, "instance {k}");
+            let material = if k % 2 == 0 { k as u32 } else { 0 };
+            assert_eq!(tag >> MATERIAL_SHIFT, material);
+            seen.push(k);
+            i += 2 + 3 * usize::from(tag & ROTATED != 0);
+        }
+        assert_eq!(i, end);
+        assert!(groups >= 9, "{groups} groups");
+        seen.sort_unstable();
+        assert_eq!(seen, (0..41).collect::<Vec<_>>());
+    }
+}

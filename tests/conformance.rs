@@ -196,11 +196,16 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let (scene, diags, _) = sdfc_compiler::check::check_str("marched.sdf", &text);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let program = lower::lower(&scene);
-    let split = lower::split(&scene, &program.options(), wgsl::MAX_INSTANCES).expect("split");
+    // Below the default threshold: the walk is asked for.
+    let walk = wgsl::Options {
+        max_instances: 256,
+        ..wgsl::Options::default()
+    };
+    let split = lower::split(&scene, &program.options(), walk.max_instances).expect("split");
     // Of 360 children, the 40 ellipsoids stay, with the plane and the twisted box.
     assert_eq!(split.instances.len(), 320);
     assert!(split.instances.iter().any(|i| i.material.is_none()));
-    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let kernel = wgsl::write_with(&scene, &program, &walk).expect("valid kernel");
     assert!(kernel.features.contains(&("SCENE_DATA", true)));
     assert!(kernel.source.contains("fn rest_map") && kernel.source.contains("const ROTATED"));
     let Some(gpu) = open_gpu() else { return };
@@ -230,7 +235,7 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let path = PathBuf::from("../examples/scaling/compound_100.sdf");
     let scene = load_small(&path, 96, 64);
     let program = lower::lower(&scene);
-    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let kernel = wgsl::write_with(&scene, &program, &walk).expect("valid kernel");
     assert!(kernel.data.is_some() && !kernel.source.contains("fn map_block"));
     assert_agree(&gpu, &scene, &program, &kernel, "compound_100");
 }

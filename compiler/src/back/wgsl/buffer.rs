@@ -56,40 +56,52 @@ fn kind(s: &Shape) -> u32 {
 }
 
 /// The bits of `x` as the f32 the kernel reads (as the literals of the unrolled code are).
-fn bits(x: f64) -> u32 {
+pub(super) fn bits(x: f64) -> u32 {
     (x as f32).clamp(-f32::MAX, f32::MAX).to_bits()
 }
 
-fn vec(v: V3, w: u32) -> [u32; 4] {
+pub(super) fn vec(v: V3, w: u32) -> [u32; 4] {
     [bits(v[0]), bits(v[1]), bits(v[2]), w]
 }
 
 /// The contents of `scene_data` for `primitives` and their hierarchy `top`, as little-endian
 /// bytes.
 pub fn data(primitives: &[Primitive], top: &[Item]) -> Vec<u8> {
-    let mut entries = vec![[0u32; 4]];
-    push(&mut entries, primitives, top);
-    entries[0][0] = entries.len() as u32;
-    entries
-        .iter()
-        .flatten()
-        .flat_map(|w| w.to_le_bytes())
-        .collect()
+    entries(top, GROUP, &mut |out, i| primitive(out, &primitives[i]))
 }
 
-fn push(out: &mut Vec<[u32; 4]>, primitives: &[Primitive], items: &[Item]) {
-    for item in items {
-        match item {
-            Item::Primitive(i) => primitive(out, &primitives[*i]),
-            Item::Group(g) => {
-                let at = out.len();
-                out.push(vec(g.centre, GROUP));
-                out.push(vec(g.half, 0));
-                push(out, primitives, &g.items);
-                out[at + 1][3] = out.len() as u32;
+/// The bytes of a `scene_data` buffer for a hierarchy `items`: `[0]` holds the index one past
+/// the last entry, then the entries of a depth-first walk, a group as `(centre, group)` and
+/// `(half-extents, next)`, a leaf as `leaf` writes it (the layout above; the marched kernel's
+/// `march.rs` shares it with other leaves).
+pub(super) fn entries(
+    items: &[Item],
+    group: u32,
+    leaf: &mut dyn FnMut(&mut Vec<[u32; 4]>, usize),
+) -> Vec<u8> {
+    fn push(
+        out: &mut Vec<[u32; 4]>,
+        items: &[Item],
+        group: u32,
+        leaf: &mut dyn FnMut(&mut Vec<[u32; 4]>, usize),
+    ) {
+        for item in items {
+            match item {
+                Item::Primitive(i) => leaf(out, *i),
+                Item::Group(g) => {
+                    let at = out.len();
+                    out.push(vec(g.centre, group));
+                    out.push(vec(g.half, 0));
+                    push(out, &g.items, group, leaf);
+                    out[at + 1][3] = out.len() as u32;
+                }
             }
         }
     }
+    let mut out = vec![[0u32; 4]];
+    push(&mut out, items, group, leaf);
+    out[0][0] = out.len() as u32;
+    out.iter().flatten().flat_map(|w| w.to_le_bytes()).collect()
 }
 
 fn primitive(out: &mut Vec<[u32; 4]>, p: &Primitive) {

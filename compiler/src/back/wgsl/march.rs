@@ -31,9 +31,10 @@
 //! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes
 //! 32 bytes, a rotated one 80, a group 32.
 
+use super::buffer::{bits, entries, vec};
 use crate::lower::Instance;
-use crate::scene::analytic::{boxed, Item};
-use crate::scene::{Node, V3};
+use crate::scene::analytic::boxed;
+use crate::scene::Node;
 use std::fmt::Write;
 
 /// The kinds of entry, in the low three bits of an entry's tag.
@@ -74,15 +75,6 @@ fn kind(shape: &Node) -> u32 {
     }
 }
 
-/// The bits of `x` as the f32 the kernel reads (as the program's constants are rounded).
-fn bits(x: f64) -> u32 {
-    (x as f32).clamp(-f32::MAX, f32::MAX).to_bits()
-}
-
-fn vec(v: V3, w: u32) -> [u32; 4] {
-    [bits(v[0]), bits(v[1]), bits(v[2]), w]
-}
-
 fn quad(v: [f64; 4]) -> [u32; 4] {
     v.map(bits)
 }
@@ -91,29 +83,7 @@ fn quad(v: [f64; 4]) -> [u32; 4] {
 /// built over their boxes.
 pub fn data(instances: &[Instance]) -> Vec<u8> {
     let top = boxed(instances.iter().map(|i| i.aabb).enumerate().collect());
-    let mut entries = vec![[0u32; 4]];
-    push(&mut entries, instances, &top);
-    entries[0][0] = entries.len() as u32;
-    entries
-        .iter()
-        .flatten()
-        .flat_map(|w| w.to_le_bytes())
-        .collect()
-}
-
-fn push(out: &mut Vec<[u32; 4]>, instances: &[Instance], items: &[Item]) {
-    for item in items {
-        match item {
-            Item::Primitive(i) => instance(out, &instances[*i]),
-            Item::Group(g) => {
-                let at = out.len();
-                out.push(vec(g.centre, GROUP));
-                out.push(vec(g.half, 0));
-                push(out, instances, &g.items);
-                out[at + 1][3] = out.len() as u32;
-            }
-        }
-    }
+    entries(&top, GROUP, &mut |out, i| instance(out, &instances[i]))
 }
 
 fn instance(out: &mut Vec<[u32; 4]>, i: &Instance) {

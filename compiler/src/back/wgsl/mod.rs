@@ -235,7 +235,7 @@ fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, O
     let split = crate::lower::split(scene, &program.options(), max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {
-            let data = march::data(&s.instances);
+            let data = march::data(&s.instances, scene.camera.position);
             (s, data)
         })
         .filter(|(_, data)| data.len() <= march::MAX_BYTES);

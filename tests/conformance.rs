@@ -38,6 +38,12 @@ fn open_gpu() -> Option<gpu::Gpu> {
     }
 }
 
+/// A scene checked from source text; its diagnostics on failure.
+fn checked(name: &str, text: &str) -> Scene {
+    let (scene, diags, _) = sdfc_compiler::check::check_str(name, text);
+    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
+}
+
 /// A scene file loaded and made small: `width`×`height`, one sample per pixel.
 fn load_small(path: &Path, width: u32, height: u32) -> Scene {
     let mut scene = frontend::load(path)
@@ -193,8 +199,7 @@ fn marched_scene(n: usize) -> String {
 #[test]
 fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let text = marched_scene(360);
-    let (scene, diags, _) = sdfc_compiler::check::check_str("marched.sdf", &text);
-    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let scene = checked("marched.sdf", &text);
     let program = lower::lower(&scene);
     // Below the default threshold: the walk is asked for.
     let walk = wgsl::Options {
@@ -250,8 +255,7 @@ fn shadows_through_glass_match_without_secondary_rays() {
                 light point { position: (0, 6, 0), intensity: 1, radius: 50 }\n\
                 render { width: 64, height: 48, max_depth: 0, method: \"march\" }\n\
                 scene { plane(); sphere(0.8).translate(0, 1.2, 0) @ glass; }";
-    let (scene, diags, _) = sdfc_compiler::check::check_str("glass.sdf", text);
-    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let scene = checked("glass.sdf", text);
     let program = lower::lower(&scene);
     let kernel = wgsl::write(&scene, &program).expect("valid kernel");
     assert!(kernel.features.contains(&("TRANSPARENT", true)));
@@ -356,8 +360,7 @@ fn mixed_scene(n: usize) -> String {
 #[test]
 fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
     let text = mixed_scene(300);
-    let (scene, diags, _) = sdfc_compiler::check::check_str("mixed.sdf", &text);
-    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let scene = checked("mixed.sdf", &text);
     let traced = sdfc_compiler::scene::analytic::choose(&scene);
     assert_eq!(traced.primitives().map(<[_]>::len), Some(302), "{traced:?}");
     let program = lower::lower(&scene);
@@ -381,8 +384,7 @@ fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
 #[test]
 fn the_buffer_walk_renders_what_the_unrolled_code_renders() {
     let text = mixed_scene(40);
-    let (scene, diags, _) = sdfc_compiler::check::check_str("mixed.sdf", &text);
-    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let scene = checked("mixed.sdf", &text);
     let program = lower::lower(&scene);
     let unrolled = wgsl::write(&scene, &program).expect("valid kernel");
     let options = wgsl::Options {

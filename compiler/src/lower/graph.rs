@@ -104,15 +104,14 @@ impl<'a> Lowerer<'a> {
             Some(a) if self.zero_set => a.node(id).step(),
             _ => 1.0,
         };
-        let f = match () {
-            _ if divide > 1.0 && !self.spine(id) => self.local_bound(id, divide, p),
-            _ => {
-                let zero_set = self.zero_set;
-                self.zero_set = zero_set && keeps_zero_set(self.graph.node(id));
-                let f = self.lower_node(id, p);
-                self.zero_set = zero_set;
-                f
-            }
+        let f = if divide > 1.0 && !self.spine(id) {
+            self.local_bound(id, divide, p)
+        } else {
+            let zero_set = self.zero_set;
+            self.zero_set = zero_set && keeps_zero_set(self.graph.node(id));
+            let f = self.lower_node(id, p);
+            self.zero_set = zero_set;
+            f
         };
         self.memo.insert(key, f);
         f

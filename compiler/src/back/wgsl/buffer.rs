@@ -36,13 +36,17 @@ const GROUP: u32 = 5;
 /// The tag bit of a primitive with a world-to-local matrix other than the identity.
 const FRAMED: u32 = 8;
 /// Materials are numbered in the tag's bits above these.
-const MATERIAL_SHIFT: u32 = 4;
+pub(super) const MATERIAL_SHIFT: u32 = 4;
 
 /// Whether every material of `primitives` fits in a tag.
 pub fn fits(primitives: &[Primitive]) -> bool {
-    primitives
-        .iter()
-        .all(|p| p.material.0 < 1 << (32 - MATERIAL_SHIFT))
+    primitives.iter().all(|p| tag_holds(p.material.0))
+}
+
+/// Whether a material id fits in a tag's bits above [`MATERIAL_SHIFT`] (shared with the
+/// marched kernel's entries, `march.rs`).
+pub(super) fn tag_holds(material: u32) -> bool {
+    material < 1 << (32 - MATERIAL_SHIFT)
 }
 
 fn kind(s: &Shape) -> u32 {

@@ -31,7 +31,7 @@
 //! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes
 //! 32 bytes, a rotated one 80, a group 32.
 
-use super::buffer::{bits, entries, vec};
+use super::buffer::{bits, entries, tag_holds, vec, MATERIAL_SHIFT};
 use crate::lower::Instance;
 use crate::scene::analytic::{boxed, Item};
 use crate::scene::{Node, V3};
@@ -48,8 +48,6 @@ const CONE: u32 = 6;
 const GROUP: u32 = 7;
 /// The tag bit of an instance with a rotation.
 const ROTATED: u32 = 8;
-/// Materials are numbered in the tag's bits above these.
-const MATERIAL_SHIFT: u32 = 4;
 
 /// The most bytes of instance data: what wgpu's default limits let a storage buffer bind
 /// (128 MiB: over a million instances, ten times the default `objects` limit); a scene with
@@ -60,7 +58,7 @@ pub const MAX_BYTES: usize = 128 << 20;
 pub fn fits(instances: &[Instance]) -> bool {
     instances
         .iter()
-        .all(|i| i.material.map_or(0, |m| m.0) < 1 << (32 - MATERIAL_SHIFT))
+        .all(|i| tag_holds(i.material.map_or(0, |m| m.0)))
 }
 
 fn kind(shape: &Node) -> u32 {

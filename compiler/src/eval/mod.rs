@@ -127,7 +127,31 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// Evaluates the distance at every point `(x[i], y[i], z[i])` into `d[i]`, and the
     /// material id into `m[i]` when asked for (and when the tape computes materials; 0
     /// otherwise). All slices must have the same length; extra elements are ignored.
-    pub fn eval(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], mut m: Option<&mut [u32]>) {
+    pub fn eval(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], m: Option<&mut [u32]>) {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2, as just checked.
+            #[allow(unsafe_code)]
+            return unsafe { self.eval_avx2(x, y, z, d, m) };
+        }
+        self.eval_any(x, y, z, d, m)
+    }
+
+    /// [`Evaluator::eval`] compiled for AVX2: the instruction loops are inlined here, so they
+    /// run eight f32 (four f64) points per vector operation instead of four (two). The same
+    /// IEEE operations in the same order: the results are bit for bit those of the baseline.
+    ///
+    /// # Safety
+    /// The processor must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)] // Only to be called where AVX2 was detected.
+    unsafe fn eval_avx2(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], m: Option<&mut [u32]>) {
+        self.eval_any(x, y, z, d, m)
+    }
+
+    #[inline(always)]
+    fn eval_any(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], mut m: Option<&mut [u32]>) {
         let n = x.len().min(y.len()).min(z.len()).min(d.len());
         let mut start = 0;
         while start < n {
@@ -168,6 +192,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
     }
 
     /// One pass over the tape for up to `chunk` points.
+    #[inline(always)]
     fn run(&mut self, x: &[T], y: &[T], z: &[T]) {
         let mut n = x.len();
         let chunk = self.chunk;
@@ -208,20 +233,24 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// Starts a guarded block over `n` points: `None` when it runs nowhere (its results then
     /// hold their values from before), else the number of points it runs on, whose values
     /// from outside are gathered.
+    #[inline(always)]
     fn enter(&mut self, guard: &Guard, depth: usize, n: usize) -> Option<usize> {
         let c = self.chunk;
         let (mut idx, _) = std::mem::take(&mut self.frames[depth]);
         idx.clear();
+        idx.resize(n, 0);
+        let mut m = 0;
         {
+            // Branch-free compaction: every index is written, the count advances where the
+            // block runs (whether it does varies from point to point).
             let bound = &self.slots[guard.bound as usize * c..][..n];
             let best = &self.slots[guard.best as usize * c..][..n];
             for (i, (b, d)) in bound.iter().zip(best).enumerate() {
-                if !(*b >= *d) {
-                    idx.push(i as u32);
-                }
+                idx[m] = i as u32;
+                m += usize::from(!(*b >= *d));
             }
         }
-        let m = idx.len();
+        idx.truncate(m);
         if m == 0 {
             for &(dst, _, other) in &guard.phis {
                 self.copy(other, dst, n);
@@ -244,6 +273,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
 
     /// Ends a guarded block that ran on `m` points: scatters its results into the enclosing
     /// block's packing, whose number of points it returns.
+    #[inline(always)]
     fn leave(&mut self, guard: &Guard, depth: usize, m: usize) -> usize {
         let c = self.chunk;
         let (idx, n) = std::mem::take(&mut self.frames[depth]);

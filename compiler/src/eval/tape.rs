@@ -522,7 +522,7 @@ impl Compiler<'_> {
 impl Inst {
     /// Runs this step on the first `n` points of `slots` (slots of `chunk` values, back to
     /// back). The destination is split off the buffer; operands are read from both sides.
-    #[inline]
+    #[inline(always)]
     pub(super) fn apply<T: Float>(&self, slots: &mut [T], chunk: usize, n: usize) {
         let dst = self.dst as usize;
         let (lo, rest) = slots.split_at_mut(dst * chunk);
@@ -567,6 +567,7 @@ fn map2<T: Float>(d: &mut [T], a: &[T], b: &[T], f: impl Fn(T, T) -> T) {
 }
 
 /// One loop per operation, each specialised by `scalar::unary` with a constant operation.
+#[inline(always)]
 fn unary_loop<T: Float>(u: Unary, d: &mut [T], a: &[T]) {
     macro_rules! arms {
         ($($v:ident),*) => {
@@ -579,6 +580,7 @@ fn unary_loop<T: Float>(u: Unary, d: &mut [T], a: &[T]) {
 }
 
 /// One loop per operation, each specialised by `scalar::binary` with a constant operation.
+#[inline(always)]
 fn binary_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], y: &[T]) {
     macro_rules! arms {
         ($($v:ident),*) => {
@@ -591,6 +593,7 @@ fn binary_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], y: &[T]) {
 }
 
 /// `op(x, k)` for an immediate `k`.
+#[inline(always)]
 fn binary_k_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], k: T) {
     macro_rules! arms {
         ($($v:ident),*) => {
@@ -603,6 +606,7 @@ fn binary_k_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], k: T) {
 }
 
 /// `op(k, y)` for an immediate `k`.
+#[inline(always)]
 fn k_binary_loop<T: Float>(b: Binary, d: &mut [T], k: T, y: &[T]) {
     macro_rules! arms {
         ($($v:ident),*) => {

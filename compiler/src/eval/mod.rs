@@ -12,9 +12,11 @@
 pub mod float;
 pub mod scalar;
 mod tape;
+mod wide;
 
 pub use float::Float;
 pub use tape::{Outputs, Tape};
+pub use wide::wide;
 
 use tape::{Guard, Step};
 
@@ -128,26 +130,10 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// material id into `m[i]` when asked for (and when the tape computes materials; 0
     /// otherwise). All slices must have the same length; extra elements are ignored.
     pub fn eval(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], m: Option<&mut [u32]>) {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2, as just checked.
-            #[allow(unsafe_code)]
-            return unsafe { self.eval_avx2(x, y, z, d, m) };
-        }
-        self.eval_any(x, y, z, d, m)
-    }
-
-    /// [`Evaluator::eval`] compiled for AVX2: the instruction loops are inlined here, so they
-    /// run eight f32 (four f64) points per vector operation instead of four (two). The same
-    /// IEEE operations in the same order: the results are bit for bit those of the baseline.
-    ///
-    /// # Safety
-    /// The processor must support AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[allow(unsafe_code)] // Only to be called where AVX2 was detected.
-    unsafe fn eval_avx2(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], m: Option<&mut [u32]>) {
-        self.eval_any(x, y, z, d, m)
+        wide(
+            #[inline(always)]
+            || self.eval_any(x, y, z, d, m),
+        )
     }
 
     #[inline(always)]

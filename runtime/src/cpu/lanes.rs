@@ -6,7 +6,7 @@
 //! queue runs dry. A ray's result depends only on its own lane, never on its position, so
 //! the output is the same whatever the order.
 
-use sdfc_compiler::eval::{Evaluator, Float};
+use sdfc_compiler::eval::{wide, Evaluator, Float};
 
 /// The state of one ray entering a march.
 #[derive(Debug, Clone, Copy)]
@@ -52,6 +52,7 @@ macro_rules! lanes {
             }
 
             /// Moves lane `from` into lane `to`.
+            #[inline(always)]
             fn move_lane(&mut self, from: usize, to: usize) {
                 $(self.$f[to] = self.$f[from];)*
             }
@@ -79,6 +80,7 @@ impl<T: Float> Lanes<T> {
     }
 
     /// Starts a ray in the next free lane (the caller checks there is one).
+    #[inline(always)]
     pub fn push(&mut self, l: &Launch<T>) {
         let k = self.len;
         self.len += 1;
@@ -99,6 +101,7 @@ impl<T: Float> Lanes<T> {
     }
 
     /// p = o + t·d for every lane.
+    #[inline(always)]
     pub fn points(&mut self) {
         let n = self.len;
         for (axis, (o, d)) in [
@@ -126,6 +129,7 @@ impl<T: Float> Lanes<T> {
     }
 
     /// Evaluates the field (and the materials, with `full`) at the lanes' points.
+    #[inline(always)]
     pub fn evaluate(&mut self, dist: &mut Evaluator<'_, T>, full: Option<&mut Evaluator<'_, T>>) {
         let n = self.len;
         match full {
@@ -148,6 +152,7 @@ impl<T: Float> Lanes<T> {
 
     /// Removes the lanes listed in `finished`, from the last one down, each replaced by the
     /// current last lane.
+    #[inline(always)]
     pub fn remove_finished(&mut self) {
         while let Some(k) = self.finished.pop() {
             let last = self.len - 1;
@@ -170,8 +175,23 @@ pub(super) trait Rule<T: Float> {
     }
 }
 
-/// Marches every ray of `queue` to completion under `rule`.
+/// Marches every ray of `queue` to completion under `rule`, with the lane loops compiled for
+/// the widest vector unit the processor has ([`wide`]).
 pub(super) fn march<T: Float, R: Rule<T>>(
+    lanes: &mut Lanes<T>,
+    dist: &mut Evaluator<'_, T>,
+    full: &mut Evaluator<'_, T>,
+    queue: &[Launch<T>],
+    rule: &mut R,
+) {
+    wide(
+        #[inline(always)]
+        || march_lanes(lanes, dist, full, queue, rule),
+    )
+}
+
+#[inline(always)]
+fn march_lanes<T: Float, R: Rule<T>>(
     lanes: &mut Lanes<T>,
     dist: &mut Evaluator<'_, T>,
     full: &mut Evaluator<'_, T>,

@@ -55,6 +55,7 @@ fn bit(b: bool, flag: u32) -> u32 {
 
 impl<T: Float> Rule<T> for Trace<'_, T> {
     /// One branch-free pass over the lanes, then a scan of the flags for finished rays.
+    #[inline(always)]
     fn advance(&mut self, l: &mut Lanes<T>) {
         let n = l.len;
         let c = self.ctx;
@@ -164,6 +165,7 @@ impl<T: Float> Shadow<'_, T> {
     }
 
     /// Opaque scenes: one branch-free pass, then a scan for finished rays.
+    #[inline(always)]
     fn advance_opaque(&mut self, l: &mut Lanes<T>) {
         let n = l.len;
         let c = self.ctx;
@@ -261,6 +263,7 @@ impl<T: Float> Rule<T> for Shadow<'_, T> {
         self.ctx.transparent
     }
 
+    #[inline(always)]
     fn advance(&mut self, l: &mut Lanes<T>) {
         if self.ctx.transparent {
             for k in 0..l.len {

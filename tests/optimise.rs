@@ -2,7 +2,7 @@
 //! for bit on the CPU), the passes keep the distance field (to rounding) at random points,
 //! the batch interpreter runs guarded blocks exactly as the reference path, and instruction
 //! counts drop. `cargo test --release --test optimise -- --ignored --nocapture` prints the
-//! tables of BENCHMARKS.md ("Optimisation and culling").
+//! tables of BENCHMARKS.md ("Distance program size, passes off and on").
 
 mod common;
 

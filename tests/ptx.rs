@@ -731,10 +731,15 @@ fn example_scenes_assemble() {
             &format!("scene_{name}.uniforms"),
             &sdfc_compiler::back::wgsl::uniforms(&scene, 1.0),
         );
-        let start = Instant::now();
-        let text = ptx::write(&kernel.module, &kernel.info, &options(80))
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let took = start.elapsed();
+        // The best of three translations: a shared machine's noise only adds time.
+        let mut took = std::time::Duration::MAX;
+        let mut text = String::new();
+        for _ in 0..3 {
+            let start = Instant::now();
+            text = ptx::write(&kernel.module, &kernel.info, &options(80))
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            took = took.min(start.elapsed());
+        }
         let exprs: usize = kernel
             .module
             .functions
@@ -742,7 +747,7 @@ fn example_scenes_assemble() {
             .map(|(_, f)| f.expressions.len())
             .sum();
         println!(
-            "{name}: {exprs} naga expressions, {} lines of PTX in {took:.2?}",
+            "{name}: {exprs} naga expressions, {} lines of PTX in {took:.2?} (best of 3)",
             text.lines().count()
         );
         if let Some(p) = &ptxas {

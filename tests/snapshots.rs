@@ -1,6 +1,7 @@
 //! Snapshot tests of every textual output: the AST, IR, distance program and WGSL kernel of
-//! every example and `tests/in/ok` file, and the rendered diagnostics of every `tests/in/err`
-//! file. Every WGSL kernel is also validated by naga (inside `back::wgsl::write`).
+//! every example and `tests/in/ok` file, the PTX of every example (for the default target,
+//! sm_70), and the rendered diagnostics of every `tests/in/err` file. Every WGSL kernel is
+//! also validated by naga (inside `back::wgsl::write`).
 
 use sdfc_compiler::{back, diagnostics, lower, scene, syntax, FileId};
 use sdfc_runtime::frontend;
@@ -34,7 +35,8 @@ fn snapshot(folder: &str, name: &str, text: &str) {
     });
 }
 
-fn check_valid(dir: &str, prefix: &str) {
+/// Snapshots every file of `dir`; with `ptx`, its PTX kernel too.
+fn check_valid(dir: &str, prefix: &str, ptx: bool) {
     let files = sdf_files(dir);
     assert!(!files.is_empty(), "no .sdf files in {dir}");
     for path in files {
@@ -53,17 +55,23 @@ fn check_valid(dir: &str, prefix: &str) {
         let kernel = back::wgsl::write(&scene, &program)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         snapshot("wgsl", &name, &kernel.source);
+        if ptx {
+            let options = back::ptx::Options::default();
+            let text = back::ptx::write(&kernel.module, &kernel.info, &options)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            snapshot("ptx", &name, &text);
+        }
     }
 }
 
 #[test]
 fn examples() {
-    check_valid("examples", "");
+    check_valid("examples", "", true);
 }
 
 #[test]
 fn ok_inputs() {
-    check_valid("tests/in/ok", "ok_");
+    check_valid("tests/in/ok", "ok_", false);
 }
 
 #[test]

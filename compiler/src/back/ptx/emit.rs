@@ -45,8 +45,36 @@ pub(super) struct Reg {
 
 impl fmt::Display for Reg {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "{}{}", CLASSES[self.class.index()].2, self.n)
+        // Written by hand, not with `write!`: a kernel has tens of thousands of operands, and
+        // the formatting machinery was most of the translator's time.
+        f.write_str(CLASSES[self.class.index()].2)?;
+        f.write_str(decimal(&mut [0; 10], self.n))
     }
+}
+
+/// `n` in decimal, written into the end of `buf`.
+fn decimal(buf: &mut [u8; 10], mut n: u32) -> &str {
+    let mut i = buf.len();
+    loop {
+        i -= 1;
+        buf[i] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    std::str::from_utf8(&buf[i..]).unwrap_or("0")
+}
+
+/// `0fXXXXXXXX`: the bits of an `f32` in PTX's exact hexadecimal notation.
+fn f32_bits(buf: &mut [u8; 10], bits: u32) -> &str {
+    const HEX: &[u8; 16] = b"0123456789ABCDEF";
+    buf[0] = b'0';
+    buf[1] = b'f';
+    for k in 0..8 {
+        buf[2 + k] = HEX[((bits >> (28 - 4 * k)) & 0xF) as usize];
+    }
+    std::str::from_utf8(&buf[..]).unwrap_or("0f00000000")
 }
 
 /// A scalar operand: a register or an immediate (immediates need no instruction, so
@@ -71,7 +99,7 @@ impl fmt::Display for Op {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         match *self {
             Op::Reg(r) => r.fmt(f),
-            Op::F32(bits) => write!(f, "0f{bits:08X}"),
+            Op::F32(bits) => f.write_str(f32_bits(&mut [0; 10], bits)),
             Op::I32(i) => write!(f, "{i}"),
             Op::U32(u) => write!(f, "{u}"),
             Op::Bool(b) => write!(f, "{}", u8::from(b)),

@@ -124,12 +124,12 @@ impl Fw<'_, '_> {
             }
             (M::Abs, Sc::U32) => x,
             (M::Min | M::Max, _) => {
-                let op = format!("{}.{}", if fun == M::Min { "min" } else { "max" }, sc.ptx());
-                self.bin(&op, sc.class(), x, arg(1)?)
+                let op = if fun == M::Min { "min" } else { "max" };
+                self.bin_typed(op, sc.ptx(), sc.class(), x, arg(1)?)
             }
             (M::Clamp, _) => {
-                let lo = self.bin(&format!("max.{}", sc.ptx()), sc.class(), x, arg(1)?);
-                self.bin(&format!("min.{}", sc.ptx()), sc.class(), lo, arg(2)?)
+                let lo = self.bin_typed("max", sc.ptx(), sc.class(), x, arg(1)?);
+                self.bin_typed("min", sc.ptx(), sc.class(), lo, arg(2)?)
             }
             (M::Saturate, Sc::F32) => {
                 let lo = self.bin("max.f32", Class::F32, x, Op::f32(0.0));

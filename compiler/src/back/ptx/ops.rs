@@ -92,14 +92,14 @@ impl Fw<'_, '_> {
     pub fn bin_leaf(&mut self, op: B, sc: Sc, a: Op, b: Op) -> Result<Op, Error> {
         let t = sc.ptx();
         let class = sc.class();
-        let cmp = |s: &mut Self, c: &str| s.setp(&format!("{c}.{t}"), a, b);
+        let cmp = |s: &mut Self, c: &str| s.setp_typed(c, t, a, b);
         Ok(match (op, sc) {
             (B::Add, Sc::F32) => self.bin(ADD, class, a, b),
             (B::Subtract, Sc::F32) => self.bin(SUB, class, a, b),
-            (B::Add, Sc::I32 | Sc::U32) => self.bin(&format!("add.{t}"), class, a, b),
-            (B::Subtract, Sc::I32 | Sc::U32) => self.bin(&format!("sub.{t}"), class, a, b),
+            (B::Add, Sc::I32 | Sc::U32) => self.bin_typed("add", t, class, a, b),
+            (B::Subtract, Sc::I32 | Sc::U32) => self.bin_typed("sub", t, class, a, b),
             (B::Multiply, Sc::F32) => self.bin(MUL, class, a, b),
-            (B::Multiply, Sc::I32 | Sc::U32) => self.bin(&format!("mul.lo.{t}"), class, a, b),
+            (B::Multiply, Sc::I32 | Sc::U32) => self.bin_typed("mul.lo", t, class, a, b),
             (B::Divide, Sc::F32) => self.bin(DIV, class, a, b),
             (B::Divide, Sc::I32 | Sc::U32) => self.int_div("div", sc, a, b),
             (B::Modulo, Sc::F32) => self.fmod(a, b),

@@ -259,6 +259,13 @@ impl<'c, 'a> Fw<'c, 'a> {
         Op::Reg(d)
     }
 
+    /// `d = op.ty a, b` into a fresh register of `class` (e.g. `op` = "min", `ty` = "f32").
+    pub fn bin_typed(&mut self, op: &str, ty: &str, class: Class, a: Op, b: Op) -> Op {
+        let d = self.out.reg(class);
+        ins!(self.out, "{op}.{ty} {d}, {a}, {b};");
+        Op::Reg(d)
+    }
+
     /// `d = op a, b, c` into a fresh register of `class`.
     pub fn tri(&mut self, op: &str, class: Class, a: Op, b: Op, c: Op) -> Op {
         let d = self.out.reg(class);
@@ -268,7 +275,16 @@ impl<'c, 'a> Fw<'c, 'a> {
 
     /// `setp.<cmp> p, a, b` (e.g. `cmp` = "lt.f32").
     pub fn setp(&mut self, cmp: &str, a: Op, b: Op) -> Op {
-        self.bin(&format!("setp.{cmp}"), Class::Pred, a, b)
+        let d = self.out.reg(Class::Pred);
+        ins!(self.out, "setp.{cmp} {d}, {a}, {b};");
+        Op::Reg(d)
+    }
+
+    /// `setp.<cmp>.<ty> p, a, b` (e.g. `cmp` = "lt", `ty` = "f32").
+    pub fn setp_typed(&mut self, cmp: &str, ty: &str, a: Op, b: Op) -> Op {
+        let d = self.out.reg(Class::Pred);
+        ins!(self.out, "setp.{cmp}.{ty} {d}, {a}, {b};");
+        Op::Reg(d)
     }
 
     /// `p ? t : f` for leaves of `sc`.

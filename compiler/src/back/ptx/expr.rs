@@ -3,9 +3,11 @@
 
 use super::emit::Op;
 use super::types::{Sc, Shape, Ty};
+use super::writer::Leaves;
 use super::writer::{Frame, Fw, Loc, Ptr, Store, Val};
 use super::Error;
 use naga::{AddressSpace, Expression, GlobalVariable, Handle, Literal};
+use smallvec::smallvec;
 
 impl<'a> Fw<'_, 'a> {
     /// Evaluates expression `h` of `f` and records its value.
@@ -19,19 +21,19 @@ impl<'a> Fw<'_, 'a> {
 
     fn eval(&mut self, f: &Frame<'a>, h: Handle<Expression>) -> Result<Val, Error> {
         use Expression as E;
-        let data = |v: Vec<Op>| Ok(Val::Data(v));
+        let data = |v: Leaves| Ok(Val::Data(v));
         match f.func.expressions[h] {
-            E::Literal(l) => data(vec![literal(l)?]),
+            E::Literal(l) => data(smallvec![literal(l)?]),
             E::Constant(c) => data(self.global_expr(self.cx.module.constants[c].init)?),
             E::ZeroValue(ty) => data(self.cx.types.zeros(Ty::H(ty))?),
             E::Compose { ref components, .. } => {
-                let mut out = Vec::new();
+                let mut out = Leaves::new();
                 for &c in components {
                     out.extend_from_slice(self.data(f, c)?);
                 }
                 data(out)
             }
-            E::Splat { size, value } => data(vec![self.scalar(f, value)?; size as usize]),
+            E::Splat { size, value } => data(smallvec![self.scalar(f, value)?; size as usize]),
             E::Swizzle {
                 size,
                 vector,
@@ -107,21 +109,21 @@ impl<'a> Fw<'_, 'a> {
 
     /// A constant from the module's global expressions (naga has folded them to
     /// literals, zeros, compositions and splats).
-    pub fn global_expr(&self, h: Handle<Expression>) -> Result<Vec<Op>, Error> {
+    pub fn global_expr(&self, h: Handle<Expression>) -> Result<Leaves, Error> {
         let module = self.cx.module;
         match module.global_expressions[h] {
-            Expression::Literal(l) => Ok(vec![literal(l)?]),
+            Expression::Literal(l) => Ok(smallvec![literal(l)?]),
             Expression::Constant(c) => self.global_expr(module.constants[c].init),
             Expression::ZeroValue(ty) => self.cx.types.zeros(Ty::H(ty)),
             Expression::Compose { ref components, .. } => {
-                let mut out = Vec::new();
+                let mut out = Leaves::new();
                 for &c in components {
                     out.extend(self.global_expr(c)?);
                 }
                 Ok(out)
             }
             Expression::Splat { size, value } => match self.global_expr(value)?.as_slice() {
-                [x] => Ok(vec![*x; size as usize]),
+                [x] => Ok(smallvec![*x; size as usize]),
                 _ => Err(Error::Invalid("a splat of a non-scalar".into())),
             },
             Expression::Override(_) => {
@@ -136,23 +138,23 @@ impl<'a> Fw<'_, 'a> {
 
     /// A constant expression of `f` (a local variable's initializer), as immediates:
     /// naga has folded it, though an `Emit` may cover it.
-    pub fn const_expr(&self, f: &Frame, h: Handle<Expression>) -> Result<Vec<Op>, Error> {
+    pub fn const_expr(&self, f: &Frame, h: Handle<Expression>) -> Result<Leaves, Error> {
         if let Some(Some(Val::Data(d))) = f.values.get(h.index()) {
             return Ok(d.clone());
         }
         match f.func.expressions[h] {
-            Expression::Literal(l) => Ok(vec![literal(l)?]),
+            Expression::Literal(l) => Ok(smallvec![literal(l)?]),
             Expression::Constant(c) => self.global_expr(self.cx.module.constants[c].init),
             Expression::ZeroValue(ty) => self.cx.types.zeros(Ty::H(ty)),
             Expression::Compose { ref components, .. } => {
-                let mut out = Vec::new();
+                let mut out = Leaves::new();
                 for &c in components {
                     out.extend(self.const_expr(f, c)?);
                 }
                 Ok(out)
             }
             Expression::Splat { size, value } => match self.const_expr(f, value)?.as_slice() {
-                [x] => Ok(vec![*x; size as usize]),
+                [x] => Ok(smallvec![*x; size as usize]),
                 _ => Err(Error::Invalid("a splat of a non-scalar".into())),
             },
             ref other => Err(Error::Unsupported(format!(
@@ -202,7 +204,7 @@ impl<'a> Fw<'_, 'a> {
         let (first, n) = self.element_range(ty, index)?;
         let d = self.data(f, base)?;
         d.get(first as usize..(first + n) as usize)
-            .map(|s| Val::Data(s.to_vec()))
+            .map(|s| Val::Data(Leaves::from_slice(s)))
             .ok_or_else(|| Error::Invalid("an index past the end of a value".into()))
     }
 
@@ -268,9 +270,9 @@ impl<'a> Fw<'_, 'a> {
         self.cx.types.scalars(elem, &mut scs)?;
         let d = self.data(f, base)?;
         let n = scs.len();
-        let mut out = Vec::with_capacity(n);
+        let mut out = Leaves::with_capacity(n);
         for (j, &sc) in scs.iter().enumerate() {
-            let column: Vec<Op> = (0..count as usize)
+            let column: Leaves = (0..count as usize)
                 .filter_map(|k| d.get(k * n + j).copied())
                 .collect();
             out.push(self.select_index(sc, &column, i));

@@ -4,11 +4,13 @@
 
 use super::emit::{ins, Class, Op, Reg};
 use super::types::{Sc, Ty};
+use super::writer::Leaves;
 use super::writer::{Cx, Frame, Fw, Ret, Space, Store, Val};
 use super::Error;
 use naga::{
     AddressSpace, Binding, BuiltIn, EntryPoint, Expression, Function, GlobalVariable, Handle,
 };
+use smallvec::smallvec;
 use std::fmt::Write;
 
 /// Whether a global variable is read-only for the whole kernel.
@@ -198,7 +200,7 @@ impl<'c, 'a> Fw<'c, 'a> {
         &mut self,
         callee: Handle<Function>,
         args: Vec<Val>,
-    ) -> Result<Option<Vec<Op>>, Error> {
+    ) -> Result<Option<Leaves>, Error> {
         let cx = self.cx;
         let func = &cx.module.functions[callee];
         let var = match &func.result {
@@ -237,7 +239,7 @@ impl<'c, 'a> Fw<'c, 'a> {
         callee: Handle<Function>,
         name: &str,
         args: &[Val],
-    ) -> Result<Option<Vec<Op>>, Error> {
+    ) -> Result<Option<Leaves>, Error> {
         let cx = self.cx;
         let func = &cx.module.functions[callee];
         self.out.raw("\t{\n");
@@ -358,7 +360,7 @@ pub(super) fn write_func(cx: &Cx, h: Handle<Function>) -> Result<String, Error> 
     for a in &func.arguments {
         let mut scs = Vec::new();
         cx.types.scalars(Ty::H(a.ty), &mut scs)?;
-        let mut leaves = Vec::with_capacity(scs.len());
+        let mut leaves = Leaves::with_capacity(scs.len());
         for sc in scs {
             let p = format!("{name}_param_{}", params.len());
             leaves.push(fw.load_param(sc, &format!("[{p}]")));
@@ -481,7 +483,7 @@ impl Fw<'_, '_> {
         &mut self,
         binding: Option<&Binding>,
         ty: Handle<naga::Type>,
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         match binding {
             Some(Binding::BuiltIn(b)) => self.builtin(*b),
             Some(Binding::Location { .. }) => Err(Error::Unsupported(
@@ -489,7 +491,7 @@ impl Fw<'_, '_> {
             )),
             None => match &self.cx.module.types[ty].inner {
                 naga::TypeInner::Struct { members, .. } => {
-                    let mut out = Vec::new();
+                    let mut out = Leaves::new();
                     for m in members {
                         out.extend(self.input(m.binding.as_ref(), m.ty)?);
                     }
@@ -506,7 +508,7 @@ impl Fw<'_, '_> {
         Op::Reg(d)
     }
 
-    fn builtin(&mut self, b: BuiltIn) -> Result<Vec<Op>, Error> {
+    fn builtin(&mut self, b: BuiltIn) -> Result<Leaves, Error> {
         let xyz = ["x", "y", "z"];
         Ok(match b {
             BuiltIn::LocalInvocationId => xyz
@@ -522,7 +524,7 @@ impl Fw<'_, '_> {
                 .map(|c| self.special(&format!("%nctaid.{c}")))
                 .collect(),
             BuiltIn::GlobalInvocationId => {
-                let mut out = Vec::with_capacity(3);
+                let mut out = Leaves::with_capacity(3);
                 for c in xyz {
                     let id = self.special(&format!("%ctaid.{c}"));
                     let n = self.special(&format!("%ntid.{c}"));
@@ -539,10 +541,10 @@ impl Fw<'_, '_> {
                 );
                 let (nx, ny) = (self.special("%ntid.x"), self.special("%ntid.y"));
                 let zy = self.tri("mad.lo.u32", Class::B32, z, ny, y);
-                vec![self.tri("mad.lo.u32", Class::B32, zy, nx, x)]
+                smallvec![self.tri("mad.lo.u32", Class::B32, zy, nx, x)]
             }
-            BuiltIn::SubgroupInvocationId => vec![self.special("%laneid")],
-            BuiltIn::SubgroupSize => vec![Op::U32(32)],
+            BuiltIn::SubgroupInvocationId => smallvec![self.special("%laneid")],
+            BuiltIn::SubgroupSize => smallvec![Op::U32(32)],
             other => return Err(Error::Unsupported(format!("the built-in input {other:?}"))),
         })
     }

@@ -4,9 +4,11 @@
 use super::emit::{Class, Op};
 use super::libm::Trig;
 use super::types::{Sc, Shape};
+use super::writer::Leaves;
 use super::writer::{Frame, Fw};
 use super::Error;
 use naga::{Expression, Handle, MathFunction as M};
+use smallvec::smallvec;
 
 // Every f32 instruction that rounds is written with `.ftz` (subnormal inputs and results
 // flushed to sign-preserving zero), as WGSL allows (§ floating-point evaluation: an
@@ -57,7 +59,7 @@ impl Fw<'_, '_> {
         f: &Frame,
         fun: M,
         args: [Option<Handle<Expression>>; 4],
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         let first =
             args[0].ok_or_else(|| Error::Invalid("a math function without arguments".into()))?;
         let ty = self.ty(f, first)?;
@@ -65,9 +67,9 @@ impl Fw<'_, '_> {
             return self.matrix_math(f, fun, first, cols, rows);
         }
         let (sc, _) = self.sv(f, first)?;
-        let mut ops: Vec<Vec<Op>> = Vec::with_capacity(4);
+        let mut ops: Vec<Leaves> = Vec::with_capacity(4);
         for a in args.iter().flatten() {
-            ops.push(self.data(f, *a)?.to_vec());
+            ops.push(Leaves::from_slice(self.data(f, *a)?));
         }
         match fun {
             M::Dot
@@ -83,14 +85,14 @@ impl Fw<'_, '_> {
     }
 
     /// A function applied to each component (scalar arguments are broadcast).
-    fn componentwise(&mut self, fun: M, sc: Sc, ops: &[Vec<Op>]) -> Result<Vec<Op>, Error> {
-        if ops.iter().any(Vec::is_empty) {
+    fn componentwise(&mut self, fun: M, sc: Sc, ops: &[Leaves]) -> Result<Leaves, Error> {
+        if ops.iter().any(|v| v.is_empty()) {
             return Err(Error::Invalid(format!("{fun:?} of an empty value")));
         }
-        let n = ops.iter().map(Vec::len).max().unwrap_or(0);
-        let mut out = Vec::with_capacity(n);
+        let n = ops.iter().map(|v| v.len()).max().unwrap_or(0);
+        let mut out = Leaves::with_capacity(n);
         for i in 0..n {
-            let a: Vec<Op> = ops
+            let a: Leaves = ops
                 .iter()
                 .map(|v| {
                     if v.len() == 1 {
@@ -223,23 +225,23 @@ impl Fw<'_, '_> {
     }
 
     /// Functions of whole vectors.
-    fn geometry(&mut self, fun: M, sc: Sc, ops: &[Vec<Op>]) -> Result<Vec<Op>, Error> {
+    fn geometry(&mut self, fun: M, sc: Sc, ops: &[Leaves]) -> Result<Leaves, Error> {
         let v = |i: usize| {
             ops.get(i)
                 .ok_or_else(|| Error::Invalid(format!("{fun:?} lacks an argument")))
         };
         let a = v(0)?;
         Ok(match fun {
-            M::Dot => vec![self.dot(sc, a, v(1)?)],
+            M::Dot => smallvec![self.dot(sc, a, v(1)?)],
             M::Cross => self.cross(a, v(1)?)?,
-            M::Length => vec![self.length(a)],
+            M::Length => smallvec![self.length(a)],
             M::Distance => {
-                let d: Vec<Op> = a
+                let d: Leaves = a
                     .iter()
                     .zip(v(1)?)
                     .map(|(&x, &y)| self.bin(SUB, Class::F32, x, y))
                     .collect();
-                vec![self.length(&d)]
+                smallvec![self.length(&d)]
             }
             M::Normalize => {
                 let d = self.dot(Sc::F32, a, a);
@@ -292,14 +294,14 @@ impl Fw<'_, '_> {
         self.un(SQRT, Class::F32, d)
     }
 
-    fn cross(&mut self, a: &[Op], b: &[Op]) -> Result<Vec<Op>, Error> {
+    fn cross(&mut self, a: &[Op], b: &[Op]) -> Result<Leaves, Error> {
         let ([ax, ay, az], [bx, by, bz]) = (three(a)?, three(b)?);
         let mut c = |p: Op, q: Op, r: Op, s: Op| {
             let m = self.bin(MUL, Class::F32, r, s);
             let nm = self.un("neg.f32", Class::F32, m);
             self.tri(FMA, Class::F32, p, q, nm)
         };
-        Ok(vec![
+        Ok(smallvec![
             c(ay, bz, az, by),
             c(az, bx, ax, bz),
             c(ax, by, ay, bx),
@@ -308,7 +310,7 @@ impl Fw<'_, '_> {
 
     /// refract(e1, e2, η): k = 1 − η²(1 − dot(e2, e1)²); 0 if k < 0, else
     /// η·e1 − (η·dot(e2, e1) + sqrt(k))·e2.
-    fn refract(&mut self, e1: &[Op], e2: &[Op], eta: &[Op]) -> Result<Vec<Op>, Error> {
+    fn refract(&mut self, e1: &[Op], e2: &[Op], eta: &[Op]) -> Result<Leaves, Error> {
         let eta = *eta
             .first()
             .ok_or_else(|| Error::Invalid("refract lacks η".into()))?;
@@ -322,7 +324,7 @@ impl Fw<'_, '_> {
         let sk = self.un(SQRT, Class::F32, k);
         let m = self.tri(FMA, Class::F32, eta, d, sk);
         let nm = self.un("neg.f32", Class::F32, m);
-        let mut out = Vec::with_capacity(e1.len());
+        let mut out = Leaves::with_capacity(e1.len());
         for (&x, &n) in e1.iter().zip(e2) {
             let ex = self.bin(MUL, Class::F32, eta, x);
             let r = self.tri(FMA, Class::F32, nm, n, ex);
@@ -339,7 +341,7 @@ impl Fw<'_, '_> {
         m: Handle<Expression>,
         cols: u32,
         rows: u32,
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         let d = self.data(f, m)?;
         match fun {
             M::Transpose => {

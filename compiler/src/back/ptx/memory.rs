@@ -4,8 +4,10 @@
 
 use super::emit::{ins, Class, Op, Reg};
 use super::types::{Chunk, Sc, Shape, Ty};
+use super::writer::Leaves;
 use super::writer::{Fw, Loc, Ptr, Space};
 use super::Error;
+use smallvec::smallvec;
 
 impl Fw<'_, '_> {
     /// The pointer to member, element or component `i` of what `p` points to.
@@ -108,7 +110,7 @@ impl Fw<'_, '_> {
     }
 
     /// The value `p` points to, leaf by leaf, in fresh registers.
-    pub fn load(&mut self, p: &Ptr) -> Result<Vec<Op>, Error> {
+    pub fn load(&mut self, p: &Ptr) -> Result<Leaves, Error> {
         match p.loc {
             Loc::Mem {
                 space,
@@ -128,7 +130,7 @@ impl Fw<'_, '_> {
             } => {
                 let src = self.var_slice(var, first, len)?;
                 let sc = src.first().map_or(Sc::F32, |&o| sc_of(o));
-                Ok(vec![self.select_index(sc, &src, index)])
+                Ok(smallvec![self.select_index(sc, &src, index)])
             }
         }
     }
@@ -166,13 +168,13 @@ impl Fw<'_, '_> {
         }
     }
 
-    fn var_slice(&self, var: usize, first: u32, n: u32) -> Result<Vec<Op>, Error> {
+    fn var_slice(&self, var: usize, first: u32, n: u32) -> Result<Leaves, Error> {
         let regs = self
             .vars
             .get(var)
             .ok_or_else(|| Error::Invalid("an unknown variable".into()))?;
         regs.get(first as usize..(first + n) as usize)
-            .map(<[Op]>::to_vec)
+            .map(Leaves::from_slice)
             .ok_or_else(|| Error::Invalid("an access past the end of a variable".into()))
     }
 
@@ -197,17 +199,17 @@ impl Fw<'_, '_> {
         acc
     }
 
-    fn load_mem(&mut self, space: Space, base: Reg, offset: u32, ty: Ty) -> Result<Vec<Op>, Error> {
+    fn load_mem(&mut self, space: Space, base: Reg, offset: u32, ty: Ty) -> Result<Leaves, Error> {
         let mut chunks = Vec::new();
         self.cx.types.chunks(ty, offset, &mut chunks)?;
-        let mut out = Vec::with_capacity(chunks.len());
+        let mut out = Leaves::with_capacity(chunks.len());
         for c in chunks {
             self.load_chunk(space, base, c, &mut out);
         }
         Ok(out)
     }
 
-    fn load_chunk(&mut self, space: Space, base: Reg, c: Chunk, out: &mut Vec<Op>) {
+    fn load_chunk(&mut self, space: Space, base: Reg, c: Chunk, out: &mut Leaves) {
         let addr = address(base, c.offset);
         let sp = space.ld();
         if c.sc == Sc::Bool {

@@ -5,11 +5,13 @@
 use super::emit::{Class, Op};
 use super::math::{ADD, DIV, FMA, MUL, SUB};
 use super::types::{Sc, Shape, Ty};
+use super::writer::Leaves;
 use super::writer::{Frame, Fw};
 use super::Error;
 use naga::{
     BinaryOperator as B, Expression, Handle, RelationalFunction, ScalarKind, UnaryOperator,
 };
+use smallvec::smallvec;
 
 /// The largest f32 below 2^31 and below 2^32: the saturation bounds of WGSL's
 /// float-to-integer conversions.
@@ -22,7 +24,7 @@ impl Fw<'_, '_> {
         f: &Frame,
         op: UnaryOperator,
         e: Handle<Expression>,
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         let sc = self.leaf_sc(self.ty(f, e)?)?;
         let (ins, class) = match (op, sc) {
             (UnaryOperator::Negate, Sc::F32) => ("neg.f32", Class::F32),
@@ -55,7 +57,7 @@ impl Fw<'_, '_> {
         op: B,
         l: Handle<Expression>,
         r: Handle<Expression>,
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         let (lt, rt) = (self.ty(f, l)?, self.ty(f, r)?);
         let (ls, rs) = (self.cx.types.shape(lt)?, self.cx.types.shape(rt)?);
         let (a, b) = (self.data(f, l)?, self.data(f, r)?);
@@ -172,7 +174,7 @@ impl Fw<'_, '_> {
         cond: Handle<Expression>,
         accept: Handle<Expression>,
         reject: Handle<Expression>,
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         let sc = self.leaf_sc(self.ty(f, accept)?)?;
         let (c, t, e) = (
             self.data(f, cond)?,
@@ -182,7 +184,7 @@ impl Fw<'_, '_> {
         if c.is_empty() || t.len() != e.len() {
             return Err(Error::Invalid("a select of mismatched values".into()));
         }
-        let mut out = Vec::with_capacity(t.len());
+        let mut out = Leaves::with_capacity(t.len());
         for i in 0..t.len() {
             let p = if c.len() == 1 {
                 c[0]
@@ -199,7 +201,7 @@ impl Fw<'_, '_> {
         f: &Frame,
         fun: RelationalFunction,
         e: Handle<Expression>,
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         let d = self.data(f, e)?;
         let fold = |s: &mut Self, ins: &str| {
             let mut acc = d.first().copied().unwrap_or(Op::Bool(false));
@@ -209,8 +211,8 @@ impl Fw<'_, '_> {
             acc
         };
         Ok(match fun {
-            RelationalFunction::All => vec![fold(self, "and.pred")],
-            RelationalFunction::Any => vec![fold(self, "or.pred")],
+            RelationalFunction::All => smallvec![fold(self, "and.pred")],
+            RelationalFunction::Any => smallvec![fold(self, "or.pred")],
             RelationalFunction::IsNan => d.iter().map(|&x| self.setp("nan.f32", x, x)).collect(),
             RelationalFunction::IsInf => d
                 .iter()
@@ -229,7 +231,7 @@ impl Fw<'_, '_> {
         e: Handle<Expression>,
         kind: ScalarKind,
         convert: Option<u8>,
-    ) -> Result<Vec<Op>, Error> {
+    ) -> Result<Leaves, Error> {
         let from = self.leaf_sc(self.ty(f, e)?)?;
         let to = Sc::of(naga::Scalar {
             kind,
@@ -292,7 +294,7 @@ impl Fw<'_, '_> {
     }
 
     /// `m * v`: column-major `m` of `cols` columns of `rows`.
-    fn mat_vec(&mut self, m: &[Op], v: &[Op], cols: u32, rows: u32) -> Vec<Op> {
+    fn mat_vec(&mut self, m: &[Op], v: &[Op], cols: u32, rows: u32) -> Leaves {
         (0..rows as usize)
             .map(|r| {
                 let terms: Vec<(Op, Op)> = (0..cols as usize)
@@ -304,7 +306,7 @@ impl Fw<'_, '_> {
     }
 
     /// `v * m`: each result component is the dot product of `v` with a column.
-    fn vec_mat(&mut self, v: &[Op], m: &[Op], cols: u32, rows: u32) -> Vec<Op> {
+    fn vec_mat(&mut self, v: &[Op], m: &[Op], cols: u32, rows: u32) -> Leaves {
         (0..cols as usize)
             .map(|c| {
                 let terms: Vec<(Op, Op)> = (0..rows as usize)
@@ -316,9 +318,9 @@ impl Fw<'_, '_> {
     }
 
     /// `a * b` with `a` of `k` columns of `rows` and `b` of `cols` columns of `k`.
-    fn mat_mat(&mut self, a: &[Op], b: &[Op], k: u32, rows: u32, cols: u32) -> Vec<Op> {
+    fn mat_mat(&mut self, a: &[Op], b: &[Op], k: u32, rows: u32, cols: u32) -> Leaves {
         let (k, rows) = (k as usize, rows as usize);
-        let mut out = Vec::with_capacity(cols as usize * rows);
+        let mut out = Leaves::with_capacity(cols as usize * rows);
         for c in 0..cols as usize {
             for r in 0..rows {
                 let terms: Vec<(Op, Op)> = (0..k)

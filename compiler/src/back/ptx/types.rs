@@ -3,6 +3,7 @@
 //! leaf lives in memory (the offsets and strides naga's WGSL layout put in the IR).
 
 use super::emit::{Class, Op};
+use super::writer::Leaves;
 use super::Error;
 use naga::proc::TypeResolution;
 use naga::{ArraySize, Handle, Module, ScalarKind, StructMember, Type, TypeInner};
@@ -298,7 +299,7 @@ impl<'a> Types<'a> {
     }
 
     /// The zero of `ty`, leaf by leaf.
-    pub fn zeros(&self, ty: Ty) -> Result<Vec<Op>, Error> {
+    pub fn zeros(&self, ty: Ty) -> Result<Leaves, Error> {
         let mut scs = Vec::new();
         self.scalars(ty, &mut scs)?;
         Ok(scs.into_iter().map(Sc::zero).collect())

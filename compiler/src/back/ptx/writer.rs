@@ -8,6 +8,7 @@ use super::types::{Resolved, Sc, Ty, Types};
 use super::Error;
 use naga::valid::{FunctionInfo, ModuleInfo};
 use naga::{Expression, Function, GlobalVariable, Handle, Module};
+use smallvec::SmallVec;
 use std::cell::Cell;
 
 /// Module-wide facts shared by every function's writer.
@@ -89,10 +90,14 @@ pub(super) struct Ptr {
 }
 
 /// What an expression evaluated to.
+/// The leaves of a value (one operand per scalar), stored inline up to a `vec4`: most
+/// expressions are scalars or small vectors, and a kernel has tens of thousands of them.
+pub(super) type Leaves = SmallVec<[Op; 4]>;
+
 #[derive(Debug, Clone)]
 pub(super) enum Val {
     /// A value: one operand per leaf.
-    Data(Vec<Op>),
+    Data(Leaves),
     Ptr(Ptr),
 }
 
@@ -155,7 +160,7 @@ pub(super) struct Fw<'c, 'a> {
     pub cx: &'c Cx<'a>,
     pub out: Out,
     /// The registers of each register variable.
-    pub vars: Vec<Vec<Op>>,
+    pub vars: Vec<Leaves>,
     /// Per global variable: where it lives in this PTX function.
     pub globals: Vec<Option<Store>>,
     /// Arguments of sin, cos and tan reduced to [−π, π] since the last control-flow
@@ -318,7 +323,7 @@ impl<'c, 'a> Fw<'c, 'a> {
 
     /// A new register variable holding `init`.
     pub fn new_var(&mut self, scs: &[Sc], init: Option<&[Op]>) -> Result<usize, Error> {
-        let mut regs = Vec::with_capacity(scs.len());
+        let mut regs = Leaves::with_capacity(scs.len());
         for (i, &sc) in scs.iter().enumerate() {
             let r = Op::Reg(self.fresh(sc));
             if let Some(v) = init {

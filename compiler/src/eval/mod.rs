@@ -136,6 +136,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
         )
     }
 
+    /// The body of [`Evaluator::eval`], inlined into both copies [`wide`] makes of it.
     #[inline(always)]
     fn eval_any(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], mut m: Option<&mut [u32]>) {
         let n = x.len().min(y.len()).min(z.len()).min(d.len());
@@ -223,7 +224,6 @@ impl<'t, T: Float> Evaluator<'t, T> {
     fn enter(&mut self, guard: &Guard, depth: usize, n: usize) -> Option<usize> {
         let c = self.chunk;
         let (mut idx, _) = std::mem::take(&mut self.frames[depth]);
-        idx.clear();
         idx.resize(n, 0);
         let mut m = 0;
         {

@@ -1,12 +1,15 @@
 //! Loops compiled for the widest vector unit the processor has: [`wide`] runs a closure
 //! inside a function compiled with AVX2 where the processor supports it (checked once and
-//! cached by the standard library), and as it is elsewhere. The interpreter's instruction
-//! loops and the renderer's lane loops go through it.
+//! cached by the standard library), and compiled as usual elsewhere. The interpreter's
+//! instruction loops and the renderer's lane loops go through it.
 //!
 //! What `f` inlines is compiled for AVX2 (eight f32 or four f64 per operation instead of four
 //! or two); what it calls without inlining is not, so the loops that matter are marked
-//! `#[inline(always)]` on the way down. The same IEEE operations run in the same order
-//! either way (no fused multiply-add is enabled), so results are bit for bit the same.
+//! `#[inline(always)]` on the way down, the closure passed in included: its body holds the
+//! whole inlined loop nest, too large for LLVM to inline on its own (without the attribute
+//! the interpreter's loops ran as a separate, baseline-compiled closure). Results do not change: rustc never lets LLVM contract
+//! or reorder floating-point operations, so the vector code performs the same IEEE operations
+//! in the same order, and the transcendental functions are the same library calls either way.
 
 /// Runs `f`, compiled for AVX2 where the processor has it.
 #[inline(always)]

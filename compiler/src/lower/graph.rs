@@ -514,7 +514,6 @@ impl<'a> Lowerer<'a> {
         self.config.cull && acc.is_some() && cost >= GUARD_COST
     }
 
-    /// Evaluates a node of a union's hierarchy into `acc`.
     /// Evaluates a node of a union's hierarchy into `acc`; `tested` is what the guards above
     /// have computed already.
     fn tree(

@@ -190,6 +190,7 @@ pub(super) fn march<T: Float, R: Rule<T>>(
     )
 }
 
+/// The body of [`march`], inlined into both copies [`wide`] makes of it.
 #[inline(always)]
 fn march_lanes<T: Float, R: Rule<T>>(
     lanes: &mut Lanes<T>,

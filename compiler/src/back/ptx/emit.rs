@@ -220,3 +220,25 @@ macro_rules! ins {
     ($out:expr, $($arg:tt)*) => { $out.ins(format_args!($($arg)*)) };
 }
 pub(super) use ins;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The hand-written formatting writes what `format!` would.
+    #[test]
+    fn registers_and_immediates_are_written_as_format_would() {
+        for n in [0, 1, 9, 10, 99, 100, 65_535, 1_000_000, u32::MAX] {
+            assert_eq!(decimal(&mut [0; 10], n), n.to_string());
+            let r = Reg {
+                class: Class::F32,
+                n,
+            };
+            assert_eq!(r.to_string(), format!("%f{n}"));
+        }
+        for bits in [0, 1, 0x0123_4567, 0x89AB_CDEF, 0x3F80_0000, u32::MAX] {
+            assert_eq!(f32_bits(&mut [0; 10], bits), format!("0f{bits:08X}"));
+            assert_eq!(Op::F32(bits).to_string(), format!("0f{bits:08X}"));
+        }
+    }
+}

@@ -3,8 +3,7 @@
 
 use super::emit::Op;
 use super::types::{Sc, Shape, Ty};
-use super::writer::Leaves;
-use super::writer::{Frame, Fw, Loc, Ptr, Store, Val};
+use super::writer::{Frame, Fw, Leaves, Loc, Ptr, Store, Val};
 use super::Error;
 use naga::{AddressSpace, Expression, GlobalVariable, Handle, Literal};
 use smallvec::smallvec;

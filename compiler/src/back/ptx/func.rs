@@ -4,8 +4,7 @@
 
 use super::emit::{ins, Class, Op, Reg};
 use super::types::{Sc, Ty};
-use super::writer::Leaves;
-use super::writer::{Cx, Frame, Fw, Ret, Space, Store, Val};
+use super::writer::{Cx, Frame, Fw, Leaves, Ret, Space, Store, Val};
 use super::Error;
 use naga::{
     AddressSpace, Binding, BuiltIn, EntryPoint, Expression, Function, GlobalVariable, Handle,

@@ -4,8 +4,7 @@
 use super::emit::{Class, Op};
 use super::libm::Trig;
 use super::types::{Sc, Shape};
-use super::writer::Leaves;
-use super::writer::{Frame, Fw};
+use super::writer::{Frame, Fw, Leaves};
 use super::Error;
 use naga::{Expression, Handle, MathFunction as M};
 use smallvec::smallvec;

@@ -4,8 +4,7 @@
 
 use super::emit::{ins, Class, Op, Reg};
 use super::types::{Chunk, Sc, Shape, Ty};
-use super::writer::Leaves;
-use super::writer::{Fw, Loc, Ptr, Space};
+use super::writer::{Fw, Leaves, Loc, Ptr, Space};
 use super::Error;
 use smallvec::smallvec;
 

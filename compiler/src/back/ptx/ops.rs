@@ -5,8 +5,7 @@
 use super::emit::{Class, Op};
 use super::math::{ADD, DIV, FMA, MUL, SUB};
 use super::types::{Sc, Shape, Ty};
-use super::writer::Leaves;
-use super::writer::{Frame, Fw};
+use super::writer::{Frame, Fw, Leaves};
 use super::Error;
 use naga::{
     BinaryOperator as B, Expression, Handle, RelationalFunction, ScalarKind, UnaryOperator,

@@ -89,11 +89,11 @@ pub(super) struct Ptr {
     pub ty: Ty,
 }
 
-/// What an expression evaluated to.
 /// The leaves of a value (one operand per scalar), stored inline up to a `vec4`: most
 /// expressions are scalars or small vectors, and a kernel has tens of thousands of them.
 pub(super) type Leaves = SmallVec<[Op; 4]>;
 
+/// What an expression evaluated to.
 #[derive(Debug, Clone)]
 pub(super) enum Val {
     /// A value: one operand per leaf.

@@ -320,9 +320,10 @@ impl Compiler<'_> {
                 reads.push(r);
             }
         };
-        for i in block.start..block.end {
-            if self.live[i] {
-                ops[i].operands().into_iter().for_each(|r| add(r, self));
+        let body = block.start..block.end;
+        for (op, &live) in ops[body.clone()].iter().zip(&self.live[body]) {
+            if live {
+                op.operands().into_iter().for_each(|r| add(r, self));
             }
         }
         for (nb, inner) in self.program.blocks().iter().enumerate() {
@@ -332,8 +333,9 @@ impl Compiler<'_> {
                 add(inner.best, self);
             }
         }
-        for i in block.end..block.end + block.results {
-            if let (true, Op::Phi(then, _)) = (self.live[i], ops[i]) {
+        let results = block.end..block.end + block.results;
+        for (&op, &live) in ops[results.clone()].iter().zip(&self.live[results]) {
+            if let (true, Op::Phi(then, _)) = (live, op) {
                 add(then, self);
             }
         }

@@ -228,7 +228,7 @@ impl<T: Float> Prim<T> {
 
     /// A local normal in world space: normals map by the transpose of the world-to-local
     /// matrix (the inverse transpose of the local-to-world one).
-    fn to_world(&self, n: V3<T>) -> V3<T> {
+    fn to_world(self, n: V3<T>) -> V3<T> {
         (self.rows[0] * n.x + self.rows[1] * n.y + self.rows[2] * n.z).normalize()
     }
 

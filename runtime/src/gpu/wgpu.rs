@@ -140,7 +140,7 @@ impl Gpu {
 
     /// Renders one frame. `progress` is called with the fraction done after each tile.
     pub fn render(&self, l: &Launch, progress: &mut dyn FnMut(f64)) -> Result<Frame, Error> {
-        let limit = self.device.limits().max_storage_buffer_binding_size as u64;
+        let limit = self.device.limits().max_storage_buffer_binding_size;
         if let Some(data) = l.data.filter(|d| d.len() as u64 > limit) {
             return Err(Error::Render(format!(
                 "the scene's primitives take {} bytes, more than the {limit} bytes a storage buffer of this adapter may bind",

@@ -147,13 +147,14 @@ macro_rules! impl_float {
                 <$t>::abs(self)
             }
             /// Truncation through an integer, corrected for negative non-integers. Values at
-            /// or beyond `$big` are integers already and pass through (so do NaN and ±inf).
+            /// or beyond `$big` are integers already and pass through (so do NaN, ±inf and ±0).
             #[inline(always)]
             fn floor(self) -> Self {
                 let big: $t = $big;
                 let t = (self as $i) as $t;
                 let f = if t > self { t - 1.0 } else { t };
-                if self.abs() < big {
+                // Zeros pass through too, so that floor(-0.0) is -0.0 as in std and WGSL.
+                if self.abs() < big && self != 0.0 {
                     f
                 } else {
                     self
@@ -179,10 +180,20 @@ mod tests {
         for &x in &[
             -2.5f32, -2.0, -0.5, -0.0, 0.0, 0.3, 1.0, 1.7, 1e7, -1e7, 3e9, -3e9,
         ] {
-            assert_eq!(Float::floor(x), x.floor(), "{x}");
+            assert_eq!(Float::floor(x).to_bits(), x.floor().to_bits(), "{x}");
         }
-        for &x in &[-2.5f64, -1e15, 1e15 + 0.5, 7.0, -7.25, 1e300] {
-            assert_eq!(Float::floor(x), x.floor(), "{x}");
+        for &x in &[
+            -2.5f64,
+            -1e15,
+            1e15 + 0.5,
+            7.0,
+            -7.25,
+            1e300,
+            -0.0,
+            0.0,
+            -0.25,
+        ] {
+            assert_eq!(Float::floor(x).to_bits(), x.floor().to_bits(), "{x}");
         }
         assert!(Float::floor(f32::NAN).is_nan());
         assert_eq!(Float::floor(f32::INFINITY), f32::INFINITY);

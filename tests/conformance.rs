@@ -2,6 +2,8 @@
 //! within a stated tolerance. On a machine without a wgpu adapter the test says it skipped,
 //! unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe): then it fails.
 
+mod common;
+
 use sdfc_compiler::scene::Scene;
 use sdfc_compiler::{back::wgsl, lower};
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
@@ -146,13 +148,8 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
 /// with shapes that must stay in the rest of the program: a twisted box and ellipsoids (a
 /// bound, not an exact distance).
 fn marched_scene(n: usize) -> String {
-    let mut state = 0x9e37_79b9_u64;
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 33) as f64 / (1u64 << 31) as f64
-    };
+    let mut rng = common::Rng::new(0x9e37_79b9_u64);
+    let mut next = move || rng.next();
     let mut text = String::from(
         "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75 };\n\
          material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\
@@ -310,13 +307,8 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
 /// capsules turned and scaled at pseudo-random places on a checkered, reflective floor, with
 /// mirrors and a floating glass ball that touches nothing (so `auto` traces it).
 fn mixed_scene(n: usize) -> String {
-    let mut state = 0x2545_f491_u64;
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 33) as f64 / (1u64 << 31) as f64
-    };
+    let mut rng = common::Rng::new(0x2545_f491_u64);
+    let mut next = move || rng.next();
     let mut text = String::from(
         "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75, reflect: 0.1 };\n\
          material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\

@@ -280,9 +280,7 @@ impl<'c, 'a> Fw<'c, 'a> {
 
     /// `setp.<cmp> p, a, b` (e.g. `cmp` = "lt.f32").
     pub fn setp(&mut self, cmp: &str, a: Op, b: Op) -> Op {
-        let d = self.out.reg(Class::Pred);
-        ins!(self.out, "setp.{cmp} {d}, {a}, {b};");
-        Op::Reg(d)
+        self.bin_typed("setp", cmp, Class::Pred, a, b)
     }
 
     /// `setp.<cmp>.<ty> p, a, b` (e.g. `cmp` = "lt", `ty` = "f32").

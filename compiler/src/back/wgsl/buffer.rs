@@ -164,8 +164,7 @@ pub fn write(primitives: &[Primitive], top: &[Item]) -> String {
     out.push_str("    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u);\n");
     walk(
         &mut out,
-        groups,
-        "best.t",
+        groups.then_some("enters(o - head.xyz, d, size.xyz, best.t)"),
         &[
             &format!("best = nearest(best, primitive_interval(i, head, o, d), tag >> {MATERIAL_SHIFT}u);"),
             &format!("i += {step};"),
@@ -180,8 +179,7 @@ pub fn write(primitives: &[Primitive], top: &[Item]) -> String {
     out.push_str("    counters.shadow += 1u;\n    var through = 1.0;\n");
     walk(
         &mut out,
-        groups,
-        "tmax",
+        groups.then_some("enters(o - head.xyz, d, size.xyz, tmax)"),
         &[
             &format!("let tau = params.materials[tag >> {MATERIAL_SHIFT}u].optics.y;"),
             "through = occlude(through, primitive_interval(i, head, o, d), tmax, tau);",
@@ -195,19 +193,18 @@ pub fn write(primitives: &[Primitive], top: &[Item]) -> String {
     out
 }
 
-/// The loop over the entries: a group is entered when the ray meets its box before `limit`,
-/// a primitive is met by the statements `visit` (which step `i` past it).
-fn walk(out: &mut String, groups: bool, limit: &str, visit: &[&str]) {
+/// The loop over the entries of `scene_data` (of the traced and the marched walks alike): a
+/// group (centre `head.xyz`, half-size `size.xyz`) is entered where the WGSL condition `enter`
+/// holds, else skipped to its end (with `enter` absent, the data has no groups); any other
+/// entry is met by the statements `visit`, which step `i` past it.
+pub(super) fn walk(out: &mut String, enter: Option<&str>, visit: &[&str]) {
     out.push_str("    let end = bitcast<u32>(scene_data[0u].x);\n    var i = 1u;\n");
     out.push_str("    while i < end {\n        let head = scene_data[i];\n");
     out.push_str("        let tag = bitcast<u32>(head.w);\n");
-    if groups {
+    if let Some(enter) = enter {
         out.push_str("        if tag == GROUP {\n            let size = scene_data[i + 1u];\n");
-        let _ = writeln!(
-            out,
-            "            let inside = enters(o - head.xyz, d, size.xyz, {limit});"
-        );
-        out.push_str("            i = select(bitcast<u32>(size.w), i + 2u, inside);\n");
+        let _ = writeln!(out, "            let enter = {enter};");
+        out.push_str("            i = select(bitcast<u32>(size.w), i + 2u, enter);\n");
         out.push_str("            continue;\n        }\n");
     }
     for line in visit {
@@ -219,9 +216,6 @@ fn walk(out: &mut String, groups: bool, limit: &str, visit: &[&str]) {
 /// `fn shape_interval`: the interval of a primitive of the tag's kind in its own frame, with
 /// a branch for each kind among `primitives`.
 fn shape_interval(out: &mut String, primitives: &[Primitive]) {
-    let mut kinds: Vec<u32> = primitives.iter().map(|p| kind(&p.shape)).collect();
-    kinds.sort_unstable();
-    kinds.dedup();
     out.push_str(
         "// The interval along (o, d) of a primitive of the tag's kind in its own frame, its shape\n\
          // given by s.\n",
@@ -229,30 +223,49 @@ fn shape_interval(out: &mut String, primitives: &[Primitive]) {
     out.push_str(
         "fn shape_interval(tag: u32, o: vec3<f32>, d: vec3<f32>, s: vec4<f32>) -> Interval {\n",
     );
-    if kinds.len() > 1 {
+    let kinds: Vec<u32> = primitives.iter().map(|p| kind(&p.shape)).collect();
+    if kinds.windows(2).any(|w| w[0] != w[1]) {
         out.push_str("    let kind = tag & 7u;\n");
     }
-    for (n, k) in kinds.iter().enumerate() {
-        let call = match *k {
-            SPHERE => "sphere_interval(o, d, s.x)",
-            BOX => "box_interval(o, d, s.xyz)",
-            CYLINDER => "cylinder_interval(o, d, s.x, s.y)",
-            CAPSULE => "capsule_interval(o, d, s.x, s.y)",
-            _ => "plane_interval(o, d, s.xyz, s.w)",
-        };
-        if n + 1 < kinds.len() {
-            let _ = writeln!(
-                out,
-                "    if kind == {k}u {{\n        return {call};\n    }}"
-            );
-        } else {
-            let _ = writeln!(out, "    return {call};");
+    let call = |k: u32| match k {
+        SPHERE => "return sphere_interval(o, d, s.x);",
+        BOX => "return box_interval(o, d, s.xyz);",
+        CYLINDER => "return cylinder_interval(o, d, s.x, s.y);",
+        CAPSULE => "return capsule_interval(o, d, s.x, s.y);",
+        _ => "return plane_interval(o, d, s.xyz, s.w);",
+    };
+    branches(out, kinds.into_iter(), call, "return missed();");
+    out.push_str("}\n\n");
+}
+
+/// The body of a function that dispatches on `kind` (a WGSL `u32` in scope): for each kind
+/// among `kinds`, sorted, the statements `body(kind)` (which end in `return`), each but the
+/// last under `if kind == …`; `empty` where there is no kind at all.
+pub(super) fn branches(
+    out: &mut String,
+    kinds: impl Iterator<Item = u32>,
+    body: impl Fn(u32) -> &'static str,
+    empty: &str,
+) {
+    let mut kinds: Vec<u32> = kinds.collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    for (n, &k) in kinds.iter().enumerate() {
+        let last = n + 1 == kinds.len();
+        let indent = if last { "    " } else { "        " };
+        if !last {
+            let _ = writeln!(out, "    if kind == {k}u {{");
+        }
+        for line in body(k).lines() {
+            let _ = writeln!(out, "{indent}{line}");
+        }
+        if !last {
+            out.push_str("    }\n");
         }
     }
     if kinds.is_empty() {
-        out.push_str("    return missed();\n");
+        let _ = writeln!(out, "    {empty}");
     }
-    out.push_str("}\n\n");
 }
 
 /// `fn primitive_interval`: the interval of the primitive whose entry starts at `i`, with

@@ -31,7 +31,7 @@
 //! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes
 //! 32 bytes, a rotated one 80, a group 32.
 
-use super::buffer::{bits, entries, tag_holds, vec, MATERIAL_SHIFT};
+use super::buffer::{self, bits, entries, tag_holds, vec, MATERIAL_SHIFT};
 use crate::lower::Instance;
 use crate::scene::analytic::{boxed, Item};
 use crate::scene::{Node, V3};
@@ -188,31 +188,13 @@ fn helpers(out: &mut String) {
 /// `fn shape_distance`: the distance of a shape of the tag's kind at q in its own frame, with
 /// a branch for each kind among `instances`.
 fn shape_distance(out: &mut String, instances: &[Instance]) {
-    let mut kinds: Vec<u32> = instances.iter().map(|i| kind(&i.shape)).collect();
-    kinds.sort_unstable();
-    kinds.dedup();
     out.push_str(
         "// The distance at q of an instance's shape of the tag's kind in its own frame, its\n\
          // constants s (lower/shapes.rs).\n\
          fn shape_distance(kind: u32, q: vec3<f32>, s: vec4<f32>) -> f32 {\n",
     );
-    for (n, k) in kinds.iter().enumerate() {
-        let body = formula(*k);
-        if n + 1 < kinds.len() {
-            let _ = writeln!(out, "    if kind == {k}u {{");
-            for line in body.lines() {
-                let _ = writeln!(out, "        {line}");
-            }
-            out.push_str("    }\n");
-        } else {
-            for line in body.lines() {
-                let _ = writeln!(out, "    {line}");
-            }
-        }
-    }
-    if kinds.is_empty() {
-        out.push_str("    return 1e30;\n");
-    }
+    let kinds = instances.iter().map(|i| kind(&i.shape));
+    buffer::branches(out, kinds, formula, "return 1e30;");
     out.push_str("}\n\n");
 }
 
@@ -300,35 +282,19 @@ fn walk(out: &mut String, material: bool) {
             ""
         }
     );
-    out.push_str(
-        "    var best = start;\n\
-         \x20   let end = bitcast<u32>(scene_data[0u].x);\n\
-         \x20   var i = 1u;\n\
-         \x20   while i < end {\n\
-         \x20       let head = scene_data[i];\n\
-         \x20       let tag = bitcast<u32>(head.w);\n\
-         \x20       if tag == GROUP {\n\
-         \x20           let size = scene_data[i + 1u];\n",
-    );
-    let _ = writeln!(
-        out,
-        "            let near = box_of(abs(p - head.xyz) - size.xyz) < {d};"
-    );
-    out.push_str(
-        "            i = select(bitcast<u32>(size.w), i + 2u, near);\n\
-         \x20           continue;\n\
-         \x20       }\n\
-         \x20       let d = instance_distance(i, head, p);\n",
-    );
-    if material {
-        let _ = writeln!(
-            out,
-            "        if d < best.x {{\n            best = vec2<f32>(d, f32(tag >> {MATERIAL_SHIFT}u));\n        }}"
-        );
+    out.push_str("    var best = start;\n");
+    let enter = format!("box_of(abs(p - head.xyz) - size.xyz) < {d}");
+    let update = format!("    best = vec2<f32>(d, f32(tag >> {MATERIAL_SHIFT}u));");
+    let keep: &[&str] = if material {
+        &["if d < best.x {", &update, "}"]
     } else {
-        out.push_str("        best = min(best, d);\n");
-    }
-    out.push_str("        i += instance_size(tag);\n    }\n    return best;\n}\n\n");
+        &["best = min(best, d);"]
+    };
+    let mut visit = vec!["let d = instance_distance(i, head, p);"];
+    visit.extend(keep);
+    visit.push("i += instance_size(tag);");
+    buffer::walk(out, Some(&enter), &visit);
+    out.push_str("    return best;\n}\n\n");
 }
 
 #[cfg(test)]

@@ -1,11 +1,12 @@
 //! The batch interpreter: f32 against f64, the batch path against the one-point reference
-//! path (bit for bit), batches of every length around the chunk size, and what a tape keeps.
+//! path (bit for bit, fused steps included, at special values too), batches of every length
+//! around the chunk size, and what a tape keeps.
 
 mod common;
 
 use common::*;
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower, Program};
+use sdfc_compiler::lower::{lower, lower_with, LowerOptions, Program};
 use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
 
 /// A scene that uses most operations: smooth blends, repetition, twist, bend, rotation,
@@ -179,4 +180,157 @@ fn slots_are_reused() {
         tape.slot_count(),
         program.len()
     );
+}
+
+/// One of each primitive, each moved off the origin (so that its length chains carry
+/// offsets), some rounded, blended or repeated.
+fn primitives_scene() -> Scene {
+    let mut b = Build::new();
+    let nodes = [
+        Node::Sphere { radius: 0.5 },
+        Node::Box {
+            half: [0.4, 0.3, 0.5],
+        },
+        Node::RoundBox {
+            half: [0.4, 0.3, 0.5],
+            radius: 0.1,
+        },
+        Node::Torus {
+            major: 0.6,
+            minor: 0.2,
+        },
+        Node::Cylinder {
+            radius: 0.3,
+            half_height: 0.5,
+        },
+        Node::Capsule {
+            radius: 0.3,
+            half_height: 0.5,
+        },
+        Node::Cone {
+            radius: 0.4,
+            half_height: 0.5,
+        },
+        Node::Ellipsoid {
+            radii: [0.3, 0.6, 0.4],
+        },
+    ];
+    let mut kids = Vec::new();
+    for (i, node) in nodes.into_iter().enumerate() {
+        let n = b.add(node);
+        let n = if i % 3 == 1 {
+            b.add(Node::Round {
+                radius: 0.05,
+                child: n,
+            })
+        } else {
+            n
+        };
+        kids.push(b.at(n, [i as f64 - 3.5, 0.25 * i as f64, -0.5]));
+    }
+    let blend = b.add(Node::SmoothCombine {
+        op: Combine::Union,
+        k: 0.3,
+        variant: Smooth::Exp,
+        a: kids[0],
+        b: kids[1],
+    });
+    kids.push(blend);
+    let s = b.add(Node::Sphere { radius: 0.3 });
+    let rep = b.add(Node::Repeat {
+        period: [2.0, 0.0, 2.0],
+        count: None,
+        child: s,
+    });
+    kids.push(rep);
+    let root = b.add(Node::Combine {
+        op: Combine::Union,
+        children: kids,
+    });
+    b.finish(root)
+}
+
+/// Points with coordinates where fused and unfused arithmetic could part if they did not
+/// perform the same operations: zeros of both signs, infinities, NaN, a subnormal, huge
+/// values, the offsets of the scene itself; every combination of three.
+fn special_points() -> Vec<[f64; 3]> {
+    let values = [
+        0.0,
+        -0.0,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        1e-40,
+        -3e38,
+        0.5,
+        -3.5,
+        -0.5,
+    ];
+    let mut pts = Vec::new();
+    for &x in &values {
+        for &y in &values {
+            for &z in &values {
+                pts.push([x, y, z]);
+            }
+        }
+    }
+    pts
+}
+
+fn same_bits<T: Float>(a: T, b: T) -> bool {
+    a.to_f64().to_bits() == b.to_f64().to_bits() || (a.is_nan() && b.is_nan())
+}
+
+fn fused_matches_reference<T: Float>(program: &Program, pts: &[[f64; 3]], what: &str) {
+    for outputs in [Outputs::Distance, Outputs::DistanceAndMaterial] {
+        for chunk in [1, 64, 256] {
+            let (d, m) = run::<T>(program, outputs, chunk, pts);
+            for (i, p) in pts.iter().enumerate() {
+                let (rd, rm) = eval_point::<T>(program, p.map(T::from_f64));
+                assert!(
+                    same_bits(rd, d[i]),
+                    "{what}, {outputs:?}, chunk {chunk}, point {p:?}: {} vs {}",
+                    rd.to_f64(),
+                    d[i].to_f64()
+                );
+                if outputs == Outputs::DistanceAndMaterial {
+                    assert_eq!(rm, m[i], "{what}, chunk {chunk}, point {p:?}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn fused_steps_match_the_reference_bit_for_bit() {
+    let mut pts = special_points();
+    pts.extend(points(500));
+    for (what, scene) in [("primitives", primitives_scene()), ("busy", busy_scene())] {
+        for level in [0, 1] {
+            let program = lower_with(&scene, &LowerOptions::level(level));
+            let what = format!("{what} at level {level}");
+            fused_matches_reference::<f32>(&program, &pts, &what);
+            fused_matches_reference::<f64>(&program, &pts, &what);
+        }
+    }
+}
+
+#[test]
+fn the_length_idiom_is_one_step() {
+    // `length(p - c) - r`: three offsets, three squares, two sums, a root and the radius.
+    let mut b = Build::new();
+    let s = b.add(Node::Sphere { radius: 0.5 });
+    let root = b.at(s, [1.0, -2.0, 0.5]);
+    let program = lower(&b.finish(root));
+    assert!(program.len() > 10, "{}", program.len());
+    assert_eq!(Tape::new(&program, Outputs::Distance).len(), 1);
+    // A torus is two lengths, the second of the first minus the major radius.
+    let mut b = Build::new();
+    let t = b.add(Node::Torus {
+        major: 1.0,
+        minor: 0.25,
+    });
+    let root = b.at(t, [0.5, 0.0, 0.0]);
+    let program = lower(&b.finish(root));
+    assert_eq!(Tape::new(&program, Outputs::Distance).len(), 2);
 }

@@ -10,6 +10,7 @@
 //! reference evaluation used by tests.
 
 pub mod float;
+mod fuse;
 pub mod scalar;
 mod tape;
 mod wide;
@@ -18,7 +19,7 @@ pub use float::Float;
 pub use tape::{Outputs, Tape};
 pub use wide::wide;
 
-use tape::{Guard, Step};
+use tape::{Guard, Step, INPUTS};
 
 use crate::lower::{Axis, Op, Program};
 
@@ -100,7 +101,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
         let chunk = chunk.max(1);
         let mut slots = vec![T::zero(); chunk * tape.slot_count()];
         for &(slot, c) in tape.constants() {
-            slots[slot as usize * chunk..][..chunk].fill(T::from_f64(c));
+            slots[(slot - INPUTS) as usize * chunk..][..chunk].fill(T::from_f64(c));
         }
         let frames = (0..tape.depth())
             .map(|_| (Vec::with_capacity(chunk), 0))
@@ -143,22 +144,23 @@ impl<'t, T: Float> Evaluator<'t, T> {
         let mut start = 0;
         while start < n {
             let end = (start + self.chunk).min(n);
-            self.run(&x[start..end], &y[start..end], &z[start..end]);
+            let inputs = [&x[start..end], &y[start..end], &z[start..end]];
+            self.run(inputs);
             let len = end - start;
-            d[start..end].copy_from_slice(self.slot(self.tape.distance_slot(), len));
+            d[start..end].copy_from_slice(self.view(inputs, self.tape.distance_slot(), len));
             if let Some(m) = m.as_deref_mut() {
                 let stop = end.min(m.len());
-                self.write_materials(&mut m[start.min(stop)..stop]);
+                self.write_materials(inputs, &mut m[start.min(stop)..stop]);
             }
             start = end;
         }
     }
 
-    fn write_materials(&self, out: &mut [u32]) {
+    fn write_materials(&self, inputs: [&[T]; 3], out: &mut [u32]) {
         match self.tape.material_slot() {
             Some(s) => {
                 let n = out.len();
-                for (o, &v) in out.iter_mut().zip(self.slot(s, n)) {
+                for (o, &v) in out.iter_mut().zip(self.view(inputs, s, n)) {
                     *o = material_id(v);
                 }
             }
@@ -166,38 +168,44 @@ impl<'t, T: Float> Evaluator<'t, T> {
         }
     }
 
-    /// The first `n` values of a slot.
-    fn slot(&self, s: u32, n: usize) -> &[T] {
-        &self.slots[s as usize * self.chunk..][..n]
-    }
-
-    /// Copies the first `n` values of slot `from` to slot `to`.
-    fn copy(&mut self, from: u32, to: u32, n: usize) {
-        let c = self.chunk;
-        let from = from as usize * c;
-        self.slots.copy_within(from..from + n, to as usize * c);
-    }
-
-    /// One pass over the tape for up to `chunk` points.
+    /// The first `n` values of slot `s`: an input, or one of the scratch slots.
     #[inline(always)]
-    fn run(&mut self, x: &[T], y: &[T], z: &[T]) {
-        let mut n = x.len();
-        let chunk = self.chunk;
-        for (axis, src) in [(Axis::X, x), (Axis::Y, y), (Axis::Z, z)] {
-            if let Some(s) = self.tape.input_slot(axis) {
-                self.slots[s as usize * chunk..][..n].copy_from_slice(src);
+    fn view<'a>(&'a self, inputs: [&'a [T]; 3], s: u32, n: usize) -> &'a [T] {
+        match s.checked_sub(INPUTS) {
+            None => &inputs[s as usize][..n],
+            Some(s) => &self.slots[s as usize * self.chunk..][..n],
+        }
+    }
+
+    /// Copies the first `n` values of slot `from` to scratch slot `to`.
+    #[inline(always)]
+    fn copy(&mut self, inputs: [&[T]; 3], from: u32, to: u32, n: usize) {
+        let c = self.chunk;
+        let to = (to - INPUTS) as usize * c;
+        match from.checked_sub(INPUTS) {
+            None => self.slots[to..][..n].copy_from_slice(&inputs[from as usize][..n]),
+            Some(from) => {
+                let from = from as usize * c;
+                self.slots.copy_within(from..from + n, to);
             }
         }
+    }
+
+    /// One pass over the tape for up to `chunk` points (the inputs' length).
+    #[inline(always)]
+    fn run(&mut self, inputs: [&[T]; 3]) {
+        let mut n = inputs[0].len();
+        let chunk = self.chunk;
         let tape = self.tape;
         let steps = tape.steps();
         let mut depth = 0;
         let mut s = 0;
         while s < steps.len() {
             match steps[s] {
-                Step::Inst(inst) => inst.apply(&mut self.slots, chunk, n),
+                Step::Inst(inst) => inst.apply(&mut self.slots, inputs, chunk, n),
                 Step::Enter(g) => {
                     let guard = tape.guard(g);
-                    match self.enter(guard, depth, n) {
+                    match self.enter(inputs, guard, depth, n) {
                         Some(m) => {
                             depth += 1;
                             n = m;
@@ -210,7 +218,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
                 }
                 Step::Leave(g) => {
                     depth -= 1;
-                    n = self.leave(tape.guard(g), depth, n);
+                    n = self.leave(inputs, tape.guard(g), depth, n);
                 }
             }
             s += 1;
@@ -221,7 +229,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// hold their values from before), else the number of points it runs on, whose values
     /// from outside are gathered.
     #[inline(always)]
-    fn enter(&mut self, guard: &Guard, depth: usize, n: usize) -> Option<usize> {
+    fn enter(&mut self, inputs: [&[T]; 3], guard: &Guard, depth: usize, n: usize) -> Option<usize> {
         let c = self.chunk;
         let (mut idx, _) = std::mem::take(&mut self.frames[depth]);
         idx.resize(n, 0);
@@ -229,8 +237,8 @@ impl<'t, T: Float> Evaluator<'t, T> {
         {
             // Branch-free compaction: every index is written, the count advances where the
             // block runs (whether it does varies from point to point).
-            let bound = &self.slots[guard.bound as usize * c..][..n];
-            let best = &self.slots[guard.best as usize * c..][..n];
+            let bound = self.view(inputs, guard.bound, n);
+            let best = self.view(inputs, guard.best, n);
             for (i, (b, d)) in bound.iter().zip(best).enumerate() {
                 idx[m] = i as u32;
                 m += usize::from(!(*b >= *d));
@@ -239,17 +247,28 @@ impl<'t, T: Float> Evaluator<'t, T> {
         idx.truncate(m);
         if m == 0 {
             for &(dst, _, other) in &guard.phis {
-                self.copy(other, dst, n);
+                self.copy(inputs, other, dst, n);
             }
         } else if m == n {
             for &(from, to) in &guard.gathers {
-                self.copy(from, to, n);
+                self.copy(inputs, from, to, n);
             }
         } else {
             for &(from, to) in &guard.gathers {
-                let (from, to) = (from as usize * c, to as usize * c);
-                for (j, &i) in idx.iter().enumerate() {
-                    self.slots[to + j] = self.slots[from + i as usize];
+                let to = (to - INPUTS) as usize * c;
+                match from.checked_sub(INPUTS) {
+                    None => {
+                        let from = inputs[from as usize];
+                        for (j, &i) in idx.iter().enumerate() {
+                            self.slots[to + j] = from[i as usize];
+                        }
+                    }
+                    Some(from) => {
+                        let from = from as usize * c;
+                        for (j, &i) in idx.iter().enumerate() {
+                            self.slots[to + j] = self.slots[from + i as usize];
+                        }
+                    }
                 }
             }
         }
@@ -260,15 +279,15 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// Ends a guarded block that ran on `m` points: scatters its results into the enclosing
     /// block's packing, whose number of points it returns.
     #[inline(always)]
-    fn leave(&mut self, guard: &Guard, depth: usize, m: usize) -> usize {
+    fn leave(&mut self, inputs: [&[T]; 3], guard: &Guard, depth: usize, m: usize) -> usize {
         let c = self.chunk;
         let (idx, n) = std::mem::take(&mut self.frames[depth]);
         for &(dst, then, other) in &guard.phis {
             if m == n {
-                self.copy(then, dst, n);
+                self.copy(inputs, then, dst, n);
             } else {
-                self.copy(other, dst, n);
-                let (then, dst) = (then as usize * c, dst as usize * c);
+                self.copy(inputs, other, dst, n);
+                let (then, dst) = ((then - INPUTS) as usize * c, (dst - INPUTS) as usize * c);
                 for (j, &i) in idx.iter().enumerate() {
                     self.slots[dst + i as usize] = self.slots[then + j];
                 }

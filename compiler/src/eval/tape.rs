@@ -9,6 +9,7 @@
 //! only, so that the block's steps run over those points alone; `Leave` scatters the
 //! results back. Blocks nest, each packing relative to the one around it.
 
+use super::fuse::{self, Finish, Fusions, Pre};
 use super::{scalar, Float};
 use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::collections::HashMap;
@@ -35,10 +36,12 @@ enum Code {
     KBinary(Binary),
     /// `select(a, b, c)`
     Select,
+    /// A fused norm of 1 to 3 terms over `a`, `b`, `c` (see [`fuse`]).
+    Norm(Pre, u8, Finish),
 }
 
-/// One instruction over slots: `dst = code(a, b, c)` with the immediate `k`. `dst` never
-/// equals an operand.
+/// One instruction over slots: `dst = code(a, b, c)` with the immediate `k` (and, for a
+/// norm, its terms' offsets `ks`). `dst` never equals an operand.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Inst {
     code: Code,
@@ -47,6 +50,7 @@ pub(super) struct Inst {
     b: u32,
     c: u32,
     k: f64,
+    ks: [f64; 3],
 }
 
 /// A step of a tape.
@@ -74,13 +78,16 @@ pub(super) struct Guard {
     pub after: usize,
 }
 
+/// Slot numbers below this one are the inputs x, y and z, read in place from the caller's
+/// slices; scratch slot `s` (from `INPUTS` up) is the evaluator's `s - INPUTS`th chunk.
+pub(super) const INPUTS: u32 = 3;
+
 /// A program prepared for an [`super::Evaluator`].
 #[derive(Debug, Clone)]
 pub struct Tape {
     steps: Vec<Step>,
     guards: Vec<Guard>,
     constants: Vec<(u32, f64)>,
-    inputs: [Option<u32>; 3],
     slots: usize,
     depth: usize,
     instructions: usize,
@@ -88,11 +95,20 @@ pub struct Tape {
     material: Option<u32>,
 }
 
-/// Where each register lives, decided once per tape.
-#[derive(Debug, Default)]
+/// Where each register lives, decided once per tape: scratch slots from [`INPUTS`] up.
+#[derive(Debug)]
 struct Allocator {
     free: Vec<u32>,
     count: u32,
+}
+
+impl Default for Allocator {
+    fn default() -> Self {
+        Allocator {
+            free: Vec::new(),
+            count: INPUTS,
+        }
+    }
 }
 
 impl Allocator {
@@ -143,6 +159,7 @@ struct Compiler<'p> {
     live: Vec<bool>,
     live_blocks: Vec<bool>,
     slot_of: Vec<Option<u32>>,
+    fusions: Fusions,
     alloc: Allocator,
     tape: Tape,
     depth: usize,
@@ -155,18 +172,20 @@ impl Tape {
         if outputs == Outputs::DistanceAndMaterial {
             roots.push(program.material());
         }
-        let (live, live_blocks) = program.live(&roots);
+        let (live, _) = program.live(&roots);
+        let fusions = fuse::fuse(program, &live, &roots);
+        let (live, live_blocks) = (fusions.live.clone(), fusions.live_blocks.clone());
         let mut c = Compiler {
             program,
             live,
             live_blocks,
             slot_of: vec![None; program.len()],
+            fusions,
             alloc: Allocator::default(),
             tape: Tape {
                 steps: Vec::new(),
                 guards: Vec::new(),
                 constants: Vec::new(),
-                inputs: [None; 3],
                 slots: 0,
                 depth: 0,
                 instructions: 0,
@@ -183,7 +202,7 @@ impl Tape {
         if outputs == Outputs::DistanceAndMaterial {
             c.tape.material = Some(slot(program.material()));
         }
-        c.tape.slots = c.alloc.count.max(1) as usize;
+        c.tape.slots = (c.alloc.count - INPUTS).max(1) as usize;
         c.tape.instructions = c
             .tape
             .steps
@@ -203,7 +222,7 @@ impl Tape {
         self.instructions == 0
     }
 
-    /// Number of scratch slots (of one chunk each) an evaluator needs.
+    /// Number of scratch slots (of one chunk each) an evaluator needs (inputs not counted).
     pub fn slot_count(&self) -> usize {
         self.slots
     }
@@ -225,10 +244,6 @@ impl Tape {
         &self.constants
     }
 
-    pub(super) fn input_slot(&self, a: Axis) -> Option<u32> {
-        self.inputs[axis_index(a)]
-    }
-
     pub(super) fn distance_slot(&self) -> u32 {
         self.distance
     }
@@ -238,7 +253,8 @@ impl Tape {
     }
 }
 
-fn axis_index(a: Axis) -> usize {
+/// The slot of an input.
+fn axis_index(a: Axis) -> u32 {
     match a {
         Axis::X => 0,
         Axis::Y => 1,
@@ -266,9 +282,8 @@ impl Compiler<'_> {
         self.slot_of[r.0 as usize].unwrap_or(0)
     }
 
-    /// Slots for the constants read from memory and for the inputs, kept for the
-    /// evaluator's life (constants hold their value in every lane, so blocks read them
-    /// directly).
+    /// Slots for the constants read from memory, kept for the evaluator's life (constants
+    /// hold their value in every lane, so blocks read them directly), and the inputs' slots.
     fn permanent(&mut self, roots: &[Reg]) {
         let ops = self.program.ops();
         let mut need = vec![false; ops.len()];
@@ -277,6 +292,12 @@ impl Compiler<'_> {
         }
         for (i, op) in ops.iter().enumerate() {
             if !self.live[i] {
+                continue;
+            }
+            if self.fusions.norms[i].is_some() {
+                for r in self.fusions.reads(self.program, i) {
+                    need[r.0 as usize] = true;
+                }
                 continue;
             }
             match *op {
@@ -299,11 +320,7 @@ impl Compiler<'_> {
                     self.slot_of[i] = Some(s);
                     self.tape.constants.push((s, c));
                 }
-                Op::Input(a) if self.live[i] => {
-                    let s = self.alloc.fresh();
-                    self.slot_of[i] = Some(s);
-                    self.tape.inputs[axis_index(a)] = Some(s);
-                }
+                Op::Input(a) if self.live[i] => self.slot_of[i] = Some(axis_index(a)),
                 _ => {}
             }
         }
@@ -320,10 +337,11 @@ impl Compiler<'_> {
                 reads.push(r);
             }
         };
-        let body = block.start..block.end;
-        for (op, &live) in ops[body.clone()].iter().zip(&self.live[body]) {
-            if live {
-                op.operands().into_iter().for_each(|r| add(r, self));
+        for i in block.start..block.end {
+            if self.live[i] {
+                for r in self.fusions.reads(self.program, i) {
+                    add(r, self);
+                }
             }
         }
         for (nb, inner) in self.program.blocks().iter().enumerate() {
@@ -366,7 +384,7 @@ impl Compiler<'_> {
         for (k, e) in entries.iter().enumerate() {
             match e {
                 Entry::Op(i) if self.live[*i] => {
-                    for r in self.ops()[*i].operands() {
+                    for r in self.fusions.reads(self.program, *i) {
                         last.insert(r.0, k);
                     }
                 }
@@ -404,7 +422,7 @@ impl Compiler<'_> {
                         let inst = self.inst(*i);
                         self.tape.steps.push(Step::Inst(inst));
                     }
-                    self.ops()[*i].operands()
+                    self.fusions.reads(self.program, *i)
                 }
                 Entry::Block(b, inner) if self.live_blocks[*b] => {
                     self.block(*b, inner);
@@ -436,15 +454,29 @@ impl Compiler<'_> {
     /// freed, so that it is never one of them.
     fn inst(&mut self, i: usize) -> Inst {
         let op = self.ops()[i];
-        let (code, operands, k) = match op {
-            Op::Unary(u, a) => (Code::Unary(u), vec![a], 0.0),
-            Op::Binary(b, x, y) => match (self.constant(x), self.constant(y)) {
-                (_, Some(k)) => (Code::BinaryK(b), vec![x], k),
-                (Some(k), None) => (Code::KBinary(b), vec![y], k),
-                (None, None) => (Code::Binary(b), vec![x, y], 0.0),
+        let mut ks = [0.0; 3];
+        let (code, operands, k) = match (&self.fusions.norms[i], op) {
+            (Some(norm), _) => {
+                for (slot, t) in ks.iter_mut().zip(&norm.terms) {
+                    *slot = t.1;
+                }
+                let regs = norm.terms.iter().map(|t| t.0).collect();
+                (
+                    Code::Norm(norm.pre, norm.terms.len() as u8, norm.finish),
+                    regs,
+                    norm.k,
+                )
+            }
+            (None, op) => match op {
+                Op::Unary(u, a) => (Code::Unary(u), vec![a], 0.0),
+                Op::Binary(b, x, y) => match (self.constant(x), self.constant(y)) {
+                    (_, Some(k)) => (Code::BinaryK(b), vec![x], k),
+                    (Some(k), None) => (Code::KBinary(b), vec![y], k),
+                    (None, None) => (Code::Binary(b), vec![x, y], 0.0),
+                },
+                Op::Select(c, a, b) => (Code::Select, vec![c, a, b], 0.0),
+                Op::Const(_) | Op::Input(_) | Op::Phi(..) => (Code::Select, Vec::new(), 0.0),
             },
-            Op::Select(c, a, b) => (Code::Select, vec![c, a, b], 0.0),
-            Op::Const(_) | Op::Input(_) | Op::Phi(..) => (Code::Select, Vec::new(), 0.0),
         };
         let s: Vec<u32> = operands.iter().map(|&r| self.slot(r)).collect();
         let at = |n: usize| s.get(n).copied().unwrap_or(0);
@@ -457,6 +489,7 @@ impl Compiler<'_> {
             b: at(1),
             c: at(2),
             k,
+            ks,
         }
     }
 
@@ -522,34 +555,77 @@ impl Compiler<'_> {
 }
 
 impl Inst {
-    /// Runs this step on the first `n` points of `slots` (slots of `chunk` values, back to
-    /// back). The destination is split off the buffer; operands are read from both sides.
+    /// Runs this step on the first `n` points of `slots` (scratch slots of `chunk` values,
+    /// back to back) and `inputs`. The destination is split off the buffer; operands are
+    /// read from both sides, or from the inputs.
     #[inline(always)]
-    pub(super) fn apply<T: Float>(&self, slots: &mut [T], chunk: usize, n: usize) {
-        let dst = self.dst as usize;
+    pub(super) fn apply<T: Float>(
+        &self,
+        slots: &mut [T],
+        inputs: [&[T]; 3],
+        chunk: usize,
+        n: usize,
+    ) {
+        let dst = (self.dst - INPUTS) as usize;
         let (lo, rest) = slots.split_at_mut(dst * chunk);
         let (d, hi) = rest.split_at_mut(chunk);
-        let read = |s: u32| -> &[T] {
-            let s = s as usize;
-            if s < dst {
-                &lo[s * chunk..][..n]
-            } else {
-                &hi[(s - dst - 1) * chunk..][..n]
-            }
+        let sources = Sources {
+            inputs,
+            lo,
+            hi,
+            dst,
+            chunk,
+            n,
         };
         let d = &mut d[..n];
         let k = T::from_f64(self.k);
         match self.code {
-            Code::Unary(u) => unary_loop(u, d, read(self.a)),
-            Code::Binary(b) => binary_loop(b, d, read(self.a), read(self.b)),
-            Code::BinaryK(b) => binary_k_loop(b, d, read(self.a), k),
-            Code::KBinary(b) => k_binary_loop(b, d, k, read(self.a)),
+            Code::Unary(u) => unary_loop(u, d, sources.get(self.a)),
+            Code::Binary(b) => binary_loop(b, d, sources.get(self.a), sources.get(self.b)),
+            Code::BinaryK(b) => binary_k_loop(b, d, sources.get(self.a), k),
+            Code::KBinary(b) => k_binary_loop(b, d, k, sources.get(self.a)),
             Code::Select => {
-                let (c, x, y) = (read(self.a), read(self.b), read(self.c));
+                let (c, x, y) = (
+                    sources.get(self.a),
+                    sources.get(self.b),
+                    sources.get(self.c),
+                );
                 for (((o, &c), &p), &q) in d.iter_mut().zip(c).zip(x).zip(y) {
                     *o = scalar::select(c, p, q);
                 }
             }
+            Code::Norm(pre, terms, finish) => {
+                let ks = self.ks.map(T::from_f64);
+                let x = [self.a, self.b, self.c].map(|s| sources.get(s));
+                norm_loop(pre, terms, finish, d, x, ks, k);
+            }
+        }
+    }
+}
+
+/// Where an instruction's operands are read: the inputs, and the scratch slots below (`lo`)
+/// and above (`hi`) its destination.
+struct Sources<'a, T> {
+    inputs: [&'a [T]; 3],
+    lo: &'a [T],
+    hi: &'a [T],
+    dst: usize,
+    chunk: usize,
+    n: usize,
+}
+
+impl<'a, T> Sources<'a, T> {
+    /// The first `n` values of slot `s` (never the destination).
+    #[inline(always)]
+    fn get(&self, s: u32) -> &'a [T] {
+        let Some(s) = s.checked_sub(INPUTS) else {
+            return &self.inputs[s as usize][..self.n];
+        };
+        let s = s as usize;
+        if s < self.dst {
+            &self.lo[s * self.chunk..][..self.n]
+        } else {
+            &self.hi[(s - self.dst - 1) * self.chunk..][..self.n]
         }
     }
 }
@@ -558,6 +634,13 @@ impl Inst {
 fn map1<T: Float>(d: &mut [T], a: &[T], f: impl Fn(T) -> T) {
     for (o, &x) in d.iter_mut().zip(a) {
         *o = f(x);
+    }
+}
+
+#[inline(always)]
+fn map3<T: Float>(d: &mut [T], a: &[T], b: &[T], c: &[T], f: impl Fn(T, T, T) -> T) {
+    for (((o, &x), &y), &z) in d.iter_mut().zip(a).zip(b).zip(c) {
+        *o = f(x, y, z);
     }
 }
 
@@ -618,4 +701,47 @@ fn k_binary_loop<T: Float>(b: Binary, d: &mut [T], k: T, y: &[T]) {
         };
     }
     arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+}
+
+/// A fused norm: `finish(Σ pre(xᵢ, kᵢ)²)` over `terms` operands, summed left to right, the
+/// operations those of the instructions it replaces (one loop per combination).
+#[inline(always)]
+fn norm_loop<T: Float>(
+    pre: Pre,
+    terms: u8,
+    finish: Finish,
+    d: &mut [T],
+    x: [&[T]; 3],
+    ks: [T; 3],
+    k: T,
+) {
+    macro_rules! sum {
+        ($pre:expr, $fin:expr) => {{
+            let sq = |v: T, k: T| {
+                let t = scalar::binary($pre, v, k);
+                t * t
+            };
+            let fin = $fin;
+            match terms {
+                1 => map1(d, x[0], |a| fin(sq(a, ks[0]))),
+                2 => map2(d, x[0], x[1], |a, b| fin(sq(a, ks[0]) + sq(b, ks[1]))),
+                _ => map3(d, x[0], x[1], x[2], |a, b, c| {
+                    fin(sq(a, ks[0]) + sq(b, ks[1]) + sq(c, ks[2]))
+                }),
+            }
+        }};
+    }
+    macro_rules! finishes {
+        ($pre:expr) => {
+            match finish {
+                Finish::None => sum!($pre, |s: T| s),
+                Finish::Sqrt => sum!($pre, |s: T| s.sqrt()),
+                Finish::SqrtAdd => sum!($pre, |s: T| s.sqrt() + k),
+            }
+        };
+    }
+    match pre {
+        Pre::Add => finishes!(Binary::Add),
+        Pre::Max => finishes!(Binary::Max),
+    }
 }

@@ -267,6 +267,16 @@ impl Program {
     /// Which instructions the registers `roots` depend on, and which blocks (a block is
     /// needed when one of its `Phi`s is; then so are its `bound` and `best`).
     pub fn live(&self, roots: &[Reg]) -> (Vec<bool>, Vec<bool>) {
+        self.live_reading(roots, |i| self.ops[i].operands())
+    }
+
+    /// [`Program::live`] where instruction `i` reads `reads(i)` instead of its operands (a
+    /// back end that computes some values its own way).
+    pub fn live_reading(
+        &self,
+        roots: &[Reg],
+        reads: impl Fn(usize) -> Vec<Reg>,
+    ) -> (Vec<bool>, Vec<bool>) {
         let mut live = vec![false; self.ops.len()];
         let mut blocks = vec![false; self.blocks.len()];
         for r in roots {
@@ -279,7 +289,7 @@ impl Program {
             if !live[i] {
                 continue;
             }
-            for r in self.ops[i].operands() {
+            for r in reads(i) {
                 live[r.0 as usize] = true;
             }
             if let Some(b) = phi_block[i] {

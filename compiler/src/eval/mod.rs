@@ -145,9 +145,11 @@ impl<'t, T: Float> Evaluator<'t, T> {
         while start < n {
             let end = (start + self.chunk).min(n);
             let inputs = [&x[start..end], &y[start..end], &z[start..end]];
-            self.run(inputs);
-            let len = end - start;
-            d[start..end].copy_from_slice(self.view(inputs, self.tape.distance_slot(), len));
+            let out = &mut d[start..end];
+            self.run(inputs, out);
+            if !self.tape.direct() {
+                out.copy_from_slice(self.view(inputs, self.tape.distance_slot(), end - start));
+            }
             if let Some(m) = m.as_deref_mut() {
                 let stop = end.min(m.len());
                 self.write_materials(inputs, &mut m[start.min(stop)..stop]);
@@ -191,18 +193,24 @@ impl<'t, T: Float> Evaluator<'t, T> {
         }
     }
 
-    /// One pass over the tape for up to `chunk` points (the inputs' length).
+    /// One pass over the tape for up to `chunk` points (the inputs' length); a tape whose
+    /// last step computes the distance writes it into `out`.
     #[inline(always)]
-    fn run(&mut self, inputs: [&[T]; 3]) {
+    fn run(&mut self, inputs: [&[T]; 3], out: &mut [T]) {
         let mut n = inputs[0].len();
         let chunk = self.chunk;
         let tape = self.tape;
         let steps = tape.steps();
+        let direct = tape.direct().then(|| steps.len() - 1);
+        let mut out = Some(out);
         let mut depth = 0;
         let mut s = 0;
         while s < steps.len() {
             match steps[s] {
-                Step::Inst(inst) => inst.apply(&mut self.slots, inputs, chunk, n),
+                Step::Inst(inst) => {
+                    let out = if direct == Some(s) { out.take() } else { None };
+                    inst.apply(&mut self.slots, out, inputs, chunk, n);
+                }
                 Step::Enter(g) => {
                     let guard = tape.guard(g);
                     match self.enter(inputs, guard, depth, n) {

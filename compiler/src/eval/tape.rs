@@ -93,6 +93,9 @@ pub struct Tape {
     instructions: usize,
     distance: u32,
     material: Option<u32>,
+    /// Whether the last step computes the distance at the top level, and so can write it
+    /// straight into the caller's output.
+    direct: bool,
 }
 
 /// Where each register lives, decided once per tape: scratch slots from [`INPUTS`] up.
@@ -191,6 +194,7 @@ impl Tape {
                 instructions: 0,
                 distance: 0,
                 material: None,
+                direct: false,
             },
             depth: 0,
         };
@@ -203,6 +207,8 @@ impl Tape {
             c.tape.material = Some(slot(program.material()));
         }
         c.tape.slots = (c.alloc.count - INPUTS).max(1) as usize;
+        c.tape.direct =
+            matches!(c.tape.steps.last(), Some(Step::Inst(i)) if i.dst == c.tape.distance);
         c.tape.instructions = c
             .tape
             .steps
@@ -250,6 +256,11 @@ impl Tape {
 
     pub(super) fn material_slot(&self) -> Option<u32> {
         self.material
+    }
+
+    /// Whether the last step writes the distance (see [`Tape::direct`]).
+    pub(super) fn direct(&self) -> bool {
+        self.direct
     }
 }
 
@@ -555,27 +566,44 @@ impl Compiler<'_> {
 }
 
 impl Inst {
-    /// Runs this step on the first `n` points of `slots` (scratch slots of `chunk` values,
-    /// back to back) and `inputs`. The destination is split off the buffer; operands are
-    /// read from both sides, or from the inputs.
+    /// Runs this step on the first `n` points: into `out` where given, else into its own
+    /// slot of `slots` (scratch slots of `chunk` values, back to back), which is split off
+    /// the buffer; operands are read from the rest of it, or from the inputs.
     #[inline(always)]
     pub(super) fn apply<T: Float>(
         &self,
         slots: &mut [T],
+        out: Option<&mut [T]>,
         inputs: [&[T]; 3],
         chunk: usize,
         n: usize,
     ) {
-        let dst = (self.dst - INPUTS) as usize;
-        let (lo, rest) = slots.split_at_mut(dst * chunk);
-        let (d, hi) = rest.split_at_mut(chunk);
-        let sources = Sources {
-            inputs,
-            lo,
-            hi,
-            dst,
-            chunk,
-            n,
+        let (d, sources) = match out {
+            Some(out) => {
+                let sources = Sources {
+                    inputs,
+                    lo: slots,
+                    hi: &[],
+                    dst: usize::MAX,
+                    chunk,
+                    n,
+                };
+                (out, sources)
+            }
+            None => {
+                let dst = (self.dst - INPUTS) as usize;
+                let (lo, rest) = slots.split_at_mut(dst * chunk);
+                let (d, hi) = rest.split_at_mut(chunk);
+                let sources = Sources {
+                    inputs,
+                    lo,
+                    hi,
+                    dst,
+                    chunk,
+                    n,
+                };
+                (d, sources)
+            }
         };
         let d = &mut d[..n];
         let k = T::from_f64(self.k);
@@ -595,8 +623,13 @@ impl Inst {
                 }
             }
             Code::Norm(pre, terms, finish) => {
-                let ks = self.ks.map(T::from_f64);
-                let x = [self.a, self.b, self.c].map(|s| sources.get(s));
+                let [k0, k1, k2] = self.ks;
+                let ks = [T::from_f64(k0), T::from_f64(k1), T::from_f64(k2)];
+                let x = [
+                    sources.get(self.a),
+                    sources.get(self.b),
+                    sources.get(self.c),
+                ];
                 norm_loop(pre, terms, finish, d, x, ks, k);
             }
         }
@@ -604,7 +637,7 @@ impl Inst {
 }
 
 /// Where an instruction's operands are read: the inputs, and the scratch slots below (`lo`)
-/// and above (`hi`) its destination.
+/// and above (`hi`) its destination slot `dst` (all in `lo` when it writes elsewhere).
 struct Sources<'a, T> {
     inputs: [&'a [T]; 3],
     lo: &'a [T],

@@ -47,6 +47,20 @@ const BUDGET: u32 = 8;
 const NAN: u32 = 16;
 const OVERSHOOT: u32 = 32;
 
+/// The first lane from `from` on with a flag set: eight clear lanes are skipped at a time
+/// (most lanes go on after most steps).
+#[inline(always)]
+fn next_flagged(flags: &[u32], mut from: usize) -> Option<usize> {
+    while let Some(group) = flags.get(from..from + 8) {
+        if group.iter().fold(0, |a, &f| a | f) != 0 {
+            break;
+        }
+        from += 8;
+    }
+    let rest = flags.get(from..)?;
+    rest.iter().position(|&f| f != 0).map(|i| from + i)
+}
+
 /// `flag` when `b` holds, else 0 (branch-free).
 #[inline(always)]
 fn bit(b: bool, flag: u32) -> u32 {
@@ -82,7 +96,10 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             let next = (t[k] + st).max(zero);
             let count = steps[k] + 1;
             steps[k] = count;
-            t[k] = if hit { t[k] } else { next };
+            // A hit stays where it is. Written as a step of zero rather than as a store
+            // that keeps the old value, which compiles to a masked store, slow on some
+            // processors; t is never negative nor NaN, so `(t + 0).max(0)` is t exactly.
+            t[k] = (t[k] + if hit { zero } else { st }).max(zero);
             let fl = bit(hit, HIT)
                 | bit(next > max_dist, MISS)
                 | bit(count >= max_steps, BUDGET)
@@ -94,11 +111,10 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
         if any == 0 {
             return;
         }
-        for k in 0..n {
+        let mut next = 0;
+        while let Some(k) = next_flagged(&l.flags[..n], next) {
+            next = k + 1;
             let fl = l.flags[k];
-            if fl == 0 {
-                continue;
-            }
             self.counters.overshoots += (fl & OVERSHOOT != 0) as u64;
             let status = if fl & NAN != 0 {
                 self.counters.nans += 1;
@@ -185,8 +201,11 @@ impl<T: Float> Shadow<'_, T> {
             let s = f * inv_l;
             let tol = c.tolerance(eps * (t0[k] + t[k]), px[k], py[k], pz[k]);
             let soft = (kk[k] > zero) & (t[k] > zero);
-            let penumbra = res[k].min(kk[k] * s / t[k]);
-            res[k] = if soft { penumbra } else { res[k] };
+            // Without a penumbra term res stays: min with +∞ rather than a store keeping the
+            // old value (a slow masked store). res is never NaN here: it starts at 1 and a NaN
+            // distance finishes the lane in the step that produces it.
+            let penumbra = if soft { kk[k] * s / t[k] } else { T::from_f64(f64::INFINITY) };
+            res[k] = res[k].min(penumbra);
             let blocked = s.abs() < tol;
             let next = (t[k] + s).max(zero);
             t[k] = next;
@@ -203,11 +222,10 @@ impl<T: Float> Shadow<'_, T> {
         if any == 0 {
             return;
         }
-        for k in 0..n {
+        let mut next = 0;
+        while let Some(k) = next_flagged(&l.flags[..n], next) {
+            next = k + 1;
             let fl = l.flags[k];
-            if fl == 0 {
-                continue;
-            }
             self.counters.overshoots += (fl & OVERSHOOT != 0) as u64;
             if fl & NAN != 0 {
                 self.finish_nan(l, k);

@@ -183,7 +183,7 @@ fn slots_are_reused() {
 }
 
 /// One of each primitive, each moved off the origin (so that its length chains carry
-/// offsets), some rounded, blended or repeated.
+/// offsets), some rounded, blended, repeated or rotated, and a tilted plane.
 fn primitives_scene() -> Scene {
     let mut b = Build::new();
     let nodes = [
@@ -243,6 +243,20 @@ fn primitives_scene() -> Scene {
         child: s,
     });
     kids.push(rep);
+    let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+    let t = b.add(Node::Torus {
+        major: 0.5,
+        minor: 0.1,
+    });
+    let t = b.add(Node::Rotate {
+        matrix: [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
+        child: t,
+    });
+    kids.push(b.at(t, [0.0, 1.5, 0.5]));
+    kids.push(b.add(Node::Plane {
+        normal: [0.6, 0.8, 0.0],
+        height: -2.0,
+    }));
     let root = b.add(Node::Combine {
         op: Combine::Union,
         children: kids,
@@ -316,14 +330,15 @@ fn fused_steps_match_the_reference_bit_for_bit() {
 }
 
 #[test]
-fn the_length_idiom_is_one_step() {
+fn the_sums_of_distance_programs_are_one_step_each() {
+    let steps = |scene: Scene| Tape::new(&lower(&scene), Outputs::Distance).len();
     // `length(p - c) - r`: three offsets, three squares, two sums, a root and the radius.
     let mut b = Build::new();
     let s = b.add(Node::Sphere { radius: 0.5 });
     let root = b.at(s, [1.0, -2.0, 0.5]);
-    let program = lower(&b.finish(root));
-    assert!(program.len() > 10, "{}", program.len());
-    assert_eq!(Tape::new(&program, Outputs::Distance).len(), 1);
+    let scene = b.finish(root);
+    assert!(lower(&scene).len() > 10, "{}", lower(&scene).len());
+    assert_eq!(steps(scene), 1);
     // A torus is two lengths, the second of the first minus the major radius.
     let mut b = Build::new();
     let t = b.add(Node::Torus {
@@ -331,6 +346,13 @@ fn the_length_idiom_is_one_step() {
         minor: 0.25,
     });
     let root = b.at(t, [0.5, 0.0, 0.0]);
-    let program = lower(&b.finish(root));
-    assert_eq!(Tape::new(&program, Outputs::Distance).len(), 2);
+    assert_eq!(steps(b.finish(root)), 2);
+    // A tilted plane is `n·p - h`: products with constants, a sum and an offset.
+    assert_eq!(
+        steps(single(Node::Plane {
+            normal: [0.6, 0.8, 0.0],
+            height: 0.5,
+        })),
+        1
+    );
 }

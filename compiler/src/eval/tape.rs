@@ -9,7 +9,7 @@
 //! only, so that the block's steps run over those points alone; `Leave` scatters the
 //! results back. Blocks nest, each packing relative to the one around it.
 
-use super::fuse::{self, Finish, Fusions, Pre};
+use super::fuse::{self, Finish, Fusions, Kind};
 use super::{scalar, Float};
 use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::collections::HashMap;
@@ -36,12 +36,12 @@ enum Code {
     KBinary(Binary),
     /// `select(a, b, c)`
     Select,
-    /// A fused norm of 1 to 3 terms over `a`, `b`, `c` (see [`fuse`]).
-    Norm(Pre, u8, Finish),
+    /// A fused sum of 1 to 3 terms over `a`, `b`, `c` (see [`fuse`]).
+    Fused(Kind, u8, Finish),
 }
 
 /// One instruction over slots: `dst = code(a, b, c)` with the immediate `k` (and, for a
-/// norm, its terms' offsets `ks`). `dst` never equals an operand.
+/// fused step, its terms' constants `ks`). `dst` never equals an operand.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Inst {
     code: Code,
@@ -305,7 +305,7 @@ impl Compiler<'_> {
             if !self.live[i] {
                 continue;
             }
-            if self.fusions.norms[i].is_some() {
+            if self.fusions.fused[i].is_some() {
                 for r in self.fusions.reads(self.program, i) {
                     need[r.0 as usize] = true;
                 }
@@ -466,16 +466,16 @@ impl Compiler<'_> {
     fn inst(&mut self, i: usize) -> Inst {
         let op = self.ops()[i];
         let mut ks = [0.0; 3];
-        let (code, operands, k) = match (&self.fusions.norms[i], op) {
-            (Some(norm), _) => {
-                for (slot, t) in ks.iter_mut().zip(&norm.terms) {
+        let (code, operands, k) = match (&self.fusions.fused[i], op) {
+            (Some(f), _) => {
+                for (slot, t) in ks.iter_mut().zip(&f.terms) {
                     *slot = t.1;
                 }
-                let regs = norm.terms.iter().map(|t| t.0).collect();
+                let regs = f.terms.iter().map(|t| t.0).collect();
                 (
-                    Code::Norm(norm.pre, norm.terms.len() as u8, norm.finish),
+                    Code::Fused(f.kind, f.terms.len() as u8, f.finish),
                     regs,
-                    norm.k,
+                    f.k,
                 )
             }
             (None, op) => match op {
@@ -622,7 +622,7 @@ impl Inst {
                     *o = scalar::select(c, p, q);
                 }
             }
-            Code::Norm(pre, terms, finish) => {
+            Code::Fused(kind, terms, finish) => {
                 let [k0, k1, k2] = self.ks;
                 let ks = [T::from_f64(k0), T::from_f64(k1), T::from_f64(k2)];
                 let x = [
@@ -630,7 +630,7 @@ impl Inst {
                     sources.get(self.b),
                     sources.get(self.c),
                 ];
-                norm_loop(pre, terms, finish, d, x, ks, k);
+                fused_loop(kind, terms, finish, d, x, ks, k);
             }
         }
     }
@@ -736,11 +736,11 @@ fn k_binary_loop<T: Float>(b: Binary, d: &mut [T], k: T, y: &[T]) {
     arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
 }
 
-/// A fused norm: `finish(Σ pre(xᵢ, kᵢ)²)` over `terms` operands, summed left to right, the
+/// A fused step: `finish(Σ term(xᵢ, kᵢ))` over `terms` operands, summed left to right, the
 /// operations those of the instructions it replaces (one loop per combination).
 #[inline(always)]
-fn norm_loop<T: Float>(
-    pre: Pre,
+fn fused_loop<T: Float>(
+    kind: Kind,
     terms: u8,
     finish: Finish,
     d: &mut [T],
@@ -749,32 +749,31 @@ fn norm_loop<T: Float>(
     k: T,
 ) {
     macro_rules! sum {
-        ($pre:expr, $fin:expr) => {{
-            let sq = |v: T, k: T| {
-                let t = scalar::binary($pre, v, k);
-                t * t
-            };
-            let fin = $fin;
+        ($term:expr, $fin:expr) => {{
+            let (term, fin) = ($term, $fin);
             match terms {
-                1 => map1(d, x[0], |a| fin(sq(a, ks[0]))),
-                2 => map2(d, x[0], x[1], |a, b| fin(sq(a, ks[0]) + sq(b, ks[1]))),
+                1 => map1(d, x[0], |a| fin(term(a, ks[0]))),
+                2 => map2(d, x[0], x[1], |a, b| fin(term(a, ks[0]) + term(b, ks[1]))),
                 _ => map3(d, x[0], x[1], x[2], |a, b, c| {
-                    fin(sq(a, ks[0]) + sq(b, ks[1]) + sq(c, ks[2]))
+                    fin(term(a, ks[0]) + term(b, ks[1]) + term(c, ks[2]))
                 }),
             }
         }};
     }
     macro_rules! finishes {
-        ($pre:expr) => {
+        ($term:expr) => {
             match finish {
-                Finish::None => sum!($pre, |s: T| s),
-                Finish::Sqrt => sum!($pre, |s: T| s.sqrt()),
-                Finish::SqrtAdd => sum!($pre, |s: T| s.sqrt() + k),
+                Finish::None => sum!($term, |s: T| s),
+                Finish::Add => sum!($term, |s: T| s + k),
+                Finish::Sqrt => sum!($term, |s: T| s.sqrt()),
+                Finish::SqrtAdd => sum!($term, |s: T| s.sqrt() + k),
             }
         };
     }
-    match pre {
-        Pre::Add => finishes!(Binary::Add),
-        Pre::Max => finishes!(Binary::Max),
+    let square = |t: T| t * t;
+    match kind {
+        Kind::SquareAdd => finishes!(|v: T, k: T| square(v + k)),
+        Kind::SquareMax => finishes!(|v: T, k: T| square(v.max(k))),
+        Kind::Scale => finishes!(|v: T, k: T| v * k),
     }
 }

@@ -204,7 +204,11 @@ impl<T: Float> Shadow<'_, T> {
             // Without a penumbra term res stays: min with +∞ rather than a store keeping the
             // old value (a slow masked store). res is never NaN here: it starts at 1 and a NaN
             // distance finishes the lane in the step that produces it.
-            let penumbra = if soft { kk[k] * s / t[k] } else { T::from_f64(f64::INFINITY) };
+            let penumbra = if soft {
+                kk[k] * s / t[k]
+            } else {
+                T::from_f64(f64::INFINITY)
+            };
             res[k] = res[k].min(penumbra);
             let blocked = s.abs() < tol;
             let next = (t[k] + s).max(zero);

@@ -6,7 +6,8 @@
 //! instruction is one pass over the batch, storing a value that the next pass loads again.
 //! A [`Fused`] step replaces such a chain with one loop computing `finish(Σ term(aᵢ, kᵢ))`
 //! point by point in registers: the same IEEE operations in the same order, so results are
-//! bit for bit those of the chain.
+//! bit for bit those of the chain (of a NaN, only which NaN may differ: its sign or payload,
+//! which nothing reads).
 //!
 //! The chain's inner instructions are recomputed by the step, not read; those that nothing
 //! else reads run no step of their own. The rest of the program is untouched.
@@ -60,51 +61,37 @@ pub(super) struct Fused {
     pub k: f64,
 }
 
-/// The fusions of a program: which instructions root a [`Fused`] step, and which
-/// instructions and blocks still run once those steps read their terms' operands.
+/// The fused steps of a program: the one each instruction roots, if any.
 #[derive(Debug)]
 pub(super) struct Fusions {
     pub fused: Vec<Option<Fused>>,
-    /// The instructions whose values some step, block or result reads.
-    pub live: Vec<bool>,
-    /// The blocks whose results are read.
-    pub live_blocks: Vec<bool>,
 }
 
 impl Fusions {
     /// The registers an instruction's step reads: a fused step's term operands, else its
     /// operands.
     pub fn reads(&self, program: &Program, i: usize) -> Vec<Reg> {
-        reads(&self.fused, program, i)
+        match &self.fused[i] {
+            Some(f) => f.terms.iter().map(|t| t.0).collect(),
+            None => program.ops()[i].operands(),
+        }
     }
 }
 
-fn reads(fused: &[Option<Fused>], program: &Program, i: usize) -> Vec<Reg> {
-    match &fused[i] {
-        Some(f) => f.terms.iter().map(|t| t.0).collect(),
-        None => program.ops()[i].operands(),
-    }
-}
-
-/// Finds the fused steps of `program`, given which instructions the results `roots` need
-/// (`live`), and what then still runs.
+/// Finds the fused steps of the instructions of `program` that are `live`.
 ///
 /// Every live instruction that ends a chain roots a fused step. A chain's inner
 /// instructions are pure arithmetic, so the step recomputes them from the chain's operands
 /// instead of reading them; they keep a step of their own only where something else still
-/// reads them (a value shared by several chains is recomputed by each, which costs a few
-/// operations per point and saves a pass over memory).
-pub(super) fn fuse(program: &Program, live: &[bool], roots: &[Reg]) -> Fusions {
+/// reads them (what runs is found again from [`Fusions::reads`]; a value shared by several
+/// chains is recomputed by each, which costs a few operations per point and saves a pass
+/// over memory).
+pub(super) fn fuse(program: &Program, live: &[bool]) -> Fusions {
     let m = Matcher { ops: program.ops() };
-    let fused: Vec<Option<Fused>> = (0..program.len())
+    let fused = (0..program.len())
         .map(|i| if live[i] { m.fused(i) } else { None })
         .collect();
-    let (live, live_blocks) = program.live_reading(roots, |i| reads(&fused, program, i));
-    Fusions {
-        fused,
-        live,
-        live_blocks,
-    }
+    Fusions { fused }
 }
 
 /// A term found while matching: `term(reg, k)` of a kind.
@@ -115,7 +102,7 @@ struct Term {
     kind: Kind,
     /// The instructions it stands for.
     ops: usize,
-    /// For a square, its operand (the term without its pre-operation).
+    /// For a square, its operand (the term without its pre-operation); unused for products.
     squared: Reg,
 }
 
@@ -196,7 +183,7 @@ impl Matcher<'_> {
     }
 
     /// `r` as a sum of one to three terms, in the order they are added: a term, or an `add`
-    /// of a term and a term or a two-term sum; and the additions it stands for.
+    /// of a term and a term or a two-term sum.
     fn sum(&self, r: Reg) -> Option<Vec<Term>> {
         if let Some(t) = self.term(r) {
             return Some(vec![t]);

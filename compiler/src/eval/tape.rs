@@ -175,9 +175,11 @@ impl Tape {
         if outputs == Outputs::DistanceAndMaterial {
             roots.push(program.material());
         }
+        // What the results need, then what still runs once fused steps read their chains'
+        // operands.
         let (live, _) = program.live(&roots);
-        let fusions = fuse::fuse(program, &live, &roots);
-        let (live, live_blocks) = (fusions.live.clone(), fusions.live_blocks.clone());
+        let fusions = fuse::fuse(program, &live);
+        let (live, live_blocks) = program.live_reading(&roots, |i| fusions.reads(program, i));
         let mut c = Compiler {
             program,
             live,
@@ -207,8 +209,9 @@ impl Tape {
             c.tape.material = Some(slot(program.material()));
         }
         c.tape.slots = (c.alloc.count - INPUTS).max(1) as usize;
-        c.tape.direct =
-            matches!(c.tape.steps.last(), Some(Step::Inst(i)) if i.dst == c.tape.distance);
+        // Not where the material is the distance register: it is read from the slot.
+        c.tape.direct = matches!(c.tape.steps.last(), Some(Step::Inst(i)) if i.dst == c.tape.distance)
+            && c.tape.material != Some(c.tape.distance);
         c.tape.instructions = c
             .tape
             .steps
@@ -258,7 +261,8 @@ impl Tape {
         self.material
     }
 
-    /// Whether the last step writes the distance (see [`Tape::direct`]).
+    /// Whether the last step computes the distance at the top level, and so can write it
+    /// straight into the caller's output instead of its slot.
     pub(super) fn direct(&self) -> bool {
         self.direct
     }

@@ -202,8 +202,9 @@ impl<T: Float> Shadow<'_, T> {
             let tol = c.tolerance(eps * (t0[k] + t[k]), px[k], py[k], pz[k]);
             let soft = (kk[k] > zero) & (t[k] > zero);
             // Without a penumbra term res stays: min with +∞ rather than a store keeping the
-            // old value (a slow masked store). res is never NaN here: it starts at 1 and a NaN
-            // distance finishes the lane in the step that produces it.
+            // old value (a slow masked store). res is never NaN here: it starts at 1, and a
+            // NaN penumbra term needs a NaN distance, which finishes the lane in the step
+            // that produces it, or a softness that overflows to +∞ (above 3.4e38 in f32).
             let penumbra = if soft {
                 kk[k] * s / t[k]
             } else {

@@ -325,8 +325,10 @@ fn useful_notes(notes: Vec<Note>, resumes: &[bool], end: usize) -> Vec<Note> {
         .collect()
 }
 
+/// Whether `b(x, y)` and `b(y, x)` are the same value for every operand: not `min` and `max`,
+/// whose NaN rule makes the order matter.
 fn commutes(b: Binary) -> bool {
-    matches!(b, Binary::Add | Binary::Mul | Binary::Min | Binary::Max)
+    matches!(b, Binary::Add | Binary::Mul)
 }
 
 fn renumber(op: &Op, new_index: &[Reg]) -> Op {
@@ -468,5 +470,23 @@ impl Builder {
     pub fn max_comp(&mut self, p: P) -> Reg {
         let yz = self.max(p[1], p[2]);
         self.max(p[0], yz)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_exactly_commuting_operations_are_shared_in_either_order() {
+        let mut b = Builder::new(true);
+        let [x, y, _] = b.input_point();
+        // IEEE addition and multiplication commute, NaN included (up to which NaN).
+        assert_eq!(b.add(x, y), b.add(y, x));
+        assert_eq!(b.mul(x, y), b.mul(y, x));
+        // min and max do not: with a NaN operand the second one wins (eval::float).
+        assert_ne!(b.min(x, y), b.min(y, x));
+        assert_ne!(b.max(x, y), b.max(y, x));
+        assert_eq!(b.max(x, y), b.max(x, y));
     }
 }

@@ -26,6 +26,10 @@ use crate::lower::{Axis, Op, Program};
 /// The default number of points an evaluator processes per pass over the tape.
 pub const DEFAULT_CHUNK: usize = 256;
 
+/// Inside guarded blocks, steps run over a multiple of this many lanes (two vectors of
+/// eight f32).
+const BLOCK_LANES: usize = 16;
+
 /// Evaluates a program at one point, instruction by instruction (the reference semantics):
 /// a guarded block whose `bound >= best` is skipped, its results taking their values from
 /// before it. The material id is the material register converted to an integer (negative and
@@ -209,7 +213,14 @@ impl<'t, T: Float> Evaluator<'t, T> {
             match steps[s] {
                 Step::Inst(inst) => {
                     let out = if direct == Some(s) { out.take() } else { None };
-                    inst.apply(&mut self.slots, out, inputs, chunk, n);
+                    // Inside a block every operand is a scratch slot of `chunk` values, so a
+                    // step may run over whole vectors: the lanes past `n` hold stale values
+                    // that no result reads, and the loops skip their scalar tails.
+                    let width = match depth {
+                        0 => n,
+                        _ => n.next_multiple_of(BLOCK_LANES).min(chunk),
+                    };
+                    inst.apply(&mut self.slots, out, inputs, chunk, width);
                 }
                 Step::Enter(g) => {
                     let guard = tape.guard(g);

@@ -494,7 +494,9 @@ impl Compiler<'_> {
             },
         };
         let s: Vec<u32> = operands.iter().map(|&r| self.slot(r)).collect();
-        let at = |n: usize| s.get(n).copied().unwrap_or(0);
+        // An operand a step has no use for repeats its first (a fused sum of fewer than
+        // three terms still names three slots, which must exist where it runs).
+        let at = |n: usize| s.get(n).or(s.first()).copied().unwrap_or(0);
         let dst = self.alloc.fresh();
         self.slot_of[i] = Some(dst);
         Inst {

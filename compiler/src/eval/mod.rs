@@ -1,10 +1,11 @@
 //! The CPU interpreter of distance programs.
 //!
 //! A [`Tape`] is a program prepared for batch evaluation: instructions the requested outputs
-//! do not need are dropped, and registers are packed into a few reusable slots. An
-//! [`Evaluator`] runs a tape over batches of points given as separate x, y, z slices: each
-//! instruction is one tight loop over the batch, so the cost of decoding an instruction is
-//! shared by the whole batch and the compiler can vectorise the loops.
+//! do not need are dropped, chains of arithmetic that sum squares or products become one
+//! step each (`fuse.rs`), and registers are packed into a few reusable slots. An
+//! [`Evaluator`] runs a tape over batches of points given as separate x, y, z slices, read in
+//! place: each step is one tight loop over the batch, so the cost of decoding it is shared
+//! by the whole batch and the compiler can vectorise the loops.
 //!
 //! Everything is generic over [`Float`] (f32 or f64). [`eval_point`] is the one-point
 //! reference evaluation used by tests.

@@ -1,6 +1,7 @@
 //! Tapes: distance programs prepared for batch evaluation (dead instructions dropped,
-//! constant operands of two-operand instructions made immediate, registers packed into
-//! reusable slots), and the loop that runs each instruction.
+//! constant operands of two-operand instructions made immediate, fused steps where
+//! [`fuse`] finds them, registers packed into reusable slots; the inputs are slots 0 to 2,
+//! read in place), and the loop that runs each step.
 //!
 //! A guarded block becomes an `Enter` step, the block's steps and a `Leave` step. `Enter`
 //! finds the points of the batch where the block runs; where none does, it sets the block's

@@ -142,7 +142,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
         )
     }
 
-    /// The body of [`Evaluator::eval`], inlined into both copies [`wide`] makes of it.
+    /// The body of [`Evaluator::eval`], inlined into both copies [`wide()`] makes of it.
     #[inline(always)]
     fn eval_any(&mut self, x: &[T], y: &[T], z: &[T], d: &mut [T], mut m: Option<&mut [u32]>) {
         let n = x.len().min(y.len()).min(z.len()).min(d.len());

@@ -20,7 +20,7 @@ pub use float::Float;
 pub use tape::{Outputs, Tape};
 pub use wide::wide;
 
-use tape::{Guard, Step, INPUTS};
+use tape::{Guard, Sources, Step, INPUTS};
 
 use crate::lower::{Axis, Op, Program};
 
@@ -178,10 +178,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// The first `n` values of slot `s`: an input, or one of the scratch slots.
     #[inline(always)]
     fn view<'a>(&'a self, inputs: [&'a [T]; 3], s: u32, n: usize) -> &'a [T] {
-        match s.checked_sub(INPUTS) {
-            None => &inputs[s as usize][..n],
-            Some(s) => &self.slots[s as usize * self.chunk..][..n],
-        }
+        Sources::whole(inputs, &self.slots, self.chunk, n).get(s)
     }
 
     /// Copies the first `n` values of slot `from` to scratch slot `to`.

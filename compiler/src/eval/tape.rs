@@ -586,17 +586,7 @@ impl Inst {
         n: usize,
     ) {
         let (d, sources) = match out {
-            Some(out) => {
-                let sources = Sources {
-                    inputs,
-                    lo: slots,
-                    hi: &[],
-                    dst: usize::MAX,
-                    chunk,
-                    n,
-                };
-                (out, sources)
-            }
+            Some(out) => (out, Sources::whole(inputs, slots, chunk, n)),
             None => {
                 let dst = (self.dst - INPUTS) as usize;
                 let (lo, rest) = slots.split_at_mut(dst * chunk);
@@ -645,7 +635,7 @@ impl Inst {
 
 /// Where an instruction's operands are read: the inputs, and the scratch slots below (`lo`)
 /// and above (`hi`) its destination slot `dst` (all in `lo` when it writes elsewhere).
-struct Sources<'a, T> {
+pub(super) struct Sources<'a, T> {
     inputs: [&'a [T]; 3],
     lo: &'a [T],
     hi: &'a [T],
@@ -655,9 +645,22 @@ struct Sources<'a, T> {
 }
 
 impl<'a, T> Sources<'a, T> {
+    /// Every slot readable: the inputs and all of `slots`.
+    #[inline(always)]
+    pub(super) fn whole(inputs: [&'a [T]; 3], slots: &'a [T], chunk: usize, n: usize) -> Self {
+        Sources {
+            inputs,
+            lo: slots,
+            hi: &[],
+            dst: usize::MAX,
+            chunk,
+            n,
+        }
+    }
+
     /// The first `n` values of slot `s` (never the destination).
     #[inline(always)]
-    fn get(&self, s: u32) -> &'a [T] {
+    pub(super) fn get(&self, s: u32) -> &'a [T] {
         let Some(s) = s.checked_sub(INPUTS) else {
             return &self.inputs[s as usize][..self.n];
         };

@@ -246,11 +246,11 @@ fn towards<T: Float>(ctx: &Context<T>, lamp: &Lamp<T>, p: V3<T>) -> (V3<T>, T, T
 fn lamp_colour<T: Float>(lamp: &Lamp<T>) -> (V3<T>, T) {
     match *lamp {
         Lamp::Point {
-            color, softness, ..
+            color, sharpness, ..
         }
         | Lamp::Directional {
-            color, softness, ..
-        } => (color, softness),
+            color, sharpness, ..
+        } => (color, sharpness),
     }
 }
 

@@ -208,6 +208,36 @@ fn a_shadowed_pixel_is_darker_than_its_lit_neighbour() {
 }
 
 /// A red ball above a floor whose reflectivity is `reflect`.
+/// A glass ball half sunk into a checkered floor shows the floor through it (refracted rays
+/// inside the glass find the floor's surface there), not a dull dome of background colour:
+/// within the ball's lower half, both checker colours are seen.
+#[test]
+fn glass_sunk_into_the_floor_shows_the_floor_through_it() {
+    let text = "material glass = phong { color: (1, 1, 1), transparency: 0.9, ior: 1.5 };\n\
+                material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 0.5 };\n\
+                camera { position: (0, 1.5, -3), look_at: (0, 0.2, 0), fov: 50deg }\n\
+                light point { position: (2, 5, -3) }\n\
+                render { width: 320, height: 240 }\n\
+                scene { plane((0, 1, 0), 0) @ floor; sphere(0.8) @ glass; }";
+    let (scene, diags, _) = sdfc_compiler::check::check_str("glass.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let r = render(&scene);
+    // The pixels of the ball's lower half, above the floor's horizon line behind it.
+    let (mut bright, mut dark, mut all) = (0, 0, 0);
+    for y in 110..150 {
+        for x in 130..190 {
+            let l = luminance(r.image.pixel(x, y));
+            bright += (l > 0.4) as u32;
+            dark += (l < 0.2) as u32;
+            all += 1;
+        }
+    }
+    assert!(
+        bright * 8 > all && dark * 8 > all,
+        "{bright} bright and {dark} dark of {all} pixels: the floor is not seen through the glass"
+    );
+}
+
 /// `penumbra` means what its name says: the wider it is, the more of the floor around the
 /// shadow lies in a partial shadow, and the further the image is from the hard shadow's.
 #[test]

@@ -177,6 +177,7 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         features.push(("DEBUG_NAN", true));
     }
     let mut values: HashMap<&str, String> = HashMap::new();
+    on.insert("MEDIA", false);
     let data = match choice.primitives() {
         // An analytically traced scene needs no distance field.
         Some(primitives) => {
@@ -186,7 +187,21 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
             bytes
         }
         None => {
-            let (text, bytes) = marched(scene, program, options.max_instances);
+            let (mut text, bytes) = marched(scene, program, options.max_instances);
+            // Rays inside glass that may overlap a solid march the scene's media.
+            let media = on["REFRACTION"]
+                .then(|| crate::lower::media(scene))
+                .flatten();
+            on.insert("MEDIA", media.is_some());
+            if let Some(m) = media {
+                features.push(("MEDIA", true));
+                text.push('\n');
+                text.push_str(&map::write_sdf_named(&m.medium, "sdf_medium"));
+                text.push('\n');
+                text.push_str(&map::write_map_named(&m.solid, "map_solid"));
+                text.push('\n');
+                text.push_str(&map::write_sdf_named(&m.solid, "sdf_solid"));
+            }
             values.insert("MAP", text);
             bytes
         }

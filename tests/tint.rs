@@ -13,7 +13,8 @@
 //! The browser is `$SDFC_CHROMIUM`, or `chromium` (Debian's package) on PATH. Without it, or
 //! without a WebGPU adapter, the test prints that it skipped, unless `CI=true` or
 //! `SDFC_REQUIRE_DEVICES=1` (set by `.ci/run`, which installs it): then it fails. Nothing but
-//! 127.0.0.1 is reached, and the browser is killed after `DEADLINE`.
+//! 127.0.0.1 is reached, and the browser is killed after `deadline` (or when it exits early,
+//! which fails). `SDFC_TINT_PIPELINES=all` makes a pipeline of every kernel (minutes).
 
 use rayon::prelude::*;
 use sdfc_compiler::back::wgsl::{self, Options};
@@ -27,8 +28,13 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-/// The longest the browser may take for all kernels.
-const DEADLINE: Duration = Duration::from_secs(300);
+/// The longest the browser may take for `kernels` kernels, `pipelines` of them with pipelines
+/// (each well under a second on SwiftShader, on two busy cores).
+fn deadline(kernels: usize, pipelines: usize) -> Duration {
+    Duration::from_secs(60)
+        + Duration::from_millis(100) * kernels as u32
+        + Duration::from_secs(5) * pipelines as u32
+}
 
 /// The features of the kernel template, in the order of a combination's bits.
 const FEATURES: [&str; 12] = [
@@ -481,20 +487,34 @@ fn kernels_pass_tint() {
     let body = serde_json::to_string(&jobs).expect("JSON");
     let (send, receive) = mpsc::channel();
     std::thread::spawn(move || serve(listener, body, send));
-    let browser = launch(&exe, &url).unwrap_or_else(|e| panic!("cannot start {exe:?}: {e}"));
-    let deadline = Instant::now() + DEADLINE;
+    let mut browser = launch(&exe, &url).unwrap_or_else(|e| panic!("cannot start {exe:?}: {e}"));
+    let allowed = deadline(jobs.len(), pipelines);
+    let end = Instant::now() + allowed;
     let mut reports: BTreeMap<String, Vec<String>> = BTreeMap::new();
     let mut times: Vec<(f64, String)> = Vec::new();
     let adapter = loop {
-        let left = deadline.saturating_duration_since(Instant::now());
-        let Ok(text) = receive.recv_timeout(left) else {
+        let missing = || {
             let missing: Vec<&String> =
                 names.iter().filter(|n| !reports.contains_key(*n)).collect();
-            panic!(
-                "the browser did not finish within {DEADLINE:?}; {} kernels unreported, from {:?}",
+            format!(
+                "{} kernels unreported, from {:?}",
                 missing.len(),
                 missing.first()
+            )
+        };
+        if let Ok(Some(status)) = browser.child.try_wait() {
+            panic!(
+                "the browser exited ({status}) before it finished; {}",
+                missing()
             );
+        }
+        let text = match receive.recv_timeout(Duration::from_secs(1)) {
+            Ok(text) => text,
+            Err(_) if Instant::now() < end => continue,
+            Err(_) => panic!(
+                "the browser did not finish within {allowed:?}; {}",
+                missing()
+            ),
         };
         match serde_json::from_str::<Message>(&text) {
             Ok(Message::Report(r)) => {

@@ -37,7 +37,7 @@ fn deadline(kernels: usize, pipelines: usize) -> Duration {
 }
 
 /// The features of the kernel template, in the order of a combination's bits.
-const FEATURES: [&str; 12] = [
+const FEATURES: [&str; 13] = [
     "ANALYTIC",
     "RELAX",
     "POINT",
@@ -50,6 +50,7 @@ const FEATURES: [&str; 12] = [
     "REFRACTION",
     "SCENE_DATA",
     "DEBUG_NAN",
+    "MEDIA",
 ];
 
 /// One kernel for the browser.
@@ -165,10 +166,12 @@ impl Combo {
     /// Whether some scene has exactly these features: relaxation and soft lights only in a
     /// marched scene, softness only with a light, a checker, transparency or reflections only
     /// with a material besides the default one, refraction exactly when transparency meets
-    /// secondary rays.
+    /// secondary rays, media (glass overlapping a solid) only for refraction in a marched
+    /// scene.
     fn possible(self) -> bool {
         let h = |f| self.has(f);
         !(h("ANALYTIC") && (h("RELAX") || h("SOFT")))
+            && (!h("MEDIA") || (h("REFRACTION") && !h("ANALYTIC")))
             && (h("MATERIALS") || !(h("CHECKER") || h("TRANSPARENT") || h("SECONDARY")))
             && (!h("SOFT") || h("POINT") || h("DIRECTIONAL"))
             && h("REFRACTION") == (h("TRANSPARENT") && h("SECONDARY"))
@@ -199,7 +202,7 @@ impl Combo {
             text += &format!("material m0 = {kind}{optics} }};\n");
         }
         text += "camera { position: (0, 2, -6), look_at: (0, 0.8, 0) }\n";
-        let soft = |on: bool| if on { ", softness: 8" } else { "" };
+        let soft = |on: bool| if on { ", penumbra: 7deg" } else { "" };
         if h("POINT") {
             text += &format!(
                 "light point {{ position: (3, 6, -4){} }}\n",
@@ -223,6 +226,10 @@ impl Combo {
         text += &format!("scene {{\n  sphere(1).translate(-1.5, 1, 0){paint};\n");
         text += "  sphere(0.7).translate(1.5, 0.7, 0);\n";
         text += "  box((0.4, 0.4, 0.4)).translate(0, 0.4, 2);\n";
+        if h("MEDIA") {
+            // A floor under the glass ball, which rests on it.
+            text += "  plane();\n";
+        }
         if !h("ANALYTIC") {
             // Not an instance: a marched scene's `rest_map` has something in it.
             text += "  box((0.3, 0.6, 0.3)).twist(1).translate(0, 0.6, -1.5);\n";

@@ -317,6 +317,24 @@ fn an_unwritable_output_is_refused_before_the_render() {
 }
 
 #[test]
+fn render_prints_the_warnings_of_check() {
+    let d = dir("warnings");
+    std::fs::write(
+        d.join("dark.sdf"),
+        "render { width: 8, height: 6 }\nscene { sphere(1); }\n",
+    )
+    .expect("write scene");
+    let out = sdfc(&d, &["render", "dark.sdf"]);
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("[W0008]") && err.contains("no lights"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn outputs_are_written_in_the_format_their_extension_names() {
     let d = dir("formats");
     scene_file(&d);

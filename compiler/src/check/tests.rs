@@ -242,3 +242,30 @@ fn rotations_follow_the_right_hand_rule() {
         assert!(d < 0.0, "{shape}: {d} at {at:?}");
     }
 }
+
+#[test]
+fn an_error_in_a_body_shows_its_calls_up_to_four() {
+    // f0 fails for a negative radius; f1 … f5 each call the one below, so the chain has five
+    // calls: four are shown, and a note says there are more.
+    let mut src = String::from("fn f0(r: float) -> shape { sphere(r) }\n");
+    for i in 1..6 {
+        src.push_str(&format!(
+            "fn f{i}(r: float) -> shape {{ f{}(r - 1) }}\n",
+            i - 1
+        ));
+    }
+    src.push_str("scene { f5(3); }");
+    let (_, diags, _) = check_str("t.sdf", &src);
+    let d = diags.iter().find(|d| d.code == "E0400").expect("E0400");
+    let calls: Vec<&str> = d.labels[1..].iter().map(|l| l.message.as_str()).collect();
+    assert_eq!(
+        calls,
+        [
+            "called here with r = -2",
+            "called here with r = -1",
+            "called here with r = 0",
+            "called here with r = 1"
+        ]
+    );
+    assert!(d.notes.iter().any(|n| n.contains("further functions")));
+}

@@ -56,17 +56,16 @@ impl fmt::Display for Memory {
 
 /// The most bytes writing the outputs of a render of `settings` allocates, in whichever
 /// format (`crate::output`): for PNG the RGBA8 image, the PNG bytes (at most the raw image
-/// with its filter bytes, in a vector that may double) and the encoder's state; for JPEG the
-/// RGBA8 and RGB8 images, the encoder's rows of blocks (3 planes of 16 rows) and the bytes
-/// (taken as at most the RGBA8 image, in a vector that may double); for OpenEXR its bytes
-/// (12 a pixel and 16 a row with the header, allocated once); and with `aux` the depth
-/// sidecar's bytes.
+/// with its filter bytes, in a vector that may double) and the encoder's state; for JPEG,
+/// streamed into the file, the RGB8 image, the encoder's rows of blocks (3 planes of 16 rows)
+/// and its tables; OpenEXR is streamed from the image itself (a header and a buffer); and with
+/// `aux` the depth sidecar's bytes.
 pub fn output(settings: &Settings, aux: bool) -> u64 {
     let (w, h) = (settings.width as u64, settings.height as u64);
     let rgba = 4 * w * h;
     let png = rgba + 2 * (rgba + h + 4096) + 4 * MIB + 16 * (4 * w + 1);
-    let jpeg = rgba + 3 * w * h + 48 * (w + 16) + 2 * (rgba + 4096) + 2 * MIB;
-    let exr = 12 * w * h + 16 * h + 4096;
+    let jpeg = 3 * w * h + 48 * (w + 16) + MIB;
+    let exr = 64 * 1024;
     let sidecar = if aux { 20 + 8 * w * h } else { 0 };
     png.max(jpeg).max(exr) + sidecar
 }

@@ -1,9 +1,9 @@
 //! Where an image goes: the format its file name's extension names (PNG, JPEG or OpenEXR), or
 //! PNG on standard output for `-`; checked before a render starts, so that a long render is
 //! never thrown away because its output cannot be written. Files are written atomically
-//! ([`crate::image::write_atomic`]).
+//! ([`crate::image::write_atomic_with`]); JPEG and OpenEXR are streamed into them.
 
-use crate::image::{write_atomic, Image};
+use crate::image::{srgb_encode, write_atomic_with, Image};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -35,12 +35,16 @@ impl Format {
         }
     }
 
-    /// The image's bytes in this format.
-    pub fn encode(self, image: &Image) -> Result<Vec<u8>, String> {
+    /// Writes the image in this format to `w`: JPEG and OpenEXR are streamed, PNG is encoded
+    /// first ([`Image::encode_png`]).
+    pub fn write(self, image: &Image, w: &mut dyn Write) -> std::io::Result<()> {
         match self {
-            Format::Png => image.encode_png().map_err(|e| e.to_string()),
-            Format::Jpeg => encode_jpeg(image),
-            Format::Exr => Ok(encode_exr(image)),
+            Format::Png => {
+                let bytes = image.encode_png().map_err(std::io::Error::other)?;
+                w.write_all(&bytes)
+            }
+            Format::Jpeg => write_jpeg(image, w),
+            Format::Exr => write_exr(image, w),
         }
     }
 }
@@ -93,19 +97,14 @@ impl Output {
     pub fn write(&self, image: &Image) -> Result<(), String> {
         match self {
             Output::Stdout => {
-                let bytes = Format::Png.encode(image)?;
                 let mut out = std::io::stdout().lock();
-                out.write_all(&bytes)
+                Format::Png
+                    .write(image, &mut out)
                     .and_then(|()| out.flush())
                     .map_err(|e| format!("cannot write the image to standard output: {e}"))
             }
-            Output::File { path, format } => {
-                let bytes = format
-                    .encode(image)
-                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
-                write_atomic(path, &bytes)
-                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
-            }
+            Output::File { path, format } => write_atomic_with(path, |w| format.write(image, w))
+                .map_err(|e| format!("cannot write `{}`: {e}", path.display())),
         }
     }
 
@@ -157,31 +156,30 @@ pub fn check_writable(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// The image as a baseline JPEG (sRGB, clamped like the PNG).
-fn encode_jpeg(image: &Image) -> Result<Vec<u8>, String> {
-    let (Ok(w), Ok(h)) = (u16::try_from(image.width), u16::try_from(image.height)) else {
-        return Err("JPEG images are at most 65535 pixels wide and high".into());
+/// The image as a baseline JPEG (sRGB, clamped like the PNG), streamed to `w`.
+fn write_jpeg(image: &Image, w: &mut dyn Write) -> std::io::Result<()> {
+    let (Ok(width), Ok(height)) = (u16::try_from(image.width), u16::try_from(image.height)) else {
+        return Err(std::io::Error::other(
+            "JPEG images are at most 65535 pixels wide and high",
+        ));
     };
     let rgb: Vec<u8> = image
-        .to_rgba8()
-        .chunks_exact(4)
-        .flat_map(|px| [px[0], px[1], px[2]])
+        .linear
+        .iter()
+        .flat_map(|c| c.map(srgb_encode))
         .collect();
-    let mut bytes = Vec::new();
-    let encoder = jpeg_encoder::Encoder::new(&mut bytes, JPEG_QUALITY);
-    encoder
-        .encode(&rgb, w, h, jpeg_encoder::ColorType::Rgb)
-        .map_err(|e| format!("JPEG error: {e}"))?;
-    Ok(bytes)
+    jpeg_encoder::Encoder::new(w, JPEG_QUALITY)
+        .encode(&rgb, width, height, jpeg_encoder::ColorType::Rgb)
+        .map_err(|e| std::io::Error::other(format!("JPEG error: {e}")))
 }
 
-/// The image as a single-part scanline OpenEXR file: channels B, G and R (the order the
-/// format sorts them in) as 32-bit floats, linear and unclamped, one uncompressed scanline
-/// per chunk, increasing y (the OpenEXR file layout: magic number and version, the header's
-/// attributes, the offset table, then the chunks).
-pub fn encode_exr(image: &Image) -> Vec<u8> {
+/// The image as a single-part scanline OpenEXR file, streamed to `sink`: channels B, G and R
+/// (the order the format sorts them in) as 32-bit floats, linear and unclamped, one
+/// uncompressed scanline per chunk, increasing y (the OpenEXR file layout: magic number and
+/// version, the header's attributes, the offset table, then the chunks).
+pub fn write_exr(image: &Image, sink: &mut dyn Write) -> std::io::Result<()> {
     let (w, h) = (image.width as usize, image.height as usize);
-    let mut out = Vec::with_capacity(400 + 8 * h + h * (8 + 12 * w));
+    let mut out = Vec::with_capacity(400);
     out.extend_from_slice(&20000630i32.to_le_bytes());
     out.extend_from_slice(&[2, 0, 0, 0]);
     let mut attribute = |name: &str, kind: &str, value: &[u8]| {
@@ -217,20 +215,21 @@ pub fn encode_exr(image: &Image) -> Vec<u8> {
     out.push(0);
     let line = 12 * w;
     let first = out.len() + 8 * h;
+    sink.write_all(&out)?;
     for y in 0..h {
-        out.extend_from_slice(&((first + y * (8 + line)) as u64).to_le_bytes());
+        sink.write_all(&((first + y * (8 + line)) as u64).to_le_bytes())?;
     }
     for y in 0..h {
-        out.extend_from_slice(&(y as i32).to_le_bytes());
-        out.extend_from_slice(&(line as i32).to_le_bytes());
+        sink.write_all(&(y as i32).to_le_bytes())?;
+        sink.write_all(&(line as i32).to_le_bytes())?;
         let row = &image.linear[y * w..(y + 1) * w];
         for c in [2, 1, 0] {
             for px in row {
-                out.extend_from_slice(&px[c].to_le_bytes());
+                sink.write_all(&px[c].to_le_bytes())?;
             }
         }
     }
-    out
+    Ok(())
 }
 
 #[cfg(test)]
@@ -255,7 +254,8 @@ mod tests {
     fn exr_keeps_the_linear_values_in_its_scanlines() {
         let mut image = Image::new(3, 2);
         image.linear[4] = [2.5, -0.25, 0.125];
-        let bytes = encode_exr(&image);
+        let mut bytes = Vec::new();
+        write_exr(&image, &mut bytes).expect("written");
         assert_eq!(&bytes[..4], &20000630i32.to_le_bytes());
         // The offset table follows the header's terminating zero; the chunk of row 1 starts
         // with its y, its size, then B, G, R of its three pixels.

@@ -217,6 +217,9 @@ fn output(args: &RenderArgs) -> Result<Output, String> {
         .clone()
         .unwrap_or_else(|| default_output(&args.file));
     let out = Output::new(&path)?;
+    if out == Output::Stdout && std::io::stdout().is_terminal() {
+        return Err("`-o -` writes the PNG's bytes to standard output, which is a terminal here; redirect it (`-o - > out.png`) or name a file".into());
+    }
     if args.aux && out == Output::Stdout {
         return Err(
             "--aux writes the depth sidecar beside the image file; it cannot be used with `-o -`"

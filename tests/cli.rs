@@ -273,6 +273,126 @@ fn a_missing_or_invalid_output_directory_leaves_nothing() {
 }
 
 #[test]
+fn an_unwritable_output_is_refused_before_the_render() {
+    let d = dir("early");
+    scene_file(&d);
+    // A render that would take long: refused before it is lowered or announced.
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--size",
+            "4000x4000",
+            "--aa",
+            "4",
+            "-o",
+            "/nonexistent/x.png",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cannot write `/nonexistent/x.png`") && err.contains("does not exist"),
+        "{err}"
+    );
+    assert!(!err.contains("allocating"), "the render started: {err}");
+    // `pareto` checks its chart's place before its sweeps.
+    let out = sdfc(
+        &d,
+        &[
+            "pareto",
+            "ball.sdf",
+            "--frames",
+            "1",
+            "-o",
+            "missing/chart.svg",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty(), "the sweeps ran");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
+    assert_eq!(entries(&d), ["ball.sdf"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn render_prints_the_warnings_of_check() {
+    let d = dir("warnings");
+    std::fs::write(
+        d.join("dark.sdf"),
+        "render { width: 8, height: 6 }\nscene { sphere(1); }\n",
+    )
+    .expect("write scene");
+    let out = sdfc(&d, &["render", "dark.sdf"]);
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("[W0008]") && err.contains("no lights"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn outputs_are_written_in_the_format_their_extension_names() {
+    let d = dir("formats");
+    scene_file(&d);
+    for name in ["out.jpg", "out.JPEG"] {
+        let out = sdfc(&d, &["render", "ball.sdf", "-o", name]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(d.join(name)).expect("jpeg");
+        assert_eq!(&bytes[..3], &[0xFF, 0xD8, 0xFF], "{name} is not a JPEG");
+        assert_eq!(&bytes[bytes.len() - 2..], &[0xFF, 0xD9]);
+    }
+    // OpenEXR: magic number, version 2 (single-part scanline), a header of 305 bytes, the
+    // offset table and 30 rows of 40 float RGB pixels (runtime/src/output.rs).
+    let out = sdfc(&d, &["render", "ball.sdf", "-o", "out.exr"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let exr = std::fs::read(d.join("out.exr")).expect("exr");
+    assert_eq!(&exr[..8], &[0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0]);
+    assert!(String::from_utf8_lossy(&exr[..100]).contains("channels\0chlist"));
+    assert_eq!(exr.len(), 8 + 305 + 30 * 8 + 30 * (8 + 40 * 12));
+    // Unknown formats are refused before the render, leaving nothing.
+    for name in ["out.tiff", "out"] {
+        let out = sdfc(&d, &["render", "ball.sdf", "-o", name]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(".png`, `.jpg`"), "{err}");
+        assert!(!err.contains("allocating"), "{err}");
+    }
+    // `-o -`: the PNG on standard output (statistics on standard error), no file named `-`.
+    let out = sdfc(&d, &["render", "ball.sdf", "-o", "-", "--stats"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(&out.stdout[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(
+        &out.stdout[out.stdout.len() - 8..out.stdout.len() - 4],
+        b"IEND"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("steps/pixel"));
+    let out = sdfc(&d, &["render", "ball.sdf", "-o", "-", "--aux"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        entries(&d),
+        ["ball.sdf", "out.JPEG", "out.exr", "out.jpg"],
+        "no other file, no temporary file left"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn no_gpu_adapter_is_a_clear_error() {
     let d = dir("adapter");
     scene_file(&d);

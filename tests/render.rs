@@ -562,3 +562,23 @@ fn debug_nan_leaves_an_image_without_nan_unchanged() {
     assert_eq!(with.stats.counters.nans, 0);
     assert!(with.image == without.image);
 }
+
+/// The world is right-handed with y up: looking along +z (as the default camera does), +x
+/// is on the left of the picture (README, docs/language.md §8).
+#[test]
+fn looking_along_plus_z_plus_x_is_on_the_left() {
+    let text = "camera { position: (0, 0, -5), look_at: (0, 0, 0), fov: 40deg }\n\
+                light directional { direction: (0, 0, 1) }\n\
+                render { width: 40, height: 20, background: (0, 0, 0) }\n\
+                scene { sphere(0.5).translate(1, 0, 0); }";
+    let (scene, diags, _) = sdfc_compiler::check::check_str("hand.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let image = render(&scene).image;
+    let light = |xs: std::ops::Range<u32>| {
+        xs.flat_map(|x| (0..20).map(move |y| (x, y)))
+            .map(|(x, y)| luminance(image.pixel(x, y)))
+            .sum::<f32>()
+    };
+    assert!(light(0..20) > 1.0, "the left half is dark");
+    assert_eq!(light(20..40), 0.0, "the right half shows something");
+}

@@ -54,16 +54,20 @@ impl fmt::Display for Memory {
     }
 }
 
-/// The most bytes writing the outputs of a render of `settings` allocates: the RGBA8 image,
-/// the PNG bytes (at most the raw image with its filter bytes, in a vector that may double)
-/// and the encoder's state, and with `aux` the depth sidecar's bytes.
+/// The most bytes writing the outputs of a render of `settings` allocates, in whichever
+/// format (`crate::output`): for PNG the RGBA8 image, the PNG bytes (at most the raw image
+/// with its filter bytes, in a vector that may double) and the encoder's state; for JPEG,
+/// streamed into the file, the RGB8 image, the encoder's rows of blocks (3 planes of 16 rows)
+/// and its tables; OpenEXR is streamed from the image itself (a header and a buffer); and with
+/// `aux` the depth sidecar's bytes.
 pub fn output(settings: &Settings, aux: bool) -> u64 {
     let (w, h) = (settings.width as u64, settings.height as u64);
     let rgba = 4 * w * h;
-    let png = 2 * (rgba + h + 4096);
-    let encoder = 4 * MIB + 16 * (4 * w + 1);
+    let png = rgba + 2 * (rgba + h + 4096) + 4 * MIB + 16 * (4 * w + 1);
+    let jpeg = 3 * w * h + 48 * (w + 16) + MIB;
+    let exr = 64 * 1024;
     let sidecar = if aux { 20 + 8 * w * h } else { 0 };
-    rgba + png + encoder + sidecar
+    png.max(jpeg).max(exr) + sidecar
 }
 
 /// The most a `sdfc render` of `scene` allocates on `prepared`: the render; with

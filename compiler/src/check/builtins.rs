@@ -797,7 +797,7 @@ const LIGHT_COMMON: [P; 4] = [
         Deg(0.0),
         Within(0.0, 89.0 * std::f64::consts::PI / 180.0),
     ),
-    // The sharpness k = 1/tan(penumbra) of the old files; W0008 says what to write instead.
+    // The sharpness k = 1/tan(penumbra) of the old files; W0012 says what to write instead.
     p("softness", F, Num(0.0), NonNeg),
 ];
 

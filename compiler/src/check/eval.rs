@@ -41,6 +41,8 @@ pub struct Ctx {
     /// Where the render block sets `method`, for the error when analytic tracing is asked
     /// of a scene that does not allow it.
     pub method_span: Option<Span>,
+    /// Where the camera, the lights and the scene are written (`placement.rs`).
+    pub places: super::placement::Places,
     locals: Vec<(String, Value)>,
     dry: u32,
     depth: usize,
@@ -522,7 +524,7 @@ impl Ctx {
                     d = d.with_help(format!("did you mean `{s}`?"));
                 } else {
                     d = d.with_help(format!(
-                        "declare it: `material {} = phong {{ color: (1, 0, 0) }}`",
+                        "declare it: `material {} = phong {{ color: (0.8, 0.8, 0.8) }}`",
                         m.name
                     ));
                 }
@@ -824,8 +826,15 @@ impl Ctx {
         }
         self.locals = frame;
         self.depth += 1;
+        let before = self.diags.len();
         let v = self.body(&decl.body);
         self.depth -= 1;
+        if self.diags[before..].iter().any(Diagnostic::is_error) {
+            let label = call_label(&self.locals);
+            for d in &mut self.diags[before..] {
+                add_call_site(d, span, &label);
+            }
+        }
         self.locals = saved;
         let v = v.coerce(ret).unwrap_or(Value::Error);
         self.memo.insert(key, v.clone());
@@ -884,6 +893,45 @@ impl Ctx {
     }
 }
 
+/// At most this many call sites are added to a diagnostic inside nested function bodies.
+const MAX_CALL_SITES: usize = 4;
+
+/// `called here with r = -1, h = 2`: the label of a call site, with its arguments.
+fn call_label(params: &[(String, Value)]) -> String {
+    let args: Vec<String> = params
+        .iter()
+        .map(|(n, v)| match v {
+            Value::Shape(_) => format!("{n} = a shape"),
+            _ => format!("{n} = {v}"),
+        })
+        .collect();
+    if args.is_empty() {
+        "called here".into()
+    } else {
+        format!("called here with {}", args.join(", "))
+    }
+}
+
+/// Adds the call site of the function whose body reported `d` as a secondary label, so that
+/// an error inside a body shows the chain of calls that led to it (innermost first), up to
+/// [`MAX_CALL_SITES`] calls; a note says when more are left out.
+fn add_call_site(d: &mut Diagnostic, span: Span, label: &str) {
+    const MORE: &str = "called through further functions, not shown";
+    let sites = d
+        .labels
+        .iter()
+        .filter(|l| l.message.starts_with("called here"))
+        .count();
+    if sites < MAX_CALL_SITES {
+        d.labels.push(crate::diagnostics::Label {
+            span,
+            message: label.to_string(),
+        });
+    } else if !d.notes.iter().any(|n| n == MORE) {
+        d.notes.push(MORE.into());
+    }
+}
+
 /// The name of a value's type for messages (`?` for an error value).
 pub fn type_name(v: &Value) -> String {
     v.ty().map_or("?".into(), |t| t.to_string())
@@ -932,6 +980,7 @@ fn bind(
     }
     let mut next = 0;
     let mut seen_named = false;
+    let mut unknown: Vec<&Ident> = Vec::new();
     for a in args {
         match &a.name {
             None => {
@@ -985,21 +1034,28 @@ fn bind(
                         slots[i] = Some((a.value.clone(), a.span));
                         filled[i] = true;
                     }
-                    None => {
-                        let mut d = Diagnostic::error(
-                            "E0202",
-                            format!("`{}` has no parameter `{}`", callee.name, name.name),
-                            name.span,
-                        )
-                        .with_label("unknown parameter");
-                        if let Some(s) = closest(&name.name, params.iter().map(|p| p.name)) {
-                            d = d.with_help(format!("did you mean `{s}`?"));
-                        }
-                        errs.push(d);
-                    }
+                    None => unknown.push(name),
                 }
             }
         }
+    }
+    // Suggestions name only parameters that no argument fills.
+    for name in unknown {
+        let mut d = Diagnostic::error(
+            "E0202",
+            format!("`{}` has no parameter `{}`", callee.name, name.name),
+            name.span,
+        )
+        .with_label("unknown parameter");
+        let free = params
+            .iter()
+            .zip(&filled)
+            .filter(|(_, f)| !**f)
+            .map(|(p, _)| p.name);
+        if let Some(s) = closest(&name.name, free) {
+            d = d.with_help(format!("did you mean `{s}`?"));
+        }
+        errs.push(d);
     }
     for (i, p) in params.iter().enumerate() {
         if !filled[i] && !p.has_default {
@@ -1098,7 +1154,13 @@ pub fn record(
                     .collect::<Vec<_>>()
                     .join(", ")
             ));
-            if let Some(s) = closest(&f.name.name, rec.fields.iter().map(|p| p.name)) {
+            // Only fields that are not given already.
+            let free = rec
+                .fields
+                .iter()
+                .map(|p| p.name)
+                .filter(|n| !fields.iter().any(|g| g.name.name == *n));
+            if let Some(s) = closest(&f.name.name, free) {
                 d = d.with_help(format!("did you mean `{s}`?"));
             }
             cx.error(d);
@@ -1124,6 +1186,7 @@ pub fn record(
                 Value::Error
             }
         };
+        super::placement::colour(cx, rec.name, p.name, &v, f.value.span);
         if !v.is_abstract() {
             if let Err(why) = p.range.check(&v, &cx.limits) {
                 let mut d = Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span)

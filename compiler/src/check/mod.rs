@@ -8,6 +8,7 @@
 pub mod builtins;
 mod eval;
 mod ops;
+mod placement;
 mod suggest;
 pub mod types;
 
@@ -85,6 +86,10 @@ pub fn check_with(
         let analysis = crate::scene::analysis::analyse(&scene);
         cx.diags.extend_from_slice(analysis.diagnostics());
         analytic_method(&mut cx, &scene);
+    }
+    if !crate::diagnostics::has_errors(&cx.diags) {
+        // Where the camera and lights stand, and whether there are any lights.
+        placement::placement(&mut cx, &scene);
     }
     // Diagnostics in source order, whatever stage found them.
     cx.diags.sort_by_key(|d| (d.span().file, d.span().start));
@@ -229,6 +234,7 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
         materials: vec![Material::default_material()],
         ..Scene::default()
     };
+    declare_materials(cx, &mut scene, items);
     let mut seen_blocks: HashMap<&str, Span> = HashMap::new();
     let mut scene_item = None;
     for item in items {
@@ -308,7 +314,10 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
         cx.check_function(&name);
     }
     match scene_item {
-        Some((ast::Item::Scene { stmts, span }, _)) => scene.root = objects(cx, stmts, *span),
+        Some((ast::Item::Scene { stmts, span }, keyword)) => {
+            cx.places.scene = Some(keyword);
+            scene.root = objects(cx, stmts, *span)
+        }
         _ => cx.error(
             Diagnostic::error(
                 "E0503",
@@ -489,9 +498,11 @@ fn material(
     fields: &[ast::Field],
 ) {
     let rec = builtins::MATERIALS.iter().find(|r| r.name == kind.name);
-    if let Some((_, first)) = cx.material_ids.get(&name.name) {
-        let first = *first;
-        dup(cx, "the material", name, first);
+    let Some(&(id, first)) = cx.material_ids.get(&name.name) else {
+        return;
+    };
+    if first != name.span {
+        // A second definition, reported by `declare_materials`.
         return;
     }
     let Some(rec) = rec else {
@@ -533,8 +544,7 @@ fn material(
     } else {
         Pattern::Solid(f["color"].v3())
     };
-    let id = MaterialId(scene.materials.len() as u32);
-    scene.materials.push(Material {
+    scene.materials[id.0 as usize] = Material {
         name: name.name.clone(),
         pattern,
         ambient: f["ambient"].num(),
@@ -544,14 +554,35 @@ fn material(
         reflect,
         transparency,
         ior: f["ior"].num(),
-    });
-    cx.material_ids.insert(name.name.clone(), (id, name.span));
+    };
+}
+
+/// Gives every material its id before any item is evaluated, so that `@ name` finds a
+/// material declared anywhere in the program, above or below its use; a second definition
+/// of a name is E0207. Each material's fields are evaluated later, in source order.
+fn declare_materials(cx: &mut Ctx, scene: &mut Scene, items: &[ast::Item]) {
+    for item in items {
+        let ast::Item::Material { name, .. } = item else {
+            continue;
+        };
+        if let Some(&(_, first)) = cx.material_ids.get(&name.name) {
+            dup(cx, "the material", name, first);
+            continue;
+        }
+        let id = MaterialId(scene.materials.len() as u32);
+        scene.materials.push(Material {
+            name: name.name.clone(),
+            ..Material::default_material()
+        });
+        cx.material_ids.insert(name.name.clone(), (id, name.span));
+    }
 }
 
 fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
     match (b.keyword.name.as_str(), &b.kind) {
         ("camera", _) => {
             let f = eval::record(cx, &builtins::CAMERA, &b.fields, &b.keyword);
+            cx.places.camera = Some(field_span(&b.fields, "position").unwrap_or(b.keyword.span));
             scene.camera = Camera {
                 position: f["position"].v3(),
                 look_at: f["look_at"].v3(),
@@ -613,6 +644,9 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
             let f = eval::record(cx, rec, &b.fields, kind);
             let (color, intensity) = (f["color"].v3(), f["intensity"].num());
             let penumbra = penumbra(cx, &b.fields, &f);
+            cx.places
+                .lights
+                .push(field_span(&b.fields, "position").unwrap_or(kind.span));
             scene.lights.push(if rec.name == "point" {
                 Light::Point {
                     position: f["position"].v3(),
@@ -639,7 +673,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
 }
 
 /// A light's penumbra angle: its `penumbra` field, or the angle of the sharpness of the old
-/// `softness` field, with warning W0008 saying what to write instead (error E0203 for both).
+/// `softness` field, with warning W0012 saying what to write instead (error E0203 for both).
 fn penumbra(cx: &mut Ctx, fields: &[ast::Field], f: &HashMap<&'static str, Value>) -> f64 {
     let given = |name: &str| fields.iter().find(|x| x.name.name == name);
     let Some(old) = given("softness") else {
@@ -668,7 +702,7 @@ fn penumbra(cx: &mut Ctx, fields: &[ast::Field], f: &HashMap<&'static str, Value
         };
         cx.error(
             Diagnostic::warning(
-                "W0008",
+                "W0012",
                 "`softness` is replaced by `penumbra`",
                 old.name.span,
             )
@@ -688,6 +722,14 @@ fn penumbra(cx: &mut Ctx, fields: &[ast::Field], f: &HashMap<&'static str, Value
 fn short_degrees(d: f64) -> String {
     let s = format!("{d:.4}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// The span of the value of the field `name` of a block, when it is given.
+fn field_span(fields: &[ast::Field], name: &str) -> Option<Span> {
+    fields
+        .iter()
+        .find(|f| f.name.name == name)
+        .map(|f| f.value.span)
 }
 
 /// Evaluates the scene statements; returns the union of all objects.

@@ -165,3 +165,107 @@ fn every_compilation_limit_is_reported_with_the_flag_that_raises_it() {
         assert!(diags.iter().all(|d| !d.is_error()), "{limit}: {diags:#?}");
     }
 }
+
+#[test]
+fn a_material_can_be_used_above_its_declaration() {
+    // A global `let` painting with a material declared below it (issue 24, item 10).
+    let s =
+        ok("let s = sphere(1) @ blue;\nmaterial blue = phong { color: (0, 0, 1) };\nscene { s; }");
+    assert_eq!(s.materials[1].name, "blue");
+    assert_eq!(
+        s.materials[1].pattern,
+        crate::scene::Pattern::Solid([0.0, 0.0, 1.0])
+    );
+    let Node::Paint { material, .. } = s.graph.node(s.root.expect("root")) else {
+        panic!("not painted")
+    };
+    assert_eq!(material.0, 1);
+    assert_eq!(
+        codes("material m = phong {};\nmaterial m = phong {};\nscene { sphere() @ m; }"),
+        ["E0207"]
+    );
+}
+
+#[test]
+fn suggestions_skip_the_parameters_already_given() {
+    let help = |src: &str| {
+        let (_, diags, _) = check_str("t.sdf", src);
+        diags
+            .iter()
+            .find(|d| d.code == "E0202")
+            .and_then(|d| d.help.clone())
+    };
+    let f = "fn f(a: float, b: float = 1, c: float = 2) -> shape { sphere(a + b + c) }\n";
+    // `d` is one edit from a, b and c; a and c are given.
+    assert_eq!(
+        help(&format!("{f}scene {{ f(1, c: 3, d: 4); }}")).as_deref(),
+        Some("did you mean `b`?")
+    );
+    assert_eq!(
+        help(&format!("{f}scene {{ f(1, b: 2, c: 3, d: 4); }}")),
+        None
+    );
+    // The same for the fields of a record.
+    assert_eq!(
+        help("material m = phong { color: (1, 1, 1), colr: (1, 0, 0) };\nscene { sphere(); }"),
+        None
+    );
+}
+
+#[test]
+fn function_bodies_see_the_global_constants() {
+    // docs/language.md §5: a body sees its parameters, its `let`s and the global constants.
+    let s = ok("let k = 2;\nfn ball() -> shape { sphere(k) }\nscene { ball(); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 2.0 }
+    );
+    // ... and a call from a constant above the one the body uses is E0208.
+    assert_eq!(
+        codes("let b = ball();\nlet k = 2;\nfn ball() -> shape { sphere(k) }\nscene { b; }"),
+        ["E0208"]
+    );
+}
+
+#[test]
+fn rotations_follow_the_right_hand_rule() {
+    // README and docs/language.md §8: rotate_y(90deg) turns +x into −z, rotate_z(90deg) +x
+    // into +y, rotate_x(90deg) +y into +z.
+    for (shape, at) in [
+        ("translate(1, 0, 0).rotate_y(90deg)", [0.0, 0.0, -1.0]),
+        ("translate(1, 0, 0).rotate_z(90deg)", [0.0, 1.0, 0.0]),
+        ("translate(0, 1, 0).rotate_x(90deg)", [0.0, 0.0, 1.0]),
+    ] {
+        let s = ok(&format!("scene {{ sphere(0.1).{shape}; }}"));
+        let program = crate::lower::lower(&s);
+        let (d, _) = crate::eval::eval_point::<f64>(&program, at);
+        assert!(d < 0.0, "{shape}: {d} at {at:?}");
+    }
+}
+
+#[test]
+fn an_error_in_a_body_shows_its_calls_up_to_four() {
+    // f0 fails for a negative radius; f1 … f5 each call the one below, so the chain has five
+    // calls: four are shown, and a note says there are more.
+    let mut src = String::from("fn f0(r: float) -> shape { sphere(r) }\n");
+    for i in 1..6 {
+        src.push_str(&format!(
+            "fn f{i}(r: float) -> shape {{ f{}(r - 1) }}\n",
+            i - 1
+        ));
+    }
+    src.push_str("scene { f5(3); }");
+    let (_, diags, _) = check_str("t.sdf", &src);
+    let d = diags.iter().find(|d| d.code == "E0400").expect("E0400");
+    let calls: Vec<&str> = d.labels[1..].iter().map(|l| l.message.as_str()).collect();
+    assert_eq!(
+        calls,
+        [
+            "called here with r = -2",
+            "called here with r = -1",
+            "called here with r = 0",
+            "called here with r = 1"
+        ]
+    );
+    assert!(d.notes.iter().any(|n| n.contains("further functions")));
+}

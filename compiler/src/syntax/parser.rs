@@ -22,17 +22,60 @@ pub fn parse(file: FileId, tokens: &[(Token, Span)], eof: usize) -> (File, Vec<D
         .as_slice()
         .map(SimpleSpan::from(eof..eof), |(t, s)| (t, s));
     let (out, errors) = file_parser(file).parse(input).into_output_errors();
-    let diags = errors
-        .into_iter()
-        .map(|e| syntax_error(file, e, tokens))
+    // The materials this file declares, for "did you mean `@ red`?".
+    let materials: Vec<&str> = tokens
+        .windows(2)
+        .filter_map(|w| match (&w[0].0, &w[1].0) {
+            (Token::Material, Token::Ident(name)) => Some(name.as_str()),
+            _ => None,
+        })
         .collect();
+    let mut diags: Vec<Diagnostic> = Vec::new();
+    // After a keyword used as a name, the rest of its statement only echoes that mistake.
+    let mut echo_until = None;
+    for e in errors {
+        let start = e.span().start;
+        if echo_until.is_some_and(|end| start < end) {
+            continue;
+        }
+        let keyword = matches!(e.found(), Some(t) if is_keyword(t))
+            && e.expected()
+                .any(|p| matches!(p, chumsky::error::RichPattern::Label(l) if *l == "name"));
+        if keyword {
+            echo_until = tokens
+                .iter()
+                .find(|(t, s)| s.start as usize > start && matches!(t, Token::Semi | Token::RBrace))
+                .map(|(_, s)| s.end as usize);
+        }
+        diags.push(syntax_error(file, e, tokens, &materials));
+    }
     (out.unwrap_or(File { items: Vec::new() }), diags)
+}
+
+/// The keywords: reserved, they cannot be names.
+fn is_keyword(t: &Token) -> bool {
+    matches!(
+        t,
+        Token::Import
+            | Token::Let
+            | Token::Fn
+            | Token::Material
+            | Token::Camera
+            | Token::Light
+            | Token::Render
+            | Token::Scene
+            | Token::If
+            | Token::Else
+            | Token::For
+            | Token::In
+    )
 }
 
 fn syntax_error(
     file: FileId,
     e: Rich<'_, Token, SimpleSpan>,
     tokens: &[(Token, Span)],
+    materials: &[&str],
 ) -> Diagnostic {
     use chumsky::error::RichPattern;
     let span = Span::new(file, e.span().into_range());
@@ -54,6 +97,18 @@ fn syntax_error(
     if let chumsky::error::RichReason::Custom(msg) = e.reason() {
         return Diagnostic::error("E0100", msg.to_string(), span);
     }
+    if let Some(t) = e.found().filter(|t| is_keyword(t)) {
+        if expected.iter().any(|x| x == "name") {
+            return Diagnostic::error(
+                "E0100",
+                format!("{found} is a keyword, not a name"),
+                span,
+            )
+            .with_label("a keyword cannot be used as a name")
+            .with_note("the keywords are import, let, fn, material, camera, light, render, scene, if, else, for and in")
+            .with_help(format!("choose another name, such as `{}1`", t.to_string().trim_matches('`')));
+        }
+    }
     // A missing `;`, `,` or closing delimiter is reported just after the previous token, where
     // it belongs, rather than at the next token.
     let closers: Vec<&str> = ["`;`", "`,`", "`)`", "`}`"]
@@ -71,14 +126,36 @@ fn syntax_error(
             let mut d = Diagnostic::error("E0101", format!("expected {list}, found {found}"), at)
                 .with_label("something is missing here")
                 .with_secondary(span, format!("found {found}"));
-            if matches!(e.found(), Some(Token::Ident(u)) if u == "deg" || u == "rad") {
-                d = d.with_help("write an angle's unit right after the number, as in `90deg`");
+            let after_call = matches!(prev.0, Token::RParen);
+            match e.found() {
+                Some(Token::Ident(u)) if u == "deg" || u == "rad" => {
+                    d = d.with_help("write an angle's unit right after the number, as in `90deg`");
+                }
+                // `sphere(1) red;`: the `@` before a material is missing.
+                Some(Token::Ident(name))
+                    if closers.contains(&"`;`")
+                        && expected.iter().any(|x| x == "`@`")
+                        && (materials.contains(&name.as_str()) || after_call) =>
+                {
+                    d = d.with_help(format!(
+                        "did you mean `@ {name}`? A shape is painted with `shape @ material`"
+                    ));
+                    if materials.contains(&name.as_str()) {
+                        d = d.with_note(format!("`{name}` is a material declared in this file"));
+                    }
+                }
+                _ => {}
             }
             return d;
         }
     }
     let mut d = Diagnostic::error("E0100", format!("unexpected {found}"), span)
         .with_label(format!("unexpected {found}"));
+    if matches!(e.found(), Some(Token::For)) && !expected.iter().any(|x| x == "`for`") {
+        d = d.with_help(
+            "`for` loops belong in the `scene` block: a function's body is its `let`s and one value; call the function from a loop in the scene, or combine shapes with `union`",
+        );
+    }
     if !expected.is_empty() {
         let list = if expected.len() > 8 {
             format!("{}, …", expected[..8].join(", "))

@@ -408,15 +408,17 @@ pub fn run(args: ParetoArgs) -> ExitCode {
     finish(&args, &report)
 }
 
-/// Refuses a chart name that is neither .svg nor .png before any work is done.
+/// Refuses a chart name that is neither .svg nor .png, or that cannot be written (a missing
+/// directory), before any work is done.
 fn check_output(out: Option<&std::path::Path>) -> Result<(), String> {
-    let ext = out.map(|p| p.extension().map(|e| e.to_string_lossy().to_lowercase()));
+    let Some(path) = out else { return Ok(()) };
+    let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
     match ext {
-        None => Ok(()),
-        Some(Some(e)) if e == "svg" || e == "png" => Ok(()),
-        Some(_) => Err(format!(
+        Some(e) if e == "svg" || e == "png" => crate::output::check_writable(path)
+            .map_err(|why| format!("cannot write `{}`: {why}", path.display())),
+        _ => Err(format!(
             "`{}`: the chart must be a .svg or .png file",
-            out.map(|p| p.display().to_string()).unwrap_or_default()
+            path.display()
         )),
     }
 }

@@ -1,4 +1,4 @@
-//! `sdfc render`: render a scene to a PNG image (optionally the reference render with its
+//! `sdfc render`: render a scene to an image (PNG, JPEG or OpenEXR; optionally the reference render with its
 //! convergence check, and the depth sidecar), and the option handling `sdfc bench` and
 //! `sdfc pareto` share (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread
 //! pools).
@@ -7,6 +7,7 @@ use crate::backend::{Frame, Prepared, Setup};
 use crate::cpu::reference::{self, Convergence};
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat};
+use crate::output::Output;
 use crate::{depth, memory};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::lower::LowerOptions;
@@ -37,7 +38,9 @@ pub struct RenderArgs {
     /// relaxation or background (as r,g,b). May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Output PNG (default: the scene file's name with .png, in the current directory).
+    /// Output image: .png, .jpg (or .jpeg), or .exr (linear, unclamped 32-bit floats); `-`
+    /// writes the PNG to standard output (default: the scene file's name with .png, in the
+    /// current directory).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Print render statistics.
@@ -76,6 +79,14 @@ pub fn run(args: RenderArgs) -> ExitCode {
     };
     let (backend, precision) = match reference_mode(&args) {
         Ok(b) => b,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            return ExitCode::from(2);
+        }
+    };
+    // The output is checked before any work, so that a render is never thrown away.
+    let out = match output(&args) {
+        Ok(o) => o,
         Err(msg) => {
             eprintln!("error: {msg}");
             return ExitCode::from(2);
@@ -146,16 +157,12 @@ pub fn run(args: RenderArgs) -> ExitCode {
         None
     };
     let render = frame.render;
-    let out = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&args.file));
-    if let Err(e) = crate::image::write_png(&out, &render.image) {
-        eprintln!("error: cannot write `{}`: {e}", out.display());
+    if let Err(msg) = out.write(&render.image) {
+        eprintln!("error: {msg}");
         return ExitCode::from(2);
     }
-    if args.aux {
-        if let Err(msg) = write_sidecar(&out, render.depth.as_ref(), prepared.name()) {
+    if let (true, Some(path)) = (args.aux, out.path()) {
+        if let Err(msg) = write_sidecar(path, render.depth.as_ref(), prepared.name()) {
             eprintln!("error: {msg}");
             return ExitCode::from(2);
         }
@@ -163,7 +170,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
     let s = &scene.settings;
     eprintln!(
         "wrote {} ({}x{}, aa {}, {} on {}, {:.3} s)",
-        out.display(),
+        out,
         s.width,
         s.height,
         s.aa,
@@ -172,28 +179,58 @@ pub fn run(args: RenderArgs) -> ExitCode {
         seconds
     );
     if args.stats {
-        println!(
-            "backend         {} ({})",
+        let mut text = format!(
+            "backend         {} ({})\n",
             prepared.name(),
             prepared.device()
         );
         if let Some(p) = prepared.preparation() {
-            println!("prepared        {p}");
+            text.push_str(&format!("prepared        {p}\n"));
         }
-        println!(
-            "time            {:.3} s (frame {:.3} s)",
+        text.push_str(&format!(
+            "time            {:.3} s (frame {:.3} s)\n{}\n",
             seconds,
-            frame.time.as_secs_f64()
-        );
-        println!("{}", render.stats);
+            frame.time.as_secs_f64(),
+            render.stats
+        ));
         if let Some(c) = &check {
-            println!("{c}");
+            text.push_str(&format!("{c}\n"));
+        }
+        // With the image on standard output, the statistics go to standard error.
+        if out == Output::Stdout {
+            eprint!("{text}");
+        } else {
+            print!("{text}");
         }
     }
     if let Some(c) = check.as_ref().filter(|c| !c.converged) {
         eprintln!("warning: {}", not_converged(c));
     }
     ExitCode::SUCCESS
+}
+
+/// Where the image goes (`-o`, or the scene's name with `.png` in the current directory),
+/// checked: a known format, a writable place; `--aux` needs a file to put its sidecar beside.
+fn output(args: &RenderArgs) -> Result<Output, String> {
+    let path = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.file));
+    let out = Output::new(&path)?;
+    if out == Output::Stdout && std::io::stdout().is_terminal() {
+        return Err("`-o -` writes the PNG's bytes to standard output, which is a terminal here; redirect it (`-o - > out.png`) or name a file".into());
+    }
+    if args.aux && out == Output::Stdout {
+        return Err(
+            "--aux writes the depth sidecar beside the image file; it cannot be used with `-o -`"
+                .into(),
+        );
+    }
+    if let (true, Some(p)) = (args.aux, out.path()) {
+        crate::output::check_writable(&depth::sidecar_path(p))
+            .map_err(|why| format!("cannot write `{}`: {why}", depth::sidecar_path(p).display()))?;
+    }
+    Ok(out)
 }
 
 /// The backend and precision of a render: `--reference` means the CPU in f64.

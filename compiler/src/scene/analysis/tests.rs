@@ -20,8 +20,26 @@ fn root(objects: &str) -> Derived {
     *analyse(&s).root().expect("objects")
 }
 
+/// The analysis's warnings (not those about lights and the camera, `check/placement.rs`).
 fn codes(objects: &str) -> Vec<&'static str> {
-    scene(objects).1.iter().map(|d| d.code).collect()
+    scene(objects)
+        .1
+        .iter()
+        .map(|d| d.code)
+        .filter(|c| !["W0008", "W0009", "W0010"].contains(c))
+        .collect()
+}
+
+#[test]
+fn the_stretch_warning_says_which_rays_step_shorter() {
+    let (_, diags) = scene("box((0.5, 1, 0.5)).twist(4)");
+    let d = diags.iter().find(|d| d.code == "W0003").expect("W0003");
+    assert!(
+        d.notes.iter().any(|n| n.contains("local bounds")),
+        "{:?}",
+        d.notes
+    );
+    assert!(!d.notes.iter().any(|n| n.contains("every ray")));
 }
 
 #[test]

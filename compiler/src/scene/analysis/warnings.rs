@@ -51,7 +51,7 @@ impl Pass<'_> {
             format!("this {what} stretches distances up to {}-fold", fmt(sigma)),
             format!("rate {} at {} from its axis", fmt(rate), fmt(rho)),
             vec![
-                format!("the {} field is then only {}-Lipschitz, and the renderer divides every step of every ray of the scene by the scene's L", if what == "twist" { "twisted" } else { "bent" }, fmt(sigma)),
+                format!("the {} field is then only {}-Lipschitz: the operand that holds it is divided by its own L (local bounds, docs/analysis.md), so rays within that operand's bounding volume take steps divided by its L, and the rest of the scene steps as before", if what == "twist" { "twisted" } else { "bent" }, fmt(sigma)),
             ],
             &format!("lower the rate, or {what} a narrower shape"),
         );

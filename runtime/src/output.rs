@@ -1,0 +1,278 @@
+//! Where an image goes: the format its file name's extension names (PNG, JPEG or OpenEXR), or
+//! PNG on standard output for `-`; checked before a render starts, so that a long render is
+//! never thrown away because its output cannot be written. Files are written atomically
+//! ([`crate::image::write_atomic_with`]); JPEG and OpenEXR are streamed into them.
+
+use crate::image::{srgb_encode, write_atomic_with, Image};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// An image file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// 8-bit sRGB PNG.
+    Png,
+    /// 8-bit sRGB JPEG (quality [`JPEG_QUALITY`]).
+    Jpeg,
+    /// OpenEXR: the linear values, unclamped, as 32-bit floats (uncompressed scanlines).
+    Exr,
+}
+
+/// The JPEG quality `sdfc render -o out.jpg` writes with.
+pub const JPEG_QUALITY: u8 = 92;
+
+/// The extensions understood, for messages.
+pub const EXTENSIONS: &str = "`.png`, `.jpg` (or `.jpeg`) and `.exr`";
+
+impl Format {
+    /// The format an extension names (case-insensitive), if any.
+    pub fn from_extension(ext: &str) -> Option<Format> {
+        match ext.to_ascii_lowercase().as_str() {
+            "png" => Some(Format::Png),
+            "jpg" | "jpeg" => Some(Format::Jpeg),
+            "exr" => Some(Format::Exr),
+            _ => None,
+        }
+    }
+
+    /// Writes the image in this format to `w`: JPEG and OpenEXR are streamed, PNG is encoded
+    /// first ([`Image::encode_png`]).
+    pub fn write(self, image: &Image, w: &mut dyn Write) -> std::io::Result<()> {
+        match self {
+            Format::Png => {
+                let bytes = image.encode_png().map_err(std::io::Error::other)?;
+                w.write_all(&bytes)
+            }
+            Format::Jpeg => write_jpeg(image, w),
+            Format::Exr => write_exr(image, w),
+        }
+    }
+}
+
+/// Where `sdfc render` writes its image.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Output {
+    /// PNG bytes on standard output (`-o -`).
+    Stdout,
+    /// A file in the format its extension names.
+    File {
+        /// The file.
+        path: PathBuf,
+        /// Its format.
+        format: Format,
+    },
+}
+
+impl Output {
+    /// The output `-o PATH` names: `-` is standard output; otherwise the extension must name
+    /// a format and the file must be writable (its directory exists and takes a new file, and
+    /// the path is not a directory). Nothing is left behind by the check.
+    pub fn new(path: &Path) -> Result<Output, String> {
+        if path.as_os_str() == "-" {
+            return Ok(Output::Stdout);
+        }
+        let cannot = |why: String| format!("cannot write `{}`: {why}", path.display());
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let Some(format) = Format::from_extension(&ext) else {
+            let what = if ext.is_empty() {
+                "the file name has no extension".to_string()
+            } else {
+                format!("`.{ext}` is not an image format sdfc writes")
+            };
+            return Err(cannot(format!(
+                "{what}; the formats are {EXTENSIONS}, or `-` for PNG on standard output"
+            )));
+        };
+        check_writable(path).map_err(cannot)?;
+        Ok(Output::File {
+            path: path.to_path_buf(),
+            format,
+        })
+    }
+
+    /// Writes `image`: to the file atomically, or to standard output.
+    pub fn write(&self, image: &Image) -> Result<(), String> {
+        match self {
+            Output::Stdout => {
+                let mut out = std::io::stdout().lock();
+                Format::Png
+                    .write(image, &mut out)
+                    .and_then(|()| out.flush())
+                    .map_err(|e| format!("cannot write the image to standard output: {e}"))
+            }
+            Output::File { path, format } => write_atomic_with(path, |w| format.write(image, w))
+                .map_err(|e| format!("cannot write `{}`: {e}", path.display())),
+        }
+    }
+
+    /// The file, or `None` for standard output.
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            Output::Stdout => None,
+            Output::File { path, .. } => Some(path),
+        }
+    }
+}
+
+impl std::fmt::Display for Output {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Output::Stdout => f.write_str("standard output"),
+            Output::File { path, .. } => write!(f, "{}", path.display()),
+        }
+    }
+}
+
+/// Checks that a new file can be written at `path`: the path is not a directory, and a file
+/// can be created in its directory (created and removed again).
+pub fn check_writable(path: &Path) -> Result<(), String> {
+    if path.is_dir() {
+        return Err("it is a directory".into());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.exists() {
+        return Err(format!("the directory `{}` does not exist", dir.display()));
+    }
+    if !dir.is_dir() {
+        return Err(format!("`{}` is not a directory", dir.display()));
+    }
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let probe = dir.join(format!(".{name}.{}.probe", std::process::id()));
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(|e| format!("cannot create a file in `{}`: {e}", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// The image as a baseline JPEG (sRGB, clamped like the PNG), streamed to `w`.
+fn write_jpeg(image: &Image, w: &mut dyn Write) -> std::io::Result<()> {
+    let (Ok(width), Ok(height)) = (u16::try_from(image.width), u16::try_from(image.height)) else {
+        return Err(std::io::Error::other(
+            "JPEG images are at most 65535 pixels wide and high",
+        ));
+    };
+    let rgb: Vec<u8> = image
+        .linear
+        .iter()
+        .flat_map(|c| c.map(srgb_encode))
+        .collect();
+    jpeg_encoder::Encoder::new(w, JPEG_QUALITY)
+        .encode(&rgb, width, height, jpeg_encoder::ColorType::Rgb)
+        .map_err(|e| std::io::Error::other(format!("JPEG error: {e}")))
+}
+
+/// The image as a single-part scanline OpenEXR file, streamed to `sink`: channels B, G and R
+/// (the order the format sorts them in) as 32-bit floats, linear and unclamped, one
+/// uncompressed scanline per chunk, increasing y (the OpenEXR file layout: magic number and
+/// version, the header's attributes, the offset table, then the chunks).
+pub fn write_exr(image: &Image, sink: &mut dyn Write) -> std::io::Result<()> {
+    let (w, h) = (image.width as usize, image.height as usize);
+    let mut out = Vec::with_capacity(400);
+    out.extend_from_slice(&20000630i32.to_le_bytes());
+    out.extend_from_slice(&[2, 0, 0, 0]);
+    let mut attribute = |name: &str, kind: &str, value: &[u8]| {
+        for s in [name, kind] {
+            out.extend_from_slice(s.as_bytes());
+            out.push(0);
+        }
+        out.extend_from_slice(&(value.len() as i32).to_le_bytes());
+        out.extend_from_slice(value);
+    };
+    let mut channels = Vec::new();
+    for name in ["B", "G", "R"] {
+        channels.extend_from_slice(name.as_bytes());
+        channels.push(0);
+        channels.extend_from_slice(&2i32.to_le_bytes()); // FLOAT
+        channels.extend_from_slice(&[0, 0, 0, 0]); // pLinear, reserved
+        channels.extend_from_slice(&1i32.to_le_bytes()); // x sampling
+        channels.extend_from_slice(&1i32.to_le_bytes()); // y sampling
+    }
+    channels.push(0);
+    let window: Vec<u8> = [0, 0, w as i32 - 1, h as i32 - 1]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    attribute("channels", "chlist", &channels);
+    attribute("compression", "compression", &[0]);
+    attribute("dataWindow", "box2i", &window);
+    attribute("displayWindow", "box2i", &window);
+    attribute("lineOrder", "lineOrder", &[0]);
+    attribute("pixelAspectRatio", "float", &1f32.to_le_bytes());
+    attribute("screenWindowCenter", "v2f", &[0; 8]);
+    attribute("screenWindowWidth", "float", &1f32.to_le_bytes());
+    out.push(0);
+    let line = 12 * w;
+    let first = out.len() + 8 * h;
+    sink.write_all(&out)?;
+    for y in 0..h {
+        sink.write_all(&((first + y * (8 + line)) as u64).to_le_bytes())?;
+    }
+    for y in 0..h {
+        sink.write_all(&(y as i32).to_le_bytes())?;
+        sink.write_all(&(line as i32).to_le_bytes())?;
+        let row = &image.linear[y * w..(y + 1) * w];
+        for c in [2, 1, 0] {
+            for px in row {
+                sink.write_all(&px[c].to_le_bytes())?;
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_come_from_extensions() {
+        assert_eq!(Format::from_extension("PNG"), Some(Format::Png));
+        assert_eq!(Format::from_extension("jpeg"), Some(Format::Jpeg));
+        assert_eq!(Format::from_extension("jpg"), Some(Format::Jpeg));
+        assert_eq!(Format::from_extension("exr"), Some(Format::Exr));
+        assert_eq!(Format::from_extension("tiff"), None);
+        assert_eq!(Output::new(Path::new("-")), Ok(Output::Stdout));
+        let err = Output::new(Path::new("picture.tiff")).unwrap_err();
+        assert!(err.contains("`.tiff` is not an image format"), "{err}");
+        let err = Output::new(Path::new("/nonexistent-sdfc/x.png")).unwrap_err();
+        assert!(err.contains("does not exist"), "{err}");
+    }
+
+    #[test]
+    fn exr_keeps_the_linear_values_in_its_scanlines() {
+        let mut image = Image::new(3, 2);
+        image.linear[4] = [2.5, -0.25, 0.125];
+        let mut bytes = Vec::new();
+        write_exr(&image, &mut bytes).expect("written");
+        assert_eq!(&bytes[..4], &20000630i32.to_le_bytes());
+        // The offset table follows the header's terminating zero; the chunk of row 1 starts
+        // with its y, its size, then B, G, R of its three pixels.
+        let header_end = bytes.len() - 2 * 8 - 2 * (8 + 36);
+        assert_eq!(bytes[header_end - 1], 0);
+        let at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
+        let row1 = at(header_end + 8) as usize;
+        let f = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
+        assert_eq!(
+            i32::from_le_bytes(bytes[row1..row1 + 4].try_into().expect("y")),
+            1
+        );
+        let data = row1 + 8;
+        // Pixel (1, 1): B at index 1, G at 3 + 1, R at 6 + 1.
+        assert_eq!(f(data + 4), 0.125);
+        assert_eq!(f(data + 16), -0.25);
+        assert_eq!(f(data + 28), 2.5);
+        assert_eq!(bytes.len(), row1 + 8 + 36);
+    }
+}

@@ -8,7 +8,7 @@
 //! need, and a warning wherever a construct makes the field unreliable. Every rule, with its
 //! source or derivation, is in `docs/analysis.md`.
 //!
-//! [`Facts::lipschitz`] is the L of RENDERER.md: `f / L` is a distance bound (Hart 1996).
+//! [`Facts::lipschitz`] is the L of docs/rendering.md: `f / L` is a distance bound (Hart 1996).
 //! For a field with a known Lipschitz constant that constant is such an L; a bound has L = 1
 //! even where its gradient is steeper (the ellipsoid's). Where nothing is proven (a fractal,
 //! a repetition whose copies overlap their cells) L is the best guess, and

@@ -5,7 +5,7 @@
 //! and combined by plain union, no light asks for soft shadows (a penumbra estimate needs a
 //! distance field) and no glass overlaps another solid. Every ray then has closed-form roots: exact hits, exact normals, no step
 //! budget and no ε. The CPU renderer and the WGSL kernel (so also PTX) both trace the list of
-//! [`Primitive`]s this module produces (RENDERER.md, "Intersection"; docs/rendering.md).
+//! [`Primitive`]s this module produces (docs/rendering.md, "Analytic ray tracing").
 
 use super::ir::{Combine, MaterialId, Method, Node, NodeId, Scene, V3};
 use crate::span::Span;

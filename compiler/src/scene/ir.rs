@@ -211,7 +211,7 @@ pub enum Pattern {
     Checker { a: V3, b: V3, size: f64 },
 }
 
-/// A Phong material (RENDERER.md, "Shading at a hit").
+/// A Phong material (docs/rendering.md, "At a hit").
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
     /// The name it was declared with.
@@ -384,7 +384,7 @@ impl Default for Camera {
     }
 }
 
-/// Render settings (RENDERER.md); `sdfc render --set key=value` overrides them.
+/// Render settings (docs/rendering.md); `sdfc render --set key=value` overrides them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
     /// Image width in pixels.
@@ -409,7 +409,7 @@ pub struct Settings {
     pub method: Method,
 }
 
-/// The intersection method of a render (RENDERER.md, "Intersection").
+/// The intersection method of a render (docs/rendering.md, "Marching" and "Analytic ray tracing").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
     /// Analytic ray tracing when the scene allows it, sphere tracing otherwise.

@@ -1,4 +1,4 @@
-//! The two marches of RENDERER.md: sphere tracing to the nearest surface (camera and
+//! The two marches of docs/rendering.md: sphere tracing to the nearest surface (camera and
 //! secondary rays, with optional over-relaxation) and shadow rays (hard or soft, through
 //! transparent occluders).
 

@@ -1,12 +1,11 @@
-//! The CPU renderer of RENDERER.md: sphere tracing of a distance program, evaluated by the
+//! The CPU renderer of docs/rendering.md: sphere tracing of a distance program, evaluated by the
 //! batch interpreter, with Phong shading, hard and soft shadows, reflection and refraction.
 //!
 //! The image is cut into tiles rendered in parallel (rayon). Within a tile, rays travel in
 //! waves: all camera rays, then all the rays their hits spawned, and so on (no recursion).
 //! Each wave is marched in lanes of up to `Options::lanes` rays that are evaluated as one
 //! batch per step. A tile's result depends only on the tile, so the image is bit-identical
-//! whatever the number of threads. The choices RENDERER.md leaves open are written in
-//! `docs/rendering.md`.
+//! whatever the number of threads.
 
 mod analytic;
 mod camera;

@@ -1,4 +1,4 @@
-//! The reference render that accuracy is measured against (RENDERER.md, "Precision"): f64,
+//! The reference render that accuracy is measured against (docs/rendering.md, "Precision"): f64,
 //! ε = 1e-6, a step budget of 100 000, no over-relaxation and steps of d/L (L from
 //! `Options::lipschitz`), and its convergence check: a second render with ε ten times smaller
 //! must agree with it.

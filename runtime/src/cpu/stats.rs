@@ -1,4 +1,4 @@
-//! Render statistics: ray counts, the stability counters of RENDERER.md (hits, misses by
+//! Render statistics: ray counts, the stability counters of docs/rendering.md (hits, misses by
 //! budget, overshoots, NaNs) and the distribution of sphere-tracing steps per pixel.
 
 use std::fmt;

@@ -1,4 +1,4 @@
-//% sdfc renderer kernel template: RENDERER.md as a WGSL compute shader, one invocation per
+//% sdfc renderer kernel template: docs/rendering.md as a WGSL compute shader, one invocation per
 //% pixel. `//#if FEATURE` blocks are kept only when the scene uses the feature, a
 //% double-brace placeholder is replaced by a value, and `//%` lines (these) are dropped (see
 //% template.rs). The CPU renderer (runtime/src/cpu) implements the same algorithm;
@@ -91,7 +91,7 @@ struct Traced {
 }
 
 //#if ANALYTIC
-// Analytic ray tracing (RENDERER.md, "Intersection"). Every primitive is convex (a plane
+// Analytic ray tracing (docs/rendering.md, "Analytic ray tracing"). Every primitive is convex (a plane
 // bounds a half-space), so a ray meets it in one interval [near, far], near > far for a miss,
 // with the outward normals in the primitive's frame at both ends. BIG stands for infinity.
 const BIG: f32 = 3.0e38;
@@ -137,7 +137,7 @@ fn occlude(through: f32, s: Interval, tmax: f32, tau: f32) -> f32 {
 
 {{ANALYTIC}}
 //#else
-// Sphere tracing (RENDERER.md, "Intersection"), with over-relaxation when ω > 1.
+// Sphere tracing (docs/rendering.md, "Marching"), with over-relaxation when ω > 1.
 fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
     let eps = params.march.x;
     let max_dist = params.march.y;
@@ -520,7 +520,7 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     return acc;
 }
 
-// The direction of sample (i, j) of pixel (x, y) (RENDERER.md, "Per pixel").
+// The direction of sample (i, j) of pixel (x, y) (docs/rendering.md, "Camera").
 fn camera_dir(x: u32, y: u32, i: u32, j: u32) -> vec3<f32> {
     let n = f32(params.counts.z);
     let ax = (f32(x) + (f32(i) + 0.5) / n) / params.view.z;

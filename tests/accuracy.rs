@@ -306,7 +306,39 @@ fn distance_ops_count_transcendentals() {
     };
     assert_eq!(fp32::evaluations(&c), 18);
     // 10 operations × 100 evaluations in 1 µs is 1 GFLOP/s, a thousandth of 1 TFLOP/s.
-    assert!(close(fp32::fraction(10.0, 100, 1e-6, 1e12), 1e-3));
+    assert!(close(
+        fp32::fraction(10.0, 100, 1e-6, 1e12).expect("below 1"),
+        1e-3
+    ));
+    // A count that implies more than the peak is not a fraction of it.
+    assert_eq!(fp32::fraction(10.0, 1_000_000, 1e-6, 1e12), None);
+}
+
+/// issue 16, item 4: the guarded blocks that culling skips are not counted as work done.
+/// 1 000 spheres lower to a program whose blocks hold nearly all of it; a frame that
+/// evaluated the distance as often as the H100 run of `compound_1000.sdf` (fraction 5.63
+/// when every block was counted) gets a fraction of at most 1 or none.
+#[test]
+fn fp32_fraction_counts_only_what_runs_at_every_evaluation() {
+    let mut text = String::from("scene {\n");
+    for i in 0..1000 {
+        let (x, z) = ((i % 40) as f64 * 0.5, (i / 40) as f64 * 0.5);
+        text.push_str(&format!("  sphere(0.2).translate({x}, 0, {z});\n"));
+    }
+    text.push('}');
+    let (scene, diags, _) = sdfc_compiler::check::check_str("many.sdf", &text);
+    let program = lower(&scene.unwrap_or_else(|| panic!("{diags:?}")));
+    assert!(!program.blocks().is_empty(), "culling makes guarded blocks");
+    let (all, always) = (fp32::distance_ops(&program), fp32::unguarded_ops(&program));
+    assert!(always > 0.0 && always * 20.0 < all, "{always} of {all}");
+    // Evaluations and time such that every block counted would give 5.63 of the peak.
+    let (evaluations, seconds, peak) = (1_000_000_u64, 1e-3, 67e12);
+    let whole = all * evaluations as f64 / (seconds * peak);
+    let scale = 5.63 / whole;
+    let evaluations = (evaluations as f64 * scale) as u64;
+    assert_eq!(fp32::fraction(all, evaluations, seconds, peak), None);
+    let f = fp32::fraction(always, evaluations, seconds, peak).expect("a fraction");
+    assert!(f <= 1.0 && f > 0.0, "{f}");
 }
 
 // The command line: `render --reference/--aux`, `compare` with sidecars, `pareto`.

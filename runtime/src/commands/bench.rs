@@ -83,20 +83,19 @@ pub struct Timing {
     /// Instructions of the distance program.
     pub program_len: usize,
     /// FP32 operations of one evaluation of the distance, every guarded block counted
-    /// (`fp32::distance_ops`): an upper bound of the work per evaluation.
+    /// (`fp32::distance_ops`): for a program with guarded blocks, an upper bound of the work
+    /// per evaluation.
     pub ops_per_eval: f64,
-    /// The operations of `ops_per_eval` outside guarded blocks, which run at every
-    /// evaluation (`fp32::unguarded_ops`): a lower bound.
-    pub ops_per_eval_unguarded: f64,
     /// Evaluations of the distance in the last frame (marching steps and normal taps; 0 under
     /// analytic tracing, which evaluates no distance, and then the FP32 fields are null).
     pub evaluations: u64,
     /// GPU targets: the device's peak FP32 rate in TFLOP/s (null for the CPU and for a
     /// device not in the table of `fp32::PEAKS`).
     pub fp32_peak_tflops: Option<f64>,
-    /// GPU targets: ops_per_eval_unguarded · evaluations / (median_s · peak), a lower bound
-    /// of the fraction of the FP32 peak achieved (null where the peak is, and where the
-    /// quotient would exceed 1: never above 1).
+    /// GPU targets: ops_per_eval · evaluations / (median_s · peak), the fraction of the
+    /// FP32 peak achieved (`fp32::fraction_of_peak`): null where the peak is, for a program
+    /// with guarded blocks (what ran is not counted) and where the quotient would exceed 1.
+    /// Never above 1.
     pub fp32_fraction: Option<f64>,
     /// Statistics of the last frame.
     pub stats: Stats,
@@ -166,7 +165,7 @@ fn time_scene(
     limits: &Limits,
 ) -> Result<Timing, String> {
     let ops_per_eval = fp32::distance_ops(&program);
-    let ops_per_eval_unguarded = fp32::unguarded_ops(&program);
+    let guarded = !program.blocks().is_empty();
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
@@ -222,11 +221,11 @@ fn time_scene(
         method: if traced { "trace" } else { "march" },
         program_len: prepared.program_len(scene),
         ops_per_eval,
-        ops_per_eval_unguarded,
         evaluations,
         fp32_peak_tflops: peak.map(|p| p / 1e12),
         fp32_fraction: peak
-            .and_then(|p| fp32::fraction(ops_per_eval_unguarded, evaluations, median, p)),
+            .filter(|_| !guarded)
+            .and_then(|p| fp32::fraction(ops_per_eval, evaluations, median, p)),
         stats: last.stats,
     })
 }

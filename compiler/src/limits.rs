@@ -141,9 +141,10 @@ impl Limit {
                 1 << 30,
                 "memory a render may allocate, in MiB (host and device together)",
             ),
-            // 4 000 000 holds 2²⁰ primitives under a transform each in a binary tree of
-            // unions (3·2²⁰ nodes; 2¹⁸ of them take 0.3 s to check); every example is far below
-            // it (the largest, examples/scaling/compound_10000.sdf, expands to 120 003).
+            // 4 000 000 holds 2¹⁹ spheres built by sharing, two translated copies per level
+            // (2²¹ − 3 nodes as a tree: 0.8 s to check on the 2-core development machine);
+            // every example is far below it (the largest, examples/scaling/compound_10000.sdf,
+            // expands to 120 003).
             Limit::Expansion => s(
                 "expansion",
                 4_000_000,

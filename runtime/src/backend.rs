@@ -67,6 +67,14 @@ pub enum Prepared {
     },
 }
 
+/// A kernel loaded on a CUDA device, with what its launches need.
+struct CudaModule {
+    loaded: gpu::cuda::Loaded,
+    data: Option<Vec<u8>>,
+    specialisation: wgsl::Specialisation,
+    ptx_time: Duration,
+}
+
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
 #[derive(Debug)]
 pub struct Frame {
@@ -162,16 +170,26 @@ impl Prepared {
 
     fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
-        Self::cuda_on(cuda, scene, program, setup)
+        let module = Self::cuda_module(&cuda, scene, program, setup)?;
+        Ok(Prepared::Cuda {
+            cuda: Box::new(cuda),
+            loaded: Box::new(module.loaded),
+            data: module.data,
+            specialisation: module.specialisation,
+            ptx_time: module.ptx_time,
+            lipschitz: program.lipschitz(),
+            program: Box::new(program.clone()),
+            setup: *setup,
+        })
     }
 
     /// Writes the kernel for `scene`, translates it to PTX and loads it on `cuda`.
-    fn cuda_on(
-        cuda: Cuda,
+    fn cuda_module(
+        cuda: &Cuda,
         scene: &Scene,
         program: &Program,
         setup: &Setup,
-    ) -> Result<Prepared, String> {
+    ) -> Result<CudaModule, String> {
         let kernel = Self::kernel(scene, program, setup)?;
         let start = Instant::now();
         let options = ptx::Options {
@@ -183,15 +201,11 @@ impl Prepared {
         let loaded = cuda
             .load(&text, wgsl::ENTRY_POINT)
             .map_err(|e| e.to_string())?;
-        Ok(Prepared::Cuda {
-            cuda: Box::new(cuda),
-            loaded: Box::new(loaded),
+        Ok(CudaModule {
+            loaded,
             data: kernel.data,
             specialisation: kernel.specialisation,
             ptx_time,
-            lipschitz: program.lipschitz(),
-            program: Box::new(program.clone()),
-            setup: *setup,
         })
     }
 
@@ -225,10 +239,22 @@ impl Prepared {
                 **kernel = Self::kernel(scene, program, setup)?;
                 Ok(())
             }
-            Prepared::Cuda { program, setup, .. } => {
-                let (program, setup) = (program.as_ref().clone(), *setup);
-                let cuda = Cuda::open().map_err(|e| e.to_string())?;
-                *self = Self::cuda_on(cuda, scene, &program, &setup)?;
+            Prepared::Cuda {
+                cuda,
+                loaded,
+                data,
+                specialisation,
+                ptx_time,
+                program,
+                setup,
+                ..
+            } => {
+                // The same device and context; the new module replaces the old one.
+                let module = Self::cuda_module(cuda, scene, program, setup)?;
+                **loaded = module.loaded;
+                *data = module.data;
+                *specialisation = module.specialisation;
+                *ptx_time = module.ptx_time;
                 Ok(())
             }
         }

@@ -306,7 +306,56 @@ fn distance_ops_count_transcendentals() {
     };
     assert_eq!(fp32::evaluations(&c), 18);
     // 10 operations × 100 evaluations in 1 µs is 1 GFLOP/s, a thousandth of 1 TFLOP/s.
-    assert!(close(fp32::fraction(10.0, 100, 1e-6, 1e12), 1e-3));
+    assert!(close(
+        fp32::fraction(10.0, 100, 1e-6, 1e12).expect("below 1"),
+        1e-3
+    ));
+    // A count that implies more than the peak is not a fraction of it.
+    assert_eq!(fp32::fraction(10.0, 1_000_000, 1e-6, 1e12), None);
+}
+
+/// issue 16, item 4: `fp32_fraction` is never above 1. The guarded blocks of culling run
+/// only where their bounds are near, which the statistics do not count: 1 000 spheres lower
+/// to a program whose blocks hold nearly all of it, and a frame that evaluated the distance
+/// as often as the H100 run of `compound_1000.sdf` (5.63 of the peak when every block was
+/// counted) gets no fraction. A program without blocks runs all of it at every evaluation:
+/// its fraction is exact.
+#[test]
+fn fp32_fraction_is_given_only_where_what_runs_is_counted_and_never_above_1() {
+    let mut text = String::from("scene {\n");
+    for i in 0..1000 {
+        let (x, z) = ((i % 40) as f64 * 0.5, (i / 40) as f64 * 0.5);
+        text.push_str(&format!("  sphere(0.2).translate({x}, 0, {z});\n"));
+    }
+    text.push('}');
+    let (scene, diags, _) = sdfc_compiler::check::check_str("many.sdf", &text);
+    let program = lower(&scene.unwrap_or_else(|| panic!("{diags:?}")));
+    assert!(!program.blocks().is_empty(), "culling makes guarded blocks");
+    let all = fp32::distance_ops(&program);
+    // Evaluations and time such that every block counted gives 5.63 of the peak.
+    let (seconds, peak) = (1e-3, 67e12);
+    let evaluations = (5.63 * seconds * peak / all) as u64;
+    assert!(all * evaluations as f64 / (seconds * peak) > 5.0);
+    assert_eq!(fp32::fraction(all, evaluations, seconds, peak), None);
+    assert_eq!(
+        fp32::fraction_of_peak(&program, evaluations, seconds, peak),
+        None
+    );
+    // Fewer evaluations: still none, as what ran is not known.
+    assert_eq!(
+        fp32::fraction_of_peak(&program, evaluations / 100, seconds, peak),
+        None
+    );
+    // One sphere: no blocks, every operation runs at every evaluation.
+    let one = lower(&single(Node::Sphere { radius: 1.0 }));
+    assert!(one.blocks().is_empty());
+    let ops = fp32::distance_ops(&one);
+    let f = fp32::fraction_of_peak(&one, 1_000_000, seconds, peak).expect("a fraction");
+    assert!(
+        (f - ops * 1e6 / (seconds * peak)).abs() < 1e-12 && f <= 1.0,
+        "{f}"
+    );
+    assert_eq!(fp32::fraction_of_peak(&one, u64::MAX, seconds, peak), None);
 }
 
 // The command line: `render --reference/--aux`, `compare` with sidecars, `pareto`.

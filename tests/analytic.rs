@@ -181,3 +181,53 @@ fn the_kernel_of_ten_thousand_spheres_stays_small() {
     let (_, seed2) = kernel("seed2.sdf");
     assert!(seed2.data.is_none() && !seed2.source.contains("scene_data"));
 }
+
+/// issue 16, item 2: the check that no glass primitive overlaps another walks the
+/// bounding-volume hierarchy instead of every pair: 40 000 glass spheres on a grid (1.6·10⁹
+/// pairs) are chosen for tracing in a moment, and one touching pair among them is still
+/// found. The `traced` limit moves where `auto` stops tracing.
+#[test]
+fn glass_overlap_is_found_through_the_hierarchy_and_traced_is_a_limit() {
+    let grid = |extra: &str| {
+        format!(
+            "material glass = phong {{ color: (1, 1, 1), transparency: 0.9, ior: 1.5 }};
+             scene {{
+               for i in 0..200 {{ for j in 0..200 {{ sphere(0.3).translate(i, 0, j) @ glass; }} }}
+               {extra}
+             }}"
+        )
+    };
+    let check = |text: &str| {
+        let (scene, diags, _) = sdfc_compiler::check::check_str("glass.sdf", text);
+        scene.unwrap_or_else(|| panic!("{diags:?}"))
+    };
+    let apart = check(&grid(""));
+    let start = std::time::Instant::now();
+    let n = choose(&apart).primitives().map(<[_]>::len);
+    let took = start.elapsed();
+    assert_eq!(n, Some(40_000));
+    assert!(took.as_secs_f64() < 5.0, "took {took:?}");
+    // One more sphere touching the glass sphere at (150, 0, 70).
+    let touching = check(&grid("sphere(0.3).translate(150.5, 0, 70);"));
+    assert!(
+        matches!(choose(&touching), Choice::March(Reason::Overlap { .. })),
+        "the touching pair is found"
+    );
+    // Fewer traced primitives allowed than the scene has: marched, naming the limit.
+    let mut limited = apart.clone();
+    limited
+        .limits
+        .set(sdfc_compiler::Limit::Traced, 1_000)
+        .expect("valid");
+    match choose(&limited) {
+        Choice::March(
+            r @ Reason::Many {
+                count: 40_000,
+                limit: 1_000,
+            },
+        ) => {
+            assert!(r.describe().contains("--limit traced"), "{}", r.describe())
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -704,3 +704,129 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
     );
     assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
 }
+
+/// The 42-line file of issue 16, item 1: forty functions, each using the one below twice,
+/// make 2⁴⁰ spheres as a tree from a graph of 121 nodes. Every pass that walked the scene
+/// as a tree (the method choice, simplification, lowering) hung on it; now the checker
+/// counts the tree once per node and stops at the `expansion` limit.
+fn exponential(levels: usize) -> String {
+    let mut text = String::from("fn f0() -> shape { sphere(0.1) }\n");
+    for i in 1..=levels {
+        let j = i - 1;
+        text.push_str(&format!(
+            "fn f{i}() -> shape {{ union(f{j}().translate(0.001, 0, 0), f{j}().translate(0, 0.001, 0)) }}\n"
+        ));
+    }
+    text.push_str(&format!("scene {{ f{levels}(); }}\n"));
+    text
+}
+
+#[test]
+fn exponential_expansion_is_a_located_limit_error_in_well_under_a_second() {
+    let d = dir("expansion");
+    std::fs::write(d.join("exp.sdf"), exponential(40)).expect("write");
+    assert_eq!(exponential(40).lines().count(), 42);
+    let start = std::time::Instant::now();
+    let out = sdfc(&d, &["check", "exp.sdf"]);
+    let took = start.elapsed();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    // At the union of f20, the first level whose tree (2²² − 3 nodes) is over 4 000 000.
+    assert!(
+        err.contains("E0507") && err.contains("exp.sdf:21:") && err.contains("--limit expansion="),
+        "{err}"
+    );
+    assert!(took.as_secs_f64() < 1.0, "took {took:?}");
+    // Raised, the same limit lets a smaller tree through; lowered, it stops a small one.
+    std::fs::write(d.join("small.sdf"), exponential(8)).expect("write");
+    let ok = sdfc(&d, &["check", "small.sdf"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let low = sdfc(&d, &["check", "small.sdf", "--limit", "expansion=100"]);
+    assert_eq!(low.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&low.stderr).contains("--limit expansion="));
+}
+
+/// issue 16, item 2: the `program` limit, counted by the builder as it emits, on a scene of
+/// 2¹⁴ distinct spheres (within the `expansion` limit): an E0507 error and no output. (That
+/// lowering stops at the limit is `lowering_stops_at_the_program_limit` in
+/// `compiler/src/lower/tests.rs`.)
+#[test]
+fn the_program_limit_stops_lowering_at_the_limit() {
+    let mut text = String::from("fn f0() -> shape { sphere(0.004) }\n");
+    for i in 1..=14 {
+        let (j, o) = (i - 1, f64::from(1u32 << i) * 1e-3);
+        text.push_str(&format!(
+            "fn f{i}() -> shape {{ union(f{j}().translate({o}, 0, 0), f{j}().translate(0, 0, {o})) }}\n"
+        ));
+    }
+    text.push_str("scene { f14(); }\n");
+    let d = dir("program-limit");
+    std::fs::write(d.join("big.sdf"), text).expect("write");
+    let out = sdfc(
+        &d,
+        &[
+            "compile",
+            "big.sdf",
+            "--emit",
+            "program",
+            "--limit",
+            "program=1000",
+            "-o",
+            "p.txt",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("E0507")
+            && err.contains("more than 1000 operations")
+            && err.contains("--limit program=2000"),
+        "{err}"
+    );
+    assert!(!d.join("p.txt").exists());
+    let out = sdfc(
+        &d,
+        &["compile", "big.sdf", "--emit", "program", "-o", "p.txt"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// issue 16, item 2: `sdfc pareto` counts the combinations of its sweeps before building
+/// them, against the `sweep_points` limit, and each sweep against `sweep_values`.
+#[test]
+fn pareto_sweeps_are_bounded_by_limits() {
+    let d = dir("pareto-limits");
+    scene_file(&d);
+    let out = sdfc(
+        &d,
+        &[
+            "pareto",
+            "ball.sdf",
+            "--sweep",
+            "epsilon=1e-2..1e-6:100",
+            "--sweep",
+            "max_steps=32..1024:100",
+            "--sweep",
+            "relaxation=1..1.8:100",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("combinations of settings, more than 1000")
+            && err.contains("--limit sweep_points="),
+        "{err}"
+    );
+    let out = sdfc(&d, &["pareto", "ball.sdf", "--sweep", "aa=1..2000"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--limit sweep_values="), "{err}");
+}

@@ -1,5 +1,6 @@
 //! Cross-backend conformance: every example rendered small on wgpu and on the CPU agrees
-//! within a stated tolerance. On a machine without a wgpu adapter the test says it skipped,
+//! within its own tolerance, a little below the agreement measured on lavapipe
+//! ([`AGREEMENT`]; other scenes within 30 dB and 2 %). On a machine without a wgpu adapter the test says it skipped,
 //! unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe): then it fails.
 
 mod common;
@@ -58,6 +59,25 @@ fn load_small(path: &Path, width: u32, height: u32) -> Scene {
     scene
 }
 
+/// Per example: the least PSNR (dB) and the largest fraction of pixels differing by more
+/// than [`THRESHOLD`] between the wgpu and CPU renders at 96×64, each set a little below the
+/// agreement measured on lavapipe (issue 16, item 6), so that a real divergence fails.
+/// Measured values in the comments (lavapipe, LLVM 15, 2026-11-24): the PSNR bound is 3 dB
+/// below it, the differing bound 3 pixels (of 6 144) above it.
+const AGREEMENT: &[(&str, f64, f64)] = &[
+    ("blends", 92.0, 0.0005),      // 95.6 dB, 0.0000 (0 px)
+    ("glass", 41.0, 0.0012),       // 44.3 dB, 0.0007 (4 px)
+    ("lattice", 87.0, 0.0005),     // 90.1 dB, 0.0000 (0 px)
+    ("primitives", 117.0, 0.0005), // 120.8 dB, 0.0000 (0 px)
+    ("seed1", 125.0, 0.0005),      // 128.9 dB, 0.0000 (0 px)
+    ("seed2", 119.0, 0.0005),      // 122.9 dB, 0.0000 (0 px)
+    ("seed3", 50.0, 0.0007),       // 53.9 dB, 0.0002 (1 px)
+    ("seed4", 48.0, 0.0009),       // 51.5 dB, 0.0003 (2 px)
+    ("seed5", 63.0, 0.0005),       // 66.2 dB, 0.0000 (0 px)
+    ("seed6", 52.0, 0.0007),       // 55.2 dB, 0.0002 (1 px)
+    ("temple", 54.0, 0.0007),      // 57.8 dB, 0.0002 (1 px)
+];
+
 #[test]
 fn wgpu_matches_cpu_on_every_example() {
     let Some(gpu) = open_gpu() else { return };
@@ -85,9 +105,20 @@ fn wgpu_matches_cpu_on_every_example() {
             "{}: NaN on the GPU",
             path.display()
         );
-        if d.psnr < MIN_PSNR || d.differing > MAX_DIFFERING {
+        let name = path.file_stem().unwrap_or_default().to_string_lossy();
+        let Some(&(_, min_psnr, max_differing)) = AGREEMENT.iter().find(|(n, ..)| *n == name)
+        else {
             failures.push(format!(
-                "{}: psnr {:.1} dB, differing {:.4}",
+                "{}: no row in AGREEMENT (measured psnr {:.1} dB, differing {:.4})",
+                path.display(),
+                d.psnr,
+                d.differing
+            ));
+            continue;
+        };
+        if d.psnr < min_psnr || d.differing > max_differing {
+            failures.push(format!(
+                "{}: psnr {:.1} dB (at least {min_psnr}), differing {:.4} (at most {max_differing})",
                 path.display(),
                 d.psnr,
                 d.differing
@@ -443,4 +474,61 @@ fn the_buffer_walk_renders_what_the_unrolled_code_renders() {
         "{differ} pixels differ"
     );
     assert!(largest <= 1e-5, "a colour differs by {largest}");
+}
+
+/// issue 16, item 5: a kernel specialised for ω = 1 (no `RELAX`) never renders ω = 1.8 as if
+/// it were 1: the render is refused until the kernel is specialised again, and then the
+/// over-relaxed march takes fewer steps, as on the CPU.
+#[test]
+fn a_sweep_of_relaxation_on_wgpu_takes_effect() {
+    use sdfc_runtime::backend::{Backend, Prepared, Setup};
+    if open_gpu().is_none() {
+        return;
+    }
+    let plain = checked(
+        "relax.sdf",
+        "camera { position: (0, 1, -5), look_at: (0, 0.5, 0) }
+         light point { position: (2, 4, -3) }
+         render { width: 64, height: 48, relaxation: 1, method: \"march\" }
+         scene { plane(); sphere(1).translate(0, 1, 0); torus(1, 0.2).translate(0, 0.3, 1); }",
+    );
+    let program = lower::lower(&plain);
+    let mut prepared =
+        Prepared::from_program(Backend::Wgpu, &plain, program.clone(), &Setup::default())
+            .expect("wgpu");
+    let steps = |p: &Prepared, s: &Scene| {
+        p.render(s, &|_| {})
+            .expect("render")
+            .render
+            .stats
+            .steps_mean
+    };
+    let at_one = steps(&prepared, &plain);
+    let mut relaxed = plain.clone();
+    relaxed.settings.relaxation = 1.8;
+    let refused = prepared.render(&relaxed, &|_| {}).map(|_| ());
+    assert!(
+        refused
+            .as_ref()
+            .is_err_and(|e| e.contains("specialised") && e.contains("no over-relaxation")),
+        "{refused:?}"
+    );
+    prepared.specialise(&relaxed).expect("specialised again");
+    let at_relaxed = steps(&prepared, &relaxed);
+    let cpu_one = cpu::render(&plain, &program, &cpu::Options::default(), &|| {})
+        .stats
+        .steps_mean;
+    let cpu_relaxed = cpu::render(&relaxed, &program, &cpu::Options::default(), &|| {})
+        .stats
+        .steps_mean;
+    println!(
+        "steps/px: wgpu ω=1 {at_one:.2}, ω=1.8 {at_relaxed:.2}; cpu {cpu_one:.2}, {cpu_relaxed:.2}"
+    );
+    assert!(at_relaxed < 0.95 * at_one, "{at_relaxed} against {at_one}");
+    assert!(
+        (at_relaxed - cpu_relaxed).abs() < 0.05 * cpu_relaxed,
+        "wgpu {at_relaxed} against cpu {cpu_relaxed}"
+    );
+    // And back: ω = 1 again needs the plain kernel.
+    assert!(prepared.render(&plain, &|_| {}).is_err());
 }

@@ -870,8 +870,8 @@ fn every_diagnostic_code_is_documented_with_an_example() {
         let row = doc.lines().find(|l| l.starts_with(&format!("| {code} |")));
         let row = row.unwrap_or_else(|| panic!("docs/diagnostics.md has no row for {code}"));
         assert!(
-            row.contains(".sdf") || row.contains('`'),
-            "the row of {code} has no example"
+            example_produces(row, &code),
+            "the examples column of the row of {code} has no example that produces {code}: {row}"
         );
     }
     // Every example file the table names exists.
@@ -882,6 +882,38 @@ fn every_diagnostic_code_is_documented_with_an_example() {
             "docs/diagnostics.md links to {rel}, which does not exist"
         );
     }
+}
+
+/// Whether the last column of a table row of docs/diagnostics.md holds an example that
+/// produces `code`: a linked `.sdf` file (checked from the file system, so imports work), or
+/// an inline snippet, checked as written or as a scene statement (`scene { SNIPPET; }`).
+fn example_produces(row: &str, code: &str) -> bool {
+    let cells: Vec<&str> = row.trim().trim_matches('|').split(" | ").collect();
+    let Some(examples) = cells.last() else {
+        return false;
+    };
+    let produces = |diags: &[sdfc_compiler::Diagnostic]| diags.iter().any(|d| d.code == code);
+    for part in examples.split("](../").skip(1) {
+        let rel = part.split(')').next().unwrap_or("");
+        if rel.ends_with(".sdf") {
+            if let Ok(loaded) = sdfc_runtime::frontend::load(&root().join(rel)) {
+                if produces(&loaded.diagnostics) {
+                    return true;
+                }
+            }
+        }
+    }
+    let parts: Vec<&str> = examples.split('`').collect();
+    for snippet in parts.iter().skip(1).step_by(2) {
+        let snippet = snippet.replace("\\|", "|");
+        for text in [snippet.clone(), format!("scene {{ {snippet}; }}")] {
+            let (_, diags, _) = sdfc_compiler::check::check_str("example.sdf", &text);
+            if produces(&diags) {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 #[test]
@@ -898,4 +930,102 @@ fn the_failure_paths_list_every_limit_with_its_default() {
             limit.default_value()
         );
     }
+}
+
+/// Constants named `MAX_…` that are not resource limits, each with the file it lives in and
+/// why it is not a limit: thresholds between two equivalent ways of generating code,
+/// properties of an analysis, the definition of the reference render, test tolerances.
+const NOT_LIMITS: &[(&str, &str, &str)] = &[
+    (
+        "compiler/src/check/eval.rs",
+        "MAX_CALL_SITES",
+        "how many calls an error's chain of labels shows; the rest is a note",
+    ),
+    (
+        "compiler/src/scene/analysis.rs",
+        "MAX_STEP_LIPSCHITZ",
+        "the clamp on the step divisor L (docs/analysis.md), a property of the field",
+    ),
+    (
+        "compiler/src/scene/analysis.rs",
+        "MAX_WINDOW_CELLS",
+        "neighbouring cells a repetition evaluates; beyond, a warning (W0005)",
+    ),
+    (
+        "compiler/src/back/wgsl/analytic.rs",
+        "MAX_UNROLLED",
+        "unrolled code or a buffer walk: the same image either way",
+    ),
+    (
+        "compiler/src/back/wgsl/mod.rs",
+        "MAX_INSTANCES",
+        "instances as code or as a buffer walk: the same image either way",
+    ),
+    (
+        "compiler/src/back/ptx/types.rs",
+        "MAX_LEAVES",
+        "values kept in registers or in memory by the PTX writer",
+    ),
+    (
+        "runtime/src/cpu/reference.rs",
+        "MAX_STEPS",
+        "the step budget that defines the reference render",
+    ),
+    ("tests/conformance.rs", "MAX_DIFFERING", "a test tolerance"),
+    ("tests/analytic.rs", "MAX_DIFFERING", "a test tolerance"),
+    ("tests/stability.rs", "MAX_MISSED", "a test tolerance"),
+    ("tests/stability.rs", "MAX_STEP_RATIO", "a test tolerance"),
+];
+
+/// The `.rs` files under `dir` (relative to the workspace root), build output left out.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("readable").flatten() {
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if path.is_dir() {
+            if name != "target" && !name.starts_with('.') {
+                rust_files(&path, out);
+            }
+        } else if name.ends_with(".rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// issue 16, item 2: every resource limit lives in `Limits` (compiler/src/limits.rs), with
+/// its `--limit` name; a `const MAX_…` anywhere else is a limit that `--limit` cannot raise,
+/// unless it is one of [`NOT_LIMITS`].
+#[test]
+fn no_limit_is_a_constant_outside_limits_rs() {
+    let mut files = Vec::new();
+    rust_files(&root(), &mut files);
+    assert!(files.len() > 50, "the sources were not found");
+    let mut found = Vec::new();
+    for path in files {
+        let rel = path
+            .strip_prefix(root())
+            .expect("under the root")
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel == "compiler/src/limits.rs" {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).expect("readable");
+        for (at, _) in text.match_indices("const MAX_") {
+            let name: String = text[at + 6..]
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            // A declaration (the name, then a colon and its type), not a mention.
+            let declared = name.len() > 4 && text[at + 6 + name.len()..].starts_with(':');
+            if declared && !NOT_LIMITS.iter().any(|(f, n, _)| *f == rel && *n == name) {
+                found.push(format!("{rel}: {name}"));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "limits outside compiler/src/limits.rs (move them into `Limits`, or list them in \
+         NOT_LIMITS with the reason they are not limits): {found:?}"
+    );
 }

@@ -719,10 +719,21 @@ fn example_scenes_assemble() {
         .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
         .collect();
     paths.sort();
+    assert!(
+        paths.len() >= 6,
+        "the report's six scenes at least: {paths:?}"
+    );
     let ptxas = ptxas();
     for path in paths {
         let loaded = sdfc_runtime::frontend::load(&path).unwrap();
-        let Some(scene) = loaded.scene else { continue };
+        // An example that does not check is a failure, not one fewer kernel to assemble.
+        let Some(scene) = loaded.scene else {
+            panic!(
+                "{} does not check:\n{}",
+                path.display(),
+                sdfc_compiler::diagnostics::render(&loaded.diagnostics, &loaded.sources, false)
+            )
+        };
         let program = sdfc_compiler::lower::lower(&scene);
         let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();

@@ -87,27 +87,63 @@ fn corpus() -> Vec<String> {
         "../tests/in/err",
         "../tests/in/fuzz",
     ] {
-        let Ok(entries) = std::fs::read_dir(dir) else {
-            continue;
-        };
+        // A folder that is missing or empty is a failure: the corpus would silently shrink.
+        let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("cannot list {dir}: {e}"));
         let mut paths: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
         paths.sort();
+        let before = out.len();
         for p in paths {
             if p.extension().is_some_and(|x| x == "sdf") {
-                if let Ok(t) = std::fs::read_to_string(&p) {
-                    out.push(t);
-                }
+                let t = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+                // Fuzz inputs need not be UTF-8; the front end sees their lossy text.
+                out.push(String::from_utf8_lossy(&t).into_owned());
             }
         }
+        assert!(out.len() > before, "no .sdf inputs in {dir}");
     }
     out
 }
 
+/// The regression inputs of `tests/in/fuzz` (inputs that once crashed or hung a stage, and
+/// tricky ones) each check in bounded time without panicking.
+#[test]
+fn fuzz_regression_inputs_exist_and_check_quickly() {
+    let dir = std::path::Path::new("../tests/in/fuzz");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).expect("tests/in/fuzz exists") {
+        let path = entry.expect("listable").path();
+        if path.extension().is_none_or(|x| x != "sdf") {
+            continue;
+        }
+        let text = String::from_utf8_lossy(&std::fs::read(&path).expect("readable")).into_owned();
+        let start = std::time::Instant::now();
+        front_end(&text);
+        assert!(
+            start.elapsed().as_secs_f64() < 5.0,
+            "{} took {:?}",
+            path.display(),
+            start.elapsed()
+        );
+        n += 1;
+    }
+    assert!(n >= 5, "only {n} inputs in tests/in/fuzz");
+}
+
+/// Checks and lowers `text`, within limits small enough that a mutation of an input near
+/// a limit (the exponential expansion of `tests/in/err`) cannot make a slow case.
 fn front_end(text: &str) {
-    let (scene, diags, sources) = check_str("t.sdf", text);
+    use sdfc_compiler::{check, lower, Limit, Limits, SourceMap};
+    let mut limits = Limits::default();
+    limits.set(Limit::Expansion, 200_000).expect("valid");
+    let mut sources = SourceMap::new();
+    let entry = sources.add("t.sdf", text);
+    let (scene, diags) = check::check_with(&mut sources, entry, &mut check::NoImports, &limits);
     let _ = sdfc_compiler::diagnostics::render(&diags, &sources, false);
     if let Some(scene) = scene {
-        let _ = sdfc_compiler::lower::lower(&scene).dump();
+        let options = lower::LowerOptions::default();
+        if let Ok(program) = lower::lower_within(&scene, &options, &limits) {
+            let _ = program.dump();
+        }
     }
 }
 

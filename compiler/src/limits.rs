@@ -35,6 +35,18 @@ pub enum Limit {
     Program,
     /// Memory a render may allocate, in MiB.
     Memory,
+    /// Shape nodes of the scene counted as a tree: a shared sub-shape once per use, as the
+    /// passes that walk the scene (method choice, simplification, lowering) visit it.
+    Expansion,
+    /// Primitives `method: "auto"` traces analytically (more are sphere traced).
+    Traced,
+    /// Bytes of a marched scene's instance data in one GPU buffer, in MiB (more keep their
+    /// instances as code).
+    SceneData,
+    /// Values of one `sdfc pareto --sweep`.
+    SweepValues,
+    /// Settings `sdfc pareto` measures: the product of its sweeps' value counts.
+    SweepPoints,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -49,7 +61,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 12] = [
+    pub const ALL: [Limit; 17] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -62,6 +74,11 @@ impl Limit {
         Limit::MaxDepth,
         Limit::Program,
         Limit::Memory,
+        Limit::Expansion,
+        Limit::Traced,
+        Limit::SceneData,
+        Limit::SweepValues,
+        Limit::SweepPoints,
     ];
 
     fn spec(self) -> Spec {
@@ -124,6 +141,49 @@ impl Limit {
                 1 << 30,
                 "memory a render may allocate, in MiB (host and device together)",
             ),
+            // 4 000 000 holds 2¹⁹ spheres built by sharing, two translated copies per level
+            // (2²¹ − 3 nodes as a tree: 0.8 s to check on the 2-core development machine);
+            // every example is far below it (the largest, examples/scaling/compound_10000.sdf,
+            // expands to 120 003).
+            Limit::Expansion => s(
+                "expansion",
+                4_000_000,
+                1 << 40,
+                "shape nodes counted as a tree (a shared shape once per use)",
+            ),
+            // Rays visit the primitives through a bounding-volume hierarchy, in O(log n) per
+            // ray, so tracing beats sphere tracing at any size (10 000 random spheres at
+            // 640×480 on the CPU: 0.22 s traced, 6.2 s marched; BENCHMARKS.md). The default
+            // keeps the GPU buffer of a large traced scene (at most 112 bytes a primitive:
+            // 80 for a rotated one, 32 for a group, of which there are fewer than primitives)
+            // under the 128 MiB that wgpu's default limits let a storage buffer bind; the
+            // default `objects` limit stays below it. `method: "trace"` has no limit.
+            Limit::Traced => s(
+                "traced",
+                1_000_000,
+                u32::MAX as u64 - 1,
+                "primitives method \"auto\" traces analytically (beyond, it sphere traces)",
+            ),
+            // What wgpu's default limits let a storage buffer bind (128 MiB: over a million
+            // instances, ten times the default `objects` limit).
+            Limit::SceneData => s(
+                "scene_data",
+                128,
+                4_095,
+                "MiB of a marched scene's instances in one GPU buffer (beyond, they are code)",
+            ),
+            Limit::SweepValues => s(
+                "sweep_values",
+                1_000,
+                1_000_000,
+                "values of one sdfc pareto --sweep",
+            ),
+            Limit::SweepPoints => s(
+                "sweep_points",
+                1_000,
+                1_000_000,
+                "settings sdfc pareto measures (the product of its sweeps' values)",
+            ),
         }
     }
 
@@ -162,7 +222,7 @@ impl fmt::Display for Limit {
 /// The value of every limit for one run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 12],
+    values: [u64; 17],
 }
 
 impl Default for Limits {
@@ -237,7 +297,7 @@ impl Limits {
     /// A heading and one line per limit: name, default and what it bounds (for `--help`).
     pub fn table() -> String {
         let row =
-            |name: &str, default: &str, what: &str| format!("{name:<11} {default:>10}  {what}");
+            |name: &str, default: &str, what: &str| format!("{name:<12} {default:>10}  {what}");
         let rows = Limit::ALL
             .iter()
             .map(|l| row(l.name(), &l.default_value().to_string(), l.describe()));

@@ -43,21 +43,36 @@ pub enum Prepared {
         tapes: Box<Tapes>,
         options: Options,
     },
-    /// wgpu: the device, the validated kernel and the scene's Lipschitz bound L.
+    /// wgpu: the device, the validated kernel and the scene's Lipschitz bound L (and the
+    /// program and setup, to specialise the kernel again for other settings).
     Wgpu {
         gpu: Box<Gpu>,
         kernel: Box<wgsl::Kernel>,
         lipschitz: f64,
+        program: Box<Program>,
+        setup: Setup,
     },
-    /// CUDA: the device, the loaded module, the kernel's scene data and the scene's
-    /// Lipschitz bound L.
+    /// CUDA: the device, the loaded module, the kernel's scene data, the settings it was
+    /// specialised for and the scene's Lipschitz bound L (and the program and setup, to
+    /// specialise the kernel again for other settings).
     Cuda {
         cuda: Box<Cuda>,
         loaded: Box<gpu::cuda::Loaded>,
         data: Option<Vec<u8>>,
+        specialisation: wgsl::Specialisation,
         ptx_time: Duration,
         lipschitz: f64,
+        program: Box<Program>,
+        setup: Setup,
     },
+}
+
+/// A kernel loaded on a CUDA device, with what its launches need.
+struct CudaModule {
+    loaded: gpu::cuda::Loaded,
+    data: Option<Vec<u8>>,
+    specialisation: wgsl::Specialisation,
+    ptx_time: Duration,
 }
 
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
@@ -148,11 +163,33 @@ impl Prepared {
             gpu: Box::new(gpu),
             kernel: Box::new(Self::kernel(scene, program, setup)?),
             lipschitz,
+            program: Box::new(program.clone()),
+            setup: *setup,
         })
     }
 
     fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
+        let module = Self::cuda_module(&cuda, scene, program, setup)?;
+        Ok(Prepared::Cuda {
+            cuda: Box::new(cuda),
+            loaded: Box::new(module.loaded),
+            data: module.data,
+            specialisation: module.specialisation,
+            ptx_time: module.ptx_time,
+            lipschitz: program.lipschitz(),
+            program: Box::new(program.clone()),
+            setup: *setup,
+        })
+    }
+
+    /// Writes the kernel for `scene`, translates it to PTX and loads it on `cuda`.
+    fn cuda_module(
+        cuda: &Cuda,
+        scene: &Scene,
+        program: &Program,
+        setup: &Setup,
+    ) -> Result<CudaModule, String> {
         let kernel = Self::kernel(scene, program, setup)?;
         let start = Instant::now();
         let options = ptx::Options {
@@ -164,13 +201,78 @@ impl Prepared {
         let loaded = cuda
             .load(&text, wgsl::ENTRY_POINT)
             .map_err(|e| e.to_string())?;
-        Ok(Prepared::Cuda {
-            cuda: Box::new(cuda),
-            loaded: Box::new(loaded),
+        Ok(CudaModule {
+            loaded,
             data: kernel.data,
+            specialisation: kernel.specialisation,
             ptx_time,
-            lipschitz: program.lipschitz(),
         })
+    }
+
+    /// The settings a GPU kernel was specialised for (`None` on the CPU, which reads every
+    /// setting at every render).
+    pub fn specialisation(&self) -> Option<wgsl::Specialisation> {
+        match self {
+            Prepared::Cpu { .. } => None,
+            Prepared::Wgpu { kernel, .. } => Some(kernel.specialisation),
+            Prepared::Cuda { specialisation, .. } => Some(*specialisation),
+        }
+    }
+
+    /// Specialises the GPU kernel again when `scene`'s settings need other features than
+    /// it has (another method, over-relaxation on or off, another `max_depth`): a sweep of
+    /// ω from 1 up must turn `RELAX` on. Keeps the device; nothing to do on the CPU.
+    pub fn specialise(&mut self, scene: &Scene) -> Result<(), String> {
+        let wanted = wgsl::Specialisation::of(&scene.settings);
+        if self.specialisation().is_none_or(|s| s == wanted) {
+            return Ok(());
+        }
+        method_allowed(scene)?;
+        match self {
+            Prepared::Cpu { .. } => Ok(()),
+            Prepared::Wgpu {
+                kernel,
+                program,
+                setup,
+                ..
+            } => {
+                **kernel = Self::kernel(scene, program, setup)?;
+                Ok(())
+            }
+            Prepared::Cuda {
+                cuda,
+                loaded,
+                data,
+                specialisation,
+                ptx_time,
+                program,
+                setup,
+                ..
+            } => {
+                // The same device and context; the new module replaces the old one.
+                let module = Self::cuda_module(cuda, scene, program, setup)?;
+                **loaded = module.loaded;
+                *data = module.data;
+                *specialisation = module.specialisation;
+                *ptx_time = module.ptx_time;
+                Ok(())
+            }
+        }
+    }
+
+    /// `Err` when `scene`'s settings need a kernel specialised otherwise than this one
+    /// ([`Prepared::specialise`]): a render never silently ignores a setting.
+    fn check_specialisation(&self, scene: &Scene) -> Result<(), String> {
+        let wanted = wgsl::Specialisation::of(&scene.settings);
+        match self.specialisation() {
+            Some(have) if have != wanted => Err(format!(
+                "the {} kernel was specialised for {} and cannot render {}: specialise it again",
+                self.name(),
+                describe(&have),
+                describe(&wanted)
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// The backend's name, as in `--backend`.
@@ -245,6 +347,7 @@ impl Prepared {
 
     /// Renders one frame; `progress` gets the fraction done.
     pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, String> {
+        self.check_specialisation(scene)?;
         match self {
             Prepared::Cpu { tapes, options, .. } => {
                 let tiles = cpu::tile_count(&scene.settings, options).max(1) as f64;
@@ -265,6 +368,7 @@ impl Prepared {
                 gpu,
                 kernel,
                 lipschitz,
+                ..
             } => {
                 let r = gpu::render(gpu, scene, kernel, *lipschitz, &mut |f| progress(f))
                     .map_err(|e| e.to_string())?;
@@ -302,4 +406,18 @@ fn uniforms(scene: &Scene) -> u64 {
 /// Bytes of a kernel's scene data.
 fn bytes(data: &Option<Vec<u8>>) -> u64 {
     data.as_ref().map_or(0, |d| d.len() as u64)
+}
+
+/// A specialisation in words, for errors.
+fn describe(s: &wgsl::Specialisation) -> String {
+    format!(
+        "method {}, {}, max_depth {}",
+        s.method.name(),
+        if s.relax {
+            "over-relaxation"
+        } else {
+            "no over-relaxation (ω = 1)"
+        },
+        s.max_depth
+    )
 }

@@ -45,7 +45,8 @@ fn binary_cost(b: Binary) -> f64 {
 
 /// Operations of one evaluation of the distance: the instructions the distance register
 /// depends on (the material's are left out, as the march does not compute them), weighted
-/// by [`op_cost`].
+/// by [`op_cost`]. Every guarded block is counted, though an evaluation runs only the blocks
+/// whose bounds are near it: for a program with blocks this is an upper bound of the work.
 pub fn distance_ops(program: &Program) -> f64 {
     let ops = program.ops();
     let mut live = vec![false; ops.len()];
@@ -116,9 +117,29 @@ fn contains_word(name: &str, key: &str) -> bool {
 }
 
 /// The fraction of the peak FP32 rate a frame achieved: `ops_per_eval · evaluations` over
-/// `seconds · peak`.
-pub fn fraction(ops_per_eval: f64, evaluations: u64, seconds: f64, peak: f64) -> f64 {
-    ops_per_eval * evaluations as f64 / (seconds * peak)
+/// `seconds · peak`. `None` where the quotient exceeds 1 (or is not a number): the count is
+/// then not what ran, and no fraction of peak above 1 is ever reported.
+pub fn fraction(ops_per_eval: f64, evaluations: u64, seconds: f64, peak: f64) -> Option<f64> {
+    let f = ops_per_eval * evaluations as f64 / (seconds * peak);
+    (f.is_finite() && (0.0..=1.0).contains(&f)).then_some(f)
+}
+
+/// The fraction of the peak FP32 rate a frame of `program` achieved, where the operations
+/// that ran are known: every evaluation of a program without guarded blocks runs all of
+/// [`distance_ops`]. `None` for a program with guarded blocks: an evaluation runs only the
+/// blocks whose bounds are near, which the statistics do not count, and counting every block
+/// reported 1.85 for a marched scene of 1 024 spheres and 5.63 for
+/// `examples/scaling/compound_1000.sdf` on an H100.
+pub fn fraction_of_peak(
+    program: &Program,
+    evaluations: u64,
+    seconds: f64,
+    peak: f64,
+) -> Option<f64> {
+    if !program.blocks().is_empty() {
+        return None;
+    }
+    fraction(distance_ops(program), evaluations, seconds, peak)
 }
 
 #[cfg(test)]

@@ -125,12 +125,12 @@ pub struct Checked {
 }
 
 impl Checked {
-    /// Lowers the scene. A program larger than the `program` limit is reported (E0507) and
-    /// gives exit code 1, before any back end or render starts.
+    /// Lowers the scene within `limits` ([`lower::lower_within`]). A program larger than the
+    /// `program` limit is reported (E0507) and gives exit code 1, before any back end or
+    /// render starts.
     pub fn lower(&self, options: &LowerOptions, limits: &Limits) -> Result<Program, ExitCode> {
-        let program = lower::lower_with(&self.scene, options);
-        match lower::check_size(&self.scene, &program, limits) {
-            Ok(()) => Ok(program),
+        match lower::lower_within(&self.scene, options, limits) {
+            Ok(program) => Ok(program),
             Err(d) => {
                 print_diagnostics(&[d], &self.sources, self.format);
                 Err(ExitCode::from(1))

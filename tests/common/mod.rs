@@ -29,6 +29,7 @@ impl Build {
             camera: Camera::default(),
             settings: Settings::default(),
             origin: [0.0; 3],
+            ..Scene::default()
         };
         Build { scene }
     }

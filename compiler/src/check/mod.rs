@@ -80,7 +80,15 @@ pub fn check_with(
     let mut cx = Ctx::default();
     cx.diags = diags;
     cx.limits = limits.clone();
-    let scene = check_items(&mut cx, &items, entry);
+    let mut scene = check_items(&mut cx, &items, entry);
+    scene.limits = limits.clone();
+    if !crate::diagnostics::has_errors(&cx.diags) {
+        // Before any pass walks the shapes as a tree: a small graph of shared shapes can
+        // expand exponentially.
+        if let Some(e) = scene.over_expanded() {
+            cx.error(scene.expansion_error(&e));
+        }
+    }
     if !crate::diagnostics::has_errors(&cx.diags) {
         // Distance semantics: warnings where a construct makes the field unreliable.
         let analysis = crate::scene::analysis::analyse(&scene);

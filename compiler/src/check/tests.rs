@@ -138,7 +138,7 @@ fn within(
 fn every_compilation_limit_is_reported_with_the_flag_that_raises_it() {
     use crate::{Limit, Limits};
     const IMPORTS: &[(&str, &str)] = &[("a.sdf", "import \"b.sdf\";"), ("b.sdf", "let r = 1;")];
-    let cases: [(Limit, u64, &str); 6] = [
+    let cases: [(Limit, u64, &str); 7] = [
         (Limit::Nesting, 5, "let x = abs(abs(abs(abs(abs(abs(1))))));\nscene { sphere(); }"),
         (Limit::Fuel, 100, "scene { for i in 0..50 { sphere(1).translate(i, 0, 0); } }"),
         (
@@ -149,6 +149,8 @@ fn every_compilation_limit_is_reported_with_the_flag_that_raises_it() {
         (Limit::Nodes, 3, "scene { union(sphere(1), sphere(2), sphere(3), sphere(4)); }"),
         (Limit::Objects, 3, "scene { sphere(1); sphere(2); sphere(3); sphere(4); }"),
         (Limit::Files, 2, "import \"a.sdf\";\nscene { sphere(r); }"),
+        // One sphere shared five times: two nodes in the graph, six as a tree.
+        (Limit::Expansion, 3, "scene { union(sphere(1), sphere(1), sphere(1), sphere(1), sphere(1)); }"),
     ];
     for (limit, value, src) in cases {
         let mut low = Limits::default();

@@ -40,6 +40,9 @@ pub(super) struct Builder {
     blocks: Vec<Block>,
     /// The blocks open now, innermost last.
     open: Vec<u32>,
+    /// The most instructions to emit (the `program` limit): past it, [`Builder::over`]
+    /// turns true and the lowering stops descending.
+    cap: usize,
 }
 
 impl Builder {
@@ -47,8 +50,22 @@ impl Builder {
     pub fn new(optimise: bool) -> Self {
         Builder {
             optimise,
+            cap: usize::MAX,
             ..Self::default()
         }
+    }
+
+    /// An empty builder that stops at `cap` instructions ([`Builder::over`]).
+    pub fn capped(optimise: bool, cap: usize) -> Self {
+        Builder {
+            cap,
+            ..Self::new(optimise)
+        }
+    }
+
+    /// Whether more instructions than the cap were emitted: the program is incomplete.
+    pub fn over(&self) -> bool {
+        self.ops.len() > self.cap
     }
 
     /// Starts a commented block at the next instruction.

@@ -97,6 +97,11 @@ impl<'a> Lowerer<'a> {
     /// as the volume allows away from the operand. A chain of paint and transforms over a
     /// plain combination is not such an operand: the combination's own operands are.
     pub fn node(&mut self, id: NodeId, p: P) -> Field {
+        if self.b.over() {
+            // Past the `program` limit the program is dropped: stop descending (any
+            // register defined outside every block stands in for the field).
+            return Field { d: p[0], m: p[0] };
+        }
         let key = (id, p, self.zero_set);
         if let Some(&f) = self.memo.get(&key) {
             if self.b.visible(f.d) && self.b.visible(f.m) {
@@ -447,6 +452,9 @@ impl<'a> Lowerer<'a> {
     /// plane. Any child's distance is at least the union's, so the guards may compare with it
     /// before the nearest child is reached.
     fn descend(&mut self, t: &Tree, p: P) -> Reg {
+        if self.b.over() {
+            return p[0];
+        }
         match &t.kind {
             Kind::Leaf(items) => {
                 // One child is enough for an upper bound: the cheapest.
@@ -496,6 +504,9 @@ impl<'a> Lowerer<'a> {
         alone: bool,
         upper: Option<Reg>,
     ) {
+        if self.b.over() {
+            return;
+        }
         if alone && self.guards(acc, item.cost) {
             let text = format!("node {} union: child culled by its bound", self.number(id));
             self.b.note(text);
@@ -525,6 +536,9 @@ impl<'a> Lowerer<'a> {
         acc: &mut Option<Field>,
         upper: Option<Reg>,
     ) {
+        if self.b.over() {
+            return;
+        }
         if !self.guards(acc, t.cost) {
             return self.tree_body(id, t, tested, p, acc, upper);
         }

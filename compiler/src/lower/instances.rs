@@ -90,7 +90,7 @@ pub fn split(scene: &Scene, options: &LowerOptions, more_than: usize) -> Option<
             Some(graph.add(union, span))
         }
     };
-    let rest = lower_simple(scene, graph, root, &simple.origin, options);
+    let (rest, _) = lower_simple(scene, graph, root, &simple.origin, options, usize::MAX);
     Some(Split { rest, instances })
 }
 

@@ -456,33 +456,52 @@ pub fn lower(scene: &Scene) -> Program {
     lower_with(scene, &LowerOptions::default())
 }
 
-/// Checks `program`, lowered from `scene`, against the `program` limit: more operations is
-/// an E0507 error at the scene's objects. Run after lowering and before any back end or
-/// render starts.
-pub fn check_size(scene: &Scene, program: &Program, limits: &Limits) -> Result<(), Diagnostic> {
-    let max = limits.get(Limit::Program);
-    let (Some(root), true) = (scene.root, program.len() as u64 > max) else {
-        return Ok(());
+/// Lowers a checked scene within its limits: a scene over the `expansion` limit is refused
+/// before any pass walks it, and the builder counts the instructions it emits and stops at
+/// the `program` limit (an E0507 error at the scene's objects), so no program larger than
+/// the limit is ever built. Run before any back end or render starts.
+pub fn lower_within(
+    scene: &Scene,
+    options: &LowerOptions,
+    limits: &Limits,
+) -> Result<Program, Diagnostic> {
+    let Some(root) = scene.root else {
+        return Ok(lower_with(scene, options));
     };
+    let expansion = scene
+        .graph
+        .over_expanded(root, limits.get(Limit::Expansion));
+    if let Some(e) = expansion {
+        return Err(scene.graph.expansion_error(&e, limits));
+    }
+    let max = limits.get(Limit::Program);
+    let cap = usize::try_from(max).unwrap_or(usize::MAX);
+    let (program, over) = lower_capped(scene, options, cap);
+    if !over && program.len() as u64 <= max {
+        return Ok(program);
+    }
     Err(Diagnostic::error(
         "E0507",
-        format!(
-            "the distance program has {} operations, more than {max}",
-            program.len()
-        ),
+        format!("the distance program has more than {max} operations"),
         scene.graph.span(root),
     )
     .with_label("the scene's objects lower to it")
     .with_note(format!(
-        "this limit keeps compilation and rendering bounded; {}",
-        limits.raise_to(Limit::Program, program.len() as u64)
+        "lowering stopped at the limit; this limit keeps compilation and rendering bounded; {}",
+        limits.raise(Limit::Program)
     )))
 }
 
 /// Lowers a checked scene to its distance program with the given options.
 pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
+    lower_capped(scene, options, usize::MAX).0
+}
+
+/// [`lower_with`], stopping once more than `cap` instructions were emitted; the flag says
+/// whether it stopped (the program is then incomplete).
+fn lower_capped(scene: &Scene, options: &LowerOptions, cap: usize) -> (Program, bool) {
     match scene.root {
-        _ if options.level == 0 => lower_literal(scene, options),
+        _ if options.level == 0 => lower_literal(scene, options, cap),
         Some(root) => {
             let simple = simplify::simplify(&scene.graph, root);
             lower_simple(
@@ -491,9 +510,10 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
                 Some(simple.root),
                 &simple.origin,
                 options,
+                cap,
             )
         }
-        None => lower_simple(scene, Graph::default(), None, &[], options),
+        None => lower_simple(scene, Graph::default(), None, &[], options, cap),
     }
 }
 
@@ -505,8 +525,9 @@ fn lower_simple(
     root: Option<NodeId>,
     origin: &[NodeId],
     options: &LowerOptions,
-) -> Program {
-    let mut b = builder::Builder::new(true);
+    cap: usize,
+) -> (Program, bool) {
+    let mut b = builder::Builder::capped(true, cap);
     let p = b.input_point();
     let mut lipschitz = 1.0;
     let (d, m) = match root {
@@ -540,8 +561,8 @@ fn lower_simple(
 }
 
 /// Lowers the scene as written (level 0).
-fn lower_literal(scene: &Scene, options: &LowerOptions) -> Program {
-    let mut b = builder::Builder::new(false);
+fn lower_literal(scene: &Scene, options: &LowerOptions, cap: usize) -> (Program, bool) {
+    let mut b = builder::Builder::capped(false, cap);
     let p = b.input_point();
     let mut lipschitz = 1.0;
     let (d, m) = match scene.root {
@@ -572,14 +593,16 @@ fn finish(
     m: Reg,
     lipschitz: f64,
     options: &LowerOptions,
-) -> Program {
+) -> (Program, bool) {
     b.note("result: unpainted shapes get the default material 0".into());
     let m = b.paint(m, 0.0);
-    Program {
+    let over = b.over();
+    let program = Program {
         lipschitz,
         options: *options,
         ..b.finish(d, m)
-    }
+    };
+    (program, over)
 }
 
 /// Everything of a scene but its shapes (for analysing a rewritten graph).
@@ -592,5 +615,6 @@ fn scene_without_graph(scene: &Scene) -> Scene {
         camera: scene.camera.clone(),
         settings: scene.settings.clone(),
         origin: scene.origin,
+        limits: scene.limits.clone(),
     }
 }

@@ -253,3 +253,36 @@ fn every_bound_is_below_its_field() {
     }
     assert!(checked > 300, "{checked} nodes checked");
 }
+
+/// issue 16, item 2: the builder counts the instructions it emits and stops at the `program`
+/// limit. 2¹² distinct spheres lower to tens of thousands of instructions; capped at 1 000,
+/// the lowering stops a node or so past the cap instead of lowering them all first.
+#[test]
+fn lowering_stops_at_the_program_limit() {
+    let mut text = String::from("fn f0() -> shape { sphere(0.004) }\n");
+    for i in 1..=12 {
+        let (j, o) = (i - 1, f64::from(1u32 << i) * 1e-3);
+        text.push_str(&format!(
+            "fn f{i}() -> shape {{ union(f{j}().translate({o}, 0, 0), f{j}().translate(0, 0, {o})) }}\n"
+        ));
+    }
+    text.push_str("scene { f12(); }");
+    let (scene, diags, _) = crate::check::check_str("many.sdf", &text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let options = super::LowerOptions::default();
+    let (whole, over) = super::lower_capped(&scene, &options, usize::MAX);
+    assert!(!over && whole.len() > 50_000, "{}", whole.len());
+    let (part, over) = super::lower_capped(&scene, &options, 1_000);
+    assert!(over && part.len() < 2_000, "stopped at {}", part.len());
+    let mut limits = crate::Limits::default();
+    limits.set(crate::Limit::Program, 1_000).expect("valid");
+    let err = super::lower_within(&scene, &options, &limits).expect_err("over the limit");
+    assert!(
+        err.notes.iter().any(|n| n.contains("--limit program=2000")),
+        "{err:?}"
+    );
+    limits
+        .set(crate::Limit::Program, whole.len() as u64 * 2)
+        .expect("valid");
+    assert_eq!(super::lower_within(&scene, &options, &limits), Ok(whole));
+}

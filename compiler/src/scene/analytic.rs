@@ -8,6 +8,7 @@
 //! [`Primitive`]s this module produces (docs/rendering.md, "Analytic ray tracing").
 
 use super::ir::{Combine, MaterialId, Method, Node, NodeId, Scene, V3};
+use crate::limits::Limit;
 use crate::span::Span;
 
 /// A primitive with a closed-form ray intersection, in its local frame.
@@ -37,17 +38,6 @@ pub struct Primitive {
     pub node: NodeId,
 }
 
-/// The most primitives `method: "auto"` traces analytically. Rays visit the primitives
-/// through a bounding-volume hierarchy ([`hierarchy`]), in O(log n) per ray on the CPU and on
-/// the GPU, whose kernel reads a large scene's primitives and hierarchy from a buffer
-/// (`back::wgsl::MAX_UNROLLED`), so tracing beats sphere tracing at any size (10 000 random
-/// spheres at 640×480 on the CPU: 0.22 s traced, 6.2 s marched; BENCHMARKS.md). The bound
-/// keeps that buffer (at most 112 bytes a primitive: 80 for a rotated one, 32 for a group, of
-/// which there are fewer than primitives) under the 128 MiB that wgpu's default limits let a
-/// storage buffer bind; the default `objects` limit stays below it. `method: "trace"` has no
-/// limit.
-pub const MAX_AUTO_PRIMITIVES: usize = 1_000_000;
-
 /// What a scene is rendered with, and why.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Choice {
@@ -66,8 +56,9 @@ pub enum Reason {
     Node { what: &'static str, span: Span },
     /// A light casts soft shadows.
     SoftLight { index: usize },
-    /// Too many primitives for `auto` to trace them from one GPU buffer.
-    Many { count: usize },
+    /// Too many primitives for `auto` to trace them from one GPU buffer: more than `limit`,
+    /// the `traced` limit.
+    Many { count: usize, limit: usize },
     /// A transparent primitive overlaps or touches another one: a ray inside it must leave
     /// through the boundary of the union, which tracing primitive by primitive does not find.
     Overlap { span: Span },
@@ -88,8 +79,8 @@ impl Reason {
             Reason::Overlap { .. } => {
                 "a transparent primitive overlaps or touches another, so rays inside it would need the boundary of their union".into()
             }
-            Reason::Many { count } => format!(
-                "{count} primitives: beyond {MAX_AUTO_PRIMITIVES}, their data would outgrow a GPU storage buffer"
+            Reason::Many { count, limit } => format!(
+                "{count} primitives: beyond {limit} (`--limit traced`), their data would outgrow a GPU storage buffer"
             ),
         }
     }
@@ -139,8 +130,17 @@ pub fn choose(scene: &Scene) -> Choice {
             return Choice::March(reason);
         }
     }
-    if scene.settings.method == Method::Auto && out.len() > MAX_AUTO_PRIMITIVES {
-        return Choice::March(Reason::Many { count: out.len() });
+    // The `traced` limit (limits.rs): rays visit the primitives through a bounding-volume
+    // hierarchy ([`hierarchy`]), in O(log n) per ray on the CPU and on the GPU, whose kernel
+    // reads a large scene's primitives and hierarchy from a buffer
+    // (`back::wgsl::MAX_UNROLLED`), so tracing beats sphere tracing at any size; the limit
+    // keeps that buffer within what a GPU binds. `method: "trace"` has no limit.
+    let limit = scene.limits.count(Limit::Traced);
+    if scene.settings.method == Method::Auto && out.len() > limit {
+        return Choice::March(Reason::Many {
+            count: out.len(),
+            limit,
+        });
     }
     if let Some(p) = transparent_overlap(scene, &out) {
         let span = scene.graph.span(p.node);
@@ -170,6 +170,16 @@ fn transparent_overlap<'a>(scene: &Scene, prims: &'a [Primitive]) -> Option<&'a 
         }
         (None, _) => true,
     };
+    // Only transparent primitives are tested, each against the hierarchy of the bounded
+    // primitives' boxes (O(log n) groups per test when the scene is spread out) and against
+    // the unbounded ones, so the test is not quadratic in the primitives.
+    let bounded: Vec<(usize, Aabb)> = boxes
+        .iter()
+        .enumerate()
+        .filter_map(|(j, b)| b.map(|b| (j, b)))
+        .collect();
+    let unbounded: Vec<usize> = (0..prims.len()).filter(|&j| boxes[j].is_none()).collect();
+    let mut tree: Option<Vec<Item>> = None;
     prims.iter().enumerate().find_map(|(i, p)| {
         if scene.material(p.material).transparency <= 0.0 {
             return None;
@@ -178,9 +188,23 @@ fn transparent_overlap<'a>(scene: &Scene, prims: &'a [Primitive]) -> Option<&'a 
         let Some(a) = &boxes[i] else {
             return (prims.len() > 1).then_some(p);
         };
-        (0..prims.len())
-            .any(|j| j != i && touches(a, j))
-            .then_some(p)
+        if unbounded.iter().any(|&j| j != i && touches(a, j)) {
+            return Some(p);
+        }
+        let tree = tree.get_or_insert_with(|| boxed(bounded.clone()));
+        any_box_meets(tree, a, &|j| j != i && touches(a, j)).then_some(p)
+    })
+}
+
+/// Whether a primitive of `items` whose box meets `a` (the groups' boxes prune the search)
+/// passes `test`.
+fn any_box_meets(items: &[Item], a: &Aabb, test: &dyn Fn(usize) -> bool) -> bool {
+    items.iter().any(|item| match item {
+        Item::Primitive(j) => test(*j),
+        Item::Group(g) => {
+            (0..3).all(|k| a.0[k] <= g.centre[k] + g.half[k] && g.centre[k] - g.half[k] <= a.1[k])
+                && any_box_meets(&g.items, a, test)
+        }
     })
 }
 

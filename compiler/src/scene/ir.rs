@@ -5,6 +5,8 @@
 //! a sub-shape used twice is one node. Computed facts (bounds, Lipschitz bound, exactness) are
 //! kept in side tables keyed by `NodeId` ([`Facts`]), next to the spans.
 
+use crate::diagnostics::Diagnostic;
+use crate::limits::{Limit, Limits};
 use crate::span::Span;
 use std::collections::HashMap;
 
@@ -200,6 +202,77 @@ impl Graph {
     pub fn ids(&self) -> impl Iterator<Item = NodeId> {
         (0..self.nodes.len() as u32).map(NodeId)
     }
+
+    /// The size of every node as a tree: the node and, for each child it names, the child's
+    /// size (a shared sub-shape counts once per use). One pass in creation order, memoised
+    /// per node and saturating, so it takes time linear in the graph, however large the
+    /// tree: the bound on the passes that walk the scene as a tree (`Limit::Expansion`).
+    pub fn tree_sizes(&self) -> Vec<u64> {
+        let mut sizes: Vec<u64> = Vec::with_capacity(self.nodes.len());
+        for node in &self.nodes {
+            let size = node
+                .children()
+                .iter()
+                .fold(1u64, |acc, c| acc.saturating_add(sizes[c.0 as usize]));
+            sizes.push(size);
+        }
+        sizes
+    }
+
+    /// When the tree below `root` has more than `max` nodes: the deepest node of it whose
+    /// own tree still has more (where the expansion crosses the limit), with the size of
+    /// that node's tree and of the root's.
+    pub fn over_expanded(&self, root: NodeId, max: u64) -> Option<Expansion> {
+        let sizes = self.tree_sizes();
+        let total = sizes[root.0 as usize];
+        if total <= max {
+            return None;
+        }
+        let mut at = root;
+        while let Some(big) = self
+            .node(at)
+            .children()
+            .into_iter()
+            .find(|c| sizes[c.0 as usize] > max)
+        {
+            at = big;
+        }
+        Some(Expansion {
+            at,
+            size: sizes[at.0 as usize],
+            total,
+        })
+    }
+
+    /// The E0507 error of a tree over the `expansion` limit of `limits`, at the shape where
+    /// the expansion crosses the limit.
+    pub fn expansion_error(&self, e: &Expansion, limits: &Limits) -> Diagnostic {
+        let max = limits.get(Limit::Expansion);
+        Diagnostic::error(
+            "E0507",
+            format!("the scene's shapes expand to more than {max} nodes"),
+            self.span(e.at),
+        )
+        .with_label(format!(
+            "this shape alone expands to {} nodes when its shared sub-shapes are counted once per use",
+            e.size
+        ))
+        .with_note(format!(
+            "passes over the scene visit a shape once per use; this limit keeps them bounded; {}",
+            limits.raise_to(Limit::Expansion, e.total)
+        ))
+    }
+}
+
+/// A scene whose tree is over the `expansion` limit ([`Graph::over_expanded`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Expansion {
+    /// The deepest node whose tree is over the limit.
+    pub at: NodeId,
+    /// The size of its tree.
+    pub size: u64,
+    /// The size of the whole scene's tree (saturated at `u64::MAX`).
+    pub total: u64,
 }
 
 /// The colour of a material at a point.
@@ -481,6 +554,9 @@ pub struct Scene {
     /// scene was moved to put a far camera at the origin ([`super::recentre`]). Patterns are
     /// laid out in the written coordinates, at p + origin.
     pub origin: V3,
+    /// The limits the scene was checked within: the passes after the checker (the choice of
+    /// method, the kernel's data) read theirs from here.
+    pub limits: Limits,
 }
 
 impl Scene {
@@ -495,5 +571,17 @@ impl Scene {
     /// The material behind an id.
     pub fn material(&self, id: MaterialId) -> &Material {
         &self.materials[id.0 as usize]
+    }
+
+    /// The scene's objects as a tree, when they have more nodes than its `expansion` limit.
+    pub fn over_expanded(&self) -> Option<Expansion> {
+        let root = self.root?;
+        self.graph
+            .over_expanded(root, self.limits.get(Limit::Expansion))
+    }
+
+    /// The E0507 error of a scene over its `expansion` limit.
+    pub fn expansion_error(&self, e: &Expansion) -> Diagnostic {
+        self.graph.expansion_error(e, &self.limits)
     }
 }

@@ -82,7 +82,9 @@ pub struct Timing {
     pub method: &'static str,
     /// Instructions of the distance program.
     pub program_len: usize,
-    /// FP32 operations of one evaluation of the distance (`fp32::distance_ops`).
+    /// FP32 operations of one evaluation of the distance, every guarded block counted
+    /// (`fp32::distance_ops`): for a program with guarded blocks, an upper bound of the work
+    /// per evaluation.
     pub ops_per_eval: f64,
     /// Evaluations of the distance in the last frame (marching steps and normal taps; 0 under
     /// analytic tracing, which evaluates no distance, and then the FP32 fields are null).
@@ -91,7 +93,9 @@ pub struct Timing {
     /// device not in the table of `fp32::PEAKS`).
     pub fp32_peak_tflops: Option<f64>,
     /// GPU targets: ops_per_eval · evaluations / (median_s · peak), the fraction of the
-    /// FP32 floor achieved (null where the peak is).
+    /// FP32 peak achieved (`fp32::fraction_of_peak`): null where the peak is, for a program
+    /// with guarded blocks (what ran is not counted) and where the quotient would exceed 1.
+    /// Never above 1.
     pub fp32_fraction: Option<f64>,
     /// Statistics of the last frame.
     pub stats: Stats,
@@ -161,6 +165,7 @@ fn time_scene(
     limits: &Limits,
 ) -> Result<Timing, String> {
     let ops_per_eval = fp32::distance_ops(&program);
+    let guarded = !program.blocks().is_empty();
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
@@ -218,7 +223,9 @@ fn time_scene(
         ops_per_eval,
         evaluations,
         fp32_peak_tflops: peak.map(|p| p / 1e12),
-        fp32_fraction: peak.map(|p| fp32::fraction(ops_per_eval, evaluations, median, p)),
+        fp32_fraction: peak
+            .filter(|_| !guarded)
+            .and_then(|p| fp32::fraction(ops_per_eval, evaluations, median, p)),
         stats: last.stats,
     })
 }

@@ -85,11 +85,14 @@ pub fn run(args: CompileArgs) -> ExitCode {
             if other == Emit::Ir {
                 return write_output(args.output.as_deref(), &scene::dump(scene));
             }
-            let program = lower::lower_with(scene, &lower::LowerOptions::level(args.opt));
-            if let Err(d) = lower::check_size(scene, &program, &limits) {
-                frontend::print_diagnostics(&[d], &loaded.sources, args.diagnostics);
-                return ExitCode::from(1);
-            }
+            let options = lower::LowerOptions::level(args.opt);
+            let program = match lower::lower_within(scene, &options, &limits) {
+                Ok(program) => program,
+                Err(d) => {
+                    frontend::print_diagnostics(&[d], &loaded.sources, args.diagnostics);
+                    return ExitCode::from(1);
+                }
+            };
             match emit(scene, &program, other, args.sm) {
                 Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
                 Err(msg) => {

@@ -12,7 +12,7 @@ use crate::frontend::{self, DiagnosticFormat};
 use crate::metrics::{self, DepthDifference};
 use sdfc_compiler::lower::{LowerOptions, Program};
 use sdfc_compiler::scene::{Method, Scene, Settings};
-use sdfc_compiler::Limits;
+use sdfc_compiler::{Limit, Limits};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -152,12 +152,21 @@ pub fn parse_sweep_within(spec: &str, limits: &Limits) -> Result<Sweep, String> 
     let key = Key::parse(key.trim())?;
     let rest = rest.trim();
     let raw = match rest.split_once("..") {
-        Some((lo, hi)) => range(key, lo, hi)?,
+        Some((lo, hi)) => range(key, lo, hi, limits)?,
         None => rest
             .split(',')
             .map(|v| number(key, v))
             .collect::<Result<Vec<_>, _>>()?,
     };
+    let max = limits.count(Limit::SweepValues);
+    if raw.len() > max {
+        return Err(format!(
+            "{}: {} values, more than {max}; {}",
+            key.name(),
+            raw.len(),
+            limits.raise_to(Limit::SweepValues, raw.len() as u64)
+        ));
+    }
     let mut values: Vec<f64> = Vec::new();
     for v in raw.into_iter().map(|v| round(key, v)) {
         key.set(&mut Settings::default(), v, limits)?;
@@ -176,15 +185,17 @@ fn number(key: Key, v: &str) -> Result<f64, String> {
 }
 
 /// The values of `lo..hi[:n]` for `key`.
-fn range(key: Key, lo: &str, hi: &str) -> Result<Vec<f64>, String> {
+fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, String> {
+    let max = limits.count(Limit::SweepValues);
     let (hi, count) = match hi.split_once(':') {
         Some((h, n)) => match n.trim().parse::<usize>() {
-            Ok(n) if (1..=1000).contains(&n) => (h, Some(n)),
+            Ok(n) if (1..=max).contains(&n) => (h, Some(n)),
             _ => {
                 return Err(format!(
-                    "{}: the count after `:` must be 1 to 1000, not `{}`",
+                    "{}: the count after `:` must be 1 to {max}, not `{}`; {}",
                     key.name(),
-                    n.trim()
+                    n.trim(),
+                    limits.raise(Limit::SweepValues)
                 ))
             }
         },
@@ -204,10 +215,11 @@ fn range(key: Key, lo: &str, hi: &str) -> Result<Vec<f64>, String> {
         Key::Relaxation => ((hi - lo).abs() / 0.2).round() as usize + 1,
         Key::Aa => (hi - lo).abs().round() as usize + 1,
     });
-    if n > 1000 {
+    if n > max {
         return Err(format!(
-            "{}: the range {lo}..{hi} has too many values",
-            key.name()
+            "{}: the range {lo}..{hi} has {n} values, more than {max}; {}",
+            key.name(),
+            limits.raise_to(Limit::SweepValues, n as u64)
         ));
     }
     let at = |i: usize| {
@@ -244,6 +256,17 @@ pub fn combinations(
     sweeps: &[Sweep],
     limits: &Limits,
 ) -> Result<Vec<Settings>, String> {
+    // Counted before any is built: the product of a few sweeps grows fast.
+    let count = sweeps
+        .iter()
+        .fold(1u64, |n, s| n.saturating_mul(s.values.len() as u64));
+    let max = limits.get(Limit::SweepPoints);
+    if count > max {
+        return Err(format!(
+            "the sweeps give {count} combinations of settings, more than {max}; {}",
+            limits.raise_to(Limit::SweepPoints, count)
+        ));
+    }
     let mut out = vec![base.clone()];
     for sweep in sweeps {
         let mut next = Vec::with_capacity(out.len() * sweep.values.len());
@@ -463,7 +486,7 @@ fn measure(
         precision: args.precision,
         debug_nan: false,
     };
-    let prepared = Prepared::from_program(args.backend, scene, program.clone(), &setup)
+    let mut prepared = Prepared::from_program(args.backend, scene, program.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
     let (reference_scene, reference_prepared) = reference_setup(scene, program, &points)?;
     // The reference frame is held while each point renders.
@@ -480,6 +503,12 @@ fn measure(
     prepared.render(scene, &|_| {})?;
     let mut measured = Vec::with_capacity(points.len());
     for (i, settings) in points.iter().enumerate() {
+        // A GPU kernel is specialised to some settings (ω > 1 or not, the method,
+        // `max_depth`): a point that needs others gets a kernel of its own, before its
+        // frames are timed.
+        let mut point = scene.clone();
+        point.settings = settings.clone();
+        prepared.specialise(&point)?;
         let m = measure_one(
             args,
             &prepared,

@@ -49,11 +49,6 @@ const GROUP: u32 = 7;
 /// The tag bit of an instance with a rotation.
 const ROTATED: u32 = 8;
 
-/// The most bytes of instance data: what wgpu's default limits let a storage buffer bind
-/// (128 MiB: over a million instances, ten times the default `objects` limit); a scene with
-/// more keeps its instances as code.
-pub const MAX_BYTES: usize = 128 << 20;
-
 /// Whether every material of `instances` fits in a tag.
 pub fn fits(instances: &[Instance]) -> bool {
     instances

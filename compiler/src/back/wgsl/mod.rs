@@ -58,10 +58,38 @@ pub struct Kernel {
     pub info: naga::valid::ModuleInfo,
     /// The features the kernel was specialised for, by name.
     pub features: Vec<(&'static str, bool)>,
+    /// The render settings that decided its features: a render with other settings of
+    /// these needs another kernel ([`Specialisation::of`]).
+    pub specialisation: Specialisation,
     /// The bytes of binding 4, `scene_data`, when the kernel declares it (the `SCENE_DATA`
     /// feature): the primitives and hierarchy of a large analytically traced scene, or the
     /// instances and their hierarchy of a large marched one.
     pub data: Option<Vec<u8>>,
+}
+
+/// What of the render settings a kernel is specialised for: the method (analytic tracing
+/// or marching: `ANALYTIC`), whether over-relaxation is on (`RELAX`) and `max_depth` (the ray
+/// stack's size, and `SECONDARY`). The values of the other settings (ε, `max_steps`, ω
+/// itself, the image size) are uniforms, read at every render.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Specialisation {
+    /// The `method` setting.
+    pub method: crate::scene::Method,
+    /// Whether ω > 1.
+    pub relax: bool,
+    /// The `max_depth` setting.
+    pub max_depth: u32,
+}
+
+impl Specialisation {
+    /// The specialisation a kernel for `settings` has.
+    pub fn of(settings: &crate::scene::Settings) -> Specialisation {
+        Specialisation {
+            method: settings.method,
+            relax: settings.relaxation > 1.0,
+            max_depth: settings.max_depth,
+        }
+    }
 }
 
 /// A generated kernel that naga rejected: always a compiler bug, reported with the generated
@@ -239,6 +267,7 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         module,
         info,
         features,
+        specialisation: Specialisation::of(&scene.settings),
         data,
     })
 }
@@ -253,7 +282,12 @@ fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, O
             let data = march::data(&s.instances, scene.camera.position);
             (s, data)
         })
-        .filter(|(_, data)| data.len() <= march::MAX_BYTES);
+        // The `scene_data` limit, in MiB: by default what wgpu's default limits let a
+        // storage buffer bind; a scene with more keeps its instances as code.
+        .filter(|(_, data)| {
+            let mib = scene.limits.get(crate::limits::Limit::SceneData);
+            data.len() as u64 <= mib.saturating_mul(1 << 20)
+        });
     match split {
         Some((s, data)) => {
             let text = format!(

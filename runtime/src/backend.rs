@@ -9,6 +9,7 @@ use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, Program};
 use sdfc_compiler::scene::analytic::{self, Choice};
 use sdfc_compiler::scene::{Method, Scene, Settings};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Where a scene is rendered.
@@ -43,9 +44,10 @@ pub enum Prepared {
         tapes: Box<Tapes>,
         options: Options,
     },
-    /// wgpu: the device, the validated kernel and the scene's Lipschitz bound L.
+    /// wgpu: the device (which may be shared, as the viewer shares its window's), the
+    /// validated kernel and the scene's Lipschitz bound L.
     Wgpu {
-        gpu: Box<Gpu>,
+        gpu: Arc<Gpu>,
         kernel: Box<wgsl::Kernel>,
         lipschitz: f64,
     },
@@ -143,12 +145,31 @@ impl Prepared {
         require_hardware: bool,
     ) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
+        Self::on_gpu(Arc::new(gpu), scene, program, setup)
+    }
+
+    /// Prepares `scene`, whose distance program is `program`, for wgpu on an already opened
+    /// device: generates and validates the kernel (its pipeline is compiled, or found in the
+    /// device's cache, at the first render or by [`Gpu::pipeline_for`]).
+    pub fn on_gpu(
+        gpu: Arc<Gpu>,
+        scene: &Scene,
+        program: &Program,
+        setup: &Setup,
+    ) -> Result<Prepared, String> {
+        method_allowed(scene)?;
         let lipschitz = program.lipschitz();
         Ok(Prepared::Wgpu {
-            gpu: Box::new(gpu),
+            gpu,
             kernel: Box::new(Self::kernel(scene, program, setup)?),
             lipschitz,
         })
+    }
+
+    /// Prepares `scene`, whose distance program is `program`, for the CPU renderer.
+    pub fn on_cpu(scene: &Scene, program: Program, setup: &Setup) -> Result<Prepared, String> {
+        method_allowed(scene)?;
+        Ok(Self::cpu(program, setup))
     }
 
     fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {

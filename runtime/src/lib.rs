@@ -12,3 +12,4 @@ pub mod gpu;
 pub mod image;
 pub mod memory;
 pub mod metrics;
+pub mod view;

@@ -263,7 +263,7 @@ fn follows_edits(name: &str, display: Option<&Display>, args: &[&str]) {
         "the error changed the picture"
     );
     assert!(
-        stderr.contains("sphre") && stderr.contains("error["),
+        stderr.contains("sphre") && stderr.contains("E0201"),
         "the diagnostics are printed as `sdfc check` prints them:\n{stderr}"
     );
     assert!(

@@ -109,8 +109,12 @@ struct Timings {
     pipeline: Option<PipelineTime>,
     /// When the newest of the scene's files was modified.
     modified: Option<SystemTime>,
-    /// The first frame's render time, once rendered.
-    first_frame: Option<Duration>,
+    /// When the load began.
+    began: SystemTime,
+    /// The first frame's render time and size, once rendered.
+    first_frame: Option<(Duration, u32, u32)>,
+    /// Whether the first frame's timings are printed (and the first full frame's are due).
+    printed: bool,
 }
 
 /// One rendered frame.
@@ -166,6 +170,11 @@ pub struct Session {
     moving_until: Option<Instant>,
     /// The divisor of the resolution while moving.
     scale: u32,
+    /// Whether the next frame is the first of a newly loaded scene, rendered at a lower
+    /// resolution when full frames take longer than the budget.
+    preview: bool,
+    /// The time of the last full-resolution frame.
+    last_full: Option<Duration>,
     accumulation: Accumulation,
     /// The image on show: the mean of the accumulated samples.
     shown: Option<Image>,
@@ -194,6 +203,8 @@ impl Session {
             size,
             moving_until: None,
             scale: 1,
+            preview: false,
+            last_full: None,
             accumulation: Accumulation::default(),
             shown: None,
             last: None,
@@ -251,11 +262,13 @@ impl Session {
         let number = self.loads;
         self.loads += 1;
         let started = Instant::now();
+        let began = SystemTime::now();
         let modified = Fingerprint::modified(&self.files);
         match self.compile() {
             Ok((good, mut timings)) => {
                 timings.number = number;
                 timings.modified = Fingerprint::modified(&self.files).or(modified);
+                timings.began = began;
                 self.install(good);
                 self.timings = Some(timings);
                 self.failed = false;
@@ -379,7 +392,9 @@ impl Session {
             prepare: prepare_time,
             pipeline,
             modified: None,
+            began: SystemTime::now(),
             first_frame: None,
+            printed: false,
         };
         Ok((good, timings))
     }
@@ -387,7 +402,17 @@ impl Session {
     fn install(&mut self, good: Good) {
         self.good = Some(good);
         self.broken = None;
+        self.preview = true;
         self.accumulation = Accumulation::default();
+    }
+
+    /// The divisor of the resolution of a new scene's first frame: enough to bring the last
+    /// full frame's time within the budget (1 before the first frame).
+    fn preview_scale(&self) -> u32 {
+        let ratio = self
+            .last_full
+            .map_or(0.0, |t| t.as_secs_f64() / FRAME_BUDGET.as_secs_f64());
+        (ratio.sqrt().ceil() as u32).clamp(1, MAX_SCALE)
     }
 
     /// Sets the view's size (the window's), clamped to the `edge` limit.
@@ -493,23 +518,32 @@ impl Session {
         let Some(base) = self.camera() else {
             return Ok(None);
         };
-        let scale = if moving { self.scale } else { 1 };
+        let scale = if moving {
+            self.scale
+        } else if self.preview {
+            self.preview_scale()
+        } else {
+            1
+        };
+        // A frame below full resolution is a single sample, replaced by the next frame.
+        let low = scale > 1 || moving;
+        self.preview = false;
         let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
         let a = &mut self.accumulation;
-        if moving || !a.still || (a.width, a.height) != (w, h) {
+        if low || !a.still || (a.width, a.height) != (w, h) {
             *a = Accumulation {
                 width: w,
                 height: h,
                 sum: vec![[0.0; 3]; w as usize * h as usize],
                 count: 0,
-                still: !moving,
+                still: !low,
             };
         }
         let Some(good) = self.good.as_mut() else {
             return Ok(None);
         };
         let n = (good.aa as f64).sqrt().round() as u32;
-        let (dx, dy) = if moving {
+        let (dx, dy) = if low {
             (0.0, 0.0)
         } else {
             camera::sample_offset(a.count, n)
@@ -542,6 +576,9 @@ impl Session {
                 .map(|c| [c[0] * inv, c[1] * inv, c[2] * inv])
                 .collect(),
         });
+        if scale == 1 {
+            self.last_full = Some(time);
+        }
         if moving {
             if time > FRAME_BUDGET && self.scale < MAX_SCALE {
                 self.scale += 1;
@@ -559,7 +596,7 @@ impl Session {
             moving,
         };
         if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
-            t.first_frame = Some(time);
+            t.first_frame = Some((time, w, h));
         }
         self.last = Some(info);
         Ok(Some(info))
@@ -575,32 +612,63 @@ impl Session {
     /// is, with `--timings` (edit to pixel: from the modification of the newest of the
     /// scene's files until now).
     pub fn presented(&mut self) {
-        let Some(t) = self.timings.as_ref().filter(|t| t.first_frame.is_some()) else {
+        let Some(t) = self.timings.as_ref() else {
             return;
         };
+        let Some((time, w, h)) = t.first_frame else {
+            return;
+        };
+        if t.printed {
+            // The first frame was smaller: say when the full resolution followed.
+            let full = self.accumulation.still && self.accumulation.count > 0;
+            if full {
+                if let (true, Some(m)) = (self.options.timings, t.modified.filter(|_| t.number > 0)) {
+                    if let Ok(total) = SystemTime::now().duration_since(m) {
+                        eprintln!(
+                            "view: load {}: first full-resolution frame shown {:.1} ms after the edit",
+                            t.number,
+                            ms(total)
+                        );
+                    }
+                }
+                self.timings = None;
+            }
+            return;
+        }
         if self.options.timings {
             let pipeline = match t.pipeline {
                 Some(p) if p.cached => format!(", pipeline cached ({:.1} ms)", ms(p.time)),
                 Some(p) => format!(", pipeline compiled {:.1} ms", ms(p.time)),
                 None => String::new(),
             };
-            let edit = t
-                .modified
-                .and_then(|m| SystemTime::now().duration_since(m).ok())
-                .filter(|_| t.number > 0)
-                .map(|d| format!(", edit to pixel {:.1} ms", ms(d)))
-                .unwrap_or_default();
+            let now = SystemTime::now();
+            let edit = match (t.modified.filter(|_| t.number > 0), now.duration_since(t.began)) {
+                (Some(m), Ok(shown)) => match (t.began.duration_since(m), now.duration_since(m)) {
+                    (Ok(seen), Ok(total)) => format!(
+                        "; edit to pixel {:.1} ms (seen after {:.1} ms, shown {:.1} ms later)",
+                        ms(total),
+                        ms(seen),
+                        ms(shown)
+                    ),
+                    _ => String::new(),
+                },
+                _ => String::new(),
+            };
             eprintln!(
-                "view: load {} timings: check {:.1} ms, lower {:.1} ms, {} {:.1} ms{pipeline}, first frame {:.1} ms{edit}",
+                "view: load {} timings: check {:.1} ms, lower {:.2} ms, {} {:.2} ms{pipeline}, first frame {:.1} ms ({w}x{h}){edit}",
                 t.number,
                 ms(t.check),
                 ms(t.lower),
                 if matches!(self.device, Device::Cpu) { "tapes" } else { "kernel" },
                 ms(t.prepare),
-                ms(t.first_frame.unwrap_or_default()),
+                ms(time),
             );
         }
-        self.timings = None;
+        if (w, h) == self.size {
+            self.timings = None;
+        } else if let Some(t) = self.timings.as_mut() {
+            t.printed = true;
+        }
     }
 
     /// The window title: the file, the problem with the last load if it failed, a render

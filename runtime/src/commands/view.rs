@@ -43,6 +43,10 @@ pub struct ViewArgs {
     /// image converges, then wait for changes.
     #[arg(long)]
     pub headless: bool,
+    /// With --headless: once the first image has settled, orbit the camera for N frames and
+    /// print the frame rate, then the time to converge after the camera stops.
+    #[arg(long, value_name = "N", requires = "headless", value_parser = clap::value_parser!(u32).range(1..))]
+    pub orbit_frames: Option<u32>,
     /// Stop after N frames have been presented.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: Option<u64>,
@@ -97,6 +101,7 @@ pub fn run(args: ViewArgs) -> ExitCode {
             screenshot_dir: args.screenshot_dir,
             exit_after_reloads: args.exit_after_reloads,
             stats: args.stats,
+            orbit_frames: args.orbit_frames,
         },
     };
     if args.headless {

@@ -32,6 +32,9 @@ pub struct Control {
     pub exit_after_reloads: Option<u32>,
     /// Start with the statistics shown in the title.
     pub stats: bool,
+    /// Headless: once the first image has settled, orbit the camera for this many frames,
+    /// print the frame rate, then the time to the converged image after the camera stops.
+    pub orbit_frames: Option<u32>,
 }
 
 /// A run of the viewer.
@@ -86,6 +89,7 @@ pub fn headless(run: Run) -> ExitCode {
     let control = &run.control;
     let mut shot_for = Some(session.load().number);
     let mut frames = 0u64;
+    let mut orbit = control.orbit_frames;
     loop {
         if let Some(w) = watch.as_mut() {
             for problem in w.add(session.files()) {
@@ -114,6 +118,9 @@ pub fn headless(run: Run) -> ExitCode {
                 break;
             }
         }
+        if let Some(n) = orbit.take() {
+            measure_orbit(&mut session, n);
+        }
         if let (Some(k), Some(dir)) = (shot_for.take(), &control.screenshot_dir) {
             let path = dir.join(format!("reload-{k}.png"));
             if let Err(msg) = write_image(&session, &path) {
@@ -137,6 +144,55 @@ pub fn headless(run: Run) -> ExitCode {
             shot_for = Some(session.load().number);
         }
     }
+}
+
+/// Orbits the camera by 4 pixels' drag a frame for `frames` frames, as a user would, and
+/// prints the frame rate and the frames' size; then lets the camera stop and prints how long
+/// the image takes to converge (the settling time after the last motion included).
+fn measure_orbit(session: &mut Session, frames: u32) {
+    let start = std::time::Instant::now();
+    let mut last = None;
+    for _ in 0..frames {
+        session.rotate(4.0, 0.0);
+        match session.frame() {
+            Ok(Some(info)) => last = Some(info),
+            Ok(None) => {}
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                return;
+            }
+        }
+    }
+    let elapsed = start.elapsed();
+    let Some(info) = last else {
+        eprintln!("view: orbit: nothing to render");
+        return;
+    };
+    eprintln!(
+        "view: orbit: {frames} frames in {:.3} s, {:.1} frames/s (last frame {}x{}, {:.2} ms)",
+        elapsed.as_secs_f64(),
+        frames as f64 / elapsed.as_secs_f64(),
+        info.width,
+        info.height,
+        info.time.as_secs_f64() * 1e3
+    );
+    let stopped = std::time::Instant::now();
+    let mut samples = 0;
+    while !session.settled() {
+        match session.frame() {
+            Ok(Some(info)) => samples = info.samples,
+            Ok(None) => std::thread::sleep(Duration::from_millis(1)),
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                return;
+            }
+        }
+    }
+    eprintln!(
+        "view: orbit: converged ({samples} samples per pixel) {:.1} ms after the camera stopped ({} ms of it waiting for the camera to count as still)",
+        stopped.elapsed().as_secs_f64() * 1e3,
+        session::SETTLE.as_millis()
+    );
 }
 
 /// Writes the session's image (the background grey when there is none yet).

@@ -60,7 +60,10 @@ impl Drop for Display {
 
 fn display() -> Option<Display> {
     let lavapipe = std::fs::read_dir("/usr/share/vulkan/icd.d")
-        .map(|d| d.flatten().any(|e| e.file_name().to_string_lossy().starts_with("lvp_icd")))
+        .map(|d| {
+            d.flatten()
+                .any(|e| e.file_name().to_string_lossy().starts_with("lvp_icd"))
+        })
         .unwrap_or(false);
     if let Ok(name) = std::env::var("DISPLAY") {
         if !name.is_empty() {
@@ -91,7 +94,11 @@ fn display() -> Option<Display> {
         .spawn();
     let child = match child {
         Ok(c) => c,
-        Err(e) => return skip(&format!("no DISPLAY and Xvfb cannot start ({e}; `apt-get install xvfb`)")),
+        Err(e) => {
+            return skip(&format!(
+                "no DISPLAY and Xvfb cannot start ({e}; `apt-get install xvfb`)"
+            ))
+        }
     };
     let display = Display {
         name: format!(":{n}"),
@@ -210,13 +217,19 @@ fn follows_edits(name: &str, display: Option<&Display>, args: &[&str]) {
     let first = wait_for(&shots.join("reload-0.png"), &mut child, &log);
     let (cx, cy) = CENTRE;
     let c = mean(&first, cx, cy);
-    assert!(c[0] > 2.0 * c[2] && c[0] > 2.0 * c[1], "a red sphere: {c:?}");
+    assert!(
+        c[0] > 2.0 * c[2] && c[0] > 2.0 * c[1],
+        "a red sphere: {c:?}"
+    );
 
     // A numeric edit: the sphere turns blue, and nothing else changes.
     std::fs::write(&scene, SCENE.replace("(0.9, 0.1, 0.1)", "(0.1, 0.1, 0.9)")).unwrap();
     let blue = wait_for(&shots.join("reload-1.png"), &mut child, &log);
     let c = mean(&blue, cx, cy);
-    assert!(c[2] > 2.0 * c[0] && c[2] > 2.0 * c[1], "a blue sphere: {c:?}");
+    assert!(
+        c[2] > 2.0 * c[0] && c[2] > 2.0 * c[1],
+        "a blue sphere: {c:?}"
+    );
     let (lx, ly) = LEFT;
     assert!(
         changed(&first, &blue, lx, ly) < 0.01,
@@ -224,12 +237,10 @@ fn follows_edits(name: &str, display: Option<&Display>, args: &[&str]) {
     );
 
     // A structural edit, saved as editors do: a new file renamed over the old one.
-    let with_box = SCENE
-        .replace("(0.9, 0.1, 0.1)", "(0.1, 0.1, 0.9)")
-        .replace(
-            "@ ball;\n",
-            "@ ball;\n  box((0.5, 0.5, 0.5)).translate(2.2, 0.5, 0) @ grey;\n",
-        );
+    let with_box = SCENE.replace("(0.9, 0.1, 0.1)", "(0.1, 0.1, 0.9)").replace(
+        "@ ball;\n",
+        "@ ball;\n  box((0.5, 0.5, 0.5)).translate(2.2, 0.5, 0) @ grey;\n",
+    );
     let new = dir.join(".scene.sdf.new");
     std::fs::write(&new, &with_box).unwrap();
     std::fs::rename(&new, &scene).unwrap();

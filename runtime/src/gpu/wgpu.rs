@@ -163,12 +163,7 @@ impl Gpu {
 
     /// Compiles the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
     /// `data`), or finds it among those already compiled on this device.
-    pub fn pipeline_for(
-        &self,
-        wgsl: &str,
-        entry: &str,
-        data: bool,
-    ) -> Result<PipelineTime, Error> {
+    pub fn pipeline_for(&self, wgsl: &str, entry: &str, data: bool) -> Result<PipelineTime, Error> {
         let start = Instant::now();
         let (_, cached) = self.cached_pipeline(wgsl, entry, data)?;
         Ok(PipelineTime {

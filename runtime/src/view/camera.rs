@@ -36,7 +36,10 @@ impl Orbit {
             target: camera.look_at,
             distance,
             yaw: d[0].atan2(d[2]),
-            pitch: (d[1] / distance).clamp(-1.0, 1.0).asin().clamp(-PITCH_LIMIT, PITCH_LIMIT),
+            pitch: (d[1] / distance)
+                .clamp(-1.0, 1.0)
+                .asin()
+                .clamp(-PITCH_LIMIT, PITCH_LIMIT),
             fov: camera.fov,
         }
     }

@@ -622,7 +622,8 @@ impl Session {
             // The first frame was smaller: say when the full resolution followed.
             let full = self.accumulation.still && self.accumulation.count > 0;
             if full {
-                if let (true, Some(m)) = (self.options.timings, t.modified.filter(|_| t.number > 0)) {
+                if let (true, Some(m)) = (self.options.timings, t.modified.filter(|_| t.number > 0))
+                {
                     if let Ok(total) = SystemTime::now().duration_since(m) {
                         eprintln!(
                             "view: load {}: first full-resolution frame shown {:.1} ms after the edit",
@@ -642,7 +643,10 @@ impl Session {
                 None => String::new(),
             };
             let now = SystemTime::now();
-            let edit = match (t.modified.filter(|_| t.number > 0), now.duration_since(t.began)) {
+            let edit = match (
+                t.modified.filter(|_| t.number > 0),
+                now.duration_since(t.began),
+            ) {
                 (Some(m), Ok(shown)) => match (t.began.duration_since(m), now.duration_since(m)) {
                     (Ok(seen), Ok(total)) => format!(
                         "; edit to pixel {:.1} ms (seen after {:.1} ms, shown {:.1} ms later)",
@@ -732,4 +736,76 @@ fn first_error(diagnostics: &[Diagnostic], sources: &SourceMap) -> String {
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = "camera { position: (0, 1, -4), look_at: (0, 0.5, 0), fov: 50deg }\n\
+        light point { position: (2, 4, -3), intensity: 1 }\n\
+        render { width: 32, height: 24, aa: 2 }\n\
+        scene { plane((0, 1, 0), 0); sphere(0.5).translate(0, 0.5, 0); }\n";
+
+    fn settle(s: &mut Session) -> u32 {
+        let mut frames = 0;
+        while s.wants_frame() {
+            s.frame().expect("a CPU frame");
+            frames += 1;
+        }
+        frames
+    }
+
+    #[test]
+    fn reloads_keep_the_moved_camera_and_errors_keep_the_image() {
+        let dir = std::env::temp_dir().join(format!("sdfc-session-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("s.sdf");
+        std::fs::write(&file, SCENE).unwrap();
+        let mut s = Session::new(file.clone(), Options::default(), Device::Cpu);
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        // aa 2: four jittered samples, then nothing more to render.
+        assert_eq!(settle(&mut s), 4);
+        assert!(s.settled());
+        let first = s.image().unwrap().clone();
+
+        // The file's camera moves the view until the user moves it.
+        std::fs::write(&file, SCENE.replace("(0, 1, -4)", "(0, 1.2, -4)")).unwrap();
+        assert!(s.needs_reload(&[]));
+        assert!(s.load().ok);
+        assert!(!s.needs_reload(&[]), "nothing changed since");
+        assert_eq!(s.camera().unwrap().position, [0.0, 1.2, -4.0]);
+        s.rotate(30.0, 0.0);
+        let moved = s.camera().unwrap();
+        settle(&mut s);
+
+        // A clean reload keeps the user's camera; R returns to the file's.
+        std::fs::write(&file, SCENE.replace("sphere(0.5)", "sphere(0.6)")).unwrap();
+        let outcome = s.load();
+        assert!(outcome.ok && outcome.number == 2);
+        assert_eq!(s.camera().unwrap(), moved);
+        settle(&mut s);
+        let good = s.image().unwrap().clone();
+        assert_ne!(good, first);
+
+        // An edit with errors keeps the image and says why in the title.
+        std::fs::write(&file, SCENE.replace("sphere(0.5)", "sphre(0.5)")).unwrap();
+        let outcome = s.load();
+        assert!(!outcome.ok);
+        assert!(outcome.summary.contains("E0201"), "{}", outcome.summary);
+        assert!(s.title(false).contains("E0201"));
+        assert!(s.settled());
+        assert_eq!(s.image(), Some(&good));
+
+        // So does a file that disappears; a failed load retries on any scene file's change.
+        std::fs::remove_file(&file).unwrap();
+        assert!(s.needs_reload(&[]));
+        assert!(!s.load().ok);
+        assert_eq!(s.image(), Some(&good));
+        assert!(s.needs_reload(&[dir.join("other.sdf")]));
+        s.reset_camera();
+        assert!(!s.camera_moved());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

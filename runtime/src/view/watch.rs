@@ -29,19 +29,24 @@ impl Watch {
     /// batch of events, or with no paths when the watcher reported an error (so that the
     /// files are looked at again).
     pub fn new(changed: impl Fn(Vec<PathBuf>) + Send + 'static) -> Result<Watch, String> {
-        let debouncer = new_debouncer(DEBOUNCE, None, move |result: DebounceEventResult| {
-            match result {
-                Ok(events) => {
-                    let paths: Vec<PathBuf> =
-                        events.iter().flat_map(|e| e.paths.iter().cloned()).collect();
-                    if !paths.is_empty() {
-                        changed(paths);
+        let debouncer =
+            new_debouncer(
+                DEBOUNCE,
+                None,
+                move |result: DebounceEventResult| match result {
+                    Ok(events) => {
+                        let paths: Vec<PathBuf> = events
+                            .iter()
+                            .flat_map(|e| e.paths.iter().cloned())
+                            .collect();
+                        if !paths.is_empty() {
+                            changed(paths);
+                        }
                     }
-                }
-                Err(_) => changed(Vec::new()),
-            }
-        })
-        .map_err(|e| format!("cannot watch files: {e}"))?;
+                    Err(_) => changed(Vec::new()),
+                },
+            )
+            .map_err(|e| format!("cannot watch files: {e}"))?;
         Ok(Watch {
             debouncer,
             dirs: BTreeSet::new(),
@@ -136,7 +141,10 @@ mod tests {
         let print = Fingerprint::of(&files);
         assert!(!print.changed());
         std::fs::write(&file, "scene { sphere(1); }").unwrap();
-        assert!(!print.changed(), "the same contents written again is no change");
+        assert!(
+            !print.changed(),
+            "the same contents written again is no change"
+        );
         std::fs::write(&file, "scene { sphere(2); }").unwrap();
         assert!(print.changed());
         std::fs::remove_file(&file).unwrap();

@@ -643,8 +643,7 @@ impl Presenter {
                     sample_count: 1,
                     dimension: wgpu::TextureDimension::D2,
                     format: self.config.format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                        | wgpu::TextureUsages::COPY_SRC,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                     view_formats: &[],
                 });
                 let mut encoder = device.create_command_encoder(&Default::default());

@@ -5,12 +5,13 @@
 //! (`--screenshot-dir`, `reload-K.png`) that the picture changes as it should and that the
 //! error leaves the last good image on show.
 //!
-//! The window tests run under X: on `DISPLAY` when it is set, else on an Xvfb the test starts
-//! on a free display number; wgpu presents through Vulkan (lavapipe on a machine without a
+//! The window tests run under X: on `DISPLAY` when it is set, else on an Xvfb of their own
+//! (which picks a free display number); wgpu presents through Vulkan (lavapipe on a machine without a
 //! GPU). Where Xvfb or a Vulkan driver is missing they print that they skipped, unless
 //! `SDFC_REQUIRE_DEVICES=1` (set by `.ci/run`): then they fail. The headless test needs neither.
 
 use sdfc_runtime::image::{read_png, Image};
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -73,26 +74,22 @@ fn display() -> Option<Display> {
     if !lavapipe {
         return skip("no DISPLAY and no lavapipe (`apt-get install mesa-vulkan-drivers`)");
     }
-    // A display number nobody holds.
-    let Some(n) = (90..400).find(|n| {
-        !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
-    }) else {
-        return skip("no free X display number");
-    };
+    // Xvfb picks a free display number itself (so tests running at once do not collide) and
+    // writes it to the descriptor given once it accepts connections.
     let child = Command::new("Xvfb")
         .args([
-            &format!(":{n}"),
+            "-displayfd",
+            "1",
             "-screen",
             "0",
             "1024x768x24",
             "-nolisten",
             "tcp",
         ])
-        .stdout(Stdio::null())
+        .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn();
-    let child = match child {
+    let mut child = match child {
         Ok(c) => c,
         Err(e) => {
             return skip(&format!(
@@ -100,18 +97,20 @@ fn display() -> Option<Display> {
             ))
         }
     };
+    let mut line = String::new();
+    let read = child
+        .stdout
+        .take()
+        .map(|out| std::io::BufReader::new(out).read_line(&mut line));
+    let number = line.trim().parse::<u32>();
+    let Ok(n) = number else {
+        let _ = child.kill();
+        panic!("Xvfb did not say which display it took ({read:?}, `{line}`)");
+    };
     let display = Display {
         name: format!(":{n}"),
         xvfb: Some(child),
     };
-    let start = Instant::now();
-    while !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "Xvfb :{n} did not start"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
     Some(display)
 }
 
@@ -302,10 +301,12 @@ fn the_headless_session_follows_edits() {
     follows_edits("headless", None, &["--headless", "--backend", "cpu"]);
 }
 
-#[test]
-fn a_screenshot_after_some_frames_shows_the_scene() {
-    let Some(display) = display() else { return };
-    let dir = temp_dir("frames");
+/// Runs the viewer for a few frames with `env` and checks the screenshot; returns stderr.
+fn screenshot_after_frames(name: &str, env: &[(&str, &str)]) -> String {
+    let Some(display) = display() else {
+        return String::new();
+    };
+    let dir = temp_dir(name);
     std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
     std::fs::create_dir_all(dir.join("xdg")).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
@@ -323,9 +324,10 @@ fn a_screenshot_after_some_frames_shows_the_scene() {
         .env("DISPLAY", &display.name)
         .env("XDG_RUNTIME_DIR", dir.join("xdg"))
         .env_remove("WAYLAND_DISPLAY")
+        .envs(env.iter().copied())
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(out.status.success(), "{stderr}");
     let shot = read_png(&dir.join("shot.png")).unwrap();
     assert_eq!((shot.width, shot.height), (200, 100), "the window's size");
@@ -333,4 +335,26 @@ fn a_screenshot_after_some_frames_shows_the_scene() {
     let c = mean(&shot, cx, cy);
     assert!(c[0] > 2.0 * c[2], "a red sphere: {c:?}\n{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
+    stderr
+}
+
+#[test]
+fn a_screenshot_after_some_frames_shows_the_scene() {
+    screenshot_after_frames("frames", &[]);
+}
+
+#[test]
+fn without_an_adapter_the_window_shows_cpu_frames() {
+    // No Vulkan driver to be found: the window falls back to softbuffer and the CPU renderer.
+    let stderr = screenshot_after_frames(
+        "soft",
+        &[
+            ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+            ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+        ],
+    );
+    assert!(
+        stderr.is_empty() || stderr.contains("presenting with softbuffer"),
+        "{stderr}"
+    );
 }

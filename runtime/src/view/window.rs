@@ -1,7 +1,8 @@
 //! Presenting a session in a window: a winit window with a wgpu surface, on the device that
-//! renders the kernel (the adapter is the one that can present to the surface), the mouse and
-//! keys that move the camera, the title line, and the screenshots of `--screenshot` and
-//! `--screenshot-dir`, read back from the surface texture that is presented.
+//! renders the kernel (the adapter is the one that can present to the surface), or, where no
+//! adapter can, softbuffer and the CPU renderer; the mouse and keys that move the camera, the
+//! title line, and the screenshots of `--screenshot` and `--screenshot-dir`, read back from
+//! what is presented.
 
 use super::session::{Device, Session};
 use super::watch::Watch;
@@ -9,13 +10,16 @@ use super::{write_rgba_png, Run};
 use crate::backend::Backend;
 use crate::gpu::Gpu;
 use crate::image::Image;
+use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
+use winit::event_loop::{
+    ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy, OwnedDisplayHandle,
+};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
@@ -95,40 +99,38 @@ impl App {
                 .create_window(attributes)
                 .map_err(|e| format!("cannot open a window: {e}"))?,
         );
-        let display = Box::new(event_loop.owned_display_handle());
-        let instance = wgpu::Instance::new(
-            wgpu::InstanceDescriptor::new_with_display_handle_from_env(display),
-        );
-        let surface = instance
-            .create_surface(window.clone())
-            .map_err(|e| format!("cannot make a wgpu surface for the window: {e}"))?;
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: Some(&surface),
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| {
-            format!(
-                "no wgpu adapter can present to the window ({e}): install a Vulkan driver (on Linux without a GPU, Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`)"
-            )
-        })?;
-        let gpu = Arc::new(Gpu::from_adapter(&adapter).map_err(|e| e.to_string())?);
-        let device = match self.run.backend {
-            Backend::Cpu => Device::Cpu,
-            Backend::Wgpu => Device::Wgpu(gpu.clone()),
-            // Like `sdfc render`, auto takes a hardware GPU and otherwise the CPU renderer.
-            _ if gpu.is_cpu() => Device::Cpu,
-            _ => Device::Wgpu(gpu.clone()),
+        let (device, presenter) = match wgpu_presenter(event_loop, &window) {
+            Ok((gpu, presenter)) => {
+                let device = match self.run.backend {
+                    Backend::Cpu => Device::Cpu,
+                    Backend::Wgpu => Device::Wgpu(gpu.clone()),
+                    // Like `sdfc render`, auto takes a hardware GPU, else the CPU renderer.
+                    _ if gpu.is_cpu() => Device::Cpu,
+                    _ => Device::Wgpu(gpu.clone()),
+                };
+                eprintln!(
+                    "view: rendering on {} ({}), presenting through wgpu on {}",
+                    device.name(),
+                    device.describe(),
+                    gpu.describe()
+                );
+                (device, Presenter::Gpu(Box::new(presenter)))
+            }
+            Err(msg) if self.run.backend == Backend::Wgpu => {
+                return Err(format!(
+                    "{msg}: install a Vulkan driver (on Linux without a GPU, Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`), or use --backend cpu"
+                ));
+            }
+            Err(msg) => {
+                let presenter = SoftPresenter::new(event_loop, &window)?;
+                eprintln!(
+                    "view: {msg}; rendering on the CPU ({}) and presenting with softbuffer",
+                    Device::Cpu.describe()
+                );
+                (Device::Cpu, Presenter::Soft(presenter))
+            }
         };
-        eprintln!(
-            "view: rendering on {} ({}), presenting on {}",
-            device.name(),
-            device.describe(),
-            gpu.describe()
-        );
         let size = window.inner_size();
-        let presenter = Presenter::new(gpu, surface, &adapter, size.width, size.height)?;
         let mut session = Session::new(self.run.file.clone(), self.run.options.clone(), device);
         session.set_size(size.width.max(1), size.height.max(1));
         let outcome = session.load();
@@ -343,10 +345,131 @@ impl ApplicationHandler<UserEvent> for App {
     }
 }
 
+/// How the window shows images: through wgpu, or, where no adapter can present to it, with
+/// softbuffer (pixels copied to the window by the CPU).
+enum Presenter {
+    Gpu(Box<GpuPresenter>),
+    Soft(SoftPresenter),
+}
+
+impl Presenter {
+    fn resize(&mut self, width: u32, height: u32) {
+        match self {
+            Presenter::Gpu(p) => p.resize(width, height),
+            Presenter::Soft(p) => p.size = (width.max(1), height.max(1)),
+        }
+    }
+
+    fn upload(&mut self, image: &Image) {
+        match self {
+            Presenter::Gpu(p) => p.upload(image),
+            Presenter::Soft(p) => p.image = Some((image.width, image.height, image.to_rgba8())),
+        }
+    }
+
+    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
+        match self {
+            Presenter::Gpu(p) => p.present(shots),
+            Presenter::Soft(p) => p.present(shots),
+        }
+    }
+}
+
+/// Opens the wgpu presenter: an instance with the window's display, a surface, and an adapter
+/// that can present to it.
+fn wgpu_presenter(
+    event_loop: &ActiveEventLoop,
+    window: &Arc<Window>,
+) -> Result<(Arc<Gpu>, GpuPresenter), String> {
+    let display = Box::new(event_loop.owned_display_handle());
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+        display,
+    ));
+    let surface = instance
+        .create_surface(window.clone())
+        .map_err(|e| format!("cannot make a wgpu surface for the window: {e}"))?;
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: Some(&surface),
+        apply_limit_buckets: false,
+    }))
+    .map_err(|e| format!("no wgpu adapter can present to the window ({e})"))?;
+    let gpu = Arc::new(Gpu::from_adapter(&adapter).map_err(|e| e.to_string())?);
+    let size = window.inner_size();
+    let presenter = GpuPresenter::new(gpu.clone(), surface, &adapter, size.width, size.height)?;
+    Ok((gpu, presenter))
+}
+
+/// Shows images with softbuffer: each is scaled to the window (nearest pixel) by the CPU and
+/// copied to it.
+struct SoftPresenter {
+    surface: softbuffer::Surface<OwnedDisplayHandle, Arc<Window>>,
+    size: (u32, u32),
+    /// The image's size and sRGB RGBA bytes.
+    image: Option<(u32, u32, Vec<u8>)>,
+}
+
+impl SoftPresenter {
+    fn new(event_loop: &ActiveEventLoop, window: &Arc<Window>) -> Result<SoftPresenter, String> {
+        let context = softbuffer::Context::new(event_loop.owned_display_handle())
+            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
+        let surface = softbuffer::Surface::new(&context, window.clone())
+            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
+        let size = window.inner_size();
+        Ok(SoftPresenter {
+            surface,
+            size: (size.width.max(1), size.height.max(1)),
+            image: None,
+        })
+    }
+
+    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
+        let (w, h) = self.size;
+        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
+            return Ok(false);
+        };
+        self.surface
+            .resize(nw, nh)
+            .map_err(|e| format!("cannot resize the window's buffer: {e}"))?;
+        let mut buffer = self
+            .surface
+            .buffer_mut()
+            .map_err(|e| format!("cannot draw in the window: {e}"))?;
+        for y in 0..h {
+            for x in 0..w {
+                let px = match &self.image {
+                    Some((iw, ih, rgba)) => {
+                        let (sx, sy) = (x * iw / w, y * ih / h);
+                        let i = 4 * (sy as usize * *iw as usize + sx as usize);
+                        (rgba[i] as u32) << 16 | (rgba[i + 1] as u32) << 8 | rgba[i + 2] as u32
+                    }
+                    None => 0x050505,
+                };
+                buffer[y as usize * w as usize + x as usize] = px;
+            }
+        }
+        if !shots.is_empty() {
+            let rgba: Vec<u8> = buffer
+                .iter()
+                .flat_map(|&p| [(p >> 16) as u8, (p >> 8) as u8, p as u8, 255])
+                .collect();
+            for path in shots {
+                write_rgba_png(path, w, h, &rgba)
+                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+            }
+        }
+        buffer
+            .present()
+            .map_err(|e| format!("cannot show the frame: {e}"))?;
+        Ok(true)
+    }
+}
+
 /// Draws the session's image into the window's surface: the image is uploaded to a texture
 /// (sRGB bytes) and drawn over the whole surface with a linear filter (so the smaller frames
 /// rendered while moving fill the window).
-struct Presenter {
+struct GpuPresenter {
     gpu: Arc<Gpu>,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
@@ -393,14 +516,14 @@ const EMPTY: wgpu::Color = wgpu::Color {
     a: 1.0,
 };
 
-impl Presenter {
+impl GpuPresenter {
     fn new(
         gpu: Arc<Gpu>,
         surface: wgpu::Surface<'static>,
         adapter: &wgpu::Adapter,
         width: u32,
         height: u32,
-    ) -> Result<Presenter, String> {
+    ) -> Result<GpuPresenter, String> {
         let caps = surface.get_capabilities(adapter);
         let format = caps
             .formats
@@ -508,7 +631,7 @@ impl Presenter {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        Ok(Presenter {
+        Ok(GpuPresenter {
             gpu,
             surface,
             config,

@@ -6,7 +6,7 @@ use std::process::{Command, Output};
 
 const SCENE: &str = "material red = phong { color: (1, 0.2, 0.1), reflect: 0.2 };
 camera { position: (0, 1, -5), look_at: (0, 0, 0), fov: 50deg }
-light point { position: (2, 4, -3), intensity: 1, radius: 50, softness: 8 }
+light point { position: (2, 4, -3), intensity: 1, radius: 50, penumbra: 7.125deg }
 render { width: 40, height: 30 }
 scene {
   plane() ;
@@ -361,7 +361,7 @@ fn the_method_setting_and_what_check_says_about_it() {
     assert_eq!(entries(&d), ["ball.sdf"]);
     std::fs::write(
         d.join("hard.sdf"),
-        SCENE.replace("softness: 8", "softness: 0"),
+        SCENE.replace("penumbra: 7.125deg", "penumbra: 0deg"),
     )
     .expect("write");
     let out = sdfc(&d, &["check", "hard.sdf"]);

@@ -156,7 +156,7 @@ fn marched_scene(n: usize) -> String {
          material mirror = phong { color: (0.9, 0.9, 0.95), diffuse: 0.2, specular: 1, shininess: 200, reflect: 0.5 };\n\
          material teal = phong { color: (0.15, 0.6, 0.6), specular: 0.5, shininess: 64 };\n\
          camera { position: (0, 4, -7), look_at: (0, 1, 3), fov: 60deg }\n\
-         light point { position: (-4, 9, -6), intensity: 1.1, radius: 60, softness: 0.1 }\n\
+         light point { position: (-4, 9, -6), intensity: 1.1, radius: 60, penumbra: 84.2894deg }\n\
          render { width: 96, height: 64, max_depth: 2, method: \"march\" }\n\
          scene {\n  plane() @ floor;\n  box((0.3, 1, 0.3)).twist(1.5).translate(0, 1, -3) @ teal;\n",
     );
@@ -240,6 +240,44 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let kernel = wgsl::write_with(&scene, &program, &walk).expect("valid kernel");
     assert!(kernel.data.is_some() && !kernel.source.contains("fn map_block"));
     assert_agree(&gpu, &scene, &program, &kernel, "compound_100");
+}
+
+/// A camera looking straight down (its view parallel to the default `up`) and one rolled by
+/// `up` render on the GPU as on the CPU: the basis is computed once, in f64, for both.
+#[test]
+fn cameras_looking_straight_down_match_the_cpu() {
+    let Some(gpu) = open_gpu() else { return };
+    for up in ["", ", up: (1, 0, 1)"] {
+        let text = format!(
+            "camera {{ position: (0, 6, 0), look_at: (0, 0, 0){up} }}\n\
+             light point {{ position: (2, 10, 1), penumbra: 4deg }}\n\
+             render {{ width: 64, height: 64 }}\n\
+             scene {{ plane((0, 1, 0), -1); sphere(1); box((0.4, 0.4, 0.4)).translate(0, 0, 2.5); }}"
+        );
+        let scene = checked("down.sdf", &text);
+        let program = lower::lower(&scene);
+        let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+        assert_agree(&gpu, &scene, &program, &kernel, &format!("down{up}"));
+    }
+}
+
+/// Glass sunk into the floor and into a box (the scene's media: rays inside the glass march
+/// the glass less the solids and shade the solids they meet there) renders on the GPU as on
+/// the CPU.
+#[test]
+fn glass_overlapping_solids_matches_the_cpu() {
+    let Some(gpu) = open_gpu() else { return };
+    let text = "material glass = phong { color: (1, 1, 1), transparency: 0.9, ior: 1.5, reflect: 0.05 };\n\
+                material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 0.5, reflect: 0.2 };\n\
+                camera { position: (0, 1.5, -3), look_at: (0, 0.2, 0), fov: 50deg }\n\
+                light point { position: (2, 5, -3) }\n\
+                render { width: 96, height: 72 }\n\
+                scene { plane((0, 1, 0), 0) @ floor; sphere(0.8) @ glass; box((0.3, 0.3, 0.3)).translate(0.5, 0.3, 0); }";
+    let scene = checked("media.sdf", text);
+    let program = lower::lower(&scene);
+    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    assert!(kernel.features.contains(&("MEDIA", true)));
+    assert_agree(&gpu, &scene, &program, &kernel, "glass in solids");
 }
 
 /// Shadow rays pass through glass on the GPU as on the CPU even when no refracted ray is

@@ -80,7 +80,7 @@ material glass = phong { color: (1, 1, 1), reflect: 0.1, transparency: 0.85, ior
 material mirror = phong { color: (0.9, 0.9, 0.9), reflect: 0.6 };
 material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 1 };
 camera { position: (0, 2, -6), look_at: (0, 0.5, 0), fov: 60deg }
-light point { position: (4, 6, -4), intensity: 1, radius: 30, softness: 16 }
+light point { position: (4, 6, -4), intensity: 1, radius: 30, penumbra: 3.5763deg }
 light directional { direction: (-1, -1, 0.5), color: (0.4, 0.4, 0.4) }
 render { width: 64, height: 48, max_depth: 8 }
 scene {

@@ -32,11 +32,12 @@ fn render_with(scene: &Scene, options: &Options, threads: usize) -> Render {
     pool.install(|| cpu::render(scene, &lower(scene), options, &|| {}))
 }
 
-/// The camera of RENDERER.md written again: (eye, u, v, w, tan(fov/2)).
+/// The camera of docs/rendering.md, "Camera", written again for a camera whose `up` is not
+/// parallel to the view: (eye, u, v, w, tan(fov/2)).
 fn basis(scene: &Scene) -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3], f64) {
     let c = &scene.camera;
     let w = normalize(sub3(c.look_at, c.position));
-    let u = normalize(cross(w, [0.0, 1.0, 0.0]));
+    let u = normalize(cross(w, c.up));
     let v = cross(u, w);
     (c.position, u, v, w, (c.fov / 2.0).tan())
 }
@@ -114,8 +115,50 @@ fn a_sphere_seen_head_on_covers_the_predicted_pixels() {
     }
 }
 
+/// A camera looking straight down (its view parallel to the default `up`) sees the scene:
+/// a sphere at the centre of the image and a marker sphere towards +z in the image's upper
+/// half (the stand-in up is +z); with `up` along +x the image rolls and the marker moves to
+/// the right, where the test's own projection puts it.
+#[test]
+fn a_camera_looking_straight_down_sees_the_scene_and_up_rolls_it() {
+    let mut b = Build::new();
+    let centre = b.add(Node::Sphere { radius: 1.0 });
+    let marker = b.add(Node::Sphere { radius: 0.4 });
+    let marker = b.at(marker, [0.0, 0.0, 2.5]);
+    let root = b.add(Node::Combine {
+        op: sdfc_compiler::scene::Combine::Union,
+        children: vec![centre, marker],
+    });
+    b.point_light([0.0, 10.0, 0.0], 0.0);
+    let mut scene = b.finish(root);
+    scene.camera.position = [0.0, 6.0, 0.0];
+    scene.camera.look_at = [0.0, 0.0, 0.0];
+    small(&mut scene, 64, 64);
+    // Where the marker must appear: with up = +z (the stand-in), and rolled with up = +x.
+    let mut facing = scene.clone();
+    facing.camera.up = [0.0, 0.0, 1.0];
+    let (mx, my) = project(&facing, [0.0, 0.0, 2.5]);
+    assert!(mx == 32 && my < 16, "marker projected to ({mx}, {my})");
+    let mut rolled = scene.clone();
+    rolled.camera.up = [1.0, 0.0, 0.0];
+    let (rx, ry) = project(&rolled, [0.0, 0.0, 2.5]);
+    assert!(rx > 48 && ry.abs_diff(32) <= 1, "rolled marker projected to ({rx}, {ry})");
+    for method in METHODS {
+        let r = render_as(method, &scene);
+        let lit = |(x, y): (u32, u32)| luminance(r.image.linear[(y * 64 + x) as usize]) > 0.0;
+        assert!(lit((32, 32)), "{method:?}: the centre sphere is not seen");
+        assert!(lit((mx, my)), "{method:?}: the marker is not above the centre");
+        assert!(!lit((mx, 63 - my)), "{method:?}: something below the centre");
+        assert!(!lit((2, 2)), "{method:?}: a corner is not background");
+        let r = render_as(method, &rolled);
+        let lit = |(x, y): (u32, u32)| luminance(r.image.linear[(y * 64 + x) as usize]) > 0.0;
+        assert!(lit((rx, ry)), "{method:?}: rolled marker not at ({rx}, {ry})");
+        assert!(!lit((mx, my)), "{method:?}: the rolled image did not roll");
+    }
+}
+
 /// A grey floor, a sphere above it, a light up and to the side.
-fn shadow_scene(softness: f64) -> Scene {
+fn shadow_scene(penumbra: f64) -> Scene {
     let mut b = Build::new();
     let floor = b.add(Node::Plane {
         normal: [0.0, 1.0, 0.0],
@@ -127,7 +170,7 @@ fn shadow_scene(softness: f64) -> Scene {
         op: sdfc_compiler::scene::Combine::Union,
         children: vec![floor, s],
     });
-    b.point_light([2.0, 5.0, 0.0], softness);
+    b.point_light([2.0, 5.0, 0.0], penumbra);
     let mut scene = b.finish(root);
     scene.camera.position = [0.0, 4.0, -6.0];
     scene.camera.look_at = [0.0, 0.0, 0.0];
@@ -138,8 +181,8 @@ fn shadow_scene(softness: f64) -> Scene {
 #[test]
 fn a_shadowed_pixel_is_darker_than_its_lit_neighbour() {
     for method in METHODS {
-        for softness in [0.0, 8.0] {
-            let scene = shadow_scene(softness);
+        for penumbra in [0.0, (1.0f64 / 8.0).atan()] {
+            let scene = shadow_scene(penumbra);
             let r = render_as(method, &scene);
             // The shadow's centre on the floor, on the line from the light through the sphere.
             let (sx, sy) = project(&scene, [-0.5, 0.0, 0.0]);
@@ -150,10 +193,10 @@ fn a_shadowed_pixel_is_darker_than_its_lit_neighbour() {
             );
             assert!(
                 dark < 0.5 * lit,
-                "softness {softness}: shadow {dark}, lit {lit}"
+                "penumbra {penumbra}: shadow {dark}, lit {lit}"
             );
             // Hard shadows leave only the ambient term: k_a · C.
-            if softness == 0.0 {
+            if penumbra == 0.0 {
                 assert!(
                     (r.image.pixel(sx, sy)[0] - 0.1 * 0.8).abs() < 1e-4,
                     "{:?}",
@@ -165,6 +208,59 @@ fn a_shadowed_pixel_is_darker_than_its_lit_neighbour() {
 }
 
 /// A red ball above a floor whose reflectivity is `reflect`.
+/// A glass ball half sunk into a checkered floor shows the floor through it (refracted rays
+/// inside the glass find the floor's surface there), not a dull dome of background colour:
+/// within the ball's lower half, both checker colours are seen.
+#[test]
+fn glass_sunk_into_the_floor_shows_the_floor_through_it() {
+    let text = "material glass = phong { color: (1, 1, 1), transparency: 0.9, ior: 1.5 };\n\
+                material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 0.5 };\n\
+                camera { position: (0, 1.5, -3), look_at: (0, 0.2, 0), fov: 50deg }\n\
+                light point { position: (2, 5, -3) }\n\
+                render { width: 320, height: 240 }\n\
+                scene { plane((0, 1, 0), 0) @ floor; sphere(0.8) @ glass; }";
+    let (scene, diags, _) = sdfc_compiler::check::check_str("glass.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let r = render(&scene);
+    // The pixels of the ball's lower half, above the floor's horizon line behind it.
+    let (mut bright, mut dark, mut all) = (0, 0, 0);
+    for y in 110..150 {
+        for x in 130..190 {
+            let l = luminance(r.image.pixel(x, y));
+            bright += (l > 0.4) as u32;
+            dark += (l < 0.2) as u32;
+            all += 1;
+        }
+    }
+    assert!(
+        bright * 8 > all && dark * 8 > all,
+        "{bright} bright and {dark} dark of {all} pixels: the floor is not seen through the glass"
+    );
+}
+
+/// `penumbra` means what its name says: the wider it is, the more of the floor around the
+/// shadow lies in a partial shadow, and the further the image is from the hard shadow's.
+#[test]
+fn a_wider_penumbra_gives_a_softer_shadow() {
+    let hard = render(&shadow_scene(0.0));
+    let apart = |deg: f64| {
+        let r = render(&shadow_scene(deg.to_radians()));
+        let partial = r
+            .image
+            .linear
+            .iter()
+            .zip(&hard.image.linear)
+            .filter(|(a, b)| (luminance(**a) - luminance(**b)).abs() > 0.01)
+            .count();
+        partial
+    };
+    let (narrow, medium, wide) = (apart(1.0), apart(5.0), apart(20.0));
+    assert!(
+        narrow < medium && medium < wide && narrow > 0,
+        "pixels off the hard shadow: 1° {narrow}, 5° {medium}, 20° {wide}"
+    );
+}
+
 fn mirror_scene(reflect: f64) -> Scene {
     let mut b = Build::new();
     let grey = b.material([0.5, 0.5, 0.5], reflect, 0.0);
@@ -301,8 +397,8 @@ fn busy() -> Scene {
         m
     };
     scene.materials[2] = glass;
-    if let Some(Light::Point { softness, .. }) = scene.lights.first_mut() {
-        *softness = 6.0;
+    if let Some(Light::Point { penumbra, .. }) = scene.lights.first_mut() {
+        *penumbra = (1.0f64 / 6.0).atan();
     }
     scene.settings.aa = 2;
     scene.settings.width = 72;

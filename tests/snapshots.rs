@@ -1,6 +1,6 @@
 //! Snapshot tests of every textual output: the AST, IR, distance program and WGSL kernel of
 //! every example and `tests/in/ok` file, the PTX of every example (for the default target,
-//! sm_70), and the rendered diagnostics of every `tests/in/err` file. Every WGSL kernel is
+//! sm_70), and the rendered diagnostics of every `tests/in/err` and `tests/in/warn` file. Every WGSL kernel is
 //! also validated by naga (inside `back::wgsl::write`).
 
 use sdfc_compiler::{back, diagnostics, lower, scene, syntax, FileId};
@@ -105,6 +105,34 @@ fn error_inputs() {
         "only {} distinct diagnostic codes are exercised: {codes:?}",
         codes.len()
     );
+}
+
+/// Every `tests/in/warn` file compiles, with at least one warning and no error; its rendered
+/// diagnostics are snapshotted.
+#[test]
+fn warning_inputs() {
+    let files = sdf_files("tests/in/warn");
+    assert!(!files.is_empty(), "no warning cases");
+    for path in files {
+        let loaded = frontend::load(&path).expect("readable");
+        let rendered = diagnostics::render(&loaded.diagnostics, &loaded.sources, false);
+        assert!(
+            loaded.scene.is_some() && !diagnostics::has_errors(&loaded.diagnostics),
+            "{} has errors:\n{rendered}",
+            path.display()
+        );
+        assert!(
+            !loaded.diagnostics.is_empty(),
+            "{} compiled without a warning",
+            path.display()
+        );
+        let source = loaded.sources.text(FileId(0));
+        snapshot(
+            "warn",
+            &stem(&path),
+            &format!("{source}\n----- diagnostics -----\n{rendered}"),
+        );
+    }
 }
 
 #[test]

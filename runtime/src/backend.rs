@@ -106,17 +106,19 @@ impl Prepared {
     ) -> Result<Prepared, String> {
         method_allowed(scene)?;
         match backend {
-            Backend::Cpu => Ok(Self::cpu(program, setup)),
+            Backend::Cpu => Ok(Self::cpu(scene, program, setup)),
             Backend::Wgpu => Self::wgpu(scene, &program, setup, false),
             Backend::Cuda => Self::cuda(scene, &program, setup),
-            Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(program, setup)),
+            Backend::Auto if setup.precision == Precision::F64 => {
+                Ok(Self::cpu(scene, program, setup))
+            }
             Backend::Auto => Self::cuda(scene, &program, setup)
                 .or_else(|_| Self::wgpu(scene, &program, setup, true))
-                .or_else(|_| Ok(Self::cpu(program, setup))),
+                .or_else(|_| Ok(Self::cpu(scene, program, setup))),
         }
     }
 
-    fn cpu(program: Program, setup: &Setup) -> Prepared {
+    fn cpu(scene: &Scene, program: Program, setup: &Setup) -> Prepared {
         let options = Options {
             precision: setup.precision,
             debug_nan: setup.debug_nan,
@@ -124,7 +126,7 @@ impl Prepared {
             ..Options::default()
         };
         Prepared::Cpu {
-            tapes: Box::new(Tapes::new(&program)),
+            tapes: Box::new(Tapes::for_scene(scene, &program)),
             program,
             options,
         }
@@ -169,7 +171,7 @@ impl Prepared {
     /// Prepares `scene`, whose distance program is `program`, for the CPU renderer.
     pub fn on_cpu(scene: &Scene, program: Program, setup: &Setup) -> Result<Prepared, String> {
         method_allowed(scene)?;
-        Ok(Self::cpu(program, setup))
+        Ok(Self::cpu(scene, program, setup))
     }
 
     fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {

@@ -65,14 +65,14 @@ impl Build {
         self.scene
     }
 
-    /// Adds a point light.
-    pub fn point_light(&mut self, position: [f64; 3], softness: f64) {
+    /// Adds a point light with a penumbra of `penumbra` radians (0: hard shadows).
+    pub fn point_light(&mut self, position: [f64; 3], penumbra: f64) {
         self.scene.lights.push(Light::Point {
             position,
             color: [1.0; 3],
             intensity: 1.0,
             radius: 100.0,
-            softness,
+            penumbra,
         });
     }
 }

@@ -788,17 +788,24 @@ pub static MATERIALS: &[Record] = &[
     },
 ];
 
-const LIGHT_COMMON: [P; 3] = [
+const LIGHT_COMMON: [P; 4] = [
     p("color", V, V3([1.0, 1.0, 1.0]), NonNeg),
     p("intensity", F, Num(1.0), NonNeg),
+    p(
+        "penumbra",
+        A,
+        Deg(0.0),
+        Within(0.0, 89.0 * std::f64::consts::PI / 180.0),
+    ),
+    // The sharpness k = 1/tan(penumbra) of the old files; W0008 says what to write instead.
     p("softness", F, Num(0.0), NonNeg),
 ];
 
-const POINT: [P; 5] = concat(
+const POINT: [P; 6] = concat(
     [p("position", V, Req, Any), p("radius", F, Num(100.0), Pos)],
     LIGHT_COMMON,
 );
-const DIRECTIONAL: [P; 4] = concat([p("direction", V, Req, NonZero)], LIGHT_COMMON);
+const DIRECTIONAL: [P; 5] = concat([p("direction", V, Req, NonZero)], LIGHT_COMMON);
 
 /// Light kinds.
 pub static LIGHTS: &[Record] = &[
@@ -818,6 +825,7 @@ pub static CAMERA: Record = Record {
     fields: &[
         p("position", V, V3([0.0, 1.0, -5.0]), Any),
         p("look_at", V, V3([0.0, 0.0, 0.0]), Any),
+        p("up", V, V3([0.0, 1.0, 0.0]), NonZero),
         p(
             "fov",
             A,

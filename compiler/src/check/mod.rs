@@ -555,6 +555,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
             scene.camera = Camera {
                 position: f["position"].v3(),
                 look_at: f["look_at"].v3(),
+                up: f["up"].v3(),
                 fov: f["fov"].num(),
             };
             if scene.camera.position == scene.camera.look_at && !f["position"].is_abstract() {
@@ -610,15 +611,15 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 return;
             };
             let f = eval::record(cx, rec, &b.fields, kind);
-            let (color, intensity, softness) =
-                (f["color"].v3(), f["intensity"].num(), f["softness"].num());
+            let (color, intensity) = (f["color"].v3(), f["intensity"].num());
+            let penumbra = penumbra(cx, &b.fields, &f);
             scene.lights.push(if rec.name == "point" {
                 Light::Point {
                     position: f["position"].v3(),
                     color,
                     intensity,
                     radius: f["radius"].num(),
-                    softness,
+                    penumbra,
                 }
             } else {
                 let d = f["direction"].v3();
@@ -629,12 +630,64 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                     direction: [d[0] / len, d[1] / len, d[2] / len],
                     color,
                     intensity,
-                    softness,
+                    penumbra,
                 }
             });
         }
         _ => {}
     }
+}
+
+/// A light's penumbra angle: its `penumbra` field, or the angle of the sharpness of the old
+/// `softness` field, with warning W0008 saying what to write instead (error E0203 for both).
+fn penumbra(cx: &mut Ctx, fields: &[ast::Field], f: &HashMap<&'static str, Value>) -> f64 {
+    let given = |name: &str| fields.iter().find(|x| x.name.name == name);
+    let Some(old) = given("softness") else {
+        return f["penumbra"].num();
+    };
+    if let Some(new) = given("penumbra") {
+        cx.error(
+            Diagnostic::error(
+                "E0203",
+                "a light has both `penumbra` and `softness`",
+                old.name.span,
+            )
+            .with_label("the old spelling of the penumbra")
+            .with_secondary(new.name.span, "the penumbra is given here")
+            .with_help("remove `softness`"),
+        );
+        return f["penumbra"].num();
+    }
+    let k = f["softness"].num();
+    let angle = crate::scene::penumbra_of_sharpness(k);
+    if !f["softness"].is_abstract() {
+        let write = if k > 0.0 {
+            format!("penumbra: {}deg", short_degrees(angle.to_degrees()))
+        } else {
+            "nothing (hard shadows are the default)".to_string()
+        };
+        cx.error(
+            Diagnostic::warning(
+                "W0008",
+                "`softness` is replaced by `penumbra`",
+                old.name.span,
+            )
+            .with_label(format!("the sharpness k = {k} of the shadow's edge"))
+            .with_note(
+                "`softness` was the sharpness k of the soft-shadow estimate: larger values give \
+                 harder shadows, small ones shadow nearly everything; `penumbra` is the angle \
+                 over which a shadow's edge fades (0 is hard), with k = 1/tan(penumbra)",
+            )
+            .with_help(format!("for the same shadows write {write}")),
+        );
+    }
+    angle
+}
+
+/// Degrees with four decimals, without trailing zeros.
+fn short_degrees(d: f64) -> String {
+    let s = format!("{d:.4}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// Evaluates the scene statements; returns the union of all objects.

@@ -70,7 +70,7 @@ fn lights_are_normalised() {
             direction: [0.0, -1.0, 0.0],
             color: [1.0; 3],
             intensity: 1.0,
-            softness: 0.0
+            penumbra: 0.0
         }
     );
 }

@@ -24,12 +24,14 @@ mod builder;
 mod bvh;
 mod graph;
 mod instances;
+mod media;
 mod shapes;
 mod simplify;
 #[cfg(test)]
 mod tests;
 
 pub use instances::{split, Instance, Split};
+pub use media::{media, Media};
 
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};

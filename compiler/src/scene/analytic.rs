@@ -7,7 +7,7 @@
 //! budget and no ε. The CPU renderer and the WGSL kernel (so also PTX) both trace the list of
 //! [`Primitive`]s this module produces (RENDERER.md, "Intersection"; docs/rendering.md).
 
-use super::ir::{Combine, Light, MaterialId, Method, Node, NodeId, Scene, V3};
+use super::ir::{Combine, MaterialId, Method, Node, NodeId, Scene, V3};
 use crate::span::Span;
 
 /// A primitive with a closed-form ray intersection, in its local frame.
@@ -124,7 +124,7 @@ pub fn choose(scene: &Scene) -> Choice {
     if scene.settings.method == Method::March {
         return Choice::March(Reason::Asked);
     }
-    if let Some(index) = scene.lights.iter().position(|l| softness(l) > 0.0) {
+    if let Some(index) = scene.lights.iter().position(|l| l.penumbra() > 0.0) {
         return Choice::March(Reason::SoftLight { index });
     }
     let mut out = Vec::new();
@@ -182,12 +182,6 @@ fn transparent_overlap<'a>(scene: &Scene, prims: &'a [Primitive]) -> Option<&'a 
             .any(|j| j != i && touches(a, j))
             .then_some(p)
     })
-}
-
-fn softness(l: &Light) -> f64 {
-    match l {
-        Light::Point { softness, .. } | Light::Directional { softness, .. } => *softness,
-    }
 }
 
 /// The world-to-local map and the material in force at a node.

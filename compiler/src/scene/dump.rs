@@ -25,9 +25,14 @@ pub fn dump(scene: &Scene) -> String {
         );
     }
     let c = &scene.camera;
+    let up = if c.up == Camera::default().up {
+        String::new()
+    } else {
+        format!(" up={}", v3(c.up))
+    };
     let _ = writeln!(
         out,
-        "camera position={} look_at={} fov={}deg",
+        "camera position={} look_at={}{up} fov={}deg",
         v3(c.position),
         v3(c.look_at),
         num(c.fov.to_degrees())
@@ -39,28 +44,28 @@ pub fn dump(scene: &Scene) -> String {
                 color,
                 intensity,
                 radius,
-                softness,
+                penumbra,
             } => writeln!(
                 out,
-                "light point position={} color={} intensity={} radius={} softness={}",
+                "light point position={} color={} intensity={} radius={} penumbra={}deg",
                 v3(*position),
                 v3(*color),
                 num(*intensity),
                 num(*radius),
-                num(*softness)
+                num(penumbra.to_degrees())
             ),
             Light::Directional {
                 direction,
                 color,
                 intensity,
-                softness,
+                penumbra,
             } => writeln!(
                 out,
-                "light directional direction={} color={} intensity={} softness={}",
+                "light directional direction={} color={} intensity={} penumbra={}deg",
                 v3(*direction),
                 v3(*color),
                 num(*intensity),
-                num(*softness)
+                num(penumbra.to_degrees())
             ),
         };
     }

@@ -260,23 +260,52 @@ pub enum Light {
         color: V3,
         intensity: f64,
         radius: f64,
-        softness: f64,
+        /// The angle of the penumbra in radians (0 gives hard shadows); see [`Light::sharpness`].
+        penumbra: f64,
     },
     /// A light from a direction (the direction light travels in), with no attenuation.
     Directional {
         direction: V3,
         color: V3,
         intensity: f64,
-        softness: f64,
+        /// The angle of the penumbra in radians (0 gives hard shadows); see [`Light::sharpness`].
+        penumbra: f64,
     },
 }
 
 impl Light {
-    /// Soft-shadow sharpness k; 0 means hard shadows.
-    pub fn softness(&self) -> f64 {
+    /// The penumbra angle in radians; 0 means hard shadows.
+    pub fn penumbra(&self) -> f64 {
         match self {
-            Light::Point { softness, .. } | Light::Directional { softness, .. } => *softness,
+            Light::Point { penumbra, .. } | Light::Directional { penumbra, .. } => *penumbra,
         }
+    }
+
+    /// The sharpness k of the soft-shadow estimate `min(k·d/t)` (docs/rendering.md,
+    /// "Shadows"): a point whose ray to the light passes an occluder at angular distance
+    /// `atan(d/t)` of at least the penumbra angle θ is fully lit, so k = 1/tan θ; 0 (hard
+    /// shadows) for θ = 0.
+    pub fn sharpness(&self) -> f64 {
+        sharpness(self.penumbra())
+    }
+}
+
+/// The soft-shadow sharpness k = 1/tan θ of a penumbra angle θ (0 for θ = 0).
+pub fn sharpness(penumbra: f64) -> f64 {
+    if penumbra > 0.0 {
+        1.0 / penumbra.tan()
+    } else {
+        0.0
+    }
+}
+
+/// The penumbra angle θ = atan(1/k) of a soft-shadow sharpness k (0 for k = 0): the inverse
+/// of [`sharpness`], for files written with the old `softness` field.
+pub fn penumbra_of_sharpness(k: f64) -> f64 {
+    if k > 0.0 {
+        (1.0 / k).atan()
+    } else {
+        0.0
     }
 }
 
@@ -287,8 +316,61 @@ pub struct Camera {
     pub position: V3,
     /// The point looked at.
     pub look_at: V3,
+    /// The direction that is up in the image (need not be perpendicular to the view).
+    pub up: V3,
     /// Vertical field of view in radians.
     pub fov: f64,
+}
+
+impl Camera {
+    /// The camera's orthonormal basis `(w, u, v)` (docs/rendering.md, "Camera"): `w` the view
+    /// direction `normalize(look_at − position)`, `u = normalize(w × up)` (the image's
+    /// rightward direction), `v = u × w` (the image's up). Where `up` is parallel to
+    /// the view (looking straight down or up with the default up), the coordinate axis least
+    /// aligned with the view stands in for it, so every camera has a valid basis. Computed in
+    /// f64 once, for every backend.
+    pub fn basis(&self) -> (V3, V3, V3) {
+        let w = normalize(sub(self.look_at, self.position));
+        let mut side = cross(w, self.up);
+        if dot(side, side) < 1e-12 * dot(self.up, self.up) {
+            // z first: of equally unaligned axes +z wins, so looking straight down the top
+            // of the image is +z, as for a camera that approaches the vertical from −z.
+            let axis = [2, 0, 1]
+                .into_iter()
+                .min_by(|&a, &b| w[a].abs().total_cmp(&w[b].abs()))
+                .unwrap_or(2);
+            let mut up = [0.0; 3];
+            up[axis] = 1.0;
+            side = cross(w, up);
+        }
+        let u = normalize(side);
+        (w, u, cross(u, w))
+    }
+}
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn normalize(a: V3) -> V3 {
+    let l = dot(a, a).sqrt();
+    if l > 0.0 {
+        [a[0] / l, a[1] / l, a[2] / l]
+    } else {
+        a
+    }
 }
 
 impl Default for Camera {
@@ -296,6 +378,7 @@ impl Default for Camera {
         Camera {
             position: [0.0, 1.0, -5.0],
             look_at: [0.0, 0.0, 0.0],
+            up: [0.0, 1.0, 0.0],
             fov: 60f64.to_radians(),
         }
     }

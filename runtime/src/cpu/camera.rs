@@ -1,4 +1,4 @@
-//! The pinhole camera of RENDERER.md, "Per pixel", and the supersampling grid.
+//! The pinhole camera of docs/rendering.md, "Camera", and the supersampling grid.
 
 use super::vec::V3;
 use sdfc_compiler::eval::Float;
@@ -18,14 +18,12 @@ pub struct Pinhole<T> {
 }
 
 impl<T: Float> Pinhole<T> {
-    /// The camera for an image of the settings' size: w = normalize(look_at - position),
-    /// u = normalize(w × up), v = u × w, with world up (0, 1, 0).
+    /// The camera for an image of the settings' size, with the basis of [`Camera::basis`]
+    /// (computed in f64, as for the GPU kernel).
     pub fn new(camera: &Camera, settings: &Settings) -> Self {
         let origin = V3::from_f64(camera.position);
-        let w = (V3::from_f64(camera.look_at) - origin).normalize();
-        let up = V3::new(T::zero(), T::one(), T::zero());
-        let u = w.cross(up).normalize();
-        let v = u.cross(w);
+        let (w, u, v) = camera.basis();
+        let (w, u, v) = (V3::from_f64(w), V3::from_f64(u), V3::from_f64(v));
         let tan = T::from_f64((camera.fov * 0.5).tan());
         let (width, height) = (settings.width.max(1) as f64, settings.height.max(1) as f64);
         let aspect = T::from_f64(width / height);

@@ -41,12 +41,12 @@ pub(super) enum Lamp<T> {
         position: V3<T>,
         color: V3<T>,
         radius: T,
-        softness: T,
+        sharpness: T,
     },
     Directional {
         to_light: V3<T>,
         color: V3<T>,
-        softness: T,
+        sharpness: T,
     },
 }
 
@@ -172,22 +172,22 @@ fn lamp<T: Float>(l: &Light) -> Lamp<T> {
             color,
             intensity,
             radius,
-            softness,
+            ..
         } => Lamp::Point {
             position: V3::from_f64(*position),
             color: V3::from_f64(*color) * T::from_f64(*intensity),
             radius: T::from_f64(*radius),
-            softness: T::from_f64(*softness),
+            sharpness: T::from_f64(l.sharpness()),
         },
         Light::Directional {
             direction,
             color,
             intensity,
-            softness,
+            ..
         } => Lamp::Directional {
             to_light: -V3::<T>::from_f64(*direction).normalize(),
             color: V3::from_f64(*color) * T::from_f64(*intensity),
-            softness: T::from_f64(*softness),
+            sharpness: T::from_f64(l.sharpness()),
         },
     }
 }

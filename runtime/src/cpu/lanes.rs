@@ -25,6 +25,9 @@ pub(super) struct Launch<T> {
     pub k: T,
     /// Over-relaxation factor ω at the start.
     pub omega: T,
+    /// Shadow rays: the light let through so far (1, or the transparency of the glass a ray
+    /// starts inside).
+    pub through: T,
 }
 
 macro_rules! lanes {
@@ -97,7 +100,7 @@ impl<T: Float> Lanes<T> {
         self.prev[k] = T::zero();
         self.step[k] = T::zero();
         self.res[k] = T::one();
-        self.through[k] = T::one();
+        self.through[k] = l.through;
     }
 
     /// p = o + t·d for every lane.

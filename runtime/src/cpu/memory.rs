@@ -114,8 +114,11 @@ fn shared<T: Float>(shape: &Shape, scene: &Scene) -> u64 {
 /// A thread's workspace, kept from tile to tile: evaluators, lanes and the buffers of a wave.
 fn workspace<T: Float>(shape: &Shape, tapes: &Tapes, options: &Options) -> u64 {
     let w = shape.wave;
-    let evaluators = Evaluator::<T>::heap_bytes(&tapes.distance, options.chunk)
-        + Evaluator::<T>::heap_bytes(&tapes.full, options.chunk);
+    let evaluators: usize = tapes
+        .all()
+        .into_iter()
+        .map(|t| Evaluator::<T>::heap_bytes(t, options.chunk))
+        .sum();
     let lanes = Lanes::<T>::heap_bytes(options.lanes.max(1));
     [
         evaluators as u64,

@@ -78,20 +78,53 @@ impl Default for Options {
 pub const NAN_COLOUR: [f32; 3] = [1.0, 0.0, 1.0];
 
 /// A distance program prepared for the CPU renderer, once per scene: its tape for the
-/// distance alone (marching, normals, shadows) and its tape for distance and material.
+/// distance alone (marching, normals, shadows) and its tape for distance and material, and
+/// where glass may overlap an opaque solid, the tapes of the scene's media.
 #[derive(Debug, Clone)]
 pub struct Tapes {
     distance: Tape,
     full: Tape,
+    media: Option<MediaTapes>,
+}
+
+/// The tapes of [`sdfc_compiler::lower::Media`]: the medium's distance (marched by rays
+/// inside glass) and the solids' distance (their normals) and distance and material.
+#[derive(Debug, Clone)]
+struct MediaTapes {
+    medium: Tape,
+    solid: Tape,
+    solid_full: Tape,
 }
 
 impl Tapes {
-    /// Prepares `program`'s two tapes.
+    /// Prepares `program`'s two tapes (no media: rays inside glass march `−f`).
     pub fn new(program: &Program) -> Self {
         Tapes {
             distance: Tape::new(program, Outputs::Distance),
             full: Tape::new(program, Outputs::DistanceAndMaterial),
+            media: None,
         }
+    }
+
+    /// Prepares the tapes of `scene`, whose program is `program`, with its media when its
+    /// glass may overlap an opaque solid (docs/rendering.md, "Inside glass").
+    pub fn for_scene(scene: &Scene, program: &Program) -> Self {
+        let mut tapes = Self::new(program);
+        tapes.media = sdfc_compiler::lower::media(scene).map(|m| MediaTapes {
+            medium: Tape::new(&m.medium, Outputs::Distance),
+            solid: Tape::new(&m.solid, Outputs::Distance),
+            solid_full: Tape::new(&m.solid, Outputs::DistanceAndMaterial),
+        });
+        tapes
+    }
+
+    /// Every tape, for the memory bound (each thread has an evaluator of each).
+    fn all(&self) -> Vec<&Tape> {
+        let mut out = vec![&self.distance, &self.full];
+        if let Some(m) = &self.media {
+            out.extend([&m.medium, &m.solid, &m.solid_full]);
+        }
+        out
     }
 }
 
@@ -137,7 +170,7 @@ pub fn render(
     options: &Options,
     progress: &(dyn Fn() + Sync),
 ) -> Render {
-    render_tapes(scene, &Tapes::new(program), options, progress)
+    render_tapes(scene, &Tapes::for_scene(scene, program), options, progress)
 }
 
 /// [`render`] with the program's tapes already prepared. It allocates at most [`memory`]

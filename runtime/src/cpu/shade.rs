@@ -22,6 +22,11 @@ pub(super) struct Hit<T> {
     /// Normal step h; offsets from the surface are 4h.
     h: T,
     mat: u32,
+    /// A ray inside glass reached an opaque solid within it (not the glass's far side): the
+    /// hit is lit and reflects as seen from outside, within the glass.
+    solid: bool,
+    /// For such a hit, the transparency of the glass around it.
+    medium_tau: T,
 }
 
 /// Traces `wave`, adds what it sees to its samples, and returns the next wave. On return
@@ -51,6 +56,8 @@ pub(super) fn bounce<T: Float>(
                     tt,
                     h,
                     mat: 0,
+                    solid: false,
+                    medium_tau: T::zero(),
                 });
                 continue;
             }
@@ -68,6 +75,7 @@ pub(super) fn bounce<T: Float>(
     } else {
         normals(ws, wave, &mut hits);
         materials(ctx, ws, &mut hits);
+        solids(ctx, ws, wave, &mut hits);
     }
     light(ctx, ws, wave, &hits, samples, counters);
     let next = spawn(ctx, wave, &hits);
@@ -110,32 +118,46 @@ fn trace<T: Float>(
         }
         return;
     }
-    ws.launches.clear();
-    ws.launches
-        .extend(wave.iter().enumerate().map(|(i, r)| Launch {
-            id: i as u32,
-            origin: [r.origin.x, r.origin.y, r.origin.z],
-            dir: [r.dir.x, r.dir.y, r.dir.z],
-            t0: r.t0,
-            sign: if r.inside { -T::one() } else { T::one() },
-            tmax: ctx.max_dist,
-            k: T::zero(),
-            omega: ctx.relaxation,
-        }));
     ws.traced.clear();
     ws.traced.resize(wave.len(), Traced::default());
-    let mut rule = Trace {
-        ctx,
-        out: &mut ws.traced,
-        counters,
+    // Where the scene has media, rays inside glass march the medium instead of the scene.
+    let passes: &[Option<bool>] = if ws.media.is_some() {
+        &[Some(false), Some(true)]
+    } else {
+        &[None]
     };
-    march(
-        &mut ws.lanes,
-        &mut ws.dist,
-        &mut ws.full,
-        &ws.launches,
-        &mut rule,
-    );
+    for &pass in passes {
+        ws.launches.clear();
+        ws.launches.extend(
+            wave.iter()
+                .enumerate()
+                .filter(|(_, r)| pass.is_none_or(|inside| r.inside == inside))
+                .map(|(i, r)| Launch {
+                    id: i as u32,
+                    origin: [r.origin.x, r.origin.y, r.origin.z],
+                    dir: [r.dir.x, r.dir.y, r.dir.z],
+                    t0: r.t0,
+                    sign: if r.inside { -T::one() } else { T::one() },
+                    tmax: ctx.max_dist,
+                    k: T::zero(),
+                    omega: ctx.relaxation,
+                    through: T::one(),
+                }),
+        );
+        if ws.launches.is_empty() {
+            continue;
+        }
+        let mut rule = Trace {
+            ctx,
+            out: &mut ws.traced,
+            counters: &mut *counters,
+        };
+        let dist = match (pass, ws.media.as_mut()) {
+            (Some(true), Some(m)) => &mut m.medium,
+            _ => &mut ws.dist,
+        };
+        march(&mut ws.lanes, dist, &mut ws.full, &ws.launches, &mut rule);
+    }
 }
 
 /// The tetrahedron's corners k_i for the 4-tap gradient.
@@ -195,6 +217,82 @@ fn materials<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, hits: &mut [
     }
 }
 
+/// Where the scene has media, the hits of rays inside glass that reached an opaque solid
+/// rather than the glass's far side: the solids' field is below the normal step there. Such
+/// a hit takes the solid's material and its normal (the solids' gradient), and keeps the
+/// glass's transparency for its shadow rays.
+fn solids<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    wave: &[Ray<T>],
+    hits: &mut [Hit<T>],
+) {
+    let Some(media) = ws.media.as_mut() else {
+        return;
+    };
+    let inside: Vec<usize> = (0..hits.len())
+        .filter(|&i| wave[hits[i].ray].inside)
+        .collect();
+    if inside.is_empty() {
+        return;
+    }
+    let n = inside.len();
+    for v in [&mut ws.x, &mut ws.y, &mut ws.z, &mut ws.d] {
+        v.clear();
+        v.resize(4 * n, T::zero());
+    }
+    ws.m.clear();
+    ws.m.resize(n, 0);
+    for (j, &i) in inside.iter().enumerate() {
+        (ws.x[j], ws.y[j], ws.z[j]) = (hits[i].p.x, hits[i].p.y, hits[i].p.z);
+    }
+    media.solid_full.eval(
+        &ws.x[..n],
+        &ws.y[..n],
+        &ws.z[..n],
+        &mut ws.d[..n],
+        Some(&mut ws.m[..n]),
+    );
+    let solid: Vec<(usize, u32)> = inside
+        .iter()
+        .enumerate()
+        .filter(|&(j, &i)| ws.d[j] < hits[i].h)
+        .map(|(j, &i)| (i, ws.m[j]))
+        .collect();
+    if solid.is_empty() {
+        return;
+    }
+    let n = solid.len();
+    for (j, &(i, _)) in solid.iter().enumerate() {
+        for (c, k) in TETRA.iter().enumerate() {
+            let q = hits[i].p + V3::from_f64(*k) * hits[i].h;
+            (ws.x[4 * j + c], ws.y[4 * j + c], ws.z[4 * j + c]) = (q.x, q.y, q.z);
+        }
+    }
+    media.solid.eval(
+        &ws.x[..4 * n],
+        &ws.y[..4 * n],
+        &ws.z[..4 * n],
+        &mut ws.d[..4 * n],
+        None,
+    );
+    for (j, &(i, m)) in solid.iter().enumerate() {
+        let g = TETRA.iter().enumerate().fold(V3::zero(), |g, (c, k)| {
+            g + V3::from_f64(*k) * ws.d[4 * j + c]
+        });
+        let l = g.length();
+        let hit = &mut hits[i];
+        hit.medium_tau = ctx.material(hit.mat).transparency;
+        hit.solid = true;
+        hit.mat = m;
+        hit.n = if l > T::zero() && !l.is_nan() {
+            g * (T::one() / l)
+        } else {
+            -wave[hit.ray].dir
+        };
+    }
+}
+
 /// The colour of a material at p. A checker is the parity of ⌊x/s⌋ + ⌊y/s⌋ + ⌊z/s⌋ (even:
 /// first colour), sampled at p - 2h·N, just inside the surface, so that a face lying on a
 /// checker boundary does not flicker between the two colours.
@@ -246,11 +344,11 @@ fn towards<T: Float>(ctx: &Context<T>, lamp: &Lamp<T>, p: V3<T>) -> (V3<T>, T, T
 fn lamp_colour<T: Float>(lamp: &Lamp<T>) -> (V3<T>, T) {
     match *lamp {
         Lamp::Point {
-            color, softness, ..
+            color, sharpness, ..
         }
         | Lamp::Directional {
-            color, softness, ..
-        } => (color, softness),
+            color, sharpness, ..
+        } => (color, sharpness),
     }
 }
 
@@ -282,15 +380,23 @@ fn lamp_term<T: Float>(
     } else {
         dist
     };
+    // From a solid inside glass, the shadow ray starts inside the glass: it marches −f to
+    // the glass's far side, having let through the glass's transparency.
+    let (sign, through) = if hit.solid {
+        (-T::one(), hit.medium_tau)
+    } else {
+        (T::one(), T::one())
+    };
     let launch = Launch {
         id: 0,
         origin: [o.x, o.y, o.z],
         dir: [l.x, l.y, l.z],
         t0: hit.tt,
-        sign: T::one(),
+        sign,
         tmax,
         k,
         omega: T::one(),
+        through,
     };
     Some((contrib, launch))
 }
@@ -316,7 +422,7 @@ fn light<T: Float>(
     ws.launches.clear();
     for (hi, hit) in hits.iter().enumerate() {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
-        if ray.inside || local_weight(m) <= T::zero() {
+        if (ray.inside && !hit.solid) || local_weight(m) <= T::zero() {
             continue;
         }
         let c = colour(m, hit);
@@ -343,7 +449,7 @@ fn light<T: Float>(
     }
     for (hit, c) in hits.iter().zip(colour_at) {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
-        if !ray.inside && local_weight(m) > T::zero() {
+        if (!ray.inside || hit.solid) && local_weight(m) > T::zero() {
             let a = &mut samples.acc[ray.sample as usize];
             *a = *a + c.mul_v(ray.weight) * local_weight(m);
         }
@@ -423,19 +529,21 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
             depth: ray.depth + 1,
             inside,
         };
-        if ray.inside {
+        if ray.inside && !hit.solid {
             match refract(ray.dir, -hit.n, m.ior) {
                 Some(t) => next.push(child(hit.p + off, t, ray.weight, false)),
                 None => next.push(child(hit.p - off, ray.dir.reflect(hit.n), ray.weight, true)),
             }
             continue;
         }
+        // A solid's surface inside glass faces the glass: what leaves it stays inside.
+        let within = hit.solid;
         if m.reflect > T::zero() {
             next.push(child(
                 hit.p + off,
                 ray.dir.reflect(hit.n),
                 ray.weight * m.reflect,
-                false,
+                within,
             ));
         }
         if m.transparency > T::zero() {
@@ -445,7 +553,7 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
                     hit.p + off,
                     ray.dir.reflect(hit.n),
                     ray.weight * m.transparency,
-                    false,
+                    within,
                 )),
             }
         }

@@ -91,11 +91,21 @@ pub(super) struct TileOut {
     pub counters: Counters,
 }
 
+/// Evaluators of the scene's media (`super::Tapes::for_scene`).
+#[derive(Debug)]
+pub(super) struct Media<'t, T: Float> {
+    pub medium: Evaluator<'t, T>,
+    pub solid: Evaluator<'t, T>,
+    pub solid_full: Evaluator<'t, T>,
+}
+
 /// Scratch space of one thread: evaluators, lanes and buffers, reused from tile to tile.
 #[derive(Debug)]
 pub(super) struct Workspace<'t, T: Float> {
     pub dist: Evaluator<'t, T>,
     pub full: Evaluator<'t, T>,
+    /// The media's evaluators, where glass may overlap an opaque solid.
+    pub media: Option<Media<'t, T>>,
     pub lanes: Lanes<T>,
     pub launches: Vec<Launch<T>>,
     pub traced: Vec<Traced<T>>,
@@ -114,6 +124,11 @@ impl<'t, T: Float> Workspace<'t, T> {
         Workspace {
             dist: Evaluator::new(&tapes.distance, chunk),
             full: Evaluator::new(&tapes.full, chunk),
+            media: tapes.media.as_ref().map(|m| Media {
+                medium: Evaluator::new(&m.medium, chunk),
+                solid: Evaluator::new(&m.solid, chunk),
+                solid_full: Evaluator::new(&m.solid_full, chunk),
+            }),
             lanes: Lanes::new(lanes.max(1)),
             launches: Vec::new(),
             traced: Vec::new(),

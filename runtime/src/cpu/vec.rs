@@ -44,16 +44,6 @@ impl<T: Float> V3<T> {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
-    /// Cross product.
-    #[inline]
-    pub fn cross(self, o: Self) -> Self {
-        V3::new(
-            self.y * o.z - self.z * o.y,
-            self.z * o.x - self.x * o.z,
-            self.x * o.y - self.y * o.x,
-        )
-    }
-
     /// Euclidean length.
     #[inline]
     pub fn length(self) -> T {

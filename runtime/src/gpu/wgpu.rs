@@ -92,13 +92,24 @@ pub struct Launch<'a> {
     pub tile: u32,
 }
 
+/// The process's one wgpu instance, never destroyed. Destroying the last Vulkan instance
+/// makes the loader unload the driver, and the NVIDIA driver keeps a thread of its own that
+/// may still run code of the unloaded library: on an H100, 2 of 6 renders of
+/// `examples/temple.sdf` under a debugger died so at exit, in that thread, at an unmapped
+/// address (BENCHMARKS.md, "Crash at exit"). An instance that lives until the process exits
+/// keeps the driver loaded; the operating system reclaims it.
+fn instance() -> &'static wgpu::Instance {
+    static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
+    INSTANCE.get_or_init(|| {
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+    })
+}
+
 impl Gpu {
     /// Opens the first adapter wgpu finds. With `require_hardware`, a CPU adapter (lavapipe)
     /// does not count.
     pub fn open(require_hardware: bool) -> Result<Gpu, Error> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()));
         let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
             wgpu::DeviceType::DiscreteGpu => 0,
             wgpu::DeviceType::IntegratedGpu => 1,

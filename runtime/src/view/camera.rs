@@ -1,18 +1,19 @@
-//! The viewer's camera: an orbit about the point the scene's camera looks at (orbit, pan and
-//! zoom from the mouse), and the sub-pixel jitter of progressive supersampling.
+//! The viewer's camera: an orbit about the point the scene's camera looks at, around the
+//! camera's up direction (orbit, pan and zoom from the mouse), and the sub-pixel jitter of
+//! progressive supersampling.
 
 use sdfc_compiler::scene::Camera;
 
 /// Radians of orbit per pixel dragged.
 const ORBIT_PER_PIXEL: f64 = 0.008;
-/// The highest and lowest elevation (the renderer's up is the world's +y, so the camera must
-/// not look straight up or down).
+/// The highest and lowest elevation above the plane perpendicular to up (the camera must not
+/// look along its up direction).
 const PITCH_LIMIT: f64 = 85.0 * std::f64::consts::PI / 180.0;
 /// Distance factor per wheel line.
 const ZOOM_PER_LINE: f64 = 0.9;
 
-/// A camera orbiting `target` at `distance`, at `yaw` about the world's +y and `pitch` above
-/// the horizontal.
+/// A camera orbiting `target` at `distance`, at `yaw` about the camera's `up` and `pitch`
+/// above the plane perpendicular to it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Orbit {
     /// The point looked at.
@@ -25,6 +26,20 @@ pub struct Orbit {
     pub pitch: f64,
     /// Vertical field of view, radians.
     pub fov: f64,
+    /// The camera's up direction (the orbit's axis).
+    pub up: [f64; 3],
+}
+
+/// The orbit's frame: (a, b, n) with n the unit up and a, b perpendicular to it; for up +y,
+/// a = +x and b = +z.
+fn frame(up: [f64; 3]) -> ([f64; 3], [f64; 3], [f64; 3]) {
+    let n = normalize(up);
+    let mut b = sub([0.0, 0.0, 1.0], scale(n, n[2]));
+    if len(b) < 1e-6 {
+        b = sub([1.0, 0.0, 0.0], scale(n, n[0]));
+    }
+    let b = normalize(b);
+    (cross(n, b), b, n)
 }
 
 impl Orbit {
@@ -32,15 +47,22 @@ impl Orbit {
     pub fn from_camera(camera: &Camera) -> Orbit {
         let d = sub(camera.position, camera.look_at);
         let distance = len(d).max(1e-9);
+        let up = if len(camera.up) > 0.0 {
+            camera.up
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let (a, b, n) = frame(up);
         Orbit {
             target: camera.look_at,
             distance,
-            yaw: d[0].atan2(d[2]),
-            pitch: (d[1] / distance)
+            yaw: dot(d, a).atan2(dot(d, b)),
+            pitch: (dot(d, n) / distance)
                 .clamp(-1.0, 1.0)
                 .asin()
                 .clamp(-PITCH_LIMIT, PITCH_LIMIT),
             fov: camera.fov,
+            up,
         }
     }
 
@@ -48,10 +70,12 @@ impl Orbit {
     pub fn camera(&self) -> Camera {
         let (sy, cy) = self.yaw.sin_cos();
         let (sp, cp) = self.pitch.sin_cos();
-        let offset = [cp * sy, sp, cp * cy];
+        let (a, b, n) = frame(self.up);
+        let offset = add(add(scale(a, cp * sy), scale(n, sp)), scale(b, cp * cy));
         Camera {
             position: add(self.target, scale(offset, self.distance)),
             look_at: self.target,
+            up: self.up,
             fov: self.fov,
         }
     }
@@ -65,7 +89,7 @@ impl Orbit {
     /// Pans by a mouse drag of (`dx`, `dy`) pixels in an image `height` pixels high: the
     /// point under the mouse at the target's depth follows it.
     pub fn pan(&mut self, dx: f64, dy: f64, height: u32) {
-        let (_, u, v) = basis(&self.camera());
+        let (_, u, v) = self.camera().basis();
         let per_pixel = 2.0 * self.distance * (self.fov * 0.5).tan() / height.max(1) as f64;
         let shift = add(scale(u, -dx * per_pixel), scale(v, dy * per_pixel));
         self.target = add(self.target, shift);
@@ -85,7 +109,7 @@ pub fn jittered(camera: &Camera, dx: f64, dy: f64, width: u32, height: u32) -> C
     if dx == 0.0 && dy == 0.0 {
         return camera.clone();
     }
-    let (w, u, v) = basis(camera);
+    let (w, u, v) = camera.basis();
     let tan = (camera.fov * 0.5).tan();
     let aspect = width.max(1) as f64 / height.max(1) as f64;
     let bx = 2.0 * dx / width.max(1) as f64;
@@ -95,6 +119,7 @@ pub fn jittered(camera: &Camera, dx: f64, dy: f64, width: u32, height: u32) -> C
     Camera {
         position: camera.position,
         look_at: add(camera.position, scale(normalize(dir), distance)),
+        up: camera.up,
         fov: camera.fov,
     }
 }
@@ -108,14 +133,6 @@ pub fn sample_offset(k: u32, n: u32) -> (f64, f64) {
     (at(k % n), at(k / n))
 }
 
-/// The renderers' camera basis: forward, screen right and screen up (world up +y).
-fn basis(camera: &Camera) -> ([f64; 3], [f64; 3], [f64; 3]) {
-    let w = normalize(sub(camera.look_at, camera.position));
-    let u = normalize(cross(w, [0.0, 1.0, 0.0]));
-    let v = cross(u, w);
-    (w, u, v)
-}
-
 fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
@@ -126,6 +143,10 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
     [a[0] * s, a[1] * s, a[2] * s]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn len(a: [f64; 3]) -> f64 {
@@ -159,13 +180,16 @@ mod tests {
 
     #[test]
     fn an_orbit_reproduces_the_camera() {
-        let c = Camera {
-            position: [1.0, 2.0, -6.0],
-            look_at: [0.0, 0.5, 0.0],
-            fov: 1.0,
-        };
-        let back = Orbit::from_camera(&c).camera();
-        assert!(close(back.position, c.position) && close(back.look_at, c.look_at));
+        for up in [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.3, 1.0, 0.1]] {
+            let c = Camera {
+                position: [1.0, 2.0, -6.0],
+                look_at: [0.0, 0.5, 0.0],
+                up,
+                fov: 1.0,
+            };
+            let back = Orbit::from_camera(&c).camera();
+            assert!(close(back.position, c.position) && close(back.look_at, c.look_at));
+        }
     }
 
     #[test]

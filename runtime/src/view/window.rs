@@ -381,10 +381,15 @@ fn wgpu_presenter(
     event_loop: &ActiveEventLoop,
     window: &Arc<Window>,
 ) -> Result<(Arc<Gpu>, GpuPresenter), String> {
-    let display = Box::new(event_loop.owned_display_handle());
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
-        display,
-    ));
+    // One instance for the process, never destroyed (as `runtime/src/gpu/wgpu.rs` keeps its
+    // own): the Vulkan driver then stays loaded until the process ends.
+    static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
+    let instance = INSTANCE.get_or_init(|| {
+        let display = Box::new(event_loop.owned_display_handle());
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+            display,
+        ))
+    });
     let surface = instance
         .create_surface(window.clone())
         .map_err(|e| format!("cannot make a wgpu surface for the window: {e}"))?;

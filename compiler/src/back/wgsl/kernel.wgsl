@@ -151,7 +151,17 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
 //#endif
     loop {
         let p = o + d * t;
+//#if MEDIA
+        // Inside glass (sign < 0) the ray marches the medium: glass less the solids in it.
+        var f: f32;
+        if sign < 0.0 {
+            f = sdf_medium(p);
+        } else {
+            f = sdf(p);
+        }
+//#else
         let f = sdf(p);
+//#endif
         steps += 1u;
         counters.steps += 1u;
         if is_nan(f) {
@@ -222,6 +232,26 @@ fn normal(p: vec3<f32>, h: f32, d: vec3<f32>) -> vec3<f32> {
     }
     return -d;
 }
+//#if MEDIA
+
+// The normal of the solids inside glass (the gradient of their own field), as `normal`.
+fn normal_solid(p: vec3<f32>, h: f32, d: vec3<f32>) -> vec3<f32> {
+    var g = vec3<f32>(0.0);
+    for (var i = 0u; i < 4u; i++) {
+        let k = TETRA[i];
+        g += k * sdf_solid(p + k * h);
+    }
+    let l = length(g);
+    if l > 0.0 && !is_nan(l) {
+        return g * (1.0 / l);
+    }
+    return -d;
+}
+
+// While a solid inside glass is shaded: the glass's transparency, which its shadow rays
+// start inside of (0 otherwise).
+var<private> medium_tau: f32 = 0.0;
+//#endif
 //#endif
 
 // The colour of material m at p (checker: parity of the cell, sampled just inside).
@@ -250,6 +280,12 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
     var res = 1.0;
     var through = 1.0;
     var sign = 1.0;
+//#if MEDIA
+    if medium_tau > 0.0 {
+        through = medium_tau;
+        sign = -1.0;
+    }
+//#endif
     loop {
         let p = o + d * t;
 //#if TRANSPARENT
@@ -405,6 +441,29 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         let p = ray.origin + ray.dir * hit.t;
         let tt = ray.t0 + hit.t;
         let h = normal_step(tt, p);
+//#if MEDIA
+        if inside {
+            let solid = map_solid(p);
+            if solid.x < h {
+                // An opaque solid inside the glass: lit and reflecting as seen from outside,
+                // within the glass (docs/rendering.md, "Inside glass").
+                let ms = params.materials[u32(solid.y)];
+                let ns = normal_solid(p, h, ray.dir);
+                let ws = 1.0 - ms.optics.x - ms.optics.y;
+                if ws > 0.0 {
+                    medium_tau = params.materials[u32(map(p).y)].optics.y;
+                    acc += shade(ms, p, ns, ray.dir, tt, h) * ray.weight * ws;
+                    medium_tau = 0.0;
+                }
+                if ray.depth < params.depth.x && ms.optics.x > 0.0 {
+                    stack[top] = Ray(p + ns * (4.0 * h), tt, reflect_dir(ray.dir, ns), ray.depth + 1u, ray.weight * ms.optics.x, 1u);
+                    top += 1u;
+                    counters.secondary += 1u;
+                }
+                continue;
+            }
+        }
+//#endif
 //#if ANALYTIC
         let n = hit.normal;
         let m = params.materials[hit.material];

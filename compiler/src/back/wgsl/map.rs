@@ -278,9 +278,21 @@ pub(crate) fn results(program: &Program, b: usize, live: &[bool]) -> Vec<(usize,
 
 /// A WGSL float literal for `x` rounded to f32 (finite values only reach here; others are
 /// clamped to the largest f32 so that the module stays valid).
+///
+/// WGSL reads a literal without suffix as an abstract float (an f64) and converts that to
+/// f32: Tint rejects an f64 beyond the largest f32, naga rounds to the nearest. The shortest
+/// text of an f32 is used when its f64 lies within f32's range and rounds to the same f32;
+/// otherwise (the shortest text of `f32::MAX`, 3.4028235e38, lies above it) the shortest text
+/// of the f32 as an f64, which is the f32 exactly.
 pub fn float(x: f64) -> String {
     let f = (x as f32).clamp(-f32::MAX, f32::MAX);
-    let s = format!("{f:?}");
+    let short = format!("{f:?}");
+    let read = short.parse::<f64>().unwrap_or(f64::INFINITY);
+    let s = if read.abs() <= f64::from(f32::MAX) && read as f32 == f {
+        short
+    } else {
+        format!("{:?}", f64::from(f))
+    };
     if s.contains('.') || s.contains('e') {
         s
     } else {
@@ -373,5 +385,46 @@ fn expr(op: &Op, names: &Names) -> String {
         }
         Op::Select(c, a, b) => format!("select({}, {}, {} != 0.0)", n(b), n(a), n(c)),
         Op::Phi(a, _) => n(a),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::float;
+
+    /// The value WGSL gives a literal without suffix: read as an f64, then rounded to the
+    /// nearest f32; `None` where Tint rejects it (an f64 beyond the largest f32).
+    fn wgsl_value(text: &str) -> Option<f32> {
+        let read: f64 = text.parse().expect("a decimal literal");
+        (read.abs() <= f64::from(f32::MAX)).then_some(read as f32)
+    }
+
+    #[test]
+    fn largest_f32_is_written_exactly() {
+        // Its shortest text, 3.4028235e38, reads as an f64 above f32::MAX, which Tint rejects.
+        assert_eq!(float(f64::from(f32::MAX)), "3.4028234663852886e38");
+        assert_eq!(float(-f64::from(f32::MAX)), "-3.4028234663852886e38");
+        assert_eq!(float(f64::INFINITY), "3.4028234663852886e38");
+        assert_eq!(float(1e300), "3.4028234663852886e38");
+        // Others keep their shortest text.
+        assert_eq!(float(0.1), "0.1");
+        assert_eq!(float(3.0e38), "3e38");
+        assert_eq!(float(2.0), "2.0");
+    }
+
+    #[test]
+    fn every_literal_reads_back_as_its_f32() {
+        let near_max = (0..20_000u32).map(|k| f32::MAX.to_bits() - k);
+        let spread = (0..=u32::MAX / 7919).map(|k| k * 7919);
+        for bits in near_max.chain(spread) {
+            let f = f32::from_bits(bits);
+            if !f.is_finite() {
+                continue;
+            }
+            for x in [f, -f] {
+                let text = float(f64::from(x));
+                assert_eq!(wgsl_value(&text), Some(x), "{x:e} written as {text}");
+            }
+        }
     }
 }

@@ -96,7 +96,7 @@ impl std::error::Error for Error {}
 /// ray traced analytically.
 fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
     let mats = &scene.materials;
-    let soft = scene.lights.iter().any(|l| l.softness() > 0.0);
+    let soft = scene.lights.iter().any(|l| l.penumbra() > 0.0);
     let points = scene
         .lights
         .iter()
@@ -177,6 +177,7 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         features.push(("DEBUG_NAN", true));
     }
     let mut values: HashMap<&str, String> = HashMap::new();
+    on.insert("MEDIA", false);
     let data = match choice.primitives() {
         // An analytically traced scene needs no distance field.
         Some(primitives) => {
@@ -186,7 +187,21 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
             bytes
         }
         None => {
-            let (text, bytes) = marched(scene, program, options.max_instances);
+            let (mut text, bytes) = marched(scene, program, options.max_instances);
+            // Rays inside glass that may overlap a solid march the scene's media.
+            let media = on["REFRACTION"]
+                .then(|| crate::lower::media(scene))
+                .flatten();
+            on.insert("MEDIA", media.is_some());
+            if let Some(m) = media {
+                features.push(("MEDIA", true));
+                text.push('\n');
+                text.push_str(&map::write_sdf_named(&m.medium, "sdf_medium"));
+                text.push('\n');
+                text.push_str(&map::write_map_named(&m.solid, "map_solid"));
+                text.push('\n');
+                text.push_str(&map::write_sdf_named(&m.solid, "sdf_solid"));
+            }
             values.insert("MAP", text);
             bytes
         }
@@ -302,9 +317,7 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
     let cam = &scene.camera;
     let s = &scene.settings;
     let eye = cam.position;
-    let fwd = normalize(sub(cam.look_at, eye));
-    let u = normalize(cross(fwd, [0.0, 1.0, 0.0]));
-    let v = cross(u, fwd);
+    let (fwd, u, v) = cam.basis();
     let tan = (cam.fov * 0.5).tan();
     let aspect = s.width.max(1) as f64 / s.height.max(1) as f64;
     w.v4(eye, 0.0);
@@ -327,11 +340,11 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
             color,
             intensity,
             radius,
-            softness,
+            ..
         } = l
         {
             w.v4(*position, if radius.is_finite() { *radius } else { 0.0 });
-            w.v4(scale(*color, *intensity), *softness);
+            w.v4(scale(*color, *intensity), l.sharpness());
         }
     }
     for l in &scene.lights {
@@ -339,14 +352,14 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
             direction,
             color,
             intensity,
-            softness,
+            ..
         } = l
         {
             w.v4(
                 normalize([-direction[0], -direction[1], -direction[2]]),
                 0.0,
             );
-            w.v4(scale(*color, *intensity), *softness);
+            w.v4(scale(*color, *intensity), l.sharpness());
         }
     }
     for m in &scene.materials {
@@ -384,20 +397,8 @@ impl Words {
     }
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
     [a[0] * s, a[1] * s, a[2] * s]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn normalize(a: [f64; 3]) -> [f64; 3] {

@@ -246,13 +246,15 @@ impl Session {
 
     /// Whether a batch of file events (`paths`, the files they name) calls for a reload: the
     /// contents of a file the last load read changed (or it appeared or disappeared), or the
-    /// last load failed and a scene file (`.sdf`) changed, perhaps a missing import.
+    /// last load failed and a scene file (`.sdf`) it did not read changed, perhaps a missing
+    /// import.
     pub fn needs_reload(&self, paths: &[PathBuf]) -> bool {
+        let read: Vec<PathBuf> = self.files.iter().map(|f| absolute(f)).collect();
         self.fingerprint.changed()
             || (self.failed
-                && paths
-                    .iter()
-                    .any(|p| p.extension().is_some_and(|e| e == "sdf")))
+                && paths.iter().any(|p| {
+                    p.extension().is_some_and(|e| e == "sdf") && !read.contains(&absolute(p))
+                }))
     }
 
     /// Loads the scene file again (or for the first time): on success the new scene replaces
@@ -703,6 +705,11 @@ impl Session {
     }
 }
 
+/// `path` made absolute (as the watcher reports paths), or as it is.
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
 /// The paths of the files of a compilation, in file order (the entry file first).
 fn files_of(sources: &SourceMap) -> Vec<PathBuf> {
     (0..sources.len() as u32)
@@ -804,6 +811,10 @@ mod tests {
         assert!(!s.load().ok);
         assert_eq!(s.image(), Some(&good));
         assert!(s.needs_reload(&[dir.join("other.sdf")]));
+        assert!(
+            !s.needs_reload(&[file.clone()]),
+            "its contents are those it failed on"
+        );
         s.reset_camera();
         assert!(!s.camera_moved());
         let _ = std::fs::remove_dir_all(&dir);

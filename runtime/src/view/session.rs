@@ -812,7 +812,7 @@ mod tests {
         assert_eq!(s.image(), Some(&good));
         assert!(s.needs_reload(&[dir.join("other.sdf")]));
         assert!(
-            !s.needs_reload(&[file.clone()]),
+            !s.needs_reload(std::slice::from_ref(&file)),
             "its contents are those it failed on"
         );
         s.reset_camera();

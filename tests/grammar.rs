@@ -937,6 +937,11 @@ fn the_failure_paths_list_every_limit_with_its_default() {
 /// properties of an analysis, the definition of the reference render, test tolerances.
 const NOT_LIMITS: &[(&str, &str, &str)] = &[
     (
+        "runtime/src/view/session.rs",
+        "MAX_SCALE",
+        "how far the viewer lowers the resolution of a frame over its time budget",
+    ),
+    (
         "compiler/src/check/eval.rs",
         "MAX_CALL_SITES",
         "how many calls an error's chain of labels shows; the rest is a note",

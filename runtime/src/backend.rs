@@ -9,6 +9,7 @@ use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, Program};
 use sdfc_compiler::scene::analytic::{self, Choice};
 use sdfc_compiler::scene::{Method, Scene, Settings};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Where a scene is rendered.
@@ -43,10 +44,11 @@ pub enum Prepared {
         tapes: Box<Tapes>,
         options: Options,
     },
-    /// wgpu: the device, the validated kernel and the scene's Lipschitz bound L (and the
-    /// program and setup, to specialise the kernel again for other settings).
+    /// wgpu: the device (which may be shared, as the viewer shares its window's), the
+    /// validated kernel and the scene's Lipschitz bound L (and the program and setup, to
+    /// specialise the kernel again for other settings).
     Wgpu {
-        gpu: Box<Gpu>,
+        gpu: Arc<Gpu>,
         kernel: Box<wgsl::Kernel>,
         lipschitz: f64,
         program: Box<Program>,
@@ -122,7 +124,9 @@ impl Prepared {
             Backend::Cpu => Ok(Self::cpu(scene, program, setup)),
             Backend::Wgpu => Self::wgpu(scene, &program, setup, false),
             Backend::Cuda => Self::cuda(scene, &program, setup),
-            Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(scene, program, setup)),
+            Backend::Auto if setup.precision == Precision::F64 => {
+                Ok(Self::cpu(scene, program, setup))
+            }
             Backend::Auto => Self::cuda(scene, &program, setup)
                 .or_else(|_| Self::wgpu(scene, &program, setup, true))
                 .or_else(|_| Ok(Self::cpu(scene, program, setup))),
@@ -158,14 +162,33 @@ impl Prepared {
         require_hardware: bool,
     ) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
+        Self::on_gpu(Arc::new(gpu), scene, program, setup)
+    }
+
+    /// Prepares `scene`, whose distance program is `program`, for wgpu on an already opened
+    /// device: generates and validates the kernel (its pipeline is compiled, or found in the
+    /// device's cache, at the first render or by [`Gpu::pipeline_for`]).
+    pub fn on_gpu(
+        gpu: Arc<Gpu>,
+        scene: &Scene,
+        program: &Program,
+        setup: &Setup,
+    ) -> Result<Prepared, String> {
+        method_allowed(scene)?;
         let lipschitz = program.lipschitz();
         Ok(Prepared::Wgpu {
-            gpu: Box::new(gpu),
+            gpu,
             kernel: Box::new(Self::kernel(scene, program, setup)?),
             lipschitz,
             program: Box::new(program.clone()),
             setup: *setup,
         })
+    }
+
+    /// Prepares `scene`, whose distance program is `program`, for the CPU renderer.
+    pub fn on_cpu(scene: &Scene, program: Program, setup: &Setup) -> Result<Prepared, String> {
+        method_allowed(scene)?;
+        Ok(Self::cpu(scene, program, setup))
     }
 
     fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {

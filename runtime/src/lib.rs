@@ -13,3 +13,4 @@ pub mod image;
 pub mod memory;
 pub mod metrics;
 pub mod output;
+pub mod view;

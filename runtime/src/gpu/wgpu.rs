@@ -2,6 +2,8 @@
 //! image in tiles (one dispatch each, so that no dispatch runs long enough to trip a driver
 //! watchdog), reading back the linear colours and the per-pixel statistics.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// What can go wrong on the wgpu path.
@@ -29,13 +31,30 @@ const TILE_STRIDE: u32 = 256;
 /// Tiles per queue submission.
 const TILES_PER_SUBMIT: usize = 8;
 
-/// An opened device.
+/// Compiled pipelines kept by a [`Gpu`] (at most this many; the cache is emptied when full).
+const PIPELINES_KEPT: usize = 16;
+
+/// A compiled kernel: its pipeline and bind group layout.
+type Pipeline = Arc<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>;
+
+/// An opened device, with the pipelines compiled on it, kept by kernel text (so a scene whose
+/// kernel is unchanged, such as one edited only in uniform data, is not compiled again).
 #[derive(Debug)]
 pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     timestamps: bool,
+    pipelines: Mutex<HashMap<(String, String, bool), Pipeline>>,
+}
+
+/// How a kernel's pipeline was obtained ([`Gpu::pipeline_for`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PipelineTime {
+    /// Time to get it (creation and validation, or the cache look-up).
+    pub time: Duration,
+    /// Whether it came from the cache of compiled pipelines.
+    pub cached: bool,
 }
 
 /// Per-pixel results of a render.
@@ -105,6 +124,12 @@ impl Gpu {
             .ok_or(Error::NoAdapter {
                 what: if require_hardware { "GPU" } else { "wgpu" },
             })?;
+        Self::from_adapter(&adapter)
+    }
+
+    /// Opens a device on `adapter` (for example one chosen to present to a window's surface,
+    /// so that the kernel renders on the device that shows its frames).
+    pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Gpu, Error> {
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let features = if timestamps {
@@ -133,7 +158,54 @@ impl Gpu {
             queue,
             info,
             timestamps,
+            pipelines: Mutex::new(HashMap::new()),
         })
+    }
+
+    /// The device.
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    /// The device's queue.
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+
+    /// Compiles the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
+    /// `data`), or finds it among those already compiled on this device.
+    pub fn pipeline_for(&self, wgsl: &str, entry: &str, data: bool) -> Result<PipelineTime, Error> {
+        let start = Instant::now();
+        let (_, cached) = self.cached_pipeline(wgsl, entry, data)?;
+        Ok(PipelineTime {
+            time: start.elapsed(),
+            cached,
+        })
+    }
+
+    /// The pipeline of a kernel, from the cache or compiled (and validated) now; `true` when
+    /// it came from the cache.
+    fn cached_pipeline(
+        &self,
+        wgsl: &str,
+        entry: &str,
+        data: bool,
+    ) -> Result<(Pipeline, bool), Error> {
+        let key = (wgsl.to_string(), entry.to_string(), data);
+        let mut cache = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(p) = cache.get(&key) {
+            return Ok((p.clone(), true));
+        }
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let pipeline = Arc::new(self.pipeline(wgsl, entry, data));
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Pipeline(e.to_string()));
+        }
+        if cache.len() >= PIPELINES_KEPT {
+            cache.clear();
+        }
+        cache.insert(key, pipeline.clone());
+        Ok((pipeline, false))
     }
 
     /// The adapter's name and backend, e.g. `NVIDIA H100 (Vulkan)`.
@@ -158,16 +230,12 @@ impl Gpu {
                 data.len()
             )));
         }
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipeline = self.pipeline(l);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::Pipeline(e.to_string()));
-        }
+        let (pipeline, _) = self.cached_pipeline(l.wgsl, l.entry, l.data.is_some())?;
         let pixels = l.width as u64 * l.height as u64;
         let tiles = tiles(l.width, l.height, l.tile);
         let buffers = self.buffers(l, pixels, tiles.len() as u64);
         let bind = self.bind_group(&pipeline.1, &buffers);
-        let pipeline = pipeline.0;
+        let pipeline = &pipeline.0;
         let queries = self.timestamps.then(|| {
             self.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("sdfc timestamps"),
@@ -202,7 +270,7 @@ impl Gpu {
                     label: None,
                     timestamp_writes: writes,
                 });
-                pass.set_pipeline(&pipeline);
+                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &bind, &[i * TILE_STRIDE]);
                 pass.dispatch_workgroups(t.2.div_ceil(l.workgroup), t.3.div_ceil(l.workgroup), 1);
             }
@@ -246,12 +314,17 @@ impl Gpu {
     /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
     /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage), and 4 the
     /// scene data (read-only storage) when the kernel has it.
-    fn pipeline(&self, l: &Launch) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+    fn pipeline(
+        &self,
+        wgsl: &str,
+        entry_point: &str,
+        data: bool,
+    ) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
         let module = self
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("sdfc kernel"),
-                source: wgpu::ShaderSource::Wgsl(l.wgsl.into()),
+                source: wgpu::ShaderSource::Wgsl(wgsl.into()),
             });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -275,7 +348,7 @@ impl Gpu {
             entry(2, storage(false)),
             entry(3, storage(false)),
         ];
-        if l.data.is_some() {
+        if data {
             entries.push(entry(4, storage(true)));
         }
         let layout = self
@@ -297,7 +370,7 @@ impl Gpu {
                 label: Some("sdfc render"),
                 layout: Some(&pipeline_layout),
                 module: &module,
-                entry_point: Some(l.entry),
+                entry_point: Some(entry_point),
                 compilation_options: Default::default(),
                 cache: None,
             });

@@ -1,0 +1,112 @@
+//! `sdfc view`: the live preview, a window that renders a scene continuously and reloads it
+//! whenever it or a file it imports is saved (see `docs/viewer.md`).
+
+use crate::backend::Backend;
+use crate::view::{self, session::Options, Control, Run};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Where the viewer renders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum ViewBackend {
+    /// The kernel on the window's GPU through wgpu when it is a hardware GPU, else the CPU.
+    #[default]
+    Auto,
+    /// The WGSL kernel through wgpu, on the device that presents the window (lavapipe too).
+    Wgpu,
+    /// The CPU renderer.
+    Cpu,
+}
+
+/// Arguments of `sdfc view`.
+#[derive(Debug, clap::Args)]
+pub struct ViewArgs {
+    /// Scene file.
+    pub file: PathBuf,
+    /// Backend to render with.
+    #[arg(long, value_enum, default_value_t)]
+    pub backend: ViewBackend,
+    /// Window (and image) size, as WIDTHxHEIGHT (default: the scene's `render` size).
+    #[arg(long, value_name = "WxH", value_parser = super::render::parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Override a render setting (as for `sdfc render`), at every reload. May be repeated.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Print the times of each load: check, lower, tapes or kernel, pipeline, first frame,
+    /// and (for reloads) from the file's modification to the first frame shown.
+    #[arg(long)]
+    pub timings: bool,
+    /// Show the statistics in the title from the start (S or Tab toggles them).
+    #[arg(long)]
+    pub stats: bool,
+    /// Run the session without a window (on a machine without a display): render until the
+    /// image converges, then wait for changes.
+    #[arg(long)]
+    pub headless: bool,
+    /// With --headless: once the first image has settled, orbit the camera for N frames and
+    /// print the frame rate, then the time to converge after the camera stops.
+    #[arg(long, value_name = "N", requires = "headless", value_parser = clap::value_parser!(u32).range(1..))]
+    pub orbit_frames: Option<u32>,
+    /// Stop after N frames have been presented.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub frames: Option<u64>,
+    /// With --frames: write what the window shows at the last frame to this PNG file.
+    #[arg(long, value_name = "OUT.png", requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+    /// Write DIR/reload-K.png once the image after load K (0 the first) has settled: converged,
+    /// or, after a load with errors, the last good image that stays on show.
+    #[arg(long, value_name = "DIR")]
+    pub screenshot_dir: Option<PathBuf>,
+    /// Stop once the screenshot of load K is written (needs --screenshot-dir).
+    #[arg(long, value_name = "K", requires = "screenshot_dir")]
+    pub exit_after_reloads: Option<u32>,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
+}
+
+/// Runs `sdfc view`.
+pub fn run(args: ViewArgs) -> ExitCode {
+    let limits = args.limits.limits();
+    // The --set values are checked once here, so that a mistake in them stops at once rather
+    // than failing every reload.
+    let mut probe = sdfc_compiler::scene::Settings::default();
+    if let Err(msg) =
+        super::render::override_settings(&mut probe, args.size, None, &args.set, &limits)
+    {
+        eprintln!("error: {msg}");
+        return ExitCode::from(2);
+    }
+    if let Some(dir) = &args.screenshot_dir {
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            eprintln!("error: cannot create `{}`: {e}", dir.display());
+            return ExitCode::from(2);
+        }
+    }
+    let run = Run {
+        file: args.file,
+        backend: match args.backend {
+            ViewBackend::Auto => Backend::Auto,
+            ViewBackend::Wgpu => Backend::Wgpu,
+            ViewBackend::Cpu => Backend::Cpu,
+        },
+        options: Options {
+            size: args.size,
+            sets: args.set,
+            limits,
+            timings: args.timings,
+        },
+        control: Control {
+            frames: args.frames,
+            screenshot: args.screenshot,
+            screenshot_dir: args.screenshot_dir,
+            exit_after_reloads: args.exit_after_reloads,
+            stats: args.stats,
+            orbit_frames: args.orbit_frames,
+        },
+    };
+    if args.headless {
+        view::headless(run)
+    } else {
+        view::window::run(run)
+    }
+}

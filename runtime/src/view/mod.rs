@@ -1,0 +1,228 @@
+//! `sdfc view`, the live preview: a session that watches a scene file and its imports,
+//! recompiles on every change, keeps the last good image when an edit has errors, and renders
+//! progressively ([`session`]); and its presentation, in a window ([`window`]) or headless
+//! (this module), with the screenshots that let tests and measurements see what it shows.
+
+pub mod camera;
+pub mod session;
+pub mod watch;
+pub mod window;
+
+use crate::backend::Backend;
+use crate::gpu::Gpu;
+use session::{Device, Options, Session};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::mpsc;
+use std::sync::Arc;
+use std::time::Duration;
+use watch::Watch;
+
+/// When the viewer stops by itself, and what it writes on the way (for tests and scripts).
+#[derive(Debug, Clone, Default)]
+pub struct Control {
+    /// Stop after this many frames are presented (the converged image is presented again).
+    pub frames: Option<u64>,
+    /// With `frames`: write what the last frame shows here (PNG).
+    pub screenshot: Option<PathBuf>,
+    /// Write `reload-K.png` here once the image after load K (0 the first) has settled:
+    /// converged, or, after a load that failed, the image still on show.
+    pub screenshot_dir: Option<PathBuf>,
+    /// Stop once the screenshot of load K is written.
+    pub exit_after_reloads: Option<u32>,
+    /// Start with the statistics shown in the title.
+    pub stats: bool,
+    /// Headless: once the first image has settled, orbit the camera for this many frames,
+    /// print the frame rate, then the time to the converged image after the camera stops.
+    pub orbit_frames: Option<u32>,
+}
+
+/// A run of the viewer.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// The scene file.
+    pub file: PathBuf,
+    /// `auto`, `wgpu` or `cpu`.
+    pub backend: Backend,
+    /// How the session treats the scene.
+    pub options: Options,
+    /// When to stop.
+    pub control: Control,
+}
+
+/// Runs the session without a window: loads, renders until the image converges, waits for
+/// changes to the files, and repeats, writing the screenshots `control` asks for from the
+/// session's image. For measuring the viewer on a machine without a display.
+pub fn headless(run: Run) -> ExitCode {
+    let device = match run.backend {
+        Backend::Cpu => Device::Cpu,
+        backend => match Gpu::open(backend == Backend::Auto) {
+            Ok(gpu) => Device::Wgpu(Arc::new(gpu)),
+            Err(e) if backend == Backend::Auto => {
+                eprintln!("view: no GPU adapter ({e}); rendering on the CPU");
+                Device::Cpu
+            }
+            Err(e) => {
+                eprintln!("error: the Wgpu backend is not available: {e}");
+                return ExitCode::from(1);
+            }
+        },
+    };
+    eprintln!(
+        "view: rendering on {} ({}), headless",
+        device.name(),
+        device.describe()
+    );
+    let size = Session::initial_size(&run.file, &run.options);
+    let mut session = Session::new(run.file.clone(), run.options.clone(), device);
+    session.set_size(size.0, size.1);
+    let (tx, rx) = mpsc::channel();
+    let mut watch = match Watch::new(move |paths| {
+        let _ = tx.send(paths);
+    }) {
+        Ok(w) => Some(w),
+        Err(msg) => {
+            eprintln!("warning: {msg}; the scene will not be reloaded when it changes");
+            None
+        }
+    };
+    let control = &run.control;
+    let mut shot_for = Some(session.load().number);
+    let mut frames = 0u64;
+    let mut orbit = control.orbit_frames;
+    loop {
+        if let Some(w) = watch.as_mut() {
+            for problem in w.add(session.files()) {
+                eprintln!("warning: {problem}");
+            }
+        }
+        // Render until the image settles; a frame limit counts the settled image too.
+        loop {
+            match session.frame() {
+                Ok(Some(_)) => session.presented(),
+                Ok(None) => {}
+                Err(msg) => eprintln!("error: {msg}"),
+            }
+            frames += 1;
+            let last = control.frames.is_some_and(|n| frames >= n);
+            if last {
+                if let Some(path) = &control.screenshot {
+                    if let Err(msg) = write_image(&session, path) {
+                        eprintln!("error: {msg}");
+                        return ExitCode::from(2);
+                    }
+                }
+                return ExitCode::SUCCESS;
+            }
+            if session.settled() {
+                break;
+            }
+        }
+        if let Some(n) = orbit.take() {
+            measure_orbit(&mut session, n);
+        }
+        if let (Some(k), Some(dir)) = (shot_for.take(), &control.screenshot_dir) {
+            let path = dir.join(format!("reload-{k}.png"));
+            if let Err(msg) = write_image(&session, &path) {
+                eprintln!("error: {msg}");
+                return ExitCode::from(2);
+            }
+            if control.exit_after_reloads == Some(k) {
+                return ExitCode::SUCCESS;
+            }
+        }
+        // Wait for a change that calls for a reload.
+        let paths = match rx.recv_timeout(Duration::from_secs(3600)) {
+            Ok(p) => p,
+            Err(mpsc::RecvTimeoutError::Timeout) => continue,
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                eprintln!("view: no longer watching the files; stopping");
+                return ExitCode::SUCCESS;
+            }
+        };
+        if session.needs_reload(&paths) {
+            shot_for = Some(session.load().number);
+        }
+    }
+}
+
+/// Orbits the camera by 4 pixels' drag a frame for `frames` frames, as a user would, and
+/// prints the frame rate and the frames' size; then lets the camera stop and prints how long
+/// the image takes to converge (the settling time after the last motion included).
+fn measure_orbit(session: &mut Session, frames: u32) {
+    let start = std::time::Instant::now();
+    let mut last = None;
+    for _ in 0..frames {
+        session.rotate(4.0, 0.0);
+        match session.frame() {
+            Ok(Some(info)) => last = Some(info),
+            Ok(None) => {}
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                return;
+            }
+        }
+    }
+    let elapsed = start.elapsed();
+    let Some(info) = last else {
+        eprintln!("view: orbit: nothing to render");
+        return;
+    };
+    eprintln!(
+        "view: orbit: {frames} frames in {:.3} s, {:.1} frames/s (last frame {}x{}, {:.2} ms)",
+        elapsed.as_secs_f64(),
+        frames as f64 / elapsed.as_secs_f64(),
+        info.width,
+        info.height,
+        info.time.as_secs_f64() * 1e3
+    );
+    let stopped = std::time::Instant::now();
+    let mut samples = 0;
+    while !session.settled() {
+        match session.frame() {
+            Ok(Some(info)) => samples = info.samples,
+            Ok(None) => std::thread::sleep(Duration::from_millis(1)),
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                return;
+            }
+        }
+    }
+    eprintln!(
+        "view: orbit: converged ({samples} samples per pixel) {:.1} ms after the camera stopped ({} ms of it waiting for the camera to count as still)",
+        stopped.elapsed().as_secs_f64() * 1e3,
+        session::SETTLE.as_millis()
+    );
+}
+
+/// Writes the session's image (the background grey when there is none yet).
+fn write_image(session: &Session, path: &Path) -> Result<(), String> {
+    let (w, h) = session.size();
+    let bytes = match session.image() {
+        Some(image) => {
+            if (image.width, image.height) != (w, h) {
+                // Only a frame rendered while moving is smaller, and headless nothing moves.
+                return Err("the image on show is not at the view's size".into());
+            }
+            image.to_rgba8()
+        }
+        None => [5, 5, 5, 255].repeat(w as usize * h as usize),
+    };
+    write_rgba_png(path, w, h, &bytes)
+        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+    eprintln!("view: wrote {}", path.display());
+    Ok(())
+}
+
+/// Writes RGBA8 sRGB pixels as a PNG file, atomically.
+pub fn write_rgba_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<(), String> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(rgba).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    crate::image::write_atomic(path, &bytes).map_err(|e| e.to_string())
+}

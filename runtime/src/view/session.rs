@@ -1,0 +1,824 @@
+//! The viewer's session, apart from any window: it loads and checks the scene file, prepares it
+//! for the CPU renderer or wgpu, keeps the last good scene when an edit has errors, holds the
+//! camera the user moved, and renders frames progressively (one sample per pixel, and fewer
+//! pixels when a frame exceeds its budget, while the camera moves; jittered samples
+//! accumulated up to the scene's `aa` when it is still).
+
+use super::camera::{self, Orbit};
+use super::watch::Fingerprint;
+use crate::backend::{Prepared, Setup};
+use crate::commands::check;
+use crate::commands::render::override_settings;
+use crate::frontend::{self, DiagnosticFormat, Loaded};
+use crate::gpu::wgpu::PipelineTime;
+use crate::gpu::Gpu;
+use crate::image::Image;
+use sdfc_compiler::back::wgsl;
+use sdfc_compiler::lower::{self, LowerOptions};
+use sdfc_compiler::scene::analytic::{self, Choice};
+use sdfc_compiler::scene::{Camera, Scene};
+use sdfc_compiler::{Diagnostic, FileId, Limit, Limits, Severity, SourceMap};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant, SystemTime};
+
+/// The time a frame may take while the camera moves; a slower one lowers the resolution.
+pub const FRAME_BUDGET: Duration = Duration::from_millis(33);
+/// How long after the last camera motion the camera counts as still (and samples accumulate).
+pub const SETTLE: Duration = Duration::from_millis(120);
+/// The largest divisor of the resolution while moving.
+pub const MAX_SCALE: u32 = 8;
+
+/// How the session treats the scene, from the command line.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// `--size`: the image size, overriding the scene's (the window's size replaces it when
+    /// the window is resized).
+    pub size: Option<(u32, u32)>,
+    /// `--set key=value` overrides of render settings, applied at every load.
+    pub sets: Vec<String>,
+    /// Resource limits.
+    pub limits: Limits,
+    /// `--timings`: print the times of each load and of its first frame.
+    pub timings: bool,
+}
+
+/// Where frames are rendered.
+#[derive(Debug, Clone)]
+pub enum Device {
+    /// The CPU renderer.
+    Cpu,
+    /// The WGSL kernel through wgpu, on this device.
+    Wgpu(Arc<Gpu>),
+}
+
+impl Device {
+    /// The backend's name, as in `--backend`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Device::Cpu => "cpu",
+            Device::Wgpu(_) => "wgpu",
+        }
+    }
+
+    /// The device, for messages.
+    pub fn describe(&self) -> String {
+        match self {
+            Device::Cpu => format!("CPU, {} threads", rayon::current_num_threads()),
+            Device::Wgpu(gpu) => gpu.describe(),
+        }
+    }
+}
+
+/// The scene being shown: the last load that compiled.
+#[derive(Debug)]
+struct Good {
+    /// The scene; its camera and size are set for each frame.
+    scene: Scene,
+    prepared: Prepared,
+    /// The camera the file gives.
+    file_camera: Camera,
+    /// Samples per pixel of a converged image (the scene's `aa`, squared).
+    aa: u32,
+    /// `trace` or `march`.
+    method: &'static str,
+}
+
+/// The result of one load of the scene file.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// 0 for the first load, then 1, 2, … for each reload.
+    pub number: u32,
+    /// Whether the scene compiled and replaced the one shown.
+    pub ok: bool,
+    /// One line: `ok` or the first error.
+    pub summary: String,
+}
+
+/// Times of one load, printed (with `--timings`) once its first frame is shown.
+#[derive(Debug, Clone)]
+struct Timings {
+    number: u32,
+    /// Reading and checking.
+    check: Duration,
+    /// Lowering to the distance program.
+    lower: Duration,
+    /// Tapes (CPU) or kernel generation and validation (wgpu).
+    prepare: Duration,
+    /// The kernel's pipeline: compiled, or found among those compiled.
+    pipeline: Option<PipelineTime>,
+    /// When the newest of the scene's files was modified.
+    modified: Option<SystemTime>,
+    /// When the load began.
+    began: SystemTime,
+    /// The first frame's render time and size, once rendered.
+    first_frame: Option<(Duration, u32, u32)>,
+    /// Whether the first frame's timings are printed (and the first full frame's are due).
+    printed: bool,
+}
+
+/// One rendered frame.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameInfo {
+    /// Its size (smaller than the view while moving, when frames are over budget).
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel accumulated so far, and the target (the scene's `aa`, squared).
+    pub samples: u32,
+    pub target: u32,
+    /// Render time of this frame (wall time, read-back included).
+    pub time: Duration,
+    /// Mean marching steps per pixel of this frame.
+    pub steps: f64,
+    /// Whether the camera was moving.
+    pub moving: bool,
+}
+
+/// Samples accumulated at one size.
+#[derive(Debug, Default)]
+struct Accumulation {
+    width: u32,
+    height: u32,
+    sum: Vec<[f32; 3]>,
+    count: u32,
+    /// Whether the samples are of a still camera at full size.
+    still: bool,
+}
+
+/// The viewer's state between frames.
+#[derive(Debug)]
+pub struct Session {
+    file: PathBuf,
+    options: Options,
+    device: Device,
+    good: Option<Good>,
+    /// The files the last load read (the entry file and its imports).
+    files: Vec<PathBuf>,
+    /// Their contents as that load saw them.
+    fingerprint: Fingerprint,
+    /// Loads so far.
+    loads: u32,
+    /// Whether the last load failed.
+    failed: bool,
+    /// The summary of the last failure, while it stands.
+    status: Option<String>,
+    /// The camera the user moved to; `None` follows the file's camera.
+    user_camera: Option<Orbit>,
+    /// The view's size.
+    size: (u32, u32),
+    /// Moving until then.
+    moving_until: Option<Instant>,
+    /// The divisor of the resolution while moving.
+    scale: u32,
+    /// Whether the next frame is the first of a newly loaded scene, rendered at a lower
+    /// resolution when full frames take longer than the budget.
+    preview: bool,
+    /// The time of the last full-resolution frame.
+    last_full: Option<Duration>,
+    accumulation: Accumulation,
+    /// The image on show: the mean of the accumulated samples.
+    shown: Option<Image>,
+    /// The last frame.
+    last: Option<FrameInfo>,
+    /// A render error that stops rendering until the next load or camera move.
+    broken: Option<String>,
+    timings: Option<Timings>,
+}
+
+impl Session {
+    /// A session on `file`, rendering on `device`; nothing is loaded until [`Session::load`].
+    pub fn new(file: PathBuf, options: Options, device: Device) -> Session {
+        let size = options.size.unwrap_or((640, 480));
+        Session {
+            files: vec![file.clone()],
+            file,
+            options,
+            device,
+            good: None,
+            fingerprint: Fingerprint::default(),
+            loads: 0,
+            failed: false,
+            status: None,
+            user_camera: None,
+            size,
+            moving_until: None,
+            scale: 1,
+            preview: false,
+            last_full: None,
+            accumulation: Accumulation::default(),
+            shown: None,
+            last: None,
+            broken: None,
+            timings: None,
+        }
+    }
+
+    /// The size a view of `file` starts at: `size`, or the scene's (640×480 when the file does
+    /// not compile yet). Nothing is printed.
+    pub fn initial_size(file: &Path, options: &Options) -> (u32, u32) {
+        if let Some(size) = options.size {
+            return size;
+        }
+        match frontend::load_with(file, &options.limits) {
+            Ok(Loaded {
+                scene: Some(mut scene),
+                ..
+            }) => {
+                let s = &mut scene.settings;
+                match override_settings(s, None, None, &options.sets, &options.limits) {
+                    Ok(()) => (s.width, s.height),
+                    Err(_) => (640, 480),
+                }
+            }
+            _ => (640, 480),
+        }
+    }
+
+    /// The device frames are rendered on.
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// The files the last load read: the scene file and every file it imports.
+    pub fn files(&self) -> &[PathBuf] {
+        &self.files
+    }
+
+    /// Whether a batch of file events (`paths`, the files they name) calls for a reload: the
+    /// contents of a file the last load read changed (or it appeared or disappeared), or the
+    /// last load failed and a scene file (`.sdf`) it did not read changed, perhaps a missing
+    /// import.
+    pub fn needs_reload(&self, paths: &[PathBuf]) -> bool {
+        let read: Vec<PathBuf> = self.files.iter().map(|f| absolute(f)).collect();
+        self.fingerprint.changed()
+            || (self.failed
+                && paths.iter().any(|p| {
+                    p.extension().is_some_and(|e| e == "sdf") && !read.contains(&absolute(p))
+                }))
+    }
+
+    /// Loads the scene file again (or for the first time): on success the new scene replaces
+    /// the old one, and the camera stays where the user moved it; on failure the diagnostics
+    /// are printed as `sdfc check` prints them and the last good scene stays.
+    pub fn load(&mut self) -> Outcome {
+        let number = self.loads;
+        self.loads += 1;
+        let started = Instant::now();
+        let began = SystemTime::now();
+        let modified = Fingerprint::modified(&self.files);
+        match self.compile() {
+            Ok((good, mut timings)) => {
+                timings.number = number;
+                timings.modified = Fingerprint::modified(&self.files).or(modified);
+                timings.began = began;
+                self.install(good);
+                self.timings = Some(timings);
+                self.failed = false;
+                self.status = None;
+                Outcome {
+                    number,
+                    ok: true,
+                    summary: "ok".into(),
+                }
+            }
+            Err(summary) => {
+                self.failed = true;
+                self.status = Some(summary.clone());
+                let kept = if self.good.is_some() {
+                    "the last good scene stays on show"
+                } else {
+                    "nothing to show yet"
+                };
+                eprintln!(
+                    "view: load {number} of `{}` failed after {:.1} ms; {kept}",
+                    self.file.display(),
+                    ms(started.elapsed())
+                );
+                Outcome {
+                    number,
+                    ok: false,
+                    summary,
+                }
+            }
+        }
+    }
+
+    /// Reads, checks, lowers and prepares the scene, printing what `sdfc check` prints;
+    /// `Err` is the one-line summary of the first problem.
+    fn compile(&mut self) -> Result<(Good, Timings), String> {
+        let limits = self.options.limits.clone();
+        let start = Instant::now();
+        let mut loaded = match frontend::load_with(&self.file, &limits) {
+            Ok(l) => l,
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                self.files = vec![self.file.clone()];
+                self.fingerprint = Fingerprint::of(&self.files);
+                return Err(msg);
+            }
+        };
+        self.files = files_of(&loaded.sources);
+        self.fingerprint = Fingerprint::from_sources(
+            self.files
+                .iter()
+                .zip(0..)
+                .map(|(f, i)| (f.clone(), loaded.sources.text(FileId(i)).as_bytes())),
+        );
+        frontend::report(&loaded, DiagnosticFormat::Human);
+        let Some(mut scene) = loaded.scene.take() else {
+            return Err(first_error(&loaded.diagnostics, &loaded.sources));
+        };
+        if let Err(msg) = override_settings(
+            &mut scene.settings,
+            self.options.size,
+            None,
+            &self.options.sets,
+            &limits,
+        ) {
+            eprintln!("error: {msg}");
+            return Err(msg);
+        }
+        eprintln!(
+            "{}: ok; {}; {}",
+            self.file.display(),
+            check::summary(&loaded, &scene),
+            check::method(&loaded, &scene)
+        );
+        let check_time = start.elapsed();
+        let start = Instant::now();
+        let program = match lower::lower_within(&scene, &LowerOptions::default(), &limits) {
+            Ok(program) => program,
+            Err(d) => {
+                let summary = first_error(std::slice::from_ref(&d), &loaded.sources);
+                frontend::print_diagnostics(&[d], &loaded.sources, DiagnosticFormat::Human);
+                return Err(summary);
+            }
+        };
+        let lower_time = start.elapsed();
+        let start = Instant::now();
+        let setup = Setup::default();
+        let prepared = match &self.device {
+            Device::Cpu => Prepared::on_cpu(&scene, program, &setup),
+            Device::Wgpu(gpu) => Prepared::on_gpu(gpu.clone(), &scene, &program, &setup),
+        };
+        let prepared = prepared.inspect_err(|msg| eprintln!("error: {msg}"))?;
+        let prepare_time = start.elapsed();
+        let mut at = scene.settings.clone();
+        (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);
+        if let Err(msg) = prepared.memory(&scene, &at).check(&limits) {
+            eprintln!("error: {msg}");
+            return Err(msg);
+        }
+        let pipeline = match &prepared {
+            Prepared::Wgpu { gpu, kernel, .. } => Some(
+                gpu.pipeline_for(&kernel.source, wgsl::ENTRY_POINT, kernel.data.is_some())
+                    .map_err(|e| e.to_string())
+                    .inspect_err(|msg| eprintln!("error: {msg}"))?,
+            ),
+            _ => None,
+        };
+        let method = match analytic::choose(&scene) {
+            Choice::Trace(_) => "trace",
+            Choice::March(_) => "march",
+        };
+        let aa = scene.settings.aa.max(1);
+        let good = Good {
+            file_camera: scene.camera.clone(),
+            scene,
+            prepared,
+            aa: aa * aa,
+            method,
+        };
+        let timings = Timings {
+            number: 0,
+            check: check_time,
+            lower: lower_time,
+            prepare: prepare_time,
+            pipeline,
+            modified: None,
+            began: SystemTime::now(),
+            first_frame: None,
+            printed: false,
+        };
+        Ok((good, timings))
+    }
+
+    fn install(&mut self, good: Good) {
+        self.good = Some(good);
+        self.broken = None;
+        self.preview = true;
+        self.accumulation = Accumulation::default();
+    }
+
+    /// The divisor of the resolution of a new scene's first frame: enough to bring the last
+    /// full frame's time within the budget (1 before the first frame).
+    fn preview_scale(&self) -> u32 {
+        let ratio = self
+            .last_full
+            .map_or(0.0, |t| t.as_secs_f64() / FRAME_BUDGET.as_secs_f64());
+        (ratio.sqrt().ceil() as u32).clamp(1, MAX_SCALE)
+    }
+
+    /// Sets the view's size (the window's), clamped to the `edge` limit.
+    pub fn set_size(&mut self, width: u32, height: u32) {
+        let edge = self.options.limits.get(Limit::Edge).min(u32::MAX as u64) as u32;
+        let size = (width.clamp(1, edge), height.clamp(1, edge));
+        if size != self.size {
+            self.size = size;
+            self.accumulation = Accumulation::default();
+        }
+    }
+
+    /// The view's size.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The camera frames are rendered from.
+    fn camera(&self) -> Option<Camera> {
+        match (&self.user_camera, &self.good) {
+            (Some(orbit), _) => Some(orbit.camera()),
+            (None, Some(good)) => Some(good.file_camera.clone()),
+            (None, None) => None,
+        }
+    }
+
+    /// The orbit to move (starting from the file's camera), marking the camera as moving.
+    fn orbit(&mut self) -> Option<&mut Orbit> {
+        let camera = self.camera()?;
+        self.moving_until = Some(Instant::now() + SETTLE);
+        self.broken = None;
+        Some(
+            self.user_camera
+                .get_or_insert_with(|| Orbit::from_camera(&camera)),
+        )
+    }
+
+    /// Orbits by a drag of (`dx`, `dy`) pixels.
+    pub fn rotate(&mut self, dx: f64, dy: f64) {
+        if let Some(o) = self.orbit() {
+            o.orbit(dx, dy);
+        }
+    }
+
+    /// Pans by a drag of (`dx`, `dy`) pixels.
+    pub fn pan(&mut self, dx: f64, dy: f64) {
+        let height = self.size.1;
+        if let Some(o) = self.orbit() {
+            o.pan(dx, dy, height);
+        }
+    }
+
+    /// Zooms by `lines` wheel lines (positive: closer).
+    pub fn zoom(&mut self, lines: f64) {
+        if let Some(o) = self.orbit() {
+            o.zoom(lines);
+        }
+    }
+
+    /// Returns to the file's camera.
+    pub fn reset_camera(&mut self) {
+        if self.user_camera.take().is_some() {
+            self.accumulation = Accumulation::default();
+            self.broken = None;
+        }
+    }
+
+    /// Whether the user has moved the camera away from the file's.
+    pub fn camera_moved(&self) -> bool {
+        self.user_camera.is_some()
+    }
+
+    fn moving(&self) -> bool {
+        self.moving_until.is_some_and(|t| Instant::now() < t)
+    }
+
+    /// Whether there is a frame to render: a scene is loaded and the camera moves or the image
+    /// has fewer samples than the scene's `aa` asks for.
+    pub fn wants_frame(&self) -> bool {
+        let Some(good) = &self.good else {
+            return false;
+        };
+        if self.broken.is_some() {
+            return false;
+        }
+        let a = &self.accumulation;
+        self.moving() || !a.still || a.count < good.aa || (a.width, a.height) != self.size
+    }
+
+    /// Whether the image on show is final until something changes (converged, or nothing to
+    /// render).
+    pub fn settled(&self) -> bool {
+        !self.wants_frame()
+    }
+
+    /// Renders the next frame into the image on show. `Ok(None)` when there is nothing to
+    /// render; `Err` is a render error (rendering stops until the next load or camera move).
+    pub fn frame(&mut self) -> Result<Option<FrameInfo>, String> {
+        if !self.wants_frame() {
+            return Ok(None);
+        }
+        let moving = self.moving();
+        let Some(base) = self.camera() else {
+            return Ok(None);
+        };
+        let scale = if moving {
+            self.scale
+        } else if self.preview {
+            self.preview_scale()
+        } else {
+            1
+        };
+        // A frame below full resolution is a single sample, replaced by the next frame.
+        let low = scale > 1 || moving;
+        self.preview = false;
+        let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
+        let a = &mut self.accumulation;
+        if low || !a.still || (a.width, a.height) != (w, h) {
+            *a = Accumulation {
+                width: w,
+                height: h,
+                sum: vec![[0.0; 3]; w as usize * h as usize],
+                count: 0,
+                still: !low,
+            };
+        }
+        let Some(good) = self.good.as_mut() else {
+            return Ok(None);
+        };
+        let n = (good.aa as f64).sqrt().round() as u32;
+        let (dx, dy) = if low {
+            (0.0, 0.0)
+        } else {
+            camera::sample_offset(a.count, n)
+        };
+        good.scene.camera = camera::jittered(&base, dx, dy, w, h);
+        let s = &mut good.scene.settings;
+        (s.width, s.height, s.aa) = (w, h, 1);
+        let start = Instant::now();
+        let frame = match good.prepared.render(&good.scene, &|_| {}) {
+            Ok(f) => f,
+            Err(msg) => {
+                self.broken = Some(msg.clone());
+                return Err(msg);
+            }
+        };
+        let time = start.elapsed();
+        for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
+            for i in 0..3 {
+                sum[i] += c[i];
+            }
+        }
+        a.count += 1;
+        let inv = 1.0 / a.count as f32;
+        self.shown = Some(Image {
+            width: w,
+            height: h,
+            linear: a
+                .sum
+                .iter()
+                .map(|c| [c[0] * inv, c[1] * inv, c[2] * inv])
+                .collect(),
+        });
+        if scale == 1 {
+            self.last_full = Some(time);
+        }
+        if moving {
+            if time > FRAME_BUDGET && self.scale < MAX_SCALE {
+                self.scale += 1;
+            } else if time * 3 < FRAME_BUDGET && self.scale > 1 {
+                self.scale -= 1;
+            }
+        }
+        let info = FrameInfo {
+            width: w,
+            height: h,
+            samples: a.count,
+            target: good.aa,
+            time,
+            steps: frame.render.stats.steps_mean,
+            moving,
+        };
+        if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
+            t.first_frame = Some((time, w, h));
+        }
+        self.last = Some(info);
+        Ok(Some(info))
+    }
+
+    /// The image on show: the mean of the samples accumulated (at the size of the last frame),
+    /// or `None` before the first good frame.
+    pub fn image(&self) -> Option<&Image> {
+        self.shown.as_ref()
+    }
+
+    /// Called once a frame is on show: prints the timings of the load whose first frame it
+    /// is, with `--timings` (edit to pixel: from the modification of the newest of the
+    /// scene's files until now).
+    pub fn presented(&mut self) {
+        let Some(t) = self.timings.as_ref() else {
+            return;
+        };
+        let Some((time, w, h)) = t.first_frame else {
+            return;
+        };
+        if t.printed {
+            // The first frame was smaller: say when the full resolution followed.
+            let full = self.accumulation.still && self.accumulation.count > 0;
+            if full {
+                if let (true, Some(m)) = (self.options.timings, t.modified.filter(|_| t.number > 0))
+                {
+                    if let Ok(total) = SystemTime::now().duration_since(m) {
+                        eprintln!(
+                            "view: load {}: first full-resolution frame shown {:.1} ms after the edit",
+                            t.number,
+                            ms(total)
+                        );
+                    }
+                }
+                self.timings = None;
+            }
+            return;
+        }
+        if self.options.timings {
+            let pipeline = match t.pipeline {
+                Some(p) if p.cached => format!(", pipeline cached ({:.1} ms)", ms(p.time)),
+                Some(p) => format!(", pipeline compiled {:.1} ms", ms(p.time)),
+                None => String::new(),
+            };
+            let now = SystemTime::now();
+            let edit = match (
+                t.modified.filter(|_| t.number > 0),
+                now.duration_since(t.began),
+            ) {
+                (Some(m), Ok(shown)) => match (t.began.duration_since(m), now.duration_since(m)) {
+                    (Ok(seen), Ok(total)) => format!(
+                        "; edit to pixel {:.1} ms (seen after {:.1} ms, shown {:.1} ms later)",
+                        ms(total),
+                        ms(seen),
+                        ms(shown)
+                    ),
+                    _ => String::new(),
+                },
+                _ => String::new(),
+            };
+            eprintln!(
+                "view: load {} timings: check {:.1} ms, lower {:.2} ms, {} {:.2} ms{pipeline}, first frame {:.1} ms ({w}x{h}){edit}",
+                t.number,
+                ms(t.check),
+                ms(t.lower),
+                if matches!(self.device, Device::Cpu) { "tapes" } else { "kernel" },
+                ms(t.prepare),
+                ms(time),
+            );
+        }
+        if (w, h) == self.size {
+            self.timings = None;
+        } else if let Some(t) = self.timings.as_mut() {
+            t.printed = true;
+        }
+    }
+
+    /// The window title: the file, the problem with the last load if it failed, a render
+    /// error, and with `stats` the backend, method, frame time, steps per pixel and samples.
+    pub fn title(&self, stats: bool) -> String {
+        let mut title = format!("sdfc view: {}", self.file.display());
+        if let Some(status) = &self.status {
+            title.push_str(&format!(" | {status}"));
+        }
+        if let Some(msg) = &self.broken {
+            title.push_str(&format!(" | render error: {msg}"));
+        }
+        if let (true, Some(good), Some(f)) = (stats, &self.good, &self.last) {
+            title.push_str(&format!(
+                " | {} ({}), {}, {}x{}, {}/{} samples, {:.1} ms, {:.1} steps/px",
+                self.device.name(),
+                self.device.describe(),
+                good.method,
+                f.width,
+                f.height,
+                f.samples,
+                f.target,
+                ms(f.time),
+                f.steps
+            ));
+        }
+        title
+    }
+}
+
+/// `path` made absolute (as the watcher reports paths), or as it is.
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// The paths of the files of a compilation, in file order (the entry file first).
+fn files_of(sources: &SourceMap) -> Vec<PathBuf> {
+    (0..sources.len() as u32)
+        .map(|i| PathBuf::from(sources.name(FileId(i))))
+        .collect()
+}
+
+/// One line for the window: the first error, where it is, and how many there are.
+fn first_error(diagnostics: &[Diagnostic], sources: &SourceMap) -> String {
+    let errors: Vec<&Diagnostic> = diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .collect();
+    let Some(d) = errors.first() else {
+        return "error".into();
+    };
+    let at = d
+        .labels
+        .first()
+        .map(|l| {
+            let (line, col) = sources.line_col(l.span);
+            format!(" at {}:{line}:{col}", sources.name(l.span.file))
+        })
+        .unwrap_or_default();
+    let more = match errors.len() {
+        1 => String::new(),
+        n => format!(" (and {} more)", n - 1),
+    };
+    format!("error[{}]: {}{at}{more}", d.code, d.message)
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = "camera { position: (0, 1, -4), look_at: (0, 0.5, 0), fov: 50deg }\n\
+        light point { position: (2, 4, -3), intensity: 1 }\n\
+        render { width: 32, height: 24, aa: 2 }\n\
+        scene { plane((0, 1, 0), 0); sphere(0.5).translate(0, 0.5, 0); }\n";
+
+    fn settle(s: &mut Session) -> u32 {
+        let mut frames = 0;
+        while s.wants_frame() {
+            s.frame().expect("a CPU frame");
+            frames += 1;
+        }
+        frames
+    }
+
+    #[test]
+    fn reloads_keep_the_moved_camera_and_errors_keep_the_image() {
+        let dir = std::env::temp_dir().join(format!("sdfc-session-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("s.sdf");
+        std::fs::write(&file, SCENE).unwrap();
+        let mut s = Session::new(file.clone(), Options::default(), Device::Cpu);
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        // aa 2: four jittered samples, then nothing more to render.
+        assert_eq!(settle(&mut s), 4);
+        assert!(s.settled());
+        let first = s.image().unwrap().clone();
+
+        // The file's camera moves the view until the user moves it.
+        std::fs::write(&file, SCENE.replace("(0, 1, -4)", "(0, 1.2, -4)")).unwrap();
+        assert!(s.needs_reload(&[]));
+        assert!(s.load().ok);
+        assert!(!s.needs_reload(&[]), "nothing changed since");
+        assert_eq!(s.camera().unwrap().position, [0.0, 1.2, -4.0]);
+        s.rotate(30.0, 0.0);
+        let moved = s.camera().unwrap();
+        settle(&mut s);
+
+        // A clean reload keeps the user's camera; R returns to the file's.
+        std::fs::write(&file, SCENE.replace("sphere(0.5)", "sphere(0.6)")).unwrap();
+        let outcome = s.load();
+        assert!(outcome.ok && outcome.number == 2);
+        assert_eq!(s.camera().unwrap(), moved);
+        settle(&mut s);
+        let good = s.image().unwrap().clone();
+        assert_ne!(good, first);
+
+        // An edit with errors keeps the image and says why in the title.
+        std::fs::write(&file, SCENE.replace("sphere(0.5)", "sphre(0.5)")).unwrap();
+        let outcome = s.load();
+        assert!(!outcome.ok);
+        assert!(outcome.summary.contains("E0201"), "{}", outcome.summary);
+        assert!(s.title(false).contains("E0201"));
+        assert!(s.settled());
+        assert_eq!(s.image(), Some(&good));
+
+        // So does a file that disappears; a failed load retries on any scene file's change.
+        std::fs::remove_file(&file).unwrap();
+        assert!(s.needs_reload(&[]));
+        assert!(!s.load().ok);
+        assert_eq!(s.image(), Some(&good));
+        assert!(s.needs_reload(&[dir.join("other.sdf")]));
+        assert!(
+            !s.needs_reload(std::slice::from_ref(&file)),
+            "its contents are those it failed on"
+        );
+        s.reset_camera();
+        assert!(!s.camera_moved());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

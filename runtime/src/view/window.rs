@@ -1,0 +1,850 @@
+//! Presenting a session in a window: a winit window with a wgpu surface, on the device that
+//! renders the kernel (the adapter is the one that can present to the surface), or, where no
+//! adapter can, softbuffer and the CPU renderer; the mouse and keys that move the camera, the
+//! title line, and the screenshots of `--screenshot` and `--screenshot-dir`, read back from
+//! what is presented.
+
+use super::session::{Device, Session};
+use super::watch::Watch;
+use super::{write_rgba_png, Run};
+use crate::backend::Backend;
+use crate::gpu::Gpu;
+use crate::image::Image;
+use std::num::NonZeroU32;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use winit::application::ApplicationHandler;
+use winit::dpi::{PhysicalPosition, PhysicalSize};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{
+    ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy, OwnedDisplayHandle,
+};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+
+/// Events sent to the event loop from other threads.
+#[derive(Debug)]
+enum UserEvent {
+    /// The watcher saw these paths change.
+    Files(Vec<PathBuf>),
+}
+
+/// Runs the viewer in a window until it is closed (or `control` says to stop).
+pub fn run(run: Run) -> ExitCode {
+    let event_loop = match EventLoop::<UserEvent>::with_user_event().build() {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!(
+                "error: cannot open a window: {e}; `sdfc view --headless` runs the viewer without one"
+            );
+            return ExitCode::from(2);
+        }
+    };
+    event_loop.set_control_flow(ControlFlow::Wait);
+    let mut app = App {
+        proxy: event_loop.create_proxy(),
+        run,
+        state: None,
+        exit: ExitCode::SUCCESS,
+    };
+    if let Err(e) = event_loop.run_app(&mut app) {
+        eprintln!("error: the window's event loop failed: {e}");
+        return ExitCode::from(2);
+    }
+    app.exit
+}
+
+struct App {
+    proxy: EventLoopProxy<UserEvent>,
+    run: Run,
+    state: Option<State>,
+    exit: ExitCode,
+}
+
+impl std::fmt::Debug for App {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("App").finish_non_exhaustive()
+    }
+}
+
+/// The open window and what runs in it.
+struct State {
+    window: Arc<Window>,
+    presenter: Presenter,
+    session: Session,
+    _watch: Option<Watch>,
+    stats: bool,
+    title: String,
+    cursor: Option<PhysicalPosition<f64>>,
+    left: bool,
+    middle: bool,
+    shift: bool,
+    /// Frames presented.
+    frames: u64,
+    /// The load whose settled image is still to be written to `--screenshot-dir`.
+    shot_for: Option<u32>,
+    /// Whether the image on show has changed since it was uploaded.
+    dirty: bool,
+}
+
+impl App {
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<State, String> {
+        let (w, h) = Session::initial_size(&self.run.file, &self.run.options);
+        let attributes = Window::default_attributes()
+            .with_title(format!("sdfc view: {}", self.run.file.display()))
+            .with_inner_size(PhysicalSize::new(w, h));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .map_err(|e| format!("cannot open a window: {e}"))?,
+        );
+        let (device, presenter) = match wgpu_presenter(event_loop, &window) {
+            Ok((gpu, presenter)) => {
+                let device = match self.run.backend {
+                    Backend::Cpu => Device::Cpu,
+                    Backend::Wgpu => Device::Wgpu(gpu.clone()),
+                    // Like `sdfc render`, auto takes a hardware GPU, else the CPU renderer.
+                    _ if gpu.is_cpu() => Device::Cpu,
+                    _ => Device::Wgpu(gpu.clone()),
+                };
+                eprintln!(
+                    "view: rendering on {} ({}), presenting through wgpu on {}",
+                    device.name(),
+                    device.describe(),
+                    gpu.describe()
+                );
+                (device, Presenter::Gpu(Box::new(presenter)))
+            }
+            Err(msg) if self.run.backend == Backend::Wgpu => {
+                return Err(format!(
+                    "{msg}: install a Vulkan driver (on Linux without a GPU, Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`), or use --backend cpu"
+                ));
+            }
+            Err(msg) => {
+                let presenter = SoftPresenter::new(event_loop, &window)?;
+                eprintln!(
+                    "view: {msg}; rendering on the CPU ({}) and presenting with softbuffer",
+                    Device::Cpu.describe()
+                );
+                (Device::Cpu, Presenter::Soft(presenter))
+            }
+        };
+        let size = window.inner_size();
+        let mut session = Session::new(self.run.file.clone(), self.run.options.clone(), device);
+        session.set_size(size.width.max(1), size.height.max(1));
+        let outcome = session.load();
+        let proxy = self.proxy.clone();
+        let watch = match Watch::new(move |paths| {
+            let _ = proxy.send_event(UserEvent::Files(paths));
+        }) {
+            Ok(mut w) => {
+                for problem in w.add(session.files()) {
+                    eprintln!("warning: {problem}");
+                }
+                Some(w)
+            }
+            Err(msg) => {
+                eprintln!("warning: {msg}; the scene will not be reloaded when it changes");
+                None
+            }
+        };
+        Ok(State {
+            window,
+            presenter,
+            session,
+            _watch: watch,
+            stats: self.run.control.stats,
+            title: String::new(),
+            cursor: None,
+            left: false,
+            middle: false,
+            shift: false,
+            frames: 0,
+            shot_for: Some(outcome.number),
+            dirty: true,
+        })
+    }
+
+    fn finish(&mut self, event_loop: &ActiveEventLoop, code: ExitCode) {
+        self.exit = code;
+        event_loop.exit();
+    }
+
+    /// Renders (when the session wants a frame), presents, and writes the screenshots due.
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(st) = self.state.as_mut() else {
+            return;
+        };
+        match st.session.frame() {
+            Ok(Some(_)) => st.dirty = true,
+            Ok(None) => {}
+            Err(msg) => eprintln!("error: {msg}"),
+        }
+        if st.dirty {
+            if let Some(image) = st.session.image() {
+                st.presenter.upload(image);
+            }
+            st.dirty = false;
+        }
+        let control = &self.run.control;
+        let settled = st.session.settled();
+        let reload_shot = match (st.shot_for, &control.screenshot_dir) {
+            (Some(k), Some(dir)) if settled => Some((k, dir.join(format!("reload-{k}.png")))),
+            _ => None,
+        };
+        let last = control.frames.is_some_and(|n| st.frames + 1 >= n);
+        let final_shot = control.screenshot.clone().filter(|_| last);
+        let wanted: Vec<PathBuf> = reload_shot
+            .iter()
+            .map(|(_, p)| p.clone())
+            .chain(final_shot)
+            .collect();
+        match st.presenter.present(&wanted) {
+            Ok(true) => {
+                st.frames += 1;
+                st.session.presented();
+            }
+            Ok(false) => {
+                st.window.request_redraw();
+                return;
+            }
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                return self.finish(event_loop, ExitCode::from(1));
+            }
+        }
+        for path in &wanted {
+            eprintln!("view: wrote {}", path.display());
+        }
+        if let Some((k, _)) = reload_shot {
+            st.shot_for = None;
+            if control.exit_after_reloads == Some(k) {
+                return self.finish(event_loop, ExitCode::SUCCESS);
+            }
+        }
+        if last {
+            self.finish(event_loop, ExitCode::SUCCESS);
+        }
+    }
+}
+
+impl ApplicationHandler<UserEvent> for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.state.is_some() {
+            return;
+        }
+        match self.start(event_loop) {
+            Ok(st) => {
+                st.window.request_redraw();
+                self.state = Some(st);
+            }
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                self.finish(event_loop, ExitCode::from(2));
+            }
+        }
+    }
+
+    fn user_event(&mut self, _: &ActiveEventLoop, event: UserEvent) {
+        let Some(st) = self.state.as_mut() else {
+            return;
+        };
+        let UserEvent::Files(paths) = event;
+        if st.session.needs_reload(&paths) {
+            let outcome = st.session.load();
+            if let Some(w) = st._watch.as_mut() {
+                for problem in w.add(st.session.files()) {
+                    eprintln!("warning: {problem}");
+                }
+            }
+            st.shot_for = Some(outcome.number);
+            st.window.request_redraw();
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(st) = self.state.as_mut() else {
+            return;
+        };
+        match event {
+            WindowEvent::CloseRequested => self.finish(event_loop, ExitCode::SUCCESS),
+            WindowEvent::Resized(size) => {
+                st.presenter.resize(size.width, size.height);
+                st.session.set_size(size.width.max(1), size.height.max(1));
+                st.window.request_redraw();
+            }
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            WindowEvent::ModifiersChanged(m) => st.shift = m.state().shift_key(),
+            WindowEvent::MouseInput { state, button, .. } => {
+                let down = state == ElementState::Pressed;
+                match button {
+                    MouseButton::Left => st.left = down,
+                    MouseButton::Middle => st.middle = down,
+                    _ => {}
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if let Some(old) = st.cursor {
+                    let (dx, dy) = (position.x - old.x, position.y - old.y);
+                    if st.middle || (st.left && st.shift) {
+                        st.session.pan(dx, dy);
+                    } else if st.left {
+                        st.session.rotate(dx, dy);
+                    }
+                    if st.left || st.middle {
+                        st.window.request_redraw();
+                    }
+                }
+                st.cursor = Some(position);
+            }
+            WindowEvent::CursorLeft { .. } => st.cursor = None,
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                st.session.zoom(lines);
+                st.window.request_redraw();
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                match event.logical_key.as_ref() {
+                    Key::Character(c) if c.eq_ignore_ascii_case("r") => {
+                        st.session.reset_camera();
+                        st.window.request_redraw();
+                    }
+                    Key::Character(c) if c.eq_ignore_ascii_case("s") => st.stats = !st.stats,
+                    Key::Named(NamedKey::Tab) => st.stats = !st.stats,
+                    Key::Named(NamedKey::Escape) => self.finish(event_loop, ExitCode::SUCCESS),
+                    Key::Character(c) if c.eq_ignore_ascii_case("q") => {
+                        self.finish(event_loop, ExitCode::SUCCESS)
+                    }
+                    _ => {}
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        let Some(st) = self.state.as_mut() else {
+            return;
+        };
+        let title = st.session.title(st.stats);
+        if title != st.title {
+            st.window.set_title(&title);
+            st.title = title;
+        }
+        let control = &self.run.control;
+        if st.session.wants_frame()
+            || control.frames.is_some()
+            || (st.shot_for.is_some() && control.screenshot_dir.is_some())
+        {
+            st.window.request_redraw();
+        }
+    }
+}
+
+/// How the window shows images: through wgpu, or, where no adapter can present to it, with
+/// softbuffer (pixels copied to the window by the CPU).
+enum Presenter {
+    Gpu(Box<GpuPresenter>),
+    Soft(SoftPresenter),
+}
+
+impl Presenter {
+    fn resize(&mut self, width: u32, height: u32) {
+        match self {
+            Presenter::Gpu(p) => p.resize(width, height),
+            Presenter::Soft(p) => p.size = (width.max(1), height.max(1)),
+        }
+    }
+
+    fn upload(&mut self, image: &Image) {
+        match self {
+            Presenter::Gpu(p) => p.upload(image),
+            Presenter::Soft(p) => p.image = Some((image.width, image.height, image.to_rgba8())),
+        }
+    }
+
+    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
+        match self {
+            Presenter::Gpu(p) => p.present(shots),
+            Presenter::Soft(p) => p.present(shots),
+        }
+    }
+}
+
+/// Opens the wgpu presenter: an instance with the window's display, a surface, and an adapter
+/// that can present to it.
+fn wgpu_presenter(
+    event_loop: &ActiveEventLoop,
+    window: &Arc<Window>,
+) -> Result<(Arc<Gpu>, GpuPresenter), String> {
+    // One instance for the process, never destroyed (as `runtime/src/gpu/wgpu.rs` keeps its
+    // own): the Vulkan driver then stays loaded until the process ends.
+    static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
+    let instance = INSTANCE.get_or_init(|| {
+        let display = Box::new(event_loop.owned_display_handle());
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+            display,
+        ))
+    });
+    let surface = instance
+        .create_surface(window.clone())
+        .map_err(|e| format!("cannot make a wgpu surface for the window: {e}"))?;
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: Some(&surface),
+        apply_limit_buckets: false,
+    }))
+    .map_err(|e| format!("no wgpu adapter can present to the window ({e})"))?;
+    let gpu = Arc::new(Gpu::from_adapter(&adapter).map_err(|e| e.to_string())?);
+    let size = window.inner_size();
+    let presenter = GpuPresenter::new(gpu.clone(), surface, &adapter, size.width, size.height)?;
+    Ok((gpu, presenter))
+}
+
+/// Shows images with softbuffer: each is scaled to the window (nearest pixel) by the CPU and
+/// copied to it.
+struct SoftPresenter {
+    surface: softbuffer::Surface<OwnedDisplayHandle, Arc<Window>>,
+    size: (u32, u32),
+    /// The image's size and sRGB RGBA bytes.
+    image: Option<(u32, u32, Vec<u8>)>,
+}
+
+impl SoftPresenter {
+    fn new(event_loop: &ActiveEventLoop, window: &Arc<Window>) -> Result<SoftPresenter, String> {
+        let context = softbuffer::Context::new(event_loop.owned_display_handle())
+            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
+        let surface = softbuffer::Surface::new(&context, window.clone())
+            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
+        let size = window.inner_size();
+        Ok(SoftPresenter {
+            surface,
+            size: (size.width.max(1), size.height.max(1)),
+            image: None,
+        })
+    }
+
+    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
+        let (w, h) = self.size;
+        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
+            return Ok(false);
+        };
+        self.surface
+            .resize(nw, nh)
+            .map_err(|e| format!("cannot resize the window's buffer: {e}"))?;
+        let mut buffer = self
+            .surface
+            .buffer_mut()
+            .map_err(|e| format!("cannot draw in the window: {e}"))?;
+        for y in 0..h {
+            for x in 0..w {
+                let px = match &self.image {
+                    Some((iw, ih, rgba)) => {
+                        let (sx, sy) = (x * iw / w, y * ih / h);
+                        let i = 4 * (sy as usize * *iw as usize + sx as usize);
+                        (rgba[i] as u32) << 16 | (rgba[i + 1] as u32) << 8 | rgba[i + 2] as u32
+                    }
+                    None => 0x050505,
+                };
+                buffer[y as usize * w as usize + x as usize] = px;
+            }
+        }
+        if !shots.is_empty() {
+            let rgba: Vec<u8> = buffer
+                .iter()
+                .flat_map(|&p| [(p >> 16) as u8, (p >> 8) as u8, p as u8, 255])
+                .collect();
+            for path in shots {
+                write_rgba_png(path, w, h, &rgba)
+                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+            }
+        }
+        buffer
+            .present()
+            .map_err(|e| format!("cannot show the frame: {e}"))?;
+        Ok(true)
+    }
+}
+
+/// Draws the session's image into the window's surface: the image is uploaded to a texture
+/// (sRGB bytes) and drawn over the whole surface with a linear filter (so the smaller frames
+/// rendered while moving fill the window).
+struct GpuPresenter {
+    gpu: Arc<Gpu>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    /// Whether the surface texture can be copied from (else screenshots are drawn into a
+    /// texture of the surface's format).
+    copyable: bool,
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    texture_format: wgpu::TextureFormat,
+    image: Option<(wgpu::Texture, wgpu::BindGroup)>,
+}
+
+/// The blit: a triangle over the whole target sampling the image.
+const BLIT: &str = r#"
+@group(0) @binding(0) var image: texture_2d<f32>;
+@group(0) @binding(1) var smp: sampler;
+
+struct Out {
+    @builtin(position) position: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+};
+
+@vertex
+fn vs(@builtin(vertex_index) i: u32) -> Out {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    var o: Out;
+    o.position = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.0, 1.0);
+    o.uv = uv;
+    return o;
+}
+
+@fragment
+fn fs(o: Out) -> @location(0) vec4<f32> {
+    return vec4<f32>(textureSample(image, smp, o.uv).rgb, 1.0);
+}
+"#;
+
+/// The colour of the window before the first image (dark grey).
+const EMPTY: wgpu::Color = wgpu::Color {
+    r: 0.02,
+    g: 0.02,
+    b: 0.02,
+    a: 1.0,
+};
+
+impl GpuPresenter {
+    fn new(
+        gpu: Arc<Gpu>,
+        surface: wgpu::Surface<'static>,
+        adapter: &wgpu::Adapter,
+        width: u32,
+        height: u32,
+    ) -> Result<GpuPresenter, String> {
+        let caps = surface.get_capabilities(adapter);
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| {
+                matches!(
+                    f,
+                    wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Rgba8UnormSrgb
+                )
+            })
+            .or_else(|| {
+                caps.formats.iter().copied().find(|f| {
+                    matches!(
+                        f,
+                        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
+                    )
+                })
+            })
+            .ok_or_else(|| {
+                format!(
+                    "the window's surface offers no 8-bit RGBA format (it offers {:?})",
+                    caps.formats
+                )
+            })?;
+        let copyable = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
+        let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        if copyable {
+            usage |= wgpu::TextureUsages::COPY_SRC;
+        }
+        let config = wgpu::SurfaceConfiguration {
+            usage,
+            format,
+            width: width.max(1),
+            height: height.max(1),
+            present_mode: wgpu::PresentMode::Fifo,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: caps.alpha_modes[0],
+            view_formats: vec![],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        let device = gpu.device();
+        surface.configure(device, &config);
+        // The image holds sRGB bytes: an sRGB texture decodes them for an sRGB surface, which
+        // encodes them again; a plain one passes them through to a plain surface.
+        let texture_format = if format.is_srgb() {
+            wgpu::TextureFormat::Rgba8UnormSrgb
+        } else {
+            wgpu::TextureFormat::Rgba8Unorm
+        };
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("sdfc view blit"),
+            source: wgpu::ShaderSource::Wgsl(BLIT.into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sdfc view blit"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("sdfc view blit"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("sdfc view blit"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("sdfc view blit"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Ok(GpuPresenter {
+            gpu,
+            surface,
+            config,
+            copyable,
+            pipeline,
+            layout,
+            sampler,
+            texture_format,
+            image: None,
+        })
+    }
+
+    fn resize(&mut self, width: u32, height: u32) {
+        if width == 0 || height == 0 {
+            return;
+        }
+        self.config.width = width;
+        self.config.height = height;
+        self.surface.configure(self.gpu.device(), &self.config);
+    }
+
+    /// Uploads `image` (sRGB-encoded) as the texture to draw.
+    fn upload(&mut self, image: &Image) {
+        let device = self.gpu.device();
+        let size = wgpu::Extent3d {
+            width: image.width,
+            height: image.height,
+            depth_or_array_layers: 1,
+        };
+        let same = self
+            .image
+            .as_ref()
+            .is_some_and(|(t, _)| t.width() == image.width && t.height() == image.height);
+        if !same {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("sdfc view image"),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: self.texture_format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&Default::default());
+            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sdfc view image"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Sampler(&self.sampler),
+                    },
+                ],
+            });
+            self.image = Some((texture, bind));
+        }
+        if let Some((texture, _)) = &self.image {
+            self.gpu.queue().write_texture(
+                texture.as_image_copy(),
+                &image.to_rgba8(),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * image.width),
+                    rows_per_image: Some(image.height),
+                },
+                size,
+            );
+        }
+    }
+
+    /// Draws the image into `view`.
+    fn draw(&self, encoder: &mut wgpu::CommandEncoder, view: &wgpu::TextureView) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("sdfc view blit"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(EMPTY),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if let Some((_, bind)) = &self.image {
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.draw(0..3, 0..1);
+        }
+    }
+
+    /// Draws the image to the surface and presents it, first writing what it shows to each of
+    /// `shots` (PNG). `Ok(false)` when the surface had no texture to give this time.
+    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f) => f,
+            wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(false)
+            }
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(self.gpu.device(), &self.config);
+                return Ok(false);
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                return Err("the window's surface reported a validation error".into())
+            }
+        };
+        let device = self.gpu.device();
+        let view = frame.texture.create_view(&Default::default());
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.draw(&mut encoder, &view);
+        self.gpu.queue().submit([encoder.finish()]);
+        if !shots.is_empty() {
+            let bytes = if self.copyable {
+                self.read(&frame.texture)?
+            } else {
+                // The same draw into a texture of the surface's format and size.
+                let texture = device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("sdfc view screenshot"),
+                    size: frame.texture.size(),
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: self.config.format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                });
+                let mut encoder = device.create_command_encoder(&Default::default());
+                self.draw(&mut encoder, &texture.create_view(&Default::default()));
+                self.gpu.queue().submit([encoder.finish()]);
+                self.read(&texture)?
+            };
+            for path in shots {
+                write_rgba_png(path, self.config.width, self.config.height, &bytes)
+                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+            }
+        }
+        self.gpu.queue().present(frame);
+        Ok(true)
+    }
+
+    /// The pixels of `texture` (of the surface's format) as RGBA8 rows.
+    fn read(&self, texture: &wgpu::Texture) -> Result<Vec<u8>, String> {
+        let device = self.gpu.device();
+        let (w, h) = (texture.width(), texture.height());
+        let row = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sdfc view screenshot"),
+            size: row as u64 * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            texture.size(),
+        );
+        self.gpu.queue().submit([encoder.finish()]);
+        let slice = buffer.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| format!("reading the window back: {e}"))?;
+        rx.recv()
+            .map_err(|e| e.to_string())?
+            .map_err(|e| format!("reading the window back: {e}"))?;
+        let mapped = slice
+            .get_mapped_range()
+            .map_err(|e| format!("reading the window back: {e}"))?;
+        let bgra = matches!(
+            self.config.format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        );
+        let mut out = Vec::with_capacity(4 * w as usize * h as usize);
+        for y in 0..h as usize {
+            let start = y * row as usize;
+            for px in mapped[start..start + 4 * w as usize].chunks_exact(4) {
+                if bgra {
+                    out.extend_from_slice(&[px[2], px[1], px[0], 255]);
+                } else {
+                    out.extend_from_slice(&[px[0], px[1], px[2], 255]);
+                }
+            }
+        }
+        drop(mapped);
+        buffer.unmap();
+        Ok(out)
+    }
+}

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Runs on the GPU machine (the `device` tool), which has no display: measures the session of
+# `sdfc view --headless --backend wgpu --timings` (the window's session without the window).
+# For each scene it opens the viewer on a copy, then saves three edits one after the other, each
+# once the image of the one before has converged: a numeric edit (the first light's intensity:
+# uniform data, the pipeline is found in the cache), a structural edit (one more shape: a new
+# kernel to compile) and a radius edit where the scene has a `sphere(` (a constant written in
+# the kernel: compiled too). The viewer prints, per load, check, lower, kernel, pipeline and
+# first-frame times and the time from the file's modification to the first frame (edit to
+# pixel). Then, for the report's scenes and temple.sdf, the frame rate while orbiting at
+# $SIZE and the time to converge after the camera stops (--orbit-frames). Expects .dev/sdfc
+# and .gl/ as scripts/device-run.sh does. Writes $OUT/view.txt.
+set -u
+. "$(dirname "$0")/device-env.sh"
+SIZE=${SIZE:-1920x1080}
+SCENES=${SCENES:-"examples/*.sdf examples/scaling/*_1000.sdf"}
+LOG="$OUT/view.txt"
+: > "$LOG"
+
+wait_for() { # FILE PID: waits for FILE while PID runs, up to 120 s
+  local i=0
+  while [ ! -f "$1" ]; do
+    kill -0 "$2" 2>/dev/null || return 1
+    sleep 0.005
+    i=$((i + 1))
+    [ $i -gt 24000 ] && return 1
+  done
+}
+
+for f in $SCENES; do
+  n=$(basename "$f" .sdf)
+  d=$(mktemp -d)
+  cp -r "$(dirname "$f")/." "$d/"
+  s="$d/$(basename "$f")"
+  "$B" view "$s" --headless --backend wgpu --size "$SIZE" --timings \
+    --screenshot-dir "$d/shots" --exit-after-reloads 3 > "$d/log" 2>&1 &
+  pid=$!
+  ok=1
+  wait_for "$d/shots/reload-0.png" $pid || ok=0
+  # numeric: the first light's intensity
+  [ $ok = 1 ] && python3 - "$s" <<'PY'
+import re, sys
+p = sys.argv[1]; t = open(p).read()
+t = re.sub(r"intensity: *([0-9.]+)", lambda m: "intensity: %g" % (float(m.group(1)) * 0.9), t, count=1)
+open(p, "w").write(t)
+PY
+  [ $ok = 1 ] && { wait_for "$d/shots/reload-1.png" $pid || ok=0; }
+  # structural: one more shape, far from everything
+  [ $ok = 1 ] && python3 - "$s" <<'PY'
+import sys
+p = sys.argv[1]; t = open(p).read()
+open(p, "w").write(t.replace("scene {", "scene {\n  sphere(0.01).translate(0, 1000, 0);", 1))
+PY
+  [ $ok = 1 ] && { wait_for "$d/shots/reload-2.png" $pid || ok=0; }
+  # a radius (or, without a sphere, the intensity again)
+  [ $ok = 1 ] && python3 - "$s" <<'PY'
+import re, sys
+p = sys.argv[1]; t = open(p).read()
+u = re.sub(r"sphere\(([0-9.]+)\)(?!\.translate\(0, 1000)", lambda m: "sphere(%g)" % (float(m.group(1)) * 1.1), t, count=1)
+if u == t:
+    u = re.sub(r"intensity: *([0-9.]+)", lambda m: "intensity: %g" % (float(m.group(1)) * 0.9), t, count=1)
+open(p, "w").write(u)
+PY
+  [ $ok = 1 ] && { wait_for "$d/shots/reload-3.png" $pid || ok=0; }
+  wait $pid
+  echo "== $n (numeric, structural, radius edits)" | tee -a "$LOG"
+  grep -E "timings|full-resolution|error" "$d/log" | tee -a "$LOG"
+  [ $ok = 1 ] || { echo "$n: FAILED"; tail -n 5 "$d/log"; } | tee -a "$LOG"
+  rm -rf "$d"
+done
+
+for n in seed1 seed2 seed3 seed4 seed5 seed6 temple; do
+  echo "== orbit $n at $SIZE" | tee -a "$LOG"
+  d=$(mktemp -d)
+  timeout 120 "$B" view "examples/$n.sdf" --headless --backend wgpu --size "$SIZE" \
+    --orbit-frames 120 --screenshot-dir "$d" --exit-after-reloads 0 2>&1 | grep "orbit" | tee -a "$LOG"
+  rm -rf "$d"
+done

@@ -5,7 +5,8 @@
 # once the image of the one before has converged: a numeric edit (the first light's intensity:
 # uniform data, the pipeline is found in the cache), a structural edit (one more shape: a new
 # kernel to compile) and a radius edit where the scene has a `sphere(` (a constant written in
-# the kernel: compiled too). The viewer prints, per load, check, lower, kernel, pipeline and
+# the kernel: compiled too), each saved as editors do, by writing a new file and renaming it
+# over the old one. The viewer prints, per load, check, lower, kernel, pipeline and
 # first-frame times and the time from the file's modification to the first frame (edit to
 # pixel). Then, for the report's scenes and temple.sdf, the frame rate while orbiting at
 # $SIZE and the time to converge after the camera stops (--orbit-frames). Expects .dev/sdfc
@@ -17,14 +18,15 @@ SCENES=${SCENES:-"examples/*.sdf examples/scaling/*_1000.sdf"}
 LOG="$OUT/view.txt"
 : > "$LOG"
 
-wait_for() { # FILE PID: waits for FILE while PID runs, up to 120 s
+wait_for() { # FILE PID: waits for FILE while PID runs, up to 60 s
   local i=0
   while [ ! -f "$1" ]; do
     kill -0 "$2" 2>/dev/null || return 1
     sleep 0.005
     i=$((i + 1))
-    [ $i -gt 24000 ] && return 1
+    [ $i -gt 12000 ] && return 1
   done
+  return 0
 }
 
 for f in $SCENES; do
@@ -39,29 +41,32 @@ for f in $SCENES; do
   wait_for "$d/shots/reload-0.png" $pid || ok=0
   # numeric: the first light's intensity
   [ $ok = 1 ] && python3 - "$s" <<'PY'
-import re, sys
+import os, re, sys
 p = sys.argv[1]; t = open(p).read()
 t = re.sub(r"intensity: *([0-9.]+)", lambda m: "intensity: %g" % (float(m.group(1)) * 0.9), t, count=1)
-open(p, "w").write(t)
+open(p + ".new", "w").write(t); os.replace(p + ".new", p)
 PY
   [ $ok = 1 ] && { wait_for "$d/shots/reload-1.png" $pid || ok=0; }
   # structural: one more shape, far from everything
   [ $ok = 1 ] && python3 - "$s" <<'PY'
-import sys
+import os, sys
 p = sys.argv[1]; t = open(p).read()
-open(p, "w").write(t.replace("scene {", "scene {\n  sphere(0.01).translate(0, 1000, 0);", 1))
+t = t.replace("scene {", "scene {\n  sphere(0.01).translate(0, 1000, 0);", 1)
+open(p + ".new", "w").write(t); os.replace(p + ".new", p)
 PY
   [ $ok = 1 ] && { wait_for "$d/shots/reload-2.png" $pid || ok=0; }
   # a radius (or, without a sphere, the intensity again)
   [ $ok = 1 ] && python3 - "$s" <<'PY'
-import re, sys
+import os, re, sys
 p = sys.argv[1]; t = open(p).read()
 u = re.sub(r"sphere\(([0-9.]+)\)(?!\.translate\(0, 1000)", lambda m: "sphere(%g)" % (float(m.group(1)) * 1.1), t, count=1)
 if u == t:
     u = re.sub(r"intensity: *([0-9.]+)", lambda m: "intensity: %g" % (float(m.group(1)) * 0.9), t, count=1)
-open(p, "w").write(u)
+open(p + ".new", "w").write(u); os.replace(p + ".new", p)
 PY
   [ $ok = 1 ] && { wait_for "$d/shots/reload-3.png" $pid || ok=0; }
+  # A viewer whose edit did not arrive would wait for it: stop it.
+  [ $ok = 1 ] || kill "$pid" 2>/dev/null
   wait $pid
   echo "== $n (numeric, structural, radius edits)" | tee -a "$LOG"
   grep -E "timings|full-resolution|error" "$d/log" | tee -a "$LOG"
@@ -69,10 +74,10 @@ PY
   rm -rf "$d"
 done
 
-for n in seed1 seed2 seed3 seed4 seed5 seed6 temple; do
+for n in ${ORBIT_SCENES:-seed1 seed2 seed3 seed4 seed5 seed6 temple}; do
   echo "== orbit $n at $SIZE" | tee -a "$LOG"
   d=$(mktemp -d)
   timeout 120 "$B" view "examples/$n.sdf" --headless --backend wgpu --size "$SIZE" \
-    --orbit-frames 120 --screenshot-dir "$d" --exit-after-reloads 0 2>&1 | grep "orbit" | tee -a "$LOG"
+    --orbit-frames ${ORBIT_FRAMES:-120} --screenshot-dir "$d" --exit-after-reloads 0 2>&1 | grep "orbit" | tee -a "$LOG"
   rm -rf "$d"
 done

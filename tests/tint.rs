@@ -1,5 +1,5 @@
 //! WGSL that browsers accept: every example's kernel, and a kernel for every possible
-//! combination of the kernel template's features (645 of them), compiled by Chromium's WebGPU
+//! combination of the kernel template's features (648 of them), compiled by Chromium's WebGPU
 //! compiler (Tint, on SwiftShader).
 //!
 //! naga accepts code that Tint rejects (a literal of `f32::MAX` written as `3.4028235e38`, whose

@@ -1,14 +1,17 @@
-//! WGSL that browsers accept: every example's kernel, and a kernel for every combination of the
-//! kernel template's features, compiled by Chromium's WebGPU compiler (Tint, on SwiftShader).
+//! WGSL that browsers accept: every example's kernel, and a kernel for every possible
+//! combination of the kernel template's features (648 of them), compiled by Chromium's WebGPU
+//! compiler (Tint, on SwiftShader).
 //!
 //! naga accepts code that Tint rejects (a literal of `f32::MAX` written as `3.4028235e38`, whose
 //! exact value lies above `f32::MAX`), so this test hands the kernels to headless Chromium: a
 //! page served on 127.0.0.1 calls `createShaderModule` and `getCompilationInfo` for every kernel
-//! (Tint's front end), and `createComputePipelineAsync` (Tint's SPIR-V writer, then
-//! SwiftShader's compiler, about 0.3 s a kernel) for every example and for a set of feature
-//! combinations holding every pair of feature values, then reports each error with the
-//! kernel's name. The examples are `examples/*.sdf`, `examples/scaling/*_10.sdf` and
-//! `*_1000.sdf` (whose instances are read from `scene_data`), and `tests/in/ok/*.sdf`.
+//! (Tint's front end: parsing, resolution, validation; a few milliseconds a kernel), and
+//! `createComputePipelineAsync` (Tint's SPIR-V writer, then SwiftShader's compiler: 0.3 s to
+//! 18 s a kernel, the largest examples the slowest) for the report's six scenes (`seed*`) and
+//! for a set of feature combinations holding every pair of values of two features, then
+//! reports each error with the kernel's name. The examples are `examples/*.sdf`,
+//! `examples/scaling/*_10.sdf` and `*_1000.sdf` (whose instances are read from `scene_data`),
+//! and `tests/in/ok/*.sdf`.
 //!
 //! The browser is `$SDFC_CHROMIUM`, or `chromium` (Debian's package) on PATH. Without it, or
 //! without a WebGPU adapter, the test prints that it skipped, unless `CI=true` or

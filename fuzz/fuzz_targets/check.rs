@@ -23,7 +23,9 @@ fn limits() -> Limits {
 }
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     let mut sources = SourceMap::new();
     let entry = sources.add("fuzz.sdf", text);
     let (_scene, diags) = check_with(&mut sources, entry, &mut NoImports, &limits());

@@ -142,17 +142,29 @@ fn a_camera_looking_straight_down_sees_the_scene_and_up_rolls_it() {
     let mut rolled = scene.clone();
     rolled.camera.up = [1.0, 0.0, 0.0];
     let (rx, ry) = project(&rolled, [0.0, 0.0, 2.5]);
-    assert!(rx > 48 && ry.abs_diff(32) <= 1, "rolled marker projected to ({rx}, {ry})");
+    assert!(
+        rx > 48 && ry.abs_diff(32) <= 1,
+        "rolled marker projected to ({rx}, {ry})"
+    );
     for method in METHODS {
         let r = render_as(method, &scene);
         let lit = |(x, y): (u32, u32)| luminance(r.image.linear[(y * 64 + x) as usize]) > 0.0;
         assert!(lit((32, 32)), "{method:?}: the centre sphere is not seen");
-        assert!(lit((mx, my)), "{method:?}: the marker is not above the centre");
-        assert!(!lit((mx, 63 - my)), "{method:?}: something below the centre");
+        assert!(
+            lit((mx, my)),
+            "{method:?}: the marker is not above the centre"
+        );
+        assert!(
+            !lit((mx, 63 - my)),
+            "{method:?}: something below the centre"
+        );
         assert!(!lit((2, 2)), "{method:?}: a corner is not background");
         let r = render_as(method, &rolled);
         let lit = |(x, y): (u32, u32)| luminance(r.image.linear[(y * 64 + x) as usize]) > 0.0;
-        assert!(lit((rx, ry)), "{method:?}: rolled marker not at ({rx}, {ry})");
+        assert!(
+            lit((rx, ry)),
+            "{method:?}: rolled marker not at ({rx}, {ry})"
+        );
         assert!(!lit((mx, my)), "{method:?}: the rolled image did not roll");
     }
 }

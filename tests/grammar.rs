@@ -8,6 +8,8 @@
 //! end, so it accepts exactly the sentences of the EBNF read as a context-free grammar (which
 //! must not be left-recursive).
 
+mod common;
+
 use sdfc_compiler::check::builtins::{self, BUILTINS};
 use sdfc_compiler::span::FileId;
 use sdfc_compiler::syntax::lexer::{lex, Token};
@@ -838,33 +840,11 @@ fn the_language_reference_lists_every_signature_and_field() {
     }
 }
 
-/// The diagnostic codes (`"E0123"`, `"W0001"`) written in the Rust sources under `dir`.
-fn codes_in(dir: &Path, out: &mut BTreeSet<String>) {
-    for entry in std::fs::read_dir(dir).expect("readable").flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            codes_in(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            let text = std::fs::read_to_string(&path).expect("readable");
-            for (i, _) in text.match_indices('"') {
-                let code = text.get(i + 1..i + 6).unwrap_or("");
-                let closed = text.get(i + 6..i + 7) == Some("\"");
-                if closed
-                    && (code.starts_with('E') || code.starts_with('W'))
-                    && code[1..].chars().all(|c| c.is_ascii_digit())
-                {
-                    out.insert(code.to_string());
-                }
-            }
-        }
-    }
-}
-
 #[test]
 fn every_diagnostic_code_is_documented_with_an_example() {
     let doc = read("docs/diagnostics.md");
     let mut codes = BTreeSet::new();
-    codes_in(&root().join("compiler/src"), &mut codes);
+    common::codes_in(&root().join("compiler/src"), &mut codes);
     assert!(codes.len() > 10, "no diagnostic codes found");
     for code in codes {
         let row = doc.lines().find(|l| l.starts_with(&format!("| {code} |")));

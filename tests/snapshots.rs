@@ -3,6 +3,8 @@
 //! sm_70), and the rendered diagnostics of every `tests/in/err` and `tests/in/warn` file.
 //! Every WGSL kernel is also validated by naga (inside `back::wgsl::write`).
 
+mod common;
+
 use sdfc_compiler::{back, diagnostics, lower, scene, syntax, FileId};
 use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};
@@ -102,7 +104,7 @@ fn error_inputs() {
     }
     // Every error code the compiler can emit has an input here that produces it.
     let mut emitted = std::collections::BTreeSet::new();
-    codes_in(Path::new("../compiler/src"), &mut emitted);
+    common::codes_in(Path::new("../compiler/src"), &mut emitted);
     let missing: Vec<&String> = emitted
         .iter()
         .filter(|c| c.starts_with('E') && !codes.contains(c.as_str()))
@@ -142,29 +144,6 @@ fn warning_inputs() {
             &stem(&path),
             &format!("{source}\n----- diagnostics -----\n{rendered}"),
         );
-    }
-}
-
-/// The diagnostic codes (`"E0123"`, `"W0001"`) written as string literals in the Rust
-/// sources under `dir`.
-fn codes_in(dir: &Path, out: &mut std::collections::BTreeSet<String>) {
-    for entry in std::fs::read_dir(dir).expect("readable").flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            codes_in(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            let text = std::fs::read_to_string(&path).expect("readable");
-            for (i, _) in text.match_indices('"') {
-                let code = text.get(i + 1..i + 6).unwrap_or("");
-                let closed = text.get(i + 6..i + 7) == Some("\"");
-                if closed
-                    && (code.starts_with('E') || code.starts_with('W'))
-                    && code[1..].chars().all(|c| c.is_ascii_digit())
-                {
-                    out.insert(code.to_string());
-                }
-            }
-        }
     }
 }
 

@@ -225,3 +225,22 @@ impl ariadne::Cache<crate::span::FileId> for SourceCache<'_> {
         Some(self.0.name(*id).to_string())
     }
 }
+
+/// A number for a message: at most `decimals` decimals, no trailing zeros, no `-0`, and `∞`
+/// for an infinite value.
+pub fn number(x: f64, decimals: usize) -> String {
+    if !x.is_finite() && !x.is_nan() {
+        return if x > 0.0 { "∞".into() } else { "-∞".into() };
+    }
+    let s = format!("{x:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}

@@ -1,5 +1,5 @@
-//! Helpers shared by the integration tests: scenes built in code, random points, and a few
-//! reference formulas.
+//! Helpers shared by the integration tests: scenes built in code, random points, a few
+//! reference formulas, and the diagnostic codes the compiler's sources can emit.
 #![allow(dead_code)]
 
 use sdfc_compiler::scene::{
@@ -123,4 +123,27 @@ pub fn len2(a: f64, b: f64) -> f64 {
 
 pub fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// The diagnostic codes (`"E0123"`, `"W0001"`) written as string literals in the Rust sources
+/// under `dir`.
+pub fn codes_in(dir: &std::path::Path, out: &mut std::collections::BTreeSet<String>) {
+    for entry in std::fs::read_dir(dir).expect("readable").flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            codes_in(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let text = std::fs::read_to_string(&path).expect("readable");
+            for (i, _) in text.match_indices('"') {
+                let code = text.get(i + 1..i + 6).unwrap_or("");
+                let closed = text.get(i + 6..i + 7) == Some("\"");
+                if closed
+                    && (code.starts_with('E') || code.starts_with('W'))
+                    && code[1..].chars().all(|c| c.is_ascii_digit())
+                {
+                    out.insert(code.to_string());
+                }
+            }
+        }
+    }
 }

@@ -704,7 +704,10 @@ fn penumbra(cx: &mut Ctx, fields: &[ast::Field], f: &HashMap<&'static str, Value
     let angle = crate::scene::penumbra_of_sharpness(k);
     if !f["softness"].is_abstract() {
         let write = if k > 0.0 {
-            format!("penumbra: {}deg", short_degrees(angle.to_degrees()))
+            format!(
+                "penumbra: {}deg",
+                crate::diagnostics::number(angle.to_degrees(), 4)
+            )
         } else {
             "nothing (hard shadows are the default)".to_string()
         };
@@ -724,12 +727,6 @@ fn penumbra(cx: &mut Ctx, fields: &[ast::Field], f: &HashMap<&'static str, Value
         );
     }
     angle
-}
-
-/// Degrees with four decimals, without trailing zeros.
-fn short_degrees(d: f64) -> String {
-    let s = format!("{d:.4}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// The span of the value of the field `name` of a block, when it is given.

@@ -132,11 +132,5 @@ fn painted(scene: &Scene, m: u32) -> String {
 
 /// A number with at most three decimals and no trailing zeros.
 fn fmt(x: f64) -> String {
-    let s = format!("{x:.3}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.into()
-    }
+    crate::diagnostics::number(x, 3)
 }

@@ -854,16 +854,7 @@ fn ellipsoid(radii: V3) -> Derived {
 
 /// A number for a message: up to three decimals, no trailing zeros.
 fn fmt(x: f64) -> String {
-    if !x.is_finite() {
-        return if x > 0.0 { "∞".into() } else { "-∞".into() };
-    }
-    let s = format!("{x:.3}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.into()
-    }
+    crate::diagnostics::number(x, 3)
 }
 
 mod aabb;

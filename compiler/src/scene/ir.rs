@@ -8,6 +8,7 @@
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::span::Span;
+use glam::DVec3;
 use std::collections::HashMap;
 
 /// A 3-vector of f64.
@@ -403,44 +404,28 @@ impl Camera {
     /// aligned with the view stands in for it, so every camera has a valid basis. Computed in
     /// f64 once, for every backend.
     pub fn basis(&self) -> (V3, V3, V3) {
-        let w = normalize(sub(self.look_at, self.position));
-        let mut side = cross(w, self.up);
-        if dot(side, side) < 1e-12 * dot(self.up, self.up) {
+        let up = DVec3::from(self.up);
+        let w = unit(DVec3::from(self.look_at) - DVec3::from(self.position));
+        let mut side = w.cross(up);
+        if side.length_squared() < 1e-12 * up.length_squared() {
             // z first: of equally unaligned axes +z wins, so looking straight down the top
             // of the image is +z, as for a camera that approaches the vertical from −z.
             let axis = [2, 0, 1]
                 .into_iter()
                 .min_by(|&a, &b| w[a].abs().total_cmp(&w[b].abs()))
                 .unwrap_or(2);
-            let mut up = [0.0; 3];
-            up[axis] = 1.0;
-            side = cross(w, up);
+            side = w.cross(DVec3::AXES[axis]);
         }
-        let u = normalize(side);
-        (w, u, cross(u, w))
+        let u = unit(side);
+        (w.into(), u.into(), u.cross(w).into())
     }
 }
 
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normalize(a: V3) -> V3 {
-    let l = dot(a, a).sqrt();
+/// `a` scaled to length 1 (zero stays zero).
+fn unit(a: DVec3) -> DVec3 {
+    let l = a.length();
     if l > 0.0 {
-        [a[0] / l, a[1] / l, a[2] / l]
+        a / l
     } else {
         a
     }

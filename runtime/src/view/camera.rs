@@ -2,6 +2,7 @@
 //! camera's up direction (orbit, pan and zoom from the mouse), and the sub-pixel jitter of
 //! progressive supersampling.
 
+use glam::DVec3;
 use sdfc_compiler::scene::Camera;
 
 /// Radians of orbit per pixel dragged.
@@ -32,22 +33,22 @@ pub struct Orbit {
 
 /// The orbit's frame: (a, b, n) with n the unit up and a, b perpendicular to it; for up +y,
 /// a = +x and b = +z.
-fn frame(up: [f64; 3]) -> ([f64; 3], [f64; 3], [f64; 3]) {
-    let n = normalize(up);
-    let mut b = sub([0.0, 0.0, 1.0], scale(n, n[2]));
-    if len(b) < 1e-6 {
-        b = sub([1.0, 0.0, 0.0], scale(n, n[0]));
+fn frame(up: [f64; 3]) -> (DVec3, DVec3, DVec3) {
+    let n = DVec3::from(up).normalize_or_zero();
+    let mut b = DVec3::Z - n * n.z;
+    if b.length() < 1e-6 {
+        b = DVec3::X - n * n.x;
     }
-    let b = normalize(b);
-    (cross(n, b), b, n)
+    let b = b.normalize_or_zero();
+    (n.cross(b), b, n)
 }
 
 impl Orbit {
     /// The orbit that reproduces `camera` (its pitch clamped to the limit).
     pub fn from_camera(camera: &Camera) -> Orbit {
-        let d = sub(camera.position, camera.look_at);
-        let distance = len(d).max(1e-9);
-        let up = if len(camera.up) > 0.0 {
+        let d = DVec3::from(camera.position) - DVec3::from(camera.look_at);
+        let distance = d.length().max(1e-9);
+        let up = if DVec3::from(camera.up).length() > 0.0 {
             camera.up
         } else {
             [0.0, 1.0, 0.0]
@@ -56,8 +57,8 @@ impl Orbit {
         Orbit {
             target: camera.look_at,
             distance,
-            yaw: dot(d, a).atan2(dot(d, b)),
-            pitch: (dot(d, n) / distance)
+            yaw: d.dot(a).atan2(d.dot(b)),
+            pitch: (d.dot(n) / distance)
                 .clamp(-1.0, 1.0)
                 .asin()
                 .clamp(-PITCH_LIMIT, PITCH_LIMIT),
@@ -71,9 +72,9 @@ impl Orbit {
         let (sy, cy) = self.yaw.sin_cos();
         let (sp, cp) = self.pitch.sin_cos();
         let (a, b, n) = frame(self.up);
-        let offset = add(add(scale(a, cp * sy), scale(n, sp)), scale(b, cp * cy));
+        let offset = a * (cp * sy) + n * sp + b * (cp * cy);
         Camera {
-            position: add(self.target, scale(offset, self.distance)),
+            position: (DVec3::from(self.target) + offset * self.distance).into(),
             look_at: self.target,
             up: self.up,
             fov: self.fov,
@@ -91,8 +92,8 @@ impl Orbit {
     pub fn pan(&mut self, dx: f64, dy: f64, height: u32) {
         let (_, u, v) = self.camera().basis();
         let per_pixel = 2.0 * self.distance * (self.fov * 0.5).tan() / height.max(1) as f64;
-        let shift = add(scale(u, -dx * per_pixel), scale(v, dy * per_pixel));
-        self.target = add(self.target, shift);
+        let shift = DVec3::from(u) * (-dx * per_pixel) + DVec3::from(v) * (dy * per_pixel);
+        self.target = (DVec3::from(self.target) + shift).into();
     }
 
     /// Zooms by `lines` wheel lines (positive: closer).
@@ -114,11 +115,13 @@ pub fn jittered(camera: &Camera, dx: f64, dy: f64, width: u32, height: u32) -> C
     let aspect = width.max(1) as f64 / height.max(1) as f64;
     let bx = 2.0 * dx / width.max(1) as f64;
     let by = -2.0 * dy / height.max(1) as f64;
-    let dir = add(w, add(scale(u, bx * tan * aspect), scale(v, by * tan)));
-    let distance = len(sub(camera.look_at, camera.position));
+    let (w, u, v) = (DVec3::from(w), DVec3::from(u), DVec3::from(v));
+    let dir = w + (u * (bx * tan * aspect) + v * (by * tan));
+    let (eye, target) = (DVec3::from(camera.position), DVec3::from(camera.look_at));
+    let distance = (target - eye).length();
     Camera {
         position: camera.position,
-        look_at: add(camera.position, scale(normalize(dir), distance)),
+        look_at: (eye + dir.normalize_or_zero() * distance).into(),
         up: camera.up,
         fov: camera.fov,
     }
@@ -131,43 +134,6 @@ pub fn sample_offset(k: u32, n: u32) -> (f64, f64) {
     let k = k % (n * n);
     let at = |i: u32| (i as f64 + 0.5) / n as f64 - 0.5;
     (at(k % n), at(k / n))
-}
-
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn len(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
-}
-
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let l = len(a);
-    if l > 0.0 {
-        scale(a, 1.0 / l)
-    } else {
-        a
-    }
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 #[cfg(test)]

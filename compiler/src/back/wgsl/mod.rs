@@ -22,6 +22,7 @@ pub(crate) use map::results;
 
 use crate::lower::Program;
 use crate::scene::{Light, Pattern, Scene};
+use glam::DVec3;
 use std::collections::HashMap;
 use std::fmt;
 
@@ -378,7 +379,7 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
         } = l
         {
             w.v4(*position, if radius.is_finite() { *radius } else { 0.0 });
-            w.v4(scale(*color, *intensity), l.sharpness());
+            w.v4((DVec3::from(*color) * *intensity).into(), l.sharpness());
         }
     }
     for l in &scene.lights {
@@ -389,11 +390,8 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
             ..
         } = l
         {
-            w.v4(
-                normalize([-direction[0], -direction[1], -direction[2]]),
-                0.0,
-            );
-            w.v4(scale(*color, *intensity), l.sharpness());
+            w.v4((-DVec3::from(*direction)).normalize_or_zero().into(), 0.0);
+            w.v4((DVec3::from(*color) * *intensity).into(), l.sharpness());
         }
     }
     for m in &scene.materials {
@@ -428,18 +426,5 @@ impl Words {
         for x in v {
             self.0.extend_from_slice(&x.to_le_bytes());
         }
-    }
-}
-
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    if l > 0.0 {
-        scale(a, 1.0 / l)
-    } else {
-        a
     }
 }

@@ -9,12 +9,8 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
 
-/// How long the file system must be quiet before a batch of events is reported. Short, since
-/// it is most of the time from a save to the screen: an editor's save (a write, or a new file
-/// renamed over the old one) is over well within it, and a batch that changes no file's
-/// contents reloads nothing; a save that takes longer may show its half-written state (as
-/// an error) for a moment before the rest of it arrives.
-pub const DEBOUNCE: Duration = Duration::from_millis(10);
+/// How long the file system must be quiet before a batch of events is reported.
+pub const DEBOUNCE: Duration = Duration::from_millis(30);
 
 /// Watches directories and calls back with the paths of each debounced batch of events.
 pub struct Watch {

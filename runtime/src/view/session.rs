@@ -26,6 +26,9 @@ use std::time::{Duration, Instant, SystemTime};
 pub const FRAME_BUDGET: Duration = Duration::from_millis(33);
 /// How long after the last camera motion the camera counts as still (and samples accumulate).
 pub const SETTLE: Duration = Duration::from_millis(120);
+/// How many times a load reads files that keep changing under it before it goes on with
+/// what it read.
+const STABLE_READS: usize = 4;
 /// The largest divisor of the resolution while moving.
 pub const MAX_SCALE: u32 = 8;
 
@@ -317,13 +320,24 @@ impl Session {
                 return Err(msg);
             }
         };
-        self.files = files_of(&loaded.sources);
-        self.fingerprint = Fingerprint::from_sources(
-            self.files
-                .iter()
-                .zip(0..)
-                .map(|(f, i)| (f.clone(), loaded.sources.text(FileId(i)).as_bytes())),
-        );
+        // Files that changed while they were read (an editor saving in place truncates, then
+        // writes) are read again: a load stands on contents still there after it was read.
+        for _ in 0..STABLE_READS {
+            self.files = files_of(&loaded.sources);
+            self.fingerprint = Fingerprint::from_sources(
+                self.files
+                    .iter()
+                    .zip(0..)
+                    .map(|(f, i)| (f.clone(), loaded.sources.text(FileId(i)).as_bytes())),
+            );
+            if !self.fingerprint.changed() {
+                break;
+            }
+            match frontend::load_with(&self.file, &limits) {
+                Ok(again) => loaded = again,
+                Err(_) => break,
+            }
+        }
         frontend::report(&loaded, DiagnosticFormat::Human);
         let Some(mut scene) = loaded.scene.take() else {
             return Err(first_error(&loaded.diagnostics, &loaded.sources));

@@ -9,7 +9,8 @@ mod common;
 use common::*;
 use sdfc_compiler::back::{rust, wgsl};
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower_with, LowerOptions, Op, Program};
+use sdfc_compiler::lower::{lower_with, LowerOptions};
+use sdfc_compiler::program::{Op, Program};
 use sdfc_compiler::scene::{Method, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision};
 use sdfc_runtime::frontend;
@@ -261,9 +262,9 @@ fn executed(program: &Program, p: [f32; 3]) -> usize {
 }
 
 fn step(program: &Program, regs: &[f32], i: usize, p: [f32; 3]) -> f32 {
-    use sdfc_compiler::eval::scalar;
-    use sdfc_compiler::lower::Axis;
-    let r = |x: sdfc_compiler::lower::Reg| regs[x.0 as usize];
+    use sdfc_compiler::program::scalar;
+    use sdfc_compiler::program::Axis;
+    let r = |x: sdfc_compiler::program::Reg| regs[x.0 as usize];
     match program.ops()[i] {
         Op::Const(c) => c as f32,
         Op::Input(Axis::X) => p[0],

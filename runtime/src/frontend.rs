@@ -3,7 +3,8 @@
 
 use sdfc_compiler::check::{self, Loader};
 use sdfc_compiler::diagnostics::{self, Diagnostic};
-use sdfc_compiler::lower::{self, LowerOptions, Program};
+use sdfc_compiler::lower::{self, LowerOptions};
+use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::Scene;
 use sdfc_compiler::{Limits, SourceMap};
 use std::io::IsTerminal;

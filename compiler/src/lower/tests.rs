@@ -4,9 +4,7 @@
 
 use super::bounds::Bounds;
 use super::graph::field_and_bound;
-use super::{Op, Program};
-use crate::eval::{scalar, Float};
-use crate::lower::Axis;
+use crate::program::{scalar, Axis, Float, Op, Program, Reg};
 use crate::scene::{Combine, Graph, MaterialId, Node, NodeId, Smooth};
 use crate::{FileId, Span};
 
@@ -15,7 +13,7 @@ use crate::{FileId, Span};
 fn eval<T: Float>(program: &Program, p: [T; 3]) -> (T, T) {
     let mut regs: Vec<T> = Vec::with_capacity(program.len());
     for op in program.ops() {
-        let r = |x: super::Reg| regs[x.0 as usize];
+        let r = |x: Reg| regs[x.0 as usize];
         let v = match *op {
             Op::Const(c) => T::from_f64(c),
             Op::Input(Axis::X) => p[0],

@@ -27,7 +27,7 @@ use crate::image::Image;
 use context::Context;
 use rayon::prelude::*;
 use sdfc_compiler::eval::{Float, Outputs, Tape};
-use sdfc_compiler::lower::Program;
+use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::{Scene, Settings};
 use tile::{Rect, Workspace};
 

@@ -18,9 +18,7 @@ mod template;
 pub use analytic::MAX_UNROLLED;
 pub use map::{float, write_map, write_sdf};
 
-pub(crate) use map::results;
-
-use crate::lower::Program;
+use crate::program::Program;
 use crate::scene::{Light, Pattern, Scene};
 use glam::DVec3;
 use std::collections::HashMap;

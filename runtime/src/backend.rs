@@ -4,7 +4,7 @@
 
 use crate::cpu::{self, Options, Precision, Render, Tapes};
 use crate::gpu::{self, cuda::Cuda, Gpu};
-use crate::memory::Memory;
+use crate::memory::{self, Memory};
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower;
 use sdfc_compiler::program::Program;
@@ -444,4 +444,14 @@ fn describe(s: &wgsl::Specialisation) -> String {
         },
         s.max_depth
     )
+}
+
+impl memory::Footprint for Prepared {
+    fn memory(&self, scene: &Scene, settings: &Settings) -> Memory {
+        Prepared::memory(self, scene, settings)
+    }
+
+    fn retained(&self, settings: &Settings) -> u64 {
+        Prepared::retained(self, settings)
+    }
 }

@@ -1,11 +1,12 @@
 //! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps, and
 //! for GPU targets the achieved fraction of the FP32 floor).
 
-use super::render::{override_settings, parse_size, thread_pool, Backend};
+use super::render::{thread_pool, Backend};
 use crate::backend::{Prepared, Setup};
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
+use crate::settings::{override_settings, parse_size};
 use sdfc_compiler::lower::LowerOptions;
 use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::{analytic, Scene};

@@ -3,13 +3,14 @@
 //! reference render (PSNR, and first-hit differences where both have depth buffers), marks the
 //! Pareto front and draws the chart (`crate::chart`).
 
-use super::render::{self, override_settings, parse_size, thread_pool, Backend};
+use super::render::{self, thread_pool, Backend};
 use crate::backend::{Prepared, Setup};
 use crate::chart::{self, Chart};
 use crate::cpu::reference::{self, Convergence};
 use crate::cpu::{Precision, Render};
 use crate::frontend::{self, DiagnosticFormat};
 use crate::metrics::{self, DepthDifference};
+use crate::settings::{self, override_settings, parse_size};
 use sdfc_compiler::lower::LowerOptions;
 use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::{Method, Scene, Settings};
@@ -107,7 +108,7 @@ impl Key {
 
     /// Sets the value in `s`, checking its range as `--set` does.
     pub fn set(self, s: &mut Settings, v: f64, limits: &Limits) -> Result<(), String> {
-        render::set(s, self.name(), &format!("{v}"), limits)
+        settings::set(s, self.name(), &format!("{v}"), limits)
     }
 
     /// Whether the values are whole numbers.

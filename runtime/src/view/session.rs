@@ -7,12 +7,11 @@
 use super::camera::{self, Orbit};
 use super::watch::Fingerprint;
 use crate::backend::{Prepared, Setup};
-use crate::commands::check;
-use crate::commands::render::override_settings;
 use crate::frontend::{self, DiagnosticFormat, Loaded};
 use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
 use crate::image::Image;
+use crate::settings::override_settings;
 use sdfc_compiler::back::wgsl;
 use sdfc_compiler::lower::{self, LowerOptions};
 use sdfc_compiler::scene::analytic::{self, Choice};
@@ -355,8 +354,8 @@ impl Session {
         eprintln!(
             "{}: ok; {}; {}",
             self.file.display(),
-            check::summary(&loaded, &scene),
-            check::method(&loaded, &scene)
+            frontend::summary(&loaded, &scene),
+            frontend::method(&loaded, &scene)
         );
         let check_time = start.elapsed();
         let start = Instant::now();

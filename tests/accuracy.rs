@@ -97,7 +97,12 @@ fn sphere_scene(w: u32, h: u32) -> sdfc_compiler::scene::Scene {
 #[test]
 fn cpu_renders_carry_first_hit_depths() {
     let scene = sphere_scene(33, 33);
-    let r = cpu::render(&scene, &lower(&scene), &Options::default(), &|| {});
+    let r = cpu::render(
+        &scene,
+        &sdfc_compiler::lower::Lowered::new(&scene),
+        &Options::default(),
+        &|| {},
+    );
     let d = r.depth.expect("the CPU renderer fills in depth");
     assert_eq!((d.width, d.height, d.samples), (33, 33, 1));
     // The centre ray meets the sphere 4 units from the eye, within the hit tolerance ε·t.
@@ -114,7 +119,12 @@ fn cpu_renders_carry_first_hit_depths() {
     // are a quarter pixel off centre, where the sphere is a little farther).
     let mut aa = scene.clone();
     aa.settings.aa = 2;
-    let r2 = cpu::render(&aa, &lower(&aa), &Options::default(), &|| {});
+    let r2 = cpu::render(
+        &aa,
+        &sdfc_compiler::lower::Lowered::new(&aa),
+        &Options::default(),
+        &|| {},
+    );
     let d2 = r2.depth.expect("depth");
     assert_eq!(d2.samples, 4);
     assert!(d2
@@ -140,7 +150,14 @@ fn depth_buffers_are_identical_whatever_the_number_of_threads() {
             .num_threads(threads)
             .build()
             .expect("pool");
-        pool.install(|| cpu::render(&scene, &lower(&scene), &Options::default(), &|| {}))
+        pool.install(|| {
+            cpu::render(
+                &scene,
+                &sdfc_compiler::lower::Lowered::new(&scene),
+                &Options::default(),
+                &|| {},
+            )
+        })
     };
     let (a, b) = (render(1), render(3));
     let (da, db) = (a.depth.expect("depth"), b.depth.expect("depth"));

@@ -21,7 +21,6 @@
 
 use rayon::prelude::*;
 use sdfc_compiler::back::wgsl::{self, Options};
-use sdfc_compiler::lower;
 use sdfc_runtime::frontend;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, BufReader, Read, Write};
@@ -136,9 +135,9 @@ fn example_jobs() -> Vec<Job> {
         let scene = loaded
             .scene
             .unwrap_or_else(|| panic!("{} has errors", path.display()));
-        let program = lower::lower(&scene);
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
         let kernel =
-            wgsl::write(&scene, &program).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            wgsl::write(&scene, &lowered).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let name = path
             .strip_prefix("..")
             .unwrap_or(path)
@@ -301,8 +300,8 @@ fn combo_jobs() -> Vec<Job> {
             let (text, options) = combo.scene();
             let (scene, diags, _) = sdfc_compiler::check::check_str("features.sdf", &text);
             let scene = scene.unwrap_or_else(|| panic!("{}:\n{text}\n{diags:?}", combo.name()));
-            let program = lower::lower(&scene);
-            let kernel = wgsl::write_with(&scene, &program, &options)
+            let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+            let kernel = wgsl::write_with(&scene, &lowered, &options)
                 .unwrap_or_else(|e| panic!("{}: {e}", combo.name()));
             assert!(
                 combo_of(&kernel) == combo,

@@ -6,9 +6,9 @@ use crate::cpu::{self, Options, Precision, Render, Tapes};
 use crate::gpu::{self, cuda::Cuda, Gpu};
 use crate::memory::{self, Memory};
 use sdfc_compiler::back::{ptx, wgsl};
-use sdfc_compiler::lower;
+use sdfc_compiler::lower::{self, LowerOptions, Lowered};
 use sdfc_compiler::program::Program;
-use sdfc_compiler::scene::analytic::{self, Choice};
+use sdfc_compiler::scene::analytic::{self, Choice, Traceable};
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -46,17 +46,17 @@ pub enum Prepared {
         options: Options,
     },
     /// wgpu: the device (which may be shared, as the viewer shares its window's), the
-    /// validated kernel and the scene's Lipschitz bound L (and the program and setup, to
-    /// specialise the kernel again for other settings).
+    /// validated kernel and the scene's Lipschitz bound L (and the lowered scene and setup,
+    /// to specialise the kernel again for other settings).
     Wgpu {
         gpu: Arc<Gpu>,
         kernel: Box<wgsl::Kernel>,
         lipschitz: f64,
-        program: Box<Program>,
+        lowered: Box<Lowered>,
         setup: Setup,
     },
     /// CUDA: the device, the loaded module, the kernel's scene data, the settings it was
-    /// specialised for and the scene's Lipschitz bound L (and the program and setup, to
+    /// specialised for and the scene's Lipschitz bound L (and the lowered scene and setup, to
     /// specialise the kernel again for other settings).
     Cuda {
         cuda: Box<Cuda>,
@@ -65,7 +65,7 @@ pub enum Prepared {
         specialisation: wgsl::Specialisation,
         ptx_time: Duration,
         lipschitz: f64,
-        program: Box<Program>,
+        lowered: Box<Lowered>,
         setup: Setup,
     },
 }
@@ -90,10 +90,16 @@ pub struct Frame {
 }
 
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
-/// does not allow it, saying why.
+/// does not allow it, saying why (before lowering: `sdfc render` refuses such settings
+/// first).
 pub fn method_allowed(scene: &Scene) -> Result<(), String> {
+    traceable_with(scene, &analytic::traceable(scene))
+}
+
+/// [`method_allowed`] for a scene whose primitives the lowering found (`traceable`).
+fn traceable_with(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
     if scene.settings.method == Method::Trace {
-        if let Choice::March(reason) = analytic::choose(scene) {
+        if let Choice::March(reason) = traceable.choose(scene.settings.method) {
             return Err(format!(
                 "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
                 reason.describe()
@@ -110,99 +116,98 @@ impl Prepared {
             precision,
             ..Setup::default()
         };
-        Self::from_program(backend, scene, lower::lower(scene), &setup)
+        let lowered = lower::lower_scene(scene, &LowerOptions::default());
+        Self::from_program(backend, scene, lowered, &setup)
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for `backend`.
+    /// Prepares `scene`, lowered as `lowered` (its program and what else the backends
+    /// read), for `backend`.
     pub fn from_program(
         backend: Backend,
         scene: &Scene,
-        program: Program,
+        lowered: Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        method_allowed(scene)?;
+        traceable_with(scene, &lowered.traceable)?;
         match backend {
-            Backend::Cpu => Ok(Self::cpu(scene, program, setup)),
-            Backend::Wgpu => Self::wgpu(scene, &program, setup, false),
-            Backend::Cuda => Self::cuda(scene, &program, setup),
-            Backend::Auto if setup.precision == Precision::F64 => {
-                Ok(Self::cpu(scene, program, setup))
-            }
-            Backend::Auto => Self::cuda(scene, &program, setup)
-                .or_else(|_| Self::wgpu(scene, &program, setup, true))
-                .or_else(|_| Ok(Self::cpu(scene, program, setup))),
+            Backend::Cpu => Ok(Self::cpu(lowered, setup)),
+            Backend::Wgpu => Self::wgpu(scene, &lowered, setup, false),
+            Backend::Cuda => Self::cuda(scene, &lowered, setup),
+            Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(lowered, setup)),
+            Backend::Auto => Self::cuda(scene, &lowered, setup)
+                .or_else(|_| Self::wgpu(scene, &lowered, setup, true))
+                .or_else(|_| Ok(Self::cpu(lowered, setup))),
         }
     }
 
-    fn cpu(scene: &Scene, program: Program, setup: &Setup) -> Prepared {
+    fn cpu(lowered: Lowered, setup: &Setup) -> Prepared {
         let options = Options {
             precision: setup.precision,
             debug_nan: setup.debug_nan,
-            lipschitz: program.lipschitz(),
+            lipschitz: lowered.program.lipschitz(),
             ..Options::default()
         };
         Prepared::Cpu {
-            tapes: Box::new(Tapes::for_scene(scene, &program)),
-            program,
+            tapes: Box::new(Tapes::new(&lowered)),
+            program: lowered.program,
             options,
         }
     }
 
-    fn kernel(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Kernel, String> {
+    fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, String> {
         let options = wgsl::Options {
             debug_nan: setup.debug_nan,
             ..wgsl::Options::default()
         };
-        wgsl::write_with(scene, program, &options).map_err(|e| e.to_string())
+        wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())
     }
 
     fn wgpu(
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
         require_hardware: bool,
     ) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
-        Self::on_gpu(Arc::new(gpu), scene, program, setup)
+        Self::on_gpu(Arc::new(gpu), scene, lowered, setup)
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for wgpu on an already opened
-    /// device: generates and validates the kernel (its pipeline is compiled, or found in the
+    /// Prepares `scene`, lowered as `lowered`, for wgpu on an already opened device:
+    /// generates and validates the kernel (its pipeline is compiled, or found in the
     /// device's cache, at the first render or by [`Gpu::pipeline_for`]).
     pub fn on_gpu(
         gpu: Arc<Gpu>,
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        method_allowed(scene)?;
-        let lipschitz = program.lipschitz();
+        traceable_with(scene, &lowered.traceable)?;
         Ok(Prepared::Wgpu {
             gpu,
-            kernel: Box::new(Self::kernel(scene, program, setup)?),
-            lipschitz,
-            program: Box::new(program.clone()),
+            kernel: Box::new(Self::kernel(scene, lowered, setup)?),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
             setup: *setup,
         })
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for the CPU renderer.
-    pub fn on_cpu(scene: &Scene, program: Program, setup: &Setup) -> Result<Prepared, String> {
-        method_allowed(scene)?;
-        Ok(Self::cpu(scene, program, setup))
+    /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
+    pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
+        traceable_with(scene, &lowered.traceable)?;
+        Ok(Self::cpu(lowered, setup))
     }
 
-    fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {
+    fn cuda(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<Prepared, String> {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
-        let module = Self::cuda_module(&cuda, scene, program, setup)?;
+        let module = Self::cuda_module(&cuda, scene, lowered, setup)?;
         Ok(Prepared::Cuda {
             cuda: Box::new(cuda),
             loaded: Box::new(module.loaded),
             data: module.data,
             specialisation: module.specialisation,
             ptx_time: module.ptx_time,
-            lipschitz: program.lipschitz(),
-            program: Box::new(program.clone()),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
             setup: *setup,
         })
     }
@@ -211,10 +216,10 @@ impl Prepared {
     fn cuda_module(
         cuda: &Cuda,
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
     ) -> Result<CudaModule, String> {
-        let kernel = Self::kernel(scene, program, setup)?;
+        let kernel = Self::kernel(scene, lowered, setup)?;
         let start = Instant::now();
         let options = ptx::Options {
             sm: cuda.sm,
@@ -251,16 +256,16 @@ impl Prepared {
         if self.specialisation().is_none_or(|s| s == wanted) {
             return Ok(());
         }
-        method_allowed(scene)?;
         match self {
             Prepared::Cpu { .. } => Ok(()),
             Prepared::Wgpu {
                 kernel,
-                program,
+                lowered,
                 setup,
                 ..
             } => {
-                **kernel = Self::kernel(scene, program, setup)?;
+                traceable_with(scene, &lowered.traceable)?;
+                **kernel = Self::kernel(scene, lowered, setup)?;
                 Ok(())
             }
             Prepared::Cuda {
@@ -269,12 +274,13 @@ impl Prepared {
                 data,
                 specialisation,
                 ptx_time,
-                program,
+                lowered,
                 setup,
                 ..
             } => {
+                traceable_with(scene, &lowered.traceable)?;
                 // The same device and context; the new module replaces the old one.
-                let module = Self::cuda_module(cuda, scene, program, setup)?;
+                let module = Self::cuda_module(cuda, scene, lowered, setup)?;
                 **loaded = module.loaded;
                 *data = module.data;
                 *specialisation = module.specialisation;
@@ -362,10 +368,20 @@ impl Prepared {
     }
 
     /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
-    pub fn program_len(&self, scene: &Scene) -> usize {
+    pub fn program_len(&self) -> usize {
         match self {
             Prepared::Cpu { program, .. } => program.len(),
-            _ => lower::lower(scene).len(),
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => {
+                lowered.program.len()
+            }
+        }
+    }
+
+    /// The scene's primitives, or why it cannot be traced analytically, as lowered.
+    pub fn traceable(&self) -> &Traceable {
+        match self {
+            Prepared::Cpu { tapes, .. } => tapes.traceable(),
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => &lowered.traceable,
         }
     }
 

@@ -4,8 +4,7 @@
 
 use sdfc_compiler::check::{self, Loader};
 use sdfc_compiler::diagnostics::{self, Diagnostic};
-use sdfc_compiler::lower::{self, LowerOptions};
-use sdfc_compiler::program::Program;
+use sdfc_compiler::lower::{self, LowerOptions, Lowered};
 use sdfc_compiler::scene::analysis::{self, Analysis};
 use sdfc_compiler::scene::analytic::{self, Choice, Reason};
 use sdfc_compiler::scene::{Exactness, Scene};
@@ -132,9 +131,9 @@ impl Checked {
     /// Lowers the scene within `limits` ([`lower::lower_within`]). A program larger than the
     /// `program` limit is reported (E0507) and gives exit code 1, before any back end or
     /// render starts.
-    pub fn lower(&self, options: &LowerOptions, limits: &Limits) -> Result<Program, ExitCode> {
+    pub fn lower(&self, options: &LowerOptions, limits: &Limits) -> Result<Lowered, ExitCode> {
         match lower::lower_within(&self.scene, options, limits) {
-            Ok(program) => Ok(program),
+            Ok(lowered) => Ok(lowered),
             Err(d) => {
                 print_diagnostics(&[d], &self.sources, self.format);
                 Err(ExitCode::from(1))

@@ -275,7 +275,6 @@ impl Builder {
             distance: d,
             material: m,
             lipschitz: 1.0,
-            options: super::LowerOptions::default(),
         };
         let (live, live_blocks) = if self.optimise {
             raw.live(&[d, m])
@@ -323,7 +322,6 @@ impl Builder {
             distance: new_index[d.0 as usize],
             material: new_index[m.0 as usize],
             lipschitz: 1.0,
-            options: super::LowerOptions::default(),
         }
     }
 }

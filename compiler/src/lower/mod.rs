@@ -20,18 +20,135 @@ mod tests;
 
 /// The program's types, at the path they had when they were defined here.
 pub use crate::program::{
-    axis_name, binary_name, op_text, unary_name, Axis, Binary, Block, Item, LowerOptions, Note, Op,
-    Program, Reg, Unary,
+    axis_name, binary_name, op_text, unary_name, Axis, Binary, Block, Item, Note, Op, Program, Reg,
+    Unary,
 };
-pub use instances::{split, Instance, Split};
+pub use instances::{Instance, Split};
 pub use media::{media, Media};
 
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
-use crate::scene::{analysis, Graph, NodeId, Scene};
+use crate::scene::analysis::{self, Analysis};
+use crate::scene::analytic::{traceable, Choice, Traceable};
+use crate::scene::{Graph, NodeId, Scene, Settings};
 
 /// The distance a program reports for a scene with no objects: far beyond any `max_dist`.
 pub const EMPTY_DISTANCE: f64 = 1e30;
+
+/// How a scene is lowered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LowerOptions {
+    /// Optimisation level: 0 lowers the scene literally (no folding, sharing, dead-code
+    /// removal, scene simplification or culling); 1 runs every pass.
+    pub level: u8,
+    /// At level 1: whether unions get bounding-volume culling (guarded blocks). Turning it
+    /// off keeps every other pass, and the same order of evaluation, so that the two
+    /// programs compute bit-identical results.
+    pub cull: bool,
+    /// At level 1: local bounds. Each operand of the scene's unions, intersections and
+    /// subtractions (and the root) whose L exceeds 1 is divided by its own L and raised to
+    /// the distance to its bounding volume (`docs/analysis.md`, "Local bounds"), so that the
+    /// program is a bound with L = 1 and only rays near such an operand step shorter. Off,
+    /// the program is the field as written and renderers step by the scene's L everywhere.
+    pub local: bool,
+}
+
+impl Default for LowerOptions {
+    fn default() -> Self {
+        LowerOptions::level(1)
+    }
+}
+
+impl LowerOptions {
+    /// The options of an optimisation level (culling on at level 1).
+    pub fn level(level: u8) -> Self {
+        LowerOptions {
+            level,
+            cull: level > 0,
+            local: level > 0,
+        }
+    }
+}
+
+/// A scene lowered for rendering, once: its distance program, what decides whether it is ray
+/// traced analytically (the `method` setting picks, [`Lowered::choice`]), the programs rays
+/// inside glass need, and the simplified scene the program came from, from which a back end
+/// that walks the root union's instances as data splits them off ([`Lowered::instances`]).
+#[derive(Debug, Clone)]
+pub struct Lowered {
+    /// The scene's distance program (a traced scene has one too: the placement warnings,
+    /// statistics and the viewer read its field).
+    pub program: Program,
+    /// The scene's primitives, or why it cannot be traced analytically.
+    pub traceable: Traceable,
+    /// Where glass may overlap an opaque solid, the medium's and the solids' programs.
+    pub media: Option<Media>,
+    /// At level 1, the simplified scene the program was lowered from.
+    simplified: Option<Simplified>,
+    /// The options the program was lowered with.
+    options: LowerOptions,
+}
+
+impl Lowered {
+    /// Lowers a checked scene for rendering with every optimisation pass ([`lower_scene`]).
+    pub fn new(scene: &Scene) -> Lowered {
+        lower_scene(scene, &LowerOptions::default())
+    }
+
+    /// How the scene is rendered with `settings` (its `method`): the primitives to trace, or
+    /// why it is marched.
+    pub fn choice(&self, settings: &Settings) -> Choice {
+        self.traceable.choose(settings.method)
+    }
+
+    /// The options the program was lowered with.
+    pub fn options(&self) -> LowerOptions {
+        self.options
+    }
+
+    /// The program without the root union's instances, and those instances, when there are
+    /// more than `more_than` of them (and the program is optimised: level 0 keeps the scene as
+    /// written). The rest is lowered from the simplified scene the program came from.
+    pub fn instances(&self, more_than: usize) -> Option<Split> {
+        instances::split(self.simplified.as_ref()?, &self.options, more_than)
+    }
+}
+
+/// The simplified scene a level-1 lowering walked, with what it derived of it.
+#[derive(Debug, Clone)]
+struct Simplified {
+    /// The simplified graph and its root, with the checked scene's materials, lights, camera
+    /// and settings.
+    scene: Scene,
+    /// For every simplified node, the checked scene's node it comes from.
+    origin: Vec<NodeId>,
+    /// The analysis of `scene`.
+    analysis: Analysis,
+    /// The bounds of `scene`'s nodes.
+    bounds: bounds::Bounds,
+}
+
+/// Lowers a checked scene for rendering ([`Lowered`]) with the given options.
+pub fn lower_scene(scene: &Scene, options: &LowerOptions) -> Lowered {
+    let (program, _, simplified) = lower_capped(scene, options, usize::MAX);
+    lowered(scene, program, simplified, options)
+}
+
+/// The [`Lowered`] of `scene` around its program.
+fn lowered(
+    scene: &Scene,
+    program: Program,
+    simplified: Option<Simplified>,
+    options: &LowerOptions,
+) -> Lowered {
+    Lowered {
+        program,
+        traceable: traceable(scene),
+        media: media(scene),
+        simplified,
+        options: *options,
+    }
+}
 
 /// Lowers a checked scene to its distance program, with every optimisation pass.
 pub fn lower(scene: &Scene) -> Program {
@@ -46,9 +163,9 @@ pub fn lower_within(
     scene: &Scene,
     options: &LowerOptions,
     limits: &Limits,
-) -> Result<Program, Diagnostic> {
+) -> Result<Lowered, Diagnostic> {
     let Some(root) = scene.root else {
-        return Ok(lower_with(scene, options));
+        return Ok(lower_scene(scene, options));
     };
     let expansion = scene
         .graph
@@ -58,9 +175,9 @@ pub fn lower_within(
     }
     let max = limits.get(Limit::Program);
     let cap = usize::try_from(max).unwrap_or(usize::MAX);
-    let (program, over) = lower_capped(scene, options, cap);
+    let (program, over, simplified) = lower_capped(scene, options, cap);
     if !over && program.len() as u64 <= max {
-        return Ok(program);
+        return Ok(lowered(scene, program, simplified, options));
     }
     Err(Diagnostic::error(
         "E0507",
@@ -80,10 +197,18 @@ pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
 }
 
 /// [`lower_with`], stopping once more than `cap` instructions were emitted; the flag says
-/// whether it stopped (the program is then incomplete).
-fn lower_capped(scene: &Scene, options: &LowerOptions, cap: usize) -> (Program, bool) {
+/// whether it stopped (the program is then incomplete). At level 1 the simplified scene
+/// comes with it.
+fn lower_capped(
+    scene: &Scene,
+    options: &LowerOptions,
+    cap: usize,
+) -> (Program, bool, Option<Simplified>) {
     match scene.root {
-        _ if options.level == 0 => lower_literal(scene, options, cap),
+        _ if options.level == 0 => {
+            let (program, over) = lower_literal(scene, cap);
+            (program, over, None)
+        }
         Some(root) => {
             let simple = simplify::simplify(&scene.graph, root);
             lower_simple(
@@ -100,7 +225,8 @@ fn lower_capped(scene: &Scene, options: &LowerOptions, cap: usize) -> (Program, 
 }
 
 /// Lowers the simplified graph `graph` below `root` (for the scene's camera and settings),
-/// `origin` naming the original node of each simplified one.
+/// `origin` naming the original node of each simplified one; with a root, the simplified
+/// scene comes with the program.
 fn lower_simple(
     scene: &Scene,
     graph: Graph,
@@ -108,10 +234,11 @@ fn lower_simple(
     origin: &[NodeId],
     options: &LowerOptions,
     cap: usize,
-) -> (Program, bool) {
+) -> (Program, bool, Option<Simplified>) {
     let mut b = builder::Builder::capped(true, cap);
     let p = b.input_point();
     let mut lipschitz = 1.0;
+    let mut simplified = None;
     let (d, m) = match root {
         Some(root) => {
             // The analysis of the simplified graph, whose nodes the lowering walks.
@@ -135,15 +262,22 @@ fn lower_simple(
                 local: options.local,
             };
             let field = graph::Lowerer::new(&simple_scene.graph, &mut b, config).node(root, p);
+            simplified = Some(Simplified {
+                scene: simple_scene,
+                origin: origin.to_vec(),
+                analysis,
+                bounds,
+            });
             (field.d, field.m)
         }
         None => (b.c(EMPTY_DISTANCE), b.c(graph::UNPAINTED)),
     };
-    finish(b, d, m, lipschitz, options)
+    let (program, over) = finish(b, d, m, lipschitz);
+    (program, over, simplified)
 }
 
 /// Lowers the scene as written (level 0).
-fn lower_literal(scene: &Scene, options: &LowerOptions, cap: usize) -> (Program, bool) {
+fn lower_literal(scene: &Scene, cap: usize) -> (Program, bool) {
     let mut b = builder::Builder::capped(false, cap);
     let p = b.input_point();
     let mut lipschitz = 1.0;
@@ -165,23 +299,16 @@ fn lower_literal(scene: &Scene, options: &LowerOptions, cap: usize) -> (Program,
         }
         None => (b.c(EMPTY_DISTANCE), b.c(graph::UNPAINTED)),
     };
-    finish(b, d, m, lipschitz, options)
+    finish(b, d, m, lipschitz)
 }
 
 /// Paints what is unpainted with material 0 and ends the program.
-fn finish(
-    mut b: builder::Builder,
-    d: Reg,
-    m: Reg,
-    lipschitz: f64,
-    options: &LowerOptions,
-) -> (Program, bool) {
+fn finish(mut b: builder::Builder, d: Reg, m: Reg, lipschitz: f64) -> (Program, bool) {
     b.note("result: unpainted shapes get the default material 0".into());
     let m = b.paint(m, 0.0);
     let over = b.over();
     let program = Program {
         lipschitz,
-        options: *options,
         ..b.finish(d, m)
     };
     (program, over)

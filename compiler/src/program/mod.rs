@@ -169,16 +169,9 @@ pub struct Program {
     pub(crate) distance: Reg,
     pub(crate) material: Reg,
     pub(crate) lipschitz: f64,
-    pub(crate) options: LowerOptions,
 }
 
 impl Program {
-    /// The options the program was lowered with (a back end that lowers part of the scene
-    /// again, [`split`](crate::lower::split), uses the same).
-    pub fn options(&self) -> LowerOptions {
-        self.options
-    }
-
     /// The L a renderer steps with (`f / L` is a distance bound): 1 for a program with local
     /// bounds, else the scene's L ([`Analysis::step_lipschitz`]).
     ///
@@ -250,40 +243,5 @@ impl Program {
             }
         }
         out
-    }
-}
-
-/// How a scene is lowered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct LowerOptions {
-    /// Optimisation level: 0 lowers the scene literally (no folding, sharing, dead-code
-    /// removal, scene simplification or culling); 1 runs every pass.
-    pub level: u8,
-    /// At level 1: whether unions get bounding-volume culling (guarded blocks). Turning it
-    /// off keeps every other pass, and the same order of evaluation, so that the two
-    /// programs compute bit-identical results.
-    pub cull: bool,
-    /// At level 1: local bounds. Each operand of the scene's unions, intersections and
-    /// subtractions (and the root) whose L exceeds 1 is divided by its own L and raised to
-    /// the distance to its bounding volume (`docs/analysis.md`, "Local bounds"), so that the
-    /// program is a bound with L = 1 and only rays near such an operand step shorter. Off,
-    /// the program is the field as written and renderers step by the scene's L everywhere.
-    pub local: bool,
-}
-
-impl Default for LowerOptions {
-    fn default() -> Self {
-        LowerOptions::level(1)
-    }
-}
-
-impl LowerOptions {
-    /// The options of an optimisation level (culling on at level 1).
-    pub fn level(level: u8) -> Self {
-        LowerOptions {
-            level,
-            cull: level > 0,
-            local: level > 0,
-        }
     }
 }

@@ -12,7 +12,7 @@ use crate::frontend::{self, DiagnosticFormat};
 use crate::metrics::{self, DepthDifference};
 use crate::settings::{self, override_settings, parse_size};
 use sdfc_compiler::lower::LowerOptions;
-use sdfc_compiler::program::Program;
+use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use sdfc_compiler::{Limit, Limits};
 use std::path::PathBuf;
@@ -419,11 +419,11 @@ pub fn run(args: ParetoArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let program = match checked.lower(&LowerOptions::default(), &limits) {
+    let lowered = match checked.lower(&LowerOptions::default(), &limits) {
         Ok(p) => p,
         Err(code) => return code,
     };
-    let report = match pool.install(|| measure(&args, &checked.scene, program, points, &limits)) {
+    let report = match pool.install(|| measure(&args, &checked.scene, lowered, points, &limits)) {
         Ok(r) => r,
         Err(msg) => {
             eprintln!("error: {msg}");
@@ -476,7 +476,7 @@ fn finish(args: &ParetoArgs, report: &Report) -> ExitCode {
 fn measure(
     args: &ParetoArgs,
     scene: &Scene,
-    program: Program,
+    lowered: Lowered,
     mut points: Vec<Settings>,
     limits: &Limits,
 ) -> Result<Report, String> {
@@ -488,9 +488,9 @@ fn measure(
         precision: args.precision,
         debug_nan: false,
     };
-    let mut prepared = Prepared::from_program(args.backend, scene, program.clone(), &setup)
+    let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
-    let (reference_scene, reference_prepared) = reference_setup(scene, program, &points)?;
+    let (reference_scene, reference_prepared) = reference_setup(scene, lowered, &points)?;
     // The reference frame is held while each point renders.
     let held = reference_prepared.retained(&reference_scene.settings);
     let reference_memory =
@@ -570,7 +570,7 @@ pub fn describe(s: &Settings) -> String {
 /// on the CPU in f64.
 fn reference_setup(
     scene: &Scene,
-    program: Program,
+    lowered: Lowered,
     points: &[Settings],
 ) -> Result<(Scene, Prepared), String> {
     let aa = points
@@ -589,7 +589,7 @@ fn reference_setup(
         precision: Precision::F64,
         debug_nan: false,
     };
-    let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, program, &setup)?;
+    let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
     Ok((reference_scene, prepared))
 }
 

@@ -18,7 +18,7 @@ mod template;
 pub use analytic::MAX_UNROLLED;
 pub use map::{float, write_map, write_sdf};
 
-use crate::program::Program;
+use crate::lower::Lowered;
 use crate::scene::{Light, Pattern, Scene};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -34,7 +34,7 @@ pub const STATS_WORDS: u32 = 8;
 
 const TEMPLATE: &str = include_str!("kernel.wgsl");
 
-/// The most instances (`lower::split`) of a marched scene's root union written as code: beyond,
+/// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
 /// they are read from `scene_data` and walked in a loop. The code grows with the scene (the
 /// CUDA JIT of a marched kernel of 10 000 spheres takes minutes), but up to a few thousand
 /// instances it is the faster of the two: its culling visits the nearer half first and
@@ -188,14 +188,14 @@ impl Default for Options {
     }
 }
 
-/// Writes and validates the kernel for `scene`, whose distance program is `program`.
-pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
-    write_with(scene, program, &Options::default())
+/// Writes and validates the kernel for `scene`, lowered as `lowered`.
+pub fn write(scene: &Scene, lowered: &Lowered) -> Result<Kernel, Error> {
+    write_with(scene, lowered, &Options::default())
 }
 
 /// [`write`] with the given options.
-pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result<Kernel, Error> {
-    let choice = crate::scene::analytic::choose(scene);
+pub fn write_with(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Kernel, Error> {
+    let choice = lowered.choice(&scene.settings);
     let mut features = features(scene, choice.primitives().is_some());
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
     // Listed in the header only when on, so that the default kernel does not change.
@@ -214,11 +214,9 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
             bytes
         }
         None => {
-            let (mut text, bytes) = marched(scene, program, options.max_instances);
+            let (mut text, bytes) = marched(scene, lowered, options.max_instances);
             // Rays inside glass that may overlap a solid march the scene's media.
-            let media = on["REFRACTION"]
-                .then(|| crate::lower::media(scene))
-                .flatten();
+            let media = lowered.media.as_ref().filter(|_| on["REFRACTION"]);
             on.insert("MEDIA", media.is_some());
             if let Some(m) = media {
                 features.push(("MEDIA", true));
@@ -274,8 +272,10 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
 /// `fn map` and `fn sdf` of a marched scene: the program as code, or, when its root union has
 /// more than `max_instances` instances, the rest of it as code and the instances as
 /// `scene_data` (march.rs), unless their materials or their bytes do not fit.
-fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, Option<Vec<u8>>) {
-    let split = crate::lower::split(scene, &program.options(), max_instances)
+fn marched(scene: &Scene, lowered: &Lowered, max_instances: usize) -> (String, Option<Vec<u8>>) {
+    let program = &lowered.program;
+    let split = lowered
+        .instances(max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {
             let data = march::data(&s.instances, scene.camera.position);

@@ -93,6 +93,10 @@ pub fn check_with(
         // Distance semantics: warnings where a construct makes the field unreliable.
         let analysis = crate::scene::analysis::analyse(&scene);
         cx.diags.extend_from_slice(analysis.diagnostics());
+        // A field with no proven bound has detail below any ε: unless the file asks for one,
+        // ε follows the pixel footprint (docs/accuracy.md, "Fields without a bound").
+        scene.settings.footprint =
+            !cx.epsilon_given && analysis.root().is_some_and(|root| !root.proven);
         analytic_method(&mut cx, &scene);
     }
     if !crate::diagnostics::has_errors(&cx.diags) {
@@ -615,6 +619,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 .iter()
                 .find(|f| f.name.name == "method")
                 .map(|f| f.value.span);
+            cx.epsilon_given = b.fields.iter().any(|f| f.name.name == "epsilon");
             let int = |k: &str| f[k].num() as u32;
             scene.settings = Settings {
                 width: int("width"),
@@ -622,6 +627,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 aa: int("aa"),
                 max_steps: int("max_steps"),
                 epsilon: f["epsilon"].num(),
+                footprint: false,
                 max_depth: int("max_depth"),
                 max_dist: f["max_dist"].num(),
                 relaxation: f["relaxation"].num(),

@@ -556,6 +556,7 @@ fn a_field_without_a_proven_bound_gets_the_pixel_footprints_epsilon() {
     // seed6's Mandelbulb has no proven bound and the file gives no ε: ε is tan(fov/2)/height.
     let mut scene = example("seed6.sdf");
     assert!(scene.settings.footprint);
+    assert_eq!(scene.settings.relaxation, 1.0, "no over-relaxation without a bound");
     let footprint = (scene.camera.fov / 2.0).tan() / scene.settings.height as f64;
     assert!(close(scene.epsilon(), footprint));
     scene.settings.height *= 2;
@@ -566,7 +567,7 @@ fn a_field_without_a_proven_bound_gets_the_pixel_footprints_epsilon() {
     // A proven field keeps the default ε; so does an ε the file or `--set` gives.
     let proven = example("seed3.sdf");
     assert!(!proven.settings.footprint);
-    assert_eq!(proven.epsilon(), 1e-5);
+    assert_eq!((proven.epsilon(), proven.settings.relaxation), (1e-5, 1.4));
     let limits = sdfc_compiler::Limits::default();
     sdfc_runtime::commands::render::set(&mut scene.settings, "epsilon", "1e-4", &limits)
         .expect("a valid ε");

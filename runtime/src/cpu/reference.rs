@@ -105,8 +105,14 @@ pub struct Convergence {
     pub depth: Option<DepthDifference>,
     /// Camera and secondary rays of the reference that ran out of steps.
     pub budget_misses: u64,
-    /// Whether PSNR ≥ [`CONVERGED_PSNR`] and no ray ran out of steps.
+    /// Whether PSNR ≥ [`CONVERGED_PSNR`] and the rays that ran out of steps amount to less
+    /// than one pixel (fewer than aa² of them: none at aa 1).
     pub converged: bool,
+}
+
+/// The samples of one pixel (aa²) of settings `s`.
+fn samples_per_pixel(s: &Settings) -> u64 {
+    u64::from(s.aa.max(1)).pow(2)
 }
 
 /// Compares the render of the reference `scene` with its check render (rendered with
@@ -136,7 +142,7 @@ pub fn convergence(scene: &Scene, reference: &Render, check: &Render) -> Converg
         difference,
         depth,
         budget_misses,
-        converged: difference.psnr >= CONVERGED_PSNR && budget_misses == 0,
+        converged: difference.psnr >= CONVERGED_PSNR && budget_misses < samples_per_pixel(settings),
     }
 }
 
@@ -167,9 +173,10 @@ impl fmt::Display for Convergence {
         }
         write!(
             f,
-            "\nconverged       {} ({} rays out of steps; needs PSNR ≥ {CONVERGED_PSNR} dB and none)",
+            "\nconverged       {} ({} rays out of steps; needs PSNR ≥ {CONVERGED_PSNR} dB and fewer than {}, one pixel's samples)",
             if self.converged { "yes" } else { "no" },
-            self.budget_misses
+            self.budget_misses,
+            self.aa * self.aa
         )
     }
 }

@@ -75,8 +75,8 @@ const AGREEMENT: &[(&str, f64, f64)] = &[
     ("seed3", 50.0, 0.0007),       // 53.9 dB, 0.0002 (1 px)
     ("seed4", 48.0, 0.0009),       // 51.5 dB, 0.0003 (2 px)
     ("seed5", 63.0, 0.0005),       // 66.2 dB, 0.0000 (0 px)
-    ("seed6", 52.0, 0.0007),       // 55.2 dB, 0.0002 (1 px)
-    ("temple", 54.0, 0.0007),      // 57.8 dB, 0.0002 (1 px)
+    ("seed6", 100.0, 0.0005), // 125.5 dB, 0 px (ε of the pixel footprint since issue 24: nearly identical; bound kept far below)
+    ("temple", 54.0, 0.0007), // 57.8 dB, 0.0002 (1 px)
 ];
 
 #[test]

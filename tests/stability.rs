@@ -221,7 +221,7 @@ fn render_global(scene: &Scene, lipschitz: f64) -> Render {
 
 /// The f64 reference: ε = 1e-6, 100 000 steps, no over-relaxation, steps of f / `lipschitz`.
 fn render_reference(scene: &Scene, lipschitz: f64) -> Render {
-    let settings: Settings = reference::settings(&scene.settings);
+    let settings: Settings = reference::settings(&scene.settings, true);
     let scene = Scene {
         settings,
         ..scene.clone()

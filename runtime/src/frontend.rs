@@ -183,8 +183,13 @@ pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
     match facts.exactness {
         Exactness::Exact | Exactness::Bound => format!("distance field: {word} (L = {})", num(l)),
         Exactness::Approximate if !root.proven => format!(
-            "distance field: {word}, no bound proven{cause}; steps with L = {}",
-            num(step)
+            "distance field: {word}, no bound proven{cause}; steps with L = {}{}",
+            num(step),
+            if scene.settings.footprint {
+                "; ε follows the pixel footprint"
+            } else {
+                ""
+            }
         ),
         Exactness::Approximate if step < l => format!(
             "distance field: {word}, L = {}{cause}, clamped to {}; divided out locally",

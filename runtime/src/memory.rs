@@ -79,14 +79,16 @@ pub trait Footprint {
 }
 
 /// The most a `sdfc render` of `scene` allocates on `prepared`: the render; with
-/// `reference`, the finished frame held while its convergence check renders; then the frame
+/// `reference`, the finished frame held while its convergence check (which may sample more)
+/// renders; then the frame
 /// held while its outputs are written.
 pub fn render(prepared: &impl Footprint, scene: &Scene, reference: bool, aux: bool) -> Memory {
     let s = &scene.settings;
     let frame = prepared.memory(scene, s);
     let held = prepared.retained(s);
     let check = if reference {
-        frame.host.saturating_add(held)
+        let finer = crate::cpu::reference::check_settings(s);
+        prepared.memory(scene, &finer).host.saturating_add(held)
     } else {
         0
     };

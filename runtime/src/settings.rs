@@ -67,7 +67,10 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
         "aa" => s.aa = limited(Limit::Aa, 1)?,
         "max_steps" => s.max_steps = limited(Limit::MaxSteps, 1)?,
         "max_depth" => s.max_depth = limited(Limit::MaxDepth, 0)?,
-        "epsilon" => s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?,
+        "epsilon" => {
+            s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?;
+            s.footprint = false;
+        }
         "max_dist" => s.max_dist = real(key, value, |v| v > 0.0, "a positive number")?,
         "relaxation" => {
             s.relaxation = real(

@@ -11,6 +11,7 @@ use crate::cpu::{Precision, Render};
 use crate::frontend::{self, DiagnosticFormat};
 use crate::metrics::{self, DepthDifference};
 use crate::settings::{self, override_settings, parse_size};
+use sdfc_compiler::diagnostics::scientific;
 use sdfc_compiler::lower::LowerOptions;
 use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::{Method, Scene, Settings};
@@ -556,13 +557,19 @@ fn same(a: &Settings, b: &Settings) -> bool {
     [Key::Epsilon, Key::MaxSteps, Key::Relaxation, Key::Aa]
         .iter()
         .all(|k| k.get(a) == k.get(b))
+        && a.footprint == b.footprint
 }
 
-/// `ε 1e-4, 256 steps, ω 1, aa 1`.
+/// `ε 1e-4, 256 steps, ω 1, aa 1` (`ε footprint, …` where ε follows the pixel footprint).
 pub fn describe(s: &Settings) -> String {
+    let epsilon = if s.footprint {
+        "footprint".to_string()
+    } else {
+        format!("{:e}", s.epsilon)
+    };
     format!(
-        "ε {:e}, {} steps, ω {}, aa {}",
-        s.epsilon, s.max_steps, s.relaxation, s.aa
+        "ε {epsilon}, {} steps, ω {}, aa {}",
+        s.max_steps, s.relaxation, s.aa
     )
 }
 
@@ -580,11 +587,12 @@ fn reference_setup(
         .unwrap_or(scene.settings.aa);
     let mut reference_scene = scene.clone();
     // The most exact render the scene allows: analytic tracing where it can be traced.
-    reference_scene.settings = reference::settings(&Settings {
+    reference_scene.settings = Settings {
         aa,
         method: Method::Auto,
         ..scene.settings.clone()
-    });
+    };
+    reference_scene.settings = reference::settings_of(&reference_scene);
     let setup = Setup {
         precision: Precision::F64,
         debug_nan: false,
@@ -607,8 +615,10 @@ fn reference_render(
         eprintln!("warning: {}", render::not_converged(&convergence));
     }
     eprintln!(
-        "reference: aa {aa}, {seconds:.1} s; agrees with ε {:e} to {:.2} dB",
-        convergence.check_epsilon, convergence.difference.psnr
+        "reference: aa {aa}, {seconds:.1} s; agrees with ε {}, aa {} to {:.2} dB",
+        scientific(convergence.check_epsilon),
+        convergence.check_aa,
+        convergence.difference.psnr
     );
     Ok((
         frame.render,
@@ -647,7 +657,7 @@ fn measure_one(
         _ => None,
     };
     Ok(Measured {
-        epsilon: settings.epsilon,
+        epsilon: point.epsilon(),
         max_steps: settings.max_steps,
         relaxation: settings.relaxation,
         aa: settings.aa,
@@ -743,25 +753,28 @@ pub fn chart_of(r: &Report, target: f64) -> Chart {
         .find(|m| m.default)
         .map(|m| {
             format!(
-                "scene's settings: ε {:e}, {} steps, ω {}",
-                m.epsilon, m.max_steps, m.relaxation
+                "scene's settings: ε {}, {} steps, ω {}",
+                scientific(m.epsilon),
+                m.max_steps,
+                m.relaxation
             )
         })
         .unwrap_or_else(|| "scene's settings".into());
     Chart {
         title: format!("{name}: speed against accuracy ({} points)", r.points.len()),
         subtitle: format!(
-            "{} on {}, {} {}x{}, median of {} frames; reference: CPU f64, ε {:e}, {} steps, aa {}; it agrees with ε {:e} to {:.1} dB{}",
+            "{} on {}, {} {}x{}, median of {} frames; reference: CPU f64, ε {}, {} steps, aa {}; it agrees with ε {}, aa {} to {:.1} dB{}",
             r.backend,
             r.device,
             r.precision,
             r.width,
             r.height,
             r.frames,
-            c.epsilon,
+            scientific(c.epsilon),
             c.max_steps,
             r.reference.aa,
-            c.check_epsilon,
+            scientific(c.check_epsilon),
+            c.check_aa,
             c.difference.psnr,
             if c.converged { "" } else { " (not converged)" }
         ),

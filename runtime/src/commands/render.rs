@@ -54,8 +54,9 @@ pub struct RenderArgs {
     pub threads: Option<usize>,
     /// Render the reference: on the CPU in f64 with ε 1e-6, 100000 steps and no
     /// over-relaxation (`--set` still applies on top), then check it against a render with ε
-    /// ten times smaller; `--stats` prints how well they agree, and a warning says when they
-    /// do not.
+    /// ten times smaller; for a field with no proven bound, the area average of at least 8×8
+    /// samples at the pixel footprint's ε, checked against twice the samples per axis.
+    /// `--stats` prints how well they agree, and a warning says when they do not.
     #[arg(long)]
     pub reference: bool,
     /// Also write the depth and hit buffers as a sidecar file beside the image (OUT.aux; see
@@ -92,10 +93,10 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let settings = &mut checked.scene.settings;
     if args.reference {
-        *settings = reference::settings(settings);
+        checked.scene.settings = reference::settings_of(&checked.scene);
     }
+    let settings = &mut checked.scene.settings;
     if let Err(msg) = override_settings(settings, args.size, args.aa, &args.set, &limits) {
         eprintln!("error: {msg}");
         return ExitCode::from(2);
@@ -247,7 +248,8 @@ fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
     }
 }
 
-/// Renders the convergence check of a reference frame (ε divided by ten) and compares.
+/// Renders the convergence check of a reference frame (ε divided by ten, or twice the samples
+/// per axis for an area-averaged reference) and compares.
 pub fn check_reference(
     prepared: &Prepared,
     scene: &Scene,
@@ -256,18 +258,15 @@ pub fn check_reference(
     let mut finer = scene.clone();
     finer.settings = reference::check_settings(&scene.settings);
     let check = prepared.render(&finer, &|_| {})?;
-    Ok(reference::convergence(
-        &scene.settings,
-        &frame.render,
-        &check.render,
-    ))
+    Ok(reference::convergence(scene, &frame.render, &check.render))
 }
 
 /// The warning printed for a reference that did not converge.
 pub fn not_converged(c: &Convergence) -> String {
     format!(
-        "the reference has not converged: against ε {:e} it reaches {:.1} dB (needs {} dB), max difference {:.3}, and {} rays ran out of {} steps; its error is not far below the errors it would measure",
-        c.check_epsilon,
+        "the reference has not converged: against ε {}, aa {} it reaches {:.1} dB (needs {} dB), max difference {:.3}, and {} rays ran out of {} steps; its error is not far below the errors it would measure",
+        sdfc_compiler::diagnostics::scientific(c.check_epsilon),
+        c.check_aa,
         c.difference.psnr,
         reference::CONVERGED_PSNR,
         c.difference.max,

@@ -87,7 +87,7 @@ impl<T: Float> Context<T> {
         let transparent = materials.iter().any(|m| m.transparency > T::zero());
         Context {
             camera: Pinhole::new(&scene.camera, s),
-            epsilon: T::from_f64(s.epsilon),
+            epsilon: T::from_f64(scene.epsilon()),
             max_dist: T::from_f64(s.max_dist),
             max_steps: s.max_steps.max(1),
             max_depth: s.max_depth,

@@ -359,7 +359,7 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
     w.v4(v, 0.0);
     w.f([tan * aspect, tan, s.width as f64, s.height as f64]);
     w.f([
-        s.epsilon,
+        scene.epsilon(),
         s.max_dist,
         s.relaxation.max(1.0),
         1.0 / lipschitz.max(1.0),

@@ -13,4 +13,5 @@ pub mod image;
 pub mod memory;
 pub mod metrics;
 pub mod output;
+pub mod sequence;
 pub mod view;

@@ -669,3 +669,39 @@ fn job_array_files_parse() {
     }
     assert!(o.status.success(), "{}", text(&o));
 }
+
+#[test]
+fn bench_times_a_sequence_and_counts_its_kernels() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let o = sdfc(
+        &root,
+        &[
+            "bench",
+            "--frames-per-second",
+            "--backend",
+            "cpu",
+            "--size",
+            "64x48",
+            "--sequence",
+            "0..5",
+            "--json",
+            "examples/animation/orbit.sdf",
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    let t = &v[0];
+    assert_eq!(t["timed"], 4);
+    assert_eq!(
+        (t["width"].as_u64(), t["height"].as_u64()),
+        (Some(64), Some(48))
+    );
+    // Only the camera moves: one program, one preparation for the whole sequence.
+    assert_eq!(t["kernels"], 1, "{t}");
+    assert!(t["frames_per_s"].as_f64().unwrap() > 0.0);
+    // A scene without a duration needs --sequence.
+    let d = dir("bench");
+    std::fs::write(d.join("still.sdf"), format!("{BASE}scene {{ sphere(1); }}")).unwrap();
+    let o = sdfc(&d, &["bench", "--frames-per-second", "still.sdf"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}

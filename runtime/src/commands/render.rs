@@ -146,10 +146,35 @@ pub struct FrameScene {
     pub program: sdfc_compiler::lower::Program,
 }
 
+/// The settings a command overrides in every frame it checks.
+#[derive(Debug, Clone, Copy)]
+pub struct Overrides<'a> {
+    /// `--reference`: the reference render's settings first.
+    pub reference: bool,
+    /// `--size`.
+    pub size: Option<(u32, u32)>,
+    /// `--aa`.
+    pub aa: Option<u32>,
+    /// `--set`, in order.
+    pub set: &'a [String],
+}
+
+impl RenderArgs {
+    /// The settings `render` overrides.
+    pub fn overrides(&self) -> Overrides<'_> {
+        Overrides {
+            reference: self.reference,
+            size: self.size,
+            aa: self.aa,
+            set: &self.set,
+        }
+    }
+}
+
 /// Checks `source` at `time`, prints its diagnostics (warnings only when `warnings`), applies
 /// `--reference`, `--size`, `--aa` and `--set`, and lowers it.
 pub fn frame_scene(
-    args: &RenderArgs,
+    args: Overrides,
     source: &mut frontend::Source,
     limits: &Limits,
     time: f64,
@@ -199,17 +224,17 @@ pub fn prepare(
     Ok((scene, prepared))
 }
 
-/// What a render of `scene` on `prepared` allocates, announced (when `announce`) and held
-/// to the `memory` limit.
+/// What a render of `scene` on `prepared` allocates (with the reference's check and the
+/// depth sidecar when asked), announced (when `announce`) and held to the `memory` limit.
 pub fn check_memory(
     pool: &rayon::ThreadPool,
     prepared: &Prepared,
     scene: &Scene,
-    args: &RenderArgs,
+    (reference, aux): (bool, bool),
     limits: &Limits,
     announce: bool,
 ) -> Result<(), CliError> {
-    let needed = pool.install(|| memory::render(prepared, scene, args.reference, args.aux));
+    let needed = pool.install(|| memory::render(prepared, scene, reference, aux));
     if announce {
         eprintln!(
             "{}",
@@ -223,7 +248,7 @@ pub fn check_memory(
 fn still(args: &RenderArgs) -> Result<(), CliError> {
     let limits = args.limits.limits();
     let mut source = frontend::Source::read(&args.file).map_err(CliError::Usage)?;
-    let frame = frame_scene(args, &mut source, &limits, 0.0, true)?;
+    let frame = frame_scene(args.overrides(), &mut source, &limits, 0.0, true)?;
     let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
     // The output is checked before any work, so that a render is never thrown away.
     let out = output(args).map_err(CliError::Usage)?;
@@ -233,7 +258,14 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         debug_nan: args.debug_nan,
     };
     let (scene, prepared) = prepare(&pool, backend, frame, &setup)?;
-    check_memory(&pool, &prepared, &scene, args, &limits, true)?;
+    check_memory(
+        &pool,
+        &prepared,
+        &scene,
+        (args.reference, args.aux),
+        &limits,
+        true,
+    )?;
     let started = Instant::now();
     let frame = pool
         .install(|| render_with_progress(&prepared, &scene))

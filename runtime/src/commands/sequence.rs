@@ -33,7 +33,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let mut source = Source::read(&args.file).map_err(CliError::Usage)?;
     // The animation's settings are the same at every time (E0406): read them at t = 0.
-    let first = frame_scene(args, &mut source, &limits, 0.0, true)?;
+    let first = frame_scene(args.overrides(), &mut source, &limits, 0.0, true)?;
     let animation = first.scene.animation;
     let fps = match args.fps {
         Some(f) if f.is_finite() && (0.01..=1000.0).contains(&f) => f,
@@ -88,35 +88,47 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         todo.len()
     );
     let bar = progress(mine.len() as u64, skipped as u64);
-    let mut state = State {
-        pool: &pool,
-        backend,
-        setup,
-        prepared: None,
-        kernels: 0,
-        still: None,
-    };
+    let mut kernels = Kernels::new(&pool, backend, setup);
+    // The image of a scene that does not read `t`, rendered once.
+    let mut still: Option<Image> = None;
     let mut first = Some(first);
     let started = Instant::now();
     for (n, &k) in todo.iter().enumerate() {
         let time = Animation::time_of(fps, k);
         let frame = match first.take().filter(|_| time == 0.0) {
             Some(f) => f,
-            None => frame_scene(args, &mut source, &limits, time, false).map_err(|e| {
-                if let Some(b) = &bar {
-                    b.abandon();
-                }
-                match e {
-                    CliError::Reported(code) => {
-                        eprintln!("error: frame {k} (t = {time} s) has errors");
-                        CliError::Reported(code)
+            None => {
+                frame_scene(args.overrides(), &mut source, &limits, time, false).map_err(|e| {
+                    if let Some(b) = &bar {
+                        b.abandon();
                     }
-                    other => other,
-                }
-            })?,
+                    match e {
+                        CliError::Reported(code) => {
+                            eprintln!("error: frame {k} (t = {time} s) has errors");
+                            CliError::Reported(code)
+                        }
+                        other => other,
+                    }
+                })?
+            }
         };
         let frame_started = Instant::now();
-        let image = state.render(frame, args, &limits, n == 0)?;
+        let image = match &still {
+            Some(image) => image.clone(),
+            None => {
+                let (scene, prepared) = kernels.prepare(frame)?;
+                check_memory(&pool, prepared, &scene, (false, false), &limits, n == 0)?;
+                let image = pool
+                    .install(|| prepared.render(&scene, &|_| {}))
+                    .map_err(CliError::Failed)?
+                    .render
+                    .image;
+                if !animation.animated() {
+                    still = Some(image.clone());
+                }
+                image
+            }
+        };
         sink.write(k, &image)?;
         let seconds = frame_started.elapsed().as_secs_f64();
         match &bar {
@@ -138,10 +150,10 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         if todo.len() == 1 { "" } else { "s" },
         path.display(),
         todo.len() as f64 / seconds.max(1e-9),
-        state.kernels,
-        if state.kernels == 1 { "" } else { "s" },
-        match &state.prepared {
-            Some((_, _, p)) => format!(" ({} on {})", p.name(), p.device()),
+        kernels.count,
+        if kernels.count == 1 { "" } else { "s" },
+        match kernels.last() {
+            Some(p) => format!(" ({} on {})", p.name(), p.device()),
             None => String::new(),
         }
     );
@@ -211,37 +223,54 @@ fn progress(len: u64, done: u64) -> Option<ProgressBar> {
     })
 }
 
-/// The prepared kernel of the frames so far.
-struct State<'a> {
+/// The backend prepared for the frames of a sequence: prepared again only when a frame's
+/// distance program (or the origin it is written relative to) differs from the last one's.
+pub struct Kernels<'a> {
     pool: &'a rayon::ThreadPool,
     backend: crate::backend::Backend,
     setup: Setup,
     /// The last frame's program and scene origin, and the backend prepared for them.
     prepared: Option<(Program, [f64; 3], Prepared)>,
     /// Kernels (or CPU tapes) prepared so far.
-    kernels: usize,
-    /// The image of a scene that does not read `t`, rendered once.
-    still: Option<Image>,
+    pub count: usize,
+    /// Time spent preparing them.
+    pub time: std::time::Duration,
 }
 
-impl State<'_> {
-    /// Renders one frame, preparing the backend again only when the distance program (or
-    /// the origin it is written relative to) changed.
-    fn render(
-        &mut self,
-        frame: FrameScene,
-        args: &RenderArgs,
-        limits: &Limits,
-        first: bool,
-    ) -> Result<Image, CliError> {
-        if let Some(image) = &self.still {
-            return Ok(image.clone());
+impl std::fmt::Debug for Kernels<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Kernels")
+            .field("count", &self.count)
+            .finish()
+    }
+}
+
+impl<'a> Kernels<'a> {
+    /// No kernel yet.
+    pub fn new(
+        pool: &'a rayon::ThreadPool,
+        backend: crate::backend::Backend,
+        setup: Setup,
+    ) -> Self {
+        Kernels {
+            pool,
+            backend,
+            setup,
+            prepared: None,
+            count: 0,
+            time: std::time::Duration::ZERO,
         }
+    }
+
+    /// The backend prepared for `frame` (the last one when its program is the same,
+    /// specialised again if its settings need it), and the frame's scene.
+    pub fn prepare(&mut self, frame: FrameScene) -> Result<(Scene, &Prepared), CliError> {
+        let started = Instant::now();
         let same = self
             .prepared
             .as_ref()
             .is_some_and(|(p, o, _)| *p == frame.program && *o == frame.scene.origin);
-        let scene: Scene = if same {
+        let scene = if same {
             let FrameScene { scene, .. } = frame;
             let (_, _, prepared) = self.prepared.as_mut().expect("prepared");
             prepared.specialise(&scene).map_err(CliError::Failed)?;
@@ -249,21 +278,18 @@ impl State<'_> {
         } else {
             let program = frame.program.clone();
             let (scene, prepared) = prepare(self.pool, self.backend, frame, &self.setup)?;
-            self.kernels += 1;
+            self.count += 1;
             self.prepared = Some((program, scene.origin, prepared));
             scene
         };
+        self.time += started.elapsed();
         let (_, _, prepared) = self.prepared.as_ref().expect("prepared");
-        check_memory(self.pool, prepared, &scene, args, limits, first)?;
-        let rendered = self
-            .pool
-            .install(|| prepared.render(&scene, &|_| {}))
-            .map_err(CliError::Failed)?;
-        let image = rendered.render.image;
-        if !scene.animation.animated() {
-            self.still = Some(image.clone());
-        }
-        Ok(image)
+        Ok((scene, prepared))
+    }
+
+    /// The backend last prepared.
+    pub fn last(&self) -> Option<&Prepared> {
+        self.prepared.as_ref().map(|(_, _, p)| p)
     }
 }
 

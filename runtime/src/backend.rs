@@ -33,6 +33,10 @@ pub struct Setup {
     pub precision: Precision,
     /// Paint pixels whose rays met a NaN magenta (`--debug-nan`).
     pub debug_nan: bool,
+    /// GPU kernels read their distance program's constants from `scene_data`
+    /// (`wgsl::Options::parameters`), so that [`Prepared::update`] reuses a kernel for a
+    /// program that differs only in numbers (the frames of an animation).
+    pub parameters: bool,
 }
 
 /// A scene prepared for one backend.
@@ -66,6 +70,8 @@ pub enum Prepared {
         lipschitz: f64,
         program: Box<Program>,
         setup: Setup,
+        /// The WGSL text the module was translated from.
+        source: String,
     },
 }
 
@@ -75,6 +81,7 @@ struct CudaModule {
     data: Option<Vec<u8>>,
     specialisation: wgsl::Specialisation,
     ptx_time: Duration,
+    source: String,
 }
 
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
@@ -150,6 +157,7 @@ impl Prepared {
     fn kernel(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Kernel, String> {
         let options = wgsl::Options {
             debug_nan: setup.debug_nan,
+            parameters: setup.parameters,
             ..wgsl::Options::default()
         };
         wgsl::write_with(scene, program, &options).map_err(|e| e.to_string())
@@ -203,6 +211,7 @@ impl Prepared {
             lipschitz: program.lipschitz(),
             program: Box::new(program.clone()),
             setup: *setup,
+            source: module.source,
         })
     }
 
@@ -213,7 +222,11 @@ impl Prepared {
         program: &Program,
         setup: &Setup,
     ) -> Result<CudaModule, String> {
-        let kernel = Self::kernel(scene, program, setup)?;
+        Self::cuda_module_of(cuda, Self::kernel(scene, program, setup)?)
+    }
+
+    /// Translates `kernel` to PTX and loads it on `cuda`.
+    fn cuda_module_of(cuda: &Cuda, kernel: wgsl::Kernel) -> Result<CudaModule, String> {
         let start = Instant::now();
         let options = ptx::Options {
             sm: cuda.sm,
@@ -229,7 +242,73 @@ impl Prepared {
             data: kernel.data,
             specialisation: kernel.specialisation,
             ptx_time,
+            source: kernel.source,
         })
+    }
+
+    /// Prepares `scene`, whose distance program is `program`, in place of the scene this was
+    /// prepared for, keeping the device: a GPU kernel whose text is unchanged (with
+    /// [`Setup::parameters`], a program that differs only in numbers) is kept and given the
+    /// new `scene_data`; another is compiled. Returns whether a kernel (or the CPU's tapes)
+    /// was built.
+    pub fn update(&mut self, scene: &Scene, program: Program) -> Result<bool, String> {
+        method_allowed(scene)?;
+        match self {
+            Prepared::Cpu { options, .. } => {
+                let setup = Setup {
+                    precision: options.precision,
+                    debug_nan: options.debug_nan,
+                    parameters: false,
+                };
+                *self = Self::cpu(scene, program, &setup);
+                Ok(true)
+            }
+            Prepared::Wgpu {
+                kernel,
+                lipschitz,
+                program: held,
+                setup,
+                ..
+            } => {
+                let new = Self::kernel(scene, &program, setup)?;
+                let built = new.source != kernel.source;
+                if built {
+                    **kernel = new;
+                } else {
+                    kernel.data = new.data;
+                }
+                *lipschitz = program.lipschitz();
+                **held = program;
+                Ok(built)
+            }
+            Prepared::Cuda {
+                cuda,
+                loaded,
+                data,
+                specialisation,
+                ptx_time,
+                lipschitz,
+                program: held,
+                setup,
+                source,
+            } => {
+                let new = Self::kernel(scene, &program, setup)?;
+                let built = new.source != *source;
+                if built {
+                    let module = Self::cuda_module_of(cuda, new)?;
+                    **loaded = module.loaded;
+                    *data = module.data;
+                    *specialisation = module.specialisation;
+                    *ptx_time = module.ptx_time;
+                    *source = module.source;
+                } else {
+                    *data = new.data;
+                }
+                *lipschitz = program.lipschitz();
+                **held = program;
+                Ok(built)
+            }
+        }
     }
 
     /// The settings a GPU kernel was specialised for (`None` on the CPU, which reads every
@@ -270,6 +349,7 @@ impl Prepared {
                 ptx_time,
                 program,
                 setup,
+                source,
                 ..
             } => {
                 // The same device and context; the new module replaces the old one.
@@ -278,6 +358,7 @@ impl Prepared {
                 *data = module.data;
                 *specialisation = module.specialisation;
                 *ptx_time = module.ptx_time;
+                *source = module.source;
                 Ok(())
             }
         }

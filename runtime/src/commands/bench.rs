@@ -52,6 +52,12 @@ pub struct BenchArgs {
     /// `fps × duration`).
     #[arg(long, value_name = "A..B", value_parser = crate::sequence::Frames::parse)]
     pub sequence: Option<crate::sequence::Frames>,
+    /// With --frames-per-second: how GPU kernels hold the distance program's constants:
+    /// read from a buffer, so that frames differing only in numbers share one kernel (as
+    /// `sdfc render` of a sequence does), or written as literals, a kernel per program (for
+    /// comparison).
+    #[arg(long, value_enum, default_value_t)]
+    pub constants: Constants,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -109,6 +115,16 @@ pub struct Timing {
     pub fp32_fraction: Option<f64>,
     /// Statistics of the last frame.
     pub stats: Stats,
+}
+
+/// How the kernels of a timed sequence hold the program's constants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Constants {
+    /// Read from the kernel's buffer: one kernel for programs that differ in numbers only.
+    #[default]
+    Parameters,
+    /// Written as literals: a kernel for every program.
+    Literal,
 }
 
 /// The timing of one scene's sequence (`--frames-per-second`).
@@ -178,6 +194,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
         let setup = Setup {
             precision: args.precision,
             debug_nan: false,
+            parameters: args.constants == Constants::Parameters,
         };
         let mut kernels = Kernels::new(&pool, args.backend, setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
@@ -350,6 +367,7 @@ fn time_scene(
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
+        parameters: false,
     };
     let prepared = Prepared::from_program(args.backend, scene, program, &setup)?;
     // The last frame is held while the next one renders.

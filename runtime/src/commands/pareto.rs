@@ -485,6 +485,7 @@ fn measure(
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
+        parameters: false,
     };
     let mut prepared = Prepared::from_program(args.backend, scene, program.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
@@ -586,6 +587,7 @@ fn reference_setup(
     let setup = Setup {
         precision: Precision::F64,
         debug_nan: false,
+        parameters: false,
     };
     let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, program, &setup)?;
     Ok((reference_scene, prepared))

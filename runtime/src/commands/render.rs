@@ -256,6 +256,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
     let setup = Setup {
         precision,
         debug_nan: args.debug_nan,
+        parameters: false,
     };
     let (scene, prepared) = prepare(&pool, backend, frame, &setup)?;
     check_memory(

@@ -65,6 +65,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let setup = Setup {
         precision,
         debug_nan: args.debug_nan,
+        parameters: true,
     };
     let mine: Vec<u64> = shard.frames(frames).collect();
     let todo: Vec<u64> = mine
@@ -223,8 +224,11 @@ fn progress(len: u64, done: u64) -> Option<ProgressBar> {
     })
 }
 
-/// The backend prepared for the frames of a sequence: prepared again only when a frame's
-/// distance program (or the origin it is written relative to) differs from the last one's.
+/// The backend prepared for the frames of a sequence: the device is opened once; a frame
+/// whose distance program (and the origin it is written relative to) is the last one's
+/// renders with the same kernel; another is prepared with [`Prepared::update`], which keeps a
+/// GPU kernel whose text is unchanged (its constants are read from `scene_data`), so `count`
+/// counts kernels built, not frames.
 pub struct Kernels<'a> {
     pool: &'a rayon::ThreadPool,
     backend: crate::backend::Backend,
@@ -270,17 +274,30 @@ impl<'a> Kernels<'a> {
             .prepared
             .as_ref()
             .is_some_and(|(p, o, _)| *p == frame.program && *o == frame.scene.origin);
-        let scene = if same {
-            let FrameScene { scene, .. } = frame;
-            let (_, _, prepared) = self.prepared.as_mut().expect("prepared");
-            prepared.specialise(&scene).map_err(CliError::Failed)?;
-            scene
-        } else {
-            let program = frame.program.clone();
-            let (scene, prepared) = prepare(self.pool, self.backend, frame, &self.setup)?;
-            self.count += 1;
-            self.prepared = Some((program, scene.origin, prepared));
-            scene
+        let scene = match &mut self.prepared {
+            Some((_, _, prepared)) if same => {
+                let FrameScene { scene, .. } = frame;
+                prepared.specialise(&scene).map_err(CliError::Failed)?;
+                scene
+            }
+            // The device stays open; the kernel is kept when its text is the same (the
+            // program differs in numbers only) and given the frame's constants.
+            Some((held, origin, prepared)) => {
+                let FrameScene { scene, program } = frame;
+                *held = program.clone();
+                *origin = scene.origin;
+                if prepared.update(&scene, program).map_err(CliError::Failed)? {
+                    self.count += 1;
+                }
+                scene
+            }
+            None => {
+                let program = frame.program.clone();
+                let (scene, prepared) = prepare(self.pool, self.backend, frame, &self.setup)?;
+                self.count += 1;
+                self.prepared = Some((program, scene.origin, prepared));
+                scene
+            }
         };
         self.time += started.elapsed();
         let (_, _, prepared) = self.prepared.as_ref().expect("prepared");

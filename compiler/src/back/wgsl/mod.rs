@@ -178,6 +178,13 @@ pub struct Options {
     /// The most instances of a marched scene's root union written as code; more are read
     /// from `scene_data` ([`MAX_INSTANCES`] unless a test compares the two ways).
     pub max_instances: usize,
+    /// The constants of a marched scene's distance program read from `scene_data` instead
+    /// of written as literals (the `PARAMS` feature; docs/animation.md): the kernel's text
+    /// then depends on the program with its constants erased, so the frames of an animation
+    /// that differ only in numbers share one kernel and differ in [`Kernel::data`]. Only the
+    /// program written as code takes them: an analytically traced scene, a marched one whose
+    /// instances are read from `scene_data`, and the media of glass keep their literals.
+    pub parameters: bool,
 }
 
 impl Default for Options {
@@ -186,6 +193,7 @@ impl Default for Options {
             debug_nan: false,
             max_unrolled: MAX_UNROLLED,
             max_instances: MAX_INSTANCES,
+            parameters: false,
         }
     }
 }
@@ -216,7 +224,10 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
             bytes
         }
         None => {
-            let (mut text, bytes) = marched(scene, program, options.max_instances);
+            let (mut text, bytes, params) = marched(scene, program, options);
+            if params {
+                features.push(("PARAMS", true));
+            }
             // Rays inside glass that may overlap a solid march the scene's media.
             let media = on["REFRACTION"]
                 .then(|| crate::lower::media(scene))
@@ -275,9 +286,15 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
 
 /// `fn map` and `fn sdf` of a marched scene: the program as code, or, when its root union has
 /// more than `max_instances` instances, the rest of it as code and the instances as
-/// `scene_data` (march.rs), unless their materials or their bytes do not fit.
-fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, Option<Vec<u8>>) {
-    let split = crate::lower::split(scene, &program.options(), max_instances)
+/// `scene_data` (march.rs), unless their materials or their bytes do not fit. The program as
+/// code reads its constants from `scene_data` with [`Options::parameters`] (then the last
+/// value is true).
+fn marched(
+    scene: &Scene,
+    program: &Program,
+    options: &Options,
+) -> (String, Option<Vec<u8>>, bool) {
+    let split = crate::lower::split(scene, &program.options(), options.max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {
             let data = march::data(&s.instances, scene.camera.position);
@@ -297,11 +314,21 @@ fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, O
                 map::write_sdf_named(&s.rest, "rest_sdf"),
                 march::write(&s.instances)
             );
-            (text, Some(data))
+            (text, Some(data), false)
+        }
+        None if options.parameters => {
+            let params = map::Params::default();
+            let text = format!(
+                "{}\n{}",
+                map::write_map_with(program, "map", Some(&params)),
+                map::write_sdf_with(program, "sdf", Some(&params))
+            );
+            (text, Some(params.bytes()), true)
         }
         None => (
             format!("{}\n{}", write_map(program), write_sdf(program)),
             None,
+            false,
         ),
     }
 }

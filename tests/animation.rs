@@ -705,3 +705,152 @@ fn bench_times_a_sequence_and_counts_its_kernels() {
     let o = sdfc(&d, &["bench", "--frames-per-second", "still.sdf"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
 }
+
+// ---- one kernel per sequence (stage B) ----
+
+/// The frames `ks` of `file` checked at their times and lowered.
+fn frames_of(file: &str, ks: &[u64]) -> Vec<(Scene, sdfc_compiler::lower::Program)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut source = sdfc_runtime::frontend::Source::read(&root.join(file)).expect("read");
+    ks.iter()
+        .map(|&k| {
+            let first = source.check(&Limits::default(), 0.0).scene.expect("checks");
+            let t = sdfc_compiler::scene::Animation::time_of(first.animation.fps, k);
+            let s = source.check(&Limits::default(), t).scene.expect("checks");
+            let p = sdfc_compiler::lower::lower(&s);
+            (s, p)
+        })
+        .collect()
+}
+
+fn kernel(
+    s: &Scene,
+    p: &sdfc_compiler::lower::Program,
+    parameters: bool,
+) -> sdfc_compiler::back::wgsl::Kernel {
+    let options = sdfc_compiler::back::wgsl::Options {
+        parameters,
+        ..Default::default()
+    };
+    sdfc_compiler::back::wgsl::write_with(s, p, &options).expect("valid kernel")
+}
+
+#[test]
+fn frames_that_differ_in_numbers_share_one_kernel_text() {
+    // Frame 0 of bounce.sdf has the sphere on the floor, where its height equals its radius
+    // and the lowering shares the two constants: the kernel's text is still the same.
+    let frames = frames_of("examples/animation/bounce.sdf", &[0, 1, 7, 18]);
+    let with: Vec<_> = frames.iter().map(|(s, p)| kernel(s, p, true)).collect();
+    for k in &with[1..] {
+        assert_eq!(k.source, with[0].source);
+        assert!(k.features.contains(&("PARAMS", true)));
+    }
+    assert_ne!(with[0].data, with[1].data, "the constants differ");
+    let literal: Vec<_> = frames.iter().map(|(s, p)| kernel(s, p, false)).collect();
+    assert_ne!(literal[1].source, literal[2].source);
+    assert!(literal[0].data.is_none());
+    // The structure check agrees.
+    let structures: Vec<_> = frames
+        .iter()
+        .map(|(s, p)| sdfc_compiler::animation::Structure::of(s, p))
+        .collect();
+    assert!(structures.iter().all(|s| *s == structures[0]));
+    // Another structure is another text.
+    let d = dir("kernels");
+    std::fs::write(
+        d.join("grow.sdf"),
+        format!("{BASE}render {{ fps: 1, duration: 3 }} scene {{ for i in 0..int(t) + 1 {{ sphere(0.3).translate(i, 0, 0) @ m; }} }}"),
+    )
+    .unwrap();
+    let mut source = sdfc_runtime::frontend::Source::read(&d.join("grow.sdf")).unwrap();
+    let texts: Vec<String> = [0.0, 1.0]
+        .iter()
+        .map(|&t| {
+            let s = source.check(&Limits::default(), t).scene.unwrap();
+            kernel(&s, &sdfc_compiler::lower::lower(&s), true).source
+        })
+        .collect();
+    assert_ne!(texts[0], texts[1]);
+    // The parameter kernel translates to PTX, which ptxas assembles where it is installed.
+    let k = &with[1];
+    let options = sdfc_compiler::back::ptx::Options {
+        sm: 70,
+        entry_point: "main".into(),
+    };
+    let ptx = sdfc_compiler::back::ptx::write(&k.module, &k.info, &options).expect("ptx");
+    let found = std::env::var_os("PATH").and_then(|p| {
+        std::env::split_paths(&p)
+            .map(|d| d.join("ptxas"))
+            .find(|p| p.is_file())
+    });
+    match found {
+        Some(ptxas) => {
+            let path = d.join("bounce.ptx");
+            std::fs::write(&path, ptx).unwrap();
+            let o = Command::new(ptxas)
+                .args(["-arch=sm_70", "-o", "/dev/null"])
+                .arg(&path)
+                .output()
+                .expect("ptxas");
+            assert!(o.status.success(), "{}", text(&o));
+        }
+        None => {
+            assert!(
+                std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+                "SDFC_REQUIRE_DEVICES=1 but no ptxas on PATH"
+            );
+            println!("SKIPPED: no ptxas on PATH; the PTX was written but not assembled");
+        }
+    }
+}
+
+#[test]
+fn a_sequence_on_wgpu_compiles_one_kernel_and_matches_the_cpu() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let d = dir("wgpu");
+    let scene = root.join("examples/animation/bounce.sdf");
+    let scene = scene.to_str().unwrap();
+    let run = |backend: &str| {
+        sdfc_env(
+            &d,
+            &[
+                "render",
+                scene,
+                "--backend",
+                backend,
+                "--frames",
+                "0..6",
+                "--size",
+                "96x72",
+                "-o",
+                &format!("{backend}/f_#.png"),
+            ],
+            &[("XDG_RUNTIME_DIR", "/tmp")],
+        )
+    };
+    let o = run("wgpu");
+    if !o.status.success() && text(&o).contains("not available") {
+        assert!(
+            std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+            "SDFC_REQUIRE_DEVICES=1 but wgpu is not available: {}",
+            text(&o)
+        );
+        println!("SKIPPED: no wgpu adapter: {}", text(&o));
+        return;
+    }
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("6 frames") && text(&o).contains("1 kernel prepared"),
+        "{}",
+        text(&o)
+    );
+    let o = run("cpu");
+    assert!(o.status.success(), "{}", text(&o));
+    for k in 0..6 {
+        let read =
+            |b: &str| sdfc_runtime::image::read_png(&d.join(format!("{b}/f_{k}.png"))).unwrap();
+        let diff =
+            sdfc_runtime::metrics::compare(&read("cpu"), &read("wgpu"), 0.1).expect("same size");
+        assert!(diff.psnr > 40.0, "frame {k}: {} dB", diff.psnr);
+    }
+}

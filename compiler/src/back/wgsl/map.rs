@@ -255,12 +255,8 @@ impl<'a> Writer<'a> {
                             } else {
                                 [".x", ".y", ".z", ".w"][n]
                             };
-                            let _ = writeln!(
-                                out,
-                                "{}{} = o{lane};",
-                                pad(depth + 1),
-                                self.names.reg(j)
-                            );
+                            let _ =
+                                writeln!(out, "{}{} = o{lane};", pad(depth + 1), self.names.reg(j));
                         }
                         self.function(&name, k + 1, end, &params, &results);
                     } else {

@@ -289,11 +289,7 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
 /// `scene_data` (march.rs), unless their materials or their bytes do not fit. The program as
 /// code reads its constants from `scene_data` with [`Options::parameters`] (then the last
 /// value is true).
-fn marched(
-    scene: &Scene,
-    program: &Program,
-    options: &Options,
-) -> (String, Option<Vec<u8>>, bool) {
+fn marched(scene: &Scene, program: &Program, options: &Options) -> (String, Option<Vec<u8>>, bool) {
     let split = crate::lower::split(scene, &program.options(), options.max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {

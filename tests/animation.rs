@@ -643,6 +643,16 @@ fn job_array_files_parse() {
     assert!(script.contains("#SBATCH --array="));
     assert!(script.contains("--shard \"$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT\""));
     let k8s = root.join("examples/jobs/kubernetes.yaml");
+    // The README shows both files as they are.
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    for f in [&slurm, &k8s] {
+        let text = std::fs::read_to_string(f).unwrap();
+        assert!(
+            readme.contains(&text),
+            "README.md does not show {} as it is",
+            f.display()
+        );
+    }
     let check = "import sys, yaml\n\
                  docs = list(yaml.safe_load_all(open(sys.argv[1])))\n\
                  job = [d for d in docs if d['kind'] == 'Job'][0]\n\

@@ -155,12 +155,21 @@ impl Prepared {
     }
 
     fn kernel(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Kernel, String> {
-        let options = wgsl::Options {
+        wgsl::write_with(scene, program, &Self::kernel_options(setup)).map_err(|e| e.to_string())
+    }
+
+    fn kernel_options(setup: &Setup) -> wgsl::Options {
+        wgsl::Options {
             debug_nan: setup.debug_nan,
             parameters: setup.parameters,
             ..wgsl::Options::default()
-        };
-        wgsl::write_with(scene, program, &options).map_err(|e| e.to_string())
+        }
+    }
+
+    /// The text and data of the kernel for `scene`, not validated (to compare with a kernel
+    /// held).
+    fn kernel_text(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Text, String> {
+        wgsl::write_text(scene, program, &Self::kernel_options(setup)).map_err(|e| e.to_string())
     }
 
     fn wgpu(
@@ -270,12 +279,12 @@ impl Prepared {
                 setup,
                 ..
             } => {
-                let new = Self::kernel(scene, &program, setup)?;
-                let built = new.source != kernel.source;
+                let text = Self::kernel_text(scene, &program, setup)?;
+                let built = text.source != kernel.source;
                 if built {
-                    **kernel = new;
+                    **kernel = Self::kernel(scene, &program, setup)?;
                 } else {
-                    kernel.data = new.data;
+                    kernel.data = text.data;
                 }
                 *lipschitz = program.lipschitz();
                 **held = program;
@@ -292,17 +301,17 @@ impl Prepared {
                 setup,
                 source,
             } => {
-                let new = Self::kernel(scene, &program, setup)?;
-                let built = new.source != *source;
+                let text = Self::kernel_text(scene, &program, setup)?;
+                let built = text.source != *source;
                 if built {
-                    let module = Self::cuda_module_of(cuda, new)?;
+                    let module = Self::cuda_module_of(cuda, Self::kernel(scene, &program, setup)?)?;
                     **loaded = module.loaded;
                     *data = module.data;
                     *specialisation = module.specialisation;
                     *ptx_time = module.ptx_time;
                     *source = module.source;
                 } else {
-                    *data = new.data;
+                    *data = text.data;
                 }
                 *lipschitz = program.lipschitz();
                 **held = program;

@@ -205,6 +205,32 @@ pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
 
 /// [`write`] with the given options.
 pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result<Kernel, Error> {
+    let text = write_text(scene, program, options)?;
+    let (module, info) = validate(&text.source, scene)?;
+    Ok(Kernel {
+        source: text.source,
+        module,
+        info,
+        features: text.features,
+        specialisation: Specialisation::of(&scene.settings),
+        data: text.data,
+    })
+}
+
+/// A kernel's text and data before naga parses and validates it: what a caller holding a
+/// kernel compares to decide whether it can keep it ([`Options::parameters`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Text {
+    /// The WGSL text.
+    pub source: String,
+    /// The features it was specialised for, by name.
+    pub features: Vec<(&'static str, bool)>,
+    /// The bytes of `scene_data`, when it has them.
+    pub data: Option<Vec<u8>>,
+}
+
+/// The text of the kernel [`write_with`] writes, not validated.
+pub fn write_text(scene: &Scene, program: &Program, options: &Options) -> Result<Text, Error> {
     let choice = crate::scene::analytic::choose(scene);
     let mut features = features(scene, choice.primitives().is_some());
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
@@ -273,13 +299,9 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         line: None,
         node_span: None,
     })?;
-    let (module, info) = validate(&source, scene)?;
-    Ok(Kernel {
+    Ok(Text {
         source,
-        module,
-        info,
         features,
-        specialisation: Specialisation::of(&scene.settings),
         data,
     })
 }

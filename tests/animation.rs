@@ -33,10 +33,13 @@ const BASE: &str = "material m = phong { color: (0.8, 0.2, 0.2) };
 light point { position: (2, 4, -3) }
 ";
 
+/// Reads a number out of a checked scene.
+type Read = fn(&Scene) -> f64;
+
 #[test]
 fn t_reaches_every_kind_of_field() {
     // Each case: a scene reading `t` in one place, and what it must read at t = 0.5.
-    let cases: &[(&str, fn(&Scene) -> f64)] = &[
+    let cases: &[(&str, Read)] = &[
         ("scene { sphere(1 + t) @ m; }", |s| match s.graph.node(s.root.unwrap()) {
             Node::Paint { child, .. } => match s.graph.node(*child) {
                 Node::Sphere { radius } => *radius,
@@ -525,7 +528,7 @@ fn an_animated_png_holds_every_frame() {
     assert_eq!((fc.delay_num, fc.delay_den), (100, 1000));
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let mut frames = Vec::new();
-    while let Ok(_) = reader.next_frame(&mut buf) {
+    while reader.next_frame(&mut buf).is_ok() {
         frames.push(buf.clone());
     }
     assert_eq!(frames.len(), 6);

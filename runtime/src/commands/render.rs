@@ -192,7 +192,7 @@ pub fn frame_scene(
     if args.reference {
         *settings = reference::settings(settings);
     }
-    override_settings(settings, args.size, args.aa, &args.set, limits).map_err(CliError::Usage)?;
+    override_settings(settings, args.size, args.aa, args.set, limits).map_err(CliError::Usage)?;
     crate::backend::method_allowed(&scene).map_err(CliError::Failed)?;
     let checked = frontend::Checked {
         scene,

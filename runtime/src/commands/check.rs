@@ -134,8 +134,10 @@ pub fn animation(
         }
         d.len()
     };
-    let kind = if distinct == 1 {
-        "animated, numbers only: every frame has the same structure".to_string()
+    let kind = if distinct == 1 && traced > 0 {
+        "animated, numbers only: every frame has the same structure (traced analytically: the GPU kernel holds the primitives' numbers and is built again for each frame whose numbers change)".to_string()
+    } else if distinct == 1 {
+        "animated, numbers only: every frame has the same structure (one GPU kernel for the sequence)".to_string()
     } else {
         format!(
             "animated, structure varies: {distinct} structures, changing at frame{} {} (the kernel is specialised again there)",

@@ -266,6 +266,16 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
                 if cx.globals.contains_key(&l.name.name) {
                     continue;
                 }
+                if l.name.name == builtins::TIME {
+                    cx.error(
+                        Diagnostic::warning("W0013", "this constant hides the time `t`", l.name.span)
+                            .with_label("a global constant named `t`")
+                            .with_note(
+                                "`t` is the time in seconds of an animation's frame; below this constant, every `t` reads the constant instead",
+                            )
+                            .with_help("give the constant another name"),
+                    );
+                }
                 let reads = cx.time_reads;
                 let v = cx.let_value(l);
                 if let (true, Some(at)) = (cx.time_reads > reads, cx.last_time_read()) {

@@ -277,7 +277,11 @@ impl<'a> Kernels<'a> {
         let scene = match &mut self.prepared {
             Some((_, _, prepared)) if same => {
                 let FrameScene { scene, .. } = frame;
+                let before = prepared.specialisation();
                 prepared.specialise(&scene).map_err(CliError::Failed)?;
+                if prepared.specialisation() != before {
+                    self.count += 1;
+                }
                 scene
             }
             // The device stays open; the kernel is kept when its text is the same (the

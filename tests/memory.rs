@@ -172,6 +172,7 @@ fn renders_stay_within_the_memory_they_announce() {
         let setup = Setup {
             precision,
             debug_nan: false,
+            parameters: false,
         };
         let prepared = pool.install(|| {
             Prepared::from_program(Backend::Cpu, &scene, lowered.clone(), &setup).expect("cpu")

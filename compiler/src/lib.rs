@@ -17,6 +17,7 @@
 //! The crate does no IO and never panics on user input: imports are read through the
 //! [`check::Loader`] the caller passes in, and every problem is a [`Diagnostic`].
 
+pub mod animation;
 pub mod back;
 pub mod check;
 pub mod diagnostics;

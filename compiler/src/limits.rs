@@ -47,6 +47,8 @@ pub enum Limit {
     SweepValues,
     /// Settings `sdfc pareto` measures: the product of its sweeps' value counts.
     SweepPoints,
+    /// Frames of one animated sequence (`render { fps, duration }`, `sdfc render --frames`).
+    Frames,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -61,7 +63,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 17] = [
+    pub const ALL: [Limit; 18] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -79,6 +81,7 @@ impl Limit {
         Limit::SceneData,
         Limit::SweepValues,
         Limit::SweepPoints,
+        Limit::Frames,
     ];
 
     fn spec(self) -> Spec {
@@ -184,6 +187,13 @@ impl Limit {
                 1_000_000,
                 "settings sdfc pareto measures (the product of its sweeps' values)",
             ),
+            // An hour at 30 frames per second is 108 000 frames: ten hours fit.
+            Limit::Frames => s(
+                "frames",
+                1_000_000,
+                1 << 40,
+                "frames of one animated sequence",
+            ),
         }
     }
 
@@ -222,7 +232,7 @@ impl fmt::Display for Limit {
 /// The value of every limit for one run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 17],
+    values: [u64; 18],
 }
 
 impl Default for Limits {

@@ -34,6 +34,10 @@ pub struct Setup {
     pub precision: Precision,
     /// Paint pixels whose rays met a NaN magenta (`--debug-nan`).
     pub debug_nan: bool,
+    /// GPU kernels read their distance program's constants from `scene_data`
+    /// (`wgsl::Options::parameters`), so that [`Prepared::update`] reuses a kernel for a
+    /// program that differs only in numbers (the frames of an animation).
+    pub parameters: bool,
 }
 
 /// A scene prepared for one backend.
@@ -67,6 +71,8 @@ pub enum Prepared {
         lipschitz: f64,
         lowered: Box<Lowered>,
         setup: Setup,
+        /// The WGSL text the module was translated from.
+        source: String,
     },
 }
 
@@ -76,6 +82,7 @@ struct CudaModule {
     data: Option<Vec<u8>>,
     specialisation: wgsl::Specialisation,
     ptx_time: Duration,
+    source: String,
 }
 
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
@@ -155,11 +162,21 @@ impl Prepared {
     }
 
     fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, String> {
-        let options = wgsl::Options {
+        wgsl::write_with(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
+    }
+
+    fn kernel_options(setup: &Setup) -> wgsl::Options {
+        wgsl::Options {
             debug_nan: setup.debug_nan,
+            parameters: setup.parameters,
             ..wgsl::Options::default()
-        };
-        wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())
+        }
+    }
+
+    /// The text and data of the kernel for `scene`, not validated (to compare with a kernel
+    /// held).
+    fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, String> {
+        wgsl::write_text(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
     }
 
     fn wgpu(
@@ -209,6 +226,7 @@ impl Prepared {
             lipschitz: lowered.program.lipschitz(),
             lowered: Box::new(lowered.clone()),
             setup: *setup,
+            source: module.source,
         })
     }
 
@@ -219,7 +237,11 @@ impl Prepared {
         lowered: &Lowered,
         setup: &Setup,
     ) -> Result<CudaModule, String> {
-        let kernel = Self::kernel(scene, lowered, setup)?;
+        Self::cuda_module_of(cuda, Self::kernel(scene, lowered, setup)?)
+    }
+
+    /// Translates `kernel` to PTX and loads it on `cuda`.
+    fn cuda_module_of(cuda: &Cuda, kernel: wgsl::Kernel) -> Result<CudaModule, String> {
         let start = Instant::now();
         let options = ptx::Options {
             sm: cuda.sm,
@@ -235,7 +257,73 @@ impl Prepared {
             data: kernel.data,
             specialisation: kernel.specialisation,
             ptx_time,
+            source: kernel.source,
         })
+    }
+
+    /// Prepares `scene`, lowered as `lowered`, in place of the scene this was prepared for,
+    /// keeping the device: a GPU kernel whose text is unchanged (with [`Setup::parameters`], a
+    /// program that differs only in numbers) is kept and given the new `scene_data`; another
+    /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
+    pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+        method_allowed(scene)?;
+        traceable_with(scene, &lowered.traceable)?;
+        match self {
+            Prepared::Cpu { options, .. } => {
+                let setup = Setup {
+                    precision: options.precision,
+                    debug_nan: options.debug_nan,
+                    parameters: false,
+                };
+                *self = Self::cpu(lowered, &setup);
+                Ok(true)
+            }
+            Prepared::Wgpu {
+                kernel,
+                lipschitz,
+                lowered: held,
+                setup,
+                ..
+            } => {
+                let text = Self::kernel_text(scene, &lowered, setup)?;
+                let built = text.source != kernel.source;
+                if built {
+                    **kernel = Self::kernel(scene, &lowered, setup)?;
+                } else {
+                    kernel.data = text.data;
+                }
+                *lipschitz = lowered.program.lipschitz();
+                **held = lowered;
+                Ok(built)
+            }
+            Prepared::Cuda {
+                cuda,
+                loaded,
+                data,
+                specialisation,
+                ptx_time,
+                lipschitz,
+                lowered: held,
+                setup,
+                source,
+            } => {
+                let text = Self::kernel_text(scene, &lowered, setup)?;
+                let built = text.source != *source;
+                if built {
+                    let module = Self::cuda_module_of(cuda, Self::kernel(scene, &lowered, setup)?)?;
+                    **loaded = module.loaded;
+                    *data = module.data;
+                    *specialisation = module.specialisation;
+                    *ptx_time = module.ptx_time;
+                    *source = module.source;
+                } else {
+                    *data = text.data;
+                }
+                *lipschitz = lowered.program.lipschitz();
+                **held = lowered;
+                Ok(built)
+            }
+        }
     }
 
     /// The settings a GPU kernel was specialised for (`None` on the CPU, which reads every
@@ -276,6 +364,7 @@ impl Prepared {
                 ptx_time,
                 lowered,
                 setup,
+                source,
                 ..
             } => {
                 traceable_with(scene, &lowered.traceable)?;
@@ -285,6 +374,7 @@ impl Prepared {
                 *data = module.data;
                 *specialisation = module.specialisation;
                 *ptx_time = module.ptx_time;
+                *source = module.source;
                 Ok(())
             }
         }

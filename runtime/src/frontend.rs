@@ -77,23 +77,59 @@ pub fn load(path: &Path) -> Result<Loaded, String> {
 
 /// [`load`] within the given limits.
 pub fn load_with(path: &Path, limits: &Limits) -> Result<Loaded, String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        format!(
-            "`{}` is not valid UTF-8 (first bad byte at offset {})",
-            path.display(),
-            e.utf8_error().valid_up_to()
-        )
-    })?;
-    let mut sources = SourceMap::new();
-    let entry = sources.add(normalise(path), text);
-    let (scene, diagnostics) = check::check_with(&mut sources, entry, &mut FsLoader, limits);
-    Ok(Loaded {
-        scene,
-        diagnostics,
-        sources,
-    })
+    Ok(Source::read(path)?.check(limits, 0.0))
+}
+
+/// A scene file and its imports read once, to be checked at many times: the frames of an
+/// animated scene (docs/animation.md) all come from the same text, even if the files
+/// change while a sequence renders.
+#[derive(Debug)]
+pub struct Source {
+    name: String,
+    text: String,
+    /// Imports read so far, by the importing file and the path written.
+    imports: std::collections::HashMap<(String, String), Result<(String, String), String>>,
+}
+
+impl Source {
+    /// Reads the entry file. `Err` is an IO or encoding problem, phrased for the user.
+    pub fn read(path: &Path) -> Result<Source, String> {
+        let bytes =
+            std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            format!(
+                "`{}` is not valid UTF-8 (first bad byte at offset {})",
+                path.display(),
+                e.utf8_error().valid_up_to()
+            )
+        })?;
+        Ok(Source {
+            name: normalise(path),
+            text,
+            imports: Default::default(),
+        })
+    }
+
+    /// Checks the scene within `limits` at the time `t` = `time` seconds.
+    pub fn check(&mut self, limits: &Limits, time: f64) -> Loaded {
+        let mut sources = SourceMap::new();
+        let entry = sources.add(self.name.clone(), self.text.clone());
+        let (scene, diagnostics) = check::check_at(&mut sources, entry, self, limits, time);
+        Loaded {
+            scene,
+            diagnostics,
+            sources,
+        }
+    }
+}
+
+impl Loader for Source {
+    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
+        self.imports
+            .entry((from.to_string(), path.to_string()))
+            .or_insert_with(|| FsLoader.load(from, path))
+            .clone()
+    }
 }
 
 /// Prints diagnostics to stderr in the chosen format.

@@ -325,5 +325,6 @@ fn scene_without_graph(scene: &Scene) -> Scene {
         settings: scene.settings.clone(),
         origin: scene.origin,
         limits: scene.limits.clone(),
+        animation: scene.animation,
     }
 }

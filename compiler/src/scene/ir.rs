@@ -561,6 +561,52 @@ pub struct Scene {
     /// The limits the scene was checked within: the passes after the checker (the choice of
     /// method, the kernel's data) read theirs from here.
     pub limits: Limits,
+    /// The animation the `render` block states, the time the scene was checked at, and
+    /// whether anything in it read the time `t`.
+    pub animation: Animation,
+}
+
+/// A scene's animation (docs/animation.md): frame `k` is the scene checked at the time
+/// `k / fps` seconds. A scene that never reads `t` is a still: every frame is the same.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Animation {
+    /// Frames per second (`render { fps }`).
+    pub fps: f64,
+    /// Length of the sequence in seconds (`render { duration }`); 0 for none.
+    pub duration: f64,
+    /// The time `t` the scene was checked at, in seconds.
+    pub time: f64,
+    /// Where the checker first read `t` (outside function bodies checked on their own);
+    /// `None` when nothing did: the scene is a still.
+    pub reads_time: Option<crate::span::Span>,
+}
+
+impl Default for Animation {
+    fn default() -> Self {
+        Animation {
+            fps: 30.0,
+            duration: 0.0,
+            time: 0.0,
+            reads_time: None,
+        }
+    }
+}
+
+impl Animation {
+    /// The number of frames the `render` block states: `fps × duration`, rounded.
+    pub fn frames(&self) -> u64 {
+        (self.fps * self.duration).round() as u64
+    }
+
+    /// The time of frame `k`, in seconds.
+    pub fn time_of(fps: f64, k: u64) -> f64 {
+        k as f64 / fps
+    }
+
+    /// Whether the scene reads `t` (otherwise every frame is the same).
+    pub fn animated(&self) -> bool {
+        self.reads_time.is_some()
+    }
 }
 
 impl Scene {

@@ -7,6 +7,7 @@ pub mod compare;
 pub mod compile;
 pub mod pareto;
 pub mod render;
+pub mod sequence;
 pub mod view;
 
 use sdfc_compiler::{Limit, Limits};

@@ -488,6 +488,7 @@ fn measure(
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
+        parameters: false,
     };
     let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
@@ -596,6 +597,7 @@ fn reference_setup(
     let setup = Setup {
         precision: Precision::F64,
         debug_nan: false,
+        parameters: false,
     };
     let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
     Ok((reference_scene, prepared))

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Runs on the GPU machine (the `device` tool), for issue 19 (animation): (fps) the sustained
+# frame rate of the animated examples at 1920x1080 with `sdfc bench --frames-per-second` on
+# CUDA and wgpu, with the distance program's constants read from the kernel's buffer (one
+# kernel per sequence when only numbers change) and written as literals (a kernel per frame
+# whose numbers change), and the kernels each prepared; (agree) a few frames of each example
+# rendered as a sequence on CUDA, wgpu and the CPU at 640x480 and compared, frame by frame.
+# Expects the sdfc binary at .dev/sdfc and the Vulkan loader packages in .gl/ (device-env.sh).
+# Writes JSON and logs under $OUT; prints tables.
+# Usage: scripts/device-anim.sh [all|fps|agree]   (FRAMES=0..60 sets the timed sequence)
+set -u
+. "$(dirname "$0")/device-env.sh"
+MODE=${1:-all}
+SEQ=${FRAMES:-0..60}
+SCENES="examples/animation/orbit.sdf examples/animation/bounce.sdf"
+
+if [ "$MODE" = all ] || [ "$MODE" = fps ]; then
+  echo "== sequence throughput at 1920x1080, frames $SEQ (first frame untimed)" | tee "$OUT/anim-fps.txt"
+  for b in cuda wgpu; do
+    for c in parameters literal; do
+      echo "-- $b, constants $c" | tee -a "$OUT/anim-fps.txt"
+      "$B" bench --frames-per-second --backend "$b" --constants "$c" --size 1920x1080 \
+        --sequence "$SEQ" $SCENES > "$OUT/anim-$b-$c.txt" 2> "$OUT/anim-$b-$c.log" \
+        || echo "$b $c FAILED: $(tail -n 3 "$OUT/anim-$b-$c.log")"
+      cat "$OUT/anim-$b-$c.txt" | tee -a "$OUT/anim-fps.txt"
+      "$B" bench --frames-per-second --backend "$b" --constants "$c" --size 1920x1080 \
+        --sequence "$SEQ" $SCENES --json > "$OUT/anim-$b-$c.json" 2>> "$OUT/anim-$b-$c.log"
+    done
+  done
+fi
+
+if [ "$MODE" = all ] || [ "$MODE" = agree ]; then
+  echo "== frames 0..8 as sequences at 640x480: worst PSNR over the frames against the CPU" | tee "$OUT/anim-agree.txt"
+  for f in $SCENES; do
+    n=$(basename "$f" .sdf)
+    for b in cpu cuda wgpu; do
+      "$B" render "$f" --backend "$b" --size 640x480 --frames 0..8 --force \
+        -o "/tmp/sdfc-img/anim-$n-$b/f_##.png" > "$OUT/anim-agree-$n-$b.log" 2>&1 \
+        || echo "$n $b FAILED: $(tail -n 2 "$OUT/anim-agree-$n-$b.log")"
+      echo "$n $b: $(tail -n 1 "$OUT/anim-agree-$n-$b.log")" | tee -a "$OUT/anim-agree.txt"
+    done
+    for b in cuda wgpu; do
+      worst=$(for k in 00 01 02 03 04 05 06 07; do
+        "$B" compare "/tmp/sdfc-img/anim-$n-$b/f_$k.png" "/tmp/sdfc-img/anim-$n-cpu/f_$k.png" --json 2>/dev/null \
+          | python3 -c 'import json,sys; print(json.load(sys.stdin)["psnr"])' 2>/dev/null || echo 0
+      done | sort -g | head -n 1)
+      echo "$n $b-cpu worst ${worst} dB" | tee -a "$OUT/anim-agree.txt"
+    done
+  done
+fi

@@ -49,7 +49,7 @@ pub struct Split {
 /// with `options`.
 pub fn split(scene: &Scene, options: &LowerOptions, more_than: usize) -> Option<Split> {
     let root = scene.root.filter(|_| options.level > 0)?;
-    let simple = simplify::simplify(&scene.graph, root);
+    let simple = simplify::simplify(&scene.graph, root, options.parametric);
     let Node::Combine {
         op: Combine::Union,
         children,

@@ -939,12 +939,10 @@ fn parametric_lowering_keeps_the_structure_and_the_values() {
     for s in &scenes {
         let a = evaluate(&sdfc_compiler::lower::lower(s), &points);
         let b = evaluate(&lower_with(s, &LowerOptions::parametric()), &points);
-        for i in 0..points.len() {
-            let (x, y) = (a.0[i], b.0[i]);
+        for ((p, x), y) in points.iter().zip(&a.0).zip(&b.0) {
             assert!(
                 (x - y).abs() <= 1e-9 * (1.0 + x.abs()),
-                "{:?}: {x} against {y}",
-                points[i]
+                "{p:?}: {x} against {y}"
             );
         }
         assert_eq!(a.1, b.1);

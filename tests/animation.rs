@@ -722,7 +722,7 @@ fn bench_times_a_sequence_and_counts_its_kernels() {
 // ---- one kernel per sequence (stage B) ----
 
 /// The frames `ks` of `file` checked at their times and lowered.
-fn frames_of(file: &str, ks: &[u64]) -> Vec<(Scene, sdfc_compiler::lower::Program)> {
+fn frames_of(file: &str, ks: &[u64]) -> Vec<(Scene, sdfc_compiler::lower::Lowered)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut source = sdfc_runtime::frontend::Source::read(&root.join(file)).expect("read");
     ks.iter()
@@ -730,7 +730,7 @@ fn frames_of(file: &str, ks: &[u64]) -> Vec<(Scene, sdfc_compiler::lower::Progra
             let first = source.check(&Limits::default(), 0.0).scene.expect("checks");
             let t = sdfc_compiler::scene::Animation::time_of(first.animation.fps, k);
             let s = source.check(&Limits::default(), t).scene.expect("checks");
-            let p = sdfc_compiler::lower::lower(&s);
+            let p = sdfc_compiler::lower::Lowered::new(&s);
             (s, p)
         })
         .collect()
@@ -738,7 +738,7 @@ fn frames_of(file: &str, ks: &[u64]) -> Vec<(Scene, sdfc_compiler::lower::Progra
 
 fn kernel(
     s: &Scene,
-    p: &sdfc_compiler::lower::Program,
+    p: &sdfc_compiler::lower::Lowered,
     parameters: bool,
 ) -> sdfc_compiler::back::wgsl::Kernel {
     let options = sdfc_compiler::back::wgsl::Options {
@@ -765,7 +765,7 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
     // The structure check agrees.
     let structures: Vec<_> = frames
         .iter()
-        .map(|(s, p)| sdfc_compiler::animation::Structure::of(s, p))
+        .map(|(s, p)| sdfc_compiler::animation::Structure::of(s, &p.program))
         .collect();
     assert!(structures.iter().all(|s| *s == structures[0]));
     // Another structure is another text.
@@ -780,7 +780,7 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
         .iter()
         .map(|&t| {
             let s = source.check(&Limits::default(), t).scene.unwrap();
-            kernel(&s, &sdfc_compiler::lower::lower(&s), true).source
+            kernel(&s, &sdfc_compiler::lower::Lowered::new(&s), true).source
         })
         .collect();
     assert_ne!(texts[0], texts[1]);

@@ -22,7 +22,6 @@
 
 use rayon::prelude::*;
 use sdfc_compiler::back::wgsl::{self, Options};
-use sdfc_compiler::lower;
 use sdfc_runtime::frontend;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, BufReader, Read, Write};
@@ -139,12 +138,12 @@ fn example_jobs() -> Vec<Job> {
         let scene = loaded
             .scene
             .unwrap_or_else(|| panic!("{} has errors", path.display()));
-        let program = lower::lower(&scene);
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
         let options = Options {
             parameters,
             ..Options::default()
         };
-        let kernel = wgsl::write_with(&scene, &program, &options)
+        let kernel = wgsl::write_with(&scene, &lowered, &options)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert_eq!(kernel.features.contains(&("PARAMS", true)), parameters);
         let name = path
@@ -309,8 +308,8 @@ fn combo_jobs() -> Vec<Job> {
             let (text, options) = combo.scene();
             let (scene, diags, _) = sdfc_compiler::check::check_str("features.sdf", &text);
             let scene = scene.unwrap_or_else(|| panic!("{}:\n{text}\n{diags:?}", combo.name()));
-            let program = lower::lower(&scene);
-            let kernel = wgsl::write_with(&scene, &program, &options)
+            let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+            let kernel = wgsl::write_with(&scene, &lowered, &options)
                 .unwrap_or_else(|e| panic!("{}: {e}", combo.name()));
             assert!(
                 combo_of(&kernel) == combo,

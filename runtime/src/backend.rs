@@ -4,10 +4,11 @@
 
 use crate::cpu::{self, Options, Precision, Render, Tapes};
 use crate::gpu::{self, cuda::Cuda, Gpu};
-use crate::memory::Memory;
+use crate::memory::{self, Memory};
 use sdfc_compiler::back::{ptx, wgsl};
-use sdfc_compiler::lower::{self, Program};
-use sdfc_compiler::scene::analytic::{self, Choice};
+use sdfc_compiler::lower::{self, LowerOptions, Lowered};
+use sdfc_compiler::program::Program;
+use sdfc_compiler::scene::analytic::{self, Choice, Traceable};
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -49,17 +50,17 @@ pub enum Prepared {
         options: Options,
     },
     /// wgpu: the device (which may be shared, as the viewer shares its window's), the
-    /// validated kernel and the scene's Lipschitz bound L (and the program and setup, to
-    /// specialise the kernel again for other settings).
+    /// validated kernel and the scene's Lipschitz bound L (and the lowered scene and setup,
+    /// to specialise the kernel again for other settings).
     Wgpu {
         gpu: Arc<Gpu>,
         kernel: Box<wgsl::Kernel>,
         lipschitz: f64,
-        program: Box<Program>,
+        lowered: Box<Lowered>,
         setup: Setup,
     },
     /// CUDA: the device, the loaded module, the kernel's scene data, the settings it was
-    /// specialised for and the scene's Lipschitz bound L (and the program and setup, to
+    /// specialised for and the scene's Lipschitz bound L (and the lowered scene and setup, to
     /// specialise the kernel again for other settings).
     Cuda {
         cuda: Box<Cuda>,
@@ -68,7 +69,7 @@ pub enum Prepared {
         specialisation: wgsl::Specialisation,
         ptx_time: Duration,
         lipschitz: f64,
-        program: Box<Program>,
+        lowered: Box<Lowered>,
         setup: Setup,
         /// The WGSL text the module was translated from.
         source: String,
@@ -96,10 +97,16 @@ pub struct Frame {
 }
 
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
-/// does not allow it, saying why.
+/// does not allow it, saying why (before lowering: `sdfc render` refuses such settings
+/// first).
 pub fn method_allowed(scene: &Scene) -> Result<(), String> {
+    traceable_with(scene, &analytic::traceable(scene))
+}
+
+/// [`method_allowed`] for a scene whose primitives the lowering found (`traceable`).
+fn traceable_with(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
     if scene.settings.method == Method::Trace {
-        if let Choice::March(reason) = analytic::choose(scene) {
+        if let Choice::March(reason) = traceable.choose(scene.settings.method) {
             return Err(format!(
                 "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
                 reason.describe()
@@ -116,46 +123,46 @@ impl Prepared {
             precision,
             ..Setup::default()
         };
-        Self::from_program(backend, scene, lower::lower(scene), &setup)
+        let lowered = lower::lower_scene(scene, &LowerOptions::default());
+        Self::from_program(backend, scene, lowered, &setup)
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for `backend`.
+    /// Prepares `scene`, lowered as `lowered` (its program and what else the backends
+    /// read), for `backend`.
     pub fn from_program(
         backend: Backend,
         scene: &Scene,
-        program: Program,
+        lowered: Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        method_allowed(scene)?;
+        traceable_with(scene, &lowered.traceable)?;
         match backend {
-            Backend::Cpu => Ok(Self::cpu(scene, program, setup)),
-            Backend::Wgpu => Self::wgpu(scene, &program, setup, false),
-            Backend::Cuda => Self::cuda(scene, &program, setup),
-            Backend::Auto if setup.precision == Precision::F64 => {
-                Ok(Self::cpu(scene, program, setup))
-            }
-            Backend::Auto => Self::cuda(scene, &program, setup)
-                .or_else(|_| Self::wgpu(scene, &program, setup, true))
-                .or_else(|_| Ok(Self::cpu(scene, program, setup))),
+            Backend::Cpu => Ok(Self::cpu(lowered, setup)),
+            Backend::Wgpu => Self::wgpu(scene, &lowered, setup, false),
+            Backend::Cuda => Self::cuda(scene, &lowered, setup),
+            Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(lowered, setup)),
+            Backend::Auto => Self::cuda(scene, &lowered, setup)
+                .or_else(|_| Self::wgpu(scene, &lowered, setup, true))
+                .or_else(|_| Ok(Self::cpu(lowered, setup))),
         }
     }
 
-    fn cpu(scene: &Scene, program: Program, setup: &Setup) -> Prepared {
+    fn cpu(lowered: Lowered, setup: &Setup) -> Prepared {
         let options = Options {
             precision: setup.precision,
             debug_nan: setup.debug_nan,
-            lipschitz: program.lipschitz(),
+            lipschitz: lowered.program.lipschitz(),
             ..Options::default()
         };
         Prepared::Cpu {
-            tapes: Box::new(Tapes::for_scene(scene, &program)),
-            program,
+            tapes: Box::new(Tapes::new(&lowered)),
+            program: lowered.program,
             options,
         }
     }
 
-    fn kernel(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Kernel, String> {
-        wgsl::write_with(scene, program, &Self::kernel_options(setup)).map_err(|e| e.to_string())
+    fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, String> {
+        wgsl::write_with(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
     }
 
     fn kernel_options(setup: &Setup) -> wgsl::Options {
@@ -168,57 +175,56 @@ impl Prepared {
 
     /// The text and data of the kernel for `scene`, not validated (to compare with a kernel
     /// held).
-    fn kernel_text(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Text, String> {
-        wgsl::write_text(scene, program, &Self::kernel_options(setup)).map_err(|e| e.to_string())
+    fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, String> {
+        wgsl::write_text(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
     }
 
     fn wgpu(
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
         require_hardware: bool,
     ) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
-        Self::on_gpu(Arc::new(gpu), scene, program, setup)
+        Self::on_gpu(Arc::new(gpu), scene, lowered, setup)
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for wgpu on an already opened
-    /// device: generates and validates the kernel (its pipeline is compiled, or found in the
+    /// Prepares `scene`, lowered as `lowered`, for wgpu on an already opened device:
+    /// generates and validates the kernel (its pipeline is compiled, or found in the
     /// device's cache, at the first render or by [`Gpu::pipeline_for`]).
     pub fn on_gpu(
         gpu: Arc<Gpu>,
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        method_allowed(scene)?;
-        let lipschitz = program.lipschitz();
+        traceable_with(scene, &lowered.traceable)?;
         Ok(Prepared::Wgpu {
             gpu,
-            kernel: Box::new(Self::kernel(scene, program, setup)?),
-            lipschitz,
-            program: Box::new(program.clone()),
+            kernel: Box::new(Self::kernel(scene, lowered, setup)?),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
             setup: *setup,
         })
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for the CPU renderer.
-    pub fn on_cpu(scene: &Scene, program: Program, setup: &Setup) -> Result<Prepared, String> {
-        method_allowed(scene)?;
-        Ok(Self::cpu(scene, program, setup))
+    /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
+    pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
+        traceable_with(scene, &lowered.traceable)?;
+        Ok(Self::cpu(lowered, setup))
     }
 
-    fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {
+    fn cuda(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<Prepared, String> {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
-        let module = Self::cuda_module(&cuda, scene, program, setup)?;
+        let module = Self::cuda_module(&cuda, scene, lowered, setup)?;
         Ok(Prepared::Cuda {
             cuda: Box::new(cuda),
             loaded: Box::new(module.loaded),
             data: module.data,
             specialisation: module.specialisation,
             ptx_time: module.ptx_time,
-            lipschitz: program.lipschitz(),
-            program: Box::new(program.clone()),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
             setup: *setup,
             source: module.source,
         })
@@ -228,10 +234,10 @@ impl Prepared {
     fn cuda_module(
         cuda: &Cuda,
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
     ) -> Result<CudaModule, String> {
-        Self::cuda_module_of(cuda, Self::kernel(scene, program, setup)?)
+        Self::cuda_module_of(cuda, Self::kernel(scene, lowered, setup)?)
     }
 
     /// Translates `kernel` to PTX and loads it on `cuda`.
@@ -255,13 +261,13 @@ impl Prepared {
         })
     }
 
-    /// Prepares `scene`, whose distance program is `program`, in place of the scene this was
-    /// prepared for, keeping the device: a GPU kernel whose text is unchanged (with
-    /// [`Setup::parameters`], a program that differs only in numbers) is kept and given the
-    /// new `scene_data`; another is compiled. Returns whether a kernel (or the CPU's tapes)
-    /// was built.
-    pub fn update(&mut self, scene: &Scene, program: Program) -> Result<bool, String> {
+    /// Prepares `scene`, lowered as `lowered`, in place of the scene this was prepared for,
+    /// keeping the device: a GPU kernel whose text is unchanged (with [`Setup::parameters`], a
+    /// program that differs only in numbers) is kept and given the new `scene_data`; another
+    /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
+    pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
         method_allowed(scene)?;
+        traceable_with(scene, &lowered.traceable)?;
         match self {
             Prepared::Cpu { options, .. } => {
                 let setup = Setup {
@@ -269,25 +275,25 @@ impl Prepared {
                     debug_nan: options.debug_nan,
                     parameters: false,
                 };
-                *self = Self::cpu(scene, program, &setup);
+                *self = Self::cpu(lowered, &setup);
                 Ok(true)
             }
             Prepared::Wgpu {
                 kernel,
                 lipschitz,
-                program: held,
+                lowered: held,
                 setup,
                 ..
             } => {
-                let text = Self::kernel_text(scene, &program, setup)?;
+                let text = Self::kernel_text(scene, &lowered, setup)?;
                 let built = text.source != kernel.source;
                 if built {
-                    **kernel = Self::kernel(scene, &program, setup)?;
+                    **kernel = Self::kernel(scene, &lowered, setup)?;
                 } else {
                     kernel.data = text.data;
                 }
-                *lipschitz = program.lipschitz();
-                **held = program;
+                *lipschitz = lowered.program.lipschitz();
+                **held = lowered;
                 Ok(built)
             }
             Prepared::Cuda {
@@ -297,14 +303,14 @@ impl Prepared {
                 specialisation,
                 ptx_time,
                 lipschitz,
-                program: held,
+                lowered: held,
                 setup,
                 source,
             } => {
-                let text = Self::kernel_text(scene, &program, setup)?;
+                let text = Self::kernel_text(scene, &lowered, setup)?;
                 let built = text.source != *source;
                 if built {
-                    let module = Self::cuda_module_of(cuda, Self::kernel(scene, &program, setup)?)?;
+                    let module = Self::cuda_module_of(cuda, Self::kernel(scene, &lowered, setup)?)?;
                     **loaded = module.loaded;
                     *data = module.data;
                     *specialisation = module.specialisation;
@@ -313,8 +319,8 @@ impl Prepared {
                 } else {
                     *data = text.data;
                 }
-                *lipschitz = program.lipschitz();
-                **held = program;
+                *lipschitz = lowered.program.lipschitz();
+                **held = lowered;
                 Ok(built)
             }
         }
@@ -338,16 +344,16 @@ impl Prepared {
         if self.specialisation().is_none_or(|s| s == wanted) {
             return Ok(());
         }
-        method_allowed(scene)?;
         match self {
             Prepared::Cpu { .. } => Ok(()),
             Prepared::Wgpu {
                 kernel,
-                program,
+                lowered,
                 setup,
                 ..
             } => {
-                **kernel = Self::kernel(scene, program, setup)?;
+                traceable_with(scene, &lowered.traceable)?;
+                **kernel = Self::kernel(scene, lowered, setup)?;
                 Ok(())
             }
             Prepared::Cuda {
@@ -356,13 +362,14 @@ impl Prepared {
                 data,
                 specialisation,
                 ptx_time,
-                program,
+                lowered,
                 setup,
                 source,
                 ..
             } => {
+                traceable_with(scene, &lowered.traceable)?;
                 // The same device and context; the new module replaces the old one.
-                let module = Self::cuda_module(cuda, scene, program, setup)?;
+                let module = Self::cuda_module(cuda, scene, lowered, setup)?;
                 **loaded = module.loaded;
                 *data = module.data;
                 *specialisation = module.specialisation;
@@ -451,10 +458,20 @@ impl Prepared {
     }
 
     /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
-    pub fn program_len(&self, scene: &Scene) -> usize {
+    pub fn program_len(&self) -> usize {
         match self {
             Prepared::Cpu { program, .. } => program.len(),
-            _ => lower::lower(scene).len(),
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => {
+                lowered.program.len()
+            }
+        }
+    }
+
+    /// The scene's primitives, or why it cannot be traced analytically, as lowered.
+    pub fn traceable(&self) -> &Traceable {
+        match self {
+            Prepared::Cpu { tapes, .. } => tapes.traceable(),
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => &lowered.traceable,
         }
     }
 
@@ -533,4 +550,14 @@ fn describe(s: &wgsl::Specialisation) -> String {
         },
         s.max_depth
     )
+}
+
+impl memory::Footprint for Prepared {
+    fn memory(&self, scene: &Scene, settings: &Settings) -> Memory {
+        Prepared::memory(self, scene, settings)
+    }
+
+    fn retained(&self, settings: &Settings) -> u64 {
+        Prepared::retained(self, settings)
+    }
 }

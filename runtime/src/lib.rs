@@ -14,4 +14,5 @@ pub mod memory;
 pub mod metrics;
 pub mod output;
 pub mod sequence;
+pub mod settings;
 pub mod view;

@@ -41,6 +41,9 @@ pub struct Ctx {
     /// Where the render block sets `method`, for the error when analytic tracing is asked
     /// of a scene that does not allow it.
     pub method_span: Option<Span>,
+    /// The settings the render block gives (a field with no proven bound has defaults of its
+    /// own for `epsilon` and `relaxation`).
+    pub settings_given: Vec<String>,
     /// Where the camera, the lights and the scene are written (`placement.rs`).
     pub places: super::placement::Places,
     locals: Vec<(String, Value)>,

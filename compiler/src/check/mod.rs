@@ -108,6 +108,9 @@ pub fn check_at(
         // Distance semantics: warnings where a construct makes the field unreliable.
         let analysis = crate::scene::analysis::analyse(&scene);
         cx.diags.extend_from_slice(analysis.diagnostics());
+        if analysis.root().is_some_and(|root| !root.proven) {
+            unbounded_defaults(&cx.settings_given, &mut scene.settings);
+        }
         analytic_method(&mut cx, &scene);
     }
     if !crate::diagnostics::has_errors(&cx.diags) {
@@ -118,6 +121,17 @@ pub fn check_at(
     cx.diags.sort_by_key(|d| (d.span().file, d.span().start));
     let errors = crate::diagnostics::has_errors(&cx.diags);
     (if errors { None } else { Some(scene) }, cx.diags)
+}
+
+/// The defaults of a field with no proven distance bound, for the settings the file does not
+/// give (docs/accuracy.md, "Fields without a bound"): such a field has detail below any ε, so
+/// ε follows the pixel footprint; and over-relaxation, whose fallback relies on a bound, is off.
+fn unbounded_defaults(given: &[String], settings: &mut Settings) {
+    let given = |name: &str| given.iter().any(|g| g == name);
+    settings.footprint = !given("epsilon");
+    if !given("relaxation") {
+        settings.relaxation = 1.0;
+    }
 }
 
 /// `method: "trace"` on a scene that cannot be ray traced analytically is an error at the
@@ -644,6 +658,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 .iter()
                 .find(|f| f.name.name == "method")
                 .map(|f| f.value.span);
+            cx.settings_given = b.fields.iter().map(|f| f.name.name.clone()).collect();
             let int = |k: &str| f[k].num() as u32;
             scene.settings = Settings {
                 width: int("width"),
@@ -651,6 +666,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 aa: int("aa"),
                 max_steps: int("max_steps"),
                 epsilon: f["epsilon"].num(),
+                footprint: false,
                 max_depth: int("max_depth"),
                 max_dist: f["max_dist"].num(),
                 relaxation: f["relaxation"].num(),

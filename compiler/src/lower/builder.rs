@@ -2,8 +2,7 @@
 //! sharing of equal instructions (when optimising), opens and closes guarded blocks, and
 //! offers the small vector helpers the lowering rules are written with.
 
-use super::{Axis, Binary, Block, Note, Op, Program, Reg, Unary};
-use crate::eval::scalar;
+use crate::program::{scalar, Axis, Binary, Block, Note, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 
 /// A point or vector: three registers.
@@ -290,7 +289,6 @@ impl Builder {
             distance: d,
             material: m,
             lipschitz: 1.0,
-            options: super::LowerOptions::default(),
         };
         let (live, live_blocks) = if self.optimise {
             raw.live(&[d, m])
@@ -338,7 +336,6 @@ impl Builder {
             distance: new_index[d.0 as usize],
             material: new_index[m.0 as usize],
             lipschitz: 1.0,
-            options: super::LowerOptions::default(),
         }
     }
 }
@@ -515,7 +512,7 @@ mod tests {
         // IEEE addition and multiplication commute, NaN included (up to which NaN).
         assert_eq!(b.add(x, y), b.add(y, x));
         assert_eq!(b.mul(x, y), b.mul(y, x));
-        // min and max do not: with a NaN operand the second one wins (eval::float).
+        // min and max do not: with a NaN operand the second one wins (program::float).
         assert_ne!(b.min(x, y), b.min(y, x));
         assert_ne!(b.max(x, y), b.max(y, x));
         assert_eq!(b.max(x, y), b.max(x, y));

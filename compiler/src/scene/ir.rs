@@ -453,8 +453,13 @@ pub struct Settings {
     pub aa: u32,
     /// Sphere-tracing step budget per ray.
     pub max_steps: u32,
-    /// Pixel-cone hit tolerance: hit when |d| < epsilon · t.
+    /// Pixel-cone hit tolerance: hit when |d| < epsilon · t (unless `footprint`).
     pub epsilon: f64,
+    /// Whether ε follows the pixel footprint instead of `epsilon`: ε is then the angular
+    /// radius of a pixel, tan(fov/2)/height (see [`Settings::hit_epsilon`]). The checker sets
+    /// it where the file gives no `epsilon` and the field has no proven distance bound
+    /// (docs/accuracy.md, "Fields without a bound"); `--set epsilon` clears it.
+    pub footprint: bool,
     /// Secondary-ray depth limit.
     pub max_depth: u32,
     /// Rays stop beyond this distance.
@@ -503,6 +508,19 @@ impl Method {
     }
 }
 
+impl Settings {
+    /// The ε of the hit test for a camera of field of view `fov` (radians): `epsilon`, or
+    /// where `footprint`, the angular radius of one pixel, tan(fov/2)/height: the surface as a
+    /// cone one pixel wide sees it.
+    pub fn hit_epsilon(&self, fov: f64) -> f64 {
+        if self.footprint {
+            (fov * 0.5).tan() / self.height.max(1) as f64
+        } else {
+            self.epsilon
+        }
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Settings {
@@ -511,6 +529,7 @@ impl Default for Settings {
             aa: 1,
             max_steps: 512,
             epsilon: 1e-5,
+            footprint: false,
             max_depth: 5,
             max_dist: 100.0,
             relaxation: 1.4,
@@ -591,6 +610,11 @@ impl Animation {
 }
 
 impl Scene {
+    /// The ε rays are marched with ([`Settings::hit_epsilon`] for this scene's camera).
+    pub fn epsilon(&self) -> f64 {
+        self.settings.hit_epsilon(self.camera.fov)
+    }
+
     /// Where a checker of cells of edge `size` starts at the scene's origin, in cells: the
     /// written pattern at p + origin is the pattern at p / size + shift. The origin is
     /// reduced modulo two cells (which keeps the parity) so that the shift stays small and

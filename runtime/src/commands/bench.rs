@@ -1,13 +1,14 @@
 //! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps, and
 //! for GPU targets the achieved fraction of the FP32 floor).
 
-use super::render::{override_settings, parse_size, thread_pool, Backend};
+use super::render::{thread_pool, Backend};
 use crate::backend::{Prepared, Setup};
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
-use sdfc_compiler::lower::{LowerOptions, Program};
-use sdfc_compiler::scene::{analytic, Scene};
+use crate::settings::{override_settings, parse_size};
+use sdfc_compiler::lower::{LowerOptions, Lowered};
+use sdfc_compiler::scene::Scene;
 use sdfc_compiler::Limits;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -323,13 +324,13 @@ pub fn run(args: BenchArgs) -> ExitCode {
             eprintln!("error: {msg}");
             return ExitCode::from(2);
         }
-        let program = match checked.lower(&LowerOptions::default(), &limits) {
-            Ok(p) => p,
+        let lowered = match checked.lower(&LowerOptions::default(), &limits) {
+            Ok(l) => l,
             Err(code) => return code,
         };
         let name = file.display().to_string();
         let scene = &checked.scene;
-        let t = match pool.install(|| time_scene(&args, name, scene, program, &limits)) {
+        let t = match pool.install(|| time_scene(&args, name, scene, lowered, &limits)) {
             Ok(t) => t,
             Err(msg) => {
                 eprintln!("error: {}: {msg}", file.display());
@@ -362,17 +363,17 @@ fn time_scene(
     args: &BenchArgs,
     name: String,
     scene: &Scene,
-    program: Program,
+    lowered: Lowered,
     limits: &Limits,
 ) -> Result<Timing, String> {
-    let ops_per_eval = fp32::distance_ops(&program);
-    let guarded = !program.blocks().is_empty();
+    let ops_per_eval = fp32::distance_ops(&lowered.program);
+    let guarded = !lowered.program.blocks().is_empty();
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
         parameters: false,
     };
-    let prepared = Prepared::from_program(args.backend, scene, program, &setup)?;
+    let prepared = Prepared::from_program(args.backend, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);
     frame.host = frame
@@ -392,7 +393,7 @@ fn time_scene(
     let median = times[times.len() / 2];
     let c = &last.stats.counters;
     let s = &scene.settings;
-    let traced = analytic::choose(scene).primitives().is_some();
+    let traced = prepared.traceable().traced(s.method).is_some();
     let evaluations = if traced { 0 } else { fp32::evaluations(c) };
     let peak = match prepared {
         Prepared::Cpu { .. } => None,
@@ -421,7 +422,7 @@ fn time_scene(
         mrays_per_s: c.camera_rays as f64 / median / 1e6,
         total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
         method: if traced { "trace" } else { "march" },
-        program_len: prepared.program_len(scene),
+        program_len: prepared.program_len(),
         ops_per_eval,
         evaluations,
         fp32_peak_tflops: peak.map(|p| p / 1e12),

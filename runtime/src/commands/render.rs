@@ -8,11 +8,12 @@ use crate::cpu::reference::{self, Convergence};
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat};
 use crate::output::Output;
+use crate::settings::{override_settings, parse_size};
 use crate::{depth, memory};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::lower::LowerOptions;
-use sdfc_compiler::scene::{Method, Scene, Settings};
-use sdfc_compiler::{Limit, Limits};
+use sdfc_compiler::scene::Scene;
+use sdfc_compiler::Limits;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -56,8 +57,9 @@ pub struct RenderArgs {
     pub threads: Option<usize>,
     /// Render the reference: on the CPU in f64 with ε 1e-6, 100000 steps and no
     /// over-relaxation (`--set` still applies on top), then check it against a render with ε
-    /// ten times smaller; `--stats` prints how well they agree, and a warning says when they
-    /// do not.
+    /// ten times smaller; for a field with no proven bound, the area average of at least 8×8
+    /// samples at the pixel footprint's ε, checked against twice the samples per axis.
+    /// `--stats` prints how well they agree, and a warning says when they do not.
     #[arg(long)]
     pub reference: bool,
     /// Also write the depth and hit buffers as a sidecar file beside the image (OUT.aux; see
@@ -142,8 +144,8 @@ pub fn run(args: RenderArgs) -> ExitCode {
 pub struct FrameScene {
     /// The scene, settings applied.
     pub scene: Scene,
-    /// Its distance program.
-    pub program: sdfc_compiler::lower::Program,
+    /// Its distance program and what else the backends read.
+    pub lowered: sdfc_compiler::lower::Lowered,
 }
 
 /// The settings a command overrides in every frame it checks.
@@ -190,10 +192,10 @@ pub fn frame_scene(
     let Some(mut scene) = loaded.scene else {
         return Err(CliError::Reported(ExitCode::from(1)));
     };
-    let settings = &mut scene.settings;
     if args.reference {
-        *settings = reference::settings(settings);
+        scene.settings = reference::settings_of(&scene);
     }
+    let settings = &mut scene.settings;
     override_settings(settings, args.size, args.aa, args.set, limits).map_err(CliError::Usage)?;
     crate::backend::method_allowed(&scene).map_err(CliError::Failed)?;
     let checked = frontend::Checked {
@@ -201,12 +203,12 @@ pub fn frame_scene(
         sources: loaded.sources,
         format: DiagnosticFormat::Human,
     };
-    let program = checked
+    let lowered = checked
         .lower(lowering, limits)
         .map_err(CliError::Reported)?;
     Ok(FrameScene {
         scene: checked.scene,
-        program,
+        lowered,
     })
 }
 
@@ -217,9 +219,9 @@ pub fn prepare(
     frame: FrameScene,
     setup: &Setup,
 ) -> Result<(Scene, Prepared), CliError> {
-    let FrameScene { scene, program } = frame;
+    let FrameScene { scene, lowered } = frame;
     let prepared = pool
-        .install(|| Prepared::from_program(backend, &scene, program, setup))
+        .install(|| Prepared::from_program(backend, &scene, lowered, setup))
         .map_err(|msg| {
             CliError::Failed(format!("the {backend:?} backend is not available: {msg}"))
         })?;
@@ -385,7 +387,8 @@ pub fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String>
     }
 }
 
-/// Renders the convergence check of a reference frame (ε divided by ten) and compares.
+/// Renders the convergence check of a reference frame (ε divided by ten, or twice the samples
+/// per axis for an area-averaged reference) and compares.
 pub fn check_reference(
     prepared: &Prepared,
     scene: &Scene,
@@ -394,18 +397,15 @@ pub fn check_reference(
     let mut finer = scene.clone();
     finer.settings = reference::check_settings(&scene.settings);
     let check = prepared.render(&finer, &|_| {})?;
-    Ok(reference::convergence(
-        &scene.settings,
-        &frame.render,
-        &check.render,
-    ))
+    Ok(reference::convergence(scene, &frame.render, &check.render))
 }
 
 /// The warning printed for a reference that did not converge.
 pub fn not_converged(c: &Convergence) -> String {
     format!(
-        "the reference has not converged: against ε {:e} it reaches {:.1} dB (needs {} dB), max difference {:.3}, and {} rays ran out of {} steps; its error is not far below the errors it would measure",
-        c.check_epsilon,
+        "the reference has not converged: against ε {}, aa {} it reaches {:.1} dB (needs {} dB), max difference {:.3}, and {} rays ran out of {} steps; its error is not far below the errors it would measure",
+        sdfc_compiler::diagnostics::scientific(c.check_epsilon),
+        c.check_aa,
         c.difference.psnr,
         reference::CONVERGED_PSNR,
         c.difference.max,
@@ -482,142 +482,4 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> 
     }
     b.build()
         .map_err(|e| format!("cannot start worker threads: {e}"))
-}
-
-/// Parses `WIDTHxHEIGHT` (each edge is checked against the `edge` limit when applied).
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, like 640x480, not `{s}`"))?;
-    let ceiling = Limit::Edge.ceiling() as u32;
-    let w = int("width", w.trim(), 1, ceiling, None)?;
-    let h = int("height", h.trim(), 1, ceiling, None)?;
-    Ok((w, h))
-}
-
-/// Applies `--size`, `--aa` and then each `--set key=value`, in order, within `limits`.
-pub fn override_settings(
-    s: &mut Settings,
-    size: Option<(u32, u32)>,
-    aa: Option<u32>,
-    sets: &[String],
-    limits: &Limits,
-) -> Result<(), String> {
-    if let Some((w, h)) = size {
-        set(s, "width", &w.to_string(), limits)?;
-        set(s, "height", &h.to_string(), limits)?;
-    }
-    if let Some(n) = aa {
-        set(s, "aa", &n.to_string(), limits)?;
-    }
-    for item in sets {
-        let (key, value) = item
-            .split_once('=')
-            .ok_or_else(|| format!("--set expects KEY=VALUE, like max_steps=512, not `{item}`"))?;
-        set(s, key.trim(), value.trim(), limits)?;
-    }
-    Ok(())
-}
-
-/// The keys `--set` accepts.
-pub const SETTING_KEYS: &[&str] = &[
-    "width",
-    "height",
-    "aa",
-    "max_steps",
-    "epsilon",
-    "max_depth",
-    "max_dist",
-    "relaxation",
-    "background",
-    "method",
-];
-
-/// Sets one render setting from text, checking its range (the top of the range of width,
-/// height, aa, max_steps and max_depth is a limit of `limits`).
-pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<(), String> {
-    let limited = |limit: Limit, lo: u32| {
-        let hi = limits.get(limit).min(u32::MAX as u64) as u32;
-        int(key, value, lo, hi, Some((limits, limit)))
-    };
-    match key {
-        "width" => s.width = limited(Limit::Edge, 1)?,
-        "height" => s.height = limited(Limit::Edge, 1)?,
-        "aa" => s.aa = limited(Limit::Aa, 1)?,
-        "max_steps" => s.max_steps = limited(Limit::MaxSteps, 1)?,
-        "max_depth" => s.max_depth = limited(Limit::MaxDepth, 0)?,
-        "epsilon" => s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?,
-        "max_dist" => s.max_dist = real(key, value, |v| v > 0.0, "a positive number")?,
-        "relaxation" => {
-            s.relaxation = real(
-                key,
-                value,
-                |v| (1.0..2.0).contains(&v),
-                "a number in [1, 2)",
-            )?
-        }
-        "background" => s.background = colour(value)?,
-        "method" => {
-            s.method = Method::from_name(value).ok_or_else(|| {
-                format!(
-                    "method must be one of {}, not `{value}`",
-                    Method::NAMES.join(", ")
-                )
-            })?
-        }
-        _ => {
-            return Err(format!(
-                "unknown render setting `{key}`; the settings are {}",
-                SETTING_KEYS.join(", ")
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// A whole number from `lo` to `hi`; with `limit`, one above `hi` says how to raise it.
-fn int(
-    key: &str,
-    value: &str,
-    lo: u32,
-    hi: u32,
-    limit: Option<(&Limits, Limit)>,
-) -> Result<u32, String> {
-    let parsed = value.parse::<u64>();
-    match parsed {
-        Ok(v) if (lo as u64..=hi as u64).contains(&v) => Ok(v as u32),
-        _ => {
-            let mut msg = format!("{key} must be a whole number from {lo} to {hi}, not `{value}`");
-            if let (Some((limits, limit)), Ok(v)) = (limit, parsed) {
-                if v > hi as u64 {
-                    msg.push_str(&format!("; {}", limits.raise_to(limit, v)));
-                }
-            }
-            Err(msg)
-        }
-    }
-}
-
-fn real(key: &str, value: &str, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
-    match value.parse::<f64>() {
-        Ok(v) if v.is_finite() && ok(v) => Ok(v),
-        _ => Err(format!("{key} must be {what}, not `{value}`")),
-    }
-}
-
-fn colour(value: &str) -> Result<[f64; 3], String> {
-    let err = || {
-        format!(
-            "background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{value}`"
-        )
-    };
-    let parts: Vec<f64> = value
-        .trim_matches(|c| c == '(' || c == ')')
-        .split(',')
-        .map(|p| p.trim().parse::<f64>().map_err(|_| err()))
-        .collect::<Result<_, _>>()?;
-    match parts[..] {
-        [r, g, b] if parts.iter().all(|v| (0.0..=1.0).contains(v)) => Ok([r, g, b]),
-        _ => Err(err()),
-    }
 }

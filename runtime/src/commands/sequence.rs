@@ -280,7 +280,7 @@ impl<'a> Kernels<'a> {
         let same = self
             .prepared
             .as_ref()
-            .is_some_and(|(p, o, _)| *p == frame.program && *o == frame.scene.origin);
+            .is_some_and(|(p, o, _)| *p == frame.lowered.program && *o == frame.scene.origin);
         let scene = match &mut self.prepared {
             Some((_, _, prepared)) if same => {
                 let FrameScene { scene, .. } = frame;
@@ -294,16 +294,16 @@ impl<'a> Kernels<'a> {
             // The device stays open; the kernel is kept when its text is the same (the
             // program differs in numbers only) and given the frame's constants.
             Some((held, origin, prepared)) => {
-                let FrameScene { scene, program } = frame;
-                *held = program.clone();
+                let FrameScene { scene, lowered } = frame;
+                *held = lowered.program.clone();
                 *origin = scene.origin;
-                if prepared.update(&scene, program).map_err(CliError::Failed)? {
+                if prepared.update(&scene, lowered).map_err(CliError::Failed)? {
                     self.count += 1;
                 }
                 scene
             }
             None => {
-                let program = frame.program.clone();
+                let program = frame.lowered.program.clone();
                 let (scene, prepared) = prepare(self.pool, self.backend, frame, &self.setup)?;
                 self.count += 1;
                 self.prepared = Some((program, scene.origin, prepared));

@@ -7,15 +7,13 @@
 use super::camera::{self, Orbit};
 use super::watch::Fingerprint;
 use crate::backend::{Prepared, Setup};
-use crate::commands::check;
-use crate::commands::render::override_settings;
 use crate::frontend::{self, DiagnosticFormat, Loaded};
 use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
 use crate::image::Image;
+use crate::settings::override_settings;
 use sdfc_compiler::back::wgsl;
 use sdfc_compiler::lower::{self, LowerOptions};
-use sdfc_compiler::scene::analytic::{self, Choice};
 use sdfc_compiler::scene::{Camera, Scene};
 use sdfc_compiler::{Diagnostic, FileId, Limit, Limits, Severity, SourceMap};
 use std::path::{Path, PathBuf};
@@ -355,13 +353,13 @@ impl Session {
         eprintln!(
             "{}: ok; {}; {}",
             self.file.display(),
-            check::summary(&loaded, &scene),
-            check::method(&loaded, &scene)
+            frontend::summary(&loaded, &scene),
+            frontend::method(&loaded, &scene)
         );
         let check_time = start.elapsed();
         let start = Instant::now();
-        let program = match lower::lower_within(&scene, &LowerOptions::default(), &limits) {
-            Ok(program) => program,
+        let lowered = match lower::lower_within(&scene, &LowerOptions::default(), &limits) {
+            Ok(lowered) => lowered,
             Err(d) => {
                 let summary = first_error(std::slice::from_ref(&d), &loaded.sources);
                 frontend::print_diagnostics(&[d], &loaded.sources, DiagnosticFormat::Human);
@@ -372,8 +370,8 @@ impl Session {
         let start = Instant::now();
         let setup = Setup::default();
         let prepared = match &self.device {
-            Device::Cpu => Prepared::on_cpu(&scene, program, &setup),
-            Device::Wgpu(gpu) => Prepared::on_gpu(gpu.clone(), &scene, &program, &setup),
+            Device::Cpu => Prepared::on_cpu(&scene, lowered, &setup),
+            Device::Wgpu(gpu) => Prepared::on_gpu(gpu.clone(), &scene, &lowered, &setup),
         };
         let prepared = prepared.inspect_err(|msg| eprintln!("error: {msg}"))?;
         let prepare_time = start.elapsed();
@@ -391,9 +389,9 @@ impl Session {
             ),
             _ => None,
         };
-        let method = match analytic::choose(&scene) {
-            Choice::Trace(_) => "trace",
-            Choice::March(_) => "march",
+        let method = match prepared.traceable().traced(scene.settings.method) {
+            Some(_) => "trace",
+            None => "march",
         };
         let aa = scene.settings.aa.max(1);
         let good = Good {

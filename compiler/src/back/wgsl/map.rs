@@ -5,7 +5,7 @@
 //! block's value inside it. In a large program, large blocks become functions of their own
 //! (`map_blockN`, `sdf_blockN`) that take the point and the values they read from outside.
 
-use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
+use crate::program::{results, Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::cell::RefCell;
 use std::fmt::Write;
 
@@ -339,18 +339,6 @@ impl<'a> Writer<'a> {
         reads.dedup();
         reads
     }
-}
-
-/// The needed results of block `b`: (register, value inside, value from before).
-pub(crate) fn results(program: &Program, b: usize, live: &[bool]) -> Vec<(usize, Reg, Reg)> {
-    let block = &program.blocks()[b];
-    (block.end..block.end + block.results)
-        .filter(|&j| live[j])
-        .filter_map(|j| match program.ops()[j] {
-            Op::Phi(then, other) => Some((j, then, other)),
-            _ => None,
-        })
-        .collect()
 }
 
 /// A WGSL float literal for `x` rounded to f32 (finite values only reach here; others are

@@ -18,9 +18,7 @@ mod template;
 pub use analytic::MAX_UNROLLED;
 pub use map::{float, write_map, write_sdf};
 
-pub(crate) use map::results;
-
-use crate::lower::Program;
+use crate::lower::Lowered;
 use crate::scene::{Light, Pattern, Scene};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -36,7 +34,7 @@ pub const STATS_WORDS: u32 = 8;
 
 const TEMPLATE: &str = include_str!("kernel.wgsl");
 
-/// The most instances (`lower::split`) of a marched scene's root union written as code: beyond,
+/// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
 /// they are read from `scene_data` and walked in a loop. The code grows with the scene (the
 /// CUDA JIT of a marched kernel of 10 000 spheres takes minutes), but up to a few thousand
 /// instances it is the faster of the two: its culling visits the nearer half first and
@@ -198,14 +196,14 @@ impl Default for Options {
     }
 }
 
-/// Writes and validates the kernel for `scene`, whose distance program is `program`.
-pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
-    write_with(scene, program, &Options::default())
+/// Writes and validates the kernel for `scene`, lowered as `lowered`.
+pub fn write(scene: &Scene, lowered: &Lowered) -> Result<Kernel, Error> {
+    write_with(scene, lowered, &Options::default())
 }
 
 /// [`write`] with the given options.
-pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result<Kernel, Error> {
-    let text = write_text(scene, program, options)?;
+pub fn write_with(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Kernel, Error> {
+    let text = write_text(scene, lowered, options)?;
     let (module, info) = validate(&text.source, scene)?;
     Ok(Kernel {
         source: text.source,
@@ -230,8 +228,8 @@ pub struct Text {
 }
 
 /// The text of the kernel [`write_with`] writes, not validated.
-pub fn write_text(scene: &Scene, program: &Program, options: &Options) -> Result<Text, Error> {
-    let choice = crate::scene::analytic::choose(scene);
+pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Text, Error> {
+    let choice = lowered.choice(&scene.settings);
     let mut features = features(scene, choice.primitives().is_some());
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
     // Listed in the header only when on, so that the default kernel does not change.
@@ -250,14 +248,12 @@ pub fn write_text(scene: &Scene, program: &Program, options: &Options) -> Result
             bytes
         }
         None => {
-            let (mut text, bytes, params) = marched(scene, program, options);
+            let (mut text, bytes, params) = marched(scene, lowered, options);
             if params {
                 features.push(("PARAMS", true));
             }
             // Rays inside glass that may overlap a solid march the scene's media.
-            let media = on["REFRACTION"]
-                .then(|| crate::lower::media(scene))
-                .flatten();
+            let media = lowered.media.as_ref().filter(|_| on["REFRACTION"]);
             on.insert("MEDIA", media.is_some());
             if let Some(m) = media {
                 features.push(("MEDIA", true));
@@ -311,8 +307,10 @@ pub fn write_text(scene: &Scene, program: &Program, options: &Options) -> Result
 /// `scene_data` (march.rs), unless their materials or their bytes do not fit. The program as
 /// code reads its constants from `scene_data` with [`Options::parameters`] (then the last
 /// value is true).
-fn marched(scene: &Scene, program: &Program, options: &Options) -> (String, Option<Vec<u8>>, bool) {
-    let split = crate::lower::split(scene, &program.options(), options.max_instances)
+fn marched(scene: &Scene, lowered: &Lowered, options: &Options) -> (String, Option<Vec<u8>>, bool) {
+    let program = &lowered.program;
+    let split = lowered
+        .instances(options.max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {
             let data = march::data(&s.instances, scene.camera.position);
@@ -406,7 +404,7 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
     w.v4(v, 0.0);
     w.f([tan * aspect, tan, s.width as f64, s.height as f64]);
     w.f([
-        s.epsilon,
+        scene.epsilon(),
         s.max_dist,
         s.relaxation.max(1.0),
         1.0 / lipschitz.max(1.0),

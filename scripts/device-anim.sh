@@ -42,7 +42,7 @@ if [ "$MODE" = all ] || [ "$MODE" = agree ]; then
     for b in cuda wgpu; do
       worst=$(for k in 00 01 02 03 04 05 06 07; do
         "$B" compare "/tmp/sdfc-img/anim-$n-$b/f_$k.png" "/tmp/sdfc-img/anim-$n-cpu/f_$k.png" --json 2>/dev/null \
-          | python3 -c 'import json,sys; print(json.load(sys.stdin)["psnr"])' 2>/dev/null || echo 0
+          | python3 -c 'import json,sys; p=json.load(sys.stdin)["psnr"]; print("inf" if p is None else p)' 2>/dev/null || echo 0
       done | sort -g | head -n 1)
       echo "$n $b-cpu worst ${worst} dB" | tee -a "$OUT/anim-agree.txt"
     done

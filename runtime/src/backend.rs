@@ -198,14 +198,65 @@ impl Prepared {
         lowered: &Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
+        Self::on_gpu_after(gpu, scene, lowered, setup, None).map(|(p, _)| p)
+    }
+
+    /// [`Prepared::on_gpu`], reusing `held`'s validated kernel when the new kernel's text is
+    /// the same (with [`Setup::parameters`], a program that differs from `held`'s only in
+    /// numbers): only its `scene_data` is new. Also says whether a kernel was built.
+    fn on_gpu_after(
+        gpu: Arc<Gpu>,
+        scene: &Scene,
+        lowered: &Lowered,
+        setup: &Setup,
+        held: Option<&wgsl::Kernel>,
+    ) -> Result<(Prepared, bool), String> {
         traceable_with(scene, &lowered.traceable)?;
-        Ok(Prepared::Wgpu {
+        let (kernel, built) = match held {
+            Some(held) => {
+                let text = Self::kernel_text(scene, lowered, setup)?;
+                if text.source == held.source {
+                    let mut kernel = held.clone();
+                    kernel.data = text.data;
+                    (kernel, false)
+                } else {
+                    (Self::kernel(scene, lowered, setup)?, true)
+                }
+            }
+            None => (Self::kernel(scene, lowered, setup)?, true),
+        };
+        let prepared = Prepared::Wgpu {
             gpu,
-            kernel: Box::new(Self::kernel(scene, lowered, setup)?),
+            kernel: Box::new(kernel),
             lipschitz: lowered.program.lipschitz(),
             lowered: Box::new(lowered.clone()),
             setup: *setup,
-        })
+        };
+        Ok((prepared, built))
+    }
+
+    /// `scene`, lowered as `lowered`, prepared as this is (the same backend, device and
+    /// setup), leaving this as it is: a wgpu kernel whose text is unchanged is reused
+    /// ([`Prepared::on_gpu_after`]); the CPU's tapes are made again. Also says whether a
+    /// kernel (or the tapes) was built. The viewer keeps its last good scene until the new one
+    /// is ready; a sequence replaces its scene with [`Prepared::update`].
+    pub fn next(&self, scene: &Scene, lowered: Lowered) -> Result<(Prepared, bool), String> {
+        match self {
+            Prepared::Cpu { options, .. } => {
+                let setup = Setup {
+                    precision: options.precision,
+                    debug_nan: options.debug_nan,
+                    parameters: false,
+                };
+                Ok((Self::on_cpu(scene, lowered, &setup)?, true))
+            }
+            Prepared::Wgpu {
+                gpu, kernel, setup, ..
+            } => Self::on_gpu_after(gpu.clone(), scene, &lowered, setup, Some(kernel)),
+            Prepared::Cuda { .. } => {
+                Err("a CUDA kernel is prepared again with Prepared::update".into())
+            }
+        }
     }
 
     /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
@@ -269,31 +320,9 @@ impl Prepared {
         method_allowed(scene)?;
         traceable_with(scene, &lowered.traceable)?;
         match self {
-            Prepared::Cpu { options, .. } => {
-                let setup = Setup {
-                    precision: options.precision,
-                    debug_nan: options.debug_nan,
-                    parameters: false,
-                };
-                *self = Self::cpu(lowered, &setup);
-                Ok(true)
-            }
-            Prepared::Wgpu {
-                kernel,
-                lipschitz,
-                lowered: held,
-                setup,
-                ..
-            } => {
-                let text = Self::kernel_text(scene, &lowered, setup)?;
-                let built = text.source != kernel.source;
-                if built {
-                    **kernel = Self::kernel(scene, &lowered, setup)?;
-                } else {
-                    kernel.data = text.data;
-                }
-                *lipschitz = lowered.program.lipschitz();
-                **held = lowered;
+            Prepared::Cpu { .. } | Prepared::Wgpu { .. } => {
+                let (next, built) = self.next(scene, lowered)?;
+                *self = next;
                 Ok(built)
             }
             Prepared::Cuda {

@@ -20,11 +20,16 @@ if [ "$MODE" = all ] || [ "$MODE" = fps ]; then
     for c in parameters literal; do
       echo "-- $b, constants $c" | tee -a "$OUT/anim-fps.txt"
       "$B" bench --frames-per-second --backend "$b" --constants "$c" --size 1920x1080 \
-        --sequence "$SEQ" $SCENES > "$OUT/anim-$b-$c.txt" 2> "$OUT/anim-$b-$c.log" \
+        --sequence "$SEQ" $SCENES --json > "$OUT/anim-$b-$c.json" 2> "$OUT/anim-$b-$c.log" \
         || echo "$b $c FAILED: $(tail -n 3 "$OUT/anim-$b-$c.log")"
-      cat "$OUT/anim-$b-$c.txt" | tee -a "$OUT/anim-fps.txt"
-      "$B" bench --frames-per-second --backend "$b" --constants "$c" --size 1920x1080 \
-        --sequence "$SEQ" $SCENES --json > "$OUT/anim-$b-$c.json" 2>> "$OUT/anim-$b-$c.log"
+      python3 -c '
+import json, sys
+for t in json.load(open(sys.argv[1])):
+    n = t["timed"]
+    print("%-12s %-5s %-28s %8.2f frames/s  kernels %3d  per frame: check %.2f ms, prepare %.2f ms, render %.2f ms" % (
+        t["scene"].split("/")[-1], t["backend"], t["device"][:28], t["frames_per_s"], t["kernels"],
+        1e3 * t["check_s"] / n, 1e3 * t["prepare_s"] / n, 1e3 * t["render_s"] / n))
+' "$OUT/anim-$b-$c.json" 2>/dev/null | tee -a "$OUT/anim-fps.txt"
     done
   done
 fi
@@ -42,7 +47,7 @@ if [ "$MODE" = all ] || [ "$MODE" = agree ]; then
     for b in cuda wgpu; do
       worst=$(for k in 00 01 02 03 04 05 06 07; do
         "$B" compare "/tmp/sdfc-img/anim-$n-$b/f_$k.png" "/tmp/sdfc-img/anim-$n-cpu/f_$k.png" --json 2>/dev/null \
-          | python3 -c 'import json,sys; print(json.load(sys.stdin)["psnr"])' 2>/dev/null || echo 0
+          | python3 -c 'import json,sys; p=json.load(sys.stdin)["psnr"]; print("inf" if p is None else p)' 2>/dev/null || echo 0
       done | sort -g | head -n 1)
       echo "$n $b-cpu worst ${worst} dB" | tee -a "$OUT/anim-agree.txt"
     done

@@ -867,3 +867,84 @@ fn a_sequence_on_wgpu_compiles_one_kernel_and_matches_the_cpu() {
         assert!(diff.psnr > 40.0, "frame {k}: {} dB", diff.psnr);
     }
 }
+
+/// Distances and materials of `program` at `points`, in f64.
+fn evaluate(program: &sdfc_compiler::lower::Program, points: &[[f64; 3]]) -> (Vec<f64>, Vec<u32>) {
+    use sdfc_compiler::eval::{Evaluator, Outputs, Tape};
+    let tape = Tape::new(program, Outputs::DistanceAndMaterial);
+    let mut ev = Evaluator::<f64>::new(&tape, 64);
+    let coord = |i: usize| points.iter().map(|p| p[i]).collect::<Vec<f64>>();
+    let (x, y, z) = (coord(0), coord(1), coord(2));
+    let mut d = vec![0.0; points.len()];
+    let mut m = vec![0u32; points.len()];
+    ev.eval(&x, &y, &z, &mut d, Some(&mut m));
+    (d, m)
+}
+
+/// The lowering of an animation's frames keeps the structure whatever the numbers: a
+/// translation through 0 or across it, a rotation through the identity and a quarter turn,
+/// a scale through 1 have the structure of every other frame; and the program computes the
+/// same distances and materials as the usual lowering, on these and on every example.
+#[test]
+fn parametric_lowering_keeps_the_structure_and_the_values() {
+    use sdfc_compiler::animation::Structure;
+    use sdfc_compiler::lower::{lower_with, LowerOptions};
+    // At t = 1 the rotation is the identity, the scale 1 and the rounding 0; at t = 2 the
+    // translation is 0 and the rotation a quarter turn; the translation is negative before.
+    let text = format!(
+        "{BASE}scene {{ sphere(0.5).translate(t - 2, 0.5, 0) @ m; \
+         box(0.3).rotate_y(degrees(90 * (t - 1))).translate(0, 0.3, 1); \
+         torus(1, 0.2).rotate_x(degrees(90 * (t - 1))).scale(t).translate(2, 1, 0); \
+         capsule(0.2, 1).round(t - 1).translate(-2, 0.6, 0); }}"
+    );
+    let times = [1.0, 1.5, 2.0, 3.0];
+    let structures = |options: &LowerOptions| -> Vec<Structure> {
+        times
+            .iter()
+            .map(|&t| {
+                let s = scene(&text, t);
+                Structure::of(&s, &lower_with(&s, options))
+            })
+            .collect()
+    };
+    let parametric = structures(&LowerOptions::parametric());
+    assert!(
+        parametric.iter().all(|s| *s == parametric[0]),
+        "parametric structures differ"
+    );
+    let usual = structures(&LowerOptions::default());
+    assert!(
+        usual.iter().any(|s| *s != usual[1]),
+        "the usual lowering folds no frame"
+    );
+    // The same values.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut scenes: Vec<Scene> = times.iter().map(|&t| scene(&text, t)).collect();
+    for dir in ["examples", "examples/animation"] {
+        for e in std::fs::read_dir(root.join(dir)).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "sdf") {
+                scenes.push(sdfc_runtime::frontend::load(&p).unwrap().scene.unwrap());
+            }
+        }
+    }
+    let mut rng = 0x2545f4914f6cdd1du64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64 * 8.0 - 4.0
+    };
+    let points: Vec<[f64; 3]> = (0..400).map(|_| [next(), next(), next()]).collect();
+    for s in &scenes {
+        let a = evaluate(&sdfc_compiler::lower::lower(s), &points);
+        let b = evaluate(&lower_with(s, &LowerOptions::parametric()), &points);
+        for ((p, x), y) in points.iter().zip(&a.0).zip(&b.0) {
+            assert!(
+                (x - y).abs() <= 1e-9 * (1.0 + x.abs()),
+                "{p:?}: {x} against {y}"
+            );
+        }
+        assert_eq!(a.1, b.1);
+    }
+}

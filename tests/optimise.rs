@@ -21,22 +21,26 @@ const CULL: LowerOptions = LowerOptions {
     level: 1,
     cull: true,
     local: true,
+    parametric: false,
 };
 const NO_CULL: LowerOptions = LowerOptions {
     level: 1,
     cull: false,
     local: true,
+    parametric: false,
 };
 /// Every pass, without local bounds: the field as written, for comparing values.
 const WRITTEN: LowerOptions = LowerOptions {
     level: 1,
     cull: true,
     local: false,
+    parametric: false,
 };
 const LITERAL: LowerOptions = LowerOptions {
     level: 0,
     cull: false,
     local: false,
+    parametric: false,
 };
 
 /// The `.sdf` files directly inside `dir` (relative to the workspace root), sorted.

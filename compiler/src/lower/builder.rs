@@ -42,6 +42,11 @@ pub(super) struct Builder {
     /// The most instructions to emit (the `program` limit): past it, [`Builder::over`]
     /// turns true and the lowering stops descending.
     cap: usize,
+    /// No folding that depends on a constant's value ([`super::LowerOptions::parametric`]):
+    /// constants are not shared, identities and sign rewrites are kept as written, a
+    /// `Select` keeps both sides. Constant operations still fold (into a constant, whatever
+    /// the values).
+    pub parametric: bool,
 }
 
 impl Builder {
@@ -127,6 +132,7 @@ impl Builder {
             return r;
         }
         let key = match op {
+            Op::Const(_) if self.parametric => return self.push(op),
             Op::Const(c) => Key::Const(c.to_bits()),
             Op::Input(a) => Key::Input(a),
             Op::Unary(u, a) => Key::Unary(u, a),
@@ -195,6 +201,7 @@ impl Builder {
             Op::Unary(u, a) => self.fold_unary(u, a),
             Op::Binary(b, x, y) => self.fold_binary(b, x, y),
             Op::Select(c, a, b) => match self.value(c) {
+                Some(_) if self.parametric => None,
                 Some(v) => Some(if v != 0.0 { a } else { b }),
                 None if a == b => Some(a),
                 None => None,
@@ -220,6 +227,13 @@ impl Builder {
         }
         if let Some(r) = self.fold_chain(b, x, y) {
             return Some(r);
+        }
+        if self.parametric {
+            return match b {
+                Binary::Min | Binary::Max if x == y => Some(x),
+                Binary::Lt if x == y => Some(self.c(0.0)),
+                _ => None,
+            };
         }
         match b {
             Binary::Add if self.is(y, 0.0) => Some(x),

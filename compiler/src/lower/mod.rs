@@ -51,6 +51,14 @@ pub struct LowerOptions {
     /// program is a bound with L = 1 and only rays near such an operand step shorter. Off,
     /// the program is the field as written and renderers step by the scene's L everywhere.
     pub local: bool,
+    /// At level 1: no rewrite that depends on the value of a number, only on the scene's
+    /// structure: no identity removed (a translation by 0, `x · 1`), no subtraction of a
+    /// negative constant written as an addition, no sharing of equal constants, no choice of
+    /// a `Select` by its constant condition, no rotation absorbed by a box at a quarter turn
+    /// or by a shape of revolution about its axis. The frames of an animation are lowered so
+    /// (docs/animation.md), so that a number passing through 0 or 1 does not change the
+    /// program's structure, and so the kernel. The program computes the same values.
+    pub parametric: bool,
 }
 
 impl Default for LowerOptions {
@@ -66,6 +74,16 @@ impl LowerOptions {
             level,
             cull: level > 0,
             local: level > 0,
+            parametric: false,
+        }
+    }
+
+    /// The options the frames of an animation are lowered with: every pass, none that
+    /// depends on a number's value ([`LowerOptions::parametric`]).
+    pub fn parametric() -> Self {
+        LowerOptions {
+            parametric: true,
+            ..LowerOptions::level(1)
         }
     }
 }
@@ -210,7 +228,7 @@ fn lower_capped(
             (program, over, None)
         }
         Some(root) => {
-            let simple = simplify::simplify(&scene.graph, root);
+            let simple = simplify::simplify(&scene.graph, root, options.parametric);
             lower_simple(
                 scene,
                 simple.graph,
@@ -236,6 +254,7 @@ fn lower_simple(
     cap: usize,
 ) -> (Program, bool, Option<Simplified>) {
     let mut b = builder::Builder::capped(true, cap);
+    b.parametric = options.parametric;
     let p = b.input_point();
     let mut lipschitz = 1.0;
     let mut simplified = None;

@@ -176,7 +176,9 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
     let mut out = Vec::new();
     for file in &args.file {
         let mut source = frontend::Source::read(file).map_err(CliError::Usage)?;
-        let first = frame_scene(overrides, &mut source, &limits, 0.0, true)?;
+        // The frames are lowered as `sdfc render --frames` lowers them.
+        let lowering = LowerOptions::parametric();
+        let first = frame_scene(overrides, &mut source, &limits, 0.0, true, &lowering)?;
         let animation = first.scene.animation;
         let frames = match args.sequence {
             Some(f) => f,
@@ -210,6 +212,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
                 &limits,
                 Animation::time_of(animation.fps, k),
                 false,
+                &lowering,
             )?;
             let t1 = Instant::now();
             let (scene, prepared) = kernels.prepare(frame)?;

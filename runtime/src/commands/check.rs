@@ -98,9 +98,10 @@ pub fn animation(
             eprintln!("error: frame {k} (t = {time} s) has errors");
             return Err(1);
         };
+        // Lowered as `sdfc render --frames` lowers a sequence's frames.
         let program = match sdfc_compiler::lower::lower_within(
             &scene,
-            &sdfc_compiler::lower::LowerOptions::default(),
+            &sdfc_compiler::lower::LowerOptions::parametric(),
             limits,
         ) {
             Ok(p) => p,

@@ -174,13 +174,15 @@ impl RenderArgs {
 }
 
 /// Checks `source` at `time`, prints its diagnostics (warnings only when `warnings`), applies
-/// `--reference`, `--size`, `--aa` and `--set`, and lowers it.
+/// `--reference`, `--size`, `--aa` and `--set`, and lowers it with `lowering` (a sequence's
+/// frames with [`LowerOptions::parametric`]).
 pub fn frame_scene(
     args: Overrides,
     source: &mut frontend::Source,
     limits: &Limits,
     time: f64,
     warnings: bool,
+    lowering: &LowerOptions,
 ) -> Result<FrameScene, CliError> {
     let mut loaded = source.check(limits, time);
     if !warnings {
@@ -202,7 +204,7 @@ pub fn frame_scene(
         format: DiagnosticFormat::Human,
     };
     let lowered = checked
-        .lower(&LowerOptions::default(), limits)
+        .lower(lowering, limits)
         .map_err(CliError::Reported)?;
     Ok(FrameScene {
         scene: checked.scene,
@@ -250,7 +252,14 @@ pub fn check_memory(
 fn still(args: &RenderArgs) -> Result<(), CliError> {
     let limits = args.limits.limits();
     let mut source = frontend::Source::read(&args.file).map_err(CliError::Usage)?;
-    let frame = frame_scene(args.overrides(), &mut source, &limits, 0.0, true)?;
+    let frame = frame_scene(
+        args.overrides(),
+        &mut source,
+        &limits,
+        0.0,
+        true,
+        &LowerOptions::default(),
+    )?;
     let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
     // The output is checked before any work, so that a render is never thrown away.
     let out = output(args).map_err(CliError::Usage)?;

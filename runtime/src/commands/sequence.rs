@@ -14,7 +14,7 @@ use crate::image::{AtomicFile, Image};
 use crate::output::Output;
 use crate::sequence::{ffmpeg, Frames, Target};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::lower::Program;
+use sdfc_compiler::lower::{LowerOptions, Program};
 use sdfc_compiler::scene::{Animation, Scene};
 use sdfc_compiler::{Limit, Limits};
 use std::cell::RefCell;
@@ -33,7 +33,8 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let mut source = Source::read(&args.file).map_err(CliError::Usage)?;
     // The animation's settings are the same at every time (E0406): read them at t = 0.
-    let first = frame_scene(args.overrides(), &mut source, &limits, 0.0, true)?;
+    let lowering = LowerOptions::parametric();
+    let first = frame_scene(args.overrides(), &mut source, &limits, 0.0, true, &lowering)?;
     let animation = first.scene.animation;
     let fps = match args.fps {
         Some(f) if f.is_finite() && (0.01..=1000.0).contains(&f) => f,
@@ -98,20 +99,26 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         let time = Animation::time_of(fps, k);
         let frame = match first.take().filter(|_| time == 0.0) {
             Some(f) => f,
-            None => {
-                frame_scene(args.overrides(), &mut source, &limits, time, false).map_err(|e| {
-                    if let Some(b) = &bar {
-                        b.abandon();
+            None => frame_scene(
+                args.overrides(),
+                &mut source,
+                &limits,
+                time,
+                false,
+                &lowering,
+            )
+            .map_err(|e| {
+                if let Some(b) = &bar {
+                    b.abandon();
+                }
+                match e {
+                    CliError::Reported(code) => {
+                        eprintln!("error: frame {k} (t = {time} s) has errors");
+                        CliError::Reported(code)
                     }
-                    match e {
-                        CliError::Reported(code) => {
-                            eprintln!("error: frame {k} (t = {time} s) has errors");
-                            CliError::Reported(code)
-                        }
-                        other => other,
-                    }
-                })?
-            }
+                    other => other,
+                }
+            })?,
         };
         let frame_started = Instant::now();
         let image = match &still {

@@ -7,7 +7,9 @@
 # rendered as a sequence on CUDA, wgpu and the CPU at 640x480 and compared, frame by frame.
 # Expects the sdfc binary at .dev/sdfc and the Vulkan loader packages in .gl/ (device-env.sh).
 # Writes JSON and logs under $OUT; prints tables.
-# Usage: scripts/device-anim.sh [all|fps|agree]   (FRAMES=0..60 sets the timed sequence)
+# (cost) what reading constants from the buffer costs a frame: `sdfc bench` of the still
+# examples at 1920x1080 on CUDA and wgpu with `--constants literal` and `--constants parameters`.
+# Usage: scripts/device-anim.sh [all|fps|agree|cost]   (FRAMES=0..60 sets the timed sequence)
 set -u
 . "$(dirname "$0")/device-env.sh"
 MODE=${1:-all}
@@ -50,6 +52,21 @@ if [ "$MODE" = all ] || [ "$MODE" = agree ]; then
           | python3 -c 'import json,sys; p=json.load(sys.stdin)["psnr"]; print("inf" if p is None else p)' 2>/dev/null || echo 0
       done | sort -g | head -n 1)
       echo "$n $b-cpu worst ${worst} dB" | tee -a "$OUT/anim-agree.txt"
+    done
+  done
+fi
+
+if [ "$MODE" = all ] || [ "$MODE" = cost ]; then
+  echo "== GPU ms per frame at 1920x1080 (median of 5): constants as literals / read from the buffer" | tee "$OUT/anim-cost.txt"
+  for b in cuda wgpu; do
+    for f in examples/seed1.sdf examples/seed2.sdf examples/seed3.sdf examples/seed4.sdf examples/seed5.sdf examples/seed6.sdf examples/temple.sdf examples/lattice.sdf examples/blends.sdf; do
+      n=$(basename "$f" .sdf)
+      ms() {
+        "$B" bench "$f" --backend "$b" --size 1920x1080 --frames 5 --set method=march --constants "$1" --json 2>/dev/null \
+          | python3 -c 'import json,sys; print("%.3f" % (json.load(sys.stdin)[0]["median_s"] * 1e3))' 2>/dev/null || echo failed
+      }
+      l=$(ms literal); p=$(ms parameters)
+      echo "$b $n literal $l ms, parameters $p ms" | tee -a "$OUT/anim-cost.txt"
     done
   done
 fi

@@ -53,12 +53,12 @@ pub struct BenchArgs {
     /// `fps × duration`).
     #[arg(long, value_name = "A..B", value_parser = crate::sequence::Frames::parse)]
     pub sequence: Option<crate::sequence::Frames>,
-    /// With --frames-per-second: how GPU kernels hold the distance program's constants:
-    /// read from a buffer, so that frames differing only in numbers share one kernel (as
-    /// `sdfc render` of a sequence does), or written as literals, a kernel per program (for
-    /// comparison).
-    #[arg(long, value_enum, default_value_t)]
-    pub constants: Constants,
+    /// How GPU kernels hold the distance program's constants: read from a buffer, so that
+    /// programs differing only in numbers share one kernel (as `sdfc render` of a sequence and
+    /// `sdfc view` do), or written as literals, a kernel per program (as `sdfc render` of a
+    /// still does). Default: parameters with --frames-per-second, literal otherwise.
+    #[arg(long, value_enum)]
+    pub constants: Option<Constants>,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -197,7 +197,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
         let setup = Setup {
             precision: args.precision,
             debug_nan: false,
-            parameters: args.constants == Constants::Parameters,
+            parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
         };
         let mut kernels = Kernels::new(&pool, args.backend, setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
@@ -371,7 +371,7 @@ fn time_scene(
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
-        parameters: false,
+        parameters: args.constants == Some(Constants::Parameters),
     };
     let prepared = Prepared::from_program(args.backend, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.

@@ -493,14 +493,23 @@ fn unit(a: DVec3) -> DVec3 {
     }
 }
 
+impl Camera {
+    /// The field of view of a camera that gives none, in degrees.
+    pub const FOV_DEGREES: f64 = 60.0;
+
+    /// The camera of a scene without a `camera` block, and the default of each field of one
+    /// (`check/builtins.rs` reads them here).
+    pub const DEFAULT: Camera = Camera {
+        position: [0.0, 1.0, -5.0],
+        look_at: [0.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov: Camera::FOV_DEGREES.to_radians(),
+    };
+}
+
 impl Default for Camera {
     fn default() -> Self {
-        Camera {
-            position: [0.0, 1.0, -5.0],
-            look_at: [0.0, 0.0, 0.0],
-            up: [0.0, 1.0, 0.0],
-            fov: 60f64.to_radians(),
-        }
+        Camera::DEFAULT
     }
 }
 
@@ -556,7 +565,7 @@ impl Method {
     }
 
     /// The method's name.
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             Method::Auto => "auto",
             Method::Trace => "trace",
@@ -565,20 +574,26 @@ impl Method {
     }
 }
 
+impl Settings {
+    /// The settings of a scene without a `render` block, and the default of each field of one
+    /// (`check/builtins.rs` reads them here).
+    pub const DEFAULT: Settings = Settings {
+        width: 640,
+        height: 480,
+        aa: 1,
+        max_steps: 512,
+        epsilon: 1e-5,
+        max_depth: 5,
+        max_dist: 100.0,
+        relaxation: 1.4,
+        background: [0.05, 0.06, 0.08],
+        method: Method::Auto,
+    };
+}
+
 impl Default for Settings {
     fn default() -> Self {
-        Settings {
-            width: 640,
-            height: 480,
-            aa: 1,
-            max_steps: 512,
-            epsilon: 1e-5,
-            max_depth: 5,
-            max_dist: 100.0,
-            relaxation: 1.4,
-            background: [0.05, 0.06, 0.08],
-            method: Method::Auto,
-        }
+        Settings::DEFAULT
     }
 }
 

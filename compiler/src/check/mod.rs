@@ -309,7 +309,7 @@ fn evaluate_items<'a>(
 
 /// Whether block `b` is the first of its kind (`light` blocks may repeat); a second
 /// `camera` or `render` block is an error.
-fn first_block<'a>(cx: &mut Ctx, seen: &mut HashMap<&'a str, Span>, b: &ast::Block) -> bool {
+fn first_block(cx: &mut Ctx, seen: &mut HashMap<&str, Span>, b: &ast::Block) -> bool {
     if b.keyword.name == "light" {
         return true;
     }

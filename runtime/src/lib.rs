@@ -13,5 +13,6 @@ pub mod image;
 pub mod memory;
 pub mod metrics;
 pub mod output;
+pub mod pareto;
 pub mod settings;
 pub mod view;

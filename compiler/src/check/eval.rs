@@ -937,6 +937,142 @@ pub fn type_name(v: &Value) -> String {
     v.ty().map_or("?".into(), |t| t.to_string())
 }
 
+/// What names are given to: a call's parameters or a record's fields (the words of the
+/// diagnostics).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Given {
+    /// Arguments to a function's parameters.
+    Arguments,
+    /// A record's fields.
+    Fields,
+}
+
+/// Names given to a list of parameters or fields, the one binder of calls ([`bind`]) and
+/// records ([`record`]): which each fills, E0203 for a name given twice, and at the end E0202
+/// for an unknown name (suggesting one not given) and E0204 for a required one not given.
+struct Binder<'a> {
+    given: Given,
+    /// The function's or the record's name.
+    owner: &'a str,
+    /// The parameters' or fields' names, and whether each is required.
+    params: Vec<(&'a str, bool)>,
+    /// Where each was given, if it was.
+    filled: Vec<Option<Span>>,
+    /// The names that match none.
+    unknown: Vec<&'a Ident>,
+}
+
+impl<'a> Binder<'a> {
+    fn new(given: Given, owner: &'a str, params: Vec<(&'a str, bool)>) -> Self {
+        let filled = vec![None; params.len()];
+        Binder {
+            given,
+            owner,
+            params,
+            filled,
+            unknown: Vec::new(),
+        }
+    }
+
+    /// Fills parameter `i` (by position, or a method's receiver).
+    fn fill(&mut self, i: usize, at: Span) {
+        self.filled[i] = Some(at);
+    }
+
+    /// Whether parameter `i` is filled.
+    fn is_filled(&self, i: usize) -> bool {
+        self.filled[i].is_some()
+    }
+
+    /// The parameter that `name` fills, if it is one and not given already (E0203); an
+    /// unknown name is kept for [`Binder::finish`].
+    fn name(&mut self, name: &'a Ident) -> Result<Option<usize>, Diagnostic> {
+        let Some(i) = self.params.iter().position(|p| p.0 == name.name) else {
+            self.unknown.push(name);
+            return Ok(None);
+        };
+        if let Some(first) = self.filled[i] {
+            let what = match self.given {
+                Given::Arguments => "argument",
+                Given::Fields => "field",
+            };
+            let d = Diagnostic::error(
+                "E0203",
+                format!("{what} `{}` is given twice", name.name),
+                name.span,
+            )
+            .with_label("given again here");
+            return Err(match self.given {
+                Given::Arguments => d,
+                Given::Fields => d.with_secondary(first, "first given here"),
+            });
+        }
+        self.fill(i, name.span);
+        Ok(Some(i))
+    }
+
+    /// E0202 for every unknown name and E0204 (at `at`) for every required parameter not
+    /// given, with the indices of the latter.
+    fn finish(&self, at: Span) -> (Vec<Diagnostic>, Vec<usize>) {
+        let mut errs = Vec::new();
+        let free = || {
+            self.params
+                .iter()
+                .zip(&self.filled)
+                .filter(|(_, f)| f.is_none())
+                .map(|(p, _)| p.0)
+        };
+        for name in &self.unknown {
+            let mut d = match self.given {
+                Given::Arguments => Diagnostic::error(
+                    "E0202",
+                    format!("`{}` has no parameter `{}`", self.owner, name.name),
+                    name.span,
+                )
+                .with_label("unknown parameter"),
+                Given::Fields => Diagnostic::error(
+                    "E0202",
+                    format!("`{}` has no field `{}`", self.owner, name.name),
+                    name.span,
+                )
+                .with_label("unknown field")
+                .with_note(format!(
+                    "the fields of `{}` are {}",
+                    self.owner,
+                    self.params
+                        .iter()
+                        .map(|p| p.0)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            };
+            if let Some(s) = closest(&name.name, free()) {
+                d = d.with_help(format!("did you mean `{s}`?"));
+            }
+            errs.push(d);
+        }
+        let mut missing = Vec::new();
+        for (i, (name, required)) in self.params.iter().enumerate() {
+            if *required && self.filled[i].is_none() {
+                let what = match self.given {
+                    Given::Arguments => "argument",
+                    Given::Fields => "field",
+                };
+                errs.push(
+                    Diagnostic::error(
+                        "E0204",
+                        format!("missing {what} `{name}` of `{}`", self.owner),
+                        at,
+                    )
+                    .with_label(format!("`{name}` is required")),
+                );
+                missing.push(i);
+            }
+        }
+        (errs, missing)
+    }
+}
+
 /// Arguments matched to parameters: one slot per parameter (`None`: use the default), then
 /// the extra arguments of a variadic last parameter.
 struct Bound {
@@ -957,7 +1093,8 @@ fn bind(
     let mut errs = Vec::new();
     let mut slots: Vec<Option<(Value, Span)>> = vec![None; params.len()];
     let mut extra = Vec::new();
-    let mut filled = vec![false; params.len()];
+    let names = params.iter().map(|p| (p.name, !p.has_default)).collect();
+    let mut binder = Binder::new(Given::Arguments, &callee.name, names);
     if let Some((v, s)) = recv {
         let idx = v
             .ty()
@@ -975,12 +1112,11 @@ fn bind(
             ));
         } else {
             slots[idx] = Some((v.clone(), *s));
-            filled[idx] = true;
+            binder.fill(idx, *s);
         }
     }
     let mut next = 0;
     let mut seen_named = false;
-    let mut unknown: Vec<&Ident> = Vec::new();
     for a in args {
         match &a.name {
             None => {
@@ -995,12 +1131,12 @@ fn bind(
                     );
                     continue;
                 }
-                while next < params.len() && filled[next] {
+                while next < params.len() && binder.is_filled(next) {
                     next += 1;
                 }
                 if next < params.len() {
                     slots[next] = Some((a.value.clone(), a.span));
-                    filled[next] = true;
+                    binder.fill(next, a.span);
                 } else if rest && !params.is_empty() {
                     extra.push((a.value.clone(), a.span));
                 } else if !errs.iter().any(|d: &Diagnostic| d.code == "E0205") {
@@ -1021,54 +1157,16 @@ fn bind(
             }
             Some(name) => {
                 seen_named = true;
-                match params.iter().position(|p| p.name == name.name) {
-                    Some(i) if filled[i] => errs.push(
-                        Diagnostic::error(
-                            "E0203",
-                            format!("argument `{}` is given twice", name.name),
-                            name.span,
-                        )
-                        .with_label("given again here"),
-                    ),
-                    Some(i) => {
-                        slots[i] = Some((a.value.clone(), a.span));
-                        filled[i] = true;
-                    }
-                    None => unknown.push(name),
+                match binder.name(name) {
+                    Ok(Some(i)) => slots[i] = Some((a.value.clone(), a.span)),
+                    Ok(None) => {}
+                    Err(d) => errs.push(d),
                 }
             }
         }
     }
     // Suggestions name only parameters that no argument fills.
-    for name in unknown {
-        let mut d = Diagnostic::error(
-            "E0202",
-            format!("`{}` has no parameter `{}`", callee.name, name.name),
-            name.span,
-        )
-        .with_label("unknown parameter");
-        let free = params
-            .iter()
-            .zip(&filled)
-            .filter(|(_, f)| !**f)
-            .map(|(p, _)| p.name);
-        if let Some(s) = closest(&name.name, free) {
-            d = d.with_help(format!("did you mean `{s}`?"));
-        }
-        errs.push(d);
-    }
-    for (i, p) in params.iter().enumerate() {
-        if !filled[i] && !p.has_default {
-            errs.push(
-                Diagnostic::error(
-                    "E0204",
-                    format!("missing argument `{}` of `{}`", p.name, callee.name),
-                    span,
-                )
-                .with_label(format!("`{}` is required", p.name)),
-            );
-        }
-    }
+    errs.extend(binder.finish(span).0);
     for (i, slot) in slots.iter_mut().enumerate() {
         if let (Some((v, s)), Some(want)) = (slot.as_mut(), params[i].ty) {
             match v.clone().coerce(want) {
@@ -1135,50 +1233,22 @@ pub fn record(
     head: &Ident,
 ) -> HashMap<&'static str, Value> {
     let mut out: HashMap<&'static str, Value> = HashMap::new();
-    let mut spans: HashMap<&'static str, Span> = HashMap::new();
+    let names = rec
+        .fields
+        .iter()
+        .map(|p| (p.name, matches!(p.def, Def::Req)))
+        .collect();
+    let mut binder = Binder::new(Given::Fields, rec.name, names);
     for f in fields {
         let v = cx.expr(&f.value);
-        let Some(p) = rec.fields.iter().find(|p| p.name == f.name.name) else {
-            let mut d = Diagnostic::error(
-                "E0202",
-                format!("`{}` has no field `{}`", rec.name, f.name.name),
-                f.name.span,
-            )
-            .with_label("unknown field")
-            .with_note(format!(
-                "the fields of `{}` are {}",
-                rec.name,
-                rec.fields
-                    .iter()
-                    .map(|p| p.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
-            // Only fields that are not given already.
-            let free = rec
-                .fields
-                .iter()
-                .map(|p| p.name)
-                .filter(|n| !fields.iter().any(|g| g.name.name == *n));
-            if let Some(s) = closest(&f.name.name, free) {
-                d = d.with_help(format!("did you mean `{s}`?"));
+        let p = match binder.name(&f.name) {
+            Ok(Some(i)) => &rec.fields[i],
+            Ok(None) => continue,
+            Err(d) => {
+                cx.error(d);
+                continue;
             }
-            cx.error(d);
-            continue;
         };
-        if let Some(prev) = spans.get(p.name) {
-            cx.error(
-                Diagnostic::error(
-                    "E0203",
-                    format!("field `{}` is given twice", p.name),
-                    f.name.span,
-                )
-                .with_label("given again here")
-                .with_secondary(*prev, "first given here"),
-            );
-            continue;
-        }
-        spans.insert(p.name, f.name.span);
         let v = match v.clone().coerce(p.ty) {
             Some(c) => c,
             None => {
@@ -1205,25 +1275,15 @@ pub fn record(
         }
         out.insert(p.name, v);
     }
-    for p in rec.fields {
-        if out.contains_key(p.name) || spans.contains_key(p.name) {
-            continue;
-        }
-        match p.def {
-            Def::Req => {
-                cx.error(
-                    Diagnostic::error(
-                        "E0204",
-                        format!("missing field `{}` of `{}`", p.name, rec.name),
-                        head.span,
-                    )
-                    .with_label(format!("`{}` is required", p.name)),
-                );
-                out.insert(p.name, Value::Error);
-            }
-            d => {
-                out.insert(p.name, d.value().unwrap_or(Value::Error));
-            }
+    let (errs, missing) = binder.finish(head.span);
+    for d in errs {
+        cx.error(d);
+    }
+    for (i, p) in rec.fields.iter().enumerate() {
+        if missing.contains(&i) {
+            out.insert(p.name, Value::Error);
+        } else if !binder.is_filled(i) {
+            out.insert(p.name, p.def.value().unwrap_or(Value::Error));
         }
     }
     out

@@ -1096,23 +1096,16 @@ fn bind(
     let names = params.iter().map(|p| (p.name, !p.has_default)).collect();
     let mut binder = Binder::new(Given::Arguments, &callee.name, names);
     if let Some((v, s)) = recv {
-        let idx = v
-            .ty()
-            .and_then(|t| {
-                params
-                    .iter()
-                    .position(|p| p.ty.is_some_and(|pt| t.fits(pt)))
-            })
-            .unwrap_or(0);
-        if params.is_empty() {
-            errs.push(Diagnostic::error(
+        match receiver_slot(params, v) {
+            Some(idx) => {
+                slots[idx] = Some((v.clone(), *s));
+                binder.fill(idx, *s);
+            }
+            None => errs.push(Diagnostic::error(
                 "E0205",
                 format!("`{}` takes no arguments", callee.name),
                 *s,
-            ));
-        } else {
-            slots[idx] = Some((v.clone(), *s));
-            binder.fill(idx, *s);
+            )),
         }
     }
     let mut next = 0;
@@ -1167,7 +1160,36 @@ fn bind(
     }
     // Suggestions name only parameters that no argument fills.
     errs.extend(binder.finish(span).0);
-    for (i, slot) in slots.iter_mut().enumerate() {
+    let mut bound = Bound { slots, rest: extra };
+    coerce(params, &mut bound, &mut errs);
+    if errs.is_empty() {
+        Ok(bound)
+    } else {
+        Err(errs)
+    }
+}
+
+/// The parameter a method's receiver fills: the first of its type, else the first (`None`
+/// when there is none).
+fn receiver_slot(params: &[PView], v: &Value) -> Option<usize> {
+    if params.is_empty() {
+        return None;
+    }
+    let idx = v
+        .ty()
+        .and_then(|t| {
+            params
+                .iter()
+                .position(|p| p.ty.is_some_and(|pt| t.fits(pt)))
+        })
+        .unwrap_or(0);
+    Some(idx)
+}
+
+/// Converts each bound argument to its parameter's type (an int to a float, …), or reports
+/// E0300 where it has another.
+fn coerce(params: &[PView], bound: &mut Bound, errs: &mut Vec<Diagnostic>) {
+    for (i, slot) in bound.slots.iter_mut().enumerate() {
         if let (Some((v, s)), Some(want)) = (slot.as_mut(), params[i].ty) {
             match v.clone().coerce(want) {
                 Some(c) => *v = c,
@@ -1176,17 +1198,12 @@ fn bind(
         }
     }
     if let Some(want) = params.last().and_then(|p| p.ty) {
-        for (v, s) in extra.iter_mut() {
+        for (v, s) in bound.rest.iter_mut() {
             match v.clone().coerce(want) {
                 Some(c) => *v = c,
                 None => errs.push(type_mismatch(params[params.len() - 1].name, want, v, *s)),
             }
         }
-    }
-    if errs.is_empty() {
-        Ok(Bound { slots, rest: extra })
-    } else {
-        Err(errs)
     }
 }
 

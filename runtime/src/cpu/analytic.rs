@@ -8,7 +8,7 @@
 
 use super::vec::V3;
 use sdfc_compiler::eval::Float;
-use sdfc_compiler::scene::analytic::{hierarchy, Item, Primitive, Shape};
+use sdfc_compiler::scene::analytic::{Item, Primitive, Shape, Traced};
 
 /// A primitive in the evaluation type.
 #[derive(Debug, Clone, Copy)]
@@ -84,9 +84,11 @@ fn enters<T: Float>(o: V3<T>, d: V3<T>, centre: V3<T>, half: V3<T>, limit: T) ->
 }
 
 impl<T: Float> Tracer<T> {
-    pub fn new(primitives: &[Primitive]) -> Self {
+    /// The tracer of `traced`'s primitives, walked through its hierarchy.
+    pub fn new(traced: &Traced) -> Self {
         let f = T::from_f64;
-        let prims = primitives
+        let prims = traced
+            .primitives
             .iter()
             .map(|p| Prim {
                 kind: match p.shape {
@@ -120,7 +122,7 @@ impl<T: Float> Tracer<T> {
                 material: p.material.0,
             })
             .collect();
-        let top = hierarchy(primitives).iter().map(node).collect();
+        let top = traced.hierarchy.iter().map(node).collect();
         Tracer { prims, top }
     }
 
@@ -214,7 +216,7 @@ pub(super) fn heap_bytes<T: Float>(
     use std::mem::size_of;
     let n = traceable
         .traced(scene.settings.method)
-        .map_or(0, <[_]>::len) as u64;
+        .map_or(0, |t| t.primitives.len()) as u64;
     let held = size_of::<Prim<T>>() + 2 * size_of::<Node<T>>();
     let building = 4 * size_of::<Primitive>() + 256;
     n * (held + building) as u64
@@ -421,7 +423,7 @@ mod tests {
     use sdfc_compiler::eval::eval_point;
     use sdfc_compiler::lower::lower;
     use sdfc_compiler::rng::Rng;
-    use sdfc_compiler::scene::analytic::choose;
+    use sdfc_compiler::scene::analytic::traceable;
 
     /// A vector uniform in [-1, 1)³.
     fn v3(rng: &mut Rng) -> V3<f64> {
@@ -453,8 +455,9 @@ mod tests {
             );
             let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
             let scene = scene.unwrap_or_else(|| panic!("{shape}: {diags:?}"));
-            let prims = choose(&scene);
-            let tracer = Tracer::<f64>::new(prims.primitives().expect("traced"));
+            let traceable = traceable(&scene);
+            let tracer =
+                Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));
             let program = lower(&scene);
             let f = |p: V3<f64>| eval_point::<f64>(&program, [p.x, p.y, p.z]);
             let mut rng = Rng::new(0x9e3779b97f4a7c15);
@@ -512,7 +515,8 @@ mod tests {
                     scene { sphere(1).translate(0, 0, 5); sphere(1).translate(0, 0, -5) @ glass; }";
         let (scene, _, _) = sdfc_compiler::check::check_str("t.sdf", text);
         let scene = scene.expect("checks");
-        let tracer = Tracer::<f64>::new(choose(&scene).primitives().expect("traced"));
+        let traceable = traceable(&scene);
+        let tracer = Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));
         let tau = |m: u32| if m == 1 { 0.5 } else { 0.0 };
         let (o, fwd, back) = (V3::zero(), V3::new(0.0, 0.0, 1.0), V3::new(0.0, 0.0, -1.0));
         assert_eq!(tracer.transmitted(o, fwd, 10.0, tau), 0.0);
@@ -548,8 +552,8 @@ mod tests {
         text.push_str("}\n");
         let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
         let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
-        let prims = choose(&scene);
-        let tracer = Tracer::<f64>::new(prims.primitives().expect("traced"));
+        let traceable = traceable(&scene);
+        let tracer = Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));
         assert!(matches!(tracer.top.last(), Some(Node::Group { .. })));
         let brute = Tracer::<f64> {
             prims: tracer.prims.clone(),

@@ -8,12 +8,12 @@ use common::*;
 use sdfc_compiler::lower::lower;
 use sdfc_compiler::scene::{Node, Settings};
 use sdfc_runtime::chart::{self, Chart, Point};
-use sdfc_runtime::commands::pareto::{self, front, parse_sweep, Key};
 use sdfc_runtime::cpu::{self, reference, Options};
 use sdfc_runtime::depth::{self, Depth};
 use sdfc_runtime::fp32;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::metrics::{compare, compare_depth};
+use sdfc_runtime::pareto::{self, front, parse_sweep, Key};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

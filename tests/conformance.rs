@@ -180,8 +180,8 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
 /// with shapes that must stay in the rest of the program: a twisted box and ellipsoids (a
 /// bound, not an exact distance).
 fn marched_scene(n: usize) -> String {
-    let mut rng = common::Rng::new(0x9e37_79b9_u64);
-    let mut next = move || rng.next();
+    let mut rng = sdfc_compiler::rng::Rng::new(0x9e37_79b9_u64);
+    let mut next = move || rng.uniform();
     let mut text = String::from(
         "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75 };\n\
          material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\
@@ -377,8 +377,8 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
 /// capsules turned and scaled at pseudo-random places on a checkered, reflective floor, with
 /// mirrors and a floating glass ball that touches nothing (so `auto` traces it).
 fn mixed_scene(n: usize) -> String {
-    let mut rng = common::Rng::new(0x2545_f491_u64);
-    let mut next = move || rng.next();
+    let mut rng = sdfc_compiler::rng::Rng::new(0x2545_f491_u64);
+    let mut next = move || rng.uniform();
     let mut text = String::from(
         "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75, reflect: 0.1 };\n\
          material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\

@@ -9,6 +9,7 @@ use sdfc_compiler::back::rust;
 use sdfc_compiler::eval::eval_point;
 use sdfc_compiler::lower::lower;
 use sdfc_compiler::program::Program;
+use sdfc_compiler::rng::Rng;
 use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
 use std::fmt::Write;
 use std::process::Command;

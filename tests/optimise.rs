@@ -10,7 +10,8 @@ use common::*;
 use sdfc_compiler::back::{rust, wgsl};
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
 use sdfc_compiler::lower::{lower_scene, lower_with, LowerOptions, Lowered};
-use sdfc_compiler::program::{Op, Program};
+use sdfc_compiler::program::{Op, Program, Step};
+use sdfc_compiler::rng::Rng;
 use sdfc_compiler::scene::{Method, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision};
 use sdfc_runtime::frontend;
@@ -237,48 +238,14 @@ fn operations(program: &Program) -> usize {
 /// Operations executed at `p` (a guarded block's test counts as one).
 fn executed(program: &Program, p: [f32; 3]) -> usize {
     let ops = program.ops();
-    let blocks = program.blocks();
-    let mut regs = vec![0f32; ops.len()];
-    let (mut next, mut i, mut count) = (0, 0, 0);
-    'run: while i < ops.len() {
-        while let Some(b) = blocks.get(next).filter(|b| b.start == i) {
-            next += 1;
-            count += 1;
-            if regs[b.bound.0 as usize] >= regs[b.best.0 as usize] {
-                for j in b.end..b.end + b.results {
-                    if let Op::Phi(_, other) = ops[j] {
-                        regs[j] = regs[other.0 as usize];
-                    }
-                }
-                i = b.end + b.results;
-                while blocks.get(next).is_some_and(|n| n.start < i) {
-                    next += 1;
-                }
-                continue 'run;
-            }
-        }
-        // Recompute the value with the reference semantics of one instruction.
-        regs[i] = step(program, &regs, i, p);
-        count += usize::from(!matches!(ops[i], Op::Const(_) | Op::Input(_) | Op::Phi(..)));
-        i += 1;
-    }
+    let mut count = 0;
+    program.run(p, |step| {
+        count += usize::from(match step {
+            Step::Test(_) => true,
+            Step::Op(i) => !matches!(ops[i], Op::Const(_) | Op::Input(_) | Op::Phi(..)),
+        })
+    });
     count
-}
-
-fn step(program: &Program, regs: &[f32], i: usize, p: [f32; 3]) -> f32 {
-    use sdfc_compiler::program::scalar;
-    use sdfc_compiler::program::Axis;
-    let r = |x: sdfc_compiler::program::Reg| regs[x.0 as usize];
-    match program.ops()[i] {
-        Op::Const(c) => c as f32,
-        Op::Input(Axis::X) => p[0],
-        Op::Input(Axis::Y) => p[1],
-        Op::Input(Axis::Z) => p[2],
-        Op::Unary(u, a) => scalar::unary(u, r(a)),
-        Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
-        Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
-        Op::Phi(a, _) => r(a),
-    }
 }
 
 /// The points a camera ray of each pixel of a `w × h` grid visits while sphere tracing.

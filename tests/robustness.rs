@@ -3,6 +3,7 @@
 //! go through the whole front end without a panic.
 
 use sdfc_compiler::check::check_str;
+use sdfc_compiler::rng::Rng;
 
 /// The codes of the diagnostics of `text`, but for W0008: these scenes have no lights.
 fn codes(text: &str) -> Vec<&'static str> {
@@ -147,21 +148,6 @@ fn front_end(text: &str) {
     }
 }
 
-/// A small deterministic generator (xorshift), so failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
-
 const SNIPPETS: &[&str] = &[
     "(",
     ")",
@@ -198,7 +184,7 @@ fn fuzz_regressions_and_mutations_do_not_panic() {
     for text in &corpus {
         front_end(text);
     }
-    let mut rng = Rng(0x5DFC_2026);
+    let mut rng = Rng::new(0x5DFC_2026);
     for _ in 0..3_000 {
         let base = &corpus[rng.below(corpus.len())];
         let mut bytes: Vec<char> = base.chars().collect();

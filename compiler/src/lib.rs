@@ -25,6 +25,7 @@ pub mod eval;
 pub mod limits;
 pub mod lower;
 pub mod program;
+pub mod rng;
 pub mod scene;
 pub mod span;
 pub mod syntax;

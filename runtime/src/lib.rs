@@ -13,6 +13,7 @@ pub mod image;
 pub mod memory;
 pub mod metrics;
 pub mod output;
+pub mod pareto;
 pub mod sequence;
 pub mod settings;
 pub mod view;

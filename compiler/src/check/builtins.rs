@@ -3,7 +3,7 @@
 
 use super::types::{Type, Value};
 use crate::limits::{Limit, Limits};
-use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
+use crate::scene::{Camera, Combine, Graph, Node, NodeId, Settings, Smooth, V3};
 use crate::span::Span;
 
 /// A parameter's default value.
@@ -835,13 +835,13 @@ pub static CAMERA: Record = Record {
     name: "camera",
     timeless: &[],
     fields: &[
-        p("position", V, V3([0.0, 1.0, -5.0]), Any),
-        p("look_at", V, V3([0.0, 0.0, 0.0]), Any),
-        p("up", V, V3([0.0, 1.0, 0.0]), NonZero),
+        p("position", V, V3(Camera::DEFAULT.position), Any),
+        p("look_at", V, V3(Camera::DEFAULT.look_at), Any),
+        p("up", V, V3(Camera::DEFAULT.up), NonZero),
         p(
             "fov",
             A,
-            Deg(60.0),
+            Deg(Camera::FOV_DEGREES),
             Within(
                 0.1f64 * std::f64::consts::PI / 180.0,
                 179.0 * std::f64::consts::PI / 180.0,
@@ -850,25 +850,48 @@ pub static CAMERA: Record = Record {
     ],
 };
 
+/// The defaults of `render`'s fields.
+const DEFAULT: Settings = Settings::DEFAULT;
+
 /// `render { ... }`; the same keys are accepted by `sdfc render --set`.
 pub static RENDER: Record = Record {
     name: "render",
     // The sequence's frames and their size: an animated PNG or a video has one size.
     timeless: &["width", "height", "fps", "duration"],
     fields: &[
-        p("width", I, Int(640), Limited(1.0, Limit::Edge)),
-        p("height", I, Int(480), Limited(1.0, Limit::Edge)),
-        p("aa", I, Int(1), Limited(1.0, Limit::Aa)),
-        p("max_steps", I, Int(512), Limited(1.0, Limit::MaxSteps)),
-        p("epsilon", F, Num(1e-5), Within(1e-9, 0.5)),
-        p("max_depth", I, Int(5), Limited(0.0, Limit::MaxDepth)),
-        p("max_dist", F, Num(100.0), Within(1e-6, 1e9)),
-        p("relaxation", F, Num(1.4), Within(1.0, 1.99)),
-        p("background", V, V3([0.05, 0.06, 0.08]), NonNeg),
+        p(
+            "width",
+            I,
+            Int(DEFAULT.width as i64),
+            Limited(1.0, Limit::Edge),
+        ),
+        p(
+            "height",
+            I,
+            Int(DEFAULT.height as i64),
+            Limited(1.0, Limit::Edge),
+        ),
+        p("aa", I, Int(DEFAULT.aa as i64), Limited(1.0, Limit::Aa)),
+        p(
+            "max_steps",
+            I,
+            Int(DEFAULT.max_steps as i64),
+            Limited(1.0, Limit::MaxSteps),
+        ),
+        p("epsilon", F, Num(DEFAULT.epsilon), Within(1e-9, 0.5)),
+        p(
+            "max_depth",
+            I,
+            Int(DEFAULT.max_depth as i64),
+            Limited(0.0, Limit::MaxDepth),
+        ),
+        p("max_dist", F, Num(DEFAULT.max_dist), Within(1e-6, 1e9)),
+        p("relaxation", F, Num(DEFAULT.relaxation), Within(1.0, 1.99)),
+        p("background", V, V3(DEFAULT.background), NonNeg),
         p(
             "method",
             Str,
-            Text("auto"),
+            Text(DEFAULT.method.name()),
             OneOf(crate::scene::Method::NAMES),
         ),
         p("fps", F, Num(30.0), Within(0.01, 1000.0)),

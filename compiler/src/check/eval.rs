@@ -983,6 +983,142 @@ pub fn type_name(v: &Value) -> String {
     v.ty().map_or("?".into(), |t| t.to_string())
 }
 
+/// What names are given to: a call's parameters or a record's fields (the words of the
+/// diagnostics).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Given {
+    /// Arguments to a function's parameters.
+    Arguments,
+    /// A record's fields.
+    Fields,
+}
+
+/// Names given to a list of parameters or fields, the one binder of calls ([`bind`]) and
+/// records ([`record`]): which each fills, E0203 for a name given twice, and at the end E0202
+/// for an unknown name (suggesting one not given) and E0204 for a required one not given.
+struct Binder<'a> {
+    given: Given,
+    /// The function's or the record's name.
+    owner: &'a str,
+    /// The parameters' or fields' names, and whether each is required.
+    params: Vec<(&'a str, bool)>,
+    /// Where each was given, if it was.
+    filled: Vec<Option<Span>>,
+    /// The names that match none.
+    unknown: Vec<&'a Ident>,
+}
+
+impl<'a> Binder<'a> {
+    fn new(given: Given, owner: &'a str, params: Vec<(&'a str, bool)>) -> Self {
+        let filled = vec![None; params.len()];
+        Binder {
+            given,
+            owner,
+            params,
+            filled,
+            unknown: Vec::new(),
+        }
+    }
+
+    /// Fills parameter `i` (by position, or a method's receiver).
+    fn fill(&mut self, i: usize, at: Span) {
+        self.filled[i] = Some(at);
+    }
+
+    /// Whether parameter `i` is filled.
+    fn is_filled(&self, i: usize) -> bool {
+        self.filled[i].is_some()
+    }
+
+    /// The parameter that `name` fills, if it is one and not given already (E0203); an
+    /// unknown name is kept for [`Binder::finish`].
+    fn name(&mut self, name: &'a Ident) -> Result<Option<usize>, Diagnostic> {
+        let Some(i) = self.params.iter().position(|p| p.0 == name.name) else {
+            self.unknown.push(name);
+            return Ok(None);
+        };
+        if let Some(first) = self.filled[i] {
+            let what = match self.given {
+                Given::Arguments => "argument",
+                Given::Fields => "field",
+            };
+            let d = Diagnostic::error(
+                "E0203",
+                format!("{what} `{}` is given twice", name.name),
+                name.span,
+            )
+            .with_label("given again here");
+            return Err(match self.given {
+                Given::Arguments => d,
+                Given::Fields => d.with_secondary(first, "first given here"),
+            });
+        }
+        self.fill(i, name.span);
+        Ok(Some(i))
+    }
+
+    /// E0202 for every unknown name and E0204 (at `at`) for every required parameter not
+    /// given, with the indices of the latter.
+    fn finish(&self, at: Span) -> (Vec<Diagnostic>, Vec<usize>) {
+        let mut errs = Vec::new();
+        let free = || {
+            self.params
+                .iter()
+                .zip(&self.filled)
+                .filter(|(_, f)| f.is_none())
+                .map(|(p, _)| p.0)
+        };
+        for name in &self.unknown {
+            let mut d = match self.given {
+                Given::Arguments => Diagnostic::error(
+                    "E0202",
+                    format!("`{}` has no parameter `{}`", self.owner, name.name),
+                    name.span,
+                )
+                .with_label("unknown parameter"),
+                Given::Fields => Diagnostic::error(
+                    "E0202",
+                    format!("`{}` has no field `{}`", self.owner, name.name),
+                    name.span,
+                )
+                .with_label("unknown field")
+                .with_note(format!(
+                    "the fields of `{}` are {}",
+                    self.owner,
+                    self.params
+                        .iter()
+                        .map(|p| p.0)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            };
+            if let Some(s) = closest(&name.name, free()) {
+                d = d.with_help(format!("did you mean `{s}`?"));
+            }
+            errs.push(d);
+        }
+        let mut missing = Vec::new();
+        for (i, (name, required)) in self.params.iter().enumerate() {
+            if *required && self.filled[i].is_none() {
+                let what = match self.given {
+                    Given::Arguments => "argument",
+                    Given::Fields => "field",
+                };
+                errs.push(
+                    Diagnostic::error(
+                        "E0204",
+                        format!("missing {what} `{name}` of `{}`", self.owner),
+                        at,
+                    )
+                    .with_label(format!("`{name}` is required")),
+                );
+                missing.push(i);
+            }
+        }
+        (errs, missing)
+    }
+}
+
 /// Arguments matched to parameters: one slot per parameter (`None`: use the default), then
 /// the extra arguments of a variadic last parameter.
 struct Bound {
@@ -1003,30 +1139,23 @@ fn bind(
     let mut errs = Vec::new();
     let mut slots: Vec<Option<(Value, Span)>> = vec![None; params.len()];
     let mut extra = Vec::new();
-    let mut filled = vec![false; params.len()];
+    let names = params.iter().map(|p| (p.name, !p.has_default)).collect();
+    let mut binder = Binder::new(Given::Arguments, &callee.name, names);
     if let Some((v, s)) = recv {
-        let idx = v
-            .ty()
-            .and_then(|t| {
-                params
-                    .iter()
-                    .position(|p| p.ty.is_some_and(|pt| t.fits(pt)))
-            })
-            .unwrap_or(0);
-        if params.is_empty() {
-            errs.push(Diagnostic::error(
+        match receiver_slot(params, v) {
+            Some(idx) => {
+                slots[idx] = Some((v.clone(), *s));
+                binder.fill(idx, *s);
+            }
+            None => errs.push(Diagnostic::error(
                 "E0205",
                 format!("`{}` takes no arguments", callee.name),
                 *s,
-            ));
-        } else {
-            slots[idx] = Some((v.clone(), *s));
-            filled[idx] = true;
+            )),
         }
     }
     let mut next = 0;
     let mut seen_named = false;
-    let mut unknown: Vec<&Ident> = Vec::new();
     for a in args {
         match &a.name {
             None => {
@@ -1041,12 +1170,12 @@ fn bind(
                     );
                     continue;
                 }
-                while next < params.len() && filled[next] {
+                while next < params.len() && binder.is_filled(next) {
                     next += 1;
                 }
                 if next < params.len() {
                     slots[next] = Some((a.value.clone(), a.span));
-                    filled[next] = true;
+                    binder.fill(next, a.span);
                 } else if rest && !params.is_empty() {
                     extra.push((a.value.clone(), a.span));
                 } else if !errs.iter().any(|d: &Diagnostic| d.code == "E0205") {
@@ -1067,55 +1196,46 @@ fn bind(
             }
             Some(name) => {
                 seen_named = true;
-                match params.iter().position(|p| p.name == name.name) {
-                    Some(i) if filled[i] => errs.push(
-                        Diagnostic::error(
-                            "E0203",
-                            format!("argument `{}` is given twice", name.name),
-                            name.span,
-                        )
-                        .with_label("given again here"),
-                    ),
-                    Some(i) => {
-                        slots[i] = Some((a.value.clone(), a.span));
-                        filled[i] = true;
-                    }
-                    None => unknown.push(name),
+                match binder.name(name) {
+                    Ok(Some(i)) => slots[i] = Some((a.value.clone(), a.span)),
+                    Ok(None) => {}
+                    Err(d) => errs.push(d),
                 }
             }
         }
     }
     // Suggestions name only parameters that no argument fills.
-    for name in unknown {
-        let mut d = Diagnostic::error(
-            "E0202",
-            format!("`{}` has no parameter `{}`", callee.name, name.name),
-            name.span,
-        )
-        .with_label("unknown parameter");
-        let free = params
-            .iter()
-            .zip(&filled)
-            .filter(|(_, f)| !**f)
-            .map(|(p, _)| p.name);
-        if let Some(s) = closest(&name.name, free) {
-            d = d.with_help(format!("did you mean `{s}`?"));
-        }
-        errs.push(d);
+    errs.extend(binder.finish(span).0);
+    let mut bound = Bound { slots, rest: extra };
+    coerce(params, &mut bound, &mut errs);
+    if errs.is_empty() {
+        Ok(bound)
+    } else {
+        Err(errs)
     }
-    for (i, p) in params.iter().enumerate() {
-        if !filled[i] && !p.has_default {
-            errs.push(
-                Diagnostic::error(
-                    "E0204",
-                    format!("missing argument `{}` of `{}`", p.name, callee.name),
-                    span,
-                )
-                .with_label(format!("`{}` is required", p.name)),
-            );
-        }
+}
+
+/// The parameter a method's receiver fills: the first of its type, else the first (`None`
+/// when there is none).
+fn receiver_slot(params: &[PView], v: &Value) -> Option<usize> {
+    if params.is_empty() {
+        return None;
     }
-    for (i, slot) in slots.iter_mut().enumerate() {
+    let idx = v
+        .ty()
+        .and_then(|t| {
+            params
+                .iter()
+                .position(|p| p.ty.is_some_and(|pt| t.fits(pt)))
+        })
+        .unwrap_or(0);
+    Some(idx)
+}
+
+/// Converts each bound argument to its parameter's type (an int to a float, …), or reports
+/// E0300 where it has another.
+fn coerce(params: &[PView], bound: &mut Bound, errs: &mut Vec<Diagnostic>) {
+    for (i, slot) in bound.slots.iter_mut().enumerate() {
         if let (Some((v, s)), Some(want)) = (slot.as_mut(), params[i].ty) {
             match v.clone().coerce(want) {
                 Some(c) => *v = c,
@@ -1124,17 +1244,12 @@ fn bind(
         }
     }
     if let Some(want) = params.last().and_then(|p| p.ty) {
-        for (v, s) in extra.iter_mut() {
+        for (v, s) in bound.rest.iter_mut() {
             match v.clone().coerce(want) {
                 Some(c) => *v = c,
                 None => errs.push(type_mismatch(params[params.len() - 1].name, want, v, *s)),
             }
         }
-    }
-    if errs.is_empty() {
-        Ok(Bound { slots, rest: extra })
-    } else {
-        Err(errs)
     }
 }
 
@@ -1181,16 +1296,32 @@ pub fn record(
     head: &Ident,
 ) -> HashMap<&'static str, Value> {
     let mut out: HashMap<&'static str, Value> = HashMap::new();
-    let mut spans: HashMap<&'static str, Span> = HashMap::new();
+    let names = rec
+        .fields
+        .iter()
+        .map(|p| (p.name, matches!(p.def, Def::Req)))
+        .collect();
+    let mut binder = Binder::new(Given::Fields, rec.name, names);
     for f in fields {
         let reads = cx.time_reads;
         let v = cx.expr(&f.value);
+        let p = match binder.name(&f.name) {
+            Ok(Some(i)) => &rec.fields[i],
+            Ok(None) => continue,
+            Err(d) => {
+                cx.error(d);
+                continue;
+            }
+        };
         if let (true, Some(at)) = (cx.time_reads > reads, cx.last_time_read()) {
-            if let Some(&name) = rec.timeless.iter().find(|n| **n == f.name.name) {
+            if rec.timeless.contains(&p.name) {
                 cx.error(
                     Diagnostic::error(
                         "E0406",
-                        format!("`{name}` of `{}` cannot depend on the time `t`", rec.name),
+                        format!(
+                            "`{}` of `{}` cannot depend on the time `t`",
+                            p.name, rec.name
+                        ),
                         f.value.span,
                     )
                     .with_label("this value changes with `t`")
@@ -1200,52 +1331,10 @@ pub fn record(
                         rec.timeless.join(", ")
                     )),
                 );
-                out.insert(name, Value::Error);
-                spans.insert(name, f.name.span);
+                out.insert(p.name, Value::Error);
                 continue;
             }
         }
-        let Some(p) = rec.fields.iter().find(|p| p.name == f.name.name) else {
-            let mut d = Diagnostic::error(
-                "E0202",
-                format!("`{}` has no field `{}`", rec.name, f.name.name),
-                f.name.span,
-            )
-            .with_label("unknown field")
-            .with_note(format!(
-                "the fields of `{}` are {}",
-                rec.name,
-                rec.fields
-                    .iter()
-                    .map(|p| p.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
-            // Only fields that are not given already.
-            let free = rec
-                .fields
-                .iter()
-                .map(|p| p.name)
-                .filter(|n| !fields.iter().any(|g| g.name.name == *n));
-            if let Some(s) = closest(&f.name.name, free) {
-                d = d.with_help(format!("did you mean `{s}`?"));
-            }
-            cx.error(d);
-            continue;
-        };
-        if let Some(prev) = spans.get(p.name) {
-            cx.error(
-                Diagnostic::error(
-                    "E0203",
-                    format!("field `{}` is given twice", p.name),
-                    f.name.span,
-                )
-                .with_label("given again here")
-                .with_secondary(*prev, "first given here"),
-            );
-            continue;
-        }
-        spans.insert(p.name, f.name.span);
         let v = match v.clone().coerce(p.ty) {
             Some(c) => c,
             None => {
@@ -1272,25 +1361,15 @@ pub fn record(
         }
         out.insert(p.name, v);
     }
-    for p in rec.fields {
-        if out.contains_key(p.name) || spans.contains_key(p.name) {
-            continue;
-        }
-        match p.def {
-            Def::Req => {
-                cx.error(
-                    Diagnostic::error(
-                        "E0204",
-                        format!("missing field `{}` of `{}`", p.name, rec.name),
-                        head.span,
-                    )
-                    .with_label(format!("`{}` is required", p.name)),
-                );
-                out.insert(p.name, Value::Error);
-            }
-            d => {
-                out.insert(p.name, d.value().unwrap_or(Value::Error));
-            }
+    let (errs, missing) = binder.finish(head.span);
+    for d in errs {
+        cx.error(d);
+    }
+    for (i, p) in rec.fields.iter().enumerate() {
+        if missing.contains(&i) {
+            out.insert(p.name, Value::Error);
+        } else if !binder.is_filled(i) {
+            out.insert(p.name, p.def.value().unwrap_or(Value::Error));
         }
     }
     out

@@ -255,7 +255,27 @@ fn dup(cx: &mut Ctx, what: &str, name: &ast::Ident, first: Span) {
     );
 }
 
+/// Checks the items of the entry file, pass by pass: declarations (functions, recursion,
+/// constants, materials), the items in order (constants, materials, blocks), the functions
+/// never called, then the scene's objects.
 fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
+    declare(cx, items);
+    let mut scene = Scene {
+        materials: vec![Material::default_material()],
+        ..Scene::default()
+    };
+    declare_materials(cx, &mut scene, items);
+    let scene_item = evaluate_items(cx, &mut scene, items);
+    check_uncalled_functions(cx);
+    scene.root = scene_objects(cx, scene_item, entry);
+    scene.graph = std::mem::take(&mut cx.graph);
+    crate::scene::recentre::recentre(&mut scene);
+    scene
+}
+
+/// Declares the functions (refusing recursion) and the constants, so that any item may use
+/// any of them.
+fn declare(cx: &mut Ctx, items: &[ast::Item]) {
     collect_functions(cx, items);
     reject_recursion(cx);
     for item in items {
@@ -267,11 +287,15 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
             }
         }
     }
-    let mut scene = Scene {
-        materials: vec![Material::default_material()],
-        ..Scene::default()
-    };
-    declare_materials(cx, &mut scene, items);
+}
+
+/// Evaluates the constants, materials and blocks in order (refusing a second `camera`,
+/// `render` or `scene` block); returns the `scene` item with the span of its keyword.
+fn evaluate_items<'a>(
+    cx: &mut Ctx,
+    scene: &mut Scene,
+    items: &'a [ast::Item],
+) -> Option<(&'a ast::Item, Span)> {
     let mut seen_blocks: HashMap<&str, Span> = HashMap::new();
     let mut scene_item = None;
     for item in items {
@@ -299,61 +323,62 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
             }
             ast::Item::Material {
                 name, kind, fields, ..
-            } => material(cx, &mut scene, name, kind, fields),
+            } => material(cx, scene, name, kind, fields),
             ast::Item::Block(b) => {
-                let once = b.keyword.name != "light";
-                if once {
-                    if let Some(first) = seen_blocks.get(b.keyword.name.as_str()) {
-                        cx.error(
-                            Diagnostic::error(
-                                "E0504",
-                                format!("more than one `{}` block", b.keyword.name),
-                                b.keyword.span,
-                            )
-                            .with_label("second block")
-                            .with_secondary(*first, "first block"),
-                        );
-                        continue;
-                    }
-                    seen_blocks.insert(
-                        if b.keyword.name == "camera" {
-                            "camera"
-                        } else {
-                            "render"
-                        },
-                        b.keyword.span,
-                    );
+                if first_block(cx, &mut seen_blocks, b) {
+                    block(cx, scene, b);
                 }
-                block(cx, &mut scene, b);
             }
             ast::Item::Scene { span, .. } => {
+                let keyword = Span {
+                    end: span.start + 5,
+                    ..*span
+                };
                 if let Some((_, first)) = scene_item {
                     cx.error(
-                        Diagnostic::error(
-                            "E0504",
-                            "more than one `scene` block",
-                            Span {
-                                end: span.start + 5,
-                                ..*span
-                            },
-                        )
-                        .with_label("second scene")
-                        .with_secondary(first, "first scene"),
+                        Diagnostic::error("E0504", "more than one `scene` block", keyword)
+                            .with_label("second scene")
+                            .with_secondary(first, "first scene"),
                     );
                 } else {
-                    scene_item = Some((
-                        item,
-                        Span {
-                            end: span.start + 5,
-                            ..*span
-                        },
-                    ));
+                    scene_item = Some((item, keyword));
                 }
             }
             ast::Item::Fn(_) | ast::Item::Import { .. } | ast::Item::Error(_) => {}
         }
     }
-    // Functions never called are still checked.
+    scene_item
+}
+
+/// Whether block `b` is the first of its kind (`light` blocks may repeat); a second
+/// `camera` or `render` block is an error.
+fn first_block(cx: &mut Ctx, seen: &mut HashMap<&str, Span>, b: &ast::Block) -> bool {
+    if b.keyword.name == "light" {
+        return true;
+    }
+    if let Some(first) = seen.get(b.keyword.name.as_str()) {
+        cx.error(
+            Diagnostic::error(
+                "E0504",
+                format!("more than one `{}` block", b.keyword.name),
+                b.keyword.span,
+            )
+            .with_label("second block")
+            .with_secondary(*first, "first block"),
+        );
+        return false;
+    }
+    let kind = if b.keyword.name == "camera" {
+        "camera"
+    } else {
+        "render"
+    };
+    seen.insert(kind, b.keyword.span);
+    true
+}
+
+/// Checks the functions no item called: a mistake in one is still reported.
+fn check_uncalled_functions(cx: &mut Ctx) {
     let mut unchecked: Vec<(u32, String)> = cx
         .fns
         .iter()
@@ -364,27 +389,35 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     for (_, name) in unchecked {
         cx.check_function(&name);
     }
+}
+
+/// The objects of the `scene` item (E0503 when there is none).
+fn scene_objects(
+    cx: &mut Ctx,
+    scene_item: Option<(&ast::Item, Span)>,
+    entry: FileId,
+) -> Option<crate::scene::NodeId> {
     match scene_item {
         Some((ast::Item::Scene { stmts, span }, keyword)) => {
             cx.places.scene = Some(keyword);
-            scene.root = objects(cx, stmts, *span)
+            objects(cx, stmts, *span)
         }
-        _ => cx.error(
-            Diagnostic::error(
-                "E0503",
-                "no `scene` block",
-                Span {
-                    file: entry,
-                    start: 0,
-                    end: 0,
-                },
-            )
-            .with_help("add the objects to render: `scene { sphere(1) @ red; }`"),
-        ),
+        _ => {
+            cx.error(
+                Diagnostic::error(
+                    "E0503",
+                    "no `scene` block",
+                    Span {
+                        file: entry,
+                        start: 0,
+                        end: 0,
+                    },
+                )
+                .with_help("add the objects to render: `scene { sphere(1) @ red; }`"),
+            );
+            None
+        }
     }
-    scene.graph = std::mem::take(&mut cx.graph);
-    crate::scene::recentre::recentre(&mut scene);
-    scene
 }
 
 fn collect_functions(cx: &mut Ctx, items: &[ast::Item]) {

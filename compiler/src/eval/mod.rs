@@ -17,13 +17,12 @@ mod wide;
 /// The evaluation types, at the path they had when they were defined here.
 pub use crate::program::Float;
 
-use crate::program::scalar;
 pub use tape::{Outputs, Tape};
 pub use wide::wide;
 
 use tape::{Guard, Sources, Step, INPUTS};
 
-use crate::program::{Axis, Op, Program, Reg};
+use crate::program::{Program, Reg};
 
 /// The default number of points an evaluator processes per pass over the tape.
 pub const DEFAULT_CHUNK: usize = 256;
@@ -37,40 +36,7 @@ const BLOCK_LANES: usize = 16;
 /// before it. The material id is the material register converted to an integer (negative and
 /// NaN become 0).
 pub fn eval_point<T: Float>(program: &Program, p: [T; 3]) -> (T, u32) {
-    let ops = program.ops();
-    let blocks = program.blocks();
-    let mut regs: Vec<T> = vec![T::zero(); ops.len()];
-    let mut next = 0;
-    let mut i = 0;
-    'run: while i < ops.len() {
-        while let Some(b) = blocks.get(next).filter(|b| b.start == i) {
-            next += 1;
-            if regs[b.bound.0 as usize] >= regs[b.best.0 as usize] {
-                for j in b.end..b.end + b.results {
-                    if let Op::Phi(_, other) = ops[j] {
-                        regs[j] = regs[other.0 as usize];
-                    }
-                }
-                i = b.end + b.results;
-                while blocks.get(next).is_some_and(|n| n.start < i) {
-                    next += 1;
-                }
-                continue 'run;
-            }
-        }
-        let r = |x: Reg| regs[x.0 as usize];
-        regs[i] = match ops[i] {
-            Op::Const(c) => T::from_f64(c),
-            Op::Input(Axis::X) => p[0],
-            Op::Input(Axis::Y) => p[1],
-            Op::Input(Axis::Z) => p[2],
-            Op::Unary(u, a) => scalar::unary(u, r(a)),
-            Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
-            Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
-            Op::Phi(a, _) => r(a),
-        };
-        i += 1;
-    }
+    let regs = program.run(p, |_| {});
     let get = |i: Reg| regs.get(i.0 as usize).copied().unwrap_or_else(T::zero);
     (
         get(program.distance()),

@@ -11,8 +11,8 @@
 //! results back. Blocks nest, each packing relative to the one around it.
 
 use super::fuse::{self, Finish, Fusions, Kind};
-use super::{scalar, Float};
-use crate::program::{Axis, Binary, Item, Op, Program, Reg, Unary};
+use super::Float;
+use crate::program::{scalar, Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 
 /// Which results a tape computes.

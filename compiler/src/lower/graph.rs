@@ -229,7 +229,7 @@ impl<'a> Lowerer<'a> {
         let graph = self.graph;
         let node = graph.node(id);
         self.b
-            .note(format!("node {} {}", self.number(id), kind(node)));
+            .note(format!("node {} {}", self.number(id), node.kind()));
         match node {
             Node::Combine {
                 op: Combine::Union,
@@ -282,8 +282,11 @@ impl<'a> Lowerer<'a> {
 
     /// Notes that the instructions that follow belong to `id` again, after its children.
     fn resume(&mut self, id: NodeId, node: &Node) {
-        self.b
-            .note_resume(format!("node {} {} (after its children)", id.0, kind(node)));
+        self.b.note_resume(format!(
+            "node {} {} (after its children)",
+            id.0,
+            node.kind()
+        ));
     }
 
     /// Lowers `child` at `q`, then maps its distance with `f` (material unchanged).
@@ -969,54 +972,4 @@ fn elongate(b: &mut Builder, p: P, h: V3) -> P {
         let c = b.clampc(x, -h[i], h[i]);
         b.sub(x, c)
     })
-}
-
-/// A short name of a node's kind, for the program's comments.
-fn kind(node: &Node) -> &'static str {
-    match node {
-        Node::Sphere { .. } => "sphere",
-        Node::Box { .. } => "box",
-        Node::RoundBox { .. } => "round_box",
-        Node::Plane { .. } => "plane",
-        Node::Torus { .. } => "torus",
-        Node::Cylinder { .. } => "cylinder",
-        Node::Capsule { .. } => "capsule",
-        Node::Cone { .. } => "cone",
-        Node::Ellipsoid { .. } => "ellipsoid",
-        Node::Mandelbulb { .. } => "mandelbulb",
-        Node::Combine {
-            op: Combine::Union, ..
-        } => "union",
-        Node::Combine {
-            op: Combine::Intersect,
-            ..
-        } => "intersect",
-        Node::Combine {
-            op: Combine::Subtract,
-            ..
-        } => "subtract",
-        Node::SmoothCombine {
-            op: Combine::Union, ..
-        } => "smooth_union",
-        Node::SmoothCombine {
-            op: Combine::Intersect,
-            ..
-        } => "smooth_intersect",
-        Node::SmoothCombine {
-            op: Combine::Subtract,
-            ..
-        } => "smooth_subtract",
-        Node::Translate { .. } => "translate",
-        Node::Rotate { .. } => "rotate",
-        Node::Scale { .. } => "scale",
-        Node::ScaleXyz { .. } => "scale_xyz",
-        Node::Repeat { .. } => "repeat",
-        Node::Mirror { .. } => "mirror",
-        Node::Twist { .. } => "twist",
-        Node::Bend { .. } => "bend",
-        Node::Round { .. } => "round",
-        Node::Shell { .. } => "shell",
-        Node::Elongate { .. } => "elongate",
-        Node::Paint { .. } => "paint",
-    }
 }

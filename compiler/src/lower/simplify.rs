@@ -518,20 +518,8 @@ fn is_primitive(node: &Node) -> bool {
 /// `node` with its single child replaced.
 fn with_child(node: Node, c: NodeId) -> Node {
     let mut node = node;
-    match &mut node {
-        Node::Translate { child, .. }
-        | Node::Rotate { child, .. }
-        | Node::Scale { child, .. }
-        | Node::ScaleXyz { child, .. }
-        | Node::Repeat { child, .. }
-        | Node::Mirror { child, .. }
-        | Node::Twist { child, .. }
-        | Node::Bend { child, .. }
-        | Node::Round { child, .. }
-        | Node::Shell { child, .. }
-        | Node::Elongate { child, .. }
-        | Node::Paint { child, .. } => *child = c,
-        _ => {}
+    if let Some(child) = node.child_mut() {
+        *child = c;
     }
     node
 }

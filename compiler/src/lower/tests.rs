@@ -4,44 +4,19 @@
 
 use super::bounds::Bounds;
 use super::graph::field_and_bound;
-use crate::program::{scalar, Axis, Float, Op, Program, Reg};
+use crate::program::{Float, Program};
+use crate::rng::Rng;
 use crate::scene::{Combine, Graph, MaterialId, Node, NodeId, Smooth};
 use crate::{FileId, Span};
 
 /// Evaluates the distance and the material register (the bound, here) of a program without
 /// blocks.
 fn eval<T: Float>(program: &Program, p: [T; 3]) -> (T, T) {
-    let mut regs: Vec<T> = Vec::with_capacity(program.len());
-    for op in program.ops() {
-        let r = |x: Reg| regs[x.0 as usize];
-        let v = match *op {
-            Op::Const(c) => T::from_f64(c),
-            Op::Input(Axis::X) => p[0],
-            Op::Input(Axis::Y) => p[1],
-            Op::Input(Axis::Z) => p[2],
-            Op::Unary(u, a) => scalar::unary(u, r(a)),
-            Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
-            Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
-            Op::Phi(a, _) => r(a),
-        };
-        regs.push(v);
-    }
+    let regs = program.run(p, |_| {});
     (
         regs[program.distance().0 as usize],
         regs[program.material().0 as usize],
     )
-}
-
-/// A small deterministic generator (xorshift64*), uniform in [0, 1).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
@@ -220,7 +195,7 @@ fn zoo() -> (Graph, Vec<NodeId>) {
 fn every_bound_is_below_its_field() {
     let (graph, ids) = zoo();
     let bounds = Bounds::new(&graph);
-    let mut rng = Rng(0x1234_5678_9ABC_DEF1);
+    let mut rng = Rng::new(0x1234_5678_9ABC_DEF1);
     let mut checked = 0;
     for id in ids {
         let Some(program) = field_and_bound(&graph, &bounds, id) else {
@@ -232,7 +207,7 @@ fn every_bound_is_below_its_field() {
         for k in 0..3000 {
             // Points from deep inside to far outside, denser near the volume.
             let scale = [0.3, 1.0, 1.5, 4.0][k % 4] * reach + 0.5;
-            let p: [f64; 3] = [0, 1, 2].map(|i| c[i] + (2.0 * rng.next() - 1.0) * scale);
+            let p: [f64; 3] = [0, 1, 2].map(|i| c[i] + (2.0 * rng.uniform() - 1.0) * scale);
             let (f, beta) = eval::<f64>(&program, p);
             assert!(
                 f.is_nan() || beta <= f,

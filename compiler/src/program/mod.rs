@@ -1,7 +1,7 @@
 //! The distance program, the IR between the lowering and every back end: one flat scalar SSA
 //! program that maps a point (x, y, z) to (distance, material id), with the meaning of each
-//! operation (`scalar.rs`, over the evaluation types of `float.rs`), liveness (`live.rs`) and
-//! its text form (`text.rs`). The lowering builds programs; the interpreter, the placement
+//! operation (`scalar.rs`, over the evaluation types of `float.rs`), the reference run of a
+//! whole program at one point (`run.rs`), liveness (`live.rs`) and its text form (`text.rs`). The lowering builds programs; the interpreter, the placement
 //! warnings and the Rust and WGSL writers read them.
 //!
 //! Every instruction defines one register, numbered by its position, over the evaluation's
@@ -17,11 +17,13 @@
 
 pub mod float;
 mod live;
+mod run;
 pub mod scalar;
 mod text;
 
 pub use float::Float;
 pub use live::results;
+pub use run::Step;
 pub use text::{axis_name, binary_name, op_text, unary_name};
 
 /// Names a register: the value defined by the instruction at this index.

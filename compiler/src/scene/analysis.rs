@@ -138,43 +138,12 @@ pub fn describe(e: Exactness) -> &'static str {
     }
 }
 
-/// A short name of a node's kind, for messages.
+/// A short name of a node's kind, for messages: its name in the IR ([`Node::kind`]), but
+/// `scale` for a per-axis scale, which the language writes `scale` too.
 pub fn kind(node: &Node) -> &'static str {
     match node {
-        Node::Sphere { .. } => "sphere",
-        Node::Box { .. } => "box",
-        Node::RoundBox { .. } => "round_box",
-        Node::Plane { .. } => "plane",
-        Node::Torus { .. } => "torus",
-        Node::Cylinder { .. } => "cylinder",
-        Node::Capsule { .. } => "capsule",
-        Node::Cone { .. } => "cone",
-        Node::Ellipsoid { .. } => "ellipsoid",
-        Node::Mandelbulb { .. } => "mandelbulb",
-        Node::Combine { op, .. } => combine_name(*op, false),
-        Node::SmoothCombine { op, .. } => combine_name(*op, true),
-        Node::Translate { .. } => "translate",
-        Node::Rotate { .. } => "rotate",
-        Node::Scale { .. } | Node::ScaleXyz { .. } => "scale",
-        Node::Repeat { .. } => "repeat",
-        Node::Mirror { .. } => "mirror",
-        Node::Twist { .. } => "twist",
-        Node::Bend { .. } => "bend",
-        Node::Round { .. } => "round",
-        Node::Shell { .. } => "shell",
-        Node::Elongate { .. } => "elongate",
-        Node::Paint { .. } => "paint",
-    }
-}
-
-fn combine_name(op: Combine, smooth: bool) -> &'static str {
-    match (op, smooth) {
-        (Combine::Union, false) => "union",
-        (Combine::Intersect, false) => "intersect",
-        (Combine::Subtract, false) => "subtract",
-        (Combine::Union, true) => "smooth_union",
-        (Combine::Intersect, true) => "smooth_intersect",
-        (Combine::Subtract, true) => "smooth_subtract",
+        Node::ScaleXyz { .. } => "scale",
+        other => other.kind(),
     }
 }
 

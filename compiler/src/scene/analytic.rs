@@ -120,12 +120,23 @@ pub fn choose(scene: &Scene) -> Choice {
 /// after checking, then picks with [`Traceable::choose`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Traceable {
-    /// The primitives in world space, or why some node or light rules tracing out.
-    primitives: Result<Vec<Primitive>, Reason>,
+    /// The primitives in world space and their hierarchy, or why some node or light rules
+    /// tracing out.
+    primitives: Result<Traced, Reason>,
     /// A transparent primitive that overlaps or touches another (its node's span).
     overlap: Option<Span>,
     /// The `traced` limit of the scene's limits.
     limit: usize,
+}
+
+/// The primitives of a traceable scene and their bounding-volume hierarchy ([`hierarchy`]),
+/// built once for every back end.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Traced {
+    /// The primitives in world space.
+    pub primitives: Vec<Primitive>,
+    /// Their hierarchy (indices into `primitives`).
+    pub hierarchy: Vec<Item>,
 }
 
 /// The primitives of `scene` and what rules tracing out, whatever its `method`.
@@ -155,8 +166,12 @@ pub fn traceable(scene: &Scene) -> Traceable {
         }
     }
     let overlap = transparent_overlap(scene, &out).map(|p| scene.graph.span(p.node));
+    let hierarchy = hierarchy(&out);
     Traceable {
-        primitives: Ok(out),
+        primitives: Ok(Traced {
+            primitives: out,
+            hierarchy,
+        }),
         overlap,
         limit,
     }
@@ -169,23 +184,24 @@ impl Traceable {
     /// reports it as an error.
     pub fn choose(&self, method: Method) -> Choice {
         match self.decide(method) {
-            Ok(primitives) => Choice::Trace(primitives.to_vec()),
+            Ok(traced) => Choice::Trace(traced.primitives.clone()),
             Err(reason) => Choice::March(reason),
         }
     }
 
-    /// The primitives to trace when a scene with this `method` setting is traced
-    /// ([`Traceable::choose`] without copying them).
-    pub fn traced(&self, method: Method) -> Option<&[Primitive]> {
+    /// The primitives to trace, with their hierarchy, when a scene with this `method`
+    /// setting is traced ([`Traceable::choose`] without copying them).
+    pub fn traced(&self, method: Method) -> Option<&Traced> {
         self.decide(method).ok()
     }
 
     /// [`Traceable::choose`]: the primitives, or why the scene is marched.
-    fn decide(&self, method: Method) -> Result<&[Primitive], Reason> {
+    fn decide(&self, method: Method) -> Result<&Traced, Reason> {
         if method == Method::March {
             return Err(Reason::Asked);
         }
-        let primitives = self.primitives.as_ref().map_err(Clone::clone)?;
+        let traced = self.primitives.as_ref().map_err(Clone::clone)?;
+        let primitives = &traced.primitives;
         // The `traced` limit (limits.rs): rays visit the primitives through a bounding-volume
         // hierarchy ([`hierarchy`]), in O(log n) per ray on the CPU and on the GPU, whose
         // kernel reads a large scene's primitives and hierarchy from a buffer
@@ -200,7 +216,7 @@ impl Traceable {
         if let Some(span) = self.overlap {
             return Err(Reason::Overlap { span });
         }
-        Ok(primitives)
+        Ok(traced)
     }
 }
 

@@ -42,6 +42,21 @@ pub enum Combine {
     Subtract,
 }
 
+impl Combine {
+    /// The combination's name, with the `smooth_` prefix for the smooth one: `union`,
+    /// `smooth_subtract`, ….
+    pub fn name(self, smooth: bool) -> &'static str {
+        match (self, smooth) {
+            (Combine::Union, false) => "union",
+            (Combine::Intersect, false) => "intersect",
+            (Combine::Subtract, false) => "subtract",
+            (Combine::Union, true) => "smooth_union",
+            (Combine::Intersect, true) => "smooth_intersect",
+            (Combine::Subtract, true) => "smooth_subtract",
+        }
+    }
+}
+
 /// A shape node. Primitives are centred on the origin; transforms wrap a child.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Node {
@@ -107,25 +122,72 @@ pub enum Node {
     Paint { material: MaterialId, child: NodeId },
 }
 
+/// The pattern of every node with exactly one child (the transforms, the modifiers and
+/// paint), binding the child to `$child`: the one list of them.
+macro_rules! one_child {
+    ($child:ident) => {
+        Node::Translate { $child, .. }
+            | Node::Rotate { $child, .. }
+            | Node::Scale { $child, .. }
+            | Node::ScaleXyz { $child, .. }
+            | Node::Repeat { $child, .. }
+            | Node::Mirror { $child, .. }
+            | Node::Twist { $child, .. }
+            | Node::Bend { $child, .. }
+            | Node::Round { $child, .. }
+            | Node::Shell { $child, .. }
+            | Node::Elongate { $child, .. }
+            | Node::Paint { $child, .. }
+    };
+}
+
 impl Node {
     /// The node's children in order.
     pub fn children(&self) -> Vec<NodeId> {
         match self {
             Node::Combine { children, .. } => children.clone(),
             Node::SmoothCombine { a, b, .. } => vec![*a, *b],
-            Node::Translate { child, .. }
-            | Node::Rotate { child, .. }
-            | Node::Scale { child, .. }
-            | Node::ScaleXyz { child, .. }
-            | Node::Repeat { child, .. }
-            | Node::Mirror { child, .. }
-            | Node::Twist { child, .. }
-            | Node::Bend { child, .. }
-            | Node::Round { child, .. }
-            | Node::Shell { child, .. }
-            | Node::Elongate { child, .. }
-            | Node::Paint { child, .. } => vec![*child],
+            one_child!(child) => vec![*child],
             _ => Vec::new(),
+        }
+    }
+
+    /// The child of a node with exactly one (a transform, a modifier or paint), to replace.
+    pub fn child_mut(&mut self) -> Option<&mut NodeId> {
+        match self {
+            one_child!(child) => Some(child),
+            _ => None,
+        }
+    }
+
+    /// The node's name in the IR (`--emit ir`, and the program's comments): `sphere`,
+    /// `smooth_union`, `scale_xyz`, ….
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Node::Sphere { .. } => "sphere",
+            Node::Box { .. } => "box",
+            Node::RoundBox { .. } => "round_box",
+            Node::Plane { .. } => "plane",
+            Node::Torus { .. } => "torus",
+            Node::Cylinder { .. } => "cylinder",
+            Node::Capsule { .. } => "capsule",
+            Node::Cone { .. } => "cone",
+            Node::Ellipsoid { .. } => "ellipsoid",
+            Node::Mandelbulb { .. } => "mandelbulb",
+            Node::Combine { op, .. } => op.name(false),
+            Node::SmoothCombine { op, .. } => op.name(true),
+            Node::Translate { .. } => "translate",
+            Node::Rotate { .. } => "rotate",
+            Node::Scale { .. } => "scale",
+            Node::ScaleXyz { .. } => "scale_xyz",
+            Node::Repeat { .. } => "repeat",
+            Node::Mirror { .. } => "mirror",
+            Node::Twist { .. } => "twist",
+            Node::Bend { .. } => "bend",
+            Node::Round { .. } => "round",
+            Node::Shell { .. } => "shell",
+            Node::Elongate { .. } => "elongate",
+            Node::Paint { .. } => "paint",
         }
     }
 
@@ -431,14 +493,23 @@ fn unit(a: DVec3) -> DVec3 {
     }
 }
 
+impl Camera {
+    /// The field of view of a camera that gives none, in degrees.
+    pub const FOV_DEGREES: f64 = 60.0;
+
+    /// The camera of a scene without a `camera` block, and the default of each field of one
+    /// (`check/builtins.rs` reads them here).
+    pub const DEFAULT: Camera = Camera {
+        position: [0.0, 1.0, -5.0],
+        look_at: [0.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov: Camera::FOV_DEGREES.to_radians(),
+    };
+}
+
 impl Default for Camera {
     fn default() -> Self {
-        Camera {
-            position: [0.0, 1.0, -5.0],
-            look_at: [0.0, 0.0, 0.0],
-            up: [0.0, 1.0, 0.0],
-            fov: 60f64.to_radians(),
-        }
+        Camera::DEFAULT
     }
 }
 
@@ -499,7 +570,7 @@ impl Method {
     }
 
     /// The method's name.
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             Method::Auto => "auto",
             Method::Trace => "trace",
@@ -519,23 +590,27 @@ impl Settings {
             self.epsilon
         }
     }
+
+    /// The settings of a scene without a `render` block, and the default of each field of one
+    /// (`check/builtins.rs` reads them here).
+    pub const DEFAULT: Settings = Settings {
+        width: 640,
+        height: 480,
+        aa: 1,
+        max_steps: 512,
+        epsilon: 1e-5,
+        footprint: false,
+        max_depth: 5,
+        max_dist: 100.0,
+        relaxation: 1.4,
+        background: [0.05, 0.06, 0.08],
+        method: Method::Auto,
+    };
 }
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings {
-            width: 640,
-            height: 480,
-            aa: 1,
-            max_steps: 512,
-            epsilon: 1e-5,
-            footprint: false,
-            max_depth: 5,
-            max_dist: 100.0,
-            relaxation: 1.4,
-            background: [0.05, 0.06, 0.08],
-            method: Method::Auto,
-        }
+        Settings::DEFAULT
     }
 }
 

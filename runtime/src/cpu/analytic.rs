@@ -8,7 +8,7 @@
 
 use super::vec::V3;
 use sdfc_compiler::eval::Float;
-use sdfc_compiler::scene::analytic::{hierarchy, Item, Primitive, Shape};
+use sdfc_compiler::scene::analytic::{Item, Primitive, Shape, Traced};
 
 /// A primitive in the evaluation type.
 #[derive(Debug, Clone, Copy)]
@@ -84,9 +84,11 @@ fn enters<T: Float>(o: V3<T>, d: V3<T>, centre: V3<T>, half: V3<T>, limit: T) ->
 }
 
 impl<T: Float> Tracer<T> {
-    pub fn new(primitives: &[Primitive]) -> Self {
+    /// The tracer of `traced`'s primitives, walked through its hierarchy.
+    pub fn new(traced: &Traced) -> Self {
         let f = T::from_f64;
-        let prims = primitives
+        let prims = traced
+            .primitives
             .iter()
             .map(|p| Prim {
                 kind: match p.shape {
@@ -120,7 +122,7 @@ impl<T: Float> Tracer<T> {
                 material: p.material.0,
             })
             .collect();
-        let top = hierarchy(primitives).iter().map(node).collect();
+        let top = traced.hierarchy.iter().map(node).collect();
         Tracer { prims, top }
     }
 
@@ -214,7 +216,7 @@ pub(super) fn heap_bytes<T: Float>(
     use std::mem::size_of;
     let n = traceable
         .traced(scene.settings.method)
-        .map_or(0, <[_]>::len) as u64;
+        .map_or(0, |t| t.primitives.len()) as u64;
     let held = size_of::<Prim<T>>() + 2 * size_of::<Node<T>>();
     let building = 4 * size_of::<Primitive>() + 256;
     n * (held + building) as u64
@@ -420,20 +422,13 @@ mod tests {
     use super::*;
     use sdfc_compiler::eval::eval_point;
     use sdfc_compiler::lower::lower;
-    use sdfc_compiler::scene::analytic::choose;
+    use sdfc_compiler::rng::Rng;
+    use sdfc_compiler::scene::analytic::traceable;
 
-    /// A small deterministic generator (xorshift) of numbers in [-1, 1).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
-        fn v3(&mut self) -> V3<f64> {
-            V3::new(self.next(), self.next(), self.next())
-        }
+    /// A vector uniform in [-1, 1)³.
+    fn v3(rng: &mut Rng) -> V3<f64> {
+        let [x, y, z] = rng.point(1.0);
+        V3::new(x, y, z)
     }
 
     /// Each shape, alone and under rotations and scales: along random rays, the traced hit
@@ -460,18 +455,19 @@ mod tests {
             );
             let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
             let scene = scene.unwrap_or_else(|| panic!("{shape}: {diags:?}"));
-            let prims = choose(&scene);
-            let tracer = Tracer::<f64>::new(prims.primitives().expect("traced"));
+            let traceable = traceable(&scene);
+            let tracer =
+                Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));
             let program = lower(&scene);
             let f = |p: V3<f64>| eval_point::<f64>(&program, [p.x, p.y, p.z]);
-            let mut rng = Rng(0x9e3779b97f4a7c15);
+            let mut rng = Rng::new(0x9e3779b97f4a7c15);
             let (mut hits, mut misses) = (0, 0);
             for _ in 0..2000 {
-                let o = rng.v3() * 3.0;
+                let o = v3(&mut rng) * 3.0;
                 if f(o).0 <= 1e-3 {
                     continue; // rays start outside every solid
                 }
-                let d = (rng.v3() * 0.6 - o * 0.3).normalize();
+                let d = (v3(&mut rng) * 0.6 - o * 0.3).normalize();
                 match tracer.nearest(o, d, 50.0) {
                     Some(s) => {
                         hits += 1;
@@ -519,7 +515,8 @@ mod tests {
                     scene { sphere(1).translate(0, 0, 5); sphere(1).translate(0, 0, -5) @ glass; }";
         let (scene, _, _) = sdfc_compiler::check::check_str("t.sdf", text);
         let scene = scene.expect("checks");
-        let tracer = Tracer::<f64>::new(choose(&scene).primitives().expect("traced"));
+        let traceable = traceable(&scene);
+        let tracer = Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));
         let tau = |m: u32| if m == 1 { 0.5 } else { 0.0 };
         let (o, fwd, back) = (V3::zero(), V3::new(0.0, 0.0, 1.0), V3::new(0.0, 0.0, -1.0));
         assert_eq!(tracer.transmitted(o, fwd, 10.0, tau), 0.0);
@@ -537,9 +534,13 @@ mod tests {
         // `tau` treats it as transparent, which is all `transmitted` looks at.
         let mut text =
             String::from("material glass = phong { reflect: 0.5 };\nscene {\n plane();\n");
-        let mut rng = Rng(0x2545f4914f6cdd1d);
+        let mut rng = Rng::new(0x2545f4914f6cdd1d);
         for i in 0..300 {
-            let (x, y, z) = (rng.next() * 8.0, rng.next() * 3.0 + 3.0, rng.next() * 8.0);
+            let (x, y, z) = (
+                rng.range(-8.0, 8.0),
+                rng.range(0.0, 6.0),
+                rng.range(-8.0, 8.0),
+            );
             let shape = match i % 3 {
                 0 => "sphere(0.3)",
                 1 => "box((0.3, 0.1, 0.2)).rotate_y(25deg)",
@@ -551,8 +552,8 @@ mod tests {
         text.push_str("}\n");
         let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
         let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
-        let prims = choose(&scene);
-        let tracer = Tracer::<f64>::new(prims.primitives().expect("traced"));
+        let traceable = traceable(&scene);
+        let tracer = Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));
         assert!(matches!(tracer.top.last(), Some(Node::Group { .. })));
         let brute = Tracer::<f64> {
             prims: tracer.prims.clone(),
@@ -561,8 +562,8 @@ mod tests {
         let tau = |m: u32| if m == 1 { 0.5 } else { 0.0 };
         let mut hits = 0;
         for _ in 0..3000 {
-            let o = rng.v3() * 12.0 + V3::new(0.0, 6.0, 0.0);
-            let d = rng.v3().normalize();
+            let o = v3(&mut rng) * 12.0 + V3::new(0.0, 6.0, 0.0);
+            let d = v3(&mut rng).normalize();
             let (a, b) = (tracer.nearest(o, d, 100.0), brute.nearest(o, d, 100.0));
             assert_eq!(a.map(|s| (s.t, s.material)), b.map(|s| (s.t, s.material)));
             hits += usize::from(a.is_some());

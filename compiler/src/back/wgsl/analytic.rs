@@ -6,7 +6,7 @@
 
 use super::buffer;
 use super::map::float;
-use crate::scene::analytic::{hierarchy, Item, Primitive, Shape};
+use crate::scene::analytic::{Item, Primitive, Shape, Traced};
 use crate::scene::V3;
 use std::fmt::Write;
 
@@ -60,12 +60,12 @@ pub const MAX_UNROLLED: usize = 256;
 /// The interval functions the scene uses and `fn trace` and `fn shadow`: unrolled over the
 /// primitives (with their frame constants) up to `max_unrolled` of them ([`MAX_UNROLLED`] by
 /// default), else walking the buffer `scene_data`, whose bytes are returned too.
-pub fn write(primitives: &[Primitive], max_unrolled: usize) -> (String, Option<Vec<u8>>) {
-    let top = hierarchy(primitives);
-    let mut out = sections(primitives, &top);
+pub fn write(traced: &Traced, max_unrolled: usize) -> (String, Option<Vec<u8>>) {
+    let (primitives, top) = (&traced.primitives[..], &traced.hierarchy[..]);
+    let mut out = sections(primitives, top);
     if primitives.len() > max_unrolled && buffer::fits(primitives) {
-        out.push_str(&buffer::write(primitives, &top));
-        return (out, Some(buffer::data(primitives, &top)));
+        out.push_str(&buffer::write(primitives, top));
+        return (out, Some(buffer::data(primitives, top)));
     }
     if primitives.iter().any(|p| !identity(&p.matrix)) {
         out.push_str("// The world-to-local rows of the primitives that are rotated or scaled.\n");
@@ -92,7 +92,7 @@ pub fn write(primitives: &[Primitive], max_unrolled: usize) -> (String, Option<V
             p.material.0
         )
     };
-    items(&mut out, primitives, &top, 1, "best.t", &nearest);
+    items(&mut out, primitives, top, 1, "best.t", &nearest);
     out.push_str("    return best;\n}\n\n");
     out.push_str(
         "// The light arriving along o + t·d, 0 < t < tmax: 0 behind an opaque primitive, else the\n\
@@ -107,7 +107,7 @@ pub fn write(primitives: &[Primitive], max_unrolled: usize) -> (String, Option<V
             p.material.0
         )
     };
-    items(&mut out, primitives, &top, 1, "tmax", &occlude);
+    items(&mut out, primitives, top, 1, "tmax", &occlude);
     out.push_str("    return through;\n}\n");
     (out, None)
 }

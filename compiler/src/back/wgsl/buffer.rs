@@ -26,17 +26,35 @@ use crate::scene::analytic::{Item, Primitive, Shape};
 use crate::scene::V3;
 use std::fmt::Write;
 
-/// The kinds of entry, in the low three bits of an entry's tag.
+// An entry's tag, in both layouts of `scene_data` (this one, of a traced scene's primitives,
+// and march.rs's, of a marched scene's instances): the kind of entry in the low bits
+// (`KIND_BITS`), GROUP or a kind of leaf; `TRANSFORMED` for a leaf with a frame of its own;
+// the material above `MATERIAL_SHIFT`.
+
+/// The tag of a group; the other values of the kind bits are the kinds of leaf of a layout.
+pub(super) const GROUP: u32 = 7;
+/// The bits of a tag that hold the kind of entry.
+pub(super) const KIND_BITS: u32 = 7;
+/// The tag bit of a leaf with a frame of its own (a primitive with a world-to-local matrix
+/// other than the identity, an instance with a rotation).
+pub(super) const TRANSFORMED: u32 = 8;
+/// Materials are numbered in the tag's bits above these.
+pub(super) const MATERIAL_SHIFT: u32 = 4;
+
+/// The tag of a leaf of kind `kind` (below [`GROUP`]).
+pub(super) fn tag(kind: u32, transformed: bool, material: u32) -> u32 {
+    kind | if transformed { TRANSFORMED } else { 0 } | material << MATERIAL_SHIFT
+}
+
+/// The kinds of primitive.
 const SPHERE: u32 = 0;
 const BOX: u32 = 1;
 const CYLINDER: u32 = 2;
 const CAPSULE: u32 = 3;
 const PLANE: u32 = 4;
-const GROUP: u32 = 5;
-/// The tag bit of a primitive with a world-to-local matrix other than the identity.
-const FRAMED: u32 = 8;
-/// Materials are numbered in the tag's bits above these.
-pub(super) const MATERIAL_SHIFT: u32 = 4;
+/// The kernel's name of [`TRANSFORMED`] here: a primitive with a world-to-local matrix other
+/// than the identity.
+const FRAMED: u32 = TRANSFORMED;
 
 /// Whether every material of `primitives` fits in a tag.
 pub fn fits(primitives: &[Primitive]) -> bool {
@@ -71,22 +89,17 @@ pub(super) fn vec(v: V3, w: u32) -> [u32; 4] {
 /// The contents of `scene_data` for `primitives` and their hierarchy `top`, as little-endian
 /// bytes.
 pub fn data(primitives: &[Primitive], top: &[Item]) -> Vec<u8> {
-    entries(top, GROUP, &mut |out, i| primitive(out, &primitives[i]))
+    entries(top, &mut |out, i| primitive(out, &primitives[i]))
 }
 
 /// The bytes of a `scene_data` buffer for a hierarchy `items`: `[0]` holds the index one past
 /// the last entry, then the entries of a depth-first walk, a group as `(centre, group)` and
 /// `(half-extents, next)`, a leaf as `leaf` writes it (the layout above; the marched kernel's
 /// `march.rs` shares it with other leaves).
-pub(super) fn entries(
-    items: &[Item],
-    group: u32,
-    leaf: &mut dyn FnMut(&mut Vec<[u32; 4]>, usize),
-) -> Vec<u8> {
+pub(super) fn entries(items: &[Item], leaf: &mut dyn FnMut(&mut Vec<[u32; 4]>, usize)) -> Vec<u8> {
     fn push(
         out: &mut Vec<[u32; 4]>,
         items: &[Item],
-        group: u32,
         leaf: &mut dyn FnMut(&mut Vec<[u32; 4]>, usize),
     ) {
         for item in items {
@@ -94,23 +107,23 @@ pub(super) fn entries(
                 Item::Primitive(i) => leaf(out, *i),
                 Item::Group(g) => {
                     let at = out.len();
-                    out.push(vec(g.centre, group));
+                    out.push(vec(g.centre, GROUP));
                     out.push(vec(g.half, 0));
-                    push(out, &g.items, group, leaf);
+                    push(out, &g.items, leaf);
                     out[at + 1][3] = out.len() as u32;
                 }
             }
         }
     }
     let mut out = vec![[0u32; 4]];
-    push(&mut out, items, group, leaf);
+    push(&mut out, items, leaf);
     out[0][0] = out.len() as u32;
     out.iter().flatten().flat_map(|w| w.to_le_bytes()).collect()
 }
 
 fn primitive(out: &mut Vec<[u32; 4]>, p: &Primitive) {
     let framed = !super::analytic::identity(&p.matrix);
-    let tag = kind(&p.shape) | if framed { FRAMED } else { 0 } | p.material.0 << MATERIAL_SHIFT;
+    let tag = tag(kind(&p.shape), framed, p.material.0);
     out.push(vec(p.offset, tag));
     out.push(match p.shape {
         Shape::Sphere { radius } => [bits(radius * radius), 0, 0, 0],
@@ -225,7 +238,7 @@ fn shape_interval(out: &mut String, primitives: &[Primitive]) {
     );
     let kinds: Vec<u32> = primitives.iter().map(|p| kind(&p.shape)).collect();
     if kinds.windows(2).any(|w| w[0] != w[1]) {
-        out.push_str("    let kind = tag & 7u;\n");
+        let _ = writeln!(out, "    let kind = tag & {KIND_BITS}u;");
     }
     let call = |k: u32| match k {
         SPHERE => "return sphere_interval(o, d, s.x);",
@@ -338,7 +351,7 @@ mod tests {
                 i += 2;
             } else {
                 seen.push((f32::from_bits(e[i][0]), tag >> MATERIAL_SHIFT));
-                assert_eq!(tag & 7, SPHERE);
+                assert_eq!(tag & KIND_BITS, SPHERE);
                 if tag & FRAMED != 0 {
                     framed.push(seen.len() - 1);
                 }

@@ -31,13 +31,15 @@
 //! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes
 //! 32 bytes, a rotated one 80, a group 32.
 
-use super::buffer::{self, bits, entries, tag_holds, vec, MATERIAL_SHIFT};
+use super::buffer::{
+    self, bits, entries, tag, tag_holds, vec, GROUP, KIND_BITS, MATERIAL_SHIFT, TRANSFORMED,
+};
 use crate::lower::Instance;
 use crate::scene::analytic::{boxed, Item};
 use crate::scene::{Node, V3};
 use std::fmt::Write;
 
-/// The kinds of entry, in the low three bits of an entry's tag.
+/// The kinds of instance (the tags are buffer.rs's).
 const SPHERE: u32 = 0;
 const BOX: u32 = 1;
 const ROUND_BOX: u32 = 2;
@@ -45,9 +47,8 @@ const TORUS: u32 = 3;
 const CYLINDER: u32 = 4;
 const CAPSULE: u32 = 5;
 const CONE: u32 = 6;
-const GROUP: u32 = 7;
-/// The tag bit of an instance with a rotation.
-const ROTATED: u32 = 8;
+/// The kernel's name of [`TRANSFORMED`] here: an instance with a rotation.
+const ROTATED: u32 = TRANSFORMED;
 
 /// Whether every material of `instances` fits in a tag.
 pub fn fits(instances: &[Instance]) -> bool {
@@ -79,7 +80,7 @@ fn quad(v: [f64; 4]) -> [u32; 4] {
 pub fn data(instances: &[Instance], eye: V3) -> Vec<u8> {
     let mut top = boxed(instances.iter().map(|i| i.aabb).enumerate().collect());
     nearer_first(&mut top, instances, eye);
-    entries(&top, GROUP, &mut |out, i| instance(out, &instances[i]))
+    entries(&top, &mut |out, i| instance(out, &instances[i]))
 }
 
 /// Orders `items`, and the items of every group among them, by the distance from `eye` to
@@ -106,9 +107,8 @@ fn nearer_first(items: &mut [Item], instances: &[Instance], eye: V3) {
 }
 
 fn instance(out: &mut Vec<[u32; 4]>, i: &Instance) {
-    let tag = kind(&i.shape)
-        | if i.rotation.is_some() { ROTATED } else { 0 }
-        | i.material.map_or(0, |m| m.0) << MATERIAL_SHIFT;
+    let material = i.material.map_or(0, |m| m.0);
+    let tag = tag(kind(&i.shape), i.rotation.is_some(), material);
     out.push(vec(i.offset, tag));
     out.push(shape(&i.shape));
     if let Some(m) = i.rotation {
@@ -249,7 +249,7 @@ fn instance_distance(out: &mut String, rotated: bool) {
              \x20   }\n",
         );
     }
-    let shape = "shape_distance(tag & 7u, q, scene_data[i + 1u])";
+    let shape = format!("shape_distance(tag & {KIND_BITS}u, q, scene_data[i + 1u])");
     let _ = writeln!(out, "    return {shape};\n}}\n");
     out.push_str("// The number of vectors of the instance whose tag this is.\n");
     out.push_str("fn instance_size(tag: u32) -> u32 {\n    return 2u");
@@ -334,7 +334,7 @@ mod tests {
             }
             let x = f32::from_bits(e[i][0]);
             let k = (x / 1.5).round() as usize;
-            assert_eq!(tag & 7, SPHERE);
+            assert_eq!(tag & KIND_BITS, SPHERE);
             assert_eq!(tag & ROTATED != 0, k % 3 == 1, "instance {k}");
             let material = if k % 2 == 0 { k as u32 } else { 0 };
             assert_eq!(tag >> MATERIAL_SHIFT, material);

@@ -229,8 +229,8 @@ pub struct Text {
 
 /// The text of the kernel [`write_with`] writes, not validated.
 pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Text, Error> {
-    let choice = lowered.choice(&scene.settings);
-    let mut features = features(scene, choice.primitives().is_some());
+    let traced = lowered.traceable.traced(scene.settings.method);
+    let mut features = features(scene, traced.is_some());
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
     // Listed in the header only when on, so that the default kernel does not change.
     on.insert("DEBUG_NAN", options.debug_nan);
@@ -239,10 +239,10 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
     }
     let mut values: HashMap<&str, String> = HashMap::new();
     on.insert("MEDIA", false);
-    let data = match choice.primitives() {
+    let data = match traced {
         // An analytically traced scene needs no distance field.
-        Some(primitives) => {
-            let (text, bytes) = analytic::write(primitives, options.max_unrolled);
+        Some(traced) => {
+            let (text, bytes) = analytic::write(traced, options.max_unrolled);
             values.insert("MAP", String::new());
             values.insert("ANALYTIC", text);
             bytes

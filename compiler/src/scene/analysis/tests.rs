@@ -8,6 +8,7 @@ use crate::check::check_str;
 use crate::eval::eval_point;
 use crate::lower::{lower, lower_with, LowerOptions};
 use crate::program::Program;
+use crate::rng::Rng;
 
 fn scene(objects: &str) -> (Scene, Vec<Diagnostic>) {
     let text = format!("scene {{ {objects}; }}");
@@ -236,20 +237,9 @@ fn the_renderers_l_is_clamped() {
 
 // ---- Empirical checks on the lowered program ----
 
-/// A small deterministic generator (xorshift), uniform in [0, 1).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn in_box(&mut self, b: &Aabb) -> V3 {
-        [0, 1, 2].map(|i| b.min[i] + (b.max[i] - b.min[i]) * self.next())
-    }
+/// A point uniform in a box.
+fn in_box(rng: &mut Rng, b: &Aabb) -> V3 {
+    [0, 1, 2].map(|i| b.min[i] + (b.max[i] - b.min[i]) * rng.uniform())
 }
 
 fn f(program: &Program, p: V3) -> f64 {
@@ -260,16 +250,16 @@ fn f(program: &Program, p: V3) -> f64 {
 /// f / l, and counts the steps that cross the surface (some point sampled along the step
 /// is inside).
 fn crossings(program: &Program, b: &Aabb, l: f64, rays: usize) -> usize {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut rng = Rng::new(0x9e37_79b9_7f4a_7c15);
     let centre = [0, 1, 2].map(|i| (b.min[i] + b.max[i]) * 0.5);
     let radius = (0..3).map(|i| b.max[i] - b.min[i]).fold(0.0, f64::max) * 1.5;
     let mut bad = 0;
     for _ in 0..rays {
-        let target = rng.in_box(b);
+        let target = in_box(&mut rng, b);
         let u = [
-            rng.next() * 2.0 - 1.0,
-            rng.next() * 2.0 - 1.0,
-            rng.next() * 2.0 - 1.0,
+            rng.uniform() * 2.0 - 1.0,
+            rng.uniform() * 2.0 - 1.0,
+            rng.uniform() * 2.0 - 1.0,
         ];
         let n = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt().max(1e-9);
         let o = [0, 1, 2].map(|i| centre[i] + u[i] / n * radius);
@@ -383,11 +373,11 @@ fn exact_primitives_have_unit_gradients() {
     ] {
         let (program, _, _, b) = traced(p);
         let b = b.grow(1.0);
-        let mut rng = Rng(7);
+        let mut rng = Rng::new(7);
         let h = 1e-6;
         let mut unit = 0;
         for _ in 0..400 {
-            let x = rng.in_box(&b);
+            let x = in_box(&mut rng, &b);
             let g: Vec<f64> = (0..3)
                 .map(|i| {
                     let (mut a, mut c) = (x, x);

@@ -1,7 +1,7 @@
 //! The warnings of the analysis (W0002–W0007): constructs that make the field unreliable,
 //! reported once per code and source span, for nodes the scene's root reaches.
 
-use super::{combine_name, fmt, Pass, MAX_STEP_LIPSCHITZ};
+use super::{fmt, Pass, MAX_STEP_LIPSCHITZ};
 use crate::diagnostics::Diagnostic;
 use crate::scene::{Combine, NodeId, V3};
 
@@ -33,7 +33,7 @@ impl Pass<'_> {
     }
 
     pub(super) fn warn_exp(&mut self, id: NodeId, op: Combine, k: f64, reach: f64, size: f64) {
-        let name = combine_name(op, true);
+        let name = op.name(true);
         self.warn(
             "W0002",
             id,

@@ -3,7 +3,7 @@
 
 use super::types::{Type, Value};
 use crate::limits::{Limit, Limits};
-use crate::scene::{Camera, Combine, Graph, Node, NodeId, Settings, Smooth, V3};
+use crate::scene::{Camera, Combine, Graph, Material, Node, NodeId, Settings, Smooth, V3};
 use crate::span::Span;
 
 /// A parameter's default value.
@@ -748,14 +748,19 @@ pub struct Record {
 }
 
 const SURFACE: [P; 8] = [
-    p("ambient", F, Num(0.1), Unit),
-    p("diffuse", F, Num(0.9), NonNeg),
-    p("specular", F, Num(0.3), NonNeg),
-    p("shininess", F, Num(32.0), Within(1.0, 10000.0)),
-    p("reflect", F, Num(0.0), Unit),
-    p("transparency", F, Num(0.0), Unit),
-    p("ior", F, Num(1.5), Within(1.0, 10.0)),
-    p("color", V, V3([0.8, 0.8, 0.8]), NonNeg),
+    p("ambient", F, Num(Material::AMBIENT), Unit),
+    p("diffuse", F, Num(Material::DIFFUSE), NonNeg),
+    p("specular", F, Num(Material::SPECULAR), NonNeg),
+    p(
+        "shininess",
+        F,
+        Num(Material::SHININESS),
+        Within(1.0, 10000.0),
+    ),
+    p("reflect", F, Num(Material::REFLECT), Unit),
+    p("transparency", F, Num(Material::TRANSPARENCY), Unit),
+    p("ior", F, Num(Material::IOR), Within(1.0, 10.0)),
+    p("color", V, V3(Material::COLOR), NonNeg),
 ];
 
 const fn concat<const N: usize, const M: usize, const T: usize>(a: [P; N], b: [P; M]) -> [P; T] {

@@ -371,18 +371,37 @@ pub struct Material {
 }
 
 impl Material {
+    // The default of each field of a material (`phong`'s and `checker`'s, check/builtins.rs
+    // reads them here), and the default material's.
+    /// The default colour.
+    pub const COLOR: V3 = [0.8, 0.8, 0.8];
+    /// The default k_a.
+    pub const AMBIENT: f64 = 0.1;
+    /// The default k_d.
+    pub const DIFFUSE: f64 = 0.9;
+    /// The default k_s.
+    pub const SPECULAR: f64 = 0.3;
+    /// The default α.
+    pub const SHININESS: f64 = 32.0;
+    /// The default weight of the reflected ray.
+    pub const REFLECT: f64 = 0.0;
+    /// The default weight of the transmitted ray.
+    pub const TRANSPARENCY: f64 = 0.0;
+    /// The default index of refraction.
+    pub const IOR: f64 = 1.5;
+
     /// The material of shapes that were not painted.
     pub fn default_material() -> Self {
         Material {
             name: "default".into(),
-            pattern: Pattern::Solid([0.8, 0.8, 0.8]),
-            ambient: 0.1,
-            diffuse: 0.9,
-            specular: 0.3,
-            shininess: 32.0,
-            reflect: 0.0,
-            transparency: 0.0,
-            ior: 1.5,
+            pattern: Pattern::Solid(Material::COLOR),
+            ambient: Material::AMBIENT,
+            diffuse: Material::DIFFUSE,
+            specular: Material::SPECULAR,
+            shininess: Material::SHININESS,
+            reflect: Material::REFLECT,
+            transparency: Material::TRANSPARENCY,
+            ior: Material::IOR,
         }
     }
 }

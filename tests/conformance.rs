@@ -293,23 +293,52 @@ fn cameras_looking_straight_down_match_the_cpu() {
     }
 }
 
-/// Glass sunk into the floor and into a box (the scene's media: rays inside the glass march
-/// the glass less the solids and shade the solids they meet there) renders on the GPU as on
-/// the CPU.
+/// Glass sunk into the floor and into a box renders on the GPU as on the CPU, sphere traced
+/// (the scene's media: rays inside the glass march the glass less the solids and shade the
+/// solids they meet there) and traced (rays inside the glass stop at the nearer of its far
+/// side and a solid's entry, and shade the solid within the glass).
 #[test]
 fn glass_overlapping_solids_matches_the_cpu() {
     let Some(gpu) = open_gpu() else { return };
-    let text = "material glass = phong { color: (1, 1, 1), transparency: 0.9, ior: 1.5, reflect: 0.05 };\n\
-                material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 0.5, reflect: 0.2 };\n\
-                camera { position: (0, 1.5, -3), look_at: (0, 0.2, 0), fov: 50deg }\n\
-                light point { position: (2, 5, -3) }\n\
-                render { width: 96, height: 72 }\n\
-                scene { plane((0, 1, 0), 0) @ floor; sphere(0.8) @ glass; box((0.3, 0.3, 0.3)).translate(0.5, 0.3, 0); }";
-    let scene = checked("media.sdf", text);
-    let lowered = Lowered::new(&scene);
-    let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
-    assert!(kernel.features.contains(&("MEDIA", true)));
-    assert_agree(&gpu, &scene, &lowered, &kernel, "glass in solids");
+    for method in ["march", "auto"] {
+        let text = format!(
+            "material glass = phong {{ color: (1, 1, 1), transparency: 0.9, ior: 1.5, reflect: 0.05 }};\n\
+             material floor = checker {{ a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 0.5, reflect: 0.2 }};\n\
+             camera {{ position: (0, 1.5, -3), look_at: (0, 0.2, 0), fov: 50deg }}\n\
+             light point {{ position: (2, 5, -3) }}\n\
+             render {{ width: 96, height: 72, method: \"{method}\" }}\n\
+             scene {{ plane((0, 1, 0), 0) @ floor; sphere(0.8) @ glass; box((0.3, 0.3, 0.3)).translate(0.5, 0.3, 0); }}"
+        );
+        let scene = checked("media.sdf", &text);
+        let lowered = Lowered::new(&scene);
+        let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
+        let traced = method == "auto";
+        assert_eq!(kernel.features.contains(&("MEDIA", true)), !traced);
+        assert_eq!(kernel.features.contains(&("ANALYTIC", true)), traced);
+        assert_agree(
+            &gpu,
+            &scene,
+            &lowered,
+            &kernel,
+            &format!("glass in solids, {method}"),
+        );
+        if traced {
+            // The same walking the primitives in `scene_data`.
+            let options = wgsl::Options {
+                max_unrolled: 0,
+                ..wgsl::Options::default()
+            };
+            let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
+            assert!(kernel.data.is_some());
+            assert_agree(
+                &gpu,
+                &scene,
+                &lowered,
+                &kernel,
+                "glass in solids, scene_data",
+            );
+        }
+    }
 }
 
 /// Shadow rays pass through glass on the GPU as on the CPU even when no refracted ray is

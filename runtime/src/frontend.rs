@@ -249,7 +249,7 @@ pub fn method(loaded: &Loaded, scene: &Scene) -> String {
             at(loaded, span)
         ),
         Choice::March(Reason::Overlap { span }) => format!(
-            "method: march (the transparent shape at {} overlaps or touches another one)",
+            "method: march (the transparent shape at {} overlaps or touches another transparent one)",
             at(loaded, span)
         ),
         choice => choice.describe(),

@@ -154,7 +154,7 @@ fn analytic_method(cx: &mut Ctx, scene: &Scene) {
         ),
         Reason::Overlap { span } => d.with_secondary(
             span,
-            "this transparent shape overlaps or touches another one",
+            "this transparent shape overlaps or touches another transparent one",
         ),
         other => d.with_note(other.describe()),
     };

@@ -3,7 +3,7 @@
 //! A scene qualifies when its objects are only spheres, planes, boxes, capped cylinders and
 //! capsules under affine transforms (translate, rotate, uniform and per-axis scale), painted
 //! and combined by plain union, no light asks for soft shadows (a penumbra estimate needs a
-//! distance field) and no glass overlaps another solid. Every ray then has closed-form roots: exact hits, exact normals, no step
+//! distance field) and no glass overlaps other glass. Every ray then has closed-form roots: exact hits, exact normals, no step
 //! budget and no ε. The CPU renderer and the WGSL kernel (so also PTX) both trace the list of
 //! [`Primitive`]s this module produces (docs/rendering.md, "Analytic ray tracing").
 
@@ -59,8 +59,10 @@ pub enum Reason {
     /// Too many primitives for `auto` to trace them from one GPU buffer: more than `limit`,
     /// the `traced` limit.
     Many { count: usize, limit: usize },
-    /// A transparent primitive overlaps or touches another one: a ray inside it must leave
-    /// through the boundary of the union, which tracing primitive by primitive does not find.
+    /// A transparent primitive overlaps or touches another transparent one: a ray inside both
+    /// must leave through the boundary of their union, which tracing primitive by primitive
+    /// does not find. (Glass may overlap opaque primitives: a ray inside it stops at the
+    /// nearer of the glass's far side and an opaque primitive's entry.)
     Overlap { span: Span },
 }
 
@@ -77,7 +79,7 @@ impl Reason {
                 )
             }
             Reason::Overlap { .. } => {
-                "a transparent primitive overlaps or touches another, so rays inside it would need the boundary of their union".into()
+                "a transparent primitive overlaps or touches another transparent one, so rays inside them would need the boundary of their union".into()
             }
             Reason::Many { count, limit } => format!(
                 "{count} primitives: beyond {limit} (`--limit traced`), their data would outgrow a GPU storage buffer"
@@ -115,7 +117,7 @@ pub fn choose(scene: &Scene) -> Choice {
 }
 
 /// What decides a scene's method apart from its render settings: its primitives, or why it
-/// has none, and a transparent primitive that overlaps another. Computed once per scene (by
+/// has none, and a transparent primitive that overlaps another transparent one. Computed once per scene (by
 /// the lowering, [`crate::lower::Lowered`]); the `method` setting, which a command may set
 /// after checking, then picks with [`Traceable::choose`].
 #[derive(Debug, Clone, PartialEq)]
@@ -123,7 +125,8 @@ pub struct Traceable {
     /// The primitives in world space and their hierarchy, or why some node or light rules
     /// tracing out.
     primitives: Result<Traced, Reason>,
-    /// A transparent primitive that overlaps or touches another (its node's span).
+    /// A transparent primitive that overlaps or touches another transparent one (its node's
+    /// span).
     overlap: Option<Span>,
     /// The `traced` limit of the scene's limits.
     limit: usize,
@@ -220,12 +223,17 @@ impl Traceable {
     }
 }
 
-/// A transparent primitive whose box meets another primitive's box or a plane's solid side
-/// (touching counts; boxes are conservative, so some disjoint pairs are reported too). Rays
-/// are traced primitive by primitive: a ray inside a solid leaves at that solid's far side,
-/// which is a surface of the union only when no other solid overlaps it. Only refracted rays
-/// travel inside solids, so only transparent primitives need the check.
+/// A transparent primitive whose box meets another transparent primitive's box or a
+/// transparent plane's solid side (touching counts; boxes are conservative, so some disjoint
+/// pairs are reported too). Rays are traced primitive by primitive: a ray inside glass stops
+/// at the nearest of the glass's far side and the entries of the opaque primitives ahead of
+/// it, which is the surface it meets whatever opaque primitives overlap the glass (it then
+/// shades the opaque surface, within the glass). Inside two overlapping glass primitives,
+/// the far side of one may lie inside the other, and the ray would stop at a surface that is
+/// not there; only refracted rays travel inside solids, so only transparent pairs need the
+/// check.
 fn transparent_overlap<'a>(scene: &Scene, prims: &'a [Primitive]) -> Option<&'a Primitive> {
+    let clear = |j: usize| scene.material(prims[j].material).transparency > 0.0;
     let boxes: Vec<Option<Aabb>> = prims.iter().map(world_box).collect();
     let touches = |a: &Aabb, j: usize| match (&boxes[j], &prims[j].shape) {
         (Some(b), _) => (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k]),
@@ -242,22 +250,26 @@ fn transparent_overlap<'a>(scene: &Scene, prims: &'a [Primitive]) -> Option<&'a 
         (None, _) => true,
     };
     // Only transparent primitives are tested, each against the hierarchy of the bounded
-    // primitives' boxes (O(log n) groups per test when the scene is spread out) and against
-    // the unbounded ones, so the test is not quadratic in the primitives.
+    // transparent primitives' boxes (O(log n) groups per test when the scene is spread out)
+    // and against the unbounded ones, so the test is not quadratic in the primitives.
     let bounded: Vec<(usize, Aabb)> = boxes
         .iter()
         .enumerate()
+        .filter(|&(j, _)| clear(j))
         .filter_map(|(j, b)| b.map(|b| (j, b)))
         .collect();
-    let unbounded: Vec<usize> = (0..prims.len()).filter(|&j| boxes[j].is_none()).collect();
+    let unbounded: Vec<usize> = (0..prims.len())
+        .filter(|&j| boxes[j].is_none() && clear(j))
+        .collect();
     let mut tree: Option<Vec<Item>> = None;
     prims.iter().enumerate().find_map(|(i, p)| {
-        if scene.material(p.material).transparency <= 0.0 {
+        if !clear(i) {
             return None;
         }
-        // A transparent primitive without a finite box (a plane) overlaps everything.
+        // A transparent primitive without a finite box (a plane) overlaps every other
+        // transparent one.
         let Some(a) = &boxes[i] else {
-            return (prims.len() > 1).then_some(p);
+            return ((0..prims.len()).any(|j| j != i && clear(j))).then_some(p);
         };
         if unbounded.iter().any(|&j| j != i && touches(a, j)) {
             return Some(p);

@@ -152,8 +152,18 @@ impl<T: Float> Tracer<T> {
         true
     }
 
-    /// The nearest surface along `o + t·d` with 0 < t < `tmax`.
-    pub fn nearest(&self, o: V3<T>, d: V3<T>, tmax: T) -> Option<Surface<T>> {
+    /// The nearest surface along `o + t·d` with 0 < t < `tmax`, the distance of a surface of
+    /// material `m` counted `slack(m)` farther. Inside glass, the caller gives transparent
+    /// surfaces the offset of secondary rays as slack, so that an opaque surface that
+    /// coincides with the glass's far side (a glass box standing on the floor) is the one
+    /// met, rather than a refracted ray leaving the glass from within the floor.
+    pub fn nearest(
+        &self,
+        o: V3<T>,
+        d: V3<T>,
+        tmax: T,
+        slack: impl Fn(u32) -> T,
+    ) -> Option<Surface<T>> {
         let mut best: Option<(T, V3<T>, Prim<T>)> = None;
         let mut limit = tmax;
         self.visit(&self.top, o, d, &mut limit, &mut |p, limit| {
@@ -165,8 +175,9 @@ impl<T: Float> Tracer<T> {
             } else {
                 (s.far, s.n_far)
             };
-            if t > T::zero() && t < *limit {
-                *limit = t;
+            let key = t + slack(p.material);
+            if t > T::zero() && key < *limit {
+                *limit = key;
                 best = Some((t, n, *p));
             }
             true
@@ -179,8 +190,10 @@ impl<T: Float> Tracer<T> {
     }
 
     /// The fraction of light that passes along `o + t·d` for 0 < t < `tmax`: 0 when an opaque
-    /// primitive is in the way, else the product of the transparencies of the primitives the
-    /// ray enters (`transparency` of a material id).
+    /// primitive is in the way, else the product of the transparencies of the primitives whose
+    /// surface the ray crosses (`transparency` of a material id): those it enters, and the
+    /// glass it starts inside of (from an opaque surface within glass), whose far side it
+    /// crosses.
     pub fn transmitted(&self, o: V3<T>, d: V3<T>, tmax: T, transparency: impl Fn(u32) -> T) -> T {
         let mut through = T::one();
         let mut limit = tmax;
@@ -196,9 +209,7 @@ impl<T: Float> Tracer<T> {
                 through = T::zero();
                 return false;
             }
-            if s.near > T::zero() {
-                through = through * tau;
-            }
+            through = through * tau;
             true
         });
         through
@@ -468,7 +479,7 @@ mod tests {
                     continue; // rays start outside every solid
                 }
                 let d = (v3(&mut rng) * 0.6 - o * 0.3).normalize();
-                match tracer.nearest(o, d, 50.0) {
+                match tracer.nearest(o, d, 50.0, |_| 0.0) {
                     Some(s) => {
                         hits += 1;
                         let p = o + d * s.t;
@@ -564,7 +575,11 @@ mod tests {
         for _ in 0..3000 {
             let o = v3(&mut rng) * 12.0 + V3::new(0.0, 6.0, 0.0);
             let d = v3(&mut rng).normalize();
-            let (a, b) = (tracer.nearest(o, d, 100.0), brute.nearest(o, d, 100.0));
+            let slack = |m: u32| if m == 1 { 0.01 } else { 0.0 };
+            let (a, b) = (
+                tracer.nearest(o, d, 100.0, slack),
+                brute.nearest(o, d, 100.0, slack),
+            );
             assert_eq!(a.map(|s| (s.t, s.material)), b.map(|s| (s.t, s.material)));
             hits += usize::from(a.is_some());
             let (a, b) = (

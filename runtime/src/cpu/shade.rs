@@ -25,7 +25,8 @@ pub(super) struct Hit<T> {
     /// A ray inside glass reached an opaque solid within it (not the glass's far side): the
     /// hit is lit and reflects as seen from outside, within the glass.
     solid: bool,
-    /// For such a hit, the transparency of the glass around it.
+    /// For such a hit, the transparency of the glass around it (sphere tracing only: a traced
+    /// shadow ray finds the glass it starts inside of).
     medium_tau: T,
 }
 
@@ -71,6 +72,11 @@ pub(super) fn bounce<T: Float>(
     if ctx.analytic.is_some() {
         for hit in &mut hits {
             (hit.n, hit.mat) = ws.surfaces[hit.ray];
+            // Glass overlaps no other glass in a traced scene, so an opaque primitive that a
+            // ray inside glass meets lies within that glass. Its shadow rays need no
+            // `medium_tau`: `Tracer::transmitted` applies the transparency of the glass they
+            // start inside of.
+            hit.solid = wave[hit.ray].inside && ctx.material(hit.mat).transparency <= T::zero();
         }
     } else {
         normals(ws, wave, &mut hits);
@@ -95,7 +101,21 @@ fn trace<T: Float>(
         ws.traced.clear();
         ws.surfaces.clear();
         for ray in wave {
-            let (traced, surface) = match tracer.nearest(ray.origin, ray.dir, ctx.max_dist) {
+            // Inside glass, its far side counts the offset of secondary rays farther
+            // (`Tracer::nearest`), with the normal step at the ray's origin, as on the GPU.
+            let slack = if ray.inside {
+                T::from_f64(4.0) * ctx.normal_step(ray.t0, ray.origin)
+            } else {
+                T::zero()
+            };
+            let clear = |m: u32| {
+                if ctx.material(m).transparency > T::zero() {
+                    slack
+                } else {
+                    T::zero()
+                }
+            };
+            let (traced, surface) = match tracer.nearest(ray.origin, ray.dir, ctx.max_dist, clear) {
                 Some(s) => (
                     Traced {
                         t: s.t,

@@ -7,8 +7,22 @@
 use super::buffer;
 use super::map::float;
 use crate::scene::analytic::{Item, Primitive, Shape, Traced};
-use crate::scene::V3;
+use crate::scene::{MaterialId, V3};
 use std::fmt::Write;
+
+/// The start of `fn trace`'s body, unrolled or walking `scene_data`: no hit yet, and, when
+/// some primitive is transparent (`glass`), the slack a transparent surface's distance gets
+/// inside glass (`nearest` in kernel.wgsl; `Tracer::nearest` on the CPU): the offset 4h of
+/// secondary rays, with the normal step at the ray's origin.
+pub(super) fn trace_start(glass: bool) -> String {
+    let mut out = String::from(
+        "    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u, params.march.y);\n",
+    );
+    if glass {
+        out.push_str("    let slack = select(0.0, 4.0 * normal_step(t0, o), sign < 0.0);\n");
+    }
+    out
+}
 
 /// The interval functions, in sections named by `//= NAME` lines.
 const INTERVALS: &str = include_str!("intervals.wgsl");
@@ -59,12 +73,18 @@ pub const MAX_UNROLLED: usize = 256;
 
 /// The interval functions the scene uses and `fn trace` and `fn shadow`: unrolled over the
 /// primitives (with their frame constants) up to `max_unrolled` of them ([`MAX_UNROLLED`] by
-/// default), else walking the buffer `scene_data`, whose bytes are returned too.
-pub fn write(traced: &Traced, max_unrolled: usize) -> (String, Option<Vec<u8>>) {
+/// default), else walking the buffer `scene_data`, whose bytes are returned too. `clear`
+/// says which materials are transparent.
+pub fn write(
+    traced: &Traced,
+    clear: &dyn Fn(MaterialId) -> bool,
+    max_unrolled: usize,
+) -> (String, Option<Vec<u8>>) {
     let (primitives, top) = (&traced.primitives[..], &traced.hierarchy[..]);
     let mut out = sections(primitives, top);
+    let glass = primitives.iter().any(|p| clear(p.material));
     if primitives.len() > max_unrolled && buffer::fits(primitives) {
-        out.push_str(&buffer::write(primitives, top));
+        out.push_str(&buffer::write(primitives, top, glass));
         return (out, Some(buffer::data(primitives, top)));
     }
     if primitives.iter().any(|p| !identity(&p.matrix)) {
@@ -84,15 +104,17 @@ pub fn write(traced: &Traced, max_unrolled: usize) -> (String, Option<Vec<u8>>) 
         "// The nearest surface along o + t·d, 0 < t < max_dist, with its normal and material.\n",
     );
     out.push_str("fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {\n");
-    out.push_str("    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u);\n");
+    out.push_str(&trace_start(glass));
+    // Only a transparent surface's distance gets the slack.
     let nearest = |i: usize, p: &Primitive| {
         format!(
-            "best = nearest(best, {}, {}u);",
+            "best = nearest(best, {}, {}u, {});",
             interval(i, p),
-            p.material.0
+            p.material.0,
+            if clear(p.material) { "slack" } else { "0.0" }
         )
     };
-    items(&mut out, primitives, top, 1, "best.t", &nearest);
+    items(&mut out, primitives, top, 1, "best.limit", &nearest);
     out.push_str("    return best;\n}\n\n");
     out.push_str(
         "// The light arriving along o + t·d, 0 < t < tmax: 0 behind an opaque primitive, else the\n\

@@ -22,6 +22,7 @@
 //! ends after at most `end` steps. An unrotated primitive takes 32 bytes, a rotated one 80,
 //! a group 32.
 
+use super::analytic::trace_start;
 use crate::scene::analytic::{Item, Primitive, Shape};
 use crate::scene::V3;
 use std::fmt::Write;
@@ -145,8 +146,8 @@ fn primitive(out: &mut Vec<[u32; 4]>, p: &Primitive) {
 
 /// `fn trace` and `fn shadow` walking `scene_data`, and the interval of one of its
 /// primitives; only the kinds of `primitives` are tested for, and groups only when `top` has
-/// any.
-pub fn write(primitives: &[Primitive], top: &[Item]) -> String {
+/// any; `glass` when some primitive is transparent.
+pub fn write(primitives: &[Primitive], top: &[Item], glass: bool) -> String {
     let framed = primitives
         .iter()
         .any(|p| !super::analytic::identity(&p.matrix));
@@ -174,12 +175,18 @@ pub fn write(primitives: &[Primitive], top: &[Item]) -> String {
          // before the nearest hit so far.\n",
     );
     out.push_str("fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {\n");
-    out.push_str("    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u);\n");
+    out.push_str(&trace_start(glass));
+    // Only a transparent surface's distance gets the slack.
+    let slack = if glass {
+        format!("select(0.0, slack, params.materials[tag >> {MATERIAL_SHIFT}u].optics.y > 0.0)")
+    } else {
+        "0.0".into()
+    };
     walk(
         &mut out,
-        groups.then_some("enters(o - head.xyz, d, size.xyz, best.t)"),
+        groups.then_some("enters(o - head.xyz, d, size.xyz, best.limit)"),
         &[
-            &format!("best = nearest(best, primitive_interval(i, head, o, d), tag >> {MATERIAL_SHIFT}u);"),
+            &format!("best = nearest(best, primitive_interval(i, head, o, d), tag >> {MATERIAL_SHIFT}u, {slack});"),
             &format!("i += {step};"),
         ],
     );

@@ -88,6 +88,7 @@ struct Traced {
 //#if ANALYTIC
     normal: vec3<f32>, // unit outward normal at the hit
     material: u32,
+    limit: f32, // t, plus the slack of `nearest` for a surface of glass seen from inside
 //#endif
 }
 
@@ -107,8 +108,10 @@ fn missed() -> Interval {
     return Interval(BIG, -BIG, vec3<f32>(0.0), vec3<f32>(0.0));
 }
 
-// The nearer of best and the first end of s beyond the ray's origin.
-fn nearest(best: Traced, s: Interval, material: u32) -> Traced {
+// The nearer of best and the first end of s beyond the ray's origin, by their distances with
+// `slack` added (to a transparent surface's inside glass, so that an opaque surface that
+// coincides with the glass's far side is the one met).
+fn nearest(best: Traced, s: Interval, material: u32, slack: f32) -> Traced {
     if !(s.near <= s.far) {
         return best;
     }
@@ -118,14 +121,16 @@ fn nearest(best: Traced, s: Interval, material: u32) -> Traced {
         t = s.near;
         n = s.n_near;
     }
-    if t > 0.0 && t < best.t {
-        return Traced(t, STATUS_HIT, normalize(n), material);
+    let limit = t + slack;
+    if t > 0.0 && limit < best.limit {
+        return Traced(t, STATUS_HIT, normalize(n), material, limit);
     }
     return best;
 }
 
 // A shadow ray's light after one primitive: blocked by an opaque one in (0, tmax), reduced
-// by the transparency of a transparent one it enters.
+// by the transparency of a transparent one whose surface it crosses (one it enters, or the
+// glass it starts inside of, from an opaque surface within it).
 fn occlude(through: f32, s: Interval, tmax: f32, tau: f32) -> f32 {
     if !(s.near <= s.far) || s.far <= 0.0 || s.near >= tmax {
         return through;
@@ -133,7 +138,7 @@ fn occlude(through: f32, s: Interval, tmax: f32, tau: f32) -> f32 {
     if tau <= 0.0 {
         return 0.0;
     }
-    return select(through, through * tau, s.near > 0.0);
+    return through * tau;
 }
 
 {{ANALYTIC}}
@@ -468,6 +473,11 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#if ANALYTIC
         let n = hit.normal;
         let m = params.materials[hit.material];
+        // Inside glass, an opaque primitive (glass overlaps no other glass in a traced scene):
+        // lit and reflecting as seen from outside, within the glass (docs/rendering.md,
+        // "Inside glass"); its shadow rays start inside the glass, whose transparency
+        // `occlude` applies.
+        let solid = inside && m.optics.y <= 0.0;
 //#else
         let n = normal(p, h, ray.dir);
 //#if MATERIALS
@@ -475,9 +485,10 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#else
         let m = params.materials[0];
 //#endif
+        let solid = false;
 //#endif
         let w = 1.0 - m.optics.x - m.optics.y;
-        if !inside && w > 0.0 {
+        if (!inside || solid) && w > 0.0 {
             acc += shade(m, p, n, ray.dir, tt, h) * ray.weight * w;
         }
 //#if SECONDARY
@@ -486,7 +497,7 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         }
         let off = n * (4.0 * h);
 //#if REFRACTION
-        if inside {
+        if inside && !solid {
             // Leaving the solid: refract out, or reflect back in on total internal reflection.
             let tr = refract_dir(ray.dir, -n, m.optics.z);
             if any(tr != vec3<f32>(0.0)) {
@@ -500,7 +511,8 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         }
 //#endif
         if m.optics.x > 0.0 {
-            stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight * m.optics.x, 0u);
+            // From a solid within glass the reflection stays inside the glass.
+            stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight * m.optics.x, u32(solid));
             top += 1u;
             counters.secondary += 1u;
         }

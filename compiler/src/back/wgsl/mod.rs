@@ -242,7 +242,8 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
     let data = match traced {
         // An analytically traced scene needs no distance field.
         Some(traced) => {
-            let (text, bytes) = analytic::write(traced, options.max_unrolled);
+            let clear = |m| scene.material(m).transparency > 0.0;
+            let (text, bytes) = analytic::write(traced, &clear, options.max_unrolled);
             values.insert("MAP", String::new());
             values.insert("ANALYTIC", text);
             bytes

@@ -47,6 +47,8 @@ pub enum Limit {
     SweepValues,
     /// Settings `sdfc pareto` measures: the product of its sweeps' value counts.
     SweepPoints,
+    /// Cells `sdfc mesh` evaluates: the octree's cells at every level (or the dense grid's).
+    Cells,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -61,7 +63,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 17] = [
+    pub const ALL: [Limit; 18] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -79,6 +81,7 @@ impl Limit {
         Limit::SceneData,
         Limit::SweepValues,
         Limit::SweepPoints,
+        Limit::Cells,
     ];
 
     fn spec(self) -> Spec {
@@ -184,6 +187,14 @@ impl Limit {
                 1_000_000,
                 "settings sdfc pareto measures (the product of its sweeps' values)",
             ),
+            // A dense grid of 512³ cells is 134 million; the octree of a scene at that
+            // resolution evaluates a few percent of it (BENCHMARKS.md, "Meshing").
+            Limit::Cells => s(
+                "cells",
+                50_000_000,
+                1 << 40,
+                "cells sdfc mesh evaluates (octree cells at every level, or the dense grid)",
+            ),
         }
     }
 
@@ -222,7 +233,7 @@ impl fmt::Display for Limit {
 /// The value of every limit for one run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 17],
+    values: [u64; 18],
 }
 
 impl Default for Limits {

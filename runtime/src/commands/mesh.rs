@@ -9,7 +9,7 @@ use crate::mesh::write::{self, Format};
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, MAX_AXIS_CELLS};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::lower::LowerOptions;
-use sdfc_compiler::scene::analysis;
+use sdfc_compiler::scene::{analysis, Combine, Node, NodeId, Scene};
 use sdfc_compiler::{Limit, Limits};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -54,9 +54,11 @@ pub struct MeshArgs {
 /// The default number of cells along the longest side.
 pub const DEFAULT_RESOLUTION: u32 = 128;
 
-/// Bytes per octree cell held while a level is evaluated (its index, centre and value, and
-/// its children's indices).
-const BYTES_PER_OCTREE_CELL: u64 = 12 + 24 + 8 + 8 * 12;
+/// Bytes per octree cell at most, counting every cell the octree may evaluate: while a level
+/// is evaluated it holds its cells' indices, centres and values (44 bytes each), and the
+/// indices of the next level's cells in a vector that may double (24 bytes each); the cells
+/// of two levels are together at most all the cells evaluated.
+const BYTES_PER_OCTREE_CELL: u64 = 44 + 24;
 
 /// Runs `sdfc mesh`.
 pub fn run(args: MeshArgs) -> ExitCode {
@@ -82,7 +84,8 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     })?;
     crate::output::check_writable(&args.output)
         .map_err(|why| usage(format!("cannot write `{}`: {why}", args.output.display())))?;
-    let settings = settings(&args.set).map_err(usage)?;
+    let mut settings = settings(&args.set).map_err(usage)?;
+    settings.materials = matches!(format, Format::Ply | Format::Glb);
     let pool = super::render::thread_pool(args.threads).map_err(usage)?;
     let checked = frontend::load_scene(&args.file, DiagnosticFormat::Human, &limits)
         .map_err(|_| (1, String::new()))?;
@@ -107,9 +110,25 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
                 .map(|(_, a)| a)
                 .collect();
             if !open.is_empty() {
+                let hint = match bounded_part(scene, &analysis) {
+                    Some([lo, hi]) => {
+                        // Grown by a tenth of the largest extent, so that what the box cuts
+                        // (a floor plane) keeps some thickness.
+                        let m = 0.1 * (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
+                        let v: Vec<String> = lo
+                            .iter()
+                            .map(|x| x - m)
+                            .chain(hi.iter().map(|x| x + m))
+                            .zip(origin.iter().chain(&origin))
+                            .map(|(x, o)| short(x + o))
+                            .collect();
+                        format!("; its bounded objects with a margin are `--bounds={}`", v.join(","))
+                    }
+                    None => String::new(),
+                };
                 return Err(usage(format!(
-                    "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `--bounds X0,Y0,Z0,X1,Y1,Z1` (what reaches out of it is cut at its faces and the cut closed)",
-                    open.join(" and ")
+                    "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `--bounds X0,Y0,Z0,X1,Y1,Z1` (what reaches out of it is cut at its faces and the cut closed){hint}",
+                    open.join(", ")
                 )));
             }
             if b.is_empty() {
@@ -325,6 +344,36 @@ fn cause(checked: &frontend::Checked, a: &analysis::Analysis) -> String {
         analysis::kind(scene.graph.node(id)),
         checked.sources.name(span.file)
     )
+}
+
+/// The box around the scene's bounded objects: the objects of its top-level unions whose
+/// bounding box is finite (`None` when there are none).
+fn bounded_part(scene: &Scene, a: &analysis::Analysis) -> Option<[[f64; 3]; 2]> {
+    let mut stack: Vec<NodeId> = scene.root.into_iter().collect();
+    let mut found: Option<[[f64; 3]; 2]> = None;
+    while let Some(id) = stack.pop() {
+        let b = a.node(id).bounds;
+        let finite = (0..3).all(|i| b.min[i].is_finite() && b.max[i].is_finite());
+        if finite && !b.is_empty() {
+            found = Some(match found {
+                None => [b.min, b.max],
+                Some([lo, hi]) => [
+                    [0, 1, 2].map(|i| lo[i].min(b.min[i])),
+                    [0, 1, 2].map(|i| hi[i].max(b.max[i])),
+                ],
+            });
+            continue;
+        }
+        match scene.graph.node(id) {
+            Node::Combine {
+                op: Combine::Union,
+                children,
+            } => stack.extend(children.iter().copied()),
+            Node::Paint { child, .. } => stack.push(*child),
+            _ => {}
+        }
+    }
+    found
 }
 
 /// The mesh settings of `--set`.

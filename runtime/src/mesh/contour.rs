@@ -14,7 +14,7 @@
 
 use super::qef;
 use super::table::{corner, patches, EDGES};
-use super::{pack, unpack, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
+use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
 use rayon::prelude::*;
 
 /// Edge vertices stay this fraction of a voxel inside their edge, and inner vertices inside
@@ -47,32 +47,37 @@ pub fn contour(
         candidates: candidates.len() as u64,
         ..Stats::default()
     };
-    // Corner values, and the closure: each crossed edge's four cells.
-    let mut values: KeyMap<f64> = KeyMap::default();
-    let mut set: KeySet = candidates.iter().copied().collect();
+    // Corner values, and the closure: each crossed edge's four cells. A point whose value
+    // was asked for holds -∞ until it comes (the field never gives -∞: see `Field`).
+    let mut values: Bricks<f64> = Bricks::new(f64::NAN);
+    let mut set: Bricks<bool> = Bricks::new(false);
+    for &c in &candidates {
+        set.set(unpack(c), true);
+    }
+    let mut held = candidates.len() as u64;
     let mut pending = candidates;
     let mut surface: Vec<(u64, u8)> = Vec::new();
     let mut first = true;
     while !pending.is_empty() {
-        if set.len() as u64 > max_cells {
-            return Err(set.len() as u64);
+        if held > max_cells {
+            return Err(held);
         }
-        let mut need: Vec<u64> = pending
-            .iter()
-            .flat_map(|&c| {
-                let i = unpack(c);
-                (0..8).map(move |k| {
-                    let o = corner(k);
-                    pack([i[0] + o[0], i[1] + o[1], i[2] + o[2]])
-                })
-            })
-            .filter(|k| !values.contains_key(k))
-            .collect();
-        need.par_sort_unstable();
-        need.dedup();
-        let points: Vec<[f64; 3]> = need.iter().map(|&k| grid.point(unpack(k))).collect();
+        let mut need: Vec<[u32; 3]> = Vec::new();
+        for &c in &pending {
+            let i = unpack(c);
+            for k in 0..8 {
+                let p = add(i, corner(k));
+                if values.get(p).is_nan() {
+                    values.set(p, f64::NEG_INFINITY);
+                    need.push(p);
+                }
+            }
+        }
+        let points: Vec<[f64; 3]> = need.iter().map(|&i| grid.point(i)).collect();
         let d = field.distances(&points);
-        values.extend(need.into_iter().zip(d));
+        for (i, v) in need.into_iter().zip(d) {
+            values.set(i, v);
+        }
         let mut missing = Vec::new();
         for &c in &pending {
             let config = configuration(&values, c);
@@ -87,9 +92,10 @@ pub fn contour(
                 }
                 let lower = add(i, corner(a));
                 for n in edge_cells(lower, e / 4) {
-                    if !set.contains(&n) {
-                        set.insert(n);
-                        missing.push(n);
+                    if !set.get(n) {
+                        set.set(n, true);
+                        held += 1;
+                        missing.push(pack(n));
                     }
                 }
             }
@@ -100,25 +106,25 @@ pub fn contour(
         first = false;
         pending = missing;
     }
+    drop(set);
     progress(0.2);
     surface.par_sort_unstable();
     stats.surface_cells = surface.len() as u64;
 
     // Edge vertices: each crossed edge is owned by the cell at its lower end.
     let mut edges: Vec<u64> = Vec::new();
+    let mut index: Bricks<[u32; 3]> = Bricks::new([u32::MAX; 3]);
     for &(c, config) in &surface {
-        for axis in 0..3 {
+        let mut ids = [u32::MAX; 3];
+        for (axis, id) in ids.iter_mut().enumerate() {
             let (a, b) = EDGES[axis * 4];
             if (config >> a & 1) != (config >> b & 1) {
+                *id = edges.len() as u32;
                 edges.push(c << 2 | axis as u64);
             }
         }
+        index.set(unpack(c), ids);
     }
-    let index: KeyMap<u32> = edges
-        .iter()
-        .enumerate()
-        .map(|(n, &k)| (k, n as u32))
-        .collect();
     let crossings = roots(field, grid, &values, &edges, settings.refine);
     progress(0.5);
     let h = GRADIENT_STEP * grid.voxel;
@@ -135,8 +141,8 @@ pub fn contour(
         for cycle in patches(config) {
             for &e in cycle {
                 let (a, _) = EDGES[e as usize];
-                let key = pack(add(i, corner(a))) << 2 | (e as u64 / 4);
-                ring.push(index.get(&key).copied().unwrap_or(0));
+                let id = index.get(add(i, corner(a)))[e as usize / 4];
+                ring.push(if id == u32::MAX { 0 } else { id });
             }
             patch_cells.push(i);
             starts.push(ring.len());
@@ -147,23 +153,35 @@ pub fn contour(
         .into_par_iter()
         .map(|p| {
             let ids = &ring[starts[p]..starts[p + 1]];
-            let pts: Vec<[f64; 3]> = ids.iter().map(|&v| crossings[v as usize]).collect();
-            let nrm: Vec<[f64; 3]> = ids.iter().map(|&v| normals[v as usize]).collect();
-            place(&pts, &nrm, settings.sharp)
+            let mut pts = [[0.0; 3]; 12];
+            let mut nrm = [[0.0; 3]; 12];
+            let n = ids.len().min(12);
+            for (k, &v) in ids.iter().take(n).enumerate() {
+                pts[k] = crossings[v as usize];
+                nrm[k] = normals[v as usize];
+            }
+            place(&pts[..n], &nrm[..n], settings.sharp)
         })
         .collect();
     let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.0).collect();
     let smooth: Vec<bool> = inner.iter().map(|c| c.1).collect();
     stats.features = smooth.iter().filter(|s| !**s).count() as u64;
-    // Smooth patches: the centroid projected onto the surface by Newton steps.
+    // Smooth patches: the centroid moved along the patch's mean normal to where the field
+    // is zero (Newton's steps for a field of unit gradient along the normal).
     let round: Vec<usize> = (0..patch_count).filter(|&p| smooth[p]).collect();
+    let mean: Vec<[f64; 3]> = round
+        .iter()
+        .map(|&p| {
+            let ids = &ring[starts[p]..starts[p + 1]];
+            normalise([0, 1, 2].map(|i| ids.iter().map(|&v| normals[v as usize][i]).sum::<f64>()))
+        })
+        .collect();
     for _ in 0..2 {
         let pts: Vec<[f64; 3]> = round.iter().map(|&p| centres[p]).collect();
-        let (d, g) = field.gradients(&pts, h);
+        let d = field.distances(&pts);
         for (k, &p) in round.iter().enumerate() {
-            let gg: f64 = g[k].iter().map(|x| x * x).sum();
-            if gg > 1e-12 && d[k].is_finite() {
-                centres[p] = [0, 1, 2].map(|i| centres[p][i] - d[k] * g[k][i] / gg);
+            if d[k].is_finite() && d[k].abs() < grid.voxel {
+                centres[p] = [0, 1, 2].map(|i| centres[p][i] - d[k] * mean[k][i]);
             }
         }
     }
@@ -190,13 +208,15 @@ pub fn contour(
         stats.flips = flip(field, &positions, &mut triangles, &owner, &smooth, grid.voxel);
     }
     progress(0.9);
-    let materials_at_centres = field.materials(&centres);
-    let materials = owner
-        .iter()
-        .map(|&p| materials_at_centres[p as usize])
-        .collect();
-    let mut vertex_materials = field.materials(&positions[..base as usize]);
-    vertex_materials.extend_from_slice(&materials_at_centres);
+    let (materials, vertex_materials) = if settings.materials {
+        let at_centres = field.materials(&centres);
+        let by_triangle = owner.iter().map(|&p| at_centres[p as usize]).collect();
+        let mut at_vertices = field.materials(&positions[..base as usize]);
+        at_vertices.extend_from_slice(&at_centres);
+        (by_triangle, at_vertices)
+    } else {
+        (vec![0; triangles.len()], vec![0; positions.len()])
+    };
     stats.evaluated = field.evaluated();
     progress(1.0);
     Ok((
@@ -215,11 +235,9 @@ fn add(a: [u32; 3], b: [u32; 3]) -> [u32; 3] {
 }
 
 /// Which corners of cell `c` are inside (bit set: negative distance).
-fn configuration(values: &KeyMap<f64>, c: u64) -> u8 {
-    let i = unpack(c);
+fn configuration(values: &Bricks<f64>, c: u64) -> u8 {
     let mut config = 0u8;
-    for k in 0..8 {
-        let d = values.get(&pack(add(i, corner(k)))).copied().unwrap_or(1.0);
+    for (k, d) in values.cube(unpack(c)).into_iter().enumerate() {
         if d < 0.0 {
             config |= 1 << k;
         }
@@ -229,7 +247,7 @@ fn configuration(values: &KeyMap<f64>, c: u64) -> u8 {
 
 /// The four cells around the grid edge from `lower` along `axis` (those inside the grid's
 /// index range).
-fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = u64> {
+fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = [u32; 3]> {
     let (u, v) = match axis {
         0 => (1, 2),
         1 => (0, 2),
@@ -242,7 +260,7 @@ fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = u64> {
                 c[a] = c[a].checked_sub(1)?;
             }
         }
-        Some(pack(c))
+        Some(c)
     })
 }
 
@@ -251,7 +269,7 @@ fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = u64> {
 fn roots(
     field: &Field,
     grid: &Grid,
-    values: &KeyMap<f64>,
+    values: &Bricks<f64>,
     edges: &[u64],
     iterations: u32,
 ) -> Vec<[f64; 3]> {
@@ -271,8 +289,7 @@ fn roots(
             let i = unpack(e >> 2);
             let mut j = i;
             j[axis] += 1;
-            let d0 = values.get(&pack(i)).copied().unwrap_or(1.0);
-            let d1 = values.get(&pack(j)).copied().unwrap_or(1.0);
+            let (d0, d1) = (values.get(i), values.get(j));
             let t = d0 / (d0 - d1);
             Root {
                 p: grid.point(i),
@@ -438,7 +455,9 @@ fn flip(
     // Each fan triangle [centre, a, b] has one patch edge, a → b.
     let mut by_edge: KeyMap<u32> = KeyMap::default();
     for (t, tri) in triangles.iter().enumerate() {
-        by_edge.insert((tri[1] as u64) << 32 | tri[2] as u64, t as u32);
+        if !smooth[owner[t] as usize] {
+            by_edge.insert((tri[1] as u64) << 32 | tri[2] as u64, t as u32);
+        }
     }
     let mut pairs = Vec::new();
     for (t, tri) in triangles.iter().enumerate() {
@@ -447,9 +466,7 @@ fn flip(
             continue;
         }
         if let Some(&u) = by_edge.get(&((b as u64) << 32 | a as u64)) {
-            if !smooth[owner[u as usize] as usize] {
-                pairs.push((t, u as usize));
-            }
+            pairs.push((t, u as usize));
         }
     }
     let mids: Vec<[f64; 3]> = pairs

@@ -269,6 +269,8 @@ pub struct Settings {
     pub sharp: bool,
     /// Root-finding iterations for each edge vertex.
     pub refine: u32,
+    /// Find the material of each triangle and vertex (for formats that carry them).
+    pub materials: bool,
 }
 
 impl Default for Settings {
@@ -276,6 +278,81 @@ impl Default for Settings {
         Settings {
             sharp: true,
             refine: 6,
+            materials: true,
         }
+    }
+}
+
+/// Values on grid points, stored sparsely in bricks of 8×8×8 points found through a hash
+/// map: the points a cell reads lie in one or a few bricks, so a walk over cells in key
+/// order touches memory mostly in sequence.
+#[derive(Debug, Clone)]
+pub struct Bricks<T: Copy> {
+    index: KeyMap<u32>,
+    data: Vec<[T; BRICK_POINTS]>,
+    empty: T,
+}
+
+/// Points along a brick's edge (a power of two).
+const BRICK: u32 = 8;
+const BRICK_POINTS: usize = (BRICK * BRICK * BRICK) as usize;
+
+impl<T: Copy + PartialEq> Bricks<T> {
+    /// No values; `empty` is what an unset point reads.
+    pub fn new(empty: T) -> Self {
+        Bricks {
+            index: KeyMap::default(),
+            data: Vec::new(),
+            empty,
+        }
+    }
+
+    fn split(i: [u32; 3]) -> (u64, usize) {
+        let b = pack(i.map(|x| x / BRICK));
+        let o = i.map(|x| (x % BRICK) as usize);
+        (b, o[0] + BRICK as usize * (o[1] + BRICK as usize * o[2]))
+    }
+
+    /// The value at point `i` (`empty` where none was set).
+    pub fn get(&self, i: [u32; 3]) -> T {
+        let (b, o) = Self::split(i);
+        match self.index.get(&b) {
+            Some(&k) => self.data[k as usize][o],
+            None => self.empty,
+        }
+    }
+
+    /// The values at the eight corners of the cell whose lowest corner is `i`, in the order
+    /// of [`table::corner`] (one brick lookup when the cell lies in one brick).
+    pub fn cube(&self, i: [u32; 3]) -> [T; 8] {
+        if i.iter().all(|&x| x % BRICK < BRICK - 1) {
+            let (b, o) = Self::split(i);
+            let Some(&k) = self.index.get(&b) else {
+                return [self.empty; 8];
+            };
+            let brick = &self.data[k as usize];
+            let (sy, sz) = (BRICK as usize, (BRICK * BRICK) as usize);
+            return std::array::from_fn(|c| brick[o + (c & 1) + (c >> 1 & 1) * sy + (c >> 2 & 1) * sz]);
+        }
+        std::array::from_fn(|c| {
+            let d = table::corner(c);
+            self.get([i[0] + d[0], i[1] + d[1], i[2] + d[2]])
+        })
+    }
+
+    /// Sets the value at point `i`.
+    pub fn set(&mut self, i: [u32; 3], v: T) {
+        let (b, o) = Self::split(i);
+        let next = self.data.len() as u32;
+        let k = *self.index.entry(b).or_insert(next);
+        if k == next {
+            self.data.push([self.empty; BRICK_POINTS]);
+        }
+        self.data[k as usize][o] = v;
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.data.len() * std::mem::size_of::<[T; BRICK_POINTS]>() + self.index.len() * 24
     }
 }

@@ -97,13 +97,15 @@ fn read_ply(path: &Path) -> (Read, Vec<[u8; 3]>) {
     let mut r = Read::default();
     let mut colours = Vec::new();
     for v in &ply.payload["vertex"] {
-        r.positions.push([float(&v["x"]), float(&v["y"]), float(&v["z"])]);
+        r.positions
+            .push([float(&v["x"]), float(&v["y"]), float(&v["z"])]);
         colours.push([byte(&v["red"]), byte(&v["green"]), byte(&v["blue"])]);
     }
     for f in &ply.payload["face"] {
         match &f["vertex_indices"] {
             Property::ListInt(i) if i.len() == 3 => {
-                r.triangles.push([i[0] as usize, i[1] as usize, i[2] as usize])
+                r.triangles
+                    .push([i[0] as usize, i[1] as usize, i[2] as usize])
             }
             other => panic!("expected three indices, got {other:?}"),
         }
@@ -129,8 +131,10 @@ fn read_glb(path: &Path) -> (Read, Vec<String>) {
             assert_eq!(r.positions, positions, "primitives share the positions");
         }
         let idx: Vec<u32> = reader.read_indices().expect("indices").into_u32().collect();
-        r.triangles
-            .extend(idx.chunks(3).map(|c| [c[0] as usize, c[1] as usize, c[2] as usize]));
+        r.triangles.extend(
+            idx.chunks(3)
+                .map(|c| [c[0] as usize, c[1] as usize, c[2] as usize]),
+        );
         names.push(p.material().name().unwrap_or("").to_string());
     }
     (r, names)
@@ -264,16 +268,25 @@ fn to_mesh(m: &Read, p: [f64; 3]) -> f64 {
 
 /// The scene of the benchmark, read back in all four formats, one surface each time: a
 /// sphere and a torus that pass through each other (genus 1), a box and a thin plate (genus
-/// 0 each), so χ = 0 + 2 + 2 = 4. The plate is 0.05 thick, 1.6 cells at resolution 64.
+/// 0 each), so χ = 0 + 2 + 2 = 4. The plate is 0.05 thick: 1.6 cells at resolution 64, 0.8
+/// at 32, where some columns of grid points miss it and holes open in it (the mesh is still
+/// closed and manifold, of another genus).
 #[test]
 fn the_parts_scene_is_a_closed_manifold_in_every_format() {
     let d = dir("parts");
     let scene = root().join("examples/mesh/parts.sdf");
-    for res in ["40", "64"] {
+    for res in ["32", "64", "96"] {
         let mut counts = Vec::new();
         for ext in ["stl", "obj", "ply", "glb"] {
             let out = d.join(format!("parts{res}.{ext}"));
-            mesh(&[s(&scene), "-o", s(&out), "--bounds=-1,-1,-1,1,1,1", "--resolution", res]);
+            mesh(&[
+                s(&scene),
+                "-o",
+                s(&out),
+                "--bounds=-1,-1,-1,1,1,1",
+                "--resolution",
+                res,
+            ]);
             let (m, what) = match ext {
                 "stl" => (read_stl(&out), "stl"),
                 "obj" => (read_obj(&out), "obj"),
@@ -281,7 +294,9 @@ fn the_parts_scene_is_a_closed_manifold_in_every_format() {
                 _ => (read_glb(&out).0, "glb"),
             };
             let chi = manifold(&m, &format!("parts at {res}, {what}"));
-            assert_eq!(chi, 4, "parts at {res}, {what}: Euler characteristic");
+            if res != "32" {
+                assert_eq!(chi, 4, "parts at {res}, {what}: Euler characteristic");
+            }
             counts.push(m.triangles.len());
         }
         assert!(counts.iter().all(|&c| c == counts[0]), "{counts:?}");
@@ -349,7 +364,11 @@ fn every_examples_bounded_part_meshes_to_a_closed_manifold() {
         let first = sdfc(&["mesh", s(f), "-o", s(&out), "--resolution", "40"]);
         let err = String::from_utf8_lossy(&first.stderr).into_owned();
         if !first.status.success() {
-            assert!(err.contains("--bounds X0,Y0,Z0,X1,Y1,Z1"), "{}: {err}", f.display());
+            assert!(
+                err.contains("--bounds X0,Y0,Z0,X1,Y1,Z1"),
+                "{}: {err}",
+                f.display()
+            );
             let bounds = err
                 .split('`')
                 .find(|w| w.starts_with("--bounds="))
@@ -367,7 +386,11 @@ fn every_examples_bounded_part_meshes_to_a_closed_manifold() {
 #[test]
 fn sphere_vertices_lie_on_the_surface() {
     let d = dir("sphere");
-    let scene = write_scene(&d, "ball.sdf", "scene { sphere(0.5).translate(0.1, -0.2, 0.3); }\n");
+    let scene = write_scene(
+        &d,
+        "ball.sdf",
+        "scene { sphere(0.5).translate(0.1, -0.2, 0.3); }\n",
+    );
     let out = d.join("ball.obj");
     let voxel = 0.03;
     mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.03"]);
@@ -419,7 +442,10 @@ fn hausdorff(m: &Read, p: &Program, voxel: f64, centre: [f64; 3], radius: f64) {
             back = back.max(to_mesh(m, q));
         }
     }
-    assert!(back <= 0.5 * voxel, "a surface point is {back} from the mesh");
+    assert!(
+        back <= 0.5 * voxel,
+        "a surface point is {back} from the mesh"
+    );
 }
 
 /// Sharp features: a box's corners are vertices within 5 % of a voxel, and its edges lie in
@@ -468,7 +494,10 @@ fn box_edges_and_corners_are_kept() {
             }
         }
     }
-    assert!(worst <= 0.05 * voxel, "a point of an edge is {worst} from the mesh");
+    assert!(
+        worst <= 0.05 * voxel,
+        "a point of an edge is {worst} from the mesh"
+    );
     hausdorff(&m, &program(&scene), voxel, c, 0.4);
 }
 
@@ -477,10 +506,22 @@ fn box_edges_and_corners_are_kept() {
 fn torus_and_plate_are_within_half_a_voxel() {
     let d = dir("torus");
     for (name, body, centre) in [
-        ("torus", "torus(0.35, 0.12).translate(0, 0.5, 0)", [0.0, 0.5, 0.0]),
-        ("plate", "box((0.9, 0.025, 0.9)).translate(0, -0.575, 0)", [0.0, -0.575, 0.0]),
+        (
+            "torus",
+            "torus(0.35, 0.12).translate(0, 0.5, 0)",
+            [0.0, 0.5, 0.0],
+        ),
+        (
+            "plate",
+            "box((0.9, 0.025, 0.9)).translate(0, -0.575, 0)",
+            [0.0, -0.575, 0.0],
+        ),
     ] {
-        let scene = write_scene(&d, &format!("{name}.sdf"), &format!("scene {{ {body}; }}\n"));
+        let scene = write_scene(
+            &d,
+            &format!("{name}.sdf"),
+            &format!("scene {{ {body}; }}\n"),
+        );
         let out = d.join(format!("{name}.stl"));
         let voxel = 2.0 / 64.0;
         mesh(&[s(&scene), "-o", s(&out), "--voxel", &voxel.to_string()]);
@@ -505,9 +546,19 @@ fn an_unbounded_scene_needs_bounds_and_is_closed_at_them() {
     let o = sdfc(&["mesh", s(&scene), "-o", s(&out)]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("unbounded") && err.contains("`--bounds X0,Y0,Z0,X1,Y1,Z1`"), "{err}");
+    assert!(
+        err.contains("unbounded") && err.contains("`--bounds X0,Y0,Z0,X1,Y1,Z1`"),
+        "{err}"
+    );
     assert!(!out.exists());
-    mesh(&[s(&scene), "-o", s(&out), "--bounds=-1,-0.5,-1,1,1,1", "--resolution", "40"]);
+    mesh(&[
+        s(&scene),
+        "-o",
+        s(&out),
+        "--bounds=-1,-0.5,-1,1,1,1",
+        "--resolution",
+        "40",
+    ]);
     // The slab and the sphere sunk into it are one surface of genus 0.
     assert_eq!(manifold(&read_stl(&out), "floor"), 2);
 }
@@ -523,14 +574,23 @@ fn limits_and_bad_arguments_are_reported() {
         let mut a = vec!["mesh", s(&scene), "-o", s(&out)];
         a.extend_from_slice(extra);
         let o = sdfc(&a);
-        (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
     };
     let (code, err) = run(&["--limit", "cells=1000"]);
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("cells limit of 1000") && err.contains("--limit cells="), "{err}");
+    assert!(
+        err.contains("cells limit of 1000") && err.contains("--limit cells="),
+        "{err}"
+    );
     let (code, err) = run(&["--limit", "memory=1", "--resolution", "200"]);
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("allocating at most") && err.contains("--limit memory="), "{err}");
+    assert!(
+        err.contains("allocating at most") && err.contains("--limit memory="),
+        "{err}"
+    );
     let (code, err) = run(&["--set", "sharp=maybe"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("sharp must be on or off"), "{err}");
@@ -557,4 +617,23 @@ fn an_unproven_field_falls_back_to_the_dense_grid() {
     );
     let chi = manifold(&read_stl(&out), "mandelbulb");
     assert_eq!(chi % 2, 0);
+}
+
+/// Faces lying on grid planes (the grid placed so, through --bounds): the corners' signs there
+/// are decided by rounding, and the mesh is still a closed manifold.
+#[test]
+fn faces_on_grid_planes_still_give_a_closed_manifold() {
+    let d = dir("aligned");
+    let scene = write_scene(
+        &d,
+        "cube.sdf",
+        "scene { box(0.5); sphere(0.3).translate(0.5, 0.5, 0); }\n",
+    );
+    // The grid starts 1.381966… cells below the bounds: here at -0.7, so that the planes
+    // x, y, z = ±0.5 hold grid points.
+    let lo = -0.7 + 1.381_966_011_250_105 * 0.1;
+    let bounds = format!("--bounds={lo},{lo},{lo},0.9,0.9,0.9");
+    let out = d.join("cube.stl");
+    mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.1", &bounds]);
+    assert_eq!(manifold(&read_stl(&out), "aligned cube"), 2);
 }

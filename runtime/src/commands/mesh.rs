@@ -51,6 +51,11 @@ pub struct MeshArgs {
     pub limits: super::LimitArgs,
 }
 
+/// The grid's points are offset from the bounds by this fraction of a cell (2 − φ), so that
+/// faces at the bounds, or at round fractions of them (a box's faces are its bounding box's),
+/// do not fall on grid planes, where the corners' signs would be decided by rounding.
+pub const GRID_OFFSET: f64 = 0.381_966_011_250_105;
+
 /// The default number of cells along the longest side.
 pub const DEFAULT_RESOLUTION: u32 = 128;
 
@@ -92,7 +97,10 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     let scene = &checked.scene;
     let analysis = analysis::analyse(scene);
     let Some(root) = analysis.root() else {
-        return Err((1, "the scene has no objects: there is no surface to mesh".into()));
+        return Err((
+            1,
+            "the scene has no objects: there is no surface to mesh".into(),
+        ));
     };
     let origin = scene.origin;
     // The clip box and the grid, in the program's coordinates (the scene's, less `origin`).
@@ -122,7 +130,10 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
                             .zip(origin.iter().chain(&origin))
                             .map(|(x, o)| short(x + o))
                             .collect();
-                        format!("; its bounded objects with a margin are `--bounds={}`", v.join(","))
+                        format!(
+                            "; its bounded objects with a margin are `--bounds={}`",
+                            v.join(",")
+                        )
                     }
                     None => String::new(),
                 };
@@ -132,7 +143,10 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
                 )));
             }
             if b.is_empty() {
-                return Err((1, "the scene's solid is empty: there is no surface to mesh".into()));
+                return Err((
+                    1,
+                    "the scene's solid is empty: there is no surface to mesh".into(),
+                ));
             }
             ([b.min, b.max], b.max)
         }
@@ -147,7 +161,10 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         (None, r) => longest / r.unwrap_or(DEFAULT_RESOLUTION) as f64,
     };
     if !(voxel > 0.0 && voxel.is_finite()) {
-        return Err(usage("the bounds are flat: give a region with some extent along every axis (`--bounds`)".into()));
+        return Err(usage(
+            "the bounds are flat: give a region with some extent along every axis (`--bounds`)"
+                .into(),
+        ));
     }
     // Without --bounds the box is the analysis's, grown by a cell so that the clip never
     // touches the surface; one more cell all round is outside the clip, which closes the mesh.
@@ -155,7 +172,14 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         Some(_) => clip,
         None => [clip[0].map(|x| x - voxel), clip[1].map(|x| x + voxel)],
     };
-    let cells = [0, 1, 2].map(|i| ((clip[1][i] - clip[0][i]) / voxel).ceil().max(1.0) + 2.0);
+    // The grid starts 1 + GRID_OFFSET cells below the clip box and ends a cell or more above
+    // it, so that its outermost points lie outside the clip and the surface is closed.
+    let cells = [0, 1, 2].map(|i| {
+        ((clip[1][i] - clip[0][i]) / voxel + 1.0 + GRID_OFFSET)
+            .ceil()
+            .max(1.0)
+            + 1.0
+    });
     if cells.iter().any(|&n| n > MAX_AXIS_CELLS as f64) {
         return Err(usage(format!(
             "the grid would have {} cells along an axis; at most {MAX_AXIS_CELLS} are possible (a larger --voxel or a smaller --resolution)",
@@ -163,7 +187,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         )));
     }
     let grid = Grid {
-        origin: clip[0].map(|x| x - voxel),
+        origin: clip[0].map(|x| x - (1.0 + GRID_OFFSET) * voxel),
         voxel,
         cells: cells.map(|n| n as u32),
     };
@@ -240,7 +264,8 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         );
     }
     check_memory(bound, &limits).map_err(|m| (1, m))?;
-    let memory_cells = (limits.get(Limit::Memory).saturating_mul(MIB) / BYTES_PER_CELL).min(max_cells);
+    let memory_cells =
+        (limits.get(Limit::Memory).saturating_mul(MIB) / BYTES_PER_CELL).min(max_cells);
     let octree_evaluated = candidates.evaluated;
     let result = pool.install(|| {
         contour::contour(
@@ -302,7 +327,11 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
         grid.cells[2],
         short(grid.voxel),
         s.octree_cells,
-        if s.dense { " (no proven bound: dense grid)" } else { "" },
+        if s.dense {
+            " (no proven bound: dense grid)"
+        } else {
+            ""
+        },
         s.candidates,
         s.added,
         s.surface_cells,
@@ -388,11 +417,9 @@ fn settings(sets: &[String]) -> Result<Settings, String> {
             ("sharp", "off" | "false") => s.sharp = false,
             ("sharp", v) => return Err(format!("sharp must be on or off, not `{v}`")),
             ("refine", v) => {
-                s.refine = v
-                    .parse::<u32>()
-                    .ok()
-                    .filter(|n| *n <= 50)
-                    .ok_or_else(|| format!("refine must be a whole number from 0 to 50, not `{v}`"))?
+                s.refine = v.parse::<u32>().ok().filter(|n| *n <= 50).ok_or_else(|| {
+                    format!("refine must be a whole number from 0 to 50, not `{v}`")
+                })?
             }
             (k, _) => {
                 return Err(format!(
@@ -412,7 +439,9 @@ pub fn parse_bounds(s: &str) -> Result<[[f64; 3]; 2], String> {
         .collect::<Result<_, _>>()
         .map_err(|_| format!("expected six numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"))?;
     if v.len() != 6 || v.iter().any(|x| !x.is_finite()) {
-        return Err(format!("expected six finite numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"));
+        return Err(format!(
+            "expected six finite numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"
+        ));
     }
     let (lo, hi) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
     if (0..3).any(|i| !(lo[i] < hi[i])) {

@@ -31,7 +31,8 @@ const SMOOTH_COS: f64 = 0.866;
 /// Bytes held per cell at most while contouring: corner values and the cell sets (hash
 /// tables at most half full), three owned edges with their position, normal and index, four
 /// patches, twelve fan triangles with their materials, and the output mesh.
-pub const BYTES_PER_CELL: u64 = 8 * 32 + 2 * 32 + 3 * (8 + 24 + 24 + 32) + 4 * 64 + 12 * 48 + 7 * 40;
+pub const BYTES_PER_CELL: u64 =
+    8 * 32 + 2 * 32 + 3 * (8 + 24 + 24 + 32) + 4 * 64 + 12 * 48 + 7 * 40;
 
 /// Contours the surface in `candidates` (sorted cell keys), holding at most `max_cells`
 /// cells (`Err` with the count when the cells a crossed edge reaches would exceed it).
@@ -205,7 +206,14 @@ pub fn contour(
     let mut positions = crossings;
     positions.extend_from_slice(&centres);
     if settings.sharp {
-        stats.flips = flip(field, &positions, &mut triangles, &owner, &smooth, grid.voxel);
+        stats.flips = flip(
+            field,
+            &positions,
+            &mut triangles,
+            &owner,
+            &smooth,
+            grid.voxel,
+        );
     }
     progress(0.9);
     let (materials, vertex_materials) = if settings.materials {
@@ -297,7 +305,11 @@ fn roots(
                 lo: (0.0, d0),
                 hi: (1.0, d1),
                 side: 0,
-                t: if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.5 },
+                t: if t.is_finite() {
+                    t.clamp(0.0, 1.0)
+                } else {
+                    0.5
+                },
             }
         })
         .collect();
@@ -381,7 +393,11 @@ fn inside_cell(grid: &Grid, c: [u32; 3], p: [f64; 3]) -> [f64; 3] {
     let lo = grid.point(c);
     let m = MARGIN * grid.voxel;
     [0, 1, 2].map(|i| {
-        let v = if p[i].is_finite() { p[i] } else { lo[i] + 0.5 * grid.voxel };
+        let v = if p[i].is_finite() {
+            p[i]
+        } else {
+            lo[i] + 0.5 * grid.voxel
+        };
         v.clamp(lo[i] + m, lo[i] + grid.voxel - m)
     })
 }
@@ -407,9 +423,8 @@ fn separate(
                 if centres[a] == centres[b] {
                     let ids = &ring[starts[b]..starts[b + 1]];
                     let n = ids.len() as f64;
-                    let c = [0, 1, 2].map(|i| {
-                        ids.iter().map(|&v| crossings[v as usize][i]).sum::<f64>() / n
-                    });
+                    let c = [0, 1, 2]
+                        .map(|i| ids.iter().map(|&v| crossings[v as usize][i]).sum::<f64>() / n);
                     let moved = [0, 1, 2].map(|i| centres[b][i] + 0.01 * (c[i] - centres[b][i]));
                     centres[b] = inside_cell(grid, cells[b], moved);
                 }
@@ -496,7 +511,10 @@ fn flip(
             continue;
         }
         let before = {
-            let (n1, n2) = (normal(positions, triangles[t]), normal(positions, triangles[u]));
+            let (n1, n2) = (
+                normal(positions, triangles[t]),
+                normal(positions, triangles[u]),
+            );
             [n1[0] + n2[0], n1[1] + n2[1], n1[2] + n2[2]]
         };
         let (s, r) = ([c1, a, c2], [c2, b, c1]);

@@ -332,7 +332,9 @@ impl<T: Copy + PartialEq> Bricks<T> {
             };
             let brick = &self.data[k as usize];
             let (sy, sz) = (BRICK as usize, (BRICK * BRICK) as usize);
-            return std::array::from_fn(|c| brick[o + (c & 1) + (c >> 1 & 1) * sy + (c >> 2 & 1) * sz]);
+            return std::array::from_fn(|c| {
+                brick[o + (c & 1) + (c >> 1 & 1) * sy + (c >> 2 & 1) * sz]
+            });
         }
         std::array::from_fn(|c| {
             let d = table::corner(c);

@@ -91,8 +91,18 @@ mod tests {
 
     #[test]
     fn three_planes_meet_at_their_corner() {
-        let points = [[0.3, 0.1, 0.2], [0.0, 0.3, 0.7], [0.9, 0.8, 0.3], [0.2, 0.3, 0.3]];
-        let normals = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+        let points = [
+            [0.3, 0.1, 0.2],
+            [0.0, 0.3, 0.7],
+            [0.9, 0.8, 0.3],
+            [0.2, 0.3, 0.3],
+        ];
+        let normals = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0],
+        ];
         let (x, rank) = solve(&points, &normals);
         assert_eq!(rank, 3);
         for (xi, want) in x.iter().zip([0.3, 0.3, 0.3]) {
@@ -107,13 +117,19 @@ mod tests {
         let normals = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let (x, rank) = solve(&points, &normals);
         assert_eq!(rank, 2);
-        assert!((x[0] - 0.5).abs() < 1e-12 && (x[1] - 0.5).abs() < 1e-12, "{x:?}");
+        assert!(
+            (x[0] - 0.5).abs() < 1e-12 && (x[1] - 0.5).abs() < 1e-12,
+            "{x:?}"
+        );
         assert!((x[2] - 0.5).abs() < 1e-12, "{x:?}");
         let (e, v) = eigen([[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 5.0]]);
         let mut sorted = e;
         sorted.sort_by(f64::total_cmp);
         assert!((sorted[0] - 1.0).abs() < 1e-12 && (sorted[1] - 3.0).abs() < 1e-12);
-        let k = e.iter().position(|x| (x - 3.0).abs() < 1e-9).expect("eigenvalue 3");
+        let k = e
+            .iter()
+            .position(|x| (x - 3.0).abs() < 1e-9)
+            .expect("eigenvalue 3");
         assert!((v[0][k].abs() - s).abs() < 1e-9 && (v[1][k].abs() - s).abs() < 1e-9);
     }
 }

@@ -81,7 +81,12 @@ fn stl(mesh: &Mesh, out: &mut Vec<u8>) -> io::Result<()> {
             u[0] * v[1] - u[1] * v[0],
         ];
         let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
-        for x in f32s(n.map(|x| x / l)).iter().chain(&f32s(a)).chain(&f32s(b)).chain(&f32s(c)) {
+        for x in f32s(n.map(|x| x / l))
+            .iter()
+            .chain(&f32s(a))
+            .chain(&f32s(b))
+            .chain(&f32s(c))
+        {
             out.write_all(&x.to_le_bytes())?;
         }
         out.write_all(&[0, 0])?;
@@ -165,7 +170,8 @@ fn glb(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()>
             bin.extend_from_slice(&x.to_le_bytes());
         }
     }
-    let mut views = vec![json!({"buffer": 0, "byteOffset": 0, "byteLength": bin.len(), "target": 34962})];
+    let mut views =
+        vec![json!({"buffer": 0, "byteOffset": 0, "byteLength": bin.len(), "target": 34962})];
     let mut accessors = vec![json!({
         "bufferView": 0, "componentType": 5126, "count": mesh.positions.len(), "type": "VEC3",
         "min": lo, "max": hi
@@ -190,7 +196,9 @@ fn glb(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()>
         accessors.push(json!({
             "bufferView": k + 1, "componentType": 5125, "count": count, "type": "SCALAR"
         }));
-        primitives.push(json!({"attributes": {"POSITION": 0}, "indices": k + 1, "material": k, "mode": 4}));
+        primitives.push(
+            json!({"attributes": {"POSITION": 0}, "indices": k + 1, "material": k, "mode": 4}),
+        );
         let (name, c) = match materials.get(id as usize) {
             Some(m) => (m.name.clone(), base_colour(m)),
             None => (format!("material {id}"), [0.8; 3]),

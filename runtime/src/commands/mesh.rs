@@ -4,8 +4,8 @@
 
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
-use crate::mesh::contour::{self, BYTES_PER_CELL};
-use crate::mesh::write::{self, Format};
+use crate::mesh::contour::{self, Stop, BYTES_PER_CANDIDATE, BYTES_PER_SURFACE_CELL};
+use crate::mesh::write::Format;
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, MAX_AXIS_CELLS};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::lower::LowerOptions;
@@ -247,25 +247,26 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             )
         })?;
     let n = candidates.cells.len() as u64;
-    let bound = n
-        .saturating_mul(BYTES_PER_CELL)
-        .saturating_add(write::encoded_bytes(7 * n, 12 * n));
-    if let Some(b) = &bar {
-        b.suspend(|| {
-            eprintln!(
-                "mesh: {n} cells may hold surface: allocating at most {} MiB to contour them",
-                mib(bound)
-            )
-        });
-    } else {
-        eprintln!(
-            "mesh: {n} cells may hold surface: allocating at most {} MiB to contour them",
-            mib(bound)
-        );
-    }
+    let say = |text: String| match &bar {
+        Some(b) => b.suspend(|| eprintln!("{text}")),
+        None => eprintln!("{text}"),
+    };
+    let bound = n.saturating_mul(BYTES_PER_CANDIDATE);
+    say(format!(
+        "mesh: {n} cells may hold surface: allocating at most {} MiB for their corners",
+        mib(bound)
+    ));
     check_memory(bound, &limits).map_err(|m| (1, m))?;
+    let surface_check = |cells: u64| {
+        let total = bound.saturating_add(cells.saturating_mul(BYTES_PER_SURFACE_CELL));
+        say(format!(
+            "mesh: {cells} cells hold surface: allocating at most {} MiB in all",
+            mib(total)
+        ));
+        check_memory(total, &limits)
+    };
     let memory_cells =
-        (limits.get(Limit::Memory).saturating_mul(MIB) / BYTES_PER_CELL).min(max_cells);
+        (limits.get(Limit::Memory).saturating_mul(MIB) / BYTES_PER_CANDIDATE).min(max_cells);
     let octree_evaluated = candidates.evaluated;
     let result = pool.install(|| {
         contour::contour(
@@ -274,20 +275,22 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             candidates.cells,
             &settings,
             memory_cells,
+            &surface_check,
             &stage("contour", 0.3, 0.7),
         )
     });
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let (mut mesh, mut stats): (Mesh, Stats) = result.map_err(|cells| {
-        (
+    let (mut mesh, mut stats): (Mesh, Stats) = result.map_err(|stop| match stop {
+        Stop::Refused(msg) => (1, msg),
+        Stop::Cells(cells) => (
             1,
             format!(
-                "the surface reaches {cells} cells, more than the memory and cells limits allow ({memory_cells}); {}",
-                limits.raise(Limit::Memory)
+                "the surface reaches {cells} cells, more than the cells and memory limits allow ({memory_cells}); {}",
+                limits.raise(Limit::Cells)
             ),
-        )
+        ),
     })?;
     let seconds = started.elapsed().as_secs_f64();
     stats.octree_cells = octree_evaluated;
@@ -295,6 +298,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     for p in &mut mesh.positions {
         *p = [0, 1, 2].map(|i| p[i] + origin[i]);
     }
+    // The file's bytes are in the surface cells' share of the announcement.
     let bytes = format.encode(&mesh, &scene.materials);
     std::fs::write(&args.output, &bytes)
         .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;

@@ -28,22 +28,38 @@ const GRADIENT_STEP: f64 = 1e-4;
 /// 30°); its inner vertex is projected onto the surface.
 const SMOOTH_COS: f64 = 0.866;
 
-/// Bytes held per cell at most while contouring: corner values and the cell sets (hash
-/// tables at most half full), three owned edges with their position, normal and index, four
-/// patches, twelve fan triangles with their materials, and the output mesh.
-pub const BYTES_PER_CELL: u64 =
-    8 * 32 + 2 * 32 + 3 * (8 + 24 + 24 + 32) + 4 * 64 + 12 * 48 + 7 * 40;
+/// Bytes held per candidate cell at most: its key, its corners' values and its membership in
+/// bricks of points (counted as eight values of 8 bytes and a flag, though neighbours share
+/// corners), and the points asked for with their positions and values.
+pub const BYTES_PER_CANDIDATE: u64 = 8 + 8 * 8 + 8 + 8 * (12 + 24 + 8);
+
+/// Bytes held per surface cell at most: three owned edges with their key, position, normal
+/// and index, four patches, twelve fan triangles with their owners and materials, the
+/// evaluations' scratch, and the output mesh with the file's bytes.
+pub const BYTES_PER_SURFACE_CELL: u64 =
+    8 + 3 * (8 + 24 + 24 + 12 + 8) + 4 * 64 + 12 * 48 + 7 * 40 + 12 * 50;
+
+/// Why contouring stopped.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Stop {
+    /// The cells held (candidates and the cells crossed edges reach) would exceed the limit.
+    Cells(u64),
+    /// The caller refused the surface cells' memory (its message).
+    Refused(String),
+}
 
 /// Contours the surface in `candidates` (sorted cell keys), holding at most `max_cells`
-/// cells (`Err` with the count when the cells a crossed edge reaches would exceed it).
+/// cells; `surface` is told the number of surface cells before they are contoured, and may
+/// refuse.
 pub fn contour(
     field: &Field,
     grid: &Grid,
     candidates: Vec<u64>,
     settings: &Settings,
     max_cells: u64,
+    surface_cells: &dyn Fn(u64) -> Result<(), String>,
     progress: &dyn Fn(f64),
-) -> Result<(Mesh, Stats), u64> {
+) -> Result<(Mesh, Stats), Stop> {
     let mut stats = Stats {
         candidates: candidates.len() as u64,
         ..Stats::default()
@@ -61,7 +77,7 @@ pub fn contour(
     let mut first = true;
     while !pending.is_empty() {
         if held > max_cells {
-            return Err(held);
+            return Err(Stop::Cells(held));
         }
         let mut need: Vec<[u32; 3]> = Vec::new();
         for &c in &pending {
@@ -111,6 +127,7 @@ pub fn contour(
     progress(0.2);
     surface.par_sort_unstable();
     stats.surface_cells = surface.len() as u64;
+    surface_cells(stats.surface_cells).map_err(Stop::Refused)?;
 
     // Edge vertices: each crossed edge is owned by the cell at its lower end.
     let mut edges: Vec<u64> = Vec::new();

@@ -2,7 +2,10 @@
 //! at most the distance from a cell's centre `c` to the surface, so a cell whose centre has
 //! `|f(c)| > L·r` (r its half-diagonal) holds none, nor do its sub-cells: an octree over
 //! the grid evaluates one point per cell, level by level, and subdivides only the cells the
-//! test keeps. A field without a proven bound gets the dense grid.
+//! test keeps. The cells of the last level are not tested by their centres: every child of a
+//! kept two-cell cube is a candidate, and its corners, which contouring evaluates anyway,
+//! decide (a cell whose corners all have one sign holds no patch). A field without a proven
+//! bound gets the dense grid.
 
 use super::{pack, Field, Grid};
 
@@ -14,13 +17,13 @@ const SLACK: f64 = 1e-6;
 pub struct Candidates {
     /// Packed keys of the cells (their lowest corner).
     pub cells: Vec<u64>,
-    /// Octree cells evaluated (0 for the dense grid).
+    /// Octree cells whose centre was evaluated (0 for the dense grid).
     pub evaluated: u64,
 }
 
-/// The cells of `grid` that may hold surface of `field`, evaluating at most `max_cells`
-/// octree cells (`Err` with the count reached when that would be exceeded; for a dense grid,
-/// its cell count). `progress` receives the fraction of levels done.
+/// The cells of `grid` that may hold surface of `field`, with at most `max_cells` octree
+/// cells evaluated and candidates returned together (`Err` with the count reached when that
+/// would be exceeded; for a dense grid, its cell count). `progress` receives the fraction of levels done.
 pub fn candidates(
     field: &Field,
     grid: &Grid,
@@ -48,10 +51,11 @@ pub fn candidates(
         });
     }
     let largest = grid.cells.iter().copied().max().unwrap_or(1).max(1);
-    let levels = u32::BITS - (largest - 1).leading_zeros();
+    // At least one level above the cells, so that the last level is cells of edge two.
+    let levels = (u32::BITS - (largest - 1).leading_zeros()).max(1);
     let mut frontier: Vec<[u32; 3]> = vec![[0; 3]];
     let mut evaluated = 0u64;
-    for level in 0..=levels {
+    for level in 0..levels {
         let size = 1u32 << (levels - level);
         evaluated += frontier.len() as u64;
         if evaluated > max_cells {
@@ -69,12 +73,7 @@ pub fn candidates(
             .zip(&d)
             .filter(|(_, d)| !(d.abs() > reach))
             .map(|(c, _)| *c);
-        progress((level + 1) as f64 / (levels + 1) as f64);
-        if level == levels {
-            let mut cells: Vec<u64> = kept.map(pack).collect();
-            cells.sort_unstable();
-            return Ok(Candidates { cells, evaluated });
-        }
+        progress((level + 1) as f64 / levels.max(1) as f64);
         let child = size / 2;
         let mut next = Vec::new();
         for c in kept {
@@ -84,6 +83,14 @@ pub fn candidates(
                     next.push(ch);
                 }
             }
+        }
+        if level + 1 == levels {
+            if evaluated + next.len() as u64 > max_cells {
+                return Err(evaluated + next.len() as u64);
+            }
+            let mut cells: Vec<u64> = next.into_iter().map(pack).collect();
+            cells.sort_unstable();
+            return Ok(Candidates { cells, evaluated });
         }
         frontier = next;
     }

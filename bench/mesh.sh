@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Meshing figures for BENCHMARKS.md ("Meshing"): time of `sdfc mesh` at resolutions 64, 128
+# and 256 for the benchmark scene (examples/mesh/parts.sdf over [-1, 1]³) and the bracket,
+# with sharp features on and off, and the cells evaluated against the dense grid at 256 for
+# the report scenes' bounded parts.
+#
+# usage: bench/mesh.sh [SDFC] [RUNS]   (default target/release/sdfc, 5 runs; median reported)
+set -euo pipefail
+SDFC=${1:-target/release/sdfc}
+RUNS=${2:-5}
+OUT=$(mktemp -d)
+trap 'rm -rf "$OUT"' EXIT
+echo "# $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), load $(cut -d' ' -f1-3 /proc/loadavg)"
+
+# median of the "time" line of --stats (octree and contouring; the meshing itself) and of
+# the whole command's wall time (reading, lowering, meshing, writing the STL)
+measure() { # name file extra-args...
+  local name=$1 file=$2; shift 2
+  local inner=() wall=() stats
+  for _ in $(seq "$RUNS"); do
+    local t0 t1
+    t0=$(date +%s.%N)
+    stats=$("$SDFC" mesh "$file" -o "$OUT/m.stl" --stats --threads 2 "$@" 2>/dev/null)
+    t1=$(date +%s.%N)
+    inner+=("$(echo "$stats" | awk '/^time/ {print $2}')")
+    wall+=("$(echo "$t1 - $t0" | bc -l)")
+  done
+  local mi mw tris
+  mi=$(printf '%s\n' "${inner[@]}" | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
+  mw=$(printf '%s\n' "${wall[@]}" | sort -g | awk '{a[NR]=$1} END {printf "%.3f", a[int((NR+1)/2)]}')
+  tris=$(( ($(stat -c %s "$OUT/m.stl") - 84) / 50 ))
+  local evals
+  evals=$(echo "$stats" | awk '/^evaluations/ {print $2, $4}')
+  printf '| %s | %s | %s | %s | %s | %s |\n' "$name" "$*" "$mi" "$mw" "$tris" "$evals"
+}
+
+echo
+echo "| scene | arguments | meshing s (median) | command s (median) | triangles | points evaluated (% of dense grid) |"
+echo "|---|---|---|---|---|---|"
+for r in 64 128 256; do
+  measure parts examples/mesh/parts.sdf --bounds=-1,-1,-1,1,1,1 --resolution "$r"
+  measure parts examples/mesh/parts.sdf --bounds=-1,-1,-1,1,1,1 --resolution "$r" --set sharp=off
+done
+for r in 64 128 256; do
+  measure bracket examples/mesh/bracket.sdf --resolution "$r"
+done
+
+echo
+echo "Cells at resolution 256 (bounded parts; floors cut to the suggested box):"
+echo
+echo "| scene | grid | octree cells evaluated | % of dense cells | surface cells | points evaluated | % of dense points |"
+echo "|---|---|---|---|---|---|---|"
+for f in examples/seed{1,2,3,4,5,6}.sdf examples/mesh/parts.sdf examples/mesh/bracket.sdf; do
+  args=(--resolution 256)
+  if ! "$SDFC" mesh "$f" -o "$OUT/m.stl" --resolution 8 >/dev/null 2>"$OUT/err"; then
+    b=$(grep -o -- '--bounds=[-0-9.,]*' "$OUT/err" | head -1 || true)
+    args+=("${b:---bounds=-4,-1,-4,4,2,4}")
+  fi
+  [ "$f" = examples/mesh/parts.sdf ] && args+=(--bounds=-1,-1,-1,1,1,1)
+  s=$("$SDFC" mesh "$f" -o "$OUT/m.stl" --stats --threads 2 "${args[@]}" 2>/dev/null)
+  grid=$(echo "$s" | awk '/^grid/ {print $2}')
+  oct=$(echo "$s" | awk '/^octree cells/ {print $3}')
+  surf=$(echo "$s" | awk '/^surface cells/ {print $3}')
+  ev=$(echo "$s" | awk '/^evaluations/ {print $2}')
+  evp=$(echo "$s" | awk '/^evaluations/ {print $4}' | tr -d '(')
+  dense=$(echo "$grid" | awk -Fx '{print $1*$2*$3}')
+  printf '| %s | %s | %s | %.2f | %s | %s | %s |\n' "$(basename "$f" .sdf)" "$grid" "$oct" \
+    "$(echo "100 * $oct / $dense" | bc -l)" "$surf" "$ev" "$evp"
+done

@@ -4,7 +4,7 @@
 
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
-use crate::mesh::contour::{self, Stop, BYTES_PER_CANDIDATE, BYTES_PER_SURFACE_CELL};
+use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::write::Format;
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, MAX_AXIS_CELLS};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -251,7 +251,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         Some(b) => b.suspend(|| eprintln!("{text}")),
         None => eprintln!("{text}"),
     };
-    let bound = n.saturating_mul(BYTES_PER_CANDIDATE);
+    let bound = contour::candidate_bytes(&grid, n);
     say(format!(
         "mesh: {n} cells may hold surface: allocating at most {} MiB for their corners",
         mib(bound)
@@ -265,8 +265,9 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         ));
         check_memory(total, &limits)
     };
-    let memory_cells =
-        (limits.get(Limit::Memory).saturating_mul(MIB) / BYTES_PER_CANDIDATE).min(max_cells);
+    // The cells the closure may hold: as many as the memory limit allows at 52 bytes each
+    // (a key and a point), within the cells limit.
+    let memory_cells = (limits.get(Limit::Memory).saturating_mul(MIB) / 52).min(max_cells);
     let octree_evaluated = candidates.evaluated;
     let result = pool.install(|| {
         contour::contour(

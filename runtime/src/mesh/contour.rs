@@ -28,10 +28,19 @@ const GRADIENT_STEP: f64 = 1e-4;
 /// 30°); its inner vertex is projected onto the surface.
 const SMOOTH_COS: f64 = 0.866;
 
-/// Bytes held per candidate cell at most: its key, its corners' values and its membership in
-/// bricks of points (counted as eight values of 8 bytes and a flag, though neighbours share
-/// corners), and the points asked for with their positions and values.
-pub const BYTES_PER_CANDIDATE: u64 = 8 + 8 * 8 + 8 + 8 * (12 + 24 + 8);
+/// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
+/// points asked for, each at most once (a position, its index and its value); and the bricks
+/// of corner values (f64), cell flags and edge indices, at most eight per candidate and at
+/// most the grid's.
+pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
+    let points = candidates.saturating_mul(8).min(grid.dense_points());
+    let bricks = grid.cells.iter().map(|&n| (n as u64 + 1).div_ceil(8) + 1).product::<u64>();
+    let brick = 512 * (8 + 1 + 12) + 64;
+    candidates
+        .saturating_mul(8)
+        .saturating_add(points.saturating_mul(24 + 12 + 8))
+        .saturating_add(candidates.saturating_mul(8).min(bricks).saturating_mul(brick))
+}
 
 /// Bytes held per surface cell at most: three owned edges with their key, position, normal
 /// and index, four patches, twelve fan triangles with their owners and materials, the

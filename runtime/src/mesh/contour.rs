@@ -34,12 +34,21 @@ const SMOOTH_COS: f64 = 0.866;
 /// most the grid's.
 pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
     let points = candidates.saturating_mul(8).min(grid.dense_points());
-    let bricks = grid.cells.iter().map(|&n| (n as u64 + 1).div_ceil(8) + 1).product::<u64>();
+    let bricks = grid
+        .cells
+        .iter()
+        .map(|&n| (n as u64 + 1).div_ceil(8) + 1)
+        .product::<u64>();
     let brick = 512 * (8 + 1 + 12) + 64;
     candidates
         .saturating_mul(8)
         .saturating_add(points.saturating_mul(24 + 12 + 8))
-        .saturating_add(candidates.saturating_mul(8).min(bricks).saturating_mul(brick))
+        .saturating_add(
+            candidates
+                .saturating_mul(8)
+                .min(bricks)
+                .saturating_mul(brick),
+        )
 }
 
 /// Bytes held per surface cell at most: three owned edges with their key, position, normal

@@ -6,7 +6,7 @@ use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::write::Format;
-use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, MAX_AXIS_CELLS};
+use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, AXIS_CELLS};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::lower::LowerOptions;
 use sdfc_compiler::scene::{analysis, Combine, Node, NodeId, Scene};
@@ -180,9 +180,9 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             .max(1.0)
             + 1.0
     });
-    if cells.iter().any(|&n| n > MAX_AXIS_CELLS as f64) {
+    if cells.iter().any(|&n| n > AXIS_CELLS as f64) {
         return Err(usage(format!(
-            "the grid would have {} cells along an axis; at most {MAX_AXIS_CELLS} are possible (a larger --voxel or a smaller --resolution)",
+            "the grid would have {} cells along an axis; at most {AXIS_CELLS} are possible (a larger --voxel or a smaller --resolution)",
             cells.iter().copied().fold(0.0f64, f64::max)
         )));
     }

@@ -21,8 +21,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Bits of one grid index in a packed key: grids of up to 2²⁰ − 2 cells along an axis.
 pub const KEY_BITS: u32 = 20;
 
-/// The largest number of cells along one axis.
-pub const MAX_AXIS_CELLS: u32 = (1 << KEY_BITS) - 2;
+/// The most cells along one axis that a packed key can index (an implementation bound, not a
+/// resource limit).
+pub const AXIS_CELLS: u32 = (1 << KEY_BITS) - 2;
 
 /// A regular grid of cubic cells: point `(i, j, k)` is at `origin + (i, j, k)·voxel`, for
 /// `0 ≤ i ≤ cells[0]` and so on.

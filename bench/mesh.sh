@@ -6,6 +6,8 @@
 # wall-clock times.
 #
 # usage: bench/mesh.sh [SDFC] [RUNS]   (default target/release/sdfc, 5 runs; median reported)
+#        FIDGET=path/to/fidget-mesh-bench bench/mesh.sh ...   also runs the peer, fidget 0.5.1's
+#        Manifold Dual Contouring on the same scene (bench/fidget-mesh), side by side
 set -euo pipefail
 SDFC=${1:-target/release/sdfc}
 RUNS=${2:-5}
@@ -45,6 +47,33 @@ done
 for r in 64 128 256; do
   measure bracket examples/mesh/bracket.sdf --resolution "$r"
 done
+
+if [ -n "${FIDGET:-}" ]; then
+  echo
+  echo "Side by side with fidget 0.5.1 (Manifold Dual Contouring, rayon's pool on $(nproc) cores):"
+  echo
+  for depth in 7 8; do
+    RAYON_NUM_THREADS=2 "$FIDGET" jit "$depth" "$RUNS" "$OUT/fidget-jit-$depth.stl"
+    RAYON_NUM_THREADS=2 "$FIDGET" vm "$depth" "$RUNS"
+    measure parts examples/mesh/parts.sdf --bounds=-1,-1,-1,1,1,1 --resolution $((1 << depth))
+  done
+  for depth in 7 8; do
+    echo "fidget jit depth $depth STL by positions: $(python3 - "$OUT/fidget-jit-$depth.stl" <<'PY'
+import struct, sys
+from collections import Counter
+d = open(sys.argv[1], "rb").read()
+n = struct.unpack("<I", d[80:84])[0]
+ids, tris = {}, []
+for k in range(n):
+    v = struct.unpack("<9f", d[84 + 50 * k + 12 : 84 + 50 * k + 48])
+    tris.append([ids.setdefault(v[3 * i : 3 * i + 3], len(ids)) for i in range(3)])
+directed = Counter((t[i], t[(i + 1) % 3]) for t in tris for i in range(3) if t[i] != t[(i + 1) % 3])
+undirected = Counter(tuple(sorted(e)) for e in directed.elements())
+print(f"{n} triangles, {len(ids)} distinct positions, {sum(1 for c in undirected.values() if c != 2)} edges not in exactly two triangles, {sum(1 for t in tris if len(set(t)) < 3)} triangles with a repeated position")
+PY
+)"
+  done
+fi
 
 echo
 echo "Cells at resolution 256: the report scenes' bounded parts (their floor planes left out; seed4's"

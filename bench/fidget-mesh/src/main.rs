@@ -9,7 +9,7 @@ fn length3(x: Tree, y: Tree, z: Tree) -> Tree {
     (x.square() + y.square() + z.square()).sqrt()
 }
 
-fn boxed(c: [f64; 3], h: [f64; 3]) -> Tree {
+fn boxed(c: [f32; 3], h: [f32; 3]) -> Tree {
     let q = [
         (Tree::x() - c[0]).abs() - h[0],
         (Tree::y() - c[1]).abs() - h[1],
@@ -29,15 +29,12 @@ fn scene() -> Tree {
     sphere.min(cube).min(torus).min(plate)
 }
 
-fn run<S>(shape: S, depth: u8, runs: usize, stl: Option<&str>)
+fn run<F>(shape: fidget_core::shape::Shape<F>, depth: u8, runs: usize, stl: Option<&str>)
 where
-    S: fidget_core::shape::Shape<f32> + Clone,
-    fidget_core::shape::BoundShape<S::Function, f32>: Sized,
-    S: TryInto<fidget_core::shape::BoundShape<S::Function, f32>>,
-    <S as TryInto<fidget_core::shape::BoundShape<S::Function, f32>>>::Error: std::fmt::Debug,
-    S::Function: fidget_core::eval::Function + fidget_core::render::RenderHints + Clone,
+    F: fidget_core::eval::Function + fidget_core::render::RenderHints + Clone,
 {
-    let bound = shape.try_into().expect("no variables");
+    let bound: fidget_core::shape::BoundShape<F, f32> =
+        shape.try_into().expect("no variables");
     let settings = Settings { depth, ..Default::default() };
     let mut times = Vec::new();
     let mut mesh = None;
@@ -58,12 +55,20 @@ where
             (b - a).cross(&(c - a)).norm() == 0.0
         })
         .count();
-    let mut pos: Vec<[u32; 3]> = m.vertices.iter().map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]).collect();
+    let mut pos: Vec<[u32; 3]> = m
+        .vertices
+        .iter()
+        .map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()])
+        .collect();
     pos.sort_unstable();
     pos.dedup();
     println!(
         "depth {depth}: median {:.3} s of {runs} (min {:.3}), {} triangles, {zero} of zero area, {} vertices at {} distinct positions",
-        times[runs / 2], times[0], m.triangles.len(), m.vertices.len(), pos.len()
+        times[runs / 2],
+        times[0],
+        m.triangles.len(),
+        m.vertices.len(),
+        pos.len()
     );
     if let Some(path) = stl {
         let mut f = std::fs::File::create(path).expect("create");

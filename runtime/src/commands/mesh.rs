@@ -59,12 +59,6 @@ pub const GRID_OFFSET: f64 = 0.381_966_011_250_105;
 /// The default number of cells along the longest side.
 pub const DEFAULT_RESOLUTION: u32 = 128;
 
-/// Bytes per octree cell at most, counting every cell the octree may evaluate: while a level
-/// is evaluated it holds its cells' indices, centres and values (44 bytes each), and the
-/// indices of the next level's cells in a vector that may double (24 bytes each); the cells
-/// of two levels are together at most all the cells evaluated.
-const BYTES_PER_OCTREE_CELL: u64 = 44 + 24;
-
 /// Runs `sdfc mesh`.
 pub fn run(args: MeshArgs) -> ExitCode {
     match mesh(&args) {
@@ -203,12 +197,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         );
     }
     let max_cells = limits.get(Limit::Cells);
-    let octree_cells = if root.proven {
-        (grid.dense_cells().saturating_mul(8) / 7 + 1).min(max_cells)
-    } else {
-        grid.dense_cells()
-    };
-    let octree_bytes = octree_cells.saturating_mul(BYTES_PER_OCTREE_CELL);
+    let octree_bytes = octree::bytes(&grid, root.proven, max_cells);
     let [nx, ny, nz] = grid.cells;
     eprintln!(
         "mesh: {nx}x{ny}x{nz} cells of {}: allocating at most {} MiB to find the surface",

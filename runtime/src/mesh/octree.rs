@@ -12,6 +12,25 @@ use super::{pack, Field, Grid};
 /// Relative slack of the test, for the rounding of the distance program.
 const SLACK: f64 = 1e-6;
 
+/// Bytes per octree cell at most, counting every cell the octree may evaluate and the
+/// candidates: while a level is evaluated it holds its cells' indices, centres and values (44
+/// bytes each), and the indices of the next level's cells in a vector that may double (24
+/// bytes each) and, at the last level, their keys (8 bytes each).
+const BYTES_PER_OCTREE_CELL: u64 = 44 + 24;
+
+/// The most [`candidates`] allocates for `grid`: every octree cell it may evaluate and every
+/// candidate (at most 8/7 of the dense grid's cells, and at most `max_cells`), or the dense
+/// grid's keys when the bound is not proven.
+pub fn bytes(grid: &Grid, proven: bool, max_cells: u64) -> u64 {
+    if proven {
+        (grid.dense_cells().saturating_mul(8) / 7 + 1)
+            .min(max_cells)
+            .saturating_mul(BYTES_PER_OCTREE_CELL)
+    } else {
+        grid.dense_cells().saturating_mul(8)
+    }
+}
+
 /// The cells that may hold surface, sorted by key, and the cells evaluated to find them.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Candidates {

@@ -98,11 +98,8 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     };
     let origin = scene.origin;
     // The clip box and the grid, in the program's coordinates (the scene's, less `origin`).
-    let (clip, extent) = match args.bounds {
-        Some([lo, hi]) => {
-            let clip = [lo, hi].map(|c| [0, 1, 2].map(|i| c[i] - origin[i]));
-            (clip, hi)
-        }
+    let clip = match args.bounds {
+        Some([lo, hi]) => [lo, hi].map(|c| [0, 1, 2].map(|i| c[i] - origin[i])),
         None => {
             let b = root.bounds;
             let open: Vec<&str> = ["x", "y", "z"]
@@ -142,10 +139,9 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
                     "the scene's solid is empty: there is no surface to mesh".into(),
                 ));
             }
-            ([b.min, b.max], b.max)
+            [b.min, b.max]
         }
     };
-    let _ = extent;
     let size = [0, 1, 2].map(|i| clip[1][i] - clip[0][i]);
     let longest = size.iter().copied().fold(0.0f64, f64::max);
     let voxel = match (args.voxel, args.resolution) {

@@ -80,7 +80,7 @@ EOF
         cat <<'EOF'
 
 use sdfc_compiler::eval::{Evaluator, Outputs, Tape, DEFAULT_CHUNK};
-use sdfc_compiler::lower::Program;
+use sdfc_compiler::program::Program;
 use std::hint::black_box;
 use std::time::Instant;
 

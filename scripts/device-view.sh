@@ -4,8 +4,9 @@
 # For each scene it opens the viewer on a copy, then saves three edits one after the other, each
 # once the image of the one before has converged: a numeric edit (the first light's intensity:
 # uniform data, the pipeline is found in the cache), a structural edit (one more shape: a new
-# kernel to compile) and a radius edit where the scene has a `sphere(` (a constant written in
-# the kernel: compiled too), each saved as editors do, by writing a new file and renaming it
+# kernel to compile) and a radius edit where the scene has a `sphere(` (a constant of the
+# distance program, which the viewer's kernel reads from `scene_data`: the kernel is kept),
+# each saved as editors do, by writing a new file and renaming it
 # over the old one. The viewer prints, per load, check, lower, kernel, pipeline and
 # first-frame times and the time from the file's modification to the first frame (edit to
 # pixel). Then, for the report's scenes and temple.sdf, the frame rate while orbiting at

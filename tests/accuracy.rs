@@ -97,7 +97,12 @@ fn sphere_scene(w: u32, h: u32) -> sdfc_compiler::scene::Scene {
 #[test]
 fn cpu_renders_carry_first_hit_depths() {
     let scene = sphere_scene(33, 33);
-    let r = cpu::render(&scene, &lower(&scene), &Options::default(), &|| {});
+    let r = cpu::render(
+        &scene,
+        &sdfc_compiler::lower::Lowered::new(&scene),
+        &Options::default(),
+        &|| {},
+    );
     let d = r.depth.expect("the CPU renderer fills in depth");
     assert_eq!((d.width, d.height, d.samples), (33, 33, 1));
     // The centre ray meets the sphere 4 units from the eye, within the hit tolerance ε·t.
@@ -114,7 +119,12 @@ fn cpu_renders_carry_first_hit_depths() {
     // are a quarter pixel off centre, where the sphere is a little farther).
     let mut aa = scene.clone();
     aa.settings.aa = 2;
-    let r2 = cpu::render(&aa, &lower(&aa), &Options::default(), &|| {});
+    let r2 = cpu::render(
+        &aa,
+        &sdfc_compiler::lower::Lowered::new(&aa),
+        &Options::default(),
+        &|| {},
+    );
     let d2 = r2.depth.expect("depth");
     assert_eq!(d2.samples, 4);
     assert!(d2
@@ -140,7 +150,14 @@ fn depth_buffers_are_identical_whatever_the_number_of_threads() {
             .num_threads(threads)
             .build()
             .expect("pool");
-        pool.install(|| cpu::render(&scene, &lower(&scene), &Options::default(), &|| {}))
+        pool.install(|| {
+            cpu::render(
+                &scene,
+                &sdfc_compiler::lower::Lowered::new(&scene),
+                &Options::default(),
+                &|| {},
+            )
+        })
     };
     let (a, b) = (render(1), render(3));
     let (da, db) = (a.depth.expect("depth"), b.depth.expect("depth"));
@@ -161,12 +178,21 @@ fn reference_settings() {
         aa: 2,
         ..Settings::default()
     };
-    let r = reference::settings(&s);
+    let r = reference::settings(&s, true);
     assert_eq!(
-        (r.epsilon, r.max_steps, r.relaxation, r.aa),
-        (1e-6, 100_000, 1.0, 2)
+        (r.epsilon, r.footprint, r.max_steps, r.relaxation, r.aa),
+        (1e-6, false, 100_000, 1.0, 2)
     );
-    assert_eq!(reference::check_settings(&r).epsilon, 1e-7);
+    let c = reference::check_settings(&r);
+    assert_eq!((c.epsilon, c.aa), (1e-7, 2));
+    // No proven bound: the area average at the footprint's ε, checked with twice the samples.
+    let r = reference::settings(&s, false);
+    assert_eq!(
+        (r.footprint, r.max_steps, r.relaxation, r.aa),
+        (true, 100_000, 1.0, reference::AREA_AA)
+    );
+    let c = reference::check_settings(&r);
+    assert_eq!((c.footprint, c.aa), (true, 2 * reference::AREA_AA));
 }
 
 #[test]
@@ -529,4 +555,77 @@ fn pareto_measures_points_and_draws_charts() {
         .expect("run sdfc");
     assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The scene of a file of `examples/`, checked.
+fn example(name: &str) -> sdfc_compiler::scene::Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples")
+        .join(name);
+    sdfc_runtime::frontend::load(&path)
+        .expect("readable")
+        .scene
+        .expect("a valid scene")
+}
+
+#[test]
+fn a_field_without_a_proven_bound_gets_the_pixel_footprints_epsilon() {
+    // seed6's Mandelbulb has no proven bound and the file gives no ε: ε is tan(fov/2)/height.
+    let mut scene = example("seed6.sdf");
+    assert!(scene.settings.footprint);
+    assert_eq!(
+        scene.settings.relaxation, 1.0,
+        "no over-relaxation without a bound"
+    );
+    let footprint = (scene.camera.fov / 2.0).tan() / scene.settings.height as f64;
+    assert!(close(scene.epsilon(), footprint));
+    scene.settings.height *= 2;
+    assert!(
+        close(scene.epsilon(), footprint / 2.0),
+        "it follows the size"
+    );
+    // A proven field keeps the default ε; so does an ε the file or `--set` gives.
+    let proven = example("seed3.sdf");
+    assert!(!proven.settings.footprint);
+    assert_eq!((proven.epsilon(), proven.settings.relaxation), (1e-5, 1.4));
+    let limits = sdfc_compiler::Limits::default();
+    sdfc_runtime::settings::set(&mut scene.settings, "epsilon", "1e-4", &limits)
+        .expect("a valid ε");
+    assert!(!scene.settings.footprint);
+    assert_eq!(scene.epsilon(), 1e-4);
+}
+
+#[test]
+fn the_area_averaged_reference_of_a_fractal_converges() {
+    // At 80×60 (CI's budget; docs/accuracy.md has 320×240): 8×8 samples at the footprint's ε,
+    // checked against 16×16.
+    let dir = std::env::temp_dir().join(format!("sdfc-area-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed6.sdf");
+    let out = sdfc(
+        &dir,
+        &[
+            "render",
+            scene.to_str().expect("utf-8 path"),
+            "--reference",
+            "--size",
+            "80x60",
+            "--stats",
+            "-o",
+            "ref.png",
+        ],
+    );
+    let text =
+        String::from_utf8_lossy(&out.stderr).to_string() + &String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("aa 8,"),
+        "the reference averages 8×8 samples: {text}"
+    );
+    assert!(
+        text.contains("against ε") && text.contains("aa 16"),
+        "{text}"
+    );
+    assert!(text.contains("converged       yes"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -2,7 +2,6 @@
 //! traced images against sphere-traced ones of the same file, and the kernel it emits.
 
 use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::lower;
 use sdfc_compiler::scene::analytic::{choose, Choice, Reason};
 use sdfc_compiler::scene::{Method, Scene};
 use sdfc_runtime::{cpu, frontend, metrics};
@@ -54,8 +53,14 @@ fn traced_images_agree_with_marched_ones() {
         let mut scene = load(name);
         scene.settings.width = 256;
         scene.settings.height = 160;
-        let render =
-            |scene: &Scene| cpu::render(scene, &lower(scene), &cpu::Options::default(), &|| {});
+        let render = |scene: &Scene| {
+            cpu::render(
+                scene,
+                &sdfc_compiler::lower::Lowered::new(scene),
+                &cpu::Options::default(),
+                &|| {},
+            )
+        };
         let traced = render(&scene);
         scene.settings.method = Method::March;
         let marched = render(&scene);
@@ -81,7 +86,8 @@ fn traced_images_agree_with_marched_ones() {
 #[test]
 fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     let scene = load("primitives.sdf");
-    let kernel = wgsl::write(&scene, &lower(&scene)).expect("naga accepts it");
+    let kernel =
+        wgsl::write(&scene, &sdfc_compiler::lower::Lowered::new(&scene)).expect("naga accepts it");
     let src = &kernel.source;
     assert!(!src.contains("fn map(") && !src.contains("fn sdf("));
     assert!(!src.contains("fn tolerance("));
@@ -91,7 +97,8 @@ fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     assert!(src.contains("fn capsule_interval(") && src.contains("fn enters("));
     // Only the interval functions a scene uses: spheres and a plane in scene 1.
     let seed1 = load("seed1.sdf");
-    let kernel = wgsl::write(&seed1, &lower(&seed1)).expect("naga accepts it");
+    let kernel =
+        wgsl::write(&seed1, &sdfc_compiler::lower::Lowered::new(&seed1)).expect("naga accepts it");
     let fns: Vec<&str> = kernel
         .source
         .lines()
@@ -105,7 +112,8 @@ fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     assert_eq!(fns, ["sphere_interval", "plane_interval"]);
     let mut marched = scene.clone();
     marched.settings.method = Method::March;
-    let kernel = wgsl::write(&marched, &lower(&marched)).expect("naga accepts it");
+    let kernel = wgsl::write(&marched, &sdfc_compiler::lower::Lowered::new(&marched))
+        .expect("naga accepts it");
     assert!(kernel.source.contains("fn sdf(") && !kernel.source.contains("Interval"));
 }
 
@@ -152,7 +160,8 @@ fn the_kernel_of_ten_thousand_spheres_stays_small() {
     let kernel = |name: &str| {
         let scene = load(name);
         let n = choose(&scene).primitives().map(<[_]>::len);
-        let kernel = wgsl::write(&scene, &lower(&scene)).expect("naga accepts it");
+        let kernel = wgsl::write(&scene, &sdfc_compiler::lower::Lowered::new(&scene))
+            .expect("naga accepts it");
         (n, kernel)
     };
     let (n, large) = kernel("scaling/random_10000.sdf");

@@ -5,8 +5,9 @@
 
 mod common;
 
+use sdfc_compiler::back::wgsl;
+use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::Scene;
-use sdfc_compiler::{back::wgsl, lower};
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
 use std::path::{Path, PathBuf};
 
@@ -74,8 +75,8 @@ const AGREEMENT: &[(&str, f64, f64)] = &[
     ("seed3", 50.0, 0.0007),       // 53.9 dB, 0.0002 (1 px)
     ("seed4", 48.0, 0.0009),       // 51.5 dB, 0.0003 (2 px)
     ("seed5", 63.0, 0.0005),       // 66.2 dB, 0.0000 (0 px)
-    ("seed6", 52.0, 0.0007),       // 55.2 dB, 0.0002 (1 px)
-    ("temple", 54.0, 0.0007),      // 57.8 dB, 0.0002 (1 px)
+    ("seed6", 100.0, 0.0005), // 125.5 dB, 0 px (ε of the pixel footprint since issue 24: nearly identical; bound kept far below)
+    ("temple", 54.0, 0.0007), // 57.8 dB, 0.0002 (1 px)
 ];
 
 #[test]
@@ -85,10 +86,10 @@ fn wgpu_matches_cpu_on_every_example() {
     let mut failures = Vec::new();
     for path in examples() {
         let scene = load_small(&path, 96, 64);
-        let program = lower::lower(&scene);
-        let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+        let lowered = Lowered::new(&scene);
+        let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
         let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-        let on_cpu = cpu::render(&scene, &program, &cpu::Options::default(), &|| {});
+        let on_cpu = cpu::render(&scene, &lowered, &cpu::Options::default(), &|| {});
         let d =
             metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
         println!(
@@ -136,12 +137,12 @@ fn wgpu_matches_cpu_on_every_example() {
 fn assert_agree(
     gpu: &gpu::Gpu,
     scene: &sdfc_compiler::scene::Scene,
-    program: &lower::Program,
+    lowered: &Lowered,
     kernel: &wgsl::Kernel,
     label: &str,
 ) {
     let on_gpu = gpu::render(gpu, scene, kernel, 1.0, &mut |_| {}).expect("gpu render");
-    let on_cpu = cpu::render(scene, program, &cpu::Options::default(), &|| {});
+    let on_cpu = cpu::render(scene, lowered, &cpu::Options::default(), &|| {});
     let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
     println!(
         "{label}: psnr {:.1} dB, differing {:.4}",
@@ -163,15 +164,15 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
     let Some(gpu) = open_gpu() else { return };
     let path = PathBuf::from("../examples/scaling/compound_100.sdf");
     let scene = load_small(&path, 64, 48);
-    let program = lower::lower(&scene);
+    let lowered = Lowered::new(&scene);
     let options = wgsl::Options {
         max_instances: usize::MAX,
         ..wgsl::Options::default()
     };
-    let kernel = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
+    let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
     assert!(kernel.data.is_none());
-    assert_agree(&gpu, &scene, &program, &kernel, "compound_100 as code");
+    assert_agree(&gpu, &scene, &lowered, &kernel, "compound_100 as code");
 }
 
 /// A marched scene of `n` instances of every kind with closed-form distances (rotated, some
@@ -228,24 +229,24 @@ fn marched_scene(n: usize) -> String {
 fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let text = marched_scene(360);
     let scene = checked("marched.sdf", &text);
-    let program = lower::lower(&scene);
+    let lowered = Lowered::new(&scene);
     // Below the default threshold: the walk is asked for.
     let walk = wgsl::Options {
         max_instances: 256,
         ..wgsl::Options::default()
     };
-    let split = lower::split(&scene, &program.options(), walk.max_instances).expect("split");
+    let split = lowered.instances(walk.max_instances).expect("split");
     // Of 360 children, the 40 ellipsoids stay, with the plane and the twisted box.
     assert_eq!(split.instances.len(), 320);
     assert!(split.instances.iter().any(|i| i.material.is_none()));
-    let kernel = wgsl::write_with(&scene, &program, &walk).expect("valid kernel");
+    let kernel = wgsl::write_with(&scene, &lowered, &walk).expect("valid kernel");
     assert!(kernel.features.contains(&("SCENE_DATA", true)));
     assert!(kernel.source.contains("fn rest_map") && kernel.source.contains("const ROTATED"));
     let Some(gpu) = open_gpu() else { return };
     assert_agree(
         &gpu,
         &scene,
-        &program,
+        &lowered,
         &kernel,
         "320 instances and the rest",
     );
@@ -255,7 +256,7 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
         max_instances: usize::MAX,
         ..wgsl::Options::default()
     };
-    let code = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
+    let code = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
     assert!(code.data.is_none());
     let render = |k: &wgsl::Kernel| gpu::render(&gpu, &scene, k, 1.0, &mut |_| {}).expect("render");
     let (walked, written) = (render(&kernel).render, render(&code).render);
@@ -267,10 +268,10 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     assert!(d.psnr >= 50.0 && d.differing <= 0.002, "{d:?}");
     let path = PathBuf::from("../examples/scaling/compound_100.sdf");
     let scene = load_small(&path, 96, 64);
-    let program = lower::lower(&scene);
-    let kernel = wgsl::write_with(&scene, &program, &walk).expect("valid kernel");
+    let lowered = Lowered::new(&scene);
+    let kernel = wgsl::write_with(&scene, &lowered, &walk).expect("valid kernel");
     assert!(kernel.data.is_some() && !kernel.source.contains("fn map_block"));
-    assert_agree(&gpu, &scene, &program, &kernel, "compound_100");
+    assert_agree(&gpu, &scene, &lowered, &kernel, "compound_100");
 }
 
 /// A camera looking straight down (its view parallel to the default `up`) and one rolled by
@@ -286,9 +287,9 @@ fn cameras_looking_straight_down_match_the_cpu() {
              scene {{ plane((0, 1, 0), -1); sphere(1); box((0.4, 0.4, 0.4)).translate(0, 0, 2.5); }}"
         );
         let scene = checked("down.sdf", &text);
-        let program = lower::lower(&scene);
-        let kernel = wgsl::write(&scene, &program).expect("valid kernel");
-        assert_agree(&gpu, &scene, &program, &kernel, &format!("down{up}"));
+        let lowered = Lowered::new(&scene);
+        let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
+        assert_agree(&gpu, &scene, &lowered, &kernel, &format!("down{up}"));
     }
 }
 
@@ -305,10 +306,10 @@ fn glass_overlapping_solids_matches_the_cpu() {
                 render { width: 96, height: 72 }\n\
                 scene { plane((0, 1, 0), 0) @ floor; sphere(0.8) @ glass; box((0.3, 0.3, 0.3)).translate(0.5, 0.3, 0); }";
     let scene = checked("media.sdf", text);
-    let program = lower::lower(&scene);
-    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let lowered = Lowered::new(&scene);
+    let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
     assert!(kernel.features.contains(&("MEDIA", true)));
-    assert_agree(&gpu, &scene, &program, &kernel, "glass in solids");
+    assert_agree(&gpu, &scene, &lowered, &kernel, "glass in solids");
 }
 
 /// Shadow rays pass through glass on the GPU as on the CPU even when no refracted ray is
@@ -322,11 +323,11 @@ fn shadows_through_glass_match_without_secondary_rays() {
                 render { width: 64, height: 48, max_depth: 0, method: \"march\" }\n\
                 scene { plane(); sphere(0.8).translate(0, 1.2, 0) @ glass; }";
     let scene = checked("glass.sdf", text);
-    let program = lower::lower(&scene);
-    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let lowered = Lowered::new(&scene);
+    let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
     assert!(kernel.features.contains(&("TRANSPARENT", true)));
     assert!(kernel.features.contains(&("REFRACTION", false)));
-    assert_agree(&gpu, &scene, &program, &kernel, "glass shadow");
+    assert_agree(&gpu, &scene, &lowered, &kernel, "glass shadow");
 }
 
 /// `--debug-nan` on wgpu: the kernel's `DEBUG_NAN` feature paints the same pixels magenta
@@ -339,11 +340,11 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
         .expect("readable")
         .scene
         .expect("valid scene");
-    let program = lower::lower(&scene);
+    let lowered = Lowered::new(&scene);
     let magenta = |image: &sdfc_runtime::image::Image| -> Vec<bool> {
         image.linear.iter().map(|&c| c == cpu::NAN_COLOUR).collect()
     };
-    let plain_kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let plain_kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
     assert!(!plain_kernel.source.contains("DEBUG_NAN"));
     let plain = gpu::render(&gpu, &scene, &plain_kernel, 1.0, &mut |_| {}).expect("render");
     assert!(plain.render.stats.counters.nans > 0, "no NaN on the GPU");
@@ -352,14 +353,14 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
         debug_nan: true,
         ..wgsl::Options::default()
     };
-    let kernel = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
+    let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
     assert!(kernel.source.contains("+DEBUG_NAN"));
     let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("render");
     let cpu_options = cpu::Options {
         debug_nan: true,
         ..cpu::Options::default()
     };
-    let on_cpu = cpu::render(&scene, &program, &cpu_options, &|| {});
+    let on_cpu = cpu::render(&scene, &lowered, &cpu_options, &|| {});
     let (g, c) = (magenta(&on_gpu.render.image), magenta(&on_cpu.image));
     let differ = g.iter().zip(&c).filter(|(a, b)| a != b).count();
     let marked = g.iter().filter(|&&m| m).count();
@@ -424,18 +425,18 @@ fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
     let scene = checked("mixed.sdf", &text);
     let traced = sdfc_compiler::scene::analytic::choose(&scene);
     assert_eq!(traced.primitives().map(<[_]>::len), Some(302), "{traced:?}");
-    let program = lower::lower(&scene);
-    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let lowered = Lowered::new(&scene);
+    let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
     assert!(kernel.features.contains(&("SCENE_DATA", true)));
     assert!(kernel.data.is_some() && !kernel.source.contains("P0_R0"));
     let Some(gpu) = open_gpu() else { return };
-    assert_agree(&gpu, &scene, &program, &kernel, "302 mixed primitives");
+    assert_agree(&gpu, &scene, &lowered, &kernel, "302 mixed primitives");
     let path = PathBuf::from("../examples/scaling/random_1000.sdf");
     let scene = load_small(&path, 96, 64);
-    let program = lower::lower(&scene);
-    let kernel = wgsl::write(&scene, &program).expect("valid kernel");
+    let lowered = Lowered::new(&scene);
+    let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
     assert!(kernel.data.is_some());
-    assert_agree(&gpu, &scene, &program, &kernel, "random_1000");
+    assert_agree(&gpu, &scene, &lowered, &kernel, "random_1000");
 }
 
 /// The walk over `scene_data` tests the primitives and groups of the unrolled code in the same
@@ -446,13 +447,13 @@ fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
 fn the_buffer_walk_renders_what_the_unrolled_code_renders() {
     let text = mixed_scene(40);
     let scene = checked("mixed.sdf", &text);
-    let program = lower::lower(&scene);
-    let unrolled = wgsl::write(&scene, &program).expect("valid kernel");
+    let lowered = Lowered::new(&scene);
+    let unrolled = wgsl::write(&scene, &lowered).expect("valid kernel");
     let options = wgsl::Options {
         max_unrolled: 0,
         ..wgsl::Options::default()
     };
-    let walked = wgsl::write_with(&scene, &program, &options).expect("valid kernel");
+    let walked = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
     assert!(unrolled.data.is_none() && walked.data.is_some());
     let Some(gpu) = open_gpu() else { return };
     let render = |k: &wgsl::Kernel| gpu::render(&gpu, &scene, k, 1.0, &mut |_| {}).expect("render");
@@ -492,9 +493,9 @@ fn a_sweep_of_relaxation_on_wgpu_takes_effect() {
          render { width: 64, height: 48, relaxation: 1, method: \"march\" }
          scene { plane(); sphere(1).translate(0, 1, 0); torus(1, 0.2).translate(0, 0.3, 1); }",
     );
-    let program = lower::lower(&plain);
+    let lowered = Lowered::new(&plain);
     let mut prepared =
-        Prepared::from_program(Backend::Wgpu, &plain, program.clone(), &Setup::default())
+        Prepared::from_program(Backend::Wgpu, &plain, lowered.clone(), &Setup::default())
             .expect("wgpu");
     let steps = |p: &Prepared, s: &Scene| {
         p.render(s, &|_| {})
@@ -515,10 +516,10 @@ fn a_sweep_of_relaxation_on_wgpu_takes_effect() {
     );
     prepared.specialise(&relaxed).expect("specialised again");
     let at_relaxed = steps(&prepared, &relaxed);
-    let cpu_one = cpu::render(&plain, &program, &cpu::Options::default(), &|| {})
+    let cpu_one = cpu::render(&plain, &lowered, &cpu::Options::default(), &|| {})
         .stats
         .steps_mean;
-    let cpu_relaxed = cpu::render(&relaxed, &program, &cpu::Options::default(), &|| {})
+    let cpu_relaxed = cpu::render(&relaxed, &lowered, &cpu::Options::default(), &|| {})
         .stats
         .steps_mean;
     println!(

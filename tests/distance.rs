@@ -7,7 +7,8 @@ mod common;
 
 use common::*;
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower, lower_with, LowerOptions, Program};
+use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
+use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
 
 /// Distance (and material) of a program at many points, in f32 through the batch path.

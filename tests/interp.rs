@@ -6,7 +6,8 @@ mod common;
 
 use common::*;
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower, lower_with, LowerOptions, Program};
+use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
+use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
 
 /// A scene that uses most operations: smooth blends, repetition, twist, bend, rotation,

@@ -8,7 +8,7 @@
 #![allow(unsafe_code)] // A global allocator is an unsafe trait; it only forwards to `System`.
 
 use sdfc_compiler::check::check_str;
-use sdfc_compiler::lower;
+use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::Scene;
 use sdfc_runtime::backend::{Backend, Prepared, Setup};
 use sdfc_runtime::cpu::{self, Options, Precision, Tapes};
@@ -130,7 +130,7 @@ fn renders_stay_within_the_memory_they_announce() {
         .expect("thread pool");
     // Warm the pool and its thread-local state before measuring.
     let warm = scene(16, 16, 1);
-    pool.install(|| cpu::render(&warm, &lower::lower(&warm), &Options::default(), &|| {}));
+    pool.install(|| cpu::render(&warm, &Lowered::new(&warm), &Options::default(), &|| {}));
     for (text, width, height, aa, precision) in [
         (SCENE, 64, 48, 1, Precision::F32),
         (SCENE, 120, 90, 3, Precision::F32),
@@ -144,8 +144,8 @@ fn renders_stay_within_the_memory_they_announce() {
             .primitives()
             .is_some();
         assert_eq!(traced, text == TRACED);
-        let program = lower::lower(&scene);
-        let tapes = Tapes::new(&program);
+        let lowered = Lowered::new(&scene);
+        let tapes = Tapes::new(&lowered);
         let options = Options {
             precision,
             ..Options::default()
@@ -172,9 +172,10 @@ fn renders_stay_within_the_memory_they_announce() {
         let setup = Setup {
             precision,
             debug_nan: false,
+            parameters: false,
         };
         let prepared = pool.install(|| {
-            Prepared::from_program(Backend::Cpu, &scene, program.clone(), &setup).expect("cpu")
+            Prepared::from_program(Backend::Cpu, &scene, lowered.clone(), &setup).expect("cpu")
         });
         let announced = pool.install(|| memory::render(&prepared, &scene, false, true));
         assert_eq!(announced.device, 0);

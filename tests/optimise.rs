@@ -9,7 +9,8 @@ mod common;
 use common::*;
 use sdfc_compiler::back::{rust, wgsl};
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower_with, LowerOptions, Op, Program};
+use sdfc_compiler::lower::{lower_scene, lower_with, LowerOptions, Lowered};
+use sdfc_compiler::program::{Op, Program};
 use sdfc_compiler::scene::{Method, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision};
 use sdfc_runtime::frontend;
@@ -20,22 +21,26 @@ const CULL: LowerOptions = LowerOptions {
     level: 1,
     cull: true,
     local: true,
+    parametric: false,
 };
 const NO_CULL: LowerOptions = LowerOptions {
     level: 1,
     cull: false,
     local: true,
+    parametric: false,
 };
 /// Every pass, without local bounds: the field as written, for comparing values.
 const WRITTEN: LowerOptions = LowerOptions {
     level: 1,
     cull: true,
     local: false,
+    parametric: false,
 };
 const LITERAL: LowerOptions = LowerOptions {
     level: 0,
     cull: false,
     local: false,
+    parametric: false,
 };
 
 /// The `.sdf` files directly inside `dir` (relative to the workspace root), sorted.
@@ -105,7 +110,7 @@ fn culling_never_changes_an_image() {
         scene.settings.width = 64;
         scene.settings.height = 48;
         scene.settings.aa = 1;
-        let (on, off) = (lower_with(&scene, &CULL), lower_with(&scene, &NO_CULL));
+        let (on, off) = (lower_scene(&scene, &CULL), lower_scene(&scene, &NO_CULL));
         for precision in [Precision::F32, Precision::F64] {
             let options = Options {
                 precision,
@@ -261,9 +266,9 @@ fn executed(program: &Program, p: [f32; 3]) -> usize {
 }
 
 fn step(program: &Program, regs: &[f32], i: usize, p: [f32; 3]) -> f32 {
-    use sdfc_compiler::eval::scalar;
-    use sdfc_compiler::lower::Axis;
-    let r = |x: sdfc_compiler::lower::Reg| regs[x.0 as usize];
+    use sdfc_compiler::program::scalar;
+    use sdfc_compiler::program::Axis;
+    let r = |x: sdfc_compiler::program::Reg| regs[x.0 as usize];
     match program.ops()[i] {
         Op::Const(c) => c as f32,
         Op::Input(Axis::X) => p[0],
@@ -362,12 +367,13 @@ fn instruction_counts_drop() {
 #[test]
 fn generated_code_handles_blocks() {
     let scene = load(Path::new("../examples/scaling/random_100.sdf"));
-    let program = lower_with(&scene, &CULL);
+    let lowered = lower_scene(&scene, &CULL);
+    let program = &lowered.program;
     assert!(!program.blocks().is_empty());
-    let kernel = wgsl::write(&scene, &program).expect("naga accepts the kernel");
+    let kernel = wgsl::write(&scene, &lowered).expect("naga accepts the kernel");
     let ifs = kernel.source.matches("if !(r").count();
     assert!(ifs >= program.blocks().len(), "{ifs} ifs");
-    let text = rust::write(&program);
+    let text = rust::write(program);
     // Two functions (f32 and f64), one `if` per block in each.
     assert_eq!(text.matches("if !(r").count(), 2 * program.blocks().len());
     let dump = program.dump();
@@ -377,13 +383,13 @@ fn generated_code_handles_blocks() {
 }
 
 /// Median time of `frames` CPU frames (after one untimed frame) at the given size.
-fn time_frames(scene: &Scene, program: &Program, frames: usize) -> f64 {
+fn time_frames(scene: &Scene, lowered: &Lowered, frames: usize) -> f64 {
     let options = Options::default();
-    let _ = cpu::render(scene, program, &options, &|| {});
+    let _ = cpu::render(scene, lowered, &options, &|| {});
     let mut times: Vec<f64> = (0..frames)
         .map(|_| {
             let start = Instant::now();
-            let _ = cpu::render(scene, program, &options, &|| {});
+            let _ = cpu::render(scene, lowered, &options, &|| {});
             start.elapsed().as_secs_f64() * 1e3
         })
         .collect();
@@ -433,12 +439,12 @@ fn report() {
         let t0 = if slow {
             f64::NAN
         } else {
-            time_frames(&scene, &literal, 3)
+            time_frames(&scene, &lower_scene(&scene, &LITERAL), 3)
         };
         let t1 = if std::env::var("SDFC_REPORT_NO_TIME").is_ok() {
             f64::NAN
         } else {
-            time_frames(&scene, &culled, 3)
+            time_frames(&scene, &lower_scene(&scene, &CULL), 3)
         };
 
         println!(

@@ -734,8 +734,8 @@ fn example_scenes_assemble() {
                 sdfc_compiler::diagnostics::render(&loaded.diagnostics, &loaded.sources, false)
             )
         };
-        let program = sdfc_compiler::lower::lower(&scene);
-        let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         keep(&format!("scene_{name}.wgsl"), kernel.source.as_bytes());
         keep(
@@ -775,13 +775,13 @@ fn example_scenes_assemble() {
 fn the_debug_nan_kernel_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/in/ok/nan_at_run_time.sdf");
     let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-    let program = sdfc_compiler::lower::lower(&scene);
+    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
     let debug = sdfc_compiler::back::wgsl::Options {
         debug_nan: true,
         ..Default::default()
     };
-    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &program, &debug).unwrap();
-    let plain = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &debug).unwrap();
+    let plain = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
     let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
     let without = ptx::write(&plain.module, &plain.info, &options(80)).unwrap();
     assert_ne!(text, without, "the feature changes the kernel");
@@ -796,13 +796,13 @@ fn the_debug_nan_kernel_assembles() {
 fn a_kernel_with_outlined_blocks_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/compound_100.sdf");
     let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-    let program = sdfc_compiler::lower::lower(&scene);
+    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
     // Its 400 instances written as code, not read from `scene_data`.
     let code = sdfc_compiler::back::wgsl::Options {
         max_instances: usize::MAX,
         ..Default::default()
     };
-    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &program, &code).unwrap();
+    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &code).unwrap();
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
     let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
     assert!(text.contains(".entry"));
@@ -828,8 +828,8 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
         let path =
             Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../examples/scaling/{name}.sdf"));
         let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-        let program = sdfc_compiler::lower::lower(&scene);
-        let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());
         keep(&format!("buffer_{name}.data"), data);
@@ -871,8 +871,8 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
     let random = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
     let ptxas = ptxas();
     for (name, scene) in [("mixed", mixed), ("random_10000", random)] {
-        let program = sdfc_compiler::lower::lower(&scene);
-        let kernel = sdfc_compiler::back::wgsl::write(&scene, &program).unwrap();
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("read from a buffer");
         keep(&format!("buffer_{name}.data"), data);
         let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();

@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use sdfc_compiler::lower::lower;
+use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::{Light, Method, Node, Pattern, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision, Render};
 
@@ -21,7 +21,7 @@ const METHODS: [Method; 2] = [Method::March, Method::Auto];
 fn render_as(method: Method, scene: &Scene) -> Render {
     let mut scene = scene.clone();
     scene.settings.method = method;
-    cpu::render(&scene, &lower(&scene), &Options::default(), &|| {})
+    cpu::render(&scene, &Lowered::new(&scene), &Options::default(), &|| {})
 }
 
 fn render_with(scene: &Scene, options: &Options, threads: usize) -> Render {
@@ -29,7 +29,7 @@ fn render_with(scene: &Scene, options: &Options, threads: usize) -> Render {
         .num_threads(threads)
         .build()
         .expect("thread pool");
-    pool.install(|| cpu::render(scene, &lower(scene), options, &|| {}))
+    pool.install(|| cpu::render(scene, &Lowered::new(scene), options, &|| {}))
 }
 
 /// The camera of docs/rendering.md, "Camera", written again for a camera whose `up` is not
@@ -523,7 +523,7 @@ fn debug_nan_paints_the_pixels_whose_rays_met_nan_magenta() {
     assert!(!plain.image.linear.iter().any(|&c| is_magenta(c)));
     let debug = cpu::render(
         &scene,
-        &lower(&scene),
+        &Lowered::new(&scene),
         &Options {
             debug_nan: true,
             ..Options::default()
@@ -550,7 +550,7 @@ fn debug_nan_paints_the_pixels_whose_rays_met_nan_magenta() {
     // In f64 nothing overflows: no NaN, nothing painted.
     let f64 = cpu::render(
         &scene,
-        &lower(&scene),
+        &Lowered::new(&scene),
         &Options {
             debug_nan: true,
             precision: Precision::F64,

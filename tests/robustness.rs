@@ -141,8 +141,8 @@ fn front_end(text: &str) {
     let _ = sdfc_compiler::diagnostics::render(&diags, &sources, false);
     if let Some(scene) = scene {
         let options = lower::LowerOptions::default();
-        if let Ok(program) = lower::lower_within(&scene, &options, &limits) {
-            let _ = program.dump();
+        if let Ok(lowered) = lower::lower_within(&scene, &options, &limits) {
+            let _ = lowered.program.dump();
         }
     }
 }

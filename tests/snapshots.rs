@@ -5,7 +5,8 @@
 
 mod common;
 
-use sdfc_compiler::{back, diagnostics, lower, scene, syntax, FileId};
+use sdfc_compiler::lower::Lowered;
+use sdfc_compiler::{back, diagnostics, scene, syntax, FileId};
 use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};
 
@@ -52,9 +53,9 @@ fn check_valid(dir: &str, prefix: &str, ptx: bool) {
         let name = format!("{prefix}{}", stem(&path));
         snapshot("ast", &name, &syntax::dump(&ast));
         snapshot("ir", &name, &scene::dump(&scene));
-        let program = lower::lower(&scene);
-        snapshot("program", &name, &program.dump());
-        let kernel = back::wgsl::write(&scene, &program)
+        let lowered = Lowered::new(&scene);
+        snapshot("program", &name, &lowered.program.dump());
+        let kernel = back::wgsl::write(&scene, &lowered)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         snapshot("wgsl", &name, &kernel.source);
         if ptx {

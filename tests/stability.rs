@@ -28,7 +28,7 @@
 //! its steps; where the analysis proves nothing, the numbers are only reported.
 
 use sdfc_compiler::check::check_str;
-use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
+use sdfc_compiler::lower::{lower_scene, LowerOptions, Lowered};
 use sdfc_compiler::scene::analytic::{self, Choice};
 use sdfc_compiler::scene::{analysis, Method, Scene, Settings};
 use sdfc_runtime::backend::{Backend, Prepared};
@@ -195,17 +195,17 @@ fn nan_pixels(r: &Render) -> usize {
 
 /// The f32 CPU render of `scene` as the backends render it (with local bounds).
 fn render(scene: &Scene) -> Render {
-    let program = lower(scene);
+    let lowered = Lowered::new(scene);
     let options = Options {
-        lipschitz: program.lipschitz(),
+        lipschitz: lowered.program.lipschitz(),
         ..Options::default()
     };
-    cpu::render(scene, &program, &options, &|| {})
+    cpu::render(scene, &lowered, &options, &|| {})
 }
 
 /// The f32 CPU render of the field as written (no local bounds), stepping with `lipschitz`.
 fn render_global(scene: &Scene, lipschitz: f64) -> Render {
-    let program = lower_with(
+    let lowered = lower_scene(
         scene,
         &LowerOptions {
             local: false,
@@ -216,12 +216,12 @@ fn render_global(scene: &Scene, lipschitz: f64) -> Render {
         lipschitz,
         ..Options::default()
     };
-    cpu::render(scene, &program, &options, &|| {})
+    cpu::render(scene, &lowered, &options, &|| {})
 }
 
 /// The f64 reference: ε = 1e-6, 100 000 steps, no over-relaxation, steps of f / `lipschitz`.
 fn render_reference(scene: &Scene, lipschitz: f64) -> Render {
-    let settings: Settings = reference::settings(&scene.settings);
+    let settings: Settings = reference::settings(&scene.settings, true);
     let scene = Scene {
         settings,
         ..scene.clone()
@@ -231,7 +231,7 @@ fn render_reference(scene: &Scene, lipschitz: f64) -> Render {
         precision: Precision::F64,
         ..Options::default()
     };
-    cpu::render(&scene, &lower(&scene), &options, &|| {})
+    cpu::render(&scene, &Lowered::new(&scene), &options, &|| {})
 }
 
 fn depth(r: &Render) -> &Depth {

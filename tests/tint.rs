@@ -11,7 +11,8 @@
 //! for a set of feature combinations holding every pair of values of two features, then
 //! reports each error with the kernel's name. The examples are `examples/*.sdf`,
 //! `examples/scaling/*_10.sdf` and `*_1000.sdf` (whose instances are read from `scene_data`),
-//! and `tests/in/ok/*.sdf`.
+//! and `tests/in/ok/*.sdf`; and `examples/animation/*.sdf` as a sequence's kernels are
+//! written, their constants read from `scene_data` (`Options::parameters`), with pipelines.
 //!
 //! The browser is `$SDFC_CHROMIUM`, or `chromium` (Debian's package) on PATH. Without it, or
 //! without a WebGPU adapter, the test prints that it skipped, unless `CI=true` or
@@ -21,7 +22,6 @@
 
 use rayon::prelude::*;
 use sdfc_compiler::back::wgsl::{self, Options};
-use sdfc_compiler::lower;
 use sdfc_runtime::frontend;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, BufReader, Read, Write};
@@ -125,20 +125,27 @@ fn example_jobs() -> Vec<Job> {
         n.ends_with("_10") || n.ends_with("_1000")
     });
     let ok = sdf_files("tests/in/ok", |_| true);
+    let animated = sdf_files("examples/animation", |_| true);
     let all = examples.iter().chain(&scaling).chain(&ok).map(|p| {
         let seed = p
             .file_stem()
             .is_some_and(|s| s.to_string_lossy().starts_with("seed"));
-        (p, seed || all_pipelines())
+        (p, seed || all_pipelines(), false)
     });
-    all.map(|(path, pipeline)| {
+    let all = all.chain(animated.iter().map(|p| (p, true, true)));
+    all.map(|(path, pipeline, parameters)| {
         let loaded = frontend::load(path).expect("readable");
         let scene = loaded
             .scene
             .unwrap_or_else(|| panic!("{} has errors", path.display()));
-        let program = lower::lower(&scene);
-        let kernel =
-            wgsl::write(&scene, &program).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let options = Options {
+            parameters,
+            ..Options::default()
+        };
+        let kernel = wgsl::write_with(&scene, &lowered, &options)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!(kernel.features.contains(&("PARAMS", true)), parameters);
         let name = path
             .strip_prefix("..")
             .unwrap_or(path)
@@ -301,8 +308,8 @@ fn combo_jobs() -> Vec<Job> {
             let (text, options) = combo.scene();
             let (scene, diags, _) = sdfc_compiler::check::check_str("features.sdf", &text);
             let scene = scene.unwrap_or_else(|| panic!("{}:\n{text}\n{diags:?}", combo.name()));
-            let program = lower::lower(&scene);
-            let kernel = wgsl::write_with(&scene, &program, &options)
+            let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+            let kernel = wgsl::write_with(&scene, &lowered, &options)
                 .unwrap_or_else(|e| panic!("{}: {e}", combo.name()));
             assert!(
                 combo_of(&kernel) == combo,

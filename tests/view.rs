@@ -280,6 +280,24 @@ fn follows_edits(name: &str, display: Option<&Display>, args: &[&str]) {
         stderr.contains("edit to pixel"),
         "--timings prints the reloads' timings:\n{stderr}"
     );
+    if name == "wgpu" {
+        // The numeric edit keeps the kernel (its constants are read from `scene_data`); the
+        // structural edit builds a new one.
+        let load = |k: u32| {
+            stderr
+                .lines()
+                .find(|l| l.contains(&format!("load {k} timings")))
+                .unwrap_or_default()
+        };
+        assert!(
+            load(1).contains("kernel kept (numbers only)"),
+            "a numeric edit keeps the wgpu kernel:\n{stderr}"
+        );
+        assert!(
+            load(2).contains(", kernel ") && !load(2).contains("kept"),
+            "a structural edit builds a new kernel:\n{stderr}"
+        );
+    }
     eprintln!("{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
 }

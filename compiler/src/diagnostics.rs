@@ -226,6 +226,13 @@ impl ariadne::Cache<crate::span::FileId> for SourceCache<'_> {
     }
 }
 
+/// A small number for a message in scientific notation, rounded to three significant
+/// digits: `9.71e-4`, `1e-6`.
+pub fn scientific(x: f64) -> String {
+    let rounded: f64 = format!("{x:.2e}").parse().unwrap_or(x);
+    format!("{rounded:e}")
+}
+
 /// A number for a message: at most `decimals` decimals, no trailing zeros, no `-0`, and `∞`
 /// for an infinite value.
 pub fn number(x: f64, decimals: usize) -> String {

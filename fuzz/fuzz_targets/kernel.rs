@@ -15,8 +15,8 @@ fuzz_target!(|data: &[u8]| {
     if scene.graph.len() > KERNEL_LIMIT {
         return;
     }
-    let program = sdfc_compiler::lower::lower(&scene);
-    let kernel = match wgsl::write(&scene, &program) {
+    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let kernel = match wgsl::write(&scene, &lowered) {
         Ok(k) => k,
         Err(e) => panic!("invalid kernel for an accepted scene: {e}"),
     };

@@ -4,10 +4,11 @@
 
 use crate::cpu::{self, Options, Precision, Render, Tapes};
 use crate::gpu::{self, cuda::Cuda, Gpu};
-use crate::memory::Memory;
+use crate::memory::{self, Memory};
 use sdfc_compiler::back::{ptx, wgsl};
-use sdfc_compiler::lower::{self, Program};
-use sdfc_compiler::scene::analytic::{self, Choice};
+use sdfc_compiler::lower::{self, LowerOptions, Lowered};
+use sdfc_compiler::program::Program;
+use sdfc_compiler::scene::analytic::{self, Choice, Traceable};
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -33,6 +34,10 @@ pub struct Setup {
     pub precision: Precision,
     /// Paint pixels whose rays met a NaN magenta (`--debug-nan`).
     pub debug_nan: bool,
+    /// GPU kernels read their distance program's constants from `scene_data`
+    /// (`wgsl::Options::parameters`), so that [`Prepared::update`] reuses a kernel for a
+    /// program that differs only in numbers (the frames of an animation).
+    pub parameters: bool,
 }
 
 /// A scene prepared for one backend.
@@ -45,17 +50,17 @@ pub enum Prepared {
         options: Options,
     },
     /// wgpu: the device (which may be shared, as the viewer shares its window's), the
-    /// validated kernel and the scene's Lipschitz bound L (and the program and setup, to
-    /// specialise the kernel again for other settings).
+    /// validated kernel and the scene's Lipschitz bound L (and the lowered scene and setup,
+    /// to specialise the kernel again for other settings).
     Wgpu {
         gpu: Arc<Gpu>,
         kernel: Box<wgsl::Kernel>,
         lipschitz: f64,
-        program: Box<Program>,
+        lowered: Box<Lowered>,
         setup: Setup,
     },
     /// CUDA: the device, the loaded module, the kernel's scene data, the settings it was
-    /// specialised for and the scene's Lipschitz bound L (and the program and setup, to
+    /// specialised for and the scene's Lipschitz bound L (and the lowered scene and setup, to
     /// specialise the kernel again for other settings).
     Cuda {
         cuda: Box<Cuda>,
@@ -64,8 +69,10 @@ pub enum Prepared {
         specialisation: wgsl::Specialisation,
         ptx_time: Duration,
         lipschitz: f64,
-        program: Box<Program>,
+        lowered: Box<Lowered>,
         setup: Setup,
+        /// The WGSL text the module was translated from.
+        source: String,
     },
 }
 
@@ -75,6 +82,7 @@ struct CudaModule {
     data: Option<Vec<u8>>,
     specialisation: wgsl::Specialisation,
     ptx_time: Duration,
+    source: String,
 }
 
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
@@ -89,10 +97,16 @@ pub struct Frame {
 }
 
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
-/// does not allow it, saying why.
+/// does not allow it, saying why (before lowering: `sdfc render` refuses such settings
+/// first).
 pub fn method_allowed(scene: &Scene) -> Result<(), String> {
+    traceable_with(scene, &analytic::traceable(scene))
+}
+
+/// [`method_allowed`] for a scene whose primitives the lowering found (`traceable`).
+fn traceable_with(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
     if scene.settings.method == Method::Trace {
-        if let Choice::March(reason) = analytic::choose(scene) {
+        if let Choice::March(reason) = traceable.choose(scene.settings.method) {
             return Err(format!(
                 "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
                 reason.describe()
@@ -109,100 +123,161 @@ impl Prepared {
             precision,
             ..Setup::default()
         };
-        Self::from_program(backend, scene, lower::lower(scene), &setup)
+        let lowered = lower::lower_scene(scene, &LowerOptions::default());
+        Self::from_program(backend, scene, lowered, &setup)
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for `backend`.
+    /// Prepares `scene`, lowered as `lowered` (its program and what else the backends
+    /// read), for `backend`.
     pub fn from_program(
         backend: Backend,
         scene: &Scene,
-        program: Program,
+        lowered: Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        method_allowed(scene)?;
+        traceable_with(scene, &lowered.traceable)?;
         match backend {
-            Backend::Cpu => Ok(Self::cpu(scene, program, setup)),
-            Backend::Wgpu => Self::wgpu(scene, &program, setup, false),
-            Backend::Cuda => Self::cuda(scene, &program, setup),
-            Backend::Auto if setup.precision == Precision::F64 => {
-                Ok(Self::cpu(scene, program, setup))
-            }
-            Backend::Auto => Self::cuda(scene, &program, setup)
-                .or_else(|_| Self::wgpu(scene, &program, setup, true))
-                .or_else(|_| Ok(Self::cpu(scene, program, setup))),
+            Backend::Cpu => Ok(Self::cpu(lowered, setup)),
+            Backend::Wgpu => Self::wgpu(scene, &lowered, setup, false),
+            Backend::Cuda => Self::cuda(scene, &lowered, setup),
+            Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(lowered, setup)),
+            Backend::Auto => Self::cuda(scene, &lowered, setup)
+                .or_else(|_| Self::wgpu(scene, &lowered, setup, true))
+                .or_else(|_| Ok(Self::cpu(lowered, setup))),
         }
     }
 
-    fn cpu(scene: &Scene, program: Program, setup: &Setup) -> Prepared {
+    fn cpu(lowered: Lowered, setup: &Setup) -> Prepared {
         let options = Options {
             precision: setup.precision,
             debug_nan: setup.debug_nan,
-            lipschitz: program.lipschitz(),
+            lipschitz: lowered.program.lipschitz(),
             ..Options::default()
         };
         Prepared::Cpu {
-            tapes: Box::new(Tapes::for_scene(scene, &program)),
-            program,
+            tapes: Box::new(Tapes::new(&lowered)),
+            program: lowered.program,
             options,
         }
     }
 
-    fn kernel(scene: &Scene, program: &Program, setup: &Setup) -> Result<wgsl::Kernel, String> {
-        let options = wgsl::Options {
+    fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, String> {
+        wgsl::write_with(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
+    }
+
+    fn kernel_options(setup: &Setup) -> wgsl::Options {
+        wgsl::Options {
             debug_nan: setup.debug_nan,
+            parameters: setup.parameters,
             ..wgsl::Options::default()
-        };
-        wgsl::write_with(scene, program, &options).map_err(|e| e.to_string())
+        }
+    }
+
+    /// The text and data of the kernel for `scene`, not validated (to compare with a kernel
+    /// held).
+    fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, String> {
+        wgsl::write_text(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
     }
 
     fn wgpu(
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
         require_hardware: bool,
     ) -> Result<Prepared, String> {
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
-        Self::on_gpu(Arc::new(gpu), scene, program, setup)
+        Self::on_gpu(Arc::new(gpu), scene, lowered, setup)
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for wgpu on an already opened
-    /// device: generates and validates the kernel (its pipeline is compiled, or found in the
+    /// Prepares `scene`, lowered as `lowered`, for wgpu on an already opened device:
+    /// generates and validates the kernel (its pipeline is compiled, or found in the
     /// device's cache, at the first render or by [`Gpu::pipeline_for`]).
     pub fn on_gpu(
         gpu: Arc<Gpu>,
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        method_allowed(scene)?;
-        let lipschitz = program.lipschitz();
-        Ok(Prepared::Wgpu {
+        Self::on_gpu_after(gpu, scene, lowered, setup, None).map(|(p, _)| p)
+    }
+
+    /// [`Prepared::on_gpu`], reusing `held`'s validated kernel when the new kernel's text is
+    /// the same (with [`Setup::parameters`], a program that differs from `held`'s only in
+    /// numbers): only its `scene_data` is new. Also says whether a kernel was built.
+    fn on_gpu_after(
+        gpu: Arc<Gpu>,
+        scene: &Scene,
+        lowered: &Lowered,
+        setup: &Setup,
+        held: Option<&wgsl::Kernel>,
+    ) -> Result<(Prepared, bool), String> {
+        traceable_with(scene, &lowered.traceable)?;
+        let (kernel, built) = match held {
+            Some(held) => {
+                let text = Self::kernel_text(scene, lowered, setup)?;
+                if text.source == held.source {
+                    let mut kernel = held.clone();
+                    kernel.data = text.data;
+                    (kernel, false)
+                } else {
+                    (Self::kernel(scene, lowered, setup)?, true)
+                }
+            }
+            None => (Self::kernel(scene, lowered, setup)?, true),
+        };
+        let prepared = Prepared::Wgpu {
             gpu,
-            kernel: Box::new(Self::kernel(scene, program, setup)?),
-            lipschitz,
-            program: Box::new(program.clone()),
+            kernel: Box::new(kernel),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
             setup: *setup,
-        })
+        };
+        Ok((prepared, built))
     }
 
-    /// Prepares `scene`, whose distance program is `program`, for the CPU renderer.
-    pub fn on_cpu(scene: &Scene, program: Program, setup: &Setup) -> Result<Prepared, String> {
-        method_allowed(scene)?;
-        Ok(Self::cpu(scene, program, setup))
+    /// `scene`, lowered as `lowered`, prepared as this is (the same backend, device and
+    /// setup), leaving this as it is: a wgpu kernel whose text is unchanged is reused
+    /// ([`Prepared::on_gpu_after`]); the CPU's tapes are made again. Also says whether a
+    /// kernel (or the tapes) was built. The viewer keeps its last good scene until the new one
+    /// is ready; a sequence replaces its scene with [`Prepared::update`].
+    pub fn next(&self, scene: &Scene, lowered: Lowered) -> Result<(Prepared, bool), String> {
+        match self {
+            Prepared::Cpu { options, .. } => {
+                let setup = Setup {
+                    precision: options.precision,
+                    debug_nan: options.debug_nan,
+                    parameters: false,
+                };
+                Ok((Self::on_cpu(scene, lowered, &setup)?, true))
+            }
+            Prepared::Wgpu {
+                gpu, kernel, setup, ..
+            } => Self::on_gpu_after(gpu.clone(), scene, &lowered, setup, Some(kernel)),
+            Prepared::Cuda { .. } => {
+                Err("a CUDA kernel is prepared again with Prepared::update".into())
+            }
+        }
     }
 
-    fn cuda(scene: &Scene, program: &Program, setup: &Setup) -> Result<Prepared, String> {
+    /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
+    pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
+        traceable_with(scene, &lowered.traceable)?;
+        Ok(Self::cpu(lowered, setup))
+    }
+
+    fn cuda(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<Prepared, String> {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
-        let module = Self::cuda_module(&cuda, scene, program, setup)?;
+        let module = Self::cuda_module(&cuda, scene, lowered, setup)?;
         Ok(Prepared::Cuda {
             cuda: Box::new(cuda),
             loaded: Box::new(module.loaded),
             data: module.data,
             specialisation: module.specialisation,
             ptx_time: module.ptx_time,
-            lipschitz: program.lipschitz(),
-            program: Box::new(program.clone()),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
             setup: *setup,
+            source: module.source,
         })
     }
 
@@ -210,10 +285,14 @@ impl Prepared {
     fn cuda_module(
         cuda: &Cuda,
         scene: &Scene,
-        program: &Program,
+        lowered: &Lowered,
         setup: &Setup,
     ) -> Result<CudaModule, String> {
-        let kernel = Self::kernel(scene, program, setup)?;
+        Self::cuda_module_of(cuda, Self::kernel(scene, lowered, setup)?)
+    }
+
+    /// Translates `kernel` to PTX and loads it on `cuda`.
+    fn cuda_module_of(cuda: &Cuda, kernel: wgsl::Kernel) -> Result<CudaModule, String> {
         let start = Instant::now();
         let options = ptx::Options {
             sm: cuda.sm,
@@ -229,7 +308,51 @@ impl Prepared {
             data: kernel.data,
             specialisation: kernel.specialisation,
             ptx_time,
+            source: kernel.source,
         })
+    }
+
+    /// Prepares `scene`, lowered as `lowered`, in place of the scene this was prepared for,
+    /// keeping the device: a GPU kernel whose text is unchanged (with [`Setup::parameters`], a
+    /// program that differs only in numbers) is kept and given the new `scene_data`; another
+    /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
+    pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+        method_allowed(scene)?;
+        traceable_with(scene, &lowered.traceable)?;
+        match self {
+            Prepared::Cpu { .. } | Prepared::Wgpu { .. } => {
+                let (next, built) = self.next(scene, lowered)?;
+                *self = next;
+                Ok(built)
+            }
+            Prepared::Cuda {
+                cuda,
+                loaded,
+                data,
+                specialisation,
+                ptx_time,
+                lipschitz,
+                lowered: held,
+                setup,
+                source,
+            } => {
+                let text = Self::kernel_text(scene, &lowered, setup)?;
+                let built = text.source != *source;
+                if built {
+                    let module = Self::cuda_module_of(cuda, Self::kernel(scene, &lowered, setup)?)?;
+                    **loaded = module.loaded;
+                    *data = module.data;
+                    *specialisation = module.specialisation;
+                    *ptx_time = module.ptx_time;
+                    *source = module.source;
+                } else {
+                    *data = text.data;
+                }
+                *lipschitz = lowered.program.lipschitz();
+                **held = lowered;
+                Ok(built)
+            }
+        }
     }
 
     /// The settings a GPU kernel was specialised for (`None` on the CPU, which reads every
@@ -250,16 +373,16 @@ impl Prepared {
         if self.specialisation().is_none_or(|s| s == wanted) {
             return Ok(());
         }
-        method_allowed(scene)?;
         match self {
             Prepared::Cpu { .. } => Ok(()),
             Prepared::Wgpu {
                 kernel,
-                program,
+                lowered,
                 setup,
                 ..
             } => {
-                **kernel = Self::kernel(scene, program, setup)?;
+                traceable_with(scene, &lowered.traceable)?;
+                **kernel = Self::kernel(scene, lowered, setup)?;
                 Ok(())
             }
             Prepared::Cuda {
@@ -268,16 +391,19 @@ impl Prepared {
                 data,
                 specialisation,
                 ptx_time,
-                program,
+                lowered,
                 setup,
+                source,
                 ..
             } => {
+                traceable_with(scene, &lowered.traceable)?;
                 // The same device and context; the new module replaces the old one.
-                let module = Self::cuda_module(cuda, scene, program, setup)?;
+                let module = Self::cuda_module(cuda, scene, lowered, setup)?;
                 **loaded = module.loaded;
                 *data = module.data;
                 *specialisation = module.specialisation;
                 *ptx_time = module.ptx_time;
+                *source = module.source;
                 Ok(())
             }
         }
@@ -361,10 +487,20 @@ impl Prepared {
     }
 
     /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
-    pub fn program_len(&self, scene: &Scene) -> usize {
+    pub fn program_len(&self) -> usize {
         match self {
             Prepared::Cpu { program, .. } => program.len(),
-            _ => lower::lower(scene).len(),
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => {
+                lowered.program.len()
+            }
+        }
+    }
+
+    /// The scene's primitives, or why it cannot be traced analytically, as lowered.
+    pub fn traceable(&self) -> &Traceable {
+        match self {
+            Prepared::Cpu { tapes, .. } => tapes.traceable(),
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => &lowered.traceable,
         }
     }
 
@@ -443,4 +579,14 @@ fn describe(s: &wgsl::Specialisation) -> String {
         },
         s.max_depth
     )
+}
+
+impl memory::Footprint for Prepared {
+    fn memory(&self, scene: &Scene, settings: &Settings) -> Memory {
+        Prepared::memory(self, scene, settings)
+    }
+
+    fn retained(&self, settings: &Settings) -> u64 {
+        Prepared::retained(self, settings)
+    }
 }

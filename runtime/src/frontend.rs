@@ -1,11 +1,14 @@
 //! Reading scenes from disk: the file-system import loader, and the shared "load, check,
-//! report and lower" steps of every subcommand.
+//! report and lower" steps of every subcommand, and the lines `sdfc check` (and `sdfc view`)
+//! print about a clean scene: what its distance field is, and how it is rendered.
 
 use sdfc_compiler::check::{self, Loader};
 use sdfc_compiler::diagnostics::{self, Diagnostic};
-use sdfc_compiler::lower::{self, LowerOptions, Program};
-use sdfc_compiler::scene::Scene;
-use sdfc_compiler::{Limits, SourceMap};
+use sdfc_compiler::lower::{self, LowerOptions, Lowered};
+use sdfc_compiler::scene::analysis::{self, Analysis};
+use sdfc_compiler::scene::analytic::{self, Choice, Reason};
+use sdfc_compiler::scene::{Exactness, Scene};
+use sdfc_compiler::{Limits, SourceMap, Span};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -74,23 +77,59 @@ pub fn load(path: &Path) -> Result<Loaded, String> {
 
 /// [`load`] within the given limits.
 pub fn load_with(path: &Path, limits: &Limits) -> Result<Loaded, String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        format!(
-            "`{}` is not valid UTF-8 (first bad byte at offset {})",
-            path.display(),
-            e.utf8_error().valid_up_to()
-        )
-    })?;
-    let mut sources = SourceMap::new();
-    let entry = sources.add(normalise(path), text);
-    let (scene, diagnostics) = check::check_with(&mut sources, entry, &mut FsLoader, limits);
-    Ok(Loaded {
-        scene,
-        diagnostics,
-        sources,
-    })
+    Ok(Source::read(path)?.check(limits, 0.0))
+}
+
+/// A scene file and its imports read once, to be checked at many times: the frames of an
+/// animated scene (docs/animation.md) all come from the same text, even if the files
+/// change while a sequence renders.
+#[derive(Debug)]
+pub struct Source {
+    name: String,
+    text: String,
+    /// Imports read so far, by the importing file and the path written.
+    imports: std::collections::HashMap<(String, String), Result<(String, String), String>>,
+}
+
+impl Source {
+    /// Reads the entry file. `Err` is an IO or encoding problem, phrased for the user.
+    pub fn read(path: &Path) -> Result<Source, String> {
+        let bytes =
+            std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            format!(
+                "`{}` is not valid UTF-8 (first bad byte at offset {})",
+                path.display(),
+                e.utf8_error().valid_up_to()
+            )
+        })?;
+        Ok(Source {
+            name: normalise(path),
+            text,
+            imports: Default::default(),
+        })
+    }
+
+    /// Checks the scene within `limits` at the time `t` = `time` seconds.
+    pub fn check(&mut self, limits: &Limits, time: f64) -> Loaded {
+        let mut sources = SourceMap::new();
+        let entry = sources.add(self.name.clone(), self.text.clone());
+        let (scene, diagnostics) = check::check_at(&mut sources, entry, self, limits, time);
+        Loaded {
+            scene,
+            diagnostics,
+            sources,
+        }
+    }
+}
+
+impl Loader for Source {
+    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
+        self.imports
+            .entry((from.to_string(), path.to_string()))
+            .or_insert_with(|| FsLoader.load(from, path))
+            .clone()
+    }
 }
 
 /// Prints diagnostics to stderr in the chosen format.
@@ -128,9 +167,9 @@ impl Checked {
     /// Lowers the scene within `limits` ([`lower::lower_within`]). A program larger than the
     /// `program` limit is reported (E0507) and gives exit code 1, before any back end or
     /// render starts.
-    pub fn lower(&self, options: &LowerOptions, limits: &Limits) -> Result<Program, ExitCode> {
+    pub fn lower(&self, options: &LowerOptions, limits: &Limits) -> Result<Lowered, ExitCode> {
         match lower::lower_within(&self.scene, options, limits) {
-            Ok(program) => Ok(program),
+            Ok(lowered) => Ok(lowered),
             Err(d) => {
                 print_diagnostics(&[d], &self.sources, self.format);
                 Err(ExitCode::from(1))
@@ -162,4 +201,78 @@ pub fn load_scene(
         }),
         None => Err(ExitCode::from(1)),
     }
+}
+
+/// What the analysis derived for the scene, in one clause: `distance field: bound (L = 1)`,
+/// or, when inexact, with the construct responsible, and, where L > 1, that the lowering
+/// divides it out locally (each operand by its own L, `docs/analysis.md`).
+pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
+    let analysis = analysis::analyse(scene);
+    let Some(root) = analysis.root() else {
+        return "no objects".into();
+    };
+    let facts = root.facts;
+    let word = analysis::describe(facts.exactness);
+    let l = facts.lipschitz;
+    let cause = cause(loaded, scene, &analysis);
+    let step = analysis.step_lipschitz();
+    match facts.exactness {
+        Exactness::Exact | Exactness::Bound => format!("distance field: {word} (L = {})", num(l)),
+        Exactness::Approximate if !root.proven => format!(
+            "distance field: {word}, no bound proven{cause}; steps with L = {}{}",
+            num(step),
+            if scene.settings.footprint {
+                "; ε follows the pixel footprint"
+            } else {
+                ""
+            }
+        ),
+        Exactness::Approximate if step < l => format!(
+            "distance field: {word}, L = {}{cause}, clamped to {}; divided out locally",
+            num(l),
+            num(step)
+        ),
+        Exactness::Approximate if l > 1.0 => format!(
+            "distance field: {word}, L = {}{cause}; divided out locally",
+            num(l)
+        ),
+        Exactness::Approximate => format!("distance field: {word}, L = {}{cause}", num(l)),
+    }
+}
+
+/// How the scene is rendered and why: `method: trace (...)` or `method: march (...)`, with
+/// the location of the node that rules out analytic tracing.
+pub fn method(loaded: &Loaded, scene: &Scene) -> String {
+    match analytic::choose(scene) {
+        Choice::March(Reason::Node { what, span }) => format!(
+            "method: march (the {what} at {} has no closed-form ray intersection)",
+            at(loaded, span)
+        ),
+        Choice::March(Reason::Overlap { span }) => format!(
+            "method: march (the transparent shape at {} overlaps or touches another one)",
+            at(loaded, span)
+        ),
+        choice => choice.describe(),
+    }
+}
+
+/// `FILE:LINE:COL` of a span.
+fn at(loaded: &Loaded, span: Span) -> String {
+    let (line, col) = loaded.sources.line_col(span);
+    format!("{}:{line}:{col}", loaded.sources.name(span.file))
+}
+
+/// ` (the twist at FILE:LINE:COL)` for the node that made the field inexact, or nothing.
+fn cause(loaded: &Loaded, scene: &Scene, analysis: &Analysis) -> String {
+    let Some(id) = analysis.root().and_then(|r| r.cause) else {
+        return String::new();
+    };
+    let kind = analysis::kind(scene.graph.node(id));
+    format!(" (the {kind} at {})", at(loaded, scene.graph.span(id)))
+}
+
+/// A number with at most three decimals and no trailing zeros.
+fn num(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }

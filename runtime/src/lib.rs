@@ -14,4 +14,6 @@ pub mod memory;
 pub mod mesh;
 pub mod metrics;
 pub mod output;
+pub mod sequence;
+pub mod settings;
 pub mod view;

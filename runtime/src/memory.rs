@@ -1,7 +1,6 @@
 //! What a render allocates: the bound announced before a render starts, held to the
 //! `memory` limit (`--limit memory=MIB`), and the allocations of writing its outputs.
 
-use crate::backend::Prepared;
 use sdfc_compiler::scene::{Scene, Settings};
 use sdfc_compiler::{Limit, Limits};
 use std::fmt;
@@ -70,15 +69,26 @@ pub fn output(settings: &Settings, aux: bool) -> u64 {
     png.max(jpeg).max(exr) + sidecar
 }
 
+/// What rendering on a prepared scene allocates (`backend::Prepared` answers it; the trait
+/// keeps this module below the backends, whose launchers count in [`Memory`]).
+pub trait Footprint {
+    /// The most memory rendering `settings` allocates, the finished frame included.
+    fn memory(&self, scene: &Scene, settings: &Settings) -> Memory;
+    /// The bytes a finished frame holds.
+    fn retained(&self, settings: &Settings) -> u64;
+}
+
 /// The most a `sdfc render` of `scene` allocates on `prepared`: the render; with
-/// `reference`, the finished frame held while its convergence check renders; then the frame
+/// `reference`, the finished frame held while its convergence check (which may sample more)
+/// renders; then the frame
 /// held while its outputs are written.
-pub fn render(prepared: &Prepared, scene: &Scene, reference: bool, aux: bool) -> Memory {
+pub fn render(prepared: &impl Footprint, scene: &Scene, reference: bool, aux: bool) -> Memory {
     let s = &scene.settings;
     let frame = prepared.memory(scene, s);
     let held = prepared.retained(s);
     let check = if reference {
-        frame.host.saturating_add(held)
+        let finer = crate::cpu::reference::check_settings(s);
+        prepared.memory(scene, &finer).host.saturating_add(held)
     } else {
         0
     };

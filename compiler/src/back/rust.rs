@@ -1,10 +1,10 @@
 //! The Rust back end (`sdfc compile --emit rust`): a distance program written as two
 //! self-contained functions over glam, `map` in f32 and `map_f64` in f64, one statement per
-//! instruction, with the meaning of every operation as in [`crate::eval::scalar`]. A guarded
+//! instruction, with the meaning of every operation as in [`crate::program::scalar`]. A guarded
 //! block is an `if`/`else`; each of its results is declared before it and assigned in both
 //! branches.
 
-use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
+use crate::program::{results, Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::fmt::Write;
 
 /// Writes `program` as Rust source.
@@ -47,7 +47,7 @@ fn function(out: &mut String, program: &Program, name: &str, vec: &str, ty: &str
             Item::Op(_) => {}
             Item::Open(b) => {
                 let block = &program.blocks()[b];
-                for (j, _, _) in crate::back::wgsl::results(program, b, &all) {
+                for (j, _, _) in results(program, b, &all) {
                     let _ = writeln!(out, "{}let r{j}: {ty};", pad(depth));
                 }
                 let (x, y) = (block.bound.0, block.best.0);
@@ -55,7 +55,7 @@ fn function(out: &mut String, program: &Program, name: &str, vec: &str, ty: &str
                 depth += 1;
             }
             Item::Close(b) => {
-                let results = crate::back::wgsl::results(program, b, &all);
+                let results = results(program, b, &all);
                 for &(j, then, _) in &results {
                     let _ = writeln!(out, "{}r{j} = r{};", pad(depth), then.0);
                 }

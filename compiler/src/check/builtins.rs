@@ -292,6 +292,10 @@ macro_rules! sigs {
     (@rest $t:tt) => { true };
 }
 
+/// The name of the time, in seconds, that every expression may read (docs/animation.md): a
+/// constant, parameter or loop variable of that name hides it.
+pub const TIME: &str = "t";
+
 /// Every builtin function.
 pub static BUILTINS: &[Builtin] = &[
     // Primitives.
@@ -738,6 +742,9 @@ pub fn builtin(name: &str) -> Option<&'static Builtin> {
 pub struct Record {
     pub name: &'static str,
     pub fields: &'static [P],
+    /// Fields whose value must not depend on the time `t` (E0406): what every frame of a
+    /// sequence shares.
+    pub timeless: &'static [&'static str],
 }
 
 const SURFACE: [P; 8] = [
@@ -780,10 +787,12 @@ const CHECKER: [P; 10] = concat(
 pub static MATERIALS: &[Record] = &[
     Record {
         name: "phong",
+        timeless: &[],
         fields: &SURFACE,
     },
     Record {
         name: "checker",
+        timeless: &[],
         fields: &CHECKER,
     },
 ];
@@ -811,10 +820,12 @@ const DIRECTIONAL: [P; 5] = concat([p("direction", V, Req, NonZero)], LIGHT_COMM
 pub static LIGHTS: &[Record] = &[
     Record {
         name: "point",
+        timeless: &[],
         fields: &POINT,
     },
     Record {
         name: "directional",
+        timeless: &[],
         fields: &DIRECTIONAL,
     },
 ];
@@ -822,6 +833,7 @@ pub static LIGHTS: &[Record] = &[
 /// `camera { ... }`
 pub static CAMERA: Record = Record {
     name: "camera",
+    timeless: &[],
     fields: &[
         p("position", V, V3([0.0, 1.0, -5.0]), Any),
         p("look_at", V, V3([0.0, 0.0, 0.0]), Any),
@@ -841,6 +853,8 @@ pub static CAMERA: Record = Record {
 /// `render { ... }`; the same keys are accepted by `sdfc render --set`.
 pub static RENDER: Record = Record {
     name: "render",
+    // The sequence's frames and their size: an animated PNG or a video has one size.
+    timeless: &["width", "height", "fps", "duration"],
     fields: &[
         p("width", I, Int(640), Limited(1.0, Limit::Edge)),
         p("height", I, Int(480), Limited(1.0, Limit::Edge)),
@@ -857,5 +871,7 @@ pub static RENDER: Record = Record {
             Text("auto"),
             OneOf(crate::scene::Method::NAMES),
         ),
+        p("fps", F, Num(30.0), Within(0.01, 1000.0)),
+        p("duration", F, Num(0.0), Within(0.0, 1e7)),
     ],
 };

@@ -41,6 +41,9 @@ pub struct Ctx {
     /// Where the render block sets `method`, for the error when analytic tracing is asked
     /// of a scene that does not allow it.
     pub method_span: Option<Span>,
+    /// The settings the render block gives (a field with no proven bound has defaults of its
+    /// own for `epsilon` and `relaxation`).
+    pub settings_given: Vec<String>,
     /// Where the camera, the lights and the scene are written (`placement.rs`).
     pub places: super::placement::Places,
     locals: Vec<(String, Value)>,
@@ -53,8 +56,19 @@ pub struct Ctx {
     pub limits: Limits,
     reported_limit: bool,
     /// Results of calls of user functions on concrete arguments: functions are pure, so a
-    /// call repeated with the same arguments is evaluated once.
-    memo: HashMap<String, Value>,
+    /// call repeated with the same arguments is evaluated once. With each, where its
+    /// evaluation read the time `t`, if it did.
+    memo: HashMap<String, (Value, Option<Span>)>,
+    /// The time `t` the scene is checked at, in seconds.
+    pub time: f64,
+    /// Reads of `t` so far (dry evaluation not counted): a count, to tell whether evaluating
+    /// something read it, the first read and the last.
+    pub time_reads: u64,
+    pub first_time_read: Option<Span>,
+    last_time_read: Option<Span>,
+    /// Global constants whose evaluation read `t`, with where it was read: reading one reads
+    /// the time.
+    pub timed_globals: HashMap<String, Span>,
 }
 
 /// An argument after evaluation.
@@ -250,12 +264,32 @@ impl Ctx {
         Value::Error
     }
 
+    /// Notes that evaluation read the time `t` at `span` (directly, or through a constant
+    /// or a call whose evaluation did). Dry evaluation (a function body checked on its own)
+    /// does not count: only what the scene evaluates makes it animated.
+    pub fn read_time(&mut self, span: Span) {
+        if self.dry == 0 {
+            self.time_reads += 1;
+            self.first_time_read.get_or_insert(span);
+            self.last_time_read = Some(span);
+        }
+    }
+
+    /// Where the last read of `t` was, if any.
+    pub fn last_time_read(&self) -> Option<Span> {
+        self.last_time_read
+    }
+
     fn var(&mut self, id: &Ident) -> Value {
         if let Some((_, v)) = self.locals.iter().rev().find(|(n, _)| *n == id.name) {
             return v.clone();
         }
         if let Some((v, _)) = self.globals.get(&id.name) {
-            return v.clone();
+            let v = v.clone();
+            if let Some(at) = self.timed_globals.get(&id.name).copied() {
+                self.read_time(at);
+            }
+            return v;
         }
         if let Some(def) = self.declared.get(&id.name).copied() {
             self.error(
@@ -269,6 +303,11 @@ impl Ctx {
                 .with_help("move the `let` above its first use"),
             );
             return Value::Error;
+        }
+        // The time, unless a constant, parameter or loop variable of that name hides it.
+        if id.name == builtins::TIME {
+            self.read_time(id.span);
+            return Value::Float(self.time);
         }
         let mut d = Diagnostic::error("E0200", format!("unknown name `{}`", id.name), id.span)
             .with_label("not defined");
@@ -820,14 +859,21 @@ impl Ctx {
             callee.name,
             frame.iter().map(|(_, v)| v).collect::<Vec<_>>()
         );
-        if let Some(v) = self.memo.get(&key) {
+        if let Some((v, read)) = self.memo.get(&key).cloned() {
             self.locals = saved;
-            return v.clone();
+            if let Some(at) = read {
+                self.read_time(at);
+            }
+            return v;
         }
         self.locals = frame;
         self.depth += 1;
         let before = self.diags.len();
+        let reads = self.time_reads;
         let v = self.body(&decl.body);
+        let read = (self.time_reads > reads)
+            .then_some(self.last_time_read)
+            .flatten();
         self.depth -= 1;
         if self.diags[before..].iter().any(Diagnostic::is_error) {
             let label = call_label(&self.locals);
@@ -837,7 +883,7 @@ impl Ctx {
         }
         self.locals = saved;
         let v = v.coerce(ret).unwrap_or(Value::Error);
-        self.memo.insert(key, v.clone());
+        self.memo.insert(key, (v.clone(), read));
         v
     }
 
@@ -1137,7 +1183,28 @@ pub fn record(
     let mut out: HashMap<&'static str, Value> = HashMap::new();
     let mut spans: HashMap<&'static str, Span> = HashMap::new();
     for f in fields {
+        let reads = cx.time_reads;
         let v = cx.expr(&f.value);
+        if let (true, Some(at)) = (cx.time_reads > reads, cx.last_time_read()) {
+            if let Some(&name) = rec.timeless.iter().find(|n| **n == f.name.name) {
+                cx.error(
+                    Diagnostic::error(
+                        "E0406",
+                        format!("`{name}` of `{}` cannot depend on the time `t`", rec.name),
+                        f.value.span,
+                    )
+                    .with_label("this value changes with `t`")
+                    .with_secondary(at, "the time is read here")
+                    .with_note(format!(
+                        "every frame of a sequence shares {}",
+                        rec.timeless.join(", ")
+                    )),
+                );
+                out.insert(name, Value::Error);
+                spans.insert(name, f.name.span);
+                continue;
+            }
+        }
         let Some(p) = rec.fields.iter().find(|p| p.name == f.name.name) else {
             let mut d = Diagnostic::error(
                 "E0202",

@@ -53,12 +53,24 @@ pub fn check(
     check_with(sources, entry, loader, &Limits::default())
 }
 
-/// [`check`] within the given limits (`--limit`).
+/// [`check`] within the given limits (`--limit`), at the time 0.
 pub fn check_with(
     sources: &mut SourceMap,
     entry: FileId,
     loader: &mut dyn Loader,
     limits: &Limits,
+) -> (Option<Scene>, Vec<Diagnostic>) {
+    check_at(sources, entry, loader, limits, 0.0)
+}
+
+/// [`check_with`] at the time `t` = `time` seconds: the scene of the frame at that time
+/// (docs/animation.md). Its [`Scene::animation`] says whether anything read `t`.
+pub fn check_at(
+    sources: &mut SourceMap,
+    entry: FileId,
+    loader: &mut dyn Loader,
+    limits: &Limits,
+    time: f64,
 ) -> (Option<Scene>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut items = Vec::new();
@@ -80,8 +92,11 @@ pub fn check_with(
     let mut cx = Ctx::default();
     cx.diags = diags;
     cx.limits = limits.clone();
+    cx.time = time;
     let mut scene = check_items(&mut cx, &items, entry);
     scene.limits = limits.clone();
+    scene.animation.time = time;
+    scene.animation.reads_time = cx.first_time_read;
     if !crate::diagnostics::has_errors(&cx.diags) {
         // Before any pass walks the shapes as a tree: a small graph of shared shapes can
         // expand exponentially.
@@ -93,6 +108,9 @@ pub fn check_with(
         // Distance semantics: warnings where a construct makes the field unreliable.
         let analysis = crate::scene::analysis::analyse(&scene);
         cx.diags.extend_from_slice(analysis.diagnostics());
+        if analysis.root().is_some_and(|root| !root.proven) {
+            unbounded_defaults(&cx.settings_given, &mut scene.settings);
+        }
         analytic_method(&mut cx, &scene);
     }
     if !crate::diagnostics::has_errors(&cx.diags) {
@@ -103,6 +121,17 @@ pub fn check_with(
     cx.diags.sort_by_key(|d| (d.span().file, d.span().start));
     let errors = crate::diagnostics::has_errors(&cx.diags);
     (if errors { None } else { Some(scene) }, cx.diags)
+}
+
+/// The defaults of a field with no proven distance bound, for the settings the file does not
+/// give (docs/accuracy.md, "Fields without a bound"): such a field has detail below any ε, so
+/// ε follows the pixel footprint; and over-relaxation, whose fallback relies on a bound, is off.
+fn unbounded_defaults(given: &[String], settings: &mut Settings) {
+    let given = |name: &str| given.iter().any(|g| g == name);
+    settings.footprint = !given("epsilon");
+    if !given("relaxation") {
+        settings.relaxation = 1.0;
+    }
 }
 
 /// `method: "trace"` on a scene that cannot be ray traced analytically is an error at the
@@ -251,7 +280,21 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
                 if cx.globals.contains_key(&l.name.name) {
                     continue;
                 }
+                if l.name.name == builtins::TIME {
+                    cx.error(
+                        Diagnostic::warning("W0013", "this constant hides the time `t`", l.name.span)
+                            .with_label("a global constant named `t`")
+                            .with_note(
+                                "`t` is the time in seconds of an animation's frame; below this constant, every `t` reads the constant instead",
+                            )
+                            .with_help("give the constant another name"),
+                    );
+                }
+                let reads = cx.time_reads;
                 let v = cx.let_value(l);
+                if let (true, Some(at)) = (cx.time_reads > reads, cx.last_time_read()) {
+                    cx.timed_globals.insert(l.name.name.clone(), at);
+                }
                 cx.globals.insert(l.name.name.clone(), (v, l.name.span));
             }
             ast::Item::Material {
@@ -615,6 +658,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 .iter()
                 .find(|f| f.name.name == "method")
                 .map(|f| f.value.span);
+            cx.settings_given = b.fields.iter().map(|f| f.name.name.clone()).collect();
             let int = |k: &str| f[k].num() as u32;
             scene.settings = Settings {
                 width: int("width"),
@@ -622,6 +666,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 aa: int("aa"),
                 max_steps: int("max_steps"),
                 epsilon: f["epsilon"].num(),
+                footprint: false,
                 max_depth: int("max_depth"),
                 max_dist: f["max_dist"].num(),
                 relaxation: f["relaxation"].num(),
@@ -631,6 +676,20 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                     _ => Method::Auto,
                 },
             };
+            if let (Value::Float(fps), Value::Float(duration)) = (&f["fps"], &f["duration"]) {
+                scene.animation.fps = *fps;
+                scene.animation.duration = *duration;
+                let max = cx.limits.get(Limit::Frames);
+                let frames = scene.animation.frames();
+                if frames > max {
+                    let at = field_span(&b.fields, "duration").unwrap_or(b.keyword.span);
+                    cx.limit(
+                        Limit::Frames,
+                        at,
+                        format!("the animation has {frames} frames, more than {max}"),
+                    );
+                }
+            }
         }
         (_, Some(kind)) => {
             let Some(rec) = builtins::LIGHTS.iter().find(|r| r.name == kind.name) else {

@@ -12,7 +12,7 @@
 //! The chain's inner instructions are recomputed by the step, not read; those that nothing
 //! else reads run no step of their own. The rest of the program is untouched.
 
-use crate::lower::{Binary, Op, Program, Reg, Unary};
+use crate::program::{Binary, Op, Program, Reg, Unary};
 
 /// The terms of a fused sum.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

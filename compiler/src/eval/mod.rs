@@ -10,19 +10,20 @@
 //! Everything is generic over [`Float`] (f32 or f64). [`eval_point`] is the one-point
 //! reference evaluation used by tests.
 
-pub mod float;
 mod fuse;
-pub mod scalar;
 mod tape;
 mod wide;
 
-pub use float::Float;
+/// The evaluation types, at the path they had when they were defined here.
+pub use crate::program::Float;
+
+use crate::program::scalar;
 pub use tape::{Outputs, Tape};
 pub use wide::wide;
 
 use tape::{Guard, Sources, Step, INPUTS};
 
-use crate::lower::{Axis, Op, Program};
+use crate::program::{Axis, Op, Program, Reg};
 
 /// The default number of points an evaluator processes per pass over the tape.
 pub const DEFAULT_CHUNK: usize = 256;
@@ -57,7 +58,7 @@ pub fn eval_point<T: Float>(program: &Program, p: [T; 3]) -> (T, u32) {
                 continue 'run;
             }
         }
-        let r = |x: crate::lower::Reg| regs[x.0 as usize];
+        let r = |x: Reg| regs[x.0 as usize];
         regs[i] = match ops[i] {
             Op::Const(c) => T::from_f64(c),
             Op::Input(Axis::X) => p[0],
@@ -70,7 +71,7 @@ pub fn eval_point<T: Float>(program: &Program, p: [T; 3]) -> (T, u32) {
         };
         i += 1;
     }
-    let get = |i: crate::lower::Reg| regs.get(i.0 as usize).copied().unwrap_or_else(T::zero);
+    let get = |i: Reg| regs.get(i.0 as usize).copied().unwrap_or_else(T::zero);
     (
         get(program.distance()),
         material_id(get(program.material())),

@@ -12,7 +12,7 @@
 
 use super::fuse::{self, Finish, Fusions, Kind};
 use super::{scalar, Float};
-use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
+use crate::program::{Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 
 /// Which results a tape computes.

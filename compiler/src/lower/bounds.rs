@@ -165,7 +165,7 @@ fn sphere_hull(a: &Sphere, b: &Sphere) -> Sphere {
 }
 
 /// The bound and the estimated cost (instructions per point) of every node of a graph.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(super) struct Bounds {
     of: Vec<Option<Bound>>,
     cost: Vec<f64>,

@@ -2,8 +2,7 @@
 //! sharing of equal instructions (when optimising), opens and closes guarded blocks, and
 //! offers the small vector helpers the lowering rules are written with.
 
-use super::{Axis, Binary, Block, Note, Op, Program, Reg, Unary};
-use crate::eval::scalar;
+use crate::program::{scalar, Axis, Binary, Block, Note, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 
 /// A point or vector: three registers.
@@ -43,6 +42,11 @@ pub(super) struct Builder {
     /// The most instructions to emit (the `program` limit): past it, [`Builder::over`]
     /// turns true and the lowering stops descending.
     cap: usize,
+    /// No folding that depends on a constant's value ([`super::LowerOptions::parametric`]):
+    /// constants are not shared, identities and sign rewrites are kept as written, a
+    /// `Select` keeps both sides. Constant operations still fold (into a constant, whatever
+    /// the values).
+    pub parametric: bool,
 }
 
 impl Builder {
@@ -128,6 +132,7 @@ impl Builder {
             return r;
         }
         let key = match op {
+            Op::Const(_) if self.parametric => return self.push(op),
             Op::Const(c) => Key::Const(c.to_bits()),
             Op::Input(a) => Key::Input(a),
             Op::Unary(u, a) => Key::Unary(u, a),
@@ -196,6 +201,7 @@ impl Builder {
             Op::Unary(u, a) => self.fold_unary(u, a),
             Op::Binary(b, x, y) => self.fold_binary(b, x, y),
             Op::Select(c, a, b) => match self.value(c) {
+                Some(_) if self.parametric => None,
                 Some(v) => Some(if v != 0.0 { a } else { b }),
                 None if a == b => Some(a),
                 None => None,
@@ -221,6 +227,13 @@ impl Builder {
         }
         if let Some(r) = self.fold_chain(b, x, y) {
             return Some(r);
+        }
+        if self.parametric {
+            return match b {
+                Binary::Min | Binary::Max if x == y => Some(x),
+                Binary::Lt if x == y => Some(self.c(0.0)),
+                _ => None,
+            };
         }
         match b {
             Binary::Add if self.is(y, 0.0) => Some(x),
@@ -276,7 +289,6 @@ impl Builder {
             distance: d,
             material: m,
             lipschitz: 1.0,
-            options: super::LowerOptions::default(),
         };
         let (live, live_blocks) = if self.optimise {
             raw.live(&[d, m])
@@ -324,7 +336,6 @@ impl Builder {
             distance: new_index[d.0 as usize],
             material: new_index[m.0 as usize],
             lipschitz: 1.0,
-            options: super::LowerOptions::default(),
         }
     }
 }
@@ -501,7 +512,7 @@ mod tests {
         // IEEE addition and multiplication commute, NaN included (up to which NaN).
         assert_eq!(b.add(x, y), b.add(y, x));
         assert_eq!(b.mul(x, y), b.mul(y, x));
-        // min and max do not: with a NaN operand the second one wins (eval::float).
+        // min and max do not: with a NaN operand the second one wins (program::float).
         assert_ne!(b.min(x, y), b.min(y, x));
         assert_ne!(b.max(x, y), b.max(y, x));
         assert_eq!(b.max(x, y), b.max(x, y));

@@ -14,9 +14,9 @@
 //! in the rest.
 
 use super::bounds::Bounds;
-use super::{lower_simple, simplify, LowerOptions, Program};
-use crate::scene::analysis::{self, Analysis};
-use crate::scene::{Combine, Exactness, Graph, MaterialId, Node, NodeId, Scene, V3};
+use super::{lower_simple, LowerOptions, Program, Simplified};
+use crate::scene::analysis::Analysis;
+use crate::scene::{Combine, Exactness, Graph, MaterialId, Node, NodeId, V3};
 
 /// One instance: `shape` evaluated at `rotate(p) − offset`.
 #[derive(Debug, Clone, PartialEq)]
@@ -44,32 +44,28 @@ pub struct Split {
     pub instances: Vec<Instance>,
 }
 
-/// Splits the instances off a scene's root union when it has more than `more_than` of them
-/// (and the program is optimised: level 0 keeps the scene as written); the rest is lowered
-/// with `options`.
-pub fn split(scene: &Scene, options: &LowerOptions, more_than: usize) -> Option<Split> {
-    let root = scene.root.filter(|_| options.level > 0)?;
-    let simple = simplify::simplify(&scene.graph, root);
+/// Splits the instances off the root union of a simplified scene when it has more than
+/// `more_than` of them; the rest is lowered with `options` ([`super::Lowered::instances`]).
+pub(super) fn split(
+    simple: &Simplified,
+    options: &LowerOptions,
+    more_than: usize,
+) -> Option<Split> {
+    let whole = &simple.scene;
+    let root = whole.root?;
     let Node::Combine {
         op: Combine::Union,
         children,
-    } = simple.graph.node(simple.root).clone()
+    } = whole.graph.node(root).clone()
     else {
         return None;
     };
     if children.len() <= more_than {
         return None;
     }
-    let whole = Scene {
-        graph: simple.graph,
-        root: Some(simple.root),
-        ..super::scene_without_graph(scene)
-    };
-    let analysis = analysis::analyse(&whole);
-    let bounds = Bounds::new(&whole.graph);
     let (mut rest, mut instances) = (Vec::new(), Vec::new());
     for c in children {
-        match instance(&whole.graph, &analysis, &bounds, c) {
+        match instance(&whole.graph, &simple.analysis, &simple.bounds, c) {
             Some(i) => instances.push(i),
             None => rest.push(c),
         }
@@ -77,12 +73,12 @@ pub fn split(scene: &Scene, options: &LowerOptions, more_than: usize) -> Option<
     if instances.len() <= more_than {
         return None;
     }
-    let mut graph = whole.graph;
+    let mut graph = whole.graph.clone();
     let root = match rest.len() {
         0 => None,
         1 => Some(rest[0]),
         _ => {
-            let span = graph.span(simple.root);
+            let span = graph.span(root);
             let union = Node::Combine {
                 op: Combine::Union,
                 children: rest,
@@ -90,7 +86,7 @@ pub fn split(scene: &Scene, options: &LowerOptions, more_than: usize) -> Option<
             Some(graph.add(union, span))
         }
     };
-    let (rest, _) = lower_simple(scene, graph, root, &simple.origin, options, usize::MAX);
+    let (rest, _, _) = lower_simple(whole, graph, root, &simple.origin, options, usize::MAX);
     Some(Split { rest, instances })
 }
 
@@ -148,6 +144,8 @@ fn instance(graph: &Graph, analysis: &Analysis, bounds: &Bounds, id: NodeId) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lower::lower_scene;
+    use crate::scene::Scene;
 
     fn scene(text: &str) -> Scene {
         let (scene, diags, _) = crate::check::check_str("split.sdf", text);
@@ -166,7 +164,8 @@ mod tests {
              box((0.2, 0.3, 0.4)).rotate_y(30deg).translate(0, 2, 0);\n\
              torus(1, 0.2).rotate_x(20deg) @ red;\n  cone(0.5, 1).translate(0, 0, 5);\n}\n",
         );
-        let split = split(&s, &LowerOptions::default(), 3).expect("more than 3 instances");
+        let lowered = lower_scene(&s, &LowerOptions::default());
+        let split = lowered.instances(3).expect("more than 3 instances");
         assert_eq!(split.instances.len(), 9);
         let rotated = split.instances.iter().filter(|i| i.rotation.is_some());
         assert_eq!(rotated.count(), 2);
@@ -175,7 +174,9 @@ mod tests {
         let text = split.rest.dump();
         assert!(text.contains("plane") && text.contains("twist") && text.contains("ellipsoid"));
         assert!(!text.contains("torus") && !text.contains("cone") && !text.contains("sphere"));
-        assert!(super::split(&s, &LowerOptions::default(), 9).is_none());
-        assert!(super::split(&s, &LowerOptions::level(0), 3).is_none());
+        assert!(lowered.instances(9).is_none());
+        assert!(lower_scene(&s, &LowerOptions::level(0))
+            .instances(3)
+            .is_none());
     }
 }

@@ -32,8 +32,9 @@ pub(super) struct Simple {
 }
 
 /// Simplifies the graph below `root`.
-pub(super) fn simplify(graph: &Graph, root: NodeId) -> Simple {
+pub(super) fn simplify(graph: &Graph, root: NodeId, parametric: bool) -> Simple {
     let mut s = Simplifier {
+        parametric,
         src: graph,
         out: Graph::default(),
         origin: Vec::new(),
@@ -53,6 +54,9 @@ const TINY: f64 = 1e-12;
 
 #[derive(Debug)]
 struct Simplifier<'a> {
+    /// Only rewrites that do not depend on a number's value (`LowerOptions::parametric`):
+    /// identities stay, and rotations are absorbed only by spheres and planes.
+    parametric: bool,
     src: &'a Graph,
     out: Graph,
     origin: Vec<NodeId>,
@@ -101,7 +105,7 @@ impl Simplifier<'_> {
                 b,
             } => {
                 let (a, b) = (self.node(a), self.node(b));
-                if k <= 0.0 {
+                if k <= 0.0 && !self.parametric {
                     return self.combine(op, vec![a, b]);
                 }
                 self.add(Node::SmoothCombine {
@@ -156,7 +160,7 @@ impl Simplifier<'_> {
     fn unary_on(&mut self, node: Node, c: NodeId) -> NodeId {
         let node = match node {
             Node::ScaleXyz { factors, .. }
-                if factors[0] == factors[1] && factors[1] == factors[2] =>
+                if factors[0] == factors[1] && factors[1] == factors[2] && !self.parametric =>
             {
                 return self.scale(factors[0], c)
             }
@@ -165,7 +169,7 @@ impl Simplifier<'_> {
                     Some(n) if n[i] <= 1.0 => 0.0,
                     _ => period[i],
                 });
-                if period == [0.0; 3] {
+                if period == [0.0; 3] && !self.parametric {
                     return c;
                 }
                 Node::Repeat {
@@ -181,8 +185,12 @@ impl Simplifier<'_> {
                 }
                 Node::Mirror { axes, child: c }
             }
-            Node::Twist { rate, .. } | Node::Bend { rate, .. } if rate == 0.0 => return c,
-            Node::Elongate { half, .. } if half == [0.0; 3] => return c,
+            Node::Twist { rate, .. } | Node::Bend { rate, .. }
+                if rate == 0.0 && !self.parametric =>
+            {
+                return c
+            }
+            Node::Elongate { half, .. } if half == [0.0; 3] && !self.parametric => return c,
             other => with_child(other, c),
         };
         self.add(node)
@@ -304,7 +312,7 @@ impl Simplifier<'_> {
 
     /// `c` translated by `t`.
     fn translate(&mut self, t: V3, c: NodeId) -> NodeId {
-        if t == [0.0; 3] {
+        if t == [0.0; 3] && !self.parametric {
             return c;
         }
         match self.get(c) {
@@ -326,11 +334,26 @@ impl Simplifier<'_> {
 
     /// `c` rotated by `m` (child points x go to m·x).
     fn rotate(&mut self, m: [V3; 3], c: NodeId) -> NodeId {
-        if is_identity(&m) {
+        if is_identity(&m) && !self.parametric {
             return c;
         }
         let node = self.get(c);
         match node {
+            // Which rotations the rest absorb depends on the angle.
+            Node::Cone { .. }
+            | Node::Torus { .. }
+            | Node::Cylinder { .. }
+            | Node::Capsule { .. }
+            | Node::Box { .. }
+            | Node::RoundBox { .. }
+            | Node::Ellipsoid { .. }
+                if self.parametric =>
+            {
+                self.add(Node::Rotate {
+                    matrix: m,
+                    child: c,
+                })
+            }
             Node::Paint { material, child } => {
                 let inner = self.rotate(m, child);
                 self.paint(material, inner)
@@ -369,7 +392,7 @@ impl Simplifier<'_> {
 
     /// `c` scaled uniformly by `s`.
     fn scale(&mut self, s: f64, c: NodeId) -> NodeId {
-        if s == 1.0 {
+        if s == 1.0 && !self.parametric {
             return c;
         }
         let a = s.abs();
@@ -442,7 +465,7 @@ impl Simplifier<'_> {
 
     /// `c` rounded by `r` (its surface moved outwards by r).
     fn round(&mut self, r: f64, c: NodeId) -> NodeId {
-        if r == 0.0 {
+        if r == 0.0 && !self.parametric {
             return c;
         }
         let node = match self.get(c) {

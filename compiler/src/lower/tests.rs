@@ -4,9 +4,7 @@
 
 use super::bounds::Bounds;
 use super::graph::field_and_bound;
-use super::{Op, Program};
-use crate::eval::{scalar, Float};
-use crate::lower::Axis;
+use crate::program::{scalar, Axis, Float, Op, Program, Reg};
 use crate::scene::{Combine, Graph, MaterialId, Node, NodeId, Smooth};
 use crate::{FileId, Span};
 
@@ -15,7 +13,7 @@ use crate::{FileId, Span};
 fn eval<T: Float>(program: &Program, p: [T; 3]) -> (T, T) {
     let mut regs: Vec<T> = Vec::with_capacity(program.len());
     for op in program.ops() {
-        let r = |x: super::Reg| regs[x.0 as usize];
+        let r = |x: Reg| regs[x.0 as usize];
         let v = match *op {
             Op::Const(c) => T::from_f64(c),
             Op::Input(Axis::X) => p[0],
@@ -270,9 +268,9 @@ fn lowering_stops_at_the_program_limit() {
     let (scene, diags, _) = crate::check::check_str("many.sdf", &text);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let options = super::LowerOptions::default();
-    let (whole, over) = super::lower_capped(&scene, &options, usize::MAX);
+    let (whole, over, _) = super::lower_capped(&scene, &options, usize::MAX);
     assert!(!over && whole.len() > 50_000, "{}", whole.len());
-    let (part, over) = super::lower_capped(&scene, &options, 1_000);
+    let (part, over, _) = super::lower_capped(&scene, &options, 1_000);
     assert!(over && part.len() < 2_000, "stopped at {}", part.len());
     let mut limits = crate::Limits::default();
     limits.set(crate::Limit::Program, 1_000).expect("valid");
@@ -284,5 +282,6 @@ fn lowering_stops_at_the_program_limit() {
     limits
         .set(crate::Limit::Program, whole.len() as u64 * 2)
         .expect("valid");
-    assert_eq!(super::lower_within(&scene, &options, &limits), Ok(whole));
+    let lowered = super::lower_within(&scene, &options, &limits).map(|l| l.program);
+    assert_eq!(lowered, Ok(whole));
 }

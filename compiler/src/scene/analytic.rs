@@ -108,15 +108,35 @@ impl Choice {
     }
 }
 
-/// Decides how `scene` is rendered: its `method` setting, and for `auto` whether every node
-/// and light allows analytic tracing. For `method: "trace"` on a scene that does not allow
-/// it, the answer is `March` with the reason, and the checker reports it as an error.
+/// Decides how `scene` is rendered: [`traceable`] and then [`Traceable::choose`] with the
+/// scene's own settings.
 pub fn choose(scene: &Scene) -> Choice {
-    if scene.settings.method == Method::March {
-        return Choice::March(Reason::Asked);
-    }
+    traceable(scene).choose(scene.settings.method)
+}
+
+/// What decides a scene's method apart from its render settings: its primitives, or why it
+/// has none, and a transparent primitive that overlaps another. Computed once per scene (by
+/// the lowering, [`crate::lower::Lowered`]); the `method` setting, which a command may set
+/// after checking, then picks with [`Traceable::choose`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Traceable {
+    /// The primitives in world space, or why some node or light rules tracing out.
+    primitives: Result<Vec<Primitive>, Reason>,
+    /// A transparent primitive that overlaps or touches another (its node's span).
+    overlap: Option<Span>,
+    /// The `traced` limit of the scene's limits.
+    limit: usize,
+}
+
+/// The primitives of `scene` and what rules tracing out, whatever its `method`.
+pub fn traceable(scene: &Scene) -> Traceable {
+    let limit = scene.limits.count(Limit::Traced);
     if let Some(index) = scene.lights.iter().position(|l| l.penumbra() > 0.0) {
-        return Choice::March(Reason::SoftLight { index });
+        return Traceable {
+            primitives: Err(Reason::SoftLight { index }),
+            overlap: None,
+            limit,
+        };
     }
     let mut out = Vec::new();
     if let Some(root) = scene.root {
@@ -127,26 +147,61 @@ pub fn choose(scene: &Scene) -> Choice {
             material: MaterialId(0),
         };
         if let Err(reason) = collect(scene, root, frame, &mut out) {
-            return Choice::March(reason);
+            return Traceable {
+                primitives: Err(reason),
+                overlap: None,
+                limit,
+            };
         }
     }
-    // The `traced` limit (limits.rs): rays visit the primitives through a bounding-volume
-    // hierarchy ([`hierarchy`]), in O(log n) per ray on the CPU and on the GPU, whose kernel
-    // reads a large scene's primitives and hierarchy from a buffer
-    // (`back::wgsl::MAX_UNROLLED`), so tracing beats sphere tracing at any size; the limit
-    // keeps that buffer within what a GPU binds. `method: "trace"` has no limit.
-    let limit = scene.limits.count(Limit::Traced);
-    if scene.settings.method == Method::Auto && out.len() > limit {
-        return Choice::March(Reason::Many {
-            count: out.len(),
-            limit,
-        });
+    let overlap = transparent_overlap(scene, &out).map(|p| scene.graph.span(p.node));
+    Traceable {
+        primitives: Ok(out),
+        overlap,
+        limit,
     }
-    if let Some(p) = transparent_overlap(scene, &out) {
-        let span = scene.graph.span(p.node);
-        return Choice::March(Reason::Overlap { span });
+}
+
+impl Traceable {
+    /// How a scene with this `method` setting is rendered: `march` marches; `auto` and
+    /// `trace` trace when every node and light allows it. For `method: "trace"` on a scene
+    /// that does not allow it, the answer is `March` with the reason, and the checker
+    /// reports it as an error.
+    pub fn choose(&self, method: Method) -> Choice {
+        match self.decide(method) {
+            Ok(primitives) => Choice::Trace(primitives.to_vec()),
+            Err(reason) => Choice::March(reason),
+        }
     }
-    Choice::Trace(out)
+
+    /// The primitives to trace when a scene with this `method` setting is traced
+    /// ([`Traceable::choose`] without copying them).
+    pub fn traced(&self, method: Method) -> Option<&[Primitive]> {
+        self.decide(method).ok()
+    }
+
+    /// [`Traceable::choose`]: the primitives, or why the scene is marched.
+    fn decide(&self, method: Method) -> Result<&[Primitive], Reason> {
+        if method == Method::March {
+            return Err(Reason::Asked);
+        }
+        let primitives = self.primitives.as_ref().map_err(Clone::clone)?;
+        // The `traced` limit (limits.rs): rays visit the primitives through a bounding-volume
+        // hierarchy ([`hierarchy`]), in O(log n) per ray on the CPU and on the GPU, whose
+        // kernel reads a large scene's primitives and hierarchy from a buffer
+        // (`back::wgsl::MAX_UNROLLED`), so tracing beats sphere tracing at any size; the
+        // limit keeps that buffer within what a GPU binds. `method: "trace"` has no limit.
+        if method == Method::Auto && primitives.len() > self.limit {
+            return Err(Reason::Many {
+                count: primitives.len(),
+                limit: self.limit,
+            });
+        }
+        if let Some(span) = self.overlap {
+            return Err(Reason::Overlap { span });
+        }
+        Ok(primitives)
+    }
 }
 
 /// A transparent primitive whose box meets another primitive's box or a plane's solid side

@@ -14,6 +14,13 @@ pub fn dump(scene: &Scene) -> String {
         s.width, s.height, s.aa, s.max_steps, num(s.epsilon), s.max_depth, num(s.max_dist),
         num(s.relaxation), v3(s.background)
     );
+    if s.footprint {
+        let _ = writeln!(
+            out,
+            "epsilon follows the pixel footprint: {}",
+            num(scene.epsilon())
+        );
+    }
     if s.method != Method::Auto {
         let _ = writeln!(out, "method {}", s.method.name());
     }

@@ -453,8 +453,13 @@ pub struct Settings {
     pub aa: u32,
     /// Sphere-tracing step budget per ray.
     pub max_steps: u32,
-    /// Pixel-cone hit tolerance: hit when |d| < epsilon · t.
+    /// Pixel-cone hit tolerance: hit when |d| < epsilon · t (unless `footprint`).
     pub epsilon: f64,
+    /// Whether ε follows the pixel footprint instead of `epsilon`: ε is then the angular
+    /// radius of a pixel, tan(fov/2)/height (see [`Settings::hit_epsilon`]). The checker sets
+    /// it where the file gives no `epsilon` and the field has no proven distance bound
+    /// (docs/accuracy.md, "Fields without a bound"); `--set epsilon` clears it.
+    pub footprint: bool,
     /// Secondary-ray depth limit.
     pub max_depth: u32,
     /// Rays stop beyond this distance.
@@ -503,6 +508,19 @@ impl Method {
     }
 }
 
+impl Settings {
+    /// The ε of the hit test for a camera of field of view `fov` (radians): `epsilon`, or
+    /// where `footprint`, the angular radius of one pixel, tan(fov/2)/height: the surface as a
+    /// cone one pixel wide sees it.
+    pub fn hit_epsilon(&self, fov: f64) -> f64 {
+        if self.footprint {
+            (fov * 0.5).tan() / self.height.max(1) as f64
+        } else {
+            self.epsilon
+        }
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Settings {
@@ -511,6 +529,7 @@ impl Default for Settings {
             aa: 1,
             max_steps: 512,
             epsilon: 1e-5,
+            footprint: false,
             max_depth: 5,
             max_dist: 100.0,
             relaxation: 1.4,
@@ -542,9 +561,60 @@ pub struct Scene {
     /// The limits the scene was checked within: the passes after the checker (the choice of
     /// method, the kernel's data) read theirs from here.
     pub limits: Limits,
+    /// The animation the `render` block states, the time the scene was checked at, and
+    /// whether anything in it read the time `t`.
+    pub animation: Animation,
+}
+
+/// A scene's animation (docs/animation.md): frame `k` is the scene checked at the time
+/// `k / fps` seconds. A scene that never reads `t` is a still: every frame is the same.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Animation {
+    /// Frames per second (`render { fps }`).
+    pub fps: f64,
+    /// Length of the sequence in seconds (`render { duration }`); 0 for none.
+    pub duration: f64,
+    /// The time `t` the scene was checked at, in seconds.
+    pub time: f64,
+    /// Where the checker first read `t` (outside function bodies checked on their own);
+    /// `None` when nothing did: the scene is a still.
+    pub reads_time: Option<crate::span::Span>,
+}
+
+impl Default for Animation {
+    fn default() -> Self {
+        Animation {
+            fps: 30.0,
+            duration: 0.0,
+            time: 0.0,
+            reads_time: None,
+        }
+    }
+}
+
+impl Animation {
+    /// The number of frames the `render` block states: `fps × duration`, rounded.
+    pub fn frames(&self) -> u64 {
+        (self.fps * self.duration).round() as u64
+    }
+
+    /// The time of frame `k`, in seconds.
+    pub fn time_of(fps: f64, k: u64) -> f64 {
+        k as f64 / fps
+    }
+
+    /// Whether the scene reads `t` (otherwise every frame is the same).
+    pub fn animated(&self) -> bool {
+        self.reads_time.is_some()
+    }
 }
 
 impl Scene {
+    /// The ε rays are marched with ([`Settings::hit_epsilon`] for this scene's camera).
+    pub fn epsilon(&self) -> f64 {
+        self.settings.hit_epsilon(self.camera.fov)
+    }
+
     /// Where a checker of cells of edge `size` starts at the scene's origin, in cells: the
     /// written pattern at p + origin is the pattern at p / size + shift. The origin is
     /// reduced modulo two cells (which keeps the parity) so that the shift stays small and

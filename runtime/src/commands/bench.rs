@@ -1,13 +1,14 @@
 //! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps, and
 //! for GPU targets the achieved fraction of the FP32 floor).
 
-use super::render::{override_settings, parse_size, thread_pool, Backend};
+use super::render::{thread_pool, Backend};
 use crate::backend::{Prepared, Setup};
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
-use sdfc_compiler::lower::{LowerOptions, Program};
-use sdfc_compiler::scene::{analytic, Scene};
+use crate::settings::{override_settings, parse_size};
+use sdfc_compiler::lower::{LowerOptions, Lowered};
+use sdfc_compiler::scene::Scene;
 use sdfc_compiler::Limits;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -42,6 +43,22 @@ pub struct BenchArgs {
     /// Print one JSON array instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Time an animated scene's sequence instead (docs/animation.md): every frame checked
+    /// at its time, lowered, prepared again only when its program changed, and rendered, at
+    /// 1920x1080 unless --size says otherwise; reports the sustained frames per second and
+    /// the kernels prepared.
+    #[arg(long)]
+    pub frames_per_second: bool,
+    /// With --frames-per-second: the frames A up to B − 1 (default: the scene's
+    /// `fps × duration`).
+    #[arg(long, value_name = "A..B", value_parser = crate::sequence::Frames::parse)]
+    pub sequence: Option<crate::sequence::Frames>,
+    /// How GPU kernels hold the distance program's constants: read from a buffer, so that
+    /// programs differing only in numbers share one kernel (as `sdfc render` of a sequence and
+    /// `sdfc view` do), or written as literals, a kernel per program (as `sdfc render` of a
+    /// still does). Default: parameters with --frames-per-second, literal otherwise.
+    #[arg(long, value_enum)]
+    pub constants: Option<Constants>,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -101,8 +118,193 @@ pub struct Timing {
     pub stats: Stats,
 }
 
+/// How the kernels of a timed sequence hold the program's constants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Constants {
+    /// Read from the kernel's buffer: one kernel for programs that differ in numbers only.
+    #[default]
+    Parameters,
+    /// Written as literals: a kernel for every program.
+    Literal,
+}
+
+/// The timing of one scene's sequence (`--frames-per-second`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SequenceTiming {
+    /// The scene file.
+    pub scene: String,
+    /// Backend used.
+    pub backend: &'static str,
+    /// The device it ran on.
+    pub device: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The first frame and one past the last (the first, rendered before timing, included).
+    pub frames: [u64; 2],
+    /// Frames timed (all but the first).
+    pub timed: u64,
+    /// Wall seconds of the timed frames, from checking each to its image in host memory.
+    pub seconds: f64,
+    /// Timed frames per second.
+    pub frames_per_s: f64,
+    /// Seconds of the timed frames spent checking and lowering.
+    pub check_s: f64,
+    /// Seconds spent preparing kernels (or CPU tapes) for the timed frames.
+    pub prepare_s: f64,
+    /// Seconds spent rendering the timed frames (wall, readback included).
+    pub render_s: f64,
+    /// Kernels prepared for the whole sequence (the first frame's included).
+    pub kernels: usize,
+}
+
+/// Times the sequence of each scene (`--frames-per-second`).
+fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render::CliError> {
+    use super::render::{check_memory, frame_scene, CliError, Overrides};
+    use super::sequence::Kernels;
+    use sdfc_compiler::scene::Animation;
+    use std::time::{Duration, Instant};
+    let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
+    let limits = args.limits.limits();
+    let overrides = Overrides {
+        reference: false,
+        size: args.size.or(Some((1920, 1080))),
+        aa: args.aa,
+        set: &args.set,
+    };
+    let mut out = Vec::new();
+    for file in &args.file {
+        let mut source = frontend::Source::read(file).map_err(CliError::Usage)?;
+        // The frames are lowered as `sdfc render --frames` lowers them.
+        let lowering = LowerOptions::parametric();
+        let first = frame_scene(overrides, &mut source, &limits, 0.0, true, &lowering)?;
+        let animation = first.scene.animation;
+        let frames = match args.sequence {
+            Some(f) => f,
+            None => crate::sequence::Frames {
+                start: 0,
+                end: animation.frames(),
+            },
+        };
+        if frames.len() < 2 {
+            return Err(CliError::Usage(format!(
+                "{}: --frames-per-second needs at least two frames: the scene's `render` block states {} (fps × duration); give --sequence A..B",
+                file.display(),
+                frames.len()
+            )));
+        }
+        let setup = Setup {
+            precision: args.precision,
+            debug_nan: false,
+            parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
+        };
+        let mut kernels = Kernels::new(&pool, args.backend, setup);
+        let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
+        let mut prepare_before = Duration::ZERO;
+        let mut started = Instant::now();
+        let mut size = (0, 0);
+        for k in frames.start..frames.end {
+            let t0 = Instant::now();
+            let frame = frame_scene(
+                overrides,
+                &mut source,
+                &limits,
+                Animation::time_of(animation.fps, k),
+                false,
+                &lowering,
+            )?;
+            let t1 = Instant::now();
+            let (scene, prepared) = kernels.prepare(frame)?;
+            let t2 = Instant::now();
+            if k == frames.start {
+                check_memory(&pool, prepared, &scene, (false, false), &limits, false)?;
+            }
+            let image = pool
+                .install(|| prepared.render(&scene, &|_| {}))
+                .map_err(CliError::Failed)?;
+            size = (image.render.image.width, image.render.image.height);
+            if k == frames.start {
+                // The first frame is not timed: the device opens and the kernel compiles.
+                prepare_before = kernels.time;
+                started = Instant::now();
+                continue;
+            }
+            check += t1 - t0;
+            render += t2.elapsed();
+        }
+        let seconds = started.elapsed().as_secs_f64();
+        let timed = frames.len() - 1;
+        let prepared = kernels.last().expect("a frame was prepared");
+        out.push(SequenceTiming {
+            scene: file.display().to_string(),
+            backend: prepared.name(),
+            device: prepared.device(),
+            width: size.0,
+            height: size.1,
+            frames: [frames.start, frames.end],
+            timed,
+            seconds,
+            frames_per_s: timed as f64 / seconds,
+            check_s: check.as_secs_f64(),
+            prepare_s: (kernels.time - prepare_before).as_secs_f64(),
+            render_s: render.as_secs_f64(),
+            kernels: kernels.count,
+        });
+    }
+    Ok(out)
+}
+
 /// Runs `sdfc bench`.
 pub fn run(args: BenchArgs) -> ExitCode {
+    if args.frames_per_second {
+        let timings = match run_sequences(&args) {
+            Ok(t) => t,
+            Err(e) => return e.exit(),
+        };
+        if args.json {
+            match serde_json::to_string_pretty(&timings) {
+                Ok(s) => println!("{s}"),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            }
+        } else {
+            println!(
+                "{:<28} {:>7} {:>9} {:>8} {:>9} {:>8} {:>9} {:>9} {:>9}",
+                "scene",
+                "backend",
+                "size",
+                "frames",
+                "frames/s",
+                "kernels",
+                "check ms",
+                "prep ms",
+                "render ms"
+            );
+            for t in &timings {
+                let name = std::path::Path::new(&t.scene)
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| t.scene.clone());
+                let per = |s: f64| s / t.timed as f64 * 1e3;
+                println!(
+                    "{:<28} {:>7} {:>9} {:>8} {:>9.2} {:>8} {:>9.2} {:>9.2} {:>9.2}",
+                    name,
+                    t.backend,
+                    format!("{}x{}", t.width, t.height),
+                    format!("{}..{}", t.frames[0], t.frames[1]),
+                    t.frames_per_s,
+                    t.kernels,
+                    per(t.check_s),
+                    per(t.prepare_s),
+                    per(t.render_s)
+                );
+            }
+        }
+        return ExitCode::SUCCESS;
+    }
     let pool = match thread_pool(args.threads) {
         Ok(p) => p,
         Err(msg) => {
@@ -122,13 +324,13 @@ pub fn run(args: BenchArgs) -> ExitCode {
             eprintln!("error: {msg}");
             return ExitCode::from(2);
         }
-        let program = match checked.lower(&LowerOptions::default(), &limits) {
-            Ok(p) => p,
+        let lowered = match checked.lower(&LowerOptions::default(), &limits) {
+            Ok(l) => l,
             Err(code) => return code,
         };
         let name = file.display().to_string();
         let scene = &checked.scene;
-        let t = match pool.install(|| time_scene(&args, name, scene, program, &limits)) {
+        let t = match pool.install(|| time_scene(&args, name, scene, lowered, &limits)) {
             Ok(t) => t,
             Err(msg) => {
                 eprintln!("error: {}: {msg}", file.display());
@@ -161,16 +363,17 @@ fn time_scene(
     args: &BenchArgs,
     name: String,
     scene: &Scene,
-    program: Program,
+    lowered: Lowered,
     limits: &Limits,
 ) -> Result<Timing, String> {
-    let ops_per_eval = fp32::distance_ops(&program);
-    let guarded = !program.blocks().is_empty();
+    let ops_per_eval = fp32::distance_ops(&lowered.program);
+    let guarded = !lowered.program.blocks().is_empty();
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
+        parameters: args.constants == Some(Constants::Parameters),
     };
-    let prepared = Prepared::from_program(args.backend, scene, program, &setup)?;
+    let prepared = Prepared::from_program(args.backend, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);
     frame.host = frame
@@ -190,7 +393,7 @@ fn time_scene(
     let median = times[times.len() / 2];
     let c = &last.stats.counters;
     let s = &scene.settings;
-    let traced = analytic::choose(scene).primitives().is_some();
+    let traced = prepared.traceable().traced(s.method).is_some();
     let evaluations = if traced { 0 } else { fp32::evaluations(c) };
     let peak = match prepared {
         Prepared::Cpu { .. } => None,
@@ -219,7 +422,7 @@ fn time_scene(
         mrays_per_s: c.camera_rays as f64 / median / 1e6,
         total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
         method: if traced { "trace" } else { "march" },
-        program_len: prepared.program_len(scene),
+        program_len: prepared.program_len(),
         ops_per_eval,
         evaluations,
         fp32_peak_tflops: peak.map(|p| p / 1e12),

@@ -1,11 +1,10 @@
 //! `sdfc check`: report every mistake in one or more scene files, and what the analysis
 //! derived about each scene's distance field.
 
-use crate::frontend::{self, DiagnosticFormat, Loaded};
-use sdfc_compiler::scene::analysis::{self, Analysis};
-use sdfc_compiler::scene::analytic::{self, Choice, Reason};
-use sdfc_compiler::scene::{Exactness, Scene};
-use sdfc_compiler::Span;
+use crate::frontend::{self, DiagnosticFormat};
+use sdfc_compiler::diagnostics::number;
+use sdfc_compiler::scene::analysis;
+use sdfc_compiler::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -38,15 +37,22 @@ pub fn run(args: CheckArgs) -> ExitCode {
                 frontend::report(&loaded, args.diagnostics);
                 match &loaded.scene {
                     None => code = code.max(1),
-                    Some(scene) if args.diagnostics == DiagnosticFormat::Human => {
-                        eprintln!(
-                            "{}: ok; {}; {}",
-                            file.display(),
-                            summary(&loaded, scene),
-                            method(&loaded, scene)
-                        );
+                    Some(scene) => {
+                        let human = args.diagnostics == DiagnosticFormat::Human;
+                        if human {
+                            eprintln!(
+                                "{}: ok; {}; {}",
+                                file.display(),
+                                frontend::summary(&loaded, scene),
+                                frontend::method(&loaded, scene)
+                            );
+                        }
+                        match animation(file, scene, &limits, args.diagnostics) {
+                            Ok(line) if human => eprintln!("{}: {line}", file.display()),
+                            Ok(_) => {}
+                            Err(c) => code = code.max(c),
+                        }
                     }
-                    Some(_) => {}
                 }
             }
         }
@@ -54,71 +60,108 @@ pub fn run(args: CheckArgs) -> ExitCode {
     ExitCode::from(code)
 }
 
-/// What the analysis derived for the scene, in one clause: `distance field: bound (L = 1)`,
-/// or, when inexact, with the construct responsible, and, where L > 1, that the lowering
-/// divides it out locally (each operand by its own L, `docs/analysis.md`).
-pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
-    let analysis = analysis::analyse(scene);
-    let Some(root) = analysis.root() else {
-        return "no objects".into();
-    };
-    let facts = root.facts;
-    let word = analysis::describe(facts.exactness);
-    let l = facts.lipschitz;
-    let cause = cause(loaded, scene, &analysis);
-    let step = analysis.step_lipschitz();
-    match facts.exactness {
-        Exactness::Exact | Exactness::Bound => format!("distance field: {word} (L = {})", num(l)),
-        Exactness::Approximate if !root.proven => format!(
-            "distance field: {word}, no bound proven{cause}; steps with L = {}",
-            num(step)
-        ),
-        Exactness::Approximate if step < l => format!(
-            "distance field: {word}, L = {}{cause}, clamped to {}; divided out locally",
-            num(l),
-            num(step)
-        ),
-        Exactness::Approximate if l > 1.0 => format!(
-            "distance field: {word}, L = {}{cause}; divided out locally",
-            num(l)
-        ),
-        Exactness::Approximate => format!("distance field: {word}, L = {}{cause}", num(l)),
+/// Whether the scene is a still, an animation whose frames differ only in numbers, or one
+/// whose structure changes, and the analysis of every frame (each frame is checked, analysed
+/// and lowered on its own: the facts are computed per frame). `Err` is the exit code of a
+/// frame that does not check or cannot be read again (its diagnostics printed).
+pub fn animation(
+    file: &std::path::Path,
+    scene: &Scene,
+    limits: &sdfc_compiler::Limits,
+    format: DiagnosticFormat,
+) -> Result<String, u8> {
+    use sdfc_compiler::animation::{runs, Structure};
+    use sdfc_compiler::scene::Animation;
+    let a = scene.animation;
+    if !a.animated() {
+        return Ok("still (nothing reads `t`)".into());
     }
-}
-
-/// How the scene is rendered and why: `method: trace (...)` or `method: march (...)`, with
-/// the location of the node that rules out analytic tracing.
-pub fn method(loaded: &Loaded, scene: &Scene) -> String {
-    match analytic::choose(scene) {
-        Choice::March(Reason::Node { what, span }) => format!(
-            "method: march (the {what} at {} has no closed-form ray intersection)",
-            at(loaded, span)
-        ),
-        Choice::March(Reason::Overlap { span }) => format!(
-            "method: march (the transparent shape at {} overlaps or touches another one)",
-            at(loaded, span)
-        ),
-        choice => choice.describe(),
+    let n = a.frames();
+    if n == 0 {
+        return Ok(
+            "reads `t` but `render` states no `duration`: a still at t = 0 unless rendered with --frames"
+                .into(),
+        );
     }
-}
-
-/// `FILE:LINE:COL` of a span.
-fn at(loaded: &Loaded, span: Span) -> String {
-    let (line, col) = loaded.sources.line_col(span);
-    format!("{}:{line}:{col}", loaded.sources.name(span.file))
-}
-
-/// ` (the twist at FILE:LINE:COL)` for the node that made the field inexact, or nothing.
-fn cause(loaded: &Loaded, scene: &Scene, analysis: &Analysis) -> String {
-    let Some(id) = analysis.root().and_then(|r| r.cause) else {
-        return String::new();
+    let mut source = frontend::Source::read(file).map_err(|msg| {
+        eprintln!("error: {msg}");
+        2u8
+    })?;
+    let mut structures = Vec::new();
+    let (mut exactness, mut lmin, mut lmax, mut traced) = (Vec::new(), f64::MAX, 0f64, 0u64);
+    for k in 0..n {
+        let time = Animation::time_of(a.fps, k);
+        let mut loaded = source.check(limits, time);
+        loaded.diagnostics.retain(|d| d.is_error());
+        frontend::report(&loaded, format);
+        let Some(scene) = loaded.scene else {
+            eprintln!("error: frame {k} (t = {time} s) has errors");
+            return Err(1);
+        };
+        // Lowered as `sdfc render --frames` lowers a sequence's frames.
+        let program = match sdfc_compiler::lower::lower_within(
+            &scene,
+            &sdfc_compiler::lower::LowerOptions::parametric(),
+            limits,
+        ) {
+            Ok(p) => p,
+            Err(d) => {
+                frontend::print_diagnostics(&[d], &loaded.sources, format);
+                eprintln!("error: frame {k} (t = {time} s) cannot be lowered");
+                return Err(1);
+            }
+        };
+        let analysis = analysis::analyse(&scene);
+        if let Some(root) = analysis.root() {
+            let word = analysis::describe(root.facts.exactness);
+            if !exactness.contains(&word) {
+                exactness.push(word);
+            }
+            lmin = lmin.min(analysis.step_lipschitz());
+            lmax = lmax.max(analysis.step_lipschitz());
+        }
+        let structure = Structure::of(&scene, &program.program);
+        traced += u64::from(structure.traced());
+        structures.push(structure);
+    }
+    let starts = runs(structures.iter().enumerate().map(|(k, s)| (k as u64, s)));
+    let distinct = {
+        let mut d: Vec<&Structure> = Vec::new();
+        for s in &structures {
+            if !d.contains(&s) {
+                d.push(s);
+            }
+        }
+        d.len()
     };
-    let kind = analysis::kind(scene.graph.node(id));
-    format!(" (the {kind} at {})", at(loaded, scene.graph.span(id)))
-}
-
-/// A number with at most three decimals and no trailing zeros.
-fn num(x: f64) -> String {
-    let s = format!("{x:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
+    let kind = if distinct == 1 && traced > 0 {
+        "animated, numbers only: every frame has the same structure (traced analytically: the GPU kernel holds the primitives' numbers and is built again for each frame whose numbers change)".to_string()
+    } else if distinct == 1 {
+        "animated, numbers only: every frame has the same structure (one GPU kernel for the sequence)".to_string()
+    } else {
+        format!(
+            "animated, structure varies: {distinct} structures, changing at frame{} {} (the kernel is specialised again there)",
+            if starts.len() == 2 { "" } else { "s" },
+            starts[1..]
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    let l = if lmin == lmax {
+        format!("L = {}", number(lmin, 3))
+    } else {
+        format!("L from {} to {}", number(lmin, 3), number(lmax, 3))
+    };
+    let method = match traced {
+        0 => "marched in every frame".to_string(),
+        t if t == n => "traced in every frame".to_string(),
+        t => format!("traced in {t} frames, marched in {}", n - t),
+    };
+    Ok(format!(
+        "{kind}; {n} frames at {} fps; per frame: distance field {} ({l}), {method}",
+        number(a.fps, 3),
+        exactness.join(" or ")
+    ))
 }

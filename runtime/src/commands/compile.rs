@@ -86,14 +86,14 @@ pub fn run(args: CompileArgs) -> ExitCode {
                 return write_output(args.output.as_deref(), &scene::dump(scene));
             }
             let options = lower::LowerOptions::level(args.opt);
-            let program = match lower::lower_within(scene, &options, &limits) {
-                Ok(program) => program,
+            let lowered = match lower::lower_within(scene, &options, &limits) {
+                Ok(lowered) => lowered,
                 Err(d) => {
                     frontend::print_diagnostics(&[d], &loaded.sources, args.diagnostics);
                     return ExitCode::from(1);
                 }
             };
-            match emit(scene, &program, other, args.sm) {
+            match emit(scene, &lowered, other, args.sm) {
                 Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
                 Err(msg) => {
                     eprintln!("{msg}");
@@ -108,10 +108,11 @@ pub fn run(args: CompileArgs) -> ExitCode {
 /// The bytes of a target that needs the distance program.
 fn emit(
     scene: &scene::Scene,
-    program: &lower::Program,
+    lowered: &lower::Lowered,
     target: Emit,
     sm: u32,
 ) -> Result<Vec<u8>, String> {
+    let program = &lowered.program;
     let lang = match target {
         Emit::Program => return Ok(program.dump().into_bytes()),
         Emit::Rust => return Ok(back::rust::write(program).into_bytes()),
@@ -124,7 +125,7 @@ fn emit(
         Emit::Hlsl => Some(Lang::Hlsl),
         Emit::Wgsl | Emit::Ptx => None,
     };
-    let kernel = back::wgsl::write(scene, program).map_err(|e| e.to_string())?;
+    let kernel = back::wgsl::write(scene, lowered).map_err(|e| e.to_string())?;
     if target == Emit::Ptx {
         let options = back::ptx::Options {
             sm,

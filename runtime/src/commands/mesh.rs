@@ -181,10 +181,10 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         voxel,
         cells: cells.map(|n| n as u32),
     };
-    let program = checked
+    let lowered = checked
         .lower(&LowerOptions::default(), &limits)
         .map_err(|_| (1, String::new()))?;
-    let field = Field::new(&program, root.proven, clip);
+    let field = Field::new(&lowered.program, root.proven, clip);
     if !root.proven {
         eprintln!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",

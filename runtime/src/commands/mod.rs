@@ -8,6 +8,7 @@ pub mod compile;
 pub mod mesh;
 pub mod pareto;
 pub mod render;
+pub mod sequence;
 pub mod view;
 
 use sdfc_compiler::{Limit, Limits};

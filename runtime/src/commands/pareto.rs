@@ -3,14 +3,17 @@
 //! reference render (PSNR, and first-hit differences where both have depth buffers), marks the
 //! Pareto front and draws the chart (`crate::chart`).
 
-use super::render::{self, override_settings, parse_size, thread_pool, Backend};
+use super::render::{self, thread_pool, Backend};
 use crate::backend::{Prepared, Setup};
 use crate::chart::{self, Chart};
 use crate::cpu::reference::{self, Convergence};
 use crate::cpu::{Precision, Render};
 use crate::frontend::{self, DiagnosticFormat};
 use crate::metrics::{self, DepthDifference};
-use sdfc_compiler::lower::{LowerOptions, Program};
+use crate::settings::{self, override_settings, parse_size};
+use sdfc_compiler::diagnostics::scientific;
+use sdfc_compiler::lower::LowerOptions;
+use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use sdfc_compiler::{Limit, Limits};
 use std::path::PathBuf;
@@ -106,7 +109,7 @@ impl Key {
 
     /// Sets the value in `s`, checking its range as `--set` does.
     pub fn set(self, s: &mut Settings, v: f64, limits: &Limits) -> Result<(), String> {
-        render::set(s, self.name(), &format!("{v}"), limits)
+        settings::set(s, self.name(), &format!("{v}"), limits)
     }
 
     /// Whether the values are whole numbers.
@@ -417,11 +420,11 @@ pub fn run(args: ParetoArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let program = match checked.lower(&LowerOptions::default(), &limits) {
+    let lowered = match checked.lower(&LowerOptions::default(), &limits) {
         Ok(p) => p,
         Err(code) => return code,
     };
-    let report = match pool.install(|| measure(&args, &checked.scene, program, points, &limits)) {
+    let report = match pool.install(|| measure(&args, &checked.scene, lowered, points, &limits)) {
         Ok(r) => r,
         Err(msg) => {
             eprintln!("error: {msg}");
@@ -474,7 +477,7 @@ fn finish(args: &ParetoArgs, report: &Report) -> ExitCode {
 fn measure(
     args: &ParetoArgs,
     scene: &Scene,
-    program: Program,
+    lowered: Lowered,
     mut points: Vec<Settings>,
     limits: &Limits,
 ) -> Result<Report, String> {
@@ -485,10 +488,11 @@ fn measure(
     let setup = Setup {
         precision: args.precision,
         debug_nan: false,
+        parameters: false,
     };
-    let mut prepared = Prepared::from_program(args.backend, scene, program.clone(), &setup)
+    let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
-    let (reference_scene, reference_prepared) = reference_setup(scene, program, &points)?;
+    let (reference_scene, reference_prepared) = reference_setup(scene, lowered, &points)?;
     // The reference frame is held while each point renders.
     let held = reference_prepared.retained(&reference_scene.settings);
     let reference_memory =
@@ -554,13 +558,19 @@ fn same(a: &Settings, b: &Settings) -> bool {
     [Key::Epsilon, Key::MaxSteps, Key::Relaxation, Key::Aa]
         .iter()
         .all(|k| k.get(a) == k.get(b))
+        && a.footprint == b.footprint
 }
 
-/// `ε 1e-4, 256 steps, ω 1, aa 1`.
+/// `ε 1e-4, 256 steps, ω 1, aa 1` (`ε footprint, …` where ε follows the pixel footprint).
 pub fn describe(s: &Settings) -> String {
+    let epsilon = if s.footprint {
+        "footprint".to_string()
+    } else {
+        format!("{:e}", s.epsilon)
+    };
     format!(
-        "ε {:e}, {} steps, ω {}, aa {}",
-        s.epsilon, s.max_steps, s.relaxation, s.aa
+        "ε {epsilon}, {} steps, ω {}, aa {}",
+        s.max_steps, s.relaxation, s.aa
     )
 }
 
@@ -568,7 +578,7 @@ pub fn describe(s: &Settings) -> String {
 /// on the CPU in f64.
 fn reference_setup(
     scene: &Scene,
-    program: Program,
+    lowered: Lowered,
     points: &[Settings],
 ) -> Result<(Scene, Prepared), String> {
     let aa = points
@@ -578,16 +588,18 @@ fn reference_setup(
         .unwrap_or(scene.settings.aa);
     let mut reference_scene = scene.clone();
     // The most exact render the scene allows: analytic tracing where it can be traced.
-    reference_scene.settings = reference::settings(&Settings {
+    reference_scene.settings = Settings {
         aa,
         method: Method::Auto,
         ..scene.settings.clone()
-    });
+    };
+    reference_scene.settings = reference::settings_of(&reference_scene);
     let setup = Setup {
         precision: Precision::F64,
         debug_nan: false,
+        parameters: false,
     };
-    let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, program, &setup)?;
+    let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
     Ok((reference_scene, prepared))
 }
 
@@ -605,8 +617,10 @@ fn reference_render(
         eprintln!("warning: {}", render::not_converged(&convergence));
     }
     eprintln!(
-        "reference: aa {aa}, {seconds:.1} s; agrees with ε {:e} to {:.2} dB",
-        convergence.check_epsilon, convergence.difference.psnr
+        "reference: aa {aa}, {seconds:.1} s; agrees with ε {}, aa {} to {:.2} dB",
+        scientific(convergence.check_epsilon),
+        convergence.check_aa,
+        convergence.difference.psnr
     );
     Ok((
         frame.render,
@@ -645,7 +659,7 @@ fn measure_one(
         _ => None,
     };
     Ok(Measured {
-        epsilon: settings.epsilon,
+        epsilon: point.epsilon(),
         max_steps: settings.max_steps,
         relaxation: settings.relaxation,
         aa: settings.aa,
@@ -741,25 +755,28 @@ pub fn chart_of(r: &Report, target: f64) -> Chart {
         .find(|m| m.default)
         .map(|m| {
             format!(
-                "scene's settings: ε {:e}, {} steps, ω {}",
-                m.epsilon, m.max_steps, m.relaxation
+                "scene's settings: ε {}, {} steps, ω {}",
+                scientific(m.epsilon),
+                m.max_steps,
+                m.relaxation
             )
         })
         .unwrap_or_else(|| "scene's settings".into());
     Chart {
         title: format!("{name}: speed against accuracy ({} points)", r.points.len()),
         subtitle: format!(
-            "{} on {}, {} {}x{}, median of {} frames; reference: CPU f64, ε {:e}, {} steps, aa {}; it agrees with ε {:e} to {:.1} dB{}",
+            "{} on {}, {} {}x{}, median of {} frames; reference: CPU f64, ε {}, {} steps, aa {}; it agrees with ε {}, aa {} to {:.1} dB{}",
             r.backend,
             r.device,
             r.precision,
             r.width,
             r.height,
             r.frames,
-            c.epsilon,
+            scientific(c.epsilon),
             c.max_steps,
             r.reference.aa,
-            c.check_epsilon,
+            scientific(c.check_epsilon),
+            c.check_aa,
             c.difference.psnr,
             if c.converged { "" } else { " (not converged)" }
         ),

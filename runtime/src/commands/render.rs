@@ -8,11 +8,12 @@ use crate::cpu::reference::{self, Convergence};
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat};
 use crate::output::Output;
+use crate::settings::{override_settings, parse_size};
 use crate::{depth, memory};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::lower::LowerOptions;
-use sdfc_compiler::scene::{Method, Scene, Settings};
-use sdfc_compiler::{Limit, Limits};
+use sdfc_compiler::scene::Scene;
+use sdfc_compiler::Limits;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -40,7 +41,9 @@ pub struct RenderArgs {
     pub set: Vec<String>,
     /// Output image: .png, .jpg (or .jpeg), or .exr (linear, unclamped 32-bit floats); `-`
     /// writes the PNG to standard output (default: the scene file's name with .png, in the
-    /// current directory).
+    /// current directory). For a sequence: a name with a run of `#` (the zero-padded frame
+    /// number, `out/frame_####.png`), an animated `.png`, or a video (`.mp4`, `.webm`,
+    /// `.mkv`, `.mov`, `.gif`) through `ffmpeg` on PATH.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Print render statistics.
@@ -54,8 +57,9 @@ pub struct RenderArgs {
     pub threads: Option<usize>,
     /// Render the reference: on the CPU in f64 with ε 1e-6, 100000 steps and no
     /// over-relaxation (`--set` still applies on top), then check it against a render with ε
-    /// ten times smaller; `--stats` prints how well they agree, and a warning says when they
-    /// do not.
+    /// ten times smaller; for a field with no proven bound, the area average of at least 8×8
+    /// samples at the pixel footprint's ε, checked against twice the samples per axis.
+    /// `--stats` prints how well they agree, and a warning says when they do not.
     #[arg(long)]
     pub reference: bool,
     /// Also write the depth and hit buffers as a sidecar file beside the image (OUT.aux; see
@@ -66,106 +70,231 @@ pub struct RenderArgs {
     /// instead of what they would show. Without it, images are unchanged.
     #[arg(long)]
     pub debug_nan: bool,
+    /// Render the frames A up to B − 1 of the animation (docs/animation.md), at the times
+    /// k / fps; without it, an output pattern with `#` renders the frames the scene's
+    /// `render { fps, duration }` states.
+    #[arg(long, value_name = "A..B", value_parser = crate::sequence::Frames::parse)]
+    pub frames: Option<crate::sequence::Frames>,
+    /// Frames per second of the sequence (overrides `render { fps }`).
+    #[arg(long, value_name = "F")]
+    pub fps: Option<f64>,
+    /// Render only the frames whose number is ≡ I (mod N): shard I of N of a job array
+    /// (`--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`).
+    #[arg(long, value_name = "I/N", value_parser = crate::sequence::Shard::parse)]
+    pub shard: Option<crate::sequence::Shard>,
+    /// Render frames whose files exist already (by default they are skipped, so that a
+    /// killed job resumes where it stopped).
+    #[arg(long)]
+    pub force: bool,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
 
-/// Runs `sdfc render`.
+/// A failure of a command, with the exit code it gives: 2 for usage and IO problems, 1 for
+/// a scene with errors or a render that failed. `Reported` has been printed already (the
+/// scene's diagnostics).
+#[derive(Debug)]
+pub enum CliError {
+    /// Bad arguments, or a file that cannot be read or written (exit 2).
+    Usage(String),
+    /// The scene or the render failed (exit 1).
+    Failed(String),
+    /// Already reported; exit with this code.
+    Reported(ExitCode),
+}
+
+impl CliError {
+    /// Prints the error (unless it was reported) and gives the exit code.
+    pub fn exit(self) -> ExitCode {
+        match self {
+            CliError::Usage(msg) => {
+                eprintln!("error: {msg}");
+                ExitCode::from(2)
+            }
+            CliError::Failed(msg) => {
+                eprintln!("error: {msg}");
+                ExitCode::from(1)
+            }
+            CliError::Reported(code) => code,
+        }
+    }
+}
+
+/// Runs `sdfc render`: one image, or a sequence of frames (`--frames`, or an output pattern
+/// with `#`; docs/animation.md).
 pub fn run(args: RenderArgs) -> ExitCode {
-    let limits = args.limits.limits();
-    let mut checked = match frontend::load_scene(&args.file, DiagnosticFormat::Human, &limits) {
-        Ok(c) => c,
-        Err(code) => return code,
+    let sequence = args.frames.is_some()
+        || args
+            .output
+            .as_deref()
+            .is_some_and(|o| o.to_string_lossy().contains('#'));
+    let result = if sequence {
+        super::sequence::run(&args)
+    } else {
+        still(&args)
     };
-    let (backend, precision) = match reference_mode(&args) {
-        Ok(b) => b,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => e.exit(),
+    }
+}
+
+/// A scene checked at one time, with its settings overridden by the arguments, and lowered.
+#[derive(Debug)]
+pub struct FrameScene {
+    /// The scene, settings applied.
+    pub scene: Scene,
+    /// Its distance program and what else the backends read.
+    pub lowered: sdfc_compiler::lower::Lowered,
+}
+
+/// The settings a command overrides in every frame it checks.
+#[derive(Debug, Clone, Copy)]
+pub struct Overrides<'a> {
+    /// `--reference`: the reference render's settings first.
+    pub reference: bool,
+    /// `--size`.
+    pub size: Option<(u32, u32)>,
+    /// `--aa`.
+    pub aa: Option<u32>,
+    /// `--set`, in order.
+    pub set: &'a [String],
+}
+
+impl RenderArgs {
+    /// The settings `render` overrides.
+    pub fn overrides(&self) -> Overrides<'_> {
+        Overrides {
+            reference: self.reference,
+            size: self.size,
+            aa: self.aa,
+            set: &self.set,
         }
+    }
+}
+
+/// Checks `source` at `time`, prints its diagnostics (warnings only when `warnings`), applies
+/// `--reference`, `--size`, `--aa` and `--set`, and lowers it with `lowering` (a sequence's
+/// frames with [`LowerOptions::parametric`]).
+pub fn frame_scene(
+    args: Overrides,
+    source: &mut frontend::Source,
+    limits: &Limits,
+    time: f64,
+    warnings: bool,
+    lowering: &LowerOptions,
+) -> Result<FrameScene, CliError> {
+    let mut loaded = source.check(limits, time);
+    if !warnings {
+        loaded.diagnostics.retain(|d| d.is_error());
+    }
+    frontend::report(&loaded, DiagnosticFormat::Human);
+    let Some(mut scene) = loaded.scene else {
+        return Err(CliError::Reported(ExitCode::from(1)));
     };
-    // The output is checked before any work, so that a render is never thrown away.
-    let out = match output(&args) {
-        Ok(o) => o,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
-        }
-    };
-    let settings = &mut checked.scene.settings;
     if args.reference {
-        *settings = reference::settings(settings);
+        scene.settings = reference::settings_of(&scene);
     }
-    if let Err(msg) = override_settings(settings, args.size, args.aa, &args.set, &limits) {
-        eprintln!("error: {msg}");
-        return ExitCode::from(2);
-    }
-    if let Err(msg) = crate::backend::method_allowed(&checked.scene) {
-        eprintln!("error: {msg}");
-        return ExitCode::from(1);
-    }
-    let pool = match thread_pool(args.threads) {
-        Ok(p) => p,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
-        }
+    let settings = &mut scene.settings;
+    override_settings(settings, args.size, args.aa, args.set, limits).map_err(CliError::Usage)?;
+    crate::backend::method_allowed(&scene).map_err(CliError::Failed)?;
+    let checked = frontend::Checked {
+        scene,
+        sources: loaded.sources,
+        format: DiagnosticFormat::Human,
     };
-    let program = match checked.lower(&LowerOptions::default(), &limits) {
-        Ok(p) => p,
-        Err(code) => return code,
-    };
-    let scene = checked.scene;
+    let lowered = checked
+        .lower(lowering, limits)
+        .map_err(CliError::Reported)?;
+    Ok(FrameScene {
+        scene: checked.scene,
+        lowered,
+    })
+}
+
+/// Prepares a frame's scene on the backend.
+pub fn prepare(
+    pool: &rayon::ThreadPool,
+    backend: Backend,
+    frame: FrameScene,
+    setup: &Setup,
+) -> Result<(Scene, Prepared), CliError> {
+    let FrameScene { scene, lowered } = frame;
+    let prepared = pool
+        .install(|| Prepared::from_program(backend, &scene, lowered, setup))
+        .map_err(|msg| {
+            CliError::Failed(format!("the {backend:?} backend is not available: {msg}"))
+        })?;
+    Ok((scene, prepared))
+}
+
+/// What a render of `scene` on `prepared` allocates (with the reference's check and the
+/// depth sidecar when asked), announced (when `announce`) and held to the `memory` limit.
+pub fn check_memory(
+    pool: &rayon::ThreadPool,
+    prepared: &Prepared,
+    scene: &Scene,
+    (reference, aux): (bool, bool),
+    limits: &Limits,
+    announce: bool,
+) -> Result<(), CliError> {
+    let needed = pool.install(|| memory::render(prepared, scene, reference, aux));
+    if announce {
+        eprintln!(
+            "{}",
+            memory::announce(&scene.settings, prepared.name(), &needed)
+        );
+    }
+    needed.check(limits).map_err(CliError::Failed)
+}
+
+/// Renders one image (the scene at the time 0).
+fn still(args: &RenderArgs) -> Result<(), CliError> {
+    let limits = args.limits.limits();
+    let mut source = frontend::Source::read(&args.file).map_err(CliError::Usage)?;
+    let frame = frame_scene(
+        args.overrides(),
+        &mut source,
+        &limits,
+        0.0,
+        true,
+        &LowerOptions::default(),
+    )?;
+    let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
+    // The output is checked before any work, so that a render is never thrown away.
+    let out = output(args).map_err(CliError::Usage)?;
+    let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
     let setup = Setup {
         precision,
         debug_nan: args.debug_nan,
+        parameters: false,
     };
-    let prepared = match pool.install(|| Prepared::from_program(backend, &scene, program, &setup)) {
-        Ok(p) => p,
-        Err(msg) => {
-            eprintln!("error: the {backend:?} backend is not available: {msg}");
-            return ExitCode::from(1);
-        }
-    };
-    let needed = pool.install(|| memory::render(&prepared, &scene, args.reference, args.aux));
-    eprintln!(
-        "{}",
-        memory::announce(&scene.settings, prepared.name(), &needed)
-    );
-    if let Err(msg) = needed.check(&limits) {
-        eprintln!("error: {msg}");
-        return ExitCode::from(1);
-    }
+    let (scene, prepared) = prepare(&pool, backend, frame, &setup)?;
+    check_memory(
+        &pool,
+        &prepared,
+        &scene,
+        (args.reference, args.aux),
+        &limits,
+        true,
+    )?;
     let started = Instant::now();
-    let frame = match pool.install(|| render_with_progress(&prepared, &scene)) {
-        Ok(f) => f,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return ExitCode::from(1);
-        }
-    };
+    let frame = pool
+        .install(|| render_with_progress(&prepared, &scene))
+        .map_err(CliError::Failed)?;
     let seconds = started.elapsed().as_secs_f64();
     let check = if args.reference {
-        match pool.install(|| check_reference(&prepared, &scene, &frame)) {
-            Ok(c) => Some(c),
-            Err(msg) => {
-                eprintln!("error: {msg}");
-                return ExitCode::from(1);
-            }
-        }
+        Some(
+            pool.install(|| check_reference(&prepared, &scene, &frame))
+                .map_err(CliError::Failed)?,
+        )
     } else {
         None
     };
-    let render = frame.render;
-    if let Err(msg) = out.write(&render.image) {
-        eprintln!("error: {msg}");
-        return ExitCode::from(2);
-    }
+    out.write(&frame.render.image).map_err(CliError::Usage)?;
     if let (true, Some(path)) = (args.aux, out.path()) {
-        if let Err(msg) = write_sidecar(path, render.depth.as_ref(), prepared.name()) {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
-        }
+        write_sidecar(path, frame.render.depth.as_ref(), prepared.name())
+            .map_err(CliError::Usage)?;
     }
     let s = &scene.settings;
     eprintln!(
@@ -179,23 +308,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         seconds
     );
     if args.stats {
-        let mut text = format!(
-            "backend         {} ({})\n",
-            prepared.name(),
-            prepared.device()
-        );
-        if let Some(p) = prepared.preparation() {
-            text.push_str(&format!("prepared        {p}\n"));
-        }
-        text.push_str(&format!(
-            "time            {:.3} s (frame {:.3} s)\n{}\n",
-            seconds,
-            frame.time.as_secs_f64(),
-            render.stats
-        ));
-        if let Some(c) = &check {
-            text.push_str(&format!("{c}\n"));
-        }
+        let text = stats(&prepared, seconds, &frame, check.as_ref());
         // With the image on standard output, the statistics go to standard error.
         if out == Output::Stdout {
             eprint!("{text}");
@@ -206,7 +319,34 @@ pub fn run(args: RenderArgs) -> ExitCode {
     if let Some(c) = check.as_ref().filter(|c| !c.converged) {
         eprintln!("warning: {}", not_converged(c));
     }
-    ExitCode::SUCCESS
+    Ok(())
+}
+
+/// The text of `--stats` for one frame.
+pub fn stats(
+    prepared: &Prepared,
+    seconds: f64,
+    frame: &Frame,
+    check: Option<&Convergence>,
+) -> String {
+    let mut text = format!(
+        "backend         {} ({})\n",
+        prepared.name(),
+        prepared.device()
+    );
+    if let Some(p) = prepared.preparation() {
+        text.push_str(&format!("prepared        {p}\n"));
+    }
+    text.push_str(&format!(
+        "time            {:.3} s (frame {:.3} s)\n{}\n",
+        seconds,
+        frame.time.as_secs_f64(),
+        frame.render.stats
+    ));
+    if let Some(c) = check {
+        text.push_str(&format!("{c}\n"));
+    }
+    text
 }
 
 /// Where the image goes (`-o`, or the scene's name with `.png` in the current directory),
@@ -234,7 +374,7 @@ fn output(args: &RenderArgs) -> Result<Output, String> {
 }
 
 /// The backend and precision of a render: `--reference` means the CPU in f64.
-fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
+pub fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
     if !args.reference {
         return Ok((args.backend, args.precision));
     }
@@ -247,7 +387,8 @@ fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
     }
 }
 
-/// Renders the convergence check of a reference frame (ε divided by ten) and compares.
+/// Renders the convergence check of a reference frame (ε divided by ten, or twice the samples
+/// per axis for an area-averaged reference) and compares.
 pub fn check_reference(
     prepared: &Prepared,
     scene: &Scene,
@@ -256,18 +397,15 @@ pub fn check_reference(
     let mut finer = scene.clone();
     finer.settings = reference::check_settings(&scene.settings);
     let check = prepared.render(&finer, &|_| {})?;
-    Ok(reference::convergence(
-        &scene.settings,
-        &frame.render,
-        &check.render,
-    ))
+    Ok(reference::convergence(scene, &frame.render, &check.render))
 }
 
 /// The warning printed for a reference that did not converge.
 pub fn not_converged(c: &Convergence) -> String {
     format!(
-        "the reference has not converged: against ε {:e} it reaches {:.1} dB (needs {} dB), max difference {:.3}, and {} rays ran out of {} steps; its error is not far below the errors it would measure",
-        c.check_epsilon,
+        "the reference has not converged: against ε {}, aa {} it reaches {:.1} dB (needs {} dB), max difference {:.3}, and {} rays ran out of {} steps; its error is not far below the errors it would measure",
+        sdfc_compiler::diagnostics::scientific(c.check_epsilon),
+        c.check_aa,
         c.difference.psnr,
         reference::CONVERGED_PSNR,
         c.difference.max,
@@ -303,7 +441,7 @@ fn write_sidecar(image: &Path, depth: Option<&depth::Depth>, backend: &str) -> R
 }
 
 /// Renders with a progress bar on stderr when stderr is a terminal.
-fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame, String> {
+pub fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame, String> {
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = ProgressBar::new(1000);
         if let Ok(style) =
@@ -344,142 +482,4 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> 
     }
     b.build()
         .map_err(|e| format!("cannot start worker threads: {e}"))
-}
-
-/// Parses `WIDTHxHEIGHT` (each edge is checked against the `edge` limit when applied).
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, like 640x480, not `{s}`"))?;
-    let ceiling = Limit::Edge.ceiling() as u32;
-    let w = int("width", w.trim(), 1, ceiling, None)?;
-    let h = int("height", h.trim(), 1, ceiling, None)?;
-    Ok((w, h))
-}
-
-/// Applies `--size`, `--aa` and then each `--set key=value`, in order, within `limits`.
-pub fn override_settings(
-    s: &mut Settings,
-    size: Option<(u32, u32)>,
-    aa: Option<u32>,
-    sets: &[String],
-    limits: &Limits,
-) -> Result<(), String> {
-    if let Some((w, h)) = size {
-        set(s, "width", &w.to_string(), limits)?;
-        set(s, "height", &h.to_string(), limits)?;
-    }
-    if let Some(n) = aa {
-        set(s, "aa", &n.to_string(), limits)?;
-    }
-    for item in sets {
-        let (key, value) = item
-            .split_once('=')
-            .ok_or_else(|| format!("--set expects KEY=VALUE, like max_steps=512, not `{item}`"))?;
-        set(s, key.trim(), value.trim(), limits)?;
-    }
-    Ok(())
-}
-
-/// The keys `--set` accepts.
-pub const SETTING_KEYS: &[&str] = &[
-    "width",
-    "height",
-    "aa",
-    "max_steps",
-    "epsilon",
-    "max_depth",
-    "max_dist",
-    "relaxation",
-    "background",
-    "method",
-];
-
-/// Sets one render setting from text, checking its range (the top of the range of width,
-/// height, aa, max_steps and max_depth is a limit of `limits`).
-pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<(), String> {
-    let limited = |limit: Limit, lo: u32| {
-        let hi = limits.get(limit).min(u32::MAX as u64) as u32;
-        int(key, value, lo, hi, Some((limits, limit)))
-    };
-    match key {
-        "width" => s.width = limited(Limit::Edge, 1)?,
-        "height" => s.height = limited(Limit::Edge, 1)?,
-        "aa" => s.aa = limited(Limit::Aa, 1)?,
-        "max_steps" => s.max_steps = limited(Limit::MaxSteps, 1)?,
-        "max_depth" => s.max_depth = limited(Limit::MaxDepth, 0)?,
-        "epsilon" => s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?,
-        "max_dist" => s.max_dist = real(key, value, |v| v > 0.0, "a positive number")?,
-        "relaxation" => {
-            s.relaxation = real(
-                key,
-                value,
-                |v| (1.0..2.0).contains(&v),
-                "a number in [1, 2)",
-            )?
-        }
-        "background" => s.background = colour(value)?,
-        "method" => {
-            s.method = Method::from_name(value).ok_or_else(|| {
-                format!(
-                    "method must be one of {}, not `{value}`",
-                    Method::NAMES.join(", ")
-                )
-            })?
-        }
-        _ => {
-            return Err(format!(
-                "unknown render setting `{key}`; the settings are {}",
-                SETTING_KEYS.join(", ")
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// A whole number from `lo` to `hi`; with `limit`, one above `hi` says how to raise it.
-fn int(
-    key: &str,
-    value: &str,
-    lo: u32,
-    hi: u32,
-    limit: Option<(&Limits, Limit)>,
-) -> Result<u32, String> {
-    let parsed = value.parse::<u64>();
-    match parsed {
-        Ok(v) if (lo as u64..=hi as u64).contains(&v) => Ok(v as u32),
-        _ => {
-            let mut msg = format!("{key} must be a whole number from {lo} to {hi}, not `{value}`");
-            if let (Some((limits, limit)), Ok(v)) = (limit, parsed) {
-                if v > hi as u64 {
-                    msg.push_str(&format!("; {}", limits.raise_to(limit, v)));
-                }
-            }
-            Err(msg)
-        }
-    }
-}
-
-fn real(key: &str, value: &str, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
-    match value.parse::<f64>() {
-        Ok(v) if v.is_finite() && ok(v) => Ok(v),
-        _ => Err(format!("{key} must be {what}, not `{value}`")),
-    }
-}
-
-fn colour(value: &str) -> Result<[f64; 3], String> {
-    let err = || {
-        format!(
-            "background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{value}`"
-        )
-    };
-    let parts: Vec<f64> = value
-        .trim_matches(|c| c == '(' || c == ')')
-        .split(',')
-        .map(|p| p.trim().parse::<f64>().map_err(|_| err()))
-        .collect::<Result<_, _>>()?;
-    match parts[..] {
-        [r, g, b] if parts.iter().all(|v| (0.0..=1.0).contains(v)) => Ok([r, g, b]),
-        _ => Err(err()),
-    }
 }

@@ -27,7 +27,7 @@ pub struct ViewArgs {
     #[arg(long, value_enum, default_value_t)]
     pub backend: ViewBackend,
     /// Window (and image) size, as WIDTHxHEIGHT (default: the scene's `render` size).
-    #[arg(long, value_name = "WxH", value_parser = super::render::parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = crate::settings::parse_size)]
     pub size: Option<(u32, u32)>,
     /// Override a render setting (as for `sdfc render`), at every reload. May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -71,7 +71,7 @@ pub fn run(args: ViewArgs) -> ExitCode {
     // than failing every reload.
     let mut probe = sdfc_compiler::scene::Settings::default();
     if let Err(msg) =
-        super::render::override_settings(&mut probe, args.size, None, &args.set, &limits)
+        crate::settings::override_settings(&mut probe, args.size, None, &args.set, &limits)
     {
         eprintln!("error: {msg}");
         return ExitCode::from(2);

@@ -207,11 +207,14 @@ impl<T: Float> Tracer<T> {
 /// is sphere traced): its primitives and the nodes of its hierarchy (fewer than two per
 /// primitive), and, while it is built, the compiler's list of primitives, their boxes and its
 /// tree (counted four times over, with 256 bytes per primitive for the vectors' slack).
-pub(super) fn heap_bytes<T: Float>(scene: &sdfc_compiler::scene::Scene) -> u64 {
+pub(super) fn heap_bytes<T: Float>(
+    scene: &sdfc_compiler::scene::Scene,
+    traceable: &sdfc_compiler::scene::analytic::Traceable,
+) -> u64 {
     use std::mem::size_of;
-    let n = sdfc_compiler::scene::analytic::choose(scene)
-        .primitives()
-        .map_or(0, |p| p.len()) as u64;
+    let n = traceable
+        .traced(scene.settings.method)
+        .map_or(0, <[_]>::len) as u64;
     let held = size_of::<Prim<T>>() + 2 * size_of::<Node<T>>();
     let building = 4 * size_of::<Primitive>() + 256;
     n * (held + building) as u64

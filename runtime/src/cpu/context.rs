@@ -6,6 +6,7 @@ use super::analytic::Tracer;
 use super::camera::Pinhole;
 use super::vec::V3;
 use sdfc_compiler::eval::Float;
+use sdfc_compiler::scene::analytic::Traceable;
 use sdfc_compiler::scene::{Light, Material, Pattern, Scene};
 
 /// The colour of a material at a point.
@@ -75,7 +76,9 @@ pub(super) struct Context<T: Float> {
 }
 
 impl<T: Float> Context<T> {
-    pub fn new(scene: &Scene, lipschitz: f64, debug_nan: bool) -> Self {
+    /// The context of a render of `scene`, traced analytically when `traceable` and its
+    /// `method` setting say so.
+    pub fn new(scene: &Scene, traceable: &Traceable, lipschitz: f64, debug_nan: bool) -> Self {
         let s = &scene.settings;
         let mut materials: Vec<Mat<T>> = scene.materials.iter().map(|m| mat(scene, m)).collect();
         if materials.is_empty() {
@@ -84,7 +87,7 @@ impl<T: Float> Context<T> {
         let transparent = materials.iter().any(|m| m.transparency > T::zero());
         Context {
             camera: Pinhole::new(&scene.camera, s),
-            epsilon: T::from_f64(s.epsilon),
+            epsilon: T::from_f64(scene.epsilon()),
             max_dist: T::from_f64(s.max_dist),
             max_steps: s.max_steps.max(1),
             max_depth: s.max_depth,
@@ -96,9 +99,7 @@ impl<T: Float> Context<T> {
             transparent,
             branching: branching(scene),
             debug_nan,
-            analytic: sdfc_compiler::scene::analytic::choose(scene)
-                .primitives()
-                .map(Tracer::new),
+            analytic: traceable.traced(s.method).map(Tracer::new),
         }
     }
 

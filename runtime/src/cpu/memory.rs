@@ -88,14 +88,14 @@ fn in_type<T: Float>(scene: &Scene, tapes: &Tapes, options: &Options, threads: u
     let shape = Shape::new(scene, options);
     let per_thread = workspace::<T>(&shape, tapes, options)
         .saturating_add(tile::<T>(&shape, scene.settings.max_depth as u64));
-    shared::<T>(&shape, scene)
+    shared::<T>(&shape, scene, tapes)
         .saturating_add(per_thread.saturating_mul(threads.max(1) as u64))
         .saturating_add(BOOKKEEPING)
 }
 
 /// What the whole render holds: the tiles' outputs, the assembled image, steps and depth
 /// buffers with the sorted copy of the steps, the list of tiles, materials and lights.
-fn shared<T: Float>(shape: &Shape, scene: &Scene) -> u64 {
+fn shared<T: Float>(shape: &Shape, scene: &Scene, tapes: &Tapes) -> u64 {
     // Per pixel: the tile outputs (colour, steps, distance, coverage: 24 bytes) and the
     // assembled image (12), steps (4), sorted steps (4) and depth buffers (8).
     let per_pixel = 24 + 12 + 4 + 4 + 8;
@@ -105,7 +105,7 @@ fn shared<T: Float>(shape: &Shape, scene: &Scene) -> u64 {
         bytes::<TileOut>(shape.tiles),
         bytes::<Mat<T>>(scene.materials.len() as u64 + 1),
         bytes::<Lamp<T>>(shape.lamps),
-        super::analytic::heap_bytes::<T>(scene),
+        super::analytic::heap_bytes::<T>(scene, &tapes.traceable),
     ]
     .into_iter()
     .fold(0, u64::saturating_add)

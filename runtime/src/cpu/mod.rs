@@ -27,7 +27,8 @@ use crate::image::Image;
 use context::Context;
 use rayon::prelude::*;
 use sdfc_compiler::eval::{Float, Outputs, Tape};
-use sdfc_compiler::lower::Program;
+use sdfc_compiler::lower::Lowered;
+use sdfc_compiler::scene::analytic::Traceable;
 use sdfc_compiler::scene::{Scene, Settings};
 use tile::{Rect, Workspace};
 
@@ -78,12 +79,15 @@ pub const NAN_COLOUR: [f32; 3] = [1.0, 0.0, 1.0];
 
 /// A distance program prepared for the CPU renderer, once per scene: its tape for the
 /// distance alone (marching, normals, shadows) and its tape for distance and material, and
-/// where glass may overlap an opaque solid, the tapes of the scene's media.
+/// where glass may overlap an opaque solid, the tapes of the scene's media; with them, the
+/// scene's primitives for analytic tracing (the lowering's [`Traceable`]), which a render
+/// traces when its `method` setting picks tracing.
 #[derive(Debug, Clone)]
 pub struct Tapes {
     distance: Tape,
     full: Tape,
     media: Option<MediaTapes>,
+    traceable: Traceable,
 }
 
 /// The tapes of [`sdfc_compiler::lower::Media`]: the medium's distance (marched by rays
@@ -96,25 +100,25 @@ struct MediaTapes {
 }
 
 impl Tapes {
-    /// Prepares `program`'s two tapes (no media: rays inside glass march `−f`).
-    pub fn new(program: &Program) -> Self {
+    /// Prepares the tapes of a lowered scene: its program's two, and its media's when its
+    /// glass may overlap an opaque solid (docs/rendering.md, "Inside glass").
+    pub fn new(lowered: &Lowered) -> Self {
+        let program = &lowered.program;
         Tapes {
             distance: Tape::new(program, Outputs::Distance),
             full: Tape::new(program, Outputs::DistanceAndMaterial),
-            media: None,
+            media: lowered.media.as_ref().map(|m| MediaTapes {
+                medium: Tape::new(&m.medium, Outputs::Distance),
+                solid: Tape::new(&m.solid, Outputs::Distance),
+                solid_full: Tape::new(&m.solid, Outputs::DistanceAndMaterial),
+            }),
+            traceable: lowered.traceable.clone(),
         }
     }
 
-    /// Prepares the tapes of `scene`, whose program is `program`, with its media when its
-    /// glass may overlap an opaque solid (docs/rendering.md, "Inside glass").
-    pub fn for_scene(scene: &Scene, program: &Program) -> Self {
-        let mut tapes = Self::new(program);
-        tapes.media = sdfc_compiler::lower::media(scene).map(|m| MediaTapes {
-            medium: Tape::new(&m.medium, Outputs::Distance),
-            solid: Tape::new(&m.solid, Outputs::Distance),
-            solid_full: Tape::new(&m.solid, Outputs::DistanceAndMaterial),
-        });
-        tapes
+    /// The scene's primitives, or why it cannot be traced analytically.
+    pub fn traceable(&self) -> &Traceable {
+        &self.traceable
     }
 
     /// Every tape, for the memory bound (each thread has an evaluator of each).
@@ -161,15 +165,15 @@ pub fn tile_count(settings: &Settings, options: &Options) -> u64 {
     tiles(settings, options.tile).len() as u64
 }
 
-/// Renders `scene` (whose distance program is `program`) on the current rayon pool, calling
-/// `progress` once per finished tile, in `options.precision`.
+/// Renders `scene` (lowered as `lowered`) on the current rayon pool, calling `progress` once
+/// per finished tile, in `options.precision`.
 pub fn render(
     scene: &Scene,
-    program: &Program,
+    lowered: &Lowered,
     options: &Options,
     progress: &(dyn Fn() + Sync),
 ) -> Render {
-    render_tapes(scene, &Tapes::for_scene(scene, program), options, progress)
+    render_tapes(scene, &Tapes::new(lowered), options, progress)
 }
 
 /// [`render`] with the program's tapes already prepared. It allocates at most [`memory`]
@@ -193,7 +197,12 @@ pub fn render_in<T: Float>(
     options: &Options,
     progress: &(dyn Fn() + Sync),
 ) -> Render {
-    let ctx = Context::<T>::new(scene, options.lipschitz, options.debug_nan);
+    let ctx = Context::<T>::new(
+        scene,
+        &tapes.traceable,
+        options.lipschitz,
+        options.debug_nan,
+    );
     let rects = tiles(&scene.settings, options.tile);
     let outs: Vec<tile::TileOut> = rects
         .par_iter()

@@ -60,21 +60,24 @@ pub struct Stats {
 impl Stats {
     /// Statistics from the counters and the steps taken for each pixel.
     pub fn new(counters: Counters, steps_per_pixel: &[u32]) -> Self {
-        let mut sorted = steps_per_pixel.to_vec();
-        sorted.sort_unstable();
-        let n = sorted.len();
-        let total: u64 = sorted.iter().map(|&s| s as u64).sum();
+        let n = steps_per_pixel.len();
+        let total: u64 = steps_per_pixel.iter().map(|&s| s as u64).sum();
+        let max = steps_per_pixel.iter().copied().max().unwrap_or(0);
+        // The percentile by selection, in linear time (a sort of a 1080p frame's two million
+        // values took longer than the frame).
         let p99 = if n == 0 {
             0
         } else {
-            sorted[((n - 1) as f64 * 0.99).round() as usize]
+            let mut steps = steps_per_pixel.to_vec();
+            let at = ((n - 1) as f64 * 0.99).round() as usize;
+            *steps.select_nth_unstable(at).1
         };
         Stats {
             counters,
             pixels: n as u64,
             steps_mean: if n == 0 { 0.0 } else { total as f64 / n as f64 },
             steps_p99: p99,
-            steps_max: sorted.last().copied().unwrap_or(0),
+            steps_max: max,
         }
     }
 }

@@ -91,7 +91,7 @@ pub(super) struct TileOut {
     pub counters: Counters,
 }
 
-/// Evaluators of the scene's media (`super::Tapes::for_scene`).
+/// Evaluators of the scene's media (`super::Tapes::new`).
 #[derive(Debug)]
 pub(super) struct Media<'t, T: Float> {
     pub medium: Evaluator<'t, T>,

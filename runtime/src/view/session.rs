@@ -7,15 +7,13 @@
 use super::camera::{self, Orbit};
 use super::watch::Fingerprint;
 use crate::backend::{Prepared, Setup};
-use crate::commands::check;
-use crate::commands::render::override_settings;
 use crate::frontend::{self, DiagnosticFormat, Loaded};
 use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
 use crate::image::Image;
+use crate::settings::override_settings;
 use sdfc_compiler::back::wgsl;
 use sdfc_compiler::lower::{self, LowerOptions};
-use sdfc_compiler::scene::analytic::{self, Choice};
 use sdfc_compiler::scene::{Camera, Scene};
 use sdfc_compiler::{Diagnostic, FileId, Limit, Limits, Severity, SourceMap};
 use std::path::{Path, PathBuf};
@@ -108,6 +106,9 @@ struct Timings {
     lower: Duration,
     /// Tapes (CPU) or kernel generation and validation (wgpu).
     prepare: Duration,
+    /// Whether a kernel (or the CPU's tapes) was built; false when the last scene's wgpu
+    /// kernel was kept (an edit of numbers only).
+    built: bool,
     /// The kernel's pipeline: compiled, or found among those compiled.
     pipeline: Option<PipelineTime>,
     /// When the newest of the scene's files was modified.
@@ -355,13 +356,13 @@ impl Session {
         eprintln!(
             "{}: ok; {}; {}",
             self.file.display(),
-            check::summary(&loaded, &scene),
-            check::method(&loaded, &scene)
+            frontend::summary(&loaded, &scene),
+            frontend::method(&loaded, &scene)
         );
         let check_time = start.elapsed();
         let start = Instant::now();
-        let program = match lower::lower_within(&scene, &LowerOptions::default(), &limits) {
-            Ok(program) => program,
+        let lowered = match lower::lower_within(&scene, &LowerOptions::default(), &limits) {
+            Ok(lowered) => lowered,
             Err(d) => {
                 let summary = first_error(std::slice::from_ref(&d), &loaded.sources);
                 frontend::print_diagnostics(&[d], &loaded.sources, DiagnosticFormat::Human);
@@ -370,12 +371,20 @@ impl Session {
         };
         let lower_time = start.elapsed();
         let start = Instant::now();
-        let setup = Setup::default();
-        let prepared = match &self.device {
-            Device::Cpu => Prepared::on_cpu(&scene, program, &setup),
-            Device::Wgpu(gpu) => Prepared::on_gpu(gpu.clone(), &scene, &program, &setup),
+        // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
+        // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.
+        let setup = Setup {
+            parameters: true,
+            ..Setup::default()
         };
-        let prepared = prepared.inspect_err(|msg| eprintln!("error: {msg}"))?;
+        let prepared = match (&self.good, &self.device) {
+            (Some(good), _) => good.prepared.next(&scene, lowered),
+            (None, Device::Cpu) => Prepared::on_cpu(&scene, lowered, &setup).map(|p| (p, true)),
+            (None, Device::Wgpu(gpu)) => {
+                Prepared::on_gpu(gpu.clone(), &scene, &lowered, &setup).map(|p| (p, true))
+            }
+        };
+        let (prepared, built) = prepared.inspect_err(|msg| eprintln!("error: {msg}"))?;
         let prepare_time = start.elapsed();
         let mut at = scene.settings.clone();
         (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);
@@ -391,9 +400,9 @@ impl Session {
             ),
             _ => None,
         };
-        let method = match analytic::choose(&scene) {
-            Choice::Trace(_) => "trace",
-            Choice::March(_) => "march",
+        let method = match prepared.traceable().traced(scene.settings.method) {
+            Some(_) => "trace",
+            None => "march",
         };
         let aa = scene.settings.aa.max(1);
         let good = Good {
@@ -408,6 +417,7 @@ impl Session {
             check: check_time,
             lower: lower_time,
             prepare: prepare_time,
+            built,
             pipeline,
             modified: None,
             began: SystemTime::now(),
@@ -681,7 +691,11 @@ impl Session {
                 t.number,
                 ms(t.check),
                 ms(t.lower),
-                if matches!(self.device, Device::Cpu) { "tapes" } else { "kernel" },
+                match (&self.device, t.built) {
+                    (Device::Cpu, _) => "tapes",
+                    (_, true) => "kernel",
+                    (_, false) => "kernel kept (numbers only)",
+                },
                 ms(t.prepare),
                 ms(time),
             );

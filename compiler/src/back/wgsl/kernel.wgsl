@@ -48,8 +48,9 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> image: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> stats: array<u32>;
 //#if SCENE_DATA
-// The primitives and hierarchy of a large analytically traced scene, or the instances of a large
-// marched one (layouts: compiler/src/back/wgsl/buffer.rs, march.rs).
+// The primitives and hierarchy of a large analytically traced scene, the instances of a large
+// marched one (layouts: compiler/src/back/wgsl/buffer.rs, march.rs), or the constants of the
+// distance program of a kernel shared by the frames of an animation (map.rs, `Params`).
 @group(0) @binding(4) var<storage, read> scene_data: array<vec4<f32>>;
 //#endif
 

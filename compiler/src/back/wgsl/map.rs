@@ -5,8 +5,39 @@
 //! block's value inside it. In a large program, large blocks become functions of their own
 //! (`map_blockN`, `sdf_blockN`) that take the point and the values they read from outside.
 
-use crate::lower::{Axis, Binary, Item, Op, Program, Reg, Unary};
+use crate::program::{results, Axis, Binary, Item, Op, Program, Reg, Unary};
+use std::cell::RefCell;
 use std::fmt::Write;
+
+/// The constants of programs written as reads of `scene_data` instead of literals
+/// ([`super::Options::parameters`]): each read of a constant is a slot of its own, in the
+/// order they are written, and registers are numbered among the instructions that are not
+/// constants; so the text depends only on the program with its constants erased as operands
+/// (`animation::Structure`), and two programs that differ in numbers only share one kernel
+/// and differ in the values, `values[k]` at `scene_data[k / 4][k % 4]`.
+#[derive(Debug, Default)]
+pub(super) struct Params {
+    /// The values of the slots so far, rounded to f32 as literals are.
+    pub values: RefCell<Vec<f32>>,
+}
+
+impl Params {
+    /// The expression reading the next slot, which holds `x`.
+    fn read(&self, x: f64) -> String {
+        let mut v = self.values.borrow_mut();
+        let k = v.len();
+        v.push((x as f32).clamp(-f32::MAX, f32::MAX));
+        format!("scene_data[{}].{}", k / 4, ["x", "y", "z", "w"][k % 4])
+    }
+
+    /// The slots as the bytes of `scene_data` (whole `vec4`s, at least one).
+    pub fn bytes(&self) -> Vec<u8> {
+        let v = self.values.borrow();
+        let mut out: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+        out.resize(out.len().div_ceil(16).max(1) * 16, 0);
+        out
+    }
+}
 
 /// Programs with more live instructions than this have their large guarded blocks written as
 /// functions of their own. naga's WGSL front end takes time that grows with the square of a
@@ -29,12 +60,24 @@ pub fn write_map(program: &Program) -> String {
 
 /// [`write_map`] as the function `name` (its outlined blocks prefixed by it).
 pub(super) fn write_map_named(program: &Program, name: &'static str) -> String {
+    write_map_with(program, name, None)
+}
+
+/// [`write_map_named`], with the constants read from `params` when given.
+pub(super) fn write_map_with(
+    program: &Program,
+    name: &'static str,
+    params: Option<&Params>,
+) -> String {
     let roots = [program.distance(), program.material()];
-    let mut w = Writer::new(program, &roots, true, name);
+    let mut w = Writer::new(program, &roots, true, name, params);
     let mut main = String::new();
     w.emit(0, w.items.len(), 1, &mut main);
     let names = &w.names;
-    let (d, m) = (names.get(program.distance()), names.get(program.material()));
+    let (d, m) = (
+        names.get(program.distance(), params),
+        names.get(program.material(), params),
+    );
     let mut out = std::mem::take(&mut w.functions);
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
     let _ = writeln!(out, "fn {name}(p: vec3<f32>) -> vec2<f32> {{");
@@ -52,11 +95,20 @@ pub fn write_sdf(program: &Program) -> String {
 
 /// [`write_sdf`] as the function `name`.
 pub(super) fn write_sdf_named(program: &Program, name: &'static str) -> String {
+    write_sdf_with(program, name, None)
+}
+
+/// [`write_sdf_named`], with the constants read from `params` when given.
+pub(super) fn write_sdf_with(
+    program: &Program,
+    name: &'static str,
+    params: Option<&Params>,
+) -> String {
     let roots = [program.distance()];
-    let mut w = Writer::new(program, &roots, false, name);
+    let mut w = Writer::new(program, &roots, false, name, params);
     let mut main = String::new();
     w.emit(0, w.items.len(), 1, &mut main);
-    let d = w.names.get(program.distance());
+    let d = w.names.get(program.distance(), params);
     let mut out = std::mem::take(&mut w.functions);
     let _ = writeln!(
         out,
@@ -70,6 +122,8 @@ pub(super) fn write_sdf_named(program: &Program, name: &'static str) -> String {
 /// Writes the statements of a program's live instructions, outlining large blocks.
 struct Writer<'a> {
     program: &'a Program,
+    /// Where constants are read from, when not written as literals.
+    params: Option<&'a Params>,
     live: Vec<bool>,
     live_blocks: Vec<bool>,
     phi_of: Vec<Option<usize>>,
@@ -89,7 +143,13 @@ struct Writer<'a> {
 }
 
 impl<'a> Writer<'a> {
-    fn new(program: &'a Program, roots: &[Reg], comments: bool, prefix: &'static str) -> Self {
+    fn new(
+        program: &'a Program,
+        roots: &[Reg],
+        comments: bool,
+        prefix: &'static str,
+        params: Option<&'a Params>,
+    ) -> Self {
         let (live, live_blocks) = program.live(roots);
         let items = program.items();
         let mut close = vec![0; items.len()];
@@ -117,7 +177,8 @@ impl<'a> Writer<'a> {
             .collect();
         Writer {
             program,
-            names: Names::new(program),
+            params,
+            names: Names::new(program, params.is_some()),
             phi_of: program.phi_blocks(),
             live,
             live_blocks,
@@ -150,9 +211,10 @@ impl<'a> Writer<'a> {
                     }
                     let _ = writeln!(
                         out,
-                        "{}let r{i} = {};",
+                        "{}let {} = {};",
                         pad(depth),
-                        expr(&ops[i], &self.names)
+                        self.names.reg(i),
+                        expr(&ops[i], &self.names, self.params)
                     );
                 }
                 Item::Open(b) if self.live_blocks[b] => {
@@ -161,12 +223,16 @@ impl<'a> Writer<'a> {
                     for &(j, _, other) in &results {
                         let _ = writeln!(
                             out,
-                            "{}var r{j}: f32 = {};",
+                            "{}var {}: f32 = {};",
                             pad(depth),
-                            self.names.get(other)
+                            self.names.reg(j),
+                            self.names.get(other, self.params)
                         );
                     }
-                    let (x, y) = (self.names.get(block.bound), self.names.get(block.best));
+                    let (x, y) = (
+                        self.names.get(block.bound, self.params),
+                        self.names.get(block.best, self.params),
+                    );
                     let _ = writeln!(out, "{}if !({x} >= {y}) {{", pad(depth));
                     let end = self.close[k];
                     let arity = results.len();
@@ -177,8 +243,10 @@ impl<'a> Writer<'a> {
                     };
                     if let Some(params) = params {
                         let name = format!("{}_block{b}", self.prefix);
-                        let args: Vec<String> =
-                            params.iter().map(|r| format!(", r{}", r.0)).collect();
+                        let args: Vec<String> = params
+                            .iter()
+                            .map(|r| format!(", {}", self.names.reg(r.0 as usize)))
+                            .collect();
                         let _ =
                             writeln!(out, "{}let o = {name}(p{});", pad(depth + 1), args.concat());
                         for (n, &(j, _, _)) in results.iter().enumerate() {
@@ -187,14 +255,20 @@ impl<'a> Writer<'a> {
                             } else {
                                 [".x", ".y", ".z", ".w"][n]
                             };
-                            let _ = writeln!(out, "{}r{j} = o{lane};", pad(depth + 1));
+                            let _ =
+                                writeln!(out, "{}{} = o{lane};", pad(depth + 1), self.names.reg(j));
                         }
                         self.function(&name, k + 1, end, &params, &results);
                     } else {
                         self.emit(k + 1, end, depth + 1, out);
                         for &(j, then, _) in &results {
-                            let _ =
-                                writeln!(out, "{}r{j} = {};", pad(depth + 1), self.names.get(then));
+                            let _ = writeln!(
+                                out,
+                                "{}{} = {};",
+                                pad(depth + 1),
+                                self.names.reg(j),
+                                self.names.get(then, self.params)
+                            );
                         }
                     }
                     let _ = writeln!(out, "{}}}", pad(depth));
@@ -222,10 +296,13 @@ impl<'a> Writer<'a> {
             1 => "f32".to_string(),
             n => format!("vec{n}<f32>"),
         };
-        let list: Vec<String> = params.iter().map(|r| format!(", r{}: f32", r.0)).collect();
+        let list: Vec<String> = params
+            .iter()
+            .map(|r| format!(", {}: f32", self.names.reg(r.0 as usize)))
+            .collect();
         let values: Vec<String> = results
             .iter()
-            .map(|&(_, then, _)| self.names.get(then))
+            .map(|&(_, then, _)| self.names.get(then, self.params))
             .collect();
         let value = if results.len() == 1 {
             values[0].clone()
@@ -264,18 +341,6 @@ impl<'a> Writer<'a> {
     }
 }
 
-/// The needed results of block `b`: (register, value inside, value from before).
-pub(crate) fn results(program: &Program, b: usize, live: &[bool]) -> Vec<(usize, Reg, Reg)> {
-    let block = &program.blocks()[b];
-    (block.end..block.end + block.results)
-        .filter(|&j| live[j])
-        .filter_map(|j| match program.ops()[j] {
-            Op::Phi(then, other) => Some((j, then, other)),
-            _ => None,
-        })
-        .collect()
-}
-
 /// A WGSL float literal for `x` rounded to f32 (finite values only reach here; others are
 /// clamped to the largest f32 so that the module stays valid).
 ///
@@ -302,12 +367,42 @@ pub fn float(x: f64) -> String {
 
 /// How each register is read: `r{i}`, or the literal of a constant that is only read by
 /// instructions with another operand (so that no expression is all constants, which naga
-/// would evaluate when parsing).
-struct Names(Vec<Option<String>>);
+/// would evaluate when parsing); with parameters, every constant is read from its slot and
+/// the other registers are numbered among themselves.
+struct Names {
+    literals: Vec<Option<String>>,
+    /// The value of each constant.
+    constants: Vec<Option<f64>>,
+    /// With parameters: each register's number among the instructions that are not
+    /// constants (constants have none).
+    numbers: Option<Vec<u32>>,
+}
 
 impl Names {
-    fn new(program: &Program) -> Names {
+    fn new(program: &Program, params: bool) -> Names {
         let ops = program.ops();
+        let constants: Vec<Option<f64>> = ops
+            .iter()
+            .map(|op| match op {
+                Op::Const(c) => Some(*c),
+                _ => None,
+            })
+            .collect();
+        if params {
+            let mut next = 0;
+            let numbers = ops
+                .iter()
+                .map(|op| {
+                    next += u32::from(!matches!(op, Op::Const(_)));
+                    next.saturating_sub(1)
+                })
+                .collect();
+            return Names {
+                literals: ops.iter().map(|_| None).collect(),
+                constants,
+                numbers: Some(numbers),
+            };
+        }
         let is_const = |r: Reg| matches!(ops[r.0 as usize], Op::Const(_));
         let mut inline: Vec<bool> = ops.iter().map(|op| matches!(op, Op::Const(_))).collect();
         for op in ops {
@@ -316,8 +411,9 @@ impl Names {
                 operands.iter().for_each(|r| inline[r.0 as usize] = false);
             }
         }
-        Names(
-            ops.iter()
+        Names {
+            literals: ops
+                .iter()
                 .zip(inline)
                 .map(|(op, i)| match (op, i) {
                     (Op::Const(c), true) => {
@@ -331,23 +427,40 @@ impl Names {
                     _ => None,
                 })
                 .collect(),
-        )
+            constants,
+            numbers: None,
+        }
     }
 
-    /// Whether the register is written as a literal (and has no `let`).
+    /// Whether the register is written where it is read (and has no `let`).
     fn inlined(&self, i: usize) -> bool {
-        self.0[i].is_some()
+        match &self.numbers {
+            Some(_) => self.constants[i].is_some(),
+            None => self.literals[i].is_some(),
+        }
     }
 
-    fn get(&self, r: Reg) -> String {
-        self.0[r.0 as usize]
+    /// The name of the variable of register `i`.
+    fn reg(&self, i: usize) -> String {
+        match &self.numbers {
+            Some(n) => format!("r{}", n[i]),
+            None => format!("r{i}"),
+        }
+    }
+
+    /// How register `r` is read (a constant's next slot, with parameters).
+    fn get(&self, r: Reg, params: Option<&Params>) -> String {
+        if let (Some(p), Some(c)) = (params, self.constants[r.0 as usize]) {
+            return p.read(c);
+        }
+        self.literals[r.0 as usize]
             .clone()
-            .unwrap_or_else(|| format!("r{}", r.0))
+            .unwrap_or_else(|| self.reg(r.0 as usize))
     }
 }
 
-fn expr(op: &Op, names: &Names) -> String {
-    let n = |r: Reg| names.get(r);
+fn expr(op: &Op, names: &Names, params: Option<&Params>) -> String {
+    let n = |r: Reg| names.get(r, params);
     match *op {
         Op::Const(c) => float(c),
         Op::Input(Axis::X) => "p.x".into(),

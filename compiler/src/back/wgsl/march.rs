@@ -1,6 +1,6 @@
 //! The instances of a large sphere-traced scene as data: the contents of the read-only storage
 //! buffer `scene_data` (binding 4) for a marched kernel, and the loop that walks it, so that
-//! the kernel's size does not grow with the number of instances (`lower::split` says which
+//! the kernel's size does not grow with the number of instances (`lower::Lowered::instances` says which
 //! children of the root union are instances). `map(p)` is `min(rest(p), walk(p))` with the
 //! nearer one's material (the rest's on a tie, else the earlier instance's): the field of the
 //! whole program, evaluated in another order.

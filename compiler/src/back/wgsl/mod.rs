@@ -18,9 +18,7 @@ mod template;
 pub use analytic::MAX_UNROLLED;
 pub use map::{float, write_map, write_sdf};
 
-pub(crate) use map::results;
-
-use crate::lower::Program;
+use crate::lower::Lowered;
 use crate::scene::{Light, Pattern, Scene};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -36,7 +34,7 @@ pub const STATS_WORDS: u32 = 8;
 
 const TEMPLATE: &str = include_str!("kernel.wgsl");
 
-/// The most instances (`lower::split`) of a marched scene's root union written as code: beyond,
+/// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
 /// they are read from `scene_data` and walked in a loop. The code grows with the scene (the
 /// CUDA JIT of a marched kernel of 10 000 spheres takes minutes), but up to a few thousand
 /// instances it is the faster of the two: its culling visits the nearer half first and
@@ -178,6 +176,13 @@ pub struct Options {
     /// The most instances of a marched scene's root union written as code; more are read
     /// from `scene_data` ([`MAX_INSTANCES`] unless a test compares the two ways).
     pub max_instances: usize,
+    /// The constants of a marched scene's distance program read from `scene_data` instead
+    /// of written as literals (the `PARAMS` feature; docs/animation.md): the kernel's text
+    /// then depends on the program with its constants erased, so the frames of an animation
+    /// that differ only in numbers share one kernel and differ in [`Kernel::data`]. Only the
+    /// program written as code takes them: an analytically traced scene, a marched one whose
+    /// instances are read from `scene_data`, and the media of glass keep their literals.
+    pub parameters: bool,
 }
 
 impl Default for Options {
@@ -186,18 +191,45 @@ impl Default for Options {
             debug_nan: false,
             max_unrolled: MAX_UNROLLED,
             max_instances: MAX_INSTANCES,
+            parameters: false,
         }
     }
 }
 
-/// Writes and validates the kernel for `scene`, whose distance program is `program`.
-pub fn write(scene: &Scene, program: &Program) -> Result<Kernel, Error> {
-    write_with(scene, program, &Options::default())
+/// Writes and validates the kernel for `scene`, lowered as `lowered`.
+pub fn write(scene: &Scene, lowered: &Lowered) -> Result<Kernel, Error> {
+    write_with(scene, lowered, &Options::default())
 }
 
 /// [`write`] with the given options.
-pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result<Kernel, Error> {
-    let choice = crate::scene::analytic::choose(scene);
+pub fn write_with(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Kernel, Error> {
+    let text = write_text(scene, lowered, options)?;
+    let (module, info) = validate(&text.source, scene)?;
+    Ok(Kernel {
+        source: text.source,
+        module,
+        info,
+        features: text.features,
+        specialisation: Specialisation::of(&scene.settings),
+        data: text.data,
+    })
+}
+
+/// A kernel's text and data before naga parses and validates it: what a caller holding a
+/// kernel compares to decide whether it can keep it ([`Options::parameters`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Text {
+    /// The WGSL text.
+    pub source: String,
+    /// The features it was specialised for, by name.
+    pub features: Vec<(&'static str, bool)>,
+    /// The bytes of `scene_data`, when it has them.
+    pub data: Option<Vec<u8>>,
+}
+
+/// The text of the kernel [`write_with`] writes, not validated.
+pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Text, Error> {
+    let choice = lowered.choice(&scene.settings);
     let mut features = features(scene, choice.primitives().is_some());
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
     // Listed in the header only when on, so that the default kernel does not change.
@@ -216,11 +248,12 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
             bytes
         }
         None => {
-            let (mut text, bytes) = marched(scene, program, options.max_instances);
+            let (mut text, bytes, params) = marched(scene, lowered, options);
+            if params {
+                features.push(("PARAMS", true));
+            }
             // Rays inside glass that may overlap a solid march the scene's media.
-            let media = on["REFRACTION"]
-                .then(|| crate::lower::media(scene))
-                .flatten();
+            let media = lowered.media.as_ref().filter(|_| on["REFRACTION"]);
             on.insert("MEDIA", media.is_some());
             if let Some(m) = media {
                 features.push(("MEDIA", true));
@@ -262,22 +295,22 @@ pub fn write_with(scene: &Scene, program: &Program, options: &Options) -> Result
         line: None,
         node_span: None,
     })?;
-    let (module, info) = validate(&source, scene)?;
-    Ok(Kernel {
+    Ok(Text {
         source,
-        module,
-        info,
         features,
-        specialisation: Specialisation::of(&scene.settings),
         data,
     })
 }
 
 /// `fn map` and `fn sdf` of a marched scene: the program as code, or, when its root union has
 /// more than `max_instances` instances, the rest of it as code and the instances as
-/// `scene_data` (march.rs), unless their materials or their bytes do not fit.
-fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, Option<Vec<u8>>) {
-    let split = crate::lower::split(scene, &program.options(), max_instances)
+/// `scene_data` (march.rs), unless their materials or their bytes do not fit. The program as
+/// code reads its constants from `scene_data` with [`Options::parameters`] (then the last
+/// value is true).
+fn marched(scene: &Scene, lowered: &Lowered, options: &Options) -> (String, Option<Vec<u8>>, bool) {
+    let program = &lowered.program;
+    let split = lowered
+        .instances(options.max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {
             let data = march::data(&s.instances, scene.camera.position);
@@ -297,11 +330,21 @@ fn marched(scene: &Scene, program: &Program, max_instances: usize) -> (String, O
                 map::write_sdf_named(&s.rest, "rest_sdf"),
                 march::write(&s.instances)
             );
-            (text, Some(data))
+            (text, Some(data), false)
+        }
+        None if options.parameters => {
+            let params = map::Params::default();
+            let text = format!(
+                "{}\n{}",
+                map::write_map_with(program, "map", Some(&params)),
+                map::write_sdf_with(program, "sdf", Some(&params))
+            );
+            (text, Some(params.bytes()), true)
         }
         None => (
             format!("{}\n{}", write_map(program), write_sdf(program)),
             None,
+            false,
         ),
     }
 }
@@ -361,7 +404,7 @@ pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
     w.v4(v, 0.0);
     w.f([tan * aspect, tan, s.width as f64, s.height as f64]);
     w.f([
-        s.epsilon,
+        scene.epsilon(),
         s.max_dist,
         s.relaxation.max(1.0),
         1.0 / lipschitz.max(1.0),

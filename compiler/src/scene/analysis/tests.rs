@@ -6,7 +6,8 @@
 use super::*;
 use crate::check::check_str;
 use crate::eval::eval_point;
-use crate::lower::{lower, lower_with, LowerOptions, Program};
+use crate::lower::{lower, lower_with, LowerOptions};
+use crate::program::Program;
 
 fn scene(objects: &str) -> (Scene, Vec<Diagnostic>) {
     let text = format!("scene {{ {objects}; }}");

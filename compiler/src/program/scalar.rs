@@ -1,8 +1,7 @@
 //! The meaning of each operation on one value: the single definition that the interpreter's
 //! loops, the constant folder and the Rust writer follow.
 
-use super::Float;
-use crate::lower::{Binary, Unary};
+use super::{Binary, Float, Unary};
 
 /// Applies a one-operand operation.
 #[inline(always)]

@@ -1,0 +1,569 @@
+//! `sdfc render --frames`: an animated scene rendered as a sequence of frames
+//! (docs/animation.md): numbered images written atomically and skipped when they exist (so
+//! a killed job resumes), one shard of a job array, an animated PNG, or a video through
+//! `ffmpeg`. The kernel is prepared again only when a frame's distance program differs from
+//! the previous frame's; camera, lights, materials and settings are read at every render.
+
+use super::render::{
+    check_memory, frame_scene, prepare, reference_mode, thread_pool, CliError, FrameScene,
+    RenderArgs,
+};
+use crate::backend::{Prepared, Setup};
+use crate::frontend::Source;
+use crate::image::{AtomicFile, Image};
+use crate::output::Output;
+use crate::sequence::{ffmpeg, Frames, Target};
+use indicatif::{ProgressBar, ProgressStyle};
+use sdfc_compiler::lower::{LowerOptions, Program};
+use sdfc_compiler::scene::{Animation, Scene};
+use sdfc_compiler::{Limit, Limits};
+use std::cell::RefCell;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::time::Instant;
+
+/// Renders the sequence `args` asks for.
+pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    let limits = args.limits.limits();
+    if args.reference || args.aux {
+        return Err(CliError::Usage(
+            "--reference and --aux render one image; they cannot be used with a sequence".into(),
+        ));
+    }
+    let mut source = Source::read(&args.file).map_err(CliError::Usage)?;
+    // The animation's settings are the same at every time (E0406): read them at t = 0.
+    let lowering = LowerOptions::parametric();
+    let first = frame_scene(args.overrides(), &mut source, &limits, 0.0, true, &lowering)?;
+    let animation = first.scene.animation;
+    let fps = match args.fps {
+        Some(f) if f.is_finite() && (0.01..=1000.0).contains(&f) => f,
+        Some(f) => {
+            return Err(CliError::Usage(format!(
+                "--fps must be a number from 0.01 to 1000, not {f}"
+            )))
+        }
+        None => animation.fps,
+    };
+    let frames = frame_range(args, &animation, &limits)?;
+    let shard = args.shard.unwrap_or_default();
+    let path = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_pattern(&args.file));
+    let target = Target::new(&path).map_err(CliError::Usage)?;
+    if shard.count > 1 && !matches!(target, Target::Numbered(..)) {
+        return Err(CliError::Usage(
+            "--shard renders part of a sequence: its frames must go to numbered files (`-o out/frame_####.png`), not one animated PNG or video".into(),
+        ));
+    }
+    if let Target::Numbered(pattern, _) = &target {
+        create_directory(&pattern.path(frames.start))?;
+    }
+    let mut sink = Sink::open(&target, frames, fps)?;
+    let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
+    let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
+    let setup = Setup {
+        precision,
+        debug_nan: args.debug_nan,
+        parameters: true,
+    };
+    let mine: Vec<u64> = shard.frames(frames).collect();
+    let todo: Vec<u64> = mine
+        .iter()
+        .copied()
+        .filter(|&k| args.force || !sink.exists(k))
+        .collect();
+    let skipped = mine.len() - todo.len();
+    if !animation.animated() {
+        eprintln!("note: the scene does not read `t`: every frame is the same");
+    }
+    eprintln!(
+        "render: frames {}..{} at {fps} fps{}: {} to render, {skipped} already written",
+        frames.start,
+        frames.end,
+        if shard.count > 1 {
+            format!(", shard {}/{}", shard.index, shard.count)
+        } else {
+            String::new()
+        },
+        todo.len()
+    );
+    let bar = progress(mine.len() as u64, skipped as u64);
+    let mut kernels = Kernels::new(&pool, backend, setup);
+    // The image of a scene that does not read `t`, rendered once.
+    let mut still: Option<Image> = None;
+    let mut first = Some(first);
+    let started = Instant::now();
+    for (n, &k) in todo.iter().enumerate() {
+        let time = Animation::time_of(fps, k);
+        let frame = match first.take().filter(|_| time == 0.0) {
+            Some(f) => f,
+            None => frame_scene(
+                args.overrides(),
+                &mut source,
+                &limits,
+                time,
+                false,
+                &lowering,
+            )
+            .map_err(|e| {
+                if let Some(b) = &bar {
+                    b.abandon();
+                }
+                match e {
+                    CliError::Reported(code) => {
+                        eprintln!("error: frame {k} (t = {time} s) has errors");
+                        CliError::Reported(code)
+                    }
+                    other => other,
+                }
+            })?,
+        };
+        let frame_started = Instant::now();
+        let image = match &still {
+            Some(image) => image.clone(),
+            None => {
+                let (scene, prepared) = kernels.prepare(frame)?;
+                check_memory(&pool, prepared, &scene, (false, false), &limits, n == 0)?;
+                let image = pool
+                    .install(|| prepared.render(&scene, &|_| {}))
+                    .map_err(CliError::Failed)?
+                    .render
+                    .image;
+                if !animation.animated() {
+                    still = Some(image.clone());
+                }
+                image
+            }
+        };
+        sink.write(k, &image)?;
+        let seconds = frame_started.elapsed().as_secs_f64();
+        match &bar {
+            Some(b) => b.inc(1),
+            None => eprintln!(
+                "frame {k} (t = {time:.4} s): {} ({seconds:.3} s)",
+                sink.describe(k)
+            ),
+        }
+    }
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    sink.finish()?;
+    let seconds = started.elapsed().as_secs_f64();
+    eprintln!(
+        "wrote {} frame{} to {} in {seconds:.3} s ({:.2} frames/s); {} kernel{} prepared{}",
+        todo.len(),
+        if todo.len() == 1 { "" } else { "s" },
+        path.display(),
+        todo.len() as f64 / seconds.max(1e-9),
+        kernels.count,
+        if kernels.count == 1 { "" } else { "s" },
+        match kernels.last() {
+            Some(p) => format!(" ({} on {})", p.name(), p.device()),
+            None => String::new(),
+        }
+    );
+    Ok(())
+}
+
+/// The frames to render: `--frames`, or the scene's `fps × duration`, within the `frames`
+/// limit.
+fn frame_range(
+    args: &RenderArgs,
+    animation: &Animation,
+    limits: &Limits,
+) -> Result<Frames, CliError> {
+    let frames = match args.frames {
+        Some(f) => f,
+        None => {
+            let n = animation.frames();
+            if n == 0 {
+                return Err(CliError::Usage(
+                    "the scene states no animation (its `render` block has no `duration`): give the frames with --frames A..B, or add `duration: SECONDS` to `render`".into(),
+                ));
+            }
+            Frames { start: 0, end: n }
+        }
+    };
+    let max = limits.get(Limit::Frames);
+    if frames.len() > max {
+        return Err(CliError::Usage(format!(
+            "the sequence has {} frames, more than {max}; {}",
+            frames.len(),
+            limits.raise_to(Limit::Frames, frames.len())
+        )));
+    }
+    Ok(frames)
+}
+
+/// `scene.sdf` → `./scene_####.png`.
+fn default_pattern(file: &Path) -> PathBuf {
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "frame".into());
+    PathBuf::from(format!("{stem}_####.png"))
+}
+
+/// Creates the directory of `file` when it is missing.
+fn create_directory(file: &Path) -> Result<(), CliError> {
+    match file.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => std::fs::create_dir_all(dir)
+            .map_err(|e| CliError::Usage(format!("cannot create `{}`: {e}", dir.display()))),
+        _ => Ok(()),
+    }
+}
+
+/// A progress bar over the shard's frames on a terminal (frames already written count as
+/// done); `None` elsewhere, where each frame prints a line.
+fn progress(len: u64, done: u64) -> Option<ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let bar = ProgressBar::new(len);
+        if let Ok(style) = ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames {elapsed_precise} eta {eta} ({per_sec})",
+        ) {
+            bar.set_style(style);
+        }
+        bar.set_position(done);
+        bar
+    })
+}
+
+/// The backend prepared for the frames of a sequence: the device is opened once; a frame
+/// whose distance program (and the origin it is written relative to) is the last one's
+/// renders with the same kernel; another is prepared with [`Prepared::update`], which keeps a
+/// GPU kernel whose text is unchanged (its constants are read from `scene_data`), so `count`
+/// counts kernels built, not frames.
+pub struct Kernels<'a> {
+    pool: &'a rayon::ThreadPool,
+    backend: crate::backend::Backend,
+    setup: Setup,
+    /// The last frame's program and scene origin, and the backend prepared for them.
+    prepared: Option<(Program, [f64; 3], Prepared)>,
+    /// Kernels (or CPU tapes) prepared so far.
+    pub count: usize,
+    /// Time spent preparing them.
+    pub time: std::time::Duration,
+}
+
+impl std::fmt::Debug for Kernels<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Kernels")
+            .field("count", &self.count)
+            .finish()
+    }
+}
+
+impl<'a> Kernels<'a> {
+    /// No kernel yet.
+    pub fn new(
+        pool: &'a rayon::ThreadPool,
+        backend: crate::backend::Backend,
+        setup: Setup,
+    ) -> Self {
+        Kernels {
+            pool,
+            backend,
+            setup,
+            prepared: None,
+            count: 0,
+            time: std::time::Duration::ZERO,
+        }
+    }
+
+    /// The backend prepared for `frame` (the last one when its program is the same,
+    /// specialised again if its settings need it), and the frame's scene.
+    pub fn prepare(&mut self, frame: FrameScene) -> Result<(Scene, &Prepared), CliError> {
+        let started = Instant::now();
+        let same = self
+            .prepared
+            .as_ref()
+            .is_some_and(|(p, o, _)| *p == frame.lowered.program && *o == frame.scene.origin);
+        let scene = match &mut self.prepared {
+            Some((_, _, prepared)) if same => {
+                let FrameScene { scene, .. } = frame;
+                let before = prepared.specialisation();
+                prepared.specialise(&scene).map_err(CliError::Failed)?;
+                if prepared.specialisation() != before {
+                    self.count += 1;
+                }
+                scene
+            }
+            // The device stays open; the kernel is kept when its text is the same (the
+            // program differs in numbers only) and given the frame's constants.
+            Some((held, origin, prepared)) => {
+                let FrameScene { scene, lowered } = frame;
+                *held = lowered.program.clone();
+                *origin = scene.origin;
+                if prepared.update(&scene, lowered).map_err(CliError::Failed)? {
+                    self.count += 1;
+                }
+                scene
+            }
+            None => {
+                let program = frame.lowered.program.clone();
+                let (scene, prepared) = prepare(self.pool, self.backend, frame, &self.setup)?;
+                self.count += 1;
+                self.prepared = Some((program, scene.origin, prepared));
+                scene
+            }
+        };
+        self.time += started.elapsed();
+        let (_, _, prepared) = self.prepared.as_ref().expect("prepared");
+        Ok((scene, prepared))
+    }
+
+    /// The backend last prepared.
+    pub fn last(&self) -> Option<&Prepared> {
+        self.prepared.as_ref().map(|(_, _, p)| p)
+    }
+}
+
+/// Where the frames go as they are rendered.
+enum Sink {
+    /// Numbered files, each written atomically.
+    Numbered(crate::sequence::Pattern, crate::output::Format),
+    /// An animated PNG, streamed into one atomic file (opened at the first frame).
+    Apng {
+        path: PathBuf,
+        frames: u64,
+        fps: f64,
+        file: Option<Rc<RefCell<AtomicFile>>>,
+        writer: Option<png::Writer<Shared>>,
+    },
+    /// `ffmpeg` reading raw RGB frames on its standard input (started at the first frame).
+    Video {
+        path: PathBuf,
+        ffmpeg: PathBuf,
+        fps: f64,
+        child: Option<(std::process::Child, PathBuf)>,
+    },
+}
+
+/// An [`AtomicFile`] shared by the PNG encoder and the sink, which finishes it.
+struct Shared(Rc<RefCell<AtomicFile>>);
+
+impl Write for Shared {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.borrow_mut().flush()
+    }
+}
+
+impl Sink {
+    fn open(target: &Target, frames: Frames, fps: f64) -> Result<Sink, CliError> {
+        Ok(match target {
+            Target::Numbered(p, f) => {
+                crate::output::check_writable(&p.path(frames.start)).map_err(|why| {
+                    CliError::Usage(format!(
+                        "cannot write `{}`: {why}",
+                        p.path(frames.start).display()
+                    ))
+                })?;
+                Sink::Numbered(p.clone(), *f)
+            }
+            Target::Apng(path) => {
+                crate::output::check_writable(path).map_err(|why| {
+                    CliError::Usage(format!("cannot write `{}`: {why}", path.display()))
+                })?;
+                Sink::Apng {
+                    path: path.clone(),
+                    frames: frames.len(),
+                    fps,
+                    file: None,
+                    writer: None,
+                }
+            }
+            Target::Video(path) => {
+                let ffmpeg = ffmpeg().map_err(CliError::Usage)?;
+                crate::output::check_writable(path).map_err(|why| {
+                    CliError::Usage(format!("cannot write `{}`: {why}", path.display()))
+                })?;
+                Sink::Video {
+                    path: path.clone(),
+                    ffmpeg,
+                    fps,
+                    child: None,
+                }
+            }
+        })
+    }
+
+    /// Whether frame `k` is written already (only numbered files are: an animated PNG or a
+    /// video is written whole).
+    fn exists(&self, k: u64) -> bool {
+        match self {
+            Sink::Numbered(p, _) => p.path(k).is_file(),
+            _ => false,
+        }
+    }
+
+    /// Where frame `k` went, for the log.
+    fn describe(&self, k: u64) -> String {
+        match self {
+            Sink::Numbered(p, _) => format!("wrote {}", p.path(k).display()),
+            Sink::Apng { path, .. } | Sink::Video { path, .. } => {
+                format!("added to {}", path.display())
+            }
+        }
+    }
+
+    fn write(&mut self, k: u64, image: &Image) -> Result<(), CliError> {
+        let io = |path: &Path| {
+            let path = path.display().to_string();
+            move |e: std::io::Error| CliError::Usage(format!("cannot write `{path}`: {e}"))
+        };
+        match self {
+            Sink::Numbered(p, format) => Output::File {
+                path: p.path(k),
+                format: *format,
+            }
+            .write(image)
+            .map_err(CliError::Usage),
+            Sink::Apng {
+                path,
+                frames,
+                fps,
+                file,
+                writer,
+            } => {
+                if writer.is_none() {
+                    let f = Rc::new(RefCell::new(AtomicFile::create(path).map_err(io(path))?));
+                    *writer = Some(apng(Shared(f.clone()), image, *frames, *fps).map_err(|e| {
+                        CliError::Usage(format!("cannot write `{}`: {e}", path.display()))
+                    })?);
+                    *file = Some(f);
+                }
+                let w = writer.as_mut().expect("writer");
+                w.write_image_data(&image.to_rgba8())
+                    .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", path.display())))
+            }
+            Sink::Video {
+                path,
+                ffmpeg,
+                fps,
+                child,
+            } => {
+                if child.is_none() {
+                    *child = Some(start_ffmpeg(ffmpeg, path, image, *fps)?);
+                }
+                let (c, _) = child.as_mut().expect("ffmpeg");
+                let stdin = c.stdin.as_mut().expect("piped");
+                stdin
+                    .write_all(&rgb8(image))
+                    .map_err(|e| CliError::Failed(format!("ffmpeg stopped reading frames: {e}")))
+            }
+        }
+    }
+
+    /// Finishes an animated PNG or a video (renamed onto the target when complete).
+    fn finish(self) -> Result<(), CliError> {
+        match self {
+            Sink::Numbered(..) => Ok(()),
+            Sink::Apng {
+                path, file, writer, ..
+            } => {
+                let (Some(w), Some(f)) = (writer, file) else {
+                    return Ok(());
+                };
+                let err =
+                    |e: String| CliError::Usage(format!("cannot write `{}`: {e}", path.display()));
+                w.finish().map_err(|e| err(e.to_string()))?;
+                let f = Rc::try_unwrap(f)
+                    .map_err(|_| err("the encoder still holds the file".into()))?
+                    .into_inner();
+                f.finish().map_err(|e| err(e.to_string()))
+            }
+            Sink::Video { path, child, .. } => {
+                let Some((mut c, tmp)) = child else {
+                    return Ok(());
+                };
+                drop(c.stdin.take());
+                let status = c
+                    .wait()
+                    .map_err(|e| CliError::Failed(format!("ffmpeg: {e}")))?;
+                if !status.success() {
+                    let _ = std::fs::remove_file(&tmp);
+                    return Err(CliError::Failed(format!(
+                        "ffmpeg failed ({status}) writing `{}`",
+                        path.display()
+                    )));
+                }
+                std::fs::rename(&tmp, &path)
+                    .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", path.display())))
+            }
+        }
+    }
+}
+
+/// An APNG encoder of `frames` frames of `image`'s size at `fps`, looping forever.
+fn apng(
+    out: Shared,
+    image: &Image,
+    frames: u64,
+    fps: f64,
+) -> Result<png::Writer<Shared>, png::EncodingError> {
+    let mut encoder = png::Encoder::new(out, image.width, image.height);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    encoder.set_animated(frames.min(u32::MAX as u64) as u32, 0)?;
+    // The delay of a frame is 1/fps seconds, as a fraction of 16-bit integers.
+    let (num, den) = if fps * 100.0 <= u16::MAX as f64 {
+        (100, (fps * 100.0).round() as u16)
+    } else {
+        (1, fps.round() as u16)
+    };
+    encoder.set_frame_delay(num, den.max(1))?;
+    encoder.write_header()
+}
+
+/// Starts `ffmpeg` encoding raw RGB frames of `image`'s size from its standard input into a
+/// temporary file beside `path` (renamed onto it when ffmpeg succeeds).
+fn start_ffmpeg(
+    ffmpeg: &Path,
+    path: &Path,
+    image: &Image,
+    fps: f64,
+) -> Result<(std::process::Child, PathBuf), CliError> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{}.{name}", std::process::id()));
+    let mut cmd = std::process::Command::new(ffmpeg);
+    cmd.args(["-hide_banner", "-loglevel", "error", "-y", "-f", "rawvideo"])
+        .args(["-pix_fmt", "rgb24"])
+        .args(["-s", &format!("{}x{}", image.width, image.height)])
+        .args(["-framerate", &fps.to_string(), "-i", "-"]);
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
+    {
+        // Players expect 4:2:0 chroma, which needs even edges.
+        cmd.args([
+            "-vf",
+            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+            "-pix_fmt",
+            "yuv420p",
+        ]);
+    }
+    cmd.arg(&tmp).stdin(std::process::Stdio::piped());
+    let child = cmd
+        .spawn()
+        .map_err(|e| CliError::Failed(format!("cannot start `{}`: {e}", ffmpeg.display())))?;
+    Ok((child, tmp))
+}
+
+/// Clamped sRGB bytes, three a pixel.
+fn rgb8(image: &Image) -> Vec<u8> {
+    image
+        .to_rgba8()
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
+}

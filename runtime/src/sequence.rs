@@ -1,0 +1,243 @@
+//! Frame sequences (docs/animation.md): the frame range `A..B`, the shard `I/N` of a job
+//! array, the numbered file names of a pattern such as `out/frame_####.png`, and where a
+//! sequence goes (numbered images, an animated PNG, or a video through `ffmpeg`).
+
+use crate::output::Format;
+use std::path::{Path, PathBuf};
+
+/// Frames `start..end` (half-open, as the language's `for` loops).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Frames {
+    /// The first frame.
+    pub start: u64,
+    /// One past the last frame.
+    pub end: u64,
+}
+
+impl Frames {
+    /// Parses `A..B` (frames A up to B − 1).
+    pub fn parse(s: &str) -> Result<Frames, String> {
+        let err =
+            || format!("--frames expects A..B, the frames A up to B − 1, like 0..120, not `{s}`");
+        let (a, b) = s.split_once("..").ok_or_else(err)?;
+        let start = a.trim().parse::<u64>().map_err(|_| err())?;
+        let end = b.trim().parse::<u64>().map_err(|_| err())?;
+        if end <= start {
+            return Err(format!(
+                "--frames {s} has no frames: B must be greater than A (the range is half-open)"
+            ));
+        }
+        Ok(Frames { start, end })
+    }
+
+    /// The number of frames.
+    pub fn len(&self) -> u64 {
+        self.end - self.start
+    }
+
+    /// True for an empty range.
+    pub fn is_empty(&self) -> bool {
+        self.end <= self.start
+    }
+}
+
+/// Shard `index` of `count`: the frames whose number is ≡ `index` (mod `count`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// This shard, from 0.
+    pub index: u64,
+    /// How many shards there are.
+    pub count: u64,
+}
+
+impl Default for Shard {
+    fn default() -> Self {
+        Shard { index: 0, count: 1 }
+    }
+}
+
+impl Shard {
+    /// Parses `I/N` with 0 ≤ I < N.
+    pub fn parse(s: &str) -> Result<Shard, String> {
+        let err = || format!("--shard expects I/N, shard I (from 0) of N, like 3/10, not `{s}`");
+        let (i, n) = s.split_once('/').ok_or_else(err)?;
+        let index = i.trim().parse::<u64>().map_err(|_| err())?;
+        let count = n.trim().parse::<u64>().map_err(|_| err())?;
+        if count == 0 || index >= count {
+            return Err(format!(
+                "--shard {s}: the shard must be from 0 to N − 1 of N ≥ 1 shards (a job array's task ids from 0, as SLURM_ARRAY_TASK_ID with --array=0-{{N-1}} or JOB_COMPLETION_INDEX)"
+            ));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The frames of `frames` in this shard, in order.
+    pub fn frames(&self, frames: Frames) -> impl Iterator<Item = u64> {
+        let Shard { index, count } = *self;
+        (frames.start..frames.end).filter(move |k| k % count == index)
+    }
+}
+
+/// A file name with one run of `#`, replaced by the zero-padded frame number (wider numbers
+/// are written in full): `out/frame_####.png` names frame 7 `out/frame_0007.png`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Pattern {
+    before: String,
+    width: usize,
+    after: String,
+}
+
+impl Pattern {
+    /// The pattern of `path`, or `None` when its file name has no `#`. A second run of `#`
+    /// is an error.
+    pub fn new(path: &Path) -> Result<Option<Pattern>, String> {
+        let text = path.to_string_lossy();
+        let name_start = text.len() - path.file_name().map_or(0, |n| n.to_string_lossy().len());
+        let Some(first) = text[name_start..].find('#').map(|i| i + name_start) else {
+            if text.contains('#') {
+                return Err(format!(
+                    "`{}`: the `#` run of the frame number must be in the file name, not in a directory",
+                    path.display()
+                ));
+            }
+            return Ok(None);
+        };
+        let width = text[first..].chars().take_while(|&c| c == '#').count();
+        let after = &text[first + width..];
+        if after.contains('#') || text[..first].contains('#') {
+            return Err(format!(
+                "`{}` has more than one run of `#`: one run is the frame number",
+                path.display()
+            ));
+        }
+        Ok(Some(Pattern {
+            before: text[..first].to_string(),
+            width,
+            after: after.to_string(),
+        }))
+    }
+
+    /// The file of frame `k`.
+    pub fn path(&self, k: u64) -> PathBuf {
+        PathBuf::from(format!(
+            "{}{:0width$}{}",
+            self.before,
+            k,
+            self.after,
+            width = self.width
+        ))
+    }
+}
+
+/// Where a sequence goes, decided by `-o`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Target {
+    /// One image per frame, named by the pattern, in the format of its extension.
+    Numbered(Pattern, Format),
+    /// One animated PNG (APNG) of every frame.
+    Apng(PathBuf),
+    /// A video encoded by `ffmpeg`, in the container its extension names.
+    Video(PathBuf),
+}
+
+/// The extensions written through `ffmpeg`.
+pub const VIDEO_EXTENSIONS: &[&str] = &["mp4", "webm", "mkv", "mov", "gif"];
+
+impl Target {
+    /// The target `-o PATH` names for a sequence.
+    pub fn new(path: &Path) -> Result<Target, String> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if let Some(pattern) = Pattern::new(path)? {
+            let format = Format::from_extension(&ext).ok_or_else(|| {
+                format!(
+                    "cannot write `{}`: numbered frames are written as {}",
+                    path.display(),
+                    crate::output::EXTENSIONS
+                )
+            })?;
+            return Ok(Target::Numbered(pattern, format));
+        }
+        if ext == "png" {
+            return Ok(Target::Apng(path.to_path_buf()));
+        }
+        if VIDEO_EXTENSIONS.contains(&ext.as_str()) {
+            return Ok(Target::Video(path.to_path_buf()));
+        }
+        Err(format!(
+            "cannot write a sequence to `{}`: name numbered frames with a run of `#` (`out/frame_####.png`), or write an animated `.png`, or a video ({}, through ffmpeg)",
+            path.display(),
+            VIDEO_EXTENSIONS
+                .iter()
+                .map(|e| format!("`.{e}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    }
+}
+
+/// The `ffmpeg` on `PATH`, or why there is none.
+pub fn ffmpeg() -> Result<PathBuf, String> {
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    std::env::split_paths(&path)
+        .map(|d| d.join("ffmpeg"))
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            "writing a video needs `ffmpeg` on PATH, and there is none; install it, or write numbered frames (`-o out/frame_####.png`) and encode them yourself".to_string()
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_partition_the_frames() {
+        let frames = Frames { start: 3, end: 50 };
+        for n in 1..8 {
+            let mut seen = vec![0; 50];
+            for i in 0..n {
+                for k in (Shard { index: i, count: n }).frames(frames) {
+                    seen[k as usize] += 1;
+                }
+            }
+            assert!(seen[..3].iter().all(|&c| c == 0));
+            assert!(seen[3..].iter().all(|&c| c == 1), "{n} shards: {seen:?}");
+        }
+    }
+
+    #[test]
+    fn patterns_number_frames() {
+        let p = Pattern::new(Path::new("out/frame_####.png"))
+            .unwrap()
+            .unwrap();
+        assert_eq!(p.path(7), PathBuf::from("out/frame_0007.png"));
+        assert_eq!(p.path(123456), PathBuf::from("out/frame_123456.png"));
+        let p = Pattern::new(Path::new("f#.exr")).unwrap().unwrap();
+        assert_eq!(p.path(12), PathBuf::from("f12.exr"));
+        assert_eq!(Pattern::new(Path::new("still.png")).unwrap(), None);
+        assert!(Pattern::new(Path::new("a##_##.png")).is_err());
+        assert!(Pattern::new(Path::new("dir#/f.png")).is_err());
+    }
+
+    #[test]
+    fn ranges_and_shards_parse() {
+        assert_eq!(
+            Frames::parse("0..120").unwrap(),
+            Frames { start: 0, end: 120 }
+        );
+        assert!(Frames::parse("5..5").is_err());
+        assert!(Frames::parse("5").is_err());
+        assert_eq!(
+            Shard::parse("3/10").unwrap(),
+            Shard {
+                index: 3,
+                count: 10
+            }
+        );
+        assert!(Shard::parse("10/10").is_err());
+        assert!(Shard::parse("0/0").is_err());
+    }
+}

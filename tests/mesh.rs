@@ -355,7 +355,7 @@ fn the_bracket_has_genus_three() {
 fn every_examples_bounded_part_meshes_to_a_closed_manifold() {
     let d = dir("examples");
     let mut files: Vec<PathBuf> = Vec::new();
-    for sub in ["examples", "examples/mesh"] {
+    for sub in ["examples", "examples/mesh", "examples/animation"] {
         for e in std::fs::read_dir(root().join(sub)).expect("examples") {
             let p = e.expect("entry").path();
             if p.extension().is_some_and(|x| x == "sdf") {
@@ -364,7 +364,7 @@ fn every_examples_bounded_part_meshes_to_a_closed_manifold() {
         }
     }
     files.sort();
-    assert!(files.len() >= 13, "{files:?}");
+    assert!(files.len() >= 15, "{files:?}");
     for f in &files {
         let out = d.join("ex.stl");
         let first = sdfc(&["mesh", s(f), "-o", s(&out), "--resolution", "40"]);

@@ -176,6 +176,20 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             cells.iter().copied().fold(0.0f64, f64::max)
         )));
     }
+    // Vertices are kept 10⁻³ of a cell apart; the files store f32 coordinates.
+    let magnitude = clip
+        .iter()
+        .flatten()
+        .map(|x| x.abs())
+        .chain(origin.iter().map(|x| x.abs()))
+        .fold(0.0f64, f64::max);
+    if 1e-3 * voxel < 8.0 * f32::EPSILON as f64 * magnitude {
+        eprintln!(
+            "warning: a cell of {} is too small for the f32 coordinates of mesh files at {}: vertices may share positions",
+            short(voxel),
+            short(magnitude)
+        );
+    }
     let grid = Grid {
         origin: clip[0].map(|x| x - (1.0 + GRID_OFFSET) * voxel),
         voxel,

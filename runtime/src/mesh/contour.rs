@@ -554,7 +554,8 @@ fn flip(
         };
         let (s, r) = ([c1, a, c2], [c2, b, c1]);
         let (ns, nr) = (normal(positions, s), normal(positions, r));
-        let tiny = 1e-12 * voxel * voxel;
+        // Well above what the files' f32 coordinates can round to zero.
+        let tiny = 1e-6 * voxel * voxel;
         let area = |n: [f64; 3]| dot(n, n).sqrt();
         if area(ns) <= tiny || area(nr) <= tiny || dot(ns, before) <= 0.0 || dot(nr, before) <= 0.0
         {

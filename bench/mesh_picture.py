@@ -3,7 +3,7 @@
 flat-shaded by each triangle's own normal (so the facets show), with the triangle edges
 drawn darker when --edges is given. Used for the picture in docs/mesh.md.
 
-usage: mesh_picture.py MESH.stl OUT.png [--size WxH] [--eye X,Y,Z] [--at X,Y,Z] [--edges]
+usage: mesh_picture.py MESH.stl OUT.png [--size WxH] [--eye X,Y,Z] [--at X,Y,Z] [--fov DEG] [--edges]
 """
 import struct, sys, zlib
 import numpy as np
@@ -35,7 +35,7 @@ def main():
     up = np.cross(fwd, right)
     rel = tris - eye
     cam = np.stack([rel @ right, rel @ up, rel @ fwd], axis=-1)
-    f = 1.0 / np.tan(np.radians(45) / 2)
+    f = 1.0 / np.tan(np.radians(float(opt("--fov", "45"))) / 2)
     sx = (cam[..., 0] / cam[..., 2] * f * h / 2 + w / 2)
     sy = (-cam[..., 1] / cam[..., 2] * f * h / 2 + h / 2)
     z = cam[..., 2]
@@ -62,7 +62,7 @@ def main():
         l0 = ((ys[1] - ys[2]) * (px - xs[2]) + (xs[2] - xs[1]) * (py - ys[2])) / d
         l1 = ((ys[2] - ys[0]) * (px - xs[2]) + (xs[0] - xs[2]) * (py - ys[2])) / d
         l2 = 1 - l0 - l1
-        inside = (l0 >= 0) & (l1 >= 0) & (l2 >= 0)
+        inside = (l0 >= -1e-6) & (l1 >= -1e-6) & (l2 >= -1e-6)
         depth = l0 * zs[0] + l1 * zs[1] + l2 * zs[2]
         sub = zbuf[y0:y1 + 1, x0:x1 + 1]
         win = inside & (depth < sub)

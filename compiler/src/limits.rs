@@ -49,6 +49,8 @@ pub enum Limit {
     SweepPoints,
     /// Frames of one animated sequence (`render { fps, duration }`, `sdfc render --frames`).
     Frames,
+    /// Cells `sdfc mesh` evaluates: the octree's cells at every level (or the dense grid's).
+    Cells,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -63,7 +65,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 18] = [
+    pub const ALL: [Limit; 19] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -82,6 +84,7 @@ impl Limit {
         Limit::SweepValues,
         Limit::SweepPoints,
         Limit::Frames,
+        Limit::Cells,
     ];
 
     fn spec(self) -> Spec {
@@ -194,6 +197,14 @@ impl Limit {
                 1 << 40,
                 "frames of one animated sequence",
             ),
+            // A dense grid of 512³ cells is 134 million; the octree of a scene at that
+            // resolution evaluates a few percent of it (BENCHMARKS.md, "Meshing").
+            Limit::Cells => s(
+                "cells",
+                50_000_000,
+                1 << 40,
+                "cells sdfc mesh evaluates (octree cells and candidates, or the dense grid)",
+            ),
         }
     }
 
@@ -232,7 +243,7 @@ impl fmt::Display for Limit {
 /// The value of every limit for one run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 18],
+    values: [u64; 19],
 }
 
 impl Default for Limits {

@@ -11,6 +11,7 @@ pub mod frontend;
 pub mod gpu;
 pub mod image;
 pub mod memory;
+pub mod mesh;
 pub mod metrics;
 pub mod output;
 pub mod pareto;

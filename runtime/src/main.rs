@@ -1,5 +1,5 @@
 //! The `sdfc` command-line tool: check, compile, render, benchmark and compare `.sdf` scenes,
-//! chart their speed against accuracy, and view them live.
+//! chart their speed against accuracy, view them live, and mesh them.
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -29,6 +29,8 @@ enum Command {
     Compare(commands::compare::CompareArgs),
     /// Chart speed against accuracy over swept render settings, with the Pareto front.
     Pareto(commands::pareto::ParetoArgs),
+    /// Mesh a scene's surface (STL, OBJ, PLY or glTF), watertight and with sharp edges kept.
+    Mesh(commands::mesh::MeshArgs),
     /// Show a scene in a window that reloads it whenever it (or a file it imports) is saved.
     View(commands::view::ViewArgs),
 }
@@ -49,6 +51,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => commands::bench::run(args),
         Command::Compare(args) => commands::compare::run(args),
         Command::Pareto(args) => commands::pareto::run(args),
+        Command::Mesh(args) => commands::mesh::run(args),
         Command::View(args) => commands::view::run(args),
     }
 }

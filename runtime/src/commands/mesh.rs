@@ -1,0 +1,457 @@
+//! `sdfc mesh`: the scene's surface as a triangle mesh (STL, OBJ, PLY or glTF), from an
+//! octree pruned by the compiler's proven bounds and patches that keep sharp features
+//! (`crate::mesh`, `docs/mesh.md`).
+
+use crate::frontend::{self, DiagnosticFormat};
+use crate::memory::{mib, MIB};
+use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
+use crate::mesh::write::Format;
+use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, AXIS_CELLS};
+use indicatif::{ProgressBar, ProgressStyle};
+use sdfc_compiler::lower::LowerOptions;
+use sdfc_compiler::scene::{analysis, Combine, Node, NodeId, Scene};
+use sdfc_compiler::{Limit, Limits};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Arguments of `sdfc mesh`.
+#[derive(Debug, clap::Args)]
+pub struct MeshArgs {
+    /// Scene file.
+    pub file: PathBuf,
+    /// Output mesh: .stl (binary), .obj, .ply (binary, vertex colours) or .glb (binary glTF,
+    /// one material per scene material).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Cells along the longest side of the bounds [default: 128].
+    #[arg(long, value_name = "N", conflicts_with = "voxel")]
+    pub resolution: Option<u32>,
+    /// Edge of a cell, in scene units (instead of --resolution).
+    #[arg(long, value_name = "SIZE")]
+    pub voxel: Option<f64>,
+    /// The region to mesh, X0,Y0,Z0,X1,Y1,Z1 (default: the scene's bounding box from the
+    /// analysis). What reaches out of it is cut at its faces and the cut is closed; a scene
+    /// with unbounded parts (a plane, an infinite repetition) needs it.
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_bounds, allow_hyphen_values = true)]
+    pub bounds: Option<[[f64; 3]; 2]>,
+    /// Mesh setting: `sharp=on|off` (inner vertices at sharp edges and corners, and edges
+    /// flipped along them; off: every inner vertex on the surface near its patch's centre),
+    /// `refine=N` (root-finding rounds per edge vertex, 0 to 50). May be repeated.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Print what meshing did (cells evaluated, surface cells, features, flips).
+    #[arg(long)]
+    pub stats: bool,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
+}
+
+/// The grid's points are offset from the bounds by this fraction of a cell (2 − φ), so that
+/// faces at the bounds, or at round fractions of them (a box's faces are its bounding box's),
+/// do not fall on grid planes, where the corners' signs would be decided by rounding.
+pub const GRID_OFFSET: f64 = 0.381_966_011_250_105;
+
+/// The default number of cells along the longest side.
+pub const DEFAULT_RESOLUTION: u32 = 128;
+
+/// Runs `sdfc mesh`.
+pub fn run(args: MeshArgs) -> ExitCode {
+    match mesh(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err((code, msg)) => {
+            if !msg.is_empty() {
+                eprintln!("error: {msg}");
+            }
+            ExitCode::from(code)
+        }
+    }
+}
+
+fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
+    let usage = |msg: String| (2u8, msg);
+    let limits = args.limits.limits();
+    let format = Format::of(&args.output).ok_or_else(|| {
+        usage(format!(
+            "cannot tell the mesh format of `{}`; name it .stl, .obj, .ply or .glb",
+            args.output.display()
+        ))
+    })?;
+    crate::output::check_writable(&args.output)
+        .map_err(|why| usage(format!("cannot write `{}`: {why}", args.output.display())))?;
+    let mut settings = settings(&args.set).map_err(usage)?;
+    settings.materials = matches!(format, Format::Ply | Format::Glb);
+    let pool = super::render::thread_pool(args.threads).map_err(usage)?;
+    let checked = frontend::load_scene(&args.file, DiagnosticFormat::Human, &limits)
+        .map_err(|_| (1, String::new()))?;
+    let scene = &checked.scene;
+    let analysis = analysis::analyse(scene);
+    let Some(root) = analysis.root() else {
+        return Err((
+            1,
+            "the scene has no objects: there is no surface to mesh".into(),
+        ));
+    };
+    let origin = scene.origin;
+    // The clip box and the grid, in the program's coordinates (the scene's, less `origin`).
+    let clip = match args.bounds {
+        Some([lo, hi]) => [lo, hi].map(|c| [0, 1, 2].map(|i| c[i] - origin[i])),
+        None => {
+            let b = root.bounds;
+            let open: Vec<&str> = ["x", "y", "z"]
+                .into_iter()
+                .enumerate()
+                .filter(|&(i, _)| !(b.min[i].is_finite() && b.max[i].is_finite()))
+                .map(|(_, a)| a)
+                .collect();
+            if !open.is_empty() {
+                let hint = match bounded_part(scene, &analysis) {
+                    Some([lo, hi]) => {
+                        // Grown by a tenth of the largest extent, so that what the box cuts
+                        // (a floor plane) keeps some thickness.
+                        let m = 0.1 * (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
+                        let v: Vec<String> = lo
+                            .iter()
+                            .map(|x| x - m)
+                            .chain(hi.iter().map(|x| x + m))
+                            .zip(origin.iter().chain(&origin))
+                            .map(|(x, o)| short(x + o))
+                            .collect();
+                        format!(
+                            "; its bounded objects with a margin are `--bounds={}`",
+                            v.join(",")
+                        )
+                    }
+                    None => String::new(),
+                };
+                return Err(usage(format!(
+                    "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `--bounds X0,Y0,Z0,X1,Y1,Z1` (what reaches out of it is cut at its faces and the cut closed){hint}",
+                    open.join(", ")
+                )));
+            }
+            if b.is_empty() {
+                return Err((
+                    1,
+                    "the scene's solid is empty: there is no surface to mesh".into(),
+                ));
+            }
+            [b.min, b.max]
+        }
+    };
+    let size = [0, 1, 2].map(|i| clip[1][i] - clip[0][i]);
+    let longest = size.iter().copied().fold(0.0f64, f64::max);
+    let voxel = match (args.voxel, args.resolution) {
+        (Some(v), _) if v.is_finite() && v > 0.0 => v,
+        (Some(v), _) => return Err(usage(format!("--voxel must be a positive number, not {v}"))),
+        (None, Some(0)) => return Err(usage("--resolution must be at least 1".into())),
+        (None, r) => longest / r.unwrap_or(DEFAULT_RESOLUTION) as f64,
+    };
+    if !(voxel > 0.0 && voxel.is_finite()) {
+        return Err(usage(
+            "the bounds are flat: give a region with some extent along every axis (`--bounds`)"
+                .into(),
+        ));
+    }
+    // Without --bounds the box is the analysis's, grown by a cell so that the clip never
+    // touches the surface; one more cell all round is outside the clip, which closes the mesh.
+    let clip = match args.bounds {
+        Some(_) => clip,
+        None => [clip[0].map(|x| x - voxel), clip[1].map(|x| x + voxel)],
+    };
+    // The grid starts 1 + GRID_OFFSET cells below the clip box and ends a cell or more above
+    // it, so that its outermost points lie outside the clip and the surface is closed.
+    let cells = [0, 1, 2].map(|i| {
+        ((clip[1][i] - clip[0][i]) / voxel + 1.0 + GRID_OFFSET)
+            .ceil()
+            .max(1.0)
+            + 1.0
+    });
+    if cells.iter().any(|&n| n > AXIS_CELLS as f64) {
+        return Err(usage(format!(
+            "the grid would have {} cells along an axis; at most {AXIS_CELLS} are possible (a larger --voxel or a smaller --resolution)",
+            cells.iter().copied().fold(0.0f64, f64::max)
+        )));
+    }
+    // Vertices are kept 10⁻³ of a cell apart; the files store f32 coordinates.
+    let magnitude = clip
+        .iter()
+        .flatten()
+        .map(|x| x.abs())
+        .chain(origin.iter().map(|x| x.abs()))
+        .fold(0.0f64, f64::max);
+    if 1e-3 * voxel < 8.0 * f32::EPSILON as f64 * magnitude {
+        eprintln!(
+            "warning: a cell of {} is too small for the f32 coordinates of mesh files at {}: vertices may share positions",
+            short(voxel),
+            short(magnitude)
+        );
+    }
+    let grid = Grid {
+        origin: clip[0].map(|x| x - (1.0 + GRID_OFFSET) * voxel),
+        voxel,
+        cells: cells.map(|n| n as u32),
+    };
+    let lowered = checked
+        .lower(&LowerOptions::default(), &limits)
+        .map_err(|_| (1, String::new()))?;
+    let field = Field::new(&lowered.program, root.proven, clip);
+    if !root.proven {
+        eprintln!(
+            "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
+            cause(&checked, &analysis),
+            grid.dense_cells()
+        );
+    }
+    let max_cells = limits.get(Limit::Cells);
+    let octree_bytes = octree::bytes(&grid, root.proven, max_cells);
+    let [nx, ny, nz] = grid.cells;
+    eprintln!(
+        "mesh: {nx}x{ny}x{nz} cells of {}: allocating at most {} MiB to find the surface",
+        short(voxel),
+        mib(octree_bytes)
+    );
+    check_memory(octree_bytes, &limits).map_err(|m| (1, m))?;
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = ProgressBar::new(1000);
+        if let Ok(style) =
+            ProgressStyle::with_template("{msg:>9} {bar:40} {percent:>3}% {elapsed_precise}")
+        {
+            bar.set_style(style);
+        }
+        bar
+    });
+    let stage = |name: &'static str, base: f64, share: f64| {
+        let bar = bar.clone();
+        move |f: f64| {
+            if let Some(b) = &bar {
+                b.set_message(name);
+                b.set_position(((base + share * f) * 1000.0) as u64);
+            }
+        }
+    };
+    let started = Instant::now();
+    let candidates = pool
+        .install(|| octree::candidates(&field, &grid, max_cells, &stage("octree", 0.0, 0.3)))
+        .map_err(|n| {
+            (
+                1,
+                format!(
+                    "meshing would evaluate {n} cells or more, more than the cells limit of {max_cells}; {} (or mesh at a lower --resolution)",
+                    limits.raise_to(Limit::Cells, n)
+                ),
+            )
+        })?;
+    let n = candidates.cells.len() as u64;
+    let say = |text: String| match &bar {
+        Some(b) => b.suspend(|| eprintln!("{text}")),
+        None => eprintln!("{text}"),
+    };
+    let bound = contour::candidate_bytes(&grid, n);
+    say(format!(
+        "mesh: {n} cells may hold surface: allocating at most {} MiB for their corners",
+        mib(bound)
+    ));
+    check_memory(bound, &limits).map_err(|m| (1, m))?;
+    let surface_check = |cells: u64| {
+        let total = bound.saturating_add(cells.saturating_mul(BYTES_PER_SURFACE_CELL));
+        say(format!(
+            "mesh: {cells} cells hold surface: allocating at most {} MiB in all",
+            mib(total)
+        ));
+        check_memory(total, &limits)
+    };
+    // The cells the closure may hold: as many as the memory limit allows at 52 bytes each
+    // (a key and a point), within the cells limit.
+    let memory_cells = (limits.get(Limit::Memory).saturating_mul(MIB) / 52).min(max_cells);
+    let octree_evaluated = candidates.evaluated;
+    let result = pool.install(|| {
+        contour::contour(
+            &field,
+            &grid,
+            candidates.cells,
+            &settings,
+            memory_cells,
+            &surface_check,
+            &stage("contour", 0.3, 0.7),
+        )
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let (mut mesh, mut stats): (Mesh, Stats) = result.map_err(|stop| match stop {
+        Stop::Refused(msg) => (1, msg),
+        Stop::Cells(cells) => (
+            1,
+            format!(
+                "the surface reaches {cells} cells, more than the cells and memory limits allow ({memory_cells}); {}",
+                limits.raise(Limit::Cells)
+            ),
+        ),
+    })?;
+    let seconds = started.elapsed().as_secs_f64();
+    stats.octree_cells = octree_evaluated;
+    stats.dense = !root.proven;
+    for p in &mut mesh.positions {
+        *p = [0, 1, 2].map(|i| p[i] + origin[i]);
+    }
+    // The file's bytes are in the surface cells' share of the announcement.
+    let bytes = format.encode(&mesh, &scene.materials);
+    std::fs::write(&args.output, &bytes)
+        .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;
+    eprintln!(
+        "wrote {} ({} triangles, {} vertices, {:.3} s)",
+        args.output.display(),
+        mesh.triangles.len(),
+        mesh.positions.len(),
+        seconds
+    );
+    if args.stats {
+        print!("{}", describe(&grid, &stats, seconds));
+    }
+    Ok(())
+}
+
+/// The `--stats` report.
+pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
+    let dense = grid.dense_points() as f64;
+    format!(
+        "grid            {}x{}x{} cells of {}\n\
+         octree cells    {} evaluated{}\n\
+         candidates      {} cells ({} added by crossed edges)\n\
+         surface cells   {}\n\
+         evaluations     {} points ({:.2} % of the dense grid's {} points)\n\
+         sharp patches   {} ({} edges flipped)\n\
+         time            {:.3} s\n",
+        grid.cells[0],
+        grid.cells[1],
+        grid.cells[2],
+        short(grid.voxel),
+        s.octree_cells,
+        if s.dense {
+            " (no proven bound: dense grid)"
+        } else {
+            ""
+        },
+        s.candidates,
+        s.added,
+        s.surface_cells,
+        s.evaluated,
+        100.0 * s.evaluated as f64 / dense,
+        grid.dense_points(),
+        s.features,
+        s.flips,
+        seconds
+    )
+}
+
+fn short(x: f64) -> String {
+    sdfc_compiler::diagnostics::number(x, 4)
+}
+
+fn check_memory(bytes: u64, limits: &Limits) -> Result<(), String> {
+    let limit = limits.get(Limit::Memory);
+    let needed = mib(bytes);
+    if needed <= limit {
+        return Ok(());
+    }
+    Err(format!(
+        "the mesh would allocate up to {needed} MiB, more than the memory limit of {limit} MiB; {} (or mesh at a lower --resolution)",
+        limits.raise_to(Limit::Memory, needed)
+    ))
+}
+
+/// ` (the fractal at FILE:LINE:COL)` for the node that left the bound unproven.
+fn cause(checked: &frontend::Checked, a: &analysis::Analysis) -> String {
+    let Some(id) = a.root().and_then(|r| r.cause) else {
+        return String::new();
+    };
+    let scene = &checked.scene;
+    let span = scene.graph.span(id);
+    let (line, col) = checked.sources.line_col(span);
+    format!(
+        " (the {} at {}:{line}:{col})",
+        analysis::kind(scene.graph.node(id)),
+        checked.sources.name(span.file)
+    )
+}
+
+/// The box around the scene's bounded objects: the objects of its top-level unions whose
+/// bounding box is finite (`None` when there are none).
+fn bounded_part(scene: &Scene, a: &analysis::Analysis) -> Option<[[f64; 3]; 2]> {
+    let mut stack: Vec<NodeId> = scene.root.into_iter().collect();
+    let mut found: Option<[[f64; 3]; 2]> = None;
+    while let Some(id) = stack.pop() {
+        let b = a.node(id).bounds;
+        let finite = (0..3).all(|i| b.min[i].is_finite() && b.max[i].is_finite());
+        if finite && !b.is_empty() {
+            found = Some(match found {
+                None => [b.min, b.max],
+                Some([lo, hi]) => [
+                    [0, 1, 2].map(|i| lo[i].min(b.min[i])),
+                    [0, 1, 2].map(|i| hi[i].max(b.max[i])),
+                ],
+            });
+            continue;
+        }
+        match scene.graph.node(id) {
+            Node::Combine {
+                op: Combine::Union,
+                children,
+            } => stack.extend(children.iter().copied()),
+            Node::Paint { child, .. } => stack.push(*child),
+            _ => {}
+        }
+    }
+    found
+}
+
+/// The mesh settings of `--set`.
+fn settings(sets: &[String]) -> Result<Settings, String> {
+    let mut s = Settings::default();
+    for item in sets {
+        let (key, value) = item
+            .split_once('=')
+            .ok_or_else(|| format!("--set expects KEY=VALUE, like sharp=off, not `{item}`"))?;
+        match (key.trim(), value.trim()) {
+            ("sharp", "on" | "true") => s.sharp = true,
+            ("sharp", "off" | "false") => s.sharp = false,
+            ("sharp", v) => return Err(format!("sharp must be on or off, not `{v}`")),
+            ("refine", v) => {
+                s.refine = v.parse::<u32>().ok().filter(|n| *n <= 50).ok_or_else(|| {
+                    format!("refine must be a whole number from 0 to 50, not `{v}`")
+                })?
+            }
+            (k, _) => {
+                return Err(format!(
+                    "unknown mesh setting `{k}`; the settings are sharp, refine"
+                ))
+            }
+        }
+    }
+    Ok(s)
+}
+
+/// Parses `X0,Y0,Z0,X1,Y1,Z1` into (min, max).
+pub fn parse_bounds(s: &str) -> Result<[[f64; 3]; 2], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected six numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"))?;
+    if v.len() != 6 || v.iter().any(|x| !x.is_finite()) {
+        return Err(format!(
+            "expected six finite numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"
+        ));
+    }
+    let (lo, hi) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
+    if (0..3).any(|i| !(lo[i] < hi[i])) {
+        return Err(format!(
+            "each lower bound must be below the upper one (X0 < X1, Y0 < Y1, Z0 < Z1), not `{s}`"
+        ));
+    }
+    Ok([lo, hi])
+}

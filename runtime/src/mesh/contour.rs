@@ -1,0 +1,570 @@
+//! The surface in the candidate cells: the corners' signs, the crossed edges (with every
+//! cell around a crossed edge taken in, so that no patch lacks its neighbour), a vertex on
+//! the surface on each crossed edge (found by root finding), each cell's patches
+//! (`table`), an inner vertex for each patch, and the patch fanned around it; then the
+//! edges between two sharp patches are flipped to run along the sharp edge.
+//!
+//! Why the result is closed, 2-manifold and oriented, by vertex positions as well as by
+//! indices: every patch edge lies on a cell face and is shared by the two patches of the
+//! cells on either side of it, in opposite directions (`table`); a fan's inner edges belong
+//! to it alone; an edge vertex lies strictly inside its grid edge and an inner vertex
+//! strictly inside its cell, so no two vertices share a position; a fan triangle has its
+//! inner vertex off the face its other two vertices lie on, so none has zero area; and a
+//! flip replaces two triangles by two that share a new edge, which is made only once.
+
+use super::qef;
+use super::table::{corner, patches, EDGES};
+use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
+use rayon::prelude::*;
+
+/// Edge vertices stay this fraction of a voxel inside their edge, and inner vertices inside
+/// their cell, so that no two vertices coincide.
+const MARGIN: f64 = 1e-3;
+
+/// Step of the gradients, as a fraction of a voxel.
+const GRADIENT_STEP: f64 = 1e-4;
+
+/// The patch normals of a smooth patch are within this angle's cosine of their mean (about
+/// 30°); its inner vertex is projected onto the surface.
+const SMOOTH_COS: f64 = 0.866;
+
+/// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
+/// points asked for, each at most once (a position, its index and its value); and the bricks
+/// of corner values (f64), cell flags and edge indices, at most eight per candidate and at
+/// most the grid's.
+pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
+    let points = candidates.saturating_mul(8).min(grid.dense_points());
+    let bricks = grid
+        .cells
+        .iter()
+        .map(|&n| (n as u64 + 1).div_ceil(8) + 1)
+        .product::<u64>();
+    let brick = 512 * (8 + 1 + 12) + 64;
+    candidates
+        .saturating_mul(8)
+        .saturating_add(points.saturating_mul(24 + 12 + 8))
+        .saturating_add(
+            candidates
+                .saturating_mul(8)
+                .min(bricks)
+                .saturating_mul(brick),
+        )
+}
+
+/// Bytes held per surface cell at most: three owned edges with their key, position, normal
+/// and index, four patches, twelve fan triangles with their owners and materials, the
+/// evaluations' scratch, and the output mesh with the file's bytes.
+pub const BYTES_PER_SURFACE_CELL: u64 =
+    8 + 3 * (8 + 24 + 24 + 12 + 8) + 4 * 64 + 12 * 48 + 7 * 40 + 12 * 50;
+
+/// Why contouring stopped.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Stop {
+    /// The cells held (candidates and the cells crossed edges reach) would exceed the limit.
+    Cells(u64),
+    /// The caller refused the surface cells' memory (its message).
+    Refused(String),
+}
+
+/// Contours the surface in `candidates` (sorted cell keys), holding at most `max_cells`
+/// cells; `surface` is told the number of surface cells before they are contoured, and may
+/// refuse.
+pub fn contour(
+    field: &Field,
+    grid: &Grid,
+    candidates: Vec<u64>,
+    settings: &Settings,
+    max_cells: u64,
+    surface_cells: &dyn Fn(u64) -> Result<(), String>,
+    progress: &dyn Fn(f64),
+) -> Result<(Mesh, Stats), Stop> {
+    let mut stats = Stats {
+        candidates: candidates.len() as u64,
+        ..Stats::default()
+    };
+    // Corner values, and the closure: each crossed edge's four cells. A point whose value
+    // was asked for holds -∞ until it comes (the field never gives -∞: see `Field`).
+    let mut values: Bricks<f64> = Bricks::new(f64::NAN);
+    let mut set: Bricks<bool> = Bricks::new(false);
+    for &c in &candidates {
+        set.set(unpack(c), true);
+    }
+    let mut held = candidates.len() as u64;
+    let mut pending = candidates;
+    let mut surface: Vec<(u64, u8)> = Vec::new();
+    let mut first = true;
+    while !pending.is_empty() {
+        if held > max_cells {
+            return Err(Stop::Cells(held));
+        }
+        let mut need: Vec<[u32; 3]> = Vec::new();
+        for &c in &pending {
+            let i = unpack(c);
+            for k in 0..8 {
+                let p = add(i, corner(k));
+                if values.get(p).is_nan() {
+                    values.set(p, f64::NEG_INFINITY);
+                    need.push(p);
+                }
+            }
+        }
+        let points: Vec<[f64; 3]> = need.iter().map(|&i| grid.point(i)).collect();
+        let d = field.distances(&points);
+        for (i, v) in need.into_iter().zip(d) {
+            values.set(i, v);
+        }
+        let mut missing = Vec::new();
+        for &c in &pending {
+            let config = configuration(&values, c);
+            if config == 0 || config == 255 {
+                continue;
+            }
+            surface.push((c, config));
+            let i = unpack(c);
+            for (e, &(a, b)) in EDGES.iter().enumerate() {
+                if (config >> a & 1) == (config >> b & 1) {
+                    continue;
+                }
+                let lower = add(i, corner(a));
+                for n in edge_cells(lower, e / 4) {
+                    if !set.get(n) {
+                        set.set(n, true);
+                        held += 1;
+                        missing.push(pack(n));
+                    }
+                }
+            }
+        }
+        if !first {
+            stats.added += pending.len() as u64;
+        }
+        first = false;
+        pending = missing;
+    }
+    drop(set);
+    progress(0.2);
+    surface.par_sort_unstable();
+    stats.surface_cells = surface.len() as u64;
+    surface_cells(stats.surface_cells).map_err(Stop::Refused)?;
+
+    // Edge vertices: each crossed edge is owned by the cell at its lower end.
+    let mut edges: Vec<u64> = Vec::new();
+    let mut index: Bricks<[u32; 3]> = Bricks::new([u32::MAX; 3]);
+    for &(c, config) in &surface {
+        let mut ids = [u32::MAX; 3];
+        for (axis, id) in ids.iter_mut().enumerate() {
+            let (a, b) = EDGES[axis * 4];
+            if (config >> a & 1) != (config >> b & 1) {
+                *id = edges.len() as u32;
+                edges.push(c << 2 | axis as u64);
+            }
+        }
+        index.set(unpack(c), ids);
+    }
+    let crossings = roots(field, grid, &values, &edges, settings.refine);
+    progress(0.5);
+    let h = GRADIENT_STEP * grid.voxel;
+    let (_, gradients) = field.gradients(&crossings, h);
+    let normals: Vec<[f64; 3]> = gradients.iter().map(|g| normalise(*g)).collect();
+    progress(0.6);
+
+    // Patches: (cell, first index into `ring`, length).
+    let mut patch_cells = Vec::new();
+    let mut ring: Vec<u32> = Vec::new();
+    let mut starts = vec![0usize];
+    for &(c, config) in &surface {
+        let i = unpack(c);
+        for cycle in patches(config) {
+            for &e in cycle {
+                let (a, _) = EDGES[e as usize];
+                let id = index.get(add(i, corner(a)))[e as usize / 4];
+                ring.push(if id == u32::MAX { 0 } else { id });
+            }
+            patch_cells.push(i);
+            starts.push(ring.len());
+        }
+    }
+    let patch_count = patch_cells.len();
+    let inner: Vec<([f64; 3], bool)> = (0..patch_count)
+        .into_par_iter()
+        .map(|p| {
+            let ids = &ring[starts[p]..starts[p + 1]];
+            let mut pts = [[0.0; 3]; 12];
+            let mut nrm = [[0.0; 3]; 12];
+            let n = ids.len().min(12);
+            for (k, &v) in ids.iter().take(n).enumerate() {
+                pts[k] = crossings[v as usize];
+                nrm[k] = normals[v as usize];
+            }
+            place(&pts[..n], &nrm[..n], settings.sharp)
+        })
+        .collect();
+    let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.0).collect();
+    let smooth: Vec<bool> = inner.iter().map(|c| c.1).collect();
+    stats.features = smooth.iter().filter(|s| !**s).count() as u64;
+    // Smooth patches: the centroid moved along the patch's mean normal to where the field
+    // is zero (Newton's steps for a field of unit gradient along the normal).
+    let round: Vec<usize> = (0..patch_count).filter(|&p| smooth[p]).collect();
+    let mean: Vec<[f64; 3]> = round
+        .iter()
+        .map(|&p| {
+            let ids = &ring[starts[p]..starts[p + 1]];
+            normalise([0, 1, 2].map(|i| ids.iter().map(|&v| normals[v as usize][i]).sum::<f64>()))
+        })
+        .collect();
+    for _ in 0..2 {
+        let pts: Vec<[f64; 3]> = round.iter().map(|&p| centres[p]).collect();
+        let d = field.distances(&pts);
+        for (k, &p) in round.iter().enumerate() {
+            if d[k].is_finite() && d[k].abs() < grid.voxel {
+                centres[p] = [0, 1, 2].map(|i| centres[p][i] - d[k] * mean[k][i]);
+            }
+        }
+    }
+    for p in 0..patch_count {
+        centres[p] = inside_cell(grid, patch_cells[p], centres[p]);
+    }
+    separate(grid, &patch_cells, &mut centres, &ring, &starts, &crossings);
+    progress(0.75);
+
+    // Fans.
+    let base = crossings.len() as u32;
+    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(ring.len());
+    let mut owner: Vec<u32> = Vec::with_capacity(ring.len());
+    for p in 0..patch_count {
+        let ids = &ring[starts[p]..starts[p + 1]];
+        for k in 0..ids.len() {
+            triangles.push([base + p as u32, ids[k], ids[(k + 1) % ids.len()]]);
+            owner.push(p as u32);
+        }
+    }
+    let mut positions = crossings;
+    positions.extend_from_slice(&centres);
+    if settings.sharp {
+        stats.flips = flip(
+            field,
+            &positions,
+            &mut triangles,
+            &owner,
+            &smooth,
+            grid.voxel,
+        );
+    }
+    progress(0.9);
+    let (materials, vertex_materials) = if settings.materials {
+        let at_centres = field.materials(&centres);
+        let by_triangle = owner.iter().map(|&p| at_centres[p as usize]).collect();
+        let mut at_vertices = field.materials(&positions[..base as usize]);
+        at_vertices.extend_from_slice(&at_centres);
+        (by_triangle, at_vertices)
+    } else {
+        (vec![0; triangles.len()], vec![0; positions.len()])
+    };
+    stats.evaluated = field.evaluated();
+    progress(1.0);
+    Ok((
+        Mesh {
+            positions,
+            triangles,
+            materials,
+            vertex_materials,
+        },
+        stats,
+    ))
+}
+
+fn add(a: [u32; 3], b: [u32; 3]) -> [u32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Which corners of cell `c` are inside (bit set: negative distance).
+fn configuration(values: &Bricks<f64>, c: u64) -> u8 {
+    let mut config = 0u8;
+    for (k, d) in values.cube(unpack(c)).into_iter().enumerate() {
+        if d < 0.0 {
+            config |= 1 << k;
+        }
+    }
+    config
+}
+
+/// The four cells around the grid edge from `lower` along `axis` (those inside the grid's
+/// index range).
+fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = [u32; 3]> {
+    let (u, v) = match axis {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    (0..4u32).filter_map(move |k| {
+        let mut c = lower;
+        for (bit, a) in [(k & 1, u), (k >> 1 & 1, v)] {
+            if bit == 1 {
+                c[a] = c[a].checked_sub(1)?;
+            }
+        }
+        Some(c)
+    })
+}
+
+/// The surface point on each edge: regula falsi (Illinois) from the corner values,
+/// `iterations` rounds, kept [`MARGIN`] inside the edge.
+fn roots(
+    field: &Field,
+    grid: &Grid,
+    values: &Bricks<f64>,
+    edges: &[u64],
+    iterations: u32,
+) -> Vec<[f64; 3]> {
+    // Per edge: its lower end, axis, bracket (t, f) on each side, and which side moved last.
+    struct Root {
+        p: [f64; 3],
+        axis: usize,
+        lo: (f64, f64),
+        hi: (f64, f64),
+        side: i8,
+        t: f64,
+    }
+    let mut state: Vec<Root> = edges
+        .iter()
+        .map(|&e| {
+            let axis = (e & 3) as usize;
+            let i = unpack(e >> 2);
+            let mut j = i;
+            j[axis] += 1;
+            let (d0, d1) = (values.get(i), values.get(j));
+            let t = d0 / (d0 - d1);
+            Root {
+                p: grid.point(i),
+                axis,
+                lo: (0.0, d0),
+                hi: (1.0, d1),
+                side: 0,
+                t: if t.is_finite() {
+                    t.clamp(0.0, 1.0)
+                } else {
+                    0.5
+                },
+            }
+        })
+        .collect();
+    let at = |r: &Root, t: f64| {
+        let mut q = r.p;
+        q[r.axis] += t * grid.voxel;
+        q
+    };
+    let mut active: Vec<usize> = (0..state.len()).collect();
+    for _ in 0..iterations {
+        if active.is_empty() {
+            break;
+        }
+        let pts: Vec<[f64; 3]> = active.iter().map(|&k| at(&state[k], state[k].t)).collect();
+        let d = field.distances(&pts);
+        let tolerance = 1e-12 * grid.voxel.max(1e-300);
+        let mut next = Vec::with_capacity(active.len());
+        for (&k, &f) in active.iter().zip(&d) {
+            let r = &mut state[k];
+            if !f.is_finite() || f.abs() <= tolerance {
+                continue;
+            }
+            if (f < 0.0) == (r.lo.1 < 0.0) {
+                r.lo = (r.t, f);
+                if r.side == -1 {
+                    r.hi.1 /= 2.0;
+                }
+                r.side = -1;
+            } else {
+                r.hi = (r.t, f);
+                if r.side == 1 {
+                    r.lo.1 /= 2.0;
+                }
+                r.side = 1;
+            }
+            let (a, b) = (r.lo, r.hi);
+            let t = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
+            r.t = if t.is_finite() && t > a.0.min(b.0) && t < a.0.max(b.0) {
+                t
+            } else {
+                0.5 * (a.0 + b.0)
+            };
+            if (b.0 - a.0).abs() > 1e-12 {
+                next.push(k);
+            }
+        }
+        active = next;
+    }
+    state
+        .iter()
+        .map(|r| at(r, r.t.clamp(MARGIN, 1.0 - MARGIN)))
+        .collect()
+}
+
+fn normalise(g: [f64; 3]) -> [f64; 3] {
+    let l = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    if l > 0.0 && l.is_finite() {
+        g.map(|x| x / l)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// The inner vertex of a patch and whether the patch is smooth (its normals close to their
+/// mean: the vertex is then the centroid, to be projected onto the surface).
+fn place(points: &[[f64; 3]], normals: &[[f64; 3]], sharp: bool) -> ([f64; 3], bool) {
+    let n = points.len() as f64;
+    let centroid = [0, 1, 2].map(|i| points.iter().map(|p| p[i]).sum::<f64>() / n);
+    let mean = normalise([0, 1, 2].map(|i| normals.iter().map(|v| v[i]).sum::<f64>()));
+    let smooth = normals
+        .iter()
+        .all(|v| v[0] * mean[0] + v[1] * mean[1] + v[2] * mean[2] >= SMOOTH_COS);
+    if smooth || !sharp {
+        return (centroid, true);
+    }
+    (qef::solve(points, normals).0, false)
+}
+
+/// `p` clamped into cell `c`, [`MARGIN`] of a voxel inside its faces.
+fn inside_cell(grid: &Grid, c: [u32; 3], p: [f64; 3]) -> [f64; 3] {
+    let lo = grid.point(c);
+    let m = MARGIN * grid.voxel;
+    [0, 1, 2].map(|i| {
+        let v = if p[i].is_finite() {
+            p[i]
+        } else {
+            lo[i] + 0.5 * grid.voxel
+        };
+        v.clamp(lo[i] + m, lo[i] + grid.voxel - m)
+    })
+}
+
+/// Moves apart the inner vertices of patches of one cell that landed on one point (two
+/// sheets fitted to the same planes), each a little towards its own patch's centroid.
+fn separate(
+    grid: &Grid,
+    cells: &[[u32; 3]],
+    centres: &mut [[f64; 3]],
+    ring: &[u32],
+    starts: &[usize],
+    crossings: &[[f64; 3]],
+) {
+    let mut p = 0;
+    while p < cells.len() {
+        let mut q = p + 1;
+        while q < cells.len() && cells[q] == cells[p] {
+            q += 1;
+        }
+        for a in p..q {
+            for b in a + 1..q {
+                if centres[a] == centres[b] {
+                    let ids = &ring[starts[b]..starts[b + 1]];
+                    let n = ids.len() as f64;
+                    let c = [0, 1, 2]
+                        .map(|i| ids.iter().map(|&v| crossings[v as usize][i]).sum::<f64>() / n);
+                    let moved = [0, 1, 2].map(|i| centres[b][i] + 0.01 * (c[i] - centres[b][i]));
+                    centres[b] = inside_cell(grid, cells[b], moved);
+                }
+            }
+        }
+        p = q;
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
+    let [a, b, c] = t.map(|i| p[i as usize]);
+    cross(sub(b, a), sub(c, a))
+}
+
+/// Flips the patch edge between two sharp patches' fans to join their inner vertices, where
+/// the field is nearer zero at the new edge's midpoint than at the old one's (the edge then
+/// follows a sharp edge of the surface instead of cutting across it), the new triangles
+/// face the way the old ones did, and the new edge is not there yet. Returns the flips made.
+fn flip(
+    field: &Field,
+    positions: &[[f64; 3]],
+    triangles: &mut [[u32; 3]],
+    owner: &[u32],
+    smooth: &[bool],
+    voxel: f64,
+) -> u64 {
+    // Each fan triangle [centre, a, b] has one patch edge, a → b.
+    let mut by_edge: KeyMap<u32> = KeyMap::default();
+    for (t, tri) in triangles.iter().enumerate() {
+        if !smooth[owner[t] as usize] {
+            by_edge.insert((tri[1] as u64) << 32 | tri[2] as u64, t as u32);
+        }
+    }
+    let mut pairs = Vec::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        let (a, b) = (tri[1], tri[2]);
+        if a > b || smooth[owner[t] as usize] {
+            continue;
+        }
+        if let Some(&u) = by_edge.get(&((b as u64) << 32 | a as u64)) {
+            pairs.push((t, u as usize));
+        }
+    }
+    let mids: Vec<[f64; 3]> = pairs
+        .iter()
+        .flat_map(|&(t, u)| {
+            let (c1, c2) = (triangles[t][0], triangles[u][0]);
+            let (a, b) = (triangles[t][1], triangles[t][2]);
+            let mid = |x: u32, y: u32| {
+                let (p, q) = (positions[x as usize], positions[y as usize]);
+                [0, 1, 2].map(|i| 0.5 * (p[i] + q[i]))
+            };
+            [mid(c1, c2), mid(a, b)]
+        })
+        .collect();
+    let d = field.distances(&mids);
+    let mut made = KeySet::default();
+    let mut flips = 0;
+    for (k, &(t, u)) in pairs.iter().enumerate() {
+        let (new, old) = (d[2 * k].abs(), d[2 * k + 1].abs());
+        if !(new < old && old > MARGIN * voxel) {
+            continue;
+        }
+        let (c1, a, b) = (triangles[t][0], triangles[t][1], triangles[t][2]);
+        let c2 = triangles[u][0];
+        let key = (c1.min(c2) as u64) << 32 | c1.max(c2) as u64;
+        if made.contains(&key) {
+            continue;
+        }
+        let before = {
+            let (n1, n2) = (
+                normal(positions, triangles[t]),
+                normal(positions, triangles[u]),
+            );
+            [n1[0] + n2[0], n1[1] + n2[1], n1[2] + n2[2]]
+        };
+        let (s, r) = ([c1, a, c2], [c2, b, c1]);
+        let (ns, nr) = (normal(positions, s), normal(positions, r));
+        // Well above what the files' f32 coordinates can round to zero.
+        let tiny = 1e-6 * voxel * voxel;
+        let area = |n: [f64; 3]| dot(n, n).sqrt();
+        if area(ns) <= tiny || area(nr) <= tiny || dot(ns, before) <= 0.0 || dot(nr, before) <= 0.0
+        {
+            continue;
+        }
+        made.insert(key);
+        triangles[t] = s;
+        triangles[u] = r;
+        flips += 1;
+    }
+    flips
+}

@@ -1,0 +1,361 @@
+//! Meshing a scene's surface (`sdfc mesh`): the cells of a grid that may hold surface, found
+//! by an octree pruned with the distance program's proven Lipschitz bound (`octree`); the
+//! surface patch of each such cell, with edge vertices found on the surface and a vertex
+//! inside the cell placed from the field's gradients, which keeps sharp edges and corners
+//! (`contour`); and the file formats (`write`). `docs/mesh.md` describes the method and its
+//! guarantees.
+
+pub mod contour;
+pub mod octree;
+pub mod qef;
+pub mod table;
+pub mod write;
+
+use rayon::prelude::*;
+use sdfc_compiler::eval::{Evaluator, Outputs, Tape, DEFAULT_CHUNK};
+use sdfc_compiler::lower::Program;
+use std::collections::{HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Bits of one grid index in a packed key: grids of up to 2²⁰ − 2 cells along an axis.
+pub const KEY_BITS: u32 = 20;
+
+/// The most cells along one axis that a packed key can index (an implementation bound, not a
+/// resource limit).
+pub const AXIS_CELLS: u32 = (1 << KEY_BITS) - 2;
+
+/// A regular grid of cubic cells: point `(i, j, k)` is at `origin + (i, j, k)·voxel`, for
+/// `0 ≤ i ≤ cells[0]` and so on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    /// The position of point (0, 0, 0).
+    pub origin: [f64; 3],
+    /// The edge of a cell.
+    pub voxel: f64,
+    /// Cells along each axis.
+    pub cells: [u32; 3],
+}
+
+impl Grid {
+    /// The position of grid point `i`.
+    pub fn point(&self, i: [u32; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|a| self.origin[a] + i[a] as f64 * self.voxel)
+    }
+
+    /// Cells of the dense grid.
+    pub fn dense_cells(&self) -> u64 {
+        self.cells.iter().map(|&n| n as u64).product()
+    }
+
+    /// Points of the dense grid.
+    pub fn dense_points(&self) -> u64 {
+        self.cells.iter().map(|&n| n as u64 + 1).product()
+    }
+}
+
+/// A grid index packed into one key (x in the low bits).
+pub fn pack(i: [u32; 3]) -> u64 {
+    i[0] as u64 | (i[1] as u64) << KEY_BITS | (i[2] as u64) << (2 * KEY_BITS)
+}
+
+/// The grid index of a key.
+pub fn unpack(k: u64) -> [u32; 3] {
+    let m = (1u64 << KEY_BITS) - 1;
+    [
+        (k & m) as u32,
+        (k >> KEY_BITS & m) as u32,
+        (k >> (2 * KEY_BITS) & m) as u32,
+    ]
+}
+
+/// A hasher for packed keys: one multiplication, its high bits folded down.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(23) ^ x).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0 ^ self.0 >> 29
+    }
+}
+
+/// A map from packed keys.
+pub type KeyMap<V> = HashMap<u64, V, BuildHasherDefault<KeyHasher>>;
+/// A set of packed keys.
+pub type KeySet = HashSet<u64, BuildHasherDefault<KeyHasher>>;
+
+/// The scene's distance field as the mesher reads it: the distance program, intersected
+/// with a clip box (so that what reaches out of the meshed region is cut and closed), with
+/// the L that bounds it.
+#[derive(Debug)]
+pub struct Field {
+    distance: Tape,
+    materials: Tape,
+    clip: [[f64; 3]; 2],
+    /// `|f(p)| / lipschitz` is at most the distance from `p` to the surface (when `proven`).
+    pub lipschitz: f64,
+    /// Whether that bound is proven; without it the mesher evaluates the dense grid.
+    pub proven: bool,
+    evaluated: AtomicU64,
+}
+
+/// Points per task of a parallel evaluation.
+const TASK: usize = 4096;
+
+impl Field {
+    /// The field of `program` (L its [`Program::lipschitz`]; `proven` from the analysis)
+    /// clipped to the box `clip` (min, max): `max(f, box)`, whose L is at least 1.
+    pub fn new(program: &Program, proven: bool, clip: [[f64; 3]; 2]) -> Field {
+        Field {
+            distance: Tape::new(program, Outputs::Distance),
+            materials: Tape::new(program, Outputs::DistanceAndMaterial),
+            clip,
+            lipschitz: program.lipschitz().max(1.0),
+            proven,
+            evaluated: AtomicU64::new(0),
+        }
+    }
+
+    /// Points evaluated so far.
+    pub fn evaluated(&self) -> u64 {
+        self.evaluated.load(Ordering::Relaxed)
+    }
+
+    /// The signed distance to the clip box (exact).
+    fn clip_distance(&self, p: [f64; 3]) -> f64 {
+        let [lo, hi] = self.clip;
+        let q: [f64; 3] = [0, 1, 2].map(|i| (lo[i] - p[i]).max(p[i] - hi[i]));
+        let outside = q.iter().map(|v| v.max(0.0).powi(2)).sum::<f64>().sqrt();
+        outside + q[0].max(q[1]).max(q[2]).min(0.0)
+    }
+
+    /// The clipped field at every point, in parallel. A NaN distance counts as outside.
+    pub fn distances(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        let mut out = vec![0.0; points.len()];
+        points
+            .par_chunks(TASK)
+            .zip(out.par_chunks_mut(TASK))
+            .for_each_init(
+                || Scratch::new(&self.distance),
+                |s, (p, o)| {
+                    s.run(p, o, None);
+                    for (d, q) in o.iter_mut().zip(p) {
+                        let b = self.clip_distance(*q);
+                        *d = if *d > b { *d } else { b };
+                    }
+                },
+            );
+        self.evaluated
+            .fetch_add(points.len() as u64, Ordering::Relaxed);
+        out
+    }
+
+    /// The material id at every point.
+    pub fn materials(&self, points: &[[f64; 3]]) -> Vec<u32> {
+        let mut out = vec![0u32; points.len()];
+        let mut scratch = vec![0.0; points.len()];
+        points
+            .par_chunks(TASK)
+            .zip(out.par_chunks_mut(TASK).zip(scratch.par_chunks_mut(TASK)))
+            .for_each_init(
+                || Scratch::new(&self.materials),
+                |s, (p, (m, d))| s.run(p, d, Some(m)),
+            );
+        out
+    }
+
+    /// The clipped field and its gradient at every point, from four samples at the corners
+    /// of a tetrahedron of edge `2√2·h` around it (their mean is the value, to O(h²)).
+    pub fn gradients(&self, points: &[[f64; 3]], h: f64) -> (Vec<f64>, Vec<[f64; 3]>) {
+        const K: [[f64; 3]; 4] = [
+            [1.0, -1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+            [-1.0, 1.0, -1.0],
+            [1.0, 1.0, 1.0],
+        ];
+        let samples: Vec<[f64; 3]> = points
+            .iter()
+            .flat_map(|p| K.map(|k| [0, 1, 2].map(|i| p[i] + h * k[i])))
+            .collect();
+        let d = self.distances(&samples);
+        d.chunks_exact(4)
+            .map(|s| {
+                let mut g = [0.0; 3];
+                for (k, v) in K.iter().zip(s) {
+                    for i in 0..3 {
+                        g[i] += k[i] * v / (4.0 * h);
+                    }
+                }
+                (s.iter().sum::<f64>() / 4.0, g)
+            })
+            .unzip()
+    }
+}
+
+/// One thread's evaluator and input columns.
+struct Scratch<'t> {
+    eval: Evaluator<'t, f64>,
+    xyz: [Vec<f64>; 3],
+}
+
+impl<'t> Scratch<'t> {
+    fn new(tape: &'t Tape) -> Self {
+        Scratch {
+            eval: Evaluator::new(tape, DEFAULT_CHUNK),
+            xyz: [Vec::new(), Vec::new(), Vec::new()],
+        }
+    }
+
+    fn run(&mut self, points: &[[f64; 3]], d: &mut [f64], m: Option<&mut [u32]>) {
+        for (i, col) in self.xyz.iter_mut().enumerate() {
+            col.clear();
+            col.extend(points.iter().map(|p| p[i]));
+        }
+        let [x, y, z] = &self.xyz;
+        self.eval.eval(x, y, z, d, m);
+    }
+}
+
+/// A triangle mesh: vertex positions (in the coordinates the scene was written in) and
+/// triangles counter-clockwise seen from outside, with the material of each.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// The material id of each triangle (at its patch's inner vertex).
+    pub materials: Vec<u32>,
+    /// The material id at each vertex (for vertex colours).
+    pub vertex_materials: Vec<u32>,
+}
+
+/// What meshing did, for `--stats`-like reports and the benchmarks.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Stats {
+    /// Octree cells whose centre was evaluated, at every level (the dense grid's cells when
+    /// the field has no proven bound).
+    pub octree_cells: u64,
+    /// Grid cells the octree left (that may hold surface).
+    pub candidates: u64,
+    /// Cells added because a neighbour's crossed edge reached them (0 when the bound holds).
+    pub added: u64,
+    /// Cells that hold surface.
+    pub surface_cells: u64,
+    /// Points evaluated in all (centres, corners, root finding, gradients, flips).
+    pub evaluated: u64,
+    /// Patches whose inner vertex was placed at a sharp feature.
+    pub features: u64,
+    /// Edges flipped to follow a sharp edge.
+    pub flips: u64,
+    /// Whether the dense grid was evaluated (no proven bound).
+    pub dense: bool,
+}
+
+/// Settings of a mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// Place inner vertices at sharp features (QEF of the gradients) and flip edges along
+    /// them; off, every inner vertex is projected onto the surface from its patch's centroid.
+    pub sharp: bool,
+    /// Root-finding iterations for each edge vertex.
+    pub refine: u32,
+    /// Find the material of each triangle and vertex (for formats that carry them).
+    pub materials: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            sharp: true,
+            refine: 6,
+            materials: true,
+        }
+    }
+}
+
+/// Values on grid points, stored sparsely in bricks of 8×8×8 points found through a hash
+/// map: the points a cell reads lie in one or a few bricks, so a walk over cells in key
+/// order touches memory mostly in sequence.
+#[derive(Debug, Clone)]
+pub struct Bricks<T: Copy> {
+    index: KeyMap<u32>,
+    data: Vec<[T; BRICK_POINTS]>,
+    empty: T,
+}
+
+/// Points along a brick's edge (a power of two).
+const BRICK: u32 = 8;
+const BRICK_POINTS: usize = (BRICK * BRICK * BRICK) as usize;
+
+impl<T: Copy + PartialEq> Bricks<T> {
+    /// No values; `empty` is what an unset point reads.
+    pub fn new(empty: T) -> Self {
+        Bricks {
+            index: KeyMap::default(),
+            data: Vec::new(),
+            empty,
+        }
+    }
+
+    fn split(i: [u32; 3]) -> (u64, usize) {
+        let b = pack(i.map(|x| x / BRICK));
+        let o = i.map(|x| (x % BRICK) as usize);
+        (b, o[0] + BRICK as usize * (o[1] + BRICK as usize * o[2]))
+    }
+
+    /// The value at point `i` (`empty` where none was set).
+    pub fn get(&self, i: [u32; 3]) -> T {
+        let (b, o) = Self::split(i);
+        match self.index.get(&b) {
+            Some(&k) => self.data[k as usize][o],
+            None => self.empty,
+        }
+    }
+
+    /// The values at the eight corners of the cell whose lowest corner is `i`, in the order
+    /// of [`table::corner`] (one brick lookup when the cell lies in one brick).
+    pub fn cube(&self, i: [u32; 3]) -> [T; 8] {
+        if i.iter().all(|&x| x % BRICK < BRICK - 1) {
+            let (b, o) = Self::split(i);
+            let Some(&k) = self.index.get(&b) else {
+                return [self.empty; 8];
+            };
+            let brick = &self.data[k as usize];
+            let (sy, sz) = (BRICK as usize, (BRICK * BRICK) as usize);
+            return std::array::from_fn(|c| {
+                brick[o + (c & 1) + (c >> 1 & 1) * sy + (c >> 2 & 1) * sz]
+            });
+        }
+        std::array::from_fn(|c| {
+            let d = table::corner(c);
+            self.get([i[0] + d[0], i[1] + d[1], i[2] + d[2]])
+        })
+    }
+
+    /// Sets the value at point `i`.
+    pub fn set(&mut self, i: [u32; 3], v: T) {
+        let (b, o) = Self::split(i);
+        let next = self.data.len() as u32;
+        let k = *self.index.entry(b).or_insert(next);
+        if k == next {
+            self.data.push([self.empty; BRICK_POINTS]);
+        }
+        self.data[k as usize][o] = v;
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.data.len() * std::mem::size_of::<[T; BRICK_POINTS]>() + self.index.len() * 24
+    }
+}

@@ -376,3 +376,63 @@ fn without_an_adapter_the_window_shows_cpu_frames() {
         "{stderr}"
     );
 }
+
+#[test]
+fn the_view_of_an_animated_scene_at_a_time_is_that_frame_of_the_sequence() {
+    // Headless, `--time` pauses the animation at a time: the picture is the sequence's frame
+    // of that time (bounce.sdf at 30 frames per second: 0.5 s is frame 15).
+    let dir = temp_dir("time");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/animation/bounce.sdf");
+    let scene = scene.to_str().expect("utf-8 path");
+    let sdfc = env!("CARGO_BIN_EXE_sdfc");
+    let run = |args: &[&str]| {
+        let out = Command::new(sdfc)
+            .current_dir(&dir)
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .args(args)
+            .output()
+            .expect("run sdfc");
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    for t in ["0", "0.5"] {
+        run(&[
+            "view",
+            scene,
+            "--headless",
+            "--backend",
+            "cpu",
+            "--size",
+            "96x72",
+            "--time",
+            t,
+            "--screenshot-dir",
+            t,
+            "--exit-after-reloads",
+            "0",
+        ]);
+    }
+    run(&[
+        "render",
+        scene,
+        "--backend",
+        "cpu",
+        "--size",
+        "96x72",
+        "--frames",
+        "15..16",
+        "-o",
+        "f_##.png",
+    ]);
+    let at = |p: &str| read_png(&dir.join(p)).expect("a PNG");
+    let (zero, half, frame) = (at("0/reload-0.png"), at("0.5/reload-0.png"), at("f_15.png"));
+    assert_eq!(half, frame, "t = 0.5 s is frame 15 of the sequence");
+    assert!(
+        changed(&zero, &half, (0.0, 1.0), (0.0, 1.0)) > 0.0,
+        "the time moves the ball"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

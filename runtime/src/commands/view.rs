@@ -57,6 +57,10 @@ pub struct ViewArgs {
     /// or, after a load with errors, the last good image that stays on show.
     #[arg(long, value_name = "DIR")]
     pub screenshot_dir: Option<PathBuf>,
+    /// An animated scene starts paused at this time, in seconds (space plays and pauses);
+    /// without it the window plays the animation, and --headless shows t = 0.
+    #[arg(long, value_name = "SECONDS", value_parser = time_value)]
+    pub time: Option<f64>,
     /// Stop once the screenshot of load K is written (needs --screenshot-dir).
     #[arg(long, value_name = "K", requires = "screenshot_dir")]
     pub exit_after_reloads: Option<u32>,
@@ -94,6 +98,8 @@ pub fn run(args: ViewArgs) -> ExitCode {
             sets: args.set,
             limits,
             timings: args.timings,
+            // Headless, nothing would ever settle while the clock runs.
+            time: args.time.or(args.headless.then_some(0.0)),
         },
         control: Control {
             frames: args.frames,
@@ -108,5 +114,13 @@ pub fn run(args: ViewArgs) -> ExitCode {
         view::headless(run)
     } else {
         view::window::run(run)
+    }
+}
+
+/// A `--time` value: a finite number of seconds, at least 0.
+fn time_value(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(t) if t.is_finite() && t >= 0.0 => Ok(t),
+        _ => Err(format!("expected a time in seconds, at least 0, not `{s}`")),
     }
 }

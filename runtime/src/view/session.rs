@@ -2,7 +2,8 @@
 //! for the CPU renderer or wgpu, keeps the last good scene when an edit has errors, holds the
 //! camera the user moved, and renders frames progressively (one sample per pixel, and fewer
 //! pixels when a frame exceeds its budget, while the camera moves; jittered samples
-//! accumulated up to the scene's `aa` when it is still).
+//! accumulated up to the scene's `aa` when it is still), and plays an animated scene's time `t`
+//! (each frame's scene checked at its time, its kernel kept while only numbers change).
 
 use super::camera::{self, Orbit};
 use super::watch::Fingerprint;
@@ -14,7 +15,7 @@ use crate::image::Image;
 use crate::settings::override_settings;
 use sdfc_compiler::back::wgsl;
 use sdfc_compiler::lower::{self, LowerOptions};
-use sdfc_compiler::scene::{Camera, Scene};
+use sdfc_compiler::scene::{Animation, Camera, Scene};
 use sdfc_compiler::{Diagnostic, FileId, Limit, Limits, Severity, SourceMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -42,6 +43,43 @@ pub struct Options {
     pub limits: Limits,
     /// `--timings`: print the times of each load and of its first frame.
     pub timings: bool,
+    /// `--time`: an animated scene starts paused at this time (seconds) instead of playing.
+    pub time: Option<f64>,
+}
+
+/// The playing of an animated scene's time `t`: the frame on show is the scene checked at the
+/// start of the animation frame (`k / fps`) the clock is in, looping over `duration` when the
+/// scene states one.
+#[derive(Debug)]
+struct Playback {
+    /// The scene's files as the load that started (or last renewed) the playback read them.
+    source: frontend::Source,
+    animation: Animation,
+    /// When the clock read 0, while playing.
+    origin: Instant,
+    /// The clock while paused.
+    paused: Option<f64>,
+    /// The animation frame on show.
+    shown: Option<u64>,
+}
+
+impl Playback {
+    /// The clock, in seconds (within `duration`, when the scene states one).
+    fn clock(&self) -> f64 {
+        let age = self
+            .paused
+            .unwrap_or_else(|| self.origin.elapsed().as_secs_f64());
+        if self.animation.duration > 0.0 {
+            age.rem_euclid(self.animation.duration)
+        } else {
+            age
+        }
+    }
+
+    /// The animation frame the clock is in.
+    fn frame(&self) -> u64 {
+        (self.clock() * self.animation.fps).floor() as u64
+    }
 }
 
 /// Where frames are rendered.
@@ -187,6 +225,8 @@ pub struct Session {
     /// A render error that stops rendering until the next load or camera move.
     broken: Option<String>,
     timings: Option<Timings>,
+    /// The animated scene's time, played or paused; `None` for a still.
+    playback: Option<Playback>,
 }
 
 impl Session {
@@ -214,6 +254,7 @@ impl Session {
             last: None,
             broken: None,
             timings: None,
+            playback: None,
         }
     }
 
@@ -361,7 +402,7 @@ impl Session {
         );
         let check_time = start.elapsed();
         let start = Instant::now();
-        let lowered = match lower::lower_within(&scene, &LowerOptions::default(), &limits) {
+        let lowered = match lower::lower_within(&scene, &lower_options(&scene), &limits) {
             Ok(lowered) => lowered,
             Err(d) => {
                 let summary = first_error(std::slice::from_ref(&d), &loaded.sources);
@@ -428,10 +469,111 @@ impl Session {
     }
 
     fn install(&mut self, good: Good) {
+        self.playback = self.playback_of(&good.scene);
         self.good = Some(good);
         self.broken = None;
         self.preview = true;
         self.accumulation = Accumulation::default();
+    }
+
+    /// The playback of a newly loaded scene: `None` for a still; for an animated scene the
+    /// clock of the last playback goes on (paused or not), or starts (paused at `--time`, if
+    /// given). The files are read again for the frames to come; if they cannot be, the scene
+    /// stays at the time it was loaded at.
+    fn playback_of(&mut self, scene: &Scene) -> Option<Playback> {
+        if !scene.animation.animated() {
+            return None;
+        }
+        let source = match frontend::Source::read(&self.file) {
+            Ok(s) => s,
+            Err(msg) => {
+                eprintln!("view: the animation stays at t = 0: {msg}");
+                return None;
+            }
+        };
+        let (origin, paused) = match &self.playback {
+            Some(p) => (p.origin, p.paused),
+            None => (Instant::now(), self.options.time),
+        };
+        Some(Playback {
+            source,
+            animation: scene.animation,
+            origin,
+            paused,
+            // The load checked the scene at t = 0.
+            shown: Some(0),
+        })
+    }
+
+    /// Whether an animated scene's time is playing.
+    pub fn playing(&self) -> bool {
+        self.playback.as_ref().is_some_and(|p| p.paused.is_none()) && self.broken.is_none()
+    }
+
+    /// Pauses a playing animation at its clock, or plays a paused one on from there.
+    pub fn toggle_pause(&mut self) {
+        if let Some(p) = self.playback.as_mut() {
+            match p.paused.take() {
+                Some(at) => p.origin = Instant::now() - Duration::from_secs_f64(at),
+                None => p.paused = Some(p.clock()),
+            }
+            self.accumulation = Accumulation::default();
+        }
+    }
+
+    /// The animation time on show, for the title; `None` for a still.
+    pub fn time(&self) -> Option<f64> {
+        let p = self.playback.as_ref()?;
+        Some(Animation::time_of(p.animation.fps, p.shown.unwrap_or(0)))
+    }
+
+    /// Brings the scene to the animation frame the clock is in: the scene checked at that
+    /// frame's time, lowered and prepared (the kernel kept when only numbers change). A frame
+    /// that fails stops the clock there, with its problem in the title.
+    fn advance(&mut self) {
+        let Some(p) = self.playback.as_mut() else {
+            return;
+        };
+        let k = p.frame();
+        if p.shown == Some(k) {
+            return;
+        }
+        p.shown = Some(k);
+        let time = Animation::time_of(p.animation.fps, k);
+        if let Err(msg) = self.scene_at(time) {
+            eprintln!("view: t = {time} s: {msg}");
+            self.status = Some(format!("t = {time} s: {msg}"));
+            if let Some(p) = self.playback.as_mut() {
+                p.paused = Some(time);
+            }
+        }
+    }
+
+    /// Replaces the scene on show with the scene checked at `time`.
+    fn scene_at(&mut self, time: f64) -> Result<(), String> {
+        let limits = self.options.limits.clone();
+        let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
+            return Ok(());
+        };
+        let mut loaded = p.source.check(&limits, time);
+        let Some(mut scene) = loaded.scene.take() else {
+            frontend::report(&loaded, DiagnosticFormat::Human);
+            return Err(first_error(&loaded.diagnostics, &loaded.sources));
+        };
+        override_settings(
+            &mut scene.settings,
+            self.options.size,
+            None,
+            &self.options.sets,
+            &limits,
+        )?;
+        let lowered = lower::lower_within(&scene, &lower_options(&scene), &limits)
+            .map_err(|d| first_error(std::slice::from_ref(&d), &loaded.sources))?;
+        let (prepared, _) = good.prepared.next(&scene, lowered)?;
+        good.file_camera = scene.camera.clone();
+        good.scene = scene;
+        good.prepared = prepared;
+        Ok(())
     }
 
     /// The divisor of the resolution of a new scene's first frame: enough to bring the last
@@ -527,7 +669,11 @@ impl Session {
             return false;
         }
         let a = &self.accumulation;
-        self.moving() || !a.still || a.count < good.aa || (a.width, a.height) != self.size
+        self.moving()
+            || self.playing()
+            || !a.still
+            || a.count < good.aa
+            || (a.width, a.height) != self.size
     }
 
     /// Whether the image on show is final until something changes (converged, or nothing to
@@ -542,7 +688,9 @@ impl Session {
         if !self.wants_frame() {
             return Ok(None);
         }
-        let moving = self.moving();
+        self.advance();
+        // A playing animation renders as a moving camera does: one sample a frame.
+        let moving = self.moving() || self.playing();
         let Some(base) = self.camera() else {
             return Ok(None);
         };
@@ -711,6 +859,10 @@ impl Session {
     /// error, and with `stats` the backend, method, frame time, steps per pixel and samples.
     pub fn title(&self, stats: bool) -> String {
         let mut title = format!("sdfc view: {}", self.file.display());
+        if let Some(t) = self.time() {
+            let state = if self.playing() { "playing" } else { "paused" };
+            title.push_str(&format!(" | t = {t:.2} s, {state}"));
+        }
         if let Some(status) = &self.status {
             title.push_str(&format!(" | {status}"));
         }
@@ -732,6 +884,16 @@ impl Session {
             ));
         }
         title
+    }
+}
+
+/// The lowering of a scene: an animated one keeps the structure of its program whatever its
+/// numbers (`LowerOptions::parametric`), so that its frames share one kernel.
+fn lower_options(scene: &Scene) -> LowerOptions {
+    if scene.animation.animated() {
+        LowerOptions::parametric()
+    } else {
+        LowerOptions::default()
     }
 }
 
@@ -791,6 +953,46 @@ mod tests {
             frames += 1;
         }
         frames
+    }
+
+    #[test]
+    fn an_animated_scene_plays_and_pauses() {
+        let dir = std::env::temp_dir().join(format!("sdfc-play-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("a.sdf");
+        let animated = SCENE
+            .replace("aa: 2 }", "aa: 2, fps: 200, duration: 10 }")
+            .replace(
+                "sphere(0.5).translate(0, 0.5, 0)",
+                "sphere(0.5).translate(0, 0.5 + t, 0)",
+            );
+        std::fs::write(&file, animated).unwrap();
+        let mut s = Session::new(file, Options::default(), Device::Cpu);
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        assert!(s.playing(), "a window plays the animation");
+        assert!(
+            s.wants_frame(),
+            "a playing animation always has a frame to render"
+        );
+        s.frame().expect("a frame");
+        let first = s.image().unwrap().clone();
+        std::thread::sleep(Duration::from_millis(300));
+        s.frame().expect("a frame");
+        assert!(s.time().unwrap() > 0.0, "the clock moved on");
+        assert_ne!(s.image().unwrap(), &first, "the sphere rose");
+        assert!(s.title(false).contains("playing"));
+        // Paused, the time stays and the samples accumulate to the scene's aa.
+        s.toggle_pause();
+        assert!(!s.playing() && s.title(false).contains("paused"));
+        let at = s.time();
+        settle(&mut s);
+        assert!(s.settled());
+        std::thread::sleep(Duration::from_millis(50));
+        assert_eq!(s.time(), at);
+        s.toggle_pause();
+        assert!(s.playing());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

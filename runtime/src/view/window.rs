@@ -315,6 +315,10 @@ impl ApplicationHandler<UserEvent> for App {
                     }
                     Key::Character(c) if c.eq_ignore_ascii_case("s") => st.stats = !st.stats,
                     Key::Named(NamedKey::Tab) => st.stats = !st.stats,
+                    Key::Named(NamedKey::Space) => {
+                        st.session.toggle_pause();
+                        st.window.request_redraw();
+                    }
                     Key::Named(NamedKey::Escape) => self.finish(event_loop, ExitCode::SUCCESS),
                     Key::Character(c) if c.eq_ignore_ascii_case("q") => {
                         self.finish(event_loop, ExitCode::SUCCESS)

@@ -94,6 +94,8 @@ pub struct Frame {
     pub time: Duration,
     /// Wall time of the frame (the same as `time` on the CPU).
     pub wall: Duration,
+    /// Where a GPU frame's wall time went on the host (`None` on the CPU).
+    pub phases: Option<crate::gpu::Phases>,
 }
 
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
@@ -521,6 +523,7 @@ impl Prepared {
                     render,
                     time,
                     wall: time,
+                    phases: None,
                 })
             }
             Prepared::Wgpu {
@@ -535,6 +538,7 @@ impl Prepared {
                     render: r.render,
                     time: r.time,
                     wall: r.wall,
+                    phases: Some(r.phases),
                 })
             }
             Prepared::Cuda {
@@ -551,6 +555,7 @@ impl Prepared {
                     render: r.render,
                     time: r.time,
                     wall: r.wall,
+                    phases: Some(r.phases),
                 })
             }
         }

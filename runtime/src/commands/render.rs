@@ -338,11 +338,14 @@ pub fn stats(
         text.push_str(&format!("prepared        {p}\n"));
     }
     text.push_str(&format!(
-        "time            {:.3} s (frame {:.3} s)\n{}\n",
+        "time            {:.3} s (frame {:.3} s)\n",
         seconds,
         frame.time.as_secs_f64(),
-        frame.render.stats
     ));
+    if let Some(p) = &frame.phases {
+        text.push_str(&format!("frame on host   {p}\n"));
+    }
+    text.push_str(&format!("{}\n", frame.render.stats));
     if let Some(c) = check {
         text.push_str(&format!("{c}\n"));
     }

@@ -71,6 +71,8 @@ pub struct Frame {
     pub gpu_time: Duration,
     /// Wall time from the first launch until the last finished (readback excluded).
     pub wall_time: Duration,
+    /// Where the wall time of the whole frame went.
+    pub phases: super::Phases,
 }
 
 impl Cuda {
@@ -220,6 +222,7 @@ impl Cuda {
         workgroup: u32,
         tile: u32,
     ) -> Result<Frame, Error> {
+        let setup = Instant::now();
         let s = &self.stream;
         let pixels = width as usize * height as usize;
         let tiles = super::wgpu::tiles(width, height, tile);
@@ -248,6 +251,8 @@ impl Cuda {
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
         let mut events = Vec::with_capacity(tiles.len());
         let fault = super::fault_after_tiles();
+        s.synchronize().map_err(driver("uploading the scene"))?;
+        let setup = setup.elapsed();
         let wall = Instant::now();
         for (i, t) in tiles.iter().enumerate() {
             if let Some(message) = super::injected_fault(fault, i) {
@@ -293,18 +298,28 @@ impl Cuda {
         for (start, end) in &events {
             ms += start.elapsed_ms(end).map_err(driver("reading the timer"))? as f64;
         }
+        let readback = Instant::now();
         let image = s
             .clone_dtoh(&d_image)
             .map_err(driver("reading the image"))?;
         let stats = s
             .clone_dtoh(&d_stats)
             .map_err(driver("reading the statistics"))?;
+        let readback = readback.elapsed();
+        let convert = Instant::now();
         let linear = image.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
+        let phases = super::Phases {
+            setup,
+            launches: wall_time,
+            readback,
+            convert: convert.elapsed(),
+        };
         Ok(Frame {
             linear,
             stats,
             gpu_time: Duration::from_secs_f64(ms / 1e3),
             wall_time,
+            phases,
         })
     }
 }

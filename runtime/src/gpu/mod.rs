@@ -44,6 +44,8 @@ pub const TILE: u32 = 512;
 pub struct GpuRender {
     /// Image and statistics.
     pub render: Render,
+    /// Where the frame's wall time went on the host.
+    pub phases: Phases,
     /// Time of the dispatches (GPU timestamps where the adapter has them, else wall time).
     pub time: Duration,
     /// Whether `time` comes from GPU timestamps.
@@ -51,6 +53,39 @@ pub struct GpuRender {
     /// Wall time from the first submission until the GPU finished (launch overheads
     /// included, readback excluded).
     pub wall: Duration,
+}
+
+/// Where a GPU frame's wall time went on the host (`sdfc render --stats`): buffers allocated
+/// and uploaded, the launches until the GPU finished, the image and statistics read back, and
+/// their conversion (to colours, statistics words and the frame's statistics).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Phases {
+    pub setup: Duration,
+    pub launches: Duration,
+    pub readback: Duration,
+    pub convert: Duration,
+}
+
+impl Phases {
+    /// The whole of it.
+    pub fn total(&self) -> Duration {
+        self.setup + self.launches + self.readback + self.convert
+    }
+}
+
+impl std::fmt::Display for Phases {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        write!(
+            f,
+            "{:.2} ms: setup {:.2} ms, launches {:.2} ms, readback {:.2} ms, conversion {:.2} ms",
+            ms(self.total()),
+            ms(self.setup),
+            ms(self.launches),
+            ms(self.readback),
+            ms(self.convert)
+        )
+    }
 }
 
 /// Renders `scene` with an already generated kernel on `gpu`.
@@ -75,7 +110,10 @@ pub fn render(
         tile: TILE,
     };
     let frame = gpu.render(&launch, progress)?;
+    let start = std::time::Instant::now();
     let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
+    let mut phases = frame.phases;
+    phases.convert += start.elapsed();
     let image = Image {
         width: s.width,
         height: s.height,
@@ -87,6 +125,7 @@ pub fn render(
             stats,
             depth: None,
         },
+        phases,
         time: frame.gpu_time.unwrap_or(frame.wall_time),
         timestamps: frame.gpu_time.is_some(),
         wall: frame.wall_time,
@@ -114,7 +153,10 @@ pub fn render_cuda(
         wgsl::WORKGROUP,
         TILE,
     )?;
+    let start = std::time::Instant::now();
     let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
+    let mut phases = frame.phases;
+    phases.convert += start.elapsed();
     let image = Image {
         width: s.width,
         height: s.height,
@@ -126,6 +168,7 @@ pub fn render_cuda(
             stats,
             depth: None,
         },
+        phases,
         time: frame.gpu_time,
         timestamps: true,
         wall: frame.wall_time,

@@ -68,6 +68,8 @@ pub struct Frame {
     pub gpu_time: Option<Duration>,
     /// Wall time from the first submit until the last dispatch finished (readback excluded).
     pub wall_time: Duration,
+    /// Where the wall time of the whole frame went.
+    pub phases: super::Phases,
 }
 
 /// A compiled kernel ready to launch: its WGSL, entry point and uniform bytes.
@@ -223,6 +225,7 @@ impl Gpu {
 
     /// Renders one frame. `progress` is called with the fraction done after each tile.
     pub fn render(&self, l: &Launch, progress: &mut dyn FnMut(f64)) -> Result<Frame, Error> {
+        let setup = Instant::now();
         let limit = self.device.limits().max_storage_buffer_binding_size;
         if let Some(data) = l.data.filter(|d| d.len() as u64 > limit) {
             return Err(Error::Render(format!(
@@ -253,6 +256,8 @@ impl Gpu {
             })
             .collect();
         self.queue.write_buffer(&buffers.tile, 0, &table);
+        // (wgpu's writes are queued: the uploads are paid for in the first submission.)
+        let setup = setup.elapsed();
         let start = Instant::now();
         let fault = super::fault_after_tiles();
         // Tiles are submitted in batches: each tile is its own dispatch, and the host waits
@@ -285,8 +290,10 @@ impl Gpu {
             progress(((b * TILES_PER_SUBMIT + batch.len()) as f64 / tiles.len() as f64).min(1.0));
         }
         let wall_time = start.elapsed();
+        let readback = Instant::now();
         let linear = self.read(&buffers.image, pixels * 16)?;
         let stats = self.read(&buffers.stats, pixels * 4 * l.stats_words as u64)?;
+        let readback = readback.elapsed();
         if let Some(e) = pollster::block_on(mem_scope.pop()) {
             return Err(Error::Render(e.to_string()));
         }
@@ -294,6 +301,7 @@ impl Gpu {
             Some(q) => Some(self.gpu_time(q, tiles.len() as u32)?),
             None => None,
         };
+        let convert = Instant::now();
         let floats: Vec<f32> = linear
             .chunks_exact(4)
             .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -303,11 +311,18 @@ impl Gpu {
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
             .collect();
+        let phases = super::Phases {
+            setup,
+            launches: wall_time,
+            readback,
+            convert: convert.elapsed(),
+        };
         Ok(Frame {
             linear,
             stats,
             gpu_time,
             wall_time,
+            phases,
         })
     }
 

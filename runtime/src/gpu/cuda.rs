@@ -307,7 +307,10 @@ impl Cuda {
             .map_err(driver("reading the statistics"))?;
         let readback = readback.elapsed();
         let convert = Instant::now();
-        let linear = image.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
+        let linear = {
+            use rayon::prelude::*;
+            image.par_chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect()
+        };
         let phases = super::Phases {
             setup,
             launches: wall_time,

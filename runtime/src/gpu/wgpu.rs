@@ -302,15 +302,19 @@ impl Gpu {
             None => None,
         };
         let convert = Instant::now();
-        let floats: Vec<f32> = linear
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
-        let linear = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
-        let stats = stats
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
+        let (linear, stats) = {
+            use rayon::prelude::*;
+            let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+            let linear = linear
+                .par_chunks_exact(16)
+                .map(|c| [f(&c[0..4]), f(&c[4..8]), f(&c[8..12])])
+                .collect();
+            let stats = stats
+                .par_chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect();
+            (linear, stats)
+        };
         let phases = super::Phases {
             setup,
             launches: wall_time,

@@ -309,7 +309,10 @@ impl Cuda {
         let convert = Instant::now();
         let linear = {
             use rayon::prelude::*;
-            image.par_chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect()
+            image
+                .par_chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect()
         };
         let phases = super::Phases {
             setup,

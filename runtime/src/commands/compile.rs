@@ -39,7 +39,7 @@ pub struct CompileArgs {
     /// The target to write.
     #[arg(long, value_enum)]
     pub emit: Emit,
-    /// Output file (default: standard output).
+    /// Output file (default: standard output; binary SPIR-V is not written to a terminal).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// How to print diagnostics.
@@ -67,6 +67,15 @@ pub fn run(args: CompileArgs) -> ExitCode {
         }
     };
     frontend::report(&loaded, args.diagnostics);
+    if args.emit == Emit::Spirv && args.output.is_none() && {
+        use std::io::IsTerminal;
+        std::io::stdout().is_terminal()
+    } {
+        eprintln!(
+            "error: SPIR-V is binary and standard output is a terminal; write it to a file with `-o FILE.spv` (or redirect it)"
+        );
+        return ExitCode::from(2);
+    }
     let text = match args.emit {
         Emit::Ast => {
             // The AST is shown even for a file with errors in later stages, but not with

@@ -13,6 +13,7 @@ mod analytic;
 mod buffer;
 mod map;
 mod march;
+pub mod part;
 mod template;
 
 pub use analytic::MAX_UNROLLED;

@@ -30,6 +30,21 @@ pub enum Emit {
     Hlsl,
     /// The kernel as PTX for the CUDA driver.
     Ptx,
+    /// The kernel's scene uniform `Params` (binding 0) as bytes (binary).
+    Params,
+    /// The kernel's storage buffer `scene_data` (binding 4) as bytes (binary), for a scene
+    /// whose kernel reads one.
+    SceneData,
+    /// The kernel's entry point, workgroup size and bindings, with the layout of each
+    /// binding's type (JSON).
+    Layout,
+}
+
+impl Emit {
+    /// Whether the target is binary (refused on a terminal).
+    fn binary(self) -> bool {
+        matches!(self, Emit::Spirv | Emit::Params | Emit::SceneData)
+    }
 }
 
 /// Which part of the generated code `sdfc compile` writes (docs/embedding.md).
@@ -90,12 +105,17 @@ pub fn run(args: CompileArgs) -> ExitCode {
         return ExitCode::from(2);
     }
     frontend::report(&loaded, args.diagnostics);
-    if args.emit == Emit::Spirv && args.output.is_none() && {
+    if args.emit.binary() && args.output.is_none() && {
         use std::io::IsTerminal;
         std::io::stdout().is_terminal()
     } {
+        let what = if args.emit == Emit::Spirv {
+            "SPIR-V"
+        } else {
+            "this target"
+        };
         eprintln!(
-            "error: SPIR-V is binary and standard output is a terminal; write it to a file with `-o FILE.spv` (or redirect it)"
+            "error: {what} is binary and standard output is a terminal; write it to a file with `-o FILE` (or redirect it)"
         );
         return ExitCode::from(2);
     }
@@ -214,9 +234,24 @@ fn emit(
         Emit::Msl => Some(Lang::Msl),
         Emit::Glsl => Some(Lang::Glsl),
         Emit::Hlsl => Some(Lang::Hlsl),
-        Emit::Wgsl | Emit::Ptx => None,
+        Emit::Wgsl | Emit::Ptx | Emit::Params | Emit::SceneData | Emit::Layout => None,
     };
     let kernel = back::wgsl::write(scene, lowered).map_err(|e| e.to_string())?;
+    match target {
+        Emit::Params => return Ok(back::wgsl::uniforms(scene, program.lipschitz())),
+        Emit::SceneData => {
+            return kernel.data.ok_or_else(|| {
+                "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 2 048 marched instances does)".into()
+            })
+        }
+        Emit::Layout => {
+            let value = back::wgsl::layout::interface(&kernel)?;
+            let mut text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())?;
+            text.push('\n');
+            return Ok(text.into_bytes());
+        }
+        _ => {}
+    }
     if target == Emit::Ptx {
         let options = back::ptx::Options {
             sm,

@@ -11,6 +11,7 @@
 
 mod analytic;
 mod buffer;
+pub mod layout;
 mod map;
 mod march;
 pub mod part;

@@ -831,7 +831,7 @@ fn pareto_sweeps_are_bounded_by_limits() {
     assert!(err.contains("--limit sweep_values="), "{err}");
 }
 
-/// `--emit spirv` writes binary: to a terminal it is refused (exit 2, pointing at `-o`),
+/// `--emit spirv` (and `params`) writes binary: to a terminal it is refused (exit 2, pointing at `-o`),
 /// while to a pipe or a file it is written. The terminal is a pseudo-terminal from
 /// util-linux's `script`.
 #[test]
@@ -848,7 +848,7 @@ fn spirv_is_not_written_to_a_terminal() {
     assert!(filed.status.success());
     assert_eq!(std::fs::read(d.join("k.spv")).expect("k.spv"), piped.stdout);
     let command = format!(
-        "'{}' compile ball.sdf --emit spirv; echo \"exit=$?\"",
+        "'{0}' compile ball.sdf --emit spirv; echo \"exit=$?\"; '{0}' compile ball.sdf --emit params; echo \"exit=$?\"",
         env!("CARGO_BIN_EXE_sdfc")
     );
     let tty = Command::new("script")
@@ -857,7 +857,7 @@ fn spirv_is_not_written_to_a_terminal() {
         .output()
         .expect("util-linux `script` runs a command on a pseudo-terminal");
     let text = String::from_utf8_lossy(&tty.stdout);
-    assert!(text.contains("exit=2"), "{text}");
+    assert_eq!(text.matches("exit=2").count(), 2, "{text}");
     assert!(text.contains("-o FILE"), "{text}");
     assert!(
         !text.contains('\u{0}'),

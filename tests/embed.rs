@@ -162,7 +162,15 @@ fn the_part_is_the_kernels_own_map() {
 fn the_command_line_refuses_what_has_no_part() {
     let path = example("seed1.sdf");
     let file = path.to_str().expect("utf-8 path");
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["--emit", "wgsl", "--part", "map", "--name", "loop"],
+            "not a name",
+        ),
+        (
+            &["--emit", "rust", "--part", "map", "--name", "min"],
+            "not a name",
+        ),
         (
             &["--emit", "ptx", "--part", "map"],
             "`--part map` is written as",

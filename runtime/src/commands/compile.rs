@@ -181,7 +181,7 @@ fn part_refused(args: &CompileArgs) -> Option<String> {
             ))
         }
         Part::Map if !back::wgsl::part::valid_name(&args.name) => Some(format!(
-            "`--name {}` is not a name for a function: use ASCII letters, digits and `_`, not starting with a digit or `__`, at most 64 characters",
+            "`--name {}` is not a name for a function: use ASCII letters, digits and `_`, not starting with a digit or `__`, at most 64 characters, and not a word WGSL or Rust reserves",
             args.name
         )),
         _ => None,

@@ -23,14 +23,28 @@ pub struct Part {
     pub info: naga::valid::ModuleInfo,
 }
 
+/// Rust's keywords, strict and reserved (`--emit rust --part map --name`).
+const RUST_KEYWORDS: &[&str] = &[
+    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
+    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
+    "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
+    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "try", "typeof", "unsized", "virtual", "yield",
+];
+
 /// Whether `name` can name a part: an identifier of ASCII letters, digits and `_`, not
-/// starting with a digit nor with `__` (reserved by WGSL), of at most 64 characters.
+/// starting with a digit nor with `__` (reserved by WGSL), of at most 64 characters, and
+/// neither a WGSL reserved word or built-in function (naga's lists) nor a Rust keyword.
 pub fn valid_name(name: &str) -> bool {
+    let taken = naga::keywords::wgsl::RESERVED.contains(&name)
+        || naga::keywords::wgsl::BUILTIN_IDENTIFIERS.contains(&name)
+        || RUST_KEYWORDS.contains(&name);
     let mut chars = name.chars();
     let first_ok = chars
         .next()
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
     first_ok
+        && !taken
         && name.len() <= 64
         && !name.starts_with("__")
         && name != "_"

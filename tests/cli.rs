@@ -830,3 +830,38 @@ fn pareto_sweeps_are_bounded_by_limits() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("--limit sweep_values="), "{err}");
 }
+
+/// `--emit spirv` (and `params`) writes binary: to a terminal it is refused (exit 2, pointing at `-o`),
+/// while to a pipe or a file it is written. The terminal is a pseudo-terminal from
+/// util-linux's `script`.
+#[test]
+fn spirv_is_not_written_to_a_terminal() {
+    let d = dir("spirv-tty");
+    scene_file(&d);
+    let piped = sdfc(&d, &["compile", "ball.sdf", "--emit", "spirv"]);
+    assert!(piped.status.success());
+    assert_eq!(&piped.stdout[..4], &0x0723_0203u32.to_le_bytes());
+    let filed = sdfc(
+        &d,
+        &["compile", "ball.sdf", "--emit", "spirv", "-o", "k.spv"],
+    );
+    assert!(filed.status.success());
+    assert_eq!(std::fs::read(d.join("k.spv")).expect("k.spv"), piped.stdout);
+    let command = format!(
+        "'{0}' compile ball.sdf --emit spirv; echo \"exit=$?\"; '{0}' compile ball.sdf --emit params; echo \"exit=$?\"",
+        env!("CARGO_BIN_EXE_sdfc")
+    );
+    let tty = Command::new("script")
+        .current_dir(&d)
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+        .expect("util-linux `script` runs a command on a pseudo-terminal");
+    let text = String::from_utf8_lossy(&tty.stdout);
+    assert_eq!(text.matches("exit=2").count(), 2, "{text}");
+    assert!(text.contains("-o FILE"), "{text}");
+    assert!(
+        !text.contains('\u{0}'),
+        "binary reached the terminal: {text:?}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -12,7 +12,9 @@
 //! reports each error with the kernel's name. The examples are `examples/*.sdf`,
 //! `examples/scaling/*_10.sdf` and `*_1000.sdf` (whose instances are read from `scene_data`),
 //! and `tests/in/ok/*.sdf`; and `examples/animation/*.sdf` as a sequence's kernels are
-//! written, their constants read from `scene_data` (`Options::parameters`), with pipelines.
+//! written, their constants read from `scene_data` (`Options::parameters`), with pipelines;
+//! and the distance function alone (`sdfc compile --part map`) of every scene that gets a
+//! pipeline (a module without an entry point: no pipeline of its own).
 //!
 //! The browser is `$SDFC_CHROMIUM`, or `chromium` (Debian's package) on PATH. Without it, or
 //! without a WebGPU adapter, the test prints that it skipped, unless `CI=true` or
@@ -133,7 +135,7 @@ fn example_jobs() -> Vec<Job> {
         (p, seed || all_pipelines(), false)
     });
     let all = all.chain(animated.iter().map(|p| (p, true, true)));
-    all.map(|(path, pipeline, parameters)| {
+    all.flat_map(|(path, pipeline, parameters)| {
         let loaded = frontend::load(path).expect("readable");
         let scene = loaded
             .scene
@@ -151,11 +153,20 @@ fn example_jobs() -> Vec<Job> {
             .unwrap_or(path)
             .display()
             .to_string();
-        Job {
+        // The distance function alone (`sdfc compile --part map`) of the report's scenes.
+        let part = pipeline.then(|| Job {
+            name: format!("{name} --part map"),
+            code: wgsl::part::write(&scene, &lowered, "map")
+                .unwrap_or_else(|e| panic!("{name}: {e}"))
+                .source,
+            pipeline: false,
+        });
+        let kernel = Job {
             name,
             code: kernel.source,
             pipeline,
-        }
+        };
+        std::iter::once(kernel).chain(part)
     })
     .collect()
 }

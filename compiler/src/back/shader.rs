@@ -1,7 +1,8 @@
 //! Other shading languages, written by naga from the validated WGSL kernel: SPIR-V, MSL,
-//! GLSL and HLSL (`sdfc compile --emit spirv|msl|glsl|hlsl`).
+//! GLSL and HLSL (`sdfc compile --emit spirv|msl|glsl|hlsl`); and the scene's distance
+//! function alone ([`super::wgsl::part`], `--part map`) in MSL, GLSL and HLSL.
 
-use super::wgsl::Kernel;
+use super::wgsl::{part::Part, Kernel};
 use std::fmt;
 
 /// A shading language naga can write.
@@ -35,7 +36,64 @@ impl std::error::Error for Error {}
 
 /// The kernel in `lang`: text for the text languages, little-endian words for SPIR-V.
 pub fn write(kernel: &Kernel, lang: Lang) -> Result<Vec<u8>, Error> {
-    let (module, info) = (&kernel.module, &kernel.info);
+    write_module(&kernel.module, &kernel.info, lang)
+}
+
+/// The functions of a distance function's part (no entry point) in `lang`, a text language.
+/// GLSL writes one entry point: the part is written with an empty one, which is then cut
+/// off with its workgroup line and compute extension, leaving `#version` and the functions.
+pub fn write_part(part: &Part, lang: Lang) -> Result<Vec<u8>, Error> {
+    match lang {
+        Lang::SpirV => Err(Error(
+            "SPIR-V holds entry points, and the distance function alone has none".into(),
+        )),
+        Lang::Msl | Lang::Hlsl => write_module(&part.module, &part.info, lang),
+        Lang::Glsl => {
+            let mut module = part.module.clone();
+            module.entry_points.push(naga::EntryPoint {
+                name: super::wgsl::ENTRY_POINT.into(),
+                stage: naga::ShaderStage::Compute,
+                early_depth_test: None,
+                workgroup_size: [1, 1, 1],
+                workgroup_size_overrides: None,
+                function: naga::Function::default(),
+                mesh_info: None,
+                task_payload: None,
+                incoming_ray_payload: None,
+            });
+            let info = naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::empty(),
+            )
+            .validate(&module)
+            .map_err(|e| Error(e.to_string()))?;
+            let text = String::from_utf8(write_module(&module, &info, lang)?)
+                .map_err(|e| Error(e.to_string()))?;
+            let cut = text
+                .rfind("void main()")
+                .ok_or_else(|| Error("no entry point in the GLSL".into()))?;
+            let kept: Vec<&str> = text[..cut]
+                .lines()
+                .filter(|l| {
+                    !l.starts_with("layout(local_size_x") && !l.contains("GL_ARB_compute_shader")
+                })
+                .collect();
+            Ok(format!(
+                "{}
+",
+                kept.join("\n").trim_end()
+            )
+            .into_bytes())
+        }
+    }
+}
+
+/// A validated module in `lang`.
+fn write_module(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    lang: Lang,
+) -> Result<Vec<u8>, Error> {
     let err = |e: &dyn fmt::Display| Error(e.to_string());
     match lang {
         Lang::SpirV => {

@@ -1,6 +1,7 @@
 //! `sdfc compile`: write a scene as one of the textual targets.
 
 use crate::frontend::{self, DiagnosticFormat};
+use clap::ValueEnum;
 use sdfc_compiler::back::{self, shader::Lang};
 use sdfc_compiler::{lower, scene, syntax};
 use std::path::PathBuf;
@@ -29,6 +30,32 @@ pub enum Emit {
     Hlsl,
     /// The kernel as PTX for the CUDA driver.
     Ptx,
+    /// The kernel's scene uniform `Params` (binding 0) as bytes (binary).
+    Params,
+    /// The kernel's storage buffer `scene_data` (binding 4) as bytes (binary), for a scene
+    /// whose kernel reads one.
+    SceneData,
+    /// The kernel's entry point, workgroup size and bindings, with the layout of each
+    /// binding's type (JSON).
+    Layout,
+}
+
+impl Emit {
+    /// Whether the target is binary (refused on a terminal).
+    fn binary(self) -> bool {
+        matches!(self, Emit::Spirv | Emit::Params | Emit::SceneData)
+    }
+}
+
+/// Which part of the generated code `sdfc compile` writes (docs/embedding.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Part {
+    /// The whole renderer kernel (the shading languages and PTX).
+    #[default]
+    Kernel,
+    /// The scene's distance function alone (`--emit wgsl|glsl|hlsl|msl|rust`), with its
+    /// material table, for a user's own shader or program.
+    Map,
 }
 
 /// Arguments of `sdfc compile`.
@@ -39,9 +66,16 @@ pub struct CompileArgs {
     /// The target to write.
     #[arg(long, value_enum)]
     pub emit: Emit,
-    /// Output file (default: standard output).
+    /// Output file (default: standard output; binary SPIR-V is not written to a terminal).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// The part to write: the renderer kernel, or the distance function alone.
+    #[arg(long, value_enum, default_value_t)]
+    pub part: Part,
+    /// The name of the distance function (`--part map`); every name the part declares
+    /// starts with it, so two scenes' parts can live in one shader.
+    #[arg(long, default_value = back::wgsl::part::DEFAULT_NAME)]
+    pub name: String,
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value_t)]
     pub diagnostics: DiagnosticFormat,
@@ -66,7 +100,25 @@ pub fn run(args: CompileArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Some(msg) = part_refused(&args) {
+        eprintln!("error: {msg}");
+        return ExitCode::from(2);
+    }
     frontend::report(&loaded, args.diagnostics);
+    if args.emit.binary() && args.output.is_none() && {
+        use std::io::IsTerminal;
+        std::io::stdout().is_terminal()
+    } {
+        let what = if args.emit == Emit::Spirv {
+            "SPIR-V"
+        } else {
+            "this target"
+        };
+        eprintln!(
+            "error: {what} is binary and standard output is a terminal; write it to a file with `-o FILE` (or redirect it)"
+        );
+        return ExitCode::from(2);
+    }
     let text = match args.emit {
         Emit::Ast => {
             // The AST is shown even for a file with errors in later stages, but not with
@@ -93,7 +145,11 @@ pub fn run(args: CompileArgs) -> ExitCode {
                     return ExitCode::from(1);
                 }
             };
-            match emit(scene, &lowered, other, args.sm) {
+            let result = match args.part {
+                Part::Kernel => emit(scene, &lowered, other, args.sm),
+                Part::Map => emit_map(scene, &lowered, other, &args.name),
+            };
+            match result {
                 Ok(bytes) => return write_bytes(args.output.as_deref(), &bytes),
                 Err(msg) => {
                     eprintln!("{msg}");
@@ -103,6 +159,61 @@ pub fn run(args: CompileArgs) -> ExitCode {
         }
     };
     write_output(args.output.as_deref(), &text)
+}
+
+/// Why `--part`/`--name` do not fit the other arguments, if they do not.
+fn part_refused(args: &CompileArgs) -> Option<String> {
+    match args.part {
+        Part::Kernel if args.name != back::wgsl::part::DEFAULT_NAME => {
+            Some("`--name` names the distance function of `--part map`".into())
+        }
+        Part::Map
+            if !matches!(
+                args.emit,
+                Emit::Wgsl | Emit::Glsl | Emit::Hlsl | Emit::Msl | Emit::Rust
+            ) =>
+        {
+            Some(format!(
+                "`--part map` is written as wgsl, glsl, hlsl, msl or rust, not `{}`",
+                args.emit
+                    .to_possible_value()
+                    .map_or(String::new(), |v| v.get_name().to_string())
+            ))
+        }
+        Part::Map if !back::wgsl::part::valid_name(&args.name) => Some(format!(
+            "`--name {}` is not a name for a function: use ASCII letters, digits and `_`, not starting with a digit or `__`, at most 64 characters, and not a word WGSL or Rust reserves",
+            args.name
+        )),
+        _ => None,
+    }
+}
+
+/// The bytes of the distance function alone, named `name`, in `target`.
+fn emit_map(
+    scene: &scene::Scene,
+    lowered: &lower::Lowered,
+    target: Emit,
+    name: &str,
+) -> Result<Vec<u8>, String> {
+    let lang = match target {
+        Emit::Rust => return Ok(back::rust::write_named(&lowered.program, name).into_bytes()),
+        Emit::Wgsl => None,
+        Emit::Glsl => Some(Lang::Glsl),
+        Emit::Hlsl => Some(Lang::Hlsl),
+        Emit::Msl => Some(Lang::Msl),
+        other => {
+            let v = other.to_possible_value();
+            return Err(format!(
+                "error: `--part map` has no `{}` form",
+                v.map_or(String::new(), |v| v.get_name().to_string())
+            ));
+        }
+    };
+    let part = back::wgsl::part::write(scene, lowered, name).map_err(|e| e.to_string())?;
+    match lang {
+        None => Ok(part.source.into_bytes()),
+        Some(lang) => back::shader::write_part(&part, lang).map_err(|e| e.to_string()),
+    }
 }
 
 /// The bytes of a target that needs the distance program.
@@ -123,9 +234,24 @@ fn emit(
         Emit::Msl => Some(Lang::Msl),
         Emit::Glsl => Some(Lang::Glsl),
         Emit::Hlsl => Some(Lang::Hlsl),
-        Emit::Wgsl | Emit::Ptx => None,
+        Emit::Wgsl | Emit::Ptx | Emit::Params | Emit::SceneData | Emit::Layout => None,
     };
     let kernel = back::wgsl::write(scene, lowered).map_err(|e| e.to_string())?;
+    match target {
+        Emit::Params => return Ok(back::wgsl::uniforms(scene, program.lipschitz())),
+        Emit::SceneData => {
+            return kernel.data.ok_or_else(|| {
+                "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 2 048 marched instances does)".into()
+            })
+        }
+        Emit::Layout => {
+            let value = back::wgsl::layout::interface(&kernel)?;
+            let mut text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())?;
+            text.push('\n');
+            return Ok(text.into_bytes());
+        }
+        _ => {}
+    }
     if target == Emit::Ptx {
         let options = back::ptx::Options {
             sm,

@@ -59,16 +59,12 @@ pub fn write_map(program: &Program) -> String {
 }
 
 /// [`write_map`] as the function `name` (its outlined blocks prefixed by it).
-pub(super) fn write_map_named(program: &Program, name: &'static str) -> String {
+pub(super) fn write_map_named(program: &Program, name: &str) -> String {
     write_map_with(program, name, None)
 }
 
 /// [`write_map_named`], with the constants read from `params` when given.
-pub(super) fn write_map_with(
-    program: &Program,
-    name: &'static str,
-    params: Option<&Params>,
-) -> String {
+pub(super) fn write_map_with(program: &Program, name: &str, params: Option<&Params>) -> String {
     let roots = [program.distance(), program.material()];
     let mut w = Writer::new(program, &roots, true, name, params);
     let mut main = String::new();
@@ -94,16 +90,12 @@ pub fn write_sdf(program: &Program) -> String {
 }
 
 /// [`write_sdf`] as the function `name`.
-pub(super) fn write_sdf_named(program: &Program, name: &'static str) -> String {
+pub(super) fn write_sdf_named(program: &Program, name: &str) -> String {
     write_sdf_with(program, name, None)
 }
 
 /// [`write_sdf_named`], with the constants read from `params` when given.
-pub(super) fn write_sdf_with(
-    program: &Program,
-    name: &'static str,
-    params: Option<&Params>,
-) -> String {
+pub(super) fn write_sdf_with(program: &Program, name: &str, params: Option<&Params>) -> String {
     let roots = [program.distance()];
     let mut w = Writer::new(program, &roots, false, name, params);
     let mut main = String::new();
@@ -137,7 +129,7 @@ struct Writer<'a> {
     /// Next program note to write.
     note: usize,
     /// Prefix of the outlined functions' names.
-    prefix: &'static str,
+    prefix: &'a str,
     /// The outlined functions written so far.
     functions: String,
 }
@@ -147,7 +139,7 @@ impl<'a> Writer<'a> {
         program: &'a Program,
         roots: &[Reg],
         comments: bool,
-        prefix: &'static str,
+        prefix: &'a str,
         params: Option<&'a Params>,
     ) -> Self {
         let (live, live_blocks) = program.live(roots);

@@ -11,8 +11,10 @@
 
 mod analytic;
 mod buffer;
+pub mod layout;
 mod map;
 mod march;
+pub mod part;
 mod template;
 
 pub use analytic::MAX_UNROLLED;

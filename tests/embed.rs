@@ -1,0 +1,425 @@
+//! Generated code a user takes away (docs/embedding.md): the distance function alone
+//! (`sdfc compile --part map`) in WGSL, GLSL, HLSL, MSL and Rust, used as a user would use
+//! it: two scenes' parts in one WGSL module with a user's function calling both, validated by
+//! naga and written by naga to the other languages; the part's function is the renderer's own
+//! `map`, word for word; the command line's refusals; and the kernel run from the files
+//! `--emit wgsl|params|layout` writes by a plain wgpu program (on lavapipe), giving `sdfc
+//! render`'s image byte for byte, and `--emit scene-data|params` the bytes the renderer binds.
+
+use sdfc_compiler::back::{self, shader::Lang, wgsl};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples")
+        .join(name)
+}
+
+fn sdfc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .args(args)
+        .output()
+        .expect("run sdfc")
+}
+
+/// `sdfc compile FILE --emit LANG --part map --name NAME`, which must succeed.
+fn part(file: &str, lang: &str, name: &str) -> String {
+    let path = example(file);
+    let out = sdfc(&[
+        "compile",
+        path.to_str().expect("utf-8 path"),
+        "--emit",
+        lang,
+        "--part",
+        "map",
+        "--name",
+        name,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("text")
+}
+
+fn validate(source: &str) -> (naga::Module, naga::valid::ModuleInfo) {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(source)));
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
+    (module, info)
+}
+
+/// A user's shader: two scenes' parts and a compute entry point that calls both functions
+/// and reads both material tables.
+const USER: &str = "
+@group(0) @binding(0) var<storage, read_write> out: array<vec4<f32>>;
+
+fn both(p: vec3<f32>) -> vec4<f32> {
+    let a = one(p);
+    let b = two(p - vec3<f32>(4.0, 0.0, 0.0));
+    let m = one_MATERIALS[min(u32(a.y), one_MATERIAL_COUNT - 1u)];
+    let n = two_MATERIALS[min(u32(b.y), two_MATERIAL_COUNT - 1u)];
+    let d = min(a.x, two_distance(p - vec3<f32>(4.0, 0.0, 0.0)));
+    return vec4<f32>(select(n.color, m.color, a.x < b.x), d);
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let p = vec3<f32>(f32(id.x) * 0.01, 0.5, -1.0);
+    out[id.x] = both(p);
+}
+";
+
+#[test]
+fn two_scenes_parts_and_a_users_function_validate_in_one_module() {
+    let source = format!(
+        "{}\n{}\n{USER}",
+        part("seed1.sdf", "wgsl", "one"),
+        part("seed2.sdf", "wgsl", "two")
+    );
+    let (module, info) = validate(&source);
+    // The user's module goes on through naga to the other languages.
+    let kernel = wgsl::Kernel {
+        source: source.clone(),
+        module,
+        info,
+        features: Vec::new(),
+        specialisation: wgsl::Specialisation::of(&Default::default()),
+        data: None,
+    };
+    for lang in [Lang::SpirV, Lang::Msl, Lang::Glsl, Lang::Hlsl] {
+        back::shader::write(&kernel, lang).unwrap_or_else(|e| panic!("{lang:?}: {e}"));
+    }
+}
+
+#[test]
+fn each_language_declares_the_named_functions_and_materials() {
+    for (lang, map, distance) in [
+        (
+            "wgsl",
+            "fn ball(p: vec3<f32>) -> vec2<f32>",
+            "fn ball_distance(",
+        ),
+        ("glsl", "vec2 ball(vec3 p)", "float ball_distance("),
+        ("hlsl", "float2 ball(float3 p)", "float ball_distance("),
+        ("msl", "metal::float2 ball(", "float ball_distance("),
+        (
+            "rust",
+            "pub fn ball(p: glam::Vec3) -> (f32, u32)",
+            "pub fn ball_f64(",
+        ),
+    ] {
+        let text = part("seed3.sdf", lang, "ball");
+        assert!(text.contains(map), "{lang}: no `{map}`\n{text}");
+        assert!(text.contains(distance), "{lang}: no `{distance}`");
+        if lang != "rust" {
+            assert!(text.contains("ball_MATERIALS"), "{lang}: no material table");
+            // Nothing of the renderer comes along.
+            for kernel_only in ["params", "counters", "shadow", "main("] {
+                assert!(!text.contains(kernel_only), "{lang}: `{kernel_only}`");
+            }
+        }
+    }
+    // GLSL is a library: no entry point, no workgroup size.
+    let glsl = part("seed3.sdf", "glsl", "ball");
+    assert!(glsl.starts_with("#version 450 core\n"), "{glsl}");
+    assert!(!glsl.contains("local_size_x") && !glsl.contains("void main"));
+}
+
+/// The part's function is the renderer kernel's `map`, word for word (the kernel's is
+/// compared with the CPU renderer by tests/render.rs), and its table is the scene's
+/// materials in order.
+#[test]
+fn the_part_is_the_kernels_own_map() {
+    let path = example("seed4.sdf");
+    let loaded = sdfc_runtime::frontend::load(&path).expect("readable");
+    let scene = loaded.scene.expect("checks");
+    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let kernel = wgsl::write(&scene, &lowered).expect("kernel");
+    let part = wgsl::part::write(&scene, &lowered, "map").expect("part");
+    let start = part.source.find("fn map(").expect("map");
+    let end = start + part.source[start..].find("\n}\n").expect("end of map") + 3;
+    assert!(
+        kernel.source.contains(&part.source[start..end]),
+        "the part's map is not the kernel's"
+    );
+    let table = part.source.matches("    map_Material(").count();
+    assert_eq!(table, scene.materials.len());
+    for (id, m) in scene.materials.iter().enumerate() {
+        let comment = format!("    // {id}: {}\n    map_Material(", m.name);
+        assert!(part.source.contains(&comment), "{comment}");
+    }
+}
+
+#[test]
+fn the_command_line_refuses_what_has_no_part() {
+    let path = example("seed1.sdf");
+    let file = path.to_str().expect("utf-8 path");
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["--emit", "wgsl", "--part", "map", "--name", "loop"],
+            "not a name",
+        ),
+        (
+            &["--emit", "rust", "--part", "map", "--name", "min"],
+            "not a name",
+        ),
+        (
+            &["--emit", "ptx", "--part", "map"],
+            "`--part map` is written as",
+        ),
+        (
+            &["--emit", "spirv", "--part", "map", "-o", "/dev/null"],
+            "not `spirv`",
+        ),
+        (
+            &["--emit", "wgsl", "--part", "map", "--name", "2d"],
+            "not a name",
+        ),
+        (
+            &["--emit", "wgsl", "--name", "x"],
+            "`--name` names the distance function",
+        ),
+    ];
+    for (args, wanted) in cases {
+        let mut all = vec!["compile", file];
+        all.extend_from_slice(args);
+        let out = sdfc(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(wanted), "{args:?}: {err}");
+    }
+}
+
+const SMALL: &str = "material red = phong { color: (1, 0.2, 0.1), reflect: 0.2 };
+material floor = checker { a: (0.9, 0.9, 0.9), b: (0.2, 0.2, 0.2), size: 0.5 };
+camera { position: (0, 1, -5), look_at: (0, 0.5, 0), fov: 50deg }
+light point { position: (2, 4, -3), intensity: 1, radius: 50, penumbra: 7deg }
+render { width: 48, height: 32 }
+scene {
+  plane() @ floor;
+  sphere(1).translate(0, 1, 0) @ red;
+  box((0.4, 0.4, 0.4)).translate(1.5, 0.4, -0.5);
+}
+";
+
+/// Whether CI asked for every device: then a missing adapter fails.
+fn required() -> bool {
+    std::env::var("CI").is_ok_and(|v| v == "true")
+        || std::env::var("SDFC_REQUIRE_DEVICES").is_ok_and(|v| v == "1")
+}
+
+/// A member's offset in the layout of a binding, as a user's program reads it.
+fn offset(binding: &serde_json::Value, member: &str) -> usize {
+    binding["type"]["members"]
+        .as_array()
+        .expect("members")
+        .iter()
+        .find(|m| m["name"] == member)
+        .and_then(|m| m["offset"].as_u64())
+        .unwrap_or_else(|| panic!("no member {member}")) as usize
+}
+
+/// The kernel run from its files by a plain wgpu program (as docs/embedding.md shows):
+/// `--emit wgsl`, `--emit params` and `--emit layout` written to files, then loaded,
+/// bound and dispatched on the first adapter (lavapipe here), with no sdfc code; the image
+/// equals `sdfc render --backend wgpu` of the same scene, byte for byte.
+#[test]
+fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
+    let dir = std::env::temp_dir().join(format!("sdfc-embed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = dir.join("small.sdf");
+    std::fs::write(&scene, SMALL).expect("scene");
+    let file = scene.to_str().expect("utf-8");
+    let at = |name: &str| dir.join(name).to_str().expect("utf-8").to_string();
+    for (emit, out) in [
+        ("wgsl", "k.wgsl"),
+        ("params", "params.bin"),
+        ("layout", "layout.json"),
+    ] {
+        let o = sdfc(&["compile", file, "--emit", emit, "-o", &at(out)]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let wgsl = std::fs::read_to_string(dir.join("k.wgsl")).expect("kernel");
+    let params = std::fs::read(dir.join("params.bin")).expect("params");
+    let layout: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("layout.json")).expect("layout"))
+            .expect("json");
+    let bindings = layout["bindings"].as_array().expect("bindings");
+    let p = &bindings[0];
+    assert_eq!(
+        (p["binding"].as_u64(), p["name"].as_str()),
+        (Some(0), Some("params"))
+    );
+    assert_eq!(p["type"]["size"].as_u64(), Some(params.len() as u64));
+    assert!(
+        bindings.iter().all(|b| b["binding"].as_u64() != Some(4)),
+        "no scene_data"
+    );
+    // The image size, read from Params at the offset the layout gives.
+    let counts = offset(p, "counts");
+    let word = |o: usize| u32::from_le_bytes(params[o..o + 4].try_into().expect("4 bytes"));
+    let (width, height) = (word(counts), word(counts + 4));
+    assert_eq!((width, height), (48, 32));
+    let group = layout["workgroup_size"][0].as_u64().expect("workgroup") as u32;
+
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter =
+        match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
+        {
+            Ok(a) => a,
+            Err(e) => {
+                assert!(
+                    !required(),
+                    "SDFC_REQUIRE_DEVICES=1, but no wgpu adapter: {e}"
+                );
+                println!("embed: SKIPPED: no wgpu adapter ({e})");
+                return;
+            }
+        };
+    let (device, queue) =
+        pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
+            .expect("device");
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("sdfc kernel"),
+        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: None,
+        layout: None,
+        module: &module,
+        entry_point: layout["entry_point"].as_str(),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    use wgpu::BufferUsages as U;
+    let buffer = |size: u64, usage: U| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size,
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    let pixels = (width * height) as u64;
+    let params_buf = buffer(params.len() as u64, U::UNIFORM | U::COPY_DST);
+    queue.write_buffer(&params_buf, 0, &params);
+    let tile: Vec<u8> = [0, 0, width, height]
+        .iter()
+        .flat_map(|w: &u32| w.to_le_bytes())
+        .collect();
+    let tile_buf = buffer(16, U::UNIFORM | U::COPY_DST);
+    queue.write_buffer(&tile_buf, 0, &tile);
+    let image = buffer(pixels * 16, U::STORAGE | U::COPY_SRC);
+    let stats = buffer(pixels * 4 * 8, U::STORAGE);
+    let readback = buffer(pixels * 16, U::MAP_READ | U::COPY_DST);
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: tile_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: image.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: stats.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(width.div_ceil(group), height.div_ceil(group), 1);
+    }
+    enc.copy_buffer_to_buffer(&image, 0, &readback, 0, pixels * 16);
+    queue.submit([enc.finish()]);
+    let slice = readback.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+    let bytes = slice.get_mapped_range().expect("mapped").to_vec();
+    let linear: Vec<[f32; 3]> = bytes
+        .chunks_exact(16)
+        .map(|c| {
+            let f = |k: usize| f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().expect("4"));
+            [f(0), f(1), f(2)]
+        })
+        .collect();
+    let ours = sdfc_runtime::image::Image {
+        width,
+        height,
+        linear,
+    };
+
+    let o = sdfc(&["render", file, "--backend", "wgpu", "-o", &at("ref.png")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let reference = sdfc_runtime::image::read_png(&dir.join("ref.png")).expect("png");
+    assert_eq!((reference.width, reference.height), (width, height));
+    let (a, b) = (ours.to_rgba8(), reference.to_rgba8());
+    let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    assert_eq!(differ, 0, "{differ} bytes differ from `sdfc render`");
+    // Not a blank image: the sphere, the box and the floor's two colours are all there.
+    let distinct: std::collections::BTreeSet<&[u8]> = a.chunks(4).collect();
+    assert!(distinct.len() > 20, "{} colours", distinct.len());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--emit scene-data` writes the storage buffer the kernel of a large scene reads, the bytes
+/// `sdfc render` binds; `--emit params` the uniform it fills; `--emit layout` names binding 4;
+/// a scene without one is refused.
+#[test]
+fn scene_data_and_params_are_the_bytes_the_renderer_binds() {
+    let path = example("scaling/random_1000.sdf");
+    let file = path.to_str().expect("utf-8");
+    let loaded = sdfc_runtime::frontend::load(&path).expect("readable");
+    let scene = loaded.scene.expect("checks");
+    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let kernel = wgsl::write(&scene, &lowered).expect("kernel");
+    let data = sdfc(&["compile", file, "--emit", "scene-data"]);
+    assert!(data.status.success());
+    assert_eq!(Some(data.stdout), kernel.data);
+    let params = sdfc(&["compile", file, "--emit", "params"]);
+    assert_eq!(
+        params.stdout,
+        wgsl::uniforms(&scene, lowered.program.lipschitz())
+    );
+    let layout = sdfc(&["compile", file, "--emit", "layout"]);
+    let layout: serde_json::Value = serde_json::from_slice(&layout.stdout).expect("json");
+    let b4 = &layout["bindings"][4];
+    assert_eq!(b4["binding"].as_u64(), Some(4));
+    assert_eq!(b4["name"].as_str(), Some("scene_data"));
+    assert_eq!(
+        (b4["space"].as_str(), b4["access"].as_str()),
+        (Some("storage"), Some("read"))
+    );
+    assert_eq!(b4["type"]["element"]["name"].as_str(), Some("vec4<f32>"));
+    let small = example("seed1.sdf");
+    let none = sdfc(&[
+        "compile",
+        small.to_str().expect("utf-8"),
+        "--emit",
+        "scene-data",
+    ]);
+    assert_eq!(none.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&none.stderr).contains("reads no `scene_data`"));
+}

@@ -4,7 +4,8 @@
 //! naga and written by naga to the other languages; the part's function is the renderer's own
 //! `map`, word for word; the command line's refusals; and the kernel run from the files
 //! `--emit wgsl|params|layout` writes by a plain wgpu program (on lavapipe), giving `sdfc
-//! render`'s image byte for byte, and `--emit scene-data|params` the bytes the renderer binds.
+//! render`'s image byte for byte; `--emit scene-data|params` the bytes the renderer binds; and the
+//! Shadertoy page compiled as Shadertoy wraps it and rendered through WebGL.
 
 use sdfc_compiler::back::{self, shader::Lang, wgsl};
 use std::path::{Path, PathBuf};
@@ -197,6 +198,10 @@ fn the_command_line_refuses_what_has_no_part() {
         assert!(err.contains(wanted), "{args:?}: {err}");
     }
 }
+
+/// The largest mean difference of the Shadertoy page's WebGL image from the CPU image, in
+/// sRGB steps of 255.
+const MEAN_LIMIT: f64 = 0.5;
 
 const SMALL: &str = "material red = phong { color: (1, 0.2, 0.1), reflect: 0.2 };
 material floor = checker { a: (0.9, 0.9, 0.9), b: (0.2, 0.2, 0.2), size: 0.5 };
@@ -422,4 +427,185 @@ fn scene_data_and_params_are_the_bytes_the_renderer_binds() {
     ]);
     assert_eq!(none.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&none.stderr).contains("reads no `scene_data`"));
+}
+
+/// A program on PATH (or at `$SDFC_CHROMIUM` for chromium), if there is one.
+fn on_path(name: &str) -> Option<PathBuf> {
+    if name == "chromium" {
+        if let Some(path) = std::env::var_os("SDFC_CHROMIUM") {
+            return Some(PathBuf::from(path));
+        }
+    }
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(name))
+        .find(|p| p.is_file())
+}
+
+/// What Shadertoy puts around an Image tab's code (its uniforms, and a `main` that calls
+/// `mainImage` with the pixel's coordinates).
+const SHADERTOY_HEAD: &str = "#version 300 es
+precision highp float;
+precision highp int;
+precision mediump sampler3D;
+uniform vec3 iResolution;
+uniform float iTime;
+uniform float iTimeDelta;
+uniform int iFrame;
+uniform float iChannelTime[4];
+uniform vec4 iMouse;
+uniform vec4 iDate;
+uniform float iSampleRate;
+uniform vec3 iChannelResolution[4];
+uniform sampler2D iChannel0;
+uniform sampler2D iChannel1;
+uniform sampler2D iChannel2;
+uniform sampler2D iChannel3;
+out vec4 shadertoy_out_color;
+";
+const SHADERTOY_TAIL: &str = "
+void main() {
+    shadertoy_out_color = vec4(1.0, 1.0, 1.0, 1.0);
+    vec4 color = vec4(1e20);
+    mainImage(color, gl_FragCoord.xy);
+    shadertoy_out_color = vec4(color.xyz, 1.0);
+}
+";
+
+/// The page of `file` wrapped the way Shadertoy wraps it.
+fn shadertoy_wrapped(file: &Path) -> String {
+    let out = sdfc(&[
+        "compile",
+        file.to_str().expect("utf-8"),
+        "--emit",
+        "shadertoy",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let page = String::from_utf8(out.stdout).expect("text");
+    assert!(page.contains("void mainImage(out vec4 fragColor, in vec2 fragCoord)"));
+    assert!(!page.contains("#version") && !page.contains("precision "));
+    format!("{SHADERTOY_HEAD}{page}{SHADERTOY_TAIL}")
+}
+
+/// `--emit shadertoy` of the report's scenes, wrapped as Shadertoy wraps it, compiles with
+/// glslangValidator (Debian's `glslang-tools`) as a GLSL ES 3.00 fragment shader.
+#[test]
+fn the_shadertoy_page_compiles_as_shadertoy_wraps_it() {
+    let Some(glslang) = on_path("glslangValidator") else {
+        assert!(
+            !required(),
+            "SDFC_REQUIRE_DEVICES=1, but no glslangValidator (glslang-tools)"
+        );
+        println!("embed: SKIPPED: no glslangValidator on PATH");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("sdfc-shadertoy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    for seed in 1..=6 {
+        let frag = dir.join(format!("seed{seed}.frag"));
+        std::fs::write(
+            &frag,
+            shadertoy_wrapped(&example(&format!("seed{seed}.sdf"))),
+        )
+        .expect("write");
+        let out = Command::new(&glslang)
+            .arg(&frag)
+            .output()
+            .expect("glslangValidator");
+        assert!(
+            out.status.success(),
+            "seed{seed}: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The page rendered by headless Chromium through WebGL 2 (SwiftShader) looks like the CPU
+/// image of a scene without reflections: the mean difference of the sRGB bytes is small.
+#[test]
+fn the_shadertoy_page_renders_the_scene_in_webgl() {
+    let Some(chromium) = on_path("chromium") else {
+        assert!(!required(), "SDFC_REQUIRE_DEVICES=1, but no chromium");
+        println!("embed: SKIPPED: no chromium on PATH");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("sdfc-shadertoy-gl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = dir.join("small.sdf");
+    std::fs::write(&scene, SMALL.replace(", reflect: 0.2", "")).expect("scene");
+    let (w, h) = (192, 128);
+    let frag = serde_json::to_string(&shadertoy_wrapped(&scene)).expect("json");
+    let html = format!(
+        "<!doctype html><html><body style=\"margin:0;overflow:hidden\"><canvas id=\"c\" width=\"{w}\" height=\"{h}\"></canvas><script>
+const gl = document.getElementById('c').getContext('webgl2', {{preserveDrawingBuffer: true}});
+function shader(type, text) {{
+  const s = gl.createShader(type); gl.shaderSource(s, text); gl.compileShader(s); return s;
+}}
+const p = gl.createProgram();
+gl.attachShader(p, shader(gl.VERTEX_SHADER, '#version 300 es\\nin vec2 pos; void main() {{ gl_Position = vec4(pos, 0.0, 1.0); }}'));
+gl.attachShader(p, shader(gl.FRAGMENT_SHADER, {frag}));
+gl.linkProgram(p); gl.useProgram(p);
+gl.bindBuffer(gl.ARRAY_BUFFER, gl.createBuffer());
+gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
+const at = gl.getAttribLocation(p, 'pos');
+gl.enableVertexAttribArray(at); gl.vertexAttribPointer(at, 2, gl.FLOAT, false, 0, 0);
+gl.uniform3f(gl.getUniformLocation(p, 'iResolution'), {w}, {h}, 1);
+gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
+</script></body></html>"
+    );
+    let page = dir.join("page.html");
+    std::fs::write(&page, html).expect("page");
+    let shot = dir.join("shot.png");
+    let out = Command::new(&chromium)
+        .args([
+            "--headless=new",
+            "--no-sandbox",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--hide-scrollbars",
+            &format!("--window-size={w},{h}"),
+            &format!("--screenshot={}", shot.display()),
+        ])
+        .arg(format!("file://{}", page.display()))
+        .env("XDG_RUNTIME_DIR", &dir)
+        .output()
+        .expect("run chromium");
+    assert!(shot.is_file(), "{}", String::from_utf8_lossy(&out.stderr));
+    let cpu = dir.join("cpu.png");
+    let file = scene.to_str().expect("utf-8");
+    let size = format!("{w}x{h}");
+    let o = sdfc(&[
+        "render",
+        file,
+        "--backend",
+        "cpu",
+        "--size",
+        &size,
+        "-o",
+        cpu.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let a = sdfc_runtime::image::read_png(&shot)
+        .expect("screenshot")
+        .to_rgba8();
+    let b = sdfc_runtime::image::read_png(&cpu).expect("cpu").to_rgba8();
+    assert_eq!(a.len(), b.len(), "screenshot size");
+    let total: u64 = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y) as u64).sum();
+    let mean = total as f64 / (w * h * 3) as f64;
+    let far = a
+        .chunks(4)
+        .zip(b.chunks(4))
+        .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| p.abs_diff(*q) > 24))
+        .count();
+    println!("shadertoy against cpu: mean |difference| {mean:.3} of 255, {far} pixels off by more than 24");
+    assert!(
+        mean < MEAN_LIMIT && far * 100 < (w * h) as usize,
+        "mean {mean}, {far} pixels far off"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -3,4 +3,5 @@
 pub mod ptx;
 pub mod rust;
 pub mod shader;
+pub mod shadertoy;
 pub mod wgsl;

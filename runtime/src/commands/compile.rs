@@ -38,6 +38,9 @@ pub enum Emit {
     /// The kernel's entry point, workgroup size and bindings, with the layout of each
     /// binding's type (JSON).
     Layout,
+    /// One GLSL ES page with `mainImage` that renders the scene on Shadertoy (camera rays
+    /// only; docs/embedding.md).
+    Shadertoy,
 }
 
 impl Emit {
@@ -227,6 +230,11 @@ fn emit(
     let lang = match target {
         Emit::Program => return Ok(program.dump().into_bytes()),
         Emit::Rust => return Ok(back::rust::write(program).into_bytes()),
+        Emit::Shadertoy => {
+            return back::shadertoy::write(scene, lowered)
+                .map(String::into_bytes)
+                .map_err(|e| e.to_string())
+        }
         Emit::Ast | Emit::Ir => {
             return Err("internal error: the AST and IR are not emitted from a program".into())
         }

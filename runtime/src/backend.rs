@@ -59,25 +59,22 @@ pub enum Prepared {
         lowered: Box<Lowered>,
         setup: Setup,
     },
-    /// CUDA: the device, the loaded module, the kernel's scene data, the settings it was
-    /// specialised for and the scene's Lipschitz bound L (and the lowered scene and setup, to
-    /// specialise the kernel again for other settings).
+    /// CUDA: the device, the loaded module (with the kernel's scene data and the settings it
+    /// was specialised for) and the scene's Lipschitz bound L (and the lowered scene and
+    /// setup, to specialise the kernel again for other settings).
     Cuda {
         cuda: Box<Cuda>,
-        loaded: Box<gpu::cuda::Loaded>,
-        data: Option<Vec<u8>>,
-        specialisation: wgsl::Specialisation,
-        ptx_time: Duration,
+        module: Box<CudaModule>,
         lipschitz: f64,
         lowered: Box<Lowered>,
         setup: Setup,
-        /// The WGSL text the module was translated from.
-        source: String,
     },
 }
 
-/// A kernel loaded on a CUDA device, with what its launches need.
-struct CudaModule {
+/// A kernel loaded on a CUDA device, with what its launches need and the WGSL text it was
+/// translated from.
+#[derive(Debug)]
+pub struct CudaModule {
     loaded: gpu::cuda::Loaded,
     data: Option<Vec<u8>>,
     specialisation: wgsl::Specialisation,
@@ -272,14 +269,10 @@ impl Prepared {
         let module = Self::cuda_module(&cuda, scene, lowered, setup)?;
         Ok(Prepared::Cuda {
             cuda: Box::new(cuda),
-            loaded: Box::new(module.loaded),
-            data: module.data,
-            specialisation: module.specialisation,
-            ptx_time: module.ptx_time,
+            module: Box::new(module),
             lipschitz: lowered.program.lipschitz(),
             lowered: Box::new(lowered.clone()),
             setup: *setup,
-            source: module.source,
         })
     }
 
@@ -320,7 +313,6 @@ impl Prepared {
     /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
     pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
         method_allowed(scene)?;
-        traceable_with(scene, &lowered.traceable)?;
         match self {
             Prepared::Cpu { .. } | Prepared::Wgpu { .. } => {
                 let (next, built) = self.next(scene, lowered)?;
@@ -329,26 +321,18 @@ impl Prepared {
             }
             Prepared::Cuda {
                 cuda,
-                loaded,
-                data,
-                specialisation,
-                ptx_time,
+                module,
                 lipschitz,
                 lowered: held,
                 setup,
-                source,
             } => {
+                traceable_with(scene, &lowered.traceable)?;
                 let text = Self::kernel_text(scene, &lowered, setup)?;
-                let built = text.source != *source;
+                let built = text.source != module.source;
                 if built {
-                    let module = Self::cuda_module_of(cuda, Self::kernel(scene, &lowered, setup)?)?;
-                    **loaded = module.loaded;
-                    *data = module.data;
-                    *specialisation = module.specialisation;
-                    *ptx_time = module.ptx_time;
-                    *source = module.source;
+                    **module = Self::cuda_module_of(cuda, Self::kernel(scene, &lowered, setup)?)?;
                 } else {
-                    *data = text.data;
+                    module.data = text.data;
                 }
                 *lipschitz = lowered.program.lipschitz();
                 **held = lowered;
@@ -363,7 +347,7 @@ impl Prepared {
         match self {
             Prepared::Cpu { .. } => None,
             Prepared::Wgpu { kernel, .. } => Some(kernel.specialisation),
-            Prepared::Cuda { specialisation, .. } => Some(*specialisation),
+            Prepared::Cuda { module, .. } => Some(module.specialisation),
         }
     }
 
@@ -389,23 +373,14 @@ impl Prepared {
             }
             Prepared::Cuda {
                 cuda,
-                loaded,
-                data,
-                specialisation,
-                ptx_time,
+                module,
                 lowered,
                 setup,
-                source,
                 ..
             } => {
                 traceable_with(scene, &lowered.traceable)?;
                 // The same device and context; the new module replaces the old one.
-                let module = Self::cuda_module(cuda, scene, lowered, setup)?;
-                **loaded = module.loaded;
-                *data = module.data;
-                *specialisation = module.specialisation;
-                *ptx_time = module.ptx_time;
-                *source = module.source;
+                **module = Self::cuda_module(cuda, scene, lowered, setup)?;
                 Ok(())
             }
         }
@@ -447,17 +422,15 @@ impl Prepared {
     /// How the backend was prepared, for `--stats`: PTX generation and JIT times for CUDA.
     pub fn preparation(&self) -> Option<String> {
         match self {
-            Prepared::Cuda {
-                loaded, ptx_time, ..
-            } => Some(format!(
+            Prepared::Cuda { module, .. } => Some(format!(
                 "PTX generated in {:.2} ms; module {} in {:.1} ms",
-                ptx_time.as_secs_f64() * 1e3,
-                if loaded.cached {
+                module.ptx_time.as_secs_f64() * 1e3,
+                if module.loaded.cached {
                     "read from the JIT cache and loaded"
                 } else {
                     "compiled by the driver JIT and loaded"
                 },
-                loaded.load_time.as_secs_f64() * 1e3
+                module.loaded.load_time.as_secs_f64() * 1e3
             )),
             _ => None,
         }
@@ -476,7 +449,9 @@ impl Prepared {
             Prepared::Wgpu { kernel, .. } => {
                 gpu::memory_wgpu(settings, uniforms(&at), bytes(&kernel.data))
             }
-            Prepared::Cuda { data, .. } => gpu::memory_cuda(settings, uniforms(&at), bytes(data)),
+            Prepared::Cuda { module, .. } => {
+                gpu::memory_cuda(settings, uniforms(&at), bytes(&module.data))
+            }
         }
     }
 
@@ -543,13 +518,18 @@ impl Prepared {
             }
             Prepared::Cuda {
                 cuda,
-                loaded,
-                data,
+                module,
                 lipschitz,
                 ..
             } => {
-                let r = gpu::render_cuda(cuda, scene, loaded, data.as_deref(), *lipschitz)
-                    .map_err(|e| e.to_string())?;
+                let r = gpu::render_cuda(
+                    cuda,
+                    scene,
+                    &module.loaded,
+                    module.data.as_deref(),
+                    *lipschitz,
+                )
+                .map_err(|e| e.to_string())?;
                 progress(1.0);
                 Ok(Frame {
                     render: r.render,

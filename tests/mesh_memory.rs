@@ -4,83 +4,21 @@
 //! library, for the benchmark scene, the bracket and a field without a proven bound.
 //!
 //! One test only: the counter sees every thread of the process, so nothing else may run.
-#![allow(unsafe_code)] // A global allocator is an unsafe trait; it only forwards to `System`.
 
 use sdfc_compiler::lower;
 use sdfc_runtime::mesh::contour::{self, BYTES_PER_SURFACE_CELL};
 use sdfc_runtime::mesh::{octree, Field, Grid, Settings};
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
-/// Counts live heap bytes and their peak.
-struct Counting;
+#[path = "common/counting.rs"]
+mod counting;
+use counting::peak_of;
+use std::sync::atomic::{AtomicU64, Ordering};
 
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-fn grew(bytes: usize) {
-    let now = LIVE.fetch_add(bytes, Ordering::SeqCst) + bytes;
-    PEAK.fetch_max(now, Ordering::SeqCst);
-}
-
-// SAFETY: every call is forwarded to `System` with the same arguments; the counters are
-// atomics and never allocate.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            grew(layout.size());
-        }
-        p
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc_zeroed(layout) };
-        if !p.is_null() {
-            grew(layout.size());
-        }
-        p
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) };
-        LIVE.fetch_sub(layout.size(), Ordering::SeqCst);
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let p = unsafe { System.realloc(ptr, layout, new_size) };
-        if !p.is_null() {
-            // Counted as the new block allocated before the old one is freed.
-            grew(new_size);
-            LIVE.fetch_sub(layout.size(), Ordering::SeqCst);
-        }
-        p
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
-/// Runs `f` and returns its result and the peak growth of live heap bytes while it ran.
-fn peak_of<R>(f: impl FnOnce() -> R) -> (R, u64) {
-    let base = LIVE.load(Ordering::SeqCst);
-    PEAK.store(base, Ordering::SeqCst);
-    let r = f();
-    let peak = PEAK.load(Ordering::SeqCst);
-    (r, peak.saturating_sub(base) as u64)
-}
-
-/// A grid as `sdfc mesh` lays it out over `[lo, hi]` with `n` cells along the longest side.
+/// The grid `sdfc mesh` lays over `[lo, hi]` with `n` cells along the longest side.
 fn grid(lo: [f64; 3], hi: [f64; 3], n: u32) -> Grid {
-    let offset = 0.381_966_011_250_105;
     let longest = (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
-    let voxel = longest / n as f64;
-    Grid {
-        origin: lo.map(|x| x - (1.0 + offset) * voxel),
-        voxel,
-        cells: [0, 1, 2].map(|i| ((hi[i] - lo[i]) / voxel + 1.0 + offset).ceil() as u32 + 1),
-    }
+    Grid::over(&[lo, hi], longest / n as f64)
 }
 
 #[test]

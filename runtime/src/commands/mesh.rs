@@ -51,11 +51,6 @@ pub struct MeshArgs {
     pub limits: super::LimitArgs,
 }
 
-/// The grid's points are offset from the bounds by this fraction of a cell (2 − φ), so that
-/// faces at the bounds, or at round fractions of them (a box's faces are its bounding box's),
-/// do not fall on grid planes, where the corners' signs would be decided by rounding.
-pub const GRID_OFFSET: f64 = 0.381_966_011_250_105;
-
 /// The default number of cells along the longest side.
 pub const DEFAULT_RESOLUTION: u32 = 128;
 
@@ -162,14 +157,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         Some(_) => clip,
         None => [clip[0].map(|x| x - voxel), clip[1].map(|x| x + voxel)],
     };
-    // The grid starts 1 + GRID_OFFSET cells below the clip box and ends a cell or more above
-    // it, so that its outermost points lie outside the clip and the surface is closed.
-    let cells = [0, 1, 2].map(|i| {
-        ((clip[1][i] - clip[0][i]) / voxel + 1.0 + GRID_OFFSET)
-            .ceil()
-            .max(1.0)
-            + 1.0
-    });
+    let cells = Grid::cells_over(&clip, voxel);
     if cells.iter().any(|&n| n > AXIS_CELLS as f64) {
         return Err(usage(format!(
             "the grid would have {} cells along an axis; at most {AXIS_CELLS} are possible (a larger --voxel or a smaller --resolution)",
@@ -190,11 +178,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             short(magnitude)
         );
     }
-    let grid = Grid {
-        origin: clip[0].map(|x| x - (1.0 + GRID_OFFSET) * voxel),
-        voxel,
-        cells: cells.map(|n| n as u32),
-    };
+    let grid = Grid::over(&clip, voxel);
     let lowered = checked
         .lower(&LowerOptions::default(), &limits)
         .map_err(|_| (1, String::new()))?;

@@ -25,6 +25,11 @@ pub const KEY_BITS: u32 = 20;
 /// resource limit).
 pub const AXIS_CELLS: u32 = (1 << KEY_BITS) - 2;
 
+/// The grid's points are offset from the bounds by this fraction of a cell (2 − φ), so that
+/// faces at the bounds, or at round fractions of them (a box's faces are its bounding box's),
+/// do not fall on grid planes, where the corners' signs would be decided by rounding.
+pub const GRID_OFFSET: f64 = 0.381_966_011_250_105;
+
 /// A regular grid of cubic cells: point `(i, j, k)` is at `origin + (i, j, k)·voxel`, for
 /// `0 ≤ i ≤ cells[0]` and so on.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,6 +43,29 @@ pub struct Grid {
 }
 
 impl Grid {
+    /// The grid `sdfc mesh` lays over the clip box `clip` (its low and high corners) with
+    /// cells of `voxel`: it starts 1 + [`GRID_OFFSET`] cells below the box and ends a cell or
+    /// more above it, so that its outermost points lie outside the clip and the surface is
+    /// closed.
+    pub fn over(clip: &[[f64; 3]; 2], voxel: f64) -> Grid {
+        Grid {
+            origin: clip[0].map(|x| x - (1.0 + GRID_OFFSET) * voxel),
+            voxel,
+            cells: Self::cells_over(clip, voxel).map(|n| n as u32),
+        }
+    }
+
+    /// The cells along each axis of [`Grid::over`], as numbers (to be checked against
+    /// [`AXIS_CELLS`] before they are made indices).
+    pub fn cells_over(clip: &[[f64; 3]; 2], voxel: f64) -> [f64; 3] {
+        [0, 1, 2].map(|i| {
+            ((clip[1][i] - clip[0][i]) / voxel + 1.0 + GRID_OFFSET)
+                .ceil()
+                .max(1.0)
+                + 1.0
+        })
+    }
+
     /// The position of grid point `i`.
     pub fn point(&self, i: [u32; 3]) -> [f64; 3] {
         [0, 1, 2].map(|a| self.origin[a] + i[a] as f64 * self.voxel)

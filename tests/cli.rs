@@ -677,7 +677,7 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
     if !wgpu_available(&d) {
         return;
     }
-    // 1100x40 is three tiles of 512 pixels: the second fails after the first rendered.
+    // 4100x16 is three tiles of 2048 pixels: the second fails after the first rendered.
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&d)
         .args([
@@ -686,7 +686,7 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
             "--backend",
             "wgpu",
             "--size",
-            "1100x40",
+            "4100x16",
         ])
         .args(["-o", "fault.png"])
         .env("SDFC_FAULT_AFTER_TILES", "1")

@@ -1,7 +1,7 @@
 //! A hand-written CUDA sphere tracer of bench/handwritten/scene.sdf, the yardstick for sdfc's
 //! own kernels (BENCHMARKS.md, "Beside a hand-written tracer"): the same primitives, camera,
 //! light and settings, written as one would by hand — the field as inline functions, a camera
-//! ray marched to |d| < ε·t, the normal from four taps, one soft-shadow ray (res = min(res,
+//! ray marched to d < ε·t (a negative distance counts as a hit, and in a shadow ray as blocked), the normal from four taps, one soft-shadow ray (res = min(res,
 //! k·d/t)), Phong shading — and the whole image in one launch.
 //!
 //! Build: nvcc -O3 -arch=sm_90 -o tracer tracer.cu
@@ -84,7 +84,7 @@ __global__ void render(Params P, float4 *image, unsigned *steps_out) {
     V p = P.eye + d * t;
     float f = sdf(p);
     steps++;
-    if (fabsf(f) < tol(P.eps, t, p)) { hit = true; break; }
+    if (f < tol(P.eps, t, p)) { hit = true; break; }
     t += f;
     if (t > P.max_dist) break;
   }
@@ -108,7 +108,7 @@ __global__ void render(Params P, float4 *image, unsigned *steps_out) {
       float f = sdf(q);
       steps++;
       if (s > 0.0f) res = fminf(res, P.k * f / s);
-      if (fabsf(f) < tol(P.eps, t + s, q)) { res = 0.0f; break; }
+      if (f < tol(P.eps, t + s, q)) { res = 0.0f; break; }
       s += f;
       if (s >= P.max_dist) break;
     }

@@ -50,7 +50,7 @@ if [ "$MODE" = all ] || [ "$MODE" = scale ]; then
   for n in compound_100 compound_1000 lattice_1000 random_1000 random_10000; do
     row "$n march" "examples/scaling/$n.sdf" --set method=march
   done
-  row "spheres_1024 march" examples/scaling/spheres_1024.sdf --set method=march
-  row "spheres_1024 traced" examples/scaling/spheres_1024.sdf
+  row "jittered_1024 march" examples/scaling/jittered_1024.sdf --set method=march
+  row "jittered_1024 traced" examples/scaling/jittered_1024.sdf
   cat "$OUT/scale.txt"
 fi

@@ -20,7 +20,7 @@ use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::program::{Binary, Op, Unary};
 use sdfc_compiler::rng::Rng;
 use sdfc_compiler::scene::{Node, Scene};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Most ulps ([`ulps`]) by which the emitted Rust may differ from the interpreter: none, it
 /// performs the same operations in the same order (docs/embedding.md: bit for bit).
@@ -302,6 +302,15 @@ fn baseline(cases: &[Case], points: &[[f64; 3]]) -> Vec<(Vec<Value<f32>>, Vec<Va
         .collect()
 }
 
+/// A scratch folder of this process (the test binary also runs on the GPU machine, away from
+/// its build folder).
+fn scratch(what: &str) -> PathBuf {
+    std::env::temp_dir().join(format!(
+        "sdfc-distance-conformance-{what}-{}",
+        std::process::id()
+    ))
+}
+
 /// Skips (saying so) or, where `var` asks for every device, fails.
 fn skip(var: &str, what: &str) {
     assert!(!evaluators::required(var), "{var}=1, but {what}");
@@ -322,7 +331,7 @@ fn the_interpreter_agrees_with_the_f64_reference() {
 fn the_emitted_rust_is_the_interpreter_bit_for_bit() {
     let (cases, points) = (cases(), points());
     let programs: Vec<_> = cases.iter().map(|c| &c.lowered.program).collect();
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("distance-conformance-rust");
+    let dir = scratch("rust");
     let results = match evaluators::emitted_rust(&programs, &points, &dir) {
         Ok(r) => r,
         Err(why) => return skip("SDFC_REQUIRE_DEVICES", &format!("emitted Rust: {why}")),
@@ -333,6 +342,7 @@ fn the_emitted_rust_is_the_interpreter_bit_for_bit() {
     }
     report.check();
     assert!(report.all_exact());
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -357,7 +367,7 @@ fn wgpu_agrees_with_the_interpreter_in_ulps() {
 #[test]
 fn the_ptx_assembles_and_cuda_agrees_with_the_interpreter_in_ulps() {
     let (cases, points) = (cases(), points());
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("distance-conformance-ptx");
+    let dir = scratch("ptx");
     std::fs::create_dir_all(&dir).expect("scratch folder");
     match evaluators::ptxas() {
         None => skip("SDFC_REQUIRE_DEVICES", "ptxas: not on the PATH"),
@@ -380,6 +390,7 @@ fn the_ptx_assembles_and_cuda_agrees_with_the_interpreter_in_ulps() {
                     String::from_utf8_lossy(&out.stderr)
                 );
             }
+            let _ = std::fs::remove_dir_all(&dir);
         }
     }
     let (ctx, sm) = match evaluators::open_cuda() {

@@ -33,7 +33,7 @@ const RUST_ULPS: f64 = 0.0;
 const GPU_ULPS: f64 = 16.0;
 /// The same on a program with sin, cos, acos, exp, log, pow or atan2
 /// ([`approximate`]): WGSL allows these errors of several ulps (absolute errors near zero,
-/// pow's error grows with the exponent), and the Mandelbulb's iteration amplifies them.
+/// pow's error grows with the exponent), and the Mandelbulb's distance estimate amplifies them.
 /// Measured on lavapipe: 375 ulps at worst (the Mandelbulb of power 7.5), 94 % bit for bit.
 const GPU_ULPS_FUNCTIONS: f64 = 1024.0;
 /// The bound of every f32 evaluator against the f64 reference on a program of arithmetic:

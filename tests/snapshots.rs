@@ -46,25 +46,84 @@ const PTX_FEATURES: &[&str] = &[
     "guard",
 ];
 
-/// Each renderer kernel input with the input its kernel is compared with (the one it extends
-/// by one feature; none: the kernel is snapshotted whole) and the writer's options it needs.
-const KERNELS: &[(&str, Option<&str>, Options)] = &[
-    ("base", None, Options::Default),
-    ("relax", Some("base"), Options::Default),
-    ("point", Some("base"), Options::Default),
-    ("directional", Some("base"), Options::Default),
-    ("soft", Some("point"), Options::Default),
-    ("materials", Some("base"), Options::Default),
-    ("checker", Some("materials"), Options::Default),
-    ("reflect", Some("materials"), Options::Default),
-    ("transparent", Some("point"), Options::Default),
-    ("refraction", Some("materials"), Options::Default),
-    ("media", Some("refraction"), Options::Default),
-    ("debug_nan", Some("base"), Options::DebugNan),
-    ("params", Some("base"), Options::Parameters),
-    ("analytic", None, Options::Default),
-    ("analytic_data", Some("analytic"), Options::OneUnrolled),
-    ("instances_data", Some("base"), Options::OneInstance),
+/// A kernel snapshot: the input file of `tests/in/kernel` and the writer's options.
+type Written = (&'static str, Options);
+
+/// Each kernel snapshot: its name, the kernel, and the kernel it is compared with (one
+/// feature less), or none where it is snapshotted whole.
+const KERNELS: &[(&str, Written, Option<Written>)] = &[
+    ("base", ("base", Options::Default), None),
+    (
+        "relax",
+        ("relax", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "point",
+        ("point", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "directional",
+        ("directional", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "soft",
+        ("soft", Options::Default),
+        Some(("point", Options::Default)),
+    ),
+    (
+        "materials",
+        ("materials", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "checker",
+        ("checker", Options::Default),
+        Some(("materials", Options::Default)),
+    ),
+    (
+        "reflect",
+        ("reflect", Options::Default),
+        Some(("materials", Options::Default)),
+    ),
+    (
+        "transparent",
+        ("transparent", Options::Default),
+        Some(("point", Options::Default)),
+    ),
+    (
+        "refraction",
+        ("refraction", Options::Default),
+        Some(("materials", Options::Default)),
+    ),
+    (
+        "media",
+        ("media", Options::Default),
+        Some(("refraction", Options::Default)),
+    ),
+    (
+        "debug_nan",
+        ("base", Options::DebugNan),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "params",
+        ("base", Options::Parameters),
+        Some(("base", Options::Default)),
+    ),
+    ("analytic", ("analytic", Options::Default), None),
+    (
+        "analytic_data",
+        ("analytic", Options::OneUnrolled),
+        Some(("analytic", Options::Default)),
+    ),
+    (
+        "instances_data",
+        ("instances", Options::OneInstance),
+        Some(("instances", Options::Default)),
+    ),
 ];
 
 /// The WGSL writer's options a kernel input needs.
@@ -219,29 +278,33 @@ fn diff(from: &str, to: &str, (a, b): (&str, &str)) -> String {
         .to_string()
 }
 
-/// Every kernel input's kernel, whole or as its difference from the kernel of the input it
-/// extends ([`KERNELS`]).
+/// Every kernel of [`KERNELS`], whole or as its difference from the kernel it extends; every
+/// input of `tests/in/kernel` is written by some row.
 #[test]
 fn kernels() {
     for path in &sdf_files("tests/in/kernel") {
         let name = stem(path);
         assert!(
-            KERNELS.iter().any(|(n, ..)| *n == name),
-            "tests/in/kernel/{name}.sdf has no row in KERNELS"
+            KERNELS.iter().any(|(_, (file, _), _)| *file == name),
+            "tests/in/kernel/{name}.sdf is in no row of KERNELS"
         );
     }
-    for &(name, from, options) in KERNELS {
-        let new = kernel(name, options);
-        let Some(from) = from else {
+    for &(name, (file, options), from) in KERNELS {
+        let new = kernel(file, options);
+        let Some((from, from_options)) = from else {
             snapshot("kernel", name, &new.source);
             continue;
         };
-        let (_, _, from_options) = KERNELS
-            .iter()
-            .find(|(n, ..)| *n == from)
-            .unwrap_or_else(|| panic!("{name} extends {from}, which has no row"));
-        let old = kernel(from, *from_options);
-        let text = diff(&old.source, &new.source, (from, name));
+        let old = kernel(from, from_options);
+        let label = |file: &str, options: Options| match options {
+            Options::Default => file.to_string(),
+            other => format!("{file} ({other:?})"),
+        };
+        let text = diff(
+            &old.source,
+            &new.source,
+            (&label(from, from_options), &label(file, options)),
+        );
         assert!(!text.is_empty(), "{name}: the same kernel as {from}");
         snapshot("kernel", name, &text);
     }

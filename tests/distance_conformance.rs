@@ -1,15 +1,15 @@
 //! One conformance suite for every evaluator of the distance program: the scenes of
 //! `tests/in/feature` (one primitive, operator, blend, domain operation or transform each)
 //! and the random scenes of `common::random_scene`, evaluated at one fixed set of points by
-//! the f64 reference, the f32 interpreter, the emitted Rust, the WGSL part through wgpu
-//! and its PTX through CUDA (`common/evaluators.rs`). The f32 evaluators are compared with
-//! the f32 interpreter in ulps ([`ulps`]), each within its stated tolerance, and each with
-//! the f64 reference within a relative bound ([`REFERENCE_BOUND`]), each bound looser for
-//! programs with transcendental functions ([`approximate`]); a failure reports the worst case
-//! of every comparison. Without a wgpu adapter, `rustc`, `ptxas` or a CUDA
-//! device the part that needs it says it skipped; SDFC_REQUIRE_DEVICES=1 makes a missing
-//! adapter, `rustc` or `ptxas` fail, SDFC_REQUIRE_CUDA=1 (scripts/device-conformance.sh, on
-//! the GPU machine) a missing CUDA device.
+//! the f64 reference, the f32 interpreter, the emitted Rust, and through wgpu and CUDA (its
+//! PTX) the WGSL part's two functions and the renderer kernel's walk over instances in
+//! `scene_data` (`common/evaluators.rs`). The f32 evaluators are compared with the f32
+//! interpreter in ulps ([`ulps`]), and each with the f64 reference within a relative bound,
+//! both bounds stated by the functions a program uses ([`CLASSES`]); a failure reports the
+//! worst case of every comparison. Without a wgpu adapter, `rustc`, `ptxas` or a CUDA device
+//! the part that needs it says it skipped; SDFC_REQUIRE_DEVICES=1 makes a missing adapter,
+//! `rustc` or `ptxas` fail, SDFC_REQUIRE_CUDA=1 (scripts/device-conformance.sh, on the GPU
+//! machine) a missing CUDA device.
 
 mod common;
 #[path = "common/evaluators.rs"]
@@ -25,23 +25,69 @@ use std::path::PathBuf;
 /// Most ulps ([`ulps`]) by which the emitted Rust may differ from the interpreter: none, it
 /// performs the same operations in the same order (docs/embedding.md: bit for bit).
 const RUST_ULPS: f64 = 0.0;
-/// Most ulps by which wgpu and CUDA may differ from the interpreter on a program of
-/// arithmetic, square roots, minima and maxima alone: WGSL lets a driver contract a product
-/// and a sum into one rounding and compute division and square roots within 2.5 ulps, and
-/// differences of larger values carry such errors into the distance. Measured on lavapipe
-/// (LLVM 15, 2026-11-24): 3 ulps at worst, 95 % of the values bit for bit.
-const GPU_ULPS: f64 = 16.0;
-/// The same on a program with sin, cos, acos, exp, log, pow or atan2
-/// ([`approximate`]): WGSL allows these errors of several ulps (absolute errors near zero,
-/// pow's error grows with the exponent), and the Mandelbulb's distance estimate amplifies them.
-/// Measured on lavapipe: 375 ulps at worst (the Mandelbulb of power 7.5), 94 % bit for bit.
-const GPU_ULPS_FUNCTIONS: f64 = 1024.0;
-/// The bound of every f32 evaluator against the f64 reference on a program of arithmetic:
-/// |d₃₂ − d₆₄| ≤ this × s (s as in [`ulps`]). Measured: 5.4e-7 at worst.
-const REFERENCE_BOUND: f64 = 2e-5;
-/// The same on a program with the functions of [`GPU_ULPS_FUNCTIONS`]. Measured: 4.5e-5 at
-/// worst (lavapipe, the Mandelbulb of power 7.5); 8.6e-7 for the interpreter.
-const REFERENCE_BOUND_FUNCTIONS: f64 = 2e-4;
+/// The classes of programs, by the operations they use, with the most ulps by which wgpu and
+/// CUDA may differ from the interpreter and the bound of every f32 evaluator against the f64
+/// reference, |d₃₂ − d₆₄| ≤ bound × s (s as in [`ulps`]). Measured on lavapipe (LLVM 15,
+/// 2026-11-24), in the comments: the worst over the part, its distance alone and the
+/// instance walk.
+///
+/// - Arithmetic, square roots, minima and maxima alone: WGSL lets a driver contract a
+///   product and a sum into one rounding and compute division and square roots within 2.5
+///   ulps, and differences of larger values carry such errors into the distance. Measured:
+///   3 ulps, 5.4e-7 against f64.
+/// - With sin, cos, exp or log (twists, bends, exponential blends): WGSL allows these
+///   absolute errors near zero and errors of a few ulps elsewhere. Measured: 5 ulps, 8.6e-7 against f64.
+/// - With pow, acos or atan2 (the Mandelbulb of a fractional power): pow's error grows with
+///   the exponent, and the distance estimate amplifies it. Measured: 375 ulps, 4.5e-5
+///   against f64.
+const CLASSES: [Bounds; 3] = [
+    Bounds {
+        name: "arithmetic",
+        ulps: 16.0,
+        reference: 2e-5,
+    },
+    Bounds {
+        name: "with sin, cos, exp or log",
+        ulps: 64.0,
+        reference: 2e-5,
+    },
+    Bounds {
+        name: "with pow, acos or atan2",
+        ulps: 1024.0,
+        reference: 2e-4,
+    },
+];
+
+/// The bounds of a class of programs ([`CLASSES`]).
+#[derive(Debug, Clone, Copy)]
+struct Bounds {
+    name: &'static str,
+    ulps: f64,
+    reference: f64,
+}
+
+/// The class of a program ([`CLASSES`]): 2 where it computes pow, acos or atan2, 1 where it
+/// computes sin, cos, exp or log, 0 otherwise.
+fn class(program: &sdfc_compiler::program::Program) -> usize {
+    let has = |f: &dyn Fn(&Op) -> bool| program.ops().iter().any(f);
+    if has(&|op| {
+        matches!(
+            op,
+            Op::Unary(Unary::Acos, _) | Op::Binary(Binary::Pow | Binary::Atan2, ..)
+        )
+    }) {
+        2
+    } else if has(&|op| {
+        matches!(
+            op,
+            Op::Unary(Unary::Sin | Unary::Cos | Unary::Exp | Unary::Log, _)
+        )
+    }) {
+        1
+    } else {
+        0
+    }
+}
 
 /// A scene of the suite, lowered once: every evaluator runs this program.
 struct Case {
@@ -50,19 +96,12 @@ struct Case {
     lowered: Lowered,
 }
 
-/// The feature scenes (`tests/in/feature`), then 40 random scenes of 1 to 6 primitives.
-fn cases() -> Vec<Case> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir("../tests/in/feature")
-        .expect("tests/in/feature")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
-        .collect();
-    files.sort();
-    assert!(files.len() >= 20, "{} feature scenes", files.len());
-    let mut cases: Vec<Case> = files
-        .iter()
+/// The scenes of `tests/in/<dir>`, lowered.
+fn scenes(dir: &str) -> Vec<Case> {
+    sdf_files(&format!("../tests/in/{dir}"))
+        .into_iter()
         .map(|path| {
-            let scene = sdfc_runtime::frontend::load(path)
+            let scene = sdfc_runtime::frontend::load(&path)
                 .expect("readable")
                 .scene
                 .unwrap_or_else(|| panic!("{} has errors", path.display()));
@@ -74,7 +113,16 @@ fn cases() -> Vec<Case> {
                 lowered,
             }
         })
-        .collect();
+        .collect()
+}
+
+/// The feature scenes (`tests/in/feature`, one feature each), the scenes that combine
+/// features for an evaluator (`tests/in/conformance`: every primitive the instance walk
+/// knows), then 40 random scenes of 1 to 6 primitives.
+fn cases() -> Vec<Case> {
+    let mut cases = scenes("feature");
+    assert!(cases.len() >= 25, "{} feature scenes", cases.len());
+    cases.extend(scenes("conformance"));
     let mut rng = Rng::new(2026);
     for i in 0..40 {
         let scene = common::random_scene(&mut rng, 1 + i % 6);
@@ -86,6 +134,17 @@ fn cases() -> Vec<Case> {
         });
     }
     cases
+}
+
+/// The `.sdf` files in `dir`, sorted.
+fn sdf_files(dir: &str) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{dir}: {e}"))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
+        .collect();
+    files.sort();
+    files
 }
 
 /// The points: 512 uniform in [-3, 3]³ (where the scenes are) and 64 in [-12, 12]³.
@@ -138,23 +197,8 @@ impl Worst {
     }
 }
 
-/// Whether a program computes one of the functions sin, cos, acos, exp, log, pow or atan2,
-/// whose results WGSL and PTX allow to differ by more than arithmetic's.
-fn approximate(program: &sdfc_compiler::program::Program) -> bool {
-    program.ops().iter().any(|op| {
-        matches!(
-            op,
-            Op::Unary(
-                Unary::Sin | Unary::Cos | Unary::Acos | Unary::Exp | Unary::Log,
-                _
-            ) | Op::Binary(Binary::Pow | Binary::Atan2, ..)
-        )
-    })
-}
-
-/// The comparisons of one f32 evaluator over the cases of one class (arithmetic alone, or
-/// with the functions of [`approximate`]): against the interpreter in ulps, material ids,
-/// and against the f64 reference.
+/// The comparisons of one f32 evaluator over the cases of one class ([`CLASSES`]): against
+/// the interpreter in ulps, material ids, and against the f64 reference.
 struct Class {
     name: &'static str,
     max_ulps: f64,
@@ -233,23 +277,27 @@ impl Class {
     }
 }
 
-/// The comparisons of one f32 evaluator: a [`Class`] for programs of arithmetic, one for
-/// programs with functions.
+/// The comparisons of one f32 evaluator: a [`Class`] for each of [`CLASSES`].
 struct Report {
     evaluator: &'static str,
-    classes: [Class; 2],
+    classes: Vec<Class>,
 }
 
 impl Report {
-    /// A report whose bounds are `ulps` and [`REFERENCE_BOUND`] on arithmetic, `ulps_functions`
-    /// and [`REFERENCE_BOUND_FUNCTIONS`] with functions.
-    fn new(evaluator: &'static str, ulps: f64, ulps_functions: f64) -> Self {
+    /// A report with the bounds of [`CLASSES`].
+    fn gpu(evaluator: &'static str) -> Self {
+        Self::with_ulps(evaluator, CLASSES.map(|c| c.ulps))
+    }
+
+    /// A report with the given ulps per class and the reference bounds of [`CLASSES`].
+    fn with_ulps(evaluator: &'static str, ulps: [f64; 3]) -> Self {
         Report {
             evaluator,
-            classes: [
-                Class::new("arithmetic", ulps, REFERENCE_BOUND),
-                Class::new("with functions", ulps_functions, REFERENCE_BOUND_FUNCTIONS),
-            ],
+            classes: CLASSES
+                .iter()
+                .zip(ulps)
+                .map(|(c, u)| Class::new(c.name, u, c.reference))
+                .collect(),
         }
     }
 
@@ -261,18 +309,13 @@ impl Report {
         got: &[Value<f32>],
         (base, truth): &(Vec<Value<f32>>, Vec<Value<f64>>),
     ) {
-        let class = approximate(&case.lowered.program) as usize;
-        self.classes[class].compare(&case.name, points, got, base, truth);
+        self.classes[class(&case.lowered.program)].compare(&case.name, points, got, base, truth);
     }
 
     /// Prints the worst cases, and panics with them where a bound was passed.
     fn check(&self) {
-        let text = format!(
-            "{}:\n{}\n{}",
-            self.evaluator,
-            self.classes[0].summary(),
-            self.classes[1].summary()
-        );
+        let lines: Vec<String> = self.classes.iter().map(Class::summary).collect();
+        let text = format!("{}:\n{}", self.evaluator, lines.join("\n"));
         println!("{text}");
         assert!(
             !self.classes.iter().any(Class::failed),
@@ -320,7 +363,7 @@ fn skip(var: &str, what: &str) {
 #[test]
 fn the_interpreter_agrees_with_the_f64_reference() {
     let (cases, points) = (cases(), points());
-    let mut report = Report::new("f32 interpreter", 0.0, 0.0);
+    let mut report = Report::with_ulps("f32 interpreter", [0.0; 3]);
     for (case, results) in cases.iter().zip(baseline(&cases, &points)) {
         report.compare(case, &points, &results.0, &results);
     }
@@ -336,13 +379,85 @@ fn the_emitted_rust_is_the_interpreter_bit_for_bit() {
         Ok(r) => r,
         Err(why) => return skip("SDFC_REQUIRE_DEVICES", &format!("emitted Rust: {why}")),
     };
-    let mut report = Report::new("emitted Rust", RUST_ULPS, RUST_ULPS);
+    let mut report = Report::with_ulps("emitted Rust", [RUST_ULPS; 3]);
     for ((case, got), base) in cases.iter().zip(&results).zip(baseline(&cases, &points)) {
         report.compare(case, &points, got, &base);
     }
     report.check();
     assert!(report.all_exact());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The distance alone of a WGSL module as values with the interpreter's materials (it has
+/// none of its own).
+fn alone(distances: &[f32], base: &[Value<f32>]) -> Vec<Value<f32>> {
+    distances
+        .iter()
+        .zip(base)
+        .map(|(&d, &(_, m))| (d, m))
+        .collect()
+}
+
+/// The reports of the GPU evaluators of one backend: the part's `map` and `map_distance`,
+/// and the instance walk's `map` and `sdf`.
+struct Gpu {
+    part: Report,
+    part_alone: Report,
+    walk: Report,
+    walk_alone: Report,
+    walked: Vec<String>,
+}
+
+impl Gpu {
+    fn new(
+        part: &'static str,
+        part_alone: &'static str,
+        walk: &'static str,
+        walk_alone: &'static str,
+    ) -> Self {
+        Gpu {
+            part: Report::gpu(part),
+            part_alone: Report::gpu(part_alone),
+            walk: Report::gpu(walk),
+            walk_alone: Report::gpu(walk_alone),
+            walked: Vec::new(),
+        }
+    }
+
+    /// Runs every case's part, and its instance walk where it has instances, through `run`.
+    fn run(
+        &mut self,
+        cases: &[Case],
+        points: &[[f64; 3]],
+        mut run: impl FnMut(&evaluators::PointsModule) -> evaluators::Results,
+    ) {
+        for (case, base) in cases.iter().zip(baseline(cases, points)) {
+            let part = evaluators::points_module(&case.scene, &case.lowered, true);
+            let (map, distance) = run(&part);
+            self.part.compare(case, points, &map, &base);
+            self.part_alone
+                .compare(case, points, &alone(&distance, &base.0), &base);
+            if let Some(walk) = evaluators::walk_module(&case.scene) {
+                let (map, distance) = run(&walk);
+                self.walk.compare(case, points, &map, &base);
+                self.walk_alone
+                    .compare(case, points, &alone(&distance, &base.0), &base);
+                self.walked.push(case.name.clone());
+            }
+        }
+    }
+
+    fn check(&self) {
+        println!("instances walked in: {}", self.walked.join(", "));
+        assert!(
+            self.walked.iter().any(|n| n == "instances") && self.walked.len() >= 5,
+            "too few cases with instances: {:?}",
+            self.walked
+        );
+        for r in [&self.part, &self.part_alone, &self.walk, &self.walk_alone] {
+            r.check();
+        }
+    }
 }
 
 #[test]
@@ -353,17 +468,18 @@ fn wgpu_agrees_with_the_interpreter_in_ulps() {
     };
     println!("adapter: {}", gpu.describe());
     let (cases, points) = (cases(), points());
-    let mut report = Report::new("wgpu", GPU_ULPS, GPU_ULPS_FUNCTIONS);
-    for (case, base) in cases.iter().zip(baseline(&cases, &points)) {
-        let (source, _, _) = evaluators::points_module(&case.scene, &case.lowered);
-        let got = evaluators::run_wgpu(&gpu, &source, &points);
-        report.compare(case, &points, &got, &base);
-    }
-    report.check();
+    let mut reports = Gpu::new(
+        "wgpu, the part's map",
+        "wgpu, the part's map_distance",
+        "wgpu, the kernel's instance walk, map",
+        "wgpu, the kernel's instance walk, sdf",
+    );
+    reports.run(&cases, &points, |m| evaluators::run_wgpu(&gpu, m, &points));
+    reports.check();
 }
 
-/// Every case's PTX assembles with `ptxas` (sm_70), and where a CUDA device is present it
-/// runs there and agrees with the interpreter.
+/// Every case's part and instance walk translate to PTX that `ptxas` assembles (sm_70), and
+/// where a CUDA device is present they run there and agree with the interpreter.
 #[test]
 fn the_ptx_assembles_and_cuda_agrees_with_the_interpreter_in_ulps() {
     let (cases, points) = (cases(), points());
@@ -373,22 +489,26 @@ fn the_ptx_assembles_and_cuda_agrees_with_the_interpreter_in_ulps() {
         None => skip("SDFC_REQUIRE_DEVICES", "ptxas: not on the PATH"),
         Some(ptxas) => {
             for (i, case) in cases.iter().enumerate() {
-                let (_, module, info) = evaluators::points_module(&case.scene, &case.lowered);
-                let file = dir.join(format!("case{i}.ptx"));
-                std::fs::write(&file, evaluators::points_ptx(&module, &info, 70)).expect("PTX");
-                let out = std::process::Command::new(&ptxas)
-                    .args(["-arch=sm_70", "-o"])
-                    .arg(dir.join(format!("case{i}.cubin")))
-                    .arg(&file)
-                    .output()
-                    .expect("run ptxas");
-                assert!(
-                    out.status.success(),
-                    "{}: ptxas refused {}:\n{}",
-                    case.name,
-                    file.display(),
-                    String::from_utf8_lossy(&out.stderr)
-                );
+                let walk = evaluators::walk_module(&case.scene);
+                let part = evaluators::points_module(&case.scene, &case.lowered, true);
+                for (what, m) in [("part", Some(part)), ("walk", walk)] {
+                    let Some(m) = m else { continue };
+                    let file = dir.join(format!("case{i}_{what}.ptx"));
+                    std::fs::write(&file, evaluators::points_ptx(&m, 70)).expect("PTX");
+                    let out = std::process::Command::new(&ptxas)
+                        .args(["-arch=sm_70", "-o"])
+                        .arg(dir.join(format!("case{i}_{what}.cubin")))
+                        .arg(&file)
+                        .output()
+                        .expect("run ptxas");
+                    assert!(
+                        out.status.success(),
+                        "{} ({what}): ptxas refused {}:\n{}",
+                        case.name,
+                        file.display(),
+                        String::from_utf8_lossy(&out.stderr)
+                    );
+                }
             }
             let _ = std::fs::remove_dir_all(&dir);
         }
@@ -397,25 +517,26 @@ fn the_ptx_assembles_and_cuda_agrees_with_the_interpreter_in_ulps() {
         Ok(c) => c,
         Err(why) => return skip("SDFC_REQUIRE_CUDA", &format!("CUDA: {why}")),
     };
-    let mut report = Report::new("CUDA", GPU_ULPS, GPU_ULPS_FUNCTIONS);
-    for (case, base) in cases.iter().zip(baseline(&cases, &points)) {
-        let (_, module, info) = evaluators::points_module(&case.scene, &case.lowered);
-        let text = evaluators::points_ptx(&module, &info, sm);
-        let got = evaluators::run_cuda(&ctx, &text, &points);
-        report.compare(case, &points, &got, &base);
-    }
-    report.check();
+    let mut reports = Gpu::new(
+        "CUDA, the part's map",
+        "CUDA, the part's map_distance",
+        "CUDA, the kernel's instance walk, map",
+        "CUDA, the kernel's instance walk, sdf",
+    );
+    reports.run(&cases, &points, |m| {
+        evaluators::run_cuda(&ctx, m, &evaluators::points_ptx(m, sm), &points)
+    });
+    reports.check();
 }
 
 /// The feature scenes hold every kind of scene node and their programs every operation,
 /// so that each evaluator meets each.
 #[test]
 fn the_feature_scenes_cover_every_node_and_operation() {
-    let cases = cases();
-    let features = cases.iter().filter(|c| !c.name.starts_with("random"));
+    let features = scenes("feature");
     let mut nodes = std::collections::BTreeSet::new();
     let mut ops = std::collections::BTreeSet::new();
-    for case in features {
+    for case in &features {
         for id in case.scene.graph.ids() {
             nodes.insert(node_kind(case.scene.graph.node(id)));
         }

@@ -250,8 +250,8 @@ fn features() {
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         snapshot("part", &name, &part.source);
         if PTX_FEATURES.contains(&name.as_str()) {
-            let (_, module, info) = evaluators::points_module(&scene, &lowered);
-            snapshot("ptx", &name, &evaluators::points_ptx(&module, &info, 70));
+            let m = evaluators::points_module(&scene, &lowered, false);
+            snapshot("ptx", &name, &evaluators::points_ptx(&m, 70));
         }
     }
     for name in PTX_FEATURES {

@@ -307,7 +307,7 @@ impl Report {
         case: &Case,
         points: &[[f64; 3]],
         got: &[Value<f32>],
-        (base, truth): &(Vec<Value<f32>>, Vec<Value<f64>>),
+        (base, truth): &Baseline,
     ) {
         self.classes[class(&case.lowered.program)].compare(&case.name, points, got, base, truth);
     }
@@ -332,8 +332,11 @@ impl Report {
     }
 }
 
+/// The f32 interpreter's and the f64 reference's results of one case.
+type Baseline = (Vec<Value<f32>>, Vec<Value<f64>>);
+
 /// The interpreter and reference results of every case, computed once per test.
-fn baseline(cases: &[Case], points: &[[f64; 3]]) -> Vec<(Vec<Value<f32>>, Vec<Value<f64>>)> {
+fn baseline(cases: &[Case], points: &[[f64; 3]]) -> Vec<Baseline> {
     cases
         .iter()
         .map(|c| {

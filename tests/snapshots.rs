@@ -1,6 +1,6 @@
 //! Snapshot tests in the manner of naga's: small inputs, each showing one feature, whose
-//! outputs a person can read (every snapshot within [`MAX_LINES`], the folder within
-//! [`MAX_TOTAL_LINES`]):
+//! outputs a person can read (every snapshot within [`SNAPSHOT_LINES`], the folder within
+//! [`ALL_SNAPSHOTS_LINES`]):
 //! - `tests/in/ok` (one feature of the language each): the AST and the scene IR;
 //! - `tests/in/feature` (one primitive, operator, blend, domain operation or transform each):
 //!   the distance program and the WGSL part (`--part map`); for [`PTX_FEATURES`], which
@@ -27,9 +27,9 @@ use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};
 
 /// The most lines of one snapshot.
-const MAX_LINES: usize = 400;
+const SNAPSHOT_LINES: usize = 400;
 /// The most lines of all snapshots together.
-const MAX_TOTAL_LINES: usize = 15_000;
+const ALL_SNAPSHOTS_LINES: usize = 15_000;
 
 /// The feature scenes whose distance over points is snapshotted as PTX: between them every
 /// operation of the distance program (the sum of squares and square root of a sphere,
@@ -324,17 +324,17 @@ fn snapshots_stay_small() {
                 .lines()
                 .count();
             total += lines;
-            if lines > MAX_LINES {
+            if lines > SNAPSHOT_LINES {
                 long.push(format!("{} ({lines} lines)", file.display()));
             }
         }
     }
     assert!(
         long.is_empty(),
-        "snapshots over {MAX_LINES} lines: {long:?}"
+        "snapshots over {SNAPSHOT_LINES} lines: {long:?}"
     );
     assert!(
-        total <= MAX_TOTAL_LINES,
-        "{total} lines of snapshots, over {MAX_TOTAL_LINES}"
+        total <= ALL_SNAPSHOTS_LINES,
+        "{total} lines of snapshots, over {ALL_SNAPSHOTS_LINES}"
     );
 }

@@ -1,9 +1,10 @@
 //! One conformance suite for every evaluator of the distance program: the scenes of
-//! `tests/in/feature` (one primitive, operator, blend, domain operation or transform each)
-//! and the random scenes of `common::random_scene`, evaluated at one fixed set of points by
-//! the f64 reference, the f32 interpreter, the emitted Rust, and through wgpu and CUDA (its
-//! PTX) the WGSL part's two functions and the renderer kernel's walk over instances in
-//! `scene_data` (`common/evaluators.rs`). The f32 evaluators are compared with the f32
+//! `tests/in/feature` (one primitive, operator, blend, domain operation or transform each),
+//! `tests/in/conformance` and the random scenes of `common::random_scene`, evaluated at one
+//! fixed set of points by the f64 reference, the f32 and f64 interpreter, the emitted Rust
+//! (f32 and f64), and through wgpu and CUDA (its PTX) the WGSL part's two functions and the
+//! renderer kernel's walk over instances in `scene_data` (`common/evaluators.rs`). The f64
+//! evaluators are the reference bit for bit; the f32 ones are compared with the f32
 //! interpreter in ulps ([`ulps`]), and each with the f64 reference within a relative bound,
 //! both bounds stated by the functions a program uses ([`CLASSES`]); a failure reports the
 //! worst case of every comparison. Without a wgpu adapter, `rustc`, `ptxas` or a CUDA device
@@ -341,7 +342,7 @@ fn baseline(cases: &[Case], points: &[[f64; 3]]) -> Vec<Baseline> {
         .iter()
         .map(|c| {
             (
-                evaluators::interpreter(&c.lowered.program, points),
+                evaluators::interpreter::<f32>(&c.lowered.program, points),
                 evaluators::reference(&c.lowered.program, points),
             )
         })
@@ -383,12 +384,49 @@ fn the_emitted_rust_is_the_interpreter_bit_for_bit() {
         Err(why) => return skip("SDFC_REQUIRE_DEVICES", &format!("emitted Rust: {why}")),
     };
     let mut report = Report::with_ulps("emitted Rust", [RUST_ULPS; 3]);
-    for ((case, got), base) in cases.iter().zip(&results).zip(baseline(&cases, &points)) {
+    for ((case, got), base) in cases
+        .iter()
+        .zip(&results.f32)
+        .zip(baseline(&cases, &points))
+    {
         report.compare(case, &points, got, &base);
     }
     report.check();
     assert!(report.all_exact());
+    // `map_f64` is the f64 reference, bit for bit (NaN as NaN).
+    for ((case, got), truth) in cases
+        .iter()
+        .zip(&results.f64)
+        .zip(&baseline(&cases, &points))
+    {
+        for (i, (&(d, m), &(t, tm))) in got.iter().zip(&truth.1).enumerate() {
+            assert!(
+                (d.to_bits() == t.to_bits() || (d.is_nan() && t.is_nan())) && m == tm,
+                "{}: map_f64 at {:?}: ({d:e}, {m}) against the reference ({t:e}, {tm})",
+                case.name,
+                points[i]
+            );
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The f64 batch interpreter is the f64 reference (`Program::run`), bit for bit.
+#[test]
+fn the_f64_interpreter_is_the_reference_bit_for_bit() {
+    let (cases, points) = (cases(), points());
+    for case in &cases {
+        let batch = evaluators::interpreter::<f64>(&case.lowered.program, &points);
+        let truth = evaluators::reference(&case.lowered.program, &points);
+        for (i, (&(d, m), &(t, tm))) in batch.iter().zip(&truth).enumerate() {
+            assert!(
+                (d.to_bits() == t.to_bits() || (d.is_nan() && t.is_nan())) && m == tm,
+                "{} at {:?}: ({d:e}, {m}) against the reference ({t:e}, {tm})",
+                case.name,
+                points[i]
+            );
+        }
+    }
 }
 
 /// The distance alone of a WGSL module as values with the interpreter's materials (it has

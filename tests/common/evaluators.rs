@@ -11,7 +11,7 @@
 #![allow(dead_code)]
 
 use sdfc_compiler::back::{ptx, rust, wgsl};
-use sdfc_compiler::eval::{eval_point, Evaluator, Outputs, Tape};
+use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
 use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::{Method, Scene};
@@ -127,25 +127,32 @@ pub fn reference(program: &Program, points: &[[f64; 3]]) -> Vec<Value<f64>> {
         .collect()
 }
 
-/// The f32 batch interpreter at every point (coordinates rounded to f32).
-pub fn interpreter(program: &Program, points: &[[f64; 3]]) -> Vec<Value<f32>> {
+/// The batch interpreter in `T` at every point (coordinates rounded to `T`).
+pub fn interpreter<T: Float>(program: &Program, points: &[[f64; 3]]) -> Vec<Value<T>> {
     let tape = Tape::new(program, Outputs::DistanceAndMaterial);
-    let mut ev = Evaluator::<f32>::new(&tape, 64);
-    let coord = |i: usize| points.iter().map(|p| p[i] as f32).collect::<Vec<f32>>();
-    let mut d = vec![0.0f32; points.len()];
+    let mut ev = Evaluator::<T>::new(&tape, 64);
+    let coord = |i: usize| points.iter().map(|p| T::from_f64(p[i])).collect::<Vec<T>>();
+    let mut d = vec![T::zero(); points.len()];
     let mut m = vec![0u32; points.len()];
     ev.eval(&coord(0), &coord(1), &coord(2), &mut d, Some(&mut m));
     d.into_iter().zip(m).collect()
 }
 
+/// What the emitted Rust computed: per program, its f32 `map` and its f64 `map_f64` at
+/// every point.
+pub struct RustResults {
+    pub f32: Vec<Vec<Value<f32>>>,
+    pub f64: Vec<Vec<Value<f64>>>,
+}
+
 /// The emitted Rust of every program, compiled by `rustc` into one program (each scene a
-/// module, glam's vector types stood in for) that reads the points as f32 bits from a file
-/// and prints each result's bits: per program, the f32 `map` at every point.
+/// module, glam's vector types stood in for) that reads the points as f64 bits from a file
+/// and prints the bits of `map` (at the point rounded to f32) and `map_f64` at each.
 pub fn emitted_rust(
     programs: &[&Program],
     points: &[[f64; 3]],
     dir: &Path,
-) -> Result<Vec<Vec<Value<f32>>>, String> {
+) -> Result<RustResults, String> {
     let mut src = String::from(
         "#![allow(dead_code)]\nmod glam {\n    #[derive(Clone, Copy)]\n    pub struct Vec3 { pub x: f32, pub y: f32, pub z: f32 }\n    #[derive(Clone, Copy)]\n    pub struct DVec3 { pub x: f64, pub y: f64, pub z: f64 }\n}\n",
     );
@@ -157,12 +164,12 @@ pub fn emitted_rust(
         );
     }
     src.push_str(
-        "fn main() {\n    let path = std::env::args().nth(1).expect(\"points file\");\n    let bytes = std::fs::read(path).expect(\"points\");\n    let f: Vec<f32> = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();\n    let mut out = String::new();\n",
+        "fn main() {\n    let path = std::env::args().nth(1).expect(\"points file\");\n    let bytes = std::fs::read(path).expect(\"points\");\n    let c: Vec<f64> = bytes.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect();\n    let mut out = String::new();\n",
     );
     for i in 0..programs.len() {
         let _ = writeln!(
             src,
-            "    for p in f.chunks_exact(3) {{ let (d, m) = s{i}::map(glam::Vec3 {{ x: p[0], y: p[1], z: p[2] }}); out.push_str(&format!(\"{{}} {{}}\\n\", d.to_bits(), m)); }}"
+            "    for p in c.chunks_exact(3) {{\n        let (a, m) = s{i}::map(glam::Vec3 {{ x: p[0] as f32, y: p[1] as f32, z: p[2] as f32 }});\n        let (b, n) = s{i}::map_f64(glam::DVec3 {{ x: p[0], y: p[1], z: p[2] }});\n        out.push_str(&format!(\"{{}} {{}} {{}} {{}}\\n\", a.to_bits(), m, b.to_bits(), n));\n    }}"
         );
     }
     src.push_str("    print!(\"{out}\");\n}\n");
@@ -175,7 +182,7 @@ pub fn emitted_rust(
     std::fs::write(&source, src).map_err(|e| e.to_string())?;
     let bits: Vec<u8> = points
         .iter()
-        .flat_map(|p| p.iter().flat_map(|&c| (c as f32).to_le_bytes()))
+        .flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes()))
         .collect();
     std::fs::write(&input, bits).map_err(|e| e.to_string())?;
     let compiled = Command::new("rustc")
@@ -199,17 +206,30 @@ pub fn emitted_rust(
         String::from_utf8_lossy(&run.stderr)
     );
     let text = String::from_utf8_lossy(&run.stdout);
-    let mut values = text.lines().map(|line| {
-        let (d, m) = line.split_once(' ').expect("two words");
+    let mut rows = text.lines().map(|line| {
+        let w: Vec<&str> = line.split(' ').collect();
+        assert_eq!(w.len(), 4, "{line}");
+        let n = |i: usize| -> u64 { w[i].parse().expect("a number") };
         (
-            f32::from_bits(d.parse().expect("bits")),
-            m.parse().expect("material"),
+            (f32::from_bits(n(0) as u32), n(1) as u32),
+            (f64::from_bits(n(2)), n(3) as u32),
         )
     });
-    Ok(programs
-        .iter()
-        .map(|_| values.by_ref().take(points.len()).collect())
-        .collect())
+    let mut results = RustResults {
+        f32: Vec::new(),
+        f64: Vec::new(),
+    };
+    for _ in programs {
+        let (a, b): (Vec<_>, Vec<_>) = rows.by_ref().take(points.len()).unzip();
+        assert_eq!(
+            a.len(),
+            points.len(),
+            "the emitted Rust printed too few results"
+        );
+        results.f32.push(a);
+        results.f64.push(b);
+    }
+    Ok(results)
 }
 
 /// The points as the entry point reads them: x, y, z, 0 per point, padded with the origin to

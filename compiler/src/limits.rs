@@ -212,11 +212,11 @@ impl Limit {
             // The interpreted kernel's file is an array of this many f32 per GPU thread
             // (compiler/src/back/wgsl/interp.rs), in the GPU's local memory: its size is part
             // of the kernel's text, so every scene that fits shares one kernel. A register's
-            // number is 16 bits of an instruction word.
+            // number is 13 bits of an instruction word.
             Limit::Registers => s(
                 "registers",
                 256,
-                65_534,
+                8_190,
                 "registers of the interpreted GPU kernel (programs that need more cannot use it)",
             ),
         }

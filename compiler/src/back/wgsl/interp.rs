@@ -12,9 +12,13 @@
 //! [1]       the first word of sdf_solid, 0, 0, 0
 //! [2 ..]    the programs, one instruction a word:
 //!           x: opcode (bits 0-7) | operand k read from a register (bit 8 + k) | destination
-//!              register (bits 16-31)
+//!              register (bits 11-23)
 //!           y, z, w: the operands: a register's number, an immediate f32 (a constant of the
 //!              program), or a word index (a block's end)
+//!
+//! Every integer (word indices, the fields of x, registers) is held as the f32 of its value,
+//! exact below 2^24, and read with `u32(…)`: held as its bits, a small integer would be a
+//! subnormal float, which drivers that flush subnormals may zero.
 //! ```
 //!
 //! Each program is its live instructions in order, constants folded into the operands that
@@ -237,7 +241,7 @@ fn allocate(ins: &[Ins], len: usize) -> (Vec<[u32; 4]>, usize) {
         };
         // Instructions without a destination write the scratch register, which the kernel
         // places after the file; it is patched in `encode` once the file's size is known.
-        word[0] |= dest.map_or(SCRATCH, |p| p) << 16;
+        word[0] |= dest.map_or(SCRATCH, |p| p) << DEST_SHIFT;
         words.push(word);
     }
     (words, used as usize)
@@ -245,7 +249,9 @@ fn allocate(ins: &[Ins], len: usize) -> (Vec<[u32; 4]>, usize) {
 
 /// The destination of an instruction that has none, before [`encode`] replaces it with the
 /// register after the file.
-const SCRATCH: u32 = 0xffff;
+const SCRATCH: u32 = 0x1fff;
+/// The destination register's place in an instruction's first field.
+const DEST_SHIFT: u32 = 11;
 
 /// What keeps a scene from the interpreted kernel.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -294,8 +300,8 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
         let (mut words, used) = allocate(list, *len);
         needed = needed.max(used);
         for (w, i) in words.iter_mut().zip(list) {
-            if w[0] >> 16 == SCRATCH {
-                w[0] = (w[0] & 0xffff) | (file as u32) << 16;
+            if w[0] >> DEST_SHIFT == SCRATCH {
+                w[0] = (w[0] & ((1 << DEST_SHIFT) - 1)) | (file as u32) << DEST_SHIFT;
             }
             if let Arg::Jump(_) = i.args[2] {
                 w[3] += base;
@@ -306,16 +312,47 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
     if needed > file {
         return Err(Unfit::Registers(needed, file));
     }
+    if HEADER + body.len() > 1 << 24 {
+        // Word indices are written as f32 (exact below 2^24).
+        return Err(Unfit::Bytes(
+            (HEADER + body.len()) * 16,
+            (1 << 24) * 16 >> 20,
+        ));
+    }
     let bytes = (HEADER + body.len()) * 16;
     if bytes as u64 > max_mib.saturating_mul(1 << 20) {
         return Err(Unfit::Bytes(bytes, max_mib));
     }
+    // Every integer is written as the f32 of its value (exact below 2^24), never as its bits:
+    // small integers' bits are subnormal floats, which a driver that flushes subnormals may
+    // turn into zeros when it moves them.
+    let int = |x: u32| (x as f32).to_bits();
     let mut out = Vec::with_capacity(bytes);
-    for w in starts.iter().chain(body.iter().flatten()) {
-        out.extend_from_slice(&w.to_le_bytes());
+    for x in starts {
+        out.extend_from_slice(&int(x).to_le_bytes());
+    }
+    for w in &body {
+        let mut fields = [int(w[0]), w[1], w[2], w[3]];
+        for k in 0..3 {
+            let jump = k == 2 && w[0] & 0xff == BLOCK;
+            if w[0] & (0x100 << k) != 0 || jump {
+                fields[k + 1] = int(w[k + 1]);
+            }
+        }
+        for f in fields {
+            out.extend_from_slice(&f.to_le_bytes());
+        }
     }
     Ok(out)
 }
+
+/// Instructions interpreted per iteration of the interpreter's loop. Mesa's llvmpipe (and so
+/// lavapipe, on which the tests render) ends every loop of a shader once the loops together
+/// have iterated 65 535 times (`LP_MAX_TGSI_LOOP_ITERATIONS`, shared by all the loops of an
+/// invocation's SIMD group): one instruction an iteration, examples/lattice.sdf ran out of it
+/// and rendered wrong pixels. Eight an iteration lift the bound to about half a million
+/// instructions per pixel and keep the kernel small.
+const UNROLL: usize = 8;
 
 /// The WGSL text of the interpreter and of the distance functions the kernel calls, for a
 /// file of `file` registers; with `media`, also those of glass over solids.
@@ -326,26 +363,31 @@ pub(super) fn write(file: usize, media: bool) -> String {
         out,
         "// The distance programs, interpreted from `scene_data` (compiler/src/back/wgsl/interp.rs):\n\
          // one instruction a word (opcode, operands from registers or immediate, destination).\n\
-         var<private> regs: array<f32, {}>;\n",
+         var<private> interp_regs: array<f32, {}>;\n\
+         // The values of the last program's RETURN.\n\
+         var<private> interp_result: vec2<f32>;\n\
+         const INTERP_DONE: u32 = 0xffffffffu;\n",
         file + 1
     );
     let _ = writeln!(
         out,
-        "fn interpret(p: vec3<f32>, start: u32) -> vec2<f32> {{\n    var pc = start;\n    loop {{\n        \
-         let w = scene_data[pc];\n        let h = bitcast<u32>(w.x);\n        var a = w.y;\n        \
-         var b = w.z;\n        var c = w.w;\n        \
-         if (h & 0x100u) != 0u {{\n            a = regs[min(bitcast<u32>(w.y), {last}u)];\n        }}\n        \
-         if (h & 0x200u) != 0u {{\n            b = regs[min(bitcast<u32>(w.z), {last}u)];\n        }}\n        \
-         if (h & 0x400u) != 0u {{\n            c = regs[min(bitcast<u32>(w.w), {last}u)];\n        }}\n        \
-         var v = 0.0;\n        var next = pc + 1u;\n        switch h & 0xffu {{"
+        "// Runs the instruction at pc; returns the next one's index, or INTERP_DONE after RETURN.\n\
+         fn interp_step(p: vec3<f32>, pc: u32) -> u32 {{\n    \
+         let w = scene_data[pc];\n    let h = u32(w.x);\n    var a = w.y;\n    \
+         var b = w.z;\n    var c = w.w;\n    \
+         if (h & 0x100u) != 0u {{\n        a = interp_regs[min(u32(w.y), {last}u)];\n    }}\n    \
+         if (h & 0x200u) != 0u {{\n        b = interp_regs[min(u32(w.z), {last}u)];\n    }}\n    \
+         if (h & 0x400u) != 0u {{\n        c = interp_regs[min(u32(w.w), {last}u)];\n    }}\n    \
+         let op = h & 0xffu;\n    \
+         if op == {RETURN}u {{\n        interp_result = vec2<f32>(a, b);\n        return INTERP_DONE;\n    }}\n    \
+         var v = 0.0;\n    var next = pc + 1u;\n    switch op {{"
     );
     let case = |out: &mut String, op: u32, body: &str| {
         let _ = writeln!(
             out,
-            "            case {op}u: {{\n                {body}\n            }}"
+            "        case {op}u: {{\n            {body}\n        }}"
         );
     };
-    case(&mut out, RETURN, "return vec2<f32>(a, b);");
     case(&mut out, INPUT + Axis::X as u32, "v = p.x;");
     case(&mut out, INPUT + Axis::Y as u32, "v = p.y;");
     case(&mut out, INPUT + Axis::Z as u32, "v = p.z;");
@@ -354,7 +396,7 @@ pub(super) fn write(file: usize, media: bool) -> String {
     case(
         &mut out,
         BLOCK,
-        "if a >= b {\n                    next = bitcast<u32>(w.w);\n                }",
+        "if a >= b {\n                next = u32(w.w);\n            }",
     );
     for (k, u) in UNARIES.iter().enumerate() {
         let e = match u {
@@ -389,9 +431,17 @@ pub(super) fn write(file: usize, media: bool) -> String {
     case(&mut out, SELECT, "v = select(c, b, a != 0.0);");
     let _ = writeln!(
         out,
-        "            default: {{}}\n        }}\n        regs[min(h >> 16u, {last}u)] = v;\n        pc = next;\n    }}\n    \
-         return vec2<f32>(0.0); // not reached: the program returns\n}}\n"
+        "        default: {{}}\n    }}\n    interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = v;\n    return next;\n}}\n"
     );
+    let _ = writeln!(
+        out,
+        "// Runs the program that starts at `start` at p: (distance, material id).\n\
+         fn interpret(p: vec3<f32>, start: u32) -> vec2<f32> {{\n    var pc = start;\n    loop {{"
+    );
+    for _ in 0..UNROLL {
+        out.push_str("        pc = interp_step(p, pc);\n        if pc == INTERP_DONE {\n            break;\n        }\n");
+    }
+    out.push_str("    }\n    return interp_result;\n}\n\n");
     let entry = |out: &mut String, name: &str, slot: &str, material: bool| {
         let (ty, tail) = if material {
             ("vec2<f32>", "")
@@ -400,7 +450,7 @@ pub(super) fn write(file: usize, media: bool) -> String {
         };
         let _ = writeln!(
             out,
-            "fn {name}(p: vec3<f32>) -> {ty} {{\n    return interpret(p, bitcast<u32>(scene_data{slot})){tail};\n}}\n"
+            "fn {name}(p: vec3<f32>) -> {ty} {{\n    return interpret(p, u32(scene_data{slot})){tail};\n}}\n"
         );
     };
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
@@ -426,10 +476,11 @@ mod tests {
         let mut pc = start as usize;
         loop {
             let w = &words[pc * 4..pc * 4 + 4];
-            let h = w[0];
+            let int = |x: u32| f32::from_bits(x) as u32;
+            let h = int(w[0]);
             let arg = |k: usize| {
                 if h & (0x100 << k) != 0 {
-                    regs[(w[k + 1] as usize).min(file)]
+                    regs[(int(w[k + 1]) as usize).min(file)]
                 } else {
                     f32::from_bits(w[k + 1])
                 }
@@ -443,7 +494,7 @@ mod tests {
                 COPY => a,
                 BLOCK => {
                     if a >= b {
-                        next = w[3] as usize;
+                        next = int(w[3]) as usize;
                     }
                     0.0
                 }
@@ -453,7 +504,7 @@ mod tests {
                 }
                 o => crate::program::scalar::unary(UNARIES[(o - UNARY) as usize], a),
             };
-            regs[((h >> 16) as usize).min(file)] = v;
+            regs[((h >> DEST_SHIFT) as usize).min(file)] = v;
             pc = next;
         }
     }
@@ -464,6 +515,15 @@ mod tests {
             scene { smooth_union(0.3, sphere(1) @ a, box((0.5, 0.7, 0.4)).rotate_y(20deg).translate(1, 0, 0) @ b);\n\
             for i in 0..6 { torus(0.4, 0.1).translate(i - 3, 1.5, 0.5 * i) @ b; }\n\
             plane((0, 1, 0), -1) @ a; }";
+        agrees(text, [4.0; 3]);
+        // Many guarded blocks, nested (examples/lattice.sdf).
+        agrees(
+            include_str!("../../../../examples/lattice.sdf"),
+            [11.0, 0.8, 11.0],
+        );
+    }
+
+    fn agrees(text: &str, extent: [f64; 3]) {
         let (scene, diags, _) = crate::check::check_str("t.sdf", text);
         let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
         let lowered = Lowered::new(&scene);
@@ -490,20 +550,21 @@ mod tests {
             program.len()
         );
         let mut rng = crate::rng::Rng::new(7);
-        for _ in 0..2000 {
-            let p = [0, 1, 2].map(|_| rng.range(-4.0, 4.0) as f32);
+        for _ in 0..20_000 {
+            let p = extent.map(|e| rng.range(-e, e) as f32);
             let regs = program.run::<f32>(p, |_| {});
             let want = [
                 regs[program.distance().0 as usize],
                 regs[program.material().0 as usize],
             ];
-            let got = run(&words, words[0], p, file);
+            let start = |k: usize| f32::from_bits(words[k]) as u32;
+            let got = run(&words, start(0), p, file);
             assert_eq!(
                 got.map(f32::to_bits),
                 want.map(f32::to_bits),
                 "map at {p:?}"
             );
-            let d = run(&words, words[1], p, file);
+            let d = run(&words, start(1), p, file);
             assert_eq!(d[0].to_bits(), want[0].to_bits(), "sdf at {p:?}");
         }
         let small = encode(

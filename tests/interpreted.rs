@@ -101,6 +101,13 @@ fn the_text_depends_on_the_specialisation_alone() {
         let lowered = Lowered::new(&scene);
         let k = kernel(&scene, &lowered, KernelChoice::Interpreted);
         media |= k.source.contains("fn sdf_medium(");
+        println!(
+            "{}: {} instructions, {} live as code, {} registers",
+            path.display(),
+            lowered.program.len(),
+            wgsl::code_size(&scene, &lowered, &Options::default()),
+            wgsl::interp::registers(&lowered.program)
+        );
         let specialised = kernel(&scene, &lowered, KernelChoice::Specialised);
         assert!(!specialised.interpreted());
         let set = |k: &wgsl::Kernel| {
@@ -265,6 +272,22 @@ fn bad_combinations_are_refused() {
         err.contains("traced analytically") && err.contains("--set method=march"),
         "{err}"
     );
+    // Through `render` too, whatever the backend, and never by falling back to the CPU.
+    for backend in ["auto", "wgpu"] {
+        let (code, err) = sdfc(&[
+            "render",
+            "../examples/seed2.sdf",
+            "--backend",
+            backend,
+            "--kernel",
+            "interpreted",
+            "-o",
+            out,
+        ]);
+        assert_eq!(code, 1, "{err}");
+        assert!(err.contains("traced analytically"), "{err}");
+        assert!(!Path::new(out).exists());
+    }
     // Too few registers: the error names the limit that raises it.
     let (code, err) = sdfc(&[
         "compile",

@@ -211,11 +211,13 @@ impl Limit {
             ),
             // The interpreted kernel's file is an array of this many f32 per GPU thread
             // (compiler/src/back/wgsl/interp.rs), in the GPU's local memory: its size is part
-            // of the kernel's text, so every scene that fits shares one kernel. A register's
-            // number is 13 bits of an instruction word.
+            // of the kernel's text, so every scene that fits shares one kernel. The examples
+            // need 5 (seed1) to 40 (lattice), examples/scaling/compound_1000.sdf 54 (linear
+            // scan over the program's liveness); 64 holds them all in 256 bytes a thread. A
+            // register's number is 13 bits of an instruction word.
             Limit::Registers => s(
                 "registers",
-                256,
+                64,
                 8_190,
                 "registers of the interpreted GPU kernel (programs that need more cannot use it)",
             ),

@@ -386,6 +386,13 @@ fn time_scene(
         parameters: args.constants == Some(Constants::Parameters),
         kernel: args.kernel.unwrap_or_default().choice(),
     };
+    if args.backend != Backend::Cpu {
+        let options = sdfc_compiler::back::wgsl::Options {
+            kernel: setup.kernel,
+            ..Default::default()
+        };
+        sdfc_compiler::back::wgsl::choose(scene, &lowered, &options)?;
+    }
     let prepared = Prepared::from_program(args.backend, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);

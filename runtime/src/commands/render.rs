@@ -52,7 +52,7 @@ pub struct RenderArgs {
     /// The GPU kernel of a marched scene: its distance program written as code
     /// (`specialised`, compiled by the driver for each scene), interpreted from a buffer
     /// (`interpreted`, one kernel for every scene), or `auto`, interpreted where the code
-    /// would be large (docs/rendering.md, "The interpreted kernel"). [default: auto]
+    /// would be large (docs/interpreted.md). [default: auto]
     #[arg(long, value_enum)]
     pub kernel: Option<Kernel>,
     /// Float type of the evaluation.
@@ -226,6 +226,15 @@ pub fn prepare(
     setup: &Setup,
 ) -> Result<(Scene, Prepared), CliError> {
     let FrameScene { scene, lowered } = frame;
+    // A kernel asked for that cannot render the scene is an error, not a reason to fall back
+    // to another backend.
+    if backend != Backend::Cpu {
+        let options = sdfc_compiler::back::wgsl::Options {
+            kernel: setup.kernel,
+            ..Default::default()
+        };
+        sdfc_compiler::back::wgsl::choose(&scene, &lowered, &options).map_err(CliError::Failed)?;
+    }
     let prepared = pool
         .install(|| Prepared::from_program(backend, &scene, lowered, setup))
         .map_err(|msg| {

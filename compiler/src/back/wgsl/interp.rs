@@ -260,6 +260,8 @@ pub enum Unfit {
     Registers(usize, usize),
     /// Its programs' words exceed the `scene_data` limit: (bytes, the limit in MiB).
     Bytes(usize, u64),
+    /// Its programs take this many words, more than 2^24 (word indices are held as f32).
+    Words(usize),
 }
 
 /// The registers that `program`'s `map` (distance and material) needs in the interpreter.
@@ -314,10 +316,7 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
     }
     if HEADER + body.len() > 1 << 24 {
         // Word indices are written as f32 (exact below 2^24).
-        return Err(Unfit::Bytes(
-            (HEADER + body.len()) * 16,
-            (1 << 24) * 16 >> 20,
-        ));
+        return Err(Unfit::Words(HEADER + body.len()));
     }
     let bytes = (HEADER + body.len()) * 16;
     if bytes as u64 > max_mib.saturating_mul(1 << 20) {

@@ -304,6 +304,10 @@ fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, String> {
              registers and the kernel has {file}; {} (or use `--kernel specialised`)",
             scene.limits.raise_to(Limit::Registers, needed as u64)
         ),
+        interp::Unfit::Words(words) => format!(
+            "the interpreted kernel cannot run this scene: its distance programs take {words} \
+             instructions, more than the 2^24 it can address; use `--kernel specialised`"
+        ),
         interp::Unfit::Bytes(bytes, mib) => format!(
             "the interpreted kernel cannot run this scene: its distance program takes {} MiB \
              of scene_data, above the scene_data limit of {mib} MiB; {} (or use \

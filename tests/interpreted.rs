@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The images of the two kernels agree to at least this PSNR (dB) and no pixel differs by
-/// more than [`THRESHOLD`] in more than [`MAX_DIFFERING`] of the pixels. Each operation of
+/// more than [`THRESHOLD`] in more than [`MOST_DIFFERING`] of the pixels. Each operation of
 /// the interpreter is the expression the code writer writes for it, on the same f32 values,
 /// so the two compute the same distances, except where the shader compiler contracts the
 /// code's products and sums into fused multiply-adds or reassociates its constants, which the
@@ -27,7 +27,7 @@ use std::process::Command;
 /// objects, below 40 dB (before `interp::UNROLL`, lavapipe's loop limit cut examples/lattice.sdf
 /// to 39 dB and 1.2 % of pixels).
 const MIN_PSNR: f64 = 45.0;
-const MAX_DIFFERING: f64 = 0.005;
+const MOST_DIFFERING: f64 = 0.005;
 const THRESHOLD: f64 = 0.1;
 
 fn open_gpu() -> Option<gpu::Gpu> {
@@ -186,8 +186,8 @@ fn assert_same(gpu: &gpu::Gpu, scene: &Scene, label: &str) -> f64 {
     );
     assert_eq!(b.render.stats.counters.nans, a.render.stats.counters.nans);
     assert!(
-        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
-        "{label}: psnr {:.1} dB (at least {MIN_PSNR}), differing {:.4} (at most {MAX_DIFFERING})",
+        d.psnr >= MIN_PSNR && d.differing <= MOST_DIFFERING,
+        "{label}: psnr {:.1} dB (at least {MIN_PSNR}), differing {:.4} (at most {MOST_DIFFERING})",
         d.psnr,
         d.differing
     );

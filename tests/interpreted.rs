@@ -159,6 +159,24 @@ fn auto_interprets_large_programs_only() {
     assert_eq!(kind, wgsl::KernelKind::Specialised);
 }
 
+#[test]
+fn auto_keeps_the_specialised_kernel_on_a_cpu_adapter() {
+    use sdfc_runtime::backend::{Prepared, Setup};
+    let Some(gpu) = open_gpu() else { return };
+    let scene = marched(Path::new("../examples/lattice.sdf"), 32, 24);
+    let lowered = Lowered::new(&scene);
+    let prepared = Prepared::on_gpu(
+        std::sync::Arc::new(gpu),
+        &scene,
+        &lowered,
+        &Setup::default(),
+    )
+    .expect("prepared");
+    let cpu = matches!(&prepared, Prepared::Wgpu { gpu, .. } if gpu.is_cpu());
+    let want = if cpu { "specialised" } else { "interpreted" };
+    assert_eq!(prepared.kernel_kind(), Some(want));
+}
+
 /// Renders `scene` with both kernels and asserts that the images agree; returns the PSNR.
 fn assert_same(gpu: &gpu::Gpu, scene: &Scene, label: &str) -> f64 {
     let lowered = Lowered::new(scene);

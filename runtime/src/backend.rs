@@ -260,6 +260,16 @@ impl Prepared {
         held: Option<&wgsl::Kernel>,
     ) -> Result<(Prepared, bool), String> {
         traceable_with(scene, &lowered.traceable)?;
+        // On a CPU adapter (lavapipe) the interpreted kernel's frames are 25 to 150 times the
+        // specialised kernel's (BENCHMARKS.md, "Interpreted against specialised"), which its
+        // compile never repays: `auto` keeps the specialised kernel there.
+        let setup = &Setup {
+            kernel: match setup.kernel {
+                wgsl::KernelChoice::Auto if gpu.is_cpu() => wgsl::KernelChoice::Specialised,
+                other => other,
+            },
+            ..*setup
+        };
         let (kernel, built) = match held {
             Some(held) => {
                 let text = Self::kernel_text(scene, lowered, setup)?;

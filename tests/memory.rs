@@ -115,6 +115,7 @@ fn renders_stay_within_the_memory_they_announce() {
             precision,
             debug_nan: false,
             parameters: false,
+            kernel: Default::default(),
         };
         let prepared = pool.install(|| {
             Prepared::from_program(Backend::Cpu, &scene, lowered.clone(), &setup).expect("cpu")

@@ -944,3 +944,50 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
         }
     }
 }
+
+/// The interpreted kernel (compiler/src/back/wgsl/interp.rs) translates and assembles: one
+/// kernel per set of features among the examples (marched), each assembled once.
+#[test]
+fn interpreted_kernels_assemble() {
+    use sdfc_compiler::back::wgsl;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
+        .collect();
+    paths.sort();
+    let ptxas = ptxas();
+    let mut seen = std::collections::BTreeMap::new();
+    for path in paths {
+        let mut scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+        scene.settings.method = sdfc_compiler::scene::Method::March;
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let interpreted = wgsl::Options {
+            kernel: wgsl::KernelChoice::Interpreted,
+            ..Default::default()
+        };
+        let kernel = wgsl::write_with(&scene, &lowered, &interpreted).unwrap();
+        assert!(kernel.interpreted());
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if let Some(other) = seen.get(&kernel.source) {
+            println!("{name}: the kernel of {other}");
+            continue;
+        }
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        println!("{name}: {} lines of PTX", text.lines().count());
+        keep(
+            &format!("interpreted_{name}.wgsl"),
+            kernel.source.as_bytes(),
+        );
+        if let Some(p) = &ptxas {
+            println!(
+                "    {}",
+                summary(&assemble(p, &text, &format!("interpreted_{name}"), 80))
+            );
+        }
+        seen.insert(kernel.source, name);
+    }
+    assert!(seen.len() >= 2, "several specialisations");
+}

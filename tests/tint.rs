@@ -14,7 +14,8 @@
 //! and `tests/in/ok/*.sdf`; and `examples/animation/*.sdf` as a sequence's kernels are
 //! written, their constants read from `scene_data` (`Options::parameters`), with pipelines;
 //! and the distance function alone (`sdfc compile --part map`) of every scene that gets a
-//! pipeline (a module without an entry point: no pipeline of its own).
+//! pipeline (a module without an entry point: no pipeline of its own); and the interpreted
+//! kernels of the examples (`--kernel interpreted`, one per distinct text), with pipelines.
 //!
 //! The browser is `$SDFC_CHROMIUM`, or `chromium` (Debian's package) on PATH. Without it, or
 //! without a WebGPU adapter, the test prints that it skipped, unless `CI=true` or
@@ -169,6 +170,39 @@ fn example_jobs() -> Vec<Job> {
         std::iter::once(kernel).chain(part)
     })
     .collect()
+}
+
+/// The interpreted kernels (`--kernel interpreted`) of the examples, marched: one job per
+/// distinct text (most examples share one), with pipelines.
+fn interpreted_jobs() -> Vec<Job> {
+    let mut seen = BTreeMap::new();
+    for path in sdf_files("examples", |_| true) {
+        let loaded = frontend::load(&path).expect("readable");
+        let mut scene = loaded
+            .scene
+            .unwrap_or_else(|| panic!("{} has errors", path.display()));
+        scene.settings.method = sdfc_compiler::scene::Method::March;
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let options = Options {
+            kernel: wgsl::KernelChoice::Interpreted,
+            ..Options::default()
+        };
+        let kernel = wgsl::write_with(&scene, &lowered, &options)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let name = path
+            .strip_prefix("..")
+            .unwrap_or(&path)
+            .display()
+            .to_string();
+        seen.entry(kernel.source).or_insert(name);
+    }
+    seen.into_iter()
+        .map(|(code, name)| Job {
+            name: format!("{name} --kernel interpreted"),
+            code,
+            pipeline: true,
+        })
+        .collect()
 }
 
 /// A combination of features, one bit each in the order of `FEATURES`.
@@ -503,6 +537,7 @@ fn kernels_pass_tint() {
     let started = Instant::now();
     let mut jobs = example_jobs();
     jobs.extend(combo_jobs());
+    jobs.extend(interpreted_jobs());
     let generated = started.elapsed();
     let Some(exe) = chromium() else {
         return skip("no chromium on PATH (set SDFC_CHROMIUM to another)");

@@ -51,6 +51,9 @@ pub enum Limit {
     Frames,
     /// Cells `sdfc mesh` evaluates: the octree's cells at every level (or the dense grid's).
     Cells,
+    /// Registers of the interpreted GPU kernel's file (programs that need more take the
+    /// specialised kernel).
+    Registers,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -65,7 +68,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 19] = [
+    pub const ALL: [Limit; 20] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -85,6 +88,7 @@ impl Limit {
         Limit::SweepPoints,
         Limit::Frames,
         Limit::Cells,
+        Limit::Registers,
     ];
 
     fn spec(self) -> Spec {
@@ -205,6 +209,18 @@ impl Limit {
                 1 << 40,
                 "cells sdfc mesh evaluates (octree cells and candidates, or the dense grid)",
             ),
+            // The interpreted kernel's file is an array of this many f32 per GPU thread
+            // (compiler/src/back/wgsl/interp.rs), in the GPU's local memory: its size is part
+            // of the kernel's text, so every scene that fits shares one kernel. The examples
+            // need 5 (seed1) to 40 (lattice), examples/scaling/compound_1000.sdf 54 (linear
+            // scan over the program's liveness); 64 holds them all in 256 bytes a thread. A
+            // register's number is 13 bits of an instruction word.
+            Limit::Registers => s(
+                "registers",
+                64,
+                8_190,
+                "registers of the interpreted GPU kernel (programs that need more cannot use it)",
+            ),
         }
     }
 
@@ -243,7 +259,7 @@ impl fmt::Display for Limit {
 /// The value of every limit for one run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 19],
+    values: [u64; 20],
 }
 
 impl Default for Limits {

@@ -38,6 +38,49 @@ pub struct Setup {
     /// (`wgsl::Options::parameters`), so that [`Prepared::update`] reuses a kernel for a
     /// program that differs only in numbers (the frames of an animation).
     pub parameters: bool,
+    /// Which GPU kernel a marched scene gets (`--kernel`): its distance program written as
+    /// code, interpreted from a buffer, or the one `wgsl::choose` expects sooner.
+    pub kernel: wgsl::KernelChoice,
+}
+
+/// The GPU kernel asked for on the command line (`--kernel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Kernel {
+    /// The interpreted kernel where the distance program written as code would be large
+    /// (compiling it takes the drivers seconds), else the specialised one.
+    #[default]
+    Auto,
+    /// The distance program written as code: the fastest frames, compiled for each scene.
+    Specialised,
+    /// One kernel that interprets the distance program from a buffer: no compile per scene.
+    Interpreted,
+}
+
+impl Kernel {
+    /// The choice for the WGSL back end.
+    pub fn choice(self) -> wgsl::KernelChoice {
+        match self {
+            Kernel::Auto => wgsl::KernelChoice::Auto,
+            Kernel::Specialised => wgsl::KernelChoice::Specialised,
+            Kernel::Interpreted => wgsl::KernelChoice::Interpreted,
+        }
+    }
+
+    /// `Err` for a `--kernel` given with a backend that has no GPU kernel.
+    pub fn check(kernel: Option<Kernel>, backend: Backend) -> Result<(), String> {
+        match kernel {
+            Some(k) if backend == Backend::Cpu => Err(format!(
+                "--kernel {} chooses a GPU kernel, and the CPU backend has none (it interprets \
+                 every program); drop --kernel or use --backend wgpu or --backend cuda",
+                match k {
+                    Kernel::Auto => "auto",
+                    Kernel::Specialised => "specialised",
+                    Kernel::Interpreted => "interpreted",
+                }
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// A scene prepared for one backend.
@@ -80,6 +123,7 @@ pub struct CudaModule {
     specialisation: wgsl::Specialisation,
     ptx_time: Duration,
     source: String,
+    interpreted: bool,
 }
 
 /// A finished frame: the render and the time it took (GPU time for GPU backends).
@@ -161,13 +205,16 @@ impl Prepared {
     }
 
     fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, String> {
-        wgsl::write_with(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
+        let options = Self::kernel_options(setup);
+        wgsl::choose(scene, lowered, &options)?;
+        wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())
     }
 
     fn kernel_options(setup: &Setup) -> wgsl::Options {
         wgsl::Options {
             debug_nan: setup.debug_nan,
             parameters: setup.parameters,
+            kernel: setup.kernel,
             ..wgsl::Options::default()
         }
     }
@@ -175,7 +222,9 @@ impl Prepared {
     /// The text and data of the kernel for `scene`, not validated (to compare with a kernel
     /// held).
     fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, String> {
-        wgsl::write_text(scene, lowered, &Self::kernel_options(setup)).map_err(|e| e.to_string())
+        let options = Self::kernel_options(setup);
+        wgsl::choose(scene, lowered, &options)?;
+        wgsl::write_text(scene, lowered, &options).map_err(|e| e.to_string())
     }
 
     fn wgpu(
@@ -211,6 +260,16 @@ impl Prepared {
         held: Option<&wgsl::Kernel>,
     ) -> Result<(Prepared, bool), String> {
         traceable_with(scene, &lowered.traceable)?;
+        // On a CPU adapter (lavapipe) the interpreted kernel's frames are 25 to 150 times the
+        // specialised kernel's (BENCHMARKS.md, "Interpreted against specialised"), which its
+        // compile never repays: `auto` keeps the specialised kernel there.
+        let setup = &Setup {
+            kernel: match setup.kernel {
+                wgsl::KernelChoice::Auto if gpu.is_cpu() => wgsl::KernelChoice::Specialised,
+                other => other,
+            },
+            ..*setup
+        };
         let (kernel, built) = match held {
             Some(held) => {
                 let text = Self::kernel_text(scene, lowered, setup)?;
@@ -246,6 +305,7 @@ impl Prepared {
                     precision: options.precision,
                     debug_nan: options.debug_nan,
                     parameters: false,
+                    kernel: wgsl::KernelChoice::default(),
                 };
                 Ok((Self::on_cpu(scene, lowered, &setup)?, true))
             }
@@ -299,6 +359,7 @@ impl Prepared {
             .load(&text, wgsl::ENTRY_POINT)
             .map_err(|e| e.to_string())?;
         Ok(CudaModule {
+            interpreted: kernel.interpreted(),
             loaded,
             data: kernel.data,
             specialisation: kernel.specialisation,
@@ -417,6 +478,21 @@ impl Prepared {
             Prepared::Wgpu { gpu, .. } => gpu.describe(),
             Prepared::Cuda { cuda, .. } => cuda.describe(),
         }
+    }
+
+    /// The GPU kernel's kind, for `--stats` and `sdfc bench`: "specialised" or
+    /// "interpreted" (`None` on the CPU).
+    pub fn kernel_kind(&self) -> Option<&'static str> {
+        let interpreted = match self {
+            Prepared::Cpu { .. } => return None,
+            Prepared::Wgpu { kernel, .. } => kernel.interpreted(),
+            Prepared::Cuda { module, .. } => module.interpreted,
+        };
+        Some(if interpreted {
+            "interpreted"
+        } else {
+            "specialised"
+        })
     }
 
     /// How the backend was prepared, for `--stats`: PTX generation and JIT times for CUDA.

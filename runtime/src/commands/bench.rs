@@ -1,7 +1,7 @@
 //! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps, and
 //! for GPU targets the achieved fraction of the FP32 floor).
 
-use super::render::{thread_pool, Backend};
+use super::render::{thread_pool, Backend, Kernel};
 use crate::backend::{Prepared, Setup};
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
@@ -40,6 +40,10 @@ pub struct BenchArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// The GPU kernel of a marched scene, as for `sdfc render`: specialised, interpreted or
+    /// auto. [default: auto]
+    #[arg(long, value_enum)]
+    pub kernel: Option<Kernel>,
     /// Print one JSON array instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -95,6 +99,9 @@ pub struct Timing {
     pub mrays_per_s: f64,
     /// All rays (camera, secondary, shadow) per second, in millions (at the median).
     pub total_mrays_per_s: f64,
+    /// The GPU kernel: "specialised" (the distance program as code) or "interpreted";
+    /// null on the CPU.
+    pub kernel: Option<&'static str>,
     /// The intersection method the scene was rendered with: "trace" (analytic) or "march".
     pub method: &'static str,
     /// Instructions of the distance program.
@@ -198,6 +205,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
             precision: args.precision,
             debug_nan: false,
             parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
+            kernel: args.kernel.unwrap_or_default().choice(),
         };
         let mut kernels = Kernels::new(&pool, args.backend, setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
@@ -257,6 +265,10 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
 
 /// Runs `sdfc bench`.
 pub fn run(args: BenchArgs) -> ExitCode {
+    if let Err(msg) = Kernel::check(args.kernel, args.backend) {
+        eprintln!("error: {msg}");
+        return ExitCode::from(2);
+    }
     if args.frames_per_second {
         let timings = match run_sequences(&args) {
             Ok(t) => t,
@@ -372,7 +384,15 @@ fn time_scene(
         precision: args.precision,
         debug_nan: false,
         parameters: args.constants == Some(Constants::Parameters),
+        kernel: args.kernel.unwrap_or_default().choice(),
     };
+    if args.backend != Backend::Cpu {
+        let options = sdfc_compiler::back::wgsl::Options {
+            kernel: setup.kernel,
+            ..Default::default()
+        };
+        sdfc_compiler::back::wgsl::choose(scene, &lowered, &options)?;
+    }
     let prepared = Prepared::from_program(args.backend, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);
@@ -421,6 +441,7 @@ fn time_scene(
         min_s: times[0],
         mrays_per_s: c.camera_rays as f64 / median / 1e6,
         total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
+        kernel: prepared.kernel_kind(),
         method: if traced { "trace" } else { "march" },
         program_len: prepared.program_len(),
         ops_per_eval,

@@ -93,6 +93,11 @@ pub struct CompileArgs {
     /// specialised to the method, relaxation and `max_depth`). May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// The kernel of a marched scene (`--part kernel`): its distance program written as code,
+    /// or interpreted from `scene_data` (then `--emit scene-data` writes the program's words),
+    /// or auto as `sdfc render` chooses. [default: specialised]
+    #[arg(long, value_enum)]
+    pub kernel: Option<crate::backend::Kernel>,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -166,7 +171,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
                 }
             };
             let result = match args.part {
-                Part::Kernel => emit(scene, &lowered, other, args.sm),
+                Part::Kernel => emit(scene, &lowered, other, args.sm, args.kernel),
                 Part::Map => emit_map(scene, &lowered, other, &args.name),
             };
             match result {
@@ -183,6 +188,17 @@ pub fn run(args: CompileArgs) -> ExitCode {
 
 /// Why `--part`/`--name` do not fit the other arguments, if they do not.
 fn part_refused(args: &CompileArgs) -> Option<String> {
+    let kernel_target = !matches!(
+        args.emit,
+        Emit::Ast | Emit::Ir | Emit::Program | Emit::Rust | Emit::Shadertoy
+    );
+    if args.kernel.is_some() && (args.part == Part::Map || !kernel_target) {
+        return Some(
+            "`--kernel` chooses the renderer kernel: it goes with `--part kernel` and --emit \
+             wgsl, spirv, msl, glsl, hlsl, ptx, params, scene-data or layout"
+                .into(),
+        );
+    }
     match args.part {
         Part::Kernel if args.name != back::wgsl::part::DEFAULT_NAME => {
             Some("`--name` names the distance function of `--part map`".into())
@@ -242,6 +258,7 @@ fn emit(
     lowered: &lower::Lowered,
     target: Emit,
     sm: u32,
+    kernel: Option<crate::backend::Kernel>,
 ) -> Result<Vec<u8>, String> {
     let program = &lowered.program;
     let lang = match target {
@@ -261,12 +278,17 @@ fn emit(
         Emit::Hlsl => Some(Lang::Hlsl),
         Emit::Wgsl | Emit::Ptx | Emit::Params | Emit::SceneData | Emit::Layout => None,
     };
-    let kernel = back::wgsl::write(scene, lowered).map_err(|e| e.to_string())?;
+    let options = back::wgsl::Options {
+        kernel: kernel.map_or(back::wgsl::KernelChoice::Specialised, |k| k.choice()),
+        ..back::wgsl::Options::default()
+    };
+    back::wgsl::choose(scene, lowered, &options).map_err(|e| format!("error: {e}"))?;
+    let kernel = back::wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())?;
     match target {
         Emit::Params => return Ok(back::wgsl::uniforms(scene, program.lipschitz())),
         Emit::SceneData => {
             return kernel.data.ok_or_else(|| {
-                "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 2 048 marched instances does)".into()
+                "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 2 048 marched instances, or an interpreted one, does)".into()
             })
         }
         Emit::Layout => {

@@ -169,6 +169,7 @@ fn measure(
         precision: args.precision,
         debug_nan: false,
         parameters: false,
+        kernel: Default::default(),
     };
     let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
@@ -257,6 +258,7 @@ fn reference_setup(
         precision: Precision::F64,
         debug_nan: false,
         parameters: false,
+        kernel: Default::default(),
     };
     let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
     Ok((reference_scene, prepared))

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-pub use crate::backend::Backend;
+pub use crate::backend::{Backend, Kernel};
 
 /// Arguments of `sdfc render`.
 #[derive(Debug, clap::Args)]
@@ -49,6 +49,12 @@ pub struct RenderArgs {
     /// Print render statistics.
     #[arg(long)]
     pub stats: bool,
+    /// The GPU kernel of a marched scene: its distance program written as code
+    /// (`specialised`, compiled by the driver for each scene), interpreted from a buffer
+    /// (`interpreted`, one kernel for every scene), or `auto`, interpreted where the code
+    /// would be large (docs/interpreted.md). [default: auto]
+    #[arg(long, value_enum)]
+    pub kernel: Option<Kernel>,
     /// Float type of the evaluation.
     #[arg(long, value_enum, default_value_t)]
     pub precision: Precision,
@@ -220,6 +226,15 @@ pub fn prepare(
     setup: &Setup,
 ) -> Result<(Scene, Prepared), CliError> {
     let FrameScene { scene, lowered } = frame;
+    // A kernel asked for that cannot render the scene is an error, not a reason to fall back
+    // to another backend.
+    if backend != Backend::Cpu {
+        let options = sdfc_compiler::back::wgsl::Options {
+            kernel: setup.kernel,
+            ..Default::default()
+        };
+        sdfc_compiler::back::wgsl::choose(&scene, &lowered, &options).map_err(CliError::Failed)?;
+    }
     let prepared = pool
         .install(|| Prepared::from_program(backend, &scene, lowered, setup))
         .map_err(|msg| {
@@ -261,6 +276,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         &LowerOptions::default(),
     )?;
     let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
+    Kernel::check(args.kernel, backend).map_err(CliError::Usage)?;
     // The output is checked before any work, so that a render is never thrown away.
     let out = output(args).map_err(CliError::Usage)?;
     let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
@@ -268,6 +284,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         precision,
         debug_nan: args.debug_nan,
         parameters: false,
+        kernel: args.kernel.unwrap_or_default().choice(),
     };
     let (scene, prepared) = prepare(&pool, backend, frame, &setup)?;
     check_memory(
@@ -334,6 +351,9 @@ pub fn stats(
         prepared.name(),
         prepared.device()
     );
+    if let Some(k) = prepared.kernel_kind() {
+        text.push_str(&format!("kernel          {k}\n"));
+    }
     if let Some(p) = prepared.preparation() {
         text.push_str(&format!("prepared        {p}\n"));
     }

@@ -62,11 +62,13 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let mut sink = Sink::open(&target, frames, fps)?;
     let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
+    crate::backend::Kernel::check(args.kernel, backend).map_err(CliError::Usage)?;
     let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
     let setup = Setup {
         precision,
         debug_nan: args.debug_nan,
         parameters: true,
+        kernel: args.kernel.unwrap_or_default().choice(),
     };
     let mine: Vec<u64> = shard.frames(frames).collect();
     let todo: Vec<u64> = mine

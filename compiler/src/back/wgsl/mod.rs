@@ -11,6 +11,7 @@
 
 mod analytic;
 mod buffer;
+pub mod interp;
 pub mod layout;
 mod map;
 mod march;
@@ -66,6 +67,13 @@ pub struct Kernel {
     /// feature): the primitives and hierarchy of a large analytically traced scene, or the
     /// instances and their hierarchy of a large marched one.
     pub data: Option<Vec<u8>>,
+}
+
+impl Kernel {
+    /// Whether the kernel interprets its distance programs from `scene_data` (interp.rs).
+    pub fn interpreted(&self) -> bool {
+        self.features.contains(&("INTERPRETED", true))
+    }
 }
 
 /// What of the render settings a kernel is specialised for: the method (analytic tracing
@@ -185,6 +193,10 @@ pub struct Options {
     /// program written as code takes them: an analytically traced scene, a marched one whose
     /// instances are read from `scene_data`, and the media of glass keep their literals.
     pub parameters: bool,
+    /// Which kernel a marched scene gets: its distance program written as code (the
+    /// specialised kernel), or interpreted from `scene_data` (interp.rs), or the one of the two
+    /// [`choose`] expects to be ready and render sooner.
+    pub kernel: KernelChoice,
 }
 
 impl Default for Options {
@@ -194,8 +206,118 @@ impl Default for Options {
             max_unrolled: MAX_UNROLLED,
             max_instances: MAX_INSTANCES,
             parameters: false,
+            kernel: KernelChoice::Specialised,
         }
     }
+}
+
+/// The kernel asked for (`--kernel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum KernelChoice {
+    /// The interpreted kernel where the program written as code has at least
+    /// [`interp::AUTO_INTERPRET`] live instructions and fits the interpreter, else the
+    /// specialised one.
+    #[default]
+    Auto,
+    /// The distance program written as code.
+    Specialised,
+    /// The distance program interpreted from `scene_data`: a kernel whose text does not
+    /// depend on the program (marched scenes only).
+    Interpreted,
+}
+
+/// The kernel a scene gets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KernelKind {
+    /// The distance program written as code (or an analytically traced scene's kernel).
+    Specialised,
+    /// The distance program interpreted from `scene_data`.
+    Interpreted,
+}
+
+/// The kernel `options.kernel` gives `scene`, lowered as `lowered`, or why the interpreted
+/// kernel that it asks for cannot render it.
+pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<KernelKind, String> {
+    let traced = lowered.traceable.traced(scene.settings.method).is_some();
+    match options.kernel {
+        KernelChoice::Specialised => Ok(KernelKind::Specialised),
+        KernelChoice::Interpreted if traced => Err(
+            "the interpreted kernel runs a distance program, and this scene is traced \
+             analytically, with no distance program in its kernel; march it with \
+             `--set method=march`, or use `--kernel specialised` or `--kernel auto`"
+                .into(),
+        ),
+        KernelChoice::Interpreted => interpreted(scene, lowered).map(|_| KernelKind::Interpreted),
+        KernelChoice::Auto if traced => Ok(KernelKind::Specialised),
+        KernelChoice::Auto => {
+            let big = code_size(scene, lowered, options) >= interp::AUTO_INTERPRET;
+            Ok(if big && interpreted(scene, lowered).is_ok() {
+                KernelKind::Interpreted
+            } else {
+                KernelKind::Specialised
+            })
+        }
+    }
+}
+
+/// The live instructions of a marched scene's distance program that its specialised kernel
+/// writes as code: the whole program's, or, where its instances are read from `scene_data`,
+/// those of the rest.
+pub fn code_size(scene: &Scene, lowered: &Lowered, options: &Options) -> usize {
+    let live = |p: &crate::program::Program| {
+        let (live, _) = p.live(&[p.distance(), p.material()]);
+        live.iter().filter(|&&l| l).count()
+    };
+    let whole = live(&lowered.program);
+    if whole < interp::AUTO_INTERPRET {
+        return whole;
+    }
+    match split(scene, lowered, options) {
+        Some((s, _)) => live(&s.rest),
+        None => whole,
+    }
+}
+
+/// The media programs a marched scene's kernel needs: glass that may overlap solids, with
+/// refracted rays traced.
+fn media_of<'a>(scene: &Scene, lowered: &'a Lowered) -> Option<&'a crate::lower::Media> {
+    let refraction = features(scene, false)
+        .iter()
+        .any(|&(n, on)| n == "REFRACTION" && on);
+    lowered.media.as_ref().filter(|_| refraction)
+}
+
+/// The `scene_data` of the interpreted kernel for a marched scene, or why it cannot hold its
+/// programs.
+fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, String> {
+    use crate::limits::Limit;
+    let media = media_of(scene, lowered);
+    let programs = interp::Programs {
+        main: &lowered.program,
+        media: media.map(|m| (&m.medium, &m.solid)),
+    };
+    let file = scene.limits.count(Limit::Registers);
+    let mib = scene.limits.get(Limit::SceneData);
+    interp::encode(&programs, file, mib).map_err(|unfit| match unfit {
+        interp::Unfit::Registers(needed, file) => format!(
+            "the interpreted kernel cannot run this scene: its distance program needs {needed} \
+             registers and the kernel has {file}; {} (or use `--kernel specialised`)",
+            scene.limits.raise_to(Limit::Registers, needed as u64)
+        ),
+        interp::Unfit::Words(words) => format!(
+            "the interpreted kernel cannot run this scene: its distance programs take {words} \
+             instructions, more than the 2^24 it can address; use `--kernel specialised`"
+        ),
+        interp::Unfit::Bytes(bytes, mib) => format!(
+            "the interpreted kernel cannot run this scene: its distance program takes {} MiB \
+             of scene_data, above the scene_data limit of {mib} MiB; {} (or use \
+             `--kernel specialised`)",
+            bytes.div_ceil(1 << 20),
+            scene
+                .limits
+                .raise_to(Limit::SceneData, bytes.div_ceil(1 << 20) as u64)
+        ),
+    })
 }
 
 /// Writes and validates the kernel for `scene`, lowered as `lowered`.
@@ -249,6 +371,29 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
             values.insert("MAP", String::new());
             values.insert("ANALYTIC", text);
             bytes
+        }
+        None if choose(scene, lowered, options).map_err(|message| Error {
+            message,
+            line: None,
+            node_span: None,
+        })? == KernelKind::Interpreted =>
+        {
+            // The distance programs interpreted from `scene_data`: the text depends only on
+            // the features and the register file's size.
+            let bytes = interpreted(scene, lowered).map_err(|message| Error {
+                message,
+                line: None,
+                node_span: None,
+            })?;
+            let media = media_of(scene, lowered).is_some();
+            on.insert("MEDIA", media);
+            if media {
+                features.push(("MEDIA", true));
+            }
+            features.push(("INTERPRETED", true));
+            let file = scene.limits.count(crate::limits::Limit::Registers);
+            values.insert("MAP", interp::write(file, media));
+            Some(bytes)
         }
         None => {
             let (mut text, bytes, params) = marched(scene, lowered, options);
@@ -312,20 +457,7 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
 /// value is true).
 fn marched(scene: &Scene, lowered: &Lowered, options: &Options) -> (String, Option<Vec<u8>>, bool) {
     let program = &lowered.program;
-    let split = lowered
-        .instances(options.max_instances)
-        .filter(|s| march::fits(&s.instances))
-        .map(|s| {
-            let data = march::data(&s.instances, scene.camera.position);
-            (s, data)
-        })
-        // The `scene_data` limit, in MiB: by default what wgpu's default limits let a
-        // storage buffer bind; a scene with more keeps its instances as code.
-        .filter(|(_, data)| {
-            let mib = scene.limits.get(crate::limits::Limit::SceneData);
-            data.len() as u64 <= mib.saturating_mul(1 << 20)
-        });
-    match split {
+    match split(scene, lowered, options) {
         Some((s, data)) => {
             let text = format!(
                 "{}\n{}\n{}",
@@ -350,6 +482,29 @@ fn marched(scene: &Scene, lowered: &Lowered, options: &Options) -> (String, Opti
             false,
         ),
     }
+}
+
+/// The distance program cut into the rest and the instances read from `scene_data`, with
+/// their bytes, where the root union has more than `max_instances` instances and they fit
+/// ([`marched`]).
+fn split(
+    scene: &Scene,
+    lowered: &Lowered,
+    options: &Options,
+) -> Option<(crate::lower::Split, Vec<u8>)> {
+    lowered
+        .instances(options.max_instances)
+        .filter(|s| march::fits(&s.instances))
+        .map(|s| {
+            let data = march::data(&s.instances, scene.camera.position);
+            (s, data)
+        })
+        // The `scene_data` limit, in MiB: by default what wgpu's default limits let a
+        // storage buffer bind; a scene with more keeps its instances as code.
+        .filter(|(_, data)| {
+            let mib = scene.limits.get(crate::limits::Limit::SceneData);
+            data.len() as u64 <= mib.saturating_mul(1 << 20)
+        })
 }
 
 /// Parses and validates WGSL with naga.

@@ -1,0 +1,579 @@
+//! The interpreted kernel's distance functions: `map` and `sdf` (and, for glass over solids,
+//! `sdf_medium`, `map_solid` and `sdf_solid`) as one loop that reads the scene's distance
+//! programs from `scene_data` and runs them on a fixed-size register file, so that the
+//! kernel's text does not depend on the program: it is compiled once per specialisation
+//! (the features and the `registers` limit) and found in the drivers' and sdfc's caches for
+//! every scene of that specialisation.
+//!
+//! Layout of `scene_data` (`array<vec4<f32>>`, integers as their bits):
+//!
+//! ```text
+//! [0]       the first word of map, sdf, sdf_medium, map_solid
+//! [1]       the first word of sdf_solid, 0, 0, 0
+//! [2 ..]    the programs, one instruction a word:
+//!           x: opcode (bits 0-7) | operand k read from a register (bit 8 + k) | destination
+//!              register (bits 11-23)
+//!           y, z, w: the operands: a register's number, an immediate f32 (a constant of the
+//!              program), or a word index (a block's end)
+//!
+//! Every integer (word indices, the fields of x, registers) is held as the f32 of its value,
+//! exact below 2^24, and read with `u32(…)`: held as its bits, a small integer would be a
+//! subnormal float, which drivers that flush subnormals may zero.
+//! ```
+//!
+//! Each program is its live instructions in order, constants folded into the operands that
+//! read them, and ends with `RETURN` (distance, material). A guarded block is a `COPY` of
+//! each needed result's value from before it, `BLOCK` (which jumps past the block where
+//! `bound >= best`, as the code's `if !(bound >= best)`), its instructions, and a `COPY` of
+//! each result's value inside it. Registers are allocated by a linear scan over that order,
+//! with each register's last read from the program's liveness: jumps only go forwards, past
+//! a block whose values are read inside it alone, so a register freed at its last read in
+//! that order is never read again. Each operation is the expression the code writer
+//! (map.rs) writes for it, so the two kernels compute the same values, unless a driver
+//! contracts the code's products and sums into fused multiply-adds.
+
+use crate::program::{results, Axis, Binary, Item, Op, Program, Reg, Unary};
+use std::fmt::Write;
+
+/// `auto` (`Options::kernel`) chooses the interpreted kernel for a marched scene whose
+/// distance program written as code (the whole program, or what remains of it beside
+/// instances read from `scene_data`) has at least this many live instructions. The figures
+/// it stands on (issue 23, measured on an H100 on 2026-11-24): through wgpu,
+/// examples/temple.sdf (about 1 600 instructions) is ready in under a second, but
+/// examples/lattice.sdf (about 10 000) took 6.3 s to compile and
+/// examples/scaling/compound_100.sdf (about 17 600) 7.4–9.4 s. The interpreted kernel's
+/// frame time beside the specialised one's is not measured yet (scripts/device-interp.sh
+/// charts it); until it is, 5 000 sits between the kernels that compile in a second and
+/// those that take several.
+pub const AUTO_INTERPRET: usize = 5_000;
+
+/// Words of the header before the first program.
+const HEADER: usize = 2;
+
+// Opcodes. The unary operations are `UNARY + Unary as index`, the binary ones `BINARY + …`.
+const RETURN: u32 = 0;
+const INPUT: u32 = 1; // 1, 2, 3: x, y, z
+const COPY: u32 = 4;
+const BLOCK: u32 = 5;
+const UNARY: u32 = 6;
+const BINARY: u32 = 16;
+const SELECT: u32 = 25;
+
+const UNARIES: [Unary; 10] = [
+    Unary::Neg,
+    Unary::Abs,
+    Unary::Sqrt,
+    Unary::Sin,
+    Unary::Cos,
+    Unary::Acos,
+    Unary::Exp,
+    Unary::Log,
+    Unary::Floor,
+    Unary::Round,
+];
+const BINARIES: [Binary; 9] = [
+    Binary::Add,
+    Binary::Sub,
+    Binary::Mul,
+    Binary::Div,
+    Binary::Min,
+    Binary::Max,
+    Binary::Pow,
+    Binary::Atan2,
+    Binary::Lt,
+];
+
+/// One operand of an instruction before registers are allocated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Arg {
+    /// Unused (zero).
+    None,
+    /// The value of a program register.
+    Reg(Reg),
+    /// A constant, rounded to f32 as map.rs's literals are.
+    Imm(f32),
+    /// A word index (a block's end), relative to the program's first word.
+    Jump(u32),
+}
+
+/// One instruction before registers are allocated: the destination is a program register
+/// (for a block's results, the `Phi`'s).
+#[derive(Debug, Clone, Copy)]
+struct Ins {
+    op: u32,
+    dest: Option<Reg>,
+    args: [Arg; 3],
+}
+
+/// A program's instructions for `roots` (distance, and material where given), in order.
+fn linear(program: &Program, roots: &[Reg]) -> Vec<Ins> {
+    let ops = program.ops();
+    let (live, live_blocks) = program.live(roots);
+    let phi_of = program.phi_blocks();
+    let arg = |r: Reg| match ops[r.0 as usize] {
+        Op::Const(c) => Arg::Imm((c as f32).clamp(-f32::MAX, f32::MAX)),
+        _ => Arg::Reg(r),
+    };
+    let mut out: Vec<Ins> = Vec::new();
+    let mut open: Vec<usize> = Vec::new();
+    for item in program.items() {
+        match item {
+            Item::Op(i) if live[i] && phi_of[i].is_none() => {
+                let (op, args) = match ops[i] {
+                    Op::Const(_) => continue,
+                    Op::Input(a) => (INPUT + a as u32, [Arg::None; 3]),
+                    Op::Unary(u, a) => (
+                        UNARY + UNARIES.iter().position(|&x| x == u).unwrap_or(0) as u32,
+                        [arg(a), Arg::None, Arg::None],
+                    ),
+                    Op::Binary(b, x, y) => (
+                        BINARY + BINARIES.iter().position(|&z| z == b).unwrap_or(0) as u32,
+                        [arg(x), arg(y), Arg::None],
+                    ),
+                    Op::Select(c, a, b) => (SELECT, [arg(c), arg(a), arg(b)]),
+                    Op::Phi(..) => continue,
+                };
+                out.push(Ins {
+                    op,
+                    dest: Some(Reg(i as u32)),
+                    args,
+                });
+            }
+            Item::Open(b) if live_blocks[b] => {
+                for (j, _, other) in results(program, b, &live) {
+                    out.push(copy(Reg(j as u32), arg(other)));
+                }
+                let block = &program.blocks()[b];
+                open.push(out.len());
+                out.push(Ins {
+                    op: BLOCK,
+                    dest: None,
+                    args: [arg(block.bound), arg(block.best), Arg::Jump(0)],
+                });
+            }
+            Item::Close(b) if live_blocks[b] => {
+                for (j, then, _) in results(program, b, &live) {
+                    out.push(copy(Reg(j as u32), arg(then)));
+                }
+                if let Some(at) = open.pop() {
+                    out[at].args[2] = Arg::Jump(out.len() as u32);
+                }
+            }
+            Item::Op(_) | Item::Open(_) | Item::Close(_) => {}
+        }
+    }
+    let material = roots.get(1).map_or(Arg::Imm(0.0), |&m| arg(m));
+    out.push(Ins {
+        op: RETURN,
+        dest: None,
+        args: [arg(roots[0]), material, Arg::None],
+    });
+    out
+}
+
+fn copy(dest: Reg, value: Arg) -> Ins {
+    Ins {
+        op: COPY,
+        dest: Some(dest),
+        args: [value, Arg::None, Arg::None],
+    }
+}
+
+/// A program's instructions with registers allocated: the words, and how many registers
+/// they use.
+fn allocate(ins: &[Ins], len: usize) -> (Vec<[u32; 4]>, usize) {
+    let mut last = vec![usize::MAX; len];
+    for (pos, i) in ins.iter().enumerate() {
+        for a in i.args {
+            if let Arg::Reg(r) = a {
+                last[r.0 as usize] = pos;
+            }
+        }
+    }
+    let mut phys: Vec<Option<u32>> = vec![None; len];
+    let mut free: std::collections::BinaryHeap<std::cmp::Reverse<u32>> = Default::default();
+    let mut used = 0u32;
+    let mut words = Vec::with_capacity(ins.len());
+    for (pos, i) in ins.iter().enumerate() {
+        let mut word = [i.op, 0, 0, 0];
+        for (k, a) in i.args.iter().enumerate() {
+            word[k + 1] = match *a {
+                Arg::None => 0,
+                Arg::Imm(x) => x.to_bits(),
+                Arg::Jump(j) => j,
+                Arg::Reg(r) => {
+                    word[0] |= 0x100 << k;
+                    phys[r.0 as usize].unwrap_or(0)
+                }
+            };
+        }
+        for a in i.args {
+            if let Arg::Reg(r) = a {
+                if last[r.0 as usize] == pos {
+                    if let Some(p) = phys[r.0 as usize].take() {
+                        free.push(std::cmp::Reverse(p));
+                    }
+                }
+            }
+        }
+        let dest = match i.dest {
+            Some(d) => {
+                let d = d.0 as usize;
+                let p = match phys[d] {
+                    Some(p) => p,
+                    None => {
+                        let p = free.pop().map(|r| r.0).unwrap_or_else(|| {
+                            used += 1;
+                            used - 1
+                        });
+                        phys[d] = Some(p);
+                        p
+                    }
+                };
+                if last[d] == usize::MAX {
+                    // Never read (not reached for live instructions): free at once.
+                    phys[d] = None;
+                    free.push(std::cmp::Reverse(p));
+                }
+                Some(p)
+            }
+            None => None,
+        };
+        // Instructions without a destination write the scratch register, which the kernel
+        // places after the file; it is patched in `encode` once the file's size is known.
+        word[0] |= dest.map_or(SCRATCH, |p| p) << DEST_SHIFT;
+        words.push(word);
+    }
+    (words, used as usize)
+}
+
+/// The destination of an instruction that has none, before [`encode`] replaces it with the
+/// register after the file.
+const SCRATCH: u32 = 0x1fff;
+/// The destination register's place in an instruction's first field.
+const DEST_SHIFT: u32 = 11;
+
+/// What keeps a scene from the interpreted kernel.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Unfit {
+    /// Its programs need more registers than the file has: (needed, the file's size).
+    Registers(usize, usize),
+    /// Its programs' words exceed the `scene_data` limit: (bytes, the limit in MiB).
+    Bytes(usize, u64),
+    /// Its programs take this many words, more than 2^24 (word indices are held as f32).
+    Words(usize),
+}
+
+/// The registers that `program`'s `map` (distance and material) needs in the interpreter.
+pub fn registers(program: &Program) -> usize {
+    let roots = [program.distance(), program.material()];
+    allocate(&linear(program, &roots), program.len()).1
+}
+
+/// The programs of a kernel, in the order of the header: each with its roots (a `map`
+/// returns distance and material, an `sdf` the distance alone).
+pub(super) struct Programs<'a> {
+    /// The scene's program (`map`, `sdf`).
+    pub main: &'a Program,
+    /// The media's (`sdf_medium`, and `map_solid`, `sdf_solid`), for glass over solids.
+    pub media: Option<(&'a Program, &'a Program)>,
+}
+
+/// The bytes of `scene_data` holding `programs` for a file of `file` registers, or why they
+/// do not fit it or `max_bytes`.
+pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<Vec<u8>, Unfit> {
+    let map = |p: &Program| linear(p, &[p.distance(), p.material()]);
+    let sdf = |p: &Program| linear(p, &[p.distance()]);
+    let mut lists = vec![
+        (map(programs.main), programs.main.len()),
+        (sdf(programs.main), programs.main.len()),
+    ];
+    if let Some((medium, solid)) = programs.media {
+        lists.push((sdf(medium), medium.len()));
+        lists.push((map(solid), solid.len()));
+        lists.push((sdf(solid), solid.len()));
+    }
+    let mut starts = [0u32; 8];
+    let mut body: Vec<[u32; 4]> = Vec::new();
+    let mut needed = 0;
+    for (k, (list, len)) in lists.iter().enumerate() {
+        let base = (HEADER + body.len()) as u32;
+        starts[k] = base;
+        let (mut words, used) = allocate(list, *len);
+        needed = needed.max(used);
+        for (w, i) in words.iter_mut().zip(list) {
+            if w[0] >> DEST_SHIFT == SCRATCH {
+                w[0] = (w[0] & ((1 << DEST_SHIFT) - 1)) | (file as u32) << DEST_SHIFT;
+            }
+            if let Arg::Jump(_) = i.args[2] {
+                w[3] += base;
+            }
+        }
+        body.extend(words);
+    }
+    if needed > file {
+        return Err(Unfit::Registers(needed, file));
+    }
+    if HEADER + body.len() > 1 << 24 {
+        // Word indices are written as f32 (exact below 2^24).
+        return Err(Unfit::Words(HEADER + body.len()));
+    }
+    let bytes = (HEADER + body.len()) * 16;
+    if bytes as u64 > max_mib.saturating_mul(1 << 20) {
+        return Err(Unfit::Bytes(bytes, max_mib));
+    }
+    // Every integer is written as the f32 of its value (exact below 2^24), never as its bits:
+    // small integers' bits are subnormal floats, which a driver that flushes subnormals may
+    // turn into zeros when it moves them.
+    let int = |x: u32| (x as f32).to_bits();
+    let mut out = Vec::with_capacity(bytes);
+    for x in starts {
+        out.extend_from_slice(&int(x).to_le_bytes());
+    }
+    for w in &body {
+        let mut fields = [int(w[0]), w[1], w[2], w[3]];
+        for k in 0..3 {
+            let jump = k == 2 && w[0] & 0xff == BLOCK;
+            if w[0] & (0x100 << k) != 0 || jump {
+                fields[k + 1] = int(w[k + 1]);
+            }
+        }
+        for f in fields {
+            out.extend_from_slice(&f.to_le_bytes());
+        }
+    }
+    Ok(out)
+}
+
+/// Instructions interpreted per iteration of the interpreter's loop. Mesa's llvmpipe (and so
+/// lavapipe, on which the tests render) ends every loop of a shader once the loops together
+/// have iterated 65 535 times (`LP_MAX_TGSI_LOOP_ITERATIONS`, shared by all the loops of an
+/// invocation's SIMD group): one instruction an iteration, examples/lattice.sdf ran out of it
+/// and rendered wrong pixels. Eight an iteration lift the bound to about half a million
+/// instructions per pixel and keep the kernel small.
+const UNROLL: usize = 8;
+
+/// The WGSL text of the interpreter and of the distance functions the kernel calls, for a
+/// file of `file` registers; with `media`, also those of glass over solids.
+pub(super) fn write(file: usize, media: bool) -> String {
+    let last = file; // the scratch register
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "// The distance programs, interpreted from `scene_data` (compiler/src/back/wgsl/interp.rs):\n\
+         // one instruction a word (opcode, operands from registers or immediate, destination).\n\
+         var<private> interp_regs: array<f32, {}>;\n\
+         // The values of the last program's RETURN.\n\
+         var<private> interp_result: vec2<f32>;\n\
+         const INTERP_DONE: u32 = 0xffffffffu;\n",
+        file + 1
+    );
+    let _ = writeln!(
+        out,
+        "// Runs the instruction at pc; returns the next one's index, or INTERP_DONE after RETURN.\n\
+         fn interp_step(p: vec3<f32>, pc: u32) -> u32 {{\n    \
+         let w = scene_data[pc];\n    let h = u32(w.x);\n    var a = w.y;\n    \
+         var b = w.z;\n    var c = w.w;\n    \
+         if (h & 0x100u) != 0u {{\n        a = interp_regs[min(u32(w.y), {last}u)];\n    }}\n    \
+         if (h & 0x200u) != 0u {{\n        b = interp_regs[min(u32(w.z), {last}u)];\n    }}\n    \
+         if (h & 0x400u) != 0u {{\n        c = interp_regs[min(u32(w.w), {last}u)];\n    }}\n    \
+         let op = h & 0xffu;\n    \
+         if op == {RETURN}u {{\n        interp_result = vec2<f32>(a, b);\n        return INTERP_DONE;\n    }}\n    \
+         var v = 0.0;\n    var next = pc + 1u;\n    switch op {{"
+    );
+    let case = |out: &mut String, op: u32, body: &str| {
+        let _ = writeln!(
+            out,
+            "        case {op}u: {{\n            {body}\n        }}"
+        );
+    };
+    case(&mut out, INPUT + Axis::X as u32, "v = p.x;");
+    case(&mut out, INPUT + Axis::Y as u32, "v = p.y;");
+    case(&mut out, INPUT + Axis::Z as u32, "v = p.z;");
+    case(&mut out, COPY, "v = a;");
+    // The block runs where !(bound >= best), as map.rs's `if`.
+    case(
+        &mut out,
+        BLOCK,
+        "if a >= b {\n                next = u32(w.w);\n            }",
+    );
+    for (k, u) in UNARIES.iter().enumerate() {
+        let e = match u {
+            Unary::Neg => "-a",
+            Unary::Abs => "abs(a)",
+            Unary::Sqrt => "sqrt(a)",
+            Unary::Sin => "sin(a)",
+            Unary::Cos => "cos(a)",
+            Unary::Acos => "acos(a)",
+            Unary::Exp => "exp(a)",
+            Unary::Log => "log(a)",
+            Unary::Floor => "floor(a)",
+            // ⌊a + 0.5⌋, as map.rs writes it.
+            Unary::Round => "floor(a + 0.5)",
+        };
+        case(&mut out, UNARY + k as u32, &format!("v = {e};"));
+    }
+    for (k, bin) in BINARIES.iter().enumerate() {
+        let e = match bin {
+            Binary::Add => "a + b",
+            Binary::Sub => "a - b",
+            Binary::Mul => "a * b",
+            Binary::Div => "a / b",
+            Binary::Min => "min(a, b)",
+            Binary::Max => "max(a, b)",
+            Binary::Pow => "pow(a, b)",
+            Binary::Atan2 => "atan2(a, b)",
+            Binary::Lt => "select(0.0, 1.0, a < b)",
+        };
+        case(&mut out, BINARY + k as u32, &format!("v = {e};"));
+    }
+    case(&mut out, SELECT, "v = select(c, b, a != 0.0);");
+    let _ = writeln!(
+        out,
+        "        default: {{}}\n    }}\n    interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = v;\n    return next;\n}}\n"
+    );
+    let _ = writeln!(
+        out,
+        "// Runs the program that starts at `start` at p: (distance, material id).\n\
+         fn interpret(p: vec3<f32>, start: u32) -> vec2<f32> {{\n    var pc = start;\n    loop {{"
+    );
+    for _ in 0..UNROLL {
+        out.push_str("        pc = interp_step(p, pc);\n        if pc == INTERP_DONE {\n            break;\n        }\n");
+    }
+    out.push_str("    }\n    return interp_result;\n}\n\n");
+    let entry = |out: &mut String, name: &str, slot: &str, material: bool| {
+        let (ty, tail) = if material {
+            ("vec2<f32>", "")
+        } else {
+            ("f32", ".x")
+        };
+        let _ = writeln!(
+            out,
+            "fn {name}(p: vec3<f32>) -> {ty} {{\n    return interpret(p, u32(scene_data{slot})){tail};\n}}\n"
+        );
+    };
+    out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
+    entry(&mut out, "map", "[0].x", true);
+    out.push_str("// The distance alone, for marching and normals.\n");
+    entry(&mut out, "sdf", "[0].y", false);
+    if media {
+        entry(&mut out, "sdf_medium", "[0].z", false);
+        entry(&mut out, "map_solid", "[0].w", true);
+        entry(&mut out, "sdf_solid", "[1].x", false);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lower::Lowered;
+
+    /// Runs the words as the kernel does, on the CPU, in f32.
+    fn run(words: &[u32], start: u32, p: [f32; 3], file: usize) -> [f32; 2] {
+        let mut regs = vec![0f32; file + 1];
+        let mut pc = start as usize;
+        loop {
+            let w = &words[pc * 4..pc * 4 + 4];
+            let int = |x: u32| f32::from_bits(x) as u32;
+            let h = int(w[0]);
+            let arg = |k: usize| {
+                if h & (0x100 << k) != 0 {
+                    regs[(int(w[k + 1]) as usize).min(file)]
+                } else {
+                    f32::from_bits(w[k + 1])
+                }
+            };
+            let (a, b, c) = (arg(0), arg(1), arg(2));
+            let mut next = pc + 1;
+            let op = h & 0xff;
+            let v = match op {
+                RETURN => return [a, b],
+                1..=3 => p[(op - 1) as usize],
+                COPY => a,
+                BLOCK => {
+                    if a >= b {
+                        next = int(w[3]) as usize;
+                    }
+                    0.0
+                }
+                SELECT => crate::program::scalar::select(a, b, c),
+                o if o >= BINARY => {
+                    crate::program::scalar::binary(BINARIES[(o - BINARY) as usize], a, b)
+                }
+                o => crate::program::scalar::unary(UNARIES[(o - UNARY) as usize], a),
+            };
+            regs[((h >> DEST_SHIFT) as usize).min(file)] = v;
+            pc = next;
+        }
+    }
+
+    #[test]
+    fn encoded_programs_run_as_the_reference() {
+        let text = "material a = phong { color: (1, 0, 0) };\nmaterial b = phong { color: (0, 1, 0) };\n\
+            scene { smooth_union(0.3, sphere(1) @ a, box((0.5, 0.7, 0.4)).rotate_y(20deg).translate(1, 0, 0) @ b);\n\
+            for i in 0..6 { torus(0.4, 0.1).translate(i - 3, 1.5, 0.5 * i) @ b; }\n\
+            plane((0, 1, 0), -1) @ a; }";
+        agrees(text, [4.0; 3]);
+        // Many guarded blocks, nested (examples/lattice.sdf).
+        agrees(
+            include_str!("../../../../examples/lattice.sdf"),
+            [11.0, 0.8, 11.0],
+        );
+    }
+
+    fn agrees(text: &str, extent: [f64; 3]) {
+        let (scene, diags, _) = crate::check::check_str("t.sdf", text);
+        let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+        let lowered = Lowered::new(&scene);
+        let program = &lowered.program;
+        assert!(!program.blocks().is_empty(), "the scene has guarded blocks");
+        let file = 64;
+        let bytes = encode(
+            &Programs {
+                main: program,
+                media: None,
+            },
+            file,
+            128,
+        )
+        .expect("fits");
+        let words: Vec<u32> = bytes
+            .chunks(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        let needed = registers(program);
+        assert!(
+            needed < program.len() / 2,
+            "{needed} registers of {}",
+            program.len()
+        );
+        let mut rng = crate::rng::Rng::new(7);
+        for _ in 0..20_000 {
+            let p = extent.map(|e| rng.range(-e, e) as f32);
+            let regs = program.run::<f32>(p, |_| {});
+            let want = [
+                regs[program.distance().0 as usize],
+                regs[program.material().0 as usize],
+            ];
+            let start = |k: usize| f32::from_bits(words[k]) as u32;
+            let got = run(&words, start(0), p, file);
+            assert_eq!(
+                got.map(f32::to_bits),
+                want.map(f32::to_bits),
+                "map at {p:?}"
+            );
+            let d = run(&words, start(1), p, file);
+            assert_eq!(d[0].to_bits(), want[0].to_bits(), "sdf at {p:?}");
+        }
+        let small = encode(
+            &Programs {
+                main: program,
+                media: None,
+            },
+            needed - 1,
+            128,
+        );
+        assert_eq!(small, Err(Unfit::Registers(needed, needed - 1)));
+    }
+}

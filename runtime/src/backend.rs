@@ -394,9 +394,9 @@ impl Prepared {
             Prepared::Wgpu {
                 gpu, kernel, setup, ..
             } => Self::on_gpu_after(gpu.clone(), scene, &lowered, setup, Some(kernel)),
-            Prepared::Cuda { .. } | Prepared::Several(_) => {
-                Err("CUDA kernels and several devices are prepared again with Prepared::update".into())
-            }
+            Prepared::Cuda { .. } | Prepared::Several(_) => Err(
+                "CUDA kernels and several devices are prepared again with Prepared::update".into(),
+            ),
         }
     }
 
@@ -748,9 +748,8 @@ impl Prepared {
                 }
                 let workers: Vec<&dyn gpu::launch::Worker> =
                     workers.iter().map(|w| w.as_ref()).collect();
-                let r = gpu::render_several(&workers, scene, lipschitz, data, &mut |f| {
-                    progress(f)
-                })?;
+                let r =
+                    gpu::render_several(&workers, scene, lipschitz, data, &mut |f| progress(f))?;
                 Ok(Frame::of(r))
             }
         }

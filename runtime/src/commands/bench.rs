@@ -2,7 +2,7 @@
 //! for GPU targets the achieved fraction of the FP32 floor).
 
 use super::render::{thread_pool, Backend};
-use crate::backend::{Prepared, Setup};
+use crate::backend::{Devices, Prepared, Setup};
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
@@ -22,6 +22,10 @@ pub struct BenchArgs {
     /// Backend to time.
     #[arg(long, value_enum, default_value_t)]
     pub backend: Backend,
+    /// Devices to time (as for `sdfc render`): `auto`, `all`, or a list of GPU indices and
+    /// `cpu`.
+    #[arg(long, value_name = "auto|all|LIST", default_value = "auto", value_parser = Devices::parse)]
+    pub devices: Devices,
     /// Image size, as WIDTHxHEIGHT (default: each scene's own).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -199,7 +203,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
             debug_nan: false,
             parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
         };
-        let mut kernels = Kernels::new(&pool, args.backend, setup);
+        let mut kernels = Kernels::new(&pool, (args.backend, args.devices.clone()), setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
         let mut prepare_before = Duration::ZERO;
         let mut started = Instant::now();
@@ -373,7 +377,7 @@ fn time_scene(
         debug_nan: false,
         parameters: args.constants == Some(Constants::Parameters),
     };
-    let prepared = Prepared::from_program(args.backend, scene, lowered, &setup)?;
+    let prepared = Prepared::on_devices(args.backend, &args.devices, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);
     frame.host = frame

@@ -90,7 +90,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         todo.len()
     );
     let bar = progress(mine.len() as u64, skipped as u64);
-    let mut kernels = Kernels::new(&pool, backend, setup);
+    let mut kernels = Kernels::new(&pool, (backend, args.devices.clone()), setup);
     // The image of a scene that does not read `t`, rendered once.
     let mut still: Option<Image> = None;
     let mut first = Some(first);
@@ -126,11 +126,13 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             None => {
                 let (scene, prepared) = kernels.prepare(frame)?;
                 check_memory(&pool, prepared, &scene, (false, false), &limits, n == 0)?;
-                let image = pool
+                let frame = pool
                     .install(|| prepared.render(&scene, &|_| {}))
-                    .map_err(CliError::Failed)?
-                    .render
-                    .image;
+                    .map_err(CliError::Failed)?;
+                for w in frame.warnings() {
+                    eprintln!("warning: frame {k}: {w}");
+                }
+                let image = frame.render.image;
                 if !animation.animated() {
                     still = Some(image.clone());
                 }
@@ -239,6 +241,7 @@ fn progress(len: u64, done: u64) -> Option<ProgressBar> {
 pub struct Kernels<'a> {
     pool: &'a rayon::ThreadPool,
     backend: crate::backend::Backend,
+    devices: crate::backend::Devices,
     setup: Setup,
     /// The last frame's program and scene origin, and the backend prepared for them.
     prepared: Option<(Program, [f64; 3], Prepared)>,
@@ -257,15 +260,16 @@ impl std::fmt::Debug for Kernels<'_> {
 }
 
 impl<'a> Kernels<'a> {
-    /// No kernel yet.
+    /// No kernel yet: the frames will render with `backend` on `devices`.
     pub fn new(
         pool: &'a rayon::ThreadPool,
-        backend: crate::backend::Backend,
+        (backend, devices): (crate::backend::Backend, crate::backend::Devices),
         setup: Setup,
     ) -> Self {
         Kernels {
             pool,
             backend,
+            devices,
             setup,
             prepared: None,
             count: 0,
@@ -304,7 +308,8 @@ impl<'a> Kernels<'a> {
             }
             None => {
                 let program = frame.lowered.program.clone();
-                let (scene, prepared) = prepare(self.pool, self.backend, frame, &self.setup)?;
+                let (scene, prepared) =
+                    prepare(self.pool, (self.backend, &self.devices), frame, &self.setup)?;
                 self.count += 1;
                 self.prepared = Some((program, scene.origin, prepared));
                 scene

@@ -278,7 +278,11 @@ impl launch::Device for Kernel<'_> {
     fn prepare(&self, job: &Job) -> Result<FrameBuffers, Error> {
         let s = &self.cuda.stream;
         let pixels = job.width as usize * job.height as usize;
-        let table: Vec<u32> = job.tiles.iter().flat_map(|t| [t.0, t.1, t.2, t.3]).collect();
+        let table: Vec<u32> = job
+            .tiles
+            .iter()
+            .flat_map(|t| [t.0, t.1, t.2, t.3])
+            .collect();
         let uniforms = s
             .clone_htod(job.uniforms)
             .map_err(driver("uploading the scene"))?;
@@ -372,7 +376,9 @@ impl launch::Device for Kernel<'_> {
         let whole = ranges.len() == 1 && ranges[0] == (0..job.width as usize * job.height as usize);
         let words = STATS_WORDS as usize;
         let (image, stats) = if whole {
-            let image = s.clone_dtoh(&f.image).map_err(driver("reading the image"))?;
+            let image = s
+                .clone_dtoh(&f.image)
+                .map_err(driver("reading the image"))?;
             let stats = s
                 .clone_dtoh(&f.stats)
                 .map_err(driver("reading the statistics"))?;

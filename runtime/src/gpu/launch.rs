@@ -77,8 +77,7 @@ pub trait Device: Sync {
     /// Allocates a frame's buffers and uploads the uniforms, the scene data and the tile table.
     fn prepare(&self, job: &Job) -> Result<Self::Frame, Self::Error>;
     /// Runs the tiles `tiles` (indices into the job's table) and waits until they are done.
-    fn run(&self, frame: &mut Self::Frame, job: &Job, tiles: &[usize])
-        -> Result<(), Self::Error>;
+    fn run(&self, frame: &mut Self::Frame, job: &Job, tiles: &[usize]) -> Result<(), Self::Error>;
     /// Reads back the pixels of `ranges` (row-major pixel indices), one after the other.
     fn read(
         &self,

@@ -2,11 +2,11 @@
 //! image in tiles (one dispatch each, so that no dispatch runs long enough to trip a driver
 //! watchdog), reading back the linear colours and the per-pixel statistics.
 
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
 use super::launch::{self, Job, Pixels};
 use sdfc_compiler::back::wgsl::STATS_WORDS;
+use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// What can go wrong on the wgpu path.
@@ -537,18 +537,25 @@ impl launch::Device for Kernel<'_> {
         for &i in tiles {
             let t = job.tiles[i];
             let i = i as u32;
-            let writes = f.queries.as_ref().map(|q| wgpu::ComputePassTimestampWrites {
-                query_set: q,
-                beginning_of_pass_write_index: Some(2 * i),
-                end_of_pass_write_index: Some(2 * i + 1),
-            });
+            let writes = f
+                .queries
+                .as_ref()
+                .map(|q| wgpu::ComputePassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(2 * i),
+                    end_of_pass_write_index: Some(2 * i + 1),
+                });
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: None,
                 timestamp_writes: writes,
             });
             pass.set_pipeline(&f.pipeline.0);
             pass.set_bind_group(0, &f.bind, &[i * TILE_STRIDE]);
-            pass.dispatch_workgroups(t.2.div_ceil(self.workgroup), t.3.div_ceil(self.workgroup), 1);
+            pass.dispatch_workgroups(
+                t.2.div_ceil(self.workgroup),
+                t.3.div_ceil(self.workgroup),
+                1,
+            );
         }
         gpu.queue.submit([enc.finish()]);
         gpu.wait()

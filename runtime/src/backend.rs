@@ -118,6 +118,25 @@ impl Devices {
             .collect::<Result<Vec<_>, _>>()
             .map(Devices::List)
     }
+
+    /// `Err` naming the first entry `backend` cannot render on (a GPU with `--backend cpu`).
+    pub fn check(&self, backend: Backend) -> Result<(), String> {
+        match self {
+            Devices::List(list) if backend == Backend::Cpu => match list.iter().find_map(|d| match d {
+                Device::Gpu(i) => Some(i),
+                Device::Cpu => None,
+            }) {
+                Some(i) => Err(format!(
+                    "--devices entry `{i}` names a GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)"
+                )),
+                None => Ok(()),
+            },
+            Devices::All if backend == Backend::Cpu => Err(
+                "--devices all names every GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)".into(),
+            ),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// A kernel loaded on a CUDA device, with what its launches need and the WGSL text it was
@@ -283,7 +302,7 @@ impl Prepared {
             Backend::Auto if Cuda::count() > 0 => Ok(Backend::Cuda),
             Backend::Auto => Ok(Backend::Wgpu),
             Backend::Cpu => Err(
-                "--backend cpu renders on the CPU alone: --devices names GPUs (`cpu` alone, or with --backend auto, wgpu or cuda)".into(),
+                "--devices names GPUs, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)".into(),
             ),
         }
     }

@@ -397,6 +397,7 @@ fn output(args: &RenderArgs) -> Result<Output, String> {
 
 /// The backend and precision of a render: `--reference` means the CPU in f64.
 pub fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
+    args.devices.check(args.backend)?;
     if !args.reference {
         return Ok((args.backend, args.precision));
     }

@@ -120,7 +120,9 @@ impl Cuda {
         if ordinal >= count as usize {
             return Err(Error::Driver {
                 during: "opening the device",
-                message: format!("there is no CUDA device {ordinal} (the driver found {count})"),
+                message: format!(
+                    "there is no CUDA device {ordinal} (the driver found {count}; `sdfc devices` lists them)"
+                ),
             });
         }
         let ctx = CudaContext::new(ordinal).map_err(driver("creating a context"))?;

@@ -18,6 +18,9 @@ pub enum Error {
         /// "GPU" or "wgpu".
         what: &'static str,
     },
+    /// `--devices` named an adapter wgpu did not find.
+    #[error("there is no wgpu adapter {index} (wgpu found {count}; `sdfc devices` lists them)")]
+    NoSuchAdapter { index: usize, count: usize },
     /// The adapter refused the device request.
     #[error("the adapter `{adapter}` refused to open a device: {message}")]
     Device { adapter: String, message: String },
@@ -121,10 +124,7 @@ impl Gpu {
         let count = adapters.len();
         match adapters.into_iter().nth(index) {
             Some(a) => Self::from_adapter(&a),
-            None => Err(Error::Device {
-                adapter: format!("#{index}"),
-                message: format!("there is no wgpu adapter {index} (wgpu found {count})"),
-            }),
+            None => Err(Error::NoSuchAdapter { index, count }),
         }
     }
 

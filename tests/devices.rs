@@ -74,10 +74,10 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
         let kb = b.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
         let workers: [&dyn Worker; 2] = [&ka, &kb];
         let mut calls = 0;
-        let two = gpu::render_several(&workers, &scene, l, kernel.data.as_deref(), &mut |_| {
-            calls += 1
-        })
-        .expect("two devices");
+        let none = gpu::launch::Faults::default();
+        let data = kernel.data.as_deref();
+        let two = gpu::render_several(&workers, &scene, (l, data), &none, &mut |_| calls += 1)
+            .expect("two devices");
         let name = path.display();
         assert!(
             bits(&one.render.image) == bits(&two.render.image),
@@ -110,9 +110,14 @@ fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
         let on_cpu = gpu::cpu::Device::new(&scene, &tapes, &options);
         let ka = a.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
         let workers: [&dyn Worker; 2] = [&on_cpu, &ka];
-        let mixed = gpu::render_several(&workers, &scene, l, kernel.data.as_deref(), &mut |_| {})
+        let none = gpu::launch::Faults::default();
+        let data = kernel.data.as_deref();
+        let mixed = gpu::render_several(&workers, &scene, (l, data), &none, &mut |_| {})
             .expect("cpu and lavapipe");
-        assert!(mixed.shares.iter().all(|s| s.tiles > 0), "{name}: both rendered");
+        assert!(
+            mixed.shares.iter().all(|s| s.tiles > 0),
+            "{name}: both rendered"
+        );
         let d = metrics::compare(&one.render.image, &mixed.render.image, 0.1).expect("same size");
         println!(
             "{name}: cpu + lavapipe against lavapipe: {:.1} dB, {:.4} differing",
@@ -138,7 +143,9 @@ fn dir(name: &str) -> PathBuf {
 
 fn sdfc(cwd: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_sdfc"));
-    c.current_dir(cwd).args(args).env_remove("SDFC_FAULT_AFTER_TILES");
+    c.current_dir(cwd)
+        .args(args)
+        .env_remove("SDFC_FAULT_AFTER_TILES");
     // Mesa's window-system code complains on stderr without it.
     c.env("XDG_RUNTIME_DIR", cwd);
     for (k, v) in env {
@@ -245,7 +252,10 @@ fn the_cpu_and_lavapipe_render_together_from_the_command_line() {
     let out = sdfc(&d, &args, &[]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{out:?}");
-    assert!(text.contains("backend         mixed (2 devices: CPU, "), "{text}");
+    assert!(
+        text.contains("backend         mixed (2 devices: CPU, "),
+        "{text}"
+    );
     assert!(text.contains("device 0        CPU, "), "{text}");
     assert!(text.contains("device 1        "), "{text}");
     let compare = sdfc(&d, &["compare", "one.png", "mixed.png", "--json"], &[]);
@@ -253,6 +263,75 @@ fn the_cpu_and_lavapipe_render_together_from_the_command_line() {
     let v: serde_json::Value = serde_json::from_str(&json).expect("json");
     let psnr = v["psnr"].as_f64().expect("psnr");
     assert!(psnr > 40.0, "{json}");
+}
+
+fn sequence(d: &Path, devices: &str, pattern: &str, env: &[(&str, &str)]) -> Output {
+    let orbit = std::fs::canonicalize("../examples/animation/orbit.sdf")
+        .expect("orbit")
+        .display()
+        .to_string();
+    let args = [
+        "render",
+        &orbit,
+        "--backend",
+        "wgpu",
+        "--devices",
+        devices,
+        "--size",
+        "96x64",
+        "--frames",
+        "0..6",
+        "-o",
+        pattern,
+    ];
+    sdfc(d, &args, env)
+}
+
+#[test]
+fn the_frames_of_a_sequence_go_to_the_devices_and_survive_one_failing() {
+    if !wgpu_here() {
+        return;
+    }
+    let d = dir("frames");
+    let one = sequence(&d, "0", "one/f_##.png", &[]);
+    assert!(one.status.success(), "{one:?}");
+    let same = |dir: &str| {
+        for k in 0..6 {
+            let a = std::fs::read(d.join(format!("one/f_{k:02}.png"))).expect("frame");
+            let b = std::fs::read(d.join(format!("{dir}/f_{k:02}.png"))).expect("frame");
+            assert!(a == b, "{dir}: frame {k} differs");
+        }
+    };
+    let two = sequence(&d, "0,0", "two/f_##.png", &[]);
+    let err = String::from_utf8_lossy(&two.stderr);
+    assert!(two.status.success(), "{err}");
+    assert!(err.contains("(2 devices: wgpu on "), "{err}");
+    same("two");
+    // The second device fails on its first frame (it opens its device after taking one,
+    // while the first is still opening its own); the first renders every frame.
+    let out = sequence(
+        &d,
+        "0,0",
+        "back/f_##.png",
+        &[("SDFC_FAULT_AFTER_TILES", "1:0")],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning: device 1 failed: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=1:0 (a testing aid); the other devices render its frame"), "{err}");
+    same("back");
+    // Every device fails at its second frame: two frames are written, then the error.
+    let out = sequence(
+        &d,
+        "0,0",
+        "none/f_##.png",
+        &[("SDFC_FAULT_AFTER_TILES", "1")],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("error: every device failed (2 of 6 frames written): device "),
+        "{err}"
+    );
 }
 
 #[test]
@@ -322,12 +401,17 @@ fn devices_lists_the_adapters_and_the_cpu() {
     let adapter = gpu::Gpu::open(false).expect("adapter").describe();
     let name = adapter.split(" (").next().unwrap_or_default().to_string();
     assert!(
-        text.lines()
-            .any(|l| l.starts_with("wgpu 0: ") && l.contains(&name) && l.contains("largest buffer")),
+        text.lines().any(|l| l.starts_with("wgpu 0: ")
+            && l.contains(&name)
+            && l.contains("largest buffer")),
         "{text}"
     );
     assert!(text.lines().any(|l| l.starts_with("cuda")), "{text}");
-    assert!(text.lines().any(|l| l.starts_with("cpu: the CPU renderer, ")), "{text}");
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("cpu: the CPU renderer, ")),
+        "{text}"
+    );
 }
 
 #[test]
@@ -338,14 +422,27 @@ fn bad_devices_are_named_in_the_error() {
         ("0,x", "wgpu", 2, "bad --devices entry `x`"),
         ("0,,1", "wgpu", 2, "bad --devices entry ``"),
         ("gpu", "auto", 2, "bad --devices entry `gpu`"),
-        ("cpu,0", "cpu", 2, "--devices entry `0` names a GPU, but --backend cpu"),
+        (
+            "cpu,0",
+            "cpu",
+            2,
+            "--devices entry `0` names a GPU, but --backend cpu",
+        ),
         ("0,99", "wgpu", 1, "there is no wgpu adapter 99"),
     ] {
         let out = sdfc(
             &d,
             &[
-                "render", &scene, "--backend", backend, "--devices", devices, "--size", "8x8",
-                "-o", "x.png",
+                "render",
+                &scene,
+                "--backend",
+                backend,
+                "--devices",
+                devices,
+                "--size",
+                "8x8",
+                "-o",
+                "x.png",
             ],
             &[],
         );
@@ -356,7 +453,15 @@ fn bad_devices_are_named_in_the_error() {
     }
     let out = sdfc(
         &d,
-        &["render", &scene, "--reference", "--devices", "0,0", "-o", "x.png"],
+        &[
+            "render",
+            &scene,
+            "--reference",
+            "--devices",
+            "0,0",
+            "-o",
+            "x.png",
+        ],
         &[],
     );
     let err = String::from_utf8_lossy(&out.stderr);

@@ -119,6 +119,26 @@ impl Devices {
             .map(Devices::List)
     }
 
+    /// The devices of `backend` these name; `None` for `auto` (the one device the backend
+    /// picks).
+    pub fn resolve(&self, backend: Backend) -> Result<Option<Vec<Device>>, String> {
+        let list: Vec<Device> = match self {
+            Devices::Auto => return Ok(None),
+            Devices::All => match Prepared::gpu_kind(backend)? {
+                Backend::Cuda => (0..Cuda::count()).map(Device::Gpu).collect(),
+                _ => (0..gpu::wgpu::adapters().len()).map(Device::Gpu).collect(),
+            },
+            Devices::List(list) => list.clone(),
+        };
+        if list.is_empty() {
+            return Err(format!(
+                "--devices all found no {} device",
+                format!("{:?}", Prepared::gpu_kind(backend)?).to_lowercase()
+            ));
+        }
+        Ok(Some(list))
+    }
+
     /// `Err` naming the first entry `backend` cannot render on (a GPU with `--backend cpu`).
     pub fn check(&self, backend: Backend) -> Result<(), String> {
         match self {
@@ -245,31 +265,20 @@ impl Prepared {
         lowered: Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        let list = match devices {
-            Devices::Auto => return Self::from_program(backend, scene, lowered, setup),
-            Devices::All => match Self::gpu_kind(backend)? {
-                Backend::Cuda => (0..Cuda::count()).map(Device::Gpu).collect(),
-                _ => (0..gpu::wgpu::adapters().len()).map(Device::Gpu).collect(),
-            },
-            Devices::List(list) => list.clone(),
+        let Some(list) = devices.resolve(backend)? else {
+            return Self::from_program(backend, scene, lowered, setup);
         };
-        if list.is_empty() {
-            return Err(format!(
-                "--devices found no {} device",
-                format!("{:?}", Self::gpu_kind(backend)?).to_lowercase()
-            ));
-        }
         traceable_with(scene, &lowered.traceable)?;
         let mut parts = Vec::with_capacity(list.len());
-        for (n, d) in list.iter().enumerate() {
+        for d in &list {
             let part = match *d {
                 Device::Cpu => Self::cpu(lowered.clone(), setup),
                 Device::Gpu(i) => {
-                    // The same index again: a second logical device on the same GPU.
-                    let again = list[..n].contains(d);
                     match Self::gpu_kind(backend)? {
                         Backend::Cuda => {
-                            let cuda = Cuda::open_device(i, again).map_err(|e| e.to_string())?;
+                            // On a stream of its own: the same index twice is two logical
+                            // devices on one GPU, running side by side.
+                            let cuda = Cuda::open_device(i, true).map_err(|e| e.to_string())?;
                             let module = Self::cuda_module(&cuda, scene, &lowered, setup)?;
                             Prepared::Cuda {
                                 cuda: Box::new(cuda),
@@ -679,8 +688,19 @@ impl Prepared {
         }
     }
 
-    /// Renders one frame; `progress` gets the fraction done.
+    /// Renders one frame; `progress` gets the fraction done. The faults of the testing aid
+    /// `SDFC_FAULT_AFTER_TILES` are injected.
     pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, String> {
+        self.render_faults(scene, progress, &gpu::launch::Faults::from_env())
+    }
+
+    /// [`Prepared::render`] with the faults `faults` injected.
+    pub fn render_faults(
+        &self,
+        scene: &Scene,
+        progress: &(dyn Fn(f64) + Sync),
+        faults: &gpu::launch::Faults,
+    ) -> Result<Frame, String> {
         self.check_specialisation(scene)?;
         match self {
             Prepared::Cpu { tapes, options, .. } => {
@@ -706,8 +726,10 @@ impl Prepared {
                 lipschitz,
                 ..
             } => {
-                let r = gpu::render(gpu, scene, kernel, *lipschitz, &mut |f| progress(f))
-                    .map_err(|e| e.to_string())?;
+                let r = gpu::render_faults(gpu, scene, kernel, *lipschitz, faults, &mut |f| {
+                    progress(f)
+                })
+                .map_err(|e| e.to_string())?;
                 Ok(Frame::of(r))
             }
             Prepared::Cuda {
@@ -719,9 +741,9 @@ impl Prepared {
                 let r = gpu::render_cuda(
                     cuda,
                     scene,
-                    &module.loaded,
-                    module.data.as_deref(),
+                    (&module.loaded, module.data.as_deref()),
                     *lipschitz,
+                    faults,
                     &mut |f| progress(f),
                 )
                 .map_err(|e| e.to_string())?;
@@ -768,7 +790,9 @@ impl Prepared {
                 let workers: Vec<&dyn gpu::launch::Worker> =
                     workers.iter().map(|w| w.as_ref()).collect();
                 let r =
-                    gpu::render_several(&workers, scene, lipschitz, data, &mut |f| progress(f))?;
+                    gpu::render_several(&workers, scene, (lipschitz, data), faults, &mut |f| {
+                        progress(f)
+                    })?;
                 Ok(Frame::of(r))
             }
         }

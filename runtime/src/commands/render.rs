@@ -146,7 +146,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
 }
 
 /// A scene checked at one time, with its settings overridden by the arguments, and lowered.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct FrameScene {
     /// The scene, settings applied.
     pub scene: Scene,

@@ -168,14 +168,19 @@ impl Faults {
 
     /// The message of the device error injected at the device's tile `tile` (0-based), if
     /// one is.
-    fn injected(&self, position: usize, tile: usize) -> Option<String> {
-        (self.after(position) == Some(tile)).then(|| {
-            format!(
-                "device error injected at tile {} by {FAULT_AFTER_TILES}={} (a testing aid)",
-                tile + 1,
-                self.text
-            )
-        })
+    pub fn injected(&self, position: usize, tile: usize) -> Option<String> {
+        self.injected_within(position, tile..tile + 1)
+    }
+
+    /// The message of the device error injected at one of the device's tiles `tiles`
+    /// (0-based, counted over every frame it rendered), if one is.
+    pub fn injected_within(&self, position: usize, tiles: Range<usize>) -> Option<String> {
+        let tile = self.after(position).filter(|t| tiles.contains(t))?;
+        Some(format!(
+            "device error injected at tile {} by {FAULT_AFTER_TILES}={} (a testing aid)",
+            tile + 1,
+            self.text
+        ))
     }
 }
 
@@ -253,60 +258,113 @@ pub fn render_one<D: Device>(
 pub trait Worker: Sync {
     /// The device, for messages.
     fn name(&self) -> String;
-    /// Takes bands from `queue` until it is empty, sending each finished band's pixels.
-    fn work(&self, queue: &Queue, position: usize) -> Share;
+    /// Takes bands from `bands` until none is left, sending each finished band's pixels.
+    fn work(&self, bands: &Bands, position: usize) -> Share;
 }
 
-/// A finished band and its pixels.
-type Event = (usize, Pixels);
-
-/// The bands of a frame waiting for a device, and what the workers share.
+/// Work waiting for whichever worker is free: the bands of a frame, or the frames of a
+/// sequence (`sdfc render --frames` on several devices). A worker that fails hands its item
+/// back, and the others take it.
 #[derive(Debug)]
-pub struct Queue<'a> {
-    job: &'a Job<'a>,
-    faults: &'a Faults,
-    state: Mutex<State>,
+pub struct Queue<T> {
+    state: Mutex<State<T>>,
     changed: Condvar,
-    events: mpsc::Sender<Event>,
 }
 
 #[derive(Debug)]
-struct State {
-    waiting: VecDeque<usize>,
-    /// Bands taken by a device and not yet finished or handed back.
+struct State<T> {
+    waiting: VecDeque<T>,
+    /// Items taken by a worker and not yet finished or handed back.
     taken: usize,
+    /// Whether more items may still be pushed.
+    open: bool,
 }
 
-impl Queue<'_> {
-    /// The next band, waiting while another device may still hand one back; `None` when
-    /// every band is done.
-    fn take(&self) -> Option<usize> {
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+impl<T> Queue<T> {
+    /// A queue of `items`; with `open`, more may be [pushed](Queue::push) until
+    /// [`Queue::close`].
+    pub fn new(items: impl IntoIterator<Item = T>, open: bool) -> Self {
+        Queue {
+            state: Mutex::new(State {
+                waiting: items.into_iter().collect(),
+                taken: 0,
+                open,
+            }),
+            changed: Condvar::new(),
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, State<T>> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Adds an item at the back.
+    pub fn push(&self, item: T) {
+        self.lock().waiting.push_back(item);
+        self.changed.notify_all();
+    }
+
+    /// No more items will be pushed.
+    pub fn close(&self) {
+        self.lock().open = false;
+        self.changed.notify_all();
+    }
+
+    /// Items waiting for a worker.
+    pub fn waiting(&self) -> usize {
+        self.lock().waiting.len()
+    }
+
+    /// The next item, waiting while one may still come (pushed, or handed back by another
+    /// worker); `None` when every item is done.
+    pub fn take(&self) -> Option<T> {
+        let mut s = self.lock();
         loop {
-            if let Some(i) = s.waiting.pop_front() {
+            if let Some(item) = s.waiting.pop_front() {
                 s.taken += 1;
-                return Some(i);
+                return Some(item);
             }
-            if s.taken == 0 {
+            if s.taken == 0 && !s.open {
                 return None;
             }
             s = self.changed.wait(s).unwrap_or_else(|e| e.into_inner());
         }
     }
 
-    fn done(&self, band: usize, pixels: Pixels) {
-        let _ = self.events.send((band, pixels));
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        s.taken -= 1;
+    /// No more items will be pushed, and those waiting are dropped: the workers end after
+    /// the items they hold.
+    pub fn abandon(&self) {
+        let mut s = self.lock();
+        s.open = false;
+        s.waiting.clear();
+        drop(s);
         self.changed.notify_all();
     }
 
-    fn hand_back(&self, band: usize) {
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        s.taken -= 1;
-        s.waiting.push_front(band);
+    /// A taken item is finished.
+    pub fn done(&self) {
+        self.lock().taken -= 1;
         self.changed.notify_all();
     }
+
+    /// A taken item goes back to the front, for another worker.
+    pub fn hand_back(&self, item: T) {
+        let mut s = self.lock();
+        s.taken -= 1;
+        s.waiting.push_front(item);
+        drop(s);
+        self.changed.notify_all();
+    }
+}
+
+/// The bands of a frame on several devices: the job, the queue of band indices, where
+/// finished bands go, and the faults to inject.
+#[derive(Debug)]
+pub struct Bands<'a> {
+    job: &'a Job<'a>,
+    faults: &'a Faults,
+    queue: Queue<usize>,
+    events: mpsc::Sender<(usize, Pixels)>,
 }
 
 impl<D: Device> Worker for D {
@@ -314,8 +372,9 @@ impl<D: Device> Worker for D {
         self.describe()
     }
 
-    fn work(&self, queue: &Queue, position: usize) -> Share {
-        let job = queue.job;
+    fn work(&self, bands: &Bands, position: usize) -> Share {
+        let job = bands.job;
+        let queue = &bands.queue;
         let mut share = Share {
             device: self.describe(),
             tiles: 0,
@@ -333,7 +392,7 @@ impl<D: Device> Worker for D {
         share.phases.setup = setup.elapsed();
         while let Some(band) = queue.take() {
             let launch = Instant::now();
-            let ran = match queue.faults.injected(position, share.tiles) {
+            let ran = match bands.faults.injected(position, share.tiles) {
                 Some(msg) => Err(self.fault(msg)),
                 None => self.run(&mut frame, job, &[band]),
             };
@@ -344,7 +403,8 @@ impl<D: Device> Worker for D {
                     share.phases.readback += read.elapsed().saturating_sub(pixels.convert);
                     share.phases.convert += pixels.convert;
                     share.tiles += 1;
-                    queue.done(band, pixels);
+                    let _ = bands.events.send((band, pixels));
+                    queue.done();
                 }
                 Err(e) => {
                     queue.hand_back(band);
@@ -371,14 +431,10 @@ pub fn render_several(
 ) -> Result<Output, String> {
     let start = Instant::now();
     let (tx, rx) = mpsc::channel();
-    let queue = Queue {
+    let bands = Bands {
         job,
         faults,
-        state: Mutex::new(State {
-            waiting: (0..job.tiles.len()).collect(),
-            taken: 0,
-        }),
-        changed: Condvar::new(),
+        queue: Queue::new(0..job.tiles.len(), false),
         events: tx,
     };
     let pixels = job.pixels();
@@ -388,15 +444,14 @@ pub fn render_several(
     let mut assembly = Duration::ZERO;
     let mut done = 0usize;
     let shares = std::thread::scope(|scope| {
-        let queue = &queue;
+        let bands = &bands;
         let handles: Vec<_> = devices
             .iter()
             .enumerate()
-            .map(|(i, d)| (i, scope.spawn(move || d.work(queue, i))))
+            .map(|(i, d)| (i, scope.spawn(move || d.work(bands, i))))
             .collect();
         // The calling thread assembles the bands as they come.
-        let mut receive = |event: Event| {
-            let (band, p) = event;
+        let mut receive = |(band, p): (usize, Pixels)| {
             let t = Instant::now();
             let range = job.band(band);
             linear[range.clone()].copy_from_slice(&p.linear);

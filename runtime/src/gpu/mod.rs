@@ -72,7 +72,8 @@ impl std::fmt::Display for Phases {
     }
 }
 
-/// Renders `scene` with an already generated kernel on `gpu`.
+/// Renders `scene` with an already generated kernel on `gpu` (with the faults of
+/// [`FAULT_AFTER_TILES`] injected).
 pub fn render(
     gpu: &Gpu,
     scene: &Scene,
@@ -80,24 +81,50 @@ pub fn render(
     lipschitz: f64,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, Error> {
+    render_faults(
+        gpu,
+        scene,
+        kernel,
+        lipschitz,
+        &launch::Faults::from_env(),
+        progress,
+    )
+}
+
+/// [`render`] with the faults `faults` injected.
+pub fn render_faults(
+    gpu: &Gpu,
+    scene: &Scene,
+    kernel: &Kernel,
+    lipschitz: f64,
+    faults: &launch::Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<GpuRender, Error> {
     let uniforms = wgsl::uniforms(scene, lipschitz);
     let device = gpu.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
-    render_one(&device, scene, &uniforms, kernel.data.as_deref(), progress)
+    render_one(
+        &device,
+        scene,
+        &uniforms,
+        kernel.data.as_deref(),
+        faults,
+        progress,
+    )
 }
 
 /// Renders `scene` with a kernel already loaded on a CUDA device; `data` is the kernel's
-/// scene data ([`Kernel::data`]).
+/// scene data ([`Kernel::data`]); `faults` are injected.
 pub fn render_cuda(
     cuda: &cuda::Cuda,
     scene: &Scene,
-    loaded: &cuda::Loaded,
-    data: Option<&[u8]>,
+    (loaded, data): (&cuda::Loaded, Option<&[u8]>),
     lipschitz: f64,
+    faults: &launch::Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, cuda::Error> {
     let uniforms = wgsl::uniforms(scene, lipschitz);
     let device = cuda.kernel(loaded, wgsl::WORKGROUP);
-    render_one(&device, scene, &uniforms, data, progress)
+    render_one(&device, scene, &uniforms, data, faults, progress)
 }
 
 /// Renders `scene` on one device, in squares of [`TILE`] pixels.
@@ -106,6 +133,7 @@ fn render_one<D: launch::Device>(
     scene: &Scene,
     uniforms: &[u8],
     data: Option<&[u8]>,
+    faults: &launch::Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, D::Error> {
     let s = &scene.settings;
@@ -118,7 +146,7 @@ fn render_one<D: launch::Device>(
         tiles: &tiles,
         timed: true,
     };
-    let out = launch::render_one(device, &job, &launch::Faults::from_env(), progress)?;
+    let out = launch::render_one(device, &job, faults, progress)?;
     Ok(finish(out, s))
 }
 
@@ -128,8 +156,8 @@ fn render_one<D: launch::Device>(
 pub fn render_several(
     devices: &[&dyn launch::Worker],
     scene: &Scene,
-    lipschitz: f64,
-    data: Option<&[u8]>,
+    (lipschitz, data): (f64, Option<&[u8]>),
+    faults: &launch::Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, String> {
     let s = &scene.settings;
@@ -143,7 +171,7 @@ pub fn render_several(
         tiles: &tiles,
         timed: false,
     };
-    let out = launch::render_several(devices, &job, &launch::Faults::from_env(), progress)?;
+    let out = launch::render_several(devices, &job, faults, progress)?;
     Ok(finish(out, s))
 }
 

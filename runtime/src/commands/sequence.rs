@@ -233,8 +233,16 @@ struct Pending {
 
 /// What a device's worker reports.
 enum Report {
-    /// Frame `k` rendered in `seconds`.
-    Frame { k: u64, image: Image, seconds: f64 },
+        /// Frame `k` rendered in `seconds`; its image, unless the worker wrote it (numbered
+    /// files are written by the workers, side by side; an animated PNG or a video takes the
+    /// frames in order).
+    Frame {
+        k: u64,
+        image: Option<Image>,
+        seconds: f64,
+    },
+    /// The frame could not be written.
+    Unwritten(String),
     /// The device failed on a frame, which it handed back.
     Failed { position: usize, message: String },
     /// The worker ended after preparing `kernels` kernels on `device`.
@@ -262,14 +270,18 @@ impl FramesOn<'_> {
         checker: &mut Checker,
         sink: &mut Sink,
     ) -> Result<(usize, Option<String>), CliError> {
-        let queue = Queue::new(std::iter::empty(), true);
+                let queue = Queue::new(std::iter::empty(), true);
+        let numbered = match &*sink {
+            Sink::Numbered(pattern, format) => Some((pattern.clone(), *format)),
+            _ => None,
+        };
         let (tx, rx) = std::sync::mpsc::channel();
         // Frames checked ahead of the devices: enough to keep each busy.
         let ahead = 2 * devices.len();
         std::thread::scope(|scope| {
             for (position, &device) in devices.iter().enumerate() {
-                let (queue, tx) = (&queue, tx.clone());
-                scope.spawn(move || self.work(position, device, queue, tx));
+                                let (queue, tx, numbered) = (&queue, tx.clone(), numbered.as_ref());
+                scope.spawn(move || self.work((position, device), queue, numbered, tx));
             }
             drop(tx);
             let mut ready = std::collections::BTreeMap::new();
@@ -282,8 +294,9 @@ impl FramesOn<'_> {
                 |report: Report, sink: &mut Sink, checker: &Checker| -> Result<(), CliError> {
                     match report {
                         Report::Frame { k, image, seconds } => {
-                            ready.insert(k, (image, seconds));
-                        }
+                        ready.insert(k, (image, seconds));
+                    }
+                    Report::Unwritten(message) => return Err(CliError::Usage(message)),
                         Report::Failed { position, message } => {
                             alive -= 1;
                             eprintln!(
@@ -303,7 +316,9 @@ impl FramesOn<'_> {
                     }
                     while let Some((image, seconds)) = todo.get(next).and_then(|k| ready.remove(k))
                     {
-                        sink.write(todo[next], &image)?;
+                                                if let Some(image) = image {
+                            sink.write(todo[next], &image)?;
+                        }
                         checker.written(todo[next], sink, seconds);
                         next += 1;
                     }
@@ -359,11 +374,11 @@ impl FramesOn<'_> {
     /// One device's worker: takes frames until none is left, or until the device fails (its
     /// frame then goes back to the queue). `SDFC_FAULT_AFTER_TILES` counts the device's tiles
     /// over every frame it rendered.
-    fn work(
+        fn work(
         &self,
-        position: usize,
-        device: crate::backend::Device,
+        (position, device): (usize, crate::backend::Device),
         queue: &Queue<Pending>,
+        numbered: Option<&(crate::sequence::Pattern, crate::output::Format)>,
         tx: std::sync::mpsc::Sender<Report>,
     ) {
         let list = crate::backend::Devices::List(vec![device]);
@@ -398,7 +413,20 @@ impl FramesOn<'_> {
                     .map_err(CliError::Failed)
             })();
             match rendered {
-                Ok(image) => {
+                                Ok(image) => {
+                    let image = match numbered {
+                        Some((pattern, format)) => {
+                            let file = Output::File {
+                                path: pattern.path(k),
+                                format: *format,
+                            };
+                            if let Err(e) = file.write(&image) {
+                                let _ = tx.send(Report::Unwritten(e));
+                            }
+                            None
+                        }
+                        None => Some(image),
+                    };
                     let seconds = started.elapsed().as_secs_f64();
                     let _ = tx.send(Report::Frame { k, image, seconds });
                     queue.done();

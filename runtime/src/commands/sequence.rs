@@ -233,7 +233,7 @@ struct Pending {
 
 /// What a device's worker reports.
 enum Report {
-        /// Frame `k` rendered in `seconds`; its image, unless the worker wrote it (numbered
+    /// Frame `k` rendered in `seconds`; its image, unless the worker wrote it (numbered
     /// files are written by the workers, side by side; an animated PNG or a video takes the
     /// frames in order).
     Frame {
@@ -270,7 +270,7 @@ impl FramesOn<'_> {
         checker: &mut Checker,
         sink: &mut Sink,
     ) -> Result<(usize, Option<String>), CliError> {
-                let queue = Queue::new(std::iter::empty(), true);
+        let queue = Queue::new(std::iter::empty(), true);
         let numbered = match &*sink {
             Sink::Numbered(pattern, format) => Some((pattern.clone(), *format)),
             _ => None,
@@ -280,7 +280,7 @@ impl FramesOn<'_> {
         let ahead = 2 * devices.len();
         std::thread::scope(|scope| {
             for (position, &device) in devices.iter().enumerate() {
-                                let (queue, tx, numbered) = (&queue, tx.clone(), numbered.as_ref());
+                let (queue, tx, numbered) = (&queue, tx.clone(), numbered.as_ref());
                 scope.spawn(move || self.work((position, device), queue, numbered, tx));
             }
             drop(tx);
@@ -294,9 +294,9 @@ impl FramesOn<'_> {
                 |report: Report, sink: &mut Sink, checker: &Checker| -> Result<(), CliError> {
                     match report {
                         Report::Frame { k, image, seconds } => {
-                        ready.insert(k, (image, seconds));
-                    }
-                    Report::Unwritten(message) => return Err(CliError::Usage(message)),
+                            ready.insert(k, (image, seconds));
+                        }
+                        Report::Unwritten(message) => return Err(CliError::Usage(message)),
                         Report::Failed { position, message } => {
                             alive -= 1;
                             eprintln!(
@@ -316,7 +316,7 @@ impl FramesOn<'_> {
                     }
                     while let Some((image, seconds)) = todo.get(next).and_then(|k| ready.remove(k))
                     {
-                                                if let Some(image) = image {
+                        if let Some(image) = image {
                             sink.write(todo[next], &image)?;
                         }
                         checker.written(todo[next], sink, seconds);
@@ -374,7 +374,7 @@ impl FramesOn<'_> {
     /// One device's worker: takes frames until none is left, or until the device fails (its
     /// frame then goes back to the queue). `SDFC_FAULT_AFTER_TILES` counts the device's tiles
     /// over every frame it rendered.
-        fn work(
+    fn work(
         &self,
         (position, device): (usize, crate::backend::Device),
         queue: &Queue<Pending>,
@@ -413,7 +413,7 @@ impl FramesOn<'_> {
                     .map_err(CliError::Failed)
             })();
             match rendered {
-                                Ok(image) => {
+                Ok(image) => {
                     let image = match numbered {
                         Some((pattern, format)) => {
                             let file = Output::File {

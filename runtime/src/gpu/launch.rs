@@ -235,7 +235,8 @@ pub fn render_one<D: Device>(
     }
     let wall = start.elapsed();
     let readback = Instant::now();
-    let pixels = device.read(&mut frame, job, &[0..job.pixels()])?;
+    let whole = 0..job.pixels();
+    let pixels = device.read(&mut frame, job, std::slice::from_ref(&whole))?;
     let readback = readback.elapsed().saturating_sub(pixels.convert);
     let device_time = device.finish(frame, job)?;
     Ok(Output {

@@ -407,7 +407,7 @@ impl Gpu {
     }
 
     fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
-        self.read_ranges(src, &[0..size])
+        self.read_ranges(src, std::slice::from_ref(&(0..size)))
     }
 
     /// The bytes of `ranges` of `src`, one after the other, through one staging buffer.

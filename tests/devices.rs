@@ -95,6 +95,9 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
 #[test]
 fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
     let Some(a) = open_gpu() else { return };
+    // Measured on lavapipe (LLVM 15, 2026-11-24): 54.1, 126.1 and 52.9 dB; the CPU's share of
+    // the bands varies from run to run, so the bounds are those of the CPU alone against
+    // lavapipe (tests/conformance.rs) less a margin.
     for (name, min_psnr) in [("seed3", 45.0), ("seed6", 90.0), ("glass", 38.0)] {
         let path = PathBuf::from(format!("../examples/{name}.sdf"));
         let scene = load(&path, 96, 64);

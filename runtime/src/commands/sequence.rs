@@ -111,6 +111,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         Some(list) => {
             let frames = FramesOn {
                 pool: &pool,
+                devices: list.len(),
                 backend,
                 setup,
                 limits: &limits,
@@ -254,6 +255,8 @@ enum Report {
 /// written in order as they come.
 struct FramesOn<'a> {
     pool: &'a rayon::ThreadPool,
+    /// How many devices render frames side by side.
+    devices: usize,
     backend: crate::backend::Backend,
     setup: Setup,
     limits: &'a Limits,
@@ -392,14 +395,21 @@ impl FramesOn<'_> {
             let rendered = (|| {
                 let (scene, prepared) = kernels.prepare(frame)?;
                 if first {
-                    check_memory(
-                        self.pool,
-                        prepared,
-                        &scene,
-                        (false, false),
-                        self.limits,
-                        position == 0,
-                    )?;
+                    // Every device holds a frame at once: what one allocates, times the
+                    // devices (announced once).
+                    let one = self
+                        .pool
+                        .install(|| crate::memory::render(prepared, &scene, false, false));
+                    let n = self.devices as u64;
+                    let all = crate::memory::Memory {
+                        host: one.host.saturating_mul(n),
+                        device: one.device.saturating_mul(n),
+                    };
+                    if position == 0 {
+                        let on = format!("{n} devices");
+                        eprintln!("{}", crate::memory::announce(&scene.settings, &on, &all));
+                    }
+                    all.check(self.limits).map_err(CliError::Failed)?;
                 }
                 let s = &scene.settings;
                 let n = crate::gpu::launch::tiling(s.width, s.height, crate::gpu::TILE, 1).len();

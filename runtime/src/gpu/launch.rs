@@ -85,6 +85,11 @@ pub trait Device: Sync {
         job: &Job,
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Self::Error>;
+    /// Errors the device held back so far (on several devices, each band is checked before
+    /// it is accepted).
+    fn check(&self, _frame: &mut Self::Frame) -> Result<(), Self::Error> {
+        Ok(())
+    }
     /// Ends the frame: errors the device held back, and the time of its tiles when the job
     /// is timed and the device can time them.
     fn finish(&self, frame: Self::Frame, job: &Job) -> Result<Option<Duration>, Self::Error>;
@@ -399,7 +404,10 @@ impl<D: Device> Worker for D {
             };
             share.phases.launches += launch.elapsed();
             let read = Instant::now();
-            match ran.and_then(|()| self.read(&mut frame, job, &[job.band(band)])) {
+            let read_back = ran
+                .and_then(|()| self.read(&mut frame, job, &[job.band(band)]))
+                .and_then(|p| self.check(&mut frame).map(|()| p));
+            match read_back {
                 Ok(pixels) => {
                     share.phases.readback += read.elapsed().saturating_sub(pixels.convert);
                     share.phases.convert += pixels.convert;

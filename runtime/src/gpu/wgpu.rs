@@ -601,6 +601,21 @@ impl launch::Device for Kernel<'_> {
         })
     }
 
+    fn check(&self, f: &mut FrameBuffers) -> Result<(), Error> {
+        if let Some(scope) = f.memory.take() {
+            let error = pollster::block_on(scope.pop());
+            f.memory = Some(
+                self.gpu
+                    .device
+                    .push_error_scope(wgpu::ErrorFilter::OutOfMemory),
+            );
+            if let Some(e) = error {
+                return Err(Error::Render(e.to_string()));
+            }
+        }
+        Ok(())
+    }
+
     fn finish(&self, mut f: FrameBuffers, job: &Job) -> Result<Option<Duration>, Error> {
         if let Some(scope) = f.memory.take() {
             if let Some(e) = pollster::block_on(scope.pop()) {

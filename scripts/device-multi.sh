@@ -7,14 +7,16 @@
 #   (sequence) examples/animation/orbit.sdf, 120 frames at 1920x1080 written as numbered
 #           PNGs with `sdfc render --frames` (frames per second over the whole sequence);
 #   (same) each still at 3840x2160, aa 2, rendered on one device and on the devices, compared
-#           (`sdfc compare`: identical on GPUs of one backend).
+#           (`sdfc compare`: identical on GPUs of one backend);
+#   (cpu) the CPU as an extra device: seed3 and seed6 at 1920x1080 with `--devices cpu,0`
+#           against `--devices 0` (whether the CPU speeds a GPU render up or slows it down).
 # With two GPUs or more the devices are all of them (`--devices all`); with one GPU it measures
 # the split-GPU case, GPU 0 opened twice as two logical devices (`--devices 0,0`: two CUDA
 # streams, or two wgpu devices on one adapter), which shows the scheduler's overhead and what
 # overlapping one device's readback with the other's launches gains.
 # Expects the sdfc binary at .dev/sdfc and the Vulkan loader packages in .gl/ (device-env.sh).
 # Writes JSON and logs under $OUT; prints the table last.
-# Usage: scripts/device-multi.sh [all|still|sequence|same]   (DEVICES=0,1 overrides the devices;
+# Usage: scripts/device-multi.sh [all|still|sequence|same|cpu]   (DEVICES=0,1 overrides the devices;
 #        BACKENDS="cuda" limits the backends; FRAMES=3 sets the timed frames of a still;
 #        STILL=7680x4320, SAME=3840x2160, SEQUENCE=1920x1080 and COUNT=120 set the sizes and
 #        the sequence's length, for a quick try on a small machine)
@@ -124,7 +126,31 @@ if [ "$MODE" = all ] || [ "$MODE" = same ]; then
   done
 fi
 
+if [ "$MODE" = all ] || [ "$MODE" = cpu ]; then
+  echo "== the CPU beside GPU 0 at $SEQUENCE, aa 1: median whole frame over $TIMED frames" | tee "$OUT/multi-cpu.txt"
+  for b in $BACKENDS; do
+    for s in seed3 seed6; do
+      for d in 0 cpu,0; do
+        tag=$(echo "$d" | tr ',' '-')
+        "$B" bench "examples/$s.sdf" --backend "$b" --devices "$d" --size "$SEQUENCE" --aa 1 \
+          --frames "$TIMED" --json > "$OUT/multi-cpu-$b-$s-$tag.json" 2> "$OUT/multi-cpu-$b-$s-$tag.log" \
+          || echo "$b $s --devices $d FAILED: $(tail -n 3 "$OUT/multi-cpu-$b-$s-$tag.log")"
+      done
+      line=$(python3 -c '
+import sys
+b, s, one, many, size = sys.argv[1:6]
+try:
+    x = "%.2fx" % (float(one) / float(many))
+except (ValueError, ZeroDivisionError):
+    x = "n/a"
+print("%-5s %-7s %-18s %10s ms %10s ms %8s" % (b, s, size + " +cpu", one, many, x))
+' "$b" "$s" "$(frame_ms "$OUT/multi-cpu-$b-$s-0.json")" "$(frame_ms "$OUT/multi-cpu-$b-$s-cpu-0.json")" "$SEQUENCE")
+      echo "$line" | tee -a "$OUT/multi-cpu.txt" >> "$TABLE"
+    done
+  done
+fi
+
 echo
-echo "== speed-up of --devices $MULTI over one device ($(head -n 1 "$OUT/gpu.txt"))"
+echo "== speed-up over one device: --devices $MULTI (rows marked +cpu: --devices cpu,0) ($(head -n 1 "$OUT/gpu.txt"))"
 printf '%-5s %-7s %-18s %13s %13s %8s\n' backend scene work "one device" "--devices" speed-up
 cat "$TABLE"

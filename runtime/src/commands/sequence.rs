@@ -284,7 +284,15 @@ impl FramesOn<'_> {
         std::thread::scope(|scope| {
             for (position, &device) in devices.iter().enumerate() {
                 let (queue, tx, numbered) = (&queue, tx.clone(), numbered.as_ref());
-                scope.spawn(move || self.work((position, device), queue, numbered, tx));
+                scope.spawn(move || {
+                    let run = std::panic::AssertUnwindSafe(|| {
+                        self.work((position, device), queue, numbered, tx)
+                    });
+                    // A worker that panicked holds a frame no one will render.
+                    if std::panic::catch_unwind(run).is_err() {
+                        queue.abandon();
+                    }
+                });
             }
             drop(tx);
             let mut ready = std::collections::BTreeMap::new();

@@ -284,6 +284,8 @@ struct State<T> {
     taken: usize,
     /// Whether more items may still be pushed.
     open: bool,
+    /// Whether the work was given up: no item is handed out any more.
+    abandoned: bool,
 }
 
 impl<T> Queue<T> {
@@ -295,6 +297,7 @@ impl<T> Queue<T> {
                 waiting: items.into_iter().collect(),
                 taken: 0,
                 open,
+                abandoned: false,
             }),
             changed: Condvar::new(),
         }
@@ -326,6 +329,9 @@ impl<T> Queue<T> {
     pub fn take(&self) -> Option<T> {
         let mut s = self.lock();
         loop {
+            if s.abandoned {
+                return None;
+            }
             if let Some(item) = s.waiting.pop_front() {
                 s.taken += 1;
                 return Some(item);
@@ -337,11 +343,12 @@ impl<T> Queue<T> {
         }
     }
 
-    /// No more items will be pushed, and those waiting are dropped: the workers end after
-    /// the items they hold.
+    /// The work is given up (an error, or a worker that panicked holding an item): those
+    /// waiting are dropped, and the workers end after the items they hold.
     pub fn abandon(&self) {
         let mut s = self.lock();
         s.open = false;
+        s.abandoned = true;
         s.waiting.clear();
         drop(s);
         self.changed.notify_all();
@@ -457,7 +464,22 @@ pub fn render_several(
         let handles: Vec<_> = devices
             .iter()
             .enumerate()
-            .map(|(i, d)| (i, scope.spawn(move || d.work(bands, i))))
+            .map(|(i, d)| {
+                let work = move || {
+                    let run = std::panic::AssertUnwindSafe(|| d.work(bands, i));
+                    std::panic::catch_unwind(run).unwrap_or_else(|_| {
+                        // Its band is lost: the frame cannot be finished.
+                        bands.queue.abandon();
+                        Share {
+                            device: d.name(),
+                            tiles: 0,
+                            phases: Phases::default(),
+                            failure: Some("its worker panicked".into()),
+                        }
+                    })
+                };
+                (i, scope.spawn(work))
+            })
             .collect();
         // The calling thread assembles the bands as they come.
         let mut receive = |(band, p): (usize, Pixels)| {

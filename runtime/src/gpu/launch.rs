@@ -583,6 +583,101 @@ mod tests {
         }
     }
 
+    /// A device that "renders" a pixel as its index, and fails on its `fails`-th tile.
+    struct Fake {
+        fails: Option<usize>,
+    }
+
+    impl Device for Fake {
+        type Frame = usize;
+        type Error = String;
+        fn describe(&self) -> String {
+            "fake".into()
+        }
+        fn prepare(&self, _job: &Job) -> Result<usize, String> {
+            Ok(0)
+        }
+        fn run(&self, ran: &mut usize, _job: &Job, tiles: &[usize]) -> Result<(), String> {
+            *ran += tiles.len();
+            match self.fails {
+                Some(n) if *ran > n => Err("lost".into()),
+                _ => Ok(()),
+            }
+        }
+        fn read(&self, _: &mut usize, _: &Job, ranges: &[Range<usize>]) -> Result<Pixels, String> {
+            let mut p = Pixels::default();
+            for r in ranges {
+                p.linear.extend(r.clone().map(|i| [i as f32, 0.0, 0.0]));
+                p.steps.extend(r.clone().map(|i| i as u32));
+                p.counters.steps += r.clone().map(|i| i as u64).sum::<u64>();
+            }
+            Ok(p)
+        }
+        fn finish(&self, _: usize, _: &Job) -> Result<Option<Duration>, String> {
+            Ok(None)
+        }
+        fn fault(&self, message: String) -> String {
+            message
+        }
+    }
+
+    #[test]
+    fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
+        let tiles = tiling(37, 29, 512, 3);
+        let job = Job {
+            uniforms: &[],
+            data: None,
+            width: 37,
+            height: 29,
+            tiles: &tiles,
+            timed: false,
+        };
+        let (good, lost) = (Fake { fails: None }, Fake { fails: Some(1) });
+        let devices: [&dyn Worker; 3] = [&lost, &good, &lost];
+        let out =
+            render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect("one survives");
+        let n = 37 * 29;
+        assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
+        assert_eq!(out.steps, (0..n as u32).collect::<Vec<_>>());
+        assert_eq!(out.counters.steps, (0..n as u64).sum::<u64>());
+        assert_eq!(out.shares[0].tiles, 1);
+        assert_eq!(out.shares[0].failure.as_deref(), Some("lost"));
+        assert_eq!(
+            out.shares.iter().map(|s| s.tiles).sum::<usize>(),
+            tiles.len()
+        );
+        // Every device fails: an error naming each.
+        let devices: [&dyn Worker; 2] = [&lost, &lost];
+        let err =
+            render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect_err("all fail");
+        assert!(err.starts_with("every device failed (2 of "), "{err}");
+        assert!(
+            err.contains("device 0 (fake): lost; device 1 (fake): lost"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_queue_waits_for_items_handed_back_and_ends_when_abandoned() {
+        let q = Queue::new([1, 2], false);
+        assert_eq!(q.take(), Some(1));
+        assert_eq!(q.take(), Some(2));
+        q.hand_back(2);
+        assert_eq!(q.take(), Some(2));
+        q.done();
+        // One item is still taken: another worker waits for it until it is done.
+        std::thread::scope(|s| {
+            let waiter = s.spawn(|| q.take());
+            std::thread::sleep(Duration::from_millis(20));
+            q.done();
+            assert_eq!(waiter.join().expect("joins"), None);
+        });
+        let open = Queue::new([7], true);
+        assert_eq!(open.take(), Some(7));
+        open.abandon();
+        assert_eq!(open.take(), None);
+    }
+
     #[test]
     fn faults_parse_per_device() {
         let f = Faults::parse("1:2, 5").expect("parses");

@@ -540,14 +540,13 @@ pub fn render_several(
         ));
     }
     let wall = start.elapsed();
-    // The workers ran side by side: each phase is the longest any device spent in it.
-    let mut phases = Phases::default();
-    for s in &shares {
-        phases.setup = phases.setup.max(s.phases.setup);
-        phases.launches = phases.launches.max(s.phases.launches);
-        phases.readback = phases.readback.max(s.phases.readback);
-        phases.convert = phases.convert.max(s.phases.convert);
-    }
+    // The workers ran side by side: the frame's phases are those of the one that took
+    // longest (the frame waited for it), with the bands' assembly as conversion.
+    let mut phases = shares
+        .iter()
+        .map(|s| s.phases)
+        .max_by_key(|p| p.total())
+        .unwrap_or_default();
     phases.convert += assembly;
     Ok(Output {
         linear,

@@ -190,14 +190,14 @@ impl Faults {
 }
 
 /// The tiles of a frame rendered by `devices` devices: squares of `edge` pixels for one,
-/// bands of whole rows for several (about `edge`² pixels each, and at least four per device,
-/// so that a fast device is not left waiting for a slow one at the end).
+/// bands of whole rows for several (at most about `edge`² pixels each, and at least eight per
+/// device, so that a device is not left waiting for another's last band at the end).
 pub fn tiling(width: u32, height: u32, edge: u32, devices: usize) -> Vec<Tile> {
     if devices <= 1 {
         return squares(width, height, edge);
     }
     let by_area = (edge.max(8) * edge.max(8) / width.max(1)).max(1);
-    let by_count = height.div_ceil(4 * devices as u32).max(1);
+    let by_count = height.div_ceil(8 * devices as u32).max(1);
     let rows = by_area.min(by_count);
     (0..height)
         .step_by(rows as usize)
@@ -578,7 +578,7 @@ mod tests {
             assert!(t.iter().all(|t| t.0 == 0 && t.2 == w));
             assert_eq!(t.iter().map(|t| t.3).sum::<u32>(), h);
             assert!(t.windows(2).all(|p| p[0].1 + p[0].3 == p[1].1));
-            assert!(t.len() >= (4 * n).min(h as usize), "{w}x{h}: {}", t.len());
+            assert!(t.len() >= (8 * n).min(h as usize), "{w}x{h}: {}", t.len());
         }
     }
 

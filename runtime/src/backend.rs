@@ -112,6 +112,94 @@ pub enum Prepared {
         lowered: Box<Lowered>,
         setup: Setup,
     },
+    /// Several devices (`--devices`), each prepared as above, rendering each frame together
+    /// ([`gpu::render_several`]).
+    Several(Vec<Prepared>),
+}
+
+/// Which devices a render uses (`--devices`).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum Devices {
+    /// The one device `--backend` picks.
+    #[default]
+    Auto,
+    /// Every GPU of the backend: every CUDA device, or every wgpu adapter (the CPU is not
+    /// one of them).
+    All,
+    /// These, in order: GPUs by index (CUDA devices, or wgpu adapters, as `sdfc devices`
+    /// lists them), and `cpu`. An index given twice opens the device twice: two logical
+    /// devices that share it.
+    List(Vec<Device>),
+}
+
+/// One entry of `--devices`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Device {
+    /// The CPU renderer.
+    Cpu,
+    /// A GPU by index.
+    Gpu(usize),
+}
+
+impl Devices {
+    /// Reads `--devices`: `auto`, `all`, or a comma-separated list of indices and `cpu`.
+    pub fn parse(text: &str) -> Result<Devices, String> {
+        match text.trim() {
+            "auto" => return Ok(Devices::Auto),
+            "all" => return Ok(Devices::All),
+            _ => {}
+        }
+        text.split(',')
+            .map(|entry| match entry.trim() {
+                "cpu" => Ok(Device::Cpu),
+                e => e.parse().map(Device::Gpu).map_err(|_| {
+                    format!(
+                        "bad --devices entry `{e}`: give auto, all, or a comma-separated list of device indices and `cpu` (`sdfc devices` lists the devices)"
+                    )
+                }),
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map(Devices::List)
+    }
+
+    /// The devices of `backend` these name; `None` for `auto` (the one device the backend
+    /// picks).
+    pub fn resolve(&self, backend: Backend) -> Result<Option<Vec<Device>>, String> {
+        let list: Vec<Device> = match self {
+            Devices::Auto => return Ok(None),
+            Devices::All => match Prepared::gpu_kind(backend)? {
+                Backend::Cuda => (0..Cuda::count()).map(Device::Gpu).collect(),
+                _ => (0..gpu::wgpu::adapters().len()).map(Device::Gpu).collect(),
+            },
+            Devices::List(list) => list.clone(),
+        };
+        if list.is_empty() {
+            return Err(format!(
+                "--devices all found no {} device",
+                format!("{:?}", Prepared::gpu_kind(backend)?).to_lowercase()
+            ));
+        }
+        Ok(Some(list))
+    }
+
+    /// `Err` naming the first entry `backend` cannot render on (a GPU with `--backend cpu`).
+    pub fn check(&self, backend: Backend) -> Result<(), String> {
+        match self {
+            Devices::List(list) if backend == Backend::Cpu => match list.iter().find_map(|d| match d {
+                Device::Gpu(i) => Some(i),
+                Device::Cpu => None,
+            }) {
+                Some(i) => Err(format!(
+                    "--devices entry `{i}` names a GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)"
+                )),
+                None => Ok(()),
+            },
+            Devices::All if backend == Backend::Cpu => Err(
+                "--devices all names every GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)".into(),
+            ),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// A kernel loaded on a CUDA device, with what its launches need and the WGSL text it was
@@ -137,6 +225,28 @@ pub struct Frame {
     pub wall: Duration,
     /// Where a GPU frame's wall time went on the host (`None` on the CPU).
     pub phases: Option<crate::gpu::Phases>,
+    /// What each device did, when several rendered the frame.
+    pub shares: Vec<gpu::launch::Share>,
+}
+
+impl Frame {
+    /// The warnings of devices that failed while others finished the frame.
+    pub fn warnings(&self) -> Vec<String> {
+        self.shares
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| {
+                s.failure.as_ref().map(|f| {
+                    format!(
+                        "device {i} ({}) failed after {} tile{}: {f}; the other devices rendered its tiles",
+                        s.device,
+                        s.tiles,
+                        if s.tiles == 1 { "" } else { "s" }
+                    )
+                })
+            })
+            .collect()
+    }
 }
 
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
@@ -187,6 +297,66 @@ impl Prepared {
             Backend::Auto => Self::cuda(scene, &lowered, setup)
                 .or_else(|_| Self::wgpu(scene, &lowered, setup, true))
                 .or_else(|_| Ok(Self::cpu(lowered, setup))),
+        }
+    }
+
+    /// Prepares `scene`, lowered as `lowered`, for `backend` on `devices`: the device the
+    /// backend picks ([`Devices::Auto`]), or several that render each frame together.
+    pub fn on_devices(
+        backend: Backend,
+        devices: &Devices,
+        scene: &Scene,
+        lowered: Lowered,
+        setup: &Setup,
+    ) -> Result<Prepared, String> {
+        let Some(list) = devices.resolve(backend)? else {
+            return Self::from_program(backend, scene, lowered, setup);
+        };
+        traceable_with(scene, &lowered.traceable)?;
+        let mut parts = Vec::with_capacity(list.len());
+        for d in &list {
+            let part = match *d {
+                Device::Cpu => Self::cpu(lowered.clone(), setup),
+                Device::Gpu(i) => {
+                    match Self::gpu_kind(backend)? {
+                        Backend::Cuda => {
+                            // On a stream of its own: the same index twice is two logical
+                            // devices on one GPU, running side by side.
+                            let cuda = Cuda::open_device(i, true).map_err(|e| e.to_string())?;
+                            let module = Self::cuda_module(&cuda, scene, &lowered, setup)?;
+                            Prepared::Cuda {
+                                cuda: Box::new(cuda),
+                                module: Box::new(module),
+                                lipschitz: lowered.program.lipschitz(),
+                                lowered: Box::new(lowered.clone()),
+                                setup: *setup,
+                            }
+                        }
+                        _ => {
+                            let gpu = Gpu::open_index(i).map_err(|e| e.to_string())?;
+                            Self::on_gpu(Arc::new(gpu), scene, &lowered, setup)?
+                        }
+                    }
+                }
+            };
+            parts.push(part);
+        }
+        Ok(match parts.len() {
+            1 => parts.remove(0),
+            _ => Prepared::Several(parts),
+        })
+    }
+
+    /// Whose GPUs `--devices` indexes: CUDA's or wgpu's (for `auto`, CUDA's where a driver
+    /// has devices).
+    fn gpu_kind(backend: Backend) -> Result<Backend, String> {
+        match backend {
+            Backend::Cuda | Backend::Wgpu => Ok(backend),
+            Backend::Auto if Cuda::count() > 0 => Ok(Backend::Cuda),
+            Backend::Auto => Ok(Backend::Wgpu),
+            Backend::Cpu => Err(
+                "--devices names GPUs, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)".into(),
+            ),
         }
     }
 
@@ -312,9 +482,9 @@ impl Prepared {
             Prepared::Wgpu {
                 gpu, kernel, setup, ..
             } => Self::on_gpu_after(gpu.clone(), scene, &lowered, setup, Some(kernel)),
-            Prepared::Cuda { .. } => {
-                Err("a CUDA kernel is prepared again with Prepared::update".into())
-            }
+            Prepared::Cuda { .. } | Prepared::Several(_) => Err(
+                "CUDA kernels and several devices are prepared again with Prepared::update".into(),
+            ),
         }
     }
 
@@ -399,6 +569,13 @@ impl Prepared {
                 **held = lowered;
                 Ok(built)
             }
+            Prepared::Several(parts) => {
+                let mut built = false;
+                for p in parts {
+                    built |= p.update(scene, lowered.clone())?;
+                }
+                Ok(built)
+            }
         }
     }
 
@@ -409,6 +586,7 @@ impl Prepared {
             Prepared::Cpu { .. } => None,
             Prepared::Wgpu { kernel, .. } => Some(kernel.specialisation),
             Prepared::Cuda { module, .. } => Some(module.specialisation),
+            Prepared::Several(parts) => parts.iter().find_map(|p| p.specialisation()),
         }
     }
 
@@ -444,6 +622,7 @@ impl Prepared {
                 **module = Self::cuda_module(cuda, scene, lowered, setup)?;
                 Ok(())
             }
+            Prepared::Several(parts) => parts.iter_mut().try_for_each(|p| p.specialise(scene)),
         }
     }
 
@@ -468,6 +647,14 @@ impl Prepared {
             Prepared::Cpu { .. } => "cpu",
             Prepared::Wgpu { .. } => "wgpu",
             Prepared::Cuda { .. } => "cuda",
+            Prepared::Several(parts) => {
+                let first = parts.first().map_or("cpu", |p| p.name());
+                if parts.iter().all(|p| p.name() == first) {
+                    first
+                } else {
+                    "mixed"
+                }
+            }
         }
     }
 
@@ -477,6 +664,10 @@ impl Prepared {
             Prepared::Cpu { .. } => format!("CPU, {} threads", rayon::current_num_threads()),
             Prepared::Wgpu { gpu, .. } => gpu.describe(),
             Prepared::Cuda { cuda, .. } => cuda.describe(),
+            Prepared::Several(parts) => {
+                let each: Vec<String> = parts.iter().map(|p| p.device()).collect();
+                format!("{} devices: {}", parts.len(), each.join(" + "))
+            }
         }
     }
 
@@ -487,6 +678,7 @@ impl Prepared {
             Prepared::Cpu { .. } => return None,
             Prepared::Wgpu { kernel, .. } => kernel.interpreted(),
             Prepared::Cuda { module, .. } => module.interpreted,
+            Prepared::Several(parts) => return parts.iter().find_map(|p| p.kernel_kind()),
         };
         Some(if interpreted {
             "interpreted"
@@ -508,6 +700,10 @@ impl Prepared {
                 },
                 module.loaded.load_time.as_secs_f64() * 1e3
             )),
+            Prepared::Several(parts) => {
+                let each: Vec<String> = parts.iter().filter_map(|p| p.preparation()).collect();
+                (!each.is_empty()).then(|| each.join("; "))
+            }
             _ => None,
         }
     }
@@ -528,6 +724,15 @@ impl Prepared {
             Prepared::Cuda { module, .. } => {
                 gpu::memory_cuda(settings, uniforms(&at), bytes(&module.data))
             }
+            // Each device holds a whole frame's buffers; the bands read back and the image
+            // they are assembled into are no more than one device's whole readback.
+            Prepared::Several(parts) => parts.iter().fold(Memory::default(), |m, p| {
+                let d = p.memory(scene, settings);
+                Memory {
+                    host: m.host + d.host,
+                    device: m.device + d.device,
+                }
+            }),
         }
     }
 
@@ -535,6 +740,7 @@ impl Prepared {
     pub fn retained(&self, settings: &Settings) -> u64 {
         match self {
             Prepared::Cpu { .. } => cpu::retained(settings),
+            Prepared::Several(parts) if parts.len() == 1 => parts[0].retained(settings),
             _ => gpu::retained(settings),
         }
     }
@@ -546,6 +752,7 @@ impl Prepared {
             Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => {
                 lowered.program.len()
             }
+            Prepared::Several(parts) => parts.first().map_or(0, |p| p.program_len()),
         }
     }
 
@@ -554,11 +761,23 @@ impl Prepared {
         match self {
             Prepared::Cpu { tapes, .. } => tapes.traceable(),
             Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => &lowered.traceable,
+            Prepared::Several(parts) => parts[0].traceable(),
         }
     }
 
-    /// Renders one frame; `progress` gets the fraction done.
+    /// Renders one frame; `progress` gets the fraction done. The faults of the testing aid
+    /// `SDFC_FAULT_AFTER_TILES` are injected.
     pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, String> {
+        self.render_faults(scene, progress, &gpu::launch::Faults::from_env())
+    }
+
+    /// [`Prepared::render`] with the faults `faults` injected.
+    pub fn render_faults(
+        &self,
+        scene: &Scene,
+        progress: &(dyn Fn(f64) + Sync),
+        faults: &gpu::launch::Faults,
+    ) -> Result<Frame, String> {
         self.check_specialisation(scene)?;
         match self {
             Prepared::Cpu { tapes, options, .. } => {
@@ -575,6 +794,7 @@ impl Prepared {
                     time,
                     wall: time,
                     phases: None,
+                    shares: Vec::new(),
                 })
             }
             Prepared::Wgpu {
@@ -583,14 +803,11 @@ impl Prepared {
                 lipschitz,
                 ..
             } => {
-                let r = gpu::render(gpu, scene, kernel, *lipschitz, &mut |f| progress(f))
-                    .map_err(|e| e.to_string())?;
-                Ok(Frame {
-                    render: r.render,
-                    time: r.time,
-                    wall: r.wall,
-                    phases: Some(r.phases),
+                let r = gpu::render_faults(gpu, scene, kernel, *lipschitz, faults, &mut |f| {
+                    progress(f)
                 })
+                .map_err(|e| e.to_string())?;
+                Ok(Frame::of(r))
             }
             Prepared::Cuda {
                 cuda,
@@ -601,19 +818,72 @@ impl Prepared {
                 let r = gpu::render_cuda(
                     cuda,
                     scene,
-                    &module.loaded,
-                    module.data.as_deref(),
+                    (&module.loaded, module.data.as_deref()),
                     *lipschitz,
+                    faults,
+                    &mut |f| progress(f),
                 )
                 .map_err(|e| e.to_string())?;
-                progress(1.0);
-                Ok(Frame {
-                    render: r.render,
-                    time: r.time,
-                    wall: r.wall,
-                    phases: Some(r.phases),
-                })
+                Ok(Frame::of(r))
             }
+            Prepared::Several(parts) => {
+                let mut workers: Vec<Box<dyn gpu::launch::Worker + '_>> = Vec::new();
+                let mut data = None;
+                let mut lipschitz = 1.0;
+                for p in parts {
+                    match p {
+                        Prepared::Cpu { tapes, options, .. } => {
+                            workers.push(Box::new(gpu::cpu::Device::new(scene, tapes, options)))
+                        }
+                        Prepared::Wgpu {
+                            gpu,
+                            kernel,
+                            lipschitz: l,
+                            ..
+                        } => {
+                            data = kernel.data.as_deref();
+                            lipschitz = *l;
+                            workers.push(Box::new(gpu.kernel(
+                                &kernel.source,
+                                wgsl::ENTRY_POINT,
+                                wgsl::WORKGROUP,
+                            )));
+                        }
+                        Prepared::Cuda {
+                            cuda,
+                            module,
+                            lipschitz: l,
+                            ..
+                        } => {
+                            data = module.data.as_deref();
+                            lipschitz = *l;
+                            workers.push(Box::new(cuda.kernel(&module.loaded, wgsl::WORKGROUP)));
+                        }
+                        Prepared::Several(_) => {
+                            return Err("several devices cannot hold several devices".into())
+                        }
+                    }
+                }
+                let workers: Vec<&dyn gpu::launch::Worker> =
+                    workers.iter().map(|w| w.as_ref()).collect();
+                let r =
+                    gpu::render_several(&workers, scene, (lipschitz, data), faults, &mut |f| {
+                        progress(f)
+                    })?;
+                Ok(Frame::of(r))
+            }
+        }
+    }
+}
+
+impl Frame {
+    fn of(r: gpu::GpuRender) -> Frame {
+        Frame {
+            render: r.render,
+            time: r.time,
+            wall: r.wall,
+            phases: Some(r.phases),
+            shares: r.shares,
         }
     }
 }

@@ -31,6 +31,9 @@ enum Command {
     Pareto(commands::pareto::ParetoArgs),
     /// Mesh a scene's surface (STL, OBJ, PLY or glTF), watertight and with sharp edges kept.
     Mesh(commands::mesh::MeshArgs),
+    /// List the devices `--devices` can name: CUDA devices and wgpu adapters by index, and
+    /// the CPU.
+    Devices(commands::devices::DevicesArgs),
     /// Show a scene in a window that reloads it whenever it (or a file it imports) is saved.
     View(commands::view::ViewArgs),
 }
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
     };
     match cli.command {
         Command::Check(args) => commands::check::run(args),
+        Command::Devices(args) => commands::devices::run(args),
         Command::Compile(args) => commands::compile::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Bench(args) => commands::bench::run(args),

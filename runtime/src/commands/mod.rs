@@ -5,6 +5,7 @@ pub mod bench;
 pub mod check;
 pub mod compare;
 pub mod compile;
+pub mod devices;
 pub mod mesh;
 pub mod pareto;
 pub mod render;

@@ -3,7 +3,7 @@
 //! `sdfc pareto` share (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread
 //! pools).
 
-use crate::backend::{Frame, Prepared, Setup};
+use crate::backend::{Devices, Frame, Prepared, Setup};
 use crate::cpu::reference::{self, Convergence};
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat};
@@ -29,6 +29,12 @@ pub struct RenderArgs {
     /// Backend to render with.
     #[arg(long, value_enum, default_value_t)]
     pub backend: Backend,
+    /// Devices to render with: `auto` (the one `--backend` picks), `all` (every GPU of the
+    /// backend), or a comma-separated list of GPU indices (CUDA devices, or wgpu adapters, as
+    /// `sdfc devices` lists them; an index twice opens that GPU as two logical devices) and
+    /// `cpu`. Several devices take tiles of each frame from one queue (docs/devices.md).
+    #[arg(long, value_name = "auto|all|LIST", default_value = "auto", value_parser = Devices::parse)]
+    pub devices: Devices,
     /// Image size, as WIDTHxHEIGHT (overrides the scene's `render` block).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -146,7 +152,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
 }
 
 /// A scene checked at one time, with its settings overridden by the arguments, and lowered.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct FrameScene {
     /// The scene, settings applied.
     pub scene: Scene,
@@ -218,10 +224,10 @@ pub fn frame_scene(
     })
 }
 
-/// Prepares a frame's scene on the backend.
+/// Prepares a frame's scene on the backend's `devices`.
 pub fn prepare(
     pool: &rayon::ThreadPool,
-    backend: Backend,
+    (backend, devices): (Backend, &Devices),
     frame: FrameScene,
     setup: &Setup,
 ) -> Result<(Scene, Prepared), CliError> {
@@ -236,7 +242,7 @@ pub fn prepare(
         sdfc_compiler::back::wgsl::choose(&scene, &lowered, &options).map_err(CliError::Failed)?;
     }
     let prepared = pool
-        .install(|| Prepared::from_program(backend, &scene, lowered, setup))
+        .install(|| Prepared::on_devices(backend, devices, &scene, lowered, setup))
         .map_err(|msg| {
             CliError::Failed(format!("the {backend:?} backend is not available: {msg}"))
         })?;
@@ -286,7 +292,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         parameters: false,
         kernel: args.kernel.unwrap_or_default().choice(),
     };
-    let (scene, prepared) = prepare(&pool, backend, frame, &setup)?;
+    let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup)?;
     check_memory(
         &pool,
         &prepared,
@@ -300,6 +306,9 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         .install(|| render_with_progress(&prepared, &scene))
         .map_err(CliError::Failed)?;
     let seconds = started.elapsed().as_secs_f64();
+    for w in frame.warnings() {
+        eprintln!("warning: {w}");
+    }
     let check = if args.reference {
         Some(
             pool.install(|| check_reference(&prepared, &scene, &frame))
@@ -365,6 +374,16 @@ pub fn stats(
     if let Some(p) = &frame.phases {
         text.push_str(&format!("frame on host   {p}\n"));
     }
+    for (i, s) in frame.shares.iter().enumerate() {
+        text.push_str(&format!(
+            "device {i}        {}: {} tile{}, {}{}\n",
+            s.device,
+            s.tiles,
+            if s.tiles == 1 { "" } else { "s" },
+            s.phases,
+            if s.failure.is_some() { " (failed)" } else { "" }
+        ));
+    }
     text.push_str(&format!("{}\n", frame.render.stats));
     if let Some(c) = check {
         text.push_str(&format!("{c}\n"));
@@ -398,8 +417,12 @@ fn output(args: &RenderArgs) -> Result<Output, String> {
 
 /// The backend and precision of a render: `--reference` means the CPU in f64.
 pub fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
+    args.devices.check(args.backend)?;
     if !args.reference {
         return Ok((args.backend, args.precision));
+    }
+    if args.devices != Devices::Auto {
+        return Err("--reference renders on the CPU in f64; it cannot use --devices".into());
     }
     match args.backend {
         Backend::Auto | Backend::Cpu => Ok((Backend::Cpu, Precision::F64)),

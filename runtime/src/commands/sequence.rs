@@ -10,6 +10,7 @@ use super::render::{
 };
 use crate::backend::{Prepared, Setup};
 use crate::frontend::Source;
+use crate::gpu::launch::{Faults, Queue};
 use crate::image::{AtomicFile, Image};
 use crate::output::Output;
 use crate::sequence::{ffmpeg, Frames, Target};
@@ -92,63 +93,67 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         todo.len()
     );
     let bar = progress(mine.len() as u64, skipped as u64);
-    let mut kernels = Kernels::new(&pool, backend, setup);
-    // The image of a scene that does not read `t`, rendered once.
-    let mut still: Option<Image> = None;
     let mut first = Some(first);
+    let mut checker = Checker {
+        args,
+        source: &mut source,
+        limits: &limits,
+        lowering: &lowering,
+        fps,
+        bar: bar.as_ref(),
+    };
     let started = Instant::now();
-    for (n, &k) in todo.iter().enumerate() {
-        let time = Animation::time_of(fps, k);
-        let frame = match first.take().filter(|_| time == 0.0) {
-            Some(f) => f,
-            None => frame_scene(
-                args.overrides(),
-                &mut source,
-                &limits,
-                time,
-                false,
-                &lowering,
-            )
-            .map_err(|e| {
-                if let Some(b) = &bar {
-                    b.abandon();
-                }
-                match e {
-                    CliError::Reported(code) => {
-                        eprintln!("error: frame {k} (t = {time} s) has errors");
-                        CliError::Reported(code)
-                    }
-                    other => other,
-                }
-            })?,
-        };
-        let frame_started = Instant::now();
-        let image = match &still {
-            Some(image) => image.clone(),
-            None => {
-                let (scene, prepared) = kernels.prepare(frame)?;
-                check_memory(&pool, prepared, &scene, (false, false), &limits, n == 0)?;
-                let image = pool
-                    .install(|| prepared.render(&scene, &|_| {}))
-                    .map_err(CliError::Failed)?
-                    .render
-                    .image;
-                if !animation.animated() {
-                    still = Some(image.clone());
-                }
-                image
-            }
-        };
-        sink.write(k, &image)?;
-        let seconds = frame_started.elapsed().as_secs_f64();
-        match &bar {
-            Some(b) => b.inc(1),
-            None => eprintln!(
-                "frame {k} (t = {time:.4} s): {} ({seconds:.3} s)",
-                sink.describe(k)
-            ),
+    // Several devices take whole frames from one queue; a scene that does not read `t` is
+    // rendered once, its one frame split among them.
+    let workers = match args.devices.resolve(backend).map_err(CliError::Usage)? {
+        Some(list) if list.len() > 1 && animation.animated() => Some(list),
+        _ => None,
+    };
+    let (count, device) = match workers {
+        Some(list) => {
+            let frames = FramesOn {
+                pool: &pool,
+                devices: list.len(),
+                backend,
+                setup,
+                limits: &limits,
+            };
+            frames.render(&list, &todo, &mut first, &mut checker, &mut sink)?
         }
-    }
+        None => {
+            let mut kernels = Kernels::new(&pool, (backend, args.devices.clone()), setup);
+            // The image of a scene that does not read `t`, rendered once.
+            let mut still: Option<Image> = None;
+            for (n, &k) in todo.iter().enumerate() {
+                let frame = checker.frame(k, &mut first)?;
+                let frame_started = Instant::now();
+                let image = match &still {
+                    Some(image) => image.clone(),
+                    None => {
+                        let (scene, prepared) = kernels.prepare(frame)?;
+                        check_memory(&pool, prepared, &scene, (false, false), &limits, n == 0)?;
+                        let frame = pool
+                            .install(|| prepared.render(&scene, &|_| {}))
+                            .map_err(CliError::Failed)?;
+                        for w in frame.warnings() {
+                            eprintln!("warning: frame {k}: {w}");
+                        }
+                        let image = frame.render.image;
+                        if !animation.animated() {
+                            still = Some(image.clone());
+                        }
+                        image
+                    }
+                };
+                sink.write(k, &image)?;
+                checker.written(k, &sink, frame_started.elapsed().as_secs_f64());
+            }
+            let device = kernels
+                .last()
+                .map(|p| format!("{} on {}", p.name(), p.device()));
+            (kernels.count, device)
+        }
+    };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -160,14 +165,311 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         if todo.len() == 1 { "" } else { "s" },
         path.display(),
         todo.len() as f64 / seconds.max(1e-9),
-        kernels.count,
-        if kernels.count == 1 { "" } else { "s" },
-        match kernels.last() {
-            Some(p) => format!(" ({} on {})", p.name(), p.device()),
+        count,
+        if count == 1 { "" } else { "s" },
+        match device {
+            Some(d) => format!(" ({d})"),
             None => String::new(),
         }
     );
     Ok(())
+}
+
+/// Checks the frames of a sequence one after the other (the source is read once and checked
+/// at each time), and logs those written.
+struct Checker<'a> {
+    args: &'a RenderArgs,
+    source: &'a mut Source,
+    limits: &'a Limits,
+    lowering: &'a LowerOptions,
+    fps: f64,
+    bar: Option<&'a ProgressBar>,
+}
+
+impl Checker<'_> {
+    /// Frame `k` checked at its time (`first`, the frame checked at t = 0, when it is that).
+    fn frame(&mut self, k: u64, first: &mut Option<FrameScene>) -> Result<FrameScene, CliError> {
+        let time = Animation::time_of(self.fps, k);
+        if let Some(f) = first.take().filter(|_| time == 0.0) {
+            return Ok(f);
+        }
+        frame_scene(
+            self.args.overrides(),
+            self.source,
+            self.limits,
+            time,
+            false,
+            self.lowering,
+        )
+        .map_err(|e| {
+            if let Some(b) = self.bar {
+                b.abandon();
+            }
+            match e {
+                CliError::Reported(code) => {
+                    eprintln!("error: frame {k} (t = {time} s) has errors");
+                    CliError::Reported(code)
+                }
+                other => other,
+            }
+        })
+    }
+
+    /// Frame `k` was written in `seconds`.
+    fn written(&self, k: u64, sink: &Sink, seconds: f64) {
+        let time = Animation::time_of(self.fps, k);
+        match self.bar {
+            Some(b) => b.inc(1),
+            None => eprintln!(
+                "frame {k} (t = {time:.4} s): {} ({seconds:.3} s)",
+                sink.describe(k)
+            ),
+        }
+    }
+}
+
+/// A frame checked and waiting for a device.
+struct Pending {
+    k: u64,
+    frame: FrameScene,
+}
+
+/// What a device's worker reports.
+enum Report {
+    /// Frame `k` rendered in `seconds`; its image, unless the worker wrote it (numbered
+    /// files are written by the workers, side by side; an animated PNG or a video takes the
+    /// frames in order).
+    Frame {
+        k: u64,
+        image: Option<Image>,
+        seconds: f64,
+    },
+    /// The frame could not be written.
+    Unwritten(String),
+    /// The device failed on a frame, which it handed back.
+    Failed { position: usize, message: String },
+    /// The worker ended after preparing `kernels` kernels on `device`.
+    Ended { kernels: usize, device: String },
+}
+
+/// The frames of a sequence on several devices: each device's worker takes the next checked
+/// frame from one queue (prepared on its device as [`Kernels`] prepares frames); frames are
+/// written in order as they come.
+struct FramesOn<'a> {
+    pool: &'a rayon::ThreadPool,
+    /// How many devices render frames side by side.
+    devices: usize,
+    backend: crate::backend::Backend,
+    setup: Setup,
+    limits: &'a Limits,
+}
+
+impl FramesOn<'_> {
+    /// Renders `todo` on `devices`; returns the kernels prepared and the devices, for the
+    /// log.
+    fn render(
+        &self,
+        devices: &[crate::backend::Device],
+        todo: &[u64],
+        first: &mut Option<FrameScene>,
+        checker: &mut Checker,
+        sink: &mut Sink,
+    ) -> Result<(usize, Option<String>), CliError> {
+        let queue = Queue::new(std::iter::empty(), true);
+        let numbered = match &*sink {
+            Sink::Numbered(pattern, format) => Some((pattern.clone(), *format)),
+            _ => None,
+        };
+        let (tx, rx) = std::sync::mpsc::channel();
+        // Frames checked ahead of the devices: enough to keep each busy.
+        let ahead = 2 * devices.len();
+        std::thread::scope(|scope| {
+            for (position, &device) in devices.iter().enumerate() {
+                let (queue, tx, numbered) = (&queue, tx.clone(), numbered.as_ref());
+                scope.spawn(move || {
+                    let run = std::panic::AssertUnwindSafe(|| {
+                        self.work((position, device), queue, numbered, tx)
+                    });
+                    // A worker that panicked holds a frame no one will render.
+                    if std::panic::catch_unwind(run).is_err() {
+                        queue.abandon();
+                    }
+                });
+            }
+            drop(tx);
+            let mut ready = std::collections::BTreeMap::new();
+            let mut next = 0;
+            let mut alive = devices.len();
+            let (mut kernels, mut names) = (0, Vec::new());
+            let mut failures = Vec::new();
+            // Handles one report: frames are written in order, as soon as they can be.
+            let mut handle =
+                |report: Report, sink: &mut Sink, checker: &Checker| -> Result<(), CliError> {
+                    match report {
+                        Report::Frame { k, image, seconds } => {
+                            ready.insert(k, (image, seconds));
+                        }
+                        Report::Unwritten(message) => return Err(CliError::Usage(message)),
+                        Report::Failed { position, message } => {
+                            alive -= 1;
+                            eprintln!(
+                                "warning: device {position} failed: {message}; {}",
+                                if alive > 0 {
+                                    "the other devices render its frame"
+                                } else {
+                                    "no device is left"
+                                }
+                            );
+                            failures.push(format!("device {position}: {message}"));
+                        }
+                        Report::Ended { kernels: n, device } => {
+                            kernels += n;
+                            names.push(device);
+                        }
+                    }
+                    while let Some((image, seconds)) = todo.get(next).and_then(|k| ready.remove(k))
+                    {
+                        if let Some(image) = image {
+                            sink.write(todo[next], &image)?;
+                        }
+                        checker.written(todo[next], sink, seconds);
+                        next += 1;
+                    }
+                    if alive == 0 && next < todo.len() {
+                        return Err(CliError::Failed(format!(
+                            "every device failed ({next} of {} frames written): {}",
+                            todo.len(),
+                            failures.join("; ")
+                        )));
+                    }
+                    Ok(())
+                };
+            let result = (|| {
+                for &k in todo {
+                    let frame = checker.frame(k, first)?;
+                    while queue.waiting() >= ahead {
+                        match rx.recv_timeout(std::time::Duration::from_millis(20)) {
+                            Ok(r) => handle(r, sink, checker)?,
+                            Err(_) => continue,
+                        }
+                    }
+                    queue.push(Pending { k, frame });
+                    while let Ok(r) = rx.try_recv() {
+                        handle(r, sink, checker)?;
+                    }
+                }
+                queue.close();
+                // Every worker ends once the queue is empty (or it failed).
+                while let Ok(r) = rx.recv() {
+                    handle(r, sink, checker)?;
+                }
+                Ok(())
+            })();
+            // On an error, the workers finish no more frames.
+            queue.abandon();
+            result?;
+            if next < todo.len() {
+                return Err(CliError::Failed(format!(
+                    "{} of {} frames were not rendered",
+                    todo.len() - next,
+                    todo.len()
+                )));
+            }
+            names.sort();
+            names.dedup();
+            Ok((
+                kernels,
+                Some(format!("{} devices: {}", devices.len(), names.join(", "))),
+            ))
+        })
+    }
+
+    /// One device's worker: takes frames until none is left, or until the device fails (its
+    /// frame then goes back to the queue). `SDFC_FAULT_AFTER_TILES` counts the device's tiles
+    /// over every frame it rendered.
+    fn work(
+        &self,
+        (position, device): (usize, crate::backend::Device),
+        queue: &Queue<Pending>,
+        numbered: Option<&(crate::sequence::Pattern, crate::output::Format)>,
+        tx: std::sync::mpsc::Sender<Report>,
+    ) {
+        let list = crate::backend::Devices::List(vec![device]);
+        let mut kernels = Kernels::new(self.pool, (self.backend, list), self.setup);
+        let faults = Faults::from_env();
+        let mut tiles = 0;
+        while let Some(Pending { k, frame }) = queue.take() {
+            let kept = frame.clone();
+            let started = Instant::now();
+            let first = kernels.last().is_none();
+            let rendered = (|| {
+                let (scene, prepared) = kernels.prepare(frame)?;
+                if first {
+                    // Every device holds a frame at once: what one allocates, times the
+                    // devices (announced once).
+                    let one = self
+                        .pool
+                        .install(|| crate::memory::render(prepared, &scene, false, false));
+                    let n = self.devices as u64;
+                    let all = crate::memory::Memory {
+                        host: one.host.saturating_mul(n),
+                        device: one.device.saturating_mul(n),
+                    };
+                    if position == 0 {
+                        let on = format!("{n} devices");
+                        eprintln!("{}", crate::memory::announce(&scene.settings, &on, &all));
+                    }
+                    all.check(self.limits).map_err(CliError::Failed)?;
+                }
+                let s = &scene.settings;
+                let n = crate::gpu::launch::tiling(s.width, s.height, crate::gpu::TILE, 1).len();
+                if let Some(message) = faults.injected_within(position, tiles..tiles + n) {
+                    return Err(CliError::Failed(message));
+                }
+                tiles += n;
+                self.pool
+                    .install(|| prepared.render_faults(&scene, &|_| {}, &Faults::default()))
+                    .map(|f| f.render.image)
+                    .map_err(CliError::Failed)
+            })();
+            match rendered {
+                Ok(image) => {
+                    let image = match numbered {
+                        Some((pattern, format)) => {
+                            let file = Output::File {
+                                path: pattern.path(k),
+                                format: *format,
+                            };
+                            if let Err(e) = file.write(&image) {
+                                let _ = tx.send(Report::Unwritten(e));
+                            }
+                            None
+                        }
+                        None => Some(image),
+                    };
+                    let seconds = started.elapsed().as_secs_f64();
+                    let _ = tx.send(Report::Frame { k, image, seconds });
+                    queue.done();
+                }
+                Err(e) => {
+                    queue.hand_back(Pending { k, frame: kept });
+                    let message = match e {
+                        CliError::Usage(m) | CliError::Failed(m) => m,
+                        CliError::Reported(_) => "the frame has errors".into(),
+                    };
+                    let _ = tx.send(Report::Failed { position, message });
+                    return;
+                }
+            }
+        }
+        let device = kernels
+            .last()
+            .map_or_else(String::new, |p| format!("{} on {}", p.name(), p.device()));
+        let _ = tx.send(Report::Ended {
+            kernels: kernels.count,
+            device,
+        });
+    }
 }
 
 /// The frames to render: `--frames`, or the scene's `fps × duration`, within the `frames`
@@ -241,6 +543,7 @@ fn progress(len: u64, done: u64) -> Option<ProgressBar> {
 pub struct Kernels<'a> {
     pool: &'a rayon::ThreadPool,
     backend: crate::backend::Backend,
+    devices: crate::backend::Devices,
     setup: Setup,
     /// The last frame's program and scene origin, and the backend prepared for them.
     prepared: Option<(Program, [f64; 3], Prepared)>,
@@ -259,15 +562,16 @@ impl std::fmt::Debug for Kernels<'_> {
 }
 
 impl<'a> Kernels<'a> {
-    /// No kernel yet.
+    /// No kernel yet: the frames will render with `backend` on `devices`.
     pub fn new(
         pool: &'a rayon::ThreadPool,
-        backend: crate::backend::Backend,
+        (backend, devices): (crate::backend::Backend, crate::backend::Devices),
         setup: Setup,
     ) -> Self {
         Kernels {
             pool,
             backend,
+            devices,
             setup,
             prepared: None,
             count: 0,
@@ -306,7 +610,8 @@ impl<'a> Kernels<'a> {
             }
             None => {
                 let program = frame.lowered.program.clone();
-                let (scene, prepared) = prepare(self.pool, self.backend, frame, &self.setup)?;
+                let (scene, prepared) =
+                    prepare(self.pool, (self.backend, &self.devices), frame, &self.setup)?;
                 self.count += 1;
                 self.prepared = Some((program, scene.origin, prepared));
                 scene

@@ -218,6 +218,73 @@ pub fn render_in<T: Float>(
     assemble(&scene.settings, &rects, &outs)
 }
 
+/// Renders the rows `rows` of `scene`'s image (every column) on the current rayon pool:
+/// their linear colours and marching steps, row-major, and the counters they add up to (the
+/// pixels are those of a whole render; their depth buffers are not kept). The scheduler of
+/// several devices renders bands of an image so when the CPU is one of them.
+pub fn render_rows(
+    scene: &Scene,
+    tapes: &Tapes,
+    options: &Options,
+    rows: std::ops::Range<u32>,
+) -> (Vec<[f32; 3]>, Vec<u32>, Counters) {
+    match options.precision {
+        Precision::F32 => rows_in::<f32>(scene, tapes, options, rows),
+        Precision::F64 => rows_in::<f64>(scene, tapes, options, rows),
+    }
+}
+
+fn rows_in<T: Float>(
+    scene: &Scene,
+    tapes: &Tapes,
+    options: &Options,
+    rows: std::ops::Range<u32>,
+) -> (Vec<[f32; 3]>, Vec<u32>, Counters) {
+    let ctx = Context::<T>::new(
+        scene,
+        &tapes.traceable,
+        options.lipschitz,
+        options.debug_nan,
+    );
+    let s = &scene.settings;
+    let edge = options.tile.max(1);
+    let rects: Vec<Rect> = tiles(s, edge)
+        .into_iter()
+        .filter(|r| r.y < rows.end && r.y + r.h > rows.start)
+        .map(|r| {
+            let y = r.y.max(rows.start);
+            Rect {
+                y,
+                h: (r.y + r.h).min(rows.end) - y,
+                ..r
+            }
+        })
+        .collect();
+    let outs: Vec<tile::TileOut> = rects
+        .par_iter()
+        .map_init(
+            || Workspace::new(tapes, options.lanes, options.chunk),
+            |ws, &rect| tile::render(&ctx, ws, rect),
+        )
+        .collect();
+    let width = s.width as usize;
+    let n = width * (rows.end - rows.start) as usize;
+    let mut linear = vec![[0.0f32; 3]; n];
+    let mut steps = vec![0u32; n];
+    let mut counters = Counters::default();
+    for (rect, out) in rects.iter().zip(&outs) {
+        counters.add(&out.counters);
+        for row in 0..rect.h {
+            let dst = (rect.y - rows.start + row) as usize * width + rect.x as usize;
+            let src = (row * rect.w) as usize;
+            let w = rect.w as usize;
+            linear[dst..dst + w].copy_from_slice(&out.pixels[src..src + w]);
+            steps[dst..dst + w].copy_from_slice(&out.steps[src..src + w]);
+        }
+    }
+    (linear, steps, counters)
+}
+
 /// Puts the tiles together into the image and the statistics.
 fn assemble(settings: &Settings, rects: &[Rect], outs: &[tile::TileOut]) -> Render {
     let mut image = Image::new(settings.width, settings.height);

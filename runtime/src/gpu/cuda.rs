@@ -6,7 +6,12 @@
 //! machines without CUDA and says so when asked to use it.
 #![allow(unsafe_code)] // The driver API is C: its calls are wrapped here, each with its reason.
 
-use cudarc::driver::{sys, CudaContext, CudaFunction, CudaStream, LaunchConfig, PushKernelArg};
+use super::launch::{self, Job, Pixels};
+use cudarc::driver::{
+    sys, CudaContext, CudaEvent, CudaFunction, CudaSlice, CudaStream, LaunchConfig, PushKernelArg,
+};
+use sdfc_compiler::back::wgsl::STATS_WORDS;
+use std::ops::Range;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -48,6 +53,7 @@ pub struct Cuda {
     /// Compute capability as major·10 + minor (90 for an H100).
     pub sm: u32,
     name: String,
+    memory: u64,
 }
 
 /// A kernel loaded into the device, with how it was loaded.
@@ -60,24 +66,49 @@ pub struct Loaded {
     pub cached: bool,
 }
 
-/// Per-pixel results of a render (same layout as the wgpu path).
-#[derive(Debug, Clone)]
-pub struct Frame {
-    /// Linear RGB per pixel, row-major.
-    pub linear: Vec<[f32; 3]>,
-    /// Statistics words per pixel.
-    pub stats: Vec<u32>,
-    /// Time of the launches, measured with CUDA events.
-    pub gpu_time: Duration,
-    /// Wall time from the first launch until the last finished (readback excluded).
-    pub wall_time: Duration,
-    /// Where the wall time of the whole frame went.
-    pub phases: super::Phases,
+/// A kernel loaded on a [`Cuda`] device, ready to render tiles ([`Cuda::kernel`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Kernel<'a> {
+    cuda: &'a Cuda,
+    loaded: &'a Loaded,
+    workgroup: u32,
+}
+
+/// A frame's buffers on the device, and the events timing its launches.
+pub struct FrameBuffers {
+    uniforms: CudaSlice<u8>,
+    tiles: CudaSlice<u32>,
+    image: CudaSlice<f32>,
+    stats: CudaSlice<u32>,
+    data: Option<CudaSlice<u8>>,
+    events: Vec<(CudaEvent, CudaEvent)>,
+}
+
+impl std::fmt::Debug for FrameBuffers {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FrameBuffers").finish_non_exhaustive()
+    }
 }
 
 impl Cuda {
     /// Opens device 0.
     pub fn open() -> Result<Cuda, Error> {
+        Self::open_device(0, false)
+    }
+
+    /// The number of CUDA devices (0 without a driver).
+    pub fn count() -> usize {
+        // SAFETY: only tries to dlopen libcuda; no driver call is made.
+        if !unsafe { sys::is_culib_present() } {
+            return 0;
+        }
+        CudaContext::device_count().map_or(0, |n| n.max(0) as usize)
+    }
+
+    /// Opens device `ordinal`. With `own_stream`, its launches go to a stream of their own
+    /// (two `Cuda` opened on one device then run side by side, as two logical devices);
+    /// otherwise to the context's default stream.
+    pub fn open_device(ordinal: usize, own_stream: bool) -> Result<Cuda, Error> {
         // SAFETY: only tries to dlopen libcuda; no driver call is made.
         if !unsafe { sys::is_culib_present() } {
             return Err(Error::NoDriver);
@@ -86,7 +117,15 @@ impl Cuda {
         if count < 1 {
             return Err(Error::NoDevice);
         }
-        let ctx = CudaContext::new(0).map_err(driver("creating a context"))?;
+        if ordinal >= count as usize {
+            return Err(Error::Driver {
+                during: "opening the device",
+                message: format!(
+                    "there is no CUDA device {ordinal} (the driver found {count}; `sdfc devices` lists them)"
+                ),
+            });
+        }
+        let ctx = CudaContext::new(ordinal).map_err(driver("creating a context"))?;
         let major = ctx
             .attribute(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR)
             .map_err(driver("reading the compute capability"))?;
@@ -94,13 +133,24 @@ impl Cuda {
             .attribute(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR)
             .map_err(driver("reading the compute capability"))?;
         let name = ctx.name().map_err(driver("reading the device name"))?;
-        let stream = ctx.default_stream();
+        let memory = ctx.total_mem().map_err(driver("reading the memory size"))? as u64;
+        let stream = if own_stream {
+            ctx.new_stream().map_err(driver("creating a stream"))?
+        } else {
+            ctx.default_stream()
+        };
         Ok(Cuda {
             ctx,
             stream,
             sm: (major * 10 + minor) as u32,
             name,
+            memory,
         })
+    }
+
+    /// The device's memory in bytes.
+    pub fn memory(&self) -> u64 {
+        self.memory
     }
 
     /// The device's name and compute capability.
@@ -208,104 +258,155 @@ impl Cuda {
         }
     }
 
-    /// Renders one frame: one launch per tile of `tile`×`tile` pixels. `data` is the
-    /// kernel's read-only `scene_data` (binding 4), when it declares one.
-    #[allow(clippy::too_many_arguments)]
-    pub fn render(
-        &self,
-        k: &Loaded,
-        uniforms: &[u8],
-        data: Option<&[u8]>,
-        width: u32,
-        height: u32,
-        stats_words: u32,
-        workgroup: u32,
-        tile: u32,
-    ) -> Result<Frame, Error> {
-        let setup = Instant::now();
-        let s = &self.stream;
-        let pixels = width as usize * height as usize;
-        let tiles = super::wgpu::tiles(width, height, tile);
-        let table: Vec<u32> = tiles.iter().flat_map(|t| [t.0, t.1, t.2, t.3]).collect();
-        let d_uniforms = s
-            .clone_htod(uniforms)
+    /// The kernel `loaded` on this device (workgroups of `workgroup`² threads), as a
+    /// [`launch::Device`] the scheduler renders tiles on.
+    pub fn kernel<'a>(&'a self, loaded: &'a Loaded, workgroup: u32) -> Kernel<'a> {
+        Kernel {
+            cuda: self,
+            loaded,
+            workgroup,
+        }
+    }
+}
+
+impl launch::Device for Kernel<'_> {
+    type Frame = FrameBuffers;
+    type Error = Error;
+
+    fn describe(&self) -> String {
+        self.cuda.describe()
+    }
+
+    fn prepare(&self, job: &Job) -> Result<FrameBuffers, Error> {
+        let s = &self.cuda.stream;
+        let pixels = job.width as usize * job.height as usize;
+        let table: Vec<u32> = job
+            .tiles
+            .iter()
+            .flat_map(|t| [t.0, t.1, t.2, t.3])
+            .collect();
+        let uniforms = s
+            .clone_htod(job.uniforms)
             .map_err(driver("uploading the scene"))?;
-        let d_tiles = s
+        let tiles = s
             .clone_htod(&table)
             .map_err(driver("uploading the tiles"))?;
-        let mut d_image = s
+        let image = s
             .alloc_zeros::<f32>(pixels * 4)
             .map_err(driver("allocating the image"))?;
-        let mut d_stats = s
-            .alloc_zeros::<u32>(pixels * stats_words as usize)
+        let stats = s
+            .alloc_zeros::<u32>(pixels * STATS_WORDS as usize)
             .map_err(driver("allocating the statistics"))?;
-        let d_data = match data {
+        let data = match job.data {
             Some(bytes) => Some(
                 s.clone_htod(bytes)
                     .map_err(driver("uploading the scene data"))?,
             ),
             None => None,
         };
+        s.synchronize().map_err(driver("uploading the scene"))?;
+        Ok(FrameBuffers {
+            uniforms,
+            tiles,
+            image,
+            stats,
+            data,
+            events: Vec::with_capacity(job.tiles.len()),
+        })
+    }
+
+    fn run(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
+        let s = &self.cuda.stream;
+        let workgroup = self.workgroup;
         // Each launch is timed by its own pair of events, and the times are summed: the
         // same measure as the wgpu path's per-pass timestamps (gaps between launches excluded).
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
-        let mut events = Vec::with_capacity(tiles.len());
-        let fault = super::fault_after_tiles();
-        s.synchronize().map_err(driver("uploading the scene"))?;
-        let setup = setup.elapsed();
-        let wall = Instant::now();
-        for (i, t) in tiles.iter().enumerate() {
-            if let Some(message) = super::injected_fault(fault, i) {
-                return Err(Error::Driver {
-                    during: "running the kernel",
-                    message,
-                });
-            }
-            let start = self
-                .ctx
-                .new_event(flags)
-                .map_err(driver("creating an event"))?;
-            let end = self
-                .ctx
-                .new_event(flags)
-                .map_err(driver("creating an event"))?;
-            let tile_view = d_tiles.slice(4 * i..4 * i + 4);
+        for &i in tiles {
+            let t = job.tiles[i];
+            let timed = if job.timed {
+                let start = self
+                    .cuda
+                    .ctx
+                    .new_event(flags)
+                    .map_err(driver("creating an event"))?;
+                let end = self
+                    .cuda
+                    .ctx
+                    .new_event(flags)
+                    .map_err(driver("creating an event"))?;
+                Some((start, end))
+            } else {
+                None
+            };
+            let tile_view = f.tiles.slice(4 * i..4 * i + 4);
             let cfg = LaunchConfig {
                 grid_dim: (t.2.div_ceil(workgroup), t.3.div_ceil(workgroup), 1),
                 block_dim: (workgroup, workgroup, 1),
                 shared_mem_bytes: 0,
             };
-            let mut launch = s.launch_builder(&k.function);
+            let mut launch = s.launch_builder(&self.loaded.function);
             launch
-                .arg(&d_uniforms)
+                .arg(&f.uniforms)
                 .arg(&tile_view)
-                .arg(&mut d_image)
-                .arg(&mut d_stats);
-            if let Some(d) = &d_data {
+                .arg(&mut f.image)
+                .arg(&mut f.stats);
+            if let Some(d) = &f.data {
                 launch.arg(d);
             }
-            start.record(s).map_err(driver("recording an event"))?;
+            if let Some((start, _)) = &timed {
+                start.record(s).map_err(driver("recording an event"))?;
+            }
             // SAFETY: the kernel's parameters are its buffers in binding order, as the PTX back
-            // end declares them: four, and the scene data when the kernel has it (the caller
-            // passes `data` exactly then); each buffer is as large as the kernel indexes.
+            // end declares them: four, and the scene data when the kernel has it (the job
+            // carries `data` exactly then); each buffer is as large as the kernel indexes.
             unsafe { launch.launch(cfg) }.map_err(driver("launching the kernel"))?;
-            end.record(s).map_err(driver("recording an event"))?;
-            events.push((start, end));
+            if let Some((start, end)) = timed {
+                end.record(s).map_err(driver("recording an event"))?;
+                f.events.push((start, end));
+            }
         }
-        s.synchronize().map_err(driver("running the kernel"))?;
-        let wall_time = wall.elapsed();
-        let mut ms = 0.0f64;
-        for (start, end) in &events {
-            ms += start.elapsed_ms(end).map_err(driver("reading the timer"))? as f64;
-        }
-        let readback = Instant::now();
-        let image = s
-            .clone_dtoh(&d_image)
-            .map_err(driver("reading the image"))?;
-        let stats = s
-            .clone_dtoh(&d_stats)
-            .map_err(driver("reading the statistics"))?;
-        let readback = readback.elapsed();
+        s.synchronize().map_err(driver("running the kernel"))
+    }
+
+    fn read(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        ranges: &[Range<usize>],
+    ) -> Result<Pixels, Error> {
+        let s = &self.cuda.stream;
+        let whole = ranges.len() == 1 && ranges[0] == (0..job.width as usize * job.height as usize);
+        let words = STATS_WORDS as usize;
+        let (image, stats) = if whole {
+            let image = s
+                .clone_dtoh(&f.image)
+                .map_err(driver("reading the image"))?;
+            let stats = s
+                .clone_dtoh(&f.stats)
+                .map_err(driver("reading the statistics"))?;
+            (image, stats)
+        } else {
+            let n: usize = ranges.iter().map(|r| r.end - r.start).sum();
+            let mut image = vec![0f32; 4 * n];
+            let mut stats = vec![0u32; words * n];
+            let mut at = 0;
+            for r in ranges {
+                let len = r.end - r.start;
+                s.memcpy_dtoh(
+                    &f.image.slice(4 * r.start..4 * r.end),
+                    &mut image[4 * at..4 * (at + len)],
+                )
+                .map_err(driver("reading the image"))?;
+                s.memcpy_dtoh(
+                    &f.stats.slice(words * r.start..words * r.end),
+                    &mut stats[words * at..words * (at + len)],
+                )
+                .map_err(driver("reading the statistics"))?;
+                at += len;
+            }
+            s.synchronize().map_err(driver("reading the image"))?;
+            (image, stats)
+        };
         let convert = Instant::now();
         let linear = {
             use rayon::prelude::*;
@@ -314,19 +415,32 @@ impl Cuda {
                 .map(|c| [c[0], c[1], c[2]])
                 .collect()
         };
-        let phases = super::Phases {
-            setup,
-            launches: wall_time,
-            readback,
-            convert: convert.elapsed(),
-        };
-        Ok(Frame {
+        drop(image);
+        let (counters, steps) = super::counters(&stats);
+        Ok(Pixels {
             linear,
-            stats,
-            gpu_time: Duration::from_secs_f64(ms / 1e3),
-            wall_time,
-            phases,
+            steps,
+            counters,
+            convert: convert.elapsed(),
         })
+    }
+
+    fn finish(&self, f: FrameBuffers, job: &Job) -> Result<Option<Duration>, Error> {
+        if !job.timed {
+            return Ok(None);
+        }
+        let mut ms = 0.0f64;
+        for (start, end) in &f.events {
+            ms += start.elapsed_ms(end).map_err(driver("reading the timer"))? as f64;
+        }
+        Ok(Some(Duration::from_secs_f64(ms / 1e3)))
+    }
+
+    fn fault(&self, message: String) -> Error {
+        Error::Driver {
+            during: "running the kernel",
+            message,
+        }
     }
 }
 

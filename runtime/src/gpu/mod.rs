@@ -2,38 +2,20 @@
 //! through the CUDA driver. Results have the CPU renderer's shape (an image and the same
 //! statistics) so that every backend is compared the same way.
 
+pub mod cpu;
 pub mod cuda;
+pub mod launch;
 pub mod wgpu;
 
 use crate::cpu::{Counters, Render, Stats};
 use crate::image::Image;
 use crate::memory::Memory;
 use sdfc_compiler::back::wgsl::{self, Kernel, STATS_WORDS};
-use sdfc_compiler::scene::Scene;
-use std::time::Duration;
+use sdfc_compiler::scene::{Scene, Settings};
+use std::time::{Duration, Instant};
 
+pub use self::launch::FAULT_AFTER_TILES;
 pub use self::wgpu::{Error, Gpu};
-
-/// The testing aid `SDFC_FAULT_AFTER_TILES=N`: the GPU backends render N tiles, then report
-/// a device error for the next one through the path a real device error takes (wgpu:
-/// [`Error::Render`]; CUDA: a driver error), so that tests can check what a failure
-/// mid-render leaves behind. Unset (or not a number), nothing is injected.
-pub const FAULT_AFTER_TILES: &str = "SDFC_FAULT_AFTER_TILES";
-
-/// The number of tiles after which to inject a device error, from [`FAULT_AFTER_TILES`].
-pub(crate) fn fault_after_tiles() -> Option<usize> {
-    std::env::var(FAULT_AFTER_TILES).ok()?.trim().parse().ok()
-}
-
-/// The message of the device error injected at tile `tile` (0-based), if one is.
-pub(crate) fn injected_fault(after: Option<usize>, tile: usize) -> Option<String> {
-    (after == Some(tile)).then(|| {
-        format!(
-            "device error injected at tile {} by {FAULT_AFTER_TILES}={tile} (a testing aid)",
-            tile + 1
-        )
-    })
-}
 
 /// Tile edge in pixels for GPU launches: a 1920×1080 frame is one launch, a 7680×4320 one
 /// twelve. Every launch waits for its slowest rays, so the fewer launches a frame takes, the
@@ -57,6 +39,8 @@ pub struct GpuRender {
     /// Wall time from the first submission until the GPU finished (launch overheads
     /// included, readback excluded).
     pub wall: Duration,
+    /// What each device did, when several rendered the frame ([`render_several`]).
+    pub shares: Vec<launch::Share>,
 }
 
 /// Where a GPU frame's wall time went on the host (`sdfc render --stats`): buffers allocated
@@ -92,7 +76,8 @@ impl std::fmt::Display for Phases {
     }
 }
 
-/// Renders `scene` with an already generated kernel on `gpu`.
+/// Renders `scene` with an already generated kernel on `gpu` (with the faults of
+/// [`FAULT_AFTER_TILES`] injected).
 pub fn render(
     gpu: &Gpu,
     scene: &Scene,
@@ -100,83 +85,124 @@ pub fn render(
     lipschitz: f64,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, Error> {
-    let s = &scene.settings;
+    render_faults(
+        gpu,
+        scene,
+        kernel,
+        lipschitz,
+        &launch::Faults::from_env(),
+        progress,
+    )
+}
+
+/// [`render`] with the faults `faults` injected.
+pub fn render_faults(
+    gpu: &Gpu,
+    scene: &Scene,
+    kernel: &Kernel,
+    lipschitz: f64,
+    faults: &launch::Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<GpuRender, Error> {
     let uniforms = wgsl::uniforms(scene, lipschitz);
-    let launch = self::wgpu::Launch {
-        wgsl: &kernel.source,
-        entry: wgsl::ENTRY_POINT,
-        uniforms: &uniforms,
-        data: kernel.data.as_deref(),
-        width: s.width,
-        height: s.height,
-        stats_words: STATS_WORDS,
-        workgroup: wgsl::WORKGROUP,
-        tile: TILE,
-    };
-    let frame = gpu.render(&launch, progress)?;
-    let start = std::time::Instant::now();
-    let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
-    let mut phases = frame.phases;
-    phases.convert += start.elapsed();
-    let image = Image {
-        width: s.width,
-        height: s.height,
-        linear: frame.linear,
-    };
-    Ok(GpuRender {
-        render: Render {
-            image,
-            stats,
-            depth: None,
-        },
-        phases,
-        time: frame.gpu_time.unwrap_or(frame.wall_time),
-        timestamps: frame.gpu_time.is_some(),
-        wall: frame.wall_time,
-    })
+    let device = gpu.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
+    render_one(
+        &device,
+        scene,
+        &uniforms,
+        kernel.data.as_deref(),
+        faults,
+        progress,
+    )
 }
 
 /// Renders `scene` with a kernel already loaded on a CUDA device; `data` is the kernel's
-/// scene data ([`Kernel::data`]).
+/// scene data ([`Kernel::data`]); `faults` are injected.
 pub fn render_cuda(
     cuda: &cuda::Cuda,
     scene: &Scene,
-    loaded: &cuda::Loaded,
-    data: Option<&[u8]>,
+    (loaded, data): (&cuda::Loaded, Option<&[u8]>),
     lipschitz: f64,
+    faults: &launch::Faults,
+    progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, cuda::Error> {
-    let s = &scene.settings;
     let uniforms = wgsl::uniforms(scene, lipschitz);
-    let frame = cuda.render(
-        loaded,
-        &uniforms,
+    let device = cuda.kernel(loaded, wgsl::WORKGROUP);
+    render_one(&device, scene, &uniforms, data, faults, progress)
+}
+
+/// Renders `scene` on one device, in squares of [`TILE`] pixels.
+fn render_one<D: launch::Device>(
+    device: &D,
+    scene: &Scene,
+    uniforms: &[u8],
+    data: Option<&[u8]>,
+    faults: &launch::Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<GpuRender, D::Error> {
+    let s = &scene.settings;
+    let tiles = launch::tiling(s.width, s.height, TILE, 1);
+    let job = launch::Job {
+        uniforms,
         data,
-        s.width,
-        s.height,
-        STATS_WORDS,
-        wgsl::WORKGROUP,
-        TILE,
-    )?;
-    let start = std::time::Instant::now();
-    let stats = stats(&frame.stats, (s.width as u64) * (s.height as u64), s.aa);
-    let mut phases = frame.phases;
-    phases.convert += start.elapsed();
-    let image = Image {
         width: s.width,
         height: s.height,
-        linear: frame.linear,
+        tiles: &tiles,
+        timed: true,
     };
-    Ok(GpuRender {
+    let out = launch::render_one(device, &job, faults, progress)?;
+    Ok(finish(out, s))
+}
+
+/// Renders `scene` on several devices at once ([`launch::render_several`]): the kernel's
+/// uniforms are those of `scene` with the Lipschitz bound `lipschitz`, and `data` its scene
+/// data, the same on every GPU device. `Err` when every device failed.
+pub fn render_several(
+    devices: &[&dyn launch::Worker],
+    scene: &Scene,
+    (lipschitz, data): (f64, Option<&[u8]>),
+    faults: &launch::Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<GpuRender, String> {
+    let s = &scene.settings;
+    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let tiles = launch::tiling(s.width, s.height, TILE, devices.len());
+    let job = launch::Job {
+        uniforms: &uniforms,
+        data,
+        width: s.width,
+        height: s.height,
+        tiles: &tiles,
+        timed: false,
+    };
+    let out = launch::render_several(devices, &job, faults, progress)?;
+    Ok(finish(out, s))
+}
+
+/// The image and statistics of a frame the scheduler rendered.
+fn finish(out: launch::Output, s: &Settings) -> GpuRender {
+    let start = Instant::now();
+    let mut counters = out.counters;
+    counters.camera_rays = (s.width as u64) * (s.height as u64) * (s.aa.max(1) as u64).pow(2);
+    let stats = Stats::new(counters, &out.steps);
+    let mut phases = out.phases;
+    phases.convert += start.elapsed();
+    GpuRender {
         render: Render {
-            image,
+            image: Image {
+                width: s.width,
+                height: s.height,
+                linear: out.linear,
+            },
             stats,
             depth: None,
         },
         phases,
-        time: frame.gpu_time,
-        timestamps: true,
-        wall: frame.wall_time,
-    })
+        time: out.device_time.unwrap_or(out.wall),
+        timestamps: out.device_time.is_some(),
+        wall: out.wall,
+        shares: out.shares,
+    }
 }
 
 /// The most a wgpu render of `settings` allocates, with a scene uniform of `uniforms` bytes and
@@ -185,7 +211,7 @@ pub fn render_cuda(
 /// queries. On the host: wgpu's staging copy of the scene data, the tile table (and its
 /// staging copy), the read-back bytes and their conversion to colours and statistics words,
 /// then the statistics' per-pixel steps and their sorted copy.
-pub fn memory_wgpu(settings: &sdfc_compiler::scene::Settings, uniforms: u64, data: u64) -> Memory {
+pub fn memory_wgpu(settings: &Settings, uniforms: u64, data: u64) -> Memory {
     let (pixels, tiles) = pixels_and_tiles(settings);
     let stats = 4 * STATS_WORDS as u64 * pixels;
     let table = tiles * 256;
@@ -202,7 +228,7 @@ pub fn memory_wgpu(settings: &sdfc_compiler::scene::Settings, uniforms: u64, dat
 /// and scene data of `data` bytes: on the device the uniform, scene data, tile table, image and
 /// statistics; on the host the tile table, the read-back floats (16 bytes a pixel), colours
 /// (12) and statistics, then the steps.
-pub fn memory_cuda(settings: &sdfc_compiler::scene::Settings, uniforms: u64, data: u64) -> Memory {
+pub fn memory_cuda(settings: &Settings, uniforms: u64, data: u64) -> Memory {
     let (pixels, tiles) = pixels_and_tiles(settings);
     let stats = 4 * STATS_WORDS as u64 * pixels;
     let device = uniforms + data + 16 * tiles + 16 * pixels + stats;
@@ -211,23 +237,24 @@ pub fn memory_cuda(settings: &sdfc_compiler::scene::Settings, uniforms: u64, dat
 }
 
 /// The bytes of a finished GPU frame: its image.
-pub fn retained(settings: &sdfc_compiler::scene::Settings) -> u64 {
+pub fn retained(settings: &Settings) -> u64 {
     12 * settings.width as u64 * settings.height as u64
 }
 
-fn pixels_and_tiles(settings: &sdfc_compiler::scene::Settings) -> (u64, u64) {
+fn pixels_and_tiles(settings: &Settings) -> (u64, u64) {
     let (w, h) = (settings.width as u64, settings.height as u64);
     let edge = TILE as u64;
     (w * h, w.div_ceil(edge) * h.div_ceil(edge))
 }
 
-/// Sums the kernel's per-pixel statistics words into the CPU renderer's statistics.
-pub fn stats(words: &[u32], pixels: u64, aa: u32) -> Stats {
+/// Sums the kernel's per-pixel statistics words into the CPU renderer's counters (all but
+/// the camera rays, which the settings give), with the marching steps of each pixel.
+pub(crate) fn counters(words: &[u32]) -> (Counters, Vec<u32>) {
     use rayon::prelude::*;
     let n = STATS_WORDS as usize;
     // In parallel: a 1080p frame has two million pixels of eight words.
     let steps: Vec<u32> = words.par_chunks_exact(n).map(|w| w[0]).collect();
-    let mut c = words
+    let c = words
         .par_chunks_exact(n)
         .fold(Counters::default, |mut c, w| {
             c.steps += w[0] as u64;
@@ -244,6 +271,5 @@ pub fn stats(words: &[u32], pixels: u64, aa: u32) -> Stats {
             a.add(&b);
             a
         });
-    c.camera_rays = pixels * (aa.max(1) as u64).pow(2);
-    Stats::new(c, &steps)
+    (c, steps)
 }

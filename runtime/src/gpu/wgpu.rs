@@ -2,7 +2,10 @@
 //! image in tiles (one dispatch each, so that no dispatch runs long enough to trip a driver
 //! watchdog), reading back the linear colours and the per-pixel statistics.
 
+use super::launch::{self, Job, Pixels};
+use sdfc_compiler::back::wgsl::STATS_WORDS;
 use std::collections::HashMap;
+use std::ops::Range;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -15,6 +18,9 @@ pub enum Error {
         /// "GPU" or "wgpu".
         what: &'static str,
     },
+    /// `--devices` named an adapter wgpu did not find.
+    #[error("there is no wgpu adapter {index} (wgpu found {count}; `sdfc devices` lists them)")]
+    NoSuchAdapter { index: usize, count: usize },
     /// The adapter refused the device request.
     #[error("the adapter `{adapter}` refused to open a device: {message}")]
     Device { adapter: String, message: String },
@@ -28,8 +34,6 @@ pub enum Error {
 
 /// Bytes between tile entries in the tile table (the largest uniform offset alignment).
 const TILE_STRIDE: u32 = 256;
-/// Tiles per queue submission.
-const TILES_PER_SUBMIT: usize = 8;
 
 /// Compiled pipelines kept by a [`Gpu`] (at most this many; the cache is emptied when full).
 const PIPELINES_KEPT: usize = 16;
@@ -57,41 +61,29 @@ pub struct PipelineTime {
     pub cached: bool,
 }
 
-/// Per-pixel results of a render.
-#[derive(Debug, Clone)]
-pub struct Frame {
-    /// Linear RGB per pixel, row-major.
-    pub linear: Vec<[f32; 3]>,
-    /// The kernel's statistics words per pixel, `stats_words` of them per pixel.
-    pub stats: Vec<u32>,
-    /// GPU time of the dispatches measured with timestamps, where the adapter has them.
-    pub gpu_time: Option<Duration>,
-    /// Wall time from the first submit until the last dispatch finished (readback excluded).
-    pub wall_time: Duration,
-    /// Where the wall time of the whole frame went.
-    pub phases: super::Phases,
+/// A kernel on a [`Gpu`], ready to render tiles ([`Gpu::kernel`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Kernel<'a> {
+    gpu: &'a Gpu,
+    wgsl: &'a str,
+    entry: &'a str,
+    workgroup: u32,
 }
 
-/// A compiled kernel ready to launch: its WGSL, entry point and uniform bytes.
-#[derive(Debug, Clone, Copy)]
-pub struct Launch<'a> {
-    /// WGSL source (validated by the compiler).
-    pub wgsl: &'a str,
-    /// Entry point name.
-    pub entry: &'a str,
-    /// Bytes of the scene uniform (binding 0).
-    pub uniforms: &'a [u8],
-    /// Bytes of the read-only `scene_data` (binding 4), when the kernel declares it.
-    pub data: Option<&'a [u8]>,
-    /// Image size.
-    pub width: u32,
-    pub height: u32,
-    /// Statistics words written per pixel (binding 3).
-    pub stats_words: u32,
-    /// Workgroup edge of the kernel (it is square).
-    pub workgroup: u32,
-    /// Tile edge in pixels.
-    pub tile: u32,
+/// A frame's buffers on the device: the pipeline and its bindings, the timestamp queries and
+/// the error scope that catches running out of memory.
+pub struct FrameBuffers {
+    pipeline: Pipeline,
+    buffers: Buffers,
+    bind: wgpu::BindGroup,
+    queries: Option<wgpu::QuerySet>,
+    memory: Option<wgpu::ErrorScopeGuard>,
+}
+
+impl std::fmt::Debug for FrameBuffers {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FrameBuffers").finish_non_exhaustive()
+    }
 }
 
 /// The process's one wgpu instance, never destroyed. Destroying the last Vulkan instance
@@ -107,11 +99,39 @@ fn instance() -> &'static wgpu::Instance {
     })
 }
 
+/// The adapters wgpu finds, in its order (the indices of `--devices` and `sdfc devices`).
+pub fn adapters() -> Vec<wgpu::Adapter> {
+    pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()))
+}
+
+/// One line about an adapter: its name, backend and kind, and its largest buffer (wgpu does
+/// not report a device's memory).
+pub fn describe_adapter(adapter: &wgpu::Adapter) -> String {
+    let info = adapter.get_info();
+    format!(
+        "{} ({:?}, {:?}); largest buffer {} MiB",
+        info.name,
+        info.backend,
+        info.device_type,
+        adapter.limits().max_buffer_size >> 20
+    )
+}
+
 impl Gpu {
+    /// Opens adapter `index` of [`adapters`].
+    pub fn open_index(index: usize) -> Result<Gpu, Error> {
+        let adapters = adapters();
+        let count = adapters.len();
+        match adapters.into_iter().nth(index) {
+            Some(a) => Self::from_adapter(&a),
+            None => Err(Error::NoSuchAdapter { index, count }),
+        }
+    }
+
     /// Opens the first adapter wgpu finds. With `require_hardware`, a CPU adapter (lavapipe)
     /// does not count.
     pub fn open(require_hardware: bool) -> Result<Gpu, Error> {
-        let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()));
+        let adapters = adapters();
         let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
             wgpu::DeviceType::DiscreteGpu => 0,
             wgpu::DeviceType::IntegratedGpu => 1,
@@ -223,111 +243,15 @@ impl Gpu {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
-    /// Renders one frame. `progress` is called with the fraction done after each tile.
-    pub fn render(&self, l: &Launch, progress: &mut dyn FnMut(f64)) -> Result<Frame, Error> {
-        let setup = Instant::now();
-        let limit = self.device.limits().max_storage_buffer_binding_size;
-        if let Some(data) = l.data.filter(|d| d.len() as u64 > limit) {
-            return Err(Error::Render(format!(
-                "the scene's primitives take {} bytes, more than the {limit} bytes a storage buffer of this adapter may bind",
-                data.len()
-            )));
+    /// The kernel `wgsl` (entry point `entry`, workgroups of `workgroup`² threads) on this
+    /// device, as a [`launch::Device`] the scheduler renders tiles on.
+    pub fn kernel<'a>(&'a self, wgsl: &'a str, entry: &'a str, workgroup: u32) -> Kernel<'a> {
+        Kernel {
+            gpu: self,
+            wgsl,
+            entry,
+            workgroup,
         }
-        let (pipeline, _) = self.cached_pipeline(l.wgsl, l.entry, l.data.is_some())?;
-        let pixels = l.width as u64 * l.height as u64;
-        let tiles = tiles(l.width, l.height, l.tile);
-        let buffers = self.buffers(l, pixels, tiles.len() as u64);
-        let bind = self.bind_group(&pipeline.1, &buffers);
-        let pipeline = &pipeline.0;
-        let queries = self.timestamps.then(|| {
-            self.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("sdfc timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2 * tiles.len() as u32,
-            })
-        });
-        let mem_scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let table: Vec<u8> = tiles
-            .iter()
-            .flat_map(|t| {
-                let mut entry = words(&[t.0, t.1, t.2, t.3]);
-                entry.resize(TILE_STRIDE as usize, 0);
-                entry
-            })
-            .collect();
-        self.queue.write_buffer(&buffers.tile, 0, &table);
-        // (wgpu's writes are queued: the uploads are paid for in the first submission.)
-        let setup = setup.elapsed();
-        let start = Instant::now();
-        let fault = super::fault_after_tiles();
-        // Tiles are submitted in batches: each tile is its own dispatch, and the host waits
-        // after each batch (progress, and a bound on how much work is queued at once).
-        for (b, batch) in tiles.chunks(TILES_PER_SUBMIT).enumerate() {
-            let mut enc = self.device.create_command_encoder(&Default::default());
-            for (j, t) in batch.iter().enumerate() {
-                let i = (b * TILES_PER_SUBMIT + j) as u32;
-                let writes = queries.as_ref().map(|q| wgpu::ComputePassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(2 * i),
-                    end_of_pass_write_index: Some(2 * i + 1),
-                });
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: None,
-                    timestamp_writes: writes,
-                });
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &bind, &[i * TILE_STRIDE]);
-                pass.dispatch_workgroups(t.2.div_ceil(l.workgroup), t.3.div_ceil(l.workgroup), 1);
-            }
-            self.queue.submit([enc.finish()]);
-            self.wait()?;
-            let first = b * TILES_PER_SUBMIT;
-            if let Some(msg) =
-                (first..first + batch.len()).find_map(|i| super::injected_fault(fault, i))
-            {
-                return Err(Error::Render(msg));
-            }
-            progress(((b * TILES_PER_SUBMIT + batch.len()) as f64 / tiles.len() as f64).min(1.0));
-        }
-        let wall_time = start.elapsed();
-        let readback = Instant::now();
-        let linear = self.read(&buffers.image, pixels * 16)?;
-        let stats = self.read(&buffers.stats, pixels * 4 * l.stats_words as u64)?;
-        let readback = readback.elapsed();
-        if let Some(e) = pollster::block_on(mem_scope.pop()) {
-            return Err(Error::Render(e.to_string()));
-        }
-        let gpu_time = match &queries {
-            Some(q) => Some(self.gpu_time(q, tiles.len() as u32)?),
-            None => None,
-        };
-        let convert = Instant::now();
-        let (linear, stats) = {
-            use rayon::prelude::*;
-            let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-            let linear = linear
-                .par_chunks_exact(16)
-                .map(|c| [f(&c[0..4]), f(&c[4..8]), f(&c[8..12])])
-                .collect();
-            let stats = stats
-                .par_chunks_exact(4)
-                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                .collect();
-            (linear, stats)
-        };
-        let phases = super::Phases {
-            setup,
-            launches: wall_time,
-            readback,
-            convert: convert.elapsed(),
-        };
-        Ok(Frame {
-            linear,
-            stats,
-            gpu_time,
-            wall_time,
-            phases,
-        })
     }
 
     /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
@@ -396,7 +320,7 @@ impl Gpu {
         (pipeline, layout)
     }
 
-    fn buffers(&self, l: &Launch, pixels: u64, tiles: u64) -> Buffers {
+    fn buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {
         use wgpu::BufferUsages as U;
         let make = |label, size: u64, usage| {
             self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -432,7 +356,7 @@ impl Gpu {
             image: make("sdfc image", pixels * 16, U::STORAGE | U::COPY_SRC),
             stats: make(
                 "sdfc stats",
-                pixels * 4 * l.stats_words as u64,
+                pixels * 4 * STATS_WORDS as u64,
                 U::STORAGE | U::COPY_SRC,
             ),
         }
@@ -483,6 +407,12 @@ impl Gpu {
     }
 
     fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
+        self.read_ranges(src, std::slice::from_ref(&(0..size)))
+    }
+
+    /// The bytes of `ranges` of `src`, one after the other, through one staging buffer.
+    fn read_ranges(&self, src: &wgpu::Buffer, ranges: &[Range<u64>]) -> Result<Vec<u8>, Error> {
+        let size: u64 = ranges.iter().map(|r| r.end - r.start).sum();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("sdfc readback"),
             size,
@@ -490,7 +420,11 @@ impl Gpu {
             mapped_at_creation: false,
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        let mut at = 0;
+        for r in ranges {
+            enc.copy_buffer_to_buffer(src, r.start, &staging, at, r.end - r.start);
+            at += r.end - r.start;
+        }
         self.queue.submit([enc.finish()]);
         let slice = staging.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();
@@ -542,31 +476,159 @@ struct Buffers {
     stats: wgpu::Buffer,
 }
 
-/// Splits the image into tiles (x, y, width, height) of at most `edge` pixels a side.
-pub fn tiles(width: u32, height: u32, edge: u32) -> Vec<(u32, u32, u32, u32)> {
-    let edge = edge.max(8);
-    let mut out = Vec::new();
-    for y in (0..height).step_by(edge as usize) {
-        for x in (0..width).step_by(edge as usize) {
-            out.push((x, y, edge.min(width - x), edge.min(height - y)));
-        }
-    }
-    out
-}
-
 fn words(w: &[u32]) -> Vec<u8> {
     w.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::tiles;
+impl launch::Device for Kernel<'_> {
+    type Frame = FrameBuffers;
+    type Error = Error;
 
-    #[test]
-    fn tiles_cover_the_image_once() {
-        let t = tiles(100, 70, 32);
-        assert_eq!(t.len(), 4 * 3);
-        let area: u32 = t.iter().map(|t| t.2 * t.3).sum();
-        assert_eq!(area, 100 * 70);
+    fn describe(&self) -> String {
+        self.gpu.describe()
+    }
+
+    fn prepare(&self, job: &Job) -> Result<FrameBuffers, Error> {
+        let gpu = self.gpu;
+        let limit = gpu.device.limits().max_storage_buffer_binding_size;
+        if let Some(data) = job.data.filter(|d| d.len() as u64 > limit) {
+            return Err(Error::Render(format!(
+                "the scene's primitives take {} bytes, more than the {limit} bytes a storage buffer of this adapter may bind",
+                data.len()
+            )));
+        }
+        let (pipeline, _) = gpu.cached_pipeline(self.wgsl, self.entry, job.data.is_some())?;
+        let pixels = job.width as u64 * job.height as u64;
+        let tiles = job.tiles.len() as u64;
+        let buffers = gpu.buffers(job, pixels, tiles);
+        let bind = gpu.bind_group(&pipeline.1, &buffers);
+        let queries = (gpu.timestamps && job.timed).then(|| {
+            gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("sdfc timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * tiles as u32,
+            })
+        });
+        let memory = Some(gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory));
+        let table: Vec<u8> = job
+            .tiles
+            .iter()
+            .flat_map(|t| {
+                let mut entry = words(&[t.0, t.1, t.2, t.3]);
+                entry.resize(TILE_STRIDE as usize, 0);
+                entry
+            })
+            .collect();
+        gpu.queue.write_buffer(&buffers.tile, 0, &table);
+        // (wgpu's writes are queued: the uploads are paid for in the first submission.)
+        Ok(FrameBuffers {
+            pipeline,
+            buffers,
+            bind,
+            queries,
+            memory,
+        })
+    }
+
+    fn run(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
+        let gpu = self.gpu;
+        // Each tile is its own dispatch, in one submission; the host waits for them.
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for &i in tiles {
+            let t = job.tiles[i];
+            let i = i as u32;
+            let writes = f
+                .queries
+                .as_ref()
+                .map(|q| wgpu::ComputePassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(2 * i),
+                    end_of_pass_write_index: Some(2 * i + 1),
+                });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: None,
+                timestamp_writes: writes,
+            });
+            pass.set_pipeline(&f.pipeline.0);
+            pass.set_bind_group(0, &f.bind, &[i * TILE_STRIDE]);
+            pass.dispatch_workgroups(
+                t.2.div_ceil(self.workgroup),
+                t.3.div_ceil(self.workgroup),
+                1,
+            );
+        }
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()
+    }
+
+    fn read(
+        &self,
+        f: &mut FrameBuffers,
+        _job: &Job,
+        ranges: &[Range<usize>],
+    ) -> Result<Pixels, Error> {
+        let bytes = |per: u64| -> Vec<Range<u64>> {
+            ranges
+                .iter()
+                .map(|r| r.start as u64 * per..r.end as u64 * per)
+                .collect()
+        };
+        let linear = self.gpu.read_ranges(&f.buffers.image, &bytes(16))?;
+        let stats = self
+            .gpu
+            .read_ranges(&f.buffers.stats, &bytes(4 * STATS_WORDS as u64))?;
+        let convert = Instant::now();
+        let (linear, words) = {
+            use rayon::prelude::*;
+            let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+            let linear = linear
+                .par_chunks_exact(16)
+                .map(|c| [f(&c[0..4]), f(&c[4..8]), f(&c[8..12])])
+                .collect();
+            let words: Vec<u32> = stats
+                .par_chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect();
+            (linear, words)
+        };
+        drop(stats);
+        let (counters, steps) = super::counters(&words);
+        Ok(Pixels {
+            linear,
+            steps,
+            counters,
+            convert: convert.elapsed(),
+        })
+    }
+
+    fn check(&self, f: &mut FrameBuffers) -> Result<(), Error> {
+        if let Some(scope) = f.memory.take() {
+            let error = pollster::block_on(scope.pop());
+            f.memory = Some(
+                self.gpu
+                    .device
+                    .push_error_scope(wgpu::ErrorFilter::OutOfMemory),
+            );
+            if let Some(e) = error {
+                return Err(Error::Render(e.to_string()));
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(&self, mut f: FrameBuffers, job: &Job) -> Result<Option<Duration>, Error> {
+        if let Some(scope) = f.memory.take() {
+            if let Some(e) = pollster::block_on(scope.pop()) {
+                return Err(Error::Render(e.to_string()));
+            }
+        }
+        match &f.queries {
+            Some(q) => Ok(Some(self.gpu.gpu_time(q, job.tiles.len() as u32)?)),
+            None => Ok(None),
+        }
+    }
+
+    fn fault(&self, message: String) -> Error {
+        Error::Render(message)
     }
 }

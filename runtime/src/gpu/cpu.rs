@@ -1,0 +1,106 @@
+//! The CPU renderer as a device of the tile scheduler ([`launch::Device`]), so that it can
+//! take bands of an image beside GPU devices (`--devices cpu,0`): it renders each band it
+//! takes with [`crate::cpu::render_rows`] in a thread pool of its own.
+
+use super::launch::{self, Job, Pixels};
+use crate::cpu::{self, Options, Tapes};
+use sdfc_compiler::scene::Scene;
+use std::ops::Range;
+use std::time::Duration;
+
+/// The CPU renderer of one scene, as a device.
+#[derive(Debug, Clone, Copy)]
+pub struct Device<'a> {
+    scene: &'a Scene,
+    tapes: &'a Tapes,
+    options: &'a Options,
+    threads: usize,
+}
+
+impl<'a> Device<'a> {
+    /// Renders `scene` from its `tapes` with `options` on as many threads as the current
+    /// rayon pool has.
+    pub fn new(scene: &'a Scene, tapes: &'a Tapes, options: &'a Options) -> Self {
+        Device {
+            scene,
+            tapes,
+            options,
+            threads: rayon::current_num_threads(),
+        }
+    }
+}
+
+/// The CPU's frame: its thread pool and the bands rendered and not yet read.
+#[derive(Debug)]
+pub struct Frame {
+    pool: rayon::ThreadPool,
+    rendered: Vec<(Range<usize>, Pixels)>,
+}
+
+impl launch::Device for Device<'_> {
+    type Frame = Frame;
+    type Error = String;
+
+    fn describe(&self) -> String {
+        format!("CPU, {} threads", self.threads)
+    }
+
+    fn prepare(&self, _job: &Job) -> Result<Frame, String> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads)
+            .build()
+            .map_err(|e| format!("cannot start the CPU's worker threads: {e}"))?;
+        Ok(Frame {
+            pool,
+            rendered: Vec::new(),
+        })
+    }
+
+    fn run(&self, f: &mut Frame, job: &Job, tiles: &[usize]) -> Result<(), String> {
+        for &i in tiles {
+            let t = job.tiles[i];
+            if t.0 != 0 || t.2 != job.width {
+                return Err("the CPU device renders bands of whole rows".into());
+            }
+            let rows = t.1..t.1 + t.3;
+            let (linear, steps, counters) = f
+                .pool
+                .install(|| cpu::render_rows(self.scene, self.tapes, self.options, rows));
+            let w = job.width as usize;
+            f.rendered.push((
+                t.1 as usize * w..(t.1 + t.3) as usize * w,
+                Pixels {
+                    linear,
+                    steps,
+                    counters,
+                    convert: Duration::ZERO,
+                },
+            ));
+        }
+        Ok(())
+    }
+
+    fn read(&self, f: &mut Frame, _job: &Job, ranges: &[Range<usize>]) -> Result<Pixels, String> {
+        let mut out = Pixels::default();
+        for r in ranges {
+            let at = f
+                .rendered
+                .iter()
+                .position(|(have, _)| have == r)
+                .ok_or_else(|| format!("the CPU did not render pixels {r:?}"))?;
+            let (_, p) = f.rendered.swap_remove(at);
+            out.linear.extend(p.linear);
+            out.steps.extend(p.steps);
+            out.counters.add(&p.counters);
+        }
+        Ok(out)
+    }
+
+    fn finish(&self, _f: Frame, _job: &Job) -> Result<Option<Duration>, String> {
+        Ok(None)
+    }
+
+    fn fault(&self, message: String) -> String {
+        message
+    }
+}

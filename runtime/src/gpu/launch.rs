@@ -1,0 +1,693 @@
+//! The one tile scheduler of every launcher: a frame is cut into tiles, each tile is one
+//! dispatch (or launch) on a [`Device`], and the scheduler owns the tiling, the batches and
+//! progress, the fault injection of `SDFC_FAULT_AFTER_TILES`, the phases and timing, and the
+//! assembly of the image and its statistics. A device (wgpu, CUDA, the CPU renderer) only
+//! prepares a frame's buffers, runs tiles, reads pixels back and says how long its tiles took.
+//!
+//! One device renders the image in squares of [`super::TILE`] pixels and reads it back
+//! whole at the end. Several devices ([`render_several`]) take bands of whole rows from one
+//! queue, each worker the next band when it is free, and read back each band as it finishes
+//! (a band is contiguous in the image, so a device reads back only what it rendered); a
+//! device that fails hands its band back to the queue and the others finish the frame.
+
+use super::Phases;
+use crate::cpu::Counters;
+use std::collections::VecDeque;
+use std::ops::Range;
+use std::sync::{mpsc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+/// A tile: x, y, width and height in pixels.
+pub type Tile = (u32, u32, u32, u32);
+
+/// Tiles per submission when one device renders a frame: the host waits after each batch
+/// (progress, and a bound on how much work is queued at once).
+const TILES_PER_SUBMIT: usize = 8;
+
+/// What every device renders of a frame: the kernel's inputs, the image size and the tiles.
+#[derive(Debug, Clone, Copy)]
+pub struct Job<'a> {
+    /// Bytes of the scene uniform (binding 0).
+    pub uniforms: &'a [u8],
+    /// Bytes of the read-only `scene_data` (binding 4), when the kernel declares it.
+    pub data: Option<&'a [u8]>,
+    /// Image size.
+    pub width: u32,
+    pub height: u32,
+    /// The tile table.
+    pub tiles: &'a [Tile],
+    /// Whether to time the tiles on the device (timestamps or events); without it the
+    /// frame's time is its wall time.
+    pub timed: bool,
+}
+
+impl Job<'_> {
+    fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// The pixels of tile `i`, which must span whole rows (a band).
+    fn band(&self, i: usize) -> Range<usize> {
+        let t = self.tiles[i];
+        debug_assert!(t.0 == 0 && t.2 == self.width, "a band spans whole rows");
+        let w = self.width as usize;
+        t.1 as usize * w..(t.1 + t.3) as usize * w
+    }
+}
+
+/// Pixels read back from a device, in the order of the ranges asked for: linear colours,
+/// marching steps per pixel and the counters they add up to, and how long converting them
+/// from the device's layout took.
+#[derive(Debug, Default)]
+pub struct Pixels {
+    pub linear: Vec<[f32; 3]>,
+    pub steps: Vec<u32>,
+    pub counters: Counters,
+    pub convert: Duration,
+}
+
+/// The per-device steps of a render.
+pub trait Device: Sync {
+    /// A frame's buffers on the device.
+    type Frame;
+    /// What goes wrong on it.
+    type Error: std::fmt::Display;
+    /// The device, for messages.
+    fn describe(&self) -> String;
+    /// Allocates a frame's buffers and uploads the uniforms, the scene data and the tile table.
+    fn prepare(&self, job: &Job) -> Result<Self::Frame, Self::Error>;
+    /// Runs the tiles `tiles` (indices into the job's table) and waits until they are done.
+    fn run(&self, frame: &mut Self::Frame, job: &Job, tiles: &[usize]) -> Result<(), Self::Error>;
+    /// Reads back the pixels of `ranges` (row-major pixel indices), one after the other.
+    fn read(
+        &self,
+        frame: &mut Self::Frame,
+        job: &Job,
+        ranges: &[Range<usize>],
+    ) -> Result<Pixels, Self::Error>;
+    /// Errors the device held back so far (on several devices, each band is checked before
+    /// it is accepted).
+    fn check(&self, _frame: &mut Self::Frame) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    /// Ends the frame: errors the device held back, and the time of its tiles when the job
+    /// is timed and the device can time them.
+    fn finish(&self, frame: Self::Frame, job: &Job) -> Result<Option<Duration>, Self::Error>;
+    /// The error a device fault of the testing aid is reported as (the path a real device
+    /// error takes).
+    fn fault(&self, message: String) -> Self::Error;
+}
+
+/// A frame rendered by the scheduler.
+#[derive(Debug)]
+pub struct Output {
+    pub linear: Vec<[f32; 3]>,
+    pub steps: Vec<u32>,
+    pub counters: Counters,
+    pub phases: Phases,
+    /// The tiles' time on the device, where measured.
+    pub device_time: Option<Duration>,
+    /// Wall time from the first launch until the last tile finished.
+    pub wall: Duration,
+    /// What each device did, when several rendered the frame.
+    pub shares: Vec<Share>,
+}
+
+/// What one device did in a frame rendered by several.
+#[derive(Debug, Clone)]
+pub struct Share {
+    /// The device.
+    pub device: String,
+    /// Tiles it rendered (and read back).
+    pub tiles: usize,
+    /// Where its worker's time went (setup, launches, readback, conversion).
+    pub phases: Phases,
+    /// Why it stopped, if it failed.
+    pub failure: Option<String>,
+}
+
+/// The testing aid `SDFC_FAULT_AFTER_TILES`: `N` makes every device report a device error
+/// after N tiles (N tiles render, the next fails), `D:N` only the device at position D of the
+/// render's device list (0-based); entries are separated by commas. Unset, or not in that
+/// form, nothing is injected.
+pub const FAULT_AFTER_TILES: &str = "SDFC_FAULT_AFTER_TILES";
+
+/// The faults asked for by [`FAULT_AFTER_TILES`].
+#[derive(Debug, Clone, Default)]
+pub struct Faults {
+    text: String,
+    entries: Vec<(Option<usize>, usize)>,
+}
+
+impl Faults {
+    /// From the environment.
+    pub fn from_env() -> Faults {
+        std::env::var(FAULT_AFTER_TILES)
+            .ok()
+            .and_then(|t| Faults::parse(&t))
+            .unwrap_or_default()
+    }
+
+    fn parse(text: &str) -> Option<Faults> {
+        let entries = text
+            .split(',')
+            .map(|e| match e.split_once(':') {
+                Some((d, n)) => Some((Some(d.trim().parse().ok()?), n.trim().parse().ok()?)),
+                None => Some((None, e.trim().parse().ok()?)),
+            })
+            .collect::<Option<Vec<_>>>()?;
+        Some(Faults {
+            text: text.trim().to_string(),
+            entries,
+        })
+    }
+
+    /// After how many tiles the device at `position` fails.
+    fn after(&self, position: usize) -> Option<usize> {
+        self.entries
+            .iter()
+            .filter(|(d, _)| d.is_none_or(|d| d == position))
+            .map(|&(_, n)| n)
+            .min()
+    }
+
+    /// The message of the device error injected at the device's tile `tile` (0-based), if
+    /// one is.
+    pub fn injected(&self, position: usize, tile: usize) -> Option<String> {
+        self.injected_within(position, tile..tile + 1)
+    }
+
+    /// The message of the device error injected at one of the device's tiles `tiles`
+    /// (0-based, counted over every frame it rendered), if one is.
+    pub fn injected_within(&self, position: usize, tiles: Range<usize>) -> Option<String> {
+        let tile = self.after(position).filter(|t| tiles.contains(t))?;
+        Some(format!(
+            "device error injected at tile {} by {FAULT_AFTER_TILES}={} (a testing aid)",
+            tile + 1,
+            self.text
+        ))
+    }
+}
+
+/// The tiles of a frame rendered by `devices` devices: squares of `edge` pixels for one,
+/// bands of whole rows for several (at most about `edge`² pixels each, and at least eight per
+/// device, so that a device is not left waiting for another's last band at the end).
+pub fn tiling(width: u32, height: u32, edge: u32, devices: usize) -> Vec<Tile> {
+    if devices <= 1 {
+        return squares(width, height, edge);
+    }
+    let by_area = (edge.max(8) * edge.max(8) / width.max(1)).max(1);
+    let by_count = height.div_ceil(8 * devices as u32).max(1);
+    let rows = by_area.min(by_count);
+    (0..height)
+        .step_by(rows as usize)
+        .map(|y| (0, y, width, rows.min(height - y)))
+        .collect()
+}
+
+/// Splits the image into tiles of at most `edge` pixels a side.
+pub fn squares(width: u32, height: u32, edge: u32) -> Vec<Tile> {
+    let edge = edge.max(8);
+    let mut out = Vec::new();
+    for y in (0..height).step_by(edge as usize) {
+        for x in (0..width).step_by(edge as usize) {
+            out.push((x, y, edge.min(width - x), edge.min(height - y)));
+        }
+    }
+    out
+}
+
+/// Renders `job` on one device: its tiles in batches, waiting after each (progress, the
+/// injected fault), then the image read back whole.
+pub fn render_one<D: Device>(
+    device: &D,
+    job: &Job,
+    faults: &Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Output, D::Error> {
+    let setup = Instant::now();
+    let mut frame = device.prepare(job)?;
+    let setup = setup.elapsed();
+    let start = Instant::now();
+    let all: Vec<usize> = (0..job.tiles.len()).collect();
+    for batch in all.chunks(TILES_PER_SUBMIT) {
+        device.run(&mut frame, job, batch)?;
+        if let Some(msg) = batch.iter().find_map(|&i| faults.injected(0, i)) {
+            return Err(device.fault(msg));
+        }
+        let done = batch.last().map_or(0, |&i| i + 1);
+        progress((done as f64 / all.len().max(1) as f64).min(1.0));
+    }
+    let wall = start.elapsed();
+    let readback = Instant::now();
+    let whole = 0..job.pixels();
+    let pixels = device.read(&mut frame, job, std::slice::from_ref(&whole))?;
+    let readback = readback.elapsed().saturating_sub(pixels.convert);
+    let device_time = device.finish(frame, job)?;
+    Ok(Output {
+        linear: pixels.linear,
+        steps: pixels.steps,
+        counters: pixels.counters,
+        phases: Phases {
+            setup,
+            launches: wall,
+            readback,
+            convert: pixels.convert,
+        },
+        device_time,
+        wall,
+        shares: Vec::new(),
+    })
+}
+
+/// A device as a worker of [`render_several`] (any [`Device`] is one).
+pub trait Worker: Sync {
+    /// The device, for messages.
+    fn name(&self) -> String;
+    /// Takes bands from `bands` until none is left, sending each finished band's pixels.
+    fn work(&self, bands: &Bands, position: usize) -> Share;
+}
+
+/// Work waiting for whichever worker is free: the bands of a frame, or the frames of a
+/// sequence (`sdfc render --frames` on several devices). A worker that fails hands its item
+/// back, and the others take it.
+#[derive(Debug)]
+pub struct Queue<T> {
+    state: Mutex<State<T>>,
+    changed: Condvar,
+}
+
+#[derive(Debug)]
+struct State<T> {
+    waiting: VecDeque<T>,
+    /// Items taken by a worker and not yet finished or handed back.
+    taken: usize,
+    /// Whether more items may still be pushed.
+    open: bool,
+    /// Whether the work was given up: no item is handed out any more.
+    abandoned: bool,
+}
+
+impl<T> Queue<T> {
+    /// A queue of `items`; with `open`, more may be [pushed](Queue::push) until
+    /// [`Queue::close`].
+    pub fn new(items: impl IntoIterator<Item = T>, open: bool) -> Self {
+        Queue {
+            state: Mutex::new(State {
+                waiting: items.into_iter().collect(),
+                taken: 0,
+                open,
+                abandoned: false,
+            }),
+            changed: Condvar::new(),
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, State<T>> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Adds an item at the back.
+    pub fn push(&self, item: T) {
+        self.lock().waiting.push_back(item);
+        self.changed.notify_all();
+    }
+
+    /// No more items will be pushed.
+    pub fn close(&self) {
+        self.lock().open = false;
+        self.changed.notify_all();
+    }
+
+    /// Items waiting for a worker.
+    pub fn waiting(&self) -> usize {
+        self.lock().waiting.len()
+    }
+
+    /// The next item, waiting while one may still come (pushed, or handed back by another
+    /// worker); `None` when every item is done.
+    pub fn take(&self) -> Option<T> {
+        let mut s = self.lock();
+        loop {
+            if s.abandoned {
+                return None;
+            }
+            if let Some(item) = s.waiting.pop_front() {
+                s.taken += 1;
+                return Some(item);
+            }
+            if s.taken == 0 && !s.open {
+                return None;
+            }
+            s = self.changed.wait(s).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+
+    /// The work is given up (an error, or a worker that panicked holding an item): those
+    /// waiting are dropped, and the workers end after the items they hold.
+    pub fn abandon(&self) {
+        let mut s = self.lock();
+        s.open = false;
+        s.abandoned = true;
+        s.waiting.clear();
+        drop(s);
+        self.changed.notify_all();
+    }
+
+    /// A taken item is finished.
+    pub fn done(&self) {
+        self.lock().taken -= 1;
+        self.changed.notify_all();
+    }
+
+    /// A taken item goes back to the front, for another worker.
+    pub fn hand_back(&self, item: T) {
+        let mut s = self.lock();
+        s.taken -= 1;
+        s.waiting.push_front(item);
+        drop(s);
+        self.changed.notify_all();
+    }
+}
+
+/// The bands of a frame on several devices: the job, the queue of band indices, where
+/// finished bands go, and the faults to inject.
+#[derive(Debug)]
+pub struct Bands<'a> {
+    job: &'a Job<'a>,
+    faults: &'a Faults,
+    queue: Queue<usize>,
+    events: mpsc::Sender<(usize, Pixels)>,
+}
+
+impl<D: Device> Worker for D {
+    fn name(&self) -> String {
+        self.describe()
+    }
+
+    fn work(&self, bands: &Bands, position: usize) -> Share {
+        let job = bands.job;
+        let queue = &bands.queue;
+        let mut share = Share {
+            device: self.describe(),
+            tiles: 0,
+            phases: Phases::default(),
+            failure: None,
+        };
+        let setup = Instant::now();
+        let mut frame = match self.prepare(job) {
+            Ok(f) => f,
+            Err(e) => {
+                share.failure = Some(e.to_string());
+                return share;
+            }
+        };
+        share.phases.setup = setup.elapsed();
+        while let Some(band) = queue.take() {
+            let launch = Instant::now();
+            let ran = match bands.faults.injected(position, share.tiles) {
+                Some(msg) => Err(self.fault(msg)),
+                None => self.run(&mut frame, job, &[band]),
+            };
+            share.phases.launches += launch.elapsed();
+            let read = Instant::now();
+            let read_back = ran
+                .and_then(|()| self.read(&mut frame, job, &[job.band(band)]))
+                .and_then(|p| self.check(&mut frame).map(|()| p));
+            match read_back {
+                Ok(pixels) => {
+                    share.phases.readback += read.elapsed().saturating_sub(pixels.convert);
+                    share.phases.convert += pixels.convert;
+                    share.tiles += 1;
+                    let _ = bands.events.send((band, pixels));
+                    queue.done();
+                }
+                Err(e) => {
+                    queue.hand_back(band);
+                    share.failure = Some(e.to_string());
+                    return share;
+                }
+            }
+        }
+        if let Err(e) = self.finish(frame, job) {
+            share.failure = Some(e.to_string());
+        }
+        share
+    }
+}
+
+/// Renders `job` (whose tiles are bands, [`tiling`]) on several devices at once: each
+/// device's worker takes the next band from one queue; the bands are assembled in order. A
+/// device that fails hands its band back; the frame fails only when every device has.
+pub fn render_several(
+    devices: &[&dyn Worker],
+    job: &Job,
+    faults: &Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Output, String> {
+    let start = Instant::now();
+    let (tx, rx) = mpsc::channel();
+    let bands = Bands {
+        job,
+        faults,
+        queue: Queue::new(0..job.tiles.len(), false),
+        events: tx,
+    };
+    let pixels = job.pixels();
+    let mut linear = vec![[0.0f32; 3]; pixels];
+    let mut steps = vec![0u32; pixels];
+    let mut counters = Counters::default();
+    let mut assembly = Duration::ZERO;
+    let mut done = 0usize;
+    let shares = std::thread::scope(|scope| {
+        let bands = &bands;
+        let handles: Vec<_> = devices
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                let work = move || {
+                    let run = std::panic::AssertUnwindSafe(|| d.work(bands, i));
+                    std::panic::catch_unwind(run).unwrap_or_else(|_| {
+                        // Its band is lost: the frame cannot be finished.
+                        bands.queue.abandon();
+                        Share {
+                            device: d.name(),
+                            tiles: 0,
+                            phases: Phases::default(),
+                            failure: Some("its worker panicked".into()),
+                        }
+                    })
+                };
+                (i, scope.spawn(work))
+            })
+            .collect();
+        // The calling thread assembles the bands as they come.
+        let mut receive = |(band, p): (usize, Pixels)| {
+            let t = Instant::now();
+            let range = job.band(band);
+            linear[range.clone()].copy_from_slice(&p.linear);
+            steps[range].copy_from_slice(&p.steps);
+            counters.add(&p.counters);
+            done += 1;
+            assembly += t.elapsed();
+            progress(done as f64 / job.tiles.len().max(1) as f64);
+        };
+        let mut shares: Vec<(usize, Share)> = Vec::new();
+        // Every band is finished or abandoned once the workers have ended.
+        let mut pending = handles;
+        loop {
+            while let Ok(e) = rx.try_recv() {
+                receive(e);
+            }
+            if pending.iter().all(|(_, h)| h.is_finished()) {
+                break;
+            }
+            match rx.recv_timeout(Duration::from_millis(5)) {
+                Ok(e) => receive(e),
+                Err(_) => continue,
+            }
+        }
+        for (i, h) in pending.drain(..) {
+            let share = h.join().unwrap_or_else(|_| Share {
+                device: devices[i].name(),
+                tiles: 0,
+                phases: Phases::default(),
+                failure: Some("its worker panicked".into()),
+            });
+            shares.push((i, share));
+        }
+        while let Ok(e) = rx.try_recv() {
+            receive(e);
+        }
+        shares.sort_by_key(|(i, _)| *i);
+        shares.into_iter().map(|(_, s)| s).collect::<Vec<_>>()
+    });
+    if done < job.tiles.len() {
+        let why: Vec<String> = shares
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| {
+                s.failure
+                    .as_ref()
+                    .map(|f| format!("device {i} ({}): {f}", s.device))
+            })
+            .collect();
+        return Err(format!(
+            "every device failed ({} of {} tiles rendered): {}",
+            done,
+            job.tiles.len(),
+            why.join("; ")
+        ));
+    }
+    let wall = start.elapsed();
+    // The workers ran side by side: the frame's phases are those of the one that took
+    // longest (the frame waited for it), with the bands' assembly as conversion.
+    let mut phases = shares
+        .iter()
+        .map(|s| s.phases)
+        .max_by_key(|p| p.total())
+        .unwrap_or_default();
+    phases.convert += assembly;
+    Ok(Output {
+        linear,
+        steps,
+        counters,
+        phases,
+        device_time: None,
+        wall,
+        shares,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn squares_cover_the_image_once() {
+        let t = squares(100, 70, 32);
+        assert_eq!(t.len(), 4 * 3);
+        let area: u32 = t.iter().map(|t| t.2 * t.3).sum();
+        assert_eq!(area, 100 * 70);
+    }
+
+    #[test]
+    fn bands_cover_the_image_once_in_whole_rows() {
+        for (w, h, n) in [(7680, 4320, 2), (100, 70, 3), (1, 1, 2), (640, 480, 4)] {
+            let t = tiling(w, h, 512, n);
+            assert!(t.iter().all(|t| t.0 == 0 && t.2 == w));
+            assert_eq!(t.iter().map(|t| t.3).sum::<u32>(), h);
+            assert!(t.windows(2).all(|p| p[0].1 + p[0].3 == p[1].1));
+            assert!(t.len() >= (8 * n).min(h as usize), "{w}x{h}: {}", t.len());
+        }
+    }
+
+    /// A device that "renders" a pixel as its index, and fails on its `fails`-th tile.
+    struct Fake {
+        fails: Option<usize>,
+    }
+
+    impl Device for Fake {
+        type Frame = usize;
+        type Error = String;
+        fn describe(&self) -> String {
+            "fake".into()
+        }
+        fn prepare(&self, _job: &Job) -> Result<usize, String> {
+            Ok(0)
+        }
+        fn run(&self, ran: &mut usize, _job: &Job, tiles: &[usize]) -> Result<(), String> {
+            *ran += tiles.len();
+            match self.fails {
+                Some(n) if *ran > n => Err("lost".into()),
+                _ => Ok(()),
+            }
+        }
+        fn read(&self, _: &mut usize, _: &Job, ranges: &[Range<usize>]) -> Result<Pixels, String> {
+            let mut p = Pixels::default();
+            for r in ranges {
+                p.linear.extend(r.clone().map(|i| [i as f32, 0.0, 0.0]));
+                p.steps.extend(r.clone().map(|i| i as u32));
+                p.counters.steps += r.clone().map(|i| i as u64).sum::<u64>();
+            }
+            Ok(p)
+        }
+        fn finish(&self, _: usize, _: &Job) -> Result<Option<Duration>, String> {
+            Ok(None)
+        }
+        fn fault(&self, message: String) -> String {
+            message
+        }
+    }
+
+    #[test]
+    fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
+        let tiles = tiling(37, 29, 512, 3);
+        let job = Job {
+            uniforms: &[],
+            data: None,
+            width: 37,
+            height: 29,
+            tiles: &tiles,
+            timed: false,
+        };
+        let (good, lost) = (Fake { fails: None }, Fake { fails: Some(1) });
+        let devices: [&dyn Worker; 3] = [&lost, &good, &lost];
+        let out =
+            render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect("one survives");
+        let n = 37 * 29;
+        assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
+        assert_eq!(out.steps, (0..n as u32).collect::<Vec<_>>());
+        assert_eq!(out.counters.steps, (0..n as u64).sum::<u64>());
+        assert_eq!(out.shares[0].tiles, 1);
+        assert_eq!(out.shares[0].failure.as_deref(), Some("lost"));
+        assert_eq!(
+            out.shares.iter().map(|s| s.tiles).sum::<usize>(),
+            tiles.len()
+        );
+        // Every device fails: an error naming each.
+        let devices: [&dyn Worker; 2] = [&lost, &lost];
+        let err =
+            render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect_err("all fail");
+        assert!(err.starts_with("every device failed (2 of "), "{err}");
+        assert!(
+            err.contains("device 0 (fake): lost; device 1 (fake): lost"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_queue_waits_for_items_handed_back_and_ends_when_abandoned() {
+        let q = Queue::new([1, 2], false);
+        assert_eq!(q.take(), Some(1));
+        assert_eq!(q.take(), Some(2));
+        q.hand_back(2);
+        assert_eq!(q.take(), Some(2));
+        q.done();
+        // One item is still taken: another worker waits for it until it is done.
+        std::thread::scope(|s| {
+            let waiter = s.spawn(|| q.take());
+            std::thread::sleep(Duration::from_millis(20));
+            q.done();
+            assert_eq!(waiter.join().expect("joins"), None);
+        });
+        let open = Queue::new([7], true);
+        assert_eq!(open.take(), Some(7));
+        open.abandon();
+        assert_eq!(open.take(), None);
+    }
+
+    #[test]
+    fn faults_parse_per_device() {
+        let f = Faults::parse("1:2, 5").expect("parses");
+        assert_eq!(f.after(0), Some(5));
+        assert_eq!(f.after(1), Some(2));
+        assert!(Faults::parse("x").is_none());
+        assert!(Faults::parse("1:").is_none());
+        let one = Faults::parse("1").expect("parses");
+        assert_eq!(
+            one.injected(0, 1).as_deref(),
+            Some("device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1 (a testing aid)")
+        );
+    }
+}

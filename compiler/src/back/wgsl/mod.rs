@@ -316,14 +316,14 @@ fn marched(scene: &Scene, lowered: &Lowered, options: &Options) -> (String, Opti
         .instances(options.max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {
-            let data = march::data(&s.instances, scene.camera.position);
+            let data = march::data(&s.instances);
             (s, data)
         })
         // The `scene_data` limit, in MiB: by default what wgpu's default limits let a
         // storage buffer bind; a scene with more keeps its instances as code.
         .filter(|(_, data)| {
             let mib = scene.limits.get(crate::limits::Limit::SceneData);
-            data.len() as u64 <= mib.saturating_mul(1 << 20)
+            data.bytes.len() as u64 <= mib.saturating_mul(1 << 20)
         });
     match split {
         Some((s, data)) => {
@@ -331,9 +331,9 @@ fn marched(scene: &Scene, lowered: &Lowered, options: &Options) -> (String, Opti
                 "{}\n{}\n{}",
                 map::write_map_named(&s.rest, "rest_map"),
                 map::write_sdf_named(&s.rest, "rest_sdf"),
-                march::write(&s.instances)
+                march::write(&s.instances, data.stack)
             );
-            (text, Some(data), false)
+            (text, Some(data.bytes), false)
         }
         None if options.parameters => {
             let params = map::Params::default();

@@ -230,7 +230,7 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let text = marched_scene(360);
     let scene = checked("marched.sdf", &text);
     let lowered = Lowered::new(&scene);
-    // Below the default threshold: the walk is asked for.
+    // The threshold set below the scene's instances whatever the default: the walk.
     let walk = wgsl::Options {
         max_instances: 256,
         ..wgsl::Options::default()

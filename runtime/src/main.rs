@@ -36,6 +36,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    commands::main_started();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

@@ -46,7 +46,8 @@ pub struct RenderArgs {
     /// `.mkv`, `.mov`, `.gif`) through `ffmpeg` on PATH.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Print render statistics.
+    /// Print render statistics, and where the whole run went from the process's start
+    /// (device, kernel, driver compile, upload, frame, readback, image).
     #[arg(long)]
     pub stats: bool,
     /// Float type of the evaluation.

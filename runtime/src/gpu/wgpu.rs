@@ -379,10 +379,9 @@ impl Gpu {
 
     /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
     /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage), and 4 the
-    /// scene data (read-only storage) when the kernel has it.
-    /// Creates the pipeline of a kernel, giving the driver the cache data an earlier process
-    /// stored for it on this device, or storing what the driver produced
-    /// ([`Gpu::driver_cache_path`]).
+    /// scene data (read-only storage) when the kernel has it. The driver is given the
+    /// pipeline cache data an earlier process stored for this kernel on this device, or else
+    /// what it produces is stored ([`Gpu::driver_cache_path`]).
     fn pipeline(
         &self,
         wgsl: &str,

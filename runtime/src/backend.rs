@@ -215,7 +215,8 @@ impl Prepared {
         } = &mut prepared
         {
             let data = kernel.data.is_some();
-            let pipeline = gpu.pipeline_for(&kernel.source, wgsl::ENTRY_POINT, data);
+            let module = Some(&kernel.module);
+            let pipeline = gpu.pipeline_for(&kernel.source, module, wgsl::ENTRY_POINT, data);
             timing.pipeline = Some(pipeline.map_err(|e| e.to_string())?);
             timing.device = device;
         }

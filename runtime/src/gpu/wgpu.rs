@@ -202,10 +202,18 @@ impl Gpu {
     }
 
     /// Compiles the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
-    /// `data`), or finds it among those already compiled on this device.
-    pub fn pipeline_for(&self, wgsl: &str, entry: &str, data: bool) -> Result<PipelineTime, Error> {
+    /// `data`), or finds it among those already compiled on this device. `module` is the
+    /// kernel's naga module when the caller has it (the compiler parsed and validated the
+    /// text): wgpu then takes it instead of parsing the text again.
+    pub fn pipeline_for(
+        &self,
+        wgsl: &str,
+        module: Option<&wgpu::naga::Module>,
+        entry: &str,
+        data: bool,
+    ) -> Result<PipelineTime, Error> {
         let start = Instant::now();
-        let (_, driver) = self.cached_pipeline(wgsl, entry, data)?;
+        let (_, driver) = self.pipeline_from(wgsl, module, entry, data)?;
         Ok(PipelineTime {
             time: start.elapsed(),
             cached: driver == DriverCache::NotAsked,
@@ -221,13 +229,24 @@ impl Gpu {
         entry: &str,
         data: bool,
     ) -> Result<(Pipeline, DriverCache), Error> {
+        self.pipeline_from(wgsl, None, entry, data)
+    }
+
+    /// [`Gpu::cached_pipeline`], created from the kernel's naga `module` when given.
+    fn pipeline_from(
+        &self,
+        wgsl: &str,
+        module: Option<&wgpu::naga::Module>,
+        entry: &str,
+        data: bool,
+    ) -> Result<(Pipeline, DriverCache), Error> {
         let key = (wgsl.to_string(), entry.to_string(), data);
         let mut cache = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(p) = cache.get(&key) {
             return Ok((p.clone(), DriverCache::NotAsked));
         }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let (pipeline, layout, driver) = self.pipeline(wgsl, entry, data);
+        let (pipeline, layout, driver) = self.pipeline(wgsl, module, entry, data);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Pipeline(e.to_string()));
         }
@@ -385,14 +404,20 @@ impl Gpu {
     fn pipeline(
         &self,
         wgsl: &str,
+        naga: Option<&wgpu::naga::Module>,
         entry_point: &str,
         data: bool,
     ) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout, DriverCache) {
+        // wgpu validates a naga module as it would the module it parses from the text.
+        let source = match naga {
+            Some(m) => wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(m.clone())),
+            None => wgpu::ShaderSource::Wgsl(wgsl.into()),
+        };
         let module = self
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("sdfc kernel"),
-                source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+                source,
             });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,

@@ -24,8 +24,8 @@ if [ "$MODE" = all ] || [ "$MODE" = check ]; then
   echo "== CUDA JIT: cold, then warm cache" | tee "$OUT/jit.txt"
   # Cold means the driver compiles too: it keeps a compute cache of its own unless told not to.
   rm -rf /tmp/sdfc-jit
-  CUDA_CACHE_DISABLE=1 "$B" render examples/seed3.sdf --backend cuda --size 64x64 -o /tmp/j.png --stats 2>&1 | grep prepared | tee -a "$OUT/jit.txt"
-  "$B" render examples/seed3.sdf --backend cuda --size 64x64 -o /tmp/j.png --stats 2>&1 | grep prepared | tee -a "$OUT/jit.txt"
+  CUDA_CACHE_DISABLE=1 "$B" render examples/seed3.sdf --backend cuda --size 64x64 -o /tmp/j.png --stats 2>&1 | grep -E "^  (PTX|driver compile) " | tee -a "$OUT/jit.txt"
+  "$B" render examples/seed3.sdf --backend cuda --size 64x64 -o /tmp/j.png --stats 2>&1 | grep -E "^  (PTX|driver compile) " | tee -a "$OUT/jit.txt"
 fi
 
 if [ "$MODE" = all ] || [ "$MODE" = bench ]; then

@@ -705,6 +705,66 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
     assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
 }
 
+/// A wgpu render on a Vulkan adapter stores the driver's pipeline cache data for its kernel
+/// in the cache directory (`SDFC_CACHE_DIR`, as the CUDA JIT cache), in a file named by the
+/// kernel and the device; a second process rendering the same kernel finds it and gives it to
+/// the driver, and a render of another kernel gets a file of its own. (Lavapipe stores no
+/// compiled code in it, 96 bytes of headers, so this shows the files are found, not that
+/// the driver's compile gets faster: that is a GPU's measurement,
+/// scripts/device-first-second.sh.)
+#[test]
+fn a_second_process_finds_the_wgpu_pipeline_cache() {
+    let d = dir("pipeline-cache");
+    scene_file(&d);
+    if !wgpu_available(&d) {
+        return;
+    }
+    let cache = d.join("cache");
+    let render = |size: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(["render", "ball.sdf", "--backend", "wgpu", "--stats"])
+            .args(["--size", size, "-o", "out.png"])
+            .env("SDFC_CACHE_DIR", &cache)
+            .env("XDG_RUNTIME_DIR", &d)
+            .output()
+            .expect("run sdfc");
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("driver compile"))
+            .unwrap_or_else(|| panic!("no driver compile line: {text}"))
+            .to_string();
+        (line, entries(&cache))
+    };
+    let (first, files) = render("16x16");
+    assert!(
+        first.contains("bytes of driver cache data stored"),
+        "{first}"
+    );
+    assert_eq!(files.len(), 1, "{files:?}");
+    assert!(files[0].ends_with(".pipeline"), "{files:?}");
+    let (second, again) = render("24x16");
+    assert!(
+        second.contains("pipeline created from")
+            && second.contains("bytes of stored driver cache data"),
+        "{second}"
+    );
+    assert_eq!(again, files, "the same kernel, the same file");
+    // Another kernel (a box in place of the sphere) gets a file of its own.
+    let scene = std::fs::read_to_string(d.join("ball.sdf")).expect("scene");
+    let boxed = scene.replace("sphere(1)", "box((0.5, 0.5, 0.5))");
+    std::fs::write(d.join("ball.sdf"), boxed).expect("write");
+    let (third, more) = render("16x16");
+    assert!(third.contains("stored"), "{third}");
+    assert_eq!(more.len(), 2, "{more:?}");
+}
+
 /// The 42-line file of issue 16, item 1: forty functions, each using the one below twice,
 /// make 2⁴⁰ spheres as a tree from a graph of 121 nodes. Every pass that walked the scene
 /// as a tree (the method choice, simplification, lowering) hung on it; now the checker

@@ -230,7 +230,7 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let text = marched_scene(360);
     let scene = checked("marched.sdf", &text);
     let lowered = Lowered::new(&scene);
-    // Below the default threshold: the walk is asked for.
+    // The threshold set below the scene's instances whatever the default: the walk.
     let walk = wgsl::Options {
         max_instances: 256,
         ..wgsl::Options::default()
@@ -272,6 +272,30 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     let kernel = wgsl::write_with(&scene, &lowered, &walk).expect("valid kernel");
     assert!(kernel.data.is_some() && !kernel.source.contains("fn map_block"));
     assert_agree(&gpu, &scene, &lowered, &kernel, "compound_100");
+}
+
+/// Large marched scenes walk their instances nearest first and render on wgpu as on the
+/// CPU: examples/scaling/compound_1000.sdf (4 000 instances, beyond the threshold) and the
+/// 1 024 spheres of examples/scaling/jittered_1024.sdf marched (`method: "march"`) and
+/// walked (the threshold lowered for the test), at 96×64.
+#[test]
+fn many_marched_instances_walked_nearest_first_match_the_cpu() {
+    let Some(gpu) = open_gpu() else { return };
+    let walk = wgsl::Options {
+        max_instances: 256,
+        ..wgsl::Options::default()
+    };
+    for (file, instances) in [("compound_1000", 4000), ("jittered_1024", 1024)] {
+        let path = PathBuf::from(format!("../examples/scaling/{file}.sdf"));
+        let mut scene = load_small(&path, 96, 64);
+        scene.settings.method = sdfc_compiler::scene::Method::March;
+        let lowered = Lowered::new(&scene);
+        let split = lowered.instances(walk.max_instances).expect("split");
+        assert_eq!(split.instances.len(), instances, "{file}");
+        let kernel = wgsl::write_with(&scene, &lowered, &walk).expect("valid kernel");
+        assert!(kernel.data.is_some() && kernel.source.contains("var stack: array<u32,"));
+        assert_agree(&gpu, &scene, &lowered, &kernel, file);
+    }
 }
 
 /// A camera looking straight down (its view parallel to the default `up`) and one rolled by

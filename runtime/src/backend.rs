@@ -101,6 +101,7 @@ pub enum Prepared {
         lipschitz: f64,
         lowered: Box<Lowered>,
         setup: Setup,
+        timing: Preparation,
     },
     /// CUDA: the device, the loaded module (with the kernel's scene data and the settings it
     /// was specialised for) and the scene's Lipschitz bound L (and the lowered scene and
@@ -111,6 +112,7 @@ pub enum Prepared {
         lipschitz: f64,
         lowered: Box<Lowered>,
         setup: Setup,
+        timing: Preparation,
     },
     /// Several devices (`--devices`), each prepared as above, rendering each frame together
     /// ([`gpu::render_several`]).
@@ -200,6 +202,21 @@ impl Devices {
             _ => Ok(()),
         }
     }
+}
+
+/// Where the first preparation of a scene for a GPU went (`sdfc render --stats`): the
+/// device opened and the kernel written; the driver's compile is the wgpu pipeline's
+/// (`pipeline`) or the CUDA module's load ([`CudaModule`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Preparation {
+    /// Opening the device: wgpu's adapters enumerated and a device opened, or the CUDA
+    /// context created (zero for a device opened by the caller, as the viewer's).
+    pub device: Duration,
+    /// Writing the WGSL kernel and validating it with naga.
+    pub kernel: Duration,
+    /// The wgpu pipeline, when the preparation created it (a device opened by the caller
+    /// creates it at its first render, or by [`Gpu::pipeline_for`]).
+    pub pipeline: Option<gpu::wgpu::PipelineTime>,
 }
 
 /// A kernel loaded on a CUDA device, with what its launches need and the WGSL text it was
@@ -322,14 +339,24 @@ impl Prepared {
                         Backend::Cuda => {
                             // On a stream of its own: the same index twice is two logical
                             // devices on one GPU, running side by side.
+                            let start = Instant::now();
                             let cuda = Cuda::open_device(i, true).map_err(|e| e.to_string())?;
-                            let module = Self::cuda_module(&cuda, scene, &lowered, setup)?;
+                            let device = start.elapsed();
+                            let start = Instant::now();
+                            let kernel = Self::kernel(scene, &lowered, setup)?;
+                            let timing = Preparation {
+                                device,
+                                kernel: start.elapsed(),
+                                pipeline: None,
+                            };
+                            let module = Self::cuda_module_of(&cuda, kernel)?;
                             Prepared::Cuda {
                                 cuda: Box::new(cuda),
                                 module: Box::new(module),
                                 lipschitz: lowered.program.lipschitz(),
                                 lowered: Box::new(lowered.clone()),
                                 setup: *setup,
+                                timing,
                             }
                         }
                         _ => {
@@ -403,8 +430,26 @@ impl Prepared {
         setup: &Setup,
         require_hardware: bool,
     ) -> Result<Prepared, String> {
+        let start = Instant::now();
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
-        Self::on_gpu(Arc::new(gpu), scene, lowered, setup)
+        let device = start.elapsed();
+        let mut prepared = Self::on_gpu(Arc::new(gpu), scene, lowered, setup)?;
+        // The pipeline is created now, so that the first render does not include the
+        // driver's compile.
+        if let Prepared::Wgpu {
+            gpu,
+            kernel,
+            timing,
+            ..
+        } = &mut prepared
+        {
+            let data = kernel.data.is_some();
+            let module = Some(&kernel.module);
+            let pipeline = gpu.pipeline_for(&kernel.source, module, wgsl::ENTRY_POINT, data);
+            timing.pipeline = Some(pipeline.map_err(|e| e.to_string())?);
+            timing.device = device;
+        }
+        Ok(prepared)
     }
 
     /// Prepares `scene`, lowered as `lowered`, for wgpu on an already opened device:
@@ -440,6 +485,7 @@ impl Prepared {
             },
             ..*setup
         };
+        let start = Instant::now();
         let (kernel, built) = match held {
             Some(held) => {
                 let text = Self::kernel_text(scene, lowered, setup)?;
@@ -453,12 +499,17 @@ impl Prepared {
             }
             None => (Self::kernel(scene, lowered, setup)?, true),
         };
+        let timing = Preparation {
+            kernel: start.elapsed(),
+            ..Preparation::default()
+        };
         let prepared = Prepared::Wgpu {
             gpu,
             kernel: Box::new(kernel),
             lipschitz: lowered.program.lipschitz(),
             lowered: Box::new(lowered.clone()),
             setup: *setup,
+            timing,
         };
         Ok((prepared, built))
     }
@@ -495,14 +546,24 @@ impl Prepared {
     }
 
     fn cuda(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<Prepared, String> {
+        let start = Instant::now();
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
-        let module = Self::cuda_module(&cuda, scene, lowered, setup)?;
+        let device = start.elapsed();
+        let start = Instant::now();
+        let kernel = Self::kernel(scene, lowered, setup)?;
+        let timing = Preparation {
+            device,
+            kernel: start.elapsed(),
+            pipeline: None,
+        };
+        let module = Self::cuda_module_of(&cuda, kernel)?;
         Ok(Prepared::Cuda {
             cuda: Box::new(cuda),
             module: Box::new(module),
             lipschitz: lowered.program.lipschitz(),
             lowered: Box::new(lowered.clone()),
             setup: *setup,
+            timing,
         })
     }
 
@@ -556,6 +617,7 @@ impl Prepared {
                 lipschitz,
                 lowered: held,
                 setup,
+                ..
             } => {
                 traceable_with(scene, &lowered.traceable)?;
                 let text = Self::kernel_text(scene, &lowered, setup)?;
@@ -687,24 +749,66 @@ impl Prepared {
         })
     }
 
-    /// How the backend was prepared, for `--stats`: PTX generation and JIT times for CUDA.
-    pub fn preparation(&self) -> Option<String> {
+    /// Where the first preparation for a GPU went, for `--stats`: (phase, time, how) for
+    /// the device, the kernel, its PTX and the driver's compile; empty on the CPU.
+    pub fn preparation(&self) -> Vec<(&'static str, Duration, String)> {
+        use gpu::wgpu::DriverCache;
         match self {
-            Prepared::Cuda { module, .. } => Some(format!(
-                "PTX generated in {:.2} ms; module {} in {:.1} ms",
-                module.ptx_time.as_secs_f64() * 1e3,
-                if module.loaded.cached {
-                    "read from the JIT cache and loaded"
-                } else {
-                    "compiled by the driver JIT and loaded"
-                },
-                module.loaded.load_time.as_secs_f64() * 1e3
-            )),
-            Prepared::Several(parts) => {
-                let each: Vec<String> = parts.iter().filter_map(|p| p.preparation()).collect();
-                (!each.is_empty()).then(|| each.join("; "))
+            Prepared::Cpu { .. } => Vec::new(),
+            // Several devices: the first device's (they are prepared one after another).
+            Prepared::Several(parts) => parts.first().map(|p| p.preparation()).unwrap_or_default(),
+            Prepared::Wgpu { timing, .. } => {
+                let mut out = vec![
+                    (
+                        "device",
+                        timing.device,
+                        "wgpu adapters enumerated, device opened".into(),
+                    ),
+                    (
+                        "kernel",
+                        timing.kernel,
+                        "WGSL written and validated by naga".into(),
+                    ),
+                ];
+                if let Some(p) = timing.pipeline {
+                    let how = match p.driver {
+                        DriverCache::NotAsked => "found among this device's pipelines".into(),
+                        DriverCache::Unsupported => {
+                            "pipeline created (the adapter keeps no pipeline cache)".into()
+                        }
+                        DriverCache::Written(n) => {
+                            format!("pipeline compiled, {n} bytes of driver cache data stored")
+                        }
+                        DriverCache::Read(n) => {
+                            format!("pipeline created from {n} bytes of stored driver cache data")
+                        }
+                    };
+                    out.push(("driver compile", p.time, how));
+                }
+                out
             }
-            _ => None,
+            Prepared::Cuda { timing, module, .. } => vec![
+                ("device", timing.device, "CUDA context created".into()),
+                (
+                    "kernel",
+                    timing.kernel,
+                    "WGSL written and validated by naga".into(),
+                ),
+                (
+                    "PTX",
+                    module.ptx_time,
+                    "translated from the naga module".into(),
+                ),
+                (
+                    "driver compile",
+                    module.loaded.load_time,
+                    if module.loaded.cached {
+                        "module read from the JIT cache and loaded".into()
+                    } else {
+                        "module compiled by the driver JIT and loaded".into()
+                    },
+                ),
+            ],
         }
     }
 

@@ -40,19 +40,31 @@ impl Image {
         self.linear[y as usize * self.width as usize + x as usize]
     }
 
-    /// Clamped, sRGB-encoded RGBA8 bytes (alpha 255).
+    /// Clamped, sRGB-encoded RGBA8 bytes (alpha 255): [`srgb_encode`] of every channel,
+    /// through [`SrgbTable`] and in parallel rows (a 1920×1080 image took 127 ms one value
+    /// at a time on this repository's 2-core VM).
     pub fn to_rgba8(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(self.linear.len() * 4);
-        for c in &self.linear {
-            out.extend_from_slice(&[srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255]);
-        }
+        use rayon::prelude::*;
+        let table = SrgbTable::get();
+        let mut out = vec![255u8; self.linear.len() * 4];
+        let row = self.width.max(1) as usize;
+        out.par_chunks_mut(row * 4)
+            .zip(self.linear.par_chunks(row))
+            .for_each(|(out, linear)| {
+                for (o, c) in out.chunks_exact_mut(4).zip(linear) {
+                    o[..3].copy_from_slice(&c.map(|x| table.encode(x)));
+                }
+            });
         out
     }
 
-    /// The image as PNG file bytes (RGBA8, sRGB).
+    /// The image as PNG file bytes (RGBA8, sRGB), compressed with the png crate's `Fast`
+    /// level (fdeflate): on this repository's 2-core VM a 1920×1080 render compressed in
+    /// 20 ms instead of 240 ms at the default level, in a file 1.45 times as large.
     pub fn encode_png(&self) -> Result<Vec<u8>, ImageError> {
         let mut bytes = Vec::new();
         let mut encoder = png::Encoder::new(&mut bytes, self.width, self.height);
+        encoder.set_compression(png::Compression::Fast);
         encoder.set_color(png::ColorType::Rgba);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -78,6 +90,56 @@ pub fn srgb_encode(c: f32) -> u8 {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     };
     (s * 255.0 + 0.5) as u8
+}
+
+/// [`srgb_encode`] by table: `at[v]` is the least linear value (an f32 in [0, 1]) that
+/// encodes to `v` or more, and `start[k]` the encoding of k / 4096, where the search for a
+/// value in [k / 4096, (k + 1) / 4096) starts (the encoding rises by less than one over such
+/// a step). `srgb_encode` never decreases as its argument grows (checked for every f32 in
+/// [0, 1] by `image::tests::the_srgb_table_is_srgb_encode_for_every_f32`, ignored for its
+/// time: 8 s in a release build), so the number of thresholds at or below a value is its
+/// encoding.
+#[derive(Debug)]
+pub struct SrgbTable {
+    at: [f32; 256],
+    start: Vec<u8>,
+}
+
+impl SrgbTable {
+    /// The table, computed once (255 binary searches over the bits of f32s).
+    pub fn get() -> &'static SrgbTable {
+        static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
+        TABLE.get_or_init(|| {
+            let mut at = [0.0f32; 256];
+            for (v, t) in at.iter_mut().enumerate().skip(1) {
+                // The least bits b in [0, bits of 1.0] with srgb_encode(b) >= v: for
+                // non-negative f32s the order of the bits is the order of the values.
+                let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+                while lo < hi {
+                    let mid = lo + (hi - lo) / 2;
+                    if (srgb_encode(f32::from_bits(mid)) as usize) < v {
+                        lo = mid + 1;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                *t = f32::from_bits(lo);
+            }
+            let start = (0..=4096).map(|k| srgb_encode(k as f32 / 4096.0)).collect();
+            SrgbTable { at, start }
+        })
+    }
+
+    /// [`srgb_encode`]`(c)`.
+    pub fn encode(&self, c: f32) -> u8 {
+        let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
+        // c · 4096 is exact (a power of two), so c lies at or above bucket k's start.
+        let mut v = self.start[(c * 4096.0) as usize];
+        while v < 255 && c >= self.at[v as usize + 1] {
+            v += 1;
+        }
+        v
+    }
 }
 
 /// The inverse of [`srgb_encode`]: an 8-bit sRGB value as linear colour.
@@ -225,6 +287,48 @@ pub fn temp_path(path: &Path) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
+    /// The table encodes as `srgb_encode` around every threshold (4 096 f32s either side),
+    /// at the special values and at a million values drawn from [-0.1, 1.1].
+    #[test]
+    fn the_srgb_table_is_srgb_encode() {
+        let table = super::SrgbTable::get();
+        let check = |c: f32| assert_eq!(table.encode(c), super::srgb_encode(c), "{c:e}");
+        for t in table.at {
+            let b = t.to_bits();
+            for d in b.saturating_sub(4096)..=b.saturating_add(4096).min(1.0f32.to_bits()) {
+                check(f32::from_bits(d));
+            }
+        }
+        for c in [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -0.0,
+            0.0,
+            1.0,
+            -1.0,
+            2.0,
+        ] {
+            check(c);
+        }
+        let mut rng = sdfc_compiler::rng::Rng::new(11);
+        for _ in 0..1_000_000 {
+            check(rng.range(-0.1, 1.1) as f32);
+        }
+    }
+
+    /// Every f32 in [0, 1] (about 10⁹ of them): ignored for its time, run with
+    /// `cargo test --release -p sdfc-runtime --lib srgb -- --ignored`.
+    #[test]
+    #[ignore]
+    fn the_srgb_table_is_srgb_encode_for_every_f32() {
+        let table = super::SrgbTable::get();
+        for b in 0..=1.0f32.to_bits() {
+            let c = f32::from_bits(b);
+            assert_eq!(table.encode(c), super::srgb_encode(c), "{c:e}");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -39,6 +39,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    commands::main_started();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

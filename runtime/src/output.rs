@@ -3,7 +3,7 @@
 //! never thrown away because its output cannot be written. Files are written atomically
 //! ([`crate::image::write_atomic_with`]); JPEG and OpenEXR are streamed into them.
 
-use crate::image::{srgb_encode, write_atomic_with, Image};
+use crate::image::{write_atomic_with, Image, SrgbTable};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -163,10 +163,11 @@ fn write_jpeg(image: &Image, w: &mut dyn Write) -> std::io::Result<()> {
             "JPEG images are at most 65535 pixels wide and high",
         ));
     };
+    let table = SrgbTable::get();
     let rgb: Vec<u8> = image
         .linear
         .iter()
-        .flat_map(|c| c.map(srgb_encode))
+        .flat_map(|c| c.map(|x| table.encode(x)))
         .collect();
     jpeg_encoder::Encoder::new(w, JPEG_QUALITY)
         .encode(&rgb, width, height, jpeg_encoder::ColorType::Rgb)

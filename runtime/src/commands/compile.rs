@@ -288,7 +288,7 @@ fn emit(
         Emit::Params => return Ok(back::wgsl::uniforms(scene, program.lipschitz())),
         Emit::SceneData => {
             return kernel.data.ok_or_else(|| {
-                "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 2 048 marched instances, or an interpreted one, does)".into()
+                "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 256 marched instances, or an interpreted one, does)".into()
             })
         }
         Emit::Layout => {

@@ -17,7 +17,7 @@ use sdfc_compiler::Limits;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 pub use crate::backend::{Backend, Kernel};
 
@@ -52,7 +52,8 @@ pub struct RenderArgs {
     /// `.mkv`, `.mov`, `.gif`) through `ffmpeg` on PATH.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Print render statistics.
+    /// Print render statistics, and where the whole run went from the process's start
+    /// (device, kernel, driver compile, upload, frame, readback, image).
     #[arg(long)]
     pub stats: bool,
     /// The GPU kernel of a marched scene: its distance program written as code
@@ -271,6 +272,7 @@ pub fn check_memory(
 
 /// Renders one image (the scene at the time 0).
 fn still(args: &RenderArgs) -> Result<(), CliError> {
+    let mut run = Run::new();
     let limits = args.limits.limits();
     let mut source = frontend::Source::read(&args.file).map_err(CliError::Usage)?;
     let frame = frame_scene(
@@ -281,11 +283,13 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         true,
         &LowerOptions::default(),
     )?;
+    run.lap("scene", "read, checked and lowered");
     let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
     Kernel::check(args.kernel, backend).map_err(CliError::Usage)?;
     // The output is checked before any work, so that a render is never thrown away.
     let out = output(args).map_err(CliError::Usage)?;
     let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
+    run.lap("setup", "output checked, thread pool");
     let setup = Setup {
         precision,
         debug_nan: args.debug_nan,
@@ -293,6 +297,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         kernel: args.kernel.unwrap_or_default().choice(),
     };
     let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup)?;
+    run.split("preparation", "the rest of it", prepared.preparation());
     check_memory(
         &pool,
         &prepared,
@@ -301,11 +306,33 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         &limits,
         true,
     )?;
+    run.lap("memory", "what the render allocates, announced");
     let started = Instant::now();
     let frame = pool
         .install(|| render_with_progress(&prepared, &scene))
         .map_err(CliError::Failed)?;
     let seconds = started.elapsed().as_secs_f64();
+    match &frame.phases {
+        Some(p) => run.split(
+            "render",
+            "the rest of it",
+            vec![
+                ("upload", p.setup, "buffers allocated and written".into()),
+                (
+                    "frame",
+                    p.launches,
+                    "launches until the GPU finished".into(),
+                ),
+                (
+                    "readback",
+                    p.readback,
+                    "image and statistics read back".into(),
+                ),
+                ("conversion", p.convert, "colours and statistics".into()),
+            ],
+        ),
+        None => run.lap("frame", "rendered on the CPU"),
+    }
     for w in frame.warnings() {
         eprintln!("warning: {w}");
     }
@@ -317,11 +344,15 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
     } else {
         None
     };
+    if check.is_some() {
+        run.lap("check", "the reference's convergence");
+    }
     out.write(&frame.render.image).map_err(CliError::Usage)?;
     if let (true, Some(path)) = (args.aux, out.path()) {
         write_sidecar(path, frame.render.depth.as_ref(), prepared.name())
             .map_err(CliError::Usage)?;
     }
+    run.lap("image", "encoded and written");
     let s = &scene.settings;
     eprintln!(
         "wrote {} ({}x{}, aa {}, {} on {}, {:.3} s)",
@@ -334,7 +365,8 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         seconds
     );
     if args.stats {
-        let text = stats(&prepared, seconds, &frame, check.as_ref());
+        let mut text = stats(&prepared, seconds, &frame, check.as_ref());
+        text.push_str(&run.to_string());
         // With the image on standard output, the statistics go to standard error.
         if out == Output::Stdout {
             eprint!("{text}");
@@ -346,6 +378,82 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         eprintln!("warning: {}", not_converged(c));
     }
     Ok(())
+}
+
+/// Where a whole `sdfc render` went, from the process's start (`--stats`): the time before
+/// `main`, then each phase as it ended, those with parts (preparing the backend, the
+/// render) split into them and the rest.
+struct Run {
+    /// When `main` began, and the time before it (when known).
+    main: (Instant, Option<Duration>),
+    /// The end of the last phase.
+    last: Instant,
+    /// Each phase: its name, time and what it is.
+    phases: Vec<(&'static str, Duration, String)>,
+}
+
+impl Run {
+    fn new() -> Run {
+        let main = super::started();
+        Run {
+            main,
+            last: main.0,
+            phases: vec![("arguments", Instant::now() - main.0, "parsed".into())],
+        }
+    }
+
+    /// Ends a phase now.
+    fn lap(&mut self, name: &'static str, what: &str) {
+        let now = Instant::now();
+        self.phases.push((name, now - self.last, what.into()));
+        self.last = now;
+    }
+
+    /// Ends a phase now, listed as its `parts` and what is left of it (`rest`).
+    fn split(
+        &mut self,
+        name: &'static str,
+        rest: &str,
+        parts: Vec<(&'static str, Duration, String)>,
+    ) {
+        let now = Instant::now();
+        let whole = now - self.last;
+        let known: Duration = parts.iter().map(|p| p.1).sum();
+        self.phases.extend(parts);
+        self.phases
+            .push((name, whole.saturating_sub(known), rest.into()));
+        self.last = now;
+    }
+}
+
+impl std::fmt::Display for Run {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let before = self.main.1.unwrap_or_default();
+        let total = before + (self.last - self.main.0);
+        writeln!(
+            f,
+            "run             {:.1} ms from the process's start to the image written:",
+            ms(total)
+        )?;
+        match self.main.1 {
+            Some(d) => writeln!(
+                f,
+                "  {:<16}{:>9.1} ms  process start until main (from /proc, ±20 ms)",
+                "start",
+                ms(d)
+            )?,
+            None => writeln!(
+                f,
+                "  {:<16}{:>9} ms  process start until main (unknown)",
+                "start", "-"
+            )?,
+        }
+        for (name, d, what) in &self.phases {
+            writeln!(f, "  {name:<16}{:>9.1} ms  {what}", ms(*d))?;
+        }
+        Ok(())
+    }
 }
 
 /// The text of `--stats` for one frame.
@@ -362,9 +470,6 @@ pub fn stats(
     );
     if let Some(k) = prepared.kernel_kind() {
         text.push_str(&format!("kernel          {k}\n"));
-    }
-    if let Some(p) = prepared.preparation() {
-        text.push_str(&format!("prepared        {p}\n"));
     }
     text.push_str(&format!(
         "time            {:.3} s (frame {:.3} s)\n",

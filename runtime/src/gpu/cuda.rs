@@ -453,21 +453,12 @@ fn max_registers() -> Option<u32> {
         .filter(|&n| n > 0)
 }
 
-/// Where the compiled module of `ptx` for a device is cached: `$SDFC_CACHE_DIR`, else
-/// `$XDG_CACHE_HOME/sdfc/cuda`, else `~/.cache/sdfc/cuda`. `None` when there is no home.
+/// Where the compiled module of `ptx` for a device is cached ([`super::cache_file`], in the
+/// `cuda` cache directory). `None` when there is no home.
 fn cache_path(ptx: &str, device: &str, sm: u32) -> Option<PathBuf> {
-    use std::hash::{Hash, Hasher};
-    let dir = match std::env::var_os("SDFC_CACHE_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => match std::env::var_os("XDG_CACHE_HOME") {
-            Some(d) => PathBuf::from(d).join("sdfc").join("cuda"),
-            None => PathBuf::from(std::env::var_os("HOME")?)
-                .join(".cache")
-                .join("sdfc")
-                .join("cuda"),
-        },
-    };
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    (ptx, device, sm, max_registers(), env!("CARGO_PKG_VERSION")).hash(&mut h);
-    Some(dir.join(format!("{:016x}.cubin", h.finish())))
+    super::cache_file(
+        "cuda",
+        &(ptx, device, sm, max_registers(), env!("CARGO_PKG_VERSION")),
+        "cubin",
+    )
 }

@@ -12,10 +12,35 @@ use crate::image::Image;
 use crate::memory::Memory;
 use sdfc_compiler::back::wgsl::{self, Kernel, STATS_WORDS};
 use sdfc_compiler::scene::{Scene, Settings};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 pub use self::launch::FAULT_AFTER_TILES;
 pub use self::wgpu::{Error, Gpu};
+
+/// The file where a compiled kernel is cached between processes, named by the hash of `key`
+/// (everything the compiled code depends on: the kernel's text, the device, the driver's
+/// options, sdfc's version) with the extension `ext`: in `$SDFC_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/sdfc/KIND`, else `~/.cache/sdfc/KIND`, where `kind` is `cuda` (the
+/// driver JIT's cubins) or `wgpu` (the Vulkan driver's pipeline cache data). `None` when
+/// there is no home. The caches are an optimisation: failing to read or write them is not an
+/// error.
+pub(crate) fn cache_file(kind: &str, key: &impl std::hash::Hash, ext: &str) -> Option<PathBuf> {
+    use std::hash::Hasher;
+    let dir = match std::env::var_os("SDFC_CACHE_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => match std::env::var_os("XDG_CACHE_HOME") {
+            Some(d) => PathBuf::from(d).join("sdfc").join(kind),
+            None => PathBuf::from(std::env::var_os("HOME")?)
+                .join(".cache")
+                .join("sdfc")
+                .join(kind),
+        },
+    };
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    key.hash(&mut h);
+    Some(dir.join(format!("{:016x}.{ext}", h.finish())))
+}
 
 /// Tile edge in pixels for GPU launches: a 1920×1080 frame is one launch, a 7680×4320 one
 /// twelve. Every launch waits for its slowest rays, so the fewer launches a frame takes, the

@@ -49,6 +49,9 @@ pub struct Gpu {
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     timestamps: bool,
+    /// Whether the device keeps the driver's compiled pipelines as data (wgpu's
+    /// `PIPELINE_CACHE`, Vulkan only), which [`Gpu::pipeline_for`] stores on disk.
+    driver_cache: bool,
     pipelines: Mutex<HashMap<(String, String, bool), Pipeline>>,
 }
 
@@ -59,6 +62,25 @@ pub struct PipelineTime {
     pub time: Duration,
     /// Whether it came from the cache of compiled pipelines.
     pub cached: bool,
+    /// Where the driver's compiled code came from, when it was created now.
+    pub driver: DriverCache,
+}
+
+/// What the driver was given when a pipeline was created: the data of its pipeline cache for
+/// this kernel from an earlier process, or nothing (then the data it produced is stored).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DriverCache {
+    /// The pipeline came from this device's own cache: no driver call.
+    NotAsked,
+    /// The device keeps no pipeline cache (a backend other than Vulkan), or there is no
+    /// cache directory.
+    Unsupported,
+    /// No data was stored for this kernel: the driver compiled it, and its cache data was
+    /// written (the number of bytes; 0 when writing failed or the driver gave none).
+    Written(u64),
+    /// The data stored by an earlier process for this kernel and device was given to the
+    /// driver (the number of bytes read).
+    Read(u64),
 }
 
 /// A kernel on a [`Gpu`], ready to render tiles ([`Gpu::kernel`]).
@@ -154,11 +176,15 @@ impl Gpu {
     pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Gpu, Error> {
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let features = if timestamps {
-            wgpu::Features::TIMESTAMP_QUERY
-        } else {
-            wgpu::Features::empty()
-        };
+        let driver_cache = adapter.features().contains(wgpu::Features::PIPELINE_CACHE)
+            && wgpu::util::pipeline_cache_key(&info).is_some();
+        let mut features = wgpu::Features::empty();
+        if timestamps {
+            features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        if driver_cache {
+            features |= wgpu::Features::PIPELINE_CACHE;
+        }
         let limits = wgpu::Limits {
             max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
             ..wgpu::Limits::default()
@@ -180,6 +206,7 @@ impl Gpu {
             queue,
             info,
             timestamps,
+            driver_cache,
             pipelines: Mutex::new(HashMap::new()),
         })
     }
@@ -195,39 +222,78 @@ impl Gpu {
     }
 
     /// Compiles the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
-    /// `data`), or finds it among those already compiled on this device.
-    pub fn pipeline_for(&self, wgsl: &str, entry: &str, data: bool) -> Result<PipelineTime, Error> {
+    /// `data`), or finds it among those already compiled on this device. `module` is the
+    /// kernel's naga module when the caller has it (the compiler parsed and validated the
+    /// text): wgpu then takes it instead of parsing the text again.
+    pub fn pipeline_for(
+        &self,
+        wgsl: &str,
+        module: Option<&wgpu::naga::Module>,
+        entry: &str,
+        data: bool,
+    ) -> Result<PipelineTime, Error> {
         let start = Instant::now();
-        let (_, cached) = self.cached_pipeline(wgsl, entry, data)?;
+        let (_, driver) = self.pipeline_from(wgsl, module, entry, data)?;
         Ok(PipelineTime {
             time: start.elapsed(),
-            cached,
+            cached: driver == DriverCache::NotAsked,
+            driver,
         })
     }
 
-    /// The pipeline of a kernel, from the cache or compiled (and validated) now; `true` when
-    /// it came from the cache.
+    /// The pipeline of a kernel, from this device's cache or created (and validated) now,
+    /// with what the driver was given ([`DriverCache::NotAsked`] when it came from the cache).
     fn cached_pipeline(
         &self,
         wgsl: &str,
         entry: &str,
         data: bool,
-    ) -> Result<(Pipeline, bool), Error> {
+    ) -> Result<(Pipeline, DriverCache), Error> {
+        self.pipeline_from(wgsl, None, entry, data)
+    }
+
+    /// [`Gpu::cached_pipeline`], created from the kernel's naga `module` when given.
+    fn pipeline_from(
+        &self,
+        wgsl: &str,
+        module: Option<&wgpu::naga::Module>,
+        entry: &str,
+        data: bool,
+    ) -> Result<(Pipeline, DriverCache), Error> {
         let key = (wgsl.to_string(), entry.to_string(), data);
         let mut cache = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(p) = cache.get(&key) {
-            return Ok((p.clone(), true));
+            return Ok((p.clone(), DriverCache::NotAsked));
         }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipeline = Arc::new(self.pipeline(wgsl, entry, data));
+        let (pipeline, layout, driver) = self.pipeline(wgsl, module, entry, data);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Pipeline(e.to_string()));
         }
+        let pipeline = Arc::new((pipeline, layout));
         if cache.len() >= PIPELINES_KEPT {
             cache.clear();
         }
         cache.insert(key, pipeline.clone());
-        Ok((pipeline, false))
+        Ok((pipeline, driver))
+    }
+
+    /// The file of the driver's pipeline cache data for a kernel on this device
+    /// ([`super::cache_file`], keyed like the CUDA cache by everything the compiled code
+    /// depends on: the kernel's text and entry point, its bindings, the adapter and driver,
+    /// sdfc's version), when the device keeps such data.
+    fn driver_cache_path(&self, wgsl: &str, entry: &str, data: bool) -> Option<std::path::PathBuf> {
+        if !self.driver_cache {
+            return None;
+        }
+        let i = &self.info;
+        let adapter = wgpu::util::pipeline_cache_key(i)?;
+        let key = (
+            (wgsl, entry, data),
+            (adapter, &i.name, &i.driver, &i.driver_info),
+            env!("CARGO_PKG_VERSION"),
+        );
+        super::cache_file("wgpu", &key, "pipeline")
     }
 
     /// The adapter's name and backend, e.g. `NVIDIA H100 (Vulkan)`.
@@ -256,18 +322,26 @@ impl Gpu {
 
     /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
     /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage), and 4 the
-    /// scene data (read-only storage) when the kernel has it.
+    /// scene data (read-only storage) when the kernel has it. The driver is given the
+    /// pipeline cache data an earlier process stored for this kernel on this device, or else
+    /// what it produces is stored ([`Gpu::driver_cache_path`]).
     fn pipeline(
         &self,
         wgsl: &str,
+        naga: Option<&wgpu::naga::Module>,
         entry_point: &str,
         data: bool,
-    ) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+    ) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout, DriverCache) {
+        // wgpu validates a naga module as it would the module it parses from the text.
+        let source = match naga {
+            Some(m) => wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(m.clone())),
+            None => wgpu::ShaderSource::Wgsl(wgsl.into()),
+        };
         let module = self
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("sdfc kernel"),
-                source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+                source,
             });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -307,6 +381,25 @@ impl Gpu {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
+        let path = self.driver_cache_path(wgsl, entry_point, data);
+        let stored = path.as_ref().and_then(|p| std::fs::read(p).ok());
+        // The one unsafe call of this module: wgpu cannot check that cache data came from
+        // `PipelineCache::get_data`.
+        #[allow(unsafe_code)]
+        let cache = path.as_ref().map(|_| {
+            // SAFETY: the data was returned by `PipelineCache::get_data` for this kernel on an
+            // adapter with the same `pipeline_cache_key` and driver (the file's name hashes
+            // them), written atomically; wgpu checks its header (adapter, driver validation
+            // key, length) and, with `fallback`, starts an empty cache from data it refuses.
+            unsafe {
+                self.device
+                    .create_pipeline_cache(&wgpu::PipelineCacheDescriptor {
+                        label: Some("sdfc pipeline cache"),
+                        data: stored.as_deref(),
+                        fallback: true,
+                    })
+            }
+        });
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -315,9 +408,20 @@ impl Gpu {
                 module: &module,
                 entry_point: Some(entry_point),
                 compilation_options: Default::default(),
-                cache: None,
+                cache: cache.as_ref(),
             });
-        (pipeline, layout)
+        let driver = match (&path, &stored, &cache) {
+            (Some(_), Some(bytes), _) => DriverCache::Read(bytes.len() as u64),
+            (Some(p), None, Some(cache)) => {
+                let written = cache.get_data().filter(|bytes| {
+                    let dir = p.parent().map(std::fs::create_dir_all);
+                    dir.is_none_or(|r| r.is_ok()) && crate::image::write_atomic(p, bytes).is_ok()
+                });
+                DriverCache::Written(written.map_or(0, |b| b.len() as u64))
+            }
+            _ => DriverCache::Unsupported,
+        };
+        (pipeline, layout, driver)
     }
 
     fn buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {

@@ -444,9 +444,14 @@ impl Session {
         }
         let pipeline = match &prepared {
             Prepared::Wgpu { gpu, kernel, .. } => Some(
-                gpu.pipeline_for(&kernel.source, wgsl::ENTRY_POINT, kernel.data.is_some())
-                    .map_err(|e| e.to_string())
-                    .inspect_err(|msg| eprintln!("error: {msg}"))?,
+                gpu.pipeline_for(
+                    &kernel.source,
+                    Some(&kernel.module),
+                    wgsl::ENTRY_POINT,
+                    kernel.data.is_some(),
+                )
+                .map_err(|e| e.to_string())
+                .inspect_err(|msg| eprintln!("error: {msg}"))?,
             ),
             _ => None,
         };

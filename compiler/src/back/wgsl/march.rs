@@ -2,18 +2,19 @@
 //! buffer `scene_data` (binding 4) for a marched kernel, and the loop that walks it, so that
 //! the kernel's size does not grow with the number of instances (`lower::Lowered::instances` says which
 //! children of the root union are instances). `map(p)` is `min(rest(p), walk(p))` with the
-//! nearer one's material (the rest's on a tie, else the earlier instance's): the field of the
-//! whole program, evaluated in another order.
+//! nearer one's material (the rest's on a tie, else the material of the instance earlier in
+//! `scene_data`): the field of the whole program, evaluated in another order.
 //!
 //! Layout: an array of `vec4<f32>`; integers are stored as their bits (`bitcast<u32>`).
 //!
 //! ```text
 //! [0]          (end, 0, 0, 0): the index one past the last entry
-//! [1 .. end)   the entries, in the order of a depth-first walk of the hierarchy:
+//! [1 .. end)   the entries, in the order of a depth-first walk of the hierarchy: either
+//!              one group, the root, or (a scene of a few instances) the instances alone
 //!   group      [i]     (centre.xyz, GROUP)
-//!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries,
-//!                      where a point whose signed distance to the group's box is not below
-//!                      the best distance so far goes on
+//!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries
+//!              [i + 2 .. next) either two groups (the second at the first's next) or from
+//!                      two to four instances (a leaf)
 //!   instance   [i]     (offset.xyz, kind | ROTATED | material << 4): the point in the
 //!                      shape's frame is q = rotate(p) − offset
 //!              [i + 1] the shape: sphere (r, 0, 0, 0), box (half.xyz, 0), round box
@@ -27,16 +28,39 @@
 //! program's are, and the walk computes in the program's order of operations, so the GPU's
 //! field equals the CPU's up to f32 rounding. Every instance is an exact distance, so its value
 //! is at least the signed distance to its box, and a group whose box is not nearer than the
-//! best distance so far cannot change the minimum: skipping it is exact. The walk needs no
-//! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes
-//! 32 bytes, a rotated one 80, a group 32.
+//! best distance so far cannot change the minimum: skipping it is exact.
+//!
+//! The walk visits the hierarchy nearest first. The hierarchy is the median-split tree of
+//! `scene::analytic::boxed`, binary down to leaves of at most four instances, and balanced:
+//! its depth D (the root's groups at level 0) is ⌈log₂(n / 4)⌉ or less. At a group the walk
+//! measures the boxes of both children, goes on into the nearer and pushes the farther, with
+//! its box's distance, on a stack; at a leaf it evaluates the instances; then it pops the
+//! stack, passing over every group whose box is no longer nearer than the best distance. The
+//! stack holds at most one group per level below the root (when a group of level k is
+//! popped, the others are of levels below k, and the descent from it pushes at most one of
+//! each level below it), so an array of max(D, 1) entries, which the kernel is written with,
+//! never overflows. A point near the surface thus meets its nearest instances first, its best
+//! distance is small early, and the boxes prune all but a few paths down the tree: a step
+//! costs about log n box tests and a few instances, where a walk in a fixed order costs what
+//! lies before the point's nearest instance in that order. (A uniform grid of cells would also
+//! find the nearest instances in constant time near the surface, but a point far from every
+//! instance, as most of a camera ray's steps are, must search ever larger rings of cells for
+//! a bound, and a scene's instances are seldom uniformly spread: compound_1000's lamp posts
+//! and a lattice over a plane would leave most cells empty or most instances in a few.)
+//!
+//! `walk_map`, which gives the material, keeps the tie rule independent of the order of the
+//! visit: among instances at the same distance the one earlier in `scene_data` wins, and it
+//! passes over a group only when its box is farther than the best distance (a group at
+//! exactly that distance may hold an earlier instance that ties). `walk_sdf`, the distance
+//! alone, passes over a group whose box is not nearer. An unrotated instance takes 32 bytes,
+//! a rotated one 80, a group 32.
 
 use super::buffer::{
     self, bits, entries, tag, tag_holds, vec, GROUP, KIND_BITS, MATERIAL_SHIFT, TRANSFORMED,
 };
 use crate::lower::Instance;
-use crate::scene::analytic::{boxed, Item};
-use crate::scene::{Node, V3};
+use crate::scene::analytic::{boxed, Group, Item};
+use crate::scene::Node;
 use std::fmt::Write;
 
 /// The kinds of instance (the tags are buffer.rs's).
@@ -73,35 +97,42 @@ fn quad(v: [f64; 4]) -> [u32; 4] {
     v.map(bits)
 }
 
-/// The contents of `scene_data` for `instances`, as little-endian bytes, their hierarchy
-/// built over their boxes, the items of every group ordered by the distance of their boxes
-/// from `eye` (the camera): camera rays, most of the evaluations, then meet the nearer
-/// instances first, and the best distance shrinks early enough to skip more groups.
-pub fn data(instances: &[Instance], eye: V3) -> Vec<u8> {
-    let mut top = boxed(instances.iter().map(|i| i.aabb).enumerate().collect());
-    nearer_first(&mut top, instances, eye);
-    entries(&top, &mut |out, i| instance(out, &instances[i]))
+/// The contents of `scene_data` for `instances`, their hierarchy built over their boxes.
+pub struct Data {
+    /// The bytes of `scene_data`, little-endian.
+    pub bytes: Vec<u8>,
+    /// The entries of the walk's stack: the hierarchy's depth, at least 1.
+    pub stack: usize,
 }
 
-/// Orders `items`, and the items of every group among them, by the distance from `eye` to
-/// their boxes (stable: ties keep the hierarchy's order).
-fn nearer_first(items: &mut [Item], instances: &[Instance], eye: V3) {
-    let distance = |item: &Item| {
-        let (c, h) = match item {
-            Item::Primitive(i) => {
-                let (lo, hi) = instances[*i].aabb;
-                let c = [0, 1, 2].map(|k| (lo[k] + hi[k]) * 0.5);
-                (c, [0, 1, 2].map(|k| (hi[k] - lo[k]) * 0.5))
-            }
-            Item::Group(g) => (g.centre, g.half),
-        };
-        let outside = [0, 1, 2].map(|k| ((eye[k] - c[k]).abs() - h[k]).max(0.0));
-        outside.iter().map(|x| x * x).sum::<f64>()
+/// The contents of `scene_data` for `instances` and the stack their walk needs.
+pub fn data(instances: &[Instance]) -> Data {
+    let top = boxed(instances.iter().map(|i| i.aabb).enumerate().collect());
+    let stack = match top.as_slice() {
+        [Item::Group(root)] => depth(root).max(1),
+        items => {
+            assert!(
+                items.iter().all(|i| matches!(i, Item::Primitive(_))),
+                "the top of the hierarchy is one group or instances alone"
+            );
+            1
+        }
     };
-    items.sort_by(|a, b| distance(a).total_cmp(&distance(b)));
-    for item in items.iter_mut() {
-        if let Item::Group(g) = item {
-            nearer_first(&mut g.items, instances, eye);
+    let bytes = entries(&top, &mut |out, i| instance(out, &instances[i]));
+    Data { bytes, stack }
+}
+
+/// The levels of groups below `group`, checking the shape the walk relies on: every group
+/// holds two groups or instances alone.
+fn depth(group: &Group) -> usize {
+    match group.items.as_slice() {
+        [Item::Group(a), Item::Group(b)] => 1 + depth(a).max(depth(b)),
+        items => {
+            assert!(
+                items.iter().all(|i| matches!(i, Item::Primitive(_))),
+                "a group of the hierarchy holds two groups or instances alone"
+            );
+            0
         }
     }
 }
@@ -142,8 +173,9 @@ fn shape(shape: &Node) -> [u32; 4] {
 }
 
 /// `fn map` and `fn sdf` of the scene: the rest's, `rest_map` and `rest_sdf`, then the walk
-/// over `scene_data`; only the kinds of `instances` are tested for.
-pub fn write(instances: &[Instance]) -> String {
+/// over `scene_data`, with a stack of `stack` entries ([`Data::stack`]); only the kinds of
+/// `instances` are tested for.
+pub fn write(instances: &[Instance], stack: usize) -> String {
     let rotated = instances.iter().any(|i| i.rotation.is_some());
     let mut out = String::from(
         "// The instances in scene_data (the layout is in compiler/src/back/wgsl/march.rs): the\n\
@@ -157,8 +189,8 @@ pub fn write(instances: &[Instance]) -> String {
     helpers(&mut out);
     shape_distance(&mut out, instances);
     instance_distance(&mut out, rotated);
-    walk(&mut out, true);
-    walk(&mut out, false);
+    walk(&mut out, true, stack);
+    walk(&mut out, false, stack);
     out.push_str(
         "// The scene's distance field: (signed distance, material id) at p, the nearer of the\n\
          // rest of the scene and its instances.\n\
@@ -176,7 +208,10 @@ fn helpers(out: &mut String) {
          fn len3(q: vec3<f32>) -> f32 {\n    return sqrt((q.x * q.x + q.y * q.y) + q.z * q.z);\n}\n\n\
          // The signed distance of a box of half-extents h about the origin, given |q| - h.\n\
          fn box_of(a: vec3<f32>) -> f32 {\n    \
-         return len3(max(a, vec3<f32>(0.0))) + min(max(a.x, max(a.y, a.z)), 0.0);\n}\n\n",
+         return len3(max(a, vec3<f32>(0.0))) + min(max(a.x, max(a.y, a.z)), 0.0);\n}\n\n\
+         // The signed distance at p to the box of the group whose entry starts at scene_data[g].\n\
+         fn group_distance(g: u32, p: vec3<f32>) -> f32 {\n    \
+         return box_of(abs(p - scene_data[g].xyz) - scene_data[g + 1u].xyz);\n}\n\n",
     );
 }
 
@@ -260,36 +295,105 @@ fn instance_distance(out: &mut String, rotated: bool) {
 }
 
 /// `fn walk_map` (`material`) or `fn walk_sdf`: the minimum of `start` and the instances,
-/// past each group whose box is not nearer than the best distance so far.
-fn walk(out: &mut String, material: bool) {
+/// nearest first, past each group whose box is not nearer than the best distance so far (the
+/// walk of the module's header, with a stack of `stack` entries).
+fn walk(out: &mut String, material: bool, stack: usize) {
     let (name, ty, d) = if material {
         ("walk_map", "vec2<f32>", "best.x")
     } else {
         ("walk_sdf", "f32", "best")
     };
+    // Where a group may be passed over: the material's walk enters a group at exactly the
+    // best distance, which may hold an earlier instance that ties.
+    let (farther, not_farther) = if material { (">", "<=") } else { (">=", "<") };
     let _ = writeln!(
         out,
-        "// The nearer of start and the instances at p{}.\n\
+        "// The nearer of start and the instances at p{}, visiting\n\
+         // the hierarchy nearest first.\n\
          fn {name}(p: vec3<f32>, start: {ty}) -> {ty} {{",
         if material {
-            ", with its material (start's on a tie,\n// else the earlier instance's)"
+            ", with its material (start's on a tie,\n// else the instance's earlier in scene_data)"
         } else {
             ""
         }
     );
     out.push_str("    var best = start;\n");
-    let enter = format!("box_of(abs(p - head.xyz) - size.xyz) < {d}");
-    let update = format!("    best = vec2<f32>(d, f32(tag >> {MATERIAL_SHIFT}u));");
-    let keep: &[&str] = if material {
-        &["if d < best.x {", &update, "}"]
+    if material {
+        out.push_str("    // The entry of best's instance; 0: start.\n    var owner = 0u;\n");
+    }
+    let _ = write!(
+        out,
+        "    // Groups still to enter and the distances of their boxes, one per level at most.\n\
+         \x20   var stack: array<u32, {stack}>;\n\
+         \x20   var near: array<f32, {stack}>;\n\
+         \x20   var sp = 0u;\n\
+         \x20   // The instances of a leaf still to visit: [i, stop).\n\
+         \x20   var i = 1u;\n\
+         \x20   var stop = bitcast<u32>(scene_data[0u].x);\n\
+         \x20   if bitcast<u32>(scene_data[1u].w) == GROUP {{\n\
+         \x20       stack[0] = 1u;\n\
+         \x20       near[0] = group_distance(1u, p);\n\
+         \x20       sp = 1u;\n\
+         \x20       i = stop;\n\
+         \x20   }}\n\
+         \x20   loop {{\n\
+         \x20       if i < stop {{\n\
+         \x20           let head = scene_data[i];\n\
+         \x20           let tag = bitcast<u32>(head.w);\n\
+         \x20           let d = instance_distance(i, head, p);\n"
+    );
+    if material {
+        let _ = write!(
+            out,
+            "            if d < best.x || (d == best.x && i < owner) {{\n\
+             \x20               best = vec2<f32>(d, f32(tag >> {MATERIAL_SHIFT}u));\n\
+             \x20               owner = i;\n\
+             \x20           }}\n"
+        );
     } else {
-        &["best = min(best, d);"]
-    };
-    let mut visit = vec!["let d = instance_distance(i, head, p);"];
-    visit.extend(keep);
-    visit.push("i += instance_size(tag);");
-    buffer::walk(out, Some(&enter), &visit);
-    out.push_str("    return best;\n}\n\n");
+        out.push_str("            best = min(best, d);\n");
+    }
+    let _ = write!(
+        out,
+        "            i += instance_size(tag);\n\
+         \x20           continue;\n\
+         \x20       }}\n\
+         \x20       if sp == 0u {{\n\
+         \x20           break;\n\
+         \x20       }}\n\
+         \x20       sp -= 1u;\n\
+         \x20       if near[sp] {farther} {d} {{\n\
+         \x20           continue;\n\
+         \x20       }}\n\
+         \x20       // Down from the group g, whose box is near enough, into the nearer child.\n\
+         \x20       var g = stack[sp];\n\
+         \x20       loop {{\n\
+         \x20           let a = g + 2u;\n\
+         \x20           let first = scene_data[a];\n\
+         \x20           if bitcast<u32>(first.w) != GROUP {{\n\
+         \x20               i = a;\n\
+         \x20               stop = bitcast<u32>(scene_data[g + 1u].w);\n\
+         \x20               break;\n\
+         \x20           }}\n\
+         \x20           let size = scene_data[a + 1u];\n\
+         \x20           let b = bitcast<u32>(size.w);\n\
+         \x20           let da = box_of(abs(p - first.xyz) - size.xyz);\n\
+         \x20           let db = group_distance(b, p);\n\
+         \x20           let a_first = da <= db;\n\
+         \x20           let far = max(da, db);\n\
+         \x20           if far {not_farther} {d} {{\n\
+         \x20               stack[sp] = select(a, b, a_first);\n\
+         \x20               near[sp] = far;\n\
+         \x20               sp += 1u;\n\
+         \x20           }}\n\
+         \x20           if min(da, db) {farther} {d} {{\n\
+         \x20               break;\n\
+         \x20           }}\n\
+         \x20           g = select(b, a, a_first);\n\
+         \x20       }}\n\
+         \x20   }}\n\
+         \x20   return best;\n}}\n\n"
+    );
 }
 
 #[cfg(test)]
@@ -314,7 +418,7 @@ mod tests {
     #[test]
     fn entries_cover_every_instance_and_groups_skip_forward() {
         let instances: Vec<Instance> = (0..41).map(|k| sphere(k as f64 * 1.5, k)).collect();
-        let bytes = data(&instances, [0.0; 3]);
+        let bytes = data(&instances).bytes;
         let w: Vec<u32> = bytes
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -345,5 +449,164 @@ mod tests {
         assert!(groups >= 9, "{groups} groups");
         seen.sort_unstable();
         assert_eq!(seen, (0..41).collect::<Vec<_>>());
+    }
+
+    fn box_of(a: [f32; 3]) -> f32 {
+        let m = a.map(|x| x.max(0.0));
+        ((m[0] * m[0] + m[1] * m[1]) + m[2] * m[2]).sqrt() + a[0].max(a[1].max(a[2])).min(0.0)
+    }
+
+    /// The walk of `walk_map` (with `material`) or `walk_sdf` as the kernel does it, over the
+    /// entries `e` of unrotated spheres: (best, owner, instances evaluated, deepest stack).
+    fn model(
+        e: &[[f32; 4]],
+        p: [f32; 3],
+        start: f32,
+        stack: usize,
+        material: bool,
+    ) -> (f32, usize, usize, usize) {
+        let bits = |x: f32| x.to_bits() as usize;
+        let group = |g: usize| {
+            let (c, h) = (e[g], e[g + 1]);
+            box_of([0, 1, 2].map(|k| (p[k] - c[k]).abs() - h[k]))
+        };
+        let farther = |x: f32, best: f32| if material { x > best } else { x >= best };
+        let (mut best, mut owner, mut evaluated, mut deepest) = (start, 0, 0, 0);
+        let mut st: Vec<(usize, f32)> = Vec::new();
+        let (mut i, mut stop) = (1, bits(e[0][0]));
+        if bits(e[1][3]) == GROUP as usize {
+            st.push((1, group(1)));
+            i = stop;
+        }
+        loop {
+            if i < stop {
+                let q = [0, 1, 2].map(|k| p[k] - e[i][k]);
+                let d = ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() - e[i + 1][0];
+                evaluated += 1;
+                if d < best || (material && d == best && i < owner) {
+                    (best, owner) = (d, i);
+                }
+                i += 2;
+                continue;
+            }
+            let Some((mut g, near)) = st.pop() else { break };
+            if farther(near, best) {
+                continue;
+            }
+            loop {
+                let a = g + 2;
+                if bits(e[a][3]) != GROUP as usize {
+                    (i, stop) = (a, bits(e[g + 1][3]));
+                    break;
+                }
+                let b = bits(e[a + 1][3]);
+                let (da, db) = (group(a), group(b));
+                let (n, f) = if da <= db { (a, b) } else { (b, a) };
+                if !farther(da.max(db), best) {
+                    st.push((f, da.max(db)));
+                    deepest = deepest.max(st.len());
+                    assert!(st.len() <= stack, "stack of {stack} overflows");
+                }
+                if farther(da.min(db), best) {
+                    break;
+                }
+                g = n;
+            }
+        }
+        (best, owner, evaluated, deepest)
+    }
+
+    /// The nearest-first walk finds the same minimum as every instance in `scene_data`'s
+    /// order (the same value, and with the material, the same instance on a tie, the rest
+    /// first), its stack never holds more than the hierarchy's depth, and near the surface
+    /// of 4 096 spheres it evaluates a few dozen of them at most.
+    #[test]
+    fn the_nearest_first_walk_finds_the_minimum_in_few_steps() {
+        let mut rng = crate::rng::Rng::new(7);
+        let mut instances = Vec::new();
+        for k in 0..4096 {
+            let c = [(k % 16) as f64, ((k / 16) % 16) as f64, (k / 256) as f64]
+                .map(|x| x * 1.5 + rng.range(-0.2, 0.2));
+            let r = rng.range(0.2, 0.6);
+            instances.push(Instance {
+                shape: Node::Sphere { radius: r },
+                offset: c,
+                rotation: None,
+                material: Some(MaterialId(k)),
+                aabb: (c.map(|x| x - r), c.map(|x| x + r)),
+            });
+        }
+        // Two copies in one place: their distances tie everywhere.
+        instances.push(Instance {
+            material: Some(MaterialId(9999)),
+            ..instances[700].clone()
+        });
+        let d = data(&instances);
+        let w: Vec<f32> = d
+            .bytes
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        let e: Vec<[f32; 4]> = w
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect();
+        assert!((10..=12).contains(&d.stack), "depth {}", d.stack);
+        let end = e[0][0].to_bits() as usize;
+        let brute = |p: [f32; 3], start: f32| {
+            let (mut best, mut owner, mut i) = (start, 0, 1);
+            while i < end {
+                if e[i][3].to_bits() == GROUP {
+                    i += 2;
+                    continue;
+                }
+                let q = [0, 1, 2].map(|k| p[k] - e[i][k]);
+                let d = ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() - e[i + 1][0];
+                if d < best {
+                    (best, owner) = (d, i);
+                }
+                i += 2;
+            }
+            (best, owner)
+        };
+        let (mut near_surface, mut evaluated, mut deepest, mut ties) = (0, 0, 0, 0);
+        for n in 0..3000 {
+            let p = if n % 3 == 0 {
+                // On the surface of a sphere, at some copies' exact distance.
+                let c = instances[if n % 2 == 0 { 700 } else { rng.below(4096) }].offset;
+                c.map(|x| (x + rng.range(-0.7, 0.7)) as f32)
+            } else {
+                [0, 1, 2].map(|_| rng.range(-4.0, 26.0) as f32)
+            };
+            for start in [f32::INFINITY, 0.3, 2.0] {
+                let (want, owner) = brute(p, start);
+                let (sdf, _, _, _) = model(&e, p, start, d.stack, false);
+                assert_eq!(sdf.to_bits(), want.to_bits(), "{p:?}");
+                let (map, who, k, s) = model(&e, p, start, d.stack, true);
+                assert_eq!((map.to_bits(), who), (want.to_bits(), owner), "{p:?}");
+                deepest = deepest.max(s);
+                let twin = instances[700].offset.map(|x| x as f32);
+                ties += usize::from(who != 0 && e[who][0..3] == twin);
+                if start.is_infinite() && want.abs() < 0.1 {
+                    near_surface += 1;
+                    evaluated += k;
+                }
+            }
+        }
+        assert!(
+            deepest <= d.stack && deepest >= d.stack - 2,
+            "deepest {deepest}"
+        );
+        assert!(near_surface > 100, "{near_surface} points near a surface");
+        assert!(ties > 100, "{ties} ties");
+        let mean = evaluated as f64 / near_surface as f64;
+        println!(
+            "{near_surface} points near a surface: {mean:.1} instances each; stack {deepest} of {}",
+            d.stack
+        );
+        assert!(
+            mean < 16.0,
+            "{mean} instances evaluated per point near a surface"
+        );
     }
 }

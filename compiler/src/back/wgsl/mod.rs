@@ -38,16 +38,17 @@ pub const STATS_WORDS: u32 = 8;
 const TEMPLATE: &str = include_str!("kernel.wgsl");
 
 /// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
-/// they are read from `scene_data` and walked in a loop. The code grows with the scene (the
-/// CUDA JIT of a marched kernel of 10 000 spheres takes minutes), but up to a few thousand
-/// instances it is the faster of the two: its culling visits the nearer half first and
-/// compares with an upper bound found by descending the hierarchy, which a walk in a fixed
-/// order cannot. Measured on an H100 at 1920×1080 (BENCHMARKS.md, 2026-11-22): walked against
-/// written as code, 1 000 random spheres 48.4 against 22.3 ms, a lattice of 1 000 48.1
-/// against 11.3 ms, 400 instances (compound_100) 16.5 against 7.6 ms, but 4 000 instances
-/// (compound_1000) 26.4 against 48.4 ms. Between 1 000 and 4 000 instances nothing was
-/// measured; 2 048 splits the difference.
-pub const MAX_INSTANCES: usize = 2048;
+/// they are read from `scene_data` and walked nearest first (march.rs). The code grows with
+/// the scene, and so does the driver's compile (the CUDA JIT of a marched kernel of 10 000
+/// spheres takes minutes); the walk's kernel is the same size for any number. A walk in a
+/// fixed order lost to the code up to a few thousand instances on an H100 (BENCHMARKS.md,
+/// 2026-11-22); the nearest-first walk, on lavapipe (this repository's 2-core VM,
+/// 2026-11-24, 320×240, marched), is 3–4× slower than the code at 100 instances
+/// (lattice_100, random_100) but 1.2× faster at 400 (compound_100), as fast at 1 000 on a
+/// lattice and 1.8–1.9× faster for 1 000 random or jittered spheres, while its pipeline is
+/// created in 44–77 ms against 0.1–12 s for the code. 256 lies between; the GPU figures are
+/// scripts/device-first-second.sh's.
+pub const MAX_INSTANCES: usize = 256;
 
 /// A generated, validated kernel.
 #[derive(Debug, Clone)]
@@ -463,9 +464,9 @@ fn marched(scene: &Scene, lowered: &Lowered, options: &Options) -> (String, Opti
                 "{}\n{}\n{}",
                 map::write_map_named(&s.rest, "rest_map"),
                 map::write_sdf_named(&s.rest, "rest_sdf"),
-                march::write(&s.instances)
+                march::write(&s.instances, data.stack)
             );
-            (text, Some(data), false)
+            (text, Some(data.bytes), false)
         }
         None if options.parameters => {
             let params = map::Params::default();
@@ -491,19 +492,19 @@ fn split(
     scene: &Scene,
     lowered: &Lowered,
     options: &Options,
-) -> Option<(crate::lower::Split, Vec<u8>)> {
+) -> Option<(crate::lower::Split, march::Data)> {
     lowered
         .instances(options.max_instances)
         .filter(|s| march::fits(&s.instances))
         .map(|s| {
-            let data = march::data(&s.instances, scene.camera.position);
+            let data = march::data(&s.instances);
             (s, data)
         })
         // The `scene_data` limit, in MiB: by default what wgpu's default limits let a
         // storage buffer bind; a scene with more keeps its instances as code.
         .filter(|(_, data)| {
             let mib = scene.limits.get(crate::limits::Limit::SceneData);
-            data.len() as u64 <= mib.saturating_mul(1 << 20)
+            data.bytes.len() as u64 <= mib.saturating_mul(1 << 20)
         })
 }
 

@@ -756,7 +756,7 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
     let with: Vec<_> = frames.iter().map(|(s, p)| kernel(s, p, true)).collect();
     for k in &with[1..] {
         assert_eq!(k.source, with[0].source);
-        assert!(k.features.contains(&("PARAMS", true)));
+        assert!(k.contract.features.contains(&("PARAMS", true)));
     }
     assert_ne!(with[0].data, with[1].data, "the constants differ");
     let literal: Vec<_> = frames.iter().map(|(s, p)| kernel(s, p, false)).collect();
@@ -790,7 +790,9 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
         sm: 70,
         entry_point: "main".into(),
     };
-    let ptx = sdfc_compiler::back::ptx::write(&k.module, &k.info, &options).expect("ptx");
+    let ptx = sdfc_compiler::back::ptx::write(&k.module, &k.info, &options)
+        .expect("ptx")
+        .text;
     let found = std::env::var_os("PATH").and_then(|p| {
         std::env::split_paths(&p)
             .map(|d| d.join("ptxas"))

@@ -521,12 +521,14 @@ fn check(name: &str, src: &str) {
     for sm in [70, 80, 90] {
         let start = Instant::now();
         let text =
-            ptx::write(&module, &info, &options(sm)).unwrap_or_else(|e| panic!("{name}: {e}"));
+            ptx::write(&module, &info, &options(sm))
+                .unwrap_or_else(|e| panic!("{name}: {e}"))
+                .text;
         let took = start.elapsed();
         assert!(text.contains(&format!(".target sm_{sm}")));
         assert_eq!(
             text,
-            ptx::write(&module, &info, &options(sm)).unwrap(),
+            ptx::write(&module, &info, &options(sm)).unwrap().text,
             "{name}: output is not deterministic"
         );
         println!(
@@ -557,7 +559,7 @@ fn integers_assemble() {
 #[test]
 fn sphere_tracer_shape() {
     let (module, info) = parse_strict(SPHERE_TRACER);
-    let text = ptx::write(&module, &info, &options(90)).unwrap();
+    let text = ptx::write(&module, &info, &options(90)).unwrap().text;
     assert!(text.contains(".version 7.8"));
     assert!(text.contains(".address_size 64"));
     assert!(text.contains("workgroup size (8, 8, 1)"));
@@ -582,7 +584,7 @@ fn sphere_tracer_shape() {
 #[test]
 fn sphere_tracer_speed_shape() {
     let (module, info) = parse_strict(SPHERE_TRACER);
-    let text = ptx::write(&module, &info, &options(90)).unwrap();
+    let text = ptx::write(&module, &info, &options(90)).unwrap().text;
     let instructions: Vec<&str> = text
         .lines()
         .map(str::trim)
@@ -693,7 +695,7 @@ fn a_large_kernel_translates_with_map_as_one_function() {
     let mut text = String::new();
     for _ in 0..5 {
         let start = Instant::now();
-        text = ptx::write(&module, &info, &options(80)).unwrap();
+        text = ptx::write(&module, &info, &options(80)).unwrap().text;
         best = best.min(start.elapsed());
     }
     println!(
@@ -740,7 +742,8 @@ fn example_scenes_assemble() {
         keep(&format!("scene_{name}.wgsl"), kernel.source.as_bytes());
         keep(
             &format!("scene_{name}.uniforms"),
-            &sdfc_compiler::back::wgsl::uniforms(&scene, 1.0),
+            &sdfc_compiler::back::wgsl::uniforms(&kernel.contract.uniform, &scene, 1.0)
+                .expect("the uniform fits the kernel"),
         );
         // The best of three translations: a shared machine's noise only adds time.
         let mut took = std::time::Duration::MAX;
@@ -748,7 +751,8 @@ fn example_scenes_assemble() {
         for _ in 0..3 {
             let start = Instant::now();
             text = ptx::write(&kernel.module, &kernel.info, &options(80))
-                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .text;
             took = took.min(start.elapsed());
         }
         let exprs: usize = kernel
@@ -782,8 +786,8 @@ fn the_debug_nan_kernel_assembles() {
     };
     let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &debug).unwrap();
     let plain = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
-    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
-    let without = ptx::write(&plain.module, &plain.info, &options(80)).unwrap();
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
+    let without = ptx::write(&plain.module, &plain.info, &options(80)).unwrap().text;
     assert_ne!(text, without, "the feature changes the kernel");
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "debug_nan", 80)));
@@ -804,7 +808,7 @@ fn a_kernel_with_outlined_blocks_assembles() {
     };
     let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &code).unwrap();
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
-    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
     assert!(text.contains(".entry"));
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "outlined", 80)));
@@ -833,7 +837,7 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());
         keep(&format!("buffer_{name}.data"), data);
-        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
         println!(
             "{name}: {} bytes of WGSL, {} lines of PTX, {} bytes of scene data",
             kernel.source.len(),
@@ -875,7 +879,7 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
         let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("read from a buffer");
         keep(&format!("buffer_{name}.data"), data);
-        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
         assert!(text.contains("@group(0) @binding(4) var<storage, read> scene_data"));
         assert!(text.contains("main_param_4"));
         assert!(
@@ -883,7 +887,7 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
             "{name}: scene data read through the cache"
         );
         for sm in [70, 80, 90] {
-            let text = ptx::write(&kernel.module, &kernel.info, &options(sm)).unwrap();
+            let text = ptx::write(&kernel.module, &kernel.info, &options(sm)).unwrap().text;
             if let Some(p) = &ptxas {
                 println!(
                     "{name} sm_{sm}: {}",

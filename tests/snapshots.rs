@@ -61,7 +61,8 @@ fn check_valid(dir: &str, prefix: &str, ptx: bool) {
         if ptx {
             let options = back::ptx::Options::default();
             let text = back::ptx::write(&kernel.module, &kernel.info, &options)
-                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .text;
             snapshot("ptx", &name, &text);
         }
     }

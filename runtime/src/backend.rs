@@ -77,7 +77,7 @@ pub enum Prepared {
 pub struct CudaModule {
     loaded: gpu::cuda::Loaded,
     data: Option<Vec<u8>>,
-    specialisation: wgsl::Specialisation,
+    contract: wgsl::Contract,
     ptx_time: Duration,
     source: String,
 }
@@ -293,15 +293,15 @@ impl Prepared {
             sm: cuda.sm,
             entry_point: wgsl::ENTRY_POINT.to_string(),
         };
-        let text = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
+        let ptx = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
         let ptx_time = start.elapsed();
         let loaded = cuda
-            .load(&text, wgsl::ENTRY_POINT)
+            .load(&ptx, wgsl::ENTRY_POINT)
             .map_err(|e| e.to_string())?;
         Ok(CudaModule {
             loaded,
             data: kernel.data,
-            specialisation: kernel.specialisation,
+            contract: kernel.contract,
             ptx_time,
             source: kernel.source,
         })
@@ -341,26 +341,27 @@ impl Prepared {
         }
     }
 
-    /// The settings a GPU kernel was specialised for (`None` on the CPU, which reads every
-    /// setting at every render).
-    pub fn specialisation(&self) -> Option<wgsl::Specialisation> {
+    /// The contract of the GPU kernel: what it was specialised for and what it reads
+    /// (`None` on the CPU, which reads every setting at every render).
+    pub fn contract(&self) -> Option<&wgsl::Contract> {
         match self {
             Prepared::Cpu { .. } => None,
-            Prepared::Wgpu { kernel, .. } => Some(kernel.specialisation),
-            Prepared::Cuda { module, .. } => Some(module.specialisation),
+            Prepared::Wgpu { kernel, .. } => Some(&kernel.contract),
+            Prepared::Cuda { module, .. } => Some(&module.contract),
         }
     }
 
-    /// Specialises the GPU kernel again when `scene`'s settings need other features than
-    /// it has (another method, over-relaxation on or off, another `max_depth`): a sweep of
-    /// ω from 1 up must turn `RELAX` on. Keeps the device; nothing to do on the CPU.
-    pub fn specialise(&mut self, scene: &Scene) -> Result<(), String> {
-        let wanted = wgsl::Specialisation::of(&scene.settings);
-        if self.specialisation().is_none_or(|s| s == wanted) {
-            return Ok(());
+    /// Specialises the GPU kernel again when `scene` needs other features than it has
+    /// (another method, over-relaxation on or off, another `max_depth`, soft shadows where
+    /// the kernel has hard ones, ...: [`wgsl::Contract::check`]): a sweep of ω from 1 up must
+    /// turn `RELAX` on. Keeps the device; nothing to do on the CPU. Says whether a kernel was
+    /// written.
+    pub fn specialise(&mut self, scene: &Scene) -> Result<bool, String> {
+        if self.check_contract(scene).is_ok() {
+            return Ok(false);
         }
         match self {
-            Prepared::Cpu { .. } => Ok(()),
+            Prepared::Cpu { .. } => Ok(false),
             Prepared::Wgpu {
                 kernel,
                 lowered,
@@ -369,7 +370,7 @@ impl Prepared {
             } => {
                 traceable_with(scene, &lowered.traceable)?;
                 **kernel = Self::kernel(scene, lowered, setup)?;
-                Ok(())
+                Ok(true)
             }
             Prepared::Cuda {
                 cuda,
@@ -381,23 +382,32 @@ impl Prepared {
                 traceable_with(scene, &lowered.traceable)?;
                 // The same device and context; the new module replaces the old one.
                 **module = Self::cuda_module(cuda, scene, lowered, setup)?;
-                Ok(())
+                Ok(true)
             }
         }
     }
 
-    /// `Err` when `scene`'s settings need a kernel specialised otherwise than this one
-    /// ([`Prepared::specialise`]): a render never silently ignores a setting.
-    fn check_specialisation(&self, scene: &Scene) -> Result<(), String> {
-        let wanted = wgsl::Specialisation::of(&scene.settings);
-        match self.specialisation() {
-            Some(have) if have != wanted => Err(format!(
-                "the {} kernel was specialised for {} and cannot render {}: specialise it again",
-                self.name(),
-                describe(&have),
-                describe(&wanted)
-            )),
-            _ => Ok(()),
+    /// `Err` when `scene` needs a kernel specialised otherwise than this one
+    /// ([`wgsl::Contract::check`]; [`Prepared::specialise`] writes it again): a render never
+    /// silently ignores a setting or a feature of the scene.
+    fn check_contract(&self, scene: &Scene) -> Result<(), String> {
+        let (Some(contract), Some(lowered)) = (self.contract(), self.lowered()) else {
+            return Ok(());
+        };
+        let traced = lowered.traceable.traced(scene.settings.method).is_some();
+        contract.check(scene, traced).map_err(|m| {
+            format!(
+                "the {} kernel cannot render this scene: {m}; specialise it again",
+                self.name()
+            )
+        })
+    }
+
+    /// The lowered scene a GPU kernel was written from.
+    fn lowered(&self) -> Option<&Lowered> {
+        match self {
+            Prepared::Cpu { .. } => None,
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => Some(lowered),
         }
     }
 
@@ -446,12 +456,16 @@ impl Prepared {
                 host: cpu::memory(&at, tapes, options, rayon::current_num_threads()),
                 device: 0,
             },
-            Prepared::Wgpu { kernel, .. } => {
-                gpu::memory_wgpu(settings, uniforms(&at), bytes(&kernel.data))
-            }
-            Prepared::Cuda { module, .. } => {
-                gpu::memory_cuda(settings, uniforms(&at), bytes(&module.data))
-            }
+            Prepared::Wgpu { kernel, .. } => gpu::memory_wgpu(
+                settings,
+                kernel.contract.uniform.size.into(),
+                bytes(&kernel.data),
+            ),
+            Prepared::Cuda { module, .. } => gpu::memory_cuda(
+                settings,
+                module.contract.uniform.size.into(),
+                bytes(&module.data),
+            ),
         }
     }
 
@@ -483,7 +497,7 @@ impl Prepared {
 
     /// Renders one frame; `progress` gets the fraction done.
     pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, String> {
-        self.check_specialisation(scene)?;
+        self.check_contract(scene)?;
         match self {
             Prepared::Cpu { tapes, options, .. } => {
                 let tiles = cpu::tile_count(&scene.settings, options).max(1) as f64;
@@ -526,6 +540,7 @@ impl Prepared {
                     cuda,
                     scene,
                     &module.loaded,
+                    &module.contract.uniform,
                     module.data.as_deref(),
                     *lipschitz,
                 )
@@ -542,28 +557,9 @@ impl Prepared {
     }
 }
 
-/// Bytes of the scene uniform of the GPU kernels.
-fn uniforms(scene: &Scene) -> u64 {
-    wgsl::uniforms(scene, 1.0).len() as u64
-}
-
 /// Bytes of a kernel's scene data.
 fn bytes(data: &Option<Vec<u8>>) -> u64 {
     data.as_ref().map_or(0, |d| d.len() as u64)
-}
-
-/// A specialisation in words, for errors.
-fn describe(s: &wgsl::Specialisation) -> String {
-    format!(
-        "method {}, {}, max_depth {}",
-        s.method.name(),
-        if s.relax {
-            "over-relaxation"
-        } else {
-            "no over-relaxation (ω = 1)"
-        },
-        s.max_depth
-    )
 }
 
 impl memory::Footprint for Prepared {

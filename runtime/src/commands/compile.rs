@@ -246,7 +246,10 @@ fn emit(
     };
     let kernel = back::wgsl::write(scene, lowered).map_err(|e| e.to_string())?;
     match target {
-        Emit::Params => return Ok(back::wgsl::uniforms(scene, program.lipschitz())),
+        Emit::Params => {
+            return back::wgsl::uniforms(&kernel.contract.uniform, scene, program.lipschitz())
+                .map_err(|e| format!("internal compiler error: {e}"))
+        }
         Emit::SceneData => {
             return kernel.data.ok_or_else(|| {
                 "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 2 048 marched instances does)".into()
@@ -266,7 +269,7 @@ fn emit(
             entry_point: back::wgsl::ENTRY_POINT.to_string(),
         };
         return back::ptx::write(&kernel.module, &kernel.info, &options)
-            .map(String::into_bytes)
+            .map(|ptx| ptx.text.into_bytes())
             .map_err(|e| e.to_string());
     }
     match lang {

@@ -7,6 +7,7 @@
 #![allow(unsafe_code)] // The driver API is C: its calls are wrapped here, each with its reason.
 
 use cudarc::driver::{sys, CudaContext, CudaFunction, CudaStream, LaunchConfig, PushKernelArg};
+use sdfc_compiler::back::ptx::{self, Argument, Param, Space};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -31,6 +32,10 @@ pub enum Error {
     /// The JIT refused the PTX (a compiler bug: the PTX is checked by ptxas in CI).
     #[error("the CUDA JIT rejected the PTX: {0}")]
     Jit(String),
+    /// What a launch would pass differs from the kernel's parameters (a bug of sdfc's):
+    /// refused before launching.
+    #[error("internal error: the CUDA kernel's parameters do not match the launch: {0}")]
+    Arguments(String),
 }
 
 fn driver(during: &'static str) -> impl Fn(cudarc::driver::DriverError) -> Error {
@@ -54,6 +59,8 @@ pub struct Cuda {
 #[derive(Debug)]
 pub struct Loaded {
     function: CudaFunction,
+    /// The kernel's parameters, as the PTX writer declared them.
+    params: Vec<Param>,
     /// Time to compile (or read from the cache) and load the module.
     pub load_time: Duration,
     /// Whether the compiled module came from the disk cache.
@@ -109,8 +116,9 @@ impl Cuda {
     }
 
     /// Compiles `ptx` for this device (or takes it from the cache) and loads `entry`.
-    pub fn load(&self, ptx: &str, entry: &str) -> Result<Loaded, Error> {
+    pub fn load(&self, kernel: &ptx::Ptx, entry: &str) -> Result<Loaded, Error> {
         let start = Instant::now();
+        let ptx = &kernel.text;
         let path = cache_path(ptx, &self.name, self.sm);
         let (cubin, cached) = match path.as_ref().and_then(|p| std::fs::read(p).ok()) {
             Some(bytes) => (bytes, true),
@@ -135,6 +143,7 @@ impl Cuda {
             .map_err(driver("finding the kernel"))?;
         Ok(Loaded {
             function,
+            params: kernel.params.clone(),
             load_time: start.elapsed(),
             cached,
         })
@@ -251,6 +260,7 @@ impl Cuda {
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
         let mut events = Vec::with_capacity(tiles.len());
         let fault = super::fault_after_tiles();
+        check_launch(k, uniforms, pixels, stats_words, data)?;
         s.synchronize().map_err(driver("uploading the scene"))?;
         let setup = setup.elapsed();
         let wall = Instant::now();
@@ -286,8 +296,9 @@ impl Cuda {
             }
             start.record(s).map_err(driver("recording an event"))?;
             // SAFETY: the kernel's parameters are its buffers in binding order, as the PTX back
-            // end declares them: four, and the scene data when the kernel has it (the caller
-            // passes `data` exactly then); each buffer is as large as the kernel indexes.
+            // end declares them: four, and the scene data when the kernel has it, each at least
+            // as large as its type (`check_launch` compared them with `k.params` above); the
+            // image and statistics hold every pixel the tiles cover.
             unsafe { launch.launch(cfg) }.map_err(driver("launching the kernel"))?;
             end.record(s).map_err(driver("recording an event"))?;
             events.push((start, end));
@@ -328,6 +339,38 @@ impl Cuda {
             phases,
         })
     }
+}
+
+/// `Err` unless the buffers a launch passes are those `k`'s parameters declare: the uniform
+/// (binding 0), a tile (1), the image (2) and statistics (3) of `pixels` pixels, and `data`
+/// (4) exactly when the kernel reads `scene_data`; each a device address, each as large as
+/// its type.
+fn check_launch(
+    k: &Loaded,
+    uniforms: &[u8],
+    pixels: usize,
+    stats_words: u32,
+    data: Option<&[u8]>,
+) -> Result<(), Error> {
+    let address = std::mem::size_of::<sys::CUdeviceptr>() as u32;
+    let arg = |binding, space, bytes: usize| Argument {
+        group: 0,
+        binding,
+        space,
+        bytes: bytes as u64,
+        size: address,
+    };
+    let writable = Space::Storage { writable: true };
+    let mut args = vec![
+        arg(0, Space::Uniform, uniforms.len()),
+        arg(1, Space::Uniform, 4 * std::mem::size_of::<u32>()),
+        arg(2, writable, pixels * 4 * std::mem::size_of::<f32>()),
+        arg(3, writable, pixels * stats_words as usize * 4),
+    ];
+    if let Some(d) = data {
+        args.push(arg(4, Space::Storage { writable: false }, d.len()));
+    }
+    ptx::check_arguments(&k.params, &args).map_err(Error::Arguments)
 }
 
 /// The register cap for the JIT: `$SDFC_CUDA_MAX_REGISTERS` (0 or unset: the JIT's choice).

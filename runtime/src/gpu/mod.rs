@@ -97,7 +97,8 @@ pub fn render(
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, Error> {
     let s = &scene.settings;
-    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)
+        .map_err(|e| Error::Pipeline(e.to_string()))?;
     let launch = self::wgpu::Launch {
         wgsl: &kernel.source,
         entry: wgsl::ENTRY_POINT,
@@ -132,17 +133,19 @@ pub fn render(
     })
 }
 
-/// Renders `scene` with a kernel already loaded on a CUDA device; `data` is the kernel's
-/// scene data ([`Kernel::data`]).
+/// Renders `scene` with a kernel already loaded on a CUDA device, whose uniform is laid out
+/// as `uniform`; `data` is the kernel's scene data ([`Kernel::data`]).
 pub fn render_cuda(
     cuda: &cuda::Cuda,
     scene: &Scene,
     loaded: &cuda::Loaded,
+    uniform: &wgsl::Uniform,
     data: Option<&[u8]>,
     lipschitz: f64,
 ) -> Result<GpuRender, cuda::Error> {
     let s = &scene.settings;
-    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let uniforms =
+        wgsl::uniforms(uniform, scene, lipschitz).map_err(|e| cuda::Error::Arguments(e.0))?;
     let frame = cuda.render(
         loaded,
         &uniforms,

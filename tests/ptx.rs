@@ -897,3 +897,70 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
         }
     }
 }
+
+/// The writer returns the kernel's parameters as the PTX declares them: each buffer's
+/// address in (group, binding) order with its address space and least size, named as in
+/// the `.entry`; `check_arguments` (which the CUDA launcher calls before its `unsafe` launch)
+/// accepts what the launcher passes and names what differs otherwise.
+#[test]
+fn the_parameters_are_returned_and_launches_checked_against_them() {
+    use ptx::{check_arguments, Argument, Space};
+    let text = "render { max_depth: 2 }\n\
+                scene {\n  for i in 0..300 { sphere(0.2).translate(i * 0.5, 0, 0); }\n}\n";
+    let (scene, diags, _) = sdfc_compiler::check::check_str("row.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
+    let data = kernel.data.as_ref().expect("scene data");
+    let written = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+    let names: Vec<(&str, u32)> = written
+        .params
+        .iter()
+        .map(|p| (p.var.as_str(), p.binding))
+        .collect();
+    assert_eq!(
+        names,
+        [("params", 0), ("tile", 1), ("image", 2), ("stats", 3), ("scene_data", 4)]
+    );
+    for p in &written.params {
+        assert!(
+            written.text.contains(&format!(".param .{} {}", p.ty, p.name)),
+            "{} declared as returned",
+            p.name
+        );
+    }
+    let uniform = u64::from(kernel.contract.uniform.size);
+    assert_eq!(written.params[0].min_bytes, uniform);
+    assert_eq!(written.params[2].stride, Some(16));
+    let pixels = 64 * 48;
+    let arg = |binding, space, bytes| Argument {
+        group: 0,
+        binding,
+        space,
+        bytes,
+        size: 8,
+    };
+    let rw = Space::Storage { writable: true };
+    let mut args = vec![
+        arg(0, Space::Uniform, uniform),
+        arg(1, Space::Uniform, 16),
+        arg(2, rw, 16 * pixels),
+        arg(3, rw, 4 * 8 * pixels),
+        arg(4, Space::Storage { writable: false }, data.len() as u64),
+    ];
+    check_arguments(&written.params, &args).expect("the launcher's arguments");
+    let refused = |args: &[Argument], what: &str| {
+        let e = check_arguments(&written.params, args).expect_err(what);
+        println!("{what}: {e}");
+        e
+    };
+    assert!(refused(&args[..4], "no scene data").contains("takes 5 buffers"));
+    let mut small = args.clone();
+    small[0].bytes = uniform - 16;
+    assert!(refused(&small, "a short uniform").contains("needs at least"));
+    let mut swapped = args.clone();
+    swapped.swap(2, 3);
+    assert!(refused(&swapped, "image and statistics swapped").contains("binding(3)"));
+    args[4].space = rw;
+    assert!(refused(&args, "scene data passed writable").contains("read_write"));
+}

@@ -343,26 +343,13 @@ impl<'a> Lowerer<'a> {
     fn primitive(&mut self, node: &Node, p: P) -> Field {
         let b = &mut *self.b;
         let d = match *node {
-            Node::Sphere { radius } => shapes::sphere(b, p, radius),
-            Node::Box { half } => shapes::boxed(b, p, half),
-            Node::RoundBox { half, radius } => shapes::round_box(b, p, half, radius),
             Node::Plane { normal, height } => shapes::plane(b, p, normal, height),
-            Node::Torus { major, minor } => shapes::torus(b, p, major, minor),
-            Node::Cylinder {
-                radius,
-                half_height,
-            } => shapes::cylinder(b, p, radius, half_height),
-            Node::Capsule {
-                radius,
-                half_height,
-            } => shapes::capsule(b, p, radius, half_height),
-            Node::Cone {
-                radius,
-                half_height,
-            } => shapes::cone(b, p, radius, half_height),
             Node::Ellipsoid { radii } => shapes::ellipsoid(b, p, radii),
             Node::Mandelbulb { power, iterations } => shapes::mandelbulb(b, p, power, iterations),
-            _ => b.c(EMPTY_DISTANCE),
+            _ => match shapes::slots(node) {
+                Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
+                None => b.c(EMPTY_DISTANCE),
+            },
         };
         Field {
             d,

@@ -23,7 +23,9 @@ pub use crate::program::{
     axis_name, binary_name, op_text, unary_name, Axis, Binary, Block, Item, Note, Op, Program, Reg,
     Unary,
 };
-pub use instances::{Instance, Split};
+pub use builder::{Param, Slots};
+pub use instances::{shape_program, Instance, ShapeProgram, Split};
+pub use shapes::slots;
 pub use media::{media, Media};
 
 use crate::diagnostics::Diagnostic;

@@ -765,7 +765,7 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
     // The structure check agrees.
     let structures: Vec<_> = frames
         .iter()
-        .map(|(s, p)| sdfc_compiler::animation::Structure::of(s, &p.program))
+        .map(|(s, p)| sdfc_compiler::animation::Structure::of(s, p))
         .collect();
     assert!(structures.iter().all(|s| *s == structures[0]));
     // Another structure is another text.
@@ -890,7 +890,7 @@ fn evaluate(program: &sdfc_compiler::lower::Program, points: &[[f64; 3]]) -> (Ve
 #[test]
 fn parametric_lowering_keeps_the_structure_and_the_values() {
     use sdfc_compiler::animation::Structure;
-    use sdfc_compiler::lower::{lower_with, LowerOptions};
+    use sdfc_compiler::lower::{lower_scene, lower_with, LowerOptions};
     // At t = 1 the rotation is the identity, the scale 1 and the rounding 0; at t = 2 the
     // translation is 0 and the rotation a quarter turn; the translation is negative before.
     let text = format!(
@@ -905,7 +905,7 @@ fn parametric_lowering_keeps_the_structure_and_the_values() {
             .iter()
             .map(|&t| {
                 let s = scene(&text, t);
-                Structure::of(&s, &lower_with(&s, options))
+                Structure::of(&s, &lower_scene(&s, options))
             })
             .collect()
     };

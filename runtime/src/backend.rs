@@ -8,7 +8,7 @@ use crate::memory::{self, Memory};
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, LowerOptions, Lowered};
 use sdfc_compiler::program::Program;
-use sdfc_compiler::scene::analytic::{self, Choice, Traceable};
+use sdfc_compiler::scene::analytic::{Choice, Traceable};
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -96,14 +96,9 @@ pub struct Frame {
 }
 
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
-/// does not allow it, saying why (before lowering: `sdfc render` refuses such settings
-/// first).
-pub fn method_allowed(scene: &Scene) -> Result<(), String> {
-    traceable_with(scene, &analytic::traceable(scene))
-}
-
-/// [`method_allowed`] for a scene whose primitives the lowering found (`traceable`).
-fn traceable_with(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
+/// does not allow it, saying why, from the primitives the lowering found (`traceable`):
+/// `sdfc render` refuses such settings before preparing a backend.
+pub fn method_allowed(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
     if scene.settings.method == Method::Trace {
         if let Choice::March(reason) = traceable.choose(scene.settings.method) {
             return Err(format!(
@@ -134,7 +129,7 @@ impl Prepared {
         lowered: Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        traceable_with(scene, &lowered.traceable)?;
+        method_allowed(scene, &lowered.traceable)?;
         match backend {
             Backend::Cpu => Ok(Self::cpu(lowered, setup)),
             Backend::Wgpu => Self::wgpu(scene, &lowered, setup, false),
@@ -210,7 +205,7 @@ impl Prepared {
         setup: &Setup,
         held: Option<&wgsl::Kernel>,
     ) -> Result<(Prepared, bool), String> {
-        traceable_with(scene, &lowered.traceable)?;
+        method_allowed(scene, &lowered.traceable)?;
         let (kernel, built) = match held {
             Some(held) => {
                 let text = Self::kernel_text(scene, lowered, setup)?;
@@ -260,7 +255,7 @@ impl Prepared {
 
     /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
     pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
-        traceable_with(scene, &lowered.traceable)?;
+        method_allowed(scene, &lowered.traceable)?;
         Ok(Self::cpu(lowered, setup))
     }
 
@@ -312,7 +307,7 @@ impl Prepared {
     /// program that differs only in numbers) is kept and given the new `scene_data`; another
     /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
     pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
-        method_allowed(scene)?;
+        method_allowed(scene, &lowered.traceable)?;
         match self {
             Prepared::Cpu { .. } | Prepared::Wgpu { .. } => {
                 let (next, built) = self.next(scene, lowered)?;
@@ -326,7 +321,7 @@ impl Prepared {
                 lowered: held,
                 setup,
             } => {
-                traceable_with(scene, &lowered.traceable)?;
+                method_allowed(scene, &lowered.traceable)?;
                 let text = Self::kernel_text(scene, &lowered, setup)?;
                 let built = text.source != module.source;
                 if built {
@@ -368,7 +363,7 @@ impl Prepared {
                 setup,
                 ..
             } => {
-                traceable_with(scene, &lowered.traceable)?;
+                method_allowed(scene, &lowered.traceable)?;
                 **kernel = Self::kernel(scene, lowered, setup)?;
                 Ok(true)
             }
@@ -379,7 +374,7 @@ impl Prepared {
                 setup,
                 ..
             } => {
-                traceable_with(scene, &lowered.traceable)?;
+                method_allowed(scene, &lowered.traceable)?;
                 // The same device and context; the new module replaces the old one.
                 **module = Self::cuda_module(cuda, scene, lowered, setup)?;
                 Ok(true)

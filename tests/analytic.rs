@@ -235,10 +235,9 @@ fn the_kernel_of_ten_thousand_spheres_stays_small() {
     );
     assert!((32 * 10_001..64 * 10_001).contains(&data), "{data} bytes");
     let options = sdfc_compiler::back::ptx::Options::default();
-    let ptx =
-        sdfc_compiler::back::ptx::write(&large.module, &large.info, &options)
-            .expect("translates")
-            .text;
+    let ptx = sdfc_compiler::back::ptx::write(&large.module, &large.info, &options)
+        .expect("translates")
+        .text;
     println!("random_10000: {} lines of PTX", ptx.lines().count());
     assert!(
         ptx.lines().count() < 4_000,

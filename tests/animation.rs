@@ -930,14 +930,8 @@ fn parametric_lowering_keeps_the_structure_and_the_values() {
             }
         }
     }
-    let mut rng = 0x2545f4914f6cdd1du64;
-    let mut next = || {
-        rng ^= rng << 13;
-        rng ^= rng >> 7;
-        rng ^= rng << 17;
-        (rng >> 11) as f64 / (1u64 << 53) as f64 * 8.0 - 4.0
-    };
-    let points: Vec<[f64; 3]> = (0..400).map(|_| [next(), next(), next()]).collect();
+    let mut rng = sdfc_compiler::rng::Rng::new(0x2545f4914f6cdd1d);
+    let points: Vec<[f64; 3]> = (0..400).map(|_| rng.point(4.0)).collect();
     for s in &scenes {
         let a = evaluate(&sdfc_compiler::lower::lower(s), &points);
         let b = evaluate(&lower_with(s, &LowerOptions::parametric()), &points);

@@ -314,7 +314,10 @@ fn glass_overlapping_solids_matches_the_cpu() {
         let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
         let traced = method == "auto";
         assert_eq!(kernel.contract.features.contains(&("MEDIA", true)), !traced);
-        assert_eq!(kernel.contract.features.contains(&("ANALYTIC", true)), traced);
+        assert_eq!(
+            kernel.contract.features.contains(&("ANALYTIC", true)),
+            traced
+        );
         assert_agree(
             &gpu,
             &scene,

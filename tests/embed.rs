@@ -405,8 +405,12 @@ fn scene_data_and_params_are_the_bytes_the_renderer_binds() {
     let params = sdfc(&["compile", file, "--emit", "params"]);
     assert_eq!(
         params.stdout,
-        wgsl::uniforms(&kernel.contract.uniform, &scene, lowered.program.lipschitz())
-            .expect("the uniform fits the kernel")
+        wgsl::uniforms(
+            &kernel.contract.uniform,
+            &scene,
+            lowered.program.lipschitz()
+        )
+        .expect("the uniform fits the kernel")
     );
     let layout = sdfc(&["compile", file, "--emit", "layout"]);
     let layout: serde_json::Value = serde_json::from_slice(&layout.stdout).expect("json");

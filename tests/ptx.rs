@@ -520,10 +520,9 @@ fn check(name: &str, src: &str) {
     let ptxas = ptxas();
     for sm in [70, 80, 90] {
         let start = Instant::now();
-        let text =
-            ptx::write(&module, &info, &options(sm))
-                .unwrap_or_else(|e| panic!("{name}: {e}"))
-                .text;
+        let text = ptx::write(&module, &info, &options(sm))
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .text;
         let took = start.elapsed();
         assert!(text.contains(&format!(".target sm_{sm}")));
         assert_eq!(
@@ -786,8 +785,12 @@ fn the_debug_nan_kernel_assembles() {
     };
     let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &debug).unwrap();
     let plain = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
-    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
-    let without = ptx::write(&plain.module, &plain.info, &options(80)).unwrap().text;
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+        .unwrap()
+        .text;
+    let without = ptx::write(&plain.module, &plain.info, &options(80))
+        .unwrap()
+        .text;
     assert_ne!(text, without, "the feature changes the kernel");
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "debug_nan", 80)));
@@ -808,7 +811,9 @@ fn a_kernel_with_outlined_blocks_assembles() {
     };
     let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &code).unwrap();
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
-    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+        .unwrap()
+        .text;
     assert!(text.contains(".entry"));
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "outlined", 80)));
@@ -837,7 +842,9 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());
         keep(&format!("buffer_{name}.data"), data);
-        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+            .unwrap()
+            .text;
         println!(
             "{name}: {} bytes of WGSL, {} lines of PTX, {} bytes of scene data",
             kernel.source.len(),
@@ -879,7 +886,9 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
         let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("read from a buffer");
         keep(&format!("buffer_{name}.data"), data);
-        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap().text;
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+            .unwrap()
+            .text;
         assert!(text.contains("@group(0) @binding(4) var<storage, read> scene_data"));
         assert!(text.contains("main_param_4"));
         assert!(
@@ -887,7 +896,9 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
             "{name}: scene data read through the cache"
         );
         for sm in [70, 80, 90] {
-            let text = ptx::write(&kernel.module, &kernel.info, &options(sm)).unwrap().text;
+            let text = ptx::write(&kernel.module, &kernel.info, &options(sm))
+                .unwrap()
+                .text;
             if let Some(p) = &ptxas {
                 println!(
                     "{name} sm_{sm}: {}",
@@ -920,11 +931,19 @@ fn the_parameters_are_returned_and_launches_checked_against_them() {
         .collect();
     assert_eq!(
         names,
-        [("params", 0), ("tile", 1), ("image", 2), ("stats", 3), ("scene_data", 4)]
+        [
+            ("params", 0),
+            ("tile", 1),
+            ("image", 2),
+            ("stats", 3),
+            ("scene_data", 4)
+        ]
     );
     for p in &written.params {
         assert!(
-            written.text.contains(&format!(".param .{} {}", p.ty, p.name)),
+            written
+                .text
+                .contains(&format!(".param .{} {}", p.ty, p.name)),
             "{} declared as returned",
             p.name
         );

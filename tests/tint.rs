@@ -147,7 +147,10 @@ fn example_jobs() -> Vec<Job> {
         };
         let kernel = wgsl::write_with(&scene, &lowered, &options)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert_eq!(kernel.contract.features.contains(&("PARAMS", true)), parameters);
+        assert_eq!(
+            kernel.contract.features.contains(&("PARAMS", true)),
+            parameters
+        );
         let name = path
             .strip_prefix("..")
             .unwrap_or(path)

@@ -13,6 +13,7 @@ use super::bvh::{self, Kind, Tree};
 use super::{shapes, Reg, Unary, EMPTY_DISTANCE};
 use crate::scene::analysis::{Analysis, Window};
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
+use glam::DVec3;
 use std::collections::HashMap;
 
 /// The material register value of a shape no `paint` has reached yet.
@@ -726,7 +727,7 @@ fn bound_distance(b: &mut Builder, bound: &Bound, p: P) -> Reg {
     let (box_volume, sphere_volume) = bound.volumes();
     if bound.finite() && sphere_volume <= 1.5 * box_volume {
         let sp = bound.sphere;
-        let pad = 1e-3 * sp.r + 1e-4 * (1.0 + norm(sp.c));
+        let pad = 1e-3 * sp.r + 1e-4 * (1.0 + DVec3::from(sp.c).length());
         let q = b.sub3c(p, sp.c);
         let l = b.len3(q);
         let s = b.subc(l, sp.r + pad);
@@ -767,7 +768,7 @@ fn slab_distance(b: &mut Builder, bound: &Bound, tested: Option<&Tested>, p: P) 
         }
     };
     let size = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
-    let pad = 1e-3 * size + 1e-4 * (1.0 + norm(c));
+    let pad = 1e-3 * size + 1e-4 * (1.0 + DVec3::from(c).length());
     for i in (0..3).filter(|&i| fresh(i)) {
         let d = b.subc(p[i], c[i]);
         let d = b.abs(d);
@@ -822,10 +823,6 @@ fn shrink(b: &mut Builder, s: Reg, scale: f64) -> Reg {
         let t = b.mulc(s, SHRINK * scale);
         b.min(s, t)
     }
-}
-
-fn norm(v: V3) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
 /// The smooth minimum. Poly: h = max(k - |a - b|, 0) / k, min(a, b) - h²·k/4 (Quilez's

@@ -25,8 +25,8 @@ pub use crate::program::{
 };
 pub use builder::{Param, Slots};
 pub use instances::{shape_program, Instance, ShapeProgram, Split};
-pub use shapes::slots;
 pub use media::{media, Media};
+pub use shapes::slots;
 
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};

@@ -205,8 +205,7 @@ pub fn frame_scene(
     let lowered = checked
         .lower(lowering, limits)
         .map_err(CliError::Reported)?;
-    crate::backend::method_allowed(&checked.scene, &lowered.traceable)
-        .map_err(CliError::Failed)?;
+    crate::backend::method_allowed(&checked.scene, &lowered.traceable).map_err(CliError::Failed)?;
     Ok(FrameScene {
         scene: checked.scene,
         lowered,

@@ -361,9 +361,7 @@ fn resolve<'a>(members: &'a [Field], path: &str) -> Result<(u32, &'a Shape), Str
     }
     match (rest, shape) {
         (None, _) => Ok((offset, shape)),
-        (Some(rest), Shape::Struct(inner)) => {
-            resolve(inner, rest).map(|(o, s)| (offset + o, s))
-        }
+        (Some(rest), Shape::Struct(inner)) => resolve(inner, rest).map(|(o, s)| (offset + o, s)),
         (Some(_), _) => Err(format!("`{head}` is not a struct")),
     }
 }

@@ -34,10 +34,10 @@
 use super::buffer::{
     self, bits, entries, tag, tag_holds, vec, GROUP, KIND_BITS, MATERIAL_SHIFT, TRANSFORMED,
 };
+use super::map;
 use crate::lower::Instance;
 use crate::scene::analytic::{boxed, Item};
 use crate::scene::{Node, V3};
-use super::map;
 use std::fmt::Write;
 
 /// The kinds of instance (the tags are buffer.rs's).
@@ -155,7 +155,10 @@ fn helpers(out: &mut String) {
 /// written from the lowering's rules (`lower::shape_program`), then `fn shape_distance`: the
 /// distance of a shape of the tag's kind at q in its own frame, with a branch for each kind.
 fn shape_distance(out: &mut String, instances: &[Instance]) {
-    let mut kinds: Vec<(u32, &Node)> = instances.iter().map(|i| (kind(&i.shape), &i.shape)).collect();
+    let mut kinds: Vec<(u32, &Node)> = instances
+        .iter()
+        .map(|i| (kind(&i.shape), &i.shape))
+        .collect();
     kinds.sort_by_key(|k| k.0);
     kinds.dedup_by_key(|k| k.0);
     out.push_str(
@@ -164,7 +167,10 @@ fn shape_distance(out: &mut String, instances: &[Instance]) {
     );
     for (k, shape) in &kinds {
         if let Some(program) = crate::lower::shape_program(shape) {
-            out.push_str(&map::write_shape(&program, &format!("shape_{}", NAMES[*k as usize])));
+            out.push_str(&map::write_shape(
+                &program,
+                &format!("shape_{}", NAMES[*k as usize]),
+            ));
             out.push('\n');
         }
     }

@@ -427,7 +427,10 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
         ],
     )?;
     w.floats("background", &v4(s.background, 0.0))?;
-    w.uints("counts", &[s.width, s.height, s.aa.max(1), s.max_steps.max(1)])?;
+    w.uints(
+        "counts",
+        &[s.width, s.height, s.aa.max(1), s.max_steps.max(1)],
+    )?;
     w.uints("depth", &[s.max_depth, 0, 0, 0])?;
     let (mut points, mut dirs) = (0, 0);
     for l in &scene.lights {
@@ -442,7 +445,10 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             } => {
                 let r = if radius.is_finite() { *radius } else { 0.0 };
                 w.floats(&format!("points[{points}].position"), &v4(*position, r))?;
-                w.floats(&format!("points[{points}].color"), &colour(*color, *intensity))?;
+                w.floats(
+                    &format!("points[{points}].color"),
+                    &colour(*color, *intensity),
+                )?;
                 points += 1;
             }
             Light::Directional {
@@ -549,16 +555,24 @@ mod tests {
         );
         let moved = write_from(&reordered, &scene, &lowered, &options).expect("kernel");
         let (a, b) = (&kernel.contract.uniform, &moved.contract.uniform);
-        let offset = |u: &Uniform, name: &str| {
-            u.members.iter().find(|m| m.name == name).map(|m| m.offset)
-        };
+        let offset =
+            |u: &Uniform, name: &str| u.members.iter().find(|m| m.name == name).map(|m| m.offset);
         assert_ne!(offset(a, "background"), offset(b, "background"));
         assert_ne!(offset(a, "depth"), offset(b, "depth"));
         let moved_bytes = uniforms(b, &scene, 2.0).expect("uniform");
         let paths: Vec<String> = [
-            "eye", "cam_w", "view", "march", "background", "counts", "depth",
-            "points[0].position", "points[0].color", "dirs[0].to_light",
-            "materials[1].optics", "materials[1].shift",
+            "eye",
+            "cam_w",
+            "view",
+            "march",
+            "background",
+            "counts",
+            "depth",
+            "points[0].position",
+            "points[0].color",
+            "dirs[0].to_light",
+            "materials[1].optics",
+            "materials[1].shift",
         ]
         .map(String::from)
         .to_vec();
@@ -581,7 +595,9 @@ mod tests {
         assert!(e.0.contains("no member `exposure`"), "{e}");
         let e = w.floats("counts", &[0.0; 4]).expect_err("u32s");
         assert!(e.0.contains("holds 4 u32"), "{e}");
-        let e = w.floats("points[1].color", &[0.0; 4]).expect_err("one light");
+        let e = w
+            .floats("points[1].color", &[0.0; 4])
+            .expect_err("one light");
         assert!(e.0.contains("holds 1"), "{e}");
     }
 

@@ -98,7 +98,7 @@ pub fn render(
 ) -> Result<GpuRender, Error> {
     let s = &scene.settings;
     let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)
-        .map_err(|e| Error::Pipeline(e.to_string()))?;
+        .map_err(|e| Error::Uniform(e.0))?;
     let launch = self::wgpu::Launch {
         wgsl: &kernel.source,
         entry: wgsl::ENTRY_POINT,

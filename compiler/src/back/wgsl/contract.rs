@@ -67,7 +67,8 @@ impl Specialisation {
     }
 }
 
-/// What a kernel was specialised for and what it reads (module header).
+/// What a kernel was specialised for and what it reads: [`super::Kernel::contract`], also
+/// held by a CUDA module translated from the kernel.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Contract {
     /// The render settings that decided its features: a render with other settings of

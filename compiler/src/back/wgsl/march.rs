@@ -165,11 +165,11 @@ fn shape_distance(out: &mut String, instances: &[Instance]) {
         "// The distance of each kind of shape at p in its own frame, its constants s (the\n\
          // rules of lower/shapes.rs, as in the scene's program).\n",
     );
-    for (k, shape) in &kinds {
+    for (_, shape) in &kinds {
         if let Some(program) = crate::lower::shape_program(shape) {
             out.push_str(&map::write_shape(
                 &program,
-                &format!("shape_{}", NAMES[*k as usize]),
+                &format!("shape_{}", shape.kind()),
             ));
             out.push('\n');
         }
@@ -179,21 +179,13 @@ fn shape_distance(out: &mut String, instances: &[Instance]) {
          // constants s (lower/shapes.rs).\n\
          fn shape_distance(kind: u32, q: vec3<f32>, s: vec4<f32>) -> f32 {\n",
     );
-    let call = |k: u32| format!("return shape_{}(q, s);", NAMES[k as usize]);
+    let call = |k: u32| {
+        let name = kinds.iter().find(|c| c.0 == k).map_or("", |c| c.1.kind());
+        format!("return shape_{name}(q, s);")
+    };
     buffer::branches(out, kinds.iter().map(|k| k.0), call, "return 1e30;");
     out.push_str("}\n\n");
 }
-
-/// The names of the kinds, by tag.
-const NAMES: [&str; 7] = [
-    "sphere",
-    "box",
-    "round_box",
-    "torus",
-    "cylinder",
-    "capsule",
-    "cone",
-];
 
 /// `fn instance_distance`: the field of the instance whose entry starts at `i` with `head`,
 /// and `fn instance_size`, its number of vectors.

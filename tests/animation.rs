@@ -803,7 +803,7 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
             let path = d.join("bounce.ptx");
             std::fs::write(&path, ptx).unwrap();
             let o = Command::new(ptxas)
-                .args(["-arch=sm_70", "-o", "/dev/null"])
+                .args(["-arch=sm_80", "-o", "/dev/null"])
                 .arg(&path)
                 .output()
                 .expect("ptxas");

@@ -677,7 +677,7 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
     if !wgpu_available(&d) {
         return;
     }
-    // 1100x40 is three tiles of 512 pixels: the second fails after the first rendered.
+    // 4100x16 is three tiles of 2048 pixels: the second fails after the first rendered.
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&d)
         .args([
@@ -686,7 +686,7 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
             "--backend",
             "wgpu",
             "--size",
-            "1100x40",
+            "4100x16",
         ])
         .args(["-o", "fault.png"])
         .env("SDFC_FAULT_AFTER_TILES", "1")
@@ -864,4 +864,47 @@ fn spirv_is_not_written_to_a_terminal() {
         "binary reached the terminal: {text:?}"
     );
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `compile --set` specialises the kernel as `render --set` would: the method, here marching a
+/// scene the file leaves to analytic tracing; a bad key or a method the scene does not allow
+/// is a usage error.
+#[test]
+fn compile_applies_set_before_specialising_the_kernel() {
+    let d = dir("compile-set");
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed1.sdf");
+    let example = example.to_str().expect("utf-8 path");
+    let features = |args: &[&str]| {
+        let out = sdfc(&d, args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        text.lines().nth(1).expect("features line").to_string()
+    };
+    assert!(features(&["compile", example, "--emit", "wgsl"]).contains("+ANALYTIC"));
+    assert!(features(&[
+        "compile",
+        example,
+        "--emit",
+        "wgsl",
+        "--set",
+        "method=march"
+    ])
+    .contains("-ANALYTIC"));
+    let bad = sdfc(
+        &d,
+        &["compile", example, "--emit", "wgsl", "--set", "methd=march"],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown render setting `methd`"));
+    let seed3 = example.replace("seed1", "seed3");
+    let refused = sdfc(
+        &d,
+        &["compile", &seed3, "--emit", "wgsl", "--set", "method=trace"],
+    );
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("cannot be ray traced"));
 }

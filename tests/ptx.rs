@@ -773,6 +773,58 @@ fn example_scenes_assemble() {
     }
 }
 
+/// The kernel of every renderer feature (`tests/in/kernel`, one feature each, whose WGSL
+/// `snapshots.rs` shows) translates and assembles: as written, with `--debug-nan` and the
+/// program's constants in `scene_data` (animation's kernels), and with the traced primitives
+/// or the marched instances read from `scene_data`.
+#[test]
+fn every_renderer_feature_kernel_assembles() {
+    use sdfc_compiler::back::wgsl;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/in/kernel");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
+        .collect();
+    paths.sort();
+    assert!(paths.len() >= 10, "{paths:?}");
+    let variants = [
+        ("plain", wgsl::Options::default()),
+        (
+            "nan_params",
+            wgsl::Options {
+                debug_nan: true,
+                parameters: true,
+                ..Default::default()
+            },
+        ),
+        (
+            "data",
+            wgsl::Options {
+                max_unrolled: 1,
+                max_instances: 1,
+                ..Default::default()
+            },
+        ),
+    ];
+    let ptxas = ptxas();
+    for path in paths {
+        let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        for (variant, opts) in &variants {
+            let kernel = wgsl::write_with(&scene, &lowered, opts)
+                .unwrap_or_else(|e| panic!("{name} ({variant}): {e}"));
+            let text = ptx::write(&kernel.module, &kernel.info, &options(70))
+                .unwrap_or_else(|e| panic!("{name} ({variant}): {e}"))
+                .text;
+            if let Some(p) = &ptxas {
+                assemble(p, &text, &format!("feature_{name}_{variant}"), 70);
+            }
+        }
+    }
+}
+
 /// `--debug-nan` reaches CUDA through the same kernel: its `DEBUG_NAN` feature translates.
 #[test]
 fn the_debug_nan_kernel_assembles() {

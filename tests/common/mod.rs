@@ -1,9 +1,11 @@
-//! Helpers shared by the integration tests: scenes built in code, random points, a few
+//! Helpers shared by the integration tests: scenes built in code, random scenes, a few
 //! reference formulas, and the diagnostic codes the compiler's sources can emit.
 #![allow(dead_code)]
 
+use sdfc_compiler::rng::Rng;
 use sdfc_compiler::scene::{
-    Camera, Graph, Light, Material, MaterialId, Node, NodeId, Pattern, Scene, Settings,
+    Camera, Combine, Graph, Light, Material, MaterialId, Node, NodeId, Pattern, Scene, Settings,
+    Smooth,
 };
 use sdfc_compiler::{FileId, Span};
 
@@ -83,6 +85,121 @@ pub fn single(node: Node) -> Scene {
     let mut b = Build::new();
     let id = b.add(node);
     b.finish(id)
+}
+
+/// A random scene of `n` primitives under random transforms and combinations (random
+/// structure for the fused steps' matcher to meet, and for the evaluators of
+/// `distance_conformance.rs` to agree on).
+pub fn random_scene(rng: &mut Rng, n: usize) -> Scene {
+    let mut b = Build::new();
+    let mut r = |lo: f64, hi: f64| rng.range(lo, hi);
+    let mut kids = Vec::new();
+    for _ in 0..n {
+        let node = match (r(0.0, 9.0)) as u32 {
+            0 => Node::Sphere {
+                radius: r(0.1, 1.0),
+            },
+            1 => Node::Box {
+                half: [r(0.1, 1.0), r(0.1, 1.0), r(0.1, 1.0)],
+            },
+            2 => Node::RoundBox {
+                half: [r(0.2, 1.0), r(0.2, 1.0), r(0.2, 1.0)],
+                radius: r(0.0, 0.2),
+            },
+            3 => Node::Torus {
+                major: r(0.3, 1.0),
+                minor: r(0.05, 0.3),
+            },
+            4 => Node::Cylinder {
+                radius: r(0.1, 0.8),
+                half_height: r(0.1, 1.0),
+            },
+            5 => Node::Capsule {
+                radius: r(0.1, 0.5),
+                half_height: r(0.1, 1.0),
+            },
+            6 => Node::Cone {
+                radius: r(0.1, 0.8),
+                half_height: r(0.1, 1.0),
+            },
+            7 => Node::Ellipsoid {
+                radii: [r(0.2, 1.0), r(0.2, 1.0), r(0.2, 1.0)],
+            },
+            _ => Node::Plane {
+                normal: {
+                    let (t, p) = (r(0.0, 3.1), r(0.0, 6.2));
+                    [t.sin() * p.cos(), t.cos(), t.sin() * p.sin()]
+                },
+                height: r(-2.0, 0.0),
+            },
+        };
+        let mut id = b.add(node);
+        for _ in 0..(r(0.0, 3.0) as u32) {
+            let node = match r(0.0, 6.0) as u32 {
+                0 => {
+                    // A rotation about y, then about x.
+                    let (a, e) = (r(0.0, 6.2), r(0.0, 6.2));
+                    let (ca, sa, ce, se) = (a.cos(), a.sin(), e.cos(), e.sin());
+                    Node::Rotate {
+                        matrix: [
+                            [ca, 0.0, sa],
+                            [se * sa, ce, -se * ca],
+                            [-ce * sa, se, ce * ca],
+                        ],
+                        child: id,
+                    }
+                }
+                1 => Node::Scale {
+                    factor: r(0.5, 2.0),
+                    child: id,
+                },
+                2 => Node::Round {
+                    radius: r(0.0, 0.1),
+                    child: id,
+                },
+                3 => Node::Mirror {
+                    axes: [true, false, r(0.0, 1.0) < 0.5],
+                    child: id,
+                },
+                4 => Node::Repeat {
+                    period: [r(2.0, 4.0), 0.0, r(2.0, 4.0)],
+                    count: None,
+                    child: id,
+                },
+                _ => Node::Shell {
+                    thickness: r(0.02, 0.1),
+                    child: id,
+                },
+            };
+            id = b.add(node);
+        }
+        kids.push(b.at(id, [r(-3.0, 3.0), r(-1.0, 2.0), r(-3.0, 3.0)]));
+    }
+    while kids.len() > 1 {
+        let (x, y) = (kids.pop().expect("two"), kids.pop().expect("two"));
+        let op = [Combine::Union, Combine::Intersect, Combine::Subtract][r(0.0, 3.0) as usize % 3];
+        let node = if r(0.0, 1.0) < 0.3 {
+            Node::SmoothCombine {
+                op,
+                k: r(0.05, 0.5),
+                variant: if r(0.0, 1.0) < 0.5 {
+                    Smooth::Poly
+                } else {
+                    Smooth::Exp
+                },
+                a: x,
+                b: y,
+            }
+        } else {
+            Node::Combine {
+                op,
+                children: vec![x, y],
+            }
+        };
+        kids.push(b.add(node));
+    }
+    let root = kids.pop().expect("at least one primitive");
+    b.finish(root)
 }
 
 pub fn len3(p: [f64; 3]) -> f64 {

@@ -89,6 +89,10 @@ pub struct CompileArgs {
     /// pass (folding, sharing, dead code, scene simplification, bounding-volume culling).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(0..=1))]
     pub opt: u8,
+    /// Override a render setting before compiling, as for `sdfc render` (the kernel is
+    /// specialised to the method, relaxation and `max_depth`). May be repeated.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -134,9 +138,21 @@ pub fn run(args: CompileArgs) -> ExitCode {
             syntax::dump(&ast)
         }
         other => {
-            let Some(scene) = &loaded.scene else {
+            let Some(mut scene) = loaded.scene.clone() else {
                 return ExitCode::from(1);
             };
+            let set = crate::settings::override_settings(
+                &mut scene.settings,
+                None,
+                None,
+                &args.set,
+                &limits,
+            );
+            if let Err(msg) = set {
+                eprintln!("error: {msg}");
+                return ExitCode::from(2);
+            }
+            let scene = &scene;
             if other == Emit::Ir {
                 return write_output(args.output.as_deref(), &scene::dump(scene));
             }
@@ -148,6 +164,11 @@ pub fn run(args: CompileArgs) -> ExitCode {
                     return ExitCode::from(1);
                 }
             };
+            // `--set method=trace` on a scene that cannot be traced: refused as a setting.
+            if let Err(msg) = crate::backend::method_allowed(scene, &lowered.traceable) {
+                eprintln!("error: {msg}");
+                return ExitCode::from(2);
+            }
             let result = match args.part {
                 Part::Kernel => emit(scene, &lowered, other, args.sm),
                 Part::Map => emit_map(scene, &lowered, other, &args.name),

@@ -35,9 +35,13 @@ pub(crate) fn injected_fault(after: Option<usize>, tile: usize) -> Option<String
     })
 }
 
-/// Tile edge in pixels for GPU launches: 512×512 pixels per dispatch keeps each dispatch
-/// short (well under a driver watchdog's limit) while filling a large GPU.
-pub const TILE: u32 = 512;
+/// Tile edge in pixels for GPU launches: a 1920×1080 frame is one launch, a 7680×4320 one
+/// twelve. Every launch waits for its slowest rays, so the fewer launches a frame takes, the
+/// less of the GPU idles in their tails: on an H100 (BENCHMARKS.md, "Beside a hand-written
+/// tracer", 2026-11-24) 2 048 against 512 pixels took seed 3 at 1920×1080 from 1.19 to
+/// 0.64 ms (CUDA) and 1.28 to 0.68 ms (wgpu). A 2048×2048 dispatch of the slowest example
+/// still lasts well under a display driver's watchdog (about 2 s).
+pub const TILE: u32 = 2048;
 
 /// A GPU render and how long the GPU spent on it.
 #[derive(Debug, Clone)]

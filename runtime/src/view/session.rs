@@ -28,6 +28,11 @@ pub const SETTLE: Duration = Duration::from_millis(120);
 /// How many times a load reads files that keep changing under it before it goes on with
 /// what it read.
 const STABLE_READS: usize = 4;
+/// How long a load waits for an empty scene file to be written: an editor saving in place
+/// truncates the file, then writes it, and a busy machine can run the load in between. No
+/// one saves a scene empty on purpose; one that stays empty this long is loaded (and reported
+/// as it is).
+const EMPTY_PATIENCE: Duration = Duration::from_millis(500);
 /// The largest divisor of the resolution while moving.
 pub const MAX_SCALE: u32 = 8;
 
@@ -353,6 +358,10 @@ impl Session {
     fn compile(&mut self) -> Result<(Good, Timings), String> {
         let limits = self.options.limits.clone();
         let start = Instant::now();
+        let empty = || std::fs::metadata(&self.file).is_ok_and(|m| m.len() == 0);
+        while empty() && start.elapsed() < EMPTY_PATIENCE {
+            std::thread::sleep(Duration::from_millis(5));
+        }
         let mut loaded = match frontend::load_with(&self.file, &limits) {
             Ok(l) => l,
             Err(msg) => {
@@ -992,6 +1001,37 @@ mod tests {
         assert_eq!(s.time(), at);
         s.toggle_pause();
         assert!(s.playing());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_file_saved_in_place_is_read_once_written() {
+        // An editor saving in place truncates the file, then writes it: a load that runs in
+        // between waits for the contents instead of reporting an empty scene; a file that
+        // stays empty is loaded as it is (and fails: no `scene` block).
+        let dir = std::env::temp_dir().join(format!("sdfc-in-place-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("a.sdf");
+        std::fs::write(&file, "").unwrap();
+        let writer = {
+            let file = file.clone();
+            std::thread::spawn(move || {
+                std::thread::sleep(Duration::from_millis(100));
+                std::fs::write(file, SCENE).unwrap();
+            })
+        };
+        let mut s = Session::new(file.clone(), Options::default(), Device::Cpu);
+        assert!(s.load().ok, "the load waited for the file's contents");
+        writer.join().unwrap();
+        std::fs::write(&file, "").unwrap();
+        let started = Instant::now();
+        let outcome = s.load();
+        assert!(
+            !outcome.ok && outcome.summary.contains("E0503"),
+            "{}",
+            outcome.summary
+        );
+        assert!(started.elapsed() >= EMPTY_PATIENCE);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

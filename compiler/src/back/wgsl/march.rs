@@ -23,9 +23,11 @@
 //!                      (q_j = Σ_i p_i·M_ij)
 //! ```
 //!
-//! The constants are those of `lower/shapes.rs`, computed in f64 and rounded to f32 as the
-//! program's are, and the walk computes in the program's order of operations, so the GPU's
-//! field equals the CPU's up to f32 rounding. Every instance is an exact distance, so its value
+//! The constants are `lower::slots`, computed in f64 and rounded to f32 as the program's are,
+//! and each kind's shape function is lowered by the rules of `lower/shapes.rs` that lower the
+//! program (`lower::shape_program`, written by `map::write_shape`), so the walk computes the
+//! program's operations in the program's order and the GPU's field equals the CPU's up to f32
+//! rounding. Every instance is an exact distance, so its value
 //! is at least the signed distance to its box, and a group whose box is not nearer than the
 //! best distance so far cannot change the minimum: skipping it is exact. The walk needs no
 //! stack and ends after at most `end` steps, as in buffer.rs. An unrotated instance takes

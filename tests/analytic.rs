@@ -139,7 +139,7 @@ fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     assert!(!src.contains("fn tolerance("));
     assert_eq!(src.matches("best = nearest(").count(), 8);
     assert_eq!(src.matches("through = occlude(").count(), 8);
-    assert!(kernel.features.contains(&("ANALYTIC", true)));
+    assert!(kernel.contract.features.contains(&("ANALYTIC", true)));
     assert!(src.contains("fn capsule_interval(") && src.contains("fn enters("));
     // Only the interval functions a scene uses: spheres and a plane in scene 1.
     let seed1 = load("seed1.sdf");
@@ -235,8 +235,9 @@ fn the_kernel_of_ten_thousand_spheres_stays_small() {
     );
     assert!((32 * 10_001..64 * 10_001).contains(&data), "{data} bytes");
     let options = sdfc_compiler::back::ptx::Options::default();
-    let ptx =
-        sdfc_compiler::back::ptx::write(&large.module, &large.info, &options).expect("translates");
+    let ptx = sdfc_compiler::back::ptx::write(&large.module, &large.info, &options)
+        .expect("translates")
+        .text;
     println!("random_10000: {} lines of PTX", ptx.lines().count());
     assert!(
         ptx.lines().count() < 4_000,

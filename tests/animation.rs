@@ -756,7 +756,7 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
     let with: Vec<_> = frames.iter().map(|(s, p)| kernel(s, p, true)).collect();
     for k in &with[1..] {
         assert_eq!(k.source, with[0].source);
-        assert!(k.features.contains(&("PARAMS", true)));
+        assert!(k.contract.features.contains(&("PARAMS", true)));
     }
     assert_ne!(with[0].data, with[1].data, "the constants differ");
     let literal: Vec<_> = frames.iter().map(|(s, p)| kernel(s, p, false)).collect();
@@ -765,7 +765,7 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
     // The structure check agrees.
     let structures: Vec<_> = frames
         .iter()
-        .map(|(s, p)| sdfc_compiler::animation::Structure::of(s, &p.program))
+        .map(|(s, p)| sdfc_compiler::animation::Structure::of(s, p))
         .collect();
     assert!(structures.iter().all(|s| *s == structures[0]));
     // Another structure is another text.
@@ -790,7 +790,9 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
         sm: 70,
         entry_point: "main".into(),
     };
-    let ptx = sdfc_compiler::back::ptx::write(&k.module, &k.info, &options).expect("ptx");
+    let ptx = sdfc_compiler::back::ptx::write(&k.module, &k.info, &options)
+        .expect("ptx")
+        .text;
     let found = std::env::var_os("PATH").and_then(|p| {
         std::env::split_paths(&p)
             .map(|d| d.join("ptxas"))
@@ -888,7 +890,7 @@ fn evaluate(program: &sdfc_compiler::lower::Program, points: &[[f64; 3]]) -> (Ve
 #[test]
 fn parametric_lowering_keeps_the_structure_and_the_values() {
     use sdfc_compiler::animation::Structure;
-    use sdfc_compiler::lower::{lower_with, LowerOptions};
+    use sdfc_compiler::lower::{lower_scene, lower_with, LowerOptions};
     // At t = 1 the rotation is the identity, the scale 1 and the rounding 0; at t = 2 the
     // translation is 0 and the rotation a quarter turn; the translation is negative before.
     let text = format!(
@@ -903,7 +905,7 @@ fn parametric_lowering_keeps_the_structure_and_the_values() {
             .iter()
             .map(|&t| {
                 let s = scene(&text, t);
-                Structure::of(&s, &lower_with(&s, options))
+                Structure::of(&s, &lower_scene(&s, options))
             })
             .collect()
     };
@@ -928,14 +930,8 @@ fn parametric_lowering_keeps_the_structure_and_the_values() {
             }
         }
     }
-    let mut rng = 0x2545f4914f6cdd1du64;
-    let mut next = || {
-        rng ^= rng << 13;
-        rng ^= rng >> 7;
-        rng ^= rng << 17;
-        (rng >> 11) as f64 / (1u64 << 53) as f64 * 8.0 - 4.0
-    };
-    let points: Vec<[f64; 3]> = (0..400).map(|_| [next(), next(), next()]).collect();
+    let mut rng = sdfc_compiler::rng::Rng::new(0x2545f4914f6cdd1d);
+    let points: Vec<[f64; 3]> = (0..400).map(|_| rng.point(4.0)).collect();
     for s in &scenes {
         let a = evaluate(&sdfc_compiler::lower::lower(s), &points);
         let b = evaluate(&lower_with(s, &LowerOptions::parametric()), &points);

@@ -240,7 +240,7 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
     assert_eq!(split.instances.len(), 320);
     assert!(split.instances.iter().any(|i| i.material.is_none()));
     let kernel = wgsl::write_with(&scene, &lowered, &walk).expect("valid kernel");
-    assert!(kernel.features.contains(&("SCENE_DATA", true)));
+    assert!(kernel.contract.features.contains(&("SCENE_DATA", true)));
     assert!(kernel.source.contains("fn rest_map") && kernel.source.contains("const ROTATED"));
     let Some(gpu) = open_gpu() else { return };
     assert_agree(
@@ -337,8 +337,11 @@ fn glass_overlapping_solids_matches_the_cpu() {
         let lowered = Lowered::new(&scene);
         let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
         let traced = method == "auto";
-        assert_eq!(kernel.features.contains(&("MEDIA", true)), !traced);
-        assert_eq!(kernel.features.contains(&("ANALYTIC", true)), traced);
+        assert_eq!(kernel.contract.features.contains(&("MEDIA", true)), !traced);
+        assert_eq!(
+            kernel.contract.features.contains(&("ANALYTIC", true)),
+            traced
+        );
         assert_agree(
             &gpu,
             &scene,
@@ -378,8 +381,8 @@ fn shadows_through_glass_match_without_secondary_rays() {
     let scene = checked("glass.sdf", text);
     let lowered = Lowered::new(&scene);
     let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
-    assert!(kernel.features.contains(&("TRANSPARENT", true)));
-    assert!(kernel.features.contains(&("REFRACTION", false)));
+    assert!(kernel.contract.features.contains(&("TRANSPARENT", true)));
+    assert!(kernel.contract.features.contains(&("REFRACTION", false)));
     assert_agree(&gpu, &scene, &lowered, &kernel, "glass shadow");
 }
 
@@ -480,7 +483,7 @@ fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
     assert_eq!(traced.primitives().map(<[_]>::len), Some(302), "{traced:?}");
     let lowered = Lowered::new(&scene);
     let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
-    assert!(kernel.features.contains(&("SCENE_DATA", true)));
+    assert!(kernel.contract.features.contains(&("SCENE_DATA", true)));
     assert!(kernel.data.is_some() && !kernel.source.contains("P0_R0"));
     let Some(gpu) = open_gpu() else { return };
     assert_agree(&gpu, &scene, &lowered, &kernel, "302 mixed primitives");

@@ -91,8 +91,7 @@ fn two_scenes_parts_and_a_users_function_validate_in_one_module() {
         source: source.clone(),
         module,
         info,
-        features: Vec::new(),
-        specialisation: wgsl::Specialisation::of(&Default::default()),
+        contract: wgsl::Contract::default(),
         data: None,
     };
     for lang in [Lang::SpirV, Lang::Msl, Lang::Glsl, Lang::Hlsl] {
@@ -406,7 +405,12 @@ fn scene_data_and_params_are_the_bytes_the_renderer_binds() {
     let params = sdfc(&["compile", file, "--emit", "params"]);
     assert_eq!(
         params.stdout,
-        wgsl::uniforms(&scene, lowered.program.lipschitz())
+        wgsl::uniforms(
+            &kernel.contract.uniform,
+            &scene,
+            lowered.program.lipschitz()
+        )
+        .expect("the uniform fits the kernel")
     );
     let layout = sdfc(&["compile", file, "--emit", "layout"]);
     let layout: serde_json::Value = serde_json::from_slice(&layout.stdout).expect("json");

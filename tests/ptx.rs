@@ -520,13 +520,14 @@ fn check(name: &str, src: &str) {
     let ptxas = ptxas();
     for sm in [70, 80, 90] {
         let start = Instant::now();
-        let text =
-            ptx::write(&module, &info, &options(sm)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let text = ptx::write(&module, &info, &options(sm))
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .text;
         let took = start.elapsed();
         assert!(text.contains(&format!(".target sm_{sm}")));
         assert_eq!(
             text,
-            ptx::write(&module, &info, &options(sm)).unwrap(),
+            ptx::write(&module, &info, &options(sm)).unwrap().text,
             "{name}: output is not deterministic"
         );
         println!(
@@ -557,7 +558,7 @@ fn integers_assemble() {
 #[test]
 fn sphere_tracer_shape() {
     let (module, info) = parse_strict(SPHERE_TRACER);
-    let text = ptx::write(&module, &info, &options(90)).unwrap();
+    let text = ptx::write(&module, &info, &options(90)).unwrap().text;
     assert!(text.contains(".version 7.8"));
     assert!(text.contains(".address_size 64"));
     assert!(text.contains("workgroup size (8, 8, 1)"));
@@ -582,7 +583,7 @@ fn sphere_tracer_shape() {
 #[test]
 fn sphere_tracer_speed_shape() {
     let (module, info) = parse_strict(SPHERE_TRACER);
-    let text = ptx::write(&module, &info, &options(90)).unwrap();
+    let text = ptx::write(&module, &info, &options(90)).unwrap().text;
     let instructions: Vec<&str> = text
         .lines()
         .map(str::trim)
@@ -693,7 +694,7 @@ fn a_large_kernel_translates_with_map_as_one_function() {
     let mut text = String::new();
     for _ in 0..5 {
         let start = Instant::now();
-        text = ptx::write(&module, &info, &options(80)).unwrap();
+        text = ptx::write(&module, &info, &options(80)).unwrap().text;
         best = best.min(start.elapsed());
     }
     println!(
@@ -740,7 +741,8 @@ fn example_scenes_assemble() {
         keep(&format!("scene_{name}.wgsl"), kernel.source.as_bytes());
         keep(
             &format!("scene_{name}.uniforms"),
-            &sdfc_compiler::back::wgsl::uniforms(&scene, 1.0),
+            &sdfc_compiler::back::wgsl::uniforms(&kernel.contract.uniform, &scene, 1.0)
+                .expect("the uniform fits the kernel"),
         );
         // The best of three translations: a shared machine's noise only adds time.
         let mut took = std::time::Duration::MAX;
@@ -748,7 +750,8 @@ fn example_scenes_assemble() {
         for _ in 0..3 {
             let start = Instant::now();
             text = ptx::write(&kernel.module, &kernel.info, &options(80))
-                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .text;
             took = took.min(start.elapsed());
         }
         let exprs: usize = kernel
@@ -813,7 +816,8 @@ fn every_renderer_feature_kernel_assembles() {
             let kernel = wgsl::write_with(&scene, &lowered, opts)
                 .unwrap_or_else(|e| panic!("{name} ({variant}): {e}"));
             let text = ptx::write(&kernel.module, &kernel.info, &options(70))
-                .unwrap_or_else(|e| panic!("{name} ({variant}): {e}"));
+                .unwrap_or_else(|e| panic!("{name} ({variant}): {e}"))
+                .text;
             if let Some(p) = &ptxas {
                 assemble(p, &text, &format!("feature_{name}_{variant}"), 70);
             }
@@ -833,8 +837,12 @@ fn the_debug_nan_kernel_assembles() {
     };
     let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &debug).unwrap();
     let plain = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
-    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
-    let without = ptx::write(&plain.module, &plain.info, &options(80)).unwrap();
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+        .unwrap()
+        .text;
+    let without = ptx::write(&plain.module, &plain.info, &options(80))
+        .unwrap()
+        .text;
     assert_ne!(text, without, "the feature changes the kernel");
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "debug_nan", 80)));
@@ -855,7 +863,9 @@ fn a_kernel_with_outlined_blocks_assembles() {
     };
     let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &code).unwrap();
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
-    let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+    let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+        .unwrap()
+        .text;
     assert!(text.contains(".entry"));
     if let Some(p) = ptxas() {
         println!("    {}", summary(&assemble(&p, &text, "outlined", 80)));
@@ -884,7 +894,9 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());
         keep(&format!("buffer_{name}.data"), data);
-        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+            .unwrap()
+            .text;
         println!(
             "{name}: {} bytes of WGSL, {} lines of PTX, {} bytes of scene data",
             kernel.source.len(),
@@ -926,7 +938,9 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
         let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("read from a buffer");
         keep(&format!("buffer_{name}.data"), data);
-        let text = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+        let text = ptx::write(&kernel.module, &kernel.info, &options(80))
+            .unwrap()
+            .text;
         assert!(text.contains("@group(0) @binding(4) var<storage, read> scene_data"));
         assert!(text.contains("main_param_4"));
         assert!(
@@ -934,7 +948,9 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
             "{name}: scene data read through the cache"
         );
         for sm in [70, 80, 90] {
-            let text = ptx::write(&kernel.module, &kernel.info, &options(sm)).unwrap();
+            let text = ptx::write(&kernel.module, &kernel.info, &options(sm))
+                .unwrap()
+                .text;
             if let Some(p) = &ptxas {
                 println!(
                     "{name} sm_{sm}: {}",
@@ -975,7 +991,8 @@ fn interpreted_kernels_assemble() {
             continue;
         }
         let text = ptx::write(&kernel.module, &kernel.info, &options(80))
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .text;
         println!("{name}: {} lines of PTX", text.lines().count());
         keep(
             &format!("interpreted_{name}.wgsl"),
@@ -990,4 +1007,79 @@ fn interpreted_kernels_assemble() {
         seen.insert(kernel.source, name);
     }
     assert!(seen.len() >= 2, "several specialisations");
+}
+
+/// The writer returns the kernel's parameters as the PTX declares them: each buffer's
+/// address in (group, binding) order with its address space and least size, named as in
+/// the `.entry`; `check_arguments` (which the CUDA launcher calls before its `unsafe` launch)
+/// accepts what the launcher passes and names what differs otherwise.
+#[test]
+fn the_parameters_are_returned_and_launches_checked_against_them() {
+    use ptx::{check_arguments, Argument, Space};
+    let text = "render { max_depth: 2 }\n\
+                scene {\n  for i in 0..300 { sphere(0.2).translate(i * 0.5, 0, 0); }\n}\n";
+    let (scene, diags, _) = sdfc_compiler::check::check_str("row.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
+    let data = kernel.data.as_ref().expect("scene data");
+    let written = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
+    let names: Vec<(&str, u32)> = written
+        .params
+        .iter()
+        .map(|p| (p.var.as_str(), p.binding))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            ("params", 0),
+            ("tile", 1),
+            ("image", 2),
+            ("stats", 3),
+            ("scene_data", 4)
+        ]
+    );
+    for p in &written.params {
+        assert!(
+            written
+                .text
+                .contains(&format!(".param .{} {}", p.ty, p.name)),
+            "{} declared as returned",
+            p.name
+        );
+    }
+    let uniform = u64::from(kernel.contract.uniform.size);
+    assert_eq!(written.params[0].min_bytes, uniform);
+    assert_eq!(written.params[2].stride, Some(16));
+    let pixels = 64 * 48;
+    let arg = |binding, space, bytes| Argument {
+        group: 0,
+        binding,
+        space,
+        bytes,
+        size: 8,
+    };
+    let rw = Space::Storage { writable: true };
+    let mut args = vec![
+        arg(0, Space::Uniform, uniform),
+        arg(1, Space::Uniform, 16),
+        arg(2, rw, 16 * pixels),
+        arg(3, rw, 4 * 8 * pixels),
+        arg(4, Space::Storage { writable: false }, data.len() as u64),
+    ];
+    check_arguments(&written.params, &args).expect("the launcher's arguments");
+    let refused = |args: &[Argument], what: &str| {
+        let e = check_arguments(&written.params, args).expect_err(what);
+        println!("{what}: {e}");
+        e
+    };
+    assert!(refused(&args[..4], "no scene data").contains("takes 5 buffers"));
+    let mut small = args.clone();
+    small[0].bytes = uniform - 16;
+    assert!(refused(&small, "a short uniform").contains("needs at least"));
+    let mut swapped = args.clone();
+    swapped.swap(2, 3);
+    assert!(refused(&swapped, "image and statistics swapped").contains("binding(3)"));
+    args[4].space = rw;
+    assert!(refused(&args, "scene data passed writable").contains("read_write"));
 }

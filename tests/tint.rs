@@ -148,7 +148,10 @@ fn example_jobs() -> Vec<Job> {
         };
         let kernel = wgsl::write_with(&scene, &lowered, &options)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert_eq!(kernel.features.contains(&("PARAMS", true)), parameters);
+        assert_eq!(
+            kernel.contract.features.contains(&("PARAMS", true)),
+            parameters
+        );
         let name = path
             .strip_prefix("..")
             .unwrap_or(path)
@@ -305,6 +308,7 @@ impl Combo {
 /// The features a kernel was specialised for, as a combination.
 fn combo_of(kernel: &wgsl::Kernel) -> Combo {
     let on: BTreeSet<&str> = kernel
+        .contract
         .features
         .iter()
         .filter(|(_, on)| *on)

@@ -5,8 +5,7 @@
 //! materials, ε, step budget, L).
 
 use crate::back::wgsl::Specialisation;
-use crate::lower::{Block, Op, Program, Reg};
-use crate::scene::analytic::{self, Choice};
+use crate::lower::{Block, Lowered, Op, Reg};
 use crate::scene::Scene;
 
 /// An operand that is a constant, in a [`Structure`].
@@ -26,12 +25,14 @@ pub struct Structure {
 }
 
 impl Structure {
-    /// The structure of `scene`, whose distance program is `program`. Constants are
+    /// The structure of `scene`, lowered as `lowered` (its program, and whether its settings
+    /// trace it, as the lowering decided). Constants are
     /// erased as operands: the lowering shares one register between equal constants, so
     /// whether two constants are shared depends on their values, not on the structure; here
     /// every operand that is a constant reads as [`CONST`], and the other registers are
     /// numbered among the instructions that are not constants.
-    pub fn of(scene: &Scene, program: &Program) -> Structure {
+    pub fn of(scene: &Scene, lowered: &Lowered) -> Structure {
+        let program = &lowered.program;
         let mut renumber = Vec::with_capacity(program.len());
         let mut next = 0u32;
         for op in program.ops() {
@@ -74,10 +75,10 @@ impl Structure {
                 results: b.results,
             })
             .collect();
-        let traced = match analytic::choose(scene) {
-            Choice::Trace(prims) => Some(prims.len()),
-            Choice::March(_) => None,
-        };
+        let traced = lowered
+            .traceable
+            .traced(scene.settings.method)
+            .map(|t| t.primitives.len());
         Structure {
             ops,
             blocks,

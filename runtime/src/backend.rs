@@ -8,7 +8,7 @@ use crate::memory::{self, Memory};
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, LowerOptions, Lowered};
 use sdfc_compiler::program::Program;
-use sdfc_compiler::scene::analytic::{self, Choice, Traceable};
+use sdfc_compiler::scene::analytic::{Choice, Traceable};
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -225,7 +225,7 @@ pub struct Preparation {
 pub struct CudaModule {
     loaded: gpu::cuda::Loaded,
     data: Option<Vec<u8>>,
-    specialisation: wgsl::Specialisation,
+    contract: wgsl::Contract,
     ptx_time: Duration,
     source: String,
     interpreted: bool,
@@ -267,14 +267,9 @@ impl Frame {
 }
 
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
-/// does not allow it, saying why (before lowering: `sdfc render` refuses such settings
-/// first).
-pub fn method_allowed(scene: &Scene) -> Result<(), String> {
-    traceable_with(scene, &analytic::traceable(scene))
-}
-
-/// [`method_allowed`] for a scene whose primitives the lowering found (`traceable`).
-fn traceable_with(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
+/// does not allow it, saying why, from the primitives the lowering found (`traceable`):
+/// `sdfc render` refuses such settings before preparing a backend.
+pub fn method_allowed(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
     if scene.settings.method == Method::Trace {
         if let Choice::March(reason) = traceable.choose(scene.settings.method) {
             return Err(format!(
@@ -305,7 +300,7 @@ impl Prepared {
         lowered: Lowered,
         setup: &Setup,
     ) -> Result<Prepared, String> {
-        traceable_with(scene, &lowered.traceable)?;
+        method_allowed(scene, &lowered.traceable)?;
         match backend {
             Backend::Cpu => Ok(Self::cpu(lowered, setup)),
             Backend::Wgpu => Self::wgpu(scene, &lowered, setup, false),
@@ -329,7 +324,7 @@ impl Prepared {
         let Some(list) = devices.resolve(backend)? else {
             return Self::from_program(backend, scene, lowered, setup);
         };
-        traceable_with(scene, &lowered.traceable)?;
+        method_allowed(scene, &lowered.traceable)?;
         let mut parts = Vec::with_capacity(list.len());
         for d in &list {
             let part = match *d {
@@ -474,7 +469,7 @@ impl Prepared {
         setup: &Setup,
         held: Option<&wgsl::Kernel>,
     ) -> Result<(Prepared, bool), String> {
-        traceable_with(scene, &lowered.traceable)?;
+        method_allowed(scene, &lowered.traceable)?;
         // On a CPU adapter (lavapipe) the interpreted kernel's frames are 25 to 150 times the
         // specialised kernel's (BENCHMARKS.md, "Interpreted against specialised"), which its
         // compile never repays: `auto` keeps the specialised kernel there.
@@ -541,7 +536,7 @@ impl Prepared {
 
     /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
     pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
-        traceable_with(scene, &lowered.traceable)?;
+        method_allowed(scene, &lowered.traceable)?;
         Ok(Self::cpu(lowered, setup))
     }
 
@@ -584,16 +579,16 @@ impl Prepared {
             sm: cuda.sm,
             entry_point: wgsl::ENTRY_POINT.to_string(),
         };
-        let text = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
+        let ptx = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
         let ptx_time = start.elapsed();
         let loaded = cuda
-            .load(&text, wgsl::ENTRY_POINT)
+            .load(&ptx, wgsl::ENTRY_POINT)
             .map_err(|e| e.to_string())?;
         Ok(CudaModule {
             interpreted: kernel.interpreted(),
             loaded,
             data: kernel.data,
-            specialisation: kernel.specialisation,
+            contract: kernel.contract,
             ptx_time,
             source: kernel.source,
         })
@@ -604,7 +599,7 @@ impl Prepared {
     /// program that differs only in numbers) is kept and given the new `scene_data`; another
     /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
     pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
-        method_allowed(scene)?;
+        method_allowed(scene, &lowered.traceable)?;
         match self {
             Prepared::Cpu { .. } | Prepared::Wgpu { .. } => {
                 let (next, built) = self.next(scene, lowered)?;
@@ -619,7 +614,7 @@ impl Prepared {
                 setup,
                 ..
             } => {
-                traceable_with(scene, &lowered.traceable)?;
+                method_allowed(scene, &lowered.traceable)?;
                 let text = Self::kernel_text(scene, &lowered, setup)?;
                 let built = text.source != module.source;
                 if built {
@@ -641,36 +636,37 @@ impl Prepared {
         }
     }
 
-    /// The settings a GPU kernel was specialised for (`None` on the CPU, which reads every
-    /// setting at every render).
-    pub fn specialisation(&self) -> Option<wgsl::Specialisation> {
+    /// The contract of the GPU kernel: what it was specialised for and what it reads
+    /// (`None` on the CPU, which reads every setting at every render).
+    pub fn contract(&self) -> Option<&wgsl::Contract> {
         match self {
             Prepared::Cpu { .. } => None,
-            Prepared::Wgpu { kernel, .. } => Some(kernel.specialisation),
-            Prepared::Cuda { module, .. } => Some(module.specialisation),
-            Prepared::Several(parts) => parts.iter().find_map(|p| p.specialisation()),
+            Prepared::Wgpu { kernel, .. } => Some(&kernel.contract),
+            Prepared::Cuda { module, .. } => Some(&module.contract),
+            Prepared::Several(parts) => parts.iter().find_map(|p| p.contract()),
         }
     }
 
-    /// Specialises the GPU kernel again when `scene`'s settings need other features than
-    /// it has (another method, over-relaxation on or off, another `max_depth`): a sweep of
-    /// ω from 1 up must turn `RELAX` on. Keeps the device; nothing to do on the CPU.
-    pub fn specialise(&mut self, scene: &Scene) -> Result<(), String> {
-        let wanted = wgsl::Specialisation::of(&scene.settings);
-        if self.specialisation().is_none_or(|s| s == wanted) {
-            return Ok(());
+    /// Specialises the GPU kernel again when `scene` needs other features than it has
+    /// (another method, over-relaxation on or off, another `max_depth`, soft shadows where
+    /// the kernel has hard ones, ...: [`wgsl::Contract::check`]): a sweep of ω from 1 up must
+    /// turn `RELAX` on. Keeps the device; nothing to do on the CPU. Says whether a kernel was
+    /// written.
+    pub fn specialise(&mut self, scene: &Scene) -> Result<bool, String> {
+        if self.check_contract(scene).is_ok() {
+            return Ok(false);
         }
         match self {
-            Prepared::Cpu { .. } => Ok(()),
+            Prepared::Cpu { .. } => Ok(false),
             Prepared::Wgpu {
                 kernel,
                 lowered,
                 setup,
                 ..
             } => {
-                traceable_with(scene, &lowered.traceable)?;
+                method_allowed(scene, &lowered.traceable)?;
                 **kernel = Self::kernel(scene, lowered, setup)?;
-                Ok(())
+                Ok(true)
             }
             Prepared::Cuda {
                 cuda,
@@ -679,27 +675,43 @@ impl Prepared {
                 setup,
                 ..
             } => {
-                traceable_with(scene, &lowered.traceable)?;
+                method_allowed(scene, &lowered.traceable)?;
                 // The same device and context; the new module replaces the old one.
                 **module = Self::cuda_module(cuda, scene, lowered, setup)?;
-                Ok(())
+                Ok(true)
             }
-            Prepared::Several(parts) => parts.iter_mut().try_for_each(|p| p.specialise(scene)),
+            Prepared::Several(parts) => {
+                let mut again = false;
+                for p in parts {
+                    again |= p.specialise(scene)?;
+                }
+                Ok(again)
+            }
         }
     }
 
-    /// `Err` when `scene`'s settings need a kernel specialised otherwise than this one
-    /// ([`Prepared::specialise`]): a render never silently ignores a setting.
-    fn check_specialisation(&self, scene: &Scene) -> Result<(), String> {
-        let wanted = wgsl::Specialisation::of(&scene.settings);
-        match self.specialisation() {
-            Some(have) if have != wanted => Err(format!(
-                "the {} kernel was specialised for {} and cannot render {}: specialise it again",
-                self.name(),
-                describe(&have),
-                describe(&wanted)
-            )),
-            _ => Ok(()),
+    /// `Err` when `scene` needs a kernel specialised otherwise than this one
+    /// ([`wgsl::Contract::check`]; [`Prepared::specialise`] writes it again): a render never
+    /// silently ignores a setting or a feature of the scene.
+    fn check_contract(&self, scene: &Scene) -> Result<(), String> {
+        let (Some(contract), Some(lowered)) = (self.contract(), self.lowered()) else {
+            return Ok(());
+        };
+        let traced = lowered.traceable.traced(scene.settings.method).is_some();
+        contract.check(scene, traced).map_err(|m| {
+            format!(
+                "the {} kernel cannot render this scene: {m}; specialise it again",
+                self.name()
+            )
+        })
+    }
+
+    /// The lowered scene a GPU kernel was written from.
+    fn lowered(&self) -> Option<&Lowered> {
+        match self {
+            Prepared::Cpu { .. } => None,
+            Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => Some(lowered),
+            Prepared::Several(parts) => parts.iter().find_map(|p| p.lowered()),
         }
     }
 
@@ -822,12 +834,16 @@ impl Prepared {
                 host: cpu::memory(&at, tapes, options, rayon::current_num_threads()),
                 device: 0,
             },
-            Prepared::Wgpu { kernel, .. } => {
-                gpu::memory_wgpu(settings, uniforms(&at), bytes(&kernel.data))
-            }
-            Prepared::Cuda { module, .. } => {
-                gpu::memory_cuda(settings, uniforms(&at), bytes(&module.data))
-            }
+            Prepared::Wgpu { kernel, .. } => gpu::memory_wgpu(
+                settings,
+                kernel.contract.uniform.size.into(),
+                bytes(&kernel.data),
+            ),
+            Prepared::Cuda { module, .. } => gpu::memory_cuda(
+                settings,
+                module.contract.uniform.size.into(),
+                bytes(&module.data),
+            ),
             // Each device holds a whole frame's buffers; the bands read back and the image
             // they are assembled into are no more than one device's whole readback.
             Prepared::Several(parts) => parts.iter().fold(Memory::default(), |m, p| {
@@ -882,7 +898,7 @@ impl Prepared {
         progress: &(dyn Fn(f64) + Sync),
         faults: &gpu::launch::Faults,
     ) -> Result<Frame, String> {
-        self.check_specialisation(scene)?;
+        self.check_contract(scene)?;
         match self {
             Prepared::Cpu { tapes, options, .. } => {
                 let tiles = cpu::tile_count(&scene.settings, options).max(1) as f64;
@@ -922,7 +938,11 @@ impl Prepared {
                 let r = gpu::render_cuda(
                     cuda,
                     scene,
-                    (&module.loaded, module.data.as_deref()),
+                    (
+                        &module.loaded,
+                        &module.contract.uniform,
+                        module.data.as_deref(),
+                    ),
                     *lipschitz,
                     faults,
                     &mut |f| progress(f),
@@ -933,6 +953,7 @@ impl Prepared {
             Prepared::Several(parts) => {
                 let mut workers: Vec<Box<dyn gpu::launch::Worker + '_>> = Vec::new();
                 let mut data = None;
+                let mut uniform = None;
                 let mut lipschitz = 1.0;
                 for p in parts {
                     match p {
@@ -946,6 +967,7 @@ impl Prepared {
                             ..
                         } => {
                             data = kernel.data.as_deref();
+                            uniform = Some(&kernel.contract.uniform);
                             lipschitz = *l;
                             workers.push(Box::new(gpu.kernel(
                                 &kernel.source,
@@ -960,6 +982,7 @@ impl Prepared {
                             ..
                         } => {
                             data = module.data.as_deref();
+                            uniform = Some(&module.contract.uniform);
                             lipschitz = *l;
                             workers.push(Box::new(cuda.kernel(&module.loaded, wgsl::WORKGROUP)));
                         }
@@ -970,10 +993,13 @@ impl Prepared {
                 }
                 let workers: Vec<&dyn gpu::launch::Worker> =
                     workers.iter().map(|w| w.as_ref()).collect();
-                let r =
-                    gpu::render_several(&workers, scene, (lipschitz, data), faults, &mut |f| {
-                        progress(f)
-                    })?;
+                let r = gpu::render_several(
+                    &workers,
+                    scene,
+                    (lipschitz, uniform, data),
+                    faults,
+                    &mut |f| progress(f),
+                )?;
                 Ok(Frame::of(r))
             }
         }
@@ -992,28 +1018,9 @@ impl Frame {
     }
 }
 
-/// Bytes of the scene uniform of the GPU kernels.
-fn uniforms(scene: &Scene) -> u64 {
-    wgsl::uniforms(scene, 1.0).len() as u64
-}
-
 /// Bytes of a kernel's scene data.
 fn bytes(data: &Option<Vec<u8>>) -> u64 {
     data.as_ref().map_or(0, |d| d.len() as u64)
-}
-
-/// A specialisation in words, for errors.
-fn describe(s: &wgsl::Specialisation) -> String {
-    format!(
-        "method {}, {}, max_depth {}",
-        s.method.name(),
-        if s.relax {
-            "over-relaxation"
-        } else {
-            "no over-relaxation (ω = 1)"
-        },
-        s.max_depth
-    )
 }
 
 impl memory::Footprint for Prepared {

@@ -6,7 +6,7 @@ use sdfc_compiler::check::{self, Loader};
 use sdfc_compiler::diagnostics::{self, Diagnostic};
 use sdfc_compiler::lower::{self, LowerOptions, Lowered};
 use sdfc_compiler::scene::analysis::{self, Analysis};
-use sdfc_compiler::scene::analytic::{self, Choice, Reason};
+use sdfc_compiler::scene::analytic::{Choice, Reason, Traceable};
 use sdfc_compiler::scene::{Exactness, Scene};
 use sdfc_compiler::{Limits, SourceMap, Span};
 use std::io::IsTerminal;
@@ -241,9 +241,11 @@ pub fn summary(loaded: &Loaded, scene: &Scene) -> String {
 }
 
 /// How the scene is rendered and why: `method: trace (...)` or `method: march (...)`, with
-/// the location of the node that rules out analytic tracing.
-pub fn method(loaded: &Loaded, scene: &Scene) -> String {
-    match analytic::choose(scene) {
+/// the location of the node that rules out analytic tracing; `traceable` is the lowering's
+/// ([`Lowered::traceable`]), or for `sdfc check` of a scene it does not lower,
+/// `analytic::traceable`.
+pub fn method(loaded: &Loaded, scene: &Scene, traceable: &Traceable) -> String {
+    match traceable.choose(scene.settings.method) {
         Choice::March(Reason::Node { what, span }) => format!(
             "method: march (the {what} at {} has no closed-form ray intersection)",
             at(loaded, span)

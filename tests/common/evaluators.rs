@@ -116,7 +116,9 @@ pub fn points_ptx(m: &PointsModule, sm: u32) -> String {
         sm,
         entry_point: ENTRY_POINT.into(),
     };
-    ptx::write(&m.module, &m.info, &options).unwrap_or_else(|e| panic!("PTX: {e}"))
+    ptx::write(&m.module, &m.info, &options)
+        .unwrap_or_else(|e| panic!("PTX: {e}"))
+        .text
 }
 
 /// The f64 reference at every point.

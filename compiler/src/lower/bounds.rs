@@ -10,6 +10,7 @@
 //! bound at all (a plane, infinite repetition in every direction) has `None`.
 
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
+use glam::DVec3;
 
 /// A sphere: centre and radius.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,7 +70,7 @@ impl Bound {
             self.sphere.r = f64::INFINITY;
             return self;
         }
-        let around_box = norm(self.aabb.h);
+        let around_box = DVec3::from(self.aabb.h).length();
         let old_sphere = self.sphere;
         if around_box < self.sphere.r {
             self.sphere = Sphere {
@@ -100,11 +101,11 @@ impl Bound {
     fn similar(self, s: f64, t: V3) -> Bound {
         Bound {
             sphere: Sphere {
-                c: add(scale3(self.sphere.c, s), t),
+                c: (DVec3::from(self.sphere.c) * s + DVec3::from(t)).to_array(),
                 r: self.sphere.r * s.abs(),
             },
             aabb: Aabb {
-                c: add(scale3(self.aabb.c, s), t),
+                c: (DVec3::from(self.aabb.c) * s + DVec3::from(t)).to_array(),
                 h: self.aabb.h.map(|h| h * s.abs()),
             },
             scale: self.scale,
@@ -149,7 +150,7 @@ fn sphere_hull(a: &Sphere, b: &Sphere) -> Sphere {
             r: f64::INFINITY,
         };
     }
-    let d = norm(sub(b.c, a.c));
+    let d = (DVec3::from(b.c) - DVec3::from(a.c)).length();
     if d + b.r <= a.r {
         return *a;
     }
@@ -159,7 +160,7 @@ fn sphere_hull(a: &Sphere, b: &Sphere) -> Sphere {
     let r = (d + a.r + b.r) * 0.5;
     let t = (r - a.r) / d;
     Sphere {
-        c: add(a.c, scale3(sub(b.c, a.c), t)),
+        c: (DVec3::from(a.c) + (DVec3::from(b.c) - DVec3::from(a.c)) * t).to_array(),
         r: r * (1.0 + 1e-12),
     }
 }
@@ -202,10 +203,11 @@ impl Bounds {
         let get = |id: &NodeId| self.get(*id);
         Some(match node {
             Node::Sphere { radius } => Bound::of_sphere(*radius),
-            Node::Box { half } => Bound::of_box(*half, norm(*half)),
-            Node::RoundBox { half, radius } => {
-                Bound::of_box(*half, norm(half.map(|h| (h - radius).max(0.0))) + radius)
-            }
+            Node::Box { half } => Bound::of_box(*half, DVec3::from(*half).length()),
+            Node::RoundBox { half, radius } => Bound::of_box(
+                *half,
+                DVec3::from(half.map(|h| (h - radius).max(0.0))).length() + radius,
+            ),
             Node::Plane { .. } => return None,
             Node::Torus { major, minor } => {
                 Bound::of_box([major + minor, *minor, major + minor], major + minor)
@@ -380,7 +382,7 @@ fn repeat(b: &Bound, period: &V3, count: Option<&V3>) -> Option<Bound> {
             out.aabb.c[i] = 0.0;
         }
     }
-    out.sphere.r += norm(reach);
+    out.sphere.r += DVec3::from(reach).length();
     if out.aabb.h.iter().all(|h| h.is_infinite()) {
         return None;
     }
@@ -398,7 +400,7 @@ fn mirror(b: &Bound, axes: &[bool; 3]) -> Bound {
         moved[i] = b.sphere.c[i];
         out.sphere.c[i] = 0.0;
     }
-    out.sphere.r += norm(moved);
+    out.sphere.r += DVec3::from(moved).length();
     out
 }
 
@@ -430,7 +432,7 @@ fn about_axis(b: &Bound, axis: usize) -> Bound {
 fn elongate(b: &Bound, h: &V3) -> Bound {
     let mut out = *b;
     out.aabb.h = [0, 1, 2].map(|i| b.aabb.h[i] + h[i].abs());
-    out.sphere.r += norm(*h);
+    out.sphere.r += DVec3::from(*h).length();
     out
 }
 
@@ -462,20 +464,4 @@ fn own_cost(node: &Node) -> f64 {
 
 fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
     [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
-}
-
-fn norm(v: V3) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn scale3(a: V3, s: f64) -> V3 {
-    a.map(|x| x * s)
 }

@@ -8,6 +8,19 @@ use std::collections::HashMap;
 /// A point or vector: three registers.
 pub(super) type P = [Reg; 3];
 
+/// The four constants of an exact primitive (`shapes::slots`).
+pub type Slots = [f64; 4];
+
+/// A constant that is a primitive's constant `slot` times `scale` ([`Builder::param`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Param {
+    /// The constant's register.
+    pub reg: Reg,
+    pub slot: usize,
+    /// An exact factor: ±1 or ±2.
+    pub scale: f64,
+}
+
 /// The identity of an instruction for sharing (constants compared by bits).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 enum Key {
@@ -47,6 +60,8 @@ pub(super) struct Builder {
     /// `Select` keeps both sides. Constant operations still fold (into a constant, whatever
     /// the values).
     pub parametric: bool,
+    /// When recording, the constants [`Builder::param`] made, in order.
+    pub params: Option<Vec<Param>>,
 }
 
 impl Builder {
@@ -101,6 +116,17 @@ impl Builder {
     /// The constant `x`.
     pub fn c(&mut self, x: f64) -> Reg {
         self.emit(Op::Const(x))
+    }
+
+    /// The constant `scale · s[slot]`, a primitive's constant `slot` times an exact factor
+    /// (±1, ±2, so that a shader computing it from the slot gets the same f32); recorded in
+    /// [`Builder::params`] when that is on.
+    pub fn param(&mut self, s: &Slots, slot: usize, scale: f64) -> Reg {
+        let reg = self.c(scale * s[slot]);
+        if let Some(params) = &mut self.params {
+            params.push(Param { reg, slot, scale });
+        }
+        reg
     }
 
     /// The value of a register when it is a constant.

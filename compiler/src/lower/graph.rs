@@ -13,6 +13,7 @@ use super::bvh::{self, Kind, Tree};
 use super::{shapes, Reg, Unary, EMPTY_DISTANCE};
 use crate::scene::analysis::{Analysis, Window};
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
+use glam::DVec3;
 use std::collections::HashMap;
 
 /// The material register value of a shape no `paint` has reached yet.
@@ -343,26 +344,13 @@ impl<'a> Lowerer<'a> {
     fn primitive(&mut self, node: &Node, p: P) -> Field {
         let b = &mut *self.b;
         let d = match *node {
-            Node::Sphere { radius } => shapes::sphere(b, p, radius),
-            Node::Box { half } => shapes::boxed(b, p, half),
-            Node::RoundBox { half, radius } => shapes::round_box(b, p, half, radius),
             Node::Plane { normal, height } => shapes::plane(b, p, normal, height),
-            Node::Torus { major, minor } => shapes::torus(b, p, major, minor),
-            Node::Cylinder {
-                radius,
-                half_height,
-            } => shapes::cylinder(b, p, radius, half_height),
-            Node::Capsule {
-                radius,
-                half_height,
-            } => shapes::capsule(b, p, radius, half_height),
-            Node::Cone {
-                radius,
-                half_height,
-            } => shapes::cone(b, p, radius, half_height),
             Node::Ellipsoid { radii } => shapes::ellipsoid(b, p, radii),
             Node::Mandelbulb { power, iterations } => shapes::mandelbulb(b, p, power, iterations),
-            _ => b.c(EMPTY_DISTANCE),
+            _ => match shapes::slots(node) {
+                Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
+                None => b.c(EMPTY_DISTANCE),
+            },
         };
         Field {
             d,
@@ -739,7 +727,7 @@ fn bound_distance(b: &mut Builder, bound: &Bound, p: P) -> Reg {
     let (box_volume, sphere_volume) = bound.volumes();
     if bound.finite() && sphere_volume <= 1.5 * box_volume {
         let sp = bound.sphere;
-        let pad = 1e-3 * sp.r + 1e-4 * (1.0 + norm(sp.c));
+        let pad = 1e-3 * sp.r + 1e-4 * (1.0 + DVec3::from(sp.c).length());
         let q = b.sub3c(p, sp.c);
         let l = b.len3(q);
         let s = b.subc(l, sp.r + pad);
@@ -780,7 +768,7 @@ fn slab_distance(b: &mut Builder, bound: &Bound, tested: Option<&Tested>, p: P) 
         }
     };
     let size = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
-    let pad = 1e-3 * size + 1e-4 * (1.0 + norm(c));
+    let pad = 1e-3 * size + 1e-4 * (1.0 + DVec3::from(c).length());
     for i in (0..3).filter(|&i| fresh(i)) {
         let d = b.subc(p[i], c[i]);
         let d = b.abs(d);
@@ -835,10 +823,6 @@ fn shrink(b: &mut Builder, s: Reg, scale: f64) -> Reg {
         let t = b.mulc(s, SHRINK * scale);
         b.min(s, t)
     }
-}
-
-fn norm(v: V3) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
 /// The smooth minimum. Poly: h = max(k - |a - b|, 0) / k, min(a, b) - h²·k/4 (Quilez's

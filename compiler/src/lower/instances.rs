@@ -14,7 +14,8 @@
 //! in the rest.
 
 use super::bounds::Bounds;
-use super::{lower_simple, LowerOptions, Program, Simplified};
+use super::builder::{Builder, Param};
+use super::{lower_simple, shapes, LowerOptions, Program, Simplified};
 use crate::scene::analysis::Analysis;
 use crate::scene::{Combine, Exactness, Graph, MaterialId, Node, NodeId, V3};
 
@@ -42,6 +43,35 @@ pub struct Split {
     pub rest: Program,
     /// The instances, in the order of the root union's children.
     pub instances: Vec<Instance>,
+}
+
+/// The distance of an instance's primitive as a program of the point in its frame, with its
+/// constants as parameters: lowered by the rules of `shapes.rs` (the lowering's own, unoptimised,
+/// so that every constant stays an instruction of its own) with placeholder constants, each
+/// read of one of the primitive's [`shapes::slots`] recorded. A back end writes the program
+/// with those constants replaced by reads of the slots (the GPU walk's shape functions,
+/// back/wgsl/march.rs), and so computes what the scene's program computes for the instance.
+#[derive(Debug, Clone)]
+pub struct ShapeProgram {
+    /// The program: its distance is the primitive's (its material is 0).
+    pub program: Program,
+    /// The constants that are slots, scaled.
+    pub params: Vec<Param>,
+}
+
+/// [`ShapeProgram`] of the kind of primitive `shape` is; `None` when it cannot be an instance.
+pub fn shape_program(shape: &Node) -> Option<ShapeProgram> {
+    shapes::slots(shape)?;
+    let mut b = Builder::new(false);
+    b.params = Some(Vec::new());
+    let p = b.input_point();
+    let d = shapes::exact(&mut b, p, shape, &[1.0; 4])?;
+    let m = b.c(0.0);
+    let params = b.params.take().unwrap_or_default();
+    Some(ShapeProgram {
+        program: b.finish(d, m),
+        params,
+    })
 }
 
 /// Splits the instances off the root union of a simplified scene when it has more than

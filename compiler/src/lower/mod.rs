@@ -23,8 +23,10 @@ pub use crate::program::{
     axis_name, binary_name, op_text, unary_name, Axis, Binary, Block, Item, Note, Op, Program, Reg,
     Unary,
 };
-pub use instances::{Instance, Split};
+pub use builder::{Param, Slots};
+pub use instances::{shape_program, Instance, ShapeProgram, Split};
 pub use media::{media, Media};
+pub use shapes::slots;
 
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};

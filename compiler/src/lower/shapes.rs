@@ -1,21 +1,77 @@
 //! Lowering rules of the primitives: Quilez's distance functions written as scalar code.
-//! Every primitive is centred on the origin; `p` is the point in the primitive's frame.
+//! Every primitive is centred on the origin; `p` is the point in the primitive's frame. The
+//! exact primitives that a marched scene's instances may be read their constants through
+//! [`Builder::param`] from their [`slots`], so that the same rules give both the program and
+//! the GPU walk's shape functions (back/wgsl/march.rs), which read the slots from `scene_data`.
 
-use super::builder::{Builder, P};
+use super::builder::{Builder, Slots, P};
 use super::{Binary, Reg, Unary};
-use crate::scene::V3;
+use crate::scene::{Node, V3};
 
-/// |p| - r
-pub(super) fn sphere(b: &mut Builder, p: P, r: f64) -> Reg {
-    let l = b.len3(p);
-    b.subc(l, r)
+/// The constants of an exact primitive, four numbers: what its formula below reads as
+/// `s[0..4]` ([`Builder::param`]), and what the GPU's walk over a marched scene's instances
+/// reads from `scene_data` (back/wgsl/march.rs). Derived constants are computed here, in f64,
+/// once: a round box's inner half-extents, a cone's 2h² and 1 / (r² + 4h²). `None` for the
+/// other primitives (a plane, an ellipsoid, a Mandelbulb, which no instance is).
+pub fn slots(node: &Node) -> Option<Slots> {
+    Some(match *node {
+        Node::Sphere { radius } => [radius, 0.0, 0.0, 0.0],
+        Node::Box { half } => [half[0], half[1], half[2], 0.0],
+        Node::RoundBox { half, radius: r } => [half[0] - r, half[1] - r, half[2] - r, r],
+        Node::Torus { major, minor } => [major, minor, 0.0, 0.0],
+        Node::Cylinder {
+            radius,
+            half_height,
+        }
+        | Node::Capsule {
+            radius,
+            half_height,
+        } => [radius, half_height, 0.0, 0.0],
+        Node::Cone {
+            radius: r,
+            half_height: h,
+        } => [r, h, 2.0 * h * h, 1.0 / (r * r + 4.0 * h * h)],
+        _ => return None,
+    })
 }
 
-/// q = |p| - h; |max(q, 0)| + min(maxcomp(q), 0)
-pub(super) fn boxed(b: &mut Builder, p: P, half: V3) -> Reg {
+/// The distance of the exact primitive `node` (one [`slots`] knows) at `p`, its constants
+/// `s` read through [`Builder::param`]: with `s = slots(node)` the lowering's program, with
+/// placeholder constants recorded as parameters the GPU walk's shape function
+/// ([`super::shape_program`]).
+pub(super) fn exact(b: &mut Builder, p: P, node: &Node, s: &Slots) -> Option<Reg> {
+    Some(match node {
+        Node::Sphere { .. } => sphere(b, p, s),
+        Node::Box { .. } => boxed(b, p, s),
+        Node::RoundBox { .. } => round_box(b, p, s),
+        Node::Torus { .. } => torus(b, p, s),
+        Node::Cylinder { .. } => cylinder(b, p, s),
+        Node::Capsule { .. } => capsule(b, p, s),
+        Node::Cone { .. } => cone(b, p, s),
+        _ => return None,
+    })
+}
+
+/// |p| - r, with s = (r, ·, ·, ·).
+fn sphere(b: &mut Builder, p: P, s: &Slots) -> Reg {
+    let l = b.len3(p);
+    let r = b.param(s, 0, 1.0);
+    b.sub(l, r)
+}
+
+/// q = |p| - h; |max(q, 0)| + min(maxcomp(q), 0), with s = (h, ·).
+fn boxed(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let a = b.abs3(p);
-    let q = b.sub3c(a, half);
+    let q = sub_slots(b, a, s);
     box_from_q(b, q)
+}
+
+/// p - s.xyz.
+fn sub_slots(b: &mut Builder, p: P, s: &Slots) -> P {
+    b.map3(p, |b, x, i| {
+        let k = b.param(s, i, 1.0);
+        b.sub(x, k)
+    })
 }
 
 fn box_from_q(b: &mut Builder, q: P) -> Reg {
@@ -26,12 +82,14 @@ fn box_from_q(b: &mut Builder, q: P) -> Reg {
     b.add(outside, inside)
 }
 
-/// A box of half-extents `half` (the rounding inside them) with edges rounded by `r`.
-pub(super) fn round_box(b: &mut Builder, p: P, half: V3, r: f64) -> Reg {
+/// A box with edges rounded by r, with s = (half-extents − r, r): the box of the inner
+/// half-extents, less r.
+fn round_box(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let a = b.abs3(p);
-    let q = b.sub3c(a, [half[0] - r, half[1] - r, half[2] - r]);
+    let q = sub_slots(b, a, s);
     let d = box_from_q(b, q);
-    b.subc(d, r)
+    let r = b.param(s, 3, 1.0);
+    b.sub(d, r)
 }
 
 /// dot(p, n) - h: the half-space below the plane.
@@ -41,21 +99,25 @@ pub(super) fn plane(b: &mut Builder, p: P, n: V3, h: f64) -> Reg {
     b.subc(d, h)
 }
 
-/// |(|p.xz| - R, p.y)| - r
-pub(super) fn torus(b: &mut Builder, p: P, major: f64, minor: f64) -> Reg {
+/// |(|p.xz| - R, p.y)| - r, with s = (R, r, ·, ·).
+fn torus(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let xz = b.len2(p[0], p[2]);
-    let qx = b.subc(xz, major);
+    let major = b.param(s, 0, 1.0);
+    let qx = b.sub(xz, major);
     let l = b.len2(qx, p[1]);
-    b.subc(l, minor)
+    let minor = b.param(s, 1, 1.0);
+    b.sub(l, minor)
 }
 
-/// Capped cylinder along y: d = |(|p.xz|, p.y)| - (r, h);
+/// Capped cylinder along y, with s = (r, h, ·, ·): d = |(|p.xz|, p.y)| - (r, h);
 /// min(max(d.x, d.y), 0) + |max(d, 0)|
-pub(super) fn cylinder(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
+fn cylinder(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let xz = b.len2(p[0], p[2]);
-    let dx = b.subc(xz, r);
+    let r = b.param(s, 0, 1.0);
+    let dx = b.sub(xz, r);
     let ay = b.abs(p[1]);
-    let dy = b.subc(ay, h);
+    let h = b.param(s, 1, 1.0);
+    let dy = b.sub(ay, h);
     let inside = b.max(dx, dy);
     let inside = b.minc(inside, 0.0);
     let ox = b.maxc(dx, 0.0);
@@ -64,41 +126,54 @@ pub(super) fn cylinder(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
     b.add(inside, outside)
 }
 
-/// Capsule along y: |p - (0, clamp(p.y, -h, h), 0)| - r
-pub(super) fn capsule(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
-    let cy = b.clampc(p[1], -h, h);
+/// Capsule along y, with s = (r, h, ·, ·): |p - (0, clamp(p.y, -h, h), 0)| - r
+fn capsule(b: &mut Builder, p: P, s: &Slots) -> Reg {
+    let lo = b.param(s, 1, -1.0);
+    let cy = b.max(p[1], lo);
+    let hi = b.param(s, 1, 1.0);
+    let cy = b.min(cy, hi);
     let y = b.sub(p[1], cy);
     let l = b.len3([p[0], y, p[2]]);
-    b.subc(l, r)
+    let r = b.param(s, 0, 1.0);
+    b.sub(l, r)
 }
 
-/// Quilez's exact capped cone with radius `r` at y = -h and radius 0 at y = +h:
+/// Quilez's exact capped cone with radius `r` at y = -h and radius 0 at y = +h, with
+/// s = (r, h, 2h², 1 / (r² + 4h²)):
 /// q = (|p.xz|, p.y), k1 = (0, h), k2 = (-r, 2h),
 /// ca = (q.x - min(q.x, q.y < 0 ? r : 0), |q.y| - h),
 /// cb = q - k1 + k2·clamp(dot(k1 - q, k2) / dot(k2, k2), 0, 1),
 /// s = (cb.x < 0 and ca.y < 0) ? -1 : 1,  d = s·√min(|ca|², |cb|²).
-pub(super) fn cone(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
+fn cone(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let qx = b.len2(p[0], p[2]);
     let qy = p[1];
     let zero = b.c(0.0);
     let below = b.lt(qy, zero);
-    let rc = b.c(r);
+    let rc = b.param(s, 0, 1.0);
     let cap = b.select(below, rc, zero);
     let cap = b.min(qx, cap);
     let cax = b.sub(qx, cap);
     let ay = b.abs(qy);
-    let cay = b.subc(ay, h);
+    let h = b.param(s, 1, 1.0);
+    let cay = b.sub(ay, h);
     // dot(k1 - q, k2) = (0 - qx)(-r) + (h - qy)(2h) = r·qx + 2h² - 2h·qy
-    let t1 = b.mulc(qx, r);
-    let t2 = b.mulc(qy, -2.0 * h);
+    let r = b.param(s, 0, 1.0);
+    let t1 = b.mul(qx, r);
+    let minus_2h = b.param(s, 1, -2.0);
+    let t2 = b.mul(qy, minus_2h);
     let t = b.add(t1, t2);
-    let t = b.addc(t, 2.0 * h * h);
-    let t = b.mulc(t, 1.0 / (r * r + 4.0 * h * h));
+    let h2 = b.param(s, 2, 1.0);
+    let t = b.add(t, h2);
+    let inv = b.param(s, 3, 1.0);
+    let t = b.mul(t, inv);
     let t = b.clampc(t, 0.0, 1.0);
-    let kx = b.mulc(t, -r);
+    let minus_r = b.param(s, 0, -1.0);
+    let kx = b.mul(t, minus_r);
     let cbx = b.add(qx, kx);
-    let ky = b.mulc(t, 2.0 * h);
-    let cby = b.subc(qy, h);
+    let two_h = b.param(s, 1, 2.0);
+    let ky = b.mul(t, two_h);
+    let h = b.param(s, 1, 1.0);
+    let cby = b.sub(qy, h);
     let cby = b.add(cby, ky);
     let inside_x = b.lt(cbx, zero);
     let inside_y = b.lt(cay, zero);

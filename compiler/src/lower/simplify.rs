@@ -17,6 +17,7 @@
 //! - A smooth combination with k ≤ 0 is the plain combination.
 
 use crate::scene::{Combine, Graph, MaterialId, Node, NodeId, V3};
+use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 
 /// A simplified scene graph.
@@ -320,10 +321,12 @@ impl Simplifier<'_> {
                 let inner = self.translate(t, child);
                 self.paint(material, inner)
             }
-            Node::Translate { offset, child } => self.translate(add(t, offset), child),
+            Node::Translate { offset, child } => {
+                self.translate((DVec3::from(t) + DVec3::from(offset)).to_array(), child)
+            }
             Node::Plane { normal, height } => self.add(Node::Plane {
                 normal,
-                height: height + dot(normal, t),
+                height: height + DVec3::from(normal).dot(DVec3::from(t)),
             }),
             _ => self.add(Node::Translate {
                 offset: t,
@@ -569,12 +572,4 @@ fn mat_mul(a: &[V3; 3], b: &[V3; 3]) -> [V3; 3] {
 
 fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
     [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
-}
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

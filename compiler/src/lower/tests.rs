@@ -260,3 +260,66 @@ fn lowering_stops_at_the_program_limit() {
     let lowered = super::lower_within(&scene, &options, &limits).map(|l| l.program);
     assert_eq!(lowered, Ok(whole));
 }
+
+/// The GPU walk's shape functions are the lowering's own rules: for every kind of instance,
+/// the program `shape_program` returns (the one the WGSL writer writes, each recorded
+/// parameter read as `scale · s[slot]`) has the instructions of the primitive lowered with
+/// its own constants, instruction for instruction, and each parameter's constant there is
+/// `scale · slots[slot]` exactly, so that the shader computes what the program computes.
+#[test]
+fn the_walks_shape_programs_are_the_lowerings_rules() {
+    use super::builder::Builder;
+    use super::{shape_program, shapes, Op};
+    let shapes_of = [
+        Node::Sphere { radius: 0.7 },
+        Node::Box {
+            half: [0.3, 0.2, 0.9],
+        },
+        Node::RoundBox {
+            half: [0.3, 0.2, 0.9],
+            radius: 0.05,
+        },
+        Node::Torus {
+            major: 0.8,
+            minor: 0.15,
+        },
+        Node::Cylinder {
+            radius: 0.3,
+            half_height: 0.55,
+        },
+        Node::Capsule {
+            radius: 0.3,
+            half_height: 0.55,
+        },
+        Node::Cone {
+            radius: 0.3,
+            half_height: 0.55,
+        },
+    ];
+    for node in &shapes_of {
+        let slots = shapes::slots(node).expect("an instance kind");
+        let shape = shape_program(node).expect("a shape program");
+        let mut b = Builder::new(false);
+        let p = b.input_point();
+        let d = shapes::exact(&mut b, p, node, &slots).expect("exact");
+        let m = b.c(0.0);
+        let real = b.finish(d, m);
+        let (a, r) = (shape.program.ops(), real.ops());
+        assert_eq!(a.len(), r.len(), "{node:?}");
+        assert!(!shape.params.is_empty(), "{node:?}");
+        for (i, (x, y)) in a.iter().zip(r).enumerate() {
+            match shape.params.iter().find(|q| q.reg.0 as usize == i) {
+                Some(q) => {
+                    assert_eq!(*y, Op::Const(q.scale * slots[q.slot]), "{node:?} at {i}");
+                    assert!([1.0, -1.0, 2.0, -2.0].contains(&q.scale));
+                }
+                None => assert_eq!(x, y, "{node:?} at {i}"),
+            }
+        }
+        assert_eq!(shape.program.distance(), real.distance());
+    }
+    assert!(shape_program(&Node::Ellipsoid {
+        radii: [1.0, 2.0, 3.0]
+    })
+    .is_none());
+}

@@ -11,6 +11,7 @@
 //! in the world through [`Scene::origin`].
 
 use super::ir::{Light, Node, NodeId, Scene, V3};
+use glam::DVec3;
 use std::collections::HashMap;
 
 /// A camera farther than this from the origin gets camera-relative coordinates. Nearer, f32
@@ -31,13 +32,13 @@ pub fn recentre(scene: &mut Scene) {
         scene.root = Some(moved(scene, root, c, &mut memo));
     }
     scene.camera.position = [0.0; 3];
-    scene.camera.look_at = sub(scene.camera.look_at, c);
+    scene.camera.look_at = (DVec3::from(scene.camera.look_at) - DVec3::from(c)).to_array();
     for light in &mut scene.lights {
         if let Light::Point { position, .. } = light {
-            *position = sub(*position, c);
+            *position = (DVec3::from(*position) - DVec3::from(c)).to_array();
         }
     }
-    scene.origin = add(scene.origin, c);
+    scene.origin = (DVec3::from(scene.origin) + DVec3::from(c)).to_array();
 }
 
 /// A node whose field at p is node `id`'s at p + c.
@@ -49,7 +50,7 @@ fn moved(scene: &mut Scene, id: NodeId, c: V3, memo: &mut HashMap<NodeId, NodeId
     let node = match scene.graph.node(id).clone() {
         // The offset absorbs the shift: the shape is placed relative to the camera in f64.
         Node::Translate { offset, child } => {
-            let offset = sub(offset, c);
+            let offset = (DVec3::from(offset) - DVec3::from(c)).to_array();
             if offset == [0.0; 3] {
                 memo.insert(id, child);
                 return child;
@@ -78,14 +79,6 @@ fn moved(scene: &mut Scene, id: NodeId, c: V3, memo: &mut HashMap<NodeId, NodeId
     let m = scene.graph.add(node, span);
     memo.insert(id, m);
     m
-}
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 #[cfg(test)]

@@ -44,7 +44,13 @@ pub fn run(args: CheckArgs) -> ExitCode {
                                 "{}: ok; {}; {}",
                                 file.display(),
                                 frontend::summary(&loaded, scene),
-                                frontend::method(&loaded, scene)
+                                // `sdfc check` does not lower a still scene: the primitives
+                                // are found here, as the lowering would find them.
+                                frontend::method(
+                                    &loaded,
+                                    scene,
+                                    &sdfc_compiler::scene::analytic::traceable(scene)
+                                )
                             );
                         }
                         match animation(file, scene, &limits, args.diagnostics) {
@@ -120,7 +126,7 @@ pub fn animation(
             lmin = lmin.min(analysis.step_lipschitz());
             lmax = lmax.max(analysis.step_lipschitz());
         }
-        let structure = Structure::of(&scene, &program.program);
+        let structure = Structure::of(&scene, &program);
         traced += u64::from(structure.traced());
         structures.push(structure);
     }

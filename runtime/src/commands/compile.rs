@@ -152,8 +152,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
                 None,
                 &args.set,
                 &limits,
-            )
-            .and_then(|()| crate::backend::method_allowed(&scene));
+            );
             if let Err(msg) = set {
                 eprintln!("error: {msg}");
                 return ExitCode::from(2);
@@ -170,6 +169,11 @@ pub fn run(args: CompileArgs) -> ExitCode {
                     return ExitCode::from(1);
                 }
             };
+            // `--set method=trace` on a scene that cannot be traced: refused as a setting.
+            if let Err(msg) = crate::backend::method_allowed(scene, &lowered.traceable) {
+                eprintln!("error: {msg}");
+                return ExitCode::from(2);
+            }
             let result = match args.part {
                 Part::Kernel => emit(scene, &lowered, other, args.sm, args.kernel),
                 Part::Map => emit_map(scene, &lowered, other, &args.name),
@@ -285,7 +289,10 @@ fn emit(
     back::wgsl::choose(scene, lowered, &options).map_err(|e| format!("error: {e}"))?;
     let kernel = back::wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())?;
     match target {
-        Emit::Params => return Ok(back::wgsl::uniforms(scene, program.lipschitz())),
+        Emit::Params => {
+            return back::wgsl::uniforms(&kernel.contract.uniform, scene, program.lipschitz())
+                .map_err(|e| format!("internal compiler error: {e}"))
+        }
         Emit::SceneData => {
             return kernel.data.ok_or_else(|| {
                 "error: this scene's kernel reads no `scene_data` (only one of more than 256 traced primitives or 256 marched instances, or an interpreted one, does)".into()
@@ -305,7 +312,7 @@ fn emit(
             entry_point: back::wgsl::ENTRY_POINT.to_string(),
         };
         return back::ptx::write(&kernel.module, &kernel.info, &options)
-            .map(String::into_bytes)
+            .map(|ptx| ptx.text.into_bytes())
             .map_err(|e| e.to_string());
     }
     match lang {

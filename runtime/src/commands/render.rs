@@ -210,7 +210,6 @@ pub fn frame_scene(
     }
     let settings = &mut scene.settings;
     override_settings(settings, args.size, args.aa, args.set, limits).map_err(CliError::Usage)?;
-    crate::backend::method_allowed(&scene).map_err(CliError::Failed)?;
     let checked = frontend::Checked {
         scene,
         sources: loaded.sources,
@@ -219,6 +218,7 @@ pub fn frame_scene(
     let lowered = checked
         .lower(lowering, limits)
         .map_err(CliError::Reported)?;
+    crate::backend::method_allowed(&checked.scene, &lowered.traceable).map_err(CliError::Failed)?;
     Ok(FrameScene {
         scene: checked.scene,
         lowered,

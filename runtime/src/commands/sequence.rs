@@ -590,9 +590,7 @@ impl<'a> Kernels<'a> {
         let scene = match &mut self.prepared {
             Some((_, _, prepared)) if same => {
                 let FrameScene { scene, .. } = frame;
-                let before = prepared.specialisation();
-                prepared.specialise(&scene).map_err(CliError::Failed)?;
-                if prepared.specialisation() != before {
+                if prepared.specialise(&scene).map_err(CliError::Failed)? {
                     self.count += 1;
                 }
                 scene

@@ -10,6 +10,7 @@ use super::launch::{self, Job, Pixels};
 use cudarc::driver::{
     sys, CudaContext, CudaEvent, CudaFunction, CudaSlice, CudaStream, LaunchConfig, PushKernelArg,
 };
+use sdfc_compiler::back::ptx::{self, Argument, Param, Space};
 use sdfc_compiler::back::wgsl::STATS_WORDS;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -36,6 +37,10 @@ pub enum Error {
     /// The JIT refused the PTX (a compiler bug: the PTX is checked by ptxas in CI).
     #[error("the CUDA JIT rejected the PTX: {0}")]
     Jit(String),
+    /// What a launch would pass differs from the kernel's parameters (a bug of sdfc's):
+    /// refused before launching.
+    #[error("internal error: the CUDA kernel's parameters do not match the launch: {0}")]
+    Arguments(String),
 }
 
 fn driver(during: &'static str) -> impl Fn(cudarc::driver::DriverError) -> Error {
@@ -60,6 +65,8 @@ pub struct Cuda {
 #[derive(Debug)]
 pub struct Loaded {
     function: CudaFunction,
+    /// The kernel's parameters, as the PTX writer declared them.
+    params: Vec<Param>,
     /// Time to compile (or read from the cache) and load the module.
     pub load_time: Duration,
     /// Whether the compiled module came from the disk cache.
@@ -159,8 +166,9 @@ impl Cuda {
     }
 
     /// Compiles `ptx` for this device (or takes it from the cache) and loads `entry`.
-    pub fn load(&self, ptx: &str, entry: &str) -> Result<Loaded, Error> {
+    pub fn load(&self, kernel: &ptx::Ptx, entry: &str) -> Result<Loaded, Error> {
         let start = Instant::now();
+        let ptx = &kernel.text;
         let path = cache_path(ptx, &self.name, self.sm);
         let (cubin, cached) = match path.as_ref().and_then(|p| std::fs::read(p).ok()) {
             Some(bytes) => (bytes, true),
@@ -185,6 +193,7 @@ impl Cuda {
             .map_err(driver("finding the kernel"))?;
         Ok(Loaded {
             function,
+            params: kernel.params.clone(),
             load_time: start.elapsed(),
             cached,
         })
@@ -280,6 +289,7 @@ impl launch::Device for Kernel<'_> {
     fn prepare(&self, job: &Job) -> Result<FrameBuffers, Error> {
         let s = &self.cuda.stream;
         let pixels = job.width as usize * job.height as usize;
+        check_launch(self.loaded, job.uniforms, pixels, STATS_WORDS, job.data)?;
         let table: Vec<u32> = job
             .tiles
             .iter()
@@ -357,8 +367,9 @@ impl launch::Device for Kernel<'_> {
                 start.record(s).map_err(driver("recording an event"))?;
             }
             // SAFETY: the kernel's parameters are its buffers in binding order, as the PTX back
-            // end declares them: four, and the scene data when the kernel has it (the job
-            // carries `data` exactly then); each buffer is as large as the kernel indexes.
+            // end declares them: four, and the scene data when the kernel has it, each at least
+            // as large as its type (`check_launch` compared them with the kernel's parameters in
+            // `prepare`); the image and statistics hold every pixel the tiles cover.
             unsafe { launch.launch(cfg) }.map_err(driver("launching the kernel"))?;
             if let Some((start, end)) = timed {
                 end.record(s).map_err(driver("recording an event"))?;
@@ -442,6 +453,38 @@ impl launch::Device for Kernel<'_> {
             message,
         }
     }
+}
+
+/// `Err` unless the buffers a launch passes are those `k`'s parameters declare: the uniform
+/// (binding 0), a tile (1), the image (2) and statistics (3) of `pixels` pixels, and `data`
+/// (4) exactly when the kernel reads `scene_data`; each a device address, each as large as
+/// its type.
+fn check_launch(
+    k: &Loaded,
+    uniforms: &[u8],
+    pixels: usize,
+    stats_words: u32,
+    data: Option<&[u8]>,
+) -> Result<(), Error> {
+    let address = std::mem::size_of::<sys::CUdeviceptr>() as u32;
+    let arg = |binding, space, bytes: usize| Argument {
+        group: 0,
+        binding,
+        space,
+        bytes: bytes as u64,
+        size: address,
+    };
+    let writable = Space::Storage { writable: true };
+    let mut args = vec![
+        arg(0, Space::Uniform, uniforms.len()),
+        arg(1, Space::Uniform, 4 * std::mem::size_of::<u32>()),
+        arg(2, writable, pixels * 4 * std::mem::size_of::<f32>()),
+        arg(3, writable, pixels * stats_words as usize * 4),
+    ];
+    if let Some(d) = data {
+        args.push(arg(4, Space::Storage { writable: false }, d.len()));
+    }
+    ptx::check_arguments(&k.params, &args).map_err(Error::Arguments)
 }
 
 /// The register cap for the JIT: `$SDFC_CUDA_MAX_REGISTERS` (0 or unset: the JIT's choice).

@@ -129,7 +129,8 @@ pub fn render_faults(
     faults: &launch::Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, Error> {
-    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)
+        .map_err(|e| Error::Uniform(e.0))?;
     let device = gpu.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
     render_one(
         &device,
@@ -141,17 +142,18 @@ pub fn render_faults(
     )
 }
 
-/// Renders `scene` with a kernel already loaded on a CUDA device; `data` is the kernel's
-/// scene data ([`Kernel::data`]); `faults` are injected.
+/// Renders `scene` with a kernel already loaded on a CUDA device, whose uniform is laid out
+/// as `uniform`; `data` is the kernel's scene data ([`Kernel::data`]); `faults` are injected.
 pub fn render_cuda(
     cuda: &cuda::Cuda,
     scene: &Scene,
-    (loaded, data): (&cuda::Loaded, Option<&[u8]>),
+    (loaded, uniform, data): (&cuda::Loaded, &wgsl::Uniform, Option<&[u8]>),
     lipschitz: f64,
     faults: &launch::Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, cuda::Error> {
-    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let uniforms =
+        wgsl::uniforms(uniform, scene, lipschitz).map_err(|e| cuda::Error::Arguments(e.0))?;
     let device = cuda.kernel(loaded, wgsl::WORKGROUP);
     render_one(&device, scene, &uniforms, data, faults, progress)
 }
@@ -180,17 +182,21 @@ fn render_one<D: launch::Device>(
 }
 
 /// Renders `scene` on several devices at once ([`launch::render_several`]): the kernel's
-/// uniforms are those of `scene` with the Lipschitz bound `lipschitz`, and `data` its scene
-/// data, the same on every GPU device. `Err` when every device failed.
+/// uniforms are those of `scene` with the Lipschitz bound `lipschitz`, laid out as `uniform`
+/// (none when every device is the CPU), and `data` its scene data, the same on every GPU
+/// device. `Err` when every device failed.
 pub fn render_several(
     devices: &[&dyn launch::Worker],
     scene: &Scene,
-    (lipschitz, data): (f64, Option<&[u8]>),
+    (lipschitz, uniform, data): (f64, Option<&wgsl::Uniform>, Option<&[u8]>),
     faults: &launch::Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, String> {
     let s = &scene.settings;
-    let uniforms = wgsl::uniforms(scene, lipschitz);
+    let uniforms = match uniform {
+        Some(u) => wgsl::uniforms(u, scene, lipschitz).map_err(|e| e.0)?,
+        None => Vec::new(),
+    };
     let tiles = launch::tiling(s.width, s.height, TILE, devices.len());
     let job = launch::Job {
         uniforms: &uniforms,

@@ -30,6 +30,10 @@ pub enum Error {
     /// The device reported an error while rendering (out of memory, device lost, …).
     #[error("GPU error while rendering: {0}")]
     Render(String),
+    /// The scene uniform does not fit the kernel's layout (`wgsl::uniforms`; a bug of
+    /// sdfc's, or a kernel written for another scene): refused before anything is uploaded.
+    #[error("internal error: the scene uniform does not fit the kernel: {0}")]
+    Uniform(String),
 }
 
 /// Bytes between tile entries in the tile table (the largest uniform offset alignment).

@@ -403,12 +403,6 @@ impl Session {
             eprintln!("error: {msg}");
             return Err(msg);
         }
-        eprintln!(
-            "{}: ok; {}; {}",
-            self.file.display(),
-            frontend::summary(&loaded, &scene),
-            frontend::method(&loaded, &scene)
-        );
         let check_time = start.elapsed();
         let start = Instant::now();
         let lowered = match lower::lower_within(&scene, &lower_options(&scene), &limits) {
@@ -420,6 +414,12 @@ impl Session {
             }
         };
         let lower_time = start.elapsed();
+        eprintln!(
+            "{}: ok; {}; {}",
+            self.file.display(),
+            frontend::summary(&loaded, &scene),
+            frontend::method(&loaded, &scene, &lowered.traceable)
+        );
         let start = Instant::now();
         // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
         // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.

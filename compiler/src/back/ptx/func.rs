@@ -407,9 +407,9 @@ pub(super) fn write_kernel(cx: &Cx, ep: &EntryPoint, index: usize) -> Result<Str
     let mut fw = Fw::new(cx);
     let name = &ep.name;
     let mut params = Vec::new();
-    for (i, &g) in cx.buffers.iter().enumerate() {
-        let p = format!("{name}_param_{i}");
-        params.push(format!(".param .u64 {p}"));
+    for (&g, param) in cx.buffers.iter().zip(&cx.params) {
+        let p = &param.name;
+        params.push(format!(".param .{} {p}", param.ty));
         if info[g].is_empty() {
             continue;
         }

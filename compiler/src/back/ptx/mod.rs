@@ -37,6 +37,7 @@ mod libm;
 mod math;
 mod memory;
 mod ops;
+mod params;
 mod stmt;
 mod types;
 mod writer;
@@ -46,6 +47,8 @@ use naga::{AddressSpace, Module, ShaderStage};
 use std::cell::Cell;
 use std::collections::HashSet;
 use std::fmt;
+
+pub use params::{check_arguments, Argument, Param, Space};
 
 /// What to write.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -122,9 +125,18 @@ fn isa_version(sm: u32) -> Result<&'static str, Error> {
     })
 }
 
+/// A written PTX module and its kernel's parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ptx {
+    /// The PTX text.
+    pub text: String,
+    /// The kernel's parameters, in order: what a launch must pass ([`check_arguments`]).
+    pub params: Vec<Param>,
+}
+
 /// Writes the entry point `options.entry_point` of `module` (validated, with `info` from
-/// naga's validator) as a PTX module for `sm_<options.sm>`.
-pub fn write(module: &Module, info: &ModuleInfo, options: &Options) -> Result<String, Error> {
+/// naga's validator) as a PTX module for `sm_<options.sm>`, with its parameters.
+pub fn write(module: &Module, info: &ModuleInfo, options: &Options) -> Result<Ptx, Error> {
     let name = &options.entry_point;
     let index = module
         .entry_points
@@ -151,12 +163,15 @@ pub fn write(module: &Module, info: &ModuleInfo, options: &Options) -> Result<St
     let version = isa_version(options.sm)?;
     let types = types::Types::new(module);
     let an = analysis::Analysis::new(module, info, &types, index)?;
+    let buffers = buffers(module);
+    let params = params::params(module, &buffers, name)?;
     let cx = writer::Cx {
         module,
         info,
         types,
         an,
-        buffers: buffers(module),
+        buffers,
+        params,
         names: names(module, name),
         trig_reduce: Cell::new(false),
     };
@@ -176,7 +191,10 @@ pub fn write(module: &Module, info: &ModuleInfo, options: &Options) -> Result<St
     }
     out.push_str(&funcs);
     out.push_str(&kernel);
-    Ok(out)
+    Ok(Ptx {
+        text: out,
+        params: cx.params,
+    })
 }
 
 /// The uniform and storage buffers, in (group, binding) order.
@@ -234,20 +252,15 @@ fn header(cx: &writer::Cx, entry: &str, sm: u32, version: &str) -> String {
         s,
         "// Kernel parameters: the global address of each buffer, in (group, binding) order:"
     );
-    for (i, &g) in cx.buffers.iter().enumerate() {
-        let gv = &cx.module.global_variables[g];
-        let (group, binding) = gv.binding.as_ref().map_or((0, 0), |b| (b.group, b.binding));
-        let space = match gv.space {
-            AddressSpace::Uniform => "uniform".to_string(),
-            AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) => {
-                "storage, read_write".into()
-            }
-            _ => "storage, read".into(),
-        };
-        let name = emit::ascii(gv.name.as_deref().unwrap_or("?"));
+    for p in &cx.params {
         let _ = writeln!(
             s,
-            "//   {entry}_param_{i}: @group({group}) @binding({binding}) var<{space}> {name}"
+            "//   {}: @group({}) @binding({}) var<{}> {}",
+            p.name,
+            p.group,
+            p.binding,
+            p.space,
+            emit::ascii(&p.var)
         );
     }
     let _ = writeln!(

@@ -20,6 +20,8 @@ pub(super) struct Cx<'a> {
     pub an: Analysis,
     /// The uniform and storage buffers in kernel-parameter order (group, binding).
     pub buffers: Vec<Handle<GlobalVariable>>,
+    /// The kernel's parameter for each of `buffers`.
+    pub params: Vec<super::Param>,
     /// The PTX name of each function.
     pub names: Vec<String>,
     /// Whether some function needs the large-argument trigonometric reduction.

@@ -261,10 +261,10 @@ fn shape_interval(out: &mut String, primitives: &[Primitive]) {
 /// The body of a function that dispatches on `kind` (a WGSL `u32` in scope): for each kind
 /// among `kinds`, sorted, the statements `body(kind)` (which end in `return`), each but the
 /// last under `if kind == …`; `empty` where there is no kind at all.
-pub(super) fn branches(
+pub(super) fn branches<S: AsRef<str>>(
     out: &mut String,
     kinds: impl Iterator<Item = u32>,
-    body: impl Fn(u32) -> &'static str,
+    body: impl Fn(u32) -> S,
     empty: &str,
 ) {
     let mut kinds: Vec<u32> = kinds.collect();
@@ -276,7 +276,7 @@ pub(super) fn branches(
         if !last {
             let _ = writeln!(out, "    if kind == {k}u {{");
         }
-        for line in body(k).lines() {
+        for line in body(k).as_ref().lines() {
             let _ = writeln!(out, "{indent}{line}");
         }
         if !last {

@@ -111,6 +111,27 @@ pub(super) fn write_sdf_with(program: &Program, name: &str, params: Option<&Para
     out
 }
 
+/// The WGSL function `fn name(p: vec3<f32>, s: vec4<f32>) -> f32` of a primitive's distance
+/// (`lower::ShapeProgram`): the program's distance, each of its constants that is a slot read
+/// as `scale · s[slot]` (`s.x`, `(-s.x)`, `(2.0 * s.y)`), the others written as literals.
+pub(super) fn write_shape(shape: &crate::lower::ShapeProgram, name: &str) -> String {
+    let program = &shape.program;
+    let roots = [program.distance()];
+    let mut w = Writer::new(program, &roots, false, name, None);
+    for p in &shape.params {
+        let lane = ["s.x", "s.y", "s.z", "s.w"][p.slot];
+        w.names.literals[p.reg.0 as usize] = Some(match p.scale {
+            1.0 => lane.to_string(),
+            -1.0 => format!("(-{lane})"),
+            k => format!("({} * {lane})", float(k)),
+        });
+    }
+    let mut body = String::new();
+    w.emit(0, w.items.len(), 1, &mut body);
+    let d = w.names.get(program.distance(), None);
+    format!("fn {name}(p: vec3<f32>, s: vec4<f32>) -> f32 {{\n{body}    return {d};\n}}\n")
+}
+
 /// Writes the statements of a program's live instructions, outlining large blocks.
 struct Writer<'a> {
     program: &'a Program,

@@ -24,9 +24,11 @@
 //!                      (q_j = Σ_i p_i·M_ij)
 //! ```
 //!
-//! The constants are those of `lower/shapes.rs`, computed in f64 and rounded to f32 as the
-//! program's are, and the walk computes in the program's order of operations, so the GPU's
-//! field equals the CPU's up to f32 rounding. Every instance is an exact distance, so its value
+//! The constants are `lower::slots`, computed in f64 and rounded to f32 as the program's are,
+//! and each kind's shape function is lowered by the rules of `lower/shapes.rs` that lower the
+//! program (`lower::shape_program`, written by `map::write_shape`), so the walk computes the
+//! program's operations in the program's order and the GPU's field equals the CPU's up to f32
+//! rounding. Every instance is an exact distance, so its value
 //! is at least the signed distance to its box, and a group whose box is not nearer than the
 //! best distance so far cannot change the minimum: skipping it is exact.
 //!
@@ -58,6 +60,7 @@
 use super::buffer::{
     self, bits, entries, tag, tag_holds, vec, GROUP, KIND_BITS, MATERIAL_SHIFT, TRANSFORMED,
 };
+use super::map;
 use crate::lower::Instance;
 use crate::scene::analytic::{boxed, Group, Item};
 use crate::scene::Node;
@@ -91,10 +94,6 @@ fn kind(shape: &Node) -> u32 {
         Node::Capsule { .. } => CAPSULE,
         _ => CONE,
     }
-}
-
-fn quad(v: [f64; 4]) -> [u32; 4] {
-    v.map(bits)
 }
 
 /// The contents of `scene_data` for `instances`, their hierarchy built over their boxes.
@@ -141,34 +140,9 @@ fn instance(out: &mut Vec<[u32; 4]>, i: &Instance) {
     let material = i.material.map_or(0, |m| m.0);
     let tag = tag(kind(&i.shape), i.rotation.is_some(), material);
     out.push(vec(i.offset, tag));
-    out.push(shape(&i.shape));
+    out.push(crate::lower::slots(&i.shape).map_or([0; 4], |s| s.map(bits)));
     if let Some(m) = i.rotation {
         out.extend((0..3).map(|j| vec([m[0][j], m[1][j], m[2][j]], 0)));
-    }
-}
-
-/// The shape's constants, as `shapes.rs` computes them.
-fn shape(shape: &Node) -> [u32; 4] {
-    match *shape {
-        Node::Sphere { radius } => quad([radius, 0.0, 0.0, 0.0]),
-        Node::Box { half } => vec(half, 0),
-        Node::RoundBox { half, radius } => {
-            quad([half[0] - radius, half[1] - radius, half[2] - radius, radius])
-        }
-        Node::Torus { major, minor } => quad([major, minor, 0.0, 0.0]),
-        Node::Cylinder {
-            radius,
-            half_height,
-        }
-        | Node::Capsule {
-            radius,
-            half_height,
-        } => quad([radius, half_height, 0.0, 0.0]),
-        Node::Cone {
-            radius: r,
-            half_height: h,
-        } => quad([r, h, 2.0 * h * h, 1.0 / (r * r + 4.0 * h * h)]),
-        _ => [0; 4],
     }
 }
 
@@ -201,11 +175,10 @@ pub fn write(instances: &[Instance], stack: usize) -> String {
     out
 }
 
-/// The lengths and the box distance, in the program's order of operations.
+/// The length and the box distance of the walk's groups, in the program's order of operations.
 fn helpers(out: &mut String) {
     out.push_str(
-        "fn len2(a: f32, b: f32) -> f32 {\n    return sqrt(a * a + b * b);\n}\n\n\
-         fn len3(q: vec3<f32>) -> f32 {\n    return sqrt((q.x * q.x + q.y * q.y) + q.z * q.z);\n}\n\n\
+        "fn len3(q: vec3<f32>) -> f32 {\n    return sqrt((q.x * q.x + q.y * q.y) + q.z * q.z);\n}\n\n\
          // The signed distance of a box of half-extents h about the origin, given |q| - h.\n\
          fn box_of(a: vec3<f32>) -> f32 {\n    \
          return len3(max(a, vec3<f32>(0.0))) + min(max(a.x, max(a.y, a.z)), 0.0);\n}\n\n\
@@ -215,47 +188,40 @@ fn helpers(out: &mut String) {
     );
 }
 
-/// `fn shape_distance`: the distance of a shape of the tag's kind at q in its own frame, with
-/// a branch for each kind among `instances`.
+/// The shape of each kind among `instances` as a function of its own, `fn shape_KIND(p, s)`,
+/// written from the lowering's rules (`lower::shape_program`), then `fn shape_distance`: the
+/// distance of a shape of the tag's kind at q in its own frame, with a branch for each kind.
 fn shape_distance(out: &mut String, instances: &[Instance]) {
+    let mut kinds: Vec<(u32, &Node)> = instances
+        .iter()
+        .map(|i| (kind(&i.shape), &i.shape))
+        .collect();
+    kinds.sort_by_key(|k| k.0);
+    kinds.dedup_by_key(|k| k.0);
+    out.push_str(
+        "// The distance of each kind of shape at p in its own frame, its constants s (the\n\
+         // rules of lower/shapes.rs, as in the scene's program).\n",
+    );
+    for (_, shape) in &kinds {
+        if let Some(program) = crate::lower::shape_program(shape) {
+            out.push_str(&map::write_shape(
+                &program,
+                &format!("shape_{}", shape.kind()),
+            ));
+            out.push('\n');
+        }
+    }
     out.push_str(
         "// The distance at q of an instance's shape of the tag's kind in its own frame, its\n\
          // constants s (lower/shapes.rs).\n\
          fn shape_distance(kind: u32, q: vec3<f32>, s: vec4<f32>) -> f32 {\n",
     );
-    let kinds = instances.iter().map(|i| kind(&i.shape));
-    buffer::branches(out, kinds, formula, "return 1e30;");
+    let call = |k: u32| {
+        let name = kinds.iter().find(|c| c.0 == k).map_or("", |c| c.1.kind());
+        format!("return shape_{name}(q, s);")
+    };
+    buffer::branches(out, kinds.iter().map(|k| k.0), call, "return 1e30;");
     out.push_str("}\n\n");
-}
-
-/// The statements of one kind's distance (ending in `return`).
-fn formula(kind: u32) -> &'static str {
-    match kind {
-        SPHERE => "return len3(q) - s.x;",
-        BOX => "return box_of(abs(q) - s.xyz);",
-        ROUND_BOX => "return box_of(abs(q) - s.xyz) - s.w;",
-        TORUS => "return len2(len2(q.x, q.z) - s.x, q.y) - s.y;",
-        CYLINDER => {
-            "let dx = len2(q.x, q.z) - s.x;\n\
-             let dy = abs(q.y) - s.y;\n\
-             return min(max(dx, dy), 0.0) + len2(max(dx, 0.0), max(dy, 0.0));"
-        }
-        CAPSULE => {
-            "let y = q.y - min(max(q.y, -s.y), s.y);\n\
-             return len3(vec3<f32>(q.x, y, q.z)) - s.x;"
-        }
-        _ => {
-            "let qx = len2(q.x, q.z);\n\
-             let cap = min(qx, select(0.0, s.x, q.y < 0.0));\n\
-             let cax = qx - cap;\n\
-             let cay = abs(q.y) - s.y;\n\
-             let t = min(max(((qx * s.x + q.y * (-2.0 * s.y)) + s.z) * s.w, 0.0), 1.0);\n\
-             let cbx = qx + t * (-s.x);\n\
-             let cby = (q.y - s.y) + t * (2.0 * s.y);\n\
-             let inside = select(1.0, -1.0, cbx < 0.0 && cay < 0.0);\n\
-             return inside * sqrt(min(cax * cax + cay * cay, cbx * cbx + cby * cby));"
-        }
-    }
 }
 
 /// `fn instance_distance`: the field of the instance whose entry starts at `i` with `head`,

@@ -11,6 +11,7 @@
 
 mod analytic;
 mod buffer;
+mod contract;
 pub mod interp;
 pub mod layout;
 mod map;
@@ -19,6 +20,7 @@ pub mod part;
 mod template;
 
 pub use analytic::MAX_UNROLLED;
+pub use contract::{Contract, Field, Mismatch, Shape, Specialisation, Uniform, UniformWriter};
 pub use map::{float, write_map, write_sdf};
 
 use crate::lower::Lowered;
@@ -59,11 +61,9 @@ pub struct Kernel {
     pub module: naga::Module,
     /// naga's validation info.
     pub info: naga::valid::ModuleInfo,
-    /// The features the kernel was specialised for, by name.
-    pub features: Vec<(&'static str, bool)>,
-    /// The render settings that decided its features: a render with other settings of
-    /// these needs another kernel ([`Specialisation::of`]).
-    pub specialisation: Specialisation,
+    /// What it was specialised for (every feature, on or off, and the settings that
+    /// decided them) and the layout of the uniform it reads, from `module`.
+    pub contract: Contract,
     /// The bytes of binding 4, `scene_data`, when the kernel declares it (the `SCENE_DATA`
     /// feature): the primitives and hierarchy of a large analytically traced scene, or the
     /// instances and their hierarchy of a large marched one.
@@ -73,32 +73,7 @@ pub struct Kernel {
 impl Kernel {
     /// Whether the kernel interprets its distance programs from `scene_data` (interp.rs).
     pub fn interpreted(&self) -> bool {
-        self.features.contains(&("INTERPRETED", true))
-    }
-}
-
-/// What of the render settings a kernel is specialised for: the method (analytic tracing
-/// or marching: `ANALYTIC`), whether over-relaxation is on (`RELAX`) and `max_depth` (the ray
-/// stack's size, and `SECONDARY`). The values of the other settings (ε, `max_steps`, ω
-/// itself, the image size) are uniforms, read at every render.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Specialisation {
-    /// The `method` setting.
-    pub method: crate::scene::Method,
-    /// Whether ω > 1.
-    pub relax: bool,
-    /// The `max_depth` setting.
-    pub max_depth: u32,
-}
-
-impl Specialisation {
-    /// The specialisation a kernel for `settings` has.
-    pub fn of(settings: &crate::scene::Settings) -> Specialisation {
-        Specialisation {
-            method: settings.method,
-            relax: settings.relaxation > 1.0,
-            max_depth: settings.max_depth,
-        }
+        self.contract.has("INTERPRETED")
     }
 }
 
@@ -132,7 +107,7 @@ impl std::error::Error for Error {}
 
 /// What the scene uses, deciding which parts of the kernel are emitted; `traced` when it is
 /// ray traced analytically.
-fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
+pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
     let mats = &scene.materials;
     let soft = scene.lights.iter().any(|l| l.penumbra() > 0.0);
     let points = scene
@@ -328,14 +303,32 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<Kernel, Error> {
 
 /// [`write`] with the given options.
 pub fn write_with(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Kernel, Error> {
-    let text = write_text(scene, lowered, options)?;
+    write_from(TEMPLATE, scene, lowered, options)
+}
+
+/// [`write_with`] from the template `template` (a test changes it).
+fn write_from(
+    template: &str,
+    scene: &Scene,
+    lowered: &Lowered,
+    options: &Options,
+) -> Result<Kernel, Error> {
+    let text = write_template(template, scene, lowered, options)?;
     let (module, info) = validate(&text.source, scene)?;
+    let uniform = Uniform::of(&module).ok_or_else(|| Error {
+        message: "the kernel has no scene uniform at binding 0".into(),
+        line: None,
+        node_span: None,
+    })?;
     Ok(Kernel {
         source: text.source,
         module,
         info,
-        features: text.features,
-        specialisation: Specialisation::of(&scene.settings),
+        contract: Contract {
+            specialisation: Specialisation::of(&scene.settings),
+            features: text.features,
+            uniform,
+        },
         data: text.data,
     })
 }
@@ -346,7 +339,7 @@ pub fn write_with(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
 pub struct Text {
     /// The WGSL text.
     pub source: String,
-    /// The features it was specialised for, by name.
+    /// Every feature of the template, on or off, by name ([`Contract::features`]).
     pub features: Vec<(&'static str, bool)>,
     /// The bytes of `scene_data`, when it has them.
     pub data: Option<Vec<u8>>,
@@ -354,16 +347,24 @@ pub struct Text {
 
 /// The text of the kernel [`write_with`] writes, not validated.
 pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Text, Error> {
+    write_template(TEMPLATE, scene, lowered, options)
+}
+
+/// [`write_text`] from the template `template` (a test changes it).
+fn write_template(
+    template: &str,
+    scene: &Scene,
+    lowered: &Lowered,
+    options: &Options,
+) -> Result<Text, Error> {
     let traced = lowered.traceable.traced(scene.settings.method);
     let mut features = features(scene, traced.is_some());
+    debug_assert_eq!(features.len(), contract::SCENE_FEATURES);
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
-    // Listed in the header only when on, so that the default kernel does not change.
-    on.insert("DEBUG_NAN", options.debug_nan);
-    if options.debug_nan {
-        features.push(("DEBUG_NAN", true));
-    }
     let mut values: HashMap<&str, String> = HashMap::new();
-    on.insert("MEDIA", false);
+    let mut params = false;
+    let mut media = false;
+    let mut interprets = false;
     let data = match traced {
         // An analytically traced scene needs no distance field.
         Some(traced) => {
@@ -386,26 +387,19 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
                 line: None,
                 node_span: None,
             })?;
-            let media = media_of(scene, lowered).is_some();
-            on.insert("MEDIA", media);
-            if media {
-                features.push(("MEDIA", true));
-            }
-            features.push(("INTERPRETED", true));
+            media = media_of(scene, lowered).is_some();
+            interprets = true;
             let file = scene.limits.count(crate::limits::Limit::Registers);
             values.insert("MAP", interp::write(file, media));
             Some(bytes)
         }
         None => {
-            let (mut text, bytes, params) = marched(scene, lowered, options);
-            if params {
-                features.push(("PARAMS", true));
-            }
+            let (mut text, bytes, read) = marched(scene, lowered, options);
+            params = read;
             // Rays inside glass that may overlap a solid march the scene's media.
-            let media = lowered.media.as_ref().filter(|_| on["REFRACTION"]);
-            on.insert("MEDIA", media.is_some());
-            if let Some(m) = media {
-                features.push(("MEDIA", true));
+            let m = lowered.media.as_ref().filter(|_| on["REFRACTION"]);
+            media = m.is_some();
+            if let Some(m) = m {
                 text.push('\n');
                 text.push_str(&map::write_sdf_named(&m.medium, "sdf_medium"));
                 text.push('\n');
@@ -417,14 +411,21 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
             bytes
         }
     };
-    // Listed in the header only when on, so that the kernels without it do not change.
-    on.insert("SCENE_DATA", data.is_some());
-    if data.is_some() {
-        features.push(("SCENE_DATA", true));
-    }
+    // The kernel's own features, after the scene's; the header lists them only when on, so
+    // that the kernels without them do not change.
+    features.extend([
+        ("DEBUG_NAN", options.debug_nan),
+        ("PARAMS", params),
+        ("MEDIA", media),
+        ("SCENE_DATA", data.is_some()),
+        ("INTERPRETED", interprets),
+    ]);
+    on.extend(features[contract::SCENE_FEATURES..].iter().copied());
     let used: Vec<String> = features
         .iter()
-        .map(|(n, on)| format!("{}{n}", if *on { "+" } else { "-" }))
+        .enumerate()
+        .filter(|&(k, &(_, on))| k < contract::SCENE_FEATURES || on)
+        .map(|(_, (n, on))| format!("{}{n}", if *on { "+" } else { "-" }))
         .collect();
     values.insert(
         "HEADER",
@@ -439,7 +440,7 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, options: &Options) -> Result
     values.insert("STACK", (scene.settings.max_depth + 2).to_string());
     values.insert("WORKGROUP", WORKGROUP.to_string());
     values.insert("ENTRY", ENTRY_POINT.to_string());
-    let source = template::expand(TEMPLATE, &on, &values).map_err(|e| Error {
+    let source = template::expand(template, &on, &values).map_err(|e| Error {
         message: format!("kernel template: {e}"),
         line: None,
         node_span: None,
@@ -548,85 +549,241 @@ fn node_of_line(source: &str, n: usize, scene: &Scene) -> Option<crate::Span> {
     (id < scene.graph.len() as u32).then(|| scene.graph.span(crate::scene::NodeId(id)))
 }
 
-/// The bytes of the scene uniform (binding 0), in the layout of `Params` in the kernel.
-pub fn uniforms(scene: &Scene, lipschitz: f64) -> Vec<u8> {
-    let mut w = Words::default();
+/// The bytes of the scene uniform (binding 0) of a kernel whose uniform is laid out as
+/// `layout` ([`Contract::uniform`], naga's layout of `Params`), each member written by name at
+/// naga's offset. `Err` when a member named here is missing from the layout or of another
+/// type, when the scene has more lights or materials than the kernel's arrays hold, or when a
+/// member of the layout is written by nothing (the kernel is another scene's, or this writer
+/// lags the template).
+pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u8>, Mismatch> {
+    let mut w = layout.writer();
     let cam = &scene.camera;
     let s = &scene.settings;
-    let eye = cam.position;
     let (fwd, u, v) = cam.basis();
     let tan = (cam.fov * 0.5).tan();
     let aspect = s.width.max(1) as f64 / s.height.max(1) as f64;
-    w.v4(eye, 0.0);
-    w.v4(fwd, 0.0);
-    w.v4(u, 0.0);
-    w.v4(v, 0.0);
-    w.f([tan * aspect, tan, s.width as f64, s.height as f64]);
-    w.f([
-        scene.epsilon(),
-        s.max_dist,
-        s.relaxation.max(1.0),
-        1.0 / lipschitz.max(1.0),
-    ]);
-    w.v4(s.background, 0.0);
-    w.u([s.width, s.height, s.aa.max(1), s.max_steps.max(1)]);
-    w.u([s.max_depth, 0, 0, 0]);
+    let v4 = |v: [f64; 3], w: f64| [v[0], v[1], v[2], w];
+    w.floats("eye", &v4(cam.position, 0.0))?;
+    w.floats("cam_w", &v4(fwd, 0.0))?;
+    w.floats("cam_u", &v4(u, 0.0))?;
+    w.floats("cam_v", &v4(v, 0.0))?;
+    w.floats(
+        "view",
+        &[tan * aspect, tan, s.width as f64, s.height as f64],
+    )?;
+    w.floats(
+        "march",
+        &[
+            scene.epsilon(),
+            s.max_dist,
+            s.relaxation.max(1.0),
+            1.0 / lipschitz.max(1.0),
+        ],
+    )?;
+    w.floats("background", &v4(s.background, 0.0))?;
+    w.uints(
+        "counts",
+        &[s.width, s.height, s.aa.max(1), s.max_steps.max(1)],
+    )?;
+    w.uints("depth", &[s.max_depth, 0, 0, 0])?;
+    let (mut points, mut dirs) = (0, 0);
     for l in &scene.lights {
-        if let Light::Point {
-            position,
-            color,
-            intensity,
-            radius,
-            ..
-        } = l
-        {
-            w.v4(*position, if radius.is_finite() { *radius } else { 0.0 });
-            w.v4((DVec3::from(*color) * *intensity).into(), l.sharpness());
+        let colour = |c: [f64; 3], i: f64| v4((DVec3::from(c) * i).into(), l.sharpness());
+        match l {
+            Light::Point {
+                position,
+                color,
+                intensity,
+                radius,
+                ..
+            } => {
+                let r = if radius.is_finite() { *radius } else { 0.0 };
+                w.floats(&format!("points[{points}].position"), &v4(*position, r))?;
+                w.floats(
+                    &format!("points[{points}].color"),
+                    &colour(*color, *intensity),
+                )?;
+                points += 1;
+            }
+            Light::Directional {
+                direction,
+                color,
+                intensity,
+                ..
+            } => {
+                let to = (-DVec3::from(*direction)).normalize_or_zero().into();
+                w.floats(&format!("dirs[{dirs}].to_light"), &v4(to, 0.0))?;
+                w.floats(&format!("dirs[{dirs}].color"), &colour(*color, *intensity))?;
+                dirs += 1;
+            }
         }
     }
-    for l in &scene.lights {
-        if let Light::Directional {
-            direction,
-            color,
-            intensity,
-            ..
-        } = l
-        {
-            w.v4((-DVec3::from(*direction)).normalize_or_zero().into(), 0.0);
-            w.v4((DVec3::from(*color) * *intensity).into(), l.sharpness());
-        }
-    }
-    for m in &scene.materials {
+    for (k, m) in scene.materials.iter().enumerate() {
         let (a, b, checker, inv, shift) = match &m.pattern {
             Pattern::Solid(c) => (*c, [0.0; 3], 0.0, 0.0, [0.0; 3]),
             Pattern::Checker { a, b, size } => {
                 (*a, *b, 1.0, 1.0 / size, scene.checker_shift(*size))
             }
         };
-        w.v4(a, checker);
-        w.v4(b, inv);
-        w.f([m.ambient, m.diffuse, m.specular, m.shininess]);
-        w.f([m.reflect, m.transparency, m.ior.max(1e-6), 0.0]);
-        w.v4(shift, 0.0);
+        let at = |member: &str| format!("materials[{k}].{member}");
+        w.floats(&at("color"), &v4(a, checker))?;
+        w.floats(&at("color_b"), &v4(b, inv))?;
+        w.floats(
+            &at("phong"),
+            &[m.ambient, m.diffuse, m.specular, m.shininess],
+        )?;
+        w.floats(
+            &at("optics"),
+            &[m.reflect, m.transparency, m.ior.max(1e-6), 0.0],
+        )?;
+        w.floats(&at("shift"), &v4(shift, 0.0))?;
     }
-    w.0
+    w.finish()
 }
 
-#[derive(Default)]
-struct Words(Vec<u8>);
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-impl Words {
-    fn f(&mut self, v: [f64; 4]) {
-        for x in v {
-            self.0.extend_from_slice(&(x as f32).to_le_bytes());
-        }
+    fn scene(text: &str) -> Scene {
+        let (scene, diags, _) = crate::check::check_str("contract.sdf", text);
+        assert!(!crate::diagnostics::has_errors(&diags), "{diags:?}");
+        scene.expect("checks")
     }
-    fn v4(&mut self, v: [f64; 3], w: f64) {
-        self.f([v[0], v[1], v[2], w]);
+
+    const LIT: &str = "material red = phong { color: (0.9, 0.2, 0.2), reflect: 0.3 };\n\
+        material floor = checker { a: (0.9, 0.9, 0.9), b: (0.1, 0.1, 0.1), size: 1 };\n\
+        light point { position: (4, 6, -4), radius: 30 }\n\
+        light directional { direction: (-1, -1, 0.5) }\n\
+        render { relaxation: 1.3 }\n\
+        scene { plane((0, 1, 0), 0) @ floor; torus(1, 0.3) @ red; }";
+
+    /// The members of `layout` at `paths`, read from `bytes` at naga's offsets, as words.
+    fn read(layout: &Uniform, bytes: &[u8], paths: &[String]) -> Vec<Vec<u32>> {
+        paths
+            .iter()
+            .map(|p| {
+                let mut w = layout.writer();
+                // The offset of `p`: write a marker there and find it.
+                w.uints(p, &[u32::MAX; 4])
+                    .or_else(|_| w.floats(p, &[f64::from(f32::from_bits(0x7f80_0001)); 4]))
+                    .expect("a member");
+                let marked = w.finish_unchecked();
+                let at = marked
+                    .chunks_exact(4)
+                    .position(|c| c != [0; 4])
+                    .expect("marked")
+                    * 4;
+                bytes[at..at + 16]
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect()
+            })
+            .collect()
     }
-    fn u(&mut self, v: [u32; 4]) {
-        for x in v {
-            self.0.extend_from_slice(&x.to_le_bytes());
-        }
+
+    /// `Params` with its members reordered and `background` moved first: the uniform is
+    /// written at the new offsets naga reports, and every member reads back the same; a
+    /// member added to the template is refused until something writes it, and a member the
+    /// writer names and the template lacks is refused.
+    #[test]
+    fn the_uniform_follows_the_templates_layout() {
+        let scene = scene(LIT);
+        let lowered = Lowered::new(&scene);
+        let options = Options::default();
+        let kernel = write_from(TEMPLATE, &scene, &lowered, &options).expect("kernel");
+        let bytes = uniforms(&kernel.contract.uniform, &scene, 2.0).expect("uniform");
+        assert_eq!(bytes.len() as u32, kernel.contract.uniform.size);
+
+        let background = "    background: vec4<f32>,\n";
+        let depth = "    depth: vec4<u32>,      // max_depth\n";
+        assert!(TEMPLATE.contains(background) && TEMPLATE.contains(depth));
+        let reordered = TEMPLATE.replace(background, "").replace(
+            "struct Params {\n",
+            &format!("struct Params {{\n{depth}{background}"),
+        );
+        let reordered = reordered.replacen(depth, "", 2).replacen(
+            "struct Params {\n",
+            &format!("struct Params {{\n{depth}"),
+            1,
+        );
+        let moved = write_from(&reordered, &scene, &lowered, &options).expect("kernel");
+        let (a, b) = (&kernel.contract.uniform, &moved.contract.uniform);
+        let offset =
+            |u: &Uniform, name: &str| u.members.iter().find(|m| m.name == name).map(|m| m.offset);
+        assert_ne!(offset(a, "background"), offset(b, "background"));
+        assert_ne!(offset(a, "depth"), offset(b, "depth"));
+        let moved_bytes = uniforms(b, &scene, 2.0).expect("uniform");
+        let paths: Vec<String> = [
+            "eye",
+            "cam_w",
+            "view",
+            "march",
+            "background",
+            "counts",
+            "depth",
+            "points[0].position",
+            "points[0].color",
+            "dirs[0].to_light",
+            "materials[1].optics",
+            "materials[1].shift",
+        ]
+        .map(String::from)
+        .to_vec();
+        assert_eq!(read(a, &bytes, &paths), read(b, &moved_bytes, &paths));
+
+        let added = TEMPLATE.replace(
+            "struct Params {\n",
+            "struct Params {\n    exposure: vec4<f32>,\n",
+        );
+        let grown = write_from(&added, &scene, &lowered, &options).expect("kernel");
+        let e = uniforms(&grown.contract.uniform, &scene, 2.0).expect_err("unwritten");
+        assert!(e.0.contains("`exposure`"), "{e}");
+
+        let shrunk = write_from(&TEMPLATE.replace(depth, ""), &scene, &lowered, &options);
+        // The template reads `params.depth`, so naga refuses it first; a writer naming a
+        // member the layout lacks is refused by name.
+        assert!(shrunk.is_err());
+        let mut w = a.writer();
+        let e = w.floats("exposure", &[0.0; 4]).expect_err("no such member");
+        assert!(e.0.contains("no member `exposure`"), "{e}");
+        let e = w.floats("counts", &[0.0; 4]).expect_err("u32s");
+        assert!(e.0.contains("holds 4 u32"), "{e}");
+        let e = w
+            .floats("points[1].color", &[0.0; 4])
+            .expect_err("one light");
+        assert!(e.0.contains("holds 1"), "{e}");
+    }
+
+    /// The contract lists every feature of the template (and PARAMS), and a render of a scene that needs
+    /// another feature (a soft light where the kernel has hard shadows) or other settings is
+    /// refused, naming the difference.
+    #[test]
+    fn the_contract_names_every_feature_and_refuses_other_scenes() {
+        let scene = scene(LIT);
+        let lowered = Lowered::new(&scene);
+        let kernel = write(&scene, &lowered).expect("kernel");
+        let flags: std::collections::BTreeSet<&str> = TEMPLATE
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("//#if "))
+            .map(|f| f.trim().trim_start_matches('!'))
+            .collect();
+        let mut named: std::collections::BTreeSet<&str> =
+            kernel.contract.features.iter().map(|(n, _)| *n).collect();
+        // PARAMS changes the distance program's text, not the template.
+        assert!(named.remove("PARAMS"));
+        assert_eq!(flags, named);
+        let contract = &kernel.contract;
+        assert!(contract.has("RELAX") && contract.has("POINT") && !contract.has("SOFT"));
+        contract.check(&scene, false).expect("its own scene");
+
+        let soft = self::scene(&LIT.replace("radius: 30", "radius: 30, penumbra: 4deg"));
+        let e = contract.check(&soft, false).expect_err("soft shadows");
+        assert!(e.0.contains("SOFT is off in the kernel and on"), "{e}");
+        let mut plain = scene.clone();
+        plain.settings.relaxation = 1.0;
+        let e = contract.check(&plain, false).expect_err("no relaxation");
+        assert!(e.0.contains("no over-relaxation"), "{e}");
+        assert!(e.0.contains("RELAX is on in the kernel and off"), "{e}");
     }
 }

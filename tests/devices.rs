@@ -76,8 +76,14 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
         let mut calls = 0;
         let none = gpu::launch::Faults::default();
         let data = kernel.data.as_deref();
-        let two = gpu::render_several(&workers, &scene, (l, data), &none, &mut |_| calls += 1)
-            .expect("two devices");
+        let two = gpu::render_several(
+            &workers,
+            &scene,
+            (l, Some(&kernel.contract.uniform), data),
+            &none,
+            &mut |_| calls += 1,
+        )
+        .expect("two devices");
         let name = path.display();
         assert!(
             bits(&one.render.image) == bits(&two.render.image),
@@ -115,8 +121,14 @@ fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
         let workers: [&dyn Worker; 2] = [&on_cpu, &ka];
         let none = gpu::launch::Faults::default();
         let data = kernel.data.as_deref();
-        let mixed = gpu::render_several(&workers, &scene, (l, data), &none, &mut |_| {})
-            .expect("cpu and lavapipe");
+        let mixed = gpu::render_several(
+            &workers,
+            &scene,
+            (l, Some(&kernel.contract.uniform), data),
+            &none,
+            &mut |_| {},
+        )
+        .expect("cpu and lavapipe");
         assert!(
             mixed.shares.iter().all(|s| s.tiles > 0),
             "{name}: both rendered"

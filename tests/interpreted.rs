@@ -111,7 +111,8 @@ fn the_text_depends_on_the_specialisation_alone() {
         let specialised = kernel(&scene, &lowered, KernelChoice::Specialised);
         assert!(!specialised.interpreted());
         let set = |k: &wgsl::Kernel| {
-            k.features
+            k.contract
+                .features
                 .iter()
                 .filter(|f| f.1 && !["INTERPRETED", "PARAMS", "SCENE_DATA"].contains(&f.0))
                 .map(|f| f.0)

@@ -130,7 +130,7 @@ fn the_text_depends_on_the_specialisation_alone() {
 
 #[test]
 fn auto_interprets_large_programs_only() {
-    let choose = |path: &str, method: Option<Method>| {
+    let choose_with = |path: &str, method: Option<Method>, max_instances: usize| {
         let mut scene = frontend::load(Path::new(path)).unwrap().scene.unwrap();
         if let Some(m) = method {
             scene.settings.method = m;
@@ -138,15 +138,28 @@ fn auto_interprets_large_programs_only() {
         let lowered = Lowered::new(&scene);
         let options = Options {
             kernel: KernelChoice::Auto,
+            max_instances,
             ..Options::default()
         };
         let size = wgsl::code_size(&scene, &lowered, &options);
         (wgsl::choose(&scene, &lowered, &options).unwrap(), size)
     };
+    let choose = |path: &str, method| choose_with(path, method, wgsl::MAX_INSTANCES);
     let (kind, size) = choose("../examples/seed3.sdf", None);
     assert_eq!(kind, wgsl::KernelKind::Specialised, "seed3: {size}");
+    // lattice's 400 spheres are walked from scene_data (the rest is small); written as code
+    // they are a large program.
     let (kind, size) = choose("../examples/lattice.sdf", None);
-    assert!(size >= wgsl::interp::AUTO_INTERPRET, "lattice: {size}");
+    assert!(
+        size < wgsl::interp::AUTO_INTERPRET,
+        "lattice's rest: {size}"
+    );
+    assert_eq!(kind, wgsl::KernelKind::Specialised);
+    let (kind, size) = choose_with("../examples/lattice.sdf", None, usize::MAX);
+    assert!(
+        size >= wgsl::interp::AUTO_INTERPRET,
+        "lattice as code: {size}"
+    );
     assert_eq!(kind, wgsl::KernelKind::Interpreted);
     // A traced scene has no program in its kernel; marched, its program is small.
     let (kind, _) = choose("../examples/seed2.sdf", None);
@@ -160,21 +173,48 @@ fn auto_interprets_large_programs_only() {
     assert_eq!(kind, wgsl::KernelKind::Specialised);
 }
 
+/// 600 hollow spheres: a shell is not an instance the walk knows, so the whole program (about
+/// 9 300 instructions) is written as code.
+const SHELLS: &str = "camera { position: (0, 4, -12), look_at: (0, 0, 0), fov: 50deg }
+light point { position: (4, 8, -6), intensity: 1 }
+render { width: 32, height: 24, method: \"march\" }
+scene {
+  plane((0, 1, 0), -1);
+  for i in 0..600 { sphere(0.2).shell(0.02).translate(i % 30 * 0.5 - 7.5, 0, i / 30 * 0.5); }
+}
+";
+
 #[test]
-fn auto_keeps_the_specialised_kernel_on_a_cpu_adapter() {
+fn auto_keeps_the_specialised_kernel_on_a_cpu_adapter_on_cuda_and_for_sequences() {
     use sdfc_runtime::backend::{Prepared, Setup};
-    let Some(gpu) = open_gpu() else { return };
-    let scene = marched(Path::new("../examples/lattice.sdf"), 32, 24);
+    let (scene, diags, _) = sdfc_compiler::check::check_str("shells.sdf", SHELLS);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let lowered = Lowered::new(&scene);
-    let prepared = Prepared::on_gpu(
-        std::sync::Arc::new(gpu),
-        &scene,
-        &lowered,
-        &Setup::default(),
-    )
-    .expect("prepared");
-    let cpu = matches!(&prepared, Prepared::Wgpu { gpu, .. } if gpu.is_cpu());
-    let want = if cpu { "specialised" } else { "interpreted" };
+    let options = Options {
+        kernel: KernelChoice::Auto,
+        ..Options::default()
+    };
+    assert!(wgsl::code_size(&scene, &lowered, &options) >= wgsl::interp::AUTO_INTERPRET);
+    assert_eq!(
+        wgsl::choose(&scene, &lowered, &options).unwrap(),
+        wgsl::KernelKind::Interpreted,
+        "the compiler's rule"
+    );
+    let Some(gpu) = open_gpu() else { return };
+    let gpu = std::sync::Arc::new(gpu);
+    let sequence = Setup {
+        parameters: true,
+        ..Setup::default()
+    };
+    let prepared = Prepared::on_gpu(gpu.clone(), &scene, &lowered, &sequence).expect("prepared");
+    assert_eq!(prepared.kernel_kind(), Some("specialised"), "a sequence");
+    let prepared =
+        Prepared::on_gpu(gpu.clone(), &scene, &lowered, &Setup::default()).expect("prepared");
+    let want = if gpu.is_cpu() {
+        "specialised"
+    } else {
+        "interpreted"
+    };
     assert_eq!(prepared.kernel_kind(), Some(want));
 }
 

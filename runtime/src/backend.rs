@@ -83,6 +83,28 @@ impl Kernel {
     }
 }
 
+impl Setup {
+    /// This setup with `--kernel auto` meaning the specialised kernel.
+    fn specialised_for_auto(&self) -> Setup {
+        Setup {
+            kernel: match self.kernel {
+                wgsl::KernelChoice::Auto => wgsl::KernelChoice::Specialised,
+                other => other,
+            },
+            ..*self
+        }
+    }
+
+    /// This setup on a CUDA device, where `--kernel auto` is the specialised kernel: on an
+    /// H100 (BENCHMARKS.md, "Interpreted against specialised", 2026-11-24) the driver's JIT of
+    /// the largest marched programs as code took at most 2.9 s cold and 0.8 s warm, a whole
+    /// render with the interpreted kernel 1.4–1.8 s cold, and its frames were 17 to 100 times
+    /// slower.
+    fn on_cuda(&self) -> Setup {
+        self.specialised_for_auto()
+    }
+}
+
 /// A scene prepared for one backend.
 #[derive(Debug)]
 pub enum Prepared {
@@ -338,7 +360,7 @@ impl Prepared {
                             let cuda = Cuda::open_device(i, true).map_err(|e| e.to_string())?;
                             let device = start.elapsed();
                             let start = Instant::now();
-                            let kernel = Self::kernel(scene, &lowered, setup)?;
+                            let kernel = Self::kernel(scene, &lowered, &setup.on_cuda())?;
                             let timing = Preparation {
                                 device,
                                 kernel: start.elapsed(),
@@ -472,13 +494,12 @@ impl Prepared {
         method_allowed(scene, &lowered.traceable)?;
         // On a CPU adapter (lavapipe) the interpreted kernel's frames are 25 to 150 times the
         // specialised kernel's (BENCHMARKS.md, "Interpreted against specialised"), which its
-        // compile never repays: `auto` keeps the specialised kernel there.
-        let setup = &Setup {
-            kernel: match setup.kernel {
-                wgsl::KernelChoice::Auto if gpu.is_cpu() => wgsl::KernelChoice::Specialised,
-                other => other,
-            },
-            ..*setup
+        // compile never repays: `auto` keeps the specialised kernel there, and for the frames
+        // of a sequence (`parameters`), which share one specialised kernel.
+        let setup = &if gpu.is_cpu() || setup.parameters {
+            setup.specialised_for_auto()
+        } else {
+            *setup
         };
         let start = Instant::now();
         let (kernel, built) = match held {
@@ -545,7 +566,7 @@ impl Prepared {
         let cuda = Cuda::open().map_err(|e| e.to_string())?;
         let device = start.elapsed();
         let start = Instant::now();
-        let kernel = Self::kernel(scene, lowered, setup)?;
+        let kernel = Self::kernel(scene, lowered, &setup.on_cuda())?;
         let timing = Preparation {
             device,
             kernel: start.elapsed(),
@@ -569,7 +590,7 @@ impl Prepared {
         lowered: &Lowered,
         setup: &Setup,
     ) -> Result<CudaModule, String> {
-        Self::cuda_module_of(cuda, Self::kernel(scene, lowered, setup)?)
+        Self::cuda_module_of(cuda, Self::kernel(scene, lowered, &setup.on_cuda())?)
     }
 
     /// Translates `kernel` to PTX and loads it on `cuda`.
@@ -618,7 +639,10 @@ impl Prepared {
                 let text = Self::kernel_text(scene, &lowered, setup)?;
                 let built = text.source != module.source;
                 if built {
-                    **module = Self::cuda_module_of(cuda, Self::kernel(scene, &lowered, setup)?)?;
+                    **module = Self::cuda_module_of(
+                        cuda,
+                        Self::kernel(scene, &lowered, &setup.on_cuda())?,
+                    )?;
                 } else {
                     module.data = text.data;
                 }

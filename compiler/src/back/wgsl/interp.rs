@@ -37,14 +37,11 @@ use std::fmt::Write;
 
 /// `auto` (`Options::kernel`) chooses the interpreted kernel for a marched scene whose
 /// distance program written as code (the whole program, or what remains of it beside
-/// instances read from `scene_data`) has at least this many live instructions. The figures
-/// it stands on (issue 23, measured on an H100 on 2026-11-24): through wgpu,
-/// examples/temple.sdf (about 1 600 instructions) is ready in under a second, but
-/// examples/lattice.sdf (about 10 000) took 6.3 s to compile and
-/// examples/scaling/compound_100.sdf (about 17 600) 7.4–9.4 s. The interpreted kernel's
-/// frame time beside the specialised one's is not measured yet (scripts/device-interp.sh
-/// charts it); until it is, 5 000 sits between the kernels that compile in a second and
-/// those that take several.
+/// instances read from `scene_data`) has at least this many live instructions; the runtime
+/// keeps the specialised kernel on CUDA, on CPU adapters and for sequences. The figures it
+/// stands on (docs/interpreted.md, an H100 on 2026-11-24): through wgpu a cold compile of
+/// 7 860 instructions took 4.0 s and of 14 739 9.0 s against the interpreted kernel's 1.6–1.9 s
+/// ready, whose frames were 2.6–6 times slower; temple (1 372) was ready in 1.1 s.
 pub const AUTO_INTERPRET: usize = 5_000;
 
 /// Words of the header before the first program.

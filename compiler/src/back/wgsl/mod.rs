@@ -770,8 +770,9 @@ mod tests {
             .collect();
         let mut named: std::collections::BTreeSet<&str> =
             kernel.contract.features.iter().map(|(n, _)| *n).collect();
-        // PARAMS changes the distance program's text, not the template.
+        // PARAMS and INTERPRETED change the distance program's text, not the template.
         assert!(named.remove("PARAMS"));
+        assert!(named.remove("INTERPRETED"));
         assert_eq!(flags, named);
         let contract = &kernel.contract;
         assert!(contract.has("RELAX") && contract.has("POINT") && !contract.has("SOFT"));

@@ -189,8 +189,11 @@ impl Gpu {
         if driver_cache {
             features |= wgpu::Features::PIPELINE_CACHE;
         }
+        // The adapter's own buffer limits, not wgpu's defaults (256 MiB, which an 8K image of
+        // 16 bytes a pixel exceeds).
         let limits = wgpu::Limits {
             max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
+            max_buffer_size: adapter.limits().max_buffer_size,
             ..wgpu::Limits::default()
         }
         .using_resolution(adapter.limits());
@@ -598,11 +601,21 @@ impl launch::Device for Kernel<'_> {
 
     fn prepare(&self, job: &Job) -> Result<FrameBuffers, Error> {
         let gpu = self.gpu;
-        let limit = gpu.device.limits().max_storage_buffer_binding_size;
+        let limits = gpu.device.limits();
+        let limit = limits.max_storage_buffer_binding_size;
         if let Some(data) = job.data.filter(|d| d.len() as u64 > limit) {
             return Err(Error::Render(format!(
                 "the scene's primitives take {} bytes, more than the {limit} bytes a storage buffer of this adapter may bind",
                 data.len()
+            )));
+        }
+        // The image (16 bytes a pixel) and the statistics are storage buffers bound whole.
+        let largest = job.width as u64 * job.height as u64 * 4 * STATS_WORDS.max(4) as u64;
+        let most = limit.min(limits.max_buffer_size);
+        if largest > most {
+            return Err(Error::Render(format!(
+                "a {}x{} frame needs buffers of {largest} bytes, more than the {most} bytes this adapter allows; render it smaller or with --backend cuda",
+                job.width, job.height
             )));
         }
         let (pipeline, _) = gpu.cached_pipeline(self.wgsl, self.entry, job.data.is_some())?;

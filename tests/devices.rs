@@ -80,7 +80,7 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
             &workers,
             &scene,
             (l, Some(&kernel.contract.uniform), data),
-            &none,
+            (&none, true),
             &mut |_| calls += 1,
         )
         .expect("two devices");
@@ -125,7 +125,7 @@ fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
             &workers,
             &scene,
             (l, Some(&kernel.contract.uniform), data),
-            &none,
+            (&none, true),
             &mut |_| {},
         )
         .expect("cpu and lavapipe");
@@ -482,4 +482,31 @@ fn bad_devices_are_named_in_the_error() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("it cannot use --devices"), "{err}");
+}
+
+/// Without the per-pixel statistics (`Setup::image_only`: `sdfc render` without `--stats`, and
+/// sequences) a GPU frame is the same image, and only its statistics are left empty.
+#[test]
+fn a_frame_without_statistics_is_the_same_image() {
+    use sdfc_runtime::backend::{Prepared, Setup};
+    let Some(gpu) = open_gpu() else { return };
+    let gpu = std::sync::Arc::new(gpu);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed3.sdf");
+    let scene = load(&path, 96, 64);
+    let lowered = Lowered::new(&scene);
+    let frame = |setup: &Setup| {
+        Prepared::on_gpu(gpu.clone(), &scene, &lowered, setup)
+            .expect("prepared")
+            .render(&scene, &|_| {})
+            .expect("rendered")
+    };
+    let with = frame(&Setup::default());
+    let without = frame(&Setup {
+        image_only: true,
+        ..Setup::default()
+    });
+    assert_eq!(with.render.image.linear, without.render.image.linear);
+    assert!(with.render.stats.counters.steps > 0 && with.render.stats.counters.hits > 0);
+    assert_eq!(without.render.stats.counters.steps, 0);
+    assert_eq!(without.render.stats.counters.hits, 0);
 }

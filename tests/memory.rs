@@ -116,6 +116,7 @@ fn renders_stay_within_the_memory_they_announce() {
             debug_nan: false,
             parameters: false,
             kernel: Default::default(),
+            image_only: false,
         };
         let prepared = pool.install(|| {
             Prepared::from_program(Backend::Cpu, &scene, lowered.clone(), &setup).expect("cpu")

@@ -41,6 +41,10 @@ pub struct Setup {
     /// Which GPU kernel a marched scene gets (`--kernel`): its distance program written as
     /// code, interpreted from a buffer, or the one `wgsl::choose` expects sooner.
     pub kernel: wgsl::KernelChoice,
+    /// GPU frames read back the image alone, not the per-pixel statistics (`sdfc render`
+    /// without `--stats`, sequences): their [`Frame`]'s statistics then count nothing but
+    /// the camera rays. At 1920×1080 the statistics are 66 MB to read back and convert.
+    pub image_only: bool,
 }
 
 /// The GPU kernel asked for on the command line (`--kernel`).
@@ -543,6 +547,7 @@ impl Prepared {
                     debug_nan: options.debug_nan,
                     parameters: false,
                     kernel: wgsl::KernelChoice::default(),
+                    image_only: false,
                 };
                 Ok((Self::on_cpu(scene, lowered, &setup)?, true))
             }
@@ -728,6 +733,15 @@ impl Prepared {
                 self.name()
             )
         })
+    }
+
+    /// The setup of a GPU kernel (of the first GPU device of several).
+    fn setup(&self) -> Option<&Setup> {
+        match self {
+            Prepared::Cpu { .. } => None,
+            Prepared::Wgpu { setup, .. } | Prepared::Cuda { setup, .. } => Some(setup),
+            Prepared::Several(parts) => parts.iter().find_map(|p| p.setup()),
+        }
     }
 
     /// The lowered scene a GPU kernel was written from.
@@ -923,6 +937,7 @@ impl Prepared {
         faults: &gpu::launch::Faults,
     ) -> Result<Frame, String> {
         self.check_contract(scene)?;
+        let statistics = !self.setup().is_some_and(|s| s.image_only);
         match self {
             Prepared::Cpu { tapes, options, .. } => {
                 let tiles = cpu::tile_count(&scene.settings, options).max(1) as f64;
@@ -947,9 +962,14 @@ impl Prepared {
                 lipschitz,
                 ..
             } => {
-                let r = gpu::render_faults(gpu, scene, kernel, *lipschitz, faults, &mut |f| {
-                    progress(f)
-                })
+                let r = gpu::render_faults(
+                    gpu,
+                    scene,
+                    kernel,
+                    *lipschitz,
+                    (faults, statistics),
+                    &mut |f| progress(f),
+                )
                 .map_err(|e| e.to_string())?;
                 Ok(Frame::of(r))
             }
@@ -968,7 +988,7 @@ impl Prepared {
                         module.data.as_deref(),
                     ),
                     *lipschitz,
-                    faults,
+                    (faults, statistics),
                     &mut |f| progress(f),
                 )
                 .map_err(|e| e.to_string())?;
@@ -1021,7 +1041,7 @@ impl Prepared {
                     &workers,
                     scene,
                     (lipschitz, uniform, data),
-                    faults,
+                    (faults, statistics),
                     &mut |f| progress(f),
                 )?;
                 Ok(Frame::of(r))

@@ -214,6 +214,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
             debug_nan: false,
             parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
             kernel: args.kernel.unwrap_or_default().choice(),
+            image_only: false,
         };
         let mut kernels = Kernels::new(&pool, (args.backend, args.devices.clone()), setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
@@ -393,6 +394,7 @@ fn time_scene(
         debug_nan: false,
         parameters: args.constants == Some(Constants::Parameters),
         kernel: args.kernel.unwrap_or_default().choice(),
+        image_only: false,
     };
     if args.backend != Backend::Cpu {
         let options = sdfc_compiler::back::wgsl::Options {

@@ -170,6 +170,7 @@ fn measure(
         debug_nan: false,
         parameters: false,
         kernel: Default::default(),
+        image_only: false,
     };
     let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
@@ -259,6 +260,7 @@ fn reference_setup(
         debug_nan: false,
         parameters: false,
         kernel: Default::default(),
+        image_only: false,
     };
     let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
     Ok((reference_scene, prepared))

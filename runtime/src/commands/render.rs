@@ -295,6 +295,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         debug_nan: args.debug_nan,
         parameters: false,
         kernel: args.kernel.unwrap_or_default().choice(),
+        image_only: !args.stats,
     };
     let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup)?;
     run.split("preparation", "the rest of it", prepared.preparation());

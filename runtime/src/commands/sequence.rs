@@ -70,6 +70,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         debug_nan: args.debug_nan,
         parameters: true,
         kernel: args.kernel.unwrap_or_default().choice(),
+        image_only: true,
     };
     let mine: Vec<u64> = shard.frames(frames).collect();
     let todo: Vec<u64> = mine

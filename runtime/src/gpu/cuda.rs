@@ -392,14 +392,17 @@ impl launch::Device for Kernel<'_> {
             let image = s
                 .clone_dtoh(&f.image)
                 .map_err(driver("reading the image"))?;
-            let stats = s
-                .clone_dtoh(&f.stats)
-                .map_err(driver("reading the statistics"))?;
+            let stats = if job.statistics {
+                s.clone_dtoh(&f.stats)
+                    .map_err(driver("reading the statistics"))?
+            } else {
+                Vec::new()
+            };
             (image, stats)
         } else {
             let n: usize = ranges.iter().map(|r| r.end - r.start).sum();
             let mut image = vec![0f32; 4 * n];
-            let mut stats = vec![0u32; words * n];
+            let mut stats = vec![0u32; if job.statistics { words * n } else { 0 }];
             let mut at = 0;
             for r in ranges {
                 let len = r.end - r.start;
@@ -408,11 +411,13 @@ impl launch::Device for Kernel<'_> {
                     &mut image[4 * at..4 * (at + len)],
                 )
                 .map_err(driver("reading the image"))?;
-                s.memcpy_dtoh(
-                    &f.stats.slice(words * r.start..words * r.end),
-                    &mut stats[words * at..words * (at + len)],
-                )
-                .map_err(driver("reading the statistics"))?;
+                if job.statistics {
+                    s.memcpy_dtoh(
+                        &f.stats.slice(words * r.start..words * r.end),
+                        &mut stats[words * at..words * (at + len)],
+                    )
+                    .map_err(driver("reading the statistics"))?;
+                }
                 at += len;
             }
             s.synchronize().map_err(driver("reading the image"))?;
@@ -427,7 +432,7 @@ impl launch::Device for Kernel<'_> {
                 .collect()
         };
         drop(image);
-        let (counters, steps) = super::counters(&stats);
+        let (counters, steps) = super::counters(&stats, ranges);
         Ok(Pixels {
             linear,
             steps,

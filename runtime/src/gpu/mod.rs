@@ -115,18 +115,19 @@ pub fn render(
         scene,
         kernel,
         lipschitz,
-        &launch::Faults::from_env(),
+        (&launch::Faults::from_env(), true),
         progress,
     )
 }
 
-/// [`render`] with the faults `faults` injected.
+/// [`render`] with the faults `faults` injected, reading the per-pixel statistics back only
+/// when `statistics` ([`launch::Job::statistics`]).
 pub fn render_faults(
     gpu: &Gpu,
     scene: &Scene,
     kernel: &Kernel,
     lipschitz: f64,
-    faults: &launch::Faults,
+    (faults, statistics): (&launch::Faults, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, Error> {
     let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)
@@ -137,25 +138,33 @@ pub fn render_faults(
         scene,
         &uniforms,
         kernel.data.as_deref(),
-        faults,
+        (faults, statistics),
         progress,
     )
 }
 
 /// Renders `scene` with a kernel already loaded on a CUDA device, whose uniform is laid out
-/// as `uniform`; `data` is the kernel's scene data ([`Kernel::data`]); `faults` are injected.
+/// as `uniform`; `data` is the kernel's scene data ([`Kernel::data`]); `faults` are injected,
+/// and the per-pixel statistics read back only when `statistics`.
 pub fn render_cuda(
     cuda: &cuda::Cuda,
     scene: &Scene,
     (loaded, uniform, data): (&cuda::Loaded, &wgsl::Uniform, Option<&[u8]>),
     lipschitz: f64,
-    faults: &launch::Faults,
+    (faults, statistics): (&launch::Faults, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, cuda::Error> {
     let uniforms =
         wgsl::uniforms(uniform, scene, lipschitz).map_err(|e| cuda::Error::Arguments(e.0))?;
     let device = cuda.kernel(loaded, wgsl::WORKGROUP);
-    render_one(&device, scene, &uniforms, data, faults, progress)
+    render_one(
+        &device,
+        scene,
+        &uniforms,
+        data,
+        (faults, statistics),
+        progress,
+    )
 }
 
 /// Renders `scene` on one device, in squares of [`TILE`] pixels.
@@ -164,7 +173,7 @@ fn render_one<D: launch::Device>(
     scene: &Scene,
     uniforms: &[u8],
     data: Option<&[u8]>,
-    faults: &launch::Faults,
+    (faults, statistics): (&launch::Faults, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, D::Error> {
     let s = &scene.settings;
@@ -176,6 +185,7 @@ fn render_one<D: launch::Device>(
         height: s.height,
         tiles: &tiles,
         timed: true,
+        statistics,
     };
     let out = launch::render_one(device, &job, faults, progress)?;
     Ok(finish(out, s))
@@ -189,7 +199,7 @@ pub fn render_several(
     devices: &[&dyn launch::Worker],
     scene: &Scene,
     (lipschitz, uniform, data): (f64, Option<&wgsl::Uniform>, Option<&[u8]>),
-    faults: &launch::Faults,
+    (faults, statistics): (&launch::Faults, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, String> {
     let s = &scene.settings;
@@ -205,6 +215,7 @@ pub fn render_several(
         height: s.height,
         tiles: &tiles,
         timed: false,
+        statistics,
     };
     let out = launch::render_several(devices, &job, faults, progress)?;
     Ok(finish(out, s))
@@ -279,10 +290,16 @@ fn pixels_and_tiles(settings: &Settings) -> (u64, u64) {
 }
 
 /// Sums the kernel's per-pixel statistics words into the CPU renderer's counters (all but
-/// the camera rays, which the settings give), with the marching steps of each pixel.
-pub(crate) fn counters(words: &[u32]) -> (Counters, Vec<u32>) {
+/// the camera rays, which the settings give), with the marching steps of each pixel of
+/// `ranges`; no words (not read back) give empty counters and zero steps.
+pub(crate) fn counters(words: &[u32], ranges: &[std::ops::Range<usize>]) -> (Counters, Vec<u32>) {
     use rayon::prelude::*;
     let n = STATS_WORDS as usize;
+    if words.is_empty() {
+        // Not read back (`launch::Job::statistics`): no steps, one zero per pixel.
+        let pixels = ranges.iter().map(|r| r.end - r.start).sum();
+        return (Counters::default(), vec![0; pixels]);
+    }
     // In parallel: a 1080p frame has two million pixels of eight words.
     let steps: Vec<u32> = words.par_chunks_exact(n).map(|w| w[0]).collect();
     let c = words

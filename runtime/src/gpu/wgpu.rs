@@ -685,7 +685,7 @@ impl launch::Device for Kernel<'_> {
     fn read(
         &self,
         f: &mut FrameBuffers,
-        _job: &Job,
+        job: &Job,
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Error> {
         let bytes = |per: u64| -> Vec<Range<u64>> {
@@ -695,9 +695,12 @@ impl launch::Device for Kernel<'_> {
                 .collect()
         };
         let linear = self.gpu.read_ranges(&f.buffers.image, &bytes(16))?;
-        let stats = self
-            .gpu
-            .read_ranges(&f.buffers.stats, &bytes(4 * STATS_WORDS as u64))?;
+        let stats = if job.statistics {
+            self.gpu
+                .read_ranges(&f.buffers.stats, &bytes(4 * STATS_WORDS as u64))?
+        } else {
+            Vec::new()
+        };
         let convert = Instant::now();
         let (linear, words) = {
             use rayon::prelude::*;
@@ -713,7 +716,7 @@ impl launch::Device for Kernel<'_> {
             (linear, words)
         };
         drop(stats);
-        let (counters, steps) = super::counters(&words);
+        let (counters, steps) = super::counters(&words, ranges);
         Ok(Pixels {
             linear,
             steps,

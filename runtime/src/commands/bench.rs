@@ -214,7 +214,8 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
             debug_nan: false,
             parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
             kernel: args.kernel.unwrap_or_default().choice(),
-            image_only: false,
+            // As `sdfc render --frames` renders a sequence: the image alone.
+            image_only: true,
         };
         let mut kernels = Kernels::new(&pool, (args.backend, args.devices.clone()), setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);

@@ -18,28 +18,8 @@ const MAX_DIFFERING: f64 = 0.02;
 /// Per-channel difference that counts a pixel as differing.
 const THRESHOLD: f64 = 0.1;
 
-fn examples() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir("../examples")
-        .expect("examples/")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
-        .collect();
-    files.sort();
-    files
-}
-
 fn open_gpu() -> Option<gpu::Gpu> {
-    match gpu::Gpu::open(false) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            assert!(
-                std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
-                "SDFC_REQUIRE_DEVICES=1 but wgpu found no adapter: {e}"
-            );
-            println!("SKIPPED: wgpu conformance: {e}");
-            None
-        }
-    }
+    common::open_gpu("wgpu conformance")
 }
 
 /// A scene checked from source text; its diagnostics on failure.
@@ -84,7 +64,7 @@ fn wgpu_matches_cpu_on_every_example() {
     let Some(gpu) = open_gpu() else { return };
     println!("adapter: {}", gpu.describe());
     let mut failures = Vec::new();
-    for path in examples() {
+    for path in common::examples() {
         let scene = load_small(&path, 96, 64);
         let lowered = Lowered::new(&scene);
         let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");

@@ -7,6 +7,8 @@
 //! a bad `--devices` entry is named in the error. Without a wgpu adapter the tests say they
 //! skipped, unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe).
 
+mod common;
+
 use sdfc_compiler::back::wgsl;
 use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::Scene;
@@ -16,17 +18,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn open_gpu() -> Option<gpu::Gpu> {
-    match gpu::Gpu::open(false) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            assert!(
-                std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
-                "SDFC_REQUIRE_DEVICES=1 but wgpu found no adapter: {e}"
-            );
-            println!("SKIPPED: several devices: {e}");
-            None
-        }
-    }
+    common::open_gpu("several devices")
 }
 
 fn load(path: &Path, width: u32, height: u32) -> Scene {
@@ -38,16 +30,6 @@ fn load(path: &Path, width: u32, height: u32) -> Scene {
     scene.settings.height = height;
     scene.settings.aa = 1;
     scene
-}
-
-fn examples() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir("../examples")
-        .expect("examples/")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
-        .collect();
-    files.sort();
-    files
 }
 
 fn bits(image: &sdfc_runtime::image::Image) -> Vec<u32> {
@@ -64,7 +46,7 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
         return;
     };
     // An odd size: bands of unequal height, the last one short.
-    for path in examples() {
+    for path in common::examples() {
         let scene = load(&path, 131, 97);
         let lowered = Lowered::new(&scene);
         let l = lowered.program.lipschitz();

@@ -12,7 +12,7 @@ use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::rng::Rng;
 use sdfc_compiler::scene::{Method, Scene};
 use sdfc_runtime::{frontend, gpu, metrics};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// The images of the two kernels agree to at least this PSNR (dB) and no pixel differs by
@@ -31,27 +31,7 @@ const MOST_DIFFERING: f64 = 0.005;
 const THRESHOLD: f64 = 0.1;
 
 fn open_gpu() -> Option<gpu::Gpu> {
-    match gpu::Gpu::open(false) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            assert!(
-                std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
-                "SDFC_REQUIRE_DEVICES=1 but wgpu found no adapter: {e}"
-            );
-            println!("SKIPPED: interpreted kernel on wgpu: {e}");
-            None
-        }
-    }
-}
-
-fn examples() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir("../examples")
-        .expect("examples/")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
-        .collect();
-    files.sort();
-    files
+    common::open_gpu("interpreted kernel on wgpu")
 }
 
 /// An example, marched (an analytically traced scene has no distance program in its
@@ -96,7 +76,7 @@ fn the_text_depends_on_the_specialisation_alone() {
     assert!(programs.len() > 5, "the programs differ");
     // Every example's interpreted kernel validates, and so do the media's entry points.
     let mut media = false;
-    for path in examples() {
+    for path in common::examples() {
         let scene = marched(&path, 32, 24);
         let lowered = Lowered::new(&scene);
         let k = kernel(&scene, &lowered, KernelChoice::Interpreted);
@@ -257,7 +237,7 @@ fn assert_same(gpu: &gpu::Gpu, scene: &Scene, label: &str) -> f64 {
 fn every_example_renders_as_with_the_specialised_kernel() {
     let Some(gpu) = open_gpu() else { return };
     println!("adapter: {}", gpu.describe());
-    for path in examples() {
+    for path in common::examples() {
         let scene = marched(&path, 48, 32);
         let name = path.file_stem().unwrap_or_default().to_string_lossy();
         assert_same(&gpu, &scene, &name);

@@ -330,9 +330,9 @@ impl Prepared {
         match backend {
             Backend::Cpu => Ok(Self::cpu(lowered, setup)),
             Backend::Wgpu => Self::wgpu(scene, &lowered, setup, false),
-            Backend::Cuda => Self::cuda(scene, &lowered, setup),
+            Backend::Cuda => Self::cuda(scene, &lowered, setup, Cuda::open),
             Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(lowered, setup)),
-            Backend::Auto => Self::cuda(scene, &lowered, setup)
+            Backend::Auto => Self::cuda(scene, &lowered, setup, Cuda::open)
                 .or_else(|_| Self::wgpu(scene, &lowered, setup, true))
                 .or_else(|_| Ok(Self::cpu(lowered, setup))),
         }
@@ -360,25 +360,7 @@ impl Prepared {
                         Backend::Cuda => {
                             // On a stream of its own: the same index twice is two logical
                             // devices on one GPU, running side by side.
-                            let start = Instant::now();
-                            let cuda = Cuda::open_device(i, true).map_err(|e| e.to_string())?;
-                            let device = start.elapsed();
-                            let start = Instant::now();
-                            let kernel = Self::kernel(scene, &lowered, &setup.on_cuda())?;
-                            let timing = Preparation {
-                                device,
-                                kernel: start.elapsed(),
-                                pipeline: None,
-                            };
-                            let module = Self::cuda_module_of(&cuda, kernel)?;
-                            Prepared::Cuda {
-                                cuda: Box::new(cuda),
-                                module: Box::new(module),
-                                lipschitz: lowered.program.lipschitz(),
-                                lowered: Box::new(lowered.clone()),
-                                setup: *setup,
-                                timing,
-                            }
+                            Self::cuda(scene, &lowered, setup, || Cuda::open_device(i, true))?
                         }
                         _ => {
                             let gpu = Gpu::open_index(i).map_err(|e| e.to_string())?;
@@ -566,9 +548,15 @@ impl Prepared {
         Ok(Self::cpu(lowered, setup))
     }
 
-    fn cuda(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<Prepared, String> {
+    /// Prepares `scene` on the CUDA device `open` opens (timing its opening).
+    fn cuda(
+        scene: &Scene,
+        lowered: &Lowered,
+        setup: &Setup,
+        open: impl FnOnce() -> Result<Cuda, gpu::cuda::Error>,
+    ) -> Result<Prepared, String> {
         let start = Instant::now();
-        let cuda = Cuda::open().map_err(|e| e.to_string())?;
+        let cuda = open().map_err(|e| e.to_string())?;
         let device = start.elapsed();
         let start = Instant::now();
         let kernel = Self::kernel(scene, lowered, &setup.on_cuda())?;

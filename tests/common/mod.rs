@@ -1,5 +1,6 @@
 //! Helpers shared by the integration tests: scenes built in code, random scenes, a few
-//! reference formulas, and the diagnostic codes the compiler's sources can emit.
+//! reference formulas, the diagnostic codes the compiler's sources can emit, the examples and
+//! the wgpu adapter the GPU tests run on.
 #![allow(dead_code)]
 
 use sdfc_compiler::rng::Rng;
@@ -233,6 +234,33 @@ pub fn codes_in(dir: &std::path::Path, out: &mut std::collections::BTreeSet<Stri
                     out.insert(code.to_string());
                 }
             }
+        }
+    }
+}
+
+/// The example scenes (`examples/*.sdf`), sorted.
+pub fn examples() -> Vec<std::path::PathBuf> {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir("../examples")
+        .expect("examples/")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
+        .collect();
+    files.sort();
+    files
+}
+
+/// A wgpu adapter (lavapipe where there is no GPU), or `None`, saying that `what` skipped;
+/// with `SDFC_REQUIRE_DEVICES=1` a missing adapter fails the test instead.
+pub fn open_gpu(what: &str) -> Option<sdfc_runtime::gpu::Gpu> {
+    match sdfc_runtime::gpu::Gpu::open(false) {
+        Ok(g) => Some(g),
+        Err(e) => {
+            assert!(
+                std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+                "SDFC_REQUIRE_DEVICES=1 but wgpu found no adapter: {e}"
+            );
+            println!("SKIPPED: {what}: {e}");
+            None
         }
     }
 }

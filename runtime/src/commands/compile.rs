@@ -105,7 +105,7 @@ pub struct CompileArgs {
 /// Compiles and writes the requested target.
 pub fn run(args: CompileArgs) -> ExitCode {
     let limits = args.limits.limits();
-    let loaded = match frontend::load_with(&args.file, &limits) {
+    let mut loaded = match frontend::load_with(&args.file, &limits) {
         Ok(l) => l,
         Err(msg) => {
             eprintln!("error: {msg}");
@@ -143,7 +143,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
             syntax::dump(&ast)
         }
         other => {
-            let Some(mut scene) = loaded.scene.clone() else {
+            let Some(mut scene) = loaded.scene.take() else {
                 return ExitCode::from(1);
             };
             let set = crate::settings::override_settings(

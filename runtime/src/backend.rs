@@ -542,6 +542,29 @@ impl Prepared {
         }
     }
 
+    /// [`Prepared::next`] with the wgpu kernel `kernel` instead of this one's choice (the
+    /// viewer shows a scene through the interpreted kernel while its specialised kernel
+    /// compiles); the same as `next` for the CPU.
+    pub fn next_with(
+        &self,
+        scene: &Scene,
+        lowered: Lowered,
+        kernel: wgsl::KernelChoice,
+    ) -> Result<(Prepared, bool), String> {
+        match self {
+            Prepared::Wgpu {
+                gpu,
+                kernel: held,
+                setup,
+                ..
+            } => {
+                let setup = Setup { kernel, ..*setup };
+                Self::on_gpu_after(gpu.clone(), scene, &lowered, &setup, Some(held))
+            }
+            _ => self.next(scene, lowered),
+        }
+    }
+
     /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
     pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
         method_allowed(scene, &lowered.traceable)?;

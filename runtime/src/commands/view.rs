@@ -1,7 +1,7 @@
 //! `sdfc view`: the live preview, a window that renders a scene continuously and reloads it
 //! whenever it or a file it imports is saved (see `docs/viewer.md`).
 
-use crate::backend::Backend;
+use crate::backend::{Backend, Kernel};
 use crate::view::{self, session::Options, Control, Run};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -32,6 +32,12 @@ pub struct ViewArgs {
     /// Override a render setting (as for `sdfc render`), at every reload. May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// The GPU kernel (wgpu): `auto` shows a scene whose specialised kernel is not compiled
+    /// yet through the interpreted kernel until it is (compiling it on another thread);
+    /// `specialised` compiles each new kernel before showing it; `interpreted` shows every
+    /// scene through the interpreted kernel (docs/interpreted.md). [default: auto]
+    #[arg(long, value_enum)]
+    pub kernel: Option<Kernel>,
     /// Print the times of each load: check, lower, tapes or kernel, pipeline, first frame,
     /// and (for reloads) from the file's modification to the first frame shown.
     #[arg(long)]
@@ -86,18 +92,24 @@ pub fn run(args: ViewArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     }
+    let backend = match args.backend {
+        ViewBackend::Auto => Backend::Auto,
+        ViewBackend::Wgpu => Backend::Wgpu,
+        ViewBackend::Cpu => Backend::Cpu,
+    };
+    if let Err(msg) = Kernel::check(args.kernel, backend) {
+        eprintln!("error: {msg}");
+        return ExitCode::from(2);
+    }
     let run = Run {
         file: args.file,
-        backend: match args.backend {
-            ViewBackend::Auto => Backend::Auto,
-            ViewBackend::Wgpu => Backend::Wgpu,
-            ViewBackend::Cpu => Backend::Cpu,
-        },
+        backend,
         options: Options {
             size: args.size,
             sets: args.set,
             limits,
             timings: args.timings,
+            kernel: args.kernel.unwrap_or_default(),
             // Headless, nothing would ever settle while the clock runs.
             time: args.time.or(args.headless.then_some(0.0)),
         },

@@ -268,21 +268,39 @@ impl Gpu {
         data: bool,
     ) -> Result<(Pipeline, DriverCache), Error> {
         let key = (wgsl.to_string(), entry.to_string(), data);
-        let mut cache = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(p) = cache.get(&key) {
+        if let Some(p) = self.lock_pipelines().get(&key) {
             return Ok((p.clone(), DriverCache::NotAsked));
         }
+        // The cache is not held while the driver compiles: the viewer compiles a kernel on
+        // another thread while its window's thread renders with another one. Two threads that
+        // ask for the same kernel at once may both compile it; the last one's is kept. wgpu's
+        // error scopes belong to the thread that pushes them.
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let (pipeline, layout, driver) = self.pipeline(wgsl, module, entry, data);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Pipeline(e.to_string()));
         }
         let pipeline = Arc::new((pipeline, layout));
+        let mut cache = self.lock_pipelines();
         if cache.len() >= PIPELINES_KEPT {
             cache.clear();
         }
         cache.insert(key, pipeline.clone());
         Ok((pipeline, driver))
+    }
+
+    /// Whether the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
+    /// `data`) is among those compiled on this device: [`Gpu::pipeline_for`] then returns at
+    /// once, with no driver call.
+    pub fn has_pipeline(&self, wgsl: &str, entry: &str, data: bool) -> bool {
+        let key = (wgsl.to_string(), entry.to_string(), data);
+        self.lock_pipelines().contains_key(&key)
+    }
+
+    fn lock_pipelines(
+        &self,
+    ) -> std::sync::MutexGuard<'_, HashMap<(String, String, bool), Pipeline>> {
+        self.pipelines.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     /// The file of the driver's pipeline cache data for a kernel on this device

@@ -4,6 +4,7 @@
 //! (this module), with the screenshots that let tests and measurements see what it shows.
 
 pub mod camera;
+pub mod compile;
 pub mod session;
 pub mod watch;
 pub mod window;
@@ -98,6 +99,9 @@ pub fn headless(run: Run) -> ExitCode {
         }
         // Render until the image settles; a frame limit counts the settled image too.
         loop {
+            // Nothing to render while a kernel compiles (the interpreted kernel's image has
+            // converged, or there is none yet): wait for it.
+            session.wait_for_compile(Duration::from_secs(1));
             match session.frame() {
                 Ok(Some(_)) => session.presented(),
                 Ok(None) => {}

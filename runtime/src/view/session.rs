@@ -3,11 +3,14 @@
 //! camera the user moved, and renders frames progressively (one sample per pixel, and fewer
 //! pixels when a frame exceeds its budget, while the camera moves; jittered samples
 //! accumulated up to the scene's `aa` when it is still), and plays an animated scene's time `t`
-//! (each frame's scene checked at its time, its kernel kept while only numbers change).
+//! (each frame's scene checked at its time, its kernel kept while only numbers change). On wgpu,
+//! a scene whose specialised kernel is not compiled yet is shown through the interpreted kernel
+//! while the specialised one compiles on another thread ([`super::compile`]).
 
 use super::camera::{self, Orbit};
+use super::compile::{Compile, Waker};
 use super::watch::Fingerprint;
-use crate::backend::{Prepared, Setup};
+use crate::backend::{Kernel, Prepared, Setup};
 use crate::frontend::{self, DiagnosticFormat, Loaded};
 use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
@@ -18,7 +21,7 @@ use sdfc_compiler::lower::{self, LowerOptions};
 use sdfc_compiler::scene::{Animation, Camera, Scene};
 use sdfc_compiler::{Diagnostic, FileId, Limit, Limits, Severity, SourceMap};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant, SystemTime};
 
 /// The time a frame may take while the camera moves; a slower one lowers the resolution.
@@ -50,6 +53,10 @@ pub struct Options {
     pub timings: bool,
     /// `--time`: an animated scene starts paused at this time (seconds) instead of playing.
     pub time: Option<f64>,
+    /// `--kernel`: on wgpu, the specialised kernel, shown through the interpreted one while it
+    /// compiles (`auto`); the specialised kernel alone, each new one compiled before it is
+    /// shown (`specialised`); or the interpreted kernel alone (`interpreted`).
+    pub kernel: Kernel,
 }
 
 /// The playing of an animated scene's time `t`: the frame on show is the scene checked at the
@@ -126,6 +133,60 @@ struct Good {
     aa: u32,
     /// `trace` or `march`.
     method: &'static str,
+    /// The load it came from.
+    load: u32,
+    /// While the pipeline of `prepared` compiles on another thread: that compile, and the
+    /// interpreted kernel shown meanwhile.
+    waiting: Option<Waiting>,
+}
+
+/// The compile of a scene's specialised pipeline, and the interpreted kernel that shows the
+/// scene until it is ready (when that kernel can render the scene). It belongs to its scene
+/// ([`Good`]): a newer load replaces both, and a stale compile's result is never seen.
+#[derive(Debug)]
+struct Waiting {
+    compile: Compile,
+    interim: Option<Interim>,
+    /// Whether a frame of the interpreted kernel was rendered.
+    shown: bool,
+}
+
+/// The interpreted kernel of a scene whose specialised pipeline compiles.
+#[derive(Debug)]
+struct Interim {
+    prepared: Prepared,
+    /// Its own pipeline's compile, while it runs (once per specialisation of the kernel).
+    compile: Option<Compile>,
+    /// How its pipeline was had, once it was.
+    pipeline: Option<PipelineTime>,
+}
+
+impl Good {
+    /// The kernel frames are rendered with now: the specialised one, or while it compiles
+    /// the interpreted one once its pipeline is ready; `None` while neither is.
+    fn kernel(&self) -> Option<&Prepared> {
+        match &self.waiting {
+            None => Some(&self.prepared),
+            Some(w) => w
+                .interim
+                .as_ref()
+                .filter(|i| i.compile.is_none())
+                .map(|i| &i.prepared),
+        }
+    }
+}
+
+impl Waiting {
+    /// Whether a compile has ended whose result is still to be taken (the specialised one's
+    /// unless `held`).
+    fn finished(&self, held: bool) -> bool {
+        (!held && self.compile.finished())
+            || self
+                .interim
+                .as_ref()
+                .and_then(|i| i.compile.as_ref())
+                .is_some_and(Compile::finished)
+    }
 }
 
 /// The result of one load of the scene file.
@@ -154,6 +215,13 @@ struct Timings {
     built: bool,
     /// The kernel's pipeline: compiled, or found among those compiled.
     pipeline: Option<PipelineTime>,
+    /// Whether the pipeline compiled on another thread (`pipeline` is then its time, once
+    /// ready before the first frame).
+    background: bool,
+    /// The kernel of the first frame: `interpreted` while the specialised one compiled.
+    first_kernel: Option<&'static str>,
+    /// The interpreted kernel's pipeline, when it rendered the first frame.
+    interim_pipeline: Option<PipelineTime>,
     /// When the newest of the scene's files was modified.
     modified: Option<SystemTime>,
     /// When the load began.
@@ -179,6 +247,8 @@ pub struct FrameInfo {
     pub steps: f64,
     /// Whether the camera was moving.
     pub moving: bool,
+    /// The GPU kernel that rendered it, `specialised` or `interpreted` (`None` on the CPU).
+    pub kernel: Option<&'static str>,
 }
 
 /// Samples accumulated at one size.
@@ -232,6 +302,13 @@ pub struct Session {
     timings: Option<Timings>,
     /// The animated scene's time, played or paused; `None` for a still.
     playback: Option<Playback>,
+    /// Told by each compile on another thread when it ends ([`Session::wait_for_compile`]).
+    compiled: (mpsc::Sender<()>, mpsc::Receiver<()>),
+    /// Also called when such a compile ends (the window's event loop).
+    waker: Option<Waker>,
+    /// Tests hold back the specialised kernel of this load, to see what is shown meanwhile.
+    #[cfg(test)]
+    held: Option<u32>,
 }
 
 impl Session {
@@ -260,7 +337,55 @@ impl Session {
             broken: None,
             timings: None,
             playback: None,
+            compiled: mpsc::channel(),
+            waker: None,
+            #[cfg(test)]
+            held: None,
         }
+    }
+
+    /// Whether the specialised kernel of load `load` is held back (by a test).
+    #[cfg(test)]
+    fn held(&self, load: u32) -> bool {
+        self.held == Some(load)
+    }
+
+    #[cfg(not(test))]
+    fn held(&self, _: u32) -> bool {
+        false
+    }
+
+    /// Calls `waker` (on another thread) whenever a pipeline compiling on another thread is
+    /// ready or has failed, as well as making [`Session::wants_frame`] true.
+    pub fn set_waker(&mut self, waker: Waker) {
+        self.waker = Some(waker);
+    }
+
+    /// What a compile on another thread calls when it ends.
+    fn compile_waker(&self) -> Waker {
+        let tx = self.compiled.0.clone();
+        let also = self.waker.clone();
+        Waker::new(move || {
+            let _ = tx.send(());
+            if let Some(w) = &also {
+                w.wake();
+            }
+        })
+    }
+
+    /// Waits, at most `timeout`, for a pipeline compiling on another thread, when there is
+    /// no frame to render until it ends; returns at once otherwise.
+    pub fn wait_for_compile(&self, timeout: Duration) {
+        let waiting = self.good.as_ref().is_some_and(|g| g.waiting.is_some());
+        if waiting && !self.wants_frame() {
+            let _ = self.compiled.1.recv_timeout(timeout);
+        }
+    }
+
+    /// Whether the scene on show waits for its specialised kernel's pipeline, compiling on
+    /// another thread (its frames are the interpreted kernel's, or none yet).
+    pub fn compiling(&self) -> bool {
+        self.good.as_ref().is_some_and(|g| g.waiting.is_some())
     }
 
     /// The size a view of `file` starts at: `size`, or the scene's (640×480 when the file does
@@ -423,12 +548,23 @@ impl Session {
         let start = Instant::now();
         // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
         // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.
+        // The kernel kept is the specialised one unless `--kernel interpreted`; with `auto`
+        // the interpreted kernel shows the scene while the specialised one compiles.
+        let kernel = match self.options.kernel {
+            Kernel::Interpreted => wgsl::KernelChoice::Interpreted,
+            Kernel::Auto | Kernel::Specialised => wgsl::KernelChoice::Specialised,
+        };
         let setup = Setup {
             parameters: true,
+            kernel,
             ..Setup::default()
         };
+        let interim_lowered = match (&self.device, self.options.kernel) {
+            (Device::Wgpu(_), Kernel::Auto) => Some(lowered.clone()),
+            _ => None,
+        };
         let prepared = match (&self.good, &self.device) {
-            (Some(good), _) => good.prepared.next(&scene, lowered),
+            (Some(good), _) => good.prepared.next_with(&scene, lowered, kernel),
             (None, Device::Cpu) => Prepared::on_cpu(&scene, lowered, &setup).map(|p| (p, true)),
             (None, Device::Wgpu(gpu)) => {
                 Prepared::on_gpu(gpu.clone(), &scene, &lowered, &setup).map(|p| (p, true))
@@ -442,17 +578,38 @@ impl Session {
             eprintln!("error: {msg}");
             return Err(msg);
         }
+        let mut waiting = None;
         let pipeline = match &prepared {
-            Prepared::Wgpu { gpu, kernel, .. } => Some(
-                gpu.pipeline_for(
-                    &kernel.source,
-                    Some(&kernel.module),
-                    wgsl::ENTRY_POINT,
-                    kernel.data.is_some(),
-                )
-                .map_err(|e| e.to_string())
-                .inspect_err(|msg| eprintln!("error: {msg}"))?,
-            ),
+            Prepared::Wgpu { gpu, kernel, .. } => {
+                let data = kernel.data.is_some();
+                let compiled = gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data);
+                let interim = match interim_lowered {
+                    Some(lowered) if !compiled => self.interim(gpu, &scene, lowered, &at),
+                    _ => None,
+                };
+                match interim {
+                    Some(interim) => {
+                        waiting = Compile::start(&prepared, self.compile_waker()).map(|compile| {
+                            Waiting {
+                                compile,
+                                interim: Some(interim),
+                                shown: false,
+                            }
+                        });
+                        None
+                    }
+                    None => Some(
+                        gpu.pipeline_for(
+                            &kernel.source,
+                            Some(&kernel.module),
+                            wgsl::ENTRY_POINT,
+                            data,
+                        )
+                        .map_err(|e| e.to_string())
+                        .inspect_err(|msg| eprintln!("error: {msg}"))?,
+                    ),
+                }
+            }
             _ => None,
         };
         let method = match prepared.traceable().traced(scene.settings.method) {
@@ -460,12 +617,15 @@ impl Session {
             None => "march",
         };
         let aa = scene.settings.aa.max(1);
+        let background = waiting.is_some();
         let good = Good {
             file_camera: scene.camera.clone(),
             scene,
             prepared,
             aa: aa * aa,
             method,
+            load: self.loads - 1,
+            waiting,
         };
         let timings = Timings {
             number: 0,
@@ -474,12 +634,135 @@ impl Session {
             prepare: prepare_time,
             built,
             pipeline,
+            background,
+            first_kernel: None,
+            interim_pipeline: None,
             modified: None,
             began: SystemTime::now(),
             first_frame: None,
             printed: false,
         };
         Ok((good, timings))
+    }
+
+    /// The interpreted kernel of `scene`, lowered as `lowered`, to show it while its specialised
+    /// kernel compiles: `None` where it cannot render the scene (an analytically traced one, a
+    /// program above the `registers` limit) or its frames would be above the `memory` limit
+    /// at `at`. Its pipeline is compiled once per specialisation; until then it compiles on
+    /// another thread too.
+    fn interim(
+        &self,
+        gpu: &Arc<Gpu>,
+        scene: &Scene,
+        lowered: lower::Lowered,
+        at: &sdfc_compiler::scene::Settings,
+    ) -> Option<Interim> {
+        let setup = Setup {
+            parameters: true,
+            kernel: wgsl::KernelChoice::Interpreted,
+            ..Setup::default()
+        };
+        let held = self
+            .good
+            .as_ref()
+            .and_then(|g| g.waiting.as_ref())
+            .and_then(|w| w.interim.as_ref());
+        let prepared = match held {
+            Some(i) => i.prepared.next_with(scene, lowered, setup.kernel).ok()?.0,
+            None => Prepared::on_gpu(gpu.clone(), scene, &lowered, &setup).ok()?,
+        };
+        prepared
+            .memory(scene, at)
+            .check(&self.options.limits)
+            .ok()?;
+        let Prepared::Wgpu { kernel, .. } = &prepared else {
+            return None;
+        };
+        let data = kernel.data.is_some();
+        let (compile, pipeline) = if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
+            let time = gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data);
+            (None, Some(time.ok()?))
+        } else {
+            (Some(Compile::start(&prepared, self.compile_waker())?), None)
+        };
+        Some(Interim {
+            prepared,
+            compile,
+            pipeline,
+        })
+    }
+
+    /// Takes the results of the compiles on other threads that have ended: a ready interpreted
+    /// pipeline shows the scene from the next frame; a ready specialised one replaces the
+    /// interpreted kernel from the next frame (the camera and the animation's time stay).
+    fn poll(&mut self) {
+        let timings = self.options.timings;
+        let held = self.good.as_ref().is_some_and(|g| self.held(g.load));
+        let Some(good) = self.good.as_mut() else {
+            return;
+        };
+        let Some(w) = good.waiting.as_mut() else {
+            return;
+        };
+        if let Some(i) = w.interim.as_mut() {
+            match i.compile.as_ref().and_then(Compile::take) {
+                Some(Ok(time)) => {
+                    i.compile = None;
+                    i.pipeline = Some(time);
+                }
+                Some(Err(msg)) => {
+                    eprintln!("error: the interpreted kernel: {msg}");
+                    w.interim = None;
+                }
+                None => {}
+            }
+        }
+        if held {
+            return;
+        }
+        let Some(result) = w.compile.take() else {
+            return;
+        };
+        let load = good.load;
+        let Some(w) = good.waiting.take() else {
+            return;
+        };
+        match result {
+            Ok(time) => {
+                if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
+                    // Ready before the interpreted kernel showed anything: the load's line
+                    // says so.
+                    t.pipeline = Some(time);
+                } else if timings {
+                    eprintln!(
+                        "view: load {load}: specialised kernel's pipeline {} {:.1} ms on another thread, shown {:.1} ms after the load (the interpreted kernel's frames until then)",
+                        if time.cached { "found" } else { "compiled" },
+                        ms(time.time),
+                        ms(w.compile.started.elapsed())
+                    );
+                }
+                if w.shown {
+                    // The image starts again from the specialised kernel's samples; the one on
+                    // show stays until its first frame replaces it.
+                    self.accumulation = Accumulation::default();
+                }
+            }
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                match w.interim {
+                    Some(i) => {
+                        eprintln!("view: load {load}: the interpreted kernel stays on show");
+                        good.prepared = i.prepared;
+                        good.waiting = i.compile.map(|compile| Waiting {
+                            compile,
+                            interim: None,
+                            shown: false,
+                        });
+                    }
+                    None => self.broken = Some(msg),
+                }
+            }
+        }
     }
 
     fn install(&mut self, good: Good) {
@@ -583,6 +866,9 @@ impl Session {
         )?;
         let lowered = lower::lower_within(&scene, &lower_options(&scene), &limits)
             .map_err(|d| first_error(std::slice::from_ref(&d), &loaded.sources))?;
+        if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
+            i.prepared = i.prepared.next(&scene, lowered.clone())?.0;
+        }
         let (prepared, _) = good.prepared.next(&scene, lowered)?;
         good.file_camera = scene.camera.clone();
         good.scene = scene;
@@ -675,11 +961,20 @@ impl Session {
 
     /// Whether there is a frame to render: a scene is loaded and the camera moves or the image
     /// has fewer samples than the scene's `aa` asks for.
+    /// While the scene's kernel compiles on another thread, only its end calls for a frame
+    /// (before, the interpreted kernel's image converges, or there is nothing to render).
     pub fn wants_frame(&self) -> bool {
         let Some(good) = &self.good else {
             return false;
         };
-        if self.broken.is_some() {
+        if good
+            .waiting
+            .as_ref()
+            .is_some_and(|w| w.finished(self.held(good.load)))
+        {
+            return true;
+        }
+        if self.broken.is_some() || good.kernel().is_none() {
             return false;
         }
         let a = &self.accumulation;
@@ -691,14 +986,15 @@ impl Session {
     }
 
     /// Whether the image on show is final until something changes (converged, or nothing to
-    /// render).
+    /// render, and no kernel compiling to replace the one that rendered it).
     pub fn settled(&self) -> bool {
-        !self.wants_frame()
+        !self.wants_frame() && !self.compiling()
     }
 
     /// Renders the next frame into the image on show. `Ok(None)` when there is nothing to
     /// render; `Err` is a render error (rendering stops until the next load or camera move).
     pub fn frame(&mut self) -> Result<Option<FrameInfo>, String> {
+        self.poll();
         if !self.wants_frame() {
             return Ok(None);
         }
@@ -729,7 +1025,7 @@ impl Session {
                 still: !low,
             };
         }
-        let Some(good) = self.good.as_mut() else {
+        let Some(good) = self.good.as_mut().filter(|g| g.kernel().is_some()) else {
             return Ok(None);
         };
         let n = (good.aa as f64).sqrt().round() as u32;
@@ -742,7 +1038,11 @@ impl Session {
         let s = &mut good.scene.settings;
         (s.width, s.height, s.aa) = (w, h, 1);
         let start = Instant::now();
-        let frame = match good.prepared.render(&good.scene, &|_| {}) {
+        let Some(kernel) = good.kernel() else {
+            return Ok(None);
+        };
+        let kind = kernel.kernel_kind();
+        let frame = match kernel.render(&good.scene, &|_| {}) {
             Ok(f) => f,
             Err(msg) => {
                 self.broken = Some(msg.clone());
@@ -784,9 +1084,19 @@ impl Session {
             time,
             steps: frame.render.stats.steps_mean,
             moving,
+            kernel: kind,
+        };
+        let interim = match good.waiting.as_mut() {
+            Some(w) => {
+                w.shown = true;
+                w.interim.as_ref().and_then(|i| i.pipeline)
+            }
+            None => None,
         };
         if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
             t.first_frame = Some((time, w, h));
+            t.first_kernel = kind;
+            t.interim_pipeline = interim;
         }
         self.last = Some(info);
         Ok(Some(info))
@@ -827,10 +1137,18 @@ impl Session {
             return;
         }
         if self.options.timings {
-            let pipeline = match t.pipeline {
-                Some(p) if p.cached => format!(", pipeline cached ({:.1} ms)", ms(p.time)),
-                Some(p) => format!(", pipeline compiled {:.1} ms", ms(p.time)),
-                None => String::new(),
+            let got = |p: PipelineTime| match p.cached {
+                true => format!("cached ({:.1} ms)", ms(p.time)),
+                false => format!("compiled {:.1} ms", ms(p.time)),
+            };
+            let pipeline = match (t.pipeline, t.background) {
+                (Some(p), false) => format!(", pipeline {}", got(p)),
+                (Some(p), true) => format!(", pipeline {} on another thread", got(p)),
+                (None, true) => format!(
+                    ", pipeline compiling on another thread, interpreted while compiling (its pipeline {})",
+                    t.interim_pipeline.map_or("?".into(), got)
+                ),
+                (None, false) => String::new(),
             };
             let now = SystemTime::now();
             let edit = match (
@@ -883,9 +1201,20 @@ impl Session {
         if let Some(msg) = &self.broken {
             title.push_str(&format!(" | render error: {msg}"));
         }
+        match self.good.as_ref().and_then(|g| g.waiting.as_ref()) {
+            Some(w) if w.interim.as_ref().is_some_and(|i| i.compile.is_none()) => {
+                title.push_str(" | interpreted while compiling")
+            }
+            Some(_) => title.push_str(" | compiling the kernel"),
+            None => {}
+        }
         if let (true, Some(good), Some(f)) = (stats, &self.good, &self.last) {
+            let kernel = f
+                .kernel
+                .map(|k| format!(" {k} kernel,"))
+                .unwrap_or_default();
             title.push_str(&format!(
-                " | {} ({}), {}, {}x{}, {}/{} samples, {:.1} ms, {:.1} steps/px",
+                " | {} ({}),{kernel} {}, {}x{}, {}/{} samples, {:.1} ms, {:.1} steps/px",
                 self.device.name(),
                 self.device.describe(),
                 good.method,
@@ -967,6 +1296,201 @@ mod tests {
             frames += 1;
         }
         frames
+    }
+
+    /// The longest a test waits for lavapipe to compile a kernel on a busy 2-core machine.
+    const PATIENCE: Duration = Duration::from_secs(300);
+
+    /// A wgpu device (lavapipe on a machine without a GPU), or `None` after saying the test
+    /// skipped (a failure under `SDFC_REQUIRE_DEVICES=1`).
+    fn wgpu() -> Option<Arc<Gpu>> {
+        match Gpu::open(false) {
+            Ok(gpu) => Some(Arc::new(gpu)),
+            Err(e) => {
+                assert!(
+                    std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+                    "SDFC_REQUIRE_DEVICES=1 but no wgpu adapter: {e}"
+                );
+                eprintln!("session test SKIPPED: no wgpu adapter ({e})");
+                None
+            }
+        }
+    }
+
+    /// Renders until the image is final, waiting for the kernels compiling on other threads.
+    fn settle_all(s: &mut Session) {
+        let start = Instant::now();
+        while !s.settled() {
+            assert!(start.elapsed() < PATIENCE, "the session never settled");
+            s.wait_for_compile(Duration::from_secs(1));
+            s.frame().expect("a frame");
+        }
+    }
+
+    /// The next frame rendered (waiting for a kernel when there is none to render with).
+    fn next_frame(s: &mut Session) -> FrameInfo {
+        let start = Instant::now();
+        loop {
+            assert!(start.elapsed() < PATIENCE, "no frame was rendered");
+            s.wait_for_compile(Duration::from_secs(1));
+            if let Some(info) = s.frame().expect("a frame") {
+                return info;
+            }
+        }
+    }
+
+    /// The text of the kernel the session keeps for its scene (the specialised one).
+    fn kernel_text(s: &Session) -> String {
+        match &s.good.as_ref().expect("a scene").prepared {
+            Prepared::Wgpu { kernel, .. } => kernel.source.clone(),
+            other => panic!("not a wgpu scene: {}", other.name()),
+        }
+    }
+
+    /// A marched scene (the interpreted kernel renders marched scenes alone), and two
+    /// structural edits of it (new kernels).
+    fn marched() -> [String; 3] {
+        let base = SCENE.replace("aa: 2 }", "aa: 2, method: \"march\" }");
+        let edit = |shape: &str| {
+            base.replace(
+                "sphere(0.5).translate(0, 0.5, 0);",
+                &format!("sphere(0.5).translate(0, 0.5, 0); {shape};"),
+            )
+        };
+        [
+            base.clone(),
+            edit("box((0.3, 0.3, 0.3)).translate(-1.2, 0.3, 0)"),
+            edit("torus(0.4, 0.1).translate(1.2, 0.1, 0)"),
+        ]
+    }
+
+    #[test]
+    fn a_new_kernel_is_shown_interpreted_until_the_specialised_one_is_ready() {
+        let Some(gpu) = wgpu() else { return };
+        let dir = std::env::temp_dir().join(format!("sdfc-interim-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("k.sdf");
+        let [first, boxed, _] = marched();
+        std::fs::write(&file, &first).unwrap();
+        let mut s = Session::new(file.clone(), Options::default(), Device::Wgpu(gpu));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+        assert_eq!(s.last.unwrap().kernel, Some("specialised"));
+        s.rotate(20.0, 5.0);
+        let camera = s.camera();
+        settle_all(&mut s);
+        let before = s.image().unwrap().clone();
+
+        // A structural edit needs a new specialised kernel, which compiles on another thread
+        // (held back here until the interpreted kernel's image has converged).
+        std::fs::write(&file, &boxed).unwrap();
+        s.held = Some(1);
+        assert!(s.load().ok);
+        assert!(s.compiling() && !s.settled());
+        let info = next_frame(&mut s);
+        assert_eq!(
+            info.kernel,
+            Some("interpreted"),
+            "the interpreted kernel first"
+        );
+        assert!(s.title(false).contains("interpreted while compiling"));
+        while s.wants_frame() {
+            s.frame().expect("a frame");
+        }
+        assert!(!s.settled(), "the specialised kernel is still to come");
+        let interpreted = s.image().unwrap().clone();
+        assert_eq!(
+            s.last.unwrap().samples,
+            4,
+            "the interpreted image converged"
+        );
+        let start = Instant::now();
+        while !s
+            .good
+            .as_ref()
+            .unwrap()
+            .waiting
+            .as_ref()
+            .unwrap()
+            .compile
+            .finished()
+        {
+            assert!(start.elapsed() < PATIENCE, "the compile never ended");
+            s.wait_for_compile(Duration::from_secs(1));
+        }
+        s.held = None;
+        settle_all(&mut s);
+        assert_eq!(
+            s.last.unwrap().kernel,
+            Some("specialised"),
+            "then the specialised"
+        );
+        assert!(!s.title(false).contains("compiling"));
+        assert_eq!(s.camera(), camera, "the camera stayed");
+        let specialised = s.image().unwrap().clone();
+        let same = crate::metrics::compare(&interpreted, &specialised, 0.1).unwrap();
+        assert!(same.psnr >= 40.0, "the two kernels agree: {same:?}");
+        let changed = crate::metrics::compare(&before, &specialised, 0.1).unwrap();
+        assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_stale_compile_does_not_replace_a_newer_edit() {
+        let Some(gpu) = wgpu() else { return };
+        let dir = std::env::temp_dir().join(format!("sdfc-stale-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("k.sdf");
+        let [first, boxed, torus] = marched();
+        std::fs::write(&file, &first).unwrap();
+        let mut s = Session::new(file.clone(), Options::default(), Device::Wgpu(gpu.clone()));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+        // Load 1's kernel compiles while load 2 replaces its scene; load 2's is held back
+        // until load 1's compile has ended.
+        std::fs::write(&file, &boxed).unwrap();
+        assert!(s.load().ok);
+        let stale = kernel_text(&s);
+        std::fs::write(&file, &torus).unwrap();
+        s.held = Some(2);
+        assert!(s.load().ok);
+        let newer = kernel_text(&s);
+        assert_ne!(stale, newer);
+        let start = Instant::now();
+        while !gpu.has_pipeline(&stale, wgsl::ENTRY_POINT, true) {
+            assert!(start.elapsed() < PATIENCE, "load 1's compile never ended");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let info = next_frame(&mut s);
+        assert_eq!(
+            info.kernel,
+            Some("interpreted"),
+            "load 2's scene, interpreted"
+        );
+        assert_eq!(s.good.as_ref().unwrap().load, 2);
+        s.held = None;
+        settle_all(&mut s);
+        assert_eq!(s.last.unwrap().kernel, Some("specialised"));
+        assert_eq!(kernel_text(&s), newer);
+        // What is shown is load 2's scene: the image of a session that compiled it at once.
+        let shown = s.image().unwrap().clone();
+        let options = Options {
+            kernel: Kernel::Specialised,
+            ..Options::default()
+        };
+        let mut reference = Session::new(file.clone(), options, Device::Wgpu(gpu));
+        reference.set_size(32, 24);
+        assert!(reference.load().ok);
+        assert!(
+            !reference.compiling(),
+            "`--kernel specialised` compiles at once"
+        );
+        settle_all(&mut reference);
+        assert_eq!(reference.last.unwrap().kernel, Some("specialised"));
+        assert_eq!(reference.image(), Some(&shown));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //! title line, and the screenshots of `--screenshot` and `--screenshot-dir`, read back from
 //! what is presented.
 
+use super::compile::Waker;
 use super::session::{Device, Session};
 use super::watch::Watch;
 use super::{write_rgba_png, Run};
@@ -28,6 +29,8 @@ use winit::window::{Window, WindowId};
 enum UserEvent {
     /// The watcher saw these paths change.
     Files(Vec<PathBuf>),
+    /// A kernel's pipeline compiling on another thread is ready (or failed).
+    Compiled,
 }
 
 /// Runs the viewer in a window until it is closed (or `control` says to stop).
@@ -133,6 +136,11 @@ impl App {
         let size = window.inner_size();
         let mut session = Session::new(self.run.file.clone(), self.run.options.clone(), device);
         session.set_size(size.width.max(1), size.height.max(1));
+        let proxy = std::sync::Mutex::new(self.proxy.clone());
+        session.set_waker(Waker::new(move || {
+            let proxy = proxy.lock().unwrap_or_else(|e| e.into_inner());
+            let _ = proxy.send_event(UserEvent::Compiled);
+        }));
         let outcome = session.load();
         let proxy = self.proxy.clone();
         let watch = match Watch::new(move |paths| {
@@ -250,7 +258,13 @@ impl ApplicationHandler<UserEvent> for App {
         let Some(st) = self.state.as_mut() else {
             return;
         };
-        let UserEvent::Files(paths) = event;
+        let paths = match event {
+            UserEvent::Files(paths) => paths,
+            UserEvent::Compiled => {
+                st.window.request_redraw();
+                return;
+            }
+        };
         if st.session.needs_reload(&paths) {
             let outcome = st.session.load();
             if let Some(w) = st._watch.as_mut() {

@@ -145,6 +145,8 @@ struct Good {
 /// ([`Good`]): a newer load replaces both, and a stale compile's result is never seen.
 #[derive(Debug)]
 struct Waiting {
+    /// The load whose kernel compiles.
+    load: u32,
     compile: Compile,
     interim: Option<Interim>,
     /// Whether a frame of the interpreted kernel was rendered.
@@ -306,7 +308,8 @@ pub struct Session {
     compiled: (mpsc::Sender<()>, mpsc::Receiver<()>),
     /// Also called when such a compile ends (the window's event loop).
     waker: Option<Waker>,
-    /// Tests hold back the specialised kernel of this load, to see what is shown meanwhile.
+    /// Tests hold back the compile of this load's specialised kernel, to see what is shown
+    /// meanwhile.
     #[cfg(test)]
     held: Option<u32>,
 }
@@ -344,7 +347,7 @@ impl Session {
         }
     }
 
-    /// Whether the specialised kernel of load `load` is held back (by a test).
+    /// Whether the compile of load `load`'s specialised kernel is held back (by a test).
     #[cfg(test)]
     fn held(&self, load: u32) -> bool {
         self.held == Some(load)
@@ -591,6 +594,7 @@ impl Session {
                     Some(interim) => {
                         waiting = Compile::start(&prepared, self.compile_waker()).map(|compile| {
                             Waiting {
+                                load: self.loads - 1,
                                 compile,
                                 interim: Some(interim),
                                 shown: false,
@@ -697,7 +701,11 @@ impl Session {
     /// interpreted kernel from the next frame (the camera and the animation's time stay).
     fn poll(&mut self) {
         let timings = self.options.timings;
-        let held = self.good.as_ref().is_some_and(|g| self.held(g.load));
+        let held = self
+            .good
+            .as_ref()
+            .and_then(|g| g.waiting.as_ref())
+            .is_some_and(|w| self.held(w.load));
         let Some(good) = self.good.as_mut() else {
             return;
         };
@@ -754,6 +762,7 @@ impl Session {
                         eprintln!("view: load {load}: the interpreted kernel stays on show");
                         good.prepared = i.prepared;
                         good.waiting = i.compile.map(|compile| Waiting {
+                            load,
                             compile,
                             interim: None,
                             shown: false,
@@ -970,7 +979,7 @@ impl Session {
         if good
             .waiting
             .as_ref()
-            .is_some_and(|w| w.finished(self.held(good.load)))
+            .is_some_and(|w| w.finished(self.held(w.load)))
         {
             return true;
         }

@@ -436,3 +436,113 @@ fn the_view_of_an_animated_scene_at_a_time_is_that_frame_of_the_sequence() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Runs the viewer through wgpu on `scene.sdf` in `dir` for 8 frames with `args` and returns
+/// the screenshot of the last one (the converged image of a kernel compiled before it is shown).
+fn window_shot(display: &Display, dir: &Path, name: &str, args: &[&str]) -> Image {
+    let shot = dir.join(format!("{name}.png"));
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(dir)
+        .args(["view", "scene.sdf", "--backend", "wgpu", "--frames", "8"])
+        .arg("--screenshot")
+        .arg(&shot)
+        .args(args)
+        .env("DISPLAY", &display.name)
+        .env("XDG_RUNTIME_DIR", dir.join("xdg"))
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?}: {stderr}");
+    read_png(&shot).unwrap_or_else(|e| panic!("{}: {e}\n{stderr}", shot.display()))
+}
+
+#[test]
+fn the_window_shows_new_kernels_interpreted_while_they_compile() {
+    // `--kernel auto` (the default): on a GPU, a marched scene whose specialised kernel is not
+    // compiled yet is shown through the interpreted kernel while the specialised one compiles
+    // on another thread (which one the first frame shows depends on which pipeline is ready
+    // first; `view::session`'s tests hold the compile back to see both, on lavapipe too).
+    // The image each load settles on is the specialised kernel's, as `--kernel specialised`
+    // shows it, and the interpreted kernel's image agrees with it.
+    let Some(display) = display() else { return };
+    let dir = temp_dir("interim");
+    let scene = dir.join("scene.sdf");
+    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::create_dir_all(dir.join("xdg")).unwrap();
+    let shots = dir.join("shots");
+    let log = dir.join("viewer.log");
+    let march = ["--set", "method=march"];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&dir)
+        .args(["view", "scene.sdf", "--backend", "wgpu", "--timings"])
+        .args(march)
+        .arg("--screenshot-dir")
+        .arg(&shots)
+        .args(["--exit-after-reloads", "1"])
+        .env("DISPLAY", &display.name)
+        .env("XDG_RUNTIME_DIR", dir.join("xdg"))
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .expect("sdfc view starts");
+    let first = wait_for(&shots.join("reload-0.png"), &mut child, &log);
+    // A structural edit: a new kernel.
+    let with_box = SCENE.replace(
+        "@ ball;\n",
+        "@ ball;\n  box((0.5, 0.5, 0.5)).translate(2.2, 0.5, 0) @ grey;\n",
+    );
+    std::fs::write(&scene, &with_box).unwrap();
+    let boxed = wait_for(&shots.join("reload-1.png"), &mut child, &log);
+    let deadline = Instant::now() + PATIENCE;
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        assert!(Instant::now() < deadline, "the viewer did not exit");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let stderr = std::fs::read_to_string(&log).unwrap();
+    assert!(status.success(), "the viewer failed: {status}\n{stderr}");
+    // On a CPU adapter (lavapipe) the interpreted kernel's frames would take longer than the
+    // compile they hide: `auto` compiles before showing there.
+    let cpu_adapter = stderr
+        .lines()
+        .any(|l| l.starts_with("view: rendering on wgpu") && l.contains("Cpu)"));
+    for k in 0..2 {
+        let line = stderr
+            .lines()
+            .find(|l| l.contains(&format!("load {k} timings")))
+            .unwrap_or_default();
+        assert!(
+            line.contains("pipeline compiled")
+                && line.contains("on another thread") != cpu_adapter,
+            "load {k}'s kernel compiled on another thread on a GPU, before it was shown on a CPU adapter:\n{stderr}"
+        );
+    }
+    let (lx, ly) = LEFT;
+    assert!(
+        changed(&first, &boxed, lx, ly) > 0.05,
+        "the box did not appear on the left"
+    );
+
+    // The settled image is the specialised kernel's; the interpreted kernel's agrees.
+    let shot = |kernel: &str| {
+        window_shot(
+            &display,
+            &dir,
+            kernel,
+            &["--kernel", kernel, march[0], march[1]],
+        )
+    };
+    let (specialised, interpreted) = (shot("specialised"), shot("interpreted"));
+    assert_eq!(
+        boxed, specialised,
+        "the window settles on the specialised kernel"
+    );
+    let d = sdfc_runtime::metrics::compare(&specialised, &interpreted, 0.1).unwrap();
+    assert!(d.psnr >= 40.0, "the kernels' images agree: {d:?}");
+    eprintln!("{stderr}\ninterpreted against specialised: {d:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

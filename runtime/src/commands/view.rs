@@ -110,6 +110,7 @@ pub fn run(args: ViewArgs) -> ExitCode {
             limits,
             timings: args.timings,
             kernel: args.kernel.unwrap_or_default(),
+            interim_on_cpu: false,
             // Headless, nothing would ever settle while the clock runs.
             time: args.time.or(args.headless.then_some(0.0)),
         },

@@ -750,12 +750,14 @@ impl Session {
                     t.pipeline = Some(time);
                 } else if timings {
                     eprintln!(
-                        "view: load {load}: specialised kernel's pipeline {} {:.1} ms on another thread, shown {:.1} ms after the load (the interpreted kernel's frames until then)",
+                        "view: load {load}: specialised kernel ready {:.1} ms after the load (pipeline {} {:.1} ms on another thread); interpreted while compiling until then",
+                        ms(w.compile.started.elapsed()),
                         if time.cached { "found" } else { "compiled" },
                         ms(time.time),
-                        ms(w.compile.started.elapsed())
                     );
                 }
+                // A render error of the interpreted kernel does not stop the specialised one.
+                self.broken = None;
                 if w.shown {
                     // The image starts again from the specialised kernel's samples; the one on
                     // show stays until its first frame replaces it.

@@ -1163,8 +1163,12 @@ impl Session {
                 (Some(p), false) => format!(", pipeline {}", got(p)),
                 (Some(p), true) => format!(", pipeline {} on another thread", got(p)),
                 (None, true) => format!(
-                    ", pipeline compiling on another thread, interpreted while compiling (its pipeline {})",
-                    t.interim_pipeline.map_or("?".into(), got)
+                    ", pipeline compiling on another thread, interpreted while compiling (whose pipeline {})",
+                    match t.interim_pipeline {
+                        Some(p) if p.cached => "was cached".to_string(),
+                        Some(p) => format!("compiled {:.1} ms", ms(p.time)),
+                        None => "was ready".to_string(),
+                    }
                 ),
                 (None, false) => String::new(),
             };

@@ -10,11 +10,15 @@
 # over the old one. The viewer prints, per load, check, lower, kernel, pipeline and
 # first-frame times and the time from the file's modification to the first frame (edit to
 # pixel). Then, for the report's scenes and temple.sdf, the frame rate while orbiting at
-# $SIZE and the time to converge after the camera stops (--orbit-frames). Expects .dev/sdfc
-# and .gl/ as scripts/device-run.sh does. Writes $OUT/view.txt.
+# $SIZE and the time to converge after the camera stops (--orbit-frames). $KERNEL (default
+# auto) is the viewer's --kernel: with auto, a structural edit is shown through the interpreted
+# kernel while the specialised one compiles, and a second line says when that was ready;
+# KERNEL=specialised measures the viewer that compiles before showing, to compare. Expects
+# .dev/sdfc and .gl/ as scripts/device-run.sh does. Writes $OUT/view.txt.
 set -u
 . "$(dirname "$0")/device-env.sh"
 SIZE=${SIZE:-1920x1080}
+KERNEL=${KERNEL:-auto}
 SCENES=${SCENES:-"examples/*.sdf examples/scaling/*_1000.sdf"}
 LOG="$OUT/view.txt"
 : > "$LOG"
@@ -35,7 +39,7 @@ for f in $SCENES; do
   d=$(mktemp -d)
   cp -r "$(dirname "$f")/." "$d/"
   s="$d/$(basename "$f")"
-  "$B" view "$s" --headless --backend wgpu --size "$SIZE" --timings \
+  "$B" view "$s" --headless --backend wgpu --kernel "$KERNEL" --size "$SIZE" --timings \
     --screenshot-dir "$d/shots" --exit-after-reloads 3 > "$d/log" 2>&1 &
   pid=$!
   ok=1
@@ -69,8 +73,8 @@ PY
   # A viewer whose edit did not arrive would wait for it: stop it.
   [ $ok = 1 ] || kill "$pid" 2>/dev/null
   wait $pid
-  echo "== $n (numeric, structural, radius edits)" | tee -a "$LOG"
-  grep -E "timings|full-resolution|error" "$d/log" | tee -a "$LOG"
+  echo "== $n (numeric, structural, radius edits; --kernel $KERNEL)" | tee -a "$LOG"
+  grep -E "timings|full-resolution|kernel ready|error" "$d/log" | tee -a "$LOG"
   [ $ok = 1 ] || { echo "$n: FAILED"; tail -n 5 "$d/log"; } | tee -a "$LOG"
   rm -rf "$d"
 done

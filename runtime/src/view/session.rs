@@ -1526,6 +1526,76 @@ mod tests {
     }
 
     #[test]
+    fn the_specialised_kernel_takes_over_at_the_animation_time_on_show() {
+        // Paused at t = 0.5 s, the interpreted kernel shows the scene at that time, and so does
+        // the specialised kernel that replaces it: the image of a session that compiled it at
+        // once.
+        let Some(gpu) = wgpu() else { return };
+        let dir = std::env::temp_dir().join(format!("sdfc-interim-t-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("a.sdf");
+        let animated = marched()[0]
+            .replace(
+                "method: \"march\" }",
+                "method: \"march\", fps: 10, duration: 2 }",
+            )
+            .replace(
+                "sphere(0.5).translate(0, 0.5, 0)",
+                "sphere(0.5).translate(0, 0.5 + t, 0)",
+            );
+        std::fs::write(&file, animated).unwrap();
+        let paused = |options: Options| Options {
+            time: Some(0.5),
+            ..options
+        };
+        let mut s = Session::new(file.clone(), paused(interim()), Device::Wgpu(gpu.clone()));
+        s.set_size(32, 24);
+        s.held = Some(0);
+        assert!(s.load().ok);
+        let info = next_frame(&mut s);
+        assert_eq!(info.kernel, Some("interpreted"));
+        assert_eq!(s.time(), Some(0.5));
+        while s.wants_frame() {
+            s.frame().expect("a frame");
+        }
+        let interpreted = s.image().unwrap().clone();
+        let start = Instant::now();
+        while !s
+            .good
+            .as_ref()
+            .unwrap()
+            .waiting
+            .as_ref()
+            .unwrap()
+            .compile
+            .finished()
+        {
+            assert!(start.elapsed() < PATIENCE, "the compile never ended");
+            s.wait_for_compile(Duration::from_secs(1));
+        }
+        s.held = None;
+        settle_all(&mut s);
+        assert_eq!(s.last.unwrap().kernel, Some("specialised"));
+        assert_eq!(s.time(), Some(0.5), "the time on show stayed");
+        let options = Options {
+            kernel: Kernel::Specialised,
+            ..Options::default()
+        };
+        let mut reference = Session::new(file.clone(), paused(options), Device::Wgpu(gpu));
+        reference.set_size(32, 24);
+        assert!(reference.load().ok);
+        settle_all(&mut reference);
+        assert_eq!(reference.time(), Some(0.5));
+        assert_eq!(s.image(), reference.image());
+        let same = crate::metrics::compare(&interpreted, reference.image().unwrap(), 0.1);
+        assert!(
+            same.unwrap().psnr >= 40.0,
+            "the interpreted kernel showed t = 0.5 s"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn an_animated_scene_plays_and_pauses() {
         let dir = std::env::temp_dir().join(format!("sdfc-play-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -42,6 +42,9 @@ const TILE_STRIDE: u32 = 256;
 /// Compiled pipelines kept by a [`Gpu`] (at most this many; the cache is emptied when full).
 const PIPELINES_KEPT: usize = 16;
 
+/// How long [`Gpu::wait`] polls before it blocks.
+const SPIN: Duration = Duration::from_millis(20);
+
 /// A compiled kernel: its pipeline and bind group layout.
 type Pipeline = Arc<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>;
 
@@ -57,6 +60,10 @@ pub struct Gpu {
     /// `PIPELINE_CACHE`, Vulkan only), which [`Gpu::pipeline_for`] stores on disk.
     driver_cache: bool,
     pipelines: Mutex<HashMap<(String, String, bool), Pipeline>>,
+    /// The buffers of the last frame finished, kept for the next frame of the same sizes
+    /// (a benchmark's or a sequence's frames): wgpu clears a new storage buffer before its
+    /// first use, which each frame would otherwise pay for within its launches.
+    spare: Mutex<Option<Buffers>>,
 }
 
 /// How a kernel's pipeline was obtained ([`Gpu::pipeline_for`]).
@@ -215,6 +222,7 @@ impl Gpu {
             timestamps,
             driver_cache,
             pipelines: Mutex::new(HashMap::new()),
+            spare: Mutex::new(None),
         })
     }
 
@@ -362,12 +370,27 @@ impl Gpu {
             Some(m) => wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(m.clone())),
             None => wgpu::ShaderSource::Wgsl(wgsl.into()),
         };
-        let module = self
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("sdfc kernel"),
-                source,
-            });
+        // wgpu's checks except the bound on loops: naga gives every loop a counter, tested
+        // each turn, which on the H100 took up to 22 % of a marched scene's frame
+        // (BENCHMARKS.md, "wgpu's runtime checks"). Index bounds stay checked.
+        let mut checks = wgpu::ShaderRuntimeChecks::checked();
+        checks.force_loop_bounding = false;
+        // SAFETY: wgpu requires that no loop of the shader runs forever. Every loop of a
+        // kernel sdfc writes ends on the data sdfc writes (ARCHITECTURE.md, "Invariants"): the
+        // march and shadow loops count steps to `max_steps`, the ray stack pops an entry each
+        // turn and pushes at most two per hit up to `max_depth`, the walks over `scene_data`
+        // move forwards or pop a stack of bounded depth, and the interpreter's jumps go
+        // forwards to its RETURN.
+        #[allow(unsafe_code)]
+        let module = unsafe {
+            self.device.create_shader_module_trusted(
+                wgpu::ShaderModuleDescriptor {
+                    label: Some("sdfc kernel"),
+                    source,
+                },
+                checks,
+            )
+        };
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -408,7 +431,7 @@ impl Gpu {
             });
         let path = self.driver_cache_path(wgsl, entry_point, data);
         let stored = path.as_ref().and_then(|p| std::fs::read(p).ok());
-        // The one unsafe call of this module: wgpu cannot check that cache data came from
+        // wgpu cannot check that cache data came from
         // `PipelineCache::get_data`.
         #[allow(unsafe_code)]
         let cache = path.as_ref().map(|_| {
@@ -449,7 +472,30 @@ impl Gpu {
         (pipeline, layout, driver)
     }
 
+    /// The buffers of a frame with the job's uniforms, scene data and tiles written (queued):
+    /// the spare ones when their sizes fit, else new ones.
     fn buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {
+        let spare = self.spare.lock().ok().and_then(|mut s| s.take());
+        let size = |n: u64| n.max(16);
+        match spare {
+            Some(b)
+                if b.uniforms.size() == size(l.uniforms.len() as u64)
+                    && b.data.as_ref().map(|d| d.size())
+                        == l.data.map(|d| size(d.len() as u64))
+                    && b.tile.size() == size(tiles * TILE_STRIDE as u64)
+                    && b.image.size() == size(pixels * 16) =>
+            {
+                self.queue.write_buffer(&b.uniforms, 0, l.uniforms);
+                if let (Some(buffer), Some(bytes)) = (&b.data, l.data) {
+                    self.queue.write_buffer(buffer, 0, bytes);
+                }
+                b
+            }
+            _ => self.new_buffers(l, pixels, tiles),
+        }
+    }
+
+    fn new_buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {
         use wgpu::BufferUsages as U;
         let make = |label, size: u64, usage| {
             self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -528,11 +574,32 @@ impl Gpu {
         })
     }
 
+    /// Waits for the work submitted. On a GPU the host first polls, yielding its core
+    /// between polls, for up to [`SPIN`]: the driver's blocking wait returned 0.1–0.15 ms
+    /// after the end of a frame on the H100 (BENCHMARKS.md, "wgpu's wall time"), as long as
+    /// a short frame itself, and CUDA's default wait polls too. A longer wait blocks, its
+    /// latency small beside the frame. A software adapter (lavapipe) renders on the host's
+    /// cores, which polling would take from it: it blocks at once.
     fn wait(&self) -> Result<(), Error> {
+        let error = |e: wgpu::PollError| Error::Render(e.to_string());
+        if !self.is_cpu() {
+            let start = Instant::now();
+            while start.elapsed() < SPIN {
+                if self
+                    .device
+                    .poll(wgpu::PollType::Poll)
+                    .map_err(error)?
+                    .is_queue_empty()
+                {
+                    return Ok(());
+                }
+                std::thread::yield_now();
+            }
+        }
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| Error::Render(e.to_string()))
+            .map_err(error)
     }
 
     fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
@@ -597,6 +664,7 @@ impl Gpu {
     }
 }
 
+#[derive(Debug)]
 struct Buffers {
     uniforms: wgpu::Buffer,
     data: Option<wgpu::Buffer>,
@@ -659,7 +727,10 @@ impl launch::Device for Kernel<'_> {
             })
             .collect();
         gpu.queue.write_buffer(&buffers.tile, 0, &table);
-        // (wgpu's writes are queued: the uploads are paid for in the first submission.)
+        // wgpu queues its writes until the next submission: submitted now, the uploads are
+        // part of the frame's setup, as CUDA's are, not of its first launch.
+        gpu.queue.submit([]);
+        gpu.wait()?;
         Ok(FrameBuffers {
             pipeline,
             buffers,
@@ -764,10 +835,14 @@ impl launch::Device for Kernel<'_> {
                 return Err(Error::Render(e.to_string()));
             }
         }
-        match &f.queries {
-            Some(q) => Ok(Some(self.gpu.gpu_time(q, job.tiles.len() as u32)?)),
-            None => Ok(None),
+        let time = match &f.queries {
+            Some(q) => Some(self.gpu.gpu_time(q, job.tiles.len() as u32)?),
+            None => None,
+        };
+        if let Ok(mut spare) = self.gpu.spare.lock() {
+            *spare = Some(f.buffers);
         }
+        Ok(time)
     }
 
     fn fault(&self, message: String) -> Error {

@@ -313,6 +313,10 @@ pub struct Session {
     compiled: (mpsc::Sender<()>, mpsc::Receiver<()>),
     /// Also called when such a compile ends (the window's event loop).
     waker: Option<Waker>,
+    /// The last interpreted kernel shown, kept after the specialised kernel replaced it: a
+    /// later scene of the same specialisation reuses its validated kernel
+    /// ([`Prepared::next_with`]).
+    interpreter: Option<Prepared>,
     /// Tests hold back the compile of this load's specialised kernel, to see what is shown
     /// meanwhile.
     #[cfg(test)]
@@ -347,6 +351,7 @@ impl Session {
             playback: None,
             compiled: mpsc::channel(),
             waker: None,
+            interpreter: None,
             #[cfg(test)]
             held: None,
         }
@@ -677,9 +682,11 @@ impl Session {
             .good
             .as_ref()
             .and_then(|g| g.waiting.as_ref())
-            .and_then(|w| w.interim.as_ref());
+            .and_then(|w| w.interim.as_ref())
+            .map(|i| &i.prepared)
+            .or(self.interpreter.as_ref());
         let prepared = match held {
-            Some(i) => i.prepared.next_with(scene, lowered, setup.kernel).ok()?.0,
+            Some(p) => p.next_with(scene, lowered, setup.kernel).ok()?.0,
             None => Prepared::on_gpu(gpu.clone(), scene, &lowered, &setup).ok()?,
         };
         prepared
@@ -758,6 +765,9 @@ impl Session {
                 }
                 // A render error of the interpreted kernel does not stop the specialised one.
                 self.broken = None;
+                if let Some(i) = w.interim {
+                    self.interpreter = Some(i.prepared);
+                }
                 if w.shown {
                     // The image starts again from the specialised kernel's samples; the one on
                     // show stays until its first frame replaces it.

@@ -227,6 +227,9 @@ struct Timings {
     background: bool,
     /// The kernel of the first frame: `interpreted` while the specialised one compiled.
     first_kernel: Option<&'static str>,
+    /// The time to prepare the interpreted kernel (with `auto`, when the specialised pipeline
+    /// was not compiled yet).
+    interim_prepare: Duration,
     /// The interpreted kernel's pipeline, when it rendered the first frame.
     interim_pipeline: Option<PipelineTime>,
     /// When the newest of the scene's files was modified.
@@ -594,14 +597,17 @@ impl Session {
             return Err(msg);
         }
         let mut waiting = None;
+        let mut interim_prepare = Duration::ZERO;
         let pipeline = match &prepared {
             Prepared::Wgpu { gpu, kernel, .. } => {
                 let data = kernel.data.is_some();
                 let compiled = gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data);
+                let start = Instant::now();
                 let interim = match interim_lowered {
                     Some(lowered) if !compiled => self.interim(gpu, &scene, lowered, &at),
                     _ => None,
                 };
+                interim_prepare = start.elapsed();
                 match interim {
                     Some(interim) => {
                         waiting = Compile::start(&prepared, self.compile_waker()).map(|compile| {
@@ -652,6 +658,7 @@ impl Session {
             pipeline,
             background,
             first_kernel: None,
+            interim_prepare,
             interim_pipeline: None,
             modified: None,
             began: SystemTime::now(),
@@ -1173,7 +1180,8 @@ impl Session {
                 (Some(p), false) => format!(", pipeline {}", got(p)),
                 (Some(p), true) => format!(", pipeline {} on another thread", got(p)),
                 (None, true) => format!(
-                    ", pipeline compiling on another thread, interpreted while compiling (whose pipeline {})",
+                    ", pipeline compiling on another thread, interpreted while compiling (interpreted kernel {:.2} ms, its pipeline {})",
+                    ms(t.interim_prepare),
                     match t.interim_pipeline {
                         Some(p) if p.cached => "was cached".to_string(),
                         Some(p) => format!("compiled {:.1} ms", ms(p.time)),

@@ -32,8 +32,9 @@ pub struct ViewArgs {
     /// Override a render setting (as for `sdfc render`), at every reload. May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// The GPU kernel (wgpu): `auto` shows a scene whose specialised kernel is not compiled
-    /// yet through the interpreted kernel until it is (compiling it on another thread);
+    /// The GPU kernel (wgpu): `auto` shows a marched scene whose specialised kernel is not
+    /// compiled yet through the interpreted kernel until it is, compiling it on another thread
+    /// (on a GPU; a CPU adapter compiles before showing, as `specialised` does);
     /// `specialised` compiles each new kernel before showing it; `interpreted` shows every
     /// scene through the interpreted kernel (docs/interpreted.md). [default: auto]
     #[arg(long, value_enum)]

@@ -37,7 +37,7 @@ pub struct ViewArgs {
     /// (on a GPU; a CPU adapter compiles before showing, as `specialised` does);
     /// `specialised` compiles each new kernel before showing it; `interpreted` shows every
     /// scene through the interpreted kernel (docs/interpreted.md). [default: auto]
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, hide_possible_values = true)]
     pub kernel: Option<Kernel>,
     /// Print the times of each load: check, lower, tapes or kernel, pipeline, first frame,
     /// and (for reloads) from the file's modification to the first frame shown.

@@ -234,17 +234,45 @@ impl AtomicFile {
     }
 
     /// Flushes, syncs and renames the file onto its target.
-    pub fn finish(mut self) -> std::io::Result<()> {
+    pub fn finish(self) -> std::io::Result<()> {
+        self.finish_timed().map(|_| ())
+    }
+
+    /// [`AtomicFile::finish`], saying how long each step took: the buffer's last bytes
+    /// written, the file's data synced to the disk (`fsync`: a file found after a crash of
+    /// the machine is complete, which a sequence resuming by the files present relies on),
+    /// and the rename onto the target.
+    pub fn finish_timed(mut self) -> std::io::Result<Finished> {
         let Some(buffered) = self.file.take() else {
-            return Ok(());
+            return Ok(Finished::default());
         };
+        let start = std::time::Instant::now();
         let file = buffered.into_inner().map_err(|e| e.into_error())?;
+        let flush = start.elapsed();
+        let start = std::time::Instant::now();
         file.sync_all()?;
         drop(file);
+        let sync = start.elapsed();
+        let start = std::time::Instant::now();
         std::fs::rename(&self.tmp, &self.path)?;
         self.tmp = PathBuf::new();
-        Ok(())
+        Ok(Finished {
+            flush,
+            sync,
+            rename: start.elapsed(),
+        })
     }
+}
+
+/// How long the steps of [`AtomicFile::finish_timed`] took.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Finished {
+    /// The buffer's last bytes written.
+    pub flush: std::time::Duration,
+    /// The file synced to the disk.
+    pub sync: std::time::Duration,
+    /// The rename onto the target.
+    pub rename: std::time::Duration,
 }
 
 impl Write for AtomicFile {

@@ -609,8 +609,13 @@ impl<'a> Kernels<'a> {
             }
             None => {
                 let program = frame.lowered.program.clone();
-                let (scene, prepared) =
-                    prepare(self.pool, (self.backend, &self.devices), frame, &self.setup)?;
+                let (scene, prepared) = prepare(
+                    self.pool,
+                    (self.backend, &self.devices),
+                    frame,
+                    &self.setup,
+                    None,
+                )?;
                 self.count += 1;
                 self.prepared = Some((program, scene.origin, prepared));
                 scene
@@ -729,6 +734,7 @@ impl Sink {
                 format: *format,
             }
             .write(image)
+            .map(|_| ())
             .map_err(CliError::Usage),
             Sink::Apng {
                 path,

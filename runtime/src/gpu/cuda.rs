@@ -103,6 +103,12 @@ impl Cuda {
         Self::open_device(0, false)
     }
 
+    /// Whether the CUDA driver's library (libcuda) can be loaded; no driver call is made.
+    pub fn driver_present() -> bool {
+        // SAFETY: only tries to dlopen libcuda; no driver call is made.
+        unsafe { sys::is_culib_present() }
+    }
+
     /// The number of CUDA devices (0 without a driver).
     pub fn count() -> usize {
         // SAFETY: only tries to dlopen libcuda; no driver call is made.

@@ -11,12 +11,13 @@
 # 10 000-sphere scenes, marched (--set method=march), whole runs and `sdfc bench`'s median
 # GPU time of FRAMES frames. With PLAIN=N, every example also as N whole warm processes
 # without --stats (what a user waits for; medians), alternating with the build at OLD (default
-# .dev/sdfc-old, when present) for a before and after. MODES (default cold,warm,sdfc) picks the
-# --stats runs; SCALING="" skips the scaling scenes. The measuring is scripts/first_second.py;
-# its tables go to $OUT/first-second.md and are printed last. Expects the sdfc binary at
-# .dev/sdfc and the Vulkan loader packages in .gl/ (scripts/device-env.sh).
-# The first second alone, before and after, in one run (about 3 minutes on an H100):
-#   SCALING="" MODES=warm WARM=5 PLAIN=7 scripts/device-first-second.sh
+# .dev/sdfc-old, when present) for a before and after. MODES (default cold,warm,sdfc; also
+# vulkan: warm with wgpu's instance limited to Vulkan) picks the --stats runs; SCALING=""
+# skips the scaling scenes. The measuring is scripts/first_second.py; its tables go to
+# $OUT/first-second.md and are printed last. Expects the sdfc binary at .dev/sdfc and the
+# Vulkan loader packages in .gl/ (scripts/device-env.sh).
+# The first second alone, before and after, in one run (about 5 minutes on an H100):
+#   SCALING="" MODES=warm,vulkan WARM=5 PLAIN=7 scripts/device-first-second.sh
 set -u
 . "$(dirname "$0")/device-env.sh"
 SIZE=${SIZE:-1920x1080}

@@ -4,14 +4,15 @@ scripts/device-first-second.sh on a GPU host (and usable anywhere: `--backends w
 lavapipe).
 
     first_second.py SDFC [--backends cuda,wgpu] [--size WxH] [--warm N] [--scenes FILE...]
-                         [--scaling FILE...] [--frames N] [--work DIR] [--modes cold,warm,sdfc]
+                         [--scaling FILE...] [--frames N] [--work DIR] [--modes cold,warm,sdfc,vulkan]
                          [--plain N] [--old OLD_SDFC]
     first_second.py --bare cuda|vulkan
 
 For each backend and scene, whole `sdfc render --stats` processes: cold (sdfc's cache
 directory and the driver's disk caches empty), warm (all filled; the median of N runs) and
 "sdfc cache" (sdfc's cache filled, the NVIDIA driver's own disk caches turned off:
-__GL_SHADER_DISK_CACHE=0, CUDA_CACHE_DISABLE=1), each phase of `--stats`'s breakdown beside
+__GL_SHADER_DISK_CACHE=0, CUDA_CACHE_DISABLE=1) and, with the mode `vulkan`, warm through wgpu
+with its instance limited to Vulkan (WGPU_BACKEND=vulkan: no GL backend), each phase of `--stats`'s breakdown beside
 the process's wall time measured from outside (and the difference, "after": the process's end
 after the image, which it cannot time itself, plus the error of `--stats`'s "start"). With
 `--plain N`, whole warm processes without `--stats` (what a user waits for), N of each, the
@@ -143,7 +144,7 @@ def main():
     ap.add_argument("--scaling", nargs="*", default=[])
     ap.add_argument("--frames", type=int, default=5)
     ap.add_argument("--work", default="/tmp/first-second")
-    ap.add_argument("--modes", default="cold,warm,sdfc")
+    ap.add_argument("--modes", default="cold,warm,sdfc")  # and vulkan
     ap.add_argument("--plain", type=int, default=0)
     ap.add_argument("--old")
     a = ap.parse_args()
@@ -156,8 +157,8 @@ def main():
     dirs = {k: os.path.join(a.work, k) for k in ["sdfc", "gl", "cuda"]}
     image = os.path.join(a.work, "image.png")
 
-    def env(driver_caches=True):
-        e = dict(os.environ)
+    def env(driver_caches=True, extra=None):
+        e = dict(os.environ, **(extra or {}))
         e["SDFC_CACHE_DIR"] = dirs["sdfc"]
         e["__GL_SHADER_DISK_CACHE_PATH"] = dirs["gl"]
         e["CUDA_CACHE_PATH"] = dirs["cuda"]
@@ -173,10 +174,10 @@ def main():
 
     rows, failures = [], []
 
-    def measure(label, backend, mode, cmd, times, driver_caches=True):
+    def measure(label, backend, mode, cmd, times, driver_caches=True, extra=None):
         walls, phases, totals, how = [], [], [], ""
         for _ in range(times):
-            wall, out, err, code = run(cmd, env(driver_caches))
+            wall, out, err, code = run(cmd, env(driver_caches, extra))
             if code != 0:
                 failures.append("%s %s %s: exit %d: %s" % (label, backend, mode, code,
                                                            err.strip().splitlines()[-1:]))
@@ -215,10 +216,17 @@ def main():
             empty_caches()
             if "cold" in modes:
                 measure(label, backend, "cold", cmd, 1)
+            else:
+                run(cmd, env())  # fills the caches, untimed
             if "warm" in modes:
                 measure(label, backend, "warm", cmd, a.warm)
             if "sdfc" in modes:
                 measure(label, backend, "sdfc cache", cmd, a.warm, driver_caches=False)
+            if "vulkan" in modes and backend == "wgpu":
+                # wgpu's instance without its GL backend (EGL): what that backend costs the
+                # device's opening.
+                measure(label, backend, "Vulkan alone", cmd, a.warm,
+                        extra={"WGPU_BACKEND": "vulkan"})
 
     # Whole processes without --stats, warm (one untimed run of each build first), the builds
     # alternating.

@@ -980,7 +980,7 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
     let diagnostics = |out: &Output| {
         let err = String::from_utf8_lossy(&out.stderr).into_owned();
         assert_eq!(out.status.code(), Some(1), "{err}");
-        assert!(err.contains("broken.sdf") && err.contains("error"), "{err}");
+        assert!(err.contains("broken.sdf") && err.contains("E0101"), "{err}");
         assert!(!err.contains("adapter") && !err.contains("CUDA"), "{err}");
         err
     };

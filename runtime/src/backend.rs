@@ -1022,6 +1022,19 @@ impl Prepared {
     /// Where the first preparation for a GPU went, for `--stats`: (phase, time, how) for
     /// the device, the kernel, its PTX and the driver's compile; empty on the CPU.
     pub fn preparation(&self) -> Vec<(&'static str, Duration, String)> {
+        let mut parts = self.preparation_parts();
+        // A device opened beside the front end was waited for after the kernel was written:
+        // the phases in the order they ended.
+        if let Prepared::Wgpu { timing, .. } | Prepared::Cuda { timing, .. } = self {
+            if timing.overlapped.is_some() && parts.len() >= 2 {
+                parts.swap(0, 1);
+            }
+        }
+        parts
+    }
+
+    /// [`Prepared::preparation`], the device first.
+    fn preparation_parts(&self) -> Vec<(&'static str, Duration, String)> {
         use gpu::wgpu::DriverCache;
         match self {
             Prepared::Cpu { .. } => Vec::new(),

@@ -36,11 +36,11 @@ import time
 
 PHASES = [
     "start", "arguments", "scene", "setup", "device", "kernel", "PTX", "driver compile",
-    "preparation", "memory", "upload", "frame", "readback", "conversion", "render", "encode",
-    "write", "fsync", "rename", "image",
+    "preparation", "memory", "upload", "frame", "readback", "conversion", "render", "sRGB",
+    "PNG", "encode", "write", "fsync", "rename", "image",
 ]
 SHOWN = ["start", "scene", "device", "kernel", "PTX", "driver compile", "upload", "frame",
-         "readback", "conversion", "encode", "write", "fsync", "rename", "image"]
+         "readback", "conversion", "sRGB", "PNG", "write", "fsync", "rename", "image"]
 
 
 def bare_cuda():

@@ -1046,7 +1046,7 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
 }
 
 /// `--stats`'s breakdown of the whole run: its phases add up to its total, a device opened
-/// beside the front end says so with its own time, and the image's steps (encoding, write,
+/// beside the front end says so with its own time, and the image's steps (sRGB, PNG, write,
 /// fsync, rename) are listed; the device is left to the operating system at the end.
 #[test]
 fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
@@ -1102,7 +1102,7 @@ fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
             "{text}"
         );
         for step in [
-            "scene", "encode", "write", "fsync", "rename", "image", "exit",
+            "scene", "sRGB", "PNG", "write", "fsync", "rename", "image", "exit",
         ] {
             assert!(names.contains(&step), "{step} in {text}");
         }

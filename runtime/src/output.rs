@@ -50,6 +50,23 @@ impl Format {
     }
 }
 
+/// The image's PNG bytes, with the steps of their encoding: the sRGB encoding and the PNG's
+/// filtering and compression.
+fn png_steps(image: &Image) -> Result<(Vec<u8>, Vec<Step>), crate::image::ImageError> {
+    let start = Instant::now();
+    let (bytes, srgb) = image.encode_png_timed()?;
+    let png = start.elapsed().saturating_sub(srgb);
+    let steps = vec![
+        ("sRGB", srgb, "clamped and encoded by table".to_string()),
+        (
+            "PNG",
+            png,
+            "filtered and compressed at the `Fast` level".to_string(),
+        ),
+    ];
+    Ok((bytes, steps))
+}
+
 /// A step of writing an image and its time, with what it was ([`Output::write`]).
 pub type Step = (&'static str, Duration, String);
 
@@ -101,31 +118,26 @@ impl Output {
     /// went (`sdfc render --stats`): (step, time, what) for the encoding, the write, and for
     /// a file its `fsync` and rename.
     pub fn write(&self, image: &Image) -> Result<Vec<Step>, String> {
-        const PNG: &str = "sRGB by table, PNG at the `Fast` level";
         let (path, format) = match self {
             Output::Stdout => {
                 let cannot = |e: String| format!("cannot write the image to standard output: {e}");
-                let start = Instant::now();
-                let bytes = image.encode_png().map_err(|e| cannot(e.to_string()))?;
-                let encode = ("encode", start.elapsed(), PNG.to_string());
+                let (bytes, mut steps) = png_steps(image).map_err(|e| cannot(e.to_string()))?;
                 let start = Instant::now();
                 let mut out = std::io::stdout().lock();
                 out.write_all(&bytes)
                     .and_then(|()| out.flush())
                     .map_err(|e| cannot(e.to_string()))?;
-                let write = ("write", start.elapsed(), "to standard output".to_string());
-                return Ok(vec![encode, write]);
+                steps.push(("write", start.elapsed(), "to standard output".to_string()));
+                return Ok(steps);
             }
             Output::File { path, format } => (path, *format),
         };
         let cannot = |e: std::io::Error| format!("cannot write `{}`: {e}", path.display());
         let mut steps = Vec::new();
         let png = if format == Format::Png {
-            let start = Instant::now();
-            let bytes = image
-                .encode_png()
-                .map_err(|e| cannot(std::io::Error::other(e)))?;
-            steps.push(("encode", start.elapsed(), PNG.to_string()));
+            let (bytes, encoded) =
+                png_steps(image).map_err(|e| cannot(std::io::Error::other(e)))?;
+            steps.extend(encoded);
             Some(bytes)
         } else {
             None

@@ -114,10 +114,11 @@ impl Output {
         })
     }
 
-    /// Writes `image`: to the file atomically, or to standard output. Says where the time
-    /// went (`sdfc render --stats`): (step, time, what) for the encoding, the write, and for
-    /// a file its `fsync` and rename.
-    pub fn write(&self, image: &Image) -> Result<Vec<Step>, String> {
+    /// Writes `image`: to the file atomically (synced to the disk before its rename when
+    /// `sync`: [`AtomicFile::create`], else [`AtomicFile::unsynced`]), or to standard output.
+    /// Says where the time went (`sdfc render --stats`): (step, time, what) for the
+    /// encoding, the write, and for a file its `fsync` and rename.
+    pub fn write(&self, image: &Image, sync: bool) -> Result<Vec<Step>, String> {
         let (path, format) = match self {
             Output::Stdout => {
                 let cannot = |e: String| format!("cannot write the image to standard output: {e}");
@@ -142,7 +143,11 @@ impl Output {
         } else {
             None
         };
-        let mut file = AtomicFile::create(path).map_err(cannot)?;
+        let file = match sync {
+            true => AtomicFile::create(path),
+            false => AtomicFile::unsynced(path),
+        };
+        let mut file = file.map_err(cannot)?;
         let start = Instant::now();
         match &png {
             Some(bytes) => file.write_all(bytes),
@@ -163,7 +168,9 @@ impl Output {
                 "encoded and streamed into a temporary file beside it".into(),
             ),
         });
-        steps.push(("fsync", done.sync, "its data synced to the disk".into()));
+        if let Some(t) = done.sync {
+            steps.push(("fsync", t, "its data synced to the disk".into()));
+        }
         steps.push(("rename", done.rename, "onto the image's name".into()));
         Ok(steps)
     }

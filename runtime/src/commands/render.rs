@@ -376,7 +376,11 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
     if check.is_some() {
         run.lap("check", "the reference's convergence");
     }
-    let steps = out.write(&frame.render.image).map_err(CliError::Usage)?;
+    // Not synced to the disk: complete or untouched whatever happens to the process, as a
+    // compiler's output (`AtomicFile::unsynced`).
+    let steps = out
+        .write(&frame.render.image, false)
+        .map_err(CliError::Usage)?;
     if let (true, Some(path)) = (args.aux, out.path()) {
         write_sidecar(path, frame.render.depth.as_ref(), prepared.name())
             .map_err(CliError::Usage)?;

@@ -441,7 +441,8 @@ impl FramesOn<'_> {
                                 path: pattern.path(k),
                                 format: *format,
                             };
-                            if let Err(e) = file.write(&image) {
+                            // Synced: a rerun skips the frames whose files it finds.
+                            if let Err(e) = file.write(&image, true) {
                                 let _ = tx.send(Report::Unwritten(e));
                             }
                             None
@@ -733,7 +734,8 @@ impl Sink {
                 path: p.path(k),
                 format: *format,
             }
-            .write(image)
+            // Synced: a rerun skips the frames whose files it finds.
+            .write(image, true)
             .map(|_| ())
             .map_err(CliError::Usage),
             Sink::Apng {

@@ -239,10 +239,10 @@ impl AtomicFile {
 
     /// Starts writing `path`, complete or untouched whatever happens to the process, but not
     /// synced to the disk (after a crash of the machine it may be found empty), as a
-    /// compiler writes its output: `sdfc render`'s still images. Syncing a 1920×1080 PNG
-    /// took a median of 0.5–5 ms on this repository's 2-core VM, and 45 ms while other
-    /// builds wrote to its disk (BENCHMARKS.md, "The first second: the device beside the
-    /// front end").
+    /// compiler writes its output: `sdfc render`'s still images. On this repository's 2-core
+    /// VM, 2026-11-24, the fsync of a 1920×1080 PNG took medians of 0.5–5 ms, and that of a
+    /// 320×240 one a median of 45 ms while other builds wrote to the disk (BENCHMARKS.md,
+    /// "The device beside the front end").
     pub fn unsynced(path: &Path) -> std::io::Result<AtomicFile> {
         Self::open(path, false)
     }

@@ -432,10 +432,13 @@ struct Run {
 impl Run {
     fn new() -> Run {
         let main = super::started();
+        let now = Instant::now();
         Run {
             main,
-            last: main.0,
-            phases: vec![("arguments", Instant::now() - main.0, "parsed".into())],
+            // The next phase starts where the arguments' ended (not at `main`: that counted
+            // the arguments twice).
+            last: now,
+            phases: vec![("arguments", now - main.0, "parsed".into())],
         }
     }
 

@@ -111,8 +111,7 @@ impl Cuda {
 
     /// The number of CUDA devices (0 without a driver).
     pub fn count() -> usize {
-        // SAFETY: only tries to dlopen libcuda; no driver call is made.
-        if !unsafe { sys::is_culib_present() } {
+        if !Self::driver_present() {
             return 0;
         }
         CudaContext::device_count().map_or(0, |n| n.max(0) as usize)
@@ -122,8 +121,7 @@ impl Cuda {
     /// (two `Cuda` opened on one device then run side by side, as two logical devices);
     /// otherwise to the context's default stream.
     pub fn open_device(ordinal: usize, own_stream: bool) -> Result<Cuda, Error> {
-        // SAFETY: only tries to dlopen libcuda; no driver call is made.
-        if !unsafe { sys::is_culib_present() } {
+        if !Self::driver_present() {
             return Err(Error::NoDriver);
         }
         let count = CudaContext::device_count().map_err(driver("counting devices"))?;

@@ -4,14 +4,20 @@ scripts/device-first-second.sh on a GPU host (and usable anywhere: `--backends w
 lavapipe).
 
     first_second.py SDFC [--backends cuda,wgpu] [--size WxH] [--warm N] [--scenes FILE...]
-                         [--scaling FILE...] [--frames N] [--work DIR]
+                         [--scaling FILE...] [--frames N] [--work DIR] [--modes cold,warm,sdfc,vulkan]
+                         [--plain N] [--old OLD_SDFC]
     first_second.py --bare cuda|vulkan
 
 For each backend and scene, whole `sdfc render --stats` processes: cold (sdfc's cache
 directory and the driver's disk caches empty), warm (all filled; the median of N runs) and
 "sdfc cache" (sdfc's cache filled, the NVIDIA driver's own disk caches turned off:
-__GL_SHADER_DISK_CACHE=0, CUDA_CACHE_DISABLE=1), each phase of `--stats`'s breakdown beside
-the process's wall time measured from outside. Beside them, a bare context creation in a
+__GL_SHADER_DISK_CACHE=0, CUDA_CACHE_DISABLE=1) and, with the mode `vulkan`, warm through wgpu
+with its instance limited to Vulkan (WGPU_BACKEND=vulkan: no GL backend), each phase of `--stats`'s breakdown beside
+the process's wall time measured from outside (and the difference, "after": the process's end
+after the image, which it cannot time itself, plus the error of `--stats`'s "start"). With
+`--plain N`, whole warm processes without `--stats` (what a user waits for), N of each, the
+medians; with `--old`, the same of another build, run alternately with SDFC's (a before and
+after on one machine at one time). Beside them, a bare context creation in a
 process of its own (`--bare`: python3 loading the driver through ctypes, no sdfc): CUDA's
 cuInit and cuCtxCreate, Vulkan's instance, physical devices and a device with one queue.
 Then the scaling scenes marched (`--set method=march`): whole warm runs and `sdfc bench`'s
@@ -30,10 +36,11 @@ import time
 
 PHASES = [
     "start", "arguments", "scene", "setup", "device", "kernel", "PTX", "driver compile",
-    "preparation", "memory", "upload", "frame", "readback", "conversion", "render", "image",
+    "preparation", "memory", "upload", "frame", "readback", "conversion", "render", "sRGB",
+    "PNG", "encode", "write", "fsync", "rename", "image",
 ]
-SHOWN = ["start", "device", "kernel", "PTX", "driver compile", "upload", "frame", "readback",
-         "conversion", "image"]
+SHOWN = ["start", "scene", "device", "kernel", "PTX", "driver compile", "upload", "frame",
+         "readback", "conversion", "sRGB", "PNG", "write", "fsync", "rename", "image"]
 
 
 def bare_cuda():
@@ -94,7 +101,8 @@ def run(cmd, env):
 
 def breakdown(stdout):
     """The phases of `--stats`'s `run` block, in ms, with the driver compile's description,
-    and the run's total."""
+    and the run's total. A device opened beside the front end gives its own time as the
+    phase "device (own)" ("device" is then the wait for it)."""
     phases, how, total = {}, "", None
     inside = False
     for line in stdout.splitlines():
@@ -108,6 +116,9 @@ def breakdown(stdout):
             phases[name] = float(value) if value != "-" else None
             if name == "driver compile":
                 how = rest.split(" ms", 1)[1].strip()
+            if name == "device" and "thread of its own in " in rest:
+                own = rest.split("thread of its own in ", 1)[1].split(" ms")[0]
+                phases["device (own)"] = float(own)
         elif inside:
             inside = False
     return phases, how, total
@@ -133,6 +144,9 @@ def main():
     ap.add_argument("--scaling", nargs="*", default=[])
     ap.add_argument("--frames", type=int, default=5)
     ap.add_argument("--work", default="/tmp/first-second")
+    ap.add_argument("--modes", default="cold,warm,sdfc")  # and vulkan
+    ap.add_argument("--plain", type=int, default=0)
+    ap.add_argument("--old")
     a = ap.parse_args()
     if a.bare:
         print("%.6f" % (bare_cuda() if a.bare == "cuda" else bare_vulkan()))
@@ -143,8 +157,8 @@ def main():
     dirs = {k: os.path.join(a.work, k) for k in ["sdfc", "gl", "cuda"]}
     image = os.path.join(a.work, "image.png")
 
-    def env(driver_caches=True):
-        e = dict(os.environ)
+    def env(driver_caches=True, extra=None):
+        e = dict(os.environ, **(extra or {}))
         e["SDFC_CACHE_DIR"] = dirs["sdfc"]
         e["__GL_SHADER_DISK_CACHE_PATH"] = dirs["gl"]
         e["CUDA_CACHE_PATH"] = dirs["cuda"]
@@ -160,10 +174,10 @@ def main():
 
     rows, failures = [], []
 
-    def measure(label, backend, mode, cmd, times, driver_caches=True):
+    def measure(label, backend, mode, cmd, times, driver_caches=True, extra=None):
         walls, phases, totals, how = [], [], [], ""
         for _ in range(times):
-            wall, out, err, code = run(cmd, env(driver_caches))
+            wall, out, err, code = run(cmd, env(driver_caches, extra))
             if code != 0:
                 failures.append("%s %s %s: exit %d: %s" % (label, backend, mode, code,
                                                            err.strip().splitlines()[-1:]))
@@ -174,7 +188,9 @@ def main():
             totals.append(total)
         row = {"label": label, "backend": backend, "mode": mode, "wall": median(walls),
                "total": median(totals), "how": how,
-               "phases": {k: median([p.get(k) for p in phases]) for k in PHASES}}
+               "after": median([w - t for w, t in zip(walls, totals) if t is not None]),
+               "phases": {k: median([p.get(k) for p in phases])
+                          for k in PHASES + ["device (own)"]}}
         rows.append(row)
         print(json.dumps(row), flush=True)
 
@@ -196,10 +212,43 @@ def main():
         for f in scenes:
             label = os.path.splitext(os.path.basename(f))[0]
             cmd = [a.sdfc, "render", f, "--backend", backend, "--size", a.size, "--stats", "-o", image]
+            modes = a.modes.split(",")
             empty_caches()
-            measure(label, backend, "cold", cmd, 1)
-            measure(label, backend, "warm", cmd, a.warm)
-            measure(label, backend, "sdfc cache", cmd, a.warm, driver_caches=False)
+            if "cold" in modes:
+                measure(label, backend, "cold", cmd, 1)
+            else:
+                run(cmd, env())  # fills the caches, untimed
+            if "warm" in modes:
+                measure(label, backend, "warm", cmd, a.warm)
+            if "sdfc" in modes:
+                measure(label, backend, "sdfc cache", cmd, a.warm, driver_caches=False)
+            if "vulkan" in modes and backend == "wgpu":
+                # wgpu's instance without its GL backend (EGL): what that backend costs the
+                # device's opening.
+                measure(label, backend, "Vulkan alone", cmd, a.warm,
+                        extra={"WGPU_BACKEND": "vulkan"})
+
+    # Whole processes without --stats, warm (one untimed run of each build first), the builds
+    # alternating.
+    plain = []
+    builds = [("new", a.sdfc)] + ([("old", a.old)] if a.old else [])
+    for backend in backends if a.plain else []:
+        for f in scenes:
+            label = os.path.splitext(os.path.basename(f))[0]
+            walls = {name: [] for name, _ in builds}
+            for i in range(a.plain + 1):
+                for name, binary in builds:
+                    cmd = [binary, "render", f, "--backend", backend, "--size", a.size, "-o", image]
+                    wall, out, err, code = run(cmd, env())
+                    if code != 0:
+                        failures.append("plain %s %s %s: exit %d: %s" % (
+                            label, backend, name, code, err.strip().splitlines()[-1:]))
+                    elif i > 0:
+                        walls[name].append(wall * 1e3)
+            row = (label, backend, {k: median(v) for k, v in walls.items()},
+                   {k: (min(v), max(v)) if v else None for k, v in walls.items()})
+            plain.append(row)
+            print(json.dumps(row), flush=True)
 
     scaling = []
     for f in a.scaling:
@@ -223,15 +272,32 @@ def main():
     print()
     print("Whole `sdfc render --size %s --stats` processes, ms (warm and sdfc cache: median of %d):"
           % (a.size, a.warm))
-    head = ["scene", "backend", "mode", "wall", "run"] + SHOWN + ["other", "driver compile: how"]
+    print("(run: from the process's start to the image written, by --stats; after: wall - run; "
+          "device: the wait for it, and its own time on its thread beside the front end)")
+    head = (["scene", "backend", "mode", "wall", "run", "after"] + SHOWN[:3] + ["device (own)"]
+            + SHOWN[3:] + ["other", "driver compile: how"])
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * 3 + "---:|" * (len(head) - 4) + "---|")
     for r in rows:
         known = sum(r["phases"][k] or 0 for k in SHOWN)
         other = None if r["total"] is None else r["total"] - known
-        cells = [r["label"], r["backend"], r["mode"], fmt(r["wall"]), fmt(r["total"])]
-        cells += [fmt(r["phases"][k]) for k in SHOWN] + [fmt(other), r["how"]]
+        cells = [r["label"], r["backend"], r["mode"], fmt(r["wall"]), fmt(r["total"]),
+                 fmt(r["after"])]
+        cells += [fmt(r["phases"][k]) for k in SHOWN[:3]] + [fmt(r["phases"]["device (own)"])]
+        cells += [fmt(r["phases"][k]) for k in SHOWN[3:]] + [fmt(other), r["how"]]
         print("| " + " | ".join(cells) + " |")
+    if plain:
+        print()
+        print("Whole warm `sdfc render --size %s` processes without --stats, wall ms, median of %d "
+              "after one untimed run (min-max)%s:" % (
+                  a.size, a.plain, ", the builds alternating" if a.old else ""))
+        names = [n for n, _ in builds]
+        print("| scene | backend | " + " | ".join(names) + " |")
+        print("|---|---|" + "---:|" * len(names))
+        for label, backend, med, spread in plain:
+            cells = ["%s (%s-%s)" % (fmt(med[n]), fmt(spread[n][0]), fmt(spread[n][1]))
+                     if spread[n] else "-" for n in names]
+            print("| %s | %s | %s |" % (label, backend, " | ".join(cells)))
     for kind, (inside, outside) in bare.items():
         print("bare %s context (python3 + ctypes, median of 3 processes): %.1f ms to create it, "
               "%.1f ms for the whole process" % (kind, inside, outside))

@@ -968,3 +968,153 @@ fn compile_applies_set_before_specialising_the_kernel() {
     assert_eq!(refused.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&refused.stderr).contains("cannot be ray traced"));
 }
+
+/// The device opens on a thread of its own while the scene is read and checked (`Opening`):
+/// a scene with errors still prints its diagnostics and exits 1 whatever the device does (no
+/// adapter, no CUDA driver, or a device still opening when the process ends), and the
+/// arguments' own errors still come after the scene's.
+#[test]
+fn a_scene_with_errors_exits_1_whatever_the_device_does() {
+    let d = dir("errors-device");
+    std::fs::write(d.join("broken.sdf"), "scene { sphere(; }").expect("write");
+    let diagnostics = |out: &Output| {
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("broken.sdf") && err.contains("E0101"), "{err}");
+        assert!(!err.contains("adapter") && !err.contains("CUDA"), "{err}");
+        err
+    };
+    // No wgpu adapter at all.
+    let no_adapter = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args(["render", "broken.sdf", "--backend", "wgpu"])
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .output()
+        .expect("run sdfc");
+    diagnostics(&no_adapter);
+    // Whatever this machine has: a device opening (lavapipe, a GPU) or none.
+    for backend in ["wgpu", "cuda", "auto"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(["render", "broken.sdf", "--backend", backend, "--stats"])
+            .env("XDG_RUNTIME_DIR", &d)
+            .output()
+            .expect("run sdfc");
+        diagnostics(&out);
+        assert!(
+            out.stdout.is_empty(),
+            "no statistics for a scene with errors"
+        );
+    }
+    // Scene errors come before the arguments' (`--reference` renders on the CPU alone).
+    let both = sdfc(
+        &d,
+        &["render", "broken.sdf", "--reference", "--backend", "wgpu"],
+    );
+    diagnostics(&both);
+    scene_file(&d);
+    let usage = sdfc(
+        &d,
+        &["render", "ball.sdf", "--reference", "--backend", "wgpu"],
+    );
+    let err = String::from_utf8_lossy(&usage.stderr);
+    assert_eq!(usage.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--reference renders on the CPU in f64"),
+        "{err}"
+    );
+    let kernel = sdfc(
+        &d,
+        &[
+            "render",
+            "broken.sdf",
+            "--backend",
+            "cpu",
+            "--kernel",
+            "interpreted",
+        ],
+    );
+    diagnostics(&kernel);
+    assert_eq!(
+        entries(&d),
+        ["ball.sdf", "broken.sdf"],
+        "no image, no temporary file"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--stats`'s breakdown of the whole run: its phases add up to its total, a device opened
+/// beside the front end says so with its own time, and the image's steps (sRGB, PNG, write,
+/// rename; a still is not synced to the disk) are listed; the device is left to the operating system at the end.
+#[test]
+fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
+    let d = dir("breakdown");
+    scene_file(&d);
+    let backends: &[&str] = if wgpu_available(&d) {
+        &["cpu", "wgpu"]
+    } else {
+        &["cpu"]
+    };
+    for backend in backends {
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(["render", "ball.sdf", "--backend", backend, "--stats"])
+            .args(["-o", "out.png"])
+            .env("XDG_RUNTIME_DIR", &d)
+            .output()
+            .expect("run sdfc");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let block: Vec<&str> = text
+            .lines()
+            .skip_while(|l| !l.starts_with("run "))
+            .collect();
+        let total: f64 = block[0]
+            .split_whitespace()
+            .nth(1)
+            .expect("total")
+            .parse()
+            .expect("ms");
+        let mut sum = 0.0;
+        let mut names = Vec::new();
+        for line in &block[1..] {
+            let name = line[2..18].trim();
+            names.push(name);
+            if let Ok(ms) = line[18..]
+                .split(" ms")
+                .next()
+                .expect("ms")
+                .trim()
+                .parse::<f64>()
+            {
+                sum += ms;
+            }
+        }
+        // Each phase is rounded to 0.1 ms.
+        assert!(
+            (sum - total).abs() <= 0.05 * names.len() as f64 + 0.1,
+            "{text}"
+        );
+        for step in ["scene", "sRGB", "PNG", "write", "rename", "image", "exit"] {
+            assert!(names.contains(&step), "{step} in {text}");
+        }
+        // A still image is not synced to the disk (`AtomicFile::unsynced`).
+        assert!(!names.contains(&"fsync"), "{text}");
+        let device = block.iter().find(|l| l.trim_start().starts_with("device "));
+        match *backend {
+            "cpu" => assert!(device.is_none(), "{text}"),
+            _ => {
+                let line = device.expect("a device phase");
+                assert!(line.contains("overlapped with the front end"), "{text}");
+            }
+        }
+        assert_eq!(png_size(&d.join("out.png")), (40, 30));
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -243,6 +243,103 @@ pub struct Preparation {
     /// The wgpu pipeline, when the preparation created it (a device opened by the caller
     /// creates it at its first render, or by [`Gpu::pipeline_for`]).
     pub pipeline: Option<gpu::wgpu::PipelineTime>,
+    /// For a device opened on a thread of its own ([`Opening`]): the time its opening took
+    /// there, beside the front end; `device` is then the time the preparation waited for it.
+    pub overlapped: Option<Duration>,
+}
+
+impl Preparation {
+    /// What the phase `device` of `--stats` was: the device's opening (`what`), or, for a
+    /// device opened beside the front end, the wait for it and how long it took there.
+    fn opening(&self, what: &str) -> String {
+        match self.overlapped {
+            None => what.into(),
+            Some(took) => format!(
+                "waited for the device: {what} on a thread of its own in {:.1} ms, overlapped with the front end",
+                took.as_secs_f64() * 1e3
+            ),
+        }
+    }
+}
+
+/// The device of a render being opened on a thread of its own ([`Opening::start`], as soon as
+/// the arguments name the backend) while the scene is read, checked and lowered and its kernel
+/// written: opening a device is most of the first second of `sdfc render` that is not the
+/// driver's floor (BENCHMARKS.md, "The first second"). [`Prepared::opened`] joins it where
+/// the device is needed. Dropped unjoined (a scene with errors), the thread is left to finish
+/// or to end with the process.
+#[derive(Debug)]
+pub struct Opening {
+    backend: Backend,
+    thread: std::thread::JoinHandle<Opened>,
+}
+
+/// What an [`Opening`]'s thread opened, and how long that took there.
+#[derive(Debug)]
+struct Opened {
+    /// The CUDA device (`--backend cuda`, or `auto` first).
+    cuda: Option<Result<Cuda, gpu::cuda::Error>>,
+    /// The wgpu device (`--backend wgpu`; for `auto`, a hardware adapter's, opened only when
+    /// CUDA could not be).
+    wgpu: Option<Result<Gpu, gpu::Error>>,
+    took: Duration,
+}
+
+impl Opening {
+    /// Starts opening the device [`Prepared::from_program`] would open for `backend` at
+    /// `precision`; `None` where it opens none (the CPU, or `auto` in f64).
+    pub fn start(backend: Backend, precision: Precision) -> Option<Opening> {
+        let open: fn() -> Opened = match backend {
+            Backend::Cpu => return None,
+            Backend::Auto if precision == Precision::F64 => return None,
+            Backend::Cuda => || Opened {
+                cuda: Some(Cuda::open()),
+                wgpu: None,
+                took: Duration::ZERO,
+            },
+            Backend::Wgpu => || Opened {
+                cuda: None,
+                wgpu: Some(Gpu::open(false)),
+                took: Duration::ZERO,
+            },
+            Backend::Auto => || {
+                let cuda = Cuda::open();
+                let wgpu = cuda.is_err().then(|| Gpu::open(true));
+                Opened {
+                    cuda: Some(cuda),
+                    wgpu,
+                    took: Duration::ZERO,
+                }
+            },
+        };
+        let thread = std::thread::Builder::new()
+            .name("sdfc device".into())
+            .spawn(move || {
+                let start = Instant::now();
+                let opened = open();
+                Opened {
+                    took: start.elapsed(),
+                    ..opened
+                }
+            })
+            .ok()?;
+        Some(Opening { backend, thread })
+    }
+
+    /// The backend it opens for.
+    pub fn backend(&self) -> Backend {
+        self.backend
+    }
+
+    /// Waits for the thread: what it opened, and how long this waited.
+    fn join(self) -> Result<(Opened, Duration), String> {
+        let start = Instant::now();
+        let opened = self
+            .thread
+            .join()
+            .map_err(|_| "the thread opening the device panicked".to_string())?;
+        Ok((opened, start.elapsed()))
+    }
 }
 
 /// A kernel loaded on a CUDA device, with what its launches need and the WGSL text it was
@@ -436,9 +533,18 @@ impl Prepared {
         let start = Instant::now();
         let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
         let device = start.elapsed();
-        let mut prepared = Self::on_gpu(Arc::new(gpu), scene, lowered, setup)?;
-        // The pipeline is created now, so that the first render does not include the
-        // driver's compile.
+        let prepared = Self::on_gpu(Arc::new(gpu), scene, lowered, setup)?;
+        Self::with_pipeline(prepared, device, None)
+    }
+
+    /// A wgpu preparation with its pipeline created now, so that the first render does not
+    /// include the driver's compile; `device` and `overlapped` are its device's opening
+    /// ([`Preparation`]).
+    fn with_pipeline(
+        mut prepared: Prepared,
+        device: Duration,
+        overlapped: Option<Duration>,
+    ) -> Result<Prepared, String> {
         if let Prepared::Wgpu {
             gpu,
             kernel,
@@ -451,8 +557,130 @@ impl Prepared {
             let pipeline = gpu.pipeline_for(&kernel.source, module, wgsl::ENTRY_POINT, data);
             timing.pipeline = Some(pipeline.map_err(|e| e.to_string())?);
             timing.device = device;
+            timing.overlapped = overlapped;
         }
         Ok(prepared)
+    }
+
+    /// The setup of a kernel on a wgpu adapter: on a CPU adapter (lavapipe) the interpreted
+    /// kernel's frames are 25 to 150 times the specialised kernel's (BENCHMARKS.md,
+    /// "Interpreted against specialised"), which its compile never repays, so `auto` keeps
+    /// the specialised kernel there, and for the frames of a sequence (`parameters`), which
+    /// share one specialised kernel.
+    fn wgpu_setup(cpu_adapter: bool, setup: &Setup) -> Setup {
+        if cpu_adapter || setup.parameters {
+            setup.specialised_for_auto()
+        } else {
+            *setup
+        }
+    }
+
+    /// [`Prepared::from_program`] on the device `opening` opens: its kernel is written while
+    /// the device opens (for `auto`, the CUDA kernel where a CUDA driver is installed), and
+    /// the thread is joined where the device is needed. The errors are those of
+    /// [`Prepared::from_program`], the device's before the kernel's, and `auto` falls back as
+    /// it does.
+    pub fn opened(
+        opening: Opening,
+        scene: &Scene,
+        lowered: Lowered,
+        setup: &Setup,
+    ) -> Result<Prepared, String> {
+        method_allowed(scene, &lowered.traceable)?;
+        let timed = |setup: &Setup| {
+            let start = Instant::now();
+            (Self::kernel(scene, &lowered, setup), start.elapsed())
+        };
+        match opening.backend {
+            Backend::Cuda => {
+                let kernel = timed(&setup.on_cuda());
+                let (opened, waited) = opening.join()?;
+                let cuda = opened.cuda.ok_or("no CUDA device was opened")?;
+                let cuda = cuda.map_err(|e| e.to_string())?;
+                let timing = Preparation {
+                    device: waited,
+                    kernel: kernel.1,
+                    pipeline: None,
+                    overlapped: Some(opened.took),
+                };
+                Self::cuda_prepared(cuda, kernel.0?, &lowered, setup, timing)
+            }
+            Backend::Wgpu => {
+                let hardware = Self::wgpu_setup(false, setup);
+                let kernel = timed(&hardware);
+                let (opened, waited) = opening.join()?;
+                let gpu = opened.wgpu.ok_or("no wgpu device was opened")?;
+                let gpu = gpu.map_err(|e| e.to_string())?;
+                let timing = (waited, opened.took);
+                Self::wgpu_opened(gpu, scene, &lowered, setup, (hardware, kernel), timing)
+            }
+            _ => {
+                let kernel = Cuda::driver_present().then(|| timed(&setup.on_cuda()));
+                let (opened, waited) = opening.join()?;
+                let cuda = match (opened.cuda, kernel) {
+                    (Some(Ok(cuda)), Some((kernel, time))) => {
+                        let timing = Preparation {
+                            device: waited,
+                            kernel: time,
+                            pipeline: None,
+                            overlapped: Some(opened.took),
+                        };
+                        kernel.and_then(|k| Self::cuda_prepared(cuda, k, &lowered, setup, timing))
+                    }
+                    (Some(Ok(cuda)), None) => Self::cuda(scene, &lowered, setup, || Ok(cuda)),
+                    _ => Err("no CUDA device".into()),
+                };
+                cuda.or_else(|_| match opened.wgpu {
+                    Some(Ok(gpu)) => {
+                        let hardware = Self::wgpu_setup(false, setup);
+                        let kernel = timed(&hardware);
+                        let timing = (waited, opened.took);
+                        Self::wgpu_opened(gpu, scene, &lowered, setup, (hardware, kernel), timing)
+                    }
+                    Some(Err(e)) => Err(e.to_string()),
+                    // CUDA opened, and its kernel failed: a GPU adapter, as `from_program`.
+                    None => Self::wgpu(scene, &lowered, setup, true),
+                })
+                .or_else(|_| Ok(Self::cpu(lowered, setup)))
+            }
+        }
+    }
+
+    /// A wgpu preparation on `gpu`, opened on an [`Opening`]'s thread in `took` while this
+    /// waited `waited` for it, with the kernel `written` (and the time it took) for the
+    /// setup `hardware` before the adapter was known: it serves when it is the kernel this
+    /// adapter's setup writes (only `wgsl::choose` reads the kernel choice, so a specialised
+    /// kernel is the same under either), and the kernel is written again otherwise.
+    fn wgpu_opened(
+        gpu: Gpu,
+        scene: &Scene,
+        lowered: &Lowered,
+        setup: &Setup,
+        (hardware, written): (Setup, (Result<wgsl::Kernel, String>, Duration)),
+        (waited, took): (Duration, Duration),
+    ) -> Result<Prepared, String> {
+        let setup = Self::wgpu_setup(gpu.is_cpu(), setup);
+        let (kernel, time) = match written {
+            (k, time) if setup == hardware || k.as_ref().is_ok_and(|k| !k.interpreted()) => {
+                (k?, time)
+            }
+            _ => {
+                let start = Instant::now();
+                (Self::kernel(scene, lowered, &setup)?, start.elapsed())
+            }
+        };
+        let prepared = Prepared::Wgpu {
+            gpu: Arc::new(gpu),
+            kernel: Box::new(kernel),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
+            setup,
+            timing: Preparation {
+                kernel: time,
+                ..Preparation::default()
+            },
+        };
+        Self::with_pipeline(prepared, waited, Some(took))
     }
 
     /// Prepares `scene`, lowered as `lowered`, for wgpu on an already opened device:
@@ -478,15 +706,7 @@ impl Prepared {
         held: Option<&wgsl::Kernel>,
     ) -> Result<(Prepared, bool), String> {
         method_allowed(scene, &lowered.traceable)?;
-        // On a CPU adapter (lavapipe) the interpreted kernel's frames are 25 to 150 times the
-        // specialised kernel's (BENCHMARKS.md, "Interpreted against specialised"), which its
-        // compile never repays: `auto` keeps the specialised kernel there, and for the frames
-        // of a sequence (`parameters`), which share one specialised kernel.
-        let setup = &if gpu.is_cpu() || setup.parameters {
-            setup.specialised_for_auto()
-        } else {
-            *setup
-        };
+        let setup = &Self::wgpu_setup(gpu.is_cpu(), setup);
         let start = Instant::now();
         let (kernel, built) = match held {
             Some(held) => {
@@ -586,8 +806,20 @@ impl Prepared {
         let timing = Preparation {
             device,
             kernel: start.elapsed(),
-            pipeline: None,
+            ..Preparation::default()
         };
+        Self::cuda_prepared(cuda, kernel, lowered, setup, timing)
+    }
+
+    /// The CUDA preparation of `kernel` (written for `lowered`) on `cuda`: translated to PTX
+    /// and loaded.
+    fn cuda_prepared(
+        cuda: Cuda,
+        kernel: wgsl::Kernel,
+        lowered: &Lowered,
+        setup: &Setup,
+        timing: Preparation,
+    ) -> Result<Prepared, String> {
         let module = Self::cuda_module_of(&cuda, kernel)?;
         Ok(Prepared::Cuda {
             cuda: Box::new(cuda),
@@ -813,24 +1045,35 @@ impl Prepared {
     /// Where the first preparation for a GPU went, for `--stats`: (phase, time, how) for
     /// the device, the kernel, its PTX and the driver's compile; empty on the CPU.
     pub fn preparation(&self) -> Vec<(&'static str, Duration, String)> {
+        let mut parts = self.preparation_parts();
+        // A device opened beside the front end was waited for after the kernel was written:
+        // the phases in the order they ended.
+        if let Prepared::Wgpu { timing, .. } | Prepared::Cuda { timing, .. } = self {
+            if timing.overlapped.is_some() && parts.len() >= 2 {
+                parts.swap(0, 1);
+            }
+        }
+        parts
+    }
+
+    /// [`Prepared::preparation`], the device first.
+    fn preparation_parts(&self) -> Vec<(&'static str, Duration, String)> {
         use gpu::wgpu::DriverCache;
         match self {
             Prepared::Cpu { .. } => Vec::new(),
             // Several devices: the first device's (they are prepared one after another).
             Prepared::Several(parts) => parts.first().map(|p| p.preparation()).unwrap_or_default(),
             Prepared::Wgpu { timing, .. } => {
-                let mut out = vec![
-                    (
-                        "device",
-                        timing.device,
-                        "wgpu adapters enumerated, device opened".into(),
-                    ),
-                    (
-                        "kernel",
-                        timing.kernel,
-                        "WGSL written and validated by naga".into(),
-                    ),
-                ];
+                let mut out = vec![(
+                    "device",
+                    timing.device,
+                    timing.opening("wgpu adapters enumerated, device opened"),
+                )];
+                out.extend([(
+                    "kernel",
+                    timing.kernel,
+                    "WGSL written and validated by naga".into(),
+                )]);
                 if let Some(p) = timing.pipeline {
                     let how = match p.driver {
                         DriverCache::NotAsked => "found among this device's pipelines".into(),
@@ -849,7 +1092,11 @@ impl Prepared {
                 out
             }
             Prepared::Cuda { timing, module, .. } => vec![
-                ("device", timing.device, "CUDA context created".into()),
+                (
+                    "device",
+                    timing.device,
+                    timing.opening("CUDA context created"),
+                ),
                 (
                     "kernel",
                     timing.kernel,

@@ -1,11 +1,12 @@
 //! Where an image goes: the format its file name's extension names (PNG, JPEG or OpenEXR), or
 //! PNG on standard output for `-`; checked before a render starts, so that a long render is
 //! never thrown away because its output cannot be written. Files are written atomically
-//! ([`crate::image::write_atomic_with`]); JPEG and OpenEXR are streamed into them.
+//! ([`crate::image::AtomicFile`]); JPEG and OpenEXR are streamed into them.
 
-use crate::image::{write_atomic_with, Image, SrgbTable};
+use crate::image::{AtomicFile, Image, SrgbTable};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// An image file format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,6 +49,26 @@ impl Format {
         }
     }
 }
+
+/// The image's PNG bytes, with the steps of their encoding: the sRGB encoding and the PNG's
+/// filtering and compression.
+fn png_steps(image: &Image) -> Result<(Vec<u8>, Vec<Step>), crate::image::ImageError> {
+    let start = Instant::now();
+    let (bytes, srgb) = image.encode_png_timed()?;
+    let png = start.elapsed().saturating_sub(srgb);
+    let steps = vec![
+        ("sRGB", srgb, "clamped and encoded by table".to_string()),
+        (
+            "PNG",
+            png,
+            "filtered and compressed at the `Fast` level".to_string(),
+        ),
+    ];
+    Ok((bytes, steps))
+}
+
+/// A step of writing an image and its time, with what it was ([`Output::write`]).
+pub type Step = (&'static str, Duration, String);
 
 /// Where `sdfc render` writes its image.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -93,19 +114,65 @@ impl Output {
         })
     }
 
-    /// Writes `image`: to the file atomically, or to standard output.
-    pub fn write(&self, image: &Image) -> Result<(), String> {
-        match self {
+    /// Writes `image`: to the file atomically (synced to the disk before its rename when
+    /// `sync`: [`AtomicFile::create`], else [`AtomicFile::unsynced`]), or to standard output.
+    /// Says where the time went (`sdfc render --stats`): (step, time, what) for the
+    /// encoding, the write, and for a file its `fsync` and rename.
+    pub fn write(&self, image: &Image, sync: bool) -> Result<Vec<Step>, String> {
+        let (path, format) = match self {
             Output::Stdout => {
+                let cannot = |e: String| format!("cannot write the image to standard output: {e}");
+                let (bytes, mut steps) = png_steps(image).map_err(|e| cannot(e.to_string()))?;
+                let start = Instant::now();
                 let mut out = std::io::stdout().lock();
-                Format::Png
-                    .write(image, &mut out)
+                out.write_all(&bytes)
                     .and_then(|()| out.flush())
-                    .map_err(|e| format!("cannot write the image to standard output: {e}"))
+                    .map_err(|e| cannot(e.to_string()))?;
+                steps.push(("write", start.elapsed(), "to standard output".to_string()));
+                return Ok(steps);
             }
-            Output::File { path, format } => write_atomic_with(path, |w| format.write(image, w))
-                .map_err(|e| format!("cannot write `{}`: {e}", path.display())),
+            Output::File { path, format } => (path, *format),
+        };
+        let cannot = |e: std::io::Error| format!("cannot write `{}`: {e}", path.display());
+        let mut steps = Vec::new();
+        let png = if format == Format::Png {
+            let (bytes, encoded) =
+                png_steps(image).map_err(|e| cannot(std::io::Error::other(e)))?;
+            steps.extend(encoded);
+            Some(bytes)
+        } else {
+            None
+        };
+        let file = match sync {
+            true => AtomicFile::create(path),
+            false => AtomicFile::unsynced(path),
+        };
+        let mut file = file.map_err(cannot)?;
+        let start = Instant::now();
+        match &png {
+            Some(bytes) => file.write_all(bytes),
+            None => format.write(image, &mut file),
         }
+        .map_err(cannot)?;
+        let wrote = start.elapsed();
+        let done = file.finish_timed().map_err(cannot)?;
+        steps.push(match png {
+            Some(_) => (
+                "write",
+                wrote + done.flush,
+                "to a temporary file beside it".into(),
+            ),
+            None => (
+                "encode",
+                wrote + done.flush,
+                "encoded and streamed into a temporary file beside it".into(),
+            ),
+        });
+        if let Some(t) = done.sync {
+            steps.push(("fsync", t, "its data synced to the disk".into()));
+        }
+        steps.push(("rename", done.rename, "onto the image's name".into()));
+        Ok(steps)
     }
 
     /// The file, or `None` for standard output.

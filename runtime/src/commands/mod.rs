@@ -31,6 +31,37 @@ pub fn started() -> (Instant, Option<Duration>) {
     *MAIN.get_or_init(|| (Instant::now(), None))
 }
 
+/// Ends the process now with `code`, after flushing standard output and error, leaving
+/// `objects` (a finished render's device, kernel and thread pool) and everything else to the
+/// operating system: neither their destructors nor the exit handlers of the libraries loaded
+/// run. Destroying a CUDA context or a Vulkan device one object at a time, and the drivers'
+/// own teardown at exit, is work the operating system does anyway when the process ends (it
+/// closes the driver's files and unmaps its memory, as for a process that is killed); and a
+/// device still being opened on its thread ([`crate::backend::Opening`]) when a command fails
+/// would otherwise run beside those exit handlers. Called at the very end of a command, once
+/// its files are written, synced and renamed and its messages printed.
+pub fn exit_now(code: std::process::ExitCode, objects: impl Sized) -> ! {
+    use std::io::Write;
+    std::mem::forget(objects);
+    let _ = std::io::stdout().flush();
+    let _ = std::io::stderr().flush();
+    // `ExitCode` does not give its number back: it is the one it equals.
+    let code = (0..=255u8)
+        .find(|&n| std::process::ExitCode::from(n) == code)
+        .unwrap_or(1);
+    #[cfg(unix)]
+    {
+        // SAFETY: `_exit` ends the process at once; nothing of it runs afterwards, and the
+        // standard streams were flushed above.
+        #[allow(unsafe_code)]
+        unsafe {
+            libc::_exit(code.into())
+        }
+    }
+    #[cfg(not(unix))]
+    std::process::exit(code.into())
+}
+
 /// How long ago this process started, from Linux's /proc: its start in clock ticks since
 /// boot (`/proc/self/stat`, field 22, at USER_HZ = 100, the value Linux's common
 /// architectures export) against the time since boot (`/proc/uptime`, in hundredths of a

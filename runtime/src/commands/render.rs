@@ -3,7 +3,7 @@
 //! `sdfc pareto` share (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread
 //! pools).
 
-use crate::backend::{Devices, Frame, Prepared, Setup};
+use crate::backend::{Devices, Frame, Opening, Prepared, Setup};
 use crate::cpu::reference::{self, Convergence};
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat};
@@ -141,14 +141,20 @@ pub fn run(args: RenderArgs) -> ExitCode {
             .output
             .as_deref()
             .is_some_and(|o| o.to_string_lossy().contains('#'));
-    let result = if sequence {
-        super::sequence::run(&args)
-    } else {
-        still(&args)
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => e.exit(),
+    if sequence {
+        return match super::sequence::run(&args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => e.exit(),
+        };
+    }
+    match still(&args) {
+        // The image is written, renamed and synced and the messages printed: the device,
+        // its kernel and the thread pool are left to the operating system (see
+        // `super::exit_now`).
+        Ok(finished) => super::exit_now(ExitCode::SUCCESS, finished),
+        // A device may still be opening on its thread ([`Opening`]): the process ends
+        // without running the libraries' exit handlers beside it.
+        Err(e) => super::exit_now(e.exit(), ()),
     }
 }
 
@@ -225,12 +231,14 @@ pub fn frame_scene(
     })
 }
 
-/// Prepares a frame's scene on the backend's `devices`.
+/// Prepares a frame's scene on the backend's `devices`, or on the device `opening` opens
+/// (for `--devices auto`) when given.
 pub fn prepare(
     pool: &rayon::ThreadPool,
     (backend, devices): (Backend, &Devices),
     frame: FrameScene,
     setup: &Setup,
+    opening: Option<Opening>,
 ) -> Result<(Scene, Prepared), CliError> {
     let FrameScene { scene, lowered } = frame;
     // A kernel asked for that cannot render the scene is an error, not a reason to fall back
@@ -243,7 +251,12 @@ pub fn prepare(
         sdfc_compiler::back::wgsl::choose(&scene, &lowered, &options).map_err(CliError::Failed)?;
     }
     let prepared = pool
-        .install(|| Prepared::on_devices(backend, devices, &scene, lowered, setup))
+        .install(|| match opening {
+            Some(o) if o.backend() == backend && *devices == Devices::Auto => {
+                Prepared::opened(o, &scene, lowered, setup)
+            }
+            _ => Prepared::on_devices(backend, devices, &scene, lowered, setup),
+        })
         .map_err(|msg| {
             CliError::Failed(format!("the {backend:?} backend is not available: {msg}"))
         })?;
@@ -270,9 +283,24 @@ pub fn check_memory(
     needed.check(limits).map_err(CliError::Failed)
 }
 
+/// What a still render leaves when it has finished: its device, kernel and thread pool.
+type Finished = (Prepared, rayon::ThreadPool);
+
 /// Renders one image (the scene at the time 0).
-fn still(args: &RenderArgs) -> Result<(), CliError> {
+fn still(args: &RenderArgs) -> Result<Finished, CliError> {
     let mut run = Run::new();
+    // The device opens on a thread of its own from here, while the scene is read, checked
+    // and lowered and its kernel written; the arguments' errors are reported after the
+    // scene's, as ever.
+    let mode = reference_mode(args);
+    let opening = match mode {
+        Ok((backend, precision))
+            if args.devices == Devices::Auto && Kernel::check(args.kernel, backend).is_ok() =>
+        {
+            Opening::start(backend, precision)
+        }
+        _ => None,
+    };
     let limits = args.limits.limits();
     let mut source = frontend::Source::read(&args.file).map_err(CliError::Usage)?;
     let frame = frame_scene(
@@ -284,7 +312,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         &LowerOptions::default(),
     )?;
     run.lap("scene", "read, checked and lowered");
-    let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
+    let (backend, precision) = mode.map_err(CliError::Usage)?;
     Kernel::check(args.kernel, backend).map_err(CliError::Usage)?;
     // The output is checked before any work, so that a render is never thrown away.
     let out = output(args).map_err(CliError::Usage)?;
@@ -297,7 +325,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
         kernel: args.kernel.unwrap_or_default().choice(),
         image_only: !args.stats,
     };
-    let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup)?;
+    let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup, opening)?;
     run.split("preparation", "the rest of it", prepared.preparation());
     check_memory(
         &pool,
@@ -348,12 +376,20 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
     if check.is_some() {
         run.lap("check", "the reference's convergence");
     }
-    out.write(&frame.render.image).map_err(CliError::Usage)?;
+    // Not synced to the disk: complete or untouched whatever happens to the process, as a
+    // compiler's output (`AtomicFile::unsynced`).
+    let steps = out
+        .write(&frame.render.image, false)
+        .map_err(CliError::Usage)?;
     if let (true, Some(path)) = (args.aux, out.path()) {
         write_sidecar(path, frame.render.depth.as_ref(), prepared.name())
             .map_err(CliError::Usage)?;
     }
-    run.lap("image", "encoded and written");
+    run.split(
+        "image",
+        "the rest of it (the depth sidecar, with --aux)",
+        steps,
+    );
     let s = &scene.settings;
     eprintln!(
         "wrote {} ({}x{}, aa {}, {} on {}, {:.3} s)",
@@ -378,7 +414,7 @@ fn still(args: &RenderArgs) -> Result<(), CliError> {
     if let Some(c) = check.as_ref().filter(|c| !c.converged) {
         eprintln!("warning: {}", not_converged(c));
     }
-    Ok(())
+    Ok((prepared, pool))
 }
 
 /// Where a whole `sdfc render` went, from the process's start (`--stats`): the time before
@@ -396,10 +432,13 @@ struct Run {
 impl Run {
     fn new() -> Run {
         let main = super::started();
+        let now = Instant::now();
         Run {
             main,
-            last: main.0,
-            phases: vec![("arguments", Instant::now() - main.0, "parsed".into())],
+            // The next phase starts where the arguments' ended (not at `main`: that counted
+            // the arguments twice).
+            last: now,
+            phases: vec![("arguments", now - main.0, "parsed".into())],
         }
     }
 
@@ -453,7 +492,11 @@ impl std::fmt::Display for Run {
         for (name, d, what) in &self.phases {
             writeln!(f, "  {name:<16}{:>9.1} ms  {what}", ms(*d))?;
         }
-        Ok(())
+        writeln!(
+            f,
+            "  {:<16}{:>9} ms  the device, kernel and thread pool left to the operating system (not destroyed; the process's end is not timed from inside it)",
+            "exit", "-"
+        )
     }
 }
 

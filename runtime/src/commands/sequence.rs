@@ -441,7 +441,8 @@ impl FramesOn<'_> {
                                 path: pattern.path(k),
                                 format: *format,
                             };
-                            if let Err(e) = file.write(&image) {
+                            // Synced: a rerun skips the frames whose files it finds.
+                            if let Err(e) = file.write(&image, true) {
                                 let _ = tx.send(Report::Unwritten(e));
                             }
                             None
@@ -609,8 +610,13 @@ impl<'a> Kernels<'a> {
             }
             None => {
                 let program = frame.lowered.program.clone();
-                let (scene, prepared) =
-                    prepare(self.pool, (self.backend, &self.devices), frame, &self.setup)?;
+                let (scene, prepared) = prepare(
+                    self.pool,
+                    (self.backend, &self.devices),
+                    frame,
+                    &self.setup,
+                    None,
+                )?;
                 self.count += 1;
                 self.prepared = Some((program, scene.origin, prepared));
                 scene
@@ -728,7 +734,9 @@ impl Sink {
                 path: p.path(k),
                 format: *format,
             }
-            .write(image)
+            // Synced: a rerun skips the frames whose files it finds.
+            .write(image, true)
+            .map(|_| ())
             .map_err(CliError::Usage),
             Sink::Apng {
                 path,

@@ -103,10 +103,15 @@ impl Cuda {
         Self::open_device(0, false)
     }
 
+    /// Whether the CUDA driver's library (libcuda) can be loaded; no driver call is made.
+    pub fn driver_present() -> bool {
+        // SAFETY: only tries to dlopen libcuda; no driver call is made.
+        unsafe { sys::is_culib_present() }
+    }
+
     /// The number of CUDA devices (0 without a driver).
     pub fn count() -> usize {
-        // SAFETY: only tries to dlopen libcuda; no driver call is made.
-        if !unsafe { sys::is_culib_present() } {
+        if !Self::driver_present() {
             return 0;
         }
         CudaContext::device_count().map_or(0, |n| n.max(0) as usize)
@@ -116,8 +121,7 @@ impl Cuda {
     /// (two `Cuda` opened on one device then run side by side, as two logical devices);
     /// otherwise to the context's default stream.
     pub fn open_device(ordinal: usize, own_stream: bool) -> Result<Cuda, Error> {
-        // SAFETY: only tries to dlopen libcuda; no driver call is made.
-        if !unsafe { sys::is_culib_present() } {
+        if !Self::driver_present() {
             return Err(Error::NoDriver);
         }
         let count = CudaContext::device_count().map_err(driver("counting devices"))?;

@@ -4,7 +4,12 @@
 # and the scaling scenes at 1920x1080 through CUDA and wgpu (GPU time and wall time, medians of
 # `sdfc bench`), marched where the scene allows it, and prints the wgpu/CUDA ratios. Expects
 # the sdfc binary at .dev/sdfc and the Vulkan loader packages in .gl/; nvcc on PATH for (hand).
-# Usage: scripts/device-scale.sh [all|hand|scale]
+# (walk) times the marched scaling scenes (compound_1000, jittered_1024, random_10000) at
+# 1920x1080 through CUDA and wgpu with each of several sdfc binaries, WALK_BINS="label:path
+# ..." (a path ending in .gz is unpacked first; default: main:.dev/sdfc-main.gz
+# hint:.dev/sdfc-hint.gz new:.dev/sdfc), and checks that every binary's CUDA image equals the
+# first's (PSNR inf).
+# Usage: scripts/device-scale.sh [all|hand|scale|walk]
 set -u
 . "$(dirname "$0")/device-env.sh"
 MODE=${1:-all}
@@ -53,4 +58,43 @@ if [ "$MODE" = all ] || [ "$MODE" = scale ]; then
   row "jittered_1024 march" examples/scaling/jittered_1024.sdf --set method=march
   row "jittered_1024 traced" examples/scaling/jittered_1024.sdf
   cat "$OUT/scale.txt"
+fi
+
+if [ "$MODE" = walk ]; then
+  bins=()
+  for spec in ${WALK_BINS:-main:.dev/sdfc-main.gz hint:.dev/sdfc-hint.gz new:.dev/sdfc}; do
+    label=${spec%%:*}; path=${spec#*:}
+    case "$path" in
+      *.gz) gunzip -c "$path" > "/tmp/sdfc-$label" || continue; path=/tmp/sdfc-$label ;;
+    esac
+    [ -f "$path" ] || { echo "no binary $path" >&2; continue; }
+    chmod +x "$path"
+    bins+=("$label:$path")
+  done
+  {
+    printf '%-22s %-5s' "scene (1920x1080)" "api"
+    for spec in "${bins[@]}"; do printf ' %12s' "${spec%%:*} ms"; done
+    printf '\n'
+  } > "$OUT/walk.txt"
+  for n in compound_1000 jittered_1024 random_10000; do
+    for api in cuda wgpu; do
+      printf '%-22s %-5s' "$n march" "$api" >> "$OUT/walk.txt"
+      for spec in "${bins[@]}"; do
+        B=${spec#*:}
+        read -r g _ _ <<<"$(bench "examples/scaling/$n.sdf" --set method=march --backend $api --size 1920x1080)"
+        printf ' %12s' "$g" >> "$OUT/walk.txt"
+      done
+      printf '\n' >> "$OUT/walk.txt"
+    done
+    first=
+    for spec in "${bins[@]}"; do
+      label=${spec%%:*}
+      "${spec#*:}" render "examples/scaling/$n.sdf" --set method=march --backend cuda --size 1920x1080 \
+        -o "/tmp/sdfc-img/walk-$n-$label.png" >/dev/null 2>>"$OUT/bench-errors.txt"
+      if [ -z "$first" ]; then first=$label; continue; fi
+      psnr=$("$B" compare "/tmp/sdfc-img/walk-$n-$first.png" "/tmp/sdfc-img/walk-$n-$label.png" 2>&1 | awk '/^psnr/ {print $2, $3}')
+      echo "$n: $label against $first, CUDA image: PSNR $psnr" >> "$OUT/walk.txt"
+    done
+  done
+  cat "$OUT/walk.txt"
 fi

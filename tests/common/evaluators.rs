@@ -34,9 +34,14 @@ pub const ENTRY_POINT: &str = "eval_points";
 /// evaluates them at point `i` (x, y, z; w unused) and writes (distance, material id, distance
 /// alone or `map`'s distance again, 0).
 /// The buffers hold a whole number of workgroups (the points padded, [`point_words`]), so
-/// that no thread needs `arrayLength`, which PTX cannot know.
-pub fn entry(group: u32, alone: Option<&str>) -> String {
+/// that no thread needs `arrayLength`, which PTX cannot know. With `warm` (a name), an odd
+/// thread first calls it at the point before its own, so that the instance walk starts from
+/// another point's hint.
+pub fn entry(group: u32, alone: Option<&str>, warm: Option<&str>) -> String {
     let alone = alone.map_or("m.x".to_string(), |f| format!("{f}(p)"));
+    let warm = warm.map_or(String::new(), |f| {
+        format!("if (id.x & 1u) == 1u {{\n        _ = {f}(eval_points_in[id.x - 1u].xyz);\n    }}\n    ")
+    });
     format!(
         "
 @group({group}) @binding(0) var<storage, read> eval_points_in: array<vec4<f32>>;
@@ -45,7 +50,7 @@ pub fn entry(group: u32, alone: Option<&str>) -> String {
 @compute @workgroup_size({WORKGROUP})
 fn {ENTRY_POINT}(@builtin(global_invocation_id) id: vec3<u32>) {{
     let p = eval_points_in[id.x].xyz;
-    let m = map(p);
+    {warm}let m = map(p);
     eval_points_out[id.x] = vec4<f32>(m, {alone}, 0.0);
 }}
 "
@@ -85,12 +90,17 @@ fn validated(source: String, group: u32, data: Option<Vec<u8>>) -> PointsModule 
 pub fn points_module(scene: &Scene, lowered: &Lowered, alone: bool) -> PointsModule {
     let part = wgsl::part::write(scene, lowered, "map").expect("the part validates");
     let alone = alone.then_some("map_distance");
-    validated(format!("{}\n{}", part.source, entry(0, alone)), 0, None)
+    validated(
+        format!("{}\n{}", part.source, entry(0, alone, None)),
+        0,
+        None,
+    )
 }
 
 /// The marched kernel of `scene` with every instance of its root union walked in
 /// `scene_data`, its `map` and `sdf` with [`entry`] (in bind group 1, beside the kernel's
-/// group 0); none where the scene has no instances.
+/// group 0), every other point's walks hinted by `sdf` at the point before it; none where
+/// the scene has no instances.
 pub fn walk_module(scene: &Scene) -> Option<PointsModule> {
     let mut marched = scene.clone();
     marched.settings.method = Method::March;
@@ -104,7 +114,7 @@ pub fn walk_module(scene: &Scene) -> Option<PointsModule> {
     let walked = kernel.source.contains("fn walk_map(");
     let data = kernel.data.filter(|_| walked)?;
     Some(validated(
-        format!("{}\n{}", kernel.source, entry(1, Some("sdf"))),
+        format!("{}\n{}", kernel.source, entry(1, Some("sdf"), Some("sdf"))),
         1,
         Some(data),
     ))

@@ -48,10 +48,10 @@
 //! measures the boxes of both children, goes on into the nearer and pushes the farther, with
 //! its box's distance, on a stack; at a leaf it evaluates the instances; then it pops the
 //! stack, passing over every child whose box is no longer nearer than the best distance. The
-//! stack starts with the root, popped before anything is pushed, then holds at most one child
-//! per level below the root (when a child of level k is popped, the others are of levels
-//! below k, and the descent from it pushes at most one of each level below it), so an array
-//! of max(D, 1) entries, which the kernel is written with, never overflows. A point near the surface thus meets its nearest instances first, its best
+//! stack holds at most one child per level below the root (when a child of level k is
+//! popped, the others are of levels below k, and the descent from it pushes at most one of
+//! each level below it), so an array of max(D, 1) entries, which the kernel is written with,
+//! never overflows. A point near the surface thus meets its nearest instances first, its best
 //! distance is small early, and the boxes prune all but a few paths down the tree: a step
 //! costs about log n box tests and a few instances, where a walk in a fixed order costs what
 //! lies before the point's nearest instance in that order. (A uniform grid of cells would also
@@ -60,8 +60,7 @@
 //! a bound, and a scene's instances are seldom uniformly spread: compound_1000's lamp posts
 //! and a lattice over a plane would leave most cells empty or most instances in a few.)
 //!
-//! Before the hierarchy each walk evaluates one instance, its hint (as a leaf of one, in the
-//! same loop, so that the kernel holds one copy of the instances' code): the private variable
+//! Before the hierarchy each walk evaluates one instance, its hint: the private variable
 //! `hint` holds the entry of the instance that was nearest at the invocation's last `sdf`
 //! (0 before the first, and kept while the rest of the scene is nearer). Successive steps of
 //! a march, a normal's taps, the material's lookup and the shadow rays from a hit stay near
@@ -387,29 +386,39 @@ fn walk(out: &mut String, material: bool, stack: usize) {
         "    var best = start;\n\
          \x20   // The entry of best's instance; 0: start.\n\
          \x20   var owner = 0u;\n\
-         \x20   // Children still to enter and the distances of their boxes: the root, then at most\n\
-         \x20   // one per level.\n\
+         \x20   if hint != 0u {{\n\
+         \x20       let head = scene_data[hint];\n\
+         \x20       let d = instance_distance(hint, head, p);\n\
+         \x20       if d < {d} {{\n\
+         \x20           best = {};\n\
+         \x20           owner = hint;\n\
+         \x20       }}\n\
+         \x20   }}\n\
+         \x20   // Children still to enter and the distances of their boxes, one per level at most.\n\
          \x20   var stack: array<u32, {stack}>;\n\
          \x20   var near: array<f32, {stack}>;\n\
          \x20   var sp = 0u;\n\
-         \x20   let root = scene_data[0u];\n\
-         \x20   let d0 = box_of(abs(p - root.xyz) - scene_data[1u].xyz);\n\
-         \x20   if d0 {not_farther} {d} {{\n\
-         \x20       stack[0] = bitcast<u32>(root.w);\n\
-         \x20       near[0] = d0;\n\
-         \x20       sp = 1u;\n\
-         \x20   }}\n\
-         \x20   // The instances of a leaf still to visit, [i, stop): first the hint alone (the step\n\
-         \x20   // past it passes stop).\n\
-         \x20   var i = hint;\n\
-         \x20   var stop = select(0u, hint + 1u, hint != 0u);\n\
+         \x20   // The instances of a leaf still to visit: [i, stop).\n\
+         \x20   var i = 0u;\n\
+         \x20   var stop = 0u;\n\
          \x20   // The group to enter next (0: none; then the stack's top).\n\
          \x20   var g = 0u;\n\
+         \x20   let root = scene_data[0u];\n\
+         \x20   if box_of(abs(p - root.xyz) - scene_data[1u].xyz) {not_farther} {d} {{\n\
+         \x20       let r = bitcast<u32>(root.w);\n\
+         \x20       {}\n\
+         \x20   }}\n\
          \x20   loop {{\n\
          \x20       if i < stop {{\n\
          \x20           let head = scene_data[i];\n\
          \x20           let tag = bitcast<u32>(head.w);\n\
-         \x20           let d = instance_distance(i, head, p);\n"
+         \x20           let d = instance_distance(i, head, p);\n",
+        if material {
+            format!("vec2<f32>(d, f32(bitcast<u32>(head.w) >> {MATERIAL_SHIFT}u))")
+        } else {
+            "d".to_string()
+        },
+        take(8)
     );
     if material {
         let _ = write!(

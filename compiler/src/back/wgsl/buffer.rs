@@ -29,8 +29,8 @@ use std::fmt::Write;
 
 // An entry's tag, in both layouts of `scene_data` (this one, of a traced scene's primitives,
 // and march.rs's, of a marched scene's instances): the kind of entry in the low bits
-// (`KIND_BITS`), GROUP (this layout's groups) or a kind of leaf; `TRANSFORMED` for a leaf
-// with a frame of its own; the material above `MATERIAL_SHIFT`.
+// (`KIND_BITS`), GROUP or a kind of leaf; `TRANSFORMED` for a leaf with a frame of its own;
+// the material above `MATERIAL_SHIFT`.
 
 /// The tag of a group; the other values of the kind bits are the kinds of leaf of a layout.
 pub(super) const GROUP: u32 = 7;
@@ -95,7 +95,8 @@ pub fn data(primitives: &[Primitive], top: &[Item]) -> Vec<u8> {
 
 /// The bytes of a `scene_data` buffer for a hierarchy `items`: `[0]` holds the index one past
 /// the last entry, then the entries of a depth-first walk, a group as `(centre, group)` and
-/// `(half-extents, next)`, a leaf as `leaf` writes it (the layout above).
+/// `(half-extents, next)`, a leaf as `leaf` writes it (the layout above; the marched kernel's
+/// `march.rs` shares it with other leaves).
 pub(super) fn entries(items: &[Item], leaf: &mut dyn FnMut(&mut Vec<[u32; 4]>, usize)) -> Vec<u8> {
     fn push(
         out: &mut Vec<[u32; 4]>,
@@ -212,7 +213,7 @@ pub fn write(primitives: &[Primitive], top: &[Item], glass: bool) -> String {
     out
 }
 
-/// The loop over the entries of `scene_data` (this layout's, of a traced scene): a
+/// The loop over the entries of `scene_data` (of the traced and the marched walks alike): a
 /// group (centre `head.xyz`, half-size `size.xyz`) is entered where the WGSL condition `enter`
 /// holds, else skipped to its end (with `enter` absent, the data has no groups); any other
 /// entry is met by the statements `visit`, which step `i` past it.

@@ -5,22 +5,16 @@
 //! nearer one's material (the rest's on a tie, else the material of the instance earlier in
 //! `scene_data`): the field of the whole program, evaluated in another order.
 //!
-//! Layout: an array of `vec4<f32>`; integers are stored as their bits (`bitcast<u32>`). A
-//! child of the hierarchy is named by a reference: the index of its entry, and above bit
-//! `LEAF_SHIFT` (27) the number of vectors of a leaf's instances, 0 for a group.
+//! Layout: an array of `vec4<f32>`; integers are stored as their bits (`bitcast<u32>`).
 //!
 //! ```text
-//! [0]          (root's box centre.xyz, root's reference)
-//! [1]          (root's box half-extents.xyz, end): end is the index past the last entry
-//! [2 .. end)   the entries, in the order of a depth-first walk of the hierarchy; the root
-//!              is one group, or (a scene of a few instances) the instances alone in a box
-//!              that holds everything (half-extents f32::MAX)
-//!   group      [i]     (first child's box centre.xyz, its reference)
-//!              [i + 1] (first child's box half-extents.xyz, 0)
-//!              [i + 2] (second child's box centre.xyz, its reference)
-//!              [i + 3] (second child's box half-extents.xyz, 0); the children's entries
-//!                      follow, the first's first; a child is a group or a leaf
-//!   leaf       the entries of its two to four instances, one after the other
+//! [0]          (end, 0, 0, 0): the index one past the last entry
+//! [1 .. end)   the entries, in the order of a depth-first walk of the hierarchy: either
+//!              one group, the root, or (a scene of a few instances) the instances alone
+//!   group      [i]     (centre.xyz, GROUP)
+//!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries
+//!              [i + 2 .. next) either two groups (the second at the first's next) or from
+//!                      two to four instances (a leaf)
 //!   instance   [i]     (offset.xyz, kind | ROTATED | material << 4): the point in the
 //!                      shape's frame is q = rotate(p) − offset
 //!              [i + 1] the shape: sphere (r, 0, 0, 0), box (half.xyz, 0), round box
@@ -30,25 +24,21 @@
 //!                      (q_j = Σ_i p_i·M_ij)
 //! ```
 //!
-//! A group holds its children's boxes, so entering it is one read of four adjacent vectors,
-//! where a group that held its own box cost two dependent reads (the first child's entry, then
-//! the second's, whose place the first's gives).
-//!
 //! The constants are `lower::slots`, computed in f64 and rounded to f32 as the program's are,
 //! and each kind's shape function is lowered by the rules of `lower/shapes.rs` that lower the
 //! program (`lower::shape_program`, written by `map::write_shape`), so the walk computes the
 //! program's operations in the program's order and the GPU's field equals the CPU's up to f32
 //! rounding. Every instance is an exact distance, so its value
-//! is at least the signed distance to its box, and a child whose box is not nearer than the
+//! is at least the signed distance to its box, and a group whose box is not nearer than the
 //! best distance so far cannot change the minimum: skipping it is exact.
 //!
 //! The walk visits the hierarchy nearest first. The hierarchy is the median-split tree of
 //! `scene::analytic::boxed`, binary down to leaves of at most four instances, and balanced:
-//! its depth D (the root's children at level 0) is ⌈log₂(n / 4)⌉ or less. In a group the walk
+//! its depth D (the root's groups at level 0) is ⌈log₂(n / 4)⌉ or less. At a group the walk
 //! measures the boxes of both children, goes on into the nearer and pushes the farther, with
 //! its box's distance, on a stack; at a leaf it evaluates the instances; then it pops the
-//! stack, passing over every child whose box is no longer nearer than the best distance. The
-//! stack holds at most one child per level below the root (when a child of level k is
+//! stack, passing over every group whose box is no longer nearer than the best distance. The
+//! stack holds at most one group per level below the root (when a group of level k is
 //! popped, the others are of levels below k, and the descent from it pushes at most one of
 //! each level below it), so an array of max(D, 1) entries, which the kernel is written with,
 //! never overflows. A point near the surface thus meets its nearest instances first, its best
@@ -75,12 +65,14 @@
 //! `walk_map`, which gives the material, keeps the tie rule independent of the order of the
 //! visit (the hint included): among instances at the same distance the one earlier in
 //! `scene_data` wins (the rest of the scene before any), and it
-//! passes over a child only when its box is farther than the best distance (a child at
+//! passes over a group only when its box is farther than the best distance (a group at
 //! exactly that distance may hold an earlier instance that ties). `walk_sdf`, the distance
-//! alone, passes over a child whose box is not nearer. An unrotated instance takes 32 bytes,
-//! a rotated one 80, a group 64.
+//! alone, passes over a group whose box is not nearer. An unrotated instance takes 32 bytes,
+//! a rotated one 80, a group 32.
 
-use super::buffer::{self, bits, tag, tag_holds, vec, KIND_BITS, MATERIAL_SHIFT, TRANSFORMED};
+use super::buffer::{
+    self, bits, entries, tag, tag_holds, vec, GROUP, KIND_BITS, MATERIAL_SHIFT, TRANSFORMED,
+};
 use super::map;
 use crate::lower::Instance;
 use crate::scene::analytic::{boxed, Group, Item};
@@ -125,82 +117,35 @@ pub struct Data {
     pub stack: usize,
 }
 
-/// Where a child's reference holds the vectors of a leaf's instances (0: a group); the bits
-/// below hold the index of its entry.
-const LEAF_SHIFT: u32 = 27;
-
-/// The reference to the leaf whose instances fill `[at, stop)`.
-fn leaf(at: usize, stop: usize) -> u32 {
-    let len = stop - at;
-    assert!(
-        len < 1 << (32 - LEAF_SHIFT),
-        "a leaf's instances fit in a reference ({len} vectors)"
-    );
-    at as u32 | (len as u32) << LEAF_SHIFT
-}
-
-/// The contents of `scene_data` for `instances` and the stack their walk needs, or `None`
-/// when the entries are too many for a child's reference to hold their indices.
-pub fn data(instances: &[Instance]) -> Option<Data> {
+/// The contents of `scene_data` for `instances` and the stack their walk needs.
+pub fn data(instances: &[Instance]) -> Data {
     let top = boxed(instances.iter().map(|i| i.aabb).enumerate().collect());
-    let mut out = vec![[0u32; 4]; 2];
-    let (centre, half, root, stack) = match top.as_slice() {
-        [Item::Group(root)] => {
-            let r = node(&mut out, root, instances);
-            (root.centre, root.half, r, depth(root).max(1))
-        }
+    let stack = match top.as_slice() {
+        [Item::Group(root)] => depth(root).max(1),
         items => {
-            // A few instances alone: one leaf, in a box that holds everything.
-            for item in items {
-                let Item::Primitive(i) = item else {
-                    panic!("the top of the hierarchy is one group or instances alone")
-                };
-                instance(&mut out, &instances[*i]);
-            }
-            ([0.0; 3], [f64::MAX; 3], leaf(2, out.len()), 1)
+            assert!(
+                items.iter().all(|i| matches!(i, Item::Primitive(_))),
+                "the top of the hierarchy is one group or instances alone"
+            );
+            1
         }
     };
-    if out.len() >= 1 << LEAF_SHIFT {
-        return None;
-    }
-    out[0] = vec(centre, root);
-    out[1] = vec(half, out.len() as u32);
-    let bytes = out.iter().flatten().flat_map(|w| w.to_le_bytes()).collect();
-    Some(Data { bytes, stack })
+    let bytes = entries(&top, &mut |out, i| instance(out, &instances[i]));
+    Data { bytes, stack }
 }
 
-/// Writes the entry of `group` (a node, or the instances of a leaf) and those below it at the
-/// end of `out`, and returns the reference to it.
-fn node(out: &mut Vec<[u32; 4]>, group: &Group, instances: &[Instance]) -> u32 {
-    let at = out.len();
-    match group.items.as_slice() {
-        [Item::Group(a), Item::Group(b)] => {
-            out.extend([[0; 4]; 4]);
-            let (ra, rb) = (node(out, a, instances), node(out, b, instances));
-            out[at] = vec(a.centre, ra);
-            out[at + 1] = vec(a.half, 0);
-            out[at + 2] = vec(b.centre, rb);
-            out[at + 3] = vec(b.half, 0);
-            at as u32
-        }
-        items => {
-            for item in items {
-                let Item::Primitive(i) = item else {
-                    panic!("a group of the hierarchy holds two groups or instances alone")
-                };
-                instance(out, &instances[*i]);
-            }
-            leaf(at, out.len())
-        }
-    }
-}
-
-/// The levels of groups below `group` (the shape the walk relies on: every group holds two
-/// groups or instances alone, which [`node`] checks).
+/// The levels of groups below `group`, checking the shape the walk relies on: every group
+/// holds two groups or instances alone.
 fn depth(group: &Group) -> usize {
     match group.items.as_slice() {
         [Item::Group(a), Item::Group(b)] => 1 + depth(a).max(depth(b)),
-        _ => 0,
+        items => {
+            assert!(
+                items.iter().all(|i| matches!(i, Item::Primitive(_))),
+                "a group of the hierarchy holds two groups or instances alone"
+            );
+            0
+        }
     }
 }
 
@@ -223,14 +168,7 @@ pub fn write(instances: &[Instance], stack: usize) -> String {
         "// The instances in scene_data (the layout is in compiler/src/back/wgsl/march.rs): the\n\
          // kind of entry in a tag's low three bits, ROTATED, the material above.\n",
     );
-    let _ = writeln!(
-        out,
-        "// A child's reference: the index of its entry, and above LEAF_SHIFT the number of\n\
-         // vectors of a leaf's instances (0: a group).\n\
-         const LEAF_SHIFT: u32 = {LEAF_SHIFT}u;\n\
-         const AT: u32 = {}u;",
-        (1u32 << LEAF_SHIFT) - 1
-    );
+    let _ = writeln!(out, "const GROUP: u32 = {GROUP}u;");
     out.push_str(
         "// The entry of the instance nearest at the last evaluation of sdf (0: none yet), which\n\
          // the next walk evaluates first: a march's steps, a normal's taps and a shadow ray\n\
@@ -268,7 +206,10 @@ fn helpers(out: &mut String) {
         "fn len3(q: vec3<f32>) -> f32 {\n    return sqrt((q.x * q.x + q.y * q.y) + q.z * q.z);\n}\n\n\
          // The signed distance of a box of half-extents h about the origin, given |q| - h.\n\
          fn box_of(a: vec3<f32>) -> f32 {\n    \
-         return len3(max(a, vec3<f32>(0.0))) + min(max(a.x, max(a.y, a.z)), 0.0);\n}\n\n",
+         return len3(max(a, vec3<f32>(0.0))) + min(max(a.x, max(a.y, a.z)), 0.0);\n}\n\n\
+         // The signed distance at p to the box of the group whose entry starts at scene_data[g].\n\
+         fn group_distance(g: u32, p: vec3<f32>) -> f32 {\n    \
+         return box_of(abs(p - scene_data[g].xyz) - scene_data[g + 1u].xyz);\n}\n\n",
     );
 }
 
@@ -345,7 +286,7 @@ fn instance_distance(out: &mut String, rotated: bool) {
 }
 
 /// `fn walk_map` (`material`) or `fn walk_sdf`: the minimum of `start` and the instances,
-/// the instance at `hint` first, then the hierarchy nearest first, past each child whose box
+/// the instance at `hint` first, then the hierarchy nearest first, past each group whose box
 /// is not nearer than the best distance so far (the walk of the module's header, with a
 /// stack of `stack` entries).
 fn walk(out: &mut String, material: bool, stack: usize) {
@@ -354,21 +295,9 @@ fn walk(out: &mut String, material: bool, stack: usize) {
     } else {
         ("walk_sdf", "f32", "best")
     };
-    // Where a child may be passed over: the material's walk enters a child at exactly the
+    // Where a group may be passed over: the material's walk enters a group at exactly the
     // best distance, which may hold an earlier instance that ties.
     let (farther, not_farther) = if material { (">", "<=") } else { (">=", "<") };
-    // Takes the child whose reference is r: a leaf's instances to visit, or a group to enter.
-    let take = |indent: usize| {
-        let s = " ".repeat(indent);
-        format!(
-            "if (r >> LEAF_SHIFT) != 0u {{\n\
-             {s}    i = r & AT;\n\
-             {s}    stop = i + (r >> LEAF_SHIFT);\n\
-             {s}}} else {{\n\
-             {s}    g = r;\n\
-             {s}}}"
-        )
-    };
     let _ = writeln!(
         out,
         "// The nearer of start and the instances at p{}, visiting the\n\
@@ -393,32 +322,33 @@ fn walk(out: &mut String, material: bool, stack: usize) {
          \x20           best = {};\n\
          \x20           owner = hint;\n\
          \x20       }}\n\
-         \x20   }}\n\
-         \x20   // Children still to enter and the distances of their boxes, one per level at most.\n\
+         \x20   }}\n",
+        if material {
+            format!("vec2<f32>(d, f32(bitcast<u32>(head.w) >> {MATERIAL_SHIFT}u))")
+        } else {
+            "d".to_string()
+        }
+    );
+    let _ = write!(
+        out,
+        "    // Groups still to enter and the distances of their boxes, one per level at most.\n\
          \x20   var stack: array<u32, {stack}>;\n\
          \x20   var near: array<f32, {stack}>;\n\
          \x20   var sp = 0u;\n\
          \x20   // The instances of a leaf still to visit: [i, stop).\n\
-         \x20   var i = 0u;\n\
-         \x20   var stop = 0u;\n\
-         \x20   // The group to enter next (0: none; then the stack's top).\n\
-         \x20   var g = 0u;\n\
-         \x20   let root = scene_data[0u];\n\
-         \x20   if box_of(abs(p - root.xyz) - scene_data[1u].xyz) {not_farther} {d} {{\n\
-         \x20       let r = bitcast<u32>(root.w);\n\
-         \x20       {}\n\
+         \x20   var i = 1u;\n\
+         \x20   var stop = bitcast<u32>(scene_data[0u].x);\n\
+         \x20   if bitcast<u32>(scene_data[1u].w) == GROUP {{\n\
+         \x20       stack[0] = 1u;\n\
+         \x20       near[0] = group_distance(1u, p);\n\
+         \x20       sp = 1u;\n\
+         \x20       i = stop;\n\
          \x20   }}\n\
          \x20   loop {{\n\
          \x20       if i < stop {{\n\
          \x20           let head = scene_data[i];\n\
          \x20           let tag = bitcast<u32>(head.w);\n\
-         \x20           let d = instance_distance(i, head, p);\n",
-        if material {
-            format!("vec2<f32>(d, f32(bitcast<u32>(head.w) >> {MATERIAL_SHIFT}u))")
-        } else {
-            "d".to_string()
-        },
-        take(8)
+         \x20           let d = instance_distance(i, head, p);\n"
     );
     if material {
         let _ = write!(
@@ -441,44 +371,41 @@ fn walk(out: &mut String, material: bool, stack: usize) {
         "            i += instance_size(tag);\n\
          \x20           continue;\n\
          \x20       }}\n\
-         \x20       if g == 0u {{\n\
-         \x20           if sp == 0u {{\n\
+         \x20       if sp == 0u {{\n\
+         \x20           break;\n\
+         \x20       }}\n\
+         \x20       sp -= 1u;\n\
+         \x20       if near[sp] {farther} {d} {{\n\
+         \x20           continue;\n\
+         \x20       }}\n\
+         \x20       // Down from the group g, whose box is near enough, into the nearer child.\n\
+         \x20       var g = stack[sp];\n\
+         \x20       loop {{\n\
+         \x20           let a = g + 2u;\n\
+         \x20           let first = scene_data[a];\n\
+         \x20           if bitcast<u32>(first.w) != GROUP {{\n\
+         \x20               i = a;\n\
+         \x20               stop = bitcast<u32>(scene_data[g + 1u].w);\n\
          \x20               break;\n\
          \x20           }}\n\
-         \x20           sp -= 1u;\n\
-         \x20           if near[sp] {farther} {d} {{\n\
-         \x20               continue;\n\
+         \x20           let size = scene_data[a + 1u];\n\
+         \x20           let b = bitcast<u32>(size.w);\n\
+         \x20           let da = box_of(abs(p - first.xyz) - size.xyz);\n\
+         \x20           let db = group_distance(b, p);\n\
+         \x20           let a_first = da <= db;\n\
+         \x20           let far = max(da, db);\n\
+         \x20           if far {not_farther} {d} {{\n\
+         \x20               stack[sp] = select(a, b, a_first);\n\
+         \x20               near[sp] = far;\n\
+         \x20               sp += 1u;\n\
          \x20           }}\n\
-         \x20           let r = stack[sp];\n\
-         \x20           {}\n\
-         \x20           if g == 0u {{\n\
-         \x20               continue;\n\
+         \x20           if min(da, db) {farther} {d} {{\n\
+         \x20               break;\n\
          \x20           }}\n\
-         \x20       }}\n\
-         \x20       // Into the group g, whose box is near enough: its children's boxes, the\n\
-         \x20       // farther child onto the stack, then into the nearer one.\n\
-         \x20       let ac = scene_data[g];\n\
-         \x20       let ah = scene_data[g + 1u];\n\
-         \x20       let bc = scene_data[g + 2u];\n\
-         \x20       let bh = scene_data[g + 3u];\n\
-         \x20       g = 0u;\n\
-         \x20       let da = box_of(abs(p - ac.xyz) - ah.xyz);\n\
-         \x20       let db = box_of(abs(p - bc.xyz) - bh.xyz);\n\
-         \x20       let a_first = da <= db;\n\
-         \x20       let far = max(da, db);\n\
-         \x20       if far {not_farther} {d} {{\n\
-         \x20           stack[sp] = bitcast<u32>(select(ac.w, bc.w, a_first));\n\
-         \x20           near[sp] = far;\n\
-         \x20           sp += 1u;\n\
-         \x20       }}\n\
-         \x20       if min(da, db) {not_farther} {d} {{\n\
-         \x20           let r = bitcast<u32>(select(bc.w, ac.w, a_first));\n\
-         \x20           {}\n\
+         \x20           g = select(b, a, a_first);\n\
          \x20       }}\n\
          \x20   }}\n\
          \x20   return {};\n}}\n\n",
-        take(12),
-        take(12),
         if material {
             "best"
         } else {
@@ -503,77 +430,43 @@ mod tests {
         }
     }
 
-    fn words(bytes: &[u8]) -> Vec<[u32; 4]> {
+    /// Every instance is written once with its flags and material, every group's `next` lies
+    /// past its own entries and within the data, and stepping by each entry's size (as
+    /// `instance_size` does) ends exactly at `end`.
+    #[test]
+    fn entries_cover_every_instance_and_groups_skip_forward() {
+        let instances: Vec<Instance> = (0..41).map(|k| sphere(k as f64 * 1.5, k)).collect();
+        let bytes = data(&instances).bytes;
         let w: Vec<u32> = bytes
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
             .collect();
-        w.chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect()
-    }
-
-    /// The entries below the child whose reference is `r`, checking that they lie past
-    /// `after` and within the data: (the vectors of each group node and each instance,
-    /// the instances' entries, the levels of groups).
-    fn visit(e: &[[u32; 4]], r: u32, after: usize, seen: &mut Vec<usize>) -> (usize, usize) {
-        let (at, len) = (
-            (r & ((1 << LEAF_SHIFT) - 1)) as usize,
-            (r >> LEAF_SHIFT) as usize,
-        );
-        assert!(
-            at > after && at + len.max(4) <= e.len(),
-            "child {at} after {after}"
-        );
-        if len == 0 {
-            let (va, da) = visit(e, e[at][3], at + 3, seen);
-            let (vb, db) = visit(e, e[at + 2][3], at + 3, seen);
-            return (4 + va + vb, 1 + da.max(db));
-        }
-        let mut i = at;
-        while i < at + len {
-            seen.push(i);
-            i += 2 + 3 * usize::from(e[i][3] & ROTATED != 0);
-        }
-        assert_eq!(i, at + len, "the leaf at {at} ends with its last instance");
-        (len, 0)
-    }
-
-    /// Every instance is written once with its flags and material, every child's entry lies
-    /// past its parent's and within the data, the entries fill the data, and the stack is
-    /// the depth of the groups; a few instances alone are one leaf in a box that holds
-    /// everything.
-    #[test]
-    fn entries_cover_every_instance_and_children_follow_their_parents() {
-        for n in [41, 3] {
-            let instances: Vec<Instance> = (0..n).map(|k| sphere(k as f64 * 1.5, k)).collect();
-            let d = data(&instances).unwrap();
-            let e = words(&d.bytes);
-            assert_eq!(e[1][3] as usize, e.len());
-            let mut seen = Vec::new();
-            let (vectors, depth) = visit(&e, e[0][3], 1, &mut seen);
-            assert_eq!(2 + vectors, e.len());
-            assert_eq!(d.stack, depth.max(1));
-            let mut ks: Vec<usize> = seen
-                .iter()
-                .map(|&i| {
-                    let (x, tag) = (f32::from_bits(e[i][0]), e[i][3]);
-                    let k = (x / 1.5).round() as usize;
-                    assert_eq!(tag & KIND_BITS, SPHERE);
-                    assert_eq!(tag & ROTATED != 0, k % 3 == 1, "instance {k}");
-                    let material = if k % 2 == 0 { k as u32 } else { 0 };
-                    assert_eq!(tag >> MATERIAL_SHIFT, material);
-                    k
-                })
-                .collect();
-            ks.sort_unstable();
-            assert_eq!(ks, (0..n).collect::<Vec<_>>());
-            if n == 3 {
-                assert_eq!((depth, f32::from_bits(e[1][0])), (0, f32::MAX));
-            } else {
-                assert!(depth >= 3, "depth {depth}");
+        let e: Vec<&[u32]> = w.chunks_exact(4).collect();
+        let end = e[0][0] as usize;
+        assert_eq!(end, e.len());
+        let (mut i, mut seen, mut groups) = (1, Vec::new(), 0);
+        while i < end {
+            let tag = e[i][3];
+            if tag == GROUP {
+                let next = e[i + 1][3] as usize;
+                assert!(next > i + 2 && next <= end, "group at {i}: next {next}");
+                groups += 1;
+                i += 2;
+                continue;
             }
+            let x = f32::from_bits(e[i][0]);
+            let k = (x / 1.5).round() as usize;
+            assert_eq!(tag & KIND_BITS, SPHERE);
+            assert_eq!(tag & ROTATED != 0, k % 3 == 1, "instance {k}");
+            let material = if k % 2 == 0 { k as u32 } else { 0 };
+            assert_eq!(tag >> MATERIAL_SHIFT, material);
+            seen.push(k);
+            i += 2 + 3 * usize::from(tag & ROTATED != 0);
         }
+        assert_eq!(i, end);
+        assert!(groups >= 9, "{groups} groups");
+        seen.sort_unstable();
+        assert_eq!(seen, (0..41).collect::<Vec<_>>());
     }
 
     fn box_of(a: [f32; 3]) -> f32 {
@@ -593,8 +486,8 @@ mod tests {
         material: bool,
     ) -> (f32, usize, usize, usize, usize) {
         let bits = |x: f32| x.to_bits() as usize;
-        let distance = |v: usize| {
-            let (c, h) = (e[v], e[v + 1]);
+        let group = |g: usize| {
+            let (c, h) = (e[g], e[g + 1]);
             box_of([0, 1, 2].map(|k| (p[k] - c[k]).abs() - h[k]))
         };
         let sphere = |i: usize| {
@@ -602,7 +495,7 @@ mod tests {
             ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() - e[i + 1][0]
         };
         let farther = |x: f32, best: f32| if material { x > best } else { x >= best };
-        let (mut best, mut owner, mut evaluated, mut boxes, mut deepest) = (start, 0, 0, 1, 0);
+        let (mut best, mut owner, mut evaluated, mut boxes, mut deepest) = (start, 0, 0, 0, 0);
         if hint != 0 {
             evaluated += 1;
             if sphere(hint) < best {
@@ -610,20 +503,11 @@ mod tests {
             }
         }
         let mut st: Vec<(usize, f32)> = Vec::new();
-        let (mut i, mut stop, mut g) = (0, 0, 0);
-        let take = |r: usize, i: &mut usize, stop: &mut usize, g: &mut usize| {
-            let len = r >> LEAF_SHIFT;
-            if len != 0 {
-                (*i, *stop) = (
-                    r & ((1 << LEAF_SHIFT) - 1),
-                    (r & ((1 << LEAF_SHIFT) - 1)) + len,
-                );
-            } else {
-                *g = r;
-            }
-        };
-        if !farther(distance(0), best) {
-            take(bits(e[0][3]), &mut i, &mut stop, &mut g);
+        let (mut i, mut stop) = (1, bits(e[0][0]));
+        if bits(e[1][3]) == GROUP as usize {
+            st.push((1, group(1)));
+            boxes += 1;
+            i = stop;
         }
         loop {
             if i < stop {
@@ -635,28 +519,29 @@ mod tests {
                 i += 2;
                 continue;
             }
-            if g == 0 {
-                let Some((r, near)) = st.pop() else { break };
-                if farther(near, best) {
-                    continue;
-                }
-                take(r, &mut i, &mut stop, &mut g);
-                if g == 0 {
-                    continue;
-                }
+            let Some((mut g, near)) = st.pop() else { break };
+            if farther(near, best) {
+                continue;
             }
-            let (a, b) = (g, g + 2);
-            g = 0;
-            let (da, db) = (distance(a), distance(b));
-            boxes += 2;
-            let (n, f) = if da <= db { (a, b) } else { (b, a) };
-            if !farther(da.max(db), best) {
-                st.push((bits(e[f][3]), da.max(db)));
-                deepest = deepest.max(st.len());
-                assert!(st.len() <= stack, "stack of {stack} overflows");
-            }
-            if !farther(da.min(db), best) {
-                take(bits(e[n][3]), &mut i, &mut stop, &mut g);
+            loop {
+                let a = g + 2;
+                if bits(e[a][3]) != GROUP as usize {
+                    (i, stop) = (a, bits(e[g + 1][3]));
+                    break;
+                }
+                let b = bits(e[a + 1][3]);
+                let (da, db) = (group(a), group(b));
+                boxes += 2;
+                let (n, f) = if da <= db { (a, b) } else { (b, a) };
+                if !farther(da.max(db), best) {
+                    st.push((f, da.max(db)));
+                    deepest = deepest.max(st.len());
+                    assert!(st.len() <= stack, "stack of {stack} overflows");
+                }
+                if farther(da.min(db), best) {
+                    break;
+                }
+                g = n;
             }
         }
         (best, owner, evaluated, boxes, deepest)
@@ -665,8 +550,8 @@ mod tests {
     /// The nearest-first walk finds the same minimum as every instance in `scene_data`'s
     /// order (the same value, and with the material, the same instance on a tie, the rest
     /// first) whatever its hint, its stack never holds more than the hierarchy's depth, and
-    /// near the surface of 4 096 spheres it evaluates a few of them, fewer boxes with the
-    /// nearest instance as its hint.
+    /// near the surface of 4 096 spheres it evaluates a few of them, and no more boxes with
+    /// the nearest instance as its hint.
     #[test]
     fn the_nearest_first_walk_finds_the_minimum_in_few_steps() {
         let mut rng = crate::rng::Rng::new(7);
@@ -688,25 +573,39 @@ mod tests {
             material: Some(MaterialId(9999)),
             ..instances[700].clone()
         });
-        let d = data(&instances).unwrap();
-        let e: Vec<[f32; 4]> = words(&d.bytes)
-            .iter()
-            .map(|v| v.map(f32::from_bits))
+        let d = data(&instances);
+        let w: Vec<f32> = d
+            .bytes
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        let e: Vec<[f32; 4]> = w
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
             .collect();
         assert!((10..=12).contains(&d.stack), "depth {}", d.stack);
-        let mut entries = Vec::new();
-        visit(&words(&d.bytes), e[0][3].to_bits(), 1, &mut entries);
+        let end = e[0][0].to_bits() as usize;
         let brute = |p: [f32; 3], start: f32| {
-            let (mut best, mut owner) = (start, 0);
-            for &i in &entries {
+            let (mut best, mut owner, mut i) = (start, 0, 1);
+            while i < end {
+                if e[i][3].to_bits() == GROUP {
+                    i += 2;
+                    continue;
+                }
                 let q = [0, 1, 2].map(|k| p[k] - e[i][k]);
                 let d = ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() - e[i + 1][0];
                 if d < best {
                     (best, owner) = (d, i);
                 }
+                i += 2;
             }
             (best, owner)
         };
+        // Every vector is a group's two or an unrotated sphere's two.
+        let entries: Vec<usize> = (1..end)
+            .step_by(2)
+            .filter(|&i| e[i][3].to_bits() != GROUP)
+            .collect();
         let (mut near_surface, mut deepest, mut ties) = (0, 0, 0);
         let (mut evaluated, mut boxes, mut hinted_boxes) = (0, 0, 0);
         for n in 0..3000 {

@@ -497,9 +497,9 @@ fn split(
     lowered
         .instances(options.max_instances)
         .filter(|s| march::fits(&s.instances))
-        .and_then(|s| {
-            let data = march::data(&s.instances)?;
-            Some((s, data))
+        .map(|s| {
+            let data = march::data(&s.instances);
+            (s, data)
         })
         // The `scene_data` limit, in MiB: by default what wgpu's default limits let a
         // storage buffer bind; a scene with more keeps its instances as code.

@@ -75,7 +75,7 @@ impl Kernel {
         match kernel {
             Some(k) if backend == Backend::Cpu => Err(format!(
                 "--kernel {} chooses a GPU kernel, and the CPU backend has none (it interprets \
-                 every program); drop --kernel or use --backend wgpu or --backend cuda",
+                 every program); drop --kernel or choose a GPU with --backend",
                 match k {
                     Kernel::Auto => "auto",
                     Kernel::Specialised => "specialised",

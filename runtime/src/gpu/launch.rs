@@ -586,12 +586,16 @@ mod tests {
         }
     }
 
-    /// A device that "renders" a pixel as its index, and fails on its `fails`-th tile.
-    struct Fake {
+    /// A device that "renders" a pixel as its index, and fails on its `fails`-th tile
+    /// (counting in `failed` the devices that failed); one with `wait` renders nothing until
+    /// one has failed, so that the others take tiles whatever the threads' scheduling.
+    struct Fake<'a> {
         fails: Option<usize>,
+        wait: bool,
+        failed: &'a std::sync::atomic::AtomicUsize,
     }
 
-    impl Device for Fake {
+    impl Device for Fake<'_> {
         type Frame = usize;
         type Error = String;
         fn describe(&self) -> String {
@@ -601,9 +605,16 @@ mod tests {
             Ok(0)
         }
         fn run(&self, ran: &mut usize, _job: &Job, tiles: &[usize]) -> Result<(), String> {
+            use std::sync::atomic::Ordering;
+            while self.wait && self.failed.load(Ordering::SeqCst) == 0 {
+                std::thread::yield_now();
+            }
             *ran += tiles.len();
             match self.fails {
-                Some(n) if *ran > n => Err("lost".into()),
+                Some(n) if *ran > n => {
+                    self.failed.fetch_add(1, Ordering::SeqCst);
+                    Err("lost".into())
+                }
                 _ => Ok(()),
             }
         }
@@ -636,7 +647,17 @@ mod tests {
             timed: false,
             statistics: true,
         };
-        let (good, lost) = (Fake { fails: None }, Fake { fails: Some(1) });
+        let failed = std::sync::atomic::AtomicUsize::new(0);
+        let good = Fake {
+            fails: None,
+            wait: true,
+            failed: &failed,
+        };
+        let lost = Fake {
+            fails: Some(1),
+            wait: false,
+            failed: &failed,
+        };
         let devices: [&dyn Worker; 3] = [&lost, &good, &lost];
         let out =
             render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect("one survives");
@@ -644,8 +665,13 @@ mod tests {
         assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
         assert_eq!(out.steps, (0..n as u32).collect::<Vec<_>>());
         assert_eq!(out.counters.steps, (0..n as u64).sum::<u64>());
-        assert_eq!(out.shares[0].tiles, 1);
-        assert_eq!(out.shares[0].failure.as_deref(), Some("lost"));
+        // The good device waited for a failure; a device that failed had rendered one band.
+        assert_eq!(out.shares[1].failure, None);
+        let lost_shares = [&out.shares[0], &out.shares[2]];
+        assert!(lost_shares
+            .iter()
+            .any(|s| s.failure.as_deref() == Some("lost")));
+        assert!(lost_shares.iter().all(|s| s.tiles <= 1));
         assert_eq!(
             out.shares.iter().map(|s| s.tiles).sum::<usize>(),
             tiles.len()

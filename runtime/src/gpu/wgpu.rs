@@ -42,6 +42,11 @@ const TILE_STRIDE: u32 = 256;
 /// Compiled pipelines kept by a [`Gpu`] (at most this many; the cache is emptied when full).
 const PIPELINES_KEPT: usize = 16;
 
+/// The size of a buffer for `n` bytes: at least 16, so that one for no bytes can be bound.
+fn padded(n: u64) -> u64 {
+    n.max(16)
+}
+
 /// How long [`Gpu::wait`] polls before it blocks.
 const SPIN: Duration = Duration::from_millis(20);
 
@@ -472,27 +477,24 @@ impl Gpu {
         (pipeline, layout, driver)
     }
 
-    /// The buffers of a frame with the job's uniforms, scene data and tiles written (queued):
-    /// the spare ones when their sizes fit, else new ones.
+    /// The buffers of a frame with the job's uniforms and scene data written (queued): the
+    /// spare ones when their sizes fit, else new ones.
     fn buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {
-        let spare = self.spare.lock().ok().and_then(|mut s| s.take());
-        let size = |n: u64| n.max(16);
-        match spare {
-            Some(b)
-                if b.uniforms.size() == size(l.uniforms.len() as u64)
-                    && b.data.as_ref().map(|d| d.size())
-                        == l.data.map(|d| size(d.len() as u64))
-                    && b.tile.size() == size(tiles * TILE_STRIDE as u64)
-                    && b.image.size() == size(pixels * 16) =>
-            {
-                self.queue.write_buffer(&b.uniforms, 0, l.uniforms);
-                if let (Some(buffer), Some(bytes)) = (&b.data, l.data) {
-                    self.queue.write_buffer(buffer, 0, bytes);
-                }
-                b
-            }
+        let fits = |b: &Buffers| {
+            b.uniforms.size() == padded(l.uniforms.len() as u64)
+                && b.data.as_ref().map(|d| d.size()) == l.data.map(|d| padded(d.len() as u64))
+                && b.tile.size() == padded(tiles * TILE_STRIDE as u64)
+                && b.image.size() == padded(pixels * 16)
+        };
+        let b = match self.spare.lock().ok().and_then(|mut s| s.take()) {
+            Some(b) if fits(&b) => b,
             _ => self.new_buffers(l, pixels, tiles),
+        };
+        self.queue.write_buffer(&b.uniforms, 0, l.uniforms);
+        if let (Some(buffer), Some(bytes)) = (&b.data, l.data) {
+            self.queue.write_buffer(buffer, 0, bytes);
         }
+        b
     }
 
     fn new_buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {
@@ -500,29 +502,24 @@ impl Gpu {
         let make = |label, size: u64, usage| {
             self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: size.max(16),
+                size: padded(size),
                 usage,
                 mapped_at_creation: false,
             })
         };
-        let uniforms = make(
-            "sdfc scene",
-            l.uniforms.len() as u64,
-            U::UNIFORM | U::COPY_DST,
-        );
-        self.queue.write_buffer(&uniforms, 0, l.uniforms);
-        let data = l.data.map(|bytes| {
-            let buffer = make(
-                "sdfc scene data",
-                bytes.len() as u64,
-                U::STORAGE | U::COPY_DST,
-            );
-            self.queue.write_buffer(&buffer, 0, bytes);
-            buffer
-        });
         Buffers {
-            uniforms,
-            data,
+            uniforms: make(
+                "sdfc scene",
+                l.uniforms.len() as u64,
+                U::UNIFORM | U::COPY_DST,
+            ),
+            data: l.data.map(|bytes| {
+                make(
+                    "sdfc scene data",
+                    bytes.len() as u64,
+                    U::STORAGE | U::COPY_DST,
+                )
+            }),
             tile: make(
                 "sdfc tiles",
                 tiles * TILE_STRIDE as u64,

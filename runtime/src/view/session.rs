@@ -1377,6 +1377,24 @@ mod tests {
         }
     }
 
+    /// Waits until the held specialised compile of the scene on show has ended, then lets the
+    /// session take it.
+    fn release_when_compiled(s: &mut Session) {
+        let start = Instant::now();
+        while !s
+            .good
+            .as_ref()
+            .and_then(|g| g.waiting.as_ref())
+            .expect("a compile")
+            .compile
+            .finished()
+        {
+            assert!(start.elapsed() < PATIENCE, "the compile never ended");
+            s.wait_for_compile(Duration::from_secs(1));
+        }
+        s.held = None;
+    }
+
     /// The next frame rendered (waiting for a kernel when there is none to render with).
     fn next_frame(s: &mut Session) -> FrameInfo {
         let start = Instant::now();
@@ -1455,21 +1473,7 @@ mod tests {
             4,
             "the interpreted image converged"
         );
-        let start = Instant::now();
-        while !s
-            .good
-            .as_ref()
-            .unwrap()
-            .waiting
-            .as_ref()
-            .unwrap()
-            .compile
-            .finished()
-        {
-            assert!(start.elapsed() < PATIENCE, "the compile never ended");
-            s.wait_for_compile(Duration::from_secs(1));
-        }
-        s.held = None;
+        release_when_compiled(&mut s);
         settle_all(&mut s);
         assert_eq!(
             s.last.unwrap().kernel,
@@ -1577,21 +1581,7 @@ mod tests {
             s.frame().expect("a frame");
         }
         let interpreted = s.image().unwrap().clone();
-        let start = Instant::now();
-        while !s
-            .good
-            .as_ref()
-            .unwrap()
-            .waiting
-            .as_ref()
-            .unwrap()
-            .compile
-            .finished()
-        {
-            assert!(start.elapsed() < PATIENCE, "the compile never ended");
-            s.wait_for_compile(Duration::from_secs(1));
-        }
-        s.held = None;
+        release_when_compiled(&mut s);
         settle_all(&mut s);
         assert_eq!(s.last.unwrap().kernel, Some("specialised"));
         assert_eq!(s.time(), Some(0.5), "the time on show stayed");

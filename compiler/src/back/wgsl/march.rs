@@ -51,16 +51,30 @@
 //! and a lattice over a plane would leave most cells empty or most instances in a few.)
 //!
 //! Before the hierarchy each walk evaluates one instance, its hint: the private variable
-//! `hint` holds the entry of the instance that was nearest at the invocation's last `sdf`
-//! (0 before the first, and kept while the rest of the scene is nearer). Successive steps of
-//! a march, a normal's taps, the material's lookup and the shadow rays from a hit stay near
-//! the same instance, so the best distance is about the final one before the first box is
-//! measured, and the farther children the descent would push are passed over at once. It
-//! costs one more instance a step and saves most pushes: counted on lavapipe (320×180, with
-//! counters added to a throwaway build; BENCHMARKS.md) jittered_1024 marched goes from 2.9
+//! `hint` holds the entry of the nearest instance the invocation's last walk of `sdf`
+//! evaluated (0 before the first). Successive steps of a march, a normal's taps, the
+//! material's lookup and the shadow rays from a hit stay near the same instance, so the best
+//! distance is about the final one before the first box is measured, and the farther children
+//! the descent would push are passed over at once. Counted on lavapipe (320×180, with counters
+//! added to a throwaway build; BENCHMARKS.md) the hint took jittered_1024 marched from 2.9
 //! pushes, 11.7 boxes and 3.2 instances a step to 0.6, 11.7 and 4.2, compound_1000 from 1.5,
 //! 10.2 and 2.8 to 1.1, 10.1 and 3.8. Any hint gives the same result: the minimum does not
 //! depend on the order of the visit, nor, with the tie rule below, the material.
+//!
+//! Most of `sdf`'s calls need no walk at all. `walk_sdf` also returns a lower bound B on the
+//! distance at its point p₀ of every instance but the nearest it evaluated (its key): the
+//! least of the other instances it evaluated and of the boxes it passed over, each a lower
+//! bound since every instance lies in its boxes. `sdf` keeps p₀ and B beside the hint. Each
+//! instance is an exact distance, so it changes no faster than the point moves: at p every
+//! other instance is at least B − |p − p₀| away, and when the rest of the scene or the hint's
+//! instance is no farther than that, their minimum is the field's (another instance can at
+//! most tie). A march's steps towards the hint's instance keep to that ball, as do a
+//! normal's taps and a shadow ray's first steps. Marching 1 024 jittered spheres (the test
+//! `the_cache_of_the_last_walk…`: camera rays, normals and shadow rays), 0.41 walks a step
+//! remain, and 8.3 boxes a step where walking every step measures 16.5; with the exact
+//! second-nearest distance as B the walks would be 0.36 a step, and with a cache of the
+//! key's whole leaf 0.33 (the same test, altered to compute them; not kept). The walks left
+//! are steps between spheres whose nearest neighbours change as the ray passes.
 //!
 //! `walk_map`, which gives the material, keeps the tie rule independent of the order of the
 //! visit (the hint included): among instances at the same distance the one earlier in
@@ -170,12 +184,18 @@ pub fn write(instances: &[Instance], stack: usize) -> String {
     );
     let _ = writeln!(out, "const GROUP: u32 = {GROUP}u;");
     out.push_str(
-        "// The entry of the instance nearest at the last evaluation of sdf (0: none yet), which\n\
-         // the next walk evaluates first: a march's steps, a normal's taps and a shadow ray\n\
-         // stay near the same instance, so the best distance is tight from the start.\n\
-         var<private> hint: u32;\n\n\
-         // The minimum of walk_sdf and the entry of its instance (0: the rest of the scene).\n\
-         struct Nearest {\n    d: f32,\n    owner: u32,\n}\n",
+        "// What the last walk of sdf found, the cache of the next calls (see march.rs): the\n\
+         // entry of the nearest instance it evaluated (0: none yet), the point of that walk, and\n\
+         // a lower bound there on the distance of every other instance. Successive steps of a\n\
+         // march, a normal's taps and a shadow ray stay near the same instance.\n\
+         var<private> hint: u32;\n\
+         var<private> hint_at: vec3<f32>;\n\
+         var<private> hint_bound: f32;\n\n\
+         // The minimum of walk_sdf; the entry of the nearest instance it evaluated (0: none)\n\
+         // and a lower bound at p on the distance of every other instance.\n\
+         struct Nearest {\n    d: f32,\n    key: u32,\n    bound: f32,\n}\n\n\
+         // Farther than any distance of a scene.\n\
+         const FAR: f32 = 1e30;\n",
     );
     if rotated {
         let _ = writeln!(out, "const ROTATED: u32 = {ROTATED}u;");
@@ -187,14 +207,26 @@ pub fn write(instances: &[Instance], stack: usize) -> String {
     walk(&mut out, true, stack);
     walk(&mut out, false, stack);
     out.push_str(
-        "// The scene's distance field: (signed distance, material id) at p, the nearer of the\n\
+        "// The distance at p of the instance at hint; FAR when there is none.\n\
+         fn hint_distance(p: vec3<f32>) -> f32 {\n    \
+         if hint == 0u {\n        return FAR;\n    }\n    \
+         return instance_distance(hint, scene_data[hint], p);\n}\n\n\
+         // The scene's distance field: (signed distance, material id) at p, the nearer of the\n\
          // rest of the scene and its instances.\n\
-         fn map(p: vec3<f32>) -> vec2<f32> {\n    return walk_map(p, rest_map(p), hint);\n}\n\n\
-         // The distance alone, for marching and normals; the nearest instance, if any, is the\n\
-         // next walk's hint.\n\
+         fn map(p: vec3<f32>) -> vec2<f32> {\n    \
+         return walk_map(p, rest_map(p), hint, hint_distance(p));\n}\n\n\
+         // The distance alone, for marching and normals. While the rest or the hint's instance\n\
+         // is no farther than the bound of the last walk less the way from its point, every\n\
+         // other instance is at least as far (each is a distance, 1-Lipschitz): the walk is\n\
+         // not needed. Otherwise the walk, whose findings are the next calls' cache.\n\
          fn sdf(p: vec3<f32>) -> f32 {\n    \
-         let n = walk_sdf(p, rest_sdf(p), hint);\n    \
-         if n.owner != 0u {\n        hint = n.owner;\n    }\n    \
+         let start = rest_sdf(p);\n    \
+         let hd = hint_distance(p);\n    \
+         let d = min(start, hd);\n    \
+         if hint != 0u && d <= hint_bound - len3(p - hint_at) {\n        return d;\n    }\n    \
+         let n = walk_sdf(p, start, hint, hd);\n    \
+         if n.key != 0u {\n        \
+         hint = n.key;\n        hint_at = p;\n        hint_bound = n.bound;\n    }\n    \
          return n.d;\n}\n",
     );
     out
@@ -290,45 +322,55 @@ fn instance_distance(out: &mut String, rotated: bool) {
 /// is not nearer than the best distance so far (the walk of the module's header, with a
 /// stack of `stack` entries).
 fn walk(out: &mut String, material: bool, stack: usize) {
-    let (name, ty, d) = if material {
-        ("walk_map", "vec2<f32>", "best.x")
-    } else {
-        ("walk_sdf", "f32", "best")
-    };
+    let d = if material { "best.x" } else { "best" };
     // Where a group may be passed over: the material's walk enters a group at exactly the
     // best distance, which may hold an earlier instance that ties.
     let (farther, not_farther) = if material { (">", "<=") } else { (">=", "<") };
-    let _ = writeln!(
-        out,
-        "// The nearer of start and the instances at p{}, visiting the\n\
-         // instance at hint first (0: none), then the hierarchy nearest first.\n\
-         fn {name}(p: vec3<f32>, start: {ty}, hint: u32) -> {} {{",
+    // The distance walk also keeps the nearest instance it evaluated (its key) and a lower
+    // bound on every other instance: each instance it evaluates and each box it passes over
+    // lowers the bound, or the key's old distance when it finds a nearer one.
+    let fold = |x: &str, indent: usize| {
         if material {
-            ", with its material (start's on a tie,\n// else the instance's earlier in scene_data)"
+            String::new()
         } else {
-            ", with the entry of its instance (0: start)"
-        },
-        if material { ty } else { "Nearest" }
-    );
-    let _ = write!(
-        out,
-        "    var best = start;\n\
-         \x20   // The entry of best's instance; 0: start.\n\
-         \x20   var owner = 0u;\n\
-         \x20   if hint != 0u {{\n\
-         \x20       let head = scene_data[hint];\n\
-         \x20       let d = instance_distance(hint, head, p);\n\
-         \x20       if d < {d} {{\n\
-         \x20           best = {};\n\
-         \x20           owner = hint;\n\
-         \x20       }}\n\
-         \x20   }}\n",
-        if material {
-            format!("vec2<f32>(d, f32(bitcast<u32>(head.w) >> {MATERIAL_SHIFT}u))")
-        } else {
-            "d".to_string()
+            format!("{:indent$}bound = min(bound, {x});\n", "")
         }
-    );
+    };
+    if material {
+        out.push_str(
+            "// The nearer of start and the instances at p, with its material (start's on a tie,\n\
+             // else the instance's earlier in scene_data), visiting the instance at hint first\n\
+             // (hd: its distance; FAR when hint is 0), then the hierarchy nearest first.\n\
+             fn walk_map(p: vec3<f32>, start: vec2<f32>, hint: u32, hd: f32) -> vec2<f32> {\n",
+        );
+    } else {
+        out.push_str(
+            "// The nearer of start and the instances at p, visiting the instance at hint first\n\
+             // (hd: its distance; FAR when hint is 0), then the hierarchy nearest first; with the\n\
+             // nearest instance evaluated and a lower bound on the distance of every other one.\n\
+             fn walk_sdf(p: vec3<f32>, start: f32, hint: u32, hd: f32) -> Nearest {\n",
+        );
+    }
+    if material {
+        let _ = writeln!(
+            out,
+            "    var best = start;\n\
+             \x20   // The entry of best's instance; 0: start.\n\
+             \x20   var owner = 0u;\n\
+             \x20   if hd < best.x {{\n\
+             \x20       best = vec2<f32>(hd, f32(bitcast<u32>(scene_data[hint].w) >> {MATERIAL_SHIFT}u));\n\
+             \x20       owner = hint;\n\
+             \x20   }}"
+        );
+    } else {
+        out.push_str(
+            "    var best = min(start, hd);\n\
+             \x20   // The nearest instance evaluated, its distance, and a bound on the others.\n\
+             \x20   var key = hint;\n\
+             \x20   var kd = hd;\n\
+             \x20   var bound = FAR;\n",
+        );
+    }
     let _ = write!(
         out,
         "    // Groups still to enter and the distances of their boxes, one per level at most.\n\
@@ -360,9 +402,13 @@ fn walk(out: &mut String, material: bool, stack: usize) {
         );
     } else {
         out.push_str(
-            "            if d < best {\n\
-             \x20               best = d;\n\
-             \x20               owner = i;\n\
+            "            best = min(best, d);\n\
+             \x20           if d < kd {\n\
+             \x20               bound = min(bound, kd);\n\
+             \x20               kd = d;\n\
+             \x20               key = i;\n\
+             \x20           } else if i != key {\n\
+             \x20               bound = min(bound, d);\n\
              \x20           }\n",
         );
     }
@@ -376,6 +422,7 @@ fn walk(out: &mut String, material: bool, stack: usize) {
          \x20       }}\n\
          \x20       sp -= 1u;\n\
          \x20       if near[sp] {farther} {d} {{\n\
+         {}\
          \x20           continue;\n\
          \x20       }}\n\
          \x20       // Down from the group g, whose box is near enough, into the nearer child.\n\
@@ -398,18 +445,26 @@ fn walk(out: &mut String, material: bool, stack: usize) {
          \x20               stack[sp] = select(a, b, a_first);\n\
          \x20               near[sp] = far;\n\
          \x20               sp += 1u;\n\
-         \x20           }}\n\
+         \x20           }}{}\n\
          \x20           if min(da, db) {farther} {d} {{\n\
+         {}\
          \x20               break;\n\
          \x20           }}\n\
          \x20           g = select(b, a, a_first);\n\
          \x20       }}\n\
          \x20   }}\n\
          \x20   return {};\n}}\n\n",
+        fold("near[sp]", 12),
+        if material {
+            String::new()
+        } else {
+            format!(" else {{\n{}\x20           }}", fold("far", 16))
+        },
+        fold("min(da, db)", 16),
         if material {
             "best"
         } else {
-            "Nearest(best, owner)"
+            "Nearest(best, key, bound)"
         }
     );
 }
@@ -474,9 +529,27 @@ mod tests {
         ((m[0] * m[0] + m[1] * m[1]) + m[2] * m[2]).sqrt() + a[0].max(a[1].max(a[2])).min(0.0)
     }
 
+    /// What [`model`] found: the minimum and its instance (0: start), for `walk_sdf` the
+    /// nearest instance evaluated (its key) and the bound on every other instance, and the
+    /// work done: instances evaluated, boxes measured, the deepest stack.
+    struct Visit {
+        best: f32,
+        owner: usize,
+        key: usize,
+        bound: f32,
+        evaluated: usize,
+        boxes: usize,
+        deepest: usize,
+    }
+
+    /// The distance at `p` of the unrotated sphere whose entry starts at `e[i]`.
+    fn sphere_at(e: &[[f32; 4]], i: usize, p: [f32; 3]) -> f32 {
+        let q = [0, 1, 2].map(|k| p[k] - e[i][k]);
+        ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() - e[i + 1][0]
+    }
+
     /// The walk of `walk_map` (with `material`) or `walk_sdf` as the kernel does it, over the
-    /// entries `e` of unrotated spheres, the instance at `hint` first: (best, owner, instances
-    /// evaluated, boxes measured, deepest stack).
+    /// entries `e` of unrotated spheres, the instance at `hint` first.
     fn model(
         e: &[[f32; 4]],
         p: [f32; 3],
@@ -484,43 +557,56 @@ mod tests {
         hint: usize,
         stack: usize,
         material: bool,
-    ) -> (f32, usize, usize, usize, usize) {
+    ) -> Visit {
         let bits = |x: f32| x.to_bits() as usize;
         let group = |g: usize| {
             let (c, h) = (e[g], e[g + 1]);
             box_of([0, 1, 2].map(|k| (p[k] - c[k]).abs() - h[k]))
         };
-        let sphere = |i: usize| {
-            let q = [0, 1, 2].map(|k| p[k] - e[i][k]);
-            ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() - e[i + 1][0]
-        };
         let farther = |x: f32, best: f32| if material { x > best } else { x >= best };
-        let (mut best, mut owner, mut evaluated, mut boxes, mut deepest) = (start, 0, 0, 0, 0);
+        let mut v = Visit {
+            best: start,
+            owner: 0,
+            key: hint,
+            bound: f32::INFINITY,
+            evaluated: 0,
+            boxes: 0,
+            deepest: 0,
+        };
+        let mut kd = f32::INFINITY;
         if hint != 0 {
-            evaluated += 1;
-            if sphere(hint) < best {
-                (best, owner) = (sphere(hint), hint);
+            v.evaluated += 1;
+            kd = sphere_at(e, hint, p);
+            if kd < v.best {
+                (v.best, v.owner) = (kd, hint);
             }
         }
         let mut st: Vec<(usize, f32)> = Vec::new();
         let (mut i, mut stop) = (1, bits(e[0][0]));
         if bits(e[1][3]) == GROUP as usize {
             st.push((1, group(1)));
-            boxes += 1;
+            v.boxes += 1;
             i = stop;
         }
         loop {
             if i < stop {
-                let d = sphere(i);
-                evaluated += 1;
-                if d < best || (material && d == best && i < owner) {
-                    (best, owner) = (d, i);
+                let d = sphere_at(e, i, p);
+                v.evaluated += 1;
+                if d < v.best || (material && d == v.best && i < v.owner) {
+                    (v.best, v.owner) = (d, i);
+                }
+                if d < kd {
+                    v.bound = v.bound.min(kd);
+                    (kd, v.key) = (d, i);
+                } else if i != v.key {
+                    v.bound = v.bound.min(d);
                 }
                 i += 2;
                 continue;
             }
             let Some((mut g, near)) = st.pop() else { break };
-            if farther(near, best) {
+            if farther(near, v.best) {
+                v.bound = v.bound.min(near);
                 continue;
             }
             loop {
@@ -531,20 +617,83 @@ mod tests {
                 }
                 let b = bits(e[a + 1][3]);
                 let (da, db) = (group(a), group(b));
-                boxes += 2;
+                v.boxes += 2;
                 let (n, f) = if da <= db { (a, b) } else { (b, a) };
-                if !farther(da.max(db), best) {
+                if !farther(da.max(db), v.best) {
                     st.push((f, da.max(db)));
-                    deepest = deepest.max(st.len());
+                    v.deepest = v.deepest.max(st.len());
                     assert!(st.len() <= stack, "stack of {stack} overflows");
+                } else {
+                    v.bound = v.bound.min(da.max(db));
                 }
-                if farther(da.min(db), best) {
+                if farther(da.min(db), v.best) {
+                    v.bound = v.bound.min(da.min(db));
                     break;
                 }
                 g = n;
             }
         }
-        (best, owner, evaluated, boxes, deepest)
+        v
+    }
+
+    /// The cache of `sdf`'s last walk: its key, its point, its bound.
+    type Cache = (usize, [f32; 3], f32);
+
+    /// `sdf` as the kernel has it: the cache of the last walk (hint, its point, its bound)
+    /// when it suffices, else the walk, which renews the cache. Adds to `walks` and `boxes`.
+    fn model_sdf(
+        e: &[[f32; 4]],
+        p: [f32; 3],
+        start: f32,
+        cache: &mut Cache,
+        stack: usize,
+        walks: &mut usize,
+        boxes: &mut usize,
+    ) -> f32 {
+        let (hint, at, bound) = *cache;
+        if hint != 0 {
+            let d = start.min(sphere_at(e, hint, p));
+            let q = [0, 1, 2].map(|k| p[k] - at[k]);
+            if d <= bound - ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() {
+                return d;
+            }
+        }
+        let v = model(e, p, start, hint, stack, false);
+        *walks += 1;
+        *boxes += v.boxes;
+        if v.key != 0 {
+            *cache = (v.key, p, v.bound);
+        }
+        v.best
+    }
+
+    /// The vectors of `scene_data` as floats.
+    fn vectors(d: &Data) -> Vec<[f32; 4]> {
+        let w: Vec<f32> = d
+            .bytes
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        w.chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect()
+    }
+
+    /// The minimum of `start` and every sphere of `e` in `scene_data`'s order, and its entry
+    /// (0: start).
+    fn brute(e: &[[f32; 4]], p: [f32; 3], start: f32) -> (f32, usize) {
+        let end = e[0][0].to_bits() as usize;
+        let (mut best, mut owner, mut i) = (start, 0, 1);
+        while i < end {
+            if e[i][3].to_bits() != GROUP {
+                let d = sphere_at(e, i, p);
+                if d < best {
+                    (best, owner) = (d, i);
+                }
+            }
+            i += 2;
+        }
+        (best, owner)
     }
 
     /// The nearest-first walk finds the same minimum as every instance in `scene_data`'s
@@ -574,33 +723,10 @@ mod tests {
             ..instances[700].clone()
         });
         let d = data(&instances);
-        let w: Vec<f32> = d
-            .bytes
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
-        let e: Vec<[f32; 4]> = w
-            .chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
+        let e = vectors(&d);
         assert!((10..=12).contains(&d.stack), "depth {}", d.stack);
+        let brute = |p: [f32; 3], start: f32| brute(&e, p, start);
         let end = e[0][0].to_bits() as usize;
-        let brute = |p: [f32; 3], start: f32| {
-            let (mut best, mut owner, mut i) = (start, 0, 1);
-            while i < end {
-                if e[i][3].to_bits() == GROUP {
-                    i += 2;
-                    continue;
-                }
-                let q = [0, 1, 2].map(|k| p[k] - e[i][k]);
-                let d = ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]).sqrt() - e[i + 1][0];
-                if d < best {
-                    (best, owner) = (d, i);
-                }
-                i += 2;
-            }
-            (best, owner)
-        };
         // Every vector is a group's two or an unrotated sphere's two.
         let entries: Vec<usize> = (1..end)
             .step_by(2)
@@ -621,9 +747,24 @@ mod tests {
                 let nearest = brute(p, f32::INFINITY).1;
                 let stray = entries[rng.below(entries.len())];
                 for hint in [0, nearest, stray] {
-                    let (sdf, ..) = model(&e, p, start, hint, d.stack, false);
-                    assert_eq!(sdf.to_bits(), want.to_bits(), "{p:?} hint {hint}");
-                    let (map, who, k, b, s) = model(&e, p, start, hint, d.stack, true);
+                    let v = model(&e, p, start, hint, d.stack, false);
+                    assert_eq!(v.best.to_bits(), want.to_bits(), "{p:?} hint {hint}");
+                    // Every instance but the key is at least as far as the bound.
+                    for &j in entries.iter().filter(|&&j| j != v.key) {
+                        assert!(
+                            sphere_at(&e, j, p) >= v.bound,
+                            "{p:?} {hint}: {j} {}",
+                            v.bound
+                        );
+                    }
+                    let Visit {
+                        best: map,
+                        owner: who,
+                        evaluated: k,
+                        boxes: b,
+                        deepest: s,
+                        ..
+                    } = model(&e, p, start, hint, d.stack, true);
                     assert_eq!(
                         (map.to_bits(), who),
                         (want.to_bits(), owner),
@@ -668,5 +809,102 @@ mod tests {
             hinted_boxes <= boxes,
             "{hinted_boxes} boxes hinted, {boxes} not"
         );
+    }
+
+    /// Camera rays, their normals' taps and shadow rays marched through 1 024 jittered
+    /// spheres over a plane (examples/scaling/jittered_1024.sdf) with `sdf`'s cache: every
+    /// step's distance is the minimum over every instance, bit for bit, and most steps need
+    /// no walk.
+    #[test]
+    fn the_cache_of_the_last_walk_gives_the_minimum_and_spares_most_walks() {
+        let mut rng = crate::rng::Rng::new(11);
+        let instances: Vec<Instance> = (0..1024)
+            .map(|k| {
+                let cell = [k % 16, k / 64, k / 16 % 4];
+                let c = [0, 1, 2].map(|a| {
+                    let centre = if a == 1 { 0.5 } else { -7.5 };
+                    (cell[a] as f64 + centre) * 0.5 + rng.range(-0.1, 0.1)
+                });
+                let r = 0.15;
+                Instance {
+                    shape: Node::Sphere { radius: r },
+                    offset: c,
+                    rotation: None,
+                    material: None,
+                    aabb: (c.map(|x| x - r), c.map(|x| x + r)),
+                }
+            })
+            .collect();
+        let d = data(&instances);
+        let e = vectors(&d);
+        let norm = |v: [f32; 3]| {
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|x| x / l)
+        };
+        let (mut steps, mut walks, mut boxes, mut uncached_boxes) = (0, 0, 0, 0);
+        let mut cache = (0, [0.0; 3], 0.0);
+        let mut field = |p: [f32; 3], cache: &mut Cache| {
+            let start = p[1];
+            let got = model_sdf(&e, p, start, cache, d.stack, &mut walks, &mut boxes);
+            assert_eq!(got.to_bits(), brute(&e, p, start).0.to_bits(), "{p:?}");
+            uncached_boxes += model(&e, p, start, cache.0, d.stack, false).boxes;
+            steps += 1;
+            got
+        };
+        let (eye, light) = ([0.0f32, 3.2, -7.5], norm([0.5, 1.0, -0.6]));
+        let mut hits = 0;
+        for y in 0..24 {
+            for x in 0..32 {
+                let target = [(x as f32 - 15.5) * 0.25, 3.0 - y as f32 * 0.2, 0.0];
+                let dir = norm([0, 1, 2].map(|k| target[k] - eye[k]));
+                let Some(p) = march(&mut field, eye, dir, &mut cache) else {
+                    continue;
+                };
+                hits += 1;
+                // The normal's taps, then a shadow ray from just above the surface.
+                let h = 1e-3;
+                let g = [0, 1, 2].map(|k| {
+                    let (mut a, mut b) = (p, p);
+                    a[k] += h;
+                    b[k] -= h;
+                    field(a, &mut cache) - field(b, &mut cache)
+                });
+                let n = norm(g);
+                let o = [0, 1, 2].map(|k| p[k] + n[k] * 2e-3);
+                march(&mut field, o, light, &mut cache);
+            }
+        }
+        assert!(hits > 500, "{hits} hits");
+        let per = |x: usize| x as f64 / steps as f64;
+        println!(
+            "{steps} steps: {:.2} walks and {:.2} boxes each ({:.2} boxes walking every step)",
+            per(walks),
+            per(boxes),
+            per(uncached_boxes)
+        );
+        assert!(per(walks) < 0.5, "{:.2} walks a step", per(walks));
+    }
+
+    /// The point where a ray from `o` along `dir` first comes within 1e-4·t of the surface,
+    /// marched through `field` with `cache`, if it does within 512 steps and 30 units.
+    fn march(
+        field: &mut impl FnMut([f32; 3], &mut Cache) -> f32,
+        o: [f32; 3],
+        dir: [f32; 3],
+        cache: &mut Cache,
+    ) -> Option<[f32; 3]> {
+        let mut t = 0.0f32;
+        for _ in 0..512 {
+            let p = [0, 1, 2].map(|k| o[k] + t * dir[k]);
+            let d = field(p, cache);
+            if d < 1e-4 * t.max(1.0) {
+                return Some(p);
+            }
+            t += d;
+            if t > 30.0 {
+                break;
+            }
+        }
+        None
     }
 }

@@ -2,7 +2,7 @@
 //! whenever it or a file it imports is saved (see `docs/viewer.md`).
 
 use crate::backend::{Backend, Kernel};
-use crate::view::{self, session::Options, Control, Run};
+use crate::view::{self, session::Options, session::GRACE, Control, Run};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -112,6 +112,7 @@ pub fn run(args: ViewArgs) -> ExitCode {
             timings: args.timings,
             kernel: args.kernel.unwrap_or_default(),
             interim_on_cpu: false,
+            grace: GRACE,
             // Headless, nothing would ever settle while the clock runs.
             time: args.time.or(args.headless.then_some(0.0)),
         },

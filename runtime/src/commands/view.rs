@@ -34,7 +34,8 @@ pub struct ViewArgs {
     pub set: Vec<String>,
     /// The GPU kernel (wgpu): `auto` shows a marched scene whose specialised kernel is not
     /// compiled yet through the interpreted kernel until it is, compiling it on another thread
-    /// (on a GPU; a CPU adapter compiles before showing, as `specialised` does);
+    /// (on a GPU, after waiting 50 ms for it: a kernel compiled by then is shown at once; a
+    /// CPU adapter compiles before showing, as `specialised` does);
     /// `specialised` compiles each new kernel before showing it; `interpreted` shows every
     /// scene through the interpreted kernel (docs/interpreted.md). [default: auto]
     #[arg(long, value_enum, hide_possible_values = true)]

@@ -42,13 +42,14 @@ pub const MAX_SCALE: u32 = 8;
 /// How long a load whose specialised pipeline compiles on another thread (`--kernel auto` on a
 /// GPU) waits for it before showing the scene through the interpreted kernel. A driver that
 /// compiles a kernel in a few milliseconds then shows the specialised kernel's frame at once,
-/// with no interpreted frame before it: on an H100 (`scripts/device-view.sh`, run by the
-/// project's lead), `lattice.sdf`'s structural edit reached the screen in 80 ms when its
-/// kernel (compiled in 8 ms) was compiled before showing, and in 296 ms when the slower
-/// interpreted frame went first. A compile that takes longer (`temple.sdf`'s took about 2 s
-/// there) is hidden as before, its interpreted frame shown this much later: 50 ms is a few
-/// frames at 60 Hz, short beside the seconds a slow compile takes and well above the few
-/// milliseconds of a fast one. The window's event loop is never held: it is woken at the end
+/// with no interpreted frame before it: on an H100 (`scripts/device-view.sh`, before this
+/// period), `lattice.sdf`'s structural edit reached the screen in 80 ms when its kernel
+/// (compiled in 8 ms) was compiled before showing, and in 296 ms when the slower interpreted
+/// frame went first. A compile that takes longer is hidden as before, its interpreted frame
+/// shown this much later (`temple.sdf`'s structural edit reached the screen there in 2 020 ms
+/// compiled before showing, in 224 ms through the interpreted kernel): 50 ms is a few frames
+/// at 60 Hz, short beside a slow compile's seconds and well above a fast one's few
+/// milliseconds. The window's event loop is never held: it is woken at the end
 /// of the period ([`Session::grace_deadline`]).
 pub const GRACE: Duration = Duration::from_millis(50);
 
@@ -67,7 +68,7 @@ pub struct Options {
     /// `--time`: an animated scene starts paused at this time (seconds) instead of playing.
     pub time: Option<f64>,
     /// `--kernel`: on wgpu, the specialised kernel, shown through the interpreted one while it
-    /// compiles on a GPU (`auto`); the specialised kernel alone, each new one compiled before
+    /// compiles on a GPU when it is not ready within the grace period (`auto`); the specialised kernel alone, each new one compiled before
     /// it is shown (`specialised`); or the interpreted kernel alone (`interpreted`).
     pub kernel: Kernel,
     /// With `auto`, show the interpreted kernel while the specialised one compiles on a CPU
@@ -288,6 +289,43 @@ struct Timings {
     printed: bool,
 }
 
+impl Timings {
+    /// What the load's line says of its kernel's pipeline: how it was had, and with `auto`
+    /// whether the specialised kernel was ready within the grace period `grace` or was shown
+    /// interpreted while it compiled.
+    fn pipeline_words(&self, grace: Duration) -> String {
+        let got = |p: PipelineTime| match p.cached {
+            true => format!("cached ({:.1} ms)", ms(p.time)),
+            false => format!("compiled {:.1} ms", ms(p.time)),
+        };
+        let grace = ms(grace);
+        match (self.pipeline, self.background, self.ready) {
+            (Some(p), false, _) => format!(", pipeline {}", got(p)),
+            (Some(p), true, Some((ready, true))) => format!(
+                ", pipeline {} on another thread, specialised compiled within the grace period in {:.1} ms (grace {grace:.0} ms, no interpreted frame)",
+                got(p),
+                ms(ready)
+            ),
+            (Some(p), true, Some((ready, false))) => format!(
+                ", pipeline {} on another thread, specialised ready {:.1} ms after its compile started (after the {grace:.0} ms grace period, before an interpreted frame)",
+                got(p),
+                ms(ready)
+            ),
+            (Some(p), true, None) => format!(", pipeline {} on another thread", got(p)),
+            (None, true, _) => format!(
+                ", pipeline compiling on another thread, not ready within the {grace:.0} ms grace period, interpreted while compiling (interpreted kernel {:.2} ms, its pipeline {})",
+                ms(self.interim_prepare),
+                match self.interim_pipeline {
+                    Some(p) if p.cached => "was cached".to_string(),
+                    Some(p) => format!("compiled {:.1} ms", ms(p.time)),
+                    None => "was ready".to_string(),
+                }
+            ),
+            (None, false, _) => String::new(),
+        }
+    }
+}
+
 /// One rendered frame.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameInfo {
@@ -457,7 +495,8 @@ impl Session {
     }
 
     /// Whether the scene on show waits for its specialised kernel's pipeline, compiling on
-    /// another thread (its frames are the interpreted kernel's, or none yet).
+    /// another thread (its frames are the interpreted kernel's, or none yet: in the grace
+    /// period, or while the interpreted kernel's pipeline compiles too).
     pub fn compiling(&self) -> bool {
         self.good.as_ref().is_some_and(|g| g.waiting.is_some())
     }
@@ -623,7 +662,8 @@ impl Session {
         // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
         // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.
         // The kernel kept is the specialised one unless `--kernel interpreted`; with `auto`
-        // the interpreted kernel shows the scene while the specialised one compiles.
+        // the interpreted kernel shows the scene while the specialised one compiles, once the
+        // grace period has passed without it.
         let kernel = match self.options.kernel {
             Kernel::Interpreted => wgsl::KernelChoice::Interpreted,
             Kernel::Auto | Kernel::Specialised => wgsl::KernelChoice::Specialised,
@@ -1062,7 +1102,8 @@ impl Session {
     /// Whether there is a frame to render: a scene is loaded and the camera moves or the image
     /// has fewer samples than the scene's `aa` asks for.
     /// While the scene's kernel compiles on another thread, only its end calls for a frame
-    /// (before, the interpreted kernel's image converges, or there is nothing to render).
+    /// (before, the interpreted kernel's image converges, or there is nothing to render: in
+    /// the grace period, the end of the period calls for one, at [`Session::grace_deadline`]).
     pub fn wants_frame(&self) -> bool {
         let Some(good) = &self.good else {
             return false;
@@ -1237,35 +1278,7 @@ impl Session {
             return;
         }
         if self.options.timings {
-            let got = |p: PipelineTime| match p.cached {
-                true => format!("cached ({:.1} ms)", ms(p.time)),
-                false => format!("compiled {:.1} ms", ms(p.time)),
-            };
-            let grace = ms(self.options.grace);
-            let pipeline = match (t.pipeline, t.background, t.ready) {
-                (Some(p), false, _) => format!(", pipeline {}", got(p)),
-                (Some(p), true, Some((ready, true))) => format!(
-                    ", pipeline {} on another thread, specialised compiled within the grace period in {:.1} ms (grace {grace:.0} ms, no interpreted frame)",
-                    got(p),
-                    ms(ready)
-                ),
-                (Some(p), true, Some((ready, false))) => format!(
-                    ", pipeline {} on another thread, specialised ready {:.1} ms after its compile started (after the {grace:.0} ms grace period, before an interpreted frame)",
-                    got(p),
-                    ms(ready)
-                ),
-                (Some(p), true, None) => format!(", pipeline {} on another thread", got(p)),
-                (None, true, _) => format!(
-                    ", pipeline compiling on another thread, not ready within the {grace:.0} ms grace period, interpreted while compiling (interpreted kernel {:.2} ms, its pipeline {})",
-                    ms(t.interim_prepare),
-                    match t.interim_pipeline {
-                        Some(p) if p.cached => "was cached".to_string(),
-                        Some(p) => format!("compiled {:.1} ms", ms(p.time)),
-                        None => "was ready".to_string(),
-                    }
-                ),
-                (None, false, _) => String::new(),
-            };
+            let pipeline = t.pipeline_words(self.options.grace);
             let now = SystemTime::now();
             let edit = match (
                 t.modified.filter(|_| t.number > 0),
@@ -1635,6 +1648,12 @@ mod tests {
             "ready within the grace period: {:?}",
             t.ready
         );
+        // The words `--timings` prints (and scripts/device-view.sh reads).
+        let words = t.pipeline_words(s.options.grace);
+        assert!(
+            words.contains("on another thread, specialised compiled within the grace period in"),
+            "{words}"
+        );
         settle_all(&mut s);
         assert_eq!(s.last.unwrap().kernel, Some("specialised"));
         let changed = crate::metrics::compare(&before, s.image().unwrap(), 0.1).unwrap();
@@ -1681,6 +1700,11 @@ mod tests {
         assert!(s.title(false).contains("interpreted while compiling"));
         let t = s.timings.as_ref().expect("the load's timings");
         assert_eq!((t.first_kernel, t.ready), (Some("interpreted"), None));
+        let words = t.pipeline_words(s.options.grace);
+        assert!(
+            words.contains("not ready within the 50 ms grace period, interpreted while compiling"),
+            "{words}"
+        );
         release_when_compiled(&mut s);
         settle_all(&mut s);
         assert_eq!(s.last.unwrap().kernel, Some("specialised"));

@@ -49,8 +49,8 @@ pub const MAX_SCALE: u32 = 8;
 /// shown this much later (`temple.sdf`'s structural edit reached the screen there in 2 020 ms
 /// compiled before showing, in 224 ms through the interpreted kernel): 50 ms is a few frames
 /// at 60 Hz, short beside a slow compile's seconds and well above a fast one's few
-/// milliseconds. The window's event loop is never held: it is woken at the end
-/// of the period ([`Session::grace_deadline`]).
+/// milliseconds. The window's event loop is never held: it is woken at the end of the period
+/// ([`Session::grace_deadline`]).
 pub const GRACE: Duration = Duration::from_millis(50);
 
 /// How the session treats the scene, from the command line.
@@ -68,8 +68,9 @@ pub struct Options {
     /// `--time`: an animated scene starts paused at this time (seconds) instead of playing.
     pub time: Option<f64>,
     /// `--kernel`: on wgpu, the specialised kernel, shown through the interpreted one while it
-    /// compiles on a GPU when it is not ready within the grace period (`auto`); the specialised kernel alone, each new one compiled before
-    /// it is shown (`specialised`); or the interpreted kernel alone (`interpreted`).
+    /// compiles on a GPU when it is not ready within the grace period (`auto`); the
+    /// specialised kernel alone, each new one compiled before it is shown (`specialised`); or
+    /// the interpreted kernel alone (`interpreted`).
     pub kernel: Kernel,
     /// With `auto`, show the interpreted kernel while the specialised one compiles on a CPU
     /// adapter (lavapipe) too. `sdfc view` leaves it off: there the interpreted kernel's
@@ -1332,10 +1333,10 @@ impl Session {
             title.push_str(&format!(" | render error: {msg}"));
         }
         match self.good.as_ref().and_then(|g| g.waiting.as_ref()) {
-            // In the grace period too: the interpreted kernel is not shown yet.
             Some(w) if !w.in_grace() && w.interim.as_ref().is_some_and(|i| i.compile.is_none()) => {
                 title.push_str(" | interpreted while compiling")
             }
+            // In the grace period, and after it until a kernel is ready.
             Some(_) => title.push_str(" | compiling the kernel"),
             None => {}
         }

@@ -11,10 +11,13 @@
 # first-frame times and the time from the file's modification to the first frame (edit to
 # pixel). Then, for the report's scenes and temple.sdf, the frame rate while orbiting at
 # $SIZE and the time to converge after the camera stops (--orbit-frames). $KERNEL (default
-# auto) is the viewer's --kernel: with auto, a structural edit is shown through the interpreted
-# kernel while the specialised one compiles, and a second line says when that was ready;
-# KERNEL=specialised measures the viewer that compiles before showing, to compare. Expects
-# .dev/sdfc and .gl/ as scripts/device-run.sh does. Writes $OUT/view.txt.
+# auto) is the viewer's --kernel: with auto, a structural edit waits 50 ms (the grace period)
+# for its specialised kernel, shown at once if it compiled by then, else through the
+# interpreted kernel while the specialised one compiles, and a second line says when that was
+# ready; a line per scene says which kernel the structural edit's first frame used and whether
+# it was ready within the grace period. KERNEL=specialised measures the viewer that compiles
+# before showing, to compare. Expects .dev/sdfc and .gl/ as scripts/device-run.sh does. Writes
+# $OUT/view.txt.
 set -u
 . "$(dirname "$0")/device-env.sh"
 SIZE=${SIZE:-1920x1080}
@@ -75,6 +78,17 @@ PY
   wait $pid
   echo "== $n (numeric, structural, radius edits; --kernel $KERNEL)" | tee -a "$LOG"
   grep -E "timings|full-resolution|kernel ready|error" "$d/log" | tee -a "$LOG"
+  # The structural edit is load 2: its first frame's kernel, and the grace period's outcome.
+  s2=$(grep "load 2 timings" "$d/log")
+  k=$(echo "$s2" | grep -oE "first frame [0-9.]+ ms \([0-9]+x[0-9]+, [a-z]+" | grep -oE "[a-z]+$")
+  case "$s2" in
+    *"specialised compiled within the grace period"*) g=", compiled within the grace period" ;;
+    *"not ready within"*) g=", not ready within the grace period" ;;
+    *"after the"*"grace period"*) g=", ready after the grace period, before an interpreted frame" ;;
+    *"on another thread"*) g="" ;;
+    *) g=", compiled before it was shown" ;;
+  esac
+  [ -n "$s2" ] && echo "$n: structural edit's first frame: ${k:-?} kernel$g" | tee -a "$LOG"
   [ $ok = 1 ] || { echo "$n: FAILED"; tail -n 5 "$d/log"; } | tee -a "$LOG"
   rm -rf "$d"
 done

@@ -2,7 +2,7 @@
 //! whenever it or a file it imports is saved (see `docs/viewer.md`).
 
 use crate::backend::{Backend, Kernel};
-use crate::view::{self, session::Options, Control, Run};
+use crate::view::{self, session::Options, session::GRACE, Control, Run};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -34,7 +34,8 @@ pub struct ViewArgs {
     pub set: Vec<String>,
     /// The GPU kernel (wgpu): `auto` shows a marched scene whose specialised kernel is not
     /// compiled yet through the interpreted kernel until it is, compiling it on another thread
-    /// (on a GPU; a CPU adapter compiles before showing, as `specialised` does);
+    /// (on a GPU, after waiting 50 ms for it: a kernel compiled by then is shown at once; a
+    /// CPU adapter compiles before showing, as `specialised` does);
     /// `specialised` compiles each new kernel before showing it; `interpreted` shows every
     /// scene through the interpreted kernel (docs/interpreted.md). [default: auto]
     #[arg(long, value_enum, hide_possible_values = true)]
@@ -112,6 +113,7 @@ pub fn run(args: ViewArgs) -> ExitCode {
             timings: args.timings,
             kernel: args.kernel.unwrap_or_default(),
             interim_on_cpu: false,
+            grace: GRACE,
             // Headless, nothing would ever settle while the clock runs.
             time: args.time.or(args.headless.then_some(0.0)),
         },

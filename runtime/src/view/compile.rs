@@ -1,6 +1,7 @@
 //! Pipelines compiled on a thread of their own, so that the viewer's window never waits for the
 //! driver: while a new scene's specialised kernel compiles, the session shows it through the
-//! interpreted kernel, and it is told (the [`Waker`]) when the compile has ended.
+//! interpreted kernel (once a short grace period has passed without it), and it is told (the
+//! [`Waker`]) when the compile has ended.
 
 use crate::backend::Prepared;
 use crate::gpu::wgpu::PipelineTime;

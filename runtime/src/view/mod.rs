@@ -99,8 +99,9 @@ pub fn headless(run: Run) -> ExitCode {
         }
         // Render until the image settles; a frame limit counts the settled image too.
         loop {
-            // Nothing to render while a kernel compiles (the interpreted kernel's image has
-            // converged, or there is none yet): wait for it.
+            // Nothing to render while a kernel compiles (in its grace period, or the
+            // interpreted kernel's image has converged, or there is none yet): wait for it,
+            // or for the end of the grace period.
             session.wait_for_compile(Duration::from_secs(1));
             match session.frame() {
                 Ok(Some(_)) => session.presented(),

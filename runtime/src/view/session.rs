@@ -4,8 +4,9 @@
 //! pixels when a frame exceeds its budget, while the camera moves; jittered samples
 //! accumulated up to the scene's `aa` when it is still), and plays an animated scene's time `t`
 //! (each frame's scene checked at its time, its kernel kept while only numbers change). On wgpu,
-//! a scene whose specialised kernel is not compiled yet is shown through the interpreted kernel
-//! while the specialised one compiles on another thread ([`super::compile`]).
+//! a scene whose specialised kernel is not compiled yet waits a short grace period ([`GRACE`])
+//! for it to compile on another thread ([`super::compile`]), and is shown through the
+//! interpreted kernel from then until it is ready.
 
 use super::camera::{self, Orbit};
 use super::compile::{Compile, Waker};
@@ -38,9 +39,22 @@ const STABLE_READS: usize = 4;
 const EMPTY_PATIENCE: Duration = Duration::from_millis(500);
 /// The largest divisor of the resolution while moving.
 pub const MAX_SCALE: u32 = 8;
+/// How long a load whose specialised pipeline compiles on another thread (`--kernel auto` on a
+/// GPU) waits for it before showing the scene through the interpreted kernel. A driver that
+/// compiles a kernel in a few milliseconds then shows the specialised kernel's frame at once,
+/// with no interpreted frame before it: on an H100 (`scripts/device-view.sh`, before this
+/// period), `lattice.sdf`'s structural edit reached the screen in 80 ms when its kernel
+/// (compiled in 8 ms) was compiled before showing, and in 296 ms when the slower interpreted
+/// frame went first. A compile that takes longer is hidden as before, its interpreted frame
+/// shown this much later (`temple.sdf`'s structural edit reached the screen there in 2 020 ms
+/// compiled before showing, in 224 ms through the interpreted kernel): 50 ms is a few frames
+/// at 60 Hz, short beside a slow compile's seconds and well above a fast one's few
+/// milliseconds. The window's event loop is never held: it is woken at the end of the period
+/// ([`Session::grace_deadline`]).
+pub const GRACE: Duration = Duration::from_millis(50);
 
 /// How the session treats the scene, from the command line.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct Options {
     /// `--size`: the image size, overriding the scene's (the window's size replaces it when
     /// the window is resized).
@@ -54,14 +68,33 @@ pub struct Options {
     /// `--time`: an animated scene starts paused at this time (seconds) instead of playing.
     pub time: Option<f64>,
     /// `--kernel`: on wgpu, the specialised kernel, shown through the interpreted one while it
-    /// compiles on a GPU (`auto`); the specialised kernel alone, each new one compiled before
-    /// it is shown (`specialised`); or the interpreted kernel alone (`interpreted`).
+    /// compiles on a GPU when it is not ready within the grace period (`auto`); the
+    /// specialised kernel alone, each new one compiled before it is shown (`specialised`); or
+    /// the interpreted kernel alone (`interpreted`).
     pub kernel: Kernel,
     /// With `auto`, show the interpreted kernel while the specialised one compiles on a CPU
     /// adapter (lavapipe) too. `sdfc view` leaves it off: there the interpreted kernel's
     /// frames took 25 to 150 times the specialised kernel's (docs/interpreted.md), longer
     /// than the compile they would hide; the tests, which have no other adapter, set it.
     pub interim_on_cpu: bool,
+    /// With `auto`, how long a load waits for its specialised pipeline before showing the
+    /// interpreted kernel ([`GRACE`]; the tests set their own).
+    pub grace: Duration,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            size: None,
+            sets: Vec::new(),
+            limits: Limits::default(),
+            timings: false,
+            time: None,
+            kernel: Kernel::default(),
+            interim_on_cpu: false,
+            grace: GRACE,
+        }
+    }
 }
 
 /// The playing of an animated scene's time `t`: the frame on show is the scene checked at the
@@ -141,7 +174,7 @@ struct Good {
     /// The load it came from.
     load: u32,
     /// While the pipeline of `prepared` compiles on another thread: that compile, and the
-    /// interpreted kernel shown meanwhile.
+    /// interpreted kernel shown meanwhile (after the grace period).
     waiting: Option<Waiting>,
 }
 
@@ -156,6 +189,9 @@ struct Waiting {
     interim: Option<Interim>,
     /// Whether a frame of the interpreted kernel was rendered.
     shown: bool,
+    /// The end of the grace period: until then nothing is rendered, the specialised kernel
+    /// being awaited (the image of the scene before stays on show).
+    grace_until: Instant,
 }
 
 /// The interpreted kernel of a scene whose specialised pipeline compiles.
@@ -170,10 +206,12 @@ struct Interim {
 
 impl Good {
     /// The kernel frames are rendered with now: the specialised one, or while it compiles
-    /// the interpreted one once its pipeline is ready; `None` while neither is.
+    /// the interpreted one once its pipeline is ready and the grace period is over; `None`
+    /// while neither is.
     fn kernel(&self) -> Option<&Prepared> {
         match &self.waiting {
             None => Some(&self.prepared),
+            Some(w) if w.in_grace() => None,
             Some(w) => w
                 .interim
                 .as_ref()
@@ -184,6 +222,12 @@ impl Good {
 }
 
 impl Waiting {
+    /// Whether the grace period runs: the specialised kernel is awaited before the interpreted
+    /// one is shown.
+    fn in_grace(&self) -> bool {
+        Instant::now() < self.grace_until
+    }
+
     /// Whether a compile has ended whose result is still to be taken (the specialised one's
     /// unless `held`).
     fn finished(&self, held: bool) -> bool {
@@ -232,6 +276,10 @@ struct Timings {
     interim_prepare: Duration,
     /// The interpreted kernel's pipeline, when it rendered the first frame.
     interim_pipeline: Option<PipelineTime>,
+    /// When the specialised pipeline compiled on another thread was ready before any frame
+    /// of the interpreted kernel: how long after its compile started the session took it,
+    /// and whether that was within the grace period.
+    ready: Option<(Duration, bool)>,
     /// When the newest of the scene's files was modified.
     modified: Option<SystemTime>,
     /// When the load began.
@@ -240,6 +288,43 @@ struct Timings {
     first_frame: Option<(Duration, u32, u32)>,
     /// Whether the first frame's timings are printed (and the first full frame's are due).
     printed: bool,
+}
+
+impl Timings {
+    /// What the load's line says of its kernel's pipeline: how it was had, and with `auto`
+    /// whether the specialised kernel was ready within the grace period `grace` or was shown
+    /// interpreted while it compiled.
+    fn pipeline_words(&self, grace: Duration) -> String {
+        let got = |p: PipelineTime| match p.cached {
+            true => format!("cached ({:.1} ms)", ms(p.time)),
+            false => format!("compiled {:.1} ms", ms(p.time)),
+        };
+        let grace = ms(grace);
+        match (self.pipeline, self.background, self.ready) {
+            (Some(p), false, _) => format!(", pipeline {}", got(p)),
+            (Some(p), true, Some((ready, true))) => format!(
+                ", pipeline {} on another thread, specialised compiled within the grace period in {:.1} ms (grace {grace:.0} ms, no interpreted frame)",
+                got(p),
+                ms(ready)
+            ),
+            (Some(p), true, Some((ready, false))) => format!(
+                ", pipeline {} on another thread, specialised ready {:.1} ms after its compile started (after the {grace:.0} ms grace period, before an interpreted frame)",
+                got(p),
+                ms(ready)
+            ),
+            (Some(p), true, None) => format!(", pipeline {} on another thread", got(p)),
+            (None, true, _) => format!(
+                ", pipeline compiling on another thread, not ready within the {grace:.0} ms grace period, interpreted while compiling (interpreted kernel {:.2} ms, its pipeline {})",
+                ms(self.interim_prepare),
+                match self.interim_pipeline {
+                    Some(p) if p.cached => "was cached".to_string(),
+                    Some(p) => format!("compiled {:.1} ms", ms(p.time)),
+                    None => "was ready".to_string(),
+                }
+            ),
+            (None, false, _) => String::new(),
+        }
+    }
 }
 
 /// One rendered frame.
@@ -389,17 +474,30 @@ impl Session {
         })
     }
 
-    /// Waits, at most `timeout`, for a pipeline compiling on another thread, when there is
-    /// no frame to render until it ends; returns at once otherwise.
+    /// Waits, at most `timeout` and not past the end of the grace period, for a pipeline
+    /// compiling on another thread, when there is no frame to render until it ends or the
+    /// grace period does; returns at once otherwise.
     pub fn wait_for_compile(&self, timeout: Duration) {
-        let waiting = self.good.as_ref().is_some_and(|g| g.waiting.is_some());
-        if waiting && !self.wants_frame() {
+        if self.compiling() && !self.wants_frame() {
+            let timeout = match self.grace_deadline() {
+                Some(end) => timeout.min(end.saturating_duration_since(Instant::now())),
+                None => timeout,
+            };
             let _ = self.compiled.1.recv_timeout(timeout);
         }
     }
 
+    /// While the scene on show waits its grace period for its specialised kernel: when the
+    /// period ends, and a frame of the interpreted kernel may be due (a window's event loop
+    /// wakes then). `None` when there is no such period, or it is over.
+    pub fn grace_deadline(&self) -> Option<Instant> {
+        let w = self.good.as_ref()?.waiting.as_ref()?;
+        w.in_grace().then_some(w.grace_until)
+    }
+
     /// Whether the scene on show waits for its specialised kernel's pipeline, compiling on
-    /// another thread (its frames are the interpreted kernel's, or none yet).
+    /// another thread (its frames are the interpreted kernel's, or none yet: in the grace
+    /// period, or while the interpreted kernel's pipeline compiles too).
     pub fn compiling(&self) -> bool {
         self.good.as_ref().is_some_and(|g| g.waiting.is_some())
     }
@@ -565,7 +663,8 @@ impl Session {
         // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
         // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.
         // The kernel kept is the specialised one unless `--kernel interpreted`; with `auto`
-        // the interpreted kernel shows the scene while the specialised one compiles.
+        // the interpreted kernel shows the scene while the specialised one compiles, once the
+        // grace period has passed without it.
         let kernel = match self.options.kernel {
             Kernel::Interpreted => wgsl::KernelChoice::Interpreted,
             Kernel::Auto | Kernel::Specialised => wgsl::KernelChoice::Specialised,
@@ -610,9 +709,11 @@ impl Session {
                 interim_prepare = start.elapsed();
                 match interim {
                     Some(interim) => {
+                        let grace = self.options.grace;
                         waiting = Compile::start(&prepared, self.compile_waker()).map(|compile| {
                             Waiting {
                                 load: self.loads - 1,
+                                grace_until: compile.started + grace,
                                 compile,
                                 interim: Some(interim),
                                 shown: false,
@@ -660,6 +761,7 @@ impl Session {
             first_kernel: None,
             interim_prepare,
             interim_pipeline: None,
+            ready: None,
             modified: None,
             began: SystemTime::now(),
             first_frame: None,
@@ -759,9 +861,11 @@ impl Session {
         match result {
             Ok(time) => {
                 if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
-                    // Ready before the interpreted kernel showed anything: the load's line
-                    // says so.
+                    // Ready before the interpreted kernel showed anything (within the grace
+                    // period, or after it but before the interpreted kernel was ready): the
+                    // load's line says so.
                     t.pipeline = Some(time);
+                    t.ready = Some((w.compile.started.elapsed(), w.in_grace()));
                 } else if timings {
                     eprintln!(
                         "view: load {load}: specialised kernel ready {:.1} ms after the load (pipeline {} {:.1} ms on another thread); interpreted while compiling until then",
@@ -787,8 +891,10 @@ impl Session {
                     Some(i) => {
                         eprintln!("view: load {load}: the interpreted kernel stays on show");
                         good.prepared = i.prepared;
+                        // No grace period: there is no other kernel to wait for.
                         good.waiting = i.compile.map(|compile| Waiting {
                             load,
+                            grace_until: compile.started,
                             compile,
                             interim: None,
                             shown: false,
@@ -997,7 +1103,8 @@ impl Session {
     /// Whether there is a frame to render: a scene is loaded and the camera moves or the image
     /// has fewer samples than the scene's `aa` asks for.
     /// While the scene's kernel compiles on another thread, only its end calls for a frame
-    /// (before, the interpreted kernel's image converges, or there is nothing to render).
+    /// (before, the interpreted kernel's image converges, or there is nothing to render: in
+    /// the grace period, the end of the period calls for one, at [`Session::grace_deadline`]).
     pub fn wants_frame(&self) -> bool {
         let Some(good) = &self.good else {
             return false;
@@ -1172,24 +1279,7 @@ impl Session {
             return;
         }
         if self.options.timings {
-            let got = |p: PipelineTime| match p.cached {
-                true => format!("cached ({:.1} ms)", ms(p.time)),
-                false => format!("compiled {:.1} ms", ms(p.time)),
-            };
-            let pipeline = match (t.pipeline, t.background) {
-                (Some(p), false) => format!(", pipeline {}", got(p)),
-                (Some(p), true) => format!(", pipeline {} on another thread", got(p)),
-                (None, true) => format!(
-                    ", pipeline compiling on another thread, interpreted while compiling (interpreted kernel {:.2} ms, its pipeline {})",
-                    ms(t.interim_prepare),
-                    match t.interim_pipeline {
-                        Some(p) if p.cached => "was cached".to_string(),
-                        Some(p) => format!("compiled {:.1} ms", ms(p.time)),
-                        None => "was ready".to_string(),
-                    }
-                ),
-                (None, false) => String::new(),
-            };
+            let pipeline = t.pipeline_words(self.options.grace);
             let now = SystemTime::now();
             let edit = match (
                 t.modified.filter(|_| t.number > 0),
@@ -1243,9 +1333,10 @@ impl Session {
             title.push_str(&format!(" | render error: {msg}"));
         }
         match self.good.as_ref().and_then(|g| g.waiting.as_ref()) {
-            Some(w) if w.interim.as_ref().is_some_and(|i| i.compile.is_none()) => {
+            Some(w) if !w.in_grace() && w.interim.as_ref().is_some_and(|i| i.compile.is_none()) => {
                 title.push_str(" | interpreted while compiling")
             }
+            // In the grace period, and after it until a kernel is ready.
             Some(_) => title.push_str(" | compiling the kernel"),
             None => {}
         }
@@ -1359,12 +1450,21 @@ mod tests {
     }
 
     /// The options of a session that shows the interpreted kernel while the specialised one
-    /// compiles, on lavapipe too.
+    /// compiles, on lavapipe too, as soon as its pipeline is ready (no grace period).
     fn interim() -> Options {
         Options {
             interim_on_cpu: true,
+            grace: Duration::ZERO,
             ..Options::default()
         }
+    }
+
+    /// The compile the scene on show waits for.
+    fn waiting(s: &Session) -> &Waiting {
+        s.good
+            .as_ref()
+            .and_then(|g| g.waiting.as_ref())
+            .expect("a compile")
     }
 
     /// Renders until the image is final, waiting for the kernels compiling on other threads.
@@ -1381,18 +1481,31 @@ mod tests {
     /// session take it.
     fn release_when_compiled(s: &mut Session) {
         let start = Instant::now();
-        while !s
-            .good
-            .as_ref()
-            .and_then(|g| g.waiting.as_ref())
-            .expect("a compile")
-            .compile
-            .finished()
-        {
+        while !waiting(s).compile.finished() {
             assert!(start.elapsed() < PATIENCE, "the compile never ended");
             s.wait_for_compile(Duration::from_secs(1));
         }
         s.held = None;
+    }
+
+    /// Renders (none is rendered, in the grace period of a held compile) until the interpreted
+    /// kernel's pipeline is ready, and once more.
+    fn nothing_in_the_grace_period(s: &mut Session) {
+        let start = Instant::now();
+        loop {
+            let interim = waiting(s).interim.as_ref().expect("an interpreted kernel");
+            let ready = interim.compile.is_none();
+            assert!(
+                start.elapsed() < PATIENCE,
+                "the interpreted kernel never compiled"
+            );
+            s.wait_for_compile(Duration::from_secs(1));
+            let frame = s.frame().expect("no render error");
+            assert!(frame.is_none(), "a frame in the grace period");
+            if ready {
+                return;
+            }
+        }
     }
 
     /// The next frame rendered (waiting for a kernel when there is none to render with).
@@ -1487,6 +1600,157 @@ mod tests {
         assert!(same.psnr >= 40.0, "the two kernels agree: {same:?}");
         let changed = crate::metrics::compare(&before, &specialised, 0.1).unwrap();
         assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_kernel_ready_within_the_grace_period_is_shown_with_no_interpreted_frame() {
+        // An hour's grace period stands for a driver that compiles within it: the compile,
+        // held back until the interpreted kernel is ready too, ends within it however busy the
+        // machine.
+        let Some(gpu) = wgpu() else { return };
+        let dir = std::env::temp_dir().join(format!("sdfc-grace-in-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("k.sdf");
+        let [first, boxed, _] = marched();
+        std::fs::write(&file, &first).unwrap();
+        let options = Options {
+            grace: Duration::from_secs(3600),
+            ..interim()
+        };
+        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+        let before = s.image().unwrap().clone();
+
+        std::fs::write(&file, &boxed).unwrap();
+        s.held = Some(1);
+        assert!(s.load().ok);
+        assert!(s.compiling() && s.grace_deadline().is_some());
+        // Nothing is rendered in the grace period, not even once the interpreted kernel's
+        // pipeline is ready: the image before stays on show.
+        nothing_in_the_grace_period(&mut s);
+        assert!(!s.wants_frame() && !s.settled());
+        assert!(s.title(false).contains("compiling the kernel"));
+        assert_eq!(s.image(), Some(&before));
+        release_when_compiled(&mut s);
+        let info = next_frame(&mut s);
+        assert_eq!(
+            info.kernel,
+            Some("specialised"),
+            "the specialised kernel first"
+        );
+        assert!(!s.compiling() && s.grace_deadline().is_none());
+        let t = s.timings.as_ref().expect("the load's timings");
+        assert_eq!(t.first_kernel, Some("specialised"));
+        assert!(
+            t.ready.is_some_and(|(_, within)| within),
+            "ready within the grace period: {:?}",
+            t.ready
+        );
+        // The words `--timings` prints (and scripts/device-view.sh reads).
+        let words = t.pipeline_words(s.options.grace);
+        assert!(
+            words.contains("on another thread, specialised compiled within the grace period in"),
+            "{words}"
+        );
+        settle_all(&mut s);
+        assert_eq!(s.last.unwrap().kernel, Some("specialised"));
+        let changed = crate::metrics::compare(&before, s.image().unwrap(), 0.1).unwrap();
+        assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_kernel_not_ready_within_the_grace_period_is_shown_interpreted_first() {
+        // The compile is held back past the grace period (the viewer's own): the interpreted
+        // kernel shows the scene from the period's end until the specialised kernel is ready.
+        let Some(gpu) = wgpu() else { return };
+        let dir = std::env::temp_dir().join(format!("sdfc-grace-out-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("k.sdf");
+        let [first, boxed, _] = marched();
+        std::fs::write(&file, &first).unwrap();
+        let options = Options {
+            grace: GRACE,
+            ..interim()
+        };
+        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+
+        std::fs::write(&file, &boxed).unwrap();
+        s.held = Some(1);
+        assert!(s.load().ok);
+        let w = waiting(&s);
+        let end = w.grace_until;
+        assert_eq!(end, w.compile.started + GRACE);
+        let info = next_frame(&mut s);
+        assert!(
+            Instant::now() >= end,
+            "an interpreted frame in the grace period"
+        );
+        assert_eq!(
+            info.kernel,
+            Some("interpreted"),
+            "the interpreted kernel first"
+        );
+        assert!(s.compiling() && s.grace_deadline().is_none());
+        assert!(s.title(false).contains("interpreted while compiling"));
+        let t = s.timings.as_ref().expect("the load's timings");
+        assert_eq!((t.first_kernel, t.ready), (Some("interpreted"), None));
+        let words = t.pipeline_words(s.options.grace);
+        assert!(
+            words.contains("not ready within the 50 ms grace period, interpreted while compiling"),
+            "{words}"
+        );
+        release_when_compiled(&mut s);
+        settle_all(&mut s);
+        assert_eq!(s.last.unwrap().kernel, Some("specialised"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_stale_compile_does_not_end_a_newer_loads_grace_period() {
+        // Load 1's compile ends while load 2's scene waits its grace period (an hour) for its
+        // own, held back: nothing is rendered until load 2's compile has ended, and then its
+        // specialised kernel is shown first.
+        let Some(gpu) = wgpu() else { return };
+        let dir = std::env::temp_dir().join(format!("sdfc-grace-stale-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("k.sdf");
+        let [first, boxed, torus] = marched();
+        std::fs::write(&file, &first).unwrap();
+        let options = Options {
+            grace: Duration::from_secs(3600),
+            ..interim()
+        };
+        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu.clone()));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+        std::fs::write(&file, &boxed).unwrap();
+        assert!(s.load().ok);
+        let stale = kernel_text(&s);
+        std::fs::write(&file, &torus).unwrap();
+        s.held = Some(2);
+        assert!(s.load().ok);
+        let newer = kernel_text(&s);
+        assert_ne!(stale, newer);
+        let start = Instant::now();
+        while !gpu.has_pipeline(&stale, wgsl::ENTRY_POINT, true) {
+            assert!(start.elapsed() < PATIENCE, "load 1's compile never ended");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        nothing_in_the_grace_period(&mut s);
+        assert_eq!(s.good.as_ref().unwrap().load, 2);
+        assert!(s.compiling() && s.grace_deadline().is_some());
+        release_when_compiled(&mut s);
+        let info = next_frame(&mut s);
+        assert_eq!(info.kernel, Some("specialised"));
+        assert_eq!(kernel_text(&s), newer);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

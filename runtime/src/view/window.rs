@@ -344,10 +344,17 @@ impl ApplicationHandler<UserEvent> for App {
         }
     }
 
-    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         let Some(st) = self.state.as_mut() else {
             return;
         };
+        // While a new scene waits its grace period for its specialised kernel, the loop goes
+        // on handling events and wakes at the period's end (a frame of the interpreted kernel
+        // may then be due); the compile's end wakes it sooner ([`UserEvent::Compiled`]).
+        event_loop.set_control_flow(match st.session.grace_deadline() {
+            Some(end) => ControlFlow::WaitUntil(end),
+            None => ControlFlow::Wait,
+        });
         let title = st.session.title(st.stats);
         if title != st.title {
             st.window.set_title(&title);

@@ -9,6 +9,7 @@
 //! bound or an estimate. A box may be infinite along some axes (a slab); a node with no
 //! bound at all (a plane, infinite repetition in every direction) has `None`.
 
+use super::simplify::mat_vec;
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
 use glam::DVec3;
 
@@ -460,8 +461,4 @@ fn own_cost(node: &Node) -> f64 {
         Node::Round { .. } | Node::Shell { .. } => 2.0,
         Node::Paint { .. } => 3.0,
     }
-}
-
-fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
-    [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
 }

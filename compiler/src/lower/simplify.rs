@@ -570,6 +570,7 @@ fn mat_mul(a: &[V3; 3], b: &[V3; 3]) -> [V3; 3] {
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
 }
 
-fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
+/// The product of the matrix `m` (rows) and `v`.
+pub(super) fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
     [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
 }

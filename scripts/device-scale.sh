@@ -8,7 +8,7 @@
 # 1920x1080 through CUDA and wgpu with each of several sdfc binaries, WALK_BINS="label:path
 # ..." (a path ending in .gz is unpacked first; default: main:.dev/sdfc-main.gz
 # hint:.dev/sdfc-hint.gz new:.dev/sdfc), and checks that every binary's CUDA image equals the
-# first's (PSNR inf).
+# first's (PSNR inf); WALK_SCENES names other scenes of examples/scaling.
 # Usage: scripts/device-scale.sh [all|hand|scale|walk]
 set -u
 . "$(dirname "$0")/device-env.sh"
@@ -76,7 +76,7 @@ if [ "$MODE" = walk ]; then
     for spec in "${bins[@]}"; do printf ' %12s' "${spec%%:*} ms"; done
     printf '\n'
   } > "$OUT/walk.txt"
-  for n in compound_1000 jittered_1024 random_10000; do
+  for n in ${WALK_SCENES:-compound_1000 jittered_1024 random_10000}; do
     for api in cuda wgpu; do
       printf '%-22s %-5s' "$n march" "$api" >> "$OUT/walk.txt"
       for spec in "${bins[@]}"; do

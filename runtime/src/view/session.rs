@@ -1528,6 +1528,36 @@ mod tests {
         }
     }
 
+    /// A session with `options` on the marched scene, settled, then two edits: load 1 (a box
+    /// more), whose kernel compiles, and load 2 (a torus instead), whose compile is held back;
+    /// returned once load 1's compile has ended, with the scene's directory (named after
+    /// `name`) and load 2's kernel.
+    fn stale_compile(gpu: &Arc<Gpu>, name: &str, options: Options) -> (Session, PathBuf, String) {
+        let dir = std::env::temp_dir().join(format!("sdfc-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("k.sdf");
+        let [first, boxed, torus] = marched();
+        std::fs::write(&file, &first).unwrap();
+        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu.clone()));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+        std::fs::write(&file, &boxed).unwrap();
+        assert!(s.load().ok);
+        let stale = kernel_text(&s);
+        std::fs::write(&file, &torus).unwrap();
+        s.held = Some(2);
+        assert!(s.load().ok);
+        let newer = kernel_text(&s);
+        assert_ne!(stale, newer);
+        let start = Instant::now();
+        while !gpu.has_pipeline(&stale, wgsl::ENTRY_POINT, true) {
+            assert!(start.elapsed() < PATIENCE, "load 1's compile never ended");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        (s, dir, newer)
+    }
+
     /// A marched scene (the interpreted kernel renders marched scenes alone), and two
     /// structural edits of it (new kernels).
     fn marched() -> [String; 3] {
@@ -1718,32 +1748,11 @@ mod tests {
         // own, held back: nothing is rendered until load 2's compile has ended, and then its
         // specialised kernel is shown first.
         let Some(gpu) = wgpu() else { return };
-        let dir = std::env::temp_dir().join(format!("sdfc-grace-stale-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("k.sdf");
-        let [first, boxed, torus] = marched();
-        std::fs::write(&file, &first).unwrap();
         let options = Options {
             grace: Duration::from_secs(3600),
             ..interim()
         };
-        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu.clone()));
-        s.set_size(32, 24);
-        assert!(s.load().ok);
-        settle_all(&mut s);
-        std::fs::write(&file, &boxed).unwrap();
-        assert!(s.load().ok);
-        let stale = kernel_text(&s);
-        std::fs::write(&file, &torus).unwrap();
-        s.held = Some(2);
-        assert!(s.load().ok);
-        let newer = kernel_text(&s);
-        assert_ne!(stale, newer);
-        let start = Instant::now();
-        while !gpu.has_pipeline(&stale, wgsl::ENTRY_POINT, true) {
-            assert!(start.elapsed() < PATIENCE, "load 1's compile never ended");
-            std::thread::sleep(Duration::from_millis(10));
-        }
+        let (mut s, dir, newer) = stale_compile(&gpu, "grace-stale", options);
         nothing_in_the_grace_period(&mut s);
         assert_eq!(s.good.as_ref().unwrap().load, 2);
         assert!(s.compiling() && s.grace_deadline().is_some());
@@ -1757,30 +1766,7 @@ mod tests {
     #[test]
     fn a_stale_compile_does_not_replace_a_newer_edit() {
         let Some(gpu) = wgpu() else { return };
-        let dir = std::env::temp_dir().join(format!("sdfc-stale-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("k.sdf");
-        let [first, boxed, torus] = marched();
-        std::fs::write(&file, &first).unwrap();
-        let mut s = Session::new(file.clone(), interim(), Device::Wgpu(gpu.clone()));
-        s.set_size(32, 24);
-        assert!(s.load().ok);
-        settle_all(&mut s);
-        // Load 1's kernel compiles while load 2 replaces its scene; load 2's is held back
-        // until load 1's compile has ended.
-        std::fs::write(&file, &boxed).unwrap();
-        assert!(s.load().ok);
-        let stale = kernel_text(&s);
-        std::fs::write(&file, &torus).unwrap();
-        s.held = Some(2);
-        assert!(s.load().ok);
-        let newer = kernel_text(&s);
-        assert_ne!(stale, newer);
-        let start = Instant::now();
-        while !gpu.has_pipeline(&stale, wgsl::ENTRY_POINT, true) {
-            assert!(start.elapsed() < PATIENCE, "load 1's compile never ended");
-            std::thread::sleep(Duration::from_millis(10));
-        }
+        let (mut s, dir, newer) = stale_compile(&gpu, "stale", interim());
         let info = next_frame(&mut s);
         assert_eq!(
             info.kernel,
@@ -1798,7 +1784,7 @@ mod tests {
             kernel: Kernel::Specialised,
             ..Options::default()
         };
-        let mut reference = Session::new(file.clone(), options, Device::Wgpu(gpu));
+        let mut reference = Session::new(dir.join("k.sdf"), options, Device::Wgpu(gpu));
         reference.set_size(32, 24);
         assert!(reference.load().ok);
         assert!(

@@ -850,8 +850,9 @@ impl Prepared {
         };
         let ptx = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
         let ptx_time = start.elapsed();
+        let marched = !kernel.contract.has("ANALYTIC");
         let loaded = cuda
-            .load(&ptx, wgsl::ENTRY_POINT)
+            .load(&ptx, wgsl::ENTRY_POINT, gpu::cuda::register_cap(marched))
             .map_err(|e| e.to_string())?;
         Ok(CudaModule {
             interpreted: kernel.interpreted(),

@@ -169,15 +169,16 @@ impl Cuda {
         format!("{} (sm_{})", self.name, self.sm)
     }
 
-    /// Compiles `ptx` for this device (or takes it from the cache) and loads `entry`.
-    pub fn load(&self, kernel: &ptx::Ptx, entry: &str) -> Result<Loaded, Error> {
+    /// Compiles `ptx` for this device (or takes it from the cache) and loads `entry`; `cap`
+    /// limits the registers of each thread (`None`: the JIT's choice; [`register_cap`]).
+    pub fn load(&self, kernel: &ptx::Ptx, entry: &str, cap: Option<u32>) -> Result<Loaded, Error> {
         let start = Instant::now();
         let ptx = &kernel.text;
-        let path = cache_path(ptx, &self.name, self.sm);
+        let path = cache_path(ptx, &self.name, self.sm, cap);
         let (cubin, cached) = match path.as_ref().and_then(|p| std::fs::read(p).ok()) {
             Some(bytes) => (bytes, true),
             None => {
-                let cubin = self.jit(ptx)?;
+                let cubin = self.jit(ptx, cap)?;
                 if let Some(p) = &path {
                     // The cache is an optimisation: failing to write it is not an error.
                     if let Some(dir) = p.parent() {
@@ -204,7 +205,7 @@ impl Cuda {
     }
 
     /// PTX to a cubin through the driver's linker (the JIT).
-    fn jit(&self, ptx: &str) -> Result<Vec<u8>, Error> {
+    fn jit(&self, ptx: &str, cap: Option<u32>) -> Result<Vec<u8>, Error> {
         self.ctx
             .bind_to_thread()
             .map_err(driver("binding the context"))?;
@@ -221,7 +222,7 @@ impl Cuda {
             log.len() as *mut std::ffi::c_void,
         ];
         // A register cap trades spills for occupancy; the value is passed through to the JIT.
-        if let Some(n) = max_registers() {
+        if let Some(n) = cap {
             options.push(sys::CUjit_option::CU_JIT_MAX_REGISTERS);
             values.push(n as usize as *mut std::ffi::c_void);
         }
@@ -496,21 +497,34 @@ fn check_launch(
     ptx::check_arguments(&k.params, &args).map_err(Error::Arguments)
 }
 
-/// The register cap for the JIT: `$SDFC_CUDA_MAX_REGISTERS` (0 or unset: the JIT's choice).
-fn max_registers() -> Option<u32> {
-    std::env::var("SDFC_CUDA_MAX_REGISTERS")
-        .ok()?
-        .parse()
-        .ok()
-        .filter(|&n| n > 0)
+/// The register cap of a kernel that sphere traces. Its march loops over memory (the
+/// instances' walk) and long arithmetic, and more warps resident on a multiprocessor hide
+/// their latency better than the JIT's own choice of registers, which spends them on fewer
+/// warps. On an H100 (BENCHMARKS.md, "CUDA's register cap", 1920×1080) caps of 0 (the JIT's
+/// choice), 72, 80, 88 and 96 registers took the 1 024 jittered spheres marched 6.25, 4.56,
+/// 4.89, 5.44 and 5.48 ms, temple 3.11, 2.58, 2.69, 2.85 and 2.83 ms and seed6 21.1, 19.1,
+/// 19.7, 20.5 and 20.2 ms. Small marched kernels lose a little: blends 1.15 against 1.10 ms,
+/// and the hand-written tracer's scene (bench/handwritten, ε 1e-5) 0.39 against 0.35 ms.
+/// Analytically traced kernels keep the JIT's choice: at 72 the primitives example took
+/// 0.38 ms against 0.30.
+pub const MARCHED_REGISTERS: u32 = 72;
+
+/// The register cap for the JIT of a kernel that sphere traces (`marched`) or traces
+/// analytically: `$SDFC_CUDA_MAX_REGISTERS` when set (0: the JIT's choice), else
+/// [`MARCHED_REGISTERS`] for a marched kernel and the JIT's choice for the other.
+pub fn register_cap(marched: bool) -> Option<u32> {
+    match std::env::var("SDFC_CUDA_MAX_REGISTERS") {
+        Ok(v) => v.trim().parse().ok().filter(|&n| n > 0),
+        Err(_) => marched.then_some(MARCHED_REGISTERS),
+    }
 }
 
 /// Where the compiled module of `ptx` for a device is cached ([`super::cache_file`], in the
 /// `cuda` cache directory). `None` when there is no home.
-fn cache_path(ptx: &str, device: &str, sm: u32) -> Option<PathBuf> {
+fn cache_path(ptx: &str, device: &str, sm: u32, cap: Option<u32>) -> Option<PathBuf> {
     super::cache_file(
         "cuda",
-        &(ptx, device, sm, max_registers(), env!("CARGO_PKG_VERSION")),
+        &(ptx, device, sm, cap, env!("CARGO_PKG_VERSION")),
         "cubin",
     )
 }

@@ -78,7 +78,8 @@
 //! (BENCHMARKS.md, "The walk's cache") the cache took those spheres at 1080p from 7.4 to
 //! 6.2 ms through CUDA and from 6.2 to 4.7 ms through wgpu, but random_10000 through CUDA
 //! from 8.6 to 9.0 ms: the point and bound, held for the whole kernel, cost ptxas 17 more
-//! registers.
+//! registers (since, CUDA caps a marched kernel's registers: 7.0 ms; BENCHMARKS.md, "CUDA's
+//! register cap").
 //!
 //! `walk_map`, which gives the material, keeps the tie rule independent of the order of the
 //! visit (the hint included): among instances at the same distance the one earlier in

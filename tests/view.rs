@@ -147,6 +147,22 @@ fn wait_for(path: &Path, child: &mut Child, log: &Path) -> Image {
     }
 }
 
+/// Waits for `child` to exit on its own, within [`PATIENCE`], checks that it succeeded and
+/// returns its log.
+fn exited(child: &mut Child, log: &Path) -> String {
+    let deadline = Instant::now() + PATIENCE;
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        assert!(Instant::now() < deadline, "the viewer did not exit");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let stderr = std::fs::read_to_string(log).unwrap();
+    assert!(status.success(), "the viewer failed: {status}\n{stderr}");
+    stderr
+}
+
 /// The mean colour of the pixels in the box (fractions of the image's width and height).
 fn mean(image: &Image, x: (f64, f64), y: (f64, f64)) -> [f32; 3] {
     let (w, h) = (image.width as f64, image.height as f64);
@@ -257,16 +273,7 @@ fn follows_edits(name: &str, display: Option<&Display>, args: &[&str]) {
     // An edit with an error: the last good image stays.
     std::fs::write(&scene, with_box.replace("sphere(0.8)", "sphre(0.8)")).unwrap();
     let kept = wait_for(&shots.join("reload-3.png"), &mut child, &log);
-    let deadline = Instant::now() + PATIENCE;
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        assert!(Instant::now() < deadline, "the viewer did not exit");
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let stderr = std::fs::read_to_string(&log).unwrap();
-    assert!(status.success(), "the viewer failed: {status}\n{stderr}");
+    let stderr = exited(&mut child, &log);
     assert_eq!(
         changed(&boxed, &kept, (0.0, 1.0), (0.0, 1.0)),
         0.0,
@@ -495,16 +502,7 @@ fn the_window_shows_new_kernels_interpreted_while_they_compile() {
     );
     std::fs::write(&scene, &with_box).unwrap();
     let boxed = wait_for(&shots.join("reload-1.png"), &mut child, &log);
-    let deadline = Instant::now() + PATIENCE;
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        assert!(Instant::now() < deadline, "the viewer did not exit");
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let stderr = std::fs::read_to_string(&log).unwrap();
-    assert!(status.success(), "the viewer failed: {status}\n{stderr}");
+    let stderr = exited(&mut child, &log);
     // On a CPU adapter (lavapipe) the interpreted kernel's frames would take longer than the
     // compile they hide: `auto` compiles before showing there.
     let cpu_adapter = stderr

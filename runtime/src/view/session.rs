@@ -1528,20 +1528,28 @@ mod tests {
         }
     }
 
+    /// A session with `options` on the first of [`marched`]'s scenes, in `k.sdf` of a fresh
+    /// directory named after `name`, loaded and settled: the session and the directory.
+    fn settled_on_marched(gpu: &Arc<Gpu>, name: &str, options: Options) -> (Session, PathBuf) {
+        let dir = std::env::temp_dir().join(format!("sdfc-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("k.sdf");
+        std::fs::write(&file, &marched()[0]).unwrap();
+        let mut s = Session::new(file, options, Device::Wgpu(gpu.clone()));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+        (s, dir)
+    }
+
     /// A session with `options` on the marched scene, settled, then two edits: load 1 (a box
     /// more), whose kernel compiles, and load 2 (a torus instead), whose compile is held back;
     /// returned once load 1's compile has ended, with the scene's directory (named after
     /// `name`) and load 2's kernel.
     fn stale_compile(gpu: &Arc<Gpu>, name: &str, options: Options) -> (Session, PathBuf, String) {
-        let dir = std::env::temp_dir().join(format!("sdfc-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let (mut s, dir) = settled_on_marched(gpu, name, options);
         let file = dir.join("k.sdf");
-        let [first, boxed, torus] = marched();
-        std::fs::write(&file, &first).unwrap();
-        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu.clone()));
-        s.set_size(32, 24);
-        assert!(s.load().ok);
-        settle_all(&mut s);
+        let [_, boxed, torus] = marched();
         std::fs::write(&file, &boxed).unwrap();
         assert!(s.load().ok);
         let stale = kernel_text(&s);
@@ -1578,15 +1586,9 @@ mod tests {
     #[test]
     fn a_new_kernel_is_shown_interpreted_until_the_specialised_one_is_ready() {
         let Some(gpu) = wgpu() else { return };
-        let dir = std::env::temp_dir().join(format!("sdfc-interim-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let (mut s, dir) = settled_on_marched(&gpu, "interim", interim());
         let file = dir.join("k.sdf");
-        let [first, boxed, _] = marched();
-        std::fs::write(&file, &first).unwrap();
-        let mut s = Session::new(file.clone(), interim(), Device::Wgpu(gpu));
-        s.set_size(32, 24);
-        assert!(s.load().ok);
-        settle_all(&mut s);
+        let [_, boxed, _] = marched();
         assert_eq!(s.last.unwrap().kernel, Some("specialised"));
         s.rotate(20.0, 5.0);
         let camera = s.camera();
@@ -1639,19 +1641,13 @@ mod tests {
         // held back until the interpreted kernel is ready too, ends within it however busy the
         // machine.
         let Some(gpu) = wgpu() else { return };
-        let dir = std::env::temp_dir().join(format!("sdfc-grace-in-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("k.sdf");
-        let [first, boxed, _] = marched();
-        std::fs::write(&file, &first).unwrap();
         let options = Options {
             grace: Duration::from_secs(3600),
             ..interim()
         };
-        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu));
-        s.set_size(32, 24);
-        assert!(s.load().ok);
-        settle_all(&mut s);
+        let (mut s, dir) = settled_on_marched(&gpu, "grace-in", options);
+        let file = dir.join("k.sdf");
+        let [_, boxed, _] = marched();
         let before = s.image().unwrap().clone();
 
         std::fs::write(&file, &boxed).unwrap();
@@ -1697,19 +1693,13 @@ mod tests {
         // The compile is held back past the grace period (the viewer's own): the interpreted
         // kernel shows the scene from the period's end until the specialised kernel is ready.
         let Some(gpu) = wgpu() else { return };
-        let dir = std::env::temp_dir().join(format!("sdfc-grace-out-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("k.sdf");
-        let [first, boxed, _] = marched();
-        std::fs::write(&file, &first).unwrap();
         let options = Options {
             grace: GRACE,
             ..interim()
         };
-        let mut s = Session::new(file.clone(), options, Device::Wgpu(gpu));
-        s.set_size(32, 24);
-        assert!(s.load().ok);
-        settle_all(&mut s);
+        let (mut s, dir) = settled_on_marched(&gpu, "grace-out", options);
+        let file = dir.join("k.sdf");
+        let [_, boxed, _] = marched();
 
         std::fs::write(&file, &boxed).unwrap();
         s.held = Some(1);

@@ -506,7 +506,9 @@ fn check_launch(
 /// 19.7, 20.5 and 20.2 ms. Small marched kernels lose a little: blends 1.15 against 1.10 ms,
 /// and the hand-written tracer's scene (bench/handwritten, ε 1e-5) 0.39 against 0.35 ms.
 /// Analytically traced kernels keep the JIT's choice: at 72 the primitives example took
-/// 0.38 ms against 0.30.
+/// 0.38 ms against 0.30. The JIT's own count does not say which kernels gain: blends (82
+/// registers) and the hand-written tracer's scene (93) lose, seed4 (92) and temple (96) gain
+/// (BENCHMARKS.md, "seed2's gap by light, and the JIT's registers by kernel").
 pub const MARCHED_REGISTERS: u32 = 72;
 
 /// The register cap for the JIT of a kernel that sphere traces (`marched`) or traces

@@ -31,7 +31,12 @@ use std::fmt;
 
 /// The kernel's entry point.
 pub const ENTRY_POINT: &str = "main";
-/// The workgroup is `WORKGROUP × WORKGROUP` invocations.
+/// The workgroup is `WORKGROUP × WORKGROUP` invocations: a warp of 32 is a block of 8×4
+/// pixels, and a small workgroup leaves its multiprocessor as soon as its own rays end.
+/// Workgroups of 768–1 024 invocations would hold the Vulkan driver to 64–80 registers a
+/// thread, which on an H100 made temple 28 % faster through wgpu, but cost every other
+/// kernel up to 60 % in the tails of workgroups that wait for their slowest warp
+/// (BENCHMARKS.md, "The Vulkan driver's registers").
 pub const WORKGROUP: u32 = 8;
 /// Statistics words per pixel: steps, hits, misses, budget misses, overshoots, NaNs,
 /// secondary rays, shadow rays.

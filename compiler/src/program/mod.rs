@@ -60,8 +60,6 @@ pub enum Unary {
     Exp,
     /// ln a
     Log,
-    /// ⌊a⌋
-    Floor,
     /// ⌊a + 0.5⌋
     Round,
 }

@@ -56,7 +56,7 @@ const UNARY: u32 = 6;
 const BINARY: u32 = 16;
 const SELECT: u32 = 25;
 
-const UNARIES: [Unary; 10] = [
+const UNARIES: [Unary; 9] = [
     Unary::Neg,
     Unary::Abs,
     Unary::Sqrt,
@@ -65,7 +65,6 @@ const UNARIES: [Unary; 10] = [
     Unary::Acos,
     Unary::Exp,
     Unary::Log,
-    Unary::Floor,
     Unary::Round,
 ];
 const BINARIES: [Binary; 9] = [
@@ -404,7 +403,6 @@ pub(super) fn write(file: usize, media: bool) -> String {
             Unary::Acos => "acos(a)",
             Unary::Exp => "exp(a)",
             Unary::Log => "log(a)",
-            Unary::Floor => "floor(a)",
             // ⌊a + 0.5⌋, as map.rs writes it.
             Unary::Round => "floor(a + 0.5)",
         };

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Runs on the GPU machine (the `device` tool): the distance conformance suite
-# (tests/distance_conformance.rs) on its GPU, through wgpu and CUDA, with a CUDA device
+# (runtime/tests/distance_conformance.rs) on its GPU, through wgpu and CUDA, with a CUDA device
 # required (SDFC_REQUIRE_CUDA=1: the suite fails, rather than skips, without one). Expects the
 # test binary at .dev/distance_conformance, built where the sources are:
 #   cargo test --release --test distance_conformance --no-run
 #   cp target/release/deps/distance_conformance-<hash> .dev/distance_conformance
-# and the Vulkan loader packages in .gl/ (device-env.sh). The test reads tests/in/feature from
+# and the Vulkan loader packages in .gl/ (device-env.sh). The test reads runtime/tests/in/feature from
 # runtime/, as cargo runs it. Writes the suite's report (worst ulps per evaluator) to
 # $OUT/distance-conformance.txt and exits with the suite's status.
 set -u

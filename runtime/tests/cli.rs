@@ -1,0 +1,1120 @@
+//! The `sdfc render` and `sdfc bench` commands: outputs, atomic writes, settings overrides
+//! and exit codes (1 for errors in the scene, 2 for usage and IO problems).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const SCENE: &str = "material red = phong { color: (1, 0.2, 0.1), reflect: 0.2 };
+camera { position: (0, 1, -5), look_at: (0, 0, 0), fov: 50deg }
+light point { position: (2, 4, -3), intensity: 1, radius: 50, penumbra: 7.125deg }
+render { width: 40, height: 30 }
+scene {
+  plane() ;
+  sphere(1).translate(0, 1, 0) @ red;
+}
+";
+
+/// A fresh directory for one test.
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sdfc-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+fn sdfc(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(cwd)
+        .args(args)
+        .output()
+        .expect("run sdfc")
+}
+
+fn scene_file(d: &Path) -> PathBuf {
+    let p = d.join("ball.sdf");
+    std::fs::write(&p, SCENE).expect("write scene");
+    p
+}
+
+fn entries(d: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(d)
+        .expect("read dir")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+fn png_size(p: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(p).expect("png");
+    assert_eq!(&bytes[1..4], b"PNG");
+    let be = |o: usize| u32::from_be_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+    (be(16), be(20))
+}
+
+#[test]
+fn render_writes_the_default_output_in_the_current_directory() {
+    let d = dir("default");
+    scene_file(&d);
+    let out = sdfc(&d, &["render", "ball.sdf", "--stats"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(png_size(&d.join("ball.png")), (40, 30));
+    assert_eq!(
+        entries(&d),
+        ["ball.png", "ball.sdf"],
+        "no temporary file left"
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("steps/pixel") && stdout.contains("overshoots"),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn size_aa_set_and_output_options() {
+    let d = dir("options");
+    scene_file(&d);
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--size",
+            "24x16",
+            "--aa",
+            "2",
+            "--set",
+            "max_steps=64",
+            "--set",
+            "epsilon=1e-3",
+            "-o",
+            "x.png",
+            "--precision",
+            "f64",
+            "--threads",
+            "1",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(png_size(&d.join("x.png")), (24, 16));
+    let out = sdfc(
+        &d,
+        &[
+            "render", "ball.sdf", "--set", "width=8", "--set", "height=6", "-o", "y.png",
+        ],
+    );
+    assert!(out.status.success());
+    assert_eq!(png_size(&d.join("y.png")), (8, 6));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn bad_settings_are_usage_errors() {
+    let d = dir("bad-set");
+    scene_file(&d);
+    for (args, needle) in [
+        (vec!["--set", "colour=1"], "unknown render setting `colour`"),
+        (vec!["--set", "max_steps=-3"], "max_steps must be"),
+        (vec!["--set", "relaxation=2.5"], "relaxation must be"),
+        (vec!["--set", "epsilon"], "KEY=VALUE"),
+        (vec!["--size", "0x10"], "1 to"),
+        (vec!["--threads", "0"], "at least 1"),
+    ] {
+        let mut all = vec!["render", "ball.sdf"];
+        all.extend(args.iter().copied());
+        let out = sdfc(&d, &all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    assert_eq!(entries(&d), ["ball.sdf"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn scene_errors_exit_1_and_io_errors_exit_2() {
+    let d = dir("errors");
+    std::fs::write(d.join("broken.sdf"), "scene { sphere(; }").expect("write");
+    assert_eq!(sdfc(&d, &["render", "broken.sdf"]).status.code(), Some(1));
+    assert_eq!(sdfc(&d, &["render", "missing.sdf"]).status.code(), Some(2));
+    scene_file(&d);
+    let out = sdfc(&d, &["render", "ball.sdf", "-o", "no/such/dir/x.png"]);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(entries(&d), ["ball.sdf", "broken.sdf"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn bench_prints_a_table_or_json() {
+    let d = dir("bench");
+    scene_file(&d);
+    let out = sdfc(
+        &d,
+        &[
+            "bench",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--size",
+            "16x12",
+            "--frames",
+            "2",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("Mrays/s") && table.contains("ball.sdf"),
+        "{table}"
+    );
+    let out = sdfc(
+        &d,
+        &[
+            "bench", "ball.sdf", "ball.sdf", "--size", "16x12", "--frames", "1", "--json",
+        ],
+    );
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let runs = v.as_array().expect("array");
+    assert_eq!(runs.len(), 2);
+    assert!(runs[0]["median_s"].as_f64().is_some_and(|s| s > 0.0));
+    assert_eq!(runs[0]["width"], 16);
+    assert!(runs[0]["stats"]["steps_mean"].as_f64().is_some());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+// ---- Failure paths (docs/failures.md lists each with its test) ----
+
+#[test]
+fn missing_unreadable_and_non_utf8_inputs_exit_2() {
+    let d = dir("inputs");
+    for args in [
+        &["check", "nope.sdf"][..],
+        &["render", "nope.sdf"],
+        &["compile", "nope.sdf", "--emit", "ir"],
+    ] {
+        let out = sdfc(&d, args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read `nope.sdf`"));
+    }
+    std::fs::create_dir(d.join("folder.sdf")).expect("dir");
+    assert_eq!(sdfc(&d, &["check", "folder.sdf"]).status.code(), Some(2));
+    std::fs::write(d.join("latin1.sdf"), b"scene { sphere(); } // caf\xe9\n").expect("write");
+    let out = sdfc(&d, &["render", "latin1.sdf"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not valid UTF-8"));
+    assert_eq!(entries(&d), ["folder.sdf", "latin1.sdf"]);
+}
+
+#[test]
+fn an_unreadable_import_is_a_diagnostic() {
+    let d = dir("import");
+    std::fs::write(d.join("lib.sdf"), b"let r = 1; // caf\xe9\n").expect("write");
+    std::fs::write(
+        d.join("main.sdf"),
+        "import \"lib.sdf\";\nscene { sphere(r); }\n",
+    )
+    .expect("write");
+    let out = sdfc(&d, &["check", "main.sdf"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("E0501") && err.contains("not valid UTF-8"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_missing_or_invalid_output_directory_leaves_nothing() {
+    let d = dir("outputs");
+    scene_file(&d);
+    std::fs::write(d.join("plain-file"), "x").expect("write");
+    for target in ["missing/out.png", "plain-file/out.png"] {
+        let out = sdfc(&d, &["render", "ball.sdf", "-o", target]);
+        assert_eq!(out.status.code(), Some(2), "{target}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("cannot write"),
+            "{target}"
+        );
+    }
+    let out = sdfc(
+        &d,
+        &[
+            "compile",
+            "ball.sdf",
+            "--emit",
+            "wgsl",
+            "-o",
+            "missing/k.wgsl",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(entries(&d), ["ball.sdf", "plain-file"]);
+}
+
+#[test]
+fn an_unwritable_output_is_refused_before_the_render() {
+    let d = dir("early");
+    scene_file(&d);
+    // A render that would take long: refused before it is lowered or announced.
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--size",
+            "4000x4000",
+            "--aa",
+            "4",
+            "-o",
+            "/nonexistent/x.png",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cannot write `/nonexistent/x.png`") && err.contains("does not exist"),
+        "{err}"
+    );
+    assert!(!err.contains("allocating"), "the render started: {err}");
+    // `pareto` checks its chart's place before its sweeps.
+    let out = sdfc(
+        &d,
+        &[
+            "pareto",
+            "ball.sdf",
+            "--frames",
+            "1",
+            "-o",
+            "missing/chart.svg",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty(), "the sweeps ran");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
+    assert_eq!(entries(&d), ["ball.sdf"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn render_prints_the_warnings_of_check() {
+    let d = dir("warnings");
+    std::fs::write(
+        d.join("dark.sdf"),
+        "render { width: 8, height: 6 }\nscene { sphere(1); }\n",
+    )
+    .expect("write scene");
+    let out = sdfc(&d, &["render", "dark.sdf"]);
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("[W0008]") && err.contains("no lights"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn outputs_are_written_in_the_format_their_extension_names() {
+    let d = dir("formats");
+    scene_file(&d);
+    for name in ["out.jpg", "out.JPEG"] {
+        let out = sdfc(&d, &["render", "ball.sdf", "-o", name]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(d.join(name)).expect("jpeg");
+        assert_eq!(&bytes[..3], &[0xFF, 0xD8, 0xFF], "{name} is not a JPEG");
+        assert_eq!(&bytes[bytes.len() - 2..], &[0xFF, 0xD9]);
+    }
+    // OpenEXR: magic number, version 2 (single-part scanline), a header of 305 bytes, the
+    // offset table and 30 rows of 40 float RGB pixels (runtime/src/output.rs).
+    let out = sdfc(&d, &["render", "ball.sdf", "-o", "out.exr"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let exr = std::fs::read(d.join("out.exr")).expect("exr");
+    assert_eq!(&exr[..8], &[0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0]);
+    assert!(String::from_utf8_lossy(&exr[..100]).contains("channels\0chlist"));
+    assert_eq!(exr.len(), 8 + 305 + 30 * 8 + 30 * (8 + 40 * 12));
+    // Unknown formats are refused before the render, leaving nothing.
+    for name in ["out.tiff", "out"] {
+        let out = sdfc(&d, &["render", "ball.sdf", "-o", name]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(".png`, `.jpg`"), "{err}");
+        assert!(!err.contains("allocating"), "{err}");
+    }
+    // `-o -`: the PNG on standard output (statistics on standard error), no file named `-`.
+    let out = sdfc(&d, &["render", "ball.sdf", "-o", "-", "--stats"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(&out.stdout[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(
+        &out.stdout[out.stdout.len() - 8..out.stdout.len() - 4],
+        b"IEND"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("steps/pixel"));
+    let out = sdfc(&d, &["render", "ball.sdf", "-o", "-", "--aux"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        entries(&d),
+        ["ball.sdf", "out.JPEG", "out.exr", "out.jpg"],
+        "no other file, no temporary file left"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn no_gpu_adapter_is_a_clear_error() {
+    let d = dir("adapter");
+    scene_file(&d);
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args(["render", "ball.sdf", "--backend", "wgpu"])
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .output()
+        .expect("run sdfc");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no wgpu adapter found") && err.contains("mesa-vulkan-drivers"),
+        "{err}"
+    );
+    assert_eq!(entries(&d), ["ball.sdf"]);
+}
+
+#[test]
+fn no_cuda_driver_is_a_clear_error() {
+    let d = dir("cuda");
+    scene_file(&d);
+    let out = sdfc(&d, &["render", "ball.sdf", "--backend", "cuda"]);
+    if out.status.success() {
+        println!("SKIPPED: a CUDA driver and device are present here");
+        return;
+    }
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("CUDA"), "{err}");
+    assert_eq!(entries(&d), ["ball.sdf"]);
+}
+
+#[test]
+fn an_interrupt_stops_a_render_and_leaves_no_file() {
+    let d = dir("interrupt");
+    scene_file(&d);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args([
+            "render",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--size",
+            "4000x3000",
+            "--aa",
+            "4",
+            "-o",
+            "big.png",
+        ])
+        .spawn()
+        .expect("spawn");
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(killed.success());
+    let status = child.wait().expect("wait");
+    assert!(!status.success());
+    assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
+}
+
+/// `sdfc check` says which intersection method a scene gets and why; `--set method=trace`
+/// on a scene that does not allow it is an error that writes nothing.
+#[test]
+fn the_method_setting_and_what_check_says_about_it() {
+    let d = dir("method");
+    scene_file(&d);
+    let out = sdfc(&d, &["check", "ball.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("method: march (light 1 casts soft shadows"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["render", "ball.sdf", "--set", "method=trace"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot be ray traced analytically"), "{err}");
+    let out = sdfc(&d, &["render", "ball.sdf", "--set", "method=fast"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("method must be one of"));
+    assert_eq!(entries(&d), ["ball.sdf"]);
+    std::fs::write(
+        d.join("hard.sdf"),
+        SCENE.replace("penumbra: 7.125deg", "penumbra: 0deg"),
+    )
+    .expect("write");
+    let out = sdfc(&d, &["check", "hard.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("method: trace (2 primitives"), "{err}");
+    let out = sdfc(
+        &d,
+        &["render", "hard.sdf", "--set", "method=trace", "--stats"],
+    );
+    assert_eq!(out.status.code(), Some(0));
+    assert!(d.join("hard.png").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_render_announces_its_memory_and_stops_above_the_memory_limit() {
+    let d = dir("memory");
+    scene_file(&d);
+    let out = sdfc(
+        &d,
+        &["render", "ball.sdf", "--backend", "cpu", "-o", "a.png"],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("render: 40x30, aa 1, cpu: allocating at most ") && err.contains(" MiB"),
+        "{err}"
+    );
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--limit",
+            "memory=1",
+            "--size",
+            "2000x2000",
+            "-o",
+            "b.png",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("more than the memory limit of 1 MiB") && err.contains("--limit memory="),
+        "{err}"
+    );
+    assert_eq!(entries(&d), ["a.png", "ball.sdf"], "no file written");
+}
+
+#[test]
+fn limits_are_set_by_name_and_named_when_exceeded() {
+    let d = dir("limits");
+    scene_file(&d);
+    let out = sdfc(&d, &["render", "ball.sdf", "--limit", "speed=3"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("unknown limit `speed`") && err.contains("fuel"),
+        "{err}"
+    );
+    for bad in ["aa=0", "aa=x", "aa"] {
+        let out = sdfc(&d, &["check", "ball.sdf", "--limit", bad]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+    }
+    // A loop over the objects limit: E0507 naming the flag, and the flag raises it.
+    let many = "scene { for i in 0..50 { sphere(0.1).translate(i, 0, 0); } }\n";
+    std::fs::write(d.join("many.sdf"), many).expect("write");
+    let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=20"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("E0507") && err.contains("--limit objects=40"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=50"]);
+    assert!(out.status.success());
+    // The render settings' limits: in the scene (E0400) and on the command line (exit 2).
+    let out = sdfc(&d, &["render", "ball.sdf", "--aa", "20"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--limit aa=20"), "{err}");
+    for (set, flag) in [
+        ("max_steps=2000000", "--limit max_steps=2000000"),
+        ("max_depth=100", "--limit max_depth=100"),
+        ("width=20000", "--limit edge=20000"),
+    ] {
+        let out = sdfc(&d, &["render", "ball.sdf", "--set", set]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(flag), "{set}: {err}");
+    }
+    let out = sdfc(
+        &d,
+        &[
+            "render", "ball.sdf", "--aa", "20", "--limit", "aa=20", "--size", "4x4",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The program limit, after lowering and before any output.
+    for args in [
+        &[
+            "compile",
+            "ball.sdf",
+            "--emit",
+            "wgsl",
+            "--limit",
+            "program=10",
+            "-o",
+            "k.wgsl",
+        ][..],
+        &["render", "ball.sdf", "--limit", "program=10", "-o", "p.png"],
+    ] {
+        let out = sdfc(&d, args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("E0507")
+                && err.contains("distance program has")
+                && err.contains("--limit program="),
+            "{err}"
+        );
+    }
+    assert_eq!(entries(&d), ["ball.png", "ball.sdf", "many.sdf"]);
+}
+
+#[test]
+fn debug_nan_paints_nan_pixels_magenta_in_the_written_image() {
+    let d = dir("debug-nan");
+    let scene = std::fs::canonicalize("tests/in/ok/nan_at_run_time.sdf").expect("scene");
+    let scene = scene.to_string_lossy();
+    let magenta = |png: &str| {
+        let image = sdfc_runtime::image::read_png(&d.join(png)).expect("png");
+        image
+            .linear
+            .iter()
+            .filter(|c| c[0] > 0.99 && c[1] < 0.01 && c[2] > 0.99)
+            .count()
+    };
+    for (flag, png) in [(None, "plain.png"), (Some("--debug-nan"), "debug.png")] {
+        let mut args = vec!["render", &scene, "--backend", "cpu", "-o", png];
+        args.extend(flag);
+        let out = sdfc(&d, &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    assert_eq!(magenta("plain.png"), 0);
+    assert!(magenta("debug.png") > 100);
+}
+
+/// Whether `sdfc` finds a wgpu adapter here; if not, the caller skips (saying so) unless
+/// SDFC_REQUIRE_DEVICES=1 (set by CI, which installs lavapipe).
+fn wgpu_available(d: &Path) -> bool {
+    let out = sdfc(
+        d,
+        &[
+            "render",
+            "ball.sdf",
+            "--backend",
+            "wgpu",
+            "--size",
+            "8x8",
+            "-o",
+            "probe.png",
+        ],
+    );
+    let _ = std::fs::remove_file(d.join("probe.png"));
+    if out.status.success() {
+        return true;
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+        "SDFC_REQUIRE_DEVICES=1 but wgpu failed: {err}"
+    );
+    println!("SKIPPED: no wgpu adapter: {err}");
+    false
+}
+
+#[test]
+fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
+    let d = dir("gpu-fault");
+    scene_file(&d);
+    if !wgpu_available(&d) {
+        return;
+    }
+    // 4100x16 is three tiles of 2048 pixels: the second fails after the first rendered.
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args([
+            "render",
+            "ball.sdf",
+            "--backend",
+            "wgpu",
+            "--size",
+            "4100x16",
+        ])
+        .args(["-o", "fault.png"])
+        .env("SDFC_FAULT_AFTER_TILES", "1")
+        // Mesa's window-system code complains on stderr without it.
+        .env("XDG_RUNTIME_DIR", &d)
+        .output()
+        .expect("run sdfc");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(
+        errors,
+        ["error: GPU error while rendering: device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1 (a testing aid)"],
+        "{err}"
+    );
+    assert_eq!(entries(&d), ["ball.sdf"], "no output and no temporary file");
+}
+
+/// A wgpu render on a Vulkan adapter stores the driver's pipeline cache data for its kernel
+/// in the cache directory (`SDFC_CACHE_DIR`, as the CUDA JIT cache), in a file named by the
+/// kernel and the device; a second process rendering the same kernel finds it and gives it to
+/// the driver, and a render of another kernel gets a file of its own. (Lavapipe stores no
+/// compiled code in it, 96 bytes of headers, so this shows the files are found, not that
+/// the driver's compile gets faster: that is a GPU's measurement,
+/// scripts/device-first-second.sh.)
+#[test]
+fn a_second_process_finds_the_wgpu_pipeline_cache() {
+    let d = dir("pipeline-cache");
+    scene_file(&d);
+    if !wgpu_available(&d) {
+        return;
+    }
+    let cache = d.join("cache");
+    let render = |size: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(["render", "ball.sdf", "--backend", "wgpu", "--stats"])
+            .args(["--size", size, "-o", "out.png"])
+            .env("SDFC_CACHE_DIR", &cache)
+            .env("XDG_RUNTIME_DIR", &d)
+            .output()
+            .expect("run sdfc");
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("driver compile"))
+            .unwrap_or_else(|| panic!("no driver compile line: {text}"))
+            .to_string();
+        (line, entries(&cache))
+    };
+    let (first, files) = render("16x16");
+    assert!(
+        first.contains("bytes of driver cache data stored"),
+        "{first}"
+    );
+    assert_eq!(files.len(), 1, "{files:?}");
+    assert!(files[0].ends_with(".pipeline"), "{files:?}");
+    let (second, again) = render("24x16");
+    assert!(
+        second.contains("pipeline created from")
+            && second.contains("bytes of stored driver cache data"),
+        "{second}"
+    );
+    assert_eq!(again, files, "the same kernel, the same file");
+    // Another kernel (a box in place of the sphere) gets a file of its own.
+    let scene = std::fs::read_to_string(d.join("ball.sdf")).expect("scene");
+    let boxed = scene.replace("sphere(1)", "box((0.5, 0.5, 0.5))");
+    std::fs::write(d.join("ball.sdf"), boxed).expect("write");
+    let (third, more) = render("16x16");
+    assert!(third.contains("stored"), "{third}");
+    assert_eq!(more.len(), 2, "{more:?}");
+}
+
+/// The 42-line file of issue 16, item 1: forty functions, each using the one below twice,
+/// make 2⁴⁰ spheres as a tree from a graph of 121 nodes. Every pass that walked the scene
+/// as a tree (the method choice, simplification, lowering) hung on it; now the checker
+/// counts the tree once per node and stops at the `expansion` limit.
+fn exponential(levels: usize) -> String {
+    let mut text = String::from("fn f0() -> shape { sphere(0.1) }\n");
+    for i in 1..=levels {
+        let j = i - 1;
+        text.push_str(&format!(
+            "fn f{i}() -> shape {{ union(f{j}().translate(0.001, 0, 0), f{j}().translate(0, 0.001, 0)) }}\n"
+        ));
+    }
+    text.push_str(&format!("scene {{ f{levels}(); }}\n"));
+    text
+}
+
+#[test]
+fn exponential_expansion_is_a_located_limit_error_in_well_under_a_second() {
+    let d = dir("expansion");
+    std::fs::write(d.join("exp.sdf"), exponential(40)).expect("write");
+    assert_eq!(exponential(40).lines().count(), 42);
+    let start = std::time::Instant::now();
+    let out = sdfc(&d, &["check", "exp.sdf"]);
+    let took = start.elapsed();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    // At the union of f20, the first level whose tree (2²² − 3 nodes) is over 4 000 000.
+    assert!(
+        err.contains("E0507") && err.contains("exp.sdf:21:") && err.contains("--limit expansion="),
+        "{err}"
+    );
+    assert!(took.as_secs_f64() < 1.0, "took {took:?}");
+    // Raised, the same limit lets a smaller tree through; lowered, it stops a small one.
+    std::fs::write(d.join("small.sdf"), exponential(8)).expect("write");
+    let ok = sdfc(&d, &["check", "small.sdf"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let low = sdfc(&d, &["check", "small.sdf", "--limit", "expansion=100"]);
+    assert_eq!(low.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&low.stderr).contains("--limit expansion="));
+}
+
+/// issue 16, item 2: the `program` limit, counted by the builder as it emits, on a scene of
+/// 2¹⁴ distinct spheres (within the `expansion` limit): an E0507 error and no output. (That
+/// lowering stops at the limit is `lowering_stops_at_the_program_limit` in
+/// `compiler/src/lower/tests.rs`.)
+#[test]
+fn the_program_limit_stops_lowering_at_the_limit() {
+    let mut text = String::from("fn f0() -> shape { sphere(0.004) }\n");
+    for i in 1..=14 {
+        let (j, o) = (i - 1, f64::from(1u32 << i) * 1e-3);
+        text.push_str(&format!(
+            "fn f{i}() -> shape {{ union(f{j}().translate({o}, 0, 0), f{j}().translate(0, 0, {o})) }}\n"
+        ));
+    }
+    text.push_str("scene { f14(); }\n");
+    let d = dir("program-limit");
+    std::fs::write(d.join("big.sdf"), text).expect("write");
+    let out = sdfc(
+        &d,
+        &[
+            "compile",
+            "big.sdf",
+            "--emit",
+            "program",
+            "--limit",
+            "program=1000",
+            "-o",
+            "p.txt",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("E0507")
+            && err.contains("more than 1000 operations")
+            && err.contains("--limit program=2000"),
+        "{err}"
+    );
+    assert!(!d.join("p.txt").exists());
+    let out = sdfc(
+        &d,
+        &["compile", "big.sdf", "--emit", "program", "-o", "p.txt"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// issue 16, item 2: `sdfc pareto` counts the combinations of its sweeps before building
+/// them, against the `sweep_points` limit, and each sweep against `sweep_values`.
+#[test]
+fn pareto_sweeps_are_bounded_by_limits() {
+    let d = dir("pareto-limits");
+    scene_file(&d);
+    let out = sdfc(
+        &d,
+        &[
+            "pareto",
+            "ball.sdf",
+            "--sweep",
+            "epsilon=1e-2..1e-6:100",
+            "--sweep",
+            "max_steps=32..1024:100",
+            "--sweep",
+            "relaxation=1..1.8:100",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("combinations of settings, more than 1000")
+            && err.contains("--limit sweep_points="),
+        "{err}"
+    );
+    let out = sdfc(&d, &["pareto", "ball.sdf", "--sweep", "aa=1..2000"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--limit sweep_values="), "{err}");
+}
+
+/// `--emit spirv` (and `params`) writes binary: to a terminal it is refused (exit 2, pointing at `-o`),
+/// while to a pipe or a file it is written. The terminal is a pseudo-terminal from
+/// util-linux's `script`.
+#[test]
+fn spirv_is_not_written_to_a_terminal() {
+    let d = dir("spirv-tty");
+    scene_file(&d);
+    let piped = sdfc(&d, &["compile", "ball.sdf", "--emit", "spirv"]);
+    assert!(piped.status.success());
+    assert_eq!(&piped.stdout[..4], &0x0723_0203u32.to_le_bytes());
+    let filed = sdfc(
+        &d,
+        &["compile", "ball.sdf", "--emit", "spirv", "-o", "k.spv"],
+    );
+    assert!(filed.status.success());
+    assert_eq!(std::fs::read(d.join("k.spv")).expect("k.spv"), piped.stdout);
+    let command = format!(
+        "'{0}' compile ball.sdf --emit spirv; echo \"exit=$?\"; '{0}' compile ball.sdf --emit params; echo \"exit=$?\"",
+        env!("CARGO_BIN_EXE_sdfc")
+    );
+    let tty = Command::new("script")
+        .current_dir(&d)
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+        .expect("util-linux `script` runs a command on a pseudo-terminal");
+    let text = String::from_utf8_lossy(&tty.stdout);
+    assert_eq!(text.matches("exit=2").count(), 2, "{text}");
+    assert!(text.contains("-o FILE"), "{text}");
+    assert!(
+        !text.contains('\u{0}'),
+        "binary reached the terminal: {text:?}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `compile --set` specialises the kernel as `render --set` would: the method, here marching a
+/// scene the file leaves to analytic tracing; a bad key or a method the scene does not allow
+/// is a usage error.
+#[test]
+fn compile_applies_set_before_specialising_the_kernel() {
+    let d = dir("compile-set");
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed1.sdf");
+    let example = example.to_str().expect("utf-8 path");
+    let features = |args: &[&str]| {
+        let out = sdfc(&d, args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        text.lines().nth(1).expect("features line").to_string()
+    };
+    assert!(features(&["compile", example, "--emit", "wgsl"]).contains("+ANALYTIC"));
+    assert!(features(&[
+        "compile",
+        example,
+        "--emit",
+        "wgsl",
+        "--set",
+        "method=march"
+    ])
+    .contains("-ANALYTIC"));
+    let bad = sdfc(
+        &d,
+        &["compile", example, "--emit", "wgsl", "--set", "methd=march"],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown render setting `methd`"));
+    let seed3 = example.replace("seed1", "seed3");
+    let refused = sdfc(
+        &d,
+        &["compile", &seed3, "--emit", "wgsl", "--set", "method=trace"],
+    );
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("cannot be ray traced"));
+}
+
+/// The device opens on a thread of its own while the scene is read and checked (`Opening`):
+/// a scene with errors still prints its diagnostics and exits 1 whatever the device does (no
+/// adapter, no CUDA driver, or a device still opening when the process ends), and the
+/// arguments' own errors still come after the scene's.
+#[test]
+fn a_scene_with_errors_exits_1_whatever_the_device_does() {
+    let d = dir("errors-device");
+    std::fs::write(d.join("broken.sdf"), "scene { sphere(; }").expect("write");
+    let diagnostics = |out: &Output| {
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("broken.sdf") && err.contains("E0101"), "{err}");
+        assert!(!err.contains("adapter") && !err.contains("CUDA"), "{err}");
+        err
+    };
+    // No wgpu adapter at all.
+    let no_adapter = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&d)
+        .args(["render", "broken.sdf", "--backend", "wgpu"])
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .output()
+        .expect("run sdfc");
+    diagnostics(&no_adapter);
+    // Whatever this machine has: a device opening (lavapipe, a GPU) or none.
+    for backend in ["wgpu", "cuda", "auto"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(["render", "broken.sdf", "--backend", backend, "--stats"])
+            .env("XDG_RUNTIME_DIR", &d)
+            .output()
+            .expect("run sdfc");
+        diagnostics(&out);
+        assert!(
+            out.stdout.is_empty(),
+            "no statistics for a scene with errors"
+        );
+    }
+    // Scene errors come before the arguments' (`--reference` renders on the CPU alone).
+    let both = sdfc(
+        &d,
+        &["render", "broken.sdf", "--reference", "--backend", "wgpu"],
+    );
+    diagnostics(&both);
+    scene_file(&d);
+    let usage = sdfc(
+        &d,
+        &["render", "ball.sdf", "--reference", "--backend", "wgpu"],
+    );
+    let err = String::from_utf8_lossy(&usage.stderr);
+    assert_eq!(usage.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--reference renders on the CPU in f64"),
+        "{err}"
+    );
+    let kernel = sdfc(
+        &d,
+        &[
+            "render",
+            "broken.sdf",
+            "--backend",
+            "cpu",
+            "--kernel",
+            "interpreted",
+        ],
+    );
+    diagnostics(&kernel);
+    assert_eq!(
+        entries(&d),
+        ["ball.sdf", "broken.sdf"],
+        "no image, no temporary file"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--stats`'s breakdown of the whole run: its phases add up to its total, a device opened
+/// beside the front end says so with its own time, and the image's steps (sRGB, PNG, write,
+/// rename; a still is not synced to the disk) are listed; the device is left to the operating system at the end.
+#[test]
+fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
+    let d = dir("breakdown");
+    scene_file(&d);
+    let backends: &[&str] = if wgpu_available(&d) {
+        &["cpu", "wgpu"]
+    } else {
+        &["cpu"]
+    };
+    for backend in backends {
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(["render", "ball.sdf", "--backend", backend, "--stats"])
+            .args(["-o", "out.png"])
+            .env("XDG_RUNTIME_DIR", &d)
+            .output()
+            .expect("run sdfc");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let block: Vec<&str> = text
+            .lines()
+            .skip_while(|l| !l.starts_with("run "))
+            .collect();
+        let total: f64 = block[0]
+            .split_whitespace()
+            .nth(1)
+            .expect("total")
+            .parse()
+            .expect("ms");
+        let mut sum = 0.0;
+        let mut names = Vec::new();
+        for line in &block[1..] {
+            let name = line[2..18].trim();
+            names.push(name);
+            if let Ok(ms) = line[18..]
+                .split(" ms")
+                .next()
+                .expect("ms")
+                .trim()
+                .parse::<f64>()
+            {
+                sum += ms;
+            }
+        }
+        // Each phase is rounded to 0.1 ms.
+        assert!(
+            (sum - total).abs() <= 0.05 * names.len() as f64 + 0.1,
+            "{text}"
+        );
+        for step in ["scene", "sRGB", "PNG", "write", "rename", "image", "exit"] {
+            assert!(names.contains(&step), "{step} in {text}");
+        }
+        // A still image is not synced to the disk (`AtomicFile::unsynced`).
+        assert!(!names.contains(&"fsync"), "{text}");
+        let device = block.iter().find(|l| l.trim_start().starts_with("device "));
+        match *backend {
+            "cpu" => assert!(device.is_none(), "{text}"),
+            _ => {
+                let line = device.expect("a device phase");
+                assert!(line.contains("overlapped with the front end"), "{text}");
+            }
+        }
+        assert_eq!(png_size(&d.join("out.png")), (40, 30));
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

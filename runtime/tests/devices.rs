@@ -1,0 +1,494 @@
+//! Several devices (`--devices`, docs/devices.md) with what this machine has: lavapipe opened
+//! twice as two logical devices renders every example bit for bit as one device does, and so
+//! does a sequence; the CPU beside lavapipe agrees with lavapipe within the conformance
+//! tolerance (the CPU renderer is another implementation); a device that fails hands its tile
+//! back and the render completes on the other, with a warning, and when every device fails
+//! the render fails with each device's error; `sdfc devices` lists the adapter and the CPU;
+//! a bad `--devices` entry is named in the error. Without a wgpu adapter the tests say they
+//! skipped, unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe).
+
+mod common;
+
+use sdfc_compiler::back::wgsl;
+use sdfc_compiler::lower::Lowered;
+use sdfc_compiler::scene::Scene;
+use sdfc_runtime::gpu::launch::Worker;
+use sdfc_runtime::{cpu, frontend, gpu, metrics};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn open_gpu() -> Option<gpu::Gpu> {
+    common::open_gpu("several devices")
+}
+
+fn load(path: &Path, width: u32, height: u32) -> Scene {
+    let mut scene = frontend::load(path)
+        .expect("readable")
+        .scene
+        .unwrap_or_else(|| panic!("{} is a valid scene", path.display()));
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene.settings.aa = 1;
+    scene
+}
+
+fn bits(image: &sdfc_runtime::image::Image) -> Vec<u32> {
+    image
+        .linear
+        .iter()
+        .flat_map(|p| p.iter().map(|c| c.to_bits()))
+        .collect()
+}
+
+#[test]
+fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
+    let (Some(a), Some(b)) = (open_gpu(), open_gpu()) else {
+        return;
+    };
+    // An odd size: bands of unequal height, the last one short.
+    for path in common::examples() {
+        let scene = load(&path, 131, 97);
+        let lowered = Lowered::new(&scene);
+        let l = lowered.program.lipschitz();
+        let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
+        let one = gpu::render(&a, &scene, &kernel, l, &mut |_| {}).expect("one device");
+        let ka = a.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
+        let kb = b.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
+        let workers: [&dyn Worker; 2] = [&ka, &kb];
+        let mut calls = 0;
+        let none = gpu::launch::Faults::default();
+        let data = kernel.data.as_deref();
+        let two = gpu::render_several(
+            &workers,
+            &scene,
+            (l, Some(&kernel.contract.uniform), data),
+            (&none, true),
+            &mut |_| calls += 1,
+        )
+        .expect("two devices");
+        let name = path.display();
+        assert!(
+            bits(&one.render.image) == bits(&two.render.image),
+            "{name}: the images differ"
+        );
+        assert_eq!(one.render.stats, two.render.stats, "{name}: statistics");
+        assert_eq!(two.shares.len(), 2);
+        let tiles: usize = two.shares.iter().map(|s| s.tiles).sum();
+        assert!(tiles >= 8, "{name}: {tiles} bands for two devices");
+        assert_eq!(calls, tiles, "{name}: progress once per band");
+        assert!(two.shares.iter().all(|s| s.failure.is_none()));
+    }
+}
+
+#[test]
+fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
+    let Some(a) = open_gpu() else { return };
+    // Measured on lavapipe (LLVM 15, 2026-11-24): 54.1, 126.1 and 52.9 dB; the CPU's share of
+    // the bands varies from run to run, so the bounds are those of the CPU alone against
+    // lavapipe (image_conformance.rs) less a margin.
+    for (name, min_psnr) in [("seed3", 45.0), ("seed6", 90.0), ("glass", 38.0)] {
+        let path = PathBuf::from(format!("../examples/{name}.sdf"));
+        let scene = load(&path, 96, 64);
+        let lowered = Lowered::new(&scene);
+        let l = lowered.program.lipschitz();
+        let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
+        let one = gpu::render(&a, &scene, &kernel, l, &mut |_| {}).expect("lavapipe");
+        let tapes = cpu::Tapes::new(&lowered);
+        let options = cpu::Options {
+            lipschitz: l,
+            ..cpu::Options::default()
+        };
+        let on_cpu = gpu::cpu::Device::new(&scene, &tapes, &options);
+        let ka = a.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
+        let workers: [&dyn Worker; 2] = [&on_cpu, &ka];
+        let none = gpu::launch::Faults::default();
+        let data = kernel.data.as_deref();
+        let mixed = gpu::render_several(
+            &workers,
+            &scene,
+            (l, Some(&kernel.contract.uniform), data),
+            (&none, true),
+            &mut |_| {},
+        )
+        .expect("cpu and lavapipe");
+        assert!(
+            mixed.shares.iter().all(|s| s.tiles > 0),
+            "{name}: both rendered"
+        );
+        let d = metrics::compare(&one.render.image, &mixed.render.image, 0.1).expect("same size");
+        println!(
+            "{name}: cpu + lavapipe against lavapipe: {:.1} dB, {:.4} differing",
+            d.psnr, d.differing
+        );
+        assert!(d.psnr >= min_psnr, "{name}: {:.1} dB", d.psnr);
+        assert!(d.differing <= 0.002, "{name}: {:.4} differing", d.differing);
+        // The CPU's bands are the CPU renderer's pixels: the whole CPU render has them.
+        let alone = cpu::render(&scene, &lowered, &options, &|| {});
+        let rows = mixed.shares[0].tiles;
+        assert!(rows > 0);
+        let c = mixed.render.stats.counters;
+        assert_eq!(c.camera_rays, alone.stats.counters.camera_rays);
+    }
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sdfc-devices-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+fn sdfc(cwd: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_sdfc"));
+    c.current_dir(cwd)
+        .args(args)
+        .env_remove("SDFC_FAULT_AFTER_TILES");
+    // Mesa's window-system code complains on stderr without it.
+    c.env("XDG_RUNTIME_DIR", cwd);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("run sdfc")
+}
+
+fn seed3() -> String {
+    std::fs::canonicalize("../examples/seed3.sdf")
+        .expect("examples/seed3.sdf")
+        .display()
+        .to_string()
+}
+
+fn wgpu_here() -> bool {
+    open_gpu().is_some()
+}
+
+fn render(d: &Path, devices: &str, out: &str, env: &[(&str, &str)]) -> Output {
+    let scene = seed3();
+    let args = [
+        "render",
+        &scene,
+        "--backend",
+        "wgpu",
+        "--devices",
+        devices,
+        "--size",
+        "160x120",
+        "-o",
+        out,
+    ];
+    sdfc(d, &args, env)
+}
+
+#[test]
+fn a_failing_device_hands_its_tile_back_and_the_others_finish() {
+    if !wgpu_here() {
+        return;
+    }
+    let d = dir("fault");
+    let one = render(&d, "0", "one.png", &[]);
+    assert!(one.status.success(), "{one:?}");
+    // The second device fails at its second band; the first renders the rest.
+    let out = render(&d, "0,0", "two.png", &[("SDFC_FAULT_AFTER_TILES", "1:1")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].starts_with("warning: device 1 (")
+            && warnings[0].contains("failed after 1 tile: GPU error while rendering: device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1:1 (a testing aid); the other devices rendered its tiles"),
+        "{err}"
+    );
+    let a = std::fs::read(d.join("one.png")).expect("one.png");
+    let b = std::fs::read(d.join("two.png")).expect("two.png");
+    assert!(a == b, "the image differs from one device's");
+
+    // Both fail: one error naming each device's, and no image.
+    let out = render(&d, "0,0", "none.png", &[("SDFC_FAULT_AFTER_TILES", "2")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(errors.len(), 1, "{err}");
+    assert!(
+        errors[0].starts_with("error: every device failed (4 of ")
+            && errors[0].contains("device 0 (")
+            && errors[0].contains("device 1 (")
+            && errors[0].matches("device error injected at tile 3").count() == 2,
+        "{err}"
+    );
+    assert!(!d.join("none.png").exists());
+
+    // One device alone: the fault is the render's error, as before.
+    let out = render(&d, "0", "alone.png", &[("SDFC_FAULT_AFTER_TILES", "0:0")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("error: GPU error while rendering: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=0:0 (a testing aid)"), "{err}");
+}
+
+#[test]
+fn the_cpu_and_lavapipe_render_together_from_the_command_line() {
+    if !wgpu_here() {
+        return;
+    }
+    let d = dir("mixed");
+    let one = render(&d, "0", "one.png", &[]);
+    assert!(one.status.success(), "{one:?}");
+    let scene = seed3();
+    let args = [
+        "render",
+        &scene,
+        "--backend",
+        "wgpu",
+        "--devices",
+        "cpu,0",
+        "--size",
+        "160x120",
+        "--stats",
+        "-o",
+        "mixed.png",
+    ];
+    let out = sdfc(&d, &args, &[]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{out:?}");
+    assert!(
+        text.contains("backend         mixed (2 devices: CPU, "),
+        "{text}"
+    );
+    assert!(text.contains("device 0        CPU, "), "{text}");
+    assert!(text.contains("device 1        "), "{text}");
+    let compare = sdfc(&d, &["compare", "one.png", "mixed.png", "--json"], &[]);
+    let json = String::from_utf8_lossy(&compare.stdout);
+    let v: serde_json::Value = serde_json::from_str(&json).expect("json");
+    let psnr = v["psnr"].as_f64().expect("psnr");
+    assert!(psnr > 40.0, "{json}");
+}
+
+fn sequence(d: &Path, devices: &str, pattern: &str, env: &[(&str, &str)]) -> Output {
+    let orbit = std::fs::canonicalize("../examples/animation/orbit.sdf")
+        .expect("orbit")
+        .display()
+        .to_string();
+    let args = [
+        "render",
+        &orbit,
+        "--backend",
+        "wgpu",
+        "--devices",
+        devices,
+        "--size",
+        "96x64",
+        "--frames",
+        "0..6",
+        "-o",
+        pattern,
+    ];
+    sdfc(d, &args, env)
+}
+
+#[test]
+fn the_frames_of_a_sequence_go_to_the_devices_and_survive_one_failing() {
+    if !wgpu_here() {
+        return;
+    }
+    let d = dir("frames");
+    let one = sequence(&d, "0", "one/f_##.png", &[]);
+    assert!(one.status.success(), "{one:?}");
+    let same = |dir: &str| {
+        for k in 0..6 {
+            let a = std::fs::read(d.join(format!("one/f_{k:02}.png"))).expect("frame");
+            let b = std::fs::read(d.join(format!("{dir}/f_{k:02}.png"))).expect("frame");
+            assert!(a == b, "{dir}: frame {k} differs");
+        }
+    };
+    let two = sequence(&d, "0,0", "two/f_##.png", &[]);
+    let err = String::from_utf8_lossy(&two.stderr);
+    assert!(two.status.success(), "{err}");
+    assert!(err.contains("(2 devices: wgpu on "), "{err}");
+    same("two");
+    // The second device fails on its first frame (it opens its device after taking one,
+    // while the first is still opening its own); the first renders every frame.
+    let out = sequence(
+        &d,
+        "0,0",
+        "back/f_##.png",
+        &[("SDFC_FAULT_AFTER_TILES", "1:0")],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning: device 1 failed: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=1:0 (a testing aid); the other devices render its frame"), "{err}");
+    same("back");
+    // Every device fails at its second frame: two frames are written, then the error.
+    let out = sequence(
+        &d,
+        "0,0",
+        "none/f_##.png",
+        &[("SDFC_FAULT_AFTER_TILES", "1")],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("error: every device failed (2 of 6 frames written): device "),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
+    if !wgpu_here() {
+        return;
+    }
+    let d = dir("sequence");
+    let orbit = std::fs::canonicalize("../examples/animation/orbit.sdf")
+        .expect("orbit")
+        .display()
+        .to_string();
+    for (devices, pattern) in [("0", "one/f_##.png"), ("0,0", "two/f_##.png")] {
+        let args = [
+            "render",
+            &orbit,
+            "--backend",
+            "wgpu",
+            "--devices",
+            devices,
+            "--size",
+            "96x64",
+            "--frames",
+            "0..3",
+            "-o",
+            pattern,
+        ];
+        let out = sdfc(&d, &args, &[]);
+        assert!(out.status.success(), "{out:?}");
+    }
+    for k in 0..3 {
+        let a = std::fs::read(d.join(format!("one/f_{k:02}.png"))).expect("frame");
+        let b = std::fs::read(d.join(format!("two/f_{k:02}.png"))).expect("frame");
+        assert!(a == b, "frame {k} differs");
+    }
+    let bench = sdfc(
+        &d,
+        &[
+            "bench",
+            &orbit,
+            "--backend",
+            "wgpu",
+            "--devices",
+            "0,0",
+            "--size",
+            "64x48",
+            "--frames",
+            "1",
+            "--json",
+        ],
+        &[],
+    );
+    let json = String::from_utf8_lossy(&bench.stdout);
+    assert!(bench.status.success(), "{bench:?}");
+    assert!(json.contains("2 devices: "), "{json}");
+}
+
+#[test]
+fn devices_lists_the_adapters_and_the_cpu() {
+    if !wgpu_here() {
+        return;
+    }
+    let d = dir("list");
+    let out = sdfc(&d, &["devices"], &[]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{out:?}");
+    let adapter = gpu::Gpu::open(false).expect("adapter").describe();
+    let name = adapter.split(" (").next().unwrap_or_default().to_string();
+    assert!(
+        text.lines().any(|l| l.starts_with("wgpu 0: ")
+            && l.contains(&name)
+            && l.contains("largest buffer")),
+        "{text}"
+    );
+    assert!(text.lines().any(|l| l.starts_with("cuda")), "{text}");
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("cpu: the CPU renderer, ")),
+        "{text}"
+    );
+}
+
+#[test]
+fn bad_devices_are_named_in_the_error() {
+    let d = dir("bad");
+    let scene = seed3();
+    for (devices, backend, code, expected) in [
+        ("0,x", "wgpu", 2, "bad --devices entry `x`"),
+        ("0,,1", "wgpu", 2, "bad --devices entry ``"),
+        ("gpu", "auto", 2, "bad --devices entry `gpu`"),
+        (
+            "cpu,0",
+            "cpu",
+            2,
+            "--devices entry `0` names a GPU, but --backend cpu",
+        ),
+        ("0,99", "wgpu", 1, "there is no wgpu adapter 99"),
+    ] {
+        let out = sdfc(
+            &d,
+            &[
+                "render",
+                &scene,
+                "--backend",
+                backend,
+                "--devices",
+                devices,
+                "--size",
+                "8x8",
+                "-o",
+                "x.png",
+            ],
+            &[],
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{devices}: {err}");
+        assert!(err.contains(expected), "{devices}: {err}");
+        assert!(!d.join("x.png").exists());
+    }
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            &scene,
+            "--reference",
+            "--devices",
+            "0,0",
+            "-o",
+            "x.png",
+        ],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("it cannot use --devices"), "{err}");
+}
+
+/// Without the per-pixel statistics (`Setup::image_only`: `sdfc render` without `--stats`, and
+/// sequences) a GPU frame is the same image, and only its statistics are left empty.
+#[test]
+fn a_frame_without_statistics_is_the_same_image() {
+    use sdfc_runtime::backend::{Prepared, Setup};
+    let Some(gpu) = open_gpu() else { return };
+    let gpu = std::sync::Arc::new(gpu);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed3.sdf");
+    let scene = load(&path, 96, 64);
+    let lowered = Lowered::new(&scene);
+    let frame = |setup: &Setup| {
+        Prepared::on_gpu(gpu.clone(), &scene, &lowered, setup)
+            .expect("prepared")
+            .render(&scene, &|_| {})
+            .expect("rendered")
+    };
+    let with = frame(&Setup::default());
+    let without = frame(&Setup {
+        image_only: true,
+        ..Setup::default()
+    });
+    assert_eq!(with.render.image.linear, without.render.image.linear);
+    assert!(with.render.stats.counters.steps > 0 && with.render.stats.counters.hits > 0);
+    assert_eq!(without.render.stats.counters.steps, 0);
+    assert_eq!(without.render.stats.counters.hits, 0);
+}

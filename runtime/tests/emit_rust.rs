@@ -1,0 +1,155 @@
+//! The Rust back end: the text's shape, and, as a user takes it away, `sdfc compile --emit
+//! rust` built in a scratch crate that depends on the glam version its header names, giving
+//! the interpreter's results bit for bit. The generated code of every scene of the distance
+//! conformance suite is compiled and compared with the interpreters there
+//! (`distance_conformance.rs`).
+
+mod common;
+
+use common::*;
+use sdfc_compiler::back::rust;
+use sdfc_compiler::eval::eval_point;
+use sdfc_compiler::lower::lower;
+use sdfc_compiler::rng::Rng;
+use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
+use std::fmt::Write;
+use std::process::Command;
+
+fn scene() -> Scene {
+    let mut b = Build::new();
+    let m = b.material([1.0, 0.0, 0.0], 0.0, 0.0);
+    let s = b.add(Node::Sphere { radius: 0.8 });
+    let s = b.paint(s, m);
+    let t = b.add(Node::Torus {
+        major: 1.0,
+        minor: 0.2,
+    });
+    let t = b.add(Node::Repeat {
+        period: [3.0, 0.0, 0.0],
+        count: None,
+        child: t,
+    });
+    let u = b.add(Node::SmoothCombine {
+        op: Combine::Union,
+        k: 0.2,
+        variant: Smooth::Poly,
+        a: s,
+        b: t,
+    });
+    let bulb = b.add(Node::Mandelbulb {
+        power: 8.0,
+        iterations: 3,
+    });
+    let bulb = b.at(bulb, [0.0, 3.0, 0.0]);
+    let root = b.add(Node::Combine {
+        op: Combine::Union,
+        children: vec![u, bulb],
+    });
+    b.finish(root)
+}
+
+#[test]
+fn text_has_both_functions_with_one_statement_per_instruction() {
+    let program = lower(&scene());
+    let text = rust::write(&program);
+    assert!(
+        text.contains("pub fn map(p: glam::Vec3) -> (f32, u32) {"),
+        "{text}"
+    );
+    assert!(
+        text.contains("pub fn map_f64(p: glam::DVec3) -> (f64, u32) {"),
+        "{text}"
+    );
+    assert_eq!(text.matches("    let r").count(), 2 * program.len());
+    assert!(text.contains(": f32 = p.x;") && text.contains(": f64 = p.z;"));
+    assert_eq!(rust::write(&program), text, "output must be stable");
+}
+
+/// The header names the glam version the code is written against, and that version is the
+/// workspace's own (one source: the workspace's Cargo.toml).
+#[test]
+fn header_names_the_glam_version_of_the_workspace() {
+    let text = rust::write(&lower(&scene()));
+    let header = text.lines().take(3).collect::<Vec<_>>().join("\n");
+    let wanted = format!("`glam = \"{}\"`", rust::GLAM_VERSION);
+    assert!(header.contains(&wanted), "{header}");
+    let manifest = include_str!("../../Cargo.toml");
+    assert!(
+        manifest.contains(&format!("glam = \"{}\"", rust::GLAM_VERSION)),
+        "the workspace's glam is not {}",
+        rust::GLAM_VERSION
+    );
+}
+
+/// `sdfc compile --emit rust` of an example, put in a new crate whose only dependency is the
+/// glam its header names, builds (offline, from the workspace's lock file) and gives the
+/// interpreter's distances and materials bit for bit.
+#[test]
+fn emitted_rust_builds_in_a_scratch_crate_with_glam() {
+    let scene_path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/seed1.sdf");
+    let root = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("emit-rust-crate");
+    std::fs::create_dir_all(root.join("src")).expect("scratch crate");
+    let emitted = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .args(["compile", scene_path, "--emit", "rust", "-o"])
+        .arg(root.join("src/scene.rs"))
+        .output()
+        .expect("run sdfc");
+    assert!(
+        emitted.status.success(),
+        "{}",
+        String::from_utf8_lossy(&emitted.stderr)
+    );
+    std::fs::write(
+        root.join("Cargo.toml"),
+        format!(
+            "[package]\nname = \"sdfc-emit-rust-user\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n[dependencies]\nglam = \"{}\"\n\n[workspace]\n",
+            rust::GLAM_VERSION
+        ),
+    )
+    .expect("manifest");
+    std::fs::copy(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../Cargo.lock"),
+        root.join("Cargo.lock"),
+    )
+    .expect("lock file");
+    let mut rng = Rng::new(11);
+    let points: Vec<[f64; 3]> = (0..32).map(|_| rng.point(4.0)).collect();
+    let mut main = String::from("mod scene;\n\nfn main() {\n");
+    for p in &points {
+        let _ = writeln!(
+            main,
+            "    let (d, m) = scene::map(glam::Vec3::new({:?}, {:?}, {:?})); println!(\"{{}} {{}}\", d.to_bits(), m);",
+            p[0] as f32, p[1] as f32, p[2] as f32
+        );
+    }
+    main.push_str("}\n");
+    std::fs::write(root.join("src/main.rs"), main).expect("main");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let run = Command::new(cargo)
+        .current_dir(&root)
+        .args(["run", "--quiet", "--offline"])
+        .env_remove("RUSTFLAGS")
+        .output()
+        .expect("run cargo");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(scene_path).expect("scene");
+    let (checked, diags, _) = sdfc_compiler::check::check_str("seed1.sdf", &text);
+    let checked = checked.unwrap_or_else(|| panic!("{diags:?}"));
+    let program =
+        sdfc_compiler::lower::lower_scene(&checked, &sdfc_compiler::lower::LowerOptions::level(1))
+            .program;
+    let out = String::from_utf8_lossy(&run.stdout);
+    let mut lines = out.lines();
+    for p in &points {
+        let (d, m) = eval_point::<f32>(&program, p.map(|v| v as f32));
+        assert_eq!(
+            lines.next(),
+            Some(format!("{} {}", d.to_bits(), m).as_str()),
+            "at {p:?}"
+        );
+    }
+}

@@ -1,0 +1,1016 @@
+//! The grammar test: `grammar/sdf.ebnf` is read, checked for undefined, unused and misspelt
+//! rules and terminals, and used as a recogniser over the lexer's tokens: every example and
+//! every file of `tests/in/ok/` must be a sentence of `file`, broken inputs must not be, and on
+//! `tests/in/err/` the grammar and the parser must agree. The editor grammar and the reference
+//! in `docs/` are checked against the compiler's built-ins, records and diagnostic codes.
+//!
+//! The recogniser is a memoised backtracking one that returns every position where a rule can
+//! end, so it accepts exactly the sentences of the EBNF read as a context-free grammar (which
+//! must not be left-recursive).
+
+mod common;
+
+use sdfc_compiler::check::builtins::{self, BUILTINS};
+use sdfc_compiler::span::FileId;
+use sdfc_compiler::syntax::lexer::{lex, Token};
+use std::collections::{BTreeSet, HashMap, HashSet};
+use std::path::{Path, PathBuf};
+
+/// The token classes of the grammar, written in capitals.
+const CLASSES: [&str; 6] = ["IDENT", "INT", "FLOAT", "ANGLE", "STRING", "BOOL"];
+
+/// A right-hand side of the EBNF.
+#[derive(Debug, Clone, PartialEq)]
+enum Ebnf {
+    /// A rule by name (lower case).
+    Rule(String),
+    /// A quoted terminal: a keyword or punctuation, by its text.
+    Lit(String),
+    /// A token class such as `IDENT`.
+    Class(String),
+    Seq(Vec<Ebnf>),
+    Alt(Vec<Ebnf>),
+    /// `{ x }`
+    Rep(Box<Ebnf>),
+    /// `[ x ]`
+    Opt(Box<Ebnf>),
+}
+
+/// A grammar: its rules in file order.
+#[derive(Debug)]
+struct Grammar {
+    rules: Vec<(String, Ebnf)>,
+}
+
+impl Grammar {
+    fn get(&self, name: &str) -> Option<usize> {
+        self.rules.iter().position(|(n, _)| n == name)
+    }
+}
+
+// ---- Reading the EBNF ----
+
+/// A token of the EBNF notation itself.
+#[derive(Debug, Clone, PartialEq)]
+enum Meta {
+    Name(String),
+    Class(String),
+    Str(String),
+    Punct(char),
+}
+
+/// Splits EBNF text into tokens, skipping `(* comments *)`; the line of each token is kept
+/// for error messages.
+fn meta_tokens(text: &str) -> Vec<(Meta, usize)> {
+    let chars: Vec<char> = text.chars().collect();
+    let (mut out, mut i, mut line) = (Vec::new(), 0, 1);
+    while i < chars.len() {
+        let c = chars[i];
+        if c == '\n' {
+            line += 1;
+        }
+        if c.is_whitespace() {
+            i += 1;
+        } else if c == '(' && chars.get(i + 1) == Some(&'*') {
+            let end = (i + 2..chars.len() - 1)
+                .find(|&j| chars[j] == '*' && chars[j + 1] == ')')
+                .unwrap_or_else(|| panic!("sdf.ebnf:{line}: unclosed comment"));
+            line += chars[i..end].iter().filter(|&&c| c == '\n').count();
+            i = end + 2;
+        } else if c == '"' {
+            let end = (i + 1..chars.len())
+                .find(|&j| chars[j] == '"' || chars[j] == '\n')
+                .filter(|&j| chars[j] == '"')
+                .unwrap_or_else(|| panic!("sdf.ebnf:{line}: unclosed terminal"));
+            out.push((Meta::Str(chars[i + 1..end].iter().collect()), line));
+            i = end + 1;
+        } else if c.is_ascii_alphabetic() || c == '_' {
+            let end = (i..chars.len())
+                .find(|&j| !(chars[j].is_ascii_alphanumeric() || chars[j] == '_'))
+                .unwrap_or(chars.len());
+            let word: String = chars[i..end].iter().collect();
+            let is_class = word.chars().all(|c| c.is_ascii_uppercase() || c == '_');
+            out.push((
+                if is_class {
+                    Meta::Class(word)
+                } else {
+                    Meta::Name(word)
+                },
+                line,
+            ));
+            i = end;
+        } else if "=|;{}[]()".contains(c) {
+            out.push((Meta::Punct(c), line));
+            i += 1;
+        } else {
+            panic!("sdf.ebnf:{line}: unexpected character {c:?}");
+        }
+    }
+    out
+}
+
+/// A recursive-descent reader of the EBNF notation.
+struct Reader {
+    toks: Vec<(Meta, usize)>,
+    pos: usize,
+}
+
+impl Reader {
+    fn peek(&self) -> Option<&Meta> {
+        self.toks.get(self.pos).map(|(m, _)| m)
+    }
+
+    fn line(&self) -> usize {
+        self.toks
+            .get(self.pos)
+            .or(self.toks.last())
+            .map_or(0, |(_, l)| *l)
+    }
+
+    fn expect(&mut self, c: char) {
+        if self.peek() != Some(&Meta::Punct(c)) {
+            panic!(
+                "sdf.ebnf:{}: expected `{c}`, found {:?}",
+                self.line(),
+                self.peek()
+            );
+        }
+        self.pos += 1;
+    }
+
+    /// `rule = name "=" alternatives ";"`
+    fn rule(&mut self) -> (String, Ebnf) {
+        let name = match self.peek() {
+            Some(Meta::Name(n)) => n.clone(),
+            other => panic!(
+                "sdf.ebnf:{}: expected a rule name, found {other:?}",
+                self.line()
+            ),
+        };
+        self.pos += 1;
+        self.expect('=');
+        let rhs = self.alternatives();
+        self.expect(';');
+        (name, rhs)
+    }
+
+    /// `alternatives = sequence { "|" sequence }`
+    fn alternatives(&mut self) -> Ebnf {
+        let mut alts = vec![self.sequence()];
+        while self.peek() == Some(&Meta::Punct('|')) {
+            self.pos += 1;
+            alts.push(self.sequence());
+        }
+        if alts.len() == 1 {
+            alts.pop().expect("one")
+        } else {
+            Ebnf::Alt(alts)
+        }
+    }
+
+    /// `sequence = factor { factor }`
+    fn sequence(&mut self) -> Ebnf {
+        let mut items = Vec::new();
+        while let Some(f) = self.factor() {
+            items.push(f);
+        }
+        if items.is_empty() {
+            panic!("sdf.ebnf:{}: empty alternative", self.line());
+        }
+        if items.len() == 1 {
+            items.pop().expect("one")
+        } else {
+            Ebnf::Seq(items)
+        }
+    }
+
+    /// `factor = name | CLASS | terminal | "{" alternatives "}" | "[" ... "]" | "(" ... ")"`
+    fn factor(&mut self) -> Option<Ebnf> {
+        let tok = self.peek()?.clone();
+        let group = |r: &mut Reader, close: char| {
+            r.pos += 1;
+            let inner = r.alternatives();
+            r.expect(close);
+            inner
+        };
+        Some(match tok {
+            Meta::Name(n) => {
+                self.pos += 1;
+                Ebnf::Rule(n)
+            }
+            Meta::Class(c) => {
+                self.pos += 1;
+                Ebnf::Class(c)
+            }
+            Meta::Str(s) => {
+                self.pos += 1;
+                Ebnf::Lit(s)
+            }
+            Meta::Punct('{') => Ebnf::Rep(Box::new(group(self, '}'))),
+            Meta::Punct('[') => Ebnf::Opt(Box::new(group(self, ']'))),
+            Meta::Punct('(') => group(self, ')'),
+            Meta::Punct(_) => return None,
+        })
+    }
+}
+
+/// Reads EBNF text into a grammar; panics with the line on malformed input.
+fn read_grammar(text: &str) -> Grammar {
+    let mut r = Reader {
+        toks: meta_tokens(text),
+        pos: 0,
+    };
+    let mut rules = Vec::new();
+    while r.peek().is_some() {
+        rules.push(r.rule());
+    }
+    Grammar { rules }
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn grammar_text() -> String {
+    let path = root().join("grammar/sdf.ebnf");
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+}
+
+fn grammar() -> Grammar {
+    read_grammar(&grammar_text())
+}
+
+// ---- Recognising token streams ----
+
+/// What a token is to the grammar: a quoted terminal or a token class.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+enum Sym {
+    Lit(&'static str),
+    Class(&'static str),
+}
+
+/// Maps a lexer token to the grammar's terminal. The match is exhaustive, so a new token
+/// cannot be added to the lexer without deciding its place in the grammar.
+fn terminal(t: &Token) -> Sym {
+    use Sym::{Class, Lit};
+    match t {
+        Token::Import => Lit("import"),
+        Token::Let => Lit("let"),
+        Token::Fn => Lit("fn"),
+        Token::Material => Lit("material"),
+        Token::Camera => Lit("camera"),
+        Token::Light => Lit("light"),
+        Token::Render => Lit("render"),
+        Token::Scene => Lit("scene"),
+        Token::If => Lit("if"),
+        Token::Else => Lit("else"),
+        Token::For => Lit("for"),
+        Token::In => Lit("in"),
+        Token::Bool(_) => Class("BOOL"),
+        Token::Int(_) => Class("INT"),
+        Token::Float(_) => Class("FLOAT"),
+        Token::Angle(_) => Class("ANGLE"),
+        Token::Str(_) => Class("STRING"),
+        Token::Ident(_) => Class("IDENT"),
+        // Never produced by `lex`: it reports these and drops them.
+        Token::UnterminatedStr => Lit("<unterminated string>"),
+        Token::BlockComment => Lit("/*"),
+        Token::LParen => Lit("("),
+        Token::RParen => Lit(")"),
+        Token::LBrace => Lit("{"),
+        Token::RBrace => Lit("}"),
+        Token::Comma => Lit(","),
+        Token::Semi => Lit(";"),
+        Token::Colon => Lit(":"),
+        Token::Dot => Lit("."),
+        Token::DotDot => Lit(".."),
+        Token::At => Lit("@"),
+        Token::Eq => Lit("="),
+        Token::Arrow => Lit("->"),
+        Token::Plus => Lit("+"),
+        Token::Minus => Lit("-"),
+        Token::Star => Lit("*"),
+        Token::Slash => Lit("/"),
+        Token::Percent => Lit("%"),
+        Token::Lt => Lit("<"),
+        Token::Le => Lit("<="),
+        Token::Gt => Lit(">"),
+        Token::Ge => Lit(">="),
+        Token::EqEq => Lit("=="),
+        Token::Ne => Lit("!="),
+        Token::AndAnd => Lit("&&"),
+        Token::OrOr => Lit("||"),
+        Token::Bang => Lit("!"),
+    }
+}
+
+/// The recogniser's state for one token stream.
+struct Recogniser<'g> {
+    g: &'g Grammar,
+    input: Vec<Sym>,
+    /// Every end position of (rule, start); `None` while being computed (left recursion).
+    memo: HashMap<(usize, usize), Option<BTreeSet<usize>>>,
+    /// The furthest position where a terminal was tried, and what was expected there.
+    furthest: usize,
+    expected: BTreeSet<String>,
+}
+
+impl<'g> Recogniser<'g> {
+    fn new(g: &'g Grammar, input: Vec<Sym>) -> Self {
+        Recogniser {
+            g,
+            input,
+            memo: HashMap::new(),
+            furthest: 0,
+            expected: BTreeSet::new(),
+        }
+    }
+
+    /// Matches one quoted terminal or token class at `pos`.
+    fn terminal(&mut self, want: &Ebnf, pos: usize) -> BTreeSet<usize> {
+        let (text, shown) = match want {
+            Ebnf::Lit(s) => (s.as_str(), format!("\"{s}\"")),
+            Ebnf::Class(c) => (c.as_str(), c.clone()),
+            _ => unreachable!("not a terminal"),
+        };
+        let hit = match self.input.get(pos) {
+            Some(Sym::Lit(s)) => matches!(want, Ebnf::Lit(_)) && *s == text,
+            Some(Sym::Class(c)) => matches!(want, Ebnf::Class(_)) && *c == text,
+            None => false,
+        };
+        if hit {
+            return BTreeSet::from([pos + 1]);
+        }
+        if pos > self.furthest {
+            self.furthest = pos;
+            self.expected.clear();
+        }
+        if pos == self.furthest {
+            self.expected.insert(shown);
+        }
+        BTreeSet::new()
+    }
+
+    fn rule(&mut self, name: &str, pos: usize) -> BTreeSet<usize> {
+        let idx = self
+            .g
+            .get(name)
+            .unwrap_or_else(|| panic!("undefined rule `{name}`"));
+        match self.memo.get(&(idx, pos)) {
+            Some(Some(ends)) => return ends.clone(),
+            Some(None) => panic!("rule `{name}` is left-recursive"),
+            None => {}
+        }
+        self.memo.insert((idx, pos), None);
+        let rhs = self.g.rules[idx].1.clone();
+        let ends = self.ends(&rhs, pos);
+        self.memo.insert((idx, pos), Some(ends.clone()));
+        ends
+    }
+
+    /// Every position where `e`, started at `pos`, can end.
+    fn ends(&mut self, e: &Ebnf, pos: usize) -> BTreeSet<usize> {
+        match e {
+            Ebnf::Rule(n) => self.rule(n, pos),
+            Ebnf::Lit(_) | Ebnf::Class(_) => self.terminal(e, pos),
+            Ebnf::Seq(items) => {
+                let mut at = BTreeSet::from([pos]);
+                for item in items {
+                    at = at.into_iter().flat_map(|p| self.ends(item, p)).collect();
+                    if at.is_empty() {
+                        break;
+                    }
+                }
+                at
+            }
+            Ebnf::Alt(alts) => alts.iter().flat_map(|a| self.ends(a, pos)).collect(),
+            Ebnf::Opt(x) => {
+                let mut at = self.ends(x, pos);
+                at.insert(pos);
+                at
+            }
+            Ebnf::Rep(x) => self.repeat(x, pos),
+        }
+    }
+
+    fn repeat(&mut self, x: &Ebnf, pos: usize) -> BTreeSet<usize> {
+        let mut all = BTreeSet::from([pos]);
+        let mut frontier = vec![pos];
+        while let Some(p) = frontier.pop() {
+            for q in self.ends(x, p) {
+                if all.insert(q) {
+                    frontier.push(q);
+                }
+            }
+        }
+        all
+    }
+}
+
+/// Recognises `text` from the rule `start`. `Err` says where the input stops fitting.
+fn recognise(g: &Grammar, start: &str, text: &str) -> Result<(), String> {
+    let (tokens, diags) = lex(FileId(0), text);
+    if !diags.is_empty() {
+        return Err(format!(
+            "lexical errors: {:?}",
+            diags.iter().map(|d| &d.message).collect::<Vec<_>>()
+        ));
+    }
+    let input: Vec<Sym> = tokens.iter().map(|(t, _)| terminal(t)).collect();
+    let n = input.len();
+    let mut r = Recogniser::new(g, input);
+    if r.rule(start, 0).contains(&n) {
+        return Ok(());
+    }
+    let at = tokens.get(r.furthest).map_or_else(
+        || "the end of the file".to_string(),
+        |(t, s)| {
+            let line = text[..s.start as usize].matches('\n').count() + 1;
+            format!("{t} on line {line}")
+        },
+    );
+    let expected: Vec<String> = r.expected.into_iter().collect();
+    Err(format!(
+        "not a `{start}`: stuck at {at}; expected one of {}",
+        expected.join(" ")
+    ))
+}
+
+/// Runs `f` on a thread with a large stack: recognition recurses once per nesting level of
+/// every rule.
+fn with_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    std::thread::Builder::new()
+        .stack_size(64 << 20)
+        .spawn(f)
+        .expect("thread")
+        .join()
+        .expect("no panic")
+}
+
+// ---- Collecting rule names ----
+
+fn refs(e: &Ebnf, out: &mut Vec<String>) {
+    match e {
+        Ebnf::Rule(n) => out.push(n.clone()),
+        Ebnf::Lit(_) | Ebnf::Class(_) => {}
+        Ebnf::Seq(xs) | Ebnf::Alt(xs) => xs.iter().for_each(|x| refs(x, out)),
+        Ebnf::Rep(x) | Ebnf::Opt(x) => refs(x, out),
+    }
+}
+
+fn lits(e: &Ebnf, out: &mut Vec<String>) {
+    match e {
+        Ebnf::Lit(s) => out.push(s.clone()),
+        Ebnf::Rule(_) | Ebnf::Class(_) => {}
+        Ebnf::Seq(xs) | Ebnf::Alt(xs) => xs.iter().for_each(|x| lits(x, out)),
+        Ebnf::Rep(x) | Ebnf::Opt(x) => lits(x, out),
+    }
+}
+
+fn classes(e: &Ebnf, out: &mut Vec<String>) {
+    match e {
+        Ebnf::Class(c) => out.push(c.clone()),
+        Ebnf::Rule(_) | Ebnf::Lit(_) => {}
+        Ebnf::Seq(xs) | Ebnf::Alt(xs) => xs.iter().for_each(|x| classes(x, out)),
+        Ebnf::Rep(x) | Ebnf::Opt(x) => classes(x, out),
+    }
+}
+
+/// The backticked snippets of the comments of a Rust source file, with the comment line
+/// each was found on (without its `//`, `///` or `//!`).
+fn cited(source: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for line in source
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("//"))
+    {
+        let text = line.trim_start_matches(['/', '!']).trim();
+        let parts: Vec<&str> = text.split('`').collect();
+        out.extend(
+            parts
+                .iter()
+                .skip(1)
+                .step_by(2)
+                .map(|s| (s.to_string(), text.to_string())),
+        );
+    }
+    out
+}
+
+fn is_name(s: &str) -> bool {
+    s.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && s.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+}
+
+/// The `.sdf` files under `dir`, recursively, in a stable order.
+fn sdf_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return out;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            out.extend(sdf_files(&path));
+        } else if path.extension().is_some_and(|e| e == "sdf") {
+            out.push(path);
+        }
+    }
+    out.sort();
+    out
+}
+
+// ---- Tests ----
+
+#[test]
+fn every_rule_used_is_defined_once_and_reachable() {
+    let g = grammar();
+    assert!(g.get("file").is_some(), "the start rule `file` is missing");
+    let mut seen = HashSet::new();
+    for (name, _) in &g.rules {
+        assert!(seen.insert(name.clone()), "rule `{name}` is defined twice");
+    }
+    for (name, rhs) in &g.rules {
+        let mut used = Vec::new();
+        refs(rhs, &mut used);
+        for u in used {
+            assert!(
+                g.get(&u).is_some(),
+                "rule `{name}` uses `{u}`, which is not defined"
+            );
+        }
+    }
+    // Every rule is reachable from `file`.
+    let mut reached = HashSet::from(["file".to_string()]);
+    let mut stack = vec!["file".to_string()];
+    while let Some(n) = stack.pop() {
+        let mut used = Vec::new();
+        refs(&g.rules[g.get(&n).expect("defined")].1, &mut used);
+        stack.extend(used.into_iter().filter(|u| reached.insert(u.clone())));
+    }
+    for (name, _) in &g.rules {
+        assert!(
+            reached.contains(name),
+            "rule `{name}` is not reachable from `file`"
+        );
+    }
+}
+
+#[test]
+fn every_terminal_is_one_token_of_the_lexer() {
+    let g = grammar();
+    for (name, rhs) in &g.rules {
+        let mut ts = Vec::new();
+        lits(rhs, &mut ts);
+        for t in ts {
+            let (tokens, diags) = lex(FileId(0), &t);
+            assert!(
+                diags.is_empty() && tokens.len() == 1,
+                "rule `{name}`: \"{t}\" is not one token"
+            );
+            let is_lit = matches!(terminal(&tokens[0].0), Sym::Lit(s) if s == t);
+            assert!(
+                is_lit,
+                "rule `{name}`: \"{t}\" is a token class, not a quoted terminal"
+            );
+        }
+        let mut cs = Vec::new();
+        classes(rhs, &mut cs);
+        for c in cs {
+            assert!(
+                CLASSES.contains(&c.as_str()),
+                "rule `{name}`: unknown token class {c}"
+            );
+        }
+    }
+}
+
+#[test]
+fn rules_cited_by_the_parser_and_lexer_exist() {
+    let g = grammar();
+    let text = grammar_text();
+    let src = root().join("compiler/src/syntax");
+    let parser = std::fs::read_to_string(src.join("parser.rs")).expect("parser.rs");
+    for (snippet, line) in cited(&parser) {
+        // A rule is cited as `name = ...`, or by its bare name at the start of a doc line.
+        let (lhs, rhs) = match snippet.split_once(" = ") {
+            Some((l, r)) => (l.trim(), r),
+            None if line.starts_with(&format!("`{snippet}`")) => (snippet.as_str(), ""),
+            None => continue,
+        };
+        if !is_name(lhs) {
+            continue;
+        }
+        assert!(
+            g.get(lhs).is_some(),
+            "parser.rs cites rule `{lhs}`, which sdf.ebnf does not define"
+        );
+        // Every rule name on the right, outside quotes.
+        let unquoted: String = rhs.split('"').step_by(2).collect::<Vec<_>>().join(" ");
+        for word in unquoted
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .filter(|w| is_name(w))
+        {
+            assert!(
+                g.get(word).is_some(),
+                "parser.rs cites `{snippet}`; `{word}` is not a rule of sdf.ebnf"
+            );
+        }
+    }
+    // The lexer cites the lexical rules, which live in the comment at the top of sdf.ebnf.
+    let lexer = std::fs::read_to_string(src.join("lexer.rs")).expect("lexer.rs");
+    for (name, _) in cited(&lexer)
+        .iter()
+        .filter(|(s, line)| is_name(s) && line.starts_with("Grammar rules"))
+    {
+        let defined = text.lines().any(|l| {
+            l.trim_start()
+                .strip_prefix(name.as_str())
+                .is_some_and(|r| r.trim_start().starts_with('='))
+        });
+        assert!(
+            defined,
+            "lexer.rs cites lexical rule `{name}`, which sdf.ebnf does not define"
+        );
+    }
+}
+
+#[test]
+fn examples_and_valid_files_are_sentences_of_the_grammar() {
+    let mut files = sdf_files(&root().join("examples"));
+    let ok = sdf_files(&root().join("runtime/tests/in/ok"));
+    assert!(!ok.is_empty(), "tests/in/ok has no .sdf files");
+    files.extend(ok);
+    with_stack(move || {
+        let g = grammar();
+        let mut failures = Vec::new();
+        for path in &files {
+            let text = std::fs::read_to_string(path).expect("readable");
+            if let Err(why) = recognise(&g, "file", &text) {
+                failures.push(format!("{}: {why}", path.display()));
+            }
+            // The parser agrees: no lexical or syntax errors.
+            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), &text);
+            if let Some(d) = diags.first() {
+                failures.push(format!(
+                    "{}: the parser reports {} {}",
+                    path.display(),
+                    d.code,
+                    d.message
+                ));
+            }
+        }
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
+    });
+}
+
+#[test]
+fn small_valid_inputs_are_recognised() {
+    let inputs = [
+        "",
+        "import \"lib/shapes.sdf\";",
+        "let a: float = -1 + 2 * 3 % 4 / 5 - !true.x;",
+        "let v = (1, 2, 3,);",
+        "let b = a < 1 == c >= 2 && d != e || !f;",
+        "let s = sphere(radius: 1,).translate(0, 1, 0) @ red @ blue;",
+        "let c = if a { let x = 1; x } else if b { 2 } else { 3 };",
+        "fn f(a: float, b: vec3 = (0, 1, 0),) -> shape { sphere(a) }",
+        "fn g() -> float { 1 }",
+        "material m = phong { color: (1, 0, 0), ior: 1.5, };",
+        "material m = checker {}",
+        "camera { fov: 45deg } render { aa: 2 }; light point { position: (0, 5, 0) }",
+        "scene { let k = 2; for i in 0..k { for j in i..(k + 1) { box(); } } sphere(); };",
+        "scene {}",
+    ];
+    with_stack(move || {
+        let g = grammar();
+        for text in inputs {
+            assert_eq!(recognise(&g, "file", text), Ok(()), "{text}");
+            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), text);
+            assert!(diags.is_empty(), "the parser rejects {text:?}: {diags:?}");
+        }
+    });
+}
+
+#[test]
+fn the_grammar_and_the_parser_agree_on_the_error_files() {
+    // A file of `tests/in/err` is a sentence of the grammar exactly when the lexer and the
+    // parser find nothing wrong with it (its mistake is found by the checker).
+    let files = sdf_files(&root().join("runtime/tests/in/err"));
+    assert!(!files.is_empty(), "tests/in/err has no .sdf files");
+    with_stack(move || {
+        let g = grammar();
+        let mut disagreements = Vec::new();
+        for path in &files {
+            let text = std::fs::read_to_string(path).expect("readable");
+            let grammar_ok = recognise(&g, "file", &text);
+            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), &text);
+            if grammar_ok.is_ok() != diags.is_empty() {
+                let parser = diags.first().map_or("nothing".to_string(), |d| {
+                    format!("{} {}", d.code, d.message)
+                });
+                disagreements.push(format!(
+                    "{}: grammar {grammar_ok:?}, parser reports {parser}",
+                    path.display()
+                ));
+            }
+        }
+        assert!(disagreements.is_empty(), "{}", disagreements.join("\n"));
+    });
+}
+
+#[test]
+fn broken_inputs_are_rejected() {
+    let inputs = [
+        "scene { sphere(1) }",                     // missing `;` after a statement
+        "let = 1;",                                // missing name
+        "let x = 1",                               // missing `;` at the end
+        "let x = 1 +;",                            // missing operand
+        "let x = (1, 2;",                          // unclosed tuple
+        "let x = (,);",                            // empty tuple
+        "let x = .5;",                             // a float needs a leading digit
+        "let x = if a { 1 };",                     // `if` without `else`
+        "let x = if a { 1 } else { let y = 2; };", // body without a value
+        "let x = f(a: );",                         // named argument without a value
+        "let x = 1 @ ;",                           // `@` without a material
+        "let x = a..b;",                           // a range outside `for`
+        "fn f(a) -> shape { a }",                  // parameter without a type
+        "fn f(a: float) { a }",                    // missing return type
+        "fn f(a: float) -> shape a",               // body without braces
+        "material m phong { }",                    // missing `=`
+        "material m = phong { color: (1, 0, 0) ior: 2 }", // missing `,` between fields
+        "light { position: (0, 1, 0) }",           // light without a kind
+        "camera ( fov: 45deg )",                   // fields in parentheses
+        "import shapes;",                          // import without quotes
+        "scene { for i in 0..3 sphere(); }",       // loop body without braces
+        "scene { for i 0..3 { sphere(); } }",      // missing `in`
+        "scene sphere();",                         // scene without braces
+        "sphere();",                               // a statement outside `scene`
+        "scene { sphere(1); ",                     // unclosed scene
+    ];
+    with_stack(move || {
+        let g = grammar();
+        for text in inputs {
+            assert!(
+                recognise(&g, "file", text).is_err(),
+                "the grammar accepts the broken input {text:?}"
+            );
+            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), text);
+            assert!(
+                !diags.is_empty(),
+                "the parser accepts the broken input {text:?}"
+            );
+        }
+    });
+}
+
+#[test]
+fn the_ebnf_reader_reads_its_own_notation() {
+    let g = read_grammar("(* c *) a = \"x\" { b | [ C ] } ( \"y\" ) ; b = a ;");
+    assert_eq!(g.rules.len(), 2);
+    assert_eq!(
+        g.rules[0].1,
+        Ebnf::Seq(vec![
+            Ebnf::Lit("x".into()),
+            Ebnf::Rep(Box::new(Ebnf::Alt(vec![
+                Ebnf::Rule("b".into()),
+                Ebnf::Opt(Box::new(Ebnf::Class("C".into())))
+            ]))),
+            Ebnf::Lit("y".into()),
+        ])
+    );
+}
+
+// ---- The editor grammar and the reference stay in step with the compiler ----
+
+fn read(rel: &str) -> String {
+    let path = root().join(rel);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+}
+
+#[test]
+fn the_editor_grammar_knows_every_builtin() {
+    let tm = read("grammar/sdf.tmLanguage.json");
+    assert!(
+        tm.contains("\"scopeName\": \"source.sdf\""),
+        "the scope name is source.sdf"
+    );
+    for b in BUILTINS {
+        let listed = [
+            format!("|{}|", b.name),
+            format!("({}|", b.name),
+            format!("|{})", b.name),
+        ];
+        assert!(
+            listed.iter().any(|l| tm.contains(l.as_str())),
+            "sdf.tmLanguage.json does not highlight the builtin `{}`",
+            b.name
+        );
+    }
+}
+
+#[test]
+fn the_language_reference_lists_every_signature_and_field() {
+    let doc = read("docs/language.md");
+    for b in BUILTINS {
+        for sig in b.sigs {
+            let text = format!("`{}`", builtins::signature(b.name, sig));
+            assert!(doc.contains(&text), "docs/language.md does not list {text}");
+        }
+    }
+    let records = builtins::MATERIALS
+        .iter()
+        .chain(builtins::LIGHTS)
+        .chain([&builtins::CAMERA, &builtins::RENDER]);
+    for rec in records {
+        assert!(
+            doc.contains(&format!("`{}`", rec.name)),
+            "docs/language.md does not mention `{}`",
+            rec.name
+        );
+        for f in rec.fields {
+            assert!(
+                doc.contains(&format!("| `{}` |", f.name)),
+                "docs/language.md has no row for the field `{}` of `{}`",
+                f.name,
+                rec.name
+            );
+        }
+    }
+}
+
+#[test]
+fn every_diagnostic_code_is_documented_with_an_example() {
+    let doc = read("docs/diagnostics.md");
+    let mut codes = BTreeSet::new();
+    common::codes_in(&root().join("compiler/src"), &mut codes);
+    assert!(codes.len() > 10, "no diagnostic codes found");
+    for code in codes {
+        let row = doc.lines().find(|l| l.starts_with(&format!("| {code} |")));
+        let row = row.unwrap_or_else(|| panic!("docs/diagnostics.md has no row for {code}"));
+        assert!(
+            example_produces(row, &code),
+            "the examples column of the row of {code} has no example that produces {code}: {row}"
+        );
+    }
+    // Every example file the table names exists.
+    for part in doc.split("](../").skip(1) {
+        let rel = part.split(')').next().expect("a link");
+        assert!(
+            root().join(rel).exists(),
+            "docs/diagnostics.md links to {rel}, which does not exist"
+        );
+    }
+}
+
+/// Whether the last column of a table row of docs/diagnostics.md holds an example that
+/// produces `code`: a linked `.sdf` file (checked from the file system, so imports work), or
+/// an inline snippet, checked as written or as a scene statement (`scene { SNIPPET; }`).
+fn example_produces(row: &str, code: &str) -> bool {
+    let cells: Vec<&str> = row.trim().trim_matches('|').split(" | ").collect();
+    let Some(examples) = cells.last() else {
+        return false;
+    };
+    let produces = |diags: &[sdfc_compiler::Diagnostic]| diags.iter().any(|d| d.code == code);
+    for part in examples.split("](../").skip(1) {
+        let rel = part.split(')').next().unwrap_or("");
+        if rel.ends_with(".sdf") {
+            if let Ok(loaded) = sdfc_runtime::frontend::load(&root().join(rel)) {
+                if produces(&loaded.diagnostics) {
+                    return true;
+                }
+            }
+        }
+    }
+    let parts: Vec<&str> = examples.split('`').collect();
+    for snippet in parts.iter().skip(1).step_by(2) {
+        let snippet = snippet.replace("\\|", "|");
+        for text in [snippet.clone(), format!("scene {{ {snippet}; }}")] {
+            let (_, diags, _) = sdfc_compiler::check::check_str("example.sdf", &text);
+            if produces(&diags) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+#[test]
+fn the_failure_paths_list_every_limit_with_its_default() {
+    let doc = read("docs/failures.md");
+    for limit in sdfc_compiler::Limit::ALL {
+        let row = doc
+            .lines()
+            .find(|l| l.starts_with(&format!("| `{}` |", limit.name())))
+            .unwrap_or_else(|| panic!("docs/failures.md has no row for the limit {limit}"));
+        assert!(
+            row.contains(&format!("| {} |", limit.default_value())),
+            "docs/failures.md gives the limit {limit} another default than {}",
+            limit.default_value()
+        );
+    }
+}
+
+/// Constants named `MAX_…` that are not resource limits, each with the file it lives in and
+/// why it is not a limit: thresholds between two equivalent ways of generating code,
+/// properties of an analysis, the definition of the reference render, test tolerances.
+const NOT_LIMITS: &[(&str, &str, &str)] = &[
+    (
+        "runtime/src/view/session.rs",
+        "MAX_SCALE",
+        "how far the viewer lowers the resolution of a frame over its time budget",
+    ),
+    (
+        "compiler/src/check/eval.rs",
+        "MAX_CALL_SITES",
+        "how many calls an error's chain of labels shows; the rest is a note",
+    ),
+    (
+        "compiler/src/scene/analysis.rs",
+        "MAX_STEP_LIPSCHITZ",
+        "the clamp on the step divisor L (docs/analysis.md), a property of the field",
+    ),
+    (
+        "compiler/src/scene/analysis.rs",
+        "MAX_WINDOW_CELLS",
+        "neighbouring cells a repetition evaluates; beyond, a warning (W0005)",
+    ),
+    (
+        "compiler/src/back/wgsl/analytic.rs",
+        "MAX_UNROLLED",
+        "unrolled code or a buffer walk: the same image either way",
+    ),
+    (
+        "compiler/src/back/wgsl/mod.rs",
+        "MAX_INSTANCES",
+        "instances as code or as a buffer walk: the same image either way",
+    ),
+    (
+        "compiler/src/back/ptx/types.rs",
+        "MAX_LEAVES",
+        "values kept in registers or in memory by the PTX writer",
+    ),
+    (
+        "runtime/src/cpu/reference.rs",
+        "MAX_STEPS",
+        "the step budget that defines the reference render",
+    ),
+    ("runtime/tests/image_conformance.rs", "MAX_DIFFERING", "a test tolerance"),
+    ("runtime/tests/analytic.rs", "MAX_DIFFERING", "a test tolerance"),
+    ("runtime/tests/stability.rs", "MAX_MISSED", "a test tolerance"),
+    ("runtime/tests/stability.rs", "MAX_STEP_RATIO", "a test tolerance"),
+];
+
+/// The `.rs` files under `dir` (relative to the workspace root), build output left out.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("readable").flatten() {
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if path.is_dir() {
+            if name != "target" && !name.starts_with('.') {
+                rust_files(&path, out);
+            }
+        } else if name.ends_with(".rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// issue 16, item 2: every resource limit lives in `Limits` (compiler/src/limits.rs), with
+/// its `--limit` name; a `const MAX_…` anywhere else is a limit that `--limit` cannot raise,
+/// unless it is one of [`NOT_LIMITS`].
+#[test]
+fn no_limit_is_a_constant_outside_limits_rs() {
+    let mut files = Vec::new();
+    rust_files(&root(), &mut files);
+    assert!(files.len() > 50, "the sources were not found");
+    let mut found = Vec::new();
+    for path in files {
+        let rel = path
+            .strip_prefix(root())
+            .expect("under the root")
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel == "compiler/src/limits.rs" {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).expect("readable");
+        for (at, _) in text.match_indices("const MAX_") {
+            let name: String = text[at + 6..]
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            // A declaration (the name, then a colon and its type), not a mention.
+            let declared = name.len() > 4 && text[at + 6 + name.len()..].starts_with(':');
+            if declared && !NOT_LIMITS.iter().any(|(f, n, _)| *f == rel && *n == name) {
+                found.push(format!("{rel}: {name}"));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "limits outside compiler/src/limits.rs (move them into `Limits`, or list them in \
+         NOT_LIMITS with the reason they are not limits): {found:?}"
+    );
+}

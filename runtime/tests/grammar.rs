@@ -956,10 +956,26 @@ const NOT_LIMITS: &[(&str, &str, &str)] = &[
         "MAX_STEPS",
         "the step budget that defines the reference render",
     ),
-    ("runtime/tests/image_conformance.rs", "MAX_DIFFERING", "a test tolerance"),
-    ("runtime/tests/analytic.rs", "MAX_DIFFERING", "a test tolerance"),
-    ("runtime/tests/stability.rs", "MAX_MISSED", "a test tolerance"),
-    ("runtime/tests/stability.rs", "MAX_STEP_RATIO", "a test tolerance"),
+    (
+        "runtime/tests/image_conformance.rs",
+        "MAX_DIFFERING",
+        "a test tolerance",
+    ),
+    (
+        "runtime/tests/analytic.rs",
+        "MAX_DIFFERING",
+        "a test tolerance",
+    ),
+    (
+        "runtime/tests/stability.rs",
+        "MAX_MISSED",
+        "a test tolerance",
+    ),
+    (
+        "runtime/tests/stability.rs",
+        "MAX_STEP_RATIO",
+        "a test tolerance",
+    ),
 ];
 
 /// The `.rs` files under `dir` (relative to the workspace root), build output left out.

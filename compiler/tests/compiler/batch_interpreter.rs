@@ -2,9 +2,7 @@
 //! path (bit for bit, fused steps included, at special values too), batches of every length
 //! around the chunk size, and what a tape keeps.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
 use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
 use sdfc_compiler::program::Program;

@@ -3,9 +3,7 @@
 //! written here at random points. Exact fields must match to rounding; bounds must never
 //! exceed the true distance.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
 use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
 use sdfc_compiler::program::Program;

@@ -1,12 +1,21 @@
-//! Design rules checked over the sources: the top-level modules of each crate
-//! (`compiler/src`, `runtime/src`) depend on each other without cycles, so that each can be
-//! read, and tested, on top of the ones below it.
+//! The repository's rules, checked over its files (a tidy test):
 //!
+//! - the top-level modules of each crate (`compiler/src`, `runtime/src`) depend on each other
+//!   without cycles, so that each can be read, and tested, on top of the ones below it;
+//! - every Rust file starts with a `//!` line saying what it holds;
+//! - the editor grammar and the reference in `docs/` name every built-in, record field,
+//!   diagnostic code and limit of the compiler;
+//! - no resource limit is a `const MAX_…` outside `compiler/src/limits.rs`.
+//!
+//! Module dependencies:
 //! The dependencies are read from the text: every `crate::` path (in `use` declarations and in
 //! code, braced groups included) and every `super::` path that climbs to the crate root names
 //! the top-level module it reaches. Comments and string literals are skipped; code under
 //! `#[cfg(test)]` (unit tests, which may use any part of their crate) is left out.
 
+mod common;
+
+use sdfc_compiler::check::builtins::{self, BUILTINS};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -448,4 +457,278 @@ fn the_scanner_finds_paths_and_cycles() {
     assert_eq!(c[0].len(), 3, "{c:?}");
     g.get_mut("c").expect("c").remove("a");
     assert!(cycles(&g).is_empty());
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Every Rust file of the repository (build output and hidden folders left out) starts with
+/// a `//!` line saying what it holds.
+#[test]
+fn every_rust_file_says_what_it_holds() {
+    let mut files = Vec::new();
+    workspace_rust_files(&root(), &mut files);
+    assert!(files.len() > 50, "the sources were not found");
+    let missing: Vec<String> = files
+        .iter()
+        .filter(|path| {
+            let text = std::fs::read_to_string(path).expect("readable");
+            !text.starts_with("//!")
+        })
+        .map(|path| path.display().to_string())
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "files without a `//!` line: {missing:?}"
+    );
+}
+
+// ---- The editor grammar and the reference stay in step with the compiler ----
+
+fn read(rel: &str) -> String {
+    let path = root().join(rel);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+}
+
+#[test]
+fn the_editor_grammar_knows_every_builtin() {
+    let tm = read("grammar/sdf.tmLanguage.json");
+    assert!(
+        tm.contains("\"scopeName\": \"source.sdf\""),
+        "the scope name is source.sdf"
+    );
+    for b in BUILTINS {
+        let listed = [
+            format!("|{}|", b.name),
+            format!("({}|", b.name),
+            format!("|{})", b.name),
+        ];
+        assert!(
+            listed.iter().any(|l| tm.contains(l.as_str())),
+            "sdf.tmLanguage.json does not highlight the builtin `{}`",
+            b.name
+        );
+    }
+}
+
+#[test]
+fn the_language_reference_lists_every_signature_and_field() {
+    let doc = read("docs/language.md");
+    for b in BUILTINS {
+        for sig in b.sigs {
+            let text = format!("`{}`", builtins::signature(b.name, sig));
+            assert!(doc.contains(&text), "docs/language.md does not list {text}");
+        }
+    }
+    let records = builtins::MATERIALS
+        .iter()
+        .chain(builtins::LIGHTS)
+        .chain([&builtins::CAMERA, &builtins::RENDER]);
+    for rec in records {
+        assert!(
+            doc.contains(&format!("`{}`", rec.name)),
+            "docs/language.md does not mention `{}`",
+            rec.name
+        );
+        for f in rec.fields {
+            assert!(
+                doc.contains(&format!("| `{}` |", f.name)),
+                "docs/language.md has no row for the field `{}` of `{}`",
+                f.name,
+                rec.name
+            );
+        }
+    }
+}
+
+#[test]
+fn every_diagnostic_code_is_documented_with_an_example() {
+    let doc = read("docs/diagnostics.md");
+    let mut codes = BTreeSet::new();
+    common::codes_in(&root().join("compiler/src"), &mut codes);
+    assert!(codes.len() > 10, "no diagnostic codes found");
+    for code in codes {
+        let row = doc.lines().find(|l| l.starts_with(&format!("| {code} |")));
+        let row = row.unwrap_or_else(|| panic!("docs/diagnostics.md has no row for {code}"));
+        assert!(
+            example_produces(row, &code),
+            "the examples column of the row of {code} has no example that produces {code}: {row}"
+        );
+    }
+    // Every example file the table names exists.
+    for part in doc.split("](../").skip(1) {
+        let rel = part.split(')').next().expect("a link");
+        assert!(
+            root().join(rel).exists(),
+            "docs/diagnostics.md links to {rel}, which does not exist"
+        );
+    }
+}
+
+/// Whether the last column of a table row of docs/diagnostics.md holds an example that
+/// produces `code`: a linked `.sdf` file (checked from the file system, so imports work), or
+/// an inline snippet, checked as written or as a scene statement (`scene { SNIPPET; }`).
+fn example_produces(row: &str, code: &str) -> bool {
+    let cells: Vec<&str> = row.trim().trim_matches('|').split(" | ").collect();
+    let Some(examples) = cells.last() else {
+        return false;
+    };
+    let produces = |diags: &[sdfc_compiler::Diagnostic]| diags.iter().any(|d| d.code == code);
+    for part in examples.split("](../").skip(1) {
+        let rel = part.split(')').next().unwrap_or("");
+        if rel.ends_with(".sdf") {
+            if let Ok(loaded) = sdfc_runtime::frontend::load(&root().join(rel)) {
+                if produces(&loaded.diagnostics) {
+                    return true;
+                }
+            }
+        }
+    }
+    let parts: Vec<&str> = examples.split('`').collect();
+    for snippet in parts.iter().skip(1).step_by(2) {
+        let snippet = snippet.replace("\\|", "|");
+        for text in [snippet.clone(), format!("scene {{ {snippet}; }}")] {
+            let (_, diags, _) = sdfc_compiler::check::check_str("example.sdf", &text);
+            if produces(&diags) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+#[test]
+fn the_failure_paths_list_every_limit_with_its_default() {
+    let doc = read("docs/failures.md");
+    for limit in sdfc_compiler::Limit::ALL {
+        let row = doc
+            .lines()
+            .find(|l| l.starts_with(&format!("| `{}` |", limit.name())))
+            .unwrap_or_else(|| panic!("docs/failures.md has no row for the limit {limit}"));
+        assert!(
+            row.contains(&format!("| {} |", limit.default_value())),
+            "docs/failures.md gives the limit {limit} another default than {}",
+            limit.default_value()
+        );
+    }
+}
+
+/// Constants named `MAX_…` that are not resource limits, each with the file it lives in and
+/// why it is not a limit: thresholds between two equivalent ways of generating code,
+/// properties of an analysis, the definition of the reference render, test tolerances.
+const NOT_LIMITS: &[(&str, &str, &str)] = &[
+    (
+        "runtime/src/view/session.rs",
+        "MAX_SCALE",
+        "how far the viewer lowers the resolution of a frame over its time budget",
+    ),
+    (
+        "compiler/src/check/eval.rs",
+        "MAX_CALL_SITES",
+        "how many calls an error's chain of labels shows; the rest is a note",
+    ),
+    (
+        "compiler/src/scene/analysis.rs",
+        "MAX_STEP_LIPSCHITZ",
+        "the clamp on the step divisor L (docs/analysis.md), a property of the field",
+    ),
+    (
+        "compiler/src/scene/analysis.rs",
+        "MAX_WINDOW_CELLS",
+        "neighbouring cells a repetition evaluates; beyond, a warning (W0005)",
+    ),
+    (
+        "compiler/src/back/wgsl/analytic.rs",
+        "MAX_UNROLLED",
+        "unrolled code or a buffer walk: the same image either way",
+    ),
+    (
+        "compiler/src/back/wgsl/mod.rs",
+        "MAX_INSTANCES",
+        "instances as code or as a buffer walk: the same image either way",
+    ),
+    (
+        "compiler/src/back/ptx/types.rs",
+        "MAX_LEAVES",
+        "values kept in registers or in memory by the PTX writer",
+    ),
+    (
+        "runtime/src/cpu/reference.rs",
+        "MAX_STEPS",
+        "the step budget that defines the reference render",
+    ),
+    (
+        "runtime/tests/image_conformance.rs",
+        "MAX_DIFFERING",
+        "a test tolerance",
+    ),
+    (
+        "runtime/tests/analytic.rs",
+        "MAX_DIFFERING",
+        "a test tolerance",
+    ),
+    (
+        "runtime/tests/stability.rs",
+        "MAX_MISSED",
+        "a test tolerance",
+    ),
+    (
+        "runtime/tests/stability.rs",
+        "MAX_STEP_RATIO",
+        "a test tolerance",
+    ),
+];
+
+/// The `.rs` files under `dir` (relative to the workspace root), build output left out.
+fn workspace_rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("readable").flatten() {
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if path.is_dir() {
+            if name != "target" && !name.starts_with('.') {
+                workspace_rust_files(&path, out);
+            }
+        } else if name.ends_with(".rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// issue 16, item 2: every resource limit lives in `Limits` (compiler/src/limits.rs), with
+/// its `--limit` name; a `const MAX_…` anywhere else is a limit that `--limit` cannot raise,
+/// unless it is one of [`NOT_LIMITS`].
+#[test]
+fn no_limit_is_a_constant_outside_limits_rs() {
+    let mut files = Vec::new();
+    workspace_rust_files(&root(), &mut files);
+    assert!(files.len() > 50, "the sources were not found");
+    let mut found = Vec::new();
+    for path in files {
+        let rel = path
+            .strip_prefix(root())
+            .expect("under the root")
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel == "compiler/src/limits.rs" {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).expect("readable");
+        for (at, _) in text.match_indices("const MAX_") {
+            let name: String = text[at + 6..]
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            // A declaration (the name, then a colon and its type), not a mention.
+            let declared = name.len() > 4 && text[at + 6 + name.len()..].starts_with(':');
+            if declared && !NOT_LIMITS.iter().any(|(f, n, _)| *f == rel && *n == name) {
+                found.push(format!("{rel}: {name}"));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "limits outside compiler/src/limits.rs (move them into `Limits`, or list them in \
+         NOT_LIMITS with the reason they are not limits): {found:?}"
+    );
 }

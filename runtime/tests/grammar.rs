@@ -276,6 +276,8 @@ fn terminal(t: &Token) -> Sym {
         Token::RParen => Lit(")"),
         Token::LBrace => Lit("{"),
         Token::RBrace => Lit("}"),
+        Token::LBracket => Lit("["),
+        Token::RBracket => Lit("]"),
         Token::Comma => Lit(","),
         Token::Semi => Lit(";"),
         Token::Colon => Lit(":"),

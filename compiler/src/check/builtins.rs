@@ -208,6 +208,18 @@ use Def::*;
 use Range::*;
 use Type::{Angle as A, Bool as B, Float as F, Int as I, Shape as S, Str, Vec2 as V2, Vec3 as V};
 
+/// A list of shapes, `[shape]`.
+const LS: Type = Type::List(&Type::Shape);
+
+/// The number of elements of a list of any type (`len` has a form for each element type but
+/// `int`: a list of ints fits `[float]`).
+fn len(a: &[Value]) -> Result<Value, String> {
+    match &a[0] {
+        Value::List(_, items) => Ok(Value::Int(items.len() as i64)),
+        _ => Ok(Value::Error),
+    }
+}
+
 const SMOOTH_VARIANTS: &[&str] = &["poly", "exp"];
 
 fn smooth(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
@@ -254,6 +266,39 @@ fn rotate(b: &mut Build, child: &Value, axis: V3, angle: f64) -> Result<Value, S
         matrix: rotation(axis, angle),
         child: sh(child),
     })
+}
+
+/// The shapes of a list argument; an empty list is an error (nothing to combine).
+fn shapes(list: &Value, name: &str) -> Result<Vec<Value>, String> {
+    match list {
+        Value::List(_, items) if items.is_empty() => Err(format!(
+            "`{name}` of an empty list: there is no shape to combine"
+        )),
+        Value::List(_, items) => Ok(items.to_vec()),
+        _ => Ok(Vec::new()),
+    }
+}
+
+/// `union(shapes)`, `intersect(shapes)`: the same node as the shapes given one by one.
+fn combine_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Value, String> {
+    let items = shapes(&a[0], name)?;
+    match items.as_slice() {
+        [one] => Ok(one.clone()),
+        _ => combine(b, &items, op),
+    }
+}
+
+/// `smooth_union(k, shapes, …)`: the left fold of the binary form,
+/// `smooth_union(k, smooth_union(k, a, b), c)`; its other arguments as the binary form's.
+fn smooth_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Value, String> {
+    let items = shapes(&a[1], name)?;
+    let mut acc = items[0].clone();
+    for x in &items[1..] {
+        let mut args = vec![a[0].clone(), acc, x.clone()];
+        args.extend_from_slice(&a[2..]);
+        acc = smooth(b, &args, op)?;
+    }
+    Ok(acc)
 }
 
 fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
@@ -385,12 +430,14 @@ pub static BUILTINS: &[Builtin] = &[
         name: "union",
         sigs: sigs![
             [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Union);
+            [p("shapes", LS, Req, Any)] -> S => |b, a| combine_list(b, a, Combine::Union, "union");
         ],
     },
     Builtin {
         name: "intersect",
         sigs: sigs![
             [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Intersect);
+            [p("shapes", LS, Req, Any)] -> S => |b, a| combine_list(b, a, Combine::Intersect, "intersect");
         ],
     },
     Builtin {
@@ -404,6 +451,8 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
                 => |b, a| smooth(b, a, Combine::Union);
+            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+                => |b, a| smooth_list(b, a, Combine::Union, "smooth_union");
         ],
     },
     Builtin {
@@ -411,6 +460,8 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
                 => |b, a| smooth(b, a, Combine::Intersect);
+            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+                => |b, a| smooth_list(b, a, Combine::Intersect, "smooth_intersect");
         ],
     },
     Builtin {
@@ -514,6 +565,19 @@ pub static BUILTINS: &[Builtin] = &[
         name: "elongate",
         sigs: sigs![
             [shape("shape"), p("half", V, Req, NonNeg)] -> S => |b, a| b.node(Node::Elongate { half: a[1].v3(), child: sh(&a[0]) });
+        ],
+    },
+    // Lists.
+    Builtin {
+        name: "len",
+        sigs: sigs![
+            [p("xs", LS, Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&F), Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&V), Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&V2), Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&A), Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&B), Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&Str), Req, Any)] -> I => |_, a| len(a);
         ],
     },
     // Vectors.

@@ -182,7 +182,222 @@ impl Ctx {
                 let v = self.expr(x);
                 self.paint(v, x.span, m, e.span)
             }
+            ExprKind::List(items) => self.list(items, e.span),
+            ExprKind::Comprehension {
+                var,
+                from,
+                to,
+                body,
+            } => self.comprehension(var, from, to, body),
+            ExprKind::Index(xs, i) => self.index(xs, i),
             ExprKind::Error => Value::Error,
+        }
+    }
+
+    /// `[a, b, c]`: the elements' one type (ints among floats become floats).
+    fn list(&mut self, items: &[Expr], span: Span) -> Value {
+        if items.is_empty() {
+            self.error(
+                Diagnostic::error("E0300", "an empty list has no element type", span)
+                    .with_label("`[]` is a list of nothing in particular")
+                    .with_help("a list that may be empty is built by a comprehension, such as `[for i in 0..n { sphere(1) }]`"),
+            );
+            return Value::Error;
+        }
+        if !self.list_length(items.len(), span) {
+            return Value::Error;
+        }
+        let vals: Vec<Value> = items.iter().map(|i| self.expr(i)).collect();
+        let mut elem: Option<(Type, Span)> = None;
+        for (v, item) in vals.iter().zip(items) {
+            let Some(t) = v.ty() else { continue };
+            match elem {
+                None => elem = Some((t, item.span)),
+                Some((e, _)) if t.fits(e) => {}
+                Some((e, at)) if e.fits(t) => elem = Some((t, at)),
+                Some((e, at)) => {
+                    self.error(
+                        Diagnostic::error(
+                            "E0300",
+                            "the elements of a list have different types",
+                            item.span,
+                        )
+                        .with_label(format!("this is `{t}`"))
+                        .with_secondary(at, format!("this is `{e}`"))
+                        .with_note("every element of a list has one type"),
+                    );
+                    return Value::Error;
+                }
+            }
+        }
+        let Some((elem, at)) = elem else {
+            return Value::Error;
+        };
+        self.make_list(elem, vals, at)
+    }
+
+    /// A list of `vals`, each converted to `elem`; `Unknown` when any is not computed.
+    fn make_list(&mut self, elem: Type, vals: Vec<Value>, at: Span) -> Value {
+        let Some(ty) = Type::list(elem) else {
+            self.error(
+                Diagnostic::error("E0300", "a list's elements cannot be lists", at)
+                    .with_label(format!("this is `{elem}`"))
+                    .with_note("lists do not nest"),
+            );
+            return Value::Error;
+        };
+        if vals.contains(&Value::Error) {
+            return Value::Error;
+        }
+        if vals.iter().any(Value::is_abstract) {
+            return Value::Unknown(ty);
+        }
+        let items: Option<Vec<Value>> = vals.into_iter().map(|v| v.coerce(elem)).collect();
+        match (items, ty) {
+            (Some(items), Type::List(e)) => Value::List(e, items.into()),
+            _ => Value::Error,
+        }
+    }
+
+    /// Whether a list of `n` elements is within the `objects` limit (reported once if not).
+    fn list_length(&mut self, n: usize, span: Span) -> bool {
+        let max = self.limits.count(Limit::Objects);
+        if n <= max {
+            return true;
+        }
+        self.limit(
+            Limit::Objects,
+            span,
+            format!("a list has {n} elements, more than {max}"),
+        );
+        false
+    }
+
+    /// `[for var in from..to { body }]`: the body's value for each int from `from` up to
+    /// `to`, excluded. The body is checked once on its own (for the element type, also of an
+    /// empty list) and then evaluated for each value.
+    fn comprehension(&mut self, var: &Ident, from: &Expr, to: &Expr, body: &Body) -> Value {
+        let bound = |cx: &mut Self, e: &Expr| match cx.expr(e) {
+            Value::Int(i) => Ok(Some(i)),
+            Value::Unknown(Type::Int) => Ok(None),
+            Value::Error => Err(()),
+            other => {
+                cx.error(
+                    Diagnostic::error("E0300", "the bounds of a range must be `int`", e.span)
+                        .with_label(format!("this is `{}`", type_name(&other))),
+                );
+                Err(())
+            }
+        };
+        let (a, b) = (bound(self, from), bound(self, to));
+        let mark = self.locals.len();
+        self.locals
+            .push((var.name.clone(), Value::Unknown(Type::Int)));
+        let before = self.diags.len();
+        let shape = self.dry(|cx| cx.body(body));
+        self.locals.truncate(mark);
+        let (Ok(a), Ok(b)) = (a, b) else {
+            return Value::Error;
+        };
+        let Some(elem) = shape.ty() else {
+            return Value::Error;
+        };
+        if self.diags[before..].iter().any(Diagnostic::is_error) {
+            return Value::Error;
+        }
+        let (Some(a), Some(b)) = (a, b) else {
+            return self.make_list(elem, vec![Value::Unknown(elem)], body.value.span);
+        };
+        if self.dry > 0 {
+            return self.make_list(elem, vec![Value::Unknown(elem)], body.value.span);
+        }
+        let n = b.saturating_sub(a).max(0);
+        if !self.list_length(n as usize, to.span) {
+            return Value::Error;
+        }
+        let mut vals = Vec::with_capacity(n as usize);
+        for i in a..b {
+            if !self.burn(var.span) {
+                return Value::Error;
+            }
+            self.locals.push((var.name.clone(), Value::Int(i)));
+            let errors = self.diags.len();
+            let v = self.body(body);
+            self.locals.truncate(mark);
+            // One report per mistake, not one per element.
+            if self.diags[errors..].iter().any(Diagnostic::is_error) {
+                return Value::Error;
+            }
+            vals.push(v);
+        }
+        self.make_list(elem, vals, body.value.span)
+    }
+
+    /// `xs[i]`: the element at `i`, counted from 0; an index outside the list is E0407.
+    fn index(&mut self, xs: &Expr, i: &Expr) -> Value {
+        let (list, at) = (self.expr(xs), self.expr(i));
+        let elem = match list.ty() {
+            None => None,
+            Some(Type::List(e)) => Some(*e),
+            Some(t) => {
+                self.error(
+                    Diagnostic::error("E0300", format!("`{t}` cannot be indexed"), xs.span)
+                        .with_label(format!("this is `{t}`, not a list"))
+                        .with_help(if matches!(t, Type::Vec2 | Type::Vec3) {
+                            "a vector's components are `v.x`, `v.y` and `v.z`"
+                        } else {
+                            "only lists, such as `[a, b, c]`, are indexed with `xs[i]`"
+                        }),
+                );
+                return Value::Error;
+            }
+        };
+        match at.ty() {
+            None | Some(Type::Int) => {}
+            Some(t) => {
+                let mut d = Diagnostic::error(
+                    "E0300",
+                    format!("a list index must be `int`, found `{t}`"),
+                    i.span,
+                )
+                .with_label(format!("this is `{t}`"));
+                if t == Type::Float {
+                    d = d.with_help("use a whole number, or `int(x)`");
+                }
+                self.error(d);
+                return Value::Error;
+            }
+        }
+        let Some(elem) = elem else {
+            return Value::Error;
+        };
+        match (&list, &at) {
+            (Value::List(_, items), Value::Int(k)) => {
+                match usize::try_from(*k).ok().and_then(|k| items.get(k)) {
+                    Some(v) => v.clone(),
+                    None => {
+                        let n = items.len();
+                        let elements = if n == 1 { "element" } else { "elements" };
+                        let note = match n {
+                            0 => "the list is empty: it has no index".to_string(),
+                            _ => format!("the indices of this list are 0 to {}", n - 1),
+                        };
+                        self.error(
+                            Diagnostic::error(
+                                "E0407",
+                                format!("index {k} is outside a list of {n} {elements}"),
+                                i.span,
+                            )
+                            .with_label(format!("this is {k}"))
+                            .with_secondary(xs.span, format!("this list has {n} {elements}"))
+                            .with_note(note),
+                        );
+                        Value::Error
+                    }
+                }
+            }
+            (Value::Error, _) | (_, Value::Error) => Value::Error,
+            _ => Value::Unknown(elem),
         }
     }
 
@@ -541,10 +756,29 @@ impl Ctx {
     pub fn type_name(&mut self, id: &Ident) -> Option<Type> {
         let t = Type::from_name(&id.name);
         if t.is_none() {
+            let inner = id.name.trim_start_matches('[').trim_end_matches(']');
+            if inner != id.name && Type::from_name(inner).is_some() {
+                self.error(
+                    Diagnostic::error("E0209", format!("unknown type `{}`", id.name), id.span)
+                        .with_label("a list of lists")
+                        .with_note("the elements of a list are not lists"),
+                );
+                return None;
+            }
             let mut d = Diagnostic::error("E0209", format!("unknown type `{}`", id.name), id.span)
                 .with_label("not a type")
                 .with_note(format!("the types are {}", Type::NAMES.join(", ")));
-            if let Some(s) = closest(&id.name, Type::NAMES) {
+            if inner != id.name {
+                d = d.with_note(format!(
+                    "a list type is written with its element type in brackets, as in `[shape]`"
+                ));
+            }
+            if let Some(s) = closest(inner, Type::NAMES) {
+                let s = if inner == id.name {
+                    s.to_string()
+                } else {
+                    format!("[{s}]")
+                };
                 d = d.with_help(format!("did you mean `{s}`?"));
             }
             self.error(d);

@@ -487,7 +487,13 @@ fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
                 stack.push(receiver);
                 stack.extend(args.iter().map(|a| &a.value));
             }
-            ast::ExprKind::Tuple(xs) => stack.extend(xs),
+            ast::ExprKind::Tuple(xs) | ast::ExprKind::List(xs) => stack.extend(xs),
+            ast::ExprKind::Index(a, b) => stack.extend([&**a, &**b]),
+            ast::ExprKind::Comprehension { from, to, body, .. } => {
+                stack.extend([&**from, &**to]);
+                stack.extend(body.lets.iter().map(|l| &l.value));
+                stack.push(&body.value);
+            }
             ast::ExprKind::Unary(_, x)
             | ast::ExprKind::Field(x, _)
             | ast::ExprKind::Material(x, _) => stack.push(x),
@@ -503,7 +509,13 @@ fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
                     stack.push(&b.value);
                 }
             }
-            _ => {}
+            ast::ExprKind::Int(_)
+            | ast::ExprKind::Float(_)
+            | ast::ExprKind::Angle(_)
+            | ast::ExprKind::Bool(_)
+            | ast::ExprKind::Str(_)
+            | ast::ExprKind::Var(_)
+            | ast::ExprKind::Error => {}
         }
     }
 }

@@ -55,7 +55,7 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
         Or | And => (a == Bool && b == Bool).then_some(Bool),
         Eq | Ne => (a == b || (num(a) && num(b)))
             .then_some(Bool)
-            .filter(|_| a != Shape),
+            .filter(|_| a != Shape && a.elem().is_none()),
         Lt | Le | Gt | Ge => ((num(a) && num(b)) || (a == Angle && b == Angle)).then_some(Bool),
         Add | Sub => match (a, b) {
             (Int, Int) => Some(Int),

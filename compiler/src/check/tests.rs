@@ -271,3 +271,117 @@ fn an_error_in_a_body_shows_its_calls_up_to_four() {
     );
     assert!(d.notes.iter().any(|n| n.contains("further functions")));
 }
+
+#[test]
+fn a_list_union_is_the_union_of_its_shapes() {
+    let given = ok("scene { union(sphere(1), box(0.5).translate(1, 0, 0), torus(1, 0.2)); }");
+    let listed = ok("scene { union([sphere(1), box(0.5).translate(1, 0, 0), torus(1, 0.2)]); }");
+    let built = ok(
+        "fn parts() -> [shape] { [sphere(1), box(0.5).translate(1, 0, 0), torus(1, 0.2)] }\nscene { union(parts()); }",
+    );
+    let shown = |s: &crate::scene::Scene| crate::scene::dump(s);
+    assert_eq!(shown(&given), shown(&listed));
+    assert_eq!(shown(&given), shown(&built));
+}
+
+#[test]
+fn comprehensions_in_function_bodies() {
+    let s = ok("fn ring(n: int, r: float) -> shape {\n  union([for i in 0..n { sphere(0.1).translate(r, 0, 0).rotate_y(360deg * i / n) }])\n}\nscene { ring(6, 2); }");
+    let Node::Combine { children, .. } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a union")
+    };
+    assert_eq!(children.len(), 6);
+    // The same with a loop of the scene.
+    let looped = ok("scene { union([for i in 0..6 { sphere(0.1).translate(2, 0, 0).rotate_y(360deg * i / 6) }]); }");
+    assert_eq!(crate::scene::dump(&s), crate::scene::dump(&looped));
+}
+
+#[test]
+fn list_values_len_and_index() {
+    let s = ok("let xs = [1, 2.5, 3];\nlet n = len(xs);\nlet sq: [float] = [for i in 0..n { xs[i] * xs[i] }];\nscene { sphere(sq[1] + n); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 9.25 }
+    );
+    // A list parameter, with a comprehension over its length.
+    let s = ok("fn sum(xs: [float], i: int = 0) -> float { if i >= len(xs) { 0 } else { xs[i] + sum2(xs, i + 1) } }\nfn sum2(xs: [float], i: int) -> float { if i >= len(xs) { 0 } else { xs[i] } }\nscene { sphere(sum([1, 2])); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 3.0 }
+    );
+}
+
+#[test]
+fn list_mistakes_are_reported_where_they_are() {
+    let (_, diags, _) = check_str("t.sdf", "let xs = [1, 2, 3];\nscene { sphere(xs[3]); }");
+    let d = diags.iter().find(|d| d.code == "E0407").expect("E0407");
+    assert_eq!(
+        d.span().start as usize,
+        "let xs = [1, 2, 3];\nscene { sphere(xs[".len()
+    );
+    assert_eq!(
+        codes("let xs = [1, 2];\nscene { sphere(xs[-1]); }"),
+        ["E0407"]
+    );
+    assert_eq!(codes("scene { sphere([1, true][0]); }"), ["E0300"]);
+    assert_eq!(codes("let xs = [];\nscene { sphere(1); }"), ["E0300"]);
+    assert_eq!(
+        codes("let v = (1, 2, 3);\nscene { sphere(v[0]); }"),
+        ["E0300"]
+    );
+    assert_eq!(
+        codes("let xs = [1, 2];\nscene { sphere(xs[0.5]); }"),
+        ["E0300"]
+    );
+    assert_eq!(
+        codes("fn f(xs: [[shape]]) -> shape { xs }\nscene { sphere(1); }"),
+        ["E0209"]
+    );
+    assert_eq!(
+        codes("scene { union([for i in 0..0 { sphere(1) }]); }"),
+        ["E0400"]
+    );
+    // An error inside a comprehension's body is reported once, not once per element.
+    assert_eq!(
+        codes("scene { union([for i in 0..9 { sphere(-1) }]); }"),
+        ["E0400"]
+    );
+    assert_eq!(
+        codes("let xs = [1, 2] == [1, 2];\nscene { sphere(1); }"),
+        ["E0301"]
+    );
+}
+
+#[test]
+fn lists_are_bounded_by_the_objects_limit() {
+    use crate::limits::{Limit, Limits};
+    let mut limits = Limits::default();
+    limits.set(Limit::Objects, 10).expect("a valid limit");
+    let src = "scene { union([for i in 0..11 { sphere(1).translate(i, 0, 0) }]); }";
+    let mut sources = crate::span::SourceMap::new();
+    let entry = sources.add("t.sdf", src);
+    let (_, diags) = super::check_with(&mut sources, entry, &mut super::NoImports, &limits);
+    assert!(diags.iter().any(|d| d.code == "E0507"), "{diags:#?}");
+}
+
+#[test]
+fn smooth_lists_fold_from_the_left() {
+    let listed =
+        ok("scene { smooth_union(0.2, [sphere(1), box(0.5), torus(1, 0.2)], variant: \"exp\"); }");
+    let nested = ok("scene { smooth_union(0.2, smooth_union(0.2, sphere(1), box(0.5), variant: \"exp\"), torus(1, 0.2), variant: \"exp\"); }");
+    // The nodes are made in another order, so they are numbered differently; the programs
+    // are the same but for the node numbers in their comments.
+    let program = |s: &crate::scene::Scene| {
+        let text = crate::lower::lower(s).dump();
+        text.lines()
+            .filter(|l| !l.starts_with(';'))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(program(&listed), program(&nested));
+    let one = ok("scene { smooth_intersect(0.2, [sphere(1)]); }");
+    assert_eq!(
+        one.graph.node(one.root.expect("root")),
+        &Node::Sphere { radius: 1.0 }
+    );
+}

@@ -4,7 +4,8 @@ use crate::scene::NodeId;
 use std::fmt;
 use std::rc::Rc;
 
-/// The types a value can have. `int` converts to `float` wherever a float is expected.
+/// The types a value can have. `int` converts to `float` wherever a float is expected (and
+/// a list of ints to a list of floats).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Type {
     Int,
@@ -15,11 +16,41 @@ pub enum Type {
     Angle,
     Str,
     Shape,
+    /// A list of values of the element type, which is never a list ([`Type::list`]).
+    List(&'static Type),
 }
 
+/// The element types of lists, for [`Type::list`]: every type but a list.
+static ELEMENTS: [Type; 8] = [
+    Type::Int,
+    Type::Float,
+    Type::Bool,
+    Type::Vec2,
+    Type::Vec3,
+    Type::Angle,
+    Type::Str,
+    Type::Shape,
+];
+
 impl Type {
-    /// The type named `name` in a declaration.
+    /// The type of lists of `elem`; `None` where `elem` is itself a list (lists do not nest).
+    pub fn list(elem: Type) -> Option<Type> {
+        ELEMENTS.iter().find(|t| **t == elem).map(Type::List)
+    }
+
+    /// The element type of a list type.
+    pub fn elem(self) -> Option<Type> {
+        match self {
+            Type::List(e) => Some(*e),
+            _ => None,
+        }
+    }
+
+    /// The type named `name` in a declaration: a type's name, or `[name]` for a list.
     pub fn from_name(name: &str) -> Option<Type> {
+        if let Some(inner) = name.strip_prefix('[').and_then(|n| n.strip_suffix(']')) {
+            return Type::list(Type::from_name(inner)?);
+        }
         Some(match name {
             "int" => Type::Int,
             "float" => Type::Float,
@@ -40,7 +71,10 @@ impl Type {
 
     /// True when a value of type `self` may be passed where `want` is expected.
     pub fn fits(self, want: Type) -> bool {
-        self == want || (self == Type::Int && want == Type::Float)
+        match (self, want) {
+            (Type::List(a), Type::List(b)) => a.fits(*b),
+            _ => self == want || (self == Type::Int && want == Type::Float),
+        }
     }
 }
 
@@ -55,6 +89,7 @@ impl fmt::Display for Type {
             Type::Angle => "angle",
             Type::Str => "string",
             Type::Shape => "shape",
+            Type::List(elem) => return write!(f, "[{elem}]"),
         })
     }
 }
@@ -73,6 +108,8 @@ pub enum Value {
     Angle(f64),
     Str(Rc<str>),
     Shape(NodeId),
+    /// A list: its element type and its elements (each of that type, or `Error`).
+    List(&'static Type, Rc<[Value]>),
     Unknown(Type),
     Error,
 }
@@ -89,6 +126,7 @@ impl Value {
             Value::Angle(_) => Type::Angle,
             Value::Str(_) => Type::Str,
             Value::Shape(_) => Type::Shape,
+            Value::List(elem, _) => Type::List(elem),
             Value::Unknown(t) => *t,
             Value::Error => return None,
         })
@@ -105,6 +143,14 @@ impl Value {
             (Value::Error, _) => Some(Value::Error),
             (Value::Int(i), Type::Float) => Some(Value::Float(i as f64)),
             (Value::Unknown(t), w) if t.fits(w) => Some(Value::Unknown(w)),
+            (Value::List(elem, items), Type::List(w)) if elem.fits(*w) => {
+                if elem == w {
+                    return Some(Value::List(elem, items));
+                }
+                let items: Option<Vec<Value>> =
+                    items.iter().map(|v| v.clone().coerce(*w)).collect();
+                Some(Value::List(w, items?.into()))
+            }
             (v, w) if v.ty() == Some(w) => Some(v),
             _ => None,
         }
@@ -150,6 +196,16 @@ impl fmt::Display for Value {
             Value::Angle(a) => write!(f, "{}deg", a.to_degrees()),
             Value::Str(s) => write!(f, "{s:?}"),
             Value::Shape(_) => write!(f, "<shape>"),
+            Value::List(_, items) => {
+                // A long list is shown by its first elements and its length.
+                const SHOWN: usize = 4;
+                let head: Vec<String> = items.iter().take(SHOWN).map(|v| v.to_string()).collect();
+                if items.len() > SHOWN {
+                    write!(f, "[{}, … ({} elements)]", head.join(", "), items.len())
+                } else {
+                    write!(f, "[{}]", head.join(", "))
+                }
+            }
             Value::Unknown(t) => write!(f, "<{t}>"),
             Value::Error => write!(f, "<error>"),
         }

@@ -73,7 +73,7 @@ pub struct Field {
 pub struct Let {
     /// The bound name.
     pub name: Ident,
-    /// The declared type, if any.
+    /// The declared type, if any (see [`Param::ty`]).
     pub ty: Option<Ident>,
     /// The value.
     pub value: Expr,
@@ -101,7 +101,8 @@ pub struct FnDecl {
 pub struct Param {
     /// The parameter's name.
     pub name: Ident,
-    /// Its type.
+    /// Its type, as written: a name (`float`) or a list type (`[shape]`), whose name is the
+    /// brackets and the element type without spaces and whose span covers the brackets.
     pub ty: Ident,
     /// Its default value.
     pub default: Option<Expr>,
@@ -243,6 +244,18 @@ pub enum ExprKind {
     },
     /// `shape @ material`
     Material(Box<Expr>, Ident),
+    /// `[a, b, c]`: a list of values of one type.
+    List(Vec<Expr>),
+    /// `[for name in from..to { body }]`: a list of the body's values, `name` an int from
+    /// `from` up to `to` (excluded).
+    Comprehension {
+        var: Ident,
+        from: Box<Expr>,
+        to: Box<Expr>,
+        body: Body,
+    },
+    /// `xs[i]`: an element of a list.
+    Index(Box<Expr>, Box<Expr>),
     /// An expression that did not parse (already reported).
     Error,
 }

@@ -163,6 +163,21 @@ impl Dumper {
                 d.body(otherwise);
             }),
             ExprKind::Material(x, m) => self.nested(format!("material @{}", m.name), |d| d.expr(x)),
+            ExprKind::List(items) => self.nested("list", |d| items.iter().for_each(|i| d.expr(i))),
+            ExprKind::Comprehension {
+                var,
+                from,
+                to,
+                body,
+            } => self.nested(format!("list for {}", var.name), |d| {
+                d.expr(from);
+                d.expr(to);
+                d.body(body);
+            }),
+            ExprKind::Index(xs, i) => self.nested("index", |d| {
+                d.expr(xs);
+                d.expr(i);
+            }),
             ExprKind::Error => self.line("<error>"),
         }
     }

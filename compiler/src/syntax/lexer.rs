@@ -65,6 +65,10 @@ pub enum Token {
     LBrace,
     #[token("}")]
     RBrace,
+    #[token("[")]
+    LBracket,
+    #[token("]")]
+    RBracket,
     #[token(",")]
     Comma,
     #[token(";")]
@@ -145,6 +149,8 @@ impl fmt::Display for Token {
             Token::RParen => ")",
             Token::LBrace => "{",
             Token::RBrace => "}",
+            Token::LBracket => "[",
+            Token::RBracket => "]",
             Token::Comma => ",",
             Token::Semi => ";",
             Token::Colon => ":",
@@ -284,7 +290,6 @@ fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnosti
         '&' => d.with_help("logical and is written `&&`"),
         '|' => d.with_help("logical or is written `||`"),
         '#' => d.with_help("comments start with `//`"),
-        '[' | ']' => d.with_help("vectors are written `(x, y, z)` or `vec3(x, y, z)`"),
         _ => d,
     }
 }

@@ -153,7 +153,7 @@ fn syntax_error(
         .with_label(format!("unexpected {found}"));
     if matches!(e.found(), Some(Token::For)) && !expected.iter().any(|x| x == "`for`") {
         d = d.with_help(
-            "`for` loops belong in the `scene` block: a function's body is its `let`s and one value; call the function from a loop in the scene, or combine shapes with `union`",
+            "a `for` statement belongs in the `scene` block; in an expression, such as a function's body, build a list with `[for i in 0..n { ... }]` and combine it with `union(...)`",
         );
     }
     if !expected.is_empty() {
@@ -184,6 +184,23 @@ where
         .labelled("name")
 }
 
+/// `type = ident | "[" type "]"`: a list type is kept as one name, `[shape]`, spanning the
+/// brackets.
+fn type_name<'t, I>(file: FileId) -> impl Parser<'t, I, Ident, Extra<'t>> + Clone
+where
+    I: ValueInput<'t, Token = Token, Span = SimpleSpan>,
+{
+    recursive(move |ty| {
+        ident(file).or(ty
+            .delimited_by(just(Token::LBracket), just(Token::RBracket))
+            .map_with(move |inner: Ident, e| Ident {
+                name: format!("[{}]", inner.name),
+                span: sp(file, e.span()),
+            }))
+    })
+    .labelled("type")
+}
+
 /// `expr` with all its precedence levels, and `body`.
 fn expr_parser<'t, I>(file: FileId) -> impl Parser<'t, I, Expr, Extra<'t>> + Clone
 where
@@ -198,7 +215,7 @@ where
         // `let_stmt = "let" ident [":" ident] "=" expr ";"`
         let local_let = just(Token::Let)
             .ignore_then(ident(file))
-            .then(just(Token::Colon).ignore_then(ident(file)).or_not())
+            .then(just(Token::Colon).ignore_then(type_name(file)).or_not())
             .then_ignore(just(Token::Eq))
             .then(expr.clone())
             .then_ignore(just(Token::Semi))
@@ -308,29 +325,73 @@ where
                 })
         });
 
-        let atom = choice((literal, call, var, tuple, if_expr))
+        // `list = "[" "for" ident "in" expr ".." expr body "]"
+        //      | "[" [ expr { "," expr } [ "," ] ] "]"`
+        let comprehension = just(Token::For)
+            .ignore_then(ident(file))
+            .then_ignore(just(Token::In))
+            .then(expr.clone())
+            .then_ignore(just(Token::DotDot))
+            .then(expr.clone())
+            .then(body.clone())
+            .map(|(((var, from), to), body)| (var, from, to, body));
+        let list = comprehension
+            .map(Ok)
+            .or(expr
+                .clone()
+                .separated_by(just(Token::Comma))
+                .allow_trailing()
+                .collect::<Vec<_>>()
+                .map(Err))
+            .delimited_by(just(Token::LBracket), just(Token::RBracket))
+            .map_with(move |list, e| {
+                let kind = match list {
+                    Ok((var, from, to, body)) => ExprKind::Comprehension {
+                        var,
+                        from: Box::new(from),
+                        to: Box::new(to),
+                        body,
+                    },
+                    Err(items) => ExprKind::List(items),
+                };
+                mk(kind, e.span())
+            })
+            .recover_with(via_parser(nested_delimiters(
+                Token::LBracket,
+                Token::RBracket,
+                [
+                    (Token::LParen, Token::RParen),
+                    (Token::LBrace, Token::RBrace),
+                ],
+                move |s| mk(ExprKind::Error, s),
+            )));
+
+        let atom = choice((literal, call, var, tuple, list, if_expr))
             .labelled("expression")
             .boxed();
 
-        // `postfix = atom { "." ident [args] }`
+        // `postfix = atom { "." ident [args] | "[" expr "]" }`
+        let suffix = just(Token::Dot)
+            .ignore_then(ident(file))
+            .then(args.clone().or_not())
+            .map(Ok)
+            .or(expr
+                .clone()
+                .delimited_by(just(Token::LBracket), just(Token::RBracket))
+                .map(Err));
         let postfix = atom
-            .foldl_with(
-                just(Token::Dot)
-                    .ignore_then(ident(file))
-                    .then(args.clone().or_not())
-                    .repeated(),
-                move |receiver, (name, args), e| {
-                    let kind = match args {
-                        Some(args) => ExprKind::Method {
-                            receiver: Box::new(receiver),
-                            name,
-                            args,
-                        },
-                        None => ExprKind::Field(Box::new(receiver), name),
-                    };
-                    mk(kind, e.span())
-                },
-            )
+            .foldl_with(suffix.repeated(), move |receiver, suffix, e| {
+                let kind = match suffix {
+                    Ok((name, Some(args))) => ExprKind::Method {
+                        receiver: Box::new(receiver),
+                        name,
+                        args,
+                    },
+                    Ok((name, None)) => ExprKind::Field(Box::new(receiver), name),
+                    Err(index) => ExprKind::Index(Box::new(receiver), Box::new(index)),
+                };
+                mk(kind, e.span())
+            })
             .boxed();
 
         // `unary = { "-" | "!" } postfix`
@@ -408,7 +469,7 @@ where
     // `let = "let" ident [":" ident] "=" expr ";"`
     let let_decl = just(Token::Let)
         .ignore_then(ident(file))
-        .then(just(Token::Colon).ignore_then(ident(file)).or_not())
+        .then(just(Token::Colon).ignore_then(type_name(file)).or_not())
         .then_ignore(just(Token::Eq))
         .then(expr.clone())
         .then_ignore(just(Token::Semi))
@@ -445,14 +506,14 @@ where
             span: sp(file, e.span()),
         });
 
-    // `param = ident ":" ident ["=" expr]`
+    // `param = ident ":" type ["=" expr]`
     let param = ident(file)
         .then_ignore(just(Token::Colon))
-        .then(ident(file))
+        .then(type_name(file))
         .then(just(Token::Eq).ignore_then(expr.clone()).or_not())
         .map(|((name, ty), default)| Param { name, ty, default });
 
-    // `fn = "fn" ident "(" params ")" "->" ident body`
+    // `fn = "fn" ident "(" params ")" "->" type body`
     let local_let = let_decl.clone();
     let body = local_let
         .repeated()
@@ -487,7 +548,7 @@ where
                 .delimited_by(just(Token::LParen), just(Token::RParen)),
         )
         .then_ignore(just(Token::Arrow))
-        .then(ident(file))
+        .then(type_name(file))
         .then(body)
         .map_with(move |(((name, params), ret), body), e| {
             Item::Fn(FnDecl {

@@ -769,9 +769,9 @@ impl Ctx {
                 .with_label("not a type")
                 .with_note(format!("the types are {}", Type::NAMES.join(", ")));
             if inner != id.name {
-                d = d.with_note(format!(
-                    "a list type is written with its element type in brackets, as in `[shape]`"
-                ));
+                d = d.with_note(
+                    "a list type is written with its element type in brackets, as in `[shape]`",
+                );
             }
             if let Some(s) = closest(inner, Type::NAMES) {
                 let s = if inner == id.name {

@@ -261,6 +261,58 @@ fn rotation(axis: V3, angle: f64) -> [V3; 3] {
     })
 }
 
+/// `repeat_polar(shape, count, axis, mirror)`: the node about y, between rotations that take
+/// y to `axis` and back for any other axis.
+fn repeat_polar(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let count = a[1].num();
+    let mirror = a[3] == Value::Bool(true);
+    if mirror && count % 2.0 != 0.0 {
+        return Err(format!(
+            "`mirror: true` alternates the copies, so `count` must be even, not {count}"
+        ));
+    }
+    let n = a[2].v3();
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let axis = n.map(|x| x / len);
+    // The rotation taking y to the axis: about y × axis by the angle between them.
+    let turn = if (axis[1] - 1.0).abs() < 1e-15 {
+        None
+    } else if (axis[1] + 1.0).abs() < 1e-15 {
+        Some(rotation([1.0, 0.0, 0.0], std::f64::consts::PI))
+    } else {
+        Some(rotation(
+            [axis[2], 0.0, -axis[0]],
+            axis[1].clamp(-1.0, 1.0).acos(),
+        ))
+    };
+    let mut child = sh(&a[0]);
+    if let Some(m) = turn {
+        let back = [0, 1, 2].map(|i| [0, 1, 2].map(|j| m[j][i]));
+        child = b.graph.add(
+            Node::Rotate {
+                matrix: back,
+                child,
+            },
+            b.span,
+        );
+    }
+    let polar = b.graph.add(
+        Node::RepeatPolar {
+            count: count as u32,
+            mirror,
+            child,
+        },
+        b.span,
+    );
+    match turn {
+        Some(matrix) => b.node(Node::Rotate {
+            matrix,
+            child: polar,
+        }),
+        None => Ok(Value::Shape(polar)),
+    }
+}
+
 fn rotate(b: &mut Build, child: &Value, axis: V3, angle: f64) -> Result<Value, String> {
     b.node(Node::Rotate {
         matrix: rotation(axis, angle),
@@ -547,6 +599,44 @@ pub static BUILTINS: &[Builtin] = &[
         name: "bend",
         sigs: sigs![
             [shape("shape"), p("rate", F, Req, Any)] -> S => |b, a| b.node(Node::Bend { rate: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    Builtin {
+        name: "repeat_polar",
+        sigs: sigs![
+            [shape("shape"), p("count", I, Req, Within(1.0, 1e6)), p("axis", V, V3([0.0, 1.0, 0.0]), NonZero), p("mirror", B, Bool(false), Any)] -> S
+                => repeat_polar;
+        ],
+    },
+    Builtin {
+        name: "wrap",
+        sigs: sigs![
+            [shape("shape"), p("radius", F, Req, Pos)] -> S => |b, a| b.node(Node::Wrap { radius: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    Builtin {
+        name: "shear",
+        sigs: sigs![
+            [shape("shape"), p("xy", F, Num(0.0), Any), p("xz", F, Num(0.0), Any), p("yx", F, Num(0.0), Any), p("yz", F, Num(0.0), Any), p("zx", F, Num(0.0), Any), p("zy", F, Num(0.0), Any)] -> S => |b, a| {
+                let k = |i: usize| a[i].num();
+                let matrix = [[1.0, k(1), k(2)], [k(3), 1.0, k(4)], [k(5), k(6), 1.0]];
+                if crate::scene::analysis::invert(&matrix).is_none() {
+                    return Err("this shear is singular: it flattens space onto a plane or a line, so the shape has no volume".to_string());
+                }
+                b.node(Node::Shear { matrix, child: sh(&a[0]) })
+            };
+        ],
+    },
+    Builtin {
+        name: "taper",
+        sigs: sigs![
+            [shape("shape"), p("rate", F, Req, Any)] -> S => |b, a| b.node(Node::Taper { rate: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    Builtin {
+        name: "morph",
+        sigs: sigs![
+            [shape("a"), shape("b"), p("t", F, Req, Unit)] -> S => |b, a| b.node(Node::Morph { t: a[2].num(), a: sh(&a[0]), b: sh(&a[1]) });
         ],
     },
     Builtin {

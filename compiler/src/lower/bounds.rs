@@ -250,6 +250,14 @@ impl Bounds {
                 child,
             } => repeat(&get(child)?, period, count.as_ref())?,
             Node::Mirror { axes, child } => mirror(&get(child)?, axes),
+            // Every rotation of the child about y; the lowering keeps its field above the
+            // distance to these volumes where it bounds the copies it leaves out.
+            Node::RepeatPolar { child, .. } => about_axis(&get(child)?, 1),
+            Node::Wrap { radius, child } => wrap(&get(child)?, *radius),
+            Node::Shear { matrix, child } => shear(&get(child)?, matrix),
+            // No volume is proven for a taper's field (f(q)·s stretches unevenly).
+            Node::Taper { .. } => return None,
+            Node::Morph { a, b, .. } => hull(&get(a)?, &get(b)?),
             Node::Twist { child, .. } => about_axis(&get(child)?, 1),
             Node::Bend { child, .. } => about_axis(&get(child)?, 2),
             Node::Elongate { half, child } => elongate(&get(child)?, half),
@@ -329,6 +337,46 @@ fn rotate(b: &Bound, m: &[V3; 3]) -> Bound {
                 .sum()
         });
     }
+    out
+}
+
+/// A wrap: the child's w in [z0, z1] becomes the distance R − w from the y axis, and its
+/// y is kept, so the wrapped shape lies within the box of half-width max |R − w| about the
+/// axis. The distance from a point to that box is at most the child's distance from the
+/// point's preimage (radial and vertical excesses are the same, the box has no angular
+/// one), so the child's guarantee carries over unchanged.
+fn wrap(b: &Bound, radius: f64) -> Bound {
+    if !b.finite() {
+        return unbounded();
+    }
+    let (z0, z1) = (b.aabb.c[2] - b.aabb.h[2], b.aabb.c[2] + b.aabb.h[2]);
+    let rho = (radius - z0).abs().max((radius - z1).abs());
+    let mut out = *b;
+    out.aabb.c = [0.0, b.aabb.c[1], 0.0];
+    out.aabb.h = [rho, b.aabb.h[1], rho];
+    out.sphere = Sphere {
+        c: [0.0, b.aabb.c[1], 0.0],
+        r: rho.hypot(b.aabb.h[1]),
+    };
+    out
+}
+
+/// A shear S whose field the lowering writes f(S⁻¹p)·σmin: the box and sphere mapped by S
+/// (the sphere's radius stretched by σmax), the scale reduced by σmin/σmax (the child's
+/// distance from S⁻¹p is at least the distance from p to the mapped volume over σmax).
+fn shear(b: &Bound, m: &[V3; 3]) -> Bound {
+    if !b.finite() {
+        return unbounded();
+    }
+    let (smin, smax) = crate::scene::analysis::singular_range(m);
+    let mut out = *b;
+    out.aabb.c = mat_vec(m, b.aabb.c);
+    out.aabb.h = [0, 1, 2].map(|i| (0..3).map(|j| m[i][j].abs() * b.aabb.h[j]).sum());
+    out.sphere = Sphere {
+        c: mat_vec(m, b.sphere.c),
+        r: b.sphere.r * smax,
+    };
+    out.scale = b.scale * (smin / smax);
     out
 }
 
@@ -457,6 +505,11 @@ fn own_cost(node: &Node) -> f64 {
         Node::Repeat { .. } => 12.0,
         Node::Mirror { .. } => 3.0,
         Node::Twist { .. } | Node::Bend { .. } => 10.0,
+        Node::RepeatPolar { .. } => 30.0,
+        Node::Wrap { .. } => 16.0,
+        Node::Shear { .. } => 12.0,
+        Node::Taper { .. } => 12.0,
+        Node::Morph { .. } => 4.0,
         Node::Elongate { .. } => 9.0,
         Node::Round { .. } | Node::Shell { .. } => 2.0,
         Node::Paint { .. } => 3.0,

@@ -10,8 +10,8 @@
 use super::bounds::{Aabb, Bound, Bounds};
 use super::builder::{Builder, P};
 use super::bvh::{self, Kind, Tree};
-use super::{shapes, Reg, Unary, EMPTY_DISTANCE};
-use crate::scene::analysis::{Analysis, Window};
+use super::{shapes, Binary, Reg, Unary, EMPTY_DISTANCE};
+use crate::scene::analysis::{self, Analysis, Window};
 use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -183,6 +183,84 @@ impl<'a> Lowerer<'a> {
         }
     }
 
+    /// A polar repetition about y: the copies of the sectors around the point's own, k + j
+    /// for j in the window ([`analysis::polar_window`]), each the child at the point rotated
+    /// back by (k + j)·360°/count (and mirrored across z = 0 for odd copies with `mirror`);
+    /// where the window leaves copies out, the minimum with a lower bound of the distance to
+    /// them: ρ·sin γ, and the distances to the node's bounding volumes, which hold every copy.
+    fn polar(&mut self, id: NodeId, count: u32, mirror: bool, child: NodeId, p: P) -> Field {
+        if count <= 1 {
+            return self.node(child, p);
+        }
+        let step = std::f64::consts::TAU / f64::from(count);
+        let (below, above) = ((count as i64 - 1) / 2, count as i64 / 2);
+        let (lo, hi, beyond) = match self.window(id) {
+            Some(w) if w.beyond.is_finite() => {
+                let r = i64::from(w.reach[0]);
+                (-r, r, Some(w.beyond))
+            }
+            Some(_) => (-below, above, None),
+            // No window: the analysis found none that bounds the field (reported), or there
+            // is no analysis; the sector and its neighbours.
+            None => (-below.min(1), above.min(1), None),
+        };
+        let b = &mut *self.b;
+        let nz = b.neg(p[2]);
+        let phi = b.bin(Binary::Atan2, nz, p[0]);
+        let u = b.mulc(phi, 1.0 / step);
+        let k = b.un(Unary::Round, u);
+        let mut acc: Option<Field> = None;
+        for j in lo..=hi {
+            let b = &mut *self.b;
+            let kj = b.addc(k, j as f64);
+            let theta = b.mulc(kj, step);
+            let (c, s) = (b.un(Unary::Cos, theta), b.un(Unary::Sin, theta));
+            let (x, mut z) = rot2(b, c, s, p[0], p[2]);
+            if mirror {
+                // The copy's parity: kj − 2·⌊kj/2⌋, with ⌊kj/2⌋ = round(kj/2 − 1/4).
+                let half = b.mulc(kj, 0.5);
+                let half = b.subc(half, 0.25);
+                let floor = b.un(Unary::Round, half);
+                let twice = b.mulc(floor, 2.0);
+                let odd = b.sub(kj, twice);
+                let sign = b.mulc(odd, -2.0);
+                let sign = b.addc(sign, 1.0);
+                z = b.mul(z, sign);
+            }
+            let f = self.node(child, [x, p[1], z]);
+            acc = Some(self.fold(acc, f));
+        }
+        self.resume(id, self.graph.node(id));
+        let f = acc.expect("a window holds the own sector");
+        let Some(sin_gamma) = beyond else { return f };
+        let b = &mut *self.b;
+        let rho = b.len2(p[0], p[2]);
+        let mut cap = b.mulc(rho, sin_gamma);
+        if let Some(bound) = self.config.bounds.and_then(|bs| bs.get(id)) {
+            // Every copy lies in both volumes, so their distances are lower bounds too, and
+            // the field stays above them as a bound's guarantee requires.
+            let b = &mut *self.b;
+            let sp = bound.sphere;
+            if sp.r.is_finite() {
+                let q = b.sub3c(p, sp.c);
+                let l = b.len3(q);
+                let pad = 1e-3 * sp.r + 1e-4 * (1.0 + DVec3::from(sp.c).length());
+                let s = b.subc(l, sp.r + pad);
+                let s = shrink(b, s, bound.scale);
+                cap = b.max(cap, s);
+            }
+            let axes: Vec<usize> = (0..3).filter(|&i| bound.aabb.h[i].is_finite()).collect();
+            if !axes.is_empty() {
+                let s = box_distance(b, &bound, &axes, p);
+                cap = b.max(cap, s);
+            }
+        }
+        Field {
+            d: self.b.min(f.d, cap),
+            m: f.m,
+        }
+    }
+
     /// Whether paint and transforms below `id` lead to a plain combination.
     fn spine(&self, mut id: NodeId) -> bool {
         loop {
@@ -269,6 +347,38 @@ impl<'a> Lowerer<'a> {
                 let w = self.window(id).expect("checked");
                 self.windowed(id, *child, *period, *count, w, p)
             }
+            Node::RepeatPolar {
+                count,
+                mirror,
+                child,
+            } => self.polar(id, *count, *mirror, *child, p),
+            Node::Shear { matrix, child } => {
+                // f(S⁻¹p)·σmin(S): a bound with the child's L (docs/analysis.md).
+                let inverse = analysis::invert(matrix).unwrap_or(IDENTITY);
+                let (smin, _) = analysis::singular_range(matrix);
+                let transposed = [0, 1, 2].map(|i| [0, 1, 2].map(|j| inverse[j][i]));
+                let q = rotate(self.b, p, &transposed);
+                self.post(id, *child, q, |b, d| b.mulc(d, smin))
+            }
+            Node::Taper { rate, child } => {
+                // f(x/s, y, z/s)·s with s = 1 + rate·y, clamped above 0 where the taper folds.
+                let b = &mut *self.b;
+                let s = b.mulc(p[1], *rate);
+                let s = b.addc(s, 1.0);
+                let s = b.maxc(s, analysis::TAPER_FLOOR);
+                let q = [b.div(p[0], s), p[1], b.div(p[2], s)];
+                self.post(id, *child, q, |b, d| b.mul(d, s))
+            }
+            Node::Morph { t, a, b } => {
+                let (fa, fb) = (self.node(*a, p), self.node(*b, p));
+                self.resume(id, node);
+                let wa = self.b.mulc(fa.d, 1.0 - t);
+                let wb = self.b.mulc(fb.d, *t);
+                Field {
+                    d: self.b.add(wa, wb),
+                    m: self.material(Combine::Union, fa, fb),
+                }
+            }
             Node::ScaleXyz { factors, child } => {
                 let q = self.b.map3(p, |b, x, i| b.mulc(x, 1.0 / factors[i]));
                 let s = factors.iter().fold(f64::INFINITY, |m, f| m.min(f.abs()));
@@ -334,6 +444,7 @@ impl<'a> Lowerer<'a> {
             ),
             Node::Twist { rate, child } => (*child, twist(b, p, *rate)),
             Node::Bend { rate, child } => (*child, bend(b, p, *rate)),
+            Node::Wrap { radius, child } => (*child, wrap(b, p, *radius)),
             Node::Elongate { half, child } => (*child, elongate(b, p, *half)),
             _ => return None,
         };
@@ -944,6 +1055,19 @@ fn bend(b: &mut Builder, p: P, k: f64) -> P {
     let (x, y) = rot2(b, c, s, p[0], p[1]);
     [x, y, p[2]]
 }
+
+/// The wrap's map to its child: q = (R·atan2(x, −z), y, R − √(x² + z²)).
+fn wrap(b: &mut Builder, p: P, radius: f64) -> P {
+    let nz = b.neg(p[2]);
+    let angle = b.bin(Binary::Atan2, p[0], nz);
+    let u = b.mulc(angle, radius);
+    let rho = b.len2(p[0], p[2]);
+    let w = b.neg(rho);
+    [u, p[1], b.addc(w, radius)]
+}
+
+/// The identity matrix.
+const IDENTITY: [V3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 fn rot2(b: &mut Builder, c: Reg, s: Reg, u: Reg, v: Reg) -> (Reg, Reg) {
     let (cu, sv, su, cv) = (b.mul(c, u), b.mul(s, v), b.mul(s, u), b.mul(c, v));

@@ -117,6 +117,16 @@ impl Simplifier<'_> {
                     b,
                 })
             }
+            Node::Morph { t, a, b } => {
+                let (a, b) = (self.node(a), self.node(b));
+                if !self.parametric && (t == 0.0 || a == b) {
+                    return a;
+                }
+                if !self.parametric && t == 1.0 {
+                    return b;
+                }
+                self.add(Node::Morph { t, a, b })
+            }
             Node::Translate { offset, child } => {
                 let c = self.node(child);
                 self.translate(offset, c)
@@ -186,12 +196,13 @@ impl Simplifier<'_> {
                 }
                 Node::Mirror { axes, child: c }
             }
-            Node::Twist { rate, .. } | Node::Bend { rate, .. }
+            Node::Twist { rate, .. } | Node::Bend { rate, .. } | Node::Taper { rate, .. }
                 if rate == 0.0 && !self.parametric =>
             {
                 return c
             }
             Node::Elongate { half, .. } if half == [0.0; 3] && !self.parametric => return c,
+            Node::RepeatPolar { count: 1, .. } if !self.parametric => return c,
             other => with_child(other, c),
         };
         self.add(node)
@@ -304,7 +315,9 @@ impl Simplifier<'_> {
                 a,
                 ..
             } => self.painted(*a),
-            Node::SmoothCombine { a, b, .. } => self.painted(*a) && self.painted(*b),
+            Node::SmoothCombine { a, b, .. } | Node::Morph { a, b, .. } => {
+                self.painted(*a) && self.painted(*b)
+            }
             node => node.children().first().is_some_and(|&k| {
                 node.children().len() == 1 && !is_primitive(node) && self.painted(k)
             }),

@@ -290,7 +290,17 @@ fn down(node: &Node, m: f64, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
             child,
         } => vec![(*child, m, repeat_region(r, *period, *count))],
         Node::Mirror { axes, child } => vec![(*child, m, fold(r, *axes))],
-        Node::Twist { child, .. } => vec![(*child, m, around(r, 1))],
+        Node::Twist { child, .. } | Node::RepeatPolar { child, .. } => {
+            vec![(*child, m, around(r, 1))]
+        }
+        Node::Wrap { radius, child } => vec![(*child, m, unwrap_region(r, *radius))],
+        Node::Shear { matrix, child } => {
+            let (smin, _) = singular_range(matrix);
+            let inverse = invert(matrix).unwrap_or(IDENTITY);
+            vec![(*child, m / smin.max(1e-12), r.transform(&inverse, false))]
+        }
+        Node::Taper { rate, child } => vec![(*child, m, untaper_region(r, *rate))],
+        Node::Morph { a, b, .. } => vec![(*a, m, r), (*b, m, r)],
         Node::Bend { child, .. } => vec![(*child, m, around(r, 2))],
         Node::Round { radius, child } => vec![(*child, m + radius, r)],
         Node::Shell { thickness, child } => vec![(*child, m + thickness, r)],
@@ -301,6 +311,144 @@ fn down(node: &Node, m: f64, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
         )],
         Node::Paint { child, .. } => vec![(*child, m, r)],
         _ => Vec::new(),
+    }
+}
+
+/// The identity matrix.
+const IDENTITY: [V3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// The inverse of a 3×3 matrix (rows), or `None` when it is singular.
+pub fn invert(m: &[V3; 3]) -> Option<[V3; 3]> {
+    let c = |i: usize, j: usize| {
+        let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+        let (x, y) = ((j + 1) % 3, (j + 2) % 3);
+        m[a][x] * m[b][y] - m[a][y] * m[b][x]
+    };
+    let det = m[0][0] * c(0, 0) + m[0][1] * c(0, 1) + m[0][2] * c(0, 2);
+    if det.abs() < 1e-12 || !det.is_finite() {
+        return None;
+    }
+    // The inverse is the transposed cofactor matrix over the determinant.
+    Some([0, 1, 2].map(|i| [0, 1, 2].map(|j| c(j, i) / det)))
+}
+
+/// The smallest and largest singular values of a 3×3 matrix: the square roots of the
+/// eigenvalues of MᵀM, found by Jacobi rotations (symmetric, so they converge).
+pub fn singular_range(m: &[V3; 3]) -> (f64, f64) {
+    let mut a = [[0.0f64; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            a[i][j] = (0..3).map(|k| m[k][i] * m[k][j]).sum();
+        }
+    }
+    for _ in 0..64 {
+        let (mut p, mut q, mut big) = (0, 1, 0.0);
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            if a[i][j].abs() > big {
+                (p, q, big) = (i, j, a[i][j].abs());
+            }
+        }
+        if big < 1e-15 {
+            break;
+        }
+        let theta = 0.5 * (2.0 * a[p][q]).atan2(a[q][q] - a[p][p]);
+        let (s, c) = theta.sin_cos();
+        let mut r = IDENTITY;
+        r[p][p] = c;
+        r[q][q] = c;
+        r[p][q] = s;
+        r[q][p] = -s;
+        // a ← Rᵀ·a·R
+        let mut t = [[0.0f64; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                t[i][j] = (0..3).map(|k| a[i][k] * r[k][j]).sum();
+            }
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i][j] = (0..3).map(|k| r[k][i] * t[k][j]).sum();
+            }
+        }
+    }
+    let eig = [a[0][0], a[1][1], a[2][2]].map(|e| e.max(0.0).sqrt());
+    let lo = eig.iter().fold(f64::INFINITY, |x, e| x.min(*e));
+    let hi = eig.iter().fold(0.0f64, |x, e| x.max(*e));
+    (lo, hi)
+}
+
+/// The region a wrap's child is read in: u = R·angle within ±π·R, y kept, w = R − ρ for ρ
+/// from 0 to the region's farthest distance from the y axis.
+fn unwrap_region(r: Aabb, radius: f64) -> Aabb {
+    let rho = r.radius(0, 2);
+    Aabb {
+        min: [-std::f64::consts::PI * radius, r.min[1], radius - rho],
+        max: [std::f64::consts::PI * radius, r.max[1], radius],
+    }
+}
+
+/// The region a taper's child is read in: (x, z) divided by 1 + rate·y, which is at least
+/// the smallest positive factor over the region's heights (clamped as the lowering clamps).
+fn untaper_region(r: Aabb, rate: f64) -> Aabb {
+    let s = taper_floor(rate, r.min[1], r.max[1]);
+    r.map(|i, lo, hi| if i == 1 { (lo, hi) } else { (lo / s, hi / s) })
+        .union(r)
+}
+
+/// The smallest factor 1 + rate·y a taper divides by over heights y0 … y1: the factor there,
+/// but never below [`TAPER_FLOOR`] (where the factor falls below it the lowering clamps it).
+pub fn taper_floor(rate: f64, y0: f64, y1: f64) -> f64 {
+    let s = (1.0 + rate * y0).min(1.0 + rate * y1);
+    if s.is_finite() {
+        s.max(TAPER_FLOOR)
+    } else {
+        TAPER_FLOOR
+    }
+}
+
+/// The smallest scale factor of a taper: below it (the cross-section shrunk to a point and
+/// beyond, where the taper folds) the factor is clamped.
+pub const TAPER_FLOOR: f64 = 1e-3;
+
+/// The angle ±α about y, in the sense of `rotate_y`, within which a box lies; π when it
+/// reaches the y axis or beyond (on the side x ≤ 0).
+pub fn angular_half_extent(b: &Aabb) -> f64 {
+    if b.is_empty() || !(b.min[0] > 0.0) || !b.is_bounded() {
+        return std::f64::consts::PI;
+    }
+    let mut alpha = 0.0f64;
+    for x in [b.min[0], b.max[0]] {
+        for z in [b.min[2], b.max[2]] {
+            alpha = alpha.max(z.atan2(x).abs());
+        }
+    }
+    alpha
+}
+
+/// The copies a polar repetition of `count` copies evaluates around the point's own sector,
+/// for a child within ±`alpha` of angle 0: `reach[0]` sectors on each side, and `beyond` the
+/// factor sin γ with γ = (2r + 1)·π/count − α, so that ρ·sin γ (ρ the distance from the
+/// axis) is a lower bound of the distance to every copy outside the window (infinite when
+/// the window holds every copy). `docs/analysis.md`, "Polar repetition", derives it.
+pub fn polar_window(count: u32, alpha: f64) -> Window {
+    let n = f64::from(count);
+    let sector = std::f64::consts::PI / n;
+    // The least r ≥ 1 with (2r + 1)·π/n > α, plus a sliver, so that γ is not 0.
+    let mut r = ((alpha / sector - 1.0) * 0.5).floor() + 1.0;
+    r = r.max(1.0);
+    if (2.0 * r + 1.0) * sector - alpha < 1e-6 {
+        r += 1.0;
+    }
+    if 2.0 * r + 1.0 >= n {
+        return Window {
+            reach: [(count / 2).max(1), 0, 0],
+            beyond: f64::INFINITY,
+        };
+    }
+    let gamma = ((2.0 * r + 1.0) * sector - alpha).min(std::f64::consts::FRAC_PI_2);
+    Window {
+        reach: [r as u32, 0, 0],
+        beyond: gamma.sin(),
     }
 }
 
@@ -476,6 +624,25 @@ impl Pass<'_> {
                 child,
             } => self.repeat(id, *period, *count, *child),
             Node::Mirror { axes, child } => self.mirror(*axes, *child),
+            Node::RepeatPolar { count, child, .. } => self.polar(id, *count, *child),
+            Node::Wrap { radius, child } => self.wrap(id, *radius, *child),
+            Node::Shear { matrix, child } => self.shear(id, matrix, *child),
+            Node::Taper { rate, child } => self.taper(id, *rate, *child),
+            Node::Morph { a, b, .. } => {
+                // A convex combination of L-Lipschitz fields is L-Lipschitz, so f / L is a
+                // bound of its own zero set; the solid lies where either operand's does.
+                let (da, db) = (self.get(*a), self.get(*b));
+                let mut d = merge(&[da, db]);
+                d.facts.exactness = Exactness::Approximate;
+                if d.gradient.is_finite() {
+                    d.facts.lipschitz = d.facts.lipschitz.max(d.gradient);
+                    d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+                } else if d.proven {
+                    d = unproven(d, id);
+                }
+                d.bounds = da.bounds.union(db.bounds);
+                d
+            }
             Node::Twist { rate, child } => self.distort(id, *rate, *child, 1),
             Node::Bend { rate, child } => self.distort(id, *rate, *child, 2),
             Node::Round { radius, child } => self.offset(id, *child, *radius),
@@ -684,6 +851,161 @@ impl Pass<'_> {
             self.warn_unbounded(id, what, sigma, rho);
         } else if sigma >= WARN_STRETCH {
             self.warn_stretch(id, what, rate, rho, sigma);
+        }
+        d
+    }
+
+    /// Polar repetition: the copies in the point's sector and its neighbours, enough of them
+    /// that every copy left out is farther than ρ·sin γ ([`polar_window`]); the minimum with
+    /// that is a bound, exact wherever the nearest copy is in the window and nearer than it.
+    /// The window counts towards [`MAX_WINDOW_CELLS`] like a repetition's.
+    fn polar(&mut self, id: NodeId, count: u32, child: NodeId) -> Derived {
+        let c = self.get(child);
+        if count <= 1 || c.bounds.is_empty() {
+            return c;
+        }
+        let margin = self.usage.margin[id.0 as usize];
+        let extent = c.bounds.grow(c.growth * margin);
+        let w = polar_window(count, angular_half_extent(&extent));
+        let mut d = at_most_bound(c);
+        let rb = c.bounds.radius(0, 2);
+        d.bounds = c
+            .bounds
+            .map(|j, lo, hi| if j == 1 { (lo, hi) } else { (-rb, rb) });
+        d.symmetric = [false, c.symmetric[1], false];
+        let cells = w.cells().min(count);
+        if cells * self.copies[child.0 as usize] > MAX_WINDOW_CELLS {
+            self.warn_polar(id, count, cells);
+            return unproven(d, id);
+        }
+        self.windows[id.0 as usize] = Some(w);
+        d
+    }
+
+    /// Wrap: the map from space to the child stretches arcs at distance ρ from the axis by
+    /// R/ρ; over the child's surface (w ≤ w_max, so ρ ≥ R − w_max) that is at most
+    /// σ = R/(R − w_max), and `f/(σ·L)` is a bound. A child reaching the axis (w_max ≥ R)
+    /// or longer than the circle (|u| > π·R) folds (W0014).
+    fn wrap(&mut self, id: NodeId, radius: f64, child: NodeId) -> Derived {
+        let c = self.get(child);
+        if c.bounds.is_empty() {
+            return c;
+        }
+        let extent = c.bounds.grow(c.growth * self.usage.margin[id.0 as usize]);
+        let mut d = c;
+        let rho = (radius - c.bounds.min[2])
+            .abs()
+            .max((radius - c.bounds.max[2]).abs());
+        d.bounds = Aabb {
+            min: [-rho, c.bounds.min[1], -rho],
+            max: [rho, c.bounds.max[1], rho],
+        };
+        d.symmetric = [true, c.symmetric[1], false];
+        let inner = radius - extent.max[2];
+        let long = extent.min[0] < -std::f64::consts::PI * radius - TOLERANCE
+            || extent.max[0] > std::f64::consts::PI * radius + TOLERANCE;
+        if !(inner > 0.0) || long {
+            let how = if long {
+                format!(
+                    "the shape spans {} … {} on x, more than the circle's length 2π·{} = {}",
+                    fmt(extent.min[0]),
+                    fmt(extent.max[0]),
+                    fmt(radius),
+                    fmt(2.0 * std::f64::consts::PI * radius)
+                )
+            } else {
+                format!(
+                    "the shape reaches z = {}, across the wrap's axis at z = {}",
+                    fmt(extent.max[2]),
+                    fmt(radius)
+                )
+            };
+            self.warn_fold(
+                id,
+                "wrap",
+                how,
+                "wrap a shape that lies within −π·radius … π·radius on x and below z = radius",
+            );
+            return unproven(d, id);
+        }
+        let sigma = (radius / inner).max(1.0);
+        d.growth *= sigma;
+        d.facts.lipschitz *= sigma;
+        d.gradient *= sigma;
+        d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+        if sigma > 1.0 && d.proven {
+            d.cause = Some(id);
+        }
+        d
+    }
+
+    /// Shear S: the lowering multiplies f(S⁻¹p) by σmin(S), which makes it a bound with the
+    /// child's L (the map S⁻¹ stretches by at most 1/σmin); it underestimates by up to
+    /// σmax/σmin, reported like a scale's ratio (W0007).
+    fn shear(&mut self, id: NodeId, matrix: &[V3; 3], child: NodeId) -> Derived {
+        let c = self.get(child);
+        let mut d = at_most_bound(c);
+        let (smin, smax) = singular_range(matrix);
+        d.bounds = c.bounds.transform(matrix, false);
+        d.symmetric = [false; 3];
+        let ratio = smax / smin;
+        d.growth *= ratio;
+        if ratio >= WARN_SCALE_RATIO {
+            self.warn_scale(id, [smin, smax, smax], ratio);
+        }
+        d
+    }
+
+    /// Taper: f(q)·s with q = (x/s, y, z/s), s = 1 + rate·y. Near the surface the gradient is
+    /// s·Jᵀ∇f, and s·J is diag(1, s, 1) plus a column of norm |rate|·ρ_q (ρ_q the child's
+    /// distance from the y axis), so σ = max(1, s_max) + |rate|·ρ_q; `f/(σ·L)` is a bound
+    /// there. Where s ≤ 0 over the child's heights the taper folds (W0014).
+    fn taper(&mut self, id: NodeId, rate: f64, child: NodeId) -> Derived {
+        let c = self.get(child);
+        if rate == 0.0 || c.bounds.is_empty() {
+            return c;
+        }
+        let extent = c.bounds.grow(c.growth * self.usage.margin[id.0 as usize]);
+        let (y0, y1) = (extent.min[1], extent.max[1]);
+        let s_lo = (1.0 + rate * y0).min(1.0 + rate * y1);
+        let s_hi = (1.0 + rate * y0).max(1.0 + rate * y1);
+        let mut d = c;
+        d.bounds = c.bounds.map(|j, lo, hi| {
+            if j == 1 {
+                (lo, hi)
+            } else {
+                (lo * s_hi.max(0.0), hi * s_hi.max(0.0))
+            }
+        });
+        d.symmetric = [c.symmetric[0], false, c.symmetric[2]];
+        if !(s_lo > TAPER_FLOOR) {
+            self.warn_fold(
+                id,
+                "taper",
+                format!(
+                    "its scale 1 + rate·y falls to {} over the shape's heights {} … {}",
+                    fmt(s_lo),
+                    fmt(y0),
+                    fmt(y1)
+                ),
+                "lower the rate so that 1 + rate·y stays above 0 over the shape",
+            );
+            return unproven(d, id);
+        }
+        let rho = extent.radius(0, 2);
+        let sigma = s_hi.max(1.0) + rate.abs() * rho;
+        if !sigma.is_finite() {
+            return unproven(d, id);
+        }
+        d.growth *= sigma;
+        d.facts.lipschitz *= sigma;
+        d.gradient *= sigma;
+        d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+        if d.proven {
+            d.cause = Some(id);
+        }
+        if sigma >= WARN_STRETCH {
+            self.warn_stretch(id, "taper", rate, rho, sigma);
         }
         d
     }

@@ -256,6 +256,24 @@ fn node(n: &Node) -> String {
                 .collect();
             format!("mirror {a} %{}", child.0)
         }
+        Node::RepeatPolar {
+            count,
+            mirror,
+            child,
+        } => {
+            let m = if *mirror { " mirror" } else { "" };
+            format!("repeat_polar count={count}{m} %{}", child.0)
+        }
+        Node::Wrap { radius, child } => format!("wrap {} %{}", num(*radius), child.0),
+        Node::Shear { matrix, child } => format!(
+            "shear [{}, {}, {}] %{}",
+            v3(matrix[0]),
+            v3(matrix[1]),
+            v3(matrix[2]),
+            child.0
+        ),
+        Node::Taper { rate, child } => format!("taper {} %{}", num(*rate), child.0),
+        Node::Morph { t, a, b } => format!("morph t={} %{}, %{}", num(*t), a.0, b.0),
         Node::Twist { rate, child } => format!("twist {} %{}", num(*rate), child.0),
         Node::Bend { rate, child } => format!("bend {} %{}", num(*rate), child.0),
         Node::Round { radius, child } => format!("round {} %{}", num(*radius), child.0),

@@ -106,12 +106,32 @@ pub enum Node {
         count: Option<V3>,
         child: NodeId,
     },
+    /// Polar repetition about the y axis: `count` copies of the child, the child itself at
+    /// angle 0 and the others rotated about y by multiples of 360°/count (as `rotate_y`
+    /// rotates); with `mirror`, every other copy mirrored across its own plane z = 0 (the
+    /// count is then even). The builtin turns other axes into rotations around this node.
+    RepeatPolar {
+        count: u32,
+        mirror: bool,
+        child: NodeId,
+    },
     /// Mirror across the planes x = 0, y = 0, z = 0 where set.
     Mirror { axes: [bool; 3], child: NodeId },
     /// Twist about y by `rate` radians per unit of height.
     Twist { rate: f64, child: NodeId },
     /// Bend in the xy plane by `rate` radians per unit of x.
     Bend { rate: f64, child: NodeId },
+    /// The child's x axis wrapped around the circle of `radius` about the y axis (in the xz
+    /// plane, through (0, 0, −radius)): the child's point (u, y, w) goes to
+    /// ((radius − w)·sin(u/radius), y, −(radius − w)·cos(u/radius)), so that a bar of length
+    /// 2π·radius along x closes into a ring.
+    Wrap { radius: f64, child: NodeId },
+    /// A linear shear: the child's point p goes to `matrix`·p (rows; ones on the diagonal).
+    Shear { matrix: [V3; 3], child: NodeId },
+    /// The child's cross-sections (x, z) scaled by 1 + rate·y at height y.
+    Taper { rate: f64, child: NodeId },
+    /// The field (1 − t)·a + t·b: a shape between `a` (t = 0) and `b` (t = 1).
+    Morph { t: f64, a: NodeId, b: NodeId },
     /// Child's surface offset outwards by a radius.
     Round { radius: f64, child: NodeId },
     /// Hollow shell of a thickness around the child's surface (onion).
@@ -131,9 +151,13 @@ macro_rules! one_child {
             | Node::Scale { $child, .. }
             | Node::ScaleXyz { $child, .. }
             | Node::Repeat { $child, .. }
+            | Node::RepeatPolar { $child, .. }
             | Node::Mirror { $child, .. }
             | Node::Twist { $child, .. }
             | Node::Bend { $child, .. }
+            | Node::Wrap { $child, .. }
+            | Node::Shear { $child, .. }
+            | Node::Taper { $child, .. }
             | Node::Round { $child, .. }
             | Node::Shell { $child, .. }
             | Node::Elongate { $child, .. }
@@ -146,7 +170,7 @@ impl Node {
     pub fn children(&self) -> Vec<NodeId> {
         match self {
             Node::Combine { children, .. } => children.clone(),
-            Node::SmoothCombine { a, b, .. } => vec![*a, *b],
+            Node::SmoothCombine { a, b, .. } | Node::Morph { a, b, .. } => vec![*a, *b],
             one_child!(child) => vec![*child],
             _ => Vec::new(),
         }
@@ -181,9 +205,14 @@ impl Node {
             Node::Scale { .. } => "scale",
             Node::ScaleXyz { .. } => "scale_xyz",
             Node::Repeat { .. } => "repeat",
+            Node::RepeatPolar { .. } => "repeat_polar",
             Node::Mirror { .. } => "mirror",
             Node::Twist { .. } => "twist",
             Node::Bend { .. } => "bend",
+            Node::Wrap { .. } => "wrap",
+            Node::Shear { .. } => "shear",
+            Node::Taper { .. } => "taper",
+            Node::Morph { .. } => "morph",
             Node::Round { .. } => "round",
             Node::Shell { .. } => "shell",
             Node::Elongate { .. } => "elongate",

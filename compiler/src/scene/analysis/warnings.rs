@@ -1,4 +1,4 @@
-//! The warnings of the analysis (W0002–W0007): constructs that make the field unreliable,
+//! The warnings of the analysis (W0002–W0007, W0014): constructs that make the field unreliable,
 //! reported once per code and source span, for nodes the scene's root reaches.
 
 use super::{fmt, Pass, MAX_STEP_LIPSCHITZ};
@@ -51,7 +51,7 @@ impl Pass<'_> {
             format!("this {what} stretches distances up to {}-fold", fmt(sigma)),
             format!("rate {} at {} from its axis", fmt(rate), fmt(rho)),
             vec![
-                format!("the {} field is then only {}-Lipschitz: the operand that holds it is divided by its own L (local bounds, docs/analysis.md), so rays within that operand's bounding volume take steps divided by its L, and the rest of the scene steps as before", if what == "twist" { "twisted" } else { "bent" }, fmt(sigma)),
+                format!("the {} field is then only {}-Lipschitz: the operand that holds it is divided by its own L (local bounds, docs/analysis.md), so rays within that operand's bounding volume take steps divided by its L, and the rest of the scene steps as before", match what { "twist" => "twisted", "bend" => "bent", _ => "tapered" }, fmt(sigma)),
             ],
             &format!("lower the rate, or {what} a narrower shape"),
         );
@@ -108,6 +108,30 @@ impl Pass<'_> {
             format!("factors ({}, {}, {})", fmt(s[0]), fmt(s[1]), fmt(s[2])),
             vec![format!("a per-axis scale multiplies the field by its smallest factor: a bound that underestimates distances up to {}-fold along the stretched axes, so rays approaching that way take up to {} times more steps and may run out of them", fmt(ratio), fmt(ratio))],
             "build the shape at its final size instead (a box's half-extents, an ellipsoid's radii)",
+        );
+    }
+
+    /// A deformation that maps several points of space to one point of its shape, or none
+    /// (W0014): `what` is the deformation, `how` says where.
+    pub(super) fn warn_fold(&mut self, id: NodeId, what: &str, how: String, help: &str) {
+        self.warn(
+            "W0014",
+            id,
+            format!("this {what} folds space over itself"),
+            how,
+            vec![format!("where the {what} folds, two parts of the shape land on one another or the shape is cut off; the field there is no longer a distance, and rays may step through surfaces")],
+            help,
+        );
+    }
+
+    pub(super) fn warn_polar(&mut self, id: NodeId, count: u32, cells: u32) {
+        self.warn(
+            "W0005",
+            id,
+            "the repeated shape reaches too far out of its sector".into(),
+            format!("{count} copies, of which {cells} would be evaluated per point"),
+            vec![format!("a polar repetition evaluates the copies whose sectors the shape reaches into, at most {} per point (with the repetitions nested in it); beyond that only the nearest copies are evaluated and the field can overstate the distance", super::MAX_WINDOW_CELLS)],
+            "make the shape narrower around the axis, or use fewer copies",
         );
     }
 }

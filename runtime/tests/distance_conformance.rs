@@ -119,7 +119,8 @@ fn scenes(dir: &str) -> Vec<Case> {
 
 /// The feature scenes (`tests/in/feature`, one feature each), the scenes that combine
 /// features for an evaluator (`tests/in/conformance`: every primitive the instance walk
-/// knows), then 40 random scenes of 1 to 6 primitives.
+/// knows; issue 33's primitives and blends moved and rotated), then 40 random scenes of 1
+/// to 6 primitives.
 fn cases() -> Vec<Case> {
     let mut cases = scenes("feature");
     assert!(cases.len() >= 25, "{} feature scenes", cases.len());
@@ -596,8 +597,21 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "cone",
         "ellipsoid",
         "mandelbulb",
+        "capped_cone",
+        "round_cone",
+        "segment",
+        "rounded_cylinder",
+        "hex_prism",
+        "tri_prism",
+        "octahedron",
+        "pyramid",
+        "box_frame",
+        "link",
+        "infinite_cylinder",
+        "slab",
         "combine",
         "smooth_combine",
+        "feature",
         "translate",
         "rotate",
         "scale",
@@ -643,8 +657,21 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Cone { .. } => "cone",
         Node::Ellipsoid { .. } => "ellipsoid",
         Node::Mandelbulb { .. } => "mandelbulb",
+        Node::CappedCone { .. } => "capped_cone",
+        Node::RoundCone { .. } => "round_cone",
+        Node::Segment { .. } => "segment",
+        Node::RoundedCylinder { .. } => "rounded_cylinder",
+        Node::HexPrism { .. } => "hex_prism",
+        Node::TriPrism { .. } => "tri_prism",
+        Node::Octahedron { .. } => "octahedron",
+        Node::Pyramid { .. } => "pyramid",
+        Node::BoxFrame { .. } => "box_frame",
+        Node::Link { .. } => "link",
+        Node::InfiniteCylinder { .. } => "infinite_cylinder",
+        Node::Slab { .. } => "slab",
         Node::Combine { .. } => "combine",
         Node::SmoothCombine { .. } => "smooth_combine",
+        Node::Feature { .. } => "feature",
         Node::Translate { .. } => "translate",
         Node::Rotate { .. } => "rotate",
         Node::Scale { .. } => "scale",

@@ -28,8 +28,9 @@ use std::path::{Path, PathBuf};
 
 /// The most lines of one snapshot.
 const SNAPSHOT_LINES: usize = 400;
-/// The most lines of all snapshots together.
-const ALL_SNAPSHOTS_LINES: usize = 15_000;
+/// The most lines of all snapshots together (raised from 15 000 by issue 33's primitives and
+/// blends, about 2 300 lines of feature scenes).
+const ALL_SNAPSHOTS_LINES: usize = 17_500;
 
 /// The feature scenes whose distance over points is snapshotted as PTX: between them every
 /// operation of the distance program (the sum of squares and square root of a sphere,

@@ -3,7 +3,7 @@
 
 use super::types::{Type, Value};
 use crate::limits::{Limit, Limits};
-use crate::scene::{Camera, Combine, Graph, Material, Node, NodeId, Settings, Smooth, V3};
+use crate::scene::{Camera, Combine, Feature, Graph, Material, Node, NodeId, Settings, Smooth, V3};
 use crate::span::Span;
 
 /// A parameter's default value.
@@ -220,11 +220,19 @@ fn len(a: &[Value]) -> Result<Value, String> {
     }
 }
 
-const SMOOTH_VARIANTS: &[&str] = &["poly", "exp"];
+const SMOOTH_VARIANTS: &[&str] = &["poly", "exp", "chamfer", "round", "stairs", "columns"];
 
 fn smooth(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
+    let steps = a[4].num() as u32;
     let variant = match &a[3] {
-        Value::Str(s) if &**s == "exp" => Smooth::Exp,
+        Value::Str(s) => match &**s {
+            "exp" => Smooth::Exp,
+            "chamfer" => Smooth::Chamfer,
+            "round" => Smooth::Round,
+            "stairs" => Smooth::Stairs(steps),
+            "columns" => Smooth::Columns(steps),
+            _ => Smooth::Poly,
+        },
         _ => Smooth::Poly,
     };
     b.node(Node::SmoothCombine {
@@ -234,6 +242,20 @@ fn smooth(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
         a: sh(&a[1]),
         b: sh(&a[2]),
     })
+}
+
+fn feature(b: &mut Build, a: &[Value], op: Feature) -> Result<Value, String> {
+    b.node(Node::Feature {
+        op,
+        a: sh(&a[0]),
+        b: sh(&a[1]),
+    })
+}
+
+/// `v` scaled to unit length (`v` is not zero: its range says so).
+fn unit(v: V3) -> V3 {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|x| x / len)
 }
 
 fn rotation(axis: V3, angle: f64) -> [V3; 3] {
@@ -393,6 +415,16 @@ macro_rules! sigs {
 /// constant, parameter or loop variable of that name hides it.
 pub const TIME: &str = "t";
 
+/// The built-in constants, read like `t`: a constant, parameter or loop variable of the
+/// same name hides them.
+pub const CONSTANTS: &[(&str, f64)] =
+    &[("pi", std::f64::consts::PI), ("tau", std::f64::consts::TAU)];
+
+/// The value of the built-in constant `name`, if it is one.
+pub fn constant(name: &str) -> Option<f64> {
+    CONSTANTS.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
+}
+
 /// Every builtin function.
 pub static BUILTINS: &[Builtin] = &[
     // Primitives.
@@ -477,6 +509,122 @@ pub static BUILTINS: &[Builtin] = &[
             };
         ],
     },
+    Builtin {
+        name: "capped_cone",
+        sigs: sigs![
+            [p("height", F, Num(1.0), Pos), p("bottom", F, Num(0.5), NonNeg), p("top", F, Num(0.25), NonNeg)] -> S => |b, a| {
+                let (bottom, top) = (a[1].num(), a[2].num());
+                if bottom == 0.0 && top == 0.0 {
+                    return Err("`bottom` and `top` are both 0: the cone has no volume".to_string());
+                }
+                b.node(Node::CappedCone { half_height: a[0].num() / 2.0, bottom, top })
+            };
+        ],
+    },
+    Builtin {
+        name: "round_cone",
+        sigs: sigs![
+            [p("bottom", F, Num(0.5), NonNeg), p("top", F, Num(0.25), NonNeg), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
+                let (bottom, top, height) = (a[0].num(), a[1].num(), a[2].num());
+                if bottom == 0.0 && top == 0.0 {
+                    return Err("`bottom` and `top` are both 0: the cone has no volume".to_string());
+                }
+                if (bottom - top).abs() >= height {
+                    return Err(format!(
+                        "the radii differ by {} but the height is {height}: one sphere would hold the other (a round cone needs |bottom - top| < height)",
+                        crate::scene::dump_num((bottom - top).abs())
+                    ));
+                }
+                b.node(Node::RoundCone { bottom, top, half_height: height / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "segment",
+        sigs: sigs![
+            [p("a", V, Req, Any), p("b", V, Req, Any), p("radius", F, Num(0.25), Pos)] -> S => |b, a| {
+                b.node(Node::Segment { a: a[0].v3(), b: a[1].v3(), radius: a[2].num() })
+            };
+        ],
+    },
+    Builtin {
+        name: "rounded_cylinder",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("round", F, Num(0.1), NonNeg), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
+                let (radius, round, height) = (a[0].num(), a[1].num(), a[2].num());
+                if round > radius || round > height / 2.0 {
+                    return Err(format!("the rounding {round} is larger than the radius or half the height"));
+                }
+                b.node(Node::RoundedCylinder { radius, round, half_height: height / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "hex_prism",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
+                b.node(Node::HexPrism { radius: a[0].num(), half_height: a[1].num() / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "tri_prism",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
+                b.node(Node::TriPrism { radius: a[0].num(), half_height: a[1].num() / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "octahedron",
+        sigs: sigs![
+            [p("radius", F, Num(1.0), Pos)] -> S => |b, a| b.node(Node::Octahedron { radius: a[0].num() });
+        ],
+    },
+    Builtin {
+        name: "pyramid",
+        sigs: sigs![
+            [p("base", F, Num(1.0), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
+                b.node(Node::Pyramid { base: a[0].num(), height: a[1].num() })
+            };
+        ],
+    },
+    Builtin {
+        name: "box_frame",
+        sigs: sigs![
+            [p("half", V, V3([0.5, 0.5, 0.5]), Pos), p("edge", F, Num(0.05), Pos)] -> S => |b, a| {
+                let (half, edge) = (a[0].v3(), a[1].num());
+                if half.iter().any(|&h| h < edge) {
+                    return Err(format!("the edge {edge} is larger than a half-extent of the frame"));
+                }
+                b.node(Node::BoxFrame { half, edge })
+            };
+        ],
+    },
+    Builtin {
+        name: "link",
+        sigs: sigs![
+            [p("length", F, Num(1.0), NonNeg), p("major", F, Num(0.5), Pos), p("minor", F, Num(0.1), Pos)] -> S => |b, a| {
+                b.node(Node::Link { half_length: a[0].num() / 2.0, major: a[1].num(), minor: a[2].num() })
+            };
+        ],
+    },
+    Builtin {
+        name: "infinite_cylinder",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("axis", V, V3([0.0, 1.0, 0.0]), NonZero)] -> S => |b, a| {
+                b.node(Node::InfiniteCylinder { radius: a[0].num(), axis: unit(a[1].v3()) })
+            };
+        ],
+    },
+    Builtin {
+        name: "slab",
+        sigs: sigs![
+            [p("thickness", F, Num(1.0), Pos), p("normal", V, V3([0.0, 1.0, 0.0]), NonZero)] -> S => |b, a| {
+                b.node(Node::Slab { thickness: a[0].num(), normal: unit(a[1].v3()) })
+            };
+        ],
+    },
     // Combinators.
     Builtin {
         name: "union",
@@ -501,26 +649,54 @@ pub static BUILTINS: &[Builtin] = &[
     Builtin {
         name: "smooth_union",
         sigs: sigs![
-            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Union);
-            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth_list(b, a, Combine::Union, "smooth_union");
         ],
     },
     Builtin {
         name: "smooth_intersect",
         sigs: sigs![
-            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Intersect);
-            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth_list(b, a, Combine::Intersect, "smooth_intersect");
         ],
     },
     Builtin {
         name: "smooth_subtract",
         sigs: sigs![
-            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS))] -> S
+            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Subtract);
+        ],
+    },
+    Builtin {
+        name: "engrave",
+        sigs: sigs![
+            [shape("a"), shape("b"), p("depth", F, Req, Pos)] -> S
+                => |b, a| feature(b, a, Feature::Engrave { depth: a[2].num() });
+        ],
+    },
+    Builtin {
+        name: "groove",
+        sigs: sigs![
+            [shape("a"), shape("b"), p("width", F, Req, Pos), p("depth", F, Req, Pos)] -> S
+                => |b, a| feature(b, a, Feature::Groove { width: a[2].num(), depth: a[3].num() });
+        ],
+    },
+    Builtin {
+        name: "tongue",
+        sigs: sigs![
+            [shape("a"), shape("b"), p("width", F, Req, Pos), p("height", F, Req, Pos)] -> S
+                => |b, a| feature(b, a, Feature::Tongue { width: a[2].num(), height: a[3].num() });
+        ],
+    },
+    Builtin {
+        name: "pipe",
+        sigs: sigs![
+            [shape("a"), shape("b"), p("radius", F, Req, Pos)] -> S
+                => |b, a| feature(b, a, Feature::Pipe { radius: a[2].num() });
         ],
     },
     // Transforms.

@@ -524,6 +524,10 @@ impl Ctx {
             self.read_time(id.span);
             return Value::Float(self.time);
         }
+        // The built-in constants (pi, tau), unless a name of this file hides them.
+        if let Some(v) = builtins::constant(&id.name) {
+            return Value::Float(v);
+        }
         let mut d = Diagnostic::error("E0200", format!("unknown name `{}`", id.name), id.span)
             .with_label("not defined");
         if self.fns.contains_key(&id.name) || builtins::builtin(&id.name).is_some() {
@@ -549,6 +553,7 @@ impl Ctx {
             .iter()
             .map(|(n, _)| n.as_str())
             .chain(self.globals.keys().map(String::as_str))
+            .chain(builtins::CONSTANTS.iter().map(|(n, _)| *n))
             .collect();
         closest(name, names).map(str::to_string)
     }

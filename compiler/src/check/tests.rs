@@ -385,3 +385,18 @@ fn smooth_lists_fold_from_the_left() {
         &Node::Sphere { radius: 1.0 }
     );
 }
+
+#[test]
+fn pi_and_tau_are_constants_a_name_of_the_file_hides() {
+    let s = ok("scene { sphere(pi / 4 + tau); }");
+    let want = std::f64::consts::PI / 4.0 + std::f64::consts::TAU;
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: want }
+    );
+    let s = ok("let pi = 3;\nfn r(tau: float) -> float { tau }\nscene { sphere(pi + r(1)); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 4.0 }
+    );
+}

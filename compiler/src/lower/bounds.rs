@@ -231,6 +231,66 @@ impl Bounds {
             Node::Ellipsoid { radii } => ellipsoid(*radii),
             // f ≥ |p| - 2 beyond radius 2, and f ≥ -0.5/e everywhere (see the docs).
             Node::Mandelbulb { .. } => Bound::of_sphere(2.2),
+            Node::CappedCone {
+                half_height,
+                bottom,
+                top,
+            } => {
+                let r = bottom.max(*top);
+                Bound::of_box([r, *half_height, r], r.hypot(*half_height))
+            }
+            Node::RoundCone {
+                bottom,
+                top,
+                half_height,
+            } => {
+                let r = bottom.max(*top);
+                Bound::of_box([r, half_height + r, r], half_height + r)
+            }
+            Node::Segment { a, b, radius } => {
+                let c = [0, 1, 2].map(|i| (a[i] + b[i]) * 0.5);
+                let h = [0, 1, 2].map(|i| (b[i] - a[i]).abs() * 0.5 + radius);
+                let l = DVec3::from(*b).distance(DVec3::from(*a)) * 0.5;
+                Bound::of_box(h, l + radius).similar(1.0, c)
+            }
+            Node::RoundedCylinder {
+                radius,
+                half_height,
+                ..
+            } => Bound::of_box([*radius, *half_height, *radius], radius.hypot(*half_height)),
+            Node::HexPrism {
+                radius,
+                half_height,
+            } => {
+                let corner = radius * 2.0 / 3f64.sqrt();
+                Bound::of_box([corner, *half_height, *radius], corner.hypot(*half_height))
+            }
+            Node::TriPrism {
+                radius,
+                half_height,
+            } => {
+                // From z = -r to the corner at z = 2r, x within ±√3·r: about (0, 0, r/2).
+                let h = [3f64.sqrt() * radius, *half_height, 1.5 * radius];
+                let far = (5.25f64.sqrt() * radius).hypot(*half_height);
+                Bound::of_box(h, far).similar(1.0, [0.0, 0.0, 0.5 * radius])
+            }
+            Node::Octahedron { radius } => Bound::of_box([*radius; 3], *radius),
+            Node::Pyramid { base, height } => {
+                let (b, h) = (base * 0.5, height * 0.5);
+                let far = (2.0 * b * b + h * h).sqrt();
+                Bound::of_box([b, h, b], far)
+            }
+            Node::BoxFrame { half, .. } => Bound::of_box(*half, DVec3::from(*half).length()),
+            Node::Link {
+                half_length,
+                major,
+                minor,
+            } => {
+                let r = major + minor;
+                Bound::of_box([r, half_length + r, *minor], half_length + r)
+            }
+            Node::InfiniteCylinder { .. } | Node::Slab { .. } => return None,
+            Node::Feature { op, a, .. } => get(a)?.grow(op.outset()),
             Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
             Node::SmoothCombine {
                 op,
@@ -297,7 +357,8 @@ fn combine(op: Combine, mut kids: impl Iterator<Item = Option<Bound>>) -> Option
 }
 
 /// A smooth union is at least min(a, b) minus its largest correction (k/4 for the
-/// polynomial, k·ln 2 for the exponential); a smooth maximum is at least the maximum.
+/// polynomial, k·ln 2 for the exponential, hg_sdf's variants' `blend_reach`); a smooth
+/// maximum is at least the maximum.
 fn smooth(op: Combine, k: f64, v: Smooth, a: Option<Bound>, b: Option<Bound>) -> Option<Bound> {
     match op {
         Combine::Union => {
@@ -306,6 +367,7 @@ fn smooth(op: Combine, k: f64, v: Smooth, a: Option<Bound>, b: Option<Bound>) ->
                 _ if k <= 0.0 => 0.0,
                 Smooth::Poly => k * 0.25,
                 Smooth::Exp => k * std::f64::consts::LN_2,
+                _ => crate::scene::analysis::blend_reach(k, v),
             };
             Some(h.grow(g * (1.0 + 1e-9)))
         }
@@ -497,8 +559,23 @@ fn own_cost(node: &Node) -> f64 {
         Node::Cone { .. } => 35.0,
         Node::Ellipsoid { .. } => 20.0,
         Node::Mandelbulb { iterations, .. } => 20.0 + 45.0 * f64::from(*iterations),
+        Node::CappedCone { .. } => 40.0,
+        Node::RoundCone { .. } => 30.0,
+        Node::Segment { .. } => 20.0,
+        Node::RoundedCylinder { .. } => 18.0,
+        Node::HexPrism { .. } | Node::TriPrism { .. } => 32.0,
+        Node::Octahedron { .. } => 35.0,
+        Node::Pyramid { .. } => 55.0,
+        Node::BoxFrame { .. } => 60.0,
+        Node::Link { .. } => 14.0,
+        Node::InfiniteCylinder { .. } => 14.0,
+        Node::Slab { .. } => 7.0,
+        Node::Feature { .. } => 8.0,
         Node::Combine { children, .. } => 4.0 * children.len() as f64,
-        Node::SmoothCombine { .. } => 14.0,
+        Node::SmoothCombine { variant, .. } => match variant {
+            Smooth::Stairs(_) | Smooth::Columns(_) => 24.0,
+            _ => 14.0,
+        },
         Node::Translate { .. } => 3.0,
         Node::Rotate { .. } => 12.0,
         Node::Scale { .. } | Node::ScaleXyz { .. } => 5.0,

@@ -10,9 +10,9 @@
 use super::bounds::{Aabb, Bound, Bounds};
 use super::builder::{Builder, P};
 use super::bvh::{self, Kind, Tree};
-use super::{shapes, Binary, Reg, Unary, EMPTY_DISTANCE};
+use super::{blends, shapes, Binary, Reg, Unary, EMPTY_DISTANCE};
 use crate::scene::analysis::{self, Analysis, Window};
-use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
+use crate::scene::{Combine, Feature, Graph, Node, NodeId, Smooth, V3};
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -322,6 +322,7 @@ impl<'a> Lowerer<'a> {
                 a,
                 b,
             } => self.smooth(id, *op, *k, *variant, [*a, *b], p),
+            Node::Feature { op, a, b } => self.feature(id, *op, [*a, *b], p),
             Node::Paint { material, child } => {
                 let f = self.node(*child, p);
                 self.resume(id, node);
@@ -458,6 +459,42 @@ impl<'a> Lowerer<'a> {
             Node::Plane { normal, height } => shapes::plane(b, p, normal, height),
             Node::Ellipsoid { radii } => shapes::ellipsoid(b, p, radii),
             Node::Mandelbulb { power, iterations } => shapes::mandelbulb(b, p, power, iterations),
+            Node::CappedCone {
+                half_height,
+                bottom,
+                top,
+            } => shapes::capped_cone(b, p, half_height, bottom, top),
+            Node::RoundCone {
+                bottom,
+                top,
+                half_height,
+            } => shapes::round_cone(b, p, bottom, top, half_height),
+            Node::Segment { a, b: e, radius } => shapes::segment(b, p, a, e, radius),
+            Node::RoundedCylinder {
+                radius,
+                round,
+                half_height,
+            } => shapes::rounded_cylinder(b, p, radius, round, half_height),
+            Node::HexPrism {
+                radius,
+                half_height,
+            } => shapes::hex_prism(b, p, radius, half_height),
+            Node::TriPrism {
+                radius,
+                half_height,
+            } => shapes::tri_prism(b, p, radius, half_height),
+            Node::Octahedron { radius } => shapes::octahedron(b, p, radius),
+            Node::Pyramid { base, height } => shapes::pyramid(b, p, base, height),
+            Node::BoxFrame { half, edge } => shapes::box_frame(b, p, half, edge),
+            Node::Link {
+                half_length,
+                major,
+                minor,
+            } => shapes::link(b, p, half_length, major, minor),
+            Node::InfiniteCylinder { radius, axis } => {
+                shapes::infinite_cylinder(b, p, radius, axis)
+            }
+            Node::Slab { thickness, normal } => shapes::slab(b, p, thickness, normal),
             _ => match shapes::slots(node) {
                 Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
                 None => b.c(EMPTY_DISTANCE),
@@ -766,10 +803,16 @@ impl<'a> Lowerer<'a> {
         let fb = self.node(ch[1], p);
         self.resume(id, self.graph.node(id));
         let b = &mut *self.b;
-        let d = match op {
-            Combine::Union => smin(b, fa.d, fb.d, k, v),
-            Combine::Intersect => smax(b, fa.d, fb.d, k, v),
-            Combine::Subtract => {
+        let blend = if k > 0.0 {
+            blends::combine(b, op, fa.d, fb.d, k, v)
+        } else {
+            None
+        };
+        let d = match (blend, op) {
+            (Some(d), _) => d,
+            (None, Combine::Union) => smin(b, fa.d, fb.d, k, v),
+            (None, Combine::Intersect) => smax(b, fa.d, fb.d, k, v),
+            (None, Combine::Subtract) => {
                 let nb = b.neg(fb.d);
                 smax(b, fa.d, nb, k, v)
             }
@@ -777,6 +820,19 @@ impl<'a> Lowerer<'a> {
         Field {
             d,
             m: self.material(op, fa, fb),
+        }
+    }
+}
+
+impl Lowerer<'_> {
+    /// A feature of `a` along the surface of `b`; the result has `a`'s material.
+    fn feature(&mut self, id: NodeId, f: Feature, ch: [NodeId; 2], p: P) -> Field {
+        let fa = self.node(ch[0], p);
+        let fb = self.node(ch[1], p);
+        self.resume(id, self.graph.node(id));
+        Field {
+            d: blends::feature(self.b, f, fa.d, fb.d),
+            m: fa.m,
         }
     }
 }
@@ -938,7 +994,8 @@ fn shrink(b: &mut Builder, s: Reg, scale: f64) -> Reg {
 
 /// The smooth minimum. Poly: h = max(k - |a - b|, 0) / k, min(a, b) - h²·k/4 (Quilez's
 /// quadratic). Exp: -k·ln(e^(-a/k) + e^(-b/k)), computed as m - k·ln(e^((m-a)/k) + e^((m-b)/k))
-/// with m = min(a, b) so that it cannot overflow. k ≤ 0 is the plain minimum.
+/// with m = min(a, b) so that it cannot overflow. k ≤ 0 is the plain minimum. (hg_sdf's
+/// variants are `blends::combine`'s: they never come here with k > 0.)
 fn smin(b: &mut Builder, x: Reg, y: Reg, k: f64, v: Smooth) -> Reg {
     if k <= 0.0 {
         return b.min(x, y);
@@ -953,6 +1010,7 @@ fn smin(b: &mut Builder, x: Reg, y: Reg, k: f64, v: Smooth) -> Reg {
             let s = exp_sum(b, m, x, y, k);
             b.sub(m, s)
         }
+        _ => m,
     }
 }
 
@@ -971,6 +1029,7 @@ fn smax(b: &mut Builder, x: Reg, y: Reg, k: f64, v: Smooth) -> Reg {
             let s = exp_sum(b, m, x, y, k);
             b.add(m, s)
         }
+        _ => m,
     }
 }
 

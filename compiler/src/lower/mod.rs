@@ -7,12 +7,15 @@
 //! whose subtrees are skipped where they cannot be the nearest. Level 0 lowers the scene
 //! literally.
 
+mod blends;
 mod bounds;
 mod builder;
 mod bvh;
 mod graph;
 mod instances;
 mod media;
+#[cfg(test)]
+mod shape_tests;
 mod shapes;
 mod simplify;
 #[cfg(test)]

@@ -188,6 +188,348 @@ fn cone(b: &mut Builder, p: P, s: &Slots) -> Reg {
     b.mul(s, m)
 }
 
+/// -1 where `x < 0`, else 1 (GLSL's `sign` but for 0, where every use below multiplies a
+/// zero length).
+fn sign(b: &mut Builder, x: Reg) -> Reg {
+    let zero = b.c(0.0);
+    let neg = b.lt(x, zero);
+    let minus = b.c(-1.0);
+    let one = b.c(1.0);
+    b.select(neg, minus, one)
+}
+
+/// The exact distance of a 2D field `d` extruded along a coordinate `y` to half-height `h`
+/// (Quilez's `opExtrusion`): w = (d, |y| - h); min(max(w.x, w.y), 0) + |max(w, 0)|.
+fn extrude(b: &mut Builder, d: Reg, y: Reg, h: f64) -> Reg {
+    let ay = b.abs(y);
+    let wy = b.subc(ay, h);
+    let inside = b.max(d, wy);
+    let inside = b.minc(inside, 0.0);
+    let ox = b.maxc(d, 0.0);
+    let oy = b.maxc(wy, 0.0);
+    let outside = b.len2(ox, oy);
+    b.add(inside, outside)
+}
+
+/// Quilez's exact capped cone (`sdCappedCone`) along y, radius r1 at y = -h and r2 at y = +h:
+/// q = (|p.xz|, p.y), k1 = (r2, h), k2 = (r2 - r1, 2h),
+/// ca = (q.x - min(q.x, q.y < 0 ? r1 : r2), |q.y| - h),
+/// cb = q - k1 + k2·clamp(dot(k1 - q, k2) / dot(k2, k2), 0, 1),
+/// d = ±√min(|ca|², |cb|²), negative where cb.x < 0 and ca.y < 0.
+pub(super) fn capped_cone(b: &mut Builder, p: P, h: f64, r1: f64, r2: f64) -> Reg {
+    let qx = b.len2(p[0], p[2]);
+    let qy = p[1];
+    let zero = b.c(0.0);
+    let below = b.lt(qy, zero);
+    let (c1, c2) = (b.c(r1), b.c(r2));
+    let cap = b.select(below, c1, c2);
+    let cap = b.min(qx, cap);
+    let cax = b.sub(qx, cap);
+    let ay = b.abs(qy);
+    let cay = b.subc(ay, h);
+    let (k2x, k2y) = (r2 - r1, 2.0 * h);
+    // dot(k1 - q, k2) = (r2 - qx)·k2x + (h - qy)·k2y
+    let tx = b.mulc(qx, -k2x);
+    let ty = b.mulc(qy, -k2y);
+    let t = b.add(tx, ty);
+    let t = b.addc(t, r2 * k2x + h * k2y);
+    let t = b.mulc(t, 1.0 / (k2x * k2x + k2y * k2y));
+    let t = b.clampc(t, 0.0, 1.0);
+    let cbx = b.mulc(t, k2x);
+    let cbx = b.add(qx, cbx);
+    let cbx = b.subc(cbx, r2);
+    let cby = b.mulc(t, k2y);
+    let cby = b.add(qy, cby);
+    let cby = b.subc(cby, h);
+    let inside_x = b.lt(cbx, zero);
+    let inside_y = b.lt(cay, zero);
+    let inside = b.mul(inside_x, inside_y);
+    let one = b.c(1.0);
+    let minus = b.c(-1.0);
+    let s = b.select(inside, minus, one);
+    let da = b.dot2(cax, cay, cax, cay);
+    let db = b.dot2(cbx, cby, cbx, cby);
+    let m = b.min(da, db);
+    let m = b.sqrt(m);
+    b.mul(s, m)
+}
+
+/// Quilez's exact round cone (`sdRoundCone`): the hull of spheres of radii r1 at y = -h and
+/// r2 at y = +h. With q = (|p.xz|, p.y + h), s = (r1 - r2) / 2h, c = √(1 - s²) and
+/// k = dot(q, (-s, c)): |q| - r1 where k < 0, |q - (0, 2h)| - r2 where k > 2h·c, else
+/// dot(q, (c, s)) - r1.
+pub(super) fn round_cone(b: &mut Builder, p: P, r1: f64, r2: f64, h: f64) -> Reg {
+    let sn = (r1 - r2) / (2.0 * h);
+    let cs = (1.0 - sn * sn).max(0.0).sqrt();
+    let qx = b.len2(p[0], p[2]);
+    let qy = b.addc(p[1], h);
+    let kx = b.mulc(qx, -sn);
+    let ky = b.mulc(qy, cs);
+    let k = b.add(kx, ky);
+    let lower = b.len2(qx, qy);
+    let lower = b.subc(lower, r1);
+    let ty = b.subc(qy, 2.0 * h);
+    let upper = b.len2(qx, ty);
+    let upper = b.subc(upper, r2);
+    let sx = b.mulc(qx, cs);
+    let sy = b.mulc(qy, sn);
+    let side = b.add(sx, sy);
+    let side = b.subc(side, r1);
+    let zero = b.c(0.0);
+    let below = b.lt(k, zero);
+    let top = b.c(2.0 * h * cs);
+    let above = b.lt(top, k);
+    let d = b.select(above, upper, side);
+    b.select(below, lower, d)
+}
+
+/// The capsule between two points (Quilez's `sdCapsule`): |pa - ba·clamp(pa·ba / ba·ba, 0, 1)| - r
+/// with pa = p - a, ba = b - a (a sphere where a = b).
+pub(super) fn segment(b: &mut Builder, p: P, a: V3, e: V3, r: f64) -> Reg {
+    let pa = b.sub3c(p, a);
+    let ba = [0, 1, 2].map(|i| e[i] - a[i]);
+    let bb: f64 = ba.iter().map(|x| x * x).sum();
+    if bb == 0.0 {
+        let l = b.len3(pa);
+        return b.subc(l, r);
+    }
+    let dir = ba.map(|x| x / bb);
+    let dir = b.c3(dir);
+    let t = b.dot3(pa, dir);
+    let t = b.clampc(t, 0.0, 1.0);
+    let q = b.map3(pa, |b, x, i| {
+        let o = b.mulc(t, ba[i]);
+        b.sub(x, o)
+    });
+    let l = b.len3(q);
+    b.subc(l, r)
+}
+
+/// A cylinder of radius `r` and half-height `h` with its rims rounded by `e` (Quilez's
+/// `sdRoundedCylinder`): the cylinder of radius r - e and half-height h - e, less e.
+pub(super) fn rounded_cylinder(b: &mut Builder, p: P, r: f64, e: f64, h: f64) -> Reg {
+    let d = cylinder(b, p, &[r - e, h - e, 0.0, 0.0]);
+    b.subc(d, e)
+}
+
+/// Quilez's exact hexagonal prism (`sdHexPrism`), its axis along y and its hexagon in the xz
+/// plane with flat sides at z = ±r: with k = (-√3/2, 1/2, 1/√3) and p = |p|,
+/// p.xz -= 2·min(dot(k.xy, p.xz), 0)·k.xy,
+/// d2 = |p.xz - (clamp(p.x, -k.z·r, k.z·r), r)|·sign(p.z - r), then extruded to half-height h.
+pub(super) fn hex_prism(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
+    let (kx, ky, kz) = (-(3f64.sqrt()) * 0.5, 0.5, 1.0 / 3f64.sqrt());
+    let x = b.abs(p[0]);
+    let z = b.abs(p[2]);
+    let (kxc, kyc) = (b.c(kx), b.c(ky));
+    let dot = b.dot2(x, z, kxc, kyc);
+    let dot = b.minc(dot, 0.0);
+    let dot = b.mulc(dot, 2.0);
+    let ox = b.mulc(dot, kx);
+    let x = b.sub(x, ox);
+    let oz = b.mulc(dot, ky);
+    let z = b.sub(z, oz);
+    let cx = b.clampc(x, -kz * r, kz * r);
+    let dx = b.sub(x, cx);
+    let dz = b.subc(z, r);
+    let l = b.len2(dx, dz);
+    let s = sign(b, dz);
+    let d = b.mul(l, s);
+    extrude(b, d, p[1], h)
+}
+
+/// An exact triangular prism: Quilez's exact equilateral triangle (`sdEquilateralTriangle`)
+/// in the xz plane, its corner towards +z and its sides `r` from the axis (half a side
+/// R = √3·r), extruded along y to half-height h. With (x, y) = (|p.x| - R, p.z + r): where
+/// x + √3·y > 0, (x, y) = ((x - √3·y) / 2, (-√3·x - y) / 2); then x -= clamp(x, -2R, 0) and
+/// d2 = -|(x, y)|·sign(y).
+pub(super) fn tri_prism(b: &mut Builder, p: P, r: f64, h: f64) -> Reg {
+    let k = 3f64.sqrt();
+    let big = k * r;
+    let x = b.abs(p[0]);
+    let x = b.subc(x, big);
+    let y = b.addc(p[2], r);
+    let ky = b.mulc(y, k);
+    let test = b.add(x, ky);
+    let zero = b.c(0.0);
+    let fold = b.lt(zero, test);
+    let fx = b.sub(x, ky);
+    let fx = b.mulc(fx, 0.5);
+    let kx = b.mulc(x, -k);
+    let fy = b.sub(kx, y);
+    let fy = b.mulc(fy, 0.5);
+    let x = b.select(fold, fx, x);
+    let y = b.select(fold, fy, y);
+    let c = b.clampc(x, -2.0 * big, 0.0);
+    let x = b.sub(x, c);
+    let l = b.len2(x, y);
+    let s = sign(b, y);
+    let d = b.mul(l, s);
+    let d = b.neg(d);
+    extrude(b, d, p[1], h)
+}
+
+/// Quilez's exact octahedron (`sdOctahedron`): with p = |p| and m = p.x + p.y + p.z - s, the
+/// first of p.xyz, p.yzx, p.zxy whose first component is below m / 3 gives q, and
+/// k = clamp((q.z - q.y + s) / 2, 0, s), d = |(q.x, q.y - s + k, q.z - k)|; where none is,
+/// d = m / √3.
+pub(super) fn octahedron(b: &mut Builder, p: P, s: f64) -> Reg {
+    let a = b.abs3(p);
+    let sum = b.add(a[0], a[1]);
+    let sum = b.add(sum, a[2]);
+    let m = b.subc(sum, s);
+    let c = [0, 1, 2].map(|i| {
+        let t = b.mulc(a[i], 3.0);
+        b.lt(t, m)
+    });
+    let pick = |b: &mut Builder, i: usize| {
+        let second = b.select(c[1], a[(i + 1) % 3], a[(i + 2) % 3]);
+        b.select(c[0], a[i], second)
+    };
+    let q = [pick(b, 0), pick(b, 1), pick(b, 2)];
+    let k = b.sub(q[2], q[1]);
+    let k = b.addc(k, s);
+    let k = b.mulc(k, 0.5);
+    let k = b.clampc(k, 0.0, s);
+    let y = b.subc(q[1], s);
+    let y = b.add(y, k);
+    let z = b.sub(q[2], k);
+    let near = b.len3([q[0], y, z]);
+    let far = b.mulc(m, 1.0 / 3f64.sqrt());
+    let any = b.max(c[1], c[2]);
+    let any = b.max(c[0], any);
+    b.select(any, near, far)
+}
+
+/// Quilez's exact pyramid (`sdPyramid`, a base of side 1 at y = 0 and its apex at height
+/// h), scaled by the side `base` and moved down by half its height:
+/// m2 = h² + 1/4; p.xz = |p.xz| sorted so that x ≥ z, less 1/2;
+/// q = (p.z, h·p.y - p.x / 2, h·p.x + p.y / 2), s = max(-q.x, 0),
+/// t = clamp((q.y - p.z / 2) / (m2 + 1/4), 0, 1),
+/// a = m2·(q.x + s)² + q.y², b = m2·(q.x + t/2)² + (q.y - m2·t)²,
+/// d2 = 0 where min(q.y, -q.x·m2 - q.y/2) > 0, else min(a, b);
+/// d = √((d2 + q.z²) / m2)·sign(max(q.z, -p.y)). That is the distance to the sides; the
+/// base is added here: max(d, -p.y) where p.y ≥ 0, and below the base's plane the distance
+/// to the base square, |(max(|p.x| - ½, 0), p.y, max(|p.z| - ½, 0))|.
+pub(super) fn pyramid(b: &mut Builder, p: P, base: f64, height: f64) -> Reg {
+    let h = height / base;
+    let m2 = h * h + 0.25;
+    let inv = 1.0 / base;
+    let px = b.mulc(p[0], inv);
+    let py = b.addc(p[1], height * 0.5);
+    let py = b.mulc(py, inv);
+    let pz = b.mulc(p[2], inv);
+    let ax = b.abs(px);
+    let az = b.abs(pz);
+    let x = b.max(ax, az);
+    let z = b.min(ax, az);
+    let x = b.subc(x, 0.5);
+    let z = b.subc(z, 0.5);
+    let qx = z;
+    let hy = b.mulc(py, h);
+    let hx = b.mulc(x, 0.5);
+    let qy = b.sub(hy, hx);
+    let hx = b.mulc(x, h);
+    let hy = b.mulc(py, 0.5);
+    let qz = b.add(hx, hy);
+    let s = b.neg(qx);
+    let s = b.maxc(s, 0.0);
+    let hz = b.mulc(z, 0.5);
+    let t = b.sub(qy, hz);
+    let t = b.mulc(t, 1.0 / (m2 + 0.25));
+    let t = b.clampc(t, 0.0, 1.0);
+    let qs = b.add(qx, s);
+    let qs2 = b.mul(qs, qs);
+    let qy2 = b.mul(qy, qy);
+    let a = b.mulc(qs2, m2);
+    let a = b.add(a, qy2);
+    let ht = b.mulc(t, 0.5);
+    let qt = b.add(qx, ht);
+    let qt2 = b.mul(qt, qt);
+    let mt = b.mulc(t, m2);
+    let ym = b.sub(qy, mt);
+    let ym2 = b.mul(ym, ym);
+    let bb = b.mulc(qt2, m2);
+    let bb = b.add(bb, ym2);
+    let l = b.mulc(qx, -m2);
+    let half_y = b.mulc(qy, 0.5);
+    let l = b.sub(l, half_y);
+    let l = b.min(qy, l);
+    let zero = b.c(0.0);
+    let flat = b.lt(zero, l);
+    let ab = b.min(a, bb);
+    let d2 = b.select(flat, zero, ab);
+    let qz2 = b.mul(qz, qz);
+    let d2 = b.add(d2, qz2);
+    let d2 = b.mulc(d2, 1.0 / m2);
+    let d = b.sqrt(d2);
+    let ny = b.neg(py);
+    let sg = b.max(qz, ny);
+    let sg = sign(b, sg);
+    let d = b.mul(d, sg);
+    // Quilez's value is the distance to the sides alone: inside, the base may be nearer;
+    // below the base's plane the nearest point is on the base.
+    let lateral = b.max(d, ny);
+    let bx = b.subc(ax, 0.5);
+    let bx = b.maxc(bx, 0.0);
+    let bz = b.subc(az, 0.5);
+    let bz = b.maxc(bz, 0.0);
+    let below = b.len3([bx, py, bz]);
+    let under = b.lt(py, zero);
+    let d = b.select(under, below, lateral);
+    b.mulc(d, base)
+}
+
+/// Quilez's exact box frame (`sdBoxFrame`): with p = |p| - half and q = |p + e| - e, the
+/// nearest of the three groups of bars, each the box formula over one component of p and two
+/// of q.
+pub(super) fn box_frame(b: &mut Builder, p: P, half: V3, e: f64) -> Reg {
+    let a = b.abs3(p);
+    let p = b.sub3c(a, half);
+    let q = b.map3(p, |b, x, _| {
+        let x = b.addc(x, e);
+        let x = b.abs(x);
+        b.subc(x, e)
+    });
+    let x = box_from_q(b, [p[0], q[1], q[2]]);
+    let y = box_from_q(b, [q[0], p[1], q[2]]);
+    let z = box_from_q(b, [q[0], q[1], p[2]]);
+    let m = b.min(x, y);
+    b.min(m, z)
+}
+
+/// Quilez's exact link (`sdLink`): q = (p.x, max(|p.y| - l, 0), p.z);
+/// |(|q.xy| - R, q.z)| - r.
+pub(super) fn link(b: &mut Builder, p: P, l: f64, major: f64, minor: f64) -> Reg {
+    let ay = b.abs(p[1]);
+    let y = b.subc(ay, l);
+    let y = b.maxc(y, 0.0);
+    let xy = b.len2(p[0], y);
+    let x = b.subc(xy, major);
+    let d = b.len2(x, p[2]);
+    b.subc(d, minor)
+}
+
+/// |p - (p·a)·a| - r: the distance to the line through the origin along the unit axis a,
+/// less the radius.
+pub(super) fn infinite_cylinder(b: &mut Builder, p: P, r: f64, axis: V3) -> Reg {
+    let a = b.c3(axis);
+    let t = b.dot3(p, a);
+    let q = b.map3(p, |b, x, i| {
+        let o = b.mulc(t, axis[i]);
+        b.sub(x, o)
+    });
+    let l = b.len3(q);
+    b.subc(l, r)
+}
+
+/// |p·n| - t/2: the slab of thickness t about the plane through the origin with unit normal n.
+pub(super) fn slab(b: &mut Builder, p: P, t: f64, n: V3) -> Reg {
+    let n = b.c3(n);
+    let d = b.dot3(p, n);
+    let d = b.abs(d);
+    b.subc(d, t * 0.5)
+}
+
 /// Quilez's ellipsoid bound: k0 = |p / r|, k1 = |p / r²|, d = k0 (k0 - 1) / k1.
 /// k1 is kept above a tiny floor so that the centre gives a finite value.
 pub(super) fn ellipsoid(b: &mut Builder, p: P, radii: V3) -> Reg {

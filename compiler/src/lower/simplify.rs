@@ -127,6 +127,10 @@ impl Simplifier<'_> {
                 }
                 self.add(Node::Morph { t, a, b })
             }
+            Node::Feature { op, a, b } => {
+                let (a, b) = (self.node(a), self.node(b));
+                self.add(Node::Feature { op, a, b })
+            }
             Node::Translate { offset, child } => {
                 let c = self.node(child);
                 self.translate(offset, c)
@@ -318,6 +322,7 @@ impl Simplifier<'_> {
             Node::SmoothCombine { a, b, .. } | Node::Morph { a, b, .. } => {
                 self.painted(*a) && self.painted(*b)
             }
+            Node::Feature { a, .. } => self.painted(*a),
             node => node.children().first().is_some_and(|&k| {
                 node.children().len() == 1 && !is_primitive(node) && self.painted(k)
             }),

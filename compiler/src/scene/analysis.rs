@@ -14,7 +14,7 @@
 //! a repetition whose copies overlap their cells) L is the best guess, and
 //! [`Derived::proven`] is false.
 
-use super::ir::{Combine, Exactness, Facts, Node, NodeId, Scene, Smooth, V3};
+use super::ir::{Combine, Exactness, Facts, Feature, Node, NodeId, Scene, Smooth, V3};
 use crate::diagnostics::Diagnostic;
 use std::collections::HashSet;
 
@@ -184,9 +184,35 @@ pub fn analyse(scene: &Scene) -> Analysis {
 /// How much a smooth combination moves the surface at most: k/4 for the quadratic smooth
 /// minimum, k·ln 2 for the exponential one.
 pub fn blend_reach(k: f64, variant: Smooth) -> f64 {
+    let k = k.max(0.0);
     match variant {
-        Smooth::Poly => k.max(0.0) * 0.25,
-        Smooth::Exp => k.max(0.0) * std::f64::consts::LN_2,
+        Smooth::Poly => k * 0.25,
+        Smooth::Exp => k * std::f64::consts::LN_2,
+        // hg_sdf's chamfer is at least min(a, b) - k/√2, its round min(a, b) - 0.42·k, its
+        // stairs min(a, b) - k/2, where a, b ≥ 0; its columns, up to k/√2 plus a column's
+        // radius, at most k.
+        Smooth::Chamfer | Smooth::Round | Smooth::Stairs(_) => k,
+        Smooth::Columns(_) => 2.0 * k,
+    }
+}
+
+/// The factor by which a blend may steepen its operands' fields: the chamfer, round and
+/// columns forms read a + b (or |(a, b)|), whose gradient is up to √2 times the larger
+/// operand's when the two surfaces meet at a shallow angle; the smooth minima and the stairs
+/// are no steeper than their operands (docs/analysis.md).
+pub fn blend_steepness(variant: Smooth) -> f64 {
+    match variant {
+        Smooth::Poly | Smooth::Exp | Smooth::Stairs(_) => 1.0,
+        Smooth::Chamfer | Smooth::Round | Smooth::Columns(_) => std::f64::consts::SQRT_2,
+    }
+}
+
+/// The same for a feature: the engraving and the pipe read a ± b, the groove and the tongue
+/// only minima and maxima of a, |b| and constants.
+pub fn feature_steepness(f: Feature) -> f64 {
+    match f {
+        Feature::Engrave { .. } | Feature::Pipe { .. } => std::f64::consts::SQRT_2,
+        Feature::Groove { .. } | Feature::Tongue { .. } => 1.0,
     }
 }
 
@@ -275,6 +301,11 @@ fn down(node: &Node, m: f64, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
             // The blend reads each operand wherever it is within k of the other, and the
             // surface lies where the smaller one is below the reach.
             let m = m + k.max(0.0) + blend_reach(*k, *variant);
+            vec![(*a, m, r), (*b, m, r)]
+        }
+        Node::Feature { op, a, b } => {
+            // The feature is shaped by both fields up to its size from either surface.
+            let m = m + op.reach();
             vec![(*a, m, r), (*b, m, r)]
         }
         Node::Translate { offset, child } => vec![(*child, m, r.translate(offset.map(|x| -x)))],
@@ -597,6 +628,82 @@ impl Pass<'_> {
                 let d = exact(Aabb::centred([2.0; 3]), [false; 3]);
                 unproven(d, id)
             }
+            Node::CappedCone {
+                half_height,
+                bottom,
+                top,
+            } => {
+                let r = bottom.max(*top);
+                exact(Aabb::centred([r, *half_height, r]), [true, false, true])
+            }
+            Node::RoundCone {
+                bottom,
+                top,
+                half_height,
+            } => {
+                let r = bottom.max(*top);
+                let b = Aabb {
+                    min: [-r, -half_height - bottom, -r],
+                    max: [r, half_height + top, r],
+                };
+                exact(b, [true, false, true])
+            }
+            Node::Segment { a, b, radius } => {
+                let bounds = Aabb {
+                    min: [0, 1, 2].map(|i| a[i].min(b[i]) - radius),
+                    max: [0, 1, 2].map(|i| a[i].max(b[i]) + radius),
+                };
+                // Across plane i: the segment lies in it, or the plane swaps its ends.
+                let mirrored =
+                    |i: usize| (0..3).all(|j| if j == i { a[j] == -b[j] } else { a[j] == b[j] });
+                let symmetric = [0, 1, 2].map(|i| (a[i] == 0.0 && b[i] == 0.0) || mirrored(i));
+                exact(bounds, symmetric)
+            }
+            Node::RoundedCylinder {
+                radius,
+                half_height,
+                ..
+            } => exact(Aabb::centred([*radius, *half_height, *radius]), [true; 3]),
+            Node::HexPrism {
+                radius,
+                half_height,
+            } => exact(
+                Aabb::centred([radius * 2.0 / 3f64.sqrt(), *half_height, *radius]),
+                [true; 3],
+            ),
+            Node::TriPrism {
+                radius,
+                half_height,
+            } => {
+                let w = 3f64.sqrt() * radius;
+                let b = Aabb {
+                    min: [-w, -half_height, -radius],
+                    max: [w, *half_height, 2.0 * radius],
+                };
+                exact(b, [true, true, false])
+            }
+            Node::Octahedron { radius } => exact(Aabb::centred([*radius; 3]), [true; 3]),
+            Node::Pyramid { base, height } => exact(
+                Aabb::centred([base * 0.5, height * 0.5, base * 0.5]),
+                [true, false, true],
+            ),
+            Node::BoxFrame { half, .. } => exact(Aabb::centred(*half), [true; 3]),
+            Node::Link {
+                half_length,
+                major,
+                minor,
+            } => exact(
+                Aabb::centred([major + minor, half_length + major + minor, *minor]),
+                [true; 3],
+            ),
+            Node::InfiniteCylinder { radius, axis } => {
+                exact(line_bounds(*axis, *radius), line_symmetry(*axis))
+            }
+            Node::Slab { thickness, normal } => exact(
+                slab_bounds(*normal, thickness * 0.5),
+                line_symmetry(*normal),
+            ),
+            Node::Feature { op, a, b } => self.feature(id, *op, *a, *b),
             Node::Combine { op, children } => self.combine(*op, children),
             Node::SmoothCombine {
                 op,
@@ -696,7 +803,9 @@ impl Pass<'_> {
         d.facts.exactness = Exactness::Approximate;
         let reach = blend_reach(k, v);
         if d.gradient.is_finite() {
-            d.facts.lipschitz = d.facts.lipschitz.max(d.gradient);
+            let steep = blend_steepness(v);
+            d.gradient *= steep;
+            d.facts.lipschitz = (d.facts.lipschitz * steep).max(d.gradient);
             d.facts.exactness = classify(d.facts.lipschitz, d.proven);
         } else if d.proven {
             d = unproven(d, id);
@@ -713,6 +822,24 @@ impl Pass<'_> {
         if v == Smooth::Exp && reach > size {
             self.warn_exp(id, op, k, reach, size);
         }
+        d
+    }
+
+    /// A feature of `a` along `b`'s surface: like a blend, L is the operands' times the
+    /// feature's steepness; the solid lies within `a`'s, grown by what stands out of it.
+    fn feature(&mut self, id: NodeId, f: Feature, a: NodeId, b: NodeId) -> Derived {
+        let (da, db) = (self.get(a), self.get(b));
+        let mut d = merge(&[da, db]);
+        d.facts.exactness = Exactness::Approximate;
+        if d.gradient.is_finite() {
+            let steep = feature_steepness(f);
+            d.gradient *= steep;
+            d.facts.lipschitz = (d.facts.lipschitz * steep).max(d.gradient);
+            d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+        } else if d.proven {
+            d = unproven(d, id);
+        }
+        d.bounds = da.bounds.grow(da.growth * f.outset());
         d
     }
 
@@ -1128,6 +1255,31 @@ fn plane_bounds(n: V3, h: f64) -> Aabb {
         }
     }
     b
+}
+
+/// The box around the points within `r` of the line through the origin along `axis`: ±r
+/// across every coordinate the axis does not move along, unbounded along the others.
+fn line_bounds(axis: V3, r: f64) -> Aabb {
+    Aabb::ALL.map(|i, lo, hi| if axis[i] == 0.0 { (-r, r) } else { (lo, hi) })
+}
+
+/// The box around the points within `h` of the plane through the origin normal to `n`: ±h
+/// along an axis-aligned normal, unbounded otherwise.
+fn slab_bounds(n: V3, h: f64) -> Aabb {
+    let mut b = Aabb::ALL;
+    for i in 0..3 {
+        let others = (0..3).filter(|&j| j != i).all(|j| n[j] == 0.0);
+        if others && n[i] != 0.0 {
+            (b.min[i], b.max[i]) = (-h, h);
+        }
+    }
+    b
+}
+
+/// The mirror symmetries of a shape about a line or plane through the origin along or
+/// normal to `v`: across plane i when `v` lies in it or along its normal.
+fn line_symmetry(v: V3) -> [bool; 3] {
+    [0, 1, 2].map(|i| v[i] == 0.0 || (0..3).filter(|&j| j != i).all(|j| v[j] == 0.0))
 }
 
 /// Quilez's ellipsoid bound `k0·(k0 − 1)/k1`: never above the distance, but not Lipschitz

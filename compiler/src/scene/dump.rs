@@ -203,6 +203,95 @@ fn node(n: &Node) -> String {
         Node::Mandelbulb { power, iterations } => {
             format!("mandelbulb power={} iterations={iterations}", num(*power))
         }
+        Node::CappedCone {
+            half_height,
+            bottom,
+            top,
+        } => format!(
+            "capped_cone half_height={} bottom={} top={}",
+            num(*half_height),
+            num(*bottom),
+            num(*top)
+        ),
+        Node::RoundCone {
+            bottom,
+            top,
+            half_height,
+        } => format!(
+            "round_cone bottom={} top={} half_height={}",
+            num(*bottom),
+            num(*top),
+            num(*half_height)
+        ),
+        Node::Segment { a, b, radius } => {
+            format!("segment a={} b={} radius={}", v3(*a), v3(*b), num(*radius))
+        }
+        Node::RoundedCylinder {
+            radius,
+            round,
+            half_height,
+        } => format!(
+            "rounded_cylinder radius={} round={} half_height={}",
+            num(*radius),
+            num(*round),
+            num(*half_height)
+        ),
+        Node::HexPrism {
+            radius,
+            half_height,
+        } => format!(
+            "hex_prism radius={} half_height={}",
+            num(*radius),
+            num(*half_height)
+        ),
+        Node::TriPrism {
+            radius,
+            half_height,
+        } => format!(
+            "tri_prism radius={} half_height={}",
+            num(*radius),
+            num(*half_height)
+        ),
+        Node::Octahedron { radius } => format!("octahedron radius={}", num(*radius)),
+        Node::Pyramid { base, height } => {
+            format!("pyramid base={} height={}", num(*base), num(*height))
+        }
+        Node::BoxFrame { half, edge } => {
+            format!("box_frame half={} edge={}", v3(*half), num(*edge))
+        }
+        Node::Link {
+            half_length,
+            major,
+            minor,
+        } => format!(
+            "link half_length={} major={} minor={}",
+            num(*half_length),
+            num(*major),
+            num(*minor)
+        ),
+        Node::InfiniteCylinder { radius, axis } => {
+            format!(
+                "infinite_cylinder radius={} axis={}",
+                num(*radius),
+                v3(*axis)
+            )
+        }
+        Node::Slab { thickness, normal } => {
+            format!("slab thickness={} normal={}", num(*thickness), v3(*normal))
+        }
+        Node::Feature { op, a, b } => {
+            let size = match *op {
+                Feature::Engrave { depth } => format!("depth={}", num(depth)),
+                Feature::Groove { width, depth } => {
+                    format!("width={} depth={}", num(width), num(depth))
+                }
+                Feature::Tongue { width, height } => {
+                    format!("width={} height={}", num(width), num(height))
+                }
+                Feature::Pipe { radius } => format!("radius={}", num(radius)),
+            };
+            format!("{} {size} %{}, %{}", op.name(), a.0, b.0)
+        }
         Node::Combine { op, children } => format!("{} {}", combine(*op), ids(children)),
         Node::SmoothCombine {
             op,
@@ -211,10 +300,9 @@ fn node(n: &Node) -> String {
             a,
             b,
         } => {
-            let v = if *variant == Smooth::Poly {
-                "poly"
-            } else {
-                "exp"
+            let v = match variant.steps() {
+                Some(n) => format!("{} steps={n}", variant.name()),
+                None => variant.name().to_string(),
             };
             format!(
                 "smooth_{} k={} {v} %{}, %{}",

@@ -29,6 +29,82 @@ pub enum Smooth {
     Poly,
     /// Exponential smooth minimum: smoother, but not a bound for large k.
     Exp,
+    /// A 45° chamfer of size k (Mercury's hg_sdf, `fOpUnionChamfer` and its forms).
+    Chamfer,
+    /// A quarter circle of radius k (hg_sdf's `fOpUnionRound` and its forms).
+    Round,
+    /// A staircase of this many steps over k (hg_sdf's `fOpUnionStairs` and its forms).
+    Stairs(u32),
+    /// Columns, this many, along the edge within k (hg_sdf's `fOpUnionColumns` and its forms).
+    Columns(u32),
+}
+
+impl Smooth {
+    /// The variant's name, as `variant:` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Smooth::Poly => "poly",
+            Smooth::Exp => "exp",
+            Smooth::Chamfer => "chamfer",
+            Smooth::Round => "round",
+            Smooth::Stairs(_) => "stairs",
+            Smooth::Columns(_) => "columns",
+        }
+    }
+
+    /// The number of steps or columns of a variant that has them.
+    pub fn steps(self) -> Option<u32> {
+        match self {
+            Smooth::Stairs(n) | Smooth::Columns(n) => Some(n),
+            _ => None,
+        }
+    }
+}
+
+/// A feature cut into or added onto a shape `a` where the surface of a shape `b` crosses it
+/// (Mercury's hg_sdf: `fOpEngrave`, `fOpGroove`, `fOpTongue`, `fOpPipe`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Feature {
+    /// A V-shaped cut `depth` deep along b's surface.
+    Engrave { depth: f64 },
+    /// A square groove `width` wide and `depth` deep along b's surface.
+    Groove { width: f64, depth: f64 },
+    /// A square tongue `width` wide standing `height` out of a along b's surface.
+    Tongue { width: f64, height: f64 },
+    /// A tube of `radius` along the curve where the two surfaces meet (neither shape stays).
+    Pipe { radius: f64 },
+}
+
+impl Feature {
+    /// The builtin's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Feature::Engrave { .. } => "engrave",
+            Feature::Groove { .. } => "groove",
+            Feature::Tongue { .. } => "tongue",
+            Feature::Pipe { .. } => "pipe",
+        }
+    }
+
+    /// How far the surface may stand out of `a`'s (for the tongue and the pipe).
+    pub fn outset(self) -> f64 {
+        match self {
+            Feature::Engrave { .. } | Feature::Groove { .. } => 0.0,
+            Feature::Tongue { height, .. } => height,
+            Feature::Pipe { radius } => radius,
+        }
+    }
+
+    /// How far from either surface the feature reads its operands' fields: the level sets
+    /// up to this value shape it.
+    pub fn reach(self) -> f64 {
+        match self {
+            Feature::Engrave { depth } => depth,
+            Feature::Groove { width, depth } => width.max(depth),
+            Feature::Tongue { width, height } => width.max(height),
+            Feature::Pipe { radius } => radius,
+        }
+    }
 }
 
 /// The three boolean combinations.
@@ -81,6 +157,51 @@ pub enum Node {
     Ellipsoid { radii: V3 },
     /// Mandelbulb fractal (distance estimator, approximate).
     Mandelbulb { power: f64, iterations: u32 },
+    /// Cone along y cut at both ends: radius `bottom` at y = -h, `top` at y = +h.
+    CappedCone {
+        half_height: f64,
+        bottom: f64,
+        top: f64,
+    },
+    /// The hull of a sphere of radius `bottom` at y = -h and one of radius `top` at y = +h.
+    RoundCone {
+        bottom: f64,
+        top: f64,
+        half_height: f64,
+    },
+    /// The points within `radius` of the segment from `a` to `b` (a capsule between them).
+    Segment { a: V3, b: V3, radius: f64 },
+    /// Cylinder along y of `radius` and half-height `half_height` with its two rims rounded
+    /// by `round`.
+    RoundedCylinder {
+        radius: f64,
+        round: f64,
+        half_height: f64,
+    },
+    /// Hexagonal prism along y; `radius` is the distance from the axis to each flat side.
+    HexPrism { radius: f64, half_height: f64 },
+    /// Prism along y of an equilateral triangle in the xz plane with a corner towards +z;
+    /// `radius` is the distance from the axis to each side.
+    TriPrism { radius: f64, half_height: f64 },
+    /// Regular octahedron with its corners on the axes, `radius` from the centre.
+    Octahedron { radius: f64 },
+    /// Pyramid of a square base of side `base` at y = -h/2 and its apex at y = +h/2.
+    Pyramid { base: f64, height: f64 },
+    /// The edges of a box of half-extents `half`, as bars of half-thickness `edge`.
+    BoxFrame { half: V3, edge: f64 },
+    /// A chain link in the xy plane: a torus of radii `major`, `minor` stretched along y by a
+    /// straight part of half-length `half_length`.
+    Link {
+        half_length: f64,
+        major: f64,
+        minor: f64,
+    },
+    /// Cylinder of `radius` without ends, about the line through the origin along `axis`
+    /// (unit length).
+    InfiniteCylinder { radius: f64, axis: V3 },
+    /// The points within `thickness / 2` of the plane through the origin normal to `normal`
+    /// (unit length).
+    Slab { thickness: f64, normal: V3 },
     /// n-ary union, or a binary intersection or subtraction.
     Combine { op: Combine, children: Vec<NodeId> },
     /// Smooth union, intersection or subtraction with blend radius `k`.
@@ -91,6 +212,8 @@ pub enum Node {
         a: NodeId,
         b: NodeId,
     },
+    /// A feature of `a` along the surface of `b` (engrave, groove, tongue, pipe).
+    Feature { op: Feature, a: NodeId, b: NodeId },
     /// Child moved by an offset.
     Translate { offset: V3, child: NodeId },
     /// Child rotated by an orthonormal matrix (rows).
@@ -170,7 +293,9 @@ impl Node {
     pub fn children(&self) -> Vec<NodeId> {
         match self {
             Node::Combine { children, .. } => children.clone(),
-            Node::SmoothCombine { a, b, .. } | Node::Morph { a, b, .. } => vec![*a, *b],
+            Node::SmoothCombine { a, b, .. }
+            | Node::Morph { a, b, .. }
+            | Node::Feature { a, b, .. } => vec![*a, *b],
             one_child!(child) => vec![*child],
             _ => Vec::new(),
         }
@@ -198,6 +323,19 @@ impl Node {
             Node::Cone { .. } => "cone",
             Node::Ellipsoid { .. } => "ellipsoid",
             Node::Mandelbulb { .. } => "mandelbulb",
+            Node::CappedCone { .. } => "capped_cone",
+            Node::RoundCone { .. } => "round_cone",
+            Node::Segment { .. } => "segment",
+            Node::RoundedCylinder { .. } => "rounded_cylinder",
+            Node::HexPrism { .. } => "hex_prism",
+            Node::TriPrism { .. } => "tri_prism",
+            Node::Octahedron { .. } => "octahedron",
+            Node::Pyramid { .. } => "pyramid",
+            Node::BoxFrame { .. } => "box_frame",
+            Node::Link { .. } => "link",
+            Node::InfiniteCylinder { .. } => "infinite_cylinder",
+            Node::Slab { .. } => "slab",
+            Node::Feature { op, .. } => op.name(),
             Node::Combine { op, .. } => op.name(false),
             Node::SmoothCombine { op, .. } => op.name(true),
             Node::Translate { .. } => "translate",

@@ -1,0 +1,354 @@
+//! Checks of the primitives of `shapes.rs` and the blends of `blends.rs` written from their
+//! source text: each exact primitive is 1-Lipschitz, agrees in sign with an independent
+//! inside test, and projects onto its own zero set (so it is the distance); the primitives
+//! that generalise older ones equal them; every blend's sampled slope stays within the L
+//! the analysis records; hg_sdf's columns, evaluated everywhere, keep the surface of its
+//! restricted form.
+
+use crate::eval::eval_point;
+use crate::program::Program;
+use crate::rng::Rng;
+use crate::scene::analysis::analyse;
+
+/// The lowered program of `scene { <shape>; }` and the L the analysis records for it.
+fn program(shape: &str) -> (Program, f64) {
+    let src = format!("scene {{ {shape}; }}");
+    let (scene, diags, _) = crate::check::check_str("t.sdf", &src);
+    assert!(diags.iter().all(|d| !d.is_error()), "{shape}: {diags:#?}");
+    let scene = scene.expect("scene");
+    let l = analyse(&scene).root().expect("root").facts.lipschitz;
+    (super::lower(&scene), l)
+}
+
+fn f(p: &Program, x: [f64; 3]) -> f64 {
+    eval_point(p, x).0
+}
+
+/// A random point in the cube of half-side `r`.
+fn point(rng: &mut Rng, r: f64) -> [f64; 3] {
+    [0; 3].map(|_| rng.range(-r, r))
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn len(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// The largest |f(p) - f(q)| / |p - q| over random pairs, near (q within 0.05 of p) and far.
+fn slope(p: &Program, rng: &mut Rng, r: f64) -> f64 {
+    let mut worst = 0.0f64;
+    for i in 0..4000 {
+        let a = point(rng, r);
+        let b = if i % 2 == 0 {
+            let d = point(rng, 0.05);
+            [a[0] + d[0], a[1] + d[1], a[2] + d[2]]
+        } else {
+            point(rng, r)
+        };
+        let d = len(sub(a, b));
+        if d > 1e-9 {
+            worst = worst.max((f(p, a) - f(p, b)).abs() / d);
+        }
+    }
+    worst
+}
+
+/// Checks that `shape` is the exact distance of the solid `inside` describes: 1-Lipschitz,
+/// negative exactly inside, and where its gradient is a unit vector (off the medial axis)
+/// the point moved by -f along it lies on the surface.
+fn exact(shape: &str, inside: impl Fn([f64; 3]) -> bool) {
+    let (p, l) = program(shape);
+    assert_eq!(l, 1.0, "{shape}: L");
+    let mut rng = Rng::new(33);
+    let s = slope(&p, &mut rng, 2.0);
+    assert!(s <= 1.0 + 1e-9, "{shape}: slope {s}");
+    let (mut projected, mut signs) = (0, 0);
+    for _ in 0..3000 {
+        let x = point(&mut rng, 1.6);
+        let d = f(&p, x);
+        if d.abs() > 1e-6 {
+            assert_eq!(d < 0.0, inside(x), "{shape}: sign at {x:?} ({d})");
+            signs += 1;
+        }
+        let h = 1e-6;
+        let g = [0, 1, 2].map(|i| {
+            let (mut a, mut b) = (x, x);
+            a[i] += h;
+            b[i] -= h;
+            (f(&p, a) - f(&p, b)) / (2.0 * h)
+        });
+        if (len(g) - 1.0).abs() > 1e-4 {
+            continue;
+        }
+        let y = [0, 1, 2].map(|i| x[i] - d * g[i]);
+        let e = f(&p, y);
+        assert!(
+            e.abs() < 1e-5,
+            "{shape}: {x:?} ({d}) projects to {y:?} at {e}"
+        );
+        projected += 1;
+    }
+    assert!(
+        signs > 2500 && projected > 2000,
+        "{shape}: {signs} signs, {projected} projections"
+    );
+}
+
+/// Checks that two shapes have the same field near the origin.
+fn same(a: &str, b: &str) {
+    let (pa, _) = program(a);
+    let (pb, _) = program(b);
+    let mut rng = Rng::new(7);
+    for _ in 0..2000 {
+        let x = point(&mut rng, 2.0);
+        let (da, db) = (f(&pa, x), f(&pb, x));
+        assert!(
+            (da - db).abs() < 1e-9,
+            "{a} against {b} at {x:?}: {da} {db}"
+        );
+    }
+}
+
+const S3: f64 = 1.732_050_807_568_877_2;
+
+#[test]
+fn capped_cone_is_exact_and_generalises_cylinder_and_cone() {
+    exact("capped_cone(1.2, 0.7, 0.3)", |p| {
+        let r = 0.5 - p[1] / 1.2 * 0.4;
+        p[1].abs() < 0.6 && p[0].hypot(p[2]) < r
+    });
+    exact("capped_cone(1, 0.2, 0.9)", |p| {
+        let r = 0.55 + p[1] * 0.7;
+        p[1].abs() < 0.5 && p[0].hypot(p[2]) < r
+    });
+    same("capped_cone(1.4, 0.6, 0.6)", "cylinder(0.6, 1.4)");
+    same("capped_cone(1.4, 0.6, 0)", "cone(0.6, 1.4)");
+}
+
+#[test]
+fn round_cone_is_exact() {
+    exact("round_cone(0.5, 0.2, 1)", |p| {
+        // Inside the hull of the two spheres: within the radius interpolated along the
+        // tangent cone, or inside either sphere.
+        let (r1, r2, h) = (0.5, 0.2, 1.0);
+        let q = (p[0].hypot(p[2]), p[1] + 0.5);
+        let s = (r1 - r2) / h;
+        let c = (1.0f64 - s * s).sqrt();
+        let k = -s * q.0 + c * q.1;
+        let side = q.0 * c + q.1 * s - r1;
+        q.0.hypot(q.1) < r1 || q.0.hypot(q.1 - h) < r2 || (k >= 0.0 && k <= c * h && side < 0.0)
+    });
+    same("round_cone(0.4, 0.4, 1.2)", "capsule(0.4, 1.2)");
+}
+
+#[test]
+fn segment_is_a_capsule_between_two_points() {
+    same(
+        "segment((0, -0.6, 0), (0, 0.6, 0), 0.3)",
+        "capsule(0.3, 1.2)",
+    );
+    same(
+        "segment((0.2, -0.1, 0.4), (0.2, 0.9, 0.4), 0.25)",
+        "capsule(0.25, 1).translate(0.2, 0.4, 0.4)",
+    );
+    same(
+        "segment((0.3, 0, 0), (0.3, 0, 0), 0.5)",
+        "sphere(0.5).translate(0.3, 0, 0)",
+    );
+    exact("segment((-0.5, -0.3, 0.2), (0.6, 0.4, -0.1), 0.3)", |p| {
+        let (a, b) = ([-0.5, -0.3, 0.2], [0.6, 0.4, -0.1]);
+        let ba = sub(b, a);
+        let pa = sub(p, a);
+        let t =
+            ((pa[0] * ba[0] + pa[1] * ba[1] + pa[2] * ba[2]) / (len(ba) * len(ba))).clamp(0.0, 1.0);
+        len(sub(pa, ba.map(|x| x * t))) < 0.3
+    });
+}
+
+#[test]
+fn rounded_cylinder_is_a_rounded_smaller_cylinder() {
+    same("rounded_cylinder(0.6, 0, 1.2)", "cylinder(0.6, 1.2)");
+    same(
+        "rounded_cylinder(0.6, 0.15, 1.2)",
+        "cylinder(0.45, 0.9).round(0.15)",
+    );
+    exact("rounded_cylinder(0.7, 0.2, 1)", |p| {
+        let (x, y) = (p[0].hypot(p[2]) - 0.5, p[1].abs() - 0.3);
+        let d = x.max(y).min(0.0) + x.max(0.0).hypot(y.max(0.0));
+        d < 0.2
+    });
+}
+
+#[test]
+fn prisms_are_exact() {
+    exact("hex_prism(0.6, 1.4)", |p| {
+        let (x, z) = (p[0].abs(), p[2].abs());
+        p[1].abs() < 0.7 && z < 0.6 && z * 0.5 + x * S3 * 0.5 < 0.6
+    });
+    exact("tri_prism(0.4, 1)", |p| {
+        // Sides 0.4 from the axis: z > -0.4 and the two sides through the corner (0, 0.8).
+        let (x, z) = (p[0].abs(), p[2]);
+        p[1].abs() < 0.5 && z > -0.4 && x * S3 * 0.5 + z * 0.5 < 0.4
+    });
+}
+
+#[test]
+fn octahedron_pyramid_frame_and_link_are_exact() {
+    exact("octahedron(1.1)", |p| {
+        p[0].abs() + p[1].abs() + p[2].abs() < 1.1
+    });
+    exact("pyramid(1.2, 1.5)", |p| {
+        // Base y = -0.75 of half-side 0.6, apex at y = 0.75.
+        let t = (p[1] + 0.75) / 1.5;
+        (0.0..1.0).contains(&t) && p[0].abs().max(p[2].abs()) < 0.6 * (1.0 - t)
+    });
+    exact("box_frame((0.8, 0.6, 0.5), 0.1)", |p| {
+        let q = [p[0].abs(), p[1].abs(), p[2].abs()];
+        let h = [0.8, 0.6, 0.5];
+        let inside = (0..3).all(|i| q[i] < h[i]);
+        let near = (0..3).filter(|&i| q[i] > h[i] - 0.2).count();
+        inside && near >= 2
+    });
+    exact("link(0.6, 0.5, 0.15)", |p| {
+        let y = (p[1].abs() - 0.3).max(0.0);
+        (p[0].hypot(y) - 0.5).hypot(p[2]) < 0.15
+    });
+}
+
+#[test]
+fn infinite_shapes_equal_huge_finite_ones_near_the_origin() {
+    same("slab(0.5)", "box((1e6, 0.25, 1e6))");
+    same("slab(0.5, (0, 0, 2))", "box((1e6, 1e6, 0.25))");
+    same("infinite_cylinder(0.4)", "cylinder(0.4, 2e6)");
+    same(
+        "infinite_cylinder(0.4, (1, 0, 0))",
+        "cylinder(0.4, 2e6).rotate_z(90deg)",
+    );
+    exact("infinite_cylinder(0.3, (1, 1, 0))", |p| {
+        let t = (p[0] + p[1]) * 0.5;
+        len([p[0] - t, p[1] - t, p[2]]) < 0.3
+    });
+    exact("slab(0.6, (1, 2, -1))", |p| {
+        (p[0] + 2.0 * p[1] - p[2]).abs() / 6f64.sqrt() < 0.3
+    });
+}
+
+/// The operands of the blend tests: two boxes crossing at right angles and a sphere.
+const A: &str = "box((0.8, 0.3, 0.5))";
+const B: &str = "sphere(0.5).translate(0.3, 0.3, 0)";
+
+#[test]
+fn blends_stay_within_their_recorded_lipschitz_bound() {
+    let mut rng = Rng::new(5);
+    let mut shapes = Vec::new();
+    for op in ["smooth_union", "smooth_intersect", "smooth_subtract"] {
+        for v in ["chamfer", "round", "stairs", "columns"] {
+            for steps in [1, 2, 5] {
+                shapes.push(format!(
+                    "{op}(0.3, {A}, {B}, variant: \"{v}\", steps: {steps})"
+                ));
+            }
+        }
+    }
+    for feature in [
+        "engrave(A, B, 0.1)",
+        "groove(A, B, 0.2, 0.1)",
+        "tongue(A, B, 0.2, 0.1)",
+        "pipe(A, B, 0.08)",
+    ] {
+        shapes.push(feature.replace('A', A).replace('B', B));
+    }
+    for shape in &shapes {
+        let (p, l) = program(shape);
+        let s = slope(&p, &mut rng, 1.5);
+        assert!(s <= l * (1.0 + 1e-9), "{shape}: slope {s} above L = {l}");
+    }
+}
+
+#[test]
+fn chamfer_and_features_follow_their_formulas() {
+    // At points where the operands are known: the box's face x = 0.8 and the sphere.
+    type Formula = fn(f64, f64) -> f64;
+    let cases: [(&str, Formula); 4] = [
+        ("smooth_union(0.3, A, B, variant: \"chamfer\")", |a, b| {
+            a.min(b)
+                .min((a + b - 0.3) * std::f64::consts::FRAC_1_SQRT_2)
+        }),
+        ("smooth_intersect(0.3, A, B, variant: \"round\")", |a, b| {
+            let u = ((0.3 + a).max(0.0)).hypot((0.3 + b).max(0.0));
+            (-0.3f64).min(a.max(b)) + u
+        }),
+        ("groove(A, B, 0.2, 0.1)", |a, b| {
+            a.max((a + 0.1).min(0.1 - b.abs()))
+        }),
+        ("tongue(A, B, 0.2, 0.1)", |a, b| {
+            a.min((a - 0.1).max(b.abs() - 0.1))
+        }),
+    ];
+    let (pa, _) = program(A);
+    let (pb, _) = program(B);
+    let mut rng = Rng::new(9);
+    for (shape, formula) in cases {
+        let shape = shape.replace('A', A).replace('B', B);
+        let (p, l) = program(&shape);
+        for _ in 0..500 {
+            let x = point(&mut rng, 1.5);
+            let want = formula(f(&pa, x), f(&pb, x));
+            let got = f(&p, x);
+            // A field of L > 1 is divided by L (and raised to its bound's distance) where only
+            // its zero set matters: the sign is kept.
+            if l <= 1.0 {
+                assert!((got - want).abs() < 1e-9, "{shape} at {x:?}: {got} {want}");
+            } else if want.abs() > 1e-9 {
+                assert_eq!(got < 0.0, want < 0.0, "{shape} at {x:?}: {got} {want}");
+            }
+        }
+    }
+}
+
+/// hg_sdf's `fOpUnionColumns`, with its restriction to a < r, b < r, in f64: what
+/// `blends.rs` evaluates everywhere must have the same sign, and never be above it.
+fn mercury_columns(a: f64, b: f64, r: f64, n: f64) -> f64 {
+    let s2 = std::f64::consts::SQRT_2;
+    if !(a < r && b < r) {
+        return a.min(b);
+    }
+    let c = r * s2 / ((n - 1.0) * 2.0 + s2);
+    let (mut px, mut py) = ((a + b) / s2, (b - a) / s2);
+    px += -s2 / 2.0 * r + c * s2;
+    if n % 2.0 == 1.0 {
+        py += c;
+    }
+    let size = 2.0 * c;
+    let y = py + size * 0.5;
+    let py = y - size * (y / size).floor() - size * 0.5;
+    (px.hypot(py) - c).min(px).min(a).min(b)
+}
+
+#[test]
+fn columns_everywhere_keep_the_surface_of_the_restricted_form() {
+    let mut rng = Rng::new(11);
+    for n in [1u32, 2, 3, 6] {
+        // The blend of the planes x = 0 and y = 0 as its operands a = x, b = y.
+        let shape = format!(
+            "smooth_union(0.4, plane((1, 0, 0), 0), plane((0, 1, 0), 0), variant: \"columns\", steps: {n})"
+        );
+        let (p, _) = program(&shape);
+        for _ in 0..4000 {
+            let x = point(&mut rng, 1.5);
+            let want = mercury_columns(x[0], x[1], 0.4, f64::from(n));
+            let got = f(&p, x);
+            if want.abs() > 1e-9 && got.abs() > 1e-9 {
+                assert_eq!(got < 0.0, want < 0.0, "{shape} at {x:?}: {got} {want}");
+            }
+            // (The program divides the field by its L = √2: compare outside only.)
+            assert!(
+                want < 0.0 || got <= want + 1e-9,
+                "{shape} at {x:?}: {got} {want}"
+            );
+        }
+    }
+}

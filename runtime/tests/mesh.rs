@@ -348,6 +348,21 @@ fn the_bracket_has_genus_three() {
     }
 }
 
+/// A bar of length 2π·R wrapped around radius R (`wrap`) closes into a ring: one closed
+/// manifold of genus one (χ = 0), with no seam where the bar's ends meet.
+#[test]
+fn a_wrapped_bar_meshes_to_a_ring_of_genus_one() {
+    let d = dir("wrap");
+    let scene = write_scene(
+        &d,
+        "ring.sdf",
+        "scene { wrap(box((4.71238898038469, 0.2, 0.25)), 1.5); }\n",
+    );
+    let out = d.join("ring.stl");
+    mesh(&[s(&scene), "-o", s(&out), "--resolution", "64"]);
+    assert_eq!(manifold(&read_stl(&out), "wrapped bar"), 0);
+}
+
 /// Every example: the objects of finite extent (with the floor cut to a box around them, or
 /// a fixed box where nothing is finite) mesh to a closed manifold with an even Euler
 /// characteristic, as a closed orientable surface has.

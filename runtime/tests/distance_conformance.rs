@@ -706,6 +706,7 @@ fn op_kind(op: &Op) -> &'static str {
             Unary::Acos => "acos",
             Unary::Exp => "exp",
             Unary::Log => "log",
+            Unary::Floor => "floor",
             Unary::Round => "round",
         },
         Op::Binary(b, ..) => match b {

@@ -135,6 +135,7 @@ fn unary(u: Unary, a: &str, ty: &str) -> String {
         Unary::Acos => format!("{a}.acos()"),
         Unary::Exp => format!("{a}.exp()"),
         Unary::Log => format!("{a}.ln()"),
+        Unary::Floor => format!("{a}.floor()"),
         Unary::Round => format!("({a} + 0.5_{ty}).floor()"),
     }
 }

@@ -704,7 +704,7 @@ fn unary_loop<T: Float>(u: Unary, d: &mut [T], a: &[T]) {
             }
         };
     }
-    arms!(Neg, Abs, Sqrt, Sin, Cos, Acos, Exp, Log, Round)
+    arms!(Neg, Abs, Sqrt, Sin, Cos, Acos, Exp, Log, Floor, Round)
 }
 
 /// One loop per operation, each specialised by `scalar::binary` with a constant operation.

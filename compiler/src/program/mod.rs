@@ -60,6 +60,8 @@ pub enum Unary {
     Exp,
     /// ln a
     Log,
+    /// ⌊a⌋
+    Floor,
     /// ⌊a + 0.5⌋
     Round,
 }

@@ -15,6 +15,7 @@ pub fn unary<T: Float>(u: Unary, a: T) -> T {
         Unary::Acos => a.acos(),
         Unary::Exp => a.exp(),
         Unary::Log => a.ln(),
+        Unary::Floor => a.floor(),
         Unary::Round => a.round_half_up(),
     }
 }

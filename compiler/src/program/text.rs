@@ -82,6 +82,7 @@ pub fn unary_name(u: Unary) -> &'static str {
         Unary::Acos => "acos",
         Unary::Exp => "exp",
         Unary::Log => "log",
+        Unary::Floor => "floor",
         Unary::Round => "round",
     }
 }

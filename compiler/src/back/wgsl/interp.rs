@@ -56,7 +56,7 @@ const UNARY: u32 = 6;
 const BINARY: u32 = 16;
 const SELECT: u32 = 25;
 
-const UNARIES: [Unary; 9] = [
+const UNARIES: [Unary; 10] = [
     Unary::Neg,
     Unary::Abs,
     Unary::Sqrt,
@@ -65,6 +65,7 @@ const UNARIES: [Unary; 9] = [
     Unary::Acos,
     Unary::Exp,
     Unary::Log,
+    Unary::Floor,
     Unary::Round,
 ];
 const BINARIES: [Binary; 9] = [
@@ -403,6 +404,7 @@ pub(super) fn write(file: usize, media: bool) -> String {
             Unary::Acos => "acos(a)",
             Unary::Exp => "exp(a)",
             Unary::Log => "log(a)",
+            Unary::Floor => "floor(a)",
             // ⌊a + 0.5⌋, as map.rs writes it.
             Unary::Round => "floor(a + 0.5)",
         };

@@ -490,6 +490,7 @@ fn expr(op: &Op, names: &Names, params: Option<&Params>) -> String {
                 Unary::Acos => format!("acos({a})"),
                 Unary::Exp => format!("exp({a})"),
                 Unary::Log => format!("log({a})"),
+                Unary::Floor => format!("floor({a})"),
                 // ⌊a + 0.5⌋, as on the CPU (WGSL's round() rounds halves to even).
                 Unary::Round => format!("floor({a} + 0.5)"),
             }

@@ -629,13 +629,14 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "shell",
         "elongate",
         "paint",
+        "field",
     ];
     let missing: Vec<_> = all_nodes.iter().filter(|n| !nodes.contains(*n)).collect();
     assert!(missing.is_empty(), "no feature scene has {missing:?}");
-    // Every operation but `floor`, which no lowering emits (repetition rounds).
+    // Every operation.
     let all_ops = [
-        "const", "input", "neg", "abs", "sqrt", "sin", "cos", "acos", "exp", "log", "round", "add",
-        "sub", "mul", "div", "min", "max", "pow", "atan2", "lt", "select", "phi",
+        "const", "input", "neg", "abs", "sqrt", "sin", "cos", "acos", "exp", "log", "floor",
+        "round", "add", "sub", "mul", "div", "min", "max", "pow", "atan2", "lt", "select", "phi",
     ];
     let missing: Vec<_> = all_ops.iter().filter(|o| !ops.contains(*o)).collect();
     assert!(
@@ -689,6 +690,7 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Shell { .. } => "shell",
         Node::Elongate { .. } => "elongate",
         Node::Paint { .. } => "paint",
+        Node::Field { .. } => "field",
     }
 }
 

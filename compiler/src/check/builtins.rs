@@ -425,6 +425,10 @@ pub fn constant(name: &str) -> Option<f64> {
     CONSTANTS.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
 }
 
+/// The error of a per-point builtin called with constants.
+const PER_POINT: &str =
+    "this is evaluated per point: call it inside `field { … }` with an argument that depends on `p`";
+
 /// Every builtin function.
 pub static BUILTINS: &[Builtin] = &[
     // Primitives.
@@ -1001,6 +1005,58 @@ pub static BUILTINS: &[Builtin] = &[
         name: "fract",
         sigs: sigs![
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, |x| x - x.floor());
+        ],
+    },
+    Builtin {
+        name: "mod",
+        sigs: sigs![
+            [p("a", F, Req, Any), p("b", F, Req, Any)] -> F => |_, a| {
+                let (x, y) = (a[0].num(), a[1].num());
+                Ok(Value::Float(x - y * (x / y).floor()))
+            };
+            [p("a", V, Req, Any), p("b", F, Req, Any)] -> V => |_, a| {
+                let y = a[1].num();
+                Ok(vmap(&a[0], |x| x - y * (x / y).floor()))
+            };
+        ],
+    },
+    Builtin {
+        name: "smoothstep",
+        sigs: sigs![
+            [p("edge0", F, Req, Any), p("edge1", F, Req, Any), p("x", F, Req, Any)] -> F => |_, a| {
+                let t = ((a[2].num() - a[0].num()) / (a[1].num() - a[0].num())).clamp(0.0, 1.0);
+                Ok(Value::Float(t * t * (3.0 - 2.0 * t)))
+            };
+        ],
+    },
+    // Per point (inside `field { … }`): with constant arguments they are errors.
+    Builtin {
+        name: "distance",
+        sigs: sigs![
+            [shape("shape"), p("at", V, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+        ],
+    },
+    Builtin {
+        name: "noise",
+        sigs: sigs![
+            [p("at", V, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+            [p("at", V2, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+        ],
+    },
+    Builtin {
+        name: "fbm",
+        sigs: sigs![
+            [p("at", V, Req, Any), p("octaves", I, Int(4), Within(1.0, 12.0)), p("lacunarity", F, Num(2.0), Within(1.0, 8.0)), p("gain", F, Num(0.5), Within(0.0, 1.0))] -> F
+                => |_, _| Err(PER_POINT.to_string());
+            [p("at", V2, Req, Any), p("octaves", I, Int(4), Within(1.0, 12.0)), p("lacunarity", F, Num(2.0), Within(1.0, 8.0)), p("gain", F, Num(0.5), Within(0.0, 1.0))] -> F
+                => |_, _| Err(PER_POINT.to_string());
+        ],
+    },
+    Builtin {
+        name: "voronoi",
+        sigs: sigs![
+            [p("at", V, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+            [p("at", V2, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
         ],
     },
     Builtin {

@@ -3,6 +3,7 @@
 //! parameters `Unknown` values of the declared types ("dry" evaluation: types only, no nodes).
 
 use super::builtins::{self, Build, Def, Range, P};
+use super::field;
 use super::ops;
 use super::suggest::closest;
 use super::types::{Type, Value};
@@ -59,6 +60,8 @@ pub struct Ctx {
     /// call repeated with the same arguments is evaluated once. With each, where its
     /// evaluation read the time `t`, if it did.
     memo: HashMap<String, (Value, Option<Span>)>,
+    /// Fields begun so far: each field's point is told apart from an enclosing one's.
+    fields: u32,
     /// The time `t` the scene is checked at, in seconds.
     pub time: f64,
     /// Reads of `t` so far (dry evaluation not counted): a count, to tell whether evaluating
@@ -139,10 +142,19 @@ impl Ctx {
             ExprKind::Tuple(items) => self.tuple(items, e.span),
             ExprKind::Unary(op, x) => {
                 let v = self.expr(x);
+                if field::is_point(&v) {
+                    return match field::unary(*op, &v) {
+                        Ok(v) => v,
+                        Err(msg) => self.per_point(msg, x.span),
+                    };
+                }
                 self.result(ops::unary(*op, &v), e.span)
             }
             ExprKind::Binary(op, a, b) => {
                 let (va, vb) = (self.expr(a), self.expr(b));
+                if field::is_point(&va) || field::is_point(&vb) {
+                    return self.point_binary(*op, (&va, a.span), (&vb, b.span), e.span);
+                }
                 match ops::binary(*op, &va, &vb) {
                     Ok(v) => self.finite(v, e.span),
                     Err(ops::OpError::Overflow) => self.overflow(e.span),
@@ -190,6 +202,7 @@ impl Ctx {
                 body,
             } => self.comprehension(var, from, to, body),
             ExprKind::Index(xs, i) => self.index(xs, i),
+            ExprKind::FieldBlock { args, body } => self.field_block(args, body, e.span),
             ExprKind::Error => Value::Error,
         }
     }
@@ -281,6 +294,13 @@ impl Ctx {
             Value::Int(i) => Ok(Some(i)),
             Value::Unknown(Type::Int) => Ok(None),
             Value::Error => Err(()),
+            v if field::is_point(&v) => {
+                cx.per_point(
+                    "the bounds of a range must be constants: a list's length cannot vary from point to point".into(),
+                    e.span,
+                );
+                Err(())
+            }
             other => {
                 cx.error(
                     Diagnostic::error("E0300", "the bounds of a range must be `int`", e.span)
@@ -530,7 +550,11 @@ impl Ctx {
         }
         let mut d = Diagnostic::error("E0200", format!("unknown name `{}`", id.name), id.span)
             .with_label("not defined");
-        if self.fns.contains_key(&id.name) || builtins::builtin(&id.name).is_some() {
+        if id.name == "p" {
+            d = d.with_help(
+                "`p` is the point inside `field { … }`; elsewhere every value is a constant",
+            );
+        } else if self.fns.contains_key(&id.name) || builtins::builtin(&id.name).is_some() {
             d = d.with_help(format!(
                 "`{}` is a function: call it as `{}(...)`",
                 id.name, id.name
@@ -605,6 +629,33 @@ impl Ctx {
     }
 
     fn field(&mut self, v: Value, name: &Ident) -> Value {
+        let dims = match v.ty() {
+            Some(Type::Vec2) => 2,
+            Some(Type::Vec3) => 3,
+            _ => 0,
+        };
+        // Swizzles (`p.xz`, `v.zyx`), and components of per-point vectors.
+        if dims > 0 && (name.name.len() > 1 || field::is_point(&v)) {
+            if let Some(idx) = field::swizzle(&name.name, dims) {
+                if let Some(c) = field::comps(&v) {
+                    let picked: Vec<_> = idx.iter().map(|&i| c[i].clone()).collect();
+                    if field::is_point(&v) {
+                        return field::point(picked);
+                    }
+                    let k: Vec<f64> = idx.iter().map(|&i| v.components()[i]).collect();
+                    return match k.len() {
+                        1 => Value::Float(k[0]),
+                        2 => Value::Vec2([k[0], k[1]]),
+                        _ => Value::Vec3([k[0], k[1], k[2]]),
+                    };
+                }
+                return Value::Unknown(match idx.len() {
+                    1 => Type::Float,
+                    2 => Type::Vec2,
+                    _ => Type::Vec3,
+                });
+            }
+        }
         let idx = match name.name.as_str() {
             "x" | "r" => 0,
             "y" | "g" => 1,
@@ -696,6 +747,175 @@ impl Ctx {
             Some(false) => b,
             None if failed => Value::Error,
             None => ta.or(tb).map_or(Value::Error, Value::Unknown),
+        }
+    }
+
+    /// E0410: a per-point value where a constant is needed, or an operation per-point values
+    /// do not support.
+    fn per_point(&mut self, msg: String, at: Span) -> Value {
+        self.error(
+            Diagnostic::error("E0410", msg, at)
+                .with_label("this depends on the point `p`")
+                .with_note(
+                    "inside `field { … }` what depends on `p` is computed per point; everything else is a constant computed once",
+                ),
+        );
+        Value::Error
+    }
+
+    /// `a op b` where an operand is per-point.
+    fn point_binary(
+        &mut self,
+        op: BinOp,
+        a: (&Value, Span),
+        b: (&Value, Span),
+        span: Span,
+    ) -> Value {
+        let (Some(ta), Some(tb)) = (a.0.ty(), b.0.ty()) else {
+            return Value::Error;
+        };
+        if a.0.is_abstract() || b.0.is_abstract() {
+            return Value::Error;
+        }
+        if ops::binary_type(op, ta, tb).is_none() {
+            let err = ops::OpError::Types(format!(
+                "`{}` cannot be applied to `{ta}` and `{tb}`",
+                op.symbol()
+            ));
+            return self.op_error(err, op, a, b, span);
+        }
+        match field::binary(op, a.0, b.0) {
+            Ok(v) => v,
+            Err(msg) => {
+                let at = if field::is_point(a.0) { a.1 } else { b.1 };
+                let v = self.per_point(msg, at);
+                if let Some(d) = self.diags.last_mut() {
+                    d.help = Some(
+                        "a field is continuous: combine values with `min`, `max`, `clamp`, `mix` or `smoothstep`"
+                            .into(),
+                    );
+                }
+                v
+            }
+        }
+    }
+
+    /// A builtin called with per-point arguments.
+    fn point_builtin(
+        &mut self,
+        b: &builtins::Builtin,
+        sig: &builtins::Sig,
+        vals: &[Value],
+        at: Span,
+        span: Span,
+    ) -> Value {
+        if vals.iter().any(Value::is_abstract) {
+            return if vals.contains(&Value::Error) {
+                Value::Error
+            } else {
+                Value::Unknown(sig.ret)
+            };
+        }
+        match field::builtin(b.name, vals) {
+            Some(Ok(v)) => v,
+            Some(Err(msg)) => {
+                self.error(
+                    Diagnostic::error("E0400", msg, span)
+                        .with_label(format!("in this call of `{}`", b.name)),
+                );
+                Value::Error
+            }
+            None => self.per_point(
+                format!("`{}` needs values known at compile time", b.name),
+                at,
+            ),
+        }
+    }
+
+    /// `field [(lipschitz: L)] { body }`: the body evaluated with `p` the point, its value
+    /// (a float of the point) the distance of a new field shape.
+    fn field_block(&mut self, args: &[Arg], body: &Body, span: Span) -> Value {
+        let mut lipschitz = None;
+        for a in args {
+            let named = a.name.as_ref().map(|n| n.name.as_str());
+            if !matches!(named, None | Some("lipschitz")) || args.len() > 1 {
+                let at = a.name.as_ref().map_or(a.value.span, |n| n.span);
+                self.error(
+                    Diagnostic::error("E0202", "`field` takes one argument, `lipschitz`", at)
+                        .with_label("not `lipschitz`")
+                        .with_help("declare a bound of the gradient: `field(lipschitz: 2) { … }`"),
+                );
+                return Value::Error;
+            }
+            match self.expr(&a.value).coerce(Type::Float) {
+                Some(Value::Float(l)) if l > 0.0 && l.is_finite() => lipschitz = Some(l),
+                Some(Value::Error) => return Value::Error,
+                Some(Value::Unknown(_)) => {}
+                Some(v @ Value::Float(_)) => {
+                    self.error(
+                        Diagnostic::error(
+                            "E0400",
+                            "`lipschitz` of `field` must be greater than 0",
+                            a.value.span,
+                        )
+                        .with_label(format!("this is {v}")),
+                    );
+                    return Value::Error;
+                }
+                other => {
+                    let v = other.unwrap_or(Value::Error);
+                    if field::is_point(&v) {
+                        return self.per_point(
+                            "`lipschitz` of `field` must be a constant".into(),
+                            a.value.span,
+                        );
+                    }
+                    self.error(type_mismatch("lipschitz", Type::Float, &v, a.value.span));
+                    return Value::Error;
+                }
+            }
+        }
+        self.fields += 1;
+        let owner = self.fields;
+        let coord = |i: u8| std::rc::Rc::new(field::Sx::Coord(i, owner));
+        let mark = self.locals.len();
+        self.locals
+            .push(("p".into(), field::point(vec![coord(0), coord(1), coord(2)])));
+        let v = self.body(body);
+        self.locals.truncate(mark);
+        let comps = match &v {
+            Value::Error => return Value::Error,
+            Value::Unknown(Type::Float | Type::Int) => return Value::Unknown(Type::Shape),
+            Value::Int(_) | Value::Float(_) | Value::Point(_)
+                if v.ty().is_some_and(|t| t.fits(Type::Float)) =>
+            {
+                field::comps(&v).unwrap_or_default()
+            }
+            other => {
+                self.error(
+                    Diagnostic::error(
+                        "E0300",
+                        format!(
+                            "the body of `field` is a `{}`, not a float",
+                            type_name(other)
+                        ),
+                        body.value.span,
+                    )
+                    .with_label(format!("this is `{}`", type_name(other)))
+                    .with_note("a field's body is its distance at the point `p`"),
+                );
+                return Value::Error;
+            }
+        };
+        if self.dry > 0 {
+            return Value::Unknown(Type::Shape);
+        }
+        match field::flatten(&comps, owner) {
+            Ok(f) => self.add_node(Node::Field { f, lipschitz }, span),
+            Err(field::OuterPoint) => self.per_point(
+                "this field reads the point `p` of an enclosing field".into(),
+                body.value.span,
+            ),
         }
     }
 
@@ -963,6 +1183,7 @@ impl Ctx {
         let mut vals = Vec::new();
         let mut ok = true;
         let mut abstract_ = false;
+        let mut point_at: Option<Span> = None;
         for (i, slot) in slots.slots.into_iter().enumerate() {
             let p: &P = &sig.params[i];
             let (v, vspan) = match slot {
@@ -971,6 +1192,9 @@ impl Ctx {
             };
             ok &= self.in_range(p, &v, vspan, callee);
             abstract_ |= v.is_abstract();
+            if field::is_point(&v) {
+                point_at.get_or_insert(vspan);
+            }
             vals.push(v);
         }
         let last = sig.params.last();
@@ -979,10 +1203,16 @@ impl Ctx {
                 ok &= self.in_range(p, &v, vspan, callee);
             }
             abstract_ |= v.is_abstract();
+            if field::is_point(&v) {
+                point_at.get_or_insert(vspan);
+            }
             vals.push(v);
         }
         if !ok {
             return Value::Error;
+        }
+        if let Some(at) = point_at {
+            return self.point_builtin(b, sig, &vals, at, span);
         }
         if abstract_ || self.dry > 0 {
             return if vals.contains(&Value::Error) {
@@ -1011,7 +1241,7 @@ impl Ctx {
     }
 
     fn in_range(&mut self, p: &P, v: &Value, span: Span, callee: &Ident) -> bool {
-        if v.is_abstract() || p.range == Range::Any || self.dry > 0 {
+        if v.is_abstract() || field::is_point(v) || p.range == Range::Any || self.dry > 0 {
             return true;
         }
         match p.range.check(v, &self.limits) {
@@ -1098,7 +1328,9 @@ impl Ctx {
             callee.name,
             frame.iter().map(|(_, v)| v).collect::<Vec<_>>()
         );
-        if let Some((v, read)) = self.memo.get(&key).cloned() {
+        // A call on per-point values builds expressions: it is not kept.
+        let keep = !frame.iter().any(|(_, v)| field::is_point(v));
+        if let Some((v, read)) = self.memo.get(&key).cloned().filter(|_| keep) {
             self.locals = saved;
             if let Some(at) = read {
                 self.read_time(at);
@@ -1122,7 +1354,9 @@ impl Ctx {
         }
         self.locals = saved;
         let v = v.coerce(ret).unwrap_or(Value::Error);
-        self.memo.insert(key, (v.clone(), read));
+        if keep && !field::is_point(&v) {
+            self.memo.insert(key, (v.clone(), read));
+        }
         v
     }
 
@@ -1573,6 +1807,14 @@ pub fn record(
                 out.insert(p.name, Value::Error);
                 continue;
             }
+        }
+        if field::is_point(&v) {
+            cx.per_point(
+                format!("`{}` of `{}` must be a constant", p.name, rec.name),
+                f.value.span,
+            );
+            out.insert(p.name, Value::Error);
+            continue;
         }
         let v = match v.clone().coerce(p.ty) {
             Some(c) => c,

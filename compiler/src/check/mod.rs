@@ -7,6 +7,7 @@
 
 pub mod builtins;
 mod eval;
+pub mod field;
 mod ops;
 mod placement;
 mod suggest;
@@ -491,6 +492,11 @@ fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
             ast::ExprKind::Index(a, b) => stack.extend([&**a, &**b]),
             ast::ExprKind::Comprehension { from, to, body, .. } => {
                 stack.extend([&**from, &**to]);
+                stack.extend(body.lets.iter().map(|l| &l.value));
+                stack.push(&body.value);
+            }
+            ast::ExprKind::FieldBlock { args, body } => {
+                stack.extend(args.iter().map(|a| &a.value));
                 stack.extend(body.lets.iter().map(|l| &l.value));
                 stack.push(&body.value);
             }

@@ -110,6 +110,9 @@ pub enum Value {
     Shape(NodeId),
     /// A list: its element type and its elements (each of that type, or `Error`).
     List(&'static Type, Rc<[Value]>),
+    /// A number or vector that depends on the point `p` of a `field` (1, 2 or 3 components):
+    /// an expression evaluated per point, not a constant.
+    Point(super::field::Comps),
     Unknown(Type),
     Error,
 }
@@ -127,6 +130,11 @@ impl Value {
             Value::Str(_) => Type::Str,
             Value::Shape(_) => Type::Shape,
             Value::List(elem, _) => Type::List(elem),
+            Value::Point(c) => match c.len() {
+                1 => Type::Float,
+                2 => Type::Vec2,
+                _ => Type::Vec3,
+            },
             Value::Unknown(t) => *t,
             Value::Error => return None,
         })
@@ -151,6 +159,8 @@ impl Value {
                     items.iter().map(|v| v.clone().coerce(*w)).collect();
                 Some(Value::List(w, items?.into()))
             }
+            // A per-point number is a float already.
+            (Value::Point(c), Type::Float) if c.len() == 1 => Some(Value::Point(c)),
             (v, w) if v.ty() == Some(w) => Some(v),
             _ => None,
         }
@@ -206,6 +216,7 @@ impl fmt::Display for Value {
                     write!(f, "[{}]", head.join(", "))
                 }
             }
+            Value::Point(_) => write!(f, "<{} of the point>", self.ty().unwrap_or(Type::Float)),
             Value::Unknown(t) => write!(f, "<{t}>"),
             Value::Error => write!(f, "<error>"),
         }

@@ -12,6 +12,7 @@
 
 mod fuse;
 mod tape;
+pub mod verify;
 mod wide;
 
 /// The evaluation types, at the path they had when they were defined here.

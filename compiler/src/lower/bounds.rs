@@ -209,7 +209,7 @@ impl Bounds {
                 *half,
                 DVec3::from(half.map(|h| (h - radius).max(0.0))).length() + radius,
             ),
-            Node::Plane { .. } => return None,
+            Node::Plane { .. } | Node::Field { .. } => return None,
             Node::Torus { major, minor } => {
                 Bound::of_box([major + minor, *minor, major + minor], major + minor)
             }
@@ -590,5 +590,6 @@ fn own_cost(node: &Node) -> f64 {
         Node::Elongate { .. } => 9.0,
         Node::Round { .. } | Node::Shell { .. } => 2.0,
         Node::Paint { .. } => 3.0,
+        Node::Field { f, .. } => f.cost(),
     }
 }

@@ -10,8 +10,9 @@
 use super::bounds::{Aabb, Bound, Bounds};
 use super::builder::{Builder, P};
 use super::bvh::{self, Kind, Tree};
-use super::{blends, shapes, Binary, Reg, Unary, EMPTY_DISTANCE};
+use super::{blends, field, shapes, Binary, Reg, Unary, EMPTY_DISTANCE};
 use crate::scene::analysis::{self, Analysis, Window};
+use crate::scene::field::{FOp, FieldFn};
 use crate::scene::{Combine, Feature, Graph, Node, NodeId, Smooth, V3};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -380,6 +381,7 @@ impl<'a> Lowerer<'a> {
                     m: self.material(Combine::Union, fa, fb),
                 }
             }
+            Node::Field { f, .. } => self.field(id, f, p),
             Node::ScaleXyz { factors, child } => {
                 let q = self.b.map3(p, |b, x, i| b.mulc(x, 1.0 / factors[i]));
                 let s = factors.iter().fold(f64::INFINITY, |m, f| m.min(f.abs()));
@@ -389,6 +391,35 @@ impl<'a> Lowerer<'a> {
                 Some((child, q)) => self.node(child, q),
                 None => self.primitive(node, p),
             },
+        }
+    }
+
+    /// A user field: its operations in order, the shapes it reads lowered at their points.
+    fn field(&mut self, id: NodeId, f: &FieldFn, p: P) -> Field {
+        let mut regs: Vec<Reg> = Vec::with_capacity(f.ops.len());
+        let mut resumed = true;
+        for op in &f.ops {
+            let r = match op {
+                FOp::Distance(shape, q) => {
+                    let q = q.map(|s| regs[s as usize]);
+                    let d = self.node(*shape, q).d;
+                    resumed = false;
+                    d
+                }
+                other => {
+                    if !resumed {
+                        self.resume(id, self.graph.node(id));
+                        resumed = true;
+                    }
+                    field::op(self.b, other, p, &regs)
+                }
+            };
+            regs.push(r);
+        }
+        let d = f.out.first().map_or(p[0], |&s| regs[s as usize]);
+        Field {
+            d,
+            m: self.b.c(UNPAINTED),
         }
     }
 

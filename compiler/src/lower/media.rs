@@ -112,7 +112,11 @@ fn kinds(
     let k = match node {
         Node::Paint { material, child } => kinds(scene, *child, Some(*material), memo),
         _ => {
-            let children = node.children();
+            // A field's surface is its own: the shapes it reads are not drawn.
+            let children = match node {
+                Node::Field { .. } => Vec::new(),
+                _ => node.children(),
+            };
             if children.is_empty() {
                 let m = scene.material(paint.unwrap_or(MaterialId(0)));
                 if m.transparency > 0.0 {

@@ -11,6 +11,7 @@ mod blends;
 mod bounds;
 mod builder;
 mod bvh;
+mod field;
 mod graph;
 mod instances;
 mod media;

@@ -151,6 +151,10 @@ impl Simplifier<'_> {
                 let c = self.node(child);
                 self.paint(material, c)
             }
+            Node::Field { f, lipschitz } => {
+                let f = f.remap(|id| self.node(id));
+                self.add(Node::Field { f, lipschitz })
+            }
             other => self.unary(other),
         }
     }

@@ -760,7 +760,35 @@ impl Pass<'_> {
                 d
             }
             Node::Paint { child, .. } => self.get(*child),
+            Node::Field { f, lipschitz } => self.field(id, f, *lipschitz),
         }
+    }
+
+    /// A user field: its declared L, or the one derived from its expression (the shapes it
+    /// reads contributing their own proven constants), or nothing proven. Its solid may be
+    /// anywhere.
+    fn field(&self, id: NodeId, f: &super::field::FieldFn, declared: Option<f64>) -> Derived {
+        let mut d = exact(Aabb::ALL, [false; 3]);
+        let l = declared.unwrap_or_else(|| {
+            field::lipschitz(f, |s| {
+                let c = self.get(s);
+                if c.proven {
+                    c.gradient
+                } else {
+                    f64::INFINITY
+                }
+            })
+        });
+        if !l.is_finite() {
+            return unproven(d, id);
+        }
+        d.facts.lipschitz = l;
+        d.gradient = l;
+        d.facts.exactness = classify(l, true);
+        if d.facts.exactness != Exactness::Exact {
+            d.cause = Some(id);
+        }
+        d
     }
 
     /// Union, intersection, subtraction: L is the largest of the children's (a min or max of
@@ -1301,6 +1329,7 @@ fn fmt(x: f64) -> String {
 }
 
 mod aabb;
+pub mod field;
 #[cfg(test)]
 mod tests;
 mod warnings;

@@ -368,6 +368,10 @@ fn node(n: &Node) -> String {
         Node::Shell { thickness, child } => format!("shell {} %{}", num(*thickness), child.0),
         Node::Elongate { half, child } => format!("elongate {} %{}", v3(*half), child.0),
         Node::Paint { material, child } => format!("paint #{} %{}", material.0, child.0),
+        Node::Field { f, lipschitz } => match lipschitz {
+            Some(l) => format!("field lipschitz={} {{ {} }}", num(*l), f.text()),
+            None => format!("field {{ {} }}", f.text()),
+        },
     }
 }
 

@@ -263,6 +263,12 @@ pub enum Node {
     Elongate { half: V3, child: NodeId },
     /// Child painted with a material (inner materials take precedence).
     Paint { material: MaterialId, child: NodeId },
+    /// A user field (`field { … }`): the distance is an expression of the point, which may
+    /// read other shapes' distances; its L is derived from the expression, or declared.
+    Field {
+        f: super::field::FieldFn,
+        lipschitz: Option<f64>,
+    },
 }
 
 /// The pattern of every node with exactly one child (the transforms, the modifiers and
@@ -297,6 +303,7 @@ impl Node {
             | Node::Morph { a, b, .. }
             | Node::Feature { a, b, .. } => vec![*a, *b],
             one_child!(child) => vec![*child],
+            Node::Field { f, .. } => f.shapes(),
             _ => Vec::new(),
         }
     }
@@ -355,6 +362,7 @@ impl Node {
             Node::Shell { .. } => "shell",
             Node::Elongate { .. } => "elongate",
             Node::Paint { .. } => "paint",
+            Node::Field { .. } => "field",
         }
     }
 

@@ -3,6 +3,7 @@
 pub mod analysis;
 pub mod analytic;
 mod dump;
+pub mod field;
 pub mod ir;
 pub mod recentre;
 

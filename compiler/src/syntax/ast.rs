@@ -256,6 +256,9 @@ pub enum ExprKind {
     },
     /// `xs[i]`: an element of a list.
     Index(Box<Expr>, Box<Expr>),
+    /// `field [args] { body }`: a shape whose distance is the body's value at the point `p`
+    /// (the arguments: `lipschitz`, a declared bound of its gradient).
+    FieldBlock { args: Vec<Arg>, body: Body },
     /// An expression that did not parse (already reported).
     Error,
 }

@@ -178,6 +178,15 @@ impl Dumper {
                 d.expr(xs);
                 d.expr(i);
             }),
+            ExprKind::FieldBlock { args, body } => self.nested("field", |d| {
+                for a in args {
+                    match &a.name {
+                        Some(n) => d.nested(format!("arg {}", n.name), |d| d.expr(&a.value)),
+                        None => d.expr(&a.value),
+                    }
+                }
+                d.body(body);
+            }),
             ExprKind::Error => self.line("<error>"),
         }
     }

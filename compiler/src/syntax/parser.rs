@@ -366,7 +366,21 @@ where
                 move |s| mk(ExprKind::Error, s),
             )));
 
-        let atom = choice((literal, call, var, tuple, list, if_expr))
+        // `field_shape = ident [ args ] body`, the name being `field` (a name elsewhere).
+        let field = select! { Token::Ident(name) if name == "field" => () }
+            .ignore_then(args.clone().or_not())
+            .then(body.clone())
+            .map_with(move |(args, body), e| {
+                mk(
+                    ExprKind::FieldBlock {
+                        args: args.unwrap_or_default(),
+                        body,
+                    },
+                    e.span(),
+                )
+            });
+
+        let atom = choice((literal, field, call, var, tuple, list, if_expr))
             .labelled("expression")
             .boxed();
 

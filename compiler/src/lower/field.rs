@@ -1,0 +1,255 @@
+//! Lowering of the operations of a user field (`scene::field`) to program instructions, and
+//! of its noise: gradient noise and the Voronoi distance over a lattice hashed by the
+//! permutation polynomial (34x² + x) mod 289 (Gustavson and McEwan's webgl-noise), computed
+//! on whole numbers below 2²⁴ so that every evaluator, f32 or f64, finds the same cell hashes
+//! exactly (docs/language.md, "Noise").
+
+use super::builder::{Builder, P};
+use super::{Reg, Unary};
+use crate::program::Binary;
+use crate::scene::field::{FBin, FOp, FUn, GOLDEN_TURN, NOISE_CELLS, VORONOI_LO, VORONOI_SPAN};
+use std::f64::consts::TAU;
+
+/// The instructions of one operation other than [`FOp::Distance`] (which the caller lowers
+/// as a shape), given the registers of the earlier ones.
+pub(super) fn op(b: &mut Builder, op: &FOp, p: P, regs: &[Reg]) -> Reg {
+    let r = |s: &u32| regs[*s as usize];
+    match op {
+        FOp::Coord(a) => p[*a as usize % 3],
+        FOp::Const(c) => b.c(*c),
+        FOp::Un(u, a) => unary(b, *u, r(a)),
+        FOp::Bin(o, x, y) => {
+            let (x, y) = (r(x), r(y));
+            let o = match o {
+                FBin::Add => Binary::Add,
+                FBin::Sub => Binary::Sub,
+                FBin::Mul => Binary::Mul,
+                FBin::Div => Binary::Div,
+                FBin::Min => Binary::Min,
+                FBin::Max => Binary::Max,
+                FBin::Pow => Binary::Pow,
+                FBin::Atan2 => Binary::Atan2,
+            };
+            b.bin(o, x, y)
+        }
+        FOp::Length(v) => {
+            let mut acc: Option<Reg> = None;
+            for s in v {
+                let x = r(s);
+                let sq = b.mul(x, x);
+                acc = Some(match acc {
+                    None => sq,
+                    Some(a) => b.add(a, sq),
+                });
+            }
+            let sum = acc.unwrap_or_else(|| b.c(0.0));
+            b.sqrt(sum)
+        }
+        FOp::Noise(v) => {
+            let q: Vec<Reg> = v.iter().map(r).collect();
+            noise(b, &q)
+        }
+        FOp::Voronoi(v) => {
+            let q: Vec<Reg> = v.iter().map(r).collect();
+            voronoi(b, &q)
+        }
+        FOp::Distance(..) => b.c(0.0),
+    }
+}
+
+fn unary(b: &mut Builder, u: FUn, a: Reg) -> Reg {
+    match u {
+        FUn::Neg => b.neg(a),
+        FUn::Abs => b.abs(a),
+        FUn::Sqrt => b.sqrt(a),
+        FUn::Sin => b.un(Unary::Sin, a),
+        FUn::Cos => b.un(Unary::Cos, a),
+        FUn::Tan => {
+            let s = b.un(Unary::Sin, a);
+            let c = b.un(Unary::Cos, a);
+            b.div(s, c)
+        }
+        FUn::Exp => b.un(Unary::Exp, a),
+        FUn::Log => b.un(Unary::Log, a),
+        FUn::Floor => b.un(Unary::Floor, a),
+        FUn::Smooth => {
+            let t = b.clampc(a, 0.0, 1.0);
+            let t2 = b.mul(t, t);
+            let twice = b.mulc(t, 2.0);
+            let three = b.c(3.0);
+            let k = b.sub(three, twice);
+            b.mul(t2, k)
+        }
+    }
+}
+
+/// x mod 289 for a whole number x (|x| < 2²³): x − ⌊(x + ½)/289⌋·289, the half keeping the
+/// quotient's rounding away from whole numbers.
+fn mod289(b: &mut Builder, x: Reg) -> Reg {
+    let h = b.addc(x, 0.5);
+    let q = b.mulc(h, 1.0 / NOISE_CELLS);
+    let f = b.un(Unary::Floor, q);
+    let m = b.mulc(f, NOISE_CELLS);
+    b.sub(x, m)
+}
+
+/// The permutation (34x² + x) mod 289 of a whole number 0 ≤ x ≤ 289 (products below 2²²).
+fn perm(b: &mut Builder, x: Reg) -> Reg {
+    let k = b.mulc(x, 34.0);
+    let k = b.addc(k, 1.0);
+    let y = b.mul(k, x);
+    mod289(b, y)
+}
+
+/// The hash of the lattice cell whose reduced coordinates are `a` (each in [−1, 289]).
+fn cell_hash(b: &mut Builder, a: &[Reg]) -> Reg {
+    let mut h = perm(b, a[0]);
+    for &x in &a[1..] {
+        let s = b.add(h, x);
+        let s = mod289(b, s);
+        h = perm(b, s);
+    }
+    h
+}
+
+/// fract(h·k) for a whole number h: its product never comes near a whole number for the
+/// irrational k used here (h < 289), so every evaluator takes the same branch.
+fn fract_of(b: &mut Builder, h: Reg, k: f64) -> Reg {
+    let x = b.mulc(h, k);
+    let f = b.un(Unary::Floor, x);
+    b.sub(x, f)
+}
+
+/// The unit gradient of hash `h`: on the unit circle in 2D, on a Fibonacci spiral over the
+/// sphere in 3D.
+fn gradient(b: &mut Builder, h: Reg, dims: usize) -> Vec<Reg> {
+    let turn = fract_of(b, h, GOLDEN_TURN);
+    let phi = b.mulc(turn, TAU);
+    let c = b.un(Unary::Cos, phi);
+    let s = b.un(Unary::Sin, phi);
+    if dims == 2 {
+        return vec![c, s];
+    }
+    // z = 1 − (2h + 1)/289, r = √(1 − z²).
+    let z = b.mulc(h, -2.0 / NOISE_CELLS);
+    let z = b.addc(z, 1.0 - 1.0 / NOISE_CELLS);
+    let z2 = b.mul(z, z);
+    let one = b.c(1.0);
+    let r2 = b.sub(one, z2);
+    let r2 = b.maxc(r2, 0.0);
+    let r = b.sqrt(r2);
+    vec![b.mul(r, c), b.mul(r, s), z]
+}
+
+/// The quintic fade t³(t(6t − 15) + 10).
+fn fade(b: &mut Builder, t: Reg) -> Reg {
+    let a = b.mulc(t, 6.0);
+    let a = b.subc(a, 15.0);
+    let a = b.mul(a, t);
+    let a = b.addc(a, 10.0);
+    let t2 = b.mul(t, t);
+    let t3 = b.mul(t2, t);
+    b.mul(t3, a)
+}
+
+/// a + (c − a)·s.
+fn lerp(b: &mut Builder, a: Reg, c: Reg, s: Reg) -> Reg {
+    let d = b.sub(c, a);
+    let m = b.mul(d, s);
+    b.add(a, m)
+}
+
+/// Gradient noise at `q` (2 or 3 coordinates): the lattice cell's corners each contribute
+/// the dot product of their gradient with the offset from the corner, blended by the quintic
+/// fade of the fractional coordinates (Perlin 2002).
+pub(super) fn noise(b: &mut Builder, q: &[Reg]) -> Reg {
+    let dims = q.len();
+    let mut f = Vec::with_capacity(dims);
+    let mut a = Vec::with_capacity(dims);
+    for &x in q {
+        let i = b.un(Unary::Floor, x);
+        f.push(b.sub(x, i));
+        let r = mod289(b, i);
+        let r1 = b.addc(r, 1.0);
+        a.push([r, r1]);
+    }
+    let s: Vec<Reg> = f.iter().map(|&t| fade(b, t)).collect();
+    // Each corner's contribution, corners numbered with bit k for axis k.
+    let corners = 1usize << dims;
+    let mut v: Vec<Reg> = (0..corners)
+        .map(|c| {
+            let cell: Vec<Reg> = (0..dims).map(|k| a[k][(c >> k) & 1]).collect();
+            let h = cell_hash(b, &cell);
+            let g = gradient(b, h, dims);
+            let mut dot: Option<Reg> = None;
+            for k in 0..dims {
+                let off = if (c >> k) & 1 == 1 {
+                    b.subc(f[k], 1.0)
+                } else {
+                    f[k]
+                };
+                let t = b.mul(g[k], off);
+                dot = Some(match dot {
+                    None => t,
+                    Some(d) => b.add(d, t),
+                });
+            }
+            dot.expect("two or three axes")
+        })
+        .collect();
+    // Blend along x, then y, then z.
+    for &sk in &s {
+        v = v
+            .chunks(2)
+            .map(|pair| lerp(b, pair[0], pair[1], sk))
+            .collect();
+    }
+    v[0]
+}
+
+/// The distance from `q` to the nearest feature point of the lattice: one per cell, at
+/// `VORONOI_LO + VORONOI_SPAN · (fract(h·k₁), …)` within it, so that the nearest lies in the
+/// 3 (×3 ×3) cells around the point's own.
+pub(super) fn voronoi(b: &mut Builder, q: &[Reg]) -> Reg {
+    const TURNS: [f64; 3] = [
+        GOLDEN_TURN,
+        std::f64::consts::SQRT_2 - 1.0,
+        1.732_050_807_568_877_2 - 1.0,
+    ];
+    let dims = q.len();
+    let mut f = Vec::with_capacity(dims);
+    let mut a = Vec::with_capacity(dims);
+    for &x in q {
+        let i = b.un(Unary::Floor, x);
+        f.push(b.sub(x, i));
+        a.push(mod289(b, i));
+    }
+    let cells = 3usize.pow(dims as u32);
+    let mut best: Option<Reg> = None;
+    for c in 0..cells {
+        let offset: Vec<i32> = (0..dims)
+            .map(|k| (c / 3usize.pow(k as u32) % 3) as i32 - 1)
+            .collect();
+        let cell: Vec<Reg> = (0..dims).map(|k| b.addc(a[k], offset[k] as f64)).collect();
+        let h = cell_hash(b, &cell);
+        let mut d2: Option<Reg> = None;
+        for k in 0..dims {
+            let j = fract_of(b, h, TURNS[k]);
+            let j = b.mulc(j, VORONOI_SPAN);
+            let feature = b.addc(j, f64::from(offset[k]) + VORONOI_LO);
+            let d = b.sub(feature, f[k]);
+            let sq = b.mul(d, d);
+            d2 = Some(match d2 {
+                None => sq,
+                Some(s) => b.add(s, sq),
+            });
+        }
+        let d2 = d2.expect("two or three axes");
+        best = Some(match best {
+            None => d2,
+            Some(m) => b.min(m, d2),
+        });
+    }
+    let best = best.expect("cells");
+    b.sqrt(best)
+}

@@ -1,0 +1,456 @@
+//! The Lipschitz bound of a user field, derived from its expression (docs/analysis.md,
+//! "Fields"): every operation's value gets an interval, an interval per component of its
+//! gradient, and a bound of its gradient's length; each rule bounds an operation's derivative
+//! over its operands' intervals (the chain rule), and the field's L is the bound of its value.
+//! An operation whose derivative is unbounded there (a division by a range holding 0, `floor`
+//! across an integer, `sqrt` near 0) makes the bound infinite: nothing is proven.
+
+use crate::scene::field::{
+    FBin, FOp, FUn, FieldFn, NOISE_LIPSCHITZ, NOISE_RANGE, VORONOI_LO, VORONOI_SPAN,
+};
+use crate::scene::NodeId;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// A closed interval; infinite ends allowed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Iv {
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl Iv {
+    const ALL: Iv = Iv {
+        lo: f64::NEG_INFINITY,
+        hi: f64::INFINITY,
+    };
+    const ZERO: Iv = Iv { lo: 0.0, hi: 0.0 };
+
+    fn new(lo: f64, hi: f64) -> Iv {
+        if lo.is_nan() || hi.is_nan() {
+            Iv::ALL
+        } else {
+            Iv { lo, hi }
+        }
+    }
+    fn point(x: f64) -> Iv {
+        Iv::new(x, x)
+    }
+    fn sym(m: f64) -> Iv {
+        Iv::new(-m, m)
+    }
+    /// The largest magnitude.
+    fn mag(self) -> f64 {
+        self.lo.abs().max(self.hi.abs())
+    }
+    fn add(self, o: Iv) -> Iv {
+        Iv::new(self.lo + o.lo, self.hi + o.hi)
+    }
+    fn neg(self) -> Iv {
+        Iv::new(-self.hi, -self.lo)
+    }
+    fn sub(self, o: Iv) -> Iv {
+        self.add(o.neg())
+    }
+    fn mul(self, o: Iv) -> Iv {
+        if self == Iv::ZERO || o == Iv::ZERO {
+            return Iv::ZERO;
+        }
+        // 0 · ∞ is a product of a bounded factor with an unbounded one: 0 stands for it.
+        let p = |a: f64, b: f64| {
+            let x = a * b;
+            if x.is_nan() {
+                0.0
+            } else {
+                x
+            }
+        };
+        let c = [
+            p(self.lo, o.lo),
+            p(self.lo, o.hi),
+            p(self.hi, o.lo),
+            p(self.hi, o.hi),
+        ];
+        Iv::new(
+            c.iter().fold(f64::INFINITY, |a, &b| a.min(b)),
+            c.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b)),
+        )
+    }
+    fn hull(self, o: Iv) -> Iv {
+        Iv::new(self.lo.min(o.lo), self.hi.max(o.hi))
+    }
+    fn contains(self, x: f64) -> bool {
+        self.lo <= x && x <= self.hi
+    }
+    /// The square: never negative.
+    fn sqr(self) -> Iv {
+        let m = self.mag();
+        let lo = if self.contains(0.0) {
+            0.0
+        } else {
+            self.lo.abs().min(self.hi.abs())
+        };
+        Iv::new(lo * lo, m * m)
+    }
+}
+
+/// What is known of one value of the expression.
+#[derive(Debug, Clone, Copy)]
+struct Val {
+    range: Iv,
+    /// ∂/∂x, ∂/∂y, ∂/∂z.
+    grad: [Iv; 3],
+    /// A bound of the gradient's length.
+    norm: f64,
+}
+
+impl Val {
+    /// The best bound of the gradient's length: the norm bound, or the length of the
+    /// gradient's component intervals.
+    fn n(&self) -> f64 {
+        let g = self
+            .grad
+            .iter()
+            .map(|c| c.mag().powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let n = self.norm.min(g);
+        if n.is_nan() {
+            f64::INFINITY
+        } else {
+            n
+        }
+    }
+
+    /// `φ(self)` where φ' lies in `d` over the operand's range.
+    fn chain(&self, range: Iv, d: Iv) -> Val {
+        Val {
+            range,
+            grad: self.grad.map(|g| d.mul(g)),
+            norm: mul0(d.mag(), self.n()),
+        }
+    }
+}
+
+/// a · b with 0 · ∞ = 0 (a zero derivative of an unbounded operand).
+fn mul0(a: f64, b: f64) -> f64 {
+    if a == 0.0 || b == 0.0 {
+        0.0
+    } else {
+        a * b
+    }
+}
+
+/// A bound of the operator norm of the Jacobian whose rows are `rows`' gradients: the least
+/// of the Frobenius norm of the magnitudes, √(‖·‖₁ ‖·‖∞) of them, and the rows' bounds'
+/// root sum of squares.
+fn jacobian_norm(rows: &[Val]) -> f64 {
+    let m: Vec<[f64; 3]> = rows.iter().map(|r| r.grad.map(Iv::mag)).collect();
+    let frob = m.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
+    let row = m.iter().map(|r| r.iter().sum::<f64>()).fold(0.0, f64::max);
+    let col = (0..3)
+        .map(|j| m.iter().map(|r| r[j]).sum::<f64>())
+        .fold(0.0, f64::max);
+    let rss = rows.iter().map(|r| r.n().powi(2)).sum::<f64>().sqrt();
+    let n = frob.min((row * col).sqrt()).min(rss);
+    if n.is_nan() {
+        f64::INFINITY
+    } else {
+        n
+    }
+}
+
+/// An L-Lipschitz function of the vector `rows`: the gradient component j is at most L times
+/// the length of column j of the Jacobian.
+fn lipschitz_of(rows: &[Val], l: f64, range: Iv) -> Val {
+    let grad = [0, 1, 2].map(|j| {
+        let c = rows
+            .iter()
+            .map(|r| r.grad[j].mag().powi(2))
+            .sum::<f64>()
+            .sqrt();
+        Iv::sym(mul0(l, c))
+    });
+    Val {
+        range,
+        grad,
+        norm: mul0(l, jacobian_norm(rows)),
+    }
+}
+
+/// The range of sin over `x`.
+fn sin_range(x: Iv) -> Iv {
+    if !(x.hi - x.lo < 2.0 * PI) {
+        return Iv::new(-1.0, 1.0);
+    }
+    let mut r = Iv::point(x.lo.sin()).hull(Iv::point(x.hi.sin()));
+    // The extremes at π/2 + kπ within the interval.
+    let k0 = ((x.lo - FRAC_PI_2) / PI).ceil();
+    let mut k = k0;
+    while FRAC_PI_2 + k * PI <= x.hi {
+        let v = if (k as i64).rem_euclid(2) == 0 {
+            1.0
+        } else {
+            -1.0
+        };
+        r = r.hull(Iv::point(v));
+        k += 1.0;
+        if k - k0 > 3.0 {
+            break;
+        }
+    }
+    r
+}
+
+fn unary(u: FUn, a: &Val) -> Val {
+    let r = a.range;
+    let unbounded = |range: Iv| Val {
+        range,
+        grad: [Iv::ALL; 3],
+        norm: f64::INFINITY,
+    };
+    match u {
+        FUn::Neg => a.chain(r.neg(), Iv::point(-1.0)),
+        FUn::Abs => {
+            let range = if r.lo >= 0.0 {
+                r
+            } else if r.hi <= 0.0 {
+                r.neg()
+            } else {
+                Iv::new(0.0, r.mag())
+            };
+            let d = if r.lo >= 0.0 {
+                Iv::point(1.0)
+            } else if r.hi <= 0.0 {
+                Iv::point(-1.0)
+            } else {
+                Iv::new(-1.0, 1.0)
+            };
+            a.chain(range, d)
+        }
+        FUn::Sqrt => {
+            let lo = r.lo.max(0.0);
+            let range = Iv::new(lo.sqrt(), r.hi.max(0.0).sqrt());
+            if lo > 0.0 {
+                a.chain(range, Iv::new(0.5 / r.hi.sqrt(), 0.5 / lo.sqrt()))
+            } else {
+                unbounded(range)
+            }
+        }
+        FUn::Sin => a.chain(
+            sin_range(r),
+            sin_range(Iv::new(r.lo + FRAC_PI_2, r.hi + FRAC_PI_2)),
+        ),
+        FUn::Cos => a.chain(
+            sin_range(Iv::new(r.lo + FRAC_PI_2, r.hi + FRAC_PI_2)),
+            sin_range(r).neg(),
+        ),
+        FUn::Tan => {
+            // Within one branch (−π/2, π/2) + kπ, tan is increasing with tan' = 1 + tan².
+            let k = (r.lo / PI + 0.5).floor();
+            let (lo, hi) = (k * PI - FRAC_PI_2, k * PI + FRAC_PI_2);
+            if r.lo > lo && r.hi < hi {
+                let range = Iv::new(r.lo.tan(), r.hi.tan());
+                a.chain(range, Iv::point(1.0).add(range.sqr()))
+            } else {
+                unbounded(Iv::ALL)
+            }
+        }
+        FUn::Exp => {
+            let range = Iv::new(r.lo.exp(), r.hi.exp());
+            a.chain(range, range)
+        }
+        FUn::Log => {
+            if r.lo > 0.0 {
+                a.chain(
+                    Iv::new(r.lo.ln(), r.hi.ln()),
+                    Iv::new(1.0 / r.hi, 1.0 / r.lo),
+                )
+            } else {
+                unbounded(Iv::new(f64::NEG_INFINITY, r.hi.max(0.0).ln()))
+            }
+        }
+        FUn::Floor => {
+            let range = Iv::new(r.lo.floor(), r.hi.floor());
+            if range.lo == range.hi {
+                a.chain(range, Iv::ZERO)
+            } else {
+                unbounded(range)
+            }
+        }
+        FUn::Smooth => {
+            let (lo, hi) = (r.lo.clamp(0.0, 1.0), r.hi.clamp(0.0, 1.0));
+            let s = |t: f64| t * t * (3.0 - 2.0 * t);
+            let ds = |t: f64| 6.0 * t * (1.0 - t);
+            let top = if lo <= 0.5 && 0.5 <= hi {
+                1.5
+            } else {
+                ds(lo).max(ds(hi))
+            };
+            a.chain(Iv::new(s(lo), s(hi)), Iv::new(0.0, top))
+        }
+    }
+}
+
+fn binary(op: FBin, a: &Val, b: &Val) -> Val {
+    let unbounded = |range: Iv| Val {
+        range,
+        grad: [Iv::ALL; 3],
+        norm: f64::INFINITY,
+    };
+    match op {
+        FBin::Add | FBin::Sub => {
+            let (range, grad) = if op == FBin::Add {
+                (
+                    a.range.add(b.range),
+                    [0, 1, 2].map(|j| a.grad[j].add(b.grad[j])),
+                )
+            } else {
+                (
+                    a.range.sub(b.range),
+                    [0, 1, 2].map(|j| a.grad[j].sub(b.grad[j])),
+                )
+            };
+            Val {
+                range,
+                grad,
+                norm: a.n() + b.n(),
+            }
+        }
+        FBin::Mul => Val {
+            range: a.range.mul(b.range),
+            grad: [0, 1, 2].map(|j| a.range.mul(b.grad[j]).add(b.range.mul(a.grad[j]))),
+            norm: mul0(a.range.mag(), b.n()) + mul0(b.range.mag(), a.n()),
+        },
+        FBin::Div => {
+            if b.range.contains(0.0) {
+                return unbounded(Iv::ALL);
+            }
+            // 1/b, whose derivative −1/b² lies in −[1/hi², 1/lo²] of |b|.
+            let inv = Iv::new(1.0 / b.range.hi, 1.0 / b.range.lo);
+            let recip = b.chain(inv, inv.sqr().neg());
+            binary(FBin::Mul, a, &recip)
+        }
+        FBin::Min | FBin::Max => {
+            let range = if op == FBin::Min {
+                Iv::new(a.range.lo.min(b.range.lo), a.range.hi.min(b.range.hi))
+            } else {
+                Iv::new(a.range.lo.max(b.range.lo), a.range.hi.max(b.range.hi))
+            };
+            // Where one operand is always the result, its gradient is the result's.
+            let (first, second) = if op == FBin::Min {
+                (a.range.hi < b.range.lo, b.range.hi < a.range.lo)
+            } else {
+                (a.range.lo > b.range.hi, b.range.lo > a.range.hi)
+            };
+            if first {
+                Val { range, ..*a }
+            } else if second {
+                Val { range, ..*b }
+            } else {
+                Val {
+                    range,
+                    grad: [0, 1, 2].map(|j| a.grad[j].hull(b.grad[j])),
+                    norm: a.n().max(b.n()),
+                }
+            }
+        }
+        FBin::Pow => {
+            let c = b.range;
+            if c.lo != c.hi || b.n() != 0.0 {
+                return unbounded(Iv::new(0.0, f64::INFINITY));
+            }
+            let c = c.lo;
+            let lo = a.range.lo.max(0.0);
+            let hi = a.range.hi.max(0.0);
+            let range = Iv::new(lo.powf(c), hi.powf(c)).hull(Iv::new(hi.powf(c), lo.powf(c)));
+            let range = Iv::new(range.lo.min(range.hi), range.hi.max(range.lo));
+            if c == 0.0 {
+                return a.chain(Iv::point(1.0), Iv::ZERO);
+            }
+            if c == 1.0 {
+                return a.chain(range, Iv::point(1.0));
+            }
+            if c < 1.0 && lo == 0.0 {
+                return unbounded(range);
+            }
+            let d1 = c * lo.powf(c - 1.0);
+            let d2 = c * hi.powf(c - 1.0);
+            a.chain(range, Iv::new(d1.min(d2), d1.max(d2)))
+        }
+        FBin::Atan2 => {
+            // |∇atan2(y, x)| = |x∇y − y∇x| / r² ≤ √2 · max(|∇y|, |∇x|) / r.
+            let gap = |r: Iv| {
+                if r.contains(0.0) {
+                    0.0
+                } else {
+                    r.lo.abs().min(r.hi.abs())
+                }
+            };
+            let rmin = gap(a.range).hypot(gap(b.range));
+            let range = Iv::new(-PI, PI);
+            if rmin == 0.0 {
+                return unbounded(range);
+            }
+            let n = std::f64::consts::SQRT_2 * a.n().max(b.n()) / rmin;
+            Val {
+                range,
+                grad: [Iv::sym(n); 3],
+                norm: n,
+            }
+        }
+    }
+}
+
+/// The Lipschitz constant the expression's value `f.out[0]` is proven to have over all of
+/// space, with `shape(id)` the L of a shape it reads; infinite where nothing is proven.
+pub fn lipschitz(f: &FieldFn, shape: impl Fn(NodeId) -> f64) -> f64 {
+    let vals = values(f, shape);
+    f.out.first().map_or(0.0, |&o| vals[o as usize].n())
+}
+
+/// What is known of every value of `f`.
+fn values(f: &FieldFn, shape: impl Fn(NodeId) -> f64) -> Vec<Val> {
+    let mut vals: Vec<Val> = Vec::with_capacity(f.ops.len());
+    for op in &f.ops {
+        let get = |s: &u32| vals[*s as usize];
+        let v = match op {
+            FOp::Coord(axis) => {
+                let mut grad = [Iv::ZERO; 3];
+                grad[*axis as usize % 3] = Iv::point(1.0);
+                Val {
+                    range: Iv::ALL,
+                    grad,
+                    norm: 1.0,
+                }
+            }
+            FOp::Const(c) => Val {
+                range: Iv::point(*c),
+                grad: [Iv::ZERO; 3],
+                norm: 0.0,
+            },
+            FOp::Un(u, a) => unary(*u, &get(a)),
+            FOp::Bin(b, x, y) => binary(*b, &get(x), &get(y)),
+            FOp::Length(v) => {
+                let rows: Vec<Val> = v.iter().map(get).collect();
+                let hi = rows.iter().map(|r| r.range.sqr().hi).sum::<f64>().sqrt();
+                let lo = rows.iter().map(|r| r.range.sqr().lo).sum::<f64>().sqrt();
+                lipschitz_of(&rows, 1.0, Iv::new(lo, hi))
+            }
+            FOp::Distance(id, q) => {
+                let rows: Vec<Val> = q.iter().map(get).collect();
+                lipschitz_of(&rows, shape(*id), Iv::ALL)
+            }
+            FOp::Noise(v) => {
+                let rows: Vec<Val> = v.iter().map(get).collect();
+                lipschitz_of(&rows, NOISE_LIPSCHITZ, Iv::sym(NOISE_RANGE))
+            }
+            FOp::Voronoi(v) => {
+                let rows: Vec<Val> = v.iter().map(get).collect();
+                let far = (VORONOI_LO + VORONOI_SPAN) * (v.len() as f64).sqrt();
+                lipschitz_of(&rows, 1.0, Iv::new(0.0, far))
+            }
+        };
+        vals.push(v);
+    }
+    vals
+}

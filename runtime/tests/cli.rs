@@ -1118,3 +1118,31 @@ fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `sdfc check --verify-bounds`: a field whose declared L is too small is reported at its
+/// place with exit 1; fields whose bounds hold (declared or derived) pass.
+#[test]
+fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
+    let d = dir("verify-bounds");
+    std::fs::write(
+        d.join("steep.sdf"),
+        "scene {\n  field(lipschitz: 1) { 3 * (length(p) - 1) };\n}\n",
+    )
+    .expect("write");
+    std::fs::write(
+        d.join("fine.sdf"),
+        "scene {\n  field { 2 * (length(p) - 1) };\n  field(lipschitz: 3) { 3 * (length(p) - 1) }.translate(3, 0, 0);\n}\n",
+    )
+    .expect("write");
+    let out = sdfc(&d, &["check", "--verify-bounds", "steep.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("steep.sdf:2:3: this field has a slope of") && err.contains("above its L = 1"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["check", "--verify-bounds", "fine.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("bounds verified: 2 field(s)"), "{err}");
+}

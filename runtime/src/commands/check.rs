@@ -17,6 +17,10 @@ pub struct CheckArgs {
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value_t)]
     pub diagnostics: DiagnosticFormat,
+    /// Sample the Lipschitz bound of every user field (`field { … }`), declared or derived,
+    /// near the camera's target, and report where a field is steeper (exit 1).
+    #[arg(long)]
+    pub verify_bounds: bool,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -53,6 +57,9 @@ pub fn run(args: CheckArgs) -> ExitCode {
                                 )
                             );
                         }
+                        if args.verify_bounds && !verify_bounds(&loaded, file, scene) {
+                            code = code.max(1);
+                        }
                         match animation(file, scene, &limits, args.diagnostics) {
                             Ok(line) if human => eprintln!("{}: {line}", file.display()),
                             Ok(_) => {}
@@ -64,6 +71,45 @@ pub fn run(args: CheckArgs) -> ExitCode {
         }
     }
     ExitCode::from(code)
+}
+
+/// Pairs of points sampled per field by `--verify-bounds`, and how far from the camera's
+/// target they lie (per axis).
+const VERIFY_PAIRS: usize = 20_000;
+const VERIFY_REACH: f64 = 4.0;
+
+/// `--verify-bounds`: every field's bound sampled; false when one is exceeded (printed).
+fn verify_bounds(loaded: &frontend::Loaded, file: &std::path::Path, scene: &Scene) -> bool {
+    let found = sdfc_compiler::eval::verify::verify_fields(scene, VERIFY_PAIRS, VERIFY_REACH);
+    let fields = scene
+        .graph
+        .ids()
+        .filter(|&id| {
+            matches!(
+                scene.graph.node(id),
+                sdfc_compiler::scene::Node::Field { .. }
+            )
+        })
+        .count();
+    for v in &found {
+        let span = scene.graph.span(v.node);
+        let (line, col) = loaded.sources.line_col(span);
+        eprintln!(
+            "{}:{line}:{col}: this field has a slope of {} between {:?} and {:?}, above its L = {}",
+            loaded.sources.name(span.file),
+            number(v.slope, 4),
+            v.at.0,
+            v.at.1,
+            number(v.bound, 4)
+        );
+    }
+    if found.is_empty() {
+        eprintln!(
+            "{}: bounds verified: {fields} field(s), {VERIFY_PAIRS} pairs of points each within {VERIFY_REACH} of the camera's target",
+            file.display()
+        );
+    }
+    found.is_empty()
 }
 
 /// Whether the scene is a still, an animation whose frames differ only in numbers, or one

@@ -400,3 +400,28 @@ fn pi_and_tau_are_constants_a_name_of_the_file_hides() {
         &Node::Sphere { radius: 4.0 }
     );
 }
+
+#[test]
+fn a_wrap_folds_only_a_shape_longer_than_its_circle() {
+    let light = "light directional { direction: (-1, -1, 1) }\n";
+    // Exactly the circle's length closes, also with a rounding above the wrap.
+    let closed = format!("{light}scene {{ wrap(box((pi * 1.5, 0.2, 0.2)), 1.5).round(0.05); }}");
+    assert_eq!(codes(&closed), Vec::<&str>::new());
+    assert_eq!(
+        codes(&format!(
+            "{light}scene {{ wrap(box((5, 0.2, 0.2)), 1.5); }}"
+        )),
+        ["W0014"]
+    );
+    // Reaching the axis folds too, as does a taper whose factor reaches 0 over the shape.
+    assert_eq!(
+        codes(&format!("{light}scene {{ wrap(box((1, 0.2, 2)), 1.5); }}")),
+        ["W0014"]
+    );
+    assert_eq!(
+        codes(&format!(
+            "{light}scene {{ taper(box((0.5, 1, 0.5)), 1.5); }}"
+        )),
+        ["W0014"]
+    );
+}

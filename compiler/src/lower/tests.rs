@@ -480,3 +480,36 @@ fn a_wrapped_bar_is_a_closed_ring() {
         check([-1e-9, p[1] * 0.5, rho]);
     }
 }
+
+#[test]
+fn the_exponential_smooth_union_of_a_list_is_independent_of_its_order() {
+    let parts = [
+        "sphere(0.6)",
+        "box(0.4).translate(0.7, 0.2, 0)",
+        "torus(0.6, 0.15).translate(-0.3, 0.4, 0.2)",
+    ];
+    let field = |variant: &str, order: [usize; 3]| {
+        let list: Vec<&str> = order.iter().map(|&i| parts[i]).collect();
+        distance_of(&format!(
+            "scene {{ smooth_union(0.4, [{}], variant: \"{variant}\"); }}",
+            list.join(", ")
+        ))
+    };
+    let (exp, exp_turned) = (field("exp", [0, 1, 2]), field("exp", [2, 0, 1]));
+    let (poly, poly_turned) = (field("poly", [0, 1, 2]), field("poly", [2, 0, 1]));
+    let mut rng = Rng::new(0x0DE2_1A57);
+    let mut poly_differs = false;
+    for _ in 0..2000 {
+        let p = [0, 1, 2].map(|_| 3.0 * rng.uniform() - 1.5);
+        let (a, b) = (exp(p), exp_turned(p));
+        assert!(
+            (a - b).abs() <= 1e-12 * (1.0 + a.abs()),
+            "{a} against {b} at {p:?}"
+        );
+        poly_differs |= (poly(p) - poly_turned(p)).abs() > 1e-6;
+    }
+    assert!(
+        poly_differs,
+        "the polynomial blend of three should depend on the order"
+    );
+}

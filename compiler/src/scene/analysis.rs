@@ -1057,14 +1057,16 @@ impl Pass<'_> {
         };
         d.symmetric = [true, c.symmetric[1], false];
         let inner = radius - extent.max[2];
-        let long = extent.min[0] < -std::f64::consts::PI * radius - TOLERANCE
-            || extent.max[0] > std::f64::consts::PI * radius + TOLERANCE;
+        // The shape itself, not its levels that ancestors read: a bar of exactly the circle's
+        // length closes, and its offsets (a `round` above) meet at the seam as its faces do.
+        let half = std::f64::consts::PI * radius * (1.0 + 1e-12) + TOLERANCE;
+        let long = c.bounds.min[0] < -half || c.bounds.max[0] > half;
         if !(inner > 0.0) || long {
             let how = if long {
                 format!(
                     "the shape spans {} … {} on x, more than the circle's length 2π·{} = {}",
-                    fmt(extent.min[0]),
-                    fmt(extent.max[0]),
+                    fmt(c.bounds.min[0]),
+                    fmt(c.bounds.max[0]),
                     fmt(radius),
                     fmt(2.0 * std::f64::consts::PI * radius)
                 )

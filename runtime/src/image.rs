@@ -249,6 +249,7 @@ impl AtomicFile {
     }
 
     fn open(path: &Path, sync: bool) -> std::io::Result<AtomicFile> {
+        refuse_read_only(path)?;
         let tmp = temp_path(path);
         let file = std::fs::OpenOptions::new()
             .write(true)
@@ -327,6 +328,18 @@ impl Drop for AtomicFile {
             self.file = None;
             let _ = std::fs::remove_file(&self.tmp);
         }
+    }
+}
+
+/// Refuses to replace a file that is read-only (no write permission in its mode): a rename
+/// would replace it all the same, and a user who made a file read-only meant it to stay.
+pub fn refuse_read_only(path: &Path) -> std::io::Result<()> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() && m.permissions().readonly() => Err(std::io::Error::new(
+            std::io::ErrorKind::PermissionDenied,
+            "the file is read-only, and is left as it is",
+        )),
+        _ => Ok(()),
     }
 }
 

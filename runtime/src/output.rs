@@ -193,12 +193,13 @@ impl std::fmt::Display for Output {
     }
 }
 
-/// Checks that a new file can be written at `path`: the path is not a directory, and a file
-/// can be created in its directory (created and removed again).
+/// Checks that a new file can be written at `path`: the path is not a directory nor a
+/// read-only file, and a file can be created in its directory (created and removed again).
 pub fn check_writable(path: &Path) -> Result<(), String> {
     if path.is_dir() {
         return Err("it is a directory".into());
     }
+    crate::image::refuse_read_only(path).map_err(|e| e.to_string())?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

@@ -316,6 +316,39 @@ fn an_unwritable_output_is_refused_before_the_render() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// A read-only output file is refused (exit 2, saying so) and left as it was, by `render`
+/// before the render starts and by `compile`.
+#[test]
+fn a_read_only_output_is_refused_and_left_unchanged() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = dir("read-only");
+    scene_file(&d);
+    for (name, args) in [
+        (
+            "x.png",
+            vec!["render", "ball.sdf", "--size", "8x8", "-o", "x.png"],
+        ),
+        (
+            "x.wgsl",
+            vec!["compile", "ball.sdf", "--emit", "wgsl", "-o", "x.wgsl"],
+        ),
+    ] {
+        let out = d.join(name);
+        std::fs::write(&out, b"keep me").expect("old file");
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o444)).expect("chmod");
+        let o = sdfc(&d, &args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains("read-only"), "{name}: {err}");
+        assert!(
+            !err.contains("allocating"),
+            "{name}: the render started: {err}"
+        );
+        assert_eq!(std::fs::read(&out).expect("kept"), b"keep me", "{name}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 #[test]
 fn render_prints_the_warnings_of_check() {
     let d = dir("warnings");

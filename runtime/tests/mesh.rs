@@ -658,3 +658,69 @@ fn faces_on_grid_planes_still_give_a_closed_manifold() {
     mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.1", &bounds]);
     assert_eq!(manifold(&read_stl(&out), "aligned cube"), 2);
 }
+
+/// Whether `bytes` are a whole binary STL: the header's triangle count matches the length.
+fn whole_binary_stl(bytes: &[u8]) -> bool {
+    bytes.len() >= 84 && {
+        let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
+        bytes.len() == 84 + 50 * count
+    }
+}
+
+/// A `sdfc mesh` killed (SIGKILL) while it writes leaves the previous file as it was or the
+/// complete new one, never a part of it: the process is killed as soon as the output changes
+/// or its temporary file appears.
+#[test]
+fn a_killed_mesh_leaves_the_old_file_or_a_whole_new_one() {
+    let d = dir("killed");
+    let out = d.join("m.stl");
+    let old = b"the previous mesh".to_vec();
+    std::fs::write(&out, &old).expect("old file");
+    let scene = root().join("examples/mesh/bracket.sdf");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .args(["mesh", s(&scene), "--resolution", "400", "-o", s(&out)])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("run sdfc");
+    let started = std::time::Instant::now();
+    loop {
+        let temporary = std::fs::read_dir(&d)
+            .expect("dir")
+            .flatten()
+            .any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
+        let changed = std::fs::read(&out).map_or(true, |b| b != old);
+        if let Some(status) = child.try_wait().expect("wait") {
+            assert!(status.success(), "sdfc mesh failed: {status}");
+            break;
+        }
+        if temporary || changed {
+            break;
+        }
+        assert!(started.elapsed().as_secs() < 120, "sdfc mesh never wrote");
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let now = std::fs::read(&out).expect("the output is still there");
+    assert!(
+        now == old || whole_binary_stl(&now),
+        "a partial mesh of {} bytes replaced the old file",
+        now.len()
+    );
+}
+
+/// A read-only output file is refused before the mesh is made, and stays as it was.
+#[test]
+fn a_read_only_output_is_refused_and_left_unchanged() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = dir("read-only");
+    let out = d.join("m.stl");
+    std::fs::write(&out, b"keep me").expect("old file");
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o444)).expect("chmod");
+    let scene = root().join("examples/mesh/parts.sdf");
+    let o = sdfc(&["mesh", s(&scene), "--resolution", "16", "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("read-only"), "{err}");
+    assert_eq!(std::fs::read(&out).expect("kept"), b"keep me");
+}

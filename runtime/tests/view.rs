@@ -544,3 +544,87 @@ fn the_window_shows_new_kernels_interpreted_while_they_compile() {
     eprintln!("{stderr}\ninterpreted against specialised: {d:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Runs `sdfc view … --headless --backend cpu` in `dir` and waits at most a minute for it to
+/// exit by itself (killed after that, which fails the test): its status and stderr.
+fn headless_run(dir: &Path, args: &[&str]) -> (std::process::ExitStatus, String) {
+    let log = dir.join("stderr.log");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(dir)
+        .arg("view")
+        .args(args)
+        .args(["--headless", "--backend", "cpu"])
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if started.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "`sdfc view {}` did not exit:\n{}",
+                args.join(" "),
+                std::fs::read_to_string(&log).unwrap_or_default()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    (status, std::fs::read_to_string(&log).unwrap_or_default())
+}
+
+/// Headless with `--frames`, the settled image counts as frames: a scene that converges in
+/// fewer frames than asked for (`aa: 2`) stops and writes its screenshot.
+#[test]
+fn headless_frames_stop_after_the_image_settles() {
+    let dir = temp_dir("headless-frames");
+    std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
+    let (status, stderr) = headless_run(
+        &dir,
+        &[
+            "scene.sdf",
+            "--size",
+            "64x48",
+            "--frames",
+            "40",
+            "--screenshot",
+            "shot.png",
+        ],
+    );
+    assert!(status.success(), "{stderr}");
+    let shot = read_png(&dir.join("shot.png")).unwrap();
+    assert_eq!((shot.width, shot.height), (64, 48));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A scene that never loads (errors, or no file) has no image: `--screenshot` fails and
+/// writes nothing, instead of an empty picture and success.
+#[test]
+fn headless_screenshot_of_a_scene_that_never_loads_fails() {
+    let dir = temp_dir("headless-broken");
+    std::fs::write(dir.join("broken.sdf"), "scene { sphre(1); }").unwrap();
+    for file in ["broken.sdf", "missing.sdf"] {
+        let (status, stderr) = headless_run(
+            &dir,
+            &[
+                file,
+                "--size",
+                "32x24",
+                "--frames",
+                "3",
+                "--screenshot",
+                "shot.png",
+            ],
+        );
+        assert!(!status.success(), "{file}: {stderr}");
+        assert!(stderr.contains("no screenshot written"), "{file}: {stderr}");
+        assert!(
+            !dir.join("shot.png").exists(),
+            "{file}: a screenshot was written"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

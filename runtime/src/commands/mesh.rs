@@ -284,7 +284,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     }
     // The file's bytes are in the surface cells' share of the announcement.
     let bytes = format.encode(&mesh, &scene.materials);
-    std::fs::write(&args.output, &bytes)
+    crate::image::write_atomic(&args.output, &bytes)
         .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;
     eprintln!(
         "wrote {} ({} triangles, {} vertices, {:.3} s)",

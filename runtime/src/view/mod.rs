@@ -54,6 +54,16 @@ pub struct Run {
 /// Runs the session without a window: loads, renders until the image converges, waits for
 /// changes to the files, and repeats, writing the screenshots `control` asks for from the
 /// session's image. For measuring the viewer on a machine without a display.
+///
+/// It stops, and only then:
+/// - with `--frames N`, after N frames, each turn of the loop counting one whether it
+///   rendered a sample or presented the settled image again (so a scene that converges in
+///   fewer frames, `aa: 2` for one, still stops); with `--screenshot`, the last frame's
+///   image is written first, and when no scene has loaded there is none: an error (exit 1),
+///   nothing written;
+/// - with `--exit-after-reloads K`, once the screenshot of load K is written;
+/// - when the files can no longer be watched;
+/// - otherwise never by itself (a live preview without a window, like the window).
 pub fn headless(run: Run) -> ExitCode {
     let device = match run.backend {
         Backend::Cpu => Device::Cpu,
@@ -112,6 +122,13 @@ pub fn headless(run: Run) -> ExitCode {
             let last = control.frames.is_some_and(|n| frames >= n);
             if last {
                 if let Some(path) = &control.screenshot {
+                    if session.image().is_none() {
+                        eprintln!(
+                            "error: `{}` has not loaded (see the errors above); no screenshot written",
+                            run.file.display()
+                        );
+                        return ExitCode::from(1);
+                    }
                     if let Err(msg) = write_image(&session, path) {
                         eprintln!("error: {msg}");
                         return ExitCode::from(2);
@@ -136,8 +153,13 @@ pub fn headless(run: Run) -> ExitCode {
                 return ExitCode::SUCCESS;
             }
         }
-        // Wait for a change that calls for a reload.
-        let paths = match rx.recv_timeout(Duration::from_secs(3600)) {
+        // Wait for a change that calls for a reload; while frames are counted, only look for
+        // one, and present the settled image again (a display's next refresh).
+        let wait = match control.frames {
+            Some(_) => Duration::from_millis(1),
+            None => Duration::from_secs(3600),
+        };
+        let paths = match rx.recv_timeout(wait) {
             Ok(p) => p,
             Err(mpsc::RecvTimeoutError::Timeout) => continue,
             Err(mpsc::RecvTimeoutError::Disconnected) => {

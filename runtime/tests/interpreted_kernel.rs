@@ -160,7 +160,7 @@ light point { position: (4, 8, -6), intensity: 1 }
 render { width: 32, height: 24, method: \"march\" }
 scene {
   plane((0, 1, 0), -1);
-  for i in 0..600 { sphere(0.2).shell(0.02).translate(i % 30 * 0.5 - 7.5, 0, i / 30 * 0.5); }
+  for i in 0..600 { sphere(0.2).shell(0.04).translate(i % 30 * 0.5 - 7.5, 0, i / 30 * 0.5); }
 }
 ";
 

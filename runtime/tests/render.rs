@@ -644,7 +644,7 @@ fn the_streaks_in_the_cut_shells_penumbra_stay_as_explained() {
                  render { width: 400, height: 300 }\n\
                  scene {\n\
                    plane((0, 1, 0), 0) @ floor;\n\
-                   subtract(sphere(1.2).shell(0.05).translate(0, 0.6, 0), box((2, 2, 2)).translate(0, 0.6, -2.3));\n\
+                   subtract(sphere(1.2).shell(0.1).translate(0, 0.6, 0), box((2, 2, 2)).translate(0, 0.6, -2.3));\n\
                  }";
     let region = (215, 120, 280, 170);
     let soft = roughness(&grey(&render(&checked("shell.sdf", shell))), 400, region);

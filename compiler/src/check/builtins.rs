@@ -828,7 +828,7 @@ pub static BUILTINS: &[Builtin] = &[
     Builtin {
         name: "shell",
         sigs: sigs![
-            [shape("shape"), p("thickness", F, Req, Pos)] -> S => |b, a| b.node(Node::Shell { thickness: a[1].num(), child: sh(&a[0]) });
+            [shape("shape"), p("thickness", F, Req, Pos)] -> S => |b, a| b.node(Node::Shell { half: a[1].num() / 2.0, child: sh(&a[0]) });
         ],
     },
     Builtin {

@@ -1117,7 +1117,10 @@ impl Ctx {
             .keys()
             .map(String::as_str)
             .chain(builtins::BUILTINS.iter().map(|b| b.name));
-        if let Some(s) = closest(&callee.name, names) {
+        let known = |n: &str| builtins::builtin(n).is_some();
+        if let Some(help) = super::suggest::ported(&callee.name, &known) {
+            d = d.with_help(help);
+        } else if let Some(s) = closest(&callee.name, names) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
         self.error(d);

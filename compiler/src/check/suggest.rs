@@ -1,4 +1,6 @@
-//! "Did you mean" suggestions by edit distance.
+//! "Did you mean" suggestions: by edit distance, and for the names of other SDF tools
+//! (Quilez's `sdSphere`/`opUnion`, Mercury hg_sdf's `fBox`/`fOpUnionChamfer`, the libraries'
+//! `difference`, `smooth_min`, `onion`, …) what this language calls them.
 
 /// The candidate closest to `name`, if it is close enough to be a plausible typo.
 pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
@@ -10,6 +12,104 @@ pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .filter(|(d, _)| *d <= limit)
         .min_by_key(|(d, c)| (*d, *c))
         .map(|(_, c)| c)
+}
+
+/// Names of other SDF tools whose spelling differs from this language's by more than a typo,
+/// with what to write instead.
+const PORTED: &[(&str, &str)] = &[
+    ("difference", "subtract"),
+    ("intersection", "intersect"),
+    ("smooth_min", "smooth_union"),
+    ("smin", "smooth_union"),
+    ("smooth_max", "smooth_intersect"),
+    ("smax", "smooth_intersect"),
+    ("smooth_difference", "smooth_subtract"),
+    ("smooth_subtraction", "smooth_subtract"),
+    ("smooth_intersection", "smooth_intersect"),
+    ("blend", "morph"),
+    ("onion", "shell"),
+    ("offset", "round"),
+    ("dilate", "round"),
+    ("rounded_box", "round_box"),
+    ("capped_cylinder", "cylinder"),
+    ("rounded_cone", "round_cone"),
+    ("frustum", "capped_cone"),
+    ("circular_array", "repeat_polar"),
+    // Quilez's names whose plain translation is another primitive here.
+    ("sdCapsule", "segment"),
+    ("sdVerticalCapsule", "capsule"),
+    ("sdCappedCylinder", "cylinder"),
+    ("sdCylinder", "infinite_cylinder"),
+    ("sdRoundedCylinder", "rounded_cylinder"),
+    ("opRep", "repeat"),
+    ("opRepetition", "repeat"),
+    ("opLimitedRepetition", "repeat"),
+    ("opCheapBend", "bend"),
+    ("opOnion", "shell"),
+    ("opSubtraction", "subtract"),
+    ("opSmoothSubtraction", "smooth_subtract"),
+    ("opSmoothIntersection", "smooth_intersect"),
+    ("fOpDifference", "subtract"),
+    ("fOpIntersection", "intersect"),
+];
+
+/// hg_sdf's edge blends, `fOp<Union|Intersection|Difference><Variant>`, with the variant.
+const EDGES: &[(&str, &str)] = &[
+    ("Chamfer", "chamfer"),
+    ("Round", "round"),
+    ("Stairs", "stairs"),
+    ("Columns", "columns"),
+];
+
+/// What a user porting a scene from another SDF tool should write for `name`, when `name` is
+/// one of that tool's spellings and `known` (this language's functions) has its counterpart:
+/// a sentence for the help of an unknown function.
+pub fn ported(name: &str, known: &dyn Fn(&str) -> bool) -> Option<String> {
+    if let Some((_, ours)) = PORTED.iter().find(|(theirs, _)| *theirs == name) {
+        return known(ours).then(|| format!("`{name}` of other SDF tools is `{ours}` here"));
+    }
+    for (op, ours) in [
+        ("Union", "smooth_union"),
+        ("Intersection", "smooth_intersect"),
+        ("Difference", "smooth_subtract"),
+    ] {
+        for (theirs, variant) in EDGES {
+            if name == format!("fOp{op}{theirs}") {
+                let steps = if matches!(*variant, "stairs" | "columns") {
+                    ", steps: n"
+                } else {
+                    ""
+                };
+                return Some(format!(
+                    "hg_sdf's `{name}` is `{ours}(r, a, b, variant: \"{variant}\"{steps})` here"
+                ));
+            }
+        }
+    }
+    // Quilez's `sdRoundBox`, `opSmoothUnion`, hg_sdf's `fHexPrism`, `fOpEngrave`: the name
+    // without its prefix, in snake case.
+    let rest = ["sd", "op", "fOp", "f"].iter().find_map(|p| {
+        name.strip_prefix(p)
+            .filter(|r| r.starts_with(|c: char| c.is_ascii_uppercase()))
+    })?;
+    let mut snake = String::new();
+    for (i, c) in rest.chars().enumerate() {
+        if c.is_ascii_uppercase() {
+            if i > 0 {
+                snake.push('_');
+            }
+            snake.push(c.to_ascii_lowercase());
+        } else {
+            snake.push(c);
+        }
+    }
+    let snake = snake.replace("smooth_intersection", "smooth_intersect");
+    let ours = match snake.as_str() {
+        "intersection" => "intersect",
+        "subtraction" | "difference" => "subtract",
+        other => other,
+    };
+    known(ours).then(|| format!("`{name}` of other SDF tools is `{ours}` here"))
 }
 
 /// Levenshtein distance over characters.
@@ -41,5 +141,32 @@ mod tests {
         assert_eq!(distance("sphere", "spher"), 1);
         assert_eq!(closest("spher", ["sphere", "box", "torus"]), Some("sphere"));
         assert_eq!(closest("xyz", ["sphere", "box"]), None);
+    }
+
+    #[test]
+    fn names_of_other_tools_are_translated() {
+        let known = |n: &str| crate::check::builtins::builtin(n).is_some();
+        let ours = |n: &str| {
+            ported(n, &known).map(|h| h.split('`').nth(3).unwrap_or_default().to_string())
+        };
+        assert_eq!(ours("difference").as_deref(), Some("subtract"));
+        assert_eq!(ours("smooth_min").as_deref(), Some("smooth_union"));
+        assert_eq!(ours("opUnion").as_deref(), Some("union"));
+        assert_eq!(ours("opSmoothUnion").as_deref(), Some("smooth_union"));
+        assert_eq!(ours("opIntersection").as_deref(), Some("intersect"));
+        assert_eq!(ours("sdSphere").as_deref(), Some("sphere"));
+        assert_eq!(ours("sdRoundBox").as_deref(), Some("round_box"));
+        assert_eq!(ours("sdHexPrism").as_deref(), Some("hex_prism"));
+        assert_eq!(ours("sdCapsule").as_deref(), Some("segment"));
+        assert_eq!(ours("fBox").as_deref(), Some("box"));
+        assert_eq!(ours("fOpEngrave").as_deref(), Some("engrave"));
+        assert_eq!(ours("onion").as_deref(), Some("shell"));
+        let chamfer = ported("fOpUnionChamfer", &known).expect("hg_sdf's chamfer");
+        assert!(
+            chamfer.contains("smooth_union(r, a, b, variant: \"chamfer\")"),
+            "{chamfer}"
+        );
+        assert_eq!(ported("sdNothing", &known), None);
+        assert_eq!(ported("frobnicate", &known), None);
     }
 }

@@ -322,7 +322,7 @@ impl Bounds {
             Node::Bend { child, .. } => about_axis(&get(child)?, 2),
             Node::Elongate { half, child } => elongate(&get(child)?, half),
             Node::Round { radius, child } => get(child)?.grow(*radius),
-            Node::Shell { thickness, child } => get(child)?.grow(*thickness),
+            Node::Shell { half, child } => get(child)?.grow(*half),
             Node::Paint { child, .. } => get(child)?,
         })
     }

@@ -333,9 +333,9 @@ impl<'a> Lowerer<'a> {
                 }
             }
             Node::Round { radius, child } => self.post(id, *child, p, |b, d| b.subc(d, *radius)),
-            Node::Shell { thickness, child } => self.post(id, *child, p, |b, d| {
+            Node::Shell { half, child } => self.post(id, *child, p, |b, d| {
                 let a = b.abs(d);
-                b.subc(a, *thickness)
+                b.subc(a, *half)
             }),
             Node::Scale { factor, child } => {
                 let q = self.b.map3(p, |b, x, _| b.mulc(x, 1.0 / factor));

@@ -178,7 +178,7 @@ fn zoo() -> (Graph, Vec<NodeId>) {
                 child: c,
             },
             Node::Shell {
-                thickness: 0.1,
+                half: 0.1,
                 child: c,
             },
             Node::Paint {

@@ -334,7 +334,7 @@ fn down(node: &Node, m: f64, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
         Node::Morph { a, b, .. } => vec![(*a, m, r), (*b, m, r)],
         Node::Bend { child, .. } => vec![(*child, m, around(r, 2))],
         Node::Round { radius, child } => vec![(*child, m + radius, r)],
-        Node::Shell { thickness, child } => vec![(*child, m + thickness, r)],
+        Node::Shell { half, child } => vec![(*child, m + half, r)],
         Node::Elongate { half, child } => vec![(
             *child,
             m,
@@ -753,7 +753,7 @@ impl Pass<'_> {
             Node::Twist { rate, child } => self.distort(id, *rate, *child, 1),
             Node::Bend { rate, child } => self.distort(id, *rate, *child, 2),
             Node::Round { radius, child } => self.offset(id, *child, *radius),
-            Node::Shell { thickness, child } => self.offset(id, *child, *thickness),
+            Node::Shell { half, child } => self.offset(id, *child, *half),
             Node::Elongate { half, child } => {
                 let mut d = at_most_bound(self.get(*child));
                 d.bounds = d.bounds.map(|i, lo, hi| (lo - half[i], hi + half[i]));

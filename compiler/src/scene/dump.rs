@@ -365,7 +365,7 @@ fn node(n: &Node) -> String {
         Node::Twist { rate, child } => format!("twist {} %{}", num(*rate), child.0),
         Node::Bend { rate, child } => format!("bend {} %{}", num(*rate), child.0),
         Node::Round { radius, child } => format!("round {} %{}", num(*radius), child.0),
-        Node::Shell { thickness, child } => format!("shell {} %{}", num(*thickness), child.0),
+        Node::Shell { half, child } => format!("shell half={} %{}", num(*half), child.0),
         Node::Elongate { half, child } => format!("elongate {} %{}", v3(*half), child.0),
         Node::Paint { material, child } => format!("paint #{} %{}", material.0, child.0),
         Node::Field { f, lipschitz } => match lipschitz {

@@ -257,8 +257,9 @@ pub enum Node {
     Morph { t: f64, a: NodeId, b: NodeId },
     /// Child's surface offset outwards by a radius.
     Round { radius: f64, child: NodeId },
-    /// Hollow shell of a thickness around the child's surface (onion).
-    Shell { thickness: f64, child: NodeId },
+    /// Hollow shell around the child's surface, `|f| - half`: a wall `2·half` thick centred on
+    /// the surface (Quilez's onion; `shell(t)` makes `half = t / 2`).
+    Shell { half: f64, child: NodeId },
     /// Child stretched by inserting a box of half-extents `half` at the origin.
     Elongate { half: V3, child: NodeId },
     /// Child painted with a material (inner materials take precedence).

@@ -287,8 +287,10 @@ fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnosti
     let d = Diagnostic::error("E0001", format!("unexpected character `{shown}`"), span)
         .with_label("not part of the language");
     match ch {
-        '&' => d.with_help("logical and is written `&&`"),
-        '|' => d.with_help("logical or is written `||`"),
+        '&' => d.with_help(
+            "shapes are intersected with `intersect(a, b)`; logical and is written `&&`",
+        ),
+        '|' => d.with_help("shapes are joined with `union(a, b)`; logical or is written `||`"),
         '#' => d.with_help("comments start with `//`"),
         _ => d,
     }

@@ -15,6 +15,21 @@ use crate::span::FileId;
 pub fn parse(file: FileId, text: &str) -> (ast::File, Vec<Diagnostic>) {
     let (tokens, mut diags) = lexer::lex(file, text);
     let (ast, syntax) = parser::parse(file, &tokens, text.len());
-    diags.extend(syntax);
+    // A character the lexer rejected between two tokens (`a | b`) makes the parser miss an
+    // operator there too: the lexer's error says what to write, so the parser's is dropped.
+    let rejected: Vec<crate::span::Span> = diags
+        .iter()
+        .filter(|d| d.code == "E0001")
+        .filter_map(|d| d.labels.first().map(|l| l.span))
+        .collect();
+    diags.extend(syntax.into_iter().filter(|d| {
+        let (Some(at), Some(found)) = (d.labels.first(), d.labels.get(1)) else {
+            return true;
+        };
+        d.code != "E0101"
+            || !rejected
+                .iter()
+                .any(|r| at.span.end <= r.start && r.end <= found.span.start)
+    }));
     (ast, diags)
 }

@@ -109,6 +109,15 @@ fn syntax_error(
             .with_help(format!("choose another name, such as `{}1`", t.to_string().trim_matches('`')));
         }
     }
+    // `.5`: a number written without its leading zero (the digits as written: `.05` is the
+    // integer 5 in two digits).
+    let leading_dot = match (e.found(), tokens.iter().find(|(_, s)| s.start >= span.end)) {
+        (Some(Token::Dot), Some((Token::Int(n), s))) if s.start == span.end => {
+            let digits = format!("{n:0width$}", width = s.range().len());
+            Some(format!("write `0.{digits}`: a number starts with a digit"))
+        }
+        _ => None,
+    };
     // A missing `;`, `,` or closing delimiter is reported just after the previous token, where
     // it belongs, rather than at the next token.
     let closers: Vec<&str> = ["`;`", "`,`", "`)`", "`}`"]
@@ -127,6 +136,9 @@ fn syntax_error(
                 .with_label("something is missing here")
                 .with_secondary(span, format!("found {found}"));
             let after_call = matches!(prev.0, Token::RParen);
+            if let Some(help) = &leading_dot {
+                d = d.with_help(help.clone());
+            }
             match e.found() {
                 Some(Token::Ident(u)) if u == "deg" || u == "rad" => {
                     d = d.with_help("write an angle's unit right after the number, as in `90deg`");
@@ -151,6 +163,9 @@ fn syntax_error(
     }
     let mut d = Diagnostic::error("E0100", format!("unexpected {found}"), span)
         .with_label(format!("unexpected {found}"));
+    if let Some(help) = leading_dot {
+        d = d.with_help(help);
+    }
     if matches!(e.found(), Some(Token::For)) && !expected.iter().any(|x| x == "`for`") {
         d = d.with_help(
             "a `for` statement belongs in the `scene` block; in an expression, such as a function's body, build a list with `[for i in 0..n { ... }]` and combine it with `union(...)`",

@@ -65,7 +65,7 @@ fn busy_scene() -> Scene {
         radii: [0.3, 0.6, 0.4],
     });
     let e = b.add(Node::Shell {
-        thickness: 0.05,
+        half: 0.05,
         child: e,
     });
     let e = b.at(e, [-2.0, 0.0, 1.0]);

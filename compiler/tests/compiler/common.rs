@@ -168,7 +168,7 @@ pub fn random_scene(rng: &mut Rng, n: usize) -> Scene {
                     child: id,
                 },
                 _ => Node::Shell {
-                    thickness: r(0.02, 0.1),
+                    half: r(0.02, 0.1),
                     child: id,
                 },
             };

@@ -582,7 +582,7 @@ fn round_shell_elongate() {
     );
     exact(
         &wrap(sphere(1.0), |c| Node::Shell {
-            thickness: 0.1,
+            half: 0.1,
             child: c,
         }),
         |p| (len3(p) - 1.0).abs() - 0.1,

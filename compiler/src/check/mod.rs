@@ -906,13 +906,18 @@ fn stmts_into(cx: &mut Ctx, stmts: &[ast::Stmt], out: &mut Vec<crate::scene::Nod
                     out.push(id)
                 }
                 Value::Error => {}
-                other => cx.error(
-                    Diagnostic::error("E0300", "a scene statement must be a shape", e.span)
-                        .with_label(format!(
-                            "this is `{}`",
-                            other.ty().map_or("?".into(), |t| t.to_string())
-                        )),
-                ),
+                other => {
+                    let mut d =
+                        Diagnostic::error("E0300", "a scene statement must be a shape", e.span)
+                            .with_label(format!(
+                                "this is `{}`",
+                                other.ty().map_or("?".into(), |t| t.to_string())
+                            ));
+                    if other.ty().and_then(Type::elem) == Some(Type::Shape) {
+                        d = d.with_help("combine the list's shapes into one: `union(...)`");
+                    }
+                    cx.error(d)
+                }
             },
             ast::Stmt::For {
                 var,

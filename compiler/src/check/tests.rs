@@ -425,3 +425,10 @@ fn a_wrap_folds_only_a_shape_longer_than_its_circle() {
         ["W0014"]
     );
 }
+
+#[test]
+fn a_list_of_shapes_as_a_scene_statement_suggests_union() {
+    let (_, diags, _) = check_str("t.sdf", "scene { [sphere(1), box(0.5)]; }");
+    let d = diags.iter().find(|d| d.code == "E0300").expect("E0300");
+    assert!(d.help.iter().any(|h| h.contains("union(...)")), "{d:?}");
+}

@@ -774,15 +774,20 @@ impl Ctx {
         let (Some(ta), Some(tb)) = (a.0.ty(), b.0.ty()) else {
             return Value::Error;
         };
-        if a.0.is_abstract() || b.0.is_abstract() {
-            return Value::Error;
-        }
-        if ops::binary_type(op, ta, tb).is_none() {
+        let Some(ty) = ops::binary_type(op, ta, tb) else {
             let err = ops::OpError::Types(format!(
                 "`{}` cannot be applied to `{ta}` and `{tb}`",
                 op.symbol()
             ));
             return self.op_error(err, op, a, b, span);
+        };
+        // A function body checked on its own: types only.
+        if a.0.is_abstract() || b.0.is_abstract() {
+            return if a.0 == &Value::Error || b.0 == &Value::Error {
+                Value::Error
+            } else {
+                Value::Unknown(if ty == Type::Angle { Type::Float } else { ty })
+            };
         }
         match field::binary(op, a.0, b.0) {
             Ok(v) => v,

@@ -129,6 +129,22 @@ mod tests {
         );
     }
 
+    /// A field spelling a built-in shape lowers to the built-in's instructions: the field
+    /// path costs nothing per step on any back end.
+    #[test]
+    fn fields_lower_to_the_programs_of_the_builtins_they_spell() {
+        for (field, builtin) in [
+            ("field { length(p) - 1 }", "sphere(1)"),
+            (
+                "field { distance(box(0.7), p) - 0.1 }",
+                "box(0.7).round(0.1)",
+            ),
+        ] {
+            let (a, b) = (lower(&scene(field)), lower(&scene(builtin)));
+            assert_eq!(a.ops(), b.ops(), "{field} and {builtin}");
+        }
+    }
+
     fn derived(body: &str) -> (f64, bool) {
         let s = scene(body);
         let a = analyse(&s);

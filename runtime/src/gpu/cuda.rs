@@ -500,15 +500,10 @@ fn check_launch(
 /// The register cap of a kernel that sphere traces. Its march loops over memory (the
 /// instances' walk) and long arithmetic, and more warps resident on a multiprocessor hide
 /// their latency better than the JIT's own choice of registers, which spends them on fewer
-/// warps. On an H100 (BENCHMARKS.md, "CUDA's register cap", 1920×1080) caps of 0 (the JIT's
-/// choice), 72, 80, 88 and 96 registers took the 1 024 jittered spheres marched 6.25, 4.56,
-/// 4.89, 5.44 and 5.48 ms, temple 3.11, 2.58, 2.69, 2.85 and 2.83 ms and seed6 21.1, 19.1,
-/// 19.7, 20.5 and 20.2 ms. Small marched kernels lose a little: blends 1.15 against 1.10 ms,
-/// and the hand-written tracer's scene (bench/handwritten, ε 1e-5) 0.39 against 0.35 ms.
-/// Analytically traced kernels keep the JIT's choice: at 72 the primitives example took
-/// 0.38 ms against 0.30. The JIT's own count does not say which kernels gain: blends (82
-/// registers) and the hand-written tracer's scene (93) lose, seed4 (92) and temple (96) gain
-/// (BENCHMARKS.md, "seed2's gap by light, and the JIT's registers by kernel").
+/// warps. Of the caps tried, 72 made the large marched kernels fastest; small ones lose a
+/// little, and analytically traced kernels more, so they keep the JIT's choice. The JIT's
+/// own count does not say which kernels gain, so the cap is one constant (BENCHMARKS.md,
+/// "Measured choices").
 pub const MARCHED_REGISTERS: u32 = 72;
 
 /// The register cap for the JIT of a kernel that sphere traces (`marched`) or traces

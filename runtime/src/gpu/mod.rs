@@ -44,10 +44,9 @@ pub(crate) fn cache_file(kind: &str, key: &impl std::hash::Hash, ext: &str) -> O
 
 /// Tile edge in pixels for GPU launches: a 1920×1080 frame is one launch, a 7680×4320 one
 /// twelve. Every launch waits for its slowest rays, so the fewer launches a frame takes, the
-/// less of the GPU idles in their tails: on an H100 (BENCHMARKS.md, "Beside a hand-written
-/// tracer", 2026-11-24) 2 048 against 512 pixels took seed 3 at 1920×1080 from 1.19 to
-/// 0.64 ms (CUDA) and 1.28 to 0.68 ms (wgpu). A 2048×2048 dispatch of the slowest example
-/// still lasts well under a display driver's watchdog (about 2 s).
+/// less of the GPU idles in their tails (BENCHMARKS.md, "Measured choices"). A 2048×2048
+/// dispatch of the slowest example still lasts well under a display driver's watchdog
+/// (about 2 s).
 pub const TILE: u32 = 2048;
 
 /// A GPU render and how long the GPU spent on it.

@@ -126,10 +126,9 @@ impl std::fmt::Debug for FrameBuffers {
 
 /// The process's one wgpu instance, never destroyed. Destroying the last Vulkan instance
 /// makes the loader unload the driver, and the NVIDIA driver keeps a thread of its own that
-/// may still run code of the unloaded library: on an H100, 2 of 6 renders of
-/// `examples/temple.sdf` under a debugger died so at exit, in that thread, at an unmapped
-/// address (BENCHMARKS.md, "Crash at exit"). An instance that lives until the process exits
-/// keeps the driver loaded; the operating system reclaims it.
+/// may still run code of the unloaded library, a segmentation fault at exit (BENCHMARKS.md,
+/// "Measured choices"). An instance that lives until the process exits keeps the driver
+/// loaded; the operating system reclaims it.
 fn instance() -> &'static wgpu::Instance {
     static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
     INSTANCE.get_or_init(|| {
@@ -376,12 +375,10 @@ impl Gpu {
             None => wgpu::ShaderSource::Wgsl(wgsl.into()),
         };
         // wgpu's checks except the bound on loops: naga gives every loop a counter, tested
-        // each turn, which on the H100 took up to 22 % of a marched scene's frame
-        // (BENCHMARKS.md, "wgpu's runtime checks"). Index bounds stay checked. Storage
-        // buffers' bounds are left to the driver's robust buffer access where the adapter has
-        // `robustBufferAccess2` (wgpu's choice; no option changes it): with them checked in
-        // the shader instead, through SPIR-V passed to the driver, the analytically traced
-        // kernels ran 4-6 % faster on an H100 (BENCHMARKS.md, "seed2's SPIR-V").
+        // each turn, a large part of a marched scene's frame (BENCHMARKS.md, "Measured
+        // choices"). Index bounds stay checked, at no measurable cost. Storage buffers'
+        // bounds are left to the driver's robust buffer access where the adapter has
+        // `robustBufferAccess2` (wgpu's choice; no option changes it).
         let mut checks = wgpu::ShaderRuntimeChecks::checked();
         checks.force_loop_bounding = false;
         // SAFETY: wgpu requires that no loop of the shader runs forever. Every loop of a
@@ -576,11 +573,11 @@ impl Gpu {
     }
 
     /// Waits for the work submitted. On a GPU the host first polls, yielding its core
-    /// between polls, for up to [`SPIN`]: the driver's blocking wait returned 0.1–0.15 ms
-    /// after the end of a frame on the H100 (BENCHMARKS.md, "wgpu's wall time"), as long as
-    /// a short frame itself, and CUDA's default wait polls too. A longer wait blocks, its
-    /// latency small beside the frame. A software adapter (lavapipe) renders on the host's
-    /// cores, which polling would take from it: it blocks at once.
+    /// between polls, for up to [`SPIN`]: the driver's blocking wait returns a tenth of a
+    /// millisecond or more after the end of a frame, as long as a short frame itself
+    /// (BENCHMARKS.md, "Measured choices"), and CUDA's default wait polls too. A longer
+    /// wait blocks, its latency small beside the frame. A software adapter (lavapipe)
+    /// renders on the host's cores, which polling would take from it: it blocks at once.
     fn wait(&self) -> Result<(), Error> {
         let error = |e: wgpu::PollError| Error::Render(e.to_string());
         if !self.is_cpu() {

@@ -150,9 +150,9 @@ impl Analysis {
 /// The most expressions inlining a function may duplicate (its size times the number of
 /// copies beyond the first): below it a call costs more than the copies (ptxas cannot
 /// optimise across a call, and saves registers around it); above it the copies cost
-/// more (code size, and register pressure that ptxas resolves by spilling). Measured on
-/// an H200 (1920×1080, 16 samples a pixel): seed6's `sdf` (4 copies, about 1800
-/// duplicated expressions) is 3 % faster inlined; temple's (about 5× that) is 2× slower.
+/// more (code size, and register pressure that ptxas resolves by spilling). The budget
+/// inlines seed6's `sdf` (4 copies, about 1 800 duplicated expressions) and calls temple's
+/// (about 5× that), each the faster way for its kernel (docs/ptx.md, "Calls").
 const DUPLICATION_BUDGET: u64 = 2500;
 
 /// Per function: inlined at each call. A function is inlined where it must be (it takes

@@ -59,16 +59,12 @@ fn sections(primitives: &[Primitive], top: &[Item]) -> String {
 
 /// The most primitives whose intersections are unrolled into the kernel. Unrolled, every
 /// primitive's constants are immediates and nothing is read from memory, which keeps small
-/// scenes fast (BENCHMARKS.md), but the kernel grows by about 180 lines of PTX a primitive and
-/// the time to assemble it more than in proportion (random spheres, ptxas for sm_90 on the
-/// development machine: 100 in 20 000 lines and 1 s, 256 in 47 000 lines and 2.3 s, 1 000 in
-/// 180 000 lines and 22 s; 10 000 did not finish in the CUDA driver's JIT in minutes). Up to 256
-/// the one-time cost stays within seconds (and the driver caches the result), and every
-/// example and the benchmarked scenes of up to 101 primitives keep the unrolled code.
-/// Beyond, the walk over `scene_data` reads 32 bytes per unrotated primitive or group it
-/// visits and its kernel is 2 000 lines of PTX whatever the scene's size; how its GPU time
-/// compares with the unrolled code's near the threshold is still to be measured
-/// (`Options::max_unrolled` chooses either way for one scene).
+/// scenes fast, but the kernel grows by about 180 lines of PTX a primitive and ptxas's time
+/// more than in proportion (seconds for a few hundred primitives, minutes for 10 000). Up to
+/// 256 the one-time cost stays within seconds (and the driver caches the result), and every
+/// example keeps the unrolled code. Beyond, the walk over `scene_data` reads 32 bytes per
+/// unrotated primitive or group it visits and its kernel is 2 000 lines of PTX whatever the
+/// scene's size (`Options::max_unrolled` chooses either way for one scene).
 pub const MAX_UNROLLED: usize = 256;
 
 /// The interval functions the scene uses and `fn trace` and `fn shadow`: unrolled over the

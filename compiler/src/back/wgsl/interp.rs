@@ -38,10 +38,10 @@ use std::fmt::Write;
 /// `auto` (`Options::kernel`) chooses the interpreted kernel for a marched scene whose
 /// distance program written as code (the whole program, or what remains of it beside
 /// instances read from `scene_data`) has at least this many live instructions; the runtime
-/// keeps the specialised kernel on CUDA, on CPU adapters and for sequences. The figures it
-/// stands on (docs/interpreted.md, an H100 on 2026-11-24): through wgpu a cold compile of
-/// 7 860 instructions took 4.0 s and of 14 739 9.0 s against the interpreted kernel's 1.6–1.9 s
-/// ready, whose frames were 2.6–6 times slower; temple (1 372) was ready in 1.1 s.
+/// keeps the specialised kernel on CUDA, on CPU adapters and for sequences. From about this
+/// size the Vulkan driver's cold compile of the code takes longer than the interpreted
+/// kernel's whole first render, whose frames are a few times slower (docs/interpreted.md;
+/// BENCHMARKS.md, "Interpreted against specialised").
 pub const AUTO_INTERPRET: usize = 5_000;
 
 /// Words of the header before the first program.

@@ -47,7 +47,7 @@ impl Params {
 const OUTLINE_PROGRAM: usize = 8_000;
 /// In such a program, a guarded block with at least this many live instructions becomes a
 /// function (nested blocks inside it may become functions in turn). Smaller pieces parse
-/// faster still but made ptxas slower (122 s against 47 s for compound_1000 at 256).
+/// faster still but made ptxas slower (BENCHMARKS.md, "Measured choices").
 const OUTLINE_BLOCK: usize = 2_000;
 /// A block that reads more values from outside than this stays inline.
 const OUTLINE_PARAMS: usize = 48;

@@ -41,28 +41,22 @@
 //! stack holds at most one group per level below the root (when a group of level k is
 //! popped, the others are of levels below k, and the descent from it pushes at most one of
 //! each level below it), so an array of max(D, 1) entries, which the kernel is written with,
-//! never overflows. A point near the surface thus meets its nearest instances first, its best
-//! distance is small early, and the boxes prune all but a few paths down the tree: a step
-//! costs about log n box tests and a few instances, where a walk in a fixed order costs what
-//! lies before the point's nearest instance in that order. (A uniform grid of cells would also
-//! find the nearest instances in constant time near the surface, but a point far from every
-//! instance, as most of a camera ray's steps are, must search ever larger rings of cells for
-//! a bound, and a scene's instances are seldom uniformly spread: compound_1000's lamp posts
-//! and a lattice over a plane would leave most cells empty or most instances in a few.)
-//! The boxes' distances keep their square roots: compared squared, they made the walk 1–4 %
-//! faster through CUDA and 1.6–1.9× slower through the Vulkan driver on an H100 (BENCHMARKS.md,
-//! "Squared box distances in the walk").
+//! never overflows. A point near the surface thus meets its nearest instances first and the
+//! boxes prune all but a few paths down the tree: a step costs about log n box tests and a
+//! few instances, where a walk in a fixed order costs what lies before the point's nearest
+//! instance. (A uniform grid of cells would search ever larger rings for a point far from
+//! every instance, as most of a ray's steps are, and suits scenes whose instances are evenly
+//! spread, which few are.) The boxes' distances keep their square roots: compared squared,
+//! the walk was slower through the Vulkan driver.
 //!
 //! Before the hierarchy each walk evaluates one instance, its hint: the private variable
 //! `hint` holds the entry of the nearest instance the invocation's last walk of `sdf`
 //! evaluated (0 before the first). Successive steps of a march, a normal's taps, the
 //! material's lookup and the shadow rays from a hit stay near the same instance, so the best
 //! distance is about the final one before the first box is measured, and the farther children
-//! the descent would push are passed over at once. Counted on lavapipe (320×180, with counters
-//! added to a throwaway build; BENCHMARKS.md) the hint took jittered_1024 marched from 2.9
-//! pushes, 11.7 boxes and 3.2 instances a step to 0.6, 11.7 and 4.2, compound_1000 from 1.5,
-//! 10.2 and 2.8 to 1.1, 10.1 and 3.8. Any hint gives the same result: the minimum does not
-//! depend on the order of the visit, nor, with the tie rule below, the material.
+//! the descent would push are passed over at once (fewer pushes to local memory). Any hint
+//! gives the same result: the minimum does not depend on the order of the visit, nor, with
+//! the tie rule below, the material.
 //!
 //! Most of `sdf`'s calls need no walk at all. `walk_sdf` also returns a lower bound B on the
 //! distance at its point p₀ of every instance but the nearest it evaluated (its key): the
@@ -72,17 +66,9 @@
 //! other instance is at least B − |p − p₀| away, and when the rest of the scene or the hint's
 //! instance is no farther than that, their minimum is the field's (another instance can at
 //! most tie). A march's steps towards the hint's instance keep to that ball, as do a
-//! normal's taps and a shadow ray's first steps. Marching 1 024 jittered spheres (the test
-//! `the_cache_of_the_last_walk…`: camera rays, normals and shadow rays), 0.41 walks a step
-//! remain, and 8.3 boxes a step where walking every step measures 16.5; with the exact
-//! second-nearest distance as B the walks would be 0.36 a step, and with a cache of the
-//! key's whole leaf 0.33 (the same test, altered to compute them; not kept). The walks left
-//! are steps between spheres whose nearest neighbours change as the ray passes. On an H100
-//! (BENCHMARKS.md, "The walk's cache") the cache took those spheres at 1080p from 7.4 to
-//! 6.2 ms through CUDA and from 6.2 to 4.7 ms through wgpu, but random_10000 through CUDA
-//! from 8.6 to 9.0 ms: the point and bound, held for the whole kernel, cost ptxas 17 more
-//! registers (since, CUDA caps a marched kernel's registers: 7.0 ms; BENCHMARKS.md, "CUDA's
-//! register cap").
+//! normal's taps and a shadow ray's first steps; the walks left are steps between instances
+//! whose nearest neighbours change as the ray passes (the test `the_cache_of_the_last_walk…`
+//! counts them). The hint and the cache: BENCHMARKS.md, "Measured choices".
 //!
 //! `walk_map`, which gives the material, keeps the tie rule independent of the order of the
 //! visit (the hint included): among instances at the same distance the one earlier in

@@ -34,9 +34,8 @@ pub const ENTRY_POINT: &str = "main";
 /// The workgroup is `WORKGROUP × WORKGROUP` invocations: a warp of 32 is a block of 8×4
 /// pixels, and a small workgroup leaves its multiprocessor as soon as its own rays end.
 /// Workgroups of 768–1 024 invocations would hold the Vulkan driver to 64–80 registers a
-/// thread, which on an H100 made temple 28 % faster through wgpu, but cost every other
-/// kernel up to 60 % in the tails of workgroups that wait for their slowest warp
-/// (BENCHMARKS.md, "The Vulkan driver's registers").
+/// thread, which helps a kernel short of registers (temple) but makes the others wait in
+/// the tails of workgroups for their slowest warp (BENCHMARKS.md, "Measured choices").
 pub const WORKGROUP: u32 = 8;
 /// Statistics words per pixel: steps, hits, misses, budget misses, overshoots, NaNs,
 /// secondary rays, shadow rays.
@@ -47,14 +46,10 @@ const TEMPLATE: &str = include_str!("kernel.wgsl");
 /// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
 /// they are read from `scene_data` and walked nearest first (march.rs). The code grows with
 /// the scene, and so does the driver's compile (the CUDA JIT of a marched kernel of 10 000
-/// spheres takes minutes); the walk's kernel is the same size for any number. A walk in a
-/// fixed order lost to the code up to a few thousand instances on an H100 (BENCHMARKS.md,
-/// 2026-11-22); the nearest-first walk, on lavapipe (this repository's 2-core VM,
-/// 2026-11-24, 320×240, marched), is 3–4× slower than the code at 100 instances
-/// (lattice_100, random_100) but 1.2× faster at 400 (compound_100), as fast at 1 000 on a
-/// lattice and 1.8–1.9× faster for 1 000 random or jittered spheres, while its pipeline is
-/// created in 44–77 ms against 0.1–12 s for the code. 256 lies between; the GPU figures are
-/// scripts/device-first-second.sh's.
+/// spheres takes minutes); the walk's kernel is the same size for any number. The code is
+/// faster at a hundred instances, the walk as fast or faster from a few hundred, and its
+/// pipeline is created in milliseconds where the code's takes seconds: 256 lies between
+/// (BENCHMARKS.md, "Measured choices").
 pub const MAX_INSTANCES: usize = 256;
 
 /// A generated, validated kernel.

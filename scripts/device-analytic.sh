@@ -52,21 +52,9 @@ if [ "$MODE" = all ] || [ "$MODE" = agree ]; then
 fi
 
 if [ "$MODE" = pareto ]; then
-  # The GPU speed-accuracy charts of docs/accuracy.md (640x480, median of 5 frames) for the
-  # report scenes in $PARETO (default: all six) on $PARETO_BACKEND (cuda, the default, written
-  # to $OUT/pareto-gpu-seedN.svg; wgpu to $OUT/pareto-wgpu-seedN.svg). The JSON and logs stay
-  # in /tmp/pareto (the device returns only a few files); a summary line per scene is printed.
-  backend=${PARETO_BACKEND:-cuda}
-  prefix=pareto-gpu
-  [ "$backend" = cuda ] || prefix=pareto-$backend
-  mkdir -p /tmp/pareto
-  for i in ${PARETO:-1 2 3 4 5 6}; do
-    "$B" pareto "examples/seed$i.sdf" --backend "$backend" --size 640x480 --frames 5 \
-      --sweep epsilon=1e-2..1e-6 --sweep max_steps=32..1024 --sweep relaxation=1..1.8 \
-      -o "$OUT/$prefix-seed$i.svg" --json > "/tmp/pareto/$prefix-seed$i.json" 2> "/tmp/pareto/$prefix-seed$i.log" \
-      || echo "seed$i pareto FAILED: $(tail -n 2 "/tmp/pareto/$prefix-seed$i.log")"
-    python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); p=[x for x in d["points"] if x["default"]][0]; print("seed%s default: %.2f dB, %.1f steps/px, %.3f ms, front time %s, steps %s; reference aa %s converged %s" % (sys.argv[2], p["psnr"], p["steps_mean"], p["median_s"]*1e3, p["front_time"], p["front_steps"], d["reference"]["aa"], d["reference"]["convergence"]["converged"]))' "/tmp/pareto/$prefix-seed$i.json" "$i" 2>/dev/null
-  done
+  # The GPU speed-accuracy charts of docs/accuracy.md for the report scenes in $PARETO
+  # (default: all six) on $PARETO_BACKEND (default cuda): scripts/charts.sh, to $OUT.
+  SCENES=${PARETO:-1 2 3 4 5 6} B=$B OUT=$OUT bash scripts/charts.sh "${PARETO_BACKEND:-cuda}"
 fi
 
 if [ "$MODE" = all ] || [ "$MODE" = analytic ]; then

@@ -124,6 +124,10 @@ pub fn render(diags: &[Diagnostic], sources: &SourceMap, colour: bool) -> String
     let mut out = Vec::new();
     let mut cache = SourceCache(sources, Vec::new());
     for d in diags {
+        if d.labels.iter().any(|l| on_a_long_line(sources, l.span)) {
+            out.extend_from_slice(excerpted(d, sources).as_bytes());
+            continue;
+        }
         let kind = match d.severity {
             Severity::Error => ReportKind::Error,
             Severity::Warning => ReportKind::Warning,
@@ -160,6 +164,80 @@ pub fn render(diags: &[Diagnostic], sources: &SourceMap, colour: bool) -> String
         }
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Lines longer than this (in bytes) are shown as an excerpt around the span, not whole: a
+/// scene written on one line of 300 KB would otherwise be repeated in every diagnostic.
+pub const LONG_LINE: usize = 240;
+
+/// Bytes of context shown on each side of a span on a long line.
+const CONTEXT: usize = 60;
+
+/// The byte range of the line that holds `at` in `text`.
+fn line_around(text: &str, at: usize) -> std::ops::Range<usize> {
+    let at = floor_boundary(text, at.min(text.len()));
+    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let end = text[at..].find('\n').map_or(text.len(), |i| at + i);
+    start..end
+}
+
+fn floor_boundary(s: &str, mut i: usize) -> usize {
+    while i > 0 && !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+fn ceil_boundary(s: &str, mut i: usize) -> usize {
+    while i < s.len() && !s.is_char_boundary(i) {
+        i += 1;
+    }
+    i
+}
+
+fn on_a_long_line(sources: &SourceMap, span: Span) -> bool {
+    line_around(sources.text(span.file), span.start as usize).len() > LONG_LINE
+}
+
+/// A diagnostic in the plain form, each label with an excerpt of its line of at most
+/// `2 × CONTEXT` bytes around the span (and the first `CONTEXT` bytes of a long span), marked
+/// with `…` where the line goes on, and carets under the span.
+fn excerpted(d: &Diagnostic, sources: &SourceMap) -> String {
+    let mut out = format!("{}[{}]: {}\n", kind_word(d.severity), d.code, d.message);
+    for l in &d.labels {
+        let text = sources.text(l.span.file);
+        let (line_no, col) = sources.line_col(l.span);
+        out.push_str(&format!(
+            "   ╭─[ {}:{line_no}:{col} ]\n",
+            sources.name(l.span.file)
+        ));
+        let line = line_around(text, l.span.start as usize);
+        let start = floor_boundary(text, (l.span.start as usize).clamp(line.start, line.end));
+        let end = ceil_boundary(
+            text,
+            (l.span.end as usize).clamp(start, line.end.min(start + CONTEXT)),
+        );
+        let from = floor_boundary(text, start.saturating_sub(CONTEXT).max(line.start));
+        let to = ceil_boundary(text, (end + CONTEXT).min(line.end));
+        let lead = if from > line.start { "…" } else { "" };
+        let tail = if to < line.end { "…" } else { "" };
+        out.push_str(&format!("{line_no:>3} │ {lead}{}{tail}\n", &text[from..to]));
+        let pad = lead.chars().count() + text[from..start].chars().count();
+        let width = text[start..end].chars().count().max(1);
+        out.push_str(&format!(
+            "    │ {}{} {}\n",
+            " ".repeat(pad),
+            "^".repeat(width),
+            l.message
+        ));
+    }
+    for n in &d.notes {
+        out.push_str(&format!("    │ Note: {n}\n"));
+    }
+    if let Some(h) = &d.help {
+        out.push_str(&format!("    │ Help: {h}\n"));
+    }
+    out
 }
 
 fn kind_word(s: Severity) -> &'static str {
@@ -249,5 +327,49 @@ pub fn number(x: f64, decimals: usize) -> String {
         "0".into()
     } else {
         s.into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An error in the middle of a 300 KB line shows an excerpt around it, not the line.
+    #[test]
+    fn a_long_line_is_shown_as_a_bounded_excerpt() {
+        let mut text = "let a = 1; ".repeat(30_000);
+        let at = text.len() / 2;
+        text.insert_str(at, "sphre(1); ");
+        let mut sources = SourceMap::new();
+        let file = sources.add("long.sdf", text.clone());
+        let d = Diagnostic::error(
+            "E0301",
+            "unknown function `sphre`",
+            Span::new(file, at..at + 5),
+        )
+        .with_label("not defined")
+        .with_help("did you mean `sphere`?");
+        let out = render(std::slice::from_ref(&d), &sources, false);
+        assert!(out.len() < 1000, "{} bytes", out.len());
+        assert!(
+            out.contains("error[E0301]: unknown function `sphre`"),
+            "{out}"
+        );
+        assert!(out.contains("…") && out.contains("sphre(1);"), "{out}");
+        assert!(out.contains("long.sdf:1:"), "{out}");
+        // The carets stand under the span: as many columns in as `sphre` is in the excerpt.
+        let lines: Vec<&str> = out.lines().collect();
+        let shown = lines.iter().find(|l| l.contains("sphre(1);")).unwrap();
+        let carets = lines.iter().find(|l| l.contains("^^^^^")).unwrap();
+        let col = |s: &str, pat: &str| s[..s.find(pat).unwrap()].chars().count();
+        assert_eq!(col(shown, "sphre"), col(carets, "^^^^^"), "{out}");
+        assert!(!carets.contains("^^^^^^"), "{out}");
+        // A short line keeps the full report.
+        let mut sources = SourceMap::new();
+        let file = sources.add("short.sdf", "scene { sphre(1); }\n");
+        let d = Diagnostic::error("E0301", "unknown function `sphre`", Span::new(file, 8..13));
+        let out = render(&[d], &sources, false);
+        assert!(out.contains("scene { sphre(1); }"), "{out}");
+        assert!(!out.contains('…'), "{out}");
     }
 }

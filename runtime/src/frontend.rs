@@ -27,10 +27,17 @@ pub enum DiagnosticFormat {
 #[derive(Debug, Default)]
 pub struct FsLoader;
 
+impl FsLoader {
+    /// The file that `import "path"` in the file named `from` reads.
+    fn resolve(from: &str, path: &str) -> PathBuf {
+        let base = Path::new(from).parent().unwrap_or(Path::new("."));
+        base.join(path)
+    }
+}
+
 impl Loader for FsLoader {
     fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
-        let base = Path::new(from).parent().unwrap_or(Path::new("."));
-        let full: PathBuf = base.join(path);
+        let full = FsLoader::resolve(from, path);
         let name = normalise(&full);
         let bytes =
             std::fs::read(&full).map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
@@ -89,6 +96,10 @@ pub struct Source {
     text: String,
     /// Imports read so far, by the importing file and the path written.
     imports: std::collections::HashMap<(String, String), Result<(String, String), String>>,
+    /// The name each file was first read under, by its canonical path (symbolic links
+    /// resolved): a file reached by two routes, a link and its target, has one name, so it
+    /// is read once (and an import of the entry file through a link is a cycle).
+    names: std::collections::HashMap<PathBuf, String>,
 }
 
 impl Source {
@@ -103,10 +114,16 @@ impl Source {
                 e.utf8_error().valid_up_to()
             )
         })?;
+        let name = normalise(path);
+        let mut names = std::collections::HashMap::new();
+        if let Ok(canonical) = std::fs::canonicalize(path) {
+            names.insert(canonical, name.clone());
+        }
         Ok(Source {
-            name: normalise(path),
+            name,
             text,
             imports: Default::default(),
+            names,
         })
     }
 
@@ -125,10 +142,18 @@ impl Source {
 
 impl Loader for Source {
     fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
-        self.imports
-            .entry((from.to_string(), path.to_string()))
-            .or_insert_with(|| FsLoader.load(from, path))
-            .clone()
+        let key = (from.to_string(), path.to_string());
+        if let Some(done) = self.imports.get(&key) {
+            return done.clone();
+        }
+        let mut loaded = FsLoader.load(from, path);
+        if let Ok((name, _)) = &mut loaded {
+            if let Ok(canonical) = std::fs::canonicalize(FsLoader::resolve(from, path)) {
+                name.clone_from(self.names.entry(canonical).or_insert_with(|| name.clone()));
+            }
+        }
+        self.imports.insert(key, loaded.clone());
+        loaded
     }
 }
 
@@ -137,18 +162,67 @@ pub fn report(loaded: &Loaded, format: DiagnosticFormat) {
     print_diagnostics(&loaded.diagnostics, &loaded.sources, format);
 }
 
-/// Prints `diags` about `sources` to stderr in the chosen format.
+/// Prints `diags` about `sources` in the chosen format: the human form on stderr, the JSON
+/// lines on stdout (the stream a script or an editor reads; `sdfc compile`, whose stdout
+/// carries its output, uses [`print_diagnostics_on_stderr`]).
 pub fn print_diagnostics(diags: &[Diagnostic], sources: &SourceMap, format: DiagnosticFormat) {
+    print_to(diags, sources, format, format == DiagnosticFormat::Json);
+}
+
+/// How many diagnostics the human form shows; the rest are counted in one line (a file with
+/// 20 000 errors would otherwise flood the terminal). The JSON form, for tools, has them all.
+pub const SHOWN: usize = 100;
+
+/// [`print_diagnostics`], always on stderr.
+pub fn print_diagnostics_on_stderr(
+    diags: &[Diagnostic],
+    sources: &SourceMap,
+    format: DiagnosticFormat,
+) {
+    print_to(diags, sources, format, false);
+}
+
+fn print_to(diags: &[Diagnostic], sources: &SourceMap, format: DiagnosticFormat, stdout: bool) {
+    use std::io::Write;
     if diags.is_empty() {
         return;
     }
     let text = match format {
         DiagnosticFormat::Human => {
-            diagnostics::render(diags, sources, std::io::stderr().is_terminal())
+            let shown = &diags[..diags.len().min(SHOWN)];
+            let mut text = diagnostics::render(shown, sources, std::io::stderr().is_terminal());
+            if let Some(rest) = diags.get(SHOWN..).filter(|r| !r.is_empty()) {
+                let errors = rest.iter().filter(|d| d.is_error()).count();
+                text.push_str(&format!(
+                    "… and {} more diagnostics ({errors} errors) not shown; the first {SHOWN} are above\n",
+                    rest.len()
+                ));
+            }
+            text
         }
         DiagnosticFormat::Json => diagnostics::to_json(diags, sources),
     };
-    eprint!("{text}");
+    // A closed pipe is not an error worth a panic: what could not be written is lost.
+    let _ = match stdout {
+        true => std::io::stdout().lock().write_all(text.as_bytes()),
+        false => std::io::stderr().lock().write_all(text.as_bytes()),
+    };
+}
+
+/// Prints an error about a file that is not a diagnostic (it cannot be read, it is not
+/// UTF-8): `error: MSG` on stderr, or in the JSON format one object of the diagnostics' shape
+/// on stdout, with the code `io` and no labels, so that the stream stays JSON lines.
+pub fn print_io_error(msg: &str, format: DiagnosticFormat) {
+    match format {
+        DiagnosticFormat::Human => eprintln!("error: {msg}"),
+        DiagnosticFormat::Json => {
+            let v = serde_json::json!({
+                "severity": "error", "code": "io", "message": msg,
+                "labels": [], "notes": [], "help": null,
+            });
+            println!("{v}");
+        }
+    }
 }
 
 /// A scene that checked without errors, with the files it was read from (for the
@@ -185,11 +259,20 @@ pub fn load_scene(
     format: DiagnosticFormat,
     limits: &Limits,
 ) -> Result<Checked, ExitCode> {
+    load_scene_code(path, format, limits).map_err(ExitCode::from)
+}
+
+/// [`load_scene`] with the exit code as a number (1 or 2), for commands that pass it on.
+pub fn load_scene_code(
+    path: &Path,
+    format: DiagnosticFormat,
+    limits: &Limits,
+) -> Result<Checked, u8> {
     let loaded = match load_with(path, limits) {
         Ok(l) => l,
         Err(msg) => {
-            eprintln!("error: {msg}");
-            return Err(ExitCode::from(2));
+            print_io_error(&msg, format);
+            return Err(2);
         }
     };
     report(&loaded, format);
@@ -199,7 +282,7 @@ pub fn load_scene(
             sources: loaded.sources,
             format,
         }),
-        None => Err(ExitCode::from(1)),
+        None => Err(1),
     }
 }
 

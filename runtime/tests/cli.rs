@@ -227,6 +227,88 @@ fn missing_unreadable_and_non_utf8_inputs_exit_2() {
 }
 
 #[test]
+fn json_diagnostics_and_io_errors_go_to_stdout() {
+    let d = dir("json");
+    std::fs::write(d.join("bad.sdf"), "scene { sphre(1); }\n").expect("write");
+    let out = sdfc(
+        &d,
+        &["check", "--diagnostics", "json", "bad.sdf", "nope.sdf"],
+    );
+    // The worst of the files: one could not be read.
+    assert_eq!(out.status.code(), Some(2));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is JSON"))
+        .collect();
+    assert!(
+        lines.iter().any(|v| v["severity"] == "error"
+            && v["labels"][0]["file"]
+                .as_str()
+                .is_some_and(|f| f.ends_with("bad.sdf"))),
+        "{stdout}"
+    );
+    let io = lines
+        .iter()
+        .find(|v| v["code"] == "io")
+        .expect("the IO error");
+    assert!(
+        io["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("cannot read `nope.sdf`")),
+        "{io}"
+    );
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("cannot read"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A library imported by its path and through a symbolic link to it is read once (no
+/// duplicate definitions).
+#[cfg(unix)]
+#[test]
+fn a_library_imported_through_a_symbolic_link_is_read_once() {
+    let d = dir("symlink");
+    std::fs::create_dir(d.join("lib")).expect("dir");
+    std::fs::write(d.join("lib/shapes.sdf"), "let r = 1;\n").expect("write");
+    std::os::unix::fs::symlink("lib/shapes.sdf", d.join("alias.sdf")).expect("link");
+    std::os::unix::fs::symlink("lib", d.join("linked")).expect("link");
+    std::fs::write(
+        d.join("main.sdf"),
+        "import \"lib/shapes.sdf\";\nimport \"alias.sdf\";\nimport \"linked/shapes.sdf\";\nscene { sphere(r); }\n",
+    )
+    .expect("write");
+    let out = sdfc(&d, &["check", "main.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("E0207"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A one-line file with 20 000 duplicate definitions: the human form shows the first 100
+/// diagnostics, each with an excerpt of the line, and counts the rest.
+#[test]
+fn twenty_thousand_errors_on_one_line_are_capped() {
+    let d = dir("many");
+    let text = format!("{}scene {{ sphere(a); }}", "let a = 1; ".repeat(20_000));
+    std::fs::write(d.join("many.sdf"), text).expect("write");
+    let out = sdfc(&d, &["check", "many.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(err.len() < 200_000, "{} bytes of diagnostics", err.len());
+    assert_eq!(err.matches("error[E0207]").count(), 100);
+    assert!(
+        err.contains("… and 19899 more diagnostics (19899 errors) not shown"),
+        "{}",
+        &err[err.len().saturating_sub(400)..]
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn an_unreadable_import_is_a_diagnostic() {
     let d = dir("import");
     std::fs::write(d.join("lib.sdf"), b"let r = 1; // caf\xe9\n").expect("write");

@@ -724,3 +724,33 @@ fn a_read_only_output_is_refused_and_left_unchanged() {
     assert!(err.contains("read-only"), "{err}");
     assert_eq!(std::fs::read(&out).expect("kept"), b"keep me");
 }
+
+/// A file that cannot be read exits 2, as for `check` and `render`; a grid that finds no
+/// surface (bounds away from the shape, or cells too coarse) is an error, exit 1, with
+/// nothing written; a tiny cell is named in scientific notation, not as `0`.
+#[test]
+fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
+    let d = dir("empty");
+    let scene = write_scene(&d, "ball.sdf", "scene { sphere(0.5); }\n");
+    let out = d.join("ball.stl");
+    let o = sdfc(&["mesh", s(&d.join("nope.sdf")), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read"));
+    let o = sdfc(&["mesh", s(&scene), "-o", s(&out), "--bounds=2,2,2,3,3,3"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("no triangles") && err.contains("--bounds"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // A sphere of radius 0.001 at --resolution 100: cells of 2e-5, cheap to mesh.
+    let tiny = write_scene(&d, "tiny.sdf", "scene { sphere(0.001); }\n");
+    let o = sdfc(&["mesh", s(&tiny), "-o", s(&out), "--resolution", "100"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !err.contains("of 0 ") && !err.contains("of 0:") && err.contains("e-5"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

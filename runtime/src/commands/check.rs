@@ -34,7 +34,7 @@ pub fn run(args: CheckArgs) -> ExitCode {
     for file in &args.files {
         match frontend::load_with(file, &limits) {
             Err(msg) => {
-                eprintln!("error: {msg}");
+                frontend::print_io_error(&msg, args.diagnostics);
                 code = 2;
             }
             Ok(loaded) => {
@@ -136,7 +136,7 @@ pub fn animation(
         );
     }
     let mut source = frontend::Source::read(file).map_err(|msg| {
-        eprintln!("error: {msg}");
+        frontend::print_io_error(&msg, format);
         2u8
     })?;
     let mut structures = Vec::new();

@@ -116,7 +116,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
         eprintln!("error: {msg}");
         return ExitCode::from(2);
     }
-    frontend::report(&loaded, args.diagnostics);
+    frontend::print_diagnostics_on_stderr(&loaded.diagnostics, &loaded.sources, args.diagnostics);
     if args.emit.binary() && args.output.is_none() && {
         use std::io::IsTerminal;
         std::io::stdout().is_terminal()
@@ -165,7 +165,7 @@ pub fn run(args: CompileArgs) -> ExitCode {
             let lowered = match lower::lower_within(scene, &options, &limits) {
                 Ok(lowered) => lowered,
                 Err(d) => {
-                    frontend::print_diagnostics(&[d], &loaded.sources, args.diagnostics);
+                    frontend::print_diagnostics_on_stderr(&[d], &loaded.sources, args.diagnostics);
                     return ExitCode::from(1);
                 }
             };

@@ -81,8 +81,9 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     let mut settings = settings(&args.set).map_err(usage)?;
     settings.materials = matches!(format, Format::Ply | Format::Glb);
     let pool = super::render::thread_pool(args.threads).map_err(usage)?;
-    let checked = frontend::load_scene(&args.file, DiagnosticFormat::Human, &limits)
-        .map_err(|_| (1, String::new()))?;
+    // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
+    let checked = frontend::load_scene_code(&args.file, DiagnosticFormat::Human, &limits)
+        .map_err(|code| (code, String::new()))?;
     let scene = &checked.scene;
     let analysis = analysis::analyse(scene);
     let Some(root) = analysis.root() else {
@@ -282,6 +283,22 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     for p in &mut mesh.positions {
         *p = [0, 1, 2].map(|i| p[i] + origin[i]);
     }
+    if mesh.triangles.is_empty() {
+        let why = match args.bounds {
+            Some(_) => "the region given with --bounds holds none of the surface, or its cells are too coarse to find it (a higher --resolution)".to_string(),
+            None => format!(
+                "cells of {} are too coarse to find it (a higher --resolution)",
+                short(voxel)
+            ),
+        };
+        return Err((
+            1,
+            format!(
+                "the mesh has no triangles: no surface crosses the grid of {nx}x{ny}x{nz} cells; {why}; `{}` is not written",
+                args.output.display()
+            ),
+        ));
+    }
     // The file's bytes are in the surface cells' share of the announcement.
     let bytes = format.encode(&mesh, &scene.materials);
     crate::image::write_atomic(&args.output, &bytes)
@@ -332,7 +349,12 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
     )
 }
 
+/// A length for a message: four decimals, or for a small one (a cell of 10⁻⁵) three
+/// significant digits in scientific notation, never `0`.
 fn short(x: f64) -> String {
+    if x != 0.0 && x.abs() < 1e-3 {
+        return sdfc_compiler::diagnostics::scientific(x);
+    }
     sdfc_compiler::diagnostics::number(x, 4)
 }
 

@@ -1173,8 +1173,17 @@ impl Ctx {
             } else {
                 format!("`{}`", builtins::signature(b.name, &b.sigs[i]))
             };
-            for d in errs {
-                self.error(d.with_note(sig_note.clone()));
+            // `min(a, b)` of two shapes, as a shader writes a union.
+            let shapes = matches!(b.name, "min" | "max")
+                && args.iter().any(|a| matches!(a.value, Value::Shape(_)));
+            for (n, d) in errs.into_iter().enumerate() {
+                let d = d.with_note(sig_note.clone());
+                let d = if shapes && n == 0 && d.help.is_none() {
+                    d.with_help("shapes are combined with `union(a, b)` (the minimum of their fields) or `intersect(a, b)` (the maximum)")
+                } else {
+                    d
+                };
+                self.error(d);
             }
         }
         Value::Error

@@ -357,17 +357,21 @@ fn combine(op: Combine, mut kids: impl Iterator<Item = Option<Bound>>) -> Option
 }
 
 /// A smooth union is at least min(a, b) minus its largest correction (k/4 for the
-/// polynomial, k·ln 2 for the exponential, hg_sdf's variants' `blend_reach`); a smooth
-/// maximum is at least the maximum.
+/// polynomial, k·ln 2 for the exponential, k/2 for hg_sdf's stairs, whatever the signs); a
+/// smooth maximum is at least the maximum (hg_sdf's variants too).
 fn smooth(op: Combine, k: f64, v: Smooth, a: Option<Bound>, b: Option<Bound>) -> Option<Bound> {
     match op {
+        // hg_sdf's chamfer, round and columns unions read a + b (or |(a, b)|): inside both
+        // operands they fall below min(a, b) by up to (√2 − 1)·|min(a, b)|, with no bound a
+        // guard distance can follow, so they have none (their operands keep theirs).
+        Combine::Union if matches!(v, Smooth::Chamfer | Smooth::Round | Smooth::Columns(_)) => None,
         Combine::Union => {
             let h = hull(&a?, &b?);
             let g = match v {
                 _ if k <= 0.0 => 0.0,
                 Smooth::Poly => k * 0.25,
                 Smooth::Exp => k * std::f64::consts::LN_2,
-                _ => crate::scene::analysis::blend_reach(k, v),
+                _ => k * 0.5,
             };
             Some(h.grow(g * (1.0 + 1e-9)))
         }

@@ -6,7 +6,7 @@ use super::bounds::Bounds;
 use super::graph::field_and_bound;
 use crate::program::{Float, Program};
 use crate::rng::Rng;
-use crate::scene::{Combine, Graph, MaterialId, Node, NodeId, Smooth};
+use crate::scene::{Combine, Feature, Graph, MaterialId, Node, NodeId, Smooth};
 use crate::{FileId, Span};
 
 /// Evaluates the distance and the material register (the bound, here) of a program without
@@ -72,6 +72,56 @@ fn zoo() -> (Graph, Vec<NodeId>) {
             power: 3.5,
             iterations: 3,
         },
+        Node::CappedCone {
+            half_height: 0.6,
+            bottom: 0.5,
+            top: 0.2,
+        },
+        Node::RoundCone {
+            bottom: 0.4,
+            top: 0.2,
+            half_height: 0.5,
+        },
+        Node::Segment {
+            a: [0.3, -0.2, 0.5],
+            b: [-0.4, 0.6, 0.1],
+            radius: 0.2,
+        },
+        Node::RoundedCylinder {
+            radius: 0.5,
+            round: 0.1,
+            half_height: 0.4,
+        },
+        Node::HexPrism {
+            radius: 0.4,
+            half_height: 0.5,
+        },
+        Node::TriPrism {
+            radius: 0.3,
+            half_height: 0.6,
+        },
+        Node::Octahedron { radius: 0.7 },
+        Node::Pyramid {
+            base: 0.8,
+            height: 1.1,
+        },
+        Node::BoxFrame {
+            half: [0.5, 0.4, 0.6],
+            edge: 0.05,
+        },
+        Node::Link {
+            half_length: 0.3,
+            major: 0.4,
+            minor: 0.1,
+        },
+        Node::InfiniteCylinder {
+            radius: 0.3,
+            axis: [0.0, 0.0, 1.0],
+        },
+        Node::Slab {
+            thickness: 0.4,
+            normal: [0.0, 1.0, 0.0],
+        },
     ];
     let prims: Vec<NodeId> = prims.into_iter().map(|n| add(&mut g, n)).collect();
     ids.extend(&prims);
@@ -91,7 +141,14 @@ fn zoo() -> (Graph, Vec<NodeId>) {
                 children: vec![a, moved],
             },
         ));
-        for variant in [Smooth::Poly, Smooth::Exp] {
+        for variant in [
+            Smooth::Poly,
+            Smooth::Exp,
+            Smooth::Chamfer,
+            Smooth::Round,
+            Smooth::Stairs(3),
+            Smooth::Columns(2),
+        ] {
             ids.push(add(
                 &mut g,
                 Node::SmoothCombine {
@@ -106,6 +163,20 @@ fn zoo() -> (Graph, Vec<NodeId>) {
     }
     for t in [0.3, 0.8] {
         ids.push(add(&mut g, Node::Morph { t, a, b: moved }));
+    }
+    for op in [
+        Feature::Engrave { depth: 0.2 },
+        Feature::Groove {
+            width: 0.3,
+            depth: 0.1,
+        },
+        Feature::Tongue {
+            width: 0.3,
+            height: 0.2,
+        },
+        Feature::Pipe { radius: 0.1 },
+    ] {
+        ids.push(add(&mut g, Node::Feature { op, a, b: moved }));
     }
     let wrappers = |c: NodeId| {
         vec![

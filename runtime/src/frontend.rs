@@ -127,6 +127,21 @@ impl Source {
         })
     }
 
+    /// A scene given as text, named `name` (a path: its imports are read relative to it;
+    /// for text of no file, a name in the current directory).
+    pub fn from_text(name: &str, text: String) -> Source {
+        Source {
+            name: normalise(Path::new(name)),
+            text,
+            imports: Default::default(),
+        }
+    }
+
+    /// The entry file's text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
     /// Checks the scene within `limits` at the time `t` = `time` seconds.
     pub fn check(&mut self, limits: &Limits, time: f64) -> Loaded {
         let mut sources = SourceMap::new();

@@ -229,7 +229,7 @@ fn part_refused(args: &CompileArgs) -> Option<String> {
 }
 
 /// The bytes of the distance function alone, named `name`, in `target`.
-fn emit_map(
+pub fn emit_map(
     scene: &scene::Scene,
     lowered: &lower::Lowered,
     target: Emit,
@@ -256,8 +256,9 @@ fn emit_map(
     }
 }
 
-/// The bytes of a target that needs the distance program.
-fn emit(
+/// The bytes of a target that needs the distance program (`sdfc compile --part kernel`,
+/// and the Python package's `Scene.compile`).
+pub fn emit(
     scene: &scene::Scene,
     lowered: &lower::Lowered,
     target: Emit,

@@ -84,6 +84,115 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
     let checked = frontend::load_scene_code(&args.file, DiagnosticFormat::Human, &limits)
         .map_err(|code| (code, String::new()))?;
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = ProgressBar::new(1000);
+        if let Ok(style) =
+            ProgressStyle::with_template("{msg:>9} {bar:40} {percent:>3}% {elapsed_precise}")
+        {
+            bar.set_style(style);
+        }
+        bar
+    });
+    let progress = |name: &'static str, f: f64| {
+        if let Some(b) = &bar {
+            b.set_message(name);
+            b.set_position((f * 1000.0) as u64);
+        }
+    };
+    let say = |text: String| match &bar {
+        Some(b) => b.suspend(|| eprintln!("{text}")),
+        None => eprintln!("{text}"),
+    };
+    let region = Region {
+        resolution: args.resolution,
+        voxel: args.voxel,
+        bounds: args.bounds,
+    };
+    let result = surface(&checked, region, &settings, &limits, &pool, &progress, &say);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let Meshed {
+        mesh,
+        stats,
+        grid,
+        seconds,
+    } = result?;
+    if mesh.triangles.is_empty() {
+        let why = match args.bounds {
+            Some(_) => "the region given with --bounds holds none of the surface, or its cells are too coarse to find it (a higher --resolution)".to_string(),
+            None => format!(
+                "cells of {} are too coarse to find it (a higher --resolution)",
+                short(grid.voxel)
+            ),
+        };
+        let [nx, ny, nz] = grid.cells;
+        return Err((
+            1,
+            format!(
+                "the mesh has no triangles: no surface crosses the grid of {nx}x{ny}x{nz} cells; {why}; `{}` is not written",
+                args.output.display()
+            ),
+        ));
+    }
+    // The file's bytes are in the surface cells' share of the announcement.
+    let bytes = format.encode(&mesh, &checked.scene.materials);
+    crate::image::write_atomic(&args.output, &bytes)
+        .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;
+    eprintln!(
+        "wrote {} ({} triangles, {} vertices, {:.3} s)",
+        args.output.display(),
+        mesh.triangles.len(),
+        mesh.positions.len(),
+        seconds
+    );
+    if args.stats {
+        print!("{}", describe(&grid, &stats, seconds));
+    }
+    Ok(())
+}
+
+/// The region `surface` meshes and the size of its cells (`--resolution`, `--voxel`,
+/// `--bounds`; all `None`: the analysis's box at [`DEFAULT_RESOLUTION`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Region {
+    /// Cells along the longest side of the bounds.
+    pub resolution: Option<u32>,
+    /// Edge of a cell, in scene units (instead of `resolution`).
+    pub voxel: Option<f64>,
+    /// The region to mesh (min, max), in the scene's coordinates.
+    pub bounds: Option<[[f64; 3]; 2]>,
+}
+
+/// A surface meshed by [`surface`]: the mesh in the scene's coordinates, its grid, what
+/// meshing did and how long it took.
+#[derive(Debug)]
+pub struct Meshed {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// What meshing did.
+    pub stats: Stats,
+    /// The grid it was meshed on.
+    pub grid: Grid,
+    /// Seconds from the octree's start to the mesh.
+    pub seconds: f64,
+}
+
+/// Meshes a checked scene's surface over `region` within `limits` on `pool`: what `sdfc
+/// mesh` does before it writes the file (and what the Python package's `Scene.mesh` calls).
+/// `progress` gets the stage's name and the fraction done of the whole; `say` the
+/// announcements and warnings. `Err` is the exit code (2 for a usage problem, 1 for a scene
+/// or limit that refuses the mesh) and the message (empty when already reported).
+pub fn surface(
+    checked: &frontend::Checked,
+    region: Region,
+    settings: &Settings,
+    limits: &Limits,
+    pool: &rayon::ThreadPool,
+    progress: &(dyn Fn(&'static str, f64) + Sync),
+    say: &(dyn Fn(String) + Sync),
+) -> Result<Meshed, (u8, String)> {
+    let usage = |msg: String| (2u8, msg);
     let scene = &checked.scene;
     let analysis = analysis::analyse(scene);
     let Some(root) = analysis.root() else {
@@ -94,7 +203,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     };
     let origin = scene.origin;
     // The clip box and the grid, in the program's coordinates (the scene's, less `origin`).
-    let clip = match args.bounds {
+    let clip = match region.bounds {
         Some([lo, hi]) => [lo, hi].map(|c| [0, 1, 2].map(|i| c[i] - origin[i])),
         None => {
             let b = root.bounds;
@@ -140,7 +249,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     };
     let size = [0, 1, 2].map(|i| clip[1][i] - clip[0][i]);
     let longest = size.iter().copied().fold(0.0f64, f64::max);
-    let voxel = match (args.voxel, args.resolution) {
+    let voxel = match (region.voxel, region.resolution) {
         (Some(v), _) if v.is_finite() && v > 0.0 => v,
         (Some(v), _) => return Err(usage(format!("--voxel must be a positive number, not {v}"))),
         (None, Some(0)) => return Err(usage("--resolution must be at least 1".into())),
@@ -154,7 +263,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     }
     // Without --bounds the box is the analysis's, grown by a cell so that the clip never
     // touches the surface; one more cell all round is outside the clip, which closes the mesh.
-    let clip = match args.bounds {
+    let clip = match region.bounds {
         Some(_) => clip,
         None => [clip[0].map(|x| x - voxel), clip[1].map(|x| x + voxel)],
     };
@@ -173,51 +282,35 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         .chain(origin.iter().map(|x| x.abs()))
         .fold(0.0f64, f64::max);
     if 1e-3 * voxel < 8.0 * f32::EPSILON as f64 * magnitude {
-        eprintln!(
+        say(format!(
             "warning: a cell of {} is too small for the f32 coordinates of mesh files at {}: vertices may share positions",
             short(voxel),
             short(magnitude)
-        );
+        ));
     }
     let grid = Grid::over(&clip, voxel);
     let lowered = checked
-        .lower(&LowerOptions::default(), &limits)
+        .lower(&LowerOptions::default(), limits)
         .map_err(|_| (1, String::new()))?;
     let field = Field::new(&lowered.program, root.proven, clip);
     if !root.proven {
-        eprintln!(
+        say(format!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
-            cause(&checked, &analysis),
+            cause(checked, &analysis),
             grid.dense_cells()
-        );
+        ));
     }
     let max_cells = limits.get(Limit::Cells);
     let octree_bytes = octree::bytes(&grid, root.proven, max_cells);
     let [nx, ny, nz] = grid.cells;
-    eprintln!(
+    say(format!(
         "mesh: {nx}x{ny}x{nz} cells of {}: allocating at most {} MiB to find the surface",
         short(voxel),
         mib(octree_bytes)
-    );
-    check_memory(octree_bytes, &limits).map_err(|m| (1, m))?;
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = ProgressBar::new(1000);
-        if let Ok(style) =
-            ProgressStyle::with_template("{msg:>9} {bar:40} {percent:>3}% {elapsed_precise}")
-        {
-            bar.set_style(style);
-        }
-        bar
-    });
-    let stage = |name: &'static str, base: f64, share: f64| {
-        let bar = bar.clone();
-        move |f: f64| {
-            if let Some(b) = &bar {
-                b.set_message(name);
-                b.set_position(((base + share * f) * 1000.0) as u64);
-            }
-        }
-    };
+    ));
+    check_memory(octree_bytes, limits).map_err(|m| (1, m))?;
+    let stage =
+        |name: &'static str, base: f64, share: f64| move |f: f64| progress(name, base + share * f);
     let started = Instant::now();
     let candidates = pool
         .install(|| octree::candidates(&field, &grid, max_cells, &stage("octree", 0.0, 0.3)))
@@ -231,23 +324,19 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             )
         })?;
     let n = candidates.cells.len() as u64;
-    let say = |text: String| match &bar {
-        Some(b) => b.suspend(|| eprintln!("{text}")),
-        None => eprintln!("{text}"),
-    };
     let bound = contour::candidate_bytes(&grid, n);
     say(format!(
         "mesh: {n} cells may hold surface: allocating at most {} MiB for their corners",
         mib(bound)
     ));
-    check_memory(bound, &limits).map_err(|m| (1, m))?;
+    check_memory(bound, limits).map_err(|m| (1, m))?;
     let surface_check = |cells: u64| {
         let total = bound.saturating_add(cells.saturating_mul(BYTES_PER_SURFACE_CELL));
         say(format!(
             "mesh: {cells} cells hold surface: allocating at most {} MiB in all",
             mib(total)
         ));
-        check_memory(total, &limits)
+        check_memory(total, limits)
     };
     // The cells the closure may hold: as many as the memory limit allows at 52 bytes each
     // (a key and a point), within the cells limit.
@@ -258,15 +347,12 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             &field,
             &grid,
             candidates.cells,
-            &settings,
+            settings,
             memory_cells,
             &surface_check,
             &stage("contour", 0.3, 0.7),
         )
     });
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
     let (mut mesh, mut stats): (Mesh, Stats) = result.map_err(|stop| match stop {
         Stop::Refused(msg) => (1, msg),
         Stop::Cells(cells) => (
@@ -283,37 +369,12 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     for p in &mut mesh.positions {
         *p = [0, 1, 2].map(|i| p[i] + origin[i]);
     }
-    if mesh.triangles.is_empty() {
-        let why = match args.bounds {
-            Some(_) => "the region given with --bounds holds none of the surface, or its cells are too coarse to find it (a higher --resolution)".to_string(),
-            None => format!(
-                "cells of {} are too coarse to find it (a higher --resolution)",
-                short(voxel)
-            ),
-        };
-        return Err((
-            1,
-            format!(
-                "the mesh has no triangles: no surface crosses the grid of {nx}x{ny}x{nz} cells; {why}; `{}` is not written",
-                args.output.display()
-            ),
-        ));
-    }
-    // The file's bytes are in the surface cells' share of the announcement.
-    let bytes = format.encode(&mesh, &scene.materials);
-    crate::image::write_atomic(&args.output, &bytes)
-        .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;
-    eprintln!(
-        "wrote {} ({} triangles, {} vertices, {:.3} s)",
-        args.output.display(),
-        mesh.triangles.len(),
-        mesh.positions.len(),
-        seconds
-    );
-    if args.stats {
-        print!("{}", describe(&grid, &stats, seconds));
-    }
-    Ok(())
+    Ok(Meshed {
+        mesh,
+        stats,
+        grid,
+        seconds,
+    })
 }
 
 /// The `--stats` report.

@@ -1,0 +1,221 @@
+"""sdfc from Python: check a scene, render it into a NumPy array, mesh it, and evaluate its
+distance field at points, through the same compiler, renderers and mesher as the `sdfc`
+command (docs/python.md).
+
+    import sdfc
+    scene = sdfc.Scene(path="examples/seed3.sdf")
+    image = scene.render(size=(320, 240))           # (240, 320, 3) float32, linear RGB
+    vertices, faces, colours = scene.mesh(resolution=64)
+    distances, materials = scene.distance([[0, 1, 0], [0, 0, 0]])
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _sdfc
+from ._sdfc import CompileError
+
+__all__ = ["CompileError", "Diagnostic", "Facts", "Scene", "check"]
+
+
+@dataclasses.dataclass(frozen=True)
+class Diagnostic:
+    """One thing the compiler said about a scene, at its primary span (lines and columns
+    1-based, columns in characters)."""
+
+    severity: str
+    code: str
+    message: str
+    file: str
+    line: int
+    column: int
+    end_line: int
+    end_column: int
+    span_text: str
+    label: str
+    notes: Tuple[str, ...]
+    help: Optional[str]
+
+    @staticmethod
+    def _of(d: Mapping[str, Any]) -> "Diagnostic":
+        return Diagnostic(**{**d, "notes": tuple(d["notes"])})
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.column}: {self.severity}[{self.code}]: {self.message}"
+
+
+@dataclasses.dataclass(frozen=True)
+class Facts:
+    """What the analysis derived about a clean scene's distance field, as `sdfc check` says:
+    exact, a bound or approximate; its Lipschitz bound L (None where none is proven); the
+    intersection method ("trace" or "march") and why."""
+
+    exactness: Optional[str]
+    lipschitz: Optional[float]
+    proven: Optional[bool]
+    step_lipschitz: Optional[float]
+    method: str
+    method_reason: str
+    summary: str
+    animated: bool
+
+
+def _diagnostics(error: CompileError) -> List[Diagnostic]:
+    return [Diagnostic._of(d) for d in getattr(error, "diagnostics", [])]
+
+
+def _wrap(error: CompileError) -> CompileError:
+    error.diagnostics = _diagnostics(error)
+    return error
+
+
+def check(source: Optional[str] = None, path: Optional[str] = None) -> Tuple[List[Diagnostic], Optional[Facts]]:
+    """Checks a scene given as text (`source`; `path`, if given, names it for its imports) or
+    read from `path`: every diagnostic, and the facts of its field when it has no errors
+    (None when it has). Raises ValueError for a file that cannot be read."""
+    diags, facts = _sdfc.check(source, path)
+    return [Diagnostic._of(d) for d in diags], (Facts(**facts) if facts is not None else None)
+
+
+def _setting(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (tuple, list, np.ndarray)):
+        return ",".join(str(v) for v in value)
+    return str(value)
+
+
+class Scene:
+    """A checked scene (raises CompileError when it has errors), from its text (`source`) or
+    file (`path`), with render settings overridden as `sdfc render --set` does
+    (`set={"max_steps": 512, "background": (0, 0, 0)}`).
+
+    Every method is safe to call from several threads at once; renders and meshes release
+    the GIL, and Ctrl-C during them raises KeyboardInterrupt."""
+
+    def __init__(
+        self,
+        source: Optional[str] = None,
+        path: Optional[str] = None,
+        set: Optional[Mapping[str, Any]] = None,
+    ) -> None:
+        sets = [f"{k}={_setting(v)}" for k, v in (set or {}).items()]
+        try:
+            self._scene = _sdfc._Scene(source, None if path is None else str(path), sets)
+        except CompileError as e:
+            raise _wrap(e) from None
+        self.path = path
+
+    def info(self) -> Dict[str, Any]:
+        """The scene's own settings: width, height, aa, fps, duration, and whether it reads t."""
+        return dict(self._scene.info())
+
+    def render(
+        self,
+        size: Optional[Tuple[int, int]] = None,
+        backend: str = "auto",
+        aa: Optional[int] = None,
+        t: float = 0.0,
+        dtype: Any = np.float32,
+    ) -> np.ndarray:
+        """Renders the scene at the time `t` into an (h, w, 3) array: float32 linear RGB
+        (unclamped), or with `dtype=np.uint8` the clamped sRGB bytes `sdfc render` writes to
+        a PNG. `size=(w, h)` and `aa` override the scene's render block; `backend` is "auto"
+        (CUDA, else a wgpu GPU, else the CPU), "cpu", "wgpu" or "cuda"."""
+        encoding = {np.dtype(np.float32): "linear", np.dtype(np.uint8): "srgb"}.get(np.dtype(dtype))
+        if encoding is None:
+            raise ValueError("dtype must be float32 (linear) or uint8 (sRGB)")
+        w, h, data = self._call(self._scene.render, _size(size), backend, aa, float(t), encoding)
+        return np.frombuffer(data, dtype=np.dtype(dtype)).reshape(h, w, 3).copy()
+
+    def png(self, size: Optional[Tuple[int, int]] = None, backend: str = "auto", aa: Optional[int] = None, t: float = 0.0) -> bytes:
+        """The render as the bytes of a PNG file (what `sdfc render -o FILE.png` writes)."""
+        return self._call(self._scene.render, _size(size), backend, aa, float(t), "png")[2]
+
+    def _repr_png_(self) -> bytes:
+        # Jupyter shows the scene as its picture: at most 640 pixels wide, on the best backend.
+        info = self._scene.info()
+        w, h = info["width"], info["height"]
+        if w > 640:
+            w, h = 640, max(1, round(h * 640 / w))
+        return self.png(size=(w, h))
+
+    def distance(self, points: Any, t: float = 0.0) -> Tuple[np.ndarray, np.ndarray]:
+        """The signed distance and material id at each of `points`, an (n, 3) array (or one
+        point of 3), through the CPU interpreter in float64: ((n,) float64, (n,) uint32)."""
+        p = np.ascontiguousarray(points, dtype=np.float64)
+        single = p.shape == (3,)
+        if single:
+            p = p.reshape(1, 3)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"points must have the shape (n, 3), not {p.shape}")
+        d, m = self._call(self._scene.distance, p.tobytes(), float(t))
+        d = np.frombuffer(d, dtype=np.float64).copy()
+        m = np.frombuffer(m, dtype=np.uint32).copy()
+        return (d, m)
+
+    def mesh(
+        self,
+        resolution: Optional[int] = None,
+        bounds: Optional[Sequence[Sequence[float]]] = None,
+        voxel: Optional[float] = None,
+        sharp: bool = True,
+        t: float = 0.0,
+    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The surface as `sdfc mesh` meshes it (watertight, sharp-edged): vertices (n, 3)
+        float64, faces (m, 3) uint32 counter-clockwise from outside, and linear vertex
+        colours (n, 3) float32. `resolution` is the cells along the longest side (default
+        128), or `voxel` a cell's edge; `bounds=((x0, y0, z0), (x1, y1, z1))` the region
+        (needed for an unbounded scene)."""
+        b = None
+        if bounds is not None:
+            lo, hi = bounds
+            b = (tuple(float(x) for x in lo), tuple(float(x) for x in hi))
+        v, f, c = self._call(self._scene.mesh, resolution, voxel, b, sharp, float(t))
+        v = np.frombuffer(v, dtype=np.float64).reshape(-1, 3).copy()
+        f = np.frombuffer(f, dtype=np.uint32).reshape(-1, 3).copy()
+        c = np.frombuffer(c, dtype=np.float32).reshape(-1, 3).copy()
+        return (v, f, c)
+
+    def compile(self, emit: str = "wgsl", part: str = "kernel", name: Optional[str] = None, sm: int = 70, t: float = 0.0) -> Union[str, bytes]:
+        """What `sdfc compile --emit EMIT --part PART` writes: text, or bytes for the binary
+        targets (spirv, params, scene-data)."""
+        data = self._call(self._scene.compile, emit, part, name, sm, float(t))
+        if emit in ("spirv", "params", "scene-data"):
+            return data
+        return data.decode("utf-8")
+
+    def frames(
+        self,
+        frames: Optional[Iterable[int]] = None,
+        size: Optional[Tuple[int, int]] = None,
+        backend: str = "auto",
+        aa: Optional[int] = None,
+        dtype: Any = np.float32,
+    ) -> Iterator[np.ndarray]:
+        """Renders frame k of the animation at the time k / fps for each k of `frames`
+        (default: the frames the scene's render block states)."""
+        info = self._scene.info()
+        fps = info["fps"]
+        if frames is None:
+            frames = range(round(fps * info["duration"]))
+        for k in frames:
+            yield self.render(size=size, backend=backend, aa=aa, t=k / fps, dtype=dtype)
+
+    @staticmethod
+    def _call(f: Any, *args: Any) -> Any:
+        try:
+            return f(*args)
+        except CompileError as e:
+            raise _wrap(e) from None
+
+
+def _size(size: Optional[Tuple[int, int]]) -> Optional[Tuple[int, int]]:
+    if size is None:
+        return None
+    w, h = size
+    return (int(w), int(h))

@@ -1,0 +1,30 @@
+# Type stubs of the native module sdfc._sdfc (python/src/lib.rs); python/sdfc/__init__.py is
+# the API users call, with its own annotations.
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+class CompileError(Exception):
+    diagnostics: List[Any]
+
+def check(source: Optional[str] = ..., path: Optional[str] = ...) -> Tuple[List[Dict[str, Any]], Optional[Dict[str, Any]]]: ...
+
+class _Scene:
+    def __init__(self, source: Optional[str] = ..., path: Optional[str] = ..., set: Sequence[str] = ...) -> None: ...
+    def info(self) -> Dict[str, Any]: ...
+    def render(
+        self,
+        size: Optional[Tuple[int, int]] = ...,
+        backend: str = ...,
+        aa: Optional[int] = ...,
+        t: float = ...,
+        encoding: str = ...,
+    ) -> Tuple[int, int, bytes]: ...
+    def distance(self, points: bytes, t: float = ...) -> Tuple[bytes, bytes]: ...
+    def mesh(
+        self,
+        resolution: Optional[int] = ...,
+        voxel: Optional[float] = ...,
+        bounds: Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = ...,
+        sharp: bool = ...,
+        t: float = ...,
+    ) -> Tuple[bytes, bytes, bytes]: ...
+    def compile(self, emit: str, part: str = ..., name: Optional[str] = ..., sm: int = ..., t: float = ...) -> bytes: ...

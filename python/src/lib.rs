@@ -1,0 +1,676 @@
+//! `sdfc._sdfc`, the native module of the Python package `sdfc` (python/sdfc): checking a
+//! scene, rendering it, its distances at points, its mesh and its compiled forms, through the
+//! same functions `sdfc check`, `sdfc render`, `sdfc mesh` and `sdfc compile` call. Arrays
+//! cross as bytes, which python/sdfc/__init__.py views as NumPy arrays; work that takes
+//! long runs on a thread of its own with the GIL released, while the calling thread waits
+//! and turns a Ctrl-C into `KeyboardInterrupt`.
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList};
+use rayon::prelude::*;
+use sdfc_compiler::diagnostics::Diagnostic;
+use sdfc_compiler::eval::{Evaluator, Outputs, Tape, DEFAULT_CHUNK};
+use sdfc_compiler::lower::{self, LowerOptions};
+use sdfc_compiler::scene::{analysis, analytic};
+use sdfc_compiler::{Limits, Severity, SourceMap};
+use sdfc_runtime::backend::{Backend, Devices, Kernel, Setup};
+use sdfc_runtime::commands::compile::{self, Emit, Part};
+use sdfc_runtime::commands::mesh as mesher;
+use sdfc_runtime::commands::render::{self as renderer, CliError, FrameScene};
+use sdfc_runtime::cpu::Precision;
+use sdfc_runtime::frontend::{self, Source};
+use sdfc_runtime::image::Image;
+use std::sync::OnceLock;
+use std::time::Duration;
+
+create_exception!(
+    _sdfc,
+    CompileError,
+    PyException,
+    "A scene with errors; `.diagnostics` holds them."
+);
+
+/// Why a call failed, carried back from its worker thread.
+enum Failure {
+    /// The scene has errors (or a later stage reported one at a place in it).
+    Compile(Vec<Diagnostic>, SourceMap),
+    /// A bad argument.
+    Value(String),
+    /// The work itself failed (a backend, a limit).
+    Runtime(String),
+}
+
+impl Failure {
+    fn into_py(self, py: Python<'_>) -> PyErr {
+        match self {
+            Failure::Compile(diags, sources) => compile_error(py, &diags, &sources),
+            Failure::Value(m) => PyValueError::new_err(m),
+            Failure::Runtime(m) => PyRuntimeError::new_err(m),
+        }
+    }
+}
+
+impl From<CliError> for Failure {
+    fn from(e: CliError) -> Failure {
+        match e {
+            CliError::Usage(m) => Failure::Value(m),
+            CliError::Failed(m) => Failure::Runtime(m),
+            CliError::Reported(_) => Failure::Runtime("the render failed".into()),
+        }
+    }
+}
+
+/// `CompileError(message)` with `.diagnostics`, the list of them as dictionaries (the
+/// package turns them into `Diagnostic` objects).
+fn compile_error(py: Python<'_>, diags: &[Diagnostic], sources: &SourceMap) -> PyErr {
+    let first = diags
+        .iter()
+        .find(|d| d.is_error())
+        .or(diags.first())
+        .map(|d| {
+            let (line, col) = d
+                .labels
+                .first()
+                .map_or((0, 0), |l| sources.line_col(l.span));
+            format!(
+                "{}:{line}:{col}: {}[{}]: {}",
+                name(d, sources),
+                word(d.severity),
+                d.code,
+                d.message
+            )
+        })
+        .unwrap_or_else(|| "the scene has errors".into());
+    let err = CompileError::new_err(first);
+    let list = diagnostics(py, diags, sources);
+    if let Ok(list) = list {
+        let _ = err.value(py).setattr("diagnostics", list);
+    }
+    err
+}
+
+fn word(s: Severity) -> &'static str {
+    match s {
+        Severity::Error => "error",
+        Severity::Warning => "warning",
+        Severity::Note => "note",
+    }
+}
+
+fn name<'s>(d: &Diagnostic, sources: &'s SourceMap) -> &'s str {
+    d.labels.first().map_or("", |l| sources.name(l.span.file))
+}
+
+/// Every diagnostic as a dictionary: severity, code, message, file, line, column (1-based,
+/// in characters), end line and column, the text of the primary span, notes and help.
+fn diagnostics<'py>(
+    py: Python<'py>,
+    diags: &[Diagnostic],
+    sources: &SourceMap,
+) -> PyResult<Bound<'py, PyList>> {
+    let list = PyList::empty(py);
+    for d in diags {
+        let item = PyDict::new(py);
+        item.set_item("severity", word(d.severity))?;
+        item.set_item("code", d.code)?;
+        item.set_item("message", &d.message)?;
+        match d.labels.first() {
+            Some(l) => {
+                let (line, col) = sources.line_col(l.span);
+                let end = sdfc_compiler::Span {
+                    start: l.span.end,
+                    ..l.span
+                };
+                let (end_line, end_col) = sources.line_col(end);
+                let text = sources.text(l.span.file);
+                let span_text = text.get(l.span.range()).unwrap_or("");
+                item.set_item("file", sources.name(l.span.file))?;
+                item.set_item("line", line)?;
+                item.set_item("column", col)?;
+                item.set_item("end_line", end_line)?;
+                item.set_item("end_column", end_col)?;
+                item.set_item("span_text", span_text)?;
+                item.set_item("label", &l.message)?;
+            }
+            None => {
+                item.set_item("file", "")?;
+                item.set_item("line", 0)?;
+                item.set_item("column", 0)?;
+                item.set_item("end_line", 0)?;
+                item.set_item("end_column", 0)?;
+                item.set_item("span_text", "")?;
+                item.set_item("label", "")?;
+            }
+        }
+        item.set_item("notes", d.notes.clone())?;
+        item.set_item("help", d.help.clone())?;
+        list.append(item)?;
+    }
+    Ok(list)
+}
+
+/// The name a scene given as text goes by (its imports are read from the current directory).
+const TEXT_NAME: &str = "<string>.sdf";
+
+/// `check(source, path)`: (diagnostics, facts or None). `source` None reads `path`.
+#[pyfunction]
+#[pyo3(signature = (source=None, path=None))]
+fn check<'py>(
+    py: Python<'py>,
+    source: Option<String>,
+    path: Option<String>,
+) -> PyResult<(Bound<'py, PyList>, Option<Bound<'py, PyDict>>)> {
+    let mut src = open(source, path).map_err(|f| f.into_py(py))?;
+    let limits = Limits::default();
+    let loaded = src.check(&limits, 0.0);
+    let list = diagnostics(py, &loaded.diagnostics, &loaded.sources)?;
+    let Some(scene) = &loaded.scene else {
+        return Ok((list, None));
+    };
+    let facts = PyDict::new(py);
+    let analysis = analysis::analyse(scene);
+    match analysis.root() {
+        Some(root) => {
+            facts.set_item("exactness", analysis::describe(root.facts.exactness))?;
+            facts.set_item("lipschitz", root.facts.lipschitz)?;
+            facts.set_item("proven", root.proven)?;
+            facts.set_item("step_lipschitz", analysis.step_lipschitz())?;
+        }
+        None => {
+            facts.set_item("exactness", py.None())?;
+            facts.set_item("lipschitz", py.None())?;
+            facts.set_item("proven", py.None())?;
+            facts.set_item("step_lipschitz", py.None())?;
+        }
+    }
+    let traceable = analytic::traceable(scene);
+    facts.set_item(
+        "method",
+        match traceable.choose(scene.settings.method) {
+            analytic::Choice::March(_) => "march",
+            _ => "trace",
+        },
+    )?;
+    facts.set_item("summary", frontend::summary(&loaded, scene))?;
+    facts.set_item(
+        "method_reason",
+        frontend::method(&loaded, scene, &traceable),
+    )?;
+    facts.set_item("animated", scene.animation.animated())?;
+    Ok((list, Some(facts)))
+}
+
+/// The scene's text: `source`, or the file at `path` (which also names the text, for its
+/// imports and diagnostics).
+fn open(source: Option<String>, path: Option<String>) -> Result<Source, Failure> {
+    match (source, path) {
+        (Some(text), path) => Ok(Source::from_text(
+            path.as_deref().unwrap_or(TEXT_NAME),
+            text,
+        )),
+        (None, Some(path)) => Source::read(std::path::Path::new(&path)).map_err(Failure::Value),
+        (None, None) => Err(Failure::Value(
+            "give the scene's text (source=...) or its file (path=...)".into(),
+        )),
+    }
+}
+
+/// The worker threads every call shares (one per core).
+fn pool() -> Result<&'static rayon::ThreadPool, Failure> {
+    static POOL: OnceLock<Result<rayon::ThreadPool, String>> = OnceLock::new();
+    POOL.get_or_init(|| renderer::thread_pool(None))
+        .as_ref()
+        .map_err(|m| Failure::Runtime(m.clone()))
+}
+
+/// Runs `work` on a thread of its own with the GIL released; the calling thread checks for
+/// signals every 50 ms, so that Ctrl-C raises `KeyboardInterrupt` at once (the work is left
+/// to finish on its thread, and its result dropped).
+fn interruptible<T: Send + 'static>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T, Failure> + Send + 'static,
+) -> PyResult<T> {
+    use std::sync::mpsc::{channel, RecvTimeoutError};
+    let (tx, mut rx) = channel();
+    std::thread::Builder::new()
+        .name("sdfc".into())
+        .spawn(move || {
+            let _ = tx.send(work());
+        })
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
+    loop {
+        let (got, back) = py.detach(move || (rx.recv_timeout(Duration::from_millis(50)), rx));
+        rx = back;
+        match got {
+            Ok(result) => return result.map_err(|f| f.into_py(py)),
+            Err(RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(PyRuntimeError::new_err("sdfc's worker thread panicked"))
+            }
+        }
+    }
+}
+
+/// A scene: its text, the name it goes by and the render settings to override.
+#[pyclass(frozen, name = "_Scene", module = "sdfc._sdfc")]
+struct Scene {
+    name: String,
+    text: String,
+    set: Vec<String>,
+}
+
+/// What a render is asked for.
+#[derive(Clone, Copy)]
+struct Ask {
+    size: Option<(u32, u32)>,
+    aa: Option<u32>,
+    backend: Backend,
+    time: f64,
+}
+
+impl Scene {
+    fn source(&self) -> Source {
+        Source::from_text(&self.name, self.text.clone())
+    }
+
+    /// The scene checked at `time` with the settings overridden, or its errors.
+    fn checked(
+        &self,
+        time: f64,
+        size: Option<(u32, u32)>,
+        aa: Option<u32>,
+    ) -> Result<frontend::Checked, Failure> {
+        let limits = Limits::default();
+        let loaded = self.source().check(&limits, time);
+        let Some(mut scene) = loaded.scene else {
+            return Err(Failure::Compile(loaded.diagnostics, loaded.sources));
+        };
+        sdfc_runtime::settings::override_settings(
+            &mut scene.settings,
+            size,
+            aa,
+            &self.set,
+            &limits,
+        )
+        .map_err(Failure::Value)?;
+        Ok(frontend::Checked {
+            scene,
+            sources: loaded.sources,
+            format: frontend::DiagnosticFormat::Human,
+        })
+    }
+
+    /// Renders as `sdfc render` does: checked, lowered, prepared, held to the memory limit.
+    fn image(&self, ask: Ask) -> Result<Image, Failure> {
+        let limits = Limits::default();
+        let checked = self.checked(ask.time, ask.size, ask.aa)?;
+        let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
+            .map_err(|d| Failure::Compile(vec![d], checked.sources.clone()))?;
+        sdfc_runtime::backend::method_allowed(&checked.scene, &lowered.traceable)
+            .map_err(Failure::Value)?;
+        let pool = pool()?;
+        let setup = Setup {
+            precision: Precision::F32,
+            debug_nan: false,
+            parameters: false,
+            kernel: Kernel::Auto.choice(),
+            image_only: true,
+        };
+        let frame = FrameScene {
+            scene: checked.scene,
+            lowered,
+        };
+        let (scene, prepared) =
+            renderer::prepare(pool, (ask.backend, &Devices::Auto), frame, &setup, None)?;
+        renderer::check_memory(pool, &prepared, &scene, (false, false), &limits, false)?;
+        let frame = pool
+            .install(|| prepared.render(&scene, &|_| {}))
+            .map_err(Failure::Runtime)?;
+        Ok(frame.render.image)
+    }
+}
+
+fn backend(name: &str) -> PyResult<Backend> {
+    match name {
+        "auto" => Ok(Backend::Auto),
+        "cpu" => Ok(Backend::Cpu),
+        "wgpu" => Ok(Backend::Wgpu),
+        "cuda" => Ok(Backend::Cuda),
+        other => Err(PyValueError::new_err(format!(
+            "backend must be \"auto\", \"cpu\", \"wgpu\" or \"cuda\", not {other:?}"
+        ))),
+    }
+}
+
+#[pymethods]
+impl Scene {
+    /// Checks the scene at t = 0 (raising `CompileError`) and keeps it.
+    #[new]
+    #[pyo3(signature = (source=None, path=None, set=Vec::new()))]
+    fn new(
+        py: Python<'_>,
+        source: Option<String>,
+        path: Option<String>,
+        set: Vec<String>,
+    ) -> PyResult<Scene> {
+        let src = open(source, path.clone()).map_err(|f| f.into_py(py))?;
+        let scene = Scene {
+            name: path.unwrap_or_else(|| TEXT_NAME.into()),
+            text: src.text().to_string(),
+            set,
+        };
+        scene.checked(0.0, None, None).map_err(|f| f.into_py(py))?;
+        Ok(scene)
+    }
+
+    /// The settings a render without overrides uses: width, height, aa, fps, duration, and
+    /// whether the scene reads `t`.
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let checked = self.checked(0.0, None, None).map_err(|f| f.into_py(py))?;
+        let s = &checked.scene;
+        let d = PyDict::new(py);
+        d.set_item("width", s.settings.width)?;
+        d.set_item("height", s.settings.height)?;
+        d.set_item("aa", s.settings.aa)?;
+        d.set_item("fps", s.animation.fps)?;
+        d.set_item("duration", s.animation.duration)?;
+        d.set_item("animated", s.animation.animated())?;
+        Ok(d)
+    }
+
+    /// Renders: (width, height, bytes) with float32 linear RGB (`encoding` "linear"), uint8
+    /// sRGB RGB ("srgb") or a PNG file's bytes ("png").
+    #[pyo3(signature = (size=None, backend="auto", aa=None, t=0.0, encoding="linear"))]
+    fn render<'py>(
+        self_: Py<Self>,
+        py: Python<'py>,
+        size: Option<(u32, u32)>,
+        backend: &str,
+        aa: Option<u32>,
+        t: f64,
+        encoding: &str,
+    ) -> PyResult<(u32, u32, Bound<'py, PyBytes>)> {
+        let ask = Ask {
+            size,
+            aa,
+            backend: self::backend(backend)?,
+            time: t,
+        };
+        if !matches!(encoding, "linear" | "srgb" | "png") {
+            return Err(PyValueError::new_err(format!(
+                "encoding must be \"linear\", \"srgb\" or \"png\", not {encoding:?}"
+            )));
+        }
+        let encoding = encoding.to_string();
+        let scene = self_.clone_ref(py);
+        let (w, h, bytes) = interruptible(py, move || {
+            let image = scene.get().image(ask)?;
+            let bytes = match encoding.as_str() {
+                "linear" => image
+                    .linear
+                    .iter()
+                    .flatten()
+                    .flat_map(|x| x.to_ne_bytes())
+                    .collect(),
+                "srgb" => image
+                    .to_rgba8()
+                    .chunks_exact(4)
+                    .flat_map(|p| [p[0], p[1], p[2]])
+                    .collect(),
+                _ => image
+                    .encode_png()
+                    .map_err(|e| Failure::Runtime(e.to_string()))?,
+            };
+            Ok((image.width, image.height, bytes))
+        })?;
+        Ok((w, h, PyBytes::new(py, &bytes)))
+    }
+
+    /// Distances and material ids at `points` (native-endian f64 triples) through the batch
+    /// interpreter in f64: (distances as f64 bytes, ids as u32 bytes).
+    #[pyo3(signature = (points, t=0.0))]
+    fn distance<'py>(
+        &self,
+        py: Python<'py>,
+        points: &[u8],
+        t: f64,
+    ) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>)> {
+        if points.len() % 24 != 0 {
+            return Err(PyValueError::new_err("points must be (n, 3) float64"));
+        }
+        let checked = self.checked(t, None, None).map_err(|f| f.into_py(py))?;
+        let limits = Limits::default();
+        let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
+            .map_err(|d| compile_error(py, &[d], &checked.sources))?;
+        let origin = checked.scene.origin;
+        let xyz: Vec<[f64; 3]> = points
+            .chunks_exact(24)
+            .map(|c| {
+                let f = |i: usize| {
+                    let mut b = [0u8; 8];
+                    b.copy_from_slice(&c[8 * i..8 * i + 8]);
+                    f64::from_ne_bytes(b)
+                };
+                // The program's coordinates are the scene's less its origin.
+                [f(0) - origin[0], f(1) - origin[1], f(2) - origin[2]]
+            })
+            .collect();
+        let pool = pool().map_err(|f| f.into_py(py))?;
+        let (d, m) = py.detach(|| {
+            let tape = Tape::new(&lowered.program, Outputs::DistanceAndMaterial);
+            let mut d = vec![0.0f64; xyz.len()];
+            let mut m = vec![0u32; xyz.len()];
+            const TASK: usize = 4096;
+            pool.install(|| {
+                xyz.par_chunks(TASK)
+                    .zip(d.par_chunks_mut(TASK).zip(m.par_chunks_mut(TASK)))
+                    .for_each_init(
+                        || {
+                            (
+                                Evaluator::<f64>::new(&tape, DEFAULT_CHUNK),
+                                [vec![], vec![], vec![]],
+                            )
+                        },
+                        |(eval, cols), (p, (d, m))| {
+                            for (i, col) in cols.iter_mut().enumerate() {
+                                col.clear();
+                                col.extend(p.iter().map(|q| q[i]));
+                            }
+                            let [x, y, z] = &*cols;
+                            eval.eval(x, y, z, d, Some(m));
+                        },
+                    )
+            });
+            let d: Vec<u8> = d.iter().flat_map(|x| x.to_ne_bytes()).collect();
+            let m: Vec<u8> = m.iter().flat_map(|x| x.to_ne_bytes()).collect();
+            (d, m)
+        });
+        Ok((PyBytes::new(py, &d), PyBytes::new(py, &m)))
+    }
+
+    /// The surface as `sdfc mesh` meshes it: (positions as f64 bytes, triangles as u32
+    /// bytes, linear vertex colours as f32 bytes).
+    #[pyo3(signature = (resolution=None, voxel=None, bounds=None, sharp=true, t=0.0))]
+    #[allow(clippy::type_complexity)]
+    fn mesh<'py>(
+        self_: Py<Self>,
+        py: Python<'py>,
+        resolution: Option<u32>,
+        voxel: Option<f64>,
+        bounds: Option<([f64; 3], [f64; 3])>,
+        sharp: bool,
+        t: f64,
+    ) -> PyResult<(
+        Bound<'py, PyBytes>,
+        Bound<'py, PyBytes>,
+        Bound<'py, PyBytes>,
+    )> {
+        if resolution.is_some() && voxel.is_some() {
+            return Err(PyValueError::new_err("give resolution or voxel, not both"));
+        }
+        if let Some((lo, hi)) = bounds {
+            if (0..3).any(|i| !(lo[i] < hi[i] && lo[i].is_finite() && hi[i].is_finite())) {
+                return Err(PyValueError::new_err(
+                    "bounds are ((x0, y0, z0), (x1, y1, z1)) with each lower bound below the upper one",
+                ));
+            }
+        }
+        let scene = self_.clone_ref(py);
+        let (p, tri, c) = interruptible(py, move || {
+            let checked = scene.get().checked(t, None, None)?;
+            let limits = Limits::default();
+            let region = mesher::Region {
+                resolution,
+                voxel,
+                bounds: bounds.map(|(lo, hi)| [lo, hi]),
+            };
+            let settings = sdfc_runtime::mesh::Settings {
+                sharp,
+                ..Default::default()
+            };
+            let say = |text: String| {
+                if text.starts_with("warning") {
+                    eprintln!("{text}");
+                }
+            };
+            let meshed = mesher::surface(
+                &checked,
+                region,
+                &settings,
+                &limits,
+                pool()?,
+                &|_, _| {},
+                &say,
+            )
+            .map_err(|(code, msg)| match code {
+                2 => Failure::Value(msg),
+                _ if msg.is_empty() => Failure::Runtime("the mesh failed".into()),
+                _ => Failure::Runtime(msg),
+            })?;
+            let mesh = meshed.mesh;
+            let materials = &checked.scene.materials;
+            let p: Vec<u8> = mesh
+                .positions
+                .iter()
+                .flatten()
+                .flat_map(|x| x.to_ne_bytes())
+                .collect();
+            let tri: Vec<u8> = mesh
+                .triangles
+                .iter()
+                .flatten()
+                .flat_map(|x| x.to_ne_bytes())
+                .collect();
+            let c: Vec<u8> = mesh
+                .positions
+                .iter()
+                .zip(&mesh.vertex_materials)
+                .flat_map(|(q, &id)| sdfc_runtime::mesh::write::colour(materials, id, *q))
+                .flat_map(|x| (x as f32).to_ne_bytes())
+                .collect();
+            Ok((p, tri, c))
+        })?;
+        Ok((
+            PyBytes::new(py, &p),
+            PyBytes::new(py, &tri),
+            PyBytes::new(py, &c),
+        ))
+    }
+
+    /// `sdfc compile --emit EMIT --part PART`: the bytes of the target.
+    #[pyo3(signature = (emit, part="kernel", name=None, sm=70, t=0.0))]
+    fn compile<'py>(
+        &self,
+        py: Python<'py>,
+        emit: &str,
+        part: &str,
+        name: Option<String>,
+        sm: u32,
+        t: f64,
+    ) -> PyResult<Bound<'py, PyBytes>> {
+        let emit = match emit {
+            "ast" => Emit::Ast,
+            "ir" => Emit::Ir,
+            "program" => Emit::Program,
+            "rust" => Emit::Rust,
+            "wgsl" => Emit::Wgsl,
+            "spirv" => Emit::Spirv,
+            "msl" => Emit::Msl,
+            "glsl" => Emit::Glsl,
+            "hlsl" => Emit::Hlsl,
+            "ptx" => Emit::Ptx,
+            "params" => Emit::Params,
+            "scene-data" => Emit::SceneData,
+            "layout" => Emit::Layout,
+            "shadertoy" => Emit::Shadertoy,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "emit must be one of ast, ir, program, rust, wgsl, spirv, msl, glsl, hlsl, ptx, params, scene-data, layout, shadertoy; not {other:?}"
+                )))
+            }
+        };
+        let part = match part {
+            "kernel" => Part::Kernel,
+            "map" => Part::Map,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "part must be \"kernel\" or \"map\", not {other:?}"
+                )))
+            }
+        };
+        if name.is_some() && part != Part::Map {
+            return Err(PyValueError::new_err(
+                "name names the distance function of part=\"map\"",
+            ));
+        }
+        if emit == Emit::Ast {
+            let src = self.source();
+            let mut sources = SourceMap::new();
+            let entry = sources.add(self.name.clone(), src.text().to_string());
+            let (ast, diags) = sdfc_compiler::syntax::parse(entry, sources.text(entry));
+            if sdfc_compiler::diagnostics::has_errors(&diags) {
+                return Err(compile_error(py, &diags, &sources));
+            }
+            return Ok(PyBytes::new(
+                py,
+                sdfc_compiler::syntax::dump(&ast).as_bytes(),
+            ));
+        }
+        let checked = self.checked(t, None, None).map_err(|f| f.into_py(py))?;
+        if emit == Emit::Ir {
+            return Ok(PyBytes::new(
+                py,
+                sdfc_compiler::scene::dump(&checked.scene).as_bytes(),
+            ));
+        }
+        let limits = Limits::default();
+        let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
+            .map_err(|d| compile_error(py, &[d], &checked.sources))?;
+        let bytes = match part {
+            Part::Kernel => compile::emit(&checked.scene, &lowered, emit, sm, None),
+            Part::Map => {
+                let name = name
+                    .unwrap_or_else(|| sdfc_compiler::back::wgsl::part::DEFAULT_NAME.to_string());
+                if !sdfc_compiler::back::wgsl::part::valid_name(&name) {
+                    return Err(PyValueError::new_err(format!(
+                        "{name:?} is not a name for a function"
+                    )));
+                }
+                compile::emit_map(&checked.scene, &lowered, emit, &name)
+            }
+        };
+        bytes
+            .map(|b| PyBytes::new(py, &b))
+            .map_err(PyRuntimeError::new_err)
+    }
+}
+
+#[pymodule]
+fn _sdfc(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_class::<Scene>()?;
+    m.add("CompileError", m.py().get_type::<CompileError>())?;
+    Ok(())
+}

@@ -1,0 +1,260 @@
+"""Tests of the Python package `sdfc`, run against the installed wheel (`.ci/run` builds it
+into a fresh virtual environment): check, CompileError, render against `sdfc render`,
+distances, meshes, compile, frames, threads and Ctrl-C. The CLI they compare with is
+$SDFC_BIN, else target/release/sdfc of this repository."""
+
+import os
+import subprocess
+import tempfile
+import threading
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+import sdfc
+
+ROOT = Path(__file__).resolve().parents[2]
+ERR = ROOT / "runtime" / "tests" / "in" / "err"
+
+SPHERE = """
+camera { position: (0, 0, -4), look_at: (0, 0, 0), fov: 50deg }
+light point { position: (2, 3, -4) }
+material red = phong { color: (0.9, 0.2, 0.1) };
+material blue = phong { color: (0.1, 0.2, 0.9) };
+render { width: 32, height: 24 }
+scene {
+  sphere(1) @ red;
+  box((0.5, 0.5, 0.5)).translate(3, 0, 0) @ blue;
+}
+"""
+
+
+def sdfc_bin() -> str:
+    path = os.environ.get("SDFC_BIN") or str(ROOT / "target" / "release" / "sdfc")
+    if not os.path.exists(path):
+        raise AssertionError(f"the sdfc binary is needed to compare with: build it (cargo build --release) or set SDFC_BIN; not found at {path}")
+    return path
+
+
+def cli_json_diagnostics(path: Path):
+    out = subprocess.run([sdfc_bin(), "check", "--diagnostics", "json", str(path)], capture_output=True, text=True)
+    import json
+
+    return [json.loads(line) for line in out.stderr.splitlines() if line.startswith("{")]
+
+
+class Check(unittest.TestCase):
+    def test_clean_scene_has_facts(self):
+        diags, facts = sdfc.check(SPHERE)
+        self.assertEqual([d for d in diags if d.severity == "error"], [])
+        self.assertIsNotNone(facts)
+        self.assertEqual(facts.exactness, "bound")  # a union of exact fields
+        self.assertEqual(facts.lipschitz, 1.0)
+        self.assertEqual(facts.method, "trace")
+        self.assertFalse(facts.animated)
+
+    def test_errors_are_located(self):
+        source = "scene {\n  sphere(1).translate(0, 0, 0) @ nothing;\n}\n"
+        diags, facts = sdfc.check(source)
+        self.assertIsNone(facts)
+        errors = [d for d in diags if d.severity == "error"]
+        self.assertEqual(len(errors), 1)
+        e = errors[0]
+        self.assertEqual((e.line, e.column), (2, 34))
+        self.assertEqual(e.span_text, "nothing")
+        self.assertTrue(e.code.startswith("E"))
+
+    def test_fixtures_match_the_cli(self):
+        # One fixture of each class: lexical, syntax, names, types, ranges, imports.
+        names = [
+            "bad_character.sdf",
+            "missing_closing_paren.sdf",
+            "let_type_mismatch.sdf",
+            "ior_below_one.sdf",
+            "missing_import.sdf",
+            "duplicate_material.sdf",
+        ]
+        for name in names:
+            with self.subTest(name):
+                path = ERR / name
+                with self.assertRaises(sdfc.CompileError) as caught:
+                    sdfc.Scene(path=str(path))
+                ours = [(d.code, d.line, d.column) for d in caught.exception.diagnostics if d.severity == "error"]
+                theirs = [
+                    (d["code"], d["labels"][0]["line"], d["labels"][0]["column"])
+                    for d in cli_json_diagnostics(path)
+                    if d["severity"] == "error"
+                ]
+                self.assertTrue(ours)
+                self.assertEqual(ours, theirs)
+
+    def test_check_reads_files(self):
+        diags, facts = sdfc.check(path=str(ROOT / "examples" / "seed1.sdf"))
+        self.assertIsNotNone(facts)
+        with self.assertRaises(ValueError):
+            sdfc.check(path=str(ROOT / "no such file.sdf"))
+
+
+class Render(unittest.TestCase):
+    def test_cpu_render_equals_the_cli(self):
+        for scene, name in [(ROOT / "examples" / "seed1.sdf", "seed1"), (ROOT / "examples" / "blends.sdf", "blends")]:
+            with self.subTest(name), tempfile.TemporaryDirectory() as tmp:
+                out = Path(tmp) / "cli.png"
+                subprocess.run(
+                    [sdfc_bin(), "render", str(scene), "--backend", "cpu", "--size", "64x48", "-o", str(out)],
+                    check=True,
+                    capture_output=True,
+                )
+                s = sdfc.Scene(path=str(scene))
+                self.assertEqual(s.png(size=(64, 48), backend="cpu"), out.read_bytes())
+                image = s.render(size=(64, 48), backend="cpu", dtype=np.uint8)
+                self.assertEqual(image.shape, (48, 64, 3))
+                self.assertEqual(image.dtype, np.uint8)
+                linear = s.render(size=(64, 48), backend="cpu")
+                self.assertEqual(linear.dtype, np.float32)
+                # The sRGB bytes are the linear values encoded (within rounding).
+                srgb = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(np.clip(linear, 0.0031308, None), 1 / 2.4) - 0.055)
+                self.assertLessEqual(np.abs(np.clip(srgb, 0, 1) * 255 - image).max(), 1.0)
+
+    def test_set_overrides_settings(self):
+        s = sdfc.Scene(SPHERE, set={"background": (1, 0, 0)})
+        image = s.render(backend="cpu")
+        self.assertEqual(image.shape, (24, 32, 3))
+        self.assertAlmostEqual(float(image[0, 0, 0]), 1.0, places=5)
+        self.assertAlmostEqual(float(image[0, 0, 1]), 0.0, places=5)
+
+    def test_threads_agree(self):
+        s = sdfc.Scene(path=str(ROOT / "examples" / "seed1.sdf"))
+        results = [None] * 4
+
+        def work(i):
+            results[i] = s.render(size=(48, 32), backend="cpu")
+
+        threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        for r in results[1:]:
+            np.testing.assert_array_equal(r, results[0])
+
+    def test_too_large_a_render_is_refused(self):
+        s = sdfc.Scene(SPHERE)
+        # 16384² pixels at aa 4: far above the default memory limit of the render.
+        with self.assertRaises((RuntimeError, ValueError)) as caught:
+            s.render(size=(16384, 16384), aa=4, backend="cpu")
+        self.assertIn("limit", str(caught.exception))
+
+    def test_bad_arguments(self):
+        s = sdfc.Scene(SPHERE)
+        with self.assertRaises(ValueError):
+            s.render(backend="metal")
+        with self.assertRaises(ValueError):
+            s.render(dtype=np.int16)
+        with self.assertRaises(ValueError):
+            sdfc.Scene(SPHERE, set={"no_such_setting": 1})
+
+    def test_repr_png(self):
+        png = sdfc.Scene(SPHERE)._repr_png_()
+        self.assertEqual(png[:8], b"\x89PNG\r\n\x1a\n")
+
+    def test_ctrl_c_interrupts(self):
+        import _thread
+
+        s = sdfc.Scene(path=str(ROOT / "examples" / "seed3.sdf"))
+        timer = threading.Timer(0.2, _thread.interrupt_main)
+        timer.start()
+        try:
+            with self.assertRaises(KeyboardInterrupt):
+                # Minutes of work on two cores: the interrupt comes long before its end.
+                s.render(size=(1600, 1200), aa=4, backend="cpu")
+        finally:
+            timer.cancel()
+
+
+class Distance(unittest.TestCase):
+    def test_sphere_and_box(self):
+        s = sdfc.Scene(SPHERE)
+        points = np.array([[0, 0, 0], [2, 0, 0], [0, -1.5, 0], [3, 0, 0], [3, 1.5, 0]], dtype=np.float64)
+        d, m = s.distance(points)
+        self.assertEqual(d.shape, (5,))
+        self.assertEqual(m.shape, (5,))
+        np.testing.assert_allclose(d, [-1.0, 0.5, 0.5, -0.5, 1.0], atol=1e-12)
+        # Materials are numbered from 1 in the order they are declared (0: the default).
+        self.assertEqual(list(m[[0, 2]]), [1, 1])
+        self.assertEqual(list(m[[3, 4]]), [2, 2])
+
+    def test_many_points(self):
+        s = sdfc.Scene(SPHERE)
+        rng = np.random.default_rng(1)
+        p = rng.uniform(-1.5, 1.5, size=(100_000, 3))
+        d, _ = s.distance(p)
+        r = np.linalg.norm(p, axis=1)
+        near = np.linalg.norm(p - [3, 0, 0], axis=1) > 2
+        np.testing.assert_allclose(d[near], (r - 1)[near], atol=1e-9)
+
+    def test_shape_is_checked(self):
+        with self.assertRaises(ValueError):
+            sdfc.Scene(SPHERE).distance(np.zeros((4, 2)))
+
+
+class Mesh(unittest.TestCase):
+    def test_sphere_mesh_is_closed(self):
+        s = sdfc.Scene("material m = phong { color: (0.2, 0.4, 0.6) };\nscene { sphere(1) @ m; }")
+        v, f, c = s.mesh(resolution=24)
+        self.assertEqual(v.shape[1], 3)
+        self.assertEqual(f.shape[1], 3)
+        self.assertEqual(c.shape, v.shape)
+        self.assertEqual(f.dtype, np.uint32)
+        self.assertLess(int(f.max()), len(v))
+        np.testing.assert_allclose(np.linalg.norm(v, axis=1), 1.0, atol=0.02)
+        np.testing.assert_allclose(c, np.tile([0.2, 0.4, 0.6], (len(v), 1)), atol=1e-6)
+        # Watertight: every edge in exactly two faces, once in each direction; a sphere's
+        # Euler characteristic is 2.
+        edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+        directed = {tuple(e) for e in edges.tolist()}
+        self.assertEqual(len(directed), len(edges))
+        self.assertTrue(all((b, a) in directed for a, b in directed))
+        self.assertEqual(len(v) - len(edges) // 2 + len(f), 2)
+
+    def test_unbounded_needs_bounds(self):
+        s = sdfc.Scene("scene { plane((0, 1, 0), 0); sphere(0.5); }")
+        with self.assertRaises(ValueError) as caught:
+            s.mesh(resolution=8)
+        self.assertIn("bounds", str(caught.exception))
+        v, f, _ = s.mesh(resolution=16, bounds=((-1, -1, -1), (1, 1, 1)))
+        self.assertGreater(len(f), 0)
+
+
+class Compile(unittest.TestCase):
+    def test_targets(self):
+        s = sdfc.Scene(SPHERE)
+        self.assertIn("fn ", s.compile("wgsl"))
+        self.assertIn("fn ", s.compile("rust"))
+        self.assertIn("sdf", s.compile("wgsl", part="map"))
+        self.assertIsInstance(s.compile("spirv"), bytes)
+        with self.assertRaises(ValueError):
+            s.compile("cobol")
+
+    def test_equals_the_cli(self):
+        path = ROOT / "examples" / "seed1.sdf"
+        cli = subprocess.run([sdfc_bin(), "compile", str(path), "--emit", "rust"], check=True, capture_output=True, text=True).stdout
+        self.assertEqual(sdfc.Scene(path=str(path)).compile("rust"), cli)
+
+
+class Frames(unittest.TestCase):
+    def test_frames_follow_t(self):
+        s = sdfc.Scene(
+            "render { width: 16, height: 12, fps: 4, duration: 0.5 }\n"
+            "camera { position: (0, 0, -4), look_at: (0, 0, 0) }\n"
+            "scene { sphere(0.5).translate(t * 2, 0, 0); }"
+        )
+        frames = list(s.frames(backend="cpu"))
+        self.assertEqual(len(frames), 2)
+        self.assertFalse(np.array_equal(frames[0], frames[1]))
+        np.testing.assert_array_equal(frames[1], s.render(backend="cpu", t=0.25))
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -41,7 +41,8 @@ def cli_json_diagnostics(path: Path):
     out = subprocess.run([sdfc_bin(), "check", "--diagnostics", "json", str(path)], capture_output=True, text=True)
     import json
 
-    return [json.loads(line) for line in out.stderr.splitlines() if line.startswith("{")]
+    lines = (out.stdout + out.stderr).splitlines()
+    return [json.loads(line) for line in lines if line.startswith("{")]
 
 
 class Check(unittest.TestCase):

@@ -130,10 +130,17 @@ impl Source {
     /// A scene given as text, named `name` (a path: its imports are read relative to it;
     /// for text of no file, a name in the current directory).
     pub fn from_text(name: &str, text: String) -> Source {
+        let path = Path::new(name);
+        let name = normalise(path);
+        let mut names = std::collections::HashMap::new();
+        if let Ok(canonical) = std::fs::canonicalize(path) {
+            names.insert(canonical, name.clone());
+        }
         Source {
-            name: normalise(Path::new(name)),
+            name,
             text,
             imports: Default::default(),
+            names,
         }
     }
 

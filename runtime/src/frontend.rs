@@ -49,7 +49,7 @@ impl Loader for FsLoader {
 
 /// A path written with `.` and `..` components folded, so that one file imported by two
 /// routes has one name (which is how import cycles are found).
-fn normalise(p: &Path) -> String {
+pub fn normalise(p: &Path) -> String {
     let mut parts: Vec<std::path::Component> = Vec::new();
     for c in p.components() {
         match c {

@@ -36,6 +36,18 @@ enum Command {
     Devices(commands::devices::DevicesArgs),
     /// Show a scene in a window that reloads it whenever it (or a file it imports) is saved.
     View(commands::view::ViewArgs),
+    /// Serve the Language Server Protocol on standard input and output, for editors
+    /// (docs/editors.md).
+    Lsp(LspArgs),
+}
+
+/// `sdfc lsp`'s arguments.
+#[derive(Debug, clap::Args)]
+struct LspArgs {
+    /// Talk over standard input and output (the only transport; accepted because clients
+    /// pass it).
+    #[arg(long)]
+    stdio: bool,
 }
 
 fn main() -> ExitCode {
@@ -58,5 +70,6 @@ fn main() -> ExitCode {
         Command::Pareto(args) => commands::pareto::run(args),
         Command::Mesh(args) => commands::mesh::run(args),
         Command::View(args) => commands::view::run(args),
+        Command::Lsp(_) => sdfc_runtime::lsp::run(),
     }
 }

@@ -1,0 +1,531 @@
+//! `sdfc lsp` at the protocol level: each request over the server's in-memory connection
+//! (the same loop stdio drives), on a document with an import and a mistake, and a server
+//! that keeps answering while the text is mutated at random through incremental changes.
+
+use lsp_server::{Connection, Message, Notification, Request, RequestId, Response};
+use sdfc_runtime::lsp::text::path_to_uri;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// A client on one end of an in-memory connection, the server on a thread at the other.
+struct Client {
+    conn: Connection,
+    server: Option<std::thread::JoinHandle<Result<(), String>>>,
+    next: i32,
+    /// Diagnostics published so far, by URI (the latest).
+    published: std::collections::HashMap<String, Value>,
+}
+
+impl Client {
+    fn start() -> Client {
+        let (server, client) = Connection::memory();
+        let handle = std::thread::spawn(move || sdfc_runtime::lsp::serve(&server));
+        let mut c = Client {
+            conn: client,
+            server: Some(handle),
+            next: 0,
+            published: Default::default(),
+        };
+        let caps = c.request("initialize", json!({ "capabilities": {} }));
+        assert!(
+            caps["capabilities"]["hoverProvider"] == json!(true),
+            "{caps}"
+        );
+        c.notify("initialized", json!({}));
+        c
+    }
+
+    fn notify(&self, method: &str, params: Value) {
+        self.conn
+            .sender
+            .send(Notification::new(method.into(), params).into())
+            .expect("server alive");
+    }
+
+    fn receive(&mut self) -> Message {
+        let msg = self
+            .conn
+            .receiver
+            .recv_timeout(Duration::from_secs(60))
+            .expect("the server answers");
+        if let Message::Notification(n) = &msg {
+            if n.method == "textDocument/publishDiagnostics" {
+                let uri = n.params["uri"].as_str().unwrap_or("").to_string();
+                self.published.insert(uri, n.params["diagnostics"].clone());
+            }
+        }
+        msg
+    }
+
+    /// Sends a request and returns its response (result or error).
+    fn respond(&mut self, method: &str, params: Value) -> Response {
+        self.next += 1;
+        let id = RequestId::from(self.next);
+        self.conn
+            .sender
+            .send(Request::new(id.clone(), method.into(), params).into())
+            .expect("server alive");
+        loop {
+            if let Message::Response(r) = self.receive() {
+                if r.id == id {
+                    return r;
+                }
+            }
+        }
+    }
+
+    /// Sends a request and returns its result, failing on an error response.
+    fn request(&mut self, method: &str, params: Value) -> Value {
+        match self.respond(method, params).response_result {
+            Ok(v) => v,
+            Err(e) => panic!("{method} failed: {} {}", e.code, e.message),
+        }
+    }
+
+    /// Waits for diagnostics of `uri` to be published.
+    fn diagnostics(&mut self, uri: &str) -> Value {
+        self.published.remove(uri);
+        while !self.published.contains_key(uri) {
+            self.receive();
+        }
+        self.published[uri].clone()
+    }
+
+    fn stop(mut self) {
+        self.request("shutdown", Value::Null);
+        self.notify("exit", Value::Null);
+        let result = self
+            .server
+            .take()
+            .expect("running")
+            .join()
+            .expect("no panic");
+        assert_eq!(result, Ok(()));
+    }
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sdfc-lsp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn uri(p: &Path) -> String {
+    path_to_uri(p).expect("uri").as_str().to_string()
+}
+
+fn at(uri: &str, text: &str, needle: &str, shift: usize) -> Value {
+    let offset = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("`{needle}` in the text"))
+        + shift;
+    position(uri, text, offset)
+}
+
+/// The request parameters naming byte `offset` of `text` (a character boundary).
+fn position(uri: &str, text: &str, offset: usize) -> Value {
+    let before = &text[..offset];
+    let line = before.matches('\n').count();
+    let col = before
+        .rsplit('\n')
+        .next()
+        .unwrap_or("")
+        .encode_utf16()
+        .count();
+    json!({ "textDocument": { "uri": uri }, "position": { "line": line, "character": col } })
+}
+
+const LIB: &str = "// a library\nlet size = 0.5 * 2;\n\nfn post(h: float = 1) -> shape {\n    box((0.1, h, 0.1))\n}\n\nmaterial red = phong { color: (1, 0, 0) };\n";
+
+const MAIN: &str = "import \"lib.sdf\";\n\nlight directional { direction: (-1, -1, 1) }\nlet ball = sphere(size).translate(0, 1, 0);\n\nscene {\n    union(ball, post(2)) @ red;\n    spher(1) @ red;\n}\n";
+
+#[test]
+fn every_request_on_a_document_with_an_import_and_a_mistake() {
+    let dir = temp_dir("requests");
+    std::fs::write(dir.join("lib.sdf"), LIB).expect("write");
+    let main = dir.join("main.sdf");
+    let main_uri = uri(&main);
+    let lib_uri = uri(&dir.join("lib.sdf"));
+    let mut c = Client::start();
+    c.notify(
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": main_uri, "languageId": "sdf", "version": 1, "text": MAIN } }),
+    );
+
+    // The mistake, at its place, with its code linked and a quick fix.
+    let diags = c.diagnostics(&main_uri);
+    let d = &diags.as_array().expect("a list")[0];
+    assert_eq!(d["code"], "E0201", "{diags}");
+    assert_eq!(
+        d["range"]["start"],
+        json!({ "line": 7, "character": 4 }),
+        "{d}"
+    );
+    assert_eq!(
+        d["range"]["end"],
+        json!({ "line": 7, "character": 9 }),
+        "{d}"
+    );
+    assert!(d["codeDescription"]["href"]
+        .as_str()
+        .unwrap()
+        .ends_with("docs/diagnostics.md"));
+    let actions = c.request(
+        "textDocument/codeAction",
+        json!({ "textDocument": { "uri": main_uri }, "range": d["range"], "context": { "diagnostics": [] } }),
+    );
+    let edit = &actions[0]["edit"]["changes"][&main_uri][0];
+    assert_eq!(edit["newText"], "sphere", "{actions}");
+    assert_eq!(edit["range"], d["range"]);
+
+    // Fix it through an incremental change: the diagnostics go away.
+    c.notify(
+        "textDocument/didChange",
+        json!({ "textDocument": { "uri": main_uri, "version": 2 },
+                "contentChanges": [{ "range": d["range"], "text": "sphere" }] }),
+    );
+    let diags = c.diagnostics(&main_uri);
+    assert!(
+        diags.as_array().unwrap().iter().all(|d| d["severity"] != 1),
+        "{diags}"
+    );
+    let text = MAIN.replace("spher(", "sphere(");
+
+    // Hover: a shape's facts, a built-in's signature and doc line, an imported constant.
+    let h = c.request("textDocument/hover", at(&main_uri, &text, "union", 1));
+    let md = h["contents"]["value"].as_str().unwrap();
+    assert!(
+        md.contains("distance field bound (L = 1)")
+            && md.contains("bounding box: (-1, -2, -1) to (1, 2, 1)"),
+        "{md}"
+    );
+    assert!(
+        md.contains("union(shapes...: shape) -> shape") || md.contains("union("),
+        "{md}"
+    );
+    let h = c.request("textDocument/hover", at(&main_uri, &text, "ball,", 0));
+    let md = h["contents"]["value"].as_str().unwrap();
+    assert!(
+        md.contains("let ball = sphere(size)") && md.contains("L = 1"),
+        "{md}"
+    );
+    let h = c.request("textDocument/hover", at(&main_uri, &text, "sphere(size", 0));
+    let md = h["contents"]["value"].as_str().unwrap();
+    assert!(
+        md.contains("sphere(radius: float = 1) -> shape") && md.contains("A sphere"),
+        "{md}"
+    );
+    let h = c.request("textDocument/hover", at(&main_uri, &text, "size)", 0));
+    let md = h["contents"]["value"].as_str().unwrap();
+    assert!(
+        md.contains("let size = 0.5 * 2;") && md.contains("lib.sdf"),
+        "{md}"
+    );
+
+    // Definition and references across the import; rename edits both files.
+    let def = c.request(
+        "textDocument/definition",
+        at(&main_uri, &text, "post(2)", 0),
+    );
+    assert_eq!(def["uri"], lib_uri.as_str(), "{def}");
+    assert_eq!(
+        def["range"]["start"],
+        json!({ "line": 3, "character": 3 }),
+        "{def}"
+    );
+    let mut refs = at(&main_uri, &text, "red;", 0);
+    refs["context"] = json!({ "includeDeclaration": true });
+    let refs = c.request("textDocument/references", refs);
+    assert_eq!(refs.as_array().unwrap().len(), 3, "{refs}");
+    let mut rename = at(&main_uri, &text, "ball,", 0);
+    rename["newName"] = json!("orb");
+    let edit = c.request("textDocument/rename", rename);
+    assert_eq!(
+        edit["changes"][&main_uri].as_array().unwrap().len(),
+        2,
+        "{edit}"
+    );
+    let mut rename = at(&main_uri, &text, "size)", 0);
+    rename["newName"] = json!("side");
+    let edit = c.request("textDocument/rename", rename);
+    assert_eq!(
+        edit["changes"][&lib_uri].as_array().unwrap().len(),
+        1,
+        "{edit}"
+    );
+    assert_eq!(
+        edit["changes"][&main_uri].as_array().unwrap().len(),
+        1,
+        "{edit}"
+    );
+
+    // Completion: names in scope, built-ins, fields, strings.
+    let items = c.request("textDocument/completion", at(&main_uri, &text, "union", 0));
+    let labels: Vec<&str> = items
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["label"].as_str().unwrap())
+        .collect();
+    for want in [
+        "ball",
+        "post",
+        "size",
+        "red",
+        "sphere",
+        "smooth_union",
+        "pi",
+    ] {
+        assert!(labels.contains(&want), "{want} in {labels:?}");
+    }
+    let items = c.request(
+        "textDocument/completion",
+        at(&main_uri, &text, "direction:", 0),
+    );
+    let labels: Vec<&str> = items
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["label"].as_str().unwrap())
+        .collect();
+    assert!(
+        labels.contains(&"direction") && labels.contains(&"color"),
+        "{labels:?}"
+    );
+
+    // Signature help inside a call.
+    let s = c.request(
+        "textDocument/signatureHelp",
+        at(&main_uri, &text, "post(2)", 5),
+    );
+    assert_eq!(
+        s["signatures"][0]["label"], "fn post(h: float = 1) -> shape",
+        "{s}"
+    );
+    assert_eq!(s["activeParameter"], 0);
+    let s = c.request(
+        "textDocument/signatureHelp",
+        at(&main_uri, &text, "translate(0, 1", 13),
+    );
+    assert!(
+        s["signatures"][0]["label"]
+            .as_str()
+            .unwrap()
+            .starts_with("translate("),
+        "{s}"
+    );
+    assert_eq!(s["activeParameter"], 1);
+
+    // The outline.
+    let syms = c.request(
+        "textDocument/documentSymbol",
+        json!({ "textDocument": { "uri": main_uri } }),
+    );
+    let names: Vec<&str> = syms
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["light directional", "ball", "scene"], "{syms}");
+    assert_eq!(syms[2]["children"].as_array().unwrap().len(), 2);
+
+    // A document that is not open is an error, not a crash.
+    let r = c.respond(
+        "textDocument/hover",
+        at(&uri(&dir.join("other.sdf")), "x", "x", 0),
+    );
+    assert!(r.response_result.is_err());
+    c.stop();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every example and test input, mutated at random by incremental changes (deleting,
+/// inserting pieces of the language, splicing in other files), with requests at random
+/// places after each change: every request gets an answer that is not an internal error.
+#[test]
+fn never_crashes_on_mutated_text() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut corpus = Vec::new();
+    for dir in ["examples", "runtime/tests/in/ok", "runtime/tests/in/err"] {
+        let Ok(entries) = std::fs::read_dir(root.join(dir)) else {
+            continue;
+        };
+        let mut files: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
+        files.sort();
+        for p in files
+            .into_iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
+        {
+            if let Ok(t) = std::fs::read_to_string(&p) {
+                corpus.push(t);
+            }
+        }
+    }
+    assert!(corpus.len() > 20);
+    const SNIPPETS: &[&str] = &[
+        "(",
+        ")",
+        "{",
+        "}",
+        ";",
+        ",",
+        "\"",
+        "é",
+        "𝔸",
+        "\n",
+        "sphere(",
+        "@",
+        "let x = ",
+        "fn f(",
+        "union(",
+        "[for i in 0..3 { ",
+        "//",
+        "/*",
+        "1e400",
+        "-",
+        ".",
+        "deg",
+    ];
+    let mut rng = sdfc_compiler::rng::Rng::new(0x15D_F0C5);
+    let dir = temp_dir("mutated");
+    let doc = uri(&dir.join("m.sdf"));
+    let mut c = Client::start();
+    let methods = [
+        "textDocument/hover",
+        "textDocument/definition",
+        "textDocument/completion",
+        "textDocument/signatureHelp",
+        "textDocument/documentSymbol",
+        "textDocument/references",
+    ];
+    for round in 0..12 {
+        let mut text = corpus[rng.below(corpus.len())].clone();
+        c.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": doc, "languageId": "sdf", "version": 1, "text": text } }),
+        );
+        for step in 0..25 {
+            // A change at a random line and character, possibly past the end of either.
+            let lines = text.matches('\n').count() + 2;
+            let pos = |rng: &mut sdfc_compiler::rng::Rng| json!({ "line": rng.below(lines), "character": rng.below(90) });
+            let (a, b) = (pos(&mut rng), pos(&mut rng));
+            let (start, end) = if (a["line"].as_u64(), a["character"].as_u64())
+                <= (b["line"].as_u64(), b["character"].as_u64())
+            {
+                (a, b)
+            } else {
+                (b, a)
+            };
+            let insert = match rng.below(3) {
+                0 => String::new(),
+                1 => SNIPPETS[rng.below(SNIPPETS.len())].to_string(),
+                _ => {
+                    let other: Vec<char> = corpus[rng.below(corpus.len())].chars().collect();
+                    let from = rng.below(other.len());
+                    other[from..(from + rng.below(60)).min(other.len())]
+                        .iter()
+                        .collect()
+                }
+            };
+            let change = json!({ "range": { "start": start, "end": end }, "text": insert });
+            let mut t = text.clone();
+            let ev: lsp_types::TextDocumentContentChangeEvent =
+                serde_json::from_value(change.clone()).unwrap();
+            sdfc_runtime::lsp::apply(&mut t, ev);
+            text = t;
+            c.notify(
+                "textDocument/didChange",
+                json!({ "textDocument": { "uri": doc, "version": 2 + step }, "contentChanges": [change] }),
+            );
+            let method = methods[rng.below(methods.len())];
+            let mut p = json!({ "textDocument": { "uri": doc }, "position": pos(&mut rng) });
+            if method == "textDocument/references" {
+                p["context"] = json!({ "includeDeclaration": true });
+            }
+            let r = c.respond(method, p);
+            assert!(
+                r.response_result.is_ok(),
+                "round {round} step {step}: {method}: {:?}\n{text}",
+                r.response_result
+            );
+        }
+        c.notify(
+            "textDocument/didClose",
+            json!({ "textDocument": { "uri": doc } }),
+        );
+    }
+    c.stop();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The time each request takes on every example, printed (run with `--nocapture`; nothing
+/// is asserted about the times): the check of the whole document after a change, then a
+/// hover, a completion, a definition and the outline at the middle of the scene.
+#[test]
+fn request_latency_on_every_example() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&root)
+        .expect("examples")
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
+        .collect();
+    files.sort();
+    let mut c = Client::start();
+    println!("example            check+publish  hover  completion  definition  symbols (ms)");
+    for path in files {
+        let text = std::fs::read_to_string(&path).expect("read");
+        let doc = uri(&path);
+        let t0 = std::time::Instant::now();
+        c.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": doc, "languageId": "sdf", "version": 1, "text": text } }),
+        );
+        c.diagnostics(&doc);
+        // Less the debounce, which the client waits on purpose.
+        let publish = t0.elapsed().saturating_sub(sdfc_runtime::lsp::DEBOUNCE);
+        let mut needle = text.find("scene").map_or(0, |i| i + 12).min(text.len());
+        while !text.is_char_boundary(needle) {
+            needle -= 1;
+        }
+        let mut times = vec![publish];
+        for method in [
+            "textDocument/hover",
+            "textDocument/completion",
+            "textDocument/definition",
+            "textDocument/documentSymbol",
+        ] {
+            // Each request after a change, so that the document is checked again.
+            c.notify(
+                "textDocument/didChange",
+                json!({ "textDocument": { "uri": doc, "version": 2 }, "contentChanges": [{ "text": text }] }),
+            );
+            let p = position(&doc, &text, needle);
+            let t = std::time::Instant::now();
+            let r = c.respond(method, p);
+            assert!(r.response_result.is_ok());
+            times.push(t.elapsed());
+        }
+        let ms: Vec<String> = times
+            .iter()
+            .map(|d| format!("{:.1}", d.as_secs_f64() * 1e3))
+            .collect();
+        println!(
+            "{:<18} {:>13}  {:>5}  {:>10}  {:>10}  {:>7}",
+            path.file_name().unwrap().to_string_lossy(),
+            ms[0],
+            ms[1],
+            ms[2],
+            ms[3],
+            ms[4]
+        );
+        c.notify(
+            "textDocument/didClose",
+            json!({ "textDocument": { "uri": doc } }),
+        );
+    }
+    c.stop();
+}

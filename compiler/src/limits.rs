@@ -99,7 +99,7 @@ impl Limit {
             what,
         };
         match self {
-            Limit::Nesting => s("nesting", 1_000, 1_000_000, "levels of expression nesting"),
+            Limit::Nesting => s("nesting", 1_000, 100_000, "levels of expression nesting"),
             Limit::Fuel => s(
                 "fuel",
                 50_000_000,

@@ -1261,3 +1261,26 @@ fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(err.contains("bounds verified: 2 field(s)"), "{err}");
 }
+
+/// 10 000 nested `union(…)` with the `nesting` limit raised, as the error suggests, check
+/// without overflowing the stack (the parser and the checker run on a stack grown to fit).
+#[test]
+fn ten_thousand_nested_unions_check_with_the_limit_raised() {
+    let d = dir("nested");
+    let n = 10_000;
+    let text = format!(
+        "scene {{ {}sphere(1){}; }}\n",
+        "union(sphere(1), ".repeat(n),
+        ")".repeat(n)
+    );
+    std::fs::write(d.join("deep.sdf"), text).expect("write");
+    let out = sdfc(&d, &["check", "deep.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("`--limit nesting=2000`"), "{err}");
+    let out = sdfc(&d, &["check", "deep.sdf", "--limit", "nesting=20000"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("deep.sdf: ok"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -29,6 +29,10 @@ pub struct FnInfo {
     pub checked: bool,
 }
 
+/// How many links a chain (`1 + 2 + …`, `s.translate(…).rotate(…)…`) may have, as a
+/// multiple of the `nesting` limit: chains are not nesting, but they recurse all the same.
+pub const CHAIN_FACTOR: usize = 10;
+
 /// The evaluation state of one compilation.
 #[derive(Debug, Default)]
 pub struct Ctx {
@@ -51,6 +55,8 @@ pub struct Ctx {
     dry: u32,
     depth: usize,
     nesting: usize,
+    /// Links of chains being evaluated (see `chained`).
+    chain: usize,
     /// Evaluation steps taken (bounded by the `fuel` limit).
     pub fuel: u64,
     /// The resource limits of this compilation: evaluation stays within them on any input.
@@ -116,6 +122,32 @@ impl Ctx {
         v
     }
 
+    /// Evaluates the left operand of a binary operator, the receiver of a method, field or
+    /// material: a link of a chain (`1 + 2 + … + 1001`, `s.translate(…).rotate(…)…`) at the
+    /// level of the chain, so that a long flat chain is not "nesting" (its stack is grown
+    /// as needed all the same).
+    /// Links of chains count apart, up to [`CHAIN_FACTOR`] times the `nesting` limit.
+    fn chained(&mut self, e: &Expr) -> Value {
+        let max = self
+            .limits
+            .count(Limit::Nesting)
+            .saturating_mul(CHAIN_FACTOR);
+        if self.chain >= max {
+            self.limit(
+                Limit::Nesting,
+                e.span,
+                format!("a chain of operators or method calls is longer than {max} links (ten times the nesting limit)"),
+            );
+            return Value::Error;
+        }
+        self.nesting -= 1;
+        self.chain += 1;
+        let v = self.expr(e);
+        self.chain -= 1;
+        self.nesting += 1;
+        v
+    }
+
     /// Spends one evaluation step; false (and a report) once the budget is spent.
     pub fn burn(&mut self, span: Span) -> bool {
         self.fuel += 1;
@@ -151,7 +183,7 @@ impl Ctx {
                 self.result(ops::unary(*op, &v), e.span)
             }
             ExprKind::Binary(op, a, b) => {
-                let (va, vb) = (self.expr(a), self.expr(b));
+                let (va, vb) = (self.chained(a), self.expr(b));
                 if field::is_point(&va) || field::is_point(&vb) {
                     return self.point_binary(*op, (&va, a.span), (&vb, b.span), e.span);
                 }
@@ -177,12 +209,12 @@ impl Ctx {
                 name,
                 args,
             } => {
-                let recv = self.expr(receiver);
+                let recv = self.chained(receiver);
                 let args = self.args(args);
                 self.call(name, Some((recv, receiver.span)), args, e.span)
             }
             ExprKind::Field(x, name) => {
-                let v = self.expr(x);
+                let v = self.chained(x);
                 self.field(v, name)
             }
             ExprKind::If {
@@ -191,7 +223,7 @@ impl Ctx {
                 otherwise,
             } => self.if_expr(cond, then, otherwise),
             ExprKind::Material(x, m) => {
-                let v = self.expr(x);
+                let v = self.chained(x);
                 self.paint(v, x.span, m, e.span)
             }
             ExprKind::List(items) => self.list(items, e.span),

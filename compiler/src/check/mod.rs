@@ -82,8 +82,26 @@ pub fn check_at(
         stack: Vec::new(),
         items: &mut items,
         diags: &mut diags,
+        depth: 0,
     };
     load.file(entry);
+    let depth = load.depth;
+    // The checker's walks of the syntax tree, and of the scene built from it, recurse as
+    // deeply as the files nest (within the `nesting` limit the parser enforced): they run on
+    // a stack that fits, and so does the drop of the tree.
+    crate::syntax::with_stack_for(depth, move || {
+        check_loaded(entry, limits, time, diags, items)
+    })
+}
+
+/// The checks after the files are read and parsed.
+fn check_loaded(
+    entry: FileId,
+    limits: &Limits,
+    time: f64,
+    mut diags: Vec<Diagnostic>,
+    items: Vec<ast::Item>,
+) -> (Option<Scene>, Vec<Diagnostic>) {
     if crate::diagnostics::has_errors(&diags) {
         // After a lexical, syntax or import error, names and items may be missing: checking
         // would report mistakes that are only echoes of the first ones.
@@ -180,6 +198,8 @@ struct Load<'a> {
     stack: Vec<FileId>,
     items: &'a mut Vec<ast::Item>,
     diags: &'a mut Vec<Diagnostic>,
+    /// The deepest nesting of the files read ([`syntax::nesting`]).
+    depth: usize,
 }
 
 impl Load<'_> {
@@ -187,7 +207,8 @@ impl Load<'_> {
     fn file(&mut self, file: FileId) {
         self.stack.push(file);
         let text = self.sources.text(file).to_string();
-        let (ast, parse_diags) = syntax::parse(file, &text);
+        let ((ast, parse_diags), depth) = syntax::parse_within(file, &text, Some(self.limits));
+        self.depth = self.depth.max(depth);
         self.diags.extend(parse_diags);
         for item in ast.items {
             if let ast::Item::Import { path, span } = &item {

@@ -432,3 +432,43 @@ fn a_list_of_shapes_as_a_scene_statement_suggests_union() {
     let d = diags.iter().find(|d| d.code == "E0300").expect("E0300");
     assert!(d.help.iter().any(|h| h.contains("union(...)")), "{d:?}");
 }
+
+/// Brackets count towards the `nesting` limit in the parser: a million nested parentheses
+/// are one E0507 at the first past the limit, before any recursion; a flat sum of 1 001
+/// terms and a chain of 1 001 method calls are not nesting.
+#[test]
+fn nesting_counts_brackets_and_not_flat_chains() {
+    use crate::Limits;
+    let n = 1_000_000;
+    let src = format!(
+        "let x = {}1{};\nscene {{ sphere(x); }}",
+        "(".repeat(n),
+        ")".repeat(n)
+    );
+    let diags = within(&src, &[], &Limits::default());
+    let e: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert_eq!(e[0].code, "E0507");
+    assert!(e[0].message.contains("more than 1000 levels"), "{:?}", e[0]);
+    assert!(e[0]
+        .notes
+        .iter()
+        .any(|n| n.contains("`--limit nesting=2000`")));
+    assert_eq!(e[0].span().start, 8 + 1000);
+    let terms = vec!["1"; 1001].join(" + ");
+    ok(&format!("let x = {terms};\nscene {{ sphere(x / 1000); }}"));
+    ok(&format!(
+        "scene {{ sphere(1){}; }}",
+        ".translate(0, 0, 0)".repeat(1001)
+    ));
+    // 1 000 levels of brackets are accepted (with the scene's own two), 1 001 are not.
+    let deep = |k: usize| {
+        format!(
+            "let x = {}1{};\nscene {{ sphere(x); }}",
+            "(".repeat(k),
+            ")".repeat(k)
+        )
+    };
+    ok(&deep(1000));
+    assert!(codes(&deep(1001)).contains(&"E0507"));
+}

@@ -13,8 +13,84 @@ use crate::span::FileId;
 /// Lexes and parses one file. Never fails: broken parts become error nodes, and every lexical
 /// and syntax error is in the returned diagnostics.
 pub fn parse(file: FileId, text: &str) -> (ast::File, Vec<Diagnostic>) {
+    parse_within(file, text, None).0
+}
+
+/// Stack the parser and the checker's walks of the syntax tree may use per level of nesting
+/// (measured well under this in debug builds); a deeper file runs on a stack grown to fit.
+pub const STACK_PER_LEVEL: usize = 64 * 1024;
+
+/// Runs `f` with stack for `depth` levels of nesting: on the current stack when enough is
+/// left, else on a new one of `depth × STACK_PER_LEVEL` and a margin.
+pub fn with_stack_for<R>(depth: usize, f: impl FnOnce() -> R) -> R {
+    let need = depth
+        .saturating_mul(STACK_PER_LEVEL)
+        .saturating_add(256 * 1024);
+    stacker::maybe_grow(need, need.saturating_add(4 << 20), f)
+}
+
+/// How deeply the tokens nest, and where they first go deeper than `max`: each open
+/// bracket (`(`, `[`, `{`) is a level until it closes, and so is each prefix operator (`-`,
+/// `!`) of a run of them. A flat sum (`1 + 2 + … + 1001`) or a chain of method calls has no
+/// depth; the parser's and the checker's recursion follows this depth.
+pub fn nesting(
+    tokens: &[(lexer::Token, crate::span::Span)],
+    max: usize,
+) -> (usize, Option<crate::span::Span>) {
+    use lexer::Token;
+    let (mut depth, mut run, mut deepest) = (0usize, 0usize, 0usize);
+    let mut first_over = None;
+    for (t, span) in tokens {
+        match t {
+            Token::LParen | Token::LBrace | Token::LBracket => {
+                depth += 1;
+                run = 0;
+            }
+            Token::RParen | Token::RBrace | Token::RBracket => {
+                depth = depth.saturating_sub(1);
+                run = 0;
+            }
+            Token::Minus | Token::Bang => run += 1,
+            _ => run = 0,
+        }
+        let level = depth + run;
+        deepest = deepest.max(level);
+        if level > max && first_over.is_none() {
+            first_over = Some(*span);
+        }
+    }
+    (deepest, first_over)
+}
+
+/// [`parse`] within the `nesting` limit ([`nesting`]; none: no limit): a file that nests deeper is not
+/// parsed, and gets one error (E0507) at the first token past the limit, so that neither
+/// the parser nor the checker recurses without bound. Also returns the file's depth.
+pub fn parse_within(
+    file: FileId,
+    text: &str,
+    limits: Option<&crate::limits::Limits>,
+) -> ((ast::File, Vec<Diagnostic>), usize) {
+    use crate::limits::Limit;
+    let max = limits.map_or(usize::MAX, |l| l.count(Limit::Nesting));
     let (tokens, mut diags) = lexer::lex(file, text);
-    let (ast, syntax) = parser::parse(file, &tokens, text.len());
+    let (depth, over) = nesting(&tokens, max);
+    if let Some(at) = over {
+        diags.push(
+            Diagnostic::error(
+                "E0507",
+                format!("brackets and prefix operators nest more than {max} levels deep"),
+                at,
+            )
+            .with_label(format!("level {} starts here", max + 1))
+            .with_note(format!(
+                "this limit keeps compilation bounded; {}",
+                limits.map(|l| l.raise(Limit::Nesting)).unwrap_or_default()
+            )),
+        );
+        // Nothing was parsed: nothing deeper than the limit is walked.
+        return ((ast::File { items: Vec::new() }, diags), max);
+    }
+    let (ast, syntax) = with_stack_for(depth, || parser::parse(file, &tokens, text.len()));
     // A character the lexer rejected between two tokens (`a | b`) makes the parser miss an
     // operator there too: the lexer's error says what to write, so the parser's is dropped.
     let rejected: Vec<crate::span::Span> = diags
@@ -31,5 +107,5 @@ pub fn parse(file: FileId, text: &str) -> (ast::File, Vec<Diagnostic>) {
                 .iter()
                 .any(|r| at.span.end <= r.start && r.end <= found.span.start)
     }));
-    (ast, diags)
+    ((ast, diags), depth)
 }

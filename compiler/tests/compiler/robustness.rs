@@ -29,13 +29,13 @@ fn on_small_stack(f: impl FnOnce() + Send + 'static) {
 fn deep_nesting_is_an_error_not_a_crash() {
     on_small_stack(|| {
         let depth = 10_000;
-        // Parentheses leave no trace in the tree: deep ones are simply accepted.
+        // Parentheses count towards the limit like any bracket (issue 37, item 4).
         let parens = format!(
             "let x = {}1{};\nscene {{ sphere(); }}",
             "(".repeat(depth),
             ")".repeat(depth)
         );
-        assert!(codes(&parens).is_empty(), "{:?}", codes(&parens));
+        assert!(codes(&parens).contains(&"E0507"), "{:?}", codes(&parens));
         let calls = format!(
             "let x = {}1{};\nscene {{ sphere(); }}",
             "abs(".repeat(depth),
@@ -54,6 +54,7 @@ fn deep_nesting_is_an_error_not_a_crash() {
 #[test]
 fn long_sums_and_unary_chains_are_errors_not_crashes() {
     on_small_stack(|| {
+        // A chain is not nesting, but is bounded at ten times the limit (10 000 links).
         let sum = format!("let x = 1{};\nscene {{ sphere(); }}", " + 1".repeat(20_000));
         assert!(codes(&sum).contains(&"E0507"));
         let neg = format!("let x = {}1;\nscene {{ sphere(); }}", "-".repeat(20_000));

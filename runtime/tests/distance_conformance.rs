@@ -609,6 +609,12 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "link",
         "infinite_cylinder",
         "slab",
+        "circle",
+        "rect",
+        "round_rect",
+        "polygon",
+        "extrude",
+        "revolve",
         "combine",
         "smooth_combine",
         "feature",
@@ -691,6 +697,12 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Elongate { .. } => "elongate",
         Node::Paint { .. } => "paint",
         Node::Field { .. } => "field",
+        Node::Circle { .. } => "circle",
+        Node::Rect { .. } => "rect",
+        Node::RoundRect { .. } => "round_rect",
+        Node::Polygon { .. } => "polygon",
+        Node::Extrude { .. } => "extrude",
+        Node::Revolve { .. } => "revolve",
     }
 }
 

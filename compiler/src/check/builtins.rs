@@ -174,11 +174,29 @@ impl Build<'_> {
     fn node(&mut self, node: Node) -> Result<Value, String> {
         Ok(Value::Shape(self.graph.add(node, self.span)))
     }
+
+    /// Adds a node of a profile (whose distance reads only x and y).
+    fn profile(&mut self, node: Node) -> Result<Value, String> {
+        Ok(Value::Profile(self.graph.add(node, self.span)))
+    }
+}
+
+/// The result of a builder of shapes as a profile: the 2D operations add the same nodes as
+/// the 3D ones, in the plane z = 0.
+fn flat(v: Result<Value, String>) -> Result<Value, String> {
+    Ok(match v? {
+        Value::Shape(id) => Value::Profile(id),
+        other => other,
+    })
+}
+
+const fn prof(name: &'static str) -> P {
+    p(name, Type::Profile, Def::Req, Range::Any)
 }
 
 fn sh(v: &Value) -> NodeId {
     match v {
-        Value::Shape(id) => *id,
+        Value::Shape(id) | Value::Profile(id) => *id,
         _ => NodeId(0),
     }
 }
@@ -210,6 +228,117 @@ use Type::{Angle as A, Bool as B, Float as F, Int as I, Shape as S, Str, Vec2 as
 
 /// A list of shapes, `[shape]`.
 const LS: Type = Type::List(&Type::Shape);
+/// A list of profiles, `[profile]`.
+const LP: Type = Type::List(&Type::Profile);
+/// A profile.
+const PR: Type = Type::Profile;
+
+/// `polygon(points)`: three or more points, not all on a line, no two edges crossing.
+fn polygon(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let Value::List(_, items) = &a[0] else {
+        return Ok(Value::Error);
+    };
+    let points: Vec<[f64; 2]> = items
+        .iter()
+        .map(|v| match v {
+            Value::Vec2(q) => *q,
+            _ => [0.0; 2],
+        })
+        .collect();
+    polygon_of(b, points)
+}
+
+fn polygon_of(b: &mut Build, points: Vec<[f64; 2]>) -> Result<Value, String> {
+    let n = points.len();
+    if n < 3 {
+        return Err(format!(
+            "a polygon needs at least 3 points, and this one has {n}"
+        ));
+    }
+    // Every point on the line through the first and some other point.
+    let o = points[0];
+    let on_line = points.iter().find(|q| **q != o).is_none_or(|e| {
+        points
+            .iter()
+            .all(|q| (e[0] - o[0]) * (q[1] - o[1]) == (e[1] - o[1]) * (q[0] - o[0]))
+    });
+    if on_line {
+        return Err("the polygon's points lie on one line: it has no area".to_string());
+    }
+    if let Some((i, j)) = crossing(&points) {
+        return Err(format!(
+            "the polygon crosses itself: its edge from point {i} and its edge from point {j} meet (a polygon's edges may only meet at their shared ends)"
+        ));
+    }
+    b.profile(Node::Polygon { points })
+}
+
+/// The first two edges of the closed polygon through `v` that meet other than at a shared
+/// end, by the index of their first points.
+fn crossing(v: &[[f64; 2]]) -> Option<(usize, usize)> {
+    let n = v.len();
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    // Whether q, on the line through a and b, lies within their box.
+    let within = |a: [f64; 2], b: [f64; 2], q: [f64; 2]| {
+        q[0] >= a[0].min(b[0])
+            && q[0] <= a[0].max(b[0])
+            && q[1] >= a[1].min(b[1])
+            && q[1] <= a[1].max(b[1])
+    };
+    let meet = |a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]| {
+        let (d1, d2) = (cross(c, d, a), cross(c, d, b));
+        let (d3, d4) = (cross(a, b, c), cross(a, b, d));
+        if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+            && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+        {
+            return true;
+        }
+        (d1 == 0.0 && within(c, d, a))
+            || (d2 == 0.0 && within(c, d, b))
+            || (d3 == 0.0 && within(a, b, c))
+            || (d4 == 0.0 && within(a, b, d))
+    };
+    for i in 0..n {
+        let (a, b) = (v[i], v[(i + 1) % n]);
+        if a == b {
+            return Some((i, (i + 1) % n));
+        }
+        for j in i + 1..n {
+            let (c, d) = (v[j], v[(j + 1) % n]);
+            let next = j == i + 1;
+            let wrap = i == 0 && j == n - 1;
+            if next || wrap {
+                // Neighbours share an end: they may only fold back onto each other.
+                let (o, p, q) = if next { (b, a, d) } else { (a, b, c) };
+                if cross(o, p, q) == 0.0
+                    && (p[0] - o[0]) * (q[0] - o[0]) + (p[1] - o[1]) * (q[1] - o[1]) > 0.0
+                {
+                    return Some((i, j));
+                }
+                continue;
+            }
+            if meet(a, b, c, d) {
+                return Some((i, j));
+            }
+        }
+    }
+    None
+}
+
+/// The points of a regular polygon of `sides` with its corners `radius` from the centre,
+/// the first on +y, turning counter-clockwise.
+fn regular(sides: usize, radius: f64, phase: f64) -> Vec<[f64; 2]> {
+    (0..sides)
+        .map(|i| {
+            let t = std::f64::consts::FRAC_PI_2
+                + phase
+                + std::f64::consts::TAU * i as f64 / sides as f64;
+            [radius * t.cos(), radius * t.sin()]
+        })
+        .collect()
+}
 
 /// The number of elements of a list of any type (`len` has a form for each element type but
 /// `int`: a list of ints fits `[float]`).
@@ -629,12 +758,114 @@ pub static BUILTINS: &[Builtin] = &[
             };
         ],
     },
+    // Profiles (2D, in the xy plane).
+    Builtin {
+        name: "circle",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos)] -> PR => |b, a| b.profile(Node::Circle { radius: a[0].num() });
+        ],
+    },
+    Builtin {
+        name: "rect",
+        sigs: sigs![
+            [p("half", V2, Req, Pos)] -> PR => |b, a| {
+                let c = a[0].components();
+                b.profile(Node::Rect { half: [c[0], c[1]] })
+            };
+            [p("half", F, Num(0.5), Pos)] -> PR => |b, a| b.profile(Node::Rect { half: [a[0].num(); 2] });
+        ],
+    },
+    Builtin {
+        name: "round_rect",
+        sigs: sigs![
+            [p("half", V2, Req, Pos), p("radius", F, Num(0.05), NonNeg)] -> PR => |b, a| {
+                let (c, radius) = (a[0].components(), a[1].num());
+                if c.iter().any(|&h| h < radius) {
+                    return Err(format!("the rounding radius {radius} is larger than a half-extent of the rectangle"));
+                }
+                b.profile(Node::RoundRect { half: [c[0], c[1]], radius })
+            };
+        ],
+    },
+    Builtin {
+        name: "polygon",
+        sigs: sigs![
+            [p("points", Type::List(&V2), Req, Any)] -> PR => polygon;
+        ],
+    },
+    Builtin {
+        name: "regular_polygon",
+        sigs: sigs![
+            [p("sides", I, Req, Within(3.0, 1e4)), p("radius", F, Num(0.5), Pos)] -> PR => |b, a| {
+                polygon_of(b, regular(a[0].num() as usize, a[1].num(), 0.0))
+            };
+        ],
+    },
+    Builtin {
+        name: "star",
+        sigs: sigs![
+            [p("points", I, Req, Within(2.0, 1e4)), p("outer", F, Num(0.5), Pos), p("inner", F, Num(0.25), Pos)] -> PR => |b, a| {
+                let (n, outer, inner) = (a[0].num() as usize, a[1].num(), a[2].num());
+                let tips = regular(n, outer, 0.0);
+                let dents = regular(n, inner, std::f64::consts::PI / n as f64);
+                let points = tips.into_iter().zip(dents).flat_map(|(t, d)| [t, d]).collect();
+                polygon_of(b, points)
+            };
+        ],
+    },
+    Builtin {
+        name: "ring",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("thickness", F, Num(0.1), Pos)] -> PR => |b, a| {
+                let circle = b.graph.add(Node::Circle { radius: a[0].num() }, b.span);
+                b.profile(Node::Shell { half: a[1].num() / 2.0, child: circle })
+            };
+        ],
+    },
+    Builtin {
+        name: "segment2",
+        sigs: sigs![
+            [p("a", V2, Req, Any), p("b", V2, Req, Any), p("radius", F, Num(0.1), Pos)] -> PR => |b, a| {
+                let (x, y) = (a[0].components(), a[1].components());
+                // The capsule of space about the segment, read in its plane z = 0.
+                b.profile(Node::Segment { a: [x[0], x[1], 0.0], b: [y[0], y[1], 0.0], radius: a[2].num() })
+            };
+        ],
+    },
+    Builtin {
+        name: "extrude",
+        sigs: sigs![
+            [prof("profile"), p("height", F, Req, Pos), p("round", F, Num(0.0), NonNeg)] -> S => |b, a| {
+                let (height, round) = (a[1].num(), a[2].num());
+                if 2.0 * round > height {
+                    return Err(format!("the rounding {round} is more than half the height {height}"));
+                }
+                b.node(Node::Extrude { half_height: height / 2.0, round, child: sh(&a[0]) })
+            };
+        ],
+    },
+    Builtin {
+        name: "revolve",
+        sigs: sigs![
+            [prof("profile"), p("offset", F, Num(0.0), Any)] -> S => |b, a| {
+                b.node(Node::Revolve { offset: a[1].num(), child: sh(&a[0]) })
+            };
+        ],
+    },
+    Builtin {
+        name: "offset",
+        sigs: sigs![
+            [prof("profile"), p("amount", F, Req, NonNeg)] -> PR => |b, a| b.profile(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
     // Combinators.
     Builtin {
         name: "union",
         sigs: sigs![
             [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Union);
             [p("shapes", LS, Req, Any)] -> S => |b, a| combine_list(b, a, Combine::Union, "union");
+            [prof("a"), prof("b")] rest + -> PR => |b, a| flat(combine(b, a, Combine::Union));
+            [p("profiles", LP, Req, Any)] -> PR => |b, a| flat(combine_list(b, a, Combine::Union, "union"));
         ],
     },
     Builtin {
@@ -642,12 +873,15 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Intersect);
             [p("shapes", LS, Req, Any)] -> S => |b, a| combine_list(b, a, Combine::Intersect, "intersect");
+            [prof("a"), prof("b")] rest + -> PR => |b, a| flat(combine(b, a, Combine::Intersect));
+            [p("profiles", LP, Req, Any)] -> PR => |b, a| flat(combine_list(b, a, Combine::Intersect, "intersect"));
         ],
     },
     Builtin {
         name: "subtract",
         sigs: sigs![
             [shape("a"), shape("b")] -> S => |b, a| combine(b, a, Combine::Subtract);
+            [prof("a"), prof("b")] -> PR => |b, a| flat(combine(b, a, Combine::Subtract));
         ],
     },
     Builtin {
@@ -655,6 +889,10 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Union);
+            [p("k", F, Req, Pos), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+                => |b, a| flat(smooth(b, a, Combine::Union));
+            [p("k", F, Req, Pos), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+                => |b, a| flat(smooth_list(b, a, Combine::Union, "smooth_union"));
             [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth_list(b, a, Combine::Union, "smooth_union");
         ],
@@ -664,6 +902,10 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Intersect);
+            [p("k", F, Req, Pos), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+                => |b, a| flat(smooth(b, a, Combine::Intersect));
+            [p("k", F, Req, Pos), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+                => |b, a| flat(smooth_list(b, a, Combine::Intersect, "smooth_intersect"));
             [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth_list(b, a, Combine::Intersect, "smooth_intersect");
         ],
@@ -673,6 +915,8 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Subtract);
+            [p("k", F, Req, Pos), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+                => |b, a| flat(smooth(b, a, Combine::Subtract));
         ],
     },
     Builtin {
@@ -711,6 +955,13 @@ pub static BUILTINS: &[Builtin] = &[
             [shape("shape"), p("x", F, Req, Any), p("y", F, Num(0.0), Any), p("z", F, Num(0.0), Any)] -> S => |b, a| {
                 b.node(Node::Translate { offset: [a[1].num(), a[2].num(), a[3].num()], child: sh(&a[0]) })
             };
+            [prof("profile"), p("offset", V2, Req, Any)] -> PR => |b, a| {
+                let c = a[1].components();
+                b.profile(Node::Translate { offset: [c[0], c[1], 0.0], child: sh(&a[0]) })
+            };
+            [prof("profile"), p("x", F, Req, Any), p("y", F, Num(0.0), Any)] -> PR => |b, a| {
+                b.profile(Node::Translate { offset: [a[1].num(), a[2].num(), 0.0], child: sh(&a[0]) })
+            };
         ],
     },
     Builtin {
@@ -735,12 +986,14 @@ pub static BUILTINS: &[Builtin] = &[
         name: "rotate",
         sigs: sigs![
             [shape("shape"), p("axis", V, Req, NonZero), p("angle", A, Req, Any)] -> S => |b, a| rotate(b, &a[0], a[1].v3(), a[2].num());
+            [prof("profile"), p("angle", A, Req, Any)] -> PR => |b, a| flat(rotate(b, &a[0], [0.0, 0.0, 1.0], a[1].num()));
         ],
     },
     Builtin {
         name: "scale",
         sigs: sigs![
             [shape("shape"), p("factor", F, Req, Pos)] -> S => |b, a| b.node(Node::Scale { factor: a[1].num(), child: sh(&a[0]) });
+            [prof("profile"), p("factor", F, Req, Pos)] -> PR => |b, a| b.profile(Node::Scale { factor: a[1].num(), child: sh(&a[0]) });
             [shape("shape"), p("factors", V, Req, Pos)] -> S => |b, a| b.node(Node::ScaleXyz { factors: a[1].v3(), child: sh(&a[0]) });
         ],
     },
@@ -766,6 +1019,10 @@ pub static BUILTINS: &[Builtin] = &[
             [shape("shape"), p("x", B, Bool(true), Any), p("y", B, Bool(false), Any), p("z", B, Bool(false), Any)] -> S => |b, a| {
                 let axes = [a[1] == Value::Bool(true), a[2] == Value::Bool(true), a[3] == Value::Bool(true)];
                 b.node(Node::Mirror { axes, child: sh(&a[0]) })
+            };
+            [prof("profile"), p("x", B, Bool(true), Any), p("y", B, Bool(false), Any)] -> PR => |b, a| {
+                let axes = [a[1] == Value::Bool(true), a[2] == Value::Bool(true), false];
+                b.profile(Node::Mirror { axes, child: sh(&a[0]) })
             };
         ],
     },

@@ -506,7 +506,10 @@ impl Ctx {
                 ),
             );
         let tys = (a.0.ty(), b.0.ty());
-        if tys.0 == Some(Type::Shape) || tys.1 == Some(Type::Shape) {
+        if [tys.0, tys.1]
+            .iter()
+            .any(|t| matches!(t, Some(Type::Shape | Type::Profile)))
+        {
             d = d.with_help(
                 "shapes are combined with `union(a, b)`, `intersect(a, b)` or `subtract(a, b)`",
             );
@@ -1270,7 +1273,7 @@ impl Ctx {
                 Value::Unknown(sig.ret)
             };
         }
-        if sig.ret == Type::Shape && self.nodes_exhausted(span) {
+        if matches!(sig.ret, Type::Shape | Type::Profile) && self.nodes_exhausted(span) {
             return Value::Error;
         }
         let mut build = Build {
@@ -1470,6 +1473,7 @@ fn call_label(params: &[(String, Value)]) -> String {
         .iter()
         .map(|(n, v)| match v {
             Value::Shape(_) => format!("{n} = a shape"),
+            Value::Profile(_) => format!("{n} = a profile"),
             _ => format!("{n} = {v}"),
         })
         .collect();

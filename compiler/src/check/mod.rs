@@ -937,6 +937,11 @@ fn stmts_into(cx: &mut Ctx, stmts: &[ast::Stmt], out: &mut Vec<crate::scene::Nod
                     if other.ty().and_then(Type::elem) == Some(Type::Shape) {
                         d = d.with_help("combine the list's shapes into one: `union(...)`");
                     }
+                    if other.ty() == Some(Type::Profile) {
+                        d = d.with_help(
+                            "a profile is flat: make it a shape with `extrude(profile, height)` or `revolve(profile)`",
+                        );
+                    }
                     cx.error(d)
                 }
             },

@@ -286,7 +286,7 @@ fn a_list_union_is_the_union_of_its_shapes() {
 
 #[test]
 fn comprehensions_in_function_bodies() {
-    let s = ok("fn ring(n: int, r: float) -> shape {\n  union([for i in 0..n { sphere(0.1).translate(r, 0, 0).rotate_y(360deg * i / n) }])\n}\nscene { ring(6, 2); }");
+    let s = ok("fn hoop(n: int, r: float) -> shape {\n  union([for i in 0..n { sphere(0.1).translate(r, 0, 0).rotate_y(360deg * i / n) }])\n}\nscene { hoop(6, 2); }");
     let Node::Combine { children, .. } = s.graph.node(s.root.expect("root")) else {
         panic!("not a union")
     };

@@ -16,12 +16,15 @@ pub enum Type {
     Angle,
     Str,
     Shape,
+    /// A 2D signed distance in the xy plane (docs/language.md, "2D profiles"): made into a
+    /// shape by `extrude`, `revolve`, ….
+    Profile,
     /// A list of values of the element type, which is never a list ([`Type::list`]).
     List(&'static Type),
 }
 
 /// The element types of lists, for [`Type::list`]: every type but a list.
-static ELEMENTS: [Type; 8] = [
+static ELEMENTS: [Type; 9] = [
     Type::Int,
     Type::Float,
     Type::Bool,
@@ -30,6 +33,7 @@ static ELEMENTS: [Type; 8] = [
     Type::Angle,
     Type::Str,
     Type::Shape,
+    Type::Profile,
 ];
 
 impl Type {
@@ -60,13 +64,14 @@ impl Type {
             "angle" => Type::Angle,
             "string" => Type::Str,
             "shape" => Type::Shape,
+            "profile" => Type::Profile,
             _ => return None,
         })
     }
 
     /// All type names, for suggestions.
-    pub const NAMES: [&'static str; 8] = [
-        "int", "float", "bool", "vec2", "vec3", "angle", "string", "shape",
+    pub const NAMES: [&'static str; 9] = [
+        "int", "float", "bool", "vec2", "vec3", "angle", "string", "shape", "profile",
     ];
 
     /// True when a value of type `self` may be passed where `want` is expected.
@@ -89,6 +94,7 @@ impl fmt::Display for Type {
             Type::Angle => "angle",
             Type::Str => "string",
             Type::Shape => "shape",
+            Type::Profile => "profile",
             Type::List(elem) => return write!(f, "[{elem}]"),
         })
     }
@@ -108,6 +114,8 @@ pub enum Value {
     Angle(f64),
     Str(Rc<str>),
     Shape(NodeId),
+    /// A 2D profile: a node of the scene graph whose distance reads only x and y.
+    Profile(NodeId),
     /// A list: its element type and its elements (each of that type, or `Error`).
     List(&'static Type, Rc<[Value]>),
     /// A number or vector that depends on the point `p` of a `field` (1, 2 or 3 components):
@@ -129,6 +137,7 @@ impl Value {
             Value::Angle(_) => Type::Angle,
             Value::Str(_) => Type::Str,
             Value::Shape(_) => Type::Shape,
+            Value::Profile(_) => Type::Profile,
             Value::List(elem, _) => Type::List(elem),
             Value::Point(c) => match c.len() {
                 1 => Type::Float,
@@ -206,6 +215,7 @@ impl fmt::Display for Value {
             Value::Angle(a) => write!(f, "{}deg", a.to_degrees()),
             Value::Str(s) => write!(f, "{s:?}"),
             Value::Shape(_) => write!(f, "<shape>"),
+            Value::Profile(_) => write!(f, "<profile>"),
             Value::List(_, items) => {
                 // A long list is shown by its first elements and its length.
                 const SHOWN: usize = 4;

@@ -290,6 +290,21 @@ impl Bounds {
                 Bound::of_box([r, half_length + r, *minor], half_length + r)
             }
             Node::InfiniteCylinder { .. } | Node::Slab { .. } => return None,
+            // A profile read as a field of space is a prism along z.
+            Node::Circle { radius } => profile([0.0; 2], [*radius; 2]),
+            Node::Rect { half } | Node::RoundRect { half, .. } => profile([0.0; 2], *half),
+            Node::Polygon { points } => {
+                let lo = [0, 1].map(|i| points.iter().fold(f64::INFINITY, |m, q| m.min(q[i])));
+                let hi = [0, 1].map(|i| points.iter().fold(f64::NEG_INFINITY, |m, q| m.max(q[i])));
+                profile(
+                    [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
+                    [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
+                )
+            }
+            Node::Extrude {
+                half_height, child, ..
+            } => extrude(&get(child)?, *half_height),
+            Node::Revolve { offset, child } => revolve(&get(child)?, *offset)?,
             Node::Feature { op, a, .. } => get(a)?.grow(op.outset()),
             Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
             Node::SmoothCombine {
@@ -326,6 +341,69 @@ impl Bounds {
             Node::Paint { child, .. } => get(child)?,
         })
     }
+}
+
+/// A profile's bound: the prism along z over the rectangle of centre `c` and half extents
+/// `h` (a profile's field is at least the distance to the prism over any rectangle around it).
+fn profile(c: [f64; 2], h: [f64; 2]) -> Bound {
+    Bound {
+        sphere: Sphere {
+            c: [c[0], c[1], 0.0],
+            r: f64::INFINITY,
+        },
+        aabb: Aabb {
+            c: [c[0], c[1], 0.0],
+            h: [h[0], h[1], f64::INFINITY],
+        },
+        scale: 1.0,
+    }
+}
+
+/// An extruded profile: the field is increasing in the profile's, and the extrusion of the
+/// distance to the profile's rectangle is the distance to the box over it (so the scale
+/// carries over; a rounded extrusion lies inside the same box).
+fn extrude(b: &Bound, h: f64) -> Bound {
+    let aabb = Aabb {
+        c: [b.aabb.c[0], b.aabb.c[1], 0.0],
+        h: [b.aabb.h[0], b.aabb.h[1], h],
+    };
+    Bound {
+        sphere: Sphere {
+            c: aabb.c,
+            r: DVec3::from(aabb.h).length(),
+        },
+        aabb,
+        scale: b.scale,
+    }
+}
+
+/// A revolved profile: read at (|p.xz| - offset, y), it lies within the distance from the
+/// axis that its rectangle reaches; `None` where it reaches no point at x ≥ -offset (an
+/// empty solid, which no volume describes).
+fn revolve(b: &Bound, offset: f64) -> Option<Bound> {
+    let r = b.aabb.c[0] + b.aabb.h[0] + offset;
+    if r.is_nan() || r < 0.0 {
+        return None;
+    }
+    let aabb = Aabb {
+        c: [0.0, b.aabb.c[1], 0.0],
+        h: [r, b.aabb.h[1], r],
+    };
+    Some(
+        Bound {
+            sphere: Sphere {
+                c: aabb.c,
+                r: if aabb.h.iter().all(|h| h.is_finite()) {
+                    DVec3::from(aabb.h).length()
+                } else {
+                    f64::INFINITY
+                },
+            },
+            aabb,
+            scale: b.scale,
+        }
+        .tight(),
+    )
 }
 
 /// Quilez's ellipsoid field k0·(k0 - 1)/k1 is at least (r_min/r_max)·(|p| - r_max) outside
@@ -574,6 +652,11 @@ fn own_cost(node: &Node) -> f64 {
         Node::Link { .. } => 14.0,
         Node::InfiniteCylinder { .. } => 14.0,
         Node::Slab { .. } => 7.0,
+        Node::Circle { .. } => 4.0,
+        Node::Rect { .. } | Node::RoundRect { .. } => 12.0,
+        Node::Polygon { points } => 20.0 * points.len() as f64,
+        Node::Extrude { .. } => 10.0,
+        Node::Revolve { .. } => 5.0,
         Node::Feature { .. } => 8.0,
         Node::Combine { children, .. } => 4.0 * children.len() as f64,
         Node::SmoothCombine { variant, .. } => match variant {

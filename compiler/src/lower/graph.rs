@@ -382,6 +382,32 @@ impl<'a> Lowerer<'a> {
                 }
             }
             Node::Field { f, .. } => self.field(id, f, p),
+            Node::Extrude {
+                half_height,
+                round,
+                child,
+            } => {
+                // The profile is read in the plane z = 0.
+                let (h, r) = (*half_height, *round);
+                let q = [p[0], p[1], self.b.c(0.0)];
+                self.post(id, *child, q, |b, d| {
+                    if r > 0.0 {
+                        let d = b.addc(d, r);
+                        let e = shapes::extrude(b, d, p[2], h - r);
+                        b.subc(e, r)
+                    } else {
+                        shapes::extrude(b, d, p[2], h)
+                    }
+                })
+            }
+            Node::Revolve { offset, child } => {
+                let b = &mut *self.b;
+                let r = b.len2(p[0], p[2]);
+                let x = b.subc(r, *offset);
+                let q = [x, p[1], b.c(0.0)];
+                let f = self.node(*child, q);
+                Field { d: f.d, m: f.m }
+            }
             Node::ScaleXyz { factors, child } => {
                 let q = self.b.map3(p, |b, x, i| b.mulc(x, 1.0 / factors[i]));
                 let s = factors.iter().fold(f64::INFINITY, |m, f| m.min(f.abs()));
@@ -526,6 +552,16 @@ impl<'a> Lowerer<'a> {
                 shapes::infinite_cylinder(b, p, radius, axis)
             }
             Node::Slab { thickness, normal } => shapes::slab(b, p, thickness, normal),
+            Node::Circle { radius } => {
+                let l = b.len2(p[0], p[1]);
+                b.subc(l, radius)
+            }
+            Node::Rect { half } => shapes::rect(b, p, half),
+            Node::RoundRect { half, radius } => {
+                let d = shapes::rect(b, p, half.map(|h| h - radius));
+                b.subc(d, radius)
+            }
+            Node::Polygon { ref points } => shapes::polygon(b, p, points),
             _ => match shapes::slots(node) {
                 Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
                 None => b.c(EMPTY_DISTANCE),

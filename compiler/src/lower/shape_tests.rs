@@ -352,3 +352,180 @@ fn columns_everywhere_keep_the_surface_of_the_restricted_form() {
         }
     }
 }
+
+#[test]
+fn profiles_made_solid_equal_the_primitives_they_describe() {
+    same("extrude(rect((1, 0.5)), 0.6)", "box((1, 0.5, 0.3))");
+    same(
+        "extrude(round_rect((1, 0.5), 0.1), 0.6, round: 0.1)",
+        "round_box((1, 0.5, 0.3), 0.1)",
+    );
+    same("revolve(circle(0.3).translate((1, 0)))", "torus(1, 0.3)");
+    same("revolve(circle(0.3), offset: 1)", "torus(1, 0.3)");
+    same("revolve(rect((0.5, 0.5)))", "cylinder(0.5, 1)");
+    same(
+        "revolve(segment2((0, -0.4), (0, 0.4), 0.3))",
+        "capsule(0.3, 0.8)",
+    );
+    // A square turned by 45° is the regular polygon of 4 sides with a corner on +y.
+    same(
+        "extrude(rotate(rect(0.5), 45deg), 1)",
+        &format!("extrude(regular_polygon(4, {}), 1)", 0.5 * 2f64.sqrt()),
+    );
+    same(
+        "extrude(polygon([(-1, -0.5), (1, -0.5), (1, 0.5), (-1, 0.5)]), 0.6)",
+        "box((1, 0.5, 0.3))",
+    );
+    // The extrusion is increasing in the profile's distance, so it commutes with min.
+    same(
+        "extrude(union(circle(0.3).translate(0.5, 0), rect(0.2)), 0.4)",
+        "union(extrude(circle(0.3).translate(0.5, 0), 0.4), extrude(rect(0.2), 0.4))",
+    );
+    same(
+        "extrude(mirror(circle(0.3).translate(0.5, 0.2)), 0.4)",
+        "union(extrude(circle(0.3).translate(0.5, 0.2), 0.4), extrude(circle(0.3).translate(-0.5, 0.2), 0.4))",
+    );
+    same(
+        "extrude(scale(circle(0.3), 2), 0.4)",
+        "cylinder(0.6, 0.4).rotate_x(90deg)",
+    );
+    same(
+        "extrude(offset(rect(0.3), 0.1), 2)",
+        "extrude(round_rect((0.4, 0.4), 0.1), 2)",
+    );
+}
+
+#[test]
+fn extruded_and_revolved_profiles_are_exact() {
+    let star = |x: f64, y: f64| {
+        // The star of 5 points, outer radius 1, inner 0.5, by its polygon's winding.
+        let v: Vec<[f64; 2]> = (0..10)
+            .map(|i| {
+                let r = if i % 2 == 0 { 1.0 } else { 0.5 };
+                let t = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * i as f64 / 5.0;
+                [r * t.cos(), r * t.sin()]
+            })
+            .collect();
+        winding(&v, [x, y])
+    };
+    exact("extrude(star(5, 1, 0.5), 1)", |p| {
+        star(p[0], p[1]) && p[2].abs() < 0.5
+    });
+    exact("revolve(rect((0.3, 0.5)).translate(0.8, 0))", |p| {
+        let r = p[0].hypot(p[2]);
+        (r - 0.8).abs() < 0.3 && p[1].abs() < 0.5
+    });
+}
+
+/// Whether `q` is inside the polygon through `v` (an odd number of crossings of the ray
+/// along +x).
+fn winding(v: &[[f64; 2]], q: [f64; 2]) -> bool {
+    let mut inside = false;
+    for i in 0..v.len() {
+        let (a, b) = (v[i], v[(i + 1) % v.len()]);
+        if (a[1] > q[1]) != (b[1] > q[1]) {
+            let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if q[0] < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+/// The distance from `q` to the segment from `a` to `b`.
+fn to_segment(a: [f64; 2], b: [f64; 2], q: [f64; 2]) -> f64 {
+    let (e, w) = ([b[0] - a[0], b[1] - a[1]], [q[0] - a[0], q[1] - a[1]]);
+    let t = ((w[0] * e[0] + w[1] * e[1]) / (e[0] * e[0] + e[1] * e[1])).clamp(0.0, 1.0);
+    (w[0] - t * e[0]).hypot(w[1] - t * e[1])
+}
+
+#[test]
+fn polygons_are_their_brute_force_distance() {
+    let mut rng = Rng::new(0x9011);
+    for _ in 0..20 {
+        // A random simple polygon: points around the origin at sorted angles, either winding.
+        let n = 3 + rng.below(12);
+        let mut angles: Vec<f64> = (0..n)
+            .map(|_| rng.range(0.0, std::f64::consts::TAU))
+            .collect();
+        angles.sort_by(f64::total_cmp);
+        if rng.uniform() < 0.5 {
+            angles.reverse();
+        }
+        let v: Vec<[f64; 2]> = angles
+            .iter()
+            .map(|t| {
+                let r = rng.range(0.3, 1.5);
+                [r * t.cos(), r * t.sin()]
+            })
+            .collect();
+        let list: Vec<String> = v.iter().map(|q| format!("({}, {})", q[0], q[1])).collect();
+        // A tall extrusion, read at z = 0, is the profile's distance where |d| < 50.
+        let (p, _) = program(&format!("extrude(polygon([{}]), 100)", list.join(", ")));
+        let mut near = 0;
+        for i in 0..400 {
+            // Half the points near an edge or a corner.
+            let q = if i % 2 == 0 {
+                let k = rng.below(n);
+                let (a, b) = (v[k], v[(k + 1) % n]);
+                let t = if i % 4 == 0 { 0.0 } else { rng.uniform() };
+                near += 1;
+                [
+                    a[0] + t * (b[0] - a[0]) + rng.range(-0.01, 0.01),
+                    a[1] + t * (b[1] - a[1]) + rng.range(-0.01, 0.01),
+                ]
+            } else {
+                [rng.range(-2.0, 2.0), rng.range(-2.0, 2.0)]
+            };
+            let d = (0..n)
+                .map(|k| to_segment(v[k], v[(k + 1) % n], q))
+                .fold(f64::INFINITY, f64::min);
+            let want = if winding(&v, q) { -d } else { d };
+            let got = f(&p, [q[0], q[1], 0.0]);
+            assert!(
+                (got - want).abs() < 1e-9,
+                "{v:?} at {q:?}: {got}, not {want}"
+            );
+        }
+        assert!(near > 0);
+    }
+}
+
+#[test]
+fn bad_profiles_are_located_errors() {
+    for (src, says, at) in [
+        (
+            "extrude(polygon([(0, 0), (1, 0)]), 1)",
+            "at least 3 points",
+            "polygon",
+        ),
+        (
+            "extrude(polygon([(0, 0), (1, 1), (1, 0), (0, 1)]), 1)",
+            "crosses itself",
+            "polygon",
+        ),
+        (
+            "extrude(polygon([(0, 0), (1, 1), (2, 2)]), 1)",
+            "no area",
+            "polygon",
+        ),
+        (
+            "extrude(rect(1), 1, round: 0.6)",
+            "more than half the height",
+            "extrude",
+        ),
+        ("circle(1)", "make it a shape with `extrude", "circle"),
+    ] {
+        let text = format!("scene {{ {src}; }}");
+        let (_, diags, _) = crate::check::check_str("t.sdf", &text);
+        let error = diags
+            .iter()
+            .find(|d| d.is_error())
+            .unwrap_or_else(|| panic!("{src}: no error"));
+        let all = format!("{error:?}");
+        assert!(all.contains(says), "{src}: {all}");
+        let start = text.find(at).expect("in the text") as u32;
+        assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
+    }
+}

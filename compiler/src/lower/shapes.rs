@@ -200,7 +200,7 @@ fn sign(b: &mut Builder, x: Reg) -> Reg {
 
 /// The exact distance of a 2D field `d` extruded along a coordinate `y` to half-height `h`
 /// (Quilez's `opExtrusion`): w = (d, |y| - h); min(max(w.x, w.y), 0) + |max(w, 0)|.
-fn extrude(b: &mut Builder, d: Reg, y: Reg, h: f64) -> Reg {
+pub(super) fn extrude(b: &mut Builder, d: Reg, y: Reg, h: f64) -> Reg {
     let ay = b.abs(y);
     let wy = b.subc(ay, h);
     let inside = b.max(d, wy);
@@ -686,4 +686,79 @@ fn real_pow(b: &mut Builder, x: Reg, k: u32) -> Reg {
         }
     }
     acc
+}
+
+/// The exact distance to the rectangle of half-extents `h` in the xy plane (Quilez's
+/// `sdBox` in 2D): q = |p.xy| - h; |max(q, 0)| + min(max(q.x, q.y), 0).
+pub(super) fn rect(b: &mut Builder, p: P, h: [f64; 2]) -> Reg {
+    let q = [0, 1].map(|i| {
+        let a = b.abs(p[i]);
+        b.subc(a, h[i])
+    });
+    let ox = b.maxc(q[0], 0.0);
+    let oy = b.maxc(q[1], 0.0);
+    let outside = b.len2(ox, oy);
+    let inside = b.max(q[0], q[1]);
+    let inside = b.minc(inside, 0.0);
+    b.add(outside, inside)
+}
+
+/// The exact signed distance to the simple polygon through `v` in the xy plane (Quilez's
+/// `sdPolygon`): the nearest of its edges, negative where a ray along +x from the point
+/// crosses the edges an odd number of times. Edge i (from v_i to v_j, j = i - 1) crosses when
+/// v_i.y ≤ y, y < v_j.y and the point is left of it, or all three are false.
+pub(super) fn polygon(b: &mut Builder, p: P, v: &[[f64; 2]]) -> Reg {
+    let (x, y) = (p[0], p[1]);
+    let mut best: Option<Reg> = None;
+    let mut sign = b.c(1.0);
+    let n = v.len();
+    for i in 0..n {
+        let j = (i + n - 1) % n;
+        let (vi, vj) = (v[i], v[j]);
+        let e = [vj[0] - vi[0], vj[1] - vi[1]];
+        let ee = e[0] * e[0] + e[1] * e[1];
+        let wx = b.subc(x, vi[0]);
+        let wy = b.subc(y, vi[1]);
+        // The nearest point of the edge: w - e·clamp(w·e / e·e, 0, 1).
+        let t = if ee > 0.0 {
+            let ex = b.mulc(wx, e[0] / ee);
+            let ey = b.mulc(wy, e[1] / ee);
+            let t = b.add(ex, ey);
+            b.clampc(t, 0.0, 1.0)
+        } else {
+            b.c(0.0)
+        };
+        let tx = b.mulc(t, e[0]);
+        let ty = b.mulc(t, e[1]);
+        let dx = b.sub(wx, tx);
+        let dy = b.sub(wy, ty);
+        let dd = b.dot2(dx, dy, dx, dy);
+        best = Some(match best {
+            Some(m) => b.min(m, dd),
+            None => dd,
+        });
+        // The three conditions as 0 or 1; the edge flips the sign when they agree.
+        let (yi, yj) = (b.c(vi[1]), b.c(vj[1]));
+        let below_i = b.lt(y, yi);
+        let one = b.c(1.0);
+        let c1 = b.sub(one, below_i);
+        let c2 = b.lt(y, yj);
+        let l = b.mulc(wx, e[1]);
+        let r = b.mulc(wy, e[0]);
+        let c3 = b.lt(l, r);
+        let s12 = b.add(c1, c2);
+        let sum = b.add(s12, c3);
+        // sum is 0 or 3 exactly when |sum - 1.5| > 1.
+        let off = b.subc(sum, 1.5);
+        let off = b.abs(off);
+        let one = b.c(1.0);
+        let flip = b.lt(one, off);
+        let neg = b.neg(sign);
+        sign = b.select(flip, neg, sign);
+    }
+    let d = match best {
+        Some(m) => b.sqrt(m),
+        None => b.c(f64::INFINITY),
+    };
+    b.mul(sign, d)
 }

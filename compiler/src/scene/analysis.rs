@@ -558,6 +558,15 @@ fn exact(bounds: Aabb, symmetric: [bool; 3]) -> Derived {
     }
 }
 
+/// The box around a profile of half-extents `half` in x and y: every z (a profile read as a
+/// field of space is a prism along z).
+fn profile_bounds(half: [f64; 2]) -> Aabb {
+    Aabb {
+        min: [-half[0], -half[1], f64::NEG_INFINITY],
+        max: [half[0], half[1], f64::INFINITY],
+    }
+}
+
 /// The exactness of a field that is not exact, from its L and whether that L is proven.
 fn classify(lipschitz: f64, proven: bool) -> Exactness {
     if proven && lipschitz <= 1.0 {
@@ -703,6 +712,59 @@ impl Pass<'_> {
                 slab_bounds(*normal, thickness * 0.5),
                 line_symmetry(*normal),
             ),
+            Node::Circle { radius } => exact(profile_bounds([*radius; 2]), [true; 3]),
+            Node::Rect { half } | Node::RoundRect { half, .. } => {
+                exact(profile_bounds(*half), [true; 3])
+            }
+            Node::Polygon { points } => {
+                let mut b = Aabb::EMPTY;
+                for q in points {
+                    b = b.union(Aabb {
+                        min: [q[0], q[1], f64::NEG_INFINITY],
+                        max: [q[0], q[1], f64::INFINITY],
+                    });
+                }
+                exact(b, [false, false, true])
+            }
+            Node::Extrude {
+                half_height,
+                round,
+                child,
+            } => {
+                let mut d = self.get(*child);
+                if *round > 0.0 {
+                    // The profile shrunk by `round` is a bound outside its solid.
+                    d = at_most_bound(d);
+                }
+                // |(a, b)| of a field a of the plane and b = |z| - h: as steep as the steeper.
+                d.facts.lipschitz = d.facts.lipschitz.max(1.0);
+                d.gradient = d.gradient.max(1.0);
+                d.bounds.min[2] = -half_height;
+                d.bounds.max[2] = *half_height;
+                d.symmetric[2] = true;
+                d
+            }
+            Node::Revolve { offset, child } => {
+                let mut d = self.get(*child);
+                let c = d.bounds;
+                // The profile is read at x = r - offset for r ≥ 0; a part of it at smaller x
+                // is never read, but may be nearer than the part that is: then a bound.
+                let read_only = c.min[0] >= -offset || (d.symmetric[0] && *offset == 0.0);
+                if !read_only {
+                    d = at_most_bound(d);
+                }
+                let r = (c.max[0] + offset).max(0.0);
+                d.bounds = if c.max[0] + offset < 0.0 || c.is_empty() {
+                    Aabb::EMPTY
+                } else {
+                    Aabb {
+                        min: [-r, c.min[1], -r],
+                        max: [r, c.max[1], r],
+                    }
+                };
+                d.symmetric = [true, d.symmetric[1], true];
+                d
+            }
             Node::Feature { op, a, b } => self.feature(id, *op, *a, *b),
             Node::Combine { op, children } => self.combine(*op, children),
             Node::SmoothCombine {

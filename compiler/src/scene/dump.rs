@@ -147,6 +147,10 @@ pub fn num(x: f64) -> String {
     }
 }
 
+fn v2(v: [f64; 2]) -> String {
+    format!("({}, {})", num(v[0]), num(v[1]))
+}
+
 fn v3(v: V3) -> String {
     format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]))
 }
@@ -278,6 +282,28 @@ fn node(n: &Node) -> String {
         }
         Node::Slab { thickness, normal } => {
             format!("slab thickness={} normal={}", num(*thickness), v3(*normal))
+        }
+        Node::Circle { radius } => format!("circle radius={}", num(*radius)),
+        Node::Rect { half } => format!("rect half={}", v2(*half)),
+        Node::RoundRect { half, radius } => {
+            format!("round_rect half={} radius={}", v2(*half), num(*radius))
+        }
+        Node::Polygon { points } => {
+            let ps: Vec<String> = points.iter().map(|q| v2(*q)).collect();
+            format!("polygon {}", ps.join(" "))
+        }
+        Node::Extrude {
+            half_height,
+            round,
+            child,
+        } => format!(
+            "extrude half_height={} round={} %{}",
+            num(*half_height),
+            num(*round),
+            child.0
+        ),
+        Node::Revolve { offset, child } => {
+            format!("revolve offset={} %{}", num(*offset), child.0)
         }
         Node::Feature { op, a, b } => {
             let size = match *op {

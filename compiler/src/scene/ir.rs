@@ -202,6 +202,25 @@ pub enum Node {
     /// The points within `thickness / 2` of the plane through the origin normal to `normal`
     /// (unit length).
     Slab { thickness: f64, normal: V3 },
+    /// Profile (2D, in the xy plane; its distance reads x and y only): a circle.
+    Circle { radius: f64 },
+    /// Profile: a rectangle of half-extents `half`.
+    Rect { half: [f64; 2] },
+    /// Profile: a rectangle of half-extents `half` with its corners rounded by `radius` (the
+    /// radius is inside the extents).
+    RoundRect { half: [f64; 2], radius: f64 },
+    /// Profile: a simple polygon through `points` (three or more, either winding).
+    Polygon { points: Vec<[f64; 2]> },
+    /// A profile extruded along z to half-height `half_height`, its edges rounded by `round`
+    /// (inside the extents).
+    Extrude {
+        half_height: f64,
+        round: f64,
+        child: NodeId,
+    },
+    /// A profile revolved about the y axis: the profile's x is the distance from the axis,
+    /// less `offset`.
+    Revolve { offset: f64, child: NodeId },
     /// n-ary union, or a binary intersection or subtraction.
     Combine { op: Combine, children: Vec<NodeId> },
     /// Smooth union, intersection or subtraction with blend radius `k`.
@@ -292,6 +311,8 @@ macro_rules! one_child {
             | Node::Shell { $child, .. }
             | Node::Elongate { $child, .. }
             | Node::Paint { $child, .. }
+            | Node::Extrude { $child, .. }
+            | Node::Revolve { $child, .. }
     };
 }
 
@@ -343,6 +364,12 @@ impl Node {
             Node::Link { .. } => "link",
             Node::InfiniteCylinder { .. } => "infinite_cylinder",
             Node::Slab { .. } => "slab",
+            Node::Circle { .. } => "circle",
+            Node::Rect { .. } => "rect",
+            Node::RoundRect { .. } => "round_rect",
+            Node::Polygon { .. } => "polygon",
+            Node::Extrude { .. } => "extrude",
+            Node::Revolve { .. } => "revolve",
             Node::Feature { op, .. } => op.name(),
             Node::Combine { op, .. } => op.name(false),
             Node::SmoothCombine { op, .. } => op.name(true),

@@ -237,23 +237,38 @@ impl<'a> Lowerer<'a> {
         let b = &mut *self.b;
         let rho = b.len2(p[0], p[2]);
         let mut cap = b.mulc(rho, sin_gamma);
-        if let Some(bound) = self.config.bounds.and_then(|bs| bs.get(id)) {
-            // Every copy lies in both volumes, so their distances are lower bounds too, and
-            // the field stays above them as a bound's guarantee requires.
-            let b = &mut *self.b;
-            let sp = bound.sphere;
-            if sp.r.is_finite() {
-                let q = b.sub3c(p, sp.c);
-                let l = b.len3(q);
-                let pad = 1e-3 * sp.r + 1e-4 * (1.0 + DVec3::from(sp.c).length());
-                let s = b.subc(l, sp.r + pad);
-                let s = shrink(b, s, bound.scale);
-                cap = b.max(cap, s);
-            }
-            let axes: Vec<usize> = (0..3).filter(|&i| bound.aabb.h[i].is_finite()).collect();
+        if let Some(a) = self.config.analysis {
+            // Every copy lies in the repetition's box, so the distance to the box is a lower
+            // bound too, and the field stays above it as a bound's guarantee requires. The
+            // box comes from the analysis, which every lowering has, so that the field does
+            // not depend on whether culling volumes were computed.
+            let bounds = a.node(id).bounds;
+            let axes: Vec<usize> = (0..3)
+                .filter(|&i| bounds.min[i].is_finite() && bounds.max[i].is_finite())
+                .collect();
             if !axes.is_empty() {
-                let s = box_distance(b, &bound, &axes, p);
-                cap = b.max(cap, s);
+                let extent = axes
+                    .iter()
+                    .map(|&i| bounds.min[i].abs().max(bounds.max[i].abs()))
+                    .fold(0.0, f64::max);
+                let b = &mut *self.b;
+                let mut sum: Option<Reg> = None;
+                for &i in &axes {
+                    let above = b.subc(p[i], bounds.max[i]);
+                    let below = b.subc(p[i], bounds.min[i]);
+                    let below = b.neg(below);
+                    let out = b.max(above, below);
+                    let out = b.maxc(out, 0.0);
+                    let sq = b.mul(out, out);
+                    sum = Some(match sum {
+                        Some(s) => b.add(s, sq),
+                        None => sq,
+                    });
+                }
+                let d = b.sqrt(sum.expect("an axis"));
+                // A margin for the rounding of f32 evaluation.
+                let d = b.subc(d, 1e-4 * (1.0 + extent));
+                cap = b.max(cap, d);
             }
         }
         Field {

@@ -175,17 +175,7 @@ fn cone(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let h = b.param(s, 1, 1.0);
     let cby = b.sub(qy, h);
     let cby = b.add(cby, ky);
-    let inside_x = b.lt(cbx, zero);
-    let inside_y = b.lt(cay, zero);
-    let inside = b.mul(inside_x, inside_y);
-    let one = b.c(1.0);
-    let minus = b.c(-1.0);
-    let s = b.select(inside, minus, one);
-    let da = b.dot2(cax, cay, cax, cay);
-    let db = b.dot2(cbx, cby, cbx, cby);
-    let m = b.min(da, db);
-    let m = b.sqrt(m);
-    b.mul(s, m)
+    nearer_signed(b, zero, [cax, cay], [cbx, cby])
 }
 
 /// -1 where `x < 0`, else 1 (GLSL's `sign` but for 0, where every use below multiplies a
@@ -209,6 +199,23 @@ pub(super) fn extrude(b: &mut Builder, d: Reg, y: Reg, h: f64) -> Reg {
     let oy = b.maxc(wy, 0.0);
     let outside = b.len2(ox, oy);
     b.add(inside, outside)
+}
+
+/// The tail of Quilez's cone distances: the nearer of the offsets `ca` (to the caps) and
+/// `cb` (to the slanted side), negative where both place the point inside (cb.x < 0 and
+/// ca.y < 0).
+fn nearer_signed(b: &mut Builder, zero: Reg, [cax, cay]: [Reg; 2], [cbx, cby]: [Reg; 2]) -> Reg {
+    let inside_x = b.lt(cbx, zero);
+    let inside_y = b.lt(cay, zero);
+    let inside = b.mul(inside_x, inside_y);
+    let one = b.c(1.0);
+    let minus = b.c(-1.0);
+    let s = b.select(inside, minus, one);
+    let da = b.dot2(cax, cay, cax, cay);
+    let db = b.dot2(cbx, cby, cbx, cby);
+    let m = b.min(da, db);
+    let m = b.sqrt(m);
+    b.mul(s, m)
 }
 
 /// Quilez's exact capped cone (`sdCappedCone`) along y, radius r1 at y = -h and r2 at y = +h:
@@ -241,17 +248,7 @@ pub(super) fn capped_cone(b: &mut Builder, p: P, h: f64, r1: f64, r2: f64) -> Re
     let cby = b.mulc(t, k2y);
     let cby = b.add(qy, cby);
     let cby = b.subc(cby, h);
-    let inside_x = b.lt(cbx, zero);
-    let inside_y = b.lt(cay, zero);
-    let inside = b.mul(inside_x, inside_y);
-    let one = b.c(1.0);
-    let minus = b.c(-1.0);
-    let s = b.select(inside, minus, one);
-    let da = b.dot2(cax, cay, cax, cay);
-    let db = b.dot2(cbx, cby, cbx, cby);
-    let m = b.min(da, db);
-    let m = b.sqrt(m);
-    b.mul(s, m)
+    nearer_signed(b, zero, [cax, cay], [cbx, cby])
 }
 
 /// Quilez's exact round cone (`sdRoundCone`): the hull of spheres of radii r1 at y = -h and

@@ -144,17 +144,36 @@ class Scene:
             w, h = 640, max(1, round(h * 640 / w))
         return self.png(size=(w, h))
 
-    def distance(self, points: Any, t: float = 0.0) -> Tuple[np.ndarray, np.ndarray]:
+    def depth(
+        self,
+        size: Optional[Tuple[int, int]] = None,
+        aa: Optional[int] = None,
+        t: float = 0.0,
+        backend: str = "cpu",
+    ) -> Tuple[np.ndarray, np.ndarray]:
+        """Where each pixel's camera rays first hit a surface, as `sdfc render --aux` writes
+        it: the mean distance from the eye along the ray of the rays that hit ((h, w) float32,
+        NaN where none did) and the fraction of the pixel's rays that hit ((h, w) float32).
+        Rendered on the CPU, the one renderer that keeps depth buffers (another `backend`
+        raises ValueError)."""
+        w, h, d, c = self._call(self._scene.depth, _size(size), backend, aa, float(t))
+        d = np.frombuffer(d, dtype=np.float32).reshape(h, w).copy()
+        c = np.frombuffer(c, dtype=np.float32).reshape(h, w).copy()
+        return (d, c)
+
+    def distance(self, points: Any, t: float = 0.0, backend: str = "cpu") -> Tuple[np.ndarray, np.ndarray]:
         """The signed distance and material id at each of `points`, an (n, 3) array (or one
-        point of 3), through the CPU interpreter in float64: ((n,) float64, (n,) uint32)."""
+        point of 3): through the CPU interpreter in float64 (`backend="cpu"`), or on a GPU
+        in float32 by the scene's compiled `map` (`"wgpu"`, or `"cuda"` through the CUDA
+        driver): ((n,) float64 or float32, (n,) uint32)."""
         p = np.ascontiguousarray(points, dtype=np.float64)
         single = p.shape == (3,)
         if single:
             p = p.reshape(1, 3)
         if p.ndim != 2 or p.shape[1] != 3:
             raise ValueError(f"points must have the shape (n, 3), not {p.shape}")
-        d, m = self._call(self._scene.distance, p.tobytes(), float(t))
-        d = np.frombuffer(d, dtype=np.float64).copy()
+        d, m = self._call(self._scene.distance, p.tobytes(), float(t), backend)
+        d = np.frombuffer(d, dtype=np.float64 if backend == "cpu" else np.float32).copy()
         m = np.frombuffer(m, dtype=np.uint32).copy()
         return (d, m)
 

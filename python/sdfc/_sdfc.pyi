@@ -18,7 +18,14 @@ class _Scene:
         t: float = ...,
         encoding: str = ...,
     ) -> Tuple[int, int, bytes]: ...
-    def distance(self, points: bytes, t: float = ...) -> Tuple[bytes, bytes]: ...
+    def depth(
+        self,
+        size: Optional[Tuple[int, int]] = ...,
+        backend: str = ...,
+        aa: Optional[int] = ...,
+        t: float = ...,
+    ) -> Tuple[int, int, bytes, bytes]: ...
+    def distance(self, points: bytes, t: float = ..., backend: str = ...) -> Tuple[bytes, bytes]: ...
     def mesh(
         self,
         resolution: Optional[int] = ...,

@@ -304,6 +304,12 @@ impl Scene {
 
     /// Renders as `sdfc render` does: checked, lowered, prepared, held to the memory limit.
     fn image(&self, ask: Ask) -> Result<Image, Failure> {
+        Ok(self.rendered(ask, true)?.image)
+    }
+
+    /// The whole render: the image, and with `image_only` false its statistics and (on the
+    /// CPU) its depth buffers.
+    fn rendered(&self, ask: Ask, image_only: bool) -> Result<sdfc_runtime::cpu::Render, Failure> {
         let limits = Limits::default();
         let checked = self.checked(ask.time, ask.size, ask.aa)?;
         let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
@@ -316,7 +322,7 @@ impl Scene {
             debug_nan: false,
             parameters: false,
             kernel: Kernel::Auto.choice(),
-            image_only: true,
+            image_only,
         };
         let frame = FrameScene {
             scene: checked.scene,
@@ -324,12 +330,42 @@ impl Scene {
         };
         let (scene, prepared) =
             renderer::prepare(pool, (ask.backend, &Devices::Auto), frame, &setup, None)?;
-        renderer::check_memory(pool, &prepared, &scene, (false, false), &limits, false)?;
+        renderer::check_memory(
+            pool,
+            &prepared,
+            &scene,
+            (false, !image_only),
+            &limits,
+            false,
+        )?;
         let frame = pool
             .install(|| prepared.render(&scene, &|_| {}))
             .map_err(Failure::Runtime)?;
-        Ok(frame.render.image)
+        Ok(frame.render)
     }
+}
+
+/// Distances (f32 bytes) and material ids (u32 bytes) at `points` (program coordinates)
+/// from the scene's WGSL part on a GPU: through wgpu, or as PTX through CUDA.
+fn gpu_distances(
+    backend: &str,
+    scene: &sdfc_compiler::scene::Scene,
+    lowered: &lower::Lowered,
+    points: &[[f64; 3]],
+) -> Result<(Vec<u8>, Vec<u8>), String> {
+    use sdfc_runtime::gpu::{points as on_gpu, Gpu};
+    let module = on_gpu::points_module(scene, lowered, false)?;
+    let (values, _) = if backend == "cuda" {
+        let (ctx, sm) = on_gpu::open_cuda()?;
+        let ptx = on_gpu::points_ptx(&module, sm)?;
+        on_gpu::run_cuda(&ctx, &module, &ptx, points)?
+    } else {
+        let gpu = Gpu::open(false).map_err(|e| e.to_string())?;
+        on_gpu::run_wgpu(&gpu, &module, points)?
+    };
+    let d = values.iter().flat_map(|(d, _)| d.to_ne_bytes()).collect();
+    let m = values.iter().flat_map(|(_, m)| m.to_ne_bytes()).collect();
+    Ok((d, m))
 }
 
 fn backend(name: &str) -> PyResult<Backend> {
@@ -428,18 +464,71 @@ impl Scene {
         Ok((w, h, PyBytes::new(py, &bytes)))
     }
 
-    /// Distances and material ids at `points` (native-endian f64 triples) through the batch
-    /// interpreter in f64: (distances as f64 bytes, ids as u32 bytes).
-    #[pyo3(signature = (points, t=0.0))]
+    /// Where each pixel's camera rays first hit a surface, as `sdfc render --aux` writes it:
+    /// (width, height, distances as f32 bytes with NaN where nothing was hit, coverage as f32
+    /// bytes). Only the CPU renderer keeps depth buffers.
+    #[pyo3(signature = (size=None, backend="cpu", aa=None, t=0.0))]
+    #[allow(clippy::type_complexity)]
+    fn depth<'py>(
+        self_: Py<Self>,
+        py: Python<'py>,
+        size: Option<(u32, u32)>,
+        backend: &str,
+        aa: Option<u32>,
+        t: f64,
+    ) -> PyResult<(u32, u32, Bound<'py, PyBytes>, Bound<'py, PyBytes>)> {
+        let ask = Ask {
+            size,
+            aa,
+            backend: self::backend(backend)?,
+            time: t,
+        };
+        let name = backend.to_string();
+        let scene = self_.clone_ref(py);
+        let (w, h, d, c) = interruptible(py, move || {
+            let render = scene.get().rendered(ask, false)?;
+            let Some(depth) = render.depth else {
+                return Err(Failure::Value(format!(
+                    "the {name} backend keeps no depth buffers; depth() needs backend=\"cpu\""
+                )));
+            };
+            let d: Vec<u8> = depth
+                .distance
+                .iter()
+                .flat_map(|x| x.to_ne_bytes())
+                .collect();
+            let c: Vec<u8> = depth
+                .coverage
+                .iter()
+                .flat_map(|x| x.to_ne_bytes())
+                .collect();
+            Ok((depth.width, depth.height, d, c))
+        })?;
+        Ok((w, h, PyBytes::new(py, &d), PyBytes::new(py, &c)))
+    }
+
+    /// Distances and material ids at `points` (native-endian f64 triples): through the batch
+    /// interpreter in f64 (`backend` "cpu"), or in f32 by the scene's WGSL part through wgpu
+    /// or, as PTX, through CUDA: (distances as f64 or f32 bytes, ids as u32 bytes).
+    #[pyo3(signature = (points, t=0.0, backend="cpu"))]
     fn distance<'py>(
         &self,
         py: Python<'py>,
         points: &[u8],
         t: f64,
+        backend: &str,
     ) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>)> {
         if points.len() % 24 != 0 {
             return Err(PyValueError::new_err("points must be (n, 3) float64"));
         }
+        let backend = match backend {
+            "cpu" | "wgpu" | "cuda" => backend.to_string(),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "backend must be \"cpu\", \"wgpu\" or \"cuda\", not {other:?}"
+                )))
+            }
+        };
         let checked = self.checked(t, None, None).map_err(|f| f.into_py(py))?;
         let limits = Limits::default();
         let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
@@ -457,6 +546,13 @@ impl Scene {
                 [f(0) - origin[0], f(1) - origin[1], f(2) - origin[2]]
             })
             .collect();
+        if backend != "cpu" {
+            let scene = checked.scene;
+            let (d, m) = py
+                .detach(move || gpu_distances(&backend, &scene, &lowered, &xyz))
+                .map_err(PyRuntimeError::new_err)?;
+            return Ok((PyBytes::new(py, &d), PyBytes::new(py, &m)));
+        }
         let pool = pool().map_err(|f| f.into_py(py))?;
         let (d, m) = py.detach(|| {
             let tape = Tape::new(&lowered.program, Outputs::DistanceAndMaterial);

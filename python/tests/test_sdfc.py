@@ -198,6 +198,93 @@ class Distance(unittest.TestCase):
     def test_shape_is_checked(self):
         with self.assertRaises(ValueError):
             sdfc.Scene(SPHERE).distance(np.zeros((4, 2)))
+        with self.assertRaises(ValueError):
+            sdfc.Scene(SPHERE).distance(np.zeros((4, 3)), backend="opengl")
+
+    def test_equals_the_emitted_rust(self):
+        # The CLI's `compile --emit rust`, compiled by rustc with glam's two vector types
+        # stood in for, evaluated at the same points: map_f64 is the interpreter bit for bit.
+        path = ROOT / "examples" / "seed3.sdf"
+        rust = subprocess.run([sdfc_bin(), "compile", str(path), "--emit", "rust"], check=True, capture_output=True, text=True).stdout
+        rng = np.random.default_rng(7)
+        points = rng.uniform(-3, 3, size=(200, 3))
+        main = (
+            "#![allow(dead_code)]\n"
+            "mod glam {\n"
+            "    #[derive(Clone, Copy)] pub struct Vec3 { pub x: f32, pub y: f32, pub z: f32 }\n"
+            "    #[derive(Clone, Copy)] pub struct DVec3 { pub x: f64, pub y: f64, pub z: f64 }\n"
+            "}\n"
+            f"mod scene {{\nuse super::glam;\n{rust}\n}}\n"
+            "fn main() {\n"
+            "    let text = std::fs::read_to_string(std::env::args().nth(1).unwrap()).unwrap();\n"
+            "    for line in text.lines() {\n"
+            "        let c: Vec<f64> = line.split(' ').map(|w| f64::from_bits(w.parse().unwrap())).collect();\n"
+            "        let (d, m) = scene::map_f64(glam::DVec3 { x: c[0], y: c[1], z: c[2] });\n"
+            "        println!(\"{} {}\", d.to_bits(), m);\n"
+            "    }\n"
+            "}\n"
+        )
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = Path(tmp)
+            (tmp / "eval.rs").write_text(main)
+            (tmp / "points.txt").write_text("\n".join(" ".join(str(int(x)) for x in row) for row in points.view(np.uint64)))
+            subprocess.run(["rustc", "--edition", "2021", "-C", "opt-level=1", "-o", str(tmp / "eval"), str(tmp / "eval.rs")], check=True, capture_output=True)
+            out = subprocess.run([str(tmp / "eval"), str(tmp / "points.txt")], check=True, capture_output=True, text=True).stdout
+        rows = [line.split(" ") for line in out.splitlines()]
+        expected = np.array([int(r[0]) for r in rows], dtype=np.uint64).view(np.float64)
+        ids = np.array([int(r[1]) for r in rows], dtype=np.uint32)
+        d, m = sdfc.Scene(path=str(path)).distance(points)
+        np.testing.assert_array_equal(d, expected)
+        np.testing.assert_array_equal(m, ids)
+
+    def test_on_the_gpu(self):
+        # wgpu (lavapipe in CI) runs the scene's compiled map in f32: the f64 distances
+        # rounded, within a few ulps of the distance's scale, and the same materials.
+        path = ROOT / "examples" / "seed3.sdf"
+        rng = np.random.default_rng(3)
+        points = rng.uniform(-3, 3, size=(5000, 3))
+        s = sdfc.Scene(path=str(path))
+        d64, m64 = s.distance(points)
+        d32, m32 = s.distance(points, backend="wgpu")
+        self.assertEqual(d32.dtype, np.float32)
+        scale = 1 + np.abs(points).max(axis=1)
+        np.testing.assert_array_less(np.abs(d32 - d64), 1e-5 * scale)
+        # Ids may differ only where two materials' distances are equal to f32 precision.
+        self.assertGreater(np.mean(m32 == m64), 0.99)
+
+
+class Depth(unittest.TestCase):
+    def test_centre_and_corner(self):
+        d, c = sdfc.Scene(SPHERE).depth(size=(32, 24))
+        self.assertEqual(d.shape, (24, 32))
+        self.assertEqual(c.shape, (24, 32))
+        self.assertEqual(d.dtype, np.float32)
+        # The eye is 4 from the centre of a unit sphere: the centre ray hits at 3.
+        centre = d[11:13, 15:17]
+        np.testing.assert_allclose(centre, 3.0, atol=0.02)
+        np.testing.assert_array_equal(c[11:13, 15:17], 1.0)
+        self.assertTrue(np.isnan(d[0, 0]))
+        self.assertEqual(c[0, 0], 0.0)
+
+    def test_equals_the_cli_sidecar(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = Path(tmp) / "s.png"
+            src = Path(tmp) / "s.sdf"
+            src.write_text(SPHERE)
+            subprocess.run([sdfc_bin(), "render", str(src), "--backend", "cpu", "--aux", "-o", str(out)], check=True, capture_output=True)
+            raw = (Path(tmp) / "s.aux").read_bytes()
+        w, h = np.frombuffer(raw[8:16], dtype="<u4")
+        n = int(w) * int(h)
+        cli_d = np.frombuffer(raw[20 : 20 + 4 * n], dtype="<f4").reshape(h, w)
+        cli_c = np.frombuffer(raw[20 + 4 * n : 20 + 8 * n], dtype="<f4").reshape(h, w)
+        d, c = sdfc.Scene(SPHERE).depth()
+        np.testing.assert_array_equal(d, cli_d)
+        np.testing.assert_array_equal(c, cli_c)
+
+    def test_gpu_backends_have_none(self):
+        with self.assertRaises(ValueError) as caught:
+            sdfc.Scene(SPHERE).depth(backend="wgpu")
+        self.assertIn("cpu", str(caught.exception))
 
 
 class Mesh(unittest.TestCase):

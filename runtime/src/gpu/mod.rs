@@ -5,6 +5,7 @@
 pub mod cpu;
 pub mod cuda;
 pub mod launch;
+pub mod points;
 pub mod wgpu;
 
 use crate::cpu::{Counters, Render, Stats};

@@ -354,14 +354,23 @@ fn gpu_distances(
     points: &[[f64; 3]],
 ) -> Result<(Vec<u8>, Vec<u8>), String> {
     use sdfc_runtime::gpu::{points as on_gpu, Gpu};
+    // Each device is opened once per process, on first use.
+    static CUDA: OnceLock<Result<on_gpu::CudaDevice, String>> = OnceLock::new();
+    static WGPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
     let module = on_gpu::points_module(scene, lowered, false)?;
     let (values, _) = if backend == "cuda" {
-        let (ctx, sm) = on_gpu::open_cuda()?;
-        let ptx = on_gpu::points_ptx(&module, sm)?;
-        on_gpu::run_cuda(&ctx, &module, &ptx, points)?
+        let (ctx, sm) = CUDA
+            .get_or_init(on_gpu::open_cuda)
+            .as_ref()
+            .map_err(Clone::clone)?;
+        let ptx = on_gpu::points_ptx(&module, *sm)?;
+        on_gpu::run_cuda(ctx, &module, &ptx, points)?
     } else {
-        let gpu = Gpu::open(false).map_err(|e| e.to_string())?;
-        on_gpu::run_wgpu(&gpu, &module, points)?
+        let gpu = WGPU
+            .get_or_init(|| Gpu::open(false).map_err(|e| e.to_string()))
+            .as_ref()
+            .map_err(Clone::clone)?;
+        on_gpu::run_wgpu(gpu, &module, points)?
     };
     let d = values.iter().flat_map(|(d, _)| d.to_ne_bytes()).collect();
     let m = values.iter().flat_map(|(_, m)| m.to_ne_bytes()).collect();

@@ -270,9 +270,12 @@ pub fn run_wgpu(
     Ok(out)
 }
 
+/// A CUDA context and its device's compute capability (`major * 10 + minor`).
+pub type CudaDevice = (std::sync::Arc<cudarc::driver::CudaContext>, u32);
+
 /// A CUDA device, opened for [`run_cuda`], with its compute capability, or why there is
 /// none.
-pub fn open_cuda() -> Result<(std::sync::Arc<cudarc::driver::CudaContext>, u32), String> {
+pub fn open_cuda() -> Result<CudaDevice, String> {
     use cudarc::driver::{sys, CudaContext};
     // SAFETY: only tries to dlopen libcuda; no driver call is made.
     #[allow(unsafe_code)]

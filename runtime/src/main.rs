@@ -36,6 +36,9 @@ enum Command {
     Devices(commands::devices::DevicesArgs),
     /// Show a scene in a window that reloads it whenever it (or a file it imports) is saved.
     View(commands::view::ViewArgs),
+    /// Format scene files in one layout, comments kept (`--check`: name those that would
+    /// change, exit 1 if any would).
+    Fmt(commands::fmt::FmtArgs),
     /// Serve the Language Server Protocol on standard input and output, for editors
     /// (docs/editors.md).
     Lsp(LspArgs),
@@ -70,6 +73,7 @@ fn main() -> ExitCode {
         Command::Pareto(args) => commands::pareto::run(args),
         Command::Mesh(args) => commands::mesh::run(args),
         Command::View(args) => commands::view::run(args),
+        Command::Fmt(args) => commands::fmt::run(args),
         Command::Lsp(_) => sdfc_runtime::lsp::run(),
     }
 }

@@ -1,5 +1,5 @@
-//! The `sdfc render` and `sdfc bench` commands: outputs, atomic writes, settings overrides
-//! and exit codes (1 for errors in the scene, 2 for usage and IO problems).
+//! The `sdfc render`, `sdfc bench` and `sdfc fmt` commands: outputs, atomic writes, settings
+//! overrides and exit codes (1 for errors in the scene, 2 for usage and IO problems).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -1282,5 +1282,99 @@ fn ten_thousand_nested_unions_check_with_the_limit_raised() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(err.contains("deep.sdf: ok"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `sdfc fmt`: files rewritten in place (only those that change), folders searched for `.sdf`
+/// files, `--check` naming the files that would change without writing, syntax errors and
+/// missing files refused, standard input to standard output.
+#[test]
+fn fmt_rewrites_checks_and_filters() {
+    let d = dir("fmt");
+    let sub = d.join("more");
+    std::fs::create_dir_all(&sub).expect("dir");
+    let messy = "let r=2*3;\nscene { sphere( r ) ; }\n";
+    let tidy = "let r = 2 * 3;\nscene {\n  sphere(r);\n}\n";
+    std::fs::write(d.join("a.sdf"), messy).expect("write");
+    std::fs::write(sub.join("b.sdf"), tidy).expect("write");
+    std::fs::write(sub.join("c.sdf"), messy).expect("write");
+    std::fs::write(d.join("broken.sdf"), "let r = ;\n").expect("write");
+
+    let out = sdfc(&d, &["fmt", "--check", "a.sdf", "more"]);
+    assert_eq!(out.status.code(), Some(1));
+    let named = String::from_utf8_lossy(&out.stdout).replace('\\', "/");
+    assert_eq!(named, "a.sdf\nmore/c.sdf\n");
+    assert_eq!(
+        std::fs::read_to_string(d.join("a.sdf")).expect("read"),
+        messy
+    );
+
+    let out = sdfc(&d, &["fmt", "a.sdf", "more"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in ["a.sdf", "more/b.sdf", "more/c.sdf"] {
+        assert_eq!(
+            std::fs::read_to_string(d.join(f)).expect("read"),
+            tidy,
+            "{f}"
+        );
+    }
+    assert_eq!(entries(&sub), ["b.sdf", "c.sdf"], "no temporary file left");
+    assert_eq!(
+        sdfc(&d, &["fmt", "--check", "."]).status.code(),
+        Some(1),
+        "broken.sdf"
+    );
+    assert_eq!(
+        sdfc(&d, &["fmt", "--check", "a.sdf", "more"]).status.code(),
+        Some(0)
+    );
+
+    let out = sdfc(&d, &["fmt", "broken.sdf"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("E0100") && err.contains("not formatted"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("broken.sdf")).expect("read"),
+        "let r = ;\n"
+    );
+    assert_eq!(sdfc(&d, &["fmt", "missing.sdf"]).status.code(), Some(2));
+
+    let run = |args: &[&str], input: &str| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .args(args)
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run sdfc");
+        use std::io::Write;
+        child
+            .stdin
+            .take()
+            .expect("stdin")
+            .write_all(input.as_bytes())
+            .expect("write");
+        child.wait_with_output().expect("wait")
+    };
+    let out = run(&["fmt"], messy);
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(String::from_utf8_lossy(&out.stdout), tidy);
+    let out = run(&["fmt", "--check", "-"], messy);
+    assert_eq!(
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).as_ref()
+        ),
+        (Some(1), "<stdin>\n")
+    );
+    assert_eq!(run(&["fmt", "--check"], tidy).status.code(), Some(0));
     let _ = std::fs::remove_dir_all(&d);
 }

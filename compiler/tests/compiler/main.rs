@@ -5,11 +5,14 @@
 //!   against an independent formula;
 //! - `batch_interpreter`: the batch interpreter against the one-point reference path;
 //! - `robustness`: the front end on deep nesting, huge expressions, endless evaluation and
-//!   mutated inputs.
+//!   mutated inputs;
+//! - `format`: the formatter over every `.sdf` file and fuzz seed, idempotent and keeping
+//!   the meaning.
 //!
 //! The scenes built in code that these and the runtime's suites share are in `common`.
 
 mod batch_interpreter;
 mod common;
 mod distance_formulas;
+mod format;
 mod robustness;

@@ -6,6 +6,7 @@ pub mod check;
 pub mod compare;
 pub mod compile;
 pub mod devices;
+pub mod fmt;
 pub mod mesh;
 pub mod pareto;
 pub mod render;

@@ -10,7 +10,9 @@
 //! - [`navigate`]: declarations and uses (definition, references, rename, symbols);
 //! - [`hover`]: built-ins' signatures and docs, declarations, a shape's field facts;
 //! - [`complete`]: completion and signature help;
-//! - [`text`]: positions, URIs and the word under the cursor.
+//! - [`text`]: positions, URIs and the word under the cursor;
+//!
+//! and formatting through the compiler's formatter (`syntax::format`, as `sdfc fmt`).
 //!
 //! Diagnostics are published once the text has been still for [`DEBOUNCE`]; requests are
 //! answered from the current text at once. A panic while answering one request becomes an
@@ -63,6 +65,7 @@ pub fn capabilities() -> lsp::ServerCapabilities {
         references_provider: Some(lsp::OneOf::Left(true)),
         document_symbol_provider: Some(lsp::OneOf::Left(true)),
         rename_provider: Some(lsp::OneOf::Left(true)),
+        document_formatting_provider: Some(lsp::OneOf::Left(true)),
         code_action_provider: Some(lsp::CodeActionProviderCapability::Simple(true)),
         completion_provider: Some(lsp::CompletionOptions {
             trigger_characters: Some(vec!["\"".into(), ".".into()]),
@@ -423,6 +426,14 @@ impl Server {
                 );
                 json(complete::signature_help(&a.index, &c.sources, c.entry, at))
             }
+            "textDocument/formatting" => {
+                let p: lsp::DocumentFormattingParams = params(req)?;
+                let path = path_of(&p.text_document.uri);
+                let Some(t) = self.docs.get(&path) else {
+                    return unknown();
+                };
+                json(formatting(t))
+            }
             "textDocument/documentSymbol" => {
                 let p: lsp::DocumentSymbolParams = params(req)?;
                 let Some(a) = self.analysed(&p.text_document.uri) else {
@@ -444,6 +455,15 @@ impl Server {
         let at = text::offset(c.sources.text(c.entry), pos);
         let (name, span) = a.index.use_at(c.entry, at)?;
         Some((a.index.resolve(name, *span)?.clone(), *span))
+    }
+}
+
+/// The edits that format the text `t` (`sdfc fmt`'s layout): one replacing the whole text
+/// when it changes, none when it is formatted or does not parse (its diagnostics say why).
+pub fn formatting(t: &str) -> Vec<lsp::TextEdit> {
+    match sdfc_compiler::syntax::format::format(t) {
+        Ok(out) if out != t => vec![lsp::TextEdit::new(text::range(t, 0, t.len()), out)],
+        _ => Vec::new(),
     }
 }
 

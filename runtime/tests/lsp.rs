@@ -223,7 +223,9 @@ fn every_request_on_a_document_with_an_import_and_a_mistake() {
     let h = c.request("textDocument/hover", at(&main_uri, &text, "size)", 0));
     let md = h["contents"]["value"].as_str().unwrap();
     assert!(
-        md.contains("let size = 0.5 * 2;") && md.contains("lib.sdf"),
+        md.contains("let size = 0.5 * 2;")
+            && md.contains("= `1` (float)")
+            && md.contains("lib.sdf"),
         "{md}"
     );
 
@@ -501,7 +503,8 @@ fn formatting_replaces_the_text_with_the_formatters() {
 
 /// The time each request takes on every example, printed (run with `--nocapture`; nothing
 /// is asserted about the times): the check of the whole document after a change, then a
-/// hover, a completion, a definition and the outline at the middle of the scene.
+/// hover, a completion, a definition, the outline and the formatting at the middle of the
+/// scene.
 #[test]
 fn request_latency_on_every_example() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
@@ -513,7 +516,9 @@ fn request_latency_on_every_example() {
         .collect();
     files.sort();
     let mut c = Client::start();
-    println!("example            check+publish  hover  completion  definition  symbols (ms)");
+    println!(
+        "example            check+publish  hover  completion  definition  symbols  format (ms)"
+    );
     for path in files {
         let text = std::fs::read_to_string(&path).expect("read");
         let doc = uri(&path);
@@ -535,13 +540,17 @@ fn request_latency_on_every_example() {
             "textDocument/completion",
             "textDocument/definition",
             "textDocument/documentSymbol",
+            "textDocument/formatting",
         ] {
             // Each request after a change, so that the document is checked again.
             c.notify(
                 "textDocument/didChange",
                 json!({ "textDocument": { "uri": doc, "version": 2 }, "contentChanges": [{ "text": text }] }),
             );
-            let p = position(&doc, &text, needle);
+            let mut p = position(&doc, &text, needle);
+            if method == "textDocument/formatting" {
+                p["options"] = json!({ "tabSize": 2, "insertSpaces": true });
+            }
             let t = std::time::Instant::now();
             let r = c.respond(method, p);
             assert!(r.response_result.is_ok());
@@ -552,13 +561,14 @@ fn request_latency_on_every_example() {
             .map(|d| format!("{:.1}", d.as_secs_f64() * 1e3))
             .collect();
         println!(
-            "{:<18} {:>13}  {:>5}  {:>10}  {:>10}  {:>7}",
+            "{:<18} {:>13}  {:>5}  {:>10}  {:>10}  {:>7}  {:>6}",
             path.file_name().unwrap().to_string_lossy(),
             ms[0],
             ms[1],
             ms[2],
             ms[3],
-            ms[4]
+            ms[4],
+            ms[5]
         );
         c.notify(
             "textDocument/didClose",

@@ -73,6 +73,41 @@ pub fn check_at(
     limits: &Limits,
     time: f64,
 ) -> (Option<Scene>, Vec<Diagnostic>) {
+    let (scene, diags, _) = check_all(sources, entry, loader, limits, time);
+    (scene, diags)
+}
+
+/// The value of a global constant, as an editor's hover shows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Constant {
+    /// The constant's name where it is declared.
+    pub at: Span,
+    /// Its value written as in the language (`6`, `(1, 2, 0.5)`, `45deg`, `"poly"`,
+    /// `[1, 2]`).
+    pub value: String,
+    /// Its type (`int`, `vec3`, `[float]`).
+    pub ty: String,
+}
+
+/// [`check_with`], with the values of the global constants that evaluated to a number,
+/// vector, angle, bool, string or list of them (not shapes: their facts are the analysis's),
+/// even when the scene has errors elsewhere.
+pub fn check_with_constants(
+    sources: &mut SourceMap,
+    entry: FileId,
+    loader: &mut dyn Loader,
+    limits: &Limits,
+) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
+    check_all(sources, entry, loader, limits, 0.0)
+}
+
+fn check_all(
+    sources: &mut SourceMap,
+    entry: FileId,
+    loader: &mut dyn Loader,
+    limits: &Limits,
+    time: f64,
+) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
     let mut diags = Vec::new();
     let mut items = Vec::new();
     let mut load = Load {
@@ -101,18 +136,30 @@ fn check_loaded(
     time: f64,
     mut diags: Vec<Diagnostic>,
     items: Vec<ast::Item>,
-) -> (Option<Scene>, Vec<Diagnostic>) {
+) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
     if crate::diagnostics::has_errors(&diags) {
         // After a lexical, syntax or import error, names and items may be missing: checking
         // would report mistakes that are only echoes of the first ones.
         diags.sort_by_key(|d| (d.span().file, d.span().start));
-        return (None, diags);
+        return (None, diags, Vec::new());
     }
     let mut cx = Ctx::default();
     cx.diags = diags;
     cx.limits = limits.clone();
     cx.time = time;
     let mut scene = check_items(&mut cx, &items, entry);
+    let mut constants: Vec<Constant> = cx
+        .globals
+        .values()
+        .filter_map(|(v, at)| {
+            Some(Constant {
+                at: *at,
+                value: v.show()?,
+                ty: eval::type_name(v),
+            })
+        })
+        .collect();
+    constants.sort_by_key(|c| (c.at.file, c.at.start));
     scene.limits = limits.clone();
     scene.animation.time = time;
     scene.animation.reads_time = cx.first_time_read;
@@ -139,7 +186,7 @@ fn check_loaded(
     // Diagnostics in source order, whatever stage found them.
     cx.diags.sort_by_key(|d| (d.span().file, d.span().start));
     let errors = crate::diagnostics::has_errors(&cx.diags);
-    (if errors { None } else { Some(scene) }, cx.diags)
+    (if errors { None } else { Some(scene) }, cx.diags, constants)
 }
 
 /// The defaults of a field with no proven distance bound, for the settings the file does not

@@ -472,3 +472,39 @@ fn nesting_counts_brackets_and_not_flat_chains() {
     ok(&deep(1000));
     assert!(codes(&deep(1001)).contains(&"E0507"));
 }
+
+#[test]
+fn constants_are_returned_with_their_values_even_beside_errors() {
+    let mut sources = crate::span::SourceMap::new();
+    let text = "let r = 2 * 3;\nlet f = 1.5 / 3;\nlet a = 45deg;\nlet v = (1, 2.5, 0);\n\
+                let s = \"po\\\"ly\";\nlet l = [for i in 0..20 { i * i }];\nlet b = sphere(1);\n\
+                let ok = r > 5;\nscene { sphre(r); }";
+    let entry = sources.add("t.sdf", text);
+    let (scene, diags, constants) = super::check_with_constants(
+        &mut sources,
+        entry,
+        &mut super::NoImports,
+        &crate::limits::Limits::default(),
+    );
+    assert!(scene.is_none() && diags.iter().any(|d| d.code == "E0201"));
+    let shown: Vec<(&str, &str, &str)> = constants
+        .iter()
+        .map(|c| (&text[c.at.range()], c.value.as_str(), c.ty.as_str()))
+        .collect();
+    assert_eq!(
+        shown,
+        [
+            ("r", "6", "int"),
+            ("f", "0.5", "float"),
+            ("a", "45deg", "angle"),
+            ("v", "(1, 2.5, 0)", "vec3"),
+            ("s", "\"po\\\"ly\"", "string"),
+            (
+                "l",
+                "[0, 1, 4, 9, 16, 25, 36, 49, 64, 81, 100, 121, 144, 169, 196, 225, … 20 in all]",
+                "[int]"
+            ),
+            ("ok", "true", "bool"),
+        ]
+    );
+}

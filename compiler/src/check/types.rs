@@ -175,6 +175,40 @@ impl Value {
         }
     }
 
+    /// The value written as in the language, for a number, vector, angle, bool, string or
+    /// list of them (a long list shortened); `None` for shapes, profiles, per-point values
+    /// and values not computed. Floats are shown to 10 significant digits, angles in degrees.
+    pub fn show(&self) -> Option<String> {
+        use crate::scene::dump_num as num;
+        let join = |xs: &[f64]| xs.iter().map(|&x| num(x)).collect::<Vec<_>>().join(", ");
+        Some(match self {
+            Value::Int(i) => i.to_string(),
+            Value::Float(f) => num(*f),
+            Value::Bool(b) => b.to_string(),
+            Value::Vec2(v) => format!("({})", join(v)),
+            Value::Vec3(v) => format!("({})", join(v)),
+            Value::Angle(a) => format!("{}deg", num(a.to_degrees())),
+            Value::Str(s) => format!("{:?}", &**s),
+            Value::List(_, items) => {
+                const SHOWN: usize = 16;
+                let mut parts = items
+                    .iter()
+                    .take(SHOWN)
+                    .map(Value::show)
+                    .collect::<Option<Vec<_>>>()?;
+                if items.len() > SHOWN {
+                    parts.push(format!("… {} in all", items.len()));
+                }
+                format!("[{}]", parts.join(", "))
+            }
+            Value::Shape(_)
+            | Value::Profile(_)
+            | Value::Point(_)
+            | Value::Unknown(_)
+            | Value::Error => return None,
+        })
+    }
+
     /// The number in an int or float (0 for others; callers check types first).
     pub fn num(&self) -> f64 {
         match self {

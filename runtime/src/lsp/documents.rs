@@ -43,11 +43,12 @@ impl Documents {
         let mut sources = SourceMap::new();
         let entry = sources.add(name, text);
         let mut loader = OpenFirst { docs: self };
-        let (scene, diagnostics) =
-            check::check_with(&mut sources, entry, &mut loader, &Limits::default());
+        let (scene, diagnostics, constants) =
+            check::check_with_constants(&mut sources, entry, &mut loader, &Limits::default());
         Some(Checked {
             scene,
             diagnostics,
+            constants,
             sources,
             entry,
         })
@@ -61,6 +62,8 @@ pub struct Checked {
     pub scene: Option<Scene>,
     /// Everything the compiler said, about this file and its imports.
     pub diagnostics: Vec<Diagnostic>,
+    /// The values of the global constants (of this file and its imports) that evaluated.
+    pub constants: Vec<check::Constant>,
     /// The document (first) and the files it imports.
     pub sources: SourceMap,
     /// The document's id in `sources`.

@@ -1,6 +1,7 @@
 //! Hover: a built-in's signatures and its line of docs/language.md's table (which
 //! runtime/tests/tidy.rs keeps equal to the builtins table), a built-in constant's value, a
-//! declaration's text, and for a shape what the analysis derived for it: exact, bound or
+//! declaration's text (a global constant's with its value, as the checker evaluated it),
+//! and for a shape what the analysis derived for it: exact, bound or
 //! approximate, L, bounding box, and whether the scene is traced or marched (the facts
 //! `sdfc check` prints, from the same functions).
 
@@ -160,6 +161,11 @@ pub fn declaration(checked: &Checked, decl: &Decl) -> String {
         head
     };
     let mut out = format!("```sdf\n{head}\n```");
+    if decl.what == What::Let {
+        if let Some(c) = checked.constants.iter().find(|c| c.at == decl.at) {
+            out.push_str(&format!("\n\n= `{}` ({})", c.value, c.ty));
+        }
+    }
     if let Some(facts) = decl.value.and_then(|v| shape_facts(checked, v)) {
         out.push_str(&format!("\n\n{facts}"));
     }

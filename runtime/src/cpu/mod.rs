@@ -18,6 +18,7 @@ mod shade;
 mod stats;
 mod tile;
 mod vec;
+mod wave;
 
 pub use memory::{memory, retained};
 pub use stats::{Counters, Stats};
@@ -30,7 +31,8 @@ use sdfc_compiler::eval::{Float, Outputs, Tape};
 use sdfc_compiler::lower::Lowered;
 use sdfc_compiler::scene::analytic::Traceable;
 use sdfc_compiler::scene::{Scene, Settings};
-use tile::{Rect, Workspace};
+use tile::Rect;
+use wave::Workspace;
 
 /// The float type a render runs in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]

@@ -5,8 +5,8 @@ use super::context::{Context, Lamp, Mat, Paint};
 use super::lanes::{march, Launch};
 use super::march::{Shadow, Shadowed, Status, Trace, Traced};
 use super::stats::Counters;
-use super::tile::{Ray, Samples, Workspace};
 use super::vec::V3;
+use super::wave::{Ray, Samples, Workspace};
 use sdfc_compiler::eval::Float;
 
 /// A surface point reached by a ray of the wave.

@@ -2,6 +2,7 @@
 //! arrays and instruction lines, with register numbering that depends only on the order
 //! of the calls (so the same module always gives the same text).
 
+use smallvec::SmallVec;
 use std::fmt::{self, Write};
 
 /// A PTX register class; each has its own numbered family (`%p1`, `%r1`, ...).
@@ -220,6 +221,10 @@ macro_rules! ins {
     ($out:expr, $($arg:tt)*) => { $out.ins(format_args!($($arg)*)) };
 }
 pub(super) use ins;
+
+/// The leaves of a value (one operand per scalar), stored inline up to a `vec4`: most
+/// expressions are scalars or small vectors, and a kernel has tens of thousands of them.
+pub(super) type Leaves = SmallVec<[Op; 4]>;
 
 #[cfg(test)]
 mod tests {

@@ -1,9 +1,10 @@
 //! Expressions: each evaluates, leaf by leaf, to operands (or to a pointer), at the
 //! `Emit` that covers it or, for constants, arguments and variables, on entry.
 
+use super::emit::Leaves;
 use super::emit::Op;
 use super::types::{Sc, Shape, Ty};
-use super::writer::{Frame, Fw, Leaves, Loc, Ptr, Store, Val};
+use super::writer::{Frame, Fw, Loc, Ptr, Store, Val};
 use super::Error;
 use naga::{AddressSpace, Expression, GlobalVariable, Handle, Literal};
 use smallvec::smallvec;

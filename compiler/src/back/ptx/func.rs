@@ -2,9 +2,10 @@
 //! `.func`s with scalarised parameters and an aggregate return value, inlined calls,
 //! and what every function does on entry (variables, constants, arguments).
 
+use super::emit::Leaves;
 use super::emit::{ins, Class, Op, Reg};
 use super::types::{Sc, Ty};
-use super::writer::{Cx, Frame, Fw, Leaves, Ret, Space, Store, Val};
+use super::writer::{Cx, Frame, Fw, Ret, Space, Store, Val};
 use super::Error;
 use naga::{
     AddressSpace, Binding, BuiltIn, EntryPoint, Expression, Function, GlobalVariable, Handle,

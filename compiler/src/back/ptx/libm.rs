@@ -7,7 +7,7 @@
 //! docs/ptx.md states each one's error.
 
 use super::emit::{ins, Class, Op};
-use super::math::{ADD, COS, DIV, DIV_FULL, EX2, FMA, LG2, MUL, SIN, SQRT, SUB};
+use super::isa::{ADD, COS, DIV, DIV_FULL, EX2, FMA, LG2, MUL, SIN, SQRT, SUB};
 use super::writer::Fw;
 
 /// The name of the large-argument reduction `.func`.

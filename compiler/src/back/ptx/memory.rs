@@ -2,9 +2,10 @@
 //! fixed-size arrays and vectors), and loading and storing whole values through them,
 //! from memory (vector loads where the layout allows) or from register variables.
 
+use super::emit::Leaves;
 use super::emit::{ins, Class, Op, Reg};
 use super::types::{Chunk, Sc, Shape, Ty};
-use super::writer::{Fw, Leaves, Loc, Ptr, Space};
+use super::writer::{Fw, Loc, Ptr, Space};
 use super::Error;
 use smallvec::smallvec;
 

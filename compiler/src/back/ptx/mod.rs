@@ -33,6 +33,7 @@ mod analysis;
 mod emit;
 mod expr;
 mod func;
+mod isa;
 mod libm;
 mod math;
 mod memory;

@@ -2,10 +2,11 @@
 //! `select`, relational functions, conversions (saturating float-to-integer, as naga's
 //! other back ends do) and matrix products.
 
+use super::emit::Leaves;
 use super::emit::{Class, Op};
-use super::math::{ADD, DIV, FMA, MUL, SUB};
+use super::isa::{ADD, DIV, FMA, MUL, SUB};
 use super::types::{Sc, Shape, Ty};
-use super::writer::{Frame, Fw, Leaves};
+use super::writer::{Frame, Fw};
 use super::Error;
 use naga::{
     BinaryOperator as B, Expression, Handle, RelationalFunction, ScalarKind, UnaryOperator,

@@ -2,8 +2,7 @@
 //! how many registers a value takes (its leaves, in declaration order) and where each
 //! leaf lives in memory (the offsets and strides naga's WGSL layout put in the IR).
 
-use super::emit::{Class, Op};
-use super::writer::Leaves;
+use super::emit::{Class, Leaves, Op};
 use super::Error;
 use naga::proc::TypeResolution;
 use naga::{ArraySize, Handle, Module, ScalarKind, StructMember, Type, TypeInner};

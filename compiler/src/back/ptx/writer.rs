@@ -3,12 +3,11 @@
 //! function where calls are inlined), and the values expressions evaluate to.
 
 use super::analysis::Analysis;
-use super::emit::{ins, Class, Label, Op, Out, Reg};
+use super::emit::{ins, Class, Label, Leaves, Op, Out, Reg};
 use super::types::{Resolved, Sc, Ty, Types};
 use super::Error;
 use naga::valid::{FunctionInfo, ModuleInfo};
 use naga::{Expression, Function, GlobalVariable, Handle, Module};
-use smallvec::SmallVec;
 use std::cell::Cell;
 
 /// Module-wide facts shared by every function's writer.
@@ -90,10 +89,6 @@ pub(super) struct Ptr {
     pub loc: Loc,
     pub ty: Ty,
 }
-
-/// The leaves of a value (one operand per scalar), stored inline up to a `vec4`: most
-/// expressions are scalars or small vectors, and a kernel has tens of thousands of them.
-pub(super) type Leaves = SmallVec<[Op; 4]>;
 
 /// What an expression evaluated to.
 #[derive(Debug, Clone)]

@@ -4,25 +4,11 @@
 //! primitives, both are unrolled over the primitives and their hierarchy; beyond, they walk
 //! the primitives and hierarchy stored in the `scene_data` buffer (buffer.rs).
 
-use super::buffer;
+use super::buffer::{self, identity, trace_start};
 use super::map::float;
 use crate::scene::analytic::{Item, Primitive, Shape, Traced};
 use crate::scene::{MaterialId, V3};
 use std::fmt::Write;
-
-/// The start of `fn trace`'s body, unrolled or walking `scene_data`: no hit yet, and, when
-/// some primitive is transparent (`glass`), the slack a transparent surface's distance gets
-/// inside glass (`nearest` in kernel.wgsl; `Tracer::nearest` on the CPU): the offset 4h of
-/// secondary rays, with the normal step at the ray's origin.
-pub(super) fn trace_start(glass: bool) -> String {
-    let mut out = String::from(
-        "    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u, params.march.y);\n",
-    );
-    if glass {
-        out.push_str("    let slack = select(0.0, 4.0 * normal_step(t0, o), sign < 0.0);\n");
-    }
-    out
-}
 
 /// The interval functions, in sections named by `//= NAME` lines.
 const INTERVALS: &str = include_str!("intervals.wgsl");
@@ -170,12 +156,6 @@ fn name(s: &Shape) -> &'static str {
         Shape::Capsule { .. } => "capsule",
         Shape::Plane { .. } => "plane",
     }
-}
-
-/// Whether a world-to-local matrix is the identity (the primitive is neither rotated nor
-/// scaled).
-pub(super) fn identity(m: &[V3; 3]) -> bool {
-    (0..3).all(|i| (0..3).all(|j| m[i][j] == if i == j { 1.0 } else { 0.0 }))
 }
 
 fn vec3(v: V3) -> String {

@@ -22,7 +22,6 @@
 //! ends after at most `end` steps. An unrotated primitive takes 32 bytes, a rotated one 80,
 //! a group 32.
 
-use super::analytic::trace_start;
 use crate::scene::analytic::{Item, Primitive, Shape};
 use crate::scene::V3;
 use std::fmt::Write;
@@ -123,7 +122,7 @@ pub(super) fn entries(items: &[Item], leaf: &mut dyn FnMut(&mut Vec<[u32; 4]>, u
 }
 
 fn primitive(out: &mut Vec<[u32; 4]>, p: &Primitive) {
-    let framed = !super::analytic::identity(&p.matrix);
+    let framed = !identity(&p.matrix);
     let tag = tag(kind(&p.shape), framed, p.material.0);
     out.push(vec(p.offset, tag));
     out.push(match p.shape {
@@ -148,9 +147,7 @@ fn primitive(out: &mut Vec<[u32; 4]>, p: &Primitive) {
 /// primitives; only the kinds of `primitives` are tested for, and groups only when `top` has
 /// any; `glass` when some primitive is transparent.
 pub fn write(primitives: &[Primitive], top: &[Item], glass: bool) -> String {
-    let framed = primitives
-        .iter()
-        .any(|p| !super::analytic::identity(&p.matrix));
+    let framed = primitives.iter().any(|p| !identity(&p.matrix));
     let groups = top.iter().any(|i| matches!(i, Item::Group(_)));
     let mut out = String::from(
         "// The entries of scene_data (the layout is in compiler/src/back/wgsl/buffer.rs): the\n\
@@ -309,6 +306,26 @@ fn primitive_interval(out: &mut String, framed: bool) {
         out.push_str("        return to_world(local, r0, r1, r2);\n    }\n");
     }
     out.push_str("    return shape_interval(tag, o + offset, d, s);\n}\n\n");
+}
+
+/// The start of `fn trace`'s body, unrolled or walking `scene_data`: no hit yet, and, when
+/// some primitive is transparent (`glass`), the slack a transparent surface's distance gets
+/// inside glass (`nearest` in kernel.wgsl; `Tracer::nearest` on the CPU): the offset 4h of
+/// secondary rays, with the normal step at the ray's origin.
+pub(super) fn trace_start(glass: bool) -> String {
+    let mut out = String::from(
+        "    var best = Traced(params.march.y, STATUS_MISS, vec3<f32>(0.0), 0u, params.march.y);\n",
+    );
+    if glass {
+        out.push_str("    let slack = select(0.0, 4.0 * normal_step(t0, o), sign < 0.0);\n");
+    }
+    out
+}
+
+/// Whether a world-to-local matrix is the identity (the primitive is neither rotated nor
+/// scaled).
+pub(super) fn identity(m: &[V3; 3]) -> bool {
+    (0..3).all(|i| (0..3).all(|j| m[i][j] == if i == j { 1.0 } else { 0.0 }))
 }
 
 #[cfg(test)]

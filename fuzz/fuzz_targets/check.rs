@@ -1,5 +1,6 @@
 //! Fuzz target: any text through the lexer, parser and checker alone (no lowering), so that
-//! a short run reaches many inputs. Nothing may panic, hang or overflow the stack.
+//! a short run reaches many inputs, and through the formatter. Nothing may panic, hang or
+//! overflow the stack; formatted text formats to itself.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -32,4 +33,15 @@ fuzz_target!(|data: &[u8]| {
     // Rendering the diagnostics exercises every span.
     let _ = sdfc_compiler::diagnostics::render(&diags, &sources, false);
     let _ = sdfc_compiler::diagnostics::to_json(&diags, &sources);
+    // The formatter keeps the tokens or refuses (syntax errors); it never fails otherwise,
+    // and what it writes it leaves as it is.
+    use sdfc_compiler::syntax::format::{format, Error};
+    match format(text) {
+        Ok(out) => match format(&out) {
+            Ok(again) => assert!(again == out, "formatting is not idempotent"),
+            Err(e) => panic!("the formatted text does not format: {e}"),
+        },
+        Err(Error::Syntax(_)) => {}
+        Err(e) => panic!("{e}"),
+    }
 });

@@ -405,6 +405,7 @@ fn never_crashes_on_mutated_text() {
         "textDocument/signatureHelp",
         "textDocument/documentSymbol",
         "textDocument/references",
+        "textDocument/formatting",
     ];
     for round in 0..12 {
         let mut text = corpus[rng.below(corpus.len())].clone();
@@ -449,6 +450,9 @@ fn never_crashes_on_mutated_text() {
             let mut p = json!({ "textDocument": { "uri": doc }, "position": pos(&mut rng) });
             if method == "textDocument/references" {
                 p["context"] = json!({ "includeDeclaration": true });
+            }
+            if method == "textDocument/formatting" {
+                p["options"] = json!({ "tabSize": 2, "insertSpaces": true });
             }
             let r = c.respond(method, p);
             assert!(

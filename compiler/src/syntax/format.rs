@@ -23,8 +23,9 @@
 //! Formatting is idempotent: formatted text formats to itself.
 
 use super::lexer::{self, Token};
-use super::{ast, parse};
+use super::{ast, parse_within};
 use crate::diagnostics::{Diagnostic, Severity};
+use crate::limits::Limits;
 use crate::span::{FileId, Span};
 use std::collections::HashSet;
 
@@ -78,10 +79,11 @@ struct Line {
     blank_before: bool,
 }
 
-/// Formats `text`, a whole `.sdf` file.
+/// Formats `text`, a whole `.sdf` file. A file nested deeper than the default `nesting`
+/// limit is refused as the checker refuses it (E0507).
 pub fn format(text: &str) -> Result<String, Error> {
     let file = FileId(0);
-    let (tree, diags) = parse(file, text);
+    let ((tree, diags), _) = parse_within(file, text, Some(&Limits::default()));
     let errors: Vec<Diagnostic> = diags
         .into_iter()
         .filter(|d| d.severity == Severity::Error)
@@ -113,12 +115,15 @@ fn forced_breaks(tree: &ast::File, tokens: &[(Token, Span)]) -> HashSet<u32> {
     for item in tree.items.iter().skip(1) {
         at.insert(item_span(item).start);
     }
-    // The last `}` at or before `end`.
+    // The last `}` at or before `end` (a block's span ends at its `}`, or at the `;` after
+    // it).
     let closing = |end: u32| {
-        tokens
+        let n = tokens.partition_point(|(_, s)| s.end <= end);
+        tokens[..n]
             .iter()
             .rev()
-            .find(|(t, s)| *t == Token::RBrace && s.end <= end)
+            .take(2)
+            .find(|(t, _)| *t == Token::RBrace)
             .map(|(_, s)| s.start)
     };
     fn statements(

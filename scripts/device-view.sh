@@ -83,6 +83,7 @@ PY
   k=$(echo "$s2" | grep -oE "first frame [0-9.]+ ms \([0-9]+x[0-9]+, [a-z]+" | grep -oE "[a-z]+$")
   case "$s2" in
     *"specialised compiled within the grace period"*) g=", compiled within the grace period" ;;
+    *"no interpreted kernel meanwhile"*) g=", compiled on another thread before it was shown" ;;
     *"not ready within"*) g=", not ready within the grace period" ;;
     *"after the"*"grace period"*) g=", ready after the grace period, before an interpreted frame" ;;
     *"on another thread"*) g="" ;;

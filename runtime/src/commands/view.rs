@@ -126,11 +126,14 @@ pub fn run(args: ViewArgs) -> ExitCode {
             orbit_frames: args.orbit_frames,
         },
     };
-    if args.headless {
+    let code = if args.headless {
         view::headless(run)
     } else {
         view::window::run(run)
-    }
+    };
+    // At once: a pipeline may still be compiling on another thread (Esc during a slow
+    // compile), which the process's exit handlers would otherwise wait for.
+    super::exit_now(code, ())
 }
 
 /// A `--time` value: a finite number of seconds, at least 0.

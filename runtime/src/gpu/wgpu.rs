@@ -37,7 +37,7 @@ pub enum Error {
 }
 
 /// Bytes between tile entries in the tile table (the largest uniform offset alignment).
-const TILE_STRIDE: u32 = 256;
+pub const TILE_STRIDE: u32 = 256;
 
 /// Compiled pipelines kept by a [`Gpu`] (at most this many; the cache is emptied when full).
 const PIPELINES_KEPT: usize = 16;
@@ -51,7 +51,7 @@ fn padded(n: u64) -> u64 {
 const SPIN: Duration = Duration::from_millis(20);
 
 /// A compiled kernel: its pipeline and bind group layout.
-type Pipeline = Arc<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>;
+pub type Pipeline = Arc<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>;
 
 /// An opened device, with the pipelines compiled on it, kept by kernel text (so a scene whose
 /// kernel is unchanged, such as one edited only in uniform data, is not compiled again).
@@ -299,6 +299,14 @@ impl Gpu {
         }
         cache.insert(key, pipeline.clone());
         Ok((pipeline, driver))
+    }
+
+    /// The pipeline of `wgsl` (entry point `entry`, with the scene-data binding when `data`)
+    /// and its bind group layout (the bindings of [`Gpu::kernel`]'s frames), compiled now or
+    /// found among those compiled: for a caller that dispatches the kernel into buffers of its
+    /// own (the viewer's frames, which stay on the device).
+    pub fn compute_pipeline(&self, wgsl: &str, entry: &str, data: bool) -> Result<Pipeline, Error> {
+        self.cached_pipeline(wgsl, entry, data).map(|(p, _)| p)
     }
 
     /// Whether the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
@@ -578,7 +586,7 @@ impl Gpu {
     /// (BENCHMARKS.md, "Measured choices"), and CUDA's default wait polls too. A longer
     /// wait blocks, its latency small beside the frame. A software adapter (lavapipe)
     /// renders on the host's cores, which polling would take from it: it blocks at once.
-    fn wait(&self) -> Result<(), Error> {
+    pub fn wait(&self) -> Result<(), Error> {
         let error = |e: wgpu::PollError| Error::Render(e.to_string());
         if !self.is_cpu() {
             let start = Instant::now();

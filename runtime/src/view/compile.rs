@@ -1,8 +1,10 @@
 //! Pipelines compiled on a thread of their own, so that the viewer's window never waits for the
 //! driver: while a new scene's specialised kernel compiles, the session shows it through the
-//! interpreted kernel (once a short grace period has passed without it), and it is told (the
-//! [`Waker`]) when the compile has ended.
+//! interpreted kernel (once a short grace period has passed without it) or keeps the image
+//! before on show, and it is told (the [`Waker`]) when the compile has ended. A new pipeline
+//! is dispatched once there, on no pixels, for drivers that compile at the first dispatch.
 
+use super::resident::FirstFrame;
 use crate::backend::Prepared;
 use crate::gpu::wgpu::PipelineTime;
 use sdfc_compiler::back::wgsl;
@@ -49,7 +51,9 @@ impl Compile {
     /// Starts compiling `prepared`'s pipeline, calling `done` on the compiling thread once it
     /// has ended. `None` for a scene prepared for anything but wgpu (nothing to compile).
     /// Where no thread can be started, the pipeline is compiled before this returns.
-    pub fn start(prepared: &Prepared, done: Waker) -> Option<Compile> {
+    /// `first` is what the scene's first frame will read, for the kernel's first dispatch
+    /// ([`super::resident::warm`]).
+    pub fn start(prepared: &Prepared, first: Option<FirstFrame>, done: Waker) -> Option<Compile> {
         let Prepared::Wgpu { gpu, kernel, .. } = prepared else {
             return None;
         };
@@ -59,9 +63,22 @@ impl Compile {
         let data = kernel.data.is_some();
         let out = result.clone();
         let job = move || {
+            // A new pipeline is dispatched once on no pixels, so that a driver that compiles
+            // at the first dispatch (lavapipe) does it here, and its time is the compile's.
             let r = gpu
                 .pipeline_for(&source, Some(&module), wgsl::ENTRY_POINT, data)
-                .map_err(|e| e.to_string());
+                .map_err(|e| e.to_string())
+                .and_then(|p| {
+                    if p.cached {
+                        return Ok(p);
+                    }
+                    let start = Instant::now();
+                    super::resident::warm(&gpu, &source, data, first.as_ref())?;
+                    Ok(PipelineTime {
+                        time: p.time + start.elapsed(),
+                        ..p
+                    })
+                });
             *out.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
             done.wake();
         };

@@ -5,6 +5,7 @@
 
 pub mod camera;
 pub mod compile;
+pub mod resident;
 pub mod session;
 pub mod watch;
 pub mod window;
@@ -58,7 +59,8 @@ pub struct Run {
 /// It stops, and only then:
 /// - with `--frames N`, after N frames, each turn of the loop counting one whether it
 ///   rendered a sample or presented the settled image again (so a scene that converges in
-///   fewer frames, `aa: 2` for one, still stops); with `--screenshot`, the last frame's
+///   fewer frames, `aa: 2` for one, still stops), except a turn that waited for a kernel's
+///   pipeline compiling on another thread and rendered nothing; with `--screenshot`, the last frame's
 ///   image is written first, and when no scene has loaded there is none: an error (exit 1),
 ///   nothing written;
 /// - with `--exit-after-reloads K`, once the screenshot of load K is written;
@@ -70,7 +72,7 @@ pub fn headless(run: Run) -> ExitCode {
         backend => match Gpu::open(backend == Backend::Auto) {
             Ok(gpu) => Device::Wgpu(Arc::new(gpu)),
             Err(e) if backend == Backend::Auto => {
-                eprintln!("view: no GPU adapter ({e}); rendering on the CPU");
+                eprintln!("view: {}; rendering on the CPU", no_gpu(&e));
                 Device::Cpu
             }
             Err(e) => {
@@ -88,8 +90,8 @@ pub fn headless(run: Run) -> ExitCode {
     let mut session = Session::new(run.file.clone(), run.options.clone(), device);
     session.set_size(size.0, size.1);
     let (tx, rx) = mpsc::channel();
-    let mut watch = match Watch::new(move |paths| {
-        let _ = tx.send(paths);
+    let mut watch = match Watch::new(move |paths, seen| {
+        let _ = tx.send((paths, seen));
     }) {
         Ok(w) => Some(w),
         Err(msg) => {
@@ -113,10 +115,20 @@ pub fn headless(run: Run) -> ExitCode {
             // interpreted kernel's image has converged, or there is none yet): wait for it,
             // or for the end of the grace period.
             session.wait_for_compile(Duration::from_secs(1));
-            match session.frame() {
-                Ok(Some(_)) => session.presented(),
-                Ok(None) => {}
-                Err(msg) => eprintln!("error: {msg}"),
+            let rendered = match session.frame() {
+                Ok(Some(_)) => {
+                    session.presented();
+                    true
+                }
+                Ok(None) => false,
+                Err(msg) => {
+                    eprintln!("error: {msg}");
+                    false
+                }
+            };
+            // A turn spent waiting for a kernel to compile, with nothing rendered, is no frame.
+            if !rendered && session.compiling() {
+                continue;
             }
             frames += 1;
             let last = control.frames.is_some_and(|n| frames >= n);
@@ -159,7 +171,7 @@ pub fn headless(run: Run) -> ExitCode {
             Some(_) => Duration::from_millis(1),
             None => Duration::from_secs(3600),
         };
-        let paths = match rx.recv_timeout(wait) {
+        let (paths, seen) = match rx.recv_timeout(wait) {
             Ok(p) => p,
             Err(mpsc::RecvTimeoutError::Timeout) => continue,
             Err(mpsc::RecvTimeoutError::Disconnected) => {
@@ -168,7 +180,7 @@ pub fn headless(run: Run) -> ExitCode {
             }
         };
         if session.needs_reload(&paths) {
-            shot_for = Some(session.load().number);
+            shot_for = Some(session.load_edited(Some(seen)).number);
         }
     }
 }
@@ -220,6 +232,23 @@ fn measure_orbit(session: &mut Session, frames: u32) {
         stopped.elapsed().as_secs_f64() * 1e3,
         session::SETTLE.as_millis()
     );
+}
+
+/// What the viewer says when `auto` finds no GPU (`e`, from [`Gpu::open`] asked for a hardware
+/// adapter): a software adapter such as lavapipe is not used, as `sdfc render` does not use
+/// it, and the CPU renders; only when there is no adapter at all does a driver need installing.
+fn no_gpu(e: &crate::gpu::wgpu::Error) -> String {
+    let software: Vec<String> = crate::gpu::wgpu::adapters()
+        .iter()
+        .filter(|a| a.get_info().device_type == wgpu::DeviceType::Cpu)
+        .map(|a| a.get_info().name)
+        .collect();
+    match software.first() {
+        Some(name) => format!(
+            "no GPU adapter, only the software adapter {name}, which `--backend auto` leaves to `--backend wgpu`"
+        ),
+        None => format!("no GPU adapter ({e})"),
+    }
 }
 
 /// Writes the session's image (the background grey when there is none yet).

@@ -10,6 +10,7 @@
 
 use super::camera::{self, Orbit};
 use super::compile::{Compile, Waker};
+use super::resident::{FirstFrame, Resident};
 use super::watch::Fingerprint;
 use crate::backend::{Kernel, Prepared, Setup};
 use crate::frontend::{self, DiagnosticFormat, Loaded};
@@ -269,6 +270,9 @@ struct Timings {
     /// Whether the pipeline compiled on another thread (`pipeline` is then its time, once
     /// ready before the first frame).
     background: bool,
+    /// Whether the interpreted kernel could show the scene while it compiled (else the image
+    /// before stayed on show until it was ready).
+    interim: bool,
     /// The kernel of the first frame: `interpreted` while the specialised one compiled.
     first_kernel: Option<&'static str>,
     /// The time to prepare the interpreted kernel (with `auto`, when the specialised pipeline
@@ -302,6 +306,11 @@ impl Timings {
         let grace = ms(grace);
         match (self.pipeline, self.background, self.ready) {
             (Some(p), false, _) => format!(", pipeline {}", got(p)),
+            (Some(p), true, Some((ready, _))) if !self.interim => format!(
+                ", pipeline {} on another thread, shown once ready {:.1} ms after its compile started (no interpreted kernel meanwhile: the image before stayed on show)",
+                got(p),
+                ms(ready)
+            ),
             (Some(p), true, Some((ready, true))) => format!(
                 ", pipeline {} on another thread, specialised compiled within the grace period in {:.1} ms (grace {grace:.0} ms, no interpreted frame)",
                 got(p),
@@ -338,7 +347,8 @@ pub struct FrameInfo {
     pub target: u32,
     /// Render time of this frame (wall time, read-back included).
     pub time: Duration,
-    /// Mean marching steps per pixel of this frame.
+    /// Mean marching steps per pixel of this frame (NaN on wgpu unless they were asked for:
+    /// [`Session::want_steps`]).
     pub steps: f64,
     /// Whether the camera was moving.
     pub moving: bool,
@@ -351,6 +361,7 @@ pub struct FrameInfo {
 struct Accumulation {
     width: u32,
     height: u32,
+    /// Their sums, on the CPU (on wgpu they stay on the device: [`Resident`]).
     sum: Vec<[f32; 3]>,
     count: u32,
     /// Whether the samples are of a still camera at full size.
@@ -388,8 +399,17 @@ pub struct Session {
     /// The time of the last full-resolution frame.
     last_full: Option<Duration>,
     accumulation: Accumulation,
-    /// The image on show: the mean of the accumulated samples.
+    /// The image on show: the mean of the accumulated samples (on the CPU; on wgpu it stays
+    /// on the device, in `resident`).
     shown: Option<Image>,
+    /// On wgpu, the frames on the device: the accumulated samples and the texture on show.
+    resident: Option<Resident>,
+    /// Counts the scenes installed (loads and animation frames), so that a kernel's scene
+    /// data is uploaded to the device once per scene.
+    version: u64,
+    /// Whether each frame's mean steps per pixel are wanted (the statistics in the title): on
+    /// wgpu they are then read back from the device.
+    steps_wanted: bool,
     /// The last frame.
     last: Option<FrameInfo>,
     /// A render error that stops rendering until the next load or camera move.
@@ -433,6 +453,9 @@ impl Session {
             last_full: None,
             accumulation: Accumulation::default(),
             shown: None,
+            resident: None,
+            version: 0,
+            steps_wanted: false,
             last: None,
             broken: None,
             timings: None,
@@ -550,6 +573,14 @@ impl Session {
     /// the old one, and the camera stays where the user moved it; on failure the diagnostics
     /// are printed as `sdfc check` prints them and the last good scene stays.
     pub fn load(&mut self) -> Outcome {
+        self.load_edited(None)
+    }
+
+    /// [`Session::load`] after an edit seen at `edited` (the first file event of the batch
+    /// that called for the reload): `--timings`' edit to pixel counts from the later of that
+    /// and the newest modification time of the scene's files. A file renamed back, or copied
+    /// with its time kept, has an old modification time; the event is when it changed.
+    pub fn load_edited(&mut self, edited: Option<SystemTime>) -> Outcome {
         let number = self.loads;
         self.loads += 1;
         let started = Instant::now();
@@ -558,7 +589,8 @@ impl Session {
         match self.compile() {
             Ok((good, mut timings)) => {
                 timings.number = number;
-                timings.modified = Fingerprint::modified(&self.files).or(modified);
+                timings.modified =
+                    edit_time(Fingerprint::modified(&self.files).or(modified), edited);
                 timings.began = began;
                 self.install(good);
                 self.timings = Some(timings);
@@ -695,42 +727,47 @@ impl Session {
             eprintln!("error: {msg}");
             return Err(msg);
         }
+        // A pipeline not compiled yet compiles on another thread (the driver may take
+        // seconds; lavapipe tens of them), never on the caller's: a window's event loop goes on
+        // answering meanwhile. With `--kernel auto` the interpreted kernel shows the scene
+        // from the end of the grace period where it can; otherwise the image before stays on
+        // show until the pipeline is ready.
         let mut waiting = None;
         let mut interim_prepare = Duration::ZERO;
+        let mut interim_possible = false;
         let pipeline = match &prepared {
             Prepared::Wgpu { gpu, kernel, .. } => {
                 let data = kernel.data.is_some();
-                let compiled = gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data);
-                let start = Instant::now();
-                let interim = match interim_lowered {
-                    Some(lowered) if !compiled => self.interim(gpu, &scene, lowered, &at),
-                    _ => None,
-                };
-                interim_prepare = start.elapsed();
-                match interim {
-                    Some(interim) => {
-                        let grace = self.options.grace;
-                        waiting = Compile::start(&prepared, self.compile_waker()).map(|compile| {
+                if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
+                    Some(
+                        gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data)
+                            .map_err(|e| e.to_string())
+                            .inspect_err(|msg| eprintln!("error: {msg}"))?,
+                    )
+                } else {
+                    let start = Instant::now();
+                    let interim = match interim_lowered {
+                        Some(lowered) => self.interim(gpu, &scene, lowered, &at),
+                        None => None,
+                    };
+                    interim_prepare = start.elapsed();
+                    interim_possible = interim.is_some();
+                    let grace = match interim {
+                        Some(_) => self.options.grace,
+                        None => Duration::ZERO,
+                    };
+                    let first = self.first_frame(&prepared, &scene);
+                    waiting =
+                        Compile::start(&prepared, first, self.compile_waker()).map(|compile| {
                             Waiting {
                                 load: self.loads - 1,
                                 grace_until: compile.started + grace,
                                 compile,
-                                interim: Some(interim),
+                                interim,
                                 shown: false,
                             }
                         });
-                        None
-                    }
-                    None => Some(
-                        gpu.pipeline_for(
-                            &kernel.source,
-                            Some(&kernel.module),
-                            wgsl::ENTRY_POINT,
-                            data,
-                        )
-                        .map_err(|e| e.to_string())
-                        .inspect_err(|msg| eprintln!("error: {msg}"))?,
-                    ),
+                    None
                 }
             }
             _ => None,
@@ -758,6 +795,7 @@ impl Session {
             built,
             pipeline,
             background,
+            interim: interim_possible,
             first_kernel: None,
             interim_prepare,
             interim_pipeline: None,
@@ -810,13 +848,52 @@ impl Session {
             let time = gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data);
             (None, Some(time.ok()?))
         } else {
-            (Some(Compile::start(&prepared, self.compile_waker())?), None)
+            let first = self.first_frame(&prepared, scene);
+            (
+                Some(Compile::start(&prepared, first, self.compile_waker())?),
+                None,
+            )
         };
         Some(Interim {
             prepared,
             compile,
             pipeline,
         })
+    }
+
+    /// What the first frame of a newly loaded `scene` will give `prepared`'s kernel to read,
+    /// as [`Session::frame`] sets it up: the camera on show (the user's, else the scene's),
+    /// the size of a new scene's first frame, and the first sample's offset.
+    fn first_frame(&self, prepared: &Prepared, scene: &Scene) -> Option<FirstFrame> {
+        let Prepared::Wgpu {
+            kernel, lipschitz, ..
+        } = prepared
+        else {
+            return None;
+        };
+        let moving = self.moving() || self.playing();
+        let scale = if moving {
+            self.scale
+        } else {
+            self.preview_scale()
+        };
+        let low = scale > 1 || moving;
+        let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
+        let base = match &self.user_camera {
+            Some(orbit) => orbit.camera(),
+            None => scene.camera.clone(),
+        };
+        let n = scene.settings.aa.max(1);
+        let (dx, dy) = if low {
+            (0.0, 0.0)
+        } else {
+            camera::sample_offset(0, n)
+        };
+        let mut first = scene.clone();
+        first.camera = camera::jittered(&base, dx, dy, w, h);
+        let s = &mut first.settings;
+        (s.width, s.height, s.aa) = (w, h, 1);
+        FirstFrame::of((kernel, *lipschitz), &first)
     }
 
     /// Takes the results of the compiles on other threads that have ended: a ready interpreted
@@ -907,6 +984,7 @@ impl Session {
     }
 
     fn install(&mut self, good: Good) {
+        self.version += 1;
         self.playback = self.playback_of(&good.scene);
         self.good = Some(good);
         self.broken = None;
@@ -1011,6 +1089,7 @@ impl Session {
             i.prepared = i.prepared.next(&scene, lowered.clone())?.0;
         }
         let (prepared, _) = good.prepared.next(&scene, lowered)?;
+        self.version += 1;
         good.file_camera = scene.camera.clone();
         good.scene = scene;
         good.prepared = prepared;
@@ -1159,10 +1238,14 @@ impl Session {
         let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
         let a = &mut self.accumulation;
         if low || !a.still || (a.width, a.height) != (w, h) {
+            let on_cpu = matches!(self.device, Device::Cpu);
             *a = Accumulation {
                 width: w,
                 height: h,
-                sum: vec![[0.0; 3]; w as usize * h as usize],
+                sum: match on_cpu {
+                    true => vec![[0.0; 3]; w as usize * h as usize],
+                    false => Vec::new(),
+                },
                 count: 0,
                 still: !low,
             };
@@ -1184,30 +1267,62 @@ impl Session {
             return Ok(None);
         };
         let kind = kernel.kernel_kind();
-        let frame = match kernel.render(&good.scene, &|_| {}) {
-            Ok(f) => f,
+        let prepared = kernel;
+        let rendered = match prepared {
+            // On wgpu the frame stays on the device: rendered, accumulated and shown there.
+            Prepared::Wgpu {
+                gpu,
+                kernel,
+                lipschitz,
+                ..
+            } => {
+                let key = (self.version, kernel.interpreted());
+                let resident = match self.resident.as_mut() {
+                    Some(r) => Ok(r),
+                    None => Resident::new(gpu.clone()).map(|r| self.resident.insert(r)),
+                };
+                check_contract(prepared, &good.scene)
+                    .and_then(|()| {
+                        resident?.render(
+                            (kernel, *lipschitz),
+                            &good.scene,
+                            key,
+                            a.count == 0,
+                            self.steps_wanted,
+                        )
+                    })
+                    .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
+            }
+            other => other.render(&good.scene, &|_| {}).map(|frame| {
+                for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
+                    for i in 0..3 {
+                        sum[i] += c[i];
+                    }
+                }
+                (a.count + 1, frame.render.stats.steps_mean)
+            }),
+        };
+        let (count, steps) = match rendered {
+            Ok(r) => r,
             Err(msg) => {
                 self.broken = Some(msg.clone());
                 return Err(msg);
             }
         };
         let time = start.elapsed();
-        for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
-            for i in 0..3 {
-                sum[i] += c[i];
-            }
+        a.count = count;
+        if !a.sum.is_empty() {
+            let inv = 1.0 / a.count as f32;
+            self.shown = Some(Image {
+                width: w,
+                height: h,
+                linear: a
+                    .sum
+                    .iter()
+                    .map(|c| [c[0] * inv, c[1] * inv, c[2] * inv])
+                    .collect(),
+            });
         }
-        a.count += 1;
-        let inv = 1.0 / a.count as f32;
-        self.shown = Some(Image {
-            width: w,
-            height: h,
-            linear: a
-                .sum
-                .iter()
-                .map(|c| [c[0] * inv, c[1] * inv, c[2] * inv])
-                .collect(),
-        });
         if scale == 1 {
             self.last_full = Some(time);
         }
@@ -1224,7 +1339,7 @@ impl Session {
             samples: a.count,
             target: good.aa,
             time,
-            steps: frame.render.stats.steps_mean,
+            steps,
             moving,
             kernel: kind,
         };
@@ -1245,9 +1360,36 @@ impl Session {
     }
 
     /// The image on show: the mean of the samples accumulated (at the size of the last frame),
-    /// or `None` before the first good frame.
-    pub fn image(&self) -> Option<&Image> {
+    /// or `None` before the first good frame. On wgpu it is read back from the device (for a
+    /// screenshot or a test: frames themselves never are); a failed read is printed, and is
+    /// `None`.
+    pub fn image(&self) -> Option<Image> {
+        match &self.resident {
+            Some(r) => r.image().unwrap_or_else(|msg| {
+                eprintln!("error: {msg}");
+                None
+            }),
+            None => self.shown.clone(),
+        }
+    }
+
+    /// The image on show as the host holds it: the CPU renderer's (a window uploads it to show
+    /// it). `None` on wgpu, whose image stays on the device ([`Session::texture`]).
+    pub fn host_image(&self) -> Option<&Image> {
         self.shown.as_ref()
+    }
+
+    /// On wgpu, the texture on show (sRGB bytes in an `Rgba8Unorm` texture, which may be
+    /// viewed as `Rgba8UnormSrgb`), on the device that renders the frames, and its number,
+    /// which changes when the texture does; `None` before the first frame and on the CPU.
+    pub fn texture(&self) -> Option<(&wgpu::Texture, u64)> {
+        self.resident.as_ref().and_then(Resident::texture)
+    }
+
+    /// Whether each frame's mean steps per pixel are wanted (the statistics in the title); on
+    /// wgpu, where frames stay on the device, a frame then reads back their sum (two words).
+    pub fn want_steps(&mut self, wanted: bool) {
+        self.steps_wanted = wanted;
     }
 
     /// Called once a frame is on show: prints the timings of the load whose first frame it
@@ -1359,6 +1501,31 @@ impl Session {
             ));
         }
         title
+    }
+}
+
+/// Refuses a frame of `scene` that `prepared`'s kernel was not specialised for (as a render
+/// does, `Prepared::render`).
+fn check_contract(prepared: &Prepared, scene: &Scene) -> Result<(), String> {
+    let Some(contract) = prepared.contract() else {
+        return Ok(());
+    };
+    let traced = prepared.traceable().traced(scene.settings.method).is_some();
+    contract.check(scene, traced).map_err(|m| {
+        format!(
+            "the {} kernel cannot render this scene: {m}; specialise it again",
+            prepared.name()
+        )
+    })
+}
+
+/// When the edit a load follows was made: the later of the newest modification time of the
+/// scene's files and the first file event of the batch that called for the load (`None`
+/// when neither is known).
+fn edit_time(modified: Option<SystemTime>, event: Option<SystemTime>) -> Option<SystemTime> {
+    match (modified, event) {
+        (Some(m), Some(e)) => Some(m.max(e)),
+        (m, e) => m.or(e),
     }
 }
 
@@ -1593,7 +1760,7 @@ mod tests {
         s.rotate(20.0, 5.0);
         let camera = s.camera();
         settle_all(&mut s);
-        let before = s.image().unwrap().clone();
+        let before = s.image().unwrap();
 
         // A structural edit needs a new specialised kernel, which compiles on another thread
         // (held back here until the interpreted kernel's image has converged).
@@ -1612,7 +1779,7 @@ mod tests {
             s.frame().expect("a frame");
         }
         assert!(!s.settled(), "the specialised kernel is still to come");
-        let interpreted = s.image().unwrap().clone();
+        let interpreted = s.image().unwrap();
         assert_eq!(
             s.last.unwrap().samples,
             4,
@@ -1627,7 +1794,7 @@ mod tests {
         );
         assert!(!s.title(false).contains("compiling"));
         assert_eq!(s.camera(), camera, "the camera stayed");
-        let specialised = s.image().unwrap().clone();
+        let specialised = s.image().unwrap();
         let same = crate::metrics::compare(&interpreted, &specialised, 0.1).unwrap();
         assert!(same.psnr >= 40.0, "the two kernels agree: {same:?}");
         let changed = crate::metrics::compare(&before, &specialised, 0.1).unwrap();
@@ -1648,7 +1815,7 @@ mod tests {
         let (mut s, dir) = settled_on_marched(&gpu, "grace-in", options);
         let file = dir.join("k.sdf");
         let [_, boxed, _] = marched();
-        let before = s.image().unwrap().clone();
+        let before = s.image().unwrap();
 
         std::fs::write(&file, &boxed).unwrap();
         s.held = Some(1);
@@ -1659,7 +1826,7 @@ mod tests {
         nothing_in_the_grace_period(&mut s);
         assert!(!s.wants_frame() && !s.settled());
         assert!(s.title(false).contains("compiling the kernel"));
-        assert_eq!(s.image(), Some(&before));
+        assert_eq!(s.image(), Some(before.clone()));
         release_when_compiled(&mut s);
         let info = next_frame(&mut s);
         assert_eq!(
@@ -1683,7 +1850,7 @@ mod tests {
         );
         settle_all(&mut s);
         assert_eq!(s.last.unwrap().kernel, Some("specialised"));
-        let changed = crate::metrics::compare(&before, s.image().unwrap(), 0.1).unwrap();
+        let changed = crate::metrics::compare(&before, &s.image().unwrap(), 0.1).unwrap();
         assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -1733,6 +1900,126 @@ mod tests {
     }
 
     #[test]
+    fn a_new_kernel_compiles_off_the_callers_thread_and_the_image_before_stays() {
+        // With no interpreted kernel to show meanwhile (`--kernel specialised` here; `auto`
+        // on lavapipe), a structural edit's load returns before its pipeline is compiled, so
+        // that a window's event loop goes on answering: nothing is rendered, the image before
+        // stays, the title says the kernel compiles, and the new kernel is shown once ready.
+        let Some(gpu) = wgpu() else { return };
+        let options = Options {
+            kernel: Kernel::Specialised,
+            ..Options::default()
+        };
+        let (mut s, dir) = settled_on_marched(&gpu, "off-thread", options);
+        let file = dir.join("k.sdf");
+        let [_, boxed, _] = marched();
+        let before = s.image().unwrap();
+
+        std::fs::write(&file, &boxed).unwrap();
+        s.held = Some(1);
+        assert!(s.load().ok);
+        assert!(s.compiling() && !s.wants_frame() && !s.settled());
+        assert!(
+            s.grace_deadline().is_none(),
+            "no grace period without an interpreted kernel"
+        );
+        assert!(s.title(false).contains("compiling the kernel"));
+        assert!(s.frame().expect("no render error").is_none());
+        assert_eq!(s.image(), Some(before.clone()), "the image before stays");
+        release_when_compiled(&mut s);
+        let info = next_frame(&mut s);
+        assert_eq!(info.kernel, Some("specialised"));
+        assert!(!s.compiling() && !s.title(false).contains("compiling"));
+        let t = s.timings.as_ref().expect("the load's timings");
+        assert!(t.background && !t.interim && t.pipeline.is_some());
+        let words = t.pipeline_words(s.options.grace);
+        assert!(
+            words.contains("on another thread, shown once ready")
+                && words.contains("no interpreted kernel meanwhile"),
+            "{words}"
+        );
+        settle_all(&mut s);
+        let changed = crate::metrics::compare(&before, &s.image().unwrap(), 0.1).unwrap();
+        assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn frames_on_the_device_accumulate_the_kernels_renders() {
+        // On wgpu the frames stay on the device: the image, read back once settled, is the
+        // mean of the kernel's renders through `sdfc render`'s path of the scene's aa × aa
+        // jittered cameras, value for value; the window is given a texture, and the host holds
+        // no image.
+        let Some(gpu) = wgpu() else { return };
+        let dir = std::env::temp_dir().join(format!("sdfc-resident-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("s.sdf");
+        std::fs::write(&file, &marched()[0]).unwrap();
+        let options = Options {
+            kernel: Kernel::Specialised,
+            ..Options::default()
+        };
+        let mut s = Session::new(file, options, Device::Wgpu(gpu));
+        s.set_size(32, 24);
+        assert!(s.load().ok);
+        settle_all(&mut s);
+        assert_eq!(s.last.unwrap().samples, 4);
+        assert!(s.texture().is_some(), "a texture on show");
+        assert!(s.host_image().is_none(), "no frame crossed to the host");
+        let shown = s.image().expect("the image, read back");
+        let base = s.camera().unwrap();
+        let good = s.good.as_ref().unwrap();
+        let mut scene = good.scene.clone();
+        let mut sum = vec![[0.0f32; 3]; 32 * 24];
+        for k in 0..4 {
+            let (dx, dy) = camera::sample_offset(k, 2);
+            scene.camera = camera::jittered(&base, dx, dy, 32, 24);
+            let frame = good.prepared.render(&scene, &|_| {}).expect("a render");
+            for (s, c) in sum.iter_mut().zip(&frame.render.image.linear) {
+                for i in 0..3 {
+                    s[i] += c[i];
+                }
+            }
+        }
+        let inv = 1.0 / 4.0f32;
+        let mean = Image {
+            width: 32,
+            height: 24,
+            linear: sum
+                .iter()
+                .map(|c| [c[0] * inv, c[1] * inv, c[2] * inv])
+                .collect(),
+        };
+        assert_eq!(shown, mean);
+        // The statistics' steps per pixel are read back when asked for, and only then.
+        assert!(s.last.unwrap().steps.is_nan());
+        s.want_steps(true);
+        s.rotate(1.0, 0.0);
+        let info = s.frame().expect("a frame").expect("a frame while moving");
+        let good = s.good.as_ref().unwrap();
+        let frame = good
+            .prepared
+            .render(&good.scene, &|_| {})
+            .expect("a render");
+        assert!(info.steps > 1.0, "{info:?}");
+        assert_eq!(info.steps, frame.render.stats.steps_mean);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn edit_to_pixel_counts_from_the_edit() {
+        // A file renamed back keeps its old modification time: the edit is when the watcher
+        // saw it. A file written after the event counts from its writing.
+        let old = SystemTime::UNIX_EPOCH + Duration::from_secs(1_000_000);
+        let seen = old + Duration::from_secs(3600);
+        assert_eq!(edit_time(Some(old), Some(seen)), Some(seen));
+        let written = seen + Duration::from_millis(5);
+        assert_eq!(edit_time(Some(written), Some(seen)), Some(written));
+        assert_eq!(edit_time(Some(old), None), Some(old));
+        assert_eq!(edit_time(None, Some(seen)), Some(seen));
+    }
+
+    #[test]
     fn a_stale_compile_does_not_end_a_newer_loads_grace_period() {
         // Load 1's compile ends while load 2's scene waits its grace period (an hour) for its
         // own, held back: nothing is rendered until load 2's compile has ended, and then its
@@ -1769,7 +2056,7 @@ mod tests {
         assert_eq!(s.last.unwrap().kernel, Some("specialised"));
         assert_eq!(kernel_text(&s), newer);
         // What is shown is load 2's scene: the image of a session that compiled it at once.
-        let shown = s.image().unwrap().clone();
+        let shown = s.image().unwrap();
         let options = Options {
             kernel: Kernel::Specialised,
             ..Options::default()
@@ -1779,11 +2066,11 @@ mod tests {
         assert!(reference.load().ok);
         assert!(
             !reference.compiling(),
-            "`--kernel specialised` compiles at once"
+            "`--kernel specialised` finds the kernel compiled for the session before"
         );
         settle_all(&mut reference);
         assert_eq!(reference.last.unwrap().kernel, Some("specialised"));
-        assert_eq!(reference.image(), Some(&shown));
+        assert_eq!(reference.image(), Some(shown));
         let _ = std::fs::remove_dir_all(&dir);
     }
 
@@ -1820,7 +2107,7 @@ mod tests {
         while s.wants_frame() {
             s.frame().expect("a frame");
         }
-        let interpreted = s.image().unwrap().clone();
+        let interpreted = s.image().unwrap();
         release_when_compiled(&mut s);
         settle_all(&mut s);
         assert_eq!(s.last.unwrap().kernel, Some("specialised"));
@@ -1835,7 +2122,7 @@ mod tests {
         settle_all(&mut reference);
         assert_eq!(reference.time(), Some(0.5));
         assert_eq!(s.image(), reference.image());
-        let same = crate::metrics::compare(&interpreted, reference.image().unwrap(), 0.1);
+        let same = crate::metrics::compare(&interpreted, &reference.image().unwrap(), 0.1);
         assert!(
             same.unwrap().psnr >= 40.0,
             "the interpreted kernel showed t = 0.5 s"
@@ -1864,11 +2151,11 @@ mod tests {
             "a playing animation always has a frame to render"
         );
         s.frame().expect("a frame");
-        let first = s.image().unwrap().clone();
+        let first = s.image().unwrap();
         std::thread::sleep(Duration::from_millis(300));
         s.frame().expect("a frame");
         assert!(s.time().unwrap() > 0.0, "the clock moved on");
-        assert_ne!(s.image().unwrap(), &first, "the sphere rose");
+        assert_ne!(s.image().unwrap(), first, "the sphere rose");
         assert!(s.title(false).contains("playing"));
         // Paused, the time stays and the samples accumulate to the scene's aa.
         s.toggle_pause();
@@ -1926,7 +2213,7 @@ mod tests {
         // aa 2: four jittered samples, then nothing more to render.
         assert_eq!(settle(&mut s), 4);
         assert!(s.settled());
-        let first = s.image().unwrap().clone();
+        let first = s.image().unwrap();
 
         // The file's camera moves the view until the user moves it.
         std::fs::write(&file, SCENE.replace("(0, 1, -4)", "(0, 1.2, -4)")).unwrap();
@@ -1944,7 +2231,7 @@ mod tests {
         assert!(outcome.ok && outcome.number == 2);
         assert_eq!(s.camera().unwrap(), moved);
         settle(&mut s);
-        let good = s.image().unwrap().clone();
+        let good = s.image().unwrap();
         assert_ne!(good, first);
 
         // An edit with errors keeps the image and says why in the title.
@@ -1954,13 +2241,13 @@ mod tests {
         assert!(outcome.summary.contains("E0201"), "{}", outcome.summary);
         assert!(s.title(false).contains("E0201"));
         assert!(s.settled());
-        assert_eq!(s.image(), Some(&good));
+        assert_eq!(s.image(), Some(good.clone()));
 
         // So does a file that disappears; a failed load retries on any scene file's change.
         std::fs::remove_file(&file).unwrap();
         assert!(s.needs_reload(&[]));
         assert!(!s.load().ok);
-        assert_eq!(s.image(), Some(&good));
+        assert_eq!(s.image(), Some(good.clone()));
         assert!(s.needs_reload(&[dir.join("other.sdf")]));
         assert!(
             !s.needs_reload(std::slice::from_ref(&file)),

@@ -7,10 +7,15 @@ use notify_debouncer_full::notify::{RecommendedWatcher, RecursiveMode};
 use notify_debouncer_full::{new_debouncer, DebounceEventResult, Debouncer, RecommendedCache};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, SystemTime};
+use std::time::{Duration, Instant, SystemTime};
 
-/// How long the file system must be quiet before a batch of events is reported.
-pub const DEBOUNCE: Duration = Duration::from_millis(30);
+/// How long the file system must be quiet before a batch of events is reported. It is part of
+/// every edit's way to the screen (a numeric edit's is meant to take at most 40 ms in all). A
+/// save by writing a new file and renaming it is over within a millisecond; one that truncates
+/// and writes in place may be seen half written, which a load finds out and reads again
+/// (`session.rs`, `STABLE_READS`, `EMPTY_PATIENCE`), and the events of its end call for
+/// another load when the contents differ from the ones loaded.
+pub const DEBOUNCE: Duration = Duration::from_millis(15);
 
 /// Watches directories and calls back with the paths of each debounced batch of events.
 pub struct Watch {
@@ -26,9 +31,11 @@ impl std::fmt::Debug for Watch {
 
 impl Watch {
     /// A watcher that calls `changed` (on its own thread) with the paths of every debounced
-    /// batch of events, or with no paths when the watcher reported an error (so that the
-    /// files are looked at again).
-    pub fn new(changed: impl Fn(Vec<PathBuf>) + Send + 'static) -> Result<Watch, String> {
+    /// batch of events and when the first of them was seen, or with no paths when the
+    /// watcher reported an error (so that the files are looked at again).
+    pub fn new(
+        changed: impl Fn(Vec<PathBuf>, SystemTime) + Send + 'static,
+    ) -> Result<Watch, String> {
         let debouncer =
             new_debouncer(
                 DEBOUNCE,
@@ -39,11 +46,12 @@ impl Watch {
                             .iter()
                             .flat_map(|e| e.paths.iter().cloned())
                             .collect();
+                        let first = events.iter().map(|e| e.time).min();
                         if !paths.is_empty() {
-                            changed(paths);
+                            changed(paths, first.map_or_else(SystemTime::now, system_time));
                         }
                     }
-                    Err(_) => changed(Vec::new()),
+                    Err(_) => changed(Vec::new(), SystemTime::now()),
                 },
             )
             .map_err(|e| format!("cannot watch files: {e}"))?;
@@ -76,6 +84,11 @@ impl Watch {
     pub fn dirs(&self) -> impl Iterator<Item = &Path> {
         self.dirs.iter().map(|d| d.as_path())
     }
+}
+
+/// The wall-clock time of `instant` (a moment of the past).
+fn system_time(instant: Instant) -> SystemTime {
+    SystemTime::now() - instant.elapsed()
 }
 
 /// The absolute directory holding `file`.

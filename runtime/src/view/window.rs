@@ -1,8 +1,9 @@
 //! Presenting a session in a window: a winit window with a wgpu surface, on the device that
-//! renders the kernel (the adapter is the one that can present to the surface), or, where no
-//! adapter can, softbuffer and the CPU renderer; the mouse and keys that move the camera, the
-//! title line, and the screenshots of `--screenshot` and `--screenshot-dir`, read back from
-//! what is presented.
+//! renders the kernel (the adapter is the one that can present to the surface), whose render
+//! pass samples the texture the kernel's frames are accumulated into on that device (the CPU
+//! renderer's images are uploaded), or, where no adapter can present, softbuffer and the CPU
+//! renderer; the mouse and keys that move the camera, the title line, and the screenshots of
+//! `--screenshot` and `--screenshot-dir`, read back from what is presented.
 
 use super::compile::Waker;
 use super::session::{Device, Session};
@@ -27,8 +28,8 @@ use winit::window::{Window, WindowId};
 /// Events sent to the event loop from other threads.
 #[derive(Debug)]
 enum UserEvent {
-    /// The watcher saw these paths change.
-    Files(Vec<PathBuf>),
+    /// The watcher saw these paths change, the first of them at this time.
+    Files(Vec<PathBuf>, std::time::SystemTime),
     /// A kernel's pipeline compiling on another thread is ready (or failed).
     Compiled,
 }
@@ -55,7 +56,13 @@ pub fn run(run: Run) -> ExitCode {
         eprintln!("error: the window's event loop failed: {e}");
         return ExitCode::from(2);
     }
-    app.exit
+    let code = app.exit;
+    // The window, its surface and the session are not dropped: a kernel may still be
+    // compiling on another thread, and dropping the surface waits for the device's queue,
+    // which that compile may hold for seconds on lavapipe. The process ends next
+    // (`commands::view`).
+    std::mem::forget(app);
+    code
 }
 
 struct App {
@@ -136,6 +143,7 @@ impl App {
         let size = window.inner_size();
         let mut session = Session::new(self.run.file.clone(), self.run.options.clone(), device);
         session.set_size(size.width.max(1), size.height.max(1));
+        session.want_steps(self.run.control.stats);
         let proxy = std::sync::Mutex::new(self.proxy.clone());
         session.set_waker(Waker::new(move || {
             let proxy = proxy.lock().unwrap_or_else(|e| e.into_inner());
@@ -143,8 +151,8 @@ impl App {
         }));
         let outcome = session.load();
         let proxy = self.proxy.clone();
-        let watch = match Watch::new(move |paths| {
-            let _ = proxy.send_event(UserEvent::Files(paths));
+        let watch = match Watch::new(move |paths, seen| {
+            let _ = proxy.send_event(UserEvent::Files(paths, seen));
         }) {
             Ok(mut w) => {
                 for problem in w.add(session.files()) {
@@ -184,17 +192,28 @@ impl App {
         let Some(st) = self.state.as_mut() else {
             return;
         };
+        // While a kernel compiles with nothing new to show, nothing is drawn: the window keeps
+        // the picture it shows. The device's queue is left to the compile, whose first
+        // dispatch is where lavapipe compiles the kernel (tens of seconds for a large one);
+        // work queued behind it would hold the event loop until it ends.
+        if st.session.compiling() && !st.session.wants_frame() {
+            return;
+        }
         match st.session.frame() {
             Ok(Some(_)) => st.dirty = true,
             Ok(None) => {}
             Err(msg) => eprintln!("error: {msg}"),
         }
-        if st.dirty {
-            if let Some(image) = st.session.image() {
+        // A frame of the GPU is on show in its texture, where the kernel's frames were
+        // accumulated; the CPU renderer's image is uploaded.
+        if let Some((texture, number)) = st.session.texture() {
+            st.presenter.show(texture, number);
+        } else if st.dirty {
+            if let Some(image) = st.session.host_image() {
                 st.presenter.upload(image);
             }
-            st.dirty = false;
         }
+        st.dirty = false;
         let control = &self.run.control;
         let settled = st.session.settled();
         let reload_shot = match (st.shot_for, &control.screenshot_dir) {
@@ -258,15 +277,17 @@ impl ApplicationHandler<UserEvent> for App {
         let Some(st) = self.state.as_mut() else {
             return;
         };
-        let paths = match event {
-            UserEvent::Files(paths) => paths,
+        let (paths, seen) = match event {
+            UserEvent::Files(paths, seen) => (paths, seen),
             UserEvent::Compiled => {
                 st.window.request_redraw();
                 return;
             }
         };
         if st.session.needs_reload(&paths) {
-            let outcome = st.session.load();
+            // The load reads, checks, lowers and prepares here (milliseconds); a new kernel's
+            // pipeline compiles on another thread, and the loop goes on meanwhile.
+            let outcome = st.session.load_edited(Some(seen));
             if let Some(w) = st._watch.as_mut() {
                 for problem in w.add(st.session.files()) {
                     eprintln!("warning: {problem}");
@@ -327,8 +348,14 @@ impl ApplicationHandler<UserEvent> for App {
                         st.session.reset_camera();
                         st.window.request_redraw();
                     }
-                    Key::Character(c) if c.eq_ignore_ascii_case("s") => st.stats = !st.stats,
-                    Key::Named(NamedKey::Tab) => st.stats = !st.stats,
+                    Key::Character(c) if c.eq_ignore_ascii_case("s") => {
+                        st.stats = !st.stats;
+                        st.session.want_steps(st.stats);
+                    }
+                    Key::Named(NamedKey::Tab) => {
+                        st.stats = !st.stats;
+                        st.session.want_steps(st.stats);
+                    }
                     Key::Named(NamedKey::Space) => {
                         st.session.toggle_pause();
                         st.window.request_redraw();
@@ -360,10 +387,13 @@ impl ApplicationHandler<UserEvent> for App {
             st.window.set_title(&title);
             st.title = title;
         }
+        // While a kernel compiles with nothing to render, the loop sleeps until the compile's
+        // end wakes it ([`UserEvent::Compiled`]): no frame is counted or shot meanwhile.
         let control = &self.run.control;
+        let waiting = st.session.compiling() && !st.session.wants_frame();
         if st.session.wants_frame()
-            || control.frames.is_some()
-            || (st.shot_for.is_some() && control.screenshot_dir.is_some())
+            || (!waiting && control.frames.is_some())
+            || (!waiting && st.shot_for.is_some() && control.screenshot_dir.is_some())
         {
             st.window.request_redraw();
         }
@@ -389,6 +419,14 @@ impl Presenter {
         match self {
             Presenter::Gpu(p) => p.upload(image),
             Presenter::Soft(p) => p.image = Some((image.width, image.height, image.to_rgba8())),
+        }
+    }
+
+    /// Shows `texture` (sRGB bytes, on the presenting device; `number` changes with the
+    /// texture): only a wgpu presenter has a device.
+    fn show(&mut self, texture: &wgpu::Texture, number: u64) {
+        if let Presenter::Gpu(p) = self {
+            p.show(texture, number);
         }
     }
 
@@ -496,9 +534,10 @@ impl SoftPresenter {
     }
 }
 
-/// Draws the session's image into the window's surface: the image is uploaded to a texture
-/// (sRGB bytes) and drawn over the whole surface with a linear filter (so the smaller frames
-/// rendered while moving fill the window).
+/// Draws the session's image into the window's surface: a texture of sRGB bytes, the one the
+/// GPU's frames are accumulated into or one the CPU renderer's image is uploaded to, drawn
+/// over the whole surface with a linear filter (so the smaller frames rendered while moving
+/// fill the window).
 struct GpuPresenter {
     gpu: Arc<Gpu>,
     surface: wgpu::Surface<'static>,
@@ -510,7 +549,11 @@ struct GpuPresenter {
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     texture_format: wgpu::TextureFormat,
+    /// The texture uploaded to, and its bindings.
     image: Option<(wgpu::Texture, wgpu::BindGroup)>,
+    /// The bindings of a texture shown in place, with its number ([`GpuPresenter::show`]):
+    /// drawn instead of `image` while it is set.
+    shown: Option<(u64, wgpu::BindGroup)>,
 }
 
 /// The blit: a triangle over the whole target sampling the image.
@@ -671,6 +714,7 @@ impl GpuPresenter {
             sampler,
             texture_format,
             image: None,
+            shown: None,
         })
     }
 
@@ -683,8 +727,46 @@ impl GpuPresenter {
         self.surface.configure(self.gpu.device(), &self.config);
     }
 
+    /// Draws `texture` (sRGB bytes in an `Rgba8Unorm` texture that may be viewed as
+    /// `Rgba8UnormSrgb`, on this device) from now on; `number` names it, so that its bindings
+    /// are made once.
+    fn show(&mut self, texture: &wgpu::Texture, number: u64) {
+        if self.shown.as_ref().is_some_and(|(n, _)| *n == number) {
+            return;
+        }
+        // Sampled only: an sRGB view of the texture cannot be a storage binding.
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.texture_format),
+            usage: Some(wgpu::TextureUsages::TEXTURE_BINDING),
+            ..Default::default()
+        });
+        let bind = self.bindings(&view);
+        self.shown = Some((number, bind));
+    }
+
+    /// The blit's bindings of `view`.
+    fn bindings(&self, view: &wgpu::TextureView) -> wgpu::BindGroup {
+        self.gpu
+            .device()
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sdfc view image"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Sampler(&self.sampler),
+                    },
+                ],
+            })
+    }
+
     /// Uploads `image` (sRGB-encoded) as the texture to draw.
     fn upload(&mut self, image: &Image) {
+        self.shown = None;
         let device = self.gpu.device();
         let size = wgpu::Extent3d {
             width: image.width,
@@ -706,21 +788,7 @@ impl GpuPresenter {
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],
             });
-            let view = texture.create_view(&Default::default());
-            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("sdfc view image"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Sampler(&self.sampler),
-                    },
-                ],
-            });
+            let bind = self.bindings(&texture.create_view(&Default::default()));
             self.image = Some((texture, bind));
         }
         if let Some((texture, _)) = &self.image {
@@ -755,7 +823,11 @@ impl GpuPresenter {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let Some((_, bind)) = &self.image {
+        let bind = match (&self.shown, &self.image) {
+            (Some((_, bind)), _) | (None, Some((_, bind))) => Some(bind),
+            (None, None) => None,
+        };
+        if let Some(bind) = bind {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, bind, &[]);
             pass.draw(0..3, 0..1);

@@ -36,7 +36,8 @@ pub struct ViewArgs {
     /// compiled yet through the interpreted kernel until it is, compiling it on another thread
     /// (on a GPU, after waiting 50 ms for it: a kernel compiled by then is shown at once; a
     /// CPU adapter compiles before showing, as `specialised` does);
-    /// `specialised` compiles each new kernel before showing it; `interpreted` shows every
+    /// `specialised` compiles each new kernel before showing it (every compile runs on another
+    /// thread, the image before staying on show); `interpreted` shows every
     /// scene through the interpreted kernel (docs/interpreted.md). [default: auto]
     #[arg(long, value_enum, hide_possible_values = true)]
     pub kernel: Option<Kernel>,

@@ -14,7 +14,8 @@ use sdfc_compiler::scene::Scene;
 use std::sync::Arc;
 
 /// The pass that accumulates a frame: binding 0 the frame's size, sample count and whether to
-/// sum the steps (a storage buffer, not a uniform: lavapipe compiles a variant of a shader for
+/// sum the steps (1; 2 sums them alone, accumulating nothing: the steps of the frame before,
+/// asked for after it was rendered) (a storage buffer, not a uniform: lavapipe compiles a variant of a shader for
 /// each value of a uniform that decides a branch, which the sample count would make one a
 /// frame); 1 the kernel's colours; 2 the sums of the samples so far; 3 the texture on
 /// show (the mean, sRGB bytes); 4 the kernel's per-pixel statistics (8 words a pixel, the
@@ -56,7 +57,7 @@ fn accumulate(
     @builtin(global_invocation_id) gid: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    if gid.x < frame.width && gid.y < frame.height {
+    if gid.x < frame.width && gid.y < frame.height && frame.steps < 2u {
         let p = gid.y * frame.width + gid.x;
         // The first sample replaces the sums; each next one is added, in the order the host
         // added them when it accumulated (the same f32 sums).
@@ -67,12 +68,12 @@ fn accumulate(
         sum[p] = s;
         let mean = s.rgb * (1.0 / f32(frame.count));
         textureStore(shown, gid.xy, vec4<f32>(encode(mean.r), encode(mean.g), encode(mean.b), 1.0));
-        if frame.steps == 1u {
-            atomicAdd(&group_steps, stats[p * 8u]);
-        }
+    }
+    if gid.x < frame.width && gid.y < frame.height && frame.steps >= 1u {
+        atomicAdd(&group_steps, stats[(gid.y * frame.width + gid.x) * 8u]);
     }
     workgroupBarrier();
-    if frame.steps == 1u && local == 0u {
+    if frame.steps >= 1u && local == 0u {
         let v = atomicLoad(&group_steps);
         let old = atomicAdd(&steps[0], v);
         if old + v < old {
@@ -282,16 +283,7 @@ impl Resident {
             pass.set_bind_group(0, &t.bind, &[]);
             pass.dispatch_workgroups(width.div_ceil(GROUP), height.div_ceil(GROUP), 1);
         }
-        let staging = steps.then(|| {
-            let staging = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("sdfc view steps"),
-                size: 8,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            encoder.copy_buffer_to_buffer(&t.steps, 0, &staging, 0, 8);
-            staging
-        });
+        let staging = steps.then(|| steps_staging(&device, &mut encoder, &t.steps));
         queue.submit([encoder.finish()]);
         let count = t.count;
         if let Some(e) = pollster::block_on(validation.pop()) {
@@ -301,18 +293,48 @@ impl Resident {
             return Err(format!("GPU error while rendering: {e}"));
         }
         let steps = match staging {
-            Some(staging) => {
-                let bytes = self.map(&staging)?;
-                let lo = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as u64;
-                let hi = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]) as u64;
-                Some(((hi << 32) | lo) as f64 / (width as f64 * height as f64))
-            }
+            Some(staging) => Some(self.mean_steps(&staging, width, height)?),
             None => {
                 self.gpu.wait().map_err(|e| e.to_string())?;
                 None
             }
         };
         Ok(Rendered { count, steps })
+    }
+
+    /// The mean marching steps per pixel of the last frame, summed on the device now (the
+    /// statistics asked for after it was rendered); `None` before the first frame.
+    pub fn last_steps(&mut self) -> Result<Option<f64>, String> {
+        let Some(t) = self.target.as_ref().filter(|t| t.count > 0) else {
+            return Ok(None);
+        };
+        let (device, queue) = (self.gpu.device(), self.gpu.queue());
+        let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        queue.write_buffer(&t.frame, 0, &words(&[t.width, t.height, t.count, 2]));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&t.steps, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.accumulate);
+            pass.set_bind_group(0, &t.bind, &[]);
+            pass.dispatch_workgroups(t.width.div_ceil(GROUP), t.height.div_ceil(GROUP), 1);
+        }
+        let staging = steps_staging(device, &mut encoder, &t.steps);
+        queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(validation.pop()) {
+            return Err(format!("the viewer's steps: {e}"));
+        }
+        self.mean_steps(&staging, t.width, t.height).map(Some)
+    }
+
+    /// The steps summed into `staging` (two words, low and high), per pixel of a
+    /// `width`×`height` frame.
+    fn mean_steps(&self, staging: &wgpu::Buffer, width: u32, height: u32) -> Result<f64, String> {
+        let bytes = self.map(staging)?;
+        let word =
+            |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+        let sum = (word(4) as u64) << 32 | word(0) as u64;
+        Ok(sum as f64 / (width as f64 * height as f64))
     }
 
     /// Makes the buffers and texture fit frames of `width`×`height` with a uniform of
@@ -545,6 +567,22 @@ fn kernel_bindings(
         layout: &pipeline.1,
         entries: &entries,
     })
+}
+
+/// A mappable copy of the steps' two words, its copy recorded in `encoder`.
+fn steps_staging(
+    device: &wgpu::Device,
+    encoder: &mut wgpu::CommandEncoder,
+    steps: &wgpu::Buffer,
+) -> wgpu::Buffer {
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("sdfc view steps"),
+        size: 8,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    encoder.copy_buffer_to_buffer(steps, 0, &staging, 0, 8);
+    staging
 }
 
 /// What a kernel's first frame will read: its scene uniform and its first tile.

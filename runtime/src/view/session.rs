@@ -1390,6 +1390,17 @@ impl Session {
     /// wgpu, where frames stay on the device, a frame then reads back their sum (two words).
     pub fn want_steps(&mut self, wanted: bool) {
         self.steps_wanted = wanted;
+        // The frame on show was rendered without them: they are summed on the device now.
+        let Some(last) = self.last.as_mut().filter(|l| wanted && l.steps.is_nan()) else {
+            return;
+        };
+        if let Some(resident) = self.resident.as_mut() {
+            match resident.last_steps() {
+                Ok(Some(steps)) => last.steps = steps,
+                Ok(None) => {}
+                Err(msg) => eprintln!("error: {msg}"),
+            }
+        }
     }
 
     /// Called once a frame is on show: prints the timings of the load whose first frame it
@@ -1991,9 +2002,12 @@ mod tests {
                 .collect(),
         };
         assert_eq!(shown, mean);
-        // The statistics' steps per pixel are read back when asked for, and only then.
+        // The statistics' steps per pixel are read back when asked for, and only then: those
+        // of the frame on show at once (the last jittered sample's).
+        let last = good.prepared.render(&scene, &|_| {}).expect("a render");
         assert!(s.last.unwrap().steps.is_nan());
         s.want_steps(true);
+        assert_eq!(s.last.unwrap().steps, last.render.stats.steps_mean);
         s.rotate(1.0, 0.0);
         let info = s.frame().expect("a frame").expect("a frame while moving");
         let good = s.good.as_ref().unwrap();

@@ -370,6 +370,18 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// The frame's pixels to write, taken out of it (its image is left empty): its linear
+    /// image.
+    pub fn take_picture(&mut self) -> crate::image::Picture {
+        let image = &mut self.render.image;
+        let empty = crate::image::Image {
+            width: image.width,
+            height: image.height,
+            linear: Vec::new(),
+        };
+        crate::image::Picture::Linear(std::mem::replace(image, empty))
+    }
+
     /// The warnings of devices that failed while others finished the frame.
     pub fn warnings(&self) -> Vec<String> {
         self.shares

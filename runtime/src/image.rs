@@ -58,36 +58,121 @@ impl Image {
         out
     }
 
-    /// The image as PNG file bytes (RGBA8, sRGB), compressed with the png crate's `Fast`
-    /// level (fdeflate): on this repository's 2-core VM a 1920×1080 render compressed in
-    /// 20 ms instead of 240 ms at the default level, in a file 1.45 times as large.
+    /// The image as PNG file bytes (RGBA8, sRGB), compressed at the [`PngLevel::Fast`] level.
     pub fn encode_png(&self) -> Result<Vec<u8>, ImageError> {
-        self.encode_png_timed().map(|(bytes, _)| bytes)
+        encode_png(self.width, self.height, &self.to_rgba8(), PngLevel::Fast)
+    }
+}
+
+/// A finished frame: sRGB-encoded RGBA8 bytes (alpha 255), row-major from the top-left
+/// pixel, as [`Image::to_rgba8`] gives them or as a GPU kernel finished them (the same
+/// bytes: the kernel encodes with the thresholds of [`srgb_encode`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rgba8 {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Four bytes a pixel.
+    pub bytes: Vec<u8>,
+}
+
+/// The pixels of a frame to write: linear colours, encoded when written, or finished ones.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Picture {
+    /// Linear colours (EXR keeps them; the 8-bit formats encode them).
+    Linear(Image),
+    /// Pixels finished already (on the GPU).
+    Finished(Rgba8),
+}
+
+impl Picture {
+    /// Width and height in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        match self {
+            Picture::Linear(i) => (i.width, i.height),
+            Picture::Finished(f) => (f.width, f.height),
+        }
     }
 
-    /// [`Image::encode_png`], with the time its sRGB encoding took (the rest is the PNG's
-    /// filtering and compression).
-    pub fn encode_png_timed(&self) -> Result<(Vec<u8>, std::time::Duration), ImageError> {
-        let start = std::time::Instant::now();
-        let rgba = self.to_rgba8();
-        let srgb = start.elapsed();
-        let mut bytes = Vec::new();
-        let mut encoder = png::Encoder::new(&mut bytes, self.width, self.height);
-        encoder.set_compression(png::Compression::Fast);
-        encoder.set_color(png::ColorType::Rgba);
-        encoder.set_depth(png::BitDepth::Eight);
-        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let mut writer = encoder
-            .write_header()
-            .map_err(|e| ImageError::Encode(e.to_string()))?;
-        writer
-            .write_image_data(&rgba)
-            .map_err(|e| ImageError::Encode(e.to_string()))?;
-        writer
-            .finish()
-            .map_err(|e| ImageError::Encode(e.to_string()))?;
-        Ok((bytes, srgb))
+    /// The sRGB-encoded RGBA8 bytes: encoded now ([`Image::to_rgba8`]) or as finished.
+    pub fn rgba8(&self) -> std::borrow::Cow<'_, [u8]> {
+        match self {
+            Picture::Linear(i) => std::borrow::Cow::Owned(i.to_rgba8()),
+            Picture::Finished(f) => std::borrow::Cow::Borrowed(&f.bytes),
+        }
     }
+
+    /// The linear image, when the picture has one.
+    pub fn linear(&self) -> Option<&Image> {
+        match self {
+            Picture::Linear(i) => Some(i),
+            Picture::Finished(_) => None,
+        }
+    }
+
+    /// Bytes the picture holds.
+    pub fn bytes(&self) -> u64 {
+        match self {
+            Picture::Linear(i) => 12 * i.linear.len() as u64,
+            Picture::Finished(f) => f.bytes.len() as u64,
+        }
+    }
+}
+
+/// How hard the PNG encoder compresses (`--png-level`): the png crate's levels. `fastest`
+/// and `fast` both deflate with fdeflate; `fastest` skips the per-row choice of filter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum PngLevel {
+    /// Stored, not compressed: the largest files.
+    None,
+    /// fdeflate with one fixed filter.
+    Fastest,
+    /// fdeflate with adaptive filters: on this repository's 2-core VM a 1920×1080 render
+    /// compressed in 20 ms instead of 240 ms at `balanced`, in a file 1.45 times as large.
+    #[default]
+    Fast,
+    /// zlib's default level.
+    Balanced,
+    /// zlib's best level.
+    High,
+}
+
+impl PngLevel {
+    fn compression(self) -> png::Compression {
+        match self {
+            PngLevel::None => png::Compression::NoCompression,
+            PngLevel::Fastest => png::Compression::Fastest,
+            PngLevel::Fast => png::Compression::Fast,
+            PngLevel::Balanced => png::Compression::Balanced,
+            PngLevel::High => png::Compression::High,
+        }
+    }
+}
+
+/// PNG file bytes of `rgba` (sRGB RGBA8, `width`×`height`) compressed at `level`.
+pub fn encode_png(
+    width: u32,
+    height: u32,
+    rgba: &[u8],
+    level: PngLevel,
+) -> Result<Vec<u8>, ImageError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_compression(level.compression());
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let mut writer = encoder
+        .write_header()
+        .map_err(|e| ImageError::Encode(e.to_string()))?;
+    writer
+        .write_image_data(rgba)
+        .map_err(|e| ImageError::Encode(e.to_string()))?;
+    writer
+        .finish()
+        .map_err(|e| ImageError::Encode(e.to_string()))?;
+    Ok(bytes)
 }
 
 /// A linear value clamped to [0, 1] and encoded with the sRGB transfer function (NaN is 0).

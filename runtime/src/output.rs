@@ -3,7 +3,7 @@
 //! never thrown away because its output cannot be written. Files are written atomically
 //! ([`crate::image::AtomicFile`]); JPEG and OpenEXR are streamed into them.
 
-use crate::image::{AtomicFile, Image, SrgbTable};
+use crate::image::{encode_png, AtomicFile, Image, Picture, PngLevel};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -36,34 +36,58 @@ impl Format {
         }
     }
 
-    /// Writes the image in this format to `w`: JPEG and OpenEXR are streamed, PNG is encoded
-    /// first ([`Image::encode_png`]).
-    pub fn write(self, image: &Image, w: &mut dyn Write) -> std::io::Result<()> {
+    /// Writes the picture in this format to `w`: JPEG and OpenEXR are streamed, PNG is
+    /// encoded first (at `png`). OpenEXR needs the linear colours: `Err` for finished pixels.
+    pub fn write(self, picture: &Picture, png: PngLevel, w: &mut dyn Write) -> std::io::Result<()> {
         match self {
             Format::Png => {
-                let bytes = image.encode_png().map_err(std::io::Error::other)?;
+                let (width, height) = picture.size();
+                let bytes = encode_png(width, height, &picture.rgba8(), png)
+                    .map_err(std::io::Error::other)?;
                 w.write_all(&bytes)
             }
-            Format::Jpeg => write_jpeg(image, w),
-            Format::Exr => write_exr(image, w),
+            Format::Jpeg => write_jpeg(picture, w),
+            Format::Exr => match picture.linear() {
+                Some(image) => write_exr(image, w),
+                None => Err(std::io::Error::other(
+                    "OpenEXR keeps linear colours, and this frame was finished as 8-bit sRGB",
+                )),
+            },
         }
+    }
+
+    /// Whether this format keeps linear colours (not the finished 8-bit pixels).
+    pub fn linear(self) -> bool {
+        self == Format::Exr
     }
 }
 
-/// The image's PNG bytes, with the steps of their encoding: the sRGB encoding and the PNG's
-/// filtering and compression.
-fn png_steps(image: &Image) -> Result<(Vec<u8>, Vec<Step>), crate::image::ImageError> {
+/// The picture's PNG bytes (at `level`), with the steps of their encoding: the sRGB encoding
+/// (none for pixels finished on the GPU) and the PNG's filtering and compression.
+fn png_steps(
+    picture: &Picture,
+    level: PngLevel,
+) -> Result<(Vec<u8>, Vec<Step>), crate::image::ImageError> {
     let start = Instant::now();
-    let (bytes, srgb) = image.encode_png_timed()?;
-    let png = start.elapsed().saturating_sub(srgb);
-    let steps = vec![
-        ("sRGB", srgb, "clamped and encoded by table".to_string()),
-        (
-            "PNG",
-            png,
-            "filtered and compressed at the `Fast` level".to_string(),
+    let rgba = picture.rgba8();
+    let srgb = start.elapsed();
+    let start = Instant::now();
+    let (width, height) = picture.size();
+    let bytes = encode_png(width, height, &rgba, level)?;
+    let png = start.elapsed();
+    let mut steps = Vec::new();
+    if picture.linear().is_some() {
+        steps.push(("sRGB", srgb, "clamped and encoded by table".to_string()));
+    }
+    steps.push((
+        "PNG",
+        png,
+        format!(
+            "filtered and compressed at the `{}` level",
+            clap::ValueEnum::to_possible_value(&level)
+                .map_or_else(String::new, |v| v.get_name().to_string())
         ),
-    ];
+    ));
     Ok((bytes, steps))
 }
 
@@ -114,15 +138,16 @@ impl Output {
         })
     }
 
-    /// Writes `image`: to the file atomically (synced to the disk before its rename when
+    /// Writes `picture` (a PNG compressed at `png`): to the file atomically (synced to the disk before its rename when
     /// `sync`: [`AtomicFile::create`], else [`AtomicFile::unsynced`]), or to standard output.
     /// Says where the time went (`sdfc render --stats`): (step, time, what) for the
     /// encoding, the write, and for a file its `fsync` and rename.
-    pub fn write(&self, image: &Image, sync: bool) -> Result<Vec<Step>, String> {
+    pub fn write(&self, picture: &Picture, sync: bool, png: PngLevel) -> Result<Vec<Step>, String> {
         let (path, format) = match self {
             Output::Stdout => {
                 let cannot = |e: String| format!("cannot write the image to standard output: {e}");
-                let (bytes, mut steps) = png_steps(image).map_err(|e| cannot(e.to_string()))?;
+                let (bytes, mut steps) =
+                    png_steps(picture, png).map_err(|e| cannot(e.to_string()))?;
                 let start = Instant::now();
                 let mut out = std::io::stdout().lock();
                 out.write_all(&bytes)
@@ -135,9 +160,9 @@ impl Output {
         };
         let cannot = |e: std::io::Error| format!("cannot write `{}`: {e}", path.display());
         let mut steps = Vec::new();
-        let png = if format == Format::Png {
+        let encoded = if format == Format::Png {
             let (bytes, encoded) =
-                png_steps(image).map_err(|e| cannot(std::io::Error::other(e)))?;
+                png_steps(picture, png).map_err(|e| cannot(std::io::Error::other(e)))?;
             steps.extend(encoded);
             Some(bytes)
         } else {
@@ -149,14 +174,14 @@ impl Output {
         };
         let mut file = file.map_err(cannot)?;
         let start = Instant::now();
-        match &png {
+        match &encoded {
             Some(bytes) => file.write_all(bytes),
-            None => format.write(image, &mut file),
+            None => format.write(picture, png, &mut file),
         }
         .map_err(cannot)?;
         let wrote = start.elapsed();
         let done = file.finish_timed().map_err(cannot)?;
-        steps.push(match png {
+        steps.push(match encoded {
             Some(_) => (
                 "write",
                 wrote + done.flush,
@@ -193,6 +218,133 @@ impl std::fmt::Display for Output {
     }
 }
 
+/// A frame handed to a [`Writers`] pool: its number, where it goes and its pixels, and
+/// when its render started (for the log).
+#[derive(Debug)]
+pub struct Task {
+    /// The frame's number.
+    pub k: u64,
+    /// Its file.
+    pub output: Output,
+    /// Its pixels.
+    pub picture: Picture,
+    /// When its render started.
+    pub started: Instant,
+}
+
+/// A frame a [`Writers`] pool has written (or failed to write): its number, the error, and
+/// the seconds from the start of its render to its file's rename.
+#[derive(Debug)]
+pub struct Written {
+    /// The frame's number.
+    pub k: u64,
+    /// Why the file could not be written.
+    pub result: Result<(), String>,
+    /// Seconds from the start of its render until its file was written.
+    pub seconds: f64,
+}
+
+/// Images encoded and written (atomically, synced) on a pool of threads while the caller
+/// renders the next frames (`sdfc render --frames` to numbered files): PNG, JPEG and
+/// OpenEXR encoders are single-threaded, and a 1920×1080 PNG takes longer to compress than
+/// a GPU takes to render most frames. At most `depth` frames wait for a thread: [`Writers::submit`]
+/// blocks beyond that, which bounds the memory the frames hold.
+#[derive(Debug)]
+pub struct Writers {
+    tasks: Option<std::sync::mpsc::SyncSender<Task>>,
+    written: std::sync::mpsc::Receiver<Written>,
+    threads: Vec<std::thread::JoinHandle<()>>,
+}
+
+/// A handle that hands frames to a [`Writers`] pool from other threads.
+#[derive(Debug, Clone)]
+pub struct Submit(std::sync::mpsc::SyncSender<Task>);
+
+impl Submit {
+    /// Hands `task` to the pool, waiting while `depth` frames wait already. `Err` when the
+    /// pool has ended.
+    pub fn submit(&self, task: Task) -> Result<(), String> {
+        self.0
+            .send(task)
+            .map_err(|_| "the image writers have ended".to_string())
+    }
+}
+
+impl Writers {
+    /// A pool of `threads` threads (at least one), with at most `depth` frames waiting;
+    /// each PNG is compressed at `png`.
+    pub fn new(threads: usize, depth: usize, png: PngLevel) -> Writers {
+        let (tasks, queue) = std::sync::mpsc::sync_channel::<Task>(depth.max(1));
+        let (done, written) = std::sync::mpsc::channel();
+        let queue = std::sync::Arc::new(std::sync::Mutex::new(queue));
+        let threads = (0..threads.max(1))
+            .map(|i| {
+                let (queue, done) = (queue.clone(), done.clone());
+                std::thread::Builder::new()
+                    .name(format!("sdfc-writer-{i}"))
+                    .spawn(move || loop {
+                        let task = match queue.lock() {
+                            Ok(q) => q.recv(),
+                            Err(_) => return,
+                        };
+                        let Ok(task) = task else { return };
+                        // Synced: a rerun skips the frames whose files it finds.
+                        let result = task.output.write(&task.picture, true, png).map(|_| ());
+                        let written = Written {
+                            k: task.k,
+                            result,
+                            seconds: task.started.elapsed().as_secs_f64(),
+                        };
+                        if done.send(written).is_err() {
+                            return;
+                        }
+                    })
+                    .expect("a thread for the image writers")
+            })
+            .collect();
+        Writers {
+            tasks: Some(tasks),
+            written,
+            threads,
+        }
+    }
+
+    /// The threads of a pool for this machine: one per core.
+    pub fn cores() -> usize {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    }
+
+    /// A handle for other threads.
+    pub fn submitter(&self) -> Submit {
+        Submit(self.tasks.clone().expect("the pool is open"))
+    }
+
+    /// Hands `task` to the pool ([`Submit::submit`]).
+    pub fn submit(&self, task: Task) -> Result<(), String> {
+        self.submitter().submit(task)
+    }
+
+    /// The frames written since the last call, without waiting.
+    pub fn written(&self) -> Vec<Written> {
+        self.written.try_iter().collect()
+    }
+
+    /// The next frame written, waiting up to `timeout`.
+    pub fn next_written(&self, timeout: Duration) -> Option<Written> {
+        self.written.recv_timeout(timeout).ok()
+    }
+
+    /// Waits for every frame handed over (by every [`Submit`] handle, which must be dropped
+    /// first) and returns those not yet reported.
+    pub fn finish(mut self) -> Vec<Written> {
+        drop(self.tasks.take());
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+        self.written.try_iter().collect()
+    }
+}
+
 /// Checks that a new file can be written at `path`: the path is not a directory nor a
 /// read-only file, and a file can be created in its directory (created and removed again).
 pub fn check_writable(path: &Path) -> Result<(), String> {
@@ -224,18 +376,18 @@ pub fn check_writable(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// The image as a baseline JPEG (sRGB, clamped like the PNG), streamed to `w`.
-fn write_jpeg(image: &Image, w: &mut dyn Write) -> std::io::Result<()> {
-    let (Ok(width), Ok(height)) = (u16::try_from(image.width), u16::try_from(image.height)) else {
+/// The picture as a baseline JPEG (sRGB, clamped like the PNG), streamed to `w`.
+fn write_jpeg(picture: &Picture, w: &mut dyn Write) -> std::io::Result<()> {
+    let (width, height) = picture.size();
+    let (Ok(width), Ok(height)) = (u16::try_from(width), u16::try_from(height)) else {
         return Err(std::io::Error::other(
             "JPEG images are at most 65535 pixels wide and high",
         ));
     };
-    let table = SrgbTable::get();
-    let rgb: Vec<u8> = image
-        .linear
-        .iter()
-        .flat_map(|c| c.map(|x| table.encode(x)))
+    let rgb: Vec<u8> = picture
+        .rgba8()
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
         .collect();
     jpeg_encoder::Encoder::new(w, JPEG_QUALITY)
         .encode(&rgb, width, height, jpeg_encoder::ColorType::Rgb)
@@ -317,6 +469,70 @@ mod tests {
         assert!(err.contains("`.tiff` is not an image format"), "{err}");
         let err = Output::new(Path::new("/nonexistent-sdfc/x.png")).unwrap_err();
         assert!(err.contains("does not exist"), "{err}");
+    }
+
+    /// Frames handed to the pool are all written, whatever order the threads finish in,
+    /// each file the frame's pixels; an unwritable one comes back as an error.
+    #[test]
+    fn the_writers_pool_writes_every_frame() {
+        let dir = std::env::temp_dir().join(format!("sdfc-writers-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("a directory");
+        let writers = Writers::new(3, 2, PngLevel::Fastest);
+        let mut images = Vec::new();
+        for k in 0..6u64 {
+            let mut image = Image::new(5, 4);
+            image.linear[k as usize] = [1.0, 0.5, 0.25];
+            images.push(image.clone());
+            let output = Output::File {
+                path: dir.join(format!("f{k}.png")),
+                format: Format::Png,
+            };
+            let picture = if k % 2 == 0 {
+                Picture::Linear(image)
+            } else {
+                Picture::Finished(crate::image::Rgba8 {
+                    width: 5,
+                    height: 4,
+                    bytes: image.to_rgba8(),
+                })
+            };
+            let started = Instant::now();
+            writers
+                .submit(Task {
+                    k,
+                    output,
+                    picture,
+                    started,
+                })
+                .expect("open");
+        }
+        let bad = Output::File {
+            path: dir.join("missing").join("f.png"),
+            format: Format::Png,
+        };
+        let picture = Picture::Linear(Image::new(1, 1));
+        let started = Instant::now();
+        writers
+            .submit(Task {
+                k: 9,
+                output: bad,
+                picture,
+                started,
+            })
+            .expect("open");
+        let mut done = writers.finish();
+        done.sort_by_key(|w| w.k);
+        assert_eq!(
+            done.iter().map(|w| w.k).collect::<Vec<_>>(),
+            [0, 1, 2, 3, 4, 5, 9]
+        );
+        assert!(done[..6].iter().all(|w| w.result.is_ok()));
+        assert!(done[6].result.is_err());
+        for (k, image) in images.iter().enumerate() {
+            let read = crate::image::read_png(&dir.join(format!("f{k}.png"))).expect("a PNG");
+            assert_eq!(read.to_rgba8(), image.to_rgba8(), "frame {k}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -99,6 +99,11 @@ pub struct RenderArgs {
     /// killed job resumes where it stopped).
     #[arg(long)]
     pub force: bool,
+    /// How hard PNG files are compressed: `fast` (fdeflate, the default, for stills and
+    /// sequences), `fastest` (fdeflate without the per-row choice of filter), `none`, or
+    /// zlib's `balanced` and `high`, smaller and many times slower.
+    #[arg(long, value_enum, value_name = "LEVEL", default_value_t)]
+    pub png_level: crate::image::PngLevel,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -378,8 +383,10 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
     }
     // Not synced to the disk: complete or untouched whatever happens to the process, as a
     // compiler's output (`AtomicFile::unsynced`).
+    let mut frame = frame;
+    let picture = frame.take_picture();
     let steps = out
-        .write(&frame.render.image, false)
+        .write(&picture, false, args.png_level)
         .map_err(CliError::Usage)?;
     if let (true, Some(path)) = (args.aux, out.path()) {
         write_sidecar(path, frame.render.depth.as_ref(), prepared.name())

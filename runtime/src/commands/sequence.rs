@@ -11,8 +11,8 @@ use super::render::{
 use crate::backend::{Prepared, Setup};
 use crate::frontend::Source;
 use crate::gpu::launch::{Faults, Queue};
-use crate::image::{AtomicFile, Image};
-use crate::output::Output;
+use crate::image::{AtomicFile, Picture, PngLevel};
+use crate::output::{Output, Submit, Task, Writers, Written};
 use crate::sequence::{ffmpeg, Frames, Target};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::lower::{LowerOptions, Program};
@@ -104,6 +104,18 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         bar: bar.as_ref(),
     };
     let started = Instant::now();
+    // Numbered files are encoded and written on a pool of threads while the next frames
+    // render; at most a gigabyte of frames waits for them.
+    let writers = match &sink {
+        Sink::Numbered(..) => {
+            let threads = Writers::cores();
+            let s = &first.as_ref().expect("the first frame").scene.settings;
+            let frame = (12 * s.width as u64 * s.height as u64).max(1);
+            let depth = (2 * threads as u64).min((1 << 30) / frame).max(1);
+            Some(Writers::new(threads, depth as usize, args.png_level))
+        }
+        _ => None,
+    };
     // Several devices take whole frames from one queue; a scene that does not read `t` is
     // rendered once, its one frame split among them.
     let workers = match args.devices.resolve(backend).map_err(CliError::Usage)? {
@@ -119,35 +131,55 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                 setup,
                 limits: &limits,
             };
-            frames.render(&list, &todo, &mut first, &mut checker, &mut sink)?
+            let writers = writers.as_ref();
+            frames.render(&list, &todo, &mut first, (&mut checker, &mut sink, writers))?
         }
         None => {
             let mut kernels = Kernels::new(&pool, (backend, args.devices.clone()), setup);
-            // The image of a scene that does not read `t`, rendered once.
-            let mut still: Option<Image> = None;
+            // The picture of a scene that does not read `t`, rendered once.
+            let mut still: Option<Picture> = None;
             for (n, &k) in todo.iter().enumerate() {
                 let frame = checker.frame(k, &mut first)?;
                 let frame_started = Instant::now();
-                let image = match &still {
-                    Some(image) => image.clone(),
+                let picture = match &still {
+                    Some(picture) => picture.clone(),
                     None => {
                         let (scene, prepared) = kernels.prepare(frame)?;
                         check_memory(&pool, prepared, &scene, (false, false), &limits, n == 0)?;
-                        let frame = pool
+                        let mut frame = pool
                             .install(|| prepared.render(&scene, &|_| {}))
                             .map_err(CliError::Failed)?;
                         for w in frame.warnings() {
                             eprintln!("warning: frame {k}: {w}");
                         }
-                        let image = frame.render.image;
+                        let picture = frame.take_picture();
                         if !animation.animated() {
-                            still = Some(image.clone());
+                            still = Some(picture.clone());
                         }
-                        image
+                        picture
                     }
                 };
-                sink.write(k, &image)?;
-                checker.written(k, &sink, frame_started.elapsed().as_secs_f64());
+                match (&writers, &sink) {
+                    (Some(w), Sink::Numbered(pattern, format)) => {
+                        let task = Task {
+                            k,
+                            output: Output::File {
+                                path: pattern.path(k),
+                                format: *format,
+                            },
+                            picture,
+                            started: frame_started,
+                        };
+                        w.submit(task).map_err(CliError::Failed)?;
+                        for done in w.written() {
+                            report(done, &checker, &sink)?;
+                        }
+                    }
+                    _ => {
+                        sink.write(k, &picture)?;
+                        checker.written(k, &sink, frame_started.elapsed().as_secs_f64());
+                    }
+                }
             }
             let device = kernels
                 .last()
@@ -155,6 +187,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             (kernels.count, device)
         }
     };
+    if let Some(w) = writers {
+        for done in w.finish() {
+            report(done, &checker, &sink)?;
+        }
+    }
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -229,6 +266,13 @@ impl Checker<'_> {
     }
 }
 
+/// Logs a frame the writers' pool wrote, or gives its error.
+fn report(done: Written, checker: &Checker, sink: &Sink) -> Result<(), CliError> {
+    done.result.map_err(CliError::Usage)?;
+    checker.written(done.k, sink, done.seconds);
+    Ok(())
+}
+
 /// A frame checked and waiting for a device.
 struct Pending {
     k: u64,
@@ -237,15 +281,15 @@ struct Pending {
 
 /// What a device's worker reports.
 enum Report {
-    /// Frame `k` rendered in `seconds`; its image, unless the worker wrote it (numbered
-    /// files are written by the workers, side by side; an animated PNG or a video takes the
-    /// frames in order).
+    /// Frame `k` rendered in `seconds`; its picture, unless the worker handed it to the
+    /// writers' pool (numbered files, written side by side and logged as the pool writes
+    /// them; an animated PNG or a video takes the frames in order).
     Frame {
         k: u64,
-        image: Option<Image>,
+        picture: Option<Picture>,
         seconds: f64,
     },
-    /// The frame could not be written.
+    /// The frame could not be handed to the writers.
     Unwritten(String),
     /// The device failed on a frame, which it handed back.
     Failed { position: usize, message: String },
@@ -273,12 +317,13 @@ impl FramesOn<'_> {
         devices: &[crate::backend::Device],
         todo: &[u64],
         first: &mut Option<FrameScene>,
-        checker: &mut Checker,
-        sink: &mut Sink,
+        (checker, sink, writers): (&mut Checker, &mut Sink, Option<&Writers>),
     ) -> Result<(usize, Option<String>), CliError> {
         let queue = Queue::new(std::iter::empty(), true);
-        let numbered = match &*sink {
-            Sink::Numbered(pattern, format) => Some((pattern.clone(), *format)),
+        let numbered = match (&*sink, writers) {
+            (Sink::Numbered(pattern, format), Some(w)) => {
+                Some((w.submitter(), pattern.clone(), *format))
+            }
             _ => None,
         };
         let (tx, rx) = std::sync::mpsc::channel();
@@ -286,7 +331,7 @@ impl FramesOn<'_> {
         let ahead = 2 * devices.len();
         std::thread::scope(|scope| {
             for (position, &device) in devices.iter().enumerate() {
-                let (queue, tx, numbered) = (&queue, tx.clone(), numbered.as_ref());
+                let (queue, tx, numbered) = (&queue, tx.clone(), numbered.clone());
                 scope.spawn(move || {
                     let run = std::panic::AssertUnwindSafe(|| {
                         self.work((position, device), queue, numbered, tx)
@@ -304,47 +349,55 @@ impl FramesOn<'_> {
             let (mut kernels, mut names) = (0, Vec::new());
             let mut failures = Vec::new();
             // Handles one report: frames are written in order, as soon as they can be.
-            let mut handle =
-                |report: Report, sink: &mut Sink, checker: &Checker| -> Result<(), CliError> {
-                    match report {
-                        Report::Frame { k, image, seconds } => {
-                            ready.insert(k, (image, seconds));
-                        }
-                        Report::Unwritten(message) => return Err(CliError::Usage(message)),
-                        Report::Failed { position, message } => {
-                            alive -= 1;
-                            eprintln!(
-                                "warning: device {position} failed: {message}; {}",
-                                if alive > 0 {
-                                    "the other devices render its frame"
-                                } else {
-                                    "no device is left"
-                                }
-                            );
-                            failures.push(format!("device {position}: {message}"));
-                        }
-                        Report::Ended { kernels: n, device } => {
-                            kernels += n;
-                            names.push(device);
-                        }
+            let mut handle = |event: Report,
+                              sink: &mut Sink,
+                              checker: &Checker|
+             -> Result<(), CliError> {
+                match event {
+                    Report::Frame {
+                        k,
+                        picture,
+                        seconds,
+                    } => {
+                        ready.insert(k, (picture, seconds));
                     }
-                    while let Some((image, seconds)) = todo.get(next).and_then(|k| ready.remove(k))
-                    {
-                        if let Some(image) = image {
-                            sink.write(todo[next], &image)?;
-                        }
+                    Report::Unwritten(message) => return Err(CliError::Usage(message)),
+                    Report::Failed { position, message } => {
+                        alive -= 1;
+                        eprintln!(
+                            "warning: device {position} failed: {message}; {}",
+                            if alive > 0 {
+                                "the other devices render its frame"
+                            } else {
+                                "no device is left"
+                            }
+                        );
+                        failures.push(format!("device {position}: {message}"));
+                    }
+                    Report::Ended { kernels: n, device } => {
+                        kernels += n;
+                        names.push(device);
+                    }
+                }
+                while let Some((picture, seconds)) = todo.get(next).and_then(|k| ready.remove(k)) {
+                    if let Some(picture) = picture {
+                        sink.write(todo[next], &picture)?;
                         checker.written(todo[next], sink, seconds);
-                        next += 1;
                     }
-                    if alive == 0 && next < todo.len() {
-                        return Err(CliError::Failed(format!(
-                            "every device failed ({next} of {} frames written): {}",
-                            todo.len(),
-                            failures.join("; ")
-                        )));
-                    }
-                    Ok(())
-                };
+                    next += 1;
+                }
+                for done in writers.map(|w| w.written()).unwrap_or_default() {
+                    report(done, checker, sink)?;
+                }
+                if alive == 0 && next < todo.len() {
+                    return Err(CliError::Failed(format!(
+                        "every device failed ({next} of {} frames written): {}",
+                        todo.len(),
+                        failures.join("; ")
+                    )));
+                }
+                Ok(())
+            };
             let result = (|| {
                 for &k in todo {
                     let frame = checker.frame(k, first)?;
@@ -392,7 +445,7 @@ impl FramesOn<'_> {
         &self,
         (position, device): (usize, crate::backend::Device),
         queue: &Queue<Pending>,
-        numbered: Option<&(crate::sequence::Pattern, crate::output::Format)>,
+        numbered: Option<(Submit, crate::sequence::Pattern, crate::output::Format)>,
         tx: std::sync::mpsc::Sender<Report>,
     ) {
         let list = crate::backend::Devices::List(vec![device]);
@@ -430,27 +483,35 @@ impl FramesOn<'_> {
                 tiles += n;
                 self.pool
                     .install(|| prepared.render_faults(&scene, &|_| {}, &Faults::default()))
-                    .map(|f| f.render.image)
+                    .map(|mut f| f.take_picture())
                     .map_err(CliError::Failed)
             })();
             match rendered {
-                Ok(image) => {
-                    let image = match numbered {
-                        Some((pattern, format)) => {
-                            let file = Output::File {
-                                path: pattern.path(k),
-                                format: *format,
+                Ok(picture) => {
+                    let picture = match &numbered {
+                        Some((writers, pattern, format)) => {
+                            let task = Task {
+                                k,
+                                output: Output::File {
+                                    path: pattern.path(k),
+                                    format: *format,
+                                },
+                                picture,
+                                started,
                             };
-                            // Synced: a rerun skips the frames whose files it finds.
-                            if let Err(e) = file.write(&image, true) {
+                            if let Err(e) = writers.submit(task) {
                                 let _ = tx.send(Report::Unwritten(e));
                             }
                             None
                         }
-                        None => Some(image),
+                        None => Some(picture),
                     };
                     let seconds = started.elapsed().as_secs_f64();
-                    let _ = tx.send(Report::Frame { k, image, seconds });
+                    let _ = tx.send(Report::Frame {
+                        k,
+                        picture,
+                        seconds,
+                    });
                     queue.done();
                 }
                 Err(e) => {
@@ -724,7 +785,7 @@ impl Sink {
         }
     }
 
-    fn write(&mut self, k: u64, image: &Image) -> Result<(), CliError> {
+    fn write(&mut self, k: u64, picture: &Picture) -> Result<(), CliError> {
         let io = |path: &Path| {
             let path = path.display().to_string();
             move |e: std::io::Error| CliError::Usage(format!("cannot write `{path}`: {e}"))
@@ -735,7 +796,7 @@ impl Sink {
                 format: *format,
             }
             // Synced: a rerun skips the frames whose files it finds.
-            .write(image, true)
+            .write(picture, true, PngLevel::Fast)
             .map(|_| ())
             .map_err(CliError::Usage),
             Sink::Apng {
@@ -747,13 +808,15 @@ impl Sink {
             } => {
                 if writer.is_none() {
                     let f = Rc::new(RefCell::new(AtomicFile::create(path).map_err(io(path))?));
-                    *writer = Some(apng(Shared(f.clone()), image, *frames, *fps).map_err(|e| {
-                        CliError::Usage(format!("cannot write `{}`: {e}", path.display()))
-                    })?);
+                    *writer = Some(
+                        apng(Shared(f.clone()), picture.size(), *frames, *fps).map_err(|e| {
+                            CliError::Usage(format!("cannot write `{}`: {e}", path.display()))
+                        })?,
+                    );
                     *file = Some(f);
                 }
                 let w = writer.as_mut().expect("writer");
-                w.write_image_data(&image.to_rgba8())
+                w.write_image_data(&picture.rgba8())
                     .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", path.display())))
             }
             Sink::Video {
@@ -763,12 +826,12 @@ impl Sink {
                 child,
             } => {
                 if child.is_none() {
-                    *child = Some(start_ffmpeg(ffmpeg, path, image, *fps)?);
+                    *child = Some(start_ffmpeg(ffmpeg, path, picture.size(), *fps)?);
                 }
                 let (c, _) = child.as_mut().expect("ffmpeg");
                 let stdin = c.stdin.as_mut().expect("piped");
                 stdin
-                    .write_all(&rgb8(image))
+                    .write_all(&rgb8(picture))
                     .map_err(|e| CliError::Failed(format!("ffmpeg stopped reading frames: {e}")))
             }
         }
@@ -814,14 +877,14 @@ impl Sink {
     }
 }
 
-/// An APNG encoder of `frames` frames of `image`'s size at `fps`, looping forever.
+/// An APNG encoder of `frames` frames of `width`×`height` at `fps`, looping forever.
 fn apng(
     out: Shared,
-    image: &Image,
+    (width, height): (u32, u32),
     frames: u64,
     fps: f64,
 ) -> Result<png::Writer<Shared>, png::EncodingError> {
-    let mut encoder = png::Encoder::new(out, image.width, image.height);
+    let mut encoder = png::Encoder::new(out, width, height);
     encoder.set_color(png::ColorType::Rgba);
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -836,12 +899,12 @@ fn apng(
     encoder.write_header()
 }
 
-/// Starts `ffmpeg` encoding raw RGB frames of `image`'s size from its standard input into a
+/// Starts `ffmpeg` encoding raw RGB frames of `width`×`height` from its standard input into a
 /// temporary file beside `path` (renamed onto it when ffmpeg succeeds).
 fn start_ffmpeg(
     ffmpeg: &Path,
     path: &Path,
-    image: &Image,
+    (width, height): (u32, u32),
     fps: f64,
 ) -> Result<(std::process::Child, PathBuf), CliError> {
     let name = path
@@ -852,7 +915,7 @@ fn start_ffmpeg(
     let mut cmd = std::process::Command::new(ffmpeg);
     cmd.args(["-hide_banner", "-loglevel", "error", "-y", "-f", "rawvideo"])
         .args(["-pix_fmt", "rgb24"])
-        .args(["-s", &format!("{}x{}", image.width, image.height)])
+        .args(["-s", &format!("{width}x{height}")])
         .args(["-framerate", &fps.to_string(), "-i", "-"]);
     if !path
         .extension()
@@ -874,9 +937,9 @@ fn start_ffmpeg(
 }
 
 /// Clamped sRGB bytes, three a pixel.
-fn rgb8(image: &Image) -> Vec<u8> {
-    image
-        .to_rgba8()
+fn rgb8(picture: &Picture) -> Vec<u8> {
+    picture
+        .rgba8()
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
         .collect()

@@ -45,6 +45,12 @@ pub struct Setup {
     /// without `--stats`, sequences): their [`Frame`]'s statistics then count nothing but
     /// the camera rays. At 1920×1080 the statistics are 66 MB to read back and convert.
     pub image_only: bool,
+    /// GPU frames are finished on the device: clamped and sRGB-encoded to RGBA8 by the kernel
+    /// (bit for bit the host's encoding), and only those 4 bytes a pixel read back instead of
+    /// the linear colours (16): their [`Frame`] has [`Frame::finished`] and an empty linear
+    /// image. For outputs of 8-bit pixels (PNG, JPEG, video); not for OpenEXR, `--reference`
+    /// or `--aux`, which read the linear colours. The CPU backend renders as ever.
+    pub finished: bool,
 }
 
 /// The GPU kernel asked for on the command line (`--kernel`).
@@ -367,12 +373,17 @@ pub struct Frame {
     pub phases: Option<crate::gpu::Phases>,
     /// What each device did, when several rendered the frame.
     pub shares: Vec<gpu::launch::Share>,
+    /// The pixels the GPU finished ([`Setup::finished`]); `render.image` is then empty.
+    pub finished: Option<crate::image::Rgba8>,
 }
 
 impl Frame {
-    /// The frame's pixels to write, taken out of it (its image is left empty): its linear
-    /// image.
+    /// The frame's pixels to write, taken out of it (its image is left empty): those the GPU
+    /// finished, else its linear image.
     pub fn take_picture(&mut self) -> crate::image::Picture {
+        if let Some(f) = self.finished.take() {
+            return crate::image::Picture::Finished(f);
+        }
         let image = &mut self.render.image;
         let empty = crate::image::Image {
             width: image.width,
@@ -762,6 +773,7 @@ impl Prepared {
                     parameters: false,
                     kernel: wgsl::KernelChoice::default(),
                     image_only: false,
+                    finished: false,
                 };
                 Ok((Self::on_cpu(scene, lowered, &setup)?, true))
             }
@@ -1209,6 +1221,7 @@ impl Prepared {
     ) -> Result<Frame, String> {
         self.check_contract(scene)?;
         let statistics = !self.setup().is_some_and(|s| s.image_only);
+        let finished = self.setup().is_some_and(|s| s.finished);
         match self {
             Prepared::Cpu { tapes, options, .. } => {
                 let tiles = cpu::tile_count(&scene.settings, options).max(1) as f64;
@@ -1225,6 +1238,7 @@ impl Prepared {
                     wall: time,
                     phases: None,
                     shares: Vec::new(),
+                    finished: None,
                 })
             }
             Prepared::Wgpu {
@@ -1238,7 +1252,7 @@ impl Prepared {
                     scene,
                     kernel,
                     *lipschitz,
-                    (faults, statistics),
+                    (faults, statistics, finished),
                     &mut |f| progress(f),
                 )
                 .map_err(|e| e.to_string())?;
@@ -1259,7 +1273,7 @@ impl Prepared {
                         module.data.as_deref(),
                     ),
                     *lipschitz,
-                    (faults, statistics),
+                    (faults, statistics, finished),
                     &mut |f| progress(f),
                 )
                 .map_err(|e| e.to_string())?;
@@ -1312,7 +1326,7 @@ impl Prepared {
                     &workers,
                     scene,
                     (lipschitz, uniform, data),
-                    (faults, statistics),
+                    (faults, statistics, finished),
                     &mut |f| progress(f),
                 )?;
                 Ok(Frame::of(r))
@@ -1329,6 +1343,7 @@ impl Frame {
             wall: r.wall,
             phases: Some(r.phases),
             shares: r.shares,
+            finished: r.finished,
         }
     }
 }

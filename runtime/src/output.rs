@@ -63,7 +63,7 @@ impl Format {
 }
 
 /// The picture's PNG bytes (at `level`), with the steps of their encoding: the sRGB encoding
-/// (none for pixels finished on the GPU) and the PNG's filtering and compression.
+/// (nothing to do for pixels finished on the GPU) and the PNG's filtering and compression.
 fn png_steps(
     picture: &Picture,
     level: PngLevel,
@@ -75,10 +75,14 @@ fn png_steps(
     let (width, height) = picture.size();
     let bytes = encode_png(width, height, &rgba, level)?;
     let png = start.elapsed();
-    let mut steps = Vec::new();
-    if picture.linear().is_some() {
-        steps.push(("sRGB", srgb, "clamped and encoded by table".to_string()));
-    }
+    let mut steps = vec![match picture.linear() {
+        Some(_) => ("sRGB", srgb, "clamped and encoded by table".to_string()),
+        None => (
+            "sRGB",
+            srgb,
+            "none here: clamped and encoded by the kernel on the GPU".to_string(),
+        ),
+    }];
     steps.push((
         "PNG",
         png,

@@ -62,7 +62,7 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
             &workers,
             &scene,
             (l, Some(&kernel.contract.uniform), data),
-            (&none, true),
+            (&none, true, false),
             &mut |_| calls += 1,
         )
         .expect("two devices");
@@ -77,6 +77,27 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
         assert!(tiles >= 8, "{name}: {tiles} bands for two devices");
         assert_eq!(calls, tiles, "{name}: progress once per band");
         assert!(two.shares.iter().all(|s| s.failure.is_none()));
+        // The pixels the kernel finishes (clamped, sRGB-encoded) are the host's encoding of
+        // its linear colours, bit for bit: on one device, and assembled from two devices'
+        // bands.
+        let srgb = one.render.image.to_rgba8();
+        let finished = |r: gpu::GpuRender| r.finished.expect("finished pixels").bytes;
+        let alone = gpu::render_faults(&a, &scene, &kernel, l, (&none, false, true), &mut |_| {})
+            .expect("finished on one device");
+        assert!(
+            alone.render.image.linear.is_empty(),
+            "{name}: no linear image"
+        );
+        assert!(finished(alone) == srgb, "{name}: finished pixels differ");
+        let banded = gpu::render_several(
+            &workers,
+            &scene,
+            (l, Some(&kernel.contract.uniform), data),
+            (&none, false, true),
+            &mut |_| {},
+        )
+        .expect("finished on two devices");
+        assert!(finished(banded) == srgb, "{name}: finished bands differ");
     }
 }
 
@@ -107,7 +128,7 @@ fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
             &workers,
             &scene,
             (l, Some(&kernel.contract.uniform), data),
-            (&none, true),
+            (&none, true, false),
             &mut |_| {},
         )
         .expect("cpu and lavapipe");

@@ -1037,7 +1037,8 @@ fn the_parameters_are_returned_and_launches_checked_against_them() {
             ("tile", 1),
             ("image", 2),
             ("stats", 3),
-            ("scene_data", 4)
+            ("scene_data", 4),
+            ("pixels", 5)
         ]
     );
     for p in &written.params {
@@ -1067,6 +1068,7 @@ fn the_parameters_are_returned_and_launches_checked_against_them() {
         arg(2, rw, 16 * pixels),
         arg(3, rw, 4 * 8 * pixels),
         arg(4, Space::Storage { writable: false }, data.len() as u64),
+        arg(5, rw, 4 * pixels),
     ];
     check_arguments(&written.params, &args).expect("the launcher's arguments");
     let refused = |args: &[Argument], what: &str| {
@@ -1074,7 +1076,7 @@ fn the_parameters_are_returned_and_launches_checked_against_them() {
         println!("{what}: {e}");
         e
     };
-    assert!(refused(&args[..4], "no scene data").contains("takes 5 buffers"));
+    assert!(refused(&args[..5], "no finished pixels").contains("takes 6 buffers"));
     let mut small = args.clone();
     small[0].bytes = uniform - 16;
     assert!(refused(&small, "a short uniform").contains("needs at least"));

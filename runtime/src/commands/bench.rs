@@ -214,8 +214,9 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
             debug_nan: false,
             parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
             kernel: args.kernel.unwrap_or_default().choice(),
-            // As `sdfc render --frames` renders a sequence: the image alone.
+            // As `sdfc render --frames` renders a sequence: the image alone, finished on the GPU.
             image_only: true,
+            finished: true,
         };
         let mut kernels = Kernels::new(&pool, (args.backend, args.devices.clone()), setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
@@ -396,6 +397,8 @@ fn time_scene(
         parameters: args.constants == Some(Constants::Parameters),
         kernel: args.kernel.unwrap_or_default().choice(),
         image_only: false,
+        // The image is not kept: the GPU finishes it, and only its 8-bit pixels cross.
+        finished: true,
     };
     if args.backend != Backend::Cpu {
         let options = sdfc_compiler::back::wgsl::Options {

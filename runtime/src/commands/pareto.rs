@@ -171,6 +171,7 @@ fn measure(
         parameters: false,
         kernel: Default::default(),
         image_only: false,
+        finished: false,
     };
     let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
@@ -261,6 +262,7 @@ fn reference_setup(
         parameters: false,
         kernel: Default::default(),
         image_only: false,
+        finished: false,
     };
     let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
     Ok((reference_scene, prepared))

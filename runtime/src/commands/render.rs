@@ -141,6 +141,11 @@ impl CliError {
 /// Runs `sdfc render`: one image, or a sequence of frames (`--frames`, or an output pattern
 /// with `#`; docs/animation.md).
 pub fn run(args: RenderArgs) -> ExitCode {
+    // One device, the first: the CUDA driver need not prepare the others (before any thread
+    // starts, as the environment is shared).
+    if args.devices == Devices::Auto && matches!(args.backend, Backend::Auto | Backend::Cuda) {
+        crate::gpu::cuda::only_first_device();
+    }
     let sequence = args.frames.is_some()
         || args
             .output
@@ -329,6 +334,11 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
         parameters: false,
         kernel: args.kernel.unwrap_or_default().choice(),
         image_only: !args.stats,
+        // 8-bit outputs take the pixels the GPU finished; OpenEXR, the reference's check
+        // and the sidecar read the linear colours.
+        finished: !args.reference
+            && !args.aux
+            && !matches!(&out, Output::File { format, .. } if format.linear()),
     };
     let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup, opening)?;
     run.split("preparation", "the rest of it", prepared.preparation());

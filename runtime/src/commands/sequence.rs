@@ -71,6 +71,8 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         parameters: true,
         kernel: args.kernel.unwrap_or_default().choice(),
         image_only: true,
+        // 8-bit frames take the pixels the GPU finished; OpenEXR the linear colours.
+        finished: !matches!(&target, Target::Numbered(_, format) if format.linear()),
     };
     let mine: Vec<u64> = shard.frames(frames).collect();
     let todo: Vec<u64> = mine

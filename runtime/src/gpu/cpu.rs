@@ -71,6 +71,7 @@ impl launch::Device for Device<'_> {
                 t.1 as usize * w..(t.1 + t.3) as usize * w,
                 Pixels {
                     linear,
+                    rgba: Vec::new(),
                     steps,
                     counters,
                     convert: Duration::ZERO,
@@ -80,7 +81,7 @@ impl launch::Device for Device<'_> {
         Ok(())
     }
 
-    fn read(&self, f: &mut Frame, _job: &Job, ranges: &[Range<usize>]) -> Result<Pixels, String> {
+    fn read(&self, f: &mut Frame, job: &Job, ranges: &[Range<usize>]) -> Result<Pixels, String> {
         let mut out = Pixels::default();
         for r in ranges {
             let at = f
@@ -89,7 +90,22 @@ impl launch::Device for Device<'_> {
                 .position(|(have, _)| have == r)
                 .ok_or_else(|| format!("the CPU did not render pixels {r:?}"))?;
             let (_, p) = f.rendered.swap_remove(at);
-            out.linear.extend(p.linear);
+            if job.finished {
+                // Finished here as a GPU finishes its pixels: clamped and sRGB-encoded.
+                let start = std::time::Instant::now();
+                let table = crate::image::SrgbTable::get();
+                out.rgba.extend(p.linear.iter().flat_map(|c| {
+                    [
+                        table.encode(c[0]),
+                        table.encode(c[1]),
+                        table.encode(c[2]),
+                        255,
+                    ]
+                }));
+                out.convert += start.elapsed();
+            } else {
+                out.linear.extend(p.linear);
+            }
             out.steps.extend(p.steps);
             out.counters.add(&p.counters);
         }

@@ -43,6 +43,10 @@ pub struct Job<'a> {
     /// 1920×1080 they are 66 MB beside the image's 33 MB. Without them the frame's steps are
     /// zero and its counters empty (the kernel still writes them on the device).
     pub statistics: bool,
+    /// Whether to read back the finished pixels (RGBA8, sRGB-encoded on the device: 4 bytes
+    /// a pixel) instead of the linear colours (16 bytes a pixel on the device, 12 on the
+    /// host): the frame then has no linear image.
+    pub finished: bool,
 }
 
 impl Job<'_> {
@@ -59,12 +63,13 @@ impl Job<'_> {
     }
 }
 
-/// Pixels read back from a device, in the order of the ranges asked for: linear colours,
-/// marching steps per pixel and the counters they add up to, and how long converting them
-/// from the device's layout took.
+/// Pixels read back from a device, in the order of the ranges asked for: linear colours (or,
+/// for a job that asks for them, finished RGBA8 bytes), marching steps per pixel and the
+/// counters they add up to, and how long converting them from the device's layout took.
 #[derive(Debug, Default)]
 pub struct Pixels {
     pub linear: Vec<[f32; 3]>,
+    pub rgba: Vec<u8>,
     pub steps: Vec<u32>,
     pub counters: Counters,
     pub convert: Duration,
@@ -102,10 +107,12 @@ pub trait Device: Sync {
     fn fault(&self, message: String) -> Self::Error;
 }
 
-/// A frame rendered by the scheduler.
+/// A frame rendered by the scheduler: its linear colours, or its finished RGBA8 bytes when
+/// the job asked for them ([`Job::finished`]).
 #[derive(Debug)]
 pub struct Output {
     pub linear: Vec<[f32; 3]>,
+    pub rgba: Vec<u8>,
     pub steps: Vec<u32>,
     pub counters: Counters,
     pub phases: Phases,
@@ -250,6 +257,7 @@ pub fn render_one<D: Device>(
     let device_time = device.finish(frame, job)?;
     Ok(Output {
         linear: pixels.linear,
+        rgba: pixels.rgba,
         steps: pixels.steps,
         counters: pixels.counters,
         phases: Phases {
@@ -458,7 +466,10 @@ pub fn render_several(
         events: tx,
     };
     let pixels = job.pixels();
-    let mut linear = vec![[0.0f32; 3]; pixels];
+    let (mut linear, mut rgba) = match job.finished {
+        true => (Vec::new(), vec![0u8; 4 * pixels]),
+        false => (vec![[0.0f32; 3]; pixels], Vec::new()),
+    };
     let mut steps = vec![0u32; pixels];
     let mut counters = Counters::default();
     let mut assembly = Duration::ZERO;
@@ -489,7 +500,10 @@ pub fn render_several(
         let mut receive = |(band, p): (usize, Pixels)| {
             let t = Instant::now();
             let range = job.band(band);
-            linear[range.clone()].copy_from_slice(&p.linear);
+            match job.finished {
+                true => rgba[4 * range.start..4 * range.end].copy_from_slice(&p.rgba),
+                false => linear[range.clone()].copy_from_slice(&p.linear),
+            }
             steps[range].copy_from_slice(&p.steps);
             counters.add(&p.counters);
             done += 1;
@@ -554,6 +568,7 @@ pub fn render_several(
     phases.convert += assembly;
     Ok(Output {
         linear,
+        rgba,
         steps,
         counters,
         phases,
@@ -646,6 +661,7 @@ mod tests {
             tiles: &tiles,
             timed: false,
             statistics: true,
+            finished: false,
         };
         let failed = std::sync::atomic::AtomicUsize::new(0);
         let good = Fake {

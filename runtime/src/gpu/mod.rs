@@ -9,7 +9,7 @@ pub mod points;
 pub mod wgpu;
 
 use crate::cpu::{Counters, Render, Stats};
-use crate::image::Image;
+use crate::image::{Image, Rgba8};
 use crate::memory::Memory;
 use sdfc_compiler::back::wgsl::{self, Kernel, STATS_WORDS};
 use sdfc_compiler::scene::{Scene, Settings};
@@ -53,8 +53,11 @@ pub const TILE: u32 = 2048;
 /// A GPU render and how long the GPU spent on it.
 #[derive(Debug, Clone)]
 pub struct GpuRender {
-    /// Image and statistics.
+    /// Image and statistics (the image empty when the frame was finished on the device).
     pub render: Render,
+    /// The pixels finished on the device (clamped, sRGB-encoded RGBA8), when they were read
+    /// back instead of the linear colours ([`launch::Job::finished`]).
+    pub finished: Option<Rgba8>,
     /// Where the frame's wall time went on the host.
     pub phases: Phases,
     /// Time of the dispatches (GPU timestamps where the adapter has them, else wall time).
@@ -115,19 +118,20 @@ pub fn render(
         scene,
         kernel,
         lipschitz,
-        (&launch::Faults::from_env(), true),
+        (&launch::Faults::from_env(), true, false),
         progress,
     )
 }
 
 /// [`render`] with the faults `faults` injected, reading the per-pixel statistics back only
-/// when `statistics` ([`launch::Job::statistics`]).
+/// when `statistics` ([`launch::Job::statistics`]), and the finished pixels instead of the
+/// linear colours when `finished` ([`launch::Job::finished`]).
 pub fn render_faults(
     gpu: &Gpu,
     scene: &Scene,
     kernel: &Kernel,
     lipschitz: f64,
-    (faults, statistics): (&launch::Faults, bool),
+    (faults, statistics, finished): (&launch::Faults, bool, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, Error> {
     let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)
@@ -138,20 +142,21 @@ pub fn render_faults(
         scene,
         &uniforms,
         kernel.data.as_deref(),
-        (faults, statistics),
+        (faults, statistics, finished),
         progress,
     )
 }
 
 /// Renders `scene` with a kernel already loaded on a CUDA device, whose uniform is laid out
 /// as `uniform`; `data` is the kernel's scene data ([`Kernel::data`]); `faults` are injected,
-/// and the per-pixel statistics read back only when `statistics`.
+/// the per-pixel statistics read back only when `statistics`, the finished pixels instead of
+/// the linear colours when `finished`.
 pub fn render_cuda(
     cuda: &cuda::Cuda,
     scene: &Scene,
     (loaded, uniform, data): (&cuda::Loaded, &wgsl::Uniform, Option<&[u8]>),
     lipschitz: f64,
-    (faults, statistics): (&launch::Faults, bool),
+    (faults, statistics, finished): (&launch::Faults, bool, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, cuda::Error> {
     let uniforms =
@@ -162,7 +167,7 @@ pub fn render_cuda(
         scene,
         &uniforms,
         data,
-        (faults, statistics),
+        (faults, statistics, finished),
         progress,
     )
 }
@@ -173,7 +178,7 @@ fn render_one<D: launch::Device>(
     scene: &Scene,
     uniforms: &[u8],
     data: Option<&[u8]>,
-    (faults, statistics): (&launch::Faults, bool),
+    (faults, statistics, finished): (&launch::Faults, bool, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, D::Error> {
     let s = &scene.settings;
@@ -186,6 +191,7 @@ fn render_one<D: launch::Device>(
         tiles: &tiles,
         timed: true,
         statistics,
+        finished,
     };
     let out = launch::render_one(device, &job, faults, progress)?;
     Ok(finish(out, s))
@@ -199,7 +205,7 @@ pub fn render_several(
     devices: &[&dyn launch::Worker],
     scene: &Scene,
     (lipschitz, uniform, data): (f64, Option<&wgsl::Uniform>, Option<&[u8]>),
-    (faults, statistics): (&launch::Faults, bool),
+    (faults, statistics, finished): (&launch::Faults, bool, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, String> {
     let s = &scene.settings;
@@ -216,6 +222,7 @@ pub fn render_several(
         tiles: &tiles,
         timed: false,
         statistics,
+        finished,
     };
     let out = launch::render_several(devices, &job, faults, progress)?;
     Ok(finish(out, s))
@@ -229,6 +236,11 @@ fn finish(out: launch::Output, s: &Settings) -> GpuRender {
     let stats = Stats::new(counters, &out.steps);
     let mut phases = out.phases;
     phases.convert += start.elapsed();
+    let finished = (!out.rgba.is_empty()).then(|| Rgba8 {
+        width: s.width,
+        height: s.height,
+        bytes: out.rgba,
+    });
     GpuRender {
         render: Render {
             image: Image {
@@ -239,6 +251,7 @@ fn finish(out: launch::Output, s: &Settings) -> GpuRender {
             stats,
             depth: None,
         },
+        finished,
         phases,
         time: out.device_time.unwrap_or(out.wall),
         timestamps: out.device_time.is_some(),
@@ -249,8 +262,8 @@ fn finish(out: launch::Output, s: &Settings) -> GpuRender {
 
 /// The most a wgpu render of `settings` allocates, with a scene uniform of `uniforms` bytes and
 /// scene data of `data` bytes. On the device: the uniform, the scene data, the tile table, the
-/// image (16 bytes a pixel) and statistics buffers, their readback copies and the timestamp
-/// queries. On the host: wgpu's staging copy of the scene data, the tile table (and its
+/// image (16 bytes a pixel), finished pixels (4) and statistics buffers, their readback copies
+/// and the timestamp queries. On the host: wgpu's staging copy of the scene data, the tile table (and its
 /// staging copy), the read-back bytes and their conversion to colours and statistics words,
 /// then the statistics' per-pixel steps and their sorted copy.
 pub fn memory_wgpu(settings: &Settings, uniforms: u64, data: u64) -> Memory {
@@ -258,7 +271,7 @@ pub fn memory_wgpu(settings: &Settings, uniforms: u64, data: u64) -> Memory {
     let stats = 4 * STATS_WORDS as u64 * pixels;
     let table = tiles * 256;
     let queries = 2 * tiles * 8;
-    let device = uniforms.max(16) + data + table + 2 * (16 * pixels + stats) + 3 * queries;
+    let device = uniforms.max(16) + data + table + 2 * (20 * pixels + stats) + 3 * queries;
     // Read back: the image's bytes (16 a pixel), floats (16) and colours (12), and the
     // statistics' bytes and words, all held at once (more than the colours, words, steps and
     // sorted steps held afterwards).
@@ -267,13 +280,13 @@ pub fn memory_wgpu(settings: &Settings, uniforms: u64, data: u64) -> Memory {
 }
 
 /// The most a CUDA render of `settings` allocates, with a scene uniform of `uniforms` bytes
-/// and scene data of `data` bytes: on the device the uniform, scene data, tile table, image and
-/// statistics; on the host the tile table, the read-back floats (16 bytes a pixel), colours
+/// and scene data of `data` bytes: on the device the uniform, scene data, tile table, image,
+/// finished pixels (4 bytes a pixel) and statistics; on the host the tile table, the read-back floats (16 bytes a pixel), colours
 /// (12) and statistics, then the steps.
 pub fn memory_cuda(settings: &Settings, uniforms: u64, data: u64) -> Memory {
     let (pixels, tiles) = pixels_and_tiles(settings);
     let stats = 4 * STATS_WORDS as u64 * pixels;
-    let device = uniforms + data + 16 * tiles + 16 * pixels + stats;
+    let device = uniforms + data + 16 * tiles + 20 * pixels + stats;
     let host = 16 * tiles + 64 * tiles + 16 * pixels + 12 * pixels + stats + 8 * pixels;
     Memory { host, device }
 }

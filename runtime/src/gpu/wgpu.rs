@@ -69,6 +69,10 @@ pub struct Gpu {
     /// (a benchmark's or a sequence's frames): wgpu clears a new storage buffer before its
     /// first use, which each frame would otherwise pay for within its launches.
     spare: Mutex<Option<Buffers>>,
+    /// Staging buffers for reading back, kept across frames by size: a new one is allocated
+    /// and mapped into the process each time otherwise (33 MB for a 1920×1080 frame's
+    /// linear colours).
+    staging: Mutex<Vec<wgpu::Buffer>>,
 }
 
 /// How a kernel's pipeline was obtained ([`Gpu::pipeline_for`]).
@@ -116,6 +120,17 @@ pub struct FrameBuffers {
     bind: wgpu::BindGroup,
     queries: Option<wgpu::QuerySet>,
     memory: Option<wgpu::ErrorScopeGuard>,
+}
+
+impl FrameBuffers {
+    /// The frame's finished pixels on the device (binding 5: RGBA8, sRGB-encoded, red in the
+    /// low byte, a row of `width` pixels after another), for a caller that draws them without
+    /// reading them back: after [`launch::Device::run`], copy it into an `Rgba8UnormSrgb`
+    /// texture (`copy_buffer_to_texture`, rows padded to 256 bytes where the width needs it)
+    /// on [`Gpu::queue`]. The buffer has `COPY_SRC` usage.
+    pub fn pixels(&self) -> &wgpu::Buffer {
+        &self.buffers.pixels
+    }
 }
 
 impl std::fmt::Debug for FrameBuffers {
@@ -227,6 +242,7 @@ impl Gpu {
             driver_cache,
             pipelines: Mutex::new(HashMap::new()),
             spare: Mutex::new(None),
+            staging: Mutex::new(Vec::new()),
         })
     }
 
@@ -366,8 +382,8 @@ impl Gpu {
     }
 
     /// The pipeline and its bind group layout: binding 0 the scene uniform, 1 the tile table
-    /// (a uniform at a dynamic offset), 2 the image and 3 the statistics (storage), and 4 the
-    /// scene data (read-only storage) when the kernel has it. The driver is given the
+    /// (a uniform at a dynamic offset), 2 the image, 3 the statistics and 5 the finished
+    /// pixels (storage), and 4 the scene data (read-only storage) when the kernel has it. The driver is given the
     /// pipeline cache data an earlier process stored for this kernel on this device, or else
     /// what it produces is stored ([`Gpu::driver_cache_path`]).
     fn pipeline(
@@ -426,6 +442,7 @@ impl Gpu {
             entry(1, uniform(true)),
             entry(2, storage(false)),
             entry(3, storage(false)),
+            entry(5, storage(false)),
         ];
         if data {
             entries.push(entry(4, storage(true)));
@@ -535,6 +552,7 @@ impl Gpu {
                 U::UNIFORM | U::COPY_DST,
             ),
             image: make("sdfc image", pixels * 16, U::STORAGE | U::COPY_SRC),
+            pixels: make("sdfc pixels", pixels * 4, U::STORAGE | U::COPY_SRC),
             stats: make(
                 "sdfc stats",
                 pixels * 4 * STATS_WORDS as u64,
@@ -565,6 +583,10 @@ impl Gpu {
             wgpu::BindGroupEntry {
                 binding: 3,
                 resource: b.stats.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: b.pixels.as_entire_binding(),
             },
         ];
         if let Some(data) = &b.data {
@@ -627,11 +649,17 @@ impl Gpu {
         f: impl FnOnce(&[u8]) -> T,
     ) -> Result<T, Error> {
         let size: u64 = ranges.iter().map(|r| r.end - r.start).sum();
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sdfc readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
+        let kept = self.staging.lock().ok().and_then(|mut kept| {
+            let at = kept.iter().position(|b| b.size() == size)?;
+            Some(kept.swap_remove(at))
+        });
+        let staging = kept.unwrap_or_else(|| {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sdfc readback"),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
         let mut at = 0;
@@ -653,6 +681,13 @@ impl Gpu {
             .get_mapped_range()
             .map_err(|e| Error::Render(e.to_string()))?);
         staging.unmap();
+        if let Ok(mut kept) = self.staging.lock() {
+            // The few sizes a frame reads back (image or pixels, statistics, timestamps).
+            if kept.len() >= 4 {
+                kept.remove(0);
+            }
+            kept.push(staging);
+        }
         Ok(out)
     }
 
@@ -687,6 +722,7 @@ struct Buffers {
     data: Option<wgpu::Buffer>,
     tile: wgpu::Buffer,
     image: wgpu::Buffer,
+    pixels: wgpu::Buffer,
     stats: wgpu::Buffer,
 }
 
@@ -804,15 +840,24 @@ impl launch::Device for Kernel<'_> {
         use rayon::prelude::*;
         let mut convert = Duration::ZERO;
         let f32_at = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-        let linear = self.gpu.read_with(&f.buffers.image, &bytes(16), |b| {
-            let start = Instant::now();
-            let linear = b
-                .par_chunks_exact(16)
-                .map(|c| [f32_at(&c[0..4]), f32_at(&c[4..8]), f32_at(&c[8..12])])
-                .collect();
-            convert += start.elapsed();
-            linear
-        })?;
+        let (linear, rgba) = if job.finished {
+            // The finished pixels are the bytes to write: copied out as they are.
+            let rgba = self
+                .gpu
+                .read_with(&f.buffers.pixels, &bytes(4), |b| b.to_vec())?;
+            (Vec::new(), rgba)
+        } else {
+            let linear = self.gpu.read_with(&f.buffers.image, &bytes(16), |b| {
+                let start = Instant::now();
+                let linear = b
+                    .par_chunks_exact(16)
+                    .map(|c| [f32_at(&c[0..4]), f32_at(&c[4..8]), f32_at(&c[8..12])])
+                    .collect();
+                convert += start.elapsed();
+                linear
+            })?;
+            (linear, Vec::new())
+        };
         let words: Vec<u32> = if job.statistics {
             let stats = bytes(4 * STATS_WORDS as u64);
             self.gpu.read_with(&f.buffers.stats, &stats, |b| {
@@ -831,6 +876,7 @@ impl launch::Device for Kernel<'_> {
         let (counters, steps) = super::counters(&words, ranges);
         Ok(Pixels {
             linear,
+            rgba,
             steps,
             counters,
             convert: convert + start.elapsed(),

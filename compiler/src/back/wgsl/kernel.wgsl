@@ -41,12 +41,15 @@ struct Params {
     dirs: array<DirLight, {{DIRS}}>,
 //#endif
     materials: array<Material, {{MATERIALS}}>,
+    srgb: array<vec4<f32>, 64>, // the least linear value of each 8-bit sRGB code (srgb.rs)
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> tile: vec4<u32>; // x0, y0, width, height
 @group(0) @binding(2) var<storage, read_write> image: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> stats: array<u32>;
+// The finished pixels: RGBA8, sRGB-encoded, red in the low byte.
+@group(0) @binding(5) var<storage, read_write> pixels: array<u32>;
 //#if SCENE_DATA
 // The primitives and hierarchy of a large analytically traced scene, the instances of a large
 // marched one (layouts: compiler/src/back/wgsl/buffer.rs, march.rs), or the constants of the
@@ -543,6 +546,28 @@ fn camera_dir(x: u32, y: u32, i: u32, j: u32) -> vec3<f32> {
     return normalize(params.cam_w.xyz + params.cam_u.xyz * (bx * params.view.x) + params.cam_v.xyz * (by * params.view.y));
 }
 
+// Threshold `k` of the sRGB encoding (`params.srgb`, four to a vector).
+fn srgb_threshold(k: u32) -> f32 {
+    let q = params.srgb[k >> 2u];
+    let m = k & 3u;
+    return select(select(q.x, q.y, m == 1u), select(q.z, q.w, m == 3u), m >= 2u);
+}
+
+// A linear value clamped to [0, 1] (NaN as 0) and sRGB-encoded to 8 bits, bit for bit the
+// host's (srgb.rs): the number of thresholds at or below it, by binary search. A NaN or a
+// value below the first threshold compares false at every step.
+fn srgb_code(c: f32) -> u32 {
+    var v = select(0u, 128u, c >= srgb_threshold(128u));
+    v += select(0u, 64u, c >= srgb_threshold(v + 64u));
+    v += select(0u, 32u, c >= srgb_threshold(v + 32u));
+    v += select(0u, 16u, c >= srgb_threshold(v + 16u));
+    v += select(0u, 8u, c >= srgb_threshold(v + 8u));
+    v += select(0u, 4u, c >= srgb_threshold(v + 4u));
+    v += select(0u, 2u, c >= srgb_threshold(v + 2u));
+    v += select(0u, 1u, c >= srgb_threshold(v + 1u));
+    return v;
+}
+
 @compute @workgroup_size({{WORKGROUP}}, {{WORKGROUP}}, 1)
 fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     if gid.x >= tile.z || gid.y >= tile.w {
@@ -564,7 +589,9 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 //#endif
     let pixel = y * params.counts.x + x;
-    image[pixel] = vec4<f32>(sum / f32(aa * aa), 1.0);
+    let colour = sum / f32(aa * aa);
+    image[pixel] = vec4<f32>(colour, 1.0);
+    pixels[pixel] = srgb_code(colour.x) | (srgb_code(colour.y) << 8u) | (srgb_code(colour.z) << 16u) | (255u << 24u);
     let s = pixel * 8u;
     stats[s] = counters.steps;
     stats[s + 1u] = counters.hits;

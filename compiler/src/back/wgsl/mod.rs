@@ -7,7 +7,10 @@
 //! linear colour per pixel), 3 the statistics ([`STATS_WORDS`] `u32` per pixel), and, only in
 //! the kernel of an analytically traced scene of more than [`MAX_UNROLLED`] primitives or of a
 //! marched scene whose root union has more than [`MAX_INSTANCES`] instances, 4 the read-only
-//! `scene_data` (`array<vec4<f32>>`, [`Kernel::data`]; layouts in buffer.rs and march.rs).
+//! `scene_data` (`array<vec4<f32>>`, [`Kernel::data`]; layouts in buffer.rs and march.rs),
+//! and 5 the finished pixels (`u32` per pixel: the colour clamped and sRGB-encoded to RGBA8,
+//! [`srgb`], alpha 255, red in the low byte), which a host that has no use for the linear
+//! colours reads back instead (a quarter of the bytes) and a viewer can draw from.
 
 mod analytic;
 mod buffer;
@@ -17,6 +20,7 @@ pub mod layout;
 mod map;
 mod march;
 pub mod part;
+pub mod srgb;
 mod template;
 
 pub use analytic::MAX_UNROLLED;
@@ -637,6 +641,10 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             &[m.reflect, m.transparency, m.ior.max(1e-6), 0.0],
         )?;
         w.floats(&at("shift"), &v4(shift, 0.0))?;
+    }
+    for (k, t) in srgb::thresholds().chunks_exact(4).enumerate() {
+        let t: Vec<f64> = t.iter().map(|&x| f64::from(x)).collect();
+        w.floats(&format!("srgb[{k}]"), &t)?;
     }
     w.finish()
 }

@@ -842,9 +842,14 @@ impl launch::Device for Kernel<'_> {
         let f32_at = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
         let (linear, rgba) = if job.finished {
             // The finished pixels are the bytes to write: copied out as they are.
-            let rgba = self
-                .gpu
-                .read_with(&f.buffers.pixels, &bytes(4), |b| b.to_vec())?;
+            let rgba = self.gpu.read_with(&f.buffers.pixels, &bytes(4), |b| {
+                // Copied out by every core, as the linear colours are converted.
+                let mut out = vec![0u8; b.len()];
+                out.par_chunks_mut(1 << 16)
+                    .zip(b.par_chunks(1 << 16))
+                    .for_each(|(o, i)| o.copy_from_slice(i));
+                out
+            })?;
             (Vec::new(), rgba)
         } else {
             let linear = self.gpu.read_with(&f.buffers.image, &bytes(16), |b| {

@@ -324,7 +324,9 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
     queue.write_buffer(&tile_buf, 0, &tile);
     let image = buffer(pixels * 16, U::STORAGE | U::COPY_SRC);
     let stats = buffer(pixels * 4 * 8, U::STORAGE);
+    let finished = buffer(pixels * 4, U::STORAGE | U::COPY_SRC);
     let readback = buffer(pixels * 16, U::MAP_READ | U::COPY_DST);
+    let readback8 = buffer(pixels * 4, U::MAP_READ | U::COPY_DST);
     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
         layout: &pipeline.get_bind_group_layout(0),
@@ -345,6 +347,10 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
                 binding: 3,
                 resource: stats.as_entire_binding(),
             },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: finished.as_entire_binding(),
+            },
         ],
     });
     let mut enc = device.create_command_encoder(&Default::default());
@@ -355,13 +361,17 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
         pass.dispatch_workgroups(width.div_ceil(group), height.div_ceil(group), 1);
     }
     enc.copy_buffer_to_buffer(&image, 0, &readback, 0, pixels * 16);
+    enc.copy_buffer_to_buffer(&finished, 0, &readback8, 0, pixels * 4);
     queue.submit([enc.finish()]);
     let slice = readback.slice(..);
     slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
+    let slice8 = readback8.slice(..);
+    slice8.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
     device
         .poll(wgpu::PollType::wait_indefinitely())
         .expect("poll");
     let bytes = slice.get_mapped_range().expect("mapped").to_vec();
+    let rgba8 = slice8.get_mapped_range().expect("mapped").to_vec();
     let linear: Vec<[f32; 3]> = bytes
         .chunks_exact(16)
         .map(|c| {
@@ -382,6 +392,11 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
     let (a, b) = (ours.to_rgba8(), reference.to_rgba8());
     let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
     assert_eq!(differ, 0, "{differ} bytes differ from `sdfc render`");
+    // The pixels the kernel finished (binding 5) are those bytes already.
+    assert!(
+        rgba8 == a,
+        "the finished pixels differ from the encoded colours"
+    );
     // Not a blank image: the sphere, the box and the floor's two colours are all there.
     let distinct: std::collections::BTreeSet<&[u8]> = a.chunks(4).collect();
     assert!(distinct.len() > 20, "{} colours", distinct.len());

@@ -236,7 +236,7 @@ fn finish(out: launch::Output, s: &Settings) -> GpuRender {
     let stats = Stats::new(counters, &out.steps);
     let mut phases = out.phases;
     phases.convert += start.elapsed();
-    let finished = (!out.rgba.is_empty()).then(|| Rgba8 {
+    let finished = (!out.rgba.is_empty()).then_some(Rgba8 {
         width: s.width,
         height: s.height,
         bytes: out.rgba,

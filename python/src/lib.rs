@@ -323,6 +323,8 @@ impl Scene {
             parameters: false,
             kernel: Kernel::Auto.choice(),
             image_only,
+            // The arrays are the linear colours.
+            finished: false,
         };
         let frame = FrameScene {
             scene: checked.scene,

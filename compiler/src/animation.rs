@@ -55,6 +55,7 @@ impl Structure {
                 Op::Binary(b, x, y) => Some(Op::Binary(b, r(x), r(y))),
                 Op::Select(c, x, y) => Some(Op::Select(r(c), r(x), r(y))),
                 Op::Phi(x, y) => Some(Op::Phi(r(x), r(y))),
+                Op::Mesh(m, x, y, z) => Some(Op::Mesh(m, r(x), r(y), r(z))),
             })
             .collect();
         // A block's range, in instructions that are not constants.

@@ -54,6 +54,8 @@ pub enum Limit {
     /// Registers of the interpreted GPU kernel's file (programs that need more take the
     /// specialised kernel).
     Registers,
+    /// Triangles of the meshes one scene reads (`mesh(path)`), in all.
+    Triangles,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -68,7 +70,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 20] = [
+    pub const ALL: [Limit; 21] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -89,6 +91,7 @@ impl Limit {
         Limit::Frames,
         Limit::Cells,
         Limit::Registers,
+        Limit::Triangles,
     ];
 
     fn spec(self) -> Spec {
@@ -221,6 +224,15 @@ impl Limit {
                 8_190,
                 "registers of the interpreted GPU kernel (programs that need more cannot use it)",
             ),
+            // A triangle takes 144 bytes of the GPU's `scene_data` (its corners and
+            // pseudo-normals) and its hierarchy some 16 more: 800 000 fit the 128 MiB that wgpu's
+            // default limits let a storage buffer bind, and load in about a second.
+            Limit::Triangles => s(
+                "triangles",
+                800_000,
+                1 << 28,
+                "triangles of the meshes one scene reads",
+            ),
         }
     }
 
@@ -259,7 +271,7 @@ impl fmt::Display for Limit {
 /// The value of every limit for one run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 20],
+    values: [u64; 21],
 }
 
 impl Default for Limits {

@@ -45,6 +45,13 @@ impl Loader for FsLoader {
             .map_err(|_| format!("`{}` is not valid UTF-8", full.display()))?;
         Ok((name, text))
     }
+
+    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+        let full = FsLoader::resolve(from, path);
+        let bytes =
+            std::fs::read(&full).map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
+        Ok((normalise(&full), bytes))
+    }
 }
 
 /// A path written with `.` and `..` components folded, so that one file imported by two
@@ -176,6 +183,10 @@ impl Loader for Source {
         }
         self.imports.insert(key, loaded.clone());
         loaded
+    }
+
+    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+        FsLoader.load_bytes(from, path)
     }
 }
 

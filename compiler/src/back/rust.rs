@@ -108,6 +108,12 @@ fn expr(op: &Op, ty: &str) -> String {
         Op::Binary(b, x, y) => binary(b, &r(x), &r(y)),
         Op::Select(c, a, b) => format!("if {} != 0.0 {{ {} }} else {{ {} }}", r(c), r(a), r(b)),
         Op::Phi(a, _) => r(a),
+        // `sdfc compile` refuses such a program before writing it; written anyway, the Rust
+        // says why it cannot build: a mesh's triangles are data the kernels read.
+        Op::Mesh(..) => {
+            "compile_error!(\"a scene with a `mesh` has no Rust form: its triangles are GPU data\")"
+                .into()
+        }
     }
 }
 

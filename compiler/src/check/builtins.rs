@@ -144,7 +144,7 @@ const fn shape(name: &'static str) -> P {
 }
 
 /// The evaluation of one overload on bound, in-range, concrete arguments.
-pub type Imp = fn(&mut Build, &[Value]) -> Result<Value, String>;
+pub type Imp = fn(&mut Build<'_, '_>, &[Value]) -> Result<Value, String>;
 
 /// One overload.
 #[derive(Debug)]
@@ -163,14 +163,106 @@ pub struct Builtin {
     pub sigs: &'static [Sig],
 }
 
-/// What a builtin may touch: the scene graph, and the span of the call for the nodes it adds.
+/// What a builtin may touch: the scene graph, the span of the call for the nodes it adds,
+/// the files `mesh` reads, the limits, and the warnings it gives.
 #[derive(Debug)]
-pub struct Build<'a> {
+pub struct Build<'a, 'l> {
     pub graph: &'a mut Graph,
     pub span: Span,
+    /// The files `mesh(path)` reads (none: no file can be read).
+    pub files: Option<&'a mut super::eval::Files<'l>>,
+    pub limits: &'a Limits,
+    pub warnings: Vec<crate::diagnostics::Diagnostic>,
 }
 
-impl Build<'_> {
+impl Build<'_, '_> {
+    /// The shape of the triangle mesh in the file `path` (relative to the calling file),
+    /// scaled by `scale`: read once per file and scale, with a warning where it is open.
+    fn mesh(&mut self, path: &str, scale: f64) -> Result<Value, String> {
+        use super::meshfile::{read, Format};
+        use crate::program::mesh::{Invalid, TriMesh};
+        let format = Format::of(path).ok_or_else(|| {
+            format!("`{path}` is not a mesh file: `mesh` reads .stl, .obj, .ply and .glb files")
+        })?;
+        let files = self
+            .files
+            .as_deref_mut()
+            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
+        let from = files
+            .names
+            .get(self.span.file.0 as usize)
+            .cloned()
+            .unwrap_or_default();
+        let loader = files
+            .loader
+            .as_deref_mut()
+            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
+        let (name, bytes) = loader.load_bytes(&from, path)?;
+        let key = (name.clone(), scale.to_bits());
+        if let Some(m) = files.meshes.get(&key) {
+            let node = Node::Mesh {
+                mesh: crate::scene::MeshRef(std::sync::Arc::clone(m)),
+            };
+            return self.node(node);
+        }
+        let max = self.limits.get(Limit::Triangles);
+        let left = max.saturating_sub(files.triangles);
+        let read = read(format, &bytes, left).map_err(|e| {
+            let e = if e.contains("`triangles` limit") {
+                format!("{e}; {}", self.limits.raise(Limit::Triangles))
+            } else {
+                e
+            };
+            format!("cannot read the mesh `{path}`: {e}")
+        })?;
+        let mut mesh = TriMesh::new(path, &read.positions, &read.faces, scale).map_err(|e| {
+            let why = match e {
+                Invalid::NotFinite(i) => format!(
+                    "vertex {i} (counting from 0 in the file's order) has a coordinate that is not a finite number"
+                ),
+                Invalid::Index(t, i) => format!("triangle {t} names vertex {i}, which does not exist"),
+                Invalid::Empty => "every triangle has no area".to_string(),
+            };
+            format!("cannot read the mesh `{path}`: {why}")
+        })?;
+        mesh.id = files.next_id;
+        mesh.base = u32::try_from(files.next_base).map_err(|_| {
+            format!("cannot read the mesh `{path}`: the scene's meshes take more than 2^32 vectors of GPU data")
+        })?;
+        files.next_id += 1;
+        files.next_base += mesh.vectors();
+        files.triangles += mesh.triangles().len() as u64;
+        let r = mesh.report;
+        if r.open_edges > 0 || r.non_manifold_edges > 0 {
+            let mut what = Vec::new();
+            if r.open_edges > 0 {
+                what.push(format!("{} open edges (the rims of holes)", r.open_edges));
+            }
+            if r.non_manifold_edges > 0 {
+                what.push(format!(
+                    "{} edges shared by more than two triangles",
+                    r.non_manifold_edges
+                ));
+            }
+            self.warnings.push(
+                crate::diagnostics::Diagnostic::warning(
+                    "W0015",
+                    format!("the mesh `{path}` is not closed: it has {}", what.join(" and ")),
+                    self.span,
+                )
+                .with_label("this mesh")
+                .with_note(
+                    "the distance is exact, but the inside is decided by the nearest triangle's side: right away from the holes, while points that see a hole may take the wrong side, which shows as a seam or a sheet across it",
+                ),
+            );
+        }
+        let mesh = std::sync::Arc::new(mesh);
+        files.meshes.insert(key, std::sync::Arc::clone(&mesh));
+        self.node(Node::Mesh {
+            mesh: crate::scene::MeshRef(mesh),
+        })
+    }
+
     fn node(&mut self, node: Node) -> Result<Value, String> {
         Ok(Value::Shape(self.graph.add(node, self.span)))
     }
@@ -632,6 +724,17 @@ pub static BUILTINS: &[Builtin] = &[
         name: "ellipsoid",
         sigs: sigs![
             [p("radii", V, Req, Pos)] -> S => |b, a| b.node(Node::Ellipsoid { radii: a[0].v3() });
+        ],
+    },
+    Builtin {
+        name: "mesh",
+        sigs: sigs![
+            [p("path", Str, Req, Any), p("scale", F, Num(1.0), Pos)] -> S => |b, a| {
+                let Value::Str(path) = &a[0] else {
+                    return Err("`path` must be a string".into());
+                };
+                b.mesh(path, a[1].num())
+            };
         ],
     },
     Builtin {

@@ -9,6 +9,7 @@ use super::suggest::closest;
 use super::types::{Type, Value};
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
+use crate::program::mesh::TriMesh;
 use crate::scene::{Graph, MaterialId, Node};
 use crate::span::Span;
 use crate::syntax::ast::*;
@@ -33,10 +34,37 @@ pub struct FnInfo {
 /// multiple of the `nesting` limit: chains are not nesting, but they recurse all the same.
 pub const CHAIN_FACTOR: usize = 10;
 
+/// The files `mesh(path)` reads, through the caller's loader, and the meshes read so far.
+#[derive(Default)]
+pub struct Files<'l> {
+    /// The caller's loader (none: no file can be read).
+    pub loader: Option<&'l mut dyn super::Loader>,
+    /// The name of each source file, by `FileId` (a path is relative to its file's).
+    pub names: Vec<String>,
+    /// The meshes built, by file name and scale's bits: a file used twice is read once.
+    pub meshes: HashMap<(String, u64), std::sync::Arc<TriMesh>>,
+    /// The next mesh's id, and where its data starts in `scene_data` (16-byte vectors).
+    pub next_id: u32,
+    pub next_base: u64,
+    /// Triangles of every mesh so far (the `triangles` limit bounds their sum).
+    pub triangles: u64,
+}
+
+impl std::fmt::Debug for Files<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.debug_struct("Files")
+            .field("names", &self.names)
+            .field("meshes", &self.meshes.len())
+            .finish()
+    }
+}
+
 /// The evaluation state of one compilation.
 #[derive(Debug, Default)]
-pub struct Ctx {
+pub struct Ctx<'l> {
     pub diags: Vec<Diagnostic>,
+    /// The files `mesh(path)` reads.
+    pub files: Files<'l>,
     pub graph: Graph,
     pub material_ids: HashMap<String, (MaterialId, Span)>,
     pub globals: HashMap<String, (Value, Span)>,
@@ -94,7 +122,7 @@ struct PView<'a> {
     has_default: bool,
 }
 
-impl Ctx {
+impl Ctx<'_> {
     pub fn error(&mut self, d: Diagnostic) {
         if self.dry == 0 || d.code != "E0401" {
             self.diags.push(d);
@@ -1279,8 +1307,14 @@ impl Ctx {
         let mut build = Build {
             graph: &mut self.graph,
             span,
+            files: Some(&mut self.files),
+            limits: &self.limits,
+            warnings: Vec::new(),
         };
-        match (sig.imp)(&mut build, &vals) {
+        let result = (sig.imp)(&mut build, &vals);
+        let warnings = std::mem::take(&mut build.warnings);
+        self.diags.extend(warnings);
+        match result {
             Ok(v) => self.finite(v, span),
             Err(msg) => {
                 self.error(

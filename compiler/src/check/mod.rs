@@ -8,6 +8,7 @@
 pub mod builtins;
 mod eval;
 pub mod field;
+pub mod meshfile;
 mod ops;
 mod placement;
 mod suggest;
@@ -31,6 +32,12 @@ pub trait Loader {
     /// canonical name (equal names mean the same file) and its text, or a message saying why
     /// it could not be read.
     fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String>;
+
+    /// Reads `path` as written in a `mesh(path)` of the file named `from`, as bytes: its
+    /// name and its contents, or why it could not be read. By default no file can be.
+    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+        Err(format!("files cannot be read here (`{path}`)"))
+    }
 }
 
 /// A loader for sources with no imports: every import is an error.
@@ -121,11 +128,19 @@ fn check_all(
     };
     load.file(entry);
     let depth = load.depth;
+    let names = (0..sources.len() as u32)
+        .map(|f| sources.name(FileId(f)).to_string())
+        .collect();
+    let files = eval::Files {
+        loader: Some(loader),
+        names,
+        ..eval::Files::default()
+    };
     // The checker's walks of the syntax tree, and of the scene built from it, recurse as
     // deeply as the files nest (within the `nesting` limit the parser enforced): they run on
     // a stack that fits, and so does the drop of the tree.
     crate::syntax::with_stack_for(depth, move || {
-        check_loaded(entry, limits, time, diags, items)
+        check_loaded(entry, limits, time, diags, items, files)
     })
 }
 
@@ -136,6 +151,7 @@ fn check_loaded(
     time: f64,
     mut diags: Vec<Diagnostic>,
     items: Vec<ast::Item>,
+    files: eval::Files,
 ) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
     if crate::diagnostics::has_errors(&diags) {
         // After a lexical, syntax or import error, names and items may be missing: checking
@@ -144,6 +160,7 @@ fn check_loaded(
         return (None, diags, Vec::new());
     }
     let mut cx = Ctx::default();
+    cx.files = files;
     cx.diags = diags;
     cx.limits = limits.clone();
     cx.time = time;

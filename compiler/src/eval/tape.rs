@@ -12,6 +12,7 @@
 
 use super::fuse::{self, Finish, Fusions, Kind};
 use super::Float;
+use crate::program::mesh::TriMesh;
 use crate::program::{scalar, Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 
@@ -39,6 +40,8 @@ enum Code {
     Select,
     /// A fused sum of 1 to 3 terms over `a`, `b`, `c` (see [`fuse`]).
     Fused(Kind, u8, Finish),
+    /// The distance to the tape's mesh of this id at the point (`a`, `b`, `c`).
+    Mesh(u32),
 }
 
 /// One instruction over slots: `dst = code(a, b, c)` with the immediate `k` (and, for a
@@ -97,6 +100,8 @@ pub struct Tape {
     /// Whether the last step computes the distance at the top level, and so can write it
     /// straight into the caller's output.
     direct: bool,
+    /// The program's meshes, by id.
+    meshes: Vec<Option<std::sync::Arc<TriMesh>>>,
 }
 
 /// Where each register lives, decided once per tape: scratch slots from [`INPUTS`] up.
@@ -198,6 +203,7 @@ impl Tape {
                 distance: 0,
                 material: None,
                 direct: false,
+                meshes: program.meshes.clone(),
             },
             depth: 0,
         };
@@ -220,6 +226,11 @@ impl Tape {
             .filter(|s| matches!(s, Step::Inst(_)))
             .count();
         c.tape
+    }
+
+    /// The meshes its steps read, by id.
+    pub(super) fn meshes(&self) -> &[Option<std::sync::Arc<TriMesh>>] {
+        &self.meshes
     }
 
     /// Number of instructions run per point (when every guarded block runs).
@@ -491,6 +502,7 @@ impl Compiler<'_> {
                     (None, None) => (Code::Binary(b), vec![x, y], 0.0),
                 },
                 Op::Select(c, a, b) => (Code::Select, vec![c, a, b], 0.0),
+                Op::Mesh(m, x, y, z) => (Code::Mesh(m), vec![x, y, z], 0.0),
                 Op::Const(_) | Op::Input(_) | Op::Phi(..) => (Code::Select, Vec::new(), 0.0),
             },
         };
@@ -577,8 +589,10 @@ impl Inst {
     /// slot of `slots` (scratch slots of `chunk` values, back to back), which is split off
     /// the buffer; operands are read from the rest of it, or from the inputs.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn apply<T: Float>(
         &self,
+        meshes: &[Option<std::sync::Arc<TriMesh>>],
         slots: &mut [T],
         out: Option<&mut [T]>,
         inputs: [&[T]; 3],
@@ -628,6 +642,17 @@ impl Inst {
                     sources.get(self.c),
                 ];
                 fused_loop(kind, terms, finish, d, x, ks, k);
+            }
+            Code::Mesh(m) => {
+                let mesh = meshes[m as usize]
+                    .as_deref()
+                    .expect("a tape holds every mesh its program names");
+                let (x, y, z) = (
+                    sources.get(self.a),
+                    sources.get(self.b),
+                    sources.get(self.c),
+                );
+                map3(d, x, y, z, |x, y, z| mesh.distance([x, y, z]));
             }
         }
     }

@@ -290,6 +290,19 @@ impl Bounds {
                 Bound::of_box([r, half_length + r, *minor], half_length + r)
             }
             Node::InfiniteCylinder { .. } | Node::Slab { .. } => return None,
+            Node::Mesh { mesh } => {
+                let (lo, hi) = mesh.0.aabb();
+                let c = [0, 1, 2].map(|i| (lo[i] + hi[i]) * 0.5);
+                let h = [0, 1, 2].map(|i| (hi[i] - lo[i]) * 0.5);
+                Bound {
+                    sphere: Sphere {
+                        c,
+                        r: (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt(),
+                    },
+                    aabb: Aabb { c, h },
+                    scale: 1.0,
+                }
+            }
             // A profile read as a field of space is a prism along z.
             Node::Circle { radius } => profile([0.0; 2], [*radius; 2]),
             Node::Rect { half } | Node::RoundRect { half, .. } => profile([0.0; 2], *half),
@@ -655,6 +668,8 @@ fn own_cost(node: &Node) -> f64 {
         Node::Circle { .. } => 4.0,
         Node::Rect { .. } | Node::RoundRect { .. } => 12.0,
         Node::Polygon { points } => 20.0 * points.len() as f64,
+        // A walk of the hierarchy: a few dozen boxes and triangles of some 40 operations.
+        Node::Mesh { mesh } => 400.0 + 40.0 * (mesh.0.triangles().len() as f64).log2(),
         Node::Extrude { .. } => 10.0,
         Node::Revolve { .. } => 5.0,
         Node::Feature { .. } => 8.0,

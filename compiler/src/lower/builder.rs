@@ -2,8 +2,10 @@
 //! sharing of equal instructions (when optimising), opens and closes guarded blocks, and
 //! offers the small vector helpers the lowering rules are written with.
 
+use crate::program::mesh::TriMesh;
 use crate::program::{scalar, Axis, Binary, Block, Note, Op, Program, Reg, Unary};
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// A point or vector: three registers.
 pub(super) type P = [Reg; 3];
@@ -29,6 +31,7 @@ enum Key {
     Unary(Unary, Reg),
     Binary(Binary, Reg, Reg),
     Select(Reg, Reg, Reg),
+    Mesh(u32, Reg, Reg, Reg),
 }
 
 /// The scope of registers defined outside every block.
@@ -62,6 +65,8 @@ pub(super) struct Builder {
     pub parametric: bool,
     /// When recording, the constants [`Builder::param`] made, in order.
     pub params: Option<Vec<Param>>,
+    /// The meshes `Op::Mesh` names, by id ([`Program::meshes`]).
+    meshes: Vec<Option<Arc<TriMesh>>>,
 }
 
 impl Builder {
@@ -165,6 +170,7 @@ impl Builder {
             Op::Binary(b, x, y) if commutes(b) && y < x => Key::Binary(b, y, x),
             Op::Binary(b, x, y) => Key::Binary(b, x, y),
             Op::Select(c, a, b) => Key::Select(c, a, b),
+            Op::Mesh(m, x, y, z) => Key::Mesh(m, x, y, z),
             Op::Phi(..) => return self.push(op),
         };
         if let Some(&r) = self.shared.get(&key) {
@@ -223,7 +229,7 @@ impl Builder {
     /// Constant folding and algebraic identities; `None` when the instruction stays.
     fn fold(&mut self, op: Op) -> Option<Reg> {
         match op {
-            Op::Const(_) | Op::Input(_) | Op::Phi(..) => None,
+            Op::Const(_) | Op::Input(_) | Op::Phi(..) | Op::Mesh(..) => None,
             Op::Unary(u, a) => self.fold_unary(u, a),
             Op::Binary(b, x, y) => self.fold_binary(b, x, y),
             Op::Select(c, a, b) => match self.value(c) {
@@ -315,6 +321,7 @@ impl Builder {
             distance: d,
             material: m,
             lipschitz: 1.0,
+            meshes: Vec::new(),
         };
         let (live, live_blocks) = if self.optimise {
             raw.live(&[d, m])
@@ -362,6 +369,7 @@ impl Builder {
             distance: new_index[d.0 as usize],
             material: new_index[m.0 as usize],
             lipschitz: 1.0,
+            meshes: self.meshes,
         }
     }
 }
@@ -393,11 +401,22 @@ fn renumber(op: &Op, new_index: &[Reg]) -> Op {
         Op::Binary(b, x, y) => Op::Binary(b, n(x), n(y)),
         Op::Select(c, a, b) => Op::Select(n(c), n(a), n(b)),
         Op::Phi(a, b) => Op::Phi(n(a), n(b)),
+        Op::Mesh(m, x, y, z) => Op::Mesh(m, n(x), n(y), n(z)),
     }
 }
 
 /// Scalar helpers, one per instruction.
 impl Builder {
+    /// The signed distance to a triangle mesh at `p`.
+    pub fn mesh(&mut self, mesh: &Arc<TriMesh>, p: P) -> Reg {
+        let id = mesh.id as usize;
+        if self.meshes.len() <= id {
+            self.meshes.resize(id + 1, None);
+        }
+        self.meshes[id] = Some(Arc::clone(mesh));
+        self.emit(Op::Mesh(mesh.id, p[0], p[1], p[2]))
+    }
+
     pub fn un(&mut self, u: Unary, a: Reg) -> Reg {
         self.emit(Op::Unary(u, a))
     }

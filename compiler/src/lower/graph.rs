@@ -577,6 +577,7 @@ impl<'a> Lowerer<'a> {
                 b.subc(d, radius)
             }
             Node::Polygon { ref points } => shapes::polygon(b, p, points),
+            Node::Mesh { ref mesh } => b.mesh(&mesh.0, p),
             _ => match shapes::slots(node) {
                 Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
                 None => b.c(EMPTY_DISTANCE),

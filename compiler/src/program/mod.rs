@@ -17,6 +17,7 @@
 
 pub mod float;
 mod live;
+pub mod mesh;
 mod run;
 pub mod scalar;
 mod text;
@@ -106,6 +107,9 @@ pub enum Op {
     /// block's other `Phi`s): `a` (defined inside the block) where the block ran, else `b`
     /// (defined before it).
     Phi(Reg, Reg),
+    /// The signed distance at the point (x, y, z) to the triangle mesh of this index in
+    /// [`Program::meshes`] (`mesh.rs`).
+    Mesh(u32, Reg, Reg, Reg),
 }
 
 impl Op {
@@ -117,6 +121,7 @@ impl Op {
             Op::Binary(_, a, b) => vec![a, b],
             Op::Select(c, a, b) => vec![c, a, b],
             Op::Phi(a, b) => vec![a, b],
+            Op::Mesh(_, x, y, z) => vec![x, y, z],
         }
     }
 }
@@ -171,6 +176,9 @@ pub struct Program {
     pub(crate) distance: Reg,
     pub(crate) material: Reg,
     pub(crate) lipschitz: f64,
+    /// The triangle meshes `Op::Mesh` names, by their index in the scene ([`mesh::TriMesh::id`],
+    /// the same in every program of a scene); `None` for those this program does not use.
+    pub(crate) meshes: Vec<Option<std::sync::Arc<mesh::TriMesh>>>,
 }
 
 impl Program {
@@ -180,6 +188,18 @@ impl Program {
     /// [`Analysis::step_lipschitz`]: crate::scene::analysis::Analysis::step_lipschitz
     pub fn lipschitz(&self) -> f64 {
         self.lipschitz
+    }
+
+    /// The triangle meshes its `Op::Mesh` instructions name, by index.
+    pub fn meshes(&self) -> impl Iterator<Item = &mesh::TriMesh> {
+        self.meshes.iter().flatten().map(|m| &**m)
+    }
+
+    /// The mesh `Op::Mesh` names by `id`.
+    pub fn mesh(&self, id: u32) -> &mesh::TriMesh {
+        self.meshes[id as usize]
+            .as_deref()
+            .expect("the builder records every mesh a program names")
     }
 
     /// The instructions; register `i` is defined by `ops()[i]`.

@@ -51,6 +51,7 @@ impl Program {
                 Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
                 Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
                 Op::Phi(a, _) => r(a),
+                Op::Mesh(m, x, y, z) => self.mesh(m).distance([r(x), r(y), r(z)]),
             };
             i += 1;
         }

@@ -59,6 +59,7 @@ pub fn op_text(op: &Op) -> String {
         Op::Binary(b, x, y) => format!("{} %{}, %{}", binary_name(b), x.0, y.0),
         Op::Select(c, a, b) => format!("select %{}, %{}, %{}", c.0, a.0, b.0),
         Op::Phi(a, b) => format!("phi %{}, %{}", a.0, b.0),
+        Op::Mesh(m, x, y, z) => format!("mesh {m} %{}, %{}, %{}", x.0, y.0, z.0),
     }
 }
 

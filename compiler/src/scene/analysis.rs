@@ -716,6 +716,10 @@ impl Pass<'_> {
             Node::Rect { half } | Node::RoundRect { half, .. } => {
                 exact(profile_bounds(*half), [true; 3])
             }
+            Node::Mesh { mesh } => {
+                let (min, max) = mesh.0.aabb();
+                exact(Aabb { min, max }, [false; 3])
+            }
             Node::Polygon { points } => {
                 let mut b = Aabb::EMPTY;
                 for q in points {

@@ -288,6 +288,15 @@ fn node(n: &Node) -> String {
         Node::RoundRect { half, radius } => {
             format!("round_rect half={} radius={}", v2(*half), num(*radius))
         }
+        Node::Mesh { mesh } => {
+            let m = &mesh.0;
+            format!(
+                "mesh {:?} triangles={} open_edges={}",
+                m.name,
+                m.triangles().len(),
+                m.report.open_edges
+            )
+        }
         Node::Polygon { points } => {
             let ps: Vec<String> = points.iter().map(|q| v2(*q)).collect();
             format!("polygon {}", ps.join(" "))

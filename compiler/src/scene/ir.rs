@@ -283,12 +283,31 @@ pub enum Node {
     Elongate { half: V3, child: NodeId },
     /// Child painted with a material (inner materials take precedence).
     Paint { material: MaterialId, child: NodeId },
+    /// A triangle mesh read from a file (`mesh("part.stl")`), with its hierarchy.
+    Mesh { mesh: MeshRef },
     /// A user field (`field { … }`): the distance is an expression of the point, which may
     /// read other shapes' distances; its L is derived from the expression, or declared.
     Field {
         f: super::field::FieldFn,
         lipschitz: Option<f64>,
     },
+}
+
+/// A triangle mesh of a scene: equal to another when it is the same mesh of the same check
+/// (its [`TriMesh::id`](crate::program::mesh::TriMesh::id)), shown by its file's name.
+#[derive(Clone)]
+pub struct MeshRef(pub std::sync::Arc<crate::program::mesh::TriMesh>);
+
+impl PartialEq for MeshRef {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.id == other.0.id
+    }
+}
+
+impl std::fmt::Debug for MeshRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "mesh {} {:?}", self.0.id, self.0.name)
+    }
 }
 
 /// The pattern of every node with exactly one child (the transforms, the modifiers and
@@ -391,6 +410,7 @@ impl Node {
             Node::Elongate { .. } => "elongate",
             Node::Paint { .. } => "paint",
             Node::Field { .. } => "field",
+            Node::Mesh { .. } => "mesh",
         }
     }
 

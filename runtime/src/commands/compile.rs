@@ -228,6 +228,10 @@ fn part_refused(args: &CompileArgs) -> Option<String> {
     }
 }
 
+/// Why a scene with a `mesh` has no form in a target without a GPU buffer.
+const MESH_DATA: &str = "error: {} has no form for a scene with a `mesh`: its triangles and \
+     their hierarchy are data the renderer kernels read from `scene_data`, not code";
+
 /// The bytes of the distance function alone, named `name`, in `target`.
 pub fn emit_map(
     scene: &scene::Scene,
@@ -235,6 +239,9 @@ pub fn emit_map(
     target: Emit,
     name: &str,
 ) -> Result<Vec<u8>, String> {
+    if lowered.program.meshes().next().is_some() {
+        return Err(MESH_DATA.replace("{}", "`--part map`"));
+    }
     let lang = match target {
         Emit::Rust => return Ok(back::rust::write_named(&lowered.program, name).into_bytes()),
         Emit::Wgsl => None,
@@ -266,6 +273,10 @@ pub fn emit(
     kernel: Option<crate::backend::Kernel>,
 ) -> Result<Vec<u8>, String> {
     let program = &lowered.program;
+    let meshes = program.meshes().next().is_some();
+    if meshes && matches!(target, Emit::Rust | Emit::Shadertoy) {
+        return Err(MESH_DATA.replace("{}", "this target"));
+    }
     let lang = match target {
         Emit::Program => return Ok(program.dump().into_bytes()),
         Emit::Rust => return Ok(back::rust::write(program).into_bytes()),

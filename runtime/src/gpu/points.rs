@@ -75,18 +75,41 @@ fn validated(source: String, group: u32, data: Option<Vec<u8>>) -> Result<Points
     })
 }
 
-/// The part of `scene` (as lowered), `map` and, with `alone`, `map_distance`, with [`entry`].
+/// The part of `scene` (as lowered), `map` and, with `alone`, `map_distance`, with [`entry`];
+/// for a scene with a mesh, which has no part, [`mesh_module`].
 pub fn points_module(
     scene: &Scene,
     lowered: &Lowered,
     alone: bool,
 ) -> Result<PointsModule, String> {
+    if lowered.program.meshes().next().is_some() {
+        return mesh_module(scene, alone);
+    }
     let part = wgsl::part::write(scene, lowered, "map").map_err(|e| e.to_string())?;
     let alone = alone.then_some("map_distance");
     validated(
         format!("{}\n{}", part.source, entry(0, alone, None)),
         0,
         None,
+    )
+}
+
+/// A scene with a mesh has no part (its triangles are data, not code): its marched kernel,
+/// with the meshes in `scene_data`, its `map` and, with `alone`, `sdf` with [`entry`] (in bind
+/// group 1, beside the kernel's group 0).
+fn mesh_module(scene: &Scene, alone: bool) -> Result<PointsModule, String> {
+    let mut marched = scene.clone();
+    marched.settings.method = Method::March;
+    let lowered = Lowered::new(&marched);
+    let kernel = wgsl::write(&marched, &lowered).map_err(|e| e.to_string())?;
+    validated(
+        format!(
+            "{}\n{}",
+            kernel.source,
+            entry(1, alone.then_some("sdf"), None)
+        ),
+        1,
+        kernel.data,
     )
 }
 

@@ -93,4 +93,8 @@ impl Loader for OpenFirst<'_> {
             None => FsLoader.load(from, path),
         }
     }
+
+    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+        FsLoader.load_bytes(from, path)
+    }
 }

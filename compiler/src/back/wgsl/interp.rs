@@ -128,7 +128,8 @@ fn linear(program: &Program, roots: &[Reg]) -> Vec<Ins> {
                         [arg(x), arg(y), Arg::None],
                     ),
                     Op::Select(c, a, b) => (SELECT, [arg(c), arg(a), arg(b)]),
-                    Op::Phi(..) => continue,
+                    // Programs with meshes are refused before they are encoded (`encode`).
+                    Op::Phi(..) | Op::Mesh(..) => continue,
                 };
                 out.push(Ins {
                     op,

@@ -227,7 +227,7 @@ impl<'a> Writer<'a> {
                         "{}let {} = {};",
                         pad(depth),
                         self.names.reg(i),
-                        expr(&ops[i], &self.names, self.params)
+                        expr(self.program, &ops[i], &self.names, self.params)
                     );
                 }
                 Item::Open(b) if self.live_blocks[b] => {
@@ -472,7 +472,7 @@ impl Names {
     }
 }
 
-fn expr(op: &Op, names: &Names, params: Option<&Params>) -> String {
+fn expr(program: &Program, op: &Op, names: &Names, params: Option<&Params>) -> String {
     let n = |r: Reg| names.get(r, params);
     match *op {
         Op::Const(c) => float(c),
@@ -511,6 +511,14 @@ fn expr(op: &Op, names: &Names, params: Option<&Params>) -> String {
         }
         Op::Select(c, a, b) => format!("select({}, {}, {} != 0.0)", n(b), n(a), n(c)),
         Op::Phi(a, _) => n(a),
+        // The walk over the mesh's hierarchy in `scene_data` (mesh.rs).
+        Op::Mesh(m, x, y, z) => format!(
+            "mesh_distance(vec3<f32>({}, {}, {}), {}u)",
+            n(x),
+            n(y),
+            n(z),
+            program.mesh(m).base
+        ),
     }
 }
 

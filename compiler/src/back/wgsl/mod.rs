@@ -19,6 +19,7 @@ pub mod interp;
 pub mod layout;
 mod map;
 mod march;
+mod mesh;
 pub mod part;
 pub mod srgb;
 mod template;
@@ -219,6 +220,29 @@ pub enum KernelKind {
 /// kernel that it asks for cannot render it.
 pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<KernelKind, String> {
     let traced = lowered.traceable.traced(scene.settings.method).is_some();
+    if let Some(data) = meshes_of(scene, lowered).filter(|_| !traced) {
+        // The meshes' triangles are read from `scene_data` by the program written as code.
+        let bytes = data.len() as u64;
+        let mib = scene.limits.get(crate::limits::Limit::SceneData);
+        if bytes > mib.saturating_mul(1 << 20) {
+            return Err(format!(
+                "the scene's meshes take {} MiB of scene_data, above the scene_data limit of \
+                 {mib} MiB; {}",
+                bytes.div_ceil(1 << 20),
+                scene
+                    .limits
+                    .raise_to(crate::limits::Limit::SceneData, bytes.div_ceil(1 << 20))
+            ));
+        }
+        return match options.kernel {
+            KernelChoice::Interpreted => Err(
+                "the interpreted kernel cannot run a scene with a `mesh`: its triangles are \
+                 walked by code; use `--kernel specialised` or `--kernel auto`"
+                    .into(),
+            ),
+            _ => Ok(KernelKind::Specialised),
+        };
+    }
     match options.kernel {
         KernelChoice::Specialised => Ok(KernelKind::Specialised),
         KernelChoice::Interpreted if traced => Err(
@@ -265,6 +289,19 @@ fn media_of<'a>(scene: &Scene, lowered: &'a Lowered) -> Option<&'a crate::lower:
         .iter()
         .any(|&(n, on)| n == "REFRACTION" && on);
     lowered.media.as_ref().filter(|_| refraction)
+}
+
+/// The `scene_data` of the meshes a marched scene's programs name (its media's too), when
+/// they name any (mesh.rs).
+fn meshes_of(scene: &Scene, lowered: &Lowered) -> Option<Vec<u8>> {
+    let media = media_of(scene, lowered);
+    let programs = std::iter::once(&lowered.program)
+        .chain(media.map(|m| &m.medium))
+        .chain(media.map(|m| &m.solid));
+    if !programs.clone().any(mesh::uses_meshes) {
+        return None;
+    }
+    Some(mesh::data(programs))
 }
 
 /// The `scene_data` of the interpreted kernel for a marched scene, or why it cannot hold its
@@ -398,7 +435,21 @@ fn write_template(
             Some(bytes)
         }
         None => {
-            let (mut text, bytes, read) = marched(scene, lowered, options);
+            let meshes = meshes_of(scene, lowered);
+            let (mut text, bytes, read) = match meshes {
+                // The program as code, its constants as literals, the meshes' walk after it.
+                Some(data) => (
+                    format!(
+                        "{}\n{}\n{}",
+                        write_map(&lowered.program),
+                        write_sdf(&lowered.program),
+                        mesh::write()
+                    ),
+                    Some(data),
+                    false,
+                ),
+                None => marched(scene, lowered, options),
+            };
             params = read;
             // Rays inside glass that may overlap a solid march the scene's media.
             let m = lowered.media.as_ref().filter(|_| on["REFRACTION"]);

@@ -1,0 +1,162 @@
+//! Triangle meshes (`mesh(path)`, program/mesh.rs) in `scene_data`, and `fn mesh_distance`,
+//! the walk over a mesh's hierarchy that the distance program's `Op::Mesh` calls: the same
+//! walk, nearest triangle and pseudo-normal sign as `TriMesh::distance`, in f32.
+//!
+//! Layout, from the mesh's `base` (in `vec4<f32>`, integers as their bits): one header
+//! vector (x: the hierarchy's vectors, twice its nodes); the nodes, two vectors each
+//! (`lo.xyz`, `first`; `hi.xyz`, `count`: a leaf's `count` triangles from `first`, or, when
+//! `count` is 0, the children `first` and `first + 1`); then the triangles, nine vectors each
+//! (the corners a, b, c, then the pseudo-normals of a, b, c and of the edges ab, bc, ca).
+//! The meshes of a scene lie one after the other in the order they were read, each at the
+//! `base` the checker gave it.
+
+use crate::program::mesh::STACK;
+use crate::program::Program;
+
+/// The bytes of `scene_data` holding every mesh `programs` name, each at its base (a mesh of
+/// the scene that none names leaves zeros).
+pub fn data<'a>(programs: impl IntoIterator<Item = &'a Program>) -> Vec<u8> {
+    let mut out: Vec<u8> = Vec::new();
+    for program in programs {
+        for mesh in program.meshes() {
+            let start = mesh.base as usize * 16;
+            let end = start + mesh.vectors() as usize * 16;
+            if out.len() < end {
+                out.resize(end, 0);
+            }
+            let mut at = start;
+            let mut put = |v: [f32; 4]| {
+                for x in v {
+                    out[at..at + 4].copy_from_slice(&x.to_le_bytes());
+                    at += 4;
+                }
+            };
+            let bits = |u: u32| f32::from_bits(u);
+            put([bits(2 * mesh.nodes().len() as u32), 0.0, 0.0, 0.0]);
+            for n in mesh.nodes() {
+                let [x, y, z] = n.lo.map(|v| v as f32);
+                put([x, y, z, bits(n.first)]);
+                let [x, y, z] = n.hi.map(|v| v as f32);
+                put([x, y, z, bits(n.count)]);
+            }
+            for t in mesh.triangles() {
+                for v in t {
+                    let [x, y, z] = v.map(|c| c as f32);
+                    put([x, y, z, 0.0]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether a program names a mesh.
+pub fn uses_meshes(program: &Program) -> bool {
+    program.meshes().next().is_some()
+}
+
+/// The WGSL functions of the mesh walk.
+pub fn write() -> String {
+    format!(
+        "// Triangle meshes in scene_data (the layout is in compiler/src/back/wgsl/mesh.rs): the\n\
+         // signed distance to the nearest triangle, its sign from the angle-weighted\n\
+         // pseudo-normal of the feature nearest (program/mesh.rs).\n\
+         fn mesh_box(p: vec3<f32>, n: u32) -> f32 {{\n\
+         \x20   let d = max(max(scene_data[n].xyz - p, vec3<f32>(0.0)), p - scene_data[n + 1u].xyz);\n\
+         \x20   return d.x * d.x + d.y * d.y + d.z * d.z;\n\
+         }}\n\n\
+         // The feature of the triangle at t nearest to p: corners 0-2, edges ab, bc, ca 3-5, the\n\
+         // face 6 (Ericson, Real-Time Collision Detection, 2005, 5.1.5).\n\
+         fn mesh_feature(p: vec3<f32>, t: u32) -> u32 {{\n\
+         \x20   let a = scene_data[t].xyz;\n\
+         \x20   let b = scene_data[t + 1u].xyz;\n\
+         \x20   let c = scene_data[t + 2u].xyz;\n\
+         \x20   let ab = b - a;\n\
+         \x20   let ac = c - a;\n\
+         \x20   let ap = p - a;\n\
+         \x20   let d1 = dot(ab, ap);\n\
+         \x20   let d2 = dot(ac, ap);\n\
+         \x20   if d1 <= 0.0 && d2 <= 0.0 {{ return 0u; }}\n\
+         \x20   let bp = p - b;\n\
+         \x20   let d3 = dot(ab, bp);\n\
+         \x20   let d4 = dot(ac, bp);\n\
+         \x20   if d3 >= 0.0 && d4 <= d3 {{ return 1u; }}\n\
+         \x20   let vc = d1 * d4 - d3 * d2;\n\
+         \x20   if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {{ return 3u; }}\n\
+         \x20   let cp = p - c;\n\
+         \x20   let d5 = dot(ab, cp);\n\
+         \x20   let d6 = dot(ac, cp);\n\
+         \x20   if d6 >= 0.0 && d5 <= d6 {{ return 2u; }}\n\
+         \x20   let vb = d5 * d2 - d1 * d6;\n\
+         \x20   if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {{ return 5u; }}\n\
+         \x20   let va = d3 * d6 - d5 * d4;\n\
+         \x20   if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {{ return 4u; }}\n\
+         \x20   return 6u;\n\
+         }}\n\n\
+         // The nearest point to p on feature f of the triangle at t.\n\
+         fn mesh_point(p: vec3<f32>, t: u32, f: u32) -> vec3<f32> {{\n\
+         \x20   if f < 3u {{ return scene_data[t + f].xyz; }}\n\
+         \x20   if f < 6u {{\n\
+         \x20       let s = scene_data[t + f - 3u].xyz;\n\
+         \x20       let d = scene_data[t + select(f - 2u, 0u, f == 5u)].xyz - s;\n\
+         \x20       return s + d * clamp(dot(p - s, d) / dot(d, d), 0.0, 1.0);\n\
+         \x20   }}\n\
+         \x20   let a = scene_data[t].xyz;\n\
+         \x20   let n = cross(scene_data[t + 1u].xyz - a, scene_data[t + 2u].xyz - a);\n\
+         \x20   return p - n * (dot(p - a, n) / dot(n, n));\n\
+         }}\n\n\
+         // The signed distance at p to the mesh whose data starts at scene_data[base].\n\
+         fn mesh_distance(p: vec3<f32>, base: u32) -> f32 {{\n\
+         \x20   let nodes = base + 1u;\n\
+         \x20   let tris = nodes + bitcast<u32>(scene_data[base].x);\n\
+         \x20   var best = 3.4e38;\n\
+         \x20   var best_t = tris;\n\
+         \x20   var best_f = 6u;\n\
+         \x20   // Nodes still to visit, the nearer child on top ({STACK} levels hold any mesh).\n\
+         \x20   var stack: array<u32, {STACK}>;\n\
+         \x20   var top = 1u;\n\
+         \x20   stack[0] = 0u;\n\
+         \x20   loop {{\n\
+         \x20       if top == 0u {{ break; }}\n\
+         \x20       top -= 1u;\n\
+         \x20       let n = nodes + 2u * stack[top];\n\
+         \x20       if mesh_box(p, n) >= best {{ continue; }}\n\
+         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
+         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
+         \x20       if count > 0u {{\n\
+         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
+         \x20               let t = tris + 9u * (first + k);\n\
+         \x20               let f = mesh_feature(p, t);\n\
+         \x20               let w = p - mesh_point(p, t, f);\n\
+         \x20               let d2 = w.x * w.x + w.y * w.y + w.z * w.z;\n\
+         \x20               if d2 < best {{\n\
+         \x20                   best = d2;\n\
+         \x20                   best_t = t;\n\
+         \x20                   best_f = f;\n\
+         \x20               }}\n\
+         \x20           }}\n\
+         \x20           continue;\n\
+         \x20       }}\n\
+         \x20       let dl = mesh_box(p, nodes + 2u * first);\n\
+         \x20       let dr = mesh_box(p, nodes + 2u * first + 2u);\n\
+         \x20       let right = dr < dl;\n\
+         \x20       if max(dl, dr) < best {{\n\
+         \x20           stack[top] = select(first + 1u, first, right);\n\
+         \x20           top += 1u;\n\
+         \x20       }}\n\
+         \x20       if min(dl, dr) < best {{\n\
+         \x20           stack[top] = select(first, first + 1u, right);\n\
+         \x20           top += 1u;\n\
+         \x20       }}\n\
+         \x20   }}\n\
+         \x20   let w = p - mesh_point(p, best_t, best_f);\n\
+         \x20   var n = scene_data[best_t + 3u + min(best_f, 5u)].xyz;\n\
+         \x20   if best_f == 6u {{\n\
+         \x20       let a = scene_data[best_t].xyz;\n\
+         \x20       n = cross(scene_data[best_t + 1u].xyz - a, scene_data[best_t + 2u].xyz - a);\n\
+         \x20   }}\n\
+         \x20   let d = sqrt(best);\n\
+         \x20   return select(d, -d, w.x * n.x + w.y * n.y + w.z * n.z < 0.0);\n\
+         }}\n"
+    )
+}

@@ -1,0 +1,730 @@
+//! Triangle meshes as shapes (`mesh("part.stl")`): the triangles, their angle-weighted
+//! pseudo-normals and a bounding volume hierarchy over them, and the signed distance at a
+//! point, in f32 or f64, that every evaluator of `Op::Mesh` computes the same way (the WGSL
+//! kernel's `mesh_distance` walks the same hierarchy in the same order: back/wgsl/mesh.rs).
+//!
+//! The distance is the distance to the nearest triangle, found through the hierarchy (a node
+//! is skipped where its box is no nearer than the best triangle so far; the nearer child is
+//! visited first). The nearest point on a triangle and the feature it lies on (a corner, an
+//! edge or the face) follow Ericson's `ClosestPtPointTriangle` (Real-Time Collision
+//! Detection, 2005, §5.1.5). The sign is that of `(p − q) · n` with `q` the nearest point and
+//! `n` the angle-weighted pseudo-normal of the feature `q` lies on (Bærentzen and Aanæs,
+//! "Signed distance computation using the angle weighted pseudonormal", IEEE TVCG 2005): the
+//! face's normal, the sum of an edge's two faces' normals, or the sum of a corner's faces'
+//! normals weighted by their angles there. On a closed, consistently oriented mesh this is
+//! the exact signed distance. Where the mesh is open, an edge with one face takes that face's
+//! normal: points nearest to the rim get the side of the face at the rim, so the sign is
+//! right away from the holes and may be wrong seen through one.
+//!
+//! Every coordinate is stored as a value an f32 holds exactly (the GPU reads f32), and every
+//! box rounded outwards to one, so the f32 and f64 evaluations and the GPU's read the same
+//! triangles and boxes.
+
+use super::Float;
+use std::collections::HashMap;
+
+/// Triangles per leaf of the hierarchy, at most.
+pub const LEAF: usize = 4;
+
+/// The deepest stack a walk needs: the hierarchy halves its triangles at each level, so it is
+/// at most log₂(2³²) + 2 deep, and a walk holds at most one entry per level and one more.
+pub const STACK: usize = 40;
+
+/// One triangle: its corners `a`, `b`, `c` (counter-clockwise seen from outside), then the
+/// pseudo-normals of `a`, `b`, `c` and of the edges `ab`, `bc`, `ca` (the face's normal is
+/// `(b − a) × (c − a)`).
+pub type Triangle = [[f64; 3]; 9];
+
+/// A node of the hierarchy: a box, and either `count` triangles from `first` (a leaf) or,
+/// when `count` is 0, two children at `first` and `first + 1`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Node {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+    pub first: u32,
+    pub count: u32,
+}
+
+/// A triangle mesh ready to be queried.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriMesh {
+    /// The file's name, for the program's text.
+    pub name: String,
+    /// Its index among the meshes of its scene (`Op::Mesh` names it so).
+    pub id: u32,
+    /// Where its data starts in the GPU's `scene_data`, in vectors of 16 bytes
+    /// (back/wgsl/mesh.rs): after every mesh of the scene with a smaller id.
+    pub base: u32,
+    triangles: Vec<Triangle>,
+    nodes: Vec<Node>,
+    /// What building found: open and non-manifold edges, dropped triangles.
+    pub report: Report,
+}
+
+/// What [`TriMesh::new`] found in a mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Report {
+    /// Edges with one triangle (the rims of holes).
+    pub open_edges: usize,
+    /// Edges with more than two triangles.
+    pub non_manifold_edges: usize,
+    /// Triangles of no area (two corners the same, or three in a line), dropped.
+    pub degenerate: usize,
+    /// Whether the triangles were wound inside out (negative volume) and turned round.
+    pub flipped: bool,
+}
+
+/// Why a mesh cannot be built.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Invalid {
+    /// A vertex's coordinate is NaN or infinite (after scaling): its index.
+    NotFinite(usize),
+    /// A triangle names a vertex that does not exist: the triangle and the index.
+    Index(usize, u32),
+    /// No triangle of any area is left.
+    Empty,
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let l = dot(a, a).sqrt();
+    if l > 0.0 {
+        a.map(|x| x / l)
+    } else {
+        a
+    }
+}
+
+fn add_to(acc: &mut [f64; 3], v: [f64; 3], w: f64) {
+    for i in 0..3 {
+        acc[i] += v[i] * w;
+    }
+}
+
+/// The f32 nearest to `x`, as an f64.
+fn f32_near(x: f64) -> f64 {
+    f64::from(x as f32)
+}
+
+/// The f32 next to the finite `f`, towards +∞ (`up`) or −∞.
+fn f32_next(f: f32, up: bool) -> f32 {
+    if f == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if up { tiny } else { -tiny };
+    }
+    let bits = f.to_bits();
+    // Away from zero the magnitude's bits grow by one, towards zero they shrink.
+    f32::from_bits(if (f > 0.0) == up { bits + 1 } else { bits - 1 })
+}
+
+/// The largest f32 at or below `x`.
+fn f32_down(x: f64) -> f64 {
+    let f = x as f32;
+    if f64::from(f) > x {
+        f64::from(f32_next(f, false))
+    } else {
+        f64::from(f)
+    }
+}
+
+/// The smallest f32 at or above `x`.
+fn f32_up(x: f64) -> f64 {
+    let f = x as f32;
+    if f64::from(f) < x {
+        f64::from(f32_next(f, true))
+    } else {
+        f64::from(f)
+    }
+}
+
+impl TriMesh {
+    /// Builds a mesh from `positions` (scaled by `scale`, rounded to f32) and `faces`
+    /// (indices into them, counter-clockwise seen from outside). Corners at the same place
+    /// are one vertex; triangles of no area are dropped; a mesh wound inside out is turned.
+    pub fn new(
+        name: &str,
+        positions: &[[f64; 3]],
+        faces: &[[u32; 3]],
+        scale: f64,
+    ) -> Result<TriMesh, Invalid> {
+        // Weld: one vertex per position.
+        let mut index: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut verts: Vec<[f64; 3]> = Vec::new();
+        let mut remap = Vec::with_capacity(positions.len());
+        for (i, p) in positions.iter().enumerate() {
+            let q = p.map(|x| f32_near(x * scale));
+            if q.iter().any(|x| !x.is_finite()) {
+                return Err(Invalid::NotFinite(i));
+            }
+            // +0 and −0 are one place.
+            let key = q.map(|x| (x + 0.0).to_bits());
+            let v = *index.entry(key).or_insert_with(|| {
+                verts.push(q);
+                verts.len() as u32 - 1
+            });
+            remap.push(v);
+        }
+        let mut report = Report::default();
+        let mut tris: Vec<[u32; 3]> = Vec::with_capacity(faces.len());
+        for (t, f) in faces.iter().enumerate() {
+            let mut g = [0u32; 3];
+            for k in 0..3 {
+                g[k] = *remap.get(f[k] as usize).ok_or(Invalid::Index(t, f[k]))?;
+            }
+            let [a, b, c] = g.map(|i| verts[i as usize]);
+            let n = cross(sub(b, a), sub(c, a));
+            if g[0] == g[1] || g[1] == g[2] || g[2] == g[0] || dot(n, n) == 0.0 {
+                report.degenerate += 1;
+                continue;
+            }
+            tris.push(g);
+        }
+        if tris.is_empty() {
+            return Err(Invalid::Empty);
+        }
+        // Six times the signed volume: negative for a mesh wound inside out.
+        let volume: f64 = tris
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| verts[i as usize]);
+                dot(a, cross(b, c))
+            })
+            .sum();
+        if volume < 0.0 {
+            report.flipped = true;
+            for t in &mut tris {
+                t.swap(1, 2);
+            }
+        }
+        // Pseudo-normals: per vertex the angle-weighted sum of its faces' unit normals, per
+        // edge the sum of its faces' (Bærentzen and Aanæs 2005).
+        let mut vn = vec![[0.0; 3]; verts.len()];
+        let mut edges: HashMap<(u32, u32), ([f64; 3], u32)> = HashMap::new();
+        for t in &tris {
+            let p = t.map(|i| verts[i as usize]);
+            let n = unit(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+            for k in 0..3 {
+                let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+                let (u, v) = (unit(sub(b, a)), unit(sub(c, a)));
+                let angle = dot(u, v).clamp(-1.0, 1.0).acos();
+                add_to(&mut vn[t[k] as usize], n, angle);
+                let (i, j) = (t[k], t[(k + 1) % 3]);
+                let e = edges.entry((i.min(j), i.max(j))).or_insert(([0.0; 3], 0));
+                add_to(&mut e.0, n, 1.0);
+                e.1 += 1;
+            }
+        }
+        for (_, count) in edges.values() {
+            match count {
+                1 => report.open_edges += 1,
+                2 => {}
+                _ => report.non_manifold_edges += 1,
+            }
+        }
+        let triangles: Vec<Triangle> = tris
+            .iter()
+            .map(|t| {
+                let en = |k: usize| {
+                    let (i, j) = (t[k], t[(k + 1) % 3]);
+                    unit(edges[&(i.min(j), i.max(j))].0)
+                };
+                [
+                    verts[t[0] as usize],
+                    verts[t[1] as usize],
+                    verts[t[2] as usize],
+                    unit(vn[t[0] as usize]),
+                    unit(vn[t[1] as usize]),
+                    unit(vn[t[2] as usize]),
+                    en(0),
+                    en(1),
+                    en(2),
+                ]
+            })
+            .collect();
+        let (triangles, nodes) = hierarchy(triangles);
+        Ok(TriMesh {
+            name: name.to_string(),
+            id: 0,
+            base: 0,
+            triangles,
+            nodes,
+            report,
+        })
+    }
+
+    /// The vectors of 16 bytes its data takes in `scene_data` (back/wgsl/mesh.rs): a header,
+    /// two per node, nine per triangle.
+    pub fn vectors(&self) -> u64 {
+        1 + 2 * self.nodes.len() as u64 + 9 * self.triangles.len() as u64
+    }
+
+    /// The triangles, in the hierarchy's order.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// The hierarchy's nodes; the root is the first.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The box around every triangle (low and high corners).
+    pub fn aabb(&self) -> ([f64; 3], [f64; 3]) {
+        (self.nodes[0].lo, self.nodes[0].hi)
+    }
+
+    /// The signed distance at `p`: negative inside.
+    pub fn distance<T: Float>(&self, p: [T; 3]) -> T {
+        let f = |x: f64| T::from_f64(x);
+        let zero = T::zero();
+        let box_d2 = |n: &Node| {
+            let mut s = zero;
+            for ((&lo, &hi), &x) in n.lo.iter().zip(&n.hi).zip(&p) {
+                let d = (f(lo) - x).max(zero).max(x - f(hi));
+                s = s + d * d;
+            }
+            s
+        };
+        let mut best = T::from_f64(f64::INFINITY);
+        let mut sign_of = (zero, 0u32, 0usize);
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let n = &self.nodes[stack[top] as usize];
+            if box_d2(n) >= best {
+                continue;
+            }
+            if n.count > 0 {
+                for t in n.first..n.first + n.count {
+                    let (d2, feature) = nearest(&self.triangles[t as usize], p);
+                    if d2 < best {
+                        best = d2;
+                        sign_of = (d2, t, feature);
+                    }
+                }
+                continue;
+            }
+            // The nearer child on top, so that it is visited first.
+            let (l, r) = (n.first, n.first + 1);
+            let dl = box_d2(&self.nodes[l as usize]);
+            let dr = box_d2(&self.nodes[r as usize]);
+            let (near, far, dn, df) = if dr < dl {
+                (r, l, dr, dl)
+            } else {
+                (l, r, dl, dr)
+            };
+            if df < best {
+                stack[top] = far;
+                top += 1;
+            }
+            if dn < best {
+                stack[top] = near;
+                top += 1;
+            }
+        }
+        let (d2, t, feature) = sign_of;
+        let tri = &self.triangles[t as usize];
+        let q = point_of(tri, p, feature);
+        let normal = if feature == FACE {
+            let a = tri[0].map(f);
+            let (u, v) = (sub3(tri[1].map(f), a), sub3(tri[2].map(f), a));
+            [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ]
+        } else {
+            tri[3 + feature].map(f)
+        };
+        let w = sub3(p, q);
+        let s = w[0] * normal[0] + w[1] * normal[1] + w[2] * normal[2];
+        let d = d2.sqrt();
+        if s < zero {
+            -d
+        } else {
+            d
+        }
+    }
+}
+
+/// The feature of the face itself (the corners are 0–2, the edges ab, bc, ca 3–5).
+pub const FACE: usize = 6;
+
+fn sub3<T: Float>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot3<T: Float>(a: [T; 3], b: [T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The squared distance from `p` to the triangle and the feature its nearest point lies on
+/// (Ericson's regions: corners 0–2, edges ab, bc, ca 3–5, the face [`FACE`]).
+pub fn nearest<T: Float>(tri: &Triangle, p: [T; 3]) -> (T, usize) {
+    let feature = feature_of(tri, p);
+    let q = point_of(tri, p, feature);
+    let w = sub3(p, q);
+    (dot3(w, w), feature)
+}
+
+/// The feature of the triangle nearest to `p` (Ericson 2005, §5.1.5).
+fn feature_of<T: Float>(tri: &Triangle, p: [T; 3]) -> usize {
+    let zero = T::zero();
+    let [a, b, c] = [0, 1, 2].map(|k| tri[k].map(T::from_f64));
+    let (ab, ac) = (sub3(b, a), sub3(c, a));
+    let ap = sub3(p, a);
+    let (d1, d2) = (dot3(ab, ap), dot3(ac, ap));
+    if d1 <= zero && d2 <= zero {
+        return 0;
+    }
+    let bp = sub3(p, b);
+    let (d3, d4) = (dot3(ab, bp), dot3(ac, bp));
+    if d3 >= zero && d4 <= d3 {
+        return 1;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= zero && d1 >= zero && d3 <= zero {
+        return 3;
+    }
+    let cp = sub3(p, c);
+    let (d5, d6) = (dot3(ab, cp), dot3(ac, cp));
+    if d6 >= zero && d5 <= d6 {
+        return 2;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= zero && d2 >= zero && d6 <= zero {
+        return 5;
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= zero && d4 - d3 >= zero && d5 - d6 >= zero {
+        return 4;
+    }
+    FACE
+}
+
+/// The nearest point to `p` on `feature` of the triangle: the corner, the nearest point of
+/// the edge's segment, or of the face's plane.
+fn point_of<T: Float>(tri: &Triangle, p: [T; 3], feature: usize) -> [T; 3] {
+    let [a, b, c] = [0, 1, 2].map(|k| tri[k].map(T::from_f64));
+    let on_segment = |s: [T; 3], e: [T; 3]| {
+        let d = sub3(e, s);
+        let t = (dot3(sub3(p, s), d) / dot3(d, d)).clamp(T::zero(), T::one());
+        [s[0] + d[0] * t, s[1] + d[1] * t, s[2] + d[2] * t]
+    };
+    match feature {
+        0 => a,
+        1 => b,
+        2 => c,
+        3 => on_segment(a, b),
+        4 => on_segment(b, c),
+        5 => on_segment(c, a),
+        _ => {
+            let n = {
+                let (u, v) = (sub3(b, a), sub3(c, a));
+                [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ]
+            };
+            let t = dot3(sub3(p, a), n) / dot3(n, n);
+            [p[0] - n[0] * t, p[1] - n[1] * t, p[2] - n[2] * t]
+        }
+    }
+}
+
+/// Orders the triangles into a hierarchy: each node's triangles are split at the median of
+/// their centres along the longest axis of the centres' box, until at most [`LEAF`] remain.
+fn hierarchy(triangles: Vec<Triangle>) -> (Vec<Triangle>, Vec<Node>) {
+    let centre = |t: &Triangle| [0, 1, 2].map(|i| (t[0][i] + t[1][i] + t[2][i]) / 3.0);
+    let centres: Vec<[f64; 3]> = triangles.iter().map(centre).collect();
+    let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+    let empty = Node {
+        lo: [0.0; 3],
+        hi: [0.0; 3],
+        first: 0,
+        count: 0,
+    };
+    let mut nodes = vec![empty];
+    let mut work = vec![(0usize, 0usize, triangles.len())];
+    while let Some((at, s, e)) = work.pop() {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let (mut clo, mut chi) = (lo, hi);
+        for &t in &order[s..e] {
+            for v in &triangles[t as usize][..3] {
+                for i in 0..3 {
+                    lo[i] = lo[i].min(v[i]);
+                    hi[i] = hi[i].max(v[i]);
+                }
+            }
+            let c = centres[t as usize];
+            for i in 0..3 {
+                clo[i] = clo[i].min(c[i]);
+                chi[i] = chi[i].max(c[i]);
+            }
+        }
+        nodes[at].lo = lo.map(f32_down);
+        nodes[at].hi = hi.map(f32_up);
+        if e - s <= LEAF {
+            nodes[at].first = s as u32;
+            nodes[at].count = (e - s) as u32;
+            continue;
+        }
+        let axis = (0..3)
+            .max_by(|&i, &j| (chi[i] - clo[i]).total_cmp(&(chi[j] - clo[j])))
+            .unwrap_or(0);
+        let mid = (s + e) / 2;
+        order[s..e].select_nth_unstable_by(mid - s, |&x, &y| {
+            centres[x as usize][axis].total_cmp(&centres[y as usize][axis])
+        });
+        let left = nodes.len();
+        nodes.push(empty);
+        nodes.push(empty);
+        nodes[at].first = left as u32;
+        work.push((left, s, mid));
+        work.push((left + 1, mid, e));
+    }
+    let triangles = order.iter().map(|&t| triangles[t as usize]).collect();
+    (triangles, nodes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed octahedron of radius 1.
+    fn octahedron() -> TriMesh {
+        let v = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let f = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        TriMesh::new("octahedron", &v, &f, 1.0).expect("a mesh")
+    }
+
+    #[test]
+    fn an_octahedron_is_exact_inside_and_out() {
+        let m = octahedron();
+        assert_eq!(m.report, Report::default());
+        let exact = |p: [f64; 3]| {
+            // The octahedron's distance is exact along the face normals and at the corners.
+            (p[0].abs() + p[1].abs() + p[2].abs() - 1.0) / 3f64.sqrt()
+        };
+        for p in [[0.0, 0.0, 0.0], [0.2, 0.1, 0.3], [1.0, 1.0, 1.0]] {
+            assert!((m.distance(p) - exact(p)).abs() < 1e-12, "{p:?}");
+        }
+        assert!((m.distance([2.0, 0.0, 0.0]) - 1.0).abs() < 1e-12);
+        assert!((m.distance([2.0f32, 0.0, 0.0]) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn inside_out_meshes_are_turned_and_holes_counted() {
+        let v = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let inward = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
+        let m = TriMesh::new("t", &v, &inward, 1.0).expect("a mesh");
+        assert!(m.report.flipped);
+        assert!(m.distance([0.1, 0.1, 0.1]) < 0.0);
+        let open = TriMesh::new("t", &v, &inward[..3], 1.0).expect("a mesh");
+        assert_eq!(open.report.open_edges, 3);
+        assert!(matches!(
+            TriMesh::new("t", &v, &[[0, 0, 1]], 1.0),
+            Err(Invalid::Empty)
+        ));
+        assert!(matches!(
+            TriMesh::new("t", &v, &[[0, 1, 9]], 1.0),
+            Err(Invalid::Index(0, 9))
+        ));
+    }
+
+    /// A torus of radii 1 and 0.4 in the xz plane, `n` × `m` quads split in two: closed,
+    /// of genus 1, wound outwards.
+    pub(crate) fn torus(n: usize, m: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut v = Vec::new();
+        for i in 0..n {
+            let u = i as f64 / n as f64 * std::f64::consts::TAU;
+            for j in 0..m {
+                let w = j as f64 / m as f64 * std::f64::consts::TAU;
+                let r = 1.0 + 0.4 * w.cos();
+                v.push([r * u.cos(), 0.4 * w.sin(), r * u.sin()]);
+            }
+        }
+        let at = |i: usize, j: usize| ((i % n) * m + j % m) as u32;
+        let mut f = Vec::new();
+        for i in 0..n {
+            for j in 0..m {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                f.push([a, c, b]);
+                f.push([a, d, c]);
+            }
+        }
+        (v, f)
+    }
+
+    /// The distance from `p` to a triangle, computed another way than Ericson's regions: the
+    /// projection onto the plane where it falls inside, else the nearest of the three edges.
+    fn brute_triangle(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
+        let seg = |a: [f64; 3], b: [f64; 3]| {
+            let d = sub(b, a);
+            let s = (dot(sub(p, a), d) / dot(d, d)).clamp(0.0, 1.0);
+            let q = [a[0] + d[0] * s, a[1] + d[1] * s, a[2] + d[2] * s];
+            dot(sub(p, q), sub(p, q)).sqrt()
+        };
+        let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+        let h = dot(sub(p, t[0]), n) / dot(n, n);
+        let q = [p[0] - n[0] * h, p[1] - n[1] * h, p[2] - n[2] * h];
+        let inside = (0..3).all(|k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            dot(cross(sub(b, a), sub(q, a)), n) >= 0.0
+        });
+        if inside {
+            dot(sub(p, q), sub(p, q)).sqrt()
+        } else {
+            seg(t[0], t[1]).min(seg(t[1], t[2])).min(seg(t[2], t[0]))
+        }
+    }
+
+    /// The generalised winding number of the triangles at `p`: the sum of their solid angles
+    /// over 4π (Van Oosterom and Strackee, IEEE Trans. Biomed. Eng., 1983), 1 inside a
+    /// closed mesh and 0 outside.
+    fn winding(p: [f64; 3], tris: &[[[f64; 3]; 3]]) -> f64 {
+        let mut sum = 0.0;
+        for t in tris {
+            let [a, b, c] = t.map(|v| sub(v, p));
+            let (la, lb, lc) = (dot(a, a).sqrt(), dot(b, b).sqrt(), dot(c, c).sqrt());
+            let det = dot(a, cross(b, c));
+            let div = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+            sum += 2.0 * det.atan2(div);
+        }
+        sum / (4.0 * std::f64::consts::PI)
+    }
+
+    /// Points to test at: random ones around the mesh, ones near and on its corners and
+    /// edges, and the corners and edge midpoints themselves.
+    fn probes(tris: &[[[f64; 3]; 3]], rng: &mut crate::rng::Rng) -> Vec<[f64; 3]> {
+        let mut out = Vec::new();
+        for _ in 0..200 {
+            out.push(rng.point(2.0));
+        }
+        for _ in 0..200 {
+            let t = tris[rng.below(tris.len())];
+            let k = rng.below(3);
+            let mid = [0, 1, 2].map(|i| 0.5 * (t[k][i] + t[(k + 1) % 3][i]));
+            let bary = {
+                let (u, v) = (rng.uniform(), rng.uniform());
+                let (u, v) = if u + v > 1.0 {
+                    (1.0 - u, 1.0 - v)
+                } else {
+                    (u, v)
+                };
+                [0, 1, 2].map(|i| t[0][i] + u * (t[1][i] - t[0][i]) + v * (t[2][i] - t[0][i]))
+            };
+            for base in [t[k], mid, bary] {
+                out.push(base);
+                let e = rng.range(1e-4, 0.05);
+                let o = rng.point(e);
+                out.push([base[0] + o[0], base[1] + o[1], base[2] + o[2]]);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn distances_and_signs_match_brute_force() {
+        let (v, f) = torus(24, 12);
+        let m = TriMesh::new("torus", &v, &f, 1.0).expect("a mesh");
+        assert_eq!(m.report, Report::default());
+        let tris: Vec<[[f64; 3]; 3]> = m.triangles().iter().map(|t| [t[0], t[1], t[2]]).collect();
+        let mut rng = crate::rng::Rng::new(40);
+        for p in probes(&tris, &mut rng) {
+            let brute = tris
+                .iter()
+                .map(|t| brute_triangle(p, *t))
+                .fold(f64::INFINITY, f64::min);
+            let inside = winding(p, &tris) > 0.5;
+            let d = m.distance(p);
+            assert!(
+                (d.abs() - brute).abs() <= 1e-12,
+                "f64 at {p:?}: {d} against {brute}"
+            );
+            if brute > 1e-9 {
+                assert_eq!(d < 0.0, inside, "sign at {p:?}: {d}");
+            }
+            let d32 = m.distance(p.map(|x| x as f32));
+            assert!(
+                (f64::from(d32.abs()) - brute).abs() <= 2e-6,
+                "f32 at {p:?}: {d32} against {brute}"
+            );
+            if brute > 1e-4 {
+                assert_eq!(d32 < 0.0, inside, "f32 sign at {p:?}: {d32}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_hole_leaves_the_sign_right_away_from_it() {
+        let (v, f) = torus(24, 12);
+        // The quads of one cell of the tube, around (1, 0, 0) outside: a hole there.
+        let open: Vec<[u32; 3]> = f
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| !(*k < 2 * 12 && (k / 2) % 12 < 2))
+            .map(|(_, t)| *t)
+            .collect();
+        let m = TriMesh::new("open torus", &v, &open, 1.0).expect("a mesh");
+        assert!(m.report.open_edges > 0);
+        let closed = TriMesh::new("torus", &v, &f, 1.0).expect("a mesh");
+        let closed_tris: Vec<[[f64; 3]; 3]> = closed
+            .triangles()
+            .iter()
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        let mut rng = crate::rng::Rng::new(41);
+        let mut checked = 0;
+        for p in probes(&closed_tris, &mut rng) {
+            // Away from the hole, whose rim lies within 0.55 of (1.4, 0, 0).
+            let far = sub(p, [1.4, 0.0, 0.0]);
+            if dot(far, far).sqrt() < 1.2 || closed.distance(p).abs() < 1e-9 {
+                continue;
+            }
+            let inside = winding(p, &closed_tris) > 0.5;
+            assert_eq!(m.distance(p) < 0.0, inside, "sign at {p:?}");
+            checked += 1;
+        }
+        assert!(checked > 300, "{checked} points checked");
+    }
+}

@@ -524,7 +524,15 @@ fn glb(b: &[u8], max: u64) -> Result<Read, String> {
     // stride, components).
     let accessor = |a: u64| -> Result<(&[u8], usize, u64, usize, usize), String> {
         let acc = &doc["accessors"][a as usize];
-        let count = get(acc, "count").ok_or(format!("accessor {a} has no count"))? as usize;
+        let count = get(acc, "count").ok_or(format!("accessor {a} has no count"))?;
+        // Elements may overlap (a stride of 0), but no more of them than bytes are read.
+        if count > bin.len() as u64 {
+            return Err(format!(
+                "accessor {a} declares {count} elements, more than the {} bytes of the BIN chunk",
+                bin.len()
+            ));
+        }
+        let count = count as usize;
         let ty = get(acc, "componentType").ok_or(format!("accessor {a} has no componentType"))?;
         let comps = match acc["type"].as_str() {
             Some("SCALAR") => 1,
@@ -675,5 +683,97 @@ mod tests {
         let lie = ply.replace("element face 1", "element face 100000000");
         let e = read(Format::Ply, lie.as_bytes(), 1_000_000_000).expect_err("lies");
         assert!(e.contains("truncated PLY"), "{e}");
+    }
+
+    /// A small valid file of each format, as `sdfc mesh` writes them where it does.
+    fn samples() -> Vec<(Format, Vec<u8>)> {
+        let ply_binary = {
+            let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+            for v in TRI {
+                for x in v {
+                    b.extend_from_slice(&x.to_le_bytes());
+                }
+            }
+            b.push(3);
+            for i in 0i32..3 {
+                b.extend_from_slice(&i.to_le_bytes());
+            }
+            b
+        };
+        let glb = {
+            let mut bin = Vec::new();
+            for v in TRI {
+                for x in v {
+                    bin.extend_from_slice(&x.to_le_bytes());
+                }
+            }
+            for i in 0u32..3 {
+                bin.extend_from_slice(&i.to_le_bytes());
+            }
+            let json = br#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":12}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},{"bufferView":1,"componentType":5125,"count":3,"type":"SCALAR"}]}"#;
+            let mut json = json.to_vec();
+            while json.len() % 4 != 0 {
+                json.push(b' ');
+            }
+            let mut b = b"glTF".to_vec();
+            b.extend_from_slice(&2u32.to_le_bytes());
+            b.extend_from_slice(&((20 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+            b.extend_from_slice(&(json.len() as u32).to_le_bytes());
+            b.extend_from_slice(b"JSON");
+            b.extend_from_slice(&json);
+            b.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+            b.extend_from_slice(b"BIN\0");
+            b.extend_from_slice(&bin);
+            b
+        };
+        vec![
+            (Format::Stl, stl_bytes(&[TRI, TRI], 2)),
+            (Format::Stl, b"solid a\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendsolid\n".to_vec()),
+            (Format::Obj, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -1 -2 -3\n".to_vec()),
+            (Format::Ply, b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec()),
+            (Format::Ply, ply_binary),
+            (Format::Glb, glb),
+        ]
+    }
+
+    /// Every sample reads, and thousands of mutations of them (bytes changed, counts made
+    /// huge, the file cut short) read or fail, and never panic, allocate for a count the
+    /// bytes do not hold, or make a mesh that panics.
+    #[test]
+    fn mutated_files_never_panic() {
+        use crate::program::mesh::TriMesh;
+        let mut rng = crate::rng::Rng::new(40);
+        for (format, bytes) in samples() {
+            let r = read(format, &bytes, 1000).unwrap_or_else(|e| panic!("{format:?}: {e}"));
+            assert!(!r.faces.is_empty());
+            for _ in 0..1500 {
+                let mut b = bytes.clone();
+                for _ in 0..1 + rng.below(4) {
+                    let at = rng.below(b.len());
+                    match rng.below(4) {
+                        0 => b[at] = rng.below(256) as u8,
+                        1 => {
+                            let chars = b"0123456789-.e \nfv/";
+                            b[at] = chars[rng.below(chars.len())];
+                        }
+                        2 => {
+                            let n = [u32::MAX, 1 << 31, 100_000_000, 0][rng.below(4)];
+                            let end = (at + 4).min(b.len());
+                            b[at..end].copy_from_slice(&n.to_le_bytes()[..end - at]);
+                        }
+                        _ => b.truncate(at),
+                    }
+                    if b.is_empty() {
+                        break;
+                    }
+                }
+                if let Ok(r) = read(format, &b, 1000) {
+                    assert!(r.positions.len() <= b.len() && r.faces.len() <= 1000);
+                    if let Ok(m) = TriMesh::new("m", &r.positions, &r.faces, 1.0) {
+                        let _ = m.distance([0.1, 0.2, 0.3]);
+                    }
+                }
+            }
+        }
     }
 }

@@ -329,6 +329,7 @@ impl Scene {
         let frame = FrameScene {
             scene: checked.scene,
             lowered,
+            phases: Vec::new(),
         };
         let (scene, prepared) =
             renderer::prepare(pool, (ask.backend, &Devices::Auto), frame, &setup, None)?;

@@ -7,7 +7,6 @@ use crate::gpu::{self, cuda::Cuda, Gpu};
 use crate::memory::{self, Memory};
 use sdfc_compiler::back::{ptx, wgsl};
 use sdfc_compiler::lower::{self, LowerOptions, Lowered};
-use sdfc_compiler::program::Program;
 use sdfc_compiler::scene::analytic::{Choice, Traceable};
 use sdfc_compiler::scene::{Method, Scene, Settings};
 use std::sync::Arc;
@@ -118,11 +117,12 @@ impl Setup {
 /// A scene prepared for one backend.
 #[derive(Debug)]
 pub enum Prepared {
-    /// CPU: the distance program, its tapes and the render options.
+    /// CPU: the distance program and its tapes, and the render options.
     Cpu {
-        program: Program,
         tapes: Box<Tapes>,
         options: Options,
+        /// How long the tapes took to prepare (`--stats`).
+        taped: Duration,
     },
     /// wgpu: the device (which may be shared, as the viewer shares its window's), the
     /// validated kernel and the scene's Lipschitz bound L (and the lowered scene and setup,
@@ -448,13 +448,15 @@ impl Prepared {
     ) -> Result<Prepared, String> {
         method_allowed(scene, &lowered.traceable)?;
         match backend {
-            Backend::Cpu => Ok(Self::cpu(lowered, setup)),
+            Backend::Cpu => Ok(Self::cpu(scene, lowered, setup)),
             Backend::Wgpu => Self::wgpu(scene, &lowered, setup, false),
             Backend::Cuda => Self::cuda(scene, &lowered, setup, Cuda::open),
-            Backend::Auto if setup.precision == Precision::F64 => Ok(Self::cpu(lowered, setup)),
+            Backend::Auto if setup.precision == Precision::F64 => {
+                Ok(Self::cpu(scene, lowered, setup))
+            }
             Backend::Auto => Self::cuda(scene, &lowered, setup, Cuda::open)
                 .or_else(|_| Self::wgpu(scene, &lowered, setup, true))
-                .or_else(|_| Ok(Self::cpu(lowered, setup))),
+                .or_else(|_| Ok(Self::cpu(scene, lowered, setup))),
         }
     }
 
@@ -474,7 +476,7 @@ impl Prepared {
         let mut parts = Vec::with_capacity(list.len());
         for d in &list {
             let part = match *d {
-                Device::Cpu => Self::cpu(lowered.clone(), setup),
+                Device::Cpu => Self::cpu(scene, lowered.clone(), setup),
                 Device::Gpu(i) => {
                     match Self::gpu_kind(backend)? {
                         Backend::Cuda => {
@@ -510,17 +512,24 @@ impl Prepared {
         }
     }
 
-    fn cpu(lowered: Lowered, setup: &Setup) -> Prepared {
+    /// The CPU's preparation: the tapes, prepared now where `scene` is marched (a traced
+    /// scene never evaluates its program).
+    fn cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Prepared {
         let options = Options {
             precision: setup.precision,
             debug_nan: setup.debug_nan,
             lipschitz: lowered.program.lipschitz(),
             ..Options::default()
         };
+        let started = Instant::now();
+        let tapes = Box::new(Tapes::of(lowered));
+        if tapes.traceable().traced(scene.settings.method).is_none() {
+            tapes.prepare();
+        }
         Prepared::Cpu {
-            tapes: Box::new(Tapes::new(&lowered)),
-            program: lowered.program,
+            tapes,
             options,
+            taped: started.elapsed(),
         }
     }
 
@@ -664,7 +673,7 @@ impl Prepared {
                     // CUDA opened, and its kernel failed: a GPU adapter, as `from_program`.
                     None => Self::wgpu(scene, &lowered, setup, true),
                 })
-                .or_else(|_| Ok(Self::cpu(lowered, setup)))
+                .or_else(|_| Ok(Self::cpu(scene, lowered, setup)))
             }
         }
     }
@@ -812,7 +821,7 @@ impl Prepared {
     /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
     pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
         method_allowed(scene, &lowered.traceable)?;
-        Ok(Self::cpu(lowered, setup))
+        Ok(Self::cpu(scene, lowered, setup))
     }
 
     /// Prepares `scene` on the CUDA device `open` opens (timing its opening).
@@ -1068,7 +1077,7 @@ impl Prepared {
     }
 
     /// Where the first preparation for a GPU went, for `--stats`: (phase, time, how) for
-    /// the device, the kernel, its PTX and the driver's compile; empty on the CPU.
+    /// the device, the kernel, its PTX and the driver's compile; on the CPU, the tapes.
     pub fn preparation(&self) -> Vec<(&'static str, Duration, String)> {
         let mut parts = self.preparation_parts();
         // A device opened beside the front end was waited for after the kernel was written:
@@ -1085,7 +1094,16 @@ impl Prepared {
     fn preparation_parts(&self) -> Vec<(&'static str, Duration, String)> {
         use gpu::wgpu::DriverCache;
         match self {
-            Prepared::Cpu { .. } => Vec::new(),
+            Prepared::Cpu { taped, tapes, .. } => vec![(
+                "tapes",
+                *taped,
+                if tapes.prepared() {
+                    "the distance program prepared for the interpreter (distance, material, media)"
+                        .into()
+                } else {
+                    "none: the scene is traced, the interpreter does not run".into()
+                },
+            )],
             // Several devices: the first device's (they are prepared one after another).
             Prepared::Several(parts) => parts.first().map(|p| p.preparation()).unwrap_or_default(),
             Prepared::Wgpu { timing, .. } => {
@@ -1189,7 +1207,7 @@ impl Prepared {
     /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
     pub fn program_len(&self) -> usize {
         match self {
-            Prepared::Cpu { program, .. } => program.len(),
+            Prepared::Cpu { tapes, .. } => tapes.program().len(),
             Prepared::Wgpu { lowered, .. } | Prepared::Cuda { lowered, .. } => {
                 lowered.program.len()
             }

@@ -726,6 +726,21 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
             "{err}"
         );
     }
+    // `check` passes the scene and warns, located, that a render will refuse it (issue 37).
+    let out = sdfc(&d, &["check", "many.sdf", "--limit", "program=100"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("[E0507] Warning")
+            && err.contains("will refuse this scene")
+            && err.contains("many.sdf:1:1")
+            && err.contains("--limit program=")
+            && err.contains("many.sdf: ok"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["check", "many.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && !err.contains("E0507"), "{err}");
     assert_eq!(entries(&d), ["ball.png", "ball.sdf", "many.sdf"]);
 }
 

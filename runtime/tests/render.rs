@@ -688,3 +688,29 @@ fn the_glass_blobs_crescents_are_max_depth_and_its_band_the_checker() {
         "the band through the glass is rough: {band:.5}"
     );
 }
+
+/// A traced render evaluates no distance program, so its tapes are never prepared (issue 37:
+/// a large traced scene spent most of its preparation on them); a marched render of the
+/// same scene prepares them, and both give the image they gave when tapes were prepared up
+/// front.
+#[test]
+fn a_traced_render_prepares_no_tapes() {
+    let mut scene = single(Node::Sphere { radius: 1.0 });
+    small(&mut scene, 32, 24);
+    let lowered = Lowered::new(&scene);
+    for (method, marches) in [(Method::Trace, false), (Method::March, true)] {
+        scene.settings.method = method;
+        let tapes = cpu::Tapes::new(&lowered);
+        let r = cpu::render_tapes(&scene, &tapes, &Options::default(), &|| {});
+        assert!(
+            r.stats.counters.hits > 20,
+            "{method:?}: {} hits",
+            r.stats.counters.hits
+        );
+        assert_eq!(tapes.prepared(), marches, "{method:?}");
+        let prepared = cpu::Tapes::new(&lowered);
+        prepared.prepare();
+        let again = cpu::render_tapes(&scene, &prepared, &Options::default(), &|| {});
+        assert_eq!(r.image.linear, again.image.linear, "{method:?}");
+    }
+}

@@ -172,6 +172,8 @@ struct Compiler<'p> {
     alloc: Allocator,
     tape: Tape,
     depth: usize,
+    /// Per block, what [`Compiler::gathered`] found it reads from before it.
+    outside: Vec<Vec<Reg>>,
 }
 
 impl Tape {
@@ -181,32 +183,7 @@ impl Tape {
         if outputs == Outputs::DistanceAndMaterial {
             roots.push(program.material());
         }
-        // What the results need, then what still runs once fused steps read their chains'
-        // operands.
-        let (live, _) = program.live(&roots);
-        let fusions = fuse::fuse(program, &live);
-        let (live, live_blocks) = program.live_reading(&roots, |i| fusions.reads(program, i));
-        let mut c = Compiler {
-            program,
-            live,
-            live_blocks,
-            slot_of: vec![None; program.len()],
-            fusions,
-            alloc: Allocator::default(),
-            tape: Tape {
-                steps: Vec::new(),
-                guards: Vec::new(),
-                constants: Vec::new(),
-                slots: 0,
-                depth: 0,
-                instructions: 0,
-                distance: 0,
-                material: None,
-                direct: false,
-                meshes: program.meshes.clone(),
-            },
-            depth: 0,
-        };
+        let mut c = Compiler::new(program, &roots);
         c.permanent(&roots);
         let entries = nest(program);
         c.scope(&entries, &roots);
@@ -289,6 +266,40 @@ fn axis_index(a: Axis) -> u32 {
     }
 }
 
+impl<'p> Compiler<'p> {
+    /// A compiler of `program` for the results `roots`: what they need, then what still
+    /// runs once fused steps read their chains' operands, and what each block gathers.
+    fn new(program: &'p Program, roots: &[Reg]) -> Self {
+        let (live, _) = program.live(roots);
+        let fusions = fuse::fuse(program, &live);
+        let (live, live_blocks) = program.live_reading(roots, |i| fusions.reads(program, i));
+        let mut c = Compiler {
+            program,
+            live,
+            live_blocks,
+            slot_of: vec![None; program.len()],
+            fusions,
+            alloc: Allocator::default(),
+            tape: Tape {
+                steps: Vec::new(),
+                guards: Vec::new(),
+                constants: Vec::new(),
+                slots: 0,
+                depth: 0,
+                instructions: 0,
+                distance: 0,
+                material: None,
+                direct: false,
+                meshes: program.meshes.clone(),
+            },
+            depth: 0,
+            outside: Vec::new(),
+        };
+        c.outside = c.gathered();
+        c
+    }
+}
+
 impl Compiler<'_> {
     fn ops(&self) -> &[Op] {
         self.program.ops()
@@ -354,39 +365,56 @@ impl Compiler<'_> {
     }
 
     /// The registers block `b` reads that are defined outside it (constants aside), the
-    /// values it must gather.
+    /// values it must gather (found once for every block by [`Compiler::gathered`]).
     fn outside_reads(&self, b: usize) -> Vec<Reg> {
         let block = self.program.blocks()[b];
-        let ops = self.ops();
-        let mut reads: Vec<Reg> = Vec::new();
-        let mut add = |r: Reg, me: &Self| {
-            if (r.0 as usize) < block.start && !me.is_const(r) {
-                reads.push(r);
-            }
-        };
-        for i in block.start..block.end {
-            if self.live[i] {
-                for r in self.fusions.reads(self.program, i) {
-                    add(r, self);
-                }
-            }
-        }
-        for (nb, inner) in self.program.blocks().iter().enumerate() {
-            let within = inner.start >= block.start && inner.end <= block.end && nb != b;
-            if within && self.live_blocks[nb] {
-                add(inner.bound, self);
-                add(inner.best, self);
-            }
-        }
+        let mut reads = self.outside[b].clone();
         let results = block.end..block.end + block.results;
-        for (&op, &live) in ops[results.clone()].iter().zip(&self.live[results]) {
+        for (&op, &live) in self.ops()[results.clone()].iter().zip(&self.live[results]) {
             if let (true, Op::Phi(then, _)) = (live, op) {
-                add(then, self);
+                if (then.0 as usize) < block.start && !self.is_const(then) {
+                    reads.push(then);
+                }
             }
         }
         reads.sort();
         reads.dedup();
         reads
+    }
+
+    /// For every block, the registers defined before it (constants aside) that its live
+    /// instructions, nested blocks' tests included, read: one walk over the program's items,
+    /// each block handing its own set to the block around it, so that the work is the
+    /// program's length plus the sizes of the sets, not the blocks times the program.
+    fn gathered(&self) -> Vec<Vec<Reg>> {
+        let blocks = self.program.blocks();
+        let mut out = vec![Vec::new(); blocks.len()];
+        let mut open: Vec<Vec<Reg>> = Vec::new();
+        for item in self.program.items() {
+            match item {
+                Item::Op(i) => {
+                    if let (true, Some(top)) = (self.live[i], open.last_mut()) {
+                        top.extend(self.fusions.reads(self.program, i));
+                    }
+                }
+                Item::Open(_) => open.push(Vec::new()),
+                Item::Close(b) => {
+                    let block = blocks[b];
+                    let mut reads = open.pop().unwrap_or_default();
+                    reads.retain(|&r| (r.0 as usize) < block.start && !self.is_const(r));
+                    reads.sort();
+                    reads.dedup();
+                    if let Some(top) = open.last_mut() {
+                        top.extend_from_slice(&reads);
+                        if self.live_blocks[b] {
+                            top.extend([block.bound, block.best]);
+                        }
+                    }
+                    out[b] = reads;
+                }
+            }
+        }
+        out
     }
 
     /// What the scope around block `b` sees it read: its outside reads, its test and the
@@ -810,5 +838,95 @@ fn fused_loop<T: Float>(
         Kind::SquareAdd => finishes!(|v: T, k: T| square(v + k)),
         Kind::SquareMax => finishes!(|v: T, k: T| square(v.max(k))),
         Kind::Scale => finishes!(|v: T, k: T| v * k),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::check_str;
+    use crate::lower::lower;
+
+    /// The registers block `b` of `c`'s program reads from before it, found the slow way:
+    /// every live instruction inside it, every live block inside it, its results.
+    fn outside_reads_by_scanning(c: &Compiler, b: usize) -> Vec<Reg> {
+        let block = c.program.blocks()[b];
+        let mut reads = Vec::new();
+        for i in block.start..block.end {
+            if c.live[i] {
+                reads.extend(c.fusions.reads(c.program, i));
+            }
+        }
+        for (nb, inner) in c.program.blocks().iter().enumerate() {
+            let within = inner.start >= block.start && inner.end <= block.end && nb != b;
+            if within && c.live_blocks[nb] {
+                reads.extend([inner.bound, inner.best]);
+            }
+        }
+        for i in block.end..block.end + block.results {
+            if let (true, Op::Phi(then, _)) = (c.live[i], c.ops()[i]) {
+                reads.push(then);
+            }
+        }
+        reads.retain(|&r| (r.0 as usize) < block.start && !c.is_const(r));
+        reads.sort();
+        reads.dedup();
+        reads
+    }
+
+    /// A scene of `n` objects in a loop, some under smooth blends and transforms, so that
+    /// its program holds blocks nested several deep.
+    fn many(n: usize) -> Program {
+        let text = format!(
+            "material a = phong {{ color: (1, 0, 0) }};
+             material b = phong {{ color: (0, 0, 1) }};
+             scene {{
+               plane((0, 1, 0), -2) @ a;
+               for i in 0..{n} {{
+                 let s = smooth_union(0.1, sphere(0.2), box((0.1, 0.3, 0.1)).rotate_y(30deg * i));
+                 if hash(i) < 0.5 {{ s.translate(hash(3 * i) * 20, hash(3 * i + 1), hash(3 * i + 2) * 20) @ a }}
+                 else {{ torus(0.3, 0.1).translate(hash(3 * i) * 20, 1, hash(3 * i + 2) * 20) @ b }};
+               }}
+             }}"
+        );
+        let (scene, diagnostics, _) = check_str("many.sdf", &text);
+        assert!(diagnostics.iter().all(|d| !d.is_error()), "{diagnostics:?}");
+        lower(&scene.expect("a scene"))
+    }
+
+    #[test]
+    fn gathered_reads_equal_the_scan_of_every_block() {
+        for n in [1, 7, 64, 300] {
+            let program = many(n);
+            assert!(program.blocks().len() >= n / 4, "{n}: few blocks");
+            for outputs in [Outputs::Distance, Outputs::DistanceAndMaterial] {
+                let mut roots = vec![program.distance()];
+                if outputs == Outputs::DistanceAndMaterial {
+                    roots.push(program.material());
+                }
+                let c = Compiler::new(&program, &roots);
+                let depth = program.blocks().iter().enumerate().any(|(b, block)| {
+                    program.blocks()[b + 1..]
+                        .iter()
+                        .any(|inner| inner.start >= block.start && inner.end <= block.end)
+                });
+                assert!(n < 64 || depth, "{n}: no nested blocks");
+                // What the walk gathers stays within a few registers a block: the sets that
+                // blocks hand outwards do not grow with the number of blocks around them.
+                let gathered: usize = c.outside.iter().map(Vec::len).sum();
+                let blocks = program.blocks().len();
+                assert!(
+                    gathered <= 8 * blocks,
+                    "{n}: {gathered} for {blocks} blocks"
+                );
+                for b in 0..program.blocks().len() {
+                    assert_eq!(
+                        c.outside_reads(b),
+                        outside_reads_by_scanning(&c, b),
+                        "{n} objects, block {b}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -116,7 +116,14 @@ pub(super) fn split(
             Some(graph.add(union, span))
         }
     };
-    let (rest, _, _) = lower_simple(whole, graph, root, &simple.origin, options, usize::MAX);
+    let (rest, _, _) = lower_simple(
+        whole,
+        graph,
+        root,
+        &simple.origin,
+        options,
+        (usize::MAX, &mut super::Phases::default()),
+    );
     Some(Split { rest, instances })
 }
 

@@ -37,6 +37,7 @@ use crate::limits::{Limit, Limits};
 use crate::scene::analysis::{self, Analysis};
 use crate::scene::analytic::{traceable, Choice, Traceable};
 use crate::scene::{Graph, NodeId, Scene, Settings};
+use std::time::{Duration, Instant};
 
 /// The distance a program reports for a scene with no objects: far beyond any `max_dist`.
 pub const EMPTY_DISTANCE: f64 = 1e30;
@@ -111,6 +112,35 @@ pub struct Lowered {
     simplified: Option<Simplified>,
     /// The options the program was lowered with.
     options: LowerOptions,
+    /// Where the lowering's time went.
+    pub phases: Phases,
+}
+
+/// Where a lowering's time went, phase by phase (`sdfc render --stats`): each phase's name,
+/// its time and what it did, in order.
+#[derive(Debug, Clone)]
+pub struct Phases {
+    /// The phases that ended.
+    pub list: Vec<(&'static str, Duration, &'static str)>,
+    last: Instant,
+}
+
+impl Default for Phases {
+    fn default() -> Self {
+        Phases {
+            list: Vec::new(),
+            last: Instant::now(),
+        }
+    }
+}
+
+impl Phases {
+    /// Ends a phase now.
+    fn lap(&mut self, name: &'static str, what: &'static str) {
+        let now = Instant::now();
+        self.list.push((name, now - self.last, what));
+        self.last = now;
+    }
 }
 
 impl Lowered {
@@ -154,8 +184,9 @@ struct Simplified {
 
 /// Lowers a checked scene for rendering ([`Lowered`]) with the given options.
 pub fn lower_scene(scene: &Scene, options: &LowerOptions) -> Lowered {
-    let (program, _, simplified) = lower_capped(scene, options, usize::MAX);
-    lowered(scene, program, simplified, options)
+    let mut phases = Phases::default();
+    let (program, _, simplified) = lower_capped(scene, options, usize::MAX, &mut phases);
+    lowered(scene, program, simplified, options, phases)
 }
 
 /// The [`Lowered`] of `scene` around its program.
@@ -164,13 +195,22 @@ fn lowered(
     program: Program,
     simplified: Option<Simplified>,
     options: &LowerOptions,
+    mut phases: Phases,
 ) -> Lowered {
+    let traceable = traceable(scene);
+    phases.lap(
+        "primitives",
+        "the primitives to trace analytically, or why not",
+    );
+    let media = media(scene);
+    phases.lap("media", "where glass may overlap a solid");
     Lowered {
         program,
-        traceable: traceable(scene),
-        media: media(scene),
+        traceable,
+        media,
         simplified,
         options: *options,
+        phases,
     }
 }
 
@@ -191,17 +231,22 @@ pub fn lower_within(
     let Some(root) = scene.root else {
         return Ok(lower_scene(scene, options));
     };
+    let mut phases = Phases::default();
     let expansion = scene
         .graph
         .over_expanded(root, limits.get(Limit::Expansion));
     if let Some(e) = expansion {
         return Err(scene.graph.expansion_error(&e, limits));
     }
+    phases.lap(
+        "expansion",
+        "shape nodes counted as a tree, within the limit",
+    );
     let max = limits.get(Limit::Program);
     let cap = usize::try_from(max).unwrap_or(usize::MAX);
-    let (program, over, simplified) = lower_capped(scene, options, cap);
+    let (program, over, simplified) = lower_capped(scene, options, cap, &mut phases);
     if !over && program.len() as u64 <= max {
-        return Ok(lowered(scene, program, simplified, options));
+        return Ok(lowered(scene, program, simplified, options, phases));
     }
     Err(Diagnostic::error(
         "E0507",
@@ -217,7 +262,7 @@ pub fn lower_within(
 
 /// Lowers a checked scene to its distance program with the given options.
 pub fn lower_with(scene: &Scene, options: &LowerOptions) -> Program {
-    lower_capped(scene, options, usize::MAX).0
+    lower_capped(scene, options, usize::MAX, &mut Phases::default()).0
 }
 
 /// [`lower_with`], stopping once more than `cap` instructions were emitted; the flag says
@@ -227,24 +272,27 @@ fn lower_capped(
     scene: &Scene,
     options: &LowerOptions,
     cap: usize,
+    phases: &mut Phases,
 ) -> (Program, bool, Option<Simplified>) {
     match scene.root {
         _ if options.level == 0 => {
             let (program, over) = lower_literal(scene, cap);
+            phases.lap("program", "the scene lowered as written");
             (program, over, None)
         }
         Some(root) => {
             let simple = simplify::simplify(&scene.graph, root, options.parametric);
+            phases.lap("simplify", "transforms composed, unions flattened");
             lower_simple(
                 scene,
                 simple.graph,
                 Some(simple.root),
                 &simple.origin,
                 options,
-                cap,
+                (cap, phases),
             )
         }
-        None => lower_simple(scene, Graph::default(), None, &[], options, cap),
+        None => lower_simple(scene, Graph::default(), None, &[], options, (cap, phases)),
     }
 }
 
@@ -257,7 +305,7 @@ fn lower_simple(
     root: Option<NodeId>,
     origin: &[NodeId],
     options: &LowerOptions,
-    cap: usize,
+    (cap, phases): (usize, &mut Phases),
 ) -> (Program, bool, Option<Simplified>) {
     let mut b = builder::Builder::capped(true, cap);
     b.parametric = options.parametric;
@@ -276,7 +324,9 @@ fn lower_simple(
             if !options.local {
                 lipschitz = analysis.step_lipschitz();
             }
+            phases.lap("analysis", "exactness and Lipschitz bounds of every node");
             let bounds = bounds::Bounds::new(&simple_scene.graph);
+            phases.lap("bounds", "the bounding volume of every node");
             let config = graph::Config {
                 cull: options.cull,
                 camera: scene.camera.position,
@@ -298,6 +348,10 @@ fn lower_simple(
         None => (b.c(EMPTY_DISTANCE), b.c(graph::UNPAINTED)),
     };
     let (program, over) = finish(b, d, m, lipschitz);
+    phases.lap(
+        "program",
+        "the distance program built (hierarchies of bounds, culling blocks)",
+    );
     (program, over, simplified)
 }
 

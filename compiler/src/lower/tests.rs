@@ -335,9 +335,11 @@ fn lowering_stops_at_the_program_limit() {
     let (scene, diags, _) = crate::check::check_str("many.sdf", &text);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let options = super::LowerOptions::default();
-    let (whole, over, _) = super::lower_capped(&scene, &options, usize::MAX);
+    let (whole, over, _) =
+        super::lower_capped(&scene, &options, usize::MAX, &mut super::Phases::default());
     assert!(!over && whole.len() > 50_000, "{}", whole.len());
-    let (part, over, _) = super::lower_capped(&scene, &options, 1_000);
+    let (part, over, _) =
+        super::lower_capped(&scene, &options, 1_000, &mut super::Phases::default());
     assert!(over && part.len() < 2_000, "stopped at {}", part.len());
     let mut limits = crate::Limits::default();
     limits.set(crate::Limit::Program, 1_000).expect("valid");

@@ -5,6 +5,7 @@ use crate::frontend::{self, DiagnosticFormat};
 use sdfc_compiler::diagnostics::number;
 use sdfc_compiler::scene::analysis;
 use sdfc_compiler::scene::Scene;
+use sdfc_compiler::{Diagnostic, Severity};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -43,6 +44,9 @@ pub fn run(args: CheckArgs) -> ExitCode {
                     None => code = code.max(1),
                     Some(scene) => {
                         let human = args.diagnostics == DiagnosticFormat::Human;
+                        if let Some(w) = beyond_render_limits(scene, &limits) {
+                            frontend::print_diagnostics(&[w], &loaded.sources, args.diagnostics);
+                        }
                         if human {
                             eprintln!(
                                 "{}: ok; {}; {}",
@@ -71,6 +75,23 @@ pub fn run(args: CheckArgs) -> ExitCode {
         }
     }
     ExitCode::from(code)
+}
+
+/// A warning where `scene`, which checks, is more than `sdfc render` and `sdfc mesh` accept
+/// within `limits`: its shapes counted as a tree beyond `expansion`, or its distance program
+/// beyond `program`. The scene is lowered as a render lowers it, and the lowering stops at
+/// the limit, so this costs no more than the render would have spent before failing.
+fn beyond_render_limits(scene: &Scene, limits: &sdfc_compiler::Limits) -> Option<Diagnostic> {
+    let options = sdfc_compiler::lower::LowerOptions::default();
+    let error = sdfc_compiler::lower::lower_within(scene, &options, limits).err()?;
+    Some(Diagnostic {
+        severity: Severity::Warning,
+        message: format!(
+            "`sdfc render` and `sdfc mesh` will refuse this scene: {}",
+            error.message
+        ),
+        ..error
+    })
 }
 
 /// Pairs of points sampled per field by `--verify-bounds`, and how far from the camera's

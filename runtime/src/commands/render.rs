@@ -175,6 +175,8 @@ pub struct FrameScene {
     pub scene: Scene,
     /// Its distance program and what else the backends read.
     pub lowered: sdfc_compiler::lower::Lowered,
+    /// Where its time went (`--stats`): the check, then the lowering's phases.
+    pub phases: Vec<(&'static str, Duration, String)>,
 }
 
 /// The settings a command overrides in every frame it checks.
@@ -213,7 +215,13 @@ pub fn frame_scene(
     warnings: bool,
     lowering: &LowerOptions,
 ) -> Result<FrameScene, CliError> {
+    let started = Instant::now();
     let mut loaded = source.check(limits, time);
+    let mut phases = vec![(
+        "check",
+        started.elapsed(),
+        "parsed, imports read, checked and evaluated".to_string(),
+    )];
     if !warnings {
         loaded.diagnostics.retain(|d| d.is_error());
     }
@@ -235,9 +243,17 @@ pub fn frame_scene(
         .lower(lowering, limits)
         .map_err(CliError::Reported)?;
     crate::backend::method_allowed(&checked.scene, &lowered.traceable).map_err(CliError::Failed)?;
+    phases.extend(
+        lowered
+            .phases
+            .list
+            .iter()
+            .map(|&(name, time, what)| (name, time, what.to_string())),
+    );
     Ok(FrameScene {
         scene: checked.scene,
         lowered,
+        phases,
     })
 }
 
@@ -250,7 +266,7 @@ pub fn prepare(
     setup: &Setup,
     opening: Option<Opening>,
 ) -> Result<(Scene, Prepared), CliError> {
-    let FrameScene { scene, lowered } = frame;
+    let FrameScene { scene, lowered, .. } = frame;
     // A kernel asked for that cannot render the scene is an error, not a reason to fall back
     // to another backend.
     if backend != Backend::Cpu {
@@ -313,6 +329,7 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
     };
     let limits = args.limits.limits();
     let mut source = frontend::Source::read(&args.file).map_err(CliError::Usage)?;
+    run.lap("read", "the scene's file read");
     let frame = frame_scene(
         args.overrides(),
         &mut source,
@@ -321,7 +338,11 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
         true,
         &LowerOptions::default(),
     )?;
-    run.lap("scene", "read, checked and lowered");
+    run.split(
+        "scene",
+        "the rest of it (diagnostics printed, settings applied)",
+        frame.phases.clone(),
+    );
     let (backend, precision) = mode.map_err(CliError::Usage)?;
     Kernel::check(args.kernel, backend).map_err(CliError::Usage)?;
     // The output is checked before any work, so that a render is never thrown away.

@@ -663,7 +663,7 @@ impl<'a> Kernels<'a> {
             // The device stays open; the kernel is kept when its text is the same (the
             // program differs in numbers only) and given the frame's constants.
             Some((held, origin, prepared)) => {
-                let FrameScene { scene, lowered } = frame;
+                let FrameScene { scene, lowered, .. } = frame;
                 *held = lowered.program.clone();
                 *origin = scene.origin;
                 if prepared.update(&scene, lowered).map_err(CliError::Failed)? {

@@ -87,7 +87,7 @@ impl Shape {
 
 fn in_type<T: Float>(scene: &Scene, tapes: &Tapes, options: &Options, threads: usize) -> u64 {
     let shape = Shape::new(scene, options);
-    let per_thread = workspace::<T>(&shape, tapes, options)
+    let per_thread = workspace::<T>(&shape, scene, tapes, options)
         .saturating_add(tile::<T>(&shape, scene.settings.max_depth as u64));
     shared::<T>(&shape, scene, tapes)
         .saturating_add(per_thread.saturating_mul(threads.max(1) as u64))
@@ -112,14 +112,20 @@ fn shared<T: Float>(shape: &Shape, scene: &Scene, tapes: &Tapes) -> u64 {
     .fold(0, u64::saturating_add)
 }
 
-/// A thread's workspace, kept from tile to tile: evaluators, lanes and the buffers of a wave.
-fn workspace<T: Float>(shape: &Shape, tapes: &Tapes, options: &Options) -> u64 {
+/// A thread's workspace, kept from tile to tile: evaluators (where `scene` marches: a
+/// traced render has none), lanes and the buffers of a wave.
+fn workspace<T: Float>(shape: &Shape, scene: &Scene, tapes: &Tapes, options: &Options) -> u64 {
     let w = shape.wave;
-    let evaluators: usize = tapes
-        .all()
-        .into_iter()
-        .map(|t| Evaluator::<T>::heap_bytes(t, options.chunk))
-        .sum();
+    let marched = tapes.traceable.traced(scene.settings.method).is_none();
+    let evaluators: usize = if marched {
+        tapes
+            .all()
+            .into_iter()
+            .map(|t| Evaluator::<T>::heap_bytes(t, options.chunk))
+            .sum()
+    } else {
+        0
+    };
     let lanes = Lanes::<T>::heap_bytes(options.lanes.max(1));
     [
         evaluators as u64,

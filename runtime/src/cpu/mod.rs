@@ -28,9 +28,10 @@ use crate::image::Image;
 use context::Context;
 use rayon::prelude::*;
 use sdfc_compiler::eval::{Float, Outputs, Tape};
-use sdfc_compiler::lower::Lowered;
+use sdfc_compiler::lower::{Lowered, Media, Program};
 use sdfc_compiler::scene::analytic::Traceable;
 use sdfc_compiler::scene::{Scene, Settings};
+use std::sync::OnceLock;
 use tile::Rect;
 use wave::Workspace;
 
@@ -84,12 +85,23 @@ pub const NAN_COLOUR: [f32; 3] = [1.0, 0.0, 1.0];
 /// where glass may overlap an opaque solid, the tapes of the scene's media; with them, the
 /// scene's primitives for analytic tracing (the lowering's [`Traceable`]), which a render
 /// traces when its `method` setting picks tracing.
+///
+/// The tapes are prepared when a render first marches (a traced scene evaluates no program,
+/// so it never prepares them), or at once by [`Tapes::prepare`].
 #[derive(Debug, Clone)]
 pub struct Tapes {
+    program: Program,
+    media: Option<Media>,
+    built: OnceLock<Built>,
+    traceable: Traceable,
+}
+
+/// The tapes of [`Tapes`], once prepared.
+#[derive(Debug, Clone)]
+struct Built {
     distance: Tape,
     full: Tape,
     media: Option<MediaTapes>,
-    traceable: Traceable,
 }
 
 /// The tapes of [`sdfc_compiler::lower::Media`]: the medium's distance (marched by rays
@@ -104,18 +116,61 @@ struct MediaTapes {
 impl Tapes {
     /// Prepares the tapes of a lowered scene: its program's two, and its media's when its
     /// glass may overlap an opaque solid (docs/rendering.md, "Inside glass").
+    /// (Not prepared yet: see [`Tapes::prepare`].)
     pub fn new(lowered: &Lowered) -> Self {
-        let program = &lowered.program;
         Tapes {
-            distance: Tape::new(program, Outputs::Distance),
-            full: Tape::new(program, Outputs::DistanceAndMaterial),
-            media: lowered.media.as_ref().map(|m| MediaTapes {
-                medium: Tape::new(&m.medium, Outputs::Distance),
-                solid: Tape::new(&m.solid, Outputs::Distance),
-                solid_full: Tape::new(&m.solid, Outputs::DistanceAndMaterial),
-            }),
+            program: lowered.program.clone(),
+            media: lowered.media.clone(),
+            built: OnceLock::new(),
             traceable: lowered.traceable.clone(),
         }
+    }
+
+    /// [`Tapes::new`], keeping the lowered scene's program rather than a copy of it.
+    pub fn of(lowered: Lowered) -> Self {
+        let Lowered {
+            program,
+            traceable,
+            media,
+            ..
+        } = lowered;
+        Tapes {
+            program,
+            media,
+            built: OnceLock::new(),
+            traceable,
+        }
+    }
+
+    /// Prepares the tapes now, if they are not yet.
+    pub fn prepare(&self) {
+        self.built();
+    }
+
+    /// Whether the tapes are prepared.
+    pub fn prepared(&self) -> bool {
+        self.built.get().is_some()
+    }
+
+    /// The tapes, prepared on first use.
+    fn built(&self) -> &Built {
+        self.built.get_or_init(|| {
+            let program = &self.program;
+            Built {
+                distance: Tape::new(program, Outputs::Distance),
+                full: Tape::new(program, Outputs::DistanceAndMaterial),
+                media: self.media.as_ref().map(|m| MediaTapes {
+                    medium: Tape::new(&m.medium, Outputs::Distance),
+                    solid: Tape::new(&m.solid, Outputs::Distance),
+                    solid_full: Tape::new(&m.solid, Outputs::DistanceAndMaterial),
+                }),
+            }
+        })
+    }
+
+    /// The distance program the tapes are prepared from.
+    pub fn program(&self) -> &Program {
+        &self.program
     }
 
     /// The scene's primitives, or why it cannot be traced analytically.
@@ -123,10 +178,12 @@ impl Tapes {
         &self.traceable
     }
 
-    /// Every tape, for the memory bound (each thread has an evaluator of each).
+    /// Every tape, for the memory bound of a marched render (each thread has an evaluator
+    /// of each); prepares them.
     fn all(&self) -> Vec<&Tape> {
-        let mut out = vec![&self.distance, &self.full];
-        if let Some(m) = &self.media {
+        let built = self.built();
+        let mut out = vec![&built.distance, &built.full];
+        if let Some(m) = &built.media {
             out.extend([&m.medium, &m.solid, &m.solid_full]);
         }
         out
@@ -209,7 +266,7 @@ pub fn render_in<T: Float>(
     let outs: Vec<tile::TileOut> = rects
         .par_iter()
         .map_init(
-            || Workspace::new(tapes, options.lanes, options.chunk),
+            || Workspace::new(&ctx, tapes, options.lanes, options.chunk),
             |ws, &rect| {
                 let out = tile::render(&ctx, ws, rect);
                 progress();
@@ -265,7 +322,7 @@ fn rows_in<T: Float>(
     let outs: Vec<tile::TileOut> = rects
         .par_iter()
         .map_init(
-            || Workspace::new(tapes, options.lanes, options.chunk),
+            || Workspace::new(&ctx, tapes, options.lanes, options.chunk),
             |ws, &rect| tile::render(&ctx, ws, rect),
         )
         .collect();

@@ -6,7 +6,7 @@ use super::lanes::{march, Launch};
 use super::march::{Shadow, Shadowed, Status, Trace, Traced};
 use super::stats::Counters;
 use super::vec::V3;
-use super::wave::{Ray, Samples, Workspace};
+use super::wave::{Evaluators, Ray, Samples, Workspace};
 use sdfc_compiler::eval::Float;
 
 /// A surface point reached by a ray of the wave.
@@ -89,6 +89,16 @@ pub(super) fn bounce<T: Float>(
     next
 }
 
+/// The evaluators of a workspace that marches: every caller runs where the context has no
+/// analytic tracer, and [`Workspace::new`] gives exactly those workspaces evaluators.
+fn marching<'a, 't, T: Float>(
+    evaluators: &'a mut Option<Evaluators<'t, T>>,
+) -> &'a mut Evaluators<'t, T> {
+    evaluators
+        .as_mut()
+        .expect("a marched scene's workspace has its evaluators")
+}
+
 /// Traces every ray of the wave into `ws.traced`: analytically (with each hit's normal and
 /// material in `ws.surfaces`) or by sphere tracing.
 fn trace<T: Float>(
@@ -140,8 +150,9 @@ fn trace<T: Float>(
     }
     ws.traced.clear();
     ws.traced.resize(wave.len(), Traced::default());
+    let ev = marching(&mut ws.marching);
     // Where the scene has media, rays inside glass march the medium instead of the scene.
-    let passes: &[Option<bool>] = if ws.media.is_some() {
+    let passes: &[Option<bool>] = if ev.media.is_some() {
         &[Some(false), Some(true)]
     } else {
         &[None]
@@ -172,11 +183,11 @@ fn trace<T: Float>(
             out: &mut ws.traced,
             counters: &mut *counters,
         };
-        let dist = match (pass, ws.media.as_mut()) {
+        let dist = match (pass, ev.media.as_mut()) {
             (Some(true), Some(m)) => &mut m.medium,
-            _ => &mut ws.dist,
+            _ => &mut ev.dist,
         };
-        march(&mut ws.lanes, dist, &mut ws.full, &ws.launches, &mut rule);
+        march(&mut ws.lanes, dist, &mut ev.full, &ws.launches, &mut rule);
     }
 }
 
@@ -201,7 +212,9 @@ fn normals<T: Float>(ws: &mut Workspace<'_, T>, wave: &[Ray<T>], hits: &mut [Hit
             (ws.x[4 * i + j], ws.y[4 * i + j], ws.z[4 * i + j]) = (q.x, q.y, q.z);
         }
     }
-    ws.dist.eval(&ws.x, &ws.y, &ws.z, &mut ws.d, None);
+    marching(&mut ws.marching)
+        .dist
+        .eval(&ws.x, &ws.y, &ws.z, &mut ws.d, None);
     for (i, hit) in hits.iter_mut().enumerate() {
         let g = TETRA.iter().enumerate().fold(V3::zero(), |g, (j, k)| {
             g + V3::from_f64(*k) * ws.d[4 * i + j]
@@ -230,7 +243,8 @@ fn materials<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, hits: &mut [
     for (i, hit) in hits.iter().enumerate() {
         (ws.x[i], ws.y[i], ws.z[i]) = (hit.p.x, hit.p.y, hit.p.z);
     }
-    ws.full
+    marching(&mut ws.marching)
+        .full
         .eval(&ws.x, &ws.y, &ws.z, &mut ws.d, Some(&mut ws.m));
     for (hit, &m) in hits.iter_mut().zip(&ws.m) {
         hit.mat = m;
@@ -247,7 +261,7 @@ fn solids<T: Float>(
     wave: &[Ray<T>],
     hits: &mut [Hit<T>],
 ) {
-    let Some(media) = ws.media.as_mut() else {
+    let Some(media) = marching(&mut ws.marching).media.as_mut() else {
         return;
     };
     let inside: Vec<usize> = (0..hits.len())
@@ -501,10 +515,11 @@ fn shadows<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, counters: &mut
         out: &mut ws.shadowed,
         counters,
     };
+    let ev = marching(&mut ws.marching);
     march(
         &mut ws.lanes,
-        &mut ws.dist,
-        &mut ws.full,
+        &mut ev.dist,
+        &mut ev.full,
         &ws.launches,
         &mut rule,
     );

@@ -2,6 +2,7 @@
 //! samples the rays of a tile add up to, and the per-thread workspace (evaluators, lanes,
 //! buffers) that tiles (`tile.rs`) and the shading of each wave (`shade.rs`) share.
 
+use super::context::Context;
 use super::lanes::{Lanes, Launch};
 use super::march::{Shadowed, Traced};
 use super::vec::V3;
@@ -65,13 +66,21 @@ pub(super) struct Media<'t, T: Float> {
     pub solid_full: Evaluator<'t, T>,
 }
 
+/// The evaluators of a marched scene: its distance, its distance and material, and the
+/// media's where glass may overlap an opaque solid.
+#[derive(Debug)]
+pub(super) struct Evaluators<'t, T: Float> {
+    pub dist: Evaluator<'t, T>,
+    pub full: Evaluator<'t, T>,
+    pub media: Option<Media<'t, T>>,
+}
+
 /// Scratch space of one thread: evaluators, lanes and buffers, reused from tile to tile.
 #[derive(Debug)]
 pub(super) struct Workspace<'t, T: Float> {
-    pub dist: Evaluator<'t, T>,
-    pub full: Evaluator<'t, T>,
-    /// The media's evaluators, where glass may overlap an opaque solid.
-    pub media: Option<Media<'t, T>>,
+    /// The evaluators, where the scene is marched (a traced scene evaluates no program, so
+    /// its tapes are never prepared).
+    pub marching: Option<Evaluators<'t, T>>,
     pub lanes: Lanes<T>,
     pub launches: Vec<Launch<T>>,
     pub traced: Vec<Traced<T>>,
@@ -86,15 +95,22 @@ pub(super) struct Workspace<'t, T: Float> {
 }
 
 impl<'t, T: Float> Workspace<'t, T> {
-    pub fn new(tapes: &'t Tapes, lanes: usize, chunk: usize) -> Self {
+    /// The workspace of a render in `ctx`: with evaluators of `tapes` where it marches.
+    pub fn new(ctx: &Context<T>, tapes: &'t Tapes, lanes: usize, chunk: usize) -> Self {
+        let marching = ctx.analytic.is_none().then(|| {
+            let built = tapes.built();
+            Evaluators {
+                dist: Evaluator::new(&built.distance, chunk),
+                full: Evaluator::new(&built.full, chunk),
+                media: built.media.as_ref().map(|m| Media {
+                    medium: Evaluator::new(&m.medium, chunk),
+                    solid: Evaluator::new(&m.solid, chunk),
+                    solid_full: Evaluator::new(&m.solid_full, chunk),
+                }),
+            }
+        });
         Workspace {
-            dist: Evaluator::new(&tapes.distance, chunk),
-            full: Evaluator::new(&tapes.full, chunk),
-            media: tapes.media.as_ref().map(|m| Media {
-                medium: Evaluator::new(&m.medium, chunk),
-                solid: Evaluator::new(&m.solid, chunk),
-                solid_full: Evaluator::new(&m.solid_full, chunk),
-            }),
+            marching,
             lanes: Lanes::new(lanes.max(1)),
             launches: Vec::new(),
             traced: Vec::new(),

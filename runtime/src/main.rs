@@ -1,14 +1,20 @@
 //! The `sdfc` command-line tool: check, compile, render, benchmark and compare `.sdf` scenes,
 //! chart their speed against accuracy, view them live, and mesh them.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 use sdfc_runtime::commands;
 
 /// sdfc compiles scenes of signed distance fields to images, shaders and programs.
 #[derive(Debug, Parser)]
-#[command(name = "sdfc", version, about, long_about = None)]
+#[command(
+    name = "sdfc",
+    version,
+    about,
+    long_about = None,
+    after_long_help = commands::limits_help()
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -20,7 +26,8 @@ enum Command {
     Check(commands::check::CheckArgs),
     /// Compile a scene to one of the textual targets.
     Compile(commands::compile::CompileArgs),
-    /// Render a scene to a PNG image.
+    /// Render a scene to an image (PNG, JPEG or OpenEXR, by the output's extension) or an
+    /// animation to numbered images, an animated PNG or a video.
     Render(commands::render::RenderArgs),
     /// Time the rendering of scenes.
     Bench(commands::bench::BenchArgs),
@@ -35,6 +42,7 @@ enum Command {
     /// the CPU.
     Devices(commands::devices::DevicesArgs),
     /// Show a scene in a window that reloads it whenever it (or a file it imports) is saved.
+    #[command(after_help = VIEW_KEYS)]
     View(commands::view::ViewArgs),
     /// Format scene files in one layout, comments kept (`--check`: name those that would
     /// change, exit 1 if any would).
@@ -42,7 +50,39 @@ enum Command {
     /// Serve the Language Server Protocol on standard input and output, for editors
     /// (docs/editors.md).
     Lsp(LspArgs),
+    /// Print a completion script for bash, zsh or fish on standard output.
+    ///
+    /// Install it where the shell looks: bash `sdfc completions bash >
+    /// ~/.local/share/bash-completion/completions/sdfc`, zsh a file `_sdfc` in a directory of
+    /// `$fpath`, fish `~/.config/fish/completions/sdfc.fish`.
+    Completions(CompletionsArgs),
 }
+
+/// `sdfc completions`' arguments.
+#[derive(Debug, clap::Args)]
+struct CompletionsArgs {
+    /// The shell to complete in.
+    #[arg(value_enum)]
+    shell: Shell,
+}
+
+/// The shells `sdfc completions` writes for.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum Shell {
+    Bash,
+    Zsh,
+    Fish,
+}
+
+/// The keys and mouse of `sdfc view`'s window (docs/viewer.md), listed by its `--help`.
+const VIEW_KEYS: &str = "In the window:
+  left drag                  orbit the camera around its target
+  shift-drag, middle drag    pan
+  wheel                      zoom
+  R                          the file's camera again
+  S, Tab                     statistics in the title (on or off)
+  Space                      pause or play an animated scene
+  Esc, Q                     quit";
 
 /// `sdfc lsp`'s arguments.
 #[derive(Debug, clap::Args)]
@@ -75,5 +115,26 @@ fn main() -> ExitCode {
         Command::View(args) => commands::view::run(args),
         Command::Fmt(args) => commands::fmt::run(args),
         Command::Lsp(_) => sdfc_runtime::lsp::run(),
+        Command::Completions(args) => completions(args.shell),
+    }
+}
+
+/// Writes the completion script of `shell` on standard output.
+fn completions(shell: Shell) -> ExitCode {
+    use clap_complete::Shell as S;
+    let shell = match shell {
+        Shell::Bash => S::Bash,
+        Shell::Zsh => S::Zsh,
+        Shell::Fish => S::Fish,
+    };
+    let mut out = Vec::new();
+    clap_complete::generate(shell, &mut Cli::command(), "sdfc", &mut out);
+    use std::io::Write;
+    match std::io::stdout().write_all(&out) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: cannot write the completion script: {e}");
+            ExitCode::from(2)
+        }
     }
 }

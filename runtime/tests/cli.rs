@@ -1393,3 +1393,119 @@ fn fmt_rewrites_checks_and_filters() {
     assert_eq!(run(&["fmt", "--check"], tidy).status.code(), Some(0));
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The help and completions of issue 37, item 8: `sdfc completions` writes a script for each
+/// shell that knows the subcommands and their flags; the limits' table is in `sdfc --help`
+/// once and in no subcommand's help; `view --help` lists every key the window handles (read
+/// from its source); `render` is not described as writing only PNG; `mesh --help` says how
+/// importers load a multi-material glTF.
+#[test]
+fn help_and_completions() {
+    let d = dir("help");
+    for (shell, marker) in [
+        ("bash", "complete"),
+        ("zsh", "#compdef"),
+        ("fish", "complete -c sdfc"),
+    ] {
+        let out = sdfc(&d, &["completions", shell]);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{shell}");
+        for word in [marker, "render", "mesh", "limit", "backend"] {
+            assert!(text.contains(word), "{shell}: no `{word}`");
+        }
+    }
+    let out = sdfc(&d, &["completions", "powershell"]);
+    assert_eq!(out.status.code(), Some(2));
+
+    let help = |args: &[&str]| {
+        let out = sdfc(&d, args);
+        assert!(out.status.success(), "{args:?}");
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let top = help(&["--help"]);
+    for limit in ["nesting", "sweep_points", "registers"] {
+        assert_eq!(
+            top.lines()
+                .filter(|l| l.trim_start().starts_with(limit))
+                .count(),
+            1,
+            "{limit} in: {top}"
+        );
+    }
+    let subcommands = [
+        "check",
+        "compile",
+        "render",
+        "bench",
+        "compare",
+        "pareto",
+        "mesh",
+        "devices",
+        "view",
+        "lsp",
+        "completions",
+    ];
+    for sub in subcommands {
+        let text = help(&[sub, "--help"]);
+        assert!(
+            !text.contains("sweep_points") && !text.contains("registers of the interpreted"),
+            "{sub} --help repeats the limits' table"
+        );
+    }
+    assert!(help(&["render", "--help"]).contains("sdfc --help"));
+
+    // Every key the window's event handler matches is in `view --help`.
+    let window =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/view/window.rs"))
+            .expect("window.rs");
+    let mut keys: Vec<String> = window
+        .split("eq_ignore_ascii_case(\"")
+        .skip(1)
+        .map(|rest| rest[..1].to_uppercase())
+        .collect();
+    keys.extend(
+        window
+            .split("NamedKey::")
+            .skip(1)
+            .map(|rest| {
+                rest.split(|c: char| !c.is_alphanumeric())
+                    .next()
+                    .unwrap_or("")
+            })
+            .filter(|k| !k.is_empty())
+            .map(|k| {
+                if k == "Escape" {
+                    "Esc".to_string()
+                } else {
+                    k.to_string()
+                }
+            }),
+    );
+    assert!(keys.len() >= 5, "{keys:?}");
+    let view = help(&["view", "--help"]);
+    let table = view
+        .split("In the window:")
+        .nth(1)
+        .expect("view --help lists the keys");
+    for key in &keys {
+        assert!(
+            table
+                .lines()
+                .any(|l| l.split_whitespace().any(|w| w.trim_end_matches(',') == key)),
+            "`{key}` is not in view --help: {table}"
+        );
+    }
+
+    let top_lines: Vec<&str> = top
+        .lines()
+        .filter(|l| l.trim_start().starts_with("render"))
+        .collect();
+    assert!(
+        top_lines
+            .iter()
+            .any(|l| l.contains("JPEG") && !l.contains("to a PNG image")),
+        "{top_lines:?}"
+    );
+    assert!(help(&["mesh", "--help"]).contains("importers load as separate parts"));
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -512,6 +512,44 @@ fn the_editor_grammar_knows_every_builtin() {
     }
 }
 
+/// The escapes docs/language.md's row for strings and grammar/sdf.ebnf's STRING list are the
+/// lexer's, and each one lexes to its character (issue 37: the docs named two of four).
+#[test]
+fn the_string_escapes_in_the_docs_are_the_lexers() {
+    use sdfc_compiler::syntax::lexer::{lex, Token, ESCAPES};
+    let escapes: Vec<String> = ESCAPES.iter().map(|(k, _)| format!("\\{k}")).collect();
+    let doc = read("docs/language.md");
+    let row = doc
+        .lines()
+        .find(|l| l.starts_with("| String |"))
+        .expect("docs/language.md has a row for strings");
+    let listed: Vec<&str> = row
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|t| t.starts_with('\\'))
+        .collect();
+    assert_eq!(listed, escapes, "docs/language.md: {row}");
+    let ebnf = read("grammar/sdf.ebnf");
+    let rule: String = ebnf
+        .lines()
+        .skip_while(|l| !l.trim_start().starts_with("STRING"))
+        .take_while(|l| !l.trim_start().starts_with("punct"))
+        .collect();
+    for e in &escapes {
+        assert!(
+            rule.contains(&format!("\"{e}\"")) || (e == "\\\"" && rule.contains("\"\\\" '\"'")),
+            "grammar/sdf.ebnf's STRING lacks {e}: {rule}"
+        );
+    }
+    for (k, v) in ESCAPES {
+        let text = format!("\"a\\{k}b\"");
+        let (tokens, diags) = lex(sdfc_compiler::FileId(0), &text);
+        assert!(diags.is_empty(), "{text}: {diags:?}");
+        assert_eq!(tokens[0].0, Token::Str(format!("a{v}b")), "{text}");
+    }
+}
+
 #[test]
 fn the_language_reference_lists_every_signature_and_field() {
     let doc = read("docs/language.md");

@@ -231,8 +231,26 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
     (tokens, diags)
 }
 
-/// Resolves the escapes `\"`, `\\`, `\n` and `\t`; any other escape is an error (the
-/// character is kept, so nothing after it is misread).
+/// The escapes of a string: the character after the backslash, and what it stands for
+/// (docs/language.md and grammar/sdf.ebnf list the same, a tidy test holds them in step).
+pub const ESCAPES: [(char, char); 4] = [('"', '"'), ('\\', '\\'), ('n', '\n'), ('t', '\t')];
+
+/// The note of an unknown escape: ``the escapes are \", \\, \n and \t``.
+fn escapes_note() -> String {
+    let list = ESCAPES.map(|(k, _)| format!("\\{k}"));
+    match list.split_last() {
+        Some((last, rest)) => format!("the escapes are {} and {last}", rest.join(", ")),
+        None => "a string has no escapes".into(),
+    }
+}
+
+/// What the escape `\c` stands for, if it is one of the [`ESCAPES`].
+fn escaped(c: char) -> Option<char> {
+    ESCAPES.iter().find(|&&(k, _)| k == c).map(|&(_, v)| v)
+}
+
+/// Resolves the [`ESCAPES`]; any other escape is an error (the character is kept, so
+/// nothing after it is misread).
 fn unescape(raw: &str, offset: usize, file: FileId) -> (String, Vec<Diagnostic>) {
     let mut out = String::with_capacity(raw.len());
     let mut diags = Vec::new();
@@ -243,10 +261,7 @@ fn unescape(raw: &str, offset: usize, file: FileId) -> (String, Vec<Diagnostic>)
             continue;
         }
         match chars.next() {
-            Some((_, '"')) => out.push('"'),
-            Some((_, '\\')) => out.push('\\'),
-            Some((_, 'n')) => out.push('\n'),
-            Some((_, 't')) => out.push('\t'),
+            Some((_, e)) if escaped(e).is_some() => out.extend(escaped(e)),
             Some((j, other)) => {
                 let span = Span::new(file, offset + i..offset + j + other.len_utf8());
                 diags.push(
@@ -256,7 +271,7 @@ fn unescape(raw: &str, offset: usize, file: FileId) -> (String, Vec<Diagnostic>)
                         span,
                     )
                     .with_label("not an escape")
-                    .with_note("the escapes are \\\", \\\\, \\n and \\t"),
+                    .with_note(escapes_note()),
                 );
                 out.push(other);
             }

@@ -22,7 +22,9 @@ pub struct MeshArgs {
     /// Scene file.
     pub file: PathBuf,
     /// Output mesh: .stl (binary), .obj, .ply (binary, vertex colours) or .glb (binary glTF,
-    /// one material per scene material).
+    /// one material per scene material: a primitive each, sharing one buffer of positions,
+    /// which importers load as separate parts with the border vertices duplicated; write .ply
+    /// for one welded mesh with colours).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Cells along the longest side of the bounds [default: 128].

@@ -81,13 +81,12 @@ fn process_age() -> Option<Duration> {
 /// `--limit NAME=VALUE`: the resource limits of a run.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct LimitArgs {
-    /// Set a resource limit (may be repeated); see `--help` for the names and defaults.
-    #[arg(
-        long = "limit",
-        value_name = "NAME=VALUE",
-        value_parser = Limits::parse,
-        long_help = limits_help()
-    )]
+    /// Set a resource limit (may be repeated); `sdfc --help` lists every limit with its
+    /// default.
+    ///
+    /// An input or render that exceeds a limit stops before any work with a message naming
+    /// the flag that raises it.
+    #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = Limits::parse)]
     pub limit: Vec<(Limit, u64)>,
 }
 
@@ -103,10 +102,12 @@ impl LimitArgs {
     }
 }
 
-fn limits_help() -> String {
+/// The limits' table, shown once, by `sdfc --help` (each subcommand's `--limit` points
+/// there).
+pub fn limits_help() -> String {
     format!(
-        "Set a resource limit (may be repeated). An input or render that exceeds a limit \
-         stops before any work with a message naming the flag that raises it.\n\n{}",
+        "Limits (`--limit NAME=VALUE` on check, compile, render, mesh, bench, pareto and view; \
+         docs/failures.md):\n\n{}",
         Limits::table()
     )
 }

@@ -15,7 +15,7 @@ use sdfc_compiler::eval::{Evaluator, Outputs, Tape, DEFAULT_CHUNK};
 use sdfc_compiler::lower::{self, LowerOptions};
 use sdfc_compiler::scene::{analysis, analytic};
 use sdfc_compiler::{Limits, Severity, SourceMap};
-use sdfc_runtime::backend::{Backend, Devices, Kernel, Setup};
+use sdfc_runtime::backend::{Backend, Devices, Kernel, Prepared, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
 use sdfc_runtime::commands::mesh as mesher;
 use sdfc_runtime::commands::render::{self as renderer, CliError, FrameScene};
@@ -331,8 +331,24 @@ impl Scene {
             lowered,
             phases: Vec::new(),
         };
-        let (scene, prepared) =
-            renderer::prepare(pool, (ask.backend, &Devices::Auto), frame, &setup, None)?;
+        let (scene, prepared) = match ask.backend {
+            // The process's wgpu device, whose compiled pipelines later renders reuse.
+            Backend::Wgpu => {
+                let gpu = wgpu_device().map_err(|e| Failure::Runtime(e.clone()))?;
+                let prepared = pool
+                    .install(|| Prepared::on_gpu(gpu.clone(), &frame.scene, &frame.lowered, &setup))
+                    .map_err(|e| Failure::Runtime(format!("the wgpu backend: {e}")))?;
+                (frame.scene, prepared)
+            }
+            backend => {
+                if matches!(backend, Backend::Cuda | Backend::Auto) {
+                    // Holding the device's primary context keeps it from being torn down
+                    // and built again (a fifth of a second) between renders.
+                    let _ = cuda_device();
+                }
+                renderer::prepare(pool, (backend, &Devices::Auto), frame, &setup, None)?
+            }
+        };
         renderer::check_memory(
             pool,
             &prepared,
@@ -348,6 +364,26 @@ impl Scene {
     }
 }
 
+/// The process's CUDA device (its primary context and compute capability), opened on first
+/// use and held while the module is loaded.
+fn cuda_device() -> &'static Result<sdfc_runtime::gpu::points::CudaDevice, String> {
+    static CUDA: OnceLock<Result<sdfc_runtime::gpu::points::CudaDevice, String>> = OnceLock::new();
+    CUDA.get_or_init(sdfc_runtime::gpu::points::open_cuda)
+}
+
+/// The process's wgpu device, opened on first use: renders and distances share it and the
+/// pipelines compiled on it.
+fn wgpu_device() -> Result<&'static std::sync::Arc<sdfc_runtime::gpu::Gpu>, String> {
+    static WGPU: OnceLock<Result<std::sync::Arc<sdfc_runtime::gpu::Gpu>, String>> = OnceLock::new();
+    WGPU.get_or_init(|| {
+        sdfc_runtime::gpu::Gpu::open(false)
+            .map(std::sync::Arc::new)
+            .map_err(|e| e.to_string())
+    })
+    .as_ref()
+    .map_err(Clone::clone)
+}
+
 /// Distances (f32 bytes) and material ids (u32 bytes) at `points` (program coordinates)
 /// from the scene's WGSL part on a GPU: through wgpu, or as PTX through CUDA.
 fn gpu_distances(
@@ -356,24 +392,15 @@ fn gpu_distances(
     lowered: &lower::Lowered,
     points: &[[f64; 3]],
 ) -> Result<(Vec<u8>, Vec<u8>), String> {
-    use sdfc_runtime::gpu::{points as on_gpu, Gpu};
+    use sdfc_runtime::gpu::points as on_gpu;
     // Each device is opened once per process, on first use.
-    static CUDA: OnceLock<Result<on_gpu::CudaDevice, String>> = OnceLock::new();
-    static WGPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
     let module = on_gpu::points_module(scene, lowered, false)?;
     let (values, _) = if backend == "cuda" {
-        let (ctx, sm) = CUDA
-            .get_or_init(on_gpu::open_cuda)
-            .as_ref()
-            .map_err(Clone::clone)?;
+        let (ctx, sm) = cuda_device().as_ref().map_err(Clone::clone)?;
         let ptx = on_gpu::points_ptx(&module, *sm)?;
         on_gpu::run_cuda(ctx, &module, &ptx, points)?
     } else {
-        let gpu = WGPU
-            .get_or_init(|| Gpu::open(false).map_err(|e| e.to_string()))
-            .as_ref()
-            .map_err(Clone::clone)?;
-        on_gpu::run_wgpu(gpu, &module, points)?
+        on_gpu::run_wgpu(wgpu_device()?, &module, points)?
     };
     let d = values.iter().flat_map(|(d, _)| d.to_ne_bytes()).collect();
     let m = values.iter().flat_map(|(_, m)| m.to_ne_bytes()).collect();

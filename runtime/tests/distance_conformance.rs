@@ -618,8 +618,12 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "rect",
         "round_rect",
         "polygon",
+        "arc",
+        "bezier",
         "extrude",
         "revolve",
+        "loft",
+        "screw",
         "combine",
         "smooth_combine",
         "feature",
@@ -708,9 +712,13 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Rect { .. } => "rect",
         Node::RoundRect { .. } => "round_rect",
         Node::Polygon { .. } => "polygon",
+        Node::Arc { .. } => "arc",
+        Node::Bezier { .. } => "bezier",
         Node::Extrude { .. } => "extrude",
         Node::Revolve { .. } => "revolve",
         Node::Mesh { .. } => "mesh",
+        Node::Loft { .. } => "loft",
+        Node::Screw { .. } => "screw",
     }
 }
 

@@ -47,6 +47,8 @@ fn load_small(path: &Path, width: u32, height: u32) -> Scene {
 /// below it, the differing bound 3 pixels (of 6 144) above it.
 const AGREEMENT: &[(&str, f64, f64)] = &[
     ("blends", 92.0, 0.0005),      // 95.6 dB, 0.0000 (0 px)
+    ("bolt", 95.0, 0.0005),        // 98.4 dB, 0.0000 (0 px), 2026-11-27
+    ("bracket2d", 100.0, 0.0005),  // 103.1 dB, 0.0000 (0 px), 2026-11-27
     ("edges", 84.0, 0.0005),       // 87.4 dB, 0.0000 (0 px), 2026-11-27
     ("gear", 85.0, 0.0005),        // 88.9 dB, 0.0000 (0 px), 2026-11-27
     ("glass", 41.0, 0.0012),       // 44.3 dB, 0.0007 (4 px)

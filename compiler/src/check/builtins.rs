@@ -419,6 +419,94 @@ fn crossing(v: &[[f64; 2]]) -> Option<(usize, usize)> {
     None
 }
 
+/// The rectangle of a profile argument and its bound's scale (`lower::bounds::profile_rect`),
+/// or why it has none.
+fn rect_of(b: &Build, v: &Value, what: &str) -> Result<([f64; 2], [f64; 2], f64), String> {
+    crate::lower::bounds::profile_rect(b.graph, sh(v)).ok_or_else(|| {
+        format!("the {what} profile has no finite extent (it reaches infinity), so it cannot be made solid this way")
+    })
+}
+
+/// `bezier(a, control, b, radius)`: the curve is a parabola's arc only where the control
+/// point is off the midpoint of `a` and `b` (at the midpoint it is the segment, which
+/// `segment2` draws).
+fn bezier(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let [x, c, y] = [0, 1, 2].map(|i| {
+        let v = a[i].components();
+        [v[0], v[1]]
+    });
+    let bend = [x[0] - 2.0 * c[0] + y[0], x[1] - 2.0 * c[1] + y[1]];
+    let span = (y[0] - x[0])
+        .hypot(y[1] - x[1])
+        .max((c[0] - x[0]).hypot(c[1] - x[1]));
+    if bend[0].hypot(bend[1]) <= 1e-6 * span.max(1e-300) {
+        return Err(
+            "the control point is the midpoint of `a` and `b`, so the curve is the straight segment: draw it with `segment2(a, b, radius)`"
+                .to_string(),
+        );
+    }
+    b.profile(Node::Bezier {
+        a: x,
+        control: c,
+        b: y,
+        radius: a[3].num(),
+    })
+}
+
+/// `loft(bottom, top, height)`: the spread bounds |b - a| for exact profiles, from the
+/// circles around their rectangles (docs/analysis.md, "Loft").
+/// Where one profile is an `offset` of the other, their fields differ by its amount
+/// everywhere, and that is the spread.
+fn loft(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let (ca, ha, _) = rect_of(b, &a[0], "bottom")?;
+    let (cb, hb, _) = rect_of(b, &a[1], "top")?;
+    let (x, y) = (sh(&a[0]), sh(&a[1]));
+    let offset = |from: NodeId, to: NodeId| match b.graph.node(to) {
+        Node::Round { radius, child } if *child == from => Some(radius.abs()),
+        _ => None,
+    };
+    let spread = offset(x, y).or_else(|| offset(y, x)).unwrap_or_else(|| {
+        (ca[0] - cb[0]).hypot(ca[1] - cb[1]) + ha[0].hypot(ha[1]) + hb[0].hypot(hb[1])
+    });
+    b.node(Node::Loft {
+        half_height: a[2].num() / 2.0,
+        spread,
+        bottom: sh(&a[0]),
+        top: sh(&a[1]),
+    })
+}
+
+/// `screw(profile, pitch, height)`: the profile, one turn's cross-section, must lie at
+/// x > 0 (x is the distance from the axis) and within one pitch about y = 0.
+fn screw(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let (c, h, scale) = rect_of(b, &a[0], "screw's")?;
+    let (pitch, height) = (a[1].num(), a[2].num());
+    let inner = c[0] - h[0];
+    if inner <= 0.0 {
+        return Err(format!(
+            "a screw's profile must lie at x > 0 (x is the distance from the axis), and this one reaches x = {}",
+            crate::scene::dump_num(inner)
+        ));
+    }
+    let (lo, hi) = (c[1] - h[1], c[1] + h[1]);
+    let half = pitch / 2.0;
+    if lo < -half - 1e-9 * pitch || hi > half + 1e-9 * pitch {
+        return Err(format!(
+            "a screw's profile is one turn of the thread: it must lie within y = ±{} (half the pitch), and this one spans y from {} to {}",
+            crate::scene::dump_num(half),
+            crate::scene::dump_num(lo),
+            crate::scene::dump_num(hi)
+        ));
+    }
+    b.node(Node::Screw {
+        pitch,
+        half_height: height / 2.0,
+        inner,
+        floor: scale.min(1.0),
+        child: sh(&a[0]),
+    })
+}
+
 /// The points of a regular polygon of `sides` with its corners `radius` from the centre,
 /// the first on +y, turning counter-clockwise.
 fn regular(sides: usize, radius: f64, phase: f64) -> Vec<[f64; 2]> {
@@ -956,9 +1044,35 @@ pub static BUILTINS: &[Builtin] = &[
         ],
     },
     Builtin {
+        name: "arc",
+        sigs: sigs![
+            [p("radius", F, Num(0.5), Pos), p("angle", A, Req, Within(0.0, std::f64::consts::TAU)), p("thickness", F, Num(0.1), Pos)] -> PR => |b, a| {
+                b.profile(Node::Arc { radius: a[0].num(), half_angle: a[1].num() / 2.0, half_width: a[2].num() / 2.0 })
+            };
+        ],
+    },
+    Builtin {
+        name: "bezier",
+        sigs: sigs![
+            [p("a", V2, Req, Any), p("control", V2, Req, Any), p("b", V2, Req, Any), p("radius", F, Num(0.05), Pos)] -> PR => bezier;
+        ],
+    },
+    Builtin {
+        name: "loft",
+        sigs: sigs![
+            [prof("bottom"), prof("top"), p("height", F, Req, Pos)] -> S => loft;
+        ],
+    },
+    Builtin {
+        name: "screw",
+        sigs: sigs![
+            [prof("profile"), p("pitch", F, Req, Pos), p("height", F, Req, Pos)] -> S => screw;
+        ],
+    },
+    Builtin {
         name: "offset",
         sigs: sigs![
-            [prof("profile"), p("amount", F, Req, NonNeg)] -> PR => |b, a| b.profile(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
+            [prof("profile"), p("amount", F, Req, Any)] -> PR => |b, a| b.profile(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
         ],
     },
     // Combinators.
@@ -1146,6 +1260,10 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [shape("shape"), p("count", I, Req, Within(1.0, 1e6)), p("axis", V, V3([0.0, 1.0, 0.0]), NonZero), p("mirror", B, Bool(false), Any)] -> S
                 => repeat_polar;
+            [prof("profile"), p("count", I, Req, Within(1.0, 1e6)), p("mirror", B, Bool(false), Any)] -> PR => |b, a| {
+                // About the origin of the plane: the z axis of the profile's prism.
+                flat(repeat_polar(b, &[a[0].clone(), a[1].clone(), Value::Vec3([0.0, 0.0, 1.0]), a[2].clone()]))
+            };
         ],
     },
     Builtin {

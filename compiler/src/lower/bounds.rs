@@ -306,6 +306,23 @@ impl Bounds {
             // A profile read as a field of space is a prism along z.
             Node::Circle { radius } => profile([0.0; 2], [*radius; 2]),
             Node::Rect { half } | Node::RoundRect { half, .. } => profile([0.0; 2], *half),
+            Node::Arc {
+                radius, half_width, ..
+            } => profile([0.0; 2], [radius + half_width; 2]),
+            // A quadratic Bézier curve lies in the triangle of its points.
+            Node::Bezier {
+                a,
+                control,
+                b,
+                radius,
+            } => {
+                let lo = [0, 1].map(|i| a[i].min(control[i]).min(b[i]) - radius);
+                let hi = [0, 1].map(|i| a[i].max(control[i]).max(b[i]) + radius);
+                profile(
+                    [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
+                    [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
+                )
+            }
             Node::Polygon { points } => {
                 let lo = [0, 1].map(|i| points.iter().fold(f64::INFINITY, |m, q| m.min(q[i])));
                 let hi = [0, 1].map(|i| points.iter().fold(f64::NEG_INFINITY, |m, q| m.max(q[i])));
@@ -318,6 +335,20 @@ impl Bounds {
                 half_height, child, ..
             } => extrude(&get(child)?, *half_height),
             Node::Revolve { offset, child } => revolve(&get(child)?, *offset)?,
+            // The loft's field is at least the smaller scale times the distance to the hull
+            // of its profiles' rectangles wherever both are, clamped or not, and is extruded.
+            Node::Loft {
+                half_height,
+                bottom,
+                top,
+                ..
+            } => extrude(&hull(&get(bottom)?, &get(top)?), *half_height),
+            Node::Screw {
+                half_height,
+                floor,
+                child,
+                ..
+            } => screw(&get(child)?, *half_height, *floor)?,
             Node::Feature { op, a, .. } => get(a)?.grow(op.outset()),
             Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
             Node::SmoothCombine {
@@ -417,6 +448,36 @@ fn revolve(b: &Bound, offset: f64) -> Option<Bound> {
         }
         .tight(),
     )
+}
+
+/// A screw of a profile whose rectangle reaches the radius R = c.x + h.x: beyond R its
+/// field is at least floor·(r - R) (the profile's rectangle and the floor term both are), and
+/// beyond the slab at least |y| - half_height; their maximum is at least floor/√2 times the
+/// distance to the cylinder, and so to its box and sphere. `None` for a profile without
+/// finite extents.
+fn screw(b: &Bound, half_height: f64, floor: f64) -> Option<Bound> {
+    let r = b.aabb.c[0] + b.aabb.h[0];
+    if !r.is_finite() || r < 0.0 {
+        return None;
+    }
+    let h = [r, half_height, r];
+    Some(Bound {
+        sphere: Sphere {
+            c: [0.0; 3],
+            r: r.hypot(half_height),
+        },
+        aabb: Aabb { c: [0.0; 3], h },
+        scale: (b.scale.min(floor) * std::f64::consts::FRAC_1_SQRT_2).min(1.0),
+    })
+}
+
+/// The centre and half extents of a profile's rectangle and the scale of its bound
+/// (`Bound`: the field is at least min(s, scale·s), s the distance to the rectangle), or
+/// `None` where the profile has no finite rectangle; for the checks of `loft` and `screw`.
+pub(crate) fn profile_rect(graph: &Graph, id: NodeId) -> Option<([f64; 2], [f64; 2], f64)> {
+    let b = Bounds::new(graph).get(id)?;
+    let (c, h) = (b.aabb.c, b.aabb.h);
+    (h[0].is_finite() && h[1].is_finite()).then_some(([c[0], c[1]], [h[0], h[1]], b.scale))
 }
 
 /// Quilez's ellipsoid field k0·(k0 - 1)/k1 is at least (r_min/r_max)·(|p| - r_max) outside
@@ -666,12 +727,16 @@ fn own_cost(node: &Node) -> f64 {
         Node::InfiniteCylinder { .. } => 14.0,
         Node::Slab { .. } => 7.0,
         Node::Circle { .. } => 4.0,
+        Node::Arc { .. } => 20.0,
+        Node::Bezier { .. } => 90.0,
         Node::Rect { .. } | Node::RoundRect { .. } => 12.0,
         Node::Polygon { points } => 20.0 * points.len() as f64,
         // A walk of the hierarchy: a few dozen boxes and triangles of some 40 operations.
         Node::Mesh { mesh } => 400.0 + 40.0 * (mesh.0.triangles().len() as f64).log2(),
         Node::Extrude { .. } => 10.0,
         Node::Revolve { .. } => 5.0,
+        Node::Loft { .. } => 18.0,
+        Node::Screw { .. } => 30.0,
         Node::Feature { .. } => 8.0,
         Node::Combine { children, .. } => 4.0 * children.len() as f64,
         Node::SmoothCombine { variant, .. } => match variant {

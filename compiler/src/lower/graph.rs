@@ -423,6 +423,41 @@ impl<'a> Lowerer<'a> {
                 let f = self.node(*child, q);
                 Field { d: f.d, m: f.m }
             }
+            Node::Loft {
+                half_height,
+                spread,
+                bottom,
+                top,
+            } => {
+                // Both profiles in the plane z = 0, mixed by the height's fraction t, the
+                // difference clamped to ±spread (docs/analysis.md, "Loft"), then extruded.
+                let (h, s) = (*half_height, *spread);
+                let q = [p[0], p[1], self.b.c(0.0)];
+                let (fa, fb) = (self.node(*bottom, q), self.node(*top, q));
+                self.resume(id, node);
+                let b = &mut *self.b;
+                let t = b.mulc(p[2], 0.5 / h);
+                let t = b.addc(t, 0.5);
+                let t = b.clampc(t, 0.0, 1.0);
+                let diff = b.sub(fb.d, fa.d);
+                let diff = b.clampc(diff, -s, s);
+                let step = b.mul(t, diff);
+                let d = b.add(fa.d, step);
+                let d = shapes::extrude(b, d, p[2], h);
+                let upper = b.c(0.5);
+                let upper = b.lt(upper, t);
+                Field {
+                    d,
+                    m: b.select(upper, fb.m, fa.m),
+                }
+            }
+            Node::Screw {
+                pitch,
+                half_height,
+                inner,
+                floor,
+                child,
+            } => self.screw(id, [*pitch, *half_height, *inner, *floor], *child, p),
             Node::ScaleXyz { factors, child } => {
                 let q = self.b.map3(p, |b, x, i| b.mulc(x, 1.0 / factors[i]));
                 let s = factors.iter().fold(f64::INFINITY, |m, f| m.min(f.abs()));
@@ -432,6 +467,53 @@ impl<'a> Lowerer<'a> {
                 Some((child, q)) => self.node(child, q),
                 None => self.primitive(node, p),
             },
+        }
+    }
+
+    /// A screw (docs/analysis.md, "Screw"): the profile read at (r, w), r the distance from
+    /// the y axis, w the height less pitch·φ/2π (φ the angle about +y, so the thread is
+    /// right-handed) folded into [-pitch/2, pitch/2], and at the nearer neighbouring turn;
+    /// their minimum, below floor·max(inner - r, r) near the axis, cut to |y| ≤ half_height.
+    fn screw(
+        &mut self,
+        id: NodeId,
+        [pitch, half_height, inner, floor]: [f64; 4],
+        child: NodeId,
+        p: P,
+    ) -> Field {
+        let b = &mut *self.b;
+        let r = b.len2(p[0], p[2]);
+        let nz = b.neg(p[2]);
+        let phi = b.bin(Binary::Atan2, nz, p[0]);
+        let rise = b.mulc(phi, pitch / std::f64::consts::TAU);
+        let v = b.sub(p[1], rise);
+        let turns = b.mulc(v, 1.0 / pitch);
+        let turns = b.un(Unary::Round, turns);
+        let back = b.mulc(turns, pitch);
+        let w = b.sub(v, back);
+        // The nearer neighbour: w - pitch above the middle of the turn, w + pitch below it.
+        let zero = b.c(0.0);
+        let below = b.lt(w, zero);
+        let up = b.mulc(below, 2.0 * pitch);
+        let next = b.subc(w, pitch);
+        let next = b.add(next, up);
+        let z = b.c(0.0);
+        let f0 = self.node(child, [r, w, z]);
+        let f1 = self.node(child, [r, next, z]);
+        self.resume(id, self.graph.node(id));
+        let m = self.material(Combine::Union, f0, f1);
+        let b = &mut *self.b;
+        let g = b.min(f0.d, f1.d);
+        let i = b.c(inner);
+        let toward = b.sub(i, r);
+        let near = b.max(toward, r);
+        let near = b.mulc(near, floor);
+        let g = b.min(g, near);
+        let ay = b.abs(p[1]);
+        let cap = b.subc(ay, half_height);
+        Field {
+            d: b.max(g, cap),
+            m,
         }
     }
 
@@ -578,6 +660,20 @@ impl<'a> Lowerer<'a> {
             }
             Node::Polygon { ref points } => shapes::polygon(b, p, points),
             Node::Mesh { ref mesh } => b.mesh(&mesh.0, p),
+            Node::Arc {
+                radius,
+                half_angle,
+                half_width,
+            } => shapes::arc(b, p, radius, half_angle, half_width),
+            Node::Bezier {
+                a,
+                control,
+                b: end,
+                radius,
+            } => {
+                let d = shapes::bezier(b, p, [a, control, end]);
+                b.subc(d, radius)
+            }
             _ => match shapes::slots(node) {
                 Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
                 None => b.c(EMPTY_DISTANCE),
@@ -648,7 +744,18 @@ impl<'a> Lowerer<'a> {
             .is_some_and(|t| matches!(t.kind, Kind::Split(..)));
         let upper = (self.config.cull && split)
             .then(|| tree.as_ref().map(|t| self.descend(t, p)))
-            .flatten();
+            .flatten()
+            .map(|u| {
+                // Raised a little above the child it is: the guards compare bounds with it,
+                // and a child whose field equals its own bound (a local bound at the
+                // distance to its volume) must not be skipped by a tie with itself, as it
+                // is not yet in the union's accumulated field.
+                let b = &mut *self.b;
+                let a = b.abs(u);
+                let a = b.mulc(a, 1.0 / 1_048_576.0);
+                let a = b.addc(a, 1e-30);
+                b.add(u, a)
+            });
         if acc.is_none() && (split || !slabs.is_empty()) {
             // A starting value, so that every group can be guarded (the same with culling
             // off, so that both programs compute the same).

@@ -8,7 +8,7 @@
 //! literally.
 
 mod blends;
-mod bounds;
+pub(crate) mod bounds;
 mod builder;
 mod bvh;
 mod field;

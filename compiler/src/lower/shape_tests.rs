@@ -529,3 +529,338 @@ fn bad_profiles_are_located_errors() {
         assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
     }
 }
+
+#[test]
+fn a_loft_of_one_profile_is_its_extrusion() {
+    same(
+        "loft(rect((1, 0.5)), rect((1, 0.5)), 0.6)",
+        "box((1, 0.5, 0.3))",
+    );
+    same(
+        "loft(star(5, 1, 0.5), star(5, 1, 0.5), 0.8)",
+        "extrude(star(5, 1, 0.5), 0.8)",
+    );
+    let (_, l) = program("loft(star(5, 1, 0.5), star(5, 1, 0.5), 0.8)");
+    assert_eq!(l, 1.0);
+}
+
+/// The largest sampled slope of `shape` (over pairs of points, and its gradient by central
+/// differences) and the L the analysis records, which neither may exceed.
+fn within_l(shape: &str, r: f64) -> (f64, f64) {
+    let (_, l) = program(shape);
+    // The field as written: with local bounds the program would be divided by L already.
+    let src = format!("scene {{ {shape}; }}");
+    let scene = crate::check::check_str("t.sdf", &src).0.expect("scene");
+    let options = super::LowerOptions {
+        local: false,
+        ..super::LowerOptions::default()
+    };
+    let p = super::lower_with(&scene, &options);
+    let mut rng = Rng::new(35);
+    let mut s = slope(&p, &mut rng, r);
+    for _ in 0..4000 {
+        let x = point(&mut rng, r);
+        let h = 1e-6;
+        let g = [0, 1, 2].map(|i| {
+            let (mut a, mut b) = (x, x);
+            a[i] += h;
+            b[i] -= h;
+            (f(&p, a) - f(&p, b)) / (2.0 * h)
+        });
+        s = s.max(len(g));
+    }
+    assert!(s <= l * (1.0 + 1e-6), "{shape}: slope {s} above L = {l}");
+    (s, l)
+}
+
+#[test]
+fn lofts_between_profiles_keep_their_sections_and_their_bound() {
+    // Concentric circles of radii 0.5 and 0.3 over the height 1: at each height the circle
+    // of the mixed radius (the frustum's section).
+    let (p, l) = program("loft(circle(0.5), circle(0.3), 1)");
+    // spread = 0.5·√2 + 0.3·√2; L = √(1 + (spread / 1)²).
+    let spread = 0.8 * 2f64.sqrt();
+    assert!((l - spread.hypot(1.0)).abs() < 1e-12, "L {l}");
+    let mut rng = Rng::new(5);
+    let mut signs = 0;
+    for _ in 0..3000 {
+        let x = point(&mut rng, 1.0);
+        let t = (x[2] + 0.5).clamp(0.0, 1.0);
+        let inside = x[0].hypot(x[1]) < 0.5 - 0.2 * t && x[2].abs() < 0.5;
+        let d = f(&p, x);
+        if d.abs() > 1e-9 {
+            assert_eq!(d < 0.0, inside, "sign at {x:?} ({d})");
+            signs += 1;
+        }
+    }
+    assert!(signs > 2900);
+    // At the ends the sections are the profiles themselves.
+    for (z, shape) in [(-0.5, "circle(0.5)"), (0.5, "circle(0.3)")] {
+        let (q, _) = program(&format!("extrude({shape}, 100)"));
+        for _ in 0..200 {
+            let x = point(&mut rng, 1.0);
+            let inner = [x[0], x[1], z * (1.0 - 1e-12)];
+            let (a, b) = (f(&p, inner), f(&q, [x[0], x[1], 0.0]));
+            assert!(b.abs() < 1e-9 || (a < 0.0) == (b < 0.0), "{z}: {a} {b}");
+        }
+    }
+    // Sampled slopes stay within the recorded L, and exceed 1 where the sections move.
+    within_l("loft(circle(0.5), circle(0.3), 1)", 1.5);
+    let (s, _) = within_l(
+        "loft(rect((0.6, 0.3)), circle(0.2).translate(0.5, 0.4), 0.5)",
+        1.5,
+    );
+    assert!(s > 1.05, "slope {s}");
+    within_l("loft(star(5, 1, 0.5), regular_polygon(6, 0.6), 0.7)", 1.5);
+}
+
+/// The screw of `rect((0.05, 0.1)).translate(0.5, 0)`, pitch 0.4, height 1.6, inside: the
+/// point's radius within 0.05 of 0.5 and its height, less 0.4·φ/2π (φ about +y), within 0.1
+/// of a multiple of 0.4.
+fn in_screw(x: [f64; 3]) -> bool {
+    let r = x[0].hypot(x[2]);
+    let phi = (-x[2]).atan2(x[0]);
+    let v = x[1] - 0.4 * phi / std::f64::consts::TAU;
+    let w = v - 0.4 * (v / 0.4).round();
+    (r - 0.5).abs() < 0.05 && w.abs() < 0.1 && x[1].abs() < 0.8
+}
+
+#[test]
+fn screws_follow_their_helix_within_their_bound() {
+    let shape = "screw(rect((0.05, 0.1)).translate(0.5, 0), 0.4, 1.6)";
+    let (p, l) = program(shape);
+    // L = √(1 + (pitch / 2π / (inner / 2))²), inner = 0.45.
+    let want = (0.4 / std::f64::consts::TAU / 0.225).hypot(1.0);
+    assert!((l - want).abs() < 1e-12, "L {l}, not {want}");
+    let mut rng = Rng::new(11);
+    let mut inside = 0;
+    for i in 0..4000 {
+        // Half the points near the thread.
+        let x = if i % 2 == 0 {
+            let t = rng.range(-std::f64::consts::PI, std::f64::consts::PI);
+            let r = rng.range(0.4, 0.6);
+            [r * t.cos(), rng.range(-0.9, 0.9), -r * t.sin()]
+        } else {
+            point(&mut rng, 1.0)
+        };
+        let d = f(&p, x);
+        if d.abs() > 1e-9 {
+            assert_eq!(d < 0.0, in_screw(x), "sign at {x:?} ({d})");
+            inside += usize::from(d < 0.0);
+        }
+    }
+    assert!(inside > 200, "{inside} inside");
+    let (s, _) = within_l(shape, 1.0);
+    assert!(s > 1.0 + 1e-3, "slope {s}");
+    // A triangular thread of a bolt, and a fine one near the axis.
+    within_l(
+        "screw(polygon([(0.3, -0.05), (0.4, 0), (0.3, 0.05)]), 0.1, 1)",
+        0.6,
+    );
+    within_l("screw(circle(0.02).translate(0.05, 0), 0.05, 0.5)", 0.2);
+}
+
+#[test]
+fn bad_lofts_and_screws_are_located_errors() {
+    for (src, says, at) in [
+        ("loft(circle(1), circle(0.5), 0)", "greater than 0", "0)"),
+        (
+            "loft(sphere(1), circle(0.5), 1)",
+            "expects a `profile`",
+            "sphere",
+        ),
+        (
+            "screw(circle(0.1).translate(0.5, 0), 0, 1)",
+            "greater than 0",
+            "0, 1",
+        ),
+        (
+            "screw(circle(0.1).translate(0.5, 0), -1, 1)",
+            "greater than 0",
+            "-1",
+        ),
+        ("screw(rect(0.1), 0.5, 1)", "x > 0", "screw"),
+        (
+            "extrude(bezier((0, 0), (1, 1), (2, 2)), 1)",
+            "segment2",
+            "bezier",
+        ),
+        (
+            "extrude(arc(1, 400deg), 1)",
+            "between 0deg and 360deg",
+            "400deg",
+        ),
+        (
+            "screw(circle(0.3).translate(0.5, 0), 0.5, 1)",
+            "half the pitch",
+            "screw",
+        ),
+    ] {
+        let text = format!("scene {{ {src}; }}");
+        let (_, diags, _) = crate::check::check_str("t.sdf", &text);
+        let error = diags
+            .iter()
+            .find(|d| d.is_error())
+            .unwrap_or_else(|| panic!("{src}: no error"));
+        let all = format!("{error:?}");
+        assert!(all.contains(says), "{src}: {all}");
+        let start = text.find(at).expect("in the text") as u32;
+        assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
+    }
+}
+
+#[test]
+fn arcs_are_exact_and_a_whole_arc_is_a_ring() {
+    // The arc of radius 0.8 over 120° about +y, 0.2 thick.
+    let (s, c) = 60f64.to_radians().sin_cos();
+    exact("extrude(arc(0.8, 120deg, 0.2), 100)", |p| {
+        let (x, y) = (p[0].abs(), p[1]);
+        let d = if x.atan2(y) <= 60f64.to_radians() {
+            (x.hypot(y) - 0.8).abs()
+        } else {
+            (x - 0.8 * s).hypot(y - 0.8 * c)
+        };
+        d < 0.1
+    });
+    same(
+        "extrude(arc(0.8, 360deg, 0.2), 1)",
+        "extrude(ring(0.8, 0.2), 1)",
+    );
+}
+
+/// The distance from `q` to the quadratic Bézier curve through `v`, by dense sampling of its
+/// parameter refined by golden-section search around the best sample.
+fn to_bezier(v: [[f64; 2]; 3], q: [f64; 2]) -> f64 {
+    let at = |t: f64| {
+        let s = 1.0 - t;
+        let x = s * s * v[0][0] + 2.0 * s * t * v[1][0] + t * t * v[2][0];
+        let y = s * s * v[0][1] + 2.0 * s * t * v[1][1] + t * t * v[2][1];
+        (x - q[0]).hypot(y - q[1])
+    };
+    let n = 2000;
+    let best = (0..=n)
+        .min_by(|&i, &j| at(i as f64 / n as f64).total_cmp(&at(j as f64 / n as f64)))
+        .expect("samples");
+    let (mut lo, mut hi) = (
+        (best as f64 - 1.0).max(0.0) / n as f64,
+        (best as f64 + 1.0).min(n as f64) / n as f64,
+    );
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    for _ in 0..80 {
+        let (a, b) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        if at(a) < at(b) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    at(0.5 * (lo + hi)).min(at(0.0)).min(at(1.0))
+}
+
+#[test]
+fn bezier_strokes_are_their_brute_force_distance() {
+    let mut rng = Rng::new(0xbe21);
+    let mut curves: Vec<[[f64; 2]; 3]> = vec![
+        [[-1.0, 0.0], [0.0, 1.5], [1.0, 0.0]],
+        // The control point on the line through the ends, beyond one of them.
+        [[-0.5, -0.5], [1.0, 1.0], [0.5, 0.5]],
+    ];
+    for _ in 0..10 {
+        curves.push([0; 3].map(|_| [rng.range(-1.2, 1.2), rng.range(-1.2, 1.2)]));
+    }
+    for v in curves {
+        let shape = format!(
+            "extrude(bezier(({}, {}), ({}, {}), ({}, {}), 0.05), 100)",
+            v[0][0], v[0][1], v[1][0], v[1][1], v[2][0], v[2][1]
+        );
+        let (p, l) = program(&shape);
+        assert_eq!(l, 1.0);
+        for i in 0..300 {
+            let q = if i % 2 == 0 {
+                // Near the curve.
+                let t = rng.uniform();
+                let s = 1.0 - t;
+                [0, 1].map(|k| {
+                    s * s * v[0][k] + 2.0 * s * t * v[1][k] + t * t * v[2][k] + rng.range(-0.1, 0.1)
+                })
+            } else {
+                [rng.range(-2.0, 2.0), rng.range(-2.0, 2.0)]
+            };
+            let want = to_bezier(v, q) - 0.05;
+            let got = f(&p, [q[0], q[1], 0.0]);
+            assert!(
+                (got - want).abs() < 1e-7,
+                "{shape} at {q:?}: {got}, not {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn polar_repetition_of_a_profile_turns_it_about_the_origin() {
+    same(
+        "extrude(repeat_polar(circle(0.1).translate(0, 0.5), 4), 0.2)",
+        "extrude(union(circle(0.1).translate(0, 0.5), circle(0.1).translate(0.5, 0), circle(0.1).translate(0, -0.5), circle(0.1).translate(-0.5, 0)), 0.2)",
+    );
+}
+
+#[test]
+fn an_inset_is_exact_inside_and_a_bound_outside() {
+    let (p, l) = program("extrude(offset(rect(0.5), -0.1), 100)");
+    let (q, _) = program("extrude(rect(0.4), 100)");
+    assert_eq!(l, 1.0);
+    let src = "scene { extrude(offset(rect(0.5), -0.1), 100); }";
+    let scene = crate::check::check_str("t.sdf", src).0.expect("scene");
+    let facts = analyse(&scene).root().expect("root").facts;
+    assert_eq!(facts.exactness, crate::scene::Exactness::Bound);
+    let mut rng = Rng::new(3);
+    let mut below = 0;
+    for _ in 0..2000 {
+        let x = point(&mut rng, 1.0);
+        let x = [x[0], x[1], 0.0];
+        let (d, e) = (f(&p, x), f(&q, x));
+        if e <= 0.0 {
+            assert!((d - e).abs() < 1e-12, "{x:?}: {d} {e}");
+        } else {
+            assert!(d > 0.0 && d <= e + 1e-12, "{x:?}: {d} {e}");
+            below += usize::from(d < e - 1e-3);
+        }
+    }
+    // Beyond the corners the inset's field is below the distance.
+    assert!(below > 100, "{below}");
+}
+
+/// A plate chamfered by lofts to its inset, as examples/bracket2d.sdf makes one: where the
+/// union's cheapest child (a loft, divided by its L and raised to the distance to its
+/// volume) gave the union's upper bound, a tie with its own guard once skipped every child
+/// (the field 10³⁰ above the plate). Culling keeps the field.
+#[test]
+fn a_chamfered_plate_keeps_its_field_under_culling() {
+    let src = "let l = polygon([(-0.9, -0.6), (0.9, -0.6), (0.9, -0.3), (-0.3, -0.3), (-0.3, 0.7), (-0.9, 0.7)]);
+let holes = union(circle(0.1).translate(0.6, -0.45), circle(0.1).translate(-0.6, -0.45), circle(0.1).translate(-0.6, 0.4));
+let o = subtract(offset(l, 0.08), holes);
+scene { union(extrude(o, 0.2), loft(o, offset(o, -0.05), 0.05).translate(0, 0, 0.125),
+              loft(offset(o, -0.05), o, 0.05).translate(0, 0, -0.125)).rotate_x(90deg); }";
+    let scene = crate::check::check_str("t.sdf", src).0.expect("scene");
+    let culled = super::lower(&scene);
+    // Over the long arm, where the tie was.
+    assert!(f(&culled, [0.5, 0.3, -0.45]) < 1.0);
+    let options = super::LowerOptions {
+        cull: false,
+        ..super::LowerOptions::default()
+    };
+    let whole = super::lower_with(&scene, &options);
+    let mut rng = Rng::new(17);
+    for i in 0..3000 {
+        // Half the points over the plate.
+        let mut x = point(&mut rng, 1.2);
+        if i % 2 == 0 {
+            x[1] = rng.range(0.16, 0.5);
+        }
+        let (a, b) = (f(&culled, x), f(&whole, x));
+        assert!(a.abs() < 10.0, "{x:?}: {a}");
+        if b < 0.2 {
+            assert!((a - b).abs() < 1e-12, "{x:?}: {a}, not {b}");
+        }
+    }
+}

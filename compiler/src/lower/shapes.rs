@@ -759,3 +759,124 @@ pub(super) fn polygon(b: &mut Builder, p: P, v: &[[f64; 2]]) -> Reg {
     };
     b.mul(sign, d)
 }
+
+/// The exact distance to the arc of radius `r` within `half` of +y on either side, stroked
+/// to `w` (Quilez's `sdArc`): with x folded to |x| and (s, c) = (sin half, cos half), the
+/// distance to the arc's end r·(s, c) where the point lies beyond it (c·x > s·y), else
+/// ||p| - r|; less w.
+pub(super) fn arc(b: &mut Builder, p: P, r: f64, half: f64, w: f64) -> Reg {
+    let (s, c) = half.sin_cos();
+    let x = b.abs(p[0]);
+    let y = p[1];
+    let sy = b.mulc(y, s);
+    let cx = b.mulc(x, c);
+    let beyond = b.lt(sy, cx);
+    let ex = b.subc(x, r * s);
+    let ey = b.subc(y, r * c);
+    let end = b.len2(ex, ey);
+    let l = b.len2(x, y);
+    let ring = b.subc(l, r);
+    let ring = b.abs(ring);
+    let d = b.select(beyond, end, ring);
+    b.subc(d, w)
+}
+
+/// The exact distance to the quadratic Bézier curve through `v` = (A, B, C) (B the control
+/// point, A - 2B + C not zero), after Quilez's `sdBezier`: the nearest parameter t solves
+/// the cubic t³ + 3·kx·t² + … = 0, in closed form. Where its discriminant h = q² + 4p³ is
+/// ≥ 0 the one real root is Cardano's (cube roots of (±√h - q)/2); otherwise of its three
+/// roots, by the trigonometric form, the two that can be nearest. Both forms are computed
+/// and the discriminant selects one; their arguments are clamped so the other stays finite.
+pub(super) fn bezier(b: &mut Builder, p: P, v: [[f64; 2]; 3]) -> Reg {
+    let [pa, pb, pc] = v;
+    let a = [pb[0] - pa[0], pb[1] - pa[1]];
+    let bb = [pa[0] - 2.0 * pb[0] + pc[0], pa[1] - 2.0 * pb[1] + pc[1]];
+    let c = [2.0 * a[0], 2.0 * a[1]];
+    let kk = 1.0 / (bb[0] * bb[0] + bb[1] * bb[1]);
+    let kx = kk * (a[0] * bb[0] + a[1] * bb[1]);
+    let aa = a[0] * a[0] + a[1] * a[1];
+    // d = A - p.
+    let dx = b.neg(p[0]);
+    let dx = b.addc(dx, pa[0]);
+    let dy = b.neg(p[1]);
+    let dy = b.addc(dy, pa[1]);
+    // ky = kk·(2·a·a + d·b) / 3, kz = kk·(d·a).
+    let db0 = b.mulc(dx, kk * bb[0] / 3.0);
+    let db1 = b.mulc(dy, kk * bb[1] / 3.0);
+    let ky = b.add(db0, db1);
+    let ky = b.addc(ky, kk * 2.0 * aa / 3.0);
+    let da0 = b.mulc(dx, kk * a[0]);
+    let da1 = b.mulc(dy, kk * a[1]);
+    let kz = b.add(da0, da1);
+    // p = ky - kx², q = kx·(2kx² - 3ky) + kz, h = q² + 4p³.
+    let pp = b.subc(ky, kx * kx);
+    let q = b.mulc(ky, -3.0 * kx);
+    let q = b.addc(q, 2.0 * kx * kx * kx);
+    let q = b.add(q, kz);
+    let p2 = b.mul(pp, pp);
+    let p3 = b.mul(p2, pp);
+    let p34 = b.mulc(p3, 4.0);
+    let q2 = b.mul(q, q);
+    let h = b.add(q2, p34);
+    // The squared distance to the curve's point at t: |d + (c + b·t)·t|².
+    let at = |b: &mut Builder, t: Reg| {
+        let ux = b.mulc(t, bb[0]);
+        let ux = b.addc(ux, c[0]);
+        let ux = b.mul(ux, t);
+        let ux = b.add(ux, dx);
+        let uy = b.mulc(t, bb[1]);
+        let uy = b.addc(uy, c[1]);
+        let uy = b.mul(uy, t);
+        let uy = b.add(uy, dy);
+        b.dot2(ux, uy, ux, uy)
+    };
+    // One real root: t = ∛((√h - q)/2) + ∛((-√h - q)/2) - kx.
+    let hp = b.maxc(h, 0.0);
+    let sh = b.sqrt(hp);
+    let third = b.c(1.0 / 3.0);
+    let zero = b.c(0.0);
+    let mut t = b.c(-kx);
+    for sign in [1.0, -1.0] {
+        let x = b.mulc(sh, sign);
+        let x = b.sub(x, q);
+        let x = b.mulc(x, 0.5);
+        let ax = b.abs(x);
+        let root = b.bin(Binary::Pow, ax, third);
+        let neg = b.lt(x, zero);
+        let minus = b.neg(root);
+        let root = b.select(neg, minus, root);
+        t = b.add(t, root);
+    }
+    let t = b.clampc(t, 0.0, 1.0);
+    let one = at(b, t);
+    // Three real roots (h < 0, so p < 0): z = √-p, v = acos(q / (2p·z)) / 3.
+    let np = b.neg(pp);
+    let np = b.maxc(np, 0.0);
+    let z = b.sqrt(np);
+    let den = b.mul(pp, z);
+    let den = b.mulc(den, 2.0);
+    let den = b.minc(den, -1e-30);
+    let ratio = b.div(q, den);
+    let ratio = b.clampc(ratio, -1.0, 1.0);
+    let angle = b.un(Unary::Acos, ratio);
+    let angle = b.mulc(angle, 1.0 / 3.0);
+    let m = b.un(Unary::Cos, angle);
+    let n = b.un(Unary::Sin, angle);
+    let n = b.mulc(n, 3f64.sqrt());
+    // t₁ = 2m·z - kx, t₂ = -(n + m)·z - kx (the third root is never the nearest).
+    let t1 = b.mulc(m, 2.0);
+    let t1 = b.mul(t1, z);
+    let t1 = b.subc(t1, kx);
+    let t1 = b.clampc(t1, 0.0, 1.0);
+    let nm = b.add(n, m);
+    let t2 = b.mul(nm, z);
+    let t2 = b.neg(t2);
+    let t2 = b.subc(t2, kx);
+    let t2 = b.clampc(t2, 0.0, 1.0);
+    let d1 = at(b, t1);
+    let d2 = at(b, t2);
+    let three = b.min(d1, d2);
+    let cubic = b.lt(h, zero);
+    let dd = b.select(cubic, three, one);
+    b.sqrt(dd)
+}

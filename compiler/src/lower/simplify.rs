@@ -131,6 +131,20 @@ impl Simplifier<'_> {
                 let (a, b) = (self.node(a), self.node(b));
                 self.add(Node::Feature { op, a, b })
             }
+            Node::Loft {
+                half_height,
+                spread,
+                bottom,
+                top,
+            } => {
+                let (bottom, top) = (self.node(bottom), self.node(top));
+                self.add(Node::Loft {
+                    half_height,
+                    spread,
+                    bottom,
+                    top,
+                })
+            }
             Node::Translate { offset, child } => {
                 let c = self.node(child);
                 self.translate(offset, c)

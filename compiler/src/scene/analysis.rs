@@ -720,6 +720,26 @@ impl Pass<'_> {
                 let (min, max) = mesh.0.aabb();
                 exact(Aabb { min, max }, [false; 3])
             }
+            Node::Arc {
+                radius, half_width, ..
+            } => exact(
+                profile_bounds([radius + half_width; 2]),
+                [true, false, true],
+            ),
+            Node::Bezier {
+                a,
+                control,
+                b,
+                radius,
+            } => {
+                let lo = [0, 1].map(|i| a[i].min(control[i]).min(b[i]) - radius);
+                let hi = [0, 1].map(|i| a[i].max(control[i]).max(b[i]) + radius);
+                let bounds = Aabb {
+                    min: [lo[0], lo[1], f64::NEG_INFINITY],
+                    max: [hi[0], hi[1], f64::INFINITY],
+                };
+                exact(bounds, [false, false, true])
+            }
             Node::Polygon { points } => {
                 let mut b = Aabb::EMPTY;
                 for q in points {
@@ -769,6 +789,19 @@ impl Pass<'_> {
                 d.symmetric = [true, d.symmetric[1], true];
                 d
             }
+            Node::Loft {
+                half_height,
+                spread,
+                bottom,
+                top,
+            } => self.loft(id, *half_height, *spread, *bottom, *top),
+            Node::Screw {
+                pitch,
+                half_height,
+                inner,
+                floor,
+                child,
+            } => self.screw(id, *pitch, *half_height, *inner, *floor, *child),
             Node::Feature { op, a, b } => self.feature(id, *op, *a, *b),
             Node::Combine { op, children } => self.combine(*op, children),
             Node::SmoothCombine {
@@ -1235,10 +1268,85 @@ impl Pass<'_> {
 
     /// Round (`f − r`) and shell (`|f| − t`): the surface is a level set of the child, so only
     /// the child's Lipschitz constant makes the result a bound.
+    /// A loft: at height z the profile a + t·clamp(b - a, ±s), extruded. Across the
+    /// profiles' plane the gradient is a convex combination of theirs (or a's alone where
+    /// the clamp holds); along z it is the clamped difference over the height, at most
+    /// s / (2h). Outside |z| ≤ h the extrusion's two terms are orthogonal. So L is
+    /// max(1, √(G² + (s / 2h)²)), G the profiles' larger constant; the same profile at both
+    /// ends is its extrusion (docs/analysis.md, "Loft").
+    fn loft(&mut self, id: NodeId, h: f64, spread: f64, bottom: NodeId, top: NodeId) -> Derived {
+        let (da, db) = (self.get(bottom), self.get(top));
+        let mut d = merge(&[da, db]);
+        if bottom == top {
+            d = da;
+        }
+        d.bounds = da.bounds.union(db.bounds);
+        d.bounds.min[2] = -h;
+        d.bounds.max[2] = h;
+        d.symmetric = [d.symmetric[0], d.symmetric[1], bottom == top];
+        if !d.gradient.is_finite() {
+            return if d.proven { unproven(d, id) } else { d };
+        }
+        let slope = if bottom == top {
+            0.0
+        } else {
+            spread / (2.0 * h)
+        };
+        let g = d.gradient.hypot(slope).max(1.0);
+        d.gradient = g;
+        d.facts.lipschitz = d.facts.lipschitz.max(g);
+        if bottom != top {
+            d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+            if d.proven && d.cause.is_none() {
+                d.cause = Some(id);
+            }
+        }
+        d
+    }
+
+    /// A screw: the profile read at (r, w), r the distance from the y axis and w the height
+    /// less pitch·φ/2π folded into one pitch, the nearer of its two nearest turns. Moving
+    /// by s round the axis at radius r moves w by pitch·s / (2π·r), so the map stretches by
+    /// √(1 + (pitch / 2πr)²); the field below r = inner / 2 is floor·max(inner - r, r),
+    /// never above the profile's there, so the profile's is read only at r ≥ inner / 2.
+    /// The nearer turn's minimum is continuous, and the distance to the profile's turns, only
+    /// for an exact profile (docs/analysis.md, "Screw").
+    fn screw(
+        &mut self,
+        id: NodeId,
+        pitch: f64,
+        half_height: f64,
+        inner: f64,
+        floor: f64,
+        child: NodeId,
+    ) -> Derived {
+        let c = self.get(child);
+        let mut d = c;
+        let r = c.bounds.max[0].max(0.0);
+        d.bounds = Aabb {
+            min: [-r, -half_height, -r],
+            max: [r, half_height, r],
+        };
+        d.symmetric = [false; 3];
+        d.growth = c.growth.max(1.0 / floor);
+        if c.facts.exactness != Exactness::Exact {
+            return unproven(d, id);
+        }
+        let k = pitch / std::f64::consts::TAU;
+        let stretch = (k / (0.5 * inner)).hypot(1.0);
+        let g = (c.gradient * stretch).max(1.0);
+        d.gradient = g;
+        d.facts.lipschitz = g;
+        d.facts.exactness = classify(g, d.proven);
+        d.cause = Some(id);
+        d
+    }
+
     fn offset(&self, id: NodeId, child: NodeId, by: f64) -> Derived {
         let c = self.get(child);
         let mut d = at_most_bound(c);
-        d.bounds = c.bounds.grow(c.growth * by);
+        // An inset (a 2D `offset` below 0) lies within the child's box.
+        d.bounds = c.bounds.grow(c.growth * by.max(0.0));
         if c.gradient.is_finite() {
             d.facts.lipschitz = c.facts.lipschitz.max(c.gradient);
             d.facts.exactness = classify(d.facts.lipschitz, d.proven);

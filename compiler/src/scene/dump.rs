@@ -297,6 +297,28 @@ fn node(n: &Node) -> String {
                 m.report.open_edges
             )
         }
+        Node::Arc {
+            radius,
+            half_angle,
+            half_width,
+        } => format!(
+            "arc radius={} half_angle={} half_width={}",
+            num(*radius),
+            num(*half_angle),
+            num(*half_width)
+        ),
+        Node::Bezier {
+            a,
+            control,
+            b,
+            radius,
+        } => format!(
+            "bezier a={} control={} b={} radius={}",
+            v2(*a),
+            v2(*control),
+            v2(*b),
+            num(*radius)
+        ),
         Node::Polygon { points } => {
             let ps: Vec<String> = points.iter().map(|q| v2(*q)).collect();
             format!("polygon {}", ps.join(" "))
@@ -314,6 +336,32 @@ fn node(n: &Node) -> String {
         Node::Revolve { offset, child } => {
             format!("revolve offset={} %{}", num(*offset), child.0)
         }
+        Node::Loft {
+            half_height,
+            spread,
+            bottom,
+            top,
+        } => format!(
+            "loft half_height={} spread={} %{}, %{}",
+            num(*half_height),
+            num(*spread),
+            bottom.0,
+            top.0
+        ),
+        Node::Screw {
+            pitch,
+            half_height,
+            inner,
+            floor,
+            child,
+        } => format!(
+            "screw pitch={} half_height={} inner={} floor={} %{}",
+            num(*pitch),
+            num(*half_height),
+            num(*inner),
+            num(*floor),
+            child.0
+        ),
         Node::Feature { op, a, b } => {
             let size = match *op {
                 Feature::Engrave { depth } => format!("depth={}", num(depth)),

@@ -211,6 +211,21 @@ pub enum Node {
     RoundRect { half: [f64; 2], radius: f64 },
     /// Profile: a simple polygon through `points` (three or more, either winding).
     Polygon { points: Vec<[f64; 2]> },
+    /// Profile: the arc of the circle of `radius` about the origin within `half_angle` of +y
+    /// on either side, stroked to `half_width` on either side.
+    Arc {
+        radius: f64,
+        half_angle: f64,
+        half_width: f64,
+    },
+    /// Profile: the quadratic Bézier curve from `a` to `b` pulled towards `control`, stroked
+    /// to `radius` on either side (`control` is not the midpoint of `a` and `b`).
+    Bezier {
+        a: [f64; 2],
+        control: [f64; 2],
+        b: [f64; 2],
+        radius: f64,
+    },
     /// A profile extruded along z to half-height `half_height`, its edges rounded by `round`
     /// (inside the extents).
     Extrude {
@@ -221,6 +236,28 @@ pub enum Node {
     /// A profile revolved about the y axis: the profile's x is the distance from the axis,
     /// less `offset`.
     Revolve { offset: f64, child: NodeId },
+    /// A solid between two profiles along z, from `bottom` at z = -half_height to `top` at
+    /// z = half_height: at height z the profile a + t·clamp(b - a, -spread, spread), t the
+    /// height's fraction, a and b the two fields (docs/analysis.md, "Loft"). `spread` is at
+    /// least |b - a| everywhere when both are exact, so the clamp only bounds the slope.
+    Loft {
+        half_height: f64,
+        spread: f64,
+        bottom: NodeId,
+        top: NodeId,
+    },
+    /// A profile swept along a helix about the y axis, like a revolved one (the profile's x is
+    /// the distance from the axis) rising `pitch` per turn, repeated every pitch and cut to
+    /// |y| ≤ half_height. `inner` is the least x of the profile's box (> 0) and `floor` the
+    /// scale of its bound (`lower/bounds.rs`): near the axis the field is
+    /// floor·max(inner - r, r), below the profile's own (docs/analysis.md, "Screw").
+    Screw {
+        pitch: f64,
+        half_height: f64,
+        inner: f64,
+        floor: f64,
+        child: NodeId,
+    },
     /// n-ary union, or a binary intersection or subtraction.
     Combine { op: Combine, children: Vec<NodeId> },
     /// Smooth union, intersection or subtraction with blend radius `k`.
@@ -332,6 +369,7 @@ macro_rules! one_child {
             | Node::Paint { $child, .. }
             | Node::Extrude { $child, .. }
             | Node::Revolve { $child, .. }
+            | Node::Screw { $child, .. }
     };
 }
 
@@ -343,6 +381,7 @@ impl Node {
             Node::SmoothCombine { a, b, .. }
             | Node::Morph { a, b, .. }
             | Node::Feature { a, b, .. } => vec![*a, *b],
+            Node::Loft { bottom, top, .. } => vec![*bottom, *top],
             one_child!(child) => vec![*child],
             Node::Field { f, .. } => f.shapes(),
             _ => Vec::new(),
@@ -387,8 +426,12 @@ impl Node {
             Node::Rect { .. } => "rect",
             Node::RoundRect { .. } => "round_rect",
             Node::Polygon { .. } => "polygon",
+            Node::Arc { .. } => "arc",
+            Node::Bezier { .. } => "bezier",
             Node::Extrude { .. } => "extrude",
             Node::Revolve { .. } => "revolve",
+            Node::Loft { .. } => "loft",
+            Node::Screw { .. } => "screw",
             Node::Feature { op, .. } => op.name(),
             Node::Combine { op, .. } => op.name(false),
             Node::SmoothCombine { op, .. } => op.name(true),

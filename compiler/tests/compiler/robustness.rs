@@ -218,3 +218,80 @@ fn fuzz_regressions_and_mutations_do_not_panic() {
         front_end(&text);
     }
 }
+
+/// Every recursive construct of the grammar, nested to the `nesting` limit (accepted, or
+/// refused for another reason than nesting), past it (E0507), and left unclosed; and lines of
+/// a megabyte: no panic, no stack overflow on a small stack (issue 37). The fuzz targets
+/// start from seeds of the same shapes within their length bound (`fuzz/seeds/front_end`).
+#[test]
+fn every_construct_deep_and_long_lines_are_diagnosed_not_crashes() {
+    on_small_stack(|| {
+        // (prefix, suffix) repeated around `1` in `let x = …;`, or around `sphere()` in a
+        // scene statement.
+        let values: [(&str, &str); 6] = [
+            ("(", ")"),
+            ("abs(", ")"),
+            ("[", "][0]"),
+            ("[for i in 0..1 { ", " }][0]"),
+            ("if true { ", " } else { 0 }"),
+            ("-(", ")"),
+        ];
+        let shapes: [(&str, &str); 3] = [
+            ("union(sphere(), ", ")"),
+            ("sphere().translate(", ", 0, 0)"),
+            ("smooth_union(0.1, [", "])"),
+        ];
+        let statements: [(&str, &str); 2] = [("if true { ", " }"), ("for i in 0..1 { ", " }")];
+        let nested = |prefix: &str, suffix: &str, depth: usize, core: &str, closed: bool| {
+            let tail = if closed {
+                suffix.repeat(depth)
+            } else {
+                String::new()
+            };
+            format!("{}{core}{tail}", prefix.repeat(depth))
+        };
+        for depth in [400, 12_000] {
+            for closed in [true, false] {
+                let mut texts = Vec::new();
+                for (p, s) in values {
+                    let x = nested(p, s, depth, "1", closed);
+                    texts.push(format!("let x = {x};\nscene {{ sphere(); }}"));
+                }
+                for (p, s) in shapes {
+                    let x = nested(p, s, depth, "sphere()", closed);
+                    texts.push(format!("scene {{ {x}; }}"));
+                }
+                for (p, s) in statements {
+                    let x = nested(p, s, depth, "sphere();", closed);
+                    texts.push(format!("scene {{ {x} }}"));
+                }
+                for text in &texts {
+                    let found = codes(text);
+                    let head: String = text.chars().take(40).collect();
+                    if depth > 1_000 {
+                        assert!(found.contains(&"E0507"), "{head}… ({depth}): {found:?}");
+                    } else if closed {
+                        assert!(!found.contains(&"E0507"), "{head}… ({depth}): {found:?}");
+                    } else {
+                        assert!(!found.is_empty(), "{head}… unclosed: no error");
+                    }
+                }
+            }
+        }
+        // A megabyte on one line: 50 000 statements, a long string, a long comment.
+        let statements = "sphere(0.1).translate(1, 2, 3); ".repeat(32_000);
+        assert!(statements.len() > 1_000_000);
+        let found = codes(&format!("scene {{ {statements} }}"));
+        assert!(!found.contains(&"E0507") || found.len() == 1, "{found:?}");
+        let string = format!("let s = \"{}\"; scene {{ sphere(); }}", "a".repeat(1 << 20));
+        assert!(codes(&string).is_empty(), "{:?}", codes(&string));
+        let comment = format!("/* {} */ scene {{ sphere(); }}", "(".repeat(1 << 20));
+        assert!(codes(&comment).is_empty(), "{:?}", codes(&comment));
+        let unclosed = format!("let s = \"{}", "(".repeat(1 << 20));
+        assert!(
+            codes(&unclosed).contains(&"E0002"),
+            "{:?}",
+            codes(&unclosed)
+        );
+    });
+}

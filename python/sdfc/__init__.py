@@ -5,8 +5,9 @@ command (docs/python.md).
     import sdfc
     scene = sdfc.Scene(path="examples/seed3.sdf")
     image = scene.render(size=(320, 240))           # (240, 320, 3) float32, linear RGB
-    vertices, faces, colours = scene.mesh(resolution=64)
     distances, materials = scene.distance([[0, 1, 0], [0, 0, 0]])
+    part = sdfc.Scene(path="examples/mesh/bracket.sdf")  # bounded: seed3's floor plane is not
+    vertices, faces, colours = part.mesh(resolution=64)
 """
 
 from __future__ import annotations

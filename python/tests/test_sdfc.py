@@ -1,10 +1,12 @@
 """Tests of the Python package `sdfc`, run against the installed wheel (`.ci/run` builds it
 into a fresh virtual environment): check, CompileError, render against `sdfc render`,
-distances, meshes, compile, frames, threads and Ctrl-C. The CLI they compare with is
-$SDFC_BIN, else target/release/sdfc of this repository."""
+distances, meshes, compile, frames, threads and Ctrl-C, and the first examples of README.md
+and docs/python.md run as written. The CLI they compare with is $SDFC_BIN, else
+target/release/sdfc of this repository."""
 
 import os
 import subprocess
+import sys
 import tempfile
 import threading
 import unittest
@@ -342,6 +344,20 @@ class Frames(unittest.TestCase):
         self.assertEqual(len(frames), 2)
         self.assertFalse(np.array_equal(frames[0], frames[1]))
         np.testing.assert_array_equal(frames[1], s.render(backend="cpu", t=0.25))
+
+
+class Docs(unittest.TestCase):
+    def test_first_examples_run_as_written(self):
+        # The first Python block of README.md and of docs/python.md, run from the
+        # repository's root as a reader would paste them (a scene with a floor plane
+        # cannot be meshed without bounds: the example once tried).
+        for doc in [ROOT / "README.md", ROOT / "docs" / "python.md"]:
+            blocks = doc.read_text().split("```python\n")
+            self.assertGreater(len(blocks), 1, f"{doc} has no Python block")
+            code = blocks[1].split("```", 1)[0]
+            self.assertIn(".mesh(", code)
+            run = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+            self.assertEqual(run.returncode, 0, f"{doc}'s example failed:\n{code}\n{run.stderr}")
 
 
 if __name__ == "__main__":

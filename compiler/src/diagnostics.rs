@@ -142,8 +142,9 @@ pub fn render(diags: &[Diagnostic], sources: &SourceMap, colour: bool) -> String
             )
             .with_code(d.code)
             .with_message(&d.message);
-        for (i, l) in d.labels.iter().enumerate() {
-            let mut label = ALabel::new((l.span.file, l.span.range())).with_order(i as i32);
+        let order = label_order(d, sources);
+        for (l, order) in d.labels.iter().zip(order) {
+            let mut label = ALabel::new((l.span.file, l.span.range())).with_order(order);
             if !l.message.is_empty() {
                 label = label.with_message(&l.message);
             }
@@ -164,6 +165,42 @@ pub fn render(diags: &[Diagnostic], sources: &SourceMap, colour: bool) -> String
         }
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The order ariadne is given the labels in: by file (the primary's first), then by the line
+/// each ends on, then as the diagnostic lists them. ariadne starts a new excerpt whenever a
+/// label lies on an earlier line than the one before it, and heads that excerpt with the
+/// primary label's line and column: a note given after the primary but above it ("first
+/// defined here") would be shown under the primary's location.
+fn label_order(d: &Diagnostic, sources: &SourceMap) -> Vec<i32> {
+    let mut files = Vec::new();
+    for l in &d.labels {
+        if !files.contains(&l.span.file) {
+            files.push(l.span.file);
+        }
+    }
+    let keys: Vec<(usize, usize, usize)> = d
+        .labels
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let file = files.iter().position(|f| *f == l.span.file).unwrap_or(0);
+            let last = l.span.end.max(l.span.start.saturating_add(1)) - 1;
+            let (line, _) = sources.line_col(Span {
+                start: last,
+                end: last,
+                ..l.span
+            });
+            (file, line, i)
+        })
+        .collect();
+    let mut by_key: Vec<usize> = (0..keys.len()).collect();
+    by_key.sort_by_key(|&i| keys[i]);
+    let mut order = vec![0; keys.len()];
+    for (rank, i) in by_key.into_iter().enumerate() {
+        order[i] = rank as i32;
+    }
+    order
 }
 
 /// Lines longer than this (in bytes) are shown as an excerpt around the span, not whole: a
@@ -371,5 +408,22 @@ mod tests {
         let out = render(&[d], &sources, false);
         assert!(out.contains("scene { sphre(1); }"), "{out}");
         assert!(!out.contains('…'), "{out}");
+    }
+
+    /// A secondary label above the primary one is shown in the same excerpt, under the
+    /// primary's location, not in a second excerpt headed by the primary's line and column.
+    #[test]
+    fn a_label_above_the_primary_shares_its_excerpt() {
+        let mut sources = SourceMap::new();
+        let file = sources.add("twice.sdf", "let a = 1;\nlet a = 2;\nscene { }\n");
+        let d = Diagnostic::error("E0207", "duplicate", Span::new(file, 15..16))
+            .with_label("defined again here")
+            .with_secondary(Span::new(file, 4..5), "first defined here");
+        let out = render(&[d], &sources, false);
+        assert_eq!(out.matches("twice.sdf:").count(), 1, "{out}");
+        assert!(out.contains("twice.sdf:2:5"), "{out}");
+        let first = out.find("first defined here").expect("the secondary label");
+        let again = out.find("defined again here").expect("the primary label");
+        assert!(first < again, "{out}");
     }
 }

@@ -112,24 +112,30 @@ pub fn ported(name: &str, known: &dyn Fn(&str) -> bool) -> Option<String> {
     known(ours).then(|| format!("`{name}` of other SDF tools is `{ours}` here"))
 }
 
-/// Levenshtein distance over characters.
+/// Edit distance over characters: insertions, deletions, substitutions, and two neighbours
+/// swapped (the optimal string alignment form of Damerau's distance), each counting 1, so
+/// that `widht` is one edit from `width` as `spher` is from `sphere`.
 pub fn distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
     let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = if ca == *cb {
-                prev
-            } else {
-                1 + prev.min(cur).min(row[j])
-            };
-            prev = cur;
+    // Three rows of the table: the one before the previous (for swaps), the previous, this.
+    let mut before: Vec<usize> = vec![0; b.len() + 1];
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    let mut row: Vec<usize> = vec![0; b.len() + 1];
+    for i in 1..=a.len() {
+        row[0] = i;
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut d = (prev[j] + 1).min(row[j - 1] + 1).min(prev[j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                d = d.min(before[j - 2] + 1);
+            }
+            row[j] = d;
         }
+        std::mem::swap(&mut before, &mut prev);
+        std::mem::swap(&mut prev, &mut row);
     }
-    row[b.len()]
+    prev[b.len()]
 }
 
 #[cfg(test)]
@@ -141,6 +147,19 @@ mod tests {
         assert_eq!(distance("sphere", "spher"), 1);
         assert_eq!(closest("spher", ["sphere", "box", "torus"]), Some("sphere"));
         assert_eq!(closest("xyz", ["sphere", "box"]), None);
+    }
+
+    #[test]
+    fn a_swap_of_neighbours_is_one_edit() {
+        assert_eq!(distance("widht", "width"), 1);
+        assert_eq!(distance("shpere", "sphere"), 1);
+        assert_eq!(distance("ab", "ba"), 1);
+        assert_eq!(distance("abc", "ca"), 3);
+        assert_eq!(distance("", "box"), 3);
+        assert_eq!(distance("torus", ""), 5);
+        assert_eq!(distance("kitten", "sitting"), 3);
+        assert_eq!(closest("widht", ["width", "height", "aa"]), Some("width"));
+        assert_eq!(closest("lenght", ["length", "len"]), Some("length"));
     }
 
     #[test]

@@ -325,6 +325,7 @@ impl Scene {
             image_only,
             // The arrays are the linear colours.
             finished: false,
+            software: false,
         };
         let frame = FrameScene {
             scene: checked.scene,
@@ -685,7 +686,8 @@ impl Scene {
                 _ => Failure::Runtime(msg),
             })?;
             let mesh = meshed.mesh;
-            let materials = &checked.scene.materials;
+            let colours = sdfc_compiler::lower::Colours::new(&checked.scene);
+            let palette = sdfc_runtime::mesh::write::Palette::new(&checked.scene, &colours);
             let p: Vec<u8> = mesh
                 .positions
                 .iter()
@@ -702,7 +704,7 @@ impl Scene {
                 .positions
                 .iter()
                 .zip(&mesh.vertex_materials)
-                .flat_map(|(q, &id)| sdfc_runtime::mesh::write::colour(materials, id, *q))
+                .flat_map(|(q, &id)| palette.colour(id, *q))
                 .flat_map(|x| (x as f32).to_ne_bytes())
                 .collect();
             Ok((p, tri, c))

@@ -50,6 +50,11 @@ pub struct Setup {
     /// image. For outputs of 8-bit pixels (PNG, JPEG, video); not for OpenEXR, `--reference`
     /// or `--aux`, which read the linear colours. The CPU backend renders as ever.
     pub finished: bool,
+    /// The kernel runs on a software adapter (lavapipe, llvmpipe), where every loop of a
+    /// shader shares one budget of iterations: the interpreted kernel then runs more
+    /// instructions an iteration (`wgsl::Options::interp_unroll`). Set by the preparation
+    /// for the adapter it finds.
+    pub software: bool,
 }
 
 /// The GPU kernel asked for on the command line (`--kernel`).
@@ -544,6 +549,11 @@ impl Prepared {
             debug_nan: setup.debug_nan,
             parameters: setup.parameters,
             kernel: setup.kernel,
+            interp_unroll: if setup.software {
+                wgsl::interp::UNROLL_SOFTWARE
+            } else {
+                wgsl::interp::UNROLL
+            },
             ..wgsl::Options::default()
         }
     }
@@ -598,12 +608,16 @@ impl Prepared {
     /// kernel's frames are 25 to 150 times the specialised kernel's (BENCHMARKS.md,
     /// "Interpreted against specialised"), which its compile never repays, so `auto` keeps
     /// the specialised kernel there, and for the frames of a sequence (`parameters`), which
-    /// share one specialised kernel.
+    /// share one specialised kernel. A CPU adapter's setup is marked [`Setup::software`].
     fn wgpu_setup(cpu_adapter: bool, setup: &Setup) -> Setup {
-        if cpu_adapter || setup.parameters {
+        let setup = if cpu_adapter || setup.parameters {
             setup.specialised_for_auto()
         } else {
             *setup
+        };
+        Setup {
+            software: cpu_adapter,
+            ..setup
         }
     }
 
@@ -783,6 +797,7 @@ impl Prepared {
                     kernel: wgsl::KernelChoice::default(),
                     image_only: false,
                     finished: false,
+                    software: false,
                 };
                 Ok((Self::on_cpu(scene, lowered, &setup)?, true))
             }

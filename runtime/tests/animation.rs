@@ -6,7 +6,7 @@
 
 use sdfc_compiler::check::{check_at, NoImports};
 use sdfc_compiler::diagnostics::Diagnostic;
-use sdfc_compiler::scene::{Light, Node, Pattern, Scene};
+use sdfc_compiler::scene::{Colour, Light, Node, Pattern, Scene};
 use sdfc_compiler::{Limits, SourceMap};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -133,7 +133,7 @@ fn t_reaches_every_kind_of_field() {
 
 fn pattern_red(s: &Scene) -> f64 {
     match s.materials[2].pattern {
-        Pattern::Solid(c) => c[0],
+        Pattern::Solid(Colour::Const(c)) => c[0],
         _ => panic!("not solid"),
     }
 }

@@ -7,7 +7,7 @@ mod common;
 
 use sdfc_compiler::back::wgsl;
 use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::scene::{Method, Scene};
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
 use std::path::{Path, PathBuf};
 
@@ -60,7 +60,7 @@ const AGREEMENT: &[(&str, f64, f64)] = &[
     ("polyhedron", 53.0, 0.0005),  // 56.5 dB, 0.0000 (0 px), 2026-11-27
     ("primitives", 117.0, 0.0005), // 120.8 dB, 0.0000 (0 px)
     ("ring", 49.0, 0.0008),        // 52.6 dB, 0.0003 (2 px), 2026-11-27
-    ("rock", 77.0, 0.0005),        // 80.0 dB, 0.0000 (0 px), 2026-11-27
+    ("rock", 72.0, 0.0005),        // 75.7 dB, 0.0000 (0 px), 2026-11-27 (two noises, marble)
     ("seed1", 125.0, 0.0005),      // 128.9 dB, 0.0000 (0 px)
     ("seed2", 119.0, 0.0005),      // 122.9 dB, 0.0000 (0 px)
     ("seed3", 50.0, 0.0007),       // 53.9 dB, 0.0002 (1 px)
@@ -580,4 +580,119 @@ fn a_sweep_of_relaxation_on_wgpu_takes_effect() {
     );
     // And back: ω = 1 again needs the plain kernel.
     assert!(prepared.render(&plain, &|_| {}).is_err());
+}
+
+/// A field of two gradient noises (about 700 instructions a distance) seen at a grazing
+/// angle with steps of an eighth of the distance (a declared L of 8), its rays taking
+/// hundreds of steps. Through the interpreted kernel on a software adapter every loop of a
+/// shader shares llvmpipe's budget of 65 535 iterations: at eight instructions an iteration
+/// the first rays spent it and every loop after them stopped after one pass (15.1 dB against
+/// the CPU, 47 % of the pixels, lavapipe 2026-11-27). The kernel the runtime writes for the
+/// adapter (`interp::UNROLL_SOFTWARE` on a software one) renders it as the CPU does
+/// (84.7 dB, 0 px).
+const TWO_NOISES: &str = "camera { position: (0, 0.4, 0), look_at: (0, 0.3, 10), fov: 8deg }
+light point { position: (0, 3, 20), intensity: 1, radius: 100, penumbra: 3deg }
+render { width: 8, height: 4, max_steps: 2000, max_dist: 100, method: \"march\" }
+scene {
+  field(lipschitz: 8) { p.y + 0.15 * fbm(p * 1.5, octaves: 2) };
+}
+";
+
+#[test]
+fn a_field_of_two_noises_through_the_interpreted_kernel_matches_the_cpu() {
+    let scene = checked("two_noises.sdf", TWO_NOISES);
+    let lowered = Lowered::new(&scene);
+    let Some(gpu) = open_gpu() else { return };
+    let options = wgsl::Options {
+        kernel: wgsl::KernelChoice::Interpreted,
+        interp_unroll: if gpu.is_cpu() {
+            wgsl::interp::UNROLL_SOFTWARE
+        } else {
+            wgsl::interp::UNROLL
+        },
+        ..wgsl::Options::default()
+    };
+    let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
+    assert!(kernel.interpreted());
+    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
+    let on_cpu = cpu::render(&scene, &lowered, &cpu::Options::default(), &|| {});
+    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+    println!(
+        "two noises, interpreted: psnr {:.1} dB, differing {:.4}",
+        d.psnr, d.differing
+    );
+    assert!(d.psnr >= 80.0 && d.differing == 0.0, "{d:?}");
+}
+
+/// Colour fields (a marble of fbm noise on a sphere, a checker whose first colour is a
+/// gradient by height) render on wgpu as on the CPU, through the analytically traced kernel,
+/// the specialised marched kernel and the interpreted one; a colour field of constants
+/// renders the plain colour's image on wgpu too.
+#[test]
+fn colour_fields_match_the_cpu_on_every_kernel() {
+    let text = |marble: &str| {
+        format!(
+            "material marble = phong {{ color: {marble}, specular: 0.3, shininess: 24 }};\n\
+             material floor = checker {{ a: field {{ vec3(0.3, 0.4 + 0.3 * clamp(p.z, 0, 1), 0.6) }}, b: (0.1, 0.1, 0.1), size: 1 }};\n\
+             camera {{ position: (0, 1.5, -4), look_at: (0, 0.3, 0), fov: 50deg }}\n\
+             light point {{ position: (3, 5, -4), intensity: 1.1, radius: 40 }}\n\
+             render {{ width: 48, height: 32 }}\n\
+             scene {{ plane((0, 1, 0), -0.8) @ floor; sphere(1) @ marble; }}"
+        )
+    };
+    let marble = "field { mix(vec3(0.25, 0.22, 0.2), vec3(0.95, 0.93, 0.9), \
+                  0.5 + 0.5 * sin(6 * p.x + 4 * fbm(p * 1.5, octaves: 2))) }";
+    let scene = checked("colours.sdf", &text(marble));
+    let Some(gpu) = open_gpu() else { return };
+    for (method, choice) in [
+        (Method::Auto, wgsl::KernelChoice::Specialised),
+        (Method::March, wgsl::KernelChoice::Specialised),
+        (Method::March, wgsl::KernelChoice::Interpreted),
+    ] {
+        let mut scene = scene.clone();
+        scene.settings.method = method;
+        let lowered = Lowered::new(&scene);
+        let options = wgsl::Options {
+            kernel: choice,
+            interp_unroll: if gpu.is_cpu() {
+                wgsl::interp::UNROLL_SOFTWARE
+            } else {
+                wgsl::interp::UNROLL
+            },
+            ..wgsl::Options::default()
+        };
+        let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
+        assert!(kernel.contract.has("COLOUR_FIELDS"));
+        assert_eq!(
+            kernel.interpreted(),
+            choice == wgsl::KernelChoice::Interpreted
+        );
+        let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
+        let on_cpu = cpu::render(&scene, &lowered, &cpu::Options::default(), &|| {});
+        let d =
+            metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+        println!(
+            "colour fields, {method:?}, {choice:?}: psnr {:.1} dB, differing {:.4}",
+            d.psnr, d.differing
+        );
+        // Measured on lavapipe (2026-11-27): traced 128.3 dB, marched 80.6 dB with either
+        // kernel, 0 px.
+        let least = if method == Method::Auto { 120.0 } else { 77.0 };
+        assert!(
+            d.psnr >= least && d.differing == 0.0,
+            "{method:?} {choice:?}: {d:?}"
+        );
+    }
+    let constant = checked("constant.sdf", &text("field { vec3(0.9, 0.2, 0.2) }"));
+    let plain = checked("plain.sdf", &text("(0.9, 0.2, 0.2)"));
+    let render = |s: &Scene| {
+        let lowered = Lowered::new(s);
+        let kernel = wgsl::write(s, &lowered).expect("valid kernel");
+        gpu::render(&gpu, s, &kernel, 1.0, &mut |_| {})
+            .expect("render")
+            .render
+            .image
+            .linear
+    };
+    assert!(render(&constant) == render(&plain));
 }

@@ -49,8 +49,24 @@ fn marched(path: &Path, width: u32, height: u32) -> Scene {
 }
 
 fn kernel(scene: &Scene, lowered: &Lowered, kernel: KernelChoice) -> wgsl::Kernel {
+    kernel_for(scene, lowered, kernel, false)
+}
+
+/// [`kernel`] for a software adapter (`software`: lavapipe, whose loops share a budget of
+/// iterations) or a GPU, as the runtime writes it (`Setup::software`).
+fn kernel_for(
+    scene: &Scene,
+    lowered: &Lowered,
+    kernel: KernelChoice,
+    software: bool,
+) -> wgsl::Kernel {
     let options = Options {
         kernel,
+        interp_unroll: if software {
+            wgsl::interp::UNROLL_SOFTWARE
+        } else {
+            wgsl::interp::UNROLL
+        },
         ..Options::default()
     };
     wgsl::write_with(scene, lowered, &options).unwrap_or_else(|e| panic!("{e}"))
@@ -202,7 +218,7 @@ fn auto_keeps_the_specialised_kernel_on_a_cpu_adapter_on_cuda_and_for_sequences(
 fn assert_same(gpu: &gpu::Gpu, scene: &Scene, label: &str) -> f64 {
     let lowered = Lowered::new(scene);
     let specialised = kernel(scene, &lowered, KernelChoice::Specialised);
-    let interpreted = kernel(scene, &lowered, KernelChoice::Interpreted);
+    let interpreted = kernel_for(scene, &lowered, KernelChoice::Interpreted, gpu.is_cpu());
     let l = lowered.program.lipschitz();
     let a = gpu::render(gpu, scene, &specialised, l, &mut |_| {}).expect("render");
     let b = gpu::render(gpu, scene, &interpreted, l, &mut |_| {}).expect("render");

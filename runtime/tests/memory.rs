@@ -118,6 +118,7 @@ fn renders_stay_within_the_memory_they_announce() {
             kernel: Default::default(),
             image_only: false,
             finished: false,
+            software: false,
         };
         let prepared = pool.install(|| {
             Prepared::from_program(Backend::Cpu, &scene, lowered.clone(), &setup).expect("cpu")

@@ -754,3 +754,85 @@ fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A colour field reaches the vertices: a gradient by height on a sphere, read back from
+/// PLY (sRGB bytes), from glTF's `COLOR_0` (linear) and from OBJ's `v x y z r g b` (sRGB
+/// from 0 to 1), each vertex's colour the field's at the vertex.
+#[test]
+fn vertex_colours_follow_a_colour_field() {
+    let d = dir("colour-field");
+    let scene = write_scene(
+        &d,
+        "gradient.sdf",
+        "material g = phong { color: field { vec3(0.5 + 0.5 * p.y, 0.25, 0.5 - 0.5 * p.y) } };\n\
+         scene { sphere(1) @ g; }\n",
+    );
+    // The field's colour at a vertex, linear.
+    let field = |p: [f32; 3]| {
+        let y = f64::from(p[1]);
+        [0.5 + 0.5 * y, 0.25, (0.5 - 0.5 * y).max(0.0)]
+    };
+    let ply = d.join("g.ply");
+    mesh(&[s(&scene), "-o", s(&ply), "--resolution", "16"]);
+    let (m, colours) = read_ply(&ply);
+    assert!(m.positions.len() > 100);
+    for (p, c) in m.positions.iter().zip(&colours) {
+        let want = field(*p).map(|x| sdfc_runtime::image::srgb_encode(x as f32));
+        for k in 0..3 {
+            assert!(
+                (i32::from(c[k]) - i32::from(want[k])).abs() <= 1,
+                "vertex {p:?}: {c:?}, the field gives {want:?}"
+            );
+        }
+    }
+    let glb = d.join("g.glb");
+    mesh(&[s(&scene), "-o", s(&glb), "--resolution", "16"]);
+    let bytes = std::fs::read(&glb).expect("read glb");
+    let gltf = gltf::Gltf::from_slice(&bytes).expect("gltf reads it");
+    let blob = gltf.blob.clone();
+    let prim = gltf
+        .meshes()
+        .next()
+        .expect("a mesh")
+        .primitives()
+        .next()
+        .expect("one");
+    let reader = prim.reader(|_| blob.as_deref());
+    let positions: Vec<[f32; 3]> = reader.read_positions().expect("positions").collect();
+    let colours: Vec<[f32; 3]> = reader
+        .read_colors(0)
+        .expect("COLOR_0")
+        .into_rgb_f32()
+        .collect();
+    assert_eq!(positions.len(), colours.len());
+    for (p, c) in positions.iter().zip(&colours) {
+        let want = field(*p);
+        for k in 0..3 {
+            assert!(
+                (f64::from(c[k]) - want[k]).abs() < 1e-5,
+                "{p:?}: {c:?} {want:?}"
+            );
+        }
+    }
+    let base = prim.material().pbr_metallic_roughness().base_color_factor();
+    assert_eq!(base, [1.0; 4], "the vertex colours are the colour");
+    let obj = d.join("g.obj");
+    mesh(&[s(&scene), "-o", s(&obj), "--resolution", "16"]);
+    let (models, _) = tobj::load_obj(
+        &obj,
+        &tobj::LoadOptions {
+            single_index: true,
+            ..Default::default()
+        },
+    )
+    .expect("tobj reads it");
+    let m = &models[0].mesh;
+    assert_eq!(m.vertex_color.len(), m.positions.len());
+    for (p, c) in m.positions.chunks(3).zip(m.vertex_color.chunks(3)) {
+        let want = field([p[0], p[1], p[2]]);
+        for k in 0..3 {
+            let byte = f32::from(sdfc_runtime::image::srgb_encode(want[k] as f32)) / 255.0;
+            assert!((c[k] - byte).abs() < 1e-4, "{p:?}: {c:?}");
+        }
+    }
+}

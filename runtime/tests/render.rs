@@ -337,8 +337,8 @@ fn glass_scene(ball: Option<(f64, f64)>) -> Scene {
         });
     }
     b.scene.materials[0].pattern = Pattern::Checker {
-        a: [0.9, 0.9, 0.9],
-        b: [0.1, 0.1, 0.1],
+        a: [0.9, 0.9, 0.9].into(),
+        b: [0.1, 0.1, 0.1].into(),
         size: 0.5,
     };
     b.point_light([0.0, 0.0, -6.0], 4.0);
@@ -712,5 +712,59 @@ fn a_traced_render_prepares_no_tapes() {
         prepared.prepare();
         let again = cpu::render_tapes(&scene, &prepared, &Options::default(), &|| {});
         assert_eq!(r.image.linear, again.image.linear, "{method:?}");
+    }
+}
+
+/// A material whose colour (and a checker whose colours) are colour fields of constants
+/// renders the image of the plain colours, bit for bit, sphere traced and traced
+/// analytically, in f32 and in the f64 reference; a field that varies changes it.
+#[test]
+fn a_constant_colour_field_renders_as_the_plain_colour() {
+    let text = |red: &str, a: &str| {
+        format!(
+            "material red = phong {{ color: {red}, specular: 0.4 }};\n\
+             material floor = checker {{ a: {a}, b: (0.1, 0.12, 0.15), size: 0.5 }};\n\
+             camera {{ position: (0, 1.5, -4), look_at: (0, 0.3, 0) }}\n\
+             light point {{ position: (3, 5, -4) }}\n\
+             render {{ width: 48, height: 32 }}\n\
+             scene {{ plane((0, 1, 0), -0.8) @ floor; sphere(1) @ red; }}"
+        )
+    };
+    let scene = |t: &str| {
+        let (scene, diags, _) = sdfc_compiler::check::check_str("colours.sdf", t);
+        scene.unwrap_or_else(|| panic!("{diags:?}"))
+    };
+    let plain = scene(&text("(0.9, 0.2, 0.2)", "(0.9, 0.9, 0.85)"));
+    let fields = scene(&text(
+        "field { vec3(0.9, 0.2, 0.2) }",
+        "field { (0.9, 0.9, 0.85) }",
+    ));
+    let varying = scene(&text(
+        "field { vec3(0.9, 0.2 + 0.2 * sin(8 * p.y), 0.2) }",
+        "(0.9, 0.9, 0.85)",
+    ));
+    for precision in [Precision::F32, Precision::F64] {
+        let options = Options {
+            precision,
+            ..Options::default()
+        };
+        for method in METHODS {
+            let run = |s: &Scene| {
+                let mut s = s.clone();
+                s.settings.method = method;
+                cpu::render(&s, &Lowered::new(&s), &options, &|| {})
+                    .image
+                    .linear
+            };
+            let want = run(&plain);
+            assert!(
+                run(&fields) == want,
+                "{precision:?} {method:?}: the constant fields change the image"
+            );
+            assert!(
+                run(&varying) != want,
+                "{precision:?} {method:?}: a field that varies"
+            );
+        }
     }
 }

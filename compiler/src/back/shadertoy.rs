@@ -2,9 +2,10 @@
 //! scene's distance function and material table ([`super::wgsl::part`], written by naga as
 //! GLSL ES 3.00) and a `mainImage` that renders it with the scene's camera (its aspect taken
 //! from the canvas), lights and materials: sphere tracing, tetrahedral normals, Phong with
-//! point-light attenuation, hard or soft shadows and checker patterns as docs/rendering.md
-//! states them, for camera rays only. Reflection, refraction, transparency, over-relaxation
-//! and antialiasing are left out, so a scene using them renders without them.
+//! point-light attenuation, hard or soft shadows, checker patterns and colour fields as
+//! docs/rendering.md states them, for camera rays only. Reflection, refraction,
+//! transparency, over-relaxation and antialiasing are left out, so a scene using them
+//! renders without them.
 
 use super::shader::{self, Error};
 use super::wgsl::{self, float};
@@ -87,7 +88,7 @@ void mainImage(out vec4 fragColor, in vec2 fragCoord) {
         int id = int(sdfc_map(p).y);
         sdfc_map_Material m = sdfc_map_MATERIALS[clamp(id, 0, int(sdfc_map_MATERIAL_COUNT) - 1)];
         vec3 c = sdfc_colour(m, p - n * (2.0 * h));
-        vec3 v = -d;
+SDFC_FIELDS        vec3 v = -d;
         col = m.ambient * c;
 SDFC_LIGHTS    }
     fragColor = vec4(sdfc_srgb(col.x), sdfc_srgb(col.y), sdfc_srgb(col.z), 1.0);
@@ -163,6 +164,35 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
             }
         }
     }
-    out.push_str(&RENDERER.replace("SDFC_LIGHTS", &lights));
+    // Colour fields: the material's colour at p (a checker's cell found as `sdfc_colour`
+    // finds it).
+    let mut fields = String::new();
+    for (id, slots) in lowered.colours.fields.iter().enumerate() {
+        let call = |k: Option<usize>, constant: &str| match k {
+            Some(k) => format!("{NAME}_colour_field({k}u, p)"),
+            None => constant.to_string(),
+        };
+        match slots {
+            [None, None] => {}
+            [a, None] if scene.materials[id].pattern.colours().len() == 1 => {
+                let _ = writeln!(fields, "        if (id == {id}) c = {};", call(*a, "c"));
+            }
+            [a, b] => {
+                let _ = writeln!(
+                    fields,
+                    "        if (id == {id}) {{\n            vec3 q = (p - n * (2.0 * h)) / m.checker + m.shift;\n            \
+                     float s = floor(q.x) + floor(q.y) + floor(q.z);\n            \
+                     c = (s - 2.0 * floor(s / 2.0)) > 0.0 ? {} : {};\n        }}",
+                    call(*b, "m.color_b"),
+                    call(*a, "m.color")
+                );
+            }
+        }
+    }
+    out.push_str(
+        &RENDERER
+            .replace("SDFC_LIGHTS", &lights)
+            .replace("SDFC_FIELDS", &fields),
+    );
     Ok(out)
 }

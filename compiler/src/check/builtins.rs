@@ -1609,6 +1609,8 @@ pub struct Record {
     /// Fields whose value must not depend on the time `t` (E0406): what every frame of a
     /// sequence shares.
     pub timeless: &'static [&'static str],
+    /// Fields that take a colour field (`field { … }` of a vec3) as well as a vec3.
+    pub painted: &'static [&'static str],
 }
 
 const SURFACE: [P; 8] = [
@@ -1657,11 +1659,13 @@ pub static MATERIALS: &[Record] = &[
     Record {
         name: "phong",
         timeless: &[],
+        painted: &["color"],
         fields: &SURFACE,
     },
     Record {
         name: "checker",
         timeless: &[],
+        painted: &["a", "b"],
         fields: &CHECKER,
     },
 ];
@@ -1690,11 +1694,13 @@ pub static LIGHTS: &[Record] = &[
     Record {
         name: "point",
         timeless: &[],
+        painted: &[],
         fields: &POINT,
     },
     Record {
         name: "directional",
         timeless: &[],
+        painted: &[],
         fields: &DIRECTIONAL,
     },
 ];
@@ -1703,6 +1709,7 @@ pub static LIGHTS: &[Record] = &[
 pub static CAMERA: Record = Record {
     name: "camera",
     timeless: &[],
+    painted: &[],
     fields: &[
         p("position", V, V3(Camera::DEFAULT.position), Any),
         p("look_at", V, V3(Camera::DEFAULT.look_at), Any),
@@ -1727,6 +1734,7 @@ pub static RENDER: Record = Record {
     name: "render",
     // The sequence's frames and their size: an animated PNG or a video has one size.
     timeless: &["width", "height", "fps", "duration"],
+    painted: &[],
     fields: &[
         p(
             "width",

@@ -951,34 +951,74 @@ impl Ctx<'_> {
             .push(("p".into(), field::point(vec![coord(0), coord(1), coord(2)])));
         let v = self.body(body);
         self.locals.truncate(mark);
-        let comps = match &v {
+        // A float body is a distance (a shape), a vec3 body a colour (a colour field).
+        let (comps, colour) = match &v {
             Value::Error => return Value::Error,
             Value::Unknown(Type::Float | Type::Int) => return Value::Unknown(Type::Shape),
+            Value::Unknown(Type::Vec3) => return Value::Unknown(Type::ColourField),
             Value::Int(_) | Value::Float(_) | Value::Point(_)
                 if v.ty().is_some_and(|t| t.fits(Type::Float)) =>
             {
-                field::comps(&v).unwrap_or_default()
+                (field::comps(&v).unwrap_or_default(), false)
+            }
+            Value::Vec3(_) | Value::Point(_) if v.ty() == Some(Type::Vec3) => {
+                (field::comps(&v).unwrap_or_default(), true)
             }
             other => {
                 self.error(
                     Diagnostic::error(
                         "E0300",
                         format!(
-                            "the body of `field` is a `{}`, not a float",
+                            "the body of `field` is a `{}`, not a float or a vec3",
                             type_name(other)
                         ),
                         body.value.span,
                     )
                     .with_label(format!("this is `{}`", type_name(other)))
-                    .with_note("a field's body is its distance at the point `p`"),
+                    .with_note(
+                        "a field's body is its distance at the point `p` (a float), or, for a \
+                         material's colour, its colour there (a vec3)",
+                    ),
                 );
                 return Value::Error;
             }
         };
+        if colour && lipschitz.is_some() {
+            self.error(
+                Diagnostic::error(
+                    "E0202",
+                    "a colour field takes no `lipschitz`",
+                    args.first().map_or(span, |a| a.value.span),
+                )
+                .with_label("a bound of a distance's gradient")
+                .with_note("this field's body is a vec3: a colour, not a distance"),
+            );
+            return Value::Error;
+        }
+        if colour && field::reads_distance(&comps) {
+            self.error(
+                Diagnostic::error(
+                    "E0410",
+                    "a colour field cannot read a shape's distance",
+                    body.value.span,
+                )
+                .with_label("this colour reads `distance(…)`")
+                .with_note(
+                    "a colour field is a formula of the point `p`: arithmetic, the maths \
+                     builtins, noise, fbm and voronoi",
+                ),
+            );
+            return Value::Error;
+        }
         if self.dry > 0 {
-            return Value::Unknown(Type::Shape);
+            return Value::Unknown(if colour {
+                Type::ColourField
+            } else {
+                Type::Shape
+            });
         }
         match field::flatten(&comps, owner) {
+            Ok(f) if colour => Value::Colour(std::rc::Rc::new(f)),
             Ok(f) => self.add_node(Node::Field { f, lipschitz }, span),
             Err(field::OuterPoint) => self.per_point(
                 "this field reads the point `p` of an enclosing field".into(),
@@ -1903,10 +1943,43 @@ pub fn record(
             out.insert(p.name, Value::Error);
             continue;
         }
+        if rec.painted.contains(&p.name) {
+            match &v {
+                Value::Colour(_) | Value::Unknown(Type::ColourField) => {
+                    out.insert(p.name, v);
+                    continue;
+                }
+                Value::Shape(id) if matches!(cx.graph.node(*id), Node::Field { .. }) => {
+                    cx.error(
+                        Diagnostic::error(
+                            "E0300",
+                            format!(
+                                "`{}` of `{}` is a field whose body is a float, not a vec3",
+                                p.name, rec.name
+                            ),
+                            f.value.span,
+                        )
+                        .with_label("this field's body is a distance")
+                        .with_note("a colour field's body is its colour at the point `p`, a vec3")
+                        .with_help("give the body three components: `field { vec3(r, g, b) }`"),
+                    );
+                    out.insert(p.name, Value::Error);
+                    continue;
+                }
+                _ => {}
+            }
+        }
         let v = match v.clone().coerce(p.ty) {
             Some(c) => c,
             None => {
-                cx.error(type_mismatch(p.name, p.ty, &v, f.value.span));
+                let mut d = type_mismatch(p.name, p.ty, &v, f.value.span);
+                if v.ty() == Some(Type::ColourField) {
+                    d = d.with_note(
+                        "a colour field goes in a material's colour: `color` of `phong`, \
+                         `a` and `b` of `checker`",
+                    );
+                }
+                cx.error(d);
                 Value::Error
             }
         };

@@ -347,6 +347,26 @@ fn fbm(a: &[Value]) -> Result<Value, String> {
     Ok(point(vec![sum.unwrap_or_else(|| k(0.0))]))
 }
 
+/// Whether any of the expressions `out` reads a shape's distance (each shared part visited
+/// once).
+pub fn reads_distance(out: &[Rc<Sx>]) -> bool {
+    let mut seen: std::collections::HashSet<*const Sx> = std::collections::HashSet::new();
+    let mut stack: Vec<&Rc<Sx>> = out.iter().collect();
+    while let Some(s) = stack.pop() {
+        if !seen.insert(Rc::as_ptr(s)) {
+            continue;
+        }
+        match &**s {
+            Sx::Distance(..) => return true,
+            Sx::Coord(..) | Sx::Const(_) => {}
+            Sx::Un(_, a) => stack.push(a),
+            Sx::Bin(_, a, b) => stack.extend([a, b]),
+            Sx::Length(v) | Sx::Noise(v) | Sx::Voronoi(v) => stack.extend(v),
+        }
+    }
+    false
+}
+
 /// A coordinate of an enclosing field's point, read by an inner field (which cannot).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct OuterPoint;

@@ -17,7 +17,7 @@ pub mod types;
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::scene::{
-    Camera, Combine, Light, Material, MaterialId, Method, Node, Pattern, Scene, Settings,
+    Camera, Colour, Combine, Light, Material, MaterialId, Method, Node, Pattern, Scene, Settings,
 };
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::{self, ast};
@@ -722,14 +722,19 @@ fn material(
             .with_note("the surface's own colour is weighted by 1 − reflect − transparency"),
         );
     }
+    // A colour field's value, or the constant's.
+    let colour = |v: &Value| match v {
+        Value::Colour(field) => Colour::Field((**field).clone()),
+        other => Colour::Const(other.v3()),
+    };
     let pattern = if rec.name == "checker" {
         Pattern::Checker {
-            a: f["a"].v3(),
-            b: f["b"].v3(),
+            a: colour(&f["a"]),
+            b: colour(&f["b"]),
             size: f["size"].num(),
         }
     } else {
-        Pattern::Solid(f["color"].v3())
+        Pattern::Solid(colour(&f["color"]))
     };
     scene.materials[id.0 as usize] = Material {
         name: name.name.clone(),

@@ -176,7 +176,7 @@ fn a_material_can_be_used_above_its_declaration() {
     assert_eq!(s.materials[1].name, "blue");
     assert_eq!(
         s.materials[1].pattern,
-        crate::scene::Pattern::Solid([0.0, 0.0, 1.0])
+        crate::scene::Pattern::Solid([0.0, 0.0, 1.0].into())
     );
     let Node::Paint { material, .. } = s.graph.node(s.root.expect("root")) else {
         panic!("not painted")
@@ -507,4 +507,45 @@ fn constants_are_returned_with_their_values_even_beside_errors() {
             ("ok", "true", "bool"),
         ]
     );
+}
+
+/// A material's colour and a checker's colours may be colour fields (a `field` of a vec3),
+/// returned by functions too; their expressions reach the scene IR, and a colour field of
+/// constants is lowered to a program of constants.
+#[test]
+fn colour_fields_reach_the_materials() {
+    use crate::scene::{Colour, Pattern};
+    let s = ok("fn bands(n: float) -> color_field { field { vec3(0.5 + 0.5 * sin(n * p.y), 0.2, 0.2) } }\n\
+         material m = phong { color: bands(8) };\n\
+         material c = checker { a: field { (0.3, 0.3, 0.3) }, b: (0.1, 0.1, 0.1) };\n\
+         scene { sphere(1) @ m; box(0.5) @ c; }");
+    let Pattern::Solid(Colour::Field(f)) = &s.materials[1].pattern else {
+        panic!("{:?}", s.materials[1].pattern)
+    };
+    assert_eq!(f.out.len(), 3);
+    assert!(f.text().contains("sin"), "{}", f.text());
+    let Pattern::Checker {
+        a: Colour::Field(a),
+        b: Colour::Const(b),
+        ..
+    } = &s.materials[2].pattern
+    else {
+        panic!("{:?}", s.materials[2].pattern)
+    };
+    assert_eq!(*b, [0.1; 3]);
+    let lowered = crate::lower::Lowered::new(&s);
+    let colours = &lowered.colours;
+    assert_eq!(colours.fields[1..], [[Some(0), None], [Some(1), None]]);
+    // 0.5 + 0.5 sin(8y) at y = 0.1.
+    let [r, g, _] = colours.programs[0].eval([0.0f64, 0.1, 0.0]);
+    assert!((r - (0.5 + 0.5 * 0.8f64.sin())).abs() < 1e-12 && g == 0.2);
+    let constant = &colours.programs[1].program;
+    assert!(
+        constant.ops().iter().all(|op| matches!(
+            op,
+            crate::program::Op::Const(_) | crate::program::Op::Input(_)
+        )),
+        "{a:?}"
+    );
+    assert_eq!(colours.programs[1].eval([5.0f64, -2.0, 1.0]), [0.3; 3]);
 }

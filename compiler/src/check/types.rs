@@ -19,6 +19,9 @@ pub enum Type {
     /// A 2D signed distance in the xy plane (docs/language.md, "2D profiles"): made into a
     /// shape by `extrude`, `revolve`, ….
     Profile,
+    /// A colour field (docs/language.md, "Colour fields"): `field { … }` whose body is a vec3
+    /// of the point, a material's `color` that varies over the surface. Not a list element.
+    ColourField,
     /// A list of values of the element type, which is never a list ([`Type::list`]).
     List(&'static Type),
 }
@@ -65,13 +68,23 @@ impl Type {
             "string" => Type::Str,
             "shape" => Type::Shape,
             "profile" => Type::Profile,
+            "color_field" => Type::ColourField,
             _ => return None,
         })
     }
 
     /// All type names, for suggestions.
-    pub const NAMES: [&'static str; 9] = [
-        "int", "float", "bool", "vec2", "vec3", "angle", "string", "shape", "profile",
+    pub const NAMES: [&'static str; 10] = [
+        "int",
+        "float",
+        "bool",
+        "vec2",
+        "vec3",
+        "angle",
+        "string",
+        "shape",
+        "profile",
+        "color_field",
     ];
 
     /// True when a value of type `self` may be passed where `want` is expected.
@@ -95,6 +108,7 @@ impl fmt::Display for Type {
             Type::Str => "string",
             Type::Shape => "shape",
             Type::Profile => "profile",
+            Type::ColourField => "color_field",
             Type::List(elem) => return write!(f, "[{elem}]"),
         })
     }
@@ -118,6 +132,8 @@ pub enum Value {
     Profile(NodeId),
     /// A list: its element type and its elements (each of that type, or `Error`).
     List(&'static Type, Rc<[Value]>),
+    /// A colour field: red, green and blue of the point as a field's three values.
+    Colour(Rc<crate::scene::field::FieldFn>),
     /// A number or vector that depends on the point `p` of a `field` (1, 2 or 3 components):
     /// an expression evaluated per point, not a constant.
     Point(super::field::Comps),
@@ -138,6 +154,7 @@ impl Value {
             Value::Str(_) => Type::Str,
             Value::Shape(_) => Type::Shape,
             Value::Profile(_) => Type::Profile,
+            Value::Colour(_) => Type::ColourField,
             Value::List(elem, _) => Type::List(elem),
             Value::Point(c) => match c.len() {
                 1 => Type::Float,
@@ -176,8 +193,8 @@ impl Value {
     }
 
     /// The value written as in the language, for a number, vector, angle, bool, string or
-    /// list of them (a long list shortened); `None` for shapes, profiles, per-point values
-    /// and values not computed. Floats are shown to 10 significant digits, angles in degrees.
+    /// list of them (a long list shortened); `None` for shapes, profiles, colour fields,
+    /// per-point values and values not computed. Floats are shown to 10 significant digits, angles in degrees.
     pub fn show(&self) -> Option<String> {
         use crate::scene::dump_num as num;
         let join = |xs: &[f64]| xs.iter().map(|&x| num(x)).collect::<Vec<_>>().join(", ");
@@ -203,6 +220,7 @@ impl Value {
             }
             Value::Shape(_)
             | Value::Profile(_)
+            | Value::Colour(_)
             | Value::Point(_)
             | Value::Unknown(_)
             | Value::Error => return None,
@@ -250,6 +268,7 @@ impl fmt::Display for Value {
             Value::Str(s) => write!(f, "{s:?}"),
             Value::Shape(_) => write!(f, "<shape>"),
             Value::Profile(_) => write!(f, "<profile>"),
+            Value::Colour(_) => write!(f, "<color_field>"),
             Value::List(_, items) => {
                 // A long list is shown by its first elements and its length.
                 const SHOWN: usize = 4;

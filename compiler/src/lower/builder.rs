@@ -314,6 +314,14 @@ impl Builder {
     /// Ends the program: drops instructions the outputs do not need (when optimising) and
     /// renumbers the rest.
     pub fn finish(self, d: Reg, m: Reg) -> Program {
+        self.finish_roots(&[d, m]).0
+    }
+
+    /// [`Builder::finish`] keeping every register of `roots` (at least one) and giving their
+    /// new numbers; the program's distance is the first root, its material the second (or
+    /// the first again).
+    pub fn finish_roots(self, roots: &[Reg]) -> (Program, Vec<Reg>) {
+        let (d, m) = (roots[0], *roots.get(1).unwrap_or(&roots[0]));
         let raw = Program {
             ops: self.ops,
             notes: Vec::new(),
@@ -324,7 +332,7 @@ impl Builder {
             meshes: Vec::new(),
         };
         let (live, live_blocks) = if self.optimise {
-            raw.live(&[d, m])
+            raw.live(roots)
         } else {
             (vec![true; raw.ops.len()], vec![true; raw.blocks.len()])
         };
@@ -362,7 +370,7 @@ impl Builder {
             })
             .collect();
         let notes = useful_notes(moved, &self.resumes, ops.len());
-        Program {
+        let program = Program {
             ops,
             notes,
             blocks,
@@ -370,7 +378,11 @@ impl Builder {
             material: new_index[m.0 as usize],
             lipschitz: 1.0,
             meshes: self.meshes,
-        }
+        };
+        (
+            program,
+            roots.iter().map(|r| new_index[r.0 as usize]).collect(),
+        )
     }
 }
 

@@ -1,14 +1,110 @@
-//! Lowering of the operations of a user field (`scene::field`) to program instructions, and
-//! of its noise: gradient noise and the Voronoi distance over a lattice hashed by the
+//! Lowering of the operations of a user field (`scene::field`) to program instructions, of
+//! the colour fields of materials to programs of their own ([`Colours`]), and of noise: gradient noise and the Voronoi distance over a lattice hashed by the
 //! permutation polynomial (34x² + x) mod 289 (Gustavson and McEwan's webgl-noise), computed
 //! on whole numbers below 2²⁴ so that every evaluator, f32 or f64, finds the same cell hashes
 //! exactly (docs/language.md, "Noise").
 
 use super::builder::{Builder, P};
 use super::{Reg, Unary};
-use crate::program::Binary;
-use crate::scene::field::{FBin, FOp, FUn, GOLDEN_TURN, NOISE_CELLS, VORONOI_LO, VORONOI_SPAN};
+use crate::program::{Binary, Float, Program};
+use crate::scene::field::{
+    FBin, FOp, FUn, FieldFn, GOLDEN_TURN, NOISE_CELLS, VORONOI_LO, VORONOI_SPAN,
+};
+use crate::scene::{Colour, Scene, V3};
 use std::f64::consts::TAU;
+
+/// A colour field lowered: a program of the point whose registers `rgb` are the colour's red,
+/// green and blue, each at least 0. Its input is the point in the program's coordinates; the
+/// scene's [`Scene::origin`] is added first, so that the colour keeps its place in the world.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourProgram {
+    /// The program (its distance and material registers are red and green; read `rgb`).
+    pub program: Program,
+    /// The registers of red, green and blue.
+    pub rgb: [Reg; 3],
+}
+
+impl ColourProgram {
+    /// Lowers the expression `f` (three values) for a scene moved by `origin`.
+    pub fn new(f: &FieldFn, origin: V3) -> ColourProgram {
+        let mut b = Builder::new(true);
+        let q = b.input_point();
+        let p = [0, 1, 2].map(|i| b.addc(q[i], origin[i]));
+        let mut regs: Vec<Reg> = Vec::with_capacity(f.ops.len());
+        for o in &f.ops {
+            let r = op(&mut b, o, p, &regs);
+            regs.push(r);
+        }
+        let rgb = [0, 1, 2].map(|i| {
+            let r = f.out.get(i).map_or_else(|| b.c(0.0), |s| regs[*s as usize]);
+            b.maxc(r, 0.0)
+        });
+        let (program, roots) = b.finish_roots(&rgb);
+        ColourProgram {
+            program,
+            rgb: [roots[0], roots[1], roots[2]],
+        }
+    }
+
+    /// The colour at `p` (the program's reference run, [`Program::run`]).
+    pub fn eval<T: Float>(&self, p: [T; 3]) -> [T; 3] {
+        let regs = self.program.run::<T>(p, |_| {});
+        self.rgb.map(|r| regs[r.0 as usize])
+    }
+}
+
+/// The colour fields of a scene's materials, each lowered once: every back end reads them
+/// here.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Colours {
+    /// The programs, in the order of the materials and, in a checker, `a` before `b`.
+    pub programs: Vec<ColourProgram>,
+    /// For each material, the index in `programs` of its colour's field (a checker's `a`)
+    /// and of a checker's `b`, where they are fields.
+    pub fields: Vec<[Option<usize>; 2]>,
+}
+
+impl Colours {
+    /// The colour fields of `scene`'s materials.
+    pub fn new(scene: &Scene) -> Colours {
+        let mut programs = Vec::new();
+        for m in &scene.materials {
+            for c in m.pattern.colours() {
+                if let Colour::Field(f) = c {
+                    programs.push(ColourProgram::new(f, scene.origin));
+                }
+            }
+        }
+        Colours {
+            programs,
+            fields: Colours::numbers(scene),
+        }
+    }
+
+    /// [`Colours::fields`] of `scene`, without lowering the fields.
+    pub fn numbers(scene: &Scene) -> Vec<[Option<usize>; 2]> {
+        let mut next = 0;
+        scene
+            .materials
+            .iter()
+            .map(|m| {
+                let mut slots = [None, None];
+                for (k, c) in m.pattern.colours().into_iter().enumerate() {
+                    if let Colour::Field(_) = c {
+                        slots[k] = Some(next);
+                        next += 1;
+                    }
+                }
+                slots
+            })
+            .collect()
+    }
+
+    /// Whether no material has a colour field.
+    pub fn is_empty(&self) -> bool {
+        self.programs.is_empty()
+    }
+}
 
 /// The instructions of one operation other than [`FOp::Distance`] (which the caller lowers
 /// as a shape), given the registers of the earlier ones.

@@ -28,6 +28,7 @@ pub use crate::program::{
     Unary,
 };
 pub use builder::{Param, Slots};
+pub use field::{ColourProgram, Colours};
 pub use instances::{shape_program, Instance, ShapeProgram, Split};
 pub use media::{media, Media};
 pub use shapes::slots;
@@ -108,6 +109,8 @@ pub struct Lowered {
     pub traceable: Traceable,
     /// Where glass may overlap an opaque solid, the medium's and the solids' programs.
     pub media: Option<Media>,
+    /// The colour fields of the materials.
+    pub colours: Colours,
     /// At level 1, the simplified scene the program was lowered from.
     simplified: Option<Simplified>,
     /// The options the program was lowered with.
@@ -208,6 +211,7 @@ fn lowered(
         program,
         traceable,
         media,
+        colours: Colours::new(scene),
         simplified,
         options: *options,
         phases,

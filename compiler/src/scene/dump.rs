@@ -77,10 +77,19 @@ pub fn dump(scene: &Scene) -> String {
         };
     }
     for (i, m) in scene.materials.iter().enumerate() {
+        let colour = |c: &Colour| match c {
+            Colour::Const(c) => v3(*c),
+            Colour::Field(f) => format!("field {{ {} }}", f.text()),
+        };
         let pattern = match &m.pattern {
-            Pattern::Solid(c) => format!("color={}", v3(*c)),
+            Pattern::Solid(c) => format!("color={}", colour(c)),
             Pattern::Checker { a, b, size } => {
-                format!("checker a={} b={} size={}", v3(*a), v3(*b), num(*size))
+                format!(
+                    "checker a={} b={} size={}",
+                    colour(a),
+                    colour(b),
+                    num(*size)
+                )
             }
         };
         let _ = writeln!(

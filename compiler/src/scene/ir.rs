@@ -604,13 +604,51 @@ pub struct Expansion {
     pub total: u64,
 }
 
+/// One colour of a material: a constant, or a colour field (`field { … }` whose body is a
+/// vec3 of the point `p`, docs/language.md "Colour fields"), evaluated at the hit point in
+/// the scene's coordinates (the world's, before [`Scene::origin`] moved them).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Colour {
+    /// The same colour everywhere.
+    Const(V3),
+    /// Red, green and blue as the three values of a field's expression; components below 0
+    /// are taken as 0.
+    Field(super::field::FieldFn),
+}
+
+impl Colour {
+    /// The constant colour, or `None` for a field.
+    pub fn constant(&self) -> Option<V3> {
+        match self {
+            Colour::Const(c) => Some(*c),
+            Colour::Field(_) => None,
+        }
+    }
+}
+
+impl From<V3> for Colour {
+    fn from(c: V3) -> Colour {
+        Colour::Const(c)
+    }
+}
+
 /// The colour of a material at a point.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Pattern {
-    /// One colour.
-    Solid(V3),
-    /// A 3D checkerboard of two colours with cubes of edge `size`.
-    Checker { a: V3, b: V3, size: f64 },
+    /// One colour (or colour field).
+    Solid(Colour),
+    /// A 3D checkerboard of two colours (or colour fields) with cubes of edge `size`.
+    Checker { a: Colour, b: Colour, size: f64 },
+}
+
+impl Pattern {
+    /// The pattern's colours: one, or the checker's two.
+    pub fn colours(&self) -> Vec<&Colour> {
+        match self {
+            Pattern::Solid(c) => vec![c],
+            Pattern::Checker { a, b, .. } => vec![a, b],
+        }
+    }
 }
 
 /// A Phong material (docs/rendering.md, "At a hit").
@@ -660,7 +698,7 @@ impl Material {
     pub fn default_material() -> Self {
         Material {
             name: "default".into(),
-            pattern: Pattern::Solid(Material::COLOR),
+            pattern: Pattern::Solid(Colour::Const(Material::COLOR)),
             ambient: Material::AMBIENT,
             diffuse: Material::DIFFUSE,
             specular: Material::SPECULAR,

@@ -46,7 +46,7 @@ impl Build {
     pub fn material(&mut self, color: [f64; 3], reflect: f64, transparency: f64) -> MaterialId {
         let mut m = Material::default_material();
         m.name = format!("m{}", self.scene.materials.len());
-        m.pattern = Pattern::Solid(color);
+        m.pattern = Pattern::Solid(color.into());
         m.reflect = reflect;
         m.transparency = transparency;
         self.scene.materials.push(m);

@@ -217,6 +217,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
             // As `sdfc render --frames` renders a sequence: the image alone, finished on the GPU.
             image_only: true,
             finished: true,
+            software: false,
         };
         let mut kernels = Kernels::new(&pool, (args.backend, args.devices.clone()), setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
@@ -399,6 +400,7 @@ fn time_scene(
         image_only: false,
         // The image is not kept: the GPU finishes it, and only its 8-bit pixels cross.
         finished: true,
+        software: false,
     };
     if args.backend != Backend::Cpu {
         let options = sdfc_compiler::back::wgsl::Options {

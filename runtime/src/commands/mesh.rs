@@ -86,6 +86,14 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
     let checked = frontend::load_scene_code(&args.file, DiagnosticFormat::Human, &limits)
         .map_err(|code| (code, String::new()))?;
+    // OBJ carries vertex colours only where a material's colour is a colour field.
+    let colour_fields = checked.scene.materials.iter().any(|m| {
+        m.pattern
+            .colours()
+            .iter()
+            .any(|c| matches!(c, sdfc_compiler::scene::Colour::Field(_)))
+    });
+    settings.materials |= format == Format::Obj && colour_fields;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = ProgressBar::new(1000);
         if let Ok(style) =
@@ -138,7 +146,9 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         ));
     }
     // The file's bytes are in the surface cells' share of the announcement.
-    let bytes = format.encode(&mesh, &checked.scene.materials);
+    let colours = sdfc_compiler::lower::Colours::new(&checked.scene);
+    let palette = crate::mesh::write::Palette::new(&checked.scene, &colours);
+    let bytes = format.encode(&mesh, &palette);
     crate::image::write_atomic(&args.output, &bytes)
         .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;
     eprintln!(

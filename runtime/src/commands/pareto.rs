@@ -172,6 +172,7 @@ fn measure(
         kernel: Default::default(),
         image_only: false,
         finished: false,
+        software: false,
     };
     let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
         .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
@@ -263,6 +264,7 @@ fn reference_setup(
         kernel: Default::default(),
         image_only: false,
         finished: false,
+        software: false,
     };
     let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
     Ok((reference_scene, prepared))

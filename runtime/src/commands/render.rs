@@ -360,6 +360,7 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
         finished: !args.reference
             && !args.aux
             && !matches!(&out, Output::File { format, .. } if format.linear()),
+        software: false,
     };
     let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup, opening)?;
     run.split("preparation", "the rest of it", prepared.preparation());

@@ -73,6 +73,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         image_only: true,
         // 8-bit frames take the pixels the GPU finished; OpenEXR the linear colours.
         finished: !matches!(&target, Target::Numbered(_, format) if format.linear()),
+        software: false,
     };
     let mine: Vec<u64> = shard.frames(frames).collect();
     let todo: Vec<u64> = mine

@@ -6,17 +6,26 @@ use super::analytic::Tracer;
 use super::camera::Pinhole;
 use super::vec::V3;
 use sdfc_compiler::eval::Float;
+use sdfc_compiler::lower::{ColourProgram, Colours};
 use sdfc_compiler::scene::analytic::Traceable;
-use sdfc_compiler::scene::{Light, Material, Pattern, Scene};
+use sdfc_compiler::scene::{Colour, Light, Material, Pattern, Scene};
+
+/// One colour of a material: a constant, or the colour field of this number
+/// ([`Context::colours`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Tint<T> {
+    Const(V3<T>),
+    Field(usize),
+}
 
 /// The colour of a material at a point.
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Paint<T> {
-    Solid(V3<T>),
+    Solid(Tint<T>),
     /// `shift`: [`Scene::checker_shift`].
     Checker {
-        a: V3<T>,
-        b: V3<T>,
+        a: Tint<T>,
+        b: Tint<T>,
         inv_size: T,
         shift: V3<T>,
     },
@@ -73,16 +82,30 @@ pub(super) struct Context<T: Float> {
     pub debug_nan: bool,
     /// The primitives, when the scene is ray traced analytically instead of sphere traced.
     pub analytic: Option<Tracer<T>>,
+    /// The materials' colour fields (`lower::Colours::programs`).
+    pub colours: Vec<ColourProgram>,
 }
 
 impl<T: Float> Context<T> {
     /// The context of a render of `scene`, traced analytically when `traceable` and its
     /// `method` setting say so.
-    pub fn new(scene: &Scene, traceable: &Traceable, lipschitz: f64, debug_nan: bool) -> Self {
+    pub fn new(
+        scene: &Scene,
+        traceable: &Traceable,
+        colours: &[ColourProgram],
+        lipschitz: f64,
+        debug_nan: bool,
+    ) -> Self {
         let s = &scene.settings;
-        let mut materials: Vec<Mat<T>> = scene.materials.iter().map(|m| mat(scene, m)).collect();
+        let numbers = Colours::numbers(scene);
+        let mut materials: Vec<Mat<T>> = scene
+            .materials
+            .iter()
+            .zip(&numbers)
+            .map(|(m, fields)| mat(scene, m, *fields))
+            .collect();
         if materials.is_empty() {
-            materials.push(mat(scene, &Material::default_material()));
+            materials.push(mat(scene, &Material::default_material(), [None; 2]));
         }
         let transparent = materials.iter().any(|m| m.transparency > T::zero());
         Context {
@@ -100,6 +123,7 @@ impl<T: Float> Context<T> {
             branching: branching(scene),
             debug_nan,
             analytic: traceable.traced(s.method).map(Tracer::new),
+            colours: colours.to_vec(),
         }
     }
 
@@ -143,13 +167,18 @@ pub(super) fn branching(scene: &Scene) -> usize {
         .unwrap_or(0)
 }
 
-fn mat<T: Float>(scene: &Scene, m: &Material) -> Mat<T> {
+fn mat<T: Float>(scene: &Scene, m: &Material, fields: [Option<usize>; 2]) -> Mat<T> {
     let f = T::from_f64;
+    let tint = |c: &Colour, slot: usize| match (c, fields[slot]) {
+        (Colour::Const(c), _) => Tint::Const(V3::from_f64(*c)),
+        (Colour::Field(_), Some(k)) => Tint::Field(k),
+        (Colour::Field(_), None) => Tint::Const(V3::zero()),
+    };
     let paint = match &m.pattern {
-        Pattern::Solid(c) => Paint::Solid(V3::from_f64(*c)),
+        Pattern::Solid(c) => Paint::Solid(tint(c, 0)),
         Pattern::Checker { a, b, size } => Paint::Checker {
-            a: V3::from_f64(*a),
-            b: V3::from_f64(*b),
+            a: tint(a, 0),
+            b: tint(b, 1),
             inv_size: f(1.0 / size),
             shift: V3::from_f64(scene.checker_shift(*size)),
         },

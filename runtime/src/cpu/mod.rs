@@ -94,6 +94,8 @@ pub struct Tapes {
     media: Option<Media>,
     built: OnceLock<Built>,
     traceable: Traceable,
+    /// The materials' colour fields, run at hit points.
+    colours: Vec<sdfc_compiler::lower::ColourProgram>,
 }
 
 /// The tapes of [`Tapes`], once prepared.
@@ -123,6 +125,7 @@ impl Tapes {
             media: lowered.media.clone(),
             built: OnceLock::new(),
             traceable: lowered.traceable.clone(),
+            colours: lowered.colours.programs.clone(),
         }
     }
 
@@ -132,6 +135,7 @@ impl Tapes {
             program,
             traceable,
             media,
+            colours,
             ..
         } = lowered;
         Tapes {
@@ -139,6 +143,7 @@ impl Tapes {
             media,
             built: OnceLock::new(),
             traceable,
+            colours: colours.programs,
         }
     }
 
@@ -259,6 +264,7 @@ pub fn render_in<T: Float>(
     let ctx = Context::<T>::new(
         scene,
         &tapes.traceable,
+        &tapes.colours,
         options.lipschitz,
         options.debug_nan,
     );
@@ -302,6 +308,7 @@ fn rows_in<T: Float>(
     let ctx = Context::<T>::new(
         scene,
         &tapes.traceable,
+        &tapes.colours,
         options.lipschitz,
         options.debug_nan,
     );

@@ -1,7 +1,7 @@
 //! One wave of rays: trace them, take the normal and material at each hit, light the hits
 //! (Phong with shadow rays) and spawn the next wave of reflected and refracted rays.
 
-use super::context::{Context, Lamp, Mat, Paint};
+use super::context::{Context, Lamp, Mat, Paint, Tint};
 use super::lanes::{march, Launch};
 use super::march::{Shadow, Shadowed, Status, Trace, Traced};
 use super::stats::Counters;
@@ -329,10 +329,18 @@ fn solids<T: Float>(
 
 /// The colour of a material at p. A checker is the parity of ⌊x/s⌋ + ⌊y/s⌋ + ⌊z/s⌋ (even:
 /// first colour), sampled at p - 2h·N, just inside the surface, so that a face lying on a
-/// checker boundary does not flicker between the two colours.
-fn colour<T: Float>(m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
+/// checker boundary does not flicker between the two colours; a colour field is its value
+/// at p.
+fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
+    let tint = |t: Tint<T>| match t {
+        Tint::Const(c) => c,
+        Tint::Field(k) => {
+            let [r, g, b] = ctx.colours[k].eval([hit.p.x, hit.p.y, hit.p.z]);
+            V3::new(r, g, b)
+        }
+    };
     match m.paint {
-        Paint::Solid(c) => c,
+        Paint::Solid(c) => tint(c),
         Paint::Checker {
             a,
             b,
@@ -343,11 +351,7 @@ fn colour<T: Float>(m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
             let s = q.x.floor() + q.y.floor() + q.z.floor();
             let two = T::from_f64(2.0);
             let odd = s - two * (s / two).floor();
-            if odd > T::zero() {
-                b
-            } else {
-                a
-            }
+            tint(if odd > T::zero() { b } else { a })
         }
     }
 }
@@ -459,7 +463,7 @@ fn light<T: Float>(
         if (ray.inside && !hit.solid) || local_weight(m) <= T::zero() {
             continue;
         }
-        let c = colour(m, hit);
+        let c = colour(ctx, m, hit);
         colour_at[hi] = c * m.ambient;
         for lamp in &ctx.lamps {
             if let Some((contrib, launch)) = lamp_term(ctx, lamp, hit, m, c, ray.dir) {

@@ -1,6 +1,8 @@
 //! Mesh files: binary STL and OBJ (geometry), binary PLY (with a colour per vertex, its
-//! material's) and binary glTF, `.glb` (one material per scene material the mesh uses, one
-//! primitive each, sharing the vertex positions).
+//! material's there) and binary glTF, `.glb` (one material per scene material the mesh uses,
+//! one primitive each, sharing the vertex positions). Where a material's colour is a colour
+//! field, OBJ's vertices carry their colours too (`v x y z r g b`), and the glTF primitives
+//! of such materials a `COLOR_0` per vertex.
 //!
 //! Each format is a few dozen lines written here with `std` and `serde_json`: the crates that
 //! write them would add dependencies for no less code; the tests read the files back with
@@ -8,7 +10,8 @@
 
 use super::Mesh;
 use crate::image::srgb_encode;
-use sdfc_compiler::scene::{Material, Pattern};
+use sdfc_compiler::lower::Colours;
+use sdfc_compiler::scene::{Colour, Material, Pattern, Scene, V3};
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -38,26 +41,89 @@ impl Format {
         }
     }
 
-    /// The bytes of `mesh` in this format; `materials` are the scene's (by id).
-    pub fn encode(self, mesh: &Mesh, materials: &[Material]) -> Vec<u8> {
+    /// The bytes of `mesh` in this format, coloured by `palette`.
+    pub fn encode(self, mesh: &Mesh, palette: &Palette) -> Vec<u8> {
         let mut out = Vec::new();
         // Writing to a vector cannot fail.
         let _ = match self {
             Format::Stl => stl(mesh, &mut out),
-            Format::Obj => obj(mesh, &mut out),
-            Format::Ply => ply(mesh, materials, &mut out),
-            Format::Glb => glb(mesh, materials, &mut out),
+            Format::Obj => obj(mesh, palette, &mut out),
+            Format::Ply => ply(mesh, palette, &mut out),
+            Format::Glb => glb(mesh, palette, &mut out),
         };
         out
+    }
+}
+
+/// What colours a mesh: the scene's materials (by id), their colour fields lowered, and
+/// where the scene's coordinates start in the programs' ([`Scene::origin`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Palette<'a> {
+    /// The scene's materials.
+    pub materials: &'a [Material],
+    /// Their colour fields.
+    pub colours: &'a Colours,
+    /// [`Scene::origin`].
+    pub origin: V3,
+}
+
+impl<'a> Palette<'a> {
+    /// The palette of `scene`, whose colour fields are `colours` (`Lowered::colours`).
+    pub fn new(scene: &'a Scene, colours: &'a Colours) -> Self {
+        Palette {
+            materials: &scene.materials,
+            colours,
+            origin: scene.origin,
+        }
+    }
+
+    /// Whether material `id`'s colour is or has a colour field.
+    pub fn varies(&self, id: u32) -> bool {
+        self.materials.get(id as usize).is_some_and(|m| {
+            m.pattern
+                .colours()
+                .iter()
+                .any(|c| matches!(c, Colour::Field(_)))
+        })
+    }
+
+    /// The linear colour of material `id` at `p`, in the scene's coordinates (a checker by
+    /// the parity of its cells, a colour field by its value, as the renderer paints them);
+    /// unknown ids get the default grey.
+    pub fn colour(&self, id: u32, p: [f64; 3]) -> [f64; 3] {
+        let Some(m) = self.materials.get(id as usize) else {
+            return [0.8; 3];
+        };
+        let slot = match &m.pattern {
+            Pattern::Solid(_) => 0,
+            Pattern::Checker { size, .. } => {
+                let s: f64 = p.iter().map(|x| (x / size).floor()).sum();
+                usize::from(s.rem_euclid(2.0) > 0.5)
+            }
+        };
+        match (
+            m.pattern.colours()[slot],
+            self.colours.fields.get(id as usize),
+        ) {
+            (Colour::Const(c), _) => *c,
+            (Colour::Field(_), Some(&[a, b])) => match [a, b][slot] {
+                Some(k) => {
+                    let q = [0, 1, 2].map(|i| p[i] - self.origin[i]);
+                    self.colours.programs[k].eval(q)
+                }
+                None => [0.8; 3],
+            },
+            (Colour::Field(_), None) => [0.8; 3],
+        }
     }
 }
 
 /// The bytes a mesh file takes at most, for the memory announcement.
 pub fn encoded_bytes(vertices: u64, triangles: u64) -> u64 {
     let stl = 84 + 50 * triangles;
-    let obj = 64 * vertices + 40 * triangles;
+    let obj = 96 * vertices + 40 * triangles;
     let ply = 512 + 15 * vertices + 13 * triangles;
-    let glb = 4096 + 12 * vertices + 12 * triangles;
+    let glb = 4096 + 24 * vertices + 12 * triangles;
     stl.max(obj).max(ply).max(glb)
 }
 
@@ -94,11 +160,24 @@ fn stl(mesh: &Mesh, out: &mut Vec<u8>) -> io::Result<()> {
     Ok(())
 }
 
-fn obj(mesh: &Mesh, out: &mut Vec<u8>) -> io::Result<()> {
+fn obj(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
     writeln!(out, "# written by sdfc mesh")?;
-    for p in &mesh.positions {
+    // Vertex colours (sRGB, 0 to 1) where a material's colour is a field.
+    let coloured = mesh.materials.iter().any(|&m| palette.varies(m));
+    if coloured {
+        writeln!(out, "# vertex colours: v x y z r g b, sRGB from 0 to 1")?;
+    }
+    for (i, p) in mesh.positions.iter().enumerate() {
         let [x, y, z] = f32s(*p);
-        writeln!(out, "v {x} {y} {z}")?;
+        if coloured {
+            let id = mesh.vertex_materials.get(i).copied().unwrap_or(0);
+            let [r, g, b] = palette
+                .colour(id, *p)
+                .map(|c| f32::from(srgb_encode(c as f32)) / 255.0);
+            writeln!(out, "v {x} {y} {z} {r} {g} {b}")?;
+        } else {
+            writeln!(out, "v {x} {y} {z}")?;
+        }
     }
     for t in &mesh.triangles {
         writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
@@ -106,32 +185,21 @@ fn obj(mesh: &Mesh, out: &mut Vec<u8>) -> io::Result<()> {
     Ok(())
 }
 
-/// The linear colour of a material at a point (a checker by the parity of its cells, as the
-/// renderer paints it); unknown ids get the default grey.
-pub fn colour(materials: &[Material], id: u32, p: [f64; 3]) -> [f64; 3] {
-    match materials.get(id as usize).map(|m| &m.pattern) {
-        Some(Pattern::Solid(c)) => *c,
-        Some(Pattern::Checker { a, b, size }) => {
-            let s: f64 = p.iter().map(|x| (x / size).floor()).sum();
-            if s.rem_euclid(2.0) > 0.5 {
-                *b
-            } else {
-                *a
-            }
-        }
-        None => [0.8; 3],
-    }
-}
-
-/// The one colour glTF gives a material: its colour, or the mean of a checker's two.
+/// The one colour glTF gives a material: its colour, or the mean of a checker's two; white
+/// for a colour field, whose colours are the vertices' (`COLOR_0`, which glTF multiplies by
+/// it).
 fn base_colour(m: &Material) -> [f64; 3] {
+    let c = |c: &Colour| c.constant().unwrap_or([1.0; 3]);
     match &m.pattern {
-        Pattern::Solid(c) => *c,
-        Pattern::Checker { a, b, .. } => [0, 1, 2].map(|i| 0.5 * (a[i] + b[i])),
+        Pattern::Solid(a) => c(a),
+        Pattern::Checker { a, b, .. } => {
+            let (a, b) = (c(a), c(b));
+            [0, 1, 2].map(|i| 0.5 * (a[i] + b[i]))
+        }
     }
 }
 
-fn ply(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()> {
+fn ply(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
     write!(
         out,
         "ply\nformat binary_little_endian 1.0\ncomment written by sdfc mesh; colours are \
@@ -146,7 +214,7 @@ fn ply(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()>
             out.write_all(&x.to_le_bytes())?;
         }
         let id = mesh.vertex_materials.get(i).copied().unwrap_or(0);
-        let c = colour(materials, id, *p);
+        let c = palette.colour(id, *p);
         out.write_all(&c.map(|x| srgb_encode(x as f32)))?;
     }
     for t in &mesh.triangles {
@@ -158,7 +226,8 @@ fn ply(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()>
     Ok(())
 }
 
-fn glb(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()> {
+fn glb(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
+    let materials = palette.materials;
     use serde_json::json;
     let mut bin: Vec<u8> = Vec::new();
     let mut lo = [f32::INFINITY; 3];
@@ -179,6 +248,21 @@ fn glb(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()>
     let mut used: Vec<u32> = mesh.materials.clone();
     used.sort_unstable();
     used.dedup();
+    // The linear colour of every vertex, where a material the mesh uses is a colour field.
+    let colours = used.iter().any(|&m| palette.varies(m)).then(|| {
+        let start = bin.len();
+        for (i, p) in mesh.positions.iter().enumerate() {
+            let id = mesh.vertex_materials.get(i).copied().unwrap_or(0);
+            for c in palette.colour(id, *p) {
+                bin.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+        }
+        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": 34962}));
+        accessors.push(json!({
+            "bufferView": views.len() - 1, "componentType": 5126, "count": mesh.positions.len(), "type": "VEC3"
+        }));
+        accessors.len() - 1
+    });
     let mut primitives = Vec::new();
     let mut mats = Vec::new();
     for (k, &id) in used.iter().enumerate() {
@@ -194,11 +278,15 @@ fn glb(mesh: &Mesh, materials: &[Material], out: &mut Vec<u8>) -> io::Result<()>
         }
         views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": 34963}));
         accessors.push(json!({
-            "bufferView": k + 1, "componentType": 5125, "count": count, "type": "SCALAR"
+            "bufferView": views.len() - 1, "componentType": 5125, "count": count, "type": "SCALAR"
         }));
-        primitives.push(
-            json!({"attributes": {"POSITION": 0}, "indices": k + 1, "material": k, "mode": 4}),
-        );
+        let attributes = match colours {
+            Some(c) if palette.varies(id) => json!({"POSITION": 0, "COLOR_0": c}),
+            _ => json!({"POSITION": 0}),
+        };
+        primitives.push(json!({
+            "attributes": attributes, "indices": accessors.len() - 1, "material": k, "mode": 4
+        }));
         let (name, c) = match materials.get(id as usize) {
             Some(m) => (m.name.clone(), base_colour(m)),
             None => (format!("material {id}"), [0.8; 3]),

@@ -85,7 +85,7 @@ pub struct Contract {
 
 /// The features that follow from the scene and its settings alone (the first ones of
 /// [`Contract::features`]): those a render checks.
-pub(super) const SCENE_FEATURES: usize = 10;
+pub(super) const SCENE_FEATURES: usize = 11;
 
 /// A scene that a kernel cannot render, or a uniform that does not fit its layout: what
 /// differs, in words.

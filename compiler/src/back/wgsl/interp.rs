@@ -9,12 +9,13 @@
 //!
 //! ```text
 //! [0]       the first word of map, sdf, sdf_medium, map_solid
-//! [1]       the first word of sdf_solid, 0, 0, 0
+//! [1]       the first word of sdf_solid, of the colour fields' table, 0, 0
 //! [2 ..]    the programs, one instruction a word:
 //!           x: opcode (bits 0-7) | operand k read from a register (bit 8 + k) | destination
 //!              register (bits 11-23)
 //!           y, z, w: the operands: a register's number, an immediate f32 (a constant of the
 //!              program), or a word index (a block's end)
+//! [table ..] the first word of each colour field's program, four a word
 //!
 //! Every integer (word indices, the fields of x, registers) is held as the f32 of its value,
 //! exact below 2^24, and read with `u32(…)`: held as its bits, a small integer would be a
@@ -22,7 +23,8 @@
 //! ```
 //!
 //! Each program is its live instructions in order, constants folded into the operands that
-//! read them, and ends with `RETURN` (distance, material). A guarded block is a `COPY` of
+//! read them, and ends with `RETURN` (distance, material; or a colour field's red, green and
+//! blue). A guarded block is a `COPY` of
 //! each needed result's value from before it, `BLOCK` (which jumps past the block where
 //! `bound >= best`, as the code's `if !(bound >= best)`), its instructions, and a `COPY` of
 //! each result's value inside it. Registers are allocated by a linear scan over that order,
@@ -161,10 +163,11 @@ fn linear(program: &Program, roots: &[Reg]) -> Vec<Ins> {
         }
     }
     let material = roots.get(1).map_or(Arg::Imm(0.0), |&m| arg(m));
+    let third = roots.get(2).map_or(Arg::None, |&m| arg(m));
     out.push(Ins {
         op: RETURN,
         dest: None,
-        args: [arg(roots[0]), material, Arg::None],
+        args: [arg(roots[0]), material, third],
     });
     out
 }
@@ -275,6 +278,8 @@ pub(super) struct Programs<'a> {
     pub main: &'a Program,
     /// The media's (`sdf_medium`, and `map_solid`, `sdf_solid`), for glass over solids.
     pub media: Option<(&'a Program, &'a Program)>,
+    /// The materials' colour fields (`colour_field`), each returning red, green and blue.
+    pub colours: &'a [crate::lower::ColourProgram],
 }
 
 /// The bytes of `scene_data` holding `programs` for a file of `file` registers, or why they
@@ -291,12 +296,21 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
         lists.push((map(solid), solid.len()));
         lists.push((sdf(solid), solid.len()));
     }
+    let fixed = lists.len();
+    for c in programs.colours {
+        lists.push((linear(&c.program, &c.rgb), c.program.len()));
+    }
     let mut starts = [0u32; 8];
+    let mut colour_starts = Vec::with_capacity(programs.colours.len());
     let mut body: Vec<[u32; 4]> = Vec::new();
     let mut needed = 0;
     for (k, (list, len)) in lists.iter().enumerate() {
         let base = (HEADER + body.len()) as u32;
-        starts[k] = base;
+        if k < fixed {
+            starts[k] = base;
+        } else {
+            colour_starts.push(base);
+        }
         let (mut words, used) = allocate(list, *len);
         needed = needed.max(used);
         for (w, i) in words.iter_mut().zip(list) {
@@ -309,14 +323,18 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
         }
         body.extend(words);
     }
+    // The colour fields' table: their first words, four a word.
+    starts[5] = (HEADER + body.len()) as u32;
+    let table_words = colour_starts.len().div_ceil(4);
     if needed > file {
         return Err(Unfit::Registers(needed, file));
     }
-    if HEADER + body.len() > 1 << 24 {
+    let words = HEADER + body.len() + table_words;
+    if words > 1 << 24 {
         // Word indices are written as f32 (exact below 2^24).
-        return Err(Unfit::Words(HEADER + body.len()));
+        return Err(Unfit::Words(words));
     }
-    let bytes = (HEADER + body.len()) * 16;
+    let bytes = words * 16;
     if bytes as u64 > max_mib.saturating_mul(1 << 20) {
         return Err(Unfit::Bytes(bytes, max_mib));
     }
@@ -340,20 +358,35 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
             out.extend_from_slice(&f.to_le_bytes());
         }
     }
+    for k in 0..table_words * 4 {
+        let start = colour_starts.get(k).copied().unwrap_or(0);
+        out.extend_from_slice(&int(start).to_le_bytes());
+    }
     Ok(out)
 }
 
-/// Instructions interpreted per iteration of the interpreter's loop. Mesa's llvmpipe (and so
+/// Instructions interpreted per iteration of the interpreter's loop on a GPU
+/// (`Options::interp_unroll`): a small kernel, quick for the drivers to compile.
+pub const UNROLL: usize = 8;
+
+/// Instructions interpreted per iteration on a software adapter. Mesa's llvmpipe (and so
 /// lavapipe, on which the tests render) ends every loop of a shader once the loops together
-/// have iterated 65 535 times (`LP_MAX_TGSI_LOOP_ITERATIONS`, shared by all the loops of an
-/// invocation's SIMD group): one instruction an iteration, examples/lattice.sdf ran out of it
-/// and rendered wrong pixels. Eight an iteration lift the bound to about half a million
-/// instructions per pixel and keep the kernel small.
-const UNROLL: usize = 8;
+/// have iterated 65 535 times (`LP_MAX_TGSI_LOOP_ITERATIONS`, one count shared by all the
+/// loops of an invocation's SIMD group): the program's every evaluation, on the camera ray,
+/// for the normal and on every shadow ray, spends its length over the unroll of that
+/// budget, and once it is spent each loop stops after one pass, so the distances are wrong
+/// from there on. One instruction an iteration, examples/lattice.sdf ran out of it; eight
+/// (the GPU's [`UNROLL`], about half a million instructions per pixel) were not enough for
+/// a field of three noises (about 1 300 instructions a distance, a pixel's hundreds of
+/// evaluations: 26 dB against the CPU at 48×32); 32 lift the bound to two million, and
+/// rendered it as the specialised kernel does (68 dB, 2026-11-27). Each doubling doubles
+/// the kernel's compile on lavapipe (0.46 s at 8, 1.6 s at 32).
+pub const UNROLL_SOFTWARE: usize = 32;
 
 /// The WGSL text of the interpreter and of the distance functions the kernel calls, for a
-/// file of `file` registers; with `media`, also those of glass over solids.
-pub(super) fn write(file: usize, media: bool) -> String {
+/// file of `file` registers, running `unroll` instructions an iteration of its loop; with
+/// `media`, also those of glass over solids.
+pub(super) fn write(file: usize, media: bool, unroll: usize) -> String {
     let last = file; // the scratch register
     let mut out = String::new();
     let _ = writeln!(
@@ -362,7 +395,7 @@ pub(super) fn write(file: usize, media: bool) -> String {
          // one instruction a word (opcode, operands from registers or immediate, destination).\n\
          var<private> interp_regs: array<f32, {}>;\n\
          // The values of the last program's RETURN.\n\
-         var<private> interp_result: vec2<f32>;\n\
+         var<private> interp_result: vec3<f32>;\n\
          const INTERP_DONE: u32 = 0xffffffffu;\n",
         file + 1
     );
@@ -376,7 +409,7 @@ pub(super) fn write(file: usize, media: bool) -> String {
          if (h & 0x200u) != 0u {{\n        b = interp_regs[min(u32(w.z), {last}u)];\n    }}\n    \
          if (h & 0x400u) != 0u {{\n        c = interp_regs[min(u32(w.w), {last}u)];\n    }}\n    \
          let op = h & 0xffu;\n    \
-         if op == {RETURN}u {{\n        interp_result = vec2<f32>(a, b);\n        return INTERP_DONE;\n    }}\n    \
+         if op == {RETURN}u {{\n        interp_result = vec3<f32>(a, b, c);\n        return INTERP_DONE;\n    }}\n    \
          var v = 0.0;\n    var next = pc + 1u;\n    switch op {{"
     );
     let case = |out: &mut String, op: u32, body: &str| {
@@ -432,16 +465,16 @@ pub(super) fn write(file: usize, media: bool) -> String {
     );
     let _ = writeln!(
         out,
-        "// Runs the program that starts at `start` at p: (distance, material id).\n\
-         fn interpret(p: vec3<f32>, start: u32) -> vec2<f32> {{\n    var pc = start;\n    loop {{"
+        "// Runs the program that starts at `start` at p: (distance, material id, 0), or a colour.\n\
+         fn interpret(p: vec3<f32>, start: u32) -> vec3<f32> {{\n    var pc = start;\n    loop {{"
     );
-    for _ in 0..UNROLL {
+    for _ in 0..unroll.max(1) {
         out.push_str("        pc = interp_step(p, pc);\n        if pc == INTERP_DONE {\n            break;\n        }\n");
     }
     out.push_str("    }\n    return interp_result;\n}\n\n");
     let entry = |out: &mut String, name: &str, slot: &str, material: bool| {
         let (ty, tail) = if material {
-            ("vec2<f32>", "")
+            ("vec2<f32>", ".xy")
         } else {
             ("f32", ".x")
         };
@@ -462,6 +495,17 @@ pub(super) fn write(file: usize, media: bool) -> String {
     out
 }
 
+/// The WGSL text of `colour_field(k, p)` in the interpreted kernel: colour field `k`'s
+/// program, found in the table of `scene_data`, run at p. The text does not depend on the
+/// fields.
+pub(super) fn write_colours() -> String {
+    "// The colour of colour field k at p, interpreted from `scene_data`.\n\
+     fn colour_field(k: u32, p: vec3<f32>) -> vec3<f32> {\n    \
+     let at = u32(scene_data[1].y) + k / 4u;\n    \
+     return interpret(p, u32(scene_data[at][k % 4u]));\n}"
+        .to_string()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -469,6 +513,12 @@ mod tests {
 
     /// Runs the words as the kernel does, on the CPU, in f32.
     fn run(words: &[u32], start: u32, p: [f32; 3], file: usize) -> [f32; 2] {
+        let [a, b, _] = run3(words, start, p, file);
+        [a, b]
+    }
+
+    /// [`run`], with the third value of `RETURN` (a colour's blue).
+    fn run3(words: &[u32], start: u32, p: [f32; 3], file: usize) -> [f32; 3] {
         let mut regs = vec![0f32; file + 1];
         let mut pc = start as usize;
         loop {
@@ -486,7 +536,7 @@ mod tests {
             let mut next = pc + 1;
             let op = h & 0xff;
             let v = match op {
-                RETURN => return [a, b],
+                RETURN => return [a, b, c],
                 1..=3 => p[(op - 1) as usize],
                 COPY => a,
                 BLOCK => {
@@ -531,6 +581,7 @@ mod tests {
             &Programs {
                 main: program,
                 media: None,
+                colours: &[],
             },
             file,
             128,
@@ -568,10 +619,61 @@ mod tests {
             &Programs {
                 main: program,
                 media: None,
+                colours: &[],
             },
             needed - 1,
             128,
         );
         assert_eq!(small, Err(Unfit::Registers(needed, needed - 1)));
+    }
+
+    /// The colour fields' programs, encoded after the distance programs and found through
+    /// their table, run as their reference (`ColourProgram::eval`), bit for bit.
+    #[test]
+    fn encoded_colour_fields_run_as_the_reference() {
+        let text = "material a = phong { color: field { vec3(0.5 + 0.5 * sin(4 * p.x), 0.3, fbm(p * 2, octaves: 2)) } };\n\
+            material b = checker { a: field { vec3(0.2) * p.y }, b: field { vec3(voronoi(p * 3), 0.5, 0.5) } };\n\
+            material c = phong { color: field { (1, 0.5, 0.25) } };\n\
+            scene { sphere(1) @ a; box(0.5).translate(2, 0, 0) @ b; sphere(0.5).translate(0, 2, 0) @ c; }";
+        let (scene, diags, _) = crate::check::check_str("t.sdf", text);
+        let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+        let lowered = Lowered::new(&scene);
+        let colours = &lowered.colours;
+        assert_eq!(colours.programs.len(), 4);
+        assert_eq!(
+            colours.fields[1..],
+            [[Some(0), None], [Some(1), Some(2)], [Some(3), None]]
+        );
+        let file = 64;
+        let bytes = encode(
+            &Programs {
+                main: &lowered.program,
+                media: None,
+                colours: &colours.programs,
+            },
+            file,
+            128,
+        )
+        .expect("fits");
+        let words: Vec<u32> = bytes
+            .chunks(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        let int = |k: usize| f32::from_bits(words[k]) as u32;
+        let table = int(5) as usize;
+        let mut rng = crate::rng::Rng::new(11);
+        for _ in 0..2_000 {
+            let p = [0; 3].map(|_| rng.range(-3.0, 3.0) as f32);
+            for (k, c) in colours.programs.iter().enumerate() {
+                let start = int(4 * (table + k / 4) + k % 4);
+                let got = run3(&words, start, p, file);
+                let want = c.eval::<f32>(p);
+                assert_eq!(
+                    got.map(f32::to_bits),
+                    want.map(f32::to_bits),
+                    "{k} at {p:?}"
+                );
+            }
+        }
     }
 }

@@ -21,8 +21,8 @@ struct Material {
     color: vec4<f32>,   // rgb, w: 1 for a checker pattern
     color_b: vec4<f32>, // checker's second colour, w: 1 / checker size
     phong: vec4<f32>,   // ambient, diffuse, specular, shininess
-    optics: vec4<f32>,  // reflect, transparency, ior, unused
-    shift: vec4<f32>,   // checker: the pattern's offset at the scene's origin, in cells
+    optics: vec4<f32>,  // reflect, transparency, ior, colour field of color (k + 1; 0: none)
+    shift: vec4<f32>,   // checker: the pattern's offset at the scene's origin, in cells; w: colour field of color_b
 }
 struct Params {
     eye: vec4<f32>,        // camera position
@@ -263,8 +263,29 @@ var<private> medium_tau: f32 = 0.0;
 //#endif
 //#endif
 
-// The colour of material m at p (checker: parity of the cell, sampled just inside).
+//#if COLOUR_FIELDS
+{{COLOURS}}
+//#endif
+// The colour of material m at p (checker: parity of the cell, sampled just inside; a colour
+// field: its value at p).
 fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> {
+//#if COLOUR_FIELDS
+    var c = m.color.xyz;
+    var field = m.optics.w;
+//#if CHECKER
+    if m.color.w > 0.0 {
+        let q = (p - n * (2.0 * h)) * m.color_b.w + m.shift.xyz;
+        let s = floor(q.x) + floor(q.y) + floor(q.z);
+        let odd = s - 2.0 * floor(s / 2.0);
+        c = select(m.color.xyz, m.color_b.xyz, odd > 0.0);
+        field = select(m.optics.w, m.shift.w, odd > 0.0);
+    }
+//#endif
+    if field > 0.0 {
+        c = colour_field(u32(field) - 1u, p);
+    }
+    return c;
+//#else
 //#if CHECKER
     if m.color.w > 0.0 {
         let q = (p - n * (2.0 * h)) * m.color_b.w + m.shift.xyz;
@@ -274,6 +295,7 @@ fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> 
     }
 //#endif
     return m.color.xyz;
+//#endif
 }
 
 //#if !ANALYTIC

@@ -111,6 +111,43 @@ pub(super) fn write_sdf_with(program: &Program, name: &str, params: Option<&Para
     out
 }
 
+/// The WGSL functions of the materials' colour fields (`lower::Colours`): `colour_fieldK(p)`
+/// for each, written as `map` is, and `colour_field(k, p)`, field `k`'s colour at p (each
+/// name after `prefix`).
+pub(super) fn write_colours(colours: &[crate::lower::ColourProgram], prefix: &str) -> String {
+    let mut out = String::new();
+    for (k, c) in colours.iter().enumerate() {
+        let name = format!("{prefix}colour_field{k}");
+        let mut w = Writer::new(&c.program, &c.rgb, true, &name, None);
+        let mut body = String::new();
+        w.emit(0, w.items.len(), 1, &mut body);
+        let rgb = c.rgb.map(|r| w.names.get(r, None));
+        out.push_str(&std::mem::take(&mut w.functions));
+        let _ = writeln!(
+            out,
+            "// Colour field {k}: (red, green, blue) at p.\nfn {name}(p: vec3<f32>) -> vec3<f32> {{"
+        );
+        out.push_str(&body);
+        let _ = writeln!(
+            out,
+            "    return vec3<f32>({}, {}, {});\n}}",
+            rgb[0], rgb[1], rgb[2]
+        );
+    }
+    let _ = writeln!(
+        out,
+        "// The colour of colour field k at p.\nfn {prefix}colour_field(k: u32, p: vec3<f32>) -> vec3<f32> {{\n    switch k {{"
+    );
+    for k in 0..colours.len() {
+        let _ = writeln!(
+            out,
+            "        case {k}u: {{\n            return {prefix}colour_field{k}(p);\n        }}"
+        );
+    }
+    out.push_str("        default: {}\n    }\n    return vec3<f32>(0.0);\n}");
+    out
+}
+
 /// The WGSL function `fn name(p: vec3<f32>, s: vec4<f32>) -> f32` of a primitive's distance
 /// (`lower::ShapeProgram`): the program's distance, each of its constants that is a slot read
 /// as `scale · s[slot]` (`s.x`, `(-s.x)`, `(2.0 * s.y)`), the others written as literals.

@@ -29,7 +29,7 @@ pub use contract::{Contract, Field, Mismatch, Shape, Specialisation, Uniform, Un
 pub use map::{float, write_map, write_sdf};
 
 use crate::lower::Lowered;
-use crate::scene::{Light, Pattern, Scene};
+use crate::scene::{Colour, Light, Pattern, Scene};
 use glam::DVec3;
 use std::collections::HashMap;
 use std::fmt;
@@ -143,6 +143,15 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
         ("SECONDARY", secondary),
         ("MATERIALS", mats.len() > 1),
         ("RELAX", !traced && scene.settings.relaxation > 1.0),
+        (
+            "COLOUR_FIELDS",
+            mats.iter().any(|m| {
+                m.pattern
+                    .colours()
+                    .iter()
+                    .any(|c| matches!(c, Colour::Field(_)))
+            }),
+        ),
     ]
 }
 
@@ -178,6 +187,10 @@ pub struct Options {
     /// specialised kernel), or interpreted from `scene_data` (interp.rs), or the one of the two
     /// [`choose`] expects to be ready and render sooner.
     pub kernel: KernelChoice,
+    /// Instructions the interpreted kernel runs an iteration of its loop: [`interp::UNROLL`]
+    /// for a GPU, [`interp::UNROLL_SOFTWARE`] for a software adapter, whose loops share a
+    /// budget of iterations.
+    pub interp_unroll: usize,
 }
 
 impl Default for Options {
@@ -188,6 +201,7 @@ impl Default for Options {
             max_instances: MAX_INSTANCES,
             parameters: false,
             kernel: KernelChoice::Specialised,
+            interp_unroll: interp::UNROLL,
         }
     }
 }
@@ -312,6 +326,7 @@ fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, String> {
     let programs = interp::Programs {
         main: &lowered.program,
         media: media.map(|m| (&m.medium, &m.solid)),
+        colours: &lowered.colours.programs,
     };
     let file = scene.limits.count(Limit::Registers);
     let mib = scene.limits.get(Limit::SceneData);
@@ -431,7 +446,7 @@ fn write_template(
             media = media_of(scene, lowered).is_some();
             interprets = true;
             let file = scene.limits.count(crate::limits::Limit::Registers);
-            values.insert("MAP", interp::write(file, media));
+            values.insert("MAP", interp::write(file, media, options.interp_unroll));
             Some(bytes)
         }
         None => {
@@ -466,6 +481,15 @@ fn write_template(
             bytes
         }
     };
+    if on["COLOUR_FIELDS"] {
+        let colours = &lowered.colours.programs;
+        let text = if interprets {
+            interp::write_colours()
+        } else {
+            map::write_colours(colours, "")
+        };
+        values.insert("COLOURS", text);
+    }
     // The kernel's own features, after the scene's; the header lists them only when on, so
     // that the kernels without them do not change.
     features.extend([
@@ -612,6 +636,7 @@ fn node_of_line(source: &str, n: usize, scene: &Scene) -> Option<crate::Span> {
 /// lags the template).
 pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u8>, Mismatch> {
     let mut w = layout.writer();
+    let colours = crate::lower::Colours::numbers(scene);
     let cam = &scene.camera;
     let s = &scene.settings;
     let (fwd, u, v) = cam.basis();
@@ -674,11 +699,20 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
         }
     }
     for (k, m) in scene.materials.iter().enumerate() {
+        // A colour field's colour is its program's (the constant is unused).
+        let v = |c: &Colour| c.constant().unwrap_or([0.0; 3]);
         let (a, b, checker, inv, shift) = match &m.pattern {
-            Pattern::Solid(c) => (*c, [0.0; 3], 0.0, 0.0, [0.0; 3]),
+            Pattern::Solid(c) => (v(c), [0.0; 3], 0.0, 0.0, [0.0; 3]),
             Pattern::Checker { a, b, size } => {
-                (*a, *b, 1.0, 1.0 / size, scene.checker_shift(*size))
+                (v(a), v(b), 1.0, 1.0 / size, scene.checker_shift(*size))
             }
+        };
+        // The colour fields' numbers, plus 1 (0: none).
+        let field = |slot: usize| {
+            colours
+                .get(k)
+                .and_then(|f| f[slot])
+                .map_or(0.0, |i| i as f64 + 1.0)
         };
         let at = |member: &str| format!("materials[{k}].{member}");
         w.floats(&at("color"), &v4(a, checker))?;
@@ -689,9 +723,9 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
         )?;
         w.floats(
             &at("optics"),
-            &[m.reflect, m.transparency, m.ior.max(1e-6), 0.0],
+            &[m.reflect, m.transparency, m.ior.max(1e-6), field(0)],
         )?;
-        w.floats(&at("shift"), &v4(shift, 0.0))?;
+        w.floats(&at("shift"), &v4(shift, field(1)))?;
     }
     for (k, t) in srgb::thresholds().chunks_exact(4).enumerate() {
         let t: Vec<f64> = t.iter().map(|&x| f64::from(x)).collect();

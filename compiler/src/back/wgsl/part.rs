@@ -6,7 +6,7 @@
 
 use super::{map, validate, Error};
 use crate::lower::Lowered;
-use crate::scene::{Pattern, Scene};
+use crate::scene::{Colour, Pattern, Scene};
 use std::fmt::Write;
 
 /// The default NAME of the part.
@@ -88,15 +88,28 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
             map::float(v[2])
         )
     };
+    let fields = &lowered.colours.fields;
     for (id, m) in scene.materials.iter().enumerate() {
+        // A colour field's colour is written as zero, and named in the comment.
+        let v = |c: &Colour| c.constant().unwrap_or([0.0; 3]);
         let (a, b, size, shift) = match &m.pattern {
-            Pattern::Solid(c) => (*c, [0.0; 3], 0.0, [0.0; 3]),
-            Pattern::Checker { a, b, size } => (*a, *b, *size, scene.checker_shift(*size)),
+            Pattern::Solid(c) => (v(c), [0.0; 3], 0.0, [0.0; 3]),
+            Pattern::Checker { a, b, size } => (v(a), v(b), *size, scene.checker_shift(*size)),
         };
+        let painted: Vec<String> = fields
+            .get(id)
+            .into_iter()
+            .flat_map(|f| f.iter().enumerate())
+            .filter_map(|(slot, k)| {
+                let member = ["color", "color_b"][slot];
+                k.map(|k| format!(" ({member}: {name}_colour_field({k}u, p))"))
+            })
+            .collect();
         let _ = writeln!(
             out,
-            "    // {id}: {}\n    {name}_Material({}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}),",
+            "    // {id}: {}{}\n    {name}_Material({}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}),",
             m.name,
+            painted.concat(),
             v3(a),
             v3(b),
             map::float(size),
@@ -114,6 +127,14 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
     out.push_str(&map::write_map_named(program, name));
     out.push('\n');
     out.push_str(&map::write_sdf_named(program, &format!("{name}_distance")));
+    if !lowered.colours.is_empty() {
+        out.push('\n');
+        out.push_str(&map::write_colours(
+            &lowered.colours.programs,
+            &format!("{name}_"),
+        ));
+        out.push('\n');
+    }
     out
 }
 

@@ -438,6 +438,18 @@ fn a_list_of_shapes_as_a_scene_statement_suggests_union() {
 /// terms and a chain of 1 001 method calls are not nesting.
 #[test]
 fn nesting_counts_brackets_and_not_flat_chains() {
+    // A thousand levels fit the test thread's 2 MiB in a release build, not in a debug build
+    // (unoptimised frames are several times larger): the body runs on a thread whose stack
+    // fits either. runtime/tests' robustness suite holds release builds to 2 MiB.
+    std::thread::Builder::new()
+        .stack_size(64 << 20)
+        .spawn(nesting_counts_brackets_and_not_flat_chains_body)
+        .expect("a test thread")
+        .join()
+        .expect("the test passes");
+}
+
+fn nesting_counts_brackets_and_not_flat_chains_body() {
     use crate::Limits;
     let n = 1_000_000;
     let src = format!(

@@ -19,6 +19,9 @@ pub struct Structure {
     blocks: Vec<Block>,
     distance: Reg,
     material: Reg,
+    /// The outlines the program reads as data, compared whole: a frame whose text changes
+    /// has new data, so another structure.
+    outlines: Vec<std::sync::Arc<crate::program::outline::Outline>>,
     /// Whether the scene is ray traced analytically, and how many primitives it has.
     traced: Option<usize>,
     specialisation: Specialisation,
@@ -56,6 +59,7 @@ impl Structure {
                 Op::Select(c, x, y) => Some(Op::Select(r(c), r(x), r(y))),
                 Op::Phi(x, y) => Some(Op::Phi(r(x), r(y))),
                 Op::Mesh(m, x, y, z) => Some(Op::Mesh(m, r(x), r(y), r(z))),
+                Op::Outline(k, x, y) => Some(Op::Outline(k, r(x), r(y))),
             })
             .collect();
         // A block's range, in instructions that are not constants.
@@ -85,6 +89,7 @@ impl Structure {
             blocks,
             distance: r(program.distance()),
             material: r(program.material()),
+            outlines: program.outlines().to_vec(),
             traced,
             specialisation: Specialisation::of(&scene.settings),
         }

@@ -21,6 +21,8 @@ pub fn op_cost(op: &Op) -> f64 {
         Op::Const(_) | Op::Input(_) => 0.0,
         Op::Unary(u, _) => unary_cost(*u),
         Op::Binary(b, _, _) => binary_cost(*b),
+        // A text's outline: a loop over its data, counted as one glyph's worth of curves.
+        Op::Outline(..) => 40.0 * (INVERSE_TRIG + 3.0 * TRANSCENDENTAL),
         _ => 1.0,
     }
 }

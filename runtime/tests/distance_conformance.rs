@@ -620,6 +620,7 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "polygon",
         "arc",
         "bezier",
+        "text",
         "extrude",
         "revolve",
         "loft",
@@ -653,7 +654,7 @@ fn the_feature_scenes_cover_every_node_and_operation() {
     let all_ops = [
         "const", "input", "neg", "abs", "sqrt", "sin", "cos", "acos", "exp", "log", "floor",
         "round", "add", "sub", "mul", "div", "min", "max", "pow", "atan2", "lt", "select", "phi",
-        "mesh",
+        "mesh", "outline",
     ];
     let missing: Vec<_> = all_ops.iter().filter(|o| !ops.contains(*o)).collect();
     assert!(
@@ -714,6 +715,7 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Polygon { .. } => "polygon",
         Node::Arc { .. } => "arc",
         Node::Bezier { .. } => "bezier",
+        Node::Text { .. } => "text",
         Node::Extrude { .. } => "extrude",
         Node::Revolve { .. } => "revolve",
         Node::Mesh { .. } => "mesh",
@@ -753,5 +755,6 @@ fn op_kind(op: &Op) -> &'static str {
         Op::Select(..) => "select",
         Op::Phi(..) => "phi",
         Op::Mesh(..) => "mesh",
+        Op::Outline(..) => "outline",
     }
 }

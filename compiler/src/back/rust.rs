@@ -28,19 +28,22 @@ pub fn write_named(program: &Program, name: &str) -> String {
     out.push_str(
         "// lt gives 1.0 or 0.0, and select picks its second operand where the first is not 0.\n\n",
     );
-    function(&mut out, program, name, "glam::Vec3", "f32");
+    outlines(&mut out, program, name);
+    function(&mut out, program, name, name, "glam::Vec3", "f32");
     out.push('\n');
     function(
         &mut out,
         program,
         &format!("{name}_f64"),
+        name,
         "glam::DVec3",
         "f64",
     );
     out
 }
 
-fn function(out: &mut String, program: &Program, name: &str, vec: &str, ty: &str) {
+/// The function `name` over `vec` and `ty`; `base` names the outline data and functions.
+fn function(out: &mut String, program: &Program, name: &str, base: &str, vec: &str, ty: &str) {
     let _ = writeln!(
         out,
         "/// The signed distance and the material id at `p` ({ty})."
@@ -59,7 +62,12 @@ fn function(out: &mut String, program: &Program, name: &str, vec: &str, ty: &str
                     let _ = writeln!(out, "{}// {}", pad(depth), n.text);
                 }
                 let op = &program.ops()[i];
-                let _ = writeln!(out, "{}let r{i}: {ty} = {};", pad(depth), expr(op, ty));
+                let _ = writeln!(
+                    out,
+                    "{}let r{i}: {ty} = {};",
+                    pad(depth),
+                    expr(op, ty, base)
+                );
             }
             Item::Op(_) => {}
             Item::Open(b) => {
@@ -97,8 +105,155 @@ fn r(x: Reg) -> String {
     format!("r{}", x.0)
 }
 
+/// The outlines of text `program` reads, as `static` data, and the function that evaluates
+/// them (as `program/outline.rs` does, operation for operation), named after `name`.
+fn outlines(out: &mut String, program: &Program, name: &str) {
+    if program.outlines().is_empty() {
+        return;
+    }
+    for (k, o) in program.outlines().iter().enumerate() {
+        let mut words: Vec<f64> = vec![o.glyphs.len() as f64];
+        for g in &o.glyphs {
+            words.extend([g.lo[0], g.lo[1], g.hi[0], g.hi[1], g.segments.len() as f64]);
+            for s in &g.segments {
+                let line = if s.line { 1.0 } else { 0.0 };
+                words.extend([s.a[0], s.a[1], s.b[0], s.b[1], s.c[0], s.c[1], line]);
+            }
+        }
+        let text: Vec<String> = words.iter().map(|w| format!("{w:?}")).collect();
+        let _ = writeln!(
+            out,
+            "/// Outline {k} of a text: its number of glyphs; per glyph its box (lo.x, lo.y, hi.x, hi.y) and\n\
+             /// number of segments, then per segment a.x, a.y, b.x, b.y, c.x, c.y, and 1 for a line.\n\
+             static {}_OUTLINE_{k}: &[f64] = &[{}];\n",
+            name.to_uppercase(),
+            text.join(", ")
+        );
+    }
+    let _ = writeln!(out, "{}", OUTLINE_MACRO.replace("NAME", name));
+}
+
+/// The outline function of the emitted Rust, for f32 and f64: `program/outline.rs`'s
+/// `distance` over the flat data [`outlines`] writes.
+const OUTLINE_MACRO: &str = r#"macro_rules! NAME_outline_fn {
+    ($f:ident, $t:ty) => {
+        /// The signed distance at (x, y) to an outline of text (sdfc's program/outline.rs).
+        #[allow(clippy::all)]
+        fn $f(o: &[f64], x: $t, y: $t) -> $t {
+            let mn = |a: $t, b: $t| if a < b { a } else { b };
+            let mx = |a: $t, b: $t| if a > b { a } else { b };
+            let cl = |v: $t, lo: $t, hi: $t| mn(mx(v, lo), hi);
+            let v = |i: usize| o[i] as $t;
+            let (zero, one, two, three, four): ($t, $t, $t, $t, $t) = (0.0, 1.0, 2.0, 3.0, 4.0);
+            let mut best = 3.0e38_f64 as $t;
+            let mut wind: i32 = 0;
+            let mut i = 1;
+            for _ in 0..o[0] as usize {
+                let next = i + 5 + 7 * o[i + 4] as usize;
+                let dx = mx(mx(v(i) - x, x - v(i + 2)), zero);
+                let dy = mx(mx(v(i + 1) - y, y - v(i + 3)), zero);
+                let gap = dx * dx + dy * dy;
+                if gap > zero && gap >= best {
+                    i = next;
+                    continue;
+                }
+                let mut s = i + 5;
+                while s < next {
+                    let (a0, a1, b0, b1, c0, c1) = (v(s), v(s + 1), v(s + 2), v(s + 3), v(s + 4), v(s + 5));
+                    if o[s + 6] != 0.0 {
+                        let (ex, ey) = (c0 - a0, c1 - a1);
+                        let (wx, wy) = (x - a0, y - a1);
+                        let t = cl((wx * ex + wy * ey) / (ex * ex + ey * ey), zero, one);
+                        let (qx, qy) = (wx - ex * t, wy - ey * t);
+                        let cross = ex * wy - ey * wx;
+                        let d2 = qx * qx + qy * qy;
+                        if d2 < best {
+                            best = d2;
+                        }
+                        if a1 <= y && y < c1 && cross > zero {
+                            wind += 1;
+                        } else if c1 <= y && y < a1 && cross < zero {
+                            wind -= 1;
+                        }
+                    } else {
+                        let gx = mx(mx(mn(mn(a0, b0), c0) - x, x - mx(mx(a0, b0), c0)), zero);
+                        let gy = mx(mx(mn(mn(a1, b1), c1) - y, y - mx(mx(a1, b1), c1)), zero);
+                        if gx * gx + gy * gy < best {
+                            let dot = |p: ($t, $t), q: ($t, $t)| p.0 * q.0 + p.1 * q.1;
+                            let ea = (b0 - a0, b1 - a1);
+                            let eb = (a0 - two * b0 + c0, a1 - two * b1 + c1);
+                            let ec = (two * ea.0, two * ea.1);
+                            let ed = (a0 - x, a1 - y);
+                            let kk = one / dot(eb, eb);
+                            let kx = kk * dot(ea, eb);
+                            let ky = kk * (two * dot(ea, ea) + dot(ed, eb)) / three;
+                            let kz = kk * dot(ed, ea);
+                            let p = ky - kx * kx;
+                            let q = kx * (two * kx * kx - three * ky) + kz;
+                            let h = q * q + four * p * p * p;
+                            let (t1, t2) = if h >= zero {
+                                let h = h.sqrt();
+                                let cbrt = |w: $t| {
+                                    let r = w.abs().powf((1.0_f64 / 3.0) as $t);
+                                    if w < zero { -r } else { r }
+                                };
+                                let t = cbrt((h - q) / two) + cbrt((-h - q) / two) - kx;
+                                (t, t)
+                            } else {
+                                let z = (-p).sqrt();
+                                let w = cl(q / (p * z * two), -one, one).acos() / three;
+                                let m = w.cos();
+                                let n = w.sin() * (1.732_050_808_f64 as $t);
+                                ((m + m) * z - kx, (-n - m) * z - kx)
+                            };
+                            let at = |t: $t| (ed.0 + (ec.0 + eb.0 * t) * t, ed.1 + (ec.1 + eb.1 * t) * t);
+                            let newton = |t: $t| {
+                                let t = cl(t, zero, one);
+                                let f = at(t);
+                                let e = (ea.0 + eb.0 * t, ea.1 + eb.1 * t);
+                                let g = dot(f, e);
+                                let gp = two * dot(e, e) + dot(f, eb);
+                                if gp > zero { cl(t - g / gp, zero, one) } else { t }
+                            };
+                            let (f1, f2) = (at(newton(t1)), at(newton(t2)));
+                            let end = (c0 - x, c1 - y);
+                            let d2 = mn(mn(mn(dot(ed, ed), dot(end, end)), dot(f1, f1)), dot(f2, f2));
+                            if d2 < best {
+                                best = d2;
+                            }
+                        }
+                        let up = a1 <= y && y < c1;
+                        let down = c1 <= y && y < a1;
+                        if up || down {
+                            let s1: $t = if up { one } else { -one };
+                            let qa = a1 - two * b1 + c1;
+                            let qb = two * (b1 - a1);
+                            let qc = a1 - y;
+                            let disc = mx(qb * qb - four * qa * qc, zero);
+                            let r = (-0.5_f64 as $t) * (qb + s1 * disc.sqrt());
+                            let t = if r != zero { cl(qc / r, zero, one) } else { zero };
+                            let u = one - t;
+                            let xt = a0 * u * u + two * b0 * t * u + c0 * t * t;
+                            if xt > x {
+                                wind += if up { 1 } else { -1 };
+                            }
+                        }
+                    }
+                    s += 7;
+                }
+                i = next;
+            }
+            let d = best.sqrt();
+            if wind != 0 { -d } else { d }
+        }
+    };
+}
+NAME_outline_fn!(NAME_outline_f32, f32);
+NAME_outline_fn!(NAME_outline_f64, f64);
+"#;
+
 /// The right-hand side of one instruction's statement.
-fn expr(op: &Op, ty: &str) -> String {
+fn expr(op: &Op, ty: &str, name: &str) -> String {
     match *op {
         Op::Const(c) => constant(c, ty),
         Op::Input(Axis::X) => "p.x".into(),
@@ -114,6 +269,12 @@ fn expr(op: &Op, ty: &str) -> String {
             "compile_error!(\"a scene with a `mesh` has no Rust form: its triangles are GPU data\")"
                 .into()
         }
+        Op::Outline(k, x, y) => format!(
+            "{name}_outline_{ty}({}_OUTLINE_{k}, {}, {})",
+            name.to_uppercase(),
+            r(x),
+            r(y)
+        ),
     }
 }
 

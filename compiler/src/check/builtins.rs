@@ -176,6 +176,25 @@ pub struct Build<'a, 'l> {
 }
 
 impl Build<'_, '_> {
+    /// The bytes of the file `path` (relative to the calling file), read through the
+    /// caller's loader.
+    fn read_bytes(&mut self, path: &str) -> Result<Vec<u8>, String> {
+        let files = self
+            .files
+            .as_deref_mut()
+            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
+        let from = files
+            .names
+            .get(self.span.file.0 as usize)
+            .cloned()
+            .unwrap_or_default();
+        let loader = files
+            .loader
+            .as_deref_mut()
+            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
+        loader.load_bytes(&from, path).map(|(_, bytes)| bytes)
+    }
+
     /// The shape of the triangle mesh in the file `path` (relative to the calling file),
     /// scaled by `scale`: read once per file and scale, with a warning where it is open.
     fn mesh(&mut self, path: &str, scale: f64) -> Result<Value, String> {
@@ -338,6 +357,27 @@ fn polygon(b: &mut Build, a: &[Value]) -> Result<Value, String> {
         })
         .collect();
     polygon_of(b, points)
+}
+
+/// `text(string, size, font)`: the glyphs of `string` in the font (the shipped DejaVu Sans
+/// when `font` is empty), laid out by `check/font.rs`.
+fn text(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let (Value::Str(string), Value::Str(font)) = (&a[0], &a[2]) else {
+        return Ok(Value::Error);
+    };
+    let size = a[1].num();
+    let outline = if font.is_empty() {
+        super::font::layout(super::font::default_font(), string, size)
+    } else {
+        let bytes = b.read_bytes(font)?;
+        super::font::layout(&bytes, string, size).map_err(|e| format!("`{font}`: {e}"))
+    }?;
+    b.profile(Node::Text {
+        text: string.to_string(),
+        size,
+        font: font.to_string(),
+        outline: std::sync::Arc::new(outline),
+    })
 }
 
 fn polygon_of(b: &mut Build, points: Vec<[f64; 2]>) -> Result<Value, String> {
@@ -982,6 +1022,12 @@ pub static BUILTINS: &[Builtin] = &[
         name: "polygon",
         sigs: sigs![
             [p("points", Type::List(&V2), Req, Any)] -> PR => polygon;
+        ],
+    },
+    Builtin {
+        name: "text",
+        sigs: sigs![
+            [p("string", Str, Req, Any), p("size", F, Num(1.0), Pos), p("font", Str, Text(""), Any)] -> PR => text;
         ],
     },
     Builtin {

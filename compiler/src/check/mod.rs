@@ -8,6 +8,7 @@
 pub mod builtins;
 mod eval;
 pub mod field;
+pub mod font;
 pub mod meshfile;
 mod ops;
 mod placement;

@@ -186,7 +186,8 @@ impl<'t, T: Float> Evaluator<'t, T> {
                         0 => n,
                         _ => n.next_multiple_of(BLOCK_LANES).min(chunk),
                     };
-                    inst.apply(tape.meshes(), &mut self.slots, out, inputs, chunk, width);
+                    let data = (tape.meshes(), tape.outlines());
+                    inst.apply(data, &mut self.slots, out, inputs, chunk, width);
                 }
                 Step::Enter(g) => {
                     let guard = tape.guard(g);

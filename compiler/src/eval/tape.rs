@@ -13,8 +13,10 @@
 use super::fuse::{self, Finish, Fusions, Kind};
 use super::Float;
 use crate::program::mesh::TriMesh;
+use crate::program::outline::{self, Outline};
 use crate::program::{scalar, Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// Which results a tape computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,6 +44,8 @@ enum Code {
     Fused(Kind, u8, Finish),
     /// The distance to the tape's mesh of this id at the point (`a`, `b`, `c`).
     Mesh(u32),
+    /// The signed distance at (`a`, `b`) to the tape's outline number `k`.
+    Outline,
 }
 
 /// One instruction over slots: `dst = code(a, b, c)` with the immediate `k` (and, for a
@@ -102,6 +106,8 @@ pub struct Tape {
     direct: bool,
     /// The program's meshes, by id.
     meshes: Vec<Option<std::sync::Arc<TriMesh>>>,
+    /// The program's outlines ([`Op::Outline`]).
+    outlines: Vec<Arc<Outline>>,
 }
 
 /// Where each register lives, decided once per tape: scratch slots from [`INPUTS`] up.
@@ -230,6 +236,10 @@ impl Tape {
         self.depth
     }
 
+    pub(super) fn outlines(&self) -> &[Arc<Outline>] {
+        &self.outlines
+    }
+
     pub(super) fn steps(&self) -> &[Step] {
         &self.steps
     }
@@ -291,6 +301,7 @@ impl<'p> Compiler<'p> {
                 material: None,
                 direct: false,
                 meshes: program.meshes.clone(),
+                outlines: program.outlines().to_vec(),
             },
             depth: 0,
             outside: Vec::new(),
@@ -531,6 +542,7 @@ impl Compiler<'_> {
                 },
                 Op::Select(c, a, b) => (Code::Select, vec![c, a, b], 0.0),
                 Op::Mesh(m, x, y, z) => (Code::Mesh(m), vec![x, y, z], 0.0),
+                Op::Outline(k, x, y) => (Code::Outline, vec![x, y], k as f64),
                 Op::Const(_) | Op::Input(_) | Op::Phi(..) => (Code::Select, Vec::new(), 0.0),
             },
         };
@@ -617,10 +629,9 @@ impl Inst {
     /// slot of `slots` (scratch slots of `chunk` values, back to back), which is split off
     /// the buffer; operands are read from the rest of it, or from the inputs.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn apply<T: Float>(
         &self,
-        meshes: &[Option<std::sync::Arc<TriMesh>>],
+        (meshes, outlines): (&[Option<std::sync::Arc<TriMesh>>], &[Arc<Outline>]),
         slots: &mut [T],
         out: Option<&mut [T]>,
         inputs: [&[T]; 3],
@@ -681,6 +692,13 @@ impl Inst {
                     sources.get(self.c),
                 );
                 map3(d, x, y, z, |x, y, z| mesh.distance([x, y, z]));
+            }
+            Code::Outline => {
+                let o = &outlines[self.k as usize];
+                let (x, y) = (sources.get(self.a), sources.get(self.b));
+                for ((r, &x), &y) in d.iter_mut().zip(x).zip(y) {
+                    *r = outline::distance(o, x, y);
+                }
             }
         }
     }

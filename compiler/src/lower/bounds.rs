@@ -331,6 +331,13 @@ impl Bounds {
                     [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
                 )
             }
+            Node::Text { outline, .. } => {
+                let (lo, hi) = outline.bounds();
+                profile(
+                    [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
+                    [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
+                )
+            }
             Node::Extrude {
                 half_height, child, ..
             } => extrude(&get(child)?, *half_height),
@@ -733,6 +740,11 @@ fn own_cost(node: &Node) -> f64 {
         Node::Polygon { points } => 20.0 * points.len() as f64,
         // A walk of the hierarchy: a few dozen boxes and triangles of some 40 operations.
         Node::Mesh { mesh } => 400.0 + 40.0 * (mesh.0.triangles().len() as f64).log2(),
+        // The glyphs near a point: a few glyphs' curves.
+        Node::Text { outline, .. } => {
+            let per_glyph = outline.segments() as f64 / outline.glyphs.len().max(1) as f64;
+            10.0 * outline.glyphs.len() as f64 + 3.0 * 40.0 * per_glyph
+        }
         Node::Extrude { .. } => 10.0,
         Node::Revolve { .. } => 5.0,
         Node::Loft { .. } => 18.0,

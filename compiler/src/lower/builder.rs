@@ -3,6 +3,7 @@
 //! offers the small vector helpers the lowering rules are written with.
 
 use crate::program::mesh::TriMesh;
+use crate::program::outline::Outline;
 use crate::program::{scalar, Axis, Binary, Block, Note, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -32,6 +33,7 @@ enum Key {
     Binary(Binary, Reg, Reg),
     Select(Reg, Reg, Reg),
     Mesh(u32, Reg, Reg, Reg),
+    Outline(u32, Reg, Reg),
 }
 
 /// The scope of registers defined outside every block.
@@ -67,6 +69,8 @@ pub(super) struct Builder {
     pub params: Option<Vec<Param>>,
     /// The meshes `Op::Mesh` names, by id ([`Program::meshes`]).
     meshes: Vec<Option<Arc<TriMesh>>>,
+    /// The outlines [`Op::Outline`] reads, by index.
+    outlines: Vec<Arc<Outline>>,
 }
 
 impl Builder {
@@ -171,6 +175,7 @@ impl Builder {
             Op::Binary(b, x, y) => Key::Binary(b, x, y),
             Op::Select(c, a, b) => Key::Select(c, a, b),
             Op::Mesh(m, x, y, z) => Key::Mesh(m, x, y, z),
+            Op::Outline(k, x, y) => Key::Outline(k, x, y),
             Op::Phi(..) => return self.push(op),
         };
         if let Some(&r) = self.shared.get(&key) {
@@ -229,7 +234,7 @@ impl Builder {
     /// Constant folding and algebraic identities; `None` when the instruction stays.
     fn fold(&mut self, op: Op) -> Option<Reg> {
         match op {
-            Op::Const(_) | Op::Input(_) | Op::Phi(..) | Op::Mesh(..) => None,
+            Op::Const(_) | Op::Input(_) | Op::Phi(..) | Op::Mesh(..) | Op::Outline(..) => None,
             Op::Unary(u, a) => self.fold_unary(u, a),
             Op::Binary(b, x, y) => self.fold_binary(b, x, y),
             Op::Select(c, a, b) => match self.value(c) {
@@ -330,6 +335,7 @@ impl Builder {
             material: m,
             lipschitz: 1.0,
             meshes: Vec::new(),
+            outlines: Vec::new(),
         };
         let (live, live_blocks) = if self.optimise {
             raw.live(roots)
@@ -370,6 +376,19 @@ impl Builder {
             })
             .collect();
         let notes = useful_notes(moved, &self.resumes, ops.len());
+        // The outlines the kept instructions read, renumbered in order of first use.
+        let mut outlines: Vec<Arc<Outline>> = Vec::new();
+        let mut index: HashMap<u32, u32> = HashMap::new();
+        for op in &mut ops {
+            if let Op::Outline(k, _, _) = op {
+                let next = outlines.len() as u32;
+                let new = *index.entry(*k).or_insert_with(|| {
+                    outlines.push(self.outlines[*k as usize].clone());
+                    next
+                });
+                *k = new;
+            }
+        }
         let program = Program {
             ops,
             notes,
@@ -378,6 +397,7 @@ impl Builder {
             material: new_index[m.0 as usize],
             lipschitz: 1.0,
             meshes: self.meshes,
+            outlines,
         };
         (
             program,
@@ -414,6 +434,7 @@ fn renumber(op: &Op, new_index: &[Reg]) -> Op {
         Op::Select(c, a, b) => Op::Select(n(c), n(a), n(b)),
         Op::Phi(a, b) => Op::Phi(n(a), n(b)),
         Op::Mesh(m, x, y, z) => Op::Mesh(m, n(x), n(y), n(z)),
+        Op::Outline(k, x, y) => Op::Outline(k, n(x), n(y)),
     }
 }
 
@@ -446,6 +467,18 @@ impl Builder {
     }
     pub fn div(&mut self, x: Reg, y: Reg) -> Reg {
         self.bin(Binary::Div, x, y)
+    }
+    /// The signed distance at (x, y) to `outline` ([`Op::Outline`]), the outline shared by
+    /// every instruction that reads it.
+    pub fn outline(&mut self, outline: &Arc<Outline>, x: Reg, y: Reg) -> Reg {
+        let k = match self.outlines.iter().position(|o| Arc::ptr_eq(o, outline)) {
+            Some(k) => k,
+            None => {
+                self.outlines.push(outline.clone());
+                self.outlines.len() - 1
+            }
+        };
+        self.emit(Op::Outline(k as u32, x, y))
     }
     pub fn min(&mut self, x: Reg, y: Reg) -> Reg {
         self.bin(Binary::Min, x, y)

@@ -674,6 +674,7 @@ impl<'a> Lowerer<'a> {
                 let d = shapes::bezier(b, p, [a, control, end]);
                 b.subc(d, radius)
             }
+            Node::Text { ref outline, .. } => b.outline(outline, p[0], p[1]),
             _ => match shapes::slots(node) {
                 Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
                 None => b.c(EMPTY_DISTANCE),

@@ -18,6 +18,7 @@
 pub mod float;
 mod live;
 pub mod mesh;
+pub mod outline;
 mod run;
 pub mod scalar;
 mod text;
@@ -110,6 +111,9 @@ pub enum Op {
     /// The signed distance at the point (x, y, z) to the triangle mesh of this index in
     /// [`Program::meshes`] (`mesh.rs`).
     Mesh(u32, Reg, Reg, Reg),
+    /// The signed distance at (x, y) = (a, b) to the outline at this index of
+    /// [`Program::outlines`] (the glyphs of a text, read as data: [`outline::distance`]).
+    Outline(u32, Reg, Reg),
 }
 
 impl Op {
@@ -120,7 +124,7 @@ impl Op {
             Op::Unary(_, a) => vec![a],
             Op::Binary(_, a, b) => vec![a, b],
             Op::Select(c, a, b) => vec![c, a, b],
-            Op::Phi(a, b) => vec![a, b],
+            Op::Phi(a, b) | Op::Outline(_, a, b) => vec![a, b],
             Op::Mesh(_, x, y, z) => vec![x, y, z],
         }
     }
@@ -179,6 +183,8 @@ pub struct Program {
     /// The triangle meshes `Op::Mesh` names, by their index in the scene ([`mesh::TriMesh::id`],
     /// the same in every program of a scene); `None` for those this program does not use.
     pub(crate) meshes: Vec<Option<std::sync::Arc<mesh::TriMesh>>>,
+    /// The outlines the [`Op::Outline`] instructions read, by index.
+    pub(crate) outlines: Vec<std::sync::Arc<outline::Outline>>,
 }
 
 impl Program {
@@ -215,6 +221,11 @@ impl Program {
     /// The guarded blocks, by increasing `start` (an enclosing block before the ones inside).
     pub fn blocks(&self) -> &[Block] {
         &self.blocks
+    }
+
+    /// The outlines [`Op::Outline`] reads, by index.
+    pub fn outlines(&self) -> &[std::sync::Arc<outline::Outline>] {
+        &self.outlines
     }
 
     /// The register holding the signed distance.

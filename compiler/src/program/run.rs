@@ -3,7 +3,7 @@
 //! best distance (its results then take their values from before it). The interpreter's
 //! batch loops, the placement warnings and the tests all compare with, or use, this one loop.
 
-use super::{scalar, Axis, Float, Op, Program, Reg};
+use super::{outline, scalar, Axis, Float, Op, Program, Reg};
 
 /// What [`Program::run`] does, step by step, for a caller that counts or traces it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -52,6 +52,7 @@ impl Program {
                 Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),
                 Op::Phi(a, _) => r(a),
                 Op::Mesh(m, x, y, z) => self.mesh(m).distance([r(x), r(y), r(z)]),
+                Op::Outline(k, x, y) => outline::distance(&self.outlines[k as usize], r(x), r(y)),
             };
             i += 1;
         }

@@ -16,6 +16,14 @@ impl Program {
             let _ = write!(out, ", {} guarded blocks", self.blocks.len());
         }
         out.push('\n');
+        for (k, o) in self.outlines.iter().enumerate() {
+            let _ = writeln!(
+                out,
+                "; outline {k}: {} glyphs, {} segments (data)",
+                o.glyphs.len(),
+                o.segments()
+            );
+        }
         let mut notes = self.notes.iter().peekable();
         let mut depth = 0;
         for item in self.items() {
@@ -60,6 +68,7 @@ pub fn op_text(op: &Op) -> String {
         Op::Select(c, a, b) => format!("select %{}, %{}, %{}", c.0, a.0, b.0),
         Op::Phi(a, b) => format!("phi %{}, %{}", a.0, b.0),
         Op::Mesh(m, x, y, z) => format!("mesh {m} %{}, %{}, %{}", x.0, y.0, z.0),
+        Op::Outline(k, x, y) => format!("outline {k} %{}, %{}", x.0, y.0),
     }
 }
 

@@ -750,6 +750,14 @@ impl Pass<'_> {
                 }
                 exact(b, [false, false, true])
             }
+            Node::Text { outline, .. } => {
+                let (lo, hi) = outline.bounds();
+                let b = Aabb {
+                    min: [lo[0], lo[1], f64::NEG_INFINITY],
+                    max: [hi[0], hi[1], f64::INFINITY],
+                };
+                exact(b, [false, false, true])
+            }
             Node::Extrude {
                 half_height,
                 round,

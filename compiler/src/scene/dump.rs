@@ -332,6 +332,17 @@ fn node(n: &Node) -> String {
             let ps: Vec<String> = points.iter().map(|q| v2(*q)).collect();
             format!("polygon {}", ps.join(" "))
         }
+        Node::Text {
+            text,
+            size,
+            font,
+            outline,
+        } => format!(
+            "text {text:?} size={} font={font:?} glyphs={} segments={}",
+            num(*size),
+            outline.glyphs.len(),
+            outline.segments()
+        ),
         Node::Extrude {
             half_height,
             round,

@@ -226,6 +226,14 @@ pub enum Node {
         b: [f64; 2],
         radius: f64,
     },
+    /// Profile: the glyphs of `text` in the font named `font` (empty: the shipped DejaVu Sans),
+    /// its em `size` high, laid out as `outline` (read as data by every back end).
+    Text {
+        text: String,
+        size: f64,
+        font: String,
+        outline: std::sync::Arc<crate::program::outline::Outline>,
+    },
     /// A profile extruded along z to half-height `half_height`, its edges rounded by `round`
     /// (inside the extents).
     Extrude {
@@ -428,6 +436,7 @@ impl Node {
             Node::Polygon { .. } => "polygon",
             Node::Arc { .. } => "arc",
             Node::Bezier { .. } => "bezier",
+            Node::Text { .. } => "text",
             Node::Extrude { .. } => "extrude",
             Node::Revolve { .. } => "revolve",
             Node::Loft { .. } => "loft",

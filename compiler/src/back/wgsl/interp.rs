@@ -131,7 +131,8 @@ fn linear(program: &Program, roots: &[Reg]) -> Vec<Ins> {
                     ),
                     Op::Select(c, a, b) => (SELECT, [arg(c), arg(a), arg(b)]),
                     // Programs with meshes are refused before they are encoded (`encode`).
-                    Op::Phi(..) | Op::Mesh(..) => continue,
+                    // Outlines are refused by `encode` before they get here.
+                    Op::Phi(..) | Op::Mesh(..) | Op::Outline(..) => continue,
                 };
                 out.push(Ins {
                     op,
@@ -263,6 +264,8 @@ pub enum Unfit {
     Bytes(usize, u64),
     /// Its programs take this many words, more than 2^24 (word indices are held as f32).
     Words(usize),
+    /// Its programs read outlines (text), which only the specialised kernel evaluates.
+    Outlines,
 }
 
 /// The registers that `program`'s `map` (distance and material) needs in the interpreter.
@@ -285,6 +288,14 @@ pub(super) struct Programs<'a> {
 /// The bytes of `scene_data` holding `programs` for a file of `file` registers, or why they
 /// do not fit it or `max_bytes`.
 pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<Vec<u8>, Unfit> {
+    let media = programs.media.map_or(Vec::new(), |(a, b)| vec![a, b]);
+    if [programs.main]
+        .iter()
+        .chain(&media)
+        .any(|p| !p.outlines().is_empty())
+    {
+        return Err(Unfit::Outlines);
+    }
     let map = |p: &Program| linear(p, &[p.distance(), p.material()]);
     let sdf = |p: &Program| linear(p, &[p.distance()]);
     let mut lists = vec![

@@ -426,11 +426,18 @@ struct Names {
     /// With parameters: each register's number among the instructions that are not
     /// constants (constants have none).
     numbers: Option<Vec<u32>>,
+    /// The constant naming each outline's place in `scene_data` (glyphs.rs).
+    glyphs: Vec<String>,
 }
 
 impl Names {
     fn new(program: &Program, params: bool) -> Names {
         let ops = program.ops();
+        let glyphs = program
+            .outlines()
+            .iter()
+            .map(|o| super::glyphs::name(o))
+            .collect();
         let constants: Vec<Option<f64>> = ops
             .iter()
             .map(|op| match op {
@@ -451,6 +458,7 @@ impl Names {
                 literals: ops.iter().map(|_| None).collect(),
                 constants,
                 numbers: Some(numbers),
+                glyphs,
             };
         }
         let is_const = |r: Reg| matches!(ops[r.0 as usize], Op::Const(_));
@@ -479,6 +487,7 @@ impl Names {
                 .collect(),
             constants,
             numbers: None,
+            glyphs,
         }
     }
 
@@ -555,6 +564,12 @@ fn expr(program: &Program, op: &Op, names: &Names, params: Option<&Params>) -> S
             n(y),
             n(z),
             program.mesh(m).base
+        ),
+        Op::Outline(k, x, y) => format!(
+            "text_outline({}, vec2<f32>({}, {}))",
+            names.glyphs[k as usize],
+            n(x),
+            n(y)
         ),
     }
 }

@@ -15,6 +15,7 @@
 mod analytic;
 mod buffer;
 mod contract;
+pub mod glyphs;
 pub mod interp;
 pub mod layout;
 mod map;
@@ -336,6 +337,9 @@ fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, String> {
              registers and the kernel has {file}; {} (or use `--kernel specialised`)",
             scene.limits.raise_to(Limit::Registers, needed as u64)
         ),
+        interp::Unfit::Outlines => "the interpreted kernel cannot run this scene: its text is \
+             read as data by the specialised kernel alone; use `--kernel specialised`"
+            .to_string(),
         interp::Unfit::Words(words) => format!(
             "the interpreted kernel cannot run this scene: its distance programs take {words} \
              instructions, more than the 2^24 it can address; use `--kernel specialised`"
@@ -476,6 +480,17 @@ fn write_template(
                 text.push_str(&map::write_map_named(&m.solid, "map_solid"));
                 text.push('\n');
                 text.push_str(&map::write_sdf_named(&m.solid, "sdf_solid"));
+            }
+            // Text: its outlines after the rest of scene_data.
+            let mut bytes = bytes;
+            let mut programs = vec![&lowered.program];
+            if let Some(m) = m {
+                programs.extend([&m.medium, &m.solid]);
+            }
+            let glyphs = glyphs::append(&programs, &mut bytes);
+            if !glyphs.is_empty() {
+                text.push('\n');
+                text.push_str(&glyphs);
             }
             values.insert("MAP", text);
             bytes

@@ -124,9 +124,18 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
         );
     }
     out.push_str(");\n\n");
-    out.push_str(&map::write_map_named(program, name));
+    let glyphs = super::glyphs::part(program, name);
+    if !glyphs.is_empty() {
+        out.push_str(&glyphs);
+        out.push('\n');
+    }
+    let rename = |text: String| super::glyphs::rename_calls(&text, name);
+    out.push_str(&rename(map::write_map_named(program, name)));
     out.push('\n');
-    out.push_str(&map::write_sdf_named(program, &format!("{name}_distance")));
+    out.push_str(&rename(map::write_sdf_named(
+        program,
+        &format!("{name}_distance"),
+    )));
     if !lowered.colours.is_empty() {
         out.push('\n');
         out.push_str(&map::write_colours(

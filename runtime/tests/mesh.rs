@@ -836,3 +836,40 @@ fn vertex_colours_follow_a_colour_field() {
         }
     }
 }
+
+/// Every printable ASCII glyph of the shipped font, extruded (`text`, six lines of them),
+/// meshes to a closed manifold with an even Euler characteristic, coarsely (a voxel of 0.07
+/// em; the strokes are about 0.09 em wide) so that it stays quick.
+#[test]
+fn every_printable_ascii_glyph_meshes_closed() {
+    let d = dir("text");
+    let chars: Vec<char> = ('!'..='~').collect();
+    let lines: Vec<String> = chars
+        .chunks(16)
+        .map(|l| {
+            l.iter()
+                .map(|c| match c {
+                    '"' => "\\\"".to_string(),
+                    '\\' => "\\\\".to_string(),
+                    c => c.to_string(),
+                })
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+        .collect();
+    let body = format!(
+        "scene {{ extrude(text(\"{}\", 1), 0.3); }}\n",
+        lines.join("\\n")
+    );
+    let scene = write_scene(&d, "ascii.sdf", &body);
+    let out = d.join("ascii.stl");
+    mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.07"]);
+    let m = read_stl(&out);
+    let chi = manifold(&m, "ASCII glyphs");
+    assert_eq!(chi % 2, 0, "χ = {chi}");
+    assert!(
+        m.triangles.len() > 10_000,
+        "{} triangles",
+        m.triangles.len()
+    );
+}

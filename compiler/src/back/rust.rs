@@ -147,17 +147,40 @@ const OUTLINE_MACRO: &str = r#"macro_rules! NAME_outline_fn {
             let (zero, one, two, three, four): ($t, $t, $t, $t, $t) = (0.0, 1.0, 2.0, 3.0, 4.0);
             let mut best = 3.0e38_f64 as $t;
             let mut wind: i32 = 0;
-            let mut i = 1;
-            for _ in 0..o[0] as usize {
-                let next = i + 5 + 7 * o[i + 4] as usize;
+            let n = o[0] as usize;
+            let gap = |i: usize| {
                 let dx = mx(mx(v(i) - x, x - v(i + 2)), zero);
                 let dy = mx(mx(v(i + 1) - y, y - v(i + 3)), zero);
-                let gap = dx * dx + dy * dy;
+                dx * dx + dy * dy
+            };
+            let after = |i: usize| i + 5 + 7 * o[i + 4] as usize;
+            // The glyph whose box is nearest first, then the others in order.
+            let (mut first, mut near) = (1, best);
+            let mut i = 1;
+            for _ in 0..n {
+                let d = gap(i);
+                if d < near {
+                    near = d;
+                    first = i;
+                }
+                i = after(i);
+            }
+            let mut i = 1;
+            for k in 0..=n {
+                let mut at = first;
+                if k > 0 {
+                    at = i;
+                    i = after(i);
+                    if at == first {
+                        continue;
+                    }
+                }
+                let next = after(at);
+                let gap = gap(at);
                 if gap > zero && gap >= best {
-                    i = next;
                     continue;
                 }
-                let mut s = i + 5;
+                let mut s = at + 5;
                 while s < next {
                     let (a0, a1, b0, b1, c0, c1) = (v(s), v(s + 1), v(s + 2), v(s + 3), v(s + 4), v(s + 5));
                     if o[s + 6] != 0.0 {
@@ -241,7 +264,6 @@ const OUTLINE_MACRO: &str = r#"macro_rules! NAME_outline_fn {
                     }
                     s += 7;
                 }
-                i = next;
             }
             let d = best.sqrt();
             if wind != 0 { -d } else { d }

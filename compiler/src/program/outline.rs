@@ -10,9 +10,9 @@
 //! of the curves about the point is not zero (TrueType's fill rule). The winding number is
 //! counted along a ray towards +x: every curve is monotone in y (the font reader splits them at
 //! their turning points), so it crosses the ray's line at most once, at the root of a quadratic
-//! of one variable. A glyph whose box is farther than the best distance so far is skipped: its
-//! winding number about a point outside its box is zero, so only the glyphs near the point cost
-//! anything.
+//! of one variable. The glyph whose box is nearest goes first, then the others in order, each
+//! skipped where its box is farther than the best distance so far: its winding number about a
+//! point outside its box is zero, so only the glyphs near the point cost anything.
 
 use super::Float;
 
@@ -109,14 +109,28 @@ pub fn distance<T: Float>(o: &Outline, x: T, y: T) -> T {
     let zero = T::zero();
     let mut best = T::from_f64(FAR);
     let mut wind: i32 = 0;
-    for g in &o.glyphs {
+    let gap = |g: &Glyph| {
         let dx = (T::from_f64(g.lo[0]) - x)
             .max(x - T::from_f64(g.hi[0]))
             .max(zero);
         let dy = (T::from_f64(g.lo[1]) - y)
             .max(y - T::from_f64(g.hi[1]))
             .max(zero);
-        let gap = dx * dx + dy * dy;
+        dx * dx + dy * dy
+    };
+    // The glyph whose box is nearest first, so that the others are skipped sooner.
+    let mut first = 0;
+    let mut near = best;
+    for (k, g) in o.glyphs.iter().enumerate() {
+        let d = gap(g);
+        if d < near {
+            near = d;
+            first = k;
+        }
+    }
+    let order = std::iter::once(first).chain((0..o.glyphs.len()).filter(|&k| k != first));
+    for g in order.map(|k| &o.glyphs[k]) {
+        let gap = gap(g);
         // Outside the box and no nearer than the best: nothing of this glyph counts.
         if gap > zero && gap >= best {
             continue;

@@ -214,6 +214,13 @@ fn text_newton(ea: vec2<f32>, eb: vec2<f32>, ec: vec2<f32>, ed: vec2<f32>, t0: f
     return t;
 }
 
+// The squared distance to the box (lo.x, lo.y, hi.x, hi.y) of a glyph, 0 inside it.
+fn text_gap(bx: vec4<f32>, q: vec2<f32>) -> f32 {
+    let dx = max(max(bx.x - q.x, q.x - bx.z), 0.0);
+    let dy = max(max(bx.y - q.y, q.y - bx.w), 0.0);
+    return dx * dx + dy * dy;
+}
+
 // The signed distance at q to the outline whose words start at scene_data[base]: the
 // nearest of its curves, negative where their winding number is not zero; a glyph whose box
 // is farther than the best so far is skipped.
@@ -221,18 +228,34 @@ fn text_outline(base: u32, q: vec2<f32>) -> f32 {
     let glyphs = u32(scene_data[base].x);
     var best = 3e38;
     var wind = 0i;
+    // The glyph whose box is nearest first, then the others in order.
+    var first = base + 1u;
+    var near = best;
     var i = base + 1u;
     for (var g = 0u; g < glyphs; g++) {
-        let bx = scene_data[i];
-        let next = i + 2u + 2u * u32(scene_data[i + 1u].x);
-        let dx = max(max(bx.x - q.x, q.x - bx.z), 0.0);
-        let dy = max(max(bx.y - q.y, q.y - bx.w), 0.0);
-        let gap = dx * dx + dy * dy;
+        let d = text_gap(scene_data[i], q);
+        if d < near {
+            near = d;
+            first = i;
+        }
+        i = i + 2u + 2u * u32(scene_data[i + 1u].x);
+    }
+    i = base + 1u;
+    for (var k = 0u; k <= glyphs; k++) {
+        var at = first;
+        if k > 0u {
+            at = i;
+            i = i + 2u + 2u * u32(scene_data[i + 1u].x);
+            if at == first {
+                continue;
+            }
+        }
+        let next = at + 2u + 2u * u32(scene_data[at + 1u].x);
+        let gap = text_gap(scene_data[at], q);
         if gap > 0.0 && gap >= best {
-            i = next;
             continue;
         }
-        for (var s = i + 2u; s < next; s += 2u) {
+        for (var s = at + 2u; s < next; s += 2u) {
             let w0 = scene_data[s];
             let w1 = scene_data[s + 1u];
             let a = w0.xy;
@@ -256,7 +279,6 @@ fn text_outline(base: u32, q: vec2<f32>) -> f32 {
                 wind += text_crossing(a, b, c, q);
             }
         }
-        i = next;
     }
     let d = sqrt(best);
     return select(d, -d, wind != 0i);

@@ -120,6 +120,9 @@ struct Target {
     tile_table: wgpu::Buffer,
     image: wgpu::Buffer,
     stats: wgpu::Buffer,
+    /// The kernel's finished pixels (binding 5), which the viewer does not read: it
+    /// accumulates the linear image.
+    pixels: wgpu::Buffer,
     sum: wgpu::Buffer,
     frame: wgpu::Buffer,
     steps: wgpu::Buffer,
@@ -260,7 +263,7 @@ impl Resident {
         let kernel_bind = kernel_bindings(
             &device,
             &pipeline,
-            [&t.uniforms, &t.tile_table, &t.image, &t.stats],
+            [&t.uniforms, &t.tile_table, &t.image, &t.stats, &t.pixels],
             t.data.as_ref(),
         );
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -359,11 +362,12 @@ impl Resident {
         if !same_size {
             let old = self.target.take();
             let capacity = old.as_ref().map_or(0, |t| t.capacity).max(pixels);
-            let (image, stats, sum) = match old {
-                Some(t) if t.capacity >= pixels => (t.image, t.stats, t.sum),
+            let (image, stats, finished, sum) = match old {
+                Some(t) if t.capacity >= pixels => (t.image, t.stats, t.pixels, t.sum),
                 _ => (
                     buffer("sdfc view image", capacity * 16, U::STORAGE),
                     buffer("sdfc view stats", capacity * 32, U::STORAGE),
+                    buffer("sdfc view pixels", capacity * 4, U::STORAGE),
                     buffer("sdfc view sums", capacity * 16, U::STORAGE | U::COPY_SRC),
                 ),
             };
@@ -442,6 +446,7 @@ impl Resident {
                 tile_table,
                 image,
                 stats,
+                pixels: finished,
                 sum,
                 frame,
                 steps,
@@ -526,12 +531,12 @@ impl Resident {
 }
 
 /// The bindings of the scene's kernel ([`Gpu::compute_pipeline`]'s layout): the scene
-/// uniform, the tile table (16 bytes at a dynamic offset), the image and the statistics, and
-/// the scene data when the kernel reads it.
+/// uniform, the tile table (16 bytes at a dynamic offset), the image, the statistics and the
+/// finished pixels, and the scene data when the kernel reads it.
 fn kernel_bindings(
     device: &wgpu::Device,
     pipeline: &Pipeline,
-    [uniforms, tiles, image, stats]: [&wgpu::Buffer; 4],
+    [uniforms, tiles, image, stats, pixels]: [&wgpu::Buffer; 5],
     data: Option<&wgpu::Buffer>,
 ) -> wgpu::BindGroup {
     let mut entries = vec![
@@ -554,6 +559,10 @@ fn kernel_bindings(
         wgpu::BindGroupEntry {
             binding: 3,
             resource: stats.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 5,
+            resource: pixels.as_entire_binding(),
         },
     ];
     if let Some(data) = data {
@@ -635,9 +644,10 @@ pub fn warm(
     // The pixels of one workgroup: the first rows of the frame.
     let width = first.map_or(1, |f| f.tile.2.max(1)) as u64;
     let pixels = width * wgsl::WORKGROUP as u64;
-    let (image, stats) = (
+    let (image, stats, finished) = (
         buffer(pixels * 16, U::STORAGE),
         buffer(pixels * 32, U::STORAGE),
+        buffer(pixels * 4, U::STORAGE),
     );
     if let Some(f) = first {
         let n = (f.uniforms.len() as u64).min(limit) as usize;
@@ -651,7 +661,7 @@ pub fn warm(
     let bind = kernel_bindings(
         device,
         &pipeline,
-        [&uniforms, &tiles, &image, &stats],
+        [&uniforms, &tiles, &image, &stats, &finished],
         scene_data.as_ref(),
     );
     let mut encoder = device.create_command_encoder(&Default::default());

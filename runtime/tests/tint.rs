@@ -190,6 +190,12 @@ fn interpreted_jobs() -> Vec<Job> {
             kernel: wgsl::KernelChoice::Interpreted,
             ..Options::default()
         };
+        // A scene the interpreted kernel refuses (text, meshes: read as data by the
+        // specialised kernel alone) has no interpreted kernel to compile.
+        if let Err(why) = wgsl::choose(&scene, &lowered, &options) {
+            println!("{}: no interpreted kernel ({why})", path.display());
+            continue;
+        }
         let kernel = wgsl::write_with(&scene, &lowered, &options)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let name = path
@@ -385,7 +391,15 @@ fn features_are_the_templates() {
         .filter_map(|l| l.trim().strip_prefix("//#if "))
         .map(|f| f.trim().trim_start_matches('!'))
         .collect();
-    assert_eq!(flags, FEATURES.iter().copied().collect::<BTreeSet<_>>());
+    // COLOUR_FIELDS is not among the combinations: its kernels reach Tint through the
+    // examples that use colour fields (rock.sdf).
+    let combined: BTreeSet<&str> = flags
+        .iter()
+        .copied()
+        .filter(|f| *f != "COLOUR_FIELDS")
+        .collect();
+    assert!(flags.contains("COLOUR_FIELDS"));
+    assert_eq!(combined, FEATURES.iter().copied().collect::<BTreeSet<_>>());
 }
 
 /// The page: compiles every kernel of `/jobs` and posts one message per kernel to `/report`.

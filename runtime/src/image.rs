@@ -177,13 +177,7 @@ pub fn encode_png(
 
 /// A linear value clamped to [0, 1] and encoded with the sRGB transfer function (NaN is 0).
 pub fn srgb_encode(c: f32) -> u8 {
-    let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-    let s = if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5) as u8
+    sdfc_compiler::back::wgsl::srgb::encode(c)
 }
 
 /// [`srgb_encode`] by table: `at[v]` is the least linear value (an f32 in [0, 1]) that
@@ -200,25 +194,12 @@ pub struct SrgbTable {
 }
 
 impl SrgbTable {
-    /// The table, computed once (255 binary searches over the bits of f32s).
+    /// The table, computed once (the thresholds are `back::wgsl::srgb`'s).
     pub fn get() -> &'static SrgbTable {
         static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
         TABLE.get_or_init(|| {
-            let mut at = [0.0f32; 256];
-            for (v, t) in at.iter_mut().enumerate().skip(1) {
-                // The least bits b in [0, bits of 1.0] with srgb_encode(b) >= v: for
-                // non-negative f32s the order of the bits is the order of the values.
-                let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
-                while lo < hi {
-                    let mid = lo + (hi - lo) / 2;
-                    if (srgb_encode(f32::from_bits(mid)) as usize) < v {
-                        lo = mid + 1;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                *t = f32::from_bits(lo);
-            }
+            // The kernel's thresholds: the same table finishes pixels on the GPU.
+            let at = *sdfc_compiler::back::wgsl::srgb::thresholds();
             let start = (0..=4096).map(|k| srgb_encode(k as f32 / 4096.0)).collect();
             SrgbTable { at, start }
         })

@@ -110,8 +110,8 @@ impl std::fmt::Debug for FrameBuffers {
 
 /// Makes the first CUDA device the only one this process's driver sees
 /// (`CUDA_VISIBLE_DEVICES=0`, unless the variable is set already), for a render on device 0
-/// alone: the driver's initialisation otherwise prepares every GPU of the host, which on a
-/// host of four H200s took 1.1 s of a 1.3 s render (0.54 s with one GPU visible; issue 36).
+/// alone: the driver's initialisation otherwise prepares every GPU of the host, most of a
+/// short render's time on a host of several GPUs.
 /// Device 0 stays the same device: the variable's indices follow the driver's order
 /// (`CUDA_DEVICE_ORDER`), as the ordinals do. Call it before any thread starts: the
 /// environment is the process's.

@@ -434,10 +434,10 @@ fn time_scene(
     let s = &scene.settings;
     let traced = prepared.traceable().traced(s.method).is_some();
     let evaluations = if traced { 0 } else { fp32::evaluations(c) };
-    let peak = match prepared {
-        Prepared::Cpu { .. } => None,
-        _ if traced => None,
-        _ => fp32::peak_flops(&prepared.device()),
+    // No peak for the CPU, nor for a traced scene.
+    let peak = match prepared.kernel_kind() {
+        Some(_) if !traced => fp32::peak_flops(&prepared.device()),
+        _ => None,
     };
     Ok(Timing {
         scene: name,

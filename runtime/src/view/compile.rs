@@ -54,9 +54,8 @@ impl Compile {
     /// `first` is what the scene's first frame will read, for the kernel's first dispatch
     /// ([`super::resident::warm`]).
     pub fn start(prepared: &Prepared, first: Option<FirstFrame>, done: Waker) -> Option<Compile> {
-        let Prepared::Wgpu { gpu, kernel, .. } = prepared else {
-            return None;
-        };
+        let wgpu = prepared.as_wgpu()?;
+        let (gpu, kernel) = (&wgpu.gpu, &wgpu.kernel);
         let started = Instant::now();
         let result = Arc::new(Mutex::new(None));
         let (gpu, source, module) = (gpu.clone(), kernel.source.clone(), kernel.module.clone());

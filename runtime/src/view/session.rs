@@ -735,8 +735,8 @@ impl Session {
         let mut waiting = None;
         let mut interim_prepare = Duration::ZERO;
         let mut interim_possible = false;
-        let pipeline = match &prepared {
-            Prepared::Wgpu { gpu, kernel, .. } => {
+        let pipeline = match prepared.as_wgpu() {
+            Some(crate::backend::WgpuPrepared { gpu, kernel, .. }) => {
                 let data = kernel.data.is_some();
                 if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
                     Some(
@@ -840,9 +840,7 @@ impl Session {
             .memory(scene, at)
             .check(&self.options.limits)
             .ok()?;
-        let Prepared::Wgpu { kernel, .. } = &prepared else {
-            return None;
-        };
+        let kernel = &prepared.as_wgpu()?.kernel;
         let data = kernel.data.is_some();
         let (compile, pipeline) = if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
             let time = gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data);
@@ -865,12 +863,9 @@ impl Session {
     /// as [`Session::frame`] sets it up: the camera on show (the user's, else the scene's),
     /// the size of a new scene's first frame, and the first sample's offset.
     fn first_frame(&self, prepared: &Prepared, scene: &Scene) -> Option<FirstFrame> {
-        let Prepared::Wgpu {
+        let crate::backend::WgpuPrepared {
             kernel, lipschitz, ..
-        } = prepared
-        else {
-            return None;
-        };
+        } = prepared.as_wgpu()?;
         let moving = self.moving() || self.playing();
         let scale = if moving {
             self.scale
@@ -1268,20 +1263,21 @@ impl Session {
         };
         let kind = kernel.kernel_kind();
         let prepared = kernel;
-        let rendered = match prepared {
+        let rendered = match prepared.as_wgpu() {
             // On wgpu the frame stays on the device: rendered, accumulated and shown there.
-            Prepared::Wgpu {
+            Some(crate::backend::WgpuPrepared {
                 gpu,
                 kernel,
                 lipschitz,
                 ..
-            } => {
+            }) => {
                 let key = (self.version, kernel.interpreted());
                 let resident = match self.resident.as_mut() {
                     Some(r) => Ok(r),
                     None => Resident::new(gpu.clone()).map(|r| self.resident.insert(r)),
                 };
-                check_contract(prepared, &good.scene)
+                prepared
+                    .check_contract(&good.scene)
                     .and_then(|()| {
                         resident?.render(
                             (kernel, *lipschitz),
@@ -1293,7 +1289,7 @@ impl Session {
                     })
                     .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
             }
-            other => other.render(&good.scene, &|_| {}).map(|frame| {
+            None => prepared.render(&good.scene, &|_| {}).map(|frame| {
                 for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
                     for i in 0..3 {
                         sum[i] += c[i];
@@ -1515,21 +1511,6 @@ impl Session {
     }
 }
 
-/// Refuses a frame of `scene` that `prepared`'s kernel was not specialised for (as a render
-/// does, `Prepared::render`).
-fn check_contract(prepared: &Prepared, scene: &Scene) -> Result<(), String> {
-    let Some(contract) = prepared.contract() else {
-        return Ok(());
-    };
-    let traced = prepared.traceable().traced(scene.settings.method).is_some();
-    contract.check(scene, traced).map_err(|m| {
-        format!(
-            "the {} kernel cannot render this scene: {m}; specialise it again",
-            prepared.name()
-        )
-    })
-}
-
 /// When the edit a load follows was made: the later of the newest modification time of the
 /// scene's files and the first file event of the batch that called for the load (`None`
 /// when neither is known).
@@ -1700,9 +1681,10 @@ mod tests {
 
     /// The text of the kernel the session keeps for its scene (the specialised one).
     fn kernel_text(s: &Session) -> String {
-        match &s.good.as_ref().expect("a scene").prepared {
-            Prepared::Wgpu { kernel, .. } => kernel.source.clone(),
-            other => panic!("not a wgpu scene: {}", other.name()),
+        let p = &s.good.as_ref().expect("a scene").prepared;
+        match p.as_wgpu() {
+            Some(w) => w.kernel.source.clone(),
+            None => panic!("not a wgpu scene: {}", p.name()),
         }
     }
 

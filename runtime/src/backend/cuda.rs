@@ -1,0 +1,241 @@
+//! CUDA behind [`Renderer`]: the device, the kernel translated to PTX and loaded as a module,
+//! and what it takes to write the kernel again.
+
+use super::{kernel, kernel_text, Frame, Part, Preparation, Prepared, Renderer, Setup};
+use crate::gpu::{self, cuda::Cuda};
+use crate::memory::Memory;
+use sdfc_compiler::back::{ptx, wgsl};
+use sdfc_compiler::lower::Lowered;
+use sdfc_compiler::scene::analytic::Traceable;
+use sdfc_compiler::scene::{Scene, Settings};
+use std::time::{Duration, Instant};
+
+/// A scene prepared for CUDA: the device, the loaded module (with the kernel's scene data and
+/// the settings it was specialised for) and the scene's Lipschitz bound L (and the lowered
+/// scene and setup, to specialise the kernel again for other settings).
+#[derive(Debug)]
+pub struct CudaPrepared {
+    cuda: Box<Cuda>,
+    module: Box<CudaModule>,
+    lipschitz: f64,
+    lowered: Box<Lowered>,
+    setup: Setup,
+    timing: Preparation,
+}
+
+/// A kernel loaded on a CUDA device, with what its launches need and the WGSL text it was
+/// translated from.
+#[derive(Debug)]
+struct CudaModule {
+    loaded: gpu::cuda::Loaded,
+    data: Option<Vec<u8>>,
+    contract: wgsl::Contract,
+    ptx_time: Duration,
+    source: String,
+    interpreted: bool,
+}
+
+impl CudaPrepared {
+    /// Prepares `scene` on the CUDA device `open` opens (timing its opening).
+    pub(super) fn open(
+        scene: &Scene,
+        lowered: &Lowered,
+        setup: &Setup,
+        open: impl FnOnce() -> Result<Cuda, gpu::cuda::Error>,
+    ) -> Result<CudaPrepared, String> {
+        let start = Instant::now();
+        let cuda = open().map_err(|e| e.to_string())?;
+        let device = start.elapsed();
+        let start = Instant::now();
+        let kernel = kernel(scene, lowered, &setup.on_cuda())?;
+        let timing = Preparation {
+            device,
+            kernel: start.elapsed(),
+            ..Preparation::default()
+        };
+        Self::new(cuda, kernel, lowered, setup, timing)
+    }
+
+    /// The CUDA preparation of `kernel` (written for `lowered`) on `cuda`: translated to PTX
+    /// and loaded.
+    pub(super) fn new(
+        cuda: Cuda,
+        kernel: wgsl::Kernel,
+        lowered: &Lowered,
+        setup: &Setup,
+        timing: Preparation,
+    ) -> Result<CudaPrepared, String> {
+        let module = CudaModule::load(&cuda, kernel)?;
+        Ok(CudaPrepared {
+            cuda: Box::new(cuda),
+            module: Box::new(module),
+            lipschitz: lowered.program.lipschitz(),
+            lowered: Box::new(lowered.clone()),
+            setup: *setup,
+            timing,
+        })
+    }
+}
+
+impl CudaModule {
+    /// Translates `kernel` to PTX and loads it on `cuda`.
+    fn load(cuda: &Cuda, kernel: wgsl::Kernel) -> Result<CudaModule, String> {
+        let start = Instant::now();
+        let options = ptx::Options {
+            sm: cuda.sm,
+            entry_point: wgsl::ENTRY_POINT.to_string(),
+        };
+        let ptx = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
+        let ptx_time = start.elapsed();
+        let marched = !kernel.contract.has("ANALYTIC");
+        let loaded = cuda
+            .load(&ptx, wgsl::ENTRY_POINT, gpu::cuda::register_cap(marched))
+            .map_err(|e| e.to_string())?;
+        Ok(CudaModule {
+            interpreted: kernel.interpreted(),
+            loaded,
+            data: kernel.data,
+            contract: kernel.contract,
+            ptx_time,
+            source: kernel.source,
+        })
+    }
+}
+
+impl Renderer for CudaPrepared {
+    fn name(&self) -> &'static str {
+        "cuda"
+    }
+
+    fn device(&self) -> String {
+        self.cuda.describe()
+    }
+
+    fn kernel_kind(&self) -> Option<&'static str> {
+        Some(super::kind(self.module.interpreted))
+    }
+
+    fn preparation(&self) -> Vec<(&'static str, Duration, String)> {
+        let (timing, module) = (&self.timing, &self.module);
+        timing.ordered(vec![
+            (
+                "device",
+                timing.device,
+                timing.opening("CUDA context created"),
+            ),
+            (
+                "kernel",
+                timing.kernel,
+                "WGSL written and validated by naga".into(),
+            ),
+            (
+                "PTX",
+                module.ptx_time,
+                "translated from the naga module".into(),
+            ),
+            (
+                "driver compile",
+                module.loaded.load_time,
+                if module.loaded.cached {
+                    "module read from the JIT cache and loaded".into()
+                } else {
+                    "module compiled by the driver JIT and loaded".into()
+                },
+            ),
+        ])
+    }
+
+    fn memory(&self, _: &Scene, settings: &Settings) -> Memory {
+        gpu::memory_cuda(
+            settings,
+            self.module.contract.uniform.size.into(),
+            super::bytes(&self.module.data),
+        )
+    }
+
+    fn retained(&self, settings: &Settings) -> u64 {
+        gpu::retained(settings)
+    }
+
+    fn program_len(&self) -> usize {
+        self.lowered.program.len()
+    }
+
+    fn traceable(&self) -> &Traceable {
+        &self.lowered.traceable
+    }
+
+    fn contract(&self) -> Option<&wgsl::Contract> {
+        Some(&self.module.contract)
+    }
+
+    fn setup(&self) -> Option<&Setup> {
+        Some(&self.setup)
+    }
+
+    fn render(
+        &self,
+        scene: &Scene,
+        progress: &(dyn Fn(f64) + Sync),
+        faults: &gpu::launch::Faults,
+    ) -> Result<Frame, String> {
+        let module = &self.module;
+        let r = gpu::render_cuda(
+            &self.cuda,
+            scene,
+            (
+                &module.loaded,
+                &module.contract.uniform,
+                module.data.as_deref(),
+            ),
+            self.lipschitz,
+            (faults, !self.setup.image_only, self.setup.finished),
+            &mut |f| progress(f),
+        )
+        .map_err(|e| e.to_string())?;
+        Ok(Frame::of(r))
+    }
+
+    fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, String> {
+        let module = &self.module;
+        Ok(Part {
+            worker: Box::new(self.cuda.kernel(&module.loaded, wgsl::WORKGROUP)),
+            kernel: Some((
+                self.lipschitz,
+                &module.contract.uniform,
+                module.data.as_deref(),
+            )),
+        })
+    }
+
+    fn next(
+        &self,
+        _: &Scene,
+        _: Lowered,
+        _: Option<wgsl::KernelChoice>,
+    ) -> Result<(Prepared, bool), String> {
+        Err("CUDA kernels and several devices are prepared again with Prepared::update".into())
+    }
+
+    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+        let text = kernel_text(scene, &lowered, &self.setup)?;
+        let built = text.source != self.module.source;
+        if built {
+            let kernel = kernel(scene, &lowered, &self.setup.on_cuda())?;
+            *self.module = CudaModule::load(&self.cuda, kernel)?;
+        } else {
+            self.module.data = text.data;
+        }
+        self.lipschitz = lowered.program.lipschitz();
+        *self.lowered = lowered;
+        Ok(built)
+    }
+
+    fn specialise(&mut self, scene: &Scene) -> Result<bool, String> {
+        super::method_allowed(scene, &self.lowered.traceable)?;
+        // The same device and context; the new module replaces the old one.
+        let kernel = kernel(scene, &self.lowered, &self.setup.on_cuda())?;
+        *self.module = CudaModule::load(&self.cuda, kernel)?;
+        Ok(true)
+    }
+}

@@ -1,0 +1,451 @@
+//! A render job and the one path from it to frames. [`Job`] is what `sdfc render` (a still or
+//! `--frames`), `bench`, `pareto`, `view` and the Python module ask to have rendered, built
+//! from their arguments: the settings overridden, the backend and its devices, the float type,
+//! the GPU kernel, the worker threads and the limits. From it a scene's source is checked at a
+//! time, its settings applied and it is lowered ([`Job::frame`]), prepared on its backend
+//! ([`prepare`], or frame after frame by [`Kernels`]), held to the memory limit
+//! ([`check_memory`]) and rendered ([`Prepared::render`]). What fails on the way is an
+//! [`Error`] saying which step.
+
+use crate::backend::{self, Backend, Devices, Kernel, Opening, Prepared, Setup};
+use crate::cpu::reference;
+use crate::cpu::Precision;
+use crate::frontend::{self, DiagnosticFormat, Loaded, Source};
+use crate::memory;
+use sdfc_compiler::back::wgsl;
+use sdfc_compiler::lower::{self, LowerOptions, Lowered, Program};
+use sdfc_compiler::scene::Scene;
+use sdfc_compiler::{Diagnostic, Limits, Severity, SourceMap};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+/// What a command asks to have rendered, from its arguments.
+#[derive(Debug, Clone, Default)]
+pub struct Job {
+    /// `--backend`.
+    pub backend: Backend,
+    /// `--devices`.
+    pub devices: Devices,
+    /// `--precision`: the CPU renderer's float type.
+    pub precision: Precision,
+    /// `--kernel`: the GPU kernel of a marched scene (`None`: not given, `auto`).
+    pub kernel: Option<Kernel>,
+    /// The settings overridden in every frame checked.
+    pub overrides: Overrides,
+    /// `--limit`.
+    pub limits: Limits,
+    /// `--threads` (default: one per core).
+    pub threads: Option<usize>,
+    /// `--debug-nan`.
+    pub debug_nan: bool,
+}
+
+/// The settings a job overrides in every frame it checks, in this order.
+#[derive(Debug, Clone, Default)]
+pub struct Overrides {
+    /// `--reference`: the reference render's settings first.
+    pub reference: bool,
+    /// `--size`.
+    pub size: Option<(u32, u32)>,
+    /// `--aa`.
+    pub aa: Option<u32>,
+    /// `--set`, in order.
+    pub set: Vec<String>,
+}
+
+/// What failed on the way from a job to its frames. `Usage` and `Io` end a command with exit
+/// code 2, the others with 1.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Bad arguments: a setting out of its range, options that do not go together.
+    #[error("{0}")]
+    Usage(String),
+    /// A file that cannot be read or written.
+    #[error("{0}")]
+    Io(String),
+    /// The scene has errors (its diagnostics are printed where they are found).
+    #[error("{}", .0.summary())]
+    Scene(Box<SceneErrors>),
+    /// The scene asks for what the backend cannot do: analytic tracing of a scene that does
+    /// not allow it, a GPU kernel that cannot render it.
+    #[error("{0}")]
+    Unsupported(String),
+    /// The backend cannot be used: no device, or the scene could not be prepared on it.
+    #[error("the {backend:?} backend is not available: {message}")]
+    Unavailable {
+        /// The backend asked for.
+        backend: Backend,
+        /// Why.
+        message: String,
+    },
+    /// A frame's scene could not be prepared on the backend already prepared (a kernel
+    /// specialised or written again).
+    #[error("{0}")]
+    Prepare(String),
+    /// What the render would allocate is above the `memory` limit.
+    #[error("{0}")]
+    Memory(String),
+    /// A render failed on its device.
+    #[error("{0}")]
+    Render(String),
+    /// An encoder the frames are handed to (`ffmpeg`) failed.
+    #[error("{0}")]
+    Encode(String),
+}
+
+/// A scene's errors: its diagnostics, and the files they point into.
+#[derive(Debug)]
+pub struct SceneErrors {
+    /// The diagnostics, errors and warnings.
+    pub diagnostics: Vec<Diagnostic>,
+    /// The files of the compilation.
+    pub sources: SourceMap,
+}
+
+impl SceneErrors {
+    /// One line: the first error, where it is, and how many there are.
+    pub fn summary(&self) -> String {
+        let errors: Vec<&Diagnostic> = self
+            .diagnostics
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .collect();
+        let Some(d) = errors.first() else {
+            return "error".into();
+        };
+        let at = d
+            .labels
+            .first()
+            .map(|l| {
+                let (line, col) = self.sources.line_col(l.span);
+                format!(" at {}:{line}:{col}", self.sources.name(l.span.file))
+            })
+            .unwrap_or_default();
+        let more = match errors.len() {
+            1 => String::new(),
+            n => format!(" (and {} more)", n - 1),
+        };
+        format!("error[{}]: {}{at}{more}", d.code, d.message)
+    }
+}
+
+impl Error {
+    /// The scene's errors `diagnostics` in `sources`.
+    fn scene(diagnostics: Vec<Diagnostic>, sources: &SourceMap) -> Error {
+        Error::Scene(Box::new(SceneErrors {
+            diagnostics,
+            sources: sources.clone(),
+        }))
+    }
+
+    /// The exit code of a command that stops on this error.
+    pub fn code(&self) -> ExitCode {
+        match self {
+            Error::Usage(_) | Error::Io(_) => ExitCode::from(2),
+            _ => ExitCode::from(1),
+        }
+    }
+
+    /// Prints the error (a scene's diagnostics are printed already) and gives the exit code.
+    pub fn exit(self) -> ExitCode {
+        if !matches!(self, Error::Scene(_)) {
+            eprintln!("error: {self}");
+        }
+        self.code()
+    }
+}
+
+/// A scene checked at one time, with its settings overridden by the job, and lowered.
+#[derive(Debug, Clone)]
+pub struct FrameScene {
+    /// The scene, settings applied.
+    pub scene: Scene,
+    /// Its distance program and what else the backends read.
+    pub lowered: Lowered,
+    /// Where its time went (`--stats`): the check, then the lowering's phases.
+    pub phases: Vec<(&'static str, Duration, String)>,
+}
+
+impl Job {
+    /// The backend and float type the job renders with: `--reference` means the CPU in f64.
+    pub fn mode(&self) -> Result<(Backend, Precision), Error> {
+        self.devices.check(self.backend).map_err(Error::Usage)?;
+        if !self.overrides.reference {
+            return Ok((self.backend, self.precision));
+        }
+        if self.devices != Devices::Auto {
+            return Err(Error::Usage(
+                "--reference renders on the CPU in f64; it cannot use --devices".into(),
+            ));
+        }
+        match self.backend {
+            Backend::Auto | Backend::Cpu => Ok((Backend::Cpu, Precision::F64)),
+            b => Err(Error::Usage(format!(
+                "--reference renders on the CPU in f64; it cannot use --backend {}",
+                format!("{b:?}").to_lowercase()
+            ))),
+        }
+    }
+
+    /// `Err` for a `--kernel` given with `backend`, which has no GPU kernel.
+    pub fn check_kernel(&self, backend: Backend) -> Result<(), Error> {
+        Kernel::check(self.kernel, backend).map_err(Error::Usage)
+    }
+
+    /// How the job's scenes are prepared: its float type (f64 for `--reference`), `--debug-nan`
+    /// and `--kernel`; the command sets the rest.
+    pub fn setup(&self) -> Setup {
+        Setup {
+            precision: self.mode().map_or(self.precision, |(_, p)| p),
+            debug_nan: self.debug_nan,
+            kernel: self.kernel.unwrap_or_default().choice(),
+            ..Setup::default()
+        }
+    }
+
+    /// A rayon pool of `--threads` workers (default: rayon's choice, one per core).
+    pub fn pool(&self) -> Result<rayon::ThreadPool, Error> {
+        thread_pool(self.threads).map_err(Error::Usage)
+    }
+
+    /// Applies the job's settings to `scene`: the reference's (`--reference`), then `--size`,
+    /// `--aa` and each `--set`, within the limits.
+    pub fn settings(&self, scene: &mut Scene) -> Result<(), Error> {
+        let o = &self.overrides;
+        if o.reference {
+            scene.settings = reference::settings_of(scene);
+        }
+        crate::settings::override_settings(&mut scene.settings, o.size, o.aa, &o.set, &self.limits)
+            .map_err(Error::Usage)
+    }
+
+    /// The scene `loaded` checked to, taken out of it, with the job's settings; its
+    /// diagnostics are printed first (warnings only when `warnings`).
+    pub fn scene(&self, loaded: &mut Loaded, warnings: bool) -> Result<Scene, Error> {
+        let mut scene = self.checked(loaded, warnings)?;
+        self.settings(&mut scene)?;
+        Ok(scene)
+    }
+
+    /// The scene `loaded` checked to, taken out of it as it is (a command that changes its
+    /// settings before the job's, as `sdfc pareto` does, applies them with
+    /// [`Job::settings`]); its diagnostics are printed first (warnings only when
+    /// `warnings`).
+    pub fn checked(&self, loaded: &mut Loaded, warnings: bool) -> Result<Scene, Error> {
+        if !warnings {
+            loaded.diagnostics.retain(|d| d.is_error());
+        }
+        frontend::report(loaded, DiagnosticFormat::Human);
+        loaded
+            .scene
+            .take()
+            .ok_or_else(|| Error::scene(loaded.diagnostics.clone(), &loaded.sources))
+    }
+
+    /// `scene` (read from `sources`) lowered with `lowering` within the limits; a program
+    /// above the `program` limit is printed as a diagnostic (E0507).
+    pub fn lower(
+        &self,
+        scene: &Scene,
+        sources: &SourceMap,
+        lowering: &LowerOptions,
+    ) -> Result<Lowered, Error> {
+        lower::lower_within(scene, lowering, &self.limits).map_err(|d| {
+            frontend::print_diagnostics(std::slice::from_ref(&d), sources, DiagnosticFormat::Human);
+            Error::scene(vec![d], sources)
+        })
+    }
+
+    /// `source` checked at `time` (its diagnostics printed, warnings only when `warnings`),
+    /// the job's settings applied, lowered with `lowering` (a sequence's frames with
+    /// [`LowerOptions::parametric`]), and its method allowed.
+    pub fn frame(
+        &self,
+        source: &mut Source,
+        time: f64,
+        warnings: bool,
+        lowering: &LowerOptions,
+    ) -> Result<FrameScene, Error> {
+        let started = Instant::now();
+        let mut loaded = source.check(&self.limits, time);
+        let mut phases = vec![(
+            "check",
+            started.elapsed(),
+            "parsed, imports read, checked and evaluated".to_string(),
+        )];
+        let scene = self.scene(&mut loaded, warnings)?;
+        let lowered = self.lower(&scene, &loaded.sources, lowering)?;
+        backend::method_allowed(&scene, &lowered.traceable).map_err(Error::Unsupported)?;
+        phases.extend(
+            lowered
+                .phases
+                .list
+                .iter()
+                .map(|&(name, time, what)| (name, time, what.to_string())),
+        );
+        Ok(FrameScene {
+            scene,
+            lowered,
+            phases,
+        })
+    }
+}
+
+/// A rayon pool of `threads` workers (default: rayon's choice, one per core).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        if n == 0 {
+            return Err("--threads must be at least 1".into());
+        }
+        b = b.num_threads(n);
+    }
+    b.build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))
+}
+
+/// Prepares a frame's scene for `backend` on `devices`, or on the device `opening` opens
+/// (for `--devices auto`) when given.
+pub fn prepare(
+    pool: &rayon::ThreadPool,
+    (backend, devices): (Backend, &Devices),
+    frame: FrameScene,
+    setup: &Setup,
+    opening: Option<Opening>,
+) -> Result<(Scene, Prepared), Error> {
+    let FrameScene { scene, lowered, .. } = frame;
+    // A kernel asked for that cannot render the scene is an error, not a reason to fall back
+    // to another backend.
+    if backend != Backend::Cpu {
+        let options = wgsl::Options {
+            kernel: setup.kernel,
+            ..Default::default()
+        };
+        wgsl::choose(&scene, &lowered, &options).map_err(Error::Unsupported)?;
+    }
+    let prepared = pool
+        .install(|| match opening {
+            Some(o) if o.backend() == backend && *devices == Devices::Auto => {
+                Prepared::opened(o, &scene, lowered, setup)
+            }
+            _ => Prepared::on_devices(backend, devices, &scene, lowered, setup),
+        })
+        .map_err(|message| Error::Unavailable { backend, message })?;
+    Ok((scene, prepared))
+}
+
+/// What a render of `scene` on `prepared` allocates (with the reference's check and the
+/// depth sidecar when asked), announced (when `announce`) and held to the `memory` limit.
+pub fn check_memory(
+    pool: &rayon::ThreadPool,
+    prepared: &Prepared,
+    scene: &Scene,
+    (reference, aux): (bool, bool),
+    limits: &Limits,
+    announce: bool,
+) -> Result<(), Error> {
+    let needed = pool.install(|| memory::render(prepared, scene, reference, aux));
+    if announce {
+        eprintln!(
+            "{}",
+            memory::announce(&scene.settings, prepared.name(), &needed)
+        );
+    }
+    needed.check(limits).map_err(Error::Memory)
+}
+
+/// The backend prepared for the frames of a sequence: the device is opened once; a frame
+/// whose distance program (and the origin it is written relative to) is the last one's
+/// renders with the same kernel; another is prepared with [`Prepared::update`], which keeps a
+/// GPU kernel whose text is unchanged (its constants are read from `scene_data`), so `count`
+/// counts kernels built, not frames.
+pub struct Kernels<'a> {
+    pool: &'a rayon::ThreadPool,
+    backend: Backend,
+    devices: Devices,
+    setup: Setup,
+    /// The last frame's program and scene origin, and the backend prepared for them.
+    prepared: Option<(Program, [f64; 3], Prepared)>,
+    /// Kernels (or CPU tapes) prepared so far.
+    pub count: usize,
+    /// Time spent preparing them.
+    pub time: Duration,
+}
+
+impl std::fmt::Debug for Kernels<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Kernels")
+            .field("count", &self.count)
+            .finish()
+    }
+}
+
+impl<'a> Kernels<'a> {
+    /// No kernel yet: the frames will render with `backend` on `devices`.
+    pub fn new(
+        pool: &'a rayon::ThreadPool,
+        (backend, devices): (Backend, Devices),
+        setup: Setup,
+    ) -> Self {
+        Kernels {
+            pool,
+            backend,
+            devices,
+            setup,
+            prepared: None,
+            count: 0,
+            time: Duration::ZERO,
+        }
+    }
+
+    /// The backend prepared for `frame` (the last one when its program is the same,
+    /// specialised again if its settings need it), and the frame's scene.
+    pub fn prepare(&mut self, frame: FrameScene) -> Result<(Scene, &Prepared), Error> {
+        let started = Instant::now();
+        let same = self
+            .prepared
+            .as_ref()
+            .is_some_and(|(p, o, _)| *p == frame.lowered.program && *o == frame.scene.origin);
+        let scene = match &mut self.prepared {
+            Some((_, _, prepared)) if same => {
+                let FrameScene { scene, .. } = frame;
+                if prepared.specialise(&scene).map_err(Error::Prepare)? {
+                    self.count += 1;
+                }
+                scene
+            }
+            // The device stays open; the kernel is kept when its text is the same (the
+            // program differs in numbers only) and given the frame's constants.
+            Some((held, origin, prepared)) => {
+                let FrameScene { scene, lowered, .. } = frame;
+                *held = lowered.program.clone();
+                *origin = scene.origin;
+                if prepared.update(&scene, lowered).map_err(Error::Prepare)? {
+                    self.count += 1;
+                }
+                scene
+            }
+            None => {
+                let program = frame.lowered.program.clone();
+                let (scene, prepared) = prepare(
+                    self.pool,
+                    (self.backend, &self.devices),
+                    frame,
+                    &self.setup,
+                    None,
+                )?;
+                self.count += 1;
+                self.prepared = Some((program, scene.origin, prepared));
+                scene
+            }
+        };
+        self.time += started.elapsed();
+        let (_, _, prepared) = self.prepared.as_ref().expect("prepared");
+        Ok((scene, prepared))
+    }
+
+    /// The backend last prepared.
+    pub fn last(&self) -> Option<&Prepared> {
+        self.prepared.as_ref().map(|(_, _, p)| p)
+    }
+}

@@ -101,6 +101,34 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
     }
 }
 
+/// The statistics a frame reports are reduced on the device (`gpu::reduce`): they are the
+/// host's sums of the per-pixel statistics read back whole, percentile included.
+#[test]
+fn statistics_reduced_on_the_device_are_the_hosts_sums() {
+    let Some(a) = open_gpu() else { return };
+    for (name, aa) in [("seed3", 2), ("seed6", 1), ("glass", 1)] {
+        let path = PathBuf::from(format!("../examples/{name}.sdf"));
+        let mut scene = load(&path, 131, 97);
+        scene.settings.aa = aa;
+        let lowered = Lowered::new(&scene);
+        let l = lowered.program.lipschitz();
+        let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
+        let frame = gpu::render(&a, &scene, &kernel, l, &mut |_| {}).expect("lavapipe");
+        let words = a
+            .last_statistics(131 * 97)
+            .expect("read back")
+            .expect("the frame's buffers are kept");
+        let (mut counters, steps) = gpu::counters(&words);
+        counters.camera_rays = frame.render.stats.counters.camera_rays;
+        let host = cpu::Stats::new(counters, &steps);
+        assert!(
+            host.counters.steps > 0 && host.steps_p99 > 0,
+            "{name}: {host:?}"
+        );
+        assert_eq!(frame.render.stats, host, "{name}");
+    }
+}
+
 #[test]
 fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
     let Some(a) = open_gpu() else { return };

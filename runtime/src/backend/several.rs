@@ -43,16 +43,22 @@ impl Renderer for SeveralPrepared {
             .unwrap_or_default()
     }
 
-    /// Each device holds a whole frame's buffers; the bands read back and the image they are
-    /// assembled into are no more than one device's whole readback.
+    /// Each GPU holds a whole frame's buffers in its own memory: the limit counts the most one
+    /// of them allocates, not their sum. The bands read back and the image they are assembled
+    /// into are no more than one GPU's whole readback on the host; the CPU's share is host
+    /// memory beside it.
     fn memory(&self, scene: &Scene, settings: &Settings) -> Memory {
-        self.parts.iter().fold(Memory::default(), |m, p| {
-            let d = p.memory(scene, settings);
-            Memory {
-                host: m.host + d.host,
-                device: m.device + d.device,
-            }
-        })
+        let each: Vec<Memory> = self
+            .parts
+            .iter()
+            .map(|p| p.memory(scene, settings))
+            .collect();
+        let (cpu, gpus): (Vec<&Memory>, Vec<&Memory>) = each.iter().partition(|m| m.device == 0);
+        Memory {
+            host: cpu.iter().map(|m| m.host).sum::<u64>()
+                + gpus.iter().map(|m| m.host).max().unwrap_or(0),
+            device: gpus.iter().map(|m| m.device).max().unwrap_or(0),
+        }
     }
 
     fn retained(&self, settings: &Settings) -> u64 {

@@ -58,6 +58,24 @@ pub struct Stats {
 }
 
 impl Stats {
+    /// Statistics from the counters and the distribution of the steps reduced elsewhere (on a
+    /// GPU, `gpu::reduce`): `pixels` pixels, the most steps of one and the 99th percentile;
+    /// the mean is the counters' steps over the pixels. The same as [`Stats::new`] of the
+    /// per-pixel steps.
+    pub fn reduced(counters: Counters, pixels: u64, max: u32, p99: u32) -> Self {
+        Stats {
+            counters,
+            pixels,
+            steps_mean: if pixels == 0 {
+                0.0
+            } else {
+                counters.steps as f64 / pixels as f64
+            },
+            steps_p99: p99,
+            steps_max: max,
+        }
+    }
+
     /// Statistics from the counters and the steps taken for each pixel.
     pub fn new(counters: Counters, steps_per_pixel: &[u32]) -> Self {
         let n = steps_per_pixel.len();

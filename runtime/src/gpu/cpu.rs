@@ -3,7 +3,8 @@
 //! takes with [`crate::cpu::render_rows`] in a thread pool of its own.
 
 use super::launch::{self, Job, Pixels};
-use crate::cpu::{self, Options, Tapes};
+use super::reduce::{Answer, Ask};
+use crate::cpu::{self, Counters, Options, Tapes};
 use sdfc_compiler::scene::Scene;
 use std::ops::Range;
 use std::time::Duration;
@@ -30,11 +31,13 @@ impl<'a> Device<'a> {
     }
 }
 
-/// The CPU's frame: its thread pool and the bands rendered and not yet read.
+/// The CPU's frame: its thread pool, the bands rendered and not yet read, and the steps and
+/// counters of those read (their statistics, reduced on the host when asked).
 #[derive(Debug)]
 pub struct Frame {
     pool: rayon::ThreadPool,
-    rendered: Vec<(Range<usize>, Pixels)>,
+    rendered: Vec<(Range<usize>, Vec<[f32; 3]>)>,
+    statistics: Vec<(Range<usize>, Vec<u32>, Counters)>,
 }
 
 impl launch::Device for Device<'_> {
@@ -53,6 +56,7 @@ impl launch::Device for Device<'_> {
         Ok(Frame {
             pool,
             rendered: Vec::new(),
+            statistics: Vec::new(),
         })
     }
 
@@ -67,16 +71,9 @@ impl launch::Device for Device<'_> {
                 .pool
                 .install(|| cpu::render_rows(self.scene, self.tapes, self.options, rows));
             let w = job.width as usize;
-            f.rendered.push((
-                t.1 as usize * w..(t.1 + t.3) as usize * w,
-                Pixels {
-                    linear,
-                    rgba: Vec::new(),
-                    steps,
-                    counters,
-                    convert: Duration::ZERO,
-                },
-            ));
+            let range = t.1 as usize * w..(t.1 + t.3) as usize * w;
+            f.rendered.push((range.clone(), linear));
+            f.statistics.push((range, steps, counters));
         }
         Ok(())
     }
@@ -89,12 +86,12 @@ impl launch::Device for Device<'_> {
                 .iter()
                 .position(|(have, _)| have == r)
                 .ok_or_else(|| format!("the CPU did not render pixels {r:?}"))?;
-            let (_, p) = f.rendered.swap_remove(at);
+            let (_, linear) = f.rendered.swap_remove(at);
             if job.finished {
                 // Finished here as a GPU finishes its pixels: clamped and sRGB-encoded.
                 let start = std::time::Instant::now();
                 let table = crate::image::SrgbTable::get();
-                out.rgba.extend(p.linear.iter().flat_map(|c| {
+                out.rgba.extend(linear.iter().flat_map(|c| {
                     [
                         table.encode(c[0]),
                         table.encode(c[1]),
@@ -104,12 +101,28 @@ impl launch::Device for Device<'_> {
                 }));
                 out.convert += start.elapsed();
             } else {
-                out.linear.extend(p.linear);
+                out.linear.extend(linear);
             }
-            out.steps.extend(p.steps);
-            out.counters.add(&p.counters);
         }
         Ok(out)
+    }
+
+    /// Reduced on the host, from the steps and counters of the bands rendered.
+    fn reduce(
+        &self,
+        f: &mut Frame,
+        _job: &Job,
+        ranges: &[Range<usize>],
+        ask: Ask,
+    ) -> Result<Answer, String> {
+        let mut steps = Vec::new();
+        let mut counters = Counters::default();
+        for (r, s, c) in f.statistics.iter().filter(|(r, ..)| ranges.contains(r)) {
+            debug_assert_eq!(r.len(), s.len());
+            steps.extend_from_slice(s);
+            counters.add(c);
+        }
+        Ok(Answer::of_steps(&steps, &counters, ask))
     }
 
     fn finish(&self, _f: Frame, _job: &Job) -> Result<Option<Duration>, String> {

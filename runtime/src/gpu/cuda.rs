@@ -1,17 +1,20 @@
 //! The CUDA launcher: loads the PTX of the kernel through the driver's JIT (the compiled
 //! module is cached on disk, keyed by a hash of the PTX and the device), renders in tiles
-//! (one launch each) and reads back the image and the statistics.
+//! (one launch each) and reads back the image, and the statistics reduced on the device
+//! (`super::reduce`).
 //!
 //! The driver is loaded at run time (cudarc's dynamic loading), so sdfc builds and runs on
 //! machines without CUDA and says so when asked to use it.
 #![allow(unsafe_code)] // The driver API is C: its calls are wrapped here, each with its reason.
 
 use super::launch::{self, Job, Pixels};
+use super::reduce::{self, Answer, Ask};
 use cudarc::driver::{
     sys, CudaContext, CudaEvent, CudaFunction, CudaSlice, CudaStream, LaunchConfig,
     PinnedHostSlice, PushKernelArg,
 };
 use sdfc_compiler::back::ptx::{self, Argument, Param, Space};
+use sdfc_compiler::back::wgsl::reduce as reduction;
 use sdfc_compiler::back::wgsl::STATS_WORDS;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -68,6 +71,9 @@ pub struct Cuda {
     /// the driver copies into pageable memory through a staging buffer of its own, at a
     /// fraction of the bus's speed.
     pinned: Mutex<Option<PinnedHostSlice<u8>>>,
+    /// The statistics' reduction (`sdfc_compiler::back::wgsl::reduce` as PTX), loaded when
+    /// first used.
+    reducer: Mutex<Option<Arc<Loaded>>>,
 }
 
 /// A kernel loaded into the device, with how it was loaded.
@@ -100,6 +106,9 @@ pub struct FrameBuffers {
     /// The finished pixels, RGBA8 (binding 5).
     pixels: CudaSlice<u8>,
     events: Vec<(CudaEvent, CudaEvent)>,
+    /// The reduction's partial records and totals, made when a frame's statistics are first
+    /// reduced.
+    reduction: Option<(CudaSlice<u32>, CudaSlice<u32>)>,
 }
 
 impl std::fmt::Debug for FrameBuffers {
@@ -182,6 +191,7 @@ impl Cuda {
             memory,
             spare: Mutex::new(None),
             pinned: Mutex::new(None),
+            reducer: Mutex::new(None),
         })
     }
 
@@ -298,6 +308,19 @@ impl Cuda {
         }
     }
 
+    /// The statistics' reduction, loaded (from the JIT cache, or compiled) when first asked.
+    fn reducer(&self) -> Result<Arc<Loaded>, Error> {
+        let mut kept = self.reducer.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(k) = kept.as_ref() {
+            return Ok(k.clone());
+        }
+        let ptx = reduction::ptx(self.sm)
+            .map_err(|e| Error::Jit(format!("the statistics' reduction: {e}")))?;
+        let loaded = Arc::new(self.load(&ptx, reduction::ENTRY_POINT, None)?);
+        *kept = Some(loaded.clone());
+        Ok(loaded)
+    }
+
     /// The kernel `loaded` on this device (workgroups of `workgroup`² threads), as a
     /// [`launch::Device`] the scheduler renders tiles on.
     pub fn kernel<'a>(&'a self, loaded: &'a Loaded, workgroup: u32) -> Kernel<'a> {
@@ -404,6 +427,7 @@ impl launch::Device for Kernel<'_> {
             data,
             pixels: finished,
             events: Vec::with_capacity(job.tiles.len()),
+            reduction: None,
         })
     }
 
@@ -470,13 +494,11 @@ impl launch::Device for Kernel<'_> {
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Error> {
         let s = &self.cuda.stream;
-        let words = STATS_WORDS as usize;
         let n: usize = ranges.iter().map(|r| r.end - r.start).sum();
         // The finished pixels (4 bytes each) or the linear colours (4 floats).
         let paged = job.finished && ranges.len() != 1;
         let mut rgba = vec![0u8; if paged { 4 * n } else { 0 }];
         let mut image = vec![0f32; if job.finished { 0 } else { 4 * n }];
-        let mut stats = vec![0u32; if job.statistics { words * n } else { 0 }];
         if job.finished && ranges.len() == 1 {
             // Through the kept page-locked buffer, then copied out.
             let r = &ranges[0];
@@ -500,13 +522,6 @@ impl launch::Device for Kernel<'_> {
                 )
                 .map_err(driver("reading the image"))?;
             }
-            if job.statistics {
-                s.memcpy_dtoh(
-                    &f.stats.slice(words * r.start..words * r.end),
-                    &mut stats[words * at..words * (at + len)],
-                )
-                .map_err(driver("reading the statistics"))?;
-            }
             at += len;
         }
         s.synchronize().map_err(driver("reading the image"))?;
@@ -519,14 +534,70 @@ impl launch::Device for Kernel<'_> {
                 .collect()
         };
         drop(image);
-        let (counters, steps) = super::counters(&stats, ranges);
         Ok(Pixels {
             linear,
             rgba,
-            steps,
-            counters,
             convert: convert.elapsed(),
         })
+    }
+
+    fn reduce(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        ranges: &[Range<usize>],
+        ask: Ask,
+    ) -> Result<Answer, Error> {
+        let queries = reduce::queries(job.pixels(), ranges, ask);
+        if queries.is_empty() {
+            return Ok(Answer::empty(ask));
+        }
+        let reducer = self.cuda.reducer()?;
+        let s = &self.cuda.stream;
+        let (first, second) = reduce::threads(job.pixels());
+        let record = reduction::RECORD as usize;
+        if f.reduction.is_none() {
+            let partial = s
+                .alloc_zeros::<u32>(first as usize * record)
+                .map_err(driver("allocating the statistics' reduction"))?;
+            let total = s
+                .alloc_zeros::<u32>(second as usize * record)
+                .map_err(driver("allocating the statistics' reduction"))?;
+            f.reduction = Some((partial, total));
+        }
+        let Some((partial, total)) = f.reduction.as_mut() else {
+            unreachable!("made above")
+        };
+        let words: Vec<u32> = queries.iter().flat_map(|q| q.words()).collect();
+        let slots = s
+            .clone_htod(&words)
+            .map_err(driver("uploading the reduction's queries"))?;
+        let n = reduction::QUERY_WORDS as usize;
+        for (i, q) in queries.iter().enumerate() {
+            let query = slots.slice(n * i..n * (i + 1));
+            let cfg = LaunchConfig {
+                grid_dim: (q.threads.div_ceil(reduction::WORKGROUP), 1, 1),
+                block_dim: (reduction::WORKGROUP, 1, 1),
+                shared_mem_bytes: 0,
+            };
+            let mut launch = s.launch_builder(&reducer.function);
+            launch
+                .arg(&query)
+                .arg(&f.stats)
+                .arg(&mut *partial)
+                .arg(&mut *total);
+            // SAFETY: the reduction's parameters are its four buffers in binding order (the
+            // PTX back end's interface): a query of `QUERY_WORDS` words, the frame's
+            // statistics (`STATS_WORDS` a pixel, every pixel a query names within the frame),
+            // and the partial records and totals, a record of `RECORD` words for each thread
+            // of the first and second stage (`reduce::threads`, which sized them).
+            unsafe { launch.launch(cfg) }.map_err(driver("reducing the statistics"))?;
+        }
+        let totals = s
+            .clone_dtoh(&*total)
+            .map_err(driver("reading the statistics"))?;
+        s.synchronize().map_err(driver("reducing the statistics"))?;
+        Ok(Answer::of_totals(&totals, ask))
     }
 
     fn finish(&self, f: FrameBuffers, job: &Job) -> Result<Option<Duration>, Error> {

@@ -10,8 +10,8 @@
 //! (a band is contiguous in the image, so a device reads back only what it rendered); a
 //! device that fails hands its band back to the queue and the others finish the frame.
 
+use super::reduce::{Answer, Ask, Rounds, Selection, Summary};
 use super::Phases;
-use crate::cpu::Counters;
 use std::collections::VecDeque;
 use std::ops::Range;
 use std::sync::{mpsc, Condvar, Mutex};
@@ -39,9 +39,10 @@ pub struct Job<'a> {
     /// Whether to time the tiles on the device (timestamps or events); without it the
     /// frame's time is its wall time.
     pub timed: bool,
-    /// Whether to read the per-pixel statistics back (`--stats`, `bench`, the viewer): at
-    /// 1920×1080 they are 66 MB beside the image's 33 MB. Without them the frame's steps are
-    /// zero and its counters empty (the kernel still writes them on the device).
+    /// Whether to reduce the per-pixel statistics on the device to the frame's counters and
+    /// steps ([`Device::reduce`], `--stats`, `bench`): a few kilobytes read back where the
+    /// statistics themselves are 66 MB at 1920×1080. Without them the frame's steps are zero
+    /// and its counters empty (the kernel still writes them on the device).
     pub statistics: bool,
     /// Whether to read back the finished pixels (RGBA8, sRGB-encoded on the device: 4 bytes
     /// a pixel) instead of the linear colours (16 bytes a pixel on the device, 12 on the
@@ -50,7 +51,8 @@ pub struct Job<'a> {
 }
 
 impl Job<'_> {
-    fn pixels(&self) -> usize {
+    /// The image's pixels.
+    pub fn pixels(&self) -> usize {
         self.width as usize * self.height as usize
     }
 
@@ -64,14 +66,12 @@ impl Job<'_> {
 }
 
 /// Pixels read back from a device, in the order of the ranges asked for: linear colours (or,
-/// for a job that asks for them, finished RGBA8 bytes), marching steps per pixel and the
-/// counters they add up to, and how long converting them from the device's layout took.
+/// for a job that asks for them, finished RGBA8 bytes), and how long converting them from the
+/// device's layout took.
 #[derive(Debug, Default)]
 pub struct Pixels {
     pub linear: Vec<[f32; 3]>,
     pub rgba: Vec<u8>,
-    pub steps: Vec<u32>,
-    pub counters: Counters,
     pub convert: Duration,
 }
 
@@ -94,6 +94,15 @@ pub trait Device: Sync {
         job: &Job,
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Self::Error>;
+    /// The statistics of the pixels of `ranges` (rendered in `frame`) reduced as `ask` asks,
+    /// on the device ([`super::reduce`]).
+    fn reduce(
+        &self,
+        frame: &mut Self::Frame,
+        job: &Job,
+        ranges: &[Range<usize>],
+        ask: Ask,
+    ) -> Result<Answer, Self::Error>;
     /// Errors the device held back so far (on several devices, each band is checked before
     /// it is accepted).
     fn check(&self, _frame: &mut Self::Frame) -> Result<(), Self::Error> {
@@ -113,8 +122,8 @@ pub trait Device: Sync {
 pub struct Output {
     pub linear: Vec<[f32; 3]>,
     pub rgba: Vec<u8>,
-    pub steps: Vec<u32>,
-    pub counters: Counters,
+    /// The statistics reduced on the devices (empty unless the job asked for them).
+    pub summary: Summary,
     pub phases: Phases,
     /// The tiles' time on the device, where measured.
     pub device_time: Option<Duration>,
@@ -253,13 +262,21 @@ pub fn render_one<D: Device>(
     let readback = Instant::now();
     let whole = 0..job.pixels();
     let pixels = device.read(&mut frame, job, std::slice::from_ref(&whole))?;
+    let mut summary = Summary::default();
+    if job.statistics {
+        let mut selection = Selection::new(job.pixels() as u64);
+        while let Some(ask) = selection.ask() {
+            let answer = device.reduce(&mut frame, job, std::slice::from_ref(&whole), ask)?;
+            selection.answer(answer);
+        }
+        summary = selection.summary();
+    }
     let readback = readback.elapsed().saturating_sub(pixels.convert);
     let device_time = device.finish(frame, job)?;
     Ok(Output {
         linear: pixels.linear,
         rgba: pixels.rgba,
-        steps: pixels.steps,
-        counters: pixels.counters,
+        summary,
         phases: Phases {
             setup,
             launches: wall,
@@ -383,13 +400,15 @@ impl<T> Queue<T> {
 }
 
 /// The bands of a frame on several devices: the job, the queue of band indices, where
-/// finished bands go, and the faults to inject.
+/// finished bands go, the faults to inject, and the rounds of the statistics' reduction
+/// when the job asks for them.
 #[derive(Debug)]
 pub struct Bands<'a> {
     job: &'a Job<'a>,
     faults: &'a Faults,
     queue: Queue<usize>,
     events: mpsc::Sender<(usize, Pixels)>,
+    rounds: Option<Rounds>,
 }
 
 impl<D: Device> Worker for D {
@@ -407,14 +426,22 @@ impl<D: Device> Worker for D {
             failure: None,
         };
         let setup = Instant::now();
+        // Leaves the statistics' rounds when the worker ends without answering them.
+        let leave = |lost: bool| {
+            if let Some(r) = &bands.rounds {
+                r.leave(lost)
+            }
+        };
         let mut frame = match self.prepare(job) {
             Ok(f) => f,
             Err(e) => {
+                leave(false);
                 share.failure = Some(e.to_string());
                 return share;
             }
         };
         share.phases.setup = setup.elapsed();
+        let mut rendered: Vec<Range<usize>> = Vec::new();
         while let Some(band) = queue.take() {
             let launch = Instant::now();
             let ran = match bands.faults.injected(position, share.tiles) {
@@ -431,15 +458,38 @@ impl<D: Device> Worker for D {
                     share.phases.readback += read.elapsed().saturating_sub(pixels.convert);
                     share.phases.convert += pixels.convert;
                     share.tiles += 1;
+                    rendered.push(job.band(band));
                     let _ = bands.events.send((band, pixels));
                     queue.done();
                 }
                 Err(e) => {
                     queue.hand_back(band);
                     share.failure = Some(e.to_string());
-                    return share;
+                    break;
                 }
             }
+        }
+        // Every band is rendered (or this device failed): the statistics of the bands this
+        // device rendered, a round at a time with the other devices. A device that failed
+        // answers for the bands it rendered before, if it still can.
+        if let Some(rounds) = &bands.rounds {
+            let read = Instant::now();
+            let mut round = 0;
+            while let Some(ask) = rounds.ask(round) {
+                match self.reduce(&mut frame, job, &rendered, ask) {
+                    Ok(answer) => rounds.answer(answer),
+                    Err(e) => {
+                        rounds.leave(!rendered.is_empty());
+                        share.failure.get_or_insert(e.to_string());
+                        return share;
+                    }
+                }
+                round += 1;
+            }
+            share.phases.readback += read.elapsed();
+        }
+        if share.failure.is_some() {
+            return share;
         }
         if let Err(e) = self.finish(frame, job) {
             share.failure = Some(e.to_string());
@@ -464,14 +514,15 @@ pub fn render_several(
         faults,
         queue: Queue::new(0..job.tiles.len(), false),
         events: tx,
+        rounds: job
+            .statistics
+            .then(|| Rounds::new(job.pixels() as u64, devices.len())),
     };
     let pixels = job.pixels();
     let (mut linear, mut rgba) = match job.finished {
         true => (Vec::new(), vec![0u8; 4 * pixels]),
         false => (vec![[0.0f32; 3]; pixels], Vec::new()),
     };
-    let mut steps = vec![0u32; pixels];
-    let mut counters = Counters::default();
     let mut assembly = Duration::ZERO;
     let mut done = 0usize;
     let shares = std::thread::scope(|scope| {
@@ -485,6 +536,9 @@ pub fn render_several(
                     std::panic::catch_unwind(run).unwrap_or_else(|_| {
                         // Its band is lost: the frame cannot be finished.
                         bands.queue.abandon();
+                        if let Some(r) = &bands.rounds {
+                            r.leave(true);
+                        }
                         Share {
                             device: d.name(),
                             tiles: 0,
@@ -502,10 +556,8 @@ pub fn render_several(
             let range = job.band(band);
             match job.finished {
                 true => rgba[4 * range.start..4 * range.end].copy_from_slice(&p.rgba),
-                false => linear[range.clone()].copy_from_slice(&p.linear),
+                false => linear[range].copy_from_slice(&p.linear),
             }
-            steps[range].copy_from_slice(&p.steps);
-            counters.add(&p.counters);
             done += 1;
             assembly += t.elapsed();
             progress(done as f64 / job.tiles.len().max(1) as f64);
@@ -566,11 +618,13 @@ pub fn render_several(
         .max_by_key(|p| p.total())
         .unwrap_or_default();
     phases.convert += assembly;
+    let summary = bands
+        .rounds
+        .map_or_else(Summary::default, |r| r.summary().0);
     Ok(Output {
         linear,
         rgba,
-        steps,
-        counters,
+        summary,
         phases,
         device_time: None,
         wall,
@@ -637,10 +691,27 @@ mod tests {
             let mut p = Pixels::default();
             for r in ranges {
                 p.linear.extend(r.clone().map(|i| [i as f32, 0.0, 0.0]));
-                p.steps.extend(r.clone().map(|i| i as u32));
-                p.counters.steps += r.clone().map(|i| i as u64).sum::<u64>();
             }
             Ok(p)
+        }
+        /// A pixel's steps are its index.
+        fn reduce(
+            &self,
+            _: &mut usize,
+            _: &Job,
+            ranges: &[Range<usize>],
+            ask: Ask,
+        ) -> Result<Answer, String> {
+            let steps: Vec<u32> = ranges
+                .iter()
+                .flat_map(|r| r.clone())
+                .map(|i| i as u32)
+                .collect();
+            let counters = crate::cpu::Counters {
+                steps: steps.iter().map(|&s| s as u64).sum(),
+                ..Default::default()
+            };
+            Ok(Answer::of_steps(&steps, &counters, ask))
         }
         fn finish(&self, _: usize, _: &Job) -> Result<Option<Duration>, String> {
             Ok(None)
@@ -679,8 +750,11 @@ mod tests {
             render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect("one survives");
         let n = 37 * 29;
         assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
-        assert_eq!(out.steps, (0..n as u32).collect::<Vec<_>>());
-        assert_eq!(out.counters.steps, (0..n as u64).sum::<u64>());
+        // The statistics of the bands every device rendered, reduced a round at a time: those
+        // of the whole frame (the failed devices' bands were rendered again by the good one).
+        assert_eq!(out.summary.counters.steps, (0..n as u64).sum::<u64>());
+        assert_eq!(out.summary.max, n as u32 - 1);
+        assert_eq!(out.summary.p99, ((n - 1) as f64 * 0.99).round() as u32);
         // The good device waited for a failure; a device that failed had rendered one band.
         assert_eq!(out.shares[1].failure, None);
         let lost_shares = [&out.shares[0], &out.shares[2]];

@@ -6,6 +6,7 @@ pub mod cpu;
 pub mod cuda;
 pub mod launch;
 pub mod points;
+pub mod reduce;
 pub mod wgpu;
 
 use crate::cpu::{Counters, Render, Stats};
@@ -231,9 +232,11 @@ pub fn render_several(
 /// The image and statistics of a frame the scheduler rendered.
 fn finish(out: launch::Output, s: &Settings) -> GpuRender {
     let start = Instant::now();
-    let mut counters = out.counters;
+    let summary = out.summary;
+    let mut counters = summary.counters;
     counters.camera_rays = (s.width as u64) * (s.height as u64) * (s.aa.max(1) as u64).pow(2);
-    let stats = Stats::new(counters, &out.steps);
+    let pixels = s.width as u64 * s.height as u64;
+    let stats = Stats::reduced(counters, pixels, summary.max, summary.p99);
     let mut phases = out.phases;
     phases.convert += start.elapsed();
     let finished = (!out.rgba.is_empty()).then_some(Rgba8 {
@@ -260,35 +263,52 @@ fn finish(out: launch::Output, s: &Settings) -> GpuRender {
     }
 }
 
-/// The most a wgpu render of `settings` allocates, with a scene uniform of `uniforms` bytes and
-/// scene data of `data` bytes. On the device: the uniform, the scene data, the tile table, the
-/// image (16 bytes a pixel), finished pixels (4) and statistics buffers, their readback copies
-/// and the timestamp queries. On the host: wgpu's staging copy of the scene data, the tile table (and its
-/// staging copy), the read-back bytes and their conversion to colours and statistics words,
-/// then the statistics' per-pixel steps and their sorted copy.
+/// The most a wgpu render of `settings` allocates on each device that renders it, with a
+/// scene uniform of `uniforms` bytes and scene data of `data` bytes (several devices each
+/// allocate a whole frame's buffers). On the device: the uniform, the scene data, the tile
+/// table, the image (16 bytes a pixel), finished pixels (4) and statistics buffers, the
+/// readback copy of the image (the larger of what is read back), the statistics' reduction
+/// ([`reduce_bytes`]) and the timestamp queries. On the host: wgpu's staging copy of the scene
+/// data, the tile table (and its staging copy), the read-back bytes and their conversion to
+/// colours (44 bytes a pixel, held at once).
 pub fn memory_wgpu(settings: &Settings, uniforms: u64, data: u64) -> Memory {
     let (pixels, tiles) = pixels_and_tiles(settings);
     let stats = 4 * STATS_WORDS as u64 * pixels;
     let table = tiles * 256;
     let queries = 2 * tiles * 8;
-    let device = uniforms.max(16) + data + table + 2 * (20 * pixels + stats) + 3 * queries;
-    // Read back: the image's bytes (16 a pixel), floats (16) and colours (12), and the
-    // statistics' bytes and words, all held at once (more than the colours, words, steps and
-    // sorted steps held afterwards).
-    let host = data + 2 * table + 2 * queries + 44 * pixels + 2 * stats;
+    let reduction = reduce_bytes(pixels);
+    let device = uniforms.max(16)
+        + data
+        + table
+        + 20 * pixels
+        + stats
+        + 16 * pixels
+        + reduction
+        + 3 * queries;
+    let host = data + 2 * table + 2 * queries + 44 * pixels + reduction;
     Memory { host, device }
 }
 
-/// The most a CUDA render of `settings` allocates, with a scene uniform of `uniforms` bytes
-/// and scene data of `data` bytes: on the device the uniform, scene data, tile table, image,
-/// finished pixels (4 bytes a pixel) and statistics; on the host the tile table, the read-back floats (16 bytes a pixel), colours
-/// (12) and statistics, then the steps.
+/// The most a CUDA render of `settings` allocates on each device that renders it, with a
+/// scene uniform of `uniforms` bytes and scene data of `data` bytes: on the device the
+/// uniform, scene data, tile table, image, finished pixels (4 bytes a pixel), statistics and
+/// their reduction ([`reduce_bytes`]); on the host the tile table, the read-back floats (16
+/// bytes a pixel) and colours (12), and the reduction's totals.
 pub fn memory_cuda(settings: &Settings, uniforms: u64, data: u64) -> Memory {
     let (pixels, tiles) = pixels_and_tiles(settings);
     let stats = 4 * STATS_WORDS as u64 * pixels;
-    let device = uniforms + data + 16 * tiles + 20 * pixels + stats;
-    let host = 16 * tiles + 64 * tiles + 16 * pixels + 12 * pixels + stats + 8 * pixels;
+    let reduction = reduce_bytes(pixels);
+    let device = uniforms + data + 16 * tiles + 20 * pixels + stats + reduction;
+    let host = 16 * tiles + 64 * tiles + 16 * pixels + 12 * pixels + reduction;
     Memory { host, device }
+}
+
+/// The bytes of the statistics' reduction for a frame of `pixels` pixels: its partial
+/// records and totals ([`reduce::threads`]).
+fn reduce_bytes(pixels: u64) -> u64 {
+    let (first, second) = reduce::threads(pixels as usize);
+    let record = 4 * sdfc_compiler::back::wgsl::reduce::RECORD as u64;
+    (first as u64 + 2 * second as u64) * record
 }
 
 /// The bytes of a finished GPU frame: its image.
@@ -302,17 +322,13 @@ fn pixels_and_tiles(settings: &Settings) -> (u64, u64) {
     (w * h, w.div_ceil(edge) * h.div_ceil(edge))
 }
 
-/// Sums the kernel's per-pixel statistics words into the CPU renderer's counters (all but
-/// the camera rays, which the settings give), with the marching steps of each pixel of
-/// `ranges`; no words (not read back) give empty counters and zero steps.
-pub(crate) fn counters(words: &[u32], ranges: &[std::ops::Range<usize>]) -> (Counters, Vec<u32>) {
+/// Sums the kernel's per-pixel statistics words, read back whole, into the CPU renderer's
+/// counters (all but the camera rays, which the settings give), with the marching steps of
+/// each pixel: what the reduction on the device ([`reduce`]) computes, here on the host (for
+/// checking it: [`wgpu::Gpu::last_statistics`]).
+pub fn counters(words: &[u32]) -> (Counters, Vec<u32>) {
     use rayon::prelude::*;
     let n = STATS_WORDS as usize;
-    if words.is_empty() {
-        // Not read back (`launch::Job::statistics`): no steps, one zero per pixel.
-        let pixels = ranges.iter().map(|r| r.end - r.start).sum();
-        return (Counters::default(), vec![0; pixels]);
-    }
     // In parallel: a 1080p frame has two million pixels of eight words.
     let steps: Vec<u32> = words.par_chunks_exact(n).map(|w| w[0]).collect();
     let c = words

@@ -1,8 +1,11 @@
 //! The wgpu launcher: finds an adapter, builds the kernel's compute pipeline, and renders an
 //! image in tiles (one dispatch each, so that no dispatch runs long enough to trip a driver
-//! watchdog), reading back the linear colours and the per-pixel statistics.
+//! watchdog), reading back the finished pixels or the linear colours, and the per-pixel
+//! statistics reduced on the device (`super::reduce`).
 
 use super::launch::{self, Job, Pixels};
+use super::reduce::{self, Answer, Ask};
+use sdfc_compiler::back::wgsl::reduce as reduction;
 use sdfc_compiler::back::wgsl::STATS_WORDS;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -73,6 +76,9 @@ pub struct Gpu {
     /// and mapped into the process each time otherwise (33 MB for a 1920×1080 frame's
     /// linear colours).
     staging: Mutex<Vec<wgpu::Buffer>>,
+    /// The statistics' reduction (`sdfc_compiler::back::wgsl::reduce`), compiled when first
+    /// used.
+    reducer: Mutex<Option<Pipeline>>,
 }
 
 /// How a kernel's pipeline was obtained ([`Gpu::pipeline_for`]).
@@ -243,6 +249,7 @@ impl Gpu {
             pipelines: Mutex::new(HashMap::new()),
             spare: Mutex::new(None),
             staging: Mutex::new(Vec::new()),
+            reducer: Mutex::new(None),
         })
     }
 
@@ -558,6 +565,7 @@ impl Gpu {
                 pixels * 4 * STATS_WORDS as u64,
                 U::STORAGE | U::COPY_SRC,
             ),
+            reduction: None,
         }
     }
 
@@ -628,6 +636,88 @@ impl Gpu {
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
             .map_err(error)
+    }
+
+    /// The statistics' reduction pipeline (`sdfc_compiler::back::wgsl::reduce`): binding 0
+    /// its query (read-only storage at a dynamic offset), 1 the kernel's statistics (read
+    /// only), 2 and 3 the partial records and totals.
+    fn reducer(&self) -> Result<Pipeline, Error> {
+        let mut kept = self.reducer.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(p) = kept.as_ref() {
+            return Ok(p.clone());
+        }
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("sdfc reduction"),
+                source: wgpu::ShaderSource::Wgsl(reduction::SOURCE.into()),
+            });
+        let entry = |binding, read_only, dynamic| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: dynamic,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = self
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("sdfc reduction"),
+                entries: &[
+                    entry(0, true, true),
+                    entry(1, true, false),
+                    entry(2, false, false),
+                    entry(3, false, false),
+                ],
+            });
+        let pipeline_layout = self
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("sdfc reduction"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("sdfc reduction"),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(reduction::ENTRY_POINT),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Pipeline(e.to_string()));
+        }
+        let p = Arc::new((pipeline, layout));
+        *kept = Some(p.clone());
+        Ok(p)
+    }
+
+    /// The per-pixel statistics of the last frame of `pixels` pixels rendered on this device,
+    /// read back whole ([`STATS_WORDS`] words a pixel), for checking their reduction on the
+    /// device against the host's sums ([`super::counters`]); `None` when no frame of that
+    /// size has been rendered.
+    pub fn last_statistics(&self, pixels: usize) -> Result<Option<Vec<u32>>, Error> {
+        let spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(b) = spare
+            .as_ref()
+            .filter(|b| b.image.size() == padded(16 * pixels as u64))
+        else {
+            return Ok(None);
+        };
+        let bytes = self.read(&b.stats, 4 * STATS_WORDS as u64 * pixels as u64)?;
+        Ok(Some(
+            bytes
+                .chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect(),
+        ))
     }
 
     fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
@@ -724,6 +814,9 @@ struct Buffers {
     image: wgpu::Buffer,
     pixels: wgpu::Buffer,
     stats: wgpu::Buffer,
+    /// The reduction's partial records and totals, made when a frame's statistics are first
+    /// reduced.
+    reduction: Option<(wgpu::Buffer, wgpu::Buffer)>,
 }
 
 fn words(w: &[u32]) -> Vec<u8> {
@@ -863,29 +956,95 @@ impl launch::Device for Kernel<'_> {
             })?;
             (linear, Vec::new())
         };
-        let words: Vec<u32> = if job.statistics {
-            let stats = bytes(4 * STATS_WORDS as u64);
-            self.gpu.read_with(&f.buffers.stats, &stats, |b| {
-                let start = Instant::now();
-                let words = b
-                    .par_chunks_exact(4)
-                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                    .collect();
-                convert += start.elapsed();
-                words
-            })?
-        } else {
-            Vec::new()
-        };
-        let start = Instant::now();
-        let (counters, steps) = super::counters(&words, ranges);
         Ok(Pixels {
             linear,
             rgba,
-            steps,
-            counters,
-            convert: convert + start.elapsed(),
+            convert,
         })
+    }
+
+    fn reduce(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        ranges: &[Range<usize>],
+        ask: Ask,
+    ) -> Result<Answer, Error> {
+        let queries = reduce::queries(job.pixels(), ranges, ask);
+        if queries.is_empty() {
+            return Ok(Answer::empty(ask));
+        }
+        let gpu = self.gpu;
+        let pipeline = gpu.reducer()?;
+        let (first, second) = reduce::threads(job.pixels());
+        let record = 4 * reduction::RECORD as u64;
+        let (partial, total) = f.buffers.reduction.get_or_insert_with(|| {
+            use wgpu::BufferUsages as U;
+            let make = |label, size| {
+                gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage: U::STORAGE | U::COPY_SRC,
+                    mapped_at_creation: false,
+                })
+            };
+            (
+                make("sdfc partial statistics", first as u64 * record),
+                make("sdfc statistics", second as u64 * record),
+            )
+        });
+        // One query a dispatch, each at its own offset of one buffer.
+        let slots: Vec<u8> = queries
+            .iter()
+            .flat_map(|q| {
+                let mut slot = words(&q.words());
+                slot.resize(TILE_STRIDE as usize, 0);
+                slot
+            })
+            .collect();
+        let query = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sdfc reduction queries"),
+            size: slots.len() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue.write_buffer(&query, 0, &slots);
+        let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sdfc reduction"),
+            layout: &pipeline.1,
+            entries: &[
+                entry(
+                    0,
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &query,
+                        offset: 0,
+                        size: std::num::NonZeroU64::new(4 * reduction::QUERY_WORDS as u64),
+                    }),
+                ),
+                entry(1, f.buffers.stats.as_entire_binding()),
+                entry(2, partial.as_entire_binding()),
+                entry(3, total.as_entire_binding()),
+            ],
+        });
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for (i, q) in queries.iter().enumerate() {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline.0);
+            pass.set_bind_group(0, &bind, &[i as u32 * TILE_STRIDE]);
+            pass.dispatch_workgroups(q.threads.div_ceil(reduction::WORKGROUP), 1, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let totals = gpu.read_with(
+            total,
+            std::slice::from_ref(&(0..second as u64 * record)),
+            |b| {
+                b.chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect::<Vec<u32>>()
+            },
+        )?;
+        Ok(Answer::of_totals(&totals, ask))
     }
 
     fn check(&self, f: &mut FrameBuffers) -> Result<(), Error> {

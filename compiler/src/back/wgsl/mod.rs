@@ -22,6 +22,7 @@ mod map;
 mod march;
 mod mesh;
 pub mod part;
+pub mod reduce;
 pub mod srgb;
 mod template;
 

@@ -5,7 +5,8 @@
 //! materials, ε, step budget, L).
 
 use crate::back::wgsl::Specialisation;
-use crate::lower::{Block, Lowered, Op, Reg};
+use crate::lower::Lowered;
+use crate::program::{Block, Op, Reg};
 use crate::scene::Scene;
 
 /// An operand that is a constant, in a [`Structure`].

@@ -1,35 +1,81 @@
 //! sdfc: a compiler for scenes of signed distance fields.
 //!
-//! The stages are typed functions with one entry each:
+//! The stages are typed functions with one entry each, re-exported here; the modules that
+//! implement them are private to the crate:
 //!
 //! ```text
-//! syntax::parse   .sdf text            → ast::File + diagnostics   (logos, chumsky)
-//! check::check    files (via a Loader) → scene::Scene + diagnostics
-//! scene::analysis::analyse  scene::Scene → exactness and Lipschitz bound per node
-//! lower::lower    scene::Scene         → program::Program           (flat scalar SSA)
-//! eval            program::Program     → distances at batches of points (CPU, f32/f64)
-//! back::rust      program::Program     → Rust source over glam
-//! back::wgsl      Scene + Program      → WGSL kernel, validated by naga
-//! back::shader    wgsl::Kernel         → SPIR-V, MSL, GLSL, HLSL (naga)
-//! back::ptx       naga::Module         → PTX
+//! parse             .sdf text            → ast::File + diagnostics   (logos, chumsky)
+//! check             files (via a Loader) → Scene + diagnostics
+//! analysis::analyse Scene                → exactness and Lipschitz bound per node
+//! Lowered::new      Scene                → Program (flat scalar SSA) and the scene's facts
+//! Evaluator         Program              → distances at batches of points (CPU, f32/f64)
+//! rust::write       Program              → Rust source over glam
+//! wgsl::write       Scene + Lowered      → WGSL kernel, validated by naga
+//! shader::write     wgsl::Kernel         → SPIR-V, MSL, GLSL, HLSL (naga)
+//! ptx::write        naga::Module         → PTX
 //! ```
 //!
 //! The crate does no IO and never panics on user input: imports are read through the
-//! [`check::Loader`] the caller passes in, and every problem is a [`Diagnostic`].
+//! [`Loader`] the caller passes in, and every problem is a [`Diagnostic`].
 
+// The stages, private to the crate: what other crates use is re-exported below.
+mod back;
+mod check;
+mod eval;
+mod limits;
+mod lower;
+mod program;
+mod rng;
+mod scene;
+mod span;
+mod syntax;
+
+/// A frame's structure, compared over frames to tell a still from an animation.
 pub mod animation;
-pub mod back;
-pub mod check;
+/// Diagnostics as data, rendered only at the edge (`render` as text, `to_json` as JSON lines).
 pub mod diagnostics;
-pub mod eval;
-pub mod limits;
-pub mod lower;
-pub mod program;
-pub mod rng;
-pub mod scene;
-pub mod span;
-pub mod syntax;
 
-pub use diagnostics::{Diagnostic, Severity};
-pub use limits::{Limit, Limits};
-pub use span::{FileId, SourceMap, Span};
+/// Sources, spans, resource limits and diagnostics.
+pub use crate::{
+    diagnostics::{has_errors, Diagnostic, Severity},
+    limits::{Limit, Limits},
+    span::{FileId, SourceMap, Span},
+};
+
+/// The front end: parse, format and check `.sdf` text (imports read through a [`Loader`]),
+/// the AST and its dump, and the built-ins table the checker, docs and editors read.
+pub use crate::{
+    check::{builtins, check, check_at, check_str, check_with, check_with_constants},
+    check::{Constant, Loader, NoImports},
+    syntax::{ast, dump as dump_ast, format, lexer, parse},
+};
+
+/// The scene IR the checker builds, its text dump, its analysis (exactness, Lipschitz
+/// bounds) and whether it is traced analytically.
+pub use crate::scene::{
+    analysis, analytic, dump as dump_ir,
+    ir::{
+        Animation, Camera, Colour, Combine, Exactness, Graph, Light, Material, MaterialId, Method,
+        Node, NodeId, Pattern, Scene, Settings, Smooth, V3,
+    },
+};
+
+/// The lowering, once per scene: the distance program and what every back end reads of the
+/// scene (`Lowered`: program, traceable primitives, media, instances, colour fields).
+pub use crate::{
+    lower::{lower, lower_scene, lower_with, lower_within, LowerOptions, Lowered},
+    lower::{ColourProgram, Colours, Media},
+    program::{Binary, Op, Program, Step, Unary},
+};
+
+/// The batch interpreter of distance programs (f32 or f64), and the bounds it verifies.
+pub use crate::eval::{
+    eval_point, verify::verify_fields, wide, Evaluator, Float, Outputs, Tape, DEFAULT_CHUNK,
+};
+
+/// The writers: the WGSL kernel (validated by naga), PTX from it, SPIR-V/MSL/GLSL/HLSL,
+/// Shadertoy, and Rust source over glam.
+pub use crate::back::{ptx, rust, shader, shadertoy, wgsl};
+
+/// The deterministic generator tests draw points from.
+pub use crate::rng::Rng;

@@ -4,9 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use sdfc_compiler::check::{check_with, NoImports};
-use sdfc_compiler::limits::{Limit, Limits};
-use sdfc_compiler::span::SourceMap;
+use sdfc_compiler::{check_with, Limit, Limits, NoImports, SourceMap};
 
 /// Limits far below the defaults: a mutated loop of 100 000 objects costs seconds under the
 /// fuzzer's instrumentation and teaches it nothing that a loop of 1 000 does not, so the
@@ -35,7 +33,7 @@ fuzz_target!(|data: &[u8]| {
     let _ = sdfc_compiler::diagnostics::to_json(&diags, &sources);
     // The formatter keeps the tokens or refuses (syntax errors); it never fails otherwise,
     // and what it writes it leaves as it is.
-    use sdfc_compiler::syntax::format::{format, Error};
+    use sdfc_compiler::format::{format, Error};
     match format(text) {
         Ok(out) => match format(&out) {
             Ok(again) => assert!(again == out, "formatting is not idempotent"),

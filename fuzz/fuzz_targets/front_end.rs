@@ -12,13 +12,13 @@ const LOWER_LIMIT: usize = 20_000;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
-    let (scene, diags, sources) = sdfc_compiler::check::check_str("fuzz.sdf", text);
+    let (scene, diags, sources) = sdfc_compiler::check_str("fuzz.sdf", text);
     // Rendering the diagnostics exercises every span.
     let _ = sdfc_compiler::diagnostics::render(&diags, &sources, false);
     let _ = sdfc_compiler::diagnostics::to_json(&diags, &sources);
     if let Some(scene) = scene.filter(|s| s.graph.len() <= LOWER_LIMIT) {
-        let _ = sdfc_compiler::scene::dump(&scene);
-        let program = sdfc_compiler::lower::lower(&scene);
+        let _ = sdfc_compiler::dump_ir(&scene);
+        let program = sdfc_compiler::lower(&scene);
         let _ = program.dump();
     }
 });

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use sdfc_compiler::back::{ptx, wgsl};
+use sdfc_compiler::{ptx, wgsl};
 
 /// Scenes larger than this (in IR nodes) are skipped: writing and validating the kernel of a
 /// scene of thousands of objects takes seconds under the fuzzer's instrumentation.
@@ -11,11 +11,11 @@ const KERNEL_LIMIT: usize = 2_000;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
-    let (Some(scene), _, _) = sdfc_compiler::check::check_str("fuzz.sdf", text) else { return };
+    let (Some(scene), _, _) = sdfc_compiler::check_str("fuzz.sdf", text) else { return };
     if scene.graph.len() > KERNEL_LIMIT {
         return;
     }
-    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let lowered = sdfc_compiler::Lowered::new(&scene);
     let kernel = match wgsl::write(&scene, &lowered) {
         Ok(k) => k,
         Err(e) => panic!("invalid kernel for an accepted scene: {e}"),

@@ -10,11 +10,10 @@ use pyo3::exceptions::{PyException, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use rayon::prelude::*;
-use sdfc_compiler::diagnostics::Diagnostic;
-use sdfc_compiler::eval::{Evaluator, Outputs, Tape, DEFAULT_CHUNK};
-use sdfc_compiler::lower::{self, LowerOptions};
-use sdfc_compiler::scene::{analysis, analytic};
-use sdfc_compiler::{Limits, Severity, SourceMap};
+use sdfc_compiler::{
+    analysis, analytic, lower_within, Diagnostic, Evaluator, Limits, LowerOptions, Lowered,
+    Outputs, Severity, SourceMap, Tape, DEFAULT_CHUNK,
+};
 use sdfc_runtime::backend::{Backend, Devices, Kernel, Prepared, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
 use sdfc_runtime::commands::mesh as mesher;
@@ -312,7 +311,7 @@ impl Scene {
     fn rendered(&self, ask: Ask, image_only: bool) -> Result<sdfc_runtime::cpu::Render, Failure> {
         let limits = Limits::default();
         let checked = self.checked(ask.time, ask.size, ask.aa)?;
-        let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
+        let lowered = lower_within(&checked.scene, &LowerOptions::default(), &limits)
             .map_err(|d| Failure::Compile(vec![d], checked.sources.clone()))?;
         sdfc_runtime::backend::method_allowed(&checked.scene, &lowered.traceable)
             .map_err(Failure::Value)?;
@@ -389,8 +388,8 @@ fn wgpu_device() -> Result<&'static std::sync::Arc<sdfc_runtime::gpu::Gpu>, Stri
 /// from the scene's WGSL part on a GPU: through wgpu, or as PTX through CUDA.
 fn gpu_distances(
     backend: &str,
-    scene: &sdfc_compiler::scene::Scene,
-    lowered: &lower::Lowered,
+    scene: &sdfc_compiler::Scene,
+    lowered: &Lowered,
     points: &[[f64; 3]],
 ) -> Result<(Vec<u8>, Vec<u8>), String> {
     use sdfc_runtime::gpu::points as on_gpu;
@@ -571,7 +570,7 @@ impl Scene {
         };
         let checked = self.checked(t, None, None).map_err(|f| f.into_py(py))?;
         let limits = Limits::default();
-        let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
+        let lowered = lower_within(&checked.scene, &LowerOptions::default(), &limits)
             .map_err(|d| compile_error(py, &[d], &checked.sources))?;
         let origin = checked.scene.origin;
         let xyz: Vec<[f64; 3]> = points
@@ -686,7 +685,7 @@ impl Scene {
                 _ => Failure::Runtime(msg),
             })?;
             let mesh = meshed.mesh;
-            let colours = sdfc_compiler::lower::Colours::new(&checked.scene);
+            let colours = sdfc_compiler::Colours::new(&checked.scene);
             let palette = sdfc_runtime::mesh::write::Palette::new(&checked.scene, &colours);
             let p: Vec<u8> = mesh
                 .positions
@@ -766,31 +765,28 @@ impl Scene {
             let src = self.source();
             let mut sources = SourceMap::new();
             let entry = sources.add(self.name.clone(), src.text().to_string());
-            let (ast, diags) = sdfc_compiler::syntax::parse(entry, sources.text(entry));
+            let (ast, diags) = sdfc_compiler::parse(entry, sources.text(entry));
             if sdfc_compiler::diagnostics::has_errors(&diags) {
                 return Err(compile_error(py, &diags, &sources));
             }
-            return Ok(PyBytes::new(
-                py,
-                sdfc_compiler::syntax::dump(&ast).as_bytes(),
-            ));
+            return Ok(PyBytes::new(py, sdfc_compiler::dump_ast(&ast).as_bytes()));
         }
         let checked = self.checked(t, None, None).map_err(|f| f.into_py(py))?;
         if emit == Emit::Ir {
             return Ok(PyBytes::new(
                 py,
-                sdfc_compiler::scene::dump(&checked.scene).as_bytes(),
+                sdfc_compiler::dump_ir(&checked.scene).as_bytes(),
             ));
         }
         let limits = Limits::default();
-        let lowered = lower::lower_within(&checked.scene, &LowerOptions::default(), &limits)
+        let lowered = lower_within(&checked.scene, &LowerOptions::default(), &limits)
             .map_err(|d| compile_error(py, &[d], &checked.sources))?;
         let bytes = match part {
             Part::Kernel => compile::emit(&checked.scene, &lowered, emit, sm, None),
             Part::Map => {
-                let name = name
-                    .unwrap_or_else(|| sdfc_compiler::back::wgsl::part::DEFAULT_NAME.to_string());
-                if !sdfc_compiler::back::wgsl::part::valid_name(&name) {
+                let name =
+                    name.unwrap_or_else(|| sdfc_compiler::wgsl::part::DEFAULT_NAME.to_string());
+                if !sdfc_compiler::wgsl::part::valid_name(&name) {
                     return Err(PyValueError::new_err(format!(
                         "{name:?} is not a name for a function"
                     )));

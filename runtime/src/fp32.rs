@@ -4,7 +4,7 @@
 //! weights and the sources of the peaks.
 
 use crate::cpu::Counters;
-use sdfc_compiler::program::{Binary, Op, Program, Unary};
+use sdfc_compiler::{Binary, Op, Program, Unary};
 
 /// Operations counted for one special-function instruction (sqrt, exp, log, sin, cos): an
 /// SM of the Hopper and Ampere data-centre GPUs issues 16 of them per clock against 128 FP32

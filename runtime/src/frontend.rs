@@ -2,13 +2,13 @@
 //! report and lower" steps of every subcommand, and the lines `sdfc check` (and `sdfc view`)
 //! print about a clean scene: what its distance field is, and how it is rendered.
 
-use sdfc_compiler::check::{self, Loader};
-use sdfc_compiler::diagnostics::{self, Diagnostic};
-use sdfc_compiler::lower::{self, LowerOptions, Lowered};
-use sdfc_compiler::scene::analysis::{self, Analysis};
-use sdfc_compiler::scene::analytic::{Choice, Reason, Traceable};
-use sdfc_compiler::scene::{Exactness, Scene};
-use sdfc_compiler::{Limits, SourceMap, Span};
+use sdfc_compiler::{
+    analysis::{self, Analysis},
+    analytic::{Choice, Reason, Traceable},
+    check_at,
+    diagnostics::{self, Diagnostic},
+    lower_within, Exactness, Limits, Loader, LowerOptions, Lowered, Scene, SourceMap, Span,
+};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -160,7 +160,7 @@ impl Source {
     pub fn check(&mut self, limits: &Limits, time: f64) -> Loaded {
         let mut sources = SourceMap::new();
         let entry = sources.add(self.name.clone(), self.text.clone());
-        let (scene, diagnostics) = check::check_at(&mut sources, entry, self, limits, time);
+        let (scene, diagnostics) = check_at(&mut sources, entry, self, limits, time);
         Loaded {
             scene,
             diagnostics,
@@ -271,11 +271,11 @@ pub struct Checked {
 }
 
 impl Checked {
-    /// Lowers the scene within `limits` ([`lower::lower_within`]). A program larger than the
+    /// Lowers the scene within `limits` ([`lower_within`]). A program larger than the
     /// `program` limit is reported (E0507) and gives exit code 1, before any back end or
     /// render starts.
     pub fn lower(&self, options: &LowerOptions, limits: &Limits) -> Result<Lowered, ExitCode> {
-        match lower::lower_within(&self.scene, options, limits) {
+        match lower_within(&self.scene, options, limits) {
             Ok(lowered) => Ok(lowered),
             Err(d) => {
                 print_diagnostics(&[d], &self.sources, self.format);

@@ -177,7 +177,7 @@ pub fn encode_png(
 
 /// A linear value clamped to [0, 1] and encoded with the sRGB transfer function (NaN is 0).
 pub fn srgb_encode(c: f32) -> u8 {
-    sdfc_compiler::back::wgsl::srgb::encode(c)
+    sdfc_compiler::wgsl::srgb::encode(c)
 }
 
 /// [`srgb_encode`] by table: `at[v]` is the least linear value (an f32 in [0, 1]) that
@@ -199,7 +199,7 @@ impl SrgbTable {
         static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
         TABLE.get_or_init(|| {
             // The kernel's thresholds: the same table finishes pixels on the GPU.
-            let at = *sdfc_compiler::back::wgsl::srgb::thresholds();
+            let at = *sdfc_compiler::wgsl::srgb::thresholds();
             let start = (0..=4096).map(|k| srgb_encode(k as f32 / 4096.0)).collect();
             SrgbTable { at, start }
         })
@@ -448,7 +448,7 @@ mod tests {
         ] {
             check(c);
         }
-        let mut rng = sdfc_compiler::rng::Rng::new(11);
+        let mut rng = sdfc_compiler::Rng::new(11);
         for _ in 0..1_000_000 {
             check(rng.range(-0.1, 1.1) as f32);
         }

@@ -12,10 +12,7 @@ use crate::cpu::reference;
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat, Loaded, Source};
 use crate::memory;
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::{self, LowerOptions, Lowered, Program};
-use sdfc_compiler::scene::Scene;
-use sdfc_compiler::{Diagnostic, Limits, Severity, SourceMap};
+use sdfc_compiler::{lower_within, wgsl, Diagnostic, Limits, LowerOptions, Lowered, Program, Scene, Severity, SourceMap};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
@@ -250,7 +247,7 @@ impl Job {
         sources: &SourceMap,
         lowering: &LowerOptions,
     ) -> Result<Lowered, Error> {
-        lower::lower_within(scene, lowering, &self.limits).map_err(|d| {
+        lower_within(scene, lowering, &self.limits).map_err(|d| {
             frontend::print_diagnostics(std::slice::from_ref(&d), sources, DiagnosticFormat::Human);
             Error::scene(vec![d], sources)
         })

@@ -1,8 +1,7 @@
 //! What a render allocates: the bound announced before a render starts, held to the
 //! `memory` limit (`--limit memory=MIB`), and the allocations of writing its outputs.
 
-use sdfc_compiler::scene::{Scene, Settings};
-use sdfc_compiler::{Limit, Limits};
+use sdfc_compiler::{Limit, Limits, Scene, Settings};
 use std::fmt;
 
 /// Bytes in a MiB.

@@ -7,9 +7,7 @@ use crate::chart::{self, Chart};
 use crate::cpu::reference::Convergence;
 use crate::metrics::DepthDifference;
 use crate::settings;
-use sdfc_compiler::diagnostics::scientific;
-use sdfc_compiler::scene::Settings;
-use sdfc_compiler::{Limit, Limits};
+use sdfc_compiler::{diagnostics::scientific, Limit, Limits, Settings};
 
 /// A setting that can be swept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

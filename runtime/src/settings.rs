@@ -2,8 +2,7 @@
 //! checked against its range and, where one applies, its limit (`render`, `bench`, `pareto`
 //! and `view` share them).
 
-use sdfc_compiler::scene::{Method, Settings};
-use sdfc_compiler::{Limit, Limits};
+use sdfc_compiler::{Limit, Limits, Method, Settings};
 
 /// Parses `WIDTHxHEIGHT` (each edge is checked against the `edge` limit when applied).
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -5,8 +5,7 @@
 mod common;
 
 use common::*;
-use sdfc_compiler::lower::lower;
-use sdfc_compiler::scene::{Node, Settings};
+use sdfc_compiler::{lower, Node, Settings};
 use sdfc_runtime::chart::{self, Chart, Point};
 use sdfc_runtime::cpu::{self, reference, Options};
 use sdfc_runtime::depth::{self, Depth};
@@ -85,7 +84,7 @@ fn depth_metrics_match_hand_computed_values() {
     assert!(compare_depth(&r, &depth(&[1.0], &[1.0]), 1e-3).is_none());
 }
 
-fn sphere_scene(w: u32, h: u32) -> sdfc_compiler::scene::Scene {
+fn sphere_scene(w: u32, h: u32) -> sdfc_compiler::Scene {
     let mut scene = single(Node::Sphere { radius: 1.0 });
     scene.camera.position = [0.0, 0.0, -5.0];
     scene.camera.look_at = [0.0, 0.0, 0.0];
@@ -99,7 +98,7 @@ fn cpu_renders_carry_first_hit_depths() {
     let scene = sphere_scene(33, 33);
     let r = cpu::render(
         &scene,
-        &sdfc_compiler::lower::Lowered::new(&scene),
+        &sdfc_compiler::Lowered::new(&scene),
         &Options::default(),
         &|| {},
     );
@@ -121,7 +120,7 @@ fn cpu_renders_carry_first_hit_depths() {
     aa.settings.aa = 2;
     let r2 = cpu::render(
         &aa,
-        &sdfc_compiler::lower::Lowered::new(&aa),
+        &sdfc_compiler::Lowered::new(&aa),
         &Options::default(),
         &|| {},
     );
@@ -153,7 +152,7 @@ fn depth_buffers_are_identical_whatever_the_number_of_threads() {
         pool.install(|| {
             cpu::render(
                 &scene,
-                &sdfc_compiler::lower::Lowered::new(&scene),
+                &sdfc_compiler::Lowered::new(&scene),
                 &Options::default(),
                 &|| {},
             )
@@ -354,7 +353,7 @@ fn fp32_fraction_is_given_only_where_what_runs_is_counted_and_never_above_1() {
         text.push_str(&format!("  sphere(0.2).translate({x}, 0, {z});\n"));
     }
     text.push('}');
-    let (scene, diags, _) = sdfc_compiler::check::check_str("many.sdf", &text);
+    let (scene, diags, _) = sdfc_compiler::check_str("many.sdf", &text);
     let program = lower(&scene.unwrap_or_else(|| panic!("{diags:?}")));
     assert!(!program.blocks().is_empty(), "culling makes guarded blocks");
     let all = fp32::distance_ops(&program);
@@ -558,7 +557,7 @@ fn pareto_measures_points_and_draws_charts() {
 }
 
 /// The scene of a file of `examples/`, checked.
-fn example(name: &str) -> sdfc_compiler::scene::Scene {
+fn example(name: &str) -> sdfc_compiler::Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples")
         .join(name);

@@ -1,9 +1,10 @@
 //! Analytic ray tracing (issue 9): which scenes the compiler traces analytically and why,
 //! traced images against sphere-traced ones of the same file, and the kernel it emits.
 
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::scene::analytic::{choose, Choice, Reason};
-use sdfc_compiler::scene::{Method, Scene};
+use sdfc_compiler::{
+    analytic::{choose, Choice, Reason},
+    wgsl, Method, Scene,
+};
 use sdfc_runtime::{cpu, frontend, metrics};
 use std::path::Path;
 
@@ -56,7 +57,7 @@ fn traced_images_agree_with_marched_ones() {
         let render = |scene: &Scene| {
             cpu::render(
                 scene,
-                &sdfc_compiler::lower::Lowered::new(scene),
+                &sdfc_compiler::Lowered::new(scene),
                 &cpu::Options::default(),
                 &|| {},
             )
@@ -102,13 +103,13 @@ fn glass_on_the_floor_is_traced_as_it_is_marched() {
                   capsule(0.15, 1.0).rotate_z(90deg).translate(-0.2, 0.1, -1.0) @ glass;\n\
                   sphere(0.35).translate(1.3, 0.35, 0.2) @ red;\n\
                 }";
-    let (scene, diags, _) = sdfc_compiler::check::check_str("sunk.sdf", text);
+    let (scene, diags, _) = sdfc_compiler::check_str("sunk.sdf", text);
     let mut scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     assert!(matches!(choose(&scene), Choice::Trace(_)));
     let render = |scene: &Scene| {
         cpu::render(
             scene,
-            &sdfc_compiler::lower::Lowered::new(scene),
+            &sdfc_compiler::Lowered::new(scene),
             &cpu::Options::default(),
             &|| {},
         )
@@ -133,7 +134,7 @@ fn glass_on_the_floor_is_traced_as_it_is_marched() {
 fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     let scene = load("primitives.sdf");
     let kernel =
-        wgsl::write(&scene, &sdfc_compiler::lower::Lowered::new(&scene)).expect("naga accepts it");
+        wgsl::write(&scene, &sdfc_compiler::Lowered::new(&scene)).expect("naga accepts it");
     let src = &kernel.source;
     assert!(!src.contains("fn map(") && !src.contains("fn sdf("));
     assert!(!src.contains("fn tolerance("));
@@ -144,7 +145,7 @@ fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     // Only the interval functions a scene uses: spheres and a plane in scene 1.
     let seed1 = load("seed1.sdf");
     let kernel =
-        wgsl::write(&seed1, &sdfc_compiler::lower::Lowered::new(&seed1)).expect("naga accepts it");
+        wgsl::write(&seed1, &sdfc_compiler::Lowered::new(&seed1)).expect("naga accepts it");
     let fns: Vec<&str> = kernel
         .source
         .lines()
@@ -158,8 +159,8 @@ fn a_traced_kernel_emits_intersections_instead_of_a_field() {
     assert_eq!(fns, ["sphere_interval", "plane_interval"]);
     let mut marched = scene.clone();
     marched.settings.method = Method::March;
-    let kernel = wgsl::write(&marched, &sdfc_compiler::lower::Lowered::new(&marched))
-        .expect("naga accepts it");
+    let kernel =
+        wgsl::write(&marched, &sdfc_compiler::Lowered::new(&marched)).expect("naga accepts it");
     assert!(kernel.source.contains("fn sdf(") && !kernel.source.contains("Interval"));
 }
 
@@ -175,7 +176,7 @@ fn only_glass_touching_other_glass_is_sphere_traced() {
             "material glass = phong {{ transparency: 0.9, ior: 1.5 }};\n\
              material clay = phong {{ color: (0.8, 0.4, 0.2) }};\nscene {{ {objects} }}"
         );
-        let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
+        let (scene, diags, _) = sdfc_compiler::check_str("t.sdf", &text);
         choose(&scene.unwrap_or_else(|| panic!("{diags:?}")))
     };
     let overlap = |c: &Choice| matches!(c, Choice::March(Reason::Overlap { .. }));
@@ -217,8 +218,8 @@ fn the_kernel_of_ten_thousand_spheres_stays_small() {
     let kernel = |name: &str| {
         let scene = load(name);
         let n = choose(&scene).primitives().map(<[_]>::len);
-        let kernel = wgsl::write(&scene, &sdfc_compiler::lower::Lowered::new(&scene))
-            .expect("naga accepts it");
+        let kernel =
+            wgsl::write(&scene, &sdfc_compiler::Lowered::new(&scene)).expect("naga accepts it");
         (n, kernel)
     };
     let (n, large) = kernel("scaling/random_10000.sdf");
@@ -234,8 +235,8 @@ fn the_kernel_of_ten_thousand_spheres_stays_small() {
         large.source.len()
     );
     assert!((32 * 10_001..64 * 10_001).contains(&data), "{data} bytes");
-    let options = sdfc_compiler::back::ptx::Options::default();
-    let ptx = sdfc_compiler::back::ptx::write(&large.module, &large.info, &options)
+    let options = sdfc_compiler::ptx::Options::default();
+    let ptx = sdfc_compiler::ptx::write(&large.module, &large.info, &options)
         .expect("translates")
         .text;
     println!("random_10000: {} lines of PTX", ptx.lines().count());
@@ -265,7 +266,7 @@ fn glass_overlap_is_found_through_the_hierarchy_and_traced_is_a_limit() {
         )
     };
     let check = |text: &str| {
-        let (scene, diags, _) = sdfc_compiler::check::check_str("glass.sdf", text);
+        let (scene, diags, _) = sdfc_compiler::check_str("glass.sdf", text);
         scene.unwrap_or_else(|| panic!("{diags:?}"))
     };
     let apart = check(&grid(""));

@@ -4,10 +4,9 @@
 //! resuming after a killed render, animated PNG, the video's `ffmpeg`; and the job-array
 //! files of examples/jobs parsed by the tools of their ecosystems.
 
-use sdfc_compiler::check::{check_at, NoImports};
-use sdfc_compiler::diagnostics::Diagnostic;
-use sdfc_compiler::scene::{Colour, Light, Node, Pattern, Scene};
-use sdfc_compiler::{Limits, SourceMap};
+use sdfc_compiler::{
+    check_at, Colour, Diagnostic, Light, Limits, NoImports, Node, Pattern, Scene, SourceMap,
+};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -722,30 +721,26 @@ fn bench_times_a_sequence_and_counts_its_kernels() {
 // ---- one kernel per sequence (stage B) ----
 
 /// The frames `ks` of `file` checked at their times and lowered.
-fn frames_of(file: &str, ks: &[u64]) -> Vec<(Scene, sdfc_compiler::lower::Lowered)> {
+fn frames_of(file: &str, ks: &[u64]) -> Vec<(Scene, sdfc_compiler::Lowered)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut source = sdfc_runtime::frontend::Source::read(&root.join(file)).expect("read");
     ks.iter()
         .map(|&k| {
             let first = source.check(&Limits::default(), 0.0).scene.expect("checks");
-            let t = sdfc_compiler::scene::Animation::time_of(first.animation.fps, k);
+            let t = sdfc_compiler::Animation::time_of(first.animation.fps, k);
             let s = source.check(&Limits::default(), t).scene.expect("checks");
-            let p = sdfc_compiler::lower::Lowered::new(&s);
+            let p = sdfc_compiler::Lowered::new(&s);
             (s, p)
         })
         .collect()
 }
 
-fn kernel(
-    s: &Scene,
-    p: &sdfc_compiler::lower::Lowered,
-    parameters: bool,
-) -> sdfc_compiler::back::wgsl::Kernel {
-    let options = sdfc_compiler::back::wgsl::Options {
+fn kernel(s: &Scene, p: &sdfc_compiler::Lowered, parameters: bool) -> sdfc_compiler::wgsl::Kernel {
+    let options = sdfc_compiler::wgsl::Options {
         parameters,
         ..Default::default()
     };
-    sdfc_compiler::back::wgsl::write_with(s, p, &options).expect("valid kernel")
+    sdfc_compiler::wgsl::write_with(s, p, &options).expect("valid kernel")
 }
 
 #[test]
@@ -780,17 +775,17 @@ fn frames_that_differ_in_numbers_share_one_kernel_text() {
         .iter()
         .map(|&t| {
             let s = source.check(&Limits::default(), t).scene.unwrap();
-            kernel(&s, &sdfc_compiler::lower::Lowered::new(&s), true).source
+            kernel(&s, &sdfc_compiler::Lowered::new(&s), true).source
         })
         .collect();
     assert_ne!(texts[0], texts[1]);
     // The parameter kernel translates to PTX, which ptxas assembles where it is installed.
     let k = &with[1];
-    let options = sdfc_compiler::back::ptx::Options {
+    let options = sdfc_compiler::ptx::Options {
         sm: 70,
         entry_point: "main".into(),
     };
-    let ptx = sdfc_compiler::back::ptx::write(&k.module, &k.info, &options)
+    let ptx = sdfc_compiler::ptx::write(&k.module, &k.info, &options)
         .expect("ptx")
         .text;
     let found = std::env::var_os("PATH").and_then(|p| {
@@ -871,8 +866,8 @@ fn a_sequence_on_wgpu_compiles_one_kernel_and_matches_the_cpu() {
 }
 
 /// Distances and materials of `program` at `points`, in f64.
-fn evaluate(program: &sdfc_compiler::lower::Program, points: &[[f64; 3]]) -> (Vec<f64>, Vec<u32>) {
-    use sdfc_compiler::eval::{Evaluator, Outputs, Tape};
+fn evaluate(program: &sdfc_compiler::Program, points: &[[f64; 3]]) -> (Vec<f64>, Vec<u32>) {
+    use sdfc_compiler::{Evaluator, Outputs, Tape};
     let tape = Tape::new(program, Outputs::DistanceAndMaterial);
     let mut ev = Evaluator::<f64>::new(&tape, 64);
     let coord = |i: usize| points.iter().map(|p| p[i]).collect::<Vec<f64>>();
@@ -890,7 +885,7 @@ fn evaluate(program: &sdfc_compiler::lower::Program, points: &[[f64; 3]]) -> (Ve
 #[test]
 fn parametric_lowering_keeps_the_structure_and_the_values() {
     use sdfc_compiler::animation::Structure;
-    use sdfc_compiler::lower::{lower_scene, lower_with, LowerOptions};
+    use sdfc_compiler::{lower_scene, lower_with, LowerOptions};
     // At t = 1 the rotation is the identity, the scale 1 and the rounding 0; at t = 2 the
     // translation is 0 and the rotation a quarter turn; the translation is negative before.
     let text = format!(
@@ -930,10 +925,10 @@ fn parametric_lowering_keeps_the_structure_and_the_values() {
             }
         }
     }
-    let mut rng = sdfc_compiler::rng::Rng::new(0x2545f4914f6cdd1d);
+    let mut rng = sdfc_compiler::Rng::new(0x2545f4914f6cdd1d);
     let points: Vec<[f64; 3]> = (0..400).map(|_| rng.point(4.0)).collect();
     for s in &scenes {
-        let a = evaluate(&sdfc_compiler::lower::lower(s), &points);
+        let a = evaluate(&sdfc_compiler::lower(s), &points);
         let b = evaluate(&lower_with(s, &LowerOptions::parametric()), &points);
         for ((p, x), y) in points.iter().zip(&a.0).zip(&b.0) {
             assert!(

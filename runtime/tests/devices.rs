@@ -9,9 +9,7 @@
 
 mod common;
 
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::{wgsl, Lowered, Scene};
 use sdfc_runtime::gpu::launch::Worker;
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
 use std::path::{Path, PathBuf};

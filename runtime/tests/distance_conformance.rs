@@ -17,10 +17,7 @@ mod common;
 mod evaluators;
 
 use evaluators::Value;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::program::{Binary, Op, Unary};
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::{Node, Scene};
+use sdfc_compiler::{Binary, Lowered, Node, Op, Rng, Scene, Unary};
 use std::path::PathBuf;
 
 /// Most ulps ([`ulps`]) by which the emitted Rust may differ from the interpreter: none, it
@@ -69,7 +66,7 @@ struct Bounds {
 
 /// The class of a program ([`CLASSES`]): 2 where it computes pow, acos or atan2, 1 where it
 /// computes sin, cos, exp or log, 0 otherwise.
-fn class(program: &sdfc_compiler::program::Program) -> usize {
+fn class(program: &sdfc_compiler::Program) -> usize {
     let has = |f: &dyn Fn(&Op) -> bool| program.ops().iter().any(f);
     if has(&|op| {
         matches!(

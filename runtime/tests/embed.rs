@@ -7,7 +7,10 @@
 //! render`'s image byte for byte; `--emit scene-data|params` the bytes the renderer binds; and the
 //! Shadertoy page compiled as Shadertoy wraps it and rendered through WebGL.
 
-use sdfc_compiler::back::{self, shader::Lang, wgsl};
+use sdfc_compiler::{
+    shader::{self, Lang},
+    wgsl,
+};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -95,7 +98,7 @@ fn two_scenes_parts_and_a_users_function_validate_in_one_module() {
         data: None,
     };
     for lang in [Lang::SpirV, Lang::Msl, Lang::Glsl, Lang::Hlsl] {
-        back::shader::write(&kernel, lang).unwrap_or_else(|e| panic!("{lang:?}: {e}"));
+        shader::write(&kernel, lang).unwrap_or_else(|e| panic!("{lang:?}: {e}"));
     }
 }
 
@@ -141,7 +144,7 @@ fn the_part_is_the_kernels_own_map() {
     let path = example("seed4.sdf");
     let loaded = sdfc_runtime::frontend::load(&path).expect("readable");
     let scene = loaded.scene.expect("checks");
-    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let lowered = sdfc_compiler::Lowered::new(&scene);
     let kernel = wgsl::write(&scene, &lowered).expect("kernel");
     let part = wgsl::part::write(&scene, &lowered, "map").expect("part");
     let start = part.source.find("fn map(").expect("map");
@@ -412,7 +415,7 @@ fn scene_data_and_params_are_the_bytes_the_renderer_binds() {
     let file = path.to_str().expect("utf-8");
     let loaded = sdfc_runtime::frontend::load(&path).expect("readable");
     let scene = loaded.scene.expect("checks");
-    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let lowered = sdfc_compiler::Lowered::new(&scene);
     let kernel = wgsl::write(&scene, &lowered).expect("kernel");
     let data = sdfc(&["compile", file, "--emit", "scene-data"]);
     assert!(data.status.success());

@@ -7,11 +7,7 @@
 mod common;
 
 use common::*;
-use sdfc_compiler::back::rust;
-use sdfc_compiler::eval::eval_point;
-use sdfc_compiler::lower::lower;
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
+use sdfc_compiler::{eval_point, lower, rust, Combine, Node, Rng, Scene, Smooth};
 use std::fmt::Write;
 use std::process::Command;
 
@@ -137,11 +133,10 @@ fn emitted_rust_builds_in_a_scratch_crate_with_glam() {
         String::from_utf8_lossy(&run.stderr)
     );
     let text = std::fs::read_to_string(scene_path).expect("scene");
-    let (checked, diags, _) = sdfc_compiler::check::check_str("seed1.sdf", &text);
+    let (checked, diags, _) = sdfc_compiler::check_str("seed1.sdf", &text);
     let checked = checked.unwrap_or_else(|| panic!("{diags:?}"));
     let program =
-        sdfc_compiler::lower::lower_scene(&checked, &sdfc_compiler::lower::LowerOptions::level(1))
-            .program;
+        sdfc_compiler::lower_scene(&checked, &sdfc_compiler::LowerOptions::level(1)).program;
     let out = String::from_utf8_lossy(&run.stdout);
     let mut lines = out.lines();
     for p in &points {

@@ -8,8 +8,10 @@
 //! end, so it accepts exactly the sentences of the EBNF read as a context-free grammar (which
 //! must not be left-recursive).
 
-use sdfc_compiler::span::FileId;
-use sdfc_compiler::syntax::lexer::{lex, Token};
+use sdfc_compiler::{
+    lexer::{lex, Token},
+    FileId,
+};
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -650,7 +652,7 @@ fn examples_and_valid_files_are_sentences_of_the_grammar() {
                 failures.push(format!("{}: {why}", path.display()));
             }
             // The parser agrees: no lexical or syntax errors.
-            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), &text);
+            let (_, diags) = sdfc_compiler::parse(FileId(0), &text);
             if let Some(d) = diags.first() {
                 failures.push(format!(
                     "{}: the parser reports {} {}",
@@ -686,7 +688,7 @@ fn small_valid_inputs_are_recognised() {
         let g = grammar();
         for text in inputs {
             assert_eq!(recognise(&g, "file", text), Ok(()), "{text}");
-            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), text);
+            let (_, diags) = sdfc_compiler::parse(FileId(0), text);
             assert!(diags.is_empty(), "the parser rejects {text:?}: {diags:?}");
         }
     });
@@ -704,7 +706,7 @@ fn the_grammar_and_the_parser_agree_on_the_error_files() {
         for path in &files {
             let text = std::fs::read_to_string(path).expect("readable");
             let grammar_ok = recognise(&g, "file", &text);
-            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), &text);
+            let (_, diags) = sdfc_compiler::parse(FileId(0), &text);
             if grammar_ok.is_ok() != diags.is_empty() {
                 let parser = diags.first().map_or("nothing".to_string(), |d| {
                     format!("{} {}", d.code, d.message)
@@ -755,7 +757,7 @@ fn broken_inputs_are_rejected() {
                 recognise(&g, "file", text).is_err(),
                 "the grammar accepts the broken input {text:?}"
             );
-            let (_, diags) = sdfc_compiler::syntax::parse(FileId(0), text);
+            let (_, diags) = sdfc_compiler::parse(FileId(0), text);
             assert!(
                 !diags.is_empty(),
                 "the parser accepts the broken input {text:?}"

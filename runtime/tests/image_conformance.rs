@@ -5,9 +5,7 @@
 
 mod common;
 
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::{Method, Scene};
+use sdfc_compiler::{wgsl, Lowered, Method, Scene};
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
 use std::path::{Path, PathBuf};
 
@@ -24,7 +22,7 @@ fn open_gpu() -> Option<gpu::Gpu> {
 
 /// A scene checked from source text; its diagnostics on failure.
 fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check::check_str(name, text);
+    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
     scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
 }
 
@@ -129,7 +127,7 @@ fn wgpu_matches_cpu_on_every_example() {
 /// Renders `scene` on wgpu and on the CPU and asserts that they agree within the tolerance.
 fn assert_agree(
     gpu: &gpu::Gpu,
-    scene: &sdfc_compiler::scene::Scene,
+    scene: &sdfc_compiler::Scene,
     lowered: &Lowered,
     kernel: &wgsl::Kernel,
     label: &str,
@@ -173,7 +171,7 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
 /// with shapes that must stay in the rest of the program: a twisted box and ellipsoids (a
 /// bound, not an exact distance).
 fn marched_scene(n: usize) -> String {
-    let mut rng = sdfc_compiler::rng::Rng::new(0x9e37_79b9_u64);
+    let mut rng = sdfc_compiler::Rng::new(0x9e37_79b9_u64);
     let mut next = move || rng.uniform();
     let mut text = String::from(
         "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75 };\n\
@@ -281,7 +279,7 @@ fn many_marched_instances_walked_nearest_first_match_the_cpu() {
     for (file, instances) in [("compound_1000", 4000), ("jittered_1024", 1024)] {
         let path = PathBuf::from(format!("../examples/scaling/{file}.sdf"));
         let mut scene = load_small(&path, 96, 64);
-        scene.settings.method = sdfc_compiler::scene::Method::March;
+        scene.settings.method = sdfc_compiler::Method::March;
         let lowered = Lowered::new(&scene);
         let split = lowered.instances(walk.max_instances).expect("split");
         assert_eq!(split.instances.len(), instances, "{file}");
@@ -426,7 +424,7 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
 /// capsules turned and scaled at pseudo-random places on a checkered, reflective floor, with
 /// mirrors and a floating glass ball that touches nothing (so `auto` traces it).
 fn mixed_scene(n: usize) -> String {
-    let mut rng = sdfc_compiler::rng::Rng::new(0x2545_f491_u64);
+    let mut rng = sdfc_compiler::Rng::new(0x2545_f491_u64);
     let mut next = move || rng.uniform();
     let mut text = String::from(
         "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75, reflect: 0.1 };\n\
@@ -472,7 +470,7 @@ fn mixed_scene(n: usize) -> String {
 fn a_traced_scene_read_from_a_buffer_matches_the_cpu() {
     let text = mixed_scene(300);
     let scene = checked("mixed.sdf", &text);
-    let traced = sdfc_compiler::scene::analytic::choose(&scene);
+    let traced = sdfc_compiler::analytic::choose(&scene);
     assert_eq!(traced.primitives().map(<[_]>::len), Some(302), "{traced:?}");
     let lowered = Lowered::new(&scene);
     let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");

@@ -7,10 +7,10 @@
 mod common;
 
 use common::random_scene;
-use sdfc_compiler::back::wgsl::{self, KernelChoice, Options};
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::{Method, Scene};
+use sdfc_compiler::{
+    wgsl::{self, KernelChoice, Options},
+    Lowered, Method, Rng, Scene,
+};
 use sdfc_runtime::{frontend, gpu, metrics};
 use std::path::Path;
 use std::process::Command;
@@ -197,7 +197,7 @@ scene {
 #[test]
 fn auto_keeps_the_specialised_kernel_on_a_cpu_adapter_on_cuda_and_for_sequences() {
     use sdfc_runtime::backend::{Prepared, Setup};
-    let (scene, diags, _) = sdfc_compiler::check::check_str("shells.sdf", SHELLS);
+    let (scene, diags, _) = sdfc_compiler::check_str("shells.sdf", SHELLS);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let lowered = Lowered::new(&scene);
     let options = Options {
@@ -284,7 +284,7 @@ fn random_scenes_render_as_with_the_specialised_kernel() {
     let mut rng = Rng::new(2026);
     for case in 0..12 {
         let mut scene = random_scene(&mut rng, 1 + case % 6);
-        scene.lights.push(sdfc_compiler::scene::Light::Point {
+        scene.lights.push(sdfc_compiler::Light::Point {
             position: [3.0, 6.0, -4.0],
             color: [1.0; 3],
             intensity: 1.0,

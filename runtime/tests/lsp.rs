@@ -394,7 +394,7 @@ fn never_crashes_on_mutated_text() {
         ".",
         "deg",
     ];
-    let mut rng = sdfc_compiler::rng::Rng::new(0x15D_F0C5);
+    let mut rng = sdfc_compiler::Rng::new(0x15D_F0C5);
     let dir = temp_dir("mutated");
     let doc = uri(&dir.join("m.sdf"));
     let mut c = Client::start();
@@ -416,7 +416,7 @@ fn never_crashes_on_mutated_text() {
         for step in 0..25 {
             // A change at a random line and character, possibly past the end of either.
             let lines = text.matches('\n').count() + 2;
-            let pos = |rng: &mut sdfc_compiler::rng::Rng| json!({ "line": rng.below(lines), "character": rng.below(90) });
+            let pos = |rng: &mut sdfc_compiler::Rng| json!({ "line": rng.below(lines), "character": rng.below(90) });
             let (a, b) = (pos(&mut rng), pos(&mut rng));
             let (start, end) = if (a["line"].as_u64(), a["character"].as_u64())
                 <= (b["line"].as_u64(), b["character"].as_u64())

@@ -6,9 +6,7 @@
 //!
 //! One test only: the counter sees every thread of the process, so nothing else may run.
 
-use sdfc_compiler::check::check_str;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::{check_str, Lowered, Scene};
 use sdfc_runtime::backend::{Backend, Prepared, Setup};
 use sdfc_runtime::cpu::{self, Options, Precision, Tapes};
 use sdfc_runtime::memory;
@@ -82,7 +80,7 @@ fn renders_stay_within_the_memory_they_announce() {
         (TRACED, 300, 200, 1, Precision::F64),
     ] {
         let scene = scene_of(text, width, height, aa);
-        let traced = sdfc_compiler::scene::analytic::choose(&scene)
+        let traced = sdfc_compiler::analytic::choose(&scene)
             .primitives()
             .is_some();
         assert_eq!(traced, text == TRACED);

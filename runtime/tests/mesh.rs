@@ -6,8 +6,7 @@
 
 mod common;
 
-use sdfc_compiler::eval::eval_point;
-use sdfc_compiler::lower::{self, Program};
+use sdfc_compiler::{eval_point, lower, Program};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -192,7 +191,7 @@ fn manifold(m: &Read, what: &str) -> i64 {
 fn program(path: &Path) -> Program {
     let loaded = sdfc_runtime::frontend::load(path).expect("load");
     let scene = loaded.scene.expect("checks");
-    lower::lower(&scene)
+    lower(&scene)
 }
 
 fn distance(p: &Program, q: [f32; 3]) -> f64 {
@@ -444,7 +443,7 @@ fn hausdorff(m: &Read, p: &Program, voxel: f64, centre: [f64; 3], radius: f64) {
         }
     }
     assert!(far <= 0.5 * voxel, "a mesh point is {far} from the surface");
-    let mut rng = sdfc_compiler::rng::Rng::new(7);
+    let mut rng = sdfc_compiler::Rng::new(7);
     let mut back = 0.0f64;
     for _ in 0..150 {
         let mut q = [0, 1, 2].map(|i| centre[i] + radius * 1.5 * (2.0 * rng.uniform() - 1.0));

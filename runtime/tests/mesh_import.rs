@@ -4,9 +4,7 @@
 //! `repeat` and materials, and `sdfc mesh` remeshes it; bad files are errors at the call
 //! that read them, naming where in the file, and never a crash.
 
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::{Lowered, Rng, Scene};
 use sdfc_runtime::cpu::{self, Options};
 use std::path::{Path, PathBuf};
 use std::process::Command;

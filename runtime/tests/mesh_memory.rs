@@ -44,9 +44,9 @@ fn meshing_stays_within_the_memory_it_announces() {
     for (k, (file, lo, hi, n)) in cases.into_iter().enumerate() {
         let loaded = sdfc_runtime::frontend::load(&root.join(file)).expect("load");
         let scene = loaded.scene.expect("checks");
-        let analysis = sdfc_compiler::scene::analysis::analyse(&scene);
+        let analysis = sdfc_compiler::analysis::analyse(&scene);
         let proven = analysis.root().expect("objects").proven;
-        let program = lower::lower(&scene);
+        let program = lower(&scene);
         let field = Field::new(&program, proven, [lo, hi]);
         let g = grid(lo, hi, n);
         let max = 1 << 40;

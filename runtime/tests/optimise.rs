@@ -7,12 +7,10 @@
 mod common;
 
 use common::*;
-use sdfc_compiler::back::{rust, wgsl};
-use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower_scene, lower_with, LowerOptions, Lowered};
-use sdfc_compiler::program::{Op, Program, Step};
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::{Method, Scene};
+use sdfc_compiler::{
+    eval_point, lower_scene, lower_with, rust, wgsl, Evaluator, Float, LowerOptions, Lowered,
+    Method, Op, Outputs, Program, Rng, Scene, Step, Tape,
+};
 use sdfc_runtime::cpu::{self, Options, Precision};
 use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 //! to keep the PTX files.
 
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
-use sdfc_compiler::back::ptx::{self, Error, Options};
+use sdfc_compiler::ptx::{self, Error, Options};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -735,13 +735,13 @@ fn example_scenes_assemble() {
                 sdfc_compiler::diagnostics::render(&loaded.diagnostics, &loaded.sources, false)
             )
         };
-        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
-        let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
+        let lowered = sdfc_compiler::Lowered::new(&scene);
+        let kernel = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         keep(&format!("scene_{name}.wgsl"), kernel.source.as_bytes());
         keep(
             &format!("scene_{name}.uniforms"),
-            &sdfc_compiler::back::wgsl::uniforms(&kernel.contract.uniform, &scene, 1.0)
+            &sdfc_compiler::wgsl::uniforms(&kernel.contract.uniform, &scene, 1.0)
                 .expect("the uniform fits the kernel"),
         );
         // The best of three translations: a shared machine's noise only adds time.
@@ -779,7 +779,7 @@ fn example_scenes_assemble() {
 /// or the marched instances read from `scene_data`.
 #[test]
 fn every_renderer_feature_kernel_assembles() {
-    use sdfc_compiler::back::wgsl;
+    use sdfc_compiler::wgsl;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/in/kernel");
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -810,7 +810,7 @@ fn every_renderer_feature_kernel_assembles() {
     let ptxas = ptxas();
     for path in paths {
         let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let lowered = sdfc_compiler::Lowered::new(&scene);
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         for (variant, opts) in &variants {
             let kernel = wgsl::write_with(&scene, &lowered, opts)
@@ -830,13 +830,13 @@ fn every_renderer_feature_kernel_assembles() {
 fn the_debug_nan_kernel_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/in/ok/nan_at_run_time.sdf");
     let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
-    let debug = sdfc_compiler::back::wgsl::Options {
+    let lowered = sdfc_compiler::Lowered::new(&scene);
+    let debug = sdfc_compiler::wgsl::Options {
         debug_nan: true,
         ..Default::default()
     };
-    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &debug).unwrap();
-    let plain = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
+    let kernel = sdfc_compiler::wgsl::write_with(&scene, &lowered, &debug).unwrap();
+    let plain = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
     let text = ptx::write(&kernel.module, &kernel.info, &options(80))
         .unwrap()
         .text;
@@ -855,13 +855,13 @@ fn the_debug_nan_kernel_assembles() {
 fn a_kernel_with_outlined_blocks_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/compound_100.sdf");
     let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+    let lowered = sdfc_compiler::Lowered::new(&scene);
     // Its 400 instances written as code, not read from `scene_data`.
-    let code = sdfc_compiler::back::wgsl::Options {
+    let code = sdfc_compiler::wgsl::Options {
         max_instances: usize::MAX,
         ..Default::default()
     };
-    let kernel = sdfc_compiler::back::wgsl::write_with(&scene, &lowered, &code).unwrap();
+    let kernel = sdfc_compiler::wgsl::write_with(&scene, &lowered, &code).unwrap();
     assert!(kernel.source.contains("fn map_block") && kernel.source.contains("fn sdf_block"));
     let text = ptx::write(&kernel.module, &kernel.info, &options(80))
         .unwrap()
@@ -890,8 +890,8 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
         let path =
             Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../examples/scaling/{name}.sdf"));
         let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
-        let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
+        let lowered = sdfc_compiler::Lowered::new(&scene);
+        let kernel = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());
         keep(&format!("buffer_{name}.data"), data);
@@ -929,14 +929,14 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
                  box((0.2, 0.1, 0.2)).rotate_y(degrees(360 * hash(3 * i + 2))).translate(x, 2, z) @ b;\n\
                  cylinder(0.1, 0.2).scale(1.5).translate(x, 3, z) @ a;\n\
                  capsule(0.1, 0.2).rotate_x(30deg).translate(x, 4, z) @ b;\n  }\n}\n";
-    let (scene, diags, _) = sdfc_compiler::check::check_str("mixed.sdf", mixed);
+    let (scene, diags, _) = sdfc_compiler::check_str("mixed.sdf", mixed);
     let mixed = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/random_10000.sdf");
     let random = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
     let ptxas = ptxas();
     for (name, scene) in [("mixed", mixed), ("random_10000", random)] {
-        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
-        let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
+        let lowered = sdfc_compiler::Lowered::new(&scene);
+        let kernel = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("read from a buffer");
         keep(&format!("buffer_{name}.data"), data);
         let text = ptx::write(&kernel.module, &kernel.info, &options(80))
@@ -966,7 +966,7 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
 /// kernel per set of features among the examples (marched), each assembled once.
 #[test]
 fn interpreted_kernels_assemble() {
-    use sdfc_compiler::back::wgsl;
+    use sdfc_compiler::wgsl;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -978,8 +978,8 @@ fn interpreted_kernels_assemble() {
     let mut seen = std::collections::BTreeMap::new();
     for path in paths {
         let mut scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
-        scene.settings.method = sdfc_compiler::scene::Method::March;
-        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        scene.settings.method = sdfc_compiler::Method::March;
+        let lowered = sdfc_compiler::Lowered::new(&scene);
         let interpreted = wgsl::Options {
             kernel: wgsl::KernelChoice::Interpreted,
             ..Default::default()
@@ -1025,10 +1025,10 @@ fn the_parameters_are_returned_and_launches_checked_against_them() {
     use ptx::{check_arguments, Argument, Space};
     let text = "render { max_depth: 2 }\n\
                 scene {\n  for i in 0..300 { sphere(0.2).translate(i * 0.5, 0, 0); }\n}\n";
-    let (scene, diags, _) = sdfc_compiler::check::check_str("row.sdf", text);
+    let (scene, diags, _) = sdfc_compiler::check_str("row.sdf", text);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
-    let lowered = sdfc_compiler::lower::Lowered::new(&scene);
-    let kernel = sdfc_compiler::back::wgsl::write(&scene, &lowered).unwrap();
+    let lowered = sdfc_compiler::Lowered::new(&scene);
+    let kernel = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
     let data = kernel.data.as_ref().expect("scene data");
     let written = ptx::write(&kernel.module, &kernel.info, &options(80)).unwrap();
     let names: Vec<(&str, u32)> = written

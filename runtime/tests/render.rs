@@ -5,8 +5,7 @@
 mod common;
 
 use common::*;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::{Light, Method, Node, Pattern, Scene};
+use sdfc_compiler::{Light, Lowered, Method, Node, Pattern, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision, Render};
 
 /// Renders `scene` sphere traced, whatever it allows (the step-related tests).
@@ -127,7 +126,7 @@ fn a_camera_looking_straight_down_sees_the_scene_and_up_rolls_it() {
     let marker = b.add(Node::Sphere { radius: 0.4 });
     let marker = b.at(marker, [0.0, 0.0, 2.5]);
     let root = b.add(Node::Combine {
-        op: sdfc_compiler::scene::Combine::Union,
+        op: sdfc_compiler::Combine::Union,
         children: vec![centre, marker],
     });
     b.point_light([0.0, 10.0, 0.0], 0.0);
@@ -180,7 +179,7 @@ fn shadow_scene(penumbra: f64) -> Scene {
     let s = b.add(Node::Sphere { radius: 0.5 });
     let s = b.at(s, [0.0, 1.0, 0.0]);
     let root = b.add(Node::Combine {
-        op: sdfc_compiler::scene::Combine::Union,
+        op: sdfc_compiler::Combine::Union,
         children: vec![floor, s],
     });
     b.point_light([2.0, 5.0, 0.0], penumbra);
@@ -232,7 +231,7 @@ fn glass_sunk_into_the_floor_shows_the_floor_through_it() {
                 light point { position: (2, 5, -3) }\n\
                 render { width: 320, height: 240 }\n\
                 scene { plane((0, 1, 0), 0) @ floor; sphere(0.8) @ glass; }";
-    let (scene, diags, _) = sdfc_compiler::check::check_str("glass.sdf", text);
+    let (scene, diags, _) = sdfc_compiler::check_str("glass.sdf", text);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let r = render(&scene);
     // The pixels of the ball's lower half, above the floor's horizon line behind it.
@@ -287,7 +286,7 @@ fn mirror_scene(reflect: f64) -> Scene {
     let s = b.at(s, [0.0, 0.6, 2.0]);
     let s = b.paint(s, red);
     let root = b.add(Node::Combine {
-        op: sdfc_compiler::scene::Combine::Union,
+        op: sdfc_compiler::Combine::Union,
         children: vec![floor, s],
     });
     b.point_light([0.0, 5.0, -2.0], 0.0);
@@ -332,7 +331,7 @@ fn glass_scene(ball: Option<(f64, f64)>) -> Scene {
         let s = b.add(Node::Sphere { radius: 1.0 });
         let s = b.paint(s, glass);
         root = b.add(Node::Combine {
-            op: sdfc_compiler::scene::Combine::Union,
+            op: sdfc_compiler::Combine::Union,
             children: vec![wall, s],
         });
     }
@@ -508,7 +507,7 @@ fn a_tiny_step_budget_misses_by_budget() {
 /// from the origin, with finite constants.
 fn nan_scene() -> Scene {
     let text = std::fs::read_to_string("tests/in/ok/nan_at_run_time.sdf").expect("scene");
-    let (scene, diags, _) = sdfc_compiler::check::check_str("nan.sdf", &text);
+    let (scene, diags, _) = sdfc_compiler::check_str("nan.sdf", &text);
     scene.unwrap_or_else(|| panic!("{diags:?}"))
 }
 
@@ -584,7 +583,7 @@ fn looking_along_plus_z_plus_x_is_on_the_left() {
                 light directional { direction: (0, 0, 1) }\n\
                 render { width: 40, height: 20, background: (0, 0, 0) }\n\
                 scene { sphere(0.5).translate(1, 0, 0); }";
-    let (scene, diags, _) = sdfc_compiler::check::check_str("hand.sdf", text);
+    let (scene, diags, _) = sdfc_compiler::check_str("hand.sdf", text);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let image = render(&scene).image;
     let light = |xs: std::ops::Range<u32>| {
@@ -626,7 +625,7 @@ fn roughness(grey: &[f64], width: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -
 }
 
 fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check::check_str(name, text);
+    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
     scene.unwrap_or_else(|| panic!("{diags:?}"))
 }
 
@@ -731,7 +730,7 @@ fn a_constant_colour_field_renders_as_the_plain_colour() {
         )
     };
     let scene = |t: &str| {
-        let (scene, diags, _) = sdfc_compiler::check::check_str("colours.sdf", t);
+        let (scene, diags, _) = sdfc_compiler::check_str("colours.sdf", t);
         scene.unwrap_or_else(|| panic!("{diags:?}"))
     };
     let plain = scene(&text("(0.9, 0.2, 0.2)", "(0.9, 0.9, 0.85)"));

@@ -19,10 +19,7 @@ mod common;
 #[path = "common/evaluators.rs"]
 mod evaluators;
 
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::Scene;
-use sdfc_compiler::{diagnostics, scene, syntax, FileId};
+use sdfc_compiler::{diagnostics, dump_ast, dump_ir, parse, wgsl, FileId, Lowered, Scene};
 use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};
 
@@ -217,11 +214,11 @@ fn check_valid(dir: &str, prefix: &str, text: bool) {
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         if text {
             let source = std::fs::read_to_string(&path).expect("readable");
-            let (ast, diags) = syntax::parse(FileId(0), &source);
+            let (ast, diags) = parse(FileId(0), &source);
             assert!(diags.is_empty(), "{}: {diags:?}", path.display());
             let name = format!("{prefix}{}", stem(&path));
-            snapshot("ast", &name, &syntax::dump(&ast));
-            snapshot("ir", &name, &scene::dump(&scene));
+            snapshot("ast", &name, &dump_ast(&ast));
+            snapshot("ir", &name, &dump_ir(&scene));
         }
     }
 }

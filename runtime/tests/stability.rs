@@ -27,10 +27,11 @@
 //! it claims), and a proven scene with an exact layout takes at most [`MAX_STEP_RATIO`] times
 //! its steps; where the analysis proves nothing, the numbers are only reported.
 
-use sdfc_compiler::check::check_str;
-use sdfc_compiler::lower::{lower_scene, LowerOptions, Lowered};
-use sdfc_compiler::scene::analytic::{self, Choice};
-use sdfc_compiler::scene::{analysis, Method, Scene, Settings};
+use sdfc_compiler::{
+    analysis,
+    analytic::{self, Choice},
+    check_str, lower_scene, LowerOptions, Lowered, Method, Scene, Settings,
+};
 use sdfc_runtime::backend::{Backend, Prepared};
 use sdfc_runtime::cpu::{self, reference, Options, Precision, Render};
 use sdfc_runtime::depth::Depth;
@@ -244,7 +245,7 @@ fn compare_depth(reference: &Depth, test: &Render) -> DepthDifference {
 }
 
 /// The scene of a sweep at one value, at the suite's image size, with its diagnostics.
-fn scene_at(s: &Sweep, value: &str) -> (Scene, Vec<sdfc_compiler::diagnostics::Diagnostic>) {
+fn scene_at(s: &Sweep, value: &str) -> (Scene, Vec<sdfc_compiler::Diagnostic>) {
     let name = format!("{}.sdf", s.stem);
     let (scene, diags, _) = check_str(&name, &with_value(s, value));
     let mut scene: Scene = scene.unwrap_or_else(|| panic!("{name} with {value}: {diags:?}"));

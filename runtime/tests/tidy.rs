@@ -15,7 +15,7 @@
 
 mod common;
 
-use sdfc_compiler::check::builtins::{self, BUILTINS};
+use sdfc_compiler::builtins::{self, BUILTINS};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -516,7 +516,7 @@ fn the_editor_grammar_knows_every_builtin() {
 /// lexer's, and each one lexes to its character (issue 37: the docs named two of four).
 #[test]
 fn the_string_escapes_in_the_docs_are_the_lexers() {
-    use sdfc_compiler::syntax::lexer::{lex, Token, ESCAPES};
+    use sdfc_compiler::lexer::{lex, Token, ESCAPES};
     let escapes: Vec<String> = ESCAPES.iter().map(|(k, _)| format!("\\{k}")).collect();
     let doc = read("docs/language.md");
     let row = doc
@@ -627,7 +627,7 @@ fn example_produces(row: &str, code: &str) -> bool {
     for snippet in parts.iter().skip(1).step_by(2) {
         let snippet = snippet.replace("\\|", "|");
         for text in [snippet.clone(), format!("scene {{ {snippet}; }}")] {
-            let (_, diags, _) = sdfc_compiler::check::check_str("example.sdf", &text);
+            let (_, diags, _) = sdfc_compiler::check_str("example.sdf", &text);
             if produces(&diags) {
                 return true;
             }

@@ -24,7 +24,7 @@
 //! which fails). `SDFC_TINT_PIPELINES=all` makes a pipeline of every kernel (minutes).
 
 use rayon::prelude::*;
-use sdfc_compiler::back::wgsl::{self, Options};
+use sdfc_compiler::wgsl::{self, Options};
 use sdfc_runtime::frontend;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, BufReader, Read, Write};
@@ -141,7 +141,7 @@ fn example_jobs() -> Vec<Job> {
         let scene = loaded
             .scene
             .unwrap_or_else(|| panic!("{} has errors", path.display()));
-        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        let lowered = sdfc_compiler::Lowered::new(&scene);
         let options = Options {
             parameters,
             ..Options::default()
@@ -184,8 +184,8 @@ fn interpreted_jobs() -> Vec<Job> {
         let mut scene = loaded
             .scene
             .unwrap_or_else(|| panic!("{} has errors", path.display()));
-        scene.settings.method = sdfc_compiler::scene::Method::March;
-        let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+        scene.settings.method = sdfc_compiler::Method::March;
+        let lowered = sdfc_compiler::Lowered::new(&scene);
         let options = Options {
             kernel: wgsl::KernelChoice::Interpreted,
             ..Options::default()
@@ -361,9 +361,9 @@ fn combo_jobs() -> Vec<Job> {
         .par_iter()
         .map(|&combo| {
             let (text, options) = combo.scene();
-            let (scene, diags, _) = sdfc_compiler::check::check_str("features.sdf", &text);
+            let (scene, diags, _) = sdfc_compiler::check_str("features.sdf", &text);
             let scene = scene.unwrap_or_else(|| panic!("{}:\n{text}\n{diags:?}", combo.name()));
-            let lowered = sdfc_compiler::lower::Lowered::new(&scene);
+            let lowered = sdfc_compiler::Lowered::new(&scene);
             let kernel = wgsl::write_with(&scene, &lowered, &options)
                 .unwrap_or_else(|e| panic!("{}: {e}", combo.name()));
             assert!(

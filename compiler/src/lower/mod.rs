@@ -22,12 +22,7 @@ mod simplify;
 #[cfg(test)]
 mod tests;
 
-/// The program's types, at the path they had when they were defined here.
-pub use crate::program::{
-    axis_name, binary_name, op_text, unary_name, Axis, Binary, Block, Item, Note, Op, Program, Reg,
-    Unary,
-};
-pub use builder::{Param, Slots};
+use crate::program::{Binary, Program, Reg, Unary};
 pub use field::{ColourProgram, Colours};
 pub use instances::{shape_program, Instance, ShapeProgram, Split};
 pub use media::{media, Media};

@@ -363,7 +363,8 @@ fn lowering_stops_at_the_program_limit() {
 #[test]
 fn the_walks_shape_programs_are_the_lowerings_rules() {
     use super::builder::Builder;
-    use super::{shape_program, shapes, Op};
+    use super::{shape_program, shapes};
+    use crate::program::Op;
     let shapes_of = [
         Node::Sphere { radius: 0.7 },
         Node::Box {

@@ -26,7 +26,6 @@ mod text;
 pub use float::Float;
 pub use live::results;
 pub use run::Step;
-pub use text::{axis_name, binary_name, op_text, unary_name};
 
 /// Names a register: the value defined by the instruction at this index.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

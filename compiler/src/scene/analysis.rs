@@ -1513,7 +1513,7 @@ fn fmt(x: f64) -> String {
 }
 
 mod aabb;
-pub mod field;
+mod field;
 #[cfg(test)]
 mod tests;
 mod warnings;

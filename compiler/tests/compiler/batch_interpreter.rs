@@ -3,11 +3,10 @@
 //! around the chunk size, and what a tape keeps.
 
 use crate::common::*;
-use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
-use sdfc_compiler::program::Program;
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
+use sdfc_compiler::{
+    eval_point, lower, lower_with, Combine, Evaluator, Float, LowerOptions, Node, Outputs, Program,
+    Rng, Scene, Smooth, Tape,
+};
 
 /// A scene that uses most operations: smooth blends, repetition, twist, bend, rotation,
 /// painting.

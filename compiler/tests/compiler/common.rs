@@ -3,12 +3,10 @@
 //! the examples (the runtime's `tests/common` includes this file).
 #![allow(dead_code)]
 
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::{
-    Camera, Combine, Graph, Light, Material, MaterialId, Node, NodeId, Pattern, Scene, Settings,
-    Smooth,
+use sdfc_compiler::{
+    Camera, Combine, FileId, Graph, Light, Material, MaterialId, Node, NodeId, Pattern, Rng, Scene,
+    Settings, Smooth, Span,
 };
-use sdfc_compiler::{FileId, Span};
 
 /// A span for nodes made in code.
 pub fn span() -> Span {

@@ -4,11 +4,10 @@
 //! exceed the true distance.
 
 use crate::common::*;
-use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::{lower, lower_with, LowerOptions};
-use sdfc_compiler::program::Program;
-use sdfc_compiler::rng::Rng;
-use sdfc_compiler::scene::{Combine, Node, Scene, Smooth};
+use sdfc_compiler::{
+    eval_point, lower, lower_with, Combine, Evaluator, Float, LowerOptions, Node, Outputs, Program,
+    Rng, Scene, Smooth, Tape,
+};
 
 /// Distance (and material) of a program at many points, in f32 through the batch path.
 fn batch<T: Float>(program: &Program, points: &[[f64; 3]]) -> (Vec<f64>, Vec<u32>) {
@@ -304,7 +303,7 @@ fn mandelbulb_matches_the_iteration() {
 
 /// Two spheres, one of them translated, combined by `make`.
 fn pair(
-    make: impl FnOnce(&mut Build, sdfc_compiler::scene::NodeId, sdfc_compiler::scene::NodeId) -> Node,
+    make: impl FnOnce(&mut Build, sdfc_compiler::NodeId, sdfc_compiler::NodeId) -> Node,
 ) -> Scene {
     let mut b = Build::new();
     let s1 = b.add(sphere(1.0));
@@ -405,7 +404,7 @@ fn smooth_union_with_zero_blend_is_the_union() {
 
 // ---- transforms ----
 
-fn wrap(inner: Node, make: impl FnOnce(sdfc_compiler::scene::NodeId) -> Node) -> Scene {
+fn wrap(inner: Node, make: impl FnOnce(sdfc_compiler::NodeId) -> Node) -> Scene {
     let mut b = Build::new();
     let c = b.add(inner);
     let root = b.add(make(c));
@@ -698,11 +697,11 @@ fn empty_scene_is_far_away() {
 }
 
 trait WithRoot {
-    fn clone_with_root(&self, root: sdfc_compiler::scene::NodeId) -> Scene;
+    fn clone_with_root(&self, root: sdfc_compiler::NodeId) -> Scene;
 }
 
 impl WithRoot for Scene {
-    fn clone_with_root(&self, root: sdfc_compiler::scene::NodeId) -> Scene {
+    fn clone_with_root(&self, root: sdfc_compiler::NodeId) -> Scene {
         let mut s = self.clone();
         s.root = Some(root);
         s

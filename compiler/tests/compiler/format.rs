@@ -2,9 +2,11 @@
 //! is idempotent, and the formatted file means what the original did (the same diagnostics,
 //! the same scene IR and distance program).
 
-use sdfc_compiler::check::{check, Loader};
-use sdfc_compiler::syntax::format::{format, Error};
-use sdfc_compiler::SourceMap;
+use sdfc_compiler::{
+    check,
+    format::{format, Error},
+    Loader, SourceMap,
+};
 use std::path::{Path, PathBuf};
 
 /// Imports read from disk, relative to the importing file.
@@ -31,12 +33,7 @@ fn meaning(name: &str, text: &str) -> (Vec<String>, Option<(String, String)>) {
         .iter()
         .map(|d| format!("{} {}", d.code, d.message))
         .collect();
-    let lowered = scene.map(|s| {
-        (
-            sdfc_compiler::scene::dump(&s),
-            sdfc_compiler::lower::lower(&s).dump(),
-        )
-    });
+    let lowered = scene.map(|s| (sdfc_compiler::dump_ir(&s), sdfc_compiler::lower(&s).dump()));
     (diags, lowered)
 }
 

@@ -2,8 +2,7 @@
 //! errors, not crashes or hangs; every fuzz regression case and thousands of mutated inputs
 //! go through the whole front end without a panic.
 
-use sdfc_compiler::check::check_str;
-use sdfc_compiler::rng::Rng;
+use sdfc_compiler::{check_str, check_with, lower_within, LowerOptions, NoImports, Rng};
 
 /// The codes of the diagnostics of `text`, but for W0008: these scenes have no lights.
 fn codes(text: &str) -> Vec<&'static str> {
@@ -134,16 +133,16 @@ fn fuzz_regression_inputs_exist_and_check_quickly() {
 /// Checks and lowers `text`, within limits small enough that a mutation of an input near
 /// a limit (the exponential expansion of `tests/in/err`) cannot make a slow case.
 fn front_end(text: &str) {
-    use sdfc_compiler::{check, lower, Limit, Limits, SourceMap};
+    use sdfc_compiler::{Limit, Limits, SourceMap};
     let mut limits = Limits::default();
     limits.set(Limit::Expansion, 200_000).expect("valid");
     let mut sources = SourceMap::new();
     let entry = sources.add("t.sdf", text);
-    let (scene, diags) = check::check_with(&mut sources, entry, &mut check::NoImports, &limits);
+    let (scene, diags) = check_with(&mut sources, entry, &mut NoImports, &limits);
     let _ = sdfc_compiler::diagnostics::render(&diags, &sources, false);
     if let Some(scene) = scene {
-        let options = lower::LowerOptions::default();
-        if let Ok(lowered) = lower::lower_within(&scene, &options, &limits) {
+        let options = LowerOptions::default();
+        if let Ok(lowered) = lower_within(&scene, &options, &limits) {
             let _ = lowered.program.dump();
         }
     }

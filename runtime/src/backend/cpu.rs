@@ -5,10 +5,7 @@ use super::{Frame, Part, Prepared, Renderer, Setup};
 use crate::cpu::{self, Options, Tapes};
 use crate::gpu;
 use crate::memory::Memory;
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::analytic::Traceable;
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
 use std::time::{Duration, Instant};
 
 /// A scene prepared for the CPU: the distance program and its tapes, and the render options.

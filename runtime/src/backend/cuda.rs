@@ -4,10 +4,7 @@
 use super::{kernel, kernel_text, Frame, Part, Preparation, Prepared, Renderer, Setup};
 use crate::gpu::{self, cuda::Cuda};
 use crate::memory::Memory;
-use sdfc_compiler::back::{ptx, wgsl};
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::analytic::Traceable;
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{analytic::Traceable, ptx, wgsl, Lowered, Scene, Settings};
 use std::time::{Duration, Instant};
 
 /// A scene prepared for CUDA: the device, the loaded module (with the kernel's scene data and

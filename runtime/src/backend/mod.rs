@@ -18,10 +18,10 @@ pub use self::wgpu::WgpuPrepared;
 use crate::cpu::{Precision, Render};
 use crate::gpu::{self, cuda::Cuda, Gpu};
 use crate::memory::{self, Memory};
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::{self, LowerOptions, Lowered};
-use sdfc_compiler::scene::analytic::{Choice, Traceable};
-use sdfc_compiler::scene::{Method, Scene, Settings};
+use sdfc_compiler::{
+    analytic::{Choice, Traceable},
+    lower_scene, wgsl, LowerOptions, Lowered, Method, Scene, Settings,
+};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -594,7 +594,7 @@ impl Prepared {
             precision,
             ..Setup::default()
         };
-        let lowered = lower::lower_scene(scene, &LowerOptions::default());
+        let lowered = lower_scene(scene, &LowerOptions::default());
         Self::from_program(backend, scene, lowered, &setup)
     }
 

@@ -4,10 +4,7 @@
 use super::{Frame, Part, Prepared, Renderer, Setup};
 use crate::gpu;
 use crate::memory::Memory;
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::analytic::Traceable;
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
 use std::time::Duration;
 
 /// A scene prepared on several devices, in the order `--devices` names them.

@@ -4,10 +4,7 @@
 use super::{kernel, kernel_text, Frame, Part, Preparation, Prepared, Renderer, Setup};
 use crate::gpu::{self, Gpu};
 use crate::memory::Memory;
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::analytic::Traceable;
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 

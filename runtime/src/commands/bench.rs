@@ -7,9 +7,7 @@ use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend::{self, DiagnosticFormat};
 use crate::settings::{override_settings, parse_size};
-use sdfc_compiler::lower::{LowerOptions, Lowered};
-use sdfc_compiler::scene::Scene;
-use sdfc_compiler::Limits;
+use sdfc_compiler::{Limits, LowerOptions, Lowered, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -178,7 +176,7 @@ pub struct SequenceTiming {
 fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render::CliError> {
     use super::render::{check_memory, frame_scene, CliError, Overrides};
     use super::sequence::Kernels;
-    use sdfc_compiler::scene::Animation;
+    use sdfc_compiler::Animation;
     use std::time::{Duration, Instant};
     let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
     let limits = args.limits.limits();
@@ -403,11 +401,11 @@ fn time_scene(
         software: false,
     };
     if args.backend != Backend::Cpu {
-        let options = sdfc_compiler::back::wgsl::Options {
+        let options = sdfc_compiler::wgsl::Options {
             kernel: setup.kernel,
             ..Default::default()
         };
-        sdfc_compiler::back::wgsl::choose(scene, &lowered, &options)?;
+        sdfc_compiler::wgsl::choose(scene, &lowered, &options)?;
     }
     let prepared = Prepared::on_devices(args.backend, &args.devices, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.

@@ -2,10 +2,7 @@
 //! derived about each scene's distance field.
 
 use crate::frontend::{self, DiagnosticFormat};
-use sdfc_compiler::diagnostics::number;
-use sdfc_compiler::scene::analysis;
-use sdfc_compiler::scene::Scene;
-use sdfc_compiler::{Diagnostic, Severity};
+use sdfc_compiler::{analysis, diagnostics::number, Diagnostic, Scene, Severity};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -57,7 +54,7 @@ pub fn run(args: CheckArgs) -> ExitCode {
                                 frontend::method(
                                     &loaded,
                                     scene,
-                                    &sdfc_compiler::scene::analytic::traceable(scene)
+                                    &sdfc_compiler::analytic::traceable(scene)
                                 )
                             );
                         }
@@ -82,8 +79,8 @@ pub fn run(args: CheckArgs) -> ExitCode {
 /// beyond `program`. The scene is lowered as a render lowers it, and the lowering stops at
 /// the limit, so this costs no more than the render would have spent before failing.
 fn beyond_render_limits(scene: &Scene, limits: &sdfc_compiler::Limits) -> Option<Diagnostic> {
-    let options = sdfc_compiler::lower::LowerOptions::default();
-    let error = sdfc_compiler::lower::lower_within(scene, &options, limits).err()?;
+    let options = sdfc_compiler::LowerOptions::default();
+    let error = sdfc_compiler::lower_within(scene, &options, limits).err()?;
     Some(Diagnostic {
         severity: Severity::Warning,
         message: format!(
@@ -101,16 +98,11 @@ const VERIFY_REACH: f64 = 4.0;
 
 /// `--verify-bounds`: every field's bound sampled; false when one is exceeded (printed).
 fn verify_bounds(loaded: &frontend::Loaded, file: &std::path::Path, scene: &Scene) -> bool {
-    let found = sdfc_compiler::eval::verify::verify_fields(scene, VERIFY_PAIRS, VERIFY_REACH);
+    let found = sdfc_compiler::verify_fields(scene, VERIFY_PAIRS, VERIFY_REACH);
     let fields = scene
         .graph
         .ids()
-        .filter(|&id| {
-            matches!(
-                scene.graph.node(id),
-                sdfc_compiler::scene::Node::Field { .. }
-            )
-        })
+        .filter(|&id| matches!(scene.graph.node(id), sdfc_compiler::Node::Field { .. }))
         .count();
     for v in &found {
         let span = scene.graph.span(v.node);
@@ -144,7 +136,7 @@ pub fn animation(
     format: DiagnosticFormat,
 ) -> Result<String, u8> {
     use sdfc_compiler::animation::{runs, Structure};
-    use sdfc_compiler::scene::Animation;
+    use sdfc_compiler::Animation;
     let a = scene.animation;
     if !a.animated() {
         return Ok("still (nothing reads `t`)".into());
@@ -172,9 +164,9 @@ pub fn animation(
             return Err(1);
         };
         // Lowered as `sdfc render --frames` lowers a sequence's frames.
-        let program = match sdfc_compiler::lower::lower_within(
+        let program = match sdfc_compiler::lower_within(
             &scene,
-            &sdfc_compiler::lower::LowerOptions::parametric(),
+            &sdfc_compiler::LowerOptions::parametric(),
             limits,
         ) {
             Ok(p) => p,

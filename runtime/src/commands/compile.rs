@@ -2,8 +2,11 @@
 
 use crate::frontend::{self, DiagnosticFormat};
 use clap::ValueEnum;
-use sdfc_compiler::back::{self, shader::Lang};
-use sdfc_compiler::{lower, scene, syntax};
+use sdfc_compiler::{
+    dump_ast, dump_ir, lower_within, parse, ptx, rust,
+    shader::{self, Lang},
+    shadertoy, wgsl, LowerOptions, Lowered, Scene,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -77,7 +80,7 @@ pub struct CompileArgs {
     pub part: Part,
     /// The name of the distance function (`--part map`); every name the part declares
     /// starts with it, so two scenes' parts can live in one shader.
-    #[arg(long, default_value = back::wgsl::part::DEFAULT_NAME)]
+    #[arg(long, default_value = wgsl::part::DEFAULT_NAME)]
     pub name: String,
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value_t)]
@@ -136,11 +139,11 @@ pub fn run(args: CompileArgs) -> ExitCode {
             // The AST is shown even for a file with errors in later stages, but not with
             // syntax errors (the tree would be partial).
             let entry = sdfc_compiler::FileId(0);
-            let (ast, diags) = syntax::parse(entry, loaded.sources.text(entry));
+            let (ast, diags) = parse(entry, loaded.sources.text(entry));
             if sdfc_compiler::diagnostics::has_errors(&diags) {
                 return ExitCode::from(1);
             }
-            syntax::dump(&ast)
+            dump_ast(&ast)
         }
         other => {
             let Some(mut scene) = loaded.scene.take() else {
@@ -159,10 +162,10 @@ pub fn run(args: CompileArgs) -> ExitCode {
             }
             let scene = &scene;
             if other == Emit::Ir {
-                return write_output(args.output.as_deref(), &scene::dump(scene));
+                return write_output(args.output.as_deref(), &dump_ir(scene));
             }
-            let options = lower::LowerOptions::level(args.opt);
-            let lowered = match lower::lower_within(scene, &options, &limits) {
+            let options = LowerOptions::level(args.opt);
+            let lowered = match lower_within(scene, &options, &limits) {
                 Ok(lowered) => lowered,
                 Err(d) => {
                     frontend::print_diagnostics_on_stderr(&[d], &loaded.sources, args.diagnostics);
@@ -204,7 +207,7 @@ fn part_refused(args: &CompileArgs) -> Option<String> {
         );
     }
     match args.part {
-        Part::Kernel if args.name != back::wgsl::part::DEFAULT_NAME => {
+        Part::Kernel if args.name != wgsl::part::DEFAULT_NAME => {
             Some("`--name` names the distance function of `--part map`".into())
         }
         Part::Map
@@ -220,7 +223,7 @@ fn part_refused(args: &CompileArgs) -> Option<String> {
                     .map_or(String::new(), |v| v.get_name().to_string())
             ))
         }
-        Part::Map if !back::wgsl::part::valid_name(&args.name) => Some(format!(
+        Part::Map if !wgsl::part::valid_name(&args.name) => Some(format!(
             "`--name {}` is not a name for a function: use ASCII letters, digits and `_`, not starting with a digit or `__`, at most 64 characters, and not a word WGSL or Rust reserves",
             args.name
         )),
@@ -234,8 +237,8 @@ const MESH_DATA: &str = "error: {} has no form for a scene with a `mesh`: its tr
 
 /// The bytes of the distance function alone, named `name`, in `target`.
 pub fn emit_map(
-    scene: &scene::Scene,
-    lowered: &lower::Lowered,
+    scene: &Scene,
+    lowered: &Lowered,
     target: Emit,
     name: &str,
 ) -> Result<Vec<u8>, String> {
@@ -243,7 +246,7 @@ pub fn emit_map(
         return Err(MESH_DATA.replace("{}", "`--part map`"));
     }
     let lang = match target {
-        Emit::Rust => return Ok(back::rust::write_named(&lowered.program, name).into_bytes()),
+        Emit::Rust => return Ok(rust::write_named(&lowered.program, name).into_bytes()),
         Emit::Wgsl => None,
         Emit::Glsl => Some(Lang::Glsl),
         Emit::Hlsl => Some(Lang::Hlsl),
@@ -256,18 +259,18 @@ pub fn emit_map(
             ));
         }
     };
-    let part = back::wgsl::part::write(scene, lowered, name).map_err(|e| e.to_string())?;
+    let part = wgsl::part::write(scene, lowered, name).map_err(|e| e.to_string())?;
     match lang {
         None => Ok(part.source.into_bytes()),
-        Some(lang) => back::shader::write_part(&part, lang).map_err(|e| e.to_string()),
+        Some(lang) => shader::write_part(&part, lang).map_err(|e| e.to_string()),
     }
 }
 
 /// The bytes of a target that needs the distance program (`sdfc compile --part kernel`,
 /// and the Python package's `Scene.compile`).
 pub fn emit(
-    scene: &scene::Scene,
-    lowered: &lower::Lowered,
+    scene: &Scene,
+    lowered: &Lowered,
     target: Emit,
     sm: u32,
     kernel: Option<crate::backend::Kernel>,
@@ -279,9 +282,9 @@ pub fn emit(
     }
     let lang = match target {
         Emit::Program => return Ok(program.dump().into_bytes()),
-        Emit::Rust => return Ok(back::rust::write(program).into_bytes()),
+        Emit::Rust => return Ok(rust::write(program).into_bytes()),
         Emit::Shadertoy => {
-            return back::shadertoy::write(scene, lowered)
+            return shadertoy::write(scene, lowered)
                 .map(String::into_bytes)
                 .map_err(|e| e.to_string())
         }
@@ -294,15 +297,15 @@ pub fn emit(
         Emit::Hlsl => Some(Lang::Hlsl),
         Emit::Wgsl | Emit::Ptx | Emit::Params | Emit::SceneData | Emit::Layout => None,
     };
-    let options = back::wgsl::Options {
-        kernel: kernel.map_or(back::wgsl::KernelChoice::Specialised, |k| k.choice()),
-        ..back::wgsl::Options::default()
+    let options = wgsl::Options {
+        kernel: kernel.map_or(wgsl::KernelChoice::Specialised, |k| k.choice()),
+        ..wgsl::Options::default()
     };
-    back::wgsl::choose(scene, lowered, &options).map_err(|e| format!("error: {e}"))?;
-    let kernel = back::wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())?;
+    wgsl::choose(scene, lowered, &options).map_err(|e| format!("error: {e}"))?;
+    let kernel = wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())?;
     match target {
         Emit::Params => {
-            return back::wgsl::uniforms(&kernel.contract.uniform, scene, program.lipschitz())
+            return wgsl::uniforms(&kernel.contract.uniform, scene, program.lipschitz())
                 .map_err(|e| format!("internal compiler error: {e}"))
         }
         Emit::SceneData => {
@@ -311,7 +314,7 @@ pub fn emit(
             })
         }
         Emit::Layout => {
-            let value = back::wgsl::layout::interface(&kernel)?;
+            let value = wgsl::layout::interface(&kernel)?;
             let mut text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())?;
             text.push('\n');
             return Ok(text.into_bytes());
@@ -319,17 +322,17 @@ pub fn emit(
         _ => {}
     }
     if target == Emit::Ptx {
-        let options = back::ptx::Options {
+        let options = ptx::Options {
             sm,
-            entry_point: back::wgsl::ENTRY_POINT.to_string(),
+            entry_point: wgsl::ENTRY_POINT.to_string(),
         };
-        return back::ptx::write(&kernel.module, &kernel.info, &options)
+        return ptx::write(&kernel.module, &kernel.info, &options)
             .map(|ptx| ptx.text.into_bytes())
             .map_err(|e| e.to_string());
     }
     match lang {
         None => Ok(kernel.source.into_bytes()),
-        Some(lang) => back::shader::write(&kernel, lang).map_err(|e| e.to_string()),
+        Some(lang) => shader::write(&kernel, lang).map_err(|e| e.to_string()),
     }
 }
 

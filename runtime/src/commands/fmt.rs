@@ -3,8 +3,10 @@
 
 use crate::frontend::{self, DiagnosticFormat};
 use crate::image::AtomicFile;
-use sdfc_compiler::syntax::format::{format, Error};
-use sdfc_compiler::SourceMap;
+use sdfc_compiler::{
+    format::{format, Error},
+    SourceMap,
+};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

@@ -8,9 +8,7 @@ use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::write::Format;
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, AXIS_CELLS};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::lower::LowerOptions;
-use sdfc_compiler::scene::{analysis, Combine, Node, NodeId, Scene};
-use sdfc_compiler::{Limit, Limits};
+use sdfc_compiler::{analysis, Combine, Limit, Limits, LowerOptions, Node, NodeId, Scene};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -91,7 +89,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         m.pattern
             .colours()
             .iter()
-            .any(|c| matches!(c, sdfc_compiler::scene::Colour::Field(_)))
+            .any(|c| matches!(c, sdfc_compiler::Colour::Field(_)))
     });
     settings.materials |= format == Format::Obj && colour_fields;
     let bar = std::io::stderr().is_terminal().then(|| {
@@ -146,7 +144,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         ));
     }
     // The file's bytes are in the surface cells' share of the announcement.
-    let colours = sdfc_compiler::lower::Colours::new(&checked.scene);
+    let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = crate::mesh::write::Palette::new(&checked.scene, &colours);
     let bytes = format.encode(&mesh, &palette);
     crate::image::write_atomic(&args.output, &bytes)

@@ -16,10 +16,9 @@ use crate::pareto::{
     ReferenceInfo, Report, DEFAULT_SWEEPS,
 };
 use crate::settings::{override_settings, parse_size};
-use sdfc_compiler::diagnostics::scientific;
-use sdfc_compiler::lower::{LowerOptions, Lowered};
-use sdfc_compiler::scene::{Method, Scene, Settings};
-use sdfc_compiler::Limits;
+use sdfc_compiler::{
+    diagnostics::scientific, Limits, LowerOptions, Lowered, Method, Scene, Settings,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -11,9 +11,7 @@ use crate::output::Output;
 use crate::settings::{override_settings, parse_size};
 use crate::{depth, memory};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::lower::LowerOptions;
-use sdfc_compiler::scene::Scene;
-use sdfc_compiler::Limits;
+use sdfc_compiler::{Limits, LowerOptions, Scene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -174,7 +172,7 @@ pub struct FrameScene {
     /// The scene, settings applied.
     pub scene: Scene,
     /// Its distance program and what else the backends read.
-    pub lowered: sdfc_compiler::lower::Lowered,
+    pub lowered: sdfc_compiler::Lowered,
     /// Where its time went (`--stats`): the check, then the lowering's phases.
     pub phases: Vec<(&'static str, Duration, String)>,
 }
@@ -270,11 +268,11 @@ pub fn prepare(
     // A kernel asked for that cannot render the scene is an error, not a reason to fall back
     // to another backend.
     if backend != Backend::Cpu {
-        let options = sdfc_compiler::back::wgsl::Options {
+        let options = sdfc_compiler::wgsl::Options {
             kernel: setup.kernel,
             ..Default::default()
         };
-        sdfc_compiler::back::wgsl::choose(&scene, &lowered, &options).map_err(CliError::Failed)?;
+        sdfc_compiler::wgsl::choose(&scene, &lowered, &options).map_err(CliError::Failed)?;
     }
     let prepared = pool
         .install(|| match opening {

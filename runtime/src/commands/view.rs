@@ -82,7 +82,7 @@ pub fn run(args: ViewArgs) -> ExitCode {
     let limits = args.limits.limits();
     // The --set values are checked once here, so that a mistake in them stops at once rather
     // than failing every reload.
-    let mut probe = sdfc_compiler::scene::Settings::default();
+    let mut probe = sdfc_compiler::Settings::default();
     if let Err(msg) =
         crate::settings::override_settings(&mut probe, args.size, None, &args.set, &limits)
     {

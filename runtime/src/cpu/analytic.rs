@@ -1,5 +1,5 @@
 //! Analytic ray tracing on the CPU: the closed-form intersections of the primitives that
-//! `sdfc_compiler::scene::analytic` found (spheres, planes, boxes, capped cylinders and
+//! `sdfc_compiler::analytic` found (spheres, planes, boxes, capped cylinders and
 //! capsules under affine maps), nearest hits with exact normals, and any-hit shadow rays.
 //!
 //! Every primitive is convex (a plane bounds a half-space), so a ray meets it in one interval
@@ -7,8 +7,10 @@
 //! on the surface offset along the normal (as in sphere tracing), so t = 0 is the origin.
 
 use super::vec::V3;
-use sdfc_compiler::eval::Float;
-use sdfc_compiler::scene::analytic::{Item, Primitive, Shape, Traced};
+use sdfc_compiler::{
+    analytic::{Item, Primitive, Shape, Traced},
+    Float,
+};
 
 /// A primitive in the evaluation type.
 #[derive(Debug, Clone, Copy)]
@@ -47,7 +49,7 @@ pub(super) struct Surface<T> {
     pub material: u32,
 }
 
-/// An entry of the hierarchy (`sdfc_compiler::scene::analytic::hierarchy`).
+/// An entry of the hierarchy (`sdfc_compiler::analytic::hierarchy`).
 #[derive(Debug, Clone)]
 enum Node<T> {
     Prim(usize),
@@ -221,8 +223,8 @@ impl<T: Float> Tracer<T> {
 /// primitive), and, while it is built, the compiler's list of primitives, their boxes and its
 /// tree (counted four times over, with 256 bytes per primitive for the vectors' slack).
 pub(super) fn heap_bytes<T: Float>(
-    scene: &sdfc_compiler::scene::Scene,
-    traceable: &sdfc_compiler::scene::analytic::Traceable,
+    scene: &sdfc_compiler::Scene,
+    traceable: &sdfc_compiler::analytic::Traceable,
 ) -> u64 {
     use std::mem::size_of;
     let n = traceable
@@ -431,10 +433,10 @@ fn plane<T: Float>(o: V3<T>, d: V3<T>, n: V3<T>, h: T) -> Option<Interval<T>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sdfc_compiler::eval::eval_point;
-    use sdfc_compiler::lower::lower;
-    use sdfc_compiler::rng::Rng;
-    use sdfc_compiler::scene::analytic::traceable;
+    use sdfc_compiler::analytic::traceable;
+    use sdfc_compiler::eval_point;
+    use sdfc_compiler::lower;
+    use sdfc_compiler::Rng;
 
     /// A vector uniform in [-1, 1)³.
     fn v3(rng: &mut Rng) -> V3<f64> {
@@ -464,7 +466,7 @@ mod tests {
             let text = format!(
                 "material a = phong {{ color: (1, 0, 0) }};\nscene {{ {shape} @ a; sphere(0.3).translate(2, 0, 0); }}"
             );
-            let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
+            let (scene, diags, _) = sdfc_compiler::check_str("t.sdf", &text);
             let scene = scene.unwrap_or_else(|| panic!("{shape}: {diags:?}"));
             let traceable = traceable(&scene);
             let tracer =
@@ -524,7 +526,7 @@ mod tests {
     fn shadow_rays_see_occluders_between_their_ends() {
         let text = "material glass = phong { transparency: 0.5, ior: 1.5 };\n\
                     scene { sphere(1).translate(0, 0, 5); sphere(1).translate(0, 0, -5) @ glass; }";
-        let (scene, _, _) = sdfc_compiler::check::check_str("t.sdf", text);
+        let (scene, _, _) = sdfc_compiler::check_str("t.sdf", text);
         let scene = scene.expect("checks");
         let traceable = traceable(&scene);
         let tracer = Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));
@@ -561,7 +563,7 @@ mod tests {
             text.push_str(&format!(" {shape}.translate({x}, {y}, {z}){paint};\n"));
         }
         text.push_str("}\n");
-        let (scene, diags, _) = sdfc_compiler::check::check_str("t.sdf", &text);
+        let (scene, diags, _) = sdfc_compiler::check_str("t.sdf", &text);
         let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
         let traceable = traceable(&scene);
         let tracer = Tracer::<f64>::new(traceable.traced(scene.settings.method).expect("traced"));

@@ -1,8 +1,7 @@
 //! The pinhole camera of docs/rendering.md, "Camera", and the supersampling grid.
 
 use super::vec::V3;
-use sdfc_compiler::eval::Float;
-use sdfc_compiler::scene::{Camera, Settings};
+use sdfc_compiler::{Camera, Float, Settings};
 
 /// A camera prepared for generating rays.
 #[derive(Debug, Clone, Copy)]

@@ -5,10 +5,9 @@
 use super::analytic::Tracer;
 use super::camera::Pinhole;
 use super::vec::V3;
-use sdfc_compiler::eval::Float;
-use sdfc_compiler::lower::{ColourProgram, Colours};
-use sdfc_compiler::scene::analytic::Traceable;
-use sdfc_compiler::scene::{Colour, Light, Material, Pattern, Scene};
+use sdfc_compiler::{
+    analytic::Traceable, Colour, ColourProgram, Colours, Float, Light, Material, Pattern, Scene,
+};
 
 /// One colour of a material: a constant, or the colour field of this number
 /// ([`Context::colours`]).

@@ -6,7 +6,7 @@
 //! queue runs dry. A ray's result depends only on its own lane, never on its position, so
 //! the output is the same whatever the order.
 
-use sdfc_compiler::eval::{wide, Evaluator, Float};
+use sdfc_compiler::{wide, Evaluator, Float};
 
 /// The state of one ray entering a march.
 #[derive(Debug, Clone, Copy)]

@@ -5,7 +5,7 @@
 use super::context::Context;
 use super::lanes::{Lanes, Rule};
 use super::stats::Counters;
-use sdfc_compiler::eval::Float;
+use sdfc_compiler::Float;
 
 /// How a traced ray ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -13,8 +13,7 @@ use super::tile::{Rect, TileOut, WAVE};
 use super::vec::V3;
 use super::wave::Ray;
 use super::{Options, Precision, Tapes};
-use sdfc_compiler::eval::{Evaluator, Float};
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{Evaluator, Float, Scene, Settings};
 use std::mem::size_of;
 
 /// Allocations of the thread pool and the collection of tiles, whatever the image.

@@ -27,10 +27,9 @@ use crate::depth::Depth;
 use crate::image::Image;
 use context::Context;
 use rayon::prelude::*;
-use sdfc_compiler::eval::{Float, Outputs, Tape};
-use sdfc_compiler::lower::{Lowered, Media, Program};
-use sdfc_compiler::scene::analytic::Traceable;
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{
+    analytic::Traceable, Float, Lowered, Media, Outputs, Program, Scene, Settings, Tape,
+};
 use std::sync::OnceLock;
 use tile::Rect;
 use wave::Workspace;
@@ -69,7 +68,7 @@ impl Default for Options {
             lipschitz: 1.0,
             tile: 32,
             lanes: 256,
-            chunk: sdfc_compiler::eval::DEFAULT_CHUNK,
+            chunk: sdfc_compiler::DEFAULT_CHUNK,
             precision: Precision::F32,
             debug_nan: false,
         }
@@ -95,7 +94,7 @@ pub struct Tapes {
     built: OnceLock<Built>,
     traceable: Traceable,
     /// The materials' colour fields, run at hit points.
-    colours: Vec<sdfc_compiler::lower::ColourProgram>,
+    colours: Vec<sdfc_compiler::ColourProgram>,
 }
 
 /// The tapes of [`Tapes`], once prepared.
@@ -106,7 +105,7 @@ struct Built {
     media: Option<MediaTapes>,
 }
 
-/// The tapes of [`sdfc_compiler::lower::Media`]: the medium's distance (marched by rays
+/// The tapes of [`sdfc_compiler::Media`]: the medium's distance (marched by rays
 /// inside glass) and the solids' distance (their normals) and distance and material.
 #[derive(Debug, Clone)]
 struct MediaTapes {

@@ -9,8 +9,7 @@
 
 use super::Render;
 use crate::metrics::{self, DepthDifference, Difference};
-use sdfc_compiler::diagnostics::scientific;
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{diagnostics::scientific, Scene, Settings};
 use std::fmt;
 
 /// The hit tolerance ε of the reference of a field with a proven bound.
@@ -64,7 +63,7 @@ pub fn settings(s: &Settings, proven: bool) -> Settings {
 
 /// The reference settings of `scene` ([`settings`], with its field's proven bound or not).
 pub fn settings_of(scene: &Scene) -> Settings {
-    let analysis = sdfc_compiler::scene::analysis::analyse(scene);
+    let analysis = sdfc_compiler::analysis::analyse(scene);
     let proven = analysis.root().is_none_or(|root| root.proven);
     settings(&scene.settings, proven)
 }

@@ -7,7 +7,7 @@ use super::march::{Shadow, Shadowed, Status, Trace, Traced};
 use super::stats::Counters;
 use super::vec::V3;
 use super::wave::{Evaluators, Ray, Samples, Workspace};
-use sdfc_compiler::eval::Float;
+use sdfc_compiler::Float;
 
 /// A surface point reached by a ray of the wave.
 #[derive(Debug, Clone, Copy)]

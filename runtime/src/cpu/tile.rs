@@ -13,7 +13,7 @@ use super::shade;
 use super::stats::Counters;
 use super::vec::V3;
 use super::wave::{Ray, Samples, Workspace};
-use sdfc_compiler::eval::Float;
+use sdfc_compiler::Float;
 
 /// A pixel rectangle.
 #[derive(Debug, Clone, Copy)]

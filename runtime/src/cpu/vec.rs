@@ -1,6 +1,6 @@
 //! A small 3-vector generic over the evaluation float type (positions, directions, colours).
 
-use sdfc_compiler::eval::Float;
+use sdfc_compiler::Float;
 use std::ops::{Add, Mul, Neg, Sub};
 
 /// A 3-vector of `T`.

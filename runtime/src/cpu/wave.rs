@@ -7,7 +7,7 @@ use super::lanes::{Lanes, Launch};
 use super::march::{Shadowed, Traced};
 use super::vec::V3;
 use super::Tapes;
-use sdfc_compiler::eval::{Evaluator, Float};
+use sdfc_compiler::{Evaluator, Float};
 
 /// A ray waiting to be traced, with what it contributes to.
 #[derive(Debug, Clone, Copy)]

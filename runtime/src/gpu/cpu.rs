@@ -5,7 +5,7 @@
 use super::launch::{self, Job, Pixels};
 use super::reduce::{Answer, Ask};
 use crate::cpu::{self, Counters, Options, Tapes};
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::Scene;
 use std::ops::Range;
 use std::time::Duration;
 

@@ -13,9 +13,10 @@ use cudarc::driver::{
     sys, CudaContext, CudaEvent, CudaFunction, CudaSlice, CudaStream, LaunchConfig,
     PinnedHostSlice, PushKernelArg,
 };
-use sdfc_compiler::back::ptx::{self, Argument, Param, Space};
-use sdfc_compiler::back::wgsl::reduce as reduction;
-use sdfc_compiler::back::wgsl::STATS_WORDS;
+use sdfc_compiler::{
+    ptx::{self, Argument, Param, Space},
+    wgsl::{reduce as reduction, STATS_WORDS},
+};
 use std::ops::Range;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -71,7 +72,7 @@ pub struct Cuda {
     /// the driver copies into pageable memory through a staging buffer of its own, at a
     /// fraction of the bus's speed.
     pinned: Mutex<Option<PinnedHostSlice<u8>>>,
-    /// The statistics' reduction (`sdfc_compiler::back::wgsl::reduce` as PTX), loaded when
+    /// The statistics' reduction (`sdfc_compiler::wgsl::reduce` as PTX), loaded when
     /// first used.
     reducer: Mutex<Option<Arc<Loaded>>>,
 }

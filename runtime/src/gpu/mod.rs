@@ -12,8 +12,10 @@ pub mod wgpu;
 use crate::cpu::{Counters, Render, Stats};
 use crate::image::{Image, Rgba8};
 use crate::memory::Memory;
-use sdfc_compiler::back::wgsl::{self, Kernel, STATS_WORDS};
-use sdfc_compiler::scene::{Scene, Settings};
+use sdfc_compiler::{
+    wgsl::{self, Kernel, STATS_WORDS},
+    Scene, Settings,
+};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -307,7 +309,7 @@ pub fn memory_cuda(settings: &Settings, uniforms: u64, data: u64) -> Memory {
 /// records and totals ([`reduce::threads`]).
 fn reduce_bytes(pixels: u64) -> u64 {
     let (first, second) = reduce::threads(pixels as usize);
-    let record = 4 * sdfc_compiler::back::wgsl::reduce::RECORD as u64;
+    let record = 4 * sdfc_compiler::wgsl::reduce::RECORD as u64;
     (first as u64 + 2 * second as u64) * record
 }
 

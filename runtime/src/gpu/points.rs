@@ -4,9 +4,7 @@
 //! distance conformance tests compare every evaluator with it, and the Python package's
 //! `Scene.distance(points, backend=…)` answers with it.
 
-use sdfc_compiler::back::{ptx, wgsl};
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::scene::{Method, Scene};
+use sdfc_compiler::{ptx, wgsl, Lowered, Method, Scene};
 use wgpu::naga;
 
 /// One evaluation: the distance and the material id at a point.

@@ -2,13 +2,15 @@
 //! prints (the counters, the most steps of a pixel) and the 99th percentile of the steps,
 //! found by histograms of narrower bins around it, one round each, until the bins are one step
 //! wide. A GPU device answers each round with the reduction module of
-//! `sdfc_compiler::back::wgsl::reduce` and reads back a few kilobytes; the CPU device sums its
+//! `sdfc_compiler::wgsl::reduce` and reads back a few kilobytes; the CPU device sums its
 //! own bands. Several devices answer each round together ([`Rounds`]), and their answers add
 //! up: the result is the one the per-pixel statistics of the whole frame give on the host
 //! ([`crate::cpu::Stats::new`]), exactly.
 
 use crate::cpu::Counters;
-use sdfc_compiler::back::wgsl::reduce::{Query, BINS, MAX_WORD, RECORD, WORKGROUP};
+use sdfc_compiler::wgsl::{
+    reduce::Query, reduce::BINS, reduce::MAX_WORD, reduce::RECORD, reduce::WORKGROUP,
+};
 use std::ops::Range;
 use std::sync::{Condvar, Mutex};
 

@@ -5,8 +5,7 @@
 
 use super::launch::{self, Job, Pixels};
 use super::reduce::{self, Answer, Ask};
-use sdfc_compiler::back::wgsl::reduce as reduction;
-use sdfc_compiler::back::wgsl::STATS_WORDS;
+use sdfc_compiler::wgsl::{reduce as reduction, STATS_WORDS};
 use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::{Arc, Mutex};
@@ -76,7 +75,7 @@ pub struct Gpu {
     /// and mapped into the process each time otherwise (33 MB for a 1920×1080 frame's
     /// linear colours).
     staging: Mutex<Vec<wgpu::Buffer>>,
-    /// The statistics' reduction (`sdfc_compiler::back::wgsl::reduce`), compiled when first
+    /// The statistics' reduction (`sdfc_compiler::wgsl::reduce`), compiled when first
     /// used.
     reducer: Mutex<Option<Pipeline>>,
 }
@@ -638,7 +637,7 @@ impl Gpu {
             .map_err(error)
     }
 
-    /// The statistics' reduction pipeline (`sdfc_compiler::back::wgsl::reduce`): binding 0
+    /// The statistics' reduction pipeline (`sdfc_compiler::wgsl::reduce`): binding 0
     /// its query (read-only storage at a dynamic offset), 1 the kernel's statistics (read
     /// only), 2 and 3 the partial records and totals.
     fn reducer(&self) -> Result<Pipeline, Error> {

@@ -4,8 +4,10 @@
 
 use super::navigate::{Index, What};
 use lsp_types as lsp;
-use sdfc_compiler::check::builtins::{self, Range, BUILTINS};
-use sdfc_compiler::{FileId, SourceMap, Span};
+use sdfc_compiler::{
+    builtins::{self, Range, BUILTINS},
+    FileId, SourceMap, Span,
+};
 
 fn item(label: &str, kind: lsp::CompletionItemKind, detail: String) -> lsp::CompletionItem {
     lsp::CompletionItem {

@@ -5,8 +5,7 @@
 
 use super::text;
 use lsp_types as lsp;
-use sdfc_compiler::diagnostics::Severity;
-use sdfc_compiler::{Diagnostic, FileId, SourceMap, Span};
+use sdfc_compiler::{Diagnostic, FileId, Severity, SourceMap, Span};
 use std::path::Path;
 
 /// The table of codes, linked from every diagnostic (the file beside the sources the

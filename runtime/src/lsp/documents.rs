@@ -2,9 +2,9 @@
 //! documents first (their unsaved text), then from disk, through the checker's `Loader`.
 
 use crate::frontend::{normalise, FsLoader};
-use sdfc_compiler::check::{self, Loader};
-use sdfc_compiler::scene::Scene;
-use sdfc_compiler::{Diagnostic, FileId, Limits, SourceMap};
+use sdfc_compiler::{
+    check_with_constants, Constant, Diagnostic, FileId, Limits, Loader, Scene, SourceMap,
+};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -44,7 +44,7 @@ impl Documents {
         let entry = sources.add(name, text);
         let mut loader = OpenFirst { docs: self };
         let (scene, diagnostics, constants) =
-            check::check_with_constants(&mut sources, entry, &mut loader, &Limits::default());
+            check_with_constants(&mut sources, entry, &mut loader, &Limits::default());
         Some(Checked {
             scene,
             diagnostics,
@@ -63,7 +63,7 @@ pub struct Checked {
     /// Everything the compiler said, about this file and its imports.
     pub diagnostics: Vec<Diagnostic>,
     /// The values of the global constants (of this file and its imports) that evaluated.
-    pub constants: Vec<check::Constant>,
+    pub constants: Vec<Constant>,
     /// The document (first) and the files it imports.
     pub sources: SourceMap,
     /// The document's id in `sources`.

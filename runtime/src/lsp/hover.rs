@@ -7,11 +7,11 @@
 
 use super::documents::Checked;
 use super::navigate::{Decl, Index, What};
-use sdfc_compiler::check::builtins::{self, BUILTINS};
-use sdfc_compiler::scene::analysis;
-use sdfc_compiler::scene::analytic;
-use sdfc_compiler::scene::NodeId;
-use sdfc_compiler::{FileId, Span};
+use sdfc_compiler::{
+    analysis, analytic,
+    builtins::{self, BUILTINS},
+    FileId, NodeId, Span,
+};
 
 /// docs/language.md, whose tables give each built-in's valid values and a line on what it does.
 const LANGUAGE: &str = include_str!("../../../docs/language.md");

@@ -461,7 +461,7 @@ impl Server {
 /// The edits that format the text `t` (`sdfc fmt`'s layout): one replacing the whole text
 /// when it changes, none when it is formatted or does not parse (its diagnostics say why).
 pub fn formatting(t: &str) -> Vec<lsp::TextEdit> {
-    match sdfc_compiler::syntax::format::format(t) {
+    match sdfc_compiler::format::format(t) {
         Ok(out) if out != t => vec![lsp::TextEdit::new(text::range(t, 0, t.len()), out)],
         _ => Vec::new(),
     }
@@ -483,7 +483,7 @@ pub fn apply(t: &mut String, change: lsp::TextDocumentContentChangeEvent) {
 /// settings blocks and lights, and the scene with its statements.
 #[allow(deprecated)] // `DocumentSymbol::deprecated` must be given.
 fn symbols(a: &Analysed) -> Vec<lsp::DocumentSymbol> {
-    use sdfc_compiler::syntax::ast;
+    use sdfc_compiler::ast;
     let c = &a.checked;
     let t = c.sources.text(c.entry);
     let r = |s: Span| text::range(t, s.start as usize, s.end as usize);

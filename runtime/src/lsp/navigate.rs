@@ -5,8 +5,7 @@
 //! it imports; a function's parameters and `let`s within the function; a scene's `let`s and
 //! `for` variables within the scene (a `for` variable within its loop).
 
-use sdfc_compiler::syntax::{self, ast};
-use sdfc_compiler::{FileId, SourceMap, Span};
+use sdfc_compiler::{ast, lexer, parse, FileId, SourceMap, Span};
 
 /// What a name is declared as.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,13 +57,13 @@ impl Index {
         for f in 0..sources.len() as u32 {
             let id = FileId(f);
             let text = sources.text(id);
-            let (file, _) = syntax::parse(id, text);
+            let (file, _) = parse(id, text);
             for item in &file.items {
                 index.item(item);
             }
-            let (tokens, _) = syntax::lexer::lex(id, text);
+            let (tokens, _) = lexer::lex(id, text);
             for (tok, span) in tokens {
-                let syntax::lexer::Token::Ident(name) = tok else {
+                let lexer::Token::Ident(name) = tok else {
                     continue;
                 };
                 // A field or argument name (`radius: 1`) names no declaration; a

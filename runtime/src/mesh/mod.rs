@@ -12,8 +12,7 @@ pub mod table;
 pub mod write;
 
 use rayon::prelude::*;
-use sdfc_compiler::eval::{Evaluator, Outputs, Tape, DEFAULT_CHUNK};
-use sdfc_compiler::lower::Program;
+use sdfc_compiler::{Evaluator, Outputs, Program, Tape, DEFAULT_CHUNK};
 use std::collections::{HashMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -10,8 +10,7 @@
 
 use super::Mesh;
 use crate::image::srgb_encode;
-use sdfc_compiler::lower::Colours;
-use sdfc_compiler::scene::{Colour, Material, Pattern, Scene, V3};
+use sdfc_compiler::{Colour, Colours, Material, Pattern, Scene, V3};
 use std::io::{self, Write};
 use std::path::Path;
 

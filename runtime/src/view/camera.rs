@@ -3,7 +3,7 @@
 //! progressive supersampling.
 
 use glam::DVec3;
-use sdfc_compiler::scene::Camera;
+use sdfc_compiler::Camera;
 
 /// Radians of orbit per pixel dragged.
 const ORBIT_PER_PIXEL: f64 = 0.008;

@@ -7,7 +7,7 @@
 use super::resident::FirstFrame;
 use crate::backend::Prepared;
 use crate::gpu::wgpu::PipelineTime;
-use sdfc_compiler::back::wgsl;
+use sdfc_compiler::wgsl;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 

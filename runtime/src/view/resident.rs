@@ -9,8 +9,7 @@
 use crate::gpu::wgpu::{Pipeline, TILE_STRIDE};
 use crate::gpu::Gpu;
 use crate::image::Image;
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::{wgsl, Scene};
 use std::sync::Arc;
 
 /// The pass that accumulates a frame: binding 0 the frame's size, sample count and whether to

@@ -18,10 +18,10 @@ use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
 use crate::image::Image;
 use crate::settings::override_settings;
-use sdfc_compiler::back::wgsl;
-use sdfc_compiler::lower::{self, LowerOptions};
-use sdfc_compiler::scene::{Animation, Camera, Scene};
-use sdfc_compiler::{Diagnostic, FileId, Limit, Limits, Severity, SourceMap};
+use sdfc_compiler::{
+    lower_within, wgsl, Animation, Camera, Diagnostic, FileId, Limit, Limits, LowerOptions,
+    Lowered, Scene, Severity, SourceMap,
+};
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant, SystemTime};
@@ -676,7 +676,7 @@ impl Session {
         }
         let check_time = start.elapsed();
         let start = Instant::now();
-        let lowered = match lower::lower_within(&scene, &lower_options(&scene), &limits) {
+        let lowered = match lower_within(&scene, &lower_options(&scene), &limits) {
             Ok(lowered) => lowered,
             Err(d) => {
                 let summary = first_error(std::slice::from_ref(&d), &loaded.sources);
@@ -817,8 +817,8 @@ impl Session {
         &self,
         gpu: &Arc<Gpu>,
         scene: &Scene,
-        lowered: lower::Lowered,
-        at: &sdfc_compiler::scene::Settings,
+        lowered: Lowered,
+        at: &sdfc_compiler::Settings,
     ) -> Option<Interim> {
         let setup = Setup {
             parameters: true,
@@ -1078,7 +1078,7 @@ impl Session {
             &self.options.sets,
             &limits,
         )?;
-        let lowered = lower::lower_within(&scene, &lower_options(&scene), &limits)
+        let lowered = lower_within(&scene, &lower_options(&scene), &limits)
             .map_err(|d| first_error(std::slice::from_ref(&d), &loaded.sources))?;
         if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
             i.prepared = i.prepared.next(&scene, lowered.clone())?.0;

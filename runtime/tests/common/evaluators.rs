@@ -10,11 +10,7 @@
 //! `Err`.
 #![allow(dead_code)]
 
-use sdfc_compiler::back::rust;
-use sdfc_compiler::eval::{eval_point, Evaluator, Float, Outputs, Tape};
-use sdfc_compiler::lower::Lowered;
-use sdfc_compiler::program::Program;
-use sdfc_compiler::scene::Scene;
+use sdfc_compiler::{eval_point, rust, Evaluator, Float, Lowered, Outputs, Program, Scene, Tape};
 use sdfc_runtime::gpu::points;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

@@ -15,7 +15,7 @@
 mod analytic;
 mod buffer;
 mod contract;
-pub mod glyphs;
+mod glyphs;
 pub mod interp;
 pub mod layout;
 mod map;

@@ -660,6 +660,7 @@ impl Scene {
                 resolution,
                 voxel,
                 bounds: bounds.map(|(lo, hi)| [lo, hi]),
+                spelling: mesher::Spelling::Parameters,
             };
             let settings = sdfc_runtime::mesh::Settings {
                 sharp,

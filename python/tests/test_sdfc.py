@@ -312,7 +312,9 @@ class Mesh(unittest.TestCase):
         s = sdfc.Scene("scene { plane((0, 1, 0), 0); sphere(0.5); }")
         with self.assertRaises(ValueError) as caught:
             s.mesh(resolution=8)
-        self.assertIn("bounds", str(caught.exception))
+        # Named as this package's parameter, not as the command line's flag.
+        self.assertIn("bounds=((x0, y0, z0), (x1, y1, z1))", str(caught.exception))
+        self.assertNotIn("--", str(caught.exception))
         v, f, _ = s.mesh(resolution=16, bounds=((-1, -1, -1), (1, 1, 1)))
         self.assertGreater(len(f), 0)
 

@@ -103,6 +103,16 @@ fn main() -> ExitCode {
             return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
         }
     };
+    if matches!(
+        cli.command,
+        Command::Check(_)
+            | Command::Compile(_)
+            | Command::Compare(_)
+            | Command::Fmt(_)
+            | Command::Completions(_)
+    ) {
+        end_quietly_on_a_closed_stdout();
+    }
     match cli.command {
         Command::Check(args) => commands::check::run(args),
         Command::Devices(args) => commands::devices::run(args),
@@ -116,6 +126,22 @@ fn main() -> ExitCode {
         Command::Fmt(args) => commands::fmt::run(args),
         Command::Lsp(_) => sdfc_runtime::lsp::run(),
         Command::Completions(args) => completions(args.shell),
+    }
+}
+
+/// Restores the default action of SIGPIPE, which Rust's runtime sets to be ignored: a
+/// command whose standard output is closed before it is done (`sdfc completions bash | head
+/// -1`) then ends at its next write, quietly, as `cat` and `grep` do, instead of failing on the
+/// write with an error message (or a panic, in `println!`). Only for the commands that open no
+/// device and no window, whose only pipe is standard output: a GPU driver or a window system
+/// may write to pipes and sockets of its own, whose closing must not end the process.
+fn end_quietly_on_a_closed_stdout() {
+    #[cfg(unix)]
+    // SAFETY: `signal` only sets the disposition of SIGPIPE; it is called before any thread
+    // of this process starts.
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

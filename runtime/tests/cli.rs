@@ -1360,6 +1360,11 @@ fn fmt_rewrites_checks_and_filters() {
         std::fs::read_to_string(d.join("broken.sdf")).expect("read"),
         "let r = ;\n"
     );
+    // Named twice, and through its folder: its error is reported once.
+    let out = sdfc(&d, &["fmt", "broken.sdf", ".", "./broken.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("E0100").count(), 1, "{err}");
+    assert_eq!(err.matches("not formatted").count(), 1, "{err}");
     assert_eq!(sdfc(&d, &["fmt", "missing.sdf"]).status.code(), Some(2));
 
     let run = |args: &[&str], input: &str| {
@@ -1507,5 +1512,51 @@ fn help_and_completions() {
         "{top_lines:?}"
     );
     assert!(help(&["mesh", "--help"]).contains("importers load as separate parts"));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A standard output closed before the command is done (`sdfc completions bash | head -1`)
+/// ends it quietly, as it ends `cat`: no message, and no failure but the signal's.
+#[cfg(unix)]
+#[test]
+fn a_closed_standard_output_ends_a_command_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    let d = dir("closed-stdout");
+    let scene = scene_file(&d);
+    let scene = scene.to_str().expect("utf-8 path");
+    let runs: [(&[&str], bool); 4] = [
+        (&["completions", "bash"], false),
+        (&["compile", scene, "--emit", "wgsl"], false),
+        (&["compile", scene, "--emit", "ir"], false),
+        (&["fmt", "-"], true),
+    ];
+    for (args, stdin) in runs {
+        // The writing end of a pipe whose reader has exited.
+        let mut reader = Command::new("true")
+            .stdin(Stdio::piped())
+            .spawn()
+            .expect("run true");
+        let closed = reader.stdin.take().expect("pipe");
+        reader.wait().expect("true exits");
+        let input = match stdin {
+            true => Stdio::from(std::fs::File::open(scene).expect("scene")),
+            false => Stdio::null(),
+        };
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(args)
+            .stdin(input)
+            .stdout(closed)
+            .output()
+            .expect("run sdfc");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.is_empty(), "sdfc {args:?} printed: {err}");
+        assert!(
+            out.status.success() || out.status.signal() == Some(libc::SIGPIPE),
+            "sdfc {args:?}: {:?}",
+            out.status
+        );
+    }
     let _ = std::fs::remove_dir_all(&d);
 }

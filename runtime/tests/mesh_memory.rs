@@ -1,7 +1,8 @@
 //! The memory `sdfc mesh` announces is an upper bound: a counting global allocator records
 //! the peak of live heap bytes while the octree (`octree::bytes`) and then contouring
 //! (`contour::candidate_bytes` and `BYTES_PER_SURFACE_CELL` per surface cell) run through the
-//! library, for the benchmark scene, the bracket and a field without a proven bound.
+//! library, for the benchmark scene, the bracket and a field without a proven bound, and the
+//! octree refused by the cells limit.
 //!
 //! One test only: the counter sees every thread of the process, so nothing else may run.
 
@@ -80,4 +81,28 @@ fn meshing_stays_within_the_memory_it_announces() {
         }
         eprintln!("{file} at {n}: contouring peak {used} B of {bound} announced");
     }
+    // An octree refused by the cells limit stays within the same announcement: the level
+    // that would pass the limit is counted, not stored. The limit is set just above what the
+    // octree evaluates before its last level, so that the last level (about four times the one
+    // before) is refused.
+    let loaded =
+        sdfc_runtime::frontend::load(&root.join("examples/mesh/bracket.sdf")).expect("load");
+    let scene = loaded.scene.expect("checks");
+    let program = lower::lower(&scene);
+    let (lo, hi) = ([-0.9, -0.5, -0.6], [0.9, 0.4, 0.6]);
+    let field = Field::new(&program, true, [lo, hi]);
+    let g = grid(lo, hi, 200);
+    let all = octree::candidates(&field, &g, 1 << 40, &|_| {}).expect("within the cells limit");
+    let max = all.evaluated + all.evaluated / 20;
+    let (refused, used) = peak_of(|| octree::candidates(&field, &g, max, &|_| {}));
+    assert_eq!(refused, Err(all.evaluated + all.cells.len() as u64));
+    let bound = octree::bytes(&g, true, max);
+    assert!(
+        used <= bound,
+        "refused octree used {used} B, announced {bound}"
+    );
+    eprintln!(
+        "refused at {} cells of {max}: octree peak {used} B of {bound} announced",
+        all.evaluated + all.cells.len() as u64
+    );
 }

@@ -5,7 +5,7 @@
 use super::builtins::{self, Build, Def, Range, P};
 use super::field;
 use super::ops;
-use super::suggest::closest;
+use super::suggest::{closest, closest_in_order};
 use super::types::{Type, Value};
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
@@ -634,15 +634,20 @@ impl Ctx<'_> {
         Value::Error
     }
 
+    /// A name in scope one or two edits from `name`; among equally close ones the nearest
+    /// binding: locals innermost first (a field's point `p` before the parameters of the
+    /// function around the field), then the file's globals, then the built-in constants.
     fn suggest_value(&self, name: &str) -> Option<String> {
-        let names: Vec<&str> = self
+        let mut globals: Vec<&str> = self.globals.keys().map(String::as_str).collect();
+        globals.sort_unstable();
+        let names = self
             .locals
             .iter()
+            .rev()
             .map(|(n, _)| n.as_str())
-            .chain(self.globals.keys().map(String::as_str))
-            .chain(builtins::CONSTANTS.iter().map(|(n, _)| *n))
-            .collect();
-        closest(name, names).map(str::to_string)
+            .chain(globals)
+            .chain(builtins::CONSTANTS.iter().map(|(n, _)| *n));
+        closest_in_order(name, names).map(str::to_string)
     }
 
     fn tuple(&mut self, items: &[Expr], span: Span) -> Value {

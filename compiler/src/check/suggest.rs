@@ -14,6 +14,25 @@ pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .map(|(_, c)| c)
 }
 
+/// The candidate closest to `name`, as [`closest`], where a tie goes to the candidate listed
+/// first rather than the first in alphabetical order. Every one-letter name is one edit from
+/// every other, so for the names in scope, listed innermost first, the nearest binding wins
+/// the tie: `q` inside a field suggests the field's point `p`, not a global `a`.
+pub fn closest_in_order<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
+    let limit = (name.chars().count() / 3).max(1);
+    let mut best: Option<(usize, &'a str)> = None;
+    for c in candidates.into_iter().filter(|c| *c != name) {
+        let d = distance(name, c);
+        if d <= limit && best.is_none_or(|(b, _)| d < b) {
+            best = Some((d, c));
+        }
+    }
+    best.map(|(_, c)| c)
+}
+
 /// Names of other SDF tools whose spelling differs from this language's by more than a typo,
 /// with what to write instead.
 const PORTED: &[(&str, &str)] = &[
@@ -147,6 +166,19 @@ mod tests {
         assert_eq!(distance("sphere", "spher"), 1);
         assert_eq!(closest("spher", ["sphere", "box", "torus"]), Some("sphere"));
         assert_eq!(closest("xyz", ["sphere", "box"]), None);
+    }
+
+    #[test]
+    fn ties_go_to_the_name_listed_first() {
+        assert_eq!(closest("q", ["p", "a"]), Some("a"));
+        assert_eq!(closest_in_order("q", ["p", "a"]), Some("p"));
+        assert_eq!(closest_in_order("q", ["a", "p"]), Some("a"));
+        // A closer name still wins over one listed earlier.
+        assert_eq!(
+            closest_in_order("lenght", ["len", "length"]),
+            Some("length")
+        );
+        assert_eq!(closest_in_order("xyz", ["p", "a"]), None);
     }
 
     #[test]

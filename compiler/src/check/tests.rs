@@ -561,3 +561,28 @@ fn colour_fields_reach_the_materials() {
     );
     assert_eq!(colours.programs[1].eval([5.0f64, -2.0, 1.0]), [0.3; 3]);
 }
+
+#[test]
+fn an_unknown_name_in_a_field_suggests_the_nearest_binding() {
+    let help = |src: &str| {
+        let (_, diags, _) = check_str("t.sdf", src);
+        diags
+            .iter()
+            .find(|d| d.code == "E0200")
+            .and_then(|d| d.help.clone())
+    };
+    // `q` is one edit from both `a` and `p`: the field's point is the nearer binding.
+    assert_eq!(
+        help("let a = 1;\nscene { field { length(q) - a }; }").as_deref(),
+        Some("did you mean `p`?")
+    );
+    assert_eq!(
+        help("fn f(a: float) -> shape { field { length(q) - a } }\nscene { f(1); }").as_deref(),
+        Some("did you mean `p`?")
+    );
+    // Outside a field the global is the only one-letter name in scope.
+    assert_eq!(
+        help("let a = 1;\nscene { sphere(q); }").as_deref(),
+        Some("did you mean `a`?")
+    );
+}

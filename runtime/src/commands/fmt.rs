@@ -113,6 +113,10 @@ pub fn run(args: FmtArgs) -> ExitCode {
             files.push(f.clone());
         }
     }
+    // A file named twice, or named and inside a folder named, is formatted (and its errors
+    // reported) once.
+    let mut seen = std::collections::HashSet::new();
+    files.retain(|f| seen.insert(std::fs::canonicalize(f).unwrap_or_else(|_| f.clone())));
     for file in &files {
         let name = file.display().to_string();
         let text = match std::fs::read_to_string(file) {

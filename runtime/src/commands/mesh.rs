@@ -115,6 +115,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         resolution: args.resolution,
         voxel: args.voxel,
         bounds: args.bounds,
+        spelling: Spelling::Flags,
     };
     let result = surface(&checked, region, &settings, &limits, &pool, &progress, &say);
     if let Some(b) = &bar {
@@ -172,6 +173,41 @@ pub struct Region {
     pub voxel: Option<f64>,
     /// The region to mesh (min, max), in the scene's coordinates.
     pub bounds: Option<[[f64; 3]; 2]>,
+    /// How the messages name these options.
+    pub spelling: Spelling,
+}
+
+/// How the caller of [`surface`] names the region's options in its messages: as `sdfc
+/// mesh`'s flags (`--bounds X0,Y0,Z0,X1,Y1,Z1`) or as the parameters of the Python package's
+/// `Scene.mesh` (`bounds=((x0, y0, z0), (x1, y1, z1))`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Spelling {
+    /// Command-line flags.
+    #[default]
+    Flags,
+    /// Keyword parameters.
+    Parameters,
+}
+
+impl Spelling {
+    /// The option `name` (`bounds`, `resolution`, `voxel`) as the caller writes it.
+    pub fn option(self, name: &str) -> String {
+        match self {
+            Spelling::Flags => format!("--{name}"),
+            Spelling::Parameters => name.to_string(),
+        }
+    }
+
+    /// A region given by its corners' coordinates, as the caller writes it.
+    pub fn bounds(self, lo: [&str; 3], hi: [&str; 3]) -> String {
+        match self {
+            // With `=`: a negative first coordinate is not taken for a flag.
+            Spelling::Flags => format!("--bounds={},{}", lo.join(","), hi.join(",")),
+            Spelling::Parameters => {
+                format!("bounds=(({}), ({}))", lo.join(", "), hi.join(", "))
+            }
+        }
+    }
 }
 
 /// A surface meshed by [`surface`]: the mesh in the scene's coordinates, its grid, what
@@ -203,6 +239,9 @@ pub fn surface(
     say: &(dyn Fn(String) + Sync),
 ) -> Result<Meshed, (u8, String)> {
     let usage = |msg: String| (2u8, msg);
+    let spell = region.spelling;
+    let [bounds_opt, resolution_opt, voxel_opt] =
+        ["bounds", "resolution", "voxel"].map(|n| spell.option(n));
     let scene = &checked.scene;
     let analysis = analysis::analyse(scene);
     let Some(root) = analysis.root() else {
@@ -229,22 +268,24 @@ pub fn surface(
                         // Grown by a tenth of the largest extent, so that what the box cuts
                         // (a floor plane) keeps some thickness.
                         let m = 0.1 * (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
-                        let v: Vec<String> = lo
-                            .iter()
-                            .map(|x| x - m)
-                            .chain(hi.iter().map(|x| x + m))
-                            .zip(origin.iter().chain(&origin))
-                            .map(|(x, o)| short(x + o))
-                            .collect();
+                        let lo = [0, 1, 2].map(|i| short(lo[i] - m + origin[i]));
+                        let hi = [0, 1, 2].map(|i| short(hi[i] + m + origin[i]));
                         format!(
-                            "; its bounded objects with a margin are `--bounds={}`",
-                            v.join(",")
+                            "; its bounded objects with a margin are `{}`",
+                            spell.bounds(
+                                lo.each_ref().map(|s| s.as_str()),
+                                hi.each_ref().map(|s| s.as_str())
+                            )
                         )
                     }
                     None => String::new(),
                 };
+                let corners = match spell {
+                    Spelling::Flags => "--bounds X0,Y0,Z0,X1,Y1,Z1".to_string(),
+                    Spelling::Parameters => spell.bounds(["x0", "y0", "z0"], ["x1", "y1", "z1"]),
+                };
                 return Err(usage(format!(
-                    "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `--bounds X0,Y0,Z0,X1,Y1,Z1` (what reaches out of it is cut at its faces and the cut closed){hint}",
+                    "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `{corners}` (what reaches out of it is cut at its faces and the cut closed){hint}",
                     open.join(", ")
                 )));
             }
@@ -261,15 +302,18 @@ pub fn surface(
     let longest = size.iter().copied().fold(0.0f64, f64::max);
     let voxel = match (region.voxel, region.resolution) {
         (Some(v), _) if v.is_finite() && v > 0.0 => v,
-        (Some(v), _) => return Err(usage(format!("--voxel must be a positive number, not {v}"))),
-        (None, Some(0)) => return Err(usage("--resolution must be at least 1".into())),
+        (Some(v), _) => {
+            return Err(usage(format!(
+                "{voxel_opt} must be a positive number, not {v}"
+            )))
+        }
+        (None, Some(0)) => return Err(usage(format!("{resolution_opt} must be at least 1"))),
         (None, r) => longest / r.unwrap_or(DEFAULT_RESOLUTION) as f64,
     };
     if !(voxel > 0.0 && voxel.is_finite()) {
-        return Err(usage(
-            "the bounds are flat: give a region with some extent along every axis (`--bounds`)"
-                .into(),
-        ));
+        return Err(usage(format!(
+            "the bounds are flat: give a region with some extent along every axis (`{bounds_opt}`)"
+        )));
     }
     // Without --bounds the box is the analysis's, grown by a cell so that the clip never
     // touches the surface; one more cell all round is outside the clip, which closes the mesh.
@@ -280,7 +324,7 @@ pub fn surface(
     let cells = Grid::cells_over(&clip, voxel);
     if cells.iter().any(|&n| n > AXIS_CELLS as f64) {
         return Err(usage(format!(
-            "the grid would have {} cells along an axis; at most {AXIS_CELLS} are possible (a larger --voxel or a smaller --resolution)",
+            "the grid would have {} cells along an axis; at most {AXIS_CELLS} are possible (a larger {voxel_opt} or a smaller {resolution_opt})",
             cells.iter().copied().fold(0.0f64, f64::max)
         )));
     }
@@ -318,7 +362,7 @@ pub fn surface(
         short(voxel),
         mib(octree_bytes)
     ));
-    check_memory(octree_bytes, limits).map_err(|m| (1, m))?;
+    check_memory(octree_bytes, limits, spell).map_err(|m| (1, m))?;
     let stage =
         |name: &'static str, base: f64, share: f64| move |f: f64| progress(name, base + share * f);
     let started = Instant::now();
@@ -328,7 +372,7 @@ pub fn surface(
             (
                 1,
                 format!(
-                    "meshing would evaluate {n} cells or more, more than the cells limit of {max_cells}; {} (or mesh at a lower --resolution)",
+                    "meshing would evaluate {n} cells or more, more than the cells limit of {max_cells}; {} (or mesh at a lower {resolution_opt})",
                     limits.raise_to(Limit::Cells, n)
                 ),
             )
@@ -339,14 +383,14 @@ pub fn surface(
         "mesh: {n} cells may hold surface: allocating at most {} MiB for their corners",
         mib(bound)
     ));
-    check_memory(bound, limits).map_err(|m| (1, m))?;
+    check_memory(bound, limits, spell).map_err(|m| (1, m))?;
     let surface_check = |cells: u64| {
         let total = bound.saturating_add(cells.saturating_mul(BYTES_PER_SURFACE_CELL));
         say(format!(
             "mesh: {cells} cells hold surface: allocating at most {} MiB in all",
             mib(total)
         ));
-        check_memory(total, limits)
+        check_memory(total, limits, spell)
     };
     // The cells the closure may hold: as many as the memory limit allows at 52 bytes each
     // (a key and a point), within the cells limit.
@@ -429,15 +473,16 @@ fn short(x: f64) -> String {
     sdfc_compiler::diagnostics::number(x, 4)
 }
 
-fn check_memory(bytes: u64, limits: &Limits) -> Result<(), String> {
+fn check_memory(bytes: u64, limits: &Limits, spell: Spelling) -> Result<(), String> {
     let limit = limits.get(Limit::Memory);
     let needed = mib(bytes);
     if needed <= limit {
         return Ok(());
     }
     Err(format!(
-        "the mesh would allocate up to {needed} MiB, more than the memory limit of {limit} MiB; {} (or mesh at a lower --resolution)",
-        limits.raise_to(Limit::Memory, needed)
+        "the mesh would allocate up to {needed} MiB, more than the memory limit of {limit} MiB; {} (or mesh at a lower {})",
+        limits.raise_to(Limit::Memory, needed),
+        spell.option("resolution")
     ))
 }
 

@@ -87,26 +87,29 @@ pub fn candidates(
             .collect();
         let d = field.distances(&centres);
         let reach = field.lipschitz * half * 3f64.sqrt() * (1.0 + SLACK) + SLACK * grid.voxel;
-        let kept = frontier
-            .iter()
-            .zip(&d)
-            .filter(|(_, d)| !(d.abs() > reach))
-            .map(|(c, _)| *c);
+        let kept = || {
+            frontier
+                .iter()
+                .zip(&d)
+                .filter(|(_, d)| !(d.abs() > reach))
+                .map(|(c, _)| *c)
+        };
         progress((level + 1) as f64 / levels.max(1) as f64);
         let child = size / 2;
-        let mut next = Vec::new();
-        for c in kept {
-            for o in 0..8u32 {
-                let ch = [0, 1, 2].map(|a| 2 * c[a] + (o >> a & 1));
-                if (0..3).all(|a| ch[a] * child < grid.cells[a]) {
-                    next.push(ch);
-                }
-            }
+        let children = |c: [u32; 3]| {
+            (0..8u32)
+                .map(move |o| [0, 1, 2].map(|a| 2 * c[a] + (o >> a & 1)))
+                .filter(move |ch| (0..3).all(|a| ch[a] * child < grid.cells[a]))
+        };
+        // The next level's cells are counted before they are stored, so that a grid too fine
+        // for the cells limit is refused without allocating them.
+        let count: u64 = kept().map(|c| children(c).count() as u64).sum();
+        if evaluated + count > max_cells {
+            return Err(evaluated + count);
         }
+        let mut next = Vec::with_capacity(count as usize);
+        next.extend(kept().flat_map(children));
         if level + 1 == levels {
-            if evaluated + next.len() as u64 > max_cells {
-                return Err(evaluated + next.len() as u64);
-            }
             let mut cells: Vec<u64> = next.into_iter().map(pack).collect();
             cells.sort_unstable();
             return Ok(Candidates { cells, evaluated });

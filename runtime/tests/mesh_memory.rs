@@ -88,7 +88,7 @@ fn meshing_stays_within_the_memory_it_announces() {
     let loaded =
         sdfc_runtime::frontend::load(&root.join("examples/mesh/bracket.sdf")).expect("load");
     let scene = loaded.scene.expect("checks");
-    let program = lower::lower(&scene);
+    let program = lower(&scene);
     let (lo, hi) = ([-0.9, -0.5, -0.6], [0.9, 0.4, 0.6]);
     let field = Field::new(&program, true, [lo, hi]);
     let g = grid(lo, hi, 200);

@@ -155,7 +155,7 @@ impl Limit {
                 "memory a render may allocate, in MiB (host and device together)",
             ),
             // 4 000 000 holds 2¹⁹ spheres built by sharing, two translated copies per level
-            // (2²¹ − 3 nodes as a tree: 0.8 s to check on the 2-core development machine);
+            // (2²¹ − 3 nodes as a tree, checked in about a second);
             // every example is far below it (the largest, examples/scaling/compound_10000.sdf,
             // expands to 120 003).
             Limit::Expansion => s(
@@ -165,8 +165,8 @@ impl Limit {
                 "shape nodes counted as a tree (a shared shape once per use)",
             ),
             // Rays visit the primitives through a bounding-volume hierarchy, in O(log n) per
-            // ray, so tracing beats sphere tracing at any size (10 000 random spheres at
-            // 640×480 on the CPU: 0.22 s traced, 6.2 s marched; BENCHMARKS.md). The default
+            // ray, so tracing beats sphere tracing at any size (BENCHMARKS.md, "Scaling with
+            // the number of objects"). The default
             // keeps the GPU buffer of a large traced scene (at most 112 bytes a primitive:
             // 80 for a rotated one, 32 for a group, of which there are fewer than primitives)
             // under the 128 MiB that wgpu's default limits let a storage buffer bind; the

@@ -130,8 +130,7 @@ pub fn fraction(ops_per_eval: f64, evaluations: u64, seconds: f64, peak: f64) ->
 /// that ran are known: every evaluation of a program without guarded blocks runs all of
 /// [`distance_ops`]. `None` for a program with guarded blocks: an evaluation runs only the
 /// blocks whose bounds are near, which the statistics do not count, and counting every block
-/// reported 1.85 for a marched scene of 1 024 spheres and 5.63 for
-/// `examples/scaling/compound_1000.sdf` on an H100.
+/// reports more than the peak (several times it for `examples/scaling/compound_1000.sdf`).
 pub fn fraction_of_peak(
     program: &Program,
     evaluations: u64,

@@ -41,8 +41,8 @@ impl Image {
     }
 
     /// Clamped, sRGB-encoded RGBA8 bytes (alpha 255): [`srgb_encode`] of every channel,
-    /// through [`SrgbTable`] and in parallel rows (a 1920×1080 image took 127 ms one value
-    /// at a time on this repository's 2-core VM).
+    /// through [`SrgbTable`] and in parallel rows, several times faster than computing each
+    /// value (BENCHMARKS.md, "Measured choices").
     pub fn to_rgba8(&self) -> Vec<u8> {
         use rayon::prelude::*;
         let table = SrgbTable::get();
@@ -128,8 +128,8 @@ pub enum PngLevel {
     None,
     /// fdeflate with one fixed filter.
     Fastest,
-    /// fdeflate with adaptive filters: on this repository's 2-core VM a 1920×1080 render
-    /// compressed in 20 ms instead of 240 ms at `balanced`, in a file 1.45 times as large.
+    /// fdeflate with adaptive filters: about a tenth of `balanced`'s time, in a file about
+    /// 1.45 times as large (BENCHMARKS.md, "Measured choices").
     #[default]
     Fast,
     /// zlib's default level.
@@ -305,11 +305,9 @@ impl AtomicFile {
 
     /// Starts writing `path`, complete or untouched whatever happens to the process, but not
     /// synced to the disk (after a crash of the machine it may be found empty), as a
-    /// compiler writes its output: `sdfc render`'s still images. On this repository's 2-core
-    /// VM, 2026-11-24, writing a file and renaming it over another took 6.9 ms with the
-    /// fsync and 0.45 ms without for 120 KB, 8.9 and 5.0 ms for 3.7 MB (medians of 20), and
-    /// the fsync of a 320×240 PNG a median of 45 ms while other builds wrote to the disk
-    /// (BENCHMARKS.md, "The device beside the front end").
+    /// compiler writes its output: `sdfc render`'s still images. The fsync costs a small
+    /// image many times its write, and far more while other programs write to the disk
+    /// (BENCHMARKS.md, "Measured choices").
     pub fn unsynced(path: &Path) -> std::io::Result<AtomicFile> {
         Self::open(path, false)
     }

@@ -23,8 +23,8 @@ pub(super) const UNPAINTED: f64 = -1.0;
 /// A subtree is guarded by a bound only when it costs at least this many instructions per
 /// point. A guard costs the distance to a box (up to about 25 instructions) and the block's
 /// bookkeeping, and it saves only where the subtree is skipped: below about three times its
-/// own cost it was a loss on the report's scenes (CPU, 320×240: seed3 120 → 80 ms, seed4 173
-/// → 137 ms without their one guard), while the scaling scenes' groups cost far more.
+/// own cost it is a loss on the report's scenes, whose one guard each guards little, while
+/// the scaling scenes' groups cost far more (BENCHMARKS.md, "Measured choices").
 const GUARD_COST: f64 = 80.0;
 
 /// 1 - 2⁻¹²: bounds are shrunk by this factor, and padded, so that rounding can never make

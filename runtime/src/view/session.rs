@@ -43,14 +43,10 @@ pub const MAX_SCALE: u32 = 8;
 /// How long a load whose specialised pipeline compiles on another thread (`--kernel auto` on a
 /// GPU) waits for it before showing the scene through the interpreted kernel. A driver that
 /// compiles a kernel in a few milliseconds then shows the specialised kernel's frame at once,
-/// with no interpreted frame before it: on an H100 (`scripts/device-view.sh`, before this
-/// period), `lattice.sdf`'s structural edit reached the screen in 80 ms when its kernel
-/// (compiled in 8 ms) was compiled before showing, and in 296 ms when the slower interpreted
-/// frame went first. A compile that takes longer is hidden as before, its interpreted frame
-/// shown this much later (`temple.sdf`'s structural edit reached the screen there in 2 020 ms
-/// compiled before showing, in 224 ms through the interpreted kernel): 50 ms is a few frames
-/// at 60 Hz, short beside a slow compile's seconds and well above a fast one's few
-/// milliseconds. The window's event loop is never held: it is woken at the end of the period
+/// with no slower interpreted frame before it; a compile that takes longer is hidden as
+/// before, its interpreted frame shown this much later (BENCHMARKS.md, "Live preview"): 50 ms
+/// is a few frames at 60 Hz, short beside a slow compile's seconds and well above a fast
+/// one's few milliseconds. The window's event loop is never held: it is woken at the end of the period
 /// ([`Session::grace_deadline`]).
 pub const GRACE: Duration = Duration::from_millis(50);
 

@@ -389,9 +389,8 @@ pub const UNROLL: usize = 8;
 /// from there on. One instruction an iteration, examples/lattice.sdf ran out of it; eight
 /// (the GPU's [`UNROLL`], about half a million instructions per pixel) were not enough for
 /// a field of three noises (about 1 300 instructions a distance, a pixel's hundreds of
-/// evaluations: 26 dB against the CPU at 48×32); 32 lift the bound to two million, and
-/// rendered it as the specialised kernel does (68 dB, 2026-11-27). Each doubling doubles
-/// the kernel's compile on lavapipe (0.46 s at 8, 1.6 s at 32).
+/// evaluations); 32 lift the bound to two million, within which it renders as the
+/// specialised kernel does. Each doubling doubles the kernel's compile on lavapipe.
 pub const UNROLL_SOFTWARE: usize = 32;
 
 /// The WGSL text of the interpreter and of the distance functions the kernel calls, for a

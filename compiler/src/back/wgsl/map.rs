@@ -41,8 +41,8 @@ impl Params {
 
 /// Programs with more live instructions than this have their large guarded blocks written as
 /// functions of their own. naga's WGSL front end takes time that grows with the square of a
-/// function's length: `sdfc compile --emit ptx` of examples/scaling/compound_1000.sdf (about
-/// 150 000 instructions) took 41 s with one `map`, and takes 2 s cut into functions; ptxas
+/// function's length (examples/scaling/compound_1000.sdf, about 150 000 instructions, parses
+/// about twenty times faster cut into functions: BENCHMARKS.md, "Measured choices"); ptxas
 /// then inlines them again. Smaller programs are written as one function.
 const OUTLINE_PROGRAM: usize = 8_000;
 /// In such a program, a guarded block with at least this many live instructions becomes a

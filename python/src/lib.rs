@@ -17,10 +17,10 @@ use sdfc_compiler::{
 use sdfc_runtime::backend::{Backend, Devices, Kernel, Prepared, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
 use sdfc_runtime::commands::mesh as mesher;
-use sdfc_runtime::commands::render::{self as renderer, CliError, FrameScene};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::frontend::{self, Source};
 use sdfc_runtime::image::Image;
+use sdfc_runtime::job::{self, FrameScene, Job, Overrides};
 use std::sync::OnceLock;
 use std::time::Duration;
 
@@ -51,12 +51,12 @@ impl Failure {
     }
 }
 
-impl From<CliError> for Failure {
-    fn from(e: CliError) -> Failure {
+impl From<job::Error> for Failure {
+    fn from(e: job::Error) -> Failure {
         match e {
-            CliError::Usage(m) => Failure::Value(m),
-            CliError::Failed(m) => Failure::Runtime(m),
-            CliError::Reported(_) => Failure::Runtime("the render failed".into()),
+            job::Error::Scene(s) => Failure::Compile(s.diagnostics, s.sources),
+            job::Error::Usage(m) => Failure::Value(m),
+            other => Failure::Runtime(other.to_string()),
         }
     }
 }
@@ -219,7 +219,7 @@ fn open(source: Option<String>, path: Option<String>) -> Result<Source, Failure>
 /// The worker threads every call shares (one per core).
 fn pool() -> Result<&'static rayon::ThreadPool, Failure> {
     static POOL: OnceLock<Result<rayon::ThreadPool, String>> = OnceLock::new();
-    POOL.get_or_init(|| renderer::thread_pool(None))
+    POOL.get_or_init(|| job::thread_pool(None))
         .as_ref()
         .map_err(|m| Failure::Runtime(m.clone()))
 }
@@ -281,19 +281,20 @@ impl Scene {
         size: Option<(u32, u32)>,
         aa: Option<u32>,
     ) -> Result<frontend::Checked, Failure> {
-        let limits = Limits::default();
-        let loaded = self.source().check(&limits, time);
+        let job = Job {
+            overrides: Overrides {
+                size,
+                aa,
+                set: self.set.clone(),
+                ..Overrides::default()
+            },
+            ..Job::default()
+        };
+        let loaded = self.source().check(&job.limits, time);
         let Some(mut scene) = loaded.scene else {
             return Err(Failure::Compile(loaded.diagnostics, loaded.sources));
         };
-        sdfc_runtime::settings::override_settings(
-            &mut scene.settings,
-            size,
-            aa,
-            &self.set,
-            &limits,
-        )
-        .map_err(Failure::Value)?;
+        job.settings(&mut scene)?;
         Ok(frontend::Checked {
             scene,
             sources: loaded.sources,
@@ -346,10 +347,10 @@ impl Scene {
                     // and built again (a fifth of a second) between renders.
                     let _ = cuda_device();
                 }
-                renderer::prepare(pool, (backend, &Devices::Auto), frame, &setup, None)?
+                job::prepare(pool, (backend, &Devices::Auto), frame, &setup, None)?
             }
         };
-        renderer::check_memory(
+        job::check_memory(
             pool,
             &prepared,
             &scene,

@@ -12,7 +12,10 @@ use crate::cpu::reference;
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat, Loaded, Source};
 use crate::memory;
-use sdfc_compiler::{lower_within, wgsl, Diagnostic, Limits, LowerOptions, Lowered, Program, Scene, Severity, SourceMap};
+use sdfc_compiler::{
+    lower_within, wgsl, Diagnostic, Limits, LowerOptions, Lowered, Program, Scene, Settings,
+    Severity, SourceMap,
+};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
@@ -102,28 +105,33 @@ pub struct SceneErrors {
 impl SceneErrors {
     /// One line: the first error, where it is, and how many there are.
     pub fn summary(&self) -> String {
-        let errors: Vec<&Diagnostic> = self
-            .diagnostics
-            .iter()
-            .filter(|d| d.severity == Severity::Error)
-            .collect();
-        let Some(d) = errors.first() else {
-            return "error".into();
-        };
-        let at = d
-            .labels
-            .first()
-            .map(|l| {
-                let (line, col) = self.sources.line_col(l.span);
-                format!(" at {}:{line}:{col}", self.sources.name(l.span.file))
-            })
-            .unwrap_or_default();
-        let more = match errors.len() {
-            1 => String::new(),
-            n => format!(" (and {} more)", n - 1),
-        };
-        format!("error[{}]: {}{at}{more}", d.code, d.message)
+        first_error(&self.diagnostics, &self.sources)
     }
+}
+
+/// One line for `diagnostics` in `sources` (the viewer's title): the first error, where it
+/// is, and how many there are.
+pub fn first_error(diagnostics: &[Diagnostic], sources: &SourceMap) -> String {
+    let errors: Vec<&Diagnostic> = diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .collect();
+    let Some(d) = errors.first() else {
+        return "error".into();
+    };
+    let at = d
+        .labels
+        .first()
+        .map(|l| {
+            let (line, col) = sources.line_col(l.span);
+            format!(" at {}:{line}:{col}", sources.name(l.span.file))
+        })
+        .unwrap_or_default();
+    let more = match errors.len() {
+        1 => String::new(),
+        n => format!(" (and {} more)", n - 1),
+    };
+    format!("error[{}]: {}{at}{more}", d.code, d.message)
 }
 
 impl Error {
@@ -208,11 +216,16 @@ impl Job {
     /// Applies the job's settings to `scene`: the reference's (`--reference`), then `--size`,
     /// `--aa` and each `--set`, within the limits.
     pub fn settings(&self, scene: &mut Scene) -> Result<(), Error> {
-        let o = &self.overrides;
-        if o.reference {
+        if self.overrides.reference {
             scene.settings = reference::settings_of(scene);
         }
-        crate::settings::override_settings(&mut scene.settings, o.size, o.aa, &o.set, &self.limits)
+        self.override_settings(&mut scene.settings)
+    }
+
+    /// Applies `--size`, `--aa` and each `--set` to `settings`, in order, within the limits.
+    pub fn override_settings(&self, settings: &mut Settings) -> Result<(), Error> {
+        let o = &self.overrides;
+        crate::settings::override_settings(settings, o.size, o.aa, &o.set, &self.limits)
             .map_err(Error::Usage)
     }
 

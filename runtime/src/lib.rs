@@ -10,6 +10,7 @@ pub mod fp32;
 pub mod frontend;
 pub mod gpu;
 pub mod image;
+pub mod job;
 pub mod lsp;
 pub mod memory;
 pub mod mesh;

@@ -1,13 +1,13 @@
 //! `sdfc bench`: time the rendering of scenes (median per frame, rays per second, steps, and
 //! for GPU targets the achieved fraction of the FP32 floor).
 
-use super::render::{thread_pool, Backend, Kernel};
-use crate::backend::{Devices, Prepared, Setup};
+use super::JobArgs;
+use crate::backend::{Backend, Prepared, Setup};
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
-use crate::frontend::{self, DiagnosticFormat};
-use crate::settings::{override_settings, parse_size};
-use sdfc_compiler::{Limits, LowerOptions, Lowered, Scene};
+use crate::frontend;
+use crate::job::{self, Error, Job, Kernels};
+use sdfc_compiler::{LowerOptions, Lowered, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -17,35 +17,11 @@ pub struct BenchArgs {
     /// Scene files.
     #[arg(required = true)]
     pub file: Vec<PathBuf>,
-    /// Backend to time.
-    #[arg(long, value_enum, default_value_t)]
-    pub backend: Backend,
-    /// Devices to time (as for `sdfc render`): `auto`, `all`, or a list of GPU indices and
-    /// `cpu`.
-    #[arg(long, value_name = "auto|all|LIST", default_value = "auto", value_parser = Devices::parse)]
-    pub devices: Devices,
-    /// Image size, as WIDTHxHEIGHT (default: each scene's own).
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
-    pub size: Option<(u32, u32)>,
-    /// Supersampling: N×N samples per pixel (default: each scene's own).
-    #[arg(long, value_name = "N")]
-    pub aa: Option<u32>,
+    #[command(flatten)]
+    pub job: JobArgs,
     /// Frames timed per scene (after one untimed warm-up frame).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub frames: u32,
-    /// Override a render setting (as for `sdfc render`). May be repeated.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
-    /// Float type of the evaluation.
-    #[arg(long, value_enum, default_value_t)]
-    pub precision: Precision,
-    /// Worker threads (default: one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
-    /// The GPU kernel of a marched scene, as for `sdfc render`: specialised, interpreted or
-    /// auto. [default: auto]
-    #[arg(long, value_enum)]
-    pub kernel: Option<Kernel>,
     /// Print one JSON array instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -65,8 +41,6 @@ pub struct BenchArgs {
     /// still does). Default: parameters with --frames-per-second, literal otherwise.
     #[arg(long, value_enum)]
     pub constants: Option<Constants>,
-    #[command(flatten)]
-    pub limits: super::LimitArgs,
 }
 
 /// The timing of one scene.
@@ -173,25 +147,18 @@ pub struct SequenceTiming {
 }
 
 /// Times the sequence of each scene (`--frames-per-second`).
-fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render::CliError> {
-    use super::render::{check_memory, frame_scene, CliError, Overrides};
-    use super::sequence::Kernels;
+fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, Error> {
     use sdfc_compiler::Animation;
     use std::time::{Duration, Instant};
-    let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
-    let limits = args.limits.limits();
-    let overrides = Overrides {
-        reference: false,
-        size: args.size.or(Some((1920, 1080))),
-        aa: args.aa,
-        set: &args.set,
-    };
+    let mut job = args.job.job();
+    job.overrides.size = job.overrides.size.or(Some((1920, 1080)));
+    let pool = job.pool()?;
     let mut out = Vec::new();
     for file in &args.file {
-        let mut source = frontend::Source::read(file).map_err(CliError::Usage)?;
+        let mut source = frontend::Source::read(file).map_err(Error::Io)?;
         // The frames are lowered as `sdfc render --frames` lowers them.
         let lowering = LowerOptions::parametric();
-        let first = frame_scene(overrides, &mut source, &limits, 0.0, true, &lowering)?;
+        let first = job.frame(&mut source, 0.0, true, &lowering)?;
         let animation = first.scene.animation;
         let frames = match args.sequence {
             Some(f) => f,
@@ -201,46 +168,37 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
             },
         };
         if frames.len() < 2 {
-            return Err(CliError::Usage(format!(
+            return Err(Error::Usage(format!(
                 "{}: --frames-per-second needs at least two frames: the scene's `render` block states {} (fps × duration); give --sequence A..B",
                 file.display(),
                 frames.len()
             )));
         }
         let setup = Setup {
-            precision: args.precision,
-            debug_nan: false,
             parameters: args.constants.unwrap_or(Constants::Parameters) == Constants::Parameters,
-            kernel: args.kernel.unwrap_or_default().choice(),
             // As `sdfc render --frames` renders a sequence: the image alone, finished on the GPU.
             image_only: true,
             finished: true,
-            software: false,
+            ..job.setup()
         };
-        let mut kernels = Kernels::new(&pool, (args.backend, args.devices.clone()), setup);
+        let mut kernels = Kernels::new(&pool, (job.backend, job.devices.clone()), setup);
         let (mut check, mut render) = (Duration::ZERO, Duration::ZERO);
         let mut prepare_before = Duration::ZERO;
         let mut started = Instant::now();
         let mut size = (0, 0);
         for k in frames.start..frames.end {
             let t0 = Instant::now();
-            let frame = frame_scene(
-                overrides,
-                &mut source,
-                &limits,
-                Animation::time_of(animation.fps, k),
-                false,
-                &lowering,
-            )?;
+            let time = Animation::time_of(animation.fps, k);
+            let frame = job.frame(&mut source, time, false, &lowering)?;
             let t1 = Instant::now();
             let (scene, prepared) = kernels.prepare(frame)?;
             let t2 = Instant::now();
             if k == frames.start {
-                check_memory(&pool, prepared, &scene, (false, false), &limits, false)?;
+                job::check_memory(&pool, prepared, &scene, (false, false), &job.limits, false)?;
             }
             let image = pool
                 .install(|| prepared.render(&scene, &|_| {}))
-                .map_err(CliError::Failed)?;
+                .map_err(Error::Render)?;
             size = (image.render.image.width, image.render.image.height);
             if k == frames.start {
                 // The first frame is not timed: the device opens and the kernel compiles.
@@ -275,9 +233,9 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, super::render:
 
 /// Runs `sdfc bench`.
 pub fn run(args: BenchArgs) -> ExitCode {
-    if let Err(msg) = Kernel::check(args.kernel, args.backend) {
-        eprintln!("error: {msg}");
-        return ExitCode::from(2);
+    let job = args.job.job();
+    if let Err(e) = job.check_kernel(job.backend) {
+        return e.exit();
     }
     if args.frames_per_second {
         let timings = match run_sequences(&args) {
@@ -327,36 +285,18 @@ pub fn run(args: BenchArgs) -> ExitCode {
         }
         return ExitCode::SUCCESS;
     }
-    let pool = match thread_pool(args.threads) {
+    let pool = match job.pool() {
         Ok(p) => p,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
-        }
+        Err(e) => return e.exit(),
     };
-    let limits = args.limits.limits();
     let mut timings = Vec::new();
     for file in &args.file {
-        let mut checked = match frontend::load_scene(file, DiagnosticFormat::Human, &limits) {
-            Ok(c) => c,
-            Err(code) => return code,
-        };
-        let settings = &mut checked.scene.settings;
-        if let Err(msg) = override_settings(settings, args.size, args.aa, &args.set, &limits) {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
-        }
-        let lowered = match checked.lower(&LowerOptions::default(), &limits) {
-            Ok(l) => l,
-            Err(code) => return code,
-        };
-        let name = file.display().to_string();
-        let scene = &checked.scene;
-        let t = match pool.install(|| time_scene(&args, name, scene, lowered, &limits)) {
+        let t = match time_file(&args, &job, &pool, file) {
             Ok(t) => t,
-            Err(msg) => {
-                eprintln!("error: {}: {msg}", file.display());
-                return ExitCode::from(1);
+            Err(e @ (Error::Usage(_) | Error::Io(_) | Error::Scene(_))) => return e.exit(),
+            Err(e) => {
+                eprintln!("error: {}: {e}", file.display());
+                return e.code();
             }
         };
         if !args.json {
@@ -379,48 +319,64 @@ pub fn run(args: BenchArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// Times one scene file: read, checked, its settings applied and lowered as a still, then
+/// [`time_scene`].
+fn time_file(
+    args: &BenchArgs,
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    file: &std::path::Path,
+) -> Result<Timing, Error> {
+    let mut source = frontend::Source::read(file).map_err(Error::Io)?;
+    let mut loaded = source.check(&job.limits, 0.0);
+    let scene = job.scene(&mut loaded, true)?;
+    let lowered = job.lower(&scene, &loaded.sources, &LowerOptions::default())?;
+    let name = file.display().to_string();
+    pool.install(|| time_scene(args, job, name, &scene, lowered))
+}
+
 /// Renders one warm-up frame and `frames` timed frames, within the memory limit. GPU backends
 /// are timed on the device (timestamps or events); the CPU by the wall clock.
 fn time_scene(
     args: &BenchArgs,
+    job: &Job,
     name: String,
     scene: &Scene,
     lowered: Lowered,
-    limits: &Limits,
-) -> Result<Timing, String> {
+) -> Result<Timing, Error> {
     let ops_per_eval = fp32::distance_ops(&lowered.program);
     let guarded = !lowered.program.blocks().is_empty();
     let setup = Setup {
-        precision: args.precision,
-        debug_nan: false,
         parameters: args.constants == Some(Constants::Parameters),
-        kernel: args.kernel.unwrap_or_default().choice(),
-        image_only: false,
         // The image is not kept: the GPU finishes it, and only its 8-bit pixels cross.
         finished: true,
-        software: false,
+        ..job.setup()
     };
-    if args.backend != Backend::Cpu {
+    if job.backend != Backend::Cpu {
         let options = sdfc_compiler::wgsl::Options {
             kernel: setup.kernel,
             ..Default::default()
         };
-        sdfc_compiler::wgsl::choose(scene, &lowered, &options)?;
+        sdfc_compiler::wgsl::choose(scene, &lowered, &options).map_err(Error::Unsupported)?;
     }
-    let prepared = Prepared::on_devices(args.backend, &args.devices, scene, lowered, &setup)?;
+    let prepared = Prepared::on_devices(job.backend, &job.devices, scene, lowered, &setup)
+        .map_err(Error::Prepare)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);
     frame.host = frame
         .host
         .saturating_add(prepared.retained(&scene.settings));
-    frame.check(limits)?;
-    let mut last = prepared.render(scene, &|_| {})?.render;
+    frame.check(&job.limits).map_err(Error::Memory)?;
+    let mut last = prepared
+        .render(scene, &|_| {})
+        .map_err(Error::Render)?
+        .render;
     let mut times = Vec::new();
     let mut walls = Vec::new();
     let mut whole = Vec::new();
     for _ in 0..args.frames {
         let started = std::time::Instant::now();
-        let frame = prepared.render(scene, &|_| {})?;
+        let frame = prepared.render(scene, &|_| {}).map_err(Error::Render)?;
         whole.push(started.elapsed().as_secs_f64());
         times.push(frame.time.as_secs_f64());
         walls.push(frame.wall.as_secs_f64());
@@ -441,7 +397,7 @@ fn time_scene(
         scene: name,
         backend: prepared.name(),
         device: prepared.device(),
-        precision: match args.precision {
+        precision: match job.precision {
             Precision::F32 => "f32",
             Precision::F64 => "f64",
         },

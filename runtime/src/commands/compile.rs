@@ -149,16 +149,16 @@ pub fn run(args: CompileArgs) -> ExitCode {
             let Some(mut scene) = loaded.scene.take() else {
                 return ExitCode::from(1);
             };
-            let set = crate::settings::override_settings(
-                &mut scene.settings,
-                None,
-                None,
-                &args.set,
-                &limits,
-            );
-            if let Err(msg) = set {
-                eprintln!("error: {msg}");
-                return ExitCode::from(2);
+            let job = crate::job::Job {
+                overrides: crate::job::Overrides {
+                    set: args.set.clone(),
+                    ..Default::default()
+                },
+                limits: limits.clone(),
+                ..Default::default()
+            };
+            if let Err(e) = job.settings(&mut scene) {
+                return e.exit();
             }
             let scene = &scene;
             if other == Emit::Ir {

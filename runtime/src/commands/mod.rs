@@ -1,5 +1,6 @@
-//! One module per `sdfc` subcommand: its clap arguments and its `run`; and `--limit`, which
-//! every command that checks or renders a scene takes.
+//! One module per `sdfc` subcommand: its clap arguments and its `run`; `--limit`, which
+//! every command that checks or renders a scene takes, and the arguments of a render job that
+//! `render` and `bench` share ([`JobArgs`]).
 
 pub mod bench;
 pub mod check;
@@ -13,6 +14,10 @@ pub mod render;
 pub mod sequence;
 pub mod view;
 
+use crate::backend::{Backend, Devices, Kernel};
+use crate::cpu::Precision;
+use crate::job::{Job, Overrides};
+use crate::settings::parse_size;
 use sdfc_compiler::{Limit, Limits};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
@@ -76,6 +81,67 @@ fn process_age() -> Option<Duration> {
     let uptime = std::fs::read_to_string("/proc/uptime").ok()?;
     let uptime: f64 = uptime.split(' ').next()?.parse().ok()?;
     Some(Duration::from_secs_f64((uptime - ticks / 100.0).max(0.0)))
+}
+
+/// The arguments `sdfc render` and `sdfc bench` share: where to render, the settings
+/// overridden, the GPU kernel, the float type, the worker threads and the limits; the
+/// [`Job`] they describe.
+#[derive(Debug, Clone, clap::Args)]
+pub struct JobArgs {
+    /// Backend to render with.
+    #[arg(long, value_enum, default_value_t)]
+    pub backend: Backend,
+    /// Devices to render with: `auto` (the one `--backend` picks), `all` (every GPU of the
+    /// backend), or a comma-separated list of GPU indices (CUDA devices, or wgpu adapters, as
+    /// `sdfc devices` lists them; an index twice opens that GPU as two logical devices) and
+    /// `cpu`. Several devices take tiles of each frame from one queue (docs/devices.md).
+    #[arg(long, value_name = "auto|all|LIST", default_value = "auto", value_parser = Devices::parse)]
+    pub devices: Devices,
+    /// Image size, as WIDTHxHEIGHT (overrides the scene's `render` block).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Supersampling: N×N samples per pixel.
+    #[arg(long, value_name = "N")]
+    pub aa: Option<u32>,
+    /// Override a render setting: width, height, aa, max_steps, epsilon, max_depth, max_dist,
+    /// relaxation or background (as r,g,b). May be repeated.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// The GPU kernel of a marched scene: its distance program written as code
+    /// (`specialised`, compiled by the driver for each scene), interpreted from a buffer
+    /// (`interpreted`, one kernel for every scene), or `auto`, interpreted where the code
+    /// would be large (docs/interpreted.md). [default: auto]
+    #[arg(long, value_enum)]
+    pub kernel: Option<Kernel>,
+    /// Float type of the evaluation.
+    #[arg(long, value_enum, default_value_t)]
+    pub precision: Precision,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub limits: LimitArgs,
+}
+
+impl JobArgs {
+    /// The job these arguments describe.
+    pub fn job(&self) -> Job {
+        Job {
+            backend: self.backend,
+            devices: self.devices.clone(),
+            precision: self.precision,
+            kernel: self.kernel,
+            overrides: Overrides {
+                reference: false,
+                size: self.size,
+                aa: self.aa,
+                set: self.set.clone(),
+            },
+            limits: self.limits.limits(),
+            threads: self.threads,
+            debug_nan: false,
+        }
+    }
 }
 
 /// `--limit NAME=VALUE`: the resource limits of a run.

@@ -4,18 +4,19 @@
 //! Pareto front and draws the chart; the sweeps, the front and the report are
 //! `crate::pareto`'s.
 
-use super::render::{self, thread_pool, Backend};
+use super::render::{self, Backend};
 use crate::backend::{Prepared, Setup};
 use crate::chart;
 use crate::cpu::reference;
 use crate::cpu::{Precision, Render};
-use crate::frontend::{self, DiagnosticFormat};
+use crate::frontend;
+use crate::job::{Error, Job, Overrides};
 use crate::metrics;
 use crate::pareto::{
     chart_of, combinations, describe, mark_fronts, parse_sweep_within, same, table, Measured,
     ReferenceInfo, Report, DEFAULT_SWEEPS,
 };
-use crate::settings::{override_settings, parse_size};
+use crate::settings::parse_size;
 use sdfc_compiler::{
     diagnostics::scientific, Limits, LowerOptions, Lowered, Method, Scene, Settings,
 };
@@ -64,53 +65,76 @@ pub struct ParetoArgs {
     pub limits: super::LimitArgs,
 }
 
+impl ParetoArgs {
+    /// The job these arguments describe: the timed renders'.
+    pub fn job(&self) -> Job {
+        Job {
+            backend: self.backend,
+            precision: self.precision,
+            overrides: Overrides {
+                size: self.size,
+                set: self.set.clone(),
+                ..Overrides::default()
+            },
+            limits: self.limits.limits(),
+            threads: self.threads,
+            ..Job::default()
+        }
+    }
+}
+
 /// Runs `sdfc pareto`.
 pub fn run(args: ParetoArgs) -> ExitCode {
-    let limits = args.limits.limits();
-    let mut checked = match frontend::load_scene(&args.file, DiagnosticFormat::Human, &limits) {
-        Ok(c) => c,
-        Err(code) => return code,
+    let job = args.job();
+    let limits = &job.limits;
+    let mut source = match frontend::Source::read(&args.file) {
+        Ok(s) => s,
+        Err(msg) => return Error::Io(msg).exit(),
+    };
+    let mut loaded = source.check(limits, 0.0);
+    let mut scene = match job.checked(&mut loaded, true) {
+        Ok(s) => s,
+        Err(e) => return e.exit(),
     };
     let specs: Vec<String> = if args.sweep.is_empty() {
         DEFAULT_SWEEPS.iter().map(|s| s.to_string()).collect()
     } else {
         args.sweep.clone()
     };
-    let settings = &mut checked.scene.settings;
     // The swept settings are sphere tracing's: a scene that `auto` would trace analytically
     // (no ε, no step budget) is marched, unless `--set method=trace` asks otherwise.
-    if settings.method == Method::Auto {
-        settings.method = Method::March;
+    if scene.settings.method == Method::Auto {
+        scene.settings.method = Method::March;
     }
     let plan = check_output(args.output.as_deref())
-        .and_then(|()| override_settings(settings, args.size, None, &args.set, &limits))
+        .and_then(|()| job.settings(&mut scene).map_err(|e| e.to_string()))
         .and_then(|()| {
             specs
                 .iter()
-                .map(|s| parse_sweep_within(s, &limits))
+                .map(|s| parse_sweep_within(s, limits))
                 .collect::<Result<Vec<_>, _>>()
         })
-        .and_then(|sweeps| combinations(settings, &sweeps, &limits))
-        .and_then(|points| thread_pool(args.threads).map(|pool| (points, pool)));
+        .and_then(|sweeps| combinations(&scene.settings, &sweeps, limits))
+        .and_then(|points| {
+            job.pool()
+                .map(|pool| (points, pool))
+                .map_err(|e| e.to_string())
+        });
     let (points, pool) = match plan {
         Ok(p) => p,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
-        }
+        Err(msg) => return Error::Usage(msg).exit(),
     };
-    let lowered = match checked.lower(&LowerOptions::default(), &limits) {
+    let lowered = match job.lower(&scene, &loaded.sources, &LowerOptions::default()) {
         Ok(p) => p,
-        Err(code) => return code,
+        Err(e) => return e.exit(),
     };
-    let report = match pool.install(|| measure(&args, &checked.scene, lowered, points, &limits)) {
-        Ok(r) => r,
+    match pool.install(|| measure(&args, &scene, lowered, points, limits)) {
+        Ok(report) => finish(&args, &report),
         Err(msg) => {
             eprintln!("error: {msg}");
-            return ExitCode::from(1);
+            ExitCode::from(1)
         }
-    };
-    finish(&args, &report)
+    }
 }
 
 /// Refuses a chart name that is neither .svg nor .png, or that cannot be written (a missing

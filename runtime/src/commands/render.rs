@@ -1,17 +1,17 @@
-//! `sdfc render`: render a scene to an image (PNG, JPEG or OpenEXR; optionally the reference render with its
-//! convergence check, and the depth sidecar), and the option handling `sdfc bench` and
-//! `sdfc pareto` share (backend choice, `--size`, `--aa`, `--set key=value` overrides, thread
-//! pools).
+//! `sdfc render`: render a scene to an image (PNG, JPEG or OpenEXR; optionally the reference
+//! render with its convergence check, and the depth sidecar) through the job's path
+//! (`crate::job`); a sequence (`--frames`) is `super::sequence`'s. Also the `--stats` text and
+//! the reference's check, which `sdfc pareto` shares.
 
+use super::sequence::{self, SequenceArgs};
+use super::JobArgs;
 use crate::backend::{Devices, Frame, Opening, Prepared, Setup};
 use crate::cpu::reference::{self, Convergence};
-use crate::cpu::Precision;
-use crate::frontend::{self, DiagnosticFormat};
+use crate::job::{self, Error, Job};
 use crate::output::Output;
-use crate::settings::{override_settings, parse_size};
-use crate::{depth, memory};
+use crate::{depth, frontend};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::{Limits, LowerOptions, Scene};
+use sdfc_compiler::{LowerOptions, Scene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -24,25 +24,8 @@ pub use crate::backend::{Backend, Kernel};
 pub struct RenderArgs {
     /// Scene file.
     pub file: PathBuf,
-    /// Backend to render with.
-    #[arg(long, value_enum, default_value_t)]
-    pub backend: Backend,
-    /// Devices to render with: `auto` (the one `--backend` picks), `all` (every GPU of the
-    /// backend), or a comma-separated list of GPU indices (CUDA devices, or wgpu adapters, as
-    /// `sdfc devices` lists them; an index twice opens that GPU as two logical devices) and
-    /// `cpu`. Several devices take tiles of each frame from one queue (docs/devices.md).
-    #[arg(long, value_name = "auto|all|LIST", default_value = "auto", value_parser = Devices::parse)]
-    pub devices: Devices,
-    /// Image size, as WIDTHxHEIGHT (overrides the scene's `render` block).
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
-    pub size: Option<(u32, u32)>,
-    /// Supersampling: N×N samples per pixel.
-    #[arg(long, value_name = "N")]
-    pub aa: Option<u32>,
-    /// Override a render setting: width, height, aa, max_steps, epsilon, max_depth, max_dist,
-    /// relaxation or background (as r,g,b). May be repeated.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub job: JobArgs,
     /// Output image: .png, .jpg (or .jpeg), or .exr (linear, unclamped 32-bit floats); `-`
     /// writes the PNG to standard output (default: the scene file's name with .png, in the
     /// current directory). For a sequence: a name with a run of `#` (the zero-padded frame
@@ -54,18 +37,6 @@ pub struct RenderArgs {
     /// (device, kernel, driver compile, upload, frame, readback, image).
     #[arg(long)]
     pub stats: bool,
-    /// The GPU kernel of a marched scene: its distance program written as code
-    /// (`specialised`, compiled by the driver for each scene), interpreted from a buffer
-    /// (`interpreted`, one kernel for every scene), or `auto`, interpreted where the code
-    /// would be large (docs/interpreted.md). [default: auto]
-    #[arg(long, value_enum)]
-    pub kernel: Option<Kernel>,
-    /// Float type of the evaluation.
-    #[arg(long, value_enum, default_value_t)]
-    pub precision: Precision,
-    /// Worker threads (default: one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
     /// Render the reference: on the CPU in f64 with ε 1e-6, 100000 steps and no
     /// over-relaxation (`--set` still applies on top), then check it against a render with ε
     /// ten times smaller; for a field with no proven bound, the area average of at least 8×8
@@ -81,58 +52,22 @@ pub struct RenderArgs {
     /// instead of what they would show. Without it, images are unchanged.
     #[arg(long)]
     pub debug_nan: bool,
-    /// Render the frames A up to B − 1 of the animation (docs/animation.md), at the times
-    /// k / fps; without it, an output pattern with `#` renders the frames the scene's
-    /// `render { fps, duration }` states.
-    #[arg(long, value_name = "A..B", value_parser = crate::sequence::Frames::parse)]
-    pub frames: Option<crate::sequence::Frames>,
-    /// Frames per second of the sequence (overrides `render { fps }`).
-    #[arg(long, value_name = "F")]
-    pub fps: Option<f64>,
-    /// Render only the frames whose number is ≡ I (mod N): shard I of N of a job array
-    /// (`--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`).
-    #[arg(long, value_name = "I/N", value_parser = crate::sequence::Shard::parse)]
-    pub shard: Option<crate::sequence::Shard>,
-    /// Render frames whose files exist already (by default they are skipped, so that a
-    /// killed job resumes where it stopped).
-    #[arg(long)]
-    pub force: bool,
+    #[command(flatten)]
+    pub sequence: SequenceArgs,
     /// How hard PNG files are compressed: `fast` (fdeflate, the default, for stills and
     /// sequences), `fastest` (fdeflate without the per-row choice of filter), `none`, or
     /// zlib's `balanced` and `high`, smaller and many times slower.
     #[arg(long, value_enum, value_name = "LEVEL", default_value_t)]
     pub png_level: crate::image::PngLevel,
-    #[command(flatten)]
-    pub limits: super::LimitArgs,
 }
 
-/// A failure of a command, with the exit code it gives: 2 for usage and IO problems, 1 for
-/// a scene with errors or a render that failed. `Reported` has been printed already (the
-/// scene's diagnostics).
-#[derive(Debug)]
-pub enum CliError {
-    /// Bad arguments, or a file that cannot be read or written (exit 2).
-    Usage(String),
-    /// The scene or the render failed (exit 1).
-    Failed(String),
-    /// Already reported; exit with this code.
-    Reported(ExitCode),
-}
-
-impl CliError {
-    /// Prints the error (unless it was reported) and gives the exit code.
-    pub fn exit(self) -> ExitCode {
-        match self {
-            CliError::Usage(msg) => {
-                eprintln!("error: {msg}");
-                ExitCode::from(2)
-            }
-            CliError::Failed(msg) => {
-                eprintln!("error: {msg}");
-                ExitCode::from(1)
-            }
-            CliError::Reported(code) => code,
-        }
+impl RenderArgs {
+    /// The job these arguments describe.
+    pub fn job(&self) -> Job {
+        let mut job = self.job.job();
+        job.overrides.reference = self.reference;
+        job.debug_nan = self.debug_nan;
+        job
     }
 }
 
@@ -141,21 +76,30 @@ impl CliError {
 pub fn run(args: RenderArgs) -> ExitCode {
     // One device, the first: the CUDA driver need not prepare the others (before any thread
     // starts, as the environment is shared).
-    if args.devices == Devices::Auto && matches!(args.backend, Backend::Auto | Backend::Cuda) {
+    let job = args.job();
+    if job.devices == Devices::Auto && matches!(job.backend, Backend::Auto | Backend::Cuda) {
         crate::gpu::cuda::only_first_device();
     }
-    let sequence = args.frames.is_some()
+    let sequence = args.sequence.frames.is_some()
         || args
             .output
             .as_deref()
             .is_some_and(|o| o.to_string_lossy().contains('#'));
     if sequence {
-        return match super::sequence::run(&args) {
+        if args.reference || args.aux {
+            return Error::Usage(
+                "--reference and --aux render one image; they cannot be used with a sequence"
+                    .into(),
+            )
+            .exit();
+        }
+        let out = args.output.as_deref();
+        return match sequence::run(&args.file, out, args.png_level, &args.sequence, &job) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => e.exit(),
         };
     }
-    match still(&args) {
+    match still(&args, &job) {
         // The image is written, renamed and synced and the messages printed: the device,
         // its kernel and the thread pool are left to the operating system (see
         // `super::exit_now`).
@@ -166,215 +110,62 @@ pub fn run(args: RenderArgs) -> ExitCode {
     }
 }
 
-/// A scene checked at one time, with its settings overridden by the arguments, and lowered.
-#[derive(Debug, Clone)]
-pub struct FrameScene {
-    /// The scene, settings applied.
-    pub scene: Scene,
-    /// Its distance program and what else the backends read.
-    pub lowered: sdfc_compiler::Lowered,
-    /// Where its time went (`--stats`): the check, then the lowering's phases.
-    pub phases: Vec<(&'static str, Duration, String)>,
-}
-
-/// The settings a command overrides in every frame it checks.
-#[derive(Debug, Clone, Copy)]
-pub struct Overrides<'a> {
-    /// `--reference`: the reference render's settings first.
-    pub reference: bool,
-    /// `--size`.
-    pub size: Option<(u32, u32)>,
-    /// `--aa`.
-    pub aa: Option<u32>,
-    /// `--set`, in order.
-    pub set: &'a [String],
-}
-
-impl RenderArgs {
-    /// The settings `render` overrides.
-    pub fn overrides(&self) -> Overrides<'_> {
-        Overrides {
-            reference: self.reference,
-            size: self.size,
-            aa: self.aa,
-            set: &self.set,
-        }
-    }
-}
-
-/// Checks `source` at `time`, prints its diagnostics (warnings only when `warnings`), applies
-/// `--reference`, `--size`, `--aa` and `--set`, and lowers it with `lowering` (a sequence's
-/// frames with [`LowerOptions::parametric`]).
-pub fn frame_scene(
-    args: Overrides,
-    source: &mut frontend::Source,
-    limits: &Limits,
-    time: f64,
-    warnings: bool,
-    lowering: &LowerOptions,
-) -> Result<FrameScene, CliError> {
-    let started = Instant::now();
-    let mut loaded = source.check(limits, time);
-    let mut phases = vec![(
-        "check",
-        started.elapsed(),
-        "parsed, imports read, checked and evaluated".to_string(),
-    )];
-    if !warnings {
-        loaded.diagnostics.retain(|d| d.is_error());
-    }
-    frontend::report(&loaded, DiagnosticFormat::Human);
-    let Some(mut scene) = loaded.scene else {
-        return Err(CliError::Reported(ExitCode::from(1)));
-    };
-    if args.reference {
-        scene.settings = reference::settings_of(&scene);
-    }
-    let settings = &mut scene.settings;
-    override_settings(settings, args.size, args.aa, args.set, limits).map_err(CliError::Usage)?;
-    let checked = frontend::Checked {
-        scene,
-        sources: loaded.sources,
-        format: DiagnosticFormat::Human,
-    };
-    let lowered = checked
-        .lower(lowering, limits)
-        .map_err(CliError::Reported)?;
-    crate::backend::method_allowed(&checked.scene, &lowered.traceable).map_err(CliError::Failed)?;
-    phases.extend(
-        lowered
-            .phases
-            .list
-            .iter()
-            .map(|&(name, time, what)| (name, time, what.to_string())),
-    );
-    Ok(FrameScene {
-        scene: checked.scene,
-        lowered,
-        phases,
-    })
-}
-
-/// Prepares a frame's scene on the backend's `devices`, or on the device `opening` opens
-/// (for `--devices auto`) when given.
-pub fn prepare(
-    pool: &rayon::ThreadPool,
-    (backend, devices): (Backend, &Devices),
-    frame: FrameScene,
-    setup: &Setup,
-    opening: Option<Opening>,
-) -> Result<(Scene, Prepared), CliError> {
-    let FrameScene { scene, lowered, .. } = frame;
-    // A kernel asked for that cannot render the scene is an error, not a reason to fall back
-    // to another backend.
-    if backend != Backend::Cpu {
-        let options = sdfc_compiler::wgsl::Options {
-            kernel: setup.kernel,
-            ..Default::default()
-        };
-        sdfc_compiler::wgsl::choose(&scene, &lowered, &options).map_err(CliError::Failed)?;
-    }
-    let prepared = pool
-        .install(|| match opening {
-            Some(o) if o.backend() == backend && *devices == Devices::Auto => {
-                Prepared::opened(o, &scene, lowered, setup)
-            }
-            _ => Prepared::on_devices(backend, devices, &scene, lowered, setup),
-        })
-        .map_err(|msg| {
-            CliError::Failed(format!("the {backend:?} backend is not available: {msg}"))
-        })?;
-    Ok((scene, prepared))
-}
-
-/// What a render of `scene` on `prepared` allocates (with the reference's check and the
-/// depth sidecar when asked), announced (when `announce`) and held to the `memory` limit.
-pub fn check_memory(
-    pool: &rayon::ThreadPool,
-    prepared: &Prepared,
-    scene: &Scene,
-    (reference, aux): (bool, bool),
-    limits: &Limits,
-    announce: bool,
-) -> Result<(), CliError> {
-    let needed = pool.install(|| memory::render(prepared, scene, reference, aux));
-    if announce {
-        eprintln!(
-            "{}",
-            memory::announce(&scene.settings, prepared.name(), &needed)
-        );
-    }
-    needed.check(limits).map_err(CliError::Failed)
-}
-
 /// What a still render leaves when it has finished: its device, kernel and thread pool.
 type Finished = (Prepared, rayon::ThreadPool);
 
 /// Renders one image (the scene at the time 0).
-fn still(args: &RenderArgs) -> Result<Finished, CliError> {
+fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
     let mut run = Run::new();
     // The device opens on a thread of its own from here, while the scene is read, checked
     // and lowered and its kernel written; the arguments' errors are reported after the
     // scene's, as ever.
-    let mode = reference_mode(args);
+    let mode = job.mode();
     let opening = match mode {
         Ok((backend, precision))
-            if args.devices == Devices::Auto && Kernel::check(args.kernel, backend).is_ok() =>
+            if job.devices == Devices::Auto && job.check_kernel(backend).is_ok() =>
         {
             Opening::start(backend, precision)
         }
         _ => None,
     };
-    let limits = args.limits.limits();
-    let mut source = frontend::Source::read(&args.file).map_err(CliError::Usage)?;
+    let mut source = frontend::Source::read(&args.file).map_err(Error::Io)?;
     run.lap("read", "the scene's file read");
-    let frame = frame_scene(
-        args.overrides(),
-        &mut source,
-        &limits,
-        0.0,
-        true,
-        &LowerOptions::default(),
-    )?;
+    let frame = job.frame(&mut source, 0.0, true, &LowerOptions::default())?;
     run.split(
         "scene",
         "the rest of it (diagnostics printed, settings applied)",
         frame.phases.clone(),
     );
-    let (backend, precision) = mode.map_err(CliError::Usage)?;
-    Kernel::check(args.kernel, backend).map_err(CliError::Usage)?;
+    let (backend, _) = mode?;
+    job.check_kernel(backend)?;
     // The output is checked before any work, so that a render is never thrown away.
-    let out = output(args).map_err(CliError::Usage)?;
-    let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
+    let out = output(args).map_err(Error::Usage)?;
+    let pool = job.pool()?;
     run.lap("setup", "output checked, thread pool");
     let setup = Setup {
-        precision,
-        debug_nan: args.debug_nan,
-        parameters: false,
-        kernel: args.kernel.unwrap_or_default().choice(),
         image_only: !args.stats,
         // 8-bit outputs take the pixels the GPU finished; OpenEXR, the reference's check
         // and the sidecar read the linear colours.
         finished: !args.reference
             && !args.aux
             && !matches!(&out, Output::File { format, .. } if format.linear()),
-        software: false,
+        ..job.setup()
     };
-    let (scene, prepared) = prepare(&pool, (backend, &args.devices), frame, &setup, opening)?;
+    let (scene, prepared) = job::prepare(&pool, (backend, &job.devices), frame, &setup, opening)?;
     run.split("preparation", "the rest of it", prepared.preparation());
-    check_memory(
+    job::check_memory(
         &pool,
         &prepared,
         &scene,
         (args.reference, args.aux),
-        &limits,
+        &job.limits,
         true,
     )?;
     run.lap("memory", "what the render allocates, announced");
     let started = Instant::now();
     let frame = pool
         .install(|| render_with_progress(&prepared, &scene))
-        .map_err(CliError::Failed)?;
+        .map_err(Error::Render)?;
     let seconds = started.elapsed().as_secs_f64();
     match &frame.phases {
         Some(p) => run.split(
@@ -403,7 +194,7 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
     let check = if args.reference {
         Some(
             pool.install(|| check_reference(&prepared, &scene, &frame))
-                .map_err(CliError::Failed)?,
+                .map_err(Error::Render)?,
         )
     } else {
         None
@@ -417,10 +208,9 @@ fn still(args: &RenderArgs) -> Result<Finished, CliError> {
     let picture = frame.take_picture();
     let steps = out
         .write(&picture, false, args.png_level)
-        .map_err(CliError::Usage)?;
+        .map_err(Error::Io)?;
     if let (true, Some(path)) = (args.aux, out.path()) {
-        write_sidecar(path, frame.render.depth.as_ref(), prepared.name())
-            .map_err(CliError::Usage)?;
+        write_sidecar(path, frame.render.depth.as_ref(), prepared.name()).map_err(Error::Io)?;
     }
     run.split(
         "image",
@@ -601,24 +391,6 @@ fn output(args: &RenderArgs) -> Result<Output, String> {
     Ok(out)
 }
 
-/// The backend and precision of a render: `--reference` means the CPU in f64.
-pub fn reference_mode(args: &RenderArgs) -> Result<(Backend, Precision), String> {
-    args.devices.check(args.backend)?;
-    if !args.reference {
-        return Ok((args.backend, args.precision));
-    }
-    if args.devices != Devices::Auto {
-        return Err("--reference renders on the CPU in f64; it cannot use --devices".into());
-    }
-    match args.backend {
-        Backend::Auto | Backend::Cpu => Ok((Backend::Cpu, Precision::F64)),
-        b => Err(format!(
-            "--reference renders on the CPU in f64; it cannot use --backend {}",
-            format!("{b:?}").to_lowercase()
-        )),
-    }
-}
-
 /// Renders the convergence check of a reference frame (ε divided by ten, or twice the samples
 /// per axis for an area-averaged reference) and compares.
 pub fn check_reference(
@@ -701,17 +473,4 @@ fn default_output(file: &Path) -> PathBuf {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "render".into());
     PathBuf::from(format!("{stem}.png"))
-}
-
-/// A rayon pool of `threads` workers (default: rayon's choice, one per core).
-pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
-    let mut b = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        if n == 0 {
-            return Err("--threads must be at least 1".into());
-        }
-        b = b.num_threads(n);
-    }
-    b.build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))
 }

@@ -4,55 +4,74 @@
 //! `ffmpeg`. The kernel is prepared again only when a frame's distance program differs from
 //! the previous frame's; camera, lights, materials and settings are read at every render.
 
-use super::render::{
-    check_memory, frame_scene, prepare, reference_mode, thread_pool, CliError, FrameScene,
-    RenderArgs,
-};
-use crate::backend::{Prepared, Setup};
+use crate::backend::Setup;
 use crate::frontend::Source;
 use crate::gpu::launch::{Faults, Queue};
 use crate::image::{AtomicFile, Picture, PngLevel};
+use crate::job::{self, Error, FrameScene, Job, Kernels};
 use crate::output::{Output, Submit, Task, Writers, Written};
 use crate::sequence::{ffmpeg, Frames, Target};
 use indicatif::{ProgressBar, ProgressStyle};
-use sdfc_compiler::{Animation, Limit, Limits, LowerOptions, Program, Scene};
+use sdfc_compiler::{Animation, LowerOptions};
+use sdfc_compiler::{Limit, Limits};
 use std::cell::RefCell;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::time::Instant;
 
-/// Renders the sequence `args` asks for.
-pub fn run(args: &RenderArgs) -> Result<(), CliError> {
-    let limits = args.limits.limits();
-    if args.reference || args.aux {
-        return Err(CliError::Usage(
-            "--reference and --aux render one image; they cannot be used with a sequence".into(),
-        ));
-    }
-    let mut source = Source::read(&args.file).map_err(CliError::Usage)?;
+/// The arguments of `sdfc render` that a sequence alone reads.
+#[derive(Debug, clap::Args)]
+pub struct SequenceArgs {
+    /// Render the frames A up to B − 1 of the animation (docs/animation.md), at the times
+    /// k / fps; without it, an output pattern with `#` renders the frames the scene's
+    /// `render { fps, duration }` states.
+    #[arg(long, value_name = "A..B", value_parser = crate::sequence::Frames::parse)]
+    pub frames: Option<Frames>,
+    /// Frames per second of the sequence (overrides `render { fps }`).
+    #[arg(long, value_name = "F")]
+    pub fps: Option<f64>,
+    /// Render only the frames whose number is ≡ I (mod N): shard I of N of a job array
+    /// (`--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`).
+    #[arg(long, value_name = "I/N", value_parser = crate::sequence::Shard::parse)]
+    pub shard: Option<crate::sequence::Shard>,
+    /// Render frames whose files exist already (by default they are skipped, so that a
+    /// killed job resumes where it stopped).
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Renders the sequence of the scene `file` that `args` ask for, `job` being its job, to
+/// `output` (default: numbered PNG files named after the scene), PNG files compressed at
+/// `png_level`.
+pub fn run(
+    file: &Path,
+    output: Option<&Path>,
+    png_level: PngLevel,
+    args: &SequenceArgs,
+    job: &Job,
+) -> Result<(), Error> {
+    let limits = &job.limits;
+    let mut source = Source::read(file).map_err(Error::Io)?;
     // The animation's settings are the same at every time (E0406): read them at t = 0.
     let lowering = LowerOptions::parametric();
-    let first = frame_scene(args.overrides(), &mut source, &limits, 0.0, true, &lowering)?;
+    let first = job.frame(&mut source, 0.0, true, &lowering)?;
     let animation = first.scene.animation;
     let fps = match args.fps {
         Some(f) if f.is_finite() && (0.01..=1000.0).contains(&f) => f,
         Some(f) => {
-            return Err(CliError::Usage(format!(
+            return Err(Error::Usage(format!(
                 "--fps must be a number from 0.01 to 1000, not {f}"
             )))
         }
         None => animation.fps,
     };
-    let frames = frame_range(args, &animation, &limits)?;
+    let frames = frame_range(args, &animation, limits)?;
     let shard = args.shard.unwrap_or_default();
-    let path = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_pattern(&args.file));
-    let target = Target::new(&path).map_err(CliError::Usage)?;
+    let path = output.map_or_else(|| default_pattern(file), Path::to_path_buf);
+    let target = Target::new(&path).map_err(Error::Usage)?;
     if shard.count > 1 && !matches!(target, Target::Numbered(..)) {
-        return Err(CliError::Usage(
+        return Err(Error::Usage(
             "--shard renders part of a sequence: its frames must go to numbered files (`-o out/frame_####.png`), not one animated PNG or video".into(),
         ));
     }
@@ -60,18 +79,15 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         create_directory(&pattern.path(frames.start))?;
     }
     let mut sink = Sink::open(&target, frames, fps)?;
-    let (backend, precision) = reference_mode(args).map_err(CliError::Usage)?;
-    crate::backend::Kernel::check(args.kernel, backend).map_err(CliError::Usage)?;
-    let pool = thread_pool(args.threads).map_err(CliError::Usage)?;
+    let (backend, _) = job.mode()?;
+    job.check_kernel(backend)?;
+    let pool = job.pool()?;
     let setup = Setup {
-        precision,
-        debug_nan: args.debug_nan,
         parameters: true,
-        kernel: args.kernel.unwrap_or_default().choice(),
         image_only: true,
         // 8-bit frames take the pixels the GPU finished; OpenEXR the linear colours.
         finished: !matches!(&target, Target::Numbered(_, format) if format.linear()),
-        software: false,
+        ..job.setup()
     };
     let mine: Vec<u64> = shard.frames(frames).collect();
     let todo: Vec<u64> = mine
@@ -97,9 +113,8 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let bar = progress(mine.len() as u64, skipped as u64);
     let mut first = Some(first);
     let mut checker = Checker {
-        args,
+        job,
         source: &mut source,
-        limits: &limits,
         lowering: &lowering,
         fps,
         bar: bar.as_ref(),
@@ -113,13 +128,13 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             let s = &first.as_ref().expect("the first frame").scene.settings;
             let frame = (12 * s.width as u64 * s.height as u64).max(1);
             let depth = (2 * threads as u64).min((1 << 30) / frame).max(1);
-            Some(Writers::new(threads, depth as usize, args.png_level))
+            Some(Writers::new(threads, depth as usize, png_level))
         }
         _ => None,
     };
     // Several devices take whole frames from one queue; a scene that does not read `t` is
     // rendered once, its one frame split among them.
-    let workers = match args.devices.resolve(backend).map_err(CliError::Usage)? {
+    let workers = match job.devices.resolve(backend).map_err(Error::Usage)? {
         Some(list) if list.len() > 1 && animation.animated() => Some(list),
         _ => None,
     };
@@ -130,13 +145,13 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                 devices: list.len(),
                 backend,
                 setup,
-                limits: &limits,
+                limits,
             };
             let writers = writers.as_ref();
             frames.render(&list, &todo, &mut first, (&mut checker, &mut sink, writers))?
         }
         None => {
-            let mut kernels = Kernels::new(&pool, (backend, args.devices.clone()), setup);
+            let mut kernels = Kernels::new(&pool, (backend, job.devices.clone()), setup);
             // The picture of a scene that does not read `t`, rendered once.
             let mut still: Option<Picture> = None;
             for (n, &k) in todo.iter().enumerate() {
@@ -146,10 +161,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                     Some(picture) => picture.clone(),
                     None => {
                         let (scene, prepared) = kernels.prepare(frame)?;
-                        check_memory(&pool, prepared, &scene, (false, false), &limits, n == 0)?;
+                        let memory = (false, false);
+                        job::check_memory(&pool, prepared, &scene, memory, limits, n == 0)?;
                         let mut frame = pool
                             .install(|| prepared.render(&scene, &|_| {}))
-                            .map_err(CliError::Failed)?;
+                            .map_err(Error::Render)?;
                         for w in frame.warnings() {
                             eprintln!("warning: frame {k}: {w}");
                         }
@@ -171,7 +187,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                             picture,
                             started: frame_started,
                         };
-                        w.submit(task).map_err(CliError::Failed)?;
+                        w.submit(task).map_err(Error::Encode)?;
                         for done in w.written() {
                             report(done, &checker, &sink)?;
                         }
@@ -217,9 +233,8 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
 /// Checks the frames of a sequence one after the other (the source is read once and checked
 /// at each time), and logs those written.
 struct Checker<'a> {
-    args: &'a RenderArgs,
+    job: &'a Job,
     source: &'a mut Source,
-    limits: &'a Limits,
     lowering: &'a LowerOptions,
     fps: f64,
     bar: Option<&'a ProgressBar>,
@@ -227,31 +242,22 @@ struct Checker<'a> {
 
 impl Checker<'_> {
     /// Frame `k` checked at its time (`first`, the frame checked at t = 0, when it is that).
-    fn frame(&mut self, k: u64, first: &mut Option<FrameScene>) -> Result<FrameScene, CliError> {
+    fn frame(&mut self, k: u64, first: &mut Option<FrameScene>) -> Result<FrameScene, Error> {
         let time = Animation::time_of(self.fps, k);
         if let Some(f) = first.take().filter(|_| time == 0.0) {
             return Ok(f);
         }
-        frame_scene(
-            self.args.overrides(),
-            self.source,
-            self.limits,
-            time,
-            false,
-            self.lowering,
-        )
-        .map_err(|e| {
-            if let Some(b) = self.bar {
-                b.abandon();
-            }
-            match e {
-                CliError::Reported(code) => {
-                    eprintln!("error: frame {k} (t = {time} s) has errors");
-                    CliError::Reported(code)
+        self.job
+            .frame(self.source, time, false, self.lowering)
+            .map_err(|e| {
+                if let Some(b) = self.bar {
+                    b.abandon();
                 }
-                other => other,
-            }
-        })
+                if let Error::Scene(_) = e {
+                    eprintln!("error: frame {k} (t = {time} s) has errors");
+                }
+                e
+            })
     }
 
     /// Frame `k` was written in `seconds`.
@@ -268,8 +274,8 @@ impl Checker<'_> {
 }
 
 /// Logs a frame the writers' pool wrote, or gives its error.
-fn report(done: Written, checker: &Checker, sink: &Sink) -> Result<(), CliError> {
-    done.result.map_err(CliError::Usage)?;
+fn report(done: Written, checker: &Checker, sink: &Sink) -> Result<(), Error> {
+    done.result.map_err(Error::Io)?;
     checker.written(done.k, sink, done.seconds);
     Ok(())
 }
@@ -319,7 +325,7 @@ impl FramesOn<'_> {
         todo: &[u64],
         first: &mut Option<FrameScene>,
         (checker, sink, writers): (&mut Checker, &mut Sink, Option<&Writers>),
-    ) -> Result<(usize, Option<String>), CliError> {
+    ) -> Result<(usize, Option<String>), Error> {
         let queue = Queue::new(std::iter::empty(), true);
         let numbered = match (&*sink, writers) {
             (Sink::Numbered(pattern, format), Some(w)) => {
@@ -353,7 +359,7 @@ impl FramesOn<'_> {
             let mut handle = |event: Report,
                               sink: &mut Sink,
                               checker: &Checker|
-             -> Result<(), CliError> {
+             -> Result<(), Error> {
                 match event {
                     Report::Frame {
                         k,
@@ -362,7 +368,7 @@ impl FramesOn<'_> {
                     } => {
                         ready.insert(k, (picture, seconds));
                     }
-                    Report::Unwritten(message) => return Err(CliError::Usage(message)),
+                    Report::Unwritten(message) => return Err(Error::Io(message)),
                     Report::Failed { position, message } => {
                         alive -= 1;
                         eprintln!(
@@ -391,7 +397,7 @@ impl FramesOn<'_> {
                     report(done, checker, sink)?;
                 }
                 if alive == 0 && next < todo.len() {
-                    return Err(CliError::Failed(format!(
+                    return Err(Error::Render(format!(
                         "every device failed ({next} of {} frames written): {}",
                         todo.len(),
                         failures.join("; ")
@@ -424,7 +430,7 @@ impl FramesOn<'_> {
             queue.abandon();
             result?;
             if next < todo.len() {
-                return Err(CliError::Failed(format!(
+                return Err(Error::Render(format!(
                     "{} of {} frames were not rendered",
                     todo.len() - next,
                     todo.len()
@@ -474,18 +480,18 @@ impl FramesOn<'_> {
                         let on = format!("{n} devices");
                         eprintln!("{}", crate::memory::announce(&scene.settings, &on, &all));
                     }
-                    all.check(self.limits).map_err(CliError::Failed)?;
+                    all.check(self.limits).map_err(Error::Memory)?;
                 }
                 let s = &scene.settings;
                 let n = crate::gpu::launch::tiling(s.width, s.height, crate::gpu::TILE, 1).len();
                 if let Some(message) = faults.injected_within(position, tiles..tiles + n) {
-                    return Err(CliError::Failed(message));
+                    return Err(Error::Render(message));
                 }
                 tiles += n;
                 self.pool
                     .install(|| prepared.render_faults(&scene, &|_| {}, &Faults::default()))
                     .map(|mut f| f.take_picture())
-                    .map_err(CliError::Failed)
+                    .map_err(Error::Render)
             })();
             match rendered {
                 Ok(picture) => {
@@ -518,8 +524,8 @@ impl FramesOn<'_> {
                 Err(e) => {
                     queue.hand_back(Pending { k, frame: kept });
                     let message = match e {
-                        CliError::Usage(m) | CliError::Failed(m) => m,
-                        CliError::Reported(_) => "the frame has errors".into(),
+                        Error::Scene(_) => "the frame has errors".into(),
+                        e => e.to_string(),
                     };
                     let _ = tx.send(Report::Failed { position, message });
                     return;
@@ -539,16 +545,16 @@ impl FramesOn<'_> {
 /// The frames to render: `--frames`, or the scene's `fps × duration`, within the `frames`
 /// limit.
 fn frame_range(
-    args: &RenderArgs,
+    args: &SequenceArgs,
     animation: &Animation,
     limits: &Limits,
-) -> Result<Frames, CliError> {
+) -> Result<Frames, Error> {
     let frames = match args.frames {
         Some(f) => f,
         None => {
             let n = animation.frames();
             if n == 0 {
-                return Err(CliError::Usage(
+                return Err(Error::Usage(
                     "the scene states no animation (its `render` block has no `duration`): give the frames with --frames A..B, or add `duration: SECONDS` to `render`".into(),
                 ));
             }
@@ -557,7 +563,7 @@ fn frame_range(
     };
     let max = limits.get(Limit::Frames);
     if frames.len() > max {
-        return Err(CliError::Usage(format!(
+        return Err(Error::Usage(format!(
             "the sequence has {} frames, more than {max}; {}",
             frames.len(),
             limits.raise_to(Limit::Frames, frames.len())
@@ -576,10 +582,10 @@ fn default_pattern(file: &Path) -> PathBuf {
 }
 
 /// Creates the directory of `file` when it is missing.
-fn create_directory(file: &Path) -> Result<(), CliError> {
+fn create_directory(file: &Path) -> Result<(), Error> {
     match file.parent() {
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => std::fs::create_dir_all(dir)
-            .map_err(|e| CliError::Usage(format!("cannot create `{}`: {e}", dir.display()))),
+            .map_err(|e| Error::Io(format!("cannot create `{}`: {e}", dir.display()))),
         _ => Ok(()),
     }
 }
@@ -597,102 +603,6 @@ fn progress(len: u64, done: u64) -> Option<ProgressBar> {
         bar.set_position(done);
         bar
     })
-}
-
-/// The backend prepared for the frames of a sequence: the device is opened once; a frame
-/// whose distance program (and the origin it is written relative to) is the last one's
-/// renders with the same kernel; another is prepared with [`Prepared::update`], which keeps a
-/// GPU kernel whose text is unchanged (its constants are read from `scene_data`), so `count`
-/// counts kernels built, not frames.
-pub struct Kernels<'a> {
-    pool: &'a rayon::ThreadPool,
-    backend: crate::backend::Backend,
-    devices: crate::backend::Devices,
-    setup: Setup,
-    /// The last frame's program and scene origin, and the backend prepared for them.
-    prepared: Option<(Program, [f64; 3], Prepared)>,
-    /// Kernels (or CPU tapes) prepared so far.
-    pub count: usize,
-    /// Time spent preparing them.
-    pub time: std::time::Duration,
-}
-
-impl std::fmt::Debug for Kernels<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Kernels")
-            .field("count", &self.count)
-            .finish()
-    }
-}
-
-impl<'a> Kernels<'a> {
-    /// No kernel yet: the frames will render with `backend` on `devices`.
-    pub fn new(
-        pool: &'a rayon::ThreadPool,
-        (backend, devices): (crate::backend::Backend, crate::backend::Devices),
-        setup: Setup,
-    ) -> Self {
-        Kernels {
-            pool,
-            backend,
-            devices,
-            setup,
-            prepared: None,
-            count: 0,
-            time: std::time::Duration::ZERO,
-        }
-    }
-
-    /// The backend prepared for `frame` (the last one when its program is the same,
-    /// specialised again if its settings need it), and the frame's scene.
-    pub fn prepare(&mut self, frame: FrameScene) -> Result<(Scene, &Prepared), CliError> {
-        let started = Instant::now();
-        let same = self
-            .prepared
-            .as_ref()
-            .is_some_and(|(p, o, _)| *p == frame.lowered.program && *o == frame.scene.origin);
-        let scene = match &mut self.prepared {
-            Some((_, _, prepared)) if same => {
-                let FrameScene { scene, .. } = frame;
-                if prepared.specialise(&scene).map_err(CliError::Failed)? {
-                    self.count += 1;
-                }
-                scene
-            }
-            // The device stays open; the kernel is kept when its text is the same (the
-            // program differs in numbers only) and given the frame's constants.
-            Some((held, origin, prepared)) => {
-                let FrameScene { scene, lowered, .. } = frame;
-                *held = lowered.program.clone();
-                *origin = scene.origin;
-                if prepared.update(&scene, lowered).map_err(CliError::Failed)? {
-                    self.count += 1;
-                }
-                scene
-            }
-            None => {
-                let program = frame.lowered.program.clone();
-                let (scene, prepared) = prepare(
-                    self.pool,
-                    (self.backend, &self.devices),
-                    frame,
-                    &self.setup,
-                    None,
-                )?;
-                self.count += 1;
-                self.prepared = Some((program, scene.origin, prepared));
-                scene
-            }
-        };
-        self.time += started.elapsed();
-        let (_, _, prepared) = self.prepared.as_ref().expect("prepared");
-        Ok((scene, prepared))
-    }
-
-    /// The backend last prepared.
-    pub fn last(&self) -> Option<&Prepared> {
-        self.prepared.as_ref().map(|(_, _, p)| p)
-    }
 }
 
 /// Where the frames go as they are rendered.
@@ -729,11 +639,11 @@ impl Write for Shared {
 }
 
 impl Sink {
-    fn open(target: &Target, frames: Frames, fps: f64) -> Result<Sink, CliError> {
+    fn open(target: &Target, frames: Frames, fps: f64) -> Result<Sink, Error> {
         Ok(match target {
             Target::Numbered(p, f) => {
                 crate::output::check_writable(&p.path(frames.start)).map_err(|why| {
-                    CliError::Usage(format!(
+                    Error::Io(format!(
                         "cannot write `{}`: {why}",
                         p.path(frames.start).display()
                     ))
@@ -742,7 +652,7 @@ impl Sink {
             }
             Target::Apng(path) => {
                 crate::output::check_writable(path).map_err(|why| {
-                    CliError::Usage(format!("cannot write `{}`: {why}", path.display()))
+                    Error::Io(format!("cannot write `{}`: {why}", path.display()))
                 })?;
                 Sink::Apng {
                     path: path.clone(),
@@ -753,9 +663,9 @@ impl Sink {
                 }
             }
             Target::Video(path) => {
-                let ffmpeg = ffmpeg().map_err(CliError::Usage)?;
+                let ffmpeg = ffmpeg().map_err(Error::Usage)?;
                 crate::output::check_writable(path).map_err(|why| {
-                    CliError::Usage(format!("cannot write `{}`: {why}", path.display()))
+                    Error::Io(format!("cannot write `{}`: {why}", path.display()))
                 })?;
                 Sink::Video {
                     path: path.clone(),
@@ -786,10 +696,10 @@ impl Sink {
         }
     }
 
-    fn write(&mut self, k: u64, picture: &Picture) -> Result<(), CliError> {
+    fn write(&mut self, k: u64, picture: &Picture) -> Result<(), Error> {
         let io = |path: &Path| {
             let path = path.display().to_string();
-            move |e: std::io::Error| CliError::Usage(format!("cannot write `{path}`: {e}"))
+            move |e: std::io::Error| Error::Io(format!("cannot write `{path}`: {e}"))
         };
         match self {
             Sink::Numbered(p, format) => Output::File {
@@ -799,7 +709,7 @@ impl Sink {
             // Synced: a rerun skips the frames whose files it finds.
             .write(picture, true, PngLevel::Fast)
             .map(|_| ())
-            .map_err(CliError::Usage),
+            .map_err(Error::Io),
             Sink::Apng {
                 path,
                 frames,
@@ -811,14 +721,14 @@ impl Sink {
                     let f = Rc::new(RefCell::new(AtomicFile::create(path).map_err(io(path))?));
                     *writer = Some(
                         apng(Shared(f.clone()), picture.size(), *frames, *fps).map_err(|e| {
-                            CliError::Usage(format!("cannot write `{}`: {e}", path.display()))
+                            Error::Io(format!("cannot write `{}`: {e}", path.display()))
                         })?,
                     );
                     *file = Some(f);
                 }
                 let w = writer.as_mut().expect("writer");
                 w.write_image_data(&picture.rgba8())
-                    .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", path.display())))
+                    .map_err(|e| Error::Io(format!("cannot write `{}`: {e}", path.display())))
             }
             Sink::Video {
                 path,
@@ -833,13 +743,13 @@ impl Sink {
                 let stdin = c.stdin.as_mut().expect("piped");
                 stdin
                     .write_all(&rgb8(picture))
-                    .map_err(|e| CliError::Failed(format!("ffmpeg stopped reading frames: {e}")))
+                    .map_err(|e| Error::Encode(format!("ffmpeg stopped reading frames: {e}")))
             }
         }
     }
 
     /// Finishes an animated PNG or a video (renamed onto the target when complete).
-    fn finish(self) -> Result<(), CliError> {
+    fn finish(self) -> Result<(), Error> {
         match self {
             Sink::Numbered(..) => Ok(()),
             Sink::Apng {
@@ -848,8 +758,7 @@ impl Sink {
                 let (Some(w), Some(f)) = (writer, file) else {
                     return Ok(());
                 };
-                let err =
-                    |e: String| CliError::Usage(format!("cannot write `{}`: {e}", path.display()));
+                let err = |e: String| Error::Io(format!("cannot write `{}`: {e}", path.display()));
                 w.finish().map_err(|e| err(e.to_string()))?;
                 let f = Rc::try_unwrap(f)
                     .map_err(|_| err("the encoder still holds the file".into()))?
@@ -863,16 +772,16 @@ impl Sink {
                 drop(c.stdin.take());
                 let status = c
                     .wait()
-                    .map_err(|e| CliError::Failed(format!("ffmpeg: {e}")))?;
+                    .map_err(|e| Error::Encode(format!("ffmpeg: {e}")))?;
                 if !status.success() {
                     let _ = std::fs::remove_file(&tmp);
-                    return Err(CliError::Failed(format!(
+                    return Err(Error::Encode(format!(
                         "ffmpeg failed ({status}) writing `{}`",
                         path.display()
                     )));
                 }
                 std::fs::rename(&tmp, &path)
-                    .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", path.display())))
+                    .map_err(|e| Error::Io(format!("cannot write `{}`: {e}", path.display())))
             }
         }
     }
@@ -907,7 +816,7 @@ fn start_ffmpeg(
     path: &Path,
     (width, height): (u32, u32),
     fps: f64,
-) -> Result<(std::process::Child, PathBuf), CliError> {
+) -> Result<(std::process::Child, PathBuf), Error> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -933,7 +842,7 @@ fn start_ffmpeg(
     cmd.arg(&tmp).stdin(std::process::Stdio::piped());
     let child = cmd
         .spawn()
-        .map_err(|e| CliError::Failed(format!("cannot start `{}`: {e}", ffmpeg.display())))?;
+        .map_err(|e| Error::Encode(format!("cannot start `{}`: {e}", ffmpeg.display())))?;
     Ok((child, tmp))
 }
 

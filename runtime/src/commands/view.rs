@@ -2,6 +2,7 @@
 //! whenever it or a file it imports is saved (see `docs/viewer.md`).
 
 use crate::backend::{Backend, Kernel};
+use crate::job::{Job, Overrides};
 use crate::view::{self, session::Options, session::GRACE, Control, Run};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -79,15 +80,26 @@ pub struct ViewArgs {
 
 /// Runs `sdfc view`.
 pub fn run(args: ViewArgs) -> ExitCode {
-    let limits = args.limits.limits();
+    let backend = match args.backend {
+        ViewBackend::Auto => Backend::Auto,
+        ViewBackend::Wgpu => Backend::Wgpu,
+        ViewBackend::Cpu => Backend::Cpu,
+    };
+    let job = Job {
+        backend,
+        overrides: Overrides {
+            size: args.size,
+            set: args.set,
+            ..Overrides::default()
+        },
+        limits: args.limits.limits(),
+        ..Job::default()
+    };
     // The --set values are checked once here, so that a mistake in them stops at once rather
     // than failing every reload.
     let mut probe = sdfc_compiler::Settings::default();
-    if let Err(msg) =
-        crate::settings::override_settings(&mut probe, args.size, None, &args.set, &limits)
-    {
-        eprintln!("error: {msg}");
-        return ExitCode::from(2);
+    if let Err(e) = job.override_settings(&mut probe) {
+        return e.exit();
     }
     if let Some(dir) = &args.screenshot_dir {
         if let Err(e) = std::fs::create_dir_all(dir) {
@@ -95,22 +107,14 @@ pub fn run(args: ViewArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     }
-    let backend = match args.backend {
-        ViewBackend::Auto => Backend::Auto,
-        ViewBackend::Wgpu => Backend::Wgpu,
-        ViewBackend::Cpu => Backend::Cpu,
-    };
     if let Err(msg) = Kernel::check(args.kernel, backend) {
         eprintln!("error: {msg}");
         return ExitCode::from(2);
     }
     let run = Run {
         file: args.file,
-        backend,
         options: Options {
-            size: args.size,
-            sets: args.set,
-            limits,
+            job,
             timings: args.timings,
             kernel: args.kernel.unwrap_or_default(),
             interim_on_cpu: false,

@@ -44,9 +44,7 @@ pub struct Control {
 pub struct Run {
     /// The scene file.
     pub file: PathBuf,
-    /// `auto`, `wgpu` or `cpu`.
-    pub backend: Backend,
-    /// How the session treats the scene.
+    /// How the session treats the scene (its job's backend: `auto`, `wgpu` or `cpu`).
     pub options: Options,
     /// When to stop.
     pub control: Control,
@@ -67,7 +65,7 @@ pub struct Run {
 /// - when the files can no longer be watched;
 /// - otherwise never by itself (a live preview without a window, like the window).
 pub fn headless(run: Run) -> ExitCode {
-    let device = match run.backend {
+    let device = match run.options.job.backend {
         Backend::Cpu => Device::Cpu,
         backend => match Gpu::open(backend == Backend::Auto) {
             Ok(gpu) => Device::Wgpu(Arc::new(gpu)),

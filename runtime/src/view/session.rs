@@ -17,11 +17,9 @@ use crate::frontend::{self, DiagnosticFormat, Loaded};
 use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
 use crate::image::Image;
-use crate::settings::override_settings;
-use sdfc_compiler::{
-    lower_within, wgsl, Animation, Camera, Diagnostic, FileId, Limit, Limits, LowerOptions,
-    Lowered, Scene, Severity, SourceMap,
-};
+use crate::job::{first_error, Error, Job};
+use sdfc_compiler::{wgsl, Animation, Camera, LowerOptions, Lowered, Scene};
+use sdfc_compiler::{FileId, Limit, SourceMap};
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant, SystemTime};
@@ -53,13 +51,10 @@ pub const GRACE: Duration = Duration::from_millis(50);
 /// How the session treats the scene, from the command line.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// `--size`: the image size, overriding the scene's (the window's size replaces it when
-    /// the window is resized).
-    pub size: Option<(u32, u32)>,
-    /// `--set key=value` overrides of render settings, applied at every load.
-    pub sets: Vec<String>,
-    /// Resource limits.
-    pub limits: Limits,
+    /// The job: its backend, `--size` (overriding the scene's; the window's size replaces it
+    /// when the window is resized), the `--set key=value` overrides of render settings,
+    /// applied at every load, and the resource limits.
+    pub job: Job,
     /// `--timings`: print the times of each load and of its first frame.
     pub timings: bool,
     /// `--time`: an animated scene starts paused at this time (seconds) instead of playing.
@@ -82,9 +77,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Options {
         Options {
-            size: None,
-            sets: Vec::new(),
-            limits: Limits::default(),
+            job: Job::default(),
             timings: false,
             time: None,
             kernel: Kernel::default(),
@@ -430,7 +423,7 @@ pub struct Session {
 impl Session {
     /// A session on `file`, rendering on `device`; nothing is loaded until [`Session::load`].
     pub fn new(file: PathBuf, options: Options, device: Device) -> Session {
-        let size = options.size.unwrap_or((640, 480));
+        let size = options.job.overrides.size.unwrap_or((640, 480));
         Session {
             files: vec![file.clone()],
             file,
@@ -524,20 +517,18 @@ impl Session {
     /// The size a view of `file` starts at: `size`, or the scene's (640×480 when the file does
     /// not compile yet). Nothing is printed.
     pub fn initial_size(file: &Path, options: &Options) -> (u32, u32) {
-        if let Some(size) = options.size {
+        let job = &options.job;
+        if let Some(size) = job.overrides.size {
             return size;
         }
-        match frontend::load_with(file, &options.limits) {
+        match frontend::load_with(file, &job.limits) {
             Ok(Loaded {
                 scene: Some(mut scene),
                 ..
-            }) => {
-                let s = &mut scene.settings;
-                match override_settings(s, None, None, &options.sets, &options.limits) {
-                    Ok(()) => (s.width, s.height),
-                    Err(_) => (640, 480),
-                }
-            }
+            }) => match job.settings(&mut scene) {
+                Ok(()) => (scene.settings.width, scene.settings.height),
+                Err(_) => (640, 480),
+            },
             _ => (640, 480),
         }
     }
@@ -623,13 +614,14 @@ impl Session {
     /// Reads, checks, lowers and prepares the scene, printing what `sdfc check` prints;
     /// `Err` is the one-line summary of the first problem.
     fn compile(&mut self) -> Result<(Good, Timings), String> {
-        let limits = self.options.limits.clone();
+        let job = self.options.job.clone();
+        let limits = &job.limits;
         let start = Instant::now();
         let empty = || std::fs::metadata(&self.file).is_ok_and(|m| m.len() == 0);
         while empty() && start.elapsed() < EMPTY_PATIENCE {
             std::thread::sleep(Duration::from_millis(5));
         }
-        let mut loaded = match frontend::load_with(&self.file, &limits) {
+        let mut loaded = match frontend::load_with(&self.file, limits) {
             Ok(l) => l,
             Err(msg) => {
                 eprintln!("error: {msg}");
@@ -651,35 +643,17 @@ impl Session {
             if !self.fingerprint.changed() {
                 break;
             }
-            match frontend::load_with(&self.file, &limits) {
+            match frontend::load_with(&self.file, limits) {
                 Ok(again) => loaded = again,
                 Err(_) => break,
             }
         }
-        frontend::report(&loaded, DiagnosticFormat::Human);
-        let Some(mut scene) = loaded.scene.take() else {
-            return Err(first_error(&loaded.diagnostics, &loaded.sources));
-        };
-        if let Err(msg) = override_settings(
-            &mut scene.settings,
-            self.options.size,
-            None,
-            &self.options.sets,
-            &limits,
-        ) {
-            eprintln!("error: {msg}");
-            return Err(msg);
-        }
+        let scene = job.scene(&mut loaded, true).map_err(summary)?;
         let check_time = start.elapsed();
         let start = Instant::now();
-        let lowered = match lower_within(&scene, &lower_options(&scene), &limits) {
-            Ok(lowered) => lowered,
-            Err(d) => {
-                let summary = first_error(std::slice::from_ref(&d), &loaded.sources);
-                frontend::print_diagnostics(&[d], &loaded.sources, DiagnosticFormat::Human);
-                return Err(summary);
-            }
-        };
+        let lowered = job
+            .lower(&scene, &loaded.sources, &lower_options(&scene))
+            .map_err(summary)?;
         let lower_time = start.elapsed();
         eprintln!(
             "{}: ok; {}; {}",
@@ -700,7 +674,7 @@ impl Session {
         let setup = Setup {
             parameters: true,
             kernel,
-            ..Setup::default()
+            ..job.setup()
         };
         let interim_lowered = match (&self.device, self.options.kernel) {
             (Device::Wgpu(gpu), Kernel::Auto) if !gpu.is_cpu() || self.options.interim_on_cpu => {
@@ -719,7 +693,7 @@ impl Session {
         let prepare_time = start.elapsed();
         let mut at = scene.settings.clone();
         (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);
-        if let Err(msg) = prepared.memory(&scene, &at).check(&limits) {
+        if let Err(msg) = prepared.memory(&scene, &at).check(limits) {
             eprintln!("error: {msg}");
             return Err(msg);
         }
@@ -834,7 +808,7 @@ impl Session {
         };
         prepared
             .memory(scene, at)
-            .check(&self.options.limits)
+            .check(&self.options.job.limits)
             .ok()?;
         let kernel = &prepared.as_wgpu()?.kernel;
         let data = kernel.data.is_some();
@@ -1058,24 +1032,19 @@ impl Session {
 
     /// Replaces the scene on show with the scene checked at `time`.
     fn scene_at(&mut self, time: f64) -> Result<(), String> {
-        let limits = self.options.limits.clone();
+        let job = &self.options.job;
         let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
             return Ok(());
         };
-        let mut loaded = p.source.check(&limits, time);
+        let mut loaded = p.source.check(&job.limits, time);
         let Some(mut scene) = loaded.scene.take() else {
             frontend::report(&loaded, DiagnosticFormat::Human);
             return Err(first_error(&loaded.diagnostics, &loaded.sources));
         };
-        override_settings(
-            &mut scene.settings,
-            self.options.size,
-            None,
-            &self.options.sets,
-            &limits,
-        )?;
-        let lowered = lower_within(&scene, &lower_options(&scene), &limits)
-            .map_err(|d| first_error(std::slice::from_ref(&d), &loaded.sources))?;
+        job.settings(&mut scene).map_err(|e| e.to_string())?;
+        let lowered = job
+            .lower(&scene, &loaded.sources, &lower_options(&scene))
+            .map_err(|e| e.to_string())?;
         if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
             i.prepared = i.prepared.next(&scene, lowered.clone())?.0;
         }
@@ -1098,7 +1067,12 @@ impl Session {
 
     /// Sets the view's size (the window's), clamped to the `edge` limit.
     pub fn set_size(&mut self, width: u32, height: u32) {
-        let edge = self.options.limits.get(Limit::Edge).min(u32::MAX as u64) as u32;
+        let edge = self
+            .options
+            .job
+            .limits
+            .get(Limit::Edge)
+            .min(u32::MAX as u64) as u32;
         let size = (width.clamp(1, edge), height.clamp(1, edge));
         if size != self.size {
             self.size = size;
@@ -1539,28 +1513,13 @@ fn files_of(sources: &SourceMap) -> Vec<PathBuf> {
         .collect()
 }
 
-/// One line for the window: the first error, where it is, and how many there are.
-fn first_error(diagnostics: &[Diagnostic], sources: &SourceMap) -> String {
-    let errors: Vec<&Diagnostic> = diagnostics
-        .iter()
-        .filter(|d| d.severity == Severity::Error)
-        .collect();
-    let Some(d) = errors.first() else {
-        return "error".into();
-    };
-    let at = d
-        .labels
-        .first()
-        .map(|l| {
-            let (line, col) = sources.line_col(l.span);
-            format!(" at {}:{line}:{col}", sources.name(l.span.file))
-        })
-        .unwrap_or_default();
-    let more = match errors.len() {
-        1 => String::new(),
-        n => format!(" (and {} more)", n - 1),
-    };
-    format!("error[{}]: {}{at}{more}", d.code, d.message)
+/// The one line of `e` for the window, printed first unless it is a scene's errors (whose
+/// diagnostics are printed where they are found).
+fn summary(e: Error) -> String {
+    if !matches!(e, Error::Scene(_)) {
+        eprintln!("error: {e}");
+    }
+    e.to_string()
 }
 
 fn ms(d: Duration) -> f64 {

@@ -111,7 +111,7 @@ impl App {
         );
         let (device, presenter) = match wgpu_presenter(event_loop, &window) {
             Ok((gpu, presenter)) => {
-                let device = match self.run.backend {
+                let device = match self.run.options.job.backend {
                     Backend::Cpu => Device::Cpu,
                     Backend::Wgpu => Device::Wgpu(gpu.clone()),
                     // Like `sdfc render`, auto takes a hardware GPU, else the CPU renderer.
@@ -126,7 +126,7 @@ impl App {
                 );
                 (device, Presenter::Gpu(Box::new(presenter)))
             }
-            Err(msg) if self.run.backend == Backend::Wgpu => {
+            Err(msg) if self.run.options.job.backend == Backend::Wgpu => {
                 return Err(format!(
                     "{msg}: install a Vulkan driver (on Linux without a GPU, Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`), or use --backend cpu"
                 ));

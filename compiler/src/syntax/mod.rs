@@ -108,5 +108,29 @@ pub fn parse_within(
                 .iter()
                 .any(|r| at.span.end <= r.start && r.end <= found.span.start)
     }));
+    // The parser's recovery can meet one error twice (a block left open inside another
+    // unclosed one: both end at the end of the file): each error is reported once.
+    let mut seen = std::collections::HashSet::new();
+    diags.retain(|d| {
+        seen.insert((
+            d.code,
+            d.message.clone(),
+            d.labels.iter().map(|l| l.span).collect::<Vec<_>>(),
+        ))
+    });
     ((ast, diags), depth)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_error_met_twice_by_the_recovery_is_reported_once() {
+        // The first scene is never closed; the second, parsed inside it, ends the file too.
+        let (_, diags) = parse(FileId(0), "scene { box(); x y;\nscene { box\n");
+        let at_end: Vec<_> = diags.iter().filter(|d| d.code == "E0100").collect();
+        assert_eq!(at_end.len(), 1, "{diags:#?}");
+        assert_eq!(at_end[0].message, "unexpected end of file");
+    }
 }

@@ -315,7 +315,7 @@ impl Scene {
         let lowered = lower_within(&checked.scene, &LowerOptions::default(), &limits)
             .map_err(|d| Failure::Compile(vec![d], checked.sources.clone()))?;
         sdfc_runtime::backend::method_allowed(&checked.scene, &lowered.traceable)
-            .map_err(Failure::Value)?;
+            .map_err(|e| Failure::Value(e.to_string()))?;
         let pool = pool()?;
         let setup = Setup {
             precision: Precision::F32,
@@ -360,7 +360,7 @@ impl Scene {
         )?;
         let frame = pool
             .install(|| prepared.render(&scene, &|_| {}))
-            .map_err(Failure::Runtime)?;
+            .map_err(|e| Failure::Runtime(e.to_string()))?;
         Ok(frame.render)
     }
 }

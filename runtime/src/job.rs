@@ -66,26 +66,23 @@ pub enum Error {
     /// The scene has errors (its diagnostics are printed where they are found).
     #[error("{}", .0.summary())]
     Scene(Box<SceneErrors>),
-    /// The scene asks for what the backend cannot do: analytic tracing of a scene that does
-    /// not allow it, a GPU kernel that cannot render it.
-    #[error("{0}")]
-    Unsupported(String),
     /// The backend cannot be used: no device, or the scene could not be prepared on it.
-    #[error("the {backend:?} backend is not available: {message}")]
+    #[error("the {backend:?} backend is not available: {source}")]
     Unavailable {
         /// The backend asked for.
         backend: Backend,
         /// Why.
-        message: String,
+        source: backend::Error,
     },
-    /// A frame's scene could not be prepared on the backend already prepared (a kernel
-    /// specialised or written again).
-    #[error("{0}")]
-    Prepare(String),
+    /// The backend failed: the scene asks for what it cannot do, a frame's kernel could not
+    /// be written again, a render failed on its device.
+    #[error(transparent)]
+    Backend(#[from] backend::Error),
     /// What the render would allocate is above the `memory` limit.
     #[error("{0}")]
     Memory(String),
-    /// A render failed on its device.
+    /// A render failed otherwise: every device of a sequence, or a result that cannot be
+    /// used.
     #[error("{0}")]
     Render(String),
     /// An encoder the frames are handed to (`ffmpeg`) failed.
@@ -285,7 +282,7 @@ impl Job {
         )];
         let scene = self.scene(&mut loaded, warnings)?;
         let lowered = self.lower(&scene, &loaded.sources, lowering)?;
-        backend::method_allowed(&scene, &lowered.traceable).map_err(Error::Unsupported)?;
+        backend::method_allowed(&scene, &lowered.traceable)?;
         phases.extend(
             lowered
                 .phases
@@ -331,7 +328,7 @@ pub fn prepare(
             kernel: setup.kernel,
             ..Default::default()
         };
-        wgsl::choose(&scene, &lowered, &options).map_err(Error::Unsupported)?;
+        wgsl::choose(&scene, &lowered, &options).map_err(backend::Error::Unsupported)?;
     }
     let prepared = pool
         .install(|| match opening {
@@ -340,7 +337,7 @@ pub fn prepare(
             }
             _ => Prepared::on_devices(backend, devices, &scene, lowered, setup),
         })
-        .map_err(|message| Error::Unavailable { backend, message })?;
+        .map_err(|source| Error::Unavailable { backend, source })?;
     Ok((scene, prepared))
 }
 
@@ -419,7 +416,7 @@ impl<'a> Kernels<'a> {
         let scene = match &mut self.prepared {
             Some((_, _, prepared)) if same => {
                 let FrameScene { scene, .. } = frame;
-                if prepared.specialise(&scene).map_err(Error::Prepare)? {
+                if prepared.specialise(&scene)? {
                     self.count += 1;
                 }
                 scene
@@ -430,7 +427,7 @@ impl<'a> Kernels<'a> {
                 let FrameScene { scene, lowered, .. } = frame;
                 *held = lowered.program.clone();
                 *origin = scene.origin;
-                if prepared.update(&scene, lowered).map_err(Error::Prepare)? {
+                if prepared.update(&scene, lowered)? {
                     self.count += 1;
                 }
                 scene

@@ -558,6 +558,7 @@ fn a_sweep_of_relaxation_on_wgpu_takes_effect() {
     assert!(
         refused
             .as_ref()
+            .map_err(|e| e.to_string())
             .is_err_and(|e| e.contains("specialised") && e.contains("no over-relaxation")),
         "{refused:?}"
     );

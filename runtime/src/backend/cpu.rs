@@ -1,7 +1,7 @@
 //! The CPU renderer behind [`Renderer`]: the distance program's tapes, prepared once, and the
 //! render options.
 
-use super::{Frame, Part, Prepared, Renderer, Setup};
+use super::{Error, Frame, Part, Prepared, Renderer, Setup};
 use crate::cpu::{self, Options, Tapes};
 use crate::gpu;
 use crate::memory::Memory;
@@ -106,7 +106,7 @@ impl Renderer for CpuPrepared {
         scene: &Scene,
         progress: &(dyn Fn(f64) + Sync),
         _: &gpu::launch::Faults,
-    ) -> Result<Frame, String> {
+    ) -> Result<Frame, Error> {
         let tiles = cpu::tile_count(&scene.settings, &self.options).max(1) as f64;
         let done = std::sync::atomic::AtomicU64::new(0);
         let start = Instant::now();
@@ -125,7 +125,7 @@ impl Renderer for CpuPrepared {
         })
     }
 
-    fn part<'a>(&'a self, scene: &'a Scene) -> Result<Part<'a>, String> {
+    fn part<'a>(&'a self, scene: &'a Scene) -> Result<Part<'a>, Error> {
         Ok(Part {
             worker: Box::new(gpu::cpu::Device::new(scene, &self.tapes, &self.options)),
             kernel: None,
@@ -137,11 +137,11 @@ impl Renderer for CpuPrepared {
         scene: &Scene,
         lowered: Lowered,
         _: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), String> {
+    ) -> Result<(Prepared, bool), Error> {
         Ok((Prepared::on_cpu(scene, lowered, &self.setup())?, true))
     }
 
-    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
         *self = CpuPrepared::new(scene, lowered, &self.setup());
         Ok(true)
     }

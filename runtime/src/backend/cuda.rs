@@ -1,7 +1,7 @@
 //! CUDA behind [`Renderer`]: the device, the kernel translated to PTX and loaded as a module,
 //! and what it takes to write the kernel again.
 
-use super::{kernel, kernel_text, Frame, Part, Preparation, Prepared, Renderer, Setup};
+use super::{kernel, kernel_text, Error, Frame, Part, Preparation, Prepared, Renderer, Setup};
 use crate::gpu::{self, cuda::Cuda};
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, ptx, wgsl, Lowered, Scene, Settings};
@@ -39,9 +39,9 @@ impl CudaPrepared {
         lowered: &Lowered,
         setup: &Setup,
         open: impl FnOnce() -> Result<Cuda, gpu::cuda::Error>,
-    ) -> Result<CudaPrepared, String> {
+    ) -> Result<CudaPrepared, Error> {
         let start = Instant::now();
-        let cuda = open().map_err(|e| e.to_string())?;
+        let cuda = open().map_err(|e| Error::Device(e.to_string()))?;
         let device = start.elapsed();
         let start = Instant::now();
         let kernel = kernel(scene, lowered, &setup.on_cuda())?;
@@ -61,7 +61,7 @@ impl CudaPrepared {
         lowered: &Lowered,
         setup: &Setup,
         timing: Preparation,
-    ) -> Result<CudaPrepared, String> {
+    ) -> Result<CudaPrepared, Error> {
         let module = CudaModule::load(&cuda, kernel)?;
         Ok(CudaPrepared {
             cuda: Box::new(cuda),
@@ -76,18 +76,19 @@ impl CudaPrepared {
 
 impl CudaModule {
     /// Translates `kernel` to PTX and loads it on `cuda`.
-    fn load(cuda: &Cuda, kernel: wgsl::Kernel) -> Result<CudaModule, String> {
+    fn load(cuda: &Cuda, kernel: wgsl::Kernel) -> Result<CudaModule, Error> {
         let start = Instant::now();
         let options = ptx::Options {
             sm: cuda.sm,
             entry_point: wgsl::ENTRY_POINT.to_string(),
         };
-        let ptx = ptx::write(&kernel.module, &kernel.info, &options).map_err(|e| e.to_string())?;
+        let ptx = ptx::write(&kernel.module, &kernel.info, &options)
+            .map_err(|e| Error::Kernel(e.to_string()))?;
         let ptx_time = start.elapsed();
         let marched = !kernel.contract.has("ANALYTIC");
         let loaded = cuda
             .load(&ptx, wgsl::ENTRY_POINT, gpu::cuda::register_cap(marched))
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| Error::Kernel(e.to_string()))?;
         Ok(CudaModule {
             interpreted: kernel.interpreted(),
             loaded,
@@ -175,7 +176,7 @@ impl Renderer for CudaPrepared {
         scene: &Scene,
         progress: &(dyn Fn(f64) + Sync),
         faults: &gpu::launch::Faults,
-    ) -> Result<Frame, String> {
+    ) -> Result<Frame, Error> {
         let module = &self.module;
         let r = gpu::render_cuda(
             &self.cuda,
@@ -189,11 +190,11 @@ impl Renderer for CudaPrepared {
             (faults, !self.setup.image_only, self.setup.finished),
             &mut |f| progress(f),
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| Error::Render(e.to_string()))?;
         Ok(Frame::of(r))
     }
 
-    fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, String> {
+    fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, Error> {
         let module = &self.module;
         Ok(Part {
             worker: Box::new(self.cuda.kernel(&module.loaded, wgsl::WORKGROUP)),
@@ -210,11 +211,13 @@ impl Renderer for CudaPrepared {
         _: &Scene,
         _: Lowered,
         _: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), String> {
-        Err("CUDA kernels and several devices are prepared again with Prepared::update".into())
+    ) -> Result<(Prepared, bool), Error> {
+        Err(Error::Misuse(
+            "CUDA kernels and several devices are prepared again with Prepared::update".into(),
+        ))
     }
 
-    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
         let text = kernel_text(scene, &lowered, &self.setup)?;
         let built = text.source != self.module.source;
         if built {
@@ -228,7 +231,7 @@ impl Renderer for CudaPrepared {
         Ok(built)
     }
 
-    fn specialise(&mut self, scene: &Scene) -> Result<bool, String> {
+    fn specialise(&mut self, scene: &Scene) -> Result<bool, Error> {
         super::method_allowed(scene, &self.lowered.traceable)?;
         // The same device and context; the new module replaces the old one.
         let kernel = kernel(scene, &self.lowered, &self.setup.on_cuda())?;

@@ -25,6 +25,29 @@ use sdfc_compiler::{
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+/// What fails preparing a scene on a backend or rendering it there.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The scene asks for what the backend or its kernel cannot do: analytic tracing of a
+    /// scene that does not allow it, a GPU kernel that cannot render it, settings its kernel
+    /// was not specialised for, GPUs of the CPU backend.
+    #[error("{0}")]
+    Unsupported(String),
+    /// A device could not be opened: no driver, no adapter, no such index.
+    #[error("{0}")]
+    Device(String),
+    /// The kernel could not be written, translated to PTX, loaded, or compiled into a
+    /// pipeline.
+    #[error("{0}")]
+    Kernel(String),
+    /// A render failed on its device (or on every device of several).
+    #[error("{0}")]
+    Render(String),
+    /// Asked of a preparation that does not do it (a CUDA preparation's `next`).
+    #[error("{0}")]
+    Misuse(String),
+}
+
 /// Where a scene is rendered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Backend {
@@ -334,12 +357,12 @@ impl Opening {
     }
 
     /// Waits for the thread: what it opened, and how long this waited.
-    fn join(self) -> Result<(Opened, Duration), String> {
+    fn join(self) -> Result<(Opened, Duration), Error> {
         let start = Instant::now();
         let opened = self
             .thread
             .join()
-            .map_err(|_| "the thread opening the device panicked".to_string())?;
+            .map_err(|_| Error::Device("the thread opening the device panicked".into()))?;
         Ok((opened, start.elapsed()))
     }
 }
@@ -399,13 +422,13 @@ impl Frame {
 /// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
 /// does not allow it, saying why, from the primitives the lowering found (`traceable`):
 /// `sdfc render` refuses such settings before preparing a backend.
-pub fn method_allowed(scene: &Scene, traceable: &Traceable) -> Result<(), String> {
+pub fn method_allowed(scene: &Scene, traceable: &Traceable) -> Result<(), Error> {
     if scene.settings.method == Method::Trace {
         if let Choice::March(reason) = traceable.choose(scene.settings.method) {
-            return Err(format!(
+            return Err(Error::Unsupported(format!(
                 "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
                 reason.describe()
-            ));
+            )));
         }
     }
     Ok(())
@@ -489,10 +512,10 @@ pub trait Renderer: std::fmt::Debug + Send + Sync {
         scene: &Scene,
         progress: &(dyn Fn(f64) + Sync),
         faults: &gpu::launch::Faults,
-    ) -> Result<Frame, String>;
+    ) -> Result<Frame, Error>;
 
     /// This device as one of several rendering `scene` together.
-    fn part<'a>(&'a self, scene: &'a Scene) -> Result<Part<'a>, String>;
+    fn part<'a>(&'a self, scene: &'a Scene) -> Result<Part<'a>, Error>;
 
     /// `scene`, lowered as `lowered`, prepared as this is (see [`Prepared::next`]), with the
     /// wgpu kernel `kernel` instead of this one's choice when given.
@@ -501,15 +524,15 @@ pub trait Renderer: std::fmt::Debug + Send + Sync {
         scene: &Scene,
         lowered: Lowered,
         kernel: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), String>;
+    ) -> Result<(Prepared, bool), Error>;
 
     /// Prepares `scene`, lowered as `lowered`, in place of this one's scene (see
     /// [`Prepared::update`]).
-    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String>;
+    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error>;
 
     /// Writes the GPU kernel again for `scene`, whose settings its contract refuses (see
     /// [`Prepared::specialise`]).
-    fn specialise(&mut self, _scene: &Scene) -> Result<bool, String> {
+    fn specialise(&mut self, _scene: &Scene) -> Result<bool, Error> {
         Ok(false)
     }
 
@@ -554,10 +577,10 @@ fn gpu_kind(backend: Backend) -> Result<Backend, String> {
 }
 
 /// The kernel for `scene`, chosen (`wgsl::choose`), written and validated.
-fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, String> {
+fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, Error> {
     let options = kernel_options(setup);
-    wgsl::choose(scene, lowered, &options)?;
-    wgsl::write_with(scene, lowered, &options).map_err(|e| e.to_string())
+    wgsl::choose(scene, lowered, &options).map_err(Error::Unsupported)?;
+    wgsl::write_with(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
 }
 
 fn kernel_options(setup: &Setup) -> wgsl::Options {
@@ -576,10 +599,10 @@ fn kernel_options(setup: &Setup) -> wgsl::Options {
 
 /// The text and data of the kernel for `scene`, not validated (to compare with a kernel
 /// held).
-fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, String> {
+fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, Error> {
     let options = kernel_options(setup);
-    wgsl::choose(scene, lowered, &options)?;
-    wgsl::write_text(scene, lowered, &options).map_err(|e| e.to_string())
+    wgsl::choose(scene, lowered, &options).map_err(Error::Unsupported)?;
+    wgsl::write_text(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
 }
 
 impl Prepared {
@@ -589,7 +612,7 @@ impl Prepared {
     }
 
     /// Prepares `scene` for `backend`. `Err` says why the backend cannot be used.
-    pub fn new(backend: Backend, scene: &Scene, precision: Precision) -> Result<Prepared, String> {
+    pub fn new(backend: Backend, scene: &Scene, precision: Precision) -> Result<Prepared, Error> {
         let setup = Setup {
             precision,
             ..Setup::default()
@@ -605,7 +628,7 @@ impl Prepared {
         scene: &Scene,
         lowered: Lowered,
         setup: &Setup,
-    ) -> Result<Prepared, String> {
+    ) -> Result<Prepared, Error> {
         method_allowed(scene, &lowered.traceable)?;
         let cpu = |lowered| Prepared::of(CpuPrepared::new(scene, lowered, setup));
         let wgpu =
@@ -631,8 +654,8 @@ impl Prepared {
         scene: &Scene,
         lowered: Lowered,
         setup: &Setup,
-    ) -> Result<Prepared, String> {
-        let Some(list) = devices.resolve(backend)? else {
+    ) -> Result<Prepared, Error> {
+        let Some(list) = devices.resolve(backend).map_err(Error::Device)? else {
             return Self::from_program(backend, scene, lowered, setup);
         };
         method_allowed(scene, &lowered.traceable)?;
@@ -640,7 +663,7 @@ impl Prepared {
         for d in &list {
             let part = match *d {
                 Device::Cpu => Prepared::of(CpuPrepared::new(scene, lowered.clone(), setup)),
-                Device::Gpu(i) => match gpu_kind(backend)? {
+                Device::Gpu(i) => match gpu_kind(backend).map_err(Error::Unsupported)? {
                     // On a stream of its own: the same index twice is two logical devices on
                     // one GPU, running side by side.
                     Backend::Cuda => {
@@ -649,7 +672,7 @@ impl Prepared {
                         })?)
                     }
                     _ => {
-                        let gpu = Gpu::open_index(i).map_err(|e| e.to_string())?;
+                        let gpu = Gpu::open_index(i).map_err(|e| Error::Device(e.to_string()))?;
                         Self::on_gpu(Arc::new(gpu), scene, &lowered, setup)?
                     }
                 },
@@ -672,14 +695,14 @@ impl Prepared {
         scene: &Scene,
         lowered: Lowered,
         setup: &Setup,
-    ) -> Result<Prepared, String> {
+    ) -> Result<Prepared, Error> {
         method_allowed(scene, &lowered.traceable)?;
         let timed = |setup: &Setup| {
             let start = Instant::now();
             (kernel(scene, &lowered, setup), start.elapsed())
         };
         let on_cuda =
-            |cuda, (kernel, time): (Result<wgsl::Kernel, String>, Duration), waited, took| {
+            |cuda, (kernel, time): (Result<wgsl::Kernel, Error>, Duration), waited, took| {
                 let timing = Preparation {
                     device: waited,
                     kernel: time,
@@ -699,15 +722,19 @@ impl Prepared {
             Backend::Cuda => {
                 let kernel = timed(&setup.on_cuda());
                 let (opened, waited) = opening.join()?;
-                let cuda = opened.cuda.ok_or("no CUDA device was opened")?;
-                let cuda = cuda.map_err(|e| e.to_string())?;
+                let cuda = opened
+                    .cuda
+                    .ok_or_else(|| Error::Device("no CUDA device was opened".into()))?;
+                let cuda = cuda.map_err(|e| Error::Device(e.to_string()))?;
                 on_cuda(cuda, kernel, waited, opened.took)
             }
             Backend::Wgpu => {
                 let kernel = timed(&hardware);
                 let (opened, waited) = opening.join()?;
-                let gpu = opened.wgpu.ok_or("no wgpu device was opened")?;
-                let gpu = gpu.map_err(|e| e.to_string())?;
+                let gpu = opened
+                    .wgpu
+                    .ok_or_else(|| Error::Device("no wgpu device was opened".into()))?;
+                let gpu = gpu.map_err(|e| Error::Device(e.to_string()))?;
                 on_wgpu(gpu, kernel, waited, opened.took)
             }
             _ => {
@@ -718,11 +745,11 @@ impl Prepared {
                     (Some(Ok(cuda)), None) => {
                         CudaPrepared::open(scene, &lowered, setup, || Ok(cuda)).map(Prepared::of)
                     }
-                    _ => Err("no CUDA device".into()),
+                    _ => Err(Error::Device("no CUDA device".into())),
                 };
                 cuda.or_else(|_| match opened.wgpu {
                     Some(Ok(gpu)) => on_wgpu(gpu, timed(&hardware), waited, opened.took),
-                    Some(Err(e)) => Err(e.to_string()),
+                    Some(Err(e)) => Err(Error::Device(e.to_string())),
                     // CUDA opened, and its kernel failed: a GPU adapter, as `from_program`.
                     None => WgpuPrepared::open(scene, &lowered, setup, true).map(Prepared::of),
                 })
@@ -739,12 +766,12 @@ impl Prepared {
         scene: &Scene,
         lowered: &Lowered,
         setup: &Setup,
-    ) -> Result<Prepared, String> {
+    ) -> Result<Prepared, Error> {
         WgpuPrepared::on_gpu_after(gpu, scene, lowered, setup, None).map(|(p, _)| Prepared::of(p))
     }
 
     /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
-    pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, String> {
+    pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, Error> {
         method_allowed(scene, &lowered.traceable)?;
         Ok(Prepared::of(CpuPrepared::new(scene, lowered, setup)))
     }
@@ -756,7 +783,7 @@ impl Prepared {
     /// built. The viewer keeps its last good scene until the new one is ready; a sequence
     /// replaces its scene with [`Prepared::update`]. CUDA and several devices are prepared
     /// again with `update` alone.
-    pub fn next(&self, scene: &Scene, lowered: Lowered) -> Result<(Prepared, bool), String> {
+    pub fn next(&self, scene: &Scene, lowered: Lowered) -> Result<(Prepared, bool), Error> {
         self.0.next(scene, lowered, None)
     }
 
@@ -768,7 +795,7 @@ impl Prepared {
         scene: &Scene,
         lowered: Lowered,
         kernel: wgsl::KernelChoice,
-    ) -> Result<(Prepared, bool), String> {
+    ) -> Result<(Prepared, bool), Error> {
         self.0.next(scene, lowered, Some(kernel))
     }
 
@@ -776,7 +803,7 @@ impl Prepared {
     /// keeping the device: a GPU kernel whose text is unchanged (with [`Setup::parameters`], a
     /// program that differs only in numbers) is kept and given the new `scene_data`; another
     /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
-    pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+    pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
         method_allowed(scene, &lowered.traceable)?;
         self.0.update(scene, lowered)
     }
@@ -792,7 +819,7 @@ impl Prepared {
     /// the kernel has hard ones, ...: [`wgsl::Contract::check`]): a sweep of ω from 1 up must
     /// turn `RELAX` on. Keeps the device; nothing to do on the CPU. Says whether a kernel was
     /// written.
-    pub fn specialise(&mut self, scene: &Scene) -> Result<bool, String> {
+    pub fn specialise(&mut self, scene: &Scene) -> Result<bool, Error> {
         if self.check_contract(scene).is_ok() {
             return Ok(false);
         }
@@ -802,16 +829,16 @@ impl Prepared {
     /// `Err` when `scene` needs a kernel specialised otherwise than this one
     /// ([`wgsl::Contract::check`]; [`Prepared::specialise`] writes it again): a render never
     /// silently ignores a setting or a feature of the scene.
-    pub fn check_contract(&self, scene: &Scene) -> Result<(), String> {
+    pub fn check_contract(&self, scene: &Scene) -> Result<(), Error> {
         let Some(contract) = self.contract() else {
             return Ok(());
         };
         let traced = self.traceable().traced(scene.settings.method).is_some();
         contract.check(scene, traced).map_err(|m| {
-            format!(
+            Error::Unsupported(format!(
                 "the {} kernel cannot render this scene: {m}; specialise it again",
                 self.name()
-            )
+            ))
         })
     }
 
@@ -866,7 +893,7 @@ impl Prepared {
 
     /// Renders one frame; `progress` gets the fraction done. The faults of the testing aid
     /// `SDFC_FAULT_AFTER_TILES` are injected.
-    pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, String> {
+    pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, Error> {
         self.render_faults(scene, progress, &gpu::launch::Faults::from_env())
     }
 
@@ -876,7 +903,7 @@ impl Prepared {
         scene: &Scene,
         progress: &(dyn Fn(f64) + Sync),
         faults: &gpu::launch::Faults,
-    ) -> Result<Frame, String> {
+    ) -> Result<Frame, Error> {
         self.check_contract(scene)?;
         self.0.render(scene, progress, faults)
     }

@@ -1,7 +1,7 @@
 //! Several devices behind [`Renderer`] (`--devices`): each prepared as one device is, rendering
 //! each frame together through the one tile scheduler ([`gpu::render_several`]).
 
-use super::{Frame, Part, Prepared, Renderer, Setup};
+use super::{Error, Frame, Part, Prepared, Renderer, Setup};
 use crate::gpu;
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
@@ -87,7 +87,7 @@ impl Renderer for SeveralPrepared {
         scene: &Scene,
         progress: &(dyn Fn(f64) + Sync),
         faults: &gpu::launch::Faults,
-    ) -> Result<Frame, String> {
+    ) -> Result<Frame, Error> {
         let statistics = !self.setup().is_some_and(|s| s.image_only);
         let finished = self.setup().is_some_and(|s| s.finished);
         let mut workers = Vec::with_capacity(self.parts.len());
@@ -106,12 +106,15 @@ impl Renderer for SeveralPrepared {
             (lipschitz, uniform, data),
             (faults, statistics, finished),
             &mut |f| progress(f),
-        )?;
+        )
+        .map_err(Error::Render)?;
         Ok(Frame::of(r))
     }
 
-    fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, String> {
-        Err("several devices cannot hold several devices".into())
+    fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, Error> {
+        Err(Error::Misuse(
+            "several devices cannot hold several devices".into(),
+        ))
     }
 
     fn next(
@@ -119,11 +122,13 @@ impl Renderer for SeveralPrepared {
         _: &Scene,
         _: Lowered,
         _: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), String> {
-        Err("CUDA kernels and several devices are prepared again with Prepared::update".into())
+    ) -> Result<(Prepared, bool), Error> {
+        Err(Error::Misuse(
+            "CUDA kernels and several devices are prepared again with Prepared::update".into(),
+        ))
     }
 
-    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
         let mut built = false;
         for p in &mut self.parts {
             built |= p.update(scene, lowered.clone())?;
@@ -131,7 +136,7 @@ impl Renderer for SeveralPrepared {
         Ok(built)
     }
 
-    fn specialise(&mut self, scene: &Scene) -> Result<bool, String> {
+    fn specialise(&mut self, scene: &Scene) -> Result<bool, Error> {
         let mut again = false;
         for p in &mut self.parts {
             again |= p.specialise(scene)?;

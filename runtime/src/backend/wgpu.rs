@@ -1,7 +1,7 @@
 //! wgpu behind [`Renderer`]: the device (which may be shared, as the viewer shares its
 //! window's), the validated kernel, and what it takes to write the kernel again.
 
-use super::{kernel, kernel_text, Frame, Part, Preparation, Prepared, Renderer, Setup};
+use super::{kernel, kernel_text, Error, Frame, Part, Preparation, Prepared, Renderer, Setup};
 use crate::gpu::{self, Gpu};
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
@@ -31,9 +31,9 @@ impl WgpuPrepared {
         lowered: &Lowered,
         setup: &Setup,
         require_hardware: bool,
-    ) -> Result<WgpuPrepared, String> {
+    ) -> Result<WgpuPrepared, Error> {
         let start = Instant::now();
-        let gpu = Gpu::open(require_hardware).map_err(|e| e.to_string())?;
+        let gpu = Gpu::open(require_hardware).map_err(|e| Error::Device(e.to_string()))?;
         let device = start.elapsed();
         let (prepared, _) = Self::on_gpu_after(Arc::new(gpu), scene, lowered, setup, None)?;
         prepared.with_pipeline(device, None)
@@ -46,13 +46,13 @@ impl WgpuPrepared {
         mut self,
         device: Duration,
         overlapped: Option<Duration>,
-    ) -> Result<WgpuPrepared, String> {
+    ) -> Result<WgpuPrepared, Error> {
         let data = self.kernel.data.is_some();
         let module = Some(&self.kernel.module);
         let pipeline = self
             .gpu
             .pipeline_for(&self.kernel.source, module, wgsl::ENTRY_POINT, data);
-        self.timing.pipeline = Some(pipeline.map_err(|e| e.to_string())?);
+        self.timing.pipeline = Some(pipeline.map_err(|e| Error::Kernel(e.to_string()))?);
         self.timing.device = device;
         self.timing.overlapped = overlapped;
         Ok(self)
@@ -85,9 +85,9 @@ impl WgpuPrepared {
         scene: &Scene,
         lowered: &Lowered,
         setup: &Setup,
-        (hardware, written): (Setup, (Result<wgsl::Kernel, String>, Duration)),
+        (hardware, written): (Setup, (Result<wgsl::Kernel, Error>, Duration)),
         (waited, took): (Duration, Duration),
-    ) -> Result<WgpuPrepared, String> {
+    ) -> Result<WgpuPrepared, Error> {
         let setup = Self::setup_for(gpu.is_cpu(), setup);
         let (kernel, time) = match written {
             (k, time) if setup == hardware || k.as_ref().is_ok_and(|k| !k.interpreted()) => {
@@ -123,7 +123,7 @@ impl WgpuPrepared {
         lowered: &Lowered,
         setup: &Setup,
         held: Option<&wgsl::Kernel>,
-    ) -> Result<(WgpuPrepared, bool), String> {
+    ) -> Result<(WgpuPrepared, bool), Error> {
         super::method_allowed(scene, &lowered.traceable)?;
         let setup = &Self::setup_for(gpu.is_cpu(), setup);
         let start = Instant::now();
@@ -235,7 +235,7 @@ impl Renderer for WgpuPrepared {
         scene: &Scene,
         progress: &(dyn Fn(f64) + Sync),
         faults: &gpu::launch::Faults,
-    ) -> Result<Frame, String> {
+    ) -> Result<Frame, Error> {
         let r = gpu::render_faults(
             &self.gpu,
             scene,
@@ -244,11 +244,11 @@ impl Renderer for WgpuPrepared {
             (faults, !self.setup.image_only, self.setup.finished),
             &mut |f| progress(f),
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| Error::Render(e.to_string()))?;
         Ok(Frame::of(r))
     }
 
-    fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, String> {
+    fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, Error> {
         Ok(Part {
             worker: Box::new(self.gpu.kernel(
                 &self.kernel.source,
@@ -268,7 +268,7 @@ impl Renderer for WgpuPrepared {
         scene: &Scene,
         lowered: Lowered,
         kernel: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), String> {
+    ) -> Result<(Prepared, bool), Error> {
         let setup = Setup {
             kernel: kernel.unwrap_or(self.setup.kernel),
             ..self.setup
@@ -278,7 +278,7 @@ impl Renderer for WgpuPrepared {
         Ok((Prepared::of(next), built))
     }
 
-    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, String> {
+    fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
         let held = Some(&*self.kernel);
         let (next, built) =
             Self::on_gpu_after(self.gpu.clone(), scene, &lowered, &self.setup, held)?;
@@ -286,7 +286,7 @@ impl Renderer for WgpuPrepared {
         Ok(built)
     }
 
-    fn specialise(&mut self, scene: &Scene) -> Result<bool, String> {
+    fn specialise(&mut self, scene: &Scene) -> Result<bool, Error> {
         super::method_allowed(scene, &self.lowered.traceable)?;
         *self.kernel = kernel(scene, &self.lowered, &self.setup)?;
         Ok(true)

@@ -196,9 +196,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, Error> {
             if k == frames.start {
                 job::check_memory(&pool, prepared, &scene, (false, false), &job.limits, false)?;
             }
-            let image = pool
-                .install(|| prepared.render(&scene, &|_| {}))
-                .map_err(Error::Render)?;
+            let image = pool.install(|| prepared.render(&scene, &|_| {}))?;
             size = (image.render.image.width, image.render.image.height);
             if k == frames.start {
                 // The first frame is not timed: the device opens and the kernel compiles.
@@ -357,26 +355,23 @@ fn time_scene(
             kernel: setup.kernel,
             ..Default::default()
         };
-        sdfc_compiler::wgsl::choose(scene, &lowered, &options).map_err(Error::Unsupported)?;
+        sdfc_compiler::wgsl::choose(scene, &lowered, &options)
+            .map_err(crate::backend::Error::Unsupported)?;
     }
-    let prepared = Prepared::on_devices(job.backend, &job.devices, scene, lowered, &setup)
-        .map_err(Error::Prepare)?;
+    let prepared = Prepared::on_devices(job.backend, &job.devices, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);
     frame.host = frame
         .host
         .saturating_add(prepared.retained(&scene.settings));
     frame.check(&job.limits).map_err(Error::Memory)?;
-    let mut last = prepared
-        .render(scene, &|_| {})
-        .map_err(Error::Render)?
-        .render;
+    let mut last = prepared.render(scene, &|_| {})?.render;
     let mut times = Vec::new();
     let mut walls = Vec::new();
     let mut whole = Vec::new();
     for _ in 0..args.frames {
         let started = std::time::Instant::now();
-        let frame = prepared.render(scene, &|_| {}).map_err(Error::Render)?;
+        let frame = prepared.render(scene, &|_| {})?;
         whole.push(started.elapsed().as_secs_f64());
         times.push(frame.time.as_secs_f64());
         walls.push(frame.wall.as_secs_f64());

@@ -130,10 +130,7 @@ pub fn run(args: ParetoArgs) -> ExitCode {
     };
     match pool.install(|| measure(&args, &scene, lowered, points, limits)) {
         Ok(report) => finish(&args, &report),
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            ExitCode::from(1)
-        }
+        Err(e) => e.exit(),
     }
 }
 
@@ -183,7 +180,7 @@ fn measure(
     lowered: Lowered,
     mut points: Vec<Settings>,
     limits: &Limits,
-) -> Result<Report, String> {
+) -> Result<Report, Error> {
     let default = scene.settings.clone();
     if !points.iter().any(|s| same(s, &default)) {
         points.push(default.clone());
@@ -198,17 +195,20 @@ fn measure(
         software: false,
     };
     let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
-        .map_err(|e| format!("the {:?} backend is not available: {e}", args.backend))?;
+        .map_err(|source| Error::Unavailable {
+            backend: args.backend,
+            source,
+        })?;
     let (reference_scene, reference_prepared) = reference_setup(scene, lowered, &points)?;
     // The reference frame is held while each point renders.
     let held = reference_prepared.retained(&reference_scene.settings);
     let reference_memory =
         crate::memory::render(&reference_prepared, &reference_scene, true, false);
-    reference_memory.check(limits)?;
+    reference_memory.check(limits).map_err(Error::Memory)?;
     for settings in &points {
         let mut point = prepared.memory(scene, settings);
         point.host = point.host.saturating_add(held);
-        point.check(limits)?;
+        point.check(limits).map_err(Error::Memory)?;
     }
     let (reference, info) = reference_render(&reference_prepared, &reference_scene)?;
     prepared.render(scene, &|_| {})?;
@@ -266,7 +266,7 @@ fn reference_setup(
     scene: &Scene,
     lowered: Lowered,
     points: &[Settings],
-) -> Result<(Scene, Prepared), String> {
+) -> Result<(Scene, Prepared), Error> {
     let aa = points
         .iter()
         .map(|s| s.aa)
@@ -297,7 +297,7 @@ fn reference_setup(
 fn reference_render(
     prepared: &Prepared,
     reference_scene: &Scene,
-) -> Result<(Render, ReferenceInfo), String> {
+) -> Result<(Render, ReferenceInfo), Error> {
     let aa = reference_scene.settings.aa;
     let start = std::time::Instant::now();
     let frame = prepared.render(reference_scene, &|_| {})?;
@@ -330,7 +330,7 @@ fn measure_one(
     settings: &Settings,
     reference: &Render,
     default: bool,
-) -> Result<Measured, String> {
+) -> Result<Measured, Error> {
     let mut point = scene.clone();
     point.settings = settings.clone();
     let mut times = Vec::with_capacity(args.frames as usize);
@@ -340,10 +340,10 @@ fn measure_one(
         times.push(frame.time.as_secs_f64());
         last = Some(frame.render);
     }
-    let render = last.ok_or("no frame rendered")?;
+    let render = last.ok_or_else(|| Error::Render("no frame rendered".into()))?;
     times.sort_by(f64::total_cmp);
     let d = metrics::compare(&reference.image, &render.image, reference::THRESHOLD)
-        .ok_or("the reference and the render differ in size")?;
+        .ok_or_else(|| Error::Render("the reference and the render differ in size".into()))?;
     let depth = match (&reference.depth, &render.depth) {
         (Some(r), Some(t)) => metrics::compare_depth(r, t, reference::DEPTH_TOLERANCE),
         _ => None,

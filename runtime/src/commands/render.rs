@@ -5,7 +5,7 @@
 
 use super::sequence::{self, SequenceArgs};
 use super::JobArgs;
-use crate::backend::{Devices, Frame, Opening, Prepared, Setup};
+use crate::backend::{self, Devices, Frame, Opening, Prepared, Setup};
 use crate::cpu::reference::{self, Convergence};
 use crate::job::{self, Error, Job};
 use crate::output::Output;
@@ -163,9 +163,7 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
     )?;
     run.lap("memory", "what the render allocates, announced");
     let started = Instant::now();
-    let frame = pool
-        .install(|| render_with_progress(&prepared, &scene))
-        .map_err(Error::Render)?;
+    let frame = pool.install(|| render_with_progress(&prepared, &scene))?;
     let seconds = started.elapsed().as_secs_f64();
     match &frame.phases {
         Some(p) => run.split(
@@ -192,10 +190,7 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
         eprintln!("warning: {w}");
     }
     let check = if args.reference {
-        Some(
-            pool.install(|| check_reference(&prepared, &scene, &frame))
-                .map_err(Error::Render)?,
-        )
+        Some(pool.install(|| check_reference(&prepared, &scene, &frame))?)
     } else {
         None
     };
@@ -397,7 +392,7 @@ pub fn check_reference(
     prepared: &Prepared,
     scene: &Scene,
     frame: &Frame,
-) -> Result<Convergence, String> {
+) -> Result<Convergence, backend::Error> {
     let mut finer = scene.clone();
     finer.settings = reference::check_settings(&scene.settings);
     let check = prepared.render(&finer, &|_| {})?;
@@ -445,7 +440,7 @@ fn write_sidecar(image: &Path, depth: Option<&depth::Depth>, backend: &str) -> R
 }
 
 /// Renders with a progress bar on stderr when stderr is a terminal.
-pub fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame, String> {
+pub fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame, backend::Error> {
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = ProgressBar::new(1000);
         if let Ok(style) =

@@ -163,9 +163,7 @@ pub fn run(
                         let (scene, prepared) = kernels.prepare(frame)?;
                         let memory = (false, false);
                         job::check_memory(&pool, prepared, &scene, memory, limits, n == 0)?;
-                        let mut frame = pool
-                            .install(|| prepared.render(&scene, &|_| {}))
-                            .map_err(Error::Render)?;
+                        let mut frame = pool.install(|| prepared.render(&scene, &|_| {}))?;
                         for w in frame.warnings() {
                             eprintln!("warning: frame {k}: {w}");
                         }
@@ -405,7 +403,7 @@ impl FramesOn<'_> {
                 }
                 Ok(())
             };
-            let result = (|| {
+            let result = (|| -> Result<(), Error> {
                 for &k in todo {
                     let frame = checker.frame(k, first)?;
                     while queue.waiting() >= ahead {
@@ -491,7 +489,7 @@ impl FramesOn<'_> {
                 self.pool
                     .install(|| prepared.render_faults(&scene, &|_| {}, &Faults::default()))
                     .map(|mut f| f.take_picture())
-                    .map_err(Error::Render)
+                    .map_err(Error::from)
             })();
             match rendered {
                 Ok(picture) => {

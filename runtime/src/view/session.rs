@@ -689,7 +689,7 @@ impl Session {
                 Prepared::on_gpu(gpu.clone(), &scene, &lowered, &setup).map(|p| (p, true))
             }
         };
-        let (prepared, built) = prepared.inspect_err(|msg| eprintln!("error: {msg}"))?;
+        let (prepared, built) = prepared.map_err(|e| summary(e.into()))?;
         let prepare_time = start.elapsed();
         let mut at = scene.settings.clone();
         (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);
@@ -1046,9 +1046,16 @@ impl Session {
             .lower(&scene, &loaded.sources, &lower_options(&scene))
             .map_err(|e| e.to_string())?;
         if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
-            i.prepared = i.prepared.next(&scene, lowered.clone())?.0;
+            i.prepared = i
+                .prepared
+                .next(&scene, lowered.clone())
+                .map_err(|e| e.to_string())?
+                .0;
         }
-        let (prepared, _) = good.prepared.next(&scene, lowered)?;
+        let (prepared, _) = good
+            .prepared
+            .next(&scene, lowered)
+            .map_err(|e| e.to_string())?;
         self.version += 1;
         good.file_camera = scene.camera.clone();
         good.scene = scene;
@@ -1248,6 +1255,7 @@ impl Session {
                 };
                 prepared
                     .check_contract(&good.scene)
+                    .map_err(|e| e.to_string())
                     .and_then(|()| {
                         resident?.render(
                             (kernel, *lipschitz),
@@ -1259,14 +1267,17 @@ impl Session {
                     })
                     .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
             }
-            None => prepared.render(&good.scene, &|_| {}).map(|frame| {
-                for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
-                    for i in 0..3 {
-                        sum[i] += c[i];
+            None => prepared
+                .render(&good.scene, &|_| {})
+                .map_err(|e| e.to_string())
+                .map(|frame| {
+                    for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
+                        for i in 0..3 {
+                            sum[i] += c[i];
+                        }
                     }
-                }
-                (a.count + 1, frame.render.stats.steps_mean)
-            }),
+                    (a.count + 1, frame.render.stats.steps_mean)
+                }),
         };
         let (count, steps) = match rendered {
             Ok(r) => r,

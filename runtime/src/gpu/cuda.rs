@@ -110,7 +110,13 @@ pub struct FrameBuffers {
     /// The reduction's partial records and totals, made when a frame's statistics are first
     /// reduced.
     reduction: Option<(CudaSlice<u32>, CudaSlice<u32>)>,
+    /// Page-locked buffers the finished pixels of a band are copied into while the next band
+    /// renders ([`launch::Device::start_read`]), with the pixels each holds.
+    readback: [Readback; 2],
 }
+
+/// A page-locked readback buffer and the pixels copied into it, if a copy was started.
+type Readback = (Option<PinnedHostSlice<u8>>, Option<Range<usize>>);
 
 impl std::fmt::Debug for FrameBuffers {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -429,10 +435,19 @@ impl launch::Device for Kernel<'_> {
             pixels: finished,
             events: Vec::with_capacity(job.tiles.len()),
             reduction: None,
+            readback: [(None, None), (None, None)],
         })
     }
 
     fn run(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
+        self.submit(f, job, tiles)?;
+        self.cuda
+            .stream
+            .synchronize()
+            .map_err(driver("running the kernel"))
+    }
+
+    fn submit(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
         let s = &self.cuda.stream;
         let workgroup = self.workgroup;
         // Each launch is timed by its own pair of events, and the times are summed: the
@@ -485,7 +500,66 @@ impl launch::Device for Kernel<'_> {
                 f.events.push((start, end));
             }
         }
-        s.synchronize().map_err(driver("running the kernel"))
+        Ok(())
+    }
+
+    /// The finished pixels of `range`, copied (on the stream, behind the launches) into
+    /// page-locked buffer `slot`; the linear colours are read at [`launch::Device::collect`].
+    fn start_read(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        range: Range<usize>,
+        slot: usize,
+    ) -> Result<(), Error> {
+        if !job.finished {
+            return Ok(());
+        }
+        let bytes = 4 * range.len();
+        let (kept, at) = &mut f.readback[slot];
+        let mut pinned = match kept.take().filter(|p| p.len() >= bytes) {
+            Some(p) => p,
+            // SAFETY: page-locked host memory, cached (the host reads it); its bytes are read
+            // only after the copy below has written them (`collect` reads the copied prefix).
+            None => unsafe { self.cuda.ctx.alloc_pinned_with_flags::<u8>(bytes, 0) }
+                .map_err(driver("allocating page-locked memory"))?,
+        };
+        self.cuda
+            .stream
+            .memcpy_dtoh(&f.pixels.slice(4 * range.start..4 * range.end), &mut pinned)
+            .map_err(driver("reading the pixels"))?;
+        *kept = Some(pinned);
+        *at = Some(range);
+        Ok(())
+    }
+
+    fn collect(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        range: Range<usize>,
+        slot: usize,
+    ) -> Result<Pixels, Error> {
+        let (kept, at) = &mut f.readback[slot];
+        let (Some(pinned), Some(true)) = (kept.as_ref(), at.take().map(|r| r == range)) else {
+            return self.read(f, job, std::slice::from_ref(&range));
+        };
+        // Waits for the copy alone: the launches queued after it may still run.
+        let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
+        let rgba = {
+            use rayon::prelude::*;
+            let src = &bytes[..4 * range.len()];
+            let mut out = vec![0u8; src.len()];
+            out.par_chunks_mut(1 << 16)
+                .zip(src.par_chunks(1 << 16))
+                .for_each(|(o, i)| o.copy_from_slice(i));
+            out
+        };
+        Ok(Pixels {
+            linear: Vec::new(),
+            rgba,
+            convert: Duration::ZERO,
+        })
     }
 
     fn read(

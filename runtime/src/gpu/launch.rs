@@ -94,6 +94,40 @@ pub trait Device: Sync {
         job: &Job,
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Self::Error>;
+    /// Starts the tiles `tiles` without waiting for them: several devices overlap a band's
+    /// readback with the next band's launches ([`Device::start_read`]). By default
+    /// [`Device::run`], which waits.
+    fn submit(
+        &self,
+        frame: &mut Self::Frame,
+        job: &Job,
+        tiles: &[usize],
+    ) -> Result<(), Self::Error> {
+        self.run(frame, job, tiles)
+    }
+    /// Starts reading back the pixels of `range` once the work submitted so far is done, into
+    /// readback buffer `slot` (0 or 1: a band's pixels are collected from one while the next
+    /// band's are copied into the other). By default nothing: [`Device::collect`] reads.
+    fn start_read(
+        &self,
+        _frame: &mut Self::Frame,
+        _job: &Job,
+        _range: Range<usize>,
+        _slot: usize,
+    ) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    /// The pixels of `range` whose read was started into `slot`, once they are copied (the
+    /// work submitted after them may still be running). By default [`Device::read`].
+    fn collect(
+        &self,
+        frame: &mut Self::Frame,
+        job: &Job,
+        range: Range<usize>,
+        _slot: usize,
+    ) -> Result<Pixels, Self::Error> {
+        self.read(frame, job, std::slice::from_ref(&range))
+    }
     /// The statistics of the pixels of `ranges` (rendered in `frame`) reduced as `ask` asks,
     /// on the device ([`super::reduce`]).
     fn reduce(
@@ -353,6 +387,17 @@ impl<T> Queue<T> {
         self.lock().waiting.len()
     }
 
+    /// The next item if one is waiting now, without waiting for one.
+    pub fn try_take(&self) -> Option<T> {
+        let mut s = self.lock();
+        if s.abandoned {
+            return None;
+        }
+        let item = s.waiting.pop_front()?;
+        s.taken += 1;
+        Some(item)
+    }
+
     /// The next item, waiting while one may still come (pushed, or handed back by another
     /// worker); `None` when every item is done.
     pub fn take(&self) -> Option<T> {
@@ -411,6 +456,34 @@ pub struct Bands<'a> {
     rounds: Option<Rounds>,
 }
 
+/// Collecting a band a device rendered, on its worker's thread.
+trait Accept: Device {
+    /// Collects `band`'s pixels from readback buffer `slot`, checks the device's errors and
+    /// sends the pixels to be assembled; the phases and tiles go to `share`.
+    fn accept(
+        &self,
+        frame: &mut Self::Frame,
+        bands: &Bands,
+        (band, slot): (usize, usize),
+        share: &mut Share,
+    ) -> Result<(), String> {
+        let job = bands.job;
+        let read = Instant::now();
+        let pixels = self
+            .collect(frame, job, job.band(band), slot)
+            .and_then(|p| self.check(frame).map(|()| p))
+            .map_err(|e| e.to_string())?;
+        share.phases.readback += read.elapsed().saturating_sub(pixels.convert);
+        share.phases.convert += pixels.convert;
+        share.tiles += 1;
+        let _ = bands.events.send((band, pixels));
+        bands.queue.done();
+        Ok(())
+    }
+}
+
+impl<D: Device> Accept for D {}
+
 impl<D: Device> Worker for D {
     fn name(&self) -> String {
         self.describe()
@@ -442,31 +515,52 @@ impl<D: Device> Worker for D {
         };
         share.phases.setup = setup.elapsed();
         let mut rendered: Vec<Range<usize>> = Vec::new();
-        while let Some(band) = queue.take() {
+        // A band is launched, its readback queued behind it, and the band before it collected
+        // while it renders: the device idles only while a band's pixels cross the bus.
+        let mut pending: Option<(usize, usize)> = None;
+        let mut started = 0;
+        let mut next = queue.take();
+        while let Some(band) = next {
+            let slot = started % 2;
             let launch = Instant::now();
-            let ran = match bands.faults.injected(position, share.tiles) {
+            let ran = match bands.faults.injected(position, started) {
                 Some(msg) => Err(self.fault(msg)),
-                None => self.run(&mut frame, job, &[band]),
+                None => self
+                    .submit(&mut frame, job, &[band])
+                    .and_then(|()| self.start_read(&mut frame, job, job.band(band), slot)),
             };
+            started += 1;
             share.phases.launches += launch.elapsed();
-            let read = Instant::now();
-            let read_back = ran
-                .and_then(|()| self.read(&mut frame, job, &[job.band(band)]))
-                .and_then(|p| self.check(&mut frame).map(|()| p));
-            match read_back {
-                Ok(pixels) => {
-                    share.phases.readback += read.elapsed().saturating_sub(pixels.convert);
-                    share.phases.convert += pixels.convert;
-                    share.tiles += 1;
-                    rendered.push(job.band(band));
-                    let _ = bands.events.send((band, pixels));
-                    queue.done();
-                }
-                Err(e) => {
-                    queue.hand_back(band);
-                    share.failure = Some(e.to_string());
+            if let Some((p, p_slot)) = pending.take() {
+                if let Err(e) = self.accept(&mut frame, bands, (p, p_slot), &mut share) {
+                    queue.hand_back(p);
+                    if ran.is_ok() {
+                        queue.hand_back(band);
+                    }
+                    share.failure = Some(e);
                     break;
                 }
+                rendered.push(job.band(p));
+            }
+            if let Err(e) = ran {
+                queue.hand_back(band);
+                share.failure = Some(e.to_string());
+                break;
+            }
+            pending = Some((band, slot));
+            // The next band if one is waiting; else the pending band is collected first, then
+            // whatever comes (a band another device hands back).
+            next = queue.try_take();
+            if next.is_none() {
+                if let Some((p, p_slot)) = pending.take() {
+                    if let Err(e) = self.accept(&mut frame, bands, (p, p_slot), &mut share) {
+                        queue.hand_back(p);
+                        share.failure = Some(e);
+                        break;
+                    }
+                    rendered.push(job.band(p));
+                }
+                next = queue.take();
             }
         }
         // Every band is rendered (or this device failed): the statistics of the bands this

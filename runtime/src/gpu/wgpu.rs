@@ -125,7 +125,17 @@ pub struct FrameBuffers {
     bind: wgpu::BindGroup,
     queries: Option<wgpu::QuerySet>,
     memory: Option<wgpu::ErrorScopeGuard>,
+    /// The reads started into each of [`Buffers::readback`]: the pixels, the copy's
+    /// submission, and the mapping's outcome to come.
+    reading: [Option<Reading>; 2],
 }
+
+/// A read started into a readback buffer ([`launch::Device::start_read`]).
+type Reading = (
+    Range<usize>,
+    wgpu::SubmissionIndex,
+    std::sync::mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>,
+);
 
 impl FrameBuffers {
     /// The frame's finished pixels on the device (binding 5: RGBA8, sRGB-encoded, red in the
@@ -565,6 +575,7 @@ impl Gpu {
                 U::STORAGE | U::COPY_SRC,
             ),
             reduction: None,
+            readback: [None, None],
         }
     }
 
@@ -719,6 +730,36 @@ impl Gpu {
         ))
     }
 
+    /// Waits until submission `index` is done and the mapping it was followed by has
+    /// reported to `mapped` (polling first, as [`Gpu::wait`] does), not for the work
+    /// submitted after it.
+    fn wait_for(
+        &self,
+        index: wgpu::SubmissionIndex,
+        mapped: &std::sync::mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>,
+    ) -> Result<(), Error> {
+        let error = |e: wgpu::PollError| Error::Render(e.to_string());
+        let done =
+            |r: Result<(), wgpu::BufferAsyncError>| r.map_err(|e| Error::Render(e.to_string()));
+        if !self.is_cpu() {
+            let start = Instant::now();
+            while start.elapsed() < SPIN {
+                self.device.poll(wgpu::PollType::Poll).map_err(error)?;
+                if let Ok(r) = mapped.try_recv() {
+                    return done(r);
+                }
+                std::thread::yield_now();
+            }
+        }
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: None,
+            })
+            .map_err(error)?;
+        done(mapped.recv().map_err(|e| Error::Render(e.to_string()))?)
+    }
+
     fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
         self.read_ranges(src, std::slice::from_ref(&(0..size)))
     }
@@ -816,6 +857,9 @@ struct Buffers {
     /// The reduction's partial records and totals, made when a frame's statistics are first
     /// reduced.
     reduction: Option<(wgpu::Buffer, wgpu::Buffer)>,
+    /// Two mappable buffers the finished pixels of a band are copied into while the next band
+    /// renders, made when first used.
+    readback: [Option<wgpu::Buffer>; 2],
 }
 
 fn words(w: &[u32]) -> Vec<u8> {
@@ -882,12 +926,18 @@ impl launch::Device for Kernel<'_> {
             bind,
             queries,
             memory,
+            reading: [None, None],
         })
     }
 
     fn run(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
+        self.submit(f, job, tiles)?;
+        self.gpu.wait()
+    }
+
+    fn submit(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
         let gpu = self.gpu;
-        // Each tile is its own dispatch, in one submission; the host waits for them.
+        // Each tile is its own dispatch, in one submission.
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for &i in tiles {
             let t = job.tiles[i];
@@ -913,7 +963,80 @@ impl launch::Device for Kernel<'_> {
             );
         }
         gpu.queue.submit([enc.finish()]);
-        gpu.wait()
+        Ok(())
+    }
+
+    /// The finished pixels of `range`, copied (in a submission after the launches) into
+    /// readback buffer `slot` and mapped when the copy is done; the linear colours are read at
+    /// [`launch::Device::collect`].
+    fn start_read(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        range: Range<usize>,
+        slot: usize,
+    ) -> Result<(), Error> {
+        if !job.finished {
+            return Ok(());
+        }
+        let gpu = self.gpu;
+        let size = 4 * range.len() as u64;
+        let kept = f.buffers.readback[slot].take();
+        let buffer = kept.filter(|b| b.size() >= size).unwrap_or_else(|| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sdfc band readback"),
+                size: padded(size),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        });
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&f.buffers.pixels, 4 * range.start as u64, &buffer, 0, size);
+        let index = gpu.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        buffer
+            .slice(..size)
+            .map_async(wgpu::MapMode::Read, move |r| {
+                let _ = tx.send(r);
+            });
+        f.buffers.readback[slot] = Some(buffer);
+        f.reading[slot] = Some((range, index, rx));
+        Ok(())
+    }
+
+    fn collect(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        range: Range<usize>,
+        slot: usize,
+    ) -> Result<Pixels, Error> {
+        let reading = f.reading[slot].take();
+        let (Some((at, index, mapped)), Some(buffer)) = (reading, &f.buffers.readback[slot]) else {
+            return self.read(f, job, std::slice::from_ref(&range));
+        };
+        debug_assert_eq!(at, range, "the band read into this slot");
+        // Waits for the copy alone: the launches submitted after it may still run.
+        self.gpu.wait_for(index, &mapped)?;
+        let size = 4 * range.len() as u64;
+        let rgba = {
+            use rayon::prelude::*;
+            let view = buffer
+                .slice(..size)
+                .get_mapped_range()
+                .map_err(|e| Error::Render(e.to_string()))?;
+            let mut out = vec![0u8; view.len()];
+            out.par_chunks_mut(1 << 16)
+                .zip(view.par_chunks(1 << 16))
+                .for_each(|(o, i)| o.copy_from_slice(i));
+            out
+        };
+        buffer.unmap();
+        Ok(Pixels {
+            linear: Vec::new(),
+            rgba,
+            convert: Duration::ZERO,
+        })
     }
 
     fn read(

@@ -354,10 +354,8 @@ impl Kernel<'_> {
         };
         s.memcpy_dtoh(src, &mut pinned)
             .map_err(driver("reading the pixels"))?;
-        let bytes = pinned
-            .as_slice()
-            .map_err(driver("reading the pixels"))?
-            .to_vec();
+        let bytes =
+            super::to_vec_parallel(pinned.as_slice().map_err(driver("reading the pixels"))?);
         if let Ok(mut p) = self.cuda.pinned.lock() {
             *p = Some(pinned);
         }
@@ -546,15 +544,7 @@ impl launch::Device for Kernel<'_> {
         };
         // Waits for the copy alone: the launches queued after it may still run.
         let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
-        let rgba = {
-            use rayon::prelude::*;
-            let src = &bytes[..4 * range.len()];
-            let mut out = vec![0u8; src.len()];
-            out.par_chunks_mut(1 << 16)
-                .zip(src.par_chunks(1 << 16))
-                .for_each(|(o, i)| o.copy_from_slice(i));
-            out
-        };
+        let rgba = super::to_vec_parallel(&bytes[..4 * range.len()]);
         Ok(Pixels {
             linear: Vec::new(),
             rgba,

@@ -649,8 +649,8 @@ pub fn render_several(
             let t = Instant::now();
             let range = job.band(band);
             match job.finished {
-                true => rgba[4 * range.start..4 * range.end].copy_from_slice(&p.rgba),
-                false => linear[range].copy_from_slice(&p.linear),
+                true => super::copy_parallel(&mut rgba[4 * range.start..4 * range.end], &p.rgba),
+                false => super::copy_parallel(&mut linear[range], &p.linear),
             }
             done += 1;
             assembly += t.elapsed();

@@ -313,6 +313,25 @@ fn reduce_bytes(pixels: u64) -> u64 {
     (first as u64 + 2 * second as u64) * record
 }
 
+/// Copies `src` into `dst` (of the same length) on every core of the current thread pool: a
+/// frame's pixels are copied into memory allocated for them, whose pages the first writes
+/// fault in, which on one core holds the copy to about a gigabyte a second (BENCHMARKS.md,
+/// "Several devices").
+pub(crate) fn copy_parallel<T: Copy + Send + Sync>(dst: &mut [T], src: &[T]) {
+    use rayon::prelude::*;
+    let chunk = (1 << 16) / std::mem::size_of::<T>().max(1);
+    dst.par_chunks_mut(chunk)
+        .zip(src.par_chunks(chunk))
+        .for_each(|(o, i)| o.copy_from_slice(i));
+}
+
+/// `src` copied into a new vector by [`copy_parallel`].
+pub(crate) fn to_vec_parallel(src: &[u8]) -> Vec<u8> {
+    let mut out = vec![0u8; src.len()];
+    copy_parallel(&mut out, src);
+    out
+}
+
 /// The bytes of a finished GPU frame: its image.
 pub fn retained(settings: &Settings) -> u64 {
     12 * settings.width as u64 * settings.height as u64

@@ -1020,16 +1020,11 @@ impl launch::Device for Kernel<'_> {
         self.gpu.wait_for(index, &mapped)?;
         let size = 4 * range.len() as u64;
         let rgba = {
-            use rayon::prelude::*;
             let view = buffer
                 .slice(..size)
                 .get_mapped_range()
                 .map_err(|e| Error::Render(e.to_string()))?;
-            let mut out = vec![0u8; view.len()];
-            out.par_chunks_mut(1 << 16)
-                .zip(view.par_chunks(1 << 16))
-                .for_each(|(o, i)| o.copy_from_slice(i));
-            out
+            super::to_vec_parallel(&view)
         };
         buffer.unmap();
         Ok(Pixels {
@@ -1059,11 +1054,7 @@ impl launch::Device for Kernel<'_> {
             // The finished pixels are the bytes to write: copied out as they are.
             let rgba = self.gpu.read_with(&f.buffers.pixels, &bytes(4), |b| {
                 // Copied out by every core, as the linear colours are converted.
-                let mut out = vec![0u8; b.len()];
-                out.par_chunks_mut(1 << 16)
-                    .zip(b.par_chunks(1 << 16))
-                    .for_each(|(o, i)| o.copy_from_slice(i));
-                out
+                super::to_vec_parallel(b)
             })?;
             (Vec::new(), rgba)
         } else {

@@ -5,7 +5,7 @@
 //!
 //! ```text
 //! parse             .sdf text            → ast::File + diagnostics   (logos, chumsky)
-//! check             files (via a Loader) → Scene + diagnostics
+//! check             files (via a Loader) → Scene + diagnostics (the placement warnings too)
 //! analysis::analyse Scene                → exactness and Lipschitz bound per node
 //! Lowered::new      Scene                → Program (flat scalar SSA) and the scene's facts
 //! Evaluator         Program              → distances at batches of points (CPU, f32/f64)
@@ -22,6 +22,7 @@
 mod back;
 mod check;
 mod eval;
+mod front;
 mod limits;
 mod lower;
 mod program;
@@ -45,8 +46,8 @@ pub use crate::{
 /// The front end: parse, format and check `.sdf` text (imports read through a [`Loader`]),
 /// the AST and its dump, and the built-ins table the checker, docs and editors read.
 pub use crate::{
-    check::{builtins, check, check_at, check_str, check_with, check_with_constants},
-    check::{Constant, Loader, NoImports},
+    check::{builtins, Constant, Loader, NoImports},
+    front::{check, check_at, check_str, check_with, check_with_constants},
     syntax::{ast, dump as dump_ast, format, lexer, parse},
 };
 
@@ -56,8 +57,9 @@ pub use crate::scene::{
     analysis, analytic, dump as dump_ir,
     ir::{
         Animation, Camera, Colour, Combine, Exactness, Graph, Light, Material, MaterialId, Method,
-        Node, NodeId, Pattern, Scene, Settings, Smooth, V3,
+        Node, Pattern, Scene, Settings, Smooth, V3,
     },
+    NodeId,
 };
 
 /// The lowering, once per scene: the distance program and what every back end reads of the

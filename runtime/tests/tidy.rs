@@ -1,7 +1,8 @@
 //! The repository's rules, checked over its files (a tidy test):
 //!
 //! - the top-level modules of each crate (`compiler/src`, `runtime/src`) depend on each other
-//!   without cycles, so that each can be read, and tested, on top of the ones below it;
+//!   without cycles, so that each can be read, and tested, on top of the ones below it; and so
+//!   do the modules within each folder of `compiler/src` (siblings, the folder's `mod.rs` aside);
 //! - every Rust file starts with a `//!` line saying what it holds;
 //! - the editor grammar and the reference in `docs/` name every built-in, record field,
 //!   diagnostic code and limit of the compiler;
@@ -136,40 +137,6 @@ fn skip_string(s: &[char], mut i: usize, hashes: usize) -> usize {
     i
 }
 
-/// The first identifiers of the paths at `toks[i..]`: one identifier, or a braced group's
-/// elements (`{a::b, c}` gives a and c).
-fn heads(toks: &[Tok], i: usize) -> Vec<String> {
-    match toks.get(i) {
-        Some(Tok::Ident(name)) => vec![name.clone()],
-        Some(Tok::Punct('{')) => {
-            let mut out = Vec::new();
-            let mut depth = 0;
-            let mut first = true;
-            for t in &toks[i..] {
-                match t {
-                    Tok::Punct('{') => {
-                        depth += 1;
-                    }
-                    Tok::Punct('}') => {
-                        depth -= 1;
-                        if depth == 0 {
-                            break;
-                        }
-                    }
-                    Tok::Punct(',') if depth == 1 => first = true,
-                    Tok::Ident(name) if depth == 1 && first => {
-                        out.push(name.clone());
-                        first = false;
-                    }
-                    _ => first = false,
-                }
-            }
-            out
-        }
-        _ => Vec::new(),
-    }
-}
-
 /// The module path of a source file below `src` (`check/eval.rs` is `[check, eval]`,
 /// `check/mod.rs` and `check.rs` are `[check]`, `lib.rs` is `[]`).
 fn module_path(src: &Path, file: &Path) -> Vec<String> {
@@ -202,10 +169,56 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// The module paths a path names from `toks[i..]` on: its identifiers up to a braced group,
+/// then each of the group's elements in turn (`a::{b::c, d}` gives a::b::c and a::d).
+fn expand(toks: &[Tok], mut i: usize) -> Vec<Vec<String>> {
+    let mut head = Vec::new();
+    loop {
+        match toks.get(i) {
+            Some(Tok::Ident(name)) => {
+                head.push(name.clone());
+                if toks.get(i + 1) != Some(&Tok::Path) {
+                    return vec![head];
+                }
+                i += 2;
+            }
+            Some(Tok::Punct('{')) => {
+                let mut out = Vec::new();
+                let mut depth = 0;
+                let mut start = true;
+                for (j, t) in toks.iter().enumerate().skip(i) {
+                    match t {
+                        Tok::Punct('{') => depth += 1,
+                        Tok::Punct('}') => {
+                            depth -= 1;
+                            if depth == 0 {
+                                break;
+                            }
+                        }
+                        Tok::Punct(',') if depth == 1 => start = true,
+                        _ if depth == 1 && start => {
+                            start = false;
+                            for tail in expand(toks, j) {
+                                out.push(head.iter().cloned().chain(tail).collect());
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                return out;
+            }
+            _ => return vec![head],
+        }
+    }
+}
+
+/// A dependency found in a file: the top-level module it reaches, the path text for the
+/// message, and the module path it names from the crate root.
+type Dependency = (String, String, Vec<String>);
+
 /// The modules declared `#[cfg(test)] mod name;` in a file, and the dependencies of the
-/// file's code outside `#[cfg(test)]` inline modules: (top-level module reached, the path
-/// text for the message).
-fn dependencies(module: &[String], toks: &[Tok]) -> (Vec<String>, Vec<(String, String)>) {
+/// file's code outside `#[cfg(test)]` inline modules.
+fn dependencies(module: &[String], toks: &[Tok]) -> (Vec<String>, Vec<Dependency>) {
     let mut test_files = Vec::new();
     let mut deps = Vec::new();
     // Inline modules open around the current token: (name, brace depth inside, under test).
@@ -264,8 +277,10 @@ fn dependencies(module: &[String], toks: &[Tok]) -> (Vec<String>, Vec<(String, S
             Tok::Ident(k) if k == "crate" && toks.get(i + 1) == Some(&Tok::Path) => {
                 let previous = i.checked_sub(1).map(|j| &toks[j]);
                 if !in_test && previous != Some(&Tok::Punct('$')) {
-                    for h in heads(toks, i + 2) {
-                        deps.push((h.clone(), format!("crate::{h}")));
+                    for path in expand(toks, i + 2) {
+                        if let Some(h) = path.first() {
+                            deps.push((h.clone(), format!("crate::{}", path.join("::")), path));
+                        }
                     }
                 }
                 i += 2;
@@ -285,12 +300,11 @@ fn dependencies(module: &[String], toks: &[Tok]) -> (Vec<String>, Vec<(String, S
                 here.truncate(here.len().saturating_sub(climbed));
                 if !in_test {
                     let text = "super::".repeat(climbed);
-                    match here.first() {
-                        Some(top) => deps.push((top.clone(), format!("{text}…"))),
-                        None => {
-                            for h in heads(toks, j) {
-                                deps.push((h.clone(), format!("{text}{h}")));
-                            }
+                    for tail in expand(toks, j) {
+                        let path: Vec<String> = here.iter().cloned().chain(tail).collect();
+                        if let Some(top) = path.first() {
+                            let named = format!("{text}{}", path[here.len()..].join("::"));
+                            deps.push((top.clone(), named, path));
                         }
                     }
                 }
@@ -304,14 +318,23 @@ fn dependencies(module: &[String], toks: &[Tok]) -> (Vec<String>, Vec<(String, S
     (test_files, deps)
 }
 
-/// The graph of a crate's top-level modules: for each, the modules it uses, with one
-/// example of where (file and path).
-fn graph(src: &Path) -> BTreeMap<String, BTreeMap<String, String>> {
+/// Which modules use which: for each module, the modules it uses, with one example of where
+/// (file and path).
+type Graph = BTreeMap<String, BTreeMap<String, String>>;
+
+/// The graphs of a crate's modules, one per folder, by the folder's module path (the crate
+/// root's is `[]`): an edge from a module of the folder to a sibling it names (the code of
+/// files below the module included, the folder's own `mod.rs` left out).
+fn graphs(src: &Path) -> BTreeMap<Vec<String>, Graph> {
     let mut files = Vec::new();
     rust_files(src, &mut files);
-    let tops: BTreeSet<String> = files
+    // Every module a file makes, with the modules above it.
+    let modules: BTreeSet<Vec<String>> = files
         .iter()
-        .filter_map(|f| module_path(src, f).first().cloned())
+        .flat_map(|f| {
+            let m = module_path(src, f);
+            (1..=m.len()).map(move |n| m[..n].to_vec())
+        })
         .collect();
     // Files declared under #[cfg(test)], by module path.
     let mut test_modules: BTreeSet<Vec<String>> = BTreeSet::new();
@@ -327,28 +350,40 @@ fn graph(src: &Path) -> BTreeMap<String, BTreeMap<String, String>> {
         }
         parsed.push((file, module, deps));
     }
-    let mut out: BTreeMap<String, BTreeMap<String, String>> = BTreeMap::new();
+    let mut out: BTreeMap<Vec<String>, Graph> = BTreeMap::new();
     for (file, module, deps) in parsed {
-        let Some(top) = module.first() else {
-            continue;
-        };
         if (1..=module.len()).any(|n| test_modules.contains(&module[..n])) {
             continue;
         }
-        let entry = out.entry(top.clone()).or_default();
-        for (to, text) in deps {
-            if &to != top && tops.contains(&to) {
-                let at = file.strip_prefix(src).expect("below src").display();
-                entry.entry(to).or_insert(format!("{at}: {text}"));
+        for (_, text, path) in deps {
+            // The folder both are in, and the siblings under it that each is or is inside.
+            let k = module.iter().zip(&path).take_while(|(a, b)| a == b).count();
+            let (Some(from), Some(to)) = (module.get(k), path.get(k)) else {
+                continue;
+            };
+            if !modules.contains(&path[..=k]) {
+                continue;
             }
+            let at = file.strip_prefix(src).expect("below src").display();
+            out.entry(module[..k].to_vec())
+                .or_default()
+                .entry(from.clone())
+                .or_default()
+                .entry(to.clone())
+                .or_insert(format!("{at}: {text}"));
         }
     }
     out
 }
 
+/// The graph of a crate's top-level modules.
+fn graph(src: &Path) -> Graph {
+    graphs(src).remove(&Vec::new()).unwrap_or_default()
+}
+
 /// The cycles of a graph: for each strongly connected component of more than one module,
 /// one cycle through it, as the list of edges with where each is.
-fn cycles(graph: &BTreeMap<String, BTreeMap<String, String>>) -> Vec<Vec<String>> {
+fn cycles(graph: &Graph) -> Vec<Vec<String>> {
     let reach = |from: &str| {
         let mut seen = BTreeSet::new();
         let mut stack = vec![from.to_string()];
@@ -435,6 +470,31 @@ fn the_runtimes_modules_have_no_cycles() {
     check_crate("runtime");
 }
 
+/// Folders of `compiler/src` whose modules may use each other, and why.
+const FOLDER_CYCLES_ALLOWED: &[(&str, &str)] = &[];
+
+#[test]
+fn the_modules_of_each_compiler_folder_have_no_cycles() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../compiler/src");
+    let all = graphs(&src);
+    assert!(all.len() > 5, "too few folders found in {}", src.display());
+    let mut found = Vec::new();
+    for (folder, graph) in all.iter().filter(|(f, _)| !f.is_empty()) {
+        let name = folder.join("/");
+        if FOLDER_CYCLES_ALLOWED.iter().any(|(f, _)| *f == name) {
+            continue;
+        }
+        for cycle in cycles(graph) {
+            found.push(format!("{name}/:\n  {}", cycle.join("\n  ")));
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "modules of a folder of compiler/src depend on each other in cycles:\n{}",
+        found.join("\n\n")
+    );
+}
+
 #[test]
 fn the_scanner_finds_paths_and_cycles() {
     let toks = tokens(
@@ -446,7 +506,13 @@ fn the_scanner_finds_paths_and_cycles() {
     let (_, deps) = dependencies(&["m".into()], &toks);
     let found: Vec<&str> = deps.iter().map(|d| d.0.as_str()).collect();
     assert_eq!(found, ["a", "b", "e", "k"]);
-    let mut g: BTreeMap<String, BTreeMap<String, String>> = BTreeMap::new();
+    let paths: Vec<String> = deps.iter().map(|d| d.2.join("::")).collect();
+    assert_eq!(paths, ["a::X", "b", "e::g", "k"]);
+    let toks = tokens("use super::{x::{Y, z::W}, v}; use crate::p::q;");
+    let (_, deps) = dependencies(&["f".into(), "m".into()], &toks);
+    let paths: Vec<String> = deps.iter().map(|d| d.2.join("::")).collect();
+    assert_eq!(paths, ["f::x::Y", "f::x::z::W", "f::v", "p::q"]);
+    let mut g: Graph = BTreeMap::new();
     for (from, to) in [("a", "b"), ("b", "c"), ("c", "a"), ("c", "d")] {
         g.entry(from.into())
             .or_default()

@@ -170,7 +170,7 @@ pub struct Build<'a, 'l> {
     pub graph: &'a mut Graph,
     pub span: Span,
     /// The files `mesh(path)` reads (none: no file can be read).
-    pub files: Option<&'a mut super::eval::Files<'l>>,
+    pub files: Option<&'a mut super::Files<'l>>,
     pub limits: &'a Limits,
     pub warnings: Vec<crate::diagnostics::Diagnostic>,
 }
@@ -459,10 +459,10 @@ fn crossing(v: &[[f64; 2]]) -> Option<(usize, usize)> {
     None
 }
 
-/// The rectangle of a profile argument and its bound's scale (`lower::bounds::profile_rect`),
+/// The rectangle of a profile argument and its bound's scale (`scene::bounds::profile_rect`),
 /// or why it has none.
 fn rect_of(b: &Build, v: &Value, what: &str) -> Result<([f64; 2], [f64; 2], f64), String> {
-    crate::lower::bounds::profile_rect(b.graph, sh(v)).ok_or_else(|| {
+    crate::scene::bounds::profile_rect(b.graph, sh(v)).ok_or_else(|| {
         format!("the {what} profile has no finite extent (it reaches infinity), so it cannot be made solid this way")
     })
 }

@@ -9,7 +9,6 @@ use super::suggest::{closest, closest_in_order};
 use super::types::{Type, Value};
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
-use crate::program::mesh::TriMesh;
 use crate::scene::{Graph, MaterialId, Node};
 use crate::span::Span;
 use crate::syntax::ast::*;
@@ -34,37 +33,12 @@ pub struct FnInfo {
 /// multiple of the `nesting` limit: chains are not nesting, but they recurse all the same.
 pub const CHAIN_FACTOR: usize = 10;
 
-/// The files `mesh(path)` reads, through the caller's loader, and the meshes read so far.
-#[derive(Default)]
-pub struct Files<'l> {
-    /// The caller's loader (none: no file can be read).
-    pub loader: Option<&'l mut dyn super::Loader>,
-    /// The name of each source file, by `FileId` (a path is relative to its file's).
-    pub names: Vec<String>,
-    /// The meshes built, by file name and scale's bits: a file used twice is read once.
-    pub meshes: HashMap<(String, u64), std::sync::Arc<TriMesh>>,
-    /// The next mesh's id, and where its data starts in `scene_data` (16-byte vectors).
-    pub next_id: u32,
-    pub next_base: u64,
-    /// Triangles of every mesh so far (the `triangles` limit bounds their sum).
-    pub triangles: u64,
-}
-
-impl std::fmt::Debug for Files<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        f.debug_struct("Files")
-            .field("names", &self.names)
-            .field("meshes", &self.meshes.len())
-            .finish()
-    }
-}
-
 /// The evaluation state of one compilation.
 #[derive(Debug, Default)]
 pub struct Ctx<'l> {
     pub diags: Vec<Diagnostic>,
     /// The files `mesh(path)` reads.
-    pub files: Files<'l>,
+    pub files: super::Files<'l>,
     pub graph: Graph,
     pub material_ids: HashMap<String, (MaterialId, Span)>,
     pub globals: HashMap<String, (Value, Span)>,
@@ -77,8 +51,8 @@ pub struct Ctx<'l> {
     /// The settings the render block gives (a field with no proven bound has defaults of its
     /// own for `epsilon` and `relaxation`).
     pub settings_given: Vec<String>,
-    /// Where the camera, the lights and the scene are written (`placement.rs`).
-    pub places: super::placement::Places,
+    /// Where the camera, the lights and the scene are written (for the placement warnings).
+    pub places: super::Places,
     locals: Vec<(String, Value)>,
     dry: u32,
     depth: usize,
@@ -950,7 +924,7 @@ impl Ctx<'_> {
         }
         self.fields += 1;
         let owner = self.fields;
-        let coord = |i: u8| std::rc::Rc::new(field::Sx::Coord(i, owner));
+        let coord = |i: u8| std::rc::Rc::new(super::types::Sx::Coord(i, owner));
         let mark = self.locals.len();
         self.locals
             .push(("p".into(), field::point(vec![coord(0), coord(1), coord(2)])));
@@ -1988,7 +1962,9 @@ pub fn record(
                 Value::Error
             }
         };
-        super::placement::colour(cx, rec.name, p.name, &v, f.value.span);
+        if let Some(d) = super::colour::warning(rec.name, p.name, &v, f.value.span) {
+            cx.error(d);
+        }
         if !v.is_abstract() {
             if let Err(why) = p.range.check(&v, &cx.limits) {
                 let mut d = Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span)

@@ -4,37 +4,11 @@
 //! flat [`FieldFn`] of a field shape. Everything else still needs constants: a per-point
 //! value where one is needed is error E0410.
 
-use super::types::Value;
+use super::types::{Sx, Value};
 use crate::scene::field::{FBin, FOp, FUn, FieldFn, Slot};
-use crate::scene::NodeId;
 use crate::syntax::ast::{BinOp, UnOp};
 use std::collections::HashMap;
-use std::fmt;
 use std::rc::Rc;
-
-/// One scalar of a per-point value: an expression tree whose shared parts are shared `Rc`s.
-#[derive(Clone, PartialEq)]
-pub enum Sx {
-    /// A coordinate of the point of field number `.1` (fields nest).
-    Coord(u8, u32),
-    Const(f64),
-    Un(FUn, Rc<Sx>),
-    Bin(FBin, Rc<Sx>, Rc<Sx>),
-    Length(Vec<Rc<Sx>>),
-    Distance(NodeId, [Rc<Sx>; 3]),
-    Noise(Vec<Rc<Sx>>),
-    Voronoi(Vec<Rc<Sx>>),
-}
-
-impl fmt::Debug for Sx {
-    /// Only the kind: a tree with shared parts printed in full could be exponentially long.
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str("<per-point>")
-    }
-}
-
-/// The components of a per-point value (1: float, 2: vec2, 3: vec3).
-pub type Comps = Rc<[Rc<Sx>]>;
 
 /// The constant `c` as an expression.
 fn k(c: f64) -> Rc<Sx> {

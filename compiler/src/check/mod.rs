@@ -6,12 +6,12 @@
 //! evaluate items in source order, and the scene last.
 
 pub mod builtins;
+mod colour;
 mod eval;
 pub mod field;
 pub mod font;
 pub mod meshfile;
 mod ops;
-mod placement;
 mod suggest;
 pub mod types;
 
@@ -41,6 +41,31 @@ pub trait Loader {
     }
 }
 
+/// The files `mesh(path)` reads, through the caller's loader, and the meshes read so far.
+#[derive(Default)]
+pub struct Files<'l> {
+    /// The caller's loader (none: no file can be read).
+    pub loader: Option<&'l mut dyn Loader>,
+    /// The name of each source file, by `FileId` (a path is relative to its file's).
+    pub names: Vec<String>,
+    /// The meshes built, by file name and scale's bits: a file used twice is read once.
+    pub meshes: HashMap<(String, u64), std::sync::Arc<crate::program::mesh::TriMesh>>,
+    /// The next mesh's id, and where its data starts in `scene_data` (16-byte vectors).
+    pub next_id: u32,
+    pub next_base: u64,
+    /// Triangles of every mesh so far (the `triangles` limit bounds their sum).
+    pub triangles: u64,
+}
+
+impl std::fmt::Debug for Files<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.debug_struct("Files")
+            .field("names", &self.names)
+            .field("meshes", &self.meshes.len())
+            .finish()
+    }
+}
+
 /// A loader for sources with no imports: every import is an error.
 #[derive(Debug, Default)]
 pub struct NoImports;
@@ -49,40 +74,6 @@ impl Loader for NoImports {
     fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), String> {
         Err(format!("imports are not available here (`{path}`)"))
     }
-}
-
-/// Checks the file `entry` of `sources` and everything it imports (added to `sources`),
-/// within the default [`Limits`]. Returns the scene when there are no errors, and all
-/// diagnostics.
-pub fn check(
-    sources: &mut SourceMap,
-    entry: FileId,
-    loader: &mut dyn Loader,
-) -> (Option<Scene>, Vec<Diagnostic>) {
-    check_with(sources, entry, loader, &Limits::default())
-}
-
-/// [`check`] within the given limits (`--limit`), at the time 0.
-pub fn check_with(
-    sources: &mut SourceMap,
-    entry: FileId,
-    loader: &mut dyn Loader,
-    limits: &Limits,
-) -> (Option<Scene>, Vec<Diagnostic>) {
-    check_at(sources, entry, loader, limits, 0.0)
-}
-
-/// [`check_with`] at the time `t` = `time` seconds: the scene of the frame at that time
-/// (docs/animation.md). Its [`Scene::animation`] says whether anything read `t`.
-pub fn check_at(
-    sources: &mut SourceMap,
-    entry: FileId,
-    loader: &mut dyn Loader,
-    limits: &Limits,
-    time: f64,
-) -> (Option<Scene>, Vec<Diagnostic>) {
-    let (scene, diags, _) = check_all(sources, entry, loader, limits, time);
-    (scene, diags)
 }
 
 /// The value of a global constant, as an editor's hover shows it.
@@ -97,24 +88,32 @@ pub struct Constant {
     pub ty: String,
 }
 
-/// [`check_with`], with the values of the global constants that evaluated to a number,
-/// vector, angle, bool, string or list of them (not shapes: their facts are the analysis's),
-/// even when the scene has errors elsewhere.
-pub fn check_with_constants(
-    sources: &mut SourceMap,
-    entry: FileId,
-    loader: &mut dyn Loader,
-    limits: &Limits,
-) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
-    check_all(sources, entry, loader, limits, 0.0)
+/// Where the parts of a scene that have a position were written, for the warnings' spans.
+#[derive(Debug, Default)]
+pub struct Places {
+    /// The camera's `position` (its value, or the `camera` keyword when it is left out);
+    /// `None` without a `camera` block.
+    pub camera: Option<Span>,
+    /// Per light of `Scene::lights`, in order: its `position` value, or its kind.
+    pub lights: Vec<Span>,
+    /// The `scene` keyword.
+    pub scene: Option<Span>,
 }
 
-fn check_all(
+/// The warnings of the passes after the checker, given a scene without errors and where its
+/// parts were written; the front end passes the placement warnings (`front/placement.rs`).
+pub type After<'a> = &'a dyn Fn(&Scene, &Places) -> Vec<Diagnostic>;
+
+/// Checks the file `entry` of `sources` and everything it imports (added to `sources`),
+/// within `limits`, at the time `time`: the scene when there are no errors, all diagnostics
+/// in source order (those of `after` too), and the values of the global constants.
+pub fn check_files(
     sources: &mut SourceMap,
     entry: FileId,
     loader: &mut dyn Loader,
     limits: &Limits,
     time: f64,
+    after: After,
 ) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
     let mut diags = Vec::new();
     let mut items = Vec::new();
@@ -132,16 +131,16 @@ fn check_all(
     let names = (0..sources.len() as u32)
         .map(|f| sources.name(FileId(f)).to_string())
         .collect();
-    let files = eval::Files {
+    let files = Files {
         loader: Some(loader),
         names,
-        ..eval::Files::default()
+        ..Files::default()
     };
     // The checker's walks of the syntax tree, and of the scene built from it, recurse as
     // deeply as the files nest (within the `nesting` limit the parser enforced): they run on
     // a stack that fits, and so does the drop of the tree.
     crate::syntax::with_stack_for(depth, move || {
-        check_loaded(entry, limits, time, diags, items, files)
+        check_loaded(entry, limits, time, diags, items, files, after)
     })
 }
 
@@ -152,7 +151,8 @@ fn check_loaded(
     time: f64,
     mut diags: Vec<Diagnostic>,
     items: Vec<ast::Item>,
-    files: eval::Files,
+    files: Files,
+    after: After,
 ) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
     if crate::diagnostics::has_errors(&diags) {
         // After a lexical, syntax or import error, names and items may be missing: checking
@@ -198,8 +198,10 @@ fn check_loaded(
         analytic_method(&mut cx, &scene);
     }
     if !crate::diagnostics::has_errors(&cx.diags) {
-        // Where the camera and lights stand, and whether there are any lights.
-        placement::placement(&mut cx, &scene);
+        // The passes after the checker: where the camera and lights stand, and whether
+        // there are any lights.
+        let places = std::mem::take(&mut cx.places);
+        cx.diags.extend(after(&scene, &places));
     }
     // Diagnostics in source order, whatever stage found them.
     cx.diags.sort_by_key(|d| (d.span().file, d.span().start));
@@ -243,14 +245,6 @@ fn analytic_method(cx: &mut Ctx, scene: &Scene) {
         other => d.with_note(other.describe()),
     };
     cx.error(d);
-}
-
-/// Checks a single source text that imports nothing (for tests and tools).
-pub fn check_str(name: &str, text: &str) -> (Option<Scene>, Vec<Diagnostic>, SourceMap) {
-    let mut sources = SourceMap::new();
-    let entry = sources.add(name, text);
-    let (scene, diags) = check(&mut sources, entry, &mut NoImports);
-    (scene, diags, sources)
 }
 
 /// The files of one compilation being read: parsed in place of their imports, depth

@@ -1,6 +1,6 @@
 //! Unit tests of constant evaluation and of the checker's diagnostics.
 
-use super::check_str;
+use crate::front::check_str;
 use crate::scene::{Light, Node};
 
 fn ok(src: &str) -> crate::scene::Scene {
@@ -131,7 +131,7 @@ fn within(
 ) -> Vec<crate::Diagnostic> {
     let mut sources = crate::SourceMap::new();
     let entry = sources.add("t.sdf", src);
-    super::check_with(&mut sources, entry, &mut Files(files), limits).1
+    crate::front::check_with(&mut sources, entry, &mut Files(files), limits).1
 }
 
 #[test]
@@ -360,7 +360,7 @@ fn lists_are_bounded_by_the_objects_limit() {
     let src = "scene { union([for i in 0..11 { sphere(1).translate(i, 0, 0) }]); }";
     let mut sources = crate::span::SourceMap::new();
     let entry = sources.add("t.sdf", src);
-    let (_, diags) = super::check_with(&mut sources, entry, &mut super::NoImports, &limits);
+    let (_, diags) = crate::front::check_with(&mut sources, entry, &mut super::NoImports, &limits);
     assert!(diags.iter().any(|d| d.code == "E0507"), "{diags:#?}");
 }
 
@@ -492,7 +492,7 @@ fn constants_are_returned_with_their_values_even_beside_errors() {
                 let s = \"po\\\"ly\";\nlet l = [for i in 0..20 { i * i }];\nlet b = sphere(1);\n\
                 let ok = r > 5;\nscene { sphre(r); }";
     let entry = sources.add("t.sdf", text);
-    let (scene, diags, constants) = super::check_with_constants(
+    let (scene, diags, constants) = crate::front::check_with_constants(
         &mut sources,
         entry,
         &mut super::NoImports,

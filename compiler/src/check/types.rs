@@ -1,5 +1,7 @@
-//! Types and constant values of the language.
+//! Types and constant values of the language, and the per-point values of a `field` (`Sx`
+//! expressions, built by `field.rs`).
 
+use crate::scene::field::{FBin, FUn};
 use crate::scene::NodeId;
 use std::fmt;
 use std::rc::Rc;
@@ -136,7 +138,7 @@ pub enum Value {
     Colour(Rc<crate::scene::field::FieldFn>),
     /// A number or vector that depends on the point `p` of a `field` (1, 2 or 3 components):
     /// an expression evaluated per point, not a constant.
-    Point(super::field::Comps),
+    Point(Comps),
     Unknown(Type),
     Error,
 }
@@ -285,3 +287,27 @@ impl fmt::Display for Value {
         }
     }
 }
+
+/// One scalar of a per-point value: an expression tree whose shared parts are shared `Rc`s.
+#[derive(Clone, PartialEq)]
+pub enum Sx {
+    /// A coordinate of the point of field number `.1` (fields nest).
+    Coord(u8, u32),
+    Const(f64),
+    Un(FUn, Rc<Sx>),
+    Bin(FBin, Rc<Sx>, Rc<Sx>),
+    Length(Vec<Rc<Sx>>),
+    Distance(NodeId, [Rc<Sx>; 3]),
+    Noise(Vec<Rc<Sx>>),
+    Voronoi(Vec<Rc<Sx>>),
+}
+
+impl fmt::Debug for Sx {
+    /// Only the kind: a tree with shared parts printed in full could be exponentially long.
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("<per-point>")
+    }
+}
+
+/// The components of a per-point value (1: float, 2: vec2, 3: vec3).
+pub type Comps = Rc<[Rc<Sx>]>;

@@ -862,7 +862,7 @@ fn fused_loop<T: Float>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::check_str;
+    use crate::front::check_str;
     use crate::lower::lower;
 
     /// The registers block `b` of `c`'s program reads from before it, found the slow way:

@@ -78,7 +78,7 @@ pub fn verify_fields(scene: &Scene, pairs: usize, reach: f64) -> Vec<Violation> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::check_str;
+    use crate::front::check_str;
     use crate::lower::lower;
     use crate::scene::analysis::analyse;
 

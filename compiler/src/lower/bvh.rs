@@ -2,7 +2,7 @@
 //! heuristic until splitting no longer pays, each half's bound the hull of its children's. The half nearer the camera comes first, so that the best distance
 //! shrinks early for the points nearest the eye.
 
-use super::bounds::{hull, Bound};
+use crate::scene::bounds::{hull, Bound};
 use crate::scene::{NodeId, V3};
 
 /// Instructions a union spends per child after evaluating it (min, lt, select).

@@ -7,11 +7,11 @@
 //! runs only where its bounding volume is nearer than the best distance so far (see
 //! `docs/optimisation.md` for why the result is the same).
 
-use super::bounds::{Aabb, Bound, Bounds};
 use super::builder::{Builder, P};
 use super::bvh::{self, Kind, Tree};
 use super::{blends, field, shapes, Binary, Reg, Unary, EMPTY_DISTANCE};
 use crate::scene::analysis::{self, Analysis, Window};
+use crate::scene::bounds::{Aabb, Bound, Bounds};
 use crate::scene::field::{FOp, FieldFn};
 use crate::scene::{Combine, Feature, Graph, Node, NodeId, Smooth, V3};
 use glam::DVec3;

@@ -13,10 +13,10 @@
 //! (which exact culling needs). The ellipsoid's field is only a bound, so an ellipsoid stays
 //! in the rest.
 
-use super::bounds::Bounds;
 use super::builder::{Builder, Param};
 use super::{lower_simple, shapes, LowerOptions, Program, Simplified};
 use crate::scene::analysis::Analysis;
+use crate::scene::bounds::Bounds;
 use crate::scene::{Combine, Exactness, Graph, MaterialId, Node, NodeId, V3};
 
 /// One instance: `shape` evaluated at `rotate(p) − offset`.
@@ -185,7 +185,7 @@ mod tests {
     use crate::scene::Scene;
 
     fn scene(text: &str) -> Scene {
-        let (scene, diags, _) = crate::check::check_str("split.sdf", text);
+        let (scene, diags, _) = crate::front::check_str("split.sdf", text);
         scene.unwrap_or_else(|| panic!("{diags:?}"))
     }
 

@@ -11,8 +11,8 @@
 //! inside the glass, whichever comes first; and `solid = O` with its materials, which tells
 //! which of the two the ray reached, and the solid's normal and material there.
 
-use super::bounds::Bounds;
 use super::{lower, Program};
+use crate::scene::bounds::Bounds;
 use crate::scene::{Combine, MaterialId, Node, NodeId, Scene};
 use std::collections::HashMap;
 

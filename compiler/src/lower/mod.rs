@@ -8,7 +8,6 @@
 //! literally.
 
 mod blends;
-pub(crate) mod bounds;
 mod builder;
 mod bvh;
 mod field;
@@ -32,6 +31,7 @@ use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::scene::analysis::{self, Analysis};
 use crate::scene::analytic::{traceable, Choice, Traceable};
+use crate::scene::bounds::Bounds;
 use crate::scene::{Graph, NodeId, Scene, Settings};
 use std::time::{Duration, Instant};
 
@@ -177,7 +177,7 @@ struct Simplified {
     /// The analysis of `scene`.
     analysis: Analysis,
     /// The bounds of `scene`'s nodes.
-    bounds: bounds::Bounds,
+    bounds: Bounds,
 }
 
 /// Lowers a checked scene for rendering ([`Lowered`]) with the given options.
@@ -324,7 +324,7 @@ fn lower_simple(
                 lipschitz = analysis.step_lipschitz();
             }
             phases.lap("analysis", "exactness and Lipschitz bounds of every node");
-            let bounds = bounds::Bounds::new(&simple_scene.graph);
+            let bounds = Bounds::new(&simple_scene.graph);
             phases.lap("bounds", "the bounding volume of every node");
             let config = graph::Config {
                 cull: options.cull,

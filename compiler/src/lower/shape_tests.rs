@@ -13,7 +13,7 @@ use crate::scene::analysis::analyse;
 /// The lowered program of `scene { <shape>; }` and the L the analysis records for it.
 fn program(shape: &str) -> (Program, f64) {
     let src = format!("scene {{ {shape}; }}");
-    let (scene, diags, _) = crate::check::check_str("t.sdf", &src);
+    let (scene, diags, _) = crate::front::check_str("t.sdf", &src);
     assert!(diags.iter().all(|d| !d.is_error()), "{shape}: {diags:#?}");
     let scene = scene.expect("scene");
     let l = analyse(&scene).root().expect("root").facts.lipschitz;
@@ -518,7 +518,7 @@ fn bad_profiles_are_located_errors() {
         ("circle(1)", "make it a shape with `extrude", "circle"),
     ] {
         let text = format!("scene {{ {src}; }}");
-        let (_, diags, _) = crate::check::check_str("t.sdf", &text);
+        let (_, diags, _) = crate::front::check_str("t.sdf", &text);
         let error = diags
             .iter()
             .find(|d| d.is_error())
@@ -550,7 +550,7 @@ fn within_l(shape: &str, r: f64) -> (f64, f64) {
     let (_, l) = program(shape);
     // The field as written: with local bounds the program would be divided by L already.
     let src = format!("scene {{ {shape}; }}");
-    let scene = crate::check::check_str("t.sdf", &src).0.expect("scene");
+    let scene = crate::front::check_str("t.sdf", &src).0.expect("scene");
     let options = super::LowerOptions {
         local: false,
         ..super::LowerOptions::default()
@@ -697,7 +697,7 @@ fn bad_lofts_and_screws_are_located_errors() {
         ),
     ] {
         let text = format!("scene {{ {src}; }}");
-        let (_, diags, _) = crate::check::check_str("t.sdf", &text);
+        let (_, diags, _) = crate::front::check_str("t.sdf", &text);
         let error = diags
             .iter()
             .find(|d| d.is_error())
@@ -810,7 +810,7 @@ fn an_inset_is_exact_inside_and_a_bound_outside() {
     let (q, _) = program("extrude(rect(0.4), 100)");
     assert_eq!(l, 1.0);
     let src = "scene { extrude(offset(rect(0.5), -0.1), 100); }";
-    let scene = crate::check::check_str("t.sdf", src).0.expect("scene");
+    let scene = crate::front::check_str("t.sdf", src).0.expect("scene");
     let facts = analyse(&scene).root().expect("root").facts;
     assert_eq!(facts.exactness, crate::scene::Exactness::Bound);
     let mut rng = Rng::new(3);
@@ -841,7 +841,7 @@ let holes = union(circle(0.1).translate(0.6, -0.45), circle(0.1).translate(-0.6,
 let o = subtract(offset(l, 0.08), holes);
 scene { union(extrude(o, 0.2), loft(o, offset(o, -0.05), 0.05).translate(0, 0, 0.125),
               loft(offset(o, -0.05), o, 0.05).translate(0, 0, -0.125)).rotate_x(90deg); }";
-    let scene = crate::check::check_str("t.sdf", src).0.expect("scene");
+    let scene = crate::front::check_str("t.sdf", src).0.expect("scene");
     let culled = super::lower(&scene);
     // Over the long arm, where the tie was.
     assert!(f(&culled, [0.5, 0.3, -0.45]) < 1.0);

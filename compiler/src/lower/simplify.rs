@@ -16,7 +16,7 @@
 //!   repeated children are dropped; paint on a shape painted everywhere is dropped.
 //! - A smooth combination with k ≤ 0 is the plain combination.
 
-use crate::scene::{Combine, Graph, MaterialId, Node, NodeId, V3};
+use crate::scene::{mat_vec, Combine, Graph, MaterialId, Node, NodeId, V3};
 use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 
@@ -604,9 +604,4 @@ fn close(a: V3, b: V3) -> bool {
 
 fn mat_mul(a: &[V3; 3], b: &[V3; 3]) -> [V3; 3] {
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
-}
-
-/// The product of the matrix `m` (rows) and `v`.
-pub(super) fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
-    [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
 }

@@ -2,10 +2,10 @@
 //! nodes, the field the lowering computes is never below the guard distance of the node's
 //! bound, at random points near and far (in f64 and in f32).
 
-use super::bounds::Bounds;
 use super::graph::field_and_bound;
 use crate::program::{Float, Program};
 use crate::rng::Rng;
+use crate::scene::bounds::Bounds;
 use crate::scene::{Combine, Feature, Graph, MaterialId, Node, NodeId, Smooth};
 use crate::{FileId, Span};
 
@@ -332,7 +332,7 @@ fn lowering_stops_at_the_program_limit() {
         ));
     }
     text.push_str("scene { f12(); }");
-    let (scene, diags, _) = crate::check::check_str("many.sdf", &text);
+    let (scene, diags, _) = crate::front::check_str("many.sdf", &text);
     let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let options = super::LowerOptions::default();
     let (whole, over, _) =
@@ -421,7 +421,7 @@ fn the_walks_shape_programs_are_the_lowerings_rules() {
 
 /// The distance of a checked scene's program at `p`, in f64.
 fn distance_of(src: &str) -> impl Fn([f64; 3]) -> f64 {
-    let (scene, diags, _) = crate::check::check_str("t.sdf", src);
+    let (scene, diags, _) = crate::front::check_str("t.sdf", src);
     assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
     let program = super::lower(&scene.expect("a scene"));
     move |p| eval::<f64>(&program, p).0

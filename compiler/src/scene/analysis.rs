@@ -14,7 +14,8 @@
 //! a repetition whose copies overlap their cells) L is the best guess, and
 //! [`Derived::proven`] is false.
 
-use super::ir::{Combine, Exactness, Facts, Feature, Node, NodeId, Scene, Smooth, V3};
+use super::ir::{Combine, Exactness, Facts, Feature, Node, Scene, Smooth, V3};
+use super::NodeId;
 use crate::diagnostics::Diagnostic;
 use std::collections::HashSet;
 

@@ -7,7 +7,8 @@
 //! budget and no ε. The CPU renderer and the WGSL kernel (so also PTX) both trace the list of
 //! [`Primitive`]s this module produces (docs/rendering.md, "Analytic ray tracing").
 
-use super::ir::{Combine, MaterialId, Method, Node, NodeId, Scene, V3};
+use super::ir::{Combine, MaterialId, Method, Node, Scene, V3};
+use super::NodeId;
 use crate::limits::Limit;
 use crate::span::Span;
 

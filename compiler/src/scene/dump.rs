@@ -1,6 +1,7 @@
 //! A stable text dump of a scene (`sdfc compile --emit ir`, snapshot tests).
 
 use super::ir::*;
+use super::NodeId;
 use std::fmt::Write;
 
 /// Dumps a scene: settings, camera, lights, materials, then every node reachable from the root

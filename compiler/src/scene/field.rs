@@ -4,7 +4,7 @@
 //! into their components, constants folded); the lowering turns each operation into program
 //! instructions (`lower/field.rs`); the analysis bounds its gradient (`analysis/field.rs`).
 
-use super::ir::NodeId;
+use super::NodeId;
 
 /// Names an operation of a [`FieldFn`] by its index: the value it defines.
 pub type Slot = u32;

@@ -5,6 +5,7 @@
 //! a sub-shape used twice is one node. Computed facts (bounds, Lipschitz bound, exactness) are
 //! kept in side tables keyed by `NodeId` ([`Facts`]), next to the spans.
 
+use super::NodeId;
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::span::Span;
@@ -14,9 +15,10 @@ use std::collections::HashMap;
 /// A 3-vector of f64.
 pub type V3 = [f64; 3];
 
-/// Names a node of a [`Graph`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct NodeId(pub u32);
+/// The product of the matrix `m` (rows) and `v`.
+pub fn mat_vec(m: &[V3; 3], v: V3) -> V3 {
+    [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+}
 
 /// Names a material of a [`Scene`]; 0 is the default material.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -257,7 +259,7 @@ pub enum Node {
     /// A profile swept along a helix about the y axis, like a revolved one (the profile's x is
     /// the distance from the axis) rising `pitch` per turn, repeated every pitch and cut to
     /// |y| ≤ half_height. `inner` is the least x of the profile's box (> 0) and `floor` the
-    /// scale of its bound (`lower/bounds.rs`): near the axis the field is
+    /// scale of its bound (`scene/bounds.rs`): near the axis the field is
     /// floor·max(inner - r, r), below the profile's own (docs/analysis.md, "Screw").
     Screw {
         pitch: f64,

@@ -1,7 +1,10 @@
-//! The scene IR and its text dump.
+//! The scene IR (`ir.rs`, with the programs of user fields in `field.rs`), its text dump, its
+//! analysis and whether it is traced analytically. [`NodeId`], the handle of a shape node,
+//! is defined here: the IR's nodes and the fields' programs both name nodes by it.
 
 pub mod analysis;
 pub mod analytic;
+pub mod bounds;
 mod dump;
 pub mod field;
 pub mod ir;
@@ -9,3 +12,7 @@ pub mod recentre;
 
 pub use dump::{dump, num as dump_num};
 pub use ir::*;
+
+/// Names a node of a [`Graph`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(pub u32);

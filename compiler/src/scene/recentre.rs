@@ -10,7 +10,8 @@
 //! offset, a plane's height), so no precision is lost on the way. Patterns keep their place
 //! in the world through [`Scene::origin`].
 
-use super::ir::{Light, Node, NodeId, Scene, V3};
+use super::ir::{Light, Node, Scene, V3};
+use super::NodeId;
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -83,8 +84,8 @@ fn moved(scene: &mut Scene, id: NodeId, c: V3, memo: &mut HashMap<NodeId, NodeId
 
 #[cfg(test)]
 mod tests {
-    use crate::check::check_str;
     use crate::eval::eval_point;
+    use crate::front::check_str;
     use crate::lower::lower;
     use crate::scene::Scene;
 

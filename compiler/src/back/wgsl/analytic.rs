@@ -5,7 +5,7 @@
 //! the primitives and hierarchy stored in the `scene_data` buffer (buffer.rs).
 
 use super::buffer::{self, identity, trace_start};
-use super::map::float;
+use super::literal::float;
 use crate::scene::analytic::{Item, Primitive, Shape, Traced};
 use crate::scene::{MaterialId, V3};
 use std::fmt::Write;

@@ -89,7 +89,10 @@ pub fn part(program: &Program, name: &str) -> String {
         words.len()
     );
     for w in &words {
-        let v: Vec<String> = w.iter().map(|&x| super::map::float(f64::from(x))).collect();
+        let v: Vec<String> = w
+            .iter()
+            .map(|&x| super::literal::float(f64::from(x)))
+            .collect();
         let _ = writeln!(text, "    vec4<f32>({}),", v.join(", "));
     }
     text.push_str(");\n\n");

@@ -581,7 +581,7 @@ mod tests {
     }
 
     fn agrees(text: &str, extent: [f64; 3]) {
-        let (scene, diags, _) = crate::check::check_str("t.sdf", text);
+        let (scene, diags, _) = crate::front::check_str("t.sdf", text);
         let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
         let lowered = Lowered::new(&scene);
         let program = &lowered.program;
@@ -645,7 +645,7 @@ mod tests {
             material b = checker { a: field { vec3(0.2) * p.y }, b: field { vec3(voronoi(p * 3), 0.5, 0.5) } };\n\
             material c = phong { color: field { (1, 0.5, 0.25) } };\n\
             scene { sphere(1) @ a; box(0.5).translate(2, 0, 0) @ b; sphere(0.5).translate(0, 2, 0) @ c; }";
-        let (scene, diags, _) = crate::check::check_str("t.sdf", text);
+        let (scene, diags, _) = crate::front::check_str("t.sdf", text);
         let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
         let lowered = Lowered::new(&scene);
         let colours = &lowered.colours;

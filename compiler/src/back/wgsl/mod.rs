@@ -18,6 +18,7 @@ mod contract;
 mod glyphs;
 pub mod interp;
 pub mod layout;
+mod literal;
 mod map;
 mod march;
 mod mesh;
@@ -28,7 +29,8 @@ mod template;
 
 pub use analytic::MAX_UNROLLED;
 pub use contract::{Contract, Field, Mismatch, Shape, Specialisation, Uniform, UniformWriter};
-pub use map::{float, write_map, write_sdf};
+pub use literal::float;
+pub use map::{write_map, write_sdf};
 
 use crate::lower::Lowered;
 use crate::scene::{Colour, Light, Pattern, Scene};
@@ -755,7 +757,7 @@ mod tests {
     use super::*;
 
     fn scene(text: &str) -> Scene {
-        let (scene, diags, _) = crate::check::check_str("contract.sdf", text);
+        let (scene, diags, _) = crate::front::check_str("contract.sdf", text);
         assert!(!crate::diagnostics::has_errors(&diags), "{diags:?}");
         scene.expect("checks")
     }

@@ -4,6 +4,7 @@
 //! material table as constants, and nothing of the renderer; every name it declares starts
 //! with NAME, so the parts of two scenes live in one module. Parsed and validated by naga.
 
+use super::literal::float;
 use super::{map, validate, Error};
 use crate::lower::Lowered;
 use crate::scene::{Colour, Pattern, Scene};
@@ -67,9 +68,9 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
     let _ = writeln!(
         out,
         "const {name}_ORIGIN = vec3<f32>({}, {}, {});",
-        map::float(o[0]),
-        map::float(o[1]),
-        map::float(o[2])
+        float(o[0]),
+        float(o[1]),
+        float(o[2])
     );
     let _ = writeln!(
         out,
@@ -83,9 +84,9 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
     let v3 = |v: [f64; 3]| {
         format!(
             "vec3<f32>({}, {}, {})",
-            map::float(v[0]),
-            map::float(v[1]),
-            map::float(v[2])
+            float(v[0]),
+            float(v[1]),
+            float(v[2])
         )
     };
     let fields = &lowered.colours.fields;
@@ -112,15 +113,15 @@ pub fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
             painted.concat(),
             v3(a),
             v3(b),
-            map::float(size),
+            float(size),
             v3(shift),
-            map::float(m.ambient),
-            map::float(m.diffuse),
-            map::float(m.specular),
-            map::float(m.shininess),
-            map::float(m.reflect),
-            map::float(m.transparency),
-            map::float(m.ior)
+            float(m.ambient),
+            float(m.diffuse),
+            float(m.specular),
+            float(m.shininess),
+            float(m.reflect),
+            float(m.transparency),
+            float(m.ior)
         );
     }
     out.push_str(");\n\n");

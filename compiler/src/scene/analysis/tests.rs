@@ -4,8 +4,8 @@
 //! have unit gradients.
 
 use super::*;
-use crate::check::check_str;
 use crate::eval::eval_point;
+use crate::front::check_str;
 use crate::lower::{lower, lower_with, LowerOptions};
 use crate::program::Program;
 use crate::rng::Rng;
@@ -22,7 +22,7 @@ fn root(objects: &str) -> Derived {
     *analyse(&s).root().expect("objects")
 }
 
-/// The analysis's warnings (not those about lights and the camera, `check/placement.rs`).
+/// The analysis's warnings (not those about lights and the camera, `front/placement.rs`).
 fn codes(objects: &str) -> Vec<&'static str> {
     scene(objects)
         .1

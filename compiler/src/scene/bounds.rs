@@ -1,4 +1,5 @@
-//! Bounding volumes of the nodes of a scene graph, and a cost estimate of each node.
+//! Bounding volumes of the nodes of a scene graph (the guarantee the lowering's culling relies
+//! on, and the checker's test that a profile is finite), and a cost estimate of each node.
 //!
 //! A node's [`Bound`] is a sphere and an axis-aligned box, each with the guarantee that the
 //! culling of guarded blocks relies on (`docs/optimisation.md`): at every point p, the
@@ -9,20 +10,20 @@
 //! bound or an estimate. A box may be infinite along some axes (a slab); a node with no
 //! bound at all (a plane, infinite repetition in every direction) has `None`.
 
-use super::simplify::mat_vec;
-use crate::scene::{Combine, Graph, Node, NodeId, Smooth, V3};
+use super::ir::{mat_vec, Combine, Graph, Node, Smooth, V3};
+use super::NodeId;
 use glam::DVec3;
 
 /// A sphere: centre and radius.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Sphere {
+pub struct Sphere {
     pub c: V3,
     pub r: f64,
 }
 
 /// An axis-aligned box: centre and half extents (infinite along an unbounded axis).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Aabb {
+pub struct Aabb {
     pub c: V3,
     pub h: V3,
 }
@@ -30,7 +31,7 @@ pub(super) struct Aabb {
 /// The bounding volumes of a node: `f(p) ≥ min(s, scale·s)` for `s` the signed distance to
 /// either volume. `sphere` is infinite (`r = ∞`) when the box is.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Bound {
+pub struct Bound {
     pub sphere: Sphere,
     pub aabb: Aabb,
     pub scale: f64,
@@ -122,7 +123,7 @@ impl Bound {
 }
 
 /// Joins two bounds: volumes containing both, the smaller scale.
-pub(super) fn hull(a: &Bound, b: &Bound) -> Bound {
+pub fn hull(a: &Bound, b: &Bound) -> Bound {
     let mut aabb = a.aabb;
     for i in 0..3 {
         let lo = (a.aabb.c[i] - a.aabb.h[i]).min(b.aabb.c[i] - b.aabb.h[i]);
@@ -168,7 +169,7 @@ fn sphere_hull(a: &Sphere, b: &Sphere) -> Sphere {
 
 /// The bound and the estimated cost (instructions per point) of every node of a graph.
 #[derive(Debug, Clone)]
-pub(super) struct Bounds {
+pub struct Bounds {
     of: Vec<Option<Bound>>,
     cost: Vec<f64>,
 }
@@ -481,7 +482,7 @@ fn screw(b: &Bound, half_height: f64, floor: f64) -> Option<Bound> {
 /// The centre and half extents of a profile's rectangle and the scale of its bound
 /// (`Bound`: the field is at least min(s, scale·s), s the distance to the rectangle), or
 /// `None` where the profile has no finite rectangle; for the checks of `loft` and `screw`.
-pub(crate) fn profile_rect(graph: &Graph, id: NodeId) -> Option<([f64; 2], [f64; 2], f64)> {
+pub fn profile_rect(graph: &Graph, id: NodeId) -> Option<([f64; 2], [f64; 2], f64)> {
     let b = Bounds::new(graph).get(id)?;
     let (c, h) = (b.aabb.c, b.aabb.h);
     (h[0].is_finite() && h[1].is_finite()).then_some(([c[0], c[1]], [h[0], h[1]], b.scale))

@@ -723,7 +723,7 @@ fn the_failure_paths_list_every_limit_with_its_default() {
 /// properties of an analysis, the definition of the reference render, test tolerances.
 const NOT_LIMITS: &[(&str, &str, &str)] = &[
     (
-        "runtime/src/view/session.rs",
+        "runtime/src/view/session/mod.rs",
         "MAX_SCALE",
         "how far the viewer lowers the resolution of a frame over its time budget",
     ),

@@ -1,0 +1,408 @@
+//! The viewer session's loads: the scene file read (again when it changed under the read),
+//! checked, lowered and prepared through the job's path, its specialised pipeline compiled on
+//! another thread while the interpreted kernel shows it, and the load installed.
+
+use super::*;
+
+impl Session {
+    /// Loads the scene file again (or for the first time): on success the new scene replaces
+    /// the old one, and the camera stays where the user moved it; on failure the diagnostics
+    /// are printed as `sdfc check` prints them and the last good scene stays.
+    pub fn load(&mut self) -> Outcome {
+        self.load_edited(None)
+    }
+
+    /// [`Session::load`] after an edit seen at `edited` (the first file event of the batch
+    /// that called for the reload): `--timings`' edit to pixel counts from the later of that
+    /// and the newest modification time of the scene's files. A file renamed back, or copied
+    /// with its time kept, has an old modification time; the event is when it changed.
+    pub fn load_edited(&mut self, edited: Option<SystemTime>) -> Outcome {
+        let number = self.loads;
+        self.loads += 1;
+        let started = Instant::now();
+        let began = SystemTime::now();
+        let modified = Fingerprint::modified(&self.files);
+        match self.compile() {
+            Ok((good, mut timings)) => {
+                timings.number = number;
+                timings.modified =
+                    edit_time(Fingerprint::modified(&self.files).or(modified), edited);
+                timings.began = began;
+                self.install(good);
+                self.timings = Some(timings);
+                self.failed = false;
+                self.status = None;
+                Outcome {
+                    number,
+                    ok: true,
+                    summary: "ok".into(),
+                }
+            }
+            Err(summary) => {
+                self.failed = true;
+                self.status = Some(summary.clone());
+                let kept = if self.good.is_some() {
+                    "the last good scene stays on show"
+                } else {
+                    "nothing to show yet"
+                };
+                eprintln!(
+                    "view: load {number} of `{}` failed after {:.1} ms; {kept}",
+                    self.file.display(),
+                    ms(started.elapsed())
+                );
+                Outcome {
+                    number,
+                    ok: false,
+                    summary,
+                }
+            }
+        }
+    }
+
+    /// Reads, checks, lowers and prepares the scene, printing what `sdfc check` prints;
+    /// `Err` is the one-line summary of the first problem.
+    fn compile(&mut self) -> Result<(Good, Timings), String> {
+        let job = self.options.job.clone();
+        let limits = &job.limits;
+        let start = Instant::now();
+        let empty = || std::fs::metadata(&self.file).is_ok_and(|m| m.len() == 0);
+        while empty() && start.elapsed() < EMPTY_PATIENCE {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        let mut loaded = match frontend::load_with(&self.file, limits) {
+            Ok(l) => l,
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                self.files = vec![self.file.clone()];
+                self.fingerprint = Fingerprint::of(&self.files);
+                return Err(msg);
+            }
+        };
+        // Files that changed while they were read (an editor saving in place truncates, then
+        // writes) are read again: a load stands on contents still there after it was read.
+        for _ in 0..STABLE_READS {
+            self.files = files_of(&loaded.sources);
+            self.fingerprint = Fingerprint::from_sources(
+                self.files
+                    .iter()
+                    .zip(0..)
+                    .map(|(f, i)| (f.clone(), loaded.sources.text(FileId(i)).as_bytes())),
+            );
+            if !self.fingerprint.changed() {
+                break;
+            }
+            match frontend::load_with(&self.file, limits) {
+                Ok(again) => loaded = again,
+                Err(_) => break,
+            }
+        }
+        let scene = job.scene(&mut loaded, true).map_err(summary)?;
+        let check_time = start.elapsed();
+        let start = Instant::now();
+        let lowered = job
+            .lower(&scene, &loaded.sources, &lower_options(&scene))
+            .map_err(summary)?;
+        let lower_time = start.elapsed();
+        eprintln!(
+            "{}: ok; {}; {}",
+            self.file.display(),
+            frontend::summary(&loaded, &scene),
+            frontend::method(&loaded, &scene, &lowered.traceable)
+        );
+        let start = Instant::now();
+        // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
+        // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.
+        // The kernel kept is the specialised one unless `--kernel interpreted`; with `auto`
+        // the interpreted kernel shows the scene while the specialised one compiles, once the
+        // grace period has passed without it.
+        let kernel = match self.options.kernel {
+            Kernel::Interpreted => wgsl::KernelChoice::Interpreted,
+            Kernel::Auto | Kernel::Specialised => wgsl::KernelChoice::Specialised,
+        };
+        let setup = Setup {
+            parameters: true,
+            kernel,
+            ..job.setup()
+        };
+        let interim_lowered = match (&self.device, self.options.kernel) {
+            (Device::Wgpu(gpu), Kernel::Auto) if !gpu.is_cpu() || self.options.interim_on_cpu => {
+                Some(lowered.clone())
+            }
+            _ => None,
+        };
+        let prepared = match (&self.good, &self.device) {
+            (Some(good), _) => good.prepared.next_with(&scene, lowered, kernel),
+            (None, Device::Cpu) => Prepared::on_cpu(&scene, lowered, &setup).map(|p| (p, true)),
+            (None, Device::Wgpu(gpu)) => {
+                Prepared::on_gpu(gpu.clone(), &scene, &lowered, &setup).map(|p| (p, true))
+            }
+        };
+        let (prepared, built) = prepared.map_err(|e| summary(e.into()))?;
+        let prepare_time = start.elapsed();
+        let mut at = scene.settings.clone();
+        (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);
+        if let Err(msg) = prepared.memory(&scene, &at).check(limits) {
+            eprintln!("error: {msg}");
+            return Err(msg);
+        }
+        // A pipeline not compiled yet compiles on another thread (the driver may take
+        // seconds; lavapipe tens of them), never on the caller's: a window's event loop goes on
+        // answering meanwhile. With `--kernel auto` the interpreted kernel shows the scene
+        // from the end of the grace period where it can; otherwise the image before stays on
+        // show until the pipeline is ready.
+        let mut waiting = None;
+        let mut interim_prepare = Duration::ZERO;
+        let mut interim_possible = false;
+        let pipeline = match prepared.as_wgpu() {
+            Some(crate::backend::WgpuPrepared { gpu, kernel, .. }) => {
+                let data = kernel.data.is_some();
+                if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
+                    Some(
+                        gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data)
+                            .map_err(|e| e.to_string())
+                            .inspect_err(|msg| eprintln!("error: {msg}"))?,
+                    )
+                } else {
+                    let start = Instant::now();
+                    let interim = match interim_lowered {
+                        Some(lowered) => self.interim(gpu, &scene, lowered, &at),
+                        None => None,
+                    };
+                    interim_prepare = start.elapsed();
+                    interim_possible = interim.is_some();
+                    let grace = match interim {
+                        Some(_) => self.options.grace,
+                        None => Duration::ZERO,
+                    };
+                    let first = self.first_frame(&prepared, &scene);
+                    waiting =
+                        Compile::start(&prepared, first, self.compile_waker()).map(|compile| {
+                            Waiting {
+                                load: self.loads - 1,
+                                grace_until: compile.started + grace,
+                                compile,
+                                interim,
+                                shown: false,
+                            }
+                        });
+                    None
+                }
+            }
+            _ => None,
+        };
+        let method = match prepared.traceable().traced(scene.settings.method) {
+            Some(_) => "trace",
+            None => "march",
+        };
+        let aa = scene.settings.aa.max(1);
+        let background = waiting.is_some();
+        let good = Good {
+            file_camera: scene.camera.clone(),
+            scene,
+            prepared,
+            aa: aa * aa,
+            method,
+            load: self.loads - 1,
+            waiting,
+        };
+        let timings = Timings {
+            number: 0,
+            check: check_time,
+            lower: lower_time,
+            prepare: prepare_time,
+            built,
+            pipeline,
+            background,
+            interim: interim_possible,
+            first_kernel: None,
+            interim_prepare,
+            interim_pipeline: None,
+            ready: None,
+            modified: None,
+            began: SystemTime::now(),
+            first_frame: None,
+            printed: false,
+        };
+        Ok((good, timings))
+    }
+
+    /// The interpreted kernel of `scene`, lowered as `lowered`, to show it while its specialised
+    /// kernel compiles: `None` where it cannot render the scene (an analytically traced one, a
+    /// program above the `registers` limit) or its frames would be above the `memory` limit
+    /// at `at`. Its pipeline is compiled once per specialisation; until then it compiles on
+    /// another thread too.
+    fn interim(
+        &self,
+        gpu: &Arc<Gpu>,
+        scene: &Scene,
+        lowered: Lowered,
+        at: &sdfc_compiler::Settings,
+    ) -> Option<Interim> {
+        let setup = Setup {
+            parameters: true,
+            kernel: wgsl::KernelChoice::Interpreted,
+            ..Setup::default()
+        };
+        let held = self
+            .good
+            .as_ref()
+            .and_then(|g| g.waiting.as_ref())
+            .and_then(|w| w.interim.as_ref())
+            .map(|i| &i.prepared)
+            .or(self.interpreter.as_ref());
+        let prepared = match held {
+            Some(p) => p.next_with(scene, lowered, setup.kernel).ok()?.0,
+            None => Prepared::on_gpu(gpu.clone(), scene, &lowered, &setup).ok()?,
+        };
+        prepared
+            .memory(scene, at)
+            .check(&self.options.job.limits)
+            .ok()?;
+        let kernel = &prepared.as_wgpu()?.kernel;
+        let data = kernel.data.is_some();
+        let (compile, pipeline) = if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
+            let time = gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data);
+            (None, Some(time.ok()?))
+        } else {
+            let first = self.first_frame(&prepared, scene);
+            (
+                Some(Compile::start(&prepared, first, self.compile_waker())?),
+                None,
+            )
+        };
+        Some(Interim {
+            prepared,
+            compile,
+            pipeline,
+        })
+    }
+
+    /// What the first frame of a newly loaded `scene` will give `prepared`'s kernel to read,
+    /// as [`Session::frame`] sets it up: the camera on show (the user's, else the scene's),
+    /// the size of a new scene's first frame, and the first sample's offset.
+    fn first_frame(&self, prepared: &Prepared, scene: &Scene) -> Option<FirstFrame> {
+        let crate::backend::WgpuPrepared {
+            kernel, lipschitz, ..
+        } = prepared.as_wgpu()?;
+        let moving = self.moving() || self.playing();
+        let scale = if moving {
+            self.scale
+        } else {
+            self.preview_scale()
+        };
+        let low = scale > 1 || moving;
+        let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
+        let base = match &self.user_camera {
+            Some(orbit) => orbit.camera(),
+            None => scene.camera.clone(),
+        };
+        let n = scene.settings.aa.max(1);
+        let (dx, dy) = if low {
+            (0.0, 0.0)
+        } else {
+            camera::sample_offset(0, n)
+        };
+        let mut first = scene.clone();
+        first.camera = camera::jittered(&base, dx, dy, w, h);
+        let s = &mut first.settings;
+        (s.width, s.height, s.aa) = (w, h, 1);
+        FirstFrame::of((kernel, *lipschitz), &first)
+    }
+
+    /// Takes the results of the compiles on other threads that have ended: a ready interpreted
+    /// pipeline shows the scene from the next frame; a ready specialised one replaces the
+    /// interpreted kernel from the next frame (the camera and the animation's time stay).
+    pub(super) fn poll(&mut self) {
+        let timings = self.options.timings;
+        let held = self
+            .good
+            .as_ref()
+            .and_then(|g| g.waiting.as_ref())
+            .is_some_and(|w| self.held(w.load));
+        let Some(good) = self.good.as_mut() else {
+            return;
+        };
+        let Some(w) = good.waiting.as_mut() else {
+            return;
+        };
+        if let Some(i) = w.interim.as_mut() {
+            match i.compile.as_ref().and_then(Compile::take) {
+                Some(Ok(time)) => {
+                    i.compile = None;
+                    i.pipeline = Some(time);
+                }
+                Some(Err(msg)) => {
+                    eprintln!("error: the interpreted kernel: {msg}");
+                    w.interim = None;
+                }
+                None => {}
+            }
+        }
+        if held {
+            return;
+        }
+        let Some(result) = w.compile.take() else {
+            return;
+        };
+        let load = good.load;
+        let Some(w) = good.waiting.take() else {
+            return;
+        };
+        match result {
+            Ok(time) => {
+                if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
+                    // Ready before the interpreted kernel showed anything (within the grace
+                    // period, or after it but before the interpreted kernel was ready): the
+                    // load's line says so.
+                    t.pipeline = Some(time);
+                    t.ready = Some((w.compile.started.elapsed(), w.in_grace()));
+                } else if timings {
+                    eprintln!(
+                        "view: load {load}: specialised kernel ready {:.1} ms after the load (pipeline {} {:.1} ms on another thread); interpreted while compiling until then",
+                        ms(w.compile.started.elapsed()),
+                        if time.cached { "found" } else { "compiled" },
+                        ms(time.time),
+                    );
+                }
+                // A render error of the interpreted kernel does not stop the specialised one.
+                self.broken = None;
+                if let Some(i) = w.interim {
+                    self.interpreter = Some(i.prepared);
+                }
+                if w.shown {
+                    // The image starts again from the specialised kernel's samples; the one on
+                    // show stays until its first frame replaces it.
+                    self.accumulation = Accumulation::default();
+                }
+            }
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                match w.interim {
+                    Some(i) => {
+                        eprintln!("view: load {load}: the interpreted kernel stays on show");
+                        good.prepared = i.prepared;
+                        // No grace period: there is no other kernel to wait for.
+                        good.waiting = i.compile.map(|compile| Waiting {
+                            load,
+                            grace_until: compile.started,
+                            compile,
+                            interim: None,
+                            shown: false,
+                        });
+                    }
+                    None => self.broken = Some(msg),
+                }
+            }
+        }
+    }
+
+    fn install(&mut self, good: Good) {
+        self.version += 1;
+        self.playback = self.playback_of(&good.scene);
+        self.good = Some(good);
+        self.broken = None;
+        self.preview = true;
+        self.accumulation = Accumulation::default();
+    }
+}

@@ -1,0 +1,1143 @@
+//! The viewer's session, apart from any window: it loads and checks the scene file, prepares it
+//! for the CPU renderer or wgpu, keeps the last good scene when an edit has errors, holds the
+//! camera the user moved, and renders frames progressively (one sample per pixel, and fewer
+//! pixels when a frame exceeds its budget, while the camera moves; jittered samples
+//! accumulated up to the scene's `aa` when it is still), and plays an animated scene's time `t`
+//! (each frame's scene checked at its time, its kernel kept while only numbers change). On wgpu,
+//! a scene whose specialised kernel is not compiled yet waits a short grace period ([`GRACE`])
+//! for it to compile on another thread ([`super::compile`]), and is shown through the
+//! interpreted kernel from then until it is ready. A load is `load.rs`'s; the tests are
+//! `tests.rs`.
+
+use super::camera::{self, Orbit};
+use super::compile::{Compile, Waker};
+use super::resident::{FirstFrame, Resident};
+use super::watch::Fingerprint;
+use crate::backend::{Kernel, Prepared, Setup};
+use crate::frontend::{self, DiagnosticFormat, Loaded};
+use crate::gpu::wgpu::PipelineTime;
+use crate::gpu::Gpu;
+use crate::image::Image;
+use crate::job::{first_error, Error, Job};
+use sdfc_compiler::{wgsl, Animation, Camera, LowerOptions, Lowered, Scene};
+use sdfc_compiler::{FileId, Limit, SourceMap};
+use std::path::{Path, PathBuf};
+use std::sync::{mpsc, Arc};
+use std::time::{Duration, Instant, SystemTime};
+
+mod load;
+
+/// The time a frame may take while the camera moves; a slower one lowers the resolution.
+pub const FRAME_BUDGET: Duration = Duration::from_millis(33);
+/// How long after the last camera motion the camera counts as still (and samples accumulate).
+pub const SETTLE: Duration = Duration::from_millis(120);
+/// How many times a load reads files that keep changing under it before it goes on with
+/// what it read.
+const STABLE_READS: usize = 4;
+/// How long a load waits for an empty scene file to be written: an editor saving in place
+/// truncates the file, then writes it, and a busy machine can run the load in between. No
+/// one saves a scene empty on purpose; one that stays empty this long is loaded (and reported
+/// as it is).
+const EMPTY_PATIENCE: Duration = Duration::from_millis(500);
+/// The largest divisor of the resolution while moving.
+pub const MAX_SCALE: u32 = 8;
+/// How long a load whose specialised pipeline compiles on another thread (`--kernel auto` on a
+/// GPU) waits for it before showing the scene through the interpreted kernel. A driver that
+/// compiles a kernel in a few milliseconds then shows the specialised kernel's frame at once,
+/// with no slower interpreted frame before it; a compile that takes longer is hidden as
+/// before, its interpreted frame shown this much later (BENCHMARKS.md, "Live preview"): 50 ms
+/// is a few frames at 60 Hz, short beside a slow compile's seconds and well above a fast
+/// one's few milliseconds. The window's event loop is never held: it is woken at the end of the period
+/// ([`Session::grace_deadline`]).
+pub const GRACE: Duration = Duration::from_millis(50);
+
+/// How the session treats the scene, from the command line.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The job: its backend, `--size` (overriding the scene's; the window's size replaces it
+    /// when the window is resized), the `--set key=value` overrides of render settings,
+    /// applied at every load, and the resource limits.
+    pub job: Job,
+    /// `--timings`: print the times of each load and of its first frame.
+    pub timings: bool,
+    /// `--time`: an animated scene starts paused at this time (seconds) instead of playing.
+    pub time: Option<f64>,
+    /// `--kernel`: on wgpu, the specialised kernel, shown through the interpreted one while it
+    /// compiles on a GPU when it is not ready within the grace period (`auto`); the
+    /// specialised kernel alone, each new one compiled before it is shown (`specialised`); or
+    /// the interpreted kernel alone (`interpreted`).
+    pub kernel: Kernel,
+    /// With `auto`, show the interpreted kernel while the specialised one compiles on a CPU
+    /// adapter (lavapipe) too. `sdfc view` leaves it off: there the interpreted kernel's
+    /// frames took 25 to 150 times the specialised kernel's (docs/interpreted.md), longer
+    /// than the compile they would hide; the tests, which have no other adapter, set it.
+    pub interim_on_cpu: bool,
+    /// With `auto`, how long a load waits for its specialised pipeline before showing the
+    /// interpreted kernel ([`GRACE`]; the tests set their own).
+    pub grace: Duration,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            job: Job::default(),
+            timings: false,
+            time: None,
+            kernel: Kernel::default(),
+            interim_on_cpu: false,
+            grace: GRACE,
+        }
+    }
+}
+
+/// The playing of an animated scene's time `t`: the frame on show is the scene checked at the
+/// start of the animation frame (`k / fps`) the clock is in, looping over `duration` when the
+/// scene states one.
+#[derive(Debug)]
+struct Playback {
+    /// The scene's files as the load that started (or last renewed) the playback read them.
+    source: frontend::Source,
+    animation: Animation,
+    /// When the clock read 0, while playing.
+    origin: Instant,
+    /// The clock while paused.
+    paused: Option<f64>,
+    /// The animation frame on show.
+    shown: Option<u64>,
+}
+
+impl Playback {
+    /// The clock, in seconds (within `duration`, when the scene states one).
+    fn clock(&self) -> f64 {
+        let age = self
+            .paused
+            .unwrap_or_else(|| self.origin.elapsed().as_secs_f64());
+        if self.animation.duration > 0.0 {
+            age.rem_euclid(self.animation.duration)
+        } else {
+            age
+        }
+    }
+
+    /// The animation frame the clock is in.
+    fn frame(&self) -> u64 {
+        (self.clock() * self.animation.fps).floor() as u64
+    }
+}
+
+/// Where frames are rendered.
+#[derive(Debug, Clone)]
+pub enum Device {
+    /// The CPU renderer.
+    Cpu,
+    /// The WGSL kernel through wgpu, on this device.
+    Wgpu(Arc<Gpu>),
+}
+
+impl Device {
+    /// The backend's name, as in `--backend`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Device::Cpu => "cpu",
+            Device::Wgpu(_) => "wgpu",
+        }
+    }
+
+    /// The device, for messages.
+    pub fn describe(&self) -> String {
+        match self {
+            Device::Cpu => format!("CPU, {} threads", rayon::current_num_threads()),
+            Device::Wgpu(gpu) => gpu.describe(),
+        }
+    }
+}
+
+/// The scene being shown: the last load that compiled.
+#[derive(Debug)]
+struct Good {
+    /// The scene; its camera and size are set for each frame.
+    scene: Scene,
+    prepared: Prepared,
+    /// The camera the file gives.
+    file_camera: Camera,
+    /// Samples per pixel of a converged image (the scene's `aa`, squared).
+    aa: u32,
+    /// `trace` or `march`.
+    method: &'static str,
+    /// The load it came from.
+    load: u32,
+    /// While the pipeline of `prepared` compiles on another thread: that compile, and the
+    /// interpreted kernel shown meanwhile (after the grace period).
+    waiting: Option<Waiting>,
+}
+
+/// The compile of a scene's specialised pipeline, and the interpreted kernel that shows the
+/// scene until it is ready (when that kernel can render the scene). It belongs to its scene
+/// ([`Good`]): a newer load replaces both, and a stale compile's result is never seen.
+#[derive(Debug)]
+struct Waiting {
+    /// The load whose kernel compiles.
+    load: u32,
+    compile: Compile,
+    interim: Option<Interim>,
+    /// Whether a frame of the interpreted kernel was rendered.
+    shown: bool,
+    /// The end of the grace period: until then nothing is rendered, the specialised kernel
+    /// being awaited (the image of the scene before stays on show).
+    grace_until: Instant,
+}
+
+/// The interpreted kernel of a scene whose specialised pipeline compiles.
+#[derive(Debug)]
+struct Interim {
+    prepared: Prepared,
+    /// Its own pipeline's compile, while it runs (once per specialisation of the kernel).
+    compile: Option<Compile>,
+    /// How its pipeline was had, once it was.
+    pipeline: Option<PipelineTime>,
+}
+
+impl Good {
+    /// The kernel frames are rendered with now: the specialised one, or while it compiles
+    /// the interpreted one once its pipeline is ready and the grace period is over; `None`
+    /// while neither is.
+    fn kernel(&self) -> Option<&Prepared> {
+        match &self.waiting {
+            None => Some(&self.prepared),
+            Some(w) if w.in_grace() => None,
+            Some(w) => w
+                .interim
+                .as_ref()
+                .filter(|i| i.compile.is_none())
+                .map(|i| &i.prepared),
+        }
+    }
+}
+
+impl Waiting {
+    /// Whether the grace period runs: the specialised kernel is awaited before the interpreted
+    /// one is shown.
+    fn in_grace(&self) -> bool {
+        Instant::now() < self.grace_until
+    }
+
+    /// Whether a compile has ended whose result is still to be taken (the specialised one's
+    /// unless `held`).
+    fn finished(&self, held: bool) -> bool {
+        (!held && self.compile.finished())
+            || self
+                .interim
+                .as_ref()
+                .and_then(|i| i.compile.as_ref())
+                .is_some_and(Compile::finished)
+    }
+}
+
+/// The result of one load of the scene file.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// 0 for the first load, then 1, 2, … for each reload.
+    pub number: u32,
+    /// Whether the scene compiled and replaced the one shown.
+    pub ok: bool,
+    /// One line: `ok` or the first error.
+    pub summary: String,
+}
+
+/// Times of one load, printed (with `--timings`) once its first frame is shown.
+#[derive(Debug, Clone)]
+struct Timings {
+    number: u32,
+    /// Reading and checking.
+    check: Duration,
+    /// Lowering to the distance program.
+    lower: Duration,
+    /// Tapes (CPU) or kernel generation and validation (wgpu).
+    prepare: Duration,
+    /// Whether a kernel (or the CPU's tapes) was built; false when the last scene's wgpu
+    /// kernel was kept (an edit of numbers only).
+    built: bool,
+    /// The kernel's pipeline: compiled, or found among those compiled.
+    pipeline: Option<PipelineTime>,
+    /// Whether the pipeline compiled on another thread (`pipeline` is then its time, once
+    /// ready before the first frame).
+    background: bool,
+    /// Whether the interpreted kernel could show the scene while it compiled (else the image
+    /// before stayed on show until it was ready).
+    interim: bool,
+    /// The kernel of the first frame: `interpreted` while the specialised one compiled.
+    first_kernel: Option<&'static str>,
+    /// The time to prepare the interpreted kernel (with `auto`, when the specialised pipeline
+    /// was not compiled yet).
+    interim_prepare: Duration,
+    /// The interpreted kernel's pipeline, when it rendered the first frame.
+    interim_pipeline: Option<PipelineTime>,
+    /// When the specialised pipeline compiled on another thread was ready before any frame
+    /// of the interpreted kernel: how long after its compile started the session took it,
+    /// and whether that was within the grace period.
+    ready: Option<(Duration, bool)>,
+    /// When the newest of the scene's files was modified.
+    modified: Option<SystemTime>,
+    /// When the load began.
+    began: SystemTime,
+    /// The first frame's render time and size, once rendered.
+    first_frame: Option<(Duration, u32, u32)>,
+    /// Whether the first frame's timings are printed (and the first full frame's are due).
+    printed: bool,
+}
+
+impl Timings {
+    /// What the load's line says of its kernel's pipeline: how it was had, and with `auto`
+    /// whether the specialised kernel was ready within the grace period `grace` or was shown
+    /// interpreted while it compiled.
+    fn pipeline_words(&self, grace: Duration) -> String {
+        let got = |p: PipelineTime| match p.cached {
+            true => format!("cached ({:.1} ms)", ms(p.time)),
+            false => format!("compiled {:.1} ms", ms(p.time)),
+        };
+        let grace = ms(grace);
+        match (self.pipeline, self.background, self.ready) {
+            (Some(p), false, _) => format!(", pipeline {}", got(p)),
+            (Some(p), true, Some((ready, _))) if !self.interim => format!(
+                ", pipeline {} on another thread, shown once ready {:.1} ms after its compile started (no interpreted kernel meanwhile: the image before stayed on show)",
+                got(p),
+                ms(ready)
+            ),
+            (Some(p), true, Some((ready, true))) => format!(
+                ", pipeline {} on another thread, specialised compiled within the grace period in {:.1} ms (grace {grace:.0} ms, no interpreted frame)",
+                got(p),
+                ms(ready)
+            ),
+            (Some(p), true, Some((ready, false))) => format!(
+                ", pipeline {} on another thread, specialised ready {:.1} ms after its compile started (after the {grace:.0} ms grace period, before an interpreted frame)",
+                got(p),
+                ms(ready)
+            ),
+            (Some(p), true, None) => format!(", pipeline {} on another thread", got(p)),
+            (None, true, _) => format!(
+                ", pipeline compiling on another thread, not ready within the {grace:.0} ms grace period, interpreted while compiling (interpreted kernel {:.2} ms, its pipeline {})",
+                ms(self.interim_prepare),
+                match self.interim_pipeline {
+                    Some(p) if p.cached => "was cached".to_string(),
+                    Some(p) => format!("compiled {:.1} ms", ms(p.time)),
+                    None => "was ready".to_string(),
+                }
+            ),
+            (None, false, _) => String::new(),
+        }
+    }
+}
+
+/// One rendered frame.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameInfo {
+    /// Its size (smaller than the view while moving, when frames are over budget).
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel accumulated so far, and the target (the scene's `aa`, squared).
+    pub samples: u32,
+    pub target: u32,
+    /// Render time of this frame (wall time, read-back included).
+    pub time: Duration,
+    /// Mean marching steps per pixel of this frame (NaN on wgpu unless they were asked for:
+    /// [`Session::want_steps`]).
+    pub steps: f64,
+    /// Whether the camera was moving.
+    pub moving: bool,
+    /// The GPU kernel that rendered it, `specialised` or `interpreted` (`None` on the CPU).
+    pub kernel: Option<&'static str>,
+}
+
+/// Samples accumulated at one size.
+#[derive(Debug, Default)]
+struct Accumulation {
+    width: u32,
+    height: u32,
+    /// Their sums, on the CPU (on wgpu they stay on the device: [`Resident`]).
+    sum: Vec<[f32; 3]>,
+    count: u32,
+    /// Whether the samples are of a still camera at full size.
+    still: bool,
+}
+
+/// The viewer's state between frames.
+#[derive(Debug)]
+pub struct Session {
+    file: PathBuf,
+    options: Options,
+    device: Device,
+    good: Option<Good>,
+    /// The files the last load read (the entry file and its imports).
+    files: Vec<PathBuf>,
+    /// Their contents as that load saw them.
+    fingerprint: Fingerprint,
+    /// Loads so far.
+    loads: u32,
+    /// Whether the last load failed.
+    failed: bool,
+    /// The summary of the last failure, while it stands.
+    status: Option<String>,
+    /// The camera the user moved to; `None` follows the file's camera.
+    user_camera: Option<Orbit>,
+    /// The view's size.
+    size: (u32, u32),
+    /// Moving until then.
+    moving_until: Option<Instant>,
+    /// The divisor of the resolution while moving.
+    scale: u32,
+    /// Whether the next frame is the first of a newly loaded scene, rendered at a lower
+    /// resolution when full frames take longer than the budget.
+    preview: bool,
+    /// The time of the last full-resolution frame.
+    last_full: Option<Duration>,
+    accumulation: Accumulation,
+    /// The image on show: the mean of the accumulated samples (on the CPU; on wgpu it stays
+    /// on the device, in `resident`).
+    shown: Option<Image>,
+    /// On wgpu, the frames on the device: the accumulated samples and the texture on show.
+    resident: Option<Resident>,
+    /// Counts the scenes installed (loads and animation frames), so that a kernel's scene
+    /// data is uploaded to the device once per scene.
+    version: u64,
+    /// Whether each frame's mean steps per pixel are wanted (the statistics in the title): on
+    /// wgpu they are then read back from the device.
+    steps_wanted: bool,
+    /// The last frame.
+    last: Option<FrameInfo>,
+    /// A render error that stops rendering until the next load or camera move.
+    broken: Option<String>,
+    timings: Option<Timings>,
+    /// The animated scene's time, played or paused; `None` for a still.
+    playback: Option<Playback>,
+    /// Told by each compile on another thread when it ends ([`Session::wait_for_compile`]).
+    compiled: (mpsc::Sender<()>, mpsc::Receiver<()>),
+    /// Also called when such a compile ends (the window's event loop).
+    waker: Option<Waker>,
+    /// The last interpreted kernel shown, kept after the specialised kernel replaced it: a
+    /// later scene of the same specialisation reuses its validated kernel
+    /// ([`Prepared::next_with`]).
+    interpreter: Option<Prepared>,
+    /// Tests hold back the compile of this load's specialised kernel, to see what is shown
+    /// meanwhile.
+    #[cfg(test)]
+    held: Option<u32>,
+}
+
+impl Session {
+    /// A session on `file`, rendering on `device`; nothing is loaded until [`Session::load`].
+    pub fn new(file: PathBuf, options: Options, device: Device) -> Session {
+        let size = options.job.overrides.size.unwrap_or((640, 480));
+        Session {
+            files: vec![file.clone()],
+            file,
+            options,
+            device,
+            good: None,
+            fingerprint: Fingerprint::default(),
+            loads: 0,
+            failed: false,
+            status: None,
+            user_camera: None,
+            size,
+            moving_until: None,
+            scale: 1,
+            preview: false,
+            last_full: None,
+            accumulation: Accumulation::default(),
+            shown: None,
+            resident: None,
+            version: 0,
+            steps_wanted: false,
+            last: None,
+            broken: None,
+            timings: None,
+            playback: None,
+            compiled: mpsc::channel(),
+            waker: None,
+            interpreter: None,
+            #[cfg(test)]
+            held: None,
+        }
+    }
+
+    /// Whether the compile of load `load`'s specialised kernel is held back (by a test).
+    #[cfg(test)]
+    fn held(&self, load: u32) -> bool {
+        self.held == Some(load)
+    }
+
+    #[cfg(not(test))]
+    fn held(&self, _: u32) -> bool {
+        false
+    }
+
+    /// Calls `waker` (on another thread) whenever a pipeline compiling on another thread is
+    /// ready or has failed, as well as making [`Session::wants_frame`] true.
+    pub fn set_waker(&mut self, waker: Waker) {
+        self.waker = Some(waker);
+    }
+
+    /// What a compile on another thread calls when it ends.
+    fn compile_waker(&self) -> Waker {
+        let tx = self.compiled.0.clone();
+        let also = self.waker.clone();
+        Waker::new(move || {
+            let _ = tx.send(());
+            if let Some(w) = &also {
+                w.wake();
+            }
+        })
+    }
+
+    /// Waits, at most `timeout` and not past the end of the grace period, for a pipeline
+    /// compiling on another thread, when there is no frame to render until it ends or the
+    /// grace period does; returns at once otherwise.
+    pub fn wait_for_compile(&self, timeout: Duration) {
+        if self.compiling() && !self.wants_frame() {
+            let timeout = match self.grace_deadline() {
+                Some(end) => timeout.min(end.saturating_duration_since(Instant::now())),
+                None => timeout,
+            };
+            let _ = self.compiled.1.recv_timeout(timeout);
+        }
+    }
+
+    /// While the scene on show waits its grace period for its specialised kernel: when the
+    /// period ends, and a frame of the interpreted kernel may be due (a window's event loop
+    /// wakes then). `None` when there is no such period, or it is over.
+    pub fn grace_deadline(&self) -> Option<Instant> {
+        let w = self.good.as_ref()?.waiting.as_ref()?;
+        w.in_grace().then_some(w.grace_until)
+    }
+
+    /// Whether the scene on show waits for its specialised kernel's pipeline, compiling on
+    /// another thread (its frames are the interpreted kernel's, or none yet: in the grace
+    /// period, or while the interpreted kernel's pipeline compiles too).
+    pub fn compiling(&self) -> bool {
+        self.good.as_ref().is_some_and(|g| g.waiting.is_some())
+    }
+
+    /// The size a view of `file` starts at: `size`, or the scene's (640×480 when the file does
+    /// not compile yet). Nothing is printed.
+    pub fn initial_size(file: &Path, options: &Options) -> (u32, u32) {
+        let job = &options.job;
+        if let Some(size) = job.overrides.size {
+            return size;
+        }
+        match frontend::load_with(file, &job.limits) {
+            Ok(Loaded {
+                scene: Some(mut scene),
+                ..
+            }) => match job.settings(&mut scene) {
+                Ok(()) => (scene.settings.width, scene.settings.height),
+                Err(_) => (640, 480),
+            },
+            _ => (640, 480),
+        }
+    }
+
+    /// The device frames are rendered on.
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// The files the last load read: the scene file and every file it imports.
+    pub fn files(&self) -> &[PathBuf] {
+        &self.files
+    }
+
+    /// Whether a batch of file events (`paths`, the files they name) calls for a reload: the
+    /// contents of a file the last load read changed (or it appeared or disappeared), or the
+    /// last load failed and a scene file (`.sdf`) it did not read changed, perhaps a missing
+    /// import.
+    pub fn needs_reload(&self, paths: &[PathBuf]) -> bool {
+        let read: Vec<PathBuf> = self.files.iter().map(|f| absolute(f)).collect();
+        self.fingerprint.changed()
+            || (self.failed
+                && paths.iter().any(|p| {
+                    p.extension().is_some_and(|e| e == "sdf") && !read.contains(&absolute(p))
+                }))
+    }
+
+    /// The playback of a newly loaded scene: `None` for a still; for an animated scene the
+    /// clock of the last playback goes on (paused or not), or starts (paused at `--time`, if
+    /// given). The files are read again for the frames to come; if they cannot be, the scene
+    /// stays at the time it was loaded at.
+    fn playback_of(&mut self, scene: &Scene) -> Option<Playback> {
+        if !scene.animation.animated() {
+            return None;
+        }
+        let source = match frontend::Source::read(&self.file) {
+            Ok(s) => s,
+            Err(msg) => {
+                eprintln!("view: the animation stays at t = 0: {msg}");
+                return None;
+            }
+        };
+        let (origin, paused) = match &self.playback {
+            Some(p) => (p.origin, p.paused),
+            None => (Instant::now(), self.options.time),
+        };
+        Some(Playback {
+            source,
+            animation: scene.animation,
+            origin,
+            paused,
+            // The load checked the scene at t = 0.
+            shown: Some(0),
+        })
+    }
+
+    /// Whether an animated scene's time is playing.
+    pub fn playing(&self) -> bool {
+        self.playback.as_ref().is_some_and(|p| p.paused.is_none()) && self.broken.is_none()
+    }
+
+    /// Pauses a playing animation at its clock, or plays a paused one on from there.
+    pub fn toggle_pause(&mut self) {
+        if let Some(p) = self.playback.as_mut() {
+            match p.paused.take() {
+                Some(at) => p.origin = Instant::now() - Duration::from_secs_f64(at),
+                None => p.paused = Some(p.clock()),
+            }
+            self.accumulation = Accumulation::default();
+        }
+    }
+
+    /// The animation time on show, for the title; `None` for a still.
+    pub fn time(&self) -> Option<f64> {
+        let p = self.playback.as_ref()?;
+        Some(Animation::time_of(p.animation.fps, p.shown.unwrap_or(0)))
+    }
+
+    /// Brings the scene to the animation frame the clock is in: the scene checked at that
+    /// frame's time, lowered and prepared (the kernel kept when only numbers change). A frame
+    /// that fails stops the clock there, with its problem in the title.
+    fn advance(&mut self) {
+        let Some(p) = self.playback.as_mut() else {
+            return;
+        };
+        let k = p.frame();
+        if p.shown == Some(k) {
+            return;
+        }
+        p.shown = Some(k);
+        let time = Animation::time_of(p.animation.fps, k);
+        if let Err(msg) = self.scene_at(time) {
+            eprintln!("view: t = {time} s: {msg}");
+            self.status = Some(format!("t = {time} s: {msg}"));
+            if let Some(p) = self.playback.as_mut() {
+                p.paused = Some(time);
+            }
+        }
+    }
+
+    /// Replaces the scene on show with the scene checked at `time`.
+    fn scene_at(&mut self, time: f64) -> Result<(), String> {
+        let job = &self.options.job;
+        let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
+            return Ok(());
+        };
+        let mut loaded = p.source.check(&job.limits, time);
+        let Some(mut scene) = loaded.scene.take() else {
+            frontend::report(&loaded, DiagnosticFormat::Human);
+            return Err(first_error(&loaded.diagnostics, &loaded.sources));
+        };
+        job.settings(&mut scene).map_err(|e| e.to_string())?;
+        let lowered = job
+            .lower(&scene, &loaded.sources, &lower_options(&scene))
+            .map_err(|e| e.to_string())?;
+        if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
+            i.prepared = i
+                .prepared
+                .next(&scene, lowered.clone())
+                .map_err(|e| e.to_string())?
+                .0;
+        }
+        let (prepared, _) = good
+            .prepared
+            .next(&scene, lowered)
+            .map_err(|e| e.to_string())?;
+        self.version += 1;
+        good.file_camera = scene.camera.clone();
+        good.scene = scene;
+        good.prepared = prepared;
+        Ok(())
+    }
+
+    /// The divisor of the resolution of a new scene's first frame: enough to bring the last
+    /// full frame's time within the budget (1 before the first frame).
+    fn preview_scale(&self) -> u32 {
+        let ratio = self
+            .last_full
+            .map_or(0.0, |t| t.as_secs_f64() / FRAME_BUDGET.as_secs_f64());
+        (ratio.sqrt().ceil() as u32).clamp(1, MAX_SCALE)
+    }
+
+    /// Sets the view's size (the window's), clamped to the `edge` limit.
+    pub fn set_size(&mut self, width: u32, height: u32) {
+        let edge = self
+            .options
+            .job
+            .limits
+            .get(Limit::Edge)
+            .min(u32::MAX as u64) as u32;
+        let size = (width.clamp(1, edge), height.clamp(1, edge));
+        if size != self.size {
+            self.size = size;
+            self.accumulation = Accumulation::default();
+        }
+    }
+
+    /// The view's size.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The camera frames are rendered from.
+    fn camera(&self) -> Option<Camera> {
+        match (&self.user_camera, &self.good) {
+            (Some(orbit), _) => Some(orbit.camera()),
+            (None, Some(good)) => Some(good.file_camera.clone()),
+            (None, None) => None,
+        }
+    }
+
+    /// The orbit to move (starting from the file's camera), marking the camera as moving.
+    fn orbit(&mut self) -> Option<&mut Orbit> {
+        let camera = self.camera()?;
+        self.moving_until = Some(Instant::now() + SETTLE);
+        self.broken = None;
+        Some(
+            self.user_camera
+                .get_or_insert_with(|| Orbit::from_camera(&camera)),
+        )
+    }
+
+    /// Orbits by a drag of (`dx`, `dy`) pixels.
+    pub fn rotate(&mut self, dx: f64, dy: f64) {
+        if let Some(o) = self.orbit() {
+            o.orbit(dx, dy);
+        }
+    }
+
+    /// Pans by a drag of (`dx`, `dy`) pixels.
+    pub fn pan(&mut self, dx: f64, dy: f64) {
+        let height = self.size.1;
+        if let Some(o) = self.orbit() {
+            o.pan(dx, dy, height);
+        }
+    }
+
+    /// Zooms by `lines` wheel lines (positive: closer).
+    pub fn zoom(&mut self, lines: f64) {
+        if let Some(o) = self.orbit() {
+            o.zoom(lines);
+        }
+    }
+
+    /// Returns to the file's camera.
+    pub fn reset_camera(&mut self) {
+        if self.user_camera.take().is_some() {
+            self.accumulation = Accumulation::default();
+            self.broken = None;
+        }
+    }
+
+    /// Whether the user has moved the camera away from the file's.
+    pub fn camera_moved(&self) -> bool {
+        self.user_camera.is_some()
+    }
+
+    fn moving(&self) -> bool {
+        self.moving_until.is_some_and(|t| Instant::now() < t)
+    }
+
+    /// Whether there is a frame to render: a scene is loaded and the camera moves or the image
+    /// has fewer samples than the scene's `aa` asks for.
+    /// While the scene's kernel compiles on another thread, only its end calls for a frame
+    /// (before, the interpreted kernel's image converges, or there is nothing to render: in
+    /// the grace period, the end of the period calls for one, at [`Session::grace_deadline`]).
+    pub fn wants_frame(&self) -> bool {
+        let Some(good) = &self.good else {
+            return false;
+        };
+        if good
+            .waiting
+            .as_ref()
+            .is_some_and(|w| w.finished(self.held(w.load)))
+        {
+            return true;
+        }
+        if self.broken.is_some() || good.kernel().is_none() {
+            return false;
+        }
+        let a = &self.accumulation;
+        self.moving()
+            || self.playing()
+            || !a.still
+            || a.count < good.aa
+            || (a.width, a.height) != self.size
+    }
+
+    /// Whether the image on show is final until something changes (converged, or nothing to
+    /// render, and no kernel compiling to replace the one that rendered it).
+    pub fn settled(&self) -> bool {
+        !self.wants_frame() && !self.compiling()
+    }
+
+    /// Renders the next frame into the image on show. `Ok(None)` when there is nothing to
+    /// render; `Err` is a render error (rendering stops until the next load or camera move).
+    pub fn frame(&mut self) -> Result<Option<FrameInfo>, String> {
+        self.poll();
+        if !self.wants_frame() {
+            return Ok(None);
+        }
+        self.advance();
+        // A playing animation renders as a moving camera does: one sample a frame.
+        let moving = self.moving() || self.playing();
+        let Some(base) = self.camera() else {
+            return Ok(None);
+        };
+        let scale = if moving {
+            self.scale
+        } else if self.preview {
+            self.preview_scale()
+        } else {
+            1
+        };
+        // A frame below full resolution is a single sample, replaced by the next frame.
+        let low = scale > 1 || moving;
+        self.preview = false;
+        let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
+        let a = &mut self.accumulation;
+        if low || !a.still || (a.width, a.height) != (w, h) {
+            let on_cpu = matches!(self.device, Device::Cpu);
+            *a = Accumulation {
+                width: w,
+                height: h,
+                sum: match on_cpu {
+                    true => vec![[0.0; 3]; w as usize * h as usize],
+                    false => Vec::new(),
+                },
+                count: 0,
+                still: !low,
+            };
+        }
+        let Some(good) = self.good.as_mut().filter(|g| g.kernel().is_some()) else {
+            return Ok(None);
+        };
+        let n = (good.aa as f64).sqrt().round() as u32;
+        let (dx, dy) = if low {
+            (0.0, 0.0)
+        } else {
+            camera::sample_offset(a.count, n)
+        };
+        good.scene.camera = camera::jittered(&base, dx, dy, w, h);
+        let s = &mut good.scene.settings;
+        (s.width, s.height, s.aa) = (w, h, 1);
+        let start = Instant::now();
+        let Some(kernel) = good.kernel() else {
+            return Ok(None);
+        };
+        let kind = kernel.kernel_kind();
+        let prepared = kernel;
+        let rendered = match prepared.as_wgpu() {
+            // On wgpu the frame stays on the device: rendered, accumulated and shown there.
+            Some(crate::backend::WgpuPrepared {
+                gpu,
+                kernel,
+                lipschitz,
+                ..
+            }) => {
+                let key = (self.version, kernel.interpreted());
+                let resident = match self.resident.as_mut() {
+                    Some(r) => Ok(r),
+                    None => Resident::new(gpu.clone()).map(|r| self.resident.insert(r)),
+                };
+                prepared
+                    .check_contract(&good.scene)
+                    .map_err(|e| e.to_string())
+                    .and_then(|()| {
+                        resident?.render(
+                            (kernel, *lipschitz),
+                            &good.scene,
+                            key,
+                            a.count == 0,
+                            self.steps_wanted,
+                        )
+                    })
+                    .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
+            }
+            None => prepared
+                .render(&good.scene, &|_| {})
+                .map_err(|e| e.to_string())
+                .map(|frame| {
+                    for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
+                        for i in 0..3 {
+                            sum[i] += c[i];
+                        }
+                    }
+                    (a.count + 1, frame.render.stats.steps_mean)
+                }),
+        };
+        let (count, steps) = match rendered {
+            Ok(r) => r,
+            Err(msg) => {
+                self.broken = Some(msg.clone());
+                return Err(msg);
+            }
+        };
+        let time = start.elapsed();
+        a.count = count;
+        if !a.sum.is_empty() {
+            let inv = 1.0 / a.count as f32;
+            self.shown = Some(Image {
+                width: w,
+                height: h,
+                linear: a
+                    .sum
+                    .iter()
+                    .map(|c| [c[0] * inv, c[1] * inv, c[2] * inv])
+                    .collect(),
+            });
+        }
+        if scale == 1 {
+            self.last_full = Some(time);
+        }
+        if moving {
+            if time > FRAME_BUDGET && self.scale < MAX_SCALE {
+                self.scale += 1;
+            } else if time * 3 < FRAME_BUDGET && self.scale > 1 {
+                self.scale -= 1;
+            }
+        }
+        let info = FrameInfo {
+            width: w,
+            height: h,
+            samples: a.count,
+            target: good.aa,
+            time,
+            steps,
+            moving,
+            kernel: kind,
+        };
+        let interim = match good.waiting.as_mut() {
+            Some(w) => {
+                w.shown = true;
+                w.interim.as_ref().and_then(|i| i.pipeline)
+            }
+            None => None,
+        };
+        if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
+            t.first_frame = Some((time, w, h));
+            t.first_kernel = kind;
+            t.interim_pipeline = interim;
+        }
+        self.last = Some(info);
+        Ok(Some(info))
+    }
+
+    /// The image on show: the mean of the samples accumulated (at the size of the last frame),
+    /// or `None` before the first good frame. On wgpu it is read back from the device (for a
+    /// screenshot or a test: frames themselves never are); a failed read is printed, and is
+    /// `None`.
+    pub fn image(&self) -> Option<Image> {
+        match &self.resident {
+            Some(r) => r.image().unwrap_or_else(|msg| {
+                eprintln!("error: {msg}");
+                None
+            }),
+            None => self.shown.clone(),
+        }
+    }
+
+    /// The image on show as the host holds it: the CPU renderer's (a window uploads it to show
+    /// it). `None` on wgpu, whose image stays on the device ([`Session::texture`]).
+    pub fn host_image(&self) -> Option<&Image> {
+        self.shown.as_ref()
+    }
+
+    /// On wgpu, the texture on show (sRGB bytes in an `Rgba8Unorm` texture, which may be
+    /// viewed as `Rgba8UnormSrgb`), on the device that renders the frames, and its number,
+    /// which changes when the texture does; `None` before the first frame and on the CPU.
+    pub fn texture(&self) -> Option<(&wgpu::Texture, u64)> {
+        self.resident.as_ref().and_then(Resident::texture)
+    }
+
+    /// Whether each frame's mean steps per pixel are wanted (the statistics in the title); on
+    /// wgpu, where frames stay on the device, a frame then reads back their sum (two words).
+    pub fn want_steps(&mut self, wanted: bool) {
+        self.steps_wanted = wanted;
+        // The frame on show was rendered without them: they are summed on the device now.
+        let Some(last) = self.last.as_mut().filter(|l| wanted && l.steps.is_nan()) else {
+            return;
+        };
+        if let Some(resident) = self.resident.as_mut() {
+            match resident.last_steps() {
+                Ok(Some(steps)) => last.steps = steps,
+                Ok(None) => {}
+                Err(msg) => eprintln!("error: {msg}"),
+            }
+        }
+    }
+
+    /// Called once a frame is on show: prints the timings of the load whose first frame it
+    /// is, with `--timings` (edit to pixel: from the modification of the newest of the
+    /// scene's files until now).
+    pub fn presented(&mut self) {
+        let Some(t) = self.timings.as_ref() else {
+            return;
+        };
+        let Some((time, w, h)) = t.first_frame else {
+            return;
+        };
+        if t.printed {
+            // The first frame was smaller: say when the full resolution followed.
+            let full = self.accumulation.still && self.accumulation.count > 0;
+            if full {
+                if let (true, Some(m)) = (self.options.timings, t.modified.filter(|_| t.number > 0))
+                {
+                    if let Ok(total) = SystemTime::now().duration_since(m) {
+                        eprintln!(
+                            "view: load {}: first full-resolution frame shown {:.1} ms after the edit",
+                            t.number,
+                            ms(total)
+                        );
+                    }
+                }
+                self.timings = None;
+            }
+            return;
+        }
+        if self.options.timings {
+            let pipeline = t.pipeline_words(self.options.grace);
+            let now = SystemTime::now();
+            let edit = match (
+                t.modified.filter(|_| t.number > 0),
+                now.duration_since(t.began),
+            ) {
+                (Some(m), Ok(shown)) => match (t.began.duration_since(m), now.duration_since(m)) {
+                    (Ok(seen), Ok(total)) => format!(
+                        "; edit to pixel {:.1} ms (seen after {:.1} ms, shown {:.1} ms later)",
+                        ms(total),
+                        ms(seen),
+                        ms(shown)
+                    ),
+                    _ => String::new(),
+                },
+                _ => String::new(),
+            };
+            eprintln!(
+                "view: load {} timings: check {:.1} ms, lower {:.2} ms, {} {:.2} ms{pipeline}, first frame {:.1} ms ({w}x{h}{}){edit}",
+                t.number,
+                ms(t.check),
+                ms(t.lower),
+                match (&self.device, t.built) {
+                    (Device::Cpu, _) => "tapes",
+                    (_, true) => "kernel",
+                    (_, false) => "kernel kept (numbers only)",
+                },
+                ms(t.prepare),
+                ms(time),
+                t.first_kernel.map(|k| format!(", {k}")).unwrap_or_default(),
+            );
+        }
+        if (w, h) == self.size {
+            self.timings = None;
+        } else if let Some(t) = self.timings.as_mut() {
+            t.printed = true;
+        }
+    }
+
+    /// The window title: the file, the problem with the last load if it failed, a render
+    /// error, and with `stats` the backend, method, frame time, steps per pixel and samples.
+    pub fn title(&self, stats: bool) -> String {
+        let mut title = format!("sdfc view: {}", self.file.display());
+        if let Some(t) = self.time() {
+            let state = if self.playing() { "playing" } else { "paused" };
+            title.push_str(&format!(" | t = {t:.2} s, {state}"));
+        }
+        if let Some(status) = &self.status {
+            title.push_str(&format!(" | {status}"));
+        }
+        if let Some(msg) = &self.broken {
+            title.push_str(&format!(" | render error: {msg}"));
+        }
+        match self.good.as_ref().and_then(|g| g.waiting.as_ref()) {
+            Some(w) if !w.in_grace() && w.interim.as_ref().is_some_and(|i| i.compile.is_none()) => {
+                title.push_str(" | interpreted while compiling")
+            }
+            // In the grace period, and after it until a kernel is ready.
+            Some(_) => title.push_str(" | compiling the kernel"),
+            None => {}
+        }
+        if let (true, Some(good), Some(f)) = (stats, &self.good, &self.last) {
+            let kernel = f
+                .kernel
+                .map(|k| format!(" {k} kernel,"))
+                .unwrap_or_default();
+            title.push_str(&format!(
+                " | {} ({}),{kernel} {}, {}x{}, {}/{} samples, {:.1} ms, {:.1} steps/px",
+                self.device.name(),
+                self.device.describe(),
+                good.method,
+                f.width,
+                f.height,
+                f.samples,
+                f.target,
+                ms(f.time),
+                f.steps
+            ));
+        }
+        title
+    }
+}
+
+/// When the edit a load follows was made: the later of the newest modification time of the
+/// scene's files and the first file event of the batch that called for the load (`None`
+/// when neither is known).
+fn edit_time(modified: Option<SystemTime>, event: Option<SystemTime>) -> Option<SystemTime> {
+    match (modified, event) {
+        (Some(m), Some(e)) => Some(m.max(e)),
+        (m, e) => m.or(e),
+    }
+}
+
+/// The lowering of a scene: an animated one keeps the structure of its program whatever its
+/// numbers (`LowerOptions::parametric`), so that its frames share one kernel.
+fn lower_options(scene: &Scene) -> LowerOptions {
+    if scene.animation.animated() {
+        LowerOptions::parametric()
+    } else {
+        LowerOptions::default()
+    }
+}
+
+/// `path` made absolute (as the watcher reports paths), or as it is.
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// The paths of the files of a compilation, in file order (the entry file first).
+fn files_of(sources: &SourceMap) -> Vec<PathBuf> {
+    (0..sources.len() as u32)
+        .map(|i| PathBuf::from(sources.name(FileId(i))))
+        .collect()
+}
+
+/// The one line of `e` for the window, printed first unless it is a scene's errors (whose
+/// diagnostics are printed where they are found).
+fn summary(e: Error) -> String {
+    if !matches!(e, Error::Scene(_)) {
+        eprintln!("error: {e}");
+    }
+    e.to_string()
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests;

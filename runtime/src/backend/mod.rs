@@ -76,9 +76,9 @@ pub struct Setup {
     /// Which GPU kernel a marched scene gets (`--kernel`): its distance program written as
     /// code, interpreted from a buffer, or the one `wgsl::choose` expects sooner.
     pub kernel: wgsl::KernelChoice,
-    /// GPU frames read back the image alone, not the per-pixel statistics (`sdfc render`
-    /// without `--stats`, sequences): their [`Frame`]'s statistics then count nothing but
-    /// the camera rays. At 1920×1080 the statistics are 66 MB to read back and convert.
+    /// GPU frames read back the image alone, without reducing the per-pixel statistics on
+    /// the device (`sdfc render` without `--stats`, sequences): their [`Frame`]'s statistics
+    /// then count nothing but the camera rays.
     pub image_only: bool,
     /// GPU frames are finished on the device: clamped and sRGB-encoded to RGBA8 by the kernel
     /// (bit for bit the host's encoding), and only those 4 bytes a pixel read back instead of

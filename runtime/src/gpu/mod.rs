@@ -126,8 +126,8 @@ pub fn render(
     )
 }
 
-/// [`render`] with the faults `faults` injected, reading the per-pixel statistics back only
-/// when `statistics` ([`launch::Job::statistics`]), and the finished pixels instead of the
+/// [`render`] with the faults `faults` injected, reducing the per-pixel statistics on the
+/// device only when `statistics` ([`launch::Job::statistics`]), and the finished pixels instead of the
 /// linear colours when `finished` ([`launch::Job::finished`]).
 pub fn render_faults(
     gpu: &Gpu,
@@ -152,7 +152,7 @@ pub fn render_faults(
 
 /// Renders `scene` with a kernel already loaded on a CUDA device, whose uniform is laid out
 /// as `uniform`; `data` is the kernel's scene data ([`Kernel::data`]); `faults` are injected,
-/// the per-pixel statistics read back only when `statistics`, the finished pixels instead of
+/// the per-pixel statistics reduced only when `statistics`, the finished pixels instead of
 /// the linear colours when `finished`.
 pub fn render_cuda(
     cuda: &cuda::Cuda,

@@ -9,7 +9,7 @@
 
 use crate::cpu::Counters;
 use sdfc_compiler::wgsl::{
-    reduce::Query, reduce::BINS, reduce::MAX_WORD, reduce::RECORD, reduce::WORKGROUP,
+    reduce::Query, reduce::BINS, reduce::MOST_STEPS_WORD, reduce::RECORD, reduce::WORKGROUP,
 };
 use std::ops::Range;
 use std::sync::{Condvar, Mutex};
@@ -98,7 +98,7 @@ impl Answer {
                     for (k, s) in sums.iter_mut().enumerate() {
                         *s += r[2 * k] as u64 | (r[2 * k + 1] as u64) << 32;
                     }
-                    max = max.max(r[MAX_WORD as usize]);
+                    max = max.max(r[MOST_STEPS_WORD as usize]);
                 }
                 // The kernel's statistics words, in order (kernel.wgsl).
                 let counters = Counters {
@@ -443,8 +443,8 @@ mod tests {
         words[0] = u32::MAX;
         words[RECORD as usize] = 1;
         words[1] = 2;
-        words[MAX_WORD as usize] = 9;
-        words[RECORD as usize + MAX_WORD as usize] = 4;
+        words[MOST_STEPS_WORD as usize] = 9;
+        words[RECORD as usize + MOST_STEPS_WORD as usize] = 4;
         let Answer::Sums { counters, max } = Answer::of_totals(&words, Ask::Sums) else {
             panic!("sums")
         };

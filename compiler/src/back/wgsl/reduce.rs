@@ -33,7 +33,7 @@ pub const RECORD: u32 = BINS;
 /// Words of a query (binding 0): first, count, threads, stage, mode, base, width, add.
 pub const QUERY_WORDS: u32 = 8;
 /// Where the sums mode puts the most steps of a pixel in a record.
-pub const MAX_WORD: u32 = 16;
+pub const MOST_STEPS_WORD: u32 = 16;
 
 /// The module's text. Bindings (group 0): 0 the query (read-only storage at a dynamic offset,
 /// not a uniform: a software adapter compiles a variant of a shader for each value of a uniform
@@ -195,7 +195,7 @@ mod tests {
         assert_eq!(RECORD, BINS);
         assert!(SOURCE.contains(&format!("const RECORD: u32 = {RECORD}u;")));
         assert!(SOURCE.contains(&format!("const BINS: u32 = {BINS}u;")));
-        assert!(SOURCE.contains(&format!("acc[{MAX_WORD}]")));
+        assert!(SOURCE.contains(&format!("acc[{MOST_STEPS_WORD}]")));
         assert!(SOURCE.contains(&format!("@workgroup_size({WORKGROUP}, 1, 1)")));
         assert_eq!(super::super::STATS_WORDS, 8);
     }

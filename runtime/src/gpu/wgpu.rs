@@ -476,7 +476,27 @@ impl Gpu {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-        let path = self.driver_cache_path(wgsl, entry_point, data);
+        let (pipeline, driver) = self.cached_compute(
+            (wgsl, entry_point, data),
+            "sdfc render",
+            &pipeline_layout,
+            &module,
+        );
+        (pipeline, layout, driver)
+    }
+
+    /// The compute pipeline of `module`'s entry point `entry` (of the text `wgsl`, with the
+    /// scene-data binding when `data`: the key of [`Gpu::driver_cache_path`]) laid out as
+    /// `layout`, the driver given the pipeline cache data an earlier process stored for it on
+    /// this device, or else what it produces stored.
+    fn cached_compute(
+        &self,
+        (wgsl, entry, data): (&str, &str, bool),
+        label: &str,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+    ) -> (wgpu::ComputePipeline, DriverCache) {
+        let path = self.driver_cache_path(wgsl, entry, data);
         let stored = path.as_ref().and_then(|p| std::fs::read(p).ok());
         // wgpu cannot check that cache data came from
         // `PipelineCache::get_data`.
@@ -498,10 +518,10 @@ impl Gpu {
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("sdfc render"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
+                label: Some(label),
+                layout: Some(layout),
+                module,
+                entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: cache.as_ref(),
             });
@@ -516,7 +536,7 @@ impl Gpu {
             }
             _ => DriverCache::Unsupported,
         };
-        (pipeline, layout, driver)
+        (pipeline, driver)
     }
 
     /// The buffers of a frame with the job's uniforms and scene data written (queued): the
@@ -691,16 +711,13 @@ impl Gpu {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-        let pipeline = self
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("sdfc reduction"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(reduction::ENTRY_POINT),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+        // The driver's compiled code kept between processes, as a kernel's is.
+        let (pipeline, _) = self.cached_compute(
+            (reduction::SOURCE, reduction::ENTRY_POINT, false),
+            "sdfc reduction",
+            &pipeline_layout,
+            &module,
+        );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Pipeline(e.to_string()));
         }

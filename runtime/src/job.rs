@@ -456,3 +456,120 @@ impl<'a> Kernels<'a> {
         self.prepared.as_ref().map(|(_, _, p)| p)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::Device;
+
+    #[test]
+    fn the_reference_renders_on_the_cpu_in_f64_and_refuses_gpus() {
+        let reference = |backend, devices| Job {
+            backend,
+            devices,
+            overrides: Overrides {
+                reference: true,
+                ..Overrides::default()
+            },
+            ..Job::default()
+        };
+        let mode = reference(Backend::Auto, Devices::Auto).mode().unwrap();
+        assert_eq!(mode, (Backend::Cpu, Precision::F64));
+        assert_eq!(
+            reference(Backend::Auto, Devices::Auto).setup().precision,
+            Precision::F64
+        );
+        let wgpu = reference(Backend::Wgpu, Devices::Auto).mode();
+        assert!(
+            matches!(&wgpu, Err(Error::Usage(m)) if m.ends_with("cannot use --backend wgpu")),
+            "{wgpu:?}"
+        );
+        let listed = reference(Backend::Cpu, Devices::List(vec![Device::Cpu])).mode();
+        assert!(
+            matches!(&listed, Err(Error::Usage(m)) if m.contains("--devices")),
+            "{listed:?}"
+        );
+        let plain = Job {
+            precision: Precision::F64,
+            ..Job::default()
+        };
+        assert_eq!(plain.mode().unwrap(), (Backend::Auto, Precision::F64));
+    }
+
+    #[test]
+    fn usage_and_io_exit_with_2_and_the_rest_with_1() {
+        let two = ExitCode::from(2);
+        let one = ExitCode::from(1);
+        assert_eq!(Error::Usage("bad".into()).code(), two);
+        assert_eq!(Error::Io("cannot read".into()).code(), two);
+        assert_eq!(Error::Memory("too much".into()).code(), one);
+        assert_eq!(Error::Encode("ffmpeg".into()).code(), one);
+        let failed = backend::Error::Device("no adapter".into());
+        let unavailable = Error::Unavailable {
+            backend: Backend::Wgpu,
+            source: failed,
+        };
+        assert_eq!(
+            unavailable.to_string(),
+            "the Wgpu backend is not available: no adapter"
+        );
+        assert_eq!(unavailable.code(), one);
+        let unsupported = Error::from(backend::Error::Unsupported("not traced".into()));
+        assert_eq!(unsupported.to_string(), "not traced");
+        assert_eq!(unsupported.code(), one);
+    }
+
+    #[test]
+    fn a_scene_with_errors_is_summarised_by_its_first_error() {
+        let mut source = Source::from_text(
+            "broken.sdf",
+            "scene { sphere(undefined_a); sphere(undefined_b); }\n".into(),
+        );
+        let job = Job::default();
+        let failed = job.frame(&mut source, 0.0, true, &LowerOptions::default());
+        let Err(Error::Scene(errors)) = failed else {
+            panic!("not the scene's errors: {failed:?}");
+        };
+        let summary = errors.summary();
+        assert!(summary.starts_with("error[E"), "{summary}");
+        assert!(summary.contains(" at broken.sdf:1:"), "{summary}");
+        assert!(summary.ends_with(" (and 1 more)"), "{summary}");
+        assert_eq!(Error::Scene(errors).code(), ExitCode::from(1));
+    }
+
+    #[test]
+    fn the_jobs_settings_are_applied_in_order_within_the_limits() {
+        let job = Job {
+            overrides: Overrides {
+                size: Some((64, 48)),
+                aa: Some(2),
+                set: vec!["width=32".into(), "max_steps=100".into()],
+                ..Overrides::default()
+            },
+            ..Job::default()
+        };
+        let mut settings = Settings::default();
+        job.override_settings(&mut settings).unwrap();
+        assert_eq!(
+            (
+                settings.width,
+                settings.height,
+                settings.aa,
+                settings.max_steps
+            ),
+            (32, 48, 2, 100)
+        );
+        let bad = Job {
+            overrides: Overrides {
+                set: vec!["max_steps".into()],
+                ..Overrides::default()
+            },
+            ..Job::default()
+        };
+        let refused = bad.override_settings(&mut settings);
+        assert!(
+            matches!(&refused, Err(Error::Usage(m)) if m.contains("KEY=VALUE")),
+            "{refused:?}"
+        );
+    }
+}

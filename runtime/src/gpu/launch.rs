@@ -871,6 +871,130 @@ mod tests {
         );
     }
 
+    /// A device whose reads are started behind its launches and collected later (as the GPU
+    /// devices' are): a band's pixels are its indices, copied at `start_read` into one of two
+    /// slots; what it did is logged.
+    struct Overlapping<'a> {
+        log: &'a Mutex<Vec<(usize, &'static str, usize)>>,
+        id: usize,
+    }
+
+    impl Device for Overlapping<'_> {
+        type Frame = [Option<Range<usize>>; 2];
+        type Error = String;
+        fn describe(&self) -> String {
+            "overlapping".into()
+        }
+        fn prepare(&self, _job: &Job) -> Result<Self::Frame, String> {
+            Ok([None, None])
+        }
+        fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), String> {
+            Err("run is not called: bands are submitted".into())
+        }
+        fn submit(&self, _: &mut Self::Frame, job: &Job, tiles: &[usize]) -> Result<(), String> {
+            let band = job.band(tiles[0]);
+            self.log
+                .lock()
+                .expect("log")
+                .push((self.id, "submit", band.start));
+            Ok(())
+        }
+        fn start_read(
+            &self,
+            slots: &mut Self::Frame,
+            _: &Job,
+            range: Range<usize>,
+            slot: usize,
+        ) -> Result<(), String> {
+            // The slot is free: its band was collected before it is used again.
+            assert!(slots[slot].is_none(), "slot {slot} still holds a band");
+            self.log
+                .lock()
+                .expect("log")
+                .push((self.id, "start", range.start));
+            slots[slot] = Some(range);
+            Ok(())
+        }
+        fn collect(
+            &self,
+            slots: &mut Self::Frame,
+            _: &Job,
+            range: Range<usize>,
+            slot: usize,
+        ) -> Result<Pixels, String> {
+            assert_eq!(slots[slot].take().as_ref(), Some(&range), "slot {slot}");
+            self.log
+                .lock()
+                .expect("log")
+                .push((self.id, "collect", range.start));
+            Ok(Pixels {
+                linear: range.map(|i| [i as f32, 0.0, 0.0]).collect(),
+                ..Pixels::default()
+            })
+        }
+        fn read(&self, _: &mut Self::Frame, _: &Job, _: &[Range<usize>]) -> Result<Pixels, String> {
+            Err("read is not called: bands are collected".into())
+        }
+        fn reduce(
+            &self,
+            _: &mut Self::Frame,
+            _: &Job,
+            _: &[Range<usize>],
+            ask: Ask,
+        ) -> Result<Answer, String> {
+            Ok(Answer::empty(ask))
+        }
+        fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, String> {
+            assert_eq!(slots, [None, None], "every band collected");
+            Ok(None)
+        }
+        fn fault(&self, message: String) -> String {
+            message
+        }
+    }
+
+    #[test]
+    fn a_band_is_collected_while_the_next_one_renders() {
+        let tiles = tiling(16, 64, 512, 2);
+        let job = Job {
+            uniforms: &[],
+            data: None,
+            width: 16,
+            height: 64,
+            tiles: &tiles,
+            timed: false,
+            statistics: false,
+            finished: false,
+        };
+        let log = Mutex::new(Vec::new());
+        let (a, b) = (
+            Overlapping { log: &log, id: 0 },
+            Overlapping { log: &log, id: 1 },
+        );
+        let devices: [&dyn Worker; 2] = [&a, &b];
+        let out = render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect("renders");
+        assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
+        let log = log.into_inner().expect("log");
+        for band in tiles.iter().map(|t| t.1 as usize * 16) {
+            let at = |what| log.iter().filter(|e| e.1 == what && e.2 == band).count();
+            assert_eq!(
+                (at("submit"), at("start"), at("collect")),
+                (1, 1, 1),
+                "band {band}"
+            );
+        }
+        // A device that rendered two bands or more submitted the next before collecting the
+        // one before.
+        for id in [0, 1] {
+            let mine: Vec<_> = log.iter().filter(|e| e.0 == id).map(|e| e.1).collect();
+            if mine.iter().filter(|&&w| w == "submit").count() >= 2 {
+                let first_collect = mine.iter().position(|&w| w == "collect").expect("collects");
+                let submits_before = mine[..first_collect].iter().filter(|&&w| w == "submit");
+                assert_eq!(submits_before.count(), 2, "device {id}: {mine:?}");
+            }
+        }
+    }
+
     #[test]
     fn a_queue_waits_for_items_handed_back_and_ends_when_abandoned() {
         let q = Queue::new([1, 2], false);

@@ -767,3 +767,46 @@ fn a_constant_colour_field_renders_as_the_plain_colour() {
         }
     }
 }
+
+/// A profile written as a formula of the plane's point renders as the built-in profile it
+/// spells: `profile { length(p) - r }` extruded and revolved against `circle(r)`, both
+/// sphere traced, in f32 and in the f64 reference (the formula is only known to be a bound,
+/// the built-in exact: the steps differ, the surfaces do not).
+#[test]
+fn a_profile_formula_renders_as_the_profile_it_spells() {
+    let text = |disc: &str| {
+        format!(
+            "material red = phong {{ color: (0.9, 0.2, 0.2), specular: 0.4 }};\n\
+             camera {{ position: (0, 1.5, -4), look_at: (0, 0, 0) }}\n\
+             light point {{ position: (3, 5, -4) }}\n\
+             render {{ width: 64, height: 48, method: \"march\" }}\n\
+             scene {{ plane((0, 1, 0), -0.8) @ red;\n\
+             extrude({disc}, 0.6).rotate_y(30deg).translate(-0.9, 0, 0);\n\
+             revolve({disc}.translate(0.6, 0)).translate(1, 0, 0); }}"
+        )
+    };
+    let scene = |t: &str| {
+        let (scene, diags, _) = sdfc_compiler::check_str("profile.sdf", t);
+        scene.unwrap_or_else(|| panic!("{diags:?}"))
+    };
+    let built_in = scene(&text("circle(0.5)"));
+    let formula = scene(&text("profile { length(p) - 0.5 }"));
+    let other = scene(&text("profile { length(p) - 0.45 }"));
+    for precision in [Precision::F32, Precision::F64] {
+        let options = Options {
+            precision,
+            ..Options::default()
+        };
+        let run = |s: &Scene| cpu::render(s, &Lowered::new(s), &options, &|| {}).image;
+        let want = run(&built_in);
+        let d = sdfc_runtime::metrics::compare(&run(&formula), &want, 0.1).expect("same size");
+        println!(
+            "{precision:?}: {:.1} dB, {:.4} differing",
+            d.psnr, d.differing
+        );
+        assert!(d.psnr > 60.0 && d.differing == 0.0, "{precision:?}: {d:?}");
+        // A different radius is seen.
+        let d = sdfc_runtime::metrics::compare(&run(&other), &want, 0.1).expect("same size");
+        assert!(d.psnr < 40.0, "{precision:?}: {d:?}");
+    }
+}

@@ -1558,6 +1558,7 @@ pub static BUILTINS: &[Builtin] = &[
         name: "distance",
         sigs: sigs![
             [shape("shape"), p("at", V, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+            [prof("profile"), p("at", V2, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
         ],
     },
     Builtin {

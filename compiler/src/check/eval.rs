@@ -70,6 +70,9 @@ pub struct Ctx<'l> {
     memo: HashMap<String, (Value, Option<Span>)>,
     /// Fields begun so far: each field's point is told apart from an enclosing one's.
     fields: u32,
+    /// For each field being evaluated, innermost last: whether it is a profile's (its point
+    /// a vec2).
+    planes: Vec<bool>,
     /// The time `t` the scene is checked at, in seconds.
     pub time: f64,
     /// Reads of `t` so far (dry evaluation not counted): a count, to tell whether evaluating
@@ -236,7 +239,9 @@ impl Ctx<'_> {
                 body,
             } => self.comprehension(var, from, to, body),
             ExprKind::Index(xs, i) => self.index(xs, i),
-            ExprKind::FieldBlock { args, body } => self.field_block(args, body, e.span),
+            ExprKind::FieldBlock { args, body, plane } => {
+                self.field_block(args, body, *plane, e.span)
+            }
             ExprKind::Error => Value::Error,
         }
     }
@@ -721,18 +726,24 @@ impl Ctx<'_> {
             }
         };
         if idx >= dims {
-            self.error(
-                Diagnostic::error(
-                    "E0210",
-                    format!("unknown vector component `{}`", name.name),
-                    name.span,
-                )
-                .with_label(if dims == 2 {
-                    "a vec2 has `x` and `y`"
-                } else {
-                    "a vec3 has `x`, `y` and `z`"
-                }),
-            );
+            let mut d = Diagnostic::error(
+                "E0210",
+                format!("unknown vector component `{}`", name.name),
+                name.span,
+            )
+            .with_label(if dims == 2 {
+                "a vec2 has `x` and `y`"
+            } else {
+                "a vec3 has `x`, `y` and `z`"
+            });
+            if dims == 2 && field::is_point(&v) && self.planes.last() == Some(&true) {
+                d = d
+                    .with_note(
+                        "inside `profile { … }` the point `p` is a vec2: a point of the plane",
+                    )
+                    .with_help("a field of points in space, with `p.z`, is written `field { … }`");
+            }
+            self.error(d);
             return Value::Error;
         }
         match v {
@@ -880,17 +891,25 @@ impl Ctx<'_> {
     }
 
     /// `field [(lipschitz: L)] { body }`: the body evaluated with `p` the point, its value
-    /// (a float of the point) the distance of a new field shape.
-    fn field_block(&mut self, args: &[Arg], body: &Body, span: Span) -> Value {
+    /// (a float of the point) the distance of a new field shape. With `plane` (`profile {
+    /// … }`), `p` is a point of the plane (a vec2) and the value a profile's distance.
+    fn field_block(&mut self, args: &[Arg], body: &Body, plane: bool, span: Span) -> Value {
+        let word = if plane { "profile" } else { "field" };
         let mut lipschitz = None;
         for a in args {
             let named = a.name.as_ref().map(|n| n.name.as_str());
             if !matches!(named, None | Some("lipschitz")) || args.len() > 1 {
                 let at = a.name.as_ref().map_or(a.value.span, |n| n.span);
                 self.error(
-                    Diagnostic::error("E0202", "`field` takes one argument, `lipschitz`", at)
-                        .with_label("not `lipschitz`")
-                        .with_help("declare a bound of the gradient: `field(lipschitz: 2) { … }`"),
+                    Diagnostic::error(
+                        "E0202",
+                        format!("`{word}` takes one argument, `lipschitz`"),
+                        at,
+                    )
+                    .with_label("not `lipschitz`")
+                    .with_help(format!(
+                        "declare a bound of the gradient: `{word}(lipschitz: 2) {{ … }}`"
+                    )),
                 );
                 return Value::Error;
             }
@@ -902,7 +921,7 @@ impl Ctx<'_> {
                     self.error(
                         Diagnostic::error(
                             "E0400",
-                            "`lipschitz` of `field` must be greater than 0",
+                            format!("`lipschitz` of `{word}` must be greater than 0"),
                             a.value.span,
                         )
                         .with_label(format!("this is {v}")),
@@ -913,7 +932,7 @@ impl Ctx<'_> {
                     let v = other.unwrap_or(Value::Error);
                     if field::is_point(&v) {
                         return self.per_point(
-                            "`lipschitz` of `field` must be a constant".into(),
+                            format!("`lipschitz` of `{word}` must be a constant"),
                             a.value.span,
                         );
                     }
@@ -926,14 +945,39 @@ impl Ctx<'_> {
         let owner = self.fields;
         let coord = |i: u8| std::rc::Rc::new(super::types::Sx::Coord(i, owner));
         let mark = self.locals.len();
-        self.locals
-            .push(("p".into(), field::point(vec![coord(0), coord(1), coord(2)])));
+        let point = if plane {
+            vec![coord(0), coord(1)]
+        } else {
+            vec![coord(0), coord(1), coord(2)]
+        };
+        self.locals.push(("p".into(), field::point(point)));
+        self.planes.push(plane);
         let v = self.body(body);
+        self.planes.pop();
         self.locals.truncate(mark);
-        // A float body is a distance (a shape), a vec3 body a colour (a colour field).
+        let distance = if plane { Type::Profile } else { Type::Shape };
+        // A float body is a distance (a shape, or a profile), a vec3 body a colour (a colour
+        // field; not of the plane).
+        if plane && v.ty().is_some_and(|t| !t.fits(Type::Float)) {
+            let ty = type_name(&v);
+            let mut d = Diagnostic::error(
+                "E0300",
+                format!("the body of `profile` is a `{ty}`, not a float"),
+                body.value.span,
+            )
+            .with_label(format!("this is `{ty}`"))
+            .with_note("a profile's body is its distance at the point `p` of the plane (a vec2)");
+            if v.ty() == Some(Type::Vec3) {
+                d = d.with_help(
+                    "a colour field is a formula of a point in space: write it `field { … }`",
+                );
+            }
+            self.error(d);
+            return Value::Error;
+        }
         let (comps, colour) = match &v {
             Value::Error => return Value::Error,
-            Value::Unknown(Type::Float | Type::Int) => return Value::Unknown(Type::Shape),
+            Value::Unknown(Type::Float | Type::Int) => return Value::Unknown(distance),
             Value::Unknown(Type::Vec3) => return Value::Unknown(Type::ColourField),
             Value::Int(_) | Value::Float(_) | Value::Point(_)
                 if v.ty().is_some_and(|t| t.fits(Type::Float)) =>
@@ -990,14 +1034,14 @@ impl Ctx<'_> {
             return Value::Error;
         }
         if self.dry > 0 {
-            return Value::Unknown(if colour {
-                Type::ColourField
-            } else {
-                Type::Shape
-            });
+            return Value::Unknown(if colour { Type::ColourField } else { distance });
         }
         match field::flatten(&comps, owner) {
             Ok(f) if colour => Value::Colour(std::rc::Rc::new(f)),
+            Ok(f) if plane => match self.add_node(Node::Field { f, lipschitz }, span) {
+                Value::Shape(id) => Value::Profile(id),
+                other => other,
+            },
             Ok(f) => self.add_node(Node::Field { f, lipschitz }, span),
             Err(field::OuterPoint) => self.per_point(
                 "this field reads the point `p` of an enclosing field".into(),
@@ -1860,6 +1904,17 @@ fn with_type_help(mut d: Diagnostic, want: Type, found: Option<Type>) -> Diagnos
         (Type::Int, Some(Type::Float)) => d = d.with_help("use a whole number, or `int(x)`"),
         (Type::Vec3, Some(Type::Float | Type::Int)) => {
             d = d.with_help("write a vector as `(x, y, z)`")
+        }
+        (Type::Profile, Some(Type::Shape)) => {
+            d = d.with_help(
+                "a profile is flat: `circle`, `rect`, `polygon`, …, or a formula of a point of \
+                 the plane, `profile { … }` (`field { … }` is a formula of a point in space)",
+            )
+        }
+        (Type::Shape, Some(Type::Profile)) => {
+            d = d.with_help(
+                "a profile is flat: make it a shape with `extrude(profile, height)` or `revolve(profile)`",
+            )
         }
         _ => {}
     }

@@ -279,13 +279,15 @@ pub fn builtin(name: &str, a: &[Value]) -> Option<Result<Value, String>> {
         "vec3" => point(vec![s(0), s(1), s(2)]),
         "float" => a[0].clone(),
         "distance" => {
-            let Value::Shape(id) = a[0] else {
+            let (Value::Shape(id) | Value::Profile(id)) = a[0] else {
                 return Some(Ok(Value::Error));
             };
+            // A profile's distance reads x and y: it is read in the plane z = 0.
             let q = c(1);
+            let z = q.get(2).cloned().unwrap_or_else(|| k(0.0));
             point(vec![Rc::new(Sx::Distance(
                 id,
-                [q[0].clone(), q[1].clone(), q[2].clone()],
+                [q[0].clone(), q[1].clone(), z],
             ))])
         }
         "noise" => point(vec![Rc::new(Sx::Noise(c(0)))]),

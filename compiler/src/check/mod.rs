@@ -575,7 +575,7 @@ fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
                 stack.extend(body.lets.iter().map(|l| &l.value));
                 stack.push(&body.value);
             }
-            ast::ExprKind::FieldBlock { args, body } => {
+            ast::ExprKind::FieldBlock { args, body, .. } => {
                 stack.extend(args.iter().map(|a| &a.value));
                 stack.extend(body.lets.iter().map(|l| &l.value));
                 stack.push(&body.value);

@@ -257,8 +257,13 @@ pub enum ExprKind {
     /// `xs[i]`: an element of a list.
     Index(Box<Expr>, Box<Expr>),
     /// `field [args] { body }`: a shape whose distance is the body's value at the point `p`
-    /// (the arguments: `lipschitz`, a declared bound of its gradient).
-    FieldBlock { args: Vec<Arg>, body: Body },
+    /// (the arguments: `lipschitz`, a declared bound of its gradient); `profile [args] {
+    /// body }` (`plane`): a profile, the same of a point `p` of the plane (a vec2).
+    FieldBlock {
+        args: Vec<Arg>,
+        body: Body,
+        plane: bool,
+    },
     /// An expression that did not parse (already reported).
     Error,
 }

@@ -178,15 +178,17 @@ impl Dumper {
                 d.expr(xs);
                 d.expr(i);
             }),
-            ExprKind::FieldBlock { args, body } => self.nested("field", |d| {
-                for a in args {
-                    match &a.name {
-                        Some(n) => d.nested(format!("arg {}", n.name), |d| d.expr(&a.value)),
-                        None => d.expr(&a.value),
+            ExprKind::FieldBlock { args, body, plane } => {
+                self.nested(if *plane { "profile" } else { "field" }, |d| {
+                    for a in args {
+                        match &a.name {
+                            Some(n) => d.nested(format!("arg {}", n.name), |d| d.expr(&a.value)),
+                            None => d.expr(&a.value),
+                        }
                     }
-                }
-                d.body(body);
-            }),
+                    d.body(body);
+                })
+            }
             ExprKind::Error => self.line("<error>"),
         }
     }

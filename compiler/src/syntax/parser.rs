@@ -381,19 +381,24 @@ where
                 move |s| mk(ExprKind::Error, s),
             )));
 
-        // `field_shape = ident [ args ] body`, the name being `field` (a name elsewhere).
-        let field = select! { Token::Ident(name) if name == "field" => () }
-            .ignore_then(args.clone().or_not())
-            .then(body.clone())
-            .map_with(move |(args, body), e| {
-                mk(
-                    ExprKind::FieldBlock {
-                        args: args.unwrap_or_default(),
-                        body,
-                    },
-                    e.span(),
-                )
-            });
+        // `field_shape = ident [ args ] body`, the name being `field` or `profile` (names
+        // elsewhere).
+        let field = select! {
+            Token::Ident(name) if name == "field" => false,
+            Token::Ident(name) if name == "profile" => true,
+        }
+        .then(args.clone().or_not())
+        .then(body.clone())
+        .map_with(move |((plane, args), body), e| {
+            mk(
+                ExprKind::FieldBlock {
+                    args: args.unwrap_or_default(),
+                    body,
+                    plane,
+                },
+                e.span(),
+            )
+        });
 
         let atom = choice((literal, field, call, var, tuple, list, if_expr))
             .labelled("expression")

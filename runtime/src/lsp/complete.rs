@@ -152,7 +152,7 @@ pub fn complete(
     ));
     for kw in [
         "let", "fn", "material", "import", "scene", "camera", "render", "light", "for", "in", "if",
-        "else", "field",
+        "else", "field", "profile",
     ] {
         out.push(item(kw, lsp::CompletionItemKind::KEYWORD, String::new()));
     }

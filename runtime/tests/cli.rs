@@ -878,7 +878,11 @@ fn a_second_process_finds_the_wgpu_pipeline_cache() {
         first.contains("bytes of driver cache data stored"),
         "{first}"
     );
-    assert_eq!(files.len(), 2, "the kernel's and the reduction's: {files:?}");
+    assert_eq!(
+        files.len(),
+        2,
+        "the kernel's and the reduction's: {files:?}"
+    );
     assert!(files.iter().all(|f| f.ends_with(".pipeline")), "{files:?}");
     let (second, again) = render("24x16");
     assert!(

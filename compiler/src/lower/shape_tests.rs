@@ -986,3 +986,65 @@ fn profile_fields_misused_are_located_errors() {
         assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
     }
 }
+
+/// A random formula of the plane's point, from the operations the bound analysis rules.
+fn random_plane_expr(rng: &mut Rng, depth: u32) -> String {
+    let leaf = |rng: &mut Rng| match rng.below(4) {
+        0 => "p.x".to_string(),
+        1 => "p.y".to_string(),
+        2 => "length(p)".to_string(),
+        _ => format!("{:.2}", rng.range(-2.0, 2.0)),
+    };
+    if depth == 0 {
+        return leaf(rng);
+    }
+    let mut e = || random_plane_expr(rng, depth - 1);
+    let (a, b) = (e(), e());
+    match rng.below(12) {
+        0 => format!("({a} + {b})"),
+        1 => format!("({a} - {b})"),
+        2 => format!("({a} * 1.3)"),
+        3 => format!("sin({a})"),
+        4 => format!("abs({a})"),
+        5 => format!("min({a}, {b})"),
+        6 => format!("max({a}, {b})"),
+        7 => format!("sqrt({a} * {a} + 1)"),
+        8 => format!("noise(vec2({a}, {b}))"),
+        9 => format!("(sin({a}) * cos({b}))"),
+        10 => format!("voronoi(vec2({a}, p.y))"),
+        _ => format!("distance(star(5, 0.8, 0.4), vec2({a}, {b}))"),
+    }
+}
+
+/// Random formulas of the plane, extruded and revolved: wherever the analysis proves a
+/// bound, sampled slopes of the solid (the field without local bounds) stay within it.
+#[test]
+fn random_profile_formulas_keep_their_bound_when_made_solid() {
+    let mut rng = Rng::new(36);
+    let options = super::LowerOptions {
+        local: false,
+        ..super::LowerOptions::default()
+    };
+    let mut proven = 0;
+    for i in 0..30 {
+        let e = random_plane_expr(&mut rng, 3);
+        let shape = if i % 2 == 0 {
+            format!("extrude(profile {{ {e} }}, 1.2)")
+        } else {
+            format!("revolve(profile {{ {e} }}, 0.3)")
+        };
+        let src = format!("scene {{ {shape}; }}");
+        let scene = crate::front::check_str("t.sdf", &src).0.expect("scene");
+        let root = *analyse(&scene).root().expect("root");
+        if !root.proven {
+            continue;
+        }
+        proven += 1;
+        let l = root.facts.lipschitz;
+        let p = super::lower_with(&scene, &options);
+        let mut sample = Rng::new(i);
+        let s = slope(&p, &mut sample, 2.0);
+        assert!(s <= l * (1.0 + 1e-6), "{shape}: slope {s} above L = {l}");
+    }
+    assert!(proven > 15, "only {proven} of 30 have a bound");
+}

@@ -1,7 +1,8 @@
-//! Per-point values inside `field { … }`: the point `p` and everything computed from it are
-//! expressions, not constants ([`Value::Point`]); arithmetic, swizzles and the builtins that
-//! accept them build expression nodes (constants folded), and the finished body becomes the
-//! flat [`FieldFn`] of a field shape. Everything else still needs constants: a per-point
+//! Per-point values inside `field { … }` and `profile { … }`: the point `p` (a vec3, or a vec2
+//! of the plane) and everything computed from it are expressions, not constants
+//! ([`Value::Point`]); arithmetic, swizzles and the builtins that accept them build expression
+//! nodes (constants folded), and the finished body becomes the flat [`FieldFn`] of a field
+//! shape or profile. Everything else still needs constants: a per-point
 //! value where one is needed is error E0410.
 
 use super::types::{Sx, Value};

@@ -1,6 +1,7 @@
-//! User fields (`field { … }`, docs/language.md "Fields"): the expression of the point that a
-//! field shape computes, as a flat list of scalar operations over the point's coordinates,
-//! constants, other shapes' distances and noise. The checker builds it (vectors are split
+//! User fields (`field { … }`, docs/language.md "Fields", and `profile { … }`, a field of
+//! the plane that reads x and y only): the expression of the point that a field shape
+//! computes, as a flat list of scalar operations over the point's coordinates, constants,
+//! other shapes' distances and noise. The checker builds it (vectors are split
 //! into their components, constants folded); the lowering turns each operation into program
 //! instructions (`lower/field.rs`); the analysis bounds its gradient (`analysis/field.rs`).
 
@@ -58,7 +59,7 @@ pub enum FBin {
 /// One operation; operands name earlier operations.
 #[derive(Debug, Clone, PartialEq)]
 pub enum FOp {
-    /// A coordinate of the point (0: x, 1: y, 2: z).
+    /// A coordinate of the point (0: x, 1: y, 2: z; a profile's reads x and y only).
     Coord(u8),
     /// A constant.
     Const(f64),

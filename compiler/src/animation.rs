@@ -10,7 +10,7 @@ use crate::program::{Block, Op, Reg};
 use crate::scene::Scene;
 
 /// An operand that is a constant, in a [`Structure`].
-pub const CONST: Reg = Reg(u32::MAX);
+pub(crate) const CONST: Reg = Reg(u32::MAX);
 
 /// What a frame's kernel is built from, numbers aside.
 #[derive(Debug, Clone, PartialEq)]

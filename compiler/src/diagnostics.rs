@@ -205,7 +205,7 @@ fn label_order(d: &Diagnostic, sources: &SourceMap) -> Vec<i32> {
 
 /// Lines longer than this (in bytes) are shown as an excerpt around the span, not whole: a
 /// scene written on one line of 300 KB would otherwise be repeated in every diagnostic.
-pub const LONG_LINE: usize = 240;
+pub(crate) const LONG_LINE: usize = 240;
 
 /// Bytes of context shown on each side of a span on a long line.
 const CONTEXT: usize = 60;

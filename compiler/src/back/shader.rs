@@ -54,7 +54,7 @@ pub fn write_part(part: &Part, lang: Lang) -> Result<Vec<u8>, Error> {
 
 /// The part as GLSL ES 3.00 functions, for a WebGL fragment shader (the Shadertoy page):
 /// no `#version`, `precision` or entry point, which the page that includes it provides.
-pub fn write_part_es(part: &Part) -> Result<String, Error> {
+pub(crate) fn write_part_es(part: &Part) -> Result<String, Error> {
     let text = String::from_utf8(library_glsl(
         part,
         naga::back::glsl::Version::new_gles(300),

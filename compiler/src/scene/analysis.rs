@@ -21,18 +21,18 @@ use std::collections::HashSet;
 
 /// The largest L the renderer steps with: a larger bound is clamped (with the warning that
 /// caused it), so that a scene still renders, with artefacts, within its step budget.
-pub const MAX_STEP_LIPSCHITZ: f64 = 16.0;
+pub(crate) const MAX_STEP_LIPSCHITZ: f64 = 16.0;
 
 /// A twist or bend that stretches distances by this factor or more is reported (W0003).
-pub const WARN_STRETCH: f64 = 1.5;
+pub(crate) const WARN_STRETCH: f64 = 1.5;
 
 /// A per-axis scale whose largest factor is this many times its smallest is reported (W0007).
-pub const WARN_SCALE_RATIO: f64 = 10.0;
+pub(crate) const WARN_SCALE_RATIO: f64 = 10.0;
 
 /// A repetition whose copies reach out of their cells evaluates the neighbouring cells too,
 /// up to this many cells per point (counting the windows of repetitions nested in it, which
 /// multiply); beyond, it evaluates only the own cell and is reported (W0005, W0006).
-pub const MAX_WINDOW_CELLS: u32 = 27;
+pub(crate) const MAX_WINDOW_CELLS: u32 = 27;
 
 /// Slack of the geometric tests (a shape touching its cell still fits).
 const TOLERANCE: f64 = 1e-9;
@@ -184,7 +184,7 @@ pub fn analyse(scene: &Scene) -> Analysis {
 
 /// How much a smooth combination moves the surface at most: k/4 for the quadratic smooth
 /// minimum, k·ln 2 for the exponential one.
-pub fn blend_reach(k: f64, variant: Smooth) -> f64 {
+pub(crate) fn blend_reach(k: f64, variant: Smooth) -> f64 {
     let k = k.max(0.0);
     match variant {
         Smooth::Poly => k * 0.25,
@@ -201,7 +201,7 @@ pub fn blend_reach(k: f64, variant: Smooth) -> f64 {
 /// columns forms read a + b (or |(a, b)|), whose gradient is up to √2 times the larger
 /// operand's when the two surfaces meet at a shallow angle; the smooth minima and the stairs
 /// are no steeper than their operands (docs/analysis.md).
-pub fn blend_steepness(variant: Smooth) -> f64 {
+pub(crate) fn blend_steepness(variant: Smooth) -> f64 {
     match variant {
         Smooth::Poly | Smooth::Exp | Smooth::Stairs(_) => 1.0,
         Smooth::Chamfer | Smooth::Round | Smooth::Columns(_) => std::f64::consts::SQRT_2,
@@ -210,7 +210,7 @@ pub fn blend_steepness(variant: Smooth) -> f64 {
 
 /// The same for a feature: the engraving and the pipe read a ± b, the groove and the tongue
 /// only minima and maxima of a, |b| and constants.
-pub fn feature_steepness(f: Feature) -> f64 {
+pub(crate) fn feature_steepness(f: Feature) -> f64 {
     match f {
         Feature::Engrave { .. } | Feature::Pipe { .. } => std::f64::consts::SQRT_2,
         Feature::Groove { .. } | Feature::Tongue { .. } => 1.0,
@@ -219,12 +219,12 @@ pub fn feature_steepness(f: Feature) -> f64 {
 
 /// How much a twist at `a = |rate|·r` (r: distance from the axis) stretches distances: the
 /// largest singular value of [[1, a], [0, 1]], a/2 + √(1 + a²/4).
-pub fn twist_stretch(a: f64) -> f64 {
+pub(crate) fn twist_stretch(a: f64) -> f64 {
     a * 0.5 + (1.0 + a * a * 0.25).sqrt()
 }
 
 /// How much a bend at `a = |rate|·r` stretches distances: 1 + a.
-pub fn bend_stretch(a: f64) -> f64 {
+pub(crate) fn bend_stretch(a: f64) -> f64 {
     1.0 + a
 }
 
@@ -350,7 +350,7 @@ fn down(node: &Node, m: f64, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
 const IDENTITY: [V3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// The inverse of a 3×3 matrix (rows), or `None` when it is singular.
-pub fn invert(m: &[V3; 3]) -> Option<[V3; 3]> {
+pub(crate) fn invert(m: &[V3; 3]) -> Option<[V3; 3]> {
     let c = |i: usize, j: usize| {
         let (a, b) = ((i + 1) % 3, (i + 2) % 3);
         let (x, y) = ((j + 1) % 3, (j + 2) % 3);
@@ -366,7 +366,7 @@ pub fn invert(m: &[V3; 3]) -> Option<[V3; 3]> {
 
 /// The smallest and largest singular values of a 3×3 matrix: the square roots of the
 /// eigenvalues of MᵀM, found by Jacobi rotations (symmetric, so they converge).
-pub fn singular_range(m: &[V3; 3]) -> (f64, f64) {
+pub(crate) fn singular_range(m: &[V3; 3]) -> (f64, f64) {
     let mut a = [[0.0f64; 3]; 3];
     for i in 0..3 {
         for j in 0..3 {
@@ -429,7 +429,7 @@ fn untaper_region(r: Aabb, rate: f64) -> Aabb {
 
 /// The smallest factor 1 + rate·y a taper divides by over heights y0 … y1: the factor there,
 /// but never below [`TAPER_FLOOR`] (where the factor falls below it the lowering clamps it).
-pub fn taper_floor(rate: f64, y0: f64, y1: f64) -> f64 {
+pub(crate) fn taper_floor(rate: f64, y0: f64, y1: f64) -> f64 {
     let s = (1.0 + rate * y0).min(1.0 + rate * y1);
     if s.is_finite() {
         s.max(TAPER_FLOOR)
@@ -440,11 +440,11 @@ pub fn taper_floor(rate: f64, y0: f64, y1: f64) -> f64 {
 
 /// The smallest scale factor of a taper: below it (the cross-section shrunk to a point and
 /// beyond, where the taper folds) the factor is clamped.
-pub const TAPER_FLOOR: f64 = 1e-3;
+pub(crate) const TAPER_FLOOR: f64 = 1e-3;
 
 /// The angle ±α about y, in the sense of `rotate_y`, within which a box lies; π when it
 /// reaches the y axis or beyond (on the side x ≤ 0).
-pub fn angular_half_extent(b: &Aabb) -> f64 {
+pub(crate) fn angular_half_extent(b: &Aabb) -> f64 {
     if b.is_empty() || !(b.min[0] > 0.0) || !b.is_bounded() {
         return std::f64::consts::PI;
     }
@@ -462,7 +462,7 @@ pub fn angular_half_extent(b: &Aabb) -> f64 {
 /// factor sin γ with γ = (2r + 1)·π/count − α, so that ρ·sin γ (ρ the distance from the
 /// axis) is a lower bound of the distance to every copy outside the window (infinite when
 /// the window holds every copy). `docs/analysis.md`, "Polar repetition", derives it.
-pub fn polar_window(count: u32, alpha: f64) -> Window {
+pub(crate) fn polar_window(count: u32, alpha: f64) -> Window {
     let n = f64::from(count);
     let sector = std::f64::consts::PI / n;
     // The least r ≥ 1 with (2r + 1)·π/n > α, plus a sliver, so that γ is not 0.
@@ -1377,7 +1377,7 @@ impl Pass<'_> {
 /// within ½·s of its own cell's centre, or outside the array beyond it): the reach r is the
 /// least ≥ 1 that makes this exceed the margin, and `beyond` is its minimum over such axes.
 /// A finite repetition whose window holds every copy on an axis needs no bound there.
-pub fn window(
+pub(crate) fn window(
     extent: &Aabb,
     symmetric: [bool; 3],
     period: V3,
@@ -1519,4 +1519,4 @@ mod field;
 mod tests;
 mod warnings;
 
-pub use aabb::Aabb;
+pub(crate) use aabb::Aabb;

@@ -417,7 +417,7 @@ pub enum Item {
 /// The hierarchy of a traced scene: what every ray tests (unbounded primitives, such as
 /// planes, and the top groups), each group only when the ray meets its box before the
 /// nearest hit so far.
-pub fn hierarchy(primitives: &[Primitive]) -> Vec<Item> {
+pub(crate) fn hierarchy(primitives: &[Primitive]) -> Vec<Item> {
     let mut top = Vec::new();
     let mut bounded = Vec::new();
     for (i, p) in primitives.iter().enumerate() {
@@ -433,7 +433,7 @@ pub fn hierarchy(primitives: &[Primitive]) -> Vec<Item> {
 /// The hierarchy over items with boxes, by index: the items themselves when there are a few,
 /// else one group around them all, split at medians (the hierarchy of [`hierarchy`], and of
 /// any other list of bounded things).
-pub fn boxed(bounded: Vec<(usize, Aabb)>) -> Vec<Item> {
+pub(crate) fn boxed(bounded: Vec<(usize, Aabb)>) -> Vec<Item> {
     if bounded.len() <= LEAF {
         bounded
             .into_iter()
@@ -445,7 +445,7 @@ pub fn boxed(bounded: Vec<(usize, Aabb)>) -> Vec<Item> {
 }
 
 /// An axis-aligned box as (low, high) corners.
-pub type Aabb = (V3, V3);
+pub(crate) type Aabb = (V3, V3);
 
 /// Splits at the median of the box centres along the axis where they spread most (a median
 /// split keeps the tree balanced: depth log₂(n / LEAF)).
@@ -510,7 +510,7 @@ fn build(mut items: Vec<(usize, Aabb)>) -> Group {
 
 /// The world-space box around a primitive (`None` for a plane): the corners of its local box
 /// mapped back to the world.
-pub fn world_box(p: &Primitive) -> Option<Aabb> {
+pub(crate) fn world_box(p: &Primitive) -> Option<Aabb> {
     let h = match p.shape {
         Shape::Sphere { radius } => [radius; 3],
         Shape::Box { half } => half,

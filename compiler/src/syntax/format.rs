@@ -30,7 +30,7 @@ use crate::span::{FileId, Span};
 use std::collections::HashSet;
 
 /// One level of indentation.
-pub const INDENT: &str = "  ";
+pub(crate) const INDENT: &str = "  ";
 
 /// Why a text was not formatted.
 #[derive(Debug, Clone)]

@@ -29,7 +29,7 @@ mod template;
 
 pub use analytic::MAX_UNROLLED;
 pub use contract::{Contract, Field, Mismatch, Shape, Specialisation, Uniform, UniformWriter};
-pub use literal::float;
+pub(crate) use literal::float;
 pub use map::{write_map, write_sdf};
 
 use crate::lower::Lowered;

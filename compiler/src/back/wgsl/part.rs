@@ -53,7 +53,7 @@ pub fn valid_name(name: &str) -> bool {
 }
 
 /// The WGSL text of the part of `scene` (lowered as `lowered`) named `name`, not validated.
-pub fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
+pub(crate) fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String {
     let program = &lowered.program;
     let n = scene.materials.len().max(1);
     let mut out = String::new();

@@ -159,7 +159,7 @@ impl Query {
 }
 
 /// [`SOURCE`] parsed and validated by naga.
-pub fn module() -> (naga::Module, ModuleInfo) {
+pub(crate) fn module() -> (naga::Module, ModuleInfo) {
     let module = naga::front::wgsl::parse_str(SOURCE).expect("the reduction's WGSL parses");
     let info = Validator::new(ValidationFlags::all(), Capabilities::empty())
         .validate(&module)

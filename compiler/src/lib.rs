@@ -39,7 +39,7 @@ pub mod diagnostics;
 /// Sources, spans, resource limits and diagnostics.
 pub use crate::{
     diagnostics::{has_errors, Diagnostic, Severity},
-    limits::{Limit, Limits},
+    limits::{Limit, Limits, Spelling},
     span::{FileId, SourceMap, Span},
 };
 

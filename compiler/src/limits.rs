@@ -4,7 +4,8 @@
 //! The checker reads the compilation limits from the [`Limits`] it is given
 //! (`check::check_with`); the render limits are checked by the checker (the `render` block)
 //! and by the runtime (`--set`, the program size, the render's memory). A diagnostic or error
-//! for an exceeded limit names the flag that raises it ([`Limits::raise`]).
+//! for an exceeded limit names the flag that raises it ([`Limits::raise`]), or the parameter,
+//! for a caller that spells its options as the Python package does ([`Spelling`]).
 
 use std::fmt;
 
@@ -268,21 +269,65 @@ impl fmt::Display for Limit {
     }
 }
 
-/// The value of every limit for one run.
+/// How a caller names its options in messages: as the command line's flags (`--limit
+/// memory=8192`, `--bounds`) or as the keyword parameters of the Python package's `Scene`
+/// (`limits={"memory": 8192}`, `bounds`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum Spelling {
+    /// Command-line flags.
+    #[default]
+    Flags,
+    /// Keyword parameters.
+    Parameters,
+}
+
+impl Spelling {
+    /// The option `name` (`bounds`, `resolution`, `voxel`) as the caller writes it.
+    pub fn option(self, name: &str) -> String {
+        match self {
+            Spelling::Flags => format!("--{name}"),
+            Spelling::Parameters => name.to_string(),
+        }
+    }
+
+    /// `limit` set to `value`, as the caller writes it: `--limit fuel=100000000`, or
+    /// `limits={"fuel": 100000000}`.
+    pub fn limit(self, limit: Limit, value: u64) -> String {
+        match self {
+            Spelling::Flags => format!("--limit {}={value}", limit.name()),
+            Spelling::Parameters => format!("limits={{\"{}\": {value}}}", limit.name()),
+        }
+    }
+}
+
+/// The value of every limit for one run, and how its messages name the option that raises
+/// one ([`Spelling`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
     values: [u64; 21],
+    spelling: Spelling,
 }
 
 impl Default for Limits {
     fn default() -> Self {
         Limits {
             values: Limit::ALL.map(Limit::default_value),
+            spelling: Spelling::Flags,
         }
     }
 }
 
 impl Limits {
+    /// These limits, their messages naming options as `spelling` writes them.
+    pub fn spelled(self, spelling: Spelling) -> Limits {
+        Limits { spelling, ..self }
+    }
+
+    /// How the messages of these limits name the option that raises one.
+    pub fn spelling(&self) -> Spelling {
+        self.spelling
+    }
+
     /// The value of `limit`.
     pub fn get(&self, limit: Limit) -> u64 {
         self.values[limit as usize]
@@ -357,7 +402,7 @@ impl Limits {
     }
 
     /// How to raise `limit` past its current value: ``raise it with `--limit fuel=100000000` ``
-    /// (twice the current value, within the ceiling).
+    /// (twice the current value, within the ceiling), spelled as [`Limits::spelling`].
     pub fn raise(&self, limit: Limit) -> String {
         let doubled = self.get(limit).saturating_mul(2);
         self.raise_to(limit, doubled.min(limit.ceiling().max(self.get(limit) + 1)))
@@ -365,11 +410,12 @@ impl Limits {
 
     /// How to raise `limit` to at least `needed`, or that it cannot be raised so far.
     pub fn raise_to(&self, limit: Limit, needed: u64) -> String {
-        let (name, ceiling) = (limit.name(), limit.ceiling());
+        let ceiling = limit.ceiling();
+        let spell = |value| self.spelling.limit(limit, value);
         if needed > ceiling {
-            return format!("it cannot be raised above {ceiling} (`--limit {name}={ceiling}`)");
+            return format!("it cannot be raised above {ceiling} (`{}`)", spell(ceiling));
         }
-        format!("raise it with `--limit {name}={}`", needed.max(1))
+        format!("raise it with `{}`", spell(needed.max(1)))
     }
 }
 
@@ -401,5 +447,20 @@ mod tests {
         assert!(l.apply("aa").expect_err("no =").contains("the limits are"));
         assert_eq!(l.raise(Limit::Fuel), "raise it with `--limit fuel=200000`");
         assert_eq!(l.raise(Limit::Aa), "raise it with `--limit aa=32`");
+    }
+
+    #[test]
+    fn limits_spelled_as_parameters_name_the_parameter() {
+        let l = Limits::default().spelled(Spelling::Parameters);
+        assert_eq!(
+            l.raise_to(Limit::Memory, 9000),
+            "raise it with `limits={\"memory\": 9000}`"
+        );
+        assert_eq!(
+            l.raise_to(Limit::Aa, 1000),
+            "it cannot be raised above 256 (`limits={\"aa\": 256}`)"
+        );
+        assert_eq!(Spelling::Parameters.option("voxel"), "voxel");
+        assert_eq!(Spelling::Flags.option("voxel"), "--voxel");
     }
 }

@@ -74,12 +74,18 @@ def _wrap(error: CompileError) -> CompileError:
     return error
 
 
-def check(source: Optional[str] = None, path: Optional[str] = None) -> Tuple[List[Diagnostic], Optional[Facts]]:
+def check(
+    source: Optional[str] = None, path: Optional[str] = None, limits: Optional[Mapping[str, int]] = None
+) -> Tuple[List[Diagnostic], Optional[Facts]]:
     """Checks a scene given as text (`source`; `path`, if given, names it for its imports) or
     read from `path`: every diagnostic, and the facts of its field when it has no errors
     (None when it has). Raises ValueError for a file that cannot be read."""
-    diags, facts = _sdfc.check(source, path)
+    diags, facts = _sdfc.check(source, path, _limits(limits))
     return [Diagnostic._of(d) for d in diags], (Facts(**facts) if facts is not None else None)
+
+
+def _limits(limits: Optional[Mapping[str, int]]) -> List[str]:
+    return [f"{k}={v}" for k, v in (limits or {}).items()]
 
 
 def _setting(value: Any) -> str:
@@ -93,7 +99,8 @@ def _setting(value: Any) -> str:
 class Scene:
     """A checked scene (raises CompileError when it has errors), from its text (`source`) or
     file (`path`), with render settings overridden as `sdfc render --set` does
-    (`set={"max_steps": 512, "background": (0, 0, 0)}`).
+    (`set={"max_steps": 512, "background": (0, 0, 0)}`), and resource limits raised or
+    lowered as `sdfc --limit` does (`limits={"memory": 8192}`; `sdfc --help` lists them).
 
     Every method is safe to call from several threads at once; renders and meshes release
     the GIL, and Ctrl-C during them raises KeyboardInterrupt."""
@@ -103,10 +110,11 @@ class Scene:
         source: Optional[str] = None,
         path: Optional[str] = None,
         set: Optional[Mapping[str, Any]] = None,
+        limits: Optional[Mapping[str, int]] = None,
     ) -> None:
         sets = [f"{k}={_setting(v)}" for k, v in (set or {}).items()]
         try:
-            self._scene = _sdfc._Scene(source, None if path is None else str(path), sets)
+            self._scene = _sdfc._Scene(source, None if path is None else str(path), sets, _limits(limits))
         except CompileError as e:
             raise _wrap(e) from None
         self.path = path

@@ -11,8 +11,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use rayon::prelude::*;
 use sdfc_compiler::{
-    analysis, analytic, lower_within, Diagnostic, Evaluator, Limits, LowerOptions, Lowered,
-    Outputs, Severity, SourceMap, Tape, DEFAULT_CHUNK,
+    analysis, analytic, Diagnostic, Evaluator, Limits, LowerOptions, Lowered, Outputs, Severity,
+    SourceMap, Spelling, Tape, DEFAULT_CHUNK,
 };
 use sdfc_runtime::backend::{Backend, Devices, Kernel, Prepared, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
@@ -20,7 +20,7 @@ use sdfc_runtime::commands::mesh as mesher;
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::frontend::{self, Source};
 use sdfc_runtime::image::Image;
-use sdfc_runtime::job::{self, FrameScene, Job, Overrides};
+use sdfc_runtime::job::{self, Job, Overrides};
 use std::sync::OnceLock;
 use std::time::Duration;
 
@@ -153,16 +153,17 @@ fn diagnostics<'py>(
 /// The name a scene given as text goes by (its imports are read from the current directory).
 const TEXT_NAME: &str = "<string>.sdf";
 
-/// `check(source, path)`: (diagnostics, facts or None). `source` None reads `path`.
+/// `check(source, path, limits)`: (diagnostics, facts or None). `source` None reads `path`.
 #[pyfunction]
-#[pyo3(signature = (source=None, path=None))]
+#[pyo3(signature = (source=None, path=None, limits=Vec::new()))]
 fn check<'py>(
     py: Python<'py>,
     source: Option<String>,
     path: Option<String>,
+    limits: Vec<String>,
 ) -> PyResult<(Bound<'py, PyList>, Option<Bound<'py, PyDict>>)> {
+    let limits = limits_of(&limits).map_err(|f| f.into_py(py))?;
     let mut src = open(source, path).map_err(|f| f.into_py(py))?;
-    let limits = Limits::default();
     let loaded = src.check(&limits, 0.0);
     let list = diagnostics(py, &loaded.diagnostics, &loaded.sources)?;
     let Some(scene) = &loaded.scene else {
@@ -216,6 +217,16 @@ fn open(source: Option<String>, path: Option<String>) -> Result<Source, Failure>
     }
 }
 
+/// The default limits with each `NAME=VALUE` of `limits` applied, in order; their messages
+/// name the parameter `limits` (`limits={"memory": 8192}`) rather than `--limit`.
+fn limits_of(limits: &[String]) -> Result<Limits, Failure> {
+    let mut l = Limits::default().spelled(Spelling::Parameters);
+    for setting in limits {
+        l.apply(setting).map_err(Failure::Value)?;
+    }
+    Ok(l)
+}
+
 /// The worker threads every call shares (one per core).
 fn pool() -> Result<&'static rayon::ThreadPool, Failure> {
     static POOL: OnceLock<Result<rayon::ThreadPool, String>> = OnceLock::new();
@@ -252,12 +263,13 @@ fn interruptible<T: Send + 'static>(
     }
 }
 
-/// A scene: its text, the name it goes by and the render settings to override.
+/// A scene: its text, the name it goes by, the render settings to override and the limits.
 #[pyclass(frozen, name = "_Scene", module = "sdfc._sdfc")]
 struct Scene {
     name: String,
     text: String,
     set: Vec<String>,
+    limits: Limits,
 }
 
 /// What a render is asked for.
@@ -274,6 +286,23 @@ impl Scene {
         Source::from_text(&self.name, self.text.clone())
     }
 
+    /// The job of a call: the scene's settings and `size` and `aa` overridden, its limits,
+    /// `backend`; its diagnostics come back in its errors, unprinted.
+    fn job(&self, size: Option<(u32, u32)>, aa: Option<u32>, backend: Backend) -> Job {
+        Job {
+            backend,
+            overrides: Overrides {
+                size,
+                aa,
+                set: self.set.clone(),
+                ..Overrides::default()
+            },
+            limits: self.limits.clone(),
+            quiet: true,
+            ..Job::default()
+        }
+    }
+
     /// The scene checked at `time` with the settings overridden, or its errors.
     fn checked(
         &self,
@@ -281,20 +310,9 @@ impl Scene {
         size: Option<(u32, u32)>,
         aa: Option<u32>,
     ) -> Result<frontend::Checked, Failure> {
-        let job = Job {
-            overrides: Overrides {
-                size,
-                aa,
-                set: self.set.clone(),
-                ..Overrides::default()
-            },
-            ..Job::default()
-        };
-        let loaded = self.source().check(&job.limits, time);
-        let Some(mut scene) = loaded.scene else {
-            return Err(Failure::Compile(loaded.diagnostics, loaded.sources));
-        };
-        job.settings(&mut scene)?;
+        let job = self.job(size, aa, Backend::Auto);
+        let mut loaded = self.source().check(&job.limits, time);
+        let scene = job.scene(&mut loaded, true)?;
         Ok(frontend::Checked {
             scene,
             sources: loaded.sources,
@@ -302,20 +320,30 @@ impl Scene {
         })
     }
 
+    /// `checked`'s scene lowered within the limits, or the diagnostic of a program above
+    /// them.
+    fn lowered(&self, checked: &frontend::Checked) -> Result<Lowered, Failure> {
+        let job = self.job(None, None, Backend::Auto);
+        Ok(job.lower(&checked.scene, &checked.sources, &LowerOptions::default())?)
+    }
+
     /// Renders as `sdfc render` does: checked, lowered, prepared, held to the memory limit.
     fn image(&self, ask: Ask) -> Result<Image, Failure> {
         Ok(self.rendered(ask, true)?.image)
     }
 
-    /// The whole render: the image, and with `image_only` false its statistics and (on the
-    /// CPU) its depth buffers.
+    /// The whole render, through the job's path as `sdfc render`'s: the image, and with
+    /// `image_only` false its statistics and (on the CPU) its depth buffers.
     fn rendered(&self, ask: Ask, image_only: bool) -> Result<sdfc_runtime::cpu::Render, Failure> {
-        let limits = Limits::default();
-        let checked = self.checked(ask.time, ask.size, ask.aa)?;
-        let lowered = lower_within(&checked.scene, &LowerOptions::default(), &limits)
-            .map_err(|d| Failure::Compile(vec![d], checked.sources.clone()))?;
-        sdfc_runtime::backend::method_allowed(&checked.scene, &lowered.traceable)
-            .map_err(|e| Failure::Value(e.to_string()))?;
+        let job = self.job(ask.size, ask.aa, ask.backend);
+        let frame = job
+            .frame(&mut self.source(), ask.time, true, &LowerOptions::default())
+            .map_err(|e| match e {
+                // Settings the scene cannot be rendered with (`method=trace` of a scene that
+                // cannot be traced): a bad argument.
+                job::Error::Backend(e) => Failure::Value(e.to_string()),
+                e => e.into(),
+            })?;
         let pool = pool()?;
         let setup = Setup {
             precision: Precision::F32,
@@ -326,11 +354,6 @@ impl Scene {
             // The arrays are the linear colours.
             finished: false,
             software: false,
-        };
-        let frame = FrameScene {
-            scene: checked.scene,
-            lowered,
-            phases: Vec::new(),
         };
         let (scene, prepared) = match ask.backend {
             // The process's wgpu device, whose compiled pipelines later renders reuse.
@@ -355,7 +378,7 @@ impl Scene {
             &prepared,
             &scene,
             (false, !image_only),
-            &limits,
+            &job.limits,
             false,
         )?;
         let frame = pool
@@ -424,18 +447,21 @@ fn backend(name: &str) -> PyResult<Backend> {
 impl Scene {
     /// Checks the scene at t = 0 (raising `CompileError`) and keeps it.
     #[new]
-    #[pyo3(signature = (source=None, path=None, set=Vec::new()))]
+    #[pyo3(signature = (source=None, path=None, set=Vec::new(), limits=Vec::new()))]
     fn new(
         py: Python<'_>,
         source: Option<String>,
         path: Option<String>,
         set: Vec<String>,
+        limits: Vec<String>,
     ) -> PyResult<Scene> {
+        let limits = limits_of(&limits).map_err(|f| f.into_py(py))?;
         let src = open(source, path.clone()).map_err(|f| f.into_py(py))?;
         let scene = Scene {
             name: path.unwrap_or_else(|| TEXT_NAME.into()),
             text: src.text().to_string(),
             set,
+            limits,
         };
         scene.checked(0.0, None, None).map_err(|f| f.into_py(py))?;
         Ok(scene)
@@ -570,9 +596,7 @@ impl Scene {
             }
         };
         let checked = self.checked(t, None, None).map_err(|f| f.into_py(py))?;
-        let limits = Limits::default();
-        let lowered = lower_within(&checked.scene, &LowerOptions::default(), &limits)
-            .map_err(|d| compile_error(py, &[d], &checked.sources))?;
+        let lowered = self.lowered(&checked).map_err(|f| f.into_py(py))?;
         let origin = checked.scene.origin;
         let xyz: Vec<[f64; 3]> = points
             .chunks_exact(24)
@@ -656,7 +680,7 @@ impl Scene {
         let scene = self_.clone_ref(py);
         let (p, tri, c) = interruptible(py, move || {
             let checked = scene.get().checked(t, None, None)?;
-            let limits = Limits::default();
+            let limits = scene.get().limits.clone();
             let region = mesher::Region {
                 resolution,
                 voxel,
@@ -780,9 +804,7 @@ impl Scene {
                 sdfc_compiler::dump_ir(&checked.scene).as_bytes(),
             ));
         }
-        let limits = Limits::default();
-        let lowered = lower_within(&checked.scene, &LowerOptions::default(), &limits)
-            .map_err(|d| compile_error(py, &[d], &checked.sources))?;
+        let lowered = self.lowered(&checked).map_err(|f| f.into_py(py))?;
         let bytes = match part {
             Part::Kernel => compile::emit(&checked.scene, &lowered, emit, sm, None),
             Part::Map => {

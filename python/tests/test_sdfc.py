@@ -148,6 +148,24 @@ class Render(unittest.TestCase):
         with self.assertRaises((RuntimeError, ValueError)) as caught:
             s.render(size=(16384, 16384), aa=4, backend="cpu")
         self.assertIn("limit", str(caught.exception))
+        # Named as this package's parameter, not as the command line's flag.
+        self.assertIn('limits={"memory": ', str(caught.exception))
+        self.assertNotIn("--", str(caught.exception))
+
+    def test_limits_are_set_by_the_limits_parameter(self):
+        # A memory limit of 1 MiB refuses a render the default allows.
+        s = sdfc.Scene(SPHERE, limits={"memory": 1})
+        with self.assertRaises(RuntimeError) as caught:
+            s.render(size=(640, 480), backend="cpu")
+        self.assertIn('limits={"memory": ', str(caught.exception))
+        self.assertEqual(sdfc.Scene(SPHERE, limits={"memory": 64}).render(size=(8, 6), backend="cpu").shape, (6, 8, 3))
+        with self.assertRaises(ValueError):
+            sdfc.Scene(SPHERE, limits={"speed": 1})
+        # A limit of the checker: the error's note names the parameter too.
+        with self.assertRaises(sdfc.CompileError) as caught:
+            sdfc.Scene("scene { union([for i in 0..50 { sphere(0.1) }]); }", limits={"objects": 10})
+        notes = " ".join(n for d in caught.exception.diagnostics for n in list(d.notes) + [d.help or ""])
+        self.assertIn('limits={"objects": ', notes)
 
     def test_bad_arguments(self):
         s = sdfc.Scene(SPHERE)

@@ -38,6 +38,9 @@ pub struct Job {
     pub threads: Option<usize>,
     /// `--debug-nan`.
     pub debug_nan: bool,
+    /// The scene's diagnostics are not printed where they are found: they come back in
+    /// [`Error::Scene`] alone (the Python module raises them; a command prints them).
+    pub quiet: bool,
 }
 
 /// The settings a job overrides in every frame it checks, in this order.
@@ -63,7 +66,8 @@ pub enum Error {
     /// A file that cannot be read or written.
     #[error("{0}")]
     Io(String),
-    /// The scene has errors (its diagnostics are printed where they are found).
+    /// The scene has errors (its diagnostics are printed where they are found, unless the
+    /// job is [`Job::quiet`]).
     #[error("{}", .0.summary())]
     Scene(Box<SceneErrors>),
     /// The backend cannot be used: no device, or the scene could not be prepared on it.
@@ -79,8 +83,8 @@ pub enum Error {
     #[error(transparent)]
     Backend(#[from] backend::Error),
     /// What the render would allocate is above the `memory` limit.
-    #[error("{0}")]
-    Memory(String),
+    #[error(transparent)]
+    Memory(#[from] memory::Exceeded),
     /// A render failed otherwise: every device of a sequence, or a result that cannot be
     /// used.
     #[error("{0}")]
@@ -227,7 +231,8 @@ impl Job {
     }
 
     /// The scene `loaded` checked to, taken out of it, with the job's settings; its
-    /// diagnostics are printed first (warnings only when `warnings`).
+    /// diagnostics are printed first unless the job is quiet (warnings only when
+    /// `warnings`).
     pub fn scene(&self, loaded: &mut Loaded, warnings: bool) -> Result<Scene, Error> {
         let mut scene = self.checked(loaded, warnings)?;
         self.settings(&mut scene)?;
@@ -236,13 +241,15 @@ impl Job {
 
     /// The scene `loaded` checked to, taken out of it as it is (a command that changes its
     /// settings before the job's, as `sdfc pareto` does, applies them with
-    /// [`Job::settings`]); its diagnostics are printed first (warnings only when
-    /// `warnings`).
+    /// [`Job::settings`]); its diagnostics are printed first unless the job is quiet
+    /// (warnings only when `warnings`).
     pub fn checked(&self, loaded: &mut Loaded, warnings: bool) -> Result<Scene, Error> {
         if !warnings {
             loaded.diagnostics.retain(|d| d.is_error());
         }
-        frontend::report(loaded, DiagnosticFormat::Human);
+        if !self.quiet {
+            frontend::report(loaded, DiagnosticFormat::Human);
+        }
         loaded
             .scene
             .take()
@@ -250,7 +257,7 @@ impl Job {
     }
 
     /// `scene` (read from `sources`) lowered with `lowering` within the limits; a program
-    /// above the `program` limit is printed as a diagnostic (E0507).
+    /// above the `program` limit is a diagnostic (E0507), printed unless the job is quiet.
     pub fn lower(
         &self,
         scene: &Scene,
@@ -258,12 +265,16 @@ impl Job {
         lowering: &LowerOptions,
     ) -> Result<Lowered, Error> {
         lower_within(scene, lowering, &self.limits).map_err(|d| {
-            frontend::print_diagnostics(std::slice::from_ref(&d), sources, DiagnosticFormat::Human);
+            if !self.quiet {
+                let d = std::slice::from_ref(&d);
+                frontend::print_diagnostics(d, sources, DiagnosticFormat::Human);
+            }
             Error::scene(vec![d], sources)
         })
     }
 
-    /// `source` checked at `time` (its diagnostics printed, warnings only when `warnings`),
+    /// `source` checked at `time` (its diagnostics printed unless the job is quiet, warnings
+    /// only when `warnings`),
     /// the job's settings applied, lowered with `lowering` (a sequence's frames with
     /// [`LowerOptions::parametric`]), and its method allowed.
     pub fn frame(
@@ -358,7 +369,7 @@ pub fn check_memory(
             memory::announce(&scene.settings, prepared.name(), &needed)
         );
     }
-    needed.check(limits).map_err(Error::Memory)
+    Ok(needed.check(limits)?)
 }
 
 /// The backend prepared for the frames of a sequence: the device is opened once; a frame
@@ -502,7 +513,12 @@ mod tests {
         let one = ExitCode::from(1);
         assert_eq!(Error::Usage("bad".into()).code(), two);
         assert_eq!(Error::Io("cannot read".into()).code(), two);
-        assert_eq!(Error::Memory("too much".into()).code(), one);
+        let exceeded = memory::Exceeded {
+            needed: 9000,
+            limit: 4096,
+            raise: "raise it".into(),
+        };
+        assert_eq!(Error::Memory(exceeded).code(), one);
         assert_eq!(Error::Encode("ffmpeg".into()).code(), one);
         let failed = backend::Error::Device("no adapter".into());
         let unavailable = Error::Unavailable {

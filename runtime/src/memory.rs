@@ -22,18 +22,31 @@ impl Memory {
         self.host.saturating_add(self.device)
     }
 
-    /// `Err` naming the flag that raises the limit when `self` exceeds the `memory` limit.
-    pub fn check(&self, limits: &Limits) -> Result<(), String> {
+    /// `Err` when `self` exceeds the `memory` limit of `limits`, saying how to raise it.
+    pub fn check(&self, limits: &Limits) -> Result<(), Exceeded> {
         let limit = limits.get(Limit::Memory);
         let needed = mib(self.total());
         if needed <= limit {
             return Ok(());
         }
-        Err(format!(
-            "the render would allocate up to {needed} MiB, more than the memory limit of {limit} MiB; {}",
-            limits.raise_to(Limit::Memory, needed)
-        ))
+        Err(Exceeded {
+            needed,
+            limit,
+            raise: limits.raise_to(Limit::Memory, needed),
+        })
     }
+}
+
+/// A render above the `memory` limit.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("the render would allocate up to {needed} MiB, more than the memory limit of {limit} MiB; {raise}")]
+pub struct Exceeded {
+    /// What the render would allocate, in MiB (rounded up).
+    pub needed: u64,
+    /// The limit, in MiB.
+    pub limit: u64,
+    /// How to raise the limit that far, as the limits spell it (`Limits::raise_to`).
+    pub raise: String,
 }
 
 /// Bytes in whole MiB, rounded up.

@@ -53,6 +53,24 @@ pub const SETTING_KEYS: &[&str] = &[
     "method",
 ];
 
+/// The help of `--set`: every key of [`SETTING_KEYS`], with the form of the values that are
+/// not numbers.
+pub fn set_help() -> String {
+    let keys: Vec<String> = SETTING_KEYS
+        .iter()
+        .map(|&key| match key {
+            "background" => "background (as r,g,b)".to_string(),
+            "method" => format!("method ({})", Method::NAMES.join(", ")),
+            key => key.to_string(),
+        })
+        .collect();
+    let (last, rest) = keys.split_last().expect("settings");
+    format!(
+        "Override a render setting: {} or {last}. May be repeated.",
+        rest.join(", ")
+    )
+}
+
 /// Sets one render setting from text, checking its range (the top of the range of width,
 /// height, aa, max_steps and max_depth is a limit of `limits`).
 pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<(), String> {
@@ -142,5 +160,31 @@ fn colour(value: &str) -> Result<[f64; 3], String> {
     match parts[..] {
         [r, g, b] if parts.iter().all(|v| (0.0..=1.0).contains(v)) => Ok([r, g, b]),
         _ => Err(err()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_setting_is_in_the_help_and_accepted() {
+        let help = set_help();
+        let limits = Limits::default();
+        for key in SETTING_KEYS {
+            assert!(help.contains(key), "{key} is missing from `{help}`");
+            let value = match *key {
+                "background" => "0.1,0.2,0.3",
+                "method" => "march",
+                "epsilon" => "0.001",
+                "relaxation" => "1.5",
+                _ => "8",
+            };
+            let mut s = Settings::default();
+            set(&mut s, key, value, &limits).unwrap_or_else(|e| panic!("{key}: {e}"));
+        }
+        assert!(help.contains("method (auto, trace, march)"), "{help}");
+        let unknown = set(&mut Settings::default(), "speed", "1", &limits).unwrap_err();
+        assert!(unknown.contains("unknown render setting"), "{unknown}");
     }
 }

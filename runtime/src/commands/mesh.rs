@@ -8,6 +8,7 @@ use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::write::Format;
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, AXIS_CELLS};
 use indicatif::{ProgressBar, ProgressStyle};
+pub use sdfc_compiler::Spelling;
 use sdfc_compiler::{analysis, Combine, Limit, Limits, LowerOptions, Node, NodeId, Scene};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -173,39 +174,20 @@ pub struct Region {
     pub voxel: Option<f64>,
     /// The region to mesh (min, max), in the scene's coordinates.
     pub bounds: Option<[[f64; 3]; 2]>,
-    /// How the messages name these options.
+    /// How the messages name these options (the limits' as the limits say,
+    /// [`Limits::spelling`]).
     pub spelling: Spelling,
 }
 
-/// How the caller of [`surface`] names the region's options in its messages: as `sdfc
-/// mesh`'s flags (`--bounds X0,Y0,Z0,X1,Y1,Z1`) or as the parameters of the Python package's
+/// A region given by its corners' coordinates, as the caller of [`surface`] writes it:
+/// `sdfc mesh`'s flag (`--bounds=X0,Y0,Z0,X1,Y1,Z1`) or the parameter of the Python package's
 /// `Scene.mesh` (`bounds=((x0, y0, z0), (x1, y1, z1))`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum Spelling {
-    /// Command-line flags.
-    #[default]
-    Flags,
-    /// Keyword parameters.
-    Parameters,
-}
-
-impl Spelling {
-    /// The option `name` (`bounds`, `resolution`, `voxel`) as the caller writes it.
-    pub fn option(self, name: &str) -> String {
-        match self {
-            Spelling::Flags => format!("--{name}"),
-            Spelling::Parameters => name.to_string(),
-        }
-    }
-
-    /// A region given by its corners' coordinates, as the caller writes it.
-    pub fn bounds(self, lo: [&str; 3], hi: [&str; 3]) -> String {
-        match self {
-            // With `=`: a negative first coordinate is not taken for a flag.
-            Spelling::Flags => format!("--bounds={},{}", lo.join(","), hi.join(",")),
-            Spelling::Parameters => {
-                format!("bounds=(({}), ({}))", lo.join(", "), hi.join(", "))
-            }
+fn bounds(spell: Spelling, lo: [&str; 3], hi: [&str; 3]) -> String {
+    match spell {
+        // With `=`: a negative first coordinate is not taken for a flag.
+        Spelling::Flags => format!("--bounds={},{}", lo.join(","), hi.join(",")),
+        Spelling::Parameters => {
+            format!("bounds=(({}), ({}))", lo.join(", "), hi.join(", "))
         }
     }
 }
@@ -272,7 +254,8 @@ pub fn surface(
                         let hi = [0, 1, 2].map(|i| short(hi[i] + m + origin[i]));
                         format!(
                             "; its bounded objects with a margin are `{}`",
-                            spell.bounds(
+                            bounds(
+                                spell,
                                 lo.each_ref().map(|s| s.as_str()),
                                 hi.each_ref().map(|s| s.as_str())
                             )
@@ -282,7 +265,7 @@ pub fn surface(
                 };
                 let corners = match spell {
                     Spelling::Flags => "--bounds X0,Y0,Z0,X1,Y1,Z1".to_string(),
-                    Spelling::Parameters => spell.bounds(["x0", "y0", "z0"], ["x1", "y1", "z1"]),
+                    Spelling::Parameters => bounds(spell, ["x0", "y0", "z0"], ["x1", "y1", "z1"]),
                 };
                 return Err(usage(format!(
                     "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `{corners}` (what reaches out of it is cut at its faces and the cut closed){hint}",

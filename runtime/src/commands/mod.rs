@@ -103,9 +103,8 @@ pub struct JobArgs {
     /// Supersampling: N×N samples per pixel.
     #[arg(long, value_name = "N")]
     pub aa: Option<u32>,
-    /// Override a render setting: width, height, aa, max_steps, epsilon, max_depth, max_dist,
-    /// relaxation or background (as r,g,b). May be repeated.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
+    // Its help lists the settings from their table (`settings::set_help`).
+    #[arg(long = "set", value_name = "KEY=VALUE", help = crate::settings::set_help())]
     pub set: Vec<String>,
     /// The GPU kernel of a marched scene: its distance program written as code
     /// (`specialised`, compiled by the driver for each scene), interpreted from a buffer
@@ -140,6 +139,7 @@ impl JobArgs {
             limits: self.limits.limits(),
             threads: self.threads,
             debug_nan: false,
+            quiet: false,
         }
     }
 }
@@ -176,4 +176,26 @@ pub fn limits_help() -> String {
          docs/failures.md):\n\n{}",
         Limits::table()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    /// A command of the job's arguments alone, as `render` and `bench` flatten them.
+    #[derive(Debug, clap::Parser)]
+    struct Flattened {
+        #[command(flatten)]
+        job: JobArgs,
+    }
+
+    #[test]
+    fn the_help_of_set_lists_every_setting() {
+        let help = Flattened::command().render_help().to_string();
+        for key in crate::settings::SETTING_KEYS {
+            assert!(help.contains(key), "`--set`'s help lacks {key}:\n{help}");
+        }
+        assert!(help.contains("method (auto, trace, march)"), "{help}");
+    }
 }

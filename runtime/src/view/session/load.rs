@@ -142,9 +142,9 @@ impl Session {
         let prepare_time = start.elapsed();
         let mut at = scene.settings.clone();
         (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);
-        if let Err(msg) = prepared.memory(&scene, &at).check(limits) {
-            eprintln!("error: {msg}");
-            return Err(msg);
+        if let Err(e) = prepared.memory(&scene, &at).check(limits) {
+            eprintln!("error: {e}");
+            return Err(e.to_string());
         }
         // A pipeline not compiled yet compiles on another thread (the driver may take
         // seconds; lavapipe tens of them), never on the caller's: a window's event loop goes on

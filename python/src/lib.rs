@@ -14,7 +14,7 @@ use sdfc_compiler::{
     analysis, analytic, Diagnostic, Evaluator, Limits, LowerOptions, Lowered, Outputs, Severity,
     SourceMap, Spelling, Tape, DEFAULT_CHUNK,
 };
-use sdfc_runtime::backend::{Backend, Devices, Kernel, Prepared, Setup};
+use sdfc_runtime::backend::{Backend, Devices, Kernel, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
 use sdfc_runtime::commands::mesh as mesher;
 use sdfc_runtime::cpu::Precision;
@@ -355,14 +355,14 @@ impl Scene {
             finished: false,
             software: false,
         };
+        let on = (ask.backend, &Devices::Auto);
         let (scene, prepared) = match ask.backend {
             // The process's wgpu device, whose compiled pipelines later renders reuse.
             Backend::Wgpu => {
                 let gpu = wgpu_device().map_err(|e| Failure::Runtime(e.clone()))?;
-                let prepared = pool
-                    .install(|| Prepared::on_gpu(gpu.clone(), &frame.scene, &frame.lowered, &setup))
-                    .map_err(|e| Failure::Runtime(format!("the wgpu backend: {e}")))?;
-                (frame.scene, prepared)
+                let open = job::Open::Gpu(gpu.clone());
+                job::prepare(pool, on, frame, &setup, open)
+                    .map_err(|e| Failure::Runtime(format!("the wgpu backend: {e}")))?
             }
             backend => {
                 if matches!(backend, Backend::Cuda | Backend::Auto) {
@@ -370,7 +370,7 @@ impl Scene {
                     // and built again (a fifth of a second) between renders.
                     let _ = cuda_device();
                 }
-                job::prepare(pool, (backend, &Devices::Auto), frame, &setup, None)?
+                job::prepare(pool, on, frame, &setup, job::Open::Backend)?
             }
         };
         job::check_memory(

@@ -3,7 +3,8 @@
 //! from their arguments: the settings overridden, the backend and its devices, the float type,
 //! the GPU kernel, the worker threads and the limits. From it a scene's source is checked at a
 //! time, its settings applied and it is lowered ([`Job::frame`]), prepared on its backend
-//! ([`prepare`], or frame after frame by [`Kernels`]), held to the memory limit
+//! ([`prepare`] on a device it opens or is given, [`Open`], or frame after frame by
+//! [`Kernels`]), held to the memory limit
 //! ([`check_memory`]) and rendered ([`Prepared::render`]). What fails on the way is an
 //! [`Error`] saying which step.
 
@@ -11,12 +12,14 @@ use crate::backend::{self, Backend, Devices, Kernel, Opening, Prepared, Setup};
 use crate::cpu::reference;
 use crate::cpu::Precision;
 use crate::frontend::{self, DiagnosticFormat, Loaded, Source};
+use crate::gpu::Gpu;
 use crate::memory;
 use sdfc_compiler::{
     lower_within, wgsl, Diagnostic, Limits, LowerOptions, Lowered, Program, Scene, Settings,
     Severity, SourceMap,
 };
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// What a command asks to have rendered, from its arguments.
@@ -322,14 +325,37 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> 
         .map_err(|e| format!("cannot start worker threads: {e}"))
 }
 
-/// Prepares a frame's scene for `backend` on `devices`, or on the device `opening` opens
-/// (for `--devices auto`) when given.
+/// Where [`prepare`] finds the device it prepares a scene on.
+#[derive(Debug)]
+pub enum Open {
+    /// The backend opens it, or several (`--devices`).
+    Backend,
+    /// Being opened on a thread of its own beside the front end (`sdfc render`; used for
+    /// `--devices auto` when it opens for the backend asked, else the backend opens its own).
+    Beside(Opening),
+    /// The caller's wgpu device, open already: the viewer's window's (whose surface shows
+    /// the frames it keeps on it), or the Python module's.
+    Gpu(Arc<Gpu>),
+}
+
+/// Prepares a frame's scene for `backend` on `devices` (or on the device `open` says) within
+/// `pool`.
 pub fn prepare(
     pool: &rayon::ThreadPool,
+    on: (Backend, &Devices),
+    frame: FrameScene,
+    setup: &Setup,
+    open: Open,
+) -> Result<(Scene, Prepared), Error> {
+    pool.install(|| prepare_here(on, frame, setup, open))
+}
+
+/// [`prepare`] on the current thread's pool (the viewer's, rayon's global one).
+pub fn prepare_here(
     (backend, devices): (Backend, &Devices),
     frame: FrameScene,
     setup: &Setup,
-    opening: Option<Opening>,
+    open: Open,
 ) -> Result<(Scene, Prepared), Error> {
     let FrameScene { scene, lowered, .. } = frame;
     // A kernel asked for that cannot render the scene is an error, not a reason to fall back
@@ -341,14 +367,17 @@ pub fn prepare(
         };
         wgsl::choose(&scene, &lowered, &options).map_err(backend::Error::Unsupported)?;
     }
-    let prepared = pool
-        .install(|| match opening {
-            Some(o) if o.backend() == backend && *devices == Devices::Auto => {
-                Prepared::opened(o, &scene, lowered, setup)
-            }
-            _ => Prepared::on_devices(backend, devices, &scene, lowered, setup),
-        })
-        .map_err(|source| Error::Unavailable { backend, source })?;
+    let unavailable = |source| Error::Unavailable { backend, source };
+    let prepared = match open {
+        Open::Beside(o) if o.backend() == backend && *devices == Devices::Auto => {
+            Prepared::opened(o, &scene, lowered, setup).map_err(unavailable)?
+        }
+        // An open device is available: what fails is the scene's preparation on it.
+        Open::Gpu(gpu) if backend == Backend::Wgpu && *devices == Devices::Auto => {
+            Prepared::on_gpu(gpu, &scene, &lowered, setup)?
+        }
+        _ => Prepared::on_devices(backend, devices, &scene, lowered, setup).map_err(unavailable)?,
+    };
     Ok((scene, prepared))
 }
 
@@ -450,7 +479,7 @@ impl<'a> Kernels<'a> {
                     (self.backend, &self.devices),
                     frame,
                     &self.setup,
-                    None,
+                    Open::Backend,
                 )?;
                 self.count += 1;
                 self.prepared = Some((program, scene.origin, prepared));

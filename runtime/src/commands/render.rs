@@ -151,7 +151,8 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
             && !matches!(&out, Output::File { format, .. } if format.linear()),
         ..job.setup()
     };
-    let (scene, prepared) = job::prepare(&pool, (backend, &job.devices), frame, &setup, opening)?;
+    let open = opening.map_or(job::Open::Backend, job::Open::Beside);
+    let (scene, prepared) = job::prepare(&pool, (backend, &job.devices), frame, &setup, open)?;
     run.split("preparation", "the rest of it", prepared.preparation());
     job::check_memory(
         &pool,

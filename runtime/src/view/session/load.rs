@@ -1,8 +1,10 @@
 //! The viewer session's loads: the scene file read (again when it changed under the read),
-//! checked, lowered and prepared through the job's path, its specialised pipeline compiled on
+//! checked, lowered and (the first) prepared through the job's path on the window's device, its specialised pipeline compiled on
 //! another thread while the interpreted kernel shows it, and the load installed.
 
 use super::*;
+use crate::backend::{Backend, Devices};
+use crate::job::{self, FrameScene};
 
 impl Session {
     /// Loads the scene file again (or for the first time): on success the new scene replaces
@@ -131,14 +133,36 @@ impl Session {
             }
             _ => None,
         };
-        let prepared = match (&self.good, &self.device) {
-            (Some(good), _) => good.prepared.next_with(&scene, lowered, kernel),
-            (None, Device::Cpu) => Prepared::on_cpu(&scene, lowered, &setup).map(|p| (p, true)),
-            (None, Device::Wgpu(gpu)) => {
-                Prepared::on_gpu(gpu.clone(), &scene, &lowered, &setup).map(|p| (p, true))
+        // A new scene is prepared as the last one was, on its device; the first through the
+        // job's path, on the window's device.
+        let (scene, prepared, built) = match &self.good {
+            Some(good) => {
+                let (prepared, built) = good
+                    .prepared
+                    .next_with(&scene, lowered, kernel)
+                    .map_err(|e| summary(e.into()))?;
+                (scene, prepared, built)
+            }
+            None => {
+                let (backend, open) = match &self.device {
+                    Device::Cpu => (Backend::Cpu, job::Open::Backend),
+                    Device::Wgpu(gpu) => (Backend::Wgpu, job::Open::Gpu(gpu.clone())),
+                };
+                // Settings the scene cannot be rendered with are the scene's fault, not the
+                // backend's (as `Job::frame` checks them).
+                crate::backend::method_allowed(&scene, &lowered.traceable)
+                    .map_err(|e| summary(e.into()))?;
+                let frame = FrameScene {
+                    scene,
+                    lowered,
+                    phases: Vec::new(),
+                };
+                let on = (backend, &Devices::Auto);
+                let (scene, prepared) =
+                    job::prepare_here(on, frame, &setup, open).map_err(summary)?;
+                (scene, prepared, true)
             }
         };
-        let (prepared, built) = prepared.map_err(|e| summary(e.into()))?;
         let prepare_time = start.elapsed();
         let mut at = scene.settings.clone();
         (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);

@@ -19,4 +19,5 @@ pub mod output;
 pub mod pareto;
 pub mod sequence;
 pub mod settings;
+pub mod tally;
 pub mod view;

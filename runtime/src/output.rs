@@ -246,6 +246,8 @@ pub struct Written {
     pub result: Result<(), String>,
     /// Seconds from the start of its render until its file was written.
     pub seconds: f64,
+    /// Where the writing went: encoding, write, `fsync` and rename ([`Output::write`]).
+    pub steps: Vec<Step>,
 }
 
 /// Images encoded and written (atomically, synced) on a pool of threads while the caller
@@ -293,11 +295,15 @@ impl Writers {
                         };
                         let Ok(task) = task else { return };
                         // Synced: a rerun skips the frames whose files it finds.
-                        let result = task.output.write(&task.picture, true, png).map(|_| ());
+                        let (result, steps) = match task.output.write(&task.picture, true, png) {
+                            Ok(steps) => (Ok(()), steps),
+                            Err(e) => (Err(e), Vec::new()),
+                        };
                         let written = Written {
                             k: task.k,
                             result,
                             seconds: task.started.elapsed().as_secs_f64(),
+                            steps,
                         };
                         if done.send(written).is_err() {
                             return;

@@ -400,11 +400,25 @@ fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
             "96x64",
             "--frames",
             "0..3",
+            "--stats",
             "-o",
             pattern,
         ];
         let out = sdfc(&d, &args, &[]);
         assert!(out.status.success(), "{out:?}");
+        // `--stats` says where the time went: each device's steps and the writers'.
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("where the sequence's time went"), "{err}");
+        let place = if devices == "0" { "device" } else { "device 1" };
+        assert!(
+            err.contains(&format!("\n  {place}: "))
+                && err.contains("opening and first preparation"),
+            "{err}"
+        );
+        assert!(
+            err.contains("\n  writers: ") && err.contains(" fsync "),
+            "{err}"
+        );
     }
     for k in 0..3 {
         let a = std::fs::read(d.join(format!("one/f_{k:02}.png"))).expect("frame");

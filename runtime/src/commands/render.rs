@@ -94,7 +94,14 @@ pub fn run(args: RenderArgs) -> ExitCode {
             .exit();
         }
         let out = args.output.as_deref();
-        return match sequence::run(&args.file, out, args.png_level, &args.sequence, &job) {
+        return match sequence::run(
+            &args.file,
+            out,
+            args.png_level,
+            &args.sequence,
+            &job,
+            args.stats,
+        ) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => e.exit(),
         };

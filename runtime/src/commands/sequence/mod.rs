@@ -12,6 +12,7 @@ use crate::image::{Picture, PngLevel};
 use crate::job::{self, Error, FrameScene, Job, Kernels};
 use crate::output::{Output, Submit, Task, Writers, Written};
 use crate::sequence::{Frames, Target};
+use crate::tally::Tally;
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{Animation, LowerOptions};
 use sdfc_compiler::{Limit, Limits};
@@ -45,13 +46,14 @@ pub struct SequenceArgs {
 
 /// Renders the sequence of the scene `file` that `args` ask for, `job` being its job, to
 /// `output` (default: numbered PNG files named after the scene), PNG files compressed at
-/// `png_level`.
+/// `png_level`; with `stats` (`--stats`), where the time went ([`Tally`]).
 pub fn run(
     file: &Path,
     output: Option<&Path>,
     png_level: PngLevel,
     args: &SequenceArgs,
     job: &Job,
+    stats: bool,
 ) -> Result<(), Error> {
     let limits = &job.limits;
     let mut source = Source::read(file).map_err(Error::Io)?;
@@ -114,12 +116,14 @@ pub fn run(
     );
     let bar = progress(mine.len() as u64, skipped as u64);
     let mut first = Some(first);
+    let tally = Tally::default();
     let mut checker = Checker {
         job,
         source: &mut source,
         lowering: &lowering,
         fps,
         bar: bar.as_ref(),
+        tally: &tally,
     };
     let started = Instant::now();
     // Numbered files are encoded and written on a pool of threads while the next frames
@@ -148,6 +152,7 @@ pub fn run(
                 backend,
                 setup,
                 limits,
+                tally: &tally,
             };
             let writers = writers.as_ref();
             frames.render(&list, &todo, &mut first, (&mut checker, &mut sink, writers))?
@@ -156,6 +161,7 @@ pub fn run(
             let mut kernels = Kernels::new(&pool, (backend, job.devices.clone()), setup);
             // The picture of a scene that does not read `t`, rendered once.
             let mut still: Option<Picture> = None;
+            const HERE: &str = "device";
             for (n, &k) in todo.iter().enumerate() {
                 let frame = checker.frame(k, &mut first)?;
                 let frame_started = Instant::now();
@@ -165,7 +171,13 @@ pub fn run(
                         let (scene, prepared) = kernels.prepare(frame)?;
                         let memory = (false, false);
                         job::check_memory(&pool, prepared, &scene, memory, limits, n == 0)?;
+                        tally.since(HERE, preparing(n == 0), frame_started);
+                        let rendered = Instant::now();
                         let mut frame = pool.install(|| prepared.render(&scene, &|_| {}))?;
+                        match &frame.phases {
+                            Some(p) => tally.phases(HERE, p),
+                            None => tally.since(HERE, "render", rendered),
+                        }
                         for w in frame.warnings() {
                             eprintln!("warning: frame {k}: {w}");
                         }
@@ -187,13 +199,17 @@ pub fn run(
                             picture,
                             started: frame_started,
                         };
+                        let handing = Instant::now();
                         w.submit(task).map_err(Error::Encode)?;
+                        tally.since(HERE, "handing to the writers", handing);
                         for done in w.written() {
                             report(done, &checker, &sink)?;
                         }
                     }
                     _ => {
+                        let writing = Instant::now();
                         sink.write(k, &picture)?;
+                        tally.since(HERE, "writing", writing);
                         checker.written(k, &sink, frame_started.elapsed().as_secs_f64());
                     }
                 }
@@ -214,6 +230,13 @@ pub fn run(
     }
     sink.finish()?;
     let seconds = started.elapsed().as_secs_f64();
+    if stats {
+        eprintln!(
+            "where the sequence's time went (each step's sum over the frames, how many, the mean in ms; the writers' steps summed over their {} threads):\n{}",
+            Writers::cores(),
+            tally.report()
+        );
+    }
     eprintln!(
         "wrote {} frame{} to {} in {seconds:.3} s ({:.2} frames/s); {} kernel{} prepared{}",
         todo.len(),
@@ -238,6 +261,8 @@ struct Checker<'a> {
     lowering: &'a LowerOptions,
     fps: f64,
     bar: Option<&'a ProgressBar>,
+    /// Where the time went.
+    tally: &'a Tally,
 }
 
 impl Checker<'_> {
@@ -247,17 +272,18 @@ impl Checker<'_> {
         if let Some(f) = first.take().filter(|_| time == 0.0) {
             return Ok(f);
         }
-        self.job
-            .frame(self.source, time, false, self.lowering)
-            .map_err(|e| {
-                if let Some(b) = self.bar {
-                    b.abandon();
-                }
-                if let Error::Scene(_) = e {
-                    eprintln!("error: frame {k} (t = {time} s) has errors");
-                }
-                e
-            })
+        let started = Instant::now();
+        let frame = self.job.frame(self.source, time, false, self.lowering);
+        self.tally.since("main thread", "check", started);
+        frame.map_err(|e| {
+            if let Some(b) = self.bar {
+                b.abandon();
+            }
+            if let Error::Scene(_) = e {
+                eprintln!("error: frame {k} (t = {time} s) has errors");
+            }
+            e
+        })
     }
 
     /// Frame `k` was written in `seconds`.
@@ -273,9 +299,22 @@ impl Checker<'_> {
     }
 }
 
+/// The tally's name of a frame's preparation: the first opens the device and prepares the
+/// kernel (a CUDA context takes about a second on a host of four GPUs), the others only give
+/// it the frame's numbers.
+fn preparing(first: bool) -> &'static str {
+    match first {
+        true => "opening and first preparation",
+        false => "prepare",
+    }
+}
+
 /// Logs a frame the writers' pool wrote, or gives its error.
 fn report(done: Written, checker: &Checker, sink: &Sink) -> Result<(), Error> {
     done.result.map_err(Error::Io)?;
+    for (step, time, _) in &done.steps {
+        checker.tally.add("writers", step, *time);
+    }
     checker.written(done.k, sink, done.seconds);
     Ok(())
 }
@@ -314,6 +353,8 @@ struct FramesOn<'a> {
     backend: crate::backend::Backend,
     setup: Setup,
     limits: &'a Limits,
+    /// Where the time went.
+    tally: &'a Tally,
 }
 
 impl FramesOn<'_> {
@@ -408,12 +449,16 @@ impl FramesOn<'_> {
             let result = (|| -> Result<(), Error> {
                 for &k in todo {
                     let frame = checker.frame(k, first)?;
+                    let waiting = Instant::now();
                     while queue.waiting() >= ahead {
                         match rx.recv_timeout(std::time::Duration::from_millis(20)) {
                             Ok(r) => handle(r, sink, checker)?,
                             Err(_) => continue,
                         }
                     }
+                    checker
+                        .tally
+                        .since("main thread", "waiting for a device", waiting);
                     queue.push(Pending { k, frame });
                     while let Ok(r) = rx.try_recv() {
                         handle(r, sink, checker)?;
@@ -459,7 +504,11 @@ impl FramesOn<'_> {
         let mut kernels = Kernels::new(self.pool, (self.backend, list), self.setup);
         let faults = Faults::from_env();
         let mut tiles = 0;
+        let here = format!("device {position}");
+        let tally = self.tally;
+        let mut idle = Instant::now();
         while let Some(Pending { k, frame }) = queue.take() {
+            tally.since(&here, "waiting for a frame", idle);
             let kept = frame.clone();
             let started = Instant::now();
             let first = kernels.last().is_none();
@@ -488,9 +537,17 @@ impl FramesOn<'_> {
                     return Err(Error::Render(message));
                 }
                 tiles += n;
+                tally.since(&here, preparing(first), started);
+                let rendered = Instant::now();
                 self.pool
                     .install(|| prepared.render_faults(&scene, &|_| {}, &Faults::default()))
-                    .map(|mut f| f.take_picture())
+                    .map(|mut f| {
+                        match &f.phases {
+                            Some(p) => tally.phases(&here, p),
+                            None => tally.since(&here, "render", rendered),
+                        }
+                        f.take_picture()
+                    })
                     .map_err(Error::from)
             })();
             match rendered {
@@ -506,9 +563,11 @@ impl FramesOn<'_> {
                                 picture,
                                 started,
                             };
+                            let handing = Instant::now();
                             if let Err(e) = writers.submit(task) {
                                 let _ = tx.send(Report::Unwritten(e));
                             }
+                            tally.since(&here, "handing to the writers", handing);
                             None
                         }
                         None => Some(picture),
@@ -520,6 +579,7 @@ impl FramesOn<'_> {
                         seconds,
                     });
                     queue.done();
+                    idle = Instant::now();
                 }
                 Err(e) => {
                     queue.hand_back(Pending { k, frame: kept });

@@ -72,14 +72,11 @@ fn kernel_for(
     wgsl::write_with(scene, lowered, &options).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Why the interpreted kernel refuses `scene` (text and meshes are read as data by the
-/// specialised kernel alone), if it does.
-fn refused(scene: &Scene, lowered: &Lowered) -> Option<String> {
-    let options = Options {
-        kernel: KernelChoice::Interpreted,
-        ..Options::default()
-    };
-    wgsl::choose(scene, lowered, &options).err()
+/// The examples, and the one that imports a triangle mesh (examples/mesh/import.sdf).
+fn examples() -> Vec<std::path::PathBuf> {
+    let mut all = common::examples();
+    all.push("../examples/mesh/import.sdf".into());
+    all
 }
 
 #[test]
@@ -102,13 +99,9 @@ fn the_text_depends_on_the_specialisation_alone() {
     assert!(programs.len() > 5, "the programs differ");
     // Every example's interpreted kernel validates, and so do the media's entry points.
     let mut media = false;
-    for path in common::examples() {
+    for path in examples() {
         let scene = marched(&path, 32, 24);
         let lowered = Lowered::new(&scene);
-        if let Some(why) = refused(&scene, &lowered) {
-            println!("{}: no interpreted kernel ({why})", path.display());
-            continue;
-        }
         let k = kernel(&scene, &lowered, KernelChoice::Interpreted);
         media |= k.source.contains("fn sdf_medium(");
         println!(
@@ -267,13 +260,9 @@ fn assert_same(gpu: &gpu::Gpu, scene: &Scene, label: &str) -> f64 {
 fn every_example_renders_as_with_the_specialised_kernel() {
     let Some(gpu) = open_gpu() else { return };
     println!("adapter: {}", gpu.describe());
-    for path in common::examples() {
+    for path in examples() {
         let scene = marched(&path, 48, 32);
         let name = path.file_stem().unwrap_or_default().to_string_lossy();
-        if let Some(why) = refused(&scene, &Lowered::new(&scene)) {
-            println!("{name}: no interpreted kernel ({why})");
-            continue;
-        }
         assert_same(&gpu, &scene, &name);
     }
 }

@@ -110,7 +110,7 @@ pub fn rename_calls(map: &str, name: &str) -> String {
 }
 
 /// [`FUNCTIONS`] with their names prefixed by `prefix` and reading the words from `data`.
-fn functions(prefix: &str, data: &str) -> String {
+pub(super) fn functions(prefix: &str, data: &str) -> String {
     FUNCTIONS
         .replace("text_", &format!("{prefix}text_"))
         .replace("scene_data[", &format!("{data}["))

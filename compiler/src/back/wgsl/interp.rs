@@ -16,6 +16,8 @@
 //!           y, z, w: the operands: a register's number, an immediate f32 (a constant of the
 //!              program), or a word index (a block's end)
 //! [table ..] the first word of each colour field's program, four a word
+//! [data ..] the meshes (mesh.rs's layout, each at data + its base), then the outlines of
+//!           text (glyphs.rs's layout)
 //!
 //! Every integer (word indices, the fields of x, registers) is held as the f32 of its value,
 //! exact below 2^24, and read with `u32(…)`: held as its bits, a small integer would be a
@@ -24,7 +26,11 @@
 //!
 //! Each program is its live instructions in order, constants folded into the operands that
 //! read them, and ends with `RETURN` (distance, material; or a colour field's red, green and
-//! blue). A guarded block is a `COPY` of
+//! blue). `MESH` (operands x, y, z) takes two words, the second holding the mesh's first
+//! word in its y; `OUTLINE` (operands x, y and the outline's first word) one. Both call the
+//! specialised kernel's functions over `scene_data` (`mesh_distance`, `text_outline`), once
+//! per call outside the unrolled steps, so that the kernel holds one copy of each. A guarded
+//! block is a `COPY` of
 //! each needed result's value from before it, `BLOCK` (which jumps past the block where
 //! `bound >= best`, as the code's `if !(bound >= best)`), its instructions, and a `COPY` of
 //! each result's value inside it. Registers are allocated by a linear scan over that order,
@@ -35,6 +41,7 @@
 //! contracts the code's products and sums into fused multiply-adds.
 
 use crate::program::{results, Axis, Binary, Item, Op, Program, Reg, Unary};
+use std::collections::HashMap;
 use std::fmt::Write;
 
 /// `auto` (`Options::kernel`) chooses the interpreted kernel for a marched scene whose
@@ -57,6 +64,10 @@ const BLOCK: u32 = 5;
 const UNARY: u32 = 6;
 const BINARY: u32 = 16;
 const SELECT: u32 = 25;
+const MESH: u32 = 26;
+const OUTLINE: u32 = 27;
+/// The second word of a `MESH`, never run.
+const OPERAND: u32 = 28;
 
 const UNARIES: [Unary; 10] = [
     Unary::Neg,
@@ -93,6 +104,9 @@ enum Arg {
     Imm(f32),
     /// A word index (a block's end), relative to the program's first word.
     Jump(u32),
+    /// A word index of data (a mesh's or an outline's first word), relative to the data's
+    /// first word.
+    Data(u32),
 }
 
 /// One instruction before registers are allocated: the destination is a program register
@@ -104,8 +118,9 @@ struct Ins {
     args: [Arg; 3],
 }
 
-/// A program's instructions for `roots` (distance, and material where given), in order.
-fn linear(program: &Program, roots: &[Reg]) -> Vec<Ins> {
+/// A program's instructions for `roots` (distance, and material where given), in order;
+/// `outlines` gives each outline's first word in the data by its name (glyphs.rs).
+fn linear(program: &Program, roots: &[Reg], outlines: &HashMap<String, u32>) -> Vec<Ins> {
     let ops = program.ops();
     let (live, live_blocks) = program.live(roots);
     let phi_of = program.phi_blocks();
@@ -130,10 +145,27 @@ fn linear(program: &Program, roots: &[Reg]) -> Vec<Ins> {
                         [arg(x), arg(y), Arg::None],
                     ),
                     Op::Select(c, a, b) => (SELECT, [arg(c), arg(a), arg(b)]),
-                    // Programs with meshes are refused before they are encoded (`encode`).
-                    // Outlines are refused by `encode` before they get here.
-                    Op::Phi(..) | Op::Mesh(..) | Op::Outline(..) => continue,
+                    Op::Mesh(..) => (MESH, [Arg::None; 3]),
+                    Op::Outline(k, x, y) => {
+                        let name = super::glyphs::name(&program.outlines()[k as usize]);
+                        let at = outlines.get(&name).copied().unwrap_or(0);
+                        (OUTLINE, [arg(x), arg(y), Arg::Data(at)])
+                    }
+                    Op::Phi(..) => continue,
                 };
+                if let Op::Mesh(m, x, y, z) = ops[i] {
+                    out.push(Ins {
+                        op: MESH,
+                        dest: Some(Reg(i as u32)),
+                        args: [arg(x), arg(y), arg(z)],
+                    });
+                    out.push(Ins {
+                        op: OPERAND,
+                        dest: None,
+                        args: [Arg::Data(program.mesh(m).base), Arg::None, Arg::None],
+                    });
+                    continue;
+                }
                 out.push(Ins {
                     op,
                     dest: Some(Reg(i as u32)),
@@ -202,7 +234,7 @@ fn allocate(ins: &[Ins], len: usize) -> (Vec<[u32; 4]>, usize) {
             word[k + 1] = match *a {
                 Arg::None => 0,
                 Arg::Imm(x) => x.to_bits(),
-                Arg::Jump(j) => j,
+                Arg::Jump(j) | Arg::Data(j) => j,
                 Arg::Reg(r) => {
                     word[0] |= 0x100 << k;
                     phys[r.0 as usize].unwrap_or(0)
@@ -264,14 +296,12 @@ pub(crate) enum Unfit {
     Bytes(usize, u64),
     /// Its programs take this many words, more than 2^24 (word indices are held as f32).
     Words(usize),
-    /// Its programs read outlines (text), which only the specialised kernel evaluates.
-    Outlines,
 }
 
 /// The registers that `program`'s `map` (distance and material) needs in the interpreter.
 pub fn registers(program: &Program) -> usize {
     let roots = [program.distance(), program.material()];
-    allocate(&linear(program, &roots), program.len()).1
+    allocate(&linear(program, &roots, &HashMap::new()), program.len()).1
 }
 
 /// The programs of a kernel, in the order of the header: each with its roots (a `map`
@@ -285,19 +315,58 @@ pub(super) struct Programs<'a> {
     pub colours: &'a [crate::lower::ColourProgram],
 }
 
-/// The bytes of `scene_data` holding `programs` for a file of `file` registers, or why they
-/// do not fit it or `max_bytes`.
-pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<Vec<u8>, Unfit> {
-    let media = programs.media.map_or(Vec::new(), |(a, b)| vec![a, b]);
-    if [programs.main]
-        .iter()
-        .chain(&media)
-        .any(|p| !p.outlines().is_empty())
-    {
-        return Err(Unfit::Outlines);
+/// What of the data the interpreted kernel's programs call: the meshes' walk, the outlines'.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(super) struct Calls {
+    /// Some program reads a mesh (`MESH`, `mesh_distance`).
+    pub meshes: bool,
+    /// Some program reads an outline (`OUTLINE`, `text_outline`).
+    pub outlines: bool,
+}
+
+impl Programs<'_> {
+    /// Every program of the kernel.
+    fn all(&self) -> Vec<&Program> {
+        let mut all = vec![self.main];
+        if let Some((a, b)) = self.media {
+            all.extend([a, b]);
+        }
+        all.extend(self.colours.iter().map(|c| &c.program));
+        all
     }
-    let map = |p: &Program| linear(p, &[p.distance(), p.material()]);
-    let sdf = |p: &Program| linear(p, &[p.distance()]);
+
+    /// The data the programs call.
+    pub(super) fn calls(&self) -> Calls {
+        let all = self.all();
+        Calls {
+            meshes: all.iter().any(|p| super::mesh::uses_meshes(p)),
+            outlines: all.iter().any(|p| !p.outlines().is_empty()),
+        }
+    }
+}
+
+/// The bytes of `scene_data` holding `programs` for a file of `file` registers, then the
+/// meshes and outlines they read, or why they do not fit it or `max_bytes`.
+pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<Vec<u8>, Unfit> {
+    // The data after the programs: the meshes, each at its base, then the outlines.
+    let all = programs.all();
+    let calls = programs.calls();
+    let mut data = if calls.meshes {
+        super::mesh::data(all.iter().copied())
+    } else {
+        Vec::new()
+    };
+    let mut outlines = HashMap::new();
+    for (name, o) in super::glyphs::collect(&all) {
+        outlines.insert(name, (data.len() / 16) as u32);
+        for w in o.words() {
+            for v in w {
+                data.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    let map = |p: &Program| linear(p, &[p.distance(), p.material()], &outlines);
+    let sdf = |p: &Program| linear(p, &[p.distance()], &outlines);
     let mut lists = vec![
         (map(programs.main), programs.main.len()),
         (sdf(programs.main), programs.main.len()),
@@ -309,8 +378,11 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
     }
     let fixed = lists.len();
     for c in programs.colours {
-        lists.push((linear(&c.program, &c.rgb), c.program.len()));
+        lists.push((linear(&c.program, &c.rgb, &outlines), c.program.len()));
     }
+    let table_words = programs.colours.len().div_ceil(4);
+    let data_start =
+        (HEADER + lists.iter().map(|(l, _)| l.len()).sum::<usize>() + table_words) as u32;
     let mut starts = [0u32; 8];
     let mut colour_starts = Vec::with_capacity(programs.colours.len());
     let mut body: Vec<[u32; 4]> = Vec::new();
@@ -331,16 +403,22 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
             if let Arg::Jump(_) = i.args[2] {
                 w[3] += base;
             }
+            // Data indices are absolute, written as the f32 of their value.
+            for (k, a) in i.args.iter().enumerate() {
+                if let Arg::Data(d) = a {
+                    w[k + 1] = ((d + data_start) as f32).to_bits();
+                }
+            }
         }
         body.extend(words);
     }
     // The colour fields' table: their first words, four a word.
     starts[5] = (HEADER + body.len()) as u32;
-    let table_words = colour_starts.len().div_ceil(4);
+    debug_assert_eq!(data_start as usize, HEADER + body.len() + table_words);
     if needed > file {
         return Err(Unfit::Registers(needed, file));
     }
-    let words = HEADER + body.len() + table_words;
+    let words = HEADER + body.len() + table_words + data.len() / 16;
     if words > 1 << 24 {
         // Word indices are written as f32 (exact below 2^24).
         return Err(Unfit::Words(words));
@@ -373,6 +451,7 @@ pub(super) fn encode(programs: &Programs, file: usize, max_mib: u64) -> Result<V
         let start = colour_starts.get(k).copied().unwrap_or(0);
         out.extend_from_slice(&int(start).to_le_bytes());
     }
+    out.extend_from_slice(&data);
     Ok(out)
 }
 
@@ -395,8 +474,10 @@ pub const UNROLL_SOFTWARE: usize = 32;
 
 /// The WGSL text of the interpreter and of the distance functions the kernel calls, for a
 /// file of `file` registers, running `unroll` instructions an iteration of its loop; with
-/// `media`, also those of glass over solids.
-pub(super) fn write(file: usize, media: bool, unroll: usize) -> String {
+/// `media`, also those of glass over solids; with `calls`, the functions over the data that
+/// `MESH` and `OUTLINE` call.
+pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> String {
+    let called = calls.meshes || calls.outlines;
     let last = file; // the scratch register
     let mut out = String::new();
     let _ = writeln!(
@@ -409,6 +490,23 @@ pub(super) fn write(file: usize, media: bool, unroll: usize) -> String {
          const INTERP_DONE: u32 = 0xffffffffu;\n",
         file + 1
     );
+    let call = if called {
+        format!(
+            "if op == {MESH}u || op == {OUTLINE}u {{\n        interp_args = vec3<f32>(a, b, c);\n        \
+             interp_pc = pc;\n        return INTERP_CALL;\n    }}\n    "
+        )
+    } else {
+        String::new()
+    };
+    if called {
+        out.push_str(
+            "// A call of the data's functions (MESH, OUTLINE): its operands and its word, run by\n\
+             // interp_call outside the unrolled steps.\n\
+             var<private> interp_args: vec3<f32>;\n\
+             var<private> interp_pc: u32;\n\
+             const INTERP_CALL: u32 = 0xfffffffeu;\n\n",
+        );
+    }
     let _ = writeln!(
         out,
         "// Runs the instruction at pc; returns the next one's index, or INTERP_DONE after RETURN.\n\
@@ -420,6 +518,7 @@ pub(super) fn write(file: usize, media: bool, unroll: usize) -> String {
          if (h & 0x400u) != 0u {{\n        c = interp_regs[min(u32(w.w), {last}u)];\n    }}\n    \
          let op = h & 0xffu;\n    \
          if op == {RETURN}u {{\n        interp_result = vec3<f32>(a, b, c);\n        return INTERP_DONE;\n    }}\n    \
+         {call}\
          var v = 0.0;\n    var next = pc + 1u;\n    switch op {{"
     );
     let case = |out: &mut String, op: u32, body: &str| {
@@ -473,15 +572,64 @@ pub(super) fn write(file: usize, media: bool, unroll: usize) -> String {
         out,
         "        default: {{}}\n    }}\n    interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = v;\n    return next;\n}}\n"
     );
+    if called {
+        let mut body = String::new();
+        if calls.meshes {
+            let _ = write!(
+                body,
+                "if (h & 0xffu) == {MESH}u {{\n        \
+                 let base = u32(scene_data[interp_pc + 1u].y);\n        \
+                 interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = mesh_distance(interp_args, base);\n        \
+                 return interp_pc + 2u;\n    }}\n    "
+            );
+        }
+        if calls.outlines {
+            let _ = write!(
+                body,
+                "if (h & 0xffu) == {OUTLINE}u {{\n        \
+                 let q = interp_args.xy;\n        \
+                 interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = text_outline(u32(interp_args.z), q);\n    }}\n    "
+            );
+        }
+        let _ = writeln!(
+            out,
+            "// Runs the call at interp_pc; returns the next instruction's index.\n\
+             fn interp_call() -> u32 {{\n    let h = u32(scene_data[interp_pc].x);\n    \
+             {body}return interp_pc + 1u;\n}}\n"
+        );
+    }
     let _ = writeln!(
         out,
         "// Runs the program that starts at `start` at p: (distance, material id, 0), or a colour.\n\
          fn interpret(p: vec3<f32>, start: u32) -> vec3<f32> {{\n    var pc = start;\n    loop {{"
     );
+    // With calls, the steps run in an inner loop that a call or the end leaves.
+    let (indent, stop) = if called {
+        out.push_str("        loop {\n");
+        ("    ", "pc >= INTERP_CALL")
+    } else {
+        ("", "pc == INTERP_DONE")
+    };
     for _ in 0..unroll.max(1) {
-        out.push_str("        pc = interp_step(p, pc);\n        if pc == INTERP_DONE {\n            break;\n        }\n");
+        let _ = write!(
+            out,
+            "{indent}        pc = interp_step(p, pc);\n{indent}        if {stop} {{\n{indent}            break;\n{indent}        }}\n"
+        );
+    }
+    if called {
+        out.push_str(
+            "        }\n        if pc == INTERP_DONE {\n            break;\n        }\n        pc = interp_call();\n",
+        );
     }
     out.push_str("    }\n    return interp_result;\n}\n\n");
+    if calls.meshes {
+        out.push_str(&super::mesh::write());
+        out.push('\n');
+    }
+    if calls.outlines {
+        out.push_str(&super::glyphs::functions("", "scene_data"));
+        out.push('\n');
+    }
     let entry = |out: &mut String, name: &str, slot: &str, material: bool| {
         let (ty, tail) = if material {
             ("vec2<f32>", ".xy")
@@ -523,12 +671,15 @@ mod tests {
 
     /// Runs the words as the kernel does, on the CPU, in f32.
     fn run(words: &[u32], start: u32, p: [f32; 3], file: usize) -> [f32; 2] {
-        let [a, b, _] = run3(words, start, p, file);
+        let [a, b, _] = run3(words, start, p, file, &|_, _, _| unreachable!());
         [a, b]
     }
 
-    /// [`run`], with the third value of `RETURN` (a colour's blue).
-    fn run3(words: &[u32], start: u32, p: [f32; 3], file: usize) -> [f32; 3] {
+    /// The value of a call (`MESH`, `OUTLINE`): its opcode, operands and the data's word.
+    type Call<'a> = dyn Fn(u32, [f32; 3], u32) -> f32 + 'a;
+
+    /// [`run`], with the third value of `RETURN` (a colour's blue), calls made by `call`.
+    fn run3(words: &[u32], start: u32, p: [f32; 3], file: usize, call: &Call) -> [f32; 3] {
         let mut regs = vec![0f32; file + 1];
         let mut pc = start as usize;
         loop {
@@ -556,6 +707,11 @@ mod tests {
                     0.0
                 }
                 SELECT => crate::program::scalar::select(a, b, c),
+                MESH => {
+                    next = pc + 2;
+                    call(MESH, [a, b, c], int(words[(pc + 1) * 4 + 1]))
+                }
+                OUTLINE => call(OUTLINE, [a, b, c], c as u32),
                 o if o >= BINARY => {
                     crate::program::scalar::binary(BINARIES[(o - BINARY) as usize], a, b)
                 }
@@ -637,6 +793,69 @@ mod tests {
         assert_eq!(small, Err(Unfit::Registers(needed, needed - 1)));
     }
 
+    /// Text: each `OUTLINE` reads the words of its outline, appended after the programs, and
+    /// the programs run as the reference, bit for bit.
+    #[test]
+    fn encoded_outlines_run_as_the_reference() {
+        let text = "scene { extrude(text(\"HELLO\", 0.7), 0.2, 0.01).translate(0, 0.3, -0.1);\n\
+            box((1.45, 0.5, 0.1)).translate(0, 0.3, 0.05); extrude(text(\"ok\", 0.5), 0.1).translate(0, -1, 0); }";
+        let (scene, diags, _) = crate::front::check_str("t.sdf", text);
+        let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+        let lowered = Lowered::new(&scene);
+        let program = &lowered.program;
+        assert_eq!(program.outlines().len(), 2);
+        let file = 64;
+        let programs = Programs {
+            main: program,
+            media: None,
+            colours: &[],
+        };
+        assert_eq!(
+            programs.calls(),
+            Calls {
+                meshes: false,
+                outlines: true
+            }
+        );
+        let bytes = encode(&programs, file, 128).expect("fits");
+        let words: Vec<u32> = bytes
+            .chunks(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        // The outline whose words start at the call's word.
+        let call = |op: u32, [x, y, _]: [f32; 3], at: u32| {
+            assert_eq!(op, OUTLINE);
+            let at = at as usize * 4;
+            let o = program
+                .outlines()
+                .iter()
+                .find(|o| {
+                    let w: Vec<u32> = o.words().iter().flatten().map(|v| v.to_bits()).collect();
+                    words.get(at..at + w.len()) == Some(&w[..])
+                })
+                .expect("an outline at the call's word");
+            crate::program::outline::distance::<f32>(o, x, y)
+        };
+        let mut rng = crate::rng::Rng::new(5);
+        for _ in 0..5_000 {
+            let p = [2.0, 1.5, 0.5].map(|e: f64| rng.range(-e, e) as f32);
+            let regs = program.run::<f32>(p, |_| {});
+            let want = [
+                regs[program.distance().0 as usize],
+                regs[program.material().0 as usize],
+            ];
+            let start = |k: usize| f32::from_bits(words[k]) as u32;
+            let [d, m, _] = run3(&words, start(0), p, file, &call);
+            assert_eq!(
+                [d, m].map(f32::to_bits),
+                want.map(f32::to_bits),
+                "map at {p:?}"
+            );
+            let [d, _, _] = run3(&words, start(1), p, file, &call);
+            assert_eq!(d.to_bits(), want[0].to_bits(), "sdf at {p:?}");
+        }
+    }
+
     /// The colour fields' programs, encoded after the distance programs and found through
     /// their table, run as their reference (`ColourProgram::eval`), bit for bit.
     #[test]
@@ -676,7 +895,7 @@ mod tests {
             let p = [0; 3].map(|_| rng.range(-3.0, 3.0) as f32);
             for (k, c) in colours.programs.iter().enumerate() {
                 let start = int(4 * (table + k / 4) + k % 4);
-                let got = run3(&words, start, p, file);
+                let got = run3(&words, start, p, file, &|_, _, _| unreachable!());
                 let want = c.eval::<f32>(p);
                 assert_eq!(
                     got.map(f32::to_bits),

@@ -239,7 +239,7 @@ pub enum KernelKind {
 pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<KernelKind, String> {
     let traced = lowered.traceable.traced(scene.settings.method).is_some();
     if let Some(data) = meshes_of(scene, lowered).filter(|_| !traced) {
-        // The meshes' triangles are read from `scene_data` by the program written as code.
+        // The meshes' triangles are read from `scene_data`, by either kernel.
         let bytes = data.len() as u64;
         let mib = scene.limits.get(crate::limits::Limit::SceneData);
         if bytes > mib.saturating_mul(1 << 20) {
@@ -252,14 +252,6 @@ pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Ker
                     .raise_to(crate::limits::Limit::SceneData, bytes.div_ceil(1 << 20))
             ));
         }
-        return match options.kernel {
-            KernelChoice::Interpreted => Err(
-                "the interpreted kernel cannot run a scene with a `mesh`: its triangles are \
-                 walked by code; use `--kernel specialised` or `--kernel auto`"
-                    .into(),
-            ),
-            _ => Ok(KernelKind::Specialised),
-        };
     }
     match options.kernel {
         KernelChoice::Specialised => Ok(KernelKind::Specialised),
@@ -340,9 +332,6 @@ fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, String> {
              registers and the kernel has {file}; {} (or use `--kernel specialised`)",
             scene.limits.raise_to(Limit::Registers, needed as u64)
         ),
-        interp::Unfit::Outlines => "the interpreted kernel cannot run this scene: its text is \
-             read as data by the specialised kernel alone; use `--kernel specialised`"
-            .to_string(),
         interp::Unfit::Words(words) => format!(
             "the interpreted kernel cannot run this scene: its distance programs take {words} \
              instructions, more than the 2^24 it can address; use `--kernel specialised`"
@@ -453,7 +442,17 @@ fn write_template(
             media = media_of(scene, lowered).is_some();
             interprets = true;
             let file = scene.limits.count(crate::limits::Limit::Registers);
-            values.insert("MAP", interp::write(file, media, options.interp_unroll));
+            let m = media_of(scene, lowered);
+            let calls = interp::Programs {
+                main: &lowered.program,
+                media: m.map(|m| (&m.medium, &m.solid)),
+                colours: &lowered.colours.programs,
+            }
+            .calls();
+            values.insert(
+                "MAP",
+                interp::write(file, media, options.interp_unroll, calls),
+            );
             Some(bytes)
         }
         None => {

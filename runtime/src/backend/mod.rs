@@ -148,11 +148,10 @@ impl Setup {
         }
     }
 
-    /// This setup on a CUDA device, where `--kernel auto` is the specialised kernel: on an
-    /// H100 (BENCHMARKS.md, "Interpreted against specialised", 2026-11-24) the driver's JIT of
-    /// the largest marched programs as code took at most 2.9 s cold and 0.8 s warm, a whole
-    /// render with the interpreted kernel 1.4–1.8 s cold, and its frames were 17 to 100 times
-    /// slower.
+    /// This setup on a CUDA device, where `--kernel auto` is the specialised kernel: the
+    /// driver's JIT compiles even the largest marched programs as code within seconds, while
+    /// the interpreted kernel's frames are many times slower (BENCHMARKS.md, "Interpreted
+    /// against specialised").
     fn on_cuda(&self) -> Setup {
         self.specialised_for_auto()
     }

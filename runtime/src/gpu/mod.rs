@@ -319,9 +319,9 @@ fn reduce_bytes(pixels: u64) -> u64 {
 /// "Several devices").
 pub(crate) fn copy_parallel<T: Copy + Send + Sync>(dst: &mut [T], src: &[T]) {
     use rayon::prelude::*;
-    // A mebibyte a task: a 1920×1080 frame's 8 MB wakes 8 threads, not every core (on a
-    // host of 64 cores, waking them all made a sequence's readback 3.6 ms a frame instead of
-    // 2.0 with 8 threads: BENCHMARKS.md, "Sequences").
+    // A mebibyte a task: a 1920×1080 frame's 8 MB wakes 8 threads, not every core; on a host
+    // of many cores waking them all costs more than the copy (BENCHMARKS.md, "Measured
+    // choices").
     let chunk = (1 << 20) / std::mem::size_of::<T>().max(1);
     dst.par_chunks_mut(chunk)
         .zip(src.par_chunks(chunk))

@@ -896,20 +896,36 @@ impl Ctx<'_> {
     fn field_block(&mut self, args: &[Arg], body: &Body, plane: bool, span: Span) -> Value {
         let word = if plane { "profile" } else { "field" };
         let mut lipschitz = None;
-        for a in args {
+        for (i, a) in args.iter().enumerate() {
             let named = a.name.as_ref().map(|n| n.name.as_str());
-            if !matches!(named, None | Some("lipschitz")) || args.len() > 1 {
-                let at = a.name.as_ref().map_or(a.value.span, |n| n.span);
+            // The label is on the argument at fault: a name other than `lipschitz`, or any
+            // argument after the first (whose own name, if any, was checked first).
+            let fault = match named {
+                Some(name) if name != "lipschitz" => Some((
+                    "E0202",
+                    format!("`{word}` has no parameter `{name}`"),
+                    "not `lipschitz`",
+                )),
+                Some(_) if i > 0 => Some((
+                    "E0203",
+                    "argument `lipschitz` is given twice".to_string(),
+                    "a second `lipschitz`",
+                )),
+                None if i > 0 => Some((
+                    "E0205",
+                    format!("too many arguments to `{word}`"),
+                    "a second argument",
+                )),
+                _ => None,
+            };
+            if let Some((code, msg, label)) = fault {
                 self.error(
-                    Diagnostic::error(
-                        "E0202",
-                        format!("`{word}` takes one argument, `lipschitz`"),
-                        at,
-                    )
-                    .with_label("not `lipschitz`")
-                    .with_help(format!(
-                        "declare a bound of the gradient: `{word}(lipschitz: 2) {{ … }}`"
-                    )),
+                    Diagnostic::error(code, msg, arg_span(a))
+                        .with_label(label)
+                        .with_note(format!("`{word}` takes one argument, `lipschitz`"))
+                        .with_help(format!(
+                            "declare a bound of the gradient: `{word}(lipschitz: 2) {{ … }}`"
+                        )),
                 );
                 return Value::Error;
             }
@@ -1011,7 +1027,7 @@ impl Ctx<'_> {
                 Diagnostic::error(
                     "E0202",
                     "a colour field takes no `lipschitz`",
-                    args.first().map_or(span, |a| a.value.span),
+                    args.first().map_or(span, arg_span),
                 )
                 .with_label("a bound of a distance's gradient")
                 .with_note("this field's body is a vec3: a colour, not a distance"),
@@ -1563,6 +1579,13 @@ impl Ctx<'_> {
 
 /// At most this many call sites are added to a diagnostic inside nested function bodies.
 const MAX_CALL_SITES: usize = 4;
+
+/// The span of an argument: `name: value`, or the value alone.
+fn arg_span(a: &Arg) -> Span {
+    a.name
+        .as_ref()
+        .map_or(a.value.span, |n| n.span.join(a.value.span))
+}
 
 /// `called here with r = -1, h = 2`: the label of a call site, with its arguments.
 fn call_label(params: &[(String, Value)]) -> String {

@@ -586,3 +586,42 @@ fn an_unknown_name_in_a_field_suggests_the_nearest_binding() {
         Some("did you mean `a`?")
     );
 }
+
+/// A wrong argument of `field` or `profile` is labelled where it is written: a name other
+/// than `lipschitz`, a second `lipschitz`, a second argument; a colour field's `lipschitz`
+/// is labelled as a whole.
+#[test]
+fn a_wrong_argument_of_a_field_is_labelled_where_it_is() {
+    let first = |src: &str| {
+        let (_, diags, _) = check_str("t.sdf", src);
+        let d = diags.iter().find(|d| d.is_error()).expect("an error");
+        let span = d.labels[0].span;
+        (
+            d.code,
+            src[span.range()].to_string(),
+            d.labels[0].message.clone(),
+        )
+    };
+    for word in ["field", "profile"] {
+        let solid = if word == "field" { "" } else { "extrude(" };
+        let close = if word == "field" { "" } else { ", 1)" };
+        let at = |args: &str| {
+            first(&format!(
+                "scene {{ {solid}{word}({args}) {{ length(p) - 1 }}{close}; }}"
+            ))
+        };
+        let (code, text, label) = at("lipschitz: 1, x: 2");
+        assert_eq!((code, text.as_str()), ("E0202", "x: 2"), "{word}: {label}");
+        assert_eq!(label, "not `lipschitz`");
+        let (code, text, _) = at("x: 2, lipschitz: 1");
+        assert_eq!((code, text.as_str()), ("E0202", "x: 2"), "{word}");
+        let (code, text, _) = at("lipschitz: 1, lipschitz: 3");
+        assert_eq!((code, text.as_str()), ("E0203", "lipschitz: 3"), "{word}");
+        let (code, text, _) = at("1, 3");
+        assert_eq!((code, text.as_str()), ("E0205", "3"), "{word}");
+    }
+    let (code, text, _) = first(
+        "material m = phong { color: field(lipschitz: 2) { vec3(p.x, 0, 0) } };\nscene { sphere(1) @ m; }",
+    );
+    assert_eq!((code, text.as_str()), ("E0202", "lipschitz: 2"));
+}

@@ -14,7 +14,7 @@ mod wgpu;
 
 pub use self::cpu::CpuPrepared;
 pub use self::cuda::CudaPrepared;
-pub use self::opening::Opening;
+pub use self::opening::{see_only, Opening};
 pub use self::several::SeveralPrepared;
 pub use self::wgpu::WgpuPrepared;
 

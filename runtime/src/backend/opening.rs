@@ -1,13 +1,38 @@
 //! The device of a render opened on a thread of its own while the front end reads, checks
-//! and lowers the scene ([`Opening`]), and the preparation that joins it
-//! ([`Prepared::opened`]).
+//! and lowers the scene ([`Opening`]), the preparation that joins it ([`Prepared::opened`]),
+//! and the CUDA driver restricted to the devices a render opens ([`see_only`]).
 
 use super::{kernel, CpuPrepared, CudaPrepared, Error, Preparation, Prepared, Setup, WgpuPrepared};
-use super::{method_allowed, Backend};
+use super::{method_allowed, Backend, Device, Devices};
 use crate::cpu::Precision;
 use crate::gpu::{self, cuda::Cuda, Gpu};
 use sdfc_compiler::{wgsl, Lowered, Scene};
 use std::time::{Duration, Instant};
+
+/// Restricts the CUDA driver of this process to the GPUs a render with `backend` on
+/// `devices` opens ([`gpu::cuda::only_devices`]): device 0 for `--devices auto`, the GPUs of
+/// a list; `all` opens every one. A CUDA context then costs its own GPU's initialisation, not
+/// every GPU's of the host (BENCHMARKS.md, "The first second"). Nothing for wgpu and the
+/// CPU. Call it before any thread starts.
+pub fn see_only(backend: Backend, devices: &Devices) {
+    if !matches!(backend, Backend::Cuda | Backend::Auto) {
+        return;
+    }
+    match devices {
+        Devices::Auto => gpu::cuda::only_devices(&[0]),
+        Devices::All => {}
+        Devices::List(list) => {
+            let gpus: Vec<usize> = list
+                .iter()
+                .filter_map(|d| match d {
+                    Device::Gpu(i) => Some(*i),
+                    Device::Cpu => None,
+                })
+                .collect();
+            gpu::cuda::only_devices(&gpus);
+        }
+    }
+}
 
 /// The device of a render being opened on a thread of its own ([`Opening::start`], as soon as
 /// the arguments name the backend) while the scene is read, checked and lowered and its kernel

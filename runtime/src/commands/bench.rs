@@ -232,6 +232,8 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, Error> {
 /// Runs `sdfc bench`.
 pub fn run(args: BenchArgs) -> ExitCode {
     let job = args.job.job();
+    // The CUDA driver prepares only the GPUs measured (before any thread starts).
+    crate::backend::see_only(job.backend, &job.devices);
     if let Err(e) = job.check_kernel(job.backend) {
         return e.exit();
     }

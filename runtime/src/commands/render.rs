@@ -74,12 +74,10 @@ impl RenderArgs {
 /// Runs `sdfc render`: one image, or a sequence of frames (`--frames`, or an output pattern
 /// with `#`; docs/animation.md).
 pub fn run(args: RenderArgs) -> ExitCode {
-    // One device, the first: the CUDA driver need not prepare the others (before any thread
-    // starts, as the environment is shared).
+    // The CUDA driver prepares only the GPUs the render opens (before any thread starts, as
+    // the environment is shared).
     let job = args.job();
-    if job.devices == Devices::Auto && matches!(job.backend, Backend::Auto | Backend::Cuda) {
-        crate::gpu::cuda::only_first_device();
-    }
+    backend::see_only(job.backend, &job.devices);
     let sequence = args.sequence.frames.is_some()
         || args
             .output

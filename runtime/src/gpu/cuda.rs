@@ -124,23 +124,64 @@ impl std::fmt::Debug for FrameBuffers {
     }
 }
 
-/// Makes the first CUDA device the only one this process's driver sees
-/// (`CUDA_VISIBLE_DEVICES=0`, unless the variable is set already), for a render on device 0
-/// alone: the driver's initialisation otherwise prepares every GPU of the host, most of a
-/// short render's time on a host of several GPUs.
-/// Device 0 stays the same device: the variable's indices follow the driver's order
-/// (`CUDA_DEVICE_ORDER`), as the ordinals do. Call it before any thread starts: the
-/// environment is the process's.
-pub fn only_first_device() {
-    if std::env::var_os("CUDA_VISIBLE_DEVICES").is_none() {
-        std::env::set_var("CUDA_VISIBLE_DEVICES", "0");
+/// The GPUs this process's driver was restricted to by [`only_devices`], by the indices
+/// `--devices` and `sdfc devices` give them, in the driver's order: the ordinal of each is its
+/// place here.
+static VISIBLE: std::sync::OnceLock<Vec<usize>> = std::sync::OnceLock::new();
+
+/// Makes the CUDA devices `indices` (the indices `sdfc devices` lists) the only ones this
+/// process's driver sees, through `CUDA_VISIBLE_DEVICES`: the driver's initialisation
+/// otherwise prepares every GPU of the host, most of a short render's time on a host of
+/// several GPUs. A user's own `CUDA_VISIBLE_DEVICES` is kept as the list the indices count
+/// in (`--devices 1` with `CUDA_VISIBLE_DEVICES=2,3` is still GPU 3); an index past it, or a
+/// variable that is not text, leaves it alone for the driver to judge. The variable's
+/// indices follow the driver's order (`CUDA_DEVICE_ORDER`), as the ordinals do, and
+/// [`Cuda::open_device`] maps an index to its ordinal among those left. Call it once, before
+/// any thread starts and before the driver is loaded: the environment is the process's.
+pub fn only_devices(indices: &[usize]) {
+    let own = match std::env::var("CUDA_VISIBLE_DEVICES") {
+        Ok(v) => Some(v),
+        Err(std::env::VarError::NotPresent) => None,
+        Err(std::env::VarError::NotUnicode(_)) => return,
+    };
+    if let Some((visible, kept)) = visible_entries(own.as_deref(), indices) {
+        std::env::set_var("CUDA_VISIBLE_DEVICES", visible);
+        let _ = VISIBLE.set(kept);
+    }
+}
+
+/// What `CUDA_VISIBLE_DEVICES` becomes for a render on `indices` when it was `own`, and the
+/// indices kept (sorted, each once); `None` to leave it as it is (no GPU named, or an index
+/// past the user's own list).
+fn visible_entries(own: Option<&str>, indices: &[usize]) -> Option<(String, Vec<usize>)> {
+    let mut kept = indices.to_vec();
+    kept.sort_unstable();
+    kept.dedup();
+    let entries: Vec<String> = match own {
+        Some(own) => {
+            let listed: Vec<&str> = own.split(',').collect();
+            kept.iter()
+                .map(|&i| listed.get(i).map(|e| e.to_string()))
+                .collect::<Option<_>>()?
+        }
+        None => kept.iter().map(usize::to_string).collect(),
+    };
+    (!entries.is_empty()).then(|| (entries.join(","), kept))
+}
+
+/// The driver's ordinal of the device `sdfc devices` lists as `index`: the same unless
+/// [`only_devices`] restricted the driver; `None` for a device it left out.
+fn ordinal_of(visible: Option<&[usize]>, index: usize) -> Option<usize> {
+    match visible {
+        Some(v) => v.iter().position(|&i| i == index),
+        None => Some(index),
     }
 }
 
 impl Cuda {
-    /// Opens device 0.
+    /// Opens the first device the driver sees.
     pub fn open() -> Result<Cuda, Error> {
-        Self::open_device(0, false)
+        Self::open_ordinal((0, 0), false)
     }
 
     /// Whether the CUDA driver's library (libcuda) can be loaded; no driver call is made.
@@ -157,22 +198,43 @@ impl Cuda {
         CudaContext::device_count().map_or(0, |n| n.max(0) as usize)
     }
 
-    /// Opens device `ordinal`. With `own_stream`, its launches go to a stream of their own
-    /// (two `Cuda` opened on one device then run side by side, as two logical devices);
-    /// otherwise to the context's default stream.
-    pub fn open_device(ordinal: usize, own_stream: bool) -> Result<Cuda, Error> {
+    /// Opens device `index` (as `sdfc devices` lists it; [`only_devices`] may have left the
+    /// driver fewer, whose ordinals differ). With `own_stream`, its launches go to a stream
+    /// of their own (two `Cuda` opened on one device then run side by side, as two logical
+    /// devices); otherwise to the context's default stream.
+    pub fn open_device(index: usize, own_stream: bool) -> Result<Cuda, Error> {
+        match ordinal_of(VISIBLE.get().map(Vec::as_slice), index) {
+            Some(ordinal) => Self::open_ordinal((ordinal, index), own_stream),
+            None => Err(Error::Driver {
+                during: "opening the device",
+                message: format!(
+                    "CUDA device {index} was not among those named before the driver started"
+                ),
+            }),
+        }
+    }
+
+    /// Opens the device of the driver's ordinal `ordinal`, `index` in the messages (as
+    /// [`Cuda::open_device`]).
+    fn open_ordinal((ordinal, index): (usize, usize), own_stream: bool) -> Result<Cuda, Error> {
         if !Self::driver_present() {
             return Err(Error::NoDriver);
         }
         let count = CudaContext::device_count().map_err(driver("counting devices"))?;
-        if count < 1 {
+        let restricted = VISIBLE.get().is_some();
+        if count < 1 && !restricted {
             return Err(Error::NoDevice);
         }
         if ordinal >= count as usize {
+            // Restricted to the devices named, the driver finds only those that exist.
+            let found = match restricted {
+                true => format!("the driver found {count} of those named"),
+                false => format!("the driver found {count}"),
+            };
             return Err(Error::Driver {
                 during: "opening the device",
                 message: format!(
-                    "there is no CUDA device {ordinal} (the driver found {count}; `sdfc devices` lists them)"
+                    "there is no CUDA device {index} ({found}; `sdfc devices` lists them)"
                 ),
             });
         }
@@ -748,4 +810,30 @@ fn cache_path(ptx: &str, device: &str, sm: u32, cap: Option<u32>) -> Option<Path
         &(ptx, device, sm, cap, env!("CARGO_PKG_VERSION")),
         "cubin",
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ordinal_of, visible_entries};
+
+    #[test]
+    fn the_driver_sees_the_devices_named_and_their_indices_map_to_its_ordinals() {
+        let visible = |own, indices: &[usize]| visible_entries(own, indices);
+        assert_eq!(visible(None, &[0]), Some(("0".into(), vec![0])));
+        // Sorted, each once: `--devices 3,1,1` is GPUs 1 and 3, the driver's ordinals 0 and 1.
+        assert_eq!(visible(None, &[3, 1, 1]), Some(("1,3".into(), vec![1, 3])));
+        assert_eq!(ordinal_of(Some(&[1, 3]), 3), Some(1));
+        assert_eq!(ordinal_of(Some(&[1, 3]), 1), Some(0));
+        assert_eq!(ordinal_of(Some(&[1, 3]), 0), None);
+        assert_eq!(ordinal_of(None, 2), Some(2));
+        // A user's own list is what the indices count in.
+        let own = Some("GPU-a,GPU-b,GPU-c");
+        assert_eq!(
+            visible(own, &[2, 0]),
+            Some(("GPU-a,GPU-c".into(), vec![0, 2]))
+        );
+        // Past it, or no GPU named: left to the driver.
+        assert_eq!(visible(Some("2,3"), &[2]), None);
+        assert_eq!(visible(None, &[]), None);
+    }
 }

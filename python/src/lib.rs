@@ -56,6 +56,7 @@ impl From<job::Error> for Failure {
         match e {
             job::Error::Scene(s) => Failure::Compile(s.diagnostics, s.sources),
             job::Error::Usage(m) => Failure::Value(m),
+            e @ (job::Error::Arguments(_) | job::Error::Read(_)) => Failure::Value(e.to_string()),
             other => Failure::Runtime(other.to_string()),
         }
     }
@@ -210,7 +211,9 @@ fn open(source: Option<String>, path: Option<String>) -> Result<Source, Failure>
             path.as_deref().unwrap_or(TEXT_NAME),
             text,
         )),
-        (None, Some(path)) => Source::read(std::path::Path::new(&path)).map_err(Failure::Value),
+        (None, Some(path)) => {
+            Source::read(std::path::Path::new(&path)).map_err(|e| Failure::Value(e.to_string()))
+        }
         (None, None) => Err(Failure::Value(
             "give the scene's text (source=...) or its file (path=...)".into(),
         )),
@@ -229,10 +232,10 @@ fn limits_of(limits: &[String]) -> Result<Limits, Failure> {
 
 /// The worker threads every call shares (one per core).
 fn pool() -> Result<&'static rayon::ThreadPool, Failure> {
-    static POOL: OnceLock<Result<rayon::ThreadPool, String>> = OnceLock::new();
+    static POOL: OnceLock<Result<rayon::ThreadPool, job::Threads>> = OnceLock::new();
     POOL.get_or_init(|| job::thread_pool(None))
         .as_ref()
-        .map_err(|m| Failure::Runtime(m.clone()))
+        .map_err(|e| Failure::Runtime(e.to_string()))
 }
 
 /// Runs `work` on a thread of its own with the GIL released; the calling thread checks for

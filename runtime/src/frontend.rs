@@ -83,14 +83,35 @@ pub struct Loaded {
     pub sources: SourceMap,
 }
 
+/// Why a scene's entry file cannot be read ([`Source::read`]), phrased for the user.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    /// The file cannot be read.
+    #[error("cannot read `{}`: {source}", .path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Its bytes are not UTF-8.
+    #[error("`{}` is not valid UTF-8 (first bad byte at offset {offset})", .path.display())]
+    Utf8 {
+        /// The file.
+        path: PathBuf,
+        /// The offset of the first byte that is not.
+        offset: usize,
+    },
+}
+
 /// Reads `path` and checks it within the default limits. `Err` is an IO or encoding problem
-/// with the entry file itself, already phrased for the user.
-pub fn load(path: &Path) -> Result<Loaded, String> {
+/// with the entry file itself.
+pub fn load(path: &Path) -> Result<Loaded, ReadError> {
     load_with(path, &Limits::default())
 }
 
 /// [`load`] within the given limits.
-pub fn load_with(path: &Path, limits: &Limits) -> Result<Loaded, String> {
+pub fn load_with(path: &Path, limits: &Limits) -> Result<Loaded, ReadError> {
     Ok(Source::read(path)?.check(limits, 0.0))
 }
 
@@ -110,16 +131,15 @@ pub struct Source {
 }
 
 impl Source {
-    /// Reads the entry file. `Err` is an IO or encoding problem, phrased for the user.
-    pub fn read(path: &Path) -> Result<Source, String> {
-        let bytes =
-            std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-        let text = String::from_utf8(bytes).map_err(|e| {
-            format!(
-                "`{}` is not valid UTF-8 (first bad byte at offset {})",
-                path.display(),
-                e.utf8_error().valid_up_to()
-            )
+    /// Reads the entry file. `Err` is an IO or encoding problem.
+    pub fn read(path: &Path) -> Result<Source, ReadError> {
+        let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| ReadError::Utf8 {
+            path: path.to_path_buf(),
+            offset: e.utf8_error().valid_up_to(),
         })?;
         let name = normalise(path);
         let mut names = std::collections::HashMap::new();
@@ -245,7 +265,8 @@ fn print_to(diags: &[Diagnostic], sources: &SourceMap, format: DiagnosticFormat,
 /// Prints an error about a file that is not a diagnostic (it cannot be read, it is not
 /// UTF-8): `error: MSG` on stderr, or in the JSON format one object of the diagnostics' shape
 /// on stdout, with the code `io` and no labels, so that the stream stays JSON lines.
-pub fn print_io_error(msg: &str, format: DiagnosticFormat) {
+pub fn print_io_error(e: &ReadError, format: DiagnosticFormat) {
+    let msg = e.to_string();
     match format {
         DiagnosticFormat::Human => eprintln!("error: {msg}"),
         DiagnosticFormat::Json => {
@@ -303,8 +324,8 @@ pub fn load_scene_code(
 ) -> Result<Checked, u8> {
     let loaded = match load_with(path, limits) {
         Ok(l) => l,
-        Err(msg) => {
-            print_io_error(&msg, format);
+        Err(e) => {
+            print_io_error(&e, format);
             return Err(2);
         }
     };

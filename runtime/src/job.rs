@@ -59,16 +59,25 @@ pub struct Overrides {
     pub set: Vec<String>,
 }
 
-/// What failed on the way from a job to its frames. `Usage` and `Io` end a command with exit
-/// code 2, the others with 1.
+/// What failed on the way from a job to its frames. `Usage`, `Arguments`, `Io`, `Read` and
+/// `--threads 0` end a command with exit code 2, the others with 1.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Bad arguments: a setting out of its range, options that do not go together.
     #[error("{0}")]
     Usage(String),
+    /// A `--kernel` or `--devices` the backend cannot take, wherever it is found.
+    #[error(transparent)]
+    Arguments(#[from] backend::Usage),
     /// A file that cannot be read or written.
     #[error("{0}")]
     Io(String),
+    /// The scene file cannot be read.
+    #[error(transparent)]
+    Read(#[from] frontend::ReadError),
+    /// The worker threads cannot be had.
+    #[error(transparent)]
+    Threads(#[from] Threads),
     /// The scene has errors (its diagnostics are printed where they are found, unless the
     /// job is [`Job::quiet`]).
     #[error("{}", .0.summary())]
@@ -82,9 +91,9 @@ pub enum Error {
         source: backend::Error,
     },
     /// The backend failed: the scene asks for what it cannot do, a frame's kernel could not
-    /// be written again, a render failed on its device.
+    /// be written again, a render failed on its device. (Its usage errors are `Arguments`.)
     #[error(transparent)]
-    Backend(#[from] backend::Error),
+    Backend(backend::Error),
     /// What the render would allocate is above the `memory` limit.
     #[error(transparent)]
     Memory(#[from] memory::Exceeded),
@@ -95,6 +104,26 @@ pub enum Error {
     /// An encoder the frames are handed to (`ffmpeg`) failed.
     #[error("{0}")]
     Encode(String),
+}
+
+impl From<backend::Error> for Error {
+    fn from(e: backend::Error) -> Error {
+        match e {
+            backend::Error::Usage(u) => Error::Arguments(u),
+            e => Error::Backend(e),
+        }
+    }
+}
+
+/// Why the worker threads of `--threads` cannot be had ([`thread_pool`]).
+#[derive(Debug, thiserror::Error)]
+pub enum Threads {
+    /// `--threads 0`: a usage error.
+    #[error("--threads must be at least 1")]
+    Zero,
+    /// The pool could not be started.
+    #[error("cannot start worker threads: {0}")]
+    Start(#[from] rayon::ThreadPoolBuildError),
 }
 
 /// A scene's errors: its diagnostics, and the files they point into.
@@ -147,10 +176,25 @@ impl Error {
         }))
     }
 
+    /// `backend`'s failure to open its devices or prepare a scene on them: arguments it
+    /// cannot take (`--devices` naming GPUs of the CPU backend) are a usage error, the rest say
+    /// the backend is not available (`--devices all` finding no device, an index that does not
+    /// open). Every caller that prepares or resolves devices reports them so.
+    pub fn unavailable(backend: Backend, source: backend::Error) -> Error {
+        match source {
+            backend::Error::Usage(u) => Error::Arguments(u),
+            source => Error::Unavailable { backend, source },
+        }
+    }
+
     /// The exit code of a command that stops on this error.
     pub fn code(&self) -> ExitCode {
         match self {
-            Error::Usage(_) | Error::Io(_) => ExitCode::from(2),
+            Error::Usage(_)
+            | Error::Arguments(_)
+            | Error::Io(_)
+            | Error::Read(_)
+            | Error::Threads(Threads::Zero) => ExitCode::from(2),
             _ => ExitCode::from(1),
         }
     }
@@ -178,7 +222,7 @@ pub struct FrameScene {
 impl Job {
     /// The backend and float type the job renders with: `--reference` means the CPU in f64.
     pub fn mode(&self) -> Result<(Backend, Precision), Error> {
-        self.devices.check(self.backend).map_err(Error::Usage)?;
+        self.devices.check(self.backend)?;
         if !self.overrides.reference {
             return Ok((self.backend, self.precision));
         }
@@ -198,7 +242,7 @@ impl Job {
 
     /// `Err` for a `--kernel` given with `backend`, which has no GPU kernel.
     pub fn check_kernel(&self, backend: Backend) -> Result<(), Error> {
-        Kernel::check(self.kernel, backend).map_err(Error::Usage)
+        Ok(Kernel::check(self.kernel, backend)?)
     }
 
     /// How the job's scenes are prepared: its float type (f64 for `--reference`), `--debug-nan`
@@ -214,7 +258,7 @@ impl Job {
 
     /// A rayon pool of `--threads` workers (default: rayon's choice, one per core).
     pub fn pool(&self) -> Result<rayon::ThreadPool, Error> {
-        thread_pool(self.threads).map_err(Error::Usage)
+        Ok(thread_pool(self.threads)?)
     }
 
     /// Applies the job's settings to `scene`: the reference's (`--reference`), then `--size`,
@@ -313,16 +357,15 @@ impl Job {
 }
 
 /// A rayon pool of `threads` workers (default: rayon's choice, one per core).
-pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Threads> {
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         if n == 0 {
-            return Err("--threads must be at least 1".into());
+            return Err(Threads::Zero);
         }
         b = b.num_threads(n);
     }
-    b.build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))
+    Ok(b.build()?)
 }
 
 /// Where [`prepare`] finds the device it prepares a scene on.
@@ -367,7 +410,7 @@ pub fn prepare_here(
         };
         wgsl::choose(&scene, &lowered, &options).map_err(backend::Error::Unsupported)?;
     }
-    let unavailable = |source| Error::Unavailable { backend, source };
+    let unavailable = |source| Error::unavailable(backend, source);
     let prepared = match open {
         Open::Beside(o) if o.backend() == backend && *devices == Devices::Auto => {
             Prepared::opened(o, &scene, lowered, setup).map_err(unavailable)?
@@ -562,6 +605,80 @@ mod tests {
         let unsupported = Error::from(backend::Error::Unsupported("not traced".into()));
         assert_eq!(unsupported.to_string(), "not traced");
         assert_eq!(unsupported.code(), one);
+    }
+
+    #[test]
+    fn bad_devices_are_usage_errors_and_devices_not_found_device_errors_for_every_caller() {
+        let two = ExitCode::from(2);
+        // A list the backend cannot take, however it is met: resolving it (as a sequence
+        // does) or preparing on it (as a still does).
+        let resolved = Devices::All.resolve(Backend::Cpu).unwrap_err();
+        assert_eq!(resolved, backend::Resolve::Usage(backend::Usage::GpusOnCpu));
+        let usage = Error::unavailable(Backend::Cpu, resolved.into());
+        assert!(matches!(usage, Error::Arguments(_)), "{usage:?}");
+        assert_eq!(usage.code(), two);
+        assert_eq!(
+            usage.to_string(),
+            "--devices names GPUs, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)"
+        );
+        let prepared = Error::from(backend::Error::Usage(backend::Usage::AllOnCpu));
+        assert!(matches!(prepared, Error::Arguments(_)), "{prepared:?}");
+        assert_eq!(prepared.code(), two);
+        // `all` finding nothing: the backend is not available, exit 1.
+        let none = Error::unavailable(Backend::Cuda, backend::Resolve::NoDevice("cuda").into());
+        assert_eq!(none.code(), ExitCode::from(1));
+        assert_eq!(
+            none.to_string(),
+            "the Cuda backend is not available: --devices all found no cuda device"
+        );
+        let bad = Devices::parse("0,gpu").unwrap_err();
+        assert_eq!(
+            Error::from(bad).to_string(),
+            "bad --devices entry `gpu`: give auto, all, or a comma-separated list of device indices and `cpu` (`sdfc devices` lists the devices)"
+        );
+        let kernel = Job {
+            backend: Backend::Cpu,
+            kernel: Some(Kernel::Interpreted),
+            ..Job::default()
+        };
+        let refused = kernel.check_kernel(Backend::Cpu).unwrap_err();
+        assert_eq!(refused.code(), two);
+        assert!(
+            refused
+                .to_string()
+                .starts_with("--kernel interpreted chooses a GPU kernel"),
+            "{refused}"
+        );
+        let zero = Job {
+            threads: Some(0),
+            ..Job::default()
+        };
+        let refused = zero.pool().unwrap_err();
+        assert_eq!(refused.to_string(), "--threads must be at least 1");
+        assert_eq!(refused.code(), two);
+    }
+
+    #[test]
+    fn a_scene_file_that_cannot_be_read_is_a_usage_error_naming_it() {
+        let missing = Source::read(std::path::Path::new("/nonexistent/scene.sdf")).unwrap_err();
+        assert!(
+            missing
+                .to_string()
+                .starts_with("cannot read `/nonexistent/scene.sdf`: "),
+            "{missing}"
+        );
+        assert_eq!(Error::from(missing).code(), ExitCode::from(2));
+        let path = std::env::temp_dir().join(format!("sdfc-job-{}.sdf", std::process::id()));
+        std::fs::write(&path, b"scene { \xff }").unwrap();
+        let bad = Source::read(&path).unwrap_err();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(
+            bad.to_string(),
+            format!(
+                "`{}` is not valid UTF-8 (first bad byte at offset 8)",
+                path.display()
+            )
+        );
     }
 
     #[test]

@@ -527,6 +527,57 @@ fn bad_devices_are_named_in_the_error() {
     assert!(err.contains("it cannot use --devices"), "{err}");
 }
 
+/// A still and a sequence report `--devices` alike: a list the backend cannot take is a usage
+/// error (exit 2), `--devices all` finding no device a device error (exit 1), with one
+/// message. (The sequence resolves the list itself, to hand whole frames to several devices.)
+#[test]
+fn a_still_and_a_sequence_report_bad_devices_alike() {
+    let d = dir("alike");
+    let listed = sdfc(&d, &["devices"], &[]);
+    let no_cuda = String::from_utf8_lossy(&listed.stdout)
+        .lines()
+        .any(|l| l.starts_with("cuda: none"));
+    let orbit = std::fs::canonicalize("../examples/animation/orbit.sdf")
+        .expect("orbit")
+        .display()
+        .to_string();
+    let mut cases = vec![
+        (
+            "cpu,0",
+            "cpu",
+            2,
+            "error: --devices entry `0` names a GPU, but --backend cpu",
+        ),
+        (
+            "all",
+            "cpu",
+            2,
+            "error: --devices all names every GPU, but --backend cpu",
+        ),
+    ];
+    if no_cuda {
+        cases.push((
+            "all",
+            "cuda",
+            1,
+            "error: the Cuda backend is not available: --devices all found no cuda device",
+        ));
+    }
+    for (devices, backend, code, expected) in cases {
+        let still = [seed3().as_str(), "-o", "x.png"].map(String::from);
+        let frames = [orbit.as_str(), "--frames", "0..2", "-o", "f_#.png"].map(String::from);
+        for what in [&still[..], &frames[..]] {
+            let mut args = vec!["render", "--backend", backend, "--devices", devices];
+            args.extend(["--size", "8x8"]);
+            args.extend(what.iter().map(String::as_str));
+            let out = sdfc(&d, &args, &[]);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+            assert!(err.contains(expected), "{args:?}: {err}");
+        }
+    }
+}
+
 /// Without the per-pixel statistics (`Setup::image_only`: `sdfc render` without `--stats`, and
 /// sequences) a GPU frame is the same image, and only its statistics are left empty.
 #[test]

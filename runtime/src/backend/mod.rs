@@ -49,6 +49,54 @@ pub enum Error {
     /// Asked of a preparation that does not do it (a CUDA preparation's `next`).
     #[error("{0}")]
     Misuse(String),
+    /// Arguments the backend cannot take: a usage error wherever it is found.
+    #[error(transparent)]
+    Usage(#[from] Usage),
+}
+
+/// A `--kernel` or `--devices` that cannot be read or that the backend cannot take: a usage
+/// error (a command stops with exit code 2).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Usage {
+    /// `--kernel` given with the CPU backend, which has no GPU kernel.
+    #[error(
+        "--kernel {} chooses a GPU kernel, and the CPU backend has none (it interprets every \
+         program); drop --kernel or choose a GPU with --backend",
+        .0.name()
+    )]
+    KernelOnCpu(Kernel),
+    /// A `--devices` entry that is neither an index nor `cpu`.
+    #[error("bad --devices entry `{0}`: give auto, all, or a comma-separated list of device indices and `cpu` (`sdfc devices` lists the devices)")]
+    DevicesEntry(String),
+    /// A GPU's index in `--devices` with the CPU backend.
+    #[error("--devices entry `{0}` names a GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)")]
+    GpuOnCpu(usize),
+    /// `--devices all` with the CPU backend.
+    #[error("--devices all names every GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)")]
+    AllOnCpu,
+    /// GPUs asked of the CPU backend, whose GPUs `--devices` would index.
+    #[error("--devices names GPUs, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)")]
+    GpusOnCpu,
+}
+
+/// Why `--devices` names no device to render on ([`Devices::resolve`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Resolve {
+    /// The list cannot be used with the backend: a usage error.
+    #[error(transparent)]
+    Usage(#[from] Usage),
+    /// `--devices all` found no GPU of the backend (`cuda` or `wgpu`): a device error.
+    #[error("--devices all found no {0} device")]
+    NoDevice(&'static str),
+}
+
+impl From<Resolve> for Error {
+    fn from(e: Resolve) -> Error {
+        match e {
+            Resolve::Usage(u) => Error::Usage(u),
+            Resolve::NoDevice(_) => Error::Device(e.to_string()),
+        }
+    }
 }
 
 /// Where a scene is rendered.
@@ -119,18 +167,19 @@ impl Kernel {
         }
     }
 
+    /// The kernel's name, as in `--kernel`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Auto => "auto",
+            Kernel::Specialised => "specialised",
+            Kernel::Interpreted => "interpreted",
+        }
+    }
+
     /// `Err` for a `--kernel` given with a backend that has no GPU kernel.
-    pub fn check(kernel: Option<Kernel>, backend: Backend) -> Result<(), String> {
+    pub fn check(kernel: Option<Kernel>, backend: Backend) -> Result<(), Usage> {
         match kernel {
-            Some(k) if backend == Backend::Cpu => Err(format!(
-                "--kernel {} chooses a GPU kernel, and the CPU backend has none (it interprets \
-                 every program); drop --kernel or choose a GPU with --backend",
-                match k {
-                    Kernel::Auto => "auto",
-                    Kernel::Specialised => "specialised",
-                    Kernel::Interpreted => "interpreted",
-                }
-            )),
+            Some(k) if backend == Backend::Cpu => Err(Usage::KernelOnCpu(k)),
             _ => Ok(()),
         }
     }
@@ -183,7 +232,7 @@ pub enum Device {
 
 impl Devices {
     /// Reads `--devices`: `auto`, `all`, or a comma-separated list of indices and `cpu`.
-    pub fn parse(text: &str) -> Result<Devices, String> {
+    pub fn parse(text: &str) -> Result<Devices, Usage> {
         match text.trim() {
             "auto" => return Ok(Devices::Auto),
             "all" => return Ok(Devices::All),
@@ -192,19 +241,19 @@ impl Devices {
         text.split(',')
             .map(|entry| match entry.trim() {
                 "cpu" => Ok(Device::Cpu),
-                e => e.parse().map(Device::Gpu).map_err(|_| {
-                    format!(
-                        "bad --devices entry `{e}`: give auto, all, or a comma-separated list of device indices and `cpu` (`sdfc devices` lists the devices)"
-                    )
-                }),
+                e => e
+                    .parse()
+                    .map(Device::Gpu)
+                    .map_err(|_| Usage::DevicesEntry(e.into())),
             })
             .collect::<Result<Vec<_>, _>>()
             .map(Devices::List)
     }
 
     /// The devices of `backend` these name; `None` for `auto` (the one device the backend
-    /// picks).
-    pub fn resolve(&self, backend: Backend) -> Result<Option<Vec<Device>>, String> {
+    /// picks). Every caller reports a failure as `job::Error::unavailable` does: GPUs asked of
+    /// the CPU backend are a usage error, `all` finding none a device error.
+    pub fn resolve(&self, backend: Backend) -> Result<Option<Vec<Device>>, Resolve> {
         let list: Vec<Device> = match self {
             Devices::Auto => return Ok(None),
             Devices::All => match gpu_kind(backend)? {
@@ -214,29 +263,27 @@ impl Devices {
             Devices::List(list) => list.clone(),
         };
         if list.is_empty() {
-            return Err(format!(
-                "--devices all found no {} device",
-                format!("{:?}", gpu_kind(backend)?).to_lowercase()
-            ));
+            return Err(Resolve::NoDevice(match gpu_kind(backend)? {
+                Backend::Cuda => "cuda",
+                _ => "wgpu",
+            }));
         }
         Ok(Some(list))
     }
 
     /// `Err` naming the first entry `backend` cannot render on (a GPU with `--backend cpu`).
-    pub fn check(&self, backend: Backend) -> Result<(), String> {
+    pub fn check(&self, backend: Backend) -> Result<(), Usage> {
         match self {
-            Devices::List(list) if backend == Backend::Cpu => match list.iter().find_map(|d| match d {
-                Device::Gpu(i) => Some(i),
-                Device::Cpu => None,
-            }) {
-                Some(i) => Err(format!(
-                    "--devices entry `{i}` names a GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)"
-                )),
-                None => Ok(()),
-            },
-            Devices::All if backend == Backend::Cpu => Err(
-                "--devices all names every GPU, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)".into(),
-            ),
+            Devices::List(list) if backend == Backend::Cpu => {
+                match list.iter().find_map(|d| match d {
+                    Device::Gpu(i) => Some(*i),
+                    Device::Cpu => None,
+                }) {
+                    Some(i) => Err(Usage::GpuOnCpu(i)),
+                    None => Ok(()),
+                }
+            }
+            Devices::All if backend == Backend::Cpu => Err(Usage::AllOnCpu),
             _ => Ok(()),
         }
     }
@@ -487,14 +534,12 @@ pub struct Prepared(Box<dyn Renderer>);
 
 /// Whose GPUs `--devices` indexes: CUDA's or wgpu's (for `auto`, CUDA's where a driver has
 /// devices).
-fn gpu_kind(backend: Backend) -> Result<Backend, String> {
+fn gpu_kind(backend: Backend) -> Result<Backend, Usage> {
     match backend {
         Backend::Cuda | Backend::Wgpu => Ok(backend),
         Backend::Auto if Cuda::count() > 0 => Ok(Backend::Cuda),
         Backend::Auto => Ok(Backend::Wgpu),
-        Backend::Cpu => Err(
-            "--devices names GPUs, but --backend cpu renders on the CPU alone (give --backend auto, wgpu or cuda)".into(),
-        ),
+        Backend::Cpu => Err(Usage::GpusOnCpu),
     }
 }
 
@@ -577,7 +622,7 @@ impl Prepared {
         lowered: Lowered,
         setup: &Setup,
     ) -> Result<Prepared, Error> {
-        let Some(list) = devices.resolve(backend).map_err(Error::Device)? else {
+        let Some(list) = devices.resolve(backend)? else {
             return Self::from_program(backend, scene, lowered, setup);
         };
         method_allowed(scene, &lowered.traceable)?;
@@ -585,7 +630,7 @@ impl Prepared {
         for d in &list {
             let part = match *d {
                 Device::Cpu => Prepared::of(CpuPrepared::new(scene, lowered.clone(), setup)),
-                Device::Gpu(i) => match gpu_kind(backend).map_err(Error::Unsupported)? {
+                Device::Gpu(i) => match gpu_kind(backend)? {
                     // On a stream of its own: the same index twice is two logical devices on
                     // one GPU, running side by side.
                     Backend::Cuda => {

@@ -155,7 +155,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, Error> {
     let pool = job.pool()?;
     let mut out = Vec::new();
     for file in &args.file {
-        let mut source = frontend::Source::read(file).map_err(Error::Io)?;
+        let mut source = frontend::Source::read(file)?;
         // The frames are lowered as `sdfc render --frames` lowers them.
         let lowering = LowerOptions::parametric();
         let first = job.frame(&mut source, 0.0, true, &lowering)?;
@@ -327,7 +327,7 @@ fn time_file(
     pool: &rayon::ThreadPool,
     file: &std::path::Path,
 ) -> Result<Timing, Error> {
-    let mut source = frontend::Source::read(file).map_err(Error::Io)?;
+    let mut source = frontend::Source::read(file)?;
     let mut loaded = source.check(&job.limits, 0.0);
     let scene = job.scene(&mut loaded, true)?;
     let lowered = job.lower(&scene, &loaded.sources, &LowerOptions::default())?;

@@ -31,8 +31,8 @@ pub fn run(args: CheckArgs) -> ExitCode {
     let limits = args.limits.limits();
     for file in &args.files {
         match frontend::load_with(file, &limits) {
-            Err(msg) => {
-                frontend::print_io_error(&msg, args.diagnostics);
+            Err(e) => {
+                frontend::print_io_error(&e, args.diagnostics);
                 code = 2;
             }
             Ok(loaded) => {
@@ -148,8 +148,8 @@ pub fn animation(
                 .into(),
         );
     }
-    let mut source = frontend::Source::read(file).map_err(|msg| {
-        frontend::print_io_error(&msg, format);
+    let mut source = frontend::Source::read(file).map_err(|e| {
+        frontend::print_io_error(&e, format);
         2u8
     })?;
     let mut structures = Vec::new();

@@ -89,7 +89,7 @@ pub fn run(args: ParetoArgs) -> ExitCode {
     let limits = &job.limits;
     let mut source = match frontend::Source::read(&args.file) {
         Ok(s) => s,
-        Err(msg) => return Error::Io(msg).exit(),
+        Err(e) => return Error::from(e).exit(),
     };
     let mut loaded = source.check(limits, 0.0);
     let mut scene = match job.checked(&mut loaded, true) {

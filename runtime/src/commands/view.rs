@@ -107,9 +107,8 @@ pub fn run(args: ViewArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     }
-    if let Err(msg) = Kernel::check(args.kernel, backend) {
-        eprintln!("error: {msg}");
-        return ExitCode::from(2);
+    if let Err(e) = Kernel::check(args.kernel, backend) {
+        return crate::job::Error::from(e).exit();
     }
     let run = Run {
         file: args.file,

@@ -56,7 +56,7 @@ pub fn run(
     stats: bool,
 ) -> Result<(), Error> {
     let limits = &job.limits;
-    let mut source = Source::read(file).map_err(Error::Io)?;
+    let mut source = Source::read(file)?;
     // The animation's settings are the same at every time (E0406): read them at t = 0.
     let lowering = LowerOptions::parametric();
     let first = job.frame(&mut source, 0.0, true, &lowering)?;
@@ -140,7 +140,8 @@ pub fn run(
     };
     // Several devices take whole frames from one queue; a scene that does not read `t` is
     // rendered once, its one frame split among them.
-    let workers = match job.devices.resolve(backend).map_err(Error::Usage)? {
+    let resolved = job.devices.resolve(backend);
+    let workers = match resolved.map_err(|e| Error::unavailable(backend, e.into()))? {
         Some(list) if list.len() > 1 && animation.animated() => Some(list),
         _ => None,
     };

@@ -74,7 +74,8 @@ impl Session {
         }
         let mut loaded = match frontend::load_with(&self.file, limits) {
             Ok(l) => l,
-            Err(msg) => {
+            Err(e) => {
+                let msg = e.to_string();
                 eprintln!("error: {msg}");
                 self.files = vec![self.file.clone()];
                 self.fingerprint = Fingerprint::of(&self.files);

@@ -391,7 +391,7 @@ pub fn method(loaded: &Loaded, scene: &Scene, traceable: &Traceable) -> String {
             "method: march (the transparent shape at {} overlaps or touches another transparent one)",
             at(loaded, span)
         ),
-        choice => choice.describe(),
+        choice => choice.describe_in(&scene.limits),
     }
 }
 

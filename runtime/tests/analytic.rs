@@ -297,7 +297,10 @@ fn glass_overlap_is_found_through_the_hierarchy_and_traced_is_a_limit() {
                 limit: 1_000,
             },
         ) => {
-            assert!(r.describe().contains("--limit traced"), "{}", r.describe())
+            let plain = r.describe();
+            assert!(plain.contains("`traced` limit of 1000"), "{plain}");
+            let spelled = r.describe_in(&limited.limits);
+            assert!(spelled.contains("--limit traced=40000"), "{spelled}");
         }
         other => panic!("{other:?}"),
     }

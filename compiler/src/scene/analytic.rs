@@ -9,7 +9,7 @@
 
 use super::ir::{Combine, MaterialId, Method, Node, Scene, V3};
 use super::NodeId;
-use crate::limits::Limit;
+use crate::limits::{Limit, Limits};
 use crate::span::Span;
 
 /// A primitive with a closed-form ray intersection, in its local frame.
@@ -68,7 +68,8 @@ pub enum Reason {
 }
 
 impl Reason {
-    /// The reason in words.
+    /// The reason in words, naming no front end's options (the language server shows it as
+    /// it is).
     pub fn describe(&self) -> String {
         match self {
             Reason::Asked => "the render sets `method: \"march\"`".into(),
@@ -83,8 +84,21 @@ impl Reason {
                 "a transparent primitive overlaps or touches another transparent one, so rays inside them would need the boundary of their union".into()
             }
             Reason::Many { count, limit } => format!(
-                "{count} primitives: beyond {limit} (`--limit traced`), their data would outgrow a GPU storage buffer"
+                "{count} primitives, more than the `traced` limit of {limit}: their data would outgrow a GPU storage buffer"
             ),
+        }
+    }
+
+    /// [`Reason::describe`], and for a limit how to raise it as `limits` spells its options
+    /// (`--limit traced=N` on the command line, `limits={"traced": N}` in Python).
+    pub fn describe_in(&self, limits: &Limits) -> String {
+        match self {
+            Reason::Many { count, .. } => format!(
+                "{}; {}",
+                self.describe(),
+                limits.raise_to(Limit::Traced, *count as u64)
+            ),
+            other => other.describe(),
         }
     }
 }
@@ -107,6 +121,15 @@ impl Choice {
                 if p.len() == 1 { "" } else { "s" }
             ),
             Choice::March(r) => format!("method: march ({})", r.describe()),
+        }
+    }
+
+    /// [`Choice::describe`] with a limit's option spelled as `limits` spell it
+    /// ([`Reason::describe_in`]).
+    pub fn describe_in(&self, limits: &Limits) -> String {
+        match self {
+            Choice::March(r) => format!("method: march ({})", r.describe_in(limits)),
+            trace => trace.describe(),
         }
     }
 }
@@ -557,4 +580,41 @@ fn inverse(m: &[V3; 3]) -> Option<[V3; 3]> {
     }
     // The inverse is the transposed cofactor matrix over the determinant.
     Some([0, 1, 2].map(|i| [0, 1, 2].map(|j| c(j, i) / det)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limits::Spelling;
+
+    /// The reason for marching many primitives names the `traced` limit without a front
+    /// end's spelling (the language server shows it so); spelled for a front end, it says
+    /// how to raise it there.
+    #[test]
+    fn the_many_primitives_reason_is_spelled_per_front_end() {
+        let many = Reason::Many {
+            count: 40_000,
+            limit: 1_000,
+        };
+        let plain = many.describe();
+        assert!(plain.contains("`traced` limit of 1000"), "{plain}");
+        assert!(
+            !plain.contains("--") && !plain.contains("limits="),
+            "{plain}"
+        );
+        let flags = Choice::March(many.clone()).describe_in(&Limits::default());
+        assert!(
+            flags.starts_with("method: march (40000 primitives"),
+            "{flags}"
+        );
+        assert!(flags.contains("`--limit traced=40000`"), "{flags}");
+        let python = many.describe_in(&Limits::default().spelled(Spelling::Parameters));
+        assert!(python.contains("`limits={\"traced\": 40000}`"), "{python}");
+        assert!(!python.contains("--"), "{python}");
+        // Other reasons have no option to name.
+        assert_eq!(
+            Reason::Asked.describe_in(&Limits::default()),
+            Reason::Asked.describe()
+        );
+    }
 }

@@ -614,6 +614,34 @@ impl launch::Device for Kernel<'_> {
         })
     }
 
+    /// A band's finished pixels copied from the page-locked buffer straight into their
+    /// place, the wait for the copy timed apart.
+    fn collect_into(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        range: Range<usize>,
+        slot: usize,
+        place: launch::Place<'_>,
+    ) -> Result<launch::Collected, Error> {
+        let (kept, at) = &mut f.readback[slot];
+        match (kept.as_ref(), place) {
+            (Some(pinned), launch::Place::Rgba(out)) if at.as_ref() == Some(&range) => {
+                *at = None;
+                let waiting = Instant::now();
+                // Waits for the copy alone: the launches queued after it may still run.
+                let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
+                let wait = waiting.elapsed();
+                super::copy_parallel(out, &bytes[..4 * range.len()]);
+                Ok(launch::Collected {
+                    wait,
+                    convert: Duration::ZERO,
+                })
+            }
+            (_, place) => launch::collect_copied(self, f, job, (range, slot), place),
+        }
+    }
+
     fn read(
         &self,
         f: &mut FrameBuffers,

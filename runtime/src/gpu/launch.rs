@@ -7,8 +7,9 @@
 //! One device renders the image in squares of [`super::TILE`] pixels and reads it back
 //! whole at the end. Several devices ([`render_several`]) take bands of whole rows from one
 //! queue, each worker the next band when it is free, and read back each band as it finishes
-//! (a band is contiguous in the image, so a device reads back only what it rendered); a
-//! device that fails hands its band back to the queue and the others finish the frame.
+//! straight into its place in the image (a band is contiguous in the image, so a device reads
+//! back only what it rendered, and the pixels cross the host's memory once); a device that
+//! fails hands its band back to the queue and the others finish the frame.
 
 use super::reduce::{Answer, Ask, Rounds, Selection, Summary};
 use super::Phases;
@@ -128,6 +129,20 @@ pub trait Device: Sync {
     ) -> Result<Pixels, Self::Error> {
         self.read(frame, job, std::slice::from_ref(&range))
     }
+    /// [`Device::collect`] straight into `place`, the band's place in the image: the pixels
+    /// cross the host's memory once, on the worker's thread. Says how long it waited for the
+    /// device (the band's launches and its copy across the bus) and converted. By default
+    /// `collect`, copied ([`collect_copied`]).
+    fn collect_into(
+        &self,
+        frame: &mut Self::Frame,
+        job: &Job,
+        range: Range<usize>,
+        slot: usize,
+        place: Place<'_>,
+    ) -> Result<Collected, Self::Error> {
+        collect_copied(self, frame, job, (range, slot), place)
+    }
     /// The statistics of the pixels of `ranges` (rendered in `frame`) reduced as `ask` asks,
     /// on the device ([`super::reduce`]).
     fn reduce(
@@ -148,6 +163,62 @@ pub trait Device: Sync {
     /// The error a device fault of the testing aid is reported as (the path a real device
     /// error takes).
     fn fault(&self, message: String) -> Self::Error;
+}
+
+/// Where a band's pixels go in the image being assembled ([`Device::collect_into`]): its
+/// finished RGBA8 bytes, or its linear colours.
+#[derive(Debug)]
+pub enum Place<'a> {
+    Rgba(&'a mut [u8]),
+    Linear(&'a mut [[f32; 3]]),
+}
+
+impl Place<'_> {
+    /// The same place, borrowed again.
+    fn reborrow(&mut self) -> Place<'_> {
+        match self {
+            Place::Rgba(p) => Place::Rgba(p),
+            Place::Linear(p) => Place::Linear(p),
+        }
+    }
+
+    /// `pixels` copied in (those the job asked for).
+    fn fill(self, pixels: &Pixels) {
+        match self {
+            Place::Rgba(p) => {
+                debug_assert_eq!(p.len(), pixels.rgba.len(), "a band's bytes");
+                super::copy_parallel(p, &pixels.rgba)
+            }
+            Place::Linear(p) => {
+                debug_assert_eq!(p.len(), pixels.linear.len(), "a band's pixels");
+                super::copy_parallel(p, &pixels.linear)
+            }
+        }
+    }
+}
+
+/// How long [`Device::collect_into`] waited for the device, and converted.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Collected {
+    pub wait: Duration,
+    pub convert: Duration,
+}
+
+/// [`Device::collect`], copied into `place`: what [`Device::collect_into`] does where the
+/// device has nothing better (its wait is not told apart from the copy).
+pub fn collect_copied<D: Device + ?Sized>(
+    device: &D,
+    frame: &mut D::Frame,
+    job: &Job,
+    (range, slot): (Range<usize>, usize),
+    place: Place<'_>,
+) -> Result<Collected, D::Error> {
+    let pixels = device.collect(frame, job, range, slot)?;
+    place.fill(&pixels);
+    Ok(Collected {
+        wait: Duration::ZERO,
+        convert: pixels.convert,
+    })
 }
 
 /// A frame rendered by the scheduler: its linear colours, or its finished RGBA8 bytes when
@@ -444,22 +515,27 @@ impl<T> Queue<T> {
     }
 }
 
-/// The bands of a frame on several devices: the job, the queue of band indices, where
-/// finished bands go, the faults to inject, and the rounds of the statistics' reduction
-/// when the job asks for them.
+/// The bands of a frame on several devices: the job, the queue of band indices, each band's
+/// place in the image, where finished bands are told, the faults to inject, and the rounds of
+/// the statistics' reduction when the job asks for them.
 #[derive(Debug)]
 pub struct Bands<'a> {
     job: &'a Job<'a>,
     faults: &'a Faults,
     queue: Queue<usize>,
-    events: mpsc::Sender<(usize, Pixels)>,
+    /// Each band's place in the image, written by the worker that collects it (again by
+    /// another, if the first failed before the band was accepted).
+    places: Vec<Mutex<Place<'a>>>,
+    events: mpsc::Sender<usize>,
     rounds: Option<Rounds>,
 }
 
 /// Collecting a band a device rendered, on its worker's thread.
 trait Accept: Device {
-    /// Collects `band`'s pixels from readback buffer `slot`, checks the device's errors and
-    /// sends the pixels to be assembled; the phases and tiles go to `share`.
+    /// Collects `band`'s pixels from readback buffer `slot` into the band's place in the
+    /// image, checks the device's errors and tells the band finished; the phases and tiles go
+    /// to `share`: the wait for the device counts among the launches (as one device's wait
+    /// for its tiles does), the copy out as readback.
     fn accept(
         &self,
         frame: &mut Self::Frame,
@@ -469,14 +545,19 @@ trait Accept: Device {
     ) -> Result<(), String> {
         let job = bands.job;
         let read = Instant::now();
-        let pixels = self
-            .collect(frame, job, job.band(band), slot)
-            .and_then(|p| self.check(frame).map(|()| p))
-            .map_err(|e| e.to_string())?;
-        share.phases.readback += read.elapsed().saturating_sub(pixels.convert);
-        share.phases.convert += pixels.convert;
+        let collected = {
+            let mut place = bands.places[band].lock().unwrap_or_else(|e| e.into_inner());
+            self.collect_into(frame, job, job.band(band), slot, place.reborrow())
+                .and_then(|c| self.check(frame).map(|()| c))
+                .map_err(|e| e.to_string())?
+        };
+        share.phases.launches += collected.wait;
+        share.phases.readback += read
+            .elapsed()
+            .saturating_sub(collected.wait + collected.convert);
+        share.phases.convert += collected.convert;
         share.tiles += 1;
-        let _ = bands.events.send((band, pixels));
+        let _ = bands.events.send(band);
         bands.queue.done();
         Ok(())
     }
@@ -603,21 +684,21 @@ pub fn render_several(
 ) -> Result<Output, String> {
     let start = Instant::now();
     let (tx, rx) = mpsc::channel();
-    let bands = Bands {
-        job,
-        faults,
-        queue: Queue::new(0..job.tiles.len(), false),
-        events: tx,
-        rounds: job
-            .statistics
-            .then(|| Rounds::new(job.pixels() as u64, devices.len())),
-    };
     let pixels = job.pixels();
     let (mut linear, mut rgba) = match job.finished {
         true => (Vec::new(), vec![0u8; 4 * pixels]),
         false => (vec![[0.0f32; 3]; pixels], Vec::new()),
     };
-    let mut assembly = Duration::ZERO;
+    let bands = Bands {
+        job,
+        faults,
+        queue: Queue::new(0..job.tiles.len(), false),
+        places: places(job, &mut rgba, &mut linear),
+        events: tx,
+        rounds: job
+            .statistics
+            .then(|| Rounds::new(job.pixels() as u64, devices.len())),
+    };
     let mut done = 0usize;
     let shares = std::thread::scope(|scope| {
         let bands = &bands;
@@ -644,16 +725,9 @@ pub fn render_several(
                 (i, scope.spawn(work))
             })
             .collect();
-        // The calling thread assembles the bands as they come.
-        let mut receive = |(band, p): (usize, Pixels)| {
-            let t = Instant::now();
-            let range = job.band(band);
-            match job.finished {
-                true => super::copy_parallel(&mut rgba[4 * range.start..4 * range.end], &p.rgba),
-                false => super::copy_parallel(&mut linear[range], &p.linear),
-            }
+        // The workers put the bands in their places; the calling thread counts them.
+        let mut receive = |_band: usize| {
             done += 1;
-            assembly += t.elapsed();
             progress(done as f64 / job.tiles.len().max(1) as f64);
         };
         let mut shares: Vec<(usize, Share)> = Vec::new();
@@ -704,17 +778,15 @@ pub fn render_several(
         ));
     }
     let wall = start.elapsed();
-    // The workers ran side by side: the frame's phases are those of the one that took
-    // longest (the frame waited for it), with the bands' assembly as conversion.
-    let mut phases = shares
+    // The workers ran side by side and put the bands in place: the frame's phases are those
+    // of the one that took longest (the frame waited for it).
+    let phases = shares
         .iter()
         .map(|s| s.phases)
         .max_by_key(|p| p.total())
         .unwrap_or_default();
-    phases.convert += assembly;
-    let summary = bands
-        .rounds
-        .map_or_else(Summary::default, |r| r.summary().0);
+    let Bands { rounds, .. } = bands;
+    let summary = rounds.map_or_else(Summary::default, |r| r.summary().0);
     Ok(Output {
         linear,
         rgba,
@@ -724,6 +796,35 @@ pub fn render_several(
         wall,
         shares,
     })
+}
+
+/// Each band's place in the image (`rgba` for a job of finished pixels, else `linear`), in
+/// the order of the job's bands, which follow each other from the first row.
+fn places<'a>(job: &Job, rgba: &'a mut [u8], linear: &'a mut [[f32; 3]]) -> Vec<Mutex<Place<'a>>> {
+    let mut places = Vec::with_capacity(job.tiles.len());
+    let (mut rgba, mut linear) = (rgba, linear);
+    for i in 0..job.tiles.len() {
+        let band = job.band(i);
+        debug_assert_eq!(
+            band.start,
+            job.band(i.saturating_sub(1)).end * usize::from(i > 0),
+            "bands follow each other"
+        );
+        let place = match job.finished {
+            true => {
+                let (here, rest) = std::mem::take(&mut rgba).split_at_mut(4 * band.len());
+                rgba = rest;
+                Place::Rgba(here)
+            }
+            false => {
+                let (here, rest) = std::mem::take(&mut linear).split_at_mut(band.len());
+                linear = rest;
+                Place::Linear(here)
+            }
+        };
+        places.push(Mutex::new(place));
+    }
+    places
 }
 
 #[cfg(test)]

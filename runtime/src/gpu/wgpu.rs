@@ -1051,6 +1051,45 @@ impl launch::Device for Kernel<'_> {
         })
     }
 
+    /// A band's finished pixels copied from the mapped buffer straight into their place,
+    /// the wait for the copy timed apart.
+    fn collect_into(
+        &self,
+        f: &mut FrameBuffers,
+        job: &Job,
+        range: Range<usize>,
+        slot: usize,
+        place: launch::Place<'_>,
+    ) -> Result<launch::Collected, Error> {
+        let started = matches!(&f.reading[slot], Some((at, ..)) if *at == range);
+        let buffer = f.buffers.readback[slot].as_ref().filter(|_| started);
+        match (buffer, place) {
+            (Some(buffer), launch::Place::Rgba(out)) => {
+                let Some((_, index, mapped)) = f.reading[slot].take() else {
+                    return Err(Error::Render("no band was read into this slot".into()));
+                };
+                let waiting = Instant::now();
+                // Waits for the copy alone: the launches submitted after it may still run.
+                self.gpu.wait_for(index, &mapped)?;
+                let wait = waiting.elapsed();
+                let size = 4 * range.len() as u64;
+                {
+                    let view = buffer
+                        .slice(..size)
+                        .get_mapped_range()
+                        .map_err(|e| Error::Render(e.to_string()))?;
+                    super::copy_parallel(out, &view);
+                }
+                buffer.unmap();
+                Ok(launch::Collected {
+                    wait,
+                    convert: Duration::ZERO,
+                })
+            }
+            (_, place) => launch::collect_copied(self, f, job, (range, slot), place),
+        }
+    }
+
     fn read(
         &self,
         f: &mut FrameBuffers,

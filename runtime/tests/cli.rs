@@ -1280,6 +1280,19 @@ fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(err.contains("bounds verified: 2 field(s)"), "{err}");
+    // A profile is named as one.
+    std::fs::write(
+        d.join("flat.sdf"),
+        "scene {\n  revolve(profile(lipschitz: 0.1) { length(p) - 0.5 });\n}\n",
+    )
+    .expect("write");
+    let out = sdfc(&d, &["check", "--verify-bounds", "flat.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("flat.sdf:2:11: this profile has a slope of"),
+        "{err}"
+    );
 }
 
 /// 10 000 nested `union(…)` with the `nesting` limit raised, as the error suggests, check

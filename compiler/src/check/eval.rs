@@ -594,7 +594,7 @@ impl Ctx<'_> {
             .with_label("not defined");
         if id.name == "p" {
             d = d.with_help(
-                "`p` is the point inside `field { … }`; elsewhere every value is a constant",
+                "`p` is the point inside `field { … }` (or `profile { … }`); elsewhere every value is a constant",
             );
         } else if self.fns.contains_key(&id.name) || builtins::builtin(&id.name).is_some() {
             d = d.with_help(format!(
@@ -806,14 +806,24 @@ impl Ctx<'_> {
     /// E0410: a per-point value where a constant is needed, or an operation per-point values
     /// do not support.
     fn per_point(&mut self, msg: String, at: Span) -> Value {
+        let word = self.word();
         self.error(
             Diagnostic::error("E0410", msg, at)
                 .with_label("this depends on the point `p`")
-                .with_note(
-                    "inside `field { … }` what depends on `p` is computed per point; everything else is a constant computed once",
-                ),
+                .with_note(format!(
+                    "inside `{word} {{ … }}` what depends on `p` is computed per point; everything else is a constant computed once"
+                )),
         );
         Value::Error
+    }
+
+    /// `profile` inside the body of a profile, else `field` (for messages).
+    fn word(&self) -> &'static str {
+        if self.planes.last() == Some(&true) {
+            "profile"
+        } else {
+            "field"
+        }
     }
 
     /// `a op b` where an operand is per-point.
@@ -842,16 +852,16 @@ impl Ctx<'_> {
                 Value::Unknown(if ty == Type::Angle { Type::Float } else { ty })
             };
         }
-        match field::binary(op, a.0, b.0) {
+        match field::binary(op, a.0, b.0, self.word()) {
             Ok(v) => v,
             Err(msg) => {
                 let at = if field::is_point(a.0) { a.1 } else { b.1 };
                 let v = self.per_point(msg, at);
+                let word = self.word();
                 if let Some(d) = self.diags.last_mut() {
-                    d.help = Some(
-                        "a field is continuous: combine values with `min`, `max`, `clamp`, `mix` or `smoothstep`"
-                            .into(),
-                    );
+                    d.help = Some(format!(
+                        "a {word} is continuous: combine values with `min`, `max`, `clamp`, `mix` or `smoothstep`"
+                    ));
                 }
                 v
             }
@@ -1054,13 +1064,19 @@ impl Ctx<'_> {
         }
         match field::flatten(&comps, owner) {
             Ok(f) if colour => Value::Colour(std::rc::Rc::new(f)),
-            Ok(f) if plane => match self.add_node(Node::Field { f, lipschitz }, span) {
-                Value::Shape(id) => Value::Profile(id),
+            Ok(f) => match self.add_node(
+                Node::Field {
+                    f,
+                    lipschitz,
+                    plane,
+                },
+                span,
+            ) {
+                Value::Shape(id) if plane => Value::Profile(id),
                 other => other,
             },
-            Ok(f) => self.add_node(Node::Field { f, lipschitz }, span),
             Err(field::OuterPoint) => self.per_point(
-                "this field reads the point `p` of an enclosing field".into(),
+                format!("this {word} reads the point `p` of an enclosing field or profile"),
                 body.value.span,
             ),
         }

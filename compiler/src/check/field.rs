@@ -124,8 +124,8 @@ fn zip(a: Vec<Rc<Sx>>, b: Vec<Rc<Sx>>, f: impl Fn(Rc<Sx>, Rc<Sx>) -> Rc<Sx>) -> 
 
 /// `a op b` where either operand is per-point (types already checked by the caller):
 /// arithmetic componentwise; `%` is the floored remainder a − b·⌊a/b⌋. Comparisons and logic
-/// need constants.
-pub fn binary(op: BinOp, a: &Value, b: &Value) -> Result<Value, String> {
+/// need constants (the message names the value as `word`'s: `field` or `profile`).
+pub fn binary(op: BinOp, a: &Value, b: &Value, word: &str) -> Result<Value, String> {
     let (Some(x), Some(y)) = (comps(a), comps(b)) else {
         return Err(format!(
             "`{}` cannot be applied to these operands",
@@ -146,7 +146,7 @@ pub fn binary(op: BinOp, a: &Value, b: &Value) -> Result<Value, String> {
         BinOp::Rem => modulo,
         _ => {
             return Err(format!(
-                "`{}` of values that depend on the point `p` is not supported: a field's value cannot branch",
+                "`{}` of values that depend on the point `p` is not supported: a {word}'s value cannot branch",
                 op.symbol()
             ))
         }

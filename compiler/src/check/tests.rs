@@ -625,3 +625,45 @@ fn a_wrong_argument_of_a_field_is_labelled_where_it_is() {
     );
     assert_eq!((code, text.as_str()), ("E0202", "lipschitz: 2"));
 }
+
+/// A profile is called a profile: in the IR printout (`--emit ir`), as the node that leaves
+/// a bound unproven, and in the messages about its body.
+#[test]
+fn a_profile_is_called_a_profile() {
+    let s = ok("scene { revolve(profile { floor(p.x) + length(p) - 1 }); field(lipschitz: 2) { length(p) - 1 }; }");
+    let ir = crate::dump_ir(&s);
+    assert!(ir.contains("= profile { "), "{ir}");
+    assert!(ir.contains("= field lipschitz=2 { "), "{ir}");
+    let s = ok("scene { revolve(profile(lipschitz: 3) { length(p) - 1 }); }");
+    let ir = crate::dump_ir(&s);
+    assert!(ir.contains("= profile lipschitz=3 { "), "{ir}");
+    assert!(!ir.contains("field"), "{ir}");
+    let s = ok("scene { revolve(profile { floor(p.x) + length(p) - 1 }); }");
+    let analysis = crate::scene::analysis::analyse(&s);
+    let cause = analysis.root().and_then(|r| r.cause).expect("a cause");
+    assert_eq!(crate::scene::analysis::kind(s.graph.node(cause)), "profile");
+    let (_, diags, _) = check_str(
+        "t.sdf",
+        "scene { revolve(profile { if p.x > 0 { 1 } else { 0 } }); }",
+    );
+    let d = diags.iter().find(|d| d.code == "E0410").expect("E0410");
+    assert!(d.message.contains("a profile's value"), "{d:?}");
+    assert!(
+        d.notes.iter().any(|n| n.contains("inside `profile { … }`")),
+        "{d:?}"
+    );
+    assert!(
+        d.help
+            .as_deref()
+            .is_some_and(|h| h.starts_with("a profile is")),
+        "{d:?}"
+    );
+    // A field's messages are unchanged.
+    let (_, diags, _) = check_str("t.sdf", "scene { field { if p.x > 0 { 1 } else { 0 } }; }");
+    let d = diags.iter().find(|d| d.code == "E0410").expect("E0410");
+    assert!(d.message.contains("a field's value"), "{d:?}");
+    assert!(
+        d.notes.iter().any(|n| n.contains("inside `field { … }`")),
+        "{d:?}"
+    );
+}

@@ -165,9 +165,17 @@ impl Simplifier<'_> {
                 let c = self.node(child);
                 self.paint(material, c)
             }
-            Node::Field { f, lipschitz } => {
+            Node::Field {
+                f,
+                lipschitz,
+                plane,
+            } => {
                 let f = f.remap(|id| self.node(id));
-                self.add(Node::Field { f, lipschitz })
+                self.add(Node::Field {
+                    f,
+                    lipschitz,
+                    plane,
+                })
             }
             other => self.unary(other),
         }

@@ -868,7 +868,7 @@ impl Pass<'_> {
                 d
             }
             Node::Paint { child, .. } => self.get(*child),
-            Node::Field { f, lipschitz } => self.field(id, f, *lipschitz),
+            Node::Field { f, lipschitz, .. } => self.field(id, f, *lipschitz),
         }
     }
 

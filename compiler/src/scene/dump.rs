@@ -472,9 +472,9 @@ fn node(n: &Node) -> String {
         Node::Shell { half, child } => format!("shell half={} %{}", num(*half), child.0),
         Node::Elongate { half, child } => format!("elongate {} %{}", v3(*half), child.0),
         Node::Paint { material, child } => format!("paint #{} %{}", material.0, child.0),
-        Node::Field { f, lipschitz } => match lipschitz {
-            Some(l) => format!("field lipschitz={} {{ {} }}", num(*l), f.text()),
-            None => format!("field {{ {} }}", f.text()),
+        Node::Field { f, lipschitz, .. } => match lipschitz {
+            Some(l) => format!("{} lipschitz={} {{ {} }}", n.kind(), num(*l), f.text()),
+            None => format!("{} {{ {} }}", n.kind(), f.text()),
         },
     }
 }

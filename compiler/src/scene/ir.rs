@@ -333,10 +333,12 @@ pub enum Node {
     /// A triangle mesh read from a file (`mesh("part.stl")`), with its hierarchy.
     Mesh { mesh: MeshRef },
     /// A user field (`field { … }`): the distance is an expression of the point, which may
-    /// read other shapes' distances; its L is derived from the expression, or declared.
+    /// read other shapes' distances; its L is derived from the expression, or declared. With
+    /// `plane`, a profile (`profile { … }`): an expression of the point's x and y alone.
     Field {
         f: super::field::FieldFn,
         lipschitz: Option<f64>,
+        plane: bool,
     },
 }
 
@@ -463,7 +465,8 @@ impl Node {
             Node::Shell { .. } => "shell",
             Node::Elongate { .. } => "elongate",
             Node::Paint { .. } => "paint",
-            Node::Field { .. } => "field",
+            Node::Field { plane: false, .. } => "field",
+            Node::Field { plane: true, .. } => "profile",
             Node::Mesh { .. } => "mesh",
         }
     }

@@ -108,8 +108,9 @@ fn verify_bounds(loaded: &frontend::Loaded, file: &std::path::Path, scene: &Scen
         let span = scene.graph.span(v.node);
         let (line, col) = loaded.sources.line_col(span);
         eprintln!(
-            "{}:{line}:{col}: this field has a slope of {} between {:?} and {:?}, above its L = {}",
+            "{}:{line}:{col}: this {} has a slope of {} between {:?} and {:?}, above its L = {}",
             loaded.sources.name(span.file),
+            scene.graph.node(v.node).kind(),
             number(v.slope, 4),
             v.at.0,
             v.at.1,

@@ -359,7 +359,9 @@ impl Scene {
             software: false,
         };
         let on = (ask.backend, &Devices::Auto);
-        let (scene, prepared) = match ask.backend {
+        let job::Ready {
+            scene, prepared, ..
+        } = match ask.backend {
             // The process's wgpu device, whose compiled pipelines later renders reuse.
             Backend::Wgpu => {
                 let gpu = wgpu_device().map_err(|e| Failure::Runtime(e.clone()))?;
@@ -380,7 +382,10 @@ impl Scene {
             pool,
             &prepared,
             &scene,
-            (false, !image_only),
+            job::Use::Written {
+                reference: false,
+                aux: !image_only,
+            },
             &job.limits,
             false,
         )?;

@@ -4,8 +4,8 @@
 //! the GPU kernel, the worker threads and the limits. From it a scene's source is checked at a
 //! time, its settings applied and it is lowered ([`Job::frame`]), prepared on its backend
 //! ([`prepare`] on a device it opens or is given, [`Open`], or frame after frame by
-//! [`Kernels`]), held to the memory limit
-//! ([`check_memory`]) and rendered ([`Prepared::render`]). What fails on the way is an
+//! [`Kernels`]), held to the memory limit for its use ([`check_memory`], [`Use`]) and
+//! rendered ([`Prepared::render`]). What fails on the way is an
 //! [`Error`] saying which step.
 
 use crate::backend::{self, Backend, Devices, Kernel, Opening, Prepared, Setup};
@@ -370,7 +370,7 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Threads>
 
 /// Where [`prepare`] finds the device it prepares a scene on.
 #[derive(Debug)]
-pub enum Open {
+pub enum Open<'a> {
     /// The backend opens it, or several (`--devices`).
     Backend,
     /// Being opened on a thread of its own beside the front end (`sdfc render`; used for
@@ -379,6 +379,26 @@ pub enum Open {
     /// The caller's wgpu device, open already: the viewer's window's (whose surface shows
     /// the frames it keeps on it), or the Python module's.
     Gpu(Arc<Gpu>),
+    /// Where a scene before was prepared, as it was (its backend, device and setup), and left
+    /// as it is: the viewer's later loads and the frames of its animation, whose last good
+    /// scene stays on show until the new one is ready. The kernel is the one `setup` chooses,
+    /// or with [`wgsl::KernelChoice::Auto`] the one before's; a GPU kernel whose text is
+    /// unchanged (a program that differs in numbers only, with [`Setup::parameters`]) is kept
+    /// and given the new `scene_data` ([`Prepared::next`]). The backend and devices asked are
+    /// the ones before's.
+    After(&'a Prepared),
+}
+
+/// A frame's scene prepared on its backend ([`prepare`]).
+#[derive(Debug)]
+pub struct Ready {
+    /// The scene.
+    pub scene: Scene,
+    /// The backend prepared for it.
+    pub prepared: Prepared,
+    /// Whether a kernel (or the CPU's tapes) was built: `false` where [`Open::After`] kept
+    /// the kernel before.
+    pub built: bool,
 }
 
 /// Prepares a frame's scene for `backend` on `devices` (or on the device `open` says) within
@@ -389,7 +409,7 @@ pub fn prepare(
     frame: FrameScene,
     setup: &Setup,
     open: Open,
-) -> Result<(Scene, Prepared), Error> {
+) -> Result<Ready, Error> {
     pool.install(|| prepare_here(on, frame, setup, open))
 }
 
@@ -399,8 +419,11 @@ pub fn prepare_here(
     frame: FrameScene,
     setup: &Setup,
     open: Open,
-) -> Result<(Scene, Prepared), Error> {
+) -> Result<Ready, Error> {
     let FrameScene { scene, lowered, .. } = frame;
+    // Settings the scene cannot be rendered with are the scene's fault, not the backend's
+    // (`Job::frame` checks them first; the viewer's loads come here directly).
+    backend::method_allowed(&scene, &lowered.traceable)?;
     // A kernel asked for that cannot render the scene is an error, not a reason to fall back
     // to another backend.
     if backend != Backend::Cpu {
@@ -411,35 +434,101 @@ pub fn prepare_here(
         wgsl::choose(&scene, &lowered, &options).map_err(backend::Error::Unsupported)?;
     }
     let unavailable = |source| Error::unavailable(backend, source);
-    let prepared = match open {
-        Open::Beside(o) if o.backend() == backend && *devices == Devices::Auto => {
-            Prepared::opened(o, &scene, lowered, setup).map_err(unavailable)?
-        }
+    let (prepared, built) = match open {
+        // The device is open and the scene before prepared on it: what fails is this scene's
+        // preparation.
+        Open::After(before) => match setup.kernel {
+            wgsl::KernelChoice::Auto => before.next(&scene, lowered)?,
+            kernel => before.next_with(&scene, lowered, kernel)?,
+        },
+        Open::Beside(o) if o.backend() == backend && *devices == Devices::Auto => (
+            Prepared::opened(o, &scene, lowered, setup).map_err(unavailable)?,
+            true,
+        ),
         // An open device is available: what fails is the scene's preparation on it.
         Open::Gpu(gpu) if backend == Backend::Wgpu && *devices == Devices::Auto => {
-            Prepared::on_gpu(gpu, &scene, &lowered, setup)?
+            (Prepared::on_gpu(gpu, &scene, &lowered, setup)?, true)
         }
-        _ => Prepared::on_devices(backend, devices, &scene, lowered, setup).map_err(unavailable)?,
+        _ => (
+            Prepared::on_devices(backend, devices, &scene, lowered, setup).map_err(unavailable)?,
+            true,
+        ),
     };
-    Ok((scene, prepared))
+    Ok(Ready {
+        scene,
+        prepared,
+        built,
+    })
 }
 
-/// What a render of `scene` on `prepared` allocates (with the reference's check and the
-/// depth sidecar when asked), announced (when `announce`) and held to the `memory` limit.
+/// What a prepared scene's frames are held to the `memory` limit for ([`check_memory`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Use {
+    /// Rendered at the scene's settings and written (`sdfc render`, sequences, `bench`,
+    /// Python): the render, the finished frame held while its outputs are written, and with
+    /// `reference` the reference's convergence check, with `aux` the depth sidecar
+    /// ([`memory::render`]).
+    Written {
+        /// `--reference`.
+        reference: bool,
+        /// `--aux`.
+        aux: bool,
+    },
+    /// Shown in a view of `width` × `height` pixels, whatever size the scene's settings
+    /// state, one sample a frame (the viewer's window, which accumulates the samples where
+    /// they are rendered): the frame's render alone.
+    Shown {
+        /// The view's width.
+        width: u32,
+        /// The view's height.
+        height: u32,
+    },
+}
+
+impl Use {
+    /// An image written, without the reference's check or the depth sidecar.
+    pub const IMAGE: Use = Use::Written {
+        reference: false,
+        aux: false,
+    };
+}
+
+/// What frames of `scene` on `prepared` allocate, used as `used` says, announced (when
+/// `announce`) and held to the `memory` limit, within `pool` (whose threads the CPU's
+/// allocation counts).
 pub fn check_memory(
     pool: &rayon::ThreadPool,
     prepared: &Prepared,
     scene: &Scene,
-    (reference, aux): (bool, bool),
+    used: Use,
     limits: &Limits,
     announce: bool,
 ) -> Result<(), Error> {
-    let needed = pool.install(|| memory::render(prepared, scene, reference, aux));
+    pool.install(|| check_memory_here(prepared, scene, used, limits, announce))
+}
+
+/// [`check_memory`] on the current thread's pool (the viewer's, rayon's global one).
+pub fn check_memory_here(
+    prepared: &Prepared,
+    scene: &Scene,
+    used: Use,
+    limits: &Limits,
+    announce: bool,
+) -> Result<(), Error> {
+    let (settings, needed) = match used {
+        Use::Written { reference, aux } => (
+            scene.settings.clone(),
+            memory::render(prepared, scene, reference, aux),
+        ),
+        Use::Shown { width, height } => {
+            let mut at = scene.settings.clone();
+            (at.width, at.height, at.aa) = (width, height, 1);
+            let needed = prepared.memory(scene, &at);
+            (at, needed)
+        }
+    };
     if announce {
-        eprintln!(
-            "{}",
-            memory::announce(&scene.settings, prepared.name(), &needed)
-        );
+        eprintln!("{}", memory::announce(&settings, prepared.name(), &needed));
     }
     Ok(needed.check(limits)?)
 }
@@ -517,7 +606,9 @@ impl<'a> Kernels<'a> {
             }
             None => {
                 let program = frame.lowered.program.clone();
-                let (scene, prepared) = prepare(
+                let Ready {
+                    scene, prepared, ..
+                } = prepare(
                     self.pool,
                     (self.backend, &self.devices),
                     frame,

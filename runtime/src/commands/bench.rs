@@ -194,7 +194,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, Error> {
             let (scene, prepared) = kernels.prepare(frame)?;
             let t2 = Instant::now();
             if k == frames.start {
-                job::check_memory(&pool, prepared, &scene, (false, false), &job.limits, false)?;
+                job::check_memory(&pool, prepared, &scene, job::Use::IMAGE, &job.limits, false)?;
             }
             let image = pool.install(|| prepared.render(&scene, &|_| {}))?;
             size = (image.render.image.width, image.render.image.height);

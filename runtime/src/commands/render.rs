@@ -157,13 +157,18 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
         ..job.setup()
     };
     let open = opening.map_or(job::Open::Backend, job::Open::Beside);
-    let (scene, prepared) = job::prepare(&pool, (backend, &job.devices), frame, &setup, open)?;
+    let job::Ready {
+        scene, prepared, ..
+    } = job::prepare(&pool, (backend, &job.devices), frame, &setup, open)?;
     run.split("preparation", "the rest of it", prepared.preparation());
     job::check_memory(
         &pool,
         &prepared,
         &scene,
-        (args.reference, args.aux),
+        job::Use::Written {
+            reference: args.reference,
+            aux: args.aux,
+        },
         &job.limits,
         true,
     )?;

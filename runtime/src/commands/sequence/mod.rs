@@ -170,7 +170,7 @@ pub fn run(
                     Some(picture) => picture.clone(),
                     None => {
                         let (scene, prepared) = kernels.prepare(frame)?;
-                        let memory = (false, false);
+                        let memory = job::Use::IMAGE;
                         job::check_memory(&pool, prepared, &scene, memory, limits, n == 0)?;
                         tally.since(HERE, preparing(n == 0), frame_started);
                         let rendered = Instant::now();

@@ -1,6 +1,8 @@
 //! The viewer session's loads: the scene file read (again when it changed under the read),
-//! checked, lowered and (the first) prepared through the job's path on the window's device, its specialised pipeline compiled on
-//! another thread while the interpreted kernel shows it, and the load installed.
+//! checked, lowered, prepared and held to the memory limit through the job's path (the first
+//! on the window's device, a later one as the last one was), its specialised pipeline compiled
+//! on another thread while the interpreted kernel (prepared the same way) shows it, and the
+//! load installed.
 
 use super::*;
 use crate::backend::{Backend, Devices};
@@ -134,43 +136,28 @@ impl Session {
             }
             _ => None,
         };
-        // A new scene is prepared as the last one was, on its device; the first through the
-        // job's path, on the window's device.
-        let (scene, prepared, built) = match &self.good {
-            Some(good) => {
-                let (prepared, built) = good
-                    .prepared
-                    .next_with(&scene, lowered, kernel)
-                    .map_err(|e| summary(e.into()))?;
-                (scene, prepared, built)
-            }
-            None => {
-                let (backend, open) = match &self.device {
-                    Device::Cpu => (Backend::Cpu, job::Open::Backend),
-                    Device::Wgpu(gpu) => (Backend::Wgpu, job::Open::Gpu(gpu.clone())),
-                };
-                // Settings the scene cannot be rendered with are the scene's fault, not the
-                // backend's (as `Job::frame` checks them).
-                crate::backend::method_allowed(&scene, &lowered.traceable)
-                    .map_err(|e| summary(e.into()))?;
-                let frame = FrameScene {
-                    scene,
-                    lowered,
-                    phases: Vec::new(),
-                };
-                let on = (backend, &Devices::Auto);
-                let (scene, prepared) =
-                    job::prepare_here(on, frame, &setup, open).map_err(summary)?;
-                (scene, prepared, true)
-            }
+        // Through the job's path: the first scene on the window's device (or the CPU), a
+        // later one as the last one was, on its device, the last one staying on show until
+        // this one is ready.
+        let open = match (&self.good, &self.device) {
+            (Some(good), _) => job::Open::After(&good.prepared),
+            (None, Device::Cpu) => job::Open::Backend,
+            (None, Device::Wgpu(gpu)) => job::Open::Gpu(gpu.clone()),
         };
+        let frame = FrameScene {
+            scene,
+            lowered,
+            phases: Vec::new(),
+        };
+        let job::Ready {
+            scene,
+            prepared,
+            built,
+        } = job::prepare_here((self.backend(), &Devices::Auto), frame, &setup, open)
+            .map_err(summary)?;
         let prepare_time = start.elapsed();
-        let mut at = scene.settings.clone();
-        (at.width, at.height, at.aa) = (self.size.0, self.size.1, 1);
-        if let Err(e) = prepared.memory(&scene, &at).check(limits) {
-            eprintln!("error: {e}");
-            return Err(e.to_string());
-        }
+        // Its frames are the view's size, whatever the scene's settings say.
+        job::check_memory_here(&prepared, &scene, self.shown(), limits, false).map_err(summary)?;
         // A pipeline not compiled yet compiles on another thread (the driver may take
         // seconds; lavapipe tens of them), never on the caller's: a window's event loop goes on
         // answering meanwhile. With `--kernel auto` the interpreted kernel shows the scene
@@ -191,7 +178,7 @@ impl Session {
                 } else {
                     let start = Instant::now();
                     let interim = match interim_lowered {
-                        Some(lowered) => self.interim(gpu, &scene, lowered, &at),
+                        Some(lowered) => self.interim(gpu, &scene, lowered),
                         None => None,
                     };
                     interim_prepare = start.elapsed();
@@ -253,22 +240,19 @@ impl Session {
     }
 
     /// The interpreted kernel of `scene`, lowered as `lowered`, to show it while its specialised
-    /// kernel compiles: `None` where it cannot render the scene (an analytically traced one, a
-    /// program above the `registers` limit) or its frames would be above the `memory` limit
-    /// at `at`. Its pipeline is compiled once per specialisation; until then it compiles on
-    /// another thread too.
-    fn interim(
-        &self,
-        gpu: &Arc<Gpu>,
-        scene: &Scene,
-        lowered: Lowered,
-        at: &sdfc_compiler::Settings,
-    ) -> Option<Interim> {
+    /// kernel compiles, prepared through the job's path: `None` where it cannot render the
+    /// scene (an analytically traced one, a program above the `registers` limit) or its frames
+    /// would be above the `memory` limit at the view's size. Its pipeline is compiled once per
+    /// specialisation; until then it compiles on another thread too.
+    fn interim(&self, gpu: &Arc<Gpu>, scene: &Scene, lowered: Lowered) -> Option<Interim> {
+        let job = &self.options.job;
         let setup = Setup {
             parameters: true,
             kernel: wgsl::KernelChoice::Interpreted,
-            ..Setup::default()
+            ..job.setup()
         };
+        // The last interpreted kernel, whose validated kernel serves again where its text is
+        // the same (and its pipeline, compiled, with it).
         let held = self
             .good
             .as_ref()
@@ -276,14 +260,18 @@ impl Session {
             .and_then(|w| w.interim.as_ref())
             .map(|i| &i.prepared)
             .or(self.interpreter.as_ref());
-        let prepared = match held {
-            Some(p) => p.next_with(scene, lowered, setup.kernel).ok()?.0,
-            None => Prepared::on_gpu(gpu.clone(), scene, &lowered, &setup).ok()?,
+        let open = match held {
+            Some(p) => job::Open::After(p),
+            None => job::Open::Gpu(gpu.clone()),
         };
-        prepared
-            .memory(scene, at)
-            .check(&self.options.job.limits)
-            .ok()?;
+        let frame = FrameScene {
+            scene: scene.clone(),
+            lowered,
+            phases: Vec::new(),
+        };
+        let on = (Backend::Wgpu, &Devices::Auto);
+        let prepared = job::prepare_here(on, frame, &setup, open).ok()?.prepared;
+        job::check_memory_here(&prepared, scene, self.shown(), &job.limits, false).ok()?;
         let kernel = &prepared.as_wgpu()?.kernel;
         let data = kernel.data.is_some();
         let (compile, pipeline) = if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
@@ -419,6 +407,22 @@ impl Session {
                     None => self.broken = Some(msg),
                 }
             }
+        }
+    }
+
+    /// The backend the session prepares its scenes for: its device's.
+    pub(super) fn backend(&self) -> Backend {
+        match self.device {
+            Device::Cpu => Backend::Cpu,
+            Device::Wgpu(_) => Backend::Wgpu,
+        }
+    }
+
+    /// How the session's frames use memory: shown at the view's size, a sample each.
+    pub(super) fn shown(&self) -> job::Use {
+        job::Use::Shown {
+            width: self.size.0,
+            height: self.size.1,
         }
     }
 

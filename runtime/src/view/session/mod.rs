@@ -13,12 +13,12 @@ use super::camera::{self, Orbit};
 use super::compile::{Compile, Waker};
 use super::resident::{FirstFrame, Resident};
 use super::watch::Fingerprint;
-use crate::backend::{Kernel, Prepared, Setup};
-use crate::frontend::{self, DiagnosticFormat, Loaded};
+use crate::backend::{Devices, Kernel, Prepared, Setup};
+use crate::frontend::{self, Loaded};
 use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
 use crate::image::Image;
-use crate::job::{first_error, Error, Job};
+use crate::job::{self, Error, Job};
 use sdfc_compiler::{wgsl, Animation, Camera, LowerOptions, Lowered, Scene};
 use sdfc_compiler::{FileId, Limit, SourceMap};
 use std::path::{Path, PathBuf};
@@ -632,32 +632,32 @@ impl Session {
         }
     }
 
-    /// Replaces the scene on show with the scene checked at `time`.
+    /// Replaces the scene on show with the scene checked at `time`, through the job's path:
+    /// checked, its settings applied and lowered (keeping its program's structure:
+    /// [`LowerOptions::parametric`]), then prepared as the scene before was, with the kernel
+    /// it had ([`job::Open::After`]), and the interpreted kernel shown meanwhile too.
     fn scene_at(&mut self, time: f64) -> Result<(), String> {
         let job = &self.options.job;
+        let on = (self.backend(), &Devices::Auto);
         let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
             return Ok(());
         };
-        let mut loaded = p.source.check(&job.limits, time);
-        let Some(mut scene) = loaded.scene.take() else {
-            frontend::report(&loaded, DiagnosticFormat::Human);
-            return Err(first_error(&loaded.diagnostics, &loaded.sources));
-        };
-        job.settings(&mut scene).map_err(|e| e.to_string())?;
-        let lowered = job
-            .lower(&scene, &loaded.sources, &lower_options(&scene))
+        let frame = job
+            .frame(&mut p.source, time, false, &LowerOptions::parametric())
             .map_err(|e| e.to_string())?;
+        // Each kernel stays the one it is (`Auto`: the one before's).
+        let setup = Setup::default();
         if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
-            i.prepared = i
-                .prepared
-                .next(&scene, lowered.clone())
+            let frame = frame.clone();
+            let open = job::Open::After(&i.prepared);
+            i.prepared = job::prepare_here(on, frame, &setup, open)
                 .map_err(|e| e.to_string())?
-                .0;
+                .prepared;
         }
-        let (prepared, _) = good
-            .prepared
-            .next(&scene, lowered)
-            .map_err(|e| e.to_string())?;
+        let open = job::Open::After(&good.prepared);
+        let job::Ready {
+            scene, prepared, ..
+        } = job::prepare_here(on, frame, &setup, open).map_err(|e| e.to_string())?;
         self.version += 1;
         good.file_camera = scene.camera.clone();
         good.scene = scene;

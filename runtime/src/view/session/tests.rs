@@ -681,3 +681,55 @@ fn reloads_keep_the_moved_camera_and_errors_keep_the_image() {
     assert!(!s.camera_moved());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Every load, the first and those after it (prepared as the scene before was), is held to the
+/// `memory` limit at the view's size, whatever size the scene's settings state: a scene that
+/// asks for a picture far above the limit is shown in a small view, and an edit loaded while
+/// the view is larger than the limit allows is refused with the limit's message, the image
+/// before staying on show.
+#[test]
+fn every_load_is_held_to_the_memory_limit_at_the_views_size() {
+    let dir = std::env::temp_dir().join(format!("sdfc-session-memory-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("m.sdf");
+    // 8000x6000 pixels: a render of the scene's size is far above 32 MiB.
+    let huge = SCENE.replace("width: 32, height: 24", "width: 8000, height: 6000");
+    std::fs::write(&file, &huge).unwrap();
+    let mut job = Job::default();
+    job.limits.apply("memory=32").unwrap();
+    let options = Options {
+        job,
+        ..Options::default()
+    };
+    let mut s = Session::new(file.clone(), options, Device::Cpu);
+    s.set_size(32, 24);
+    let first = s.load();
+    assert!(first.ok, "{}", first.summary);
+    settle(&mut s);
+    let shown = s.image().expect("an image");
+
+    // A later load, in a view above the limit: refused, saying which limit.
+    s.set_size(4000, 3000);
+    std::fs::write(&file, huge.replace("sphere(0.5)", "sphere(0.6)")).unwrap();
+    let refused = s.load();
+    assert!(!refused.ok);
+    assert!(
+        refused
+            .summary
+            .contains("more than the memory limit of 32 MiB; raise it with `--limit memory="),
+        "{}",
+        refused.summary
+    );
+    assert!(
+        s.title(false).contains("memory limit"),
+        "{}",
+        s.title(false)
+    );
+    assert_eq!(s.image(), Some(shown));
+
+    // The same edit in a small view again loads.
+    s.set_size(32, 24);
+    let again = s.load();
+    assert!(again.ok, "{}", again.summary);
+    let _ = std::fs::remove_dir_all(&dir);
+}

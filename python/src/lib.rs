@@ -56,7 +56,9 @@ impl From<job::Error> for Failure {
         match e {
             job::Error::Scene(s) => Failure::Compile(s.diagnostics, s.sources),
             job::Error::Usage(m) => Failure::Value(m),
-            e @ (job::Error::Arguments(_) | job::Error::Read(_)) => Failure::Value(e.to_string()),
+            e @ (job::Error::Setting(_) | job::Error::Arguments(_) | job::Error::Read(_)) => {
+                Failure::Value(e.to_string())
+            }
             other => Failure::Runtime(other.to_string()),
         }
     }

@@ -59,13 +59,16 @@ pub struct Overrides {
     pub set: Vec<String>,
 }
 
-/// What failed on the way from a job to its frames. `Usage`, `Arguments`, `Io`, `Read` and
-/// `--threads 0` end a command with exit code 2, the others with 1.
+/// What failed on the way from a job to its frames. `Usage`, `Setting`, `Arguments`, `Io`,
+/// `Read` and `--threads 0` end a command with exit code 2, the others with 1.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Bad arguments: a setting out of its range, options that do not go together.
     #[error("{0}")]
     Usage(String),
+    /// A setting (`--size`, `--aa`, `--set`) that cannot be read or is out of its range.
+    #[error(transparent)]
+    Setting(#[from] crate::settings::Error),
     /// A `--kernel` or `--devices` the backend cannot take, wherever it is found.
     #[error(transparent)]
     Arguments(#[from] backend::Usage),
@@ -191,6 +194,7 @@ impl Error {
     pub fn code(&self) -> ExitCode {
         match self {
             Error::Usage(_)
+            | Error::Setting(_)
             | Error::Arguments(_)
             | Error::Io(_)
             | Error::Read(_)
@@ -273,8 +277,13 @@ impl Job {
     /// Applies `--size`, `--aa` and each `--set` to `settings`, in order, within the limits.
     pub fn override_settings(&self, settings: &mut Settings) -> Result<(), Error> {
         let o = &self.overrides;
-        crate::settings::override_settings(settings, o.size, o.aa, &o.set, &self.limits)
-            .map_err(Error::Usage)
+        Ok(crate::settings::override_settings(
+            settings,
+            o.size,
+            o.aa,
+            &o.set,
+            &self.limits,
+        )?)
     }
 
     /// The scene `loaded` checked to, taken out of it, with the job's settings; its
@@ -821,7 +830,7 @@ mod tests {
         };
         let refused = bad.override_settings(&mut settings);
         assert!(
-            matches!(&refused, Err(Error::Usage(m)) if m.contains("KEY=VALUE")),
+            matches!(&refused, Err(Error::Setting(e)) if e.to_string().contains("KEY=VALUE")),
             "{refused:?}"
         );
     }

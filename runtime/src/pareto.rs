@@ -57,7 +57,7 @@ impl Key {
 
     /// Sets the value in `s`, checking its range as `--set` does.
     pub fn set(self, s: &mut Settings, v: f64, limits: &Limits) -> Result<(), String> {
-        settings::set(s, self.name(), &format!("{v}"), limits)
+        settings::set(s, self.name(), &format!("{v}"), limits).map_err(|e| e.to_string())
     }
 
     /// Whether the values are whole numbers.

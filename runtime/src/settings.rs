@@ -4,11 +4,57 @@
 
 use sdfc_compiler::{Limit, Limits, Method, Settings};
 
+/// A setting given on the command line that cannot be read or is out of its range: a usage
+/// error.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Error {
+    /// `--size` not as `WIDTHxHEIGHT`.
+    #[error("expected WIDTHxHEIGHT, like 640x480, not `{0}`")]
+    Size(String),
+    /// A `--set` not as `KEY=VALUE`.
+    #[error("--set expects KEY=VALUE, like max_steps=512, not `{0}`")]
+    NotKeyValue(String),
+    /// A key `--set` does not know.
+    #[error("unknown render setting `{0}`; the settings are {keys}", keys = SETTING_KEYS.join(", "))]
+    Unknown(String),
+    /// A whole number out of its range (`raise`: how to raise the limit that bounds it, for
+    /// a value above it).
+    #[error("{key} must be a whole number from {lo} to {hi}, not `{value}`{}", .raise.as_ref().map(|r| format!("; {r}")).unwrap_or_default())]
+    Whole {
+        /// The setting.
+        key: String,
+        /// The value given.
+        value: String,
+        /// The least value.
+        lo: u32,
+        /// The greatest value.
+        hi: u32,
+        /// How to raise the limit `hi` is.
+        raise: Option<String>,
+    },
+    /// A number out of its range.
+    #[error("{key} must be {what}, not `{value}`")]
+    Real {
+        /// The setting.
+        key: String,
+        /// The value given.
+        value: String,
+        /// What it must be.
+        what: &'static str,
+    },
+    /// A `background` that is not a colour.
+    #[error("background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{0}`")]
+    Background(String),
+    /// A `method` that is not one.
+    #[error("method must be one of {names}, not `{0}`", names = Method::NAMES.join(", "))]
+    Method(String),
+}
+
 /// Parses `WIDTHxHEIGHT` (each edge is checked against the `edge` limit when applied).
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub fn parse_size(s: &str) -> Result<(u32, u32), Error> {
     let (w, h) = s
         .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, like 640x480, not `{s}`"))?;
+        .ok_or_else(|| Error::Size(s.into()))?;
     let ceiling = Limit::Edge.ceiling() as u32;
     let w = int("width", w.trim(), 1, ceiling, None)?;
     let h = int("height", h.trim(), 1, ceiling, None)?;
@@ -22,7 +68,7 @@ pub fn override_settings(
     aa: Option<u32>,
     sets: &[String],
     limits: &Limits,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     if let Some((w, h)) = size {
         set(s, "width", &w.to_string(), limits)?;
         set(s, "height", &h.to_string(), limits)?;
@@ -33,7 +79,7 @@ pub fn override_settings(
     for item in sets {
         let (key, value) = item
             .split_once('=')
-            .ok_or_else(|| format!("--set expects KEY=VALUE, like max_steps=512, not `{item}`"))?;
+            .ok_or_else(|| Error::NotKeyValue(item.clone()))?;
         set(s, key.trim(), value.trim(), limits)?;
     }
     Ok(())
@@ -73,7 +119,7 @@ pub fn set_help() -> String {
 
 /// Sets one render setting from text, checking its range (the top of the range of width,
 /// height, aa, max_steps and max_depth is a limit of `limits`).
-pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<(), String> {
+pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<(), Error> {
     let limited = |limit: Limit, lo: u32| {
         let hi = limits.get(limit).min(u32::MAX as u64) as u32;
         int(key, value, lo, hi, Some((limits, limit)))
@@ -99,19 +145,9 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
         }
         "background" => s.background = colour(value)?,
         "method" => {
-            s.method = Method::from_name(value).ok_or_else(|| {
-                format!(
-                    "method must be one of {}, not `{value}`",
-                    Method::NAMES.join(", ")
-                )
-            })?
+            s.method = Method::from_name(value).ok_or_else(|| Error::Method(value.into()))?
         }
-        _ => {
-            return Err(format!(
-                "unknown render setting `{key}`; the settings are {}",
-                SETTING_KEYS.join(", ")
-            ));
-        }
+        _ => return Err(Error::Unknown(key.into())),
     }
     Ok(())
 }
@@ -123,35 +159,41 @@ fn int(
     lo: u32,
     hi: u32,
     limit: Option<(&Limits, Limit)>,
-) -> Result<u32, String> {
+) -> Result<u32, Error> {
     let parsed = value.parse::<u64>();
     match parsed {
         Ok(v) if (lo as u64..=hi as u64).contains(&v) => Ok(v as u32),
-        _ => {
-            let mut msg = format!("{key} must be a whole number from {lo} to {hi}, not `{value}`");
-            if let (Some((limits, limit)), Ok(v)) = (limit, parsed) {
-                if v > hi as u64 {
-                    msg.push_str(&format!("; {}", limits.raise_to(limit, v)));
-                }
-            }
-            Err(msg)
-        }
+        _ => Err(Error::Whole {
+            key: key.into(),
+            value: value.into(),
+            lo,
+            hi,
+            raise: match (limit, parsed) {
+                (Some((limits, limit)), Ok(v)) if v > hi as u64 => Some(limits.raise_to(limit, v)),
+                _ => None,
+            },
+        }),
     }
 }
 
-fn real(key: &str, value: &str, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
+fn real(
+    key: &str,
+    value: &str,
+    ok: impl Fn(f64) -> bool,
+    what: &'static str,
+) -> Result<f64, Error> {
     match value.parse::<f64>() {
         Ok(v) if v.is_finite() && ok(v) => Ok(v),
-        _ => Err(format!("{key} must be {what}, not `{value}`")),
+        _ => Err(Error::Real {
+            key: key.into(),
+            value: value.into(),
+            what,
+        }),
     }
 }
 
-fn colour(value: &str) -> Result<[f64; 3], String> {
-    let err = || {
-        format!(
-            "background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{value}`"
-        )
-    };
+fn colour(value: &str) -> Result<[f64; 3], Error> {
+    let err = || Error::Background(value.into());
     let parts: Vec<f64> = value
         .trim_matches(|c| c == '(' || c == ')')
         .split(',')
@@ -185,6 +227,60 @@ mod tests {
         }
         assert!(help.contains("method (auto, trace, march)"), "{help}");
         let unknown = set(&mut Settings::default(), "speed", "1", &limits).unwrap_err();
-        assert!(unknown.contains("unknown render setting"), "{unknown}");
+        assert_eq!(unknown, Error::Unknown("speed".into()));
+        assert!(
+            unknown
+                .to_string()
+                .starts_with("unknown render setting `speed`; the settings are width, height, aa,"),
+            "{unknown}"
+        );
+    }
+
+    #[test]
+    fn each_refusal_says_what_the_value_must_be() {
+        let limits = Limits::default();
+        let refused = |key: &str, value: &str| {
+            set(&mut Settings::default(), key, value, &limits)
+                .unwrap_err()
+                .to_string()
+        };
+        let edge = limits.get(Limit::Edge);
+        assert_eq!(
+            refused("width", &(edge + 1).to_string()),
+            format!(
+                "width must be a whole number from 1 to {edge}, not `{}`; {}",
+                edge + 1,
+                limits.raise_to(Limit::Edge, edge + 1)
+            )
+        );
+        assert_eq!(
+            refused("aa", "two"),
+            format!(
+                "aa must be a whole number from 1 to {}, not `two`",
+                limits.get(Limit::Aa)
+            )
+        );
+        assert_eq!(
+            refused("epsilon", "2"),
+            "epsilon must be a number in (0, 1), not `2`"
+        );
+        assert_eq!(
+            refused("background", "red"),
+            "background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `red`"
+        );
+        assert_eq!(
+            refused("method", "fast"),
+            "method must be one of auto, trace, march, not `fast`"
+        );
+        assert_eq!(
+            parse_size("640by480").unwrap_err().to_string(),
+            "expected WIDTHxHEIGHT, like 640x480, not `640by480`"
+        );
+        let mut s = Settings::default();
+        let sets = ["max_steps".to_string()];
+        assert_eq!(
+            override_settings(&mut s, None, None, &sets, &limits).unwrap_err(),
+            Error::NotKeyValue("max_steps".into())
+        );
     }
 }

@@ -5,12 +5,12 @@
 //! `crate::pareto`'s.
 
 use super::render::{self, Backend};
-use crate::backend::{Prepared, Setup};
+use crate::backend::{Devices, Prepared, Setup};
 use crate::chart;
 use crate::cpu::reference;
 use crate::cpu::{Precision, Render};
 use crate::frontend;
-use crate::job::{Error, Job, Overrides};
+use crate::job::{self, Error, FrameScene, Job, Open, Overrides, Ready, Use};
 use crate::metrics;
 use crate::pareto::{
     chart_of, combinations, describe, mark_fronts, parse_sweep_within, same, table, Measured,
@@ -194,17 +194,28 @@ fn measure(
         finished: false,
         software: false,
     };
-    let mut prepared = Prepared::from_program(args.backend, scene, lowered.clone(), &setup)
-        .map_err(|source| Error::Unavailable {
-            backend: args.backend,
-            source,
-        })?;
+    // Through the job's path, on the pool this runs in.
+    let frame = FrameScene {
+        scene: scene.clone(),
+        lowered: lowered.clone(),
+        phases: Vec::new(),
+    };
+    let on = (args.backend, &Devices::Auto);
+    let mut prepared = job::prepare_here(on, frame, &setup, Open::Backend)?.prepared;
     let (reference_scene, reference_prepared) = reference_setup(scene, lowered, &points)?;
     // The reference frame is held while each point renders.
     let held = reference_prepared.retained(&reference_scene.settings);
-    let reference_memory =
-        crate::memory::render(&reference_prepared, &reference_scene, true, false);
-    reference_memory.check(limits).map_err(Error::Memory)?;
+    let reference = Use::Written {
+        reference: true,
+        aux: false,
+    };
+    job::check_memory_here(
+        &reference_prepared,
+        &reference_scene,
+        reference,
+        limits,
+        false,
+    )?;
     for settings in &points {
         let mut point = prepared.memory(scene, settings);
         point.host = point.host.saturating_add(held);
@@ -280,6 +291,11 @@ fn reference_setup(
         ..scene.settings.clone()
     };
     reference_scene.settings = reference::settings_of(&reference_scene);
+    let frame = FrameScene {
+        scene: reference_scene,
+        lowered,
+        phases: Vec::new(),
+    };
     let setup = Setup {
         precision: Precision::F64,
         debug_nan: false,
@@ -289,8 +305,11 @@ fn reference_setup(
         finished: false,
         software: false,
     };
-    let prepared = Prepared::from_program(Backend::Cpu, &reference_scene, lowered, &setup)?;
-    Ok((reference_scene, prepared))
+    let on = (Backend::Cpu, &Devices::Auto);
+    let Ready {
+        scene, prepared, ..
+    } = job::prepare_here(on, frame, &setup, Open::Backend)?;
+    Ok((scene, prepared))
 }
 
 /// The reference render and its check.

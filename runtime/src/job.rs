@@ -59,8 +59,9 @@ pub struct Overrides {
     pub set: Vec<String>,
 }
 
-/// What failed on the way from a job to its frames. `Usage`, `Setting`, `Arguments`, `Io`,
-/// `Read` and `--threads 0` end a command with exit code 2, the others with 1.
+/// What failed on the way from a job to its frames. `Usage`, `Setting`, `Sequence`,
+/// `Arguments`, `Io`, `Read` and `--threads 0` end a command with exit code 2, the others
+/// with 1.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Bad arguments: a setting out of its range, options that do not go together.
@@ -69,6 +70,9 @@ pub enum Error {
     /// A setting (`--size`, `--aa`, `--set`) that cannot be read or is out of its range.
     #[error(transparent)]
     Setting(#[from] crate::settings::Error),
+    /// A frame range, shard or sequence output that cannot be used.
+    #[error(transparent)]
+    Sequence(#[from] crate::sequence::Error),
     /// A `--kernel` or `--devices` the backend cannot take, wherever it is found.
     #[error(transparent)]
     Arguments(#[from] backend::Usage),
@@ -195,6 +199,7 @@ impl Error {
         match self {
             Error::Usage(_)
             | Error::Setting(_)
+            | Error::Sequence(_)
             | Error::Arguments(_)
             | Error::Io(_)
             | Error::Read(_)

@@ -5,6 +5,47 @@
 use crate::output::Format;
 use std::path::{Path, PathBuf};
 
+/// A frame range, shard or sequence output that cannot be used: a usage error.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Error {
+    /// `--frames` not as `A..B`.
+    #[error("--frames expects A..B, the frames A up to B − 1, like 0..120, not `{0}`")]
+    Frames(String),
+    /// `--frames A..B` with no frame in it.
+    #[error("--frames {0} has no frames: B must be greater than A (the range is half-open)")]
+    NoFrames(String),
+    /// `--shard` not as `I/N`.
+    #[error("--shard expects I/N, shard I (from 0) of N, like 3/10, not `{0}`")]
+    Shard(String),
+    /// `--shard I/N` with I not below N.
+    #[error("--shard {0}: the shard must be from 0 to N − 1 of N ≥ 1 shards (a job array's task ids from 0, as SLURM_ARRAY_TASK_ID with --array=0-{{N-1}} or JOB_COMPLETION_INDEX)")]
+    NoShard(String),
+    /// A run of `#` in a directory of the output's path.
+    #[error("`{}`: the `#` run of the frame number must be in the file name, not in a directory", .0.display())]
+    RunInDirectory(PathBuf),
+    /// More than one run of `#`.
+    #[error("`{}` has more than one run of `#`: one run is the frame number", .0.display())]
+    Runs(PathBuf),
+    /// Numbered frames in a format that is not an image's.
+    #[error("cannot write `{}`: numbered frames are written as {}", .0.display(), crate::output::EXTENSIONS)]
+    FrameFormat(PathBuf),
+    /// An output that names no way to write a sequence.
+    #[error("cannot write a sequence to `{}`: name numbered frames with a run of `#` (`out/frame_####.png`), or write an animated `.png`, or a video ({}, through ffmpeg)", .0.display(), video_extensions())]
+    Target(PathBuf),
+    /// A video asked for without `ffmpeg`.
+    #[error("writing a video needs `ffmpeg` on PATH, and there is none; install it, or write numbered frames (`-o out/frame_####.png`) and encode them yourself")]
+    NoFfmpeg,
+}
+
+/// The video extensions, as the messages list them.
+fn video_extensions() -> String {
+    VIDEO_EXTENSIONS
+        .iter()
+        .map(|e| format!("`.{e}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Frames `start..end` (half-open, as the language's `for` loops).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Frames {
@@ -16,16 +57,13 @@ pub struct Frames {
 
 impl Frames {
     /// Parses `A..B` (frames A up to B − 1).
-    pub fn parse(s: &str) -> Result<Frames, String> {
-        let err =
-            || format!("--frames expects A..B, the frames A up to B − 1, like 0..120, not `{s}`");
+    pub fn parse(s: &str) -> Result<Frames, Error> {
+        let err = || Error::Frames(s.into());
         let (a, b) = s.split_once("..").ok_or_else(err)?;
         let start = a.trim().parse::<u64>().map_err(|_| err())?;
         let end = b.trim().parse::<u64>().map_err(|_| err())?;
         if end <= start {
-            return Err(format!(
-                "--frames {s} has no frames: B must be greater than A (the range is half-open)"
-            ));
+            return Err(Error::NoFrames(s.into()));
         }
         Ok(Frames { start, end })
     }
@@ -58,15 +96,13 @@ impl Default for Shard {
 
 impl Shard {
     /// Parses `I/N` with 0 ≤ I < N.
-    pub fn parse(s: &str) -> Result<Shard, String> {
-        let err = || format!("--shard expects I/N, shard I (from 0) of N, like 3/10, not `{s}`");
+    pub fn parse(s: &str) -> Result<Shard, Error> {
+        let err = || Error::Shard(s.into());
         let (i, n) = s.split_once('/').ok_or_else(err)?;
         let index = i.trim().parse::<u64>().map_err(|_| err())?;
         let count = n.trim().parse::<u64>().map_err(|_| err())?;
         if count == 0 || index >= count {
-            return Err(format!(
-                "--shard {s}: the shard must be from 0 to N − 1 of N ≥ 1 shards (a job array's task ids from 0, as SLURM_ARRAY_TASK_ID with --array=0-{{N-1}} or JOB_COMPLETION_INDEX)"
-            ));
+            return Err(Error::NoShard(s.into()));
         }
         Ok(Shard { index, count })
     }
@@ -90,25 +126,19 @@ pub struct Pattern {
 impl Pattern {
     /// The pattern of `path`, or `None` when its file name has no `#`. A second run of `#`
     /// is an error.
-    pub fn new(path: &Path) -> Result<Option<Pattern>, String> {
+    pub fn new(path: &Path) -> Result<Option<Pattern>, Error> {
         let text = path.to_string_lossy();
         let name_start = text.len() - path.file_name().map_or(0, |n| n.to_string_lossy().len());
         let Some(first) = text[name_start..].find('#').map(|i| i + name_start) else {
             if text.contains('#') {
-                return Err(format!(
-                    "`{}`: the `#` run of the frame number must be in the file name, not in a directory",
-                    path.display()
-                ));
+                return Err(Error::RunInDirectory(path.to_path_buf()));
             }
             return Ok(None);
         };
         let width = text[first..].chars().take_while(|&c| c == '#').count();
         let after = &text[first + width..];
         if after.contains('#') || text[..first].contains('#') {
-            return Err(format!(
-                "`{}` has more than one run of `#`: one run is the frame number",
-                path.display()
-            ));
+            return Err(Error::Runs(path.to_path_buf()));
         }
         Ok(Some(Pattern {
             before: text[..first].to_string(),
@@ -145,19 +175,14 @@ pub const VIDEO_EXTENSIONS: &[&str] = &["mp4", "webm", "mkv", "mov", "gif"];
 
 impl Target {
     /// The target `-o PATH` names for a sequence.
-    pub fn new(path: &Path) -> Result<Target, String> {
+    pub fn new(path: &Path) -> Result<Target, Error> {
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         if let Some(pattern) = Pattern::new(path)? {
-            let format = Format::from_extension(&ext).ok_or_else(|| {
-                format!(
-                    "cannot write `{}`: numbered frames are written as {}",
-                    path.display(),
-                    crate::output::EXTENSIONS
-                )
-            })?;
+            let format = Format::from_extension(&ext)
+                .ok_or_else(|| Error::FrameFormat(path.to_path_buf()))?;
             return Ok(Target::Numbered(pattern, format));
         }
         if ext == "png" {
@@ -166,27 +191,17 @@ impl Target {
         if VIDEO_EXTENSIONS.contains(&ext.as_str()) {
             return Ok(Target::Video(path.to_path_buf()));
         }
-        Err(format!(
-            "cannot write a sequence to `{}`: name numbered frames with a run of `#` (`out/frame_####.png`), or write an animated `.png`, or a video ({}, through ffmpeg)",
-            path.display(),
-            VIDEO_EXTENSIONS
-                .iter()
-                .map(|e| format!("`.{e}`"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))
+        Err(Error::Target(path.to_path_buf()))
     }
 }
 
 /// The `ffmpeg` on `PATH`, or why there is none.
-pub fn ffmpeg() -> Result<PathBuf, String> {
+pub fn ffmpeg() -> Result<PathBuf, Error> {
     let path = std::env::var_os("PATH").unwrap_or_default();
     std::env::split_paths(&path)
         .map(|d| d.join("ffmpeg"))
         .find(|p| p.is_file())
-        .ok_or_else(|| {
-            "writing a video needs `ffmpeg` on PATH, and there is none; install it, or write numbered frames (`-o out/frame_####.png`) and encode them yourself".to_string()
-        })
+        .ok_or(Error::NoFfmpeg)
 }
 
 #[cfg(test)]
@@ -218,8 +233,16 @@ mod tests {
         let p = Pattern::new(Path::new("f#.exr")).unwrap().unwrap();
         assert_eq!(p.path(12), PathBuf::from("f12.exr"));
         assert_eq!(Pattern::new(Path::new("still.png")).unwrap(), None);
-        assert!(Pattern::new(Path::new("a##_##.png")).is_err());
-        assert!(Pattern::new(Path::new("dir#/f.png")).is_err());
+        assert_eq!(
+            Pattern::new(Path::new("a##_##.png"))
+                .unwrap_err()
+                .to_string(),
+            "`a##_##.png` has more than one run of `#`: one run is the frame number"
+        );
+        assert_eq!(
+            Pattern::new(Path::new("dir#/f.png")).unwrap_err().to_string(),
+            "`dir#/f.png`: the `#` run of the frame number must be in the file name, not in a directory"
+        );
     }
 
     #[test]
@@ -228,8 +251,14 @@ mod tests {
             Frames::parse("0..120").unwrap(),
             Frames { start: 0, end: 120 }
         );
-        assert!(Frames::parse("5..5").is_err());
-        assert!(Frames::parse("5").is_err());
+        assert_eq!(
+            Frames::parse("5..5").unwrap_err().to_string(),
+            "--frames 5..5 has no frames: B must be greater than A (the range is half-open)"
+        );
+        assert_eq!(
+            Frames::parse("5").unwrap_err().to_string(),
+            "--frames expects A..B, the frames A up to B − 1, like 0..120, not `5`"
+        );
         assert_eq!(
             Shard::parse("3/10").unwrap(),
             Shard {
@@ -237,7 +266,27 @@ mod tests {
                 count: 10
             }
         );
-        assert!(Shard::parse("10/10").is_err());
-        assert!(Shard::parse("0/0").is_err());
+        assert_eq!(
+            Shard::parse("10/10").unwrap_err().to_string(),
+            "--shard 10/10: the shard must be from 0 to N − 1 of N ≥ 1 shards (a job array's task ids from 0, as SLURM_ARRAY_TASK_ID with --array=0-{N-1} or JOB_COMPLETION_INDEX)"
+        );
+        assert_eq!(
+            Shard::parse("0/0").unwrap_err(),
+            Error::NoShard("0/0".into())
+        );
+        assert_eq!(Shard::parse("3").unwrap_err(), Error::Shard("3".into()));
+    }
+
+    #[test]
+    fn sequence_outputs_name_what_they_can_be() {
+        assert_eq!(
+            Target::new(Path::new("out.txt")).unwrap_err().to_string(),
+            "cannot write a sequence to `out.txt`: name numbered frames with a run of `#` (`out/frame_####.png`), or write an animated `.png`, or a video (`.mp4`, `.webm`, `.mkv`, `.mov`, `.gif`, through ffmpeg)"
+        );
+        let refused = Target::new(Path::new("f_##.txt")).unwrap_err().to_string();
+        assert!(
+            refused.starts_with("cannot write `f_##.txt`: numbered frames are written as "),
+            "{refused}"
+        );
     }
 }

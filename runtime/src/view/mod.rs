@@ -74,8 +74,8 @@ pub fn headless(run: Run) -> ExitCode {
                 Device::Cpu
             }
             Err(e) => {
-                eprintln!("error: the Wgpu backend is not available: {e}");
-                return ExitCode::from(1);
+                let source = crate::backend::Error::Device(e.to_string());
+                return crate::job::Error::unavailable(Backend::Wgpu, source).exit();
             }
         },
     };

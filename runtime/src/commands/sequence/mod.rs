@@ -73,7 +73,7 @@ pub fn run(
     let frames = frame_range(args, &animation, limits)?;
     let shard = args.shard.unwrap_or_default();
     let path = output.map_or_else(|| default_pattern(file), Path::to_path_buf);
-    let target = Target::new(&path).map_err(Error::Usage)?;
+    let target = Target::new(&path)?;
     if shard.count > 1 && !matches!(target, Target::Numbered(..)) {
         return Err(Error::Usage(
             "--shard renders part of a sequence: its frames must go to numbered files (`-o out/frame_####.png`), not one animated PNG or video".into(),

@@ -69,7 +69,7 @@ impl Sink {
                 }
             }
             Target::Video(path) => {
-                let ffmpeg = ffmpeg().map_err(Error::Usage)?;
+                let ffmpeg = ffmpeg()?;
                 crate::output::check_writable(path).map_err(|why| {
                     Error::Io(format!("cannot write `{}`: {why}", path.display()))
                 })?;

@@ -488,6 +488,24 @@ impl<T> Queue<T> {
         }
     }
 
+    /// What `f` makes of the next item, left waiting for whichever worker takes it, once
+    /// one is there (waiting as [`Queue::take`] does); `None` when every item is done.
+    pub fn first<R>(&self, f: impl FnOnce(&T) -> R) -> Option<R> {
+        let mut s = self.lock();
+        loop {
+            if s.abandoned {
+                return None;
+            }
+            if let Some(item) = s.waiting.front() {
+                return Some(f(item));
+            }
+            if s.taken == 0 && !s.open {
+                return None;
+            }
+            s = self.changed.wait(s).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+
     /// The work is given up (an error, or a worker that panicked holding an item): those
     /// waiting are dropped, and the workers end after the items they hold.
     pub fn abandon(&self) {

@@ -508,11 +508,31 @@ impl FramesOn<'_> {
         let here = format!("device {position}");
         let tally = self.tally;
         let mut idle = Instant::now();
+        // The device is opened (and its kernel prepared) on a copy of the next frame before
+        // it takes one: frames go only to devices that are open, so a device slow to open
+        // holds back none of them (the others render them all if it opens last).
+        let next = queue.first(|p| p.frame.clone());
+        tally.since(&here, "waiting for a frame", idle);
+        if let Some(frame) = next {
+            let opening = Instant::now();
+            if let Err(e) = kernels.prepare(frame) {
+                let message = match e {
+                    Error::Scene(_) => "the frame has errors".into(),
+                    e => e.to_string(),
+                };
+                let _ = tx.send(Report::Failed { position, message });
+                return;
+            }
+            tally.since(&here, preparing(true), opening);
+            idle = Instant::now();
+        }
+        // Whether the memory a frame takes was checked (at the first frame taken).
+        let mut checked = false;
         while let Some(Pending { k, frame }) = queue.take() {
             tally.since(&here, "waiting for a frame", idle);
             let kept = frame.clone();
             let started = Instant::now();
-            let first = kernels.last().is_none();
+            let first = !checked;
             let rendered = (|| {
                 let (scene, prepared) = kernels.prepare(frame)?;
                 if first {
@@ -538,7 +558,7 @@ impl FramesOn<'_> {
                     return Err(Error::Render(message));
                 }
                 tiles += n;
-                tally.since(&here, preparing(first), started);
+                tally.since(&here, preparing(false), started);
                 let rendered = Instant::now();
                 self.pool
                     .install(|| prepared.render_faults(&scene, &|_| {}, &Faults::default()))
@@ -553,6 +573,7 @@ impl FramesOn<'_> {
             })();
             match rendered {
                 Ok(picture) => {
+                    checked = true;
                     let picture = match &numbered {
                         Some((writers, pattern, format)) => {
                             let task = Task {

@@ -103,6 +103,11 @@ pub struct Timing {
     pub fp32_fraction: Option<f64>,
     /// Statistics of the last frame.
     pub stats: Stats,
+    /// On several devices, what each did in the last frame (as `render --stats` prints it:
+    /// bands, and its setup with the uploads, launches with the waits for them, readback and
+    /// conversion); absent on one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub devices: Vec<String>,
 }
 
 /// How the kernels of a timed sequence hold the program's constants.
@@ -367,7 +372,8 @@ fn time_scene(
         .host
         .saturating_add(prepared.retained(&scene.settings));
     frame.check(&job.limits).map_err(Error::Memory)?;
-    let mut last = prepared.render(scene, &|_| {})?.render;
+    let first = prepared.render(scene, &|_| {})?;
+    let (mut last, mut shares) = (first.render, first.shares);
     let mut times = Vec::new();
     let mut walls = Vec::new();
     let mut whole = Vec::new();
@@ -378,6 +384,7 @@ fn time_scene(
         times.push(frame.time.as_secs_f64());
         walls.push(frame.wall.as_secs_f64());
         last = frame.render;
+        shares = frame.shares;
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
@@ -425,6 +432,10 @@ fn time_scene(
             .filter(|_| !guarded)
             .and_then(|p| fp32::fraction(ops_per_eval, evaluations, median, p)),
         stats: last.stats,
+        devices: shares
+            .iter()
+            .map(|s| format!("{}: {} bands, {}", s.device, s.tiles, s.phases))
+            .collect(),
     })
 }
 

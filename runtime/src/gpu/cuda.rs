@@ -115,8 +115,12 @@ pub struct FrameBuffers {
     readback: [Readback; 2],
 }
 
-/// A page-locked readback buffer and the pixels copied into it, if a copy was started.
-type Readback = (Option<PinnedHostSlice<u8>>, Option<Range<usize>>);
+/// A page-locked readback buffer, and the pixels copied into it with the event recorded
+/// behind the copy, if a copy was started.
+type Readback = (
+    Option<PinnedHostSlice<u8>>,
+    Option<(Range<usize>, CudaEvent)>,
+);
 
 impl std::fmt::Debug for FrameBuffers {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -584,12 +588,24 @@ impl launch::Device for Kernel<'_> {
             None => unsafe { self.cuda.ctx.alloc_pinned_with_flags::<u8>(bytes, 0) }
                 .map_err(driver("allocating page-locked memory"))?,
         };
-        self.cuda
-            .stream
-            .memcpy_dtoh(&f.pixels.slice(4 * range.start..4 * range.end), &mut pinned)
+        let s = &self.cuda.stream;
+        // The band's bytes alone, into the buffer's start: a buffer kept from a longer band
+        // (the last band is shorter) is longer, and the driver copies as many bytes as the
+        // destination holds, past the end of the pixels. The copy into a plain slice records
+        // no event of the buffer's: its own is recorded behind it.
+        let host = pinned
+            .as_mut_slice()
+            .map_err(driver("reading the pixels"))?;
+        s.memcpy_dtoh(
+            &f.pixels.slice(4 * range.start..4 * range.end),
+            &mut host[..bytes],
+        )
+        .map_err(driver("reading the pixels"))?;
+        let copied = s
+            .record_event(Some(sys::CUevent_flags::CU_EVENT_DISABLE_TIMING))
             .map_err(driver("reading the pixels"))?;
         *kept = Some(pinned);
-        *at = Some(range);
+        *at = Some((range, copied));
         Ok(())
     }
 
@@ -601,10 +617,12 @@ impl launch::Device for Kernel<'_> {
         slot: usize,
     ) -> Result<Pixels, Error> {
         let (kept, at) = &mut f.readback[slot];
-        let (Some(pinned), Some(true)) = (kept.as_ref(), at.take().map(|r| r == range)) else {
+        let copied = at.take().filter(|(r, _)| *r == range);
+        let (Some(pinned), Some((_, copied))) = (kept.as_ref(), copied) else {
             return self.read(f, job, std::slice::from_ref(&range));
         };
         // Waits for the copy alone: the launches queued after it may still run.
+        copied.synchronize().map_err(driver("reading the pixels"))?;
         let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
         let rgba = super::to_vec_parallel(&bytes[..4 * range.len()]);
         Ok(Pixels {
@@ -625,20 +643,25 @@ impl launch::Device for Kernel<'_> {
         place: launch::Place<'_>,
     ) -> Result<launch::Collected, Error> {
         let (kept, at) = &mut f.readback[slot];
-        match (kept.as_ref(), place) {
-            (Some(pinned), launch::Place::Rgba(out)) if at.as_ref() == Some(&range) => {
-                *at = None;
+        let started = at.as_ref().is_some_and(|(r, _)| *r == range);
+        match (kept.as_ref(), at.take().filter(|_| started), place) {
+            (Some(pinned), Some((_, copied)), launch::Place::Rgba(out)) => {
                 let waiting = Instant::now();
                 // Waits for the copy alone: the launches queued after it may still run.
-                let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
+                copied.synchronize().map_err(driver("reading the pixels"))?;
                 let wait = waiting.elapsed();
+                let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
                 super::copy_parallel(out, &bytes[..4 * range.len()]);
                 Ok(launch::Collected {
                     wait,
                     convert: Duration::ZERO,
                 })
             }
-            (_, place) => launch::collect_copied(self, f, job, (range, slot), place),
+            (_, copied, place) => {
+                // A read started for this band, collected through `collect`.
+                f.readback[slot].1 = copied;
+                launch::collect_copied(self, f, job, (range, slot), place)
+            }
         }
     }
 

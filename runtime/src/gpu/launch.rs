@@ -704,8 +704,8 @@ pub fn render_several(
     let (tx, rx) = mpsc::channel();
     let pixels = job.pixels();
     let (mut linear, mut rgba) = match job.finished {
-        true => (Vec::new(), vec![0u8; 4 * pixels]),
-        false => (vec![[0.0f32; 3]; pixels], Vec::new()),
+        true => (Vec::new(), super::zeroed(4 * pixels)),
+        false => (super::zeroed(pixels), Vec::new()),
     };
     let bands = Bands {
         job,

@@ -271,8 +271,8 @@ fn terminal(t: &Token) -> Sym {
         Token::Angle(_) => Class("ANGLE"),
         Token::Str(_) => Class("STRING"),
         Token::Ident(_) => Class("IDENT"),
-        // Never produced by `lex`: it reports these and drops them.
-        Token::UnterminatedStr => Lit("<unterminated string>"),
+        // Never produced by `lex`: it scans a string from its quote, or drops a comment.
+        Token::Quote => Lit("\""),
         Token::BlockComment => Lit("/*"),
         Token::LParen => Lit("("),
         Token::RParen => Lit(")"),

@@ -49,12 +49,16 @@ pub enum Token {
     /// An angle literal such as `45deg` or `0.5rad`, in radians.
     #[regex(r"([0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?)(deg|rad)", angle)]
     Angle(f64),
-    /// A string literal, without its quotes; escapes are resolved by [`lex`].
-    #[regex(r#""([^"\\\n]|\\[^\n])*""#, |lex| { let s = lex.slice(); s[1..s.len() - 1].to_string() })]
+    /// A string literal, without its quotes, its escapes resolved: made by [`lex`], which
+    /// scans it from its opening [`Token::Quote`].
     Str(String),
-    /// A string literal missing its closing quote (reported, then skipped).
-    #[regex(r#""([^"\\\n]|\\[^\n])*"#, priority = 1)]
-    UnterminatedStr,
+    /// The opening quote of a string: [`lex`] scans the rest of the string, `"` then any
+    /// characters but `"`, `\` and a line break, or escapes (a backslash and any character
+    /// but a line break), then `"`. (A regex of logos would do it with two states that call
+    /// each other once per escape, nesting a function call for each; the stack of a debug
+    /// build overflows on a string of a few thousand escapes.)
+    #[token("\"")]
+    Quote,
     #[regex(r"[A-Za-z_][A-Za-z0-9_]*", |lex| lex.slice().to_string())]
     Ident(String),
     #[token("(")]
@@ -143,7 +147,7 @@ impl fmt::Display for Token {
             Token::Bool(b) => return write!(f, "{b}"),
             Token::Int(_) | Token::Float(_) => "number",
             Token::Angle(_) => "angle",
-            Token::Str(_) | Token::UnterminatedStr => "string",
+            Token::Str(_) | Token::Quote => "string",
             Token::Ident(name) => return write!(f, "identifier `{name}`"),
             Token::LParen => "(",
             Token::RParen => ")",
@@ -203,19 +207,24 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
                     }
                 }
             }
-            Ok(Token::UnterminatedStr) => {
-                diags.push(
-                    Diagnostic::error("E0002", "unterminated string literal", span)
-                        .with_label("this string has no closing quote on its line")
-                        .with_help("strings end with `\"` on the same line"),
-                );
-                // The parser sees a string, so the rest of the line is not misread.
-                tokens.push((Token::Str(String::new()), span));
-            }
-            Ok(Token::Str(raw)) => {
-                let (text, bad) = unescape(&raw, range.start + 1, file);
-                diags.extend(bad);
-                tokens.push((Token::Str(text), span));
+            Ok(Token::Quote) => {
+                let rest = &text[range.end..];
+                let (len, closed) = string_body(rest);
+                let span = Span::new(file, range.start..range.end + len + closed as usize);
+                lexer.bump(len + closed as usize);
+                if closed {
+                    let (text, bad) = unescape(&rest[..len], range.end, file);
+                    diags.extend(bad);
+                    tokens.push((Token::Str(text), span));
+                } else {
+                    diags.push(
+                        Diagnostic::error("E0002", "unterminated string literal", span)
+                            .with_label("this string has no closing quote on its line")
+                            .with_help("strings end with `\"` on the same line"),
+                    );
+                    // The parser sees a string, so the rest of the line is not misread.
+                    tokens.push((Token::Str(String::new()), span));
+                }
             }
             Ok(tok) => tokens.push((tok, span)),
             Err(()) => {
@@ -229,6 +238,29 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
         }
     }
     (tokens, diags)
+}
+
+/// The length in bytes of the body of a string whose opening quote is just before `rest`,
+/// and whether a closing quote follows it. The body is characters other than `"`, `\` and
+/// a line break, and escapes (a backslash and any character but a line break); an
+/// unterminated string ends before the line break, or before a backslash that escapes
+/// nothing (which is then lexed on its own, as an unexpected character).
+fn string_body(rest: &str) -> (usize, bool) {
+    let mut chars = rest.char_indices().peekable();
+    while let Some((i, c)) = chars.next() {
+        match c {
+            '"' => return (i, true),
+            '\n' => return (i, false),
+            '\\' => match chars.peek() {
+                Some(&(_, e)) if e != '\n' => {
+                    chars.next();
+                }
+                _ => return (i, false),
+            },
+            _ => {}
+        }
+    }
+    (rest.len(), false)
 }
 
 /// The escapes of a string: the character after the backslash, and what it stands for
@@ -308,5 +340,82 @@ fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnosti
         '|' => d.with_help("shapes are joined with `union(a, b)`; logical or is written `||`"),
         '#' => d.with_help("comments start with `//`"),
         _ => d,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(r: std::ops::Range<usize>) -> Span {
+        Span::new(FileId(0), r)
+    }
+
+    /// A string is scanned by a loop: 100 000 escapes lex on a test thread's stack in a debug
+    /// build (a regex's states recursed once per escape and overflowed it).
+    #[test]
+    fn a_string_of_many_escapes_lexes_on_a_small_stack() {
+        let text = format!("\"{}\"", "\\n".repeat(100_000));
+        let (tokens, diags) = lex(FileId(0), &text);
+        assert!(diags.is_empty(), "{diags:?}");
+        assert_eq!(
+            tokens,
+            [(Token::Str("\n".repeat(100_000)), at(0..text.len()))]
+        );
+    }
+
+    /// Where a string ends, closed or not, and what follows it.
+    #[test]
+    fn strings_end_at_their_quote_or_their_line() {
+        let lexed = |text: &str| {
+            let (tokens, diags) = lex(FileId(0), text);
+            let codes: Vec<_> = diags.iter().map(|d| (d.code, d.labels[0].span)).collect();
+            (tokens, codes)
+        };
+        let s = |t: &str| Token::Str(t.into());
+        let x = Token::Ident("x".into());
+        assert_eq!(
+            lexed("\"a\\\"b\\\\\" x"),
+            (
+                vec![(s("a\"b\\"), at(0..8)), (x.clone(), at(9..10))],
+                vec![]
+            )
+        );
+        assert_eq!(
+            lexed("\"ab\nx"),
+            (
+                vec![(s(""), at(0..3)), (x.clone(), at(4..5))],
+                vec![("E0002", at(0..3))]
+            )
+        );
+        // A backslash before the line's end escapes nothing: the string ends before it, and
+        // it is a character of its own.
+        assert_eq!(
+            lexed("\"ab\\\nx"),
+            (
+                vec![(s(""), at(0..3)), (x.clone(), at(5..6))],
+                vec![("E0002", at(0..3)), ("E0001", at(3..4))]
+            )
+        );
+        assert_eq!(
+            lexed("\"ab\\"),
+            (
+                vec![(s(""), at(0..3))],
+                vec![("E0002", at(0..3)), ("E0001", at(3..4))]
+            )
+        );
+        assert_eq!(
+            lexed("\"ab"),
+            (vec![(s(""), at(0..3))], vec![("E0002", at(0..3))])
+        );
+        // An unknown escape keeps its character; any character may be escaped, a multi-byte
+        // one too.
+        assert_eq!(
+            lexed("\"é\\q\\é\" x"),
+            (
+                vec![(s("éqé"), at(0..9)), (x, at(10..11))],
+                vec![("E0005", at(3..5)), ("E0005", at(5..8))]
+            )
+        );
     }
 }

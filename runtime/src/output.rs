@@ -98,6 +98,47 @@ fn png_steps(
 /// A step of writing an image and its time, with what it was ([`Output::write`]).
 pub type Step = (&'static str, Duration, String);
 
+/// Why an output named on the command line cannot be written ([`Output::new`]).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write `{}`: {why}", .path.display())]
+pub struct CannotWrite {
+    /// The output.
+    pub path: PathBuf,
+    /// Why.
+    pub why: Refused,
+}
+
+/// Why a path cannot be written to: its format, or the file system ([`check_writable`]).
+#[derive(Debug, thiserror::Error)]
+pub enum Refused {
+    /// The file name has no extension to name a format.
+    #[error("the file name has no extension; the formats are {EXTENSIONS}, or `-` for PNG on standard output")]
+    NoExtension,
+    /// The extension names no format sdfc writes.
+    #[error("`.{0}` is not an image format sdfc writes; the formats are {EXTENSIONS}, or `-` for PNG on standard output")]
+    Format(String),
+    /// The path is a directory.
+    #[error("it is a directory")]
+    Directory,
+    /// The file is read-only.
+    #[error("{0}")]
+    ReadOnly(std::io::Error),
+    /// Its directory does not exist.
+    #[error("the directory `{}` does not exist", .0.display())]
+    NoDirectory(PathBuf),
+    /// What would be its directory is not one.
+    #[error("`{}` is not a directory", .0.display())]
+    NotDirectory(PathBuf),
+    /// No file can be created in its directory.
+    #[error("cannot create a file in `{}`: {source}", .dir.display())]
+    Create {
+        /// The directory.
+        dir: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+}
+
 /// Where `sdfc render` writes its image.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Output {
@@ -116,24 +157,23 @@ impl Output {
     /// The output `-o PATH` names: `-` is standard output; otherwise the extension must name
     /// a format and the file must be writable (its directory exists and takes a new file, and
     /// the path is not a directory). Nothing is left behind by the check.
-    pub fn new(path: &Path) -> Result<Output, String> {
+    pub fn new(path: &Path) -> Result<Output, CannotWrite> {
         if path.as_os_str() == "-" {
             return Ok(Output::Stdout);
         }
-        let cannot = |why: String| format!("cannot write `{}`: {why}", path.display());
+        let cannot = |why| CannotWrite {
+            path: path.to_path_buf(),
+            why,
+        };
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().into_owned())
             .unwrap_or_default();
         let Some(format) = Format::from_extension(&ext) else {
-            let what = if ext.is_empty() {
-                "the file name has no extension".to_string()
-            } else {
-                format!("`.{ext}` is not an image format sdfc writes")
-            };
-            return Err(cannot(format!(
-                "{what}; the formats are {EXTENSIONS}, or `-` for PNG on standard output"
-            )));
+            return Err(cannot(match ext.is_empty() {
+                true => Refused::NoExtension,
+                false => Refused::Format(ext),
+            }));
         };
         check_writable(path).map_err(cannot)?;
         Ok(Output::File {
@@ -357,20 +397,20 @@ impl Writers {
 
 /// Checks that a new file can be written at `path`: the path is not a directory nor a
 /// read-only file, and a file can be created in its directory (created and removed again).
-pub fn check_writable(path: &Path) -> Result<(), String> {
+pub fn check_writable(path: &Path) -> Result<(), Refused> {
     if path.is_dir() {
-        return Err("it is a directory".into());
+        return Err(Refused::Directory);
     }
-    crate::image::refuse_read_only(path).map_err(|e| e.to_string())?;
+    crate::image::refuse_read_only(path).map_err(Refused::ReadOnly)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
     if !dir.exists() {
-        return Err(format!("the directory `{}` does not exist", dir.display()));
+        return Err(Refused::NoDirectory(dir.to_path_buf()));
     }
     if !dir.is_dir() {
-        return Err(format!("`{}` is not a directory", dir.display()));
+        return Err(Refused::NotDirectory(dir.to_path_buf()));
     }
     let name = path
         .file_name()
@@ -381,7 +421,10 @@ pub fn check_writable(path: &Path) -> Result<(), String> {
         .write(true)
         .create_new(true)
         .open(&probe)
-        .map_err(|e| format!("cannot create a file in `{}`: {e}", dir.display()))?;
+        .map_err(|source| Refused::Create {
+            dir: dir.to_path_buf(),
+            source,
+        })?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
 }
@@ -474,11 +517,19 @@ mod tests {
         assert_eq!(Format::from_extension("jpg"), Some(Format::Jpeg));
         assert_eq!(Format::from_extension("exr"), Some(Format::Exr));
         assert_eq!(Format::from_extension("tiff"), None);
-        assert_eq!(Output::new(Path::new("-")), Ok(Output::Stdout));
+        assert_eq!(Output::new(Path::new("-")).unwrap(), Output::Stdout);
         let err = Output::new(Path::new("picture.tiff")).unwrap_err();
-        assert!(err.contains("`.tiff` is not an image format"), "{err}");
+        assert_eq!(
+            err.to_string(),
+            format!("cannot write `picture.tiff`: `.tiff` is not an image format sdfc writes; the formats are {EXTENSIONS}, or `-` for PNG on standard output")
+        );
+        let err = Output::new(Path::new("picture")).unwrap_err();
+        assert!(matches!(err.why, Refused::NoExtension), "{err}");
         let err = Output::new(Path::new("/nonexistent-sdfc/x.png")).unwrap_err();
-        assert!(err.contains("does not exist"), "{err}");
+        assert_eq!(
+            err.to_string(),
+            "cannot write `/nonexistent-sdfc/x.png`: the directory `/nonexistent-sdfc` does not exist"
+        );
     }
 
     /// Frames handed to the pool are all written, whatever order the threads finish in,

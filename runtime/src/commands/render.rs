@@ -380,7 +380,7 @@ fn output(args: &RenderArgs) -> Result<Output, String> {
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.file));
-    let out = Output::new(&path)?;
+    let out = Output::new(&path).map_err(|e| e.to_string())?;
     if out == Output::Stdout && std::io::stdout().is_terminal() {
         return Err("`-o -` writes the PNG's bytes to standard output, which is a terminal here; redirect it (`-o - > out.png`) or name a file".into());
     }

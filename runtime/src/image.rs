@@ -77,6 +77,56 @@ pub struct Rgba8 {
     pub bytes: Vec<u8>,
 }
 
+impl Rgba8 {
+    /// Hands the pixels' buffer back to the pool of [`pixel_buffer`] (the frame was written,
+    /// or is no longer needed), for the next frame of the same size.
+    pub fn recycle(self) {
+        recycle(self.bytes);
+    }
+}
+
+/// Buffers of finished pixels that frames no longer need, kept for the next frames of the
+/// same size (a sequence's, a benchmark's): a new buffer of a frame's size is memory the
+/// system maps and faults in page by page at its first write, and gives back when it is
+/// freed, which took most of a 1920×1080 frame's host time (BENCHMARKS.md, "The render
+/// path"). At most [`SPARE_COUNT`] buffers and [`SPARE_BYTES`] bytes are kept.
+static SPARE: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
+
+/// The most buffers [`SPARE`] keeps.
+const SPARE_COUNT: usize = 64;
+
+/// The most bytes [`SPARE`] keeps: those of the frames that waited for the image writers at
+/// once (`sdfc render --frames` bounds them to a gigabyte).
+const SPARE_BYTES: usize = 1 << 30;
+
+/// A buffer of `len` bytes for a frame's finished pixels, to be written whole: one handed
+/// back ([`recycle`]) when there is one of that size (its bytes are those of an earlier
+/// frame), else a new one of zeros (in huge pages where it is large: `gpu::zeroed`).
+pub fn pixel_buffer(len: usize) -> Vec<u8> {
+    let mut spare = SPARE.lock().unwrap_or_else(|e| e.into_inner());
+    match spare.iter().rposition(|b| b.len() == len) {
+        Some(i) => spare.swap_remove(i),
+        None => {
+            drop(spare);
+            crate::gpu::zeroed(len)
+        }
+    }
+}
+
+/// Keeps `bytes` for [`pixel_buffer`], dropping the buffers handed back longest ago when the
+/// pool would hold more than [`SPARE_COUNT`] buffers or [`SPARE_BYTES`] bytes.
+pub fn recycle(bytes: Vec<u8>) {
+    if bytes.is_empty() || bytes.len() > SPARE_BYTES {
+        return;
+    }
+    let mut spare = SPARE.lock().unwrap_or_else(|e| e.into_inner());
+    let mut held: usize = spare.iter().map(Vec::len).sum();
+    while !spare.is_empty() && (spare.len() >= SPARE_COUNT || held + bytes.len() > SPARE_BYTES) {
+        held -= spare.remove(0).len();
+    }
+    spare.push(bytes);
+}
+
 /// The pixels of a frame to write: linear colours, encoded when written, or finished ones.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Picture {
@@ -422,6 +472,21 @@ pub fn temp_path(path: &Path) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
+    /// A buffer handed back is the next one of its size given out (its memory, not a new
+    /// one); one of another size is not.
+    #[test]
+    fn pixel_buffers_are_handed_out_again() {
+        // A size no other test uses: the pool is the process's.
+        let len = 4 * 7919;
+        let first = super::pixel_buffer(len);
+        assert_eq!(first, vec![0u8; len]);
+        let at = first.as_ptr();
+        super::recycle(first);
+        assert!(super::pixel_buffer(len + 4).len() == len + 4);
+        let again = super::pixel_buffer(len);
+        assert_eq!((again.as_ptr(), again.len()), (at, len));
+    }
+
     /// The table encodes as `srgb_encode` around every threshold (4 096 f32s either side),
     /// at the special values and at a million values drawn from [-0.1, 1.1].
     #[test]

@@ -345,6 +345,10 @@ impl Writers {
                             seconds: task.started.elapsed().as_secs_f64(),
                             steps,
                         };
+                        // The next frame's pixels are read back into its buffer.
+                        if let Picture::Finished(f) = task.picture {
+                            f.recycle();
+                        }
                         if done.send(written).is_err() {
                             return;
                         }

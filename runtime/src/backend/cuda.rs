@@ -171,6 +171,10 @@ impl Renderer for CudaPrepared {
         Some(&self.setup)
     }
 
+    fn reduce_statistics(&mut self, on: bool) {
+        self.setup.image_only = !on;
+    }
+
     fn render(
         &self,
         scene: &Scene,

@@ -483,6 +483,11 @@ pub trait Renderer: std::fmt::Debug + Send + Sync {
         faults: &gpu::launch::Faults,
     ) -> Result<Frame, Error>;
 
+    /// Whether GPU frames reduce the per-pixel statistics on the device (the opposite of
+    /// [`Setup::image_only`]): `sdfc bench` reduces them for its warm-up frame alone. Nothing
+    /// to do on the CPU, which counts them as it renders.
+    fn reduce_statistics(&mut self, _on: bool) {}
+
     /// This device as one of several rendering `scene` together.
     fn part<'a>(&'a self, scene: &'a Scene) -> Result<Part<'a>, Error>;
 
@@ -706,6 +711,13 @@ impl Prepared {
     /// (`None` on the CPU, which reads every setting at every render).
     pub fn contract(&self) -> Option<&wgsl::Contract> {
         self.0.contract()
+    }
+
+    /// Whether the next GPU frames reduce their per-pixel statistics on the device (they
+    /// do unless prepared with [`Setup::image_only`]); without them a frame's statistics
+    /// count nothing but the camera rays.
+    pub fn reduce_statistics(&mut self, on: bool) {
+        self.0.reduce_statistics(on)
     }
 
     /// Specialises the GPU kernel again when `scene` needs other features than it has

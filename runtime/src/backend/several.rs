@@ -77,6 +77,12 @@ impl Renderer for SeveralPrepared {
         self.parts.iter().find_map(|p| p.contract())
     }
 
+    fn reduce_statistics(&mut self, on: bool) {
+        for p in &mut self.parts {
+            p.reduce_statistics(on);
+        }
+    }
+
     /// The setup of the first GPU device's kernel.
     fn setup(&self) -> Option<&Setup> {
         self.parts.iter().find_map(|p| p.0.setup())

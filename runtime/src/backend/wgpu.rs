@@ -230,6 +230,10 @@ impl Renderer for WgpuPrepared {
         Some(&self.setup)
     }
 
+    fn reduce_statistics(&mut self, on: bool) {
+        self.setup.image_only = !on;
+    }
+
     fn render(
         &self,
         scene: &Scene,

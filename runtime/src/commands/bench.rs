@@ -69,9 +69,10 @@ pub struct Timing {
     /// Median wall time per frame, seconds: for GPU backends from the first submission until
     /// the GPU finished (launch overheads included, readback excluded).
     pub median_wall_s: f64,
-    /// Median host time of the whole frame, seconds: from the render's call until its image
-    /// and statistics are on the host (setup, launches, readback and conversion; on several
-    /// devices, the measure their speed-up is taken in).
+    /// Median host time of the whole frame, seconds: from the render's call until its
+    /// pixels are in host memory (setup, launches, readback and conversion; on several
+    /// devices, the measure their speed-up is taken in). The timed frames reduce no
+    /// statistics: those printed are the warm-up frame's.
     pub median_frame_s: f64,
     /// Fastest frame, seconds.
     pub min_s: f64,
@@ -90,7 +91,7 @@ pub struct Timing {
     /// (`fp32::distance_ops`): for a program with guarded blocks, an upper bound of the work
     /// per evaluation.
     pub ops_per_eval: f64,
-    /// Evaluations of the distance in the last frame (marching steps and normal taps; 0 under
+    /// Evaluations of the distance in the warm-up frame (marching steps and normal taps; 0 under
     /// analytic tracing, which evaluates no distance, and then the FP32 fields are null).
     pub evaluations: u64,
     /// GPU targets: the device's peak FP32 rate in TFLOP/s (null for the CPU and for a
@@ -101,7 +102,7 @@ pub struct Timing {
     /// with guarded blocks (what ran is not counted) and where the quotient would exceed 1.
     /// Never above 1.
     pub fp32_fraction: Option<f64>,
-    /// Statistics of the last frame.
+    /// Statistics of the warm-up frame (the timed frames render the same).
     pub stats: Stats,
     /// On several devices, what each did in the last frame (as `render --stats` prints it:
     /// bands, and its setup with the uploads, launches with the waits for them, readback and
@@ -365,15 +366,21 @@ fn time_scene(
         sdfc_compiler::wgsl::choose(scene, &lowered, &options)
             .map_err(crate::backend::Error::Unsupported)?;
     }
-    let prepared = Prepared::on_devices(job.backend, &job.devices, scene, lowered, &setup)?;
+    let mut prepared = Prepared::on_devices(job.backend, &job.devices, scene, lowered, &setup)?;
     // The last frame is held while the next one renders.
     let mut frame = prepared.memory(scene, &scene.settings);
     frame.host = frame
         .host
         .saturating_add(prepared.retained(&scene.settings));
     frame.check(&job.limits).map_err(Error::Memory)?;
-    let first = prepared.render(scene, &|_| {})?;
-    let (mut last, mut shares) = (first.render, first.shares);
+    // The warm-up frame's statistics are those printed (every frame has the same); the
+    // timed frames read back their pixels alone, as `sdfc render` and sequences do.
+    let warm = prepared.render(scene, &|_| {})?;
+    let (last, mut shares) = (warm.render, warm.shares);
+    if let Some(f) = warm.finished {
+        f.recycle();
+    }
+    prepared.reduce_statistics(false);
     let mut times = Vec::new();
     let mut walls = Vec::new();
     let mut whole = Vec::new();
@@ -383,8 +390,11 @@ fn time_scene(
         whole.push(started.elapsed().as_secs_f64());
         times.push(frame.time.as_secs_f64());
         walls.push(frame.wall.as_secs_f64());
-        last = frame.render;
         shares = frame.shares;
+        // Its buffer takes the next frame's pixels.
+        if let Some(f) = frame.finished {
+            f.recycle();
+        }
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
@@ -441,7 +451,7 @@ fn time_scene(
 
 fn header() -> String {
     format!(
-        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>9} {:>6} {:>6}",
+        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>8} {:>9} {:>6} {:>6}",
         "scene",
         "backend",
         "method",
@@ -450,6 +460,7 @@ fn header() -> String {
         "threads",
         "median ms",
         "min ms",
+        "host ms",
         "Mrays/s",
         "steps/px",
         "p99",
@@ -462,7 +473,7 @@ fn row(t: &Timing) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned());
     format!(
-        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>9.1} {:>6} {:>6}",
+        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>8.2} {:>9.1} {:>6} {:>6}",
         name.unwrap_or_else(|| t.scene.clone()),
         t.backend,
         t.method,
@@ -471,6 +482,7 @@ fn row(t: &Timing) -> String {
         t.threads,
         t.median_s * 1e3,
         t.min_s * 1e3,
+        t.median_frame_s * 1e3,
         t.mrays_per_s,
         t.stats.steps_mean,
         t.stats.steps_p99,

@@ -4,8 +4,10 @@
 //! assembly of the image and its statistics. A device (wgpu, CUDA, the CPU renderer) only
 //! prepares a frame's buffers, runs tiles, reads pixels back and says how long its tiles took.
 //!
-//! One device renders the image in squares of [`super::TILE`] pixels and reads it back
-//! whole at the end. Several devices ([`render_several`]) take bands of whole rows from one
+//! One device renders the image in squares of [`super::TILE`] pixels. Finished pixels are
+//! read back a row of squares at a time ([`rows`]), each row's readback queued behind its
+//! launches and collected straight into the frame's buffer while the next row renders; linear
+//! colours are read back whole at the end. Several devices ([`render_several`]) take bands of whole rows from one
 //! queue, each worker the next band when it is free, and read back each band as it finishes
 //! straight into its place in the image (a band is contiguous in the image, so a device reads
 //! back only what it rendered, and the pixels cross the host's memory once); a device that
@@ -342,8 +344,11 @@ pub fn squares(width: u32, height: u32, edge: u32) -> Vec<Tile> {
     out
 }
 
-/// Renders `job` on one device: its tiles in batches, waiting after each (progress, the
-/// injected fault), then the image read back whole.
+/// Renders `job` on one device. Finished pixels ([`Job::finished`]): a row of tiles at a
+/// time, each row's readback queued behind its launches and the row before collected while
+/// it renders, straight into the frame's buffer (one of [`crate::image::pixel_buffer`]'s).
+/// Linear colours: the tiles in batches, waiting after each (progress, the injected fault),
+/// then the image read back whole.
 pub fn render_one<D: Device>(
     device: &D,
     job: &Job,
@@ -354,19 +359,38 @@ pub fn render_one<D: Device>(
     let mut frame = device.prepare(job)?;
     let setup = setup.elapsed();
     let start = Instant::now();
-    let all: Vec<usize> = (0..job.tiles.len()).collect();
-    for batch in all.chunks(TILES_PER_SUBMIT) {
-        device.run(&mut frame, job, batch)?;
-        if let Some(msg) = batch.iter().find_map(|&i| faults.injected(0, i)) {
-            return Err(device.fault(msg));
-        }
-        let done = batch.last().map_or(0, |&i| i + 1);
-        progress((done as f64 / all.len().max(1) as f64).min(1.0));
-    }
-    let wall = start.elapsed();
-    let readback = Instant::now();
     let whole = 0..job.pixels();
-    let pixels = device.read(&mut frame, job, std::slice::from_ref(&whole))?;
+    let (pixels, wall, readback) = match job.finished {
+        true => {
+            let (rgba, collecting) = overlapped(device, &mut frame, job, faults, progress)?;
+            let pixels = Pixels {
+                rgba,
+                ..Pixels::default()
+            };
+            (
+                pixels,
+                start.elapsed().saturating_sub(collecting),
+                collecting,
+            )
+        }
+        false => {
+            let all: Vec<usize> = (0..job.tiles.len()).collect();
+            for batch in all.chunks(TILES_PER_SUBMIT) {
+                device.run(&mut frame, job, batch)?;
+                if let Some(msg) = batch.iter().find_map(|&i| faults.injected(0, i)) {
+                    return Err(device.fault(msg));
+                }
+                let done = batch.last().map_or(0, |&i| i + 1);
+                progress((done as f64 / all.len().max(1) as f64).min(1.0));
+            }
+            let wall = start.elapsed();
+            let readback = Instant::now();
+            let pixels = device.read(&mut frame, job, std::slice::from_ref(&whole))?;
+            let readback = readback.elapsed().saturating_sub(pixels.convert);
+            (pixels, wall, readback)
+        }
+    };
+    let reducing = Instant::now();
     let mut summary = Summary::default();
     if job.statistics {
         let mut selection = Selection::new(job.pixels() as u64);
@@ -376,7 +400,7 @@ pub fn render_one<D: Device>(
         }
         summary = selection.summary();
     }
-    let readback = readback.elapsed().saturating_sub(pixels.convert);
+    let readback = readback + reducing.elapsed();
     let device_time = device.finish(frame, job)?;
     Ok(Output {
         linear: pixels.linear,
@@ -392,6 +416,69 @@ pub fn render_one<D: Device>(
         wall,
         shares: Vec::new(),
     })
+}
+
+/// The finished pixels of `job`'s tiles on one device, a row of tiles at a time ([`rows`]):
+/// each row's launches submitted with its readback queued behind them, the row before
+/// collected into the frame's buffer while it renders. Returns the pixels and the time spent
+/// reading them back (starting the copies, and copying into the frame's buffer; the waits for
+/// the device count among the launches).
+fn overlapped<D: Device>(
+    device: &D,
+    frame: &mut D::Frame,
+    job: &Job,
+    faults: &Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<(Vec<u8>, Duration), D::Error> {
+    let mut rgba = crate::image::pixel_buffer(4 * job.pixels());
+    let mut reading = Duration::ZERO;
+    let rows = rows(job.tiles);
+    let w = job.width as usize;
+    let pixels = |r: &Range<u32>| r.start as usize * w..r.end as usize * w;
+    // Collects the pixels of `range` from readback buffer `slot`: the time spent copying.
+    let collect = |frame: &mut D::Frame, range: Range<usize>, slot, rgba: &mut [u8]| {
+        let t = Instant::now();
+        let place = Place::Rgba(&mut rgba[4 * range.start..4 * range.end]);
+        let collected = device.collect_into(frame, job, range, slot, place)?;
+        Ok(t.elapsed().saturating_sub(collected.wait))
+    };
+    for (i, (tiles, lines)) in rows.iter().enumerate() {
+        let tiles: Vec<usize> = tiles.clone().collect();
+        device.submit(frame, job, &tiles)?;
+        if let Some(msg) = tiles.iter().find_map(|&t| faults.injected(0, t)) {
+            return Err(device.fault(msg));
+        }
+        let t = Instant::now();
+        device.start_read(frame, job, pixels(lines), i % 2)?;
+        reading += t.elapsed();
+        if i > 0 {
+            reading += collect(frame, pixels(&rows[i - 1].1), (i - 1) % 2, &mut rgba)?;
+            progress(tiles[0] as f64 / job.tiles.len().max(1) as f64);
+        }
+    }
+    if let Some((_, lines)) = rows.last() {
+        reading += collect(frame, pixels(lines), (rows.len() - 1) % 2, &mut rgba)?;
+    }
+    device.check(frame)?;
+    progress(1.0);
+    Ok((rgba, reading))
+}
+
+/// The rows of `tiles` ([`squares`], in the order they cut the image): for each row of
+/// tiles, the indices of its tiles and the image rows they cover together (contiguous in the
+/// image, so read back as one range).
+pub fn rows(tiles: &[Tile]) -> Vec<(Range<usize>, Range<u32>)> {
+    let mut out: Vec<(Range<usize>, Range<u32>)> = Vec::new();
+    for (i, t) in tiles.iter().enumerate() {
+        match out.last_mut() {
+            Some((indices, lines)) if lines.start == t.1 => {
+                indices.end = i + 1;
+                lines.end = lines.end.max(t.1 + t.3);
+            }
+            _ => out.push((i..i + 1, t.1..t.1 + t.3)),
+        }
+    }
+    out
 }
 
 /// A device as a worker of [`render_several`] (any [`Device`] is one).
@@ -855,6 +942,26 @@ mod tests {
         assert_eq!(t.len(), 4 * 3);
         let area: u32 = t.iter().map(|t| t.2 * t.3).sum();
         assert_eq!(area, 100 * 70);
+    }
+
+    #[test]
+    fn rows_of_squares_cover_the_image_once() {
+        for (w, h) in [(1920, 1080), (7680, 4320), (4100, 16), (3840, 2160), (1, 1)] {
+            let tiles = squares(w, h, 2048);
+            let rows = rows(&tiles);
+            assert_eq!(rows.len() as u32, h.div_ceil(2048), "{w}x{h}");
+            assert_eq!((rows[0].1.start, rows[rows.len() - 1].1.end), (0, h));
+            assert!(rows.windows(2).all(|p| p[0].1.end == p[1].1.start));
+            assert!(rows.windows(2).all(|p| p[0].0.end == p[1].0.start));
+            assert_eq!(rows[rows.len() - 1].0.end, tiles.len());
+            for (indices, lines) in &rows {
+                let covered: u32 = indices.clone().map(|i| tiles[i].2).sum();
+                assert_eq!(covered, w, "a row of tiles spans the width");
+                assert!(indices
+                    .clone()
+                    .all(|i| tiles[i].1 == lines.start && tiles[i].1 + tiles[i].3 == lines.end));
+            }
+        }
     }
 
     #[test]

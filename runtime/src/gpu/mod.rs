@@ -175,7 +175,8 @@ pub fn render_cuda(
     )
 }
 
-/// Renders `scene` on one device, in squares of [`TILE`] pixels.
+/// Renders `scene` on one device, in squares of [`TILE`] pixels (finished pixels read back a
+/// row of squares at a time, each while the next renders: [`launch::render_one`]).
 fn render_one<D: launch::Device>(
     device: &D,
     scene: &Scene,
@@ -328,9 +329,11 @@ pub(crate) fn copy_parallel<T: Copy + Send + Sync>(dst: &mut [T], src: &[T]) {
         .for_each(|(o, i)| o.copy_from_slice(i));
 }
 
-/// `src` copied into a new vector ([`zeroed`]) by [`copy_parallel`].
+/// `src` copied by [`copy_parallel`] into a buffer of finished pixels from the pool of
+/// [`crate::image::pixel_buffer`] (one an earlier frame handed back, its pages in memory
+/// already, when there is one; else a new one, [`zeroed`]).
 pub(crate) fn to_vec_parallel(src: &[u8]) -> Vec<u8> {
-    let mut out = zeroed(src.len());
+    let mut out = crate::image::pixel_buffer(src.len());
     copy_parallel(&mut out, src);
     out
 }

@@ -119,11 +119,12 @@ pub fn run(
     let tally = Tally::default();
     let mut checker = Checker {
         job,
-        source: &mut source,
+        source: std::sync::Mutex::new(&mut source),
         lowering: &lowering,
         fps,
         bar: bar.as_ref(),
         tally: &tally,
+        place: "main thread",
     };
     let started = Instant::now();
     // Numbered files are encoded and written on a pool of threads while the next frames
@@ -163,58 +164,82 @@ pub fn run(
             // The picture of a scene that does not read `t`, rendered once.
             let mut still: Option<Picture> = None;
             const HERE: &str = "device";
-            for (n, &k) in todo.iter().enumerate() {
-                let frame = checker.frame(k, &mut first)?;
-                let frame_started = Instant::now();
-                let picture = match &still {
-                    Some(picture) => picture.clone(),
-                    None => {
-                        let (scene, prepared) = kernels.prepare(frame)?;
-                        let memory = job::Use::IMAGE;
-                        job::check_memory(&pool, prepared, &scene, memory, limits, n == 0)?;
-                        tally.since(HERE, preparing(n == 0), frame_started);
-                        let rendered = Instant::now();
-                        let mut frame = pool.install(|| prepared.render(&scene, &|_| {}))?;
-                        match &frame.phases {
-                            Some(p) => tally.phases(HERE, p),
-                            None => tally.since(HERE, "render", rendered),
-                        }
-                        for w in frame.warnings() {
-                            eprintln!("warning: frame {k}: {w}");
-                        }
-                        let picture = frame.take_picture();
-                        if !animation.animated() {
-                            still = Some(picture.clone());
-                        }
-                        picture
-                    }
-                };
-                match (&writers, &sink) {
-                    (Some(w), Sink::Numbered(pattern, format)) => {
-                        let task = Task {
-                            k,
-                            output: Output::File {
-                                path: pattern.path(k),
-                                format: *format,
-                            },
-                            picture,
-                            started: frame_started,
-                        };
-                        let handing = Instant::now();
-                        w.submit(task).map_err(Error::Encode)?;
-                        tally.since(HERE, "handing to the writers", handing);
-                        for done in w.written() {
-                            report(done, &checker, &sink)?;
+            // The frames are checked on a thread of their own, a frame or two ahead of the
+            // device, which renders one while the next is checked.
+            checker.place = "checking thread";
+            let checker = &checker;
+            let first = &mut first;
+            std::thread::scope(|scope| -> Result<(), Error> {
+                let (tx, checked) = std::sync::mpsc::sync_channel(2);
+                let todo = &todo;
+                scope.spawn(move || {
+                    for &k in todo {
+                        let frame = checker.frame(k, first);
+                        let failed = frame.is_err();
+                        // The receiver is gone after an error of its own.
+                        if tx.send((k, frame)).is_err() || failed {
+                            return;
                         }
                     }
-                    _ => {
-                        let writing = Instant::now();
-                        sink.write(k, &picture)?;
-                        tally.since(HERE, "writing", writing);
-                        checker.written(k, &sink, frame_started.elapsed().as_secs_f64());
+                });
+                for (n, (k, frame)) in checked.iter().enumerate() {
+                    let frame = frame?;
+                    let frame_started = Instant::now();
+                    let picture = match &still {
+                        Some(picture) => picture.clone(),
+                        None => {
+                            let (scene, prepared) = kernels.prepare(frame)?;
+                            let memory = job::Use::IMAGE;
+                            job::check_memory(&pool, prepared, &scene, memory, limits, n == 0)?;
+                            tally.since(HERE, preparing(n == 0), frame_started);
+                            let rendered = Instant::now();
+                            let mut frame = pool.install(|| prepared.render(&scene, &|_| {}))?;
+                            match &frame.phases {
+                                Some(p) => tally.phases(HERE, p),
+                                None => tally.since(HERE, "render", rendered),
+                            }
+                            for w in frame.warnings() {
+                                eprintln!("warning: frame {k}: {w}");
+                            }
+                            let picture = frame.take_picture();
+                            if !animation.animated() {
+                                still = Some(picture.clone());
+                            }
+                            picture
+                        }
+                    };
+                    match (&writers, &sink) {
+                        (Some(w), Sink::Numbered(pattern, format)) => {
+                            let task = Task {
+                                k,
+                                output: Output::File {
+                                    path: pattern.path(k),
+                                    format: *format,
+                                },
+                                picture,
+                                started: frame_started,
+                            };
+                            let handing = Instant::now();
+                            w.submit(task).map_err(Error::Encode)?;
+                            tally.since(HERE, "handing to the writers", handing);
+                            for done in w.written() {
+                                report(done, checker, &sink)?;
+                            }
+                        }
+                        _ => {
+                            let writing = Instant::now();
+                            sink.write(k, &picture)?;
+                            // Its buffer takes the next frame's pixels.
+                            if let Picture::Finished(f) = picture {
+                                f.recycle();
+                            }
+                            tally.since(HERE, "writing", writing);
+                            checker.written(k, &sink, frame_started.elapsed().as_secs_f64());
+                        }
                     }
                 }
-            }
+                Ok(())
+            })?;
             let device = kernels
                 .last()
                 .map(|p| format!("{} on {}", p.name(), p.device()));
@@ -255,27 +280,32 @@ pub fn run(
 }
 
 /// Checks the frames of a sequence one after the other (the source is read once and checked
-/// at each time), and logs those written.
+/// at each time), and logs those written; shared by the thread that checks and the one that
+/// logs.
 struct Checker<'a> {
     job: &'a Job,
-    source: &'a mut Source,
+    source: std::sync::Mutex<&'a mut Source>,
     lowering: &'a LowerOptions,
     fps: f64,
     bar: Option<&'a ProgressBar>,
     /// Where the time went.
     tally: &'a Tally,
+    /// The tally's name of the thread that checks.
+    place: &'static str,
 }
 
 impl Checker<'_> {
     /// Frame `k` checked at its time (`first`, the frame checked at t = 0, when it is that).
-    fn frame(&mut self, k: u64, first: &mut Option<FrameScene>) -> Result<FrameScene, Error> {
+    fn frame(&self, k: u64, first: &mut Option<FrameScene>) -> Result<FrameScene, Error> {
         let time = Animation::time_of(self.fps, k);
         if let Some(f) = first.take().filter(|_| time == 0.0) {
             return Ok(f);
         }
         let started = Instant::now();
-        let frame = self.job.frame(self.source, time, false, self.lowering);
-        self.tally.since("main thread", "check", started);
+        let mut source = self.source.lock().unwrap_or_else(|e| e.into_inner());
+        let frame = self.job.frame(&mut source, time, false, self.lowering);
+        drop(source);
+        self.tally.since(self.place, "check", started);
         frame.map_err(|e| {
             if let Some(b) = self.bar {
                 b.abandon();

@@ -786,6 +786,66 @@ mod tests {
         );
     }
 
+    /// A scene prepared after another ([`Open::After`], the viewer's later loads and animation
+    /// frames) keeps the kernel before when `setup` says `auto`, takes the one it names
+    /// otherwise, and builds none where the kernel's text is unchanged (numbers only).
+    #[test]
+    fn a_scene_prepared_after_another_keeps_or_changes_its_kernel_as_asked() {
+        let gpu = match Gpu::open(false) {
+            Ok(gpu) => Arc::new(gpu),
+            Err(e) => {
+                assert!(
+                    std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
+                    "SDFC_REQUIRE_DEVICES=1 but no wgpu adapter: {e}"
+                );
+                eprintln!("job test SKIPPED: no wgpu adapter ({e})");
+                return;
+            }
+        };
+        let text = |r: &str| {
+            format!(
+                "render {{ width: 16, height: 12, method: \"march\" }}\n\
+                 scene {{ plane((0, 1, 0), 0); sphere({r}).translate(0, 0.5, 0); }}\n"
+            )
+        };
+        let frame = |r: &str| {
+            let mut source = Source::from_text("after.sdf", text(r));
+            let job = Job {
+                quiet: true,
+                ..Job::default()
+            };
+            job.frame(&mut source, 0.0, false, &LowerOptions::default())
+                .expect("the scene")
+        };
+        let on = (Backend::Wgpu, &Devices::Auto);
+        let interpreted = Setup {
+            parameters: true,
+            kernel: wgsl::KernelChoice::Interpreted,
+            ..Setup::default()
+        };
+        let first = prepare_here(on, frame("0.5"), &interpreted, Open::Gpu(gpu)).unwrap();
+        assert!(first.built);
+        assert_eq!(first.prepared.kernel_kind(), Some("interpreted"));
+        let auto = Setup::default();
+        let kept = prepare_here(on, frame("0.6"), &auto, Open::After(&first.prepared)).unwrap();
+        assert_eq!(kept.prepared.kernel_kind(), Some("interpreted"));
+        assert!(
+            !kept.built,
+            "a program that differs in numbers only keeps its kernel"
+        );
+        let specialised = Setup {
+            kernel: wgsl::KernelChoice::Specialised,
+            ..auto
+        };
+        let after = Open::After(&kept.prepared);
+        let other = prepare_here(on, frame("0.6"), &specialised, after).unwrap();
+        assert_eq!(other.prepared.kernel_kind(), Some("specialised"));
+        assert!(other.built);
+        // On the device the scene before was prepared on, not another opened.
+        let device = |r: &Ready| r.prepared.as_wgpu().expect("wgpu").gpu.clone();
+        assert!(Arc::ptr_eq(&device(&first), &device(&other)));
+    }
+
     #[test]
     fn a_scene_with_errors_is_summarised_by_its_first_error() {
         let mut source = Source::from_text(

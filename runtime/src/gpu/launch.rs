@@ -1242,6 +1242,127 @@ mod tests {
         assert_eq!(open.take(), None);
     }
 
+    /// One device whose finished pixels are read back into two slots, started behind the
+    /// launches and collected later: a pixel's bytes are its index's; what it did is logged.
+    struct Rows {
+        log: Mutex<Vec<(&'static str, usize)>>,
+    }
+
+    impl Device for Rows {
+        type Frame = [Option<Range<usize>>; 2];
+        type Error = String;
+        fn describe(&self) -> String {
+            "rows".into()
+        }
+        fn prepare(&self, _job: &Job) -> Result<Self::Frame, String> {
+            Ok([None, None])
+        }
+        fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), String> {
+            Err("run is not called: rows are submitted".into())
+        }
+        fn submit(&self, _: &mut Self::Frame, _: &Job, tiles: &[usize]) -> Result<(), String> {
+            let mut log = self.log.lock().expect("log");
+            log.extend(tiles.iter().map(|&t| ("submit", t)));
+            Ok(())
+        }
+        fn start_read(
+            &self,
+            slots: &mut Self::Frame,
+            _: &Job,
+            range: Range<usize>,
+            slot: usize,
+        ) -> Result<(), String> {
+            assert!(slots[slot].is_none(), "slot {slot} still holds a row");
+            self.log.lock().expect("log").push(("start", range.start));
+            slots[slot] = Some(range);
+            Ok(())
+        }
+        fn collect(
+            &self,
+            slots: &mut Self::Frame,
+            _: &Job,
+            range: Range<usize>,
+            slot: usize,
+        ) -> Result<Pixels, String> {
+            assert_eq!(slots[slot].take().as_ref(), Some(&range), "slot {slot}");
+            self.log.lock().expect("log").push(("collect", range.start));
+            Ok(Pixels {
+                rgba: range.flat_map(|i| [i as u8; 4]).collect(),
+                ..Pixels::default()
+            })
+        }
+        fn read(&self, _: &mut Self::Frame, _: &Job, _: &[Range<usize>]) -> Result<Pixels, String> {
+            Err("read is not called: rows are collected".into())
+        }
+        fn reduce(
+            &self,
+            _: &mut Self::Frame,
+            _: &Job,
+            _: &[Range<usize>],
+            ask: Ask,
+        ) -> Result<Answer, String> {
+            Ok(Answer::empty(ask))
+        }
+        fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, String> {
+            assert_eq!(slots, [None, None], "every row collected");
+            Ok(None)
+        }
+        fn fault(&self, message: String) -> String {
+            message
+        }
+    }
+
+    #[test]
+    fn one_device_collects_a_row_of_tiles_while_the_next_renders() {
+        // Squares of 8 pixels over 20×20: three rows of three tiles (8, 8 and 4 pixels high).
+        let tiles = squares(20, 20, 8);
+        let job = Job {
+            uniforms: &[],
+            data: None,
+            width: 20,
+            height: 20,
+            tiles: &tiles,
+            timed: false,
+            statistics: false,
+            finished: true,
+        };
+        let rows = Rows {
+            log: Mutex::new(Vec::new()),
+        };
+        let out = render_one(&rows, &job, &Faults::default(), &mut |_| {}).expect("renders");
+        let expected: Vec<u8> = (0..400).flat_map(|i| [i as u8; 4]).collect();
+        assert_eq!(out.rgba, expected);
+        let log = rows.log.lock().expect("log").clone();
+        let s = |t| ("submit", t);
+        assert_eq!(
+            log,
+            [
+                s(0),
+                s(1),
+                s(2),
+                ("start", 0),
+                s(3),
+                s(4),
+                s(5),
+                ("start", 160),
+                ("collect", 0),
+                s(6),
+                s(7),
+                s(8),
+                ("start", 320),
+                ("collect", 160),
+                ("collect", 320),
+            ]
+        );
+        // A fault at the fifth tile ends the frame after its row was submitted.
+        let rows = Rows {
+            log: Mutex::new(Vec::new()),
+        };
+        let faults = Faults::parse("4").expect("parses");
+        let err = render_one(&rows, &job, &faults, &mut |_| {}).expect_err("fails");
+        assert!(err.contains("injected at tile 5"), "{err}");
+    }
+
     #[test]
     fn faults_parse_per_device() {
         let f = Faults::parse("1:2, 5").expect("parses");

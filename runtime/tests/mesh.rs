@@ -872,3 +872,63 @@ fn every_printable_ascii_glyph_meshes_closed() {
         m.triangles.len()
     );
 }
+
+/// A grid far too fine for the limits is refused from the octree's first levels, which prove
+/// enough surface through the balls about their centres inside the solid, before the large
+/// levels are evaluated: by the cells limit (resolution 100 000) or by the candidates the
+/// memory limit lets contouring hold (resolution 2000). The proof is a lower bound: with the
+/// true number of candidates as the most allowed, the octree finishes.
+#[test]
+fn a_grid_too_fine_is_refused_from_the_first_levels() {
+    use sdfc_runtime::mesh::{octree, Field, Grid};
+    let bracket = program(&root().join("examples/mesh/bracket.sdf"));
+    let (lo, hi) = ([-0.9, -0.5, -0.6], [0.9, 0.4, 0.6]);
+    let field = Field::new(&bracket, true, [lo, hi]);
+    let fine = Grid::over(&[lo, hi], 1.8 / 100_000.0);
+    let refused = octree::candidates(&field, &fine, 50_000_000, u64::MAX, &|_| {});
+    assert!(
+        matches!(refused, Err(octree::Refused::Cells(n)) if n > 50_000_000),
+        "{refused:?}"
+    );
+    assert!(field.evaluated() < 100_000, "{}", field.evaluated());
+    let field = Field::new(&bracket, true, [lo, hi]);
+    let grid = Grid::over(&[lo, hi], 1.8 / 2000.0);
+    let refused = octree::candidates(&field, &grid, 50_000_000, 40_000, &|_| {});
+    assert!(
+        matches!(refused, Err(octree::Refused::Candidates(n)) if n > 40_000),
+        "{refused:?}"
+    );
+    assert!(field.evaluated() < 100_000, "{}", field.evaluated());
+    // Never more than the octree finds.
+    let cases = [
+        ("examples/mesh/bracket.sdf", lo, hi, 160),
+        ("examples/mesh/parts.sdf", [-1.0; 3], [1.0; 3], 160),
+    ];
+    for (file, lo, hi, n) in cases {
+        let p = program(&root().join(file));
+        let field = Field::new(&p, true, [lo, hi]);
+        let longest = (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
+        let grid = Grid::over(&[lo, hi], longest / n as f64);
+        let all = octree::candidates(&field, &grid, 1 << 40, u64::MAX, &|_| {}).expect("all");
+        let found = all.cells.len() as u64;
+        let again = octree::candidates(&field, &grid, 1 << 40, found, &|_| {});
+        assert_eq!(
+            again.as_ref().map(|c| c.cells.len() as u64),
+            Ok(found),
+            "{file}"
+        );
+        // Fewer allowed: refused by a number of candidates between the most and the truth.
+        let mut refused = 0;
+        for most in [found / 4, found / 16, found / 64, 10] {
+            match octree::candidates(&field, &grid, 1 << 40, most, &|_| {}) {
+                Err(octree::Refused::Candidates(k)) => {
+                    assert!(k > most && k <= found, "{file}: {k} of {found}");
+                    refused += 1;
+                }
+                Ok(c) => assert_eq!(c.cells.len() as u64, found, "{file}"),
+                Err(other) => panic!("{file}: {other:?}"),
+            }
+        }
+        assert!(refused > 0, "{file}: never refused");
+    }
+}

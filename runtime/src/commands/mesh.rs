@@ -348,17 +348,33 @@ pub fn surface(
     check_memory(octree_bytes, limits, spell).map_err(|m| (1, m))?;
     let stage =
         |name: &'static str, base: f64, share: f64| move |f: f64| progress(name, base + share * f);
+    // The most candidates whose corners the memory limit lets contouring hold: the octree
+    // stops at the first level that proves more, with the message the check after it gives.
+    let fits = |n: u64| check_memory(contour::candidate_bytes(&grid, n), limits, spell).is_ok();
+    let max_candidates = most(fits);
     let started = Instant::now();
     let candidates = pool
-        .install(|| octree::candidates(&field, &grid, max_cells, &stage("octree", 0.0, 0.3)))
-        .map_err(|n| {
-            (
+        .install(|| {
+            octree::candidates(
+                &field,
+                &grid,
+                max_cells,
+                max_candidates,
+                &stage("octree", 0.0, 0.3),
+            )
+        })
+        .map_err(|refused| match refused {
+            octree::Refused::Cells(n) => (
                 1,
                 format!(
                     "meshing would evaluate {n} cells or more, more than the cells limit of {max_cells}; {} (or mesh at a lower {resolution_opt})",
                     limits.raise_to(Limit::Cells, n)
                 ),
-            )
+            ),
+            octree::Refused::Candidates(n) => (
+                1,
+                refuse_memory(contour::candidate_bytes(&grid, n), true, limits, spell),
+            ),
         })?;
     let n = candidates.cells.len() as u64;
     let bound = contour::candidate_bytes(&grid, n);
@@ -456,17 +472,47 @@ fn short(x: f64) -> String {
     sdfc_compiler::diagnostics::number(x, 4)
 }
 
+/// The largest `n` for which `fits(n)` holds (`fits` true up to some `n`, false beyond; 0
+/// when it fails at 1).
+fn most(fits: impl Fn(u64) -> bool) -> u64 {
+    let (mut lo, mut hi) = (0u64, 1u64 << 50);
+    if fits(hi) {
+        return hi;
+    }
+    // fits(lo) is taken as true, fits(hi) is false.
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 fn check_memory(bytes: u64, limits: &Limits, spell: Spelling) -> Result<(), String> {
-    let limit = limits.get(Limit::Memory);
-    let needed = mib(bytes);
-    if needed <= limit {
+    if mib(bytes) <= limits.get(Limit::Memory) {
         return Ok(());
     }
-    Err(format!(
-        "the mesh would allocate up to {needed} MiB, more than the memory limit of {limit} MiB; {} (or mesh at a lower {})",
+    Err(refuse_memory(bytes, false, limits, spell))
+}
+
+/// The message of a mesh refused by the memory limit, needing `bytes`: the bound announced,
+/// or with `lower`, a lower bound of it (the octree proved enough surface before its end).
+fn refuse_memory(bytes: u64, lower: bool, limits: &Limits, spell: Spelling) -> String {
+    let needed = mib(bytes);
+    let amount = if lower {
+        format!("{needed} MiB or more")
+    } else {
+        format!("up to {needed} MiB")
+    };
+    format!(
+        "the mesh would allocate {amount}, more than the memory limit of {} MiB; {} (or mesh at a lower {})",
+        limits.get(Limit::Memory),
         limits.raise_to(Limit::Memory, needed),
         spell.option("resolution")
-    ))
+    )
 }
 
 /// ` (the fractal at FILE:LINE:COL)` for the node that left the bound unproven.

@@ -6,6 +6,13 @@
 //! kept two-cell cube is a candidate, and its corners, which contouring evaluates anyway,
 //! decide (a cell whose corners all have one sign holds no patch). A field without a proven
 //! bound gets the dense grid.
+//!
+//! A grid too fine for the cells limit, or with more candidates than the memory limit lets
+//! contouring hold, is refused at the first level that proves it ([`candidates_at_least`]),
+//! usually one of the first few, before the large levels are evaluated or stored: a point
+//! inside the solid whose value is `d` is the centre of a ball of radius `|d| / L` inside it,
+//! and every line through the ball meets the surface on both sides of it (the clipped solid
+//! is bounded), in cells that the octree keeps.
 
 use super::{pack, Field, Grid};
 
@@ -40,19 +47,33 @@ pub struct Candidates {
     pub evaluated: u64,
 }
 
+/// Why [`candidates`] stopped early.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refused {
+    /// The octree cells evaluated and the candidates would exceed the cells limit: this many
+    /// or more.
+    Cells(u64),
+    /// There would be more candidates than asked for at most: this many or more.
+    Candidates(u64),
+}
+
 /// The cells of `grid` that may hold surface of `field`, with at most `max_cells` octree
-/// cells evaluated and candidates returned together (`Err` with the count reached when that
-/// would be exceeded; for a dense grid, its cell count). `progress` receives the fraction of levels done.
+/// cells evaluated and candidates returned together (`Err` with the count reached, or a
+/// lower bound of it, when that would be exceeded; for a dense grid, its cell count). A
+/// level that proves more than `max_candidates` candidates stops it too (more may be
+/// returned: the caller checks their number). `progress` receives the fraction of levels
+/// done.
 pub fn candidates(
     field: &Field,
     grid: &Grid,
     max_cells: u64,
+    max_candidates: u64,
     progress: &dyn Fn(f64),
-) -> Result<Candidates, u64> {
+) -> Result<Candidates, Refused> {
     if !field.proven {
         let n = grid.dense_cells();
         if n > max_cells {
-            return Err(n);
+            return Err(Refused::Cells(n));
         }
         let [nx, ny, nz] = grid.cells;
         let mut cells = Vec::with_capacity(n as usize);
@@ -78,7 +99,7 @@ pub fn candidates(
         let size = 1u32 << (levels - level);
         evaluated += frontier.len() as u64;
         if evaluated > max_cells {
-            return Err(evaluated);
+            return Err(Refused::Cells(evaluated));
         }
         let half = 0.5 * size as f64 * grid.voxel;
         let centres: Vec<[f64; 3]> = frontier
@@ -86,6 +107,15 @@ pub fn candidates(
             .map(|c| [0, 1, 2].map(|a| grid.origin[a] + c[a] as f64 * 2.0 * half + half))
             .collect();
         let d = field.distances(&centres);
+        // The surface these values prove, before the next level is counted or stored.
+        let within = max_cells.saturating_sub(evaluated).min(max_candidates);
+        let surface = candidates_at_least(&frontier, &d, size, grid.voxel, field.lipschitz, within);
+        if evaluated.saturating_add(surface) > max_cells {
+            return Err(Refused::Cells(evaluated.saturating_add(surface)));
+        }
+        if surface > max_candidates {
+            return Err(Refused::Candidates(surface));
+        }
         let reach = field.lipschitz * half * 3f64.sqrt() * (1.0 + SLACK) + SLACK * grid.voxel;
         let kept = || {
             frontier
@@ -105,7 +135,7 @@ pub fn candidates(
         // for the cells limit is refused without allocating them.
         let count: u64 = kept().map(|c| children(c).count() as u64).sum();
         if evaluated + count > max_cells {
-            return Err(evaluated + count);
+            return Err(Refused::Cells(evaluated + count));
         }
         let mut next = Vec::with_capacity(count as usize);
         next.extend(kept().flat_map(children));
@@ -120,4 +150,69 @@ pub fn candidates(
         cells: Vec::new(),
         evaluated,
     })
+}
+
+/// Relative slack of the radii in [`candidates_at_least`], for the rounding of the distances.
+const BALL_SLACK: f64 = 1e-6;
+
+/// Grid columns of a disc of radius `r` cells about a cell corner of the grid, at least: the
+/// column centres (at half-integers of it) strictly inside the square inscribed in the disc,
+/// of half side `r / √2`, `2k` along each side where `k` counts the `m + ½ < r / √2`.
+fn columns_within(r: f64) -> u64 {
+    let k = (r / std::f64::consts::SQRT_2 - 0.5 - 1e-9).ceil().max(0.0) as u64;
+    (2 * k).saturating_mul(2 * k)
+}
+
+/// A lower bound on the candidates [`candidates`] returns, from one level's cells (`cells`,
+/// indices at the level, `size` grid cells of edge `voxel` along an edge) and their centres'
+/// values `d` under the bound `lipschitz`: `0` unless it may exceed `within` (the rows are
+/// not sorted otherwise).
+///
+/// A centre with `d < 0` is inside the solid, with the ball of radius `ρ = |d| / L` about it
+/// (the field is proven). The solid is bounded, so every line through that ball parallel to
+/// an axis passes from inside to outside on each side of it: two points of the surface
+/// (zeros of the field), in two grid cells of the line's column, which the octree keeps at
+/// every level (a cell holding a zero has `|f(c)| ≤ L·r`) and returns. The balls about the
+/// centres of one row of this level along the axis have one disc as their shadow, that of
+/// the largest, which within half the level's edge lies in the row's square: the rows'
+/// columns are distinct. So each axis gives twice the sum over rows of the columns of the
+/// largest disc (within half an edge), and the bound is the largest of the three.
+pub fn candidates_at_least(
+    cells: &[[u32; 3]],
+    d: &[f64],
+    size: u32,
+    voxel: f64,
+    lipschitz: f64,
+    within: u64,
+) -> u64 {
+    // Radii in grid cells, within half the level's edge.
+    let cap = 0.5 * size as f64;
+    let radius = |d: f64| (-d * (1.0 - BALL_SLACK) / (lipschitz * voxel) - BALL_SLACK).min(cap);
+    let inside = || {
+        cells
+            .iter()
+            .zip(d)
+            .filter(|(_, &d)| d < 0.0)
+            .map(|(c, &d)| (c, radius(d)))
+            .filter(|&(_, r)| columns_within(r) > 0)
+    };
+    // Without sharing rows: when even that stays within, so does the bound.
+    let unshared: u64 = inside().map(|(_, r)| 2 * columns_within(r)).sum();
+    if unshared <= within {
+        return 0;
+    }
+    let mut best = 0u64;
+    let mut rows: Vec<(u64, f64)> = Vec::new();
+    for axis in 0..3 {
+        rows.clear();
+        rows.extend(inside().map(|(c, r)| {
+            let (u, v) = (c[(axis + 1) % 3] as u64, c[(axis + 2) % 3] as u64);
+            (u | v << 32, r)
+        }));
+        rows.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
+        rows.dedup_by_key(|row| row.0);
+        let lines: u64 = rows.iter().map(|&(_, r)| 2 * columns_within(r)).sum();
+        best = best.max(lines);
+    }
+    best
 }

@@ -92,6 +92,15 @@ class Check(unittest.TestCase):
                 self.assertTrue(ours)
                 self.assertEqual(ours, theirs)
 
+    def test_method_reason_names_the_parameter(self):
+        # Sphere traced beyond the `traced` limit: the reason says how to raise it here.
+        source = "scene { union([for i in 0..20 { sphere(0.1).translate(i, 0, 0) }]); }"
+        _, facts = sdfc.check(source, limits={"traced": 10})
+        self.assertEqual(facts.method, "march")
+        self.assertIn("`traced` limit of 10", facts.method_reason)
+        self.assertIn('limits={"traced": 20}', facts.method_reason)
+        self.assertNotIn("--", facts.method_reason)
+
     def test_check_reads_files(self):
         diags, facts = sdfc.check(path=str(ROOT / "examples" / "seed1.sdf"))
         self.assertIsNotNone(facts)
@@ -335,6 +344,16 @@ class Mesh(unittest.TestCase):
         self.assertNotIn("--", str(caught.exception))
         v, f, _ = s.mesh(resolution=16, bounds=((-1, -1, -1), (1, 1, 1)))
         self.assertGreater(len(f), 0)
+
+
+    def test_too_fine_a_grid_is_refused(self):
+        s = sdfc.Scene(path=str(ROOT / "examples" / "mesh" / "bracket.sdf"))
+        with self.assertRaises(RuntimeError) as caught:
+            s.mesh(resolution=100000)
+        message = str(caught.exception)
+        self.assertIn("or more", message)
+        self.assertIn("limits={", message)
+        self.assertNotIn("--", message)
 
 
 class Compile(unittest.TestCase):

@@ -791,7 +791,7 @@ pub fn render_several(
     let (tx, rx) = mpsc::channel();
     let pixels = job.pixels();
     let (mut linear, mut rgba) = match job.finished {
-        true => (Vec::new(), super::zeroed(4 * pixels)),
+        true => (Vec::new(), crate::image::pixel_buffer(4 * pixels)),
         false => (super::zeroed(pixels), Vec::new()),
     };
     let bands = Bands {

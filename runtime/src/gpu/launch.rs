@@ -317,20 +317,31 @@ impl Faults {
 }
 
 /// The tiles of a frame rendered by `devices` devices: squares of `edge` pixels for one,
-/// bands of whole rows for several (at most about `edge`² pixels each, and at least eight per
-/// device, so that a device is not left waiting for another's last band at the end).
+/// bands of whole rows for several (at most about `edge`² pixels each; [`BANDS`] in all, and
+/// at least [`BANDS_PER_DEVICE`] a device, so that a device is not left waiting long for
+/// another's last band at the end).
 pub fn tiling(width: u32, height: u32, edge: u32, devices: usize) -> Vec<Tile> {
     if devices <= 1 {
         return squares(width, height, edge);
     }
     let by_area = (edge.max(8) * edge.max(8) / width.max(1)).max(1);
-    let by_count = height.div_ceil(8 * devices as u32).max(1);
+    let bands = BANDS.max(BANDS_PER_DEVICE * devices as u32);
+    let by_count = height.div_ceil(bands).max(1);
     let rows = by_area.min(by_count);
     (0..height)
         .step_by(rows as usize)
         .map(|y| (0, y, width, rows.min(height - y)))
         .collect()
 }
+
+/// The bands of a frame on several devices, unless [`BANDS_PER_DEVICE`] asks for more. Each
+/// band costs a launch, a wait and a copy out on its device's thread: 7680×4320 stills on
+/// four H200s were faster in 16 bands (four a device) than in 32 (eight a device, the rule
+/// before); two devices had 16 already (BENCHMARKS.md, "Several devices").
+pub const BANDS: u32 = 16;
+
+/// The fewest bands a device of several takes in a frame, on average.
+pub const BANDS_PER_DEVICE: u32 = 4;
 
 /// Splits the image into tiles of at most `edge` pixels a side.
 pub fn squares(width: u32, height: u32, edge: u32) -> Vec<Tile> {
@@ -790,6 +801,8 @@ pub fn render_several(
     let start = Instant::now();
     let (tx, rx) = mpsc::channel();
     let pixels = job.pixels();
+    // The finished pixels go into a buffer an earlier frame handed back when there is one
+    // (every band overwrites its place), its pages in memory already.
     let (mut linear, mut rgba) = match job.finished {
         true => (Vec::new(), crate::image::pixel_buffer(4 * pixels)),
         false => (super::zeroed(pixels), Vec::new()),
@@ -971,7 +984,8 @@ mod tests {
             assert!(t.iter().all(|t| t.0 == 0 && t.2 == w));
             assert_eq!(t.iter().map(|t| t.3).sum::<u32>(), h);
             assert!(t.windows(2).all(|p| p[0].1 + p[0].3 == p[1].1));
-            assert!(t.len() >= (8 * n).min(h as usize), "{w}x{h}: {}", t.len());
+            let fewest = (BANDS_PER_DEVICE as usize * n).min(h as usize);
+            assert!(t.len() >= fewest, "{w}x{h}: {}", t.len());
         }
     }
 

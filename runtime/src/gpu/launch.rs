@@ -1256,6 +1256,24 @@ mod tests {
         assert_eq!(open.take(), None);
     }
 
+    #[test]
+    fn the_first_item_is_seen_without_taking_it() {
+        let q = Queue::new(std::iter::empty::<u32>(), true);
+        std::thread::scope(|s| {
+            // A worker looking before anything is pushed waits for the first item.
+            let looker = s.spawn(|| q.first(|&k| k * 10));
+            std::thread::sleep(Duration::from_millis(20));
+            q.push(3);
+            assert_eq!(looker.join().expect("joins"), Some(30));
+        });
+        // Seen, not taken: it is still there for whichever worker takes it.
+        assert_eq!(q.waiting(), 1);
+        assert_eq!(q.take(), Some(3));
+        q.done();
+        q.close();
+        assert_eq!(q.first(|&k| k), None);
+    }
+
     /// One device whose finished pixels are read back into two slots, started behind the
     /// launches and collected later: a pixel's bytes are its index's; what it did is logged.
     struct Rows {

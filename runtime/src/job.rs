@@ -59,7 +59,7 @@ pub struct Overrides {
     pub set: Vec<String>,
 }
 
-/// What failed on the way from a job to its frames. `Usage`, `Setting`, `Sequence`,
+/// What failed on the way from a job to its frames. `Usage`, `Setting`, `Sequence`, `Sweep`,
 /// `Arguments`, `Io`, `Read` and `--threads 0` end a command with exit code 2, the others
 /// with 1.
 #[derive(Debug, thiserror::Error)]
@@ -70,6 +70,9 @@ pub enum Error {
     /// A setting (`--size`, `--aa`, `--set`) that cannot be read or is out of its range.
     #[error(transparent)]
     Setting(#[from] crate::settings::Error),
+    /// A `--sweep` of `sdfc pareto` that cannot be read, or sweeps above their limits.
+    #[error(transparent)]
+    Sweep(#[from] crate::pareto::Error),
     /// A frame range, shard or sequence output that cannot be used.
     #[error(transparent)]
     Sequence(#[from] crate::sequence::Error),
@@ -200,6 +203,7 @@ impl Error {
             Error::Usage(_)
             | Error::Setting(_)
             | Error::Sequence(_)
+            | Error::Sweep(_)
             | Error::Arguments(_)
             | Error::Io(_)
             | Error::Read(_)

@@ -9,6 +9,81 @@ use crate::metrics::DepthDifference;
 use crate::settings;
 use sdfc_compiler::{diagnostics::scientific, Limit, Limits, Settings};
 
+/// A `--sweep` that cannot be read, or sweeps above their limits: a usage error.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// Not `KEY=…`.
+    #[error("--sweep expects KEY=LO..HI or KEY=V1,V2, like epsilon=1e-2..1e-6, not `{0}`")]
+    Spec(String),
+    /// A setting that is not swept.
+    #[error("cannot sweep `{0}`; the swept settings are epsilon, max_steps, relaxation and aa")]
+    Key(String),
+    /// A value that is not a number.
+    #[error("{key}: `{value}` is not a number")]
+    Number {
+        /// The swept setting.
+        key: &'static str,
+        /// The value given.
+        value: String,
+    },
+    /// A count after `:` out of its range (`raise`: how to raise the `sweep_values` limit).
+    #[error("{key}: the count after `:` must be 1 to {max}, not `{value}`; {raise}")]
+    Count {
+        /// The swept setting.
+        key: &'static str,
+        /// The count given.
+        value: String,
+        /// The `sweep_values` limit.
+        max: usize,
+        /// How to raise it.
+        raise: String,
+    },
+    /// A logarithmic range with a bound that is not positive.
+    #[error("{0}: a range must be of positive numbers")]
+    NotPositive(&'static str),
+    /// A range of more values than the `sweep_values` limit.
+    #[error("{key}: the range {lo}..{hi} has {n} values, more than {max}; {raise}")]
+    Range {
+        /// The swept setting.
+        key: &'static str,
+        /// The range's bounds.
+        lo: f64,
+        /// The range's bounds.
+        hi: f64,
+        /// Its values.
+        n: usize,
+        /// The `sweep_values` limit.
+        max: usize,
+        /// How to raise it.
+        raise: String,
+    },
+    /// A list of more values than the `sweep_values` limit.
+    #[error("{key}: {n} values, more than {max}; {raise}")]
+    Values {
+        /// The swept setting.
+        key: &'static str,
+        /// Its values.
+        n: usize,
+        /// The `sweep_values` limit.
+        max: usize,
+        /// How to raise it.
+        raise: String,
+    },
+    /// More combinations than the `sweep_points` limit.
+    #[error("the sweeps give {count} combinations of settings, more than {max}; {raise}")]
+    Points {
+        /// The combinations.
+        count: u64,
+        /// The `sweep_points` limit.
+        max: u64,
+        /// How to raise it.
+        raise: String,
+    },
+    /// A value the setting refuses.
+    #[error(transparent)]
+    Setting(#[from] settings::Error),
+}
+
 /// A setting that can be swept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Key {
@@ -33,15 +108,13 @@ impl Key {
         }
     }
 
-    fn parse(s: &str) -> Result<Key, String> {
+    fn parse(s: &str) -> Result<Key, Error> {
         match s {
             "epsilon" => Ok(Key::Epsilon),
             "max_steps" => Ok(Key::MaxSteps),
             "relaxation" => Ok(Key::Relaxation),
             "aa" => Ok(Key::Aa),
-            _ => Err(format!(
-                "cannot sweep `{s}`; the swept settings are epsilon, max_steps, relaxation and aa"
-            )),
+            _ => Err(Error::Key(s.into())),
         }
     }
 
@@ -56,8 +129,8 @@ impl Key {
     }
 
     /// Sets the value in `s`, checking its range as `--set` does.
-    pub fn set(self, s: &mut Settings, v: f64, limits: &Limits) -> Result<(), String> {
-        settings::set(s, self.name(), &format!("{v}"), limits).map_err(|e| e.to_string())
+    pub fn set(self, s: &mut Settings, v: f64, limits: &Limits) -> Result<(), settings::Error> {
+        settings::set(s, self.name(), &format!("{v}"), limits)
     }
 
     /// Whether the values are whole numbers.
@@ -91,15 +164,15 @@ pub const DEFAULT_SWEEPS: &[&str] = &[
 /// for epsilon and max_steps, linear otherwise). Values are rounded to three significant
 /// digits (whole numbers for max_steps and aa), duplicates dropped, and each checked as
 /// `--set` checks it (within the default limits; see [`parse_sweep_within`]).
-pub fn parse_sweep(spec: &str) -> Result<Sweep, String> {
+pub fn parse_sweep(spec: &str) -> Result<Sweep, Error> {
     parse_sweep_within(spec, &Limits::default())
 }
 
 /// [`parse_sweep`] with the values checked within `limits`.
-pub fn parse_sweep_within(spec: &str, limits: &Limits) -> Result<Sweep, String> {
-    let (key, rest) = spec.split_once('=').ok_or_else(|| {
-        format!("--sweep expects KEY=LO..HI or KEY=V1,V2, like epsilon=1e-2..1e-6, not `{spec}`")
-    })?;
+pub fn parse_sweep_within(spec: &str, limits: &Limits) -> Result<Sweep, Error> {
+    let (key, rest) = spec
+        .split_once('=')
+        .ok_or_else(|| Error::Spec(spec.into()))?;
     let key = Key::parse(key.trim())?;
     let rest = rest.trim();
     let raw = match rest.split_once("..") {
@@ -111,12 +184,12 @@ pub fn parse_sweep_within(spec: &str, limits: &Limits) -> Result<Sweep, String> 
     };
     let max = limits.count(Limit::SweepValues);
     if raw.len() > max {
-        return Err(format!(
-            "{}: {} values, more than {max}; {}",
-            key.name(),
-            raw.len(),
-            limits.raise_to(Limit::SweepValues, raw.len() as u64)
-        ));
+        return Err(Error::Values {
+            key: key.name(),
+            n: raw.len(),
+            max,
+            raise: limits.raise_to(Limit::SweepValues, raw.len() as u64),
+        });
     }
     let mut values: Vec<f64> = Vec::new();
     for v in raw.into_iter().map(|v| round(key, v)) {
@@ -128,26 +201,29 @@ pub fn parse_sweep_within(spec: &str, limits: &Limits) -> Result<Sweep, String> 
     Ok(Sweep { key, values })
 }
 
-fn number(key: Key, v: &str) -> Result<f64, String> {
+fn number(key: Key, v: &str) -> Result<f64, Error> {
     match v.trim().parse::<f64>() {
         Ok(x) if x.is_finite() => Ok(x),
-        _ => Err(format!("{}: `{}` is not a number", key.name(), v.trim())),
+        _ => Err(Error::Number {
+            key: key.name(),
+            value: v.trim().into(),
+        }),
     }
 }
 
 /// The values of `lo..hi[:n]` for `key`.
-fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, String> {
+fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, Error> {
     let max = limits.count(Limit::SweepValues);
     let (hi, count) = match hi.split_once(':') {
         Some((h, n)) => match n.trim().parse::<usize>() {
             Ok(n) if (1..=max).contains(&n) => (h, Some(n)),
             _ => {
-                return Err(format!(
-                    "{}: the count after `:` must be 1 to {max}, not `{}`; {}",
-                    key.name(),
-                    n.trim(),
-                    limits.raise(Limit::SweepValues)
-                ))
+                return Err(Error::Count {
+                    key: key.name(),
+                    value: n.trim().into(),
+                    max,
+                    raise: limits.raise(Limit::SweepValues),
+                })
             }
         },
         None => (hi, None),
@@ -155,10 +231,7 @@ fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, Stri
     let (lo, hi) = (number(key, lo)?, number(key, hi)?);
     let log = matches!(key, Key::Epsilon | Key::MaxSteps);
     if log && (lo <= 0.0 || hi <= 0.0) {
-        return Err(format!(
-            "{}: a range must be of positive numbers",
-            key.name()
-        ));
+        return Err(Error::NotPositive(key.name()));
     }
     let n = count.unwrap_or_else(|| match key {
         Key::Epsilon => (2.0 * (hi / lo).log10().abs()).round() as usize + 1,
@@ -167,11 +240,14 @@ fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, Stri
         Key::Aa => (hi - lo).abs().round() as usize + 1,
     });
     if n > max {
-        return Err(format!(
-            "{}: the range {lo}..{hi} has {n} values, more than {max}; {}",
-            key.name(),
-            limits.raise_to(Limit::SweepValues, n as u64)
-        ));
+        return Err(Error::Range {
+            key: key.name(),
+            lo,
+            hi,
+            n,
+            max,
+            raise: limits.raise_to(Limit::SweepValues, n as u64),
+        });
     }
     let at = |i: usize| {
         let f = if n == 1 {
@@ -206,17 +282,18 @@ pub fn combinations(
     base: &Settings,
     sweeps: &[Sweep],
     limits: &Limits,
-) -> Result<Vec<Settings>, String> {
+) -> Result<Vec<Settings>, Error> {
     // Counted before any is built: the product of a few sweeps grows fast.
     let count = sweeps
         .iter()
         .fold(1u64, |n, s| n.saturating_mul(s.values.len() as u64));
     let max = limits.get(Limit::SweepPoints);
     if count > max {
-        return Err(format!(
-            "the sweeps give {count} combinations of settings, more than {max}; {}",
-            limits.raise_to(Limit::SweepPoints, count)
-        ));
+        return Err(Error::Points {
+            count,
+            max,
+            raise: limits.raise_to(Limit::SweepPoints, count),
+        });
     }
     let mut out = vec![base.clone()];
     for sweep in sweeps {

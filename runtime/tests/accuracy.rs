@@ -242,9 +242,12 @@ fn bad_sweeps_are_refused() {
         ("max_steps=32..64:0", "count"),
         ("aa=0,1", "aa must be"),
     ] {
-        let e = parse_sweep(spec).expect_err(spec);
+        let e = parse_sweep(spec).expect_err(spec).to_string();
         assert!(e.contains(needle), "{spec}: {e}");
     }
+    // A value the setting refuses is the setting's error, as `--set` gives it.
+    let refused = parse_sweep("aa=0,1").expect_err("aa 0");
+    assert!(matches!(refused, pareto::Error::Setting(_)), "{refused:?}");
 }
 
 #[test]

@@ -106,23 +106,19 @@ pub fn run(args: ParetoArgs) -> ExitCode {
     if scene.settings.method == Method::Auto {
         scene.settings.method = Method::March;
     }
-    let plan = check_output(args.output.as_deref())
-        .and_then(|()| job.settings(&mut scene).map_err(|e| e.to_string()))
-        .and_then(|()| {
-            specs
-                .iter()
-                .map(|s| parse_sweep_within(s, limits))
-                .collect::<Result<Vec<_>, _>>()
-        })
-        .and_then(|sweeps| combinations(&scene.settings, &sweeps, limits))
-        .and_then(|points| {
-            job.pool()
-                .map(|pool| (points, pool))
-                .map_err(|e| e.to_string())
-        });
-    let (points, pool) = match plan {
+    let mut plan = || -> Result<_, Error> {
+        check_output(args.output.as_deref()).map_err(Error::Usage)?;
+        job.settings(&mut scene)?;
+        let sweeps = specs
+            .iter()
+            .map(|s| parse_sweep_within(s, limits))
+            .collect::<Result<Vec<_>, _>>()?;
+        let points = combinations(&scene.settings, &sweeps, limits)?;
+        Ok((points, job.pool()?))
+    };
+    let (points, pool) = match plan() {
         Ok(p) => p,
-        Err(msg) => return Error::Usage(msg).exit(),
+        Err(e) => return e.exit(),
     };
     let lowered = match job.lower(&scene, &loaded.sources, &LowerOptions::default()) {
         Ok(p) => p,

@@ -155,6 +155,11 @@ pub fn candidates(
 /// Relative slack of the radii in [`candidates_at_least`], for the rounding of the distances.
 const BALL_SLACK: f64 = 1e-6;
 
+/// The most balls [`candidates_at_least`] sorts into rows (16 bytes each); beyond (a fine
+/// level, whose sorting would cost about as much as its evaluation) it counts them by slices
+/// alone.
+const ROWS_SORTED: usize = 1 << 16;
+
 /// Grid columns of a disc of radius `r` cells about a cell corner of the grid, at least: the
 /// column centres (at half-integers of it) strictly inside the square inscribed in the disc,
 /// of half side `r / √2`, `2k` along each side where `k` counts the `m + ½ < r / √2`.
@@ -176,7 +181,8 @@ fn columns_within(r: f64) -> u64 {
 /// centres of one row of this level along the axis have one disc as their shadow, that of
 /// the largest, which within half the level's edge lies in the row's square: the rows'
 /// columns are distinct. So each axis gives twice the sum over rows of the columns of the
-/// largest disc (within half an edge), and the bound is the largest of the three.
+/// largest disc (within half an edge), or, counted in one pass, over the cells of one slice
+/// across the axis (one per row); the bound is the largest of these.
 pub fn candidates_at_least(
     cells: &[[u32; 3]],
     d: &[f64],
@@ -188,31 +194,62 @@ pub fn candidates_at_least(
     // Radii in grid cells, within half the level's edge.
     let cap = 0.5 * size as f64;
     let radius = |d: f64| (-d * (1.0 - BALL_SLACK) / (lipschitz * voxel) - BALL_SLACK).min(cap);
-    let inside = || {
-        cells
-            .iter()
-            .zip(d)
-            .filter(|(_, &d)| d < 0.0)
-            .map(|(c, &d)| (c, radius(d)))
-            .filter(|&(_, r)| columns_within(r) > 0)
-    };
+    let lines = |d: f64| 2 * columns_within(radius(d));
+    // One pass: the lines of every ball, and by slices across each axis (the cells of one
+    // slice lie in distinct rows along it), where there are no more slices than cells: their
+    // sums then take at most the 24 bytes a cell that the octree's memory bound leaves free
+    // while a level is evaluated ([`BYTES_PER_OCTREE_CELL`]).
+    let slices = cells.iter().flatten().max().map_or(0, |&m| m as usize + 1);
+    let slices = if slices <= cells.len() { slices } else { 0 };
+    let mut sums = [(); 3].map(|_| vec![0u64; slices]);
+    let (mut unshared, mut balls) = (0u64, 0usize);
+    for (c, &d) in cells.iter().zip(d) {
+        if !(d < 0.0) {
+            continue;
+        }
+        let n = lines(d);
+        if n == 0 {
+            continue;
+        }
+        unshared += n;
+        balls += 1;
+        if slices > 0 {
+            for (axis, sum) in sums.iter_mut().enumerate() {
+                sum[c[axis] as usize] += n;
+            }
+        }
+    }
     // Without sharing rows: when even that stays within, so does the bound.
-    let unshared: u64 = inside().map(|(_, r)| 2 * columns_within(r)).sum();
     if unshared <= within {
         return 0;
     }
-    let mut best = 0u64;
-    let mut rows: Vec<(u64, f64)> = Vec::new();
+    let mut best = sums
+        .iter()
+        .map(|s| s.iter().copied().max().unwrap_or(0))
+        .max()
+        .unwrap_or(0);
+    drop(sums);
+    // The largest ball of each row, where the balls are few enough to sort.
+    if best > within || balls > ROWS_SORTED {
+        return best;
+    }
+    let mut rows: Vec<(u64, f64)> = Vec::with_capacity(balls);
     for axis in 0..3 {
         rows.clear();
-        rows.extend(inside().map(|(c, r)| {
-            let (u, v) = (c[(axis + 1) % 3] as u64, c[(axis + 2) % 3] as u64);
-            (u | v << 32, r)
-        }));
+        rows.extend(
+            cells
+                .iter()
+                .zip(d)
+                .filter(|&(_, &d)| d < 0.0 && lines(d) > 0)
+                .map(|(c, &d)| {
+                    let (u, v) = (c[(axis + 1) % 3] as u64, c[(axis + 2) % 3] as u64);
+                    (u | v << 32, radius(d))
+                }),
+        );
         rows.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
         rows.dedup_by_key(|row| row.0);
-        let lines: u64 = rows.iter().map(|&(_, r)| 2 * columns_within(r)).sum();
-        best = best.max(lines);
+        let sum: u64 = rows.iter().map(|&(_, r)| 2 * columns_within(r)).sum();
+        best = best.max(sum);
     }
     best
 }

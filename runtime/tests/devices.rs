@@ -150,17 +150,29 @@ fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
         let workers: [&dyn Worker; 2] = [&on_cpu, &ka];
         let none = gpu::launch::Faults::default();
         let data = kernel.data.as_deref();
-        let mixed = gpu::render_several(
-            &workers,
-            &scene,
-            (l, Some(&kernel.contract.uniform), data),
-            (&none, true, false),
-            &mut |_| {},
-        )
-        .expect("cpu and lavapipe");
+        // Which device takes which band depends on the threads' timing: a device may take
+        // every band before the other starts. The render is repeated, up to five times, until
+        // both devices rendered bands; that render must agree with lavapipe's.
+        let render = || {
+            gpu::render_several(
+                &workers,
+                &scene,
+                (l, Some(&kernel.contract.uniform), data),
+                (&none, true, false),
+                &mut |_| {},
+            )
+            .expect("cpu and lavapipe")
+        };
+        let mut mixed = render();
+        for _ in 1..5 {
+            if mixed.shares.iter().all(|s| s.tiles > 0) {
+                break;
+            }
+            mixed = render();
+        }
         assert!(
             mixed.shares.iter().all(|s| s.tiles > 0),
-            "{name}: both rendered"
+            "{name}: both rendered in one of five renders"
         );
         let d = metrics::compare(&one.render.image, &mixed.render.image, 0.1).expect("same size");
         println!(

@@ -805,7 +805,7 @@ pub fn render_several(
     // (every band overwrites its place), its pages in memory already.
     let (mut linear, mut rgba) = match job.finished {
         true => (Vec::new(), crate::image::pixel_buffer(4 * pixels)),
-        false => (super::zeroed(pixels), Vec::new()),
+        false => (crate::image::zeroed(pixels), Vec::new()),
     };
     let bands = Bands {
         job,

@@ -317,7 +317,7 @@ fn reduce_bytes(pixels: u64) -> u64 {
 /// Copies `src` into `dst` (of the same length) on every core of the current thread pool: a
 /// frame's pixels are copied into memory allocated for them, whose pages the first writes
 /// fault in, which on one core holds the copy to about a gigabyte a second (BENCHMARKS.md,
-/// "Several devices"; [`zeroed`] asks for fewer, larger pages).
+/// "Several devices"; [`crate::image::zeroed`] asks for fewer, larger pages).
 pub(crate) fn copy_parallel<T: Copy + Send + Sync>(dst: &mut [T], src: &[T]) {
     use rayon::prelude::*;
     // A mebibyte a task: a 1920×1080 frame's 8 MB wakes 8 threads, not every core; on a host
@@ -331,45 +331,11 @@ pub(crate) fn copy_parallel<T: Copy + Send + Sync>(dst: &mut [T], src: &[T]) {
 
 /// `src` copied by [`copy_parallel`] into a buffer of finished pixels from the pool of
 /// [`crate::image::pixel_buffer`] (one an earlier frame handed back, its pages in memory
-/// already, when there is one; else a new one, [`zeroed`]).
+/// already, when there is one; else a new one, [`crate::image::zeroed`]).
 pub(crate) fn to_vec_parallel(src: &[u8]) -> Vec<u8> {
     let mut out = crate::image::pixel_buffer(src.len());
     copy_parallel(&mut out, src);
     out
-}
-
-/// A new vector of `len` zeroed elements for a frame's pixels, its memory asked for in huge
-/// pages (Linux's transparent huge pages, `MADV_HUGEPAGE`) where it is large: the memory is
-/// mapped untouched, and the first copy into it faults it in a page at a time, a 7680×4320
-/// image's 133 MB in 32 400 pages of 4 KiB or 64 of 2 MiB. Elsewhere, or where the system
-/// gives no huge pages, the pages are the small ones.
-pub(crate) fn zeroed<T: Clone + Default>(len: usize) -> Vec<T> {
-    let mut out = vec![T::default(); len];
-    huge_pages(&mut out);
-    out
-}
-
-/// Advises the kernel to back `memory`'s whole huge pages with huge pages (nothing for less
-/// than a few of them, nor off Linux).
-#[allow(unsafe_code)] // madvise: a hint about the pages of memory this function borrows.
-fn huge_pages<T>(memory: &mut [T]) {
-    #[cfg(target_os = "linux")]
-    {
-        const HUGE: usize = 2 << 20;
-        let start = memory.as_mut_ptr() as usize;
-        let end = start + std::mem::size_of_val(memory);
-        let (from, to) = (start.next_multiple_of(HUGE), end / HUGE * HUGE);
-        if to >= from + 4 * HUGE {
-            // SAFETY: [from, to) lies within `memory`, borrowed mutably here; the advice
-            // changes how its pages are backed, never their contents, and the kernel may
-            // ignore it (its result is not needed).
-            unsafe {
-                libc::madvise(from as *mut libc::c_void, to - from, libc::MADV_HUGEPAGE);
-            }
-        }
-    }
-    #[cfg(not(target_os = "linux"))]
-    let _ = memory;
 }
 
 /// The bytes of a finished GPU frame: its image.

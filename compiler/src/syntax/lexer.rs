@@ -314,12 +314,8 @@ fn unescape(raw: &str, offset: usize, file: FileId) -> (String, Vec<Diagnostic>)
 }
 
 fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnostic {
+    // (A quote is never an error here: it is a token, and `lex` scans its string.)
     let slice = &text[range.clone()];
-    if slice.starts_with('"') {
-        return Diagnostic::error("E0002", "unterminated string literal", span)
-            .with_label("this string has no closing quote on its line")
-            .with_help("strings end with `\"` on the same line");
-    }
     if slice.starts_with(|c: char| c.is_ascii_digit()) {
         return Diagnostic::error("E0004", format!("invalid number literal `{slice}`"), span)
             .with_label("not a valid number")

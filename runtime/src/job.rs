@@ -482,16 +482,20 @@ pub fn prepare_here(
 /// What a prepared scene's frames are held to the `memory` limit for ([`check_memory`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Use {
-    /// Rendered at the scene's settings and written (`sdfc render`, sequences, `bench`,
-    /// Python): the render, the finished frame held while its outputs are written, and with
-    /// `reference` the reference's convergence check, with `aux` the depth sidecar
-    /// ([`memory::render`]).
+    /// Rendered at the scene's settings and written (`sdfc render`, sequences, those of
+    /// `bench --frames-per-second`, Python): the render, the finished frame held while its
+    /// outputs are written, and with `reference` the reference's convergence check, with
+    /// `aux` the depth sidecar ([`memory::render`]).
     Written {
         /// `--reference`.
         reference: bool,
         /// `--aux`.
         aux: bool,
     },
+    /// Rendered at the scene's settings frame after frame, a finished frame held while the
+    /// next renders (`sdfc bench`, which keeps its warm-up frame's statistics through the
+    /// timed frames): the render and the frame held ([`memory::held`]).
+    Held,
     /// Shown in a view of `width` × `height` pixels, whatever size the scene's settings
     /// state, one sample a frame (the viewer's window, which accumulates the samples where
     /// they are rendered): the frame's render alone.
@@ -538,6 +542,7 @@ pub fn check_memory_here(
             scene.settings.clone(),
             memory::render(prepared, scene, reference, aux),
         ),
+        Use::Held => (scene.settings.clone(), memory::held(prepared, scene)),
         Use::Shown { width, height } => {
             let mut at = scene.settings.clone();
             (at.width, at.height, at.aa) = (width, height, 1);
@@ -653,6 +658,7 @@ impl<'a> Kernels<'a> {
 mod tests {
     use super::*;
     use crate::backend::Device;
+    use sdfc_compiler::Limit;
 
     #[test]
     fn the_reference_renders_on_the_cpu_in_f64_and_refuses_gpus() {
@@ -848,6 +854,46 @@ mod tests {
         // On the device the scene before was prepared on, not another opened.
         let device = |r: &Ready| r.prepared.as_wgpu().expect("wgpu").gpu.clone();
         assert!(Arc::ptr_eq(&device(&first), &device(&other)));
+    }
+
+    /// `sdfc bench` holds its warm-up frame while the timed ones render: [`Use::Held`] counts
+    /// that frame beside the render, so a limit the render alone fits refuses it.
+    #[test]
+    fn a_frame_held_while_the_next_renders_is_counted() {
+        let mut source = Source::from_text(
+            "held.sdf",
+            "render { width: 640, height: 480, aa: 1, method: \"march\" }\n\
+             scene { sphere(1); }\n"
+                .to_string(),
+        );
+        let job = Job {
+            backend: Backend::Cpu,
+            quiet: true,
+            ..Job::default()
+        };
+        let frame = job
+            .frame(&mut source, 0.0, false, &LowerOptions::default())
+            .expect("the scene");
+        let on = (Backend::Cpu, &Devices::Auto);
+        let ready = prepare_here(on, frame, &job.setup(), Open::Backend).expect("prepared");
+        let (scene, prepared) = (&ready.scene, &ready.prepared);
+        let s = &scene.settings;
+        let (render, held) = (prepared.memory(scene, s), prepared.retained(s));
+        assert_eq!(memory::held(prepared, scene).host, render.host + held);
+        let alone = memory::mib(render.total());
+        let both = memory::mib(render.total() + held);
+        assert!(both > alone, "{alone} MiB, {both} MiB with the frame held");
+        let mut limits = Limits::default();
+        limits.set(Limit::Memory, alone).expect("a limit");
+        let shown = Use::Shown {
+            width: s.width,
+            height: s.height,
+        };
+        assert!(check_memory_here(prepared, scene, shown, &limits, false).is_ok());
+        match check_memory_here(prepared, scene, Use::Held, &limits, false) {
+            Err(Error::Memory(e)) => assert_eq!((e.needed, e.limit), (both, alone)),
+            other => panic!("held to {alone} MiB: {other:?}"),
+        }
     }
 
     #[test]

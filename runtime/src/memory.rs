@@ -111,6 +111,18 @@ pub fn render(prepared: &impl Footprint, scene: &Scene, reference: bool, aux: bo
     }
 }
 
+/// The most frames of `scene` rendered one after another on `prepared` allocate when a
+/// finished frame is held while the next renders (`sdfc bench`, which keeps its warm-up
+/// frame's statistics): the render and the frame held.
+pub fn held(prepared: &impl Footprint, scene: &Scene) -> Memory {
+    let s = &scene.settings;
+    let frame = prepared.memory(scene, s);
+    Memory {
+        host: frame.host.saturating_add(prepared.retained(s)),
+        device: frame.device,
+    }
+}
+
 /// The announcement before a render: `render: 1920x1080, aa 4, cpu: allocating at most 96 MiB`.
 pub fn announce(settings: &Settings, backend: &str, memory: &Memory) -> String {
     format!(

@@ -2,12 +2,12 @@
 //! for GPU targets the achieved fraction of the FP32 floor).
 
 use super::JobArgs;
-use crate::backend::{Backend, Prepared, Setup};
+use crate::backend::Setup;
 use crate::cpu::{Precision, Stats};
 use crate::fp32;
 use crate::frontend;
-use crate::job::{self, Error, Job, Kernels};
-use sdfc_compiler::{LowerOptions, Lowered, Scene};
+use crate::job::{self, Error, FrameScene, Job, Kernels, Open, Ready, Use};
+use sdfc_compiler::LowerOptions;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -200,7 +200,7 @@ fn run_sequences(args: &BenchArgs) -> Result<Vec<SequenceTiming>, Error> {
             let (scene, prepared) = kernels.prepare(frame)?;
             let t2 = Instant::now();
             if k == frames.start {
-                job::check_memory(&pool, prepared, &scene, job::Use::IMAGE, &job.limits, false)?;
+                job::check_memory(&pool, prepared, &scene, Use::IMAGE, &job.limits, false)?;
             }
             let image = pool.install(|| prepared.render(&scene, &|_| {}))?;
             size = (image.render.image.width, image.render.image.height);
@@ -325,8 +325,8 @@ pub fn run(args: BenchArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// Times one scene file: read, checked, its settings applied and lowered as a still, then
-/// [`time_scene`].
+/// Times one scene file: read, checked, its settings applied and lowered as a still
+/// ([`Job::frame`]), then [`time_scene`].
 fn time_file(
     args: &BenchArgs,
     job: &Job,
@@ -334,45 +334,38 @@ fn time_file(
     file: &std::path::Path,
 ) -> Result<Timing, Error> {
     let mut source = frontend::Source::read(file)?;
-    let mut loaded = source.check(&job.limits, 0.0);
-    let scene = job.scene(&mut loaded, true)?;
-    let lowered = job.lower(&scene, &loaded.sources, &LowerOptions::default())?;
+    let frame = job.frame(&mut source, 0.0, true, &LowerOptions::default())?;
     let name = file.display().to_string();
-    pool.install(|| time_scene(args, job, name, &scene, lowered))
+    pool.install(|| time_scene(args, job, name, frame))
 }
 
-/// Renders one warm-up frame and `frames` timed frames, within the memory limit. GPU backends
-/// are timed on the device (timestamps or events); the CPU by the wall clock.
+/// Prepares `frame` through the job's path ([`job::prepare_here`]), holds it to the memory
+/// limit with a frame held while the next renders ([`Use::Held`]), then renders one warm-up
+/// frame and `frames` timed frames. GPU backends are timed on the device (timestamps or
+/// events); the CPU by the wall clock.
 fn time_scene(
     args: &BenchArgs,
     job: &Job,
     name: String,
-    scene: &Scene,
-    lowered: Lowered,
+    frame: FrameScene,
 ) -> Result<Timing, Error> {
-    let ops_per_eval = fp32::distance_ops(&lowered.program);
-    let guarded = !lowered.program.blocks().is_empty();
+    let ops_per_eval = fp32::distance_ops(&frame.lowered.program);
+    let guarded = !frame.lowered.program.blocks().is_empty();
     let setup = Setup {
         parameters: args.constants == Some(Constants::Parameters),
         // The image is not kept: the GPU finishes it, and only its 8-bit pixels cross.
         finished: true,
         ..job.setup()
     };
-    if job.backend != Backend::Cpu {
-        let options = sdfc_compiler::wgsl::Options {
-            kernel: setup.kernel,
-            ..Default::default()
-        };
-        sdfc_compiler::wgsl::choose(scene, &lowered, &options)
-            .map_err(crate::backend::Error::Unsupported)?;
-    }
-    let mut prepared = Prepared::on_devices(job.backend, &job.devices, scene, lowered, &setup)?;
-    // The last frame is held while the next one renders.
-    let mut frame = prepared.memory(scene, &scene.settings);
-    frame.host = frame
-        .host
-        .saturating_add(prepared.retained(&scene.settings));
-    frame.check(&job.limits).map_err(Error::Memory)?;
+    let on = (job.backend, &job.devices);
+    let Ready {
+        scene,
+        mut prepared,
+        ..
+    } = job::prepare_here(on, frame, &setup, Open::Backend)?;
+    // The warm-up frame is held while the timed ones render.
+    job::check_memory_here(&prepared, &scene, Use::Held, &job.limits, false)?;
+    let scene = &scene;
     // The warm-up frame's statistics are those printed (every frame has the same); the
     // timed frames read back their pixels alone, as `sdfc render` and sequences do.
     let warm = prepared.render(scene, &|_| {})?;

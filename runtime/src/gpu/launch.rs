@@ -642,8 +642,18 @@ pub struct Bands<'a> {
     /// Each band's place in the image, written by the worker that collects it (again by
     /// another, if the first failed before the band was accepted).
     places: Vec<Mutex<Place<'a>>>,
-    events: mpsc::Sender<usize>,
+    events: mpsc::Sender<Event>,
     rounds: Option<Rounds>,
+}
+
+/// What a worker tells the calling thread of [`render_several`].
+#[derive(Debug, Clone, Copy)]
+enum Event {
+    /// A band is in its place in the image.
+    Band,
+    /// The worker has ended (every band taken, or its device failed): the calling thread
+    /// waits for these, not polls, so a frame ends as soon as its last worker does.
+    Ended,
 }
 
 /// Collecting a band a device rendered, on its worker's thread.
@@ -673,7 +683,7 @@ trait Accept: Device {
             .saturating_sub(collected.wait + collected.convert);
         share.phases.convert += collected.convert;
         share.tiles += 1;
-        let _ = bands.events.send(band);
+        let _ = bands.events.send(Event::Band);
         bands.queue.done();
         Ok(())
     }
@@ -826,7 +836,7 @@ pub fn render_several(
             .map(|(i, d)| {
                 let work = move || {
                     let run = std::panic::AssertUnwindSafe(|| d.work(bands, i));
-                    std::panic::catch_unwind(run).unwrap_or_else(|_| {
+                    let share = std::panic::catch_unwind(run).unwrap_or_else(|_| {
                         // Its band is lost: the frame cannot be finished.
                         bands.queue.abandon();
                         if let Some(r) = &bands.rounds {
@@ -838,32 +848,29 @@ pub fn render_several(
                             phases: Phases::default(),
                             failure: Some("its worker panicked".into()),
                         }
-                    })
+                    });
+                    let _ = bands.events.send(Event::Ended);
+                    share
                 };
                 (i, scope.spawn(work))
             })
             .collect();
-        // The workers put the bands in their places; the calling thread counts them.
-        let mut receive = |_band: usize| {
-            done += 1;
-            progress(done as f64 / job.tiles.len().max(1) as f64);
-        };
-        let mut shares: Vec<(usize, Share)> = Vec::new();
-        // Every band is finished or abandoned once the workers have ended.
-        let mut pending = handles;
-        loop {
-            while let Ok(e) = rx.try_recv() {
-                receive(e);
-            }
-            if pending.iter().all(|(_, h)| h.is_finished()) {
-                break;
-            }
-            match rx.recv_timeout(Duration::from_millis(5)) {
-                Ok(e) => receive(e),
-                Err(_) => continue,
+        // The workers put the bands in their places; the calling thread counts them, and
+        // the workers' ends, until every worker has ended (each says so last, panicked or
+        // not, so the count is reached).
+        let mut ended = 0;
+        while ended < devices.len() {
+            match rx.recv() {
+                Ok(Event::Band) => {
+                    done += 1;
+                    progress(done as f64 / job.tiles.len().max(1) as f64);
+                }
+                Ok(Event::Ended) => ended += 1,
+                Err(_) => break,
             }
         }
-        for (i, h) in pending.drain(..) {
+        let mut shares: Vec<(usize, Share)> = Vec::new();
+        for (i, h) in handles {
             let share = h.join().unwrap_or_else(|_| Share {
                 device: devices[i].name(),
                 tiles: 0,
@@ -871,9 +878,6 @@ pub fn render_several(
                 failure: Some("its worker panicked".into()),
             });
             shares.push((i, share));
-        }
-        while let Ok(e) = rx.try_recv() {
-            receive(e);
         }
         shares.sort_by_key(|(i, _)| *i);
         shares.into_iter().map(|(_, s)| s).collect::<Vec<_>>()

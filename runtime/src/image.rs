@@ -88,8 +88,7 @@ impl Rgba8 {
 /// Buffers of finished pixels that frames no longer need, kept for the next frames of the
 /// same size (a sequence's, a benchmark's): a new buffer of a frame's size is memory the
 /// system maps and faults in page by page at its first write, and gives back when it is
-/// freed, which took most of a 1920×1080 frame's host time (BENCHMARKS.md, "The render
-/// path"). At most [`SPARE_COUNT`] buffers and [`SPARE_BYTES`] bytes are kept.
+/// freed, which took most of a 1920×1080 frame's host time. At most [`SPARE_COUNT`] buffers and [`SPARE_BYTES`] bytes are kept.
 static SPARE: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
 
 /// The most buffers [`SPARE`] keeps.

@@ -199,8 +199,7 @@ impl Setup {
 
     /// This setup on a CUDA device, where `--kernel auto` is the specialised kernel: the
     /// driver's JIT compiles even the largest marched programs as code within seconds, while
-    /// the interpreted kernel's frames are many times slower (BENCHMARKS.md, "Interpreted
-    /// against specialised").
+    /// the interpreted kernel's frames are many times slower.
     fn on_cuda(&self) -> Setup {
         self.specialised_for_auto()
     }

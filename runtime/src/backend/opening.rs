@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 /// Restricts the CUDA driver of this process to the GPUs a render with `backend` on
 /// `devices` opens ([`gpu::cuda::only_devices`]): device 0 for `--devices auto`, the GPUs of
 /// a list; `all` opens every one. A CUDA context then costs its own GPU's initialisation, not
-/// every GPU's of the host (BENCHMARKS.md, "The first second"). Nothing for wgpu and the
+/// every GPU's of the host. Nothing for wgpu and the
 /// CPU. Call it before any thread starts.
 pub fn see_only(backend: Backend, devices: &Devices) {
     if !matches!(backend, Backend::Cuda | Backend::Auto) {
@@ -37,7 +37,7 @@ pub fn see_only(backend: Backend, devices: &Devices) {
 /// The device of a render being opened on a thread of its own ([`Opening::start`], as soon as
 /// the arguments name the backend) while the scene is read, checked and lowered and its kernel
 /// written: opening a device is most of the first second of `sdfc render` that is not the
-/// driver's floor (BENCHMARKS.md, "The first second"). [`Prepared::opened`] joins it where
+/// driver's floor. [`Prepared::opened`] joins it where
 /// the device is needed. Dropped unjoined (a scene with errors), the thread is left to finish
 /// or to end with the process.
 #[derive(Debug)]

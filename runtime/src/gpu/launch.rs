@@ -335,9 +335,9 @@ pub fn tiling(width: u32, height: u32, edge: u32, devices: usize) -> Vec<Tile> {
 }
 
 /// The bands of a frame on several devices, unless [`BANDS_PER_DEVICE`] asks for more. Each
-/// band costs a launch, a wait and a copy out on its device's thread: 7680×4320 stills on
-/// four H200s were faster in 16 bands (four a device) than in 32 (eight a device, the rule
-/// before); two devices had 16 already (BENCHMARKS.md, "Several devices").
+/// band costs a launch, a wait and a copy out on its device's thread, so fewer bands cost
+/// less, while more bands let a device that finishes early take work from one that does
+/// not: on four devices, four bands a device measured faster than eight.
 pub const BANDS: u32 = 16;
 
 /// The fewest bands a device of several takes in a frame, on average.

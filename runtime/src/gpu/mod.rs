@@ -48,7 +48,7 @@ pub(crate) fn cache_file(kind: &str, key: &impl std::hash::Hash, ext: &str) -> O
 
 /// Tile edge in pixels for GPU launches: a 1920×1080 frame is one launch, a 7680×4320 one
 /// twelve. Every launch waits for its slowest rays, so the fewer launches a frame takes, the
-/// less of the GPU idles in their tails (BENCHMARKS.md, "Measured choices"). A 2048×2048
+/// less of the GPU idles in their tails. A 2048×2048
 /// dispatch of the slowest example still lasts well under a display driver's watchdog
 /// (about 2 s).
 pub const TILE: u32 = 2048;
@@ -321,8 +321,7 @@ fn reduce_bytes(pixels: u64) -> u64 {
 pub(crate) fn copy_parallel<T: Copy + Send + Sync>(dst: &mut [T], src: &[T]) {
     use rayon::prelude::*;
     // A mebibyte a task: a 1920×1080 frame's 8 MB wakes 8 threads, not every core; on a host
-    // of many cores waking them all costs more than the copy (BENCHMARKS.md, "Measured
-    // choices").
+    // of many cores waking them all costs more than the copy.
     let chunk = (1 << 20) / std::mem::size_of::<T>().max(1);
     dst.par_chunks_mut(chunk)
         .zip(src.par_chunks(chunk))

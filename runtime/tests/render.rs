@@ -810,3 +810,31 @@ fn a_profile_formula_renders_as_the_profile_it_spells() {
         assert!(d.psnr < 40.0, "{precision:?}: {d:?}");
     }
 }
+
+/// The fraction of `image`'s pixels that are not the background.
+fn coverage(image: &sdfc_runtime::image::Image, background: [f64; 3]) -> f64 {
+    let off = |c: &[f32; 3]| (0..3).any(|i| (f64::from(c[i]) - background[i]).abs() > 0.02);
+    image.linear.iter().filter(|c| off(c)).count() as f64 / image.linear.len() as f64
+}
+
+/// A marched surface 73 units away, within the default `max_dist` of 100, is seen on every
+/// backend: the first over-relaxed step (ω·73 > 100) crosses `max_dist`, and only a step the
+/// march has verified may end the ray as a miss (docs/rendering.md, "Marching").
+#[test]
+fn a_surface_near_max_dist_is_not_lost_to_a_relaxed_step() {
+    let text = "camera { position: (0, 0, -74), look_at: (0, 0, 0), fov: 3deg }\n\
+                render { width: 32, height: 24, method: \"march\" }\n\
+                scene { sphere(1).round(0.01); }";
+    let (scene, diags, _) = sdfc_compiler::check_str("far.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    assert!(scene.settings.relaxation > 1.0 && scene.settings.max_dist == 100.0);
+    for (backend, image) in render_everywhere("far sphere", &scene) {
+        let c = coverage(&image, scene.settings.background);
+        println!("{backend}: {:.1} % of pixels on the sphere", 100.0 * c);
+        assert!(
+            c > 0.15,
+            "{backend}: the sphere covers {:.3} of the picture",
+            c
+        );
+    }
+}

@@ -1641,7 +1641,29 @@ pub static BUILTINS: &[Builtin] = &[
             [p("x", F, Req, Within(-9.0e15, 9.0e15))] -> I => |_, a| Ok(Value::Int(a[0].num().floor() as i64));
         ],
     },
+    Builtin {
+        name: "div",
+        sigs: sigs![
+            [p("a", I, Req, Any), p("b", I, Req, Any)] -> I => |_, a| match (&a[0], &a[1]) {
+                (Value::Int(_), Value::Int(0)) => Err("division by zero: `b` is 0".to_string()),
+                (Value::Int(x), Value::Int(y)) => floor_div(*x, *y)
+                    .map(Value::Int)
+                    .ok_or_else(|| format!("integer overflow in `div({x}, {y})`")),
+                _ => Ok(Value::Error),
+            };
+        ],
+    },
 ];
+
+/// `a / b` rounded down (towards −∞, as Python's `//`), or `None` on overflow; `b` ≠ 0.
+fn floor_div(a: i64, b: i64) -> Option<i64> {
+    let q = a.checked_div(b)?;
+    Some(if a % b != 0 && (a < 0) != (b < 0) {
+        q - 1
+    } else {
+        q
+    })
+}
 
 /// Looks a builtin up by name.
 pub fn builtin(name: &str) -> Option<&'static Builtin> {

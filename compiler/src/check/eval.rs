@@ -341,10 +341,13 @@ impl Ctx<'_> {
                 Err(())
             }
             other => {
-                cx.error(
+                let mut d =
                     Diagnostic::error("E0300", "the bounds of a range must be `int`", e.span)
-                        .with_label(format!("this is `{}`", type_name(&other))),
-                );
+                        .with_label(format!("this is `{}`", type_name(&other)));
+                if other.ty() == Some(Type::Float) {
+                    d = d.with_help(WHOLE_NUMBER_HELP);
+                }
+                cx.error(d);
                 Err(())
             }
         };
@@ -421,7 +424,7 @@ impl Ctx<'_> {
                 )
                 .with_label(format!("this is `{t}`"));
                 if t == Type::Float {
-                    d = d.with_help("use a whole number, or `int(x)`");
+                    d = d.with_help(WHOLE_NUMBER_HELP);
                 }
                 self.error(d);
                 return Value::Error;
@@ -1934,13 +1937,18 @@ fn type_mismatch(param: &str, want: Type, v: &Value, span: Span) -> Diagnostic {
     d
 }
 
+/// The help where a float is given for an int: most often a `/`, which divides as real
+/// numbers do.
+pub(super) const WHOLE_NUMBER_HELP: &str = "use a whole number: `div(a, b)` divides whole numbers \
+     (`/` gives a float: `5 / 2` is 2.5), and `int(x)` rounds a float down";
+
 /// Adds the hint for a common type mix-up (a number for an angle, a float for an int...).
 fn with_type_help(mut d: Diagnostic, want: Type, found: Option<Type>) -> Diagnostic {
     match (want, found) {
         (Type::Angle, Some(Type::Float | Type::Int)) => {
             d = d.with_help("give the angle a unit: `90deg` or `1.57rad`")
         }
-        (Type::Int, Some(Type::Float)) => d = d.with_help("use a whole number, or `int(x)`"),
+        (Type::Int, Some(Type::Float)) => d = d.with_help(WHOLE_NUMBER_HELP),
         (Type::Vec3, Some(Type::Float | Type::Int)) => {
             d = d.with_help("write a vector as `(x, y, z)`")
         }

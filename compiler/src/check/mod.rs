@@ -1033,14 +1033,16 @@ fn for_loop(
         Value::Int(i) => Some(i),
         Value::Error => None,
         other => {
-            cx.error(
-                Diagnostic::error("E0300", "loop bounds must be `int`", e.span).with_label(
-                    format!(
-                        "this is `{}`",
-                        other.ty().map_or("?".into(), |t| t.to_string())
-                    ),
+            let mut d = Diagnostic::error("E0300", "loop bounds must be `int`", e.span).with_label(
+                format!(
+                    "this is `{}`",
+                    other.ty().map_or("?".into(), |t| t.to_string())
                 ),
             );
+            if other.ty() == Some(Type::Float) {
+                d = d.with_help(eval::WHOLE_NUMBER_HELP);
+            }
+            cx.error(d);
             None
         }
     };

@@ -8,7 +8,7 @@ use crate::syntax::ast::{BinOp, UnOp};
 pub enum OpError {
     /// The operand types do not go with the operator.
     Types(String),
-    /// Integer division or remainder by zero.
+    /// Division by zero, or an integer remainder by zero.
     DivZero,
     /// Integer overflow.
     Overflow,
@@ -72,8 +72,8 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
             _ if vec(a) && a == b => Some(a),
             _ => None,
         },
+        // `5 / 2` is 2.5: whole numbers divide with `div(a, b)`.
         Div => match (a, b) {
-            (Int, Int) => Some(Int),
             _ if num(a) && num(b) => Some(Float),
             (Angle, x) if num(x) => Some(Angle),
             (Angle, Angle) => Some(Float),
@@ -116,6 +116,9 @@ pub fn binary(op: BinOp, a: &Value, b: &Value) -> Result<Value, OpError> {
     };
     if a.is_abstract() || b.is_abstract() {
         return Ok(Value::Unknown(ty));
+    }
+    if op == BinOp::Div && comps(b).contains(&0.0) {
+        return Err(OpError::DivZero);
     }
     if let (Value::Int(x), Value::Int(y)) = (a, b) {
         if ty == Type::Int {
@@ -167,9 +170,7 @@ fn int_op(op: BinOp, x: i64, y: i64) -> Result<i64, OpError> {
         BinOp::Add => x.checked_add(y).ok_or_else(overflow),
         BinOp::Sub => x.checked_sub(y).ok_or_else(overflow),
         BinOp::Mul => x.checked_mul(y).ok_or_else(overflow),
-        BinOp::Div if y == 0 => Err(OpError::DivZero),
         BinOp::Rem if y == 0 => Err(OpError::DivZero),
-        BinOp::Div => x.checked_div(y).ok_or_else(overflow),
         _ => x.checked_rem(y).ok_or_else(overflow),
     }
 }
@@ -190,7 +191,11 @@ mod tests {
         );
         assert_eq!(
             binary(BinOp::Div, &Value::Int(7), &Value::Int(2)),
-            Ok(Value::Int(3))
+            Ok(Value::Float(3.5))
+        );
+        assert_eq!(
+            binary(BinOp::Div, &Value::Float(1.0), &Value::Int(0)),
+            Err(OpError::DivZero)
         );
         assert_eq!(
             binary(BinOp::Div, &Value::Int(7), &Value::Int(0)),

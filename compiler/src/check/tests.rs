@@ -667,3 +667,38 @@ fn a_profile_is_called_a_profile() {
         "{d:?}"
     );
 }
+
+#[test]
+fn division_gives_what_users_of_other_tools_expect() {
+    // `5 / 2` is 2.5: a box 5 wide, not 4.
+    let s = ok("let w = 5;\nscene { box((w / 2, 0.5, 0.5)); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Box {
+            half: [2.5, 0.5, 0.5]
+        }
+    );
+    // Whole numbers divide with `div`, rounded down as Python's `//`.
+    let s =
+        ok("scene { for i in 0..1 { sphere(1).translate(div(7, 2), div(-7, 2), div(7, -2)); } }");
+    let Node::Translate { offset, .. } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a translation")
+    };
+    assert_eq!(offset, &[3.0, -4.0, -4.0]);
+    assert_eq!(codes("let x = div(1, 0);\nscene { sphere(); }"), ["E0400"]);
+    assert_eq!(codes("let x = 1.5 / 0;\nscene { sphere(); }"), ["E0401"]);
+    // A float where an int is needed says why and what to write.
+    for src in [
+        "let n = 5;\nscene { for i in 0..n / 2 { sphere(); } }",
+        "let xs = [1, 2, 3];\nlet x = xs[4 / 2];\nscene { sphere(x); }",
+        "let n = 6;\nscene { repeat_polar(sphere(0.2), n / 2); }",
+    ] {
+        let (_, diags, _) = check_str("t.sdf", src);
+        let d = diags.iter().find(|d| d.is_error()).expect("an error");
+        assert_eq!(d.code, "E0300", "{src}");
+        assert!(
+            d.help.iter().any(|h| h.contains("div(a, b)")),
+            "{src}: {d:#?}"
+        );
+    }
+}

@@ -93,7 +93,8 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             omega[k] = if fail { one } else { om };
             prev[k] = r;
             let hit = !fail & (r < tol);
-            let next = (t[k] + st).max(zero);
+            // A miss needs the verified reach t + f/L past max_dist, not a relaxed step's.
+            let gone = !fail & (t[k] + s > max_dist);
             let count = steps[k] + 1;
             steps[k] = count;
             // A hit stays where it is. Written as a step of zero rather than as a store
@@ -101,7 +102,7 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             // processors; t is never negative nor NaN, so `(t + 0).max(0)` is t exactly.
             t[k] = (t[k] + if hit { zero } else { st }).max(zero);
             let fl = bit(hit, HIT)
-                | bit(next > max_dist, MISS)
+                | bit(gone, MISS)
                 | bit(count >= max_steps, BUDGET)
                 | bit(f.is_nan(), NAN)
                 | bit(s < -tol, OVERSHOOT);

@@ -23,3 +23,38 @@ pub fn open_gpu(what: &str) -> Option<sdfc_runtime::gpu::Gpu> {
         }
     }
 }
+
+/// `scene` rendered by every backend this machine has, each with its name: the CPU always,
+/// wgpu where it finds an adapter (required under `SDFC_REQUIRE_DEVICES=1`) and CUDA where it
+/// finds a device (required under `SDFC_REQUIRE_CUDA=1`, as on the GPU machine); a missing
+/// one is said to have skipped.
+pub fn render_everywhere(
+    what: &str,
+    scene: &sdfc_compiler::Scene,
+) -> Vec<(&'static str, sdfc_runtime::image::Image)> {
+    use sdfc_runtime::backend::{Backend, Prepared};
+    let mut out = Vec::new();
+    for (name, backend, required) in [
+        ("cpu", Backend::Cpu, true),
+        ("wgpu", Backend::Wgpu, env_is("SDFC_REQUIRE_DEVICES")),
+        ("cuda", Backend::Cuda, env_is("SDFC_REQUIRE_CUDA")),
+    ] {
+        let prepared = match Prepared::new(backend, scene, sdfc_runtime::cpu::Precision::F32) {
+            Ok(p) => p,
+            Err(e) => {
+                assert!(!required, "{what}: {name} is required but failed: {e}");
+                println!("SKIPPED: {what} on {name}: {e}");
+                continue;
+            }
+        };
+        let frame = prepared
+            .render(scene, &|_| {})
+            .unwrap_or_else(|e| panic!("{what}: {name} render failed: {e}"));
+        out.push((name, frame.render.image));
+    }
+    out
+}
+
+fn env_is(name: &str) -> bool {
+    std::env::var(name).as_deref() == Ok("1")
+}

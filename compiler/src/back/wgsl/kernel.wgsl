@@ -196,14 +196,18 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
             return Traced(t, STATUS_HIT);
         }
         let next = max(t + step, 0.0);
+        // A miss needs the verified reach t + f/L (this point's empty sphere) past
+        // max_dist: a relaxed step that crosses it is checked at the next point first.
+        let gone = !fail && t + signed > max_dist;
 //#else
         if r < tol {
             return Traced(t, STATUS_HIT);
         }
         let next = max(t + signed, 0.0);
+        let gone = next > max_dist;
 //#endif
         t = next;
-        if next > max_dist {
+        if gone {
             return Traced(next, STATUS_MISS);
         }
         if steps >= params.counts.w {

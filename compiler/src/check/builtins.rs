@@ -538,13 +538,29 @@ fn screw(b: &mut Build, a: &[Value]) -> Result<Value, String> {
             crate::scene::dump_num(hi)
         ));
     }
-    b.node(Node::Screw {
+    let thread = b.node(Node::Screw {
         pitch,
         half_height: height / 2.0,
         inner,
         floor: scale.min(1.0),
         child: sh(&a[0]),
-    })
+    })?;
+    match &a[3] {
+        // A left-handed thread is the right-handed one's mirror image: reflected across x = 0,
+        // which keeps the axis and the profile's half-plane.
+        Value::Str(hand) if &**hand == "left" => b.node(Node::Rotate {
+            matrix: householder([1.0, 0.0, 0.0]),
+            child: sh(&thread),
+        }),
+        _ => Ok(thread),
+    }
+}
+
+/// The reflection across the plane through the origin with normal `n` (not zero):
+/// I − 2·n·nᵀ/|n|², orthogonal, symmetric and its own inverse.
+fn householder(n: V3) -> [V3; 3] {
+    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    [0, 1, 2].map(|i| [0, 1, 2].map(|j| f64::from(u8::from(i == j)) - 2.0 * n[i] * n[j] / nn))
 }
 
 /// The points of a regular polygon of `sides` with its corners `radius` from the centre,
@@ -568,6 +584,8 @@ fn len(a: &[Value]) -> Result<Value, String> {
         _ => Ok(Value::Error),
     }
 }
+
+const HANDS: &[&str] = &["right", "left"];
 
 const SMOOTH_VARIANTS: &[&str] = &["poly", "exp", "chamfer", "round", "stairs", "columns"];
 
@@ -1112,7 +1130,7 @@ pub static BUILTINS: &[Builtin] = &[
     Builtin {
         name: "screw",
         sigs: sigs![
-            [prof("profile"), p("pitch", F, Req, Pos), p("height", F, Req, Pos)] -> S => screw;
+            [prof("profile"), p("pitch", F, Req, Pos), p("height", F, Req, Pos), p("hand", Str, Text("right"), OneOf(HANDS))] -> S => screw;
         ],
     },
     Builtin {
@@ -1286,6 +1304,18 @@ pub static BUILTINS: &[Builtin] = &[
             [prof("profile"), p("x", B, Bool(true), Any), p("y", B, Bool(false), Any)] -> PR => |b, a| {
                 let axes = [a[1] == Value::Bool(true), a[2] == Value::Bool(true), false];
                 b.profile(Node::Mirror { axes, child: sh(&a[0]) })
+            };
+        ],
+    },
+    Builtin {
+        name: "reflect",
+        sigs: sigs![
+            [shape("shape"), p("normal", V, Req, NonZero)] -> S => |b, a| {
+                b.node(Node::Rotate { matrix: householder(a[1].v3()), child: sh(&a[0]) })
+            };
+            [prof("profile"), p("normal", V2, Req, NonZero)] -> PR => |b, a| {
+                let n = a[1].components();
+                flat(b.node(Node::Rotate { matrix: householder([n[0], n[1], 0.0]), child: sh(&a[0]) }))
             };
         ],
     },

@@ -1048,3 +1048,68 @@ fn random_profile_formulas_keep_their_bound_when_made_solid() {
     }
     assert!(proven > 15, "only {proven} of 30 have a bound");
 }
+
+#[test]
+fn reflect_is_one_mirror_image_where_mirror_folds() {
+    // A sphere at +x reflected across x = 0 is the sphere at -x, and only that one; `mirror`
+    // keeps both.
+    same(
+        "sphere(0.5).translate(1, 0.2, 0).reflect((1, 0, 0))",
+        "sphere(0.5).translate(-1, 0.2, 0)",
+    );
+    let (folded, _) = program("sphere(0.5).translate(1, 0.2, 0).mirror()");
+    let (reflected, l) = program("sphere(0.5).translate(1, 0.2, 0).reflect((2, 0, 0))");
+    assert_eq!(l, 1.0);
+    assert!(f(&folded, [1.0, 0.2, 0.0]) < 0.0 && f(&folded, [-1.0, 0.2, 0.0]) < 0.0);
+    assert!(f(&reflected, [1.0, 0.2, 0.0]) > 0.0 && f(&reflected, [-1.0, 0.2, 0.0]) < 0.0);
+    // Any plane through the origin: a point goes to p − 2(p·n)n.
+    same(
+        "box((0.2, 0.3, 0.4)).translate(0.5, 0.1, 0).reflect((1, 1, 0))",
+        "box((0.3, 0.2, 0.4)).translate(-0.1, -0.5, 0)",
+    );
+    exact(
+        "box((0.3, 0.2, 0.1)).translate(0.4, 0, 0).reflect((0, 0, 1))",
+        |x| (x[0] - 0.4).abs() < 0.3 && x[1].abs() < 0.2 && x[2].abs() < 0.1,
+    );
+    // Profiles reflect across a line of the plane.
+    same(
+        "extrude(circle(0.3).translate(0.5, 0.2).reflect((0, 1)), 0.4)",
+        "extrude(circle(0.3).translate(0.5, -0.2), 0.4)",
+    );
+}
+
+#[test]
+fn a_left_handed_screw_is_the_right_handed_one_reflected() {
+    let right = "screw(rect((0.05, 0.1)).translate(0.5, 0), 0.4, 1.6)";
+    let left = "screw(rect((0.05, 0.1)).translate(0.5, 0), 0.4, 1.6, hand: \"left\")";
+    same(left, &format!("{right}.reflect((1, 0, 0))"));
+    let (p, _) = program(left);
+    let mut rng = Rng::new(12);
+    let mut inside = 0;
+    for _ in 0..3000 {
+        let t = rng.range(-std::f64::consts::PI, std::f64::consts::PI);
+        let r = rng.range(0.4, 0.6);
+        let x = [r * t.cos(), rng.range(-0.9, 0.9), -r * t.sin()];
+        let d = f(&p, x);
+        if d.abs() > 1e-9 {
+            // The left-handed thread at x is the right-handed one at x's mirror image.
+            assert_eq!(
+                d < 0.0,
+                in_screw([-x[0], x[1], x[2]]),
+                "sign at {x:?} ({d})"
+            );
+            inside += usize::from(d < 0.0);
+        }
+    }
+    assert!(inside > 200, "{inside} inside");
+    // The two hands differ (a chevron would be symmetric).
+    let (r, _) = program(right);
+    let differ = (0..200)
+        .map(|i| {
+            let t = f64::from(i) * 0.031;
+            [0.5 * t.cos(), 0.05, -0.5 * t.sin()]
+        })
+        .filter(|x| (f(&r, *x) < 0.0) != (f(&p, *x) < 0.0))
+        .count();
+    assert!(differ > 20, "{differ}");
+}

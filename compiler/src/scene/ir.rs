@@ -282,7 +282,8 @@ pub enum Node {
     Feature { op: Feature, a: NodeId, b: NodeId },
     /// Child moved by an offset.
     Translate { offset: V3, child: NodeId },
-    /// Child rotated by an orthonormal matrix (rows).
+    /// Child turned by an orthogonal matrix (rows): a rotation, or a reflection
+    /// (`reflect`, a left-handed `screw`) where its determinant is −1. Either keeps distances.
     Rotate { matrix: [V3; 3], child: NodeId },
     /// Child scaled uniformly.
     Scale { factor: f64, child: NodeId },

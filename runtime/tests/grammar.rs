@@ -16,7 +16,7 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// The token classes of the grammar, written in capitals.
-const CLASSES: [&str; 6] = ["IDENT", "INT", "FLOAT", "ANGLE", "STRING", "BOOL"];
+const CLASSES: [&str; 7] = ["IDENT", "INT", "FLOAT", "ANGLE", "COLOUR", "STRING", "BOOL"];
 
 /// A right-hand side of the EBNF.
 #[derive(Debug, Clone, PartialEq)]
@@ -269,6 +269,7 @@ fn terminal(t: &Token) -> Sym {
         Token::Int(_) => Class("INT"),
         Token::Float(_) => Class("FLOAT"),
         Token::Angle(_) => Class("ANGLE"),
+        Token::Colour(_) => Class("COLOUR"),
         Token::Str(_) => Class("STRING"),
         Token::Ident(_) => Class("IDENT"),
         // Never produced by `lex`: it scans a string from its quote, or drops a comment.

@@ -1640,16 +1640,13 @@ pub static BUILTINS: &[Builtin] = &[
             };
         ],
     },
-    Builtin {
-        name: "radians",
-        sigs: sigs![
-            [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num()));
-        ],
-    },
+    // No `radians`: GLSL's turns degrees into radians, the opposite of "x radians", so the
+    // name is refused with the spelling that works (`suggest::ported`).
     Builtin {
         name: "degrees",
         sigs: sigs![
             [p("x", F, Req, Any)] -> A => |_, a| Ok(Value::Angle(a[0].num().to_radians()));
+            [p("x", A, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().to_degrees()));
         ],
     },
     Builtin {

@@ -10,7 +10,7 @@ use super::types::{Type, Value};
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::scene::{Graph, MaterialId, Node};
-use crate::span::Span;
+use crate::span::{FileId, Span};
 use crate::syntax::ast::*;
 use std::collections::HashMap;
 use std::rc::Rc;
@@ -45,6 +45,9 @@ pub struct Ctx<'l> {
     /// Every global `let`, declared or not yet evaluated, for "used before its definition".
     pub declared: HashMap<String, Span>,
     pub fns: HashMap<String, FnInfo>,
+    /// Which file imports which (importer, imported): where a function that hides a built-in
+    /// is seen.
+    pub imports: Vec<(FileId, FileId)>,
     /// Where the render block sets `method`, for the error when analytic tracing is asked
     /// of a scene that does not allow it.
     pub method_span: Option<Span>,
@@ -173,6 +176,7 @@ impl Ctx<'_> {
             ExprKind::Int(i) => Value::Int(*i),
             ExprKind::Float(f) => self.finite(Value::Float(*f), e.span),
             ExprKind::Angle(a) => self.finite(Value::Angle(*a), e.span),
+            ExprKind::Colour(c) => Value::Vec3(c.map(srgb_to_linear)),
             ExprKind::Bool(b) => Value::Bool(*b),
             ExprKind::Str(s) => Value::Str(s.as_str().into()),
             ExprKind::Var(id) => self.var(id),
@@ -1266,8 +1270,12 @@ impl Ctx<'_> {
         args: Vec<ArgVal>,
         span: Span,
     ) -> Value {
-        if self.fns.contains_key(&callee.name) {
-            return self.call_user(callee, recv, args, span);
+        if let Some(info) = self.fns.get(&callee.name) {
+            // A function named like a built-in hides it where its file is seen (W0016).
+            let defined = info.decl.name.span.file;
+            if builtins::builtin(&callee.name).is_none() || self.sees(callee.span.file, defined) {
+                return self.call_user(callee, recv, args, span);
+            }
         }
         if let Some(b) = builtins::builtin(&callee.name) {
             return self.call_builtin(b, callee, recv, args, span);
@@ -1291,6 +1299,25 @@ impl Ctx<'_> {
         }
         self.error(d);
         Value::Error
+    }
+
+    /// Whether the file `from` sees the definitions of `file`: it is that file, or imports it
+    /// (directly or through other imports).
+    fn sees(&self, from: FileId, file: FileId) -> bool {
+        let mut seen = vec![from];
+        let mut next = vec![from];
+        while let Some(f) = next.pop() {
+            if f == file {
+                return true;
+            }
+            for &(a, b) in &self.imports {
+                if a == f && !seen.contains(&b) {
+                    seen.push(b);
+                    next.push(b);
+                }
+            }
+        }
+        false
     }
 
     fn call_builtin(
@@ -1935,6 +1962,17 @@ fn type_mismatch(param: &str, want: Type, v: &Value, span: Span) -> Diagnostic {
     .with_label(format!("this is `{found}`"));
     d = with_type_help(d, want, v.ty());
     d
+}
+
+/// An sRGB byte as the linear value the renderer's colours are (the sRGB transfer function,
+/// IEC 61966-2-1).
+fn srgb_to_linear(byte: u8) -> f64 {
+    let c = f64::from(byte) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// The help where a float is given for an int: most often a `/`, which divides as real

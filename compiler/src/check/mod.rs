@@ -125,9 +125,11 @@ pub fn check_files(
         items: &mut items,
         diags: &mut diags,
         depth: 0,
+        imports: Vec::new(),
     };
     load.file(entry);
     let depth = load.depth;
+    let imports = std::mem::take(&mut load.imports);
     let names = (0..sources.len() as u32)
         .map(|f| sources.name(FileId(f)).to_string())
         .collect();
@@ -140,7 +142,7 @@ pub fn check_files(
     // deeply as the files nest (within the `nesting` limit the parser enforced): they run on
     // a stack that fits, and so does the drop of the tree.
     crate::syntax::with_stack_for(depth, move || {
-        check_loaded(entry, limits, time, diags, items, files, after)
+        check_loaded(entry, limits, time, (diags, items, imports), files, after)
     })
 }
 
@@ -149,8 +151,7 @@ fn check_loaded(
     entry: FileId,
     limits: &Limits,
     time: f64,
-    mut diags: Vec<Diagnostic>,
-    items: Vec<ast::Item>,
+    (mut diags, items, imports): (Vec<Diagnostic>, Vec<ast::Item>, Vec<(FileId, FileId)>),
     files: Files,
     after: After,
 ) -> (Option<Scene>, Vec<Diagnostic>, Vec<Constant>) {
@@ -162,6 +163,7 @@ fn check_loaded(
     }
     let mut cx = Ctx::default();
     cx.files = files;
+    cx.imports = imports;
     cx.diags = diags;
     cx.limits = limits.clone();
     cx.time = time;
@@ -259,6 +261,8 @@ struct Load<'a> {
     diags: &'a mut Vec<Diagnostic>,
     /// The deepest nesting of the files read ([`syntax::nesting`]).
     depth: usize,
+    /// Which file imports which (importer, imported).
+    imports: Vec<(FileId, FileId)>,
 }
 
 impl Load<'_> {
@@ -292,6 +296,7 @@ impl Load<'_> {
             }
         };
         if let Some(existing) = self.sources.find(&name) {
+            self.imports.push((from, existing));
             if self.stack.contains(&existing) {
                 let chain: Vec<&str> = self
                     .stack
@@ -320,6 +325,7 @@ impl Load<'_> {
             return;
         }
         let id = self.sources.add(name, text);
+        self.imports.push((from, id));
         self.file(id);
     }
 }
@@ -509,17 +515,23 @@ fn collect_functions(cx: &mut Ctx, items: &[ast::Item]) {
             dup(cx, "the function", &f.name, first);
             continue;
         }
-        if builtins::builtin(&f.name.name).is_some() {
-            cx.error(
-                Diagnostic::error(
-                    "E0207",
-                    format!("`{}` is a built-in function", f.name.name),
-                    f.name.span,
-                )
-                .with_label("this would hide it")
-                .with_help("choose another name"),
-            );
-            continue;
+        if let Some(b) = builtins::builtin(&f.name.name) {
+            let name = &f.name.name;
+            let sig = b.sigs.first().map(|s| builtins::signature(name, s));
+            let mut d = Diagnostic::warning(
+                "W0016",
+                format!("this function `{name}` hides the built-in `{name}`"),
+                f.name.span,
+            )
+            .with_label(format!(
+                "calls to `{name}` in this file, and in files that import it, call this function"
+            ))
+            .with_note("files that do not see this one (a library it imports) keep the built-in");
+            if let Some(sig) = sig {
+                d = d.with_note(format!("the built-in is `{sig}`"));
+            }
+            cx.diags
+                .push(d.with_help("rename the function to keep both in reach"));
         }
         let mut names: HashMap<&str, Span> = HashMap::new();
         let mut ok = true;
@@ -598,6 +610,7 @@ fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
             ast::ExprKind::Int(_)
             | ast::ExprKind::Float(_)
             | ast::ExprKind::Angle(_)
+            | ast::ExprKind::Colour(_)
             | ast::ExprKind::Bool(_)
             | ast::ExprKind::Str(_)
             | ast::ExprKind::Var(_)

@@ -84,6 +84,15 @@ const EDGES: &[(&str, &str)] = &[
 /// one of that tool's spellings and `known` (this language's functions) has its counterpart:
 /// a sentence for the help of an unknown function.
 pub fn ported(name: &str, known: &dyn Fn(&str) -> bool) -> Option<String> {
+    if name == "radians" {
+        // GLSL's `radians(d)` is d degrees in radians; read the other way it would turn a
+        // shader's 30 degrees into 30 radians without a word.
+        return Some(
+            "an angle carries its unit here: for GLSL's `radians(d)` (d degrees) write `30deg` \
+             or `d * 1deg`, and for an angle of x radians `0.5rad` or `x * 1rad`"
+                .to_string(),
+        );
+    }
     if let Some((_, ours)) = PORTED.iter().find(|(theirs, _)| *theirs == name) {
         return known(ours).then(|| format!("`{name}` of other SDF tools is `{ours}` here"));
     }

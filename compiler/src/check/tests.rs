@@ -702,3 +702,67 @@ fn division_gives_what_users_of_other_tools_expect() {
         );
     }
 }
+
+#[test]
+fn a_function_named_like_a_built_in_hides_it_with_a_warning() {
+    let src = "fn ring(r: float) -> shape { torus(r, 0.1) }\n\
+               fn offset(s: shape, d: vec3) -> shape { s.translate(d) }\n\
+               light point { position: (0, 5, 0) }\n\
+               scene { ring(1).offset((0, 2, 0)); }";
+    let (scene, diags, _) = check_str("t.sdf", src);
+    let codes: Vec<_> = diags.iter().map(|d| d.code).collect();
+    assert_eq!(codes, ["W0016", "W0016"], "{diags:#?}");
+    assert!(
+        diags[0].message.contains("`ring`"),
+        "{:?}",
+        diags[0].message
+    );
+    assert!(
+        diags[0].notes.iter().any(|n| n.contains("ring(")),
+        "the built-in's signature: {:?}",
+        diags[0].notes
+    );
+    // The calls are the user's: a torus moved up, not a profile.
+    let s = scene.expect("scene");
+    let Node::Translate { offset, child } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a translation")
+    };
+    assert_eq!(offset, &[0.0, 2.0, 0.0]);
+    assert!(matches!(s.graph.node(*child), Node::Torus { .. }));
+}
+
+#[test]
+fn web_colours_are_srgb_made_linear() {
+    let s = ok("material m = phong { color: #ff8000 };\n\
+                light point { position: (0, 5, 0), color: #FFFFFF }\n\
+                render { background: #000000 }\n\
+                scene { sphere(1) @ m; }");
+    let crate::scene::Pattern::Solid(crate::scene::Colour::Const(c)) = s.materials[1].pattern
+    else {
+        panic!("{:?}", s.materials[1].pattern)
+    };
+    assert_eq!(c[0], 1.0);
+    // sRGB 0x80 = 128/255 is linear 0.2158 (IEC 61966-2-1).
+    assert!((c[1] - 0.215_860_5).abs() < 1e-6, "{c:?}");
+    assert_eq!(c[2], 0.0);
+    assert_eq!(s.settings.background, [0.0; 3]);
+    // Not six hex digits: a lexical error.
+    assert_eq!(codes("let c = #ff80;\nscene { sphere(); }")[0], "E0001");
+}
+
+#[test]
+fn radians_is_refused_with_the_spelling_that_works_and_degrees_reads_both_ways() {
+    let (_, diags, _) = check_str("t.sdf", "scene { box(1).rotate_y(radians(30)); }");
+    let d = diags.iter().find(|d| d.is_error()).expect("an error");
+    assert_eq!(d.code, "E0201");
+    let help = d.help.as_deref().unwrap_or("");
+    assert!(help.contains("30deg") && help.contains("1rad"), "{help}");
+    // `degrees` of a number is that many degrees; of an angle, its number of degrees.
+    let s = ok(
+        "let a = degrees(90);\nlet n = degrees(a) + degrees(0.5rad);\nscene { sphere(n / 100); }",
+    );
+    let Node::Sphere { radius } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a sphere")
+    };
+    assert!((radius - (90.0 + 0.5f64.to_degrees()) / 100.0).abs() < 1e-12);
+}

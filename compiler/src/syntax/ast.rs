@@ -246,6 +246,8 @@ pub enum ExprKind {
     Float(f64),
     /// `45deg`, `0.5rad` (stored in radians)
     Angle(f64),
+    /// `#rrggbb`: the sRGB bytes as written (the checker makes them a linear vec3).
+    Colour([u8; 3]),
     /// `true`, `false`
     Bool(bool),
     /// `"text"`

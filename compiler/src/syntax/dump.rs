@@ -127,6 +127,7 @@ impl Dumper {
             ExprKind::Int(v) => self.line(format!("int {v}")),
             ExprKind::Float(v) => self.line(format!("float {v:?}")),
             ExprKind::Angle(v) => self.line(format!("angle {v:?}rad")),
+            ExprKind::Colour([r, g, b]) => self.line(format!("colour #{r:02x}{g:02x}{b:02x}")),
             ExprKind::Bool(v) => self.line(format!("bool {v}")),
             ExprKind::Str(v) => self.line(format!("string {v:?}")),
             ExprKind::Var(id) => self.line(format!("var {}", id.name)),

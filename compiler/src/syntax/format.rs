@@ -318,6 +318,7 @@ fn ends_operand(t: &Token) -> bool {
             | Token::Int(_)
             | Token::Float(_)
             | Token::Angle(_)
+            | Token::Colour(_)
             | Token::Str(_)
             | Token::Bool(_)
             | Token::RParen

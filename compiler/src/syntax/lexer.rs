@@ -49,6 +49,9 @@ pub enum Token {
     /// An angle literal such as `45deg` or `0.5rad`, in radians.
     #[regex(r"([0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?)(deg|rad)", angle)]
     Angle(f64),
+    /// A colour written as the web writes it, `#rrggbb`: three sRGB bytes.
+    #[regex(r"#[0-9a-fA-F]{6}", colour)]
+    Colour([u8; 3]),
     /// A string literal, without its quotes, its escapes resolved: made by [`lex`], which
     /// scans it from its opening [`Token::Quote`].
     Str(String),
@@ -122,6 +125,12 @@ pub enum Token {
     BlockComment,
 }
 
+fn colour(lex: &mut logos::Lexer<Token>) -> Option<[u8; 3]> {
+    let hex = lex.slice().get(1..)?;
+    let byte = |i: usize| u8::from_str_radix(hex.get(i..i + 2)?, 16).ok();
+    Some([byte(0)?, byte(2)?, byte(4)?])
+}
+
 fn angle(lex: &mut logos::Lexer<Token>) -> Option<f64> {
     let s = lex.slice();
     let (num, unit) = s.split_at(s.len() - 3);
@@ -147,6 +156,7 @@ impl fmt::Display for Token {
             Token::Bool(b) => return write!(f, "{b}"),
             Token::Int(_) | Token::Float(_) => "number",
             Token::Angle(_) => "angle",
+            Token::Colour(_) => "colour",
             Token::Str(_) | Token::Quote => "string",
             Token::Ident(name) => return write!(f, "identifier `{name}`"),
             Token::LParen => "(",

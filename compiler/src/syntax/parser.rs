@@ -272,6 +272,7 @@ where
             Token::Int(v) => ExprKind::Int(v),
             Token::Float(v) => ExprKind::Float(v),
             Token::Angle(v) => ExprKind::Angle(v),
+            Token::Colour(c) => ExprKind::Colour(c),
             Token::Bool(v) => ExprKind::Bool(v),
             Token::Str(v) => ExprKind::Str(v),
         }

@@ -838,3 +838,32 @@ fn a_surface_near_max_dist_is_not_lost_to_a_relaxed_step() {
         );
     }
 }
+
+/// A warp written as a field, `distance(s, q)`, shows `s`'s materials on every backend: the
+/// red sphere stays red (it rendered all grey, the default material).
+#[test]
+fn a_warp_written_as_a_field_shows_the_warped_shapes_materials() {
+    let text = "material red = phong { color: (0.9, 0.1, 0.1) };\n\
+                material grey = phong { color: (0.5, 0.5, 0.5) };\n\
+                camera { position: (0, 1, -4), look_at: (0.7, 0, 0), fov: 50deg }\n\
+                light point { position: (2, 4, -4) }\n\
+                render { width: 48, height: 32 }\n\
+                let s = union(sphere(0.5) @ red, box(0.3).translate(1.5, 0, 0) @ grey);\n\
+                scene { field { distance(s, vec3(p.x, p.y + 0.2 * sin(3 * p.x), p.z)) }; }";
+    let (scene, diags, _) = sdfc_compiler::check_str("warp.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    for (backend, image) in render_everywhere("warp", &scene) {
+        let red = image
+            .linear
+            .iter()
+            .filter(|c| c[0] > 0.2 && c[0] > 3.0 * c[1])
+            .count();
+        let grey = image
+            .linear
+            .iter()
+            .filter(|c| c[0] > 0.1 && (c[0] - c[1]).abs() < 0.02)
+            .count();
+        println!("{backend}: {red} red and {grey} grey pixels");
+        assert!(red > 20 && grey > 10, "{backend}: {red} red, {grey} grey");
+    }
+}

@@ -521,13 +521,24 @@ impl<'a> Lowerer<'a> {
     fn field(&mut self, id: NodeId, f: &FieldFn, p: P) -> Field {
         let mut regs: Vec<Reg> = Vec::with_capacity(f.ops.len());
         let mut resumed = true;
+        // The shapes read, for the field's material: a warp written as a field,
+        // `distance(s, q(p))`, keeps `s`'s materials as a transform does; of several shapes
+        // read, the nearest's, as in a union.
+        let mut read: Option<Field> = None;
         for op in &f.ops {
             let r = match op {
                 FOp::Distance(shape, q) => {
                     let q = q.map(|s| regs[s as usize]);
-                    let d = self.node(*shape, q).d;
+                    let shape = self.node(*shape, q);
                     resumed = false;
-                    d
+                    read = Some(match read {
+                        None => shape,
+                        Some(before) => Field {
+                            m: self.material(Combine::Union, before, shape),
+                            d: self.b.min(before.d, shape.d),
+                        },
+                    });
+                    shape.d
                 }
                 other => {
                     if !resumed {
@@ -540,10 +551,11 @@ impl<'a> Lowerer<'a> {
             regs.push(r);
         }
         let d = f.out.first().map_or(p[0], |&s| regs[s as usize]);
-        Field {
-            d,
-            m: self.b.c(UNPAINTED),
-        }
+        let m = match read {
+            Some(shape) => shape.m,
+            None => self.b.c(UNPAINTED),
+        };
+        Field { d, m }
     }
 
     /// Notes that the instructions that follow belong to `id` again, after its children.

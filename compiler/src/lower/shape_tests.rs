@@ -1113,3 +1113,45 @@ fn a_left_handed_screw_is_the_right_handed_one_reflected() {
         .count();
     assert!(differ > 20, "{differ}");
 }
+
+#[test]
+fn a_warp_written_as_a_field_keeps_the_materials_of_the_shape_it_reads() {
+    let src = "material red = phong { color: (0.9, 0.1, 0.1) };\n\
+               material grey = phong { color: (0.5, 0.5, 0.5) };\n\
+               let s = union(sphere(0.5) @ red, box(0.3).translate(1.5, 0, 0) @ grey);\n\
+               scene { field { distance(s, vec3(p.x, p.y + 0.2 * sin(3 * p.x), p.z)) }; }";
+    let (scene, diags, _) = crate::front::check_str("t.sdf", src);
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
+    let scene = scene.expect("scene");
+    let program = super::lower(&scene);
+    let id = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .position(|m| m.name == name)
+            .expect("material") as u32
+    };
+    // Inside the warped sphere (at x = 0 the warp is 0) and inside the warped box (at
+    // x = 1.5 it moves y by 0.2·sin 4.5).
+    let (d, m) = eval_point(&program, [0.0f64, 0.0, 0.0]);
+    assert!(d < 0.0 && m == id("red"), "{d} {m}");
+    let y = -0.2 * (4.5f64).sin();
+    let (d, m) = eval_point(&program, [1.5, y, 0.0]);
+    assert!(d < 0.0 && m == id("grey"), "{d} {m}");
+    // Several shapes read: the nearer one's, as in a union.
+    let (program, _) = program_of_two_reads();
+    let (_, m) = eval_point(&program, [-0.4, 0.0, 0.0]);
+    let (_, n) = eval_point(&program, [1.4, 0.0, 0.0]);
+    assert!(m != n, "{m} {n}");
+}
+
+fn program_of_two_reads() -> (Program, f64) {
+    let (scene, diags, _) = crate::front::check_str(
+        "t.sdf",
+        "material red = phong { color: (0.9, 0.1, 0.1) };\n\
+         scene { field { min(distance(sphere(0.5) @ red, p), distance(box(0.3), p - vec3(1.5, 0, 0))) }; }",
+    );
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
+    let scene = scene.expect("scene");
+    (super::lower(&scene), 1.0)
+}

@@ -867,3 +867,23 @@ fn a_warp_written_as_a_field_shows_the_warped_shapes_materials() {
         assert!(red > 20 && grey > 10, "{backend}: {red} red, {grey} grey");
     }
 }
+
+/// A scene whose bounded parts lie beyond the default `max_dist` of 100 is seen (the default
+/// covers them from the camera) on every backend: it was an empty picture without a word.
+#[test]
+fn a_scene_beyond_a_hundred_units_is_seen_with_the_default_max_dist() {
+    let text = "camera { position: (0, 0, -150), look_at: (0, 0, 0), fov: 3deg }\n\
+                light point { position: (0, 10, -100) }\n\
+                render { width: 32, height: 24 }\n\
+                scene { sphere(3); }";
+    let (scene, diags, _) = sdfc_compiler::check_str("far.sdf", text);
+    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
+    for (backend, image) in render_everywhere("far scene", &scene) {
+        let c = coverage(&image, scene.settings.background);
+        println!("{backend}: {:.1} % of pixels on the sphere", 100.0 * c);
+        assert!(
+            c > 0.08,
+            "{backend}: the sphere covers {c:.3} of the picture"
+        );
+    }
+}

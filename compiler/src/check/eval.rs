@@ -48,12 +48,10 @@ pub struct Ctx<'l> {
     /// Which file imports which (importer, imported): where a function that hides a built-in
     /// is seen.
     pub imports: Vec<(FileId, FileId)>,
-    /// Where the render block sets `method`, for the error when analytic tracing is asked
-    /// of a scene that does not allow it.
-    pub method_span: Option<Span>,
-    /// The settings the render block gives (a field with no proven bound has defaults of its
-    /// own for `epsilon` and `relaxation`).
-    pub settings_given: Vec<String>,
+    /// The settings the render block gives, with where: a field with no proven bound has
+    /// defaults of its own for `epsilon` and `relaxation`, `max_dist` follows the scene unless
+    /// given, and `method: "trace"` of a scene that does not allow it is an error there.
+    pub settings_given: Vec<(String, Span)>,
     /// Where the camera, the lights and the scene are written (for the placement warnings).
     pub places: super::Places,
     locals: Vec<(String, Value)>,

@@ -195,8 +195,9 @@ fn check_loaded(
         let analysis = crate::scene::analysis::analyse(&scene);
         cx.diags.extend_from_slice(analysis.diagnostics());
         if analysis.root().is_some_and(|root| !root.proven) {
-            unbounded_defaults(&cx.settings_given, &mut scene.settings);
+            unbounded_defaults(&cx, &mut scene.settings);
         }
+        reach(&mut cx, &mut scene);
         analytic_method(&mut cx, &scene);
     }
     if !crate::diagnostics::has_errors(&cx.diags) {
@@ -214,11 +215,35 @@ fn check_loaded(
 /// The defaults of a field with no proven distance bound, for the settings the file does not
 /// give (docs/accuracy.md, "Fields without a bound"): such a field has detail below any ε, so
 /// ε follows the pixel footprint; and over-relaxation, whose fallback relies on a bound, is off.
-fn unbounded_defaults(given: &[String], settings: &mut Settings) {
-    let given = |name: &str| given.iter().any(|g| g == name);
-    settings.footprint = !given("epsilon");
-    if !given("relaxation") {
+fn unbounded_defaults(cx: &Ctx, settings: &mut Settings) {
+    settings.footprint = given(cx, "epsilon").is_none();
+    if given(cx, "relaxation").is_none() {
         settings.relaxation = 1.0;
+    }
+}
+
+/// Where the render block sets the setting `name`, if it does.
+fn given(cx: &Ctx, name: &str) -> Option<Span> {
+    cx.settings_given
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, at)| *at)
+}
+
+/// `max_dist` and the scene's bounded parts (docs/rendering.md, "Marching"): unless the file
+/// sets it, it covers every one of them as seen from the camera; where the file sets it
+/// short of one, W0017 says so.
+fn reach(cx: &mut Ctx, scene: &mut Scene) {
+    use crate::scene::reach;
+    let parts = reach::parts(scene);
+    match given(cx, "max_dist") {
+        None => {
+            scene.settings.max_dist = reach::default_max_dist(&parts, scene.settings.max_dist);
+        }
+        Some(at) => {
+            let far = reach::beyond(&parts, scene.settings.max_dist, at);
+            cx.diags.extend(far);
+        }
     }
 }
 
@@ -226,7 +251,7 @@ fn unbounded_defaults(given: &[String], settings: &mut Settings) {
 /// setting, pointing at what prevents it.
 fn analytic_method(cx: &mut Ctx, scene: &Scene) {
     use crate::scene::analytic::{choose, Choice, Reason};
-    let (Method::Trace, Some(at)) = (scene.settings.method, cx.method_span) else {
+    let (Method::Trace, Some(at)) = (scene.settings.method, given(cx, "method")) else {
         return;
     };
     let Choice::March(reason) = choose(scene) else {
@@ -802,12 +827,11 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
         }
         ("render", _) => {
             let f = eval::record(cx, &builtins::RENDER, &b.fields, &b.keyword);
-            cx.method_span = b
+            cx.settings_given = b
                 .fields
                 .iter()
-                .find(|f| f.name.name == "method")
-                .map(|f| f.value.span);
-            cx.settings_given = b.fields.iter().map(|f| f.name.name.clone()).collect();
+                .map(|f| (f.name.name.clone(), f.value.span))
+                .collect();
             let int = |k: &str| f[k].num() as u32;
             scene.settings = Settings {
                 width: int("width"),

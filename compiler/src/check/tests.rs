@@ -766,3 +766,31 @@ fn radians_is_refused_with_the_spelling_that_works_and_degrees_reads_both_ways()
     };
     assert!((radius - (90.0 + 0.5f64.to_degrees()) / 100.0).abs() < 1e-12);
 }
+
+#[test]
+fn max_dist_covers_the_bounded_parts_unless_set_and_then_says_what_it_cuts() {
+    // Not set: it reaches past the far side of a sphere 150 units away (a floor plane, which
+    // is unbounded, does not stretch it).
+    let s = ok("camera { position: (0, 0, -150), look_at: (0, 0, 0) }\n\
+                light point { position: (0, 10, -10) }\n\
+                scene { sphere(1); plane((0, 1, 0), -5); }");
+    assert!(s.settings.max_dist >= 151.0, "{}", s.settings.max_dist);
+    // A near scene keeps the default of 100.
+    let s = ok("light point { position: (0, 10, -10) }\nscene { sphere(1); }");
+    assert_eq!(s.settings.max_dist, 100.0);
+    // Set short: a warning at the part, naming the setting.
+    let (scene, diags, _) = check_str(
+        "t.sdf",
+        "camera { position: (0, 0, -30), look_at: (0, 0, 0) }\n\
+         light point { position: (0, 10, -10) }\n\
+         render { max_dist: 30 }\n\
+         scene { sphere(2); sphere(1).translate(0, 0, 40); }",
+    );
+    let far: Vec<_> = diags.iter().filter(|d| d.code == "W0017").collect();
+    assert_eq!(far.len(), 2, "{diags:#?}");
+    assert!(
+        far.iter().any(|d| d.message.contains("not seen")),
+        "{far:#?}"
+    );
+    assert_eq!(scene.expect("scene").settings.max_dist, 30.0);
+}

@@ -7,6 +7,37 @@
 
 use sdfc_compiler::{ast, lexer, parse, FileId, SourceMap, Span};
 
+/// Why `new` cannot be the new name of a declaration (`None` when it can): it must be one
+/// name as the lexer reads it, not a keyword, and not hide a built-in function, a built-in
+/// constant or the time, which the file's uses of them would then no longer reach.
+pub fn not_a_new_name(new: &str) -> Option<String> {
+    use sdfc_compiler::builtins;
+    let (tokens, errors) = lexer::lex(FileId(0), new);
+    match tokens.as_slice() {
+        [(lexer::Token::Ident(name), _)] if errors.is_empty() && name == new => {}
+        [(_, _)] if errors.is_empty() && new.bytes().all(|b| b.is_ascii_alphabetic()) => {
+            return Some(format!("`{new}` is a keyword, not a name"))
+        }
+        _ => return Some(format!("`{new}` is not a name")),
+    }
+    if builtins::builtin(new).is_some() {
+        return Some(format!(
+            "`{new}` is a built-in function: a declaration of that name would hide it"
+        ));
+    }
+    if builtins::constant(new).is_some() {
+        return Some(format!(
+            "`{new}` is a built-in constant: a declaration of that name would hide it"
+        ));
+    }
+    if new == builtins::TIME {
+        return Some(format!(
+            "`{new}` is the time: a declaration of that name would hide it"
+        ));
+    }
+    None
+}
+
 /// What a name is declared as.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum What {

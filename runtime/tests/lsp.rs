@@ -995,3 +995,34 @@ fn serve_bytes_serves_a_stream_in_one_thread() {
         "{text}"
     );
 }
+
+/// A byte-order mark at the start of a document is skipped: no diagnostic about it, and the
+/// positions of the first line count it as the client does (one UTF-16 unit).
+#[test]
+fn a_byte_order_mark_is_skipped_by_the_language_server() {
+    let dir = temp_dir("bom");
+    let main_uri = uri(&dir.join("main.sdf"));
+    let text = "\u{feff}let r = 1;\nscene {\n    sphere(r);\n}\n";
+    let mut c = Client::start();
+    c.notify(
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": main_uri, "languageId": "sdf", "version": 1, "text": text } }),
+    );
+    let diags = c.diagnostics(&main_uri);
+    assert!(
+        diags
+            .as_array()
+            .expect("a list")
+            .iter()
+            .all(|d| d["severity"] != json!(1)),
+        "{diags:#}"
+    );
+    let def = c.request("textDocument/definition", at(&main_uri, text, "r);", 0));
+    assert_eq!(
+        def["range"]["start"],
+        json!({ "line": 0, "character": 5 }),
+        "{def}"
+    );
+    c.stop();
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -35,7 +35,7 @@ use documents::{Checked, Documents};
 use lsp_server::{Connection, Message, Notification, Request, RequestId, Response};
 use lsp_types as lsp;
 use navigate::Index;
-use sdfc_compiler::{FileId, Span};
+use sdfc_compiler::{FileId, Limits, Span};
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -47,8 +47,8 @@ pub const DEBOUNCE: Duration = Duration::from_millis(150);
 
 /// `sdfc lsp`: serves on stdin/stdout until the client says `exit`; exits 0 after
 /// `shutdown`, else 1 (as the protocol says), and 2 when it cannot write to the client.
-pub fn run() -> ExitCode {
-    match serve_stream(std::io::stdin(), std::io::stdout().lock()) {
+pub fn run(limits: Limits) -> ExitCode {
+    match serve_stream(std::io::stdin(), std::io::stdout().lock(), limits) {
         Ok(exit) => {
             if let Exit::Closed { shutdown: false } = exit {
                 eprintln!("sdfc lsp: the input ended before `shutdown` and `exit`");
@@ -95,14 +95,17 @@ pub enum ServeError {
 }
 
 /// Serves the messages framed in `input` (read on a thread of its own, as they come) until
-/// `exit` or the end of the input, writing to `output`.
+/// `exit` or the end of the input, writing to `output`, within `limits`.
 pub fn serve_stream<R: std::io::Read + Send + 'static>(
     input: R,
     mut output: impl std::io::Write,
+    limits: Limits,
 ) -> Result<Exit, ServeError> {
     let (sender, receiver) = crossbeam_channel::bounded::<wire::Incoming>(16);
+    let message_limit = wire::message_limit(&limits);
     std::thread::spawn(move || {
-        let mut reader = wire::Reader::new(std::io::BufReader::new(input));
+        let reader = std::io::BufReader::new(input);
+        let mut reader = wire::Reader::with_limit(reader, message_limit);
         // Ends at the end of the input, when it cannot be read, or when the server is gone.
         while let Ok(Some(frame)) = reader.next_frame() {
             if sender.send(wire::classify(frame)).is_err() {
@@ -110,23 +113,34 @@ pub fn serve_stream<R: std::io::Read + Send + 'static>(
             }
         }
     });
-    serve_with(&mut ChannelInbox(receiver), &mut WriteOutbox(&mut output))
+    serve_with(
+        &mut ChannelInbox(receiver),
+        &mut WriteOutbox(&mut output),
+        limits,
+    )
 }
 
 /// Serves the messages framed in `input`, in order, as if the client paused between each two
 /// long enough for diagnostics to be published, until `exit` or the end of the input, writing
-/// to `output`: the whole server in one thread, deterministic (for fuzzing).
+/// to `output`, within the default limits: the whole server in one thread, deterministic (for
+/// fuzzing).
 pub fn serve_bytes(input: &[u8], output: &mut Vec<u8>) -> Result<Exit, ServeError> {
+    let limits = Limits::default();
     let mut inbox = BytesInbox {
-        reader: wire::Reader::new(input),
+        reader: wire::Reader::with_limit(input, wire::message_limit(&limits)),
     };
-    serve_with(&mut inbox, &mut WriteOutbox(output))
+    serve_with(&mut inbox, &mut WriteOutbox(output), limits)
 }
 
-/// Serves an in-memory connection (the same loop: tests drive it with typed messages).
+/// Serves an in-memory connection within the default limits (the same loop: tests drive it
+/// with typed messages).
 pub fn serve(connection: &Connection) -> Result<Exit, ServeError> {
     let mut inbox = ChannelInbox(connection.receiver.clone());
-    serve_with(&mut inbox, &mut ConnectionOutbox(connection))
+    serve_with(
+        &mut inbox,
+        &mut ConnectionOutbox(connection),
+        Limits::default(),
+    )
 }
 
 /// What the loop gets next.
@@ -252,9 +266,16 @@ enum Stage {
 
 /// The loop: `initialize`, then requests and notifications until `exit` or the end of the
 /// input. What is not a message is answered with an error and the loop goes on.
-fn serve_with(inbox: &mut dyn Inbox, out: &mut dyn Outbox) -> Result<Exit, ServeError> {
+fn serve_with(
+    inbox: &mut dyn Inbox,
+    out: &mut dyn Outbox,
+    limits: Limits,
+) -> Result<Exit, ServeError> {
     use lsp_server::ErrorCode;
-    let mut server = Server::default();
+    let mut server = Server {
+        limits,
+        ..Server::default()
+    };
     let mut stage = Stage::Starting;
     loop {
         let wait = server
@@ -360,6 +381,8 @@ struct Analysed {
 /// The server's state.
 #[derive(Debug, Default)]
 struct Server {
+    /// The limits of checking a document and reading its imports.
+    limits: Limits,
     docs: Documents,
     /// The URI each open document was opened under, by normalised path.
     uris: HashMap<String, lsp::Uri>,
@@ -488,7 +511,7 @@ impl Server {
         if let Some(a) = self.cache.get(&name) {
             return Some(a.clone());
         }
-        let checked = self.docs.check(&path)?;
+        let checked = self.docs.check(&path, &self.limits)?;
         let index = Index::new(&checked.sources);
         let a = Rc::new(Analysed { checked, index });
         self.cache.insert(name, a.clone());

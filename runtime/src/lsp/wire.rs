@@ -3,7 +3,7 @@
 //! stream), and messages written to any sink.
 //!
 //! Reading never allocates more than the bytes that arrived: a body is collected as it comes,
-//! up to [`MESSAGE_LIMIT`]; a longer one is discarded as it comes. After a malformed header the
+//! up to [`message_limit`]; a longer one is discarded as it comes. After a malformed header the
 //! reader skips to the next `Content-Length:`, and a body ends early where `Content-Length:`
 //! begins outside a JSON string (JSON text has no such bytes there: it is the next message's
 //! header), so that a message whose `Content-Length` says too much does not swallow the next.
@@ -13,9 +13,13 @@ use lsp_server::{ErrorCode, Message, Notification, Request, RequestId};
 use serde_json::{value::RawValue, Value};
 use std::io::{self, BufRead, Write};
 
-/// The largest body of one message, in bytes (a document of the default `file_size` limit,
-/// its escapes and the message around it fit).
-pub const MESSAGE_LIMIT: u64 = 512 << 20;
+/// The largest body of one message, in bytes: twice the `file_size` limit (a document of
+/// that size, its JSON escapes and the message around it fit).
+pub fn message_limit(limits: &sdfc_compiler::Limits) -> u64 {
+    limits
+        .get(sdfc_compiler::Limit::FileSize)
+        .saturating_mul(2 << 20)
+}
 
 /// The longest header line kept; a longer one is malformed (and skipped as it comes).
 const LINE_LIMIT: usize = 1024;
@@ -41,8 +45,8 @@ pub enum FrameError {
         /// The value written.
         value: String,
     },
-    /// The body is longer than [`MESSAGE_LIMIT`].
-    #[error("a message of {length} bytes is over the limit of {limit} bytes")]
+    /// The body is longer than the limit ([`message_limit`]).
+    #[error("a message of {length} bytes is over the limit of {limit} bytes (twice the file_size limit)")]
     TooLong {
         /// Its `Content-Length`.
         length: u64,
@@ -83,11 +87,6 @@ pub struct Reader<R> {
 }
 
 impl<R: BufRead> Reader<R> {
-    /// A reader of `input`, with bodies up to [`MESSAGE_LIMIT`].
-    pub fn new(input: R) -> Reader<R> {
-        Reader::with_limit(input, MESSAGE_LIMIT)
-    }
-
     /// A reader of `input` with bodies up to `limit` bytes.
     pub fn with_limit(input: R, limit: u64) -> Reader<R> {
         Reader {

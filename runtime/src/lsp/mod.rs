@@ -376,6 +376,8 @@ pub fn capabilities() -> lsp::ServerCapabilities {
 struct Analysed {
     checked: Checked,
     index: Index,
+    /// The lines of the entry document.
+    lines: text::Lines,
 }
 
 /// The server's state.
@@ -513,7 +515,12 @@ impl Server {
         }
         let checked = self.docs.check(&path, &self.limits)?;
         let index = Index::new(&checked.sources);
-        let a = Rc::new(Analysed { checked, index });
+        let lines = text::Lines::new(checked.sources.text(checked.entry));
+        let a = Rc::new(Analysed {
+            checked,
+            index,
+            lines,
+        });
         self.cache.insert(name, a.clone());
         Some(a)
     }
@@ -525,7 +532,7 @@ impl Server {
             let t = c.sources.text(span.file);
             return Some(lsp::Location::new(
                 uri.clone(),
-                text::range(t, span.start as usize, span.end as usize),
+                a.lines.range(t, span.start as usize, span.end as usize),
             ));
         }
         let name = c.sources.name(span.file);
@@ -732,7 +739,7 @@ fn symbols(a: &Analysed) -> Vec<lsp::DocumentSymbol> {
     use sdfc_compiler::ast;
     let c = &a.checked;
     let t = c.sources.text(c.entry);
-    let r = |s: Span| text::range(t, s.start as usize, s.end as usize);
+    let r = |s: Span| a.lines.range(t, s.start as usize, s.end as usize);
     let sym = |name: String,
                kind: lsp::SymbolKind,
                span: Span,

@@ -57,6 +57,8 @@ pub enum Limit {
     Registers,
     /// Triangles of the meshes one scene reads (`mesh(path)`), in all.
     Triangles,
+    /// Bytes of one file read (a scene, an import, a mesh, a font), in MiB.
+    FileSize,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -71,7 +73,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 21] = [
+    pub const ALL: [Limit; 22] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -93,6 +95,7 @@ impl Limit {
         Limit::Cells,
         Limit::Registers,
         Limit::Triangles,
+        Limit::FileSize,
     ];
 
     fn spec(self) -> Spec {
@@ -234,6 +237,14 @@ impl Limit {
                 1 << 28,
                 "triangles of the meshes one scene reads",
             ),
+            // Files are read whole: a mesh of the default `triangles` limit is about 40 MB as
+            // binary STL and several times that as text; a scene is far smaller.
+            Limit::FileSize => s(
+                "file_size",
+                256,
+                1 << 20,
+                "MiB of one file read (a scene, an import, a mesh, a font)",
+            ),
         }
     }
 
@@ -304,7 +315,7 @@ impl Spelling {
 /// one ([`Spelling`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 21],
+    values: [u64; 22],
     spelling: Spelling,
 }
 

@@ -7,7 +7,7 @@ use sdfc_compiler::{
     analytic::{Choice, Reason, Traceable},
     check_at,
     diagnostics::{self, Diagnostic},
-    lower_within, Exactness, Limits, Loader, LowerOptions, Lowered, Scene, SourceMap, Span,
+    lower_within, Exactness, Limit, Limits, Loader, LowerOptions, Lowered, Scene, SourceMap, Span,
 };
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -23,9 +23,109 @@ pub enum DiagnosticFormat {
     Json,
 }
 
-/// Loads imports relative to the importing file.
-#[derive(Debug, Default)]
-pub struct FsLoader;
+/// Why a file cannot be read ([`read_file`]).
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    /// The operating system's error.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// It is not a regular file (a FIFO or a device would be read forever, or block).
+    #[error("it is {kind}, not a regular file")]
+    NotAFile {
+        /// What it is: `a directory`, `a FIFO`, `a character device`, ….
+        kind: &'static str,
+    },
+    /// It is larger than the `file_size` limit.
+    #[error("it is over the file_size limit of {limit_mib} MiB; raise it with `--limit file_size={}`", .size.map_or_else(|| "N".to_string(), |s| s.div_ceil(1 << 20).to_string()))]
+    TooLarge {
+        /// The limit, in MiB.
+        limit_mib: u64,
+        /// Its size in bytes, when known.
+        size: Option<u64>,
+    },
+}
+
+/// What a file that is not a regular file is, in words.
+fn kind(t: std::fs::FileType) -> Option<&'static str> {
+    if t.is_file() {
+        return None;
+    }
+    if t.is_dir() {
+        return Some("a directory");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return Some("a FIFO");
+        }
+        if t.is_char_device() {
+            return Some("a character device");
+        }
+        if t.is_block_device() {
+            return Some("a block device");
+        }
+        if t.is_socket() {
+            return Some("a socket");
+        }
+    }
+    Some("not a file")
+}
+
+/// Reads the regular file at `path` whole, if it is at most `limit_mib` MiB (the `file_size`
+/// limit). A FIFO, a device, a socket or a directory is refused at once: it is opened without
+/// blocking (a FIFO with no writer would wait for one) and looked at before anything is read;
+/// and no more than the limit and a byte is ever read, whatever the file's size says.
+pub fn read_file(path: &Path, limit_mib: u64) -> Result<Vec<u8>, FileError> {
+    use std::io::Read;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let meta = file.metadata()?;
+    if let Some(kind) = kind(meta.file_type()) {
+        return Err(FileError::NotAFile { kind });
+    }
+    let limit = limit_mib.saturating_mul(1 << 20);
+    let too_large = |size| FileError::TooLarge { limit_mib, size };
+    if meta.len() > limit {
+        return Err(too_large(Some(meta.len())));
+    }
+    let mut bytes = Vec::with_capacity(usize::try_from(meta.len()).unwrap_or(0));
+    file.take(limit.saturating_add(1)).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(None));
+    }
+    Ok(bytes)
+}
+
+/// `text` without the byte-order mark that some editors write at the start of a UTF-8 file
+/// (so that the columns of the first line count from its first visible character).
+pub fn without_bom(mut text: String) -> String {
+    if text.starts_with(sdfc_compiler::lexer::BOM) {
+        text.drain(..sdfc_compiler::lexer::BOM.len_utf8());
+    }
+    text
+}
+
+/// Loads imports relative to the importing file, each within the `file_size` limit.
+#[derive(Debug)]
+pub struct FsLoader {
+    /// The `file_size` limit, in MiB.
+    pub file_size: u64,
+}
+
+impl Default for FsLoader {
+    fn default() -> Self {
+        FsLoader {
+            file_size: Limit::FileSize.default_value(),
+        }
+    }
+}
 
 impl FsLoader {
     /// The file that `import "path"` in the file named `from` reads.
@@ -39,17 +139,17 @@ impl Loader for FsLoader {
     fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
         let full = FsLoader::resolve(from, path);
         let name = normalise(&full);
-        let bytes =
-            std::fs::read(&full).map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
+        let bytes = read_file(&full, self.file_size)
+            .map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
         let text = String::from_utf8(bytes)
             .map_err(|_| format!("`{}` is not valid UTF-8", full.display()))?;
-        Ok((name, text))
+        Ok((name, without_bom(text)))
     }
 
     fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
         let full = FsLoader::resolve(from, path);
-        let bytes =
-            std::fs::read(&full).map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
+        let bytes = read_file(&full, self.file_size)
+            .map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
         Ok((normalise(&full), bytes))
     }
 }
@@ -86,13 +186,13 @@ pub struct Loaded {
 /// Why a scene's entry file cannot be read ([`Source::read`]), phrased for the user.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
-    /// The file cannot be read.
+    /// The file cannot be read (or is not a regular file, or is over the `file_size` limit).
     #[error("cannot read `{}`: {source}", .path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// Why.
-        source: std::io::Error,
+        source: FileError,
     },
     /// Its bytes are not UTF-8.
     #[error("`{}` is not valid UTF-8 (first bad byte at offset {offset})", .path.display())]
@@ -112,7 +212,7 @@ pub fn load(path: &Path) -> Result<Loaded, ReadError> {
 
 /// [`load`] within the given limits.
 pub fn load_with(path: &Path, limits: &Limits) -> Result<Loaded, ReadError> {
-    Ok(Source::read(path)?.check(limits, 0.0))
+    Ok(Source::read_within(path, limits)?.check(limits, 0.0))
 }
 
 /// A scene file and its imports read once, to be checked at many times: the frames of an
@@ -128,12 +228,21 @@ pub struct Source {
     /// resolved): a file reached by two routes, a link and its target, has one name, so it
     /// is read once (and an import of the entry file through a link is a cycle).
     names: std::collections::HashMap<PathBuf, String>,
+    /// The `file_size` limit of the files read, in MiB.
+    file_size: u64,
 }
 
 impl Source {
-    /// Reads the entry file. `Err` is an IO or encoding problem.
+    /// Reads the entry file within the default limits. `Err` is an IO or encoding problem.
     pub fn read(path: &Path) -> Result<Source, ReadError> {
-        let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+        Source::read_within(path, &Limits::default())
+    }
+
+    /// Reads the entry file (and later its imports) within the `file_size` limit of `limits`.
+    /// `Err` is an IO or encoding problem.
+    pub fn read_within(path: &Path, limits: &Limits) -> Result<Source, ReadError> {
+        let file_size = limits.get(Limit::FileSize);
+        let bytes = read_file(path, file_size).map_err(|source| ReadError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -141,6 +250,7 @@ impl Source {
             path: path.to_path_buf(),
             offset: e.utf8_error().valid_up_to(),
         })?;
+        let text = without_bom(text);
         let name = normalise(path);
         let mut names = std::collections::HashMap::new();
         if let Ok(canonical) = std::fs::canonicalize(path) {
@@ -151,6 +261,7 @@ impl Source {
             text,
             imports: Default::default(),
             names,
+            file_size,
         })
     }
 
@@ -168,6 +279,7 @@ impl Source {
             text,
             imports: Default::default(),
             names,
+            file_size: Limit::FileSize.default_value(),
         }
     }
 
@@ -178,6 +290,7 @@ impl Source {
 
     /// Checks the scene within `limits` at the time `t` = `time` seconds.
     pub fn check(&mut self, limits: &Limits, time: f64) -> Loaded {
+        self.file_size = limits.get(Limit::FileSize);
         let mut sources = SourceMap::new();
         let entry = sources.add(self.name.clone(), self.text.clone());
         let (scene, diagnostics) = check_at(&mut sources, entry, self, limits, time);
@@ -195,7 +308,7 @@ impl Loader for Source {
         if let Some(done) = self.imports.get(&key) {
             return done.clone();
         }
-        let mut loaded = FsLoader.load(from, path);
+        let mut loaded = self.loader().load(from, path);
         if let Ok((name, _)) = &mut loaded {
             if let Ok(canonical) = std::fs::canonicalize(FsLoader::resolve(from, path)) {
                 name.clone_from(self.names.entry(canonical).or_insert_with(|| name.clone()));
@@ -206,7 +319,15 @@ impl Loader for Source {
     }
 
     fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        FsLoader.load_bytes(from, path)
+        self.loader().load_bytes(from, path)
+    }
+}
+
+impl Source {
+    fn loader(&self) -> FsLoader {
+        FsLoader {
+            file_size: self.file_size,
+        }
     }
 }
 

@@ -376,6 +376,25 @@ impl AtomicFile {
         })
     }
 
+    /// Gives the file the permissions of `meta` (the file it replaces), and its owner and
+    /// group where the process may (as root; another user cannot give a file away, and the
+    /// file stays theirs, as any rewrite would leave it).
+    pub fn keep_metadata_of(&mut self, meta: &std::fs::Metadata) -> std::io::Result<()> {
+        let Some(file) = self.file.as_ref().map(|b| b.get_ref()) else {
+            return Ok(());
+        };
+        file.set_permissions(meta.permissions())?;
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            match std::os::unix::fs::fchown(file, Some(meta.uid()), Some(meta.gid())) {
+                Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => {}
+                other => other?,
+            }
+        }
+        Ok(())
+    }
+
     /// Flushes, syncs (unless [`AtomicFile::unsynced`]) and renames the file onto its target.
     pub fn finish(self) -> std::io::Result<()> {
         self.finish_timed().map(|_| ())

@@ -91,6 +91,10 @@ struct LspArgs {
     /// pass it).
     #[arg(long)]
     stdio: bool,
+    /// The limits of checking each document, and `file_size`: of each file read, and of a
+    /// message (twice it, for a document and its JSON escapes).
+    #[command(flatten)]
+    limits: commands::LimitArgs,
 }
 
 fn main() -> ExitCode {
@@ -124,7 +128,7 @@ fn main() -> ExitCode {
         Command::Mesh(args) => commands::mesh::run(args),
         Command::View(args) => commands::view::run(args),
         Command::Fmt(args) => commands::fmt::run(args),
-        Command::Lsp(_) => sdfc_runtime::lsp::run(),
+        Command::Lsp(args) => sdfc_runtime::lsp::run(args.limits.limits()),
         Command::Completions(args) => completions(args.shell),
     }
 }

@@ -7,6 +7,7 @@
 
 use lsp_server::{Connection, Message, Notification, Request, RequestId, Response};
 use sdfc_runtime::lsp::text::path_to_uri;
+use sdfc_runtime::lsp::{Exit, ServeError};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -14,7 +15,7 @@ use std::time::Duration;
 /// A client on one end of an in-memory connection, the server on a thread at the other.
 struct Client {
     conn: Connection,
-    server: Option<std::thread::JoinHandle<Result<(), String>>>,
+    server: Option<std::thread::JoinHandle<Result<Exit, ServeError>>>,
     next: i32,
     /// Diagnostics published so far, by URI (the latest).
     published: std::collections::HashMap<String, Value>,
@@ -104,7 +105,7 @@ impl Client {
             .expect("running")
             .join()
             .expect("no panic");
-        assert_eq!(result, Ok(()));
+        assert!(matches!(result, Ok(Exit::Clean)), "{result:?}");
     }
 }
 
@@ -672,5 +673,356 @@ fn neovim_gets_diagnostics_applies_a_fix_hovers_and_goes_to_a_definition() {
         json!({ "file": "lib.sdf", "row": 2, "col": 3 }),
         "{seen:#}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `body` framed as the protocol says.
+fn framed(body: &[u8]) -> Vec<u8> {
+    let mut out = format!("Content-Length: {}\r\n\r\n", body.len()).into_bytes();
+    out.extend_from_slice(body);
+    out
+}
+
+fn framed_json(v: Value) -> Vec<u8> {
+    framed(v.to_string().as_bytes())
+}
+
+/// Runs `sdfc lsp` on `input` (written whole, then the input closed) and returns the
+/// messages it wrote and its exit status.
+fn run_lsp(input: Vec<u8>) -> (Vec<Value>, Option<i32>) {
+    let (messages, status, _) = run_lsp_raw(input);
+    (messages, status)
+}
+
+/// [`run_lsp`], and the bytes it wrote.
+fn run_lsp_raw(input: Vec<u8>) -> (Vec<Value>, Option<i32>, Vec<u8>) {
+    use std::io::{Read, Write};
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .arg("lsp")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("start sdfc lsp");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let writer = std::thread::spawn(move || {
+        // The server may exit before reading everything (after `exit`).
+        let _ = stdin.write_all(&input);
+    });
+    let mut out = Vec::new();
+    child
+        .stdout
+        .take()
+        .expect("stdout")
+        .read_to_end(&mut out)
+        .expect("read");
+    let started = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s;
+        }
+        if started.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("sdfc lsp did not exit");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    writer.join().expect("writer");
+    let mut messages = Vec::new();
+    let mut rest = out.as_slice();
+    while !rest.is_empty() {
+        let end = rest
+            .windows(4)
+            .position(|w| w == b"\r\n\r\n")
+            .expect("a header");
+        let header = std::str::from_utf8(&rest[..end]).expect("ASCII header");
+        let length: usize = header
+            .strip_prefix("Content-Length: ")
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("header {header:?}"));
+        let body = &rest[end + 4..end + 4 + length];
+        messages.push(serde_json::from_slice(body).expect("JSON"));
+        rest = &rest[end + 4 + length..];
+    }
+    (messages, status.code(), out)
+}
+
+fn initialize() -> Vec<u8> {
+    framed_json(
+        json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "capabilities": {} } }),
+    )
+}
+
+/// Each malformed message, between `initialize` and a valid request, is answered with the
+/// JSON-RPC error the protocol gives it (a parse error for bytes that are not a JSON message,
+/// an invalid request for JSON that is not one), and the valid request after it is answered.
+#[test]
+fn malformed_messages_are_answered_with_errors_and_the_server_reads_on() {
+    const PARSE: i64 = -32700;
+    const INVALID: i64 = -32600;
+    let cases: Vec<(&str, Vec<u8>, &[i64])> = vec![
+        (
+            "a huge Content-Length",
+            b"Content-Length: 1000000000000\r\n\r\n".to_vec(),
+            &[PARSE],
+        ),
+        (
+            "a Content-Length of 4 GB",
+            b"Content-Length: 4000000000\r\n\r\n{}".to_vec(),
+            &[PARSE],
+        ),
+        ("not JSON", framed(b"not json"), &[PARSE]),
+        ("truncated JSON", framed(b"{\"id\": 2, \"meth"), &[PARSE]),
+        (
+            "a batch",
+            framed(b"[{\"jsonrpc\":\"2.0\",\"id\":3,\"method\":\"shutdown\"}]"),
+            &[INVALID],
+        ),
+        ("not UTF-8", framed(b"{\"a\":\"\xff\xfe\"}"), &[PARSE]),
+        (
+            "a short Content-Length",
+            b"Content-Length: 3\r\n\r\n{\"jsonrpc\":\"2.0\"}".to_vec(),
+            &[PARSE, PARSE],
+        ),
+        (
+            "a long Content-Length",
+            b"Content-Length: 500\r\n\r\n{\"jsonrpc\":\"2.0\"}".to_vec(),
+            &[PARSE],
+        ),
+        (
+            "a negative Content-Length",
+            b"Content-Length: -5\r\n\r\n{}".to_vec(),
+            &[PARSE],
+        ),
+        (
+            "a zero Content-Length",
+            b"Content-Length: 0\r\n\r\n".to_vec(),
+            &[PARSE],
+        ),
+        (
+            "no Content-Length",
+            b"Content-Type: application/json\r\n\r\n{}".to_vec(),
+            &[PARSE],
+        ),
+        (
+            "a Content-Length that is not a number",
+            b"Content-Length: twelve\r\n\r\n{}".to_vec(),
+            &[PARSE],
+        ),
+        ("a message that is a number", framed(b"42"), &[INVALID]),
+        (
+            "a request whose method is not a string",
+            framed(b"{\"jsonrpc\":\"2.0\",\"id\":5,\"method\":7}"),
+            &[INVALID],
+        ),
+    ];
+    let symbols = json!({ "jsonrpc": "2.0", "id": 99, "method": "textDocument/documentSymbol",
+        "params": { "textDocument": { "uri": "file:///nowhere/a.sdf" } } });
+    for (what, bad, codes) in cases {
+        let mut input = initialize();
+        input.extend(bad);
+        input.extend(framed_json(symbols.clone()));
+        let (messages, _) = run_lsp(input);
+        assert_eq!(messages[0]["id"], json!(1), "{what}: {messages:?}");
+        let errors: Vec<i64> = messages[1..messages.len() - 1]
+            .iter()
+            .map(|m| m["error"]["code"].as_i64().unwrap_or(0))
+            .collect();
+        assert_eq!(errors, codes, "{what}: {messages:#?}");
+        // The valid request after it is answered (the document is not open: an error naming
+        // that, from the request's own handler).
+        let last = messages.last().expect("an answer");
+        assert_eq!(last["id"], json!(99), "{what}: {messages:#?}");
+        assert_eq!(
+            last["error"]["message"],
+            json!("the document is not open"),
+            "{what}: {last}"
+        );
+    }
+}
+
+/// Framing with bare line feeds (no carriage returns) and a header of any case is read.
+#[test]
+fn framing_with_line_feeds_alone_is_read() {
+    let body = json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "capabilities": {} } })
+        .to_string();
+    let mut input = format!("content-length: {}\n\n{body}", body.len()).into_bytes();
+    input.extend(framed_json(
+        json!({ "jsonrpc": "2.0", "id": 2, "method": "shutdown" }),
+    ));
+    input.extend(framed_json(json!({ "jsonrpc": "2.0", "method": "exit" })));
+    let (messages, status) = run_lsp(input);
+    assert_eq!(messages.len(), 2, "{messages:#?}");
+    assert!(messages[0]["result"]["capabilities"].is_object());
+    assert_eq!(messages[1]["id"], json!(2));
+    assert_eq!(status, Some(0));
+}
+
+/// Ids the protocol does not allow (a fraction, an integer beyond 32 bits, an object) are
+/// refused with an error to that id, not ignored; a request after `shutdown` is refused;
+/// `exit` after `shutdown` exits 0 and without it 1, as the protocol says.
+#[test]
+fn odd_ids_and_requests_after_shutdown_are_refused_and_exit_says_how_it_ended() {
+    let hover = |id: &str| {
+        framed(
+            format!(
+                "{{\"jsonrpc\":\"2.0\",\"id\":{id},\"method\":\"textDocument/hover\",\"params\":{{}}}}"
+            )
+            .as_bytes(),
+        )
+    };
+    let mut input = initialize();
+    input.extend(hover("1.5"));
+    input.extend(hover("1180591620717411303424"));
+    input.extend(hover("{\"a\":1}"));
+    input.extend(framed_json(
+        json!({ "jsonrpc": "2.0", "id": 2, "method": "shutdown" }),
+    ));
+    input.extend(hover("3"));
+    input.extend(framed_json(json!({ "jsonrpc": "2.0", "method": "exit" })));
+    let (messages, status, raw) = run_lsp_raw(input);
+    assert_eq!(messages.len(), 6, "{messages:#?}");
+    assert_eq!(messages[1]["id"], json!(1.5), "{:#}", messages[1]);
+    assert_eq!(messages[1]["error"]["code"], json!(-32600));
+    assert!(
+        String::from_utf8_lossy(&raw).contains("\"id\":1180591620717411303424"),
+        "the id as it was written"
+    );
+    assert!(messages[2]["id"].is_number(), "{:#}", messages[2]);
+    assert_eq!(messages[2]["error"]["code"], json!(-32600));
+    assert_eq!(messages[3]["id"], json!({ "a": 1 }));
+    assert_eq!(messages[3]["error"]["code"], json!(-32600));
+    assert_eq!(messages[4]["id"], json!(2));
+    assert_eq!(messages[4]["result"], Value::Null);
+    assert_eq!(messages[5]["id"], json!(3));
+    assert_eq!(
+        messages[5]["error"]["code"],
+        json!(-32600),
+        "{:#}",
+        messages[5]
+    );
+    assert_eq!(status, Some(0));
+
+    let mut input = initialize();
+    input.extend(framed_json(json!({ "jsonrpc": "2.0", "method": "exit" })));
+    let (_, status) = run_lsp(input);
+    assert_eq!(status, Some(1), "exit without shutdown");
+    let (messages, status) = run_lsp(initialize());
+    assert_eq!(messages.len(), 1);
+    assert_eq!(status, Some(1), "the input closed without shutdown");
+}
+
+/// Rename refuses a new name that is a keyword or would hide a built-in (the file's uses of
+/// it would then mean the renamed declaration), and one that is not a name at all.
+#[test]
+fn rename_refuses_keywords_and_built_in_names() {
+    let dir = temp_dir("rename");
+    let main = dir.join("main.sdf");
+    let main_uri = uri(&main);
+    let text = "let r = 1;\nscene {\n    sphere(r * pi);\n}\n";
+    let mut c = Client::start();
+    c.notify(
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": main_uri, "languageId": "sdf", "version": 1, "text": text } }),
+    );
+    for (new, why) in [
+        ("let", "keyword"),
+        ("scene", "keyword"),
+        ("true", "keyword"),
+        ("sphere", "built-in function"),
+        ("pi", "built-in constant"),
+        ("t", "time"),
+        ("2r", "not a name"),
+        ("a b", "not a name"),
+        ("", "not a name"),
+    ] {
+        let mut rename = at(&main_uri, text, "r = 1", 0);
+        rename["newName"] = json!(new);
+        let r = c.respond("textDocument/rename", rename);
+        let e = r
+            .response_result
+            .err()
+            .unwrap_or_else(|| panic!("`{new}` accepted"));
+        assert_eq!(e.code, -32602, "{new}: {}", e.message);
+        assert!(e.message.contains(why), "{new}: {}", e.message);
+    }
+    let mut rename = at(&main_uri, text, "r = 1", 0);
+    rename["newName"] = json!("radius");
+    let edit = c.request("textDocument/rename", rename);
+    assert_eq!(
+        edit["changes"][&main_uri].as_array().map(Vec::len),
+        Some(2),
+        "{edit}"
+    );
+    c.stop();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `serve_bytes` (the fuzz target's entry) serves a whole stream in one thread: diagnostics
+/// are published before the next message, requests answered, and `exit` after `shutdown` is
+/// a clean end.
+#[test]
+fn serve_bytes_serves_a_stream_in_one_thread() {
+    let mut input = initialize();
+    input.extend(framed_json(
+        json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }),
+    ));
+    input.extend(framed_json(
+        json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen",
+        "params": { "textDocument": { "uri": "file:///nowhere/a.sdf", "languageId": "sdf",
+        "version": 1, "text": "scene {\n  sphre(1);\n}\n" } } }),
+    ));
+    input.extend(b"Content-Length: 3\r\n\r\n[1]");
+    input.extend(framed_json(
+        json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/documentSymbol",
+        "params": { "textDocument": { "uri": "file:///nowhere/a.sdf" } } }),
+    ));
+    input.extend(framed_json(
+        json!({ "jsonrpc": "2.0", "id": 3, "method": "shutdown" }),
+    ));
+    input.extend(framed_json(json!({ "jsonrpc": "2.0", "method": "exit" })));
+    let mut output = Vec::new();
+    let exit = sdfc_runtime::lsp::serve_bytes(&input, &mut output).expect("written");
+    assert_eq!(exit, Exit::Clean);
+    let text = String::from_utf8(output).expect("UTF-8");
+    let diagnostics = text.find("publishDiagnostics").expect("diagnostics");
+    assert!(text[diagnostics..].contains("sphre"), "{text}");
+    let batch = text.find("batches").expect("the batch refused");
+    let symbols = text.find("\"id\":2").expect("the symbols");
+    assert!(diagnostics < batch && batch < symbols, "{text}");
+    assert!(
+        text.contains("\"id\":3,\"jsonrpc\":\"2.0\",\"result\":null"),
+        "{text}"
+    );
+}
+
+/// A byte-order mark at the start of a document is skipped: no diagnostic about it, and the
+/// positions of the first line count it as the client does (one UTF-16 unit).
+#[test]
+fn a_byte_order_mark_is_skipped_by_the_language_server() {
+    let dir = temp_dir("bom");
+    let main_uri = uri(&dir.join("main.sdf"));
+    let text = "\u{feff}let r = 1;\nscene {\n    sphere(r);\n}\n";
+    let mut c = Client::start();
+    c.notify(
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": main_uri, "languageId": "sdf", "version": 1, "text": text } }),
+    );
+    let diags = c.diagnostics(&main_uri);
+    assert!(
+        diags
+            .as_array()
+            .expect("a list")
+            .iter()
+            .all(|d| d["severity"] != json!(1)),
+        "{diags:#}"
+    );
+    let def = c.request("textDocument/definition", at(&main_uri, text, "r);", 0));
+    assert_eq!(
+        def["range"]["start"],
+        json!({ "line": 0, "character": 5 }),
+        "{def}"
+    );
+    c.stop();
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -82,6 +82,8 @@ struct Line {
 /// Formats `text`, a whole `.sdf` file. A file nested deeper than the default `nesting`
 /// limit is refused as the checker refuses it (E0507).
 pub fn format(text: &str) -> Result<String, Error> {
+    // A byte-order mark at the start is not kept: the formatted text is plain UTF-8.
+    let text = text.strip_prefix(lexer::BOM).unwrap_or(text);
     let file = FileId(0);
     let ((tree, diags), _) = parse_within(file, text, Some(&Limits::default()));
     let errors: Vec<Diagnostic> = diags
@@ -462,7 +464,12 @@ fn render(text: &str, tokens: &[(Token, Span)], lines: &[Line]) -> String {
                 } => {
                     let body = text[start..end].trim_end().replace("\r\n", "\n");
                     if let Some(p) = prev {
-                        let width = indent * INDENT.len() + content.chars().count();
+                        // The column on the output's line: after the last line break of a
+                        // block comment earlier on the line, if there is one.
+                        let width = match content.rfind('\n') {
+                            Some(nl) => content[nl + 1..].chars().count(),
+                            None => indent * INDENT.len() + content.chars().count(),
+                        };
                         if is_line && gap > 1 && column > width {
                             content.push_str(&" ".repeat(column - width));
                         } else if !matches!(p, Elem::Token(j) if matches!(tokens[j].0, Token::LParen | Token::LBracket))
@@ -585,6 +592,22 @@ mod tests {
             "scene {\n\n  sphere(1);\n// last\n\n}\n",
             "scene {\n  sphere(1);\n  // last\n}\n",
         );
+    }
+
+    #[test]
+    fn a_comment_after_a_block_comment_over_lines_keeps_its_column_on_its_own_line() {
+        // The column of `// c` is counted from the line break inside the block comment, in
+        // the input and in the output alike, so formatting again changes nothing.
+        check("let d=/*\n*/1;  // c", "let d = /*\n*/ 1; // c\n");
+        check(
+            "let d=/*\n*/1;                    // c\n",
+            "let d = /*\n*/ 1;                   // c\n",
+        );
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_dropped() {
+        check("\u{feff}let a=1;\n", "let a = 1;\n");
     }
 
     #[test]

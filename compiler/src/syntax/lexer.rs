@@ -194,11 +194,15 @@ impl fmt::Display for Token {
 }
 
 /// Splits `text` into tokens. Lexical errors become diagnostics and the offending bytes are
-/// skipped, so the parser still sees every valid token.
+/// skipped, so the parser still sees every valid token. A byte-order mark at the start (which
+/// some editors write) is skipped; spans stay offsets into `text`.
 pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
     let mut tokens = Vec::new();
     let mut diags = Vec::new();
     let mut lexer = Token::lexer(text);
+    if text.starts_with(BOM) {
+        lexer.bump(BOM.len_utf8());
+    }
     while let Some(result) = lexer.next() {
         let range = lexer.span();
         let span = Span::new(file, range.clone());
@@ -249,6 +253,9 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
     }
     (tokens, diags)
 }
+
+/// The byte-order mark, U+FEFF, that may start a UTF-8 file.
+pub const BOM: char = '\u{feff}';
 
 /// The length in bytes of the body of a string whose opening quote is just before `rest`,
 /// and whether a closing quote follows it. The body is characters other than `"`, `\` and

@@ -149,7 +149,7 @@ pub fn animation(
                 .into(),
         );
     }
-    let mut source = frontend::Source::read(file).map_err(|e| {
+    let mut source = frontend::Source::read_within(file, limits).map_err(|e| {
         frontend::print_io_error(&e, format);
         2u8
     })?;

@@ -343,15 +343,11 @@ pub fn write_output(path: Option<&std::path::Path>, text: &str) -> ExitCode {
 
 /// Writes bytes to a file (atomically) or to standard output.
 pub fn write_bytes(path: Option<&std::path::Path>, bytes: &[u8]) -> ExitCode {
-    use std::io::Write;
     match path {
-        None => {
-            let mut out = std::io::stdout().lock();
-            if out.write_all(bytes).and_then(|_| out.flush()).is_err() {
-                return ExitCode::from(2);
-            }
-            ExitCode::SUCCESS
-        }
+        None => match super::write_stdout(bytes) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(code) => code,
+        },
         Some(p) => match crate::image::write_atomic(p, bytes) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {

@@ -5,7 +5,7 @@ use crate::frontend::{self, DiagnosticFormat};
 use crate::image::AtomicFile;
 use sdfc_compiler::{
     format::{format, Error},
-    SourceMap,
+    Limit, SourceMap,
 };
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -20,6 +20,9 @@ pub struct FmtArgs {
     /// Change nothing: name each file that would change, and exit 1 if any would.
     #[arg(long)]
     pub check: bool,
+    /// The limits (`file_size`: each file is read whole, up to it).
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// What became of one text.
@@ -69,28 +72,53 @@ fn sdf_files(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Formats standard input to standard output (with `--check`, writes nothing).
-fn stdin(check: bool) -> ExitCode {
-    let mut text = String::new();
-    if let Err(e) = std::io::stdin().read_to_string(&mut text) {
+/// Formats standard input (at most `file_size` MiB) to standard output (with `--check`,
+/// writes nothing).
+fn stdin(check: bool, file_size: u64) -> ExitCode {
+    let limit = file_size.saturating_mul(1 << 20);
+    let mut bytes = Vec::new();
+    if let Err(e) = std::io::stdin()
+        .lock()
+        .take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+    {
         eprintln!("error: cannot read standard input: {e}");
         return ExitCode::from(2);
     }
+    if bytes.len() as u64 > limit {
+        eprintln!(
+            "error: cannot read standard input: it is over the file_size limit of {file_size} MiB; raise it with `--limit file_size=N`"
+        );
+        return ExitCode::from(2);
+    }
+    let text = match String::from_utf8(bytes) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!(
+                "error: standard input is not valid UTF-8 (first bad byte at offset {})",
+                e.utf8_error().valid_up_to()
+            );
+            return ExitCode::from(2);
+        }
+    };
     let out = match format_text("<stdin>", &text) {
         Outcome::Refused => return ExitCode::from(1),
         Outcome::Same => text,
-        Outcome::Changed(out) if check => {
-            println!("<stdin>");
-            drop(out);
-            return ExitCode::from(1);
+        Outcome::Changed(_) if check => {
+            return match super::write_stdout(b"<stdin>\n") {
+                Ok(()) => ExitCode::from(1),
+                Err(code) => code,
+            };
         }
         Outcome::Changed(out) => out,
     };
     if check {
         return ExitCode::SUCCESS;
     }
-    let _ = std::io::stdout().lock().write_all(out.as_bytes());
-    ExitCode::SUCCESS
+    match super::write_stdout(out.as_bytes()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(code) => code,
+    }
 }
 
 /// Formats each file in place (written whole or not at all, through [`AtomicFile`]; a
@@ -98,8 +126,9 @@ fn stdin(check: bool) -> ExitCode {
 /// already were), 1 when a file has syntax errors or would change, 2 when a file cannot be
 /// read or written.
 pub fn run(args: FmtArgs) -> ExitCode {
+    let file_size = args.limits.limits().get(Limit::FileSize);
     if args.files.is_empty() || args.files == [PathBuf::from("-")] {
-        return stdin(args.check);
+        return stdin(args.check, file_size);
     }
     let mut files = Vec::new();
     let mut code = 0u8;
@@ -119,8 +148,18 @@ pub fn run(args: FmtArgs) -> ExitCode {
     files.retain(|f| seen.insert(std::fs::canonicalize(f).unwrap_or_else(|_| f.clone())));
     for file in &files {
         let name = file.display().to_string();
-        let text = match std::fs::read_to_string(file) {
-            Ok(t) => t,
+        let text = match frontend::read_file(file, file_size) {
+            Ok(bytes) => match String::from_utf8(bytes) {
+                Ok(t) => t,
+                Err(e) => {
+                    eprintln!(
+                        "error: {name} is not valid UTF-8 (first bad byte at offset {})",
+                        e.utf8_error().valid_up_to()
+                    );
+                    code = 2;
+                    continue;
+                }
+            },
             Err(e) => {
                 eprintln!("error: cannot read {name}: {e}");
                 code = 2;
@@ -131,12 +170,17 @@ pub fn run(args: FmtArgs) -> ExitCode {
             Outcome::Same => {}
             Outcome::Refused => code = code.max(1),
             Outcome::Changed(_) if args.check => {
-                println!("{name}");
+                if let Err(failed) = super::write_stdout(format!("{name}\n").as_bytes()) {
+                    return failed;
+                }
                 code = code.max(1);
             }
             Outcome::Changed(out) => {
                 let target = std::fs::canonicalize(file).unwrap_or_else(|_| file.clone());
+                // The new file takes the old one's permissions (and owner, where the process
+                // may give it: as root) before it replaces it.
                 let written = AtomicFile::unsynced(&target).and_then(|mut w| {
+                    w.keep_metadata_of(&std::fs::metadata(&target)?)?;
                     w.write_all(out.as_bytes())?;
                     w.finish()
                 });

@@ -144,6 +144,20 @@ impl JobArgs {
     }
 }
 
+/// Writes `bytes` to standard output and flushes it; a failure (a full disk: `> /dev/full`) is
+/// reported, `error: cannot write to standard output: …`, and is exit code 2. (A closed pipe
+/// ends the process quietly before this, by SIGPIPE, as `head` expects.)
+pub fn write_stdout(bytes: &[u8]) -> Result<(), std::process::ExitCode> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(bytes)
+        .and_then(|()| out.flush())
+        .map_err(|e| {
+            eprintln!("error: cannot write to standard output: {e}");
+            std::process::ExitCode::from(2)
+        })
+}
+
 /// `--limit NAME=VALUE`: the resource limits of a run.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct LimitArgs {
@@ -172,7 +186,7 @@ impl LimitArgs {
 /// there).
 pub fn limits_help() -> String {
     format!(
-        "Limits (`--limit NAME=VALUE` on check, compile, render, mesh, bench, pareto and view; \
+        "Limits (`--limit NAME=VALUE` on check, compile, render, mesh, bench, pareto, view, fmt and lsp; \
          docs/failures.md):\n\n{}",
         Limits::table()
     )

@@ -87,7 +87,7 @@ impl ParetoArgs {
 pub fn run(args: ParetoArgs) -> ExitCode {
     let job = args.job();
     let limits = &job.limits;
-    let mut source = match frontend::Source::read(&args.file) {
+    let mut source = match frontend::Source::read_within(&args.file, limits) {
         Ok(s) => s,
         Err(e) => return Error::from(e).exit(),
     };

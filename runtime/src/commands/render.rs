@@ -133,7 +133,7 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
         }
         _ => None,
     };
-    let mut source = frontend::Source::read(&args.file)?;
+    let mut source = frontend::Source::read_within(&args.file, &job.limits)?;
     run.lap("read", "the scene's file read");
     let frame = job.frame(&mut source, 0.0, true, &LowerOptions::default())?;
     run.split(

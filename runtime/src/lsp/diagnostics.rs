@@ -40,6 +40,7 @@ pub fn absolute(name: &str) -> std::path::PathBuf {
 /// top of it for each error in a file it imports (with that place as related information).
 pub fn convert(diags: &[Diagnostic], sources: &SourceMap, entry: FileId) -> Vec<lsp::Diagnostic> {
     let entry_text = sources.text(entry);
+    let lines = text::Lines::new(entry_text);
     let docs = docs_uri();
     diags
         .iter()
@@ -71,7 +72,7 @@ pub fn convert(diags: &[Diagnostic], sources: &SourceMap, entry: FileId) -> Vec<
                 })
                 .collect();
             let range = if span.file == entry {
-                text::range(entry_text, span.start as usize, span.end as usize)
+                lines.range(entry_text, span.start as usize, span.end as usize)
             } else {
                 message = format!("in `{}`: {message}", sources.name(span.file));
                 if let Some(location) = location(sources, span) {

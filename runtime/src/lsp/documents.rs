@@ -3,7 +3,7 @@
 
 use crate::frontend::{normalise, FsLoader};
 use sdfc_compiler::{
-    check_with_constants, Constant, Diagnostic, FileId, Limits, Loader, Scene, SourceMap,
+    check_with_constants, Constant, Diagnostic, FileId, Limit, Limits, Loader, Scene, SourceMap,
 };
 use std::collections::HashMap;
 use std::path::Path;
@@ -37,14 +37,19 @@ impl Documents {
 
     /// Checks the open document at `path` with everything it imports. `None` when it is not
     /// open.
-    pub fn check(&self, path: &Path) -> Option<Checked> {
+    pub fn check(&self, path: &Path, limits: &Limits) -> Option<Checked> {
         let name = normalise(path);
         let text = self.open.get(&name)?.clone();
         let mut sources = SourceMap::new();
         let entry = sources.add(name, text);
-        let mut loader = OpenFirst { docs: self };
+        let mut loader = OpenFirst {
+            docs: self,
+            files: FsLoader {
+                file_size: limits.get(Limit::FileSize),
+            },
+        };
         let (scene, diagnostics, constants) =
-            check_with_constants(&mut sources, entry, &mut loader, &Limits::default());
+            check_with_constants(&mut sources, entry, &mut loader, limits);
         Some(Checked {
             scene,
             diagnostics,
@@ -82,6 +87,7 @@ impl Checked {
 /// Reads imports from the open documents, else from disk as the command line does.
 struct OpenFirst<'a> {
     docs: &'a Documents,
+    files: FsLoader,
 }
 
 impl Loader for OpenFirst<'_> {
@@ -90,11 +96,11 @@ impl Loader for OpenFirst<'_> {
         let name = normalise(&base.join(path));
         match self.docs.open.get(&name) {
             Some(text) => Ok((name, text.clone())),
-            None => FsLoader.load(from, path),
+            None => self.files.load(from, path),
         }
     }
 
     fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        FsLoader.load_bytes(from, path)
+        self.files.load_bytes(from, path)
     }
 }

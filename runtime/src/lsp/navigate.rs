@@ -7,6 +7,37 @@
 
 use sdfc_compiler::{ast, lexer, parse, FileId, SourceMap, Span};
 
+/// Why `new` cannot be the new name of a declaration (`None` when it can): it must be one
+/// name as the lexer reads it, not a keyword, and not hide a built-in function, a built-in
+/// constant or the time, which the file's uses of them would then no longer reach.
+pub fn not_a_new_name(new: &str) -> Option<String> {
+    use sdfc_compiler::builtins;
+    let (tokens, errors) = lexer::lex(FileId(0), new);
+    match tokens.as_slice() {
+        [(lexer::Token::Ident(name), _)] if errors.is_empty() && name == new => {}
+        [(_, _)] if errors.is_empty() && new.bytes().all(|b| b.is_ascii_alphabetic()) => {
+            return Some(format!("`{new}` is a keyword, not a name"))
+        }
+        _ => return Some(format!("`{new}` is not a name")),
+    }
+    if builtins::builtin(new).is_some() {
+        return Some(format!(
+            "`{new}` is a built-in function: a declaration of that name would hide it"
+        ));
+    }
+    if builtins::constant(new).is_some() {
+        return Some(format!(
+            "`{new}` is a built-in constant: a declaration of that name would hide it"
+        ));
+    }
+    if new == builtins::TIME {
+        return Some(format!(
+            "`{new}` is the time: a declaration of that name would hide it"
+        ));
+    }
+    None
+}
+
 /// What a name is declared as.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum What {
@@ -48,6 +79,10 @@ pub struct Index {
     pub uses: Vec<(String, Span)>,
     /// The syntax tree of each file, by id.
     pub files: Vec<ast::File>,
+    /// The indices in `decls` of each name's declarations (built by [`Index::new`]), so that
+    /// resolving a name looks at its own declarations alone: completion and references
+    /// resolve every name of a document, which over all declarations would be quadratic.
+    by_name: std::collections::HashMap<String, Vec<usize>>,
 }
 
 impl Index {
@@ -58,9 +93,12 @@ impl Index {
             let id = FileId(f);
             let text = sources.text(id);
             let (file, _) = parse(id, text);
+            let first = index.decls.len();
             for item in &file.items {
                 index.item(item);
             }
+            let declared: std::collections::HashSet<Span> =
+                index.decls[first..].iter().map(|d| d.at).collect();
             let (tokens, _) = lexer::lex(id, text);
             for (tok, span) in tokens {
                 let lexer::Token::Ident(name) = tok else {
@@ -70,11 +108,14 @@ impl Index {
                 // declaration's own name (`let a: float`) is kept.
                 let after = text.get(span.end as usize..).unwrap_or("").trim_start();
                 let label = after.starts_with(':') && !after.starts_with("::");
-                if !label || index.decls.iter().any(|d| d.at == span) {
+                if !label || declared.contains(&span) {
                     index.uses.push((name, span));
                 }
             }
             index.files.push(file);
+        }
+        for (i, d) in index.decls.iter().enumerate() {
+            index.by_name.entry(d.name.clone()).or_default().push(i);
         }
         index
     }
@@ -134,22 +175,19 @@ impl Index {
     /// an item of its own file, else an item of another file (an import).
     pub fn resolve(&self, name: &str, at: Span) -> Option<&Decl> {
         let within = |s: &Span| s.file == at.file && s.start <= at.start && at.end <= s.end;
-        let scoped = self
-            .decls
-            .iter()
-            .filter(|d| d.name == name && d.scope.as_ref().is_some_and(within))
+        let named = || {
+            self.by_name
+                .get(name)
+                .into_iter()
+                .flatten()
+                .filter_map(|&i| self.decls.get(i))
+        };
+        let scoped = named()
+            .filter(|d| d.scope.as_ref().is_some_and(within))
             .min_by_key(|d| d.scope.map_or(u32::MAX, |s| s.end - s.start));
         scoped
-            .or_else(|| {
-                self.decls
-                    .iter()
-                    .find(|d| d.name == name && d.scope.is_none() && d.at.file == at.file)
-            })
-            .or_else(|| {
-                self.decls
-                    .iter()
-                    .find(|d| d.name == name && d.scope.is_none())
-            })
+            .or_else(|| named().find(|d| d.scope.is_none() && d.at.file == at.file))
+            .or_else(|| named().find(|d| d.scope.is_none()))
     }
 
     /// The identifier token covering byte `offset` of `file`.

@@ -20,6 +20,47 @@ pub fn position(text: &str, offset: usize) -> Position {
     Position::new(line as u32, character as u32)
 }
 
+/// The byte offsets where the lines of a text start: positions of many offsets in one text
+/// in O(log lines + the line's length) each, where [`position`] counts from the start of the
+/// text (an outline of a large document asks for tens of thousands).
+#[derive(Debug, Clone, Default)]
+pub struct Lines {
+    starts: Vec<usize>,
+}
+
+impl Lines {
+    /// The line starts of `text`.
+    pub fn new(text: &str) -> Lines {
+        let starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Lines { starts }
+    }
+
+    /// [`position`] of `offset` in `text` (the text these lines are of).
+    pub fn position(&self, text: &str, offset: usize) -> Position {
+        let mut offset = offset.min(text.len());
+        while offset > 0 && !text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line = self
+            .starts
+            .partition_point(|&s| s <= offset)
+            .saturating_sub(1);
+        let start = self.starts.get(line).copied().unwrap_or(0).min(offset);
+        let character = text[start..offset].encode_utf16().count();
+        Position::new(line as u32, character as u32)
+    }
+
+    /// [`range`] of `start..end` in `text` (the text these lines are of).
+    pub fn range(&self, text: &str, start: usize, end: usize) -> Range {
+        Range::new(
+            self.position(text, start),
+            self.position(text, end.max(start)),
+        )
+    }
+}
+
 /// The byte offset of an LSP position in `text`; a position past the end of its line is the
 /// end of the line, one past the last line the end of the text.
 pub fn offset(text: &str, pos: Position) -> usize {
@@ -124,6 +165,20 @@ mod tests {
         assert_eq!(offset(text, Position::new(1, 8)), second);
         assert_eq!(offset(text, Position::new(1, 99)), text.len() - 1);
         assert_eq!(offset(text, Position::new(9, 0)), text.len());
+    }
+
+    #[test]
+    fn lines_give_the_positions_that_position_gives() {
+        let text = "let a = 1;\r\nlet é𝔸 = 2;\n\nx";
+        let lines = Lines::new(text);
+        for offset in 0..=text.len() + 2 {
+            assert_eq!(
+                lines.position(text, offset),
+                position(text, offset),
+                "{offset}"
+            );
+        }
+        assert_eq!(lines.range(text, 5, 3), range(text, 5, 3));
     }
 
     #[test]

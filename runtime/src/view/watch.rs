@@ -106,13 +106,19 @@ pub struct Fingerprint {
     files: Vec<(PathBuf, Option<Vec<u8>>)>,
 }
 
+/// The bytes of a scene's file as a load reads them (a FIFO or a device is not read: it would
+/// block the watcher, or never end).
+fn read(f: &Path) -> Option<Vec<u8>> {
+    crate::frontend::read_file(f, sdfc_compiler::Limit::FileSize.default_value()).ok()
+}
+
 impl Fingerprint {
     /// Reads `files` now.
     pub fn of(files: &[PathBuf]) -> Fingerprint {
         Fingerprint {
             files: files
                 .iter()
-                .map(|f| (f.clone(), std::fs::read(f).ok()))
+                .map(|f| (f.clone(), read(f)))
                 .collect(),
         }
     }
@@ -128,7 +134,7 @@ impl Fingerprint {
     pub fn changed(&self) -> bool {
         self.files
             .iter()
-            .any(|(f, bytes)| std::fs::read(f).ok().as_ref() != bytes.as_ref())
+            .any(|(f, bytes)| read(f).as_ref() != bytes.as_ref())
     }
 
     /// The latest modification time of the files that exist.

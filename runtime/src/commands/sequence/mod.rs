@@ -56,7 +56,7 @@ pub fn run(
     stats: bool,
 ) -> Result<(), Error> {
     let limits = &job.limits;
-    let mut source = Source::read(file)?;
+    let mut source = Source::read_within(file, limits)?;
     // The animation's settings are the same at every time (E0406): read them at t = 0.
     let lowering = LowerOptions::parametric();
     let first = job.frame(&mut source, 0.0, true, &lowering)?;

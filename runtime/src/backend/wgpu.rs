@@ -231,7 +231,8 @@ impl Renderer for WgpuPrepared {
     }
 
     fn reduce_statistics(&mut self, on: bool) {
-        self.setup.image_only = !on;
+        // A software adapter's frames always count their cut loops (`render` checks them).
+        self.setup.image_only = !on && !self.setup.software;
     }
 
     fn render(
@@ -249,6 +250,16 @@ impl Renderer for WgpuPrepared {
             &mut |f| progress(f),
         )
         .map_err(|e| Error::Render(e.to_string()))?;
+        let cut = r.render.stats.counters.cut;
+        if cut > 0 {
+            return Err(Error::Render(format!(
+                "the adapter {} ended {cut} marching loops before they returned: a software adapter \
+                 (Mesa's llvmpipe, as lavapipe) stops every loop of a shader once they have run \
+                 65 535 iterations together, and this scene's distance walks need more, so the \
+                 picture would be wrong; render it with `--backend cpu`, or on a GPU",
+                self.gpu.describe()
+            )));
+        }
         Ok(Frame::of(r))
     }
 

@@ -24,6 +24,9 @@ pub struct Counters {
     pub nans: u64,
     /// Sphere-tracing steps of all rays (field evaluations while marching).
     pub steps: u64,
+    /// Marching loops a software adapter ended on its own budget of iterations, from which
+    /// its distances were wrong (always 0 on the CPU and on a GPU).
+    pub cut: u64,
 }
 
 impl Counters {
@@ -38,6 +41,7 @@ impl Counters {
         self.overshoots += o.overshoots;
         self.nans += o.nans;
         self.steps += o.steps;
+        self.cut += o.cut;
     }
 }
 

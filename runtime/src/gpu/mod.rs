@@ -368,6 +368,7 @@ pub fn counters(words: &[u32]) -> (Counters, Vec<u32>) {
             c.nans += w[5] as u64;
             c.secondary_rays += w[6] as u64;
             c.shadow_rays += w[7] as u64;
+            c.cut += w[8] as u64;
             c
         })
         .reduce(Counters::default, |mut a, b| {

@@ -92,7 +92,7 @@ impl Answer {
         let records = words.chunks_exact(RECORD as usize);
         match ask {
             Ask::Sums => {
-                let mut sums = [0u64; 8];
+                let mut sums = [0u64; sdfc_compiler::wgsl::STATS_WORDS as usize];
                 let mut max = 0;
                 for r in records {
                     for (k, s) in sums.iter_mut().enumerate() {
@@ -110,6 +110,7 @@ impl Answer {
                     nans: sums[5],
                     secondary_rays: sums[6],
                     shadow_rays: sums[7],
+                    cut: sums[8],
                     camera_rays: 0,
                 };
                 Answer::Sums { counters, max }

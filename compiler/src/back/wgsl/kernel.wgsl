@@ -67,6 +67,9 @@ struct Counters {
     nans: u32,
     secondary: u32,
     shadow: u32,
+    // Marching loops a software adapter ended early (docs/rendering.md, "Software
+    // adapters"): never on a GPU.
+    cut: u32,
 }
 var<private> counters: Counters;
 
@@ -211,10 +214,16 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
             return Traced(next, STATUS_MISS);
         }
         if steps >= params.counts.w {
-            return Traced(next, STATUS_BUDGET);
+            break;
         }
     }
-    return Traced(t, STATUS_BUDGET); // not reached: the loop returns
+    // The loop ends on the step budget, or, on a software adapter (Mesa's llvmpipe), where
+    // every loop of a shader stops once they have run 65 535 iterations together, before
+    // it: the distances were wrong from there on, and the frame is refused.
+    if steps < params.counts.w {
+        counters.cut += 1u;
+    }
+    return Traced(t, STATUS_BUDGET);
 }
 //#endif
 
@@ -362,10 +371,14 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
         }
         t = max(next, 0.0);
         if t >= tmax || steps >= params.counts.w {
-            return through * clamp(res, 0.0, 1.0);
+            break;
         }
     }
-    return through * clamp(res, 0.0, 1.0); // not reached: the loop returns
+    // Ended by neither: a software adapter cut the loop (see `trace`).
+    if t < tmax && steps < params.counts.w {
+        counters.cut += 1u;
+    }
+    return through * clamp(res, 0.0, 1.0);
 }
 //#endif
 
@@ -618,7 +631,7 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     let colour = sum / f32(aa * aa);
     image[pixel] = vec4<f32>(colour, 1.0);
     pixels[pixel] = srgb_code(colour.x) | (srgb_code(colour.y) << 8u) | (srgb_code(colour.z) << 16u) | (255u << 24u);
-    let s = pixel * 8u;
+    let s = pixel * 9u;
     stats[s] = counters.steps;
     stats[s + 1u] = counters.hits;
     stats[s + 2u] = counters.misses;
@@ -627,4 +640,5 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     stats[s + 5u] = counters.nans;
     stats[s + 6u] = counters.secondary;
     stats[s + 7u] = counters.shadow;
+    stats[s + 8u] = counters.cut;
 }

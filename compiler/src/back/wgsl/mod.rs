@@ -48,7 +48,7 @@ pub const ENTRY_POINT: &str = "main";
 pub const WORKGROUP: u32 = 8;
 /// Statistics words per pixel: steps, hits, misses, budget misses, overshoots, NaNs,
 /// secondary rays, shadow rays.
-pub const STATS_WORDS: u32 = 8;
+pub const STATS_WORDS: u32 = 9;
 
 const TEMPLATE: &str = include_str!("kernel.wgsl");
 

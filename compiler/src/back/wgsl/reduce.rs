@@ -14,7 +14,7 @@
 //!   up.
 //!
 //! The mode says what a record holds: 0 the sum of each statistics word as a 64-bit count
-//! (low word, high word: 16 words) and, in word 16, the most steps of a pixel; 1 a histogram
+//! (low word, high word: 18 words) and, in word 18, the most steps of a pixel; 1 a histogram
 //! of the pixels' steps in [`BINS`] bins of `width` steps from `base` (a pixel outside them
 //! counts in none). The host finds the 99th percentile of the steps with histograms of
 //! narrower bins around it, a round each, until the bins are one step wide
@@ -33,7 +33,7 @@ pub const RECORD: u32 = BINS;
 /// Words of a query (binding 0): first, count, threads, stage, mode, base, width, add.
 pub const QUERY_WORDS: u32 = 8;
 /// Where the sums mode puts the most steps of a pixel in a record.
-pub const MOST_STEPS_WORD: u32 = 16;
+pub const MOST_STEPS_WORD: u32 = 18;
 
 /// The module's text. Bindings (group 0): 0 the query (read-only storage at a dynamic offset,
 /// not a uniform: a software adapter compiles a variant of a shader for each value of a uniform
@@ -57,7 +57,7 @@ struct Query {
 
 const RECORD: u32 = 64u;
 const BINS: u32 = 64u;
-const STATS_WORDS: u32 = 8u;
+const STATS_WORDS: u32 = 9u;
 
 @compute @workgroup_size(64, 1, 1)
 fn reduce(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -82,7 +82,7 @@ fn reduce(@builtin(global_invocation_id) gid: vec3<u32>) {
                     acc[2u * k + 1u] += select(0u, 1u, lo < v);
                     acc[2u * k] = lo;
                 }
-                acc[16] = max(acc[16], stats[s]);
+                acc[18] = max(acc[18], stats[s]);
             } else {
                 let v = stats[s];
                 if v >= query.base {
@@ -101,7 +101,7 @@ fn reduce(@builtin(global_invocation_id) gid: vec3<u32>) {
                     acc[2u * k + 1u] += partial[r + 2u * k + 1u] + select(0u, 1u, lo < v);
                     acc[2u * k] = lo;
                 }
-                acc[16] = max(acc[16], partial[r + 16u]);
+                acc[18] = max(acc[18], partial[r + 18u]);
             } else {
                 for (var k = 0u; k < BINS; k++) {
                     acc[k] += partial[r + k];
@@ -197,6 +197,9 @@ mod tests {
         assert!(SOURCE.contains(&format!("const BINS: u32 = {BINS}u;")));
         assert!(SOURCE.contains(&format!("acc[{MOST_STEPS_WORD}]")));
         assert!(SOURCE.contains(&format!("@workgroup_size({WORKGROUP}, 1, 1)")));
-        assert_eq!(super::super::STATS_WORDS, 8);
+        assert!(SOURCE.contains(&format!(
+            "const STATS_WORDS: u32 = {}u;",
+            super::super::STATS_WORDS
+        )));
     }
 }

@@ -355,7 +355,7 @@ fn pixels_and_tiles(settings: &Settings) -> (u64, u64) {
 pub fn counters(words: &[u32]) -> (Counters, Vec<u32>) {
     use rayon::prelude::*;
     let n = STATS_WORDS as usize;
-    // In parallel: a 1080p frame has two million pixels of eight words.
+    // In parallel: a 1080p frame has two million pixels of STATS_WORDS words.
     let steps: Vec<u32> = words.par_chunks_exact(n).map(|w| w[0]).collect();
     let c = words
         .par_chunks_exact(n)

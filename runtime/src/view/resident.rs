@@ -17,7 +17,7 @@ use std::sync::Arc;
 /// asked for after it was rendered) (a storage buffer, not a uniform: lavapipe compiles a variant of a shader for
 /// each value of a uniform that decides a branch, which the sample count would make one a
 /// frame); 1 the kernel's colours; 2 the sums of the samples so far; 3 the texture on
-/// show (the mean, sRGB bytes); 4 the kernel's per-pixel statistics (8 words a pixel, the
+/// show (the mean, sRGB bytes); 4 the kernel's per-pixel statistics (`STATS_WORDS` a pixel, the
 /// first the marching steps); 5 the steps summed over the frame, as a 64-bit count in two
 /// words (low, high).
 const ACCUMULATE: &str = r#"
@@ -69,7 +69,7 @@ fn accumulate(
         textureStore(shown, gid.xy, vec4<f32>(encode(mean.r), encode(mean.g), encode(mean.b), 1.0));
     }
     if gid.x < frame.width && gid.y < frame.height && frame.steps >= 1u {
-        atomicAdd(&group_steps, stats[(gid.y * frame.width + gid.x) * 8u]);
+        atomicAdd(&group_steps, stats[(gid.y * frame.width + gid.x) * STATS_WORDSu]);
     }
     workgroupBarrier();
     if frame.steps >= 1u && local == 0u {
@@ -150,7 +150,11 @@ impl Resident {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("sdfc view accumulate"),
-            source: wgpu::ShaderSource::Wgsl(ACCUMULATE.into()),
+            source: wgpu::ShaderSource::Wgsl(
+                ACCUMULATE
+                    .replace("STATS_WORDS", &wgsl::STATS_WORDS.to_string())
+                    .into(),
+            ),
         });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -365,7 +369,11 @@ impl Resident {
                 Some(t) if t.capacity >= pixels => (t.image, t.stats, t.pixels, t.sum),
                 _ => (
                     buffer("sdfc view image", capacity * 16, U::STORAGE),
-                    buffer("sdfc view stats", capacity * 32, U::STORAGE),
+                    buffer(
+                        "sdfc view stats",
+                        capacity * 4 * wgsl::STATS_WORDS as u64,
+                        U::STORAGE,
+                    ),
                     buffer("sdfc view pixels", capacity * 4, U::STORAGE),
                     buffer("sdfc view sums", capacity * 16, U::STORAGE | U::COPY_SRC),
                 ),
@@ -645,7 +653,7 @@ pub fn warm(
     let pixels = width * wgsl::WORKGROUP as u64;
     let (image, stats, finished) = (
         buffer(pixels * 16, U::STORAGE),
-        buffer(pixels * 32, U::STORAGE),
+        buffer(pixels * 4 * wgsl::STATS_WORDS as u64, U::STORAGE),
         buffer(pixels * 4, U::STORAGE),
     );
     if let Some(f) = first {

@@ -116,10 +116,7 @@ impl Fingerprint {
     /// Reads `files` now.
     pub fn of(files: &[PathBuf]) -> Fingerprint {
         Fingerprint {
-            files: files
-                .iter()
-                .map(|f| (f.clone(), read(f)))
-                .collect(),
+            files: files.iter().map(|f| (f.clone(), read(f))).collect(),
         }
     }
 

@@ -376,11 +376,27 @@ fn print_to(diags: &[Diagnostic], sources: &SourceMap, format: DiagnosticFormat,
         }
         DiagnosticFormat::Json => diagnostics::to_json(diags, sources),
     };
-    // A closed pipe is not an error worth a panic: what could not be written is lost.
-    let _ = match stdout {
-        true => std::io::stdout().lock().write_all(text.as_bytes()),
-        false => std::io::stderr().lock().write_all(text.as_bytes()),
-    };
+    if stdout {
+        let mut out = std::io::stdout().lock();
+        // The JSON lines are the command's output: one that cannot be written (a full disk)
+        // ends the run with the reason, as any other output would. (A closed pipe ends the
+        // process quietly before this, by SIGPIPE; where it does not, it is not an error
+        // worth a message.)
+        match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => unwritable_stdout(&e),
+            _ => {}
+        }
+    } else {
+        // Nothing is left to tell about a standard error that cannot be written.
+        let _ = std::io::stderr().lock().write_all(text.as_bytes());
+    }
+}
+
+/// Ends the process on output that cannot be written: `error: cannot write to standard
+/// output: …`, exit 2 (what `sdfc` does for every write to standard output that fails).
+pub fn unwritable_stdout(e: &dyn std::fmt::Display) -> ! {
+    eprintln!("error: cannot write to standard output: {e}");
+    std::process::exit(2)
 }
 
 /// Prints an error about a file that is not a diagnostic (it cannot be read, it is not

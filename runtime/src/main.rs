@@ -99,10 +99,14 @@ struct LspArgs {
 
 fn main() -> ExitCode {
     commands::main_started();
+    report_unwritable_stdout();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
-            let _ = e.print();
+            if let Err(why) = e.print() {
+                eprintln!("error: cannot write to standard output: {why}");
+                return ExitCode::from(2);
+            }
             // clap reports --help and --version as "errors" with exit code 0.
             return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
         }
@@ -139,6 +143,25 @@ fn main() -> ExitCode {
 /// write with an error message (or a panic, in `println!`). Only for the commands that open no
 /// device and no window, whose only pipe is standard output: a GPU driver or a window system
 /// may write to pipes and sockets of its own, whose closing must not end the process.
+/// `println!` panics when standard output cannot be written (a full disk: `> /dev/full`);
+/// that panic is reported as the write error it is, `error: cannot write to standard output:
+/// …`, exit 2, not as a crash (exit 101). Every other panic goes to the default hook.
+fn report_unwritable_stdout() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if let Some(why) = message.strip_prefix("failed printing to stdout: ") {
+            sdfc_runtime::frontend::unwritable_stdout(&why);
+        }
+        default(info)
+    }));
+}
+
 fn end_quietly_on_a_closed_stdout() {
     #[cfg(unix)]
     // SAFETY: `signal` only sets the disposition of SIGPIPE; it is called before any thread

@@ -1716,10 +1716,14 @@ fn output_that_cannot_be_written_is_an_error_and_fmt_keeps_permissions() {
     std::fs::write(&messy, "scene{sphere(1);}\n").expect("write");
     scene_file(&d);
     if Path::new("/dev/full").exists() {
+        std::fs::write(d.join("bad.sdf"), "scene { sphre(1); }\n").expect("write");
         for (args, input) in [
             (&["fmt"][..], &messy),
             (&["compile", "ball.sdf", "--emit", "wgsl"], &messy),
             (&["fmt", "--check", "messy.sdf"], &messy),
+            // JSON diagnostics, `println!` (here `--help`'s text) alike.
+            (&["check", "--diagnostics", "json", "bad.sdf"], &messy),
+            (&["--help"], &messy),
         ] {
             let (code, err) = sdfc_redirected(&d, args, input, Path::new("/dev/full"));
             assert_eq!(code, Some(2), "{args:?}: {err}");

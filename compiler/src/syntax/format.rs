@@ -95,8 +95,13 @@ pub fn format(text: &str) -> Result<String, Error> {
     }
     let (tokens, _) = lexer::lex(file, text);
     let breaks = forced_breaks(&tree, &tokens);
+    // What each step no longer needs is dropped before the next (the tree, then the lines):
+    // the memory a large file takes is that of one step's data, not of all of them.
+    drop(tree);
     let lines = split_lines(text, &tokens, &breaks)?;
+    drop(breaks);
     let out = render(text, &tokens, &lines);
+    drop(lines);
     same_tokens(text, &tokens, &out)?;
     Ok(out)
 }

@@ -628,6 +628,55 @@ fn check_says_still_numbers_or_structure() {
     assert!(out.contains("frame 6 (t = 1.5 s) has errors"), "{out}");
 }
 
+/// A sequence whose source changes only in numbers: a radius, an offset, a rotation passing
+/// through 0 and a quarter turn, a twist whose rate passes through 0 (its L through 1), a ring
+/// of shapes turning past each other (a union's hierarchy), a moving camera and light. Every
+/// frame has one structure and one kernel text: the lowering's choices that depend on numbers
+/// (a local bound where L > 1, the hierarchy's splits and order, the nearer volume of a
+/// bound, the comments' numbers) are constants of the program, not its shape.
+const NUMBERS_ONLY: &str = "material m = phong { color: (0.8, 0.2, 0.2) };
+let a = degrees(90 * t - 90);
+let o = sin(degrees(120 * t));
+camera { position: (7 * sin(a), 2.5, -7 * cos(a)), look_at: (0, 0.5, 0) }
+light point { position: (4 * cos(a), 5, -4 + o) }
+render { fps: 12, duration: 3 }
+scene {
+  plane((0, 1, 0), 0);
+  sphere(0.4 + 0.2 * o).translate(o, 0.6, 0) @ m;
+  box((0.3, 0.2 + 0.1 * t, 0.3)).rotate_y(a).translate(-1.5, 0.3, 0);
+  torus(0.5, 0.1).twist(0.8 * o).translate(1.5, 0.5, 0);
+  for i in 0..24 {
+    sphere(0.15).translate(3 * cos(degrees(15 * i) + a), 0.3 + 0.1 * sin(degrees(40 * i) + a),
+      3 * sin(degrees(15 * i) + a));
+  }
+}
+";
+
+#[test]
+fn a_sequence_that_moves_only_numbers_keeps_one_structure_and_one_kernel() {
+    let d = dir("moving");
+    std::fs::write(d.join("moving.sdf"), NUMBERS_ONLY).unwrap();
+    let o = sdfc(&d, &["check", "moving.sdf"]);
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert!(
+        out.contains("moving.sdf: animated, numbers only") && out.contains("36 frames at 12 fps"),
+        "{out}"
+    );
+    // The kernels of frames at the rotation's 0 and quarter turn, the twist's 0 and between.
+    let texts: Vec<String> = [0u64, 1, 12, 24, 35]
+        .iter()
+        .map(|&k| {
+            let s = scene(NUMBERS_ONLY, sdfc_compiler::Animation::time_of(12.0, k));
+            let l = sdfc_compiler::lower_scene(&s, &sdfc_compiler::LowerOptions::parametric());
+            kernel(&s, &l, true).source
+        })
+        .collect();
+    for (k, t) in texts.iter().enumerate() {
+        assert!(*t == texts[0], "the kernel of the {k}th frame differs");
+    }
+}
+
 /// The job-array files of the README: the Slurm script parses with `bash -n`, the
 /// Kubernetes manifest with a YAML parser (python3's `yaml`), and both run `sdfc render`
 /// with the shard of their index.

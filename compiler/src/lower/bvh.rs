@@ -1,6 +1,9 @@
 //! The bounding volume hierarchy of a union's bounded children, split by the surface area
-//! heuristic until splitting no longer pays, each half's bound the hull of its children's. The half nearer the camera comes first, so that the best distance
-//! shrinks early for the points nearest the eye.
+//! heuristic until splitting no longer pays, each half's bound the hull of its children's. The
+//! half nearer the camera comes first, so that the best distance shrinks early for the points
+//! nearest the eye. For the frames of a sequence ([`Shape::Fixed`]) the hierarchy is a
+//! function of the children's order and costs alone, so that moving shapes and a moving camera
+//! keep one program (their bounds are its constants).
 
 use crate::scene::bounds::{hull, Bound};
 use crate::scene::{NodeId, V3};
@@ -46,8 +49,24 @@ pub(super) struct Plane {
     pub first_low: bool,
 }
 
+/// How a hierarchy is shaped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Shape {
+    /// By the surface area heuristic over where the children are, the half nearer `eye`
+    /// first.
+    Sah { eye: V3 },
+    /// By the children's order: each group of more than one child costing more than
+    /// [`MIN_SPLIT_COST`] is halved, the first half first, its plane across the axis of the
+    /// group's depth (x, y, z, x, …); no choice reads a number.
+    Fixed,
+}
+
 /// Builds the hierarchy of a non-empty list of children.
-pub(super) fn build(mut items: Vec<Item>, eye: V3) -> Tree {
+pub(super) fn build(items: Vec<Item>, shape: Shape) -> Tree {
+    build_at(items, shape, 0)
+}
+
+fn build_at(mut items: Vec<Item>, shape: Shape, depth: usize) -> Tree {
     let bound = items
         .iter()
         .map(|i| i.bound)
@@ -56,8 +75,11 @@ pub(super) fn build(mut items: Vec<Item>, eye: V3) -> Tree {
     let cost: f64 = items.iter().map(|i| i.cost + FOLD_COST).sum();
     let split = if items.len() < 2 || cost <= MIN_SPLIT_COST {
         None
-    } else {
+    } else if let Shape::Sah { .. } = shape {
         best_split(&mut items, area(&bound), cost)
+    } else {
+        items.sort_by_key(|i| i.index);
+        Some((depth % 3, items.len() / 2))
     };
     let Some(split) = split else {
         items.sort_by_key(|i| i.index);
@@ -70,8 +92,14 @@ pub(super) fn build(mut items: Vec<Item>, eye: V3) -> Tree {
     let (axis, k) = split;
     let at = (items[k - 1].bound.aabb.c[axis] + items[k].bound.aabb.c[axis]) * 0.5;
     let rest = items.split_off(k);
-    let (a, b) = (build(items, eye), build(rest, eye));
-    let swap = distance(&b.bound, eye) < distance(&a.bound, eye);
+    let (a, b) = (
+        build_at(items, shape, depth + 1),
+        build_at(rest, shape, depth + 1),
+    );
+    let swap = match shape {
+        Shape::Sah { eye } => distance(&b.bound, eye) < distance(&a.bound, eye),
+        Shape::Fixed => false,
+    };
     let plane = Plane {
         axis,
         at,

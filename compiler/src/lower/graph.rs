@@ -70,15 +70,25 @@ pub(super) struct Lowerer<'a> {
     /// plain combinations, paint and rigid or uniformly scaling transforms): where local
     /// bounds are on, its operands may then be divided by their own L.
     zero_set: bool,
+    /// With a parametric builder, whether each node's L may differ from 1 for some values of
+    /// its numbers ([`steepening`]): such an operand keeps its local bound even where its L is
+    /// 1, so that a frame where a twist's rate passes through 0 keeps the program's shape.
+    steepens: Vec<bool>,
 }
 
 impl<'a> Lowerer<'a> {
     pub fn new(graph: &'a Graph, b: &'a mut Builder, config: Config<'a>) -> Self {
+        let steepens = if b.parametric {
+            steepening(graph)
+        } else {
+            Vec::new()
+        };
         Lowerer {
             graph,
             b,
             memo: HashMap::new(),
             zero_set: config.local && config.analysis.is_some(),
+            steepens,
             config,
         }
     }
@@ -114,8 +124,12 @@ impl<'a> Lowerer<'a> {
             Some(a) if self.zero_set => a.node(id).step(),
             _ => 1.0,
         };
-        let f = if divide > 1.0 && !self.spine(id) {
-            self.local_bound(id, divide, p)
+        let steep = divide > 1.0
+            || (self.zero_set
+                && self.config.analysis.is_some()
+                && self.steepens.get(id.0 as usize) == Some(&true));
+        let f = if steep && !self.spine(id) {
+            self.local_bound(id, divide, p, divide > 1.0)
         } else {
             let zero_set = self.zero_set;
             self.zero_set = zero_set && keeps_zero_set(self.graph.node(id));
@@ -291,15 +305,23 @@ impl<'a> Lowerer<'a> {
         }
     }
 
-    /// `max(f / l, β)` for node `id`'s field `f` and β the distance to its bound.
-    fn local_bound(&mut self, id: NodeId, l: f64, p: P) -> Field {
+    /// `max(f / l, β)` for node `id`'s field `f` and β the distance to its bound; where not
+    /// `used` (a parametric program's operand whose L is 1 in this frame), both and `f`
+    /// chosen by a constant, so that the program has the shape of the frames that use it.
+    fn local_bound(&mut self, id: NodeId, l: f64, p: P, used: bool) -> Field {
         self.zero_set = false;
         let f = self.node(id, p);
         self.zero_set = true;
+        // A parametric program's comments name no number: the kernel's text is a function of
+        // the frame's structure.
+        let l_text = if self.b.parametric {
+            "L".to_string()
+        } else {
+            format!("L = {}", crate::scene::dump_num(l))
+        };
         let text = format!(
-            "node {} local bound: the field divided by its L = {}, at least the distance to its bound",
+            "node {} local bound: the field divided by its {l_text}, at least the distance to its bound",
             self.number(id),
-            crate::scene::dump_num(l)
         );
         self.b.note(text);
         let scaled = self.b.mulc(f.d, 1.0 / l);
@@ -316,6 +338,11 @@ impl<'a> Lowerer<'a> {
             }
             None => scaled,
         };
+        if self.b.parametric {
+            let c = self.b.c(if used { 1.0 } else { 0.0 });
+            let d = self.b.select(c, d, f.d);
+            return Field { d, m: f.m };
+        }
         Field { d, m: f.m }
     }
 
@@ -751,7 +778,14 @@ impl<'a> Lowerer<'a> {
             let f = self.node(c, p);
             acc = Some(self.fold(acc, f));
         }
-        let tree = (!finite.is_empty()).then(|| bvh::build(finite, self.config.camera));
+        let shape = if self.b.parametric {
+            bvh::Shape::Fixed
+        } else {
+            bvh::Shape::Sah {
+                eye: self.config.camera,
+            }
+        };
+        let tree = (!finite.is_empty()).then(|| bvh::build(finite, shape));
         let split = tree
             .as_ref()
             .is_some_and(|t| matches!(t.kind, Kind::Split(..)));
@@ -950,6 +984,10 @@ impl<'a> Lowerer<'a> {
     /// Computes, before the children of a union, the rotated point Mᵀp of every rotation
     /// that two or more children start with, so that they share it.
     fn share_rotations(&mut self, children: &[NodeId], p: P) {
+        if self.b.parametric {
+            // Which rotations are equal is a matter of numbers.
+            return;
+        }
         let mut count: HashMap<[u64; 9], (usize, [V3; 3])> = HashMap::new();
         for &c in children {
             if let Some(m) = self.leading_rotation(c) {
@@ -1069,6 +1107,33 @@ pub(super) fn field_and_bound(
 /// plain combinations (a minimum or maximum of bounds is a bound), paint, translation,
 /// rotation and uniform scale; false where the children's values are read (offsets, smooth
 /// combinations) or the point map stretches (repetition, twist, bend, per-axis scale).
+/// For each node of `graph`, whether its L may exceed 1 for some values of its numbers (and of
+/// its descendants'): the maps that stretch distances by an amount their numbers set (twist,
+/// bend, taper, shear, wrap, a scale per axis, a screw, a loft) and user fields do; shapes,
+/// combinations, rigid and uniform transforms, offsets, folds and repetitions pass their
+/// children's on, and a blend's or a feature's steepness is a matter of its kind.
+fn steepening(graph: &Graph) -> Vec<bool> {
+    let mut out: Vec<bool> = Vec::with_capacity(graph.len());
+    for id in graph.ids() {
+        let node = graph.node(id);
+        let own = matches!(
+            node,
+            Node::Field { .. }
+                | Node::Twist { .. }
+                | Node::Bend { .. }
+                | Node::Taper { .. }
+                | Node::Shear { .. }
+                | Node::Wrap { .. }
+                | Node::ScaleXyz { .. }
+                | Node::Screw { .. }
+                | Node::Loft { .. }
+        );
+        let below = node.children().iter().any(|c| out[c.0 as usize]);
+        out.push(own || below);
+    }
+    out
+}
+
 fn keeps_zero_set(node: &Node) -> bool {
     matches!(
         node,
@@ -1095,15 +1160,27 @@ fn leaves(t: &Tree) -> usize {
 /// cover the rounding of both this value and the field (`docs/optimisation.md`).
 fn bound_distance(b: &mut Builder, bound: &Bound, p: P) -> Reg {
     let (box_volume, sphere_volume) = bound.volumes();
-    if bound.finite() && sphere_volume <= 1.5 * box_volume {
+    let sphere = |b: &mut Builder| {
         let sp = bound.sphere;
         let pad = 1e-3 * sp.r + 1e-4 * (1.0 + DVec3::from(sp.c).length());
         let q = b.sub3c(p, sp.c);
         let l = b.len3(q);
         let s = b.subc(l, sp.r + pad);
-        return shrink(b, s, bound.scale);
-    }
+        shrink(b, s, bound.scale)
+    };
     let axes: Vec<usize> = (0..3).filter(|&i| bound.aabb.h[i].is_finite()).collect();
+    let use_sphere = bound.finite() && sphere_volume <= 1.5 * box_volume;
+    if bound.finite() && b.parametric {
+        // Which volume is the smaller is a matter of numbers: both, and the choice a
+        // constant (the same distance as the usual program's).
+        let s = sphere(b);
+        let x = box_distance(b, bound, &axes, p);
+        let c = b.c(if use_sphere { 1.0 } else { 0.0 });
+        return b.select(c, s, x);
+    }
+    if use_sphere {
+        return sphere(b);
+    }
     box_distance(b, bound, &axes, p)
 }
 
@@ -1129,7 +1206,11 @@ fn slab_distance(b: &mut Builder, bound: &Bound, tested: Option<&Tested>, p: P) 
         region: bound.aabb,
         terms: [None; 3],
     });
+    let parametric = b.parametric;
     let fresh = |i: usize| match tested {
+        // Whether a box is narrower than the region tested is a matter of numbers: every
+        // finite axis afresh (a distance to the node's own box is as low a bound).
+        _ if parametric => h[i].is_finite(),
         None => h[i].is_finite(),
         Some(t) => {
             let margin = 0.1 * t.region.h[i];
@@ -1187,6 +1268,14 @@ fn box_distance(b: &mut Builder, bound: &Bound, axes: &[usize], p: P) -> Reg {
 
 /// `SHRINK·s` for a bound of scale 1, else `min(s, SHRINK·scale·s)`.
 fn shrink(b: &mut Builder, s: Reg, scale: f64) -> Reg {
+    if b.parametric {
+        // Whether the scale is 1 is a matter of numbers: both, and the choice a constant.
+        let one = b.mulc(s, SHRINK);
+        let t = b.mulc(s, SHRINK * scale);
+        let less = b.min(s, t);
+        let c = b.c(if scale >= 1.0 { 1.0 } else { 0.0 });
+        return b.select(c, one, less);
+    }
     if scale >= 1.0 {
         b.mulc(s, SHRINK)
     } else {

@@ -72,7 +72,7 @@ pub use crate::{
 
 /// The batch interpreter of distance programs (f32 or f64), and the bounds it verifies.
 pub use crate::eval::{
-    eval_point, verify::verify_fields, wide, Evaluator, Float, Outputs, Tape, DEFAULT_CHUNK,
+    eval_point, verify, verify::verify_fields, wide, Evaluator, Float, Outputs, Tape, DEFAULT_CHUNK,
 };
 
 /// The writers: the WGSL kernel (validated by naga), PTX from it, SPIR-V/MSL/GLSL/HLSL,

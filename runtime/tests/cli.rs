@@ -1279,7 +1279,11 @@ fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
     let out = sdfc(&d, &["check", "--verify-bounds", "fine.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{err}");
-    assert!(err.contains("bounds verified: 2 field(s)"), "{err}");
+    assert!(
+        err.contains("bounds sampled, not proven: 2 field(s), none steeper than its L"),
+        "{err}"
+    );
+    assert!(!err.contains("verified"), "{err}");
     // A profile is named as one.
     std::fs::write(
         d.join("flat.sdf"),
@@ -1293,6 +1297,56 @@ fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
         err.contains("flat.sdf:2:11: this profile has a slope of"),
         "{err}"
     );
+}
+
+/// `--verify-bounds` samples the whole of the scene's bounded region, in each field's own
+/// coordinates, not only near the camera's target: a field steeper than its L only 6 units
+/// and more from the target, inside the box it is cut to, is caught; the output names the
+/// boxes sampled and the pairs of points, and where an unbounded scene was clipped.
+#[test]
+fn check_verify_bounds_samples_the_scene_and_says_where() {
+    let d = dir("verify-bounds-far");
+    std::fs::write(
+        d.join("far.sdf"),
+        "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nscene {\n  intersect(field(lipschitz: 1) { length(p) - 1 + 0.5 * max(p.x - 6, 0) }, box(9));\n}\n",
+    )
+    .expect("write");
+    let out = sdfc(&d, &["check", "--verify-bounds", "far.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("far.sdf:3:13: this field has a slope of") && err.contains("above its L = 1"),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "found in 20000 pairs of points over the scene's box [(-9, -9, -9), (9, 9, 9)]"
+        ),
+        "{err}"
+    );
+    assert!(!err.contains("verified"), "{err}");
+    // A scene unbounded along every axis: sampled within max_dist of the camera, and said so.
+    std::fs::write(
+        d.join("open.sdf"),
+        "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nrender { max_dist: 50 }\nscene {\n  field { length(p) - 1 };\n  field { p.x * p.y };\n}\n",
+    )
+    .expect("write");
+    let out = sdfc(&d, &["check", "--verify-bounds", "open.sdf"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("open.sdf:4:3: this field: no slope above its L = 1 in 20000 pairs of points over the scene's box [(-50, -50, -55), (50, 50, 45)]"),
+        "{err}"
+    );
+    assert!(
+        err.contains("open.sdf:5:3: this field has no declared or proven L: nothing to sample"),
+        "{err}"
+    );
+    assert!(
+        err.contains("the scene is unbounded along x, y, z, sampled within max_dist = 50 of the camera there, and not beyond"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// 10 000 nested `union(…)` with the `nesting` limit raised, as the error suggests, check

@@ -266,6 +266,69 @@ impl Usage {
     }
 }
 
+/// The region of each node, in its own coordinates, that the box `start` (in the root's
+/// coordinates) reaches through the maps above the node (the union over the paths that reach
+/// it; empty where none does), as the analysis carries the region rays reach. With `clip`,
+/// each node's region is also cut to its own box (`scene/bounds.rs`) along the axes where
+/// that is finite: the part of `start` around the node's shape.
+pub(crate) fn regions(
+    scene: &Scene,
+    start: Aabb,
+    clip: Option<&super::bounds::Bounds>,
+) -> Vec<Aabb> {
+    let n = scene.graph.len();
+    let mut region = vec![Aabb::EMPTY; n];
+    let Some(root) = scene.root else {
+        return region;
+    };
+    let cut = |id: NodeId, r: Aabb| match clip.and_then(|b| b.get(id)) {
+        Some(b) => r.intersect(Aabb {
+            min: [0, 1, 2].map(|i| b.aabb.c[i] - b.aabb.h[i]),
+            max: [0, 1, 2].map(|i| b.aabb.c[i] + b.aabb.h[i]),
+        }),
+        None => r,
+    };
+    region[root.0 as usize] = cut(root, start);
+    for i in (0..n).rev() {
+        if region[i].is_empty() {
+            continue;
+        }
+        let node = scene.graph.node(NodeId(i as u32));
+        for (child, _, r) in down(node, 0.0, region[i])
+            .into_iter()
+            .chain(profiles(node, region[i]))
+        {
+            let c = child.0 as usize;
+            region[c] = region[c].union(cut(child, r));
+        }
+    }
+    region
+}
+
+/// The region the profiles of a solid made of profiles are read in (their plane z = 0): an
+/// extrusion's and a loft's at (x, y); a revolution's and a screw's at the distance from the
+/// y axis (less the revolution's offset) and y.
+fn profiles(node: &Node, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
+    let flat = |r: Aabb| Aabb {
+        min: [r.min[0], r.min[1], 0.0],
+        max: [r.max[0], r.max[1], 0.0],
+    };
+    let around = |r: Aabb, offset: f64| Aabb {
+        min: [-offset, r.min[1], 0.0],
+        max: [r.radius(0, 2) - offset, r.max[1], 0.0],
+    };
+    if r.is_empty() {
+        return Vec::new();
+    }
+    match node {
+        Node::Extrude { child, .. } => vec![(*child, 0.0, flat(r))],
+        Node::Loft { bottom, top, .. } => vec![(*bottom, 0.0, flat(r)), (*top, 0.0, flat(r))],
+        Node::Revolve { offset, child } => vec![(*child, 0.0, around(r, *offset))],
+        Node::Screw { child, .. } => vec![(*child, 0.0, around(r, 0.0))],
+        _ => Vec::new(),
+    }
+}
+
 /// Where rays can go: within `max_dist` of the camera for camera rays, of a hit for each
 /// bounce and each shadow ray towards a directional light, and up to every point light.
 fn view_region(scene: &Scene) -> Aabb {

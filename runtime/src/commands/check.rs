@@ -16,7 +16,8 @@ pub struct CheckArgs {
     #[arg(long, value_enum, default_value_t)]
     pub diagnostics: DiagnosticFormat,
     /// Sample the Lipschitz bound of every user field (`field { … }`), declared or derived,
-    /// near the camera's target, and report where a field is steeper (exit 1).
+    /// over the scene's bounded region and the field's own, and report where a field is
+    /// steeper (exit 1), and where and how much was sampled.
     #[arg(long)]
     pub verify_bounds: bool,
     #[command(flatten)]
@@ -91,39 +92,103 @@ fn beyond_render_limits(scene: &Scene, limits: &sdfc_compiler::Limits) -> Option
     })
 }
 
-/// Pairs of points sampled per field by `--verify-bounds`, and how far from the camera's
-/// target they lie (per axis).
+/// Pairs of points sampled per field and region by `--verify-bounds`.
 const VERIFY_PAIRS: usize = 20_000;
-const VERIFY_REACH: f64 = 4.0;
 
-/// `--verify-bounds`: every field's bound sampled; false when one is exceeded (printed).
+/// A box as `sdfc check` prints it: `[(x, y, z), (x, y, z)]`, its corners.
+fn corners(r: &sdfc_compiler::verify::Region) -> String {
+    let v = |p: [f64; 3]| {
+        format!(
+            "({}, {}, {})",
+            number(p[0], 3),
+            number(p[1], 3),
+            number(p[2], 3)
+        )
+    };
+    format!("[{}, {}]", v(r.min), v(r.max))
+}
+
+/// `--verify-bounds`: every field's bound sampled over the scene's bounded region and its
+/// own; false when one is exceeded. Prints, for each field, where it was sampled and with how
+/// many pairs of points, and the fields that were not; never claims more than was sampled.
 fn verify_bounds(loaded: &frontend::Loaded, file: &std::path::Path, scene: &Scene) -> bool {
-    let found = sdfc_compiler::verify_fields(scene, VERIFY_PAIRS, VERIFY_REACH);
-    let fields = scene
-        .graph
-        .ids()
-        .filter(|&id| matches!(scene.graph.node(id), sdfc_compiler::Node::Field { .. }))
-        .count();
-    for v in &found {
-        let span = scene.graph.span(v.node);
+    use sdfc_compiler::verify::{Over, Unsampled};
+    let v = sdfc_compiler::verify_fields(scene, VERIFY_PAIRS);
+    let at = |id: sdfc_compiler::NodeId| {
+        let span = scene.graph.span(id);
         let (line, col) = loaded.sources.line_col(span);
-        eprintln!(
-            "{}:{line}:{col}: this {} has a slope of {} between {:?} and {:?}, above its L = {}",
+        format!(
+            "{}:{line}:{col}: this {}",
             loaded.sources.name(span.file),
-            scene.graph.node(v.node).kind(),
-            number(v.slope, 4),
-            v.at.0,
-            v.at.1,
-            number(v.bound, 4)
-        );
+            scene.graph.node(id).kind()
+        )
+    };
+    let over = |regions: &[(Over, sdfc_compiler::verify::Region, usize)]| {
+        regions
+            .iter()
+            .map(|(o, r, n)| {
+                let what = match o {
+                    Over::Scene => "the scene's box",
+                    Over::Own => "its own box",
+                };
+                format!("{n} pairs of points over {what} {}", corners(r))
+            })
+            .collect::<Vec<_>>()
+            .join(" and ")
+    };
+    let mut clean = true;
+    for f in &v.sampled {
+        match &f.violation {
+            Some(w) => {
+                clean = false;
+                eprintln!(
+                    "{} has a slope of {} between {:?} and {:?}, above its L = {} (found in {}, in its coordinates)",
+                    at(f.node),
+                    number(w.slope, 4),
+                    w.at.0,
+                    w.at.1,
+                    number(w.bound, 4),
+                    over(&f.regions)
+                );
+            }
+            None => eprintln!(
+                "{}: no slope above its L = {} in {}, in its coordinates",
+                at(f.node),
+                number(f.bound, 4),
+                over(&f.regions)
+            ),
+        }
     }
-    if found.is_empty() {
-        eprintln!(
-            "{}: bounds verified: {fields} field(s), {VERIFY_PAIRS} pairs of points each within {VERIFY_REACH} of the camera's target",
-            file.display()
-        );
+    for (id, why) in &v.unsampled {
+        let why = match why {
+            Unsampled::NoBound => "has no declared or proven L: nothing to sample",
+            Unsampled::Unreached => "lies outside the scene's box: not sampled",
+        };
+        eprintln!("{} {why}", at(*id));
     }
-    found.is_empty()
+    let axes: Vec<&str> = ["x", "y", "z"]
+        .iter()
+        .zip(v.scope.clipped)
+        .filter(|(_, c)| *c)
+        .map(|(a, _)| *a)
+        .collect();
+    let clipped = if axes.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; the scene is unbounded along {}, sampled within max_dist = {} of the camera there, and not beyond",
+            axes.join(", "),
+            number(scene.settings.max_dist, 4)
+        )
+    };
+    eprintln!(
+        "{}: bounds sampled, not proven: {} field(s), {} steeper than its L where sampled; the scene's box {}{clipped}",
+        file.display(),
+        v.sampled.len(),
+        if clean { "none" } else { "some" },
+        corners(&v.scope.region),
+    );
+    clean
 }
 
 /// Whether the scene is a still, an animation whose frames differ only in numbers, or one

@@ -520,9 +520,6 @@ struct Element {
     properties: Vec<Property>,
 }
 
-/// The most corners a PLY face may have.
-const MAX_CORNERS: f64 = 1024.0;
-
 /// PLY: a text header, then the elements in ASCII or binary; the `vertex` element's `x`,
 /// `y`, `z` and the `face` element's list `vertex_indices` (or `vertex_index`) are read,
 /// faces of more than three corners fanned.
@@ -646,7 +643,7 @@ fn ply(b: &[u8], max: u64) -> Result<Read, Error> {
                     Some(c) => {
                         let at = values.at;
                         let n = values.next(c)?;
-                        if !(0.0..=MAX_CORNERS).contains(&n) {
+                        if !(0.0..=1024.0).contains(&n) {
                             return Err(bad(
                                 Place::Byte(at as u64),
                                 format!("a list of {n} items is not a face"),

@@ -3,7 +3,7 @@
 # (fuzz/seeds/*/) and the files of examples/ and runtime/tests/in/; or, with `seeds`, minimises what
 # the runs found (fuzz/corpus/TARGET/, not kept) with the target's seeds into new seeds
 # (fuzz/seeds/TARGET/), keeping only what reaches beyond the examples and the other seeds.
-# Usage: scripts/fuzz.sh TARGET SECONDS   (TARGET: check, front_end, kernel or lsp)
+# Usage: scripts/fuzz.sh TARGET SECONDS   (TARGET: check, front_end, kernel, lsp or mesh_file)
 #        scripts/fuzz.sh TARGET seeds
 set -euo pipefail
 cd "$(dirname "$0")/.."

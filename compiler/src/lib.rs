@@ -44,9 +44,10 @@ pub use crate::{
 };
 
 /// The front end: parse, format and check `.sdf` text (imports read through a [`Loader`]),
-/// the AST and its dump, and the built-ins table the checker, docs and editors read.
+/// the AST and its dump, the built-ins table the checker, docs and editors read, and the
+/// readers of the mesh files `mesh(path)` reads.
 pub use crate::{
-    check::{builtins, Constant, Loader, NoImports},
+    check::{builtins, meshfile, Constant, Loader, NoImports},
     front::{check, check_at, check_str, check_with, check_with_constants},
     syntax::{ast, dump as dump_ast, format, lexer, parse},
 };

@@ -217,13 +217,17 @@ fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, Erro
     let (hi, count) = match hi.split_once(':') {
         Some((h, n)) => match n.trim().parse::<usize>() {
             Ok(n) if (1..=max).contains(&n) => (h, Some(n)),
-            _ => {
+            parsed => {
                 return Err(Error::Count {
                     key: key.name(),
                     value: n.trim().into(),
                     max,
-                    raise: limits.raise(Limit::SweepValues),
-                })
+                    // The count asked for is the value that would do.
+                    raise: match parsed {
+                        Ok(n) if n > max => limits.raise_to(Limit::SweepValues, n as u64),
+                        _ => limits.raise(Limit::SweepValues),
+                    },
+                });
             }
         },
         None => (hi, None),

@@ -664,14 +664,15 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         let out = sdfc(&d, &["check", "ball.sdf", "--limit", bad]);
         assert_eq!(out.status.code(), Some(2), "{bad}");
     }
-    // A loop over the objects limit: E0507 naming the flag, and the flag raises it.
+    // A loop over the objects limit: E0507 naming the flag with the value that would do
+    // (the loop's count, not twice the limit), and the flag raises it.
     let many = "scene { for i in 0..50 { sphere(0.1).translate(i, 0, 0); } }\n";
     std::fs::write(d.join("many.sdf"), many).expect("write");
     let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=20"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("E0507") && err.contains("--limit objects=40"),
+        err.contains("E0507") && err.contains("--limit objects=50"),
         "{err}"
     );
     let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=50"]);

@@ -188,6 +188,24 @@ fn a_mesh_composes_and_remeshes() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A binary glTF file of `json` and `bin`.
+fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut json = json.as_bytes().to_vec();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let mut b = b"glTF".to_vec();
+    for n in [2, 20 + json.len() + 8 + bin.len(), json.len()] {
+        b.extend_from_slice(&(n as u32).to_le_bytes());
+    }
+    b.extend_from_slice(b"JSON");
+    b.extend_from_slice(&json);
+    b.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    b.extend_from_slice(b"BIN\0");
+    b.extend_from_slice(bin);
+    b
+}
+
 /// Bad files: an error E0400 at the `mesh` call whose message says what and where.
 #[test]
 fn bad_mesh_files_are_located_errors() {
@@ -206,6 +224,20 @@ fn bad_mesh_files_are_located_errors() {
     };
     let tri = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     let nan = [f32::NAN, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    // A binary STL whose 80-byte header begins with `solid`, cut short.
+    let mut solid = stl(2, &[tri, tri]);
+    solid[..5].copy_from_slice(b"solid");
+    solid.truncate(120);
+    // An ASCII STL cut in the middle of `endfacet`.
+    let cut = b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfa".to_vec();
+    // A glTF file whose index buffer view starts 2^64 - 1 bytes in.
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":{},"byteLength":12}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}},{{"bufferView":1,"componentType":5125,"count":3,"type":"SCALAR"}}]}}"#,
+        u64::MAX
+    );
+    let mut bin: Vec<u8> = tri.iter().flat_map(|x: &f32| x.to_le_bytes()).collect();
+    bin.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+    let offset = glb(&json, &bin);
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         ("truncated.stl", stl(2, &[tri])[..120].to_vec(), "truncated binary STL"),
         ("nan.stl", stl(1, &[nan]), "not a finite number"),
@@ -215,6 +247,11 @@ fn bad_mesh_files_are_located_errors() {
         ("bad.obj", b"v 0 0 0\nv 1 0 0\nf 1 2 7\n".to_vec(), "line 3"),
         ("short.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 100000000\nproperty float x\nend_header\n".to_vec(), "truncated PLY"),
         ("bad.glb", b"glTF\x02\0\0\0\xff\xff\0\0".to_vec(), "glTF"),
+        ("solid.stl", solid, "truncated binary STL"),
+        ("cut.stl", cut, "line 8: ASCII STL: expected `endfacet`, found `endfa`"),
+        ("offset.glb", offset, "at `bufferViews[1]` of the JSON chunk"),
+        ("sparse.glb", glb(&json.replace(r#""type":"SCALAR""#, r#""type":"SCALAR","sparse":{}"#), &bin), "accessors[1].sparse"),
+        ("v1.glb", { let mut b = glb(&json, &bin); b[4] = 1; b }, "glTF version 1"),
         ("missing.stl", Vec::new(), "cannot read"),
         ("part.txt", Vec::new(), "not a mesh file"),
     ];
@@ -236,27 +273,28 @@ fn bad_mesh_files_are_located_errors() {
             "{name}"
         );
     }
-    // The limit names the flag that raises it.
-    std::fs::write(
-        dir.join("two.stl"),
-        stl(2, &[tri, [0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 1.0]]),
-    )
-    .expect("write");
-    let path = dir.join("limited.sdf");
-    std::fs::write(&path, format!("{LIGHTS}scene {{ mesh(\"two.stl\"); }}")).expect("write");
+    // The limit names the flag that raises it, with the value that would do: the file's
+    // triangles and those of the meshes read before it (not twice the limit).
+    let other = [0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 1.0];
+    std::fs::write(dir.join("two.stl"), stl(2, &[tri, other])).expect("write");
+    std::fs::write(dir.join("three.stl"), stl(3, &[tri, other, tri])).expect("write");
     let mut limits = sdfc_compiler::Limits::default();
     limits
-        .set(sdfc_compiler::Limit::Triangles, 1)
+        .set(sdfc_compiler::Limit::Triangles, 4)
         .expect("a valid limit");
-    let loaded = sdfc_runtime::frontend::load_with(&path, &limits).expect("readable");
-    assert!(
-        loaded
-            .diagnostics
-            .iter()
-            .any(|d| d.message.contains("--limit triangles=")),
-        "{:?}",
-        loaded.diagnostics
-    );
+    for (scene, says) in [
+        ("mesh(\"two.stl\"); mesh(\"three.stl\");", "the file has 3 triangles, and the scene's other meshes 2, more than the `triangles` limit of 4; raise it with `--limit triangles=5`"),
+        ("mesh(\"three.stl\", 2); mesh(\"three.stl\");", "the file has 3 triangles, and the scene's other meshes 3, more than the `triangles` limit of 4; raise it with `--limit triangles=6`"),
+    ] {
+        let path = dir.join("limited.sdf");
+        std::fs::write(&path, format!("{LIGHTS}scene {{ {scene} }}")).expect("write");
+        let loaded = sdfc_runtime::frontend::load_with(&path, &limits).expect("readable");
+        assert!(
+            loaded.diagnostics.iter().any(|d| d.message.contains(says)),
+            "{scene}: {:?}",
+            loaded.diagnostics
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -304,5 +342,27 @@ fn a_software_adapter_that_would_cut_loops_refuses_instead_of_a_wrong_picture() 
     } else {
         let frame = frame.expect("a GPU renders it");
         assert_eq!(frame.render.stats.counters.cut, 0);
+    }
+}
+
+/// The seeds of the `mesh_file` fuzz target (fuzz/seeds/mesh_file/: a byte picking the
+/// format, then the file) are valid files of each format, so that a fuzz run starts from
+/// inputs that reach every reader's whole path.
+#[test]
+fn the_mesh_file_fuzz_seeds_read() {
+    use sdfc_compiler::meshfile::{read, Format};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/seeds/mesh_file");
+    let mut formats = Vec::new();
+    for entry in std::fs::read_dir(&dir).expect("the seeds") {
+        let path = entry.expect("an entry").path();
+        let bytes = std::fs::read(&path).expect("a seed");
+        let format = [Format::Stl, Format::Obj, Format::Ply, Format::Glb][bytes[0] as usize % 4];
+        let r =
+            read(format, &bytes[1..], 1000).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(!r.faces.is_empty());
+        formats.push(format);
+    }
+    for f in [Format::Stl, Format::Obj, Format::Ply, Format::Glb] {
+        assert!(formats.contains(&f), "no seed of {f:?}");
     }
 }

@@ -198,7 +198,7 @@ impl Build<'_, '_> {
     /// The shape of the triangle mesh in the file `path` (relative to the calling file),
     /// scaled by `scale`: read once per file and scale, with a warning where it is open.
     fn mesh(&mut self, path: &str, scale: f64) -> Result<Value, String> {
-        use super::meshfile::{read, Format};
+        use super::meshfile::{read, Error, Format};
         use crate::program::mesh::{Invalid, TriMesh};
         let format = Format::of(path).ok_or_else(|| {
             format!("`{path}` is not a mesh file: `mesh` reads .stl, .obj, .ply and .glb files")
@@ -225,14 +225,23 @@ impl Build<'_, '_> {
             return self.node(node);
         }
         let max = self.limits.get(Limit::Triangles);
-        let left = max.saturating_sub(files.triangles);
-        let read = read(format, &bytes, left).map_err(|e| {
-            let e = if e.contains("`triangles` limit") {
-                format!("{e}; {}", self.limits.raise(Limit::Triangles))
-            } else {
-                e
-            };
-            format!("cannot read the mesh `{path}`: {e}")
+        let used = files.triangles;
+        let read = read(format, &bytes, max.saturating_sub(used)).map_err(|e| match e {
+            // The limit is for all the scene's meshes: the value that would do is this
+            // file's triangles and those read before it.
+            Error::Limit { triangles, at, .. } => {
+                let at = at.map(|p| format!("{p}: ")).unwrap_or_default();
+                let others = if used > 0 {
+                    format!(", and the scene's other meshes {used}")
+                } else {
+                    String::new()
+                };
+                format!(
+                    "cannot read the mesh `{path}`: {at}the file has {triangles} triangles{others}, more than the `triangles` limit of {max}; {}",
+                    self.limits.raise_to(Limit::Triangles, triangles.saturating_add(used))
+                )
+            }
+            e => format!("cannot read the mesh `{path}`: {e}"),
         })?;
         let mut mesh = TriMesh::new(path, &read.positions, &read.faces, scale).map_err(|e| {
             let why = match e {

@@ -6,7 +6,7 @@ use super::builtins::{self, Build, Def, Range, P};
 use super::field;
 use super::ops;
 use super::suggest::{closest, closest_in_order};
-use super::types::{Type, Value};
+use super::types::{CallKey, Type, Value};
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::scene::{Graph, MaterialId, Node};
@@ -68,7 +68,9 @@ pub struct Ctx<'l> {
     /// Results of calls of user functions on concrete arguments: functions are pure, so a
     /// call repeated with the same arguments is evaluated once. With each, where its
     /// evaluation read the time `t`, if it did.
-    memo: HashMap<String, (Value, Option<Span>)>,
+    memo: HashMap<CallKey, (Value, Option<Span>)>,
+    /// The last list an argument was converted from, and to.
+    converted: Converted,
     /// Fields begun so far: each field's point is told apart from an enclosing one's.
     fields: u32,
     /// For each field being evaluated, innermost last: whether it is a profile's (its point
@@ -156,7 +158,12 @@ impl Ctx<'_> {
 
     /// Spends one evaluation step; false (and a report) once the budget is spent.
     pub fn burn(&mut self, span: Span) -> bool {
-        self.fuel += 1;
+        self.burn_steps(1, span)
+    }
+
+    /// Spends `steps` evaluation steps (elements copied count as one each).
+    fn burn_steps(&mut self, steps: u64, span: Span) -> bool {
+        self.fuel = self.fuel.saturating_add(steps);
         let max = self.limits.get(Limit::Fuel);
         if self.fuel > max {
             self.limit(
@@ -319,10 +326,11 @@ impl Ctx<'_> {
         if n <= max {
             return true;
         }
-        self.limit(
+        self.limit_to(
             Limit::Objects,
             span,
             format!("a list has {n} elements, more than {max}"),
+            n as u64,
         );
         false
     }
@@ -1241,12 +1249,22 @@ impl Ctx<'_> {
 
     /// Reports an exceeded resource limit once, naming the flag that raises it.
     pub fn limit(&mut self, limit: Limit, span: Span, msg: String) {
+        self.limit_report(limit, span, msg, None);
+    }
+
+    /// [`Ctx::limit`] where the value that would do is known, `needed`: the note suggests it.
+    pub fn limit_to(&mut self, limit: Limit, span: Span, msg: String, needed: u64) {
+        self.limit_report(limit, span, msg, Some(needed));
+    }
+
+    fn limit_report(&mut self, limit: Limit, span: Span, msg: String, needed: Option<u64>) {
         if !self.reported_limit {
             self.reported_limit = true;
-            let note = format!(
-                "this limit keeps compilation bounded; {}",
-                self.limits.raise(limit)
-            );
+            let raise = match needed {
+                Some(n) => self.limits.raise_to(limit, n),
+                None => self.limits.raise(limit),
+            };
+            let note = format!("this limit keeps compilation bounded; {raise}");
             self.error(Diagnostic::error("E0507", msg, span).with_note(note));
         }
     }
@@ -1339,8 +1357,21 @@ impl Ctx<'_> {
                     has_default: p.def.value().is_some(),
                 })
                 .collect();
-            match bind(&params, sig.rest, &recv, &args, callee, span) {
-                Ok(slots) => return self.run_builtin(b, sig, slots, callee, span),
+            match bind(
+                &params,
+                sig.rest,
+                &recv,
+                &args,
+                callee,
+                span,
+                &mut self.converted,
+            ) {
+                Ok(slots) => {
+                    if !self.burn_steps(slots.copied, span) {
+                        return Value::Error;
+                    }
+                    return self.run_builtin(b, sig, slots, callee, span);
+                }
                 Err(errs) => {
                     if best.as_ref().is_none_or(|(_, e)| errs.len() < e.len()) {
                         best = Some((i, errs));
@@ -1476,7 +1507,11 @@ impl Ctx<'_> {
         args: Vec<ArgVal>,
         span: Span,
     ) -> Value {
-        if !self.fns[&callee.name].checked {
+        // A body is checked on its own at its function's first evaluated call. A call met
+        // while another body is checked needs only the declared types: its function is
+        // checked at its own first call, or with the functions never called, so that
+        // checking does not nest as deep as a chain of functions is long.
+        if !self.fns[&callee.name].checked && self.dry == 0 {
             self.check_function(&callee.name);
         }
         let info = &self.fns[&callee.name];
@@ -1492,7 +1527,15 @@ impl Ctx<'_> {
                 has_default: p.default.is_some(),
             })
             .collect();
-        let slots = match bind(&params, false, &recv, &args, callee, span) {
+        let slots = match bind(
+            &params,
+            false,
+            &recv,
+            &args,
+            callee,
+            span,
+            &mut self.converted,
+        ) {
             Ok(s) => s,
             Err(errs) => {
                 for d in errs {
@@ -1502,7 +1545,7 @@ impl Ctx<'_> {
             }
         };
         let Some(ret) = ret else { return Value::Error };
-        if !ok {
+        if !ok || !self.burn_steps(slots.copied, span) {
             return Value::Error;
         }
         // The body was checked on its own: a types-only call needs only the return type.
@@ -1532,14 +1575,10 @@ impl Ctx<'_> {
             };
             frame.push((p.name.name.clone(), v));
         }
-        let key = format!(
-            "{}{:?}",
-            callee.name,
-            frame.iter().map(|(_, v)| v).collect::<Vec<_>>()
-        );
-        // A call on per-point values builds expressions: it is not kept.
-        let keep = !frame.iter().any(|(_, v)| field::is_point(v));
-        if let Some((v, read)) = self.memo.get(&key).cloned().filter(|_| keep) {
+        // A call on per-point values builds expressions, and one on a long list or string
+        // would make a long key: neither is kept.
+        let key = CallKey::new(&callee.name, frame.iter().map(|(_, v)| v));
+        if let Some((v, read)) = key.as_ref().and_then(|k| self.memo.get(k)).cloned() {
             self.locals = saved;
             if let Some(at) = read {
                 self.read_time(at);
@@ -1563,7 +1602,7 @@ impl Ctx<'_> {
         }
         self.locals = saved;
         let v = v.coerce(ret).unwrap_or(Value::Error);
-        if keep && !field::is_point(&v) {
+        if let Some(key) = key.filter(|_| !field::is_point(&v)) {
             self.memo.insert(key, (v.clone(), read));
         }
         v
@@ -1814,10 +1853,13 @@ impl<'a> Binder<'a> {
 struct Bound {
     slots: Vec<Option<(Value, Span)>>,
     rest: Vec<(Value, Span)>,
+    /// Elements of lists copied to convert them (ints to floats), spent as fuel.
+    copied: u64,
 }
 
 /// Matches arguments to parameters and checks their types. A method receiver goes to the first
 /// parameter of its type. Returns every problem found.
+#[allow(clippy::too_many_arguments)]
 fn bind(
     params: &[PView],
     rest: bool,
@@ -1825,6 +1867,7 @@ fn bind(
     args: &[ArgVal],
     callee: &Ident,
     span: Span,
+    converted: &mut Converted,
 ) -> Result<Bound, Vec<Diagnostic>> {
     let mut errs = Vec::new();
     let mut slots: Vec<Option<(Value, Span)>> = vec![None; params.len()];
@@ -1896,8 +1939,12 @@ fn bind(
     }
     // Suggestions name only parameters that no argument fills.
     errs.extend(binder.finish(span).0);
-    let mut bound = Bound { slots, rest: extra };
-    coerce(params, &mut bound, &mut errs);
+    let mut bound = Bound {
+        slots,
+        rest: extra,
+        copied: 0,
+    };
+    coerce(params, &mut bound, converted, &mut errs);
     if errs.is_empty() {
         Ok(bound)
     } else {
@@ -1924,21 +1971,69 @@ fn receiver_slot(params: &[PView], v: &Value) -> Option<usize> {
 
 /// Converts each bound argument to its parameter's type (an int to a float, …), or reports
 /// E0300 where it has another.
-fn coerce(params: &[PView], bound: &mut Bound, errs: &mut Vec<Diagnostic>) {
+fn coerce(
+    params: &[PView],
+    bound: &mut Bound,
+    converted: &mut Converted,
+    errs: &mut Vec<Diagnostic>,
+) {
     for (i, slot) in bound.slots.iter_mut().enumerate() {
         if let (Some((v, s)), Some(want)) = (slot.as_mut(), params[i].ty) {
-            match v.clone().coerce(want) {
-                Some(c) => *v = c,
-                None => errs.push(type_mismatch(params[i].name, want, v, *s)),
+            if !converted.convert(v, want, &mut bound.copied) {
+                errs.push(type_mismatch(params[i].name, want, v, *s));
             }
         }
     }
     if let Some(want) = params.last().and_then(|p| p.ty) {
         for (v, s) in bound.rest.iter_mut() {
-            match v.clone().coerce(want) {
-                Some(c) => *v = c,
-                None => errs.push(type_mismatch(params[params.len() - 1].name, want, v, *s)),
+            if !converted.convert(v, want, &mut bound.copied) {
+                errs.push(type_mismatch(params[params.len() - 1].name, want, v, *s));
             }
+        }
+    }
+}
+
+/// The last list converted to another element type (ints to floats) for an argument: the
+/// list, the element type and the copy. A list passed call after call (in a loop) is
+/// copied once; every copy's elements are spent as fuel, so that copying is bounded too.
+#[derive(Debug, Default)]
+pub struct Converted {
+    last: Option<Conversion>,
+}
+
+/// A list converted: the list, the element type it was converted to, and its copy.
+type Conversion = (Rc<[Value]>, &'static Type, Rc<[Value]>);
+
+impl Converted {
+    /// Converts `v` to `want` where it fits (false where it does not), adding the elements
+    /// of a list copied to `copied`.
+    fn convert(&mut self, v: &mut Value, want: Type, copied: &mut u64) -> bool {
+        if let (Value::List(elem, items), Type::List(w)) = (&*v, want) {
+            if *elem != w {
+                if let Some((from, to, out)) = &self.last {
+                    if Rc::ptr_eq(from, items) && *to == w {
+                        *v = Value::List(w, Rc::clone(out));
+                        return true;
+                    }
+                }
+                let from = Rc::clone(items);
+                let Some(c) = v.clone().coerce(want) else {
+                    return false;
+                };
+                if let Value::List(_, out) = &c {
+                    *copied += from.len() as u64;
+                    self.last = Some((from, w, Rc::clone(out)));
+                }
+                *v = c;
+                return true;
+            }
+        }
+        match v.clone().coerce(want) {
+            Some(c) => {
+                *v = c;
+                true
+            }
+            None => false,
         }
     }
 }

@@ -644,57 +644,75 @@ fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
     }
 }
 
-/// Reports every cycle in the call graph of user functions (recursion cannot be evaluated).
+/// Reports every cycle in the call graph of user functions (recursion cannot be evaluated):
+/// one report for each set of functions that reach one another (a strongly connected part
+/// of the graph, of which there is one cycle or more), on a shortest cycle through its first
+/// function by name; every function of the set is marked. Linear in the calls: a chain of
+/// thousands of functions costs no more than its size.
 fn reject_recursion(cx: &mut Ctx) {
-    let mut graph: HashMap<String, Vec<(String, Span)>> = HashMap::new();
-    for (name, info) in &cx.fns {
-        let mut calls = Vec::new();
-        calls_in(&info.decl.body, &mut calls);
-        for p in &info.decl.params {
-            if let Some(d) = &p.default {
-                calls_in(
-                    &ast::Body {
-                        lets: Vec::new(),
-                        value: Box::new(d.clone()),
-                        span: d.span,
-                    },
-                    &mut calls,
-                );
-            }
-        }
-        calls.retain(|(c, _)| cx.fns.contains_key(c));
-        graph.insert(name.clone(), calls);
-    }
-    let mut names: Vec<&String> = graph.keys().collect();
+    let mut names: Vec<String> = cx.fns.keys().cloned().collect();
     names.sort();
-    let mut bad: HashSet<String> = HashSet::new();
-    let mut reports = Vec::new();
-    for start in names {
-        // Depth-first search for a path back to `start`.
-        let mut seen = HashSet::new();
-        let mut stack: Vec<(String, Vec<(String, Span)>)> = vec![(start.clone(), Vec::new())];
-        while let Some((f, path)) = stack.pop() {
-            for (callee, span) in &graph[&f] {
-                let mut p = path.clone();
-                p.push((callee.clone(), *span));
-                if callee == start {
-                    // One report per cycle: every function on it is marked.
-                    if !bad.contains(start) {
-                        bad.insert(start.clone());
-                        bad.extend(p.iter().map(|(n, _)| n.clone()));
-                        reports.push((start.clone(), p.clone()));
-                    }
-                } else if seen.insert(callee.clone()) {
-                    stack.push((callee.clone(), p));
+    let number: HashMap<&str, usize> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.as_str(), i))
+        .collect();
+    // The calls of each function (by number), with their spans.
+    let calls: Vec<Vec<(usize, Span)>> = names
+        .iter()
+        .map(|name| {
+            let info = &cx.fns[name];
+            let mut calls = Vec::new();
+            calls_in(&info.decl.body, &mut calls);
+            for p in &info.decl.params {
+                if let Some(d) = &p.default {
+                    calls_in(
+                        &ast::Body {
+                            lets: Vec::new(),
+                            value: Box::new(d.clone()),
+                            span: d.span,
+                        },
+                        &mut calls,
+                    );
                 }
             }
+            calls
+                .into_iter()
+                .filter_map(|(c, span)| Some((*number.get(c.as_str())?, span)))
+                .collect()
+        })
+        .collect();
+    let mut bad: Vec<usize> = Vec::new();
+    let mut reports: Vec<(usize, Vec<(usize, Span)>)> = Vec::new();
+    for part in strongly_connected(&calls) {
+        let first = part[0];
+        let cyclic = part.len() > 1 || calls[first].iter().any(|&(c, _)| c == first);
+        if !cyclic {
+            continue;
         }
+        let start = part.iter().copied().min().unwrap_or(first);
+        let inside: HashSet<usize> = part.iter().copied().collect();
+        if let Some(path) = shortest_cycle(&calls, start, &inside) {
+            reports.push((start, path));
+        }
+        bad.extend(part);
     }
-    for (name, path) in &reports {
-        let chain: Vec<&str> = std::iter::once(name.as_str())
-            .chain(path.iter().map(|(n, _)| n.as_str()))
+    reports.sort_by_key(|(start, _)| *start);
+    for (start, path) in &reports {
+        let mut chain: Vec<String> = std::iter::once(*start)
+            .chain(path.iter().map(|&(n, _)| n))
+            .map(|n| names[n].clone())
             .collect();
-        let name = name.clone();
+        // A long chain is shown by its ends.
+        const SHOWN: usize = 8;
+        if chain.len() > SHOWN {
+            let hidden = chain.len() - SHOWN;
+            chain.splice(
+                SHOWN / 2..chain.len() - SHOWN / 2,
+                [format!("… {hidden} more …")],
+            );
+        }
+        let name = &names[*start];
         let span = path[0].1;
         cx.error(
             Diagnostic::error("E0502", format!("function `{name}` calls itself"), span)
@@ -703,11 +721,97 @@ fn reject_recursion(cx: &mut Ctx) {
                 .with_note("scenes are evaluated at compile time, so functions cannot recurse; use a `for` loop in the scene"),
         );
     }
-    for name in &bad {
-        if let Some(info) = cx.fns.get_mut(name) {
+    for f in bad {
+        if let Some(info) = cx.fns.get_mut(&names[f]) {
             info.ok = false;
         }
     }
+}
+
+/// The strongly connected parts of the graph whose edges from node `i` are `edges[i]`
+/// (Tarjan's algorithm, without recursion: a chain of any length runs on the heap).
+fn strongly_connected(edges: &[Vec<(usize, Span)>]) -> Vec<Vec<usize>> {
+    const NONE: usize = usize::MAX;
+    let n = edges.len();
+    let (mut index, mut low) = (vec![NONE; n], vec![0; n]);
+    let mut on_stack = vec![false; n];
+    let (mut stack, mut parts) = (Vec::new(), Vec::new());
+    let mut next = 0;
+    for root in 0..n {
+        if index[root] != NONE {
+            continue;
+        }
+        // The walk: each node with the position of its next edge.
+        let mut walk = vec![(root, 0usize)];
+        index[root] = next;
+        low[root] = next;
+        next += 1;
+        stack.push(root);
+        on_stack[root] = true;
+        while let Some(&mut (v, ref mut e)) = walk.last_mut() {
+            if let Some(&(w, _)) = edges[v].get(*e) {
+                *e += 1;
+                if index[w] == NONE {
+                    index[w] = next;
+                    low[w] = next;
+                    next += 1;
+                    stack.push(w);
+                    on_stack[w] = true;
+                    walk.push((w, 0));
+                } else if on_stack[w] {
+                    low[v] = low[v].min(index[w]);
+                }
+                continue;
+            }
+            walk.pop();
+            if let Some(&(parent, _)) = walk.last() {
+                low[parent] = low[parent].min(low[v]);
+            }
+            if low[v] == index[v] {
+                let mut part = Vec::new();
+                while let Some(w) = stack.pop() {
+                    on_stack[w] = false;
+                    part.push(w);
+                    if w == v {
+                        break;
+                    }
+                }
+                parts.push(part);
+            }
+        }
+    }
+    parts
+}
+
+/// A shortest path of calls from `start` back to it within `inside` (breadth first): each
+/// step the function called and the call's span.
+fn shortest_cycle(
+    edges: &[Vec<(usize, Span)>],
+    start: usize,
+    inside: &HashSet<usize>,
+) -> Option<Vec<(usize, Span)>> {
+    let mut came: HashMap<usize, (usize, Span)> = HashMap::new();
+    let mut queue = std::collections::VecDeque::from([start]);
+    while let Some(v) = queue.pop_front() {
+        for &(w, span) in &edges[v] {
+            if w == start {
+                let mut path = vec![(start, span)];
+                let mut at = v;
+                while at != start {
+                    let &(from, span) = came.get(&at)?;
+                    path.push((at, span));
+                    at = from;
+                }
+                path.reverse();
+                return Some(path);
+            }
+            if inside.contains(&w) && !came.contains_key(&w) {
+                came.insert(w, (v, span));
+                queue.push_back(w);
+            }
+        }
+    }
+    None
 }
 
 fn material(
@@ -856,10 +960,11 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 let frames = scene.animation.frames();
                 if frames > max {
                     let at = field_span(&b.fields, "duration").unwrap_or(b.keyword.span);
-                    cx.limit(
+                    cx.limit_to(
                         Limit::Frames,
                         at,
                         format!("the animation has {frames} frames, more than {max}"),
+                        frames,
                     );
                 }
             }
@@ -1088,13 +1193,12 @@ fn for_loop(
     };
     let max = cx.limits.get(Limit::Objects);
     if b > a && b.saturating_sub(a) as u64 > max {
-        cx.limit(
+        let runs = b.saturating_sub(a) as u64;
+        cx.limit_to(
             Limit::Objects,
             to.span,
-            format!(
-                "the loop runs {} times, more than {max}",
-                b.saturating_sub(a)
-            ),
+            format!("the loop runs {runs} times, more than {max}"),
+            runs,
         );
         return;
     }

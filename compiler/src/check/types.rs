@@ -288,6 +288,72 @@ impl fmt::Display for Value {
     }
 }
 
+/// A call of a user function on concrete arguments, as the key of the checker's memo of
+/// calls: each argument by its bits or, for a string or list, its contents. Only short
+/// strings and lists make keys ([`CallKey::new`]), so that a key costs little to build,
+/// hash, compare and keep whatever the arguments.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct CallKey {
+    name: String,
+    args: Vec<KeyArg>,
+}
+
+impl CallKey {
+    /// The key of a call of `name` on `args`; none where an argument is a string or list
+    /// longer than [`SHORT`], a colour field or a per-point value: such a call is evaluated
+    /// each time (keyed by its contents, a call on a list of 20 000 elements in a loop cost
+    /// time and memory in the square of the length).
+    pub fn new<'a>(name: &str, args: impl IntoIterator<Item = &'a Value>) -> Option<CallKey> {
+        Some(CallKey {
+            name: name.to_string(),
+            args: args
+                .into_iter()
+                .map(KeyArg::of)
+                .collect::<Option<Vec<_>>>()?,
+        })
+    }
+}
+
+/// Strings and lists up to this length are keys by their contents.
+pub const SHORT: usize = 16;
+
+/// One argument of a [`CallKey`].
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+enum KeyArg {
+    /// A number, bool, vector, shape or profile: its kind and bits.
+    Bits(u8, [u64; 3]),
+    Unknown(Type),
+    Error,
+    /// A short string, by its text.
+    Text(Rc<str>),
+    /// A short list: its element type and its elements' keys.
+    List(Type, Vec<KeyArg>),
+}
+
+impl KeyArg {
+    fn of(v: &Value) -> Option<KeyArg> {
+        let bits = |kind, b: [u64; 3]| Some(KeyArg::Bits(kind, b));
+        match v {
+            Value::Int(i) => bits(0, [*i as u64, 0, 0]),
+            Value::Float(x) => bits(1, [x.to_bits(), 0, 0]),
+            Value::Bool(b) => bits(2, [u64::from(*b), 0, 0]),
+            Value::Vec2(p) => bits(3, [p[0].to_bits(), p[1].to_bits(), 0]),
+            Value::Vec3(p) => bits(4, p.map(f64::to_bits)),
+            Value::Angle(a) => bits(5, [a.to_bits(), 0, 0]),
+            Value::Shape(id) => bits(6, [u64::from(id.0), 0, 0]),
+            Value::Profile(id) => bits(7, [u64::from(id.0), 0, 0]),
+            Value::Unknown(t) => Some(KeyArg::Unknown(*t)),
+            Value::Error => Some(KeyArg::Error),
+            Value::Str(s) if s.len() <= SHORT => Some(KeyArg::Text(Rc::clone(s))),
+            Value::List(elem, items) if items.len() <= SHORT => Some(KeyArg::List(
+                **elem,
+                items.iter().map(KeyArg::of).collect::<Option<_>>()?,
+            )),
+            Value::Str(_) | Value::List(..) | Value::Colour(_) | Value::Point(_) => None,
+        }
+    }
+}
+
 /// One scalar of a per-point value: an expression tree whose shared parts are shared `Rc`s.
 #[derive(Clone, PartialEq)]
 pub enum Sx {

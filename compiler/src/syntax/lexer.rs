@@ -197,12 +197,30 @@ impl fmt::Display for Token {
 /// skipped, so the parser still sees every valid token. A byte-order mark at the start (which
 /// some editors write) is skipped; spans stay offsets into `text`.
 pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
+    lex_watched(file, text, |_, _| true)
+}
+
+/// [`lex`], showing each token to `keep` as it is lexed: once `keep` returns false, the
+/// tokens after it are shown but not kept (a caller that refuses the text at some token
+/// still sees the rest, in memory that does not grow with it).
+pub fn lex_watched(
+    file: FileId,
+    text: &str,
+    mut keep: impl FnMut(&Token, Span) -> bool,
+) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
     let mut tokens = Vec::new();
     let mut diags = Vec::new();
     let mut lexer = Token::lexer(text);
     if text.starts_with(BOM) {
         lexer.bump(BOM.len_utf8());
     }
+    let mut keeping = true;
+    let mut push = |tokens: &mut Vec<(Token, Span)>, token: Token, span: Span| {
+        keeping &= keep(&token, span);
+        if keeping {
+            tokens.push((token, span));
+        }
+    };
     while let Some(result) = lexer.next() {
         let range = lexer.span();
         let span = Span::new(file, range.clone());
@@ -229,7 +247,7 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
                 if closed {
                     let (text, bad) = unescape(&rest[..len], range.end, file);
                     diags.extend(bad);
-                    tokens.push((Token::Str(text), span));
+                    push(&mut tokens, Token::Str(text), span);
                 } else {
                     diags.push(
                         Diagnostic::error("E0002", "unterminated string literal", span)
@@ -237,15 +255,15 @@ pub fn lex(file: FileId, text: &str) -> (Vec<(Token, Span)>, Vec<Diagnostic>) {
                             .with_help("strings end with `\"` on the same line"),
                     );
                     // The parser sees a string, so the rest of the line is not misread.
-                    tokens.push((Token::Str(String::new()), span));
+                    push(&mut tokens, Token::Str(String::new()), span);
                 }
             }
-            Ok(tok) => tokens.push((tok, span)),
+            Ok(tok) => push(&mut tokens, tok, span),
             Err(()) => {
                 let d = lex_error(text, range.clone(), span);
                 // A malformed number still stands for a number to the parser.
                 if d.code == "E0004" {
-                    tokens.push((Token::Float(0.0), span));
+                    push(&mut tokens, Token::Float(0.0), span);
                 }
                 diags.push(d);
             }

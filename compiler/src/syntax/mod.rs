@@ -63,6 +63,67 @@ pub fn nesting(
     (deepest, first_over)
 }
 
+/// The elements of the literal lists of a file's tokens, counted as they are lexed: the
+/// first list with more than `max` (the `objects` limit, which bounds every list) and its
+/// count, found before anything is parsed, so that a file of millions of elements costs
+/// its tokens up to the limit and no syntax tree.
+struct Lists {
+    max: usize,
+    /// The brackets open: a list's `[` (where, its elements so far, whether an element is
+    /// to start) or another bracket.
+    open: Vec<Option<(crate::span::Span, usize, bool)>>,
+    /// The list past the limit: where it opens and its elements (all of them once it closes).
+    over: Option<(crate::span::Span, usize)>,
+    /// Its depth in `open`, while it is open.
+    over_depth: Option<usize>,
+}
+
+impl Lists {
+    fn new(max: usize) -> Lists {
+        Lists {
+            max,
+            open: Vec::new(),
+            over: None,
+            over_depth: None,
+        }
+    }
+
+    /// Sees one token; false once a list is past the limit (the tokens need not be kept).
+    fn see(&mut self, t: &lexer::Token, span: crate::span::Span) -> bool {
+        use lexer::Token;
+        let depth = self.open.len();
+        if let Some(Some((at, elements, expecting))) = self.open.last_mut() {
+            match t {
+                Token::Comma => *expecting = true,
+                Token::RBracket | Token::RParen | Token::RBrace => {}
+                _ if *expecting => {
+                    *expecting = false;
+                    *elements += 1;
+                    if self.over_depth == Some(depth) {
+                        self.over = Some((*at, *elements));
+                    } else if *elements > self.max && self.over.is_none() {
+                        self.over = Some((*at, *elements));
+                        self.over_depth = Some(depth);
+                    }
+                }
+                _ => {}
+            }
+        }
+        match t {
+            Token::LBracket => self.open.push(Some((span, 0, true))),
+            Token::LParen | Token::LBrace => self.open.push(None),
+            Token::RBracket | Token::RParen | Token::RBrace => {
+                if self.over_depth == Some(self.open.len()) {
+                    self.over_depth = None;
+                }
+                self.open.pop();
+            }
+            _ => {}
+        }
+        self.over.is_none()
+    }
+}
+
 /// [`parse`] within the `nesting` limit ([`nesting`]; none: no limit): a file that nests deeper is not
 /// parsed, and gets one error (E0507) at the first token past the limit, so that neither
 /// the parser nor the checker recurses without bound. Also returns the file's depth.
@@ -73,7 +134,26 @@ pub fn parse_within(
 ) -> ((ast::File, Vec<Diagnostic>), usize) {
     use crate::limits::Limit;
     let max = limits.map_or(usize::MAX, |l| l.count(Limit::Nesting));
-    let (tokens, mut diags) = lexer::lex(file, text);
+    let mut lists = Lists::new(limits.map_or(usize::MAX, |l| l.count(Limit::Objects)));
+    let (tokens, mut diags) = lexer::lex_watched(file, text, |t, span| lists.see(t, span));
+    if let Some((at, n)) = lists.over {
+        diags.push(
+            Diagnostic::error(
+                "E0507",
+                format!("a list has {n} elements, more than {}", lists.max),
+                at,
+            )
+            .with_label("this list")
+            .with_note(format!(
+                "this limit keeps compilation bounded; {}",
+                limits
+                    .map(|l| l.raise_to(Limit::Objects, n as u64))
+                    .unwrap_or_default()
+            )),
+        );
+        // Nothing was parsed: the tokens past the limit were counted, not kept.
+        return ((ast::File { items: Vec::new() }, diags), 0);
+    }
     let (depth, over) = nesting(&tokens, max);
     if let Some(at) = over {
         diags.push(

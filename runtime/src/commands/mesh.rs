@@ -412,7 +412,7 @@ pub fn surface(
             1,
             format!(
                 "the surface reaches {cells} cells, more than the cells and memory limits allow ({memory_cells}); {}",
-                limits.raise(Limit::Cells)
+                limits.raise_to(Limit::Cells, cells)
             ),
         ),
     })?;

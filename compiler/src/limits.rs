@@ -57,6 +57,8 @@ pub enum Limit {
     Registers,
     /// Triangles of the meshes one scene reads (`mesh(path)`), in all.
     Triangles,
+    /// Worker threads `--threads` may start.
+    Threads,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -71,7 +73,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 21] = [
+    pub const ALL: [Limit; 22] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -93,6 +95,7 @@ impl Limit {
         Limit::Cells,
         Limit::Registers,
         Limit::Triangles,
+        Limit::Threads,
     ];
 
     fn spec(self) -> Spec {
@@ -234,6 +237,17 @@ impl Limit {
                 1 << 28,
                 "triangles of the meshes one scene reads",
             ),
+            // Each worker is a thread of the operating system with its own stack and, on the
+            // CPU renderer, its evaluators' slots: far more workers than cores only costs
+            // (`--threads 100000` started threads until the system refused them). 1 024 is
+            // beyond any machine the project meets; the ceiling is where Linux's default
+            // limit of threads a process may start lies.
+            Limit::Threads => s(
+                "threads",
+                1_024,
+                32_768,
+                "worker threads --threads may start",
+            ),
         }
     }
 
@@ -304,7 +318,7 @@ impl Spelling {
 /// one ([`Spelling`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 21],
+    values: [u64; 22],
     spelling: Spelling,
 }
 

@@ -59,6 +59,8 @@ pub enum Limit {
     Triangles,
     /// Bytes of one file read (a scene, an import, a mesh, a font), in MiB.
     FileSize,
+    /// Worker threads `--threads` may start.
+    Threads,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -73,7 +75,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 22] = [
+    pub const ALL: [Limit; 23] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -96,6 +98,7 @@ impl Limit {
         Limit::Registers,
         Limit::Triangles,
         Limit::FileSize,
+        Limit::Threads,
     ];
 
     fn spec(self) -> Spec {
@@ -245,6 +248,17 @@ impl Limit {
                 1 << 20,
                 "MiB of one file read (a scene, an import, a mesh, a font)",
             ),
+            // Each worker is a thread of the operating system with its own stack and, on the
+            // CPU renderer, its evaluators' slots: far more workers than cores only costs
+            // (`--threads 100000` started threads until the system refused them). 1 024 is
+            // beyond any machine the project meets; the ceiling is where Linux's default
+            // limit of threads a process may start lies.
+            Limit::Threads => s(
+                "threads",
+                1_024,
+                32_768,
+                "worker threads --threads may start",
+            ),
         }
     }
 
@@ -315,7 +329,7 @@ impl Spelling {
 /// one ([`Spelling`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 22],
+    values: [u64; 23],
     spelling: Spelling,
 }
 

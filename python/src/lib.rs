@@ -235,7 +235,7 @@ fn limits_of(limits: &[String]) -> Result<Limits, Failure> {
 /// The worker threads every call shares (one per core).
 fn pool() -> Result<&'static rayon::ThreadPool, Failure> {
     static POOL: OnceLock<Result<rayon::ThreadPool, job::Threads>> = OnceLock::new();
-    POOL.get_or_init(|| job::thread_pool(None))
+    POOL.get_or_init(|| job::thread_pool(None, &sdfc_compiler::Limits::default()))
         .as_ref()
         .map_err(|e| Failure::Runtime(e.to_string()))
 }

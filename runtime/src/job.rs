@@ -15,7 +15,7 @@ use crate::frontend::{self, DiagnosticFormat, Loaded, Source};
 use crate::gpu::Gpu;
 use crate::memory;
 use sdfc_compiler::{
-    lower_within, wgsl, Diagnostic, Limits, LowerOptions, Lowered, Program, Scene, Settings,
+    lower_within, wgsl, Diagnostic, Limit, Limits, LowerOptions, Lowered, Program, Scene, Settings,
     Severity, SourceMap,
 };
 use std::process::ExitCode;
@@ -131,6 +131,13 @@ pub enum Threads {
     /// `--threads 0`: a usage error.
     #[error("--threads must be at least 1")]
     Zero,
+    /// More than the `threads` limit: a usage error, naming the range and how to raise it.
+    #[error("--threads must be from 1 to {max} (the `threads` limit), not {asked}; {raise}")]
+    TooMany {
+        asked: usize,
+        max: u64,
+        raise: String,
+    },
     /// The pool could not be started.
     #[error("cannot start worker threads: {0}")]
     Start(#[from] rayon::ThreadPoolBuildError),
@@ -207,7 +214,7 @@ impl Error {
             | Error::Arguments(_)
             | Error::Io(_)
             | Error::Read(_)
-            | Error::Threads(Threads::Zero) => ExitCode::from(2),
+            | Error::Threads(Threads::Zero | Threads::TooMany { .. }) => ExitCode::from(2),
             _ => ExitCode::from(1),
         }
     }
@@ -271,7 +278,7 @@ impl Job {
 
     /// A rayon pool of `--threads` workers (default: rayon's choice, one per core).
     pub fn pool(&self) -> Result<rayon::ThreadPool, Error> {
-        Ok(thread_pool(self.threads)?)
+        Ok(thread_pool(self.threads, &self.limits)?)
     }
 
     /// Applies the job's settings to `scene`: the reference's (`--reference`), then `--size`,
@@ -374,12 +381,21 @@ impl Job {
     }
 }
 
-/// A rayon pool of `threads` workers (default: rayon's choice, one per core).
-pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Threads> {
+/// A rayon pool of `threads` workers (default: rayon's choice, one per core), at most the
+/// `threads` limit.
+pub fn thread_pool(threads: Option<usize>, limits: &Limits) -> Result<rayon::ThreadPool, Threads> {
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         if n == 0 {
             return Err(Threads::Zero);
+        }
+        let max = limits.get(Limit::Threads);
+        if n as u64 > max {
+            return Err(Threads::TooMany {
+                asked: n,
+                max,
+                raise: limits.raise_to(Limit::Threads, n as u64),
+            });
         }
         b = b.num_threads(n);
     }

@@ -130,6 +130,7 @@ fn bad_settings_are_usage_errors() {
         (vec!["--set", "epsilon"], "KEY=VALUE"),
         (vec!["--size", "0x10"], "1 to"),
         (vec!["--threads", "0"], "at least 1"),
+        (vec!["--threads", "100000"], "from 1 to 1024"),
     ] {
         let mut all = vec!["render", "ball.sdf"];
         all.extend(args.iter().copied());

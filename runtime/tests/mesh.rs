@@ -617,6 +617,14 @@ fn limits_and_bad_arguments_are_reported() {
     let (code, err) = run(&["--bounds=1,0,0,0,1,1"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("X0 < X1"), "{err}");
+    // More workers than the `threads` limit (10 000 never finished): refused, naming the
+    // range and the value that would do.
+    let (code, err) = run(&["--threads", "10000"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("from 1 to 1024") && err.contains("`--limit threads=10000`"),
+        "{err}"
+    );
     assert!(!out.exists());
     let o = sdfc(&["mesh", s(&scene), "-o", s(&d.join("p.xyz"))]);
     assert_eq!(o.status.code(), Some(2));

@@ -81,7 +81,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         .map_err(|why| usage(format!("cannot write `{}`: {why}", args.output.display())))?;
     let mut settings = settings(&args.set).map_err(usage)?;
     settings.materials = matches!(format, Format::Ply | Format::Glb);
-    let pool = crate::job::thread_pool(args.threads).map_err(|e| usage(e.to_string()))?;
+    let pool = crate::job::thread_pool(args.threads, &limits).map_err(|e| usage(e.to_string()))?;
     // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
     let checked = frontend::load_scene_code(&args.file, DiagnosticFormat::Human, &limits)
         .map_err(|code| (code, String::new()))?;

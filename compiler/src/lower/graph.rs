@@ -399,7 +399,7 @@ impl<'a> Lowerer<'a> {
             Node::Shear { matrix, child } => {
                 // f(S⁻¹p)·σmin(S): a bound with the child's L (docs/analysis.md).
                 let inverse = analysis::invert(matrix).unwrap_or(IDENTITY);
-                let (smin, _) = analysis::singular_range(matrix);
+                let (smin, _) = crate::scene::bounds::singular_range(matrix);
                 let transposed = [0, 1, 2].map(|i| [0, 1, 2].map(|j| inverse[j][i]));
                 let q = rotate(self.b, p, &transposed);
                 self.post(id, *child, q, |b, d| b.mulc(d, smin))

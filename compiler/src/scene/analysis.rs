@@ -14,6 +14,7 @@
 //! a repetition whose copies overlap their cells) L is the best guess, and
 //! [`Derived::proven`] is false.
 
+use super::bounds::singular_range;
 use super::ir::{Combine, Exactness, Facts, Feature, Node, Scene, Smooth, V3};
 use super::NodeId;
 use crate::diagnostics::Diagnostic;
@@ -425,51 +426,6 @@ pub(crate) fn invert(m: &[V3; 3]) -> Option<[V3; 3]> {
     }
     // The inverse is the transposed cofactor matrix over the determinant.
     Some([0, 1, 2].map(|i| [0, 1, 2].map(|j| c(j, i) / det)))
-}
-
-/// The smallest and largest singular values of a 3×3 matrix: the square roots of the
-/// eigenvalues of MᵀM, found by Jacobi rotations (symmetric, so they converge).
-pub(crate) fn singular_range(m: &[V3; 3]) -> (f64, f64) {
-    let mut a = [[0.0f64; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            a[i][j] = (0..3).map(|k| m[k][i] * m[k][j]).sum();
-        }
-    }
-    for _ in 0..64 {
-        let (mut p, mut q, mut big) = (0, 1, 0.0);
-        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
-            if a[i][j].abs() > big {
-                (p, q, big) = (i, j, a[i][j].abs());
-            }
-        }
-        if big < 1e-15 {
-            break;
-        }
-        let theta = 0.5 * (2.0 * a[p][q]).atan2(a[q][q] - a[p][p]);
-        let (s, c) = theta.sin_cos();
-        let mut r = IDENTITY;
-        r[p][p] = c;
-        r[q][q] = c;
-        r[p][q] = s;
-        r[q][p] = -s;
-        // a ← Rᵀ·a·R
-        let mut t = [[0.0f64; 3]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                t[i][j] = (0..3).map(|k| a[i][k] * r[k][j]).sum();
-            }
-        }
-        for i in 0..3 {
-            for j in 0..3 {
-                a[i][j] = (0..3).map(|k| r[k][i] * t[k][j]).sum();
-            }
-        }
-    }
-    let eig = [a[0][0], a[1][1], a[2][2]].map(|e| e.max(0.0).sqrt());
-    let lo = eig.iter().fold(f64::INFINITY, |x, e| x.min(*e));
-    let hi = eig.iter().fold(0.0f64, |x, e| x.max(*e));
-    (lo, hi)
 }
 
 /// The region a wrap's child is read in: u = R·angle within ±π·R, y kept, w = R − ρ for ρ

@@ -1405,6 +1405,7 @@ pub static BUILTINS: &[Builtin] = &[
         name: "len",
         sigs: sigs![
             [p("xs", LS, Req, Any)] -> I => |_, a| len(a);
+            [p("xs", LP, Req, Any)] -> I => |_, a| len(a);
             [p("xs", Type::List(&F), Req, Any)] -> I => |_, a| len(a);
             [p("xs", Type::List(&V), Req, Any)] -> I => |_, a| len(a);
             [p("xs", Type::List(&V2), Req, Any)] -> I => |_, a| len(a);

@@ -890,3 +890,12 @@ fn a_literal_list_past_the_objects_limit_is_refused_before_parsing() {
         "{diags:#?}"
     );
 }
+
+#[test]
+fn len_takes_a_list_of_profiles() {
+    let s = ok("let n = len([circle(1), rect(1)]);\nlight point { position: (0, 5, 0) }\nscene { sphere(n); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 2.0 }
+    );
+}

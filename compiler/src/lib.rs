@@ -47,7 +47,7 @@ pub use crate::{
 /// the AST and its dump, the built-ins table the checker, docs and editors read, and the
 /// readers of the mesh files `mesh(path)` reads.
 pub use crate::{
-    check::{builtins, meshfile, Constant, Loader, NoImports},
+    check::{builtins, colour::srgb_to_linear, meshfile, Constant, Loader, NoImports},
     front::{check, check_at, check_str, check_with, check_with_constants},
     syntax::{ast, dump as dump_ast, format, lexer, parse},
 };

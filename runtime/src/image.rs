@@ -268,12 +268,7 @@ impl SrgbTable {
 
 /// The inverse of [`srgb_encode`]: an 8-bit sRGB value as linear colour.
 pub fn srgb_decode(v: u8) -> f32 {
-    let s = v as f32 / 255.0;
-    if s <= 0.040_45 {
-        s / 12.92
-    } else {
-        ((s + 0.055) / 1.055).powf(2.4)
-    }
+    sdfc_compiler::srgb_to_linear(v) as f32
 }
 
 /// Reads a PNG file (8-bit grey, grey-alpha, RGB or RGBA; alpha ignored) as a linear image.

@@ -1,4 +1,5 @@
-//! W0011: a colour component above 1 in a record's colour field (the 0–255 habit).
+//! Colours as written: W0011, a component above 1 in a record's colour field (the 0–255
+//! habit), and the sRGB bytes of `#rrggbb` (and of images read back) as linear values.
 
 use super::types::Value;
 use crate::diagnostics::Diagnostic;
@@ -37,4 +38,15 @@ pub fn warning(record: &str, field: &str, v: &Value, span: Span) -> Option<Diagn
 /// A number with at most three decimals and no trailing zeros.
 fn fmt(x: f64) -> String {
     crate::diagnostics::number(x, 3)
+}
+
+/// An sRGB byte as the linear value the renderer's colours are (the sRGB transfer function,
+/// IEC 61966-2-1).
+pub fn srgb_to_linear(byte: u8) -> f64 {
+    let c = f64::from(byte) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }

@@ -181,7 +181,7 @@ impl Ctx<'_> {
             ExprKind::Int(i) => Value::Int(*i),
             ExprKind::Float(f) => self.finite(Value::Float(*f), e.span),
             ExprKind::Angle(a) => self.finite(Value::Angle(*a), e.span),
-            ExprKind::Colour(c) => Value::Vec3(c.map(srgb_to_linear)),
+            ExprKind::Colour(c) => Value::Vec3(c.map(super::colour::srgb_to_linear)),
             ExprKind::Bool(b) => Value::Bool(*b),
             ExprKind::Str(s) => Value::Str(s.as_str().into()),
             ExprKind::Var(id) => self.var(id),
@@ -2055,17 +2055,6 @@ fn type_mismatch(param: &str, want: Type, v: &Value, span: Span) -> Diagnostic {
     .with_label(format!("this is `{found}`"));
     d = with_type_help(d, want, v.ty());
     d
-}
-
-/// An sRGB byte as the linear value the renderer's colours are (the sRGB transfer function,
-/// IEC 61966-2-1).
-fn srgb_to_linear(byte: u8) -> f64 {
-    let c = f64::from(byte) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// The help where a float is given for an int: most often a `/`, which divides as real

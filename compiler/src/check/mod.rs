@@ -6,7 +6,7 @@
 //! evaluate items in source order, and the scene last.
 
 pub mod builtins;
-mod colour;
+pub mod colour;
 mod eval;
 pub mod field;
 pub mod font;

@@ -747,7 +747,15 @@ fn web_colours_are_srgb_made_linear() {
     assert_eq!(c[2], 0.0);
     assert_eq!(s.settings.background, [0.0; 3]);
     // Not six hex digits: a lexical error.
-    assert_eq!(codes("let c = #ff80;\nscene { sphere(); }")[0], "E0001");
+    let (_, diags, _) = check_str("t.sdf", "let c = #ff80;\nscene { sphere(); }");
+    assert_eq!(diags[0].code, "E0001");
+    assert!(
+        diags[0]
+            .help
+            .as_deref()
+            .is_some_and(|h| h.contains("six hex digits")),
+        "{diags:#?}"
+    );
 }
 
 #[test]

@@ -369,6 +369,10 @@ fn lex_error(text: &str, range: std::ops::Range<usize>, span: Span) -> Diagnosti
             "shapes are intersected with `intersect(a, b)`; logical and is written `&&`",
         ),
         '|' => d.with_help("shapes are joined with `union(a, b)`; logical or is written `||`"),
+        // `#ff80`: a colour short of its six hex digits.
+        '#' if text[range.start + 1..].starts_with(|c: char| c.is_ascii_hexdigit()) => d.with_help(
+            "a colour is `#` and six hex digits, as `#ff8800`; comments start with `//`",
+        ),
         '#' => d.with_help("comments start with `//`"),
         _ => d,
     }

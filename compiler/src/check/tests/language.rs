@@ -1,0 +1,149 @@
+//! Checker tests of what users of other tools write: division, names that hide built-ins,
+//! web colours, angles, `max_dist` and `len`.
+
+use super::{check_str, codes, ok};
+use crate::scene::Node;
+
+#[test]
+fn division_gives_what_users_of_other_tools_expect() {
+    // `5 / 2` is 2.5: a box 5 wide, not 4.
+    let s = ok("let w = 5;\nscene { box((w / 2, 0.5, 0.5)); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Box {
+            half: [2.5, 0.5, 0.5]
+        }
+    );
+    // Whole numbers divide with `div`, rounded down as Python's `//`.
+    let s =
+        ok("scene { for i in 0..1 { sphere(1).translate(div(7, 2), div(-7, 2), div(7, -2)); } }");
+    let Node::Translate { offset, .. } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a translation")
+    };
+    assert_eq!(offset, &[3.0, -4.0, -4.0]);
+    assert_eq!(codes("let x = div(1, 0);\nscene { sphere(); }"), ["E0400"]);
+    assert_eq!(codes("let x = 1.5 / 0;\nscene { sphere(); }"), ["E0401"]);
+    // A float where an int is needed says why and what to write.
+    for src in [
+        "let n = 5;\nscene { for i in 0..n / 2 { sphere(); } }",
+        "let xs = [1, 2, 3];\nlet x = xs[4 / 2];\nscene { sphere(x); }",
+        "let n = 6;\nscene { repeat_polar(sphere(0.2), n / 2); }",
+    ] {
+        let (_, diags, _) = check_str("t.sdf", src);
+        let d = diags.iter().find(|d| d.is_error()).expect("an error");
+        assert_eq!(d.code, "E0300", "{src}");
+        assert!(
+            d.help.iter().any(|h| h.contains("div(a, b)")),
+            "{src}: {d:#?}"
+        );
+    }
+}
+
+#[test]
+fn a_function_named_like_a_built_in_hides_it_with_a_warning() {
+    let src = "fn ring(r: float) -> shape { torus(r, 0.1) }\n\
+               fn offset(s: shape, d: vec3) -> shape { s.translate(d) }\n\
+               light point { position: (0, 5, 0) }\n\
+               scene { ring(1).offset((0, 2, 0)); }";
+    let (scene, diags, _) = check_str("t.sdf", src);
+    let codes: Vec<_> = diags.iter().map(|d| d.code).collect();
+    assert_eq!(codes, ["W0016", "W0016"], "{diags:#?}");
+    assert!(
+        diags[0].message.contains("`ring`"),
+        "{:?}",
+        diags[0].message
+    );
+    assert!(
+        diags[0].notes.iter().any(|n| n.contains("ring(")),
+        "the built-in's signature: {:?}",
+        diags[0].notes
+    );
+    // The calls are the user's: a torus moved up, not a profile.
+    let s = scene.expect("scene");
+    let Node::Translate { offset, child } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a translation")
+    };
+    assert_eq!(offset, &[0.0, 2.0, 0.0]);
+    assert!(matches!(s.graph.node(*child), Node::Torus { .. }));
+}
+
+#[test]
+fn web_colours_are_srgb_made_linear() {
+    let s = ok("material m = phong { color: #ff8000 };\n\
+                light point { position: (0, 5, 0), color: #FFFFFF }\n\
+                render { background: #000000 }\n\
+                scene { sphere(1) @ m; }");
+    let crate::scene::Pattern::Solid(crate::scene::Colour::Const(c)) = s.materials[1].pattern
+    else {
+        panic!("{:?}", s.materials[1].pattern)
+    };
+    assert_eq!(c[0], 1.0);
+    // sRGB 0x80 = 128/255 is linear 0.2158 (IEC 61966-2-1).
+    assert!((c[1] - 0.215_860_5).abs() < 1e-6, "{c:?}");
+    assert_eq!(c[2], 0.0);
+    assert_eq!(s.settings.background, [0.0; 3]);
+    // Not six hex digits: a lexical error.
+    let (_, diags, _) = check_str("t.sdf", "let c = #ff80;\nscene { sphere(); }");
+    assert_eq!(diags[0].code, "E0001");
+    assert!(
+        diags[0]
+            .help
+            .as_deref()
+            .is_some_and(|h| h.contains("six hex digits")),
+        "{diags:#?}"
+    );
+}
+
+#[test]
+fn radians_is_refused_with_the_spelling_that_works_and_degrees_reads_both_ways() {
+    let (_, diags, _) = check_str("t.sdf", "scene { box(1).rotate_y(radians(30)); }");
+    let d = diags.iter().find(|d| d.is_error()).expect("an error");
+    assert_eq!(d.code, "E0201");
+    let help = d.help.as_deref().unwrap_or("");
+    assert!(help.contains("30deg") && help.contains("1rad"), "{help}");
+    // `degrees` of a number is that many degrees; of an angle, its number of degrees.
+    let s = ok(
+        "let a = degrees(90);\nlet n = degrees(a) + degrees(0.5rad);\nscene { sphere(n / 100); }",
+    );
+    let Node::Sphere { radius } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a sphere")
+    };
+    assert!((radius - (90.0 + 0.5f64.to_degrees()) / 100.0).abs() < 1e-12);
+}
+
+#[test]
+fn max_dist_covers_the_bounded_parts_unless_set_and_then_says_what_it_cuts() {
+    // Not set: it reaches past the far side of a sphere 150 units away (a floor plane, which
+    // is unbounded, does not stretch it).
+    let s = ok("camera { position: (0, 0, -150), look_at: (0, 0, 0) }\n\
+                light point { position: (0, 10, -10) }\n\
+                scene { sphere(1); plane((0, 1, 0), -5); }");
+    assert!(s.settings.max_dist >= 151.0, "{}", s.settings.max_dist);
+    // A near scene keeps the default of 100.
+    let s = ok("light point { position: (0, 10, -10) }\nscene { sphere(1); }");
+    assert_eq!(s.settings.max_dist, 100.0);
+    // Set short: a warning at the part, naming the setting.
+    let (scene, diags, _) = check_str(
+        "t.sdf",
+        "camera { position: (0, 0, -30), look_at: (0, 0, 0) }\n\
+         light point { position: (0, 10, -10) }\n\
+         render { max_dist: 30 }\n\
+         scene { sphere(2); sphere(1).translate(0, 0, 40); }",
+    );
+    let far: Vec<_> = diags.iter().filter(|d| d.code == "W0017").collect();
+    assert_eq!(far.len(), 2, "{diags:#?}");
+    assert!(
+        far.iter().any(|d| d.message.contains("not seen")),
+        "{far:#?}"
+    );
+    assert_eq!(scene.expect("scene").settings.max_dist, 30.0);
+}
+
+#[test]
+fn len_takes_a_list_of_profiles() {
+    let s = ok("let n = len([circle(1), rect(1)]);\nlight point { position: (0, 5, 0) }\nscene { sphere(n); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 2.0 }
+    );
+}

@@ -35,6 +35,8 @@ mod syntax;
 pub mod animation;
 /// Diagnostics as data, rendered only at the edge (`render` as text, `to_json` as JSON lines).
 pub mod diagnostics;
+/// The primitives' table: one entry per built-in shape or profile marched by its formula.
+pub mod prim;
 
 /// Sources, spans, resource limits and diagnostics.
 pub use crate::{

@@ -598,24 +598,8 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "capsule",
         "cone",
         "ellipsoid",
-        "mandelbulb",
-        "capped_cone",
-        "round_cone",
-        "segment",
-        "rounded_cylinder",
-        "hex_prism",
-        "tri_prism",
-        "octahedron",
-        "pyramid",
-        "box_frame",
-        "link",
-        "infinite_cylinder",
-        "slab",
-        "circle",
         "rect",
-        "round_rect",
         "polygon",
-        "arc",
         "bezier",
         "text",
         "extrude",
@@ -645,7 +629,13 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "field",
         "mesh",
     ];
-    let missing: Vec<_> = all_nodes.iter().filter(|n| !nodes.contains(*n)).collect();
+    // And every primitive of the table.
+    let table = sdfc_compiler::prim::all().map(|p| p.name);
+    let missing: Vec<_> = all_nodes
+        .into_iter()
+        .chain(table)
+        .filter(|n| !nodes.contains(n))
+        .collect();
     assert!(missing.is_empty(), "no feature scene has {missing:?}");
     // Every operation.
     let all_ops = [
@@ -672,19 +662,6 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Capsule { .. } => "capsule",
         Node::Cone { .. } => "cone",
         Node::Ellipsoid { .. } => "ellipsoid",
-        Node::Mandelbulb { .. } => "mandelbulb",
-        Node::CappedCone { .. } => "capped_cone",
-        Node::RoundCone { .. } => "round_cone",
-        Node::Segment { .. } => "segment",
-        Node::RoundedCylinder { .. } => "rounded_cylinder",
-        Node::HexPrism { .. } => "hex_prism",
-        Node::TriPrism { .. } => "tri_prism",
-        Node::Octahedron { .. } => "octahedron",
-        Node::Pyramid { .. } => "pyramid",
-        Node::BoxFrame { .. } => "box_frame",
-        Node::Link { .. } => "link",
-        Node::InfiniteCylinder { .. } => "infinite_cylinder",
-        Node::Slab { .. } => "slab",
         Node::Combine { .. } => "combine",
         Node::SmoothCombine { .. } => "smooth_combine",
         Node::Feature { .. } => "feature",
@@ -706,11 +683,8 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Elongate { .. } => "elongate",
         Node::Paint { .. } => "paint",
         Node::Field { .. } => "field",
-        Node::Circle { .. } => "circle",
         Node::Rect { .. } => "rect",
-        Node::RoundRect { .. } => "round_rect",
         Node::Polygon { .. } => "polygon",
-        Node::Arc { .. } => "arc",
         Node::Bezier { .. } => "bezier",
         Node::Text { .. } => "text",
         Node::Extrude { .. } => "extrude",
@@ -718,6 +692,7 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Mesh { .. } => "mesh",
         Node::Loft { .. } => "loft",
         Node::Screw { .. } => "screw",
+        Node::Prim { prim, .. } => prim.name,
     }
 }
 

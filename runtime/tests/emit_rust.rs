@@ -32,10 +32,8 @@ fn scene() -> Scene {
         a: s,
         b: t,
     });
-    let bulb = b.add(Node::Mandelbulb {
-        power: 8.0,
-        iterations: 3,
-    });
+    let bulb = Node::prim("mandelbulb", &[&[8.0], &[3.0]]);
+    let bulb = b.add(bulb.expect("mandelbulb is a primitive of the table"));
     let bulb = b.at(bulb, [0.0, 3.0, 0.0]);
     let root = b.add(Node::Combine {
         op: Combine::Union,

@@ -564,7 +564,7 @@ fn the_editor_grammar_knows_every_builtin() {
         tm.contains("\"scopeName\": \"source.sdf\""),
         "the scope name is source.sdf"
     );
-    for b in BUILTINS {
+    for b in BUILTINS.iter() {
         let listed = [
             format!("|{}|", b.name),
             format!("({}|", b.name),
@@ -616,10 +616,40 @@ fn the_string_escapes_in_the_docs_are_the_lexers() {
     }
 }
 
+/// The language reference's row of each primitive of the table (`compiler/src/prim/`) is the
+/// one the table gives: signature, accepted values, and what it is (with "Exact." where its
+/// distance is exact).
+#[test]
+fn the_language_reference_rows_of_the_primitives_are_the_tables() {
+    let doc = read("docs/language.md");
+    let mut wrong = Vec::new();
+    for prim in sdfc_compiler::prim::all() {
+        let b = builtins::builtin(prim.name).expect("every primitive is a builtin");
+        let exact = match prim.field {
+            sdfc_compiler::prim::Field::Exact => " Exact.",
+            sdfc_compiler::prim::Field::Unproven => "",
+        };
+        let row = format!(
+            "| `{}` | {} | {}{exact} |",
+            builtins::signature(prim.name, &b.sigs[0]),
+            prim.accepts,
+            prim.doc
+        );
+        if !doc.lines().any(|l| l == row) {
+            wrong.push(row);
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "docs/language.md lacks these rows of the primitives' table (write them as shown):\n{}",
+        wrong.join("\n")
+    );
+}
+
 #[test]
 fn the_language_reference_lists_every_signature_and_field() {
     let doc = read("docs/language.md");
-    for b in BUILTINS {
+    for b in BUILTINS.iter() {
         for sig in b.sigs {
             let text = format!("`{}`", builtins::signature(b.name, sig));
             assert!(doc.contains(&text), "docs/language.md does not list {text}");

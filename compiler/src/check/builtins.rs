@@ -3,22 +3,10 @@
 
 use super::types::{Type, Value};
 use crate::limits::{Limit, Limits};
+use crate::prim::{Args, Kind, Prim, PrimRef};
+pub use crate::prim::{Def, Range};
 use crate::scene::{Camera, Combine, Feature, Graph, Material, Node, NodeId, Settings, Smooth, V3};
 use crate::span::Span;
-
-/// A parameter's default value.
-#[derive(Debug, Clone, Copy)]
-pub enum Def {
-    /// The argument must be given.
-    Req,
-    Num(f64),
-    Int(i64),
-    Bool(bool),
-    V3(V3),
-    Text(&'static str),
-    /// An angle in degrees.
-    Deg(f64),
-}
 
 impl Def {
     /// The default as a value; `None` for a required parameter.
@@ -33,27 +21,6 @@ impl Def {
             Def::Deg(d) => Value::Angle(d.to_radians()),
         })
     }
-}
-
-/// The values a numeric parameter accepts (checked per component for vectors).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Range {
-    /// Any finite value.
-    Any,
-    /// > 0
-    Pos,
-    /// ≥ 0
-    NonNeg,
-    /// In [0, 1].
-    Unit,
-    /// In [lo, hi].
-    Within(f64, f64),
-    /// A vector that is not zero.
-    NonZero,
-    /// One of the listed strings.
-    OneOf(&'static [&'static str]),
-    /// In [lo, the value of a resource limit] (the render settings bounded by `--limit`).
-    Limited(f64, Limit),
 }
 
 impl Range {
@@ -144,7 +111,53 @@ const fn shape(name: &'static str) -> P {
 }
 
 /// The evaluation of one overload on bound, in-range, concrete arguments.
-pub type Imp = fn(&mut Build<'_, '_>, &[Value]) -> Result<Value, String>;
+#[derive(Clone, Copy)]
+pub enum Imp {
+    /// A function of the arguments.
+    Fn(fn(&mut Build<'_, '_>, &[Value]) -> Result<Value, String>),
+    /// A primitive of the table: its node, once its checks pass.
+    Prim(&'static Prim),
+}
+
+impl std::fmt::Debug for Imp {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            Imp::Fn(_) => f.write_str("Fn"),
+            Imp::Prim(p) => write!(f, "Prim({})", p.name),
+        }
+    }
+}
+
+impl Imp {
+    /// Evaluates the overload on its arguments.
+    pub fn call(self, b: &mut Build<'_, '_>, a: &[Value]) -> Result<Value, String> {
+        match self {
+            Imp::Fn(f) => f(b, a),
+            Imp::Prim(prim) => {
+                let args = Args(
+                    a.iter()
+                        .map(|v| {
+                            let c = v.components();
+                            [0, 1, 2].map(|i| c.get(i).copied().unwrap_or(0.0))
+                        })
+                        .collect(),
+                );
+                if let Some(why) = (prim.check)(&args) {
+                    return Err(why);
+                }
+                let node = Node::Prim {
+                    prim: PrimRef(prim),
+                    args,
+                };
+                if prim.profile {
+                    b.profile(node)
+                } else {
+                    b.node(node)
+                }
+            }
+        }
+    }
+}
 
 /// One overload.
 #[derive(Debug)]
@@ -157,7 +170,7 @@ pub struct Sig {
 }
 
 /// A builtin function with its overloads, tried in order.
-#[derive(Debug)]
+#[derive(Debug, Clone, Copy)]
 pub struct Builtin {
     pub name: &'static str,
     pub sigs: &'static [Sig],
@@ -628,12 +641,6 @@ fn feature(b: &mut Build, a: &[Value], op: Feature) -> Result<Value, String> {
     })
 }
 
-/// `v` scaled to unit length (`v` is not zero: its range says so).
-fn unit(v: V3) -> V3 {
-    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|x| x / len)
-}
-
 fn rotation(axis: V3, angle: f64) -> [V3; 3] {
     let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
     let [x, y, z] = [axis[0] / len, axis[1] / len, axis[2] / len];
@@ -781,7 +788,7 @@ fn vmap(v: &Value, f: impl Fn(f64) -> f64) -> Value {
 
 macro_rules! sigs {
     ($([$($p:expr),*] $(rest $rest:tt)? -> $ret:expr => $imp:expr;)*) => {
-        &[$(Sig { params: &[$($p),*], rest: sigs!(@rest $($rest)?), ret: $ret, imp: $imp }),*]
+        &[$(Sig { params: &[$($p),*], rest: sigs!(@rest $($rest)?), ret: $ret, imp: Imp::Fn($imp) }),*]
     };
     (@rest) => { false };
     (@rest $t:tt) => { true };
@@ -801,12 +808,52 @@ pub fn constant(name: &str) -> Option<f64> {
     CONSTANTS.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
 }
 
+/// The error of a builtin built on a primitive the table lacks (a mistake of the compiler's).
+const NO_PRIM: &str = "a primitive this builtin is built on is missing from the table";
+
 /// The error of a per-point builtin called with constants.
 const PER_POINT: &str =
     "this is evaluated per point: call it inside `field { … }` with an argument that depends on `p`";
 
-/// Every builtin function.
-pub static BUILTINS: &[Builtin] = &[
+/// Every builtin function: those written here and the primitives of the table (`prim/`).
+pub static BUILTINS: std::sync::LazyLock<Vec<Builtin>> = std::sync::LazyLock::new(|| {
+    let prims = crate::prim::all().map(|prim| {
+        let params: Vec<P> = prim
+            .params
+            .iter()
+            .map(|q| p(q.name, kind_type(q.kind), q.def, q.range))
+            .collect();
+        let sig = Sig {
+            params: Vec::leak(params),
+            rest: false,
+            ret: if prim.profile {
+                Type::Profile
+            } else {
+                Type::Shape
+            },
+            imp: Imp::Prim(prim),
+        };
+        Builtin {
+            name: prim.name,
+            sigs: Vec::leak(vec![sig]),
+        }
+    });
+    FUNCTIONS.iter().copied().chain(prims).collect()
+});
+
+/// The type of a primitive's parameter.
+fn kind_type(k: Kind) -> Type {
+    match k {
+        Kind::Float => Type::Float,
+        Kind::Int => Type::Int,
+        Kind::Angle => Type::Angle,
+        Kind::Vec2 => Type::Vec2,
+        Kind::Vec3 => Type::Vec3,
+    }
+}
+
+/// The builtin functions written here.
+static FUNCTIONS: &[Builtin] = &[
     // Primitives.
     Builtin {
         name: "sphere",
@@ -892,137 +939,7 @@ pub static BUILTINS: &[Builtin] = &[
             };
         ],
     },
-    Builtin {
-        name: "mandelbulb",
-        sigs: sigs![
-            [p("power", F, Num(8.0), Within(2.0, 16.0)), p("iterations", I, Int(8), Within(1.0, 64.0))] -> S => |b, a| {
-                b.node(Node::Mandelbulb { power: a[0].num(), iterations: a[1].num() as u32 })
-            };
-        ],
-    },
-    Builtin {
-        name: "capped_cone",
-        sigs: sigs![
-            [p("height", F, Num(1.0), Pos), p("bottom", F, Num(0.5), NonNeg), p("top", F, Num(0.25), NonNeg)] -> S => |b, a| {
-                let (bottom, top) = (a[1].num(), a[2].num());
-                if bottom == 0.0 && top == 0.0 {
-                    return Err("`bottom` and `top` are both 0: the cone has no volume".to_string());
-                }
-                b.node(Node::CappedCone { half_height: a[0].num() / 2.0, bottom, top })
-            };
-        ],
-    },
-    Builtin {
-        name: "round_cone",
-        sigs: sigs![
-            [p("bottom", F, Num(0.5), NonNeg), p("top", F, Num(0.25), NonNeg), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
-                let (bottom, top, height) = (a[0].num(), a[1].num(), a[2].num());
-                if bottom == 0.0 && top == 0.0 {
-                    return Err("`bottom` and `top` are both 0: the cone has no volume".to_string());
-                }
-                if (bottom - top).abs() >= height {
-                    return Err(format!(
-                        "the radii differ by {} but the height is {height}: one sphere would hold the other (a round cone needs |bottom - top| < height)",
-                        crate::scene::dump_num((bottom - top).abs())
-                    ));
-                }
-                b.node(Node::RoundCone { bottom, top, half_height: height / 2.0 })
-            };
-        ],
-    },
-    Builtin {
-        name: "segment",
-        sigs: sigs![
-            [p("a", V, Req, Any), p("b", V, Req, Any), p("radius", F, Num(0.25), Pos)] -> S => |b, a| {
-                b.node(Node::Segment { a: a[0].v3(), b: a[1].v3(), radius: a[2].num() })
-            };
-        ],
-    },
-    Builtin {
-        name: "rounded_cylinder",
-        sigs: sigs![
-            [p("radius", F, Num(0.5), Pos), p("round", F, Num(0.1), NonNeg), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
-                let (radius, round, height) = (a[0].num(), a[1].num(), a[2].num());
-                if round > radius || round > height / 2.0 {
-                    return Err(format!("the rounding {round} is larger than the radius or half the height"));
-                }
-                b.node(Node::RoundedCylinder { radius, round, half_height: height / 2.0 })
-            };
-        ],
-    },
-    Builtin {
-        name: "hex_prism",
-        sigs: sigs![
-            [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
-                b.node(Node::HexPrism { radius: a[0].num(), half_height: a[1].num() / 2.0 })
-            };
-        ],
-    },
-    Builtin {
-        name: "tri_prism",
-        sigs: sigs![
-            [p("radius", F, Num(0.5), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
-                b.node(Node::TriPrism { radius: a[0].num(), half_height: a[1].num() / 2.0 })
-            };
-        ],
-    },
-    Builtin {
-        name: "octahedron",
-        sigs: sigs![
-            [p("radius", F, Num(1.0), Pos)] -> S => |b, a| b.node(Node::Octahedron { radius: a[0].num() });
-        ],
-    },
-    Builtin {
-        name: "pyramid",
-        sigs: sigs![
-            [p("base", F, Num(1.0), Pos), p("height", F, Num(1.0), Pos)] -> S => |b, a| {
-                b.node(Node::Pyramid { base: a[0].num(), height: a[1].num() })
-            };
-        ],
-    },
-    Builtin {
-        name: "box_frame",
-        sigs: sigs![
-            [p("half", V, V3([0.5, 0.5, 0.5]), Pos), p("edge", F, Num(0.05), Pos)] -> S => |b, a| {
-                let (half, edge) = (a[0].v3(), a[1].num());
-                if half.iter().any(|&h| h < edge) {
-                    return Err(format!("the edge {edge} is larger than a half-extent of the frame"));
-                }
-                b.node(Node::BoxFrame { half, edge })
-            };
-        ],
-    },
-    Builtin {
-        name: "link",
-        sigs: sigs![
-            [p("length", F, Num(1.0), NonNeg), p("major", F, Num(0.5), Pos), p("minor", F, Num(0.1), Pos)] -> S => |b, a| {
-                b.node(Node::Link { half_length: a[0].num() / 2.0, major: a[1].num(), minor: a[2].num() })
-            };
-        ],
-    },
-    Builtin {
-        name: "infinite_cylinder",
-        sigs: sigs![
-            [p("radius", F, Num(0.5), Pos), p("axis", V, V3([0.0, 1.0, 0.0]), NonZero)] -> S => |b, a| {
-                b.node(Node::InfiniteCylinder { radius: a[0].num(), axis: unit(a[1].v3()) })
-            };
-        ],
-    },
-    Builtin {
-        name: "slab",
-        sigs: sigs![
-            [p("thickness", F, Num(1.0), Pos), p("normal", V, V3([0.0, 1.0, 0.0]), NonZero)] -> S => |b, a| {
-                b.node(Node::Slab { thickness: a[0].num(), normal: unit(a[1].v3()) })
-            };
-        ],
-    },
     // Profiles (2D, in the xy plane).
-    Builtin {
-        name: "circle",
-        sigs: sigs![
-            [p("radius", F, Num(0.5), Pos)] -> PR => |b, a| b.profile(Node::Circle { radius: a[0].num() });
-        ],
-    },
     Builtin {
         name: "rect",
         sigs: sigs![
@@ -1031,18 +948,6 @@ pub static BUILTINS: &[Builtin] = &[
                 b.profile(Node::Rect { half: [c[0], c[1]] })
             };
             [p("half", F, Num(0.5), Pos)] -> PR => |b, a| b.profile(Node::Rect { half: [a[0].num(); 2] });
-        ],
-    },
-    Builtin {
-        name: "round_rect",
-        sigs: sigs![
-            [p("half", V2, Req, Pos), p("radius", F, Num(0.05), NonNeg)] -> PR => |b, a| {
-                let (c, radius) = (a[0].components(), a[1].num());
-                if c.iter().any(|&h| h < radius) {
-                    return Err(format!("the rounding radius {radius} is larger than a half-extent of the rectangle"));
-                }
-                b.profile(Node::RoundRect { half: [c[0], c[1]], radius })
-            };
         ],
     },
     Builtin {
@@ -1081,7 +986,8 @@ pub static BUILTINS: &[Builtin] = &[
         name: "ring",
         sigs: sigs![
             [p("radius", F, Num(0.5), Pos), p("thickness", F, Num(0.1), Pos)] -> PR => |b, a| {
-                let circle = b.graph.add(Node::Circle { radius: a[0].num() }, b.span);
+                let circle = Node::prim("circle", &[&[a[0].num()]]).ok_or(NO_PRIM)?;
+                let circle = b.graph.add(circle, b.span);
                 b.profile(Node::Shell { half: a[1].num() / 2.0, child: circle })
             };
         ],
@@ -1092,7 +998,8 @@ pub static BUILTINS: &[Builtin] = &[
             [p("a", V2, Req, Any), p("b", V2, Req, Any), p("radius", F, Num(0.1), Pos)] -> PR => |b, a| {
                 let (x, y) = (a[0].components(), a[1].components());
                 // The capsule of space about the segment, read in its plane z = 0.
-                b.profile(Node::Segment { a: [x[0], x[1], 0.0], b: [y[0], y[1], 0.0], radius: a[2].num() })
+                let segment = Node::prim("segment", &[&[x[0], x[1], 0.0], &[y[0], y[1], 0.0], &[a[2].num()]]);
+                b.profile(segment.ok_or(NO_PRIM)?)
             };
         ],
     },
@@ -1113,14 +1020,6 @@ pub static BUILTINS: &[Builtin] = &[
         sigs: sigs![
             [prof("profile"), p("offset", F, Num(0.0), Any)] -> S => |b, a| {
                 b.node(Node::Revolve { offset: a[1].num(), child: sh(&a[0]) })
-            };
-        ],
-    },
-    Builtin {
-        name: "arc",
-        sigs: sigs![
-            [p("radius", F, Num(0.5), Pos), p("angle", A, Req, Within(0.0, std::f64::consts::TAU)), p("thickness", F, Num(0.1), Pos)] -> PR => |b, a| {
-                b.profile(Node::Arc { radius: a[0].num(), half_angle: a[1].num() / 2.0, half_width: a[2].num() / 2.0 })
             };
         ],
     },

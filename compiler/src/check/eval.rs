@@ -1465,7 +1465,7 @@ impl Ctx<'_> {
             limits: &self.limits,
             warnings: Vec::new(),
         };
-        let result = (sig.imp)(&mut build, &vals);
+        let result = sig.imp.call(&mut build, &vals);
         let warnings = std::mem::take(&mut build.warnings);
         self.diags.extend(warnings);
         match result {

@@ -3,8 +3,8 @@
 //! tongue and pipe), written as scalar code over the two operands' distances `a` and `b`.
 //! Each names the hg_sdf function it follows; `docs/analysis.md` gives their Lipschitz bounds.
 
-use super::builder::Builder;
 use super::{Reg, Unary};
+use crate::program::builder::Builder;
 use crate::scene::{Combine, Feature, Smooth};
 use std::f64::consts::{FRAC_1_SQRT_2, SQRT_2};
 

@@ -4,8 +4,8 @@
 //! on whole numbers below 2²⁴ so that every evaluator, f32 or f64, finds the same cell hashes
 //! exactly (docs/language.md, "Noise").
 
-use super::builder::{Builder, P};
 use super::{Reg, Unary};
+use crate::program::builder::{Builder, P};
 use crate::program::{Binary, Float, Program};
 use crate::scene::field::{
     FBin, FOp, FUn, FieldFn, GOLDEN_TURN, NOISE_CELLS, VORONOI_LO, VORONOI_SPAN,

@@ -7,9 +7,9 @@
 //! runs only where its bounding volume is nearer than the best distance so far (see
 //! `docs/optimisation.md` for why the result is the same).
 
-use super::builder::{Builder, P};
 use super::bvh::{self, Kind, Tree};
 use super::{blends, field, shapes, Binary, Reg, Unary, EMPTY_DISTANCE};
+use crate::program::builder::{Builder, P};
 use crate::scene::analysis::{self, Analysis, Window};
 use crate::scene::bounds::{Aabb, Bound, Bounds};
 use crate::scene::field::{FOp, FieldFn};
@@ -435,10 +435,10 @@ impl<'a> Lowerer<'a> {
                 self.post(id, *child, q, |b, d| {
                     if r > 0.0 {
                         let d = b.addc(d, r);
-                        let e = shapes::extrude(b, d, p[2], h - r);
+                        let e = crate::prim::extrude(b, d, p[2], h - r);
                         b.subc(e, r)
                     } else {
-                        shapes::extrude(b, d, p[2], h)
+                        crate::prim::extrude(b, d, p[2], h)
                     }
                 })
             }
@@ -470,7 +470,7 @@ impl<'a> Lowerer<'a> {
                 let diff = b.clampc(diff, -s, s);
                 let step = b.mul(t, diff);
                 let d = b.add(fa.d, step);
-                let d = shapes::extrude(b, d, p[2], h);
+                let d = crate::prim::extrude(b, d, p[2], h);
                 let upper = b.c(0.5);
                 let upper = b.lt(upper, t);
                 Field {
@@ -651,59 +651,9 @@ impl<'a> Lowerer<'a> {
         let d = match *node {
             Node::Plane { normal, height } => shapes::plane(b, p, normal, height),
             Node::Ellipsoid { radii } => shapes::ellipsoid(b, p, radii),
-            Node::Mandelbulb { power, iterations } => shapes::mandelbulb(b, p, power, iterations),
-            Node::CappedCone {
-                half_height,
-                bottom,
-                top,
-            } => shapes::capped_cone(b, p, half_height, bottom, top),
-            Node::RoundCone {
-                bottom,
-                top,
-                half_height,
-            } => shapes::round_cone(b, p, bottom, top, half_height),
-            Node::Segment { a, b: e, radius } => shapes::segment(b, p, a, e, radius),
-            Node::RoundedCylinder {
-                radius,
-                round,
-                half_height,
-            } => shapes::rounded_cylinder(b, p, radius, round, half_height),
-            Node::HexPrism {
-                radius,
-                half_height,
-            } => shapes::hex_prism(b, p, radius, half_height),
-            Node::TriPrism {
-                radius,
-                half_height,
-            } => shapes::tri_prism(b, p, radius, half_height),
-            Node::Octahedron { radius } => shapes::octahedron(b, p, radius),
-            Node::Pyramid { base, height } => shapes::pyramid(b, p, base, height),
-            Node::BoxFrame { half, edge } => shapes::box_frame(b, p, half, edge),
-            Node::Link {
-                half_length,
-                major,
-                minor,
-            } => shapes::link(b, p, half_length, major, minor),
-            Node::InfiniteCylinder { radius, axis } => {
-                shapes::infinite_cylinder(b, p, radius, axis)
-            }
-            Node::Slab { thickness, normal } => shapes::slab(b, p, thickness, normal),
-            Node::Circle { radius } => {
-                let l = b.len2(p[0], p[1]);
-                b.subc(l, radius)
-            }
-            Node::Rect { half } => shapes::rect(b, p, half),
-            Node::RoundRect { half, radius } => {
-                let d = shapes::rect(b, p, half.map(|h| h - radius));
-                b.subc(d, radius)
-            }
+            Node::Rect { half } => crate::prim::rect(b, p, half),
             Node::Polygon { ref points } => shapes::polygon(b, p, points),
             Node::Mesh { ref mesh } => b.mesh(&mesh.0, p),
-            Node::Arc {
-                radius,
-                half_angle,
-                half_width,
-            } => shapes::arc(b, p, radius, half_angle, half_width),
             Node::Bezier {
                 a,
                 control,
@@ -714,6 +664,7 @@ impl<'a> Lowerer<'a> {
                 b.subc(d, radius)
             }
             Node::Text { ref outline, .. } => b.outline(outline, p[0], p[1]),
+            Node::Prim { prim, ref args } => (prim.distance)(b, p, args),
             _ => match shapes::slots(node) {
                 Some(s) => shapes::exact(b, p, node, &s).unwrap_or_else(|| b.c(EMPTY_DISTANCE)),
                 None => b.c(EMPTY_DISTANCE),

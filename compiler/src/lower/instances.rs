@@ -13,8 +13,8 @@
 //! (which exact culling needs). The ellipsoid's field is only a bound, so an ellipsoid stays
 //! in the rest.
 
-use super::builder::{Builder, Param};
 use super::{lower_simple, shapes, LowerOptions, Program, Simplified};
+use crate::program::builder::{Builder, Param};
 use crate::scene::analysis::Analysis;
 use crate::scene::bounds::Bounds;
 use crate::scene::{Combine, Exactness, Graph, MaterialId, Node, NodeId, V3};

@@ -8,7 +8,6 @@
 //! literally.
 
 mod blends;
-mod builder;
 mod bvh;
 mod field;
 mod graph;
@@ -306,7 +305,7 @@ fn lower_simple(
     options: &LowerOptions,
     (cap, phases): (usize, &mut Phases),
 ) -> (Program, bool, Option<Simplified>) {
-    let mut b = builder::Builder::capped(true, cap);
+    let mut b = crate::program::builder::Builder::capped(true, cap);
     b.parametric = options.parametric;
     let p = b.input_point();
     let mut lipschitz = 1.0;
@@ -356,7 +355,7 @@ fn lower_simple(
 
 /// Lowers the scene as written (level 0).
 fn lower_literal(scene: &Scene, cap: usize) -> (Program, bool) {
-    let mut b = builder::Builder::capped(false, cap);
+    let mut b = crate::program::builder::Builder::capped(false, cap);
     let p = b.input_point();
     let mut lipschitz = 1.0;
     let (d, m) = match scene.root {
@@ -381,7 +380,12 @@ fn lower_literal(scene: &Scene, cap: usize) -> (Program, bool) {
 }
 
 /// Paints what is unpainted with material 0 and ends the program.
-fn finish(mut b: builder::Builder, d: Reg, m: Reg, lipschitz: f64) -> (Program, bool) {
+fn finish(
+    mut b: crate::program::builder::Builder,
+    d: Reg,
+    m: Reg,
+    lipschitz: f64,
+) -> (Program, bool) {
     b.note("result: unpainted shapes get the default material 0".into());
     let m = b.paint(m, 0.0);
     let over = b.over();

@@ -32,6 +32,10 @@ fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
 }
 
 /// A graph holding one of every kind of node, alone and nested.
+fn prim(name: &str, args: &[&[f64]]) -> Node {
+    Node::prim(name, args).expect("a primitive of the table")
+}
+
 fn zoo() -> (Graph, Vec<NodeId>) {
     let mut g = Graph::default();
     let add = |g: &mut Graph, n: Node| g.add(n, Span::new(FileId(0), 0..0));
@@ -64,64 +68,20 @@ fn zoo() -> (Graph, Vec<NodeId>) {
         Node::Ellipsoid {
             radii: [0.3, 0.9, 0.5],
         },
-        Node::Mandelbulb {
-            power: 8.0,
-            iterations: 4,
-        },
-        Node::Mandelbulb {
-            power: 3.5,
-            iterations: 3,
-        },
-        Node::CappedCone {
-            half_height: 0.6,
-            bottom: 0.5,
-            top: 0.2,
-        },
-        Node::RoundCone {
-            bottom: 0.4,
-            top: 0.2,
-            half_height: 0.5,
-        },
-        Node::Segment {
-            a: [0.3, -0.2, 0.5],
-            b: [-0.4, 0.6, 0.1],
-            radius: 0.2,
-        },
-        Node::RoundedCylinder {
-            radius: 0.5,
-            round: 0.1,
-            half_height: 0.4,
-        },
-        Node::HexPrism {
-            radius: 0.4,
-            half_height: 0.5,
-        },
-        Node::TriPrism {
-            radius: 0.3,
-            half_height: 0.6,
-        },
-        Node::Octahedron { radius: 0.7 },
-        Node::Pyramid {
-            base: 0.8,
-            height: 1.1,
-        },
-        Node::BoxFrame {
-            half: [0.5, 0.4, 0.6],
-            edge: 0.05,
-        },
-        Node::Link {
-            half_length: 0.3,
-            major: 0.4,
-            minor: 0.1,
-        },
-        Node::InfiniteCylinder {
-            radius: 0.3,
-            axis: [0.0, 0.0, 1.0],
-        },
-        Node::Slab {
-            thickness: 0.4,
-            normal: [0.0, 1.0, 0.0],
-        },
+        prim("mandelbulb", &[&[8.0], &[4.0]]),
+        prim("mandelbulb", &[&[3.5], &[3.0]]),
+        prim("capped_cone", &[&[1.2], &[0.5], &[0.2]]),
+        prim("round_cone", &[&[0.4], &[0.2], &[1.0]]),
+        prim("segment", &[&[0.3, -0.2, 0.5], &[-0.4, 0.6, 0.1], &[0.2]]),
+        prim("rounded_cylinder", &[&[0.5], &[0.1], &[0.8]]),
+        prim("hex_prism", &[&[0.4], &[1.0]]),
+        prim("tri_prism", &[&[0.3], &[1.2]]),
+        prim("octahedron", &[&[0.7]]),
+        prim("pyramid", &[&[0.8], &[1.1]]),
+        prim("box_frame", &[&[0.5, 0.4, 0.6], &[0.05]]),
+        prim("link", &[&[0.6], &[0.4], &[0.1]]),
+        prim("infinite_cylinder", &[&[0.3], &[0.0, 0.0, 1.0]]),
+        prim("slab", &[&[0.4], &[0.0, 1.0, 0.0]]),
     ];
     let prims: Vec<NodeId> = prims.into_iter().map(|n| add(&mut g, n)).collect();
     ids.extend(&prims);
@@ -362,8 +322,8 @@ fn lowering_stops_at_the_program_limit() {
 /// `scale · slots[slot]` exactly, so that the shader computes what the program computes.
 #[test]
 fn the_walks_shape_programs_are_the_lowerings_rules() {
-    use super::builder::Builder;
     use super::{shape_program, shapes};
+    use crate::program::builder::Builder;
     use crate::program::Op;
     let shapes_of = [
         Node::Sphere { radius: 0.7 },

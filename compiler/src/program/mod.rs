@@ -15,6 +15,7 @@
 //! instructions that carry its results out (the block's value where it ran, the value from
 //! before it elsewhere). Blocks nest; a register defined inside a block is read only inside it.
 
+pub(crate) mod builder;
 pub mod float;
 mod live;
 pub mod mesh;

@@ -18,6 +18,7 @@ use super::bounds::singular_range;
 use super::ir::{Combine, Exactness, Facts, Feature, Node, Scene, Smooth, V3};
 use super::NodeId;
 use crate::diagnostics::Diagnostic;
+use crate::prim::Field as PrimField;
 use std::collections::HashSet;
 
 /// The largest L the renderer steps with: a larger bound is clamped (with the warning that
@@ -653,99 +654,26 @@ impl Pass<'_> {
                 [true, false, true],
             ),
             Node::Ellipsoid { radii } => ellipsoid(*radii),
-            Node::Mandelbulb { .. } => {
-                let d = exact(Aabb::centred([2.0; 3]), [false; 3]);
-                unproven(d, id)
-            }
-            Node::CappedCone {
-                half_height,
-                bottom,
-                top,
-            } => {
-                let r = bottom.max(*top);
-                exact(Aabb::centred([r, *half_height, r]), [true, false, true])
-            }
-            Node::RoundCone {
-                bottom,
-                top,
-                half_height,
-            } => {
-                let r = bottom.max(*top);
-                let b = Aabb {
-                    min: [-r, -half_height - bottom, -r],
-                    max: [r, half_height + top, r],
+            Node::Rect { half } => exact(profile_bounds(*half), [true; 3]),
+            Node::Prim { prim, args } => {
+                let e = (prim.extent)(args);
+                let mut bounds = Aabb {
+                    min: e.min,
+                    max: e.max,
                 };
-                exact(b, [true, false, true])
-            }
-            Node::Segment { a, b, radius } => {
-                let bounds = Aabb {
-                    min: [0, 1, 2].map(|i| a[i].min(b[i]) - radius),
-                    max: [0, 1, 2].map(|i| a[i].max(b[i]) + radius),
-                };
-                // Across plane i: the segment lies in it, or the plane swaps its ends.
-                let mirrored =
-                    |i: usize| (0..3).all(|j| if j == i { a[j] == -b[j] } else { a[j] == b[j] });
-                let symmetric = [0, 1, 2].map(|i| (a[i] == 0.0 && b[i] == 0.0) || mirrored(i));
-                exact(bounds, symmetric)
-            }
-            Node::RoundedCylinder {
-                radius,
-                half_height,
-                ..
-            } => exact(Aabb::centred([*radius, *half_height, *radius]), [true; 3]),
-            Node::HexPrism {
-                radius,
-                half_height,
-            } => exact(
-                Aabb::centred([radius * 2.0 / 3f64.sqrt(), *half_height, *radius]),
-                [true; 3],
-            ),
-            Node::TriPrism {
-                radius,
-                half_height,
-            } => {
-                let w = 3f64.sqrt() * radius;
-                let b = Aabb {
-                    min: [-w, -half_height, -radius],
-                    max: [w, *half_height, 2.0 * radius],
-                };
-                exact(b, [true, true, false])
-            }
-            Node::Octahedron { radius } => exact(Aabb::centred([*radius; 3]), [true; 3]),
-            Node::Pyramid { base, height } => exact(
-                Aabb::centred([base * 0.5, height * 0.5, base * 0.5]),
-                [true, false, true],
-            ),
-            Node::BoxFrame { half, .. } => exact(Aabb::centred(*half), [true; 3]),
-            Node::Link {
-                half_length,
-                major,
-                minor,
-            } => exact(
-                Aabb::centred([major + minor, half_length + major + minor, *minor]),
-                [true; 3],
-            ),
-            Node::InfiniteCylinder { radius, axis } => {
-                exact(line_bounds(*axis, *radius), line_symmetry(*axis))
-            }
-            Node::Slab { thickness, normal } => exact(
-                slab_bounds(*normal, thickness * 0.5),
-                line_symmetry(*normal),
-            ),
-            Node::Circle { radius } => exact(profile_bounds([*radius; 2]), [true; 3]),
-            Node::Rect { half } | Node::RoundRect { half, .. } => {
-                exact(profile_bounds(*half), [true; 3])
+                if prim.profile {
+                    (bounds.min[2], bounds.max[2]) = (f64::NEG_INFINITY, f64::INFINITY);
+                }
+                let d = exact(bounds, e.symmetric);
+                match prim.field {
+                    PrimField::Exact => d,
+                    PrimField::Unproven => unproven(d, id),
+                }
             }
             Node::Mesh { mesh } => {
                 let (min, max) = mesh.0.aabb();
                 exact(Aabb { min, max }, [false; 3])
             }
-            Node::Arc {
-                radius, half_width, ..
-            } => exact(
-                profile_bounds([radius + half_width; 2]),
-                [true, false, true],
-            ),
             Node::Bezier {
                 a,
                 control,
@@ -1487,31 +1415,6 @@ fn plane_bounds(n: V3, h: f64) -> Aabb {
         }
     }
     b
-}
-
-/// The box around the points within `r` of the line through the origin along `axis`: ±r
-/// across every coordinate the axis does not move along, unbounded along the others.
-fn line_bounds(axis: V3, r: f64) -> Aabb {
-    Aabb::ALL.map(|i, lo, hi| if axis[i] == 0.0 { (-r, r) } else { (lo, hi) })
-}
-
-/// The box around the points within `h` of the plane through the origin normal to `n`: ±h
-/// along an axis-aligned normal, unbounded otherwise.
-fn slab_bounds(n: V3, h: f64) -> Aabb {
-    let mut b = Aabb::ALL;
-    for i in 0..3 {
-        let others = (0..3).filter(|&j| j != i).all(|j| n[j] == 0.0);
-        if others && n[i] != 0.0 {
-            (b.min[i], b.max[i]) = (-h, h);
-        }
-    }
-    b
-}
-
-/// The mirror symmetries of a shape about a line or plane through the origin along or
-/// normal to `v`: across plane i when `v` lies in it or along its normal.
-fn line_symmetry(v: V3) -> [bool; 3] {
-    [0, 1, 2].map(|i| v[i] == 0.0 || (0..3).filter(|&j| j != i).all(|j| v[j] == 0.0))
 }
 
 /// Quilez's ellipsoid bound `k0·(k0 − 1)/k1`: never above the distance, but not Lipschitz

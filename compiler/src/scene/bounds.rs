@@ -231,66 +231,6 @@ impl Bounds {
             ),
             Node::Ellipsoid { radii } => ellipsoid(*radii),
             // f ≥ |p| - 2 beyond radius 2, and f ≥ -0.5/e everywhere (see the docs).
-            Node::Mandelbulb { .. } => Bound::of_sphere(2.2),
-            Node::CappedCone {
-                half_height,
-                bottom,
-                top,
-            } => {
-                let r = bottom.max(*top);
-                Bound::of_box([r, *half_height, r], r.hypot(*half_height))
-            }
-            Node::RoundCone {
-                bottom,
-                top,
-                half_height,
-            } => {
-                let r = bottom.max(*top);
-                Bound::of_box([r, half_height + r, r], half_height + r)
-            }
-            Node::Segment { a, b, radius } => {
-                let c = [0, 1, 2].map(|i| (a[i] + b[i]) * 0.5);
-                let h = [0, 1, 2].map(|i| (b[i] - a[i]).abs() * 0.5 + radius);
-                let l = DVec3::from(*b).distance(DVec3::from(*a)) * 0.5;
-                Bound::of_box(h, l + radius).similar(1.0, c)
-            }
-            Node::RoundedCylinder {
-                radius,
-                half_height,
-                ..
-            } => Bound::of_box([*radius, *half_height, *radius], radius.hypot(*half_height)),
-            Node::HexPrism {
-                radius,
-                half_height,
-            } => {
-                let corner = radius * 2.0 / 3f64.sqrt();
-                Bound::of_box([corner, *half_height, *radius], corner.hypot(*half_height))
-            }
-            Node::TriPrism {
-                radius,
-                half_height,
-            } => {
-                // From z = -r to the corner at z = 2r, x within ±√3·r: about (0, 0, r/2).
-                let h = [3f64.sqrt() * radius, *half_height, 1.5 * radius];
-                let far = (5.25f64.sqrt() * radius).hypot(*half_height);
-                Bound::of_box(h, far).similar(1.0, [0.0, 0.0, 0.5 * radius])
-            }
-            Node::Octahedron { radius } => Bound::of_box([*radius; 3], *radius),
-            Node::Pyramid { base, height } => {
-                let (b, h) = (base * 0.5, height * 0.5);
-                let far = (2.0 * b * b + h * h).sqrt();
-                Bound::of_box([b, h, b], far)
-            }
-            Node::BoxFrame { half, .. } => Bound::of_box(*half, DVec3::from(*half).length()),
-            Node::Link {
-                half_length,
-                major,
-                minor,
-            } => {
-                let r = major + minor;
-                Bound::of_box([r, half_length + r, *minor], half_length + r)
-            }
-            Node::InfiniteCylinder { .. } | Node::Slab { .. } => return None,
             Node::Mesh { mesh } => {
                 let (lo, hi) = mesh.0.aabb();
                 let c = [0, 1, 2].map(|i| (lo[i] + hi[i]) * 0.5);
@@ -305,11 +245,19 @@ impl Bounds {
                 }
             }
             // A profile read as a field of space is a prism along z.
-            Node::Circle { radius } => profile([0.0; 2], [*radius; 2]),
-            Node::Rect { half } | Node::RoundRect { half, .. } => profile([0.0; 2], *half),
-            Node::Arc {
-                radius, half_width, ..
-            } => profile([0.0; 2], [radius + half_width; 2]),
+            Node::Rect { half } => profile([0.0; 2], *half),
+            Node::Prim { prim, args } => {
+                let e = (prim.extent)(args);
+                let c = [0, 1, 2].map(|i| (e.min[i] + e.max[i]) * 0.5);
+                let h = [0, 1, 2].map(|i| (e.max[i] - e.min[i]) * 0.5);
+                if prim.profile {
+                    profile([c[0], c[1]], [h[0], h[1]])
+                } else if h.iter().all(|h| h.is_finite()) {
+                    Bound::of_box(h, e.radius).similar(1.0, c)
+                } else {
+                    return None;
+                }
+            }
             // A quadratic Bézier curve lies in the triangle of its points.
             Node::Bezier {
                 a,
@@ -722,22 +670,9 @@ fn own_cost(node: &Node) -> f64 {
         Node::Capsule { .. } => 11.0,
         Node::Cone { .. } => 35.0,
         Node::Ellipsoid { .. } => 20.0,
-        Node::Mandelbulb { iterations, .. } => 20.0 + 45.0 * f64::from(*iterations),
-        Node::CappedCone { .. } => 40.0,
-        Node::RoundCone { .. } => 30.0,
-        Node::Segment { .. } => 20.0,
-        Node::RoundedCylinder { .. } => 18.0,
-        Node::HexPrism { .. } | Node::TriPrism { .. } => 32.0,
-        Node::Octahedron { .. } => 35.0,
-        Node::Pyramid { .. } => 55.0,
-        Node::BoxFrame { .. } => 60.0,
-        Node::Link { .. } => 14.0,
-        Node::InfiniteCylinder { .. } => 14.0,
-        Node::Slab { .. } => 7.0,
-        Node::Circle { .. } => 4.0,
-        Node::Arc { .. } => 20.0,
         Node::Bezier { .. } => 90.0,
-        Node::Rect { .. } | Node::RoundRect { .. } => 12.0,
+        Node::Rect { .. } => 12.0,
+        Node::Prim { prim, args } => (prim.cost)(args),
         Node::Polygon { points } => 20.0 * points.len() as f64,
         // A walk of the hierarchy: a few dozen boxes and triangles of some 40 operations.
         Node::Mesh { mesh } => 400.0 + 40.0 * (mesh.0.triangles().len() as f64).log2(),

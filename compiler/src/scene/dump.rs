@@ -2,6 +2,7 @@
 
 use super::ir::*;
 use super::NodeId;
+use crate::prim::Kind;
 use std::fmt::Write;
 
 /// Dumps a scene: settings, camera, lights, materials, then every node reachable from the root
@@ -214,90 +215,7 @@ fn node(n: &Node) -> String {
             num(*half_height)
         ),
         Node::Ellipsoid { radii } => format!("ellipsoid radii={}", v3(*radii)),
-        Node::Mandelbulb { power, iterations } => {
-            format!("mandelbulb power={} iterations={iterations}", num(*power))
-        }
-        Node::CappedCone {
-            half_height,
-            bottom,
-            top,
-        } => format!(
-            "capped_cone half_height={} bottom={} top={}",
-            num(*half_height),
-            num(*bottom),
-            num(*top)
-        ),
-        Node::RoundCone {
-            bottom,
-            top,
-            half_height,
-        } => format!(
-            "round_cone bottom={} top={} half_height={}",
-            num(*bottom),
-            num(*top),
-            num(*half_height)
-        ),
-        Node::Segment { a, b, radius } => {
-            format!("segment a={} b={} radius={}", v3(*a), v3(*b), num(*radius))
-        }
-        Node::RoundedCylinder {
-            radius,
-            round,
-            half_height,
-        } => format!(
-            "rounded_cylinder radius={} round={} half_height={}",
-            num(*radius),
-            num(*round),
-            num(*half_height)
-        ),
-        Node::HexPrism {
-            radius,
-            half_height,
-        } => format!(
-            "hex_prism radius={} half_height={}",
-            num(*radius),
-            num(*half_height)
-        ),
-        Node::TriPrism {
-            radius,
-            half_height,
-        } => format!(
-            "tri_prism radius={} half_height={}",
-            num(*radius),
-            num(*half_height)
-        ),
-        Node::Octahedron { radius } => format!("octahedron radius={}", num(*radius)),
-        Node::Pyramid { base, height } => {
-            format!("pyramid base={} height={}", num(*base), num(*height))
-        }
-        Node::BoxFrame { half, edge } => {
-            format!("box_frame half={} edge={}", v3(*half), num(*edge))
-        }
-        Node::Link {
-            half_length,
-            major,
-            minor,
-        } => format!(
-            "link half_length={} major={} minor={}",
-            num(*half_length),
-            num(*major),
-            num(*minor)
-        ),
-        Node::InfiniteCylinder { radius, axis } => {
-            format!(
-                "infinite_cylinder radius={} axis={}",
-                num(*radius),
-                v3(*axis)
-            )
-        }
-        Node::Slab { thickness, normal } => {
-            format!("slab thickness={} normal={}", num(*thickness), v3(*normal))
-        }
-        Node::Circle { radius } => format!("circle radius={}", num(*radius)),
         Node::Rect { half } => format!("rect half={}", v2(*half)),
-        Node::RoundRect { half, radius } => {
-            format!("round_rect half={} radius={}", v2(*half), num(*radius))
-        }
         Node::Mesh { mesh } => {
             let m = &mesh.0;
             format!(
@@ -307,16 +225,6 @@ fn node(n: &Node) -> String {
                 m.report.open_edges
             )
         }
-        Node::Arc {
-            radius,
-            half_angle,
-            half_width,
-        } => format!(
-            "arc radius={} half_angle={} half_width={}",
-            num(*radius),
-            num(*half_angle),
-            num(*half_width)
-        ),
         Node::Bezier {
             a,
             control,
@@ -329,6 +237,18 @@ fn node(n: &Node) -> String {
             v2(*b),
             num(*radius)
         ),
+        Node::Prim { prim, args } => {
+            let mut out = prim.name.to_string();
+            for (i, p) in prim.params.iter().enumerate() {
+                let v = match p.kind {
+                    Kind::Vec2 => v2(args.v2(i)),
+                    Kind::Vec3 => v3(args.v3(i)),
+                    Kind::Float | Kind::Int | Kind::Angle => num(args.f(i)),
+                };
+                out += &format!(" {}={v}", p.name);
+            }
+            out
+        }
         Node::Polygon { points } => {
             let ps: Vec<String> = points.iter().map(|q| v2(*q)).collect();
             format!("polygon {}", ps.join(" "))

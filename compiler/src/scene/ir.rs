@@ -157,69 +157,15 @@ pub enum Node {
     Cone { radius: f64, half_height: f64 },
     /// Axis-aligned ellipsoid of radii (a bound, not exact).
     Ellipsoid { radii: V3 },
-    /// Mandelbulb fractal (distance estimator, approximate).
-    Mandelbulb { power: f64, iterations: u32 },
-    /// Cone along y cut at both ends: radius `bottom` at y = -h, `top` at y = +h.
-    CappedCone {
-        half_height: f64,
-        bottom: f64,
-        top: f64,
+    /// A primitive of the table (`prim/`): its entry and its arguments.
+    Prim {
+        prim: crate::prim::PrimRef,
+        args: crate::prim::Args,
     },
-    /// The hull of a sphere of radius `bottom` at y = -h and one of radius `top` at y = +h.
-    RoundCone {
-        bottom: f64,
-        top: f64,
-        half_height: f64,
-    },
-    /// The points within `radius` of the segment from `a` to `b` (a capsule between them).
-    Segment { a: V3, b: V3, radius: f64 },
-    /// Cylinder along y of `radius` and half-height `half_height` with its two rims rounded
-    /// by `round`.
-    RoundedCylinder {
-        radius: f64,
-        round: f64,
-        half_height: f64,
-    },
-    /// Hexagonal prism along y; `radius` is the distance from the axis to each flat side.
-    HexPrism { radius: f64, half_height: f64 },
-    /// Prism along y of an equilateral triangle in the xz plane with a corner towards +z;
-    /// `radius` is the distance from the axis to each side.
-    TriPrism { radius: f64, half_height: f64 },
-    /// Regular octahedron with its corners on the axes, `radius` from the centre.
-    Octahedron { radius: f64 },
-    /// Pyramid of a square base of side `base` at y = -h/2 and its apex at y = +h/2.
-    Pyramid { base: f64, height: f64 },
-    /// The edges of a box of half-extents `half`, as bars of half-thickness `edge`.
-    BoxFrame { half: V3, edge: f64 },
-    /// A chain link in the xy plane: a torus of radii `major`, `minor` stretched along y by a
-    /// straight part of half-length `half_length`.
-    Link {
-        half_length: f64,
-        major: f64,
-        minor: f64,
-    },
-    /// Cylinder of `radius` without ends, about the line through the origin along `axis`
-    /// (unit length).
-    InfiniteCylinder { radius: f64, axis: V3 },
-    /// The points within `thickness / 2` of the plane through the origin normal to `normal`
-    /// (unit length).
-    Slab { thickness: f64, normal: V3 },
-    /// Profile (2D, in the xy plane; its distance reads x and y only): a circle.
-    Circle { radius: f64 },
     /// Profile: a rectangle of half-extents `half`.
     Rect { half: [f64; 2] },
-    /// Profile: a rectangle of half-extents `half` with its corners rounded by `radius` (the
-    /// radius is inside the extents).
-    RoundRect { half: [f64; 2], radius: f64 },
     /// Profile: a simple polygon through `points` (three or more, either winding).
     Polygon { points: Vec<[f64; 2]> },
-    /// Profile: the arc of the circle of `radius` about the origin within `half_angle` of +y
-    /// on either side, stroked to `half_width` on either side.
-    Arc {
-        radius: f64,
-        half_angle: f64,
-        half_width: f64,
-    },
     /// Profile: the quadratic Bézier curve from `a` to `b` pulled towards `control`, stroked
     /// to `radius` on either side (`control` is not the midpoint of `a` and `b`).
     Bezier {
@@ -387,6 +333,20 @@ macro_rules! one_child {
 }
 
 impl Node {
+    /// The node of the table's primitive `name` (`prim/`) with these arguments, each one
+    /// number or the two or three of a vector; `None` where the table has no such entry.
+    pub fn prim(name: &str, args: &[&[f64]]) -> Option<Node> {
+        let prim = crate::prim::find(name)?;
+        let args = args
+            .iter()
+            .map(|a| [0, 1, 2].map(|i| a.get(i).copied().unwrap_or(0.0)))
+            .collect();
+        Some(Node::Prim {
+            prim: crate::prim::PrimRef(prim),
+            args: crate::prim::Args(args),
+        })
+    }
+
     /// The node's children in order.
     pub fn children(&self) -> Vec<NodeId> {
         match self {
@@ -422,26 +382,11 @@ impl Node {
             Node::Capsule { .. } => "capsule",
             Node::Cone { .. } => "cone",
             Node::Ellipsoid { .. } => "ellipsoid",
-            Node::Mandelbulb { .. } => "mandelbulb",
-            Node::CappedCone { .. } => "capped_cone",
-            Node::RoundCone { .. } => "round_cone",
-            Node::Segment { .. } => "segment",
-            Node::RoundedCylinder { .. } => "rounded_cylinder",
-            Node::HexPrism { .. } => "hex_prism",
-            Node::TriPrism { .. } => "tri_prism",
-            Node::Octahedron { .. } => "octahedron",
-            Node::Pyramid { .. } => "pyramid",
-            Node::BoxFrame { .. } => "box_frame",
-            Node::Link { .. } => "link",
-            Node::InfiniteCylinder { .. } => "infinite_cylinder",
-            Node::Slab { .. } => "slab",
-            Node::Circle { .. } => "circle",
             Node::Rect { .. } => "rect",
-            Node::RoundRect { .. } => "round_rect",
             Node::Polygon { .. } => "polygon",
-            Node::Arc { .. } => "arc",
             Node::Bezier { .. } => "bezier",
             Node::Text { .. } => "text",
+            Node::Prim { prim, .. } => prim.name,
             Node::Extrude { .. } => "extrude",
             Node::Revolve { .. } => "revolve",
             Node::Loft { .. } => "loft",

@@ -288,7 +288,10 @@ fn mandelbulb_matches_the_iteration() {
         let r = len3(z);
         0.5 * r.ln() * r / dr
     };
-    let program = lower(&single(Node::Mandelbulb { power, iterations }));
+    let node = Node::prim("mandelbulb", &[&[power], &[f64::from(iterations)]]);
+    let program = lower(&single(
+        node.expect("mandelbulb is a primitive of the table"),
+    ));
     for p in points(3, 500, 1.6).into_iter().chain(points(4, 100, 6.0)) {
         let (d, _) = eval_point::<f64>(&program, p);
         let want = reference(p);

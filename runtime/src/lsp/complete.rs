@@ -126,7 +126,7 @@ pub fn complete(
         };
         out.push(item(&d.name, kind, String::new()));
     }
-    for b in BUILTINS {
+    for b in BUILTINS.iter() {
         let sigs: Vec<String> = b
             .sigs
             .iter()

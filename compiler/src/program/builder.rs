@@ -2,14 +2,14 @@
 //! sharing of equal instructions (when optimising), opens and closes guarded blocks, and
 //! offers the small vector helpers the lowering rules are written with.
 
-use crate::program::mesh::TriMesh;
-use crate::program::outline::Outline;
-use crate::program::{scalar, Axis, Binary, Block, Note, Op, Program, Reg, Unary};
+use super::mesh::TriMesh;
+use super::outline::Outline;
+use super::{scalar, Axis, Binary, Block, Note, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 use std::sync::Arc;
 
 /// A point or vector: three registers.
-pub(super) type P = [Reg; 3];
+pub(crate) type P = [Reg; 3];
 
 /// The four constants of an exact primitive (`shapes::slots`).
 pub type Slots = [f64; 4];
@@ -41,7 +41,7 @@ const TOP: u32 = u32::MAX;
 
 /// Builds one program.
 #[derive(Debug, Default)]
-pub(super) struct Builder {
+pub(crate) struct Builder {
     /// Fold, share and drop dead instructions (optimisation level ≥ 1).
     optimise: bool,
     ops: Vec<Op>,

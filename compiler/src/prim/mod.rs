@@ -1,0 +1,223 @@
+//! The primitives' table: one entry per built-in shape or profile that is marched by its
+//! formula, stating all that the stages read about it — its signature and the checks among
+//! its arguments (the checker, the language server, the language reference), its distance
+//! written over the program's operations (the lowering), whether that distance is exact, its
+//! box and bounding sphere (the analysis and the culling bounds), its cost, and its doc line.
+//!
+//! Adding such a primitive is one [`Prim`] in one of the files below, its row in
+//! docs/language.md (a test prints the row the table gives), its name in the editor grammar
+//! (a test names what is missing) and a conformance line. The primitives that are also traced
+//! analytically or walked as instances (sphere, box, torus, cylinder, capsule, cone, plane)
+//! and those read from data (polygon, text, mesh) keep their own nodes.
+
+mod mandelbulb;
+mod polyhedra;
+mod profiles;
+mod solids;
+
+use crate::limits::Limit;
+use crate::program::builder::{Builder, P};
+use crate::program::Reg;
+
+pub(crate) use profiles::rect;
+pub(crate) use solids::{box_from_q, cylinder, extrude, nearer_signed};
+
+/// A parameter's default value.
+#[derive(Debug, Clone, Copy)]
+pub enum Def {
+    /// The argument must be given.
+    Req,
+    Num(f64),
+    Int(i64),
+    Bool(bool),
+    V3([f64; 3]),
+    Text(&'static str),
+    /// An angle in degrees.
+    Deg(f64),
+}
+
+/// The values a numeric parameter accepts (checked per component for vectors).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Range {
+    /// Any finite value.
+    Any,
+    /// > 0
+    Pos,
+    /// ≥ 0
+    NonNeg,
+    /// In [0, 1].
+    Unit,
+    /// In [lo, hi].
+    Within(f64, f64),
+    /// A vector that is not zero.
+    NonZero,
+    /// One of the listed strings.
+    OneOf(&'static [&'static str]),
+    /// In [lo, the value of a resource limit] (the render settings bounded by `--limit`).
+    Limited(f64, Limit),
+}
+
+/// What a primitive's parameter holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    Float,
+    Int,
+    /// An angle, held in radians.
+    Angle,
+    Vec2,
+    Vec3,
+}
+
+/// One parameter of a primitive.
+#[derive(Debug, Clone, Copy)]
+pub struct Param {
+    pub name: &'static str,
+    pub kind: Kind,
+    pub def: Def,
+    pub range: Range,
+}
+
+const fn param(name: &'static str, kind: Kind, def: Def, range: Range) -> Param {
+    Param {
+        name,
+        kind,
+        def,
+        range,
+    }
+}
+
+/// The arguments of a primitive, in the order of its parameters, each as three numbers (a
+/// float, an int or an angle in the first; a vec2 in the first two).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Args(pub Vec<[f64; 3]>);
+
+impl Args {
+    /// The float, int (as a float) or angle (in radians) argument `i`.
+    pub fn f(&self, i: usize) -> f64 {
+        self.0[i][0]
+    }
+
+    pub fn v2(&self, i: usize) -> [f64; 2] {
+        [self.0[i][0], self.0[i][1]]
+    }
+
+    pub fn v3(&self, i: usize) -> [f64; 3] {
+        self.0[i]
+    }
+}
+
+/// How a primitive's field relates to the distance to its surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Field {
+    /// The exact signed distance.
+    Exact,
+    /// An estimate with no proven bound (a fractal's distance estimator).
+    Unproven,
+}
+
+/// Where a primitive's solid lies: a box (unbounded along an axis where it is infinite), a
+/// sphere about the box's centre that holds it, and the coordinate planes across which it is
+/// symmetric. A profile's box and sphere are read in the xy plane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Extent {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    /// The radius of a sphere about the box's centre that holds the solid (∞ for an
+    /// unbounded one).
+    pub radius: f64,
+    /// Across plane i (x = 0, y = 0, z = 0) the solid is its own mirror image.
+    pub symmetric: [bool; 3],
+}
+
+impl Extent {
+    /// The box of half-extents `half` about the origin, within `radius` of it.
+    fn centred(half: [f64; 3], radius: f64, symmetric: [bool; 3]) -> Extent {
+        Extent {
+            min: half.map(|h| -h),
+            max: half,
+            radius,
+            symmetric,
+        }
+    }
+}
+
+/// One built-in primitive: everything the stages read about it.
+#[derive(Debug)]
+pub struct Prim {
+    /// The name users call it by.
+    pub name: &'static str,
+    /// A 2D profile in the xy plane (its distance reads x and y), or a solid.
+    pub profile: bool,
+    pub params: &'static [Param],
+    /// The values accepted, in words, beyond what each parameter's range says: the
+    /// language reference's second column.
+    pub accepts: &'static str,
+    /// What it is, for the language reference, hovers and completion.
+    pub doc: &'static str,
+    /// Checks among the arguments beyond each one's range: why they are refused.
+    pub check: fn(&Args) -> Option<String>,
+    pub field: Field,
+    pub extent: fn(&Args) -> Extent,
+    /// The instructions it costs per point, roughly.
+    pub cost: fn(&Args) -> f64,
+    /// Its distance at the point `p` (in its own frame), written over the program's
+    /// operations.
+    pub(crate) distance: fn(&mut Builder, P, &Args) -> Reg,
+}
+
+/// A primitive of the table as a node of the scene graph names it: shown by its name,
+/// equal when it is the same entry.
+#[derive(Clone, Copy)]
+pub struct PrimRef(pub &'static Prim);
+
+impl PartialEq for PrimRef {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.name == other.0.name
+    }
+}
+
+impl std::fmt::Debug for PrimRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(self.0.name)
+    }
+}
+
+impl std::ops::Deref for PrimRef {
+    type Target = Prim;
+    fn deref(&self) -> &Prim {
+        self.0
+    }
+}
+
+/// Every entry, solids then profiles, in the order of the language reference.
+pub fn all() -> impl Iterator<Item = &'static Prim> {
+    [
+        mandelbulb::PRIMS,
+        solids::PRIMS,
+        polyhedra::PRIMS,
+        profiles::PRIMS,
+    ]
+    .into_iter()
+    .flatten()
+}
+
+/// The entry of the primitive `name`.
+pub fn find(name: &str) -> Option<&'static Prim> {
+    all().find(|p| p.name == name)
+}
+
+/// No check among the arguments.
+fn any(_: &Args) -> Option<String> {
+    None
+}
+
+/// The unit vector along `v` (not zero: its range says so).
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|x| x / l)
+}
+
+/// A number for a message.
+fn num(x: f64) -> String {
+    crate::diagnostics::number(x, 6)
+}

@@ -625,13 +625,18 @@ fn the_language_reference_rows_of_the_primitives_are_the_tables() {
     let mut wrong = Vec::new();
     for prim in sdfc_compiler::prim::all() {
         let b = builtins::builtin(prim.name).expect("every primitive is a builtin");
+        let sig = b
+            .sigs
+            .iter()
+            .find(|s| matches!(s.imp, builtins::Imp::Prim(p) if std::ptr::eq(p, prim)))
+            .expect("every primitive is an overload of its name");
         let exact = match prim.field {
             sdfc_compiler::prim::Field::Exact => " Exact.",
             sdfc_compiler::prim::Field::Unproven => "",
         };
         let row = format!(
             "| `{}` | {} | {}{exact} |",
-            builtins::signature(prim.name, &b.sigs[0]),
+            builtins::signature(prim.name, sig),
             prim.accepts,
             prim.doc
         );

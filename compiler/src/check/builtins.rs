@@ -160,7 +160,7 @@ impl Imp {
 }
 
 /// One overload.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Sig {
     pub params: &'static [P],
     /// The last parameter may be repeated (variadic).
@@ -838,7 +838,15 @@ pub static BUILTINS: std::sync::LazyLock<Vec<Builtin>> = std::sync::LazyLock::ne
             sigs: Vec::leak(vec![sig]),
         }
     });
-    FUNCTIONS.iter().copied().chain(prims).collect()
+    // An entry named like a builtin before it is one more overload of that builtin.
+    let mut all: Vec<Builtin> = FUNCTIONS.to_vec();
+    for prim in prims {
+        match all.iter_mut().find(|b| b.name == prim.name) {
+            Some(b) => b.sigs = Vec::leak([b.sigs, prim.sigs].concat()),
+            None => all.push(prim),
+        }
+    }
+    all
 });
 
 /// The type of a primitive's parameter.

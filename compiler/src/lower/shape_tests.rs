@@ -1155,3 +1155,55 @@ fn program_of_two_reads() -> (Program, f64) {
     let scene = scene.expect("scene");
     (super::lower(&scene), 1.0)
 }
+
+/// The frame of the segment from `a` to `b` at `p`: (the distance from the axis, the
+/// distance along it from `a`), and the segment's length.
+fn along(a: [f64; 3], b: [f64; 3], p: [f64; 3]) -> ((f64, f64), f64) {
+    let ab = [0, 1, 2].map(|i| b[i] - a[i]);
+    let l = len(ab);
+    let u = ab.map(|x| x / l);
+    let ap = [0, 1, 2].map(|i| p[i] - a[i]);
+    let t = (0..3).map(|i| ap[i] * u[i]).sum::<f64>();
+    let radial = len([0, 1, 2].map(|i| ap[i] - t * u[i]));
+    ((radial, t), l)
+}
+
+#[test]
+fn shapes_between_two_points_are_exact_and_their_y_aligned_shapes_moved() {
+    same(
+        "cylinder((0, -0.7, 0), (0, 0.7, 0), 0.5)",
+        "cylinder(0.5, 1.4)",
+    );
+    same("cone((0, -0.6, 0), (0, 0.6, 0), 0.6, 0)", "cone(0.6, 1.2)");
+    same(
+        "round_cone((0, -0.5, 0), (0, 0.5, 0), 0.5, 0.2)",
+        "round_cone(0.5, 0.2, 1)",
+    );
+    // Turned: b → a along y is the same solid as a → b upside down.
+    same(
+        "cone((0, 0.6, 0), (0, -0.6, 0), 0.2, 0.5)",
+        "capped_cone(1.2, 0.5, 0.2)",
+    );
+    let (a, b) = ([-0.5, -0.4, 0.3], [0.6, 0.5, -0.2]);
+    exact("cylinder((-0.5, -0.4, 0.3), (0.6, 0.5, -0.2), 0.35)", |p| {
+        let ((r, t), l) = along(a, b, p);
+        t > 0.0 && t < l && r < 0.35
+    });
+    exact("cone((-0.5, -0.4, 0.3), (0.6, 0.5, -0.2), 0.5, 0.1)", |p| {
+        let ((r, t), l) = along(a, b, p);
+        t > 0.0 && t < l && r < 0.5 + (0.1 - 0.5) * t / l
+    });
+    exact(
+        "round_cone((-0.5, -0.4, 0.3), (0.6, 0.5, -0.2), 0.45, 0.2)",
+        |p| {
+            // As round_cone_is_exact, in the segment's frame.
+            let ((r, t), h) = along(a, b, p);
+            let (r1, r2) = (0.45, 0.2);
+            let s = (r1 - r2) / h;
+            let c = (1.0f64 - s * s).sqrt();
+            let k = -s * r + c * t;
+            let side = r * c + t * s - r1;
+            r.hypot(t) < r1 || r.hypot(t - h) < r2 || (k >= 0.0 && k <= c * h && side < 0.0)
+        },
+    );
+}

@@ -4,12 +4,15 @@
 //! written over the program's operations (the lowering), whether that distance is exact, its
 //! box and bounding sphere (the analysis and the culling bounds), its cost, and its doc line.
 //!
-//! Adding such a primitive is one [`Prim`] in one of the files below, its row in
+//! An entry may share its name with another entry or with a built-in of the checker: it is
+//! then one more overload of that name (`cylinder(a, b, radius)` beside `cylinder(radius,
+//! height)`). Adding such a primitive is one [`Prim`] in one of the files below, its row in
 //! docs/language.md (a test prints the row the table gives), its name in the editor grammar
 //! (a test names what is missing) and a conformance line. The primitives that are also traced
 //! analytically or walked as instances (sphere, box, torus, cylinder, capsule, cone, plane)
 //! and those read from data (polygon, text, mesh) keep their own nodes.
 
+mod between;
 mod mandelbulb;
 mod polyhedra;
 mod profiles;
@@ -165,20 +168,21 @@ pub struct Prim {
     pub(crate) distance: fn(&mut Builder, P, &Args) -> Reg,
 }
 
-/// A primitive of the table as a node of the scene graph names it: shown by its name,
-/// equal when it is the same entry.
+/// A primitive of the table as a node of the scene graph names it: shown by its name and
+/// parameters (overloads share a name), equal when it is the same entry.
 #[derive(Clone, Copy)]
 pub struct PrimRef(pub &'static Prim);
 
 impl PartialEq for PrimRef {
     fn eq(&self, other: &Self) -> bool {
-        self.0.name == other.0.name
+        std::ptr::eq(self.0, other.0)
     }
 }
 
 impl std::fmt::Debug for PrimRef {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        f.write_str(self.0.name)
+        let params: Vec<&str> = self.0.params.iter().map(|p| p.name).collect();
+        write!(f, "{}({})", self.0.name, params.join(", "))
     }
 }
 
@@ -194,6 +198,7 @@ pub fn all() -> impl Iterator<Item = &'static Prim> {
     [
         mandelbulb::PRIMS,
         solids::PRIMS,
+        between::PRIMS,
         polyhedra::PRIMS,
         profiles::PRIMS,
     ]
@@ -201,7 +206,7 @@ pub fn all() -> impl Iterator<Item = &'static Prim> {
     .flatten()
 }
 
-/// The entry of the primitive `name`.
+/// The first entry of the primitive `name` (others of that name are its overloads).
 pub fn find(name: &str) -> Option<&'static Prim> {
     all().find(|p| p.name == name)
 }

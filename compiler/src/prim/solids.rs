@@ -254,7 +254,7 @@ pub(crate) fn nearer_signed(
 /// ca = (q.x - min(q.x, q.y < 0 ? r1 : r2), |q.y| - h),
 /// cb = q - k1 + k2·clamp(dot(k1 - q, k2) / dot(k2, k2), 0, 1),
 /// d = ±√min(|ca|², |cb|²), negative where cb.x < 0 and ca.y < 0.
-fn capped_cone(b: &mut Builder, p: P, h: f64, r1: f64, r2: f64) -> Reg {
+pub(super) fn capped_cone(b: &mut Builder, p: P, h: f64, r1: f64, r2: f64) -> Reg {
     let qx = b.len2(p[0], p[2]);
     let qy = p[1];
     let zero = b.c(0.0);
@@ -286,7 +286,7 @@ fn capped_cone(b: &mut Builder, p: P, h: f64, r1: f64, r2: f64) -> Reg {
 /// r2 at y = +h. With q = (|p.xz|, p.y + h), s = (r1 - r2) / 2h, c = √(1 - s²) and
 /// k = dot(q, (-s, c)): |q| - r1 where k < 0, |q - (0, 2h)| - r2 where k > 2h·c, else
 /// dot(q, (c, s)) - r1.
-fn round_cone(b: &mut Builder, p: P, r1: f64, r2: f64, h: f64) -> Reg {
+pub(super) fn round_cone(b: &mut Builder, p: P, r1: f64, r2: f64, h: f64) -> Reg {
     let sn = (r1 - r2) / (2.0 * h);
     let cs = (1.0 - sn * sn).max(0.0).sqrt();
     let qx = b.len2(p[0], p[2]);

@@ -1,0 +1,172 @@
+//! Shapes between two points (issue 50, item 3): `cylinder(a, b, radius)`,
+//! `cone(a, b, radius_a, radius_b)` and `round_cone(a, b, radius_a, radius_b)`, overloads
+//! beside the shapes along y. Each is its shape along y in the frame of the segment from `a`
+//! to `b` (centred on its midpoint, the segment along y): a rotation and a translation keep
+//! distances, so each is exact as its shape along y is.
+
+use super::solids::{capped_cone, cylinder, round_cone};
+use super::Kind::{Float as F, Vec3 as V};
+use super::Range::{Any, NonNeg, Pos};
+use super::{num, param, Args, Def, Extent, Field, Prim};
+use crate::program::builder::{Builder, P};
+
+type V3 = [f64; 3];
+
+pub(super) static PRIMS: &[Prim] = &[
+    Prim {
+        name: "cylinder",
+        profile: false,
+        params: &[
+            param("a", V, Def::Req, Any),
+            param("b", V, Def::Req, Any),
+            param("radius", F, Def::Num(0.5), Pos),
+        ],
+        accepts: "`a` ≠ `b`; `radius` > 0",
+        doc: "A capped cylinder whose axis runs from the point `a` to the point `b`.",
+        check: apart,
+        field: Field::Exact,
+        extent: |args| discs(args, args.f(2), args.f(2)),
+        cost: |_| 32.0,
+        distance: |b, p, args| {
+            let (q, h) = frame(b, p, args);
+            cylinder(b, q, &[args.f(2), h, 0.0, 0.0])
+        },
+    },
+    Prim {
+        name: "cone",
+        profile: false,
+        params: &[
+            param("a", V, Def::Req, Any),
+            param("b", V, Def::Req, Any),
+            param("radius_a", F, Def::Num(0.5), NonNeg),
+            param("radius_b", F, Def::Num(0.0), NonNeg),
+        ],
+        accepts: "`a` ≠ `b`; `radius_a`, `radius_b` ≥ 0, not both 0",
+        doc: "A cone (a frustum where both radii are above 0) whose axis runs from `a`, where its radius is `radius_a`, to `b`, where it is `radius_b`.",
+        check: |args| apart(args).or_else(|| no_volume(args)),
+        field: Field::Exact,
+        extent: |args| discs(args, args.f(2), args.f(3)),
+        cost: |_| 55.0,
+        distance: |b, p, args| {
+            let (q, h) = frame(b, p, args);
+            capped_cone(b, q, h, args.f(2), args.f(3))
+        },
+    },
+    Prim {
+        name: "round_cone",
+        profile: false,
+        params: &[
+            param("a", V, Def::Req, Any),
+            param("b", V, Def::Req, Any),
+            param("radius_a", F, Def::Num(0.5), NonNeg),
+            param("radius_b", F, Def::Num(0.25), NonNeg),
+        ],
+        accepts: "`radius_a`, `radius_b` ≥ 0, not both 0; \\|`a` − `b`\\| above \\|`radius_a` − `radius_b`\\|",
+        doc: "The hull of the ball of radius `radius_a` about `a` and that of radius `radius_b` about `b`.",
+        check: |args| {
+            apart(args).or_else(|| no_volume(args)).or_else(|| {
+                let (l, d) = (length(args), (args.f(2) - args.f(3)).abs());
+                (d >= l).then(|| {
+                    format!(
+                        "the radii differ by {} but the points are {} apart: one ball would hold the other (a round cone needs |radius_a - radius_b| < |a - b|)",
+                        num(d),
+                        num(l)
+                    )
+                })
+            })
+        },
+        field: Field::Exact,
+        extent: |args| {
+            let (a, b, ra, rb) = (args.v3(0), args.v3(1), args.f(2), args.f(3));
+            Extent {
+                min: [0, 1, 2].map(|i| (a[i] - ra).min(b[i] - rb)),
+                max: [0, 1, 2].map(|i| (a[i] + ra).max(b[i] + rb)),
+                radius: length(args) / 2.0 + ra.max(rb),
+                symmetric: symmetric(args),
+            }
+        },
+        cost: |_| 42.0,
+        distance: |b, p, args| {
+            let (q, h) = frame(b, p, args);
+            round_cone(b, q, args.f(2), args.f(3), h)
+        },
+    },
+];
+
+/// |b - a| of arguments `a` and `b`.
+fn length(args: &Args) -> f64 {
+    let (a, b) = (args.v3(0), args.v3(1));
+    (0..3).map(|i| (b[i] - a[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Refuses two points that are one: the axis has no direction.
+fn apart(args: &Args) -> Option<String> {
+    (length(args) == 0.0).then(|| {
+        "`a` and `b` are the same point: the axis between them has no direction".to_string()
+    })
+}
+
+/// Refuses radii (arguments 2 and 3) that are both 0.
+fn no_volume(args: &Args) -> Option<String> {
+    (args.f(2) == 0.0 && args.f(3) == 0.0)
+        .then(|| "`radius_a` and `radius_b` are both 0: the shape has no volume".to_string())
+}
+
+/// The planes across which the shape is its own mirror image: those that hold its axis, and
+/// those that swap its ends when its two radii are equal.
+fn symmetric(args: &Args) -> [bool; 3] {
+    let (a, b) = (args.v3(0), args.v3(1));
+    let equal = args.f(2) == args.f(args.0.len() - 1);
+    let mirrored = |i: usize| (0..3).all(|j| if j == i { a[j] == -b[j] } else { a[j] == b[j] });
+    [0, 1, 2].map(|i| (a[i] == 0.0 && b[i] == 0.0) || (equal && mirrored(i)))
+}
+
+/// The box and sphere around the discs of radius `ra` about `a` and `rb` about `b`, normal to
+/// the axis (a disc of radius r normal to the unit u reaches r·√(1 − u_i²) along axis i).
+fn discs(args: &Args, ra: f64, rb: f64) -> Extent {
+    let (a, b, l) = (args.v3(0), args.v3(1), length(args));
+    let reach = |i: usize, r: f64| r * (1.0 - ((b[i] - a[i]) / l).powi(2)).max(0.0).sqrt();
+    Extent {
+        min: [0, 1, 2].map(|i| (a[i] - reach(i, ra)).min(b[i] - reach(i, rb))),
+        max: [0, 1, 2].map(|i| (a[i] + reach(i, ra)).max(b[i] + reach(i, rb))),
+        radius: (l / 2.0).hypot(ra.max(rb)),
+        symmetric: symmetric(args),
+    }
+}
+
+/// The point in the frame of the segment from argument `a` to argument `b`: about its
+/// midpoint, turned so that `a` lies at y = -h and `b` at y = +h; and h.
+fn frame(b: &mut Builder, p: P, args: &Args) -> (P, f64) {
+    let (from, to) = (args.v3(0), args.v3(1));
+    let l = length(args);
+    let u: V3 = [0, 1, 2].map(|i| (to[i] - from[i]) / l);
+    // e1 ⟂ u from the axis u is least along; e3 = e1 × u, so the rows e1, u, e3 are a rotation.
+    let k = (0..3)
+        .min_by(|&i, &j| u[i].abs().total_cmp(&u[j].abs()))
+        .unwrap_or(0);
+    let mut axis = [0.0; 3];
+    axis[k] = 1.0;
+    let e1 = normalise(cross(axis, u));
+    let e3 = cross(e1, u);
+    let mid: V3 = [0, 1, 2].map(|i| (from[i] + to[i]) / 2.0);
+    let d = b.sub3c(p, mid);
+    let q = [e1, u, e3].map(|row| {
+        let terms = [0, 1, 2].map(|j| b.mulc(d[j], row[j]));
+        let s = b.add(terms[0], terms[1]);
+        b.add(s, terms[2])
+    });
+    (q, l / 2.0)
+}
+
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn normalise(v: V3) -> V3 {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|x| x / l)
+}

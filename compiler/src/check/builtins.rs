@@ -388,18 +388,39 @@ fn text(b: &mut Build, a: &[Value]) -> Result<Value, String> {
         return Ok(Value::Error);
     };
     let size = a[1].num();
-    let outline = if font.is_empty() {
-        super::font::layout(super::font::default_font(), string, size)
-    } else {
-        let bytes = b.read_bytes(font)?;
-        super::font::layout(&bytes, string, size).map_err(|e| format!("`{font}`: {e}"))
-    }?;
+    let outline = outline_of(b, string, size, font)?;
     b.profile(Node::Text {
         text: string.to_string(),
         size,
         font: font.to_string(),
         outline: std::sync::Arc::new(outline),
     })
+}
+
+/// The glyphs of `string` in the font file `font` (empty: the shipped DejaVu Sans), the em
+/// `size` high, laid out as `text` lays them out.
+fn outline_of(
+    b: &mut Build,
+    string: &str,
+    size: f64,
+    font: &str,
+) -> Result<crate::program::outline::Outline, String> {
+    if font.is_empty() {
+        super::font::layout(super::font::default_font(), string, size)
+    } else {
+        let bytes = b.read_bytes(font)?;
+        super::font::layout(&bytes, string, size).map_err(|e| format!("`{font}`: {e}"))
+    }
+}
+
+/// `text_size`: the width and height of the box around the ink of what `text` draws with
+/// the same arguments.
+fn text_size(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let (Value::Str(string), Value::Str(font)) = (&a[0], &a[2]) else {
+        return Ok(Value::Error);
+    };
+    let (lo, hi) = outline_of(b, string, a[1].num(), font)?.bounds();
+    Ok(Value::Vec2([hi[0] - lo[0], hi[1] - lo[1]]))
 }
 
 fn polygon_of(b: &mut Build, points: Vec<[f64; 2]>) -> Result<Value, String> {
@@ -968,6 +989,12 @@ static FUNCTIONS: &[Builtin] = &[
         name: "text",
         sigs: sigs![
             [p("string", Str, Req, Any), p("size", F, Num(1.0), Pos), p("font", Str, Text(""), Any)] -> PR => text;
+        ],
+    },
+    Builtin {
+        name: "text_size",
+        sigs: sigs![
+            [p("string", Str, Req, Any), p("size", F, Num(1.0), Pos), p("font", Str, Text(""), Any)] -> V2 => text_size;
         ],
     },
     Builtin {

@@ -147,3 +147,29 @@ fn len_takes_a_list_of_profiles() {
         &Node::Sphere { radius: 2.0 }
     );
 }
+
+/// `text_size` is the size of the box around the ink `text` draws: a plate fits the text
+/// it measures (issue 50, item 7).
+#[test]
+fn text_size_measures_the_ink_of_text() {
+    let outline = crate::check::font::layout(crate::check::font::default_font(), "HELLO", 2.0)
+        .expect("laid out");
+    let (lo, hi) = outline.bounds();
+    let s = ok("let s = text_size(\"HELLO\", 2);\nscene { box((s.x, s.y, 1)); }");
+    let Node::Box { half } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a box")
+    };
+    assert_eq!(half[0], hi[0] - lo[0]);
+    assert_eq!(half[1], hi[1] - lo[1]);
+    assert!(half[0] > 4.0 * half[1], "HELLO is wide: {half:?}");
+    // Twice the size, twice the box; the text's mistakes are text's.
+    let t = ok("let s = text_size(\"HELLO\", 4);\nscene { box((s.x, s.y, 1)); }");
+    let Node::Box { half: twice } = t.graph.node(t.root.expect("root")) else {
+        panic!("not a box")
+    };
+    assert!((twice[0] - 2.0 * half[0]).abs() < 1e-9 * half[0]);
+    assert_eq!(
+        codes("let s = text_size(\"\");\nscene { sphere(); }"),
+        ["E0400"]
+    );
+}

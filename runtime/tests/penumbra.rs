@@ -13,7 +13,8 @@ use sdfc_runtime::image::Image;
 
 /// Issue 47, item 7: a thin-walled vase turned from the curve of its wall (a Curv gallery
 /// scene as a user writes it), whose rim casts a soft shadow into it and onto the floor.
-const VASE: &str = "material glaze = phong { color: (0.8, 0.5, 0.3), specular: 0.4, shininess: 32 };\n\
+const VASE: &str =
+    "material glaze = phong { color: (0.8, 0.5, 0.3), specular: 0.4, shininess: 32 };\n\
     material floor = phong { color: (0.7, 0.7, 0.72) };\n\
     camera { position: (0, 2.6, -1.6), look_at: (0, 0, 0), fov: 40deg }\n\
     light point { position: (1.2, 5, -1.5), intensity: 1, penumbra: 3deg }\n\
@@ -37,7 +38,11 @@ fn checked(name: &str, text: &str) -> Scene {
 
 fn render_cpu(scene: &Scene, precision: Precision) -> Image {
     let prepared = Prepared::new(Backend::Cpu, scene, precision).expect("the CPU backend");
-    prepared.render(scene, &|_| {}).expect("a CPU render").render.image
+    prepared
+        .render(scene, &|_| {})
+        .expect("a CPU render")
+        .render
+        .image
 }
 
 /// The vase's penumbrae are smooth on every backend. The rim's field `max(wall, cap)` has a
@@ -71,7 +76,11 @@ fn the_backends_draw_the_vase_alike() {
     let (_, cpu) = &images[0];
     for (backend, image) in &images[1..] {
         let d = sdfc_runtime::metrics::compare(cpu, image, 0.1).expect("images of one size");
-        println!("{backend}: {:.1} dB from the CPU, {:.4} % of pixels off", d.psnr, 100.0 * d.differing);
+        println!(
+            "{backend}: {:.1} dB from the CPU, {:.4} % of pixels off",
+            d.psnr,
+            100.0 * d.differing
+        );
         assert!(d.psnr > 50.0, "{backend}: {:.1} dB from the CPU", d.psnr);
     }
 }
@@ -96,7 +105,11 @@ fn the_dark_pixels_at_the_vases_rim_ends_are_its_wall_in_its_own_shade() {
         let column: Vec<f64> = (78..88).map(|y| at(219, y)).collect();
         println!("{precision:?}: x = 219, y = 78 to 87: {column:.2?}");
         for y in [80, 81, 85, 86] {
-            assert!((at(219, y) - ambient).abs() < 0.01, "({y}): {:.3}", at(219, y));
+            assert!(
+                (at(219, y) - ambient).abs() < 0.01,
+                "({y}): {:.3}",
+                at(219, y)
+            );
         }
         for y in 82..85 {
             assert!(at(219, y) > 0.6, "the rim at (219, {y}): {:.3}", at(219, y));

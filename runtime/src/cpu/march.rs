@@ -258,7 +258,8 @@ impl<T: Float> Shadow<'_, T> {
     fn advance_opaque(&mut self, l: &mut Lanes<T>) {
         let n = l.len;
         let c = self.ctx;
-        let zero = T::zero();
+        let (zero, one, half) = (T::zero(), T::one(), T::from_f64(0.5));
+        let bracket = T::from_f64(Light::PENUMBRA_BRACKET);
         let (inv_l, eps, max_steps) = (c.inv_lipschitz, c.epsilon, c.max_steps);
         let (dist, t0, kk, tmax) = (&l.dist[..n], &l.t0[..n], &l.k[..n], &l.tmax[..n]);
         let (px, py, pz) = (&l.px[..n], &l.py[..n], &l.pz[..n]);
@@ -279,14 +280,27 @@ impl<T: Float> Shadow<'_, T> {
             let q = penumbra(kk[k], s, t[k]);
             res[k] = res[k].min(q);
             let blocked = s.abs() < tol;
-            // A search goes on, or may start where the term fell and rose again: the scan
-            // below moves such a lane ([`Shadow::search`]); the others step on here and
+            // A search goes on, or starts: the scan below moves such a lane
+            // ([`Shadow::search`], whose test this repeats); the others step on here and
             // shift their sample into their last two.
-            let search = (probes[k] > 0) | ((qm[k] < qa[k]) & (q > qm[k]));
+            let low = (sa[k] + sm[k] - (tm[k] - ta[k])).min(sm[k] + s - (t[k] - tm[k])) * half;
+            let start = (qm[k] < qa[k])
+                & (q > qm[k])
+                & (kk[k] * low < res[k].min(one) * t[k])
+                & (kk[k] * (t[k] - ta[k]) > bracket * tm[k]);
+            let search = (probes[k] > 0) | start;
             let next = (t[k] + s).max(zero);
             let on = !search;
-            (ta[k], sa[k], qa[k]) = if on { (tm[k], sm[k], qm[k]) } else { (ta[k], sa[k], qa[k]) };
-            (tm[k], sm[k], qm[k]) = if on { (t[k], s, q) } else { (tm[k], sm[k], qm[k]) };
+            (ta[k], sa[k], qa[k]) = if on {
+                (tm[k], sm[k], qm[k])
+            } else {
+                (ta[k], sa[k], qa[k])
+            };
+            (tm[k], sm[k], qm[k]) = if on {
+                (t[k], s, q)
+            } else {
+                (tm[k], sm[k], qm[k])
+            };
             t[k] = if on { next } else { t[k] };
             let count = steps[k] + 1;
             steps[k] = count;

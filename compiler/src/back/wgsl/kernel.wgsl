@@ -324,8 +324,8 @@ const PENUMBRA_PROBES: u32 = {{PENUMBRA_PROBES}};
 fn probe(a: f32, m: f32, b: f32) -> f32 {
     return select((m + b) * 0.5, (a + m) * 0.5, m - a > b - m);
 }
-//#endif
 
+//#endif
 // A shadow ray towards a light at distance tmax: the fraction of light that arrives.
 // Soft (k > 0): res = min(res, k·d/t), the least found by a search wherever the steps
 // bracket one. A transparent occluder passes its transparency and the ray goes on through

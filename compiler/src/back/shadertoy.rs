@@ -33,16 +33,45 @@ float sdfc_march(vec3 o, vec3 d) {
     return -1.0;
 }
 
-// The fraction of a light reaching o along d up to tmax; k > 0: soft (docs/rendering.md, "Shadows").
+// The fraction of a light reaching o along d up to tmax; k > 0: soft, the least k·d/t
+// searched for between the steps that bracket one (docs/rendering.md, "Shadows").
 float sdfc_shadow(vec3 o, vec3 d, float tt, float tmax, float k) {
     float res = 1.0;
     float t = 0.0;
+    float ta = 0.0, sa = 0.0, qa = 3.4e38, tm = 0.0, sm = 0.0, qm = 3.4e38;
+    float ra = 0.0, rm = 0.0, rb = 0.0, rq = 0.0;
+    int probes = 0;
     for (int i = 0; i < SDFC_MAX_STEPS; i++) {
-        if (t >= tmax) break;
+        if (probes == 0 && t >= tmax) break;
         float s = sdfc_map_distance(o + d * t) * SDFC_INV_L;
         if (abs(s) < SDFC_EPS * (tt + t)) return 0.0;
-        if (k > 0.0 && t > 0.0) res = min(res, k * s / t);
-        t += s;
+        float q = (k > 0.0 && t > 0.0) ? k * s / t : 3.4e38;
+        res = min(res, q);
+        float next = t + s;
+        if (probes > 0) {
+            if (q < rq) {
+                if (t < rm) rb = rm; else ra = rm;
+                rm = t;
+                rq = q;
+            } else if (t < rm) ra = t; else rb = t;
+            if (k * (rb - ra) <= SDFC_PENUMBRA_BRACKET * rm || probes >= SDFC_PENUMBRA_PROBES) {
+                probes = 0;
+                next = tm + sm;
+            } else {
+                probes++;
+                next = rm - ra > rb - rm ? (ra + rm) * 0.5 : (rm + rb) * 0.5;
+            }
+        } else {
+            float low = min(sa + sm - (tm - ta), sm + s - (t - tm)) * 0.5;
+            if (qm < qa && q > qm && k * low < min(res, 1.0) * t && k * (t - ta) > SDFC_PENUMBRA_BRACKET * tm) {
+                ra = ta; rm = tm; rb = t; rq = qm;
+                probes = 1;
+                next = rm - ra > rb - rm ? (ra + rm) * 0.5 : (rm + rb) * 0.5;
+            }
+            ta = tm; sa = sm; qa = qm;
+            tm = t; sm = s; qm = q;
+        }
+        t = next;
     }
     return clamp(res, 0.0, 1.0);
 }
@@ -124,6 +153,16 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
     let _ = writeln!(out, "const int SDFC_MAX_STEPS = {};", s.max_steps.max(1));
     let _ = writeln!(out, "const float SDFC_L = {};", float(l));
     let _ = writeln!(out, "const float SDFC_INV_L = {};", float(1.0 / l));
+    let _ = writeln!(
+        out,
+        "const float SDFC_PENUMBRA_BRACKET = {};",
+        float(Light::PENUMBRA_BRACKET)
+    );
+    let _ = writeln!(
+        out,
+        "const int SDFC_PENUMBRA_PROBES = {};",
+        Light::PENUMBRA_PROBES
+    );
     let _ = writeln!(out, "const vec3 SDFC_BACKGROUND = {};\n", v3(s.background));
     out.push_str(&functions);
     let mut lights = String::new();

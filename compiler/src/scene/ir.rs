@@ -707,6 +707,12 @@ impl Light {
     pub fn sharpness(&self) -> f64 {
         sharpness(self.penumbra())
     }
+
+    /// A soft shadow ray's search around a least `k·d/t` (docs/rendering.md, "Shadows") ends
+    /// once its bracket is narrower than this fraction of the penumbra cone's width there.
+    pub const PENUMBRA_BRACKET: f64 = 0.02;
+    /// The most evaluations one such search takes.
+    pub const PENUMBRA_PROBES: u32 = 16;
 }
 
 /// The soft-shadow sharpness k = 1/tan θ of a penumbra angle θ (0 for θ = 0).

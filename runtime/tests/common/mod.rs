@@ -58,3 +58,32 @@ pub fn render_everywhere(
 fn env_is(name: &str) -> bool {
     std::env::var(name).as_deref() == Ok("1")
 }
+
+/// The sRGB-encoded grey levels (0 to 1, the mean of the channels) of an image, as a PNG
+/// viewer shows them, row by row.
+pub fn grey(image: &sdfc_runtime::image::Image) -> Vec<f64> {
+    image
+        .to_rgba8()
+        .chunks(4)
+        .map(|c| (c[0] as f64 + c[1] as f64 + c[2] as f64) / (3.0 * 255.0))
+        .collect()
+}
+
+/// The mean departure of each pixel of the box [x0, x1) × [y0, y1) from the mean of its 3×3
+/// neighbourhood: small on smooth shading, large on speckles, streaks and ripples.
+pub fn roughness(grey: &[f64], width: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> f64 {
+    let at = |x: u32, y: u32| grey[(y * width + x) as usize];
+    let mut sum = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let mut around = 0.0;
+            for dy in 0..3 {
+                for dx in 0..3 {
+                    around += at(x + dx - 1, y + dy - 1);
+                }
+            }
+            sum += (at(x, y) - around / 9.0).abs();
+        }
+    }
+    sum / f64::from((x1 - x0) * (y1 - y0))
+}

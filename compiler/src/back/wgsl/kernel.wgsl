@@ -312,9 +312,24 @@ fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> 
 }
 
 //#if !ANALYTIC
+//#if SOFT
+// A penumbra term where there is none (transparent, inside a solid, t = 0).
+const NO_PENUMBRA: f32 = 3.4e38;
+// The search around a least k·d/t ends when its bracket is narrower than this fraction of
+// the penumbra cone's width, or after this many probes (docs/rendering.md, "Shadows").
+const PENUMBRA_BRACKET: f32 = {{PENUMBRA_BRACKET}};
+const PENUMBRA_PROBES: u32 = {{PENUMBRA_PROBES}};
+
+// The next probe of the bracket (a, m, b): the middle of its longer half.
+fn probe(a: f32, m: f32, b: f32) -> f32 {
+    return select((m + b) * 0.5, (a + m) * 0.5, m - a > b - m);
+}
+
+//#endif
 // A shadow ray towards a light at distance tmax: the fraction of light that arrives.
-// Soft (k > 0): res = min(res, k·d/t). A transparent occluder passes its transparency and
-// the ray goes on through it; an opaque one blocks the light.
+// Soft (k > 0): res = min(res, k·d/t), the least found by a search wherever the steps
+// bracket one. A transparent occluder passes its transparency and the ray goes on through
+// it; an opaque one blocks the light.
 fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
     counters.shadow += 1u;
     let eps = params.march.x;
@@ -324,6 +339,21 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
     var res = 1.0;
     var through = 1.0;
     var sign = 1.0;
+//#if SOFT
+    // The last two samples of the march (t, d/L, penumbra term): a, then m.
+    var ta = 0.0;
+    var sa = 0.0;
+    var qa = NO_PENUMBRA;
+    var tm = 0.0;
+    var sm = 0.0;
+    var qm = NO_PENUMBRA;
+    // A search's bracket ra < rm < rb, rq the term at rm, and its probes (0: marching).
+    var ra = 0.0;
+    var rm = 0.0;
+    var rb = 0.0;
+    var rq = 0.0;
+    var probes = 0u;
+//#endif
 //#if MEDIA
     if medium_tau > 0.0 {
         through = medium_tau;
@@ -354,22 +384,87 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
         }
         let outside = sign > 0.0;
 //#if SOFT
+        var q = NO_PENUMBRA;
         if outside && k > 0.0 && t > 0.0 && tau <= 0.0 {
-            res = min(res, k * signed / t);
+            q = k * signed / t;
+            res = min(res, q);
         }
 //#endif
         var next = t + signed;
-        if abs(signed) < tol {
-            if tau <= 0.0 {
-                return 0.0;
+        let reached = abs(signed) < tol;
+        if reached && tau <= 0.0 {
+            return 0.0;
+        }
+//#if SOFT
+        if probes > 0u {
+            // A probe: the bracket closes in on the least term; a transparent surface within
+            // it is not crossed (the march crosses it when it gets there).
+            if q < rq {
+                if t < rm {
+                    rb = rm;
+                } else {
+                    ra = rm;
+                }
+                rm = t;
+                rq = q;
+            } else if t < rm {
+                ra = t;
+            } else {
+                rb = t;
             }
+            if k * (rb - ra) <= PENUMBRA_BRACKET * rm || probes >= PENUMBRA_PROBES {
+                probes = 0u;
+                next = tm + sm;
+            } else {
+                probes += 1u;
+                next = probe(ra, rm, rb);
+            }
+        } else if reached {
+//#else
+        if reached {
+//#endif
             if outside {
                 through = through * tau;
             }
             sign = -sign;
             next = t + 4.0 * normal_step(tt, p);
+//#if SOFT
+            ta = tm;
+            sa = sm;
+            qa = qm;
+            tm = t;
+            sm = signed;
+            qm = NO_PENUMBRA;
+        } else {
+            // The term fell at m and rose again: search (a, b) where its Lipschitz bound
+            // allows a term below res and 1 there, unless the bracket is narrow already.
+            let low = min(sa + sm - (tm - ta), sm + signed - (t - tm)) * 0.5;
+            if qm < qa && q > qm && k * low < min(res, 1.0) * t
+                && k * (t - ta) > PENUMBRA_BRACKET * tm {
+                ra = ta;
+                rm = tm;
+                rb = t;
+                rq = qm;
+                probes = 1u;
+                next = probe(ra, rm, rb);
+            }
+            ta = tm;
+            sa = sm;
+            qa = qm;
+            tm = t;
+            sm = signed;
+            qm = q;
+//#endif
         }
         t = max(next, 0.0);
+//#if SOFT
+        if probes > 0u {
+            if steps >= params.counts.w {
+                break;
+            }
+            continue;
+        }
+//#endif
         if t >= tmax || steps >= params.counts.w {
             break;
         }

@@ -534,6 +534,8 @@ fn write_template(
     values.insert("DIRS", count(scene, false).to_string());
     values.insert("MATERIALS", scene.materials.len().max(1).to_string());
     values.insert("STACK", (scene.settings.max_depth + 2).to_string());
+    values.insert("PENUMBRA_BRACKET", float(Light::PENUMBRA_BRACKET));
+    values.insert("PENUMBRA_PROBES", format!("{}u", Light::PENUMBRA_PROBES));
     values.insert("WORKGROUP", WORKGROUP.to_string());
     values.insert("ENTRY", ENTRY_POINT.to_string());
     let source = template::expand(template, &on, &values).map_err(|e| Error {

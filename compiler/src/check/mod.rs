@@ -11,6 +11,7 @@ mod eval;
 pub mod field;
 pub mod font;
 pub mod meshfile;
+mod polygon;
 mod ops;
 mod suggest;
 pub mod types;

@@ -303,11 +303,18 @@ impl Ctx<'_> {
     /// A list of `vals`, each converted to `elem`; `Unknown` when any is not computed.
     fn make_list(&mut self, elem: Type, vals: Vec<Value>, at: Span) -> Value {
         let Some(ty) = Type::list(elem) else {
-            self.error(
+            let d = if elem == Type::ColourField {
+                // A `field` of a vec3 is a colour, where a list of shapes was likely meant.
+                Diagnostic::error("E0300", "a colour field cannot be a list's element", at)
+                    .with_label("this `field` is of a vec3: a `color_field`, a material's `color`")
+                    .with_note("a list holds ints, floats, bools, vectors, angles, strings, shapes or profiles")
+                    .with_help("a `field` is a shape when its body is a float, the distance: `field { length(p) - 1 }`; a colour field goes in a material's `color`")
+            } else {
                 Diagnostic::error("E0300", "a list's elements cannot be lists", at)
                     .with_label(format!("this is `{elem}`"))
-                    .with_note("lists do not nest"),
-            );
+                    .with_note("lists do not nest")
+            };
+            self.error(d);
             return Value::Error;
         };
         if vals.contains(&Value::Error) {

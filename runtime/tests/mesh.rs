@@ -753,7 +753,13 @@ fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
         "{err}"
     );
     assert!(!out.exists());
-    let o = sdfc(&["mesh", s(&scene), "-o", s(&out), "--bounds=0.4,0.4,0.4,0.5,0.5,0.5"]);
+    let o = sdfc(&[
+        "mesh",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--bounds=0.4,0.4,0.4,0.5,0.5,0.5",
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(

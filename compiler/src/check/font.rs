@@ -122,7 +122,11 @@ fn glyph(segments: Vec<Segment>) -> Glyph {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     for s in &segments {
-        let points = if s.line { &[s.a, s.c][..] } else { &[s.a, s.b, s.c] };
+        let points = if s.line {
+            &[s.a, s.c][..]
+        } else {
+            &[s.a, s.b, s.c]
+        };
         for &p in points {
             for i in 0..2 {
                 lo[i] = lo[i].min(p[i]);

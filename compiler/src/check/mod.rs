@@ -11,8 +11,8 @@ mod eval;
 pub mod field;
 pub mod font;
 pub mod meshfile;
-mod polygon;
 mod ops;
+mod polygon;
 mod suggest;
 pub mod types;
 

@@ -275,7 +275,10 @@ mod tests {
         let mut crossed = circle.clone();
         crossed.swap(n - 10, n - 20);
         let mut steps = 0;
-        assert!(matches!(crossing(&crossed, u64::MAX, &mut steps), Ok(Some(_))));
+        assert!(matches!(
+            crossing(&crossed, u64::MAX, &mut steps),
+            Ok(Some(_))
+        ));
         // A budget too small is out of steps, not a long wait.
         let mut steps = 0;
         assert_eq!(crossing(&circle, 1000, &mut steps), Err(OutOfSteps));

@@ -155,10 +155,19 @@ fn a_list_of_a_colour_field_says_what_it_holds() {
     let (_, diags, _) = check_str("t.sdf", "scene { union([field { vec3(1, 0, 0) }]); }");
     assert_eq!(diags.len(), 1, "{diags:#?}");
     assert_eq!(diags[0].code, "E0300");
-    assert_eq!(diags[0].message, "a colour field cannot be a list's element");
+    assert_eq!(
+        diags[0].message,
+        "a colour field cannot be a list's element"
+    );
     assert_eq!(diags[0].span().start, 15);
-    assert!(diags[0].help.as_deref().is_some_and(|h| h.contains("field { length(p) - 1 }")));
+    assert!(diags[0]
+        .help
+        .as_deref()
+        .is_some_and(|h| h.contains("field { length(p) - 1 }")));
     // A list of lists keeps its message.
     let (_, diags, _) = check_str("t.sdf", "let xs = [[1], [2]];\nscene { sphere(1); }");
-    assert_eq!(diags[0].message, "a list's elements cannot be lists", "{diags:#?}");
+    assert_eq!(
+        diags[0].message, "a list's elements cannot be lists",
+        "{diags:#?}"
+    );
 }

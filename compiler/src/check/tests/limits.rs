@@ -101,7 +101,10 @@ fn a_literal_list_past_the_objects_limit_is_refused_before_parsing() {
 }
 
 /// Checks `src` within the default limits but for `changes`.
-fn check_within(src: &str, changes: &[(crate::limits::Limit, u64)]) -> Vec<crate::diagnostics::Diagnostic> {
+fn check_within(
+    src: &str,
+    changes: &[(crate::limits::Limit, u64)],
+) -> Vec<crate::diagnostics::Diagnostic> {
     let mut limits = crate::limits::Limits::default();
     for &(limit, value) in changes {
         limits.set(limit, value).expect("a valid limit");
@@ -173,13 +176,19 @@ fn a_polygon_is_tested_for_crossings_within_the_fuel() {
     let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
     assert_eq!(errors.len(), 1, "{diags:#?}");
     assert_eq!(errors[0].code, "E0507");
-    assert!(errors[0].message.contains("more than 50000000 steps"), "{errors:#?}");
+    assert!(
+        errors[0].message.contains("more than 50000000 steps"),
+        "{errors:#?}"
+    );
     assert_eq!(errors[0].span().start, 16, "at the call");
     // A crossing far along is still found, and named.
     let mut src = circle(20_000);
     let (p, q) = ("(0.999955587, 0.009424638)", "(0.999955587, -0.009424638)");
     assert!(src.contains(p) && src.contains(q));
-    src = src.replacen(p, "X", 1).replacen(q, p, 1).replacen("X", q, 1);
+    src = src
+        .replacen(p, "X", 1)
+        .replacen(q, p, 1)
+        .replacen("X", q, 1);
     let (_, diags, _) = check_str("t.sdf", &src);
     assert!(
         diags[0].message.starts_with("the polygon crosses itself"),

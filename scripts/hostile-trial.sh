@@ -178,7 +178,7 @@ fmt("not_utf8.sdf", b"let x = \xff;\n", stdin=True)
 fmt("nul_bytes.sdf", b"let x\0 = 1;\n", stdin=True)
 fmt("big_comment.sdf", "/*" + "x" * 20000000 + "*/\nlet x = 1;\n", stdin=True)
 fmt("many_items.sdf", "".join("let a%d=sphere(1).translate(%d,0,0);\n" % (i, i) for i in range(100000)), stdin=True)
-os.mkdir("fmtdir"); os.symlink("..", "fmtdir/up"); os.mkfifo("fmtdir/pipe.sdf")
+os.mkdir("fmtdir"); os.symlink("..", "fmtdir/up"); os.symlink("..", "fmtdir/up2"); os.mkfifo("fmtdir/pipe.sdf")
 put("fmtdir/a.sdf", "let x=1;\n")
 cases.append(("fmt", "directory_with_loop_and_fifo", ["fmt", "--check", "fmtdir"], None, False))
 

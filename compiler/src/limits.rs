@@ -61,6 +61,8 @@ pub enum Limit {
     FileSize,
     /// Worker threads `--threads` may start.
     Threads,
+    /// Characters of the text one scene lays out (`text`), in all.
+    TextChars,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -75,7 +77,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 23] = [
+    pub const ALL: [Limit; 24] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -99,6 +101,7 @@ impl Limit {
         Limit::Triangles,
         Limit::FileSize,
         Limit::Threads,
+        Limit::TextChars,
     ];
 
     fn spec(self) -> Spec {
@@ -259,6 +262,16 @@ impl Limit {
                 32_768,
                 "worker threads --threads may start",
             ),
+            // A glyph of DejaVu Sans holds some 30 lines and curves, about 2 KB as they are
+            // laid out and lowered, and every point walks the glyphs near it: 10 000
+            // characters (a few pages, far beyond any plaque or label) check in a tenth of a
+            // second within some 40 MB. `text` of a million characters took 1.9 GB.
+            Limit::TextChars => s(
+                "text_chars",
+                10_000,
+                1 << 32,
+                "characters of the text one scene lays out (text), in all",
+            ),
         }
     }
 
@@ -329,7 +342,7 @@ impl Spelling {
 /// one ([`Spelling`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 23],
+    values: [u64; 24],
     spelling: Spelling,
 }
 

@@ -1422,6 +1422,24 @@ fn fmt_rewrites_checks_and_filters() {
         sdfc(&d, &["fmt", "--check", "a.sdf", "more"]).status.code(),
         Some(0)
     );
+    // Links to a folder above are entered once: each file is named once (it was listed 40
+    // times over `more/up/more/up/…`, and two such links never ended).
+    #[cfg(unix)]
+    {
+        std::fs::write(sub.join("c.sdf"), messy).expect("write");
+        std::os::unix::fs::symlink("..", sub.join("up")).expect("link");
+        std::os::unix::fs::symlink("..", sub.join("up2")).expect("link");
+        let out = sdfc(&d, &["fmt", "--check", "more"]);
+        let (named, err) = (
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr),
+        );
+        assert_eq!(named, "more/c.sdf\n", "{err}");
+        assert_eq!(err.matches("broken.sdf: not formatted").count(), 1, "{err}");
+        std::fs::remove_file(sub.join("up")).expect("unlink");
+        std::fs::remove_file(sub.join("up2")).expect("unlink");
+        std::fs::write(sub.join("c.sdf"), tidy).expect("write");
+    }
 
     let out = sdfc(&d, &["fmt", "broken.sdf"]);
     assert_eq!(out.status.code(), Some(1));

@@ -991,7 +991,7 @@ fn serve_bytes_serves_a_stream_in_one_thread() {
     let symbols = text.find("\"id\":2").expect("the symbols");
     assert!(diagnostics < batch && batch < symbols, "{text}");
     assert!(
-        text.contains("\"id\":3,\"jsonrpc\":\"2.0\",\"result\":null"),
+        text.contains("{\"jsonrpc\":\"2.0\",\"id\":3,\"result\":null}"),
         "{text}"
     );
 }

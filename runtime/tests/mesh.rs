@@ -743,7 +743,23 @@ fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
     let o = sdfc(&["mesh", s(&d.join("nope.sdf")), "-o", s(&out)]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read"));
+    // Bounds away from the shape's box say where it is; bounds in its box's corner, that they
+    // hold none of the surface.
     let o = sdfc(&["mesh", s(&scene), "-o", s(&out), "--bounds=2,2,2,3,3,3"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--bounds does not reach the scene's solid, which lies within `--bounds=-0.5,-0.5,-0.5,0.5,0.5,0.5`"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let o = sdfc(&[
+        "mesh",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--bounds=0.4,0.4,0.4,0.5,0.5,0.5",
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
@@ -751,6 +767,23 @@ fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
         "{err}"
     );
     assert!(!out.exists());
+    // A solid known to be empty says so, with no advice on cells or bounds (it was told to
+    // raise the resolution, or that it was unbounded).
+    for empty in [
+        "intersect(sphere(1), sphere(1).translate(5, 0, 0))",
+        "extrude(intersect(circle(1), circle(1).translate(5, 0)), 1)",
+    ] {
+        let e = write_scene(&d, "e.sdf", &format!("scene {{ {empty}; }}\n"));
+        let o = sdfc(&["mesh", s(&e), "-o", s(&out)]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{empty}: {err}");
+        assert!(
+            err.contains("the scene's solid is empty")
+                && !err.contains("resolution")
+                && !err.contains("unbounded"),
+            "{empty}: {err}"
+        );
+    }
     // A sphere of radius 0.001 at --resolution 100: cells of 2e-5, cheap to mesh.
     let tiny = write_scene(&d, "tiny.sdf", "scene { sphere(0.001); }\n");
     let o = sdfc(&["mesh", s(&tiny), "-o", s(&out), "--resolution", "100"]);

@@ -58,7 +58,7 @@ impl Range {
                 Value::Str(s) => opts.contains(&&**s),
                 _ => true,
             },
-            Range::Limited(..) => true,
+            Range::Limited(..) | Range::Chars(_) => true,
         };
         if ok {
             return Ok(());
@@ -71,7 +71,7 @@ impl Range {
             _ => crate::scene::dump_num(x),
         };
         Err(match range {
-            Range::Any | Range::Limited(..) => String::new(),
+            Range::Any | Range::Limited(..) | Range::Chars(_) => String::new(),
             Range::Pos => format!("{each}must be greater than 0"),
             Range::NonNeg => format!("{each}must be 0 or more"),
             Range::Unit => format!("{each}must be between 0 and 1"),
@@ -186,6 +186,10 @@ pub struct Build<'a, 'l> {
     pub files: Option<&'a mut super::Files<'l>>,
     pub limits: &'a Limits,
     pub warnings: Vec<crate::diagnostics::Diagnostic>,
+    /// Evaluation steps the `fuel` limit leaves, and those the call has taken (spent by the
+    /// evaluator after it: more than were left reports the limit at the call).
+    pub fuel_left: u64,
+    pub steps: u64,
 }
 
 impl Build<'_, '_> {
@@ -440,66 +444,17 @@ fn polygon_of(b: &mut Build, points: Vec<[f64; 2]>) -> Result<Value, String> {
     if on_line {
         return Err("the polygon's points lie on one line: it has no area".to_string());
     }
-    if let Some((i, j)) = crossing(&points) {
+    let crossing = super::polygon::crossing(&points, b.fuel_left, &mut b.steps);
+    let Ok(crossing) = crossing else {
+        // Out of steps: the evaluator reports the `fuel` limit at the call.
+        return Ok(Value::Error);
+    };
+    if let Some((i, j)) = crossing {
         return Err(format!(
             "the polygon crosses itself: its edge from point {i} and its edge from point {j} meet (a polygon's edges may only meet at their shared ends)"
         ));
     }
     b.profile(Node::Polygon { points })
-}
-
-/// The first two edges of the closed polygon through `v` that meet other than at a shared
-/// end, by the index of their first points.
-fn crossing(v: &[[f64; 2]]) -> Option<(usize, usize)> {
-    let n = v.len();
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    // Whether q, on the line through a and b, lies within their box.
-    let within = |a: [f64; 2], b: [f64; 2], q: [f64; 2]| {
-        q[0] >= a[0].min(b[0])
-            && q[0] <= a[0].max(b[0])
-            && q[1] >= a[1].min(b[1])
-            && q[1] <= a[1].max(b[1])
-    };
-    let meet = |a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]| {
-        let (d1, d2) = (cross(c, d, a), cross(c, d, b));
-        let (d3, d4) = (cross(a, b, c), cross(a, b, d));
-        if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-            && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-        {
-            return true;
-        }
-        (d1 == 0.0 && within(c, d, a))
-            || (d2 == 0.0 && within(c, d, b))
-            || (d3 == 0.0 && within(a, b, c))
-            || (d4 == 0.0 && within(a, b, d))
-    };
-    for i in 0..n {
-        let (a, b) = (v[i], v[(i + 1) % n]);
-        if a == b {
-            return Some((i, (i + 1) % n));
-        }
-        for j in i + 1..n {
-            let (c, d) = (v[j], v[(j + 1) % n]);
-            let next = j == i + 1;
-            let wrap = i == 0 && j == n - 1;
-            if next || wrap {
-                // Neighbours share an end: they may only fold back onto each other.
-                let (o, p, q) = if next { (b, a, d) } else { (a, b, c) };
-                if cross(o, p, q) == 0.0
-                    && (p[0] - o[0]) * (q[0] - o[0]) + (p[1] - o[1]) * (q[1] - o[1]) > 0.0
-                {
-                    return Some((i, j));
-                }
-                continue;
-            }
-            if meet(a, b, c, d) {
-                return Some((i, j));
-            }
-        }
-    }
-    None
 }
 
 /// The rectangle of a profile argument and its bound's scale (`scene::bounds::profile_rect`),
@@ -988,13 +943,13 @@ static FUNCTIONS: &[Builtin] = &[
     Builtin {
         name: "text",
         sigs: sigs![
-            [p("string", Str, Req, Any), p("size", F, Num(1.0), Pos), p("font", Str, Text(""), Any)] -> PR => text;
+            [p("string", Str, Req, Chars(Limit::TextChars)), p("size", F, Num(1.0), Pos), p("font", Str, Text(""), Any)] -> PR => text;
         ],
     },
     Builtin {
         name: "text_size",
         sigs: sigs![
-            [p("string", Str, Req, Any), p("size", F, Num(1.0), Pos), p("font", Str, Text(""), Any)] -> V2 => text_size;
+            [p("string", Str, Req, Chars(Limit::TextChars)), p("size", F, Num(1.0), Pos), p("font", Str, Text(""), Any)] -> V2 => text_size;
         ],
     },
     Builtin {

@@ -62,6 +62,9 @@ pub struct Ctx<'l> {
     chain: usize,
     /// Evaluation steps taken (bounded by the `fuel` limit).
     pub fuel: u64,
+    /// Characters of the strings passed to a parameter of range `Chars` so far (`text`'s:
+    /// the `text_chars` limit bounds their sum).
+    pub chars: u64,
     /// The resource limits of this compilation: evaluation stays within them on any input.
     pub limits: Limits,
     reported_limit: bool,
@@ -300,11 +303,18 @@ impl Ctx<'_> {
     /// A list of `vals`, each converted to `elem`; `Unknown` when any is not computed.
     fn make_list(&mut self, elem: Type, vals: Vec<Value>, at: Span) -> Value {
         let Some(ty) = Type::list(elem) else {
-            self.error(
+            let d = if elem == Type::ColourField {
+                // A `field` of a vec3 is a colour, where a list of shapes was likely meant.
+                Diagnostic::error("E0300", "a colour field cannot be a list's element", at)
+                    .with_label("this `field` is of a vec3: a `color_field`, a material's `color`")
+                    .with_note("a list holds ints, floats, bools, vectors, angles, strings, shapes or profiles")
+                    .with_help("a `field` is a shape when its body is a float, the distance: `field { length(p) - 1 }`; a colour field goes in a material's `color`")
+            } else {
                 Diagnostic::error("E0300", "a list's elements cannot be lists", at)
                     .with_label(format!("this is `{elem}`"))
-                    .with_note("lists do not nest"),
-            );
+                    .with_note("lists do not nest")
+            };
+            self.error(d);
             return Value::Error;
         };
         if vals.contains(&Value::Error) {
@@ -1464,10 +1474,16 @@ impl Ctx<'_> {
             files: Some(&mut self.files),
             limits: &self.limits,
             warnings: Vec::new(),
+            fuel_left: self.limits.get(Limit::Fuel).saturating_sub(self.fuel),
+            steps: 0,
         };
         let result = sig.imp.call(&mut build, &vals);
         let warnings = std::mem::take(&mut build.warnings);
+        let steps = build.steps;
         self.diags.extend(warnings);
+        if !self.burn_steps(steps, span) {
+            return Value::Error;
+        }
         match result {
             Ok(v) => self.finite(v, span),
             Err(msg) => {
@@ -1484,6 +1500,9 @@ impl Ctx<'_> {
         if v.is_abstract() || field::is_point(v) || p.range == Range::Any || self.dry > 0 {
             return true;
         }
+        if let (Range::Chars(limit), Value::Str(s)) = (p.range, v) {
+            return self.count_chars(limit, s, span);
+        }
         match p.range.check(v, &self.limits) {
             Ok(()) => true,
             Err(why) => {
@@ -1498,6 +1517,33 @@ impl Ctx<'_> {
                 false
             }
         }
+    }
+
+    /// Counts the characters of `s`, passed at `span`, against `limit` with those of the
+    /// strings counted before; false (and a report naming the sum) past it. Counted before
+    /// the call lays anything out, so a string of any length costs only its count.
+    fn count_chars(&mut self, limit: Limit, s: &str, span: Span) -> bool {
+        let here = s.chars().count() as u64;
+        let (before, max) = (self.chars, self.limits.get(limit));
+        self.chars = before.saturating_add(here);
+        if self.chars <= max {
+            return true;
+        }
+        let others = if before > 0 {
+            format!(", and the scene's other text {before}")
+        } else {
+            String::new()
+        };
+        self.limit_to(
+            limit,
+            span,
+            format!(
+                "this text has {here} characters{others}, more than the `{}` limit of {max}",
+                limit.name()
+            ),
+            self.chars,
+        );
+        false
     }
 
     fn call_user(

@@ -94,17 +94,16 @@ pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, String> {
         .filter(|&c| c > 0.0)
         .unwrap_or(f64::from(face.ascender()));
     let rise = (cap + baseline) / 2.0;
-    // Place each line, in font units, then scale.
-    let mut placed = Vec::with_capacity(glyphs.len());
+    // Place each line, in font units, then scale, moving the glyphs' segments in place (a
+    // copy doubled what a long text holds).
     for (k, &(start, width)) in lines.iter().enumerate() {
         let end = lines.get(k + 1).map_or(glyphs.len(), |l| l.0);
-        for g in &glyphs[start..end] {
+        for g in &mut glyphs[start..end] {
             // Mirrored in x: the text reads from left to right seen looking along +z, as the
             // default camera looks (+x is on the picture's left).
             let shift = |p: [f64; 2]| [(width / 2.0 - p[0]) * scale, (p[1] - rise) * scale];
-            let segments = g
-                .segments
-                .iter()
+            let segments = std::mem::take(&mut g.segments)
+                .into_iter()
                 .map(|s| Segment {
                     a: shift(s.a),
                     b: shift(s.b),
@@ -112,10 +111,10 @@ pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, String> {
                     line: s.line,
                 })
                 .collect();
-            placed.push(glyph(segments));
+            *g = glyph(segments);
         }
     }
-    Ok(Outline { glyphs: placed })
+    Ok(Outline { glyphs })
 }
 
 /// A glyph of `segments`, with the box of their points.
@@ -124,11 +123,11 @@ fn glyph(segments: Vec<Segment>) -> Glyph {
     let mut hi = [f64::NEG_INFINITY; 2];
     for s in &segments {
         let points = if s.line {
-            vec![s.a, s.c]
+            &[s.a, s.c][..]
         } else {
-            vec![s.a, s.b, s.c]
+            &[s.a, s.b, s.c]
         };
-        for p in points {
+        for &p in points {
             for i in 0..2 {
                 lo[i] = lo[i].min(p[i]);
                 hi[i] = hi[i].max(p[i]);

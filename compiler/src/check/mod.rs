@@ -12,6 +12,7 @@ pub mod field;
 pub mod font;
 pub mod meshfile;
 mod ops;
+mod polygon;
 mod suggest;
 pub mod types;
 

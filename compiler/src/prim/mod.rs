@@ -58,6 +58,10 @@ pub enum Range {
     OneOf(&'static [&'static str]),
     /// In [lo, the value of a resource limit] (the render settings bounded by `--limit`).
     Limited(f64, Limit),
+    /// A string whose characters, with those of every string passed so far to a parameter of
+    /// this range, are at most the value of a resource limit (`text`'s string, bounded in
+    /// all by `text_chars`; checked by the evaluator, which keeps the count).
+    Chars(Limit),
 }
 
 /// What a primitive's parameter holds.

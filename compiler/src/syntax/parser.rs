@@ -14,13 +14,15 @@ type Extra<'t> = extra::Err<Rich<'t, Token, SimpleSpan>>;
 /// Parses a token stream into a file. Always returns a tree (possibly with error nodes) and
 /// the syntax errors found.
 pub fn parse(file: FileId, tokens: &[(Token, Span)], eof: usize) -> (File, Vec<Diagnostic>) {
-    let simple: Vec<(Token, SimpleSpan)> = tokens
+    // The tokens borrowed, not cloned: a copy of a 5 MB file's tokens, their names with them,
+    // was 90 MB of `sdfc fmt`'s peak.
+    let simple: Vec<(&Token, SimpleSpan)> = tokens
         .iter()
-        .map(|(t, s)| (t.clone(), SimpleSpan::from(s.range())))
+        .map(|(t, s)| (t, SimpleSpan::from(s.range())))
         .collect();
     let input = simple
         .as_slice()
-        .map(SimpleSpan::from(eof..eof), |(t, s)| (t, s));
+        .map(SimpleSpan::from(eof..eof), |(t, s)| (*t, s));
     let (out, errors) = file_parser(file).parse(input).into_output_errors();
     // The materials this file declares, for "did you mean `@ red`?".
     let materials: Vec<&str> = tokens

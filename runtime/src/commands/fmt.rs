@@ -54,7 +54,17 @@ fn format_text(name: &str, text: &str) -> Outcome {
 }
 
 /// The `.sdf` files under `dir`, sorted, at any depth (hidden folders and `target` skipped).
-fn sdf_files(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+/// A folder is entered once, however many symbolic links lead to it (`seen`, its canonical
+/// paths): a link to a folder above it was followed until the system refused the path (each
+/// file listed 40 times; with two such links, 2⁴⁰ paths).
+fn sdf_files(
+    dir: &Path,
+    seen: &mut std::collections::HashSet<PathBuf>,
+    out: &mut Vec<PathBuf>,
+) -> std::io::Result<()> {
+    if !seen.insert(std::fs::canonicalize(dir)?) {
+        return Ok(());
+    }
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)?
         .map(|e| e.map(|e| e.path()))
         .collect::<Result<_, _>>()?;
@@ -63,7 +73,7 @@ fn sdf_files(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
         let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
         if p.is_dir() {
             if !name.is_some_and(|n| n.starts_with('.') || n == "target") {
-                sdf_files(&p, out)?;
+                sdf_files(&p, seen, out)?;
             }
         } else if p.extension().is_some_and(|x| x == "sdf") {
             out.push(p);
@@ -132,9 +142,10 @@ pub fn run(args: FmtArgs) -> ExitCode {
     }
     let mut files = Vec::new();
     let mut code = 0u8;
+    let mut folders = std::collections::HashSet::new();
     for f in &args.files {
         if f.is_dir() {
-            if let Err(e) = sdf_files(f, &mut files) {
+            if let Err(e) = sdf_files(f, &mut folders, &mut files) {
                 eprintln!("error: cannot list {}: {e}", f.display());
                 code = 2;
             }

@@ -233,11 +233,35 @@ pub fn surface(
         ));
     };
     let origin = scene.origin;
+    let b = root.bounds;
+    // Known empty (an intersection of parts that do not meet, a profile revolved from beyond
+    // its axis): no grid would find a surface, whatever its cells (it was told to try a
+    // higher resolution, or that the scene was unbounded).
+    if b.is_empty() {
+        return Err((
+            1,
+            "the scene's solid is empty (its parts' bounds leave no point inside it): there is no surface to mesh".into(),
+        ));
+    }
     // The clip box and the grid, in the program's coordinates (the scene's, less `origin`).
     let clip = match region.bounds {
-        Some([lo, hi]) => [lo, hi].map(|c| [0, 1, 2].map(|i| c[i] - origin[i])),
+        Some([lo, hi]) => {
+            let clip = [lo, hi].map(|c| [0, 1, 2].map(|i| c[i] - origin[i]));
+            let apart = (0..3).any(|i| b.min[i] > clip[1][i] || b.max[i] < clip[0][i]);
+            if apart {
+                let at = |c: [f64; 3]| [0, 1, 2].map(|i| short(c[i] + origin[i]));
+                let (lo, hi) = (at(b.min), at(b.max));
+                return Err((
+                    1,
+                    format!(
+                        "the region given with {bounds_opt} does not reach the scene's solid, which lies within `{}`: there is no surface to mesh in it",
+                        bounds(spell, lo.each_ref().map(|s| s.as_str()), hi.each_ref().map(|s| s.as_str()))
+                    ),
+                ));
+            }
+            clip
+        }
         None => {
-            let b = root.bounds;
             let open: Vec<&str> = ["x", "y", "z"]
                 .into_iter()
                 .enumerate()
@@ -271,12 +295,6 @@ pub fn surface(
                     "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `{corners}` (what reaches out of it is cut at its faces and the cut closed){hint}",
                     open.join(", ")
                 )));
-            }
-            if b.is_empty() {
-                return Err((
-                    1,
-                    "the scene's solid is empty: there is no surface to mesh".into(),
-                ));
             }
             [b.min, b.max]
         }

@@ -173,3 +173,27 @@ fn text_size_measures_the_ink_of_text() {
         ["E0400"]
     );
 }
+
+/// A list of a `field` of a vec3 says it holds a colour field, not that lists do not nest
+/// (the message it gave), and how a field makes a shape.
+#[test]
+fn a_list_of_a_colour_field_says_what_it_holds() {
+    let (_, diags, _) = check_str("t.sdf", "scene { union([field { vec3(1, 0, 0) }]); }");
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0].code, "E0300");
+    assert_eq!(
+        diags[0].message,
+        "a colour field cannot be a list's element"
+    );
+    assert_eq!(diags[0].span().start, 15);
+    assert!(diags[0]
+        .help
+        .as_deref()
+        .is_some_and(|h| h.contains("field { length(p) - 1 }")));
+    // A list of lists keeps its message.
+    let (_, diags, _) = check_str("t.sdf", "let xs = [[1], [2]];\nscene { sphere(1); }");
+    assert_eq!(
+        diags[0].message, "a list's elements cannot be lists",
+        "{diags:#?}"
+    );
+}

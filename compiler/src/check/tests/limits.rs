@@ -1,5 +1,5 @@
 //! Checker tests of inputs built to reach the limits early: chains of functions, cycles,
-//! literal lists.
+//! literal lists, text, polygons.
 
 use super::{check_str, ok};
 use crate::scene::Node;
@@ -96,6 +96,102 @@ fn a_literal_list_past_the_objects_limit_is_refused_before_parsing() {
     let (_, diags, _) = check_str("t.sdf", "scene { for i in 0..250000 { sphere(1); } }");
     assert!(
         diags[0].notes[0].ends_with("`--limit objects=250000`"),
+        "{diags:#?}"
+    );
+}
+
+/// Checks `src` within the default limits but for `changes`.
+fn check_within(
+    src: &str,
+    changes: &[(crate::limits::Limit, u64)],
+) -> Vec<crate::diagnostics::Diagnostic> {
+    let mut limits = crate::limits::Limits::default();
+    for &(limit, value) in changes {
+        limits.set(limit, value).expect("a valid limit");
+    }
+    let mut sources = crate::span::SourceMap::new();
+    let entry = sources.add("t.sdf", src.to_string());
+    crate::front::check_with(&mut sources, entry, &mut crate::check::NoImports, &limits).1
+}
+
+/// `text` of more characters than the `text_chars` limit, in all, is E0507 at the string
+/// that crosses it, suggesting the sum, before anything is laid out (a string of a million
+/// characters took 1.9 GB).
+#[test]
+fn text_past_the_text_chars_limit_is_refused_at_its_string() {
+    let long = "a".repeat(10_001);
+    let src = format!("scene {{ extrude(text(\"{long}\"), 0.1); }}\n");
+    let (scene, diags, _) = check_str("t.sdf", &src);
+    assert!(scene.is_none());
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0].code, "E0507");
+    assert_eq!(
+        diags[0].message,
+        "this text has 10001 characters, more than the `text_chars` limit of 10000"
+    );
+    assert_eq!(diags[0].span().start, 21, "at the string");
+    assert_eq!(
+        diags[0].notes,
+        ["this limit keeps compilation bounded; raise it with `--limit text_chars=10001`"]
+    );
+    // Characters, not bytes; and the limit bounds the scene's text in all, a loop's too.
+    let word = "é".repeat(3_000);
+    let src = format!(
+        "let w = \"{word}\";\nscene {{ for i in 0..4 {{ extrude(text(w), 0.1).translate(i, 0, 0); }} }}\n"
+    );
+    let (_, diags, _) = check_str("t.sdf", &src);
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(
+        diags[0].message,
+        "this text has 3000 characters, and the scene's other text 9000, more than the \
+         `text_chars` limit of 10000"
+    );
+    assert!(diags[0].notes[0].ends_with("`--limit text_chars=12000`"));
+    // Raised, both check.
+    let diags = check_within(&src, &[(crate::limits::Limit::TextChars, 12_000)]);
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
+}
+
+/// A polygon's edges are tested for crossings over a grid, each step spent as fuel: 100 000
+/// points check in a few steps each (every pair was tested: 74 s), and a polygon whose test
+/// needs more steps than the fuel left is E0507 at the call.
+#[test]
+fn a_polygon_is_tested_for_crossings_within_the_fuel() {
+    let circle = |n: usize| {
+        let points: Vec<String> = (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                format!("({:.9}, {:.9})", a.cos(), a.sin())
+            })
+            .collect();
+        format!(
+            "scene {{ extrude(polygon([{}]), 0.1); }}\n",
+            points.join(", ")
+        )
+    };
+    let s = ok(&circle(100_000));
+    assert!(s.root.is_some());
+    // A star of 10 000 thin points has every edge through its middle: 2·10⁸ pairs there.
+    let (_, diags, _) = check_str("t.sdf", "scene { extrude(star(10000, 1, 0.000001), 0.1); }");
+    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
+    assert_eq!(errors.len(), 1, "{diags:#?}");
+    assert_eq!(errors[0].code, "E0507");
+    assert!(
+        errors[0].message.contains("more than 50000000 steps"),
+        "{errors:#?}"
+    );
+    assert_eq!(errors[0].span().start, 16, "at the call");
+    // A crossing far along is still found, and named.
+    let mut src = circle(20_000);
+    let (p, q) = ("(0.999955587, 0.009424638)", "(0.999955587, -0.009424638)");
+    assert!(src.contains(p) && src.contains(q));
+    src = src
+        .replacen(p, "X", 1)
+        .replacen(q, p, 1)
+        .replacen("X", q, 1);
+    let (_, diags, _) = check_str("t.sdf", &src);
+    assert!(
+        diags[0].message.starts_with("the polygon crosses itself"),
         "{diags:#?}"
     );
 }

@@ -57,6 +57,8 @@ pub struct Ctx<'l> {
     locals: Vec<(String, Value)>,
     dry: u32,
     depth: usize,
+    /// The user functions whose calls are being evaluated, outermost first.
+    calling: Vec<String>,
     nesting: usize,
     /// Links of chains being evaluated (see `chained`).
     chain: usize,
@@ -1600,11 +1602,20 @@ impl Ctx<'_> {
         }
         let max = self.limits.count(Limit::CallDepth);
         if self.depth >= max {
+            let before = self.diags.len();
             self.limit(
                 Limit::CallDepth,
                 span,
                 format!("calls nest deeper than {max}"),
             );
+            // A function that calls itself without end is the likely cause: say which.
+            let name = &callee.name;
+            let times = self.calling.iter().filter(|c| *c == name).count();
+            if let (Some(d), true) = (self.diags.get_mut(before), times > 0) {
+                d.notes.push(format!(
+                    "`{name}` calls itself, directly or through other functions, and had done so {times} times here: a case that returns without calling it again may be missing or never reached"
+                ));
+            }
             return Value::Error;
         }
         // Defaults are evaluated in the global scope; the body sees its parameters and the
@@ -1633,12 +1644,14 @@ impl Ctx<'_> {
         }
         self.locals = frame;
         self.depth += 1;
+        self.calling.push(callee.name.clone());
         let before = self.diags.len();
         let reads = self.time_reads;
         let v = self.body(&decl.body);
         let read = (self.time_reads > reads)
             .then_some(self.last_time_read)
             .flatten();
+        self.calling.pop();
         self.depth -= 1;
         if self.diags[before..].iter().any(Diagnostic::is_error) {
             let label = call_label(&self.locals);

@@ -2,7 +2,8 @@
 //! expression and builds the scene IR.
 //!
 //! Order: load and parse all files (imports first, depth first); collect declarations
-//! (duplicates are errors); reject recursion; check each function body on its own; then
+//! (duplicates are errors); check each function body on its own (a function may call itself:
+//! evaluated within the `call_depth` limit); then
 //! evaluate items in source order, and the scene last.
 
 pub mod builtins;
@@ -24,7 +25,7 @@ use crate::scene::{
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::{self, ast};
 use eval::{Ctx, FnInfo};
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::rc::Rc;
 use types::{Type, Value};
 
@@ -386,11 +387,11 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     scene
 }
 
-/// Declares the functions (refusing recursion) and the constants, so that any item may use
-/// any of them.
+/// Declares the functions and the constants, so that any item may use any of them. A
+/// function may call itself, directly or through others: a call is evaluated when it is met,
+/// within the `call_depth` limit.
 fn declare(cx: &mut Ctx, items: &[ast::Item]) {
     collect_functions(cx, items);
-    reject_recursion(cx);
     for item in items {
         if let ast::Item::Let(l) = item {
             if let Some(first) = cx.declared.get(&l.name.name).copied() {
@@ -581,238 +582,6 @@ fn collect_functions(cx: &mut Ctx, items: &[ast::Item]) {
             },
         );
     }
-}
-
-/// Calls made by a function body, by name, with their spans.
-fn calls_in(body: &ast::Body, out: &mut Vec<(String, Span)>) {
-    let mut stack: Vec<&ast::Expr> = body
-        .lets
-        .iter()
-        .map(|l| &l.value)
-        .chain([&*body.value])
-        .collect();
-    while let Some(e) = stack.pop() {
-        match &e.kind {
-            ast::ExprKind::Call { callee, args } => {
-                out.push((callee.name.clone(), callee.span));
-                stack.extend(args.iter().map(|a| &a.value));
-            }
-            ast::ExprKind::Method {
-                receiver,
-                name,
-                args,
-            } => {
-                out.push((name.name.clone(), name.span));
-                stack.push(receiver);
-                stack.extend(args.iter().map(|a| &a.value));
-            }
-            ast::ExprKind::Tuple(xs) | ast::ExprKind::List(xs) => stack.extend(xs),
-            ast::ExprKind::Index(a, b) => stack.extend([&**a, &**b]),
-            ast::ExprKind::Comprehension { from, to, body, .. } => {
-                stack.extend([&**from, &**to]);
-                stack.extend(body.lets.iter().map(|l| &l.value));
-                stack.push(&body.value);
-            }
-            ast::ExprKind::FieldBlock { args, body, .. } => {
-                stack.extend(args.iter().map(|a| &a.value));
-                stack.extend(body.lets.iter().map(|l| &l.value));
-                stack.push(&body.value);
-            }
-            ast::ExprKind::Unary(_, x)
-            | ast::ExprKind::Field(x, _)
-            | ast::ExprKind::Material(x, _) => stack.push(x),
-            ast::ExprKind::Binary(_, a, b) => stack.extend([&**a, &**b]),
-            ast::ExprKind::If {
-                cond,
-                then,
-                otherwise,
-            } => {
-                stack.push(cond);
-                for b in [then, otherwise] {
-                    stack.extend(b.lets.iter().map(|l| &l.value));
-                    stack.push(&b.value);
-                }
-            }
-            ast::ExprKind::Int(_)
-            | ast::ExprKind::Float(_)
-            | ast::ExprKind::Angle(_)
-            | ast::ExprKind::Colour(_)
-            | ast::ExprKind::Bool(_)
-            | ast::ExprKind::Str(_)
-            | ast::ExprKind::Var(_)
-            | ast::ExprKind::Error => {}
-        }
-    }
-}
-
-/// Reports every cycle in the call graph of user functions (recursion cannot be evaluated):
-/// one report for each set of functions that reach one another (a strongly connected part
-/// of the graph, of which there is one cycle or more), on a shortest cycle through its first
-/// function by name; every function of the set is marked. Linear in the calls: a chain of
-/// thousands of functions costs no more than its size.
-fn reject_recursion(cx: &mut Ctx) {
-    let mut names: Vec<String> = cx.fns.keys().cloned().collect();
-    names.sort();
-    let number: HashMap<&str, usize> = names
-        .iter()
-        .enumerate()
-        .map(|(i, n)| (n.as_str(), i))
-        .collect();
-    // The calls of each function (by number), with their spans.
-    let calls: Vec<Vec<(usize, Span)>> = names
-        .iter()
-        .map(|name| {
-            let info = &cx.fns[name];
-            let mut calls = Vec::new();
-            calls_in(&info.decl.body, &mut calls);
-            for p in &info.decl.params {
-                if let Some(d) = &p.default {
-                    calls_in(
-                        &ast::Body {
-                            lets: Vec::new(),
-                            value: Box::new(d.clone()),
-                            span: d.span,
-                        },
-                        &mut calls,
-                    );
-                }
-            }
-            calls
-                .into_iter()
-                .filter_map(|(c, span)| Some((*number.get(c.as_str())?, span)))
-                .collect()
-        })
-        .collect();
-    let mut bad: Vec<usize> = Vec::new();
-    let mut reports: Vec<(usize, Vec<(usize, Span)>)> = Vec::new();
-    for part in strongly_connected(&calls) {
-        let first = part[0];
-        let cyclic = part.len() > 1 || calls[first].iter().any(|&(c, _)| c == first);
-        if !cyclic {
-            continue;
-        }
-        let start = part.iter().copied().min().unwrap_or(first);
-        let inside: HashSet<usize> = part.iter().copied().collect();
-        if let Some(path) = shortest_cycle(&calls, start, &inside) {
-            reports.push((start, path));
-        }
-        bad.extend(part);
-    }
-    reports.sort_by_key(|(start, _)| *start);
-    for (start, path) in &reports {
-        let mut chain: Vec<String> = std::iter::once(*start)
-            .chain(path.iter().map(|&(n, _)| n))
-            .map(|n| names[n].clone())
-            .collect();
-        // A long chain is shown by its ends.
-        const SHOWN: usize = 8;
-        if chain.len() > SHOWN {
-            let hidden = chain.len() - SHOWN;
-            chain.splice(
-                SHOWN / 2..chain.len() - SHOWN / 2,
-                [format!("… {hidden} more …")],
-            );
-        }
-        let name = &names[*start];
-        let span = path[0].1;
-        cx.error(
-            Diagnostic::error("E0502", format!("function `{name}` calls itself"), span)
-                .with_label("this call leads back to it")
-                .with_note(format!("the call chain is {}", chain.join(" → ")))
-                .with_note("scenes are evaluated at compile time, so functions cannot recurse; use a `for` loop in the scene"),
-        );
-    }
-    for f in bad {
-        if let Some(info) = cx.fns.get_mut(&names[f]) {
-            info.ok = false;
-        }
-    }
-}
-
-/// The strongly connected parts of the graph whose edges from node `i` are `edges[i]`
-/// (Tarjan's algorithm, without recursion: a chain of any length runs on the heap).
-fn strongly_connected(edges: &[Vec<(usize, Span)>]) -> Vec<Vec<usize>> {
-    const NONE: usize = usize::MAX;
-    let n = edges.len();
-    let (mut index, mut low) = (vec![NONE; n], vec![0; n]);
-    let mut on_stack = vec![false; n];
-    let (mut stack, mut parts) = (Vec::new(), Vec::new());
-    let mut next = 0;
-    for root in 0..n {
-        if index[root] != NONE {
-            continue;
-        }
-        // The walk: each node with the position of its next edge.
-        let mut walk = vec![(root, 0usize)];
-        index[root] = next;
-        low[root] = next;
-        next += 1;
-        stack.push(root);
-        on_stack[root] = true;
-        while let Some(&mut (v, ref mut e)) = walk.last_mut() {
-            if let Some(&(w, _)) = edges[v].get(*e) {
-                *e += 1;
-                if index[w] == NONE {
-                    index[w] = next;
-                    low[w] = next;
-                    next += 1;
-                    stack.push(w);
-                    on_stack[w] = true;
-                    walk.push((w, 0));
-                } else if on_stack[w] {
-                    low[v] = low[v].min(index[w]);
-                }
-                continue;
-            }
-            walk.pop();
-            if let Some(&(parent, _)) = walk.last() {
-                low[parent] = low[parent].min(low[v]);
-            }
-            if low[v] == index[v] {
-                let mut part = Vec::new();
-                while let Some(w) = stack.pop() {
-                    on_stack[w] = false;
-                    part.push(w);
-                    if w == v {
-                        break;
-                    }
-                }
-                parts.push(part);
-            }
-        }
-    }
-    parts
-}
-
-/// A shortest path of calls from `start` back to it within `inside` (breadth first): each
-/// step the function called and the call's span.
-fn shortest_cycle(
-    edges: &[Vec<(usize, Span)>],
-    start: usize,
-    inside: &HashSet<usize>,
-) -> Option<Vec<(usize, Span)>> {
-    let mut came: HashMap<usize, (usize, Span)> = HashMap::new();
-    let mut queue = std::collections::VecDeque::from([start]);
-    while let Some(v) = queue.pop_front() {
-        for &(w, span) in &edges[v] {
-            if w == start {
-                let mut path = vec![(start, span)];
-                let mut at = v;
-                while at != start {
-                    let &(from, span) = came.get(&at)?;
-                    path.push((at, span));
-                    at = from;
-                }
-                path.reverse();
-                return Some(path);
-            }
-            if inside.contains(&w) && !came.contains_key(&w) {
-                came.insert(w, (v, span));
-                queue.push_back(w);
-            }
-        }
-    }
-    None
 }
 
 fn material(

@@ -84,7 +84,7 @@ fn reports_mistakes() {
     assert_eq!(codes("let x = 1 / 0;\nscene { sphere(); }"), ["E0401"]);
     assert_eq!(
         codes("fn f(a: float) -> shape { f(a) }\nscene { f(1); }"),
-        ["E0502"]
+        ["E0507"]
     );
     assert_eq!(codes("let a = 1;"), ["E0503"]);
     assert_eq!(

@@ -197,3 +197,59 @@ fn a_list_of_a_colour_field_says_what_it_holds() {
         "{diags:#?}"
     );
 }
+
+/// Functions may call themselves, directly or through others (issue 50, item 5): a tree of
+/// 2 to 4 children a branch chosen by a hash is one short function; each distinct call is
+/// evaluated once; without a stopping case the call depth is met and the note names the
+/// function.
+#[test]
+fn functions_may_call_themselves() {
+    let src = "fn branch(level: int, seed: int) -> shape {
+  let stem = cylinder((0, 0, 0), (0, 1, 0), 0.06);
+  if level == 0 { stem } else {
+    let n = 2 + int(hash(seed) * 3);
+    union(stem, union([for i in 0..n { branch(level - 1, seed * 4 + i + 1).scale(0.7).translate(0, 1, 0) }]))
+  }
+}
+scene { branch(4, 1); }";
+    let s = ok(src);
+    // Every level adds its stems: the leaves are as many as the hash chose.
+    let stems = s
+        .graph
+        .ids()
+        .filter(
+            |&id| matches!(s.graph.node(id), Node::Prim { prim, .. } if prim.name == "cylinder"),
+        )
+        .count();
+    assert_eq!(stems, 1, "one stem node, shared");
+    let scales = s
+        .graph
+        .ids()
+        .filter(|&id| matches!(s.graph.node(id), Node::Scale { .. }))
+        .count();
+    assert!(scales >= 4, "the branches of four levels: {scales}");
+    // Mutual recursion with stopping cases.
+    let s = ok(
+        "fn even(n: int) -> bool { if n == 0 { true } else { odd(n - 1) } }
+fn odd(n: int) -> bool { if n == 0 { false } else { even(n - 1) } }
+scene { sphere(if even(10) { 1 } else { 2 }); }",
+    );
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 1.0 }
+    );
+    // Without a stopping case: E0507 at `call_depth`, naming the function.
+    let (_, diags, _) = check_str(
+        "t.sdf",
+        "fn f(n: int) -> shape { f(n + 1) }\nscene { f(0); }",
+    );
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0].code, "E0507");
+    assert!(
+        diags[0].notes.iter().any(|n| n.starts_with(
+            "`f` calls itself, directly or through other functions, and had done so 256 times"
+        )),
+        "{:?}",
+        diags[0].notes
+    );
+}

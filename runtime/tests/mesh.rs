@@ -5,56 +5,14 @@
 //! formats are read back by independent readers (`stl_io`, `tobj`, `ply-rs-bw`, `gltf`).
 
 mod common;
+#[path = "common/meshes.rs"]
+mod meshes;
 
-use sdfc_compiler::{eval_point, lower, Program};
-use std::collections::HashMap;
+use meshes::*;
+use sdfc_compiler::{eval_point, Program};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sdfc-mesh-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn sdfc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .args(args)
-        .output()
-        .expect("run sdfc")
-}
-
-/// Runs `sdfc mesh` and insists that it succeeded.
-fn mesh(args: &[&str]) -> String {
-    let mut all = vec!["mesh"];
-    all.extend_from_slice(args);
-    let out = sdfc(&all);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(out.status.success(), "sdfc {all:?}: {err}");
-    err
-}
-
-/// A triangle mesh as read back: positions and triangles.
-#[derive(Debug, Default)]
-struct Read {
-    positions: Vec<[f32; 3]>,
-    triangles: Vec<[usize; 3]>,
-}
-
-fn read_stl(path: &Path) -> Read {
-    let mut f = std::fs::File::open(path).expect("open stl");
-    // stl_io merges vertices by their exact f32 bits: the positions an STL reader sees.
-    let m = stl_io::read_stl(&mut f).expect("stl_io reads it");
-    Read {
-        positions: m.vertices.iter().map(|v| v.0).collect(),
-        triangles: m.faces.iter().map(|f| f.vertices).collect(),
-    }
-}
+use std::process::Command;
 
 fn read_obj(path: &Path) -> Read {
     let (models, _) = tobj::load_obj(
@@ -137,75 +95,6 @@ fn read_glb(path: &Path) -> (Read, Vec<String>) {
         names.push(p.material().name().unwrap_or("").to_string());
     }
     (r, names)
-}
-
-/// Checks a closed, oriented 2-manifold by positions (vertices with the same f32 coordinates
-/// are one vertex): every directed edge once and its reverse once (so each undirected edge
-/// in exactly two triangles), no triangle of zero area. Returns the Euler characteristic.
-fn manifold(m: &Read, what: &str) -> i64 {
-    assert!(!m.triangles.is_empty(), "{what}: no triangles");
-    let mut id: HashMap<[u32; 3], usize> = HashMap::new();
-    let same: Vec<usize> = m
-        .positions
-        .iter()
-        .map(|p| {
-            let n = id.len();
-            *id.entry(p.map(f32::to_bits)).or_insert(n)
-        })
-        .collect();
-    let mut directed: HashMap<(usize, usize), u32> = HashMap::new();
-    for (k, t) in m.triangles.iter().enumerate() {
-        let v = t.map(|i| same[i]);
-        let p = t.map(|i| m.positions[i].map(f64::from));
-        let u = [0, 1, 2].map(|i| p[1][i] - p[0][i]);
-        let w = [0, 1, 2].map(|i| p[2][i] - p[0][i]);
-        let c = [
-            u[1] * w[2] - u[2] * w[1],
-            u[2] * w[0] - u[0] * w[2],
-            u[0] * w[1] - u[1] * w[0],
-        ];
-        assert!(
-            c.iter().any(|x| *x != 0.0),
-            "{what}: triangle {k} has zero area: {p:?}"
-        );
-        for (a, b) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])] {
-            assert_ne!(a, b, "{what}: triangle {k} repeats a vertex");
-            *directed.entry((a, b)).or_default() += 1;
-        }
-    }
-    for (&(a, b), &n) in &directed {
-        assert_eq!(n, 1, "{what}: directed edge {a}→{b} in {n} triangles");
-        assert_eq!(
-            directed.get(&(b, a)),
-            Some(&1),
-            "{what}: edge {a}–{b} has no opposite (open or inconsistently oriented)"
-        );
-    }
-    let used: std::collections::HashSet<usize> =
-        m.triangles.iter().flatten().map(|&i| same[i]).collect();
-    let edges = directed.len() / 2;
-    used.len() as i64 - edges as i64 + m.triangles.len() as i64
-}
-
-/// The f64 distance program of a scene file.
-fn program(path: &Path) -> Program {
-    let loaded = sdfc_runtime::frontend::load(path).expect("load");
-    let scene = loaded.scene.expect("checks");
-    lower(&scene)
-}
-
-fn distance(p: &Program, q: [f32; 3]) -> f64 {
-    eval_point::<f64>(p, q.map(f64::from)).0
-}
-
-fn write_scene(d: &Path, name: &str, body: &str) -> PathBuf {
-    let p = d.join(name);
-    std::fs::write(&p, body).expect("write scene");
-    p
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
 }
 
 /// The distance from `p` to triangle `t` (exact, by regions).

@@ -80,6 +80,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     crate::output::check_writable(&args.output)
         .map_err(|why| usage(format!("cannot write `{}`: {why}", args.output.display())))?;
     let mut settings = settings(&args.set).map_err(usage)?;
+    settings.measure = args.stats;
     settings.materials = matches!(format, Format::Ply | Format::Glb);
     let pool = crate::job::thread_pool(args.threads, &limits).map_err(|e| usage(e.to_string()))?;
     // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
@@ -435,6 +436,9 @@ pub fn surface(
         ),
     })?;
     let seconds = started.elapsed().as_secs_f64();
+    if settings.measure {
+        stats.error = Some(pool.install(|| crate::mesh::error(&field, &mesh)));
+    }
     stats.octree_cells = octree_evaluated;
     stats.dense = !root.proven;
     for p in &mut mesh.positions {
@@ -457,7 +461,8 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
          candidates      {} cells ({} added by crossed edges)\n\
          surface cells   {}\n\
          evaluations     {} points ({:.2} % of the dense grid's {} points)\n\
-         sharp patches   {} ({} edges flipped)\n\
+         sharp patches   {} ({} edges flipped, {} inner vertices projected onto the surface)\n\
+         {}\
          time            {:.3} s\n",
         grid.cells[0],
         grid.cells[1],
@@ -477,6 +482,17 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
         grid.dense_points(),
         s.features,
         s.flips,
+        s.projected,
+        match s.error {
+            Some([v, f]) => format!(
+                "distance        vertices {} ({:.2} % of a cell), triangle centres {} ({:.2} %): the largest |f| (exact fields: the distance to the surface)\n",
+                short(v),
+                100.0 * v / grid.voxel,
+                short(f),
+                100.0 * f / grid.voxel
+            ),
+            None => String::new(),
+        },
         seconds
     )
 }

@@ -1,8 +1,8 @@
 //! The surface in the candidate cells: the corners' signs, the crossed edges (with every
 //! cell around a crossed edge taken in, so that no patch lacks its neighbour), a vertex on
 //! the surface on each crossed edge (found by root finding), each cell's patches
-//! (`table`), an inner vertex for each patch, and the patch fanned around it; then the
-//! edges between two sharp patches are flipped to run along the sharp edge.
+//! (`table`), an inner vertex for each patch (`place`), and the patch fanned around it;
+//! then the edges between two sharp patches are flipped to run along the sharp edge.
 //!
 //! Why the result is closed, 2-manifold and oriented, by vertex positions as well as by
 //! indices: every patch edge lies on a cell face and is shared by the two patches of the
@@ -12,21 +12,16 @@
 //! inner vertex off the face its other two vertices lie on, so none has zero area; and a
 //! flip replaces two triangles by two that share a new edge, which is made only once.
 
-use super::qef;
+use super::place::{
+    choose, dot, inside_cell, normalise, onto_surface, place, separate, sub, Patches, Placed,
+    GRADIENT_STEP, MARGIN, ON_SURFACE,
+};
 use super::table::{corner, patches, EDGES};
 use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
 use rayon::prelude::*;
 
-/// Edge vertices stay this fraction of a voxel inside their edge, and inner vertices inside
-/// their cell, so that no two vertices coincide.
-const MARGIN: f64 = 1e-3;
-
-/// Step of the gradients, as a fraction of a voxel.
-const GRADIENT_STEP: f64 = 1e-4;
-
-/// The patch normals of a smooth patch are within this angle's cosine of their mean (about
-/// 30°); its inner vertex is projected onto the surface.
-const SMOOTH_COS: f64 = 0.866;
+/// Bisections after the root finding's rounds for an edge vertex still off the surface.
+const BISECTIONS: u32 = 24;
 
 /// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
 /// points asked for, each at most once (a position, its index and its value); and the bricks
@@ -185,7 +180,7 @@ pub fn contour(
         }
     }
     let patch_count = patch_cells.len();
-    let inner: Vec<([f64; 3], bool)> = (0..patch_count)
+    let inner: Vec<Placed> = (0..patch_count)
         .into_par_iter()
         .map(|p| {
             let ids = &ring[starts[p]..starts[p + 1]];
@@ -196,11 +191,14 @@ pub fn contour(
                 pts[k] = crossings[v as usize];
                 nrm[k] = normals[v as usize];
             }
-            place(&pts[..n], &nrm[..n], settings.sharp)
+            let lo = grid.point(patch_cells[p]).map(|x| x + MARGIN * grid.voxel);
+            let hi = lo.map(|x| x + (1.0 - 2.0 * MARGIN) * grid.voxel);
+            place(&pts[..n], &nrm[..n], settings.sharp, [lo, hi])
         })
         .collect();
-    let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.0).collect();
-    let smooth: Vec<bool> = inner.iter().map(|c| c.1).collect();
+    let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.point).collect();
+    let smooth: Vec<bool> = inner.iter().map(|c| c.smooth).collect();
+    choose(field, grid.voxel, &inner, &mut centres);
     stats.features = smooth.iter().filter(|s| !**s).count() as u64;
     // Smooth patches: the centroid moved along the patch's mean normal to where the field
     // is zero (Newton's steps for a field of unit gradient along the normal).
@@ -224,6 +222,13 @@ pub fn contour(
     for p in 0..patch_count {
         centres[p] = inside_cell(grid, patch_cells[p], centres[p]);
     }
+    let patches = Patches {
+        cells: &patch_cells,
+        ring: &ring,
+        starts: &starts,
+        crossings: &crossings,
+    };
+    stats.projected = onto_surface(field, grid, &patches, &mut centres);
     separate(grid, &patch_cells, &mut centres, &ring, &starts, &crossings);
     progress(0.75);
 
@@ -354,13 +359,25 @@ fn roots(
         q
     };
     let mut active: Vec<usize> = (0..state.len()).collect();
-    for _ in 0..iterations {
+    // Past `iterations`, the edges whose field is still above a quarter of [`ON_SURFACE`]
+    // (regula falsi stalls at a kink of the field, beside an edge or corner of the surface) go
+    // on by bisection.
+    let rounds = if iterations > 0 {
+        iterations + BISECTIONS
+    } else {
+        0
+    };
+    for round in 0..rounds {
         if active.is_empty() {
             break;
         }
         let pts: Vec<[f64; 3]> = active.iter().map(|&k| at(&state[k], state[k].t)).collect();
         let d = field.distances(&pts);
-        let tolerance = 1e-12 * grid.voxel.max(1e-300);
+        let tolerance = if round + 1 < iterations {
+            1e-12 * grid.voxel.max(1e-300)
+        } else {
+            0.25 * ON_SURFACE * grid.voxel
+        };
         let mut next = Vec::with_capacity(active.len());
         for (&k, &f) in active.iter().zip(&d) {
             let r = &mut state[k];
@@ -382,7 +399,8 @@ fn roots(
             }
             let (a, b) = (r.lo, r.hi);
             let t = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
-            r.t = if t.is_finite() && t > a.0.min(b.0) && t < a.0.max(b.0) {
+            r.t = if round + 1 < iterations && t.is_finite() && t > a.0.min(b.0) && t < a.0.max(b.0)
+            {
                 t
             } else {
                 0.5 * (a.0 + b.0)
@@ -399,90 +417,12 @@ fn roots(
         .collect()
 }
 
-fn normalise(g: [f64; 3]) -> [f64; 3] {
-    let l = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-    if l > 0.0 && l.is_finite() {
-        g.map(|x| x / l)
-    } else {
-        [0.0; 3]
-    }
-}
-
-/// The inner vertex of a patch and whether the patch is smooth (its normals close to their
-/// mean: the vertex is then the centroid, to be projected onto the surface).
-fn place(points: &[[f64; 3]], normals: &[[f64; 3]], sharp: bool) -> ([f64; 3], bool) {
-    let n = points.len() as f64;
-    let centroid = [0, 1, 2].map(|i| points.iter().map(|p| p[i]).sum::<f64>() / n);
-    let mean = normalise([0, 1, 2].map(|i| normals.iter().map(|v| v[i]).sum::<f64>()));
-    let smooth = normals
-        .iter()
-        .all(|v| v[0] * mean[0] + v[1] * mean[1] + v[2] * mean[2] >= SMOOTH_COS);
-    if smooth || !sharp {
-        return (centroid, true);
-    }
-    (qef::solve(points, normals).0, false)
-}
-
-/// `p` clamped into cell `c`, [`MARGIN`] of a voxel inside its faces.
-fn inside_cell(grid: &Grid, c: [u32; 3], p: [f64; 3]) -> [f64; 3] {
-    let lo = grid.point(c);
-    let m = MARGIN * grid.voxel;
-    [0, 1, 2].map(|i| {
-        let v = if p[i].is_finite() {
-            p[i]
-        } else {
-            lo[i] + 0.5 * grid.voxel
-        };
-        v.clamp(lo[i] + m, lo[i] + grid.voxel - m)
-    })
-}
-
-/// Moves apart the inner vertices of patches of one cell that landed on one point (two
-/// sheets fitted to the same planes), each a little towards its own patch's centroid.
-fn separate(
-    grid: &Grid,
-    cells: &[[u32; 3]],
-    centres: &mut [[f64; 3]],
-    ring: &[u32],
-    starts: &[usize],
-    crossings: &[[f64; 3]],
-) {
-    let mut p = 0;
-    while p < cells.len() {
-        let mut q = p + 1;
-        while q < cells.len() && cells[q] == cells[p] {
-            q += 1;
-        }
-        for a in p..q {
-            for b in a + 1..q {
-                if centres[a] == centres[b] {
-                    let ids = &ring[starts[b]..starts[b + 1]];
-                    let n = ids.len() as f64;
-                    let c = [0, 1, 2]
-                        .map(|i| ids.iter().map(|&v| crossings[v as usize][i]).sum::<f64>() / n);
-                    let moved = [0, 1, 2].map(|i| centres[b][i] + 0.01 * (c[i] - centres[b][i]));
-                    centres[b] = inside_cell(grid, cells[b], moved);
-                }
-            }
-        }
-        p = q;
-    }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {

@@ -7,6 +7,7 @@
 
 pub mod contour;
 pub mod octree;
+pub mod place;
 pub mod qef;
 pub mod table;
 pub mod write;
@@ -229,6 +230,27 @@ impl Field {
     }
 }
 
+/// The largest |f| of `field` at the vertices of `mesh` and at its triangles' centres.
+pub fn error(field: &Field, mesh: &Mesh) -> [f64; 2] {
+    let largest = |d: Vec<f64>| d.into_iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let centres: Vec<[f64; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            [0, 1, 2].map(|i| {
+                t.iter()
+                    .map(|&v| mesh.positions[v as usize][i])
+                    .sum::<f64>()
+                    / 3.0
+            })
+        })
+        .collect();
+    [
+        largest(field.distances(&mesh.positions)),
+        largest(field.distances(&centres)),
+    ]
+}
+
 /// One thread's evaluator and input columns.
 struct Scratch<'t> {
     eval: Evaluator<'t, f64>,
@@ -285,8 +307,14 @@ pub struct Stats {
     pub features: u64,
     /// Edges flipped to follow a sharp edge.
     pub flips: u64,
+    /// Inner vertices that their placement left off the surface (a QEF solution outside its
+    /// cell), projected onto it within their cell.
+    pub projected: u64,
     /// Whether the dense grid was evaluated (no proven bound).
     pub dense: bool,
+    /// The largest |f| at the mesh's vertices and at its triangles' centres (the distance to
+    /// the surface where the field is exact), when measured ([`Settings::measure`]).
+    pub error: Option<[f64; 2]>,
 }
 
 /// Settings of a mesh.
@@ -299,6 +327,8 @@ pub struct Settings {
     pub refine: u32,
     /// Find the material of each triangle and vertex (for formats that carry them).
     pub materials: bool,
+    /// Measure the mesh's distance to the surface ([`Stats::error`]).
+    pub measure: bool,
 }
 
 impl Default for Settings {
@@ -307,6 +337,7 @@ impl Default for Settings {
             sharp: true,
             refine: 6,
             materials: true,
+            measure: false,
         }
     }
 }

@@ -250,8 +250,9 @@ impl Ctx<'_> {
                 var,
                 from,
                 to,
+                cond,
                 body,
-            } => self.comprehension(var, from, to, body),
+            } => self.comprehension(var, from, to, cond.as_deref(), body),
             ExprKind::Index(xs, i) => self.index(xs, i),
             ExprKind::FieldBlock { args, body, plane } => {
                 self.field_block(args, body, *plane, e.span)
@@ -350,7 +351,14 @@ impl Ctx<'_> {
     /// `[for var in from..to { body }]`: the body's value for each int from `from` up to
     /// `to`, excluded. The body is checked once on its own (for the element type, also of an
     /// empty list) and then evaluated for each value.
-    fn comprehension(&mut self, var: &Ident, from: &Expr, to: &Expr, body: &Body) -> Value {
+    fn comprehension(
+        &mut self,
+        var: &Ident,
+        from: &Expr,
+        to: &Expr,
+        cond: Option<&Expr>,
+        body: &Body,
+    ) -> Value {
         let bound = |cx: &mut Self, e: &Expr| match cx.expr(e) {
             Value::Int(i) => Ok(Some(i)),
             Value::Unknown(Type::Int) => Ok(None),
@@ -378,7 +386,12 @@ impl Ctx<'_> {
         self.locals
             .push((var.name.clone(), Value::Unknown(Type::Int)));
         let before = self.diags.len();
-        let shape = self.dry(|cx| cx.body(body));
+        let shape = self.dry(|cx| {
+            if let Some(c) = cond {
+                cx.condition(c);
+            }
+            cx.body(body)
+        });
         self.locals.truncate(mark);
         let (Ok(a), Ok(b)) = (a, b) else {
             return Value::Error;
@@ -406,6 +419,19 @@ impl Ctx<'_> {
             }
             self.locals.push((var.name.clone(), Value::Int(i)));
             let errors = self.diags.len();
+            if let Some(c) = cond {
+                match self.condition(c) {
+                    Some(true) => {}
+                    Some(false) => {
+                        self.locals.truncate(mark);
+                        continue;
+                    }
+                    None => {
+                        self.locals.truncate(mark);
+                        return Value::Error;
+                    }
+                }
+            }
             let v = self.body(body);
             self.locals.truncate(mark);
             // One report per mistake, not one per element.
@@ -775,6 +801,33 @@ impl Ctx<'_> {
             Value::Vec2(a) => Value::Float(a[idx]),
             Value::Vec3(a) => Value::Float(a[idx]),
             _ => Value::Unknown(Type::Float),
+        }
+    }
+
+    /// The condition of a comprehension's `if` (`[for i in 0..n if c { … }]`): its value, or
+    /// `None` where it is not known (types only) or is not a bool (reported).
+    fn condition(&mut self, cond: &Expr) -> Option<bool> {
+        match self.expr(cond) {
+            Value::Bool(b) => Some(b),
+            Value::Error | Value::Unknown(Type::Bool) => None,
+            v if field::is_point(&v) => {
+                self.per_point(
+                    "which elements a list keeps must be decided by constants: a list's length cannot vary from point to point".into(),
+                    cond.span,
+                );
+                None
+            }
+            other => {
+                self.error(
+                    Diagnostic::error(
+                        "E0303",
+                        "the condition of a comprehension's `if` must be a bool",
+                        cond.span,
+                    )
+                    .with_label(format!("this is `{}`", type_name(&other))),
+                );
+                None
+            }
         }
     }
 

@@ -164,9 +164,24 @@ impl Drop for Expr {
                 | ExprKind::If { cond: a, .. } => stack.push(*a),
                 ExprKind::Binary(_, a, b)
                 | ExprKind::Index(a, b)
-                | ExprKind::Comprehension { from: a, to: b, .. } => {
+                | ExprKind::Comprehension {
+                    from: a,
+                    to: b,
+                    cond: None,
+                    ..
+                } => {
                     stack.push(*a);
                     stack.push(*b);
+                }
+                ExprKind::Comprehension {
+                    from: a,
+                    to: b,
+                    cond: Some(c),
+                    ..
+                } => {
+                    stack.push(*a);
+                    stack.push(*b);
+                    stack.push(*c);
                 }
                 _ => {}
             }
@@ -281,11 +296,13 @@ pub enum ExprKind {
     /// `[a, b, c]`: a list of values of one type.
     List(Vec<Expr>),
     /// `[for name in from..to { body }]`: a list of the body's values, `name` an int from
-    /// `from` up to `to` (excluded).
+    /// `from` up to `to` (excluded); with `if cond` before the body, of those where `cond`
+    /// holds.
     Comprehension {
         var: Ident,
         from: Box<Expr>,
         to: Box<Expr>,
+        cond: Option<Box<Expr>>,
         body: Body,
     },
     /// `xs[i]`: an element of a list.

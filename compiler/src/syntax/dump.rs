@@ -169,10 +169,14 @@ impl Dumper {
                 var,
                 from,
                 to,
+                cond,
                 body,
             } => self.nested(format!("list for {}", var.name), |d| {
                 d.expr(from);
                 d.expr(to);
+                if let Some(c) = cond {
+                    d.nested("if", |d| d.expr(c));
+                }
                 d.body(body);
             }),
             ExprKind::Index(xs, i) => self.nested("index", |d| {

@@ -343,7 +343,7 @@ where
                 })
         });
 
-        // `list = "[" "for" ident "in" expr ".." expr body "]"
+        // `list = "[" "for" ident "in" expr ".." expr [ "if" expr ] body "]"
         //      | "[" [ expr { "," expr } [ "," ] ] "]"`
         let comprehension = just(Token::For)
             .ignore_then(ident(file))
@@ -351,8 +351,9 @@ where
             .then(expr.clone())
             .then_ignore(just(Token::DotDot))
             .then(expr.clone())
+            .then(just(Token::If).ignore_then(expr.clone()).or_not())
             .then(body.clone())
-            .map(|(((var, from), to), body)| (var, from, to, body));
+            .map(|((((var, from), to), cond), body)| (var, from, to, cond, body));
         let list = comprehension
             .map(Ok)
             .or(expr
@@ -364,10 +365,11 @@ where
             .delimited_by(just(Token::LBracket), just(Token::RBracket))
             .map_with(move |list, e| {
                 let kind = match list {
-                    Ok((var, from, to, body)) => ExprKind::Comprehension {
+                    Ok((var, from, to, cond, body)) => ExprKind::Comprehension {
                         var,
                         from: Box::new(from),
                         to: Box::new(to),
+                        cond: cond.map(Box::new),
                         body,
                     },
                     Err(items) => ExprKind::List(items),

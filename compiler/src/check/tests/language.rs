@@ -253,3 +253,27 @@ scene { sphere(if even(10) { 1 } else { 2 }); }",
         diags[0].notes
     );
 }
+
+/// A comprehension keeps the elements whose condition holds (issue 50, item 5):
+/// `[for i in 0..n if c { … }]`; a condition that is not a bool is E0303.
+#[test]
+fn comprehensions_keep_what_their_condition_allows() {
+    let s = ok(
+        "let xs = [for i in 0..10 if i % 3 == 0 { i * 2 }];\nscene { sphere(len(xs) + xs[3]); }",
+    );
+    // 0, 3, 6, 9 kept: four elements, the last 18.
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Sphere { radius: 22.0 }
+    );
+    // Inside a function, with a hash choosing what stays.
+    let s = ok("fn some(n: int) -> shape { union([for i in 0..n if hash(i) < 2 { sphere(0.1).translate(i, 0, 0) }]) }\nscene { some(3); }");
+    assert!(matches!(
+        s.graph.node(s.root.expect("root")),
+        Node::Combine { children, .. } if children.len() == 3
+    ));
+    assert_eq!(
+        codes("let xs = [for i in 0..3 if i { i }];\nscene { sphere(); }"),
+        ["E0303"]
+    );
+}

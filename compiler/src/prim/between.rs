@@ -9,6 +9,7 @@ use super::Kind::{Float as F, Vec3 as V};
 use super::Range::{Any, NonNeg, Pos};
 use super::{num, param, Args, Def, Extent, Field, Prim};
 use crate::program::builder::{Builder, P};
+use glam::DVec3;
 
 type V3 = [f64; 3];
 
@@ -144,10 +145,11 @@ fn frame(b: &mut Builder, p: P, args: &Args) -> (P, f64) {
     let k = (0..3)
         .min_by(|&i, &j| u[i].abs().total_cmp(&u[j].abs()))
         .unwrap_or(0);
-    let mut axis = [0.0; 3];
+    let mut axis = DVec3::ZERO;
     axis[k] = 1.0;
-    let e1 = normalise(cross(axis, u));
-    let e3 = cross(e1, u);
+    let e1 = axis.cross(DVec3::from(u)).normalize();
+    let e3 = e1.cross(DVec3::from(u));
+    let (e1, e3) = (e1.to_array(), e3.to_array());
     let mid: V3 = [0, 1, 2].map(|i| (from[i] + to[i]) / 2.0);
     let d = b.sub3c(p, mid);
     let q = [e1, u, e3].map(|row| {
@@ -156,17 +158,4 @@ fn frame(b: &mut Builder, p: P, args: &Args) -> (P, f64) {
         b.add(s, terms[2])
     });
     (q, l / 2.0)
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normalise(v: V3) -> V3 {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|x| x / l)
 }

@@ -3,6 +3,7 @@
 
 use super::types::{Type, Value};
 use crate::limits::{Limit, Limits};
+use crate::lower::hash_of;
 use crate::prim::{Args, Kind, Prim, PrimRef};
 pub use crate::prim::{Def, Range};
 use crate::scene::{Camera, Combine, Feature, Graph, Material, Node, NodeId, Settings, Smooth, V3};
@@ -1439,6 +1440,7 @@ static FUNCTIONS: &[Builtin] = &[
         sigs: sigs![
             [p("x", I, Req, Any)] -> I => |_, a| match &a[0] { Value::Int(i) => i.checked_abs().map(Value::Int).ok_or_else(|| "integer overflow".to_string()), _ => Ok(Value::Error) };
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::abs);
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::abs));
             [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::abs));
         ],
     },
@@ -1446,18 +1448,24 @@ static FUNCTIONS: &[Builtin] = &[
         name: "floor",
         sigs: sigs![
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::floor);
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::floor));
+            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::floor));
         ],
     },
     Builtin {
         name: "ceil",
         sigs: sigs![
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::ceil);
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::ceil));
+            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::ceil));
         ],
     },
     Builtin {
         name: "fract",
         sigs: sigs![
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, |x| x - x.floor());
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], |x| x - x.floor()));
+            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], |x| x - x.floor()));
         ],
     },
     Builtin {
@@ -1552,6 +1560,9 @@ static FUNCTIONS: &[Builtin] = &[
         name: "hash",
         sigs: sigs![
             [p("seed", I, Req, Any)] -> F => |_, a| match &a[0] { Value::Int(i) => Ok(Value::Float(hash(*i))), _ => Ok(Value::Error) };
+            [p("cell", F, Req, Any)] -> F => |_, a| Ok(Value::Float(hash_of(&[a[0].num()])));
+            [p("cell", V2, Req, Any)] -> F => |_, a| match &a[0] { Value::Vec2(v) => Ok(Value::Float(hash_of(v))), _ => Ok(Value::Error) };
+            [p("cell", V, Req, Any)] -> F => |_, a| match &a[0] { Value::Vec3(v) => Ok(Value::Float(hash_of(v))), _ => Ok(Value::Error) };
         ],
     },
     Builtin {

@@ -1,5 +1,5 @@
 //! Checker tests of what users of other tools write: division, names that hide built-ins,
-//! web colours, angles, `max_dist` and `len`.
+//! web colours, angles, `max_dist`, `len`, recursion and hashes of lattice cells.
 
 use super::{check_str, codes, ok};
 use crate::scene::Node;
@@ -275,5 +275,57 @@ fn comprehensions_keep_what_their_condition_allows() {
     assert_eq!(
         codes("let xs = [for i in 0..3 if i { i }];\nscene { sphere(); }"),
         ["E0303"]
+    );
+}
+
+#[test]
+fn hashes_of_lattice_cells_agree_in_the_checker_and_in_fields_of_either_precision() {
+    use crate::eval::eval_point;
+    // A field reads `p` through `hash`: the distance at a point of cell (i, j) is that cell's
+    // hash minus 2, the same as `hash` of a constant in the cell, in f64 and in f32.
+    let field = ok("scene { field(lipschitz: 1) { hash(p.xy) - 2 }; }");
+    let program = crate::lower::lower(&field);
+    let mut seen = std::collections::BTreeSet::new();
+    for i in -32..32 {
+        for j in -32..32 {
+            let at = [i as f64 + 0.37, j as f64 + 0.81, 0.0];
+            let constant = ok(&format!(
+                "let h = hash(vec2({}, {}));\nscene {{ sphere(h); }}",
+                at[0], at[1]
+            ));
+            let Node::Sphere { radius } = constant.graph.node(constant.root.expect("root")) else {
+                panic!("not a sphere")
+            };
+            assert!(*radius > 0.0 && *radius < 1.0, "{radius}");
+            let (d64, _) = eval_point::<f64>(&program, at);
+            assert!(
+                (d64 + 2.0 - radius).abs() < 1e-12,
+                "cell ({i}, {j}): {d64} {radius}"
+            );
+            let (d32, _) = eval_point::<f32>(&program, at.map(|x| x as f32));
+            assert!(
+                (d32 as f64 - d64).abs() < 1e-6,
+                "cell ({i}, {j}): {d32} {d64}"
+            );
+            // Constant within the cell.
+            let (corner, _) = eval_point::<f64>(&program, [i as f64 + 0.999, j as f64, 0.0]);
+            assert_eq!(corner, d64, "cell ({i}, {j})");
+            seen.insert((*radius * 1e9) as i64);
+        }
+    }
+    // 4096 cells, nearly all different (the hash has 289² values).
+    assert!(seen.len() > 4000, "{} distinct hashes", seen.len());
+    // A step at every cell's side: the field is a bound of unknown slope unless declared.
+    let s = ok("scene { field { p.y - hash(floor(p.x * 4)) }; }");
+    let analysis = crate::scene::analysis::analyse(&s);
+    let cause = analysis
+        .root()
+        .and_then(|r| r.cause)
+        .expect("no bound proven");
+    assert_eq!(crate::scene::analysis::kind(s.graph.node(cause)), "field");
+    // An int seed keeps its own hash, known when the scene is checked.
+    assert_eq!(
+        codes("let h = hash(3) + hash(3.5) + hash((1, 2, 3));\nlight point { position: (0, 5, 0) }\nscene { sphere(h); }"),
+        Vec::<&str>::new()
     );
 }

@@ -329,3 +329,39 @@ fn hashes_of_lattice_cells_agree_in_the_checker_and_in_fields_of_either_precisio
         Vec::<&str>::new()
     );
 }
+
+#[test]
+fn lists_concatenate_with_plus() {
+    let s = ok("let xs = [1, 2] + [3.5];\n\
+                fn twigs(n: int) -> [shape] { if n == 0 { [sphere(0.1)] } else { twigs(n - 1) + [sphere(0.1).translate(n, 0, 0)] } }\n\
+                light point { position: (0, 5, 0) }\n\
+                scene { union(twigs(3)).translate(xs[2], 0, 0); }");
+    let mut spheres = 0;
+    let mut moved = Vec::new();
+    for id in s.graph.ids() {
+        match s.graph.node(id) {
+            Node::Sphere { .. } => spheres += 1,
+            Node::Translate { offset, .. } => moved.push(offset[0]),
+            _ => {}
+        }
+    }
+    assert_eq!(spheres, 1, "one sphere, shared");
+    moved.sort_by(f64::total_cmp);
+    assert_eq!(moved, [1.0, 2.0, 3.0, 3.5]);
+    // Lists of different element types do not concatenate.
+    assert_eq!(
+        codes("let xs = [1] + [sphere(1)];\nscene { sphere(1); }"),
+        ["E0301"]
+    );
+    // Growing a list spends fuel by its elements: a list doubled 40 times stops at a limit.
+    let src =
+        "fn grow(n: int) -> [float] { if n == 0 { [1.0] } else { let h = grow(n - 1); h + h } }\n\
+               let xs = grow(40);\nscene { sphere(xs[0]); }";
+    let (_, diags, _) = check_str("t.sdf", src);
+    assert!(
+        diags
+            .iter()
+            .any(|d| d.code == "E0507" && d.message.contains("elements")),
+        "{diags:#?}"
+    );
+}

@@ -135,14 +135,17 @@ impl Imp {
         match self {
             Imp::Fn(f) => f(b, a),
             Imp::Prim(prim) => {
-                let args = Args(
-                    a.iter()
-                        .map(|v| {
-                            let c = v.components();
-                            [0, 1, 2].map(|i| c.get(i).copied().unwrap_or(0.0))
-                        })
-                        .collect(),
-                );
+                let three = |v: &Value| {
+                    let c = v.components();
+                    [0, 1, 2].map(|i| c.get(i).copied().unwrap_or(0.0))
+                };
+                let mut args = Args(a.iter().map(three).collect());
+                for (i, v) in a.iter().enumerate() {
+                    if let Value::List(_, items) = v {
+                        args.0[i] = [items.len() as f64, 0.0, 0.0];
+                        args.0.extend(items.iter().map(three));
+                    }
+                }
                 if let Some(why) = (prim.check)(&args) {
                     return Err(why);
                 }
@@ -834,6 +837,7 @@ fn kind_type(k: Kind) -> Type {
         Kind::Angle => Type::Angle,
         Kind::Vec2 => Type::Vec2,
         Kind::Vec3 => Type::Vec3,
+        Kind::Points => Type::List(&Type::Vec3),
     }
 }
 
@@ -1276,6 +1280,16 @@ static FUNCTIONS: &[Builtin] = &[
         name: "round",
         sigs: sigs![
             [shape("shape"), p("radius", F, Req, NonNeg)] -> S => |b, a| b.node(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    // OpenSCAD's `minkowski` with a ball is a rounding: the distance less the radius.
+    Builtin {
+        name: "minkowski",
+        sigs: sigs![
+            [shape("shape"), shape("ball")] -> S => |b, a| match *b.graph.node(sh(&a[1])) {
+                Node::Sphere { radius } => b.node(Node::Round { radius, child: sh(&a[0]) }),
+                _ => Err("`minkowski` takes a ball about the origin, `sphere(r)`, as its second shape: it is `shape.round(r)`; the sum with another shape has no exact distance here".to_string()),
+            };
         ],
     },
     Builtin {

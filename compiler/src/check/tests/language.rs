@@ -365,3 +365,49 @@ fn lists_concatenate_with_plus() {
         "{diags:#?}"
     );
 }
+
+#[test]
+fn hulls_of_points_and_minkowski_with_a_ball() {
+    let light = "light point { position: (0, 5, 0) }\n";
+    let s = ok(&format!(
+        "{light}scene {{ hull([for i in 0..8 {{ (hash(i), hash(i + 8), hash(i + 16)) }}]); }}"
+    ));
+    let Node::Prim { prim, args } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a primitive")
+    };
+    assert_eq!((prim.name, args.list(0).len(), args.f(1)), ("hull", 8, 0.0));
+    // Points in one plane have no volume without a radius: said at the call, with the fix.
+    let (_, diags, _) = check_str(
+        "t.sdf",
+        &format!("{light}scene {{ hull([(0, 0, 0), (1, 0, 0), (0, 0, 1), (1, 0, 1)]); }}"),
+    );
+    let d = diags.iter().find(|d| d.is_error()).expect("an error");
+    assert!(
+        d.message.contains("one plane") && d.message.contains("radius"),
+        "{d:#?}"
+    );
+    assert_eq!(
+        codes(&format!(
+            "{light}scene {{ hull([(0, 0, 0), (1, 0, 0), (0, 0, 1)], radius: 0.1); }}"
+        )),
+        Vec::<&str>::new()
+    );
+    // minkowski with a ball is the rounding; with anything else it says what it takes.
+    let s = ok(&format!(
+        "{light}scene {{ minkowski(box((1, 1, 1)), sphere(0.2)); }}"
+    ));
+    assert!(matches!(
+        s.graph.node(s.root.expect("root")),
+        Node::Round { radius, .. } if *radius == 0.2
+    ));
+    let (_, diags, _) = check_str(
+        "t.sdf",
+        &format!("{light}scene {{ minkowski(box((1, 1, 1)), box((0.1, 0.1, 0.1))); }}"),
+    );
+    assert!(
+        diags
+            .iter()
+            .any(|d| d.is_error() && d.message.contains("round(r)")),
+        "{diags:#?}"
+    );
+}

@@ -34,11 +34,22 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 def _caller() -> Tuple[str, int]:
     """The file and line of the nearest caller outside this package."""
     f = sys._getframe(1)
-    while f is not None and os.path.dirname(os.path.abspath(f.f_code.co_filename)) == _HERE:
+    while f is not None and _inside(f.f_code.co_filename):
         f = f.f_back
     if f is None:
         return ("<unknown>", 0)
     return (f.f_code.co_filename, f.f_lineno)
+
+
+_INSIDE: Dict[str, bool] = {}
+
+
+def _inside(filename: str) -> bool:
+    """Whether the file is one of this package's (asked once per file)."""
+    inside = _INSIDE.get(filename)
+    if inside is None:
+        inside = _INSIDE[filename] = os.path.dirname(os.path.abspath(filename)) == _HERE
+    return inside
 
 
 # --- values -------------------------------------------------------------------------------

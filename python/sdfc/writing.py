@@ -109,9 +109,6 @@ class Text:
             if isinstance(item, End):
                 self.spans.append((item.start, self.pos, item.node._loc))
                 continue
-            if not isinstance(item, model._Expr):
-                self.write(value(item))
-                continue
             name = self.names.get(id(item))
             if name is not None:
                 self.write(name)
@@ -120,7 +117,7 @@ class Text:
             stack.extend(reversed(self._parts(item)))
 
     def _parts(self, n: model._Expr) -> List[Any]:
-        """The pieces of a node's text: strings, values and child nodes, in order."""
+        """The pieces of a node's text, in order: text, and child nodes."""
         if n._name == "@":
             return [n._args[0][1], f" @ {self.materials[id(n._args[1][1])]}"]
         if n._name in ("field", "profile"):
@@ -128,7 +125,7 @@ class Text:
             head = n._name if lipschitz is None else f"{n._name}(lipschitz: {num(lipschitz)})"
             out: List[Any] = [head + " { "]
             for name, v in n._args[2:]:
-                out += [f"let {name} = ", v, "; "]
+                out += [f"let {name} = ", piece(v), "; "]
             return out + [formula, " }"]
         args = n._args
         if n._flat and n._name in ("union", "intersect"):
@@ -152,7 +149,7 @@ class Text:
             if p is not None:
                 previous = max(previous, p.index)
             items.append(f"{p.name}: " if named and p is not None else "")
-            items.append(v)
+            items.append(v if isinstance(v, list) else piece(v))
         if n._method and args and isinstance(args[0][1], model._Expr):
             out = [args[0][1], f".{n._name}("]
             rest = items[2:]
@@ -202,8 +199,14 @@ def joined(items: Sequence[Any]) -> List[Any]:
     for i, v in enumerate(items):
         if i:
             out.append(", ")
-        out.append(v)
+        out.append(piece(v))
     return out
+
+
+def piece(v: Any) -> Any:
+    """A value as a piece of a node's text: a node stays one (its text is written in its
+    turn, its span recorded), any other value becomes its text."""
+    return v if isinstance(v, model._Expr) else value(v)
 
 
 def walk(root: model._Expr) -> Tuple[List[model._Expr], Dict[int, int]]:

@@ -327,7 +327,7 @@ class _Expr:
                 out.extend(x for x in v if isinstance(x, _Expr))
         return out
 
-    def _binary(self, other: Any, name: str, op: str) -> "_Expr":
+    def _binary(self, other: Any, name: str) -> "_Expr":
         if not isinstance(other, type(self)):
             return NotImplemented
         ty = "shape" if isinstance(self, Shape) else "profile"
@@ -337,18 +337,18 @@ class _Expr:
 
     def __or__(self, other: Any) -> Any:
         """`a | b`: `union(a, b)`."""
-        return self._binary(other, "union", "|")
+        return self._binary(other, "union")
 
     def __and__(self, other: Any) -> Any:
         """`a & b`: `intersect(a, b)`."""
-        return self._binary(other, "intersect", "&")
+        return self._binary(other, "intersect")
 
     def __sub__(self, other: Any) -> Any:
         """`a - b`: `subtract(a, b)`."""
-        return self._binary(other, "subtract", "-")
+        return self._binary(other, "subtract")
 
     def source(self) -> str:
-        """The expression's `.sdf` text."""
+        """The expression's `.sdf` text (a profile's as a `let`; a shape's is a file)."""
         return writing.fmt(writing.Text(self, profile=isinstance(self, Profile)).text)
 
     def __repr__(self) -> str:
@@ -387,8 +387,6 @@ class Shape(_Expr):
 
     def _text(self, camera: Any, lights: Any, render: Any) -> "writing.Text":
         settings = _settings(camera, lights, render)
-        if camera is None and lights is None and render is None:
-            pass
         if camera is None:
             framed = _framing(self)
             if framed is not None:
@@ -410,9 +408,11 @@ class Shape(_Expr):
         the offending shape."""
         return writing.compiled(self._text(camera, lights, render), set, limits)
 
-    def _bare(self) -> Any:
+    def _bare(self, limits: Optional[Dict[str, int]] = None) -> Any:
         """The shape's scene without camera or lights (what meshes, distances and facts
-        read), compiled once."""
+        read), compiled once (with other `limits` than the default, each time)."""
+        if limits is not None:
+            return writing.compiled(writing.Text(self), None, limits)
         kept = _BARE.get(id(self))
         if kept is not None and kept[0] is self:
             return kept[1]
@@ -428,10 +428,12 @@ class Shape(_Expr):
         bounds: Optional[Sequence[Sequence[float]]] = None,
         voxel: Optional[float] = None,
         sharp: bool = True,
+        limits: Optional[Dict[str, int]] = None,
     ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(vertices, faces, colours) as `sdfc.Scene.mesh` gives them: watertight, sharp
-        edged; `resolution` cells along the longest side (128) or `voxel` a cell's edge."""
-        return self._bare().mesh(resolution=resolution, bounds=bounds, voxel=voxel, sharp=sharp)
+        edged; `resolution` cells along the longest side (128) or `voxel` a cell's edge;
+        `limits` as `sdfc.Scene`'s (`{"memory": 8192}` for a finer mesh)."""
+        return self._bare(limits).mesh(resolution=resolution, bounds=bounds, voxel=voxel, sharp=sharp)
 
     def save(
         self,
@@ -440,10 +442,12 @@ class Shape(_Expr):
         bounds: Optional[Sequence[Sequence[float]]] = None,
         voxel: Optional[float] = None,
         sharp: bool = True,
+        limits: Optional[Dict[str, int]] = None,
     ) -> Tuple[int, int]:
         """Meshes the shape and writes it to `path` as `sdfc mesh -o PATH` does, in the
-        format of its extension (.stl, .obj, .ply, .glb): (triangles, vertices)."""
-        return self._bare().save(os.fspath(path), resolution=resolution, bounds=bounds, voxel=voxel, sharp=sharp)
+        format of its extension (.stl, .obj, .ply, .glb): (triangles, vertices); the other
+        parameters as `mesh`'s."""
+        return self._bare(limits).save(os.fspath(path), resolution=resolution, bounds=bounds, voxel=voxel, sharp=sharp)
 
     def distance(self, points: Any, backend: str = "cpu") -> np.ndarray:
         """The signed distance at each of `points` ((n, 3), or one point): float64 on the

@@ -65,10 +65,21 @@ class Shape(_Expr):
         limits: Optional[Dict[str, int]] = ...,
     ) -> Scene: ...
     def mesh(
-        self, resolution: Optional[int] = ..., bounds: Optional[Sequence[Sequence[float]]] = ..., voxel: Optional[float] = ..., sharp: bool = ...
+        self,
+        resolution: Optional[int] = ...,
+        bounds: Optional[Sequence[Sequence[float]]] = ...,
+        voxel: Optional[float] = ...,
+        sharp: bool = ...,
+        limits: Optional[Dict[str, int]] = ...,
     ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]: ...
     def save(
-        self, path: Any, resolution: Optional[int] = ..., bounds: Optional[Sequence[Sequence[float]]] = ..., voxel: Optional[float] = ..., sharp: bool = ...
+        self,
+        path: Any,
+        resolution: Optional[int] = ...,
+        bounds: Optional[Sequence[Sequence[float]]] = ...,
+        voxel: Optional[float] = ...,
+        sharp: bool = ...,
+        limits: Optional[Dict[str, int]] = ...,
     ) -> Tuple[int, int]: ...
     def distance(self, points: Any, backend: str = ...) -> np.ndarray: ...
     def facts(self) -> Facts: ...

@@ -344,6 +344,24 @@ class Stubs(unittest.TestCase):
             self.assertEqual(public - stubbed - inherited, set())
 
 
+class Fogleman(unittest.TestCase):
+    def test_the_ports_of_fogleman_sdf_examples_run(self):
+        # bench/fogleman: fogleman/sdf's README examples in sdfc's Python, each meshed coarsely
+        # here (the benchmark meshes them at the peer's cell size): closed meshes.
+        import runpy
+
+        names = ["example", "gearlike", "knurling", "blobby", "weave"]
+        bounds = {"weave": ((-12.2, -12.2, -0.6), (12.2, 12.2, 0.6))}
+        for name in names:
+            with self.subTest(name):
+                f = runpy.run_path(str(ROOT / "bench" / "fogleman" / f"{name}.py"))["f"]
+                v, faces, _ = f.mesh(resolution=48, bounds=bounds.get(name))
+                self.assertGreater(len(faces), 1000)
+                edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+                _, counts = np.unique(edges, axis=0, return_counts=True)
+                self.assertTrue((counts == 2).all())
+
+
 class Docs(unittest.TestCase):
     def test_readme_model_example_runs(self):
         text = (ROOT / "README.md").read_text().split("## Model in Python", 1)[1]

@@ -6,8 +6,9 @@ For each example: the peer's `save` as the example calls it (its samples, its bo
 estimate, its threads; binary STL), timed, once; sdfc's `Shape.save` of the port at the
 peer's cell size over the peer's bounds (binary STL), timed, the median of `--runs`; the
 triangles; whether each mesh is closed (every edge, its vertices welded by position, in
-exactly two triangles); and how far each mesh's vertices lie from the surfaces, by the
-peer's field and by sdfc's, in cells.
+exactly two triangles); how far each mesh's vertices lie from the surfaces, by the peer's
+field and by sdfc's, and its triangles' centres by sdfc's, in cells (mean, 99th percentile,
+largest).
 
     python bench/fogleman/side_by_side.py --peer-python /path/to/venv-with-sdf-fork/bin/python \\
         --examples /path/to/fogleman-sdf/examples [--runs 3] [--only example,gearlike]
@@ -69,8 +70,8 @@ def main():
     peer = [args.peer_python, str(HERE / "peer.py")]
     load = os.getloadavg()
     print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, {platform.processor() or platform.machine()}, load {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
-    print("| example | lines (peer / sdfc) | samples | cell | peer s | sdfc s | speed-up | triangles (peer / sdfc) | open edges (peer / sdfc) | peer's vertices from the surface, cells: by peer / by sdfc (mean, p99, max) | sdfc's vertices: by sdfc / by peer |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| example | lines (peer / sdfc) | samples | cell | peer s | sdfc s | speed-up | triangles (peer / sdfc) | open edges (peer / sdfc) | peer's vertices from the surface, cells: by peer / by sdfc (mean, p99, max) | sdfc's vertices: by sdfc / by peer | triangle centres by sdfc's field: peer / sdfc |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in args.only.split(","):
         example = Path(args.examples) / f"{name}.py"
         ours = HERE / f"{name}.py"
@@ -102,6 +103,10 @@ def main():
         peer_by_ours = stats(shape.distance(peer_vertices), step)
         ours_by_ours = stats(shape.distance(v), step)
         ours_by_peer = stats(np.load(out / "ov-d.npy"), step)
+        # The triangles' centres, by sdfc's field: how far the faces, not only their
+        # corners, stray from the surface.
+        centres_peer = stats(shape.distance(tri_peer.mean(axis=1)), step)
+        centres_ours = stats(shape.distance(tri_ours.mean(axis=1)), step)
 
         def three(s):
             return f"{s['mean']:.3f}, {s['p99']:.3f}, {s['max']:.3f}"
@@ -110,7 +115,8 @@ def main():
         print(
             f"| {name} | {lines[0]} / {lines[1]} | 2^{int(np.log2(info['samples']))} | {step:.4f} | {info['seconds']:.2f} | {ours_s:.3f} | {info['seconds'] / ours_s:.1f}× "
             f"| {info['triangles']} / {len(tri_ours)} | {open_edges(tri_peer)} / {open_edges(tri_ours)} "
-            f"| {three(peer_by_peer)} / {three(peer_by_ours)} | {three(ours_by_ours)} / {three(ours_by_peer)} |",
+            f"| {three(peer_by_peer)} / {three(peer_by_ours)} | {three(ours_by_ours)} / {three(ours_by_peer)} "
+            f"| {three(centres_peer)} / {three(centres_ours)} |",
             flush=True,
         )
 

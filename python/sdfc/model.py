@@ -348,7 +348,7 @@ class _Expr:
         return self._binary(other, "subtract")
 
     def source(self) -> str:
-        """The expression's `.sdf` text (a profile's as a `let`; a shape's is a file)."""
+        """The expression's `.sdf` text (a profile's as `let result = …;`; a shape's is a file)."""
         return writing.fmt(writing.Text(self, profile=isinstance(self, Profile)).text)
 
     def __repr__(self) -> str:

@@ -30,7 +30,6 @@ def string(s: str) -> str:
     return '"' + "".join(ESCAPES.get(c, c) for c in s) + '"'
 
 
-
 class Text:
     """The `.sdf` text of a shape (with its settings) and, for each node, the range of the
     text it wrote and the Python line that built it."""
@@ -43,6 +42,7 @@ class Text:
         self.loc = model._caller()
         nodes, self.uses = walk(root)
         uses = self.uses
+        self.names: Dict[int, str] = {}
         materials: Dict[int, str] = {}
         for n in nodes:
             if n._name == "@":
@@ -53,30 +53,31 @@ class Text:
         self.materials = materials
         for s in settings:
             self._record(s, "light " if s._group == "light" else "", "\n", materials)
-        # A node used more than once (and not a leaf) is written once, as a `let`.
-        self.names: Dict[int, str] = {}
+        # A node used more than once (and not a leaf) is written once, as a `let`: in the
+        # scene block, or for a profile alone before it, as constants.
         counts = {"shape": 0, "profile": 0}
         shared = [n for n in nodes if uses[id(n)] > 1 and n._children()]
-        if profile:
-            self.write("let profile0 = ")
-        else:
+        indent = "" if profile else "    "
+        if not profile:
             self.write("scene {\n")
         for n in shared:
             kind = "profile" if isinstance(n, model.Profile) else "shape"
             counts[kind] += 1
             name = f"{kind}{counts[kind]}"
-            self.write(f"    let {name} = ")
+            self.write(f"{indent}let {name} = ")
             self.emit(n)
             self.write(";\n")
             self.names[id(n)] = name
-        self.body = self.pos
-        self.write("" if profile else "    ")
+        self.write("let result = " if profile else indent)
+        self.body = (self.pos, 0)
         self.emit(root)
+        self.body = (self.body[0], self.pos)
         self.write(";\n" if profile else ";\n}\n")
         self.text = "".join(self.parts)
 
     def expression(self) -> str:
-        return self.text[self.body :].strip().removeprefix("let profile0 = ").rstrip(";\n}").strip()
+        """The text of the root's expression (shared parts by their names)."""
+        return self.text[self.body[0] : self.body[1]]
 
     def write(self, s: str) -> None:
         self.parts.append(s)

@@ -16,7 +16,6 @@ use sdfc_compiler::{
 };
 use sdfc_runtime::backend::{Backend, Devices, Kernel, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
-use sdfc_runtime::commands::mesh as mesher;
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::frontend::{self, Source};
 use sdfc_runtime::image::Image;

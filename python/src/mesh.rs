@@ -87,8 +87,11 @@ fn surface(scene: &Scene, ask: Ask) -> Result<(Mesh, Checked), Failure> {
     Ok((meshed.mesh, checked))
 }
 
-/// The mesh as bytes: positions (f64), triangles (u32), linear vertex colours (f32).
-pub fn arrays(scene: &Scene, ask: Ask) -> Result<(Vec<u8>, Vec<u8>, Vec<u8>), Failure> {
+/// A mesh as bytes: positions (f64), triangles (u32), linear vertex colours (f32).
+pub type Arrays = (Vec<u8>, Vec<u8>, Vec<u8>);
+
+/// The mesh as [`Arrays`].
+pub fn arrays(scene: &Scene, ask: Ask) -> Result<Arrays, Failure> {
     let (mesh, checked) = surface(scene, ask)?;
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = Palette::new(&checked.scene, &colours);

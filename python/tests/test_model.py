@@ -190,6 +190,21 @@ class RoundTrip(unittest.TestCase):
         np.testing.assert_array_equal(m, shape.scene().distance(POINTS)[1])
         self.assertGreater(len(set(m)), 1)
 
+    def test_shared_profiles_and_colour_fields(self):
+        c = sdfc.circle(0.5).translate(1, 0)
+        p = c | c.rotate(90)
+        self.assertEqual(p.source(), "let profile1 = circle(0.5).translate(1, 0);\nlet result = union(profile1, profile1.rotate(90deg));\n")
+        self.assertIn("<sdfc.Profile union(profile1, profile1.rotate(90deg))>", repr(p))
+        solid = p.extrude(0.2)
+        self.assertLess(solid.distance([0, 1, 0])[0], 0)
+        stripes = sdfc.Phong(color=sdfc.field("vec3(0.5 + 0.5 * sin(8 * p.y), 0.3, 0.3)"))
+        ball = sdfc.sphere(1) @ stripes
+        self.assertIn("material m1 = phong { color: field { vec3(0.5 + 0.5 * sin(8 * p.y), 0.3, 0.3) } };", ball.source())
+        image = ball.render(size=(32, 24), backend="cpu")
+        # The stripes: red varies over the ball while green stays, whatever the shading.
+        middle = image[6:18, 10:22]
+        self.assertGreater(np.ptp(middle[..., 0] / np.maximum(middle[..., 1], 1e-6)), 1.0)
+
     def test_facts(self):
         f = sdfc.sphere(1).translate(1, 2, 3).facts()
         self.assertEqual((f.exactness, f.lipschitz), ("exact", 1.0))

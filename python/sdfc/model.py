@@ -203,7 +203,7 @@ class _Param:
 
 
 class _Sig:
-    __slots__ = ("index", "params", "rest", "ret", "signature")
+    __slots__ = ("index", "params", "rest", "ret", "signature", "method")
 
     def __init__(self, d: Dict[str, Any], index: int) -> None:
         self.index = index
@@ -211,6 +211,7 @@ class _Sig:
         self.rest = d["rest"]
         self.ret = d["ret"]
         self.signature = d["signature"]
+        self.method = d["method"]
 
 
 class _Builtin:
@@ -712,7 +713,7 @@ FUNCTIONS: Dict[str, Any] = {n: _make(n) for n in SHAPE_BUILTINS}
 # the name is one of the shape's own (`mesh`, `distance`, …).
 for _n in SHAPE_BUILTINS:
     for _cls, _ty in ((Shape, "shape"), (Profile, "profile")):
-        if any(s.params and s.params[0].type == _ty and s.ret in ("shape", "profile") for s in BUILTINS[_n].sigs):
+        if any(s.method == _ty and s.ret in ("shape", "profile") for s in BUILTINS[_n].sigs):
             if _n not in _cls.__dict__ and _n not in _Expr.__dict__:
                 setattr(_cls, _n, _make_method(_n, _cls))
 

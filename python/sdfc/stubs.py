@@ -174,7 +174,7 @@ def generate() -> str:
             # The methods model.py made from the table (not the shape's own of that name).
             if not getattr(getattr(getattr(model, cls), name, None), "_table", False):
                 continue
-            mine = [s for s in sigs if s.params and s.params[0].type == ty]
+            mine = [s for s in sigs if s.method == ty]
             out += _defs(name, mine, True, "", "    ")
         out.append("")
     for name, sigs in shaped.items():

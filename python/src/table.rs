@@ -48,8 +48,9 @@ fn checked(range: Range) -> bool {
 }
 
 /// `builtins()`: every built-in of the checker's table, in its order: `{"name", "doc",
-/// "sigs": [{"params", "rest", "ret"}]}` (`doc` the markdown the language server's hover
-/// shows: each signature with its valid values and what it does).
+/// "sigs": [{"params", "rest", "ret", "signature", "method"}]}` (`doc` the markdown the
+/// language server's hover shows: each signature with its valid values and what it does;
+/// `method` "shape" or "profile" where the form is a method of one, else None).
 #[pyfunction]
 pub fn builtins(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     let list = PyList::empty(py);
@@ -66,6 +67,15 @@ pub fn builtins(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
             }
             s.set_item("params", params)?;
             s.set_item("rest", sig.rest)?;
+            // A method of the shape or profile its first parameter takes (`a.f(b)` is
+            // `f(a, b)` for every function; Python offers it where the first is one).
+            let receiver = sig.params.first().map(|p| p.ty);
+            let method = match receiver {
+                Some(Type::Shape) => Some("shape"),
+                Some(Type::Profile) => Some("profile"),
+                _ => None,
+            };
+            s.set_item("method", method)?;
             s.set_item("ret", sig.ret.to_string())?;
             s.set_item("signature", language::signature(b.name, sig))?;
             sigs.append(s)?;

@@ -232,8 +232,9 @@ VALUE_BUILTINS: List[str] = [n for n in BUILTINS if n not in SHAPE_BUILTINS]
 
 
 def _bind(b: _Builtin, sig: _Sig, args: Sequence[Any], kwargs: Dict[str, Any]) -> Tuple[int, Any]:
-    """Binds the call to one overload: (how many parameters fit, the bound arguments as
-    [(param, value)] in order) or (fit, an error to raise)."""
+    """Binds the call to one overload: (how many arguments fit, the bound arguments as
+    [(param, value)] in the parameters' order, a repeated one's values in theirs) or (how
+    many fit before the first that does not, the error to raise)."""
     params = sig.params
     bound: List[Tuple[_Param, Any]] = []
     fit = 0
@@ -253,6 +254,7 @@ def _bind(b: _Builtin, sig: _Sig, args: Sequence[Any], kwargs: Dict[str, Any]) -
         bound.append((next(p for p in params if p.name == k), v))
         given.add(k)
     out = []
+    # Sorting is stable: a repeated (last) parameter's values keep their order.
     for p, v in sorted(bound, key=lambda pv: pv[0].index):
         try:
             out.append((p, _conform(v, p.type)))
@@ -263,11 +265,7 @@ def _bind(b: _Builtin, sig: _Sig, args: Sequence[Any], kwargs: Dict[str, Any]) -
     for p in params:
         if p.required and p.name not in given:
             return (fit, TypeError(f"missing the argument `{p.name}`"))
-    # The repeated parameter's values stay in order; the others in the parameters' order.
-    if sig.rest:
-        last = params[-1]
-        out = [pv for pv in out if pv[0] is not last] + [(last, _conform(v, last.type)) for p, v in bound if p is last]
-    return (fit + 1000, out)
+    return (fit, out)
 
 
 def _call(name: str, args: Sequence[Any], kwargs: Dict[str, Any], method: bool = False) -> "_Expr":

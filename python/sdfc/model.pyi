@@ -129,6 +129,7 @@ class Shape(_Expr):
     def taper(self, rate: float) -> Shape: ...
     def morph(self, b: Shape, t: float) -> Shape: ...
     def round(self, radius: float) -> Shape: ...
+    def minkowski(self, ball: Shape) -> Shape: ...
     def shell(self, thickness: float) -> Shape: ...
     def elongate(self, half: Vec3) -> Shape: ...
 
@@ -789,6 +790,15 @@ def round(shape: Shape, radius: float) -> Shape:
     Offsets a shape's surface outwards by `radius`.
     """
     ...
+def minkowski(shape: Shape, ball: Shape) -> Shape:
+    """```sdf
+    minkowski(shape: shape, ball: shape) -> shape
+    ```
+    Valid: `ball` is `sphere(r)`
+
+    OpenSCAD's Minkowski sum with a ball about the origin: the same node as `shape.round(r)`.
+    """
+    ...
 def shell(shape: Shape, thickness: float) -> Shape:
     """```sdf
     shell(shape: shape, thickness: float) -> shape
@@ -889,6 +899,15 @@ def slab(thickness: float = ..., normal: Vec3 = ...) -> Shape:
     The space between two parallel planes `thickness` apart, centred on the origin, normal to `normal` (normalised). Exact.
     """
     ...
+def hull(points: Sequence[Vec3], radius: float = ...) -> Shape:
+    """```sdf
+    hull(points: [vec3], radius: float = 0) -> shape
+    ```
+    Valid: 4 points or more not in one plane, or `radius` > 0
+
+    The convex hull of the points; with a `radius`, the hull of balls of that radius about them. Exact.
+    """
+    ...
 def hex_prism(radius: float = ..., height: float = ...) -> Shape:
     """```sdf
     hex_prism(radius: float = 0.5, height: float = 1) -> shape
@@ -980,4 +999,4 @@ class Camera(Record):
 class Render(Record):
     def __init__(self, *, width: int = ..., height: int = ..., aa: int = ..., max_steps: int = ..., epsilon: float = ..., max_depth: int = ..., max_dist: float = ..., relaxation: float = ..., background: Vec3 = ..., method: str = ..., fps: float = ..., duration: float = ...) -> None: ...
 
-__all__ = ["Angle", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "PointLight", "DirectionalLight", "Camera", "Render"]
+__all__ = ["Angle", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "PointLight", "DirectionalLight", "Camera", "Render"]

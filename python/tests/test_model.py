@@ -43,6 +43,7 @@ def sample(p):
         "[shape]": [sdfc.sphere(0.5), sdfc.box(0.3)],
         "[profile]": [sdfc.circle(0.5), sdfc.rect(0.3)],
         "[vec2]": [(0, 0), (1, 0), (0, 1)],
+        "[vec3]": [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)],
     }[p.type]
 
 

@@ -64,6 +64,7 @@ pub use crate::scene::{
         Animation, Camera, Colour, Combine, Exactness, Graph, Light, Material, MaterialId, Method,
         Node, Pattern, Scene, Settings, Smooth, V3,
     },
+    params::{Accepts, ParamValue, Parameter},
     NodeId,
 };
 

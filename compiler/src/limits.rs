@@ -339,11 +339,13 @@ impl Spelling {
 }
 
 /// The value of every limit for one run, and how its messages name the option that raises
-/// one ([`Spelling`]).
+/// one ([`Spelling`]); and the values given from outside for the scene's parameters
+/// (`--param name=value`), which a run is checked with beside its limits.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
     values: [u64; 24],
     spelling: Spelling,
+    params: Vec<(String, String)>,
 }
 
 impl Default for Limits {
@@ -351,6 +353,7 @@ impl Default for Limits {
         Limits {
             values: Limit::ALL.map(Limit::default_value),
             spelling: Spelling::Flags,
+            params: Vec::new(),
         }
     }
 }
@@ -359,6 +362,16 @@ impl Limits {
     /// These limits, their messages naming options as `spelling` writes them.
     pub fn spelled(self, spelling: Spelling) -> Limits {
         Limits { spelling, ..self }
+    }
+
+    /// Gives the parameter `name` the value written `value` (the last given counts).
+    pub fn set_param(&mut self, name: &str, value: &str) {
+        self.params.push((name.to_string(), value.to_string()));
+    }
+
+    /// The values given for parameters, as written, in the order given.
+    pub fn params(&self) -> &[(String, String)] {
+        &self.params
     }
 
     /// How the messages of these limits name the option that raises one.

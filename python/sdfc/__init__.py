@@ -112,7 +112,8 @@ class Scene:
     """A checked scene (raises CompileError when it has errors), from its text (`source`) or
     file (`path`), with render settings overridden as `sdfc render --set` does
     (`set={"max_steps": 512, "background": (0, 0, 0)}`), and resource limits raised or
-    lowered as `sdfc --limit` does (`limits={"memory": 8192}`; `sdfc --help` lists them).
+    lowered as `sdfc --limit` does (`limits={"memory": 8192}`; `sdfc --help` lists them),
+    and its parameters given values as `sdfc --param` does (`params={"width": 60}`).
 
     Every method is safe to call from several threads at once; renders and meshes release
     the GIL, and Ctrl-C during them raises KeyboardInterrupt."""
@@ -123,13 +124,23 @@ class Scene:
         path: Optional[str] = None,
         set: Optional[Mapping[str, Any]] = None,
         limits: Optional[Mapping[str, int]] = None,
+        params: Optional[Mapping[str, Any]] = None,
         _locate: Any = None,
     ) -> None:
         sets = [f"{k}={_setting(v)}" for k, v in (set or {}).items()]
+        values = [(k, _setting(v)) for k, v in (params or {}).items()]
         # A scene of a modelled shape places its errors at the Python lines (model.py).
         self._locate = _locate
-        self._scene = self._call(_sdfc._Scene, source, None if path is None else str(path), sets, _limits(limits))
+        self._scene = self._call(
+            _sdfc._Scene, source, None if path is None else str(path), sets, _limits(limits), values
+        )
         self.path = path
+
+    @property
+    def params(self) -> List[Dict[str, Any]]:
+        """The scene's parameters (`param`): name, type, value, default, doc, and min, max,
+        step or choices where stated."""
+        return [dict(p) for p in self._scene.params()]
 
     def info(self) -> Dict[str, Any]:
         """The scene's own settings: width, height, aa, fps, duration, and whether it reads t."""

@@ -466,15 +466,19 @@ fn backend(name: &str) -> PyResult<Backend> {
 impl Scene {
     /// Checks the scene at t = 0 (raising `CompileError`) and keeps it.
     #[new]
-    #[pyo3(signature = (source=None, path=None, set=Vec::new(), limits=Vec::new()))]
+    #[pyo3(signature = (source=None, path=None, set=Vec::new(), limits=Vec::new(), params=Vec::new()))]
     fn new(
         py: Python<'_>,
         source: Option<String>,
         path: Option<String>,
         set: Vec<String>,
         limits: Vec<String>,
+        params: Vec<(String, String)>,
     ) -> PyResult<Scene> {
-        let limits = limits_of(&limits).map_err(|f| f.into_py(py))?;
+        let mut limits = limits_of(&limits).map_err(|f| f.into_py(py))?;
+        for (name, value) in &params {
+            limits.set_param(name, value);
+        }
         let src = open(source, path.clone()).map_err(|f| f.into_py(py))?;
         let scene = Scene {
             name: path.unwrap_or_else(|| TEXT_NAME.into()),
@@ -499,6 +503,40 @@ impl Scene {
         d.set_item("duration", s.animation.duration)?;
         d.set_item("animated", s.animation.animated())?;
         Ok(d)
+    }
+
+    /// The scene's parameters (`param`), in source order: each a dict of name, type, value,
+    /// default, doc, and min, max, step or choices where the parameter states them.
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let checked = self.checked(0.0, None, None).map_err(|f| f.into_py(py))?;
+        let set = |d: &Bound<'py, PyDict>, key: &str, v: &sdfc_compiler::ParamValue| match v {
+            sdfc_compiler::ParamValue::Float(x) => d.set_item(key, *x),
+            sdfc_compiler::ParamValue::Int(i) => d.set_item(key, *i),
+            sdfc_compiler::ParamValue::Bool(b) => d.set_item(key, *b),
+            sdfc_compiler::ParamValue::Str(s) => d.set_item(key, s),
+        };
+        let mut out = Vec::new();
+        for p in &checked.scene.params {
+            let d = PyDict::new(py);
+            d.set_item("name", &p.name)?;
+            d.set_item("type", p.default.type_name())?;
+            set(&d, "value", &p.value)?;
+            set(&d, "default", &p.default)?;
+            d.set_item("doc", &p.doc)?;
+            match &p.accepts {
+                sdfc_compiler::Accepts::Any => {}
+                sdfc_compiler::Accepts::Range { lo, hi, step } => {
+                    d.set_item("min", lo)?;
+                    d.set_item("max", hi)?;
+                    if let Some(s) = step {
+                        d.set_item("step", s)?;
+                    }
+                }
+                sdfc_compiler::Accepts::Choices(c) => d.set_item("choices", c.clone())?,
+            }
+            out.push(d);
+        }
+        Ok(out)
     }
 
     /// Renders: (width, height, bytes) with float32 linear RGB (`encoding` "linear"), uint8

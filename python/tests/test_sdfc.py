@@ -401,3 +401,27 @@ class Docs(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class Parameters(unittest.TestCase):
+    SOURCE = (
+        'param width = 40.0 in 10..100 step 1 "Box width (mm)";\n'
+        'param style = "round" in ["round", "square"];\n'
+        "light point { position: (0, 5, -5) }\n"
+        "scene { box((width / 100, 0.5, 0.5)); }\n"
+    )
+
+    def test_params_are_listed_and_set(self):
+        scene = sdfc.Scene(self.SOURCE, params={"width": 60, "style": "square"})
+        width, style = scene.params
+        self.assertEqual((width["name"], width["value"], width["default"]), ("width", 60.0, 40.0))
+        self.assertEqual((width["min"], width["max"], width["step"], width["doc"]), (10.0, 100.0, 1.0, "Box width (mm)"))
+        self.assertEqual((style["value"], style["choices"]), ("square", ["round", "square"]))
+        # The value reaches the shape: the box is 1.2 wide.
+        d, _ = scene.distance(np.array([[0.7, 0.0, 0.0]]))
+        self.assertAlmostEqual(float(d[0]), 0.1, places=5)
+
+    def test_a_value_outside_is_refused_naming_the_keyword(self):
+        with self.assertRaises(sdfc.CompileError) as e:
+            sdfc.Scene(self.SOURCE, params={"width": 500})
+        self.assertIn('params={"width": 500}', str(e.exception))

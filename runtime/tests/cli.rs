@@ -1877,3 +1877,69 @@ fn a_byte_order_mark_is_skipped() {
     assert!(err.contains("first.sdf:1:9"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn parameters_are_listed_set_and_refused_before_any_work() {
+    let d = dir("params");
+    std::fs::write(
+        d.join("part.sdf"),
+        "param width = 40.0 in 10..100 \"Box width (mm)\";\n\
+         light point { position: (0, 5, -5) }\n\
+         scene { box((width / 100, 0.5, 0.5)); }\n",
+    )
+    .expect("write scene");
+    let out = sdfc(&d, &["check", "part.sdf", "--param", "width=60"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("param width = 60 (default 40) in 10..100: Box width (mm)"),
+        "{err}"
+    );
+    let out = sdfc(&d, &["check", "part.sdf", "--diagnostics", "json"]);
+    let json = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        json.contains("\"name\":\"width\"") && json.contains("\"max\":100.0"),
+        "{json}"
+    );
+    // Out of range: refused at the declaration, nothing written.
+    let out = sdfc(
+        &d,
+        &[
+            "render",
+            "part.sdf",
+            "-o",
+            "part.png",
+            "--param",
+            "width=500",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("`--param width=500` is outside") && err.contains("part.sdf:1:7"),
+        "{err}"
+    );
+    assert!(!d.join("part.png").exists());
+    let out = sdfc(
+        &d,
+        &["mesh", "part.sdf", "-o", "part.stl", "--param", "depth=3"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no parameter `depth`"));
+    // Not NAME=VALUE: refused by the command line.
+    let out = sdfc(&d, &["check", "part.sdf", "--param", "width"]);
+    assert_eq!(out.status.code(), Some(2));
+    // Given: the render is of the part that wide.
+    let out = sdfc(
+        &d,
+        &[
+            "render", "part.sdf", "-o", "part.png", "--param", "width=80", "--size", "32x24",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(png_size(&d.join("part.png")), (32, 24));
+}

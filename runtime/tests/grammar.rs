@@ -255,6 +255,7 @@ fn terminal(t: &Token) -> Sym {
     match t {
         Token::Import => Lit("import"),
         Token::Let => Lit("let"),
+        Token::Param => Lit("param"),
         Token::Fn => Lit("fn"),
         Token::Material => Lit("material"),
         Token::Camera => Lit("camera"),

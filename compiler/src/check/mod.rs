@@ -13,6 +13,7 @@ pub mod field;
 pub mod font;
 pub mod meshfile;
 mod ops;
+mod params;
 mod polygon;
 mod suggest;
 pub mod types;
@@ -380,6 +381,7 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     };
     declare_materials(cx, &mut scene, items);
     let scene_item = evaluate_items(cx, &mut scene, items);
+    params::unknown(cx, items, entry);
     check_uncalled_functions(cx);
     scene.root = scene_objects(cx, scene_item, entry);
     scene.graph = std::mem::take(&mut cx.graph);
@@ -429,7 +431,10 @@ fn evaluate_items<'a>(
                     );
                 }
                 let reads = cx.time_reads;
-                let v = cx.let_value(l);
+                let mut v = cx.let_value(l);
+                if let Some(spec) = &l.param {
+                    v = params::declare(cx, scene, l, spec, v);
+                }
                 if let (true, Some(at)) = (cx.time_reads > reads, cx.last_time_read()) {
                     cx.timed_globals.insert(l.name.name.clone(), at);
                 }

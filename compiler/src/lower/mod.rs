@@ -409,5 +409,6 @@ fn scene_without_graph(scene: &Scene) -> Scene {
         origin: scene.origin,
         limits: scene.limits.clone(),
         animation: scene.animation,
+        params: scene.params.clone(),
     }
 }

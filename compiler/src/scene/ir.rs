@@ -928,6 +928,8 @@ pub struct Scene {
     /// The animation the `render` block states, the time the scene was checked at, and
     /// whether anything in it read the time `t`.
     pub animation: Animation,
+    /// The parameters (`param`), in the order of the source, with the values checked.
+    pub params: Vec<super::params::Parameter>,
 }
 
 /// A scene's animation (docs/animation.md): frame `k` is the scene checked at the time

@@ -8,6 +8,7 @@ pub mod bounds;
 mod dump;
 pub mod field;
 pub mod ir;
+pub mod params;
 pub mod reach;
 pub mod recentre;
 

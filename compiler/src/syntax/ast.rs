@@ -22,7 +22,7 @@ pub struct File {
     pub items: Vec<Item>,
 }
 
-/// `item = import | let | fn | material | camera | light | render | scene`.
+/// `item = import | let | parameter | fn | material | camera | light | render | scene`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Item {
     /// `import "path";`
@@ -68,17 +68,33 @@ pub struct Field {
     pub value: Expr,
 }
 
-/// `let name [: type] = value;`
+/// `let name [: type] = value;`, or a parameter, `param name = value [in …] ["doc"];`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Let {
     /// The bound name.
     pub name: Ident,
     /// The declared type, if any (see [`Param::ty`]).
     pub ty: Option<Ident>,
-    /// The value.
+    /// The value (a parameter's default).
     pub value: Expr,
+    /// What makes it a parameter a user may set from outside (`--param name=value`).
+    pub param: Option<Box<ParamSpec>>,
     /// The whole declaration.
     pub span: Span,
+}
+
+/// The values a `param` accepts and what it is: `in lo..hi [step s]` for a number, `in
+/// [choices]` for a string, and a description.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamSpec {
+    /// `lo..hi`.
+    pub range: Option<(Expr, Expr)>,
+    /// `step s` after the range.
+    pub step: Option<Expr>,
+    /// `in [a, b, …]`: the strings it may be.
+    pub choices: Option<Expr>,
+    /// The description, a string.
+    pub doc: Option<Expr>,
 }
 
 /// A user function.

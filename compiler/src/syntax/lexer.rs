@@ -17,6 +17,8 @@ pub enum Token {
     Import,
     #[token("let")]
     Let,
+    #[token("param")]
+    Param,
     #[token("fn")]
     Fn,
     #[token("material")]
@@ -143,6 +145,7 @@ impl fmt::Display for Token {
         let s = match self {
             Token::Import => "import",
             Token::Let => "let",
+            Token::Param => "param",
             Token::Fn => "fn",
             Token::Material => "material",
             Token::Camera => "camera",

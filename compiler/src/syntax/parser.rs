@@ -240,6 +240,7 @@ where
                 name,
                 ty,
                 value,
+                param: None,
                 span: sp(file, e.span()),
             });
 
@@ -516,7 +517,48 @@ where
             name,
             ty,
             value,
+            param: None,
             span: sp(file, e.span()),
+        })
+        .boxed();
+
+    // `parameter = "param" ident "=" expr ["in" (expr ".." expr [ident expr] | expr)] [expr] ";"`: the ident is `step`
+    let step = select! { Token::Ident(s) if s == "step" => () };
+    let param_decl = just(Token::Param)
+        .ignore_then(ident(file))
+        .then_ignore(just(Token::Eq))
+        .then(expr.clone())
+        .then(
+            just(Token::In)
+                .ignore_then(expr.clone())
+                .then(
+                    just(Token::DotDot)
+                        .ignore_then(expr.clone())
+                        .then(step.ignore_then(expr.clone()).or_not())
+                        .or_not(),
+                )
+                .or_not(),
+        )
+        .then(expr.clone().or_not())
+        .then_ignore(just(Token::Semi))
+        .map_with(move |(((name, value), values), doc), e| {
+            let (range, step, choices) = match values {
+                Some((lo, Some((hi, step)))) => (Some((lo, hi)), step, None),
+                Some((list, None)) => (None, None, Some(list)),
+                None => (None, None, None),
+            };
+            Let {
+                name,
+                ty: None,
+                value,
+                param: Some(Box::new(ParamSpec {
+                    range,
+                    step,
+                    choices,
+                    doc,
+                })),
+                span: sp(file, e.span()),
+            }
         })
         .boxed();
 
@@ -690,6 +732,7 @@ where
     let item_start = [
         Token::Import,
         Token::Let,
+        Token::Param,
         Token::Fn,
         Token::Material,
         Token::Camera,
@@ -703,6 +746,7 @@ where
     let item = choice((
         import,
         let_decl.map(Item::Let),
+        param_decl.map(Item::Let),
         function,
         material,
         block,

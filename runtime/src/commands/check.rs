@@ -2,7 +2,9 @@
 //! derived about each scene's distance field.
 
 use crate::frontend::{self, DiagnosticFormat};
-use sdfc_compiler::{analysis, diagnostics::number, Diagnostic, Scene, Severity};
+use sdfc_compiler::{
+    analysis, diagnostics::number, Accepts, Diagnostic, ParamValue, Parameter, Scene, Severity,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -59,6 +61,13 @@ pub fn run(args: CheckArgs) -> ExitCode {
                                 )
                             );
                         }
+                        if human {
+                            for p in &scene.params {
+                                eprintln!("{}: {}", file.display(), param_line(p));
+                            }
+                        } else if !scene.params.is_empty() {
+                            println!("{}", params_json(file, &scene.params));
+                        }
                         if args.verify_bounds && !verify_bounds(&loaded, file, scene) {
                             code = code.max(1);
                         }
@@ -73,6 +82,58 @@ pub fn run(args: CheckArgs) -> ExitCode {
         }
     }
     ExitCode::from(code)
+}
+
+/// One parameter as `sdfc check` lists it: `param width = 60 (default 40) in 10..100: Box
+/// width (mm)`.
+fn param_line(p: &Parameter) -> String {
+    let mut line = format!("param {} = {}", p.name, p.value);
+    if p.value != p.default {
+        line += &format!(" (default {})", p.default);
+    }
+    if p.accepts != Accepts::Any {
+        line += &format!(" in {}", p.accepts);
+    }
+    if !p.doc.is_empty() {
+        line += &format!(": {}", p.doc);
+    }
+    line
+}
+
+/// The parameters as one JSON line: `{"file": …, "params": [{"name", "type", "value",
+/// "default", "doc", and "min", "max", "step" or "choices"}]}`.
+fn params_json(file: &std::path::Path, params: &[Parameter]) -> String {
+    let value = |v: &ParamValue| match v {
+        ParamValue::Float(x) => serde_json::json!(x),
+        ParamValue::Int(i) => serde_json::json!(i),
+        ParamValue::Bool(b) => serde_json::json!(b),
+        ParamValue::Str(s) => serde_json::json!(s),
+    };
+    let list: Vec<serde_json::Value> = params
+        .iter()
+        .map(|p| {
+            let mut o = serde_json::json!({
+                "name": p.name,
+                "type": p.default.type_name(),
+                "value": value(&p.value),
+                "default": value(&p.default),
+                "doc": p.doc,
+            });
+            match &p.accepts {
+                Accepts::Any => {}
+                Accepts::Range { lo, hi, step } => {
+                    o["min"] = serde_json::json!(lo);
+                    o["max"] = serde_json::json!(hi);
+                    if let Some(s) = step {
+                        o["step"] = serde_json::json!(s);
+                    }
+                }
+                Accepts::Choices(c) => o["choices"] = serde_json::json!(c),
+            }
+            o
+        })
+        .collect();
+    serde_json::json!({ "file": file.display().to_string(), "params": list }).to_string()
 }
 
 /// A warning where `scene`, which checks, is more than `sdfc render` and `sdfc mesh` accept

@@ -136,6 +136,10 @@ fn stdin(check: bool, file_size: u64) -> ExitCode {
 /// already were), 1 when a file has syntax errors or would change, 2 when a file cannot be
 /// read or written.
 pub fn run(args: FmtArgs) -> ExitCode {
+    if let Some((name, _)) = args.limits.param.first() {
+        eprintln!("error: `sdfc fmt` rewrites text and checks no scene: `--param {name}=…` would change nothing");
+        return ExitCode::from(2);
+    }
     let file_size = args.limits.limits().get(Limit::FileSize);
     if args.files.is_empty() || args.files == [PathBuf::from("-")] {
         return stdin(args.check, file_size);

@@ -168,6 +168,31 @@ pub struct LimitArgs {
     /// the flag that raises it.
     #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = Limits::parse)]
     pub limit: Vec<(Limit, u64)>,
+
+    /// Give the scene's parameter NAME (`param NAME = … ;`) this value instead of its
+    /// default (may be repeated); `sdfc check` lists the parameters.
+    ///
+    /// A value of the wrong type or outside the parameter's range is refused, at its
+    /// declaration, before any work.
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = param_arg)]
+    pub param: Vec<(String, String)>,
+}
+
+/// `NAME=VALUE` of `--param`.
+fn param_arg(s: &str) -> Result<(String, String), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}` is not NAME=VALUE"))?;
+    let name = name.trim();
+    let ident = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !ident {
+        return Err(format!("`{name}` is not a parameter's name"));
+    }
+    Ok((name.to_string(), value.to_string()))
 }
 
 impl LimitArgs {
@@ -177,6 +202,9 @@ impl LimitArgs {
         for &(limit, value) in &self.limit {
             // The parser has already checked the value's range.
             let _ = limits.set(limit, value);
+        }
+        for (name, value) in &self.param {
+            limits.set_param(name, value);
         }
         limits
     }

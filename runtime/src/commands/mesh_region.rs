@@ -129,8 +129,9 @@ pub fn frame(
                     Spelling::Parameters => bounds(spell, ["x0", "y0", "z0"], ["x1", "y1", "z1"]),
                 };
                 return Err(usage(format!(
-                    "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `{corners}` (what reaches out of it is cut at its faces and the cut closed){hint}",
-                    open.join(", ")
+                    "the scene is unbounded along {}: {}; give the region to mesh with `{corners}` (what reaches out of it is cut at its faces and the cut closed){hint}",
+                    open.join(", "),
+                    unbounded_parts(checked, analysis)
                 )));
             }
             [b.min, b.max]
@@ -194,6 +195,68 @@ pub fn short(x: f64) -> String {
         return sdfc_compiler::diagnostics::scientific(x);
     }
     sdfc_compiler::diagnostics::number(x, 4)
+}
+
+/// The objects that make the scene unbounded, for the message: each top-level object
+/// (through the scene's top-level unions and paints) whose box is infinite, named by the
+/// innermost node of it that is (`the plane at FILE:LINE:COL`, a field inside a translation),
+/// with the axes it is unbounded along; a field's box is what its formula proves by interval
+/// arithmetic, so a field is said to prove none. At most three, and how many more.
+fn unbounded_parts(checked: &frontend::Checked, a: &analysis::Analysis) -> String {
+    let scene = &checked.scene;
+    let open = |id: NodeId| {
+        let b = a.node(id).bounds;
+        ["x", "y", "z"]
+            .into_iter()
+            .enumerate()
+            .filter(|&(i, _)| !(b.min[i].is_finite() && b.max[i].is_finite()))
+            .map(|(_, x)| x)
+            .collect::<Vec<_>>()
+    };
+    let mut found = Vec::new();
+    let mut stack: Vec<NodeId> = scene.root.into_iter().collect();
+    while let Some(id) = stack.pop() {
+        match scene.graph.node(id) {
+            Node::Combine {
+                op: Combine::Union,
+                children,
+            } => stack.extend(children.iter().rev().copied()),
+            Node::Paint { child, .. } => stack.push(*child),
+            _ if open(id).is_empty() => {}
+            _ => {
+                let mut at = id;
+                while let Some(c) = scene
+                    .graph
+                    .node(at)
+                    .children()
+                    .into_iter()
+                    .find(|&c| !open(c).is_empty())
+                {
+                    at = c;
+                }
+                let node = scene.graph.node(at);
+                let span = scene.graph.span(at);
+                let (line, col) = checked.sources.line_col(span);
+                let axes = open(at).join(", ");
+                let how = match node {
+                    Node::Field { .. } => format!("whose formula proves no bound along {axes}"),
+                    _ => format!("unbounded along {axes}"),
+                };
+                found.push(format!(
+                    "the {} at {}:{line}:{col} ({how})",
+                    analysis::kind(node),
+                    checked.sources.name(span.file)
+                ));
+            }
+        }
+    }
+    let more = found.len().saturating_sub(3);
+    found.truncate(3);
+    let mut text = found.join(", ");
+    if more > 0 {
+        text.push_str(&format!(" and {more} more"));
+    }
+    text
 }
 
 /// The box around the scene's bounded objects: the objects of its top-level unions whose

@@ -46,9 +46,11 @@ pub use crate::{
 };
 
 /// The front end: parse, format and check `.sdf` text (imports read through a [`Loader`]),
-/// the AST and its dump, the built-ins table the checker, docs and editors read, and the
+/// the AST and its dump, the built-ins table the checker, docs, editors and the Python package
+/// read (with the types and values of its signatures), and the
 /// readers of the mesh files `mesh(path)` reads.
 pub use crate::{
+    check::types::{Type, Value},
     check::{builtins, colour::srgb_to_linear, meshfile, Constant, Loader, NoImports},
     front::{check, check_at, check_str, check_with, check_with_constants},
     syntax::{ast, dump as dump_ast, format, lexer, parse},

@@ -8,17 +8,27 @@ command (docs/python.md).
     distances, materials = scene.distance([[0, 1, 0], [0, 0, 0]])
     part = sdfc.Scene(path="examples/mesh/bracket.sdf")  # bounded: seed3's floor plane is not
     vertices, faces, colours = part.mesh(resolution=64)
+
+Shapes are Python objects too (python/sdfc/model.py, docs/python.md "Model in Python"):
+
+    f = sdfc.sphere(1) & sdfc.box(0.75)
+    f -= sdfc.cylinder(0.5, 3)
+    f.save("part.stl", resolution=128)
 """
 
 from __future__ import annotations
 
 import dataclasses
+import os
 from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _sdfc
 from ._sdfc import CompileError
+
+# Python's `round`: the package's own `round` (the language's, below) is a shape's.
+_round = round
 
 __all__ = ["CompileError", "Diagnostic", "Facts", "Scene", "check"]
 
@@ -53,7 +63,8 @@ class Diagnostic:
 class Facts:
     """What the analysis derived about a clean scene's distance field, as `sdfc check` says:
     exact, a bound or approximate; its Lipschitz bound L (None where none is proven); the
-    intersection method ("trace" or "march") and why."""
+    intersection method ("trace" or "march") and why; the box that holds the solid, (lo,
+    hi), infinite along an axis where it is unbounded (None for a scene with no objects)."""
 
     exactness: Optional[str]
     lipschitz: Optional[float]
@@ -63,6 +74,7 @@ class Facts:
     method_reason: str
     summary: str
     animated: bool
+    box: Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = None
 
 
 def _diagnostics(error: CompileError) -> List[Diagnostic]:
@@ -111,12 +123,12 @@ class Scene:
         path: Optional[str] = None,
         set: Optional[Mapping[str, Any]] = None,
         limits: Optional[Mapping[str, int]] = None,
+        _locate: Any = None,
     ) -> None:
         sets = [f"{k}={_setting(v)}" for k, v in (set or {}).items()]
-        try:
-            self._scene = _sdfc._Scene(source, None if path is None else str(path), sets, _limits(limits))
-        except CompileError as e:
-            raise _wrap(e) from None
+        # A scene of a modelled shape places its errors at the Python lines (model.py).
+        self._locate = _locate
+        self._scene = self._call(_sdfc._Scene, source, None if path is None else str(path), sets, _limits(limits))
         self.path = path
 
     def info(self) -> Dict[str, Any]:
@@ -150,7 +162,7 @@ class Scene:
         info = self._scene.info()
         w, h = info["width"], info["height"]
         if w > 640:
-            w, h = 640, max(1, round(h * 640 / w))
+            w, h = 640, max(1, _round(h * 640 / w))
         return self.png(size=(w, h))
 
     def depth(
@@ -199,15 +211,25 @@ class Scene:
         colours (n, 3) float32. `resolution` is the cells along the longest side (default
         128), or `voxel` a cell's edge; `bounds=((x0, y0, z0), (x1, y1, z1))` the region
         (needed for an unbounded scene)."""
-        b = None
-        if bounds is not None:
-            lo, hi = bounds
-            b = (tuple(float(x) for x in lo), tuple(float(x) for x in hi))
-        v, f, c = self._call(self._scene.mesh, resolution, voxel, b, sharp, float(t))
+        v, f, c = self._call(self._scene.mesh, resolution, voxel, _bounds(bounds), sharp, float(t))
         v = np.frombuffer(v, dtype=np.float64).reshape(-1, 3).copy()
         f = np.frombuffer(f, dtype=np.uint32).reshape(-1, 3).copy()
         c = np.frombuffer(c, dtype=np.float32).reshape(-1, 3).copy()
         return (v, f, c)
+
+    def save(
+        self,
+        path: Any,
+        resolution: Optional[int] = None,
+        bounds: Optional[Sequence[Sequence[float]]] = None,
+        voxel: Optional[float] = None,
+        sharp: bool = True,
+        t: float = 0.0,
+    ) -> Tuple[int, int]:
+        """Meshes as `mesh` does and writes the mesh to `path` as `sdfc mesh -o PATH` does,
+        in the format its extension names (.stl, .obj, .ply, .glb; another raises
+        ValueError): (triangles, vertices)."""
+        return self._call(self._scene.save, os.fspath(path), resolution, voxel, _bounds(bounds), sharp, float(t))
 
     def compile(self, emit: str = "wgsl", part: str = "kernel", name: Optional[str] = None, sm: int = 70, t: float = 0.0) -> Union[str, bytes]:
         """What `sdfc compile --emit EMIT --part PART` writes: text, or bytes for the binary
@@ -230,16 +252,25 @@ class Scene:
         info = self._scene.info()
         fps = info["fps"]
         if frames is None:
-            frames = range(round(fps * info["duration"]))
+            frames = range(_round(fps * info["duration"]))
         for k in frames:
             yield self.render(size=size, backend=backend, aa=aa, t=k / fps, dtype=dtype)
 
-    @staticmethod
-    def _call(f: Any, *args: Any) -> Any:
+    def _call(self, f: Any, *args: Any) -> Any:
         try:
             return f(*args)
         except CompileError as e:
-            raise _wrap(e) from None
+            error = _wrap(e)
+            if self._locate is not None:
+                error = self._locate(error)
+            raise error from None
+
+
+def _bounds(bounds: Optional[Sequence[Sequence[float]]]) -> Any:
+    if bounds is None:
+        return None
+    lo, hi = bounds
+    return (tuple(float(x) for x in lo), tuple(float(x) for x in hi))
 
 
 def _size(size: Optional[Tuple[int, int]]) -> Optional[Tuple[int, int]]:
@@ -247,3 +278,12 @@ def _size(size: Optional[Tuple[int, int]]) -> Optional[Tuple[int, int]]:
         return None
     w, h = size
     return (int(w), int(h))
+
+
+# The modelling API (model.py): a function per built-in that makes a shape or a profile,
+# generated from the checker's table, and the keyword classes of the materials, lights,
+# camera and render settings; model.pyi, generated from the same table, types them.
+from . import model  # noqa: E402
+from .model import *  # noqa: E402,F401,F403
+
+__all__ += model.__all__

@@ -16,13 +16,15 @@ use sdfc_compiler::{
 };
 use sdfc_runtime::backend::{Backend, Devices, Kernel, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
-use sdfc_runtime::commands::mesh as mesher;
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::frontend::{self, Source};
 use sdfc_runtime::image::Image;
 use sdfc_runtime::job::{self, Job, Overrides};
 use std::sync::OnceLock;
 use std::time::Duration;
+
+mod mesh;
+mod table;
 
 create_exception!(
     _sdfc,
@@ -180,12 +182,19 @@ fn check<'py>(
             facts.set_item("lipschitz", root.facts.lipschitz)?;
             facts.set_item("proven", root.proven)?;
             facts.set_item("step_lipschitz", analysis.step_lipschitz())?;
+            // The box in the scene's coordinates (the analysis's is the program's, less
+            // the origin); infinite along an axis where the solid is unbounded.
+            let o = scene.origin;
+            let b = root.bounds;
+            let at = |c: [f64; 3]| (c[0] + o[0], c[1] + o[1], c[2] + o[2]);
+            facts.set_item("box", (at(b.min), at(b.max)))?;
         }
         None => {
             facts.set_item("exactness", py.None())?;
             facts.set_item("lipschitz", py.None())?;
             facts.set_item("proven", py.None())?;
             facts.set_item("step_lipschitz", py.None())?;
+            facts.set_item("box", py.None())?;
         }
     }
     let traceable = analytic::traceable(scene);
@@ -677,78 +686,33 @@ impl Scene {
         Bound<'py, PyBytes>,
         Bound<'py, PyBytes>,
     )> {
-        if resolution.is_some() && voxel.is_some() {
-            return Err(PyValueError::new_err("give resolution or voxel, not both"));
-        }
-        if let Some((lo, hi)) = bounds {
-            if (0..3).any(|i| !(lo[i] < hi[i] && lo[i].is_finite() && hi[i].is_finite())) {
-                return Err(PyValueError::new_err(
-                    "bounds are ((x0, y0, z0), (x1, y1, z1)) with each lower bound below the upper one",
-                ));
-            }
-        }
+        let ask = mesh::Ask::new(resolution, voxel, bounds, sharp, t)?;
         let scene = self_.clone_ref(py);
-        let (p, tri, c) = interruptible(py, move || {
-            let checked = scene.get().checked(t, None, None)?;
-            let limits = scene.get().limits.clone();
-            let region = mesher::Region {
-                resolution,
-                voxel,
-                bounds: bounds.map(|(lo, hi)| [lo, hi]),
-                spelling: mesher::Spelling::Parameters,
-            };
-            let settings = sdfc_runtime::mesh::Settings {
-                sharp,
-                ..Default::default()
-            };
-            let say = |text: String| {
-                if text.starts_with("warning") {
-                    eprintln!("{text}");
-                }
-            };
-            let meshed = mesher::surface(
-                &checked,
-                region,
-                &settings,
-                &limits,
-                pool()?,
-                &|_, _| {},
-                &say,
-            )
-            .map_err(|(code, msg)| match code {
-                2 => Failure::Value(msg),
-                _ if msg.is_empty() => Failure::Runtime("the mesh failed".into()),
-                _ => Failure::Runtime(msg),
-            })?;
-            let mesh = meshed.mesh;
-            let colours = sdfc_compiler::Colours::new(&checked.scene);
-            let palette = sdfc_runtime::mesh::write::Palette::new(&checked.scene, &colours);
-            let p: Vec<u8> = mesh
-                .positions
-                .iter()
-                .flatten()
-                .flat_map(|x| x.to_ne_bytes())
-                .collect();
-            let tri: Vec<u8> = mesh
-                .triangles
-                .iter()
-                .flatten()
-                .flat_map(|x| x.to_ne_bytes())
-                .collect();
-            let c: Vec<u8> = mesh
-                .positions
-                .iter()
-                .zip(&mesh.vertex_materials)
-                .flat_map(|(q, &id)| palette.colour(id, *q))
-                .flat_map(|x| (x as f32).to_ne_bytes())
-                .collect();
-            Ok((p, tri, c))
-        })?;
+        let (p, tri, c) = interruptible(py, move || mesh::arrays(scene.get(), ask))?;
         Ok((
             PyBytes::new(py, &p),
             PyBytes::new(py, &tri),
             PyBytes::new(py, &c),
         ))
+    }
+
+    /// Meshes as `mesh` does and writes the mesh to `path` as `sdfc mesh -o PATH` does, in
+    /// the format its extension names (.stl, .obj, .ply, .glb): (triangles, vertices).
+    #[pyo3(signature = (path, resolution=None, voxel=None, bounds=None, sharp=true, t=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn save(
+        self_: Py<Self>,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        resolution: Option<u32>,
+        voxel: Option<f64>,
+        bounds: Option<([f64; 3], [f64; 3])>,
+        sharp: bool,
+        t: f64,
+    ) -> PyResult<(usize, usize)> {
+        let ask = mesh::Ask::new(resolution, voxel, bounds, sharp, t)?;
+        let scene = self_.clone_ref(py);
+        interruptible(py, move || mesh::save(scene.get(), ask, &path))
     }
 
     /// `sdfc compile --emit EMIT --part PART`: the bytes of the target.
@@ -838,6 +802,10 @@ impl Scene {
 fn _sdfc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_class::<Scene>()?;
+    m.add_function(wrap_pyfunction!(table::builtins, m)?)?;
+    m.add_function(wrap_pyfunction!(table::records, m)?)?;
+    m.add_function(wrap_pyfunction!(table::range_error, m)?)?;
+    m.add_function(wrap_pyfunction!(table::fmt, m)?)?;
     m.add("CompileError", m.py().get_type::<CompileError>())?;
     Ok(())
 }

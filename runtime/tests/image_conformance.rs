@@ -45,6 +45,7 @@ fn load_small(path: &Path, width: u32, height: u32) -> Scene {
 /// below it, the differing bound 3 pixels (of 6 144) above it.
 const AGREEMENT: &[(&str, f64, f64)] = &[
     ("blends", 92.0, 0.0005),      // 95.6 dB, 0.0000 (0 px)
+    ("cells", 89.0, 0.0005),       // 92.6 dB, 0.0000 (0 px), 2026-12-06
     ("bolt", 95.0, 0.0005),        // 98.4 dB, 0.0000 (0 px), 2026-11-27
     ("bracket2d", 100.0, 0.0005),  // 103.1 dB, 0.0000 (0 px), 2026-11-27
     ("edges", 84.0, 0.0005),       // 87.4 dB, 0.0000 (0 px), 2026-11-27

@@ -3,6 +3,7 @@
 
 use super::types::{Type, Value};
 use crate::limits::{Limit, Limits};
+use crate::lower::hash_of;
 use crate::prim::{Args, Kind, Prim, PrimRef};
 pub use crate::prim::{Def, Range};
 use crate::scene::{Camera, Combine, Feature, Graph, Material, Node, NodeId, Settings, Smooth, V3};
@@ -134,14 +135,17 @@ impl Imp {
         match self {
             Imp::Fn(f) => f(b, a),
             Imp::Prim(prim) => {
-                let args = Args(
-                    a.iter()
-                        .map(|v| {
-                            let c = v.components();
-                            [0, 1, 2].map(|i| c.get(i).copied().unwrap_or(0.0))
-                        })
-                        .collect(),
-                );
+                let three = |v: &Value| {
+                    let c = v.components();
+                    [0, 1, 2].map(|i| c.get(i).copied().unwrap_or(0.0))
+                };
+                let mut args = Args(a.iter().map(three).collect());
+                for (i, v) in a.iter().enumerate() {
+                    if let Value::List(_, items) = v {
+                        args.0[i] = [items.len() as f64, 0.0, 0.0];
+                        args.0.extend(items.iter().map(three));
+                    }
+                }
                 if let Some(why) = (prim.check)(&args) {
                     return Err(why);
                 }
@@ -833,6 +837,7 @@ fn kind_type(k: Kind) -> Type {
         Kind::Angle => Type::Angle,
         Kind::Vec2 => Type::Vec2,
         Kind::Vec3 => Type::Vec3,
+        Kind::Points => Type::List(&Type::Vec3),
     }
 }
 
@@ -1277,6 +1282,16 @@ static FUNCTIONS: &[Builtin] = &[
             [shape("shape"), p("radius", F, Req, NonNeg)] -> S => |b, a| b.node(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
         ],
     },
+    // OpenSCAD's `minkowski` with a ball is a rounding: the distance less the radius.
+    Builtin {
+        name: "minkowski",
+        sigs: sigs![
+            [shape("shape"), shape("ball")] -> S => |b, a| match *b.graph.node(sh(&a[1])) {
+                Node::Sphere { radius } => b.node(Node::Round { radius, child: sh(&a[0]) }),
+                _ => Err("`minkowski` takes a ball about the origin, `sphere(r)`, as its second shape: it is `shape.round(r)`; the sum with another shape has no exact distance here".to_string()),
+            };
+        ],
+    },
     Builtin {
         name: "shell",
         sigs: sigs![
@@ -1439,6 +1454,7 @@ static FUNCTIONS: &[Builtin] = &[
         sigs: sigs![
             [p("x", I, Req, Any)] -> I => |_, a| match &a[0] { Value::Int(i) => i.checked_abs().map(Value::Int).ok_or_else(|| "integer overflow".to_string()), _ => Ok(Value::Error) };
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::abs);
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::abs));
             [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::abs));
         ],
     },
@@ -1446,18 +1462,24 @@ static FUNCTIONS: &[Builtin] = &[
         name: "floor",
         sigs: sigs![
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::floor);
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::floor));
+            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::floor));
         ],
     },
     Builtin {
         name: "ceil",
         sigs: sigs![
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::ceil);
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::ceil));
+            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::ceil));
         ],
     },
     Builtin {
         name: "fract",
         sigs: sigs![
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, |x| x - x.floor());
+            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], |x| x - x.floor()));
+            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], |x| x - x.floor()));
         ],
     },
     Builtin {
@@ -1552,6 +1574,9 @@ static FUNCTIONS: &[Builtin] = &[
         name: "hash",
         sigs: sigs![
             [p("seed", I, Req, Any)] -> F => |_, a| match &a[0] { Value::Int(i) => Ok(Value::Float(hash(*i))), _ => Ok(Value::Error) };
+            [p("cell", F, Req, Any)] -> F => |_, a| Ok(Value::Float(hash_of(&[a[0].num()])));
+            [p("cell", V2, Req, Any)] -> F => |_, a| match &a[0] { Value::Vec2(v) => Ok(Value::Float(hash_of(v))), _ => Ok(Value::Error) };
+            [p("cell", V, Req, Any)] -> F => |_, a| match &a[0] { Value::Vec3(v) => Ok(Value::Float(hash_of(v))), _ => Ok(Value::Error) };
         ],
     },
     Builtin {

@@ -206,6 +206,12 @@ impl Ctx<'_> {
                 if field::is_point(&va) || field::is_point(&vb) {
                     return self.point_binary(*op, (&va, a.span), (&vb, b.span), e.span);
                 }
+                if let (Value::List(_, x), Value::List(_, y)) = (&va, &vb) {
+                    let n = x.len() + y.len();
+                    if !self.list_length(n, e.span) || !self.burn_steps(n as u64, e.span) {
+                        return Value::Error;
+                    }
+                }
                 match ops::binary(*op, &va, &vb) {
                     Ok(v) => self.finite(v, e.span),
                     Err(ops::OpError::Overflow) => self.overflow(e.span),

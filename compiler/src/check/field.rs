@@ -293,6 +293,7 @@ pub fn builtin(name: &str, a: &[Value]) -> Option<Result<Value, String>> {
         }
         "noise" => point(vec![Rc::new(Sx::Noise(c(0)))]),
         "voronoi" => point(vec![Rc::new(Sx::Voronoi(c(0)))]),
+        "hash" => point(vec![Rc::new(Sx::Hash(c(0)))]),
         "fbm" => return Some(fbm(a)),
         _ => return None,
     }))
@@ -338,7 +339,7 @@ pub fn reads_distance(out: &[Rc<Sx>]) -> bool {
             Sx::Coord(..) | Sx::Const(_) => {}
             Sx::Un(_, a) => stack.push(a),
             Sx::Bin(_, a, b) => stack.extend([a, b]),
-            Sx::Length(v) | Sx::Noise(v) | Sx::Voronoi(v) => stack.extend(v),
+            Sx::Length(v) | Sx::Noise(v) | Sx::Voronoi(v) | Sx::Hash(v) => stack.extend(v),
         }
     }
     false
@@ -395,6 +396,7 @@ impl Flat {
                 Sx::Length(v) => FOp::Length(self.list(v)?),
                 Sx::Noise(v) => FOp::Noise(self.list(v)?),
                 Sx::Voronoi(v) => FOp::Voronoi(self.list(v)?),
+                Sx::Hash(v) => FOp::Hash(self.list(v)?),
                 Sx::Distance(id, q) => {
                     let l = self.list(q)?;
                     FOp::Distance(*id, [l[0], l[1], l[2]])

@@ -57,6 +57,10 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
             .then_some(Bool)
             .filter(|_| a != Shape && a.elem().is_none()),
         Lt | Le | Gt | Ge => ((num(a) && num(b)) || (a == Angle && b == Angle)).then_some(Bool),
+        // Lists concatenate, ints among floats becoming floats as in a list literal.
+        Add if a.elem().is_some() && b.elem().is_some() => {
+            [b, a].into_iter().find(|w| a.fits(*w) && b.fits(*w))
+        }
         Add | Sub => match (a, b) {
             (Int, Int) => Some(Int),
             _ if num(a) && num(b) => Some(Float),
@@ -116,6 +120,17 @@ pub fn binary(op: BinOp, a: &Value, b: &Value) -> Result<Value, OpError> {
     };
     if a.is_abstract() || b.is_abstract() {
         return Ok(Value::Unknown(ty));
+    }
+    if let (Value::List(..), Value::List(..)) = (a, b) {
+        let (Some(Value::List(_, x)), Some(Value::List(elem, y))) =
+            (a.clone().coerce(ty), b.clone().coerce(ty))
+        else {
+            return Ok(Value::Error);
+        };
+        return Ok(Value::List(
+            elem,
+            x.iter().chain(y.iter()).cloned().collect(),
+        ));
     }
     if op == BinOp::Div && comps(b).contains(&0.0) {
         return Err(OpError::DivZero);

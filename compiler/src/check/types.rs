@@ -366,6 +366,7 @@ pub enum Sx {
     Distance(NodeId, [Rc<Sx>; 3]),
     Noise(Vec<Rc<Sx>>),
     Voronoi(Vec<Rc<Sx>>),
+    Hash(Vec<Rc<Sx>>),
 }
 
 impl fmt::Debug for Sx {

@@ -149,6 +149,10 @@ pub(super) fn op(b: &mut Builder, op: &FOp, p: P, regs: &[Reg]) -> Reg {
             let q: Vec<Reg> = v.iter().map(r).collect();
             voronoi(b, &q)
         }
+        FOp::Hash(v) => {
+            let q: Vec<Reg> = v.iter().map(r).collect();
+            lattice_hash(b, &q)
+        }
         FOp::Distance(..) => b.c(0.0),
     }
 }
@@ -253,6 +257,49 @@ fn lerp(b: &mut Builder, a: Reg, c: Reg, s: Reg) -> Reg {
     let d = b.sub(c, a);
     let m = b.mul(d, s);
     b.add(a, m)
+}
+
+/// The hash of the unit lattice cell holding `q` (1 to 3 coordinates), in (0, 1): two cell
+/// hashes `h₁`, `h₂` (the second of `h₁` and the cell's coordinates, last first, times 2, 3
+/// and 4) as the whole number 289·h₁ + h₂, scaled into the unit interval at the middle of its
+/// step; no two cells of one 289 × 289 period of the plane share it. Every step is on
+/// whole numbers below 2²⁴, so f32 and f64 find the same cell; the lattice repeats every 289
+/// cells along each axis (docs/language.md, "Noise").
+pub(super) fn lattice_hash(b: &mut Builder, q: &[Reg]) -> Reg {
+    let a: Vec<Reg> = q
+        .iter()
+        .map(|&x| {
+            let i = b.un(Unary::Floor, x);
+            mod289(b, i)
+        })
+        .collect();
+    let h1 = cell_hash(b, &a);
+    // The permutation keeps x mod 17, so a second hash of the same sums would repeat h₁'s
+    // residue: the coordinates enter it with factors 2, 3, 4 instead.
+    let mut second = vec![h1];
+    for (k, &x) in a.iter().rev().enumerate() {
+        let y = b.mulc(x, k as f64 + 2.0);
+        second.push(mod289(b, y));
+    }
+    let h2 = cell_hash(b, &second);
+    let n = b.mulc(h1, NOISE_CELLS);
+    let n = b.add(n, h2);
+    let n = b.addc(n, 0.5);
+    b.mulc(n, 1.0 / (NOISE_CELLS * NOISE_CELLS))
+}
+
+/// [`lattice_hash`] of a constant cell (1 to 3 coordinates), computed in f64 by the very
+/// instructions a field runs: `hash(x)` of a number known when the scene is checked.
+pub(crate) fn hash_of(cell: &[f64]) -> f64 {
+    let mut b = Builder::new(false);
+    let p = b.input_point();
+    let h = lattice_hash(&mut b, &p[..cell.len().min(3)]);
+    let (program, roots) = b.finish_roots(&[h]);
+    let mut at = [0.0; 3];
+    for (a, c) in at.iter_mut().zip(cell) {
+        *a = *c;
+    }
+    program.run::<f64>(at, |_| {})[roots[0].0 as usize]
 }
 
 /// Gradient noise at `q` (2 or 3 coordinates): the lattice cell's corners each contribute

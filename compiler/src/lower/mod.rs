@@ -21,6 +21,7 @@ mod simplify;
 mod tests;
 
 use crate::program::{Binary, Program, Reg, Unary};
+pub(crate) use field::hash_of;
 pub use field::{ColourProgram, Colours};
 pub use instances::{shape_program, Instance, ShapeProgram, Split};
 pub use media::{media, Media};

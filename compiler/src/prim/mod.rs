@@ -13,6 +13,7 @@
 //! and those read from data (polygon, text, mesh) keep their own nodes.
 
 mod between;
+mod hull;
 mod mandelbulb;
 mod polyhedra;
 mod profiles;
@@ -73,6 +74,8 @@ pub enum Kind {
     Angle,
     Vec2,
     Vec3,
+    /// A list of points (`[vec3]`); a primitive has at most one such parameter.
+    Points,
 }
 
 /// One parameter of a primitive.
@@ -94,11 +97,26 @@ const fn param(name: &'static str, kind: Kind, def: Def, range: Range) -> Param 
 }
 
 /// The arguments of a primitive, in the order of its parameters, each as three numbers (a
-/// float, an int or an angle in the first; a vec2 in the first two).
+/// float, an int or an angle in the first; a vec2 in the first two); a list of points as its
+/// length in the first, its points after every parameter's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Args(pub Vec<[f64; 3]>);
 
 impl Args {
+    /// The arguments `numbers` (one each) with the list `points` as parameter `at`.
+    pub fn with_list(numbers: &[f64], at: usize, points: &[[f64; 3]]) -> Args {
+        let mut v: Vec<[f64; 3]> = numbers.iter().map(|&x| [x, 0.0, 0.0]).collect();
+        v.insert(at, [points.len() as f64, 0.0, 0.0]);
+        v.extend_from_slice(points);
+        Args(v)
+    }
+
+    /// The list of points argument `i`.
+    pub fn list(&self, i: usize) -> &[[f64; 3]] {
+        let n = self.0[i][0] as usize;
+        &self.0[self.0.len() - n..]
+    }
+
     /// The float, int (as a float) or angle (in radians) argument `i`.
     pub fn f(&self, i: usize) -> f64 {
         self.0[i][0]
@@ -203,6 +221,7 @@ pub fn all() -> impl Iterator<Item = &'static Prim> {
         mandelbulb::PRIMS,
         solids::PRIMS,
         between::PRIMS,
+        hull::PRIMS,
         polyhedra::PRIMS,
         profiles::PRIMS,
     ]

@@ -243,6 +243,10 @@ fn node(n: &Node) -> String {
                 let v = match p.kind {
                     Kind::Vec2 => v2(args.v2(i)),
                     Kind::Vec3 => v3(args.v3(i)),
+                    Kind::Points => {
+                        let ps: Vec<String> = args.list(i).iter().map(|q| v3(*q)).collect();
+                        format!("[{}]", ps.join(" "))
+                    }
                     Kind::Float | Kind::Int | Kind::Angle => num(args.f(i)),
                 };
                 out += &format!(" {}={v}", p.name);

@@ -76,6 +76,9 @@ pub enum FOp {
     /// The distance from a point of 2 or 3 coordinates to the nearest of the feature points
     /// of the unit lattice (one per cell, jittered within the cell's middle 0.3…0.7).
     Voronoi(Vec<Slot>),
+    /// The hash of the unit lattice cell holding a point of 1 to 3 coordinates, in (0, 1):
+    /// constant within a cell, so a step at every cell's side.
+    Hash(Vec<Slot>),
 }
 
 impl FOp {
@@ -85,7 +88,7 @@ impl FOp {
             FOp::Coord(_) | FOp::Const(_) => Vec::new(),
             FOp::Un(_, a) => vec![*a],
             FOp::Bin(_, a, b) => vec![*a, *b],
-            FOp::Length(v) | FOp::Noise(v) | FOp::Voronoi(v) => v.clone(),
+            FOp::Length(v) | FOp::Noise(v) | FOp::Voronoi(v) | FOp::Hash(v) => v.clone(),
             FOp::Distance(_, q) => q.to_vec(),
         }
     }
@@ -167,6 +170,7 @@ impl FieldFn {
                 FOp::Noise(_) => 320.0,
                 FOp::Voronoi(v) if v.len() == 2 => 9.0 * 40.0,
                 FOp::Voronoi(_) => 27.0 * 50.0,
+                FOp::Hash(v) => 20.0 * v.len() as f64,
             })
             .sum()
     }
@@ -189,6 +193,7 @@ impl FieldFn {
                     FOp::Distance(id, q) => format!("distance %{} at {}", id.0, list(q)),
                     FOp::Noise(v) => format!("noise {}", list(v)),
                     FOp::Voronoi(v) => format!("voronoi {}", list(v)),
+                    FOp::Hash(v) => format!("hash {}", list(v)),
                 };
                 format!("s{i} = {rhs}")
             })

@@ -1,5 +1,5 @@
 //! Checker tests of what users of other tools write: division, names that hide built-ins,
-//! web colours, angles, `max_dist` and `len`.
+//! web colours, angles, `max_dist`, `len`, recursion and hashes of lattice cells.
 
 use super::{check_str, codes, ok};
 use crate::scene::Node;
@@ -275,5 +275,139 @@ fn comprehensions_keep_what_their_condition_allows() {
     assert_eq!(
         codes("let xs = [for i in 0..3 if i { i }];\nscene { sphere(); }"),
         ["E0303"]
+    );
+}
+
+#[test]
+fn hashes_of_lattice_cells_agree_in_the_checker_and_in_fields_of_either_precision() {
+    use crate::eval::eval_point;
+    // A field reads `p` through `hash`: the distance at a point of cell (i, j) is that cell's
+    // hash minus 2, the same as `hash` of a constant in the cell, in f64 and in f32.
+    let field = ok("scene { field(lipschitz: 1) { hash(p.xy) - 2 }; }");
+    let program = crate::lower::lower(&field);
+    let mut seen = std::collections::BTreeSet::new();
+    for i in -32..32 {
+        for j in -32..32 {
+            let at = [i as f64 + 0.37, j as f64 + 0.81, 0.0];
+            let constant = ok(&format!(
+                "let h = hash(vec2({}, {}));\nscene {{ sphere(h); }}",
+                at[0], at[1]
+            ));
+            let Node::Sphere { radius } = constant.graph.node(constant.root.expect("root")) else {
+                panic!("not a sphere")
+            };
+            assert!(*radius > 0.0 && *radius < 1.0, "{radius}");
+            let (d64, _) = eval_point::<f64>(&program, at);
+            assert!(
+                (d64 + 2.0 - radius).abs() < 1e-12,
+                "cell ({i}, {j}): {d64} {radius}"
+            );
+            let (d32, _) = eval_point::<f32>(&program, at.map(|x| x as f32));
+            assert!(
+                (d32 as f64 - d64).abs() < 1e-6,
+                "cell ({i}, {j}): {d32} {d64}"
+            );
+            // Constant within the cell.
+            let (corner, _) = eval_point::<f64>(&program, [i as f64 + 0.999, j as f64, 0.0]);
+            assert_eq!(corner, d64, "cell ({i}, {j})");
+            seen.insert((*radius * 1e9) as i64);
+        }
+    }
+    // 4096 cells, nearly all different (the hash has 289² values).
+    assert!(seen.len() > 4000, "{} distinct hashes", seen.len());
+    // A step at every cell's side: the field is a bound of unknown slope unless declared.
+    let s = ok("scene { field { p.y - hash(floor(p.x * 4)) }; }");
+    let analysis = crate::scene::analysis::analyse(&s);
+    let cause = analysis
+        .root()
+        .and_then(|r| r.cause)
+        .expect("no bound proven");
+    assert_eq!(crate::scene::analysis::kind(s.graph.node(cause)), "field");
+    // An int seed keeps its own hash, known when the scene is checked.
+    assert_eq!(
+        codes("let h = hash(3) + hash(3.5) + hash((1, 2, 3));\nlight point { position: (0, 5, 0) }\nscene { sphere(h); }"),
+        Vec::<&str>::new()
+    );
+}
+
+#[test]
+fn lists_concatenate_with_plus() {
+    let s = ok("let xs = [1, 2] + [3.5];\n\
+                fn twigs(n: int) -> [shape] { if n == 0 { [sphere(0.1)] } else { twigs(n - 1) + [sphere(0.1).translate(n, 0, 0)] } }\n\
+                light point { position: (0, 5, 0) }\n\
+                scene { union(twigs(3)).translate(xs[2], 0, 0); }");
+    let mut spheres = 0;
+    let mut moved = Vec::new();
+    for id in s.graph.ids() {
+        match s.graph.node(id) {
+            Node::Sphere { .. } => spheres += 1,
+            Node::Translate { offset, .. } => moved.push(offset[0]),
+            _ => {}
+        }
+    }
+    assert_eq!(spheres, 1, "one sphere, shared");
+    moved.sort_by(f64::total_cmp);
+    assert_eq!(moved, [1.0, 2.0, 3.0, 3.5]);
+    // Lists of different element types do not concatenate.
+    assert_eq!(
+        codes("let xs = [1] + [sphere(1)];\nscene { sphere(1); }"),
+        ["E0301"]
+    );
+    // Growing a list spends fuel by its elements: a list doubled 40 times stops at a limit.
+    let src =
+        "fn grow(n: int) -> [float] { if n == 0 { [1.0] } else { let h = grow(n - 1); h + h } }\n\
+               let xs = grow(40);\nscene { sphere(xs[0]); }";
+    let (_, diags, _) = check_str("t.sdf", src);
+    assert!(
+        diags
+            .iter()
+            .any(|d| d.code == "E0507" && d.message.contains("elements")),
+        "{diags:#?}"
+    );
+}
+
+#[test]
+fn hulls_of_points_and_minkowski_with_a_ball() {
+    let light = "light point { position: (0, 5, 0) }\n";
+    let s = ok(&format!(
+        "{light}scene {{ hull([for i in 0..8 {{ (hash(i), hash(i + 8), hash(i + 16)) }}]); }}"
+    ));
+    let Node::Prim { prim, args } = s.graph.node(s.root.expect("root")) else {
+        panic!("not a primitive")
+    };
+    assert_eq!((prim.name, args.list(0).len(), args.f(1)), ("hull", 8, 0.0));
+    // Points in one plane have no volume without a radius: said at the call, with the fix.
+    let (_, diags, _) = check_str(
+        "t.sdf",
+        &format!("{light}scene {{ hull([(0, 0, 0), (1, 0, 0), (0, 0, 1), (1, 0, 1)]); }}"),
+    );
+    let d = diags.iter().find(|d| d.is_error()).expect("an error");
+    assert!(
+        d.message.contains("one plane") && d.message.contains("radius"),
+        "{d:#?}"
+    );
+    assert_eq!(
+        codes(&format!(
+            "{light}scene {{ hull([(0, 0, 0), (1, 0, 0), (0, 0, 1)], radius: 0.1); }}"
+        )),
+        Vec::<&str>::new()
+    );
+    // minkowski with a ball is the rounding; with anything else it says what it takes.
+    let s = ok(&format!(
+        "{light}scene {{ minkowski(box((1, 1, 1)), sphere(0.2)); }}"
+    ));
+    assert!(matches!(
+        s.graph.node(s.root.expect("root")),
+        Node::Round { radius, .. } if *radius == 0.2
+    ));
+    let (_, diags, _) = check_str(
+        "t.sdf",
+        &format!("{light}scene {{ minkowski(box((1, 1, 1)), box((0.1, 0.1, 0.1))); }}"),
+    );
+    assert!(
+        diags
+            .iter()
+            .any(|d| d.is_error() && d.message.contains("round(r)")),
+        "{diags:#?}"
     );
 }

@@ -544,6 +544,21 @@ fn values(
                 let far = (VORONOI_LO + VORONOI_SPAN) * (v.len() as f64).sqrt();
                 lipschitz_of(&rows, 1.0, Iv::new(0.0, far))
             }
+            // Constant within a lattice cell: a step wherever an input crosses a whole number,
+            // so nothing is proven unless the inputs are constant.
+            FOp::Hash(v) => {
+                let rows: Vec<Val> = v.iter().map(get).collect();
+                let range = Iv::new(0.0, 1.0);
+                if rows.iter().all(|r| r.norm == 0.0) {
+                    lipschitz_of(&rows, 0.0, range)
+                } else {
+                    Val {
+                        range,
+                        grad: [Iv::ALL; 3],
+                        norm: f64::INFINITY,
+                    }
+                }
+            }
         };
         vals.push(v);
     }

@@ -1,0 +1,147 @@
+//! `Scene.mesh` and `Scene.save` of the native module: the surface meshed as `sdfc mesh`
+//! meshes it (`commands::mesh::surface`), as arrays or written to a mesh file in the format
+//! its extension names, by the writers `sdfc mesh -o` uses.
+
+use super::{pool, Failure, Scene};
+use pyo3::exceptions::PyValueError;
+use pyo3::PyResult;
+use sdfc_runtime::commands::mesh as mesher;
+use sdfc_runtime::frontend::Checked;
+use sdfc_runtime::mesh::write::{Format, Palette};
+use sdfc_runtime::mesh::Mesh;
+use std::path::Path;
+
+/// What a mesh is asked for: the cells (`resolution` along the longest side, or `voxel` a
+/// cell's edge), the region, sharp features, the time.
+#[derive(Clone, Copy)]
+pub struct Ask {
+    resolution: Option<u32>,
+    voxel: Option<f64>,
+    bounds: Option<([f64; 3], [f64; 3])>,
+    sharp: bool,
+    t: f64,
+}
+
+impl Ask {
+    /// The request, or `ValueError` for both `resolution` and `voxel` or bounds that are
+    /// not a box.
+    pub fn new(
+        resolution: Option<u32>,
+        voxel: Option<f64>,
+        bounds: Option<([f64; 3], [f64; 3])>,
+        sharp: bool,
+        t: f64,
+    ) -> PyResult<Ask> {
+        if resolution.is_some() && voxel.is_some() {
+            return Err(PyValueError::new_err("give resolution or voxel, not both"));
+        }
+        if let Some((lo, hi)) = bounds {
+            if (0..3).any(|i| !(lo[i] < hi[i] && lo[i].is_finite() && hi[i].is_finite())) {
+                return Err(PyValueError::new_err(
+                    "bounds are ((x0, y0, z0), (x1, y1, z1)) with each lower bound below the upper one",
+                ));
+            }
+        }
+        Ok(Ask {
+            resolution,
+            voxel,
+            bounds,
+            sharp,
+            t,
+        })
+    }
+}
+
+/// The scene's surface, and the checked scene it came from.
+fn surface(scene: &Scene, ask: Ask) -> Result<(Mesh, Checked), Failure> {
+    let checked = scene.checked(ask.t, None, None)?;
+    let region = mesher::Region {
+        resolution: ask.resolution,
+        voxel: ask.voxel,
+        bounds: ask.bounds.map(|(lo, hi)| [lo, hi]),
+        spelling: mesher::Spelling::Parameters,
+    };
+    let settings = sdfc_runtime::mesh::Settings {
+        sharp: ask.sharp,
+        ..Default::default()
+    };
+    let say = |text: String| {
+        if text.starts_with("warning") {
+            eprintln!("{text}");
+        }
+    };
+    let meshed = mesher::surface(
+        &checked,
+        region,
+        &settings,
+        &scene.limits,
+        pool()?,
+        &|_, _| {},
+        &say,
+    )
+    .map_err(|(code, msg)| match code {
+        2 => Failure::Value(msg),
+        _ if msg.is_empty() => Failure::Runtime("the mesh failed".into()),
+        _ => Failure::Runtime(msg),
+    })?;
+    Ok((meshed.mesh, checked))
+}
+
+/// A mesh as bytes: positions (f64), triangles (u32), linear vertex colours (f32).
+pub type Arrays = (Vec<u8>, Vec<u8>, Vec<u8>);
+
+/// The mesh as [`Arrays`].
+pub fn arrays(scene: &Scene, ask: Ask) -> Result<Arrays, Failure> {
+    let (mesh, checked) = surface(scene, ask)?;
+    let colours = sdfc_compiler::Colours::new(&checked.scene);
+    let palette = Palette::new(&checked.scene, &colours);
+    let p: Vec<u8> = mesh
+        .positions
+        .iter()
+        .flatten()
+        .flat_map(|x| x.to_ne_bytes())
+        .collect();
+    let tri: Vec<u8> = mesh
+        .triangles
+        .iter()
+        .flatten()
+        .flat_map(|x| x.to_ne_bytes())
+        .collect();
+    let c: Vec<u8> = mesh
+        .positions
+        .iter()
+        .zip(&mesh.vertex_materials)
+        .flat_map(|(q, &id)| palette.colour(id, *q))
+        .flat_map(|x| (x as f32).to_ne_bytes())
+        .collect();
+    Ok((p, tri, c))
+}
+
+/// Meshes and writes the file at `path` (replacing it whole, as `sdfc mesh -o` does):
+/// (triangles, vertices). A name whose format is unknown, a place that cannot be written and
+/// a mesh with no triangles are refused, the last two before and without writing.
+pub fn save(scene: &Scene, ask: Ask, path: &Path) -> Result<(usize, usize), Failure> {
+    let format = Format::of(path).ok_or_else(|| {
+        Failure::Value(format!(
+            "cannot tell the mesh format of `{}`; name it .stl, .obj, .ply, .glb or .3mf",
+            path.display()
+        ))
+    })?;
+    sdfc_runtime::output::check_writable(path)
+        .map_err(|why| Failure::Value(format!("cannot write `{}`: {why}", path.display())))?;
+    let (mesh, checked) = surface(scene, ask)?;
+    if mesh.triangles.is_empty() {
+        return Err(Failure::Runtime(format!(
+            "the mesh has no triangles: no surface crosses the grid (a higher resolution, or bounds that hold the surface); `{}` is not written",
+            path.display()
+        )));
+    }
+    let colours = sdfc_compiler::Colours::new(&checked.scene);
+    let palette = Palette::new(&checked.scene, &colours);
+    let bytes = format
+        .encode(&mesh, &palette)
+        .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;
+    sdfc_runtime::image::write_atomic(path, &bytes)
+        .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;
+    Ok((mesh.triangles.len(), mesh.positions.len()))
+}

@@ -12,7 +12,7 @@ use super::write::{base_colour, Palette};
 use super::zip::{self, Deflated, Entry};
 use super::Mesh;
 use crate::image::srgb_encode;
-use std::io::{self, Write};
+use std::io::{self, BufWriter, Write};
 
 const CONTENT_TYPES: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 <Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">
@@ -33,7 +33,9 @@ const BASE: u32 = 1;
 /// A 3MF model being written: its `basematerials`, then its objects one at a time.
 #[derive(Debug)]
 pub struct Model {
-    text: Deflated,
+    /// The model's text, buffered in blocks on its way to the compressor (a write of a few
+    /// bytes per number straight into it is slow).
+    text: BufWriter<Deflated>,
     /// The `basematerials` entries: the scene's materials.
     count: u32,
     /// The object ids written, for the build.
@@ -78,7 +80,7 @@ impl Model {
     /// material id `i`): the header and the `basematerials` are written. Where a material is
     /// a colour field, the Materials extension is declared required (its colour groups).
     pub fn new(palette: &Palette) -> io::Result<Model> {
-        let mut text = Deflated::default();
+        let mut text = BufWriter::with_capacity(1 << 18, Deflated::default());
         let count = palette.materials.len().max(1) as u32;
         let required = if (0..count).any(|m| palette.varies(m)) {
             r#" requiredextensions="m""#
@@ -178,7 +180,10 @@ impl Model {
         zip::archive(&[
             Entry::stored("[Content_Types].xml", CONTENT_TYPES.as_bytes()),
             Entry::stored("_rels/.rels", RELS.as_bytes()),
-            self.text.finish("3D/3dmodel.model")?,
+            self.text
+                .into_inner()
+                .map_err(|e| e.into_error())?
+                .finish("3D/3dmodel.model")?,
         ])
     }
 }

@@ -5,8 +5,9 @@ example.py, gearlike.py, knurling.py, blobby.py, weave.py), meshed at the same c
 For each example: the peer's `save` as the example calls it (its samples, its bounds
 estimate, its threads; binary STL), timed, once; sdfc's `Shape.save` of the port at the
 peer's cell size over the peer's bounds (binary STL), timed, the median of `--runs`; the
-triangles; whether each mesh is closed (every edge, its vertices welded by position, in
-exactly two triangles); how far each mesh's vertices lie from the surfaces, by the peer's
+triangles; the triangles of zero area (as written, in f32); whether each mesh is closed
+(every edge, its vertices welded by position, in exactly two triangles) and whether
+manifold3d (PyPI `manifold3d`) takes it as a manifold; how far each mesh's vertices lie from the surfaces, by the peer's
 field and by sdfc's, and its triangles' centres by sdfc's, in cells (mean, 99th percentile,
 largest).
 
@@ -25,6 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import manifold3d
 import numpy as np
 
 import sdfc  # noqa: F401 (the ports import it: a Python without it stops here)
@@ -54,6 +56,23 @@ def open_edges(triangles):
     return int((counts != 2).sum())
 
 
+def zero_area(triangles):
+    """Triangles whose cross product is exactly zero, at the f32 coordinates written."""
+    t = triangles.astype(np.float64)
+    c = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    return int((np.abs(c).sum(axis=1) == 0).sum())
+
+
+def manifold(triangles):
+    """manifold3d's verdict on the mesh, its vertices welded by position: `ok`, or the name
+    of the error it reports (`NotManifold`, ...)."""
+    flat = triangles.reshape(-1, 3).astype(np.float32)
+    vertices, ids = np.unique(flat, axis=0, return_inverse=True)
+    mesh = manifold3d.Mesh(np.ascontiguousarray(vertices), np.ascontiguousarray(ids.reshape(-1, 3).astype(np.uint32)))
+    status = manifold3d.Manifold(mesh).status()
+    return "ok" if status == manifold3d.Error.NoError else status.name
+
+
 def stats(d, step):
     a = np.abs(d) / step
     return {"mean": float(a.mean()), "p99": float(np.percentile(a, 99)), "max": float(a.max())}
@@ -70,8 +89,8 @@ def main():
     peer = [args.peer_python, str(HERE / "peer.py")]
     load = os.getloadavg()
     print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, {platform.processor() or platform.machine()}, load {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
-    print("| example | lines (peer / sdfc) | samples | cell | peer s | sdfc s | speed-up | triangles (peer / sdfc) | open edges (peer / sdfc) | peer's vertices from the surface, cells: by peer / by sdfc (mean, p99, max) | sdfc's vertices: by sdfc / by peer | triangle centres by sdfc's field: peer / sdfc |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| example | lines (peer / sdfc) | samples | cell | peer s | sdfc s | speed-up | triangles (peer / sdfc) | zero-area triangles (peer / sdfc) | open edges (peer / sdfc) | manifold3d (peer / sdfc) | peer's vertices from the surface, cells: by peer / by sdfc (mean, p99, max) | sdfc's vertices: by sdfc / by peer | triangle centres by sdfc's field: peer / sdfc |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in args.only.split(","):
         example = Path(args.examples) / f"{name}.py"
         ours = HERE / f"{name}.py"
@@ -114,7 +133,8 @@ def main():
         lines = [sum(1 for line in p.read_text().splitlines() if line.strip() and not line.lstrip().startswith("#")) for p in (example, ours)]
         print(
             f"| {name} | {lines[0]} / {lines[1]} | 2^{int(np.log2(info['samples']))} | {step:.4f} | {info['seconds']:.2f} | {ours_s:.3f} | {info['seconds'] / ours_s:.1f}× "
-            f"| {info['triangles']} / {len(tri_ours)} | {open_edges(tri_peer)} / {open_edges(tri_ours)} "
+            f"| {info['triangles']} / {len(tri_ours)} | {zero_area(tri_peer)} / {zero_area(tri_ours)} "
+            f"| {open_edges(tri_peer)} / {open_edges(tri_ours)} | {manifold(tri_peer)} / {manifold(tri_ours)} "
             f"| {three(peer_by_peer)} / {three(peer_by_ours)} | {three(ours_by_ours)} / {three(ours_by_peer)} "
             f"| {three(centres_peer)} / {three(centres_ours)} |",
             flush=True,

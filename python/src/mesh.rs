@@ -123,7 +123,7 @@ pub fn arrays(scene: &Scene, ask: Ask) -> Result<Arrays, Failure> {
 pub fn save(scene: &Scene, ask: Ask, path: &Path) -> Result<(usize, usize), Failure> {
     let format = Format::of(path).ok_or_else(|| {
         Failure::Value(format!(
-            "cannot tell the mesh format of `{}`; name it .stl, .obj, .ply or .glb",
+            "cannot tell the mesh format of `{}`; name it .stl, .obj, .ply, .glb or .3mf",
             path.display()
         ))
     })?;
@@ -138,7 +138,9 @@ pub fn save(scene: &Scene, ask: Ask, path: &Path) -> Result<(usize, usize), Fail
     }
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = Palette::new(&checked.scene, &colours);
-    let bytes = format.encode(&mesh, &palette);
+    let bytes = format
+        .encode(&mesh, &palette)
+        .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;
     sdfc_runtime::image::write_atomic(path, &bytes)
         .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;
     Ok((mesh.triangles.len(), mesh.positions.len()))

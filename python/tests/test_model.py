@@ -294,7 +294,7 @@ class Outputs(unittest.TestCase):
     def test_save_writes_a_watertight_mesh(self):
         shape = sdfc.sphere(1) - sdfc.cylinder(0.4, 3)
         folder = Path(tempfile.mkdtemp())
-        for ext in ("stl", "obj", "ply", "glb"):
+        for ext in ("stl", "obj", "ply", "glb", "3mf"):
             triangles, vertices = shape.save(folder / f"part.{ext}", resolution=32)
             self.assertGreater(triangles, 100)
             self.assertGreater((folder / f"part.{ext}").stat().st_size, 1000)
@@ -304,8 +304,8 @@ class Outputs(unittest.TestCase):
         _, counts = np.unique(edges, axis=0, return_counts=True)
         self.assertTrue((counts == 2).all())  # every edge between two triangles: closed
         with self.assertRaises(ValueError) as e:
-            shape.save(folder / "part.3mf")
-        self.assertIn(".stl, .obj, .ply or .glb", str(e.exception))
+            shape.save(folder / "part.step")
+        self.assertIn(".stl, .obj, .ply, .glb or .3mf", str(e.exception))
 
     def test_pictures(self):
         shape = sdfc.torus(1, 0.3) @ sdfc.Phong(color=(0.9, 0.5, 0.1))

@@ -517,7 +517,7 @@ fn limits_and_bad_arguments_are_reported() {
     assert!(!out.exists());
     let o = sdfc(&["mesh", s(&scene), "-o", s(&d.join("p.xyz"))]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains(".stl, .obj, .ply or .glb"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains(".stl, .obj, .ply, .glb or .3mf"));
 }
 
 /// A field with no proven bound (the Mandelbulb) is meshed on the dense grid, with a warning

@@ -820,10 +820,33 @@ impl Pass<'_> {
     }
 
     /// A user field: its declared L, or the one derived from its expression (the shapes it
-    /// reads contributing their own proven constants), or nothing proven. Its solid may be
-    /// anywhere.
+    /// reads contributing their own proven constants), or nothing proven. Its solid lies in
+    /// the box its expression proves by interval arithmetic ([`field::solid_box`]), with the
+    /// shapes it reads bounded by their boxes: outside a shape's box its field is above 0,
+    /// and an exact one's at least the distance to the box.
     fn field(&self, id: NodeId, f: &super::field::FieldFn, declared: Option<f64>) -> Derived {
-        let mut d = exact(Aabb::ALL, [false; 3]);
+        let (min, max) = field::solid_box(f, |s, q| {
+            let c = self.get(s);
+            let b = c.bounds;
+            if b.is_empty() {
+                return f64::MIN_POSITIVE;
+            }
+            let gap = (0..3)
+                .map(|i| {
+                    (b.min[i] - q[i][1])
+                        .max(q[i][0] - b.max[i])
+                        .max(0.0)
+                        .powi(2)
+                })
+                .sum::<f64>()
+                .sqrt();
+            match gap > 0.0 {
+                true if c.proven && c.facts.exactness == Exactness::Exact => gap,
+                true => f64::MIN_POSITIVE,
+                false => f64::NEG_INFINITY,
+            }
+        });
+        let mut d = exact(Aabb { min, max }, [false; 3]);
         let l = declared.unwrap_or_else(|| {
             field::lipschitz(f, |s| {
                 let c = self.get(s);

@@ -1,15 +1,16 @@
-//! `sdfc mesh`: the scene's surface as a triangle mesh (STL, OBJ, PLY or glTF), from an
+//! `sdfc mesh`: the scene's surface as a triangle mesh (STL, OBJ, PLY, glTF or 3MF), from an
 //! octree pruned by the compiler's proven bounds and patches that keep sharp features
-//! (`crate::mesh`, `docs/mesh.md`).
+//! (`crate::mesh`, `docs/mesh.md`); the region and cell size are `mesh_region`'s.
 
+use super::mesh_region::{frame, short, Frame};
+pub use super::mesh_region::{parse_bounds, Region, Spelling, DEFAULT_RESOLUTION};
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::write::Format;
-use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats, AXIS_CELLS};
+use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats};
 use indicatif::{ProgressBar, ProgressStyle};
-pub use sdfc_compiler::Spelling;
-use sdfc_compiler::{analysis, Combine, Limit, Limits, LowerOptions, Node, NodeId, Scene};
+use sdfc_compiler::{analysis, Limit, Limits, LowerOptions};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -20,10 +21,11 @@ use std::time::Instant;
 pub struct MeshArgs {
     /// Scene file.
     pub file: PathBuf,
-    /// Output mesh: .stl (binary), .obj, .ply (binary, vertex colours) or .glb (binary glTF,
+    /// Output mesh: .stl (binary), .obj, .ply (binary, vertex colours), .glb (binary glTF,
     /// one material per scene material: a primitive each, sharing one buffer of positions,
     /// which importers load as separate parts with the border vertices duplicated; write .ply
-    /// for one welded mesh with colours).
+    /// for one welded mesh with colours) or .3mf (millimetres, one closed object per material
+    /// with its colour, for multi-material printers).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Cells along the longest side of the bounds [default: 128].
@@ -52,9 +54,6 @@ pub struct MeshArgs {
     pub limits: super::LimitArgs,
 }
 
-/// The default number of cells along the longest side.
-pub const DEFAULT_RESOLUTION: u32 = 128;
-
 /// Runs `sdfc mesh`.
 pub fn run(args: MeshArgs) -> ExitCode {
     match mesh(&args) {
@@ -73,7 +72,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     let limits = args.limits.limits();
     let format = Format::of(&args.output).ok_or_else(|| {
         usage(format!(
-            "cannot tell the mesh format of `{}`; name it .stl, .obj, .ply or .glb",
+            "cannot tell the mesh format of `{}`; name it .stl, .obj, .ply, .glb or .3mf",
             args.output.display()
         ))
     })?;
@@ -81,7 +80,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         .map_err(|why| usage(format!("cannot write `{}`: {why}", args.output.display())))?;
     let mut settings = settings(&args.set).map_err(usage)?;
     settings.measure = args.stats;
-    settings.materials = matches!(format, Format::Ply | Format::Glb);
+    settings.materials = matches!(format, Format::Ply | Format::Glb | Format::ThreeMf);
     let pool = crate::job::thread_pool(args.threads, &limits).map_err(|e| usage(e.to_string()))?;
     // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
     let checked = frontend::load_scene_code(&args.file, DiagnosticFormat::Human, &limits)
@@ -119,6 +118,25 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         bounds: args.bounds,
         spelling: Spelling::Flags,
     };
+    // 3MF: an object per material, where the scene has several.
+    let parts = match format {
+        Format::ThreeMf => crate::mesh::parts::by_material(&checked.scene),
+        _ => Vec::new(),
+    };
+    if parts.len() > 1 {
+        let how = Meshing {
+            settings: &settings,
+            limits: &limits,
+            pool: &pool,
+            progress: &progress,
+            say: &say,
+        };
+        let result = objects(args, &checked, parts, region, &how);
+        if let Some(b) = &bar {
+            b.finish_and_clear();
+        }
+        return result;
+    }
     let result = surface(&checked, region, &settings, &limits, &pool, &progress, &say);
     if let Some(b) = &bar {
         b.finish_and_clear();
@@ -149,7 +167,9 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     // The file's bytes are in the surface cells' share of the announcement.
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = crate::mesh::write::Palette::new(&checked.scene, &colours);
-    let bytes = format.encode(&mesh, &palette);
+    let bytes = format
+        .encode(&mesh, &palette)
+        .map_err(|e| (1, format!("cannot write `{}`: {e}", args.output.display())))?;
     crate::image::write_atomic(&args.output, &bytes)
         .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;
     eprintln!(
@@ -165,32 +185,108 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     Ok(())
 }
 
-/// The region `surface` meshes and the size of its cells (`--resolution`, `--voxel`,
-/// `--bounds`; all `None`: the analysis's box at [`DEFAULT_RESOLUTION`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Region {
-    /// Cells along the longest side of the bounds.
-    pub resolution: Option<u32>,
-    /// Edge of a cell, in scene units (instead of `resolution`).
-    pub voxel: Option<f64>,
-    /// The region to mesh (min, max), in the scene's coordinates.
-    pub bounds: Option<[[f64; 3]; 2]>,
-    /// How the messages name these options (the limits' as the limits say,
-    /// [`Limits::spelling`]).
-    pub spelling: Spelling,
+/// How to mesh: what [`surface`] takes besides the scene and the region.
+struct Meshing<'a> {
+    settings: &'a Settings,
+    limits: &'a Limits,
+    pool: &'a rayon::ThreadPool,
+    progress: &'a (dyn Fn(&'static str, f64) + Sync),
+    say: &'a (dyn Fn(String) + Sync),
 }
 
-/// A region given by its corners' coordinates, as the caller of [`surface`] writes it:
-/// `sdfc mesh`'s flag (`--bounds=X0,Y0,Z0,X1,Y1,Z1`) or the parameter of the Python package's
-/// `Scene.mesh` (`bounds=((x0, y0, z0), (x1, y1, z1))`).
-fn bounds(spell: Spelling, lo: [&str; 3], hi: [&str; 3]) -> String {
-    match spell {
-        // With `=`: a negative first coordinate is not taken for a flag.
-        Spelling::Flags => format!("--bounds={},{}", lo.join(","), hi.join(",")),
-        Spelling::Parameters => {
-            format!("bounds=(({}), ({}))", lo.join(", "), hi.join(", "))
+/// `sdfc mesh -o FILE.3mf` for a scene of several materials: each part
+/// (`mesh::parts`) meshed on the whole scene's grid, so that where two parts touch their
+/// faces are meshed alike, and written as an object as soon as it is meshed.
+fn objects(
+    args: &MeshArgs,
+    checked: &frontend::Checked,
+    parts: Vec<crate::mesh::parts::Part>,
+    region: Region,
+    how: &Meshing,
+) -> Result<(), (u8, String)> {
+    let out = args.output.display();
+    let whole = frame(checked, &analysis::analyse(&checked.scene), region, how.say)?;
+    let origin = checked.scene.origin;
+    let bounds = whole.clip.map(|c| [0, 1, 2].map(|i| c[i] + origin[i]));
+    let colours = sdfc_compiler::Colours::new(&checked.scene);
+    let palette = crate::mesh::write::Palette::new(&checked.scene, &colours);
+    let failed = |e: std::io::Error| (1, format!("cannot write `{out}`: {e}"));
+    let mut model = crate::mesh::threemf::Model::new(&palette).map_err(failed)?;
+    let (mut objects, mut triangles, mut vertices, mut seconds) = (0, 0, 0, 0.0);
+    let n = parts.len();
+    for (k, part) in parts.into_iter().enumerate() {
+        let name = palette
+            .materials
+            .get(part.material as usize)
+            .map_or_else(|| format!("material {}", part.material), |m| m.name.clone());
+        let reaches = analysis::analyse(&part.scene).root().is_some_and(|r| {
+            let b = r.bounds;
+            !b.is_empty()
+                && (0..3).all(|i| b.min[i] <= whole.clip[1][i] && b.max[i] >= whole.clip[0][i])
+        });
+        if !reaches {
+            (how.say)(format!(
+                "mesh: the part of material `{name}` lies outside the region: no object for it"
+            ));
+            continue;
+        }
+        (how.say)(format!("mesh: part {} of {n}, material `{name}`", k + 1));
+        let one = frontend::Checked {
+            scene: part.scene,
+            sources: checked.sources.clone(),
+            format: checked.format,
+        };
+        let within = Region {
+            resolution: None,
+            voxel: Some(whole.voxel),
+            bounds: Some(bounds),
+            spelling: region.spelling,
+        };
+        let progress =
+            |stage: &'static str, f: f64| (how.progress)(stage, (k as f64 + f) / n as f64);
+        let meshed = surface(
+            &one,
+            within,
+            how.settings,
+            how.limits,
+            how.pool,
+            &progress,
+            how.say,
+        )?;
+        if meshed.mesh.triangles.is_empty() {
+            (how.say)(format!(
+                "mesh: the part of material `{name}` has no triangles at cells of {}: no object for it",
+                short(whole.voxel)
+            ));
+            continue;
+        }
+        model
+            .object(&name, part.material, &meshed.mesh, &palette)
+            .map_err(failed)?;
+        objects += 1;
+        triangles += meshed.mesh.triangles.len();
+        vertices += meshed.mesh.positions.len();
+        seconds += meshed.seconds;
+        if args.stats {
+            print!(
+                "object          `{name}`\n{}",
+                describe(&meshed.grid, &meshed.stats, meshed.seconds)
+            );
         }
     }
+    if objects == 0 {
+        return Err((
+            1,
+            format!("the mesh has no triangles: no part's surface was found at cells of {} (a higher --resolution); `{out}` is not written", short(whole.voxel)),
+        ));
+    }
+    let bytes = model.finish().map_err(failed)?;
+    crate::image::write_atomic(&args.output, &bytes)
+        .map_err(|e| (2, format!("cannot write `{out}`: {e}")))?;
+    eprintln!(
+        "wrote {out} ({objects} objects, {triangles} triangles, {vertices} vertices, {seconds:.3} s)"
+    );
+    Ok(())
 }
 
 /// A surface meshed by [`surface`]: the mesh in the scene's coordinates, its grid, what
@@ -221,135 +317,21 @@ pub fn surface(
     progress: &(dyn Fn(&'static str, f64) + Sync),
     say: &(dyn Fn(String) + Sync),
 ) -> Result<Meshed, (u8, String)> {
-    let usage = |msg: String| (2u8, msg);
+    let analysis = analysis::analyse(&checked.scene);
+    let Frame {
+        clip,
+        voxel,
+        proven,
+    } = frame(checked, &analysis, region, say)?;
     let spell = region.spelling;
-    let [bounds_opt, resolution_opt, voxel_opt] =
-        ["bounds", "resolution", "voxel"].map(|n| spell.option(n));
-    let scene = &checked.scene;
-    let analysis = analysis::analyse(scene);
-    let Some(root) = analysis.root() else {
-        return Err((
-            1,
-            "the scene has no objects: there is no surface to mesh".into(),
-        ));
-    };
-    let origin = scene.origin;
-    let b = root.bounds;
-    // Known empty (an intersection of parts that do not meet, a profile revolved from beyond
-    // its axis): no grid would find a surface, whatever its cells (it was told to try a
-    // higher resolution, or that the scene was unbounded).
-    if b.is_empty() {
-        return Err((
-            1,
-            "the scene's solid is empty (its parts' bounds leave no point inside it): there is no surface to mesh".into(),
-        ));
-    }
-    // The clip box and the grid, in the program's coordinates (the scene's, less `origin`).
-    let clip = match region.bounds {
-        Some([lo, hi]) => {
-            let clip = [lo, hi].map(|c| [0, 1, 2].map(|i| c[i] - origin[i]));
-            let apart = (0..3).any(|i| b.min[i] > clip[1][i] || b.max[i] < clip[0][i]);
-            if apart {
-                let at = |c: [f64; 3]| [0, 1, 2].map(|i| short(c[i] + origin[i]));
-                let (lo, hi) = (at(b.min), at(b.max));
-                return Err((
-                    1,
-                    format!(
-                        "the region given with {bounds_opt} does not reach the scene's solid, which lies within `{}`: there is no surface to mesh in it",
-                        bounds(spell, lo.each_ref().map(|s| s.as_str()), hi.each_ref().map(|s| s.as_str()))
-                    ),
-                ));
-            }
-            clip
-        }
-        None => {
-            let open: Vec<&str> = ["x", "y", "z"]
-                .into_iter()
-                .enumerate()
-                .filter(|&(i, _)| !(b.min[i].is_finite() && b.max[i].is_finite()))
-                .map(|(_, a)| a)
-                .collect();
-            if !open.is_empty() {
-                let hint = match bounded_part(scene, &analysis) {
-                    Some([lo, hi]) => {
-                        // Grown by a tenth of the largest extent, so that what the box cuts
-                        // (a floor plane) keeps some thickness.
-                        let m = 0.1 * (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
-                        let lo = [0, 1, 2].map(|i| short(lo[i] - m + origin[i]));
-                        let hi = [0, 1, 2].map(|i| short(hi[i] + m + origin[i]));
-                        format!(
-                            "; its bounded objects with a margin are `{}`",
-                            bounds(
-                                spell,
-                                lo.each_ref().map(|s| s.as_str()),
-                                hi.each_ref().map(|s| s.as_str())
-                            )
-                        )
-                    }
-                    None => String::new(),
-                };
-                let corners = match spell {
-                    Spelling::Flags => "--bounds X0,Y0,Z0,X1,Y1,Z1".to_string(),
-                    Spelling::Parameters => bounds(spell, ["x0", "y0", "z0"], ["x1", "y1", "z1"]),
-                };
-                return Err(usage(format!(
-                    "the scene is unbounded along {} (a plane, a half-space or an infinite repetition reaches to infinity); give the region to mesh with `{corners}` (what reaches out of it is cut at its faces and the cut closed){hint}",
-                    open.join(", ")
-                )));
-            }
-            [b.min, b.max]
-        }
-    };
-    let size = [0, 1, 2].map(|i| clip[1][i] - clip[0][i]);
-    let longest = size.iter().copied().fold(0.0f64, f64::max);
-    let voxel = match (region.voxel, region.resolution) {
-        (Some(v), _) if v.is_finite() && v > 0.0 => v,
-        (Some(v), _) => {
-            return Err(usage(format!(
-                "{voxel_opt} must be a positive number, not {v}"
-            )))
-        }
-        (None, Some(0)) => return Err(usage(format!("{resolution_opt} must be at least 1"))),
-        (None, r) => longest / r.unwrap_or(DEFAULT_RESOLUTION) as f64,
-    };
-    if !(voxel > 0.0 && voxel.is_finite()) {
-        return Err(usage(format!(
-            "the bounds are flat: give a region with some extent along every axis (`{bounds_opt}`)"
-        )));
-    }
-    // Without --bounds the box is the analysis's, grown by a cell so that the clip never
-    // touches the surface; one more cell all round is outside the clip, which closes the mesh.
-    let clip = match region.bounds {
-        Some(_) => clip,
-        None => [clip[0].map(|x| x - voxel), clip[1].map(|x| x + voxel)],
-    };
-    let cells = Grid::cells_over(&clip, voxel);
-    if cells.iter().any(|&n| n > AXIS_CELLS as f64) {
-        return Err(usage(format!(
-            "the grid would have {} cells along an axis; at most {AXIS_CELLS} are possible (a larger {voxel_opt} or a smaller {resolution_opt})",
-            cells.iter().copied().fold(0.0f64, f64::max)
-        )));
-    }
-    // Vertices are kept 10⁻³ of a cell apart; the files store f32 coordinates.
-    let magnitude = clip
-        .iter()
-        .flatten()
-        .map(|x| x.abs())
-        .chain(origin.iter().map(|x| x.abs()))
-        .fold(0.0f64, f64::max);
-    if 1e-3 * voxel < 8.0 * f32::EPSILON as f64 * magnitude {
-        say(format!(
-            "warning: a cell of {} is too small for the f32 coordinates of mesh files at {}: vertices may share positions",
-            short(voxel),
-            short(magnitude)
-        ));
-    }
+    let resolution_opt = spell.option("resolution");
+    let origin = checked.scene.origin;
     let grid = Grid::over(&clip, voxel);
     let lowered = checked
         .lower(&LowerOptions::default(), limits)
         .map_err(|_| (1, String::new()))?;
-    let field = Field::new(&lowered.program, root.proven, clip);
-    if !root.proven {
+    let field = Field::new(&lowered.program, proven, clip);
+    if !proven {
         say(format!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
             cause(checked, &analysis),
@@ -357,7 +339,7 @@ pub fn surface(
         ));
     }
     let max_cells = limits.get(Limit::Cells);
-    let octree_bytes = octree::bytes(&grid, root.proven, max_cells);
+    let octree_bytes = octree::bytes(&grid, proven, max_cells);
     let [nx, ny, nz] = grid.cells;
     say(format!(
         "mesh: {nx}x{ny}x{nz} cells of {}: allocating at most {} MiB to find the surface",
@@ -440,7 +422,7 @@ pub fn surface(
         stats.error = Some(pool.install(|| crate::mesh::error(&field, &mesh)));
     }
     stats.octree_cells = octree_evaluated;
-    stats.dense = !root.proven;
+    stats.dense = !proven;
     for p in &mut mesh.positions {
         *p = [0, 1, 2].map(|i| p[i] + origin[i]);
     }
@@ -495,15 +477,6 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
         },
         seconds
     )
-}
-
-/// A length for a message: four decimals, or for a small one (a cell of 10⁻⁵) three
-/// significant digits in scientific notation, never `0`.
-fn short(x: f64) -> String {
-    if x != 0.0 && x.abs() < 1e-3 {
-        return sdfc_compiler::diagnostics::scientific(x);
-    }
-    sdfc_compiler::diagnostics::number(x, 4)
 }
 
 /// The largest `n` for which `fits(n)` holds (`fits` true up to some `n`, false beyond; 0
@@ -564,36 +537,6 @@ fn cause(checked: &frontend::Checked, a: &analysis::Analysis) -> String {
     )
 }
 
-/// The box around the scene's bounded objects: the objects of its top-level unions whose
-/// bounding box is finite (`None` when there are none).
-fn bounded_part(scene: &Scene, a: &analysis::Analysis) -> Option<[[f64; 3]; 2]> {
-    let mut stack: Vec<NodeId> = scene.root.into_iter().collect();
-    let mut found: Option<[[f64; 3]; 2]> = None;
-    while let Some(id) = stack.pop() {
-        let b = a.node(id).bounds;
-        let finite = (0..3).all(|i| b.min[i].is_finite() && b.max[i].is_finite());
-        if finite && !b.is_empty() {
-            found = Some(match found {
-                None => [b.min, b.max],
-                Some([lo, hi]) => [
-                    [0, 1, 2].map(|i| lo[i].min(b.min[i])),
-                    [0, 1, 2].map(|i| hi[i].max(b.max[i])),
-                ],
-            });
-            continue;
-        }
-        match scene.graph.node(id) {
-            Node::Combine {
-                op: Combine::Union,
-                children,
-            } => stack.extend(children.iter().copied()),
-            Node::Paint { child, .. } => stack.push(*child),
-            _ => {}
-        }
-    }
-    found
-}
-
 /// The mesh settings of `--set`.
 fn settings(sets: &[String]) -> Result<Settings, String> {
     let mut s = Settings::default();
@@ -618,25 +561,4 @@ fn settings(sets: &[String]) -> Result<Settings, String> {
         }
     }
     Ok(s)
-}
-
-/// Parses `X0,Y0,Z0,X1,Y1,Z1` into (min, max).
-pub fn parse_bounds(s: &str) -> Result<[[f64; 3]; 2], String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("expected six numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"))?;
-    if v.len() != 6 || v.iter().any(|x| !x.is_finite()) {
-        return Err(format!(
-            "expected six finite numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"
-        ));
-    }
-    let (lo, hi) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
-    if (0..3).any(|i| !(lo[i] < hi[i])) {
-        return Err(format!(
-            "each lower bound must be below the upper one (X0 < X1, Y0 < Y1, Z0 < Z1), not `{s}`"
-        ));
-    }
-    Ok([lo, hi])
 }

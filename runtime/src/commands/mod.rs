@@ -9,6 +9,7 @@ pub mod compile;
 pub mod devices;
 pub mod fmt;
 pub mod mesh;
+pub mod mesh_region;
 pub mod pareto;
 pub mod render;
 pub mod sequence;

@@ -2,15 +2,18 @@
 //! by an octree pruned with the distance program's proven Lipschitz bound (`octree`); the
 //! surface patch of each such cell, with edge vertices found on the surface and a vertex
 //! inside the cell placed from the field's gradients, which keeps sharp edges and corners
-//! (`contour`); and the file formats (`write`). `docs/mesh.md` describes the method and its
+//! (`contour`); and the file formats (`write`; 3MF in `threemf`, its archive in `zip`). `docs/mesh.md` describes the method and its
 //! guarantees.
 
 pub mod contour;
 pub mod octree;
+pub mod parts;
 pub mod place;
 pub mod qef;
 pub mod table;
+pub mod threemf;
 pub mod write;
+pub mod zip;
 
 use rayon::prelude::*;
 use sdfc_compiler::{Evaluator, Outputs, Program, Tape, DEFAULT_CHUNK};

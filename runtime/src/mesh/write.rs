@@ -2,7 +2,7 @@
 //! material's there) and binary glTF, `.glb` (one material per scene material the mesh uses,
 //! one primitive each, sharing the vertex positions). Where a material's colour is a colour
 //! field, OBJ's vertices carry their colours too (`v x y z r g b`), and the glTF primitives
-//! of such materials a `COLOR_0` per vertex.
+//! of such materials a `COLOR_0` per vertex. 3MF packages are `threemf.rs`'s.
 //!
 //! Each format is a few dozen lines written here with `std` and `serde_json`: the crates that
 //! write them would add dependencies for no less code; the tests read the files back with
@@ -25,6 +25,9 @@ pub enum Format {
     Ply,
     /// Binary glTF 2.0.
     Glb,
+    /// 3MF: a ZIP package of an XML model in millimetres, an object per material
+    /// (`threemf.rs`).
+    ThreeMf,
 }
 
 impl Format {
@@ -36,21 +39,31 @@ impl Format {
             "obj" => Some(Format::Obj),
             "ply" => Some(Format::Ply),
             "glb" => Some(Format::Glb),
+            "3mf" => Some(Format::ThreeMf),
             _ => None,
         }
     }
 
-    /// The bytes of `mesh` in this format, coloured by `palette`.
-    pub fn encode(self, mesh: &Mesh, palette: &Palette) -> Vec<u8> {
+    /// The bytes of `mesh` in this format, coloured by `palette` (3MF: one object, of
+    /// the material of its first triangle). `Err` only for a 3MF package too large for a ZIP
+    /// without its 64-bit extension.
+    pub fn encode(self, mesh: &Mesh, palette: &Palette) -> io::Result<Vec<u8>> {
         let mut out = Vec::new();
-        // Writing to a vector cannot fail.
-        let _ = match self {
-            Format::Stl => stl(mesh, &mut out),
-            Format::Obj => obj(mesh, palette, &mut out),
-            Format::Ply => ply(mesh, palette, &mut out),
-            Format::Glb => glb(mesh, palette, &mut out),
-        };
-        out
+        match self {
+            Format::Stl => stl(mesh, &mut out)?,
+            Format::Obj => obj(mesh, palette, &mut out)?,
+            Format::Ply => ply(mesh, palette, &mut out)?,
+            Format::Glb => glb(mesh, palette, &mut out)?,
+            Format::ThreeMf => {
+                let m = mesh.materials.first().copied().unwrap_or(0);
+                let name = palette
+                    .materials
+                    .get(m as usize)
+                    .map_or("sdfc mesh", |m| &m.name);
+                out = super::threemf::one(name, m, mesh, palette)?;
+            }
+        }
+        Ok(out)
     }
 }
 
@@ -187,7 +200,7 @@ fn obj(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
 /// The one colour glTF gives a material: its colour, or the mean of a checker's two; white
 /// for a colour field, whose colours are the vertices' (`COLOR_0`, which glTF multiplies by
 /// it).
-fn base_colour(m: &Material) -> [f64; 3] {
+pub fn base_colour(m: &Material) -> [f64; 3] {
     let c = |c: &Colour| c.constant().unwrap_or([1.0; 3]);
     match &m.pattern {
         Pattern::Solid(a) => c(a),

@@ -3,7 +3,8 @@
 //! gradient, and a bound of its gradient's length; each rule bounds an operation's derivative
 //! over its operands' intervals (the chain rule), and the field's L is the bound of its value.
 //! An operation whose derivative is unbounded there (a division by a range holding 0, `floor`
-//! across an integer, `sqrt` near 0) makes the bound infinite: nothing is proven.
+//! across an integer, `sqrt` near 0) makes the bound infinite: nothing is proven. The same
+//! intervals over half-spaces give the box of the field's solid (`solid_box`).
 
 use crate::scene::field::{
     FBin, FOp, FUn, FieldFn, NOISE_LIPSCHITZ, NOISE_RANGE, VORONOI_LO, VORONOI_SPAN,
@@ -404,12 +405,100 @@ fn binary(op: FBin, a: &Val, b: &Val) -> Val {
 /// The Lipschitz constant the expression's value `f.out[0]` is proven to have over all of
 /// space, with `shape(id)` the L of a shape it reads; infinite where nothing is proven.
 pub fn lipschitz(f: &FieldFn, shape: impl Fn(NodeId) -> f64) -> f64 {
-    let vals = values(f, shape);
+    let vals = values(f, EVERYWHERE, shape, |_, _| f64::NEG_INFINITY);
     f.out.first().map_or(0.0, |&o| vals[o as usize].n())
 }
 
-/// What is known of every value of `f`.
-fn values(f: &FieldFn, shape: impl Fn(NodeId) -> f64) -> Vec<Val> {
+/// Doublings of the search for a side of [`solid_box`] beyond which the solid is proven
+/// absent (from 1 to 2⁶³), and halvings of the bisection that then narrows it.
+const DOUBLINGS: i32 = 63;
+const HALVINGS: u32 = 60;
+
+/// A box around the solid of `f` (the points where its value is ≤ 0) that the expression
+/// proves by interval arithmetic (docs/analysis.md, "Fields"): a side of the box is a plane
+/// beyond which the value's interval over the half-space is above 0. Each of the six sides
+/// is found by doubling until such a half-space is found (none within 2⁶³: the side is
+/// infinite), then by bisection; then again with the other axes limited to the box found,
+/// which tightens expressions that mix the coordinates (a length). `below(id, q)` is a lower
+/// bound of the field of a shape the expression reads, over the box `q` of points it is read
+/// at (−∞ when none is known). The box may be loose, never too small: it is widened by a
+/// millionth of its size for the rounding of the interval bounds.
+pub fn solid_box(f: &FieldFn, below: impl Fn(NodeId, Region) -> f64) -> ([f64; 3], [f64; 3]) {
+    let Some(&out) = f.out.first() else {
+        return ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
+    };
+    let empty = |r: Region| {
+        let v = values(f, r, |_| f64::INFINITY, &below)[out as usize].range;
+        v.lo > 0.0
+    };
+    let mut bounds = EVERYWHERE;
+    for _pass in 0..2 {
+        let within = bounds;
+        for axis in 0..3 {
+            for side in [1.0f64, -1.0] {
+                // The half-space beyond `t` along the side's direction, within `within`.
+                let beyond = |t: f64| {
+                    let mut r = within;
+                    r[axis] = if side > 0.0 {
+                        [t, f64::INFINITY]
+                    } else {
+                        [f64::NEG_INFINITY, -t]
+                    };
+                    empty(r)
+                };
+                let Some(mut far) = (0..=DOUBLINGS).map(|k| 2f64.powi(k)).find(|&t| beyond(t))
+                else {
+                    continue;
+                };
+                let Some(mut near) = (0..=DOUBLINGS)
+                    .map(|k| -(2f64.powi(k)))
+                    .find(|&t| !beyond(t))
+                else {
+                    // Nothing anywhere along the axis: no solid.
+                    return ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                };
+                for _ in 0..HALVINGS {
+                    let mid = 0.5 * (near + far);
+                    if beyond(mid) {
+                        far = mid;
+                    } else {
+                        near = mid;
+                    }
+                }
+                let k = if side > 0.0 { 1 } else { 0 };
+                let t = side * far;
+                bounds[axis][k] = if side > 0.0 {
+                    t.min(bounds[axis][k])
+                } else {
+                    t.max(bounds[axis][k])
+                };
+            }
+        }
+    }
+    let size = bounds
+        .iter()
+        .flatten()
+        .filter(|x| x.is_finite())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let pad = 1e-6 * size + 1e-300;
+    (bounds.map(|[a, _]| a - pad), bounds.map(|[_, b]| b + pad))
+}
+
+/// Where the point lies, for [`values`]: a box, infinite sides allowed.
+type Region = [[f64; 2]; 3];
+
+/// All of space.
+const EVERYWHERE: Region = [[f64::NEG_INFINITY, f64::INFINITY]; 3];
+
+/// What is known of every value of `f` for points in `region`, with `shape(id)` the L of a
+/// shape the expression reads and `below(id, q)` a lower bound of that shape's field over
+/// the box `q` of the points it is read at.
+fn values(
+    f: &FieldFn,
+    region: Region,
+    shape: impl Fn(NodeId) -> f64,
+    below: impl Fn(NodeId, Region) -> f64,
+) -> Vec<Val> {
     let mut vals: Vec<Val> = Vec::with_capacity(f.ops.len());
     for op in &f.ops {
         let get = |s: &u32| vals[*s as usize];
@@ -417,8 +506,9 @@ fn values(f: &FieldFn, shape: impl Fn(NodeId) -> f64) -> Vec<Val> {
             FOp::Coord(axis) => {
                 let mut grad = [Iv::ZERO; 3];
                 grad[*axis as usize % 3] = Iv::point(1.0);
+                let [lo, hi] = region[*axis as usize % 3];
                 Val {
-                    range: Iv::ALL,
+                    range: Iv::new(lo, hi),
                     grad,
                     norm: 1.0,
                 }
@@ -438,7 +528,12 @@ fn values(f: &FieldFn, shape: impl Fn(NodeId) -> f64) -> Vec<Val> {
             }
             FOp::Distance(id, q) => {
                 let rows: Vec<Val> = q.iter().map(get).collect();
-                lipschitz_of(&rows, shape(*id), Iv::ALL)
+                let at = [0, 1, 2].map(|i| match rows.get(i) {
+                    Some(r) => [r.range.lo, r.range.hi],
+                    None => [0.0, 0.0],
+                });
+                let lo = below(*id, at);
+                lipschitz_of(&rows, shape(*id), Iv::new(lo, f64::INFINITY))
             }
             FOp::Noise(v) => {
                 let rows: Vec<Val> = v.iter().map(get).collect();
@@ -468,4 +563,39 @@ fn values(f: &FieldFn, shape: impl Fn(NodeId) -> f64) -> Vec<Val> {
         vals.push(v);
     }
     vals
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn field(ops: Vec<FOp>) -> FieldFn {
+        let out = vec![ops.len() as u32 - 1];
+        FieldFn { ops, out }
+    }
+
+    /// `length(p) − 1` is in the unit cube (within the millionth it is widened by); a
+    /// constant above 0 has no solid; `sin x` (a slab of sheets) has no box along x.
+    #[test]
+    fn solid_boxes_come_from_the_intervals() {
+        let none = |_: NodeId, _: Region| f64::NEG_INFINITY;
+        let sphere = field(vec![
+            FOp::Coord(0),
+            FOp::Coord(1),
+            FOp::Coord(2),
+            FOp::Length(vec![0, 1, 2]),
+            FOp::Const(1.0),
+            FOp::Bin(FBin::Sub, 3, 4),
+        ]);
+        let (lo, hi) = solid_box(&sphere, none);
+        for i in 0..3 {
+            assert!((lo[i] + 1.0).abs() < 1e-5 && lo[i] <= -1.0, "{lo:?}");
+            assert!((hi[i] - 1.0).abs() < 1e-5 && hi[i] >= 1.0, "{hi:?}");
+        }
+        let (lo, hi) = solid_box(&field(vec![FOp::Const(1.0)]), none);
+        assert!((0..3).any(|i| lo[i] > hi[i]), "empty: {lo:?} {hi:?}");
+        let sheets = field(vec![FOp::Coord(0), FOp::Un(FUn::Sin, 0)]);
+        let (lo, hi) = solid_box(&sheets, none);
+        assert_eq!((lo[0], hi[0]), (f64::NEG_INFINITY, f64::INFINITY));
+    }
 }

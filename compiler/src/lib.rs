@@ -62,7 +62,7 @@ pub use crate::scene::{
         Animation, Camera, Colour, Combine, Exactness, Graph, Light, Material, MaterialId, Method,
         Node, Pattern, Scene, Settings, Smooth, V3,
     },
-    NodeId,
+    look, NodeId, Tonemap,
 };
 
 /// The lowering, once per scene: the distance program and what every back end reads of the

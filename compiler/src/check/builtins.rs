@@ -1768,5 +1768,15 @@ pub static RENDER: Record = Record {
         ),
         p("fps", F, Num(30.0), Within(0.01, 1000.0)),
         p("duration", F, Num(0.0), Within(0.0, 1e7)),
+        p("occlusion", F, Num(DEFAULT.occlusion), Within(0.0, 1e9)),
+        p("fog", F, Num(DEFAULT.fog), Within(0.0, 1e9)),
+        p("fog_color", V, V3(DEFAULT.background), NonNeg),
+        p("exposure", F, Num(DEFAULT.exposure), Within(-20.0, 20.0)),
+        p(
+            "tonemap",
+            Str,
+            Text(DEFAULT.tonemap.name()),
+            OneOf(crate::scene::Tonemap::NAMES),
+        ),
     ],
 };

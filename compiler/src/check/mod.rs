@@ -21,6 +21,7 @@ use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::scene::{
     Camera, Colour, Combine, Light, Material, MaterialId, Method, Node, Pattern, Scene, Settings,
+    Tonemap,
 };
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::{self, ast};
@@ -721,6 +722,15 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 method: match &f["method"] {
                     Value::Str(s) => Method::from_name(s).unwrap_or_default(),
                     _ => Method::Auto,
+                },
+                occlusion: f["occlusion"].num(),
+                fog: f["fog"].num(),
+                // Left out, the fog takes the background's colour.
+                fog_color: field_span(&b.fields, "fog_color").map(|_| f["fog_color"].v3()),
+                exposure: f["exposure"].num(),
+                tonemap: match &f["tonemap"] {
+                    Value::Str(s) => Tonemap::from_name(s).unwrap_or_default(),
+                    _ => Tonemap::None,
                 },
             };
             if let (Value::Float(fps), Value::Float(duration)) = (&f["fps"], &f["duration"]) {

@@ -830,6 +830,17 @@ pub struct Settings {
     pub background: V3,
     /// How rays find surfaces (see [`Method`]).
     pub method: Method,
+    /// How far from a surface ambient occlusion looks, R (0: none; docs/rendering.md, "The
+    /// look").
+    pub occlusion: f64,
+    /// The distance D over which fog leaves e^(−t/D) of a surface's light (0: none).
+    pub fog: f64,
+    /// The fog's colour; `None`: the background.
+    pub fog_color: Option<V3>,
+    /// Exposure in stops: the pixel's colour is multiplied by 2^exposure.
+    pub exposure: f64,
+    /// The tone curve after the exposure.
+    pub tonemap: super::Tonemap,
 }
 
 /// The intersection method of a render (docs/rendering.md, "Marching" and "Analytic ray tracing").
@@ -880,6 +891,11 @@ impl Settings {
         }
     }
 
+    /// The fog's colour: `fog_color`, or where it is not given, the background.
+    pub fn fog_colour(&self) -> V3 {
+        self.fog_color.unwrap_or(self.background)
+    }
+
     /// The settings of a scene without a `render` block, and the default of each field of one
     /// (`check/builtins.rs` reads them here).
     pub const DEFAULT: Settings = Settings {
@@ -894,6 +910,11 @@ impl Settings {
         relaxation: 1.4,
         background: [0.05, 0.06, 0.08],
         method: Method::Auto,
+        occlusion: 0.0,
+        fog: 0.0,
+        fog_color: None,
+        exposure: 0.0,
+        tonemap: super::Tonemap::None,
     };
 }
 

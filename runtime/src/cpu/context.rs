@@ -7,6 +7,7 @@ use super::camera::Pinhole;
 use super::vec::V3;
 use sdfc_compiler::{
     analytic::Traceable, Colour, ColourProgram, Colours, Float, Light, Material, Pattern, Scene,
+    Tonemap,
 };
 
 /// One colour of a material: a constant, or the colour field of this number
@@ -83,6 +84,20 @@ pub(super) struct Context<T: Float> {
     pub analytic: Option<Tracer<T>>,
     /// The materials' colour fields (`lower::Colours::programs`).
     pub colours: Vec<ColourProgram>,
+    /// The occlusion radius R (0: none).
+    pub occlusion: T,
+    /// 1/D for fog over a distance D (0: none).
+    pub inv_fog: T,
+    /// The fog's colour.
+    pub fog: V3<T>,
+    /// Whether the pixels are graded (an exposure or a tone curve): [`super::look::grade`].
+    pub graded: bool,
+    /// 2^exposure.
+    pub exposure: T,
+    pub tonemap: Tonemap,
+    /// A sample's pitch at unit distance: 2·tan(fov/2)/(height·aa), the width of its
+    /// footprint on a surface facing it at distance 1 (the filtered checker's).
+    pub pitch: T,
 }
 
 impl<T: Float> Context<T> {
@@ -123,6 +138,15 @@ impl<T: Float> Context<T> {
             debug_nan,
             analytic: traceable.traced(s.method).map(Tracer::new),
             colours: colours.to_vec(),
+            occlusion: T::from_f64(s.occlusion),
+            inv_fog: T::from_f64(if s.fog > 0.0 { 1.0 / s.fog } else { 0.0 }),
+            fog: V3::from_f64(s.fog_colour()),
+            graded: s.exposure != 0.0 || s.tonemap != Tonemap::None,
+            exposure: T::from_f64(s.exposure.exp2()),
+            tonemap: s.tonemap,
+            pitch: T::from_f64(2.0)
+                * T::from_f64((scene.camera.fov * 0.5).tan())
+                / (T::from_f64(s.height.max(1) as f64) * T::from_f64(s.aa.max(1) as f64)),
         }
     }
 

@@ -50,7 +50,9 @@ pub const WORKGROUP: u32 = 8;
 /// secondary rays, shadow rays.
 pub const STATS_WORDS: u32 = 9;
 
-const TEMPLATE: &str = include_str!("kernel.wgsl");
+/// The kernel template: the renderer (kernel.wgsl) and its shading (shading.wgsl), one
+/// module (WGSL declarations may come in any order).
+const TEMPLATE: &str = concat!(include_str!("kernel.wgsl"), include_str!("shading.wgsl"));
 
 /// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
 /// they are read from `scene_data` and walked nearest first (march.rs). The code grows with
@@ -155,6 +157,13 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
                     .iter()
                     .any(|c| matches!(c, Colour::Field(_)))
             }),
+        ),
+        // The look (docs/rendering.md): occlusion samples the field, so a traced scene has none.
+        ("OCCLUSION", !traced && scene.settings.occlusion > 0.0),
+        ("FOG", scene.settings.fog > 0.0),
+        (
+            "GRADE",
+            scene.settings.exposure != 0.0 || scene.settings.tonemap != crate::scene::Tonemap::None,
         ),
     ]
 }
@@ -537,6 +546,19 @@ fn write_template(
     values.insert("PENUMBRA_BRACKET", float(Light::PENUMBRA_BRACKET));
     values.insert("PENUMBRA_PROBES", format!("{}u", Light::PENUMBRA_PROBES));
     values.insert("WORKGROUP", WORKGROUP.to_string());
+    {
+        use crate::scene::look;
+        values.insert("FOOTPRINT_MIN", float(look::FOOTPRINT_MIN));
+        values.insert("FOOTPRINT_COS", float(look::FOOTPRINT_COS));
+        values.insert("OCCLUSION_SAMPLES", format!("{}u", look::OCCLUSION_SAMPLES));
+        values.insert("OCCLUSION_STRENGTH", float(look::OCCLUSION_STRENGTH));
+        for (k, c) in ["FILMIC_A", "FILMIC_B", "FILMIC_C", "FILMIC_D", "FILMIC_E"]
+            .into_iter()
+            .zip(look::FILMIC)
+        {
+            values.insert(k, float(c));
+        }
+    }
     values.insert("ENTRY", ENTRY_POINT.to_string());
     let source = template::expand(template, &on, &values).map_err(|e| Error {
         message: format!("kernel template: {e}"),
@@ -680,6 +702,17 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
         ],
     )?;
     w.floats("background", &v4(s.background, 0.0))?;
+    let inv_fog = if s.fog > 0.0 { 1.0 / s.fog } else { 0.0 };
+    w.floats(
+        "look",
+        &[
+            s.occlusion,
+            inv_fog,
+            s.exposure.exp2(),
+            s.tonemap.index() as f64,
+        ],
+    )?;
+    w.floats("fog", &v4(s.fog_colour(), 0.0))?;
     w.uints(
         "counts",
         &[s.width, s.height, s.aa.max(1), s.max_steps.max(1)],

@@ -75,6 +75,28 @@ fn occlusion_darkens_a_crease_by_the_formulas_amount() {
         }
     }
     assert!(darkened >= 4, "the crease spans {darkened} pixels");
+    // A uniform sky of 1 instead of the ambient term: its light is scaled by the same
+    // occlusion (k_d = 1, E/π = 1).
+    let sky = checked(
+        "sky crease",
+        &CREASE
+            .replace("OCCLUSION", &format!(", occlusion: {r}"))
+            .replace("ambient: 1, diffuse: 0", "ambient: 0, diffuse: 1")
+            .replace("scene {", "light sky { color: (1, 1, 1), background: false }\nscene {"),
+    );
+    for (backend, image) in render_everywhere("sky crease", &sky) {
+        for px in 0..sky.settings.width {
+            let x = crease_x(&sky, px);
+            if x > -0.02 {
+                continue;
+            }
+            let (expected, got) = (crease_ao(r, x), image.pixel(px, y)[0] as f64);
+            assert!(
+                (got - expected).abs() < 0.02,
+                "{backend}: sky light at x = {x:.3} is {got:.4}, the occlusion {expected:.4}"
+            );
+        }
+    }
     for (backend, image) in render_everywhere("plain crease", &plain) {
         let far = (0..plain.settings.width)
             .find(|&px| crease_x(&plain, px) < -r - 0.05)
@@ -199,5 +221,120 @@ scene { plane() @ floor; }
             })
             .count();
         assert!(pure * 10 >= one.settings.width as usize * 8, "{backend}: {pure} pure pixels");
+    }
+}
+
+/// The furnace for sky light: a diffuse white sphere (k_d = 1, no ambient) under a sky of
+/// radiance 1 all round, without occlusion, is 1 wherever it is seen, from every side (the
+/// sky's irradiance over π is 1 for every normal); the background, which the sky is not here,
+/// stays black.
+#[test]
+fn a_white_sphere_under_a_uniform_sky_is_white() {
+    let scene = checked(
+        "furnace",
+        "
+material white = phong { color: (1, 1, 1), ambient: 0, diffuse: 1, specular: 0 };
+camera { position: (0, 2, -4), look_at: (0, 0, 0), fov: 40deg }
+light sky { color: (1, 1, 1), background: false }
+render { width: 48, height: 48, background: (0, 0, 0) }
+scene { sphere(1) @ white; }
+",
+    );
+    for (backend, image) in render_everywhere("furnace", &scene) {
+        let mut seen = 0;
+        for y in 0..48 {
+            for x in 0..48 {
+                let c = image.pixel(x, y);
+                if c == [0.0; 3] {
+                    continue;
+                }
+                seen += 1;
+                for v in c {
+                    assert!((v - 1.0).abs() < 1e-4, "{backend}: ({x}, {y}) is {c:?}");
+                }
+            }
+        }
+        assert!(seen > 400, "{backend}: the sphere covers {seen} pixels");
+    }
+}
+
+/// A sky that is the background: a miss shows its gradient, `horizon + (zenith − horizon)·y`
+/// for a direction of height y, and its ground below the horizon.
+#[test]
+fn the_background_may_be_the_sky() {
+    let scene = checked(
+        "sky background",
+        "
+camera { position: (0, 0, 0), look_at: (0, 0, 1), fov: 90deg }
+light sky { zenith: (0, 0, 1), horizon: (1, 1, 1), ground: (0.2, 0.1, 0) }
+render { width: 9, height: 9 }
+scene { sphere(0.1).translate(0, 0, -50); }
+",
+    );
+    let row = |j: u32| {
+        let by = 1.0 - 2.0 * (j as f64 + 0.5) / 9.0;
+        by / (1.0 + by * by).sqrt()
+    };
+    for (backend, image) in render_everywhere("sky background", &scene) {
+        let y = row(0);
+        let top = image.pixel(4, 0);
+        let expected = [1.0 - y, 1.0 - y, 1.0];
+        for k in 0..3 {
+            assert!(
+                (top[k] as f64 - expected[k]).abs() < 1e-5,
+                "{backend}: {top:?} against {expected:?}"
+            );
+        }
+        assert_eq!(image.pixel(4, 8), [0.2, 0.1, 0.0], "{backend}: the ground");
+    }
+}
+
+/// Seen from above: a white floor (k_d = 1) lit by a sun from above and to the side,
+/// shadowed by a square slab floating above it. The penumbra (pixels between 5 % and 95 % of
+/// the lit floor) widens with the sun's `angle`, alike on every backend; `shadows: false`
+/// leaves no shadow at all.
+#[test]
+fn a_suns_penumbra_widens_with_its_angle() {
+    let text = "
+material white = phong { color: (1, 1, 1), ambient: 0, diffuse: 1, specular: 0 };
+camera { position: (-2, 10, 0), look_at: (-2, 0, 0), up: (0, 0, 1), fov: 10deg }
+light sun { direction: (-1, -2, 0) SUN }
+render { width: 96, height: 96, background: (0, 0, 0) }
+scene { plane() @ white; box((1, 0.05, 1)).translate(0, 2, 0) @ white; }
+";
+    // The lit floor: N·L.
+    let lit = 2.0 / 5.0f32.sqrt();
+    let mut widths = Vec::new();
+    for angle in ["1deg", "4deg"] {
+        let scene = checked("sun", &text.replace("SUN", &format!(", angle: {angle}")));
+        let mut found = None;
+        for (backend, image) in render_everywhere("sun", &scene) {
+            let partial = (0..96)
+                .filter(|&x| {
+                    let v = image.pixel(x, 48)[0] / lit;
+                    v > 0.05 && v < 0.95
+                })
+                .count();
+            println!("{backend}: angle {angle}: {partial} pixels in the penumbra");
+            if let Some(first) = found {
+                assert!(partial.abs_diff(first) <= 1, "{backend} against the CPU");
+            }
+            found.get_or_insert(partial);
+        }
+        widths.push(found.expect("the CPU"));
+    }
+    assert!(widths[0] >= 1 && widths[1] > 2 * widths[0], "{widths:?}");
+    let dark = |image: &Image| (0..96).filter(|&x| image.pixel(x, 48)[0] < 0.5 * lit).count();
+    let shadowed = checked("shadows", &text.replace("SUN", ", angle: 4deg"));
+    for (backend, image) in render_everywhere("shadows", &shadowed) {
+        assert!(dark(&image) >= 10, "{backend}: {} dark pixels", dark(&image));
+    }
+    let unshadowed = checked(
+        "no shadows",
+        &text.replace("SUN", ", angle: 4deg, shadows: false"),
+    );
+    for (backend, image) in render_everywhere("no shadows", &unshadowed) {
+        // The slab's side, facing away from the sun, may show as a dark pixel.
+        assert!(dark(&image) <= 2, "{backend}: {} dark pixels", dark(&image));
     }
 }

@@ -757,7 +757,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                     kind.span,
                 )
                 .with_label("not a light kind")
-                .with_note("the light kinds are point and directional");
+                .with_note("the light kinds are point, directional, sun and sky");
                 if let Some(s) =
                     suggest::closest(&kind.name, builtins::LIGHTS.iter().map(|r| r.name))
                 {
@@ -768,10 +768,47 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
             };
             let f = eval::record(cx, rec, &b.fields, kind);
             let (color, intensity) = (f["color"].v3(), f["intensity"].num());
-            let penumbra = penumbra(cx, &b.fields, &f);
             cx.places
                 .lights
                 .push(field_span(&b.fields, "position").unwrap_or(kind.span));
+            let shadows = !matches!(f["shadows"], Value::Bool(false));
+            let unit = |d: [f64; 3]| {
+                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                    .sqrt()
+                    .max(f64::MIN_POSITIVE);
+                [d[0] / len, d[1] / len, d[2] / len]
+            };
+            if rec.name == "sky" {
+                // `color` gives all three; those given beside it win.
+                let given = |name: &str| field_span(&b.fields, name).is_some();
+                let part = |name: &str| {
+                    if given(name) || !given("color") {
+                        f[name].v3()
+                    } else {
+                        color
+                    }
+                };
+                scene.lights.push(Light::Sky {
+                    zenith: part("zenith"),
+                    horizon: part("horizon"),
+                    ground: part("ground"),
+                    intensity,
+                    shadows,
+                    background: !matches!(f["background"], Value::Bool(false)),
+                });
+                return;
+            }
+            if rec.name == "sun" {
+                scene.lights.push(Light::Directional {
+                    direction: unit(f["direction"].v3()),
+                    color,
+                    intensity,
+                    penumbra: f["angle"].num(),
+                    shadows,
+                });
+                return;
+            }
+            let penumbra = penumbra(cx, &b.fields, &f);
             scene.lights.push(if rec.name == "point" {
                 Light::Point {
                     position: f["position"].v3(),
@@ -779,17 +816,15 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                     intensity,
                     radius: f["radius"].num(),
                     penumbra,
+                    shadows,
                 }
             } else {
-                let d = f["direction"].v3();
-                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-                    .sqrt()
-                    .max(f64::MIN_POSITIVE);
                 Light::Directional {
-                    direction: [d[0] / len, d[1] / len, d[2] / len],
+                    direction: unit(f["direction"].v3()),
                     color,
                     intensity,
                     penumbra,
+                    shadows,
                 }
             });
         }

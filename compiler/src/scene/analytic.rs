@@ -174,7 +174,11 @@ pub struct Traced {
 /// The primitives of `scene` and what rules tracing out, whatever its `method`.
 pub fn traceable(scene: &Scene) -> Traceable {
     let limit = scene.limits.count(Limit::Traced);
-    if let Some(index) = scene.lights.iter().position(|l| l.penumbra() > 0.0) {
+    if let Some(index) = scene
+        .lights
+        .iter()
+        .position(|l| l.penumbra() > 0.0 && l.shadows())
+    {
         return Traceable {
             primitives: Err(Reason::SoftLight { index }),
             overlap: None,

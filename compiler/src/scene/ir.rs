@@ -681,6 +681,8 @@ pub enum Light {
         radius: f64,
         /// The angle of the penumbra in radians (0 gives hard shadows); see [`Light::sharpness`].
         penumbra: f64,
+        /// Whether it casts shadows (`shadows: false`: no shadow rays).
+        shadows: bool,
     },
     /// A light from a direction (the direction light travels in), with no attenuation.
     Directional {
@@ -688,7 +690,23 @@ pub enum Light {
         color: V3,
         intensity: f64,
         /// The angle of the penumbra in radians (0 gives hard shadows); see [`Light::sharpness`].
+        /// A `sun`'s is its angular size, `angle`.
         penumbra: f64,
+        /// Whether it casts shadows (`shadows: false`: no shadow rays).
+        shadows: bool,
+    },
+    /// Light from the whole sky (docs/rendering.md, "Sky light"): radiance `zenith` straight
+    /// up, `horizon` at the horizon, linear in the height of the direction between them,
+    /// `ground` below the horizon, each times `intensity`.
+    Sky {
+        zenith: V3,
+        horizon: V3,
+        ground: V3,
+        intensity: f64,
+        /// Whether the ambient occlusion (the `occlusion` render setting) scales its light.
+        shadows: bool,
+        /// Whether rays that hit nothing show it instead of the `background` colour.
+        background: bool,
     },
 }
 
@@ -697,6 +715,16 @@ impl Light {
     pub fn penumbra(&self) -> f64 {
         match self {
             Light::Point { penumbra, .. } | Light::Directional { penumbra, .. } => *penumbra,
+            Light::Sky { .. } => 0.0,
+        }
+    }
+
+    /// Whether it casts shadows (a sky's are its occlusion).
+    pub fn shadows(&self) -> bool {
+        match self {
+            Light::Point { shadows, .. }
+            | Light::Directional { shadows, .. }
+            | Light::Sky { shadows, .. } => *shadows,
         }
     }
 

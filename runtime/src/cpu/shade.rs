@@ -61,7 +61,7 @@ pub(super) fn bounce<T: Float>(
                 };
                 if fade < T::one() {
                     let a = &mut samples.acc[ray.sample as usize];
-                    *a = *a + (ray.weight * (T::one() - fade)).mul_v(ctx.fog);
+                    *a = *a + (ray.weight * (T::one() - fade)).mul_v(ctx.fog_colour(ray.dir));
                 }
                 hits.push(Hit {
                     ray: i,
@@ -82,9 +82,9 @@ pub(super) fn bounce<T: Float>(
         }
         // Fog hides what lies beyond every surface: a miss outside solids is its colour.
         let seen = if ctx.inv_fog > T::zero() && !ray.inside {
-            ctx.fog
+            ctx.fog_colour(ray.dir)
         } else {
-            ctx.background
+            ctx.background(ray.dir)
         };
         let a = &mut samples.acc[ray.sample as usize];
         *a = *a + ray.weight.mul_v(seen);
@@ -495,8 +495,21 @@ fn light<T: Float>(
         }
         let c = colour(ctx, m, hit, ray.dir);
         colour_at[hi] = c * (m.ambient * ao[hi]);
+        // Sky light: k_d·C·E(N)/π, times the occlusion where it casts shadows.
+        let ny = hit.n.y;
+        for sky in &ctx.skies {
+            let [c0, c1, c2] = sky.irradiance;
+            let e = c0 + c1 * ny + c2 * (T::from_f64(3.0) * ny * ny - T::one());
+            let seen = if sky.occluded { ao[hi] } else { T::one() };
+            colour_at[hi] = colour_at[hi] + c.mul_v(e) * (m.diffuse * seen);
+        }
         for lamp in &ctx.lamps {
             if let Some((contrib, launch)) = lamp_term(ctx, lamp, hit, m, c, ray.dir) {
+                // k < 0: a light without shadows.
+                if launch.k < T::zero() {
+                    colour_at[hi] = colour_at[hi] + contrib;
+                    continue;
+                }
                 ws.launches.push(Launch {
                     id: pending.len() as u32,
                     ..launch

@@ -82,7 +82,7 @@ pub struct Contract {
     pub specialisation: Specialisation,
     /// Every feature of the template by name, on or off: those of the scene and its settings
     /// (`ANALYTIC`, `POINT`, `DIRECTIONAL`, `SOFT`, `CHECKER`, `TRANSPARENT`, `REFRACTION`,
-    /// `SECONDARY`, `MATERIALS`, `RELAX`, `COLOUR_FIELDS`, `OCCLUSION`, `FOG`, `GRADE`), then the kernel's own (`DEBUG_NAN`, `PARAMS`,
+    /// `SECONDARY`, `MATERIALS`, `RELAX`, `COLOUR_FIELDS`, `OCCLUSION`, `SKY`, `FOG`, `GRADE`), then the kernel's own (`DEBUG_NAN`, `PARAMS`,
     /// `MEDIA`, `SCENE_DATA`, `INTERPRETED`).
     pub features: Vec<(&'static str, bool)>,
     /// The scene uniform (binding 0) as naga laid it out.
@@ -91,7 +91,7 @@ pub struct Contract {
 
 /// The features that follow from the scene and its settings alone (the first ones of
 /// [`Contract::features`]): those a render checks.
-pub(super) const SCENE_FEATURES: usize = 14;
+pub(super) const SCENE_FEATURES: usize = 15;
 
 /// A scene that a kernel cannot render, or a uniform that does not fit its layout: what
 /// differs, in words.

@@ -17,6 +17,16 @@ struct DirLight {
     color: vec4<f32>,    // rgb = colour × intensity, w: softness k
 }
 //#endif
+//#if SKY
+struct SkyLight {
+    c0: vec4<f32>,      // irradiance over π: c0 + c1·N_y + c2·(3N_y² − 1), times the intensity;
+    c1: vec4<f32>,      // c0.w: 1 when the occlusion scales it
+    c2: vec4<f32>,
+    zenith: vec4<f32>,  // radiance, times the intensity; w: 1 when it is the background
+    horizon: vec4<f32>,
+    ground: vec4<f32>,
+}
+//#endif
 struct Material {
     color: vec4<f32>,   // rgb, w: 1 for a checker pattern
     color_b: vec4<f32>, // checker's second colour, w: 1 / checker size
@@ -31,9 +41,9 @@ struct Params {
     cam_v: vec4<f32>,      // up
     view: vec4<f32>,       // tan(fov/2)·aspect, tan(fov/2), width, height
     march: vec4<f32>,      // epsilon, max_dist, relaxation ω, 1/L
-    background: vec4<f32>,
+    background: vec4<f32>, // w: 1 when rays that hit nothing show the skies instead
     look: vec4<f32>,       // occlusion radius R, 1/fog distance, 2^exposure, tone curve
-    fog: vec4<f32>,        // the fog's colour
+    fog: vec4<f32>,        // the fog's colour; w: 0 where it is the background seen along the ray
     counts: vec4<u32>,     // width, height, aa, max_steps
     depth: vec4<u32>,      // max_depth
 //#if POINT
@@ -41,6 +51,9 @@ struct Params {
 //#endif
 //#if DIRECTIONAL
     dirs: array<DirLight, {{DIRS}}>,
+//#endif
+//#if SKY
+    skies: array<SkyLight, {{SKIES}}>,
 //#endif
     materials: array<Material, {{MATERIALS}}>,
     srgb: array<vec4<f32>, 64>, // the least linear value of each 8-bit sRGB code (srgb.rs)
@@ -504,11 +517,11 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#if FOG
             // Fog hides what lies beyond every surface: a miss outside solids is its colour.
             if !inside {
-                acc += ray.weight * params.fog.xyz;
+                acc += ray.weight * fog_colour(ray.dir);
                 continue;
             }
 //#endif
-            acc += ray.weight * params.background.xyz;
+            acc += ray.weight * background(ray.dir);
             continue;
         }
         counters.hits += 1u;
@@ -520,7 +533,7 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#if FOG
         if !inside {
             let e = fade(hit.t);
-            acc += weight * (1.0 - e) * params.fog.xyz;
+            acc += weight * (1.0 - e) * fog_colour(ray.dir);
             weight = weight * e;
         }
 //#endif

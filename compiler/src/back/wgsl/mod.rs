@@ -120,7 +120,10 @@ impl std::error::Error for Error {}
 /// ray traced analytically.
 pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
     let mats = &scene.materials;
-    let soft = scene.lights.iter().any(|l| l.penumbra() > 0.0);
+    let soft = scene
+        .lights
+        .iter()
+        .any(|l| l.penumbra() > 0.0 && l.shadows());
     let points = scene
         .lights
         .iter()
@@ -160,6 +163,10 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
         ),
         // The look (docs/rendering.md): occlusion samples the field, so a traced scene has none.
         ("OCCLUSION", !traced && scene.settings.occlusion > 0.0),
+        (
+            "SKY",
+            scene.lights.iter().any(|l| matches!(l, Light::Sky { .. })),
+        ),
         ("FOG", scene.settings.fog > 0.0),
         (
             "GRADE",
@@ -168,11 +175,19 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
     ]
 }
 
-fn count(scene: &Scene, point: bool) -> usize {
+/// The number of the scene's lights of a kind: `kind` 0 point, 1 directional (suns too),
+/// 2 sky.
+fn count(scene: &Scene, kind: u32) -> usize {
     scene
         .lights
         .iter()
-        .filter(|l| matches!(l, Light::Point { .. }) == point)
+        .filter(|l| {
+            kind == match l {
+                Light::Point { .. } => 0,
+                Light::Directional { .. } => 1,
+                Light::Sky { .. } => 2,
+            }
+        })
         .count()
 }
 
@@ -539,8 +554,9 @@ fn write_template(
             used.join(" ")
         ),
     );
-    values.insert("POINTS", count(scene, true).to_string());
-    values.insert("DIRS", count(scene, false).to_string());
+    values.insert("POINTS", count(scene, 0).to_string());
+    values.insert("DIRS", count(scene, 1).to_string());
+    values.insert("SKIES", count(scene, 2).to_string());
     values.insert("MATERIALS", scene.materials.len().max(1).to_string());
     values.insert("STACK", (scene.settings.max_depth + 2).to_string());
     values.insert("PENUMBRA_BRACKET", float(Light::PENUMBRA_BRACKET));
@@ -701,7 +717,6 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             1.0 / lipschitz.max(1.0),
         ],
     )?;
-    w.floats("background", &v4(s.background, 0.0))?;
     let inv_fog = if s.fog > 0.0 { 1.0 / s.fog } else { 0.0 };
     w.floats(
         "look",
@@ -712,15 +727,31 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             s.tonemap.index() as f64,
         ],
     )?;
-    w.floats("fog", &v4(s.fog_colour(), 0.0))?;
+    // w: 1 where `fog_color` is given; else the fog is the background seen along the ray.
+    w.floats(
+        "fog",
+        &v4(s.fog_colour(), if s.fog_color.is_some() { 1.0 } else { 0.0 }),
+    )?;
     w.uints(
         "counts",
         &[s.width, s.height, s.aa.max(1), s.max_steps.max(1)],
     )?;
     w.uints("depth", &[s.max_depth, 0, 0, 0])?;
-    let (mut points, mut dirs) = (0, 0);
+    let (mut points, mut dirs, mut skies) = (0, 0, 0);
+    // Whether a sky is the background (`background.w`): rays that hit nothing show the skies
+    // that are.
+    let sky_background = scene
+        .lights
+        .iter()
+        .any(|l| matches!(l, Light::Sky { background: true, .. }));
+    w.floats(
+        "background",
+        &v4(s.background, if sky_background { 1.0 } else { 0.0 }),
+    )?;
     for l in &scene.lights {
-        let colour = |c: [f64; 3], i: f64| v4((DVec3::from(c) * i).into(), l.sharpness());
+        // w: the shadows' sharpness k (0: hard), or −1 for a light without shadows.
+        let k = if l.shadows() { l.sharpness() } else { -1.0 };
+        let colour = |c: [f64; 3], i: f64| v4((DVec3::from(c) * i).into(), k);
         match l {
             Light::Point {
                 position,
@@ -747,6 +778,26 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
                 w.floats(&format!("dirs[{dirs}].to_light"), &v4(to, 0.0))?;
                 w.floats(&format!("dirs[{dirs}].color"), &colour(*color, *intensity))?;
                 dirs += 1;
+            }
+            Light::Sky {
+                zenith,
+                horizon,
+                ground,
+                intensity,
+                shadows,
+                background,
+            } => {
+                let c = crate::scene::look::sky_irradiance(*zenith, *horizon, *ground);
+                let at = |name: &str| format!("skies[{skies}].{name}");
+                let flag = |on: bool| if on { 1.0 } else { 0.0 };
+                let scaled = |c: [f64; 3]| -> [f64; 3] { (DVec3::from(c) * *intensity).into() };
+                w.floats(&at("c0"), &v4(scaled(c[0]), flag(*shadows)))?;
+                w.floats(&at("c1"), &v4(scaled(c[1]), 0.0))?;
+                w.floats(&at("c2"), &v4(scaled(c[2]), 0.0))?;
+                w.floats(&at("zenith"), &v4(scaled(*zenith), flag(*background)))?;
+                w.floats(&at("horizon"), &v4(scaled(*horizon), 0.0))?;
+                w.floats(&at("ground"), &v4(scaled(*ground), 0.0))?;
+                skies += 1;
             }
         }
     }

@@ -104,9 +104,32 @@ fn phong_term(c: vec3<f32>, m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32
     let rv = max(dot(r, -d), 0.0);
     let spec = m.phong.z * pow(rv, m.phong.w);
     let contrib = (c * (m.phong.y * ndl) + vec3<f32>(spec)) * il * atten;
+    // k < 0: a light without shadows.
+    if k < 0.0 {
+        return contrib;
+    }
     let off = 4.0 * h;
     let tmax = select(dist, dist - off, is_point);
     return contrib * shadow(p + n * off, l, tt, tmax, k);
+}
+
+// What a ray that hits nothing sees: the skies that are the background, or the background.
+fn background(d: vec3<f32>) -> vec3<f32> {
+//#if SKY
+    if params.background.w > 0.0 {
+        var sum = vec3<f32>(0.0);
+        for (var i = 0u; i < {{SKIES}}u; i++) {
+            let sky = params.skies[i];
+            var l = sky.ground.xyz;
+            if d.y >= 0.0 {
+                l = sky.horizon.xyz + (sky.zenith.xyz - sky.horizon.xyz) * d.y;
+            }
+            sum += l * sky.zenith.w;
+        }
+        return sum;
+    }
+//#endif
+    return params.background.xyz;
 }
 
 // Ambient (times the occlusion ao) plus every light:
@@ -134,17 +157,31 @@ fn shade(m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32,
         sum += phong_term(c, m, p, n, d, tt, h, light.to_light.xyz, params.march.y, 1.0, light.color.xyz, light.color.w, false);
     }
 //#endif
+//#if SKY
+    // Sky light: k_d·C·E(N)/π, times the occlusion where it casts shadows.
+    for (var i = 0u; i < {{SKIES}}u; i++) {
+        let sky = params.skies[i];
+        let e = sky.c0.xyz + sky.c1.xyz * n.y + sky.c2.xyz * (3.0 * n.y * n.y - 1.0);
+        sum += c * e * (m.phong.y * select(1.0, ao, sky.c0.w > 0.0));
+    }
+//#endif
     return sum;
 }
 
-// What fog leaves of a ray segment of length t: e^(−t/D), with 1/D in look.y (1 without fog).
-fn fade(t: f32) -> f32 {
 //#if FOG
+// What fog leaves of a ray segment of length t: e^(−t/D), with 1/D in look.y.
+fn fade(t: f32) -> f32 {
     return exp(-t * params.look.y);
-//#else
-    return 1.0;
-//#endif
 }
+
+// The fog's colour along d: `fog_color`, or the background seen along d.
+fn fog_colour(d: vec3<f32>) -> vec3<f32> {
+    if params.fog.w > 0.0 {
+        return params.fog.xyz;
+    }
+    return background(d);
+}
+//#endif
 
 // A pixel's linear colour after the exposure (2^exposure in look.z) and the tone curve
 // (look.w: 0 none, 1 filmic, 2 Reinhard).

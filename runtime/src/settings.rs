@@ -156,13 +156,36 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
                 "a number in [1, 2)",
             )?
         }
-        "background" => s.background = colour(value).ok_or_else(|| Error::Background(value.into()))?,
-        "occlusion" => s.occlusion = real(key, value, |v| (0.0..=1e9).contains(&v), "a distance from 0 (none) to 1e9")?,
-        "fog" => s.fog = real(key, value, |v| (0.0..=1e9).contains(&v), "a distance from 0 (none) to 1e9")?,
+        "background" => {
+            s.background = colour(value).ok_or_else(|| Error::Background(value.into()))?
+        }
+        "occlusion" => {
+            s.occlusion = real(
+                key,
+                value,
+                |v| (0.0..=1e9).contains(&v),
+                "a distance from 0 (none) to 1e9",
+            )?
+        }
+        "fog" => {
+            s.fog = real(
+                key,
+                value,
+                |v| (0.0..=1e9).contains(&v),
+                "a distance from 0 (none) to 1e9",
+            )?
+        }
         "fog_color" => {
             s.fog_color = Some(colour(value).ok_or_else(|| Error::FogColour(value.into()))?)
         }
-        "exposure" => s.exposure = real(key, value, |v| (-20.0..=20.0).contains(&v), "a number of stops from -20 to 20")?,
+        "exposure" => {
+            s.exposure = real(
+                key,
+                value,
+                |v| (-20.0..=20.0).contains(&v),
+                "a number of stops from -20 to 20",
+            )?
+        }
         "tonemap" => {
             s.tonemap = Tonemap::from_name(value).ok_or_else(|| Error::Tonemap(value.into()))?
         }

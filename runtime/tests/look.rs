@@ -52,7 +52,10 @@ fn crease_ao(r: f64, x: f64) -> f64 {
 #[test]
 fn occlusion_darkens_a_crease_by_the_formulas_amount() {
     let r = 0.5;
-    let scene = checked("crease", &CREASE.replace("OCCLUSION", &format!(", occlusion: {r}")));
+    let scene = checked(
+        "crease",
+        &CREASE.replace("OCCLUSION", &format!(", occlusion: {r}")),
+    );
     let plain = checked("plain crease", &CREASE.replace("OCCLUSION", ""));
     let y = scene.settings.height / 2;
     let mut darkened = 0;
@@ -82,7 +85,10 @@ fn occlusion_darkens_a_crease_by_the_formulas_amount() {
         &CREASE
             .replace("OCCLUSION", &format!(", occlusion: {r}"))
             .replace("ambient: 1, diffuse: 0", "ambient: 0, diffuse: 1")
-            .replace("scene {", "light sky { color: (1, 1, 1), background: false }\nscene {"),
+            .replace(
+                "scene {",
+                "light sky { color: (1, 1, 1), background: false }\nscene {",
+            ),
     );
     for (backend, image) in render_everywhere("sky crease", &sky) {
         for px in 0..sky.settings.width {
@@ -220,7 +226,10 @@ scene { plane() @ floor; }
                 c.abs() < 1e-3 || (c - 1.0).abs() < 1e-3
             })
             .count();
-        assert!(pure * 10 >= one.settings.width as usize * 8, "{backend}: {pure} pure pixels");
+        assert!(
+            pure * 10 >= one.settings.width as usize * 8,
+            "{backend}: {pure} pure pixels"
+        );
     }
 }
 
@@ -324,10 +333,18 @@ scene { plane() @ white; box((1, 0.05, 1)).translate(0, 2, 0) @ white; }
         widths.push(found.expect("the CPU"));
     }
     assert!(widths[0] >= 1 && widths[1] > 2 * widths[0], "{widths:?}");
-    let dark = |image: &Image| (0..96).filter(|&x| image.pixel(x, 48)[0] < 0.5 * lit).count();
+    let dark = |image: &Image| {
+        (0..96)
+            .filter(|&x| image.pixel(x, 48)[0] < 0.5 * lit)
+            .count()
+    };
     let shadowed = checked("shadows", &text.replace("SUN", ", angle: 4deg"));
     for (backend, image) in render_everywhere("shadows", &shadowed) {
-        assert!(dark(&image) >= 10, "{backend}: {} dark pixels", dark(&image));
+        assert!(
+            dark(&image) >= 10,
+            "{backend}: {} dark pixels",
+            dark(&image)
+        );
     }
     let unshadowed = checked(
         "no shadows",

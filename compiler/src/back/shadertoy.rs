@@ -169,7 +169,11 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
     let mut lights = String::new();
     for light in &scene.lights {
         // k < 0: a light without shadows.
-        let k = float(if light.shadows() { light.sharpness() } else { -1.0 });
+        let k = float(if light.shadows() {
+            light.sharpness()
+        } else {
+            -1.0
+        });
         match light {
             Light::Point {
                 position,

@@ -153,10 +153,15 @@ impl<T: Float> Context<T> {
             materials,
             lamps: scene.lights.iter().filter_map(lamp).collect(),
             skies: scene.lights.iter().filter_map(sky).collect(),
-            sky_background: scene
-                .lights
-                .iter()
-                .any(|l| matches!(l, Light::Sky { background: true, .. })),
+            sky_background: scene.lights.iter().any(|l| {
+                matches!(
+                    l,
+                    Light::Sky {
+                        background: true,
+                        ..
+                    }
+                )
+            }),
             transparent,
             branching: branching(scene),
             debug_nan,
@@ -168,8 +173,7 @@ impl<T: Float> Context<T> {
             graded: s.exposure != 0.0 || s.tonemap != Tonemap::None,
             exposure: T::from_f64(s.exposure.exp2()),
             tonemap: s.tonemap,
-            pitch: T::from_f64(2.0)
-                * T::from_f64((scene.camera.fov * 0.5).tan())
+            pitch: T::from_f64(2.0) * T::from_f64((scene.camera.fov * 0.5).tan())
                 / (T::from_f64(s.height.max(1) as f64) * T::from_f64(s.aa.max(1) as f64)),
         }
     }

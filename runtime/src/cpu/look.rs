@@ -113,15 +113,30 @@ mod tests {
     /// a fine sum), and the point sign where the footprint is narrow.
     #[test]
     fn the_filtered_sign_is_the_mean_over_the_footprint() {
-        let point = |u: f64| if u.floor().rem_euclid(2.0) == 0.0 { 1.0 } else { -1.0 };
-        for &(u, w) in &[(0.3, 0.5), (1.7, 0.9), (-2.2, 3.3), (5.5, 0.0001), (-0.01, 0.2)] {
+        let point = |u: f64| {
+            if u.floor().rem_euclid(2.0) == 0.0 {
+                1.0
+            } else {
+                -1.0
+            }
+        };
+        for &(u, w) in &[
+            (0.3, 0.5),
+            (1.7, 0.9),
+            (-2.2, 3.3),
+            (5.5, 0.0001),
+            (-0.01, 0.2),
+        ] {
             let n = 200_000;
             let mean = (0..n)
                 .map(|i| point(u - w / 2.0 + w * (i as f64 + 0.5) / n as f64))
                 .sum::<f64>()
                 / n as f64;
             let got = checker_sign(u, w);
-            assert!((got - mean).abs() < 1e-3, "u {u} w {w}: {got} against {mean}");
+            assert!(
+                (got - mean).abs() < 1e-3,
+                "u {u} w {w}: {got} against {mean}"
+            );
         }
         assert_eq!(checker_sign(3.2f64, 1e-4), -1.0);
         assert_eq!(checker_sign(-0.5f64, 0.0), -1.0);

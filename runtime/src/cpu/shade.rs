@@ -2,8 +2,8 @@
 //! (Phong with shadow rays) and spawn the next wave of reflected and refracted rays.
 
 use super::context::{Context, Lamp, Mat, Paint, Tint};
-use super::look;
 use super::lanes::{march, Launch};
+use super::look;
 use super::march::{Shadow, Shadowed, Status, Trace, Traced};
 use super::stats::Counters;
 use super::vec::V3;

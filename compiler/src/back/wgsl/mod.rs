@@ -730,7 +730,10 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
     // w: 1 where `fog_color` is given; else the fog is the background seen along the ray.
     w.floats(
         "fog",
-        &v4(s.fog_colour(), if s.fog_color.is_some() { 1.0 } else { 0.0 }),
+        &v4(
+            s.fog_colour(),
+            if s.fog_color.is_some() { 1.0 } else { 0.0 },
+        ),
     )?;
     w.uints(
         "counts",
@@ -740,10 +743,15 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
     let (mut points, mut dirs, mut skies) = (0, 0, 0);
     // Whether a sky is the background (`background.w`): rays that hit nothing show the skies
     // that are.
-    let sky_background = scene
-        .lights
-        .iter()
-        .any(|l| matches!(l, Light::Sky { background: true, .. }));
+    let sky_background = scene.lights.iter().any(|l| {
+        matches!(
+            l,
+            Light::Sky {
+                background: true,
+                ..
+            }
+        )
+    });
     w.floats(
         "background",
         &v4(s.background, if sky_background { 1.0 } else { 0.0 }),

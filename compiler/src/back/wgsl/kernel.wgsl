@@ -41,7 +41,8 @@ struct Params {
     cam_v: vec4<f32>,      // up
     view: vec4<f32>,       // tan(fov/2)·aspect, tan(fov/2), width, height
     march: vec4<f32>,      // epsilon, max_dist, relaxation ω, 1/L
-    background: vec4<f32>, // w: 1 when rays that hit nothing show the skies instead
+    // background.w: 1 when rays that hit nothing show the skies instead.
+    background: vec4<f32>,
     look: vec4<f32>,       // occlusion radius R, 1/fog distance, 2^exposure, tone curve
     fog: vec4<f32>,        // the fog's colour; w: 0 where it is the background seen along the ray
     counts: vec4<u32>,     // width, height, aa, max_steps

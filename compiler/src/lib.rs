@@ -64,8 +64,9 @@ pub use crate::scene::{
         Animation, Camera, Colour, Combine, Exactness, Graph, Light, Material, MaterialId, Method,
         Node, Pattern, Scene, Settings, Smooth, V3,
     },
+    look,
     params::{Accepts, ParamValue, Parameter},
-    NodeId,
+    NodeId, Tonemap,
 };
 
 /// The lowering, once per scene: the distance program and what every back end reads of the

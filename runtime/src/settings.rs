@@ -2,7 +2,7 @@
 //! checked against its range and, where one applies, its limit (`render`, `bench`, `pareto`
 //! and `view` share them).
 
-use sdfc_compiler::{Limit, Limits, Method, Settings};
+use sdfc_compiler::{Limit, Limits, Method, Settings, Tonemap};
 
 /// A setting given on the command line that cannot be read or is out of its range: a usage
 /// error.
@@ -45,6 +45,12 @@ pub enum Error {
     /// A `background` that is not a colour.
     #[error("background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `{0}`")]
     Background(String),
+    /// A `fog_color` that is not a colour.
+    #[error("fog_color must be three numbers r,g,b from 0 to 1, like 0.6,0.65,0.7, not `{0}`")]
+    FogColour(String),
+    /// A `tonemap` that is not one.
+    #[error("tonemap must be one of {names}, not `{0}`", names = Tonemap::NAMES.join(", "))]
+    Tonemap(String),
     /// A `method` that is not one.
     #[error("method must be one of {names}, not `{0}`", names = Method::NAMES.join(", "))]
     Method(String),
@@ -97,6 +103,11 @@ pub const SETTING_KEYS: &[&str] = &[
     "relaxation",
     "background",
     "method",
+    "occlusion",
+    "fog",
+    "fog_color",
+    "exposure",
+    "tonemap",
 ];
 
 /// The help of `--set`: every key of [`SETTING_KEYS`], with the form of the values that are
@@ -107,6 +118,8 @@ pub fn set_help() -> String {
         .map(|&key| match key {
             "background" => "background (as r,g,b)".to_string(),
             "method" => format!("method ({})", Method::NAMES.join(", ")),
+            "fog_color" => "fog_color (as r,g,b)".to_string(),
+            "tonemap" => format!("tonemap ({})", Tonemap::NAMES.join(", ")),
             key => key.to_string(),
         })
         .collect();
@@ -143,7 +156,39 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
                 "a number in [1, 2)",
             )?
         }
-        "background" => s.background = colour(value)?,
+        "background" => {
+            s.background = colour(value).ok_or_else(|| Error::Background(value.into()))?
+        }
+        "occlusion" => {
+            s.occlusion = real(
+                key,
+                value,
+                |v| (0.0..=1e9).contains(&v),
+                "a distance from 0 (none) to 1e9",
+            )?
+        }
+        "fog" => {
+            s.fog = real(
+                key,
+                value,
+                |v| (0.0..=1e9).contains(&v),
+                "a distance from 0 (none) to 1e9",
+            )?
+        }
+        "fog_color" => {
+            s.fog_color = Some(colour(value).ok_or_else(|| Error::FogColour(value.into()))?)
+        }
+        "exposure" => {
+            s.exposure = real(
+                key,
+                value,
+                |v| (-20.0..=20.0).contains(&v),
+                "a number of stops from -20 to 20",
+            )?
+        }
+        "tonemap" => {
+            s.tonemap = Tonemap::from_name(value).ok_or_else(|| Error::Tonemap(value.into()))?
+        }
         "method" => {
             s.method = Method::from_name(value).ok_or_else(|| Error::Method(value.into()))?
         }
@@ -192,16 +237,16 @@ fn real(
     }
 }
 
-fn colour(value: &str) -> Result<[f64; 3], Error> {
-    let err = || Error::Background(value.into());
+/// Three numbers `r,g,b` from 0 to 1, or `None`.
+fn colour(value: &str) -> Option<[f64; 3]> {
     let parts: Vec<f64> = value
         .trim_matches(|c| c == '(' || c == ')')
         .split(',')
-        .map(|p| p.trim().parse::<f64>().map_err(|_| err()))
-        .collect::<Result<_, _>>()?;
+        .map(|p| p.trim().parse::<f64>().ok())
+        .collect::<Option<_>>()?;
     match parts[..] {
-        [r, g, b] if parts.iter().all(|v| (0.0..=1.0).contains(v)) => Ok([r, g, b]),
-        _ => Err(err()),
+        [r, g, b] if parts.iter().all(|v| (0.0..=1.0).contains(v)) => Some([r, g, b]),
+        _ => None,
     }
 }
 
@@ -216,7 +261,8 @@ mod tests {
         for key in SETTING_KEYS {
             assert!(help.contains(key), "{key} is missing from `{help}`");
             let value = match *key {
-                "background" => "0.1,0.2,0.3",
+                "background" | "fog_color" => "0.1,0.2,0.3",
+                "tonemap" => "filmic",
                 "method" => "march",
                 "epsilon" => "0.001",
                 "relaxation" => "1.5",
@@ -267,6 +313,14 @@ mod tests {
         assert_eq!(
             refused("background", "red"),
             "background must be three numbers r,g,b from 0 to 1, like 0.1,0.1,0.2, not `red`"
+        );
+        assert_eq!(
+            refused("tonemap", "aces"),
+            "tonemap must be one of none, filmic, reinhard, not `aces`"
+        );
+        assert_eq!(
+            refused("fog", "-1"),
+            "fog must be a distance from 0 (none) to 1e9, not `-1`"
         );
         assert_eq!(
             refused("method", "fast"),

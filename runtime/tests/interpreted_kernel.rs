@@ -279,6 +279,7 @@ fn random_scenes_render_as_with_the_specialised_kernel() {
             intensity: 1.0,
             radius: 100.0,
             penumbra: if case % 2 == 0 { 0.1 } else { 0.0 },
+            shadows: true,
         });
         scene.settings.width = 48;
         scene.settings.height = 32;

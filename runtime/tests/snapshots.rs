@@ -29,9 +29,11 @@ const SNAPSHOT_LINES: usize = 400;
 /// blends, about 2 300 lines of feature scenes, to 19 000 by issue 35's loft, screw, arc
 /// and Bézier stroke, about 1 450, and to 19 500 by text's feature scene and errors, about 350
 /// lines, most of them the WGSL that walks a text's outline, and to 19 800 by profiles written
-/// as formulas (issue 35), their feature scene and three errors, about 250 lines, and to
-/// 20 200 by the hull's feature scene, a tetrahedron, about 460 lines).
-const ALL_SNAPSHOTS_LINES: usize = 20_200;
+/// as formulas (issue 35), their feature scene and three errors, about 250 lines), to 20 100
+/// by the look and the sky (issue 49: the filtered checker, occlusion, fog, tone curves and
+/// sky light in the kernels, about 100 lines, and the kernels of two feature scenes, about
+/// 170), and to 20 560 by the hull's feature scene, a tetrahedron, about 460 lines.
+const ALL_SNAPSHOTS_LINES: usize = 20_560;
 
 /// The feature scenes whose distance over points is snapshotted as PTX: between them every
 /// operation of the distance program (the sum of squares and square root of a sphere,
@@ -78,6 +80,16 @@ const KERNELS: &[(&str, Written, Option<Written>)] = &[
     (
         "materials",
         ("materials", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "look",
+        ("look", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "sky",
+        ("sky", Options::Default),
         Some(("base", Options::Default)),
     ),
     (

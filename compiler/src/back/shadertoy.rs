@@ -4,7 +4,8 @@
 //! from the canvas), lights and materials: sphere tracing, tetrahedral normals, Phong with
 //! point-light attenuation, hard or soft shadows, checker patterns and colour fields as
 //! docs/rendering.md states them, for camera rays only. Reflection, refraction,
-//! transparency, over-relaxation and antialiasing are left out, so a scene using them
+//! transparency, over-relaxation, antialiasing, sky lights and the look (occlusion, fog,
+//! exposure and tone curves, the checker's filter) are left out, so a scene using them
 //! renders without them.
 
 use super::shader::{self, Error};
@@ -90,7 +91,7 @@ vec3 sdfc_light(sdfc_map_Material m, vec3 c, vec3 p, vec3 n, vec3 v, float h, fl
                 vec3 l, vec3 il, float atten, float tmax, float k) {
     float nl = dot(n, l);
     if (nl <= 0.0 || atten <= 0.0) return vec3(0.0);
-    float sh = sdfc_shadow(p + n * (4.0 * h), l, tt, tmax, k);
+    float sh = k < 0.0 ? 1.0 : sdfc_shadow(p + n * (4.0 * h), l, tt, tmax, k);
     vec3 r = 2.0 * nl * n - l;
     return sh * atten * (m.diffuse * nl * c * il + m.specular * pow(max(dot(r, v), 0.0), m.shininess) * il);
 }
@@ -167,7 +168,12 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
     out.push_str(&functions);
     let mut lights = String::new();
     for light in &scene.lights {
-        let k = float(light.sharpness());
+        // k < 0: a light without shadows.
+        let k = float(if light.shadows() {
+            light.sharpness()
+        } else {
+            -1.0
+        });
         match light {
             Light::Point {
                 position,
@@ -201,6 +207,8 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
                     v3(to)
                 );
             }
+            // Left out, as the module says.
+            Light::Sky { .. } => {}
         }
     }
     // Colour fields: the material's colour at p (a checker's cell found as `sdfc_colour`

@@ -1690,7 +1690,7 @@ pub static MATERIALS: &[Record] = &[
     },
 ];
 
-const LIGHT_COMMON: [P; 4] = [
+const LIGHT_COMMON: [P; 5] = [
     p("color", V, V3([1.0, 1.0, 1.0]), NonNeg),
     p("intensity", F, Num(1.0), NonNeg),
     p(
@@ -1701,13 +1701,39 @@ const LIGHT_COMMON: [P; 4] = [
     ),
     // The sharpness k = 1/tan(penumbra) of the old files; W0012 says what to write instead.
     p("softness", F, Num(0.0), NonNeg),
+    p("shadows", B, Bool(true), Any),
 ];
 
-const POINT: [P; 6] = concat(
+const POINT: [P; 7] = concat(
     [p("position", V, Req, Any), p("radius", F, Num(100.0), Pos)],
     LIGHT_COMMON,
 );
-const DIRECTIONAL: [P; 5] = concat([p("direction", V, Req, NonZero)], LIGHT_COMMON);
+const DIRECTIONAL: [P; 6] = concat([p("direction", V, Req, NonZero)], LIGHT_COMMON);
+
+/// `light sun`: a directional light whose shadows soften over its angular size.
+const SUN: [P; 5] = [
+    p("direction", V, Req, NonZero),
+    LIGHT_COMMON[0],
+    LIGHT_COMMON[1],
+    p(
+        "angle",
+        A,
+        Deg(0.53),
+        Within(0.0, 89.0 * std::f64::consts::PI / 180.0),
+    ),
+    LIGHT_COMMON[4],
+];
+
+/// `light sky`: light from the whole sky, a gradient or one colour.
+const SKY: [P; 7] = [
+    p("color", V, V3([1.0, 1.0, 1.0]), NonNeg),
+    p("zenith", V, V3(crate::scene::look::SKY_ZENITH), NonNeg),
+    p("horizon", V, V3(crate::scene::look::SKY_HORIZON), NonNeg),
+    p("ground", V, V3(crate::scene::look::SKY_GROUND), NonNeg),
+    LIGHT_COMMON[1],
+    LIGHT_COMMON[4],
+    p("background", B, Bool(true), Any),
+];
 
 /// Light kinds.
 pub static LIGHTS: &[Record] = &[
@@ -1722,6 +1748,18 @@ pub static LIGHTS: &[Record] = &[
         timeless: &[],
         painted: &[],
         fields: &DIRECTIONAL,
+    },
+    Record {
+        name: "sun",
+        timeless: &[],
+        painted: &[],
+        fields: &SUN,
+    },
+    Record {
+        name: "sky",
+        timeless: &[],
+        painted: &[],
+        fields: &SKY,
     },
 ];
 
@@ -1793,5 +1831,15 @@ pub static RENDER: Record = Record {
         ),
         p("fps", F, Num(30.0), Within(0.01, 1000.0)),
         p("duration", F, Num(0.0), Within(0.0, 1e7)),
+        p("occlusion", F, Num(DEFAULT.occlusion), Within(0.0, 1e9)),
+        p("fog", F, Num(DEFAULT.fog), Within(0.0, 1e9)),
+        p("fog_color", V, V3(DEFAULT.background), NonNeg),
+        p("exposure", F, Num(DEFAULT.exposure), Within(-20.0, 20.0)),
+        p(
+            "tonemap",
+            Str,
+            Text(DEFAULT.tonemap.name()),
+            OneOf(crate::scene::Tonemap::NAMES),
+        ),
     ],
 };

@@ -11,6 +11,7 @@ pub mod colour;
 mod eval;
 pub mod field;
 pub mod font;
+mod lights;
 pub mod meshfile;
 mod ops;
 mod params;
@@ -21,7 +22,7 @@ pub mod types;
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::scene::{
-    Camera, Colour, Combine, Light, Material, MaterialId, Method, Node, Pattern, Scene, Settings,
+    Camera, Colour, Combine, Material, MaterialId, Method, Node, Pattern, Scene, Settings, Tonemap,
 };
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::{self, ast};
@@ -727,6 +728,15 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                     Value::Str(s) => Method::from_name(s).unwrap_or_default(),
                     _ => Method::Auto,
                 },
+                occlusion: f["occlusion"].num(),
+                fog: f["fog"].num(),
+                // Left out, the fog takes the background's colour.
+                fog_color: field_span(&b.fields, "fog_color").map(|_| f["fog_color"].v3()),
+                exposure: f["exposure"].num(),
+                tonemap: match &f["tonemap"] {
+                    Value::Str(s) => Tonemap::from_name(s).unwrap_or_default(),
+                    _ => Tonemap::None,
+                },
             };
             if let (Value::Float(fps), Value::Float(duration)) = (&f["fps"], &f["duration"]) {
                 scene.animation.fps = *fps;
@@ -744,105 +754,13 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 }
             }
         }
-        (_, Some(kind)) => {
-            let Some(rec) = builtins::LIGHTS.iter().find(|r| r.name == kind.name) else {
-                let mut d = Diagnostic::error(
-                    "E0211",
-                    format!("unknown light kind `{}`", kind.name),
-                    kind.span,
-                )
-                .with_label("not a light kind")
-                .with_note("the light kinds are point and directional");
-                if let Some(s) =
-                    suggest::closest(&kind.name, builtins::LIGHTS.iter().map(|r| r.name))
-                {
-                    d = d.with_help(format!("did you mean `{s}`?"));
-                }
-                cx.error(d);
-                return;
-            };
-            let f = eval::record(cx, rec, &b.fields, kind);
-            let (color, intensity) = (f["color"].v3(), f["intensity"].num());
-            let penumbra = penumbra(cx, &b.fields, &f);
-            cx.places
-                .lights
-                .push(field_span(&b.fields, "position").unwrap_or(kind.span));
-            scene.lights.push(if rec.name == "point" {
-                Light::Point {
-                    position: f["position"].v3(),
-                    color,
-                    intensity,
-                    radius: f["radius"].num(),
-                    penumbra,
-                }
-            } else {
-                let d = f["direction"].v3();
-                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-                    .sqrt()
-                    .max(f64::MIN_POSITIVE);
-                Light::Directional {
-                    direction: [d[0] / len, d[1] / len, d[2] / len],
-                    color,
-                    intensity,
-                    penumbra,
-                }
-            });
-        }
+        (_, Some(kind)) => lights::light(cx, scene, b, kind),
         _ => {}
     }
 }
 
-/// A light's penumbra angle: its `penumbra` field, or the angle of the sharpness of the old
-/// `softness` field, with warning W0012 saying what to write instead (error E0203 for both).
-fn penumbra(cx: &mut Ctx, fields: &[ast::Field], f: &HashMap<&'static str, Value>) -> f64 {
-    let given = |name: &str| fields.iter().find(|x| x.name.name == name);
-    let Some(old) = given("softness") else {
-        return f["penumbra"].num();
-    };
-    if let Some(new) = given("penumbra") {
-        cx.error(
-            Diagnostic::error(
-                "E0203",
-                "a light has both `penumbra` and `softness`",
-                old.name.span,
-            )
-            .with_label("the old spelling of the penumbra")
-            .with_secondary(new.name.span, "the penumbra is given here")
-            .with_help("remove `softness`"),
-        );
-        return f["penumbra"].num();
-    }
-    let k = f["softness"].num();
-    let angle = crate::scene::penumbra_of_sharpness(k);
-    if !f["softness"].is_abstract() {
-        let write = if k > 0.0 {
-            format!(
-                "penumbra: {}deg",
-                crate::diagnostics::number(angle.to_degrees(), 4)
-            )
-        } else {
-            "nothing (hard shadows are the default)".to_string()
-        };
-        cx.error(
-            Diagnostic::warning(
-                "W0012",
-                "`softness` is replaced by `penumbra`",
-                old.name.span,
-            )
-            .with_label(format!("the sharpness k = {k} of the shadow's edge"))
-            .with_note(
-                "`softness` was the sharpness k of the soft-shadow estimate: larger values give \
-                 harder shadows, small ones shadow nearly everything; `penumbra` is the angle \
-                 over which a shadow's edge fades (0 is hard), with k = 1/tan(penumbra)",
-            )
-            .with_help(format!("for the same shadows write {write}")),
-        );
-    }
-    angle
-}
-
 /// The span of the value of the field `name` of a block, when it is given.
-fn field_span(fields: &[ast::Field], name: &str) -> Option<Span> {
+pub(super) fn field_span(fields: &[ast::Field], name: &str) -> Option<Span> {
     fields
         .iter()
         .find(|f| f.name.name == name)

@@ -70,9 +70,46 @@ fn lights_are_normalised() {
             direction: [0.0, -1.0, 0.0],
             color: [1.0; 3],
             intensity: 1.0,
-            penumbra: 0.0
+            penumbra: 0.0,
+            shadows: true,
         }
     );
+}
+
+/// `sun` is a directional light whose penumbra is its angle (the real sun's by default);
+/// `sky`'s `color` gives the parts not given beside it; `shadows: false` reaches the IR.
+#[test]
+fn suns_and_skies() {
+    let s = ok("light sun { direction: (0, -2, 0), shadows: false }\n\
+                light sky { color: (0.5, 0.5, 0.5), ground: (0.1, 0.1, 0.1), background: false }\n\
+                scene { sphere(); }");
+    assert_eq!(
+        s.lights[0],
+        Light::Directional {
+            direction: [0.0, -1.0, 0.0],
+            color: [1.0; 3],
+            intensity: 1.0,
+            penumbra: 0.53f64.to_radians(),
+            shadows: false,
+        }
+    );
+    assert_eq!(
+        s.lights[1],
+        Light::Sky {
+            zenith: [0.5; 3],
+            horizon: [0.5; 3],
+            ground: [0.1; 3],
+            intensity: 1.0,
+            shadows: true,
+            background: false,
+        }
+    );
+    assert_eq!(codes("light sun { }\nscene { sphere(); }"), ["E0204"]);
+    assert_eq!(
+        codes("light sun { direction: (0, -1, 0), angle: 95deg }\nscene { sphere(); }"),
+        ["E0400"]
+    );
+    assert_eq!(codes("light lamp { }\nscene { sphere(); }"), ["E0211"]);
 }
 
 #[test]

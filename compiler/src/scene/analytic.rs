@@ -57,6 +57,8 @@ pub enum Reason {
     Node { what: &'static str, span: Span },
     /// A light casts soft shadows.
     SoftLight { index: usize },
+    /// The render asks for ambient occlusion, which samples the distance field.
+    Occlusion,
     /// Too many primitives for `auto` to trace them from one GPU buffer: more than `limit`,
     /// the `traced` limit.
     Many { count: usize, limit: usize },
@@ -79,6 +81,9 @@ impl Reason {
                     "light {} casts soft shadows, which need a distance field",
                     index + 1
                 )
+            }
+            Reason::Occlusion => {
+                "the render asks for ambient `occlusion`, which samples a distance field".into()
             }
             Reason::Overlap { .. } => {
                 "a transparent primitive overlaps or touches another transparent one, so rays inside them would need the boundary of their union".into()
@@ -169,9 +174,20 @@ pub struct Traced {
 /// The primitives of `scene` and what rules tracing out, whatever its `method`.
 pub fn traceable(scene: &Scene) -> Traceable {
     let limit = scene.limits.count(Limit::Traced);
-    if let Some(index) = scene.lights.iter().position(|l| l.penumbra() > 0.0) {
+    if let Some(index) = scene
+        .lights
+        .iter()
+        .position(|l| l.penumbra() > 0.0 && l.shadows())
+    {
         return Traceable {
             primitives: Err(Reason::SoftLight { index }),
+            overlap: None,
+            limit,
+        };
+    }
+    if scene.settings.occlusion > 0.0 {
+        return Traceable {
+            primitives: Err(Reason::Occlusion),
             overlap: None,
             limit,
         };

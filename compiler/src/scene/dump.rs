@@ -26,6 +26,22 @@ pub fn dump(scene: &Scene) -> String {
     if s.method != Method::Auto {
         let _ = writeln!(out, "method {}", s.method.name());
     }
+    // The look, where a setting of it is on.
+    if s.occlusion > 0.0 {
+        let _ = writeln!(out, "occlusion {}", num(s.occlusion));
+    }
+    if s.fog > 0.0 {
+        let colour = s.fog_color.map_or("the background".to_string(), v3);
+        let _ = writeln!(out, "fog {} colour {colour}", num(s.fog));
+    }
+    if s.exposure != 0.0 || s.tonemap != crate::scene::Tonemap::None {
+        let _ = writeln!(
+            out,
+            "exposure {} tonemap {}",
+            num(s.exposure),
+            s.tonemap.name()
+        );
+    }
     if scene.origin != [0.0; 3] {
         let _ = writeln!(
             out,
@@ -47,6 +63,7 @@ pub fn dump(scene: &Scene) -> String {
         num(c.fov.to_degrees())
     );
     for l in &scene.lights {
+        let shadows = if l.shadows() { "" } else { " shadows=false" };
         let _ = match l {
             Light::Point {
                 position,
@@ -54,9 +71,10 @@ pub fn dump(scene: &Scene) -> String {
                 intensity,
                 radius,
                 penumbra,
+                ..
             } => writeln!(
                 out,
-                "light point position={} color={} intensity={} radius={} penumbra={}deg",
+                "light point position={} color={} intensity={} radius={} penumbra={}deg{shadows}",
                 v3(*position),
                 v3(*color),
                 num(*intensity),
@@ -68,13 +86,29 @@ pub fn dump(scene: &Scene) -> String {
                 color,
                 intensity,
                 penumbra,
+                ..
             } => writeln!(
                 out,
-                "light directional direction={} color={} intensity={} penumbra={}deg",
+                "light directional direction={} color={} intensity={} penumbra={}deg{shadows}",
                 v3(*direction),
                 v3(*color),
                 num(*intensity),
                 num(penumbra.to_degrees())
+            ),
+            Light::Sky {
+                zenith,
+                horizon,
+                ground,
+                intensity,
+                background,
+                ..
+            } => writeln!(
+                out,
+                "light sky zenith={} horizon={} ground={} intensity={} background={background}{shadows}",
+                v3(*zenith),
+                v3(*horizon),
+                v3(*ground),
+                num(*intensity),
             ),
         };
     }

@@ -681,6 +681,8 @@ pub enum Light {
         radius: f64,
         /// The angle of the penumbra in radians (0 gives hard shadows); see [`Light::sharpness`].
         penumbra: f64,
+        /// Whether it casts shadows (`shadows: false`: no shadow rays).
+        shadows: bool,
     },
     /// A light from a direction (the direction light travels in), with no attenuation.
     Directional {
@@ -688,7 +690,23 @@ pub enum Light {
         color: V3,
         intensity: f64,
         /// The angle of the penumbra in radians (0 gives hard shadows); see [`Light::sharpness`].
+        /// A `sun`'s is its angular size, `angle`.
         penumbra: f64,
+        /// Whether it casts shadows (`shadows: false`: no shadow rays).
+        shadows: bool,
+    },
+    /// Light from the whole sky (docs/rendering.md, "Sky light"): radiance `zenith` straight
+    /// up, `horizon` at the horizon, linear in the height of the direction between them,
+    /// `ground` below the horizon, each times `intensity`.
+    Sky {
+        zenith: V3,
+        horizon: V3,
+        ground: V3,
+        intensity: f64,
+        /// Whether the ambient occlusion (the `occlusion` render setting) scales its light.
+        shadows: bool,
+        /// Whether rays that hit nothing show it instead of the `background` colour.
+        background: bool,
     },
 }
 
@@ -697,6 +715,16 @@ impl Light {
     pub fn penumbra(&self) -> f64 {
         match self {
             Light::Point { penumbra, .. } | Light::Directional { penumbra, .. } => *penumbra,
+            Light::Sky { .. } => 0.0,
+        }
+    }
+
+    /// Whether it casts shadows (a sky's are its occlusion).
+    pub fn shadows(&self) -> bool {
+        match self {
+            Light::Point { shadows, .. }
+            | Light::Directional { shadows, .. }
+            | Light::Sky { shadows, .. } => *shadows,
         }
     }
 
@@ -830,6 +858,17 @@ pub struct Settings {
     pub background: V3,
     /// How rays find surfaces (see [`Method`]).
     pub method: Method,
+    /// How far from a surface ambient occlusion looks, R (0: none; docs/rendering.md, "The
+    /// look").
+    pub occlusion: f64,
+    /// The distance D over which fog leaves e^(−t/D) of a surface's light (0: none).
+    pub fog: f64,
+    /// The fog's colour; `None`: the background.
+    pub fog_color: Option<V3>,
+    /// Exposure in stops: the pixel's colour is multiplied by 2^exposure.
+    pub exposure: f64,
+    /// The tone curve after the exposure.
+    pub tonemap: super::Tonemap,
 }
 
 /// The intersection method of a render (docs/rendering.md, "Marching" and "Analytic ray tracing").
@@ -880,6 +919,11 @@ impl Settings {
         }
     }
 
+    /// The fog's colour: `fog_color`, or where it is not given, the background.
+    pub fn fog_colour(&self) -> V3 {
+        self.fog_color.unwrap_or(self.background)
+    }
+
     /// The settings of a scene without a `render` block, and the default of each field of one
     /// (`check/builtins.rs` reads them here).
     pub const DEFAULT: Settings = Settings {
@@ -894,6 +938,11 @@ impl Settings {
         relaxation: 1.4,
         background: [0.05, 0.06, 0.08],
         method: Method::Auto,
+        occlusion: 0.0,
+        fog: 0.0,
+        fog_color: None,
+        exposure: 0.0,
+        tonemap: super::Tonemap::None,
     };
 }
 

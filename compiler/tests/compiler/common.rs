@@ -75,6 +75,7 @@ impl Build {
             intensity: 1.0,
             radius: 100.0,
             penumbra,
+            shadows: true,
         });
     }
 }

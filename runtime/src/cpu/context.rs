@@ -7,6 +7,7 @@ use super::camera::Pinhole;
 use super::vec::V3;
 use sdfc_compiler::{
     analytic::Traceable, Colour, ColourProgram, Colours, Float, Light, Material, Pattern, Scene,
+    Tonemap,
 };
 
 /// One colour of a material: a constant, or the colour field of this number
@@ -43,7 +44,8 @@ pub(super) struct Mat<T> {
     pub ior: T,
 }
 
-/// A light in the evaluation type; `color` is colour × intensity (I_l).
+/// A light in the evaluation type; `color` is colour × intensity (I_l); `sharpness` is
+/// the shadows' k (0: hard), or −1 for a light without shadows.
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Lamp<T> {
     Point {
@@ -57,6 +59,20 @@ pub(super) enum Lamp<T> {
         color: V3<T>,
         sharpness: T,
     },
+}
+
+/// A sky light in the evaluation type, times its intensity: its irradiance coefficients
+/// (`look::sky_irradiance`) and its radiance.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Sky<T> {
+    pub irradiance: [V3<T>; 3],
+    pub zenith: V3<T>,
+    pub horizon: V3<T>,
+    pub ground: V3<T>,
+    /// Whether the occlusion scales its light.
+    pub occluded: bool,
+    /// Whether rays that hit nothing show it.
+    pub background: bool,
 }
 
 /// Render-wide constants.
@@ -73,6 +89,9 @@ pub(super) struct Context<T: Float> {
     pub background: V3<T>,
     pub materials: Vec<Mat<T>>,
     pub lamps: Vec<Lamp<T>>,
+    pub skies: Vec<Sky<T>>,
+    /// Whether rays that hit nothing show the skies that are the background.
+    pub sky_background: bool,
     /// Whether any material is transparent (shadow rays then look up materials).
     pub transparent: bool,
     /// The most rays one hit spawns (0, 1 or 2: a reflection and a refraction).
@@ -83,6 +102,21 @@ pub(super) struct Context<T: Float> {
     pub analytic: Option<Tracer<T>>,
     /// The materials' colour fields (`lower::Colours::programs`).
     pub colours: Vec<ColourProgram>,
+    /// The occlusion radius R (0: none).
+    pub occlusion: T,
+    /// 1/D for fog over a distance D (0: none).
+    pub inv_fog: T,
+    /// The fog's colour, where `fog_color` is given (else the background seen along the ray:
+    /// [`Context::fog_colour`]).
+    pub fog: Option<V3<T>>,
+    /// Whether the pixels are graded (an exposure or a tone curve): [`super::look::grade`].
+    pub graded: bool,
+    /// 2^exposure.
+    pub exposure: T,
+    pub tonemap: Tonemap,
+    /// A sample's pitch at unit distance: 2·tan(fov/2)/(height·aa), the width of its
+    /// footprint on a surface facing it at distance 1 (the filtered checker's).
+    pub pitch: T,
 }
 
 impl<T: Float> Context<T> {
@@ -117,12 +151,30 @@ impl<T: Float> Context<T> {
             inv_lipschitz: T::from_f64(1.0 / lipschitz.max(1.0)),
             background: V3::from_f64(s.background),
             materials,
-            lamps: scene.lights.iter().map(lamp).collect(),
+            lamps: scene.lights.iter().filter_map(lamp).collect(),
+            skies: scene.lights.iter().filter_map(sky).collect(),
+            sky_background: scene.lights.iter().any(|l| {
+                matches!(
+                    l,
+                    Light::Sky {
+                        background: true,
+                        ..
+                    }
+                )
+            }),
             transparent,
             branching: branching(scene),
             debug_nan,
             analytic: traceable.traced(s.method).map(Tracer::new),
             colours: colours.to_vec(),
+            occlusion: T::from_f64(s.occlusion),
+            inv_fog: T::from_f64(if s.fog > 0.0 { 1.0 / s.fog } else { 0.0 }),
+            fog: s.fog_color.map(V3::from_f64),
+            graded: s.exposure != 0.0 || s.tonemap != Tonemap::None,
+            exposure: T::from_f64(s.exposure.exp2()),
+            tonemap: s.tonemap,
+            pitch: T::from_f64(2.0) * T::from_f64((scene.camera.fov * 0.5).tan())
+                / (T::from_f64(s.height.max(1) as f64) * T::from_f64(s.aa.max(1) as f64)),
         }
     }
 
@@ -194,8 +246,37 @@ fn mat<T: Float>(scene: &Scene, m: &Material, fields: [Option<usize>; 2]) -> Mat
     }
 }
 
-fn lamp<T: Float>(l: &Light) -> Lamp<T> {
-    match l {
+/// The shadows' sharpness k of a light, −1 without shadows.
+fn sharpness<T: Float>(l: &Light) -> T {
+    T::from_f64(if l.shadows() { l.sharpness() } else { -1.0 })
+}
+
+fn sky<T: Float>(l: &Light) -> Option<Sky<T>> {
+    let Light::Sky {
+        zenith,
+        horizon,
+        ground,
+        intensity,
+        shadows,
+        background,
+    } = l
+    else {
+        return None;
+    };
+    let scaled = |c: [f64; 3]| V3::from_f64(c) * T::from_f64(*intensity);
+    let c = sdfc_compiler::look::sky_irradiance(*zenith, *horizon, *ground);
+    Some(Sky {
+        irradiance: c.map(scaled),
+        zenith: scaled(*zenith),
+        horizon: scaled(*horizon),
+        ground: scaled(*ground),
+        occluded: *shadows,
+        background: *background,
+    })
+}
+
+fn lamp<T: Float>(l: &Light) -> Option<Lamp<T>> {
+    Some(match l {
         Light::Point {
             position,
             color,
@@ -206,7 +287,7 @@ fn lamp<T: Float>(l: &Light) -> Lamp<T> {
             position: V3::from_f64(*position),
             color: V3::from_f64(*color) * T::from_f64(*intensity),
             radius: T::from_f64(*radius),
-            sharpness: T::from_f64(l.sharpness()),
+            sharpness: sharpness(l),
         },
         Light::Directional {
             direction,
@@ -216,7 +297,33 @@ fn lamp<T: Float>(l: &Light) -> Lamp<T> {
         } => Lamp::Directional {
             to_light: -V3::<T>::from_f64(*direction).normalize(),
             color: V3::from_f64(*color) * T::from_f64(*intensity),
-            sharpness: T::from_f64(l.sharpness()),
+            sharpness: sharpness(l),
         },
+        Light::Sky { .. } => return None,
+    })
+}
+
+impl<T: Float> Context<T> {
+    /// The fog's colour along `d`: `fog_color`, or the background seen along `d`.
+    pub fn fog_colour(&self, d: V3<T>) -> V3<T> {
+        self.fog.unwrap_or_else(|| self.background(d))
+    }
+
+    /// What a ray along `d` that hits nothing sees: the skies that are the background, or
+    /// the background.
+    pub fn background(&self, d: V3<T>) -> V3<T> {
+        if !self.sky_background {
+            return self.background;
+        }
+        self.skies
+            .iter()
+            .filter(|s| s.background)
+            .fold(V3::zero(), |sum, s| {
+                sum + if d.y >= T::zero() {
+                    s.horizon + (s.zenith - s.horizon) * d.y
+                } else {
+                    s.ground
+                }
+            })
     }
 }

@@ -11,6 +11,7 @@ mod analytic;
 mod camera;
 mod context;
 mod lanes;
+mod look;
 mod march;
 mod memory;
 pub mod reference;

@@ -3,6 +3,7 @@
 
 use super::context::{Context, Lamp, Mat, Paint, Tint};
 use super::lanes::{march, Launch};
+use super::look;
 use super::march::{Shadow, Shadowed, Status, Trace, Traced};
 use super::stats::Counters;
 use super::vec::V3;
@@ -28,6 +29,8 @@ pub(super) struct Hit<T> {
     /// For such a hit, the transparency of the glass around it (sphere tracing only: a traced
     /// shadow ray finds the glass it starts inside of).
     medium_tau: T,
+    /// What fog left of the ray's segment (1 without fog, and inside solids).
+    fade: T,
 }
 
 /// Traces `wave`, adds what it sees to its samples, and returns the next wave. On return
@@ -50,6 +53,16 @@ pub(super) fn bounce<T: Float>(
                 let p = ray.origin + ray.dir * tr.t;
                 let tt = ray.t0 + tr.t;
                 let h = ctx.normal_step(tt, p);
+                // Fog over the segment (none inside solids): what it hides is its colour.
+                let fade = if ray.inside {
+                    T::one()
+                } else {
+                    look::fade(ctx, tr.t)
+                };
+                if fade < T::one() {
+                    let a = &mut samples.acc[ray.sample as usize];
+                    *a = *a + (ray.weight * (T::one() - fade)).mul_v(ctx.fog_colour(ray.dir));
+                }
                 hits.push(Hit {
                     ray: i,
                     p,
@@ -59,6 +72,7 @@ pub(super) fn bounce<T: Float>(
                     mat: 0,
                     solid: false,
                     medium_tau: T::zero(),
+                    fade,
                 });
                 continue;
             }
@@ -66,8 +80,14 @@ pub(super) fn bounce<T: Float>(
             Status::Budget => counters.budget_misses += 1,
             Status::Nan => samples.met_nan(ray.sample),
         }
+        // Fog hides what lies beyond every surface: a miss outside solids is its colour.
+        let seen = if ctx.inv_fog > T::zero() && !ray.inside {
+            ctx.fog_colour(ray.dir)
+        } else {
+            ctx.background(ray.dir)
+        };
         let a = &mut samples.acc[ray.sample as usize];
-        *a = *a + ray.weight.mul_v(ctx.background);
+        *a = *a + ray.weight.mul_v(seen);
     }
     if ctx.analytic.is_some() {
         for hit in &mut hits {
@@ -327,11 +347,12 @@ fn solids<T: Float>(
     }
 }
 
-/// The colour of a material at p. A checker is the parity of ⌊x/s⌋ + ⌊y/s⌋ + ⌊z/s⌋ (even:
-/// first colour), sampled at p - 2h·N, just inside the surface, so that a face lying on a
-/// checker boundary does not flicker between the two colours; a colour field is its value
-/// at p.
-fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
+/// The colour of a material at p, seen along `dir`. A checker is the parity of
+/// ⌊x/s⌋ + ⌊y/s⌋ + ⌊z/s⌋ (even: first colour), sampled at p - 2h·N, just inside the surface,
+/// so that a face lying on a checker boundary does not flicker between the two colours, and
+/// its two colours mixed over the sample's footprint ([`look::checker_weight`]); a colour
+/// field is its value at p.
+fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>, dir: V3<T>) -> V3<T> {
     let tint = |t: Tint<T>| match t {
         Tint::Const(c) => c,
         Tint::Field(k) => {
@@ -348,10 +369,14 @@ fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>) -> V3<T> {
             shift,
         } => {
             let q = (hit.p - hit.n * (T::from_f64(2.0) * hit.h)) * inv_size + shift;
-            let s = q.x.floor() + q.y.floor() + q.z.floor();
-            let two = T::from_f64(2.0);
-            let odd = s - two * (s / two).floor();
-            tint(if odd > T::zero() { b } else { a })
+            let wb = look::checker_weight(q, hit.n, dir, hit.tt * ctx.pitch * inv_size);
+            if wb >= T::one() {
+                tint(b)
+            } else if wb > T::zero() {
+                tint(a) * (T::one() - wb) + tint(b) * wb
+            } else {
+                tint(a)
+            }
         }
     }
 }
@@ -457,16 +482,34 @@ fn light<T: Float>(
 ) {
     let mut colour_at: Vec<V3<T>> = vec![V3::zero(); hits.len()];
     let mut pending: Vec<(usize, V3<T>)> = Vec::new();
+    let lit = |hit: &Hit<T>| {
+        let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
+        (!ray.inside || hit.solid) && local_weight(m) > T::zero()
+    };
+    let ao = occlusions(ctx, ws, hits, &lit);
     ws.launches.clear();
     for (hi, hit) in hits.iter().enumerate() {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
-        if (ray.inside && !hit.solid) || local_weight(m) <= T::zero() {
+        if !lit(hit) {
             continue;
         }
-        let c = colour(ctx, m, hit);
-        colour_at[hi] = c * m.ambient;
+        let c = colour(ctx, m, hit, ray.dir);
+        colour_at[hi] = c * (m.ambient * ao[hi]);
+        // Sky light: k_d·C·E(N)/π, times the occlusion where it casts shadows.
+        let ny = hit.n.y;
+        for sky in &ctx.skies {
+            let [c0, c1, c2] = sky.irradiance;
+            let e = c0 + c1 * ny + c2 * (T::from_f64(3.0) * ny * ny - T::one());
+            let seen = if sky.occluded { ao[hi] } else { T::one() };
+            colour_at[hi] = colour_at[hi] + c.mul_v(e) * (m.diffuse * seen);
+        }
         for lamp in &ctx.lamps {
             if let Some((contrib, launch)) = lamp_term(ctx, lamp, hit, m, c, ray.dir) {
+                // k < 0: a light without shadows.
+                if launch.k < T::zero() {
+                    colour_at[hi] = colour_at[hi] + contrib;
+                    continue;
+                }
                 ws.launches.push(Launch {
                     id: pending.len() as u32,
                     ..launch
@@ -487,11 +530,38 @@ fn light<T: Float>(
     }
     for (hit, c) in hits.iter().zip(colour_at) {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
-        if (!ray.inside || hit.solid) && local_weight(m) > T::zero() {
+        if lit(hit) {
             let a = &mut samples.acc[ray.sample as usize];
-            *a = *a + c.mul_v(ray.weight) * local_weight(m);
+            *a = *a + c.mul_v(ray.weight * hit.fade) * local_weight(m);
         }
     }
+}
+
+/// The ambient occlusion at each hit (1 where the scene has none, at hits that are not lit,
+/// and at a solid inside glass, whose surroundings the field does not describe).
+fn occlusions<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    hits: &[Hit<T>],
+    lit: &impl Fn(&Hit<T>) -> bool,
+) -> Vec<T> {
+    let mut ao = vec![T::one(); hits.len()];
+    if ctx.occlusion <= T::zero() || ctx.analytic.is_some() {
+        return ao;
+    }
+    let at: Vec<usize> = (0..hits.len())
+        .filter(|&i| lit(&hits[i]) && !hits[i].solid)
+        .collect();
+    if at.is_empty() {
+        return ao;
+    }
+    let points: Vec<(V3<T>, V3<T>)> = at.iter().map(|&i| (hits[i].p, hits[i].n)).collect();
+    let buffers = [&mut ws.x, &mut ws.y, &mut ws.z, &mut ws.d];
+    let found = look::occlusion(ctx, marching(&mut ws.marching), buffers, &points);
+    for (&i, v) in at.iter().zip(found) {
+        ao[i] = v;
+    }
+    ao
 }
 
 /// Marches the shadow rays of `ws.launches` into `ws.shadowed`.
@@ -559,6 +629,7 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
         }
         let m = ctx.material(hit.mat);
         let off = hit.n * (T::from_f64(4.0) * hit.h);
+        let weight = ray.weight * hit.fade;
         let child = |origin: V3<T>, dir: V3<T>, weight: V3<T>, inside: bool| Ray {
             origin,
             dir,
@@ -570,8 +641,8 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
         };
         if ray.inside && !hit.solid {
             match refract(ray.dir, -hit.n, m.ior) {
-                Some(t) => next.push(child(hit.p + off, t, ray.weight, false)),
-                None => next.push(child(hit.p - off, ray.dir.reflect(hit.n), ray.weight, true)),
+                Some(t) => next.push(child(hit.p + off, t, weight, false)),
+                None => next.push(child(hit.p - off, ray.dir.reflect(hit.n), weight, true)),
             }
             continue;
         }
@@ -581,17 +652,17 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
             next.push(child(
                 hit.p + off,
                 ray.dir.reflect(hit.n),
-                ray.weight * m.reflect,
+                weight * m.reflect,
                 within,
             ));
         }
         if m.transparency > T::zero() {
             match refract(ray.dir, hit.n, T::one() / m.ior) {
-                Some(t) => next.push(child(hit.p - off, t, ray.weight * m.transparency, true)),
+                Some(t) => next.push(child(hit.p - off, t, weight * m.transparency, true)),
                 None => next.push(child(
                     hit.p + off,
                     ray.dir.reflect(hit.n),
-                    ray.weight * m.transparency,
+                    weight * m.transparency,
                     within,
                 )),
             }

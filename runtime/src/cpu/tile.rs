@@ -58,7 +58,7 @@ pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect
         .acc
         .chunks(chunk)
         .map(|s| {
-            let sum = s.iter().fold(V3::zero(), |a, &c| a + c) * scale;
+            let sum = super::look::grade(ctx, s.iter().fold(V3::zero(), |a, &c| a + c) * scale);
             [
                 sum.x.to_f64() as f32,
                 sum.y.to_f64() as f32,

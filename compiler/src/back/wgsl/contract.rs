@@ -40,6 +40,12 @@ impl Specialisation {
             footprint: _,
             max_dist: _,
             background: _,
+            // Read at every render (`look`, `fog`); whether each is on is a feature.
+            occlusion: _,
+            fog: _,
+            fog_color: _,
+            exposure: _,
+            tonemap: _,
             // Specialised (and read: ω in `march.z`, max_depth in `depth.x`).
             relaxation,
             max_depth,
@@ -76,7 +82,7 @@ pub struct Contract {
     pub specialisation: Specialisation,
     /// Every feature of the template by name, on or off: those of the scene and its settings
     /// (`ANALYTIC`, `POINT`, `DIRECTIONAL`, `SOFT`, `CHECKER`, `TRANSPARENT`, `REFRACTION`,
-    /// `SECONDARY`, `MATERIALS`, `RELAX`), then the kernel's own (`DEBUG_NAN`, `PARAMS`,
+    /// `SECONDARY`, `MATERIALS`, `RELAX`, `COLOUR_FIELDS`, `OCCLUSION`, `SKY`, `FOG`, `GRADE`), then the kernel's own (`DEBUG_NAN`, `PARAMS`,
     /// `MEDIA`, `SCENE_DATA`, `INTERPRETED`).
     pub features: Vec<(&'static str, bool)>,
     /// The scene uniform (binding 0) as naga laid it out.
@@ -85,7 +91,7 @@ pub struct Contract {
 
 /// The features that follow from the scene and its settings alone (the first ones of
 /// [`Contract::features`]): those a render checks.
-pub(super) const SCENE_FEATURES: usize = 11;
+pub(super) const SCENE_FEATURES: usize = 15;
 
 /// A scene that a kernel cannot render, or a uniform that does not fit its layout: what
 /// differs, in words.

@@ -17,6 +17,16 @@ struct DirLight {
     color: vec4<f32>,    // rgb = colour × intensity, w: softness k
 }
 //#endif
+//#if SKY
+struct SkyLight {
+    c0: vec4<f32>,      // irradiance over π: c0 + c1·N_y + c2·(3N_y² − 1), times the intensity;
+    c1: vec4<f32>,      // c0.w: 1 when the occlusion scales it
+    c2: vec4<f32>,
+    zenith: vec4<f32>,  // radiance, times the intensity; w: 1 when it is the background
+    horizon: vec4<f32>,
+    ground: vec4<f32>,
+}
+//#endif
 struct Material {
     color: vec4<f32>,   // rgb, w: 1 for a checker pattern
     color_b: vec4<f32>, // checker's second colour, w: 1 / checker size
@@ -31,7 +41,10 @@ struct Params {
     cam_v: vec4<f32>,      // up
     view: vec4<f32>,       // tan(fov/2)·aspect, tan(fov/2), width, height
     march: vec4<f32>,      // epsilon, max_dist, relaxation ω, 1/L
+    // background.w: 1 when rays that hit nothing show the skies instead.
     background: vec4<f32>,
+    look: vec4<f32>,       // occlusion radius R, 1/fog distance, 2^exposure, tone curve
+    fog: vec4<f32>,        // the fog's colour; w: 0 where it is the background seen along the ray
     counts: vec4<u32>,     // width, height, aa, max_steps
     depth: vec4<u32>,      // max_depth
 //#if POINT
@@ -39,6 +52,9 @@ struct Params {
 //#endif
 //#if DIRECTIONAL
     dirs: array<DirLight, {{DIRS}}>,
+//#endif
+//#if SKY
+    skies: array<SkyLight, {{SKIES}}>,
 //#endif
     materials: array<Material, {{MATERIALS}}>,
     srgb: array<vec4<f32>, 64>, // the least linear value of each 8-bit sRGB code (srgb.rs)
@@ -276,41 +292,6 @@ var<private> medium_tau: f32 = 0.0;
 //#endif
 //#endif
 
-//#if COLOUR_FIELDS
-{{COLOURS}}
-//#endif
-// The colour of material m at p (checker: parity of the cell, sampled just inside; a colour
-// field: its value at p).
-fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32) -> vec3<f32> {
-//#if COLOUR_FIELDS
-    var c = m.color.xyz;
-    var field = m.optics.w;
-//#if CHECKER
-    if m.color.w > 0.0 {
-        let q = (p - n * (2.0 * h)) * m.color_b.w + m.shift.xyz;
-        let s = floor(q.x) + floor(q.y) + floor(q.z);
-        let odd = s - 2.0 * floor(s / 2.0);
-        c = select(m.color.xyz, m.color_b.xyz, odd > 0.0);
-        field = select(m.optics.w, m.shift.w, odd > 0.0);
-    }
-//#endif
-    if field > 0.0 {
-        c = colour_field(u32(field) - 1u, p);
-    }
-    return c;
-//#else
-//#if CHECKER
-    if m.color.w > 0.0 {
-        let q = (p - n * (2.0 * h)) * m.color_b.w + m.shift.xyz;
-        let s = floor(q.x) + floor(q.y) + floor(q.z);
-        let odd = s - 2.0 * floor(s / 2.0);
-        return select(m.color.xyz, m.color_b.xyz, odd > 0.0);
-    }
-//#endif
-    return m.color.xyz;
-//#endif
-}
-
 //#if !ANALYTIC
 //#if SOFT
 // A penumbra term where there is none (transparent, inside a solid, t = 0).
@@ -477,49 +458,6 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
 }
 //#endif
 
-// One light's Phong term at a hit, shadow included.
-fn phong_term(c: vec3<f32>, m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32,
-              l: vec3<f32>, dist: f32, atten: f32, il: vec3<f32>, k: f32, is_point: bool) -> vec3<f32> {
-    let ndl = dot(n, l);
-    if ndl <= 0.0 || atten <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    let r = n * (2.0 * ndl) - l;
-    let rv = max(dot(r, -d), 0.0);
-    let spec = m.phong.z * pow(rv, m.phong.w);
-    let contrib = (c * (m.phong.y * ndl) + vec3<f32>(spec)) * il * atten;
-    let off = 4.0 * h;
-    let tmax = select(dist, dist - off, is_point);
-    return contrib * shadow(p + n * off, l, tt, tmax, k);
-}
-
-// Ambient plus every light: I = k_a·C + Σ shadow·atten·(k_d·max(N·L,0)·C·I_l + k_s·max(R·V,0)^α·I_l).
-fn shade(m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32) -> vec3<f32> {
-    let c = surface_colour(m, p, n, h);
-    var sum = c * m.phong.x;
-//#if POINT
-    for (var i = 0u; i < {{POINTS}}u; i++) {
-        let light = params.points[i];
-        let v = light.position.xyz - p;
-        let dist = length(v);
-        var atten = 1.0;
-        if light.position.w > 0.0 {
-            let x = dist / light.position.w;
-            let f = clamp(1.0 - x * x, 0.0, 1.0);
-            atten = f * f;
-        }
-        sum += phong_term(c, m, p, n, d, tt, h, v * (1.0 / dist), dist, atten, light.color.xyz, light.color.w, true);
-    }
-//#endif
-//#if DIRECTIONAL
-    for (var i = 0u; i < {{DIRS}}u; i++) {
-        let light = params.dirs[i];
-        sum += phong_term(c, m, p, n, d, tt, h, light.to_light.xyz, params.march.y, 1.0, light.color.xyz, light.color.w, false);
-    }
-//#endif
-    return sum;
-}
-
 // A ray to trace, with the weight its colour is added with.
 struct Ray {
     origin: vec3<f32>,
@@ -577,13 +515,29 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             } else if hit.status == STATUS_BUDGET {
                 counters.budget += 1u;
             }
-            acc += ray.weight * params.background.xyz;
+//#if FOG
+            // Fog hides what lies beyond every surface: a miss outside solids is its colour.
+            if !inside {
+                acc += ray.weight * fog_colour(ray.dir);
+                continue;
+            }
+//#endif
+            acc += ray.weight * background(ray.dir);
             continue;
         }
         counters.hits += 1u;
         let p = ray.origin + ray.dir * hit.t;
         let tt = ray.t0 + hit.t;
         let h = normal_step(tt, p);
+        // Fog over the segment (none inside solids): what it hides is the fog's colour.
+        var weight = ray.weight;
+//#if FOG
+        if !inside {
+            let e = fade(hit.t);
+            acc += weight * (1.0 - e) * fog_colour(ray.dir);
+            weight = weight * e;
+        }
+//#endif
 //#if MEDIA
         if inside {
             let solid = map_solid(p);
@@ -595,11 +549,11 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                 let ws = 1.0 - ms.optics.x - ms.optics.y;
                 if ws > 0.0 {
                     medium_tau = params.materials[u32(map(p).y)].optics.y;
-                    acc += shade(ms, p, ns, ray.dir, tt, h) * ray.weight * ws;
+                    acc += shade(ms, p, ns, ray.dir, tt, h, 1.0) * weight * ws;
                     medium_tau = 0.0;
                 }
                 if ray.depth < params.depth.x && ms.optics.x > 0.0 {
-                    stack[top] = Ray(p + ns * (4.0 * h), tt, reflect_dir(ray.dir, ns), ray.depth + 1u, ray.weight * ms.optics.x, 1u);
+                    stack[top] = Ray(p + ns * (4.0 * h), tt, reflect_dir(ray.dir, ns), ray.depth + 1u, weight * ms.optics.x, 1u);
                     top += 1u;
                     counters.secondary += 1u;
                 }
@@ -626,7 +580,13 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#endif
         let w = 1.0 - m.optics.x - m.optics.y;
         if (!inside || solid) && w > 0.0 {
-            acc += shade(m, p, n, ray.dir, tt, h) * ray.weight * w;
+            var ao = 1.0;
+//#if OCCLUSION
+            if !solid {
+                ao = occlusion(p, n);
+            }
+//#endif
+            acc += shade(m, p, n, ray.dir, tt, h, ao) * weight * w;
         }
 //#if SECONDARY
         if ray.depth >= params.depth.x {
@@ -638,9 +598,9 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             // Leaving the solid: refract out, or reflect back in on total internal reflection.
             let tr = refract_dir(ray.dir, -n, m.optics.z);
             if any(tr != vec3<f32>(0.0)) {
-                stack[top] = Ray(p + off, tt, tr, ray.depth + 1u, ray.weight, 0u);
+                stack[top] = Ray(p + off, tt, tr, ray.depth + 1u, weight, 0u);
             } else {
-                stack[top] = Ray(p - off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight, 1u);
+                stack[top] = Ray(p - off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, weight, 1u);
             }
             top += 1u;
             counters.secondary += 1u;
@@ -649,7 +609,7 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#endif
         if m.optics.x > 0.0 {
             // From a solid within glass the reflection stays inside the glass.
-            stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight * m.optics.x, u32(solid));
+            stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, weight * m.optics.x, u32(solid));
             top += 1u;
             counters.secondary += 1u;
         }
@@ -657,9 +617,9 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         if m.optics.y > 0.0 {
             let tr = refract_dir(ray.dir, n, 1.0 / m.optics.z);
             if any(tr != vec3<f32>(0.0)) {
-                stack[top] = Ray(p - off, tt, tr, ray.depth + 1u, ray.weight * m.optics.y, 1u);
+                stack[top] = Ray(p - off, tt, tr, ray.depth + 1u, weight * m.optics.y, 1u);
             } else {
-                stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, ray.weight * m.optics.y, 0u);
+                stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, weight * m.optics.y, 0u);
             }
             top += 1u;
             counters.secondary += 1u;
@@ -716,14 +676,14 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
             sum += radiance(params.eye.xyz, camera_dir(x, y, i, j));
         }
     }
+    let pixel = y * params.counts.x + x;
+    var colour = grade(sum / f32(aa * aa));
 //#if DEBUG_NAN
     // --debug-nan: a pixel any of whose rays met a NaN is magenta.
     if counters.nans > 0u {
-        sum = vec3<f32>(1.0, 0.0, 1.0) * f32(aa * aa);
+        colour = vec3<f32>(1.0, 0.0, 1.0);
     }
 //#endif
-    let pixel = y * params.counts.x + x;
-    let colour = sum / f32(aa * aa);
     image[pixel] = vec4<f32>(colour, 1.0);
     pixels[pixel] = srgb_code(colour.x) | (srgb_code(colour.y) << 8u) | (srgb_code(colour.z) << 16u) | (255u << 24u);
     let s = pixel * 9u;

@@ -26,15 +26,16 @@ pub mod part;
 pub mod reduce;
 pub mod srgb;
 mod template;
+mod uniform;
 
 pub use analytic::MAX_UNROLLED;
 pub use contract::{Contract, Field, Mismatch, Shape, Specialisation, Uniform, UniformWriter};
 pub(crate) use literal::float;
 pub use map::{write_map, write_sdf};
+pub use uniform::uniforms;
 
 use crate::lower::Lowered;
 use crate::scene::{Colour, Light, Pattern, Scene};
-use glam::DVec3;
 use std::collections::HashMap;
 use std::fmt;
 
@@ -50,7 +51,9 @@ pub const WORKGROUP: u32 = 8;
 /// secondary rays, shadow rays.
 pub const STATS_WORDS: u32 = 9;
 
-const TEMPLATE: &str = include_str!("kernel.wgsl");
+/// The kernel template: the renderer (kernel.wgsl) and its shading (shading.wgsl), one
+/// module (WGSL declarations may come in any order).
+const TEMPLATE: &str = concat!(include_str!("kernel.wgsl"), include_str!("shading.wgsl"));
 
 /// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
 /// they are read from `scene_data` and walked nearest first (march.rs). The code grows with
@@ -118,7 +121,10 @@ impl std::error::Error for Error {}
 /// ray traced analytically.
 pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
     let mats = &scene.materials;
-    let soft = scene.lights.iter().any(|l| l.penumbra() > 0.0);
+    let soft = scene
+        .lights
+        .iter()
+        .any(|l| l.penumbra() > 0.0 && l.shadows());
     let points = scene
         .lights
         .iter()
@@ -156,14 +162,33 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
                     .any(|c| matches!(c, Colour::Field(_)))
             }),
         ),
+        // The look (docs/rendering.md): occlusion samples the field, so a traced scene has none.
+        ("OCCLUSION", !traced && scene.settings.occlusion > 0.0),
+        (
+            "SKY",
+            scene.lights.iter().any(|l| matches!(l, Light::Sky { .. })),
+        ),
+        ("FOG", scene.settings.fog > 0.0),
+        (
+            "GRADE",
+            scene.settings.exposure != 0.0 || scene.settings.tonemap != crate::scene::Tonemap::None,
+        ),
     ]
 }
 
-fn count(scene: &Scene, point: bool) -> usize {
+/// The number of the scene's lights of a kind: `kind` 0 point, 1 directional (suns too),
+/// 2 sky.
+fn count(scene: &Scene, kind: u32) -> usize {
     scene
         .lights
         .iter()
-        .filter(|l| matches!(l, Light::Point { .. }) == point)
+        .filter(|l| {
+            kind == match l {
+                Light::Point { .. } => 0,
+                Light::Directional { .. } => 1,
+                Light::Sky { .. } => 2,
+            }
+        })
         .count()
 }
 
@@ -530,13 +555,27 @@ fn write_template(
             used.join(" ")
         ),
     );
-    values.insert("POINTS", count(scene, true).to_string());
-    values.insert("DIRS", count(scene, false).to_string());
+    values.insert("POINTS", count(scene, 0).to_string());
+    values.insert("DIRS", count(scene, 1).to_string());
+    values.insert("SKIES", count(scene, 2).to_string());
     values.insert("MATERIALS", scene.materials.len().max(1).to_string());
     values.insert("STACK", (scene.settings.max_depth + 2).to_string());
     values.insert("PENUMBRA_BRACKET", float(Light::PENUMBRA_BRACKET));
     values.insert("PENUMBRA_PROBES", format!("{}u", Light::PENUMBRA_PROBES));
     values.insert("WORKGROUP", WORKGROUP.to_string());
+    {
+        use crate::scene::look;
+        values.insert("FOOTPRINT_MIN", float(look::FOOTPRINT_MIN));
+        values.insert("FOOTPRINT_COS", float(look::FOOTPRINT_COS));
+        values.insert("OCCLUSION_SAMPLES", format!("{}u", look::OCCLUSION_SAMPLES));
+        values.insert("OCCLUSION_STRENGTH", float(look::OCCLUSION_STRENGTH));
+        for (k, c) in ["FILMIC_A", "FILMIC_B", "FILMIC_C", "FILMIC_D", "FILMIC_E"]
+            .into_iter()
+            .zip(look::FILMIC)
+        {
+            values.insert(k, float(c));
+        }
+    }
     values.insert("ENTRY", ENTRY_POINT.to_string());
     let source = template::expand(template, &on, &values).map_err(|e| Error {
         message: format!("kernel template: {e}"),
@@ -645,112 +684,6 @@ fn node_of_line(source: &str, n: usize, scene: &Scene) -> Option<crate::Span> {
         .find_map(|l| l.trim().strip_prefix("// node "))?;
     let id: u32 = comment.split_whitespace().next()?.parse().ok()?;
     (id < scene.graph.len() as u32).then(|| scene.graph.span(crate::scene::NodeId(id)))
-}
-
-/// The bytes of the scene uniform (binding 0) of a kernel whose uniform is laid out as
-/// `layout` ([`Contract::uniform`], naga's layout of `Params`), each member written by name at
-/// naga's offset. `Err` when a member named here is missing from the layout or of another
-/// type, when the scene has more lights or materials than the kernel's arrays hold, or when a
-/// member of the layout is written by nothing (the kernel is another scene's, or this writer
-/// lags the template).
-pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u8>, Mismatch> {
-    let mut w = layout.writer();
-    let colours = crate::lower::Colours::numbers(scene);
-    let cam = &scene.camera;
-    let s = &scene.settings;
-    let (fwd, u, v) = cam.basis();
-    let tan = (cam.fov * 0.5).tan();
-    let aspect = s.width.max(1) as f64 / s.height.max(1) as f64;
-    let v4 = |v: [f64; 3], w: f64| [v[0], v[1], v[2], w];
-    w.floats("eye", &v4(cam.position, 0.0))?;
-    w.floats("cam_w", &v4(fwd, 0.0))?;
-    w.floats("cam_u", &v4(u, 0.0))?;
-    w.floats("cam_v", &v4(v, 0.0))?;
-    w.floats(
-        "view",
-        &[tan * aspect, tan, s.width as f64, s.height as f64],
-    )?;
-    w.floats(
-        "march",
-        &[
-            scene.epsilon(),
-            s.max_dist,
-            s.relaxation.max(1.0),
-            1.0 / lipschitz.max(1.0),
-        ],
-    )?;
-    w.floats("background", &v4(s.background, 0.0))?;
-    w.uints(
-        "counts",
-        &[s.width, s.height, s.aa.max(1), s.max_steps.max(1)],
-    )?;
-    w.uints("depth", &[s.max_depth, 0, 0, 0])?;
-    let (mut points, mut dirs) = (0, 0);
-    for l in &scene.lights {
-        let colour = |c: [f64; 3], i: f64| v4((DVec3::from(c) * i).into(), l.sharpness());
-        match l {
-            Light::Point {
-                position,
-                color,
-                intensity,
-                radius,
-                ..
-            } => {
-                let r = if radius.is_finite() { *radius } else { 0.0 };
-                w.floats(&format!("points[{points}].position"), &v4(*position, r))?;
-                w.floats(
-                    &format!("points[{points}].color"),
-                    &colour(*color, *intensity),
-                )?;
-                points += 1;
-            }
-            Light::Directional {
-                direction,
-                color,
-                intensity,
-                ..
-            } => {
-                let to = (-DVec3::from(*direction)).normalize_or_zero().into();
-                w.floats(&format!("dirs[{dirs}].to_light"), &v4(to, 0.0))?;
-                w.floats(&format!("dirs[{dirs}].color"), &colour(*color, *intensity))?;
-                dirs += 1;
-            }
-        }
-    }
-    for (k, m) in scene.materials.iter().enumerate() {
-        // A colour field's colour is its program's (the constant is unused).
-        let v = |c: &Colour| c.constant().unwrap_or([0.0; 3]);
-        let (a, b, checker, inv, shift) = match &m.pattern {
-            Pattern::Solid(c) => (v(c), [0.0; 3], 0.0, 0.0, [0.0; 3]),
-            Pattern::Checker { a, b, size } => {
-                (v(a), v(b), 1.0, 1.0 / size, scene.checker_shift(*size))
-            }
-        };
-        // The colour fields' numbers, plus 1 (0: none).
-        let field = |slot: usize| {
-            colours
-                .get(k)
-                .and_then(|f| f[slot])
-                .map_or(0.0, |i| i as f64 + 1.0)
-        };
-        let at = |member: &str| format!("materials[{k}].{member}");
-        w.floats(&at("color"), &v4(a, checker))?;
-        w.floats(&at("color_b"), &v4(b, inv))?;
-        w.floats(
-            &at("phong"),
-            &[m.ambient, m.diffuse, m.specular, m.shininess],
-        )?;
-        w.floats(
-            &at("optics"),
-            &[m.reflect, m.transparency, m.ior.max(1e-6), field(0)],
-        )?;
-        w.floats(&at("shift"), &v4(shift, field(1)))?;
-    }
-    for (k, t) in srgb::thresholds().chunks_exact(4).enumerate() {
-        let t: Vec<f64> = t.iter().map(|&x| f64::from(x)).collect();
-        w.floats(&format!("srgb[{k}]"), &t)?;
-    }
-    w.finish()
 }
 
 #[cfg(test)]

@@ -1,0 +1,203 @@
+//% The shading part of the renderer kernel template (appended to kernel.wgsl, expanded with
+//% it: see template.rs): surface colours (the checker filtered over the sample's footprint),
+//% ambient occlusion, Phong, fog and the pixel's exposure and tone curve, as docs/rendering.md
+//% ("At a hit", "The look") states them. The CPU renderer's copy is runtime/src/cpu/shade.rs
+//% and look.rs.
+
+//#if COLOUR_FIELDS
+{{COLOURS}}
+//#endif
+//#if CHECKER
+// The checker's footprint: an axis narrower than FOOTPRINT_MIN cells is point sampled; a
+// grazing ray's footprint stretches by 1/max(|N·D|, FOOTPRINT_COS).
+const FOOTPRINT_MIN: f32 = {{FOOTPRINT_MIN}};
+const FOOTPRINT_COS: f32 = {{FOOTPRINT_COS}};
+
+// The mean over [u − w/2, u + w/2] of the checker's sign along one axis (+1 in even cells,
+// −1 in odd ones), u and w in cells: 2·(T(f − w/2) − T(f + w/2))/w with T(x) = |fract(x/2) − ½|,
+// f the offset of u in its cell, times the cell's sign.
+fn checker_sign(u: f32, w: f32) -> f32 {
+    let c = floor(u);
+    let cell = 1.0 - 2.0 * (c - 2.0 * floor(c * 0.5));
+    if w < FOOTPRINT_MIN {
+        return cell;
+    }
+    let f = u - c;
+    let x = (f - 0.5 * w) * 0.5;
+    let y = (f + 0.5 * w) * 0.5;
+    let a = abs(x - floor(x) - 0.5);
+    let b = abs(y - floor(y) - 0.5);
+    return cell * 2.0 * (a - b) / w;
+}
+
+// The weight of the checker's second colour at q (in cells) for a sample whose footprint at
+// the hit is s cells wide, seen along d on a surface of normal n: the footprint's width along
+// axis k is s·√max(1 − n_k² + ((d_k − (N·D)·n_k)/c)², 0), c = max(|N·D|, FOOTPRINT_COS), and
+// the weight is ½ − ½·Π sign_k.
+fn checker_weight(q: vec3<f32>, n: vec3<f32>, d: vec3<f32>, s: f32) -> f32 {
+    let nd = dot(n, d);
+    let c = max(abs(nd), FOOTPRINT_COS);
+    let e = (d - n * nd) * (1.0 / c);
+    let w = s * sqrt(max(vec3<f32>(1.0) - n * n + e * e, vec3<f32>(0.0)));
+    return 0.5 - 0.5 * checker_sign(q.x, w.x) * checker_sign(q.y, w.y) * checker_sign(q.z, w.z);
+}
+//#endif
+
+// The colour of material m at p (a checker: its two colours mixed over the sample's
+// footprint, sampled just inside; a colour field: its value at p). d: the ray's direction,
+// tt: its path length.
+fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32, d: vec3<f32>, tt: f32) -> vec3<f32> {
+    var ca = m.color.xyz;
+//#if COLOUR_FIELDS
+    if m.optics.w > 0.0 {
+        ca = colour_field(u32(m.optics.w) - 1u, p);
+    }
+//#endif
+//#if CHECKER
+    if m.color.w > 0.0 {
+        let q = (p - n * (2.0 * h)) * m.color_b.w + m.shift.xyz;
+        // The sample's footprint: the pixel's pitch at unit distance over aa, times tt.
+        let pitch = 2.0 * params.view.y / (params.view.w * f32(params.counts.z));
+        let wb = checker_weight(q, n, d, tt * pitch * m.color_b.w);
+        var cb = m.color_b.xyz;
+//#if COLOUR_FIELDS
+        if m.shift.w > 0.0 && wb > 0.0 {
+            cb = colour_field(u32(m.shift.w) - 1u, p);
+        }
+//#endif
+        if wb >= 1.0 {
+            return cb;
+        }
+        if wb > 0.0 {
+            return ca * (1.0 - wb) + cb * wb;
+        }
+    }
+//#endif
+    return ca;
+}
+
+//#if OCCLUSION
+// Ambient occlusion at p on a surface of normal n: with R = look.x and n = OCCLUSION_SAMPLES,
+// hᵢ = R·i/n, dᵢ = f(p + hᵢ·N)/L, ao = clamp(1 − (k/n)·Σ max(hᵢ − dᵢ, 0)/hᵢ, 0, 1).
+const OCCLUSION_SAMPLES: u32 = {{OCCLUSION_SAMPLES}};
+const OCCLUSION_STRENGTH: f32 = {{OCCLUSION_STRENGTH}};
+fn occlusion(p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let r = params.look.x;
+    var sum = 0.0;
+    for (var i = 1u; i <= OCCLUSION_SAMPLES; i++) {
+        let h = r * f32(i) / f32(OCCLUSION_SAMPLES);
+        let d = sdf(p + n * h) * params.march.w;
+        sum += max(h - d, 0.0) / h;
+    }
+    return clamp(1.0 - OCCLUSION_STRENGTH / f32(OCCLUSION_SAMPLES) * sum, 0.0, 1.0);
+}
+//#endif
+
+// One light's Phong term at a hit, shadow included.
+fn phong_term(c: vec3<f32>, m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32,
+              l: vec3<f32>, dist: f32, atten: f32, il: vec3<f32>, k: f32, is_point: bool) -> vec3<f32> {
+    let ndl = dot(n, l);
+    if ndl <= 0.0 || atten <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let r = n * (2.0 * ndl) - l;
+    let rv = max(dot(r, -d), 0.0);
+    let spec = m.phong.z * pow(rv, m.phong.w);
+    let contrib = (c * (m.phong.y * ndl) + vec3<f32>(spec)) * il * atten;
+    // k < 0: a light without shadows.
+    if k < 0.0 {
+        return contrib;
+    }
+    let off = 4.0 * h;
+    let tmax = select(dist, dist - off, is_point);
+    return contrib * shadow(p + n * off, l, tt, tmax, k);
+}
+
+// What a ray that hits nothing sees: the skies that are the background, or the background.
+fn background(d: vec3<f32>) -> vec3<f32> {
+//#if SKY
+    if params.background.w > 0.0 {
+        var sum = vec3<f32>(0.0);
+        for (var i = 0u; i < {{SKIES}}u; i++) {
+            let sky = params.skies[i];
+            var l = sky.ground.xyz;
+            if d.y >= 0.0 {
+                l = sky.horizon.xyz + (sky.zenith.xyz - sky.horizon.xyz) * d.y;
+            }
+            sum += l * sky.zenith.w;
+        }
+        return sum;
+    }
+//#endif
+    return params.background.xyz;
+}
+
+// Ambient (times the occlusion ao) plus every light:
+// I = ao·k_a·C + Σ shadow·atten·(k_d·max(N·L,0)·C·I_l + k_s·max(R·V,0)^α·I_l).
+fn shade(m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32, ao: f32) -> vec3<f32> {
+    let c = surface_colour(m, p, n, h, d, tt);
+    var sum = c * (m.phong.x * ao);
+//#if POINT
+    for (var i = 0u; i < {{POINTS}}u; i++) {
+        let light = params.points[i];
+        let v = light.position.xyz - p;
+        let dist = length(v);
+        var atten = 1.0;
+        if light.position.w > 0.0 {
+            let x = dist / light.position.w;
+            let f = clamp(1.0 - x * x, 0.0, 1.0);
+            atten = f * f;
+        }
+        sum += phong_term(c, m, p, n, d, tt, h, v * (1.0 / dist), dist, atten, light.color.xyz, light.color.w, true);
+    }
+//#endif
+//#if DIRECTIONAL
+    for (var i = 0u; i < {{DIRS}}u; i++) {
+        let light = params.dirs[i];
+        sum += phong_term(c, m, p, n, d, tt, h, light.to_light.xyz, params.march.y, 1.0, light.color.xyz, light.color.w, false);
+    }
+//#endif
+//#if SKY
+    // Sky light: k_d·C·E(N)/π, times the occlusion where it casts shadows.
+    for (var i = 0u; i < {{SKIES}}u; i++) {
+        let sky = params.skies[i];
+        let e = sky.c0.xyz + sky.c1.xyz * n.y + sky.c2.xyz * (3.0 * n.y * n.y - 1.0);
+        sum += c * e * (m.phong.y * select(1.0, ao, sky.c0.w > 0.0));
+    }
+//#endif
+    return sum;
+}
+
+//#if FOG
+// What fog leaves of a ray segment of length t: e^(−t/D), with 1/D in look.y.
+fn fade(t: f32) -> f32 {
+    return exp(-t * params.look.y);
+}
+
+// The fog's colour along d: `fog_color`, or the background seen along d.
+fn fog_colour(d: vec3<f32>) -> vec3<f32> {
+    if params.fog.w > 0.0 {
+        return params.fog.xyz;
+    }
+    return background(d);
+}
+//#endif
+
+// A pixel's linear colour after the exposure (2^exposure in look.z) and the tone curve
+// (look.w: 0 none, 1 filmic, 2 Reinhard).
+fn grade(c: vec3<f32>) -> vec3<f32> {
+//#if GRADE
+    let x = c * params.look.z;
+    if params.look.w == 1.0 {
+        let num = x * ({{FILMIC_A}} * x + {{FILMIC_B}});
+        let den = x * ({{FILMIC_C}} * x + {{FILMIC_D}}) + {{FILMIC_E}};
+        return clamp(num / den, vec3<f32>(0.0), vec3<f32>(1.0));
+    }
+    if params.look.w == 2.0 {
+        return x / (vec3<f32>(1.0) + x);
+    }
+    return x;
+//#else
+    return c;
+//#endif
+}

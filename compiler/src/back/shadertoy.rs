@@ -3,15 +3,15 @@
 //! GLSL ES 3.00) and a `mainImage` that renders it with the scene's camera (its aspect taken
 //! from the canvas), lights and materials: sphere tracing, tetrahedral normals, Phong with
 //! point-light attenuation, hard or soft shadows, checker patterns and colour fields as
-//! docs/rendering.md states them, for camera rays only. Reflection, refraction,
-//! transparency, over-relaxation, antialiasing, sky lights and the look (occlusion, fog,
-//! exposure and tone curves, the checker's filter) are left out, so a scene using them
-//! renders without them.
+//! docs/rendering.md states them (the checker filtered over the pixel's footprint), for
+//! camera rays only. Reflection, refraction, transparency, over-relaxation, antialiasing, sky
+//! lights and the rest of the look (occlusion, fog, exposure and tone curves) are left out, so
+//! a scene using them renders without them.
 
 use super::shader::{self, Error};
 use super::wgsl::{self, float};
 use crate::lower::Lowered;
-use crate::scene::{Light, Scene};
+use crate::scene::{look, Light, Scene};
 use glam::DVec3;
 use std::fmt::Write;
 
@@ -77,13 +77,32 @@ float sdfc_shadow(vec3 o, vec3 d, float tt, float tmax, float k) {
     return clamp(res, 0.0, 1.0);
 }
 
-vec3 sdfc_colour(sdfc_map_Material m, vec3 p) {
-    if (m.checker > 0.0) {
-        vec3 q = p / m.checker + m.shift;
-        float s = floor(q.x) + floor(q.y) + floor(q.z);
-        return (s - 2.0 * floor(s / 2.0)) > 0.0 ? m.color_b : m.color;
-    }
-    return m.color;
+// The checker filtered over the pixel's footprint (docs/rendering.md, "The look"): the mean
+// of one axis's sign over [u - w/2, u + w/2] cells, and the second colour's weight at q for a
+// footprint s cells wide seen along d on a surface of normal n.
+float sdfc_checker_sign(float u, float w) {
+    float c = floor(u);
+    float cell = 1.0 - 2.0 * (c - 2.0 * floor(c * 0.5));
+    if (w < SDFC_FOOTPRINT_MIN) return cell;
+    float f = u - c;
+    float x = (f - 0.5 * w) * 0.5;
+    float y = (f + 0.5 * w) * 0.5;
+    return cell * 2.0 * (abs(x - floor(x) - 0.5) - abs(y - floor(y) - 0.5)) / w;
+}
+
+float sdfc_checker_weight(vec3 q, vec3 n, vec3 d, float s) {
+    float nd = dot(n, d);
+    float c = max(abs(nd), SDFC_FOOTPRINT_COS);
+    vec3 e = (d - n * nd) / c;
+    vec3 w = s * sqrt(max(vec3(1.0) - n * n + e * e, vec3(0.0)));
+    return 0.5 - 0.5 * sdfc_checker_sign(q.x, w.x) * sdfc_checker_sign(q.y, w.y) * sdfc_checker_sign(q.z, w.z);
+}
+
+// The second colour's weight of material m at p (0 for a plain colour); s: the footprint's
+// width at the hit in scene units.
+float sdfc_checker(sdfc_map_Material m, vec3 p, vec3 n, vec3 d, float s) {
+    if (m.checker <= 0.0) return 0.0;
+    return sdfc_checker_weight(p / m.checker + m.shift, n, d, s / m.checker);
 }
 
 // Phong for one light in direction l (towards it) with intensity il and attenuation atten.
@@ -117,7 +136,8 @@ void mainImage(out vec4 fragColor, in vec2 fragCoord) {
         vec3 n = dot(g, g) > 0.0 ? normalize(g) : -d;
         int id = int(sdfc_map(p).y);
         sdfc_map_Material m = sdfc_map_MATERIALS[clamp(id, 0, int(sdfc_map_MATERIAL_COUNT) - 1)];
-        vec3 c = sdfc_colour(m, p - n * (2.0 * h));
+        float wb = sdfc_checker(m, p - n * (2.0 * h), n, d, t * 2.0 * SDFC_TAN / iResolution.y);
+        vec3 c = mix(m.color, m.color_b, wb);
 SDFC_FIELDS        vec3 v = -d;
         col = m.ambient * c;
 SDFC_LIGHTS    }
@@ -150,6 +170,8 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
         float((cam.fov * 0.5).tan())
     );
     let _ = writeln!(out, "const float SDFC_EPS = {};", float(scene.epsilon()));
+    let _ = writeln!(out, "const float SDFC_FOOTPRINT_MIN = {};", float(look::FOOTPRINT_MIN));
+    let _ = writeln!(out, "const float SDFC_FOOTPRINT_COS = {};", float(look::FOOTPRINT_COS));
     let _ = writeln!(out, "const float SDFC_MAX_DIST = {};", float(s.max_dist));
     let _ = writeln!(out, "const int SDFC_MAX_STEPS = {};", s.max_steps.max(1));
     let _ = writeln!(out, "const float SDFC_L = {};", float(l));
@@ -227,11 +249,9 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
             [a, b] => {
                 let _ = writeln!(
                     fields,
-                    "        if (id == {id}) {{\n            vec3 q = (p - n * (2.0 * h)) / m.checker + m.shift;\n            \
-                     float s = floor(q.x) + floor(q.y) + floor(q.z);\n            \
-                     c = (s - 2.0 * floor(s / 2.0)) > 0.0 ? {} : {};\n        }}",
-                    call(*b, "m.color_b"),
-                    call(*a, "m.color")
+                    "        if (id == {id}) c = mix({}, {}, wb);",
+                    call(*a, "m.color"),
+                    call(*b, "m.color_b")
                 );
             }
         }

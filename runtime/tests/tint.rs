@@ -380,21 +380,30 @@ fn combo_jobs() -> Vec<Job> {
 #[test]
 fn features_are_the_templates() {
     // Every `//#if` flag of the template is one of FEATURES, and every feature is a flag.
-    let template = std::fs::read_to_string("../compiler/src/back/wgsl/kernel.wgsl")
-        .expect("the kernel template");
+    // The template is the kernel and its shading part, appended to it.
+    let template = ["kernel.wgsl", "shading.wgsl"]
+        .map(|f| {
+            std::fs::read_to_string(format!("../compiler/src/back/wgsl/{f}"))
+                .expect("the kernel template")
+        })
+        .concat();
     let flags: BTreeSet<&str> = template
         .lines()
         .filter_map(|l| l.trim().strip_prefix("//#if "))
         .map(|f| f.trim().trim_start_matches('!'))
         .collect();
-    // COLOUR_FIELDS is not among the combinations: its kernels reach Tint through the
-    // examples that use colour fields (rock.sdf).
+    // Not among the combinations: colour fields reach Tint through the examples that use
+    // them (rock.sdf), the sky, occlusion, fog and the tone curve (GRADE) through
+    // gallery.sdf, which uses all four.
+    let by_examples = ["COLOUR_FIELDS", "SKY", "OCCLUSION", "FOG", "GRADE"];
     let combined: BTreeSet<&str> = flags
         .iter()
         .copied()
-        .filter(|f| *f != "COLOUR_FIELDS")
+        .filter(|f| !by_examples.contains(f))
         .collect();
-    assert!(flags.contains("COLOUR_FIELDS"));
+    for f in by_examples {
+        assert!(flags.contains(f), "{f}");
+    }
     assert_eq!(combined, FEATURES.iter().copied().collect::<BTreeSet<_>>());
 }
 

@@ -170,8 +170,16 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
         float((cam.fov * 0.5).tan())
     );
     let _ = writeln!(out, "const float SDFC_EPS = {};", float(scene.epsilon()));
-    let _ = writeln!(out, "const float SDFC_FOOTPRINT_MIN = {};", float(look::FOOTPRINT_MIN));
-    let _ = writeln!(out, "const float SDFC_FOOTPRINT_COS = {};", float(look::FOOTPRINT_COS));
+    let _ = writeln!(
+        out,
+        "const float SDFC_FOOTPRINT_MIN = {};",
+        float(look::FOOTPRINT_MIN)
+    );
+    let _ = writeln!(
+        out,
+        "const float SDFC_FOOTPRINT_COS = {};",
+        float(look::FOOTPRINT_COS)
+    );
     let _ = writeln!(out, "const float SDFC_MAX_DIST = {};", float(s.max_dist));
     let _ = writeln!(out, "const int SDFC_MAX_STEPS = {};", s.max_steps.max(1));
     let _ = writeln!(out, "const float SDFC_L = {};", float(l));

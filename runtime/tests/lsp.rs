@@ -1026,3 +1026,25 @@ fn a_byte_order_mark_is_skipped_by_the_language_server() {
     c.stop();
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_parameters_hover_shows_its_range_description_and_value() {
+    let dir = temp_dir("param-hover");
+    let main = dir.join("part.sdf");
+    let main_uri = uri(&main);
+    let text = "param width = 40.0 in 10..100 step 1 \"Box width (mm)\";\n\
+                light directional { direction: (-1, -1, 1) }\n\
+                scene { box((width / 100, 0.5, 0.5)); }\n";
+    let mut c = Client::start();
+    c.notify(
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": main_uri, "languageId": "sdf", "version": 1, "text": text } }),
+    );
+    let h = c.request("textDocument/hover", at(&main_uri, text, "width /", 0));
+    let md = h["contents"]["value"].as_str().unwrap();
+    assert!(
+        md.contains("param width = 40.0 in 10..100 step 1 \"Box width (mm)\";")
+            && md.contains("= `40` (float)"),
+        "{md}"
+    );
+}

@@ -179,11 +179,31 @@ pub struct LimitArgs {
     pub param: Vec<(String, String)>,
 }
 
+/// Why a `--param` argument is refused.
+#[derive(Debug)]
+pub enum ParamArgError {
+    /// The argument has no `=`.
+    NotNameValue(String),
+    /// What stands before `=` is not a name.
+    NotAName(String),
+}
+
+impl std::fmt::Display for ParamArgError {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            ParamArgError::NotNameValue(s) => write!(f, "`{s}` is not NAME=VALUE"),
+            ParamArgError::NotAName(n) => write!(f, "`{n}` is not a parameter's name"),
+        }
+    }
+}
+
+impl std::error::Error for ParamArgError {}
+
 /// `NAME=VALUE` of `--param`.
-fn param_arg(s: &str) -> Result<(String, String), String> {
+fn param_arg(s: &str) -> Result<(String, String), ParamArgError> {
     let (name, value) = s
         .split_once('=')
-        .ok_or_else(|| format!("`{s}` is not NAME=VALUE"))?;
+        .ok_or_else(|| ParamArgError::NotNameValue(s.to_string()))?;
     let name = name.trim();
     let ident = name
         .chars()
@@ -191,7 +211,7 @@ fn param_arg(s: &str) -> Result<(String, String), String> {
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
         && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
     if !ident {
-        return Err(format!("`{name}` is not a parameter's name"));
+        return Err(ParamArgError::NotAName(name.to_string()));
     }
     Ok((name.to_string(), value.to_string()))
 }

@@ -35,6 +35,7 @@ mod syntax;
 pub mod animation;
 /// Diagnostics as data, rendered only at the edge (`render` as text, `to_json` as JSON lines).
 pub mod diagnostics;
+pub mod files;
 /// The primitives' table: one entry per built-in shape or profile marched by its formula.
 pub mod prim;
 

@@ -95,7 +95,7 @@ fuzz_target!(|data: &[u8]| {
 
     let mut output = Vec::new();
     // Serving into memory cannot fail to write.
-    let _ = sdfc_runtime::lsp::serve_bytes(&input, &mut output);
+    let _ = sdfc_lsp::serve_bytes(&input, &mut output);
     assert!(
         !output.windows(14).any(|w| w == b"\"code\":-32603,"),
         "an internal error (a panic caught while answering): {}",

@@ -11,7 +11,8 @@ pub mod frontend;
 pub mod gpu;
 pub mod image;
 pub mod job;
-pub mod lsp;
+/// `sdfc lsp`, its own crate (it needs neither the GPU nor the renderer).
+pub use sdfc_lsp as lsp;
 pub mod memory;
 pub mod mesh;
 pub mod metrics;

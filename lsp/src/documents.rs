@@ -1,7 +1,7 @@
 //! The open documents and the checking of one of them: imports are read from other open
 //! documents first (their unsaved text), then from disk, through the checker's `Loader`.
 
-use crate::frontend::{normalise, FsLoader};
+use sdfc_compiler::files::{normalise, FsLoader};
 use sdfc_compiler::{
     check_with_constants, Constant, Diagnostic, FileId, Limit, Limits, Loader, Scene, SourceMap,
 };

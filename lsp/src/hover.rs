@@ -14,7 +14,7 @@ use sdfc_compiler::{
 };
 
 /// docs/language.md, whose tables give each built-in's valid values and a line on what it does.
-const LANGUAGE: &str = include_str!("../../../docs/language.md");
+const LANGUAGE: &str = include_str!("../../docs/language.md");
 
 /// The "valid values" and "what it does" cells of the row of docs/language.md whose first
 /// cell is the signature `sig`.

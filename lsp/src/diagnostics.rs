@@ -12,7 +12,7 @@ use std::path::Path;
 /// server was built from).
 fn docs_uri() -> Option<lsp::Uri> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/diagnostics.md");
-    text::path_to_uri(Path::new(&crate::frontend::normalise(&path)))
+    text::path_to_uri(Path::new(&sdfc_compiler::files::normalise(&path)))
 }
 
 /// The location of a span in `sources` (its file named by a path).

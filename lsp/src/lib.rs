@@ -423,7 +423,7 @@ impl Server {
                     let path = path_of(&p.text_document.uri);
                     self.docs.set(&path, p.text_document.text);
                     self.uris
-                        .insert(crate::frontend::normalise(&path), p.text_document.uri);
+                        .insert(sdfc_compiler::files::normalise(&path), p.text_document.uri);
                     self.changed(&path);
                 }
             }
@@ -444,7 +444,7 @@ impl Server {
                     let path = path_of(&p.text_document.uri);
                     self.docs.close(&path);
                     self.cache.clear();
-                    self.pending.remove(&crate::frontend::normalise(&path));
+                    self.pending.remove(&sdfc_compiler::files::normalise(&path));
                 }
             }
             "workspace/didChangeWatchedFiles" | "textDocument/didSave" => {
@@ -509,7 +509,7 @@ impl Server {
     /// The open document `uri` checked and indexed (cached until a document changes).
     fn analysed(&mut self, uri: &lsp::Uri) -> Option<Rc<Analysed>> {
         let path = path_of(uri);
-        let name = crate::frontend::normalise(&path);
+        let name = sdfc_compiler::files::normalise(&path);
         if let Some(a) = self.cache.get(&name) {
             return Some(a.clone());
         }

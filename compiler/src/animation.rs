@@ -138,3 +138,122 @@ pub fn runs<'a>(frames: impl IntoIterator<Item = (u64, &'a Structure)>) -> Vec<u
     }
     out
 }
+
+/// Where frame `after`'s scene as written differs from frame `before`'s in more than numbers,
+/// walking both from their roots in step: a node of another kind (`sphere` where there was a
+/// `box`, `smooth_union` where there was `union`), another number of children (the children
+/// both have are compared on), another text. Each place is the expression that built the node
+/// in `after`, with words saying what it became; in written order. Empty when the two have one
+/// structure as written: their programs then differ by a setting the kernel is specialised
+/// for, or by a choice the lowering made from the numbers ([`why_not_the_same`]).
+pub fn structural_changes(before: &Scene, after: &Scene) -> Vec<(crate::Span, String)> {
+    use crate::scene::ir::Node;
+    let (b, a) = (&before.graph, &after.graph);
+    let mut out = Vec::new();
+    let mut stack = match (before.root, after.root) {
+        (Some(x), Some(y)) => vec![(x, y)],
+        _ => return out,
+    };
+    let mut seen = std::collections::HashSet::new();
+    while let Some((x, y)) = stack.pop() {
+        if !seen.insert((x, y)) {
+            continue;
+        }
+        let (nx, ny) = (b.node(x), a.node(y));
+        if nx.kind() != ny.kind() {
+            out.push((
+                a.span(y),
+                format!("`{}` here was `{}`", ny.kind(), nx.kind()),
+            ));
+            continue;
+        }
+        let (cx, cy) = (nx.children(), ny.children());
+        if cx.len() != cy.len() {
+            let what = format!(
+                "this `{}` has {} parts, {} in the frame before",
+                ny.kind(),
+                cy.len(),
+                cx.len()
+            );
+            out.push((a.span(y), what));
+        }
+        if let (Node::Text { text: tx, .. }, Node::Text { text: ty, .. }) = (nx, ny) {
+            if tx != ty {
+                let what = format!("this text is {ty:?}, {tx:?} in the frame before");
+                out.push((a.span(y), what));
+            }
+        }
+        // Children in reverse, so that the walk meets them in written order.
+        stack.extend(cx.into_iter().zip(cy).rev());
+    }
+    out
+}
+
+/// Why two frames whose scenes have one structure as written ([`structural_changes`] found
+/// nothing) still have two: a setting the kernel is specialised for, or the lowering.
+pub fn why_not_the_same(before: &Scene, after: &Scene) -> String {
+    let (x, y) = (
+        Specialisation::of(&before.settings),
+        Specialisation::of(&after.settings),
+    );
+    if x.method != y.method {
+        return format!(
+            "the `method` setting is \"{}\", \"{}\" in the frame before",
+            y.method.name(),
+            x.method.name()
+        );
+    }
+    if x.relax != y.relax {
+        return "the `relaxation` setting crosses 1 (the kernel over-relaxes or not)".into();
+    }
+    if x.max_depth != y.max_depth {
+        return format!(
+            "the `max_depth` setting is {}, {} in the frame before",
+            y.max_depth, x.max_depth
+        );
+    }
+    if x != y {
+        return "a setting the kernel is specialised for changes".into();
+    }
+    "the scene as written keeps its structure; the lowering chose differently from the numbers \
+     (whether a primitive is traced analytically, or how a part is bounded)"
+        .into()
+}
+
+/// The note `sdfc check` prints at frame `k` (time `time`), whose structure differs from the
+/// frame before's: where in the source the structure changes and how, or which setting or
+/// choice of the lowering changed it (at the scene's root, when nothing as written did).
+/// `None` for a scene without a root.
+pub fn change_note(
+    k: u64,
+    time: f64,
+    before: (&Scene, &Structure),
+    after: (&Scene, &Structure),
+) -> Option<crate::Diagnostic> {
+    let at = format!("the structure changes at frame {k} (t = {time} s)");
+    let mut changes = structural_changes(before.0, after.0).into_iter();
+    let (span, what) = match changes.next() {
+        Some(found) => found,
+        None => {
+            let why = if before.1.traced() != after.1.traced() {
+                let (was, is) = if after.1.traced() {
+                    ("marched", "traced analytically")
+                } else {
+                    ("traced analytically", "marched")
+                };
+                format!("the scene is {is} here, {was} in the frame before (docs/rendering.md)")
+            } else {
+                why_not_the_same(before.0, after.0)
+            };
+            (after.0.graph.span(after.0.root?), why)
+        }
+    };
+    let mut note = crate::Diagnostic::note("N0001", at, span).with_label(what);
+    for (span, what) in changes {
+        note = note.with_secondary(span, what);
+    }
+    Some(
+        note
+            .with_note("the kernel is specialised again at this frame; a sequence whose structure stays the same is one kernel (docs/animation.md)"),
+    )
+}

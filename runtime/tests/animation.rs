@@ -622,6 +622,16 @@ fn check_says_still_numbers_or_structure() {
         out.contains("structure varies: 4 structures, changing at frames 2, 4, 6"),
         "{out}"
     );
+    // Each change is said where it happens in the source, and how.
+    for said in [
+        "[N0001] Advice: the structure changes at frame 2 (t = 0.5 s)",
+        "has 3 parts, 2 in the frame before",
+        "[N0001] Advice: the structure changes at frame 4 (t = 1 s)",
+        "`box` here was `sphere`",
+        "structure.sdf:",
+    ] {
+        assert!(out.contains(said), "{said}: {out}");
+    }
     // A frame whose scene does not check is reported with its time.
     let (code, out) = line("broken.sdf");
     assert_eq!(code, Some(1));

@@ -262,7 +262,7 @@ pub fn animation(
     limits: &sdfc_compiler::Limits,
     format: DiagnosticFormat,
 ) -> Result<String, u8> {
-    use sdfc_compiler::animation::{runs, Structure};
+    use sdfc_compiler::animation::{change_note, runs, Structure};
     use sdfc_compiler::Animation;
     let a = scene.animation;
     if !a.animated() {
@@ -279,7 +279,11 @@ pub fn animation(
         frontend::print_io_error(&e, format);
         2u8
     })?;
+    // How many changes of structure are shown where they happen.
+    const NOTED_CHANGES: usize = 3;
     let mut structures = Vec::new();
+    let mut previous: Option<(Scene, Structure)> = None;
+    let mut changes = 0usize;
     let (mut exactness, mut lmin, mut lmax, mut traced) = (Vec::new(), f64::MAX, 0f64, 0u64);
     for k in 0..n {
         let time = Animation::time_of(a.fps, k);
@@ -314,7 +318,26 @@ pub fn animation(
         }
         let structure = Structure::of(&scene, &program);
         traced += u64::from(structure.traced());
-        structures.push(structure);
+        // Where the structure changes from the frame before, said at its place in the source
+        // (the first few such frames; the summary line counts them all).
+        if let Some((before, was)) = &previous {
+            if structures.last() != Some(&structure) {
+                changes += 1;
+                if changes <= NOTED_CHANGES {
+                    if let Some(note) = change_note(k, time, (before, was), (&scene, &structure)) {
+                        frontend::print_diagnostics(&[note], &loaded.sources, format);
+                    }
+                }
+            }
+        }
+        structures.push(structure.clone());
+        previous = Some((scene, structure));
+    }
+    if changes > NOTED_CHANGES {
+        eprintln!(
+            "note: the structure changes at {} more frames, not shown",
+            changes - NOTED_CHANGES
+        );
     }
     let starts = runs(structures.iter().enumerate().map(|(k, s)| (k as u64, s)));
     let distinct = {

@@ -939,19 +939,22 @@ fn evaluate(program: &sdfc_compiler::Program, points: &[[f64; 3]]) -> (Vec<f64>,
 
 /// The lowering of an animation's frames keeps the structure whatever the numbers: a
 /// translation through 0 or across it, a rotation through the identity and a quarter turn,
-/// a scale through 1 have the structure of every other frame; and the program computes the
+/// a scale through 1, a blend radius through 0 have the structure of every other frame; and the program computes the
 /// same distances and materials as the usual lowering, on these and on every example.
 #[test]
 fn parametric_lowering_keeps_the_structure_and_the_values() {
     use sdfc_compiler::animation::Structure;
     use sdfc_compiler::{lower_scene, lower_with, LowerOptions};
-    // At t = 1 the rotation is the identity, the scale 1 and the rounding 0; at t = 2 the
+    // At t = 1 the rotation is the identity, the scale 1, the rounding and the blend radii 0
+    // (the plain union and subtraction); at t = 2 the
     // translation is 0 and the rotation a quarter turn; the translation is negative before.
     let text = format!(
         "{BASE}scene {{ sphere(0.5).translate(t - 2, 0.5, 0) @ m; \
          box(0.3).rotate_y(degrees(90 * (t - 1))).translate(0, 0.3, 1); \
          torus(1, 0.2).rotate_x(degrees(90 * (t - 1))).scale(t).translate(2, 1, 0); \
-         capsule(0.2, 1).round(t - 1).translate(-2, 0.6, 0); }}"
+         capsule(0.2, 1).round(t - 1).translate(-2, 0.6, 0); \
+         smooth_intersect(0.3 * abs(t - 1), sphere(0.4), box(0.3).translate(0.2, 0, 0)).translate(0, 0.4, -2); \
+         smooth_subtract(0.2 * abs(t - 1), box(0.4), sphere(0.3).translate(0.3, 0.3, 0), \"chamfer\").translate(1.5, 0.4, -2); }}"
     );
     let times = [1.0, 1.5, 2.0, 3.0];
     let structures = |options: &LowerOptions| -> Vec<Structure> {
@@ -986,13 +989,13 @@ fn parametric_lowering_keeps_the_structure_and_the_values() {
     }
     let mut rng = sdfc_compiler::Rng::new(0x2545f4914f6cdd1d);
     let points: Vec<[f64; 3]> = (0..400).map(|_| rng.point(4.0)).collect();
-    for s in &scenes {
+    for (i, s) in scenes.iter().enumerate() {
         let a = evaluate(&sdfc_compiler::lower(s), &points);
         let b = evaluate(&lower_with(s, &LowerOptions::parametric()), &points);
         for ((p, x), y) in points.iter().zip(&a.0).zip(&b.0) {
             assert!(
                 (x - y).abs() <= 1e-9 * (1.0 + x.abs()),
-                "{p:?}: {x} against {y}"
+                "scene {i}: {p:?}: {x} against {y}"
             );
         }
         assert_eq!(a.1, b.1);

@@ -1071,35 +1071,35 @@ static FUNCTIONS: &[Builtin] = &[
     Builtin {
         name: "smooth_union",
         sigs: sigs![
-            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
+            [p("k", F, Req, NonNeg), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Union);
-            [p("k", F, Req, Pos), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+            [p("k", F, Req, NonNeg), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
                 => |b, a| flat(smooth(b, a, Combine::Union));
-            [p("k", F, Req, Pos), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+            [p("k", F, Req, NonNeg), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
                 => |b, a| flat(smooth_list(b, a, Combine::Union, "smooth_union"));
-            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
+            [p("k", F, Req, NonNeg), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth_list(b, a, Combine::Union, "smooth_union");
         ],
     },
     Builtin {
         name: "smooth_intersect",
         sigs: sigs![
-            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
+            [p("k", F, Req, NonNeg), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Intersect);
-            [p("k", F, Req, Pos), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+            [p("k", F, Req, NonNeg), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
                 => |b, a| flat(smooth(b, a, Combine::Intersect));
-            [p("k", F, Req, Pos), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+            [p("k", F, Req, NonNeg), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
                 => |b, a| flat(smooth_list(b, a, Combine::Intersect, "smooth_intersect"));
-            [p("k", F, Req, Pos), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
+            [p("k", F, Req, NonNeg), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth_list(b, a, Combine::Intersect, "smooth_intersect");
         ],
     },
     Builtin {
         name: "smooth_subtract",
         sigs: sigs![
-            [p("k", F, Req, Pos), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
+            [p("k", F, Req, NonNeg), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
                 => |b, a| smooth(b, a, Combine::Subtract);
-            [p("k", F, Req, Pos), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
+            [p("k", F, Req, NonNeg), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
                 => |b, a| flat(smooth(b, a, Combine::Subtract));
         ],
     },

@@ -995,19 +995,37 @@ impl<'a> Lowerer<'a> {
         let fb = self.node(ch[1], p);
         self.resume(id, self.graph.node(id));
         let b = &mut *self.b;
-        let blend = if k > 0.0 {
-            blends::combine(b, op, fa.d, fb.d, k, v)
+        // k = 0 is the plain combination. A sequence's frames keep the blend's formula at
+        // every k (a radius passing through 0 keeps one structure), at a radius of at least
+        // LEAST_BLEND, and choose the plain combination by a constant where k is 0.
+        let kb = if b.parametric { k.max(LEAST_BLEND) } else { k };
+        let blend = if kb > 0.0 {
+            blends::combine(b, op, fa.d, fb.d, kb, v)
         } else {
             None
         };
         let d = match (blend, op) {
             (Some(d), _) => d,
-            (None, Combine::Union) => smin(b, fa.d, fb.d, k, v),
-            (None, Combine::Intersect) => smax(b, fa.d, fb.d, k, v),
+            (None, Combine::Union) => smin(b, fa.d, fb.d, kb, v),
+            (None, Combine::Intersect) => smax(b, fa.d, fb.d, kb, v),
             (None, Combine::Subtract) => {
                 let nb = b.neg(fb.d);
-                smax(b, fa.d, nb, k, v)
+                smax(b, fa.d, nb, kb, v)
             }
+        };
+        let d = if b.parametric {
+            let plain = match op {
+                Combine::Union => b.min(fa.d, fb.d),
+                Combine::Intersect => b.max(fa.d, fb.d),
+                Combine::Subtract => {
+                    let nb = b.neg(fb.d);
+                    b.max(fa.d, nb)
+                }
+            };
+            let at_zero = b.c(if k > 0.0 { 0.0 } else { 1.0 });
+            b.select(at_zero, plain, d)
+        } else {
+            d
         };
         Field {
             d,
@@ -1078,6 +1096,9 @@ fn steepening(graph: &Graph) -> Vec<bool> {
                 | Node::ScaleXyz { .. }
                 | Node::Screw { .. }
                 | Node::Loft { .. }
+        ) || matches!(node,
+            // L is 1 at k = 0, the plain combination, and the variant's steepness above.
+            Node::SmoothCombine { variant, .. } if analysis::blend_steepness(*variant) > 1.0
         );
         let below = node.children().iter().any(|c| out[c.0 as usize]);
         out.push(own || below);
@@ -1234,6 +1255,11 @@ fn shrink(b: &mut Builder, s: Reg, scale: f64) -> Reg {
         b.min(s, t)
     }
 }
+
+/// The least blend radius of a parametric program's smooth combinations: at k = 0 the blend
+/// is computed at this radius (and not chosen), so that its formula stays that of every other
+/// k and its values finite: its reciprocal is far inside f32's range.
+const LEAST_BLEND: f64 = 1e-12;
 
 /// The smooth minimum. Poly: h = max(k - |a - b|, 0) / k, min(a, b) - h²·k/4 (Quilez's
 /// quadratic). Exp: -k·ln(e^(-a/k) + e^(-b/k)), computed as m - k·ln(e^((m-a)/k) + e^((m-b)/k))

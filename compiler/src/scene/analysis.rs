@@ -904,6 +904,10 @@ impl Pass<'_> {
         a: NodeId,
         b: NodeId,
     ) -> Derived {
+        // A radius of 0 is the plain combination (an animated radius passing through 0).
+        if k <= 0.0 {
+            return self.combine(op, &[a, b]);
+        }
         let (da, db) = (self.get(a), self.get(b));
         let mut d = merge(&[da, db]);
         d.facts.exactness = Exactness::Approximate;

@@ -236,11 +236,13 @@ class Scene:
         voxel: Optional[float] = None,
         sharp: bool = True,
         t: float = 0.0,
+        up: Optional[str] = None,
     ) -> Tuple[int, int]:
         """Meshes as `mesh` does and writes the mesh to `path` as `sdfc mesh -o PATH` does,
-        in the format its extension names (.stl, .obj, .ply, .glb; another raises
-        ValueError): (triangles, vertices)."""
-        return self._call(self._scene.save, os.fspath(path), resolution, voxel, _bounds(bounds), sharp, float(t))
+        in the format its extension names (.stl, .obj, .ply, .glb, .3mf; another raises
+        ValueError): (triangles, vertices). `up` is the file's up axis, "y" (the scene's) or
+        "z" (a slicer's); by default z for .3mf, y for the others."""
+        return self._call(self._scene.save, os.fspath(path), resolution, voxel, _bounds(bounds), sharp, float(t), up)
 
     def compile(self, emit: str = "wgsl", part: str = "kernel", name: Optional[str] = None, sm: int = 70, t: float = 0.0) -> Union[str, bytes]:
         """What `sdfc compile --emit EMIT --part PART` writes: text, or bytes for the binary

@@ -47,5 +47,6 @@ class _Scene:
         bounds: Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = ...,
         sharp: bool = ...,
         t: float = ...,
+        up: Optional[str] = ...,
     ) -> Tuple[int, int]: ...
     def compile(self, emit: str, part: str = ..., name: Optional[str] = ..., sm: int = ..., t: float = ...) -> bytes: ...

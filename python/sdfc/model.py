@@ -442,11 +442,13 @@ class Shape(_Expr):
         voxel: Optional[float] = None,
         sharp: bool = True,
         limits: Optional[Dict[str, int]] = None,
+        up: Optional[str] = None,
     ) -> Tuple[int, int]:
         """Meshes the shape and writes it to `path` as `sdfc mesh -o PATH` does, in the
-        format of its extension (.stl, .obj, .ply, .glb): (triangles, vertices); the other
-        parameters as `mesh`'s."""
-        return self._bare(limits).save(os.fspath(path), resolution=resolution, bounds=bounds, voxel=voxel, sharp=sharp)
+        format of its extension (.stl, .obj, .ply, .glb, .3mf): (triangles, vertices); `up`
+        the file's up axis, "y" (the scene's) or "z" (a slicer's; the default for .3mf); the
+        other parameters as `mesh`'s."""
+        return self._bare(limits).save(os.fspath(path), resolution=resolution, bounds=bounds, voxel=voxel, sharp=sharp, up=up)
 
     def distance(self, points: Any, backend: str = "cpu") -> np.ndarray:
         """The signed distance at each of `points` ((n, 3), or one point): float64 on the

@@ -734,9 +734,10 @@ impl Scene {
         ))
     }
 
-    /// Meshes as `mesh` does and writes the mesh to `path` as `sdfc mesh -o PATH` does, in
-    /// the format its extension names (.stl, .obj, .ply, .glb): (triangles, vertices).
-    #[pyo3(signature = (path, resolution=None, voxel=None, bounds=None, sharp=true, t=0.0))]
+    /// Meshes as `mesh` does and writes the mesh to `path` as `sdfc mesh -o PATH --up UP`
+    /// does, in the format its extension names (.stl, .obj, .ply, .glb, .3mf): (triangles,
+    /// vertices).
+    #[pyo3(signature = (path, resolution=None, voxel=None, bounds=None, sharp=true, t=0.0, up=None))]
     #[allow(clippy::too_many_arguments)]
     fn save(
         self_: Py<Self>,
@@ -747,10 +748,12 @@ impl Scene {
         bounds: Option<([f64; 3], [f64; 3])>,
         sharp: bool,
         t: f64,
+        up: Option<&str>,
     ) -> PyResult<(usize, usize)> {
         let ask = mesh::Ask::new(resolution, voxel, bounds, sharp, t)?;
+        let up = up.map(mesh::up).transpose()?;
         let scene = self_.clone_ref(py);
-        interruptible(py, move || mesh::save(scene.get(), ask, &path))
+        interruptible(py, move || mesh::save(scene.get(), ask, &path, up))
     }
 
     /// `sdfc compile --emit EMIT --part PART`: the bytes of the target.

@@ -7,7 +7,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::PyResult;
 use sdfc_runtime::commands::mesh as mesher;
 use sdfc_runtime::frontend::Checked;
-use sdfc_runtime::mesh::write::{Format, Palette};
+use sdfc_runtime::mesh::write::{Format, Palette, Up};
 use sdfc_runtime::mesh::Mesh;
 use std::path::Path;
 
@@ -117,10 +117,27 @@ pub fn arrays(scene: &Scene, ask: Ask) -> Result<Arrays, Failure> {
     Ok((p, tri, c))
 }
 
-/// Meshes and writes the file at `path` (replacing it whole, as `sdfc mesh -o` does):
-/// (triangles, vertices). A name whose format is unknown, a place that cannot be written and
-/// a mesh with no triangles are refused, the last two before and without writing.
-pub fn save(scene: &Scene, ask: Ask, path: &Path) -> Result<(usize, usize), Failure> {
+/// The axis `up=` names ("y" or "z"), as `sdfc mesh --up`.
+pub fn up(name: &str) -> PyResult<Up> {
+    match name {
+        "y" => Ok(Up::Y),
+        "z" => Ok(Up::Z),
+        other => Err(PyValueError::new_err(format!(
+            "up must be \"y\" (the scene's up) or \"z\" (a slicer's), not {other:?}"
+        ))),
+    }
+}
+
+/// Meshes and writes the file at `path` (replacing it whole, as `sdfc mesh -o` does) with
+/// `up` up (`None`: the format's default, z for 3MF): (triangles, vertices). A name whose
+/// format is unknown, a place that cannot be written and a mesh with no triangles are
+/// refused, the last two before and without writing.
+pub fn save(
+    scene: &Scene,
+    ask: Ask,
+    path: &Path,
+    up: Option<Up>,
+) -> Result<(usize, usize), Failure> {
     let format = Format::of(path).ok_or_else(|| {
         Failure::Value(format!(
             "cannot tell the mesh format of `{}`; name it .stl, .obj, .ply, .glb or .3mf",
@@ -139,7 +156,7 @@ pub fn save(scene: &Scene, ask: Ask, path: &Path) -> Result<(usize, usize), Fail
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = Palette::new(&checked.scene, &colours);
     let bytes = format
-        .encode(&mesh, &palette)
+        .encode(&mesh, &palette, up.unwrap_or(format.default_up()))
         .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;
     sdfc_runtime::image::write_atomic(path, &bytes)
         .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;

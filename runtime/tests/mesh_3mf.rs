@@ -1,7 +1,7 @@
 //! `sdfc mesh -o FILE.3mf` (issue 51 item 6), read back with independent readers (`zip`,
 //! `quick-xml`): the package's three parts, millimetres, one object per material with its
 //! colour, each object a closed oriented 2-manifold, a one-material part the same mesh as
-//! its STL, and a colour field's colours per vertex. `python/tests/test_mesh_files.py`
+//! its STL, a colour field's colours per vertex, and z up (`--up`). `python/tests/test_mesh_files.py`
 //! reads the same files with lib3mf and checks them with manifold3d.
 
 mod common;
@@ -237,7 +237,8 @@ fn a_colour_field_is_a_colour_per_vertex() {
         }
     }
     for (q, c) in sphere.mesh.positions.iter().zip(group) {
-        let y = q[1];
+        // The package has z up: the scene's y is the file's z.
+        let y = q[2];
         let want = [0.5 + 0.5 * y, 0.25, (0.5 - 0.5 * y).max(0.0)];
         let got = u32::from_str_radix(&c[1..], 16).expect("hex");
         let want = u32::from_str_radix(&hex(want)[1..], 16).unwrap();
@@ -279,4 +280,86 @@ fn a_part_outside_the_region_is_left_out() {
     for o in &p.objects {
         manifold(&o.mesh, &o.attributes["name"]);
     }
+}
+
+/// The signed volume of a closed mesh (positive when its triangles wind counter-clockwise
+/// seen from outside).
+fn volume(m: &Read) -> f64 {
+    m.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i].map(f64::from));
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum()
+}
+
+/// The smallest and largest coordinate along each axis.
+fn extent(m: &Read) -> [[f32; 2]; 3] {
+    [0, 1, 2].map(|i| {
+        let (lo, hi) = m
+            .positions
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+                (lo.min(p[i]), hi.max(p[i]))
+            });
+        [lo, hi]
+    })
+}
+
+/// A 3MF stands on the build plate: the scene's up (+y) is the file's +z unless `--up y`
+/// keeps the scene's axes; `--up z` turns an STL the same way. A quarter turn about x, so
+/// the triangles keep their winding (the volume stays positive) and the mesh its shape.
+#[test]
+fn a_3mf_has_z_up_and_up_turns_any_format() {
+    let d = dir("3mf-up");
+    // 1 wide (x), 3 tall (y, from 0 to 3), half deep (z, towards -z from 0).
+    let scene = write_scene(
+        &d,
+        "post.sdf",
+        "scene { box((0.5, 1.5, 0.25)).translate(0, 1.5, -0.25); }\n",
+    );
+    let near = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 0.05 && (a[1] - b[1]).abs() < 0.05;
+    let file = |name: &str, up: Option<&str>| {
+        let out = d.join(name);
+        let mut args = vec![s(&scene), "-o", s(&out), "--resolution", "32"];
+        if let Some(up) = up {
+            args.extend(["--up", up]);
+        }
+        mesh(&args);
+        out
+    };
+    let tall = read_3mf(&file("tall.3mf", None)).objects.remove(0).mesh;
+    let e = extent(&tall);
+    assert!(near(e[2], [0.0, 3.0]), "z: {e:?}");
+    assert!(near(e[1], [0.0, 0.5]), "y (the scene's -z): {e:?}");
+    assert!(near(e[0], [-0.5, 0.5]), "x: {e:?}");
+    assert!(volume(&tall) > 1.4, "{}", volume(&tall));
+    let y = read_3mf(&file("y.3mf", Some("y"))).objects.remove(0).mesh;
+    assert!(near(extent(&y)[1], [0.0, 3.0]), "{:?}", extent(&y));
+    // STL keeps the scene's axes unless asked; with --up z it is the 3MF's placement.
+    let stl = read_stl(&file("plain.stl", None));
+    assert!(near(extent(&stl)[1], [0.0, 3.0]), "{:?}", extent(&stl));
+    let turned = read_stl(&file("z.stl", Some("z")));
+    assert_eq!(turned.triangles.len(), stl.triangles.len());
+    for (t, u) in stl.triangles.iter().zip(&turned.triangles) {
+        for (&i, &j) in t.iter().zip(u) {
+            let [x, y, z] = stl.positions[i];
+            assert_eq!(turned.positions[j], [x, -z, y]);
+        }
+    }
+    for m in [&y, &stl, &turned] {
+        assert!(
+            (volume(m) - volume(&tall)).abs() < 1e-3,
+            "{} {}",
+            volume(m),
+            volume(&tall)
+        );
+    }
+    // A wrong axis is refused by name.
+    let o = sdfc(&["mesh", s(&scene), "-o", s(&d.join("x.stl")), "--up", "x"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("possible values: y, z"));
 }

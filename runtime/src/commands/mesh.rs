@@ -7,7 +7,7 @@ pub use super::mesh_region::{parse_bounds, Region, Spelling, DEFAULT_RESOLUTION}
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
-use crate::mesh::write::Format;
+use crate::mesh::write::{Format, Up};
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{analysis, Limit, Limits, LowerOptions};
@@ -44,6 +44,11 @@ pub struct MeshArgs {
     /// `refine=N` (root-finding rounds per edge vertex, 0 to 50). May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// The file's up axis: y, the scene's up, or z, the build plate's normal that slicers
+    /// read (the scene turned a quarter turn about x, its +y the file's +z) [default: z for
+    /// .3mf, y for the others].
+    #[arg(long, value_enum)]
+    pub up: Option<Up>,
     /// Print what meshing did (cells evaluated, surface cells, features, flips).
     #[arg(long)]
     pub stats: bool,
@@ -168,7 +173,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = crate::mesh::write::Palette::new(&checked.scene, &colours);
     let bytes = format
-        .encode(&mesh, &palette)
+        .encode(&mesh, &palette, args.up.unwrap_or(format.default_up()))
         .map_err(|e| (1, format!("cannot write `{}`: {e}", args.output.display())))?;
     crate::image::write_atomic(&args.output, &bytes)
         .map_err(|e| (2, format!("cannot write `{}`: {e}", args.output.display())))?;
@@ -261,7 +266,13 @@ fn objects(
             continue;
         }
         model
-            .object(&name, part.material, &meshed.mesh, &palette)
+            .object(
+                &name,
+                part.material,
+                &meshed.mesh,
+                &palette,
+                args.up.unwrap_or(Format::ThreeMf.default_up()),
+            )
             .map_err(failed)?;
         objects += 1;
         triangles += meshed.mesh.triangles.len();

@@ -8,7 +8,7 @@
 //! The model's text is written object by object into its compressed entry ([`Model`]), so
 //! that a caller can drop each mesh once it is written.
 
-use super::write::{base_colour, Palette};
+use super::write::{base_colour, Palette, Up};
 use super::zip::{self, Deflated, Entry};
 use super::Mesh;
 use crate::image::srgb_encode;
@@ -116,15 +116,19 @@ impl Model {
         })
     }
 
-    /// Writes `mesh` as an object named `name` of material `material` (its triangles of
-    /// other materials keep theirs, from `mesh.materials`).
+    /// Writes `mesh` (in the scene's coordinates) as an object named `name` of material
+    /// `material` (its triangles of other materials keep theirs, from `mesh.materials`), with
+    /// `up` up.
     pub fn object(
         &mut self,
         name: &str,
         material: u32,
         mesh: &Mesh,
         palette: &Palette,
+        up: Up,
     ) -> io::Result<()> {
+        let (mesh, palette) = up.orient(mesh, palette);
+        let (mesh, palette) = (&*mesh, &palette);
         let varies = |m: u32| palette.varies(m);
         // A colour per vertex, where a triangle's material is a colour field.
         let group = mesh.materials.iter().any(|&m| varies(m)).then(|| {
@@ -188,9 +192,15 @@ impl Model {
     }
 }
 
-/// `mesh` as a 3MF package of one object, named `name`, of material `material`.
-pub fn one(name: &str, material: u32, mesh: &Mesh, palette: &Palette) -> io::Result<Vec<u8>> {
+/// `mesh` as a 3MF package of one object, named `name`, of material `material`, with `up` up.
+pub fn one(
+    name: &str,
+    material: u32,
+    mesh: &Mesh,
+    palette: &Palette,
+    up: Up,
+) -> io::Result<Vec<u8>> {
     let mut model = Model::new(palette)?;
-    model.object(name, material, mesh, palette)?;
+    model.object(name, material, mesh, palette, up)?;
     model.finish()
 }

@@ -44,31 +44,102 @@ impl Format {
         }
     }
 
-    /// The bytes of `mesh` in this format, coloured by `palette` (3MF: one object, of
-    /// the material of its first triangle). `Err` only for a 3MF package too large for a ZIP
-    /// without its 64-bit extension.
-    pub fn encode(self, mesh: &Mesh, palette: &Palette) -> io::Result<Vec<u8>> {
+    /// The axis a file of this format has up unless asked otherwise: z for 3MF, whose build
+    /// plate is the xy plane; the scene's y for the others (glTF's up is y; STL, OBJ and PLY
+    /// say nothing, and slicers reading STL take z: `sdfc mesh --up z`).
+    pub fn default_up(self) -> Up {
+        match self {
+            Format::ThreeMf => Up::Z,
+            _ => Up::Y,
+        }
+    }
+
+    /// The bytes of `mesh` (in the scene's coordinates) in this format with `up` up,
+    /// coloured by `palette` (3MF: one object, of the material of its first triangle). `Err`
+    /// only for a 3MF package too large for a ZIP without its 64-bit extension.
+    pub fn encode(self, mesh: &Mesh, palette: &Palette, up: Up) -> io::Result<Vec<u8>> {
         let mut out = Vec::new();
         match self {
-            Format::Stl => stl(mesh, &mut out)?,
-            Format::Obj => obj(mesh, palette, &mut out)?,
-            Format::Ply => ply(mesh, palette, &mut out)?,
-            Format::Glb => glb(mesh, palette, &mut out)?,
+            Format::Stl => stl(&up.orient(mesh, palette).0, &mut out)?,
+            Format::Obj => {
+                let (mesh, palette) = up.orient(mesh, palette);
+                obj(&mesh, &palette, &mut out)?;
+            }
+            Format::Ply => {
+                let (mesh, palette) = up.orient(mesh, palette);
+                ply(&mesh, &palette, &mut out)?;
+            }
+            Format::Glb => {
+                let (mesh, palette) = up.orient(mesh, palette);
+                glb(&mesh, &palette, &mut out)?;
+            }
             Format::ThreeMf => {
                 let m = mesh.materials.first().copied().unwrap_or(0);
                 let name = palette
                     .materials
                     .get(m as usize)
                     .map_or("sdfc mesh", |m| &m.name);
-                out = super::threemf::one(name, m, mesh, palette)?;
+                out = super::threemf::one(name, m, mesh, palette, up)?;
             }
         }
         Ok(out)
     }
 }
 
-/// What colours a mesh: the scene's materials (by id), their colour fields lowered, and
-/// where the scene's coordinates start in the programs' ([`Scene::origin`]).
+/// Which of a mesh file's axes is up: the scene's y (its up, and glTF's), or z, the normal of
+/// a printer's build plate, which slicers read (3MF's convention; `sdfc mesh --up`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Up {
+    /// The scene's coordinates as written.
+    #[default]
+    Y,
+    /// The scene turned a quarter turn about x, so that its +y is the file's +z: (x, y, z) is
+    /// written (x, −z, y). A rotation, so triangles keep their winding and their outside.
+    Z,
+}
+
+impl Up {
+    /// A point of the scene in the file's axes.
+    pub fn place(self, [x, y, z]: [f64; 3]) -> [f64; 3] {
+        match self {
+            Up::Y => [x, y, z],
+            Up::Z => [x, -z, y],
+        }
+    }
+
+    /// A point of the file in the scene's axes ([`Up::place`] undone).
+    pub fn unplace(self, [x, y, z]: [f64; 3]) -> [f64; 3] {
+        match self {
+            Up::Y => [x, y, z],
+            Up::Z => [x, z, -y],
+        }
+    }
+
+    /// `mesh` and `palette` as a file with this axis up: the positions placed, and the palette
+    /// reading each written position's colour at its point of the scene.
+    pub fn orient<'m, 'a>(
+        self,
+        mesh: &'m Mesh,
+        palette: &Palette<'a>,
+    ) -> (std::borrow::Cow<'m, Mesh>, Palette<'a>) {
+        let palette = Palette {
+            up: self,
+            ..*palette
+        };
+        if self == Up::Y {
+            return (std::borrow::Cow::Borrowed(mesh), palette);
+        }
+        let mut turned = mesh.clone();
+        for p in &mut turned.positions {
+            *p = self.place(*p);
+        }
+        (std::borrow::Cow::Owned(turned), palette)
+    }
+}
+
+/// What colours a mesh: the scene's materials (by id), their colour fields lowered, where the
+/// scene's coordinates start in the programs' ([`Scene::origin`]), and the axes of the
+/// positions it is asked about ([`Up::orient`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Palette<'a> {
     /// The scene's materials.
@@ -77,6 +148,8 @@ pub struct Palette<'a> {
     pub colours: &'a Colours,
     /// [`Scene::origin`].
     pub origin: V3,
+    /// The axes of the positions [`Palette::colour`] is given: the scene's, or a file's.
+    pub up: Up,
 }
 
 impl<'a> Palette<'a> {
@@ -86,6 +159,7 @@ impl<'a> Palette<'a> {
             materials: &scene.materials,
             colours,
             origin: scene.origin,
+            up: Up::Y,
         }
     }
 
@@ -99,13 +173,14 @@ impl<'a> Palette<'a> {
         })
     }
 
-    /// The linear colour of material `id` at `p`, in the scene's coordinates (a checker by
+    /// The linear colour of material `id` at `p`, in the axes of [`Palette::up`] (a checker by
     /// the parity of its cells, a colour field by its value, as the renderer paints them);
     /// unknown ids get the default grey.
     pub fn colour(&self, id: u32, p: [f64; 3]) -> [f64; 3] {
         let Some(m) = self.materials.get(id as usize) else {
             return [0.8; 3];
         };
+        let p = self.up.unplace(p);
         let slot = match &m.pattern {
             Pattern::Solid(_) => 0,
             Pattern::Checker { size, .. } => {

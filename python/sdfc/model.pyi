@@ -80,6 +80,7 @@ class Shape(_Expr):
         voxel: Optional[float] = ...,
         sharp: bool = ...,
         limits: Optional[Dict[str, int]] = ...,
+        up: Optional[str] = ...,
     ) -> Tuple[int, int]: ...
     def distance(self, points: Any, backend: str = ...) -> np.ndarray: ...
     def facts(self) -> Facts: ...
@@ -463,9 +464,9 @@ def smooth_union(k: float, shapes: Sequence[Shape], variant: str = ..., steps: i
     """```sdf
     smooth_union(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; `variant` "poly", "exp", "chamfer", "round", "stairs" or "columns"; `steps` 1 … 64
+    Valid: `k` ≥ 0; `variant` "poly", "exp", "chamfer", "round", "stairs" or "columns"; `steps` 1 … 64
 
-    Union blended over a radius `k`; `variant` "poly" (quadratic, default) or "exp" (exponential) smooth minima, or the edges of Mercury's hg_sdf library: "chamfer" (a 45° bevel `k` wide), "round" (a quarter circle of radius `k`), "stairs" (`steps` steps within `k`), "columns" (`steps` round columns within `k`). `steps` is read by "stairs" and "columns" only.
+    Union blended over a radius `k` (0: the plain union, which an animated radius may pass through); `variant` "poly" (quadratic, default) or "exp" (exponential) smooth minima, or the edges of Mercury's hg_sdf library: "chamfer" (a 45° bevel `k` wide), "round" (a quarter circle of radius `k`), "stairs" (`steps` steps within `k`), "columns" (`steps` round columns within `k`). `steps` is read by "stairs" and "columns" only.
 
     ```sdf
     smooth_union(k: float, a: profile, b: profile, variant: string = "poly", steps: int = 4) -> profile
@@ -482,7 +483,7 @@ def smooth_union(k: float, shapes: Sequence[Shape], variant: str = ..., steps: i
     ```sdf
     smooth_union(k: float, shapes: [shape], variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; not empty
+    Valid: `k` ≥ 0; not empty
 
     The left fold of the binary form over the list; independent of the list's order only with `variant: "exp"` (§6a).
     """
@@ -498,7 +499,7 @@ def smooth_intersect(k: float, shapes: Sequence[Shape], variant: str = ..., step
     """```sdf
     smooth_intersect(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; `variant` and `steps` as for `smooth_union`
+    Valid: `k` ≥ 0; `variant` and `steps` as for `smooth_union`
 
     Intersection blended over `k`; `variant` as for `smooth_union`.
 
@@ -515,7 +516,7 @@ def smooth_intersect(k: float, shapes: Sequence[Shape], variant: str = ..., step
     ```sdf
     smooth_intersect(k: float, shapes: [shape], variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; not empty
+    Valid: `k` ≥ 0; not empty
 
     The left fold of the binary form over the list, as for `smooth_union`.
     """
@@ -527,7 +528,7 @@ def smooth_subtract(k: float, a: Profile, b: Profile, variant: str = ..., steps:
     """```sdf
     smooth_subtract(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; `variant` and `steps` as for `smooth_union`
+    Valid: `k` ≥ 0; `variant` and `steps` as for `smooth_union`
 
     Subtraction blended over `k`; `variant` as for `smooth_union`.
 

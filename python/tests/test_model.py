@@ -307,6 +307,27 @@ class Outputs(unittest.TestCase):
             shape.save(folder / "part.step")
         self.assertIn(".stl, .obj, .ply, .glb or .3mf", str(e.exception))
 
+    def test_save_turns_the_mesh_up(self):
+        # A post 3 tall along the scene's y: with up="z" (a slicer's) the file's z is its height.
+        shape = sdfc.box((0.5, 1.5, 0.25)).translate((0, 1.5, 0))
+        folder = Path(tempfile.mkdtemp())
+
+        def corners(name, **kw):
+            shape.save(folder / name, resolution=16, **kw)
+            data = (folder / name).read_bytes()[84:]
+            tri = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
+            v = tri["v"].reshape(-1, 3)
+            return v.min(axis=0), v.max(axis=0)
+
+        lo, hi = corners("y.stl")
+        self.assertAlmostEqual(float(hi[1] - lo[1]), 3.0, delta=0.1)
+        lo, hi = corners("z.stl", up="z")
+        self.assertAlmostEqual(float(hi[2] - lo[2]), 3.0, delta=0.1)
+        self.assertAlmostEqual(float(hi[1] - lo[1]), 0.5, delta=0.1)
+        with self.assertRaises(ValueError) as e:
+            shape.save(folder / "x.stl", up="x")
+        self.assertIn('up must be "y"', str(e.exception))
+
     def test_pictures(self):
         shape = sdfc.torus(1, 0.3) @ sdfc.Phong(color=(0.9, 0.5, 0.1))
         png = shape._repr_png_()

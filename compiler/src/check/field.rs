@@ -237,10 +237,7 @@ pub fn builtin(name: &str, a: &[Value]) -> Option<Result<Value, String>> {
         "atan2" => point(vec![bin(FBin::Atan2, s(0), s(1))]),
         "mix" => {
             let t = s(2);
-            point(zip(c(0), c(1), |x, y| {
-                let d = bin(FBin::Sub, y, x.clone());
-                bin(FBin::Add, x, bin(FBin::Mul, d, t.clone()))
-            }))
+            point(zip(c(0), c(1), |x, y| Rc::new(Sx::Mix(x, y, t.clone()))))
         }
         "smoothstep" => {
             let (e0, e1) = (s(0), s(1));
@@ -340,6 +337,7 @@ pub fn reads_distance(out: &[Rc<Sx>]) -> bool {
             Sx::Un(_, a) => stack.push(a),
             Sx::Bin(_, a, b) => stack.extend([a, b]),
             Sx::Length(v) | Sx::Noise(v) | Sx::Voronoi(v) | Sx::Hash(v) => stack.extend(v),
+            Sx::Mix(a, b, t) => stack.extend([a, b, t]),
         }
     }
     false
@@ -397,6 +395,10 @@ impl Flat {
                 Sx::Noise(v) => FOp::Noise(self.list(v)?),
                 Sx::Voronoi(v) => FOp::Voronoi(self.list(v)?),
                 Sx::Hash(v) => FOp::Hash(self.list(v)?),
+                Sx::Mix(a, b, t) => {
+                    let (a, b) = (self.slot(a)?, self.slot(b)?);
+                    FOp::Mix(a, b, self.slot(t)?)
+                }
                 Sx::Distance(id, q) => {
                     let l = self.list(q)?;
                     FOp::Distance(*id, [l[0], l[1], l[2]])

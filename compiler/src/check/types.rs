@@ -367,6 +367,9 @@ pub enum Sx {
     Noise(Vec<Rc<Sx>>),
     Voronoi(Vec<Rc<Sx>>),
     Hash(Vec<Rc<Sx>>),
+    /// mix(a, b, t) = a + (b − a)·t, kept whole so that its range is known to lie between
+    /// a's and b's where t is within [0, 1].
+    Mix(Rc<Sx>, Rc<Sx>, Rc<Sx>),
 }
 
 impl fmt::Debug for Sx {

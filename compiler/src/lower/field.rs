@@ -153,6 +153,12 @@ pub(super) fn op(b: &mut Builder, op: &FOp, p: P, regs: &[Reg]) -> Reg {
             let q: Vec<Reg> = v.iter().map(r).collect();
             lattice_hash(b, &q)
         }
+        FOp::Mix(x, y, t) => {
+            let (x, y, t) = (r(x), r(y), r(t));
+            let d = b.sub(y, x);
+            let m = b.mul(d, t);
+            b.add(x, m)
+        }
         FOp::Distance(..) => b.c(0.0),
     }
 }

@@ -79,6 +79,9 @@ pub enum FOp {
     /// The hash of the unit lattice cell holding a point of 1 to 3 coordinates, in (0, 1):
     /// constant within a cell, so a step at every cell's side.
     Hash(Vec<Slot>),
+    /// mix(a, b, t) = a + (b − a)·t: between a and b where t is within [0, 1], which interval
+    /// arithmetic over its three operations would not see.
+    Mix(Slot, Slot, Slot),
 }
 
 impl FOp {
@@ -90,6 +93,7 @@ impl FOp {
             FOp::Bin(_, a, b) => vec![*a, *b],
             FOp::Length(v) | FOp::Noise(v) | FOp::Voronoi(v) | FOp::Hash(v) => v.clone(),
             FOp::Distance(_, q) => q.to_vec(),
+            FOp::Mix(a, b, t) => vec![*a, *b, *t],
         }
     }
 }
@@ -171,6 +175,7 @@ impl FieldFn {
                 FOp::Voronoi(v) if v.len() == 2 => 9.0 * 40.0,
                 FOp::Voronoi(_) => 27.0 * 50.0,
                 FOp::Hash(v) => 20.0 * v.len() as f64,
+                FOp::Mix(..) => 3.0,
             })
             .sum()
     }
@@ -194,6 +199,7 @@ impl FieldFn {
                     FOp::Noise(v) => format!("noise {}", list(v)),
                     FOp::Voronoi(v) => format!("voronoi {}", list(v)),
                     FOp::Hash(v) => format!("hash {}", list(v)),
+                    FOp::Mix(a, b, t) => format!("mix {}, {}, {}", s(a), s(b), s(t)),
                 };
                 format!("s{i} = {rhs}")
             })

@@ -544,6 +544,18 @@ fn values(
                 let far = (VORONOI_LO + VORONOI_SPAN) * (v.len() as f64).sqrt();
                 lipschitz_of(&rows, 1.0, Iv::new(0.0, far))
             }
+            FOp::Mix(a, b, t) => {
+                let (a, b, t) = (get(a), get(b), get(t));
+                let d = binary(FBin::Sub, &b, &a);
+                let mut v = binary(FBin::Add, &a, &binary(FBin::Mul, &d, &t));
+                // For t within [0, 1] the value lies between a's and b's.
+                if t.range.lo >= 0.0 && t.range.hi <= 1.0 {
+                    let lo = v.range.lo.max(a.range.lo.min(b.range.lo));
+                    let hi = v.range.hi.min(a.range.hi.max(b.range.hi));
+                    v.range = Iv::new(lo, hi);
+                }
+                v
+            }
             // Constant within a lattice cell: a step wherever an input crosses a whole number,
             // so nothing is proven unless the inputs are constant.
             FOp::Hash(v) => {
@@ -575,7 +587,8 @@ mod tests {
     }
 
     /// `length(p) − 1` is in the unit cube (within the millionth it is widened by); a
-    /// constant above 0 has no solid; `sin x` (a slab of sheets) has no box along x.
+    /// constant above 0 has no solid; `sin x` (a slab of sheets) has no box along x; a `mix`
+    /// of two bounded fields by a weight within [0, 1] is bounded by both.
     #[test]
     fn solid_boxes_come_from_the_intervals() {
         let none = |_: NodeId, _: Region| f64::NEG_INFINITY;
@@ -597,5 +610,23 @@ mod tests {
         let sheets = field(vec![FOp::Coord(0), FOp::Un(FUn::Sin, 0)]);
         let (lo, hi) = solid_box(&sheets, none);
         assert_eq!((lo[0], hi[0]), (f64::NEG_INFINITY, f64::INFINITY));
+        // A blend of two spheres' fields, of radius 1 about 0 and about x = 1, by a weight in
+        // [0, 1] that varies with the point: inside both spheres' boxes together. Written as
+        // its three operations the difference of the two would be unbounded and so the box.
+        let mut ops = sphere.ops.clone();
+        ops.extend([
+            FOp::Const(1.0),
+            FOp::Bin(FBin::Sub, 0, 6),
+            FOp::Length(vec![7, 1, 2]),
+            FOp::Bin(FBin::Sub, 8, 4),
+            FOp::Un(FUn::Sin, 1),
+            FOp::Const(0.5),
+            FOp::Bin(FBin::Mul, 10, 11),
+            FOp::Bin(FBin::Add, 12, 11),
+            FOp::Mix(5, 9, 13),
+        ]);
+        let (lo, hi) = solid_box(&field(ops), none);
+        assert!(lo[0] >= -1.0 - 1e-5 && hi[0] <= 2.0 + 1e-5, "{lo:?} {hi:?}");
+        assert!(lo[1] >= -1.0 - 1e-5 && hi[1] <= 1.0 + 1e-5, "{lo:?} {hi:?}");
     }
 }

@@ -3,7 +3,7 @@
 //! (`crate::mesh`, `docs/mesh.md`); the region and cell size are `mesh_region`'s.
 
 use super::mesh_region::{frame, short, Frame};
-pub use super::mesh_region::{parse_bounds, Region, Spelling, DEFAULT_RESOLUTION};
+pub use super::mesh_region::{parse_bounds, BoundsError, Region, Spelling, DEFAULT_RESOLUTION};
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};

@@ -289,23 +289,63 @@ fn bounded_part(scene: &Scene, a: &analysis::Analysis) -> Option<[[f64; 3]; 2]> 
     found
 }
 
+/// Why `--bounds` is refused ([`parse_bounds`]); each names the text given.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BoundsError {
+    /// A part is not a number.
+    #[error("expected six numbers X0,Y0,Z0,X1,Y1,Z1, not `{0}`")]
+    NotNumbers(String),
+    /// Not six numbers, or one not finite.
+    #[error("expected six finite numbers X0,Y0,Z0,X1,Y1,Z1, not `{0}`")]
+    NotSixFinite(String),
+    /// A lower bound not below its upper one.
+    #[error("each lower bound must be below the upper one (X0 < X1, Y0 < Y1, Z0 < Z1), not `{0}`")]
+    Reversed(String),
+}
+
 /// Parses `X0,Y0,Z0,X1,Y1,Z1` into (min, max).
-pub fn parse_bounds(s: &str) -> Result<[[f64; 3]; 2], String> {
+pub fn parse_bounds(s: &str) -> Result<[[f64; 3]; 2], BoundsError> {
     let v: Vec<f64> = s
         .split(',')
         .map(|p| p.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("expected six numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"))?;
+        .map_err(|_| BoundsError::NotNumbers(s.to_string()))?;
     if v.len() != 6 || v.iter().any(|x| !x.is_finite()) {
-        return Err(format!(
-            "expected six finite numbers X0,Y0,Z0,X1,Y1,Z1, not `{s}`"
-        ));
+        return Err(BoundsError::NotSixFinite(s.to_string()));
     }
     let (lo, hi) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
     if (0..3).any(|i| !(lo[i] < hi[i])) {
-        return Err(format!(
-            "each lower bound must be below the upper one (X0 < X1, Y0 < Y1, Z0 < Z1), not `{s}`"
-        ));
+        return Err(BoundsError::Reversed(s.to_string()));
     }
     Ok([lo, hi])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--bounds` takes six finite numbers, each lower below its upper, and says which rule
+    /// a refused text breaks.
+    #[test]
+    fn bounds_are_six_numbers_in_order() {
+        assert_eq!(
+            parse_bounds("-1, 0,-2,1,0.5,2"),
+            Ok([[-1.0, 0.0, -2.0], [1.0, 0.5, 2.0]])
+        );
+        let refused = |s: &str| parse_bounds(s).unwrap_err();
+        assert_eq!(
+            refused("1,2,x,4,5,6"),
+            BoundsError::NotNumbers("1,2,x,4,5,6".into())
+        );
+        assert_eq!(refused("1,2,3"), BoundsError::NotSixFinite("1,2,3".into()));
+        assert_eq!(
+            refused("0,0,0,1,inf,1"),
+            BoundsError::NotSixFinite("0,0,0,1,inf,1".into())
+        );
+        assert_eq!(
+            refused("1,0,0,0,1,1"),
+            BoundsError::Reversed("1,0,0,0,1,1".into())
+        );
+        assert!(refused("1,0,0,1,1,1").to_string().contains("X0 < X1"));
+    }
 }

@@ -6,7 +6,7 @@ from sdfc import *
 f = rounded_cylinder(1, 0.1, 5)
 
 # knurling
-x = box((0.5, 2, 0.5)).rotate_y(45).translate(1.6, 0, 0).repeat_polar(24)
+x = box((0.5, 2, 0.5)).rotate_y(deg(45)).translate(1.6, 0, 0).repeat_polar(24)
 x = x.twist(0.75) | x.twist(-0.75)
 f = smooth_subtract(0.1, f, x)
 
@@ -16,7 +16,7 @@ f = smooth_subtract(0.1, f, infinite_cylinder(0.5))
 # vent holes
 c = infinite_cylinder(0.25, (1, 0, 0))
 f = smooth_subtract(0.1, f, c.translate(0, -2.5, 0))
-f = smooth_subtract(0.1, f, c.translate(0, 2.5, 0)).rotate_x(90)
+f = smooth_subtract(0.1, f, c.translate(0, 2.5, 0)).rotate_x(deg(90))
 
 if __name__ == "__main__":
     f.save("knurling.stl")

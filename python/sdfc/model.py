@@ -9,7 +9,7 @@ renders, evaluates and states its facts.
     import sdfc
     f = sdfc.sphere(1) & sdfc.box(0.75)
     c = sdfc.cylinder(0.5, 3)
-    f -= c | c.rotate_x(90) | c.rotate_z(90)
+    f -= c | c.rotate_x(sdfc.deg(90)) | c.rotate_z(sdfc.deg(90))
     f.save("out.stl", resolution=128)
 """
 
@@ -56,8 +56,9 @@ def _inside(filename: str) -> bool:
 
 
 class Angle:
-    """An angle: `deg(30)` or `rad(0.5)`. A plain number where an angle goes is degrees,
-    as the language writes angles (`30deg`)."""
+    """An angle: `deg(30)` or `rad(0.5)`, as the language writes `30deg` and `0.5rad`. A plain
+    number where an angle goes is refused, as in the language: it could be either (fogleman/sdf
+    reads radians, OpenSCAD degrees)."""
 
     __slots__ = ("value", "unit")
 
@@ -97,7 +98,7 @@ _TYPE_WORDS = {
     "bool": "a bool",
     "vec2": "2 numbers",
     "vec3": "3 numbers",
-    "angle": "an angle (degrees, or sdfc.deg(x) / sdfc.rad(x))",
+    "angle": "an angle, sdfc.deg(x) or sdfc.rad(x)",
     "string": "a str",
     "shape": "a shape",
     "profile": "a profile",
@@ -151,7 +152,8 @@ def _conform(value: Any, ty: str) -> Any:
             if not math.isfinite(value.value):
                 raise _Bad("must be finite")
             return value
-        return Angle(_real(value), "deg")
+        n = writing.num(_real(value))
+        raise _Bad(f"must be an angle with its unit, sdfc.deg({n}) or sdfc.rad({n}), not the plain number {n}")
     if ty == "string":
         if not isinstance(value, str):
             raise _Bad()
@@ -657,7 +659,7 @@ def _framing(shape: Shape) -> Optional[Record]:
     eye = centre + direction * radius / math.sin(math.radians(fov / 2)) * 1.05
     # Rounded to the box's scale: what a person would write.
     digits = max(0, 3 - math.floor(math.log10(radius)))
-    return RECORDS["Camera"](position=tuple(round(float(x), digits) for x in eye), look_at=tuple(round(float(x), digits) for x in centre), fov=fov)
+    return RECORDS["Camera"](position=tuple(round(float(x), digits) for x in eye), look_at=tuple(round(float(x), digits) for x in centre), fov=deg(fov))
 
 
 def show(shape: Shape, **scene: Any) -> Any:

@@ -19,7 +19,7 @@ _TYPES = {
     "bool": "bool",
     "vec2": "Vec2",
     "vec3": "Vec3",
-    "angle": "AngleLike",
+    "angle": "Angle",
     "string": "str",
     "shape": "Shape",
     "profile": "Profile",
@@ -90,7 +90,6 @@ from . import Facts, Scene
 
 Vec2 = Union[Tuple[float, float], Sequence[float], np.ndarray]
 Vec3 = Union[Tuple[float, float, float], Sequence[float], np.ndarray]
-AngleLike = Union["Angle", float]
 _E = TypeVar("_E", bound="_Expr")
 
 class Angle:

@@ -36,7 +36,7 @@ def sample(p):
         "bool": True,
         "vec2": (0.5, 0.5),
         "vec3": (0.5, 0.5, 0.5),
-        "angle": 90,
+        "angle": sdfc.deg(90),
         "string": "A",
         "shape": sdfc.sphere(0.5),
         "profile": sdfc.circle(0.5),
@@ -131,9 +131,9 @@ class Operators(unittest.TestCase):
         c = sdfc.cylinder(0.3, 4)
         f = self.a
         f -= c
-        f -= c.rotate_x(90)
-        f -= c.rotate_z(90)
-        expected = np.maximum(np.maximum(np.maximum(self.d(self.a), -self.d(c)), -self.d(c.rotate_x(90))), -self.d(c.rotate_z(90)))
+        f -= c.rotate_x(sdfc.deg(90))
+        f -= c.rotate_z(sdfc.deg(90))
+        expected = np.maximum(np.maximum(np.maximum(self.d(self.a), -self.d(c)), -self.d(c.rotate_x(sdfc.deg(90)))), -self.d(c.rotate_z(sdfc.deg(90))))
         np.testing.assert_allclose(self.d(f), expected, atol=1e-12)
         # A chain of `-` is one subtraction of a union; of `|`, one union.
         self.assertEqual(f.source().count("subtract("), 1)
@@ -193,7 +193,7 @@ class RoundTrip(unittest.TestCase):
 
     def test_shared_profiles_and_colour_fields(self):
         c = sdfc.circle(0.5).translate(1, 0)
-        p = c | c.rotate(90)
+        p = c | c.rotate(sdfc.deg(90))
         self.assertEqual(p.source(), "let profile1 = circle(0.5).translate(1, 0);\nlet result = union(profile1, profile1.rotate(90deg));\n")
         self.assertIn("<sdfc.Profile union(profile1, profile1.rotate(90deg))>", repr(p))
         solid = p.extrude(0.2)
@@ -227,13 +227,14 @@ class Errors(unittest.TestCase):
             (lambda: sdfc.extrude(sdfc.circle(1)), TypeError, "missing the argument `height`"),
             (lambda: sdfc.extrude(sdfc.sphere(1), 1), TypeError, "`profile` must be a profile, not a shape"),
             (lambda: sdfc.regular_polygon(2.5), TypeError, "`sides` must be an int"),
+            (lambda: sdfc.box(1).rotate_y(1.57), TypeError, "`angle` must be an angle with its unit, sdfc.deg(1.57) or sdfc.rad(1.57), not the plain number 1.57"),
             (lambda: sdfc.regular_polygon(2), ValueError, "`sides` must be between 3 and 10000"),
             (lambda: sdfc.smooth_union(0.1, sdfc.sphere(), sdfc.box(), variant="x"), ValueError, '`variant` must be one of "poly"'),
             (lambda: sdfc.text("a\x01"), TypeError, "control character"),
             (lambda: sdfc.Phong(colour=(1, 0, 0)), TypeError, "unknown field `colour`"),
             (lambda: sdfc.Phong(ambient=2), ValueError, "`ambient` must be between 0 and 1, not 2"),
             (lambda: sdfc.PointLight(), TypeError, "missing the field `position`"),
-            (lambda: sdfc.Camera(fov=200), ValueError, "`fov` must be between 0.1deg and 179deg"),
+            (lambda: sdfc.Camera(fov=sdfc.deg(200)), ValueError, "`fov` must be between 0.1deg and 179deg"),
             (lambda: sdfc.field("length(p) - 1", p=1), ValueError, "`p` cannot name a value"),
             (lambda: sdfc.sphere() | 1, TypeError, "unsupported operand"),
             (lambda: sdfc.sphere() | sdfc.circle(1), TypeError, "unsupported operand"),

@@ -10,6 +10,8 @@
 //! GPU). Where Xvfb or a Vulkan driver is missing they print that they skipped, unless
 //! `SDFC_REQUIRE_DEVICES=1` (set by `.ci/run`): then they fail. The headless test needs neither.
 
+mod panel;
+
 use sdfc_runtime::image::{read_png, Image};
 use std::io::BufRead;
 use std::path::{Path, PathBuf};

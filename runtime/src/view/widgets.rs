@@ -264,7 +264,7 @@ mod tests {
             Kind::Number { int: false }
         );
         let b = Control::of(&param(ParamValue::Bool(true), Accepts::Any));
-        assert_eq!((b.kind, b.raw()), (Kind::Check, Raw::Bool(true)));
+        assert_eq!((b.kind.clone(), b.raw()), (Kind::Check, Raw::Bool(true)));
         let choices = vec!["round".to_string(), "square".to_string()];
         let s = ParamValue::Str("round".into());
         let c = Control::of(&param(s.clone(), Accepts::Choices(choices.clone())));

@@ -53,7 +53,7 @@ impl Timings {
     /// What the load's line says of its kernel's pipeline: how it was had, and with `auto`
     /// whether the specialised kernel was ready within the grace period `grace` or was shown
     /// interpreted while it compiled.
-    fn pipeline_words(&self, grace: Duration) -> String {
+    pub(super) fn pipeline_words(&self, grace: Duration) -> String {
         let got = |p: PipelineTime| match p.cached {
             true => format!("cached ({:.1} ms)", ms(p.time)),
             false => format!("compiled {:.1} ms", ms(p.time)),

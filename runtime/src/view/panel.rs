@@ -126,9 +126,10 @@ impl Panel {
         self.shown() && self.ctx.egui_wants_pointer_input()
     }
 
-    /// Whether a text field has the keys (the viewer's keys then do nothing).
+    /// Whether a text field has the keys (the viewer's keys then do nothing). A slider or
+    /// checkbox that has the focus after a click leaves them to the viewer.
     pub fn wants_keys(&self) -> bool {
-        self.shown() && self.ctx.egui_wants_keyboard_input()
+        self.shown() && self.ctx.text_edit_focused()
     }
 
     /// Runs one pass of the panel's interface for the frame to be presented; returns the

@@ -234,6 +234,15 @@ impl App {
             Some(panel) => panel.run(&st.window),
             None => (Vec::new(), false),
         };
+        // The panel's changes load the scene with their values (each a load, with its
+        // screenshot in `--screenshot-dir`); the frame drawn now shows the panel with them
+        // over the image before, and the next frames the new scene.
+        for (name, value) in changes {
+            st.shot_for = Some(st.session.set_param(&name, &value).number);
+        }
+        if again {
+            st.window.request_redraw();
+        }
         // A frame of the GPU is on show in its texture, where the kernel's frames were
         // accumulated; the CPU renderer's image is uploaded.
         if let Some((texture, number)) = st.session.texture() {
@@ -274,14 +283,6 @@ impl App {
         }
         for path in &wanted {
             eprintln!("view: wrote {}", path.display());
-        }
-        // The panel's changes load the scene with their values (each a load, with its
-        // screenshot in `--screenshot-dir`).
-        for (name, value) in changes {
-            st.shot_for = Some(st.session.set_param(&name, &value).number);
-        }
-        if again {
-            st.window.request_redraw();
         }
         if let Some((k, _)) = reload_shot {
             st.shot_for = None;

@@ -340,12 +340,14 @@ impl Spelling {
 
 /// The value of every limit for one run, and how its messages name the option that raises
 /// one ([`Spelling`]); and the values given from outside for the scene's parameters
-/// (`--param name=value`), which a run is checked with beside its limits.
+/// (`--param name=value`), which a run is checked with beside its limits, and those offered
+/// (the viewer's panel), taken only where the scene accepts them.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
     values: [u64; 24],
     spelling: Spelling,
     params: Vec<(String, String)>,
+    offered: Vec<(String, String)>,
 }
 
 impl Default for Limits {
@@ -354,6 +356,7 @@ impl Default for Limits {
             values: Limit::ALL.map(Limit::default_value),
             spelling: Spelling::Flags,
             params: Vec::new(),
+            offered: Vec::new(),
         }
     }
 }
@@ -372,6 +375,20 @@ impl Limits {
     /// The values given for parameters, as written, in the order given.
     pub fn params(&self) -> &[(String, String)] {
         &self.params
+    }
+
+    /// Offers the parameter `name` the value written `value` (the last offered counts): the
+    /// scene is checked with it, over a value given with [`Limits::set_param`], where it
+    /// declares `name` and accepts the value; elsewhere it is passed over in silence (the
+    /// viewer's panel keeps what the user set across edits of the file that may rename a
+    /// parameter or narrow its range).
+    pub fn offer_param(&mut self, name: &str, value: &str) {
+        self.offered.push((name.to_string(), value.to_string()));
+    }
+
+    /// The values offered for parameters, as written, in the order offered.
+    pub fn offered(&self) -> &[(String, String)] {
+        &self.offered
     }
 
     /// How the messages of these limits name the option that raises one.

@@ -82,6 +82,7 @@ const VIEW_KEYS: &str = "In the window:
   R                          the file's camera again
   S, Tab                     statistics in the title (on or off)
   Space                      pause or play an animated scene
+  P                          hide or show the parameter panel (a scene with parameters)
   Esc, Q                     quit";
 
 /// `sdfc lsp`'s arguments.

@@ -3,12 +3,16 @@
 //! structural edit (a new shape, saved by writing a new file and renaming it over the old one)
 //! and an edit with an error, and checks from the screenshot written after each reload
 //! (`--screenshot-dir`, `reload-K.png`) that the picture changes as it should and that the
-//! error leaves the last good image on show.
+//! error leaves the last good image on show. The parameter panel's tests are in
+//! `view/panel.rs`.
 //!
 //! The window tests run under X: on `DISPLAY` when it is set, else on an Xvfb of their own
 //! (which picks a free display number); wgpu presents through Vulkan (lavapipe on a machine without a
 //! GPU). Where Xvfb or a Vulkan driver is missing they print that they skipped, unless
 //! `SDFC_REQUIRE_DEVICES=1` (set by `.ci/run`): then they fail. The headless test needs neither.
+
+#[path = "view/panel.rs"]
+mod panel;
 
 use sdfc_runtime::image::{read_png, Image};
 use std::io::BufRead;

@@ -2,7 +2,9 @@
 //! A parameter is a global constant whose value a user may set from outside the file
 //! (`--param name=value`, carried with the run's [`crate::Limits`]); the value is refused,
 //! located at the declaration, when it is not of the default's type or not among the values
-//! the parameter accepts, before any work is done.
+//! the parameter accepts, before any work is done. A value offered instead
+//! ([`crate::Limits::offer_param`], the viewer's panel) is taken where it is accepted and
+//! passed over otherwise.
 
 use super::eval::Ctx;
 use super::types::Value;
@@ -81,8 +83,14 @@ pub fn declare(
         );
         return Value::Error;
     }
+    let offered = cx.limits.offered().iter().rev().find(|(n, _)| *n == p.name);
+    let offered = offered
+        .and_then(|(_, text)| p.default.parse_like(text))
+        .filter(|v| p.accepts(v));
     let given = given(cx).into_iter().rev().find(|(n, _)| *n == p.name);
-    if let Some((_, text)) = given {
+    if let Some(v) = offered {
+        p.value = v;
+    } else if let Some((_, text)) = given {
         match p.default.parse_like(&text) {
             None => {
                 cx.error(

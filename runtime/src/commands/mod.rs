@@ -200,7 +200,7 @@ impl std::fmt::Display for ParamArgError {
 impl std::error::Error for ParamArgError {}
 
 /// `NAME=VALUE` of `--param`.
-fn param_arg(s: &str) -> Result<(String, String), ParamArgError> {
+pub(crate) fn param_arg(s: &str) -> Result<(String, String), ParamArgError> {
     let (name, value) = s
         .split_once('=')
         .ok_or_else(|| ParamArgError::NotNameValue(s.to_string()))?;

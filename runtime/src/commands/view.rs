@@ -74,6 +74,12 @@ pub struct ViewArgs {
     /// Stop once the screenshot of load K is written (needs --screenshot-dir).
     #[arg(long, value_name = "K", requires = "screenshot_dir")]
     pub exit_after_reloads: Option<u32>,
+    /// Once the image of the last load has settled (and its screenshot is written), change the
+    /// parameter NAME to VALUE as its control in the panel would (kept within its range and
+    /// on its step): a load, whose --timings say how long the change took to reach the
+    /// screen. May be repeated: each change follows the last one's settled image.
+    #[arg(long = "change", value_name = "NAME=VALUE", value_parser = super::param_arg)]
+    pub change: Vec<(String, String)>,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -128,6 +134,7 @@ pub fn run(args: ViewArgs) -> ExitCode {
             exit_after_reloads: args.exit_after_reloads,
             stats: args.stats,
             orbit_frames: args.orbit_frames,
+            changes: args.change,
         },
     };
     let code = if args.headless {

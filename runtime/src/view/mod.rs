@@ -1,13 +1,18 @@
 //! `sdfc view`, the live preview: a session that watches a scene file and its imports,
 //! recompiles on every change, keeps the last good image when an edit has errors, and renders
-//! progressively ([`session`]); and its presentation, in a window ([`window`]) or headless
-//! (this module), with the screenshots that let tests and measurements see what it shows.
+//! progressively ([`session`]); and its presentation, in a window ([`window`], [`present`],
+//! with the parameter panel: [`panel`], [`widgets`]) or headless (this module), with the
+//! screenshots and scripted parameter changes that let tests and measurements see what it
+//! shows.
 
 pub mod camera;
 pub mod compile;
+pub mod panel;
+pub mod present;
 pub mod resident;
 pub mod session;
 pub mod watch;
+pub mod widgets;
 pub mod window;
 
 use crate::backend::Backend;
@@ -37,6 +42,10 @@ pub struct Control {
     /// Headless: once the first image has settled, orbit the camera for this many frames,
     /// print the frame rate, then the time to the converged image after the camera stops.
     pub orbit_frames: Option<u32>,
+    /// `--change NAME=VALUE`: once the image of the last load has settled (and its screenshot
+    /// is written), give the parameter NAME the value VALUE as its control in the panel would
+    /// (kept within its range and on its step), one change after another; each is a load.
+    pub changes: Vec<(String, String)>,
 }
 
 /// A run of the viewer.
@@ -101,6 +110,7 @@ pub fn headless(run: Run) -> ExitCode {
     let mut shot_for = Some(session.load().number);
     let mut frames = 0u64;
     let mut orbit = control.orbit_frames;
+    let mut changes: std::collections::VecDeque<_> = control.changes.iter().collect();
     loop {
         if let Some(w) = watch.as_mut() {
             for problem in w.add(session.files()) {
@@ -162,6 +172,17 @@ pub fn headless(run: Run) -> ExitCode {
             if control.exit_after_reloads == Some(k) {
                 return ExitCode::SUCCESS;
             }
+        }
+        // `--change`'s next change, through the control the panel would show.
+        if let Some((name, text)) = changes.pop_front() {
+            match widgets::change(session.params(), name, text) {
+                Ok(value) => shot_for = Some(session.set_param(name, &value).number),
+                Err(msg) => {
+                    eprintln!("error: --change {name}={text}: {msg}");
+                    return ExitCode::from(2);
+                }
+            }
+            continue;
         }
         // Wait for a change that calls for a reload; while frames are counted, only look for
         // one, and present the settled image again (a display's next refresh).

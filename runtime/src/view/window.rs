@@ -1,27 +1,25 @@
 //! Presenting a session in a window: a winit window with a wgpu surface, on the device that
-//! renders the kernel (the adapter is the one that can present to the surface), whose render
-//! pass samples the texture the kernel's frames are accumulated into on that device (the CPU
-//! renderer's images are uploaded), or, where no adapter can present, softbuffer and the CPU
-//! renderer; the mouse and keys that move the camera, the title line, and the screenshots of
-//! `--screenshot` and `--screenshot-dir`, read back from what is presented.
+//! renders the kernel (the adapter is the one that can present to the surface), or, where no
+//! adapter can present, softbuffer and the CPU renderer ([`super::present`]); the parameter
+//! panel beside the image ([`super::panel`]) and `--change`'s scripted changes through it; the
+//! mouse and keys that move the camera, the title line, and the screenshots of `--screenshot`
+//! and `--screenshot-dir`, read back from what is presented.
 
 use super::compile::Waker;
-use super::session::{Device, Session};
+use super::panel::Panel;
+use super::present::{wgpu_presenter, Overlay, Presenter, SoftPresenter};
+use super::session::{Device, Outcome, Session};
 use super::watch::Watch;
-use super::{write_rgba_png, Run};
+use super::{widgets, Run};
 use crate::backend::Backend;
-use crate::gpu::Gpu;
-use crate::image::Image;
-use std::num::NonZeroU32;
+use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{
-    ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy, OwnedDisplayHandle,
-};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
@@ -96,6 +94,12 @@ struct State {
     shot_for: Option<u32>,
     /// Whether the image on show has changed since it was uploaded.
     dirty: bool,
+    /// The parameter panel (where wgpu presents).
+    panel: Option<Panel>,
+    /// The panel's width while it is on show, as the layout last took it.
+    panel_width: Option<u32>,
+    /// `--change`'s changes still to make, each once the image before has settled.
+    changes: VecDeque<(String, String)>,
 }
 
 impl App {
@@ -150,6 +154,19 @@ impl App {
             let _ = proxy.send_event(UserEvent::Compiled);
         }));
         let outcome = session.load();
+        let mut panel = match (&presenter, session.device()) {
+            (Presenter::Gpu(p), _) => Some(Panel::new(&window, p.gpu(), p.format())),
+            (Presenter::Soft(_), _) => None,
+        };
+        if let Some(panel) = panel.as_mut() {
+            panel.follow(session.params());
+            // The panel goes beside the image: the window widens by it, the image keeps its
+            // size.
+            if let Some(extra) = panel.width(&window) {
+                let _ =
+                    window.request_inner_size(PhysicalSize::new(size.width + extra, size.height));
+            }
+        }
         let proxy = self.proxy.clone();
         let watch = match Watch::new(move |paths, seen| {
             let _ = proxy.send_event(UserEvent::Files(paths, seen));
@@ -179,6 +196,9 @@ impl App {
             frames: 0,
             shot_for: Some(outcome.number),
             dirty: true,
+            panel,
+            panel_width: None,
+            changes: self.run.control.changes.iter().cloned().collect(),
         })
     }
 
@@ -199,10 +219,29 @@ impl App {
         if st.session.compiling() && !st.session.wants_frame() {
             return;
         }
+        // The panel follows the scene on show (a load may add, remove or change parameters);
+        // the image's part of the window follows the panel.
+        if let Some(panel) = st.panel.as_mut() {
+            panel.follow(st.session.params());
+        }
+        st.layout();
         match st.session.frame() {
             Ok(Some(_)) => st.dirty = true,
             Ok(None) => {}
             Err(msg) => eprintln!("error: {msg}"),
+        }
+        let (changes, again) = match st.panel.as_mut() {
+            Some(panel) => panel.run(&st.window),
+            None => (Vec::new(), false),
+        };
+        // The panel's changes load the scene with their values (each a load, with its
+        // screenshot in `--screenshot-dir`); the frame drawn now shows the panel with them
+        // over the image before, and the next frames the new scene.
+        for (name, value) in changes {
+            st.shot_for = Some(st.session.set_param(&name, &value).number);
+        }
+        if again {
+            st.window.request_redraw();
         }
         // A frame of the GPU is on show in its texture, where the kernel's frames were
         // accumulated; the CPU renderer's image is uploaded.
@@ -227,7 +266,8 @@ impl App {
             .map(|(_, p)| p.clone())
             .chain(final_shot)
             .collect();
-        match st.presenter.present(&wanted) {
+        let overlay = st.panel.as_mut().map(|p| p as &mut dyn Overlay);
+        match st.presenter.present(&wanted, overlay) {
             Ok(true) => {
                 st.frames += 1;
                 st.session.presented();
@@ -249,10 +289,60 @@ impl App {
             if control.exit_after_reloads == Some(k) {
                 return self.finish(event_loop, ExitCode::SUCCESS);
             }
+            // `--change`'s next change, now that the image before it has settled.
+            if let Some((name, text)) = st.changes.pop_front() {
+                match st.change(&name, &text) {
+                    Ok(outcome) => st.shot_for = Some(outcome.number),
+                    Err(msg) => {
+                        eprintln!("error: --change {name}={text}: {msg}");
+                        return self.finish(event_loop, ExitCode::from(2));
+                    }
+                }
+                st.window.request_redraw();
+            }
         }
         if last {
             self.finish(event_loop, ExitCode::SUCCESS);
         }
+    }
+}
+
+impl State {
+    /// Gives the image the part of the window the panel leaves it (all of it while the panel
+    /// is hidden or the scene has no parameters): the session renders at that size.
+    fn layout(&mut self) {
+        let width = self.panel.as_ref().and_then(|p| p.width(&self.window));
+        if width == self.panel_width {
+            return;
+        }
+        self.panel_width = width;
+        self.fit();
+    }
+
+    /// Sizes the session's image and the presenter's view to the window less the panel.
+    fn fit(&mut self) {
+        let size = self.window.inner_size();
+        let view = size
+            .width
+            .saturating_sub(self.panel_width.unwrap_or(0))
+            .max(1);
+        self.presenter
+            .set_view_width(self.panel_width.map(|_| view));
+        self.session.set_size(view, size.height.max(1));
+        self.window.request_redraw();
+    }
+
+    /// `--change NAME=VALUE`: sets the parameter's control to the value as its widget would
+    /// be set, and gives the session the value it stands for.
+    fn change(&mut self, name: &str, text: &str) -> Result<Outcome, String> {
+        let value = match self.panel.as_mut() {
+            Some(panel) => {
+                panel.follow(self.session.params());
+                panel.change(name, text)?
+            }
+            None => widgets::change(self.session.params(), name, text)?,
+        };
+        Ok(self.session.set_param(name, &value))
     }
 }
 
@@ -302,17 +392,26 @@ impl ApplicationHandler<UserEvent> for App {
         let Some(st) = self.state.as_mut() else {
             return;
         };
+        // The panel sees every event first; what it takes (the pointer over it or dragging
+        // one of its controls, the keys while a text field has them) moves no camera.
+        let (mut pointer, mut keys) = (false, false);
+        if let Some(panel) = st.panel.as_mut() {
+            if panel.on_event(&st.window, &event) {
+                st.window.request_redraw();
+            }
+            (pointer, keys) = (panel.wants_pointer(), panel.wants_keys());
+        }
         match event {
             WindowEvent::CloseRequested => self.finish(event_loop, ExitCode::SUCCESS),
             WindowEvent::Resized(size) => {
                 st.presenter.resize(size.width, size.height);
-                st.session.set_size(size.width.max(1), size.height.max(1));
-                st.window.request_redraw();
+                st.fit();
             }
             WindowEvent::RedrawRequested => self.redraw(event_loop),
             WindowEvent::ModifiersChanged(m) => st.shift = m.state().shift_key(),
             WindowEvent::MouseInput { state, button, .. } => {
-                let down = state == ElementState::Pressed;
+                // A press on the panel is the panel's; a release ends any drag.
+                let down = state == ElementState::Pressed && !pointer;
                 match button {
                     MouseButton::Left => st.left = down,
                     MouseButton::Middle => st.middle = down,
@@ -339,11 +438,21 @@ impl ApplicationHandler<UserEvent> for App {
                     MouseScrollDelta::LineDelta(_, y) => y as f64,
                     MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
                 };
-                st.session.zoom(lines);
-                st.window.request_redraw();
+                if !pointer {
+                    st.session.zoom(lines);
+                    st.window.request_redraw();
+                }
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            WindowEvent::KeyboardInput { event, .. }
+                if event.state == ElementState::Pressed && !keys =>
+            {
                 match event.logical_key.as_ref() {
+                    Key::Character(c) if c.eq_ignore_ascii_case("p") => {
+                        if let Some(panel) = st.panel.as_mut() {
+                            panel.visible = !panel.visible;
+                            st.window.request_redraw();
+                        }
+                    }
                     Key::Character(c) if c.eq_ignore_ascii_case("r") => {
                         st.session.reset_camera();
                         st.window.request_redraw();
@@ -397,551 +506,5 @@ impl ApplicationHandler<UserEvent> for App {
         {
             st.window.request_redraw();
         }
-    }
-}
-
-/// How the window shows images: through wgpu, or, where no adapter can present to it, with
-/// softbuffer (pixels copied to the window by the CPU).
-enum Presenter {
-    Gpu(Box<GpuPresenter>),
-    Soft(SoftPresenter),
-}
-
-impl Presenter {
-    fn resize(&mut self, width: u32, height: u32) {
-        match self {
-            Presenter::Gpu(p) => p.resize(width, height),
-            Presenter::Soft(p) => p.size = (width.max(1), height.max(1)),
-        }
-    }
-
-    fn upload(&mut self, image: &Image) {
-        match self {
-            Presenter::Gpu(p) => p.upload(image),
-            Presenter::Soft(p) => p.image = Some((image.width, image.height, image.to_rgba8())),
-        }
-    }
-
-    /// Shows `texture` (sRGB bytes, on the presenting device; `number` changes with the
-    /// texture): only a wgpu presenter has a device.
-    fn show(&mut self, texture: &wgpu::Texture, number: u64) {
-        if let Presenter::Gpu(p) = self {
-            p.show(texture, number);
-        }
-    }
-
-    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
-        match self {
-            Presenter::Gpu(p) => p.present(shots),
-            Presenter::Soft(p) => p.present(shots),
-        }
-    }
-}
-
-/// Opens the wgpu presenter: an instance with the window's display, a surface, and an adapter
-/// that can present to it.
-fn wgpu_presenter(
-    event_loop: &ActiveEventLoop,
-    window: &Arc<Window>,
-) -> Result<(Arc<Gpu>, GpuPresenter), String> {
-    // One instance for the process, never destroyed (as `runtime/src/gpu/wgpu.rs` keeps its
-    // own): the Vulkan driver then stays loaded until the process ends.
-    static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
-    let instance = INSTANCE.get_or_init(|| {
-        let display = Box::new(event_loop.owned_display_handle());
-        wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
-            display,
-        ))
-    });
-    let surface = instance
-        .create_surface(window.clone())
-        .map_err(|e| format!("cannot make a wgpu surface for the window: {e}"))?;
-    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-        power_preference: wgpu::PowerPreference::HighPerformance,
-        force_fallback_adapter: false,
-        compatible_surface: Some(&surface),
-        apply_limit_buckets: false,
-    }))
-    .map_err(|e| format!("no wgpu adapter can present to the window ({e})"))?;
-    let gpu = Arc::new(Gpu::from_adapter(&adapter).map_err(|e| e.to_string())?);
-    let size = window.inner_size();
-    let presenter = GpuPresenter::new(gpu.clone(), surface, &adapter, size.width, size.height)?;
-    Ok((gpu, presenter))
-}
-
-/// Shows images with softbuffer: each is scaled to the window (nearest pixel) by the CPU and
-/// copied to it.
-struct SoftPresenter {
-    surface: softbuffer::Surface<OwnedDisplayHandle, Arc<Window>>,
-    size: (u32, u32),
-    /// The image's size and sRGB RGBA bytes.
-    image: Option<(u32, u32, Vec<u8>)>,
-}
-
-impl SoftPresenter {
-    fn new(event_loop: &ActiveEventLoop, window: &Arc<Window>) -> Result<SoftPresenter, String> {
-        let context = softbuffer::Context::new(event_loop.owned_display_handle())
-            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
-        let surface = softbuffer::Surface::new(&context, window.clone())
-            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
-        let size = window.inner_size();
-        Ok(SoftPresenter {
-            surface,
-            size: (size.width.max(1), size.height.max(1)),
-            image: None,
-        })
-    }
-
-    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
-        let (w, h) = self.size;
-        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
-            return Ok(false);
-        };
-        self.surface
-            .resize(nw, nh)
-            .map_err(|e| format!("cannot resize the window's buffer: {e}"))?;
-        let mut buffer = self
-            .surface
-            .buffer_mut()
-            .map_err(|e| format!("cannot draw in the window: {e}"))?;
-        for y in 0..h {
-            for x in 0..w {
-                let px = match &self.image {
-                    Some((iw, ih, rgba)) => {
-                        let (sx, sy) = (x * iw / w, y * ih / h);
-                        let i = 4 * (sy as usize * *iw as usize + sx as usize);
-                        (rgba[i] as u32) << 16 | (rgba[i + 1] as u32) << 8 | rgba[i + 2] as u32
-                    }
-                    None => 0x050505,
-                };
-                buffer[y as usize * w as usize + x as usize] = px;
-            }
-        }
-        if !shots.is_empty() {
-            let rgba: Vec<u8> = buffer
-                .iter()
-                .flat_map(|&p| [(p >> 16) as u8, (p >> 8) as u8, p as u8, 255])
-                .collect();
-            for path in shots {
-                write_rgba_png(path, w, h, &rgba)
-                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
-            }
-        }
-        buffer
-            .present()
-            .map_err(|e| format!("cannot show the frame: {e}"))?;
-        Ok(true)
-    }
-}
-
-/// Draws the session's image into the window's surface: a texture of sRGB bytes, the one the
-/// GPU's frames are accumulated into or one the CPU renderer's image is uploaded to, drawn
-/// over the whole surface with a linear filter (so the smaller frames rendered while moving
-/// fill the window).
-struct GpuPresenter {
-    gpu: Arc<Gpu>,
-    surface: wgpu::Surface<'static>,
-    config: wgpu::SurfaceConfiguration,
-    /// Whether the surface texture can be copied from (else screenshots are drawn into a
-    /// texture of the surface's format).
-    copyable: bool,
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
-    texture_format: wgpu::TextureFormat,
-    /// The texture uploaded to, and its bindings.
-    image: Option<(wgpu::Texture, wgpu::BindGroup)>,
-    /// The bindings of a texture shown in place, with its number ([`GpuPresenter::show`]):
-    /// drawn instead of `image` while it is set.
-    shown: Option<(u64, wgpu::BindGroup)>,
-}
-
-/// The blit: a triangle over the whole target sampling the image.
-const BLIT: &str = r#"
-@group(0) @binding(0) var image: texture_2d<f32>;
-@group(0) @binding(1) var smp: sampler;
-
-struct Out {
-    @builtin(position) position: vec4<f32>,
-    @location(0) uv: vec2<f32>,
-};
-
-@vertex
-fn vs(@builtin(vertex_index) i: u32) -> Out {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    var o: Out;
-    o.position = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.0, 1.0);
-    o.uv = uv;
-    return o;
-}
-
-@fragment
-fn fs(o: Out) -> @location(0) vec4<f32> {
-    return vec4<f32>(textureSample(image, smp, o.uv).rgb, 1.0);
-}
-"#;
-
-/// The colour of the window before the first image (dark grey).
-const EMPTY: wgpu::Color = wgpu::Color {
-    r: 0.02,
-    g: 0.02,
-    b: 0.02,
-    a: 1.0,
-};
-
-impl GpuPresenter {
-    fn new(
-        gpu: Arc<Gpu>,
-        surface: wgpu::Surface<'static>,
-        adapter: &wgpu::Adapter,
-        width: u32,
-        height: u32,
-    ) -> Result<GpuPresenter, String> {
-        let caps = surface.get_capabilities(adapter);
-        let format = caps
-            .formats
-            .iter()
-            .copied()
-            .find(|f| {
-                matches!(
-                    f,
-                    wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Rgba8UnormSrgb
-                )
-            })
-            .or_else(|| {
-                caps.formats.iter().copied().find(|f| {
-                    matches!(
-                        f,
-                        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
-                    )
-                })
-            })
-            .ok_or_else(|| {
-                format!(
-                    "the window's surface offers no 8-bit RGBA format (it offers {:?})",
-                    caps.formats
-                )
-            })?;
-        let copyable = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
-        let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        if copyable {
-            usage |= wgpu::TextureUsages::COPY_SRC;
-        }
-        let config = wgpu::SurfaceConfiguration {
-            usage,
-            format,
-            width: width.max(1),
-            height: height.max(1),
-            present_mode: wgpu::PresentMode::Fifo,
-            desired_maximum_frame_latency: 2,
-            alpha_mode: caps.alpha_modes[0],
-            view_formats: vec![],
-            color_space: wgpu::SurfaceColorSpace::Auto,
-        };
-        let device = gpu.device();
-        surface.configure(device, &config);
-        // The image holds sRGB bytes: an sRGB texture decodes them for an sRGB surface, which
-        // encodes them again; a plain one passes them through to a plain surface.
-        let texture_format = if format.is_srgb() {
-            wgpu::TextureFormat::Rgba8UnormSrgb
-        } else {
-            wgpu::TextureFormat::Rgba8Unorm
-        };
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("sdfc view blit"),
-            source: wgpu::ShaderSource::Wgsl(BLIT.into()),
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sdfc view blit"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sdfc view blit"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sdfc view blit"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            multiview_mask: None,
-            cache: None,
-        });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("sdfc view blit"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
-        Ok(GpuPresenter {
-            gpu,
-            surface,
-            config,
-            copyable,
-            pipeline,
-            layout,
-            sampler,
-            texture_format,
-            image: None,
-            shown: None,
-        })
-    }
-
-    fn resize(&mut self, width: u32, height: u32) {
-        if width == 0 || height == 0 {
-            return;
-        }
-        self.config.width = width;
-        self.config.height = height;
-        self.surface.configure(self.gpu.device(), &self.config);
-    }
-
-    /// Draws `texture` (sRGB bytes in an `Rgba8Unorm` texture that may be viewed as
-    /// `Rgba8UnormSrgb`, on this device) from now on; `number` names it, so that its bindings
-    /// are made once.
-    fn show(&mut self, texture: &wgpu::Texture, number: u64) {
-        if self.shown.as_ref().is_some_and(|(n, _)| *n == number) {
-            return;
-        }
-        // Sampled only: an sRGB view of the texture cannot be a storage binding.
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            format: Some(self.texture_format),
-            usage: Some(wgpu::TextureUsages::TEXTURE_BINDING),
-            ..Default::default()
-        });
-        let bind = self.bindings(&view);
-        self.shown = Some((number, bind));
-    }
-
-    /// The blit's bindings of `view`.
-    fn bindings(&self, view: &wgpu::TextureView) -> wgpu::BindGroup {
-        self.gpu
-            .device()
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("sdfc view image"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Sampler(&self.sampler),
-                    },
-                ],
-            })
-    }
-
-    /// Uploads `image` (sRGB-encoded) as the texture to draw.
-    fn upload(&mut self, image: &Image) {
-        self.shown = None;
-        let device = self.gpu.device();
-        let size = wgpu::Extent3d {
-            width: image.width,
-            height: image.height,
-            depth_or_array_layers: 1,
-        };
-        let same = self
-            .image
-            .as_ref()
-            .is_some_and(|(t, _)| t.width() == image.width && t.height() == image.height);
-        if !same {
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("sdfc view image"),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: self.texture_format,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            let bind = self.bindings(&texture.create_view(&Default::default()));
-            self.image = Some((texture, bind));
-        }
-        if let Some((texture, _)) = &self.image {
-            self.gpu.queue().write_texture(
-                texture.as_image_copy(),
-                &image.to_rgba8(),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4 * image.width),
-                    rows_per_image: Some(image.height),
-                },
-                size,
-            );
-        }
-    }
-
-    /// Draws the image into `view`.
-    fn draw(&self, encoder: &mut wgpu::CommandEncoder, view: &wgpu::TextureView) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("sdfc view blit"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(EMPTY),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        let bind = match (&self.shown, &self.image) {
-            (Some((_, bind)), _) | (None, Some((_, bind))) => Some(bind),
-            (None, None) => None,
-        };
-        if let Some(bind) = bind {
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, bind, &[]);
-            pass.draw(0..3, 0..1);
-        }
-    }
-
-    /// Draws the image to the surface and presents it, first writing what it shows to each of
-    /// `shots` (PNG). `Ok(false)` when the surface had no texture to give this time.
-    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
-        let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(f) => f,
-            wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                return Ok(false)
-            }
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                self.surface.configure(self.gpu.device(), &self.config);
-                return Ok(false);
-            }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                return Err("the window's surface reported a validation error".into())
-            }
-        };
-        let device = self.gpu.device();
-        let view = frame.texture.create_view(&Default::default());
-        let mut encoder = device.create_command_encoder(&Default::default());
-        self.draw(&mut encoder, &view);
-        self.gpu.queue().submit([encoder.finish()]);
-        if !shots.is_empty() {
-            let bytes = if self.copyable {
-                self.read(&frame.texture)?
-            } else {
-                // The same draw into a texture of the surface's format and size.
-                let texture = device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("sdfc view screenshot"),
-                    size: frame.texture.size(),
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: self.config.format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                    view_formats: &[],
-                });
-                let mut encoder = device.create_command_encoder(&Default::default());
-                self.draw(&mut encoder, &texture.create_view(&Default::default()));
-                self.gpu.queue().submit([encoder.finish()]);
-                self.read(&texture)?
-            };
-            for path in shots {
-                write_rgba_png(path, self.config.width, self.config.height, &bytes)
-                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
-            }
-        }
-        self.gpu.queue().present(frame);
-        Ok(true)
-    }
-
-    /// The pixels of `texture` (of the surface's format) as RGBA8 rows.
-    fn read(&self, texture: &wgpu::Texture) -> Result<Vec<u8>, String> {
-        let device = self.gpu.device();
-        let (w, h) = (texture.width(), texture.height());
-        let row = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sdfc view screenshot"),
-            size: row as u64 * h as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
-                },
-            },
-            texture.size(),
-        );
-        self.gpu.queue().submit([encoder.finish()]);
-        let slice = buffer.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("reading the window back: {e}"))?;
-        rx.recv()
-            .map_err(|e| e.to_string())?
-            .map_err(|e| format!("reading the window back: {e}"))?;
-        let mapped = slice
-            .get_mapped_range()
-            .map_err(|e| format!("reading the window back: {e}"))?;
-        let bgra = matches!(
-            self.config.format,
-            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
-        );
-        let mut out = Vec::with_capacity(4 * w as usize * h as usize);
-        for y in 0..h as usize {
-            let start = y * row as usize;
-            for px in mapped[start..start + 4 * w as usize].chunks_exact(4) {
-                if bgra {
-                    out.extend_from_slice(&[px[2], px[1], px[0], 255]);
-                } else {
-                    out.extend_from_slice(&[px[0], px[1], px[2], 255]);
-                }
-            }
-        }
-        drop(mapped);
-        buffer.unmap();
-        Ok(out)
     }
 }

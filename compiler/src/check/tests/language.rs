@@ -487,3 +487,43 @@ fn parameters_take_values_from_outside_within_what_they_accept() {
     );
     assert_eq!(codes("param s = sphere(1);\nscene { s; }"), ["E0300"]);
 }
+
+#[test]
+fn offered_parameter_values_are_taken_where_accepted_and_passed_over_elsewhere() {
+    use crate::scene::params::ParamValue;
+    let src = "param width = 40.0 in 10..100 \"Box width (mm)\";\n\
+               param holes = 3 in 1..8;\n\
+               light point { position: (0, 5, 0) }\n\
+               scene { box((width / 2, 1, 1)); }";
+    let run = |given: &[(&str, &str)], offered: &[(&str, &str)]| {
+        let mut limits = crate::Limits::default();
+        for (n, v) in given {
+            limits.set_param(n, v);
+        }
+        for (n, v) in offered {
+            limits.offer_param(n, v);
+        }
+        let mut sources = crate::SourceMap::new();
+        let entry = sources.add("t.sdf", src);
+        let (scene, diags) =
+            crate::front::check_with(&mut sources, entry, &mut crate::check::NoImports, &limits);
+        assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
+        let scene = scene.expect("scene");
+        (scene.params[0].value.clone(), scene.params[1].value.clone())
+    };
+    // Taken, over a value given (the panel moved on from the command line's value); the last
+    // offered counts.
+    assert_eq!(
+        run(&[("width", "60")], &[("width", "70"), ("width", "80")]),
+        (ParamValue::Float(80.0), ParamValue::Int(3))
+    );
+    // Passed over in silence: out of range, of the wrong type, or a name the scene does not
+    // declare (no E0200); the given value or the default stands.
+    assert_eq!(
+        run(
+            &[("width", "60")],
+            &[("width", "160"), ("holes", "2.5"), ("gone", "1")]
+        ),
+        (ParamValue::Float(60.0), ParamValue::Int(3))
+    );
+}

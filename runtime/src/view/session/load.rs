@@ -21,6 +21,16 @@ impl Session {
     /// and the newest modification time of the scene's files. A file renamed back, or copied
     /// with its time kept, has an old modification time; the event is when it changed.
     pub fn load_edited(&mut self, edited: Option<SystemTime>) -> Outcome {
+        self.load_because(edited, None)
+    }
+
+    /// [`Session::load_edited`], for `cause` when it is not an edit of the files (the panel's
+    /// change of a parameter, made at `edited`).
+    pub(super) fn load_because(
+        &mut self,
+        edited: Option<SystemTime>,
+        cause: Option<String>,
+    ) -> Outcome {
         let number = self.loads;
         self.loads += 1;
         let started = Instant::now();
@@ -29,10 +39,14 @@ impl Session {
         match self.compile() {
             Ok((good, mut timings)) => {
                 timings.number = number;
-                timings.modified =
-                    edit_time(Fingerprint::modified(&self.files).or(modified), edited);
+                timings.modified = match cause {
+                    Some(_) => edited,
+                    None => edit_time(Fingerprint::modified(&self.files).or(modified), edited),
+                };
+                timings.cause = cause;
                 timings.began = began;
                 self.install(good);
+                self.keep_taken_values();
                 self.timings = Some(timings);
                 self.failed = false;
                 self.status = None;
@@ -67,7 +81,7 @@ impl Session {
     /// Reads, checks, lowers and prepares the scene, printing what `sdfc check` prints;
     /// `Err` is the one-line summary of the first problem.
     fn compile(&mut self) -> Result<(Good, Timings), String> {
-        let job = self.options.job.clone();
+        let job = self.job();
         let limits = &job.limits;
         let start = Instant::now();
         let empty = || std::fs::metadata(&self.file).is_ok_and(|m| m.len() == 0);
@@ -220,6 +234,7 @@ impl Session {
         };
         let timings = Timings {
             number: 0,
+            cause: None,
             check: check_time,
             lower: lower_time,
             prepare: prepare_time,
@@ -245,7 +260,7 @@ impl Session {
     /// would be above the `memory` limit at the view's size. Its pipeline is compiled once per
     /// specialisation; until then it compiles on another thread too.
     fn interim(&self, gpu: &Arc<Gpu>, scene: &Scene, lowered: Lowered) -> Option<Interim> {
-        let job = &self.options.job;
+        let job = &self.job();
         let setup = Setup {
             parameters: true,
             kernel: wgsl::KernelChoice::Interpreted,

@@ -26,6 +26,10 @@ use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant, SystemTime};
 
 mod load;
+mod params;
+mod timings;
+
+use timings::Timings;
 
 /// The time a frame may take while the camera moves; a slower one lowers the resolution.
 pub const FRAME_BUDGET: Duration = Duration::from_millis(33);
@@ -244,90 +248,6 @@ pub struct Outcome {
     pub summary: String,
 }
 
-/// Times of one load, printed (with `--timings`) once its first frame is shown.
-#[derive(Debug, Clone)]
-struct Timings {
-    number: u32,
-    /// Reading and checking.
-    check: Duration,
-    /// Lowering to the distance program.
-    lower: Duration,
-    /// Tapes (CPU) or kernel generation and validation (wgpu).
-    prepare: Duration,
-    /// Whether a kernel (or the CPU's tapes) was built; false when the last scene's wgpu
-    /// kernel was kept (an edit of numbers only).
-    built: bool,
-    /// The kernel's pipeline: compiled, or found among those compiled.
-    pipeline: Option<PipelineTime>,
-    /// Whether the pipeline compiled on another thread (`pipeline` is then its time, once
-    /// ready before the first frame).
-    background: bool,
-    /// Whether the interpreted kernel could show the scene while it compiled (else the image
-    /// before stayed on show until it was ready).
-    interim: bool,
-    /// The kernel of the first frame: `interpreted` while the specialised one compiled.
-    first_kernel: Option<&'static str>,
-    /// The time to prepare the interpreted kernel (with `auto`, when the specialised pipeline
-    /// was not compiled yet).
-    interim_prepare: Duration,
-    /// The interpreted kernel's pipeline, when it rendered the first frame.
-    interim_pipeline: Option<PipelineTime>,
-    /// When the specialised pipeline compiled on another thread was ready before any frame
-    /// of the interpreted kernel: how long after its compile started the session took it,
-    /// and whether that was within the grace period.
-    ready: Option<(Duration, bool)>,
-    /// When the newest of the scene's files was modified.
-    modified: Option<SystemTime>,
-    /// When the load began.
-    began: SystemTime,
-    /// The first frame's render time and size, once rendered.
-    first_frame: Option<(Duration, u32, u32)>,
-    /// Whether the first frame's timings are printed (and the first full frame's are due).
-    printed: bool,
-}
-
-impl Timings {
-    /// What the load's line says of its kernel's pipeline: how it was had, and with `auto`
-    /// whether the specialised kernel was ready within the grace period `grace` or was shown
-    /// interpreted while it compiled.
-    fn pipeline_words(&self, grace: Duration) -> String {
-        let got = |p: PipelineTime| match p.cached {
-            true => format!("cached ({:.1} ms)", ms(p.time)),
-            false => format!("compiled {:.1} ms", ms(p.time)),
-        };
-        let grace = ms(grace);
-        match (self.pipeline, self.background, self.ready) {
-            (Some(p), false, _) => format!(", pipeline {}", got(p)),
-            (Some(p), true, Some((ready, _))) if !self.interim => format!(
-                ", pipeline {} on another thread, shown once ready {:.1} ms after its compile started (no interpreted kernel meanwhile: the image before stayed on show)",
-                got(p),
-                ms(ready)
-            ),
-            (Some(p), true, Some((ready, true))) => format!(
-                ", pipeline {} on another thread, specialised compiled within the grace period in {:.1} ms (grace {grace:.0} ms, no interpreted frame)",
-                got(p),
-                ms(ready)
-            ),
-            (Some(p), true, Some((ready, false))) => format!(
-                ", pipeline {} on another thread, specialised ready {:.1} ms after its compile started (after the {grace:.0} ms grace period, before an interpreted frame)",
-                got(p),
-                ms(ready)
-            ),
-            (Some(p), true, None) => format!(", pipeline {} on another thread", got(p)),
-            (None, true, _) => format!(
-                ", pipeline compiling on another thread, not ready within the {grace:.0} ms grace period, interpreted while compiling (interpreted kernel {:.2} ms, its pipeline {})",
-                ms(self.interim_prepare),
-                match self.interim_pipeline {
-                    Some(p) if p.cached => "was cached".to_string(),
-                    Some(p) => format!("compiled {:.1} ms", ms(p.time)),
-                    None => "was ready".to_string(),
-                }
-            ),
-            (None, false, _) => String::new(),
-        }
-    }
-}
-
 /// One rendered frame.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameInfo {
@@ -417,6 +337,9 @@ pub struct Session {
     /// later scene of the same specialisation reuses its validated kernel
     /// ([`Prepared::next_with`]).
     interpreter: Option<Prepared>,
+    /// The values the panel gave parameters (name, value as text), offered to every load
+    /// ([`sdfc_compiler::Limits::offer_param`]): kept while the scene accepts them.
+    panel: Vec<(String, String)>,
     /// Tests hold back the compile of this load's specialised kernel, to see what is shown
     /// meanwhile.
     #[cfg(test)]
@@ -455,6 +378,7 @@ impl Session {
             compiled: mpsc::channel(),
             waker: None,
             interpreter: None,
+            panel: Vec::new(),
             #[cfg(test)]
             held: None,
         }
@@ -637,7 +561,7 @@ impl Session {
     /// [`LowerOptions::parametric`]), then prepared as the scene before was, with the kernel
     /// it had ([`job::Open::After`]), and the interpreted kernel shown meanwhile too.
     fn scene_at(&mut self, time: f64) -> Result<(), String> {
-        let job = &self.options.job;
+        let job = &self.job();
         let on = (self.backend(), &Devices::Auto);
         let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
             return Ok(());
@@ -982,74 +906,6 @@ impl Session {
         }
     }
 
-    /// Called once a frame is on show: prints the timings of the load whose first frame it
-    /// is, with `--timings` (edit to pixel: from the modification of the newest of the
-    /// scene's files until now).
-    pub fn presented(&mut self) {
-        let Some(t) = self.timings.as_ref() else {
-            return;
-        };
-        let Some((time, w, h)) = t.first_frame else {
-            return;
-        };
-        if t.printed {
-            // The first frame was smaller: say when the full resolution followed.
-            let full = self.accumulation.still && self.accumulation.count > 0;
-            if full {
-                if let (true, Some(m)) = (self.options.timings, t.modified.filter(|_| t.number > 0))
-                {
-                    if let Ok(total) = SystemTime::now().duration_since(m) {
-                        eprintln!(
-                            "view: load {}: first full-resolution frame shown {:.1} ms after the edit",
-                            t.number,
-                            ms(total)
-                        );
-                    }
-                }
-                self.timings = None;
-            }
-            return;
-        }
-        if self.options.timings {
-            let pipeline = t.pipeline_words(self.options.grace);
-            let now = SystemTime::now();
-            let edit = match (
-                t.modified.filter(|_| t.number > 0),
-                now.duration_since(t.began),
-            ) {
-                (Some(m), Ok(shown)) => match (t.began.duration_since(m), now.duration_since(m)) {
-                    (Ok(seen), Ok(total)) => format!(
-                        "; edit to pixel {:.1} ms (seen after {:.1} ms, shown {:.1} ms later)",
-                        ms(total),
-                        ms(seen),
-                        ms(shown)
-                    ),
-                    _ => String::new(),
-                },
-                _ => String::new(),
-            };
-            eprintln!(
-                "view: load {} timings: check {:.1} ms, lower {:.2} ms, {} {:.2} ms{pipeline}, first frame {:.1} ms ({w}x{h}{}){edit}",
-                t.number,
-                ms(t.check),
-                ms(t.lower),
-                match (&self.device, t.built) {
-                    (Device::Cpu, _) => "tapes",
-                    (_, true) => "kernel",
-                    (_, false) => "kernel kept (numbers only)",
-                },
-                ms(t.prepare),
-                ms(time),
-                t.first_kernel.map(|k| format!(", {k}")).unwrap_or_default(),
-            );
-        }
-        if (w, h) == self.size {
-            self.timings = None;
-        } else if let Some(t) = self.timings.as_mut() {
-            t.printed = true;
-        }
-    }
-
     /// The window title: the file, the problem with the last load if it failed, a render
     /// error, and with `stats` the backend, method, frame time, steps per pixel and samples.
     pub fn title(&self, stats: bool) -> String {
@@ -1104,10 +960,12 @@ fn edit_time(modified: Option<SystemTime>, event: Option<SystemTime>) -> Option<
     }
 }
 
-/// The lowering of a scene: an animated one keeps the structure of its program whatever its
-/// numbers (`LowerOptions::parametric`), so that its frames share one kernel.
+/// The lowering of a scene: an animated one, or one with parameters, keeps the structure of
+/// its program whatever its numbers (`LowerOptions::parametric`), so that its frames share one
+/// kernel, as do the values a parameter's slider passes through (a translation by a length
+/// that passes 0 stays in the program).
 fn lower_options(scene: &Scene) -> LowerOptions {
-    if scene.animation.animated() {
+    if scene.animation.animated() || !scene.params.is_empty() {
         LowerOptions::parametric()
     } else {
         LowerOptions::default()

@@ -204,3 +204,63 @@ scene { plane() @ m; }
         );
     }
 }
+
+/// A black floor of `MAT` under a uniform sky of 1 that is also the background, seen from a
+/// little above: the column of pixel values from the horizon (row 0 of the floor) down.
+fn floor_column(name: &str, material: &str) -> Vec<(&'static str, Vec<f32>)> {
+    let scene = checked(
+        name,
+        &format!(
+            "
+material m = {material};
+camera {{ position: (0, 1, -4), look_at: (0, 0, 4), fov: 60deg }}
+light sky {{ color: (1, 1, 1) }}
+render {{ width: 16, height: 64, max_dist: 1000 }}
+scene {{ plane() @ m; }}
+"
+        ),
+    );
+    render_everywhere(name, &scene)
+        .into_iter()
+        .map(|(backend, image)| {
+            let column: Vec<f32> = (0..64)
+                .map(|y| image.pixel(8, y)[0])
+                .filter(|&v| v < 0.999)
+                .collect();
+            (backend, column)
+        })
+        .collect()
+}
+
+/// `fresnel: true` on a Phong material: a black floor reflecting 10 % (`reflect: 0.1`)
+/// reflects more of the sky towards the horizon, as `fresnel_weights` says
+/// (r' = r + w·(1 − |N·V|)⁵, with the local colour black); without it every row reflects
+/// 10 %, as before.
+#[test]
+fn fresnel_on_phong_brightens_grazing_angles_and_is_off_by_default() {
+    let lit =
+        "phong { color: (0, 0, 0), ambient: 0, diffuse: 0, specular: 0, reflect: 0.1 FRESNEL }";
+    for (backend, column) in floor_column("plain", &lit.replace("FRESNEL", "")) {
+        assert!(column.len() > 30, "{backend}: {column:?}");
+        for v in &column {
+            assert!((v - 0.1).abs() < 1e-5, "{backend}: {column:?}");
+        }
+    }
+    for (backend, column) in floor_column("fresnel", &lit.replace("FRESNEL", ", fresnel: true")) {
+        assert!(column.len() > 30, "{backend}: {column:?}");
+        let near = *column.last().unwrap();
+        // The nearest row: N·V ≈ sin 37°, s = (1 − 0.6)⁵ ≈ 0.01.
+        assert!(
+            near > 0.1 && near < 0.13,
+            "{backend}: the nearest row is {near}"
+        );
+        for w in column.windows(2) {
+            assert!(w[0] >= w[1] - 1e-6, "{backend}: {column:?}");
+        }
+        assert!(
+            column[0] > 0.5,
+            "{backend}: towards the horizon {}",
+            column[0]
+        );
+    }
+}

@@ -1637,7 +1637,7 @@ pub struct Record {
     pub help: &'static [(&'static str, &'static str)],
 }
 
-const SURFACE: [P; 8] = [
+const SURFACE: [P; 9] = [
     p("ambient", F, Num(Material::AMBIENT), Unit),
     p("diffuse", F, Num(Material::DIFFUSE), NonNeg),
     p("specular", F, Num(Material::SPECULAR), NonNeg),
@@ -1651,6 +1651,9 @@ const SURFACE: [P; 8] = [
     p("transparency", F, Num(Material::TRANSPARENCY), Unit),
     p("ior", F, Num(Material::IOR), Within(1.0, 10.0)),
     p("color", V, V3(Material::COLOR), NonNeg),
+    // Schlick's Fresnel term on the reflected and refracted rays (docs/rendering.md,
+    // "Secondary rays"): off, so that the scenes written before it keep their look.
+    p("fresnel", B, Bool(false), Any),
 ];
 
 const fn concat<const N: usize, const M: usize, const T: usize>(a: [P; N], b: [P; M]) -> [P; T] {
@@ -1667,9 +1670,10 @@ const fn concat<const N: usize, const M: usize, const T: usize>(a: [P; N], b: [P
     out
 }
 
-const CHECKER: [P; 10] = concat(
+const CHECKER: [P; 11] = concat(
     [
         SURFACE[0], SURFACE[1], SURFACE[2], SURFACE[3], SURFACE[4], SURFACE[5], SURFACE[6],
+        SURFACE[8],
     ],
     [
         p("a", V, V3([0.9, 0.9, 0.9]), NonNeg),

@@ -664,7 +664,7 @@ fn material(
         reflect,
         transparency,
         ior: f["ior"].num(),
-        fresnel: false,
+        fresnel: matches!(f["fresnel"], Value::Bool(true)),
         pbr: None,
     };
 }

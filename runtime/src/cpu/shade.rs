@@ -669,7 +669,8 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
         // A solid's surface inside glass faces the glass: what leaves it stays inside.
         let within = hit.solid;
         let lobes = pbr::lobes(m, hit.n, ray.dir, || colour(ctx, m, hit, ray.dir));
-        if m.reflects {
+        // A reflection of no weight (Fresnel's rim facing the camera) is not traced.
+        if m.reflects && lobes.reflect.max_abs() > T::zero() {
             next.push(child(
                 hit.p + off,
                 ray.dir.reflect(hit.n),

@@ -1716,7 +1716,7 @@ pub static MATERIALS: &[Record] = &[
             ("roughness", "write a roughness from 0 (a mirror) to 1 (fully rough): `roughness: 0.5`"),
             ("metallic", "write a metallic from 0 (plastic, stone, glass) to 1 (a metal): `metallic: 1`"),
             ("transmission", "write a transmission from 0 (opaque) to 1 (clear glass): `transmission: 1`"),
-            ("ior", "write an index of refraction of at least 1 (air 1, water 1.33, glass 1.5, diamond 2.42): `ior: 1.5`"),
+            ("ior", "write an index of refraction from 1 to 10 (air 1, water 1.33, glass 1.5, diamond 2.42): `ior: 1.5`"),
         ],
         fields: &PBR,
     },

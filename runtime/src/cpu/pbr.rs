@@ -84,6 +84,16 @@ pub(super) fn sky<T: Float>(s: &Surface<T>, sky: &Sky<T>, n: V3<T>, v: V3<T>) ->
     diffuse + spec
 }
 
+/// The weight of the local colour of a hit on `m` of normal `n` seen along `dir` (that of
+/// [`lobes`], without the base colour it does not need).
+pub(super) fn local_weight<T: Float>(m: &Mat<T>, n: V3<T>, dir: V3<T>) -> T {
+    if m.pbr.is_some() {
+        T::one()
+    } else {
+        lobes(m, n, dir, V3::zero).local
+    }
+}
+
 /// The weights of a hit on `m` of normal `n` seen along `dir`: Phong's `1 − r − τ`, `r` and
 /// `τ` (with `fresnel`, `pbr::fresnel_weights` at `|N·V|`); a `pbr` material's local colour
 /// has weight 1 (its terms weigh themselves), its reflected ray `E_s·g`, its refracted ray

@@ -549,8 +549,7 @@ fn light<T: Float>(
     for (hit, c) in hits.iter().zip(colour_at) {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
         if lit(hit) {
-            // The local weight does not depend on the colour (1 for `pbr`).
-            let w = pbr::lobes(m, hit.n, ray.dir, V3::zero).local;
+            let w = pbr::local_weight(m, hit.n, ray.dir);
             let a = &mut samples.acc[ray.sample as usize];
             *a = *a + c.mul_v(ray.weight * hit.fade) * w;
         }

@@ -67,7 +67,7 @@ pub use crate::scene::{
     },
     look,
     params::{Accepts, ParamValue, Parameter},
-    NodeId, Tonemap,
+    pbr, NodeId, Pbr, Tonemap,
 };
 
 /// The lowering, once per scene: the distance program and what every back end reads of the

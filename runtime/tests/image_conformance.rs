@@ -70,6 +70,7 @@ const AGREEMENT: &[(&str, f64, f64)] = &[
     ("seed5", 73.0, 0.0005),   // 76.2 dB, 0.0000 (0 px), 2026-12-06 (filtered checker)
     ("seed6", 100.0, 0.0005), // 125.5 dB, 0 px (ε of the pixel footprint since issue 24: nearly identical; bound kept far below)
     ("star", 105.0, 0.0005),  // 108.9 dB, 0.0000 (0 px), 2026-11-27
+    ("studio", 78.0, 0.0005), // 81.5 dB, 0.0000 (0 px), 2026-12-06 (pbr: GGX, metal, glass, emission)
     ("temple", 80.0, 0.0005), // 83.9 dB, 0.0000 (0 px), 2026-12-06 (filtered checker)
     ("vase", 86.0, 0.0005),   // 89.1 dB, 0.0000 (0 px), 2026-11-27
 ];

@@ -394,8 +394,17 @@ fn features_are_the_templates() {
         .collect();
     // Not among the combinations: colour fields reach Tint through the examples that use
     // them (rock.sdf), the sky, occlusion, fog and the tone curve (GRADE) through
-    // gallery.sdf, which uses all four.
-    let by_examples = ["COLOUR_FIELDS", "SKY", "OCCLUSION", "FOG", "GRADE"];
+    // gallery.sdf, which uses all four, the physically based material (PBR, and FRESNEL
+    // with it, whose blocks are all in its kernel) through studio.sdf.
+    let by_examples = [
+        "COLOUR_FIELDS",
+        "SKY",
+        "OCCLUSION",
+        "FOG",
+        "GRADE",
+        "FRESNEL",
+        "PBR",
+    ];
     let combined: BTreeSet<&str> = flags
         .iter()
         .copied()

@@ -6,7 +6,9 @@ use crate::limits::{Limit, Limits};
 use crate::lower::hash_of;
 use crate::prim::{Args, Kind, Prim, PrimRef};
 pub use crate::prim::{Def, Range};
-use crate::scene::{Camera, Combine, Feature, Graph, Material, Node, NodeId, Settings, Smooth, V3};
+use crate::scene::{
+    Camera, Combine, Feature, Graph, Material, Node, NodeId, Pbr, Settings, Smooth, V3,
+};
 use crate::span::Span;
 
 impl Def {
@@ -1631,9 +1633,11 @@ pub struct Record {
     pub timeless: &'static [&'static str],
     /// Fields that take a colour field (`field { … }` of a vec3) as well as a vec3.
     pub painted: &'static [&'static str],
+    /// The help of a field's E0400 (its value out of range): how to give a valid one.
+    pub help: &'static [(&'static str, &'static str)],
 }
 
-const SURFACE: [P; 8] = [
+const SURFACE: [P; 9] = [
     p("ambient", F, Num(Material::AMBIENT), Unit),
     p("diffuse", F, Num(Material::DIFFUSE), NonNeg),
     p("specular", F, Num(Material::SPECULAR), NonNeg),
@@ -1647,6 +1651,9 @@ const SURFACE: [P; 8] = [
     p("transparency", F, Num(Material::TRANSPARENCY), Unit),
     p("ior", F, Num(Material::IOR), Within(1.0, 10.0)),
     p("color", V, V3(Material::COLOR), NonNeg),
+    // Schlick's Fresnel term on the reflected and refracted rays (docs/rendering.md,
+    // "Secondary rays"): off, so that the scenes written before it keep their look.
+    p("fresnel", B, Bool(false), Any),
 ];
 
 const fn concat<const N: usize, const M: usize, const T: usize>(a: [P; N], b: [P; M]) -> [P; T] {
@@ -1663,9 +1670,10 @@ const fn concat<const N: usize, const M: usize, const T: usize>(a: [P; N], b: [P
     out
 }
 
-const CHECKER: [P; 10] = concat(
+const CHECKER: [P; 11] = concat(
     [
         SURFACE[0], SURFACE[1], SURFACE[2], SURFACE[3], SURFACE[4], SURFACE[5], SURFACE[6],
+        SURFACE[8],
     ],
     [
         p("a", V, V3([0.9, 0.9, 0.9]), NonNeg),
@@ -1674,19 +1682,43 @@ const CHECKER: [P; 10] = concat(
     ],
 );
 
+/// `pbr`: the physically based material (docs/rendering.md, "Physically based materials").
+const PBR: [P; 6] = [
+    p("base_color", V, V3(Material::COLOR), NonNeg),
+    p("roughness", F, Num(Pbr::ROUGHNESS), Unit),
+    p("metallic", F, Num(Pbr::METALLIC), Unit),
+    p("emission", V, V3([0.0; 3]), NonNeg),
+    p("transmission", F, Num(Pbr::TRANSMISSION), Unit),
+    SURFACE[6],
+];
+
 /// Material kinds.
 pub static MATERIALS: &[Record] = &[
     Record {
         name: "phong",
         timeless: &[],
         painted: &["color"],
+        help: &[],
         fields: &SURFACE,
     },
     Record {
         name: "checker",
         timeless: &[],
         painted: &["a", "b"],
+        help: &[],
         fields: &CHECKER,
+    },
+    Record {
+        name: "pbr",
+        timeless: &[],
+        painted: &["base_color"],
+        help: &[
+            ("roughness", "write a roughness from 0 (a mirror) to 1 (fully rough): `roughness: 0.5`"),
+            ("metallic", "write a metallic from 0 (plastic, stone, glass) to 1 (a metal): `metallic: 1`"),
+            ("transmission", "write a transmission from 0 (opaque) to 1 (clear glass): `transmission: 1`"),
+            ("ior", "write an index of refraction from 1 to 10 (air 1, water 1.33, glass 1.5, diamond 2.42): `ior: 1.5`"),
+        ],
+        fields: &PBR,
     },
 ];
 
@@ -1741,24 +1773,28 @@ pub static LIGHTS: &[Record] = &[
         name: "point",
         timeless: &[],
         painted: &[],
+        help: &[],
         fields: &POINT,
     },
     Record {
         name: "directional",
         timeless: &[],
         painted: &[],
+        help: &[],
         fields: &DIRECTIONAL,
     },
     Record {
         name: "sun",
         timeless: &[],
         painted: &[],
+        help: &[],
         fields: &SUN,
     },
     Record {
         name: "sky",
         timeless: &[],
         painted: &[],
+        help: &[],
         fields: &SKY,
     },
 ];
@@ -1768,6 +1804,7 @@ pub static CAMERA: Record = Record {
     name: "camera",
     timeless: &[],
     painted: &[],
+    help: &[],
     fields: &[
         p("position", V, V3(Camera::DEFAULT.position), Any),
         p("look_at", V, V3(Camera::DEFAULT.look_at), Any),
@@ -1793,6 +1830,7 @@ pub static RENDER: Record = Record {
     // The sequence's frames and their size: an animated PNG or a video has one size.
     timeless: &["width", "height", "fps", "duration"],
     painted: &[],
+    help: &[],
     fields: &[
         p(
             "width",

@@ -2295,7 +2295,7 @@ pub fn record(
                 if v.ty() == Some(Type::ColourField) {
                     d = d.with_note(
                         "a colour field goes in a material's colour: `color` of `phong`, \
-                         `a` and `b` of `checker`",
+                         `a` and `b` of `checker`, `base_color` of `pbr`",
                     );
                 }
                 cx.error(d);
@@ -2309,6 +2309,9 @@ pub fn record(
             if let Err(why) = p.range.check(&v, &cx.limits) {
                 let mut d = Diagnostic::error("E0400", format!("`{}` {why}", p.name), f.value.span)
                     .with_label(format!("this is {v}"));
+                if let Some((_, help)) = rec.help.iter().find(|(n, _)| *n == p.name) {
+                    d = d.with_help(*help);
+                }
                 if let Some(limit) = p.range.limit(&v, &cx.limits) {
                     let needed = v.components().into_iter().fold(0.0, f64::max) as u64;
                     d = d.with_note(format!(

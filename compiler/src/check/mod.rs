@@ -22,7 +22,8 @@ pub mod types;
 use crate::diagnostics::Diagnostic;
 use crate::limits::{Limit, Limits};
 use crate::scene::{
-    Camera, Colour, Combine, Material, MaterialId, Method, Node, Pattern, Scene, Settings, Tonemap,
+    Camera, Colour, Combine, Material, MaterialId, Method, Node, Pattern, Pbr, Scene, Settings,
+    Tonemap,
 };
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::{self, ast};
@@ -612,7 +613,7 @@ fn material(
             kind.span,
         )
         .with_label("not a material kind")
-        .with_note("the material kinds are phong and checker");
+        .with_note("the material kinds are phong, checker and pbr");
         if let Some(s) = suggest::closest(&kind.name, builtins::MATERIALS.iter().map(|r| r.name)) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
@@ -620,6 +621,15 @@ fn material(
         return;
     };
     let f = eval::record(cx, rec, fields, kind);
+    // A colour field's value, or the constant's.
+    let colour = |v: &Value| match v {
+        Value::Colour(field) => Colour::Field((**field).clone()),
+        other => Colour::Const(other.v3()),
+    };
+    if rec.name == "pbr" {
+        scene.materials[id.0 as usize] = pbr_material(&name.name, &f, colour(&f["base_color"]));
+        return;
+    }
     let (reflect, transparency) = (f["reflect"].num(), f["transparency"].num());
     if reflect + transparency > 1.0 + 1e-12 {
         cx.error(
@@ -635,11 +645,6 @@ fn material(
             .with_note("the surface's own colour is weighted by 1 − reflect − transparency"),
         );
     }
-    // A colour field's value, or the constant's.
-    let colour = |v: &Value| match v {
-        Value::Colour(field) => Colour::Field((**field).clone()),
-        other => Colour::Const(other.v3()),
-    };
     let pattern = if rec.name == "checker" {
         Pattern::Checker {
             a: colour(&f["a"]),
@@ -659,7 +664,41 @@ fn material(
         reflect,
         transparency,
         ior: f["ior"].num(),
+        fresnel: matches!(f["fresnel"], Value::Bool(true)),
+        pbr: None,
     };
+}
+
+/// A `pbr` material of base colour `base` from its record's values: its transmission is the
+/// transparency of its dielectric part, `transmission·(1 − metallic)`, and its Phong fields
+/// the nearest Phong material's (no ambient term, the diffuse weight of the dielectric part,
+/// the reflectance at normal incidence as `specular`, the exponent of the same highlight
+/// width), which the material tables of `--part map` and the Shadertoy page show.
+fn pbr_material(name: &str, f: &HashMap<&'static str, Value>, base: Colour) -> Material {
+    let p = Pbr {
+        roughness: f["roughness"].num(),
+        metallic: f["metallic"].num(),
+        emission: f["emission"].v3(),
+        transmission: f["transmission"].num(),
+    };
+    let ior = f["ior"].num();
+    let transparency = p.transmission * (1.0 - p.metallic);
+    let grey = base
+        .constant()
+        .map_or(Material::COLOR[0], |c| (c[0] + c[1] + c[2]) / 3.0);
+    Material {
+        name: name.to_string(),
+        pattern: Pattern::Solid(base),
+        ambient: 0.0,
+        diffuse: 1.0 - p.metallic - transparency,
+        specular: crate::scene::pbr::f0(ior) * (1.0 - p.metallic) + grey * p.metallic,
+        shininess: p.shininess(),
+        reflect: 0.0,
+        transparency,
+        ior,
+        fresnel: true,
+        pbr: Some(p),
+    }
 }
 
 /// Gives every material its id before any item is evaluated, so that `@ name` finds a

@@ -338,7 +338,7 @@ fn view_region(scene: &Scene) -> Aabb {
     let secondary = scene
         .materials
         .iter()
-        .any(|m| m.reflect > 0.0 || m.transparency > 0.0);
+        .any(|m| m.reflects() || m.transparency > 0.0);
     let legs = if secondary {
         s.max_depth as f64 + 2.0
     } else {

@@ -128,9 +128,21 @@ pub fn dump(scene: &Scene) -> String {
                 )
             }
         };
+        // A `pbr` material's own parameters, and Phong's Fresnel, only where they are given.
+        let extra = match m.pbr {
+            Some(p) => format!(
+                " pbr roughness={} metallic={} emission={} transmission={}",
+                num(p.roughness),
+                num(p.metallic),
+                v3(p.emission),
+                num(p.transmission)
+            ),
+            None if m.fresnel => " fresnel".to_string(),
+            None => String::new(),
+        };
         let _ = writeln!(
             out,
-            "material #{i} {} {pattern} ambient={} diffuse={} specular={} shininess={} reflect={} transparency={} ior={}",
+            "material #{i} {} {pattern} ambient={} diffuse={} specular={} shininess={} reflect={} transparency={} ior={}{extra}",
             m.name, num(m.ambient), num(m.diffuse), num(m.specular), num(m.shininess), num(m.reflect),
             num(m.transparency), num(m.ior)
         );

@@ -611,7 +611,9 @@ impl Pattern {
     }
 }
 
-/// A Phong material (docs/rendering.md, "At a hit").
+/// A material (docs/rendering.md, "At a hit"): Phong, or physically based where `pbr` is
+/// given (its Phong fields then hold the nearest Phong material, for the material tables of
+/// `--part map` and the Shadertoy page).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
     /// The name it was declared with.
@@ -632,6 +634,11 @@ pub struct Material {
     pub transparency: f64,
     /// Index of refraction, ≥ 1.
     pub ior: f64,
+    /// Schlick's Fresnel term on the reflected and refracted rays (`fresnel: true`; always
+    /// on for `pbr`).
+    pub fresnel: bool,
+    /// The physically based model's parameters (`pbr { … }`), or `None` for Phong.
+    pub pbr: Option<super::Pbr>,
 }
 
 impl Material {
@@ -654,6 +661,16 @@ impl Material {
     /// The default index of refraction.
     pub const IOR: f64 = 1.5;
 
+    /// Whether a hit on it may spawn a reflected ray: `reflect` > 0, a `pbr` material
+    /// that is not fully rough (its mirror weight `(1 − roughness)²` > 0), or a Phong
+    /// material with Fresnel (which reflects at grazing incidence).
+    pub fn reflects(&self) -> bool {
+        match self.pbr {
+            Some(p) => p.mirror() > 0.0,
+            None => self.reflect > 0.0 || self.fresnel,
+        }
+    }
+
     /// The material of shapes that were not painted.
     pub fn default_material() -> Self {
         Material {
@@ -666,6 +683,8 @@ impl Material {
             reflect: Material::REFLECT,
             transparency: Material::TRANSPARENCY,
             ior: Material::IOR,
+            fresnel: false,
+            pbr: None,
         }
     }
 }

@@ -31,7 +31,7 @@ pub(super) enum Paint<T> {
     },
 }
 
-/// A Phong material in the evaluation type.
+/// A material in the evaluation type: Phong, or physically based where `pbr` is given.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Mat<T> {
     pub paint: Paint<T>,
@@ -42,6 +42,25 @@ pub(super) struct Mat<T> {
     pub reflect: T,
     pub transparency: T,
     pub ior: T,
+    /// Schlick's Fresnel term on the reflected and refracted rays.
+    pub fresnel: bool,
+    /// Whether a hit on it spawns a reflected ray ([`Material::reflects`]).
+    pub reflects: bool,
+    /// The reflectance at normal incidence of a dielectric of its `ior`.
+    pub f0: T,
+    pub pbr: Option<PbrMat<T>>,
+}
+
+/// The parameters of a `pbr` material in the evaluation type (`sdfc_compiler::pbr`).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PbrMat<T> {
+    pub roughness: T,
+    /// The GGX width α.
+    pub alpha: T,
+    pub metallic: T,
+    pub emission: V3<T>,
+    /// The weight g of the environment's specular reflection a reflected ray carries.
+    pub mirror: T,
 }
 
 /// A light in the evaluation type; `color` is colour × intensity (I_l); `sharpness` is
@@ -203,7 +222,8 @@ impl<T: Float> Context<T> {
     }
 }
 
-/// The most rays one hit spawns: a reflection where `reflect` > 0 and a refraction (or, on
+/// The most rays one hit spawns: a reflection where the material reflects
+/// ([`Material::reflects`]) and a refraction (or, on
 /// total internal reflection, a reflection) where `transparency` > 0; an exit from a solid
 /// spawns one, and no hit spawns any at `max_depth` 0.
 pub(super) fn branching(scene: &Scene) -> usize {
@@ -213,7 +233,7 @@ pub(super) fn branching(scene: &Scene) -> usize {
     scene
         .materials
         .iter()
-        .map(|m| (m.reflect > 0.0) as usize + (m.transparency > 0.0) as usize)
+        .map(|m| (m.reflects() as usize) + (m.transparency > 0.0) as usize)
         .max()
         .unwrap_or(0)
 }
@@ -243,6 +263,16 @@ fn mat<T: Float>(scene: &Scene, m: &Material, fields: [Option<usize>; 2]) -> Mat
         reflect: f(m.reflect),
         transparency: f(m.transparency),
         ior: f(m.ior.max(1e-6)),
+        fresnel: m.fresnel,
+        reflects: m.reflects(),
+        f0: f(sdfc_compiler::pbr::f0(m.ior)),
+        pbr: m.pbr.map(|p| PbrMat {
+            roughness: f(p.roughness),
+            alpha: f(p.alpha()),
+            metallic: f(p.metallic),
+            emission: V3::from_f64(p.emission),
+            mirror: f(p.mirror()),
+        }),
     }
 }
 
@@ -301,6 +331,15 @@ fn lamp<T: Float>(l: &Light) -> Option<Lamp<T>> {
         },
         Light::Sky { .. } => return None,
     })
+}
+
+impl<T: Float> Sky<T> {
+    /// Its irradiance over π on a surface whose normal's height is `y`:
+    /// `c₀ + c₁·y + c₂·(3y² − 1)` (docs/rendering.md, "Sky light").
+    pub fn irradiance_at(&self, y: T) -> V3<T> {
+        let [c0, c1, c2] = self.irradiance;
+        c0 + c1 * y + c2 * (T::from_f64(3.0) * y * y - T::one())
+    }
 }
 
 impl<T: Float> Context<T> {

@@ -5,6 +5,7 @@ use super::context::{Context, Lamp, Mat, Paint, Tint};
 use super::lanes::{march, Launch};
 use super::look;
 use super::march::{Shadow, Shadowed, Status, Trace, Traced};
+use super::pbr::{self, Surface};
 use super::stats::Counters;
 use super::vec::V3;
 use super::wave::{Evaluators, Ray, Samples, Workspace};
@@ -415,9 +416,10 @@ fn lamp_colour<T: Float>(lamp: &Lamp<T>) -> (V3<T>, T) {
     }
 }
 
-/// The Phong terms of one light at a hit, before its shadow: the contribution
-/// atten·(k_d·(N·L)·C·I_l + k_s·max(R·V, 0)^α·I_l) and the shadow ray towards the light, or
-/// `None` when the light cannot contribute (N·L ≤ 0 or atten = 0).
+/// The terms of one light at a hit, before its shadow: Phong's
+/// atten·(k_d·(N·L)·C·I_l + k_s·max(R·V, 0)^α·I_l), or a `pbr` surface's
+/// ([`pbr::lamp`]) times atten, and the shadow ray towards the light, or `None` when the
+/// light cannot contribute (N·L ≤ 0 or atten = 0).
 fn lamp_term<T: Float>(
     ctx: &Context<T>,
     lamp: &Lamp<T>,
@@ -425,6 +427,7 @@ fn lamp_term<T: Float>(
     m: &Mat<T>,
     c: V3<T>,
     dir: V3<T>,
+    surface: Option<&Surface<T>>,
 ) -> Option<(V3<T>, Launch<T>)> {
     let (l, dist, atten) = towards(ctx, lamp, hit.p);
     let ndl = hit.n.dot(l);
@@ -432,10 +435,15 @@ fn lamp_term<T: Float>(
         return None;
     }
     let (il, k) = lamp_colour(lamp);
-    let r = hit.n * (T::from_f64(2.0) * ndl) - l;
-    let rv = r.dot(-dir).max(T::zero());
-    let spec = m.specular * rv.powf(m.shininess);
-    let contrib = (c * (m.diffuse * ndl) + V3::splat(spec)).mul_v(il) * atten;
+    let contrib = match surface {
+        Some(s) => pbr::lamp(s, hit.n, -dir, l, il) * atten,
+        None => {
+            let r = hit.n * (T::from_f64(2.0) * ndl) - l;
+            let rv = r.dot(-dir).max(T::zero());
+            let spec = m.specular * rv.powf(m.shininess);
+            (c * (m.diffuse * ndl) + V3::splat(spec)).mul_v(il) * atten
+        }
+    };
     let off = T::from_f64(4.0) * hit.h;
     let o = hit.p + hit.n * off;
     let tmax = if matches!(lamp, Lamp::Point { .. }) {
@@ -464,14 +472,16 @@ fn lamp_term<T: Float>(
     Some((contrib, launch))
 }
 
-/// The weight of a material's local colour: 1 - r - τ.
-fn local_weight<T: Float>(m: &Mat<T>) -> T {
-    T::one() - m.reflect - m.transparency
+/// Whether a material has a local colour: Phong's 1 − r − τ > 0 (before Fresnel), always
+/// for `pbr` (whose terms weigh themselves).
+fn has_local<T: Float>(m: &Mat<T>) -> bool {
+    m.pbr.is_some() || T::one() - m.reflect - m.transparency > T::zero()
 }
 
-/// Phong at every hit seen from outside, with one shadow ray per (hit, light) that can
-/// contribute: I = k_a·C + Σ shadow·atten·(k_d·max(N·L, 0)·C·I_l + k_s·max(R·V, 0)^α·I_l),
-/// added to the sample with the weight (1 - r - τ).
+/// The light of every hit seen from outside, with one shadow ray per (hit, light) that can
+/// contribute: Phong's I = k_a·C + Σ shadow·atten·(k_d·max(N·L, 0)·C·I_l + k_s·max(R·V,
+/// 0)^α·I_l), or a `pbr` material's emission and terms ([`pbr`]), added to the sample with
+/// the weight of the local colour ([`pbr::lobes`]).
 fn light<T: Float>(
     ctx: &Context<T>,
     ws: &mut Workspace<'_, T>,
@@ -484,7 +494,7 @@ fn light<T: Float>(
     let mut pending: Vec<(usize, V3<T>)> = Vec::new();
     let lit = |hit: &Hit<T>| {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
-        (!ray.inside || hit.solid) && local_weight(m) > T::zero()
+        (!ray.inside || hit.solid) && has_local(m)
     };
     let ao = occlusions(ctx, ws, hits, &lit);
     ws.launches.clear();
@@ -494,17 +504,25 @@ fn light<T: Float>(
             continue;
         }
         let c = colour(ctx, m, hit, ray.dir);
-        colour_at[hi] = c * (m.ambient * ao[hi]);
-        // Sky light: k_d·C·E(N)/π, times the occlusion where it casts shadows.
-        let ny = hit.n.y;
+        let surface = m.pbr.map(|p| pbr::surface(m, p, c, hit.n, -ray.dir));
+        colour_at[hi] = match &surface {
+            Some(s) => s.pbr.emission,
+            None => c * (m.ambient * ao[hi]),
+        };
+        // Sky light: Phong's k_d·C·E(N)/π, or a `pbr` surface's ([`pbr::sky`]), times the
+        // occlusion where it casts shadows.
         for sky in &ctx.skies {
-            let [c0, c1, c2] = sky.irradiance;
-            let e = c0 + c1 * ny + c2 * (T::from_f64(3.0) * ny * ny - T::one());
             let seen = if sky.occluded { ao[hi] } else { T::one() };
-            colour_at[hi] = colour_at[hi] + c.mul_v(e) * (m.diffuse * seen);
+            let term = match &surface {
+                Some(s) => pbr::sky(s, sky, hit.n, -ray.dir),
+                None => c.mul_v(sky.irradiance_at(hit.n.y)) * m.diffuse,
+            };
+            colour_at[hi] = colour_at[hi] + term * seen;
         }
         for lamp in &ctx.lamps {
-            if let Some((contrib, launch)) = lamp_term(ctx, lamp, hit, m, c, ray.dir) {
+            if let Some((contrib, launch)) =
+                lamp_term(ctx, lamp, hit, m, c, ray.dir, surface.as_ref())
+            {
                 // k < 0: a light without shadows.
                 if launch.k < T::zero() {
                     colour_at[hi] = colour_at[hi] + contrib;
@@ -531,8 +549,9 @@ fn light<T: Float>(
     for (hit, c) in hits.iter().zip(colour_at) {
         let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
         if lit(hit) {
+            let w = pbr::local_weight(m, hit.n, ray.dir);
             let a = &mut samples.acc[ray.sample as usize];
-            *a = *a + c.mul_v(ray.weight * hit.fade) * local_weight(m);
+            *a = *a + c.mul_v(ray.weight * hit.fade) * w;
         }
     }
 }
@@ -648,23 +667,21 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
         }
         // A solid's surface inside glass faces the glass: what leaves it stays inside.
         let within = hit.solid;
-        if m.reflect > T::zero() {
+        let lobes = pbr::lobes(m, hit.n, ray.dir, || colour(ctx, m, hit, ray.dir));
+        // A reflection of no weight (Fresnel's rim facing the camera) is not traced.
+        if m.reflects && lobes.reflect.max_abs() > T::zero() {
             next.push(child(
                 hit.p + off,
                 ray.dir.reflect(hit.n),
-                weight * m.reflect,
+                weight.mul_v(lobes.reflect),
                 within,
             ));
         }
         if m.transparency > T::zero() {
+            let weight = weight.mul_v(lobes.transmit);
             match refract(ray.dir, hit.n, T::one() / m.ior) {
-                Some(t) => next.push(child(hit.p - off, t, weight * m.transparency, true)),
-                None => next.push(child(
-                    hit.p + off,
-                    ray.dir.reflect(hit.n),
-                    weight * m.transparency,
-                    within,
-                )),
+                Some(t) => next.push(child(hit.p - off, t, weight, true)),
+                None => next.push(child(hit.p + off, ray.dir.reflect(hit.n), weight, within)),
             }
         }
     }

@@ -33,6 +33,13 @@ struct Material {
     phong: vec4<f32>,   // ambient, diffuse, specular, shininess
     optics: vec4<f32>,  // reflect, transparency, ior, colour field of color (k + 1; 0: none)
     shift: vec4<f32>,   // checker: the pattern's offset at the scene's origin, in cells; w: colour field of color_b
+//#if FRESNEL
+    fresnel: vec4<f32>, // F0 of a dielectric of its ior, 1 for Phong with Fresnel, 1 for pbr
+//#endif
+//#if PBR
+    pbr: vec4<f32>,      // roughness, GGX α, metallic, mirror weight g = (1 − roughness)²
+    emission: vec4<f32>, // rgb
+//#endif
 }
 struct Params {
     eye: vec4<f32>,        // camera position
@@ -546,14 +553,14 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
                 // within the glass (docs/rendering.md, "Inside glass").
                 let ms = params.materials[u32(solid.y)];
                 let ns = normal_solid(p, h, ray.dir);
-                let ws = 1.0 - ms.optics.x - ms.optics.y;
-                if ws > 0.0 {
+                let ls = lobes(ms, p, ns, ray.dir, tt, h);
+                if ls.local > 0.0 {
                     medium_tau = params.materials[u32(map(p).y)].optics.y;
-                    acc += shade(ms, p, ns, ray.dir, tt, h, 1.0) * weight * ws;
+                    acc += shade(ms, p, ns, ray.dir, tt, h, 1.0) * weight * ls.local;
                     medium_tau = 0.0;
                 }
-                if ray.depth < params.depth.x && ms.optics.x > 0.0 {
-                    stack[top] = Ray(p + ns * (4.0 * h), tt, reflect_dir(ray.dir, ns), ray.depth + 1u, weight * ms.optics.x, 1u);
+                if ray.depth < params.depth.x && any(ls.reflect > vec3<f32>(0.0)) {
+                    stack[top] = Ray(p + ns * (4.0 * h), tt, reflect_dir(ray.dir, ns), ray.depth + 1u, weight * ls.reflect, 1u);
                     top += 1u;
                     counters.secondary += 1u;
                 }
@@ -578,15 +585,15 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#endif
         let solid = false;
 //#endif
-        let w = 1.0 - m.optics.x - m.optics.y;
-        if (!inside || solid) && w > 0.0 {
+        let lb = lobes(m, p, n, ray.dir, tt, h);
+        if (!inside || solid) && lb.local > 0.0 {
             var ao = 1.0;
 //#if OCCLUSION
             if !solid {
                 ao = occlusion(p, n);
             }
 //#endif
-            acc += shade(m, p, n, ray.dir, tt, h, ao) * weight * w;
+            acc += shade(m, p, n, ray.dir, tt, h, ao) * weight * lb.local;
         }
 //#if SECONDARY
         if ray.depth >= params.depth.x {
@@ -607,9 +614,9 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             continue;
         }
 //#endif
-        if m.optics.x > 0.0 {
+        if any(lb.reflect > vec3<f32>(0.0)) {
             // From a solid within glass the reflection stays inside the glass.
-            stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, weight * m.optics.x, u32(solid));
+            stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, weight * lb.reflect, u32(solid));
             top += 1u;
             counters.secondary += 1u;
         }
@@ -617,9 +624,9 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         if m.optics.y > 0.0 {
             let tr = refract_dir(ray.dir, n, 1.0 / m.optics.z);
             if any(tr != vec3<f32>(0.0)) {
-                stack[top] = Ray(p - off, tt, tr, ray.depth + 1u, weight * m.optics.y, 1u);
+                stack[top] = Ray(p - off, tt, tr, ray.depth + 1u, weight * lb.transmit, 1u);
             } else {
-                stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, weight * m.optics.y, 0u);
+                stack[top] = Ray(p + off, tt, reflect_dir(ray.dir, n), ray.depth + 1u, weight * lb.transmit, 0u);
             }
             top += 1u;
             counters.secondary += 1u;

@@ -134,8 +134,8 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
         .iter()
         .any(|l| matches!(l, Light::Directional { .. }));
     let refraction = mats.iter().any(|m| m.transparency > 0.0);
-    let secondary = scene.settings.max_depth > 0
-        && mats.iter().any(|m| m.reflect > 0.0 || m.transparency > 0.0);
+    let secondary =
+        scene.settings.max_depth > 0 && mats.iter().any(|m| m.reflects() || m.transparency > 0.0);
     vec![
         ("ANALYTIC", traced),
         ("POINT", points),
@@ -169,6 +169,10 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
             scene.lights.iter().any(|l| matches!(l, Light::Sky { .. })),
         ),
         ("FOG", scene.settings.fog > 0.0),
+        // Schlick's Fresnel term on a material's rays (`fresnel: true`, or `pbr`), and the
+        // physically based material (docs/rendering.md, "Physically based materials").
+        ("FRESNEL", mats.iter().any(|m| m.fresnel)),
+        ("PBR", mats.iter().any(|m| m.pbr.is_some())),
         (
             "GRADE",
             scene.settings.exposure != 0.0 || scene.settings.tonemap != crate::scene::Tonemap::None,
@@ -575,6 +579,15 @@ fn write_template(
         {
             values.insert(k, float(c));
         }
+    }
+    {
+        use crate::scene::pbr;
+        let v4 = |c: [f64; 4]| c.map(float).join(", ");
+        values.insert("NV_MIN", float(pbr::NV_MIN));
+        values.insert("ENV_C0", v4(pbr::ENV_C0));
+        values.insert("ENV_C1", v4(pbr::ENV_C1));
+        values.insert("ENV_EXP", float(pbr::ENV_EXP));
+        values.insert("PI", float(std::f64::consts::PI));
     }
     values.insert("ENTRY", ENTRY_POINT.to_string());
     let source = template::expand(template, &on, &values).map_err(|e| Error {

@@ -93,17 +93,99 @@ fn occlusion(p: vec3<f32>, n: vec3<f32>) -> f32 {
 }
 //#endif
 
-// One light's Phong term at a hit, shadow included.
+//#if FRESNEL
+// Schlick's (1 − c)⁵.
+fn schlick(c: f32) -> f32 {
+    let x = 1.0 - clamp(c, 0.0, 1.0);
+    let x2 = x * x;
+    return x2 * x2 * x;
+}
+//#endif
+//#if PBR
+// The physically based material (docs/rendering.md, "Physically based materials"; the
+// formulas of compiler/src/scene/pbr.rs). The terms it shares at a hit of base colour c.
+struct Surface {
+    nv: f32,            // max(N·V, NV_MIN)
+    f0: vec3<f32>,      // the reflectance at normal incidence
+    albedo: vec3<f32>,  // the specular lobe's directional albedo E_s = clamp(F0·A + B, 0, 1)
+}
+
+fn pbr_surface(m: Material, c: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> Surface {
+    let nv = max(dot(n, v), {{NV_MIN}});
+    let f0 = vec3<f32>(m.fresnel.x * (1.0 - m.pbr.z)) + c * m.pbr.z;
+    // Karis's fit of the split-sum environment BRDF: r = roughness·c0 + c1.
+    let r = m.pbr.x * vec4<f32>({{ENV_C0}}) + vec4<f32>({{ENV_C1}});
+    let a = min(r.x * r.x, exp2({{ENV_EXP}} * nv)) * r.x + r.y;
+    let ab = vec2<f32>(-1.04, 1.04) * a + r.zw;
+    return Surface(nv, f0, clamp(f0 * ab.x + vec3<f32>(ab.y), vec3<f32>(0.0), vec3<f32>(1.0)));
+}
+
+// A lamp's light on a pbr surface before attenuation and shadow, N·L > 0:
+// (k_d·(1 − F)·C + π·D·Vis·F)·I_l·(N·L).
+fn pbr_lamp(m: Material, s: Surface, c: vec3<f32>, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, il: vec3<f32>) -> vec3<f32> {
+    let nl = dot(n, l);
+    let hv = normalize(l + v);
+    let nh = max(dot(n, hv), 0.0);
+    let f = s.f0 + (vec3<f32>(1.0) - s.f0) * schlick(dot(v, hv));
+    let a2 = m.pbr.y * m.pbr.y;
+    let dd = nh * nh * (a2 - 1.0) + 1.0;
+    let dist = a2 / ({{PI}} * dd * dd);
+    let vis = 0.5 / (nl * sqrt(s.nv * s.nv * (1.0 - a2) + a2) + s.nv * sqrt(nl * nl * (1.0 - a2) + a2));
+    let diffuse = (vec3<f32>(1.0) - f) * c * m.phong.y;
+    return (diffuse + f * ({{PI}} * dist * vis)) * il * nl;
+}
+//#endif
+
+//% The weights of a hit's local colour, reflected ray and refracted ray on m of normal n seen
+//% along d: Phong's 1 − r − τ, r, τ (with Fresnel, moved towards the mirror at grazing
+//% incidence); pbr's 1, E_s·g and τ·(1 − E_s)·C.
+// The weights of a hit's local colour, reflected and refracted ray (docs/rendering.md).
+struct Lobes { local: f32, reflect: vec3<f32>, transmit: vec3<f32> }
+fn lobes(m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32) -> Lobes {
+//#if PBR
+    if m.fresnel.z > 0.0 {
+        let c = surface_colour(m, p, n, h, d, tt);
+        let s = pbr_surface(m, c, n, -d);
+        return Lobes(1.0, s.albedo * m.pbr.w, (vec3<f32>(1.0) - s.albedo) * c * m.optics.y);
+    }
+//#endif
+//#if FRESNEL
+    let r = m.optics.x;
+    let tau = m.optics.y;
+    if m.fresnel.y > 0.0 {
+        // w' = w·(1 − s), τ' = τ·(1 − R), r' = r + w·s + τ·R with s = (1 − |N·V|)⁵ and the
+        // glass's R = F0 + (1 − F0)·s.
+        let sg = schlick(abs(dot(n, d)));
+        let w = 1.0 - r - tau;
+        let big_r = m.fresnel.x + (1.0 - m.fresnel.x) * sg;
+        return Lobes(w * (1.0 - sg), vec3<f32>(r + w * sg + tau * big_r), vec3<f32>(tau * (1.0 - big_r)));
+    }
+//#endif
+    return Lobes(1.0 - m.optics.x - m.optics.y, vec3<f32>(m.optics.x), vec3<f32>(m.optics.y));
+}
+
+// One light's term at a hit, shadow included: Phong's, or a pbr surface's.
 fn phong_term(c: vec3<f32>, m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32,
               l: vec3<f32>, dist: f32, atten: f32, il: vec3<f32>, k: f32, is_point: bool) -> vec3<f32> {
     let ndl = dot(n, l);
     if ndl <= 0.0 || atten <= 0.0 {
         return vec3<f32>(0.0);
     }
+//#if PBR
+    var contrib: vec3<f32>;
+    if m.fresnel.z > 0.0 {
+        contrib = pbr_lamp(m, pbr_surface(m, c, n, -d), c, n, -d, l, il) * atten;
+    } else {
+        let r = n * (2.0 * ndl) - l;
+        let spec = m.phong.z * pow(max(dot(r, -d), 0.0), m.phong.w);
+        contrib = (c * (m.phong.y * ndl) + vec3<f32>(spec)) * il * atten;
+    }
+//#else
     let r = n * (2.0 * ndl) - l;
     let rv = max(dot(r, -d), 0.0);
     let spec = m.phong.z * pow(rv, m.phong.w);
     let contrib = (c * (m.phong.y * ndl) + vec3<f32>(spec)) * il * atten;
+//#endif
     // k < 0: a light without shadows.
     if k < 0.0 {
         return contrib;
@@ -133,10 +215,18 @@ fn background(d: vec3<f32>) -> vec3<f32> {
 }
 
 // Ambient (times the occlusion ao) plus every light:
-// I = ao·k_a·C + Σ shadow·atten·(k_d·max(N·L,0)·C·I_l + k_s·max(R·V,0)^α·I_l).
+// I = ao·k_a·C + Σ shadow·atten·(k_d·max(N·L,0)·C·I_l + k_s·max(R·V,0)^α·I_l) (pbr: emission).
 fn shade(m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32, ao: f32) -> vec3<f32> {
     let c = surface_colour(m, p, n, h, d, tt);
     var sum = c * (m.phong.x * ao);
+//#if PBR
+    let pbr = m.fresnel.z > 0.0;
+    var es = vec3<f32>(0.0);
+    if pbr {
+        sum = m.emission.xyz;
+        es = pbr_surface(m, c, n, -d).albedo;
+    }
+//#endif
 //#if POINT
     for (var i = 0u; i < {{POINTS}}u; i++) {
         let light = params.points[i];
@@ -162,7 +252,16 @@ fn shade(m: Material, p: vec3<f32>, n: vec3<f32>, d: vec3<f32>, tt: f32, h: f32,
     for (var i = 0u; i < {{SKIES}}u; i++) {
         let sky = params.skies[i];
         let e = sky.c0.xyz + sky.c1.xyz * n.y + sky.c2.xyz * (3.0 * n.y * n.y - 1.0);
-        sum += c * e * (m.phong.y * select(1.0, ao, sky.c0.w > 0.0));
+        var term = c * e * m.phong.y;
+//#if PBR
+        // pbr: k_d·(1 − E_s)·C·E(N)/π + E_s·(1 − g)·E(R)/π.
+        if pbr {
+            let ry = 2.0 * dot(n, -d) * n.y + d.y;
+            let er = sky.c0.xyz + sky.c1.xyz * ry + sky.c2.xyz * (3.0 * ry * ry - 1.0);
+            term = (vec3<f32>(1.0) - es) * term + es * er * (1.0 - m.pbr.w);
+        }
+//#endif
+        sum += term * select(1.0, ao, sky.c0.w > 0.0);
     }
 //#endif
     return sum;

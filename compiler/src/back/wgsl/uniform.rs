@@ -160,6 +160,32 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             &[m.reflect, m.transparency, m.ior.max(1e-6), field(0)],
         )?;
         w.floats(&at("shift"), &v4(shift, field(1)))?;
+        // The members of the kernels that have them (the scene's features FRESNEL and PBR).
+        if scene.materials.iter().any(|m| m.fresnel) {
+            let flag = |on: bool| if on { 1.0 } else { 0.0 };
+            w.floats(
+                &at("fresnel"),
+                &[
+                    crate::scene::pbr::f0(m.ior),
+                    flag(m.fresnel && m.pbr.is_none()),
+                    flag(m.pbr.is_some()),
+                    0.0,
+                ],
+            )?;
+        }
+        if scene.materials.iter().any(|m| m.pbr.is_some()) {
+            let p = m.pbr.unwrap_or(crate::scene::Pbr {
+                roughness: 1.0,
+                metallic: 0.0,
+                emission: [0.0; 3],
+                transmission: 0.0,
+            });
+            w.floats(
+                &at("pbr"),
+                &[p.roughness, p.alpha(), p.metallic, p.mirror()],
+            )?;
+            w.floats(&at("emission"), &v4(p.emission, 0.0))?;
+        }
     }
     for (k, t) in srgb::thresholds().chunks_exact(4).enumerate() {
         let t: Vec<f64> = t.iter().map(|&x| f64::from(x)).collect();

@@ -17,6 +17,7 @@ mod media;
 mod shape_tests;
 mod shapes;
 mod simplify;
+mod sweep;
 #[cfg(test)]
 mod tests;
 

@@ -10,12 +10,14 @@ pub mod field;
 pub mod ir;
 pub mod look;
 pub mod params;
+pub mod path;
 pub mod reach;
 pub mod recentre;
 
 pub use dump::{dump, num as dump_num};
 pub use ir::*;
 pub use look::Tonemap;
+pub use path::Path;
 
 /// Names a node of a [`Graph`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -19,6 +19,8 @@ mod shapes;
 mod simplify;
 mod sweep;
 #[cfg(test)]
+mod sweep_tests;
+#[cfg(test)]
 mod tests;
 
 use crate::program::{Binary, Program, Reg, Unary};

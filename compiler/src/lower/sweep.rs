@@ -172,31 +172,17 @@ fn polyline(
     let corners: Vec<usize> = if closed { (0..n).collect() } else { (1..n).collect() };
     for i in corners {
         let j = (i + n - 1) % n;
-        let (t0, t1) = (dir(j), dir(i));
-        let axis = t0.cross(t1);
-        if axis.length() < 1e-9 {
-            continue;
-        }
-        let axis = axis.normalize();
-        let out = -(t1 - t0 * t1.dot(t0)).normalize();
         let [nn, bb] = frames[j].map(v3);
-        let q = b.sub3c(p, points[i]);
-        let d2 = b.dot3(q, q);
-        let a = dot(b, q, axis);
-        let a2 = b.mul(a, a);
-        let r2 = b.sub(d2, a2);
-        let r2 = b.maxc(r2, 0.0);
-        let rho = b.sqrt(r2);
-        let comb = |b: &mut Builder, k: DVec3| {
-            let x = b.mulc(a, axis.dot(k));
-            let y = b.mulc(rho, out.dot(k));
-            b.add(x, y)
+        let Some(h) = corner(b, p, v3(points[i]), [dir(j), dir(i)], [nn, bb]) else {
+            continue;
         };
-        let (u, v) = (comb(b, nn), comb(b, bb));
-        let w = b.c(-FAR);
-        let at = if i == 0 { before[n - 1] + (v3(points[n]) - v3(points[n - 1])).length() } else { before[i] };
+        let at = if i == 0 {
+            before[n - 1] + (v3(points[n]) - v3(points[n - 1])).length()
+        } else {
+            before[i]
+        };
         let angle = b.c(twist * at);
-        keep(b, Hit { d2, u, v, w }, angle);
+        keep(b, h, angle);
     }
     let (h, angle) = best.expect("a polyline has a segment");
     if twist == 0.0 {
@@ -204,6 +190,35 @@ fn polyline(
     }
     let (u, v) = turn(b, h.u, h.v, angle);
     Hit { u, v, ..h }
+}
+
+/// At the corner `x` from direction `t[0]` to `t[1]` (`None` where they are one), the point's
+/// hit as the profile turned about the corner's axis (t₀ × t₁) would give it, in the frame
+/// (N, B) that arrives there: its distance, the height along the axis and the distance from
+/// it, away from the turn. The nearest point of a path is the corner only in the wedge
+/// beyond both directions, where this holds.
+fn corner(b: &mut Builder, p: P, x: DVec3, t: [DVec3; 2], [nn, bb]: [DVec3; 2]) -> Option<Hit> {
+    let axis = t[0].cross(t[1]);
+    if axis.length() < 1e-9 {
+        return None;
+    }
+    let axis = axis.normalize();
+    let out = -(t[1] - t[0] * t[1].dot(t[0])).normalize();
+    let q = b.sub3c(p, x.to_array());
+    let d2 = b.dot3(q, q);
+    let a = dot(b, q, axis);
+    let a2 = b.mul(a, a);
+    let r2 = b.sub(d2, a2);
+    let r2 = b.maxc(r2, 0.0);
+    let rho = b.sqrt(r2);
+    let comb = |b: &mut Builder, k: DVec3| {
+        let x = b.mulc(a, axis.dot(k));
+        let y = b.mulc(rho, out.dot(k));
+        b.add(x, y)
+    };
+    let (u, v) = (comb(b, nn), comb(b, bb));
+    let w = b.c(-FAR);
+    Some(Hit { d2, u, v, w })
 }
 
 /// The helix: Newton's method on the squared distance from the angle of the point's own turn
@@ -220,16 +235,33 @@ fn helix(b: &mut Builder, p: P, radius: f64, pitch: f64, turns: f64) -> Hit {
     let diff = b.sub(level, phi0);
     let n = b.mulc(diff, 1.0 / TAU);
     let n = b.un(Unary::Round, n);
-    let n = b.mulc(n, TAU);
-    let first = b.add(phi0, n);
+    // The turns the helix has at the point's angle: from the first at or after its start to
+    // the last at or before its end.
+    let zero = b.c(0.0);
+    let negative = b.lt(phi0, zero);
+    let (one, none) = (b.c(1.0), b.c(0.0));
+    let lowest = b.select(negative, one, none);
+    let left = b.neg(phi0);
+    let left = b.addc(left, total);
+    let left = b.mulc(left, 1.0 / TAU);
+    let highest = b.un(Unary::Floor, left);
+    let own = b.max(n, lowest);
+    let own = b.min(own, highest);
+    let at = b.mulc(own, TAU);
+    let first = b.add(phi0, at);
     let below = b.lt(level, first);
-    let (down, up) = (b.c(-TAU), b.c(TAU));
+    let (down, up) = (b.c(-1.0), b.c(1.0));
     let step = b.select(below, down, up);
-    let second = b.add(first, step);
+    let next = b.add(own, step);
+    let next = b.max(next, lowest);
+    let next = b.min(next, highest);
+    let at = b.mulc(next, TAU);
+    let second = b.add(phi0, at);
+    let (start, end) = (b.c(0.0), b.c(total));
     let mut best = None;
-    for start in [first, second] {
-        let mut phi = b.clampc(start, 0.0, total);
-        for _ in 0..3 {
+    for (from, newton) in [(first, true), (second, true), (start, false), (end, false)] {
+        let mut phi = b.clampc(from, 0.0, total);
+        for _ in 0..if newton { 3 } else { 0 } {
             let (s, c) = (b.un(Unary::Sin, phi), b.un(Unary::Cos, phi));
             let (xs, zc) = (b.mul(p[0], s), b.mul(p[2], c));
             let side = b.add(xs, zc);
@@ -370,7 +402,8 @@ fn bezier(
             let g = b.dot3(d1, d1);
             let h = b.dot3(d, d2);
             let f2 = b.add(g, h);
-            let f2 = b.max(f2, g);
+            let floor = b.mulc(g, 0.1);
+            let f2 = b.max(f2, floor);
             let f2 = b.maxc(f2, 1e-12);
             let step = b.div(f1, f2);
             let next = b.sub(t, step);
@@ -385,7 +418,7 @@ fn bezier(
         let mt = b.mulc(t, pieces as f64);
         let mut nv: Option<P> = None;
         for j in 0..=pieces {
-            let nj = normals[c * pieces + j];
+            let nj = normals[c * (pieces + 1) + j];
             let x = b.subc(mt, j as f64);
             let x = b.abs(x);
             let x = b.neg(x);
@@ -410,6 +443,26 @@ fn bezier(
         let bb = cross(b, tan, nn);
         let u = b.dot3(qv, nn);
         let v = b.dot3(qv, bb);
+        // Beyond an end at a corner the corner's wedge holds the nearest point.
+        let along = b.dot3(qv, tan);
+        let mut d2 = d2;
+        let (starts, ends) = (joint(&pts, c, closed), joint(&pts, c + 1, closed));
+        if starts.is_some() {
+            let (lim, zero) = (b.c(1e-6), b.c(0.0));
+            let at = b.lt(t, lim);
+            let back = b.lt(along, zero);
+            let out = b.mul(at, back);
+            let far = b.c(FAR);
+            d2 = b.select(out, far, d2);
+        }
+        if ends.is_some() {
+            let (lim, zero) = (b.c(1.0 - 1e-6), b.c(0.0));
+            let at = b.lt(lim, t);
+            let ahead = b.lt(zero, along);
+            let out = b.mul(at, ahead);
+            let far = b.c(FAR);
+            d2 = b.select(out, far, d2);
+        }
         let mut w = b.c(-FAR);
         if !closed && c == 0 {
             let t0 = tangent(q, 0.0).normalize();
@@ -433,7 +486,30 @@ fn bezier(
         }
         best = Some(nearer(b, best, Hit { d2, u, v, w }));
     }
+    for c in 0..k {
+        if let Some((x, t0, t1)) = joint(&pts, c, closed) {
+            let prev = (c + k - 1) % k;
+            let nn = v3(normals[prev * (pieces + 1) + pieces]);
+            let bb = t0.cross(nn);
+            if let Some(h) = corner(b, p, x, [t0, t1], [nn, bb]) {
+                best = Some(nearer(b, best, h));
+            }
+        }
+    }
     best.expect("a Bézier path has a curve")
+}
+
+/// The corner where curve `c` starts, if the curve before it (the last, on a closed path)
+/// ends in another direction: the point, the direction arriving and the one leaving.
+fn joint(pts: &[DVec3], c: usize, closed: bool) -> Option<(DVec3, DVec3, DVec3)> {
+    let k = (pts.len() - 1) / 3;
+    if (c == 0 || c == k) && !closed {
+        return None;
+    }
+    let (c, prev) = (c % k, (c + k - 1) % k);
+    let t0 = tangent(&pts[3 * prev..3 * prev + 4], 1.0).normalize();
+    let t1 = tangent(&pts[3 * c..3 * c + 4], 0.0).normalize();
+    (t0.cross(t1).length() >= 1e-9).then_some((pts[3 * c], t0, t1))
 }
 
 fn cross(b: &mut Builder, x: P, y: P) -> P {

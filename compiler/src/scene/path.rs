@@ -42,8 +42,8 @@ pub enum PathKind {
     /// `turns` turns (h = pitch·turns), turning from +x towards −z.
     Helix { radius: f64, pitch: f64, turns: f64 },
     /// Cubic Bézier curves through `controls` (3k + 1 points), each cut at check time into
-    /// `pieces` equal spans of its parameter; `normals` holds the frame's N at each cut
-    /// (k·pieces + 1 of them, the twist already in them).
+    /// `pieces` equal spans of its parameter; `normals` holds the frame's N at each cut of
+    /// each curve, its ends included (k·(pieces + 1) of them, the twist already in them).
     Bezier {
         controls: Vec<V3>,
         pieces: usize,
@@ -242,56 +242,52 @@ impl Path {
             }
             pieces = pieces.max(((turn / (PI / 8.0)).ceil() as usize).clamp(2, 16).next_power_of_two());
         }
-        // Frames at every dense sample, by double reflection; kept at the pieces' cuts.
-        let samples = k * DENSE;
-        let at = |s: usize| {
-            let (c, t) = (s / DENSE, (s % DENSE) as f64 / DENSE as f64);
-            let (c, t) = if c == k { (k - 1, 1.0) } else { (c, t) };
+        // Frames at every dense sample of each curve (both its ends included), by double
+        // reflection; from one curve to the next by the least rotation at their joint (a
+        // corner where their directions differ, turned about as a polyline's).
+        let mut dense: Vec<(DVec3, DVec3, DVec3)> = Vec::with_capacity(k * (DENSE + 1));
+        let mut arc = Vec::with_capacity(k * (DENSE + 1));
+        let mut length = 0.0;
+        for c in 0..k {
             let q = &pts[3 * c..3 * c + 4];
-            (cubic(q, t), tangent(q, t))
-        };
-        let mut frames = Vec::with_capacity(samples + 1);
-        let (x0, t0) = at(0);
-        if t0.length_squared() == 0.0 {
-            return Err(
-                "the Bézier path has no direction at its start (its first control points are all one point)"
-                    .to_string(),
-            );
-        }
-        let mut prev = (x0, t0.normalize(), first_normal(t0.normalize()));
-        let mut arc = vec![0.0];
-        frames.push(prev.2);
-        for s in 1..=samples {
-            let (x, t) = at(s);
-            if t.length_squared() < 1e-24 {
-                return Err(format!(
-                    "the Bézier path stops at {} (its direction is undefined there: a control point sits on its end point)",
-                    point(x)
-                ));
+            for j in 0..=DENSE {
+                let t = j as f64 / DENSE as f64;
+                let (x, d) = (cubic(q, t), tangent(q, t));
+                if d.length_squared() < 1e-24 {
+                    return Err(format!(
+                        "the Bézier path stops at {} (its direction is undefined there: its curve {c} doubles back on itself)",
+                        point(x)
+                    ));
+                }
+                let d = d.normalize();
+                let nn = match dense.last() {
+                    None => first_normal(d),
+                    Some(&(_, t0, n0)) if j == 0 => reflect_towards(n0, t0, d),
+                    Some(&(x0, t0, n0)) => {
+                        length += x.distance(x0);
+                        double_reflection(n0, x0, t0, x, d)
+                    }
+                };
+                arc.push(length);
+                dense.push((x, d, (nn - d * nn.dot(d)).normalize()));
             }
-            let t = t.normalize();
-            let nn = double_reflection(prev.2, prev.0, prev.1, x, t);
-            let nn = (nn - t * nn.dot(t)).normalize();
-            arc.push(arc[arc.len() - 1] + x.distance(prev.0));
-            prev = (x, t, nn);
-            frames.push(nn);
         }
-        let length = arc[arc.len() - 1];
         let twist = if closed {
-            let (t_end, t_start) = (prev.1, at(0).1.normalize());
-            let back = reflect_towards(prev.2, t_end, t_start);
-            -angle_about(frames[0], back, t_start) / length
+            let (_, t_end, n_end) = dense[dense.len() - 1];
+            let (_, t_start, n_start) = dense[0];
+            let back = reflect_towards(n_end, t_end, t_start);
+            -angle_about(n_start, back, t_start) / length
         } else {
             0.0
         };
-        // Each cut's normal: the dense frame there (pieces divide the dense samples evenly),
-        // turned by the twist so far.
+        // Each cut's normal (pieces divide the dense samples evenly), turned by the twist so
+        // far: pieces + 1 of them per curve.
         let step = DENSE / pieces;
-        let normals = (0..=k * pieces)
-            .map(|j| {
-                let s = j * step;
-                let t = at(s).1.normalize();
-                let nrm = rotate(frames[s], t, twist * arc[s]);
+        let normals = (0..k)
+            .flat_map(|c| (0..=pieces).map(move |j| c * (DENSE + 1) + j * step))
+            .map(|s| {
+                let (_, t, n) = dense[s];
+                let nrm = rotate(n, t, twist * arc[s]);
                 (nrm - t * nrm.dot(t)).normalize().to_array()
             })
             .collect();

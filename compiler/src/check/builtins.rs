@@ -587,7 +587,7 @@ fn sweep(b: &mut Build, a: &[Value]) -> Result<Value, String> {
     let round = crate::scene::path::round_profile(b.graph, child);
     let folds = !round && extent >= reach;
     if folds {
-        let show = crate::scene::dump_num;
+        let show = |x: f64| crate::diagnostics::number(x, 4);
         let how = if why == "curvature" {
             format!("bends with a radius of {}", show(reach))
         } else {

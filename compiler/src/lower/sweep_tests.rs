@@ -74,6 +74,26 @@ fn a_disc_swept_along_a_straight_polyline_is_the_cylinder() {
 }
 
 #[test]
+fn a_disc_swept_round_a_closed_chain_of_quarter_circles_is_the_torus() {
+    // Four cubic curves each within 2.7e-4 of a quarter of the unit circle (k = 0.5523).
+    let k = 0.5523;
+    let shape = format!(
+        "sweep(circle(0.15), bezier([(1, 0, 0), (1, 0, {k}), ({k}, 0, 1), (0, 0, 1), (-{k}, 0, 1), (-1, 0, {k}), (-1, 0, 0), (-1, 0, -{k}), (-{k}, 0, -1), (0, 0, -1), ({k}, 0, -1), (1, 0, -{k}), (1, 0, 0)]))"
+    );
+    let (p, exactness, _, path) = program(&shape);
+    assert!(path.closed && path.twist.abs() < 1e-12, "{path:?}");
+    assert_eq!(exactness, Exactness::Exact);
+    let (scene, _, _) = crate::front::check_str("c.sdf", "scene { torus(1, 0.15); }");
+    let torus = super::lower(&scene.expect("scene"));
+    let mut rng = Rng::new(8);
+    for _ in 0..3000 {
+        let x = DVec3::from([0; 3].map(|_| rng.range(-1.5, 1.5)));
+        let (a, b) = (f(&p, x), f(&torus, x));
+        assert!((a - b).abs() < 3e-4, "{x}: {a} against the torus's {b}");
+    }
+}
+
+#[test]
 fn a_disc_swept_along_any_path_is_the_distance_to_the_path_less_its_radius() {
     for path in [
         "helix(0.5, 0.4, 2.5)",

@@ -32,8 +32,10 @@ const SNAPSHOT_LINES: usize = 400;
 /// as formulas (issue 35), their feature scene and three errors, about 250 lines), to 20 100
 /// by the look and the sky (issue 49: the filtered checker, occlusion, fog, tone curves and
 /// sky light in the kernels, about 100 lines, and the kernels of two feature scenes, about
-/// 170), and to 20 560 by the hull's feature scene, a tetrahedron, about 460 lines.
-const ALL_SNAPSHOTS_LINES: usize = 20_560;
+/// 170), to 20 560 by the hull's feature scene, a tetrahedron, about 460 lines, and to
+/// 20 840 by the sweep's feature scene (a rectangle along a polyline with one corner) and its
+/// warning, about 275 lines.
+const ALL_SNAPSHOTS_LINES: usize = 20_840;
 
 /// The feature scenes whose distance over points is snapshotted as PTX: between them every
 /// operation of the distance program (the sum of squares and square root of a sphere,

@@ -612,7 +612,11 @@ fn sweep(b: &mut Build, a: &[Value]) -> Result<Value, String> {
             )),
         );
     }
-    let inner = if round || folds { f64::INFINITY } else { reach - extent };
+    let inner = if round || folds {
+        f64::INFINITY
+    } else {
+        reach - extent
+    };
     b.node(Node::Sweep {
         path: crate::scene::PathRef(std::sync::Arc::clone(path)),
         inner,
@@ -1417,6 +1421,7 @@ static FUNCTIONS: &[Builtin] = &[
             [p("xs", Type::List(&A), Req, Any)] -> I => |_, a| len(a);
             [p("xs", Type::List(&B), Req, Any)] -> I => |_, a| len(a);
             [p("xs", Type::List(&Str), Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&Type::Path), Req, Any)] -> I => |_, a| len(a);
         ],
     },
     // Vectors.

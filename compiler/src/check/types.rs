@@ -25,14 +25,14 @@ pub enum Type {
     /// of the point, a material's `color` that varies over the surface. Not a list element.
     ColourField,
     /// A path a profile is swept along (`polyline`, `helix`, `bezier`, `arc3`; docs/language.md,
-    /// "Sweeps"). Not a list element.
+    /// "Sweeps").
     Path,
     /// A list of values of the element type, which is never a list ([`Type::list`]).
     List(&'static Type),
 }
 
 /// The element types of lists, for [`Type::list`]: every type but a list.
-static ELEMENTS: [Type; 9] = [
+static ELEMENTS: [Type; 10] = [
     Type::Int,
     Type::Float,
     Type::Bool,
@@ -42,6 +42,7 @@ static ELEMENTS: [Type; 9] = [
     Type::Str,
     Type::Shape,
     Type::Profile,
+    Type::Path,
 ];
 
 impl Type {

@@ -76,7 +76,13 @@ pub(super) fn locate(b: &mut Builder, p: P, path: &Path) -> Hit {
             e2,
             angle,
             n0,
-        } => arc(b, p, [*centre, *e1, *e2, *n0].map(DVec3::from), *radius, *angle),
+        } => arc(
+            b,
+            p,
+            [*centre, *e1, *e2, *n0].map(DVec3::from),
+            *radius,
+            *angle,
+        ),
     }
 }
 
@@ -169,7 +175,11 @@ fn polyline(
         keep(b, Hit { d2, u, v, w }, angle);
     }
     // The corners: between segment i − 1 and i.
-    let corners: Vec<usize> = if closed { (0..n).collect() } else { (1..n).collect() };
+    let corners: Vec<usize> = if closed {
+        (0..n).collect()
+    } else {
+        (1..n).collect()
+    };
     for i in corners {
         let j = (i + n - 1) % n;
         let [nn, bb] = frames[j].map(v3);
@@ -401,11 +411,15 @@ fn bezier(
             let f1 = b.dot3(d, d1);
             let g = b.dot3(d1, d1);
             let h = b.dot3(d, d2);
+            // Newton's step where the squared distance curves up enough, at most a piece's
+            // span (near the centre of curvature it is flat, and beyond it curves down).
             let f2 = b.add(g, h);
-            let floor = b.mulc(g, 0.1);
+            let floor = b.mulc(g, 0.02);
             let f2 = b.max(f2, floor);
             let f2 = b.maxc(f2, 1e-12);
             let step = b.div(f1, f2);
+            let span = 1.0 / pieces as f64;
+            let step = b.clampc(step, -span, span);
             let next = b.sub(t, step);
             t = b.clampc(next, 0.0, 1.0);
         }
@@ -562,8 +576,14 @@ fn arc(b: &mut Builder, p: P, [centre, e1, e2, n0]: [DVec3; 4], radius: f64, ang
     let quarter = FRAC_PI_2.min(angle / 2.0);
     let (sa, ca) = angle.sin_cos();
     for (plane_of, near) in [
-        ((-e2, centre + e1 * radius), phi_near(b, phi, quarter, false, angle)),
-        ((e2 * ca - e1 * sa, centre + (e1 * ca + e2 * sa) * radius), phi_near(b, phi, quarter, true, angle)),
+        (
+            (-e2, centre + e1 * radius),
+            phi_near(b, phi, quarter, false, angle),
+        ),
+        (
+            (e2 * ca - e1 * sa, centre + (e1 * ca + e2 * sa) * radius),
+            phi_near(b, phi, quarter, true, angle),
+        ),
     ] {
         let (normal, at) = plane_of;
         let r = b.sub3c(p, at.to_array());

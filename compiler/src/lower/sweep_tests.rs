@@ -30,12 +30,7 @@ fn program(shape: &str) -> (Program, Exactness, f64, crate::scene::Path) {
         panic!("{shape}: not a sweep");
     };
     let path = (*path.0).clone();
-    (
-        super::lower(&scene),
-        facts.exactness,
-        facts.lipschitz,
-        path,
-    )
+    (super::lower(&scene), facts.exactness, facts.lipschitz, path)
 }
 
 /// A closed chain of four curves round a saddle, smooth where they meet.
@@ -175,7 +170,10 @@ fn surface(path: &crate::scene::Path, half: [f64; 2], per: usize) -> Vec<DVec3> 
 fn a_rectangle_swept_lies_on_its_sampled_surface_and_is_a_bound() {
     for (path, tol) in [
         ("helix(0.5, 0.4, 2.5)", 1e-6),
-        ("bezier([(-1, 0, 0), (-0.5, 0.8, 0.2), (0.5, -0.6, 0.3), (1, 0.2, -0.2)])", 2e-3),
+        (
+            "bezier([(-1, 0, 0), (-0.5, 0.8, 0.2), (0.5, -0.6, 0.3), (1, 0.2, -0.2)])",
+            2e-3,
+        ),
         ("arc3((1, 0, 0), (0, 1, 0.3), (-1, 0.2, 0))", 1e-6),
         (SADDLE, 2e-3),
     ] {
@@ -196,8 +194,14 @@ fn a_rectangle_swept_lies_on_its_sampled_surface_and_is_a_bound() {
             if d <= 0.0 {
                 continue;
             }
-            let near = cloud.iter().map(|c| c.distance(x)).fold(f64::INFINITY, f64::min);
-            assert!(d / l <= near + spacing, "{shape} at {x}: {d} / {l} beyond {near}");
+            let near = cloud
+                .iter()
+                .map(|c| c.distance(x))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                d / l <= near + spacing,
+                "{shape} at {x}: {d} / {l} beyond {near}"
+            );
         }
     }
 }
@@ -212,7 +216,10 @@ fn the_closing_twist_joins_a_closed_path_without_a_seam() {
     let mut rng = Rng::new(1);
     for _ in 0..500 {
         let off = DVec3::new(0.0, rng.range(-0.12, 0.12), rng.range(-0.12, 0.12));
-        let (a, b) = (DVec3::new(-1e-7, 0.0, 0.0) + off, DVec3::new(1e-7, 0.0, 0.0) + off);
+        let (a, b) = (
+            DVec3::new(-1e-7, 0.0, 0.0) + off,
+            DVec3::new(1e-7, 0.0, 0.0) + off,
+        );
         let (fa, fb) = (f(&p, a), f(&p, b));
         assert!((fa - fb).abs() < 1e-5, "{off}: {fa} against {fb}");
     }

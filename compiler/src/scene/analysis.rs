@@ -336,7 +336,14 @@ fn profiles(node: &Node, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
                 .map(|x| x * x)
                 .sum::<f64>()
                 .sqrt();
-            vec![(*child, 0.0, Aabb { min: [-m, -m, 0.0], max: [m, m, 0.0] })]
+            vec![(
+                *child,
+                0.0,
+                Aabb {
+                    min: [-m, -m, 0.0],
+                    max: [m, m, 0.0],
+                },
+            )]
         }
         _ => Vec::new(),
     }

@@ -305,7 +305,12 @@ impl Bounds {
                 child,
                 ..
             } => screw(&get(child)?, *half_height, *floor)?,
-            Node::Sweep { path, extent, child, .. } => sweep(&path.0, *extent, &get(child)?),
+            Node::Sweep {
+                path,
+                extent,
+                child,
+                ..
+            } => sweep(&path.0, *extent, &get(child)?),
             Node::Feature { op, a, .. } => get(a)?.grow(op.outset()),
             Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
             Node::SmoothCombine {

@@ -67,7 +67,11 @@ fn v(x: V3) -> DVec3 {
 
 /// The frame's first N for direction `t` (unit): B the world's up made normal to `t`.
 pub fn first_normal(t: DVec3) -> DVec3 {
-    let up = if t.y.abs() > 0.999 { DVec3::Z } else { DVec3::Y };
+    let up = if t.y.abs() > 0.999 {
+        DVec3::Z
+    } else {
+        DVec3::Y
+    };
     let b = (up - t * up.dot(t)).normalize();
     b.cross(t)
 }
@@ -240,7 +244,11 @@ impl Path {
                 }
                 last = Some(t);
             }
-            pieces = pieces.max(((turn / (PI / 8.0)).ceil() as usize).clamp(2, 16).next_power_of_two());
+            pieces = pieces.max(
+                ((turn / (PI / 8.0)).ceil() as usize)
+                    .clamp(2, 16)
+                    .next_power_of_two(),
+            );
         }
         // Frames at every dense sample of each curve (both its ends included), by double
         // reflection; from one curve to the next by the least rotation at their joint (a
@@ -441,11 +449,52 @@ impl Path {
     /// path's reach): the least radius of curvature of a smooth path, and half the least
     /// distance between parts of it that are not neighbours; with where it is least.
     pub fn reach(&self) -> (f64, DVec3, &'static str) {
-        let s = self.samples(48);
+        match &self.kind {
+            // In closed form: the radius of curvature r + (pitch/2π)²/r, and half the gap
+            // between neighbouring turns, pitch·r/√(r² + (pitch/2π)²) across the wire.
+            PathKind::Helix {
+                radius,
+                pitch,
+                turns,
+            } => {
+                let k = pitch / TAU;
+                let len = radius.hypot(k);
+                let bend = len * (len / radius);
+                let gap = if *turns > 1.0 {
+                    pitch * (radius / len) / 2.0
+                } else {
+                    f64::INFINITY
+                };
+                let at = helix_at(*radius, *pitch, *turns, 0.0).0;
+                return if bend <= gap {
+                    (bend, at, "curvature")
+                } else {
+                    (gap, at, "closeness")
+                };
+            }
+            PathKind::Arc {
+                radius, centre, e1, ..
+            } => {
+                return (*radius, v(*centre) + v(*e1) * *radius, "curvature");
+            }
+            _ => {}
+        }
+        // At most some 2 000 samples, whatever the number of pieces: the pairs are compared
+        // all with all.
+        let pieces = match &self.kind {
+            PathKind::Polyline { points, .. } => points.len() - 1,
+            PathKind::Bezier { controls, .. } => (controls.len() - 1) / 3,
+            _ => 1,
+        };
+        let per = (2000 / pieces).clamp(1, 48);
+        let s = self.samples(per);
         let mut best = (f64::INFINITY, s[0].0, "");
-        let smooth = !matches!(self.kind, PathKind::Polyline { .. });
-        if smooth {
-            for w in s.windows(3) {
+        if matches!(self.kind, PathKind::Bezier { .. }) {
+            // Within each curve (a corner where two meet is turned about, not bent).
+            for (i, w) in s.windows(3).enumerate() {
+                if (i + 1) % per == 0 {
+                    continue;
+                }
                 let (a, b, c) = (w[0].0, w[1].0, w[2].0);
                 // The circle through three neighbouring samples.
                 let (u, x) = (b - a, c - a);
@@ -554,7 +603,9 @@ pub fn cubic(q: &[DVec3], t: f64) -> DVec3 {
 /// Its derivative at `t` (the second's direction where the first vanishes at an end).
 pub fn tangent(q: &[DVec3], t: f64) -> DVec3 {
     let s = 1.0 - t;
-    let d = (q[1] - q[0]) * (3.0 * s * s) + (q[2] - q[1]) * (6.0 * s * t) + (q[3] - q[2]) * (3.0 * t * t);
+    let d = (q[1] - q[0]) * (3.0 * s * s)
+        + (q[2] - q[1]) * (6.0 * s * t)
+        + (q[3] - q[2]) * (3.0 * t * t);
     if d.length_squared() > 1e-24 {
         return d;
     }

@@ -36,11 +36,12 @@ fn every_path_makes_a_sweep_node() {
         "bezier([(0, 0, 0), (0.3, 0.5, 0), (0.7, 0.5, 0), (1, 0, 0)])",
         "arc3((1, 0, 0), (0, 1, 0), (-1, 0, 0))",
     ] {
-        let s = ok(&format!(
-            "{LIGHT}scene {{ sweep(circle(0.05), {path}); }}"
-        ));
+        let s = ok(&format!("{LIGHT}scene {{ sweep(circle(0.05), {path}); }}"));
         assert!(
-            matches!(s.graph.node(s.root.expect("root")), Node::Sweep { folds: false, .. }),
+            matches!(
+                s.graph.node(s.root.expect("root")),
+                Node::Sweep { folds: false, .. }
+            ),
             "{path}"
         );
     }
@@ -49,11 +50,21 @@ fn every_path_makes_a_sweep_node() {
         "{LIGHT}let p = helix(0.5, 0.2, 3);\nfn pipe(q: path, r: float) -> shape {{ sweep(circle(r), q) }}\nscene {{ union(pipe(p, 0.05), sweep(rect((0.04, 0.02)), p).translate(0, 1, 0)); }}"
     ));
     assert!(s.root.is_some());
+    // Paths in a list, swept in a comprehension.
+    let s = ok(&format!(
+        "{LIGHT}let ps: [path] = [helix(0.5, 0.2, 3), arc3((0, 0, 0), (1, 1, 0), (2, 0, 0))];\nscene {{ union([for i in 0..len(ps) {{ sweep(circle(0.05), ps[i]) }}]); }}"
+    ));
+    assert!(
+        matches!(s.graph.node(s.root.expect("root")), Node::Combine { children, .. } if children.len() == 2)
+    );
 }
 
 #[test]
 fn bad_paths_are_located_errors_that_say_what_to_write() {
-    let d = error("sweep(circle(0.1), polyline([(0, 0, 0)]))", "polyline([(0, 0, 0)])");
+    let d = error(
+        "sweep(circle(0.1), polyline([(0, 0, 0)]))",
+        "polyline([(0, 0, 0)])",
+    );
     assert!(d.message.contains("at least 2 points"), "{d:#?}");
     let d = error(
         "sweep(circle(0.1), polyline([(0, 0, 0), (1, 0, 0), (1, 0, 0)]))",
@@ -64,17 +75,25 @@ fn bad_paths_are_located_errors_that_say_what_to_write() {
         "sweep(circle(0.1), polyline([(0, 0, 0), (1, 0, 0), (0.5, 0, 0)]))",
         "polyline(",
     );
-    assert!(d.message.contains("turns straight back at point 1"), "{d:#?}");
+    assert!(
+        d.message.contains("turns straight back at point 1"),
+        "{d:#?}"
+    );
     // A Bézier path says how many control points it needs, near the count given.
     let d = error(
         "sweep(circle(0.1), bezier([(0, 0, 0), (1, 0, 0), (1, 1, 0), (2, 1, 0), (3, 1, 0)]))",
         "bezier(",
     );
     assert!(
-        d.message.contains("3k + 1") && d.message.contains("has 5") && d.message.contains("give 4 or 7"),
+        d.message.contains("3k + 1")
+            && d.message.contains("has 5")
+            && d.message.contains("give 4 or 7"),
         "{d:#?}"
     );
-    let d = error("sweep(circle(0.1), bezier([(0, 0, 0), (1, 0, 0)]))", "bezier(");
+    let d = error(
+        "sweep(circle(0.1), bezier([(0, 0, 0), (1, 0, 0)]))",
+        "bezier(",
+    );
     assert!(d.message.contains("give 4"), "{d:#?}");
     let d = error(
         "sweep(circle(0.1), bezier([(0, 0, 0), (0, 0, 0), (1, 1, 0), (2, 1, 0)]))",
@@ -94,12 +113,12 @@ fn bad_paths_are_located_errors_that_say_what_to_write() {
         "sweep(circle(0.1), arc3((0, 0, 0), (1, 1, 1), (2, 2, 2)))",
         "arc3(",
     );
-    assert!(d.message.contains("one line") && d.message.contains("polyline"), "{d:#?}");
-    // A profile with no finite extent cannot be swept.
-    let d = error(
-        "sweep(profile { p.x }, helix(0.5, 0.2, 3))",
-        "sweep(",
+    assert!(
+        d.message.contains("one line") && d.message.contains("polyline"),
+        "{d:#?}"
     );
+    // A profile with no finite extent cannot be swept.
+    let d = error("sweep(profile { p.x }, helix(0.5, 0.2, 3))", "sweep(");
     assert!(d.message.contains("no finite extent"), "{d:#?}");
 }
 
@@ -116,7 +135,8 @@ fn a_profile_wider_than_the_path_allows_is_warned_about_with_the_radius() {
     let w = warned("sweep(rect((0.8, 0.05)), helix(0.5, 2, 3))");
     assert_eq!(w.len(), 1, "{w:#?}");
     assert!(
-        w[0].message.contains("reaches 0.80") && w[0].message.contains("bends with a radius of 0.70"),
+        w[0].message.contains("reaches 0.80")
+            && w[0].message.contains("bends with a radius of 0.70"),
         "{:#?}",
         w[0]
     );

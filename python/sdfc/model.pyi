@@ -34,9 +34,12 @@ def field(formula: str, lipschitz: Optional[float] = ..., **values: Any) -> Shap
 def profile(formula: str, lipschitz: Optional[float] = ..., **values: Any) -> Profile: ...
 def show(shape: Shape, **scene: Any) -> subprocess.Popen[bytes]: ...
 
+class Path(_Expr): ...
+
 class Profile(_Expr):
     def extrude(self, height: float, round: float = ...) -> Shape: ...
     def revolve(self, offset: float = ...) -> Shape: ...
+    def sweep(self, path: Path) -> Shape: ...
     def loft(self, top: Profile, height: float) -> Shape: ...
     def screw(self, pitch: float, height: float, hand: str = ...) -> Shape: ...
     def offset(self, amount: float) -> Profile: ...
@@ -338,13 +341,59 @@ def revolve(profile: Profile, offset: float = ...) -> Shape:
     The profile turned about the y axis, its x the distance from the axis less `offset` (§9c).
     """
     ...
-def bezier(a: Vec2, control: Vec2, b: Vec2, radius: float = ...) -> Profile:
+@overload
+def bezier(a: Vec2, control: Vec2, b: Vec2, radius: float = ...) -> Profile: ...
+@overload
+def bezier(points: Sequence[Vec3]) -> Path:
     """```sdf
     bezier(a: vec2, control: vec2, b: vec2, radius: float = 0.05) -> profile
     ```
     Valid: `radius` > 0; `control` not the midpoint of `a` and `b`
 
     The points within `radius` of the quadratic Bézier curve from `a` to `b` pulled towards `control`, as `segment2` is of a segment (§9c). Exact.
+
+    ```sdf
+    bezier(points: [vec3]) -> path
+    ```
+    Valid: 3k + 1 points (k ≥ 1); no control point on its curve's end
+
+    Cubic Bézier curves, each through 4 of the points, the next starting at the last one's end; closed where the last point is the first.
+    """
+    ...
+def sweep(profile: Profile, path: Path) -> Shape:
+    """```sdf
+    sweep(profile: profile, path: path) -> shape
+    ```
+    Valid: the profile of finite extent
+
+    The profile moved along the path, its plane normal to the path on a rotation-minimising frame, closed paths joined without a seam, open ends cut flat (§9c, "Sweeps"). Exact for a `circle`; otherwise a bound, with L as §9c says, or not proven where the profile reaches past the path's reach (W0018).
+    """
+    ...
+def polyline(points: Sequence[Vec3]) -> Path:
+    """```sdf
+    polyline(points: [vec3]) -> path
+    ```
+    Valid: two or more points, no two in a row equal, no corner turning straight back
+
+    The path through the points; closed where the last is the first.
+    """
+    ...
+def helix(radius: float, pitch: float, turns: float) -> Path:
+    """```sdf
+    helix(radius: float, pitch: float, turns: float) -> path
+    ```
+    Valid: all > 0
+
+    The right-handed helix about y from (`radius`, −h/2, 0) to y = h/2, h = `pitch`·`turns`.
+    """
+    ...
+def arc3(start: Vec3, through: Vec3, end: Vec3) -> Path:
+    """```sdf
+    arc3(start: vec3, through: vec3, end: vec3) -> path
+    ```
+    Valid: three points not on one line
+
+    The arc of the circle through the three points, from `start` to `end` by way of `through`.
     """
     ...
 def loft(bottom: Profile, top: Profile, height: float) -> Shape:
@@ -1005,4 +1054,4 @@ class Camera(Record):
 class Render(Record):
     def __init__(self, *, width: int = ..., height: int = ..., aa: int = ..., max_steps: int = ..., epsilon: float = ..., max_depth: int = ..., max_dist: float = ..., relaxation: float = ..., background: Vec3 = ..., method: str = ..., fps: float = ..., duration: float = ..., occlusion: float = ..., fog: float = ..., fog_color: Vec3 = ..., exposure: float = ..., tonemap: str = ...) -> None: ...
 
-__all__ = ["Angle", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]
+__all__ = ["Angle", "Path", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "sweep", "polyline", "helix", "arc3", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]

@@ -87,8 +87,8 @@ pub(super) fn locate(b: &mut Builder, p: P, path: &Path) -> Hit {
 }
 
 /// The sweep's distance from the profile's `g` at the hit: capped beyond an open end (as an
-/// extrusion is), and beyond `inner` from the path the distance to the tube of radius
-/// `extent` about it (where the nearest point's frame is no longer one to one).
+/// extrusion is), and beyond `inner` from the path (but never within `extent` of it, where the
+/// surface is) the distance to the tube of radius `extent` about it.
 pub(super) fn finish(b: &mut Builder, g: Reg, hit: &Hit, inner: f64, extent: f64) -> Reg {
     let (gx, wx) = (b.maxc(g, 0.0), b.maxc(hit.w, 0.0));
     let out = b.len2(gx, wx);
@@ -98,7 +98,7 @@ pub(super) fn finish(b: &mut Builder, g: Reg, hit: &Hit, inner: f64, extent: f64
     if inner.is_finite() {
         let rho = b.sqrt(hit.d2);
         let tube = b.subc(rho, extent);
-        let limit = b.c(inner);
+        let limit = b.c(inner.max(extent));
         let near = b.lt(rho, limit);
         b.select(near, d, tube)
     } else {

@@ -778,11 +778,11 @@ impl Pass<'_> {
             } => self.screw(id, *pitch, *half_height, *inner, *floor, *child),
             Node::Sweep {
                 path,
+                inner,
                 extent,
                 folds,
                 child,
-                ..
-            } => self.sweep(id, &path.0, *folds, *extent, *child),
+            } => self.sweep(id, &path.0, *folds || inner < extent, *extent, *child),
             Node::Feature { op, a, b } => self.feature(id, *op, *a, *b),
             Node::Combine { op, children } => self.combine(*op, children),
             Node::SmoothCombine {
@@ -1351,8 +1351,8 @@ impl Pass<'_> {
     /// change as the point moves across the path and not along it (the frame does not turn
     /// about the path), but for the twist that closes a closed path: L is the profile's times
     /// √(1 + (twist·extent)²), a bound within `inner` of the path and the tube's distance
-    /// beyond. Where the profile reaches past the path's reach (it `folds`) nothing is
-    /// proven.
+    /// beyond. Where the profile reaches past half the path's reach (`inner` below `extent`;
+    /// past the whole of it, the sweep `folds`) nothing is proven.
     fn sweep(
         &mut self,
         id: NodeId,

@@ -216,8 +216,9 @@ pub enum Node {
     },
     /// A profile swept along a path (`scene/path.rs`, `lower/sweep.rs`): read at the point's
     /// coordinates in the path's frame at its nearest point, capped at open ends. Beyond
-    /// `inner` from the path (∞: nowhere) the field is the distance to the tube of radius
-    /// `extent` (the profile's reach from its origin) about the path (docs/analysis.md, "Sweep").
+    /// `inner` from the path (∞: nowhere), and beyond `extent` (the profile's reach from its
+    /// origin), the field is the distance to the tube of radius `extent` about the path
+    /// (docs/analysis.md, "Sweep"); it is proven a bound where `inner` ≥ `extent`.
     Sweep {
         path: PathRef,
         inner: f64,

@@ -102,6 +102,7 @@ _TYPE_WORDS = {
     "string": "a str",
     "shape": "a shape",
     "profile": "a profile",
+    "path": "a path (sdfc.polyline, sdfc.helix, sdfc.bezier or sdfc.arc3)",
 }
 
 
@@ -169,6 +170,10 @@ def _conform(value: Any, ty: str) -> Any:
         if not isinstance(value, Profile):
             raise _Bad()
         return value
+    if ty == "path":
+        if not isinstance(value, Path):
+            raise _Bad()
+        return value
     if ty.startswith("["):
         if not isinstance(value, (list, tuple)):
             raise _Bad()
@@ -227,9 +232,12 @@ class _Builtin:
 
 BUILTINS: Dict[str, _Builtin] = {d["name"]: _Builtin(d) for d in _sdfc.builtins()}
 
-# The built-ins that make shapes or profiles, reachable from Python; the others compute
+# The kinds of value a built-in makes that Python builds as expressions.
+_MADE = ("shape", "profile", "path")
+
+# The built-ins that make shapes, profiles or paths, reachable from Python; the others compute
 # numbers and vectors (Python's own arithmetic does that, and a `field` formula calls them).
-SHAPE_BUILTINS: List[str] = [n for n, b in BUILTINS.items() if any(s.ret in ("shape", "profile") for s in b.sigs)]
+SHAPE_BUILTINS: List[str] = [n for n, b in BUILTINS.items() if any(s.ret in _MADE for s in b.sigs)]
 VALUE_BUILTINS: List[str] = [n for n in BUILTINS if n not in SHAPE_BUILTINS]
 
 
@@ -274,7 +282,7 @@ def _call(name: str, args: Sequence[Any], kwargs: Dict[str, Any], method: bool =
     b = BUILTINS[name]
     best: Optional[Tuple[int, Exception, _Sig]] = None
     for sig in b.sigs:
-        if sig.ret not in ("shape", "profile"):
+        if sig.ret not in _MADE:
             continue
         fit, bound = _bind(b, sig, args, kwargs)
         if isinstance(bound, Exception):
@@ -286,11 +294,11 @@ def _call(name: str, args: Sequence[Any], kwargs: Dict[str, Any], method: bool =
                 why = _sdfc.range_error(f"builtin:{name}", sig.index, p.index, _range_value(v))
                 if why:
                     raise ValueError(f"sdfc.{name}(): `{p.name}` {why}, not {_show(v)}")
-        node_type = Shape if sig.ret == "shape" else Profile
+        node_type = {"shape": Shape, "profile": Profile, "path": Path}[sig.ret]
         return node_type(name, bound, method=method)
     assert best is not None
     fit, error, sig = best
-    shapes = [s.signature for s in b.sigs if s.ret in ("shape", "profile")]
+    shapes = [s.signature for s in b.sigs if s.ret in _MADE]
     hint = "" if len(shapes) == 1 else " (its forms: " + "; ".join(shapes) + ")"
     raise type(error)(f"sdfc.{name}(): {error}{hint}")
 
@@ -362,6 +370,16 @@ class Profile(_Expr):
     made a shape by `extrude`, `revolve`, `loft` or `screw`."""
 
     __slots__ = ()
+
+
+class Path(_Expr):
+    """A path a profile is swept along (`sweep(profile, path)`): `polyline`, `helix`,
+    `bezier` or `arc3`. Paths are not combined."""
+
+    __slots__ = ()
+
+    def _binary(self, other: Any, name: str) -> Any:
+        return NotImplemented
 
 
 class Shape(_Expr):
@@ -731,5 +749,5 @@ def __getattr__(name: str) -> Any:
         raise AttributeError(f"module 'sdfc.model' has no attribute {name!r}")
     return found
 
-__all__ = ["Angle", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show"]
+__all__ = ["Angle", "Path", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show"]
 __all__ += list(FUNCTIONS) + list(RECORDS)

@@ -9,6 +9,7 @@ from . import Facts, Scene
 
 Vec2 = Union[Tuple[float, float], Sequence[float], np.ndarray]
 Vec3 = Union[Tuple[float, float, float], Sequence[float], np.ndarray]
+AngleLike = Union["Angle", float]
 _E = TypeVar("_E", bound="_Expr")
 
 class Angle:
@@ -33,9 +34,12 @@ def field(formula: str, lipschitz: Optional[float] = ..., **values: Any) -> Shap
 def profile(formula: str, lipschitz: Optional[float] = ..., **values: Any) -> Profile: ...
 def show(shape: Shape, **scene: Any) -> subprocess.Popen[bytes]: ...
 
+class Path(_Expr): ...
+
 class Profile(_Expr):
     def extrude(self, height: float, round: float = ...) -> Shape: ...
     def revolve(self, offset: float = ...) -> Shape: ...
+    def sweep(self, path: Path) -> Shape: ...
     def loft(self, top: Profile, height: float) -> Shape: ...
     def screw(self, pitch: float, height: float, hand: str = ...) -> Shape: ...
     def offset(self, amount: float) -> Profile: ...
@@ -46,7 +50,7 @@ class Profile(_Expr):
     def translate(self, offset: Vec2) -> Profile: ...
     @overload
     def translate(self, x: float, y: float = ...) -> Profile: ...
-    def rotate(self, angle: Angle) -> Profile: ...
+    def rotate(self, angle: AngleLike) -> Profile: ...
     def scale(self, factor: float) -> Profile: ...
     def mirror(self, x: bool = ..., y: bool = ...) -> Profile: ...
     def reflect(self, normal: Vec2) -> Profile: ...
@@ -79,7 +83,6 @@ class Shape(_Expr):
         voxel: Optional[float] = ...,
         sharp: bool = ...,
         limits: Optional[Dict[str, int]] = ...,
-        up: Optional[str] = ...,
     ) -> Tuple[int, int]: ...
     def distance(self, points: Any, backend: str = ...) -> np.ndarray: ...
     def facts(self) -> Facts: ...
@@ -107,10 +110,10 @@ class Shape(_Expr):
     def translate(self, offset: Vec3) -> Shape: ...
     @overload
     def translate(self, x: float, y: float = ..., z: float = ...) -> Shape: ...
-    def rotate_x(self, angle: Angle) -> Shape: ...
-    def rotate_y(self, angle: Angle) -> Shape: ...
-    def rotate_z(self, angle: Angle) -> Shape: ...
-    def rotate(self, axis: Vec3, angle: Angle) -> Shape: ...
+    def rotate_x(self, angle: AngleLike) -> Shape: ...
+    def rotate_y(self, angle: AngleLike) -> Shape: ...
+    def rotate_z(self, angle: AngleLike) -> Shape: ...
+    def rotate(self, axis: Vec3, angle: AngleLike) -> Shape: ...
     @overload
     def scale(self, factor: float) -> Shape: ...
     @overload
@@ -338,13 +341,59 @@ def revolve(profile: Profile, offset: float = ...) -> Shape:
     The profile turned about the y axis, its x the distance from the axis less `offset` (§9c).
     """
     ...
-def bezier(a: Vec2, control: Vec2, b: Vec2, radius: float = ...) -> Profile:
+@overload
+def bezier(a: Vec2, control: Vec2, b: Vec2, radius: float = ...) -> Profile: ...
+@overload
+def bezier(points: Sequence[Vec3]) -> Path:
     """```sdf
     bezier(a: vec2, control: vec2, b: vec2, radius: float = 0.05) -> profile
     ```
     Valid: `radius` > 0; `control` not the midpoint of `a` and `b`
 
     The points within `radius` of the quadratic Bézier curve from `a` to `b` pulled towards `control`, as `segment2` is of a segment (§9c). Exact.
+
+    ```sdf
+    bezier(points: [vec3]) -> path
+    ```
+    Valid: 3k + 1 points (k ≥ 1); no control point on its curve's end
+
+    Cubic Bézier curves, each through 4 of the points, the next starting at the last one's end; closed where the last point is the first.
+    """
+    ...
+def sweep(profile: Profile, path: Path) -> Shape:
+    """```sdf
+    sweep(profile: profile, path: path) -> shape
+    ```
+    Valid: the profile of finite extent
+
+    The profile moved along the path, its plane normal to the path on a rotation-minimising frame, closed paths joined without a seam, open ends cut flat (§9c, "Sweeps"). Exact for a `circle`; otherwise a bound, with L as §9c says, or not proven where the profile reaches past the path's reach (W0018).
+    """
+    ...
+def polyline(points: Sequence[Vec3]) -> Path:
+    """```sdf
+    polyline(points: [vec3]) -> path
+    ```
+    Valid: two or more points, no two in a row equal, no corner turning straight back
+
+    The path through the points; closed where the last is the first.
+    """
+    ...
+def helix(radius: float, pitch: float, turns: float) -> Path:
+    """```sdf
+    helix(radius: float, pitch: float, turns: float) -> path
+    ```
+    Valid: all > 0
+
+    The right-handed helix about y from (`radius`, −h/2, 0) to y = h/2, h = `pitch`·`turns`.
+    """
+    ...
+def arc3(start: Vec3, through: Vec3, end: Vec3) -> Path:
+    """```sdf
+    arc3(start: vec3, through: vec3, end: vec3) -> path
+    ```
+    Valid: three points not on one line
+
+    The arc of the circle through the three points, from `start` to `end` by way of `through`.
     """
     ...
 def loft(bottom: Profile, top: Profile, height: float) -> Shape:
@@ -463,9 +512,9 @@ def smooth_union(k: float, shapes: Sequence[Shape], variant: str = ..., steps: i
     """```sdf
     smooth_union(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` ≥ 0; `variant` "poly", "exp", "chamfer", "round", "stairs" or "columns"; `steps` 1 … 64
+    Valid: `k` > 0; `variant` "poly", "exp", "chamfer", "round", "stairs" or "columns"; `steps` 1 … 64
 
-    Union blended over a radius `k` (0: the plain union, which an animated radius may pass through); `variant` "poly" (quadratic, default) or "exp" (exponential) smooth minima, or the edges of Mercury's hg_sdf library: "chamfer" (a 45° bevel `k` wide), "round" (a quarter circle of radius `k`), "stairs" (`steps` steps within `k`), "columns" (`steps` round columns within `k`). `steps` is read by "stairs" and "columns" only.
+    Union blended over a radius `k`; `variant` "poly" (quadratic, default) or "exp" (exponential) smooth minima, or the edges of Mercury's hg_sdf library: "chamfer" (a 45° bevel `k` wide), "round" (a quarter circle of radius `k`), "stairs" (`steps` steps within `k`), "columns" (`steps` round columns within `k`). `steps` is read by "stairs" and "columns" only.
 
     ```sdf
     smooth_union(k: float, a: profile, b: profile, variant: string = "poly", steps: int = 4) -> profile
@@ -482,7 +531,7 @@ def smooth_union(k: float, shapes: Sequence[Shape], variant: str = ..., steps: i
     ```sdf
     smooth_union(k: float, shapes: [shape], variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` ≥ 0; not empty
+    Valid: `k` > 0; not empty
 
     The left fold of the binary form over the list; independent of the list's order only with `variant: "exp"` (§6a).
     """
@@ -498,7 +547,7 @@ def smooth_intersect(k: float, shapes: Sequence[Shape], variant: str = ..., step
     """```sdf
     smooth_intersect(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` ≥ 0; `variant` and `steps` as for `smooth_union`
+    Valid: `k` > 0; `variant` and `steps` as for `smooth_union`
 
     Intersection blended over `k`; `variant` as for `smooth_union`.
 
@@ -515,7 +564,7 @@ def smooth_intersect(k: float, shapes: Sequence[Shape], variant: str = ..., step
     ```sdf
     smooth_intersect(k: float, shapes: [shape], variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` ≥ 0; not empty
+    Valid: `k` > 0; not empty
 
     The left fold of the binary form over the list, as for `smooth_union`.
     """
@@ -527,7 +576,7 @@ def smooth_subtract(k: float, a: Profile, b: Profile, variant: str = ..., steps:
     """```sdf
     smooth_subtract(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` ≥ 0; `variant` and `steps` as for `smooth_union`
+    Valid: `k` > 0; `variant` and `steps` as for `smooth_union`
 
     Subtraction blended over `k`; `variant` as for `smooth_union`.
 
@@ -599,21 +648,21 @@ def translate(profile: Profile, x: float, y: float = ...) -> Profile:
     ```
     """
     ...
-def rotate_x(shape: Shape, angle: Angle) -> Shape:
+def rotate_x(shape: Shape, angle: AngleLike) -> Shape:
     """```sdf
     rotate_x(shape: shape, angle: angle) -> shape
     ```
     Rotates a shape about the x axis.
     """
     ...
-def rotate_y(shape: Shape, angle: Angle) -> Shape:
+def rotate_y(shape: Shape, angle: AngleLike) -> Shape:
     """```sdf
     rotate_y(shape: shape, angle: angle) -> shape
     ```
     Rotates a shape about the y axis.
     """
     ...
-def rotate_z(shape: Shape, angle: Angle) -> Shape:
+def rotate_z(shape: Shape, angle: AngleLike) -> Shape:
     """```sdf
     rotate_z(shape: shape, angle: angle) -> shape
     ```
@@ -621,9 +670,9 @@ def rotate_z(shape: Shape, angle: Angle) -> Shape:
     """
     ...
 @overload
-def rotate(shape: Shape, axis: Vec3, angle: Angle) -> Shape: ...
+def rotate(shape: Shape, axis: Vec3, angle: AngleLike) -> Shape: ...
 @overload
-def rotate(profile: Profile, angle: Angle) -> Profile:
+def rotate(profile: Profile, angle: AngleLike) -> Profile:
     """```sdf
     rotate(shape: shape, axis: vec3, angle: angle) -> shape
     ```
@@ -971,7 +1020,7 @@ def round_rect(half: Vec2, radius: float = ...) -> Profile:
     A rectangle with its corners rounded by `radius`, inside the extents. Exact.
     """
     ...
-def arc(radius: float = ..., angle: Angle = ..., thickness: float = ...) -> Profile:
+def arc(radius: float = ..., angle: AngleLike = ..., thickness: float = ...) -> Profile:
     """```sdf
     arc(radius: float = 0.5, angle: angle, thickness: float = 0.1) -> profile
     ```
@@ -982,30 +1031,27 @@ def arc(radius: float = ..., angle: Angle = ..., thickness: float = ...) -> Prof
     ...
 
 class Phong(Record):
-    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., color: Union[Vec3, Shape] = ..., fresnel: bool = ...) -> None: ...
+    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., color: Union[Vec3, Shape] = ...) -> None: ...
 
 class Checker(Record):
-    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., fresnel: bool = ..., a: Union[Vec3, Shape] = ..., b: Union[Vec3, Shape] = ..., size: float = ...) -> None: ...
-
-class Pbr(Record):
-    def __init__(self, *, base_color: Union[Vec3, Shape] = ..., roughness: float = ..., metallic: float = ..., emission: Vec3 = ..., transmission: float = ..., ior: float = ...) -> None: ...
+    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., a: Union[Vec3, Shape] = ..., b: Union[Vec3, Shape] = ..., size: float = ...) -> None: ...
 
 class PointLight(Record):
-    def __init__(self, *, position: Vec3, radius: float = ..., color: Vec3 = ..., intensity: float = ..., penumbra: Angle = ..., softness: float = ..., shadows: bool = ...) -> None: ...
+    def __init__(self, *, position: Vec3, radius: float = ..., color: Vec3 = ..., intensity: float = ..., penumbra: AngleLike = ..., softness: float = ..., shadows: bool = ...) -> None: ...
 
 class DirectionalLight(Record):
-    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., penumbra: Angle = ..., softness: float = ..., shadows: bool = ...) -> None: ...
+    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., penumbra: AngleLike = ..., softness: float = ..., shadows: bool = ...) -> None: ...
 
 class SunLight(Record):
-    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., angle: Angle = ..., shadows: bool = ...) -> None: ...
+    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., angle: AngleLike = ..., shadows: bool = ...) -> None: ...
 
 class SkyLight(Record):
     def __init__(self, *, color: Vec3 = ..., zenith: Vec3 = ..., horizon: Vec3 = ..., ground: Vec3 = ..., intensity: float = ..., shadows: bool = ..., background: bool = ...) -> None: ...
 
 class Camera(Record):
-    def __init__(self, *, position: Vec3 = ..., look_at: Vec3 = ..., up: Vec3 = ..., fov: Angle = ...) -> None: ...
+    def __init__(self, *, position: Vec3 = ..., look_at: Vec3 = ..., up: Vec3 = ..., fov: AngleLike = ...) -> None: ...
 
 class Render(Record):
     def __init__(self, *, width: int = ..., height: int = ..., aa: int = ..., max_steps: int = ..., epsilon: float = ..., max_depth: int = ..., max_dist: float = ..., relaxation: float = ..., background: Vec3 = ..., method: str = ..., fps: float = ..., duration: float = ..., occlusion: float = ..., fog: float = ..., fog_color: Vec3 = ..., exposure: float = ..., tonemap: str = ...) -> None: ...
 
-__all__ = ["Angle", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "Pbr", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]
+__all__ = ["Angle", "Path", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "sweep", "polyline", "helix", "arc3", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]

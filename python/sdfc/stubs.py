@@ -23,6 +23,7 @@ _TYPES = {
     "string": "str",
     "shape": "Shape",
     "profile": "Profile",
+    "path": "Path",
 }
 
 
@@ -165,7 +166,9 @@ def _docstring(doc: str, indent: str) -> List[str]:
 def generate() -> str:
     """The text of model.pyi."""
     out = [_HEAD]
-    shaped = {n: [s for s in model.BUILTINS[n].sigs if s.ret in ("shape", "profile")] for n in model.SHAPE_BUILTINS}
+    shaped = {n: [s for s in model.BUILTINS[n].sigs if s.ret in model._MADE] for n in model.SHAPE_BUILTINS}
+    out.append("class Path(_Expr): ...")
+    out.append("")
     for cls, ty in (("Profile", "profile"), ("Shape", "shape")):
         out.append(f"class {cls}(_Expr):")
         if cls == "Shape":

@@ -55,13 +55,13 @@ class Text:
             self._record(s, "light " if s._group == "light" else "", "\n", materials)
         # A node used more than once (and not a leaf) is written once, as a `let`: in the
         # scene block, or for a profile alone before it, as constants.
-        counts = {"shape": 0, "profile": 0}
+        counts = {"shape": 0, "profile": 0, "path": 0}
         shared = [n for n in nodes if uses[id(n)] > 1 and n._children()]
         indent = "" if profile else "    "
         if not profile:
             self.write("scene {\n")
         for n in shared:
-            kind = "profile" if isinstance(n, model.Profile) else "shape"
+            kind = "profile" if isinstance(n, model.Profile) else "path" if isinstance(n, model.Path) else "shape"
             counts[kind] += 1
             name = f"{kind}{counts[kind]}"
             self.write(f"{indent}let {name} = ")

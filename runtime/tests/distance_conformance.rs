@@ -606,6 +606,7 @@ fn the_feature_scenes_cover_every_node_and_operation() {
         "revolve",
         "loft",
         "screw",
+        "sweep",
         "combine",
         "smooth_combine",
         "feature",
@@ -692,6 +693,7 @@ fn node_kind(node: &Node) -> &'static str {
         Node::Mesh { .. } => "mesh",
         Node::Loft { .. } => "loft",
         Node::Screw { .. } => "screw",
+        Node::Sweep { .. } => "sweep",
         Node::Prim { prim, .. } => prim.name,
     }
 }

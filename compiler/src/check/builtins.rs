@@ -7,7 +7,7 @@ use crate::lower::hash_of;
 use crate::prim::{Args, Kind, Prim, PrimRef};
 pub use crate::prim::{Def, Range};
 use crate::scene::{
-    Camera, Combine, Feature, Graph, Material, Node, NodeId, Pbr, Settings, Smooth, V3,
+    Camera, Combine, Feature, Graph, Material, Node, NodeId, Path, Pbr, Settings, Smooth, V3,
 };
 use crate::span::Span;
 
@@ -560,6 +560,72 @@ fn screw(b: &mut Build, a: &[Value]) -> Result<Value, String> {
     }
 }
 
+/// The points of a list of vec3.
+fn points3(v: &Value) -> Vec<V3> {
+    match v {
+        Value::List(_, items) => items
+            .iter()
+            .map(|x| {
+                let c = x.components();
+                [0, 1, 2].map(|i| c.get(i).copied().unwrap_or(0.0))
+            })
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// `sweep(profile, path)`: the profile's reach from its origin against the path's reach; a
+/// profile that reaches past it (but a disc, whose sweep is a union of balls) is W0018.
+fn sweep(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let Value::Path(path) = &a[1] else {
+        return Ok(Value::Error);
+    };
+    let (c, h, _) = rect_of(b, &a[0], "swept")?;
+    let extent = (c[0].abs() + h[0]).hypot(c[1].abs() + h[1]);
+    let child = sh(&a[0]);
+    let (reach, at, why) = path.reach();
+    let round = crate::scene::path::round_profile(b.graph, child);
+    let folds = !round && extent >= reach;
+    if folds {
+        let show = |x: f64| crate::diagnostics::number(x, 4);
+        let how = if why == "curvature" {
+            format!("bends with a radius of {}", show(reach))
+        } else {
+            format!("comes within {} of itself", show(2.0 * reach))
+        };
+        b.warnings.push(
+            crate::diagnostics::Diagnostic::warning(
+                "W0018",
+                format!(
+                    "the profile reaches {} from the path, but the path {how} at ({}, {}, {}): the sweep folds over itself there",
+                    show(extent),
+                    show(at.x),
+                    show(at.y),
+                    show(at.z)
+                ),
+                b.span,
+            )
+            .with_label("this sweep")
+            .with_note(format!(
+                "a profile swept along a path must stay within the path's reach ({} here) of its origin, or its planes cross and the field is wrong there (not proven a bound); make the profile smaller or the path gentler",
+                show(reach)
+            )),
+        );
+    }
+    let inner = if round || folds {
+        f64::INFINITY
+    } else {
+        reach - extent
+    };
+    b.node(Node::Sweep {
+        path: crate::scene::PathRef(std::sync::Arc::clone(path)),
+        inner,
+        extent,
+        folds,
+        child,
+    })
+}
+
 /// The reflection across the plane through the origin with normal `n` (not zero):
 /// I − 2·n·nᵀ/|n|², orthogonal, symmetric and its own inverse.
 fn householder(n: V3) -> [V3; 3] {
@@ -1024,6 +1090,43 @@ static FUNCTIONS: &[Builtin] = &[
         name: "bezier",
         sigs: sigs![
             [p("a", V2, Req, Any), p("control", V2, Req, Any), p("b", V2, Req, Any), p("radius", F, Num(0.05), Pos)] -> PR => bezier;
+            [p("points", Type::List(&V), Req, Any)] -> Type::Path => |_, a| {
+                Ok(Value::Path(std::sync::Arc::new(Path::bezier(&points3(&a[0]))?)))
+            };
+        ],
+    },
+    Builtin {
+        name: "sweep",
+        sigs: sigs![
+            [prof("profile"), p("path", Type::Path, Req, Any)] -> S => sweep;
+        ],
+    },
+    Builtin {
+        name: "polyline",
+        sigs: sigs![
+            [p("points", Type::List(&V), Req, Any)] -> Type::Path => |_, a| {
+                Ok(Value::Path(std::sync::Arc::new(Path::polyline(&points3(&a[0]))?)))
+            };
+        ],
+    },
+    Builtin {
+        name: "helix",
+        sigs: sigs![
+            [p("radius", F, Req, Pos), p("pitch", F, Req, Pos), p("turns", F, Req, Pos)] -> Type::Path => |_, a| {
+                Ok(Value::Path(std::sync::Arc::new(Path::helix(a[0].num(), a[1].num(), a[2].num()))))
+            };
+        ],
+    },
+    Builtin {
+        name: "arc3",
+        sigs: sigs![
+            [p("start", V, Req, Any), p("through", V, Req, Any), p("end", V, Req, Any)] -> Type::Path => |_, a| {
+                let [x, y, z] = [0, 1, 2].map(|i| {
+                    let c = a[i].components();
+                    [c[0], c[1], c[2]]
+                });
+                Ok(Value::Path(std::sync::Arc::new(Path::arc3(x, y, z)?)))
+            };
         ],
     },
     Builtin {
@@ -1318,6 +1421,7 @@ static FUNCTIONS: &[Builtin] = &[
             [p("xs", Type::List(&A), Req, Any)] -> I => |_, a| len(a);
             [p("xs", Type::List(&B), Req, Any)] -> I => |_, a| len(a);
             [p("xs", Type::List(&Str), Req, Any)] -> I => |_, a| len(a);
+            [p("xs", Type::List(&Type::Path), Req, Any)] -> I => |_, a| len(a);
         ],
     },
     // Vectors.

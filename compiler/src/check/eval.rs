@@ -316,7 +316,7 @@ impl Ctx<'_> {
                 // A `field` of a vec3 is a colour, where a list of shapes was likely meant.
                 Diagnostic::error("E0300", "a colour field cannot be a list's element", at)
                     .with_label("this `field` is of a vec3: a `color_field`, a material's `color`")
-                    .with_note("a list holds ints, floats, bools, vectors, angles, strings, shapes or profiles")
+                    .with_note("a list holds ints, floats, bools, vectors, angles, strings, shapes, profiles or paths")
                     .with_help("a `field` is a shape when its body is a float, the distance: `field { length(p) - 1 }`; a colour field goes in a material's `color`")
             } else {
                 Diagnostic::error("E0300", "a list's elements cannot be lists", at)

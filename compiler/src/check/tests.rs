@@ -707,3 +707,4 @@ fn a_profile_is_called_a_profile() {
 
 mod language;
 mod limits;
+mod sweeps;

@@ -24,12 +24,15 @@ pub enum Type {
     /// A colour field (docs/language.md, "Colour fields"): `field { … }` whose body is a vec3
     /// of the point, a material's `color` that varies over the surface. Not a list element.
     ColourField,
+    /// A path a profile is swept along (`polyline`, `helix`, `bezier`, `arc3`; docs/language.md,
+    /// "Sweeps").
+    Path,
     /// A list of values of the element type, which is never a list ([`Type::list`]).
     List(&'static Type),
 }
 
 /// The element types of lists, for [`Type::list`]: every type but a list.
-static ELEMENTS: [Type; 9] = [
+static ELEMENTS: [Type; 10] = [
     Type::Int,
     Type::Float,
     Type::Bool,
@@ -39,6 +42,7 @@ static ELEMENTS: [Type; 9] = [
     Type::Str,
     Type::Shape,
     Type::Profile,
+    Type::Path,
 ];
 
 impl Type {
@@ -71,12 +75,13 @@ impl Type {
             "shape" => Type::Shape,
             "profile" => Type::Profile,
             "color_field" => Type::ColourField,
+            "path" => Type::Path,
             _ => return None,
         })
     }
 
     /// All type names, for suggestions.
-    pub const NAMES: [&'static str; 10] = [
+    pub const NAMES: [&'static str; 11] = [
         "int",
         "float",
         "bool",
@@ -87,6 +92,7 @@ impl Type {
         "shape",
         "profile",
         "color_field",
+        "path",
     ];
 
     /// True when a value of type `self` may be passed where `want` is expected.
@@ -111,6 +117,7 @@ impl fmt::Display for Type {
             Type::Shape => "shape",
             Type::Profile => "profile",
             Type::ColourField => "color_field",
+            Type::Path => "path",
             Type::List(elem) => return write!(f, "[{elem}]"),
         })
     }
@@ -136,6 +143,8 @@ pub enum Value {
     List(&'static Type, Rc<[Value]>),
     /// A colour field: red, green and blue of the point as a field's three values.
     Colour(Rc<crate::scene::field::FieldFn>),
+    /// A path of `sweep`.
+    Path(std::sync::Arc<crate::scene::Path>),
     /// A number or vector that depends on the point `p` of a `field` (1, 2 or 3 components):
     /// an expression evaluated per point, not a constant.
     Point(Comps),
@@ -157,6 +166,7 @@ impl Value {
             Value::Shape(_) => Type::Shape,
             Value::Profile(_) => Type::Profile,
             Value::Colour(_) => Type::ColourField,
+            Value::Path(_) => Type::Path,
             Value::List(elem, _) => Type::List(elem),
             Value::Point(c) => match c.len() {
                 1 => Type::Float,
@@ -223,6 +233,7 @@ impl Value {
             Value::Shape(_)
             | Value::Profile(_)
             | Value::Colour(_)
+            | Value::Path(_)
             | Value::Point(_)
             | Value::Unknown(_)
             | Value::Error => return None,
@@ -271,6 +282,7 @@ impl fmt::Display for Value {
             Value::Shape(_) => write!(f, "<shape>"),
             Value::Profile(_) => write!(f, "<profile>"),
             Value::Colour(_) => write!(f, "<color_field>"),
+            Value::Path(_) => write!(f, "<path>"),
             Value::List(_, items) => {
                 // A long list is shown by its first elements and its length.
                 const SHOWN: usize = 4;
@@ -349,7 +361,11 @@ impl KeyArg {
                 **elem,
                 items.iter().map(KeyArg::of).collect::<Option<_>>()?,
             )),
-            Value::Str(_) | Value::List(..) | Value::Colour(_) | Value::Point(_) => None,
+            Value::Str(_)
+            | Value::List(..)
+            | Value::Colour(_)
+            | Value::Path(_)
+            | Value::Point(_) => None,
         }
     }
 }

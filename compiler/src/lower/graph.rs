@@ -485,6 +485,21 @@ impl<'a> Lowerer<'a> {
                 floor,
                 child,
             } => self.screw(id, [*pitch, *half_height, *inner, *floor], *child, p),
+            Node::Sweep {
+                path,
+                inner,
+                extent,
+                child,
+                ..
+            } => {
+                // The profile read in its plane z = 0 at the point's place about the path.
+                let hit = super::sweep::locate(self.b, p, &path.0);
+                let q = [hit.u, hit.v, self.b.c(0.0)];
+                let f = self.node(*child, q);
+                self.resume(id, node);
+                let d = super::sweep::finish(self.b, f.d, &hit, *inner, *extent);
+                Field { d, m: f.m }
+            }
             Node::ScaleXyz { factors, child } => {
                 let q = self.b.map3(p, |b, x, i| b.mulc(x, 1.0 / factors[i]));
                 let s = factors.iter().fold(f64::INFINITY, |m, f| m.min(f.abs()));

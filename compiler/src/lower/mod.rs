@@ -17,6 +17,9 @@ mod media;
 mod shape_tests;
 mod shapes;
 mod simplify;
+mod sweep;
+#[cfg(test)]
+mod sweep_tests;
 #[cfg(test)]
 mod tests;
 

@@ -327,6 +327,24 @@ fn profiles(node: &Node, r: Aabb) -> Vec<(NodeId, f64, Aabb)> {
         Node::Loft { bottom, top, .. } => vec![(*bottom, 0.0, flat(r)), (*top, 0.0, flat(r))],
         Node::Revolve { offset, child } => vec![(*child, 0.0, around(r, *offset))],
         Node::Screw { child, .. } => vec![(*child, 0.0, around(r, 0.0))],
+        // Within the farthest the region reaches from the path's box, either way.
+        Node::Sweep { path, child, .. } => {
+            let (lo, hi) = path.0.aabb();
+            let m = [0, 1, 2]
+                .map(|i| (r.max[i] - lo[i]).abs().max((hi[i] - r.min[i]).abs()))
+                .iter()
+                .map(|x| x * x)
+                .sum::<f64>()
+                .sqrt();
+            vec![(
+                *child,
+                0.0,
+                Aabb {
+                    min: [-m, -m, 0.0],
+                    max: [m, m, 0.0],
+                },
+            )]
+        }
         _ => Vec::new(),
     }
 }
@@ -758,6 +776,13 @@ impl Pass<'_> {
                 floor,
                 child,
             } => self.screw(id, *pitch, *half_height, *inner, *floor, *child),
+            Node::Sweep {
+                path,
+                inner,
+                extent,
+                folds,
+                child,
+            } => self.sweep(id, &path.0, *folds || inner < extent, *extent, *child),
             Node::Feature { op, a, b } => self.feature(id, *op, *a, *b),
             Node::Combine { op, children } => self.combine(*op, children),
             Node::SmoothCombine {
@@ -1318,6 +1343,46 @@ impl Pass<'_> {
         let k = pitch / std::f64::consts::TAU;
         let stretch = (k / (0.5 * inner)).hypot(1.0);
         let g = (c.gradient * stretch).max(1.0);
+        d.gradient = g;
+        d.facts.lipschitz = g;
+        d.facts.exactness = classify(g, d.proven);
+        d.cause = Some(id);
+        d
+    }
+
+    /// A sweep (docs/analysis.md, "Sweep"): a disc about the origin swept is the distance to
+    /// the path less its radius, exact; another profile's field is read at coordinates that
+    /// change as the point moves across the path and not along it (the frame does not turn
+    /// about the path), but for the twist that closes a closed path: L is the profile's times
+    /// √(1 + (twist·extent)²), a bound within `inner` of the path and the tube's distance
+    /// beyond. Where the profile reaches past half the path's reach (`inner` below `extent`;
+    /// past the whole of it, the sweep `folds`) nothing is proven.
+    fn sweep(
+        &mut self,
+        id: NodeId,
+        path: &super::Path,
+        folds: bool,
+        extent: f64,
+        child: NodeId,
+    ) -> Derived {
+        let c = self.get(child);
+        let mut d = c;
+        let (lo, hi) = path.aabb();
+        d.bounds = Aabb {
+            min: lo.map(|x| x - extent),
+            max: hi.map(|x| x + extent),
+        };
+        d.symmetric = [false; 3];
+        d.growth = c.growth.max(1.0);
+        if super::path::round_profile(&self.scene.graph, child) {
+            d.gradient = 1.0;
+            d.facts.lipschitz = 1.0;
+            return d;
+        }
+        if !c.proven || folds || c.facts.exactness == Exactness::Approximate {
+            return unproven(d, id);
+        }
+        let g = (c.gradient * (path.twist * extent).hypot(1.0)).max(1.0);
         d.gradient = g;
         d.facts.lipschitz = g;
         d.facts.exactness = classify(g, d.proven);

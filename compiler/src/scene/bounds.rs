@@ -305,6 +305,12 @@ impl Bounds {
                 child,
                 ..
             } => screw(&get(child)?, *half_height, *floor)?,
+            Node::Sweep {
+                path,
+                extent,
+                child,
+                ..
+            } => sweep(&path.0, *extent, &get(child)?),
             Node::Feature { op, a, .. } => get(a)?.grow(op.outset()),
             Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
             Node::SmoothCombine {
@@ -411,6 +417,22 @@ fn revolve(b: &Bound, offset: f64) -> Option<Bound> {
 /// beyond the slab at least |y| - half_height; their maximum is at least floor/√2 times the
 /// distance to the cylinder, and so to its box and sphere. `None` for a profile without
 /// finite extents.
+/// The path's box grown by the profile's reach: the field is at least the distance to the tube
+/// of that radius about the path (docs/analysis.md, "Sweep"), scaled as the profile's.
+fn sweep(path: &super::Path, extent: f64, profile: &Bound) -> Bound {
+    let (lo, hi) = path.aabb();
+    let c = [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0);
+    let h = [0, 1, 2].map(|i| (hi[i] - lo[i]) / 2.0 + extent);
+    Bound {
+        sphere: Sphere {
+            c,
+            r: DVec3::from(h).length(),
+        },
+        aabb: Aabb { c, h },
+        scale: profile.scale.min(1.0),
+    }
+}
+
 fn screw(b: &Bound, half_height: f64, floor: f64) -> Option<Bound> {
     let r = b.aabb.c[0] + b.aabb.h[0];
     if !r.is_finite() || r < 0.0 {
@@ -685,6 +707,7 @@ fn own_cost(node: &Node) -> f64 {
         Node::Revolve { .. } => 5.0,
         Node::Loft { .. } => 18.0,
         Node::Screw { .. } => 30.0,
+        Node::Sweep { path, .. } => path.0.cost(),
         Node::Feature { .. } => 8.0,
         Node::Combine { children, .. } => 4.0 * children.len() as f64,
         Node::SmoothCombine { variant, .. } => match variant {

@@ -339,6 +339,20 @@ fn node(n: &Node) -> String {
             bottom.0,
             top.0
         ),
+        Node::Sweep {
+            path,
+            inner,
+            extent,
+            folds,
+            child,
+        } => format!(
+            "sweep {} inner={} extent={}{} %{}",
+            path.0.describe(),
+            num(*inner),
+            num(*extent),
+            if *folds { " folds" } else { "" },
+            child.0
+        ),
         Node::Screw {
             pitch,
             half_height,

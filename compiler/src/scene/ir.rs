@@ -214,6 +214,20 @@ pub enum Node {
         floor: f64,
         child: NodeId,
     },
+    /// A profile swept along a path (`scene/path.rs`, `lower/sweep.rs`): read at the point's
+    /// coordinates in the path's frame at its nearest point, capped at open ends. Beyond
+    /// `inner` from the path (∞: nowhere), and beyond `extent` (the profile's reach from its
+    /// origin), the field is the distance to the tube of radius `extent` about the path
+    /// (docs/analysis.md, "Sweep"); it is proven a bound where `inner` ≥ `extent`.
+    Sweep {
+        path: PathRef,
+        inner: f64,
+        extent: f64,
+        /// The profile reaches past the path's reach: the sweep folds over itself (W0018) and
+        /// its field is not proven.
+        folds: bool,
+        child: NodeId,
+    },
     /// n-ary union, or a binary intersection or subtraction.
     Combine { op: Combine, children: Vec<NodeId> },
     /// Smooth union, intersection or subtraction with blend radius `k`.
@@ -306,6 +320,23 @@ impl std::fmt::Debug for MeshRef {
     }
 }
 
+/// A path of a sweep: equal to another of the same points and frames, shown by its kind.
+#[derive(Clone)]
+pub struct PathRef(pub std::sync::Arc<super::path::Path>);
+
+impl PartialEq for PathRef {
+    fn eq(&self, other: &Self) -> bool {
+        *self.0 == *other.0
+    }
+}
+
+impl std::fmt::Debug for PathRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        // Every number: the hash-consing key tells paths apart by it.
+        write!(f, "{:?}", self.0)
+    }
+}
+
 /// The pattern of every node with exactly one child (the transforms, the modifiers and
 /// paint), binding the child to `$child`: the one list of them.
 macro_rules! one_child {
@@ -329,6 +360,7 @@ macro_rules! one_child {
             | Node::Extrude { $child, .. }
             | Node::Revolve { $child, .. }
             | Node::Screw { $child, .. }
+            | Node::Sweep { $child, .. }
     };
 }
 
@@ -391,6 +423,7 @@ impl Node {
             Node::Revolve { .. } => "revolve",
             Node::Loft { .. } => "loft",
             Node::Screw { .. } => "screw",
+            Node::Sweep { .. } => "sweep",
             Node::Feature { op, .. } => op.name(),
             Node::Combine { op, .. } => op.name(false),
             Node::SmoothCombine { op, .. } => op.name(true),

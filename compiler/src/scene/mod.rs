@@ -10,6 +10,7 @@ pub mod field;
 pub mod ir;
 pub mod look;
 pub mod params;
+pub mod path;
 pub mod pbr;
 pub mod reach;
 pub mod recentre;
@@ -17,6 +18,7 @@ pub mod recentre;
 pub use dump::{dump, num as dump_num};
 pub use ir::*;
 pub use look::Tonemap;
+pub use path::Path;
 pub use pbr::Pbr;
 
 /// Names a node of a [`Graph`].

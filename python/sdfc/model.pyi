@@ -9,7 +9,6 @@ from . import Facts, Scene
 
 Vec2 = Union[Tuple[float, float], Sequence[float], np.ndarray]
 Vec3 = Union[Tuple[float, float, float], Sequence[float], np.ndarray]
-AngleLike = Union["Angle", float]
 _E = TypeVar("_E", bound="_Expr")
 
 class Angle:
@@ -50,7 +49,7 @@ class Profile(_Expr):
     def translate(self, offset: Vec2) -> Profile: ...
     @overload
     def translate(self, x: float, y: float = ...) -> Profile: ...
-    def rotate(self, angle: AngleLike) -> Profile: ...
+    def rotate(self, angle: Angle) -> Profile: ...
     def scale(self, factor: float) -> Profile: ...
     def mirror(self, x: bool = ..., y: bool = ...) -> Profile: ...
     def reflect(self, normal: Vec2) -> Profile: ...
@@ -83,6 +82,7 @@ class Shape(_Expr):
         voxel: Optional[float] = ...,
         sharp: bool = ...,
         limits: Optional[Dict[str, int]] = ...,
+        up: Optional[str] = ...,
     ) -> Tuple[int, int]: ...
     def distance(self, points: Any, backend: str = ...) -> np.ndarray: ...
     def facts(self) -> Facts: ...
@@ -110,10 +110,10 @@ class Shape(_Expr):
     def translate(self, offset: Vec3) -> Shape: ...
     @overload
     def translate(self, x: float, y: float = ..., z: float = ...) -> Shape: ...
-    def rotate_x(self, angle: AngleLike) -> Shape: ...
-    def rotate_y(self, angle: AngleLike) -> Shape: ...
-    def rotate_z(self, angle: AngleLike) -> Shape: ...
-    def rotate(self, axis: Vec3, angle: AngleLike) -> Shape: ...
+    def rotate_x(self, angle: Angle) -> Shape: ...
+    def rotate_y(self, angle: Angle) -> Shape: ...
+    def rotate_z(self, angle: Angle) -> Shape: ...
+    def rotate(self, axis: Vec3, angle: Angle) -> Shape: ...
     @overload
     def scale(self, factor: float) -> Shape: ...
     @overload
@@ -512,9 +512,9 @@ def smooth_union(k: float, shapes: Sequence[Shape], variant: str = ..., steps: i
     """```sdf
     smooth_union(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; `variant` "poly", "exp", "chamfer", "round", "stairs" or "columns"; `steps` 1 … 64
+    Valid: `k` ≥ 0; `variant` "poly", "exp", "chamfer", "round", "stairs" or "columns"; `steps` 1 … 64
 
-    Union blended over a radius `k`; `variant` "poly" (quadratic, default) or "exp" (exponential) smooth minima, or the edges of Mercury's hg_sdf library: "chamfer" (a 45° bevel `k` wide), "round" (a quarter circle of radius `k`), "stairs" (`steps` steps within `k`), "columns" (`steps` round columns within `k`). `steps` is read by "stairs" and "columns" only.
+    Union blended over a radius `k` (0: the plain union, which an animated radius may pass through); `variant` "poly" (quadratic, default) or "exp" (exponential) smooth minima, or the edges of Mercury's hg_sdf library: "chamfer" (a 45° bevel `k` wide), "round" (a quarter circle of radius `k`), "stairs" (`steps` steps within `k`), "columns" (`steps` round columns within `k`). `steps` is read by "stairs" and "columns" only.
 
     ```sdf
     smooth_union(k: float, a: profile, b: profile, variant: string = "poly", steps: int = 4) -> profile
@@ -531,7 +531,7 @@ def smooth_union(k: float, shapes: Sequence[Shape], variant: str = ..., steps: i
     ```sdf
     smooth_union(k: float, shapes: [shape], variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; not empty
+    Valid: `k` ≥ 0; not empty
 
     The left fold of the binary form over the list; independent of the list's order only with `variant: "exp"` (§6a).
     """
@@ -547,7 +547,7 @@ def smooth_intersect(k: float, shapes: Sequence[Shape], variant: str = ..., step
     """```sdf
     smooth_intersect(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; `variant` and `steps` as for `smooth_union`
+    Valid: `k` ≥ 0; `variant` and `steps` as for `smooth_union`
 
     Intersection blended over `k`; `variant` as for `smooth_union`.
 
@@ -564,7 +564,7 @@ def smooth_intersect(k: float, shapes: Sequence[Shape], variant: str = ..., step
     ```sdf
     smooth_intersect(k: float, shapes: [shape], variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; not empty
+    Valid: `k` ≥ 0; not empty
 
     The left fold of the binary form over the list, as for `smooth_union`.
     """
@@ -576,7 +576,7 @@ def smooth_subtract(k: float, a: Profile, b: Profile, variant: str = ..., steps:
     """```sdf
     smooth_subtract(k: float, a: shape, b: shape, variant: string = "poly", steps: int = 4) -> shape
     ```
-    Valid: `k` > 0; `variant` and `steps` as for `smooth_union`
+    Valid: `k` ≥ 0; `variant` and `steps` as for `smooth_union`
 
     Subtraction blended over `k`; `variant` as for `smooth_union`.
 
@@ -648,21 +648,21 @@ def translate(profile: Profile, x: float, y: float = ...) -> Profile:
     ```
     """
     ...
-def rotate_x(shape: Shape, angle: AngleLike) -> Shape:
+def rotate_x(shape: Shape, angle: Angle) -> Shape:
     """```sdf
     rotate_x(shape: shape, angle: angle) -> shape
     ```
     Rotates a shape about the x axis.
     """
     ...
-def rotate_y(shape: Shape, angle: AngleLike) -> Shape:
+def rotate_y(shape: Shape, angle: Angle) -> Shape:
     """```sdf
     rotate_y(shape: shape, angle: angle) -> shape
     ```
     Rotates a shape about the y axis.
     """
     ...
-def rotate_z(shape: Shape, angle: AngleLike) -> Shape:
+def rotate_z(shape: Shape, angle: Angle) -> Shape:
     """```sdf
     rotate_z(shape: shape, angle: angle) -> shape
     ```
@@ -670,9 +670,9 @@ def rotate_z(shape: Shape, angle: AngleLike) -> Shape:
     """
     ...
 @overload
-def rotate(shape: Shape, axis: Vec3, angle: AngleLike) -> Shape: ...
+def rotate(shape: Shape, axis: Vec3, angle: Angle) -> Shape: ...
 @overload
-def rotate(profile: Profile, angle: AngleLike) -> Profile:
+def rotate(profile: Profile, angle: Angle) -> Profile:
     """```sdf
     rotate(shape: shape, axis: vec3, angle: angle) -> shape
     ```
@@ -1020,7 +1020,7 @@ def round_rect(half: Vec2, radius: float = ...) -> Profile:
     A rectangle with its corners rounded by `radius`, inside the extents. Exact.
     """
     ...
-def arc(radius: float = ..., angle: AngleLike = ..., thickness: float = ...) -> Profile:
+def arc(radius: float = ..., angle: Angle = ..., thickness: float = ...) -> Profile:
     """```sdf
     arc(radius: float = 0.5, angle: angle, thickness: float = 0.1) -> profile
     ```
@@ -1031,27 +1031,30 @@ def arc(radius: float = ..., angle: AngleLike = ..., thickness: float = ...) -> 
     ...
 
 class Phong(Record):
-    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., color: Union[Vec3, Shape] = ...) -> None: ...
+    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., color: Union[Vec3, Shape] = ..., fresnel: bool = ...) -> None: ...
 
 class Checker(Record):
-    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., a: Union[Vec3, Shape] = ..., b: Union[Vec3, Shape] = ..., size: float = ...) -> None: ...
+    def __init__(self, *, ambient: float = ..., diffuse: float = ..., specular: float = ..., shininess: float = ..., reflect: float = ..., transparency: float = ..., ior: float = ..., fresnel: bool = ..., a: Union[Vec3, Shape] = ..., b: Union[Vec3, Shape] = ..., size: float = ...) -> None: ...
+
+class Pbr(Record):
+    def __init__(self, *, base_color: Union[Vec3, Shape] = ..., roughness: float = ..., metallic: float = ..., emission: Vec3 = ..., transmission: float = ..., ior: float = ...) -> None: ...
 
 class PointLight(Record):
-    def __init__(self, *, position: Vec3, radius: float = ..., color: Vec3 = ..., intensity: float = ..., penumbra: AngleLike = ..., softness: float = ..., shadows: bool = ...) -> None: ...
+    def __init__(self, *, position: Vec3, radius: float = ..., color: Vec3 = ..., intensity: float = ..., penumbra: Angle = ..., softness: float = ..., shadows: bool = ...) -> None: ...
 
 class DirectionalLight(Record):
-    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., penumbra: AngleLike = ..., softness: float = ..., shadows: bool = ...) -> None: ...
+    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., penumbra: Angle = ..., softness: float = ..., shadows: bool = ...) -> None: ...
 
 class SunLight(Record):
-    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., angle: AngleLike = ..., shadows: bool = ...) -> None: ...
+    def __init__(self, *, direction: Vec3, color: Vec3 = ..., intensity: float = ..., angle: Angle = ..., shadows: bool = ...) -> None: ...
 
 class SkyLight(Record):
     def __init__(self, *, color: Vec3 = ..., zenith: Vec3 = ..., horizon: Vec3 = ..., ground: Vec3 = ..., intensity: float = ..., shadows: bool = ..., background: bool = ...) -> None: ...
 
 class Camera(Record):
-    def __init__(self, *, position: Vec3 = ..., look_at: Vec3 = ..., up: Vec3 = ..., fov: AngleLike = ...) -> None: ...
+    def __init__(self, *, position: Vec3 = ..., look_at: Vec3 = ..., up: Vec3 = ..., fov: Angle = ...) -> None: ...
 
 class Render(Record):
     def __init__(self, *, width: int = ..., height: int = ..., aa: int = ..., max_steps: int = ..., epsilon: float = ..., max_depth: int = ..., max_dist: float = ..., relaxation: float = ..., background: Vec3 = ..., method: str = ..., fps: float = ..., duration: float = ..., occlusion: float = ..., fog: float = ..., fog_color: Vec3 = ..., exposure: float = ..., tonemap: str = ...) -> None: ...
 
-__all__ = ["Angle", "Path", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "sweep", "polyline", "helix", "arc3", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]
+__all__ = ["Angle", "Path", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "sweep", "polyline", "helix", "arc3", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "Pbr", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]

@@ -44,6 +44,7 @@ def sample(p):
         "[profile]": [sdfc.circle(0.5), sdfc.rect(0.3)],
         "[vec2]": [(0, 0), (1, 0), (0, 1)],
         "[vec3]": [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)],
+        "path": sdfc.polyline([(0, 0, 0), (0, 1, 0), (1, 2, 0)]),
     }[p.type]
 
 

@@ -36,7 +36,7 @@ enum Command {
     Compare(commands::compare::CompareArgs),
     /// Chart speed against accuracy over swept render settings, with the Pareto front.
     Pareto(commands::pareto::ParetoArgs),
-    /// Mesh a scene's surface (STL, OBJ, PLY or glTF), watertight and with sharp edges kept.
+    /// Mesh a scene's surface (STL, OBJ, PLY, glTF or 3MF), watertight and with sharp edges kept.
     Mesh(commands::mesh::MeshArgs),
     /// List the devices `--devices` can name: CUDA devices and wgpu adapters by index, and
     /// the CPU.

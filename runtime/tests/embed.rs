@@ -513,6 +513,34 @@ fn shadertoy_wrapped(file: &Path) -> String {
     format!("{SHADERTOY_HEAD}{page}{SHADERTOY_TAIL}")
 }
 
+/// The page renders camera rays with Phong shading: `--emit shadertoy` says what of a scene it
+/// leaves out, on standard error, and says nothing for a scene it shows whole.
+#[test]
+fn the_shadertoy_page_says_what_it_leaves_out() {
+    let said = |file: &Path| {
+        let out = sdfc(&[
+            "compile",
+            file.to_str().expect("utf-8"),
+            "--emit",
+            "shadertoy",
+        ]);
+        assert!(out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let studio = said(&example("studio.sdf"));
+    for what in [
+        "warning: the Shadertoy page",
+        "pbr materials (shaded as the nearest Phong)",
+        "sky lights",
+        "refraction and transparency",
+    ] {
+        assert!(studio.contains(what), "{what}: {studio}");
+    }
+    assert!(said(&example("seed3.sdf")).contains("leaves out this scene's reflection"));
+    let plain = said(&example("blends.sdf"));
+    assert!(!plain.contains("warning"), "{plain}");
+}
+
 /// `--emit shadertoy` of the report's scenes, wrapped as Shadertoy wraps it, compiles with
 /// glslangValidator (Debian's `glslang-tools`) as a GLSL ES 3.00 fragment shader.
 #[test]

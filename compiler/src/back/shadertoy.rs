@@ -6,7 +6,8 @@
 //! docs/rendering.md states them (the checker filtered over the pixel's footprint), for
 //! camera rays only. Reflection, refraction, transparency, over-relaxation, antialiasing, sky
 //! lights and the rest of the look (occlusion, fog, exposure and tone curves) are left out, so
-//! a scene using them renders without them.
+//! a scene using them renders without them ([`left_out`] names those a scene uses, for the
+//! warning `sdfc compile` prints).
 
 use super::shader::{self, Error};
 use super::wgsl::{self, float};
@@ -146,6 +147,40 @@ SDFC_LIGHTS    }
 "#;
 
 /// The page for `scene`, lowered as `lowered`.
+/// What `scene` asks for that the page does not render (the module's list), in words, for the
+/// warning `sdfc compile --emit shadertoy` prints; empty where the page shows what the
+/// renderers show (over-relaxation changes only the speed, so it is not named).
+pub fn left_out(scene: &Scene) -> Vec<&'static str> {
+    let (m, s) = (&scene.materials, &scene.settings);
+    let asked = [
+        (m.iter().any(|m| m.reflect > 0.0), "reflection"),
+        (
+            m.iter().any(|m| m.transparency > 0.0),
+            "refraction and transparency",
+        ),
+        (
+            m.iter().any(|m| m.pbr.is_some()),
+            "pbr materials (shaded as the nearest Phong)",
+        ),
+        (
+            scene.lights.iter().any(|l| matches!(l, Light::Sky { .. })),
+            "sky lights",
+        ),
+        (s.occlusion > 0.0, "occlusion"),
+        (s.fog > 0.0, "fog"),
+        (
+            s.exposure != 0.0 || s.tonemap != look::Tonemap::None,
+            "exposure and the tone curve",
+        ),
+        (s.aa > 1, "antialiasing"),
+    ];
+    asked
+        .into_iter()
+        .filter(|(used, _)| *used)
+        .map(|(_, what)| what)
+        .collect()
+}
+
 pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
     let part = wgsl::part::write(scene, lowered, NAME).map_err(|e| Error(e.to_string()))?;
     let functions = shader::write_part_es(&part)?;

@@ -177,6 +177,14 @@ pub fn run(args: CompileArgs) -> ExitCode {
                 eprintln!("error: {msg}");
                 return ExitCode::from(2);
             }
+            // The Shadertoy page renders camera rays only: say what of this scene it leaves out.
+            let missing = shadertoy::left_out(scene);
+            if other == Emit::Shadertoy && !missing.is_empty() {
+                eprintln!(
+                    "warning: the Shadertoy page renders camera rays with Phong shading only; it leaves out this scene's {} (docs/embedding.md)",
+                    missing.join(", ")
+                );
+            }
             let result = match args.part {
                 Part::Kernel => emit(scene, &lowered, other, args.sm, args.kernel),
                 Part::Map => emit_map(scene, &lowered, other, &args.name),

@@ -1091,7 +1091,7 @@ static FUNCTIONS: &[Builtin] = &[
         sigs: sigs![
             [p("a", V2, Req, Any), p("control", V2, Req, Any), p("b", V2, Req, Any), p("radius", F, Num(0.05), Pos)] -> PR => bezier;
             [p("points", Type::List(&V), Req, Any)] -> Type::Path => |_, a| {
-                Ok(Value::Path(std::sync::Arc::new(Path::bezier(&points3(&a[0]))?)))
+                Ok(Value::Path(std::sync::Arc::new(Path::bezier(&points3(&a[0])).map_err(|e| e.to_string())?)))
             };
         ],
     },
@@ -1105,7 +1105,7 @@ static FUNCTIONS: &[Builtin] = &[
         name: "polyline",
         sigs: sigs![
             [p("points", Type::List(&V), Req, Any)] -> Type::Path => |_, a| {
-                Ok(Value::Path(std::sync::Arc::new(Path::polyline(&points3(&a[0]))?)))
+                Ok(Value::Path(std::sync::Arc::new(Path::polyline(&points3(&a[0])).map_err(|e| e.to_string())?)))
             };
         ],
     },
@@ -1125,7 +1125,7 @@ static FUNCTIONS: &[Builtin] = &[
                     let c = a[i].components();
                     [c[0], c[1], c[2]]
                 });
-                Ok(Value::Path(std::sync::Arc::new(Path::arc3(x, y, z)?)))
+                Ok(Value::Path(std::sync::Arc::new(Path::arc3(x, y, z).map_err(|e| e.to_string())?)))
             };
         ],
     },

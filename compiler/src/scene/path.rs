@@ -122,24 +122,63 @@ fn point(x: DVec3) -> String {
     format!("({}, {}, {})", num(x.x), num(x.y), num(x.z))
 }
 
+/// Why a path's points make no path: each the checker's message, located at the call.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PathError {
+    /// A polyline of fewer than two points.
+    #[error("a polyline needs at least 2 points, and this one has {0}")]
+    TooFewPoints(usize),
+    /// Two consecutive points of a polyline are one point.
+    #[error("points {first} and {second} of the polyline are the same point {at}: its segment has no direction")]
+    RepeatedPoint {
+        first: usize,
+        second: usize,
+        /// The point, as written.
+        at: String,
+    },
+    /// A polyline's corner that turns straight back.
+    #[error("the polyline turns straight back at point {index} {at}: a profile cannot follow a turn of 180°")]
+    TurnsBack { index: usize, at: String },
+    /// A Bézier chain whose count of points is not 3k + 1.
+    #[error("a Bézier path takes 3k + 1 control points (4 for one cubic curve, 7 for two, …: each curve after the first adds 3), and this one has {count}: give {near}")]
+    BezierCount {
+        count: usize,
+        /// The nearest counts that are, in words.
+        near: String,
+    },
+    /// A control point on its curve's end point.
+    #[error("control point {control} is the same point as end point {end} {at}: the curve has no direction there (move it along the direction the curve should leave or reach its end)")]
+    ControlAtEnd {
+        control: usize,
+        end: usize,
+        at: String,
+    },
+    /// A Bézier curve whose direction vanishes inside it.
+    #[error("the Bézier path stops at {at} (its direction is undefined there: its curve {curve} doubles back on itself)")]
+    BezierStops { curve: usize, at: String },
+    /// An arc through two equal points.
+    #[error("an arc's three points must be three different points")]
+    ArcPointsEqual,
+    /// An arc through three points on one line.
+    #[error("the arc's three points lie on one line: no circle goes through them (draw the segment with `polyline([start, end])`)")]
+    ArcCollinear,
+}
+
 impl Path {
     /// `polyline(points)`: two or more points, no two consecutive ones equal, and no corner
     /// that turns straight back; closed where the last point is the first.
-    pub fn polyline(points: &[V3]) -> Result<Path, String> {
+    pub fn polyline(points: &[V3]) -> Result<Path, PathError> {
         if points.len() < 2 {
-            return Err(format!(
-                "a polyline needs at least 2 points, and this one has {}",
-                points.len()
-            ));
+            return Err(PathError::TooFewPoints(points.len()));
         }
         let pts: Vec<DVec3> = points.iter().map(|x| v(*x)).collect();
         for i in 1..pts.len() {
             if pts[i] == pts[i - 1] {
-                return Err(format!(
-                    "points {} and {i} of the polyline are the same point {}: its segment has no direction",
-                    i - 1,
-                    point(pts[i])
-                ));
+                return Err(PathError::RepeatedPoint {
+                    first: i - 1,
+                    second: i,
+                    at: point(pts[i]),
+                });
             }
         }
         let closed = pts.len() > 3 && pts[0] == pts[pts.len() - 1];
@@ -148,11 +187,10 @@ impl Path {
         for i in 0..corners {
             let (a, b) = (dirs[i], dirs[(i + 1) % dirs.len()]);
             if a.dot(b) < -1.0 + 1e-9 {
-                return Err(format!(
-                    "the polyline turns straight back at point {} {}: a profile cannot follow a turn of 180°",
-                    (i + 1) % dirs.len(),
-                    point(pts[(i + 1) % dirs.len()])
-                ));
+                return Err(PathError::TurnsBack {
+                    index: (i + 1) % dirs.len(),
+                    at: point(pts[(i + 1) % dirs.len()]),
+                });
             }
         }
         let mut n = vec![first_normal(dirs[0])];
@@ -201,7 +239,7 @@ impl Path {
 
     /// `bezier(points)`: 3k + 1 control points (k ≥ 1) of k cubic curves, each starting
     /// where the one before ends; closed where the last point is the first.
-    pub fn bezier(points: &[V3]) -> Result<Path, String> {
+    pub fn bezier(points: &[V3]) -> Result<Path, PathError> {
         let n = points.len();
         if n < 4 || (n - 1) % 3 != 0 {
             let k = (n.max(2) - 1).div_ceil(3).max(1);
@@ -211,19 +249,18 @@ impl Path {
             } else {
                 format!("{lo} or {hi}")
             };
-            return Err(format!(
-                "a Bézier path takes 3k + 1 control points (4 for one cubic curve, 7 for two, …: each curve after the first adds 3), and this one has {n}: give {near}"
-            ));
+            return Err(PathError::BezierCount { count: n, near });
         }
         let pts: Vec<DVec3> = points.iter().map(|x| v(*x)).collect();
         let k = (n - 1) / 3;
         for c in 0..k {
             for (i, j) in [(3 * c, 3 * c + 1), (3 * c + 3, 3 * c + 2)] {
                 if pts[i] == pts[j] {
-                    return Err(format!(
-                        "control point {j} is the same point as end point {i} {}: the curve has no direction there (move it along the direction the curve should leave or reach its end)",
-                        point(pts[i])
-                    ));
+                    return Err(PathError::ControlAtEnd {
+                        control: j,
+                        end: i,
+                        at: point(pts[i]),
+                    });
                 }
             }
         }
@@ -262,10 +299,10 @@ impl Path {
                 let t = j as f64 / DENSE as f64;
                 let (x, d) = (cubic(q, t), tangent(q, t));
                 if d.length_squared() < 1e-24 {
-                    return Err(format!(
-                        "the Bézier path stops at {} (its direction is undefined there: its curve {c} doubles back on itself)",
-                        point(x)
-                    ));
+                    return Err(PathError::BezierStops {
+                        curve: c,
+                        at: point(x),
+                    });
                 }
                 let d = d.normalize();
                 let nn = match dense.last() {
@@ -312,19 +349,16 @@ impl Path {
 
     /// `arc3(start, through, end)`: the arc of the circle through the three points from
     /// `start` to `end` passing `through`.
-    pub fn arc3(a: V3, b: V3, c: V3) -> Result<Path, String> {
+    pub fn arc3(a: V3, b: V3, c: V3) -> Result<Path, PathError> {
         let (a, b, c) = (v(a), v(b), v(c));
         if a == b || b == c || a == c {
-            return Err("an arc's three points must be three different points".to_string());
+            return Err(PathError::ArcPointsEqual);
         }
         let (u, w) = (b - a, c - a);
         let n = u.cross(w);
         let size = u.length().max(w.length());
         if n.length() <= 1e-9 * size * size {
-            return Err(
-                "the arc's three points lie on one line: no circle goes through them (draw the segment with `polyline([start, end])`)"
-                    .to_string(),
-            );
+            return Err(PathError::ArcCollinear);
         }
         // The circumcentre of the triangle.
         let centre = a

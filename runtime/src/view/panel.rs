@@ -180,7 +180,7 @@ impl Panel {
     /// Sets the control of the parameter `name` to the value written `text`, as its widget
     /// would be set (`--change NAME=VALUE`): the value it stands for, within the range and on
     /// the step, which the caller gives the session.
-    pub fn change(&mut self, name: &str, text: &str) -> Result<ParamValue, String> {
+    pub fn change(&mut self, name: &str, text: &str) -> Result<ParamValue, widgets::ChangeError> {
         let i = self
             .controls
             .iter()

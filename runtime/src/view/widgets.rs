@@ -149,15 +149,46 @@ pub fn decimals(lo: f64, step: Option<f64>) -> Option<usize> {
 
 /// The value `text` stands for in control `c` (`--change`'s value, read as its widget reads
 /// what it is given).
-pub fn value_from_text(c: &Control, text: &str) -> Result<ParamValue, String> {
+pub fn value_from_text(c: &Control, text: &str) -> Result<ParamValue, ChangeError> {
     c.parse(text)
         .and_then(|raw| c.value_of(&raw))
-        .ok_or_else(|| format!("`{text}` is not a value of `{}` ({})", c.name, c.accepts))
+        .ok_or_else(|| ChangeError::NotAValue {
+            text: text.to_string(),
+            name: c.name.clone(),
+            accepts: c.accepts.clone(),
+        })
+}
+
+/// Why `--change NAME=VALUE` is refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ChangeError {
+    /// The scene on show declares no parameter `name`; `declared` are those it does.
+    #[error("the scene has no parameter `{name}`{}", declared_names(.declared))]
+    Unknown { name: String, declared: Vec<String> },
+    /// The text is no value the parameter's control takes.
+    #[error("`{text}` is not a value of `{name}` ({accepts})")]
+    NotAValue {
+        text: String,
+        name: String,
+        /// What the parameter accepts, as `sdfc check` writes it.
+        accepts: String,
+    },
+}
+
+/// The end of [`ChangeError::Unknown`]'s message: the parameters the scene declares.
+fn declared_names(declared: &[String]) -> String {
+    match declared.is_empty() {
+        true => ": it declares none".to_string(),
+        false => {
+            let names: Vec<String> = declared.iter().map(|n| format!("`{n}`")).collect();
+            format!("; its parameters: {}", names.join(", "))
+        }
+    }
 }
 
 /// The value `--change NAME=VALUE` gives the parameter `name` of `params` (the scene on show),
 /// through its control, as the panel would.
-pub fn change(params: &[Parameter], name: &str, text: &str) -> Result<ParamValue, String> {
+pub fn change(params: &[Parameter], name: &str, text: &str) -> Result<ParamValue, ChangeError> {
     let p = params
         .iter()
         .find(|p| p.name == name)
@@ -166,14 +197,10 @@ pub fn change(params: &[Parameter], name: &str, text: &str) -> Result<ParamValue
 }
 
 /// Why `--change` names no parameter of the scene on show.
-pub fn unknown(params: &[Parameter], name: &str) -> String {
-    let names: Vec<String> = params.iter().map(|p| format!("`{}`", p.name)).collect();
-    match names.is_empty() {
-        true => format!("the scene has no parameter `{name}`: it declares none"),
-        false => format!(
-            "the scene has no parameter `{name}`; its parameters: {}",
-            names.join(", ")
-        ),
+pub fn unknown(params: &[Parameter], name: &str) -> ChangeError {
+    ChangeError::Unknown {
+        name: name.to_string(),
+        declared: params.iter().map(|p| p.name.clone()).collect(),
     }
 }
 

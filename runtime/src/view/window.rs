@@ -334,7 +334,7 @@ impl State {
 
     /// `--change NAME=VALUE`: sets the parameter's control to the value as its widget would
     /// be set, and gives the session the value it stands for.
-    fn change(&mut self, name: &str, text: &str) -> Result<Outcome, String> {
+    fn change(&mut self, name: &str, text: &str) -> Result<Outcome, widgets::ChangeError> {
         let value = match self.panel.as_mut() {
             Some(panel) => {
                 panel.follow(self.session.params());

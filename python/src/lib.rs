@@ -23,6 +23,7 @@ use sdfc_runtime::job::{self, Job, Overrides};
 use std::sync::OnceLock;
 use std::time::Duration;
 
+mod kept;
 mod mesh;
 mod table;
 
@@ -284,6 +285,8 @@ struct Scene {
     text: String,
     set: Vec<String>,
     limits: Limits,
+    /// The render and the distance kernel prepared last.
+    kept: kept::Kept,
 }
 
 /// What a render is asked for.
@@ -370,17 +373,21 @@ impl Scene {
             software: false,
         };
         let on = (ask.backend, &Devices::Auto);
+        // The render prepared last for the same backend and outputs is prepared again as the
+        // viewer's later loads are: its kernel kept where its text is unchanged.
+        let before = self.kept.take_render(ask.backend, image_only);
         let job::Ready {
             scene, prepared, ..
-        } = match ask.backend {
+        } = match (&before, ask.backend) {
+            (Some(before), _) => job::prepare(pool, on, frame, &setup, job::Open::After(before))?,
             // The process's wgpu device, whose compiled pipelines later renders reuse.
-            Backend::Wgpu => {
+            (None, Backend::Wgpu) => {
                 let gpu = wgpu_device().map_err(|e| Failure::Runtime(e.clone()))?;
                 let open = job::Open::Gpu(gpu.clone());
                 job::prepare(pool, on, frame, &setup, open)
                     .map_err(|e| Failure::Runtime(format!("the wgpu backend: {e}")))?
             }
-            backend => {
+            (None, backend) => {
                 if matches!(backend, Backend::Cuda | Backend::Auto) {
                     // Holding the device's primary context keeps it from being torn down
                     // and built again (a fifth of a second) between renders.
@@ -389,6 +396,7 @@ impl Scene {
                 job::prepare(pool, on, frame, &setup, job::Open::Backend)?
             }
         };
+        drop(before);
         job::check_memory(
             pool,
             &prepared,
@@ -403,6 +411,7 @@ impl Scene {
         let frame = pool
             .install(|| prepared.render(&scene, &|_| {}))
             .map_err(|e| Failure::Runtime(e.to_string()))?;
+        self.kept.keep_render(ask.backend, image_only, prepared);
         Ok(frame.render)
     }
 }
@@ -425,29 +434,6 @@ fn wgpu_device() -> Result<&'static std::sync::Arc<sdfc_runtime::gpu::Gpu>, Stri
     })
     .as_ref()
     .map_err(Clone::clone)
-}
-
-/// Distances (f32 bytes) and material ids (u32 bytes) at `points` (program coordinates)
-/// from the scene's WGSL part on a GPU: through wgpu, or as PTX through CUDA.
-fn gpu_distances(
-    backend: &str,
-    scene: &sdfc_compiler::Scene,
-    lowered: &Lowered,
-    points: &[[f64; 3]],
-) -> Result<(Vec<u8>, Vec<u8>), String> {
-    use sdfc_runtime::gpu::points as on_gpu;
-    // Each device is opened once per process, on first use.
-    let module = on_gpu::points_module(scene, lowered, false)?;
-    let (values, _) = if backend == "cuda" {
-        let (ctx, sm) = cuda_device().as_ref().map_err(Clone::clone)?;
-        let ptx = on_gpu::points_ptx(&module, *sm)?;
-        on_gpu::run_cuda(ctx, &module, &ptx, points)?
-    } else {
-        on_gpu::run_wgpu(wgpu_device()?, &module, points)?
-    };
-    let d = values.iter().flat_map(|(d, _)| d.to_ne_bytes()).collect();
-    let m = values.iter().flat_map(|(_, m)| m.to_ne_bytes()).collect();
-    Ok((d, m))
 }
 
 fn backend(name: &str) -> PyResult<Backend> {
@@ -485,6 +471,7 @@ impl Scene {
             text: src.text().to_string(),
             set,
             limits,
+            kept: kept::Kept::default(),
         };
         scene.checked(0.0, None, None).map_err(|f| f.into_py(py))?;
         Ok(scene)
@@ -670,7 +657,7 @@ impl Scene {
         if backend != "cpu" {
             let scene = checked.scene;
             let (d, m) = py
-                .detach(move || gpu_distances(&backend, &scene, &lowered, &xyz))
+                .detach(|| self.kept.distances(&backend, &scene, &lowered, &xyz))
                 .map_err(PyRuntimeError::new_err)?;
             return Ok((PyBytes::new(py, &d), PyBytes::new(py, &m)));
         }

@@ -385,6 +385,39 @@ class Frames(unittest.TestCase):
         np.testing.assert_array_equal(frames[1], s.render(backend="cpu", t=0.25))
 
 
+class Kept(unittest.TestCase):
+    """A scene keeps the render and the distance kernel it prepared last: asked again, with
+    the same settings or others, it answers as a scene made anew would."""
+
+    ANIMATED = (
+        "render { width: 24, height: 16 }\n"
+        "camera { position: (0, 0, -4), look_at: (0, 0, 0) }\n"
+        "light point { position: (2, 3, -4) }\n"
+        "scene { sphere(0.5).translate(t * 2, 0, 0); box((0.3, 0.3, 0.3)).translate(-1, 0, 0); }"
+    )
+
+    def test_renders_again_as_a_new_scene_would(self):
+        for backend in ("cpu", "wgpu"):
+            with self.subTest(backend=backend):
+                s = sdfc.Scene(self.ANIMATED)
+                asks = [dict(t=0.0), dict(t=0.25), dict(t=0.25, size=(40, 30)), dict(t=0.0), dict(t=0.0, aa=2)]
+                for ask in asks:
+                    kept = s.render(backend=backend, **ask)
+                    fresh = sdfc.Scene(self.ANIMATED).render(backend=backend, **ask)
+                    np.testing.assert_array_equal(kept, fresh, err_msg=str(ask))
+                self.assertFalse(np.array_equal(s.render(backend=backend, t=0.0), s.render(backend=backend, t=0.25)))
+
+    def test_distances_again_as_a_new_scene_would(self):
+        rng = np.random.default_rng(5)
+        s = sdfc.Scene(self.ANIMATED)
+        for t in (0.0, 0.5, 0.0):
+            points = rng.uniform(-2, 2, size=(300, 3))
+            d, m = s.distance(points, t=t, backend="wgpu")
+            d_new, m_new = sdfc.Scene(self.ANIMATED).distance(points, t=t, backend="wgpu")
+            np.testing.assert_array_equal(d, d_new)
+            np.testing.assert_array_equal(m, m_new)
+
+
 class Docs(unittest.TestCase):
     def test_first_examples_run_as_written(self):
         # The first Python block of README.md and of docs/python.md, run from the

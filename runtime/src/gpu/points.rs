@@ -198,97 +198,131 @@ pub fn run_wgpu(
     m: &PointsModule,
     points: &[[f64; 3]],
 ) -> Result<Results, String> {
-    let (device, queue) = (gpu.device(), gpu.queue());
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("distance over points"),
-        source: wgpu::ShaderSource::Wgsl(m.source.as_str().into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: None,
-        layout: None,
-        module: &module,
-        entry_point: Some(ENTRY_POINT),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    use wgpu::BufferUsages as U;
-    let buffer = |size: u64, usage: U| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size,
-            usage,
-            mapped_at_creation: false,
-        })
-    };
-    let data = m.data.as_ref().map(|bytes| {
-        let b = buffer(bytes.len() as u64, U::STORAGE | U::COPY_DST);
-        queue.write_buffer(&b, 0, bytes);
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 4,
-                resource: b.as_entire_binding(),
-            }],
-        })
-    });
-    let mut out: Results = (
-        Vec::with_capacity(points.len()),
-        Vec::with_capacity(points.len()),
-    );
-    for chunk in points.chunks(POINTS_PER_DISPATCH) {
-        let input = point_bytes(chunk);
-        let size = result_bytes(chunk);
-        let points_buf = buffer(input.len() as u64, U::STORAGE | U::COPY_DST);
-        queue.write_buffer(&points_buf, 0, &input);
-        let results_buf = buffer(size, U::STORAGE | U::COPY_SRC);
-        let readback = buffer(size, U::MAP_READ | U::COPY_DST);
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &pipeline.get_bind_group_layout(m.group),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: points_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: results_buf.as_entire_binding(),
-                },
-            ],
+    WgpuPoints::new(gpu, m).run(gpu, points)
+}
+
+/// [`entry`] of a module compiled into a wgpu pipeline, with its `scene_data` on the device:
+/// kept, it evaluates points again without compiling (the Python package's `Scene.distance`).
+#[derive(Debug)]
+pub struct WgpuPoints {
+    pipeline: wgpu::ComputePipeline,
+    /// The bind group of `scene_data`, where the module reads it.
+    data: Option<wgpu::BindGroup>,
+    /// The bind group of the points and results.
+    group: u32,
+}
+
+impl WgpuPoints {
+    /// `m`'s pipeline on `gpu`, its `scene_data` written.
+    pub fn new(gpu: &crate::gpu::Gpu, m: &PointsModule) -> WgpuPoints {
+        let (device, queue) = (gpu.device(), gpu.queue());
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("distance over points"),
+            source: wgpu::ShaderSource::Wgsl(m.source.as_str().into()),
         });
-        let mut enc = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(m.group, &bind, &[]);
-            if let Some(d) = &data {
-                pass.set_bind_group(0, d, &[]);
-            }
-            pass.dispatch_workgroups(groups(chunk), 1, 1);
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: None,
+            layout: None,
+            module: &module,
+            entry_point: Some(ENTRY_POINT),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let data = m.data.as_ref().map(|bytes| {
+            let b = device.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size: bytes.len() as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            queue.write_buffer(&b, 0, bytes);
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: b.as_entire_binding(),
+                }],
+            })
+        });
+        WgpuPoints {
+            pipeline,
+            data,
+            group: m.group,
         }
-        enc.copy_buffer_to_buffer(&results_buf, 0, &readback, 0, size);
-        queue.submit([enc.finish()]);
-        let slice = readback.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("waiting for the GPU: {e}"))?;
-        rx.recv()
-            .map_err(|e| format!("reading the distances back: {e}"))?
-            .map_err(|e| format!("reading the distances back: {e}"))?;
-        let bytes = slice
-            .get_mapped_range()
-            .map_err(|e| format!("reading the distances back: {e}"))?
-            .to_vec();
-        let (v, d) = results(&bytes, chunk.len());
-        out.0.extend(v);
-        out.1.extend(d);
     }
-    Ok(out)
+
+    /// The pipeline run at every point, [`POINTS_PER_DISPATCH`] at a time, on the `gpu` it
+    /// was compiled on.
+    pub fn run(&self, gpu: &crate::gpu::Gpu, points: &[[f64; 3]]) -> Result<Results, String> {
+        let (device, queue) = (gpu.device(), gpu.queue());
+        use wgpu::BufferUsages as U;
+        let buffer = |size: u64, usage: U| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let mut out: Results = (
+            Vec::with_capacity(points.len()),
+            Vec::with_capacity(points.len()),
+        );
+        for chunk in points.chunks(POINTS_PER_DISPATCH) {
+            let input = point_bytes(chunk);
+            let size = result_bytes(chunk);
+            let points_buf = buffer(input.len() as u64, U::STORAGE | U::COPY_DST);
+            queue.write_buffer(&points_buf, 0, &input);
+            let results_buf = buffer(size, U::STORAGE | U::COPY_SRC);
+            let readback = buffer(size, U::MAP_READ | U::COPY_DST);
+            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &self.pipeline.get_bind_group_layout(self.group),
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: points_buf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: results_buf.as_entire_binding(),
+                    },
+                ],
+            });
+            let mut enc = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(self.group, &bind, &[]);
+                if let Some(d) = &self.data {
+                    pass.set_bind_group(0, d, &[]);
+                }
+                pass.dispatch_workgroups(groups(chunk), 1, 1);
+            }
+            enc.copy_buffer_to_buffer(&results_buf, 0, &readback, 0, size);
+            queue.submit([enc.finish()]);
+            let slice = readback.slice(..);
+            let (tx, rx) = std::sync::mpsc::channel();
+            slice.map_async(wgpu::MapMode::Read, move |r| {
+                let _ = tx.send(r);
+            });
+            device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| format!("waiting for the GPU: {e}"))?;
+            rx.recv()
+                .map_err(|e| format!("reading the distances back: {e}"))?
+                .map_err(|e| format!("reading the distances back: {e}"))?;
+            let bytes = slice
+                .get_mapped_range()
+                .map_err(|e| format!("reading the distances back: {e}"))?
+                .to_vec();
+            let (v, d) = results(&bytes, chunk.len());
+            out.0.extend(v);
+            out.1.extend(d);
+        }
+        Ok(out)
+    }
 }
 
 /// A CUDA context and its device's compute capability (`major * 10 + minor`).
@@ -317,75 +351,117 @@ pub fn open_cuda() -> Result<CudaDevice, String> {
 }
 
 /// [`entry`] of `m` translated to PTX (`ptx_text`, for the context's device) run through
-/// CUDA at every point, [`POINTS_PER_DISPATCH`] at a time. The kernel's parameters are the
-/// module's buffers in (group, binding) order (docs/ptx.md): the points and results,
-/// `scene_data`, and a small zeroed buffer for each binding the entry point does not use
-/// (the renderer kernel's others).
+/// CUDA at every point, [`POINTS_PER_DISPATCH`] at a time.
 pub fn run_cuda(
     ctx: &std::sync::Arc<cudarc::driver::CudaContext>,
     m: &PointsModule,
     ptx_text: &str,
     points: &[[f64; 3]],
 ) -> Result<Results, String> {
-    use cudarc::driver::{LaunchConfig, PushKernelArg};
-    let module = ctx
-        .load_module(cudarc::nvrtc::Ptx::from_src(ptx_text))
-        .map_err(|e| format!("the CUDA JIT refused the PTX: {e}"))?;
-    let function = module
-        .load_function(ENTRY_POINT)
-        .map_err(|e| format!("the kernel {ENTRY_POINT}: {e}"))?;
-    let s = ctx.default_stream();
-    let mut bindings: Vec<(u32, u32)> = m
-        .module
-        .global_variables
-        .iter()
-        .filter_map(|(_, g)| g.binding.as_ref().map(|b| (b.group, b.binding)))
-        .collect();
-    bindings.sort();
-    let out_at = bindings
-        .iter()
-        .position(|&b| b == (m.group, 1))
-        .ok_or("the module binds no results")?;
-    let cuda = |e: cudarc::driver::DriverError| format!("CUDA: {e}");
-    let mut out: Results = (
-        Vec::with_capacity(points.len()),
-        Vec::with_capacity(points.len()),
-    );
-    for chunk in points.chunks(POINTS_PER_DISPATCH) {
-        let buffers = bindings
+    CudaPoints::new(ctx, m, ptx_text)?.run(points)
+}
+
+/// [`entry`] of a module loaded into a CUDA context: kept, it evaluates points again
+/// without translating or loading (the Python package's `Scene.distance`). The kernel's
+/// parameters are the module's buffers in (group, binding) order (docs/ptx.md): the points
+/// and results, `scene_data`, and a small zeroed buffer for each binding the entry point
+/// does not use (the renderer kernel's others).
+#[derive(Debug)]
+pub struct CudaPoints {
+    ctx: std::sync::Arc<cudarc::driver::CudaContext>,
+    function: cudarc::driver::CudaFunction,
+    /// The module's bindings, (group, binding), in order.
+    bindings: Vec<(u32, u32)>,
+    /// The bind group of the points and results.
+    group: u32,
+    /// The bytes of `scene_data`, where the module reads it.
+    data: Option<Vec<u8>>,
+}
+
+impl CudaPoints {
+    /// `m`'s entry point, as `ptx_text` for the context's device, loaded by the CUDA JIT.
+    pub fn new(
+        ctx: &std::sync::Arc<cudarc::driver::CudaContext>,
+        m: &PointsModule,
+        ptx_text: &str,
+    ) -> Result<CudaPoints, String> {
+        let module = ctx
+            .load_module(cudarc::nvrtc::Ptx::from_src(ptx_text))
+            .map_err(|e| format!("the CUDA JIT refused the PTX: {e}"))?;
+        let function = module
+            .load_function(ENTRY_POINT)
+            .map_err(|e| format!("the kernel {ENTRY_POINT}: {e}"))?;
+        let mut bindings: Vec<(u32, u32)> = m
+            .module
+            .global_variables
             .iter()
-            .map(|&b| {
-                let bytes = match b {
-                    b if b == (m.group, 0) => point_bytes(chunk),
-                    b if b == (m.group, 1) => vec![0; result_bytes(chunk) as usize],
-                    (0, 4) => m
-                        .data
-                        .clone()
-                        .ok_or("the module reads scene_data it lacks")?,
-                    _ => vec![0; 256],
-                };
-                s.clone_htod(&bytes).map_err(cuda)
-            })
-            .collect::<Result<Vec<cudarc::driver::CudaSlice<u8>>, String>>()?;
-        let cfg = LaunchConfig {
-            grid_dim: (groups(chunk), 1, 1),
-            block_dim: (WORKGROUP, 1, 1),
-            shared_mem_bytes: 0,
-        };
-        let mut launch = s.launch_builder(&function);
-        for b in &buffers {
-            launch.arg(b);
+            .filter_map(|(_, g)| g.binding.as_ref().map(|b| (b.group, b.binding)))
+            .collect();
+        bindings.sort();
+        if !bindings.contains(&(m.group, 1)) {
+            return Err("the module binds no results".into());
         }
-        // SAFETY: the kernel's parameters are the module's buffers in (group, binding) order,
-        // as the PTX back end declares them, each passed here; the points and results hold
-        // one element for every thread of the grid, scene_data is the kernel's own, and the
-        // entry point reads nothing of the other buffers.
-        #[allow(unsafe_code)]
-        unsafe { launch.launch(cfg) }.map_err(cuda)?;
-        s.synchronize().map_err(cuda)?;
-        let (v, d) = results(&s.clone_dtoh(&buffers[out_at]).map_err(cuda)?, chunk.len());
-        out.0.extend(v);
-        out.1.extend(d);
+        Ok(CudaPoints {
+            ctx: ctx.clone(),
+            function,
+            bindings,
+            group: m.group,
+            data: m.data.clone(),
+        })
     }
-    Ok(out)
+
+    /// The kernel run at every point, [`POINTS_PER_DISPATCH`] at a time.
+    pub fn run(&self, points: &[[f64; 3]]) -> Result<Results, String> {
+        use cudarc::driver::{LaunchConfig, PushKernelArg};
+        let s = self.ctx.default_stream();
+        let group = self.group;
+        let out_at = self
+            .bindings
+            .iter()
+            .position(|&b| b == (group, 1))
+            .ok_or("the module binds no results")?;
+        let cuda = |e: cudarc::driver::DriverError| format!("CUDA: {e}");
+        let mut out: Results = (
+            Vec::with_capacity(points.len()),
+            Vec::with_capacity(points.len()),
+        );
+        for chunk in points.chunks(POINTS_PER_DISPATCH) {
+            let buffers = self
+                .bindings
+                .iter()
+                .map(|&b| {
+                    let bytes = match b {
+                        b if b == (group, 0) => point_bytes(chunk),
+                        b if b == (group, 1) => vec![0; result_bytes(chunk) as usize],
+                        (0, 4) => self
+                            .data
+                            .clone()
+                            .ok_or("the module reads scene_data it lacks")?,
+                        _ => vec![0; 256],
+                    };
+                    s.clone_htod(&bytes).map_err(cuda)
+                })
+                .collect::<Result<Vec<cudarc::driver::CudaSlice<u8>>, String>>()?;
+            let cfg = LaunchConfig {
+                grid_dim: (groups(chunk), 1, 1),
+                block_dim: (WORKGROUP, 1, 1),
+                shared_mem_bytes: 0,
+            };
+            let mut launch = s.launch_builder(&self.function);
+            for b in &buffers {
+                launch.arg(b);
+            }
+            // SAFETY: the kernel's parameters are the module's buffers in (group, binding)
+            // order, as the PTX back end declares them, each passed here; the points and
+            // results hold one element for every thread of the grid, scene_data is the
+            // kernel's own, and the entry point reads nothing of the other buffers.
+            #[allow(unsafe_code)]
+            unsafe { launch.launch(cfg) }.map_err(cuda)?;
+            s.synchronize().map_err(cuda)?;
+            let (v, d) = results(&s.clone_dtoh(&buffers[out_at]).map_err(cuda)?, chunk.len());
+            out.0.extend(v);
+            out.1.extend(d);
+        }
+        Ok(out)
+    }
 }

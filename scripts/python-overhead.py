@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Measures what the Python package adds on top of the work itself (docs/python.md): the
 median wall time of `Scene.render` (uint8 sRGB, in-process) against the phases of
-`sdfc render --stats` that do the same work (scene, setup, preparation, memory, frame and
-sRGB; not the process start, the PNG or the file), each of the same scene, size and backend,
-run alternately; and `Scene.distance` throughput on 10^6 points on each backend asked for.
+`sdfc render --stats` that do the same work (every phase but the process's start, the
+arguments, the file read, the wait for the device, the PNG and the file), each of the same scene, size and backend,
+run alternately, by one Scene (which keeps what it prepared) and by a new Scene each call;
+and `Scene.distance` throughput on 10^6 points on each backend asked for, both ways.
 
     python3 scripts/python-overhead.py SDFC_BIN SCENE --size 1920x1080 --backends cpu,cuda
 
@@ -23,7 +24,10 @@ import numpy as np
 
 import sdfc
 
-PHASES = ("scene", "setup", "preparation", "memory", "frame", "sRGB")
+# The phases of `sdfc render --stats` that a Python render does not do: the process's start,
+# its arguments, the file read, the wait for a device (Python holds its devices open), the
+# PNG and the file.
+OUTSIDE = {"start", "arguments", "read", "device", "PNG", "write"}
 
 
 def cli_ms(binary: str, scene: str, size: str, backend: str, out: Path) -> float:
@@ -34,12 +38,11 @@ def cli_ms(binary: str, scene: str, size: str, backend: str, out: Path) -> float
         capture_output=True,
         text=True,
     )
-    total = 0.0
-    for name in PHASES:
-        m = re.search(rf"^\s+{re.escape(name)}\s+([0-9.]+) ms", run.stdout + run.stderr, re.M)
-        if m is None:
-            raise SystemExit(f"`render --stats` printed no {name!r} phase:\n{run.stderr}")
-        total += float(m.group(1))
+    # The phases of the run's breakdown: two spaces, the name, its milliseconds.
+    phases = re.findall(r"^  (\S[^\n]*?)\s+([0-9.]+) ms  ", run.stdout + run.stderr, re.M)
+    if not phases:
+        raise SystemExit(f"`render --stats` printed no phases:\n{run.stderr}")
+    total = sum(float(ms) for name, ms in phases if name not in OUTSIDE)
     return total
 
 
@@ -61,14 +64,20 @@ def main() -> None:
             # One of each first: JIT caches, the pool, the driver.
             scene.render(size=(w, h), backend=backend, dtype=np.uint8)
             cli_ms(args.binary, args.scene, args.size, backend, out)
-            py, cli = [], []
+            py, fresh, cli = [], [], []
             for _ in range(args.runs):
                 t0 = time.perf_counter()
                 scene.render(size=(w, h), backend=backend, dtype=np.uint8)
                 py.append((time.perf_counter() - t0) * 1e3)
+                # A new Scene each call prepares everything again (the device and the
+                # pipelines the process holds excepted).
+                t0 = time.perf_counter()
+                sdfc.Scene(path=args.scene).render(size=(w, h), backend=backend, dtype=np.uint8)
+                fresh.append((time.perf_counter() - t0) * 1e3)
                 cli.append(cli_ms(args.binary, args.scene, args.size, backend, out))
-            p, c = statistics.median(py), statistics.median(cli)
+            p, f, c = statistics.median(py), statistics.median(fresh), statistics.median(cli)
             rows.append((f"render {args.size} {backend}", f"{p:.1f} ms", f"{c:.1f} ms", f"{p - c:+.1f} ms"))
+            rows.append((f"  the same, a new Scene each call", f"{f:.1f} ms", f"{c:.1f} ms", f"{f - c:+.1f} ms"))
         rng = np.random.default_rng(1)
         points = rng.uniform(-3, 3, size=(args.points, 3))
         for backend in args.backends.split(","):
@@ -80,6 +89,13 @@ def main() -> None:
                 times.append(time.perf_counter() - t0)
             t = statistics.median(times)
             rows.append((f"distance {args.points} points {backend}", f"{t * 1e3:.1f} ms", "-", f"{args.points / t / 1e6:.1f} M points/s"))
+            times = []
+            for _ in range(3):
+                t0 = time.perf_counter()
+                sdfc.Scene(path=args.scene).distance(points, backend=backend)
+                times.append(time.perf_counter() - t0)
+            t = statistics.median(times)
+            rows.append((f"  the same, a new Scene each call", f"{t * 1e3:.1f} ms", "-", f"{args.points / t / 1e6:.1f} M points/s"))
     print(f"{'':40} {'Python':>12} {'CLI phases':>12} {'difference / rate':>20}")
     for r in rows:
         print(f"{r[0]:40} {r[1]:>12} {r[2]:>12} {r[3]:>20}")

@@ -224,14 +224,23 @@ impl<'a> Lowerer<'a> {
         let phi = b.bin(Binary::Atan2, nz, p[0]);
         let u = b.mulc(phi, 1.0 / step);
         let k = b.un(Unary::Round, u);
+        // The point rotated into its own sector once (one cosine and one sine a point); the
+        // other copies of the window are that point turned by constant rotations.
+        let theta = b.mulc(k, step);
+        let (c, s) = (b.un(Unary::Cos, theta), b.un(Unary::Sin, theta));
+        let own = rot2(b, c, s, p[0], p[2]);
         let mut acc: Option<Field> = None;
         for j in lo..=hi {
             let b = &mut *self.b;
-            let kj = b.addc(k, j as f64);
-            let theta = b.mulc(kj, step);
-            let (c, s) = (b.un(Unary::Cos, theta), b.un(Unary::Sin, theta));
-            let (x, mut z) = rot2(b, c, s, p[0], p[2]);
+            let (x, mut z) = match j {
+                0 => own,
+                _ => {
+                    let turn = j as f64 * step;
+                    rot2c(b, turn.cos(), turn.sin(), own.0, own.1)
+                }
+            };
             if mirror {
+                let kj = b.addc(k, j as f64);
                 // The copy's parity: kj − 2·⌊kj/2⌋, with ⌊kj/2⌋ = round(kj/2 − 1/4).
                 let half = b.mulc(kj, 0.5);
                 let half = b.subc(half, 0.25);
@@ -1414,6 +1423,12 @@ const IDENTITY: [V3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 fn rot2(b: &mut Builder, c: Reg, s: Reg, u: Reg, v: Reg) -> (Reg, Reg) {
     let (cu, sv, su, cv) = (b.mul(c, u), b.mul(s, v), b.mul(s, u), b.mul(c, v));
+    (b.sub(cu, sv), b.add(su, cv))
+}
+
+/// [`rot2`] by a constant angle, of cosine `c` and sine `s`.
+fn rot2c(b: &mut Builder, c: f64, s: f64, u: Reg, v: Reg) -> (Reg, Reg) {
+    let (cu, sv, su, cv) = (b.mulc(u, c), b.mulc(v, s), b.mulc(u, s), b.mulc(v, c));
     (b.sub(cu, sv), b.add(su, cv))
 }
 

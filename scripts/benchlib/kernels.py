@@ -226,7 +226,8 @@ def anim(ctx):
         asize = ctx.opt("agree_size", "640x480")
         gpus = ctx.gpu_backends()
         t = ctx.table("`sdfc render SCENE --size %s --frames 0..8`: the worst PSNR over the "
-                      "frames against the CPU's." % asize, ["scene", "build"] + gpus)
+                      "frames against the CPU's." % asize, ["scene", "build"] + gpus,
+                      ["---"] * (2 + len(gpus)))
         for f in ANIMATED:
             for x in ctx.builds:
                 dirs = {}

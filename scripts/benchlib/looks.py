@@ -21,8 +21,9 @@ def analytic(ctx):
     for b in ctx.backends:
         head += ["%s traced" % b, "%s marched" % b, "%s marched / traced" % b]
     t = ctx.table("`sdfc bench SCENE --size S --aa A --frames %d --set method=trace|march`: "
-                  "median GPU ms (the CPU: frame ms); marched renders above %s samples not run."
-                  % (frames, max_samples or "any number of"), head,
+                  "median GPU ms (the CPU: frame ms)%s." % (frames, "; marched renders above "
+                                                            "%d samples not run" % max_samples
+                                                            if max_samples else ""), head,
                   ["---"] * 4 + ["---:"] * (len(head) - 4))
     for f in scenes:
         for size, _ in ctx.size_list(["1920x1080"]):
@@ -154,20 +155,23 @@ def pareto(ctx):
     size = ctx.size_list(["640x480"])[0][0]
     frames = ctx.n_frames(5)
     t = ctx.table("`sdfc pareto examples/seedN.sdf --size %s --frames %d --sweep %s`: where "
-                  "the defaults stand, the charts in $OUT (pareto-B-seedN.svg)." % (
+                  "the defaults stand; the charts in $OUT (pareto-gpu-seedN.svg through CUDA, "
+                  "pareto-wgpu-seedN.svg through wgpu)." % (
                       size, frames, " --sweep ".join(sweeps.split())),
                   ["scene", "backend", "PSNR dB", "steps/px", "ms", "time front",
                    "steps front"])
     for i in ctx.opt("scenes", ["1", "2", "3", "4", "5", "6"]):
         for b in ctx.backends:
             cmd = [ctx.new.path, "pareto", "examples/seed%s.sdf" % i, "--backend", b, "--size",
-                   size, "--frames", frames, "-o", "%s/pareto-%s-seed%s.svg" % (ctx.out, b, i),
+                   size, "--frames", frames, "-o", "%s/pareto-%s-seed%s.svg" % (
+                       ctx.out, "gpu" if b == "cuda" else b, i),
                    "--json"]
             for s in sweeps.split():
                 cmd += ["--sweep", s]
             if i == "6":
                 cmd += ["--limit", "memory=12000"]
             _, out, err, code = core.run(cmd)
+            open("%s/pareto-%s-seed%s.json" % (ctx.out, b, i), "w").write(out)
             try:
                 p = [x for x in json.loads(out)["points"] if x["default"]][0]
             except (ValueError, IndexError, KeyError):
@@ -256,8 +260,9 @@ def view(ctx):
                                           "--backend", backend, "--size", size, "--orbit-frames",
                                           ctx.opt("orbit_frames", 120), "--screenshot-dir", d,
                                           "--exit-after-reloads", "0"], timeout=120)
-            line = [ln for ln in (out + err).splitlines() if "orbit" in ln]
-            t.add(n, x.name, line[-1].strip() if line else "failed")
+            lines = [ln.strip().replace("view: orbit: ", "") for ln in (out + err).splitlines()
+                     if "orbit" in ln]
+            t.add(n, x.name, "; ".join(lines) or "failed")
             subprocess.run(["rm", "-rf", d])
 
 

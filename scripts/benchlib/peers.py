@@ -116,31 +116,34 @@ def python(ctx):
 def cpu_ab(ctx):
     """The examples on the CPU, the builds alternating round by round (on a shared machine
     only neighbouring runs compare: the rounds show the spread)."""
-    scenes = ctx.scene_list(["examples/seed%d.sdf" % i for i in range(3, 7)])
-    size = ctx.size_list(["640x480"])[0][0]
-    frames = ctx.n_frames(5)
+    scenes = ctx.scene_list(["examples/seed%d.sdf" % i for i in range(1, 7)])
     threads = ctx.opt("threads", ["2"])
-    head = ["scene", "threads", "round"] + [x.name for x in ctx.builds]
+    head = ["scene", "size", "threads", "round"] + [x.name for x in ctx.builds]
     if ctx.side_by_side:
         head.append("new / old")
     head += ["Mrays/s", "steps/px"]
     load = open("/proc/loadavg").read().split()[:3]
-    t = ctx.table("`sdfc bench SCENE --backend cpu --size %s --frames %d --threads T`: median "
-                  "ms; Mrays/s and steps/px of the new build; load average at the start %s." %
-                  (size, frames, " ".join(load)), head)
+    t = ctx.table("`sdfc bench SCENE --backend cpu --size S --frames N --threads T` (N = %d at "
+                  "640x480 and below, else %d): median ms; Mrays/s and steps/px of the new "
+                  "build; load average at the start %s." % (
+                      ctx.n_frames(5), ctx.n_frames(3), " ".join(load)), head,
+                  ["---"] * 4 + ["---:"] * (len(head) - 4))
     for r in range(ctx.n_runs(1)):
-        for f in scenes:
-            for th in threads:
-                got = {}
-                for x in ctx.builds:
-                    e = bench(x, [f], "cpu", size, None, frames, ["--threads", th], ctx.fails)
-                    got[x.name] = e[0] if e else None
-                cells = [ms(got[x.name]) for x in ctx.builds]
-                if ctx.side_by_side:
-                    cells.append(ratio(ms(got["new"]), ms(got["old"])))
-                n = got["new"]
-                t.add(scene_name(f), th, str(r + 1), *cells,
-                      fmt(n and n["mrays_per_s"]), fmt(n and n["stats"]["steps_mean"], 1))
+        for size, aa in ctx.size_list(["640x480", "1920x1080"]):
+            w, h = map(int, size.split("x"))
+            frames = ctx.n_frames(5 if w * h <= 640 * 480 else 3)
+            for f in scenes:
+                for th in threads:
+                    got = {}
+                    for x in ctx.builds:
+                        e = bench(x, [f], "cpu", size, aa, frames, ["--threads", th], ctx.fails)
+                        got[x.name] = e[0] if e else None
+                    cells = [ms(got[x.name]) for x in ctx.builds]
+                    if ctx.side_by_side:
+                        cells.append(ratio(ms(got["new"]), ms(got["old"])))
+                    n = got["new"]
+                    t.add(scene_name(f), size, th, str(r + 1), *cells,
+                          fmt(n and n["mrays_per_s"]), fmt(n and n["stats"]["steps_mean"], 1))
 
 
 SUITES = {
@@ -148,6 +151,6 @@ SUITES = {
              "1 024 steps; --with arch=sm_90"),
     "python": (python, "import sdfc: Scene.render against the CLI's phases, Scene.distance "
                "throughput (the package importable)"),
-    "cpu": (cpu_ab, "the CPU renderer: examples' median ms, the builds alternating; --runs "
-            "rounds, --with threads=1,2"),
+    "cpu": (cpu_ab, "the CPU renderer: the report scenes at 640x480 and 1080p, median ms, the "
+            "builds alternating; --runs rounds, --with threads=1,2"),
 }

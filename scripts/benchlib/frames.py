@@ -196,16 +196,17 @@ def devices(ctx, parts=None):
     if not gpus:
         raise core.Skip("the devices suite needs a GPU backend")
     n = core.gpu_count()
-    lists = ctx.opt("lists", ["0"] + (["0,1"] if n >= 2 else ["0,0"]) +
-                    (["0,1,2,3"] if n >= 4 else []))
+    # Lists are separated by spaces (`--with "lists=0 0,1"`): a list is comma-separated.
+    lists = (ctx.options.get("lists") or "").split() or (
+        ["0"] + (["0,1"] if n >= 2 else ["0,0"]) + (["0,1,2,3"] if n >= 4 else []))
     scenes = ctx.scene_list(["examples/seed3.sdf", "examples/seed6.sdf", "examples/temple.sdf"])
     if "still" in parts:
         size, aa = ctx.size_list(["7680x4320:2"])[0]
         frames = ctx.n_frames(5)
         t = ctx.table(
-            "`sdfc bench SCENE --devices LIST --size %s --aa %s --frames %d %s`: median whole "
-            "frame (host) ms, %d runs (their medians' median); speed-up over the first list." % (
-                size, aa or 1, frames, " ".join(BIG), ctx.n_runs(1)),
+            "`sdfc bench SCENE --devices LIST --size %s%s --frames %d %s`: median whole frame "
+            "(host) ms, %d runs (their medians' median); speed-up over the first list." % (
+                size, " --aa %d" % aa if aa else "", frames, " ".join(BIG), ctx.n_runs(1)),
             ["backend", "scene", "build"] + ["[%s]" % d for d in lists] +
             ["speed-up [%s]" % d for d in lists[1:]], ["---"] * 3 + ["---:"] * (2 * len(lists) - 1))
         for b in gpus:
@@ -302,6 +303,6 @@ SUITES = {
                      "sdfc cache, each phase, bare CUDA/Vulkan contexts, plain warm processes; "
                      "--with modes=cold,warm,sdfc[,vulkan], plain=N, scaling=FILE ..."),
     "devices": (devices, "several GPUs: 8K stills, sequences, same pictures, first picture "
-                "per --devices list, the CPU beside a GPU; --with parts=, lists=0,0,1"),
+                "per --devices list, the CPU beside a GPU; --with parts=, \"lists=0 0,1\""),
     "stills": (stills, "the devices suite's 8K stills and same pictures alone"),
 }

@@ -6,10 +6,10 @@
 #   scripts/charts.sh cpu          here, with $SDFC (default target/release/sdfc): 320×240,
 #                                  median of 3 frames, to $DIR/pareto-seedN.svg (DIR=docs);
 #                                  hours on 2 cores
-#   scripts/charts.sh cuda wgpu    on the GPU machine (the `device` tool, .dev/sdfc and .gl/
-#                                  carried as for the other device scripts, whose setup
-#                                  scripts/device-env.sh this sources): 640×480, median of 5
-#                                  frames, to $OUT/pareto-gpu-seedN.svg (CUDA) and
+#   scripts/charts.sh cuda wgpu    on the GPU machine: the runner's `pareto` suite
+#                                  (scripts/bench.py --suite pareto, .dev/sdfc and .gl/
+#                                  carried): 640×480, median of 5 frames, to
+#                                  $OUT/pareto-gpu-seedN.svg (CUDA) and
 #                                  $OUT/pareto-wgpu-seedN.svg; copy the ones docs show to docs/
 #
 # The repository keeps only the charts a page shows (README.md and docs/accuracy.md:
@@ -35,14 +35,11 @@ for backend in "$@"; do
       frames=${FRAMES:-3}
       ;;
     cuda | wgpu)
-      # Sets B (the carried binary) and OUT, and points Vulkan at the NVIDIA driver.
-      if [ -z "${B:-}" ] || [ -z "${OUT:-}" ]; then . scripts/device-env.sh; fi
-      bin=$B
-      dir=$OUT
-      prefix=pareto-gpu
-      [ "$backend" = cuda ] || prefix=pareto-wgpu
-      size=${SIZE:-640x480}
-      frames=${FRAMES:-5}
+      # The runner sets the GPU machine up (the Vulkan loader of .gl/, the NVIDIA driver).
+      python3 scripts/bench.py --suite pareto --backends "$backend" \
+        --with scenes="${SCENES:-1 2 3 4 5 6}" ${SIZE:+--size "$SIZE"} \
+        ${FRAMES:+--frames "$FRAMES"} || status=1
+      continue
       ;;
     *)
       echo "unknown backend '$backend': cpu, cuda or wgpu" >&2

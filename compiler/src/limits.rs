@@ -175,8 +175,7 @@ impl Limit {
                 "shape nodes counted as a tree (a shared shape once per use)",
             ),
             // Rays visit the primitives through a bounding-volume hierarchy, in O(log n) per
-            // ray, so tracing beats sphere tracing at any size (BENCHMARKS.md, "Scaling with
-            // the number of objects"). The default
+            // ray, so tracing beats sphere tracing at any size. The default
             // keeps the GPU buffer of a large traced scene (at most 112 bytes a primitive:
             // 80 for a rotated one, 32 for a group, of which there are fewer than primitives)
             // under the 128 MiB that wgpu's default limits let a storage buffer bind; the
@@ -215,7 +214,7 @@ impl Limit {
                 "frames of one animated sequence",
             ),
             // A dense grid of 512³ cells is 134 million; the octree of a scene at that
-            // resolution evaluates a few percent of it (BENCHMARKS.md, "Meshing").
+            // resolution evaluates a few percent of it.
             Limit::Cells => s(
                 "cells",
                 50_000_000,

@@ -42,7 +42,7 @@ impl Image {
 
     /// Clamped, sRGB-encoded RGBA8 bytes (alpha 255): [`srgb_encode`] of every channel,
     /// through [`SrgbTable`] and in parallel rows, several times faster than computing each
-    /// value (BENCHMARKS.md, "Measured choices").
+    /// value (measured).
     pub fn to_rgba8(&self) -> Vec<u8> {
         use rayon::prelude::*;
         let table = SrgbTable::get();
@@ -178,7 +178,7 @@ pub enum PngLevel {
     /// fdeflate with one fixed filter.
     Fastest,
     /// fdeflate with adaptive filters: about a tenth of `balanced`'s time, in a file about
-    /// 1.45 times as large (BENCHMARKS.md, "Measured choices").
+    /// 1.45 times as large (measured).
     #[default]
     Fast,
     /// zlib's default level.
@@ -351,7 +351,7 @@ impl AtomicFile {
     /// synced to the disk (after a crash of the machine it may be found empty), as a
     /// compiler writes its output: `sdfc render`'s still images. The fsync costs a small
     /// image many times its write, and far more while other programs write to the disk
-    /// (BENCHMARKS.md, "Measured choices").
+    /// (measured).
     pub fn unsynced(path: &Path) -> std::io::Result<AtomicFile> {
         Self::open(path, false)
     }

@@ -24,7 +24,7 @@ pub(super) const UNPAINTED: f64 = -1.0;
 /// point. A guard costs the distance to a box (up to about 25 instructions) and the block's
 /// bookkeeping, and it saves only where the subtree is skipped: below about three times its
 /// own cost it is a loss on the report's scenes, whose one guard each guards little, while
-/// the scaling scenes' groups cost far more (BENCHMARKS.md, "Measured choices").
+/// the scaling scenes' groups cost far more (measured).
 const GUARD_COST: f64 = 80.0;
 
 /// 1 - 2⁻¹²: bounds are shrunk by this factor, and padded, so that rounding can never make

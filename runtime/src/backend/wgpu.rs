@@ -59,10 +59,10 @@ impl WgpuPrepared {
     }
 
     /// The setup of a kernel on a wgpu adapter: on a CPU adapter (lavapipe) the interpreted
-    /// kernel's frames are 25 to 150 times the specialised kernel's (BENCHMARKS.md,
-    /// "Interpreted against specialised"), which its compile never repays, so `auto` keeps
-    /// the specialised kernel there, and for the frames of a sequence (`parameters`), which
-    /// share one specialised kernel. A CPU adapter's setup is marked [`Setup::software`].
+    /// kernel's frames are 25 to 150 times the specialised kernel's, which its compile never
+    /// repays, so `auto` keeps the specialised kernel there, and for the frames of a sequence
+    /// (`parameters`), which share one specialised kernel. A CPU adapter's setup is marked
+    /// [`Setup::software`].
     pub(super) fn setup_for(cpu_adapter: bool, setup: &Setup) -> Setup {
         let setup = if cpu_adapter || setup.parameters {
             setup.specialised_for_auto()

@@ -60,7 +60,7 @@ fn driver(during: &'static str) -> impl Fn(cudarc::driver::DriverError) -> Error
 pub struct Cuda {
     ctx: Arc<CudaContext>,
     stream: Arc<CudaStream>,
-    /// Compute capability as major·10 + minor (90 for an H100).
+    /// Compute capability as major·10 + minor (90 for compute capability 9.0).
     pub sm: u32,
     name: String,
     memory: u64,
@@ -839,8 +839,7 @@ fn check_launch(
 /// their latency better than the JIT's own choice of registers, which spends them on fewer
 /// warps. Of the caps tried, 72 made the large marched kernels fastest; small ones lose a
 /// little, and analytically traced kernels more, so they keep the JIT's choice. The JIT's
-/// own count does not say which kernels gain, so the cap is one constant (BENCHMARKS.md,
-/// "Measured choices").
+/// own count does not say which kernels gain, so the cap is one constant.
 pub const MARCHED_REGISTERS: u32 = 72;
 
 /// The register cap for the JIT of a kernel that sphere traces (`marched`) or traces

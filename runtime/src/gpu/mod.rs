@@ -316,8 +316,8 @@ fn reduce_bytes(pixels: u64) -> u64 {
 
 /// Copies `src` into `dst` (of the same length) on every core of the current thread pool: a
 /// frame's pixels are copied into memory allocated for them, whose pages the first writes
-/// fault in, which on one core holds the copy to about a gigabyte a second (BENCHMARKS.md,
-/// "Several devices"; [`crate::image::zeroed`] asks for fewer, larger pages).
+/// fault in, which on one core holds the copy to about a gigabyte a second (measured;
+/// [`crate::image::zeroed`] asks for fewer, larger pages).
 pub(crate) fn copy_parallel<T: Copy + Send + Sync>(dst: &mut [T], src: &[T]) {
     use rayon::prelude::*;
     // A mebibyte a task: a 1920×1080 frame's 8 MB wakes 8 threads, not every core; on a host

@@ -156,9 +156,9 @@ impl std::fmt::Debug for FrameBuffers {
 
 /// The process's one wgpu instance, never destroyed. Destroying the last Vulkan instance
 /// makes the loader unload the driver, and the NVIDIA driver keeps a thread of its own that
-/// may still run code of the unloaded library, a segmentation fault at exit (BENCHMARKS.md,
-/// "Measured choices"). An instance that lives until the process exits keeps the driver
-/// loaded; the operating system reclaims it.
+/// may still run code of the unloaded library, a segmentation fault at exit. An
+/// instance that lives until the process exits keeps the driver loaded; the operating system
+/// reclaims it.
 fn instance() -> &'static wgpu::Instance {
     static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
     INSTANCE.get_or_init(|| {
@@ -373,7 +373,7 @@ impl Gpu {
         super::cache_file("wgpu", &key, "pipeline")
     }
 
-    /// The adapter's name and backend, e.g. `NVIDIA H100 (Vulkan)`.
+    /// The adapter's name and backend, e.g. `<the GPU's name> (Vulkan)`.
     pub fn describe(&self) -> String {
         format!(
             "{} ({:?}, {:?})",
@@ -415,9 +415,9 @@ impl Gpu {
             None => wgpu::ShaderSource::Wgsl(wgsl.into()),
         };
         // wgpu's checks except the bound on loops: naga gives every loop a counter, tested
-        // each turn, a large part of a marched scene's frame (BENCHMARKS.md, "Measured
-        // choices"). Index bounds stay checked, at no measurable cost. Storage buffers'
-        // bounds are left to the driver's robust buffer access where the adapter has
+        // each turn, up to a fifth more time on a marched scene's frame. Index bounds stay
+        // checked, at no measurable cost. Storage buffers' bounds are left to the driver's
+        // robust buffer access where the adapter has
         // `robustBufferAccess2` (wgpu's choice; no option changes it).
         let mut checks = wgpu::ShaderRuntimeChecks::checked();
         checks.force_loop_bounding = false;
@@ -643,7 +643,7 @@ impl Gpu {
     /// Waits for the work submitted. On a GPU the host first polls, yielding its core
     /// between polls, for up to [`SPIN`]: the driver's blocking wait returns a tenth of a
     /// millisecond or more after the end of a frame, as long as a short frame itself
-    /// (BENCHMARKS.md, "Measured choices"), and CUDA's default wait polls too. A longer
+    /// (measured), and CUDA's default wait polls too. A longer
     /// wait blocks, its latency small beside the frame. A software adapter (lavapipe)
     /// renders on the host's cores, which polling would take from it: it blocks at once.
     pub fn wait(&self) -> Result<(), Error> {

@@ -49,8 +49,7 @@ use std::fmt::Write;
 /// instances read from `scene_data`) has at least this many live instructions; the runtime
 /// keeps the specialised kernel on CUDA, on CPU adapters and for sequences. From about this
 /// size the Vulkan driver's cold compile of the code takes longer than the interpreted
-/// kernel's whole first render, whose frames are a few times slower (docs/interpreted.md;
-/// BENCHMARKS.md, "Interpreted against specialised").
+/// kernel's whole first render, whose frames are a few times slower (docs/interpreted.md).
 pub const AUTO_INTERPRET: usize = 5_000;
 
 /// Words of the header before the first program.

@@ -43,12 +43,12 @@ impl Params {
 /// Programs with more live instructions than this have their large guarded blocks written as
 /// functions of their own. naga's WGSL front end takes time that grows with the square of a
 /// function's length (examples/scaling/compound_1000.sdf, about 150 000 instructions, parses
-/// about twenty times faster cut into functions: BENCHMARKS.md, "Measured choices"); ptxas
+/// about twenty times faster cut into functions); ptxas
 /// then inlines them again. Smaller programs are written as one function.
 const OUTLINE_PROGRAM: usize = 8_000;
 /// In such a program, a guarded block with at least this many live instructions becomes a
 /// function (nested blocks inside it may become functions in turn). Smaller pieces parse
-/// faster still but made ptxas slower (BENCHMARKS.md, "Measured choices").
+/// faster still but made ptxas slower.
 const OUTLINE_BLOCK: usize = 2_000;
 /// A block that reads more values from outside than this stays inline.
 const OUTLINE_PARAMS: usize = 48;

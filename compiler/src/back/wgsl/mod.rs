@@ -45,7 +45,7 @@ pub const ENTRY_POINT: &str = "main";
 /// pixels, and a small workgroup leaves its multiprocessor as soon as its own rays end.
 /// Workgroups of 768–1 024 invocations would hold the Vulkan driver to 64–80 registers a
 /// thread, which helps a kernel short of registers (temple) but makes the others wait in
-/// the tails of workgroups for their slowest warp (BENCHMARKS.md, "Measured choices").
+/// the tails of workgroups for their slowest warp (measured).
 pub const WORKGROUP: u32 = 8;
 /// Statistics words per pixel: steps, hits, misses, budget misses, overshoots, NaNs,
 /// secondary rays, shadow rays.
@@ -60,8 +60,7 @@ const TEMPLATE: &str = concat!(include_str!("kernel.wgsl"), include_str!("shadin
 /// the scene, and so does the driver's compile (the CUDA JIT of a marched kernel of 10 000
 /// spheres takes minutes); the walk's kernel is the same size for any number. The code is
 /// faster at a hundred instances, the walk as fast or faster from a few hundred, and its
-/// pipeline is created in milliseconds where the code's takes seconds: 256 lies between
-/// (BENCHMARKS.md, "Measured choices").
+/// pipeline is created in milliseconds where the code's takes seconds: 256 lies between.
 pub const MAX_INSTANCES: usize = 256;
 
 /// A generated, validated kernel.

@@ -49,7 +49,7 @@ pub const MAX_SCALE: u32 = 8;
 /// GPU) waits for it before showing the scene through the interpreted kernel. A driver that
 /// compiles a kernel in a few milliseconds then shows the specialised kernel's frame at once,
 /// with no slower interpreted frame before it; a compile that takes longer is hidden as
-/// before, its interpreted frame shown this much later (BENCHMARKS.md, "Live preview"): 50 ms
+/// before, its interpreted frame shown this much later (measured): 50 ms
 /// is a few frames at 60 Hz, short beside a slow compile's seconds and well above a fast
 /// one's few milliseconds. The window's event loop is never held: it is woken at the end of the period
 /// ([`Session::grace_deadline`]).

@@ -263,7 +263,7 @@ fn a_kernel_ready_within_the_grace_period_is_shown_with_no_interpreted_frame() {
         "ready within the grace period: {:?}",
         t.ready
     );
-    // The words `--timings` prints (and scripts/device-view.sh reads).
+    // The words `--timings` prints (and scripts/bench.py's view suite reads).
     let words = t.pipeline_words(s.options.grace);
     assert!(
         words.contains("on another thread, specialised compiled within the grace period in"),

@@ -1,7 +1,9 @@
 //! Binary glTF 2.0 (`.glb`) for `mesh(path)`: the JSON chunk's accessors checked against
-//! the BIN chunk, and the triangle primitives of the meshes the scene's nodes place.
+//! the BIN chunk, and the triangle primitives of the meshes the scene's nodes place, each
+//! where its node's transforms put it.
 
 use super::{bad, bad_file, f32_at, u32_at, Error, Place, Read};
+use glam::{DMat4, DQuat, DVec3};
 use std::collections::HashMap;
 
 type Json = serde_json::Value;
@@ -165,9 +167,10 @@ fn accessor<'a>(doc: &Json, bin: &'a [u8], a: u64, from: String) -> Result<Acces
 
 /// Binary glTF 2.0: every primitive of mode 4 (triangles) of the JSON chunk's meshes, with
 /// its `POSITION` accessor (f32 VEC3) and its indices (u8, u16 or u32) or none, read from
-/// the BIN chunk. The nodes' transforms are not applied: the meshes are read in their own
-/// space. Every accessor is checked and the triangles of all primitives counted against the
-/// limit before any is read; the positions read are those the triangles use.
+/// the BIN chunk, once for each node of the scene that places the mesh, through that node's
+/// transform and its ancestors' ([`placed`]); a file without nodes, its meshes in their own
+/// space. Every accessor is checked and the triangles of every placed primitive counted
+/// against the limit before any is read; the positions read are those the triangles use.
 pub(super) fn glb(b: &[u8], max: u64) -> Result<Read, Error> {
     if b.len() < 12 || &b[..4] != b"glTF" {
         return Err(bad_file(
@@ -253,10 +256,12 @@ pub(super) fn glb(b: &[u8], max: u64) -> Result<Read, Error> {
             )),
         }
     };
-    let mut primitives = Vec::new();
-    let mut triangles: u64 = 0;
-    for (m, mesh) in array(&doc, "meshes", "")?.iter().enumerate() {
+    // The triangle primitives of each mesh.
+    let meshes = array(&doc, "meshes", "")?;
+    let mut primitives = Vec::with_capacity(meshes.len());
+    for (m, mesh) in meshes.iter().enumerate() {
         let mpath = format!("meshes[{m}]");
+        let mut list = Vec::new();
         for (p, prim) in array(mesh, "primitives", &mpath)?.iter().enumerate() {
             let path = format!("{mpath}.primitives[{p}]");
             if uint(prim, &path, "mode")?.unwrap_or(4) != 4 {
@@ -294,8 +299,16 @@ pub(super) fn glb(b: &[u8], max: u64) -> Result<Read, Error> {
                     format!("{corners} corners of triangles, not a multiple of 3"),
                 ));
             }
+            list.push((pos, positions, indices));
+        }
+        primitives.push(list);
+    }
+    let placements = placed(&doc, meshes.len())?;
+    let mut triangles: u64 = 0;
+    for (mesh, _) in &placements {
+        for (_, positions, indices) in &primitives[*mesh] {
+            let corners = indices.as_ref().map_or(positions.count, |i| i.count);
             triangles = triangles.saturating_add(corners as u64 / 3);
-            primitives.push((pos, positions, indices));
         }
     }
     if triangles > max {
@@ -306,32 +319,181 @@ pub(super) fn glb(b: &[u8], max: u64) -> Result<Read, Error> {
         });
     }
     let mut read = Read::default();
-    // The positions read so far: (accessor, element) to the index in `read.positions`.
-    let mut used: HashMap<(u64, usize), u32> = HashMap::new();
-    for (pos, positions, indices) in &primitives {
-        let corners = indices.as_ref().map_or(positions.count, |i| i.count);
-        let mut face = [0u32; 3];
-        for c in 0..corners {
-            let i = match indices {
-                Some(ix) => ix.get(c, 0) as usize,
-                None => c,
-            };
-            if i >= positions.count {
-                return Err(bad(
-                    Place::Json(format!("accessors[{pos}]")),
-                    format!("index {i} is past its {} positions", positions.count),
-                ));
-            }
-            let next = read.positions.len() as u32;
-            let v = *used.entry((*pos, i)).or_insert_with(|| {
-                read.positions.push([0, 1, 2].map(|k| positions.get(i, k)));
-                next
-            });
-            face[c % 3] = v;
-            if c % 3 == 2 {
-                read.faces.push(face);
+    for (mesh, transform) in &placements {
+        // A transform that mirrors turns the triangles inside out: their corners are
+        // taken in the other order, so that they stay counter-clockwise seen from outside.
+        let mirrored = transform.determinant() < 0.0;
+        // The positions read for this placement: (accessor, element) to the index in
+        // `read.positions`.
+        let mut used: HashMap<(u64, usize), u32> = HashMap::new();
+        for (pos, positions, indices) in &primitives[*mesh] {
+            let corners = indices.as_ref().map_or(positions.count, |i| i.count);
+            let mut face = [0u32; 3];
+            for c in 0..corners {
+                let i = match indices {
+                    Some(ix) => ix.get(c, 0) as usize,
+                    None => c,
+                };
+                if i >= positions.count {
+                    return Err(bad(
+                        Place::Json(format!("accessors[{pos}]")),
+                        format!("index {i} is past its {} positions", positions.count),
+                    ));
+                }
+                let next = read.positions.len() as u32;
+                let v = *used.entry((*pos, i)).or_insert_with(|| {
+                    let local = DVec3::from_array([0, 1, 2].map(|k| positions.get(i, k)));
+                    read.positions
+                        .push(transform.transform_point3(local).to_array());
+                    next
+                });
+                face[c % 3] = v;
+                if c % 3 == 2 {
+                    if mirrored {
+                        face.swap(1, 2);
+                    }
+                    read.faces.push(face);
+                }
             }
         }
     }
     Ok(read)
+}
+
+/// The meshes the file's scene places, each with its world transform: the nodes of the scene
+/// `scene` names (or the first of `scenes`; or, without scenes, every node that is no node's
+/// child) walked down their `children`, each node's transform (`matrix`, or `translation`,
+/// `rotation` and `scale`) applied after its children's. A file without nodes places each of
+/// its `meshes` as it is. The nodes must form trees, as glTF requires: a node reached twice
+/// (a cycle, or two parents) is an error naming it, so the walk visits each node once.
+fn placed(doc: &Json, meshes: usize) -> Result<Vec<(usize, DMat4)>, Error> {
+    let nodes = match doc.get("nodes") {
+        None => return Ok((0..meshes).map(|m| (m, DMat4::IDENTITY)).collect()),
+        Some(Json::Array(nodes)) => nodes,
+        Some(_) => return Err(bad(Place::Json("nodes".into()), "it is not an array")),
+    };
+    let index = |v: &Json, path: String| -> Result<usize, Error> {
+        v.as_u64()
+            .and_then(|i| usize::try_from(i).ok())
+            .filter(|&i| i < nodes.len())
+            .ok_or_else(|| {
+                bad(
+                    Place::Json(path),
+                    format!("`{v}` is not a node (the file has {})", nodes.len()),
+                )
+            })
+    };
+    let list = |v: Option<&Json>, path: &str| -> Result<Vec<usize>, Error> {
+        match v {
+            None => Ok(Vec::new()),
+            Some(Json::Array(items)) => items
+                .iter()
+                .enumerate()
+                .map(|(i, x)| index(x, format!("{path}[{i}]")))
+                .collect(),
+            Some(_) => Err(bad(Place::Json(path.to_string()), "it is not an array")),
+        }
+    };
+    let roots = match (doc.get("scene"), doc.get("scenes")) {
+        (chosen, Some(Json::Array(scenes))) if !scenes.is_empty() => {
+            let s = match chosen {
+                None => 0,
+                Some(v) => v
+                    .as_u64()
+                    .and_then(|i| usize::try_from(i).ok())
+                    .filter(|&i| i < scenes.len())
+                    .ok_or_else(|| {
+                        bad(
+                            Place::Json("scene".into()),
+                            format!("`{v}` is not a scene (the file has {})", scenes.len()),
+                        )
+                    })?,
+            };
+            list(scenes[s].get("nodes"), &format!("scenes[{s}].nodes"))?
+        }
+        _ => {
+            let mut child = vec![false; nodes.len()];
+            for (n, node) in nodes.iter().enumerate() {
+                for c in list(node.get("children"), &format!("nodes[{n}].children"))? {
+                    child[c] = true;
+                }
+            }
+            (0..nodes.len()).filter(|&n| !child[n]).collect()
+        }
+    };
+    let mut seen = vec![false; nodes.len()];
+    let mut out = Vec::new();
+    let mut stack: Vec<(usize, DMat4)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, DMat4::IDENTITY))
+        .collect();
+    while let Some((n, parent)) = stack.pop() {
+        let path = format!("nodes[{n}]");
+        if std::mem::replace(&mut seen[n], true) {
+            return Err(bad(
+                Place::Json(path),
+                "the node is reached twice (glTF's nodes form trees: no cycles, one parent each)",
+            ));
+        }
+        let node = &nodes[n];
+        let world = parent * local(node, &path)?;
+        if let Some(m) = uint(node, &path, "mesh")? {
+            let m = usize::try_from(m)
+                .ok()
+                .filter(|&m| m < meshes)
+                .ok_or_else(|| {
+                    bad(
+                        Place::Json(format!("{path}.mesh")),
+                        format!("it names `meshes[{m}]`, which does not exist"),
+                    )
+                })?;
+            out.push((m, world));
+        }
+        let children = list(node.get("children"), &format!("{path}.children"))?;
+        stack.extend(children.into_iter().rev().map(|c| (c, world)));
+    }
+    Ok(out)
+}
+
+/// A node's own transform: its `matrix` (16 numbers, column by column), or its
+/// `translation`, `rotation` (a quaternion x, y, z, w) and `scale`, applied scale first.
+fn local(node: &Json, path: &str) -> Result<DMat4, Error> {
+    let numbers = |key: &str, n: usize| -> Result<Option<Vec<f64>>, Error> {
+        let Some(v) = node.get(key) else {
+            return Ok(None);
+        };
+        let xs: Option<Vec<f64>> = v.as_array().filter(|a| a.len() == n).and_then(|a| {
+            a.iter()
+                .map(|x| x.as_f64().filter(|x| x.is_finite()))
+                .collect()
+        });
+        xs.map(Some).ok_or_else(|| {
+            bad(
+                Place::Json(format!("{path}.{key}")),
+                format!("it is not an array of {n} numbers"),
+            )
+        })
+    };
+    if let Some(m) = numbers("matrix", 16)? {
+        let mut cols = [0.0; 16];
+        cols.copy_from_slice(&m);
+        return Ok(DMat4::from_cols_array(&cols));
+    }
+    let t = numbers("translation", 3)?.map_or(DVec3::ZERO, |v| DVec3::new(v[0], v[1], v[2]));
+    let s = numbers("scale", 3)?.map_or(DVec3::ONE, |v| DVec3::new(v[0], v[1], v[2]));
+    let r = match numbers("rotation", 4)? {
+        None => DQuat::IDENTITY,
+        Some(q) => {
+            let q = DQuat::from_xyzw(q[0], q[1], q[2], q[3]);
+            if q.length() < 1e-6 {
+                return Err(bad(
+                    Place::Json(format!("{path}.rotation")),
+                    "a rotation is a unit quaternion; this one has length 0",
+                ));
+            }
+            q.normalize()
+        }
+    };
+    Ok(DMat4::from_scale_rotation_translation(s, r, t))
 }

@@ -439,3 +439,120 @@ fn mutated_files_never_panic() {
         }
     }
 }
+
+/// The sample glTF with `nodes` (and `scenes`, where given) added, read within `max`.
+fn glb_placed(nodes: &str, max: u64) -> Result<Read, Error> {
+    glb_edited(r#""meshes":"#, &format!(r#"{nodes},"meshes":"#), max)
+}
+
+/// Each node that names a mesh places it through its transform and its ancestors':
+/// translation, rotation, scale and matrix; a mirroring transform keeps the triangles
+/// counter-clockwise seen from outside.
+#[test]
+fn glb_nodes_place_their_meshes() {
+    let r = |x: &[[f64; 3]]| {
+        x.iter()
+            .map(|p| p.map(|c| (c * 1e9).round() / 1e9))
+            .collect::<Vec<_>>()
+    };
+    // A translated copy and a mirrored one, the scene's two nodes.
+    let got = glb_placed(
+        r#""scenes":[{"nodes":[0,1]}],"nodes":[{"mesh":0,"translation":[1,2,3]},{"mesh":0,"scale":[-1,1,1]}]"#,
+        100,
+    )
+    .unwrap();
+    assert_eq!(
+        r(&got.positions),
+        [
+            [1.0, 2.0, 3.0],
+            [2.0, 2.0, 3.0],
+            [1.0, 3.0, 3.0],
+            [0.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0]
+        ]
+    );
+    assert_eq!(got.faces, [[0, 1, 2], [3, 5, 4]]);
+    // A child's rotation (a quarter turn about z) inside its parent's translation.
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let got = glb_placed(
+        &format!(r#""nodes":[{{"translation":[1,0,0],"children":[1]}},{{"mesh":0,"rotation":[0,0,{h},{h}]}}]"#),
+        100,
+    )
+    .unwrap();
+    assert_eq!(
+        r(&got.positions),
+        [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 0.0]]
+    );
+    // A matrix, column by column; `scene` picks the second scene.
+    let got = glb_placed(
+        r#""scene":1,"scenes":[{"nodes":[0]},{"nodes":[1]}],"nodes":[{"mesh":0},{"mesh":0,"matrix":[2,0,0,0, 0,2,0,0, 0,0,2,0, 5,0,0,1]}]"#,
+        100,
+    )
+    .unwrap();
+    assert_eq!(
+        r(&got.positions),
+        [[5.0, 0.0, 0.0], [7.0, 0.0, 0.0], [5.0, 2.0, 0.0]]
+    );
+    // Without nodes, the meshes as they are (the sample itself).
+    assert_eq!(
+        read(Format::Glb, &glb_bytes(2, GLB_JSON, &glb_bin()), 100)
+            .unwrap()
+            .faces
+            .len(),
+        1
+    );
+}
+
+/// Nodes that do not form trees, name what does not exist or hold transforms that are not
+/// numbers are errors naming the member; every placement counts against the limit.
+#[test]
+fn bad_glb_nodes_are_located_errors() {
+    let message = |nodes: &str, max: u64| glb_placed(nodes, max).unwrap_err().to_string();
+    let cycle = message(
+        r#""scenes":[{"nodes":[0]}],"nodes":[{"children":[1]},{"children":[0],"mesh":0}]"#,
+        100,
+    );
+    assert!(
+        cycle.contains("`nodes[0]`") && cycle.contains("reached twice"),
+        "{cycle}"
+    );
+    let shared = message(
+        r#""nodes":[{"children":[2]},{"children":[2]},{"mesh":0}]"#,
+        100,
+    );
+    assert!(
+        shared.contains("`nodes[2]`") && shared.contains("reached twice"),
+        "{shared}"
+    );
+    let child = message(r#""nodes":[{"children":[7]}]"#, 100);
+    assert!(
+        child.contains("`nodes[0].children[0]`") && child.contains("not a node"),
+        "{child}"
+    );
+    let mesh = message(r#""nodes":[{"mesh":3}]"#, 100);
+    assert!(mesh.contains("`nodes[0].mesh`"), "{mesh}");
+    let matrix = message(r#""nodes":[{"mesh":0,"matrix":[1,0,0]}]"#, 100);
+    assert!(
+        matrix.contains("`nodes[0].matrix`") && matrix.contains("16 numbers"),
+        "{matrix}"
+    );
+    let rotation = message(r#""nodes":[{"mesh":0,"rotation":[0,0,0,0]}]"#, 100);
+    assert!(rotation.contains("`nodes[0].rotation`"), "{rotation}");
+    let scene = message(
+        r#""scene":4,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}]"#,
+        100,
+    );
+    assert!(scene.contains("`scene`"), "{scene}");
+    match glb_placed(
+        r#""nodes":[{"mesh":0},{"mesh":0,"translation":[3,0,0]}]"#,
+        1,
+    ) {
+        Err(Error::Limit {
+            triangles: 2,
+            max: 1,
+            ..
+        }) => {}
+        other => panic!("{other:?}"),
+    }
+}

@@ -34,6 +34,8 @@ pub struct Loaded {
     pub diagnostics: Vec<Diagnostic>,
     /// The files read, for rendering diagnostics.
     pub sources: SourceMap,
+    /// The other files the scene read (meshes, fonts), each by its name with the bytes read.
+    pub data: Vec<(String, Vec<u8>)>,
 }
 
 /// Why a scene's entry file cannot be read ([`Source::read`]), phrased for the user.
@@ -83,6 +85,8 @@ pub struct Source {
     names: std::collections::HashMap<PathBuf, String>,
     /// The `file_size` limit of the files read, in MiB.
     file_size: u64,
+    /// The other files the last check read as bytes, by name.
+    data: Vec<(String, Vec<u8>)>,
 }
 
 impl Source {
@@ -115,6 +119,7 @@ impl Source {
             imports: Default::default(),
             names,
             file_size,
+            data: Vec::new(),
         })
     }
 
@@ -133,6 +138,7 @@ impl Source {
             imports: Default::default(),
             names,
             file_size: Limit::FileSize.default_value(),
+            data: Vec::new(),
         }
     }
 
@@ -144,6 +150,7 @@ impl Source {
     /// Checks the scene within `limits` at the time `t` = `time` seconds.
     pub fn check(&mut self, limits: &Limits, time: f64) -> Loaded {
         self.file_size = limits.get(Limit::FileSize);
+        self.data.clear();
         let mut sources = SourceMap::new();
         let entry = sources.add(self.name.clone(), self.text.clone());
         let (scene, diagnostics) = check_at(&mut sources, entry, self, limits, time);
@@ -151,6 +158,7 @@ impl Source {
             scene,
             diagnostics,
             sources,
+            data: std::mem::take(&mut self.data),
         }
     }
 }
@@ -172,7 +180,13 @@ impl Loader for Source {
     }
 
     fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        self.loader().load_bytes(from, path)
+        let read = self.loader().load_bytes(from, path);
+        if let Ok((name, bytes)) = &read {
+            if !self.data.iter().any(|(n, _)| n == name) {
+                self.data.push((name.clone(), bytes.clone()));
+            }
+        }
+        read
     }
 }
 

@@ -101,13 +101,18 @@ impl Session {
         // Files that changed while they were read (an editor saving in place truncates, then
         // writes) are read again: a load stands on contents still there after it was read.
         for _ in 0..STABLE_READS {
-            self.files = files_of(&loaded.sources);
-            self.fingerprint = Fingerprint::from_sources(
-                self.files
-                    .iter()
-                    .zip(0..)
-                    .map(|(f, i)| (f.clone(), loaded.sources.text(FileId(i)).as_bytes())),
-            );
+            // The scene's files and the others it read (meshes, fonts), as the load read them.
+            let sources = files_of(&loaded.sources)
+                .into_iter()
+                .zip(0..)
+                .map(|(f, i)| (f, loaded.sources.text(FileId(i)).as_bytes()));
+            let data = loaded
+                .data
+                .iter()
+                .map(|(name, bytes)| (PathBuf::from(name), bytes.as_slice()));
+            let read: Vec<(PathBuf, &[u8])> = sources.chain(data).collect();
+            self.files = read.iter().map(|(f, _)| f.clone()).collect();
+            self.fingerprint = Fingerprint::from_sources(read.into_iter());
             if !self.fingerprint.changed() {
                 break;
             }

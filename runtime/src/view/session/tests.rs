@@ -682,6 +682,61 @@ fn reloads_keep_the_moved_camera_and_errors_keep_the_image() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An ASCII STL of the tetrahedron with corners at the origin and at `size` along each axis.
+fn tetrahedron_stl(size: f64) -> String {
+    let [o, x, y, z] = [
+        [0.0; 3],
+        [size, 0.0, 0.0],
+        [0.0, size, 0.0],
+        [0.0, 0.0, size],
+    ];
+    let mut stl = String::from("solid t\n");
+    for f in [[o, y, x], [o, x, z], [o, z, y], [x, y, z]] {
+        stl.push_str(" facet normal 0 0 0\n  outer loop\n");
+        for v in f {
+            stl.push_str(&format!("   vertex {} {} {}\n", v[0], v[1], v[2]));
+        }
+        stl.push_str("  endloop\n endfacet\n");
+    }
+    stl + "endsolid t\n"
+}
+
+/// The files a scene reads besides its sources (a mesh) are watched as its imports are: a
+/// change of the mesh file calls for a reload, and the reload shows the new mesh.
+#[test]
+fn a_changed_mesh_file_reloads() {
+    let dir = std::env::temp_dir().join(format!("sdfc-session-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (file, mesh) = (dir.join("s.sdf"), dir.join("part.stl"));
+    std::fs::write(&mesh, tetrahedron_stl(1.0)).unwrap();
+    std::fs::write(
+        &file,
+        SCENE.replace(
+            "sphere(0.5).translate(0, 0.5, 0)",
+            "mesh(\"part.stl\").translate(-0.3, 0, 0)",
+        ),
+    )
+    .unwrap();
+    let mut s = Session::new(file.clone(), Options::default(), Device::Cpu);
+    s.set_size(32, 24);
+    assert!(s.load().ok);
+    assert!(
+        s.files().iter().any(|f| f.ends_with("part.stl")),
+        "{:?}",
+        s.files()
+    );
+    assert!(!s.needs_reload(&[]));
+    settle(&mut s);
+    let before = s.image().unwrap();
+    std::fs::write(&mesh, tetrahedron_stl(1.4)).unwrap();
+    assert!(s.needs_reload(std::slice::from_ref(&mesh)));
+    assert!(s.load().ok);
+    assert!(!s.needs_reload(&[]), "nothing changed since");
+    settle(&mut s);
+    assert_ne!(s.image().unwrap(), before);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Every load, the first and those after it (prepared as the scene before was), is held to the
 /// `memory` limit at the view's size, whatever size the scene's settings state: a scene that
 /// asks for a picture far above the limit is shown in a small view, and an edit loaded while

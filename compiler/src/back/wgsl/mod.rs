@@ -212,8 +212,9 @@ pub struct Options {
     /// of written as literals (the `PARAMS` feature; docs/animation.md): the kernel's text
     /// then depends on the program with its constants erased, so the frames of an animation
     /// that differ only in numbers share one kernel and differ in [`Kernel::data`]. Only the
-    /// program written as code takes them: an analytically traced scene, a marched one whose
-    /// instances are read from `scene_data`, and the media of glass keep their literals.
+    /// program written as code takes them: a marched scene whose instances are read from
+    /// `scene_data` and the media of glass keep their literals; an analytically traced scene
+    /// with parameters (`param`) walks its primitives in `scene_data`, whatever their count.
     pub parameters: bool,
     /// Which kernel a marched scene gets: its distance program written as code (the
     /// specialised kernel), or interpreted from `scene_data` (interp.rs), or the one of the two
@@ -449,7 +450,14 @@ fn write_template(
         // An analytically traced scene needs no distance field.
         Some(traced) => {
             let clear = |m| scene.material(m).transparency > 0.0;
-            let (text, bytes) = analytic::write(traced, &clear, options.max_unrolled);
+            // A scene with parameters, asked for a kernel whose text does not depend on its
+            // numbers (the viewer's panel), walks its primitives in `scene_data`: a changed
+            // size or place is new data for the same kernel, not a new kernel.
+            let unrolled = match options.parameters && !scene.params.is_empty() {
+                true => 0,
+                false => options.max_unrolled,
+            };
+            let (text, bytes) = analytic::write(traced, &clear, unrolled);
             values.insert("MAP", String::new());
             values.insert("ANALYTIC", text);
             bytes

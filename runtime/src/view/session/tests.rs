@@ -788,3 +788,49 @@ fn every_load_is_held_to_the_memory_limit_at_the_views_size() {
     assert!(again.ok, "{}", again.summary);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A traced scene with parameters keeps its kernel when a parameter changes a size: its
+/// primitives are walked in `scene_data`, so the change is new data, not a new kernel, and
+/// the picture is the one a session started with the new value shows.
+#[test]
+fn a_parameter_of_a_traced_scene_keeps_the_kernel() {
+    let Some(gpu) = wgpu() else { return };
+    let dir = std::env::temp_dir().join(format!("sdfc-traced-param-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("ball.sdf");
+    std::fs::write(
+        &file,
+        format!(
+            "param r = 0.5 in 0.2..1.0;\n{}",
+            SCENE.replace(
+                "sphere(0.5).translate(0, 0.5, 0)",
+                "sphere(r).translate(0, r, 0)"
+            )
+        ),
+    )
+    .unwrap();
+    let mut s = Session::new(file.clone(), Options::default(), Device::Wgpu(gpu.clone()));
+    s.set_size(32, 24);
+    assert!(s.load().ok);
+    settle_all(&mut s);
+    let kernel = kernel_text(&s);
+    assert!(
+        kernel.contains("fn trace("),
+        "the scene is traced analytically"
+    );
+    let before = s.image().unwrap();
+    assert!(s.set_param("r", &sdfc_compiler::ParamValue::Float(0.8)).ok);
+    assert!(!s.compiling(), "a size is new data for the kernel on show");
+    assert_eq!(kernel_text(&s), kernel);
+    settle_all(&mut s);
+    let changed = s.image().unwrap();
+    assert_ne!(changed, before);
+    let mut options = Options::default();
+    options.job.limits.set_param("r", "0.8");
+    let mut fresh = Session::new(file, options, Device::Wgpu(gpu));
+    fresh.set_size(32, 24);
+    assert!(fresh.load().ok);
+    settle_all(&mut fresh);
+    assert_eq!(fresh.image(), Some(changed));
+    let _ = std::fs::remove_dir_all(&dir);
+}

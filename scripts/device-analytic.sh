@@ -40,7 +40,7 @@ if [ "$MODE" = all ] || [ "$MODE" = agree ]; then
   # primitives), local bounds (temple's twisted columns), neighbouring cells (overlapping
   # repetition), far from the origin; CUDA and wgpu against the CPU.
   echo "== agreement at 640x480 (psnr dB / differing %)" | tee "$OUT/agree.txt"
-  for f in examples/scaling/random_1000.sdf examples/scaling/random_10000.sdf examples/scaling/compound_1000.sdf examples/lattice.sdf examples/temple.sdf runtime/tests/in/ok/neighbours.sdf runtime/tests/stability/far.sdf; do
+  for f in examples/scaling/random_1000.sdf examples/scaling/random_10000.sdf examples/scaling/compound_1000.sdf examples/lattice.sdf examples/temple.sdf compiler/tests/in/ok/neighbours.sdf runtime/tests/stability/far.sdf; do
     n=$(basename "$f" .sdf)
     for b in cpu cuda wgpu; do
       timeout 120 "$B" render "$f" --backend "$b" --size 640x480 -o "/tmp/sdfc-img/$n-$b.png" > "$OUT/agree-$n-$b.txt" 2>&1 || echo "$n $b FAILED: $(tail -n 2 "$OUT/agree-$n-$b.txt")"

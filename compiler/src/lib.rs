@@ -84,8 +84,8 @@ pub use crate::eval::{
 };
 
 /// The writers: the WGSL kernel (validated by naga), PTX from it, SPIR-V/MSL/GLSL/HLSL,
-/// Shadertoy, and Rust source over glam.
-pub use crate::back::{ptx, rust, shader, shadertoy, wgsl};
+/// Shadertoy, Rust source over glam, and the distance at a buffer of points (WGSL and PTX).
+pub use crate::back::{points, ptx, rust, shader, shadertoy, wgsl};
 
 /// The deterministic generator tests draw points from.
 pub use crate::rng::Rng;

@@ -72,7 +72,14 @@ fn idempotent(name: &str, text: &str) -> Option<String> {
 #[test]
 fn every_sdf_file_formats_idempotently_and_keeps_its_meaning() {
     let mut files = Vec::new();
-    for dir in ["examples", "runtime/tests", "bench", "grammar", "docs"] {
+    for dir in [
+        "examples",
+        "compiler/tests",
+        "runtime/tests",
+        "bench",
+        "grammar",
+        "docs",
+    ] {
         sdf_files(&root().join(dir), &mut files);
     }
     files.sort();

@@ -14,7 +14,7 @@
 //! the top-level module it reaches. Comments and string literals are skipped; code under
 //! `#[cfg(test)]` (unit tests, which may use any part of their crate) is left out.
 
-mod common;
+use crate::common;
 
 use sdfc_compiler::builtins::{self, BUILTINS};
 use std::collections::{BTreeMap, BTreeSet};
@@ -724,7 +724,7 @@ fn example_produces(row: &str, code: &str) -> bool {
     for part in examples.split("](../").skip(1) {
         let rel = part.split(')').next().unwrap_or("");
         if rel.ends_with(".sdf") {
-            if let Ok(loaded) = sdfc_runtime::frontend::load(&root().join(rel)) {
+            if let Ok(loaded) = common::load(&root().join(rel)) {
                 if produces(&loaded.diagnostics) {
                     return true;
                 }
@@ -805,22 +805,22 @@ const NOT_LIMITS: &[(&str, &str, &str)] = &[
         "the step budget that defines the reference render",
     ),
     (
-        "runtime/tests/image_conformance.rs",
+        "runtime/tests/render/image_conformance.rs",
         "MAX_DIFFERING",
         "a test tolerance",
     ),
     (
-        "runtime/tests/analytic.rs",
+        "runtime/tests/render/analytic.rs",
         "MAX_DIFFERING",
         "a test tolerance",
     ),
     (
-        "runtime/tests/stability.rs",
+        "runtime/tests/render/stability.rs",
         "MAX_MISSED",
         "a test tolerance",
     ),
     (
-        "runtime/tests/stability.rs",
+        "runtime/tests/render/stability.rs",
         "MAX_STEP_RATIO",
         "a test tolerance",
     ),

@@ -1,0 +1,13 @@
+//! The command line, one test binary: the `sdfc` commands and their outputs (`cli`), the
+//! code a user takes away (`embed`, `emit_rust`), and speed against accuracy (`accuracy`).
+//!
+//! Filter by module: `cargo test --release --test cli -- embed::`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod accuracy;
+#[allow(clippy::module_inception)] // The binary's first concern, named as the binary.
+mod cli;
+mod embed;
+mod emit_rust;

@@ -18,6 +18,7 @@ use sdfc_runtime::backend::{Backend, Devices, Kernel, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::frontend::{self, Source};
+use sdfc_runtime::gpu::points::RunError;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::job::{self, Job, Overrides};
 use std::sync::OnceLock;
@@ -409,8 +410,9 @@ impl Scene {
 
 /// The process's CUDA device (its primary context and compute capability), opened on first
 /// use and held while the module is loaded.
-fn cuda_device() -> &'static Result<sdfc_runtime::gpu::points::CudaDevice, String> {
-    static CUDA: OnceLock<Result<sdfc_runtime::gpu::points::CudaDevice, String>> = OnceLock::new();
+fn cuda_device() -> &'static Result<sdfc_runtime::gpu::points::CudaDevice, RunError> {
+    static CUDA: OnceLock<Result<sdfc_runtime::gpu::points::CudaDevice, RunError>> =
+        OnceLock::new();
     CUDA.get_or_init(sdfc_runtime::gpu::points::open_cuda)
 }
 
@@ -427,6 +429,20 @@ fn wgpu_device() -> Result<&'static std::sync::Arc<sdfc_runtime::gpu::Gpu>, Stri
     .map_err(Clone::clone)
 }
 
+/// Why distances at points could not be computed on a GPU (a `RuntimeError` in Python).
+#[derive(Debug, thiserror::Error)]
+enum GpuError {
+    /// The module of distances at points cannot be written.
+    #[error("{0}")]
+    Module(#[from] sdfc_compiler::points::Error),
+    /// The device cannot run it.
+    #[error("{0}")]
+    Run(#[from] RunError),
+    /// There is no wgpu device: why, as it was first told.
+    #[error("{0}")]
+    NoWgpu(String),
+}
+
 /// Distances (f32 bytes) and material ids (u32 bytes) at `points` (program coordinates)
 /// from the scene's WGSL part on a GPU: through wgpu, or as PTX through CUDA.
 fn gpu_distances(
@@ -434,7 +450,7 @@ fn gpu_distances(
     scene: &sdfc_compiler::Scene,
     lowered: &Lowered,
     points: &[[f64; 3]],
-) -> Result<(Vec<u8>, Vec<u8>), String> {
+) -> Result<(Vec<u8>, Vec<u8>), GpuError> {
     use sdfc_runtime::gpu::points as on_gpu;
     // Each device is opened once per process, on first use.
     let module = on_gpu::points_module(scene, lowered, false)?;
@@ -443,7 +459,7 @@ fn gpu_distances(
         let ptx = on_gpu::points_ptx(&module, *sm)?;
         on_gpu::run_cuda(ctx, &module, &ptx, points)?
     } else {
-        on_gpu::run_wgpu(wgpu_device()?, &module, points)?
+        on_gpu::run_wgpu(wgpu_device().map_err(GpuError::NoWgpu)?, &module, points)?
     };
     let d = values.iter().flat_map(|(d, _)| d.to_ne_bytes()).collect();
     let m = values.iter().flat_map(|(_, m)| m.to_ne_bytes()).collect();
@@ -671,7 +687,7 @@ impl Scene {
             let scene = checked.scene;
             let (d, m) = py
                 .detach(move || gpu_distances(&backend, &scene, &lowered, &xyz))
-                .map_err(PyRuntimeError::new_err)?;
+                .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
             return Ok((PyBytes::new(py, &d), PyBytes::new(py, &m)));
         }
         let pool = pool().map_err(|f| f.into_py(py))?;

@@ -58,14 +58,56 @@ pub struct PointsModule {
     pub data: Option<Vec<u8>>,
 }
 
-fn validated(source: String, group: u32, data: Option<Vec<u8>>) -> Result<PointsModule, String> {
-    let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
-    let info = naga::valid::Validator::new(
+/// Why a module of distances at points cannot be written.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The scene's WGSL part or kernel that the entry point joins is invalid.
+    #[error("{0}")]
+    Wgsl(#[from] wgsl::Error),
+    /// naga cannot parse the joined module: its message, placed in the source.
+    #[error("{}", .error.emit_to_string(.text))]
+    Parse {
+        error: naga::front::wgsl::ParseError,
+        /// The joined module.
+        text: String,
+    },
+    /// naga finds the joined module invalid: its message, placed in the source.
+    #[error("{}", .error.emit_to_string(.text))]
+    Invalid {
+        error: Box<naga::WithSpan<naga::valid::ValidationError>>,
+        /// The joined module.
+        text: String,
+    },
+    /// The PTX writer cannot translate the entry point.
+    #[error("PTX: {0}")]
+    Ptx(#[from] ptx::Error),
+}
+
+fn validated(source: String, group: u32, data: Option<Vec<u8>>) -> Result<PointsModule, Error> {
+    let module = match naga::front::wgsl::parse_str(&source) {
+        Ok(m) => m,
+        Err(error) => {
+            return Err(Error::Parse {
+                error,
+                text: source,
+            })
+        }
+    };
+    let validation = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
-    .validate(&module)
-    .map_err(|e| e.emit_to_string(&source))?;
+    .validate(&module);
+    let info = match validation {
+        Ok(info) => info,
+        Err(error) => {
+            let error = Box::new(error);
+            return Err(Error::Invalid {
+                error,
+                text: source,
+            });
+        }
+    };
     Ok(PointsModule {
         source,
         module,
@@ -77,15 +119,11 @@ fn validated(source: String, group: u32, data: Option<Vec<u8>>) -> Result<Points
 
 /// The part of `scene` (as lowered), `map` and, with `alone`, `map_distance`, with [`entry`];
 /// for a scene with a mesh, which has no part, [`mesh_module`].
-pub fn points_module(
-    scene: &Scene,
-    lowered: &Lowered,
-    alone: bool,
-) -> Result<PointsModule, String> {
+pub fn points_module(scene: &Scene, lowered: &Lowered, alone: bool) -> Result<PointsModule, Error> {
     if lowered.program.meshes().next().is_some() {
         return mesh_module(scene, alone);
     }
-    let part = wgsl::part::write(scene, lowered, "map").map_err(|e| e.to_string())?;
+    let part = wgsl::part::write(scene, lowered, "map")?;
     let alone = alone.then_some("map_distance");
     validated(
         format!("{}\n{}", part.source, entry(0, alone, None)),
@@ -97,11 +135,11 @@ pub fn points_module(
 /// A scene with a mesh has no part (its triangles are data, not code): its marched kernel,
 /// with the meshes in `scene_data`, its `map` and, with `alone`, `sdf` with [`entry`] (in bind
 /// group 1, beside the kernel's group 0).
-fn mesh_module(scene: &Scene, alone: bool) -> Result<PointsModule, String> {
+fn mesh_module(scene: &Scene, alone: bool) -> Result<PointsModule, Error> {
     let mut marched = scene.clone();
     marched.settings.method = Method::March;
     let lowered = Lowered::new(&marched);
-    let kernel = wgsl::write(&marched, &lowered).map_err(|e| e.to_string())?;
+    let kernel = wgsl::write(&marched, &lowered)?;
     validated(
         format!(
             "{}\n{}",
@@ -117,7 +155,7 @@ fn mesh_module(scene: &Scene, alone: bool) -> Result<PointsModule, String> {
 /// `scene_data`, its `map` and `sdf` with [`entry`] (in bind group 1, beside the kernel's
 /// group 0), every other point's walks hinted by `sdf` at the point before it; none where
 /// the scene has no instances.
-pub fn walk_module(scene: &Scene) -> Option<Result<PointsModule, String>> {
+pub fn walk_module(scene: &Scene) -> Option<Result<PointsModule, Error>> {
     let mut marched = scene.clone();
     marched.settings.method = Method::March;
     let lowered = Lowered::new(&marched);
@@ -128,7 +166,7 @@ pub fn walk_module(scene: &Scene) -> Option<Result<PointsModule, String>> {
     };
     let kernel = match wgsl::write_with(&marched, &lowered, &options) {
         Ok(k) => k,
-        Err(e) => return Some(Err(e.to_string())),
+        Err(e) => return Some(Err(e.into())),
     };
     let walked = kernel.source.contains("fn walk_map(");
     let data = kernel.data.filter(|_| walked)?;
@@ -140,12 +178,10 @@ pub fn walk_module(scene: &Scene) -> Option<Result<PointsModule, String>> {
 }
 
 /// The PTX of a [`PointsModule`]'s entry point for `sm`.
-pub fn points_ptx(m: &PointsModule, sm: u32) -> Result<String, String> {
+pub fn points_ptx(m: &PointsModule, sm: u32) -> Result<String, Error> {
     let options = ptx::Options {
         sm,
         entry_point: ENTRY_POINT.into(),
     };
-    ptx::write(&m.module, &m.info, &options)
-        .map(|p| p.text)
-        .map_err(|e| format!("PTX: {e}"))
+    Ok(ptx::write(&m.module, &m.info, &options)?.text)
 }

@@ -8,6 +8,44 @@ pub use sdfc_compiler::points::{
     entry, points_module, points_ptx, walk_module, PointsModule, Value, ENTRY_POINT, WORKGROUP,
 };
 
+/// Why distances at points cannot be computed on a device.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum RunError {
+    /// There is no CUDA driver library to load.
+    #[error("no CUDA driver (libcuda.so)")]
+    NoCudaDriver,
+    /// The CUDA driver found no device.
+    #[error("the CUDA driver found no device")]
+    NoCudaDevice,
+    /// A call of the CUDA driver failed: `what` it was doing.
+    #[error("{what}: {error}")]
+    Cuda {
+        what: &'static str,
+        error: cudarc::driver::DriverError,
+    },
+    /// The PTX holds no entry point [`ENTRY_POINT`] that the driver can load.
+    #[error("the kernel {ENTRY_POINT}: {error}")]
+    Function { error: cudarc::driver::DriverError },
+    /// The module binds no results buffer in its group.
+    #[error("the module binds no results")]
+    NoResults,
+    /// The module reads `scene_data`, which it was not given.
+    #[error("the module reads scene_data it lacks")]
+    NoSceneData,
+    /// Waiting for the wgpu device failed.
+    #[error("waiting for the GPU: {0}")]
+    Wait(std::sync::Arc<wgpu::PollError>),
+    /// The mapping of the results ended without a word.
+    #[error("reading the distances back: {0}")]
+    Unanswered(#[from] std::sync::mpsc::RecvError),
+    /// The results could not be mapped back to the host.
+    #[error("reading the distances back: {0}")]
+    Map(#[from] wgpu::BufferAsyncError),
+    /// The mapped results could not be viewed.
+    #[error("reading the distances back: {0}")]
+    MapRange(#[from] wgpu::MapRangeError),
+}
+
 /// The points as the entry point reads them: x, y, z, 0 per point, padded with the origin to
 /// a whole number of workgroups, as bytes.
 fn point_bytes(points: &[[f64; 3]]) -> Vec<u8> {
@@ -57,7 +95,7 @@ pub fn run_wgpu(
     gpu: &crate::gpu::Gpu,
     m: &PointsModule,
     points: &[[f64; 3]],
-) -> Result<Results, String> {
+) -> Result<Results, RunError> {
     let (device, queue) = (gpu.device(), gpu.queue());
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("distance over points"),
@@ -136,14 +174,9 @@ pub fn run_wgpu(
         });
         device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("waiting for the GPU: {e}"))?;
-        rx.recv()
-            .map_err(|e| format!("reading the distances back: {e}"))?
-            .map_err(|e| format!("reading the distances back: {e}"))?;
-        let bytes = slice
-            .get_mapped_range()
-            .map_err(|e| format!("reading the distances back: {e}"))?
-            .to_vec();
+            .map_err(|e| RunError::Wait(e.into()))?;
+        rx.recv()??;
+        let bytes = slice.get_mapped_range()?.to_vec();
         let (v, d) = results(&bytes, chunk.len());
         out.0.extend(v);
         out.1.extend(d);
@@ -156,21 +189,28 @@ pub type CudaDevice = (std::sync::Arc<cudarc::driver::CudaContext>, u32);
 
 /// A CUDA device, opened for [`run_cuda`], with its compute capability, or why there is
 /// none.
-pub fn open_cuda() -> Result<CudaDevice, String> {
+pub fn open_cuda() -> Result<CudaDevice, RunError> {
     use cudarc::driver::{sys, CudaContext};
     // SAFETY: only tries to dlopen libcuda; no driver call is made.
     #[allow(unsafe_code)]
     let present = unsafe { sys::is_culib_present() };
     if !present {
-        return Err("no CUDA driver (libcuda.so)".into());
+        return Err(RunError::NoCudaDriver);
     }
     match CudaContext::device_count() {
         Ok(n) if n > 0 => {}
-        Ok(_) => return Err("the CUDA driver found no device".into()),
-        Err(e) => return Err(format!("the CUDA driver: {e}")),
+        Ok(_) => return Err(RunError::NoCudaDevice),
+        Err(error) => {
+            let what = "the CUDA driver";
+            return Err(RunError::Cuda { what, error });
+        }
     }
-    let ctx = CudaContext::new(0).map_err(|e| format!("a CUDA context: {e}"))?;
-    let attr = |a| ctx.attribute(a).map_err(|e| format!("{e}"));
+    let cuda = |what| move |error| RunError::Cuda { what, error };
+    let ctx = CudaContext::new(0).map_err(cuda("a CUDA context"))?;
+    let attr = |a| {
+        ctx.attribute(a)
+            .map_err(cuda("the device's compute capability"))
+    };
     let major = attr(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR)?;
     let minor = attr(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR)?;
     Ok((ctx, (major * 10 + minor) as u32))
@@ -186,14 +226,15 @@ pub fn run_cuda(
     m: &PointsModule,
     ptx_text: &str,
     points: &[[f64; 3]],
-) -> Result<Results, String> {
+) -> Result<Results, RunError> {
     use cudarc::driver::{LaunchConfig, PushKernelArg};
+    let cuda = |what| move |error| RunError::Cuda { what, error };
     let module = ctx
         .load_module(cudarc::nvrtc::Ptx::from_src(ptx_text))
-        .map_err(|e| format!("the CUDA JIT refused the PTX: {e}"))?;
+        .map_err(cuda("the CUDA JIT refused the PTX"))?;
     let function = module
         .load_function(ENTRY_POINT)
-        .map_err(|e| format!("the kernel {ENTRY_POINT}: {e}"))?;
+        .map_err(|error| RunError::Function { error })?;
     let s = ctx.default_stream();
     let mut bindings: Vec<(u32, u32)> = m
         .module
@@ -205,8 +246,7 @@ pub fn run_cuda(
     let out_at = bindings
         .iter()
         .position(|&b| b == (m.group, 1))
-        .ok_or("the module binds no results")?;
-    let cuda = |e: cudarc::driver::DriverError| format!("CUDA: {e}");
+        .ok_or(RunError::NoResults)?;
     let mut out: Results = (
         Vec::with_capacity(points.len()),
         Vec::with_capacity(points.len()),
@@ -218,15 +258,12 @@ pub fn run_cuda(
                 let bytes = match b {
                     b if b == (m.group, 0) => point_bytes(chunk),
                     b if b == (m.group, 1) => vec![0; result_bytes(chunk) as usize],
-                    (0, 4) => m
-                        .data
-                        .clone()
-                        .ok_or("the module reads scene_data it lacks")?,
+                    (0, 4) => m.data.clone().ok_or(RunError::NoSceneData)?,
                     _ => vec![0; 256],
                 };
-                s.clone_htod(&bytes).map_err(cuda)
+                s.clone_htod(&bytes).map_err(cuda("CUDA"))
             })
-            .collect::<Result<Vec<cudarc::driver::CudaSlice<u8>>, String>>()?;
+            .collect::<Result<Vec<cudarc::driver::CudaSlice<u8>>, RunError>>()?;
         let cfg = LaunchConfig {
             grid_dim: (groups(chunk), 1, 1),
             block_dim: (WORKGROUP, 1, 1),
@@ -241,9 +278,10 @@ pub fn run_cuda(
         // one element for every thread of the grid, scene_data is the kernel's own, and the
         // entry point reads nothing of the other buffers.
         #[allow(unsafe_code)]
-        unsafe { launch.launch(cfg) }.map_err(cuda)?;
-        s.synchronize().map_err(cuda)?;
-        let (v, d) = results(&s.clone_dtoh(&buffers[out_at]).map_err(cuda)?, chunk.len());
+        unsafe { launch.launch(cfg) }.map_err(cuda("CUDA"))?;
+        s.synchronize().map_err(cuda("CUDA"))?;
+        let out_bytes = s.clone_dtoh(&buffers[out_at]).map_err(cuda("CUDA"))?;
+        let (v, d) = results(&out_bytes, chunk.len());
         out.0.extend(v);
         out.1.extend(d);
     }

@@ -52,7 +52,7 @@ pub use crate::{
 /// readers of the mesh files `mesh(path)` reads.
 pub use crate::{
     check::types::{Type, Value},
-    check::{builtins, colour::srgb_to_linear, meshfile, Constant, Loader, NoImports},
+    check::{builtins, colour::srgb_to_linear, meshfile, Constant, LoadError, Loader, NoImports},
     front::{check, check_at, check_str, check_with, check_with_constants},
     syntax::{ast, dump as dump_ast, format, lexer, parse},
 };

@@ -7,7 +7,9 @@
 //! The counter sees every thread of the process, so the test measures alone
 //! ([`counting::alone`]).
 
-use sdfc_compiler::{check_str, check_with, has_errors, Diagnostic, Limits, Loader, SourceMap};
+use sdfc_compiler::{
+    check_str, check_with, has_errors, Diagnostic, Limits, LoadError, Loader, SourceMap,
+};
 
 use crate::counting;
 use counting::peak_of;
@@ -18,11 +20,11 @@ const MB: u64 = 1 << 20;
 struct One(Vec<u8>);
 
 impl Loader for One {
-    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), String> {
-        Err(format!("no imports here (`{path}`)"))
+    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), LoadError> {
+        Err(LoadError::NoImports { path: path.into() })
     }
 
-    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         Ok((path.to_string(), self.0.clone()))
     }
 }

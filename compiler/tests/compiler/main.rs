@@ -17,12 +17,14 @@
 //! - `ptx`: the PTX back end, assembled by `ptxas`;
 //! - `tint`: the WGSL kernels compiled by Chromium's WebGPU compiler;
 //! - `tidy`: the repository's rules (module cycles, file headers, the docs and the editor
-//!   grammar against the compiler's tables).
+//!   grammar against the compiler's tables); `counts`: the counts that may only fall
+//!   (`Result<_, String>`).
 //!
 //! The scenes built in code that these and the runtime's suites share are in `common`.
 
 mod batch_interpreter;
 mod common;
+mod counts;
 mod distance_formulas;
 mod emit_rust;
 mod format;

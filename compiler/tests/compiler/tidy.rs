@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 /// A token of the little lexer below: what dependency paths are made of.
 #[derive(Debug, Clone, PartialEq)]
-enum Tok {
+pub(crate) enum Tok {
     Ident(String),
     /// `::`
     Path,
@@ -32,7 +32,7 @@ enum Tok {
 
 /// The identifiers and punctuation of Rust source, without comments, strings, characters
 /// and lifetimes.
-fn tokens(src: &str) -> Vec<Tok> {
+pub(crate) fn tokens(src: &str) -> Vec<Tok> {
     let s: Vec<char> = src.chars().collect();
     let mut out = Vec::new();
     let mut i = 0;
@@ -532,7 +532,7 @@ fn the_scanner_finds_paths_and_cycles() {
     assert!(cycles(&g).is_empty());
 }
 
-fn root() -> PathBuf {
+pub(crate) fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
@@ -827,7 +827,7 @@ const NOT_LIMITS: &[(&str, &str, &str)] = &[
 ];
 
 /// The `.rs` files under `dir` (relative to the workspace root), build output left out.
-fn workspace_rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub(crate) fn workspace_rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).expect("readable").flatten() {
         let path = entry.path();
         let name = entry.file_name().to_string_lossy().into_owned();

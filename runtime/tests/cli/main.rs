@@ -7,7 +7,6 @@
 mod common;
 
 mod accuracy;
-#[allow(clippy::module_inception)] // The binary's first concern, named as the binary.
 mod cli;
 mod embed;
 mod emit_rust;

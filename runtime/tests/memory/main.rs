@@ -8,6 +8,5 @@
 mod counting;
 
 mod check_memory;
-#[allow(clippy::module_inception)] // The binary's first concern, named as the binary.
 mod memory;
 mod mesh_memory;

@@ -10,7 +10,6 @@ mod common;
 #[path = "../common/meshes.rs"]
 mod meshes;
 
-#[allow(clippy::module_inception)] // The binary's first concern, named as the binary.
 mod mesh;
 mod mesh_3mf;
 mod mesh_accuracy;

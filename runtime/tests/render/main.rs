@@ -30,6 +30,5 @@ mod look;
 mod optimise;
 mod pbr;
 mod penumbra;
-#[allow(clippy::module_inception)] // The binary's first concern, named as the binary.
 mod render;
 mod stability;

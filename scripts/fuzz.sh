@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs one cargo-fuzz target for a number of seconds, starting from the kept seeds
-# (fuzz/seeds/*/) and the files of examples/ and runtime/tests/in/; or, with `seeds`, minimises what
+# (fuzz/seeds/*/) and the files of examples/, compiler/tests/in/ and runtime/tests/in/; or, with `seeds`, minimises what
 # the runs found (fuzz/corpus/TARGET/, not kept) with the target's seeds into new seeds
 # (fuzz/seeds/TARGET/), keeping only what reaches beyond the examples and the other seeds.
 # Usage: scripts/fuzz.sh TARGET SECONDS   (TARGET: check, front_end, kernel, lsp or mesh_file)
@@ -12,7 +12,7 @@ seconds=${2:-60}
 corpus=fuzz/corpus/$target
 seeds=fuzz/seeds/$target
 mkdir -p "$corpus" "$seeds"
-find examples runtime/tests/in -name '*.sdf' -exec cp {} "$corpus/" \;
+find examples compiler/tests/in runtime/tests/in -name '*.sdf' -exec cp {} "$corpus/" \;
 export RUSTC_BOOTSTRAP=1
 cd fuzz
 # No sanitizer: the code the targets reach is safe Rust (the compiler's only `unsafe`, the AVX2

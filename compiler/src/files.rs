@@ -1,9 +1,67 @@
-//! Scene files on disk: reading one within the `file_size` limit (never a FIFO or a device),
-//! the byte-order mark some editors write, the loader that resolves `import` against the
-//! importing file, and the one name a file has however it was reached.
+//! Scene files: the interface the checker reads imports and meshes through (`Loader`, and why
+//! a file cannot be read, `LoadError`); on disk, reading one within the `file_size` limit
+//! (never a FIFO or a device), the byte-order mark some editors write, the loader that
+//! resolves `import` against the importing file, and the one name a file has however it was
+//! reached.
 
-use crate::{check::Loader, Limit};
+use crate::limits::Limit;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Reads imported files for the checker (the compiler itself does no IO).
+pub trait Loader {
+    /// Reads `path` as written in an `import` of the file named `from`. Returns the file's
+    /// canonical name (equal names mean the same file) and its text, or why it could not be
+    /// read.
+    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), LoadError>;
+
+    /// Reads `path` as written in a `mesh(path)` of the file named `from`, as bytes: its
+    /// name and its contents, or why it could not be read. By default no file can be.
+    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
+        Err(LoadError::NoFiles { path: path.into() })
+    }
+}
+
+/// Why a [`Loader`] cannot read a file; its message is the label of the checker's diagnostic.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum LoadError {
+    /// The file cannot be read (missing, not a regular file, over the `file_size` limit).
+    #[error("cannot read `{}`: {source}", .path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: Arc<FileError>,
+    },
+    /// Its bytes are not UTF-8.
+    #[error("`{}` is not valid UTF-8", .path.display())]
+    NotUtf8 {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The loader reads no imports (text checked on its own).
+    #[error("imports are not available here (`{path}`)")]
+    NoImports {
+        /// The path the import names.
+        path: String,
+    },
+    /// The loader reads no files of data (meshes, fonts).
+    #[error("files cannot be read here (`{path}`)")]
+    NoFiles {
+        /// The path the call names.
+        path: String,
+    },
+}
+
+/// A loader for sources with no imports: every import is an error.
+#[derive(Debug, Default)]
+pub struct NoImports;
+
+impl Loader for NoImports {
+    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), LoadError> {
+        Err(LoadError::NoImports { path: path.into() })
+    }
+}
 
 /// Why a file cannot be read ([`read_file`]).
 #[derive(Debug, thiserror::Error)]
@@ -110,6 +168,14 @@ impl Default for FsLoader {
 }
 
 impl FsLoader {
+    /// The bytes of the file at `full`, within the `file_size` limit.
+    fn read(&self, full: &Path) -> Result<Vec<u8>, LoadError> {
+        read_file(full, self.file_size).map_err(|e| LoadError::Read {
+            path: full.to_path_buf(),
+            source: Arc::new(e),
+        })
+    }
+
     /// The file that `import "path"` in the file named `from` reads.
     pub fn resolve(from: &str, path: &str) -> PathBuf {
         let base = Path::new(from).parent().unwrap_or(Path::new("."));
@@ -118,20 +184,17 @@ impl FsLoader {
 }
 
 impl Loader for FsLoader {
-    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
+    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), LoadError> {
         let full = FsLoader::resolve(from, path);
         let name = normalise(&full);
-        let bytes = read_file(&full, self.file_size)
-            .map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
-        let text = String::from_utf8(bytes)
-            .map_err(|_| format!("`{}` is not valid UTF-8", full.display()))?;
+        let bytes = self.read(&full)?;
+        let text = String::from_utf8(bytes).map_err(|_| LoadError::NotUtf8 { path: full })?;
         Ok((name, without_bom(text)))
     }
 
-    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         let full = FsLoader::resolve(from, path);
-        let bytes = read_file(&full, self.file_size)
-            .map_err(|e| format!("cannot read `{}`: {e}", full.display()))?;
+        let bytes = self.read(&full)?;
         Ok((normalise(&full), bytes))
     }
 }

@@ -52,7 +52,7 @@ pub use crate::{
 /// readers of the mesh files `mesh(path)` reads.
 pub use crate::{
     check::types::{Type, Value},
-    check::{builtins, colour::srgb_to_linear, meshfile, Constant, Loader, NoImports},
+    check::{builtins, colour::srgb_to_linear, meshfile, Constant, LoadError, Loader, NoImports},
     front::{check, check_at, check_str, check_with, check_with_constants},
     syntax::{ast, dump as dump_ast, format, lexer, parse},
 };
@@ -84,8 +84,8 @@ pub use crate::eval::{
 };
 
 /// The writers: the WGSL kernel (validated by naga), PTX from it, SPIR-V/MSL/GLSL/HLSL,
-/// Shadertoy, and Rust source over glam.
-pub use crate::back::{ptx, rust, shader, shadertoy, wgsl};
+/// Shadertoy, Rust source over glam, and the distance at a buffer of points (WGSL and PTX).
+pub use crate::back::{points, ptx, rust, shader, shadertoy, wgsl};
 
 /// The deterministic generator tests draw points from.
 pub use crate::rng::Rng;

@@ -6,7 +6,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use sdfc_compiler::meshfile::{read, Format};
-use sdfc_compiler::{check_with, Limit, Limits, Loader, SourceMap};
+use sdfc_compiler::{check_with, Limit, Limits, LoadError, Loader, SourceMap};
 
 const FORMATS: [(Format, &str); 4] = [
     (Format::Stl, "stl"),
@@ -23,11 +23,11 @@ const TRIANGLES: u64 = 10_000;
 struct One<'a>(&'a [u8]);
 
 impl Loader for One<'_> {
-    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), String> {
-        Err(format!("no imports here (`{path}`)"))
+    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), LoadError> {
+        Err(LoadError::NoImports { path: path.into() })
     }
 
-    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         Ok((path.to_string(), self.0.to_vec()))
     }
 }

@@ -3,7 +3,8 @@
 
 use sdfc_compiler::files::{normalise, FsLoader};
 use sdfc_compiler::{
-    check_with_constants, Constant, Diagnostic, FileId, Limit, Limits, Loader, Scene, SourceMap,
+    check_with_constants, Constant, Diagnostic, FileId, Limit, Limits, LoadError, Loader, Scene,
+    SourceMap,
 };
 use std::collections::HashMap;
 use std::path::Path;
@@ -91,7 +92,7 @@ struct OpenFirst<'a> {
 }
 
 impl Loader for OpenFirst<'_> {
-    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
+    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), LoadError> {
         let base = Path::new(from).parent().unwrap_or(Path::new("."));
         let name = normalise(&base.join(path));
         match self.docs.open.get(&name) {
@@ -100,7 +101,7 @@ impl Loader for OpenFirst<'_> {
         }
     }
 
-    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         self.files.load_bytes(from, path)
     }
 }

@@ -1,5 +1,5 @@
 //! Hover: a built-in's signatures and its line of docs/language.md's table (which
-//! runtime/tests/tidy.rs keeps equal to the builtins table), a built-in constant's value, a
+//! compiler/tests/compiler/tidy.rs keeps equal to the builtins table), a built-in constant's value, a
 //! declaration's text (a global constant's with its value, as the checker evaluated it),
 //! and for a shape what the analysis derived for it: exact, bound or
 //! approximate, L, bounding box, and whether the scene is traced or marched (the facts

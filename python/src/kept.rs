@@ -4,7 +4,7 @@
 
 use sdfc_compiler::Lowered;
 use sdfc_runtime::backend::{Backend, Prepared};
-use sdfc_runtime::gpu::points::{self as on_gpu, CudaPoints, WgpuPoints};
+use sdfc_runtime::gpu::points::{self as on_gpu, CudaPoints, RunError, WgpuPoints};
 use std::sync::{Mutex, PoisonError};
 
 /// A scene's kept preparations. Each is taken out while a call uses it and put back after,
@@ -39,6 +39,20 @@ enum Kernel {
     Cuda(CudaPoints),
 }
 
+/// Why distances at points could not be computed on a GPU (a `RuntimeError` in Python).
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// The module of distances at points cannot be written.
+    #[error("{0}")]
+    Module(#[from] sdfc_compiler::points::Error),
+    /// The device cannot run it.
+    #[error("{0}")]
+    Run(#[from] RunError),
+    /// There is no wgpu device: why, as it was first told.
+    #[error("{0}")]
+    NoWgpu(String),
+}
+
 impl Kept {
     /// The render kept for `backend` and `image_only`, taken out (a kept one of other
     /// settings is dropped).
@@ -69,7 +83,7 @@ impl Kept {
         scene: &sdfc_compiler::Scene,
         lowered: &Lowered,
         points: &[[f64; 3]],
-    ) -> Result<(Vec<u8>, Vec<u8>), String> {
+    ) -> Result<(Vec<u8>, Vec<u8>), GpuError> {
         let module = on_gpu::points_module(scene, lowered, false)?;
         let kept = self
             .points
@@ -84,11 +98,14 @@ impl Kept {
                 let ptx = on_gpu::points_ptx(&module, *sm)?;
                 Kernel::Cuda(CudaPoints::new(ctx, &module, &ptx)?)
             }
-            None => Kernel::Wgpu(WgpuPoints::new(super::wgpu_device()?, &module)),
+            None => {
+                let gpu = super::wgpu_device().map_err(GpuError::NoWgpu)?;
+                Kernel::Wgpu(WgpuPoints::new(gpu, &module))
+            }
         };
         let (values, _) = match &kernel {
             Kernel::Cuda(k) => k.run(points)?,
-            Kernel::Wgpu(k) => k.run(super::wgpu_device()?, points)?,
+            Kernel::Wgpu(k) => k.run(super::wgpu_device().map_err(GpuError::NoWgpu)?, points)?,
         };
         *self.points.lock().unwrap_or_else(PoisonError::into_inner) = Some(Points {
             backend: backend.to_string(),

@@ -18,6 +18,7 @@ use sdfc_runtime::backend::{Backend, Devices, Kernel, Setup};
 use sdfc_runtime::commands::compile::{self, Emit, Part};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::frontend::{self, Source};
+use sdfc_runtime::gpu::points::RunError;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::job::{self, Job, Overrides};
 use std::sync::OnceLock;
@@ -418,8 +419,9 @@ impl Scene {
 
 /// The process's CUDA device (its primary context and compute capability), opened on first
 /// use and held while the module is loaded.
-fn cuda_device() -> &'static Result<sdfc_runtime::gpu::points::CudaDevice, String> {
-    static CUDA: OnceLock<Result<sdfc_runtime::gpu::points::CudaDevice, String>> = OnceLock::new();
+fn cuda_device() -> &'static Result<sdfc_runtime::gpu::points::CudaDevice, RunError> {
+    static CUDA: OnceLock<Result<sdfc_runtime::gpu::points::CudaDevice, RunError>> =
+        OnceLock::new();
     CUDA.get_or_init(sdfc_runtime::gpu::points::open_cuda)
 }
 
@@ -658,7 +660,7 @@ impl Scene {
             let scene = checked.scene;
             let (d, m) = py
                 .detach(|| self.kept.distances(&backend, &scene, &lowered, &xyz))
-                .map_err(PyRuntimeError::new_err)?;
+                .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
             return Ok((PyBytes::new(py, &d), PyBytes::new(py, &m)));
         }
         let pool = pool().map_err(|f| f.into_py(py))?;

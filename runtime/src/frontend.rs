@@ -7,7 +7,8 @@ use sdfc_compiler::{
     analytic::{Choice, Reason, Traceable},
     check_at,
     diagnostics::{self, Diagnostic},
-    lower_within, Exactness, Limit, Limits, Loader, LowerOptions, Lowered, Scene, SourceMap, Span,
+    lower_within, Exactness, Limit, Limits, LoadError, Loader, LowerOptions, Lowered, Scene,
+    SourceMap, Span,
 };
 // Reading files is the compiler's (`sdfc_compiler::files`); its names are used here as before.
 pub use sdfc_compiler::files::{normalise, read_file, without_bom, FileError, FsLoader};
@@ -78,7 +79,7 @@ pub struct Source {
     name: String,
     text: String,
     /// Imports read so far, by the importing file and the path written.
-    imports: std::collections::HashMap<(String, String), Result<(String, String), String>>,
+    imports: std::collections::HashMap<(String, String), Result<(String, String), LoadError>>,
     /// The name each file was first read under, by its canonical path (symbolic links
     /// resolved): a file reached by two routes, a link and its target, has one name, so it
     /// is read once (and an import of the entry file through a link is a cycle).
@@ -164,7 +165,7 @@ impl Source {
 }
 
 impl Loader for Source {
-    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
+    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), LoadError> {
         let key = (from.to_string(), path.to_string());
         if let Some(done) = self.imports.get(&key) {
             return done.clone();
@@ -179,7 +180,7 @@ impl Loader for Source {
         loaded
     }
 
-    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load_bytes(&mut self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         let read = self.loader().load_bytes(from, path);
         if let Ok((name, bytes)) = &read {
             if !self.data.iter().any(|(n, _)| n == name) {

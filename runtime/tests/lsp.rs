@@ -355,7 +355,7 @@ fn every_request_on_a_document_with_an_import_and_a_mistake() {
 fn never_crashes_on_mutated_text() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut corpus = Vec::new();
-    for dir in ["examples", "runtime/tests/in/ok", "runtime/tests/in/err"] {
+    for dir in ["examples", "compiler/tests/in/ok", "compiler/tests/in/err"] {
         let Ok(entries) = std::fs::read_dir(root.join(dir)) else {
             continue;
         };

@@ -1,5 +1,6 @@
 //! Back ends that write a distance program as source text.
 
+pub mod points;
 pub mod ptx;
 pub mod rust;
 pub mod shader;

@@ -2,6 +2,7 @@
 //! their constant evaluation. Shape builtins add nodes to the scene graph.
 
 use super::types::{Type, Value};
+use super::LoadError;
 use crate::limits::{Limit, Limits};
 use crate::lower::hash_of;
 use crate::prim::{Args, Kind, Prim, PrimRef};
@@ -201,20 +202,15 @@ pub struct Build<'a, 'l> {
 impl Build<'_, '_> {
     /// The bytes of the file `path` (relative to the calling file), read through the
     /// caller's loader.
-    fn read_bytes(&mut self, path: &str) -> Result<Vec<u8>, String> {
-        let files = self
-            .files
-            .as_deref_mut()
-            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
+    fn read_bytes(&mut self, path: &str) -> Result<Vec<u8>, LoadError> {
+        let no_files = || LoadError::NoFiles { path: path.into() };
+        let files = self.files.as_deref_mut().ok_or_else(no_files)?;
         let from = files
             .names
             .get(self.span.file.0 as usize)
             .cloned()
             .unwrap_or_default();
-        let loader = files
-            .loader
-            .as_deref_mut()
-            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
+        let loader = files.loader.as_deref_mut().ok_or_else(no_files)?;
         loader.load_bytes(&from, path).map(|(_, bytes)| bytes)
     }
 
@@ -226,20 +222,16 @@ impl Build<'_, '_> {
         let format = Format::of(path).ok_or_else(|| {
             format!("`{path}` is not a mesh file: `mesh` reads .stl, .obj, .ply and .glb files")
         })?;
-        let files = self
-            .files
-            .as_deref_mut()
-            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
+        // The builtins' errors are the labels of their diagnostics, as text.
+        let no_files = || LoadError::NoFiles { path: path.into() }.to_string();
+        let files = self.files.as_deref_mut().ok_or_else(no_files)?;
         let from = files
             .names
             .get(self.span.file.0 as usize)
             .cloned()
             .unwrap_or_default();
-        let loader = files
-            .loader
-            .as_deref_mut()
-            .ok_or_else(|| format!("files cannot be read here (`{path}`)"))?;
-        let (name, bytes) = loader.load_bytes(&from, path)?;
+        let loader = files.loader.as_deref_mut().ok_or_else(no_files)?;
+        let (name, bytes) = loader.load_bytes(&from, path).map_err(|e| e.to_string())?;
         let key = (name.clone(), scale.to_bits());
         if let Some(m) = files.meshes.get(&key) {
             let node = Node::Mesh {
@@ -418,7 +410,8 @@ fn outline_of(
     if font.is_empty() {
         super::font::layout(super::font::default_font(), string, size)
     } else {
-        let bytes = b.read_bytes(font)?;
+        // The label of the call's diagnostic.
+        let bytes = b.read_bytes(font).map_err(|e| e.to_string())?;
         super::font::layout(&bytes, string, size).map_err(|e| format!("`{font}`: {e}"))
     }
 }

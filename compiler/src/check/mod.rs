@@ -20,6 +20,8 @@ mod suggest;
 pub mod types;
 
 use crate::diagnostics::Diagnostic;
+// The loader is the file system's interface (`files`); the checker reads through it.
+pub use crate::files::{LoadError, Loader, NoImports};
 use crate::limits::{Limit, Limits};
 use crate::scene::{
     Camera, Colour, Combine, Material, MaterialId, Method, Node, Pattern, Pbr, Scene, Settings,
@@ -31,20 +33,6 @@ use eval::{Ctx, FnInfo};
 use std::collections::HashMap;
 use std::rc::Rc;
 use types::{Type, Value};
-
-/// Reads imported files for the checker (the compiler itself does no IO).
-pub trait Loader {
-    /// Reads `path` as written in an `import` of the file named `from`. Returns the file's
-    /// canonical name (equal names mean the same file) and its text, or a message saying why
-    /// it could not be read.
-    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String>;
-
-    /// Reads `path` as written in a `mesh(path)` of the file named `from`, as bytes: its
-    /// name and its contents, or why it could not be read. By default no file can be.
-    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        Err(format!("files cannot be read here (`{path}`)"))
-    }
-}
 
 /// The files `mesh(path)` reads, through the caller's loader, and the meshes read so far.
 #[derive(Default)]
@@ -68,16 +56,6 @@ impl std::fmt::Debug for Files<'_> {
             .field("names", &self.names)
             .field("meshes", &self.meshes.len())
             .finish()
-    }
-}
-
-/// A loader for sources with no imports: every import is an error.
-#[derive(Debug, Default)]
-pub struct NoImports;
-
-impl Loader for NoImports {
-    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), String> {
-        Err(format!("imports are not available here (`{path}`)"))
     }
 }
 
@@ -317,10 +295,11 @@ impl Load<'_> {
         let from_name = self.sources.name(from).to_string();
         let (name, text) = match self.loader.load(&from_name, path) {
             Ok(x) => x,
-            Err(msg) => {
+            Err(e) => {
+                // The diagnostic's label: where the error's message is shown to the user.
                 self.diags.push(
                     Diagnostic::error("E0501", format!("cannot import `{path}`"), span)
-                        .with_label(msg),
+                        .with_label(e.to_string()),
                 );
                 return;
             }

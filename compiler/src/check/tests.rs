@@ -150,12 +150,16 @@ fn function_bodies_are_checked_without_calls() {
 struct Files(&'static [(&'static str, &'static str)]);
 
 impl super::Loader for Files {
-    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), String> {
+    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), super::LoadError> {
+        let missing = || super::LoadError::Read {
+            path: path.into(),
+            source: std::sync::Arc::new(std::io::Error::from(std::io::ErrorKind::NotFound).into()),
+        };
         let (name, text) = self
             .0
             .iter()
             .find(|(n, _)| *n == path)
-            .ok_or("no such file")?;
+            .ok_or_else(missing)?;
         Ok((name.to_string(), text.to_string()))
     }
 }

@@ -247,3 +247,31 @@ pub fn examples() -> Vec<std::path::PathBuf> {
     files.sort();
     files
 }
+
+/// A scene file read and checked as `sdfc check` reads it: its imports and meshes from disk
+/// relative to it, within the default limits, at t = 0.
+#[derive(Debug)]
+pub struct Loaded {
+    /// The checked scene, when there were no errors.
+    pub scene: Option<Scene>,
+    /// Everything the compiler said.
+    pub diagnostics: Vec<sdfc_compiler::Diagnostic>,
+    /// The files read, for rendering diagnostics.
+    pub sources: sdfc_compiler::SourceMap,
+}
+
+/// [`Loaded`] for the file at `path`; `Err` where the file cannot be read or is not UTF-8.
+pub fn load(path: &std::path::Path) -> std::io::Result<Loaded> {
+    use sdfc_compiler::files::{normalise, without_bom, FsLoader};
+    let text = without_bom(std::fs::read_to_string(path)?);
+    let mut sources = sdfc_compiler::SourceMap::new();
+    let entry = sources.add(normalise(path), text);
+    let limits = sdfc_compiler::Limits::default();
+    let (scene, diagnostics) =
+        sdfc_compiler::check_at(&mut sources, entry, &mut FsLoader::default(), &limits, 0.0);
+    Ok(Loaded {
+        scene,
+        diagnostics,
+        sources,
+    })
+}

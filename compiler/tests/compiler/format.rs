@@ -5,7 +5,7 @@
 use sdfc_compiler::{
     check,
     format::{format, Error},
-    Loader, SourceMap,
+    LoadError, Loader, SourceMap,
 };
 use std::path::{Path, PathBuf};
 
@@ -13,12 +13,15 @@ use std::path::{Path, PathBuf};
 struct Disk;
 
 impl Loader for Disk {
-    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), String> {
+    fn load(&mut self, from: &str, path: &str) -> Result<(String, String), LoadError> {
         let p = Path::new(from)
             .parent()
             .unwrap_or(Path::new("."))
             .join(path);
-        let text = std::fs::read_to_string(&p).map_err(|e| e.to_string())?;
+        let text = std::fs::read_to_string(&p).map_err(|e| LoadError::Read {
+            path: p.clone(),
+            source: std::sync::Arc::new(e.into()),
+        })?;
         Ok((p.to_string_lossy().into_owned(), text))
     }
 }
@@ -72,7 +75,14 @@ fn idempotent(name: &str, text: &str) -> Option<String> {
 #[test]
 fn every_sdf_file_formats_idempotently_and_keeps_its_meaning() {
     let mut files = Vec::new();
-    for dir in ["examples", "runtime/tests", "bench", "grammar", "docs"] {
+    for dir in [
+        "examples",
+        "compiler/tests",
+        "runtime/tests",
+        "bench",
+        "grammar",
+        "docs",
+    ] {
         sdf_files(&root().join(dir), &mut files);
     }
     files.sort();

@@ -84,9 +84,9 @@ fn corpus() -> Vec<String> {
     let mut out = Vec::new();
     for dir in [
         "../examples",
-        "../runtime/tests/in/ok",
-        "../runtime/tests/in/err",
-        "../runtime/tests/in/fuzz",
+        "tests/in/ok",
+        "tests/in/err",
+        "tests/in/fuzz",
     ] {
         // A folder that is missing or empty is a failure: the corpus would silently shrink.
         let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("cannot list {dir}: {e}"));
@@ -109,9 +109,9 @@ fn corpus() -> Vec<String> {
 /// tricky ones) each check in bounded time without panicking.
 #[test]
 fn fuzz_regression_inputs_exist_and_check_quickly() {
-    let dir = std::path::Path::new("../runtime/tests/in/fuzz");
+    let dir = std::path::Path::new("tests/in/fuzz");
     let mut n = 0;
-    for entry in std::fs::read_dir(dir).expect("../runtime/tests/in/fuzz exists") {
+    for entry in std::fs::read_dir(dir).expect("tests/in/fuzz exists") {
         let path = entry.expect("listable").path();
         if path.extension().is_none_or(|x| x != "sdf") {
             continue;

@@ -1,5 +1,5 @@
 //! What a CPU render allocates, at most: the bound `sdfc render` announces and holds to the
-//! `memory` limit. `runtime/tests/memory.rs` measures renders with a counting allocator against it.
+//! `memory` limit. `runtime/tests/memory/memory.rs` measures renders with a counting allocator against it.
 //!
 //! Every vector the renderer allocates is counted at its largest: a vector filled by `push`
 //! or `resize` may hold up to twice its largest length (and at least 8 elements). A tile's

@@ -1,151 +1,49 @@
-//! Distances at points on a GPU: a compute entry point joined to a WGSL module that declares
-//! `map` (the scene's part, or the marched kernel with its instances walked in `scene_data`),
-//! run over a buffer of points through wgpu or, translated to PTX, through CUDA. The
-//! distance conformance tests compare every evaluator with it, and the Python package's
-//! `Scene.distance(points, backend=…)` answers with it.
+//! Distances at points on a GPU: the compiler's module of them (`sdfc_compiler::points`, a
+//! compute entry point joined to a WGSL module that declares `map`) run over a buffer of
+//! points through wgpu or, translated to PTX, through CUDA. The distance conformance tests
+//! compare every evaluator with it, and the Python package's `Scene.distance(points,
+//! backend=…)` answers with it.
 
-use sdfc_compiler::{ptx, wgsl, Lowered, Method, Scene};
-use wgpu::naga;
+pub use sdfc_compiler::points::{
+    entry, points_module, points_ptx, walk_module, PointsModule, Value, ENTRY_POINT, WORKGROUP,
+};
 
-/// One evaluation: the distance and the material id at a point.
-pub type Value<T> = (T, u32);
-
-/// The workgroup size of [`entry`].
-pub const WORKGROUP: u32 = 64;
-
-/// The name of [`entry`]'s entry point.
-pub const ENTRY_POINT: &str = "eval_points";
-
-/// The entry point joined to a module that declares `map` (distance, material id) and, where
-/// given, the distance alone as `alone`, its two buffers in bind group `group`: thread `i`
-/// evaluates them at point `i` (x, y, z; w unused) and writes (distance, material id, distance
-/// alone or `map`'s distance again, 0).
-/// The buffers hold a whole number of workgroups (the points padded, [`point_words`]), so
-/// that no thread needs `arrayLength`, which PTX cannot know. With `warm` (a name), an odd
-/// thread first calls it at the point before its own, so that the instance walk starts from
-/// another point's hint.
-pub fn entry(group: u32, alone: Option<&str>, warm: Option<&str>) -> String {
-    let alone = alone.map_or("m.x".to_string(), |f| format!("{f}(p)"));
-    let warm = warm.map_or(String::new(), |f| {
-        format!("if (id.x & 1u) == 1u {{\n        _ = {f}(eval_points_in[id.x - 1u].xyz);\n    }}\n    ")
-    });
-    format!(
-        "
-@group({group}) @binding(0) var<storage, read> eval_points_in: array<vec4<f32>>;
-@group({group}) @binding(1) var<storage, read_write> eval_points_out: array<vec4<f32>>;
-
-@compute @workgroup_size({WORKGROUP})
-fn {ENTRY_POINT}(@builtin(global_invocation_id) id: vec3<u32>) {{
-    let p = eval_points_in[id.x].xyz;
-    {warm}let m = map(p);
-    eval_points_out[id.x] = vec4<f32>(m, {alone}, 0.0);
-}}
-"
-    )
-}
-
-/// A WGSL module with [`entry`], validated by naga, and what it binds besides its points.
-#[derive(Debug)]
-pub struct PointsModule {
-    pub source: String,
-    pub module: naga::Module,
-    pub info: naga::valid::ModuleInfo,
-    /// The bind group of the points and results.
-    pub group: u32,
-    /// The bytes of `scene_data` (group 0, binding 4), where the module reads it.
-    pub data: Option<Vec<u8>>,
-}
-
-fn validated(source: String, group: u32, data: Option<Vec<u8>>) -> Result<PointsModule, String> {
-    let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
-    let info = naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::all(),
-    )
-    .validate(&module)
-    .map_err(|e| e.emit_to_string(&source))?;
-    Ok(PointsModule {
-        source,
-        module,
-        info,
-        group,
-        data,
-    })
-}
-
-/// The part of `scene` (as lowered), `map` and, with `alone`, `map_distance`, with [`entry`];
-/// for a scene with a mesh, which has no part, [`mesh_module`].
-pub fn points_module(
-    scene: &Scene,
-    lowered: &Lowered,
-    alone: bool,
-) -> Result<PointsModule, String> {
-    if lowered.program.meshes().next().is_some() {
-        return mesh_module(scene, alone);
-    }
-    let part = wgsl::part::write(scene, lowered, "map").map_err(|e| e.to_string())?;
-    let alone = alone.then_some("map_distance");
-    validated(
-        format!("{}\n{}", part.source, entry(0, alone, None)),
-        0,
-        None,
-    )
-}
-
-/// A scene with a mesh has no part (its triangles are data, not code): its marched kernel,
-/// with the meshes in `scene_data`, its `map` and, with `alone`, `sdf` with [`entry`] (in bind
-/// group 1, beside the kernel's group 0).
-fn mesh_module(scene: &Scene, alone: bool) -> Result<PointsModule, String> {
-    let mut marched = scene.clone();
-    marched.settings.method = Method::March;
-    let lowered = Lowered::new(&marched);
-    let kernel = wgsl::write(&marched, &lowered).map_err(|e| e.to_string())?;
-    validated(
-        format!(
-            "{}\n{}",
-            kernel.source,
-            entry(1, alone.then_some("sdf"), None)
-        ),
-        1,
-        kernel.data,
-    )
-}
-
-/// The marched kernel of `scene` with every instance of its root union walked in
-/// `scene_data`, its `map` and `sdf` with [`entry`] (in bind group 1, beside the kernel's
-/// group 0), every other point's walks hinted by `sdf` at the point before it; none where
-/// the scene has no instances.
-pub fn walk_module(scene: &Scene) -> Option<Result<PointsModule, String>> {
-    let mut marched = scene.clone();
-    marched.settings.method = Method::March;
-    let lowered = Lowered::new(&marched);
-    lowered.instances(0)?;
-    let options = wgsl::Options {
-        max_instances: 0,
-        ..Default::default()
-    };
-    let kernel = match wgsl::write_with(&marched, &lowered, &options) {
-        Ok(k) => k,
-        Err(e) => return Some(Err(e.to_string())),
-    };
-    let walked = kernel.source.contains("fn walk_map(");
-    let data = kernel.data.filter(|_| walked)?;
-    Some(validated(
-        format!("{}\n{}", kernel.source, entry(1, Some("sdf"), Some("sdf"))),
-        1,
-        Some(data),
-    ))
-}
-
-/// The PTX of a [`PointsModule`]'s entry point for `sm`.
-pub fn points_ptx(m: &PointsModule, sm: u32) -> Result<String, String> {
-    let options = ptx::Options {
-        sm,
-        entry_point: ENTRY_POINT.into(),
-    };
-    ptx::write(&m.module, &m.info, &options)
-        .map(|p| p.text)
-        .map_err(|e| format!("PTX: {e}"))
+/// Why distances at points cannot be computed on a device.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum RunError {
+    /// There is no CUDA driver library to load.
+    #[error("no CUDA driver (libcuda.so)")]
+    NoCudaDriver,
+    /// The CUDA driver found no device.
+    #[error("the CUDA driver found no device")]
+    NoCudaDevice,
+    /// A call of the CUDA driver failed: `what` it was doing.
+    #[error("{what}: {error}")]
+    Cuda {
+        what: &'static str,
+        error: cudarc::driver::DriverError,
+    },
+    /// The PTX holds no entry point [`ENTRY_POINT`] that the driver can load.
+    #[error("the kernel {ENTRY_POINT}: {error}")]
+    Function { error: cudarc::driver::DriverError },
+    /// The module binds no results buffer in its group.
+    #[error("the module binds no results")]
+    NoResults,
+    /// The module reads `scene_data`, which it was not given.
+    #[error("the module reads scene_data it lacks")]
+    NoSceneData,
+    /// Waiting for the wgpu device failed.
+    #[error("waiting for the GPU: {0}")]
+    Wait(std::sync::Arc<wgpu::PollError>),
+    /// The mapping of the results ended without a word.
+    #[error("reading the distances back: {0}")]
+    Unanswered(#[from] std::sync::mpsc::RecvError),
+    /// The results could not be mapped back to the host.
+    #[error("reading the distances back: {0}")]
+    Map(#[from] wgpu::BufferAsyncError),
+    /// The mapped results could not be viewed.
+    #[error("reading the distances back: {0}")]
+    MapRange(#[from] wgpu::MapRangeError),
 }
 
 /// The points as the entry point reads them: x, y, z, 0 per point, padded with the origin to
@@ -197,7 +95,7 @@ pub fn run_wgpu(
     gpu: &crate::gpu::Gpu,
     m: &PointsModule,
     points: &[[f64; 3]],
-) -> Result<Results, String> {
+) -> Result<Results, RunError> {
     WgpuPoints::new(gpu, m).run(gpu, points)
 }
 
@@ -254,7 +152,7 @@ impl WgpuPoints {
 
     /// The pipeline run at every point, [`POINTS_PER_DISPATCH`] at a time, on the `gpu` it
     /// was compiled on.
-    pub fn run(&self, gpu: &crate::gpu::Gpu, points: &[[f64; 3]]) -> Result<Results, String> {
+    pub fn run(&self, gpu: &crate::gpu::Gpu, points: &[[f64; 3]]) -> Result<Results, RunError> {
         let (device, queue) = (gpu.device(), gpu.queue());
         use wgpu::BufferUsages as U;
         let buffer = |size: u64, usage: U| {
@@ -309,14 +207,9 @@ impl WgpuPoints {
             });
             device
                 .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| format!("waiting for the GPU: {e}"))?;
-            rx.recv()
-                .map_err(|e| format!("reading the distances back: {e}"))?
-                .map_err(|e| format!("reading the distances back: {e}"))?;
-            let bytes = slice
-                .get_mapped_range()
-                .map_err(|e| format!("reading the distances back: {e}"))?
-                .to_vec();
+                .map_err(|e| RunError::Wait(e.into()))?;
+            rx.recv()??;
+            let bytes = slice.get_mapped_range()?.to_vec();
             let (v, d) = results(&bytes, chunk.len());
             out.0.extend(v);
             out.1.extend(d);
@@ -330,21 +223,28 @@ pub type CudaDevice = (std::sync::Arc<cudarc::driver::CudaContext>, u32);
 
 /// A CUDA device, opened for [`run_cuda`], with its compute capability, or why there is
 /// none.
-pub fn open_cuda() -> Result<CudaDevice, String> {
+pub fn open_cuda() -> Result<CudaDevice, RunError> {
     use cudarc::driver::{sys, CudaContext};
     // SAFETY: only tries to dlopen libcuda; no driver call is made.
     #[allow(unsafe_code)]
     let present = unsafe { sys::is_culib_present() };
     if !present {
-        return Err("no CUDA driver (libcuda.so)".into());
+        return Err(RunError::NoCudaDriver);
     }
     match CudaContext::device_count() {
         Ok(n) if n > 0 => {}
-        Ok(_) => return Err("the CUDA driver found no device".into()),
-        Err(e) => return Err(format!("the CUDA driver: {e}")),
+        Ok(_) => return Err(RunError::NoCudaDevice),
+        Err(error) => {
+            let what = "the CUDA driver";
+            return Err(RunError::Cuda { what, error });
+        }
     }
-    let ctx = CudaContext::new(0).map_err(|e| format!("a CUDA context: {e}"))?;
-    let attr = |a| ctx.attribute(a).map_err(|e| format!("{e}"));
+    let cuda = |what| move |error| RunError::Cuda { what, error };
+    let ctx = CudaContext::new(0).map_err(cuda("a CUDA context"))?;
+    let attr = |a| {
+        ctx.attribute(a)
+            .map_err(cuda("the device's compute capability"))
+    };
     let major = attr(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR)?;
     let minor = attr(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR)?;
     Ok((ctx, (major * 10 + minor) as u32))
@@ -357,7 +257,7 @@ pub fn run_cuda(
     m: &PointsModule,
     ptx_text: &str,
     points: &[[f64; 3]],
-) -> Result<Results, String> {
+) -> Result<Results, RunError> {
     CudaPoints::new(ctx, m, ptx_text)?.run(points)
 }
 
@@ -372,6 +272,8 @@ pub struct CudaPoints {
     function: cudarc::driver::CudaFunction,
     /// The module's bindings, (group, binding), in order.
     bindings: Vec<(u32, u32)>,
+    /// Where the results are among them.
+    out_at: usize,
     /// The bind group of the points and results.
     group: u32,
     /// The bytes of `scene_data`, where the module reads it.
@@ -384,13 +286,14 @@ impl CudaPoints {
         ctx: &std::sync::Arc<cudarc::driver::CudaContext>,
         m: &PointsModule,
         ptx_text: &str,
-    ) -> Result<CudaPoints, String> {
+    ) -> Result<CudaPoints, RunError> {
+        let cuda = |what| move |error| RunError::Cuda { what, error };
         let module = ctx
             .load_module(cudarc::nvrtc::Ptx::from_src(ptx_text))
-            .map_err(|e| format!("the CUDA JIT refused the PTX: {e}"))?;
+            .map_err(cuda("the CUDA JIT refused the PTX"))?;
         let function = module
             .load_function(ENTRY_POINT)
-            .map_err(|e| format!("the kernel {ENTRY_POINT}: {e}"))?;
+            .map_err(|error| RunError::Function { error })?;
         let mut bindings: Vec<(u32, u32)> = m
             .module
             .global_variables
@@ -398,29 +301,26 @@ impl CudaPoints {
             .filter_map(|(_, g)| g.binding.as_ref().map(|b| (b.group, b.binding)))
             .collect();
         bindings.sort();
-        if !bindings.contains(&(m.group, 1)) {
-            return Err("the module binds no results".into());
-        }
+        let out_at = bindings
+            .iter()
+            .position(|&b| b == (m.group, 1))
+            .ok_or(RunError::NoResults)?;
         Ok(CudaPoints {
             ctx: ctx.clone(),
             function,
             bindings,
+            out_at,
             group: m.group,
             data: m.data.clone(),
         })
     }
 
     /// The kernel run at every point, [`POINTS_PER_DISPATCH`] at a time.
-    pub fn run(&self, points: &[[f64; 3]]) -> Result<Results, String> {
+    pub fn run(&self, points: &[[f64; 3]]) -> Result<Results, RunError> {
         use cudarc::driver::{LaunchConfig, PushKernelArg};
+        let cuda = |what| move |error| RunError::Cuda { what, error };
         let s = self.ctx.default_stream();
         let group = self.group;
-        let out_at = self
-            .bindings
-            .iter()
-            .position(|&b| b == (group, 1))
-            .ok_or("the module binds no results")?;
-        let cuda = |e: cudarc::driver::DriverError| format!("CUDA: {e}");
         let mut out: Results = (
             Vec::with_capacity(points.len()),
             Vec::with_capacity(points.len()),
@@ -433,15 +333,12 @@ impl CudaPoints {
                     let bytes = match b {
                         b if b == (group, 0) => point_bytes(chunk),
                         b if b == (group, 1) => vec![0; result_bytes(chunk) as usize],
-                        (0, 4) => self
-                            .data
-                            .clone()
-                            .ok_or("the module reads scene_data it lacks")?,
+                        (0, 4) => self.data.clone().ok_or(RunError::NoSceneData)?,
                         _ => vec![0; 256],
                     };
-                    s.clone_htod(&bytes).map_err(cuda)
+                    s.clone_htod(&bytes).map_err(cuda("CUDA"))
                 })
-                .collect::<Result<Vec<cudarc::driver::CudaSlice<u8>>, String>>()?;
+                .collect::<Result<Vec<cudarc::driver::CudaSlice<u8>>, RunError>>()?;
             let cfg = LaunchConfig {
                 grid_dim: (groups(chunk), 1, 1),
                 block_dim: (WORKGROUP, 1, 1),
@@ -456,9 +353,10 @@ impl CudaPoints {
             // results hold one element for every thread of the grid, scene_data is the
             // kernel's own, and the entry point reads nothing of the other buffers.
             #[allow(unsafe_code)]
-            unsafe { launch.launch(cfg) }.map_err(cuda)?;
-            s.synchronize().map_err(cuda)?;
-            let (v, d) = results(&s.clone_dtoh(&buffers[out_at]).map_err(cuda)?, chunk.len());
+            unsafe { launch.launch(cfg) }.map_err(cuda("CUDA"))?;
+            s.synchronize().map_err(cuda("CUDA"))?;
+            let out_bytes = s.clone_dtoh(&buffers[self.out_at]).map_err(cuda("CUDA"))?;
+            let (v, d) = results(&out_bytes, chunk.len());
             out.0.extend(v);
             out.1.extend(d);
         }

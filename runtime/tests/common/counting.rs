@@ -1,11 +1,12 @@
-//! A counting global allocator for the tests that hold renders and meshes to the memory they
-//! announce (`tests/memory.rs`, `tests/mesh_memory.rs`): it records the peak of live heap
-//! bytes. Included by those tests alone (`#[path]`), since it becomes the test binary's
-//! allocator; the counter sees every thread of the process.
+//! A counting global allocator for the tests that hold renders, meshes and the checker to the
+//! memory they announce (the `memory` test binary): it records the peak of live heap bytes.
+//! Included by that binary alone (`#[path]`), since it becomes the test binary's allocator;
+//! the counter sees every thread of the process, so each test holds [`alone`] while it runs.
 #![allow(unsafe_code)] // A global allocator is an unsafe trait; it only forwards to `System`.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard};
 
 /// Counts live heap bytes and their peak.
 struct Counting;
@@ -64,4 +65,12 @@ pub fn peak_of<R>(f: impl FnOnce() -> R) -> (R, u64) {
     let r = f();
     let peak = PEAK.load(Ordering::SeqCst);
     (r, peak.saturating_sub(base) as u64)
+}
+
+/// Held by a test for as long as it measures, so that no other test of the binary allocates
+/// meanwhile (the tests of one binary run on parallel threads).
+pub fn alone() -> MutexGuard<'static, ()> {
+    static ONE: Mutex<()> = Mutex::new(());
+    // A test that failed while holding it leaves nothing to clean up.
+    ONE.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
 }

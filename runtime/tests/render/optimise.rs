@@ -1,10 +1,10 @@
 //! The optimisation passes and bounding-volume culling: culling never changes an image (bit
 //! for bit on the CPU), the passes keep the distance field (to rounding) at random points,
 //! the batch interpreter runs guarded blocks exactly as the reference path, and instruction
-//! counts drop. `cargo test --release --test optimise -- --ignored --nocapture` prints the
+//! counts drop. `cargo test --release --test render -- optimise:: --ignored --nocapture` prints the
 //! tables of BENCHMARKS.md ("Distance program size, passes off and on").
 
-mod common;
+use crate::common;
 
 use common::*;
 use sdfc_compiler::{

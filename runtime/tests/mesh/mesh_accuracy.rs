@@ -3,8 +3,7 @@
 //! honeycomb panel, whose hexagonal cells' 120° edges and their corners on the plate's faces
 //! fall anywhere in the grid, and on a box turned off the grid's axes.
 
-#[path = "common/meshes.rs"]
-mod meshes;
+use crate::meshes;
 
 use meshes::*;
 

@@ -8,7 +8,6 @@ use sdfc_compiler::ptx::{self, Error, Options};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use wgpu::naga;
 
 /// A sphere tracer shaped like the project's renderer kernel.
 const SPHERE_TRACER: &str = r#"
@@ -726,7 +725,7 @@ fn example_scenes_assemble() {
     );
     let ptxas = ptxas();
     for path in paths {
-        let loaded = sdfc_runtime::frontend::load(&path).unwrap();
+        let loaded = crate::common::load(&path).unwrap();
         // An example that does not check is a failure, not one fewer kernel to assemble.
         let Some(scene) = loaded.scene else {
             panic!(
@@ -809,7 +808,7 @@ fn every_renderer_feature_kernel_assembles() {
     ];
     let ptxas = ptxas();
     for path in paths {
-        let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+        let scene = crate::common::load(&path).unwrap().scene.unwrap();
         let lowered = sdfc_compiler::Lowered::new(&scene);
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         for (variant, opts) in &variants {
@@ -829,7 +828,7 @@ fn every_renderer_feature_kernel_assembles() {
 #[test]
 fn the_debug_nan_kernel_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/in/ok/nan_at_run_time.sdf");
-    let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+    let scene = crate::common::load(&path).unwrap().scene.unwrap();
     let lowered = sdfc_compiler::Lowered::new(&scene);
     let debug = sdfc_compiler::wgsl::Options {
         debug_nan: true,
@@ -854,7 +853,7 @@ fn the_debug_nan_kernel_assembles() {
 #[test]
 fn a_kernel_with_outlined_blocks_assembles() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/compound_100.sdf");
-    let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+    let scene = crate::common::load(&path).unwrap().scene.unwrap();
     let lowered = sdfc_compiler::Lowered::new(&scene);
     // Its 400 instances written as code, not read from `scene_data`.
     let code = sdfc_compiler::wgsl::Options {
@@ -889,7 +888,7 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
         let name = format!("compound_{n}");
         let path =
             Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../examples/scaling/{name}.sdf"));
-        let scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+        let scene = crate::common::load(&path).unwrap().scene.unwrap();
         let lowered = sdfc_compiler::Lowered::new(&scene);
         let kernel = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("instances read from a buffer");
@@ -932,7 +931,7 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
     let (scene, diags, _) = sdfc_compiler::check_str("mixed.sdf", mixed);
     let mixed = scene.unwrap_or_else(|| panic!("{diags:?}"));
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/random_10000.sdf");
-    let random = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+    let random = crate::common::load(&path).unwrap().scene.unwrap();
     let ptxas = ptxas();
     for (name, scene) in [("mixed", mixed), ("random_10000", random)] {
         let lowered = sdfc_compiler::Lowered::new(&scene);
@@ -979,7 +978,7 @@ fn interpreted_kernels_assemble() {
     let ptxas = ptxas();
     let mut seen = std::collections::BTreeMap::new();
     for path in paths {
-        let mut scene = sdfc_runtime::frontend::load(&path).unwrap().scene.unwrap();
+        let mut scene = crate::common::load(&path).unwrap().scene.unwrap();
         scene.settings.method = sdfc_compiler::Method::March;
         let lowered = sdfc_compiler::Lowered::new(&scene);
         let interpreted = wgsl::Options {

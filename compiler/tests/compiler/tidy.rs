@@ -14,7 +14,7 @@
 //! the top-level module it reaches. Comments and string literals are skipped; code under
 //! `#[cfg(test)]` (unit tests, which may use any part of their crate) is left out.
 
-mod common;
+use crate::common;
 
 use sdfc_compiler::builtins::{self, BUILTINS};
 use std::collections::{BTreeMap, BTreeSet};
@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 /// A token of the little lexer below: what dependency paths are made of.
 #[derive(Debug, Clone, PartialEq)]
-enum Tok {
+pub(crate) enum Tok {
     Ident(String),
     /// `::`
     Path,
@@ -32,7 +32,7 @@ enum Tok {
 
 /// The identifiers and punctuation of Rust source, without comments, strings, characters
 /// and lifetimes.
-fn tokens(src: &str) -> Vec<Tok> {
+pub(crate) fn tokens(src: &str) -> Vec<Tok> {
     let s: Vec<char> = src.chars().collect();
     let mut out = Vec::new();
     let mut i = 0;
@@ -532,7 +532,7 @@ fn the_scanner_finds_paths_and_cycles() {
     assert!(cycles(&g).is_empty());
 }
 
-fn root() -> PathBuf {
+pub(crate) fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
@@ -724,7 +724,7 @@ fn example_produces(row: &str, code: &str) -> bool {
     for part in examples.split("](../").skip(1) {
         let rel = part.split(')').next().unwrap_or("");
         if rel.ends_with(".sdf") {
-            if let Ok(loaded) = sdfc_runtime::frontend::load(&root().join(rel)) {
+            if let Ok(loaded) = common::load(&root().join(rel)) {
                 if produces(&loaded.diagnostics) {
                     return true;
                 }
@@ -805,29 +805,29 @@ const NOT_LIMITS: &[(&str, &str, &str)] = &[
         "the step budget that defines the reference render",
     ),
     (
-        "runtime/tests/image_conformance.rs",
+        "runtime/tests/render/image_conformance.rs",
         "MAX_DIFFERING",
         "a test tolerance",
     ),
     (
-        "runtime/tests/analytic.rs",
+        "runtime/tests/render/analytic.rs",
         "MAX_DIFFERING",
         "a test tolerance",
     ),
     (
-        "runtime/tests/stability.rs",
+        "runtime/tests/render/stability.rs",
         "MAX_MISSED",
         "a test tolerance",
     ),
     (
-        "runtime/tests/stability.rs",
+        "runtime/tests/render/stability.rs",
         "MAX_STEP_RATIO",
         "a test tolerance",
     ),
 ];
 
 /// The `.rs` files under `dir` (relative to the workspace root), build output left out.
-fn workspace_rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub(crate) fn workspace_rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).expect("readable").flatten() {
         let path = entry.path();
         let name = entry.file_name().to_string_lossy().into_owned();

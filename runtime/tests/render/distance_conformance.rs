@@ -1,5 +1,5 @@
 //! One conformance suite for every evaluator of the distance program: the scenes of
-//! `tests/in/feature` (one primitive, operator, blend, domain operation or transform each),
+//! `compiler/tests/in/feature` (one primitive, operator, blend, domain operation or transform each),
 //! `tests/in/conformance` and the random scenes of `common::random_scene`, evaluated at one
 //! fixed set of points by the f64 reference, the f32 and f64 interpreter, the emitted Rust
 //! (f32 and f64), and through wgpu and CUDA (its PTX) the WGSL part's two functions and the
@@ -12,9 +12,8 @@
 //! `rustc` or `ptxas` fail, SDFC_REQUIRE_CUDA=1 (scripts/device-conformance.sh, on the GPU
 //! machine) a missing CUDA device.
 
-mod common;
-#[path = "common/evaluators.rs"]
-mod evaluators;
+use crate::common;
+use crate::evaluators;
 
 use evaluators::Value;
 use sdfc_compiler::{Binary, Lowered, Node, Op, Rng, Scene, Unary};
@@ -94,9 +93,13 @@ struct Case {
     lowered: Lowered,
 }
 
-/// The scenes of `tests/in/<dir>`, lowered.
+/// The feature scenes: one primitive, operator, blend, domain operation or transform each (the
+/// compiler's snapshot inputs).
+const FEATURES: &str = "../compiler/tests/in/feature";
+
+/// The scenes of the folder `dir` (relative to the runtime crate), lowered.
 fn scenes(dir: &str) -> Vec<Case> {
-    sdf_files(&format!("tests/in/{dir}"))
+    sdf_files(dir)
         .into_iter()
         .map(|path| {
             let scene = sdfc_runtime::frontend::load(&path)
@@ -114,14 +117,14 @@ fn scenes(dir: &str) -> Vec<Case> {
         .collect()
 }
 
-/// The feature scenes (`tests/in/feature`, one feature each), the scenes that combine
+/// The feature scenes (`compiler/tests/in/feature`, one feature each), the scenes that combine
 /// features for an evaluator (`tests/in/conformance`: every primitive the instance walk
 /// knows; issue 33's primitives and blends moved and rotated), then 40 random scenes of 1
 /// to 6 primitives.
 fn cases() -> Vec<Case> {
-    let mut cases = scenes("feature");
+    let mut cases = scenes(FEATURES);
     assert!(cases.len() >= 25, "{} feature scenes", cases.len());
-    cases.extend(scenes("conformance"));
+    cases.extend(scenes("tests/in/conformance"));
     let mut rng = Rng::new(2026);
     for i in 0..40 {
         let scene = common::random_scene(&mut rng, 1 + i % 6);
@@ -577,7 +580,7 @@ fn the_ptx_assembles_and_cuda_agrees_with_the_interpreter_in_ulps() {
 /// so that each evaluator meets each.
 #[test]
 fn the_feature_scenes_cover_every_node_and_operation() {
-    let features = scenes("feature");
+    let features = scenes(FEATURES);
     let mut nodes = std::collections::BTreeSet::new();
     let mut ops = std::collections::BTreeSet::new();
     for case in &features {

@@ -749,7 +749,8 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
 #[test]
 fn debug_nan_paints_nan_pixels_magenta_in_the_written_image() {
     let d = dir("debug-nan");
-    let scene = std::fs::canonicalize("tests/in/ok/nan_at_run_time.sdf").expect("scene");
+    let scene =
+        std::fs::canonicalize("../compiler/tests/in/ok/nan_at_run_time.sdf").expect("scene");
     let scene = scene.to_string_lossy();
     let magenta = |png: &str| {
         let image = sdfc_runtime::image::read_png(&d.join(png)).expect("png");

@@ -4,9 +4,7 @@
 //! corners are kept, the mesh is within half a voxel of the surface both ways; the four
 //! formats are read back by independent readers (`stl_io`, `tobj`, `ply-rs-bw`, `gltf`).
 
-mod common;
-#[path = "common/meshes.rs"]
-mod meshes;
+use crate::meshes;
 
 use meshes::*;
 use sdfc_compiler::{eval_point, Program};

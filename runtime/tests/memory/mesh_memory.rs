@@ -4,15 +4,15 @@
 //! library, for the benchmark scene, the bracket and a field without a proven bound, and the
 //! octree refused by the cells limit.
 //!
-//! One test only: the counter sees every thread of the process, so nothing else may run.
+//! The counter sees every thread of the process, so the test measures alone
+//! ([`counting::alone`]).
 
 use sdfc_compiler::lower;
 use sdfc_runtime::mesh::contour::{self, BYTES_PER_SURFACE_CELL};
 use sdfc_runtime::mesh::{octree, Field, Grid, Settings};
 use std::path::Path;
 
-#[path = "common/counting.rs"]
-mod counting;
+use crate::counting;
 use counting::peak_of;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -24,6 +24,7 @@ fn grid(lo: [f64; 3], hi: [f64; 3], n: u32) -> Grid {
 
 #[test]
 fn meshing_stays_within_the_memory_it_announces() {
+    let _alone = counting::alone();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let cases: [(&str, [f64; 3], [f64; 3], u32); 5] = [
         ("examples/mesh/parts.sdf", [-1.0; 3], [1.0; 3], 48),

@@ -2,7 +2,7 @@
 //! formula predicts, fog by the documented amount, exposure and tone curves, and the checker
 //! filtered over each sample's footprint.
 
-mod common;
+use crate::common;
 
 use common::render_everywhere;
 use sdfc_compiler::{look, Scene, Tonemap};

@@ -7,7 +7,7 @@
 //! a bad `--devices` entry is named in the error. Without a wgpu adapter the tests say they
 //! skipped, unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe).
 
-mod common;
+use crate::common;
 
 use sdfc_compiler::{wgsl, Lowered, Scene};
 use sdfc_runtime::gpu::launch::Worker;

@@ -1,10 +1,10 @@
 //! `mesh(path)`: every format `sdfc mesh` writes reads back to the same field; a meshed
-//! sphere (tests/in/mesh/sphere.ply) is within its own error of `sphere` as a field and as
+//! sphere (compiler/tests/in/mesh/sphere.ply) is within its own error of `sphere` as a field and as
 //! a CPU render; the shape composes with transforms, `round`, `shell`, smooth blends,
 //! `repeat` and materials, and `sdfc mesh` remeshes it; bad files are errors at the call
 //! that read them, naming where in the file, and never a crash.
 
-mod common;
+use crate::common;
 
 use sdfc_compiler::{Lowered, Rng, Scene};
 use sdfc_runtime::cpu::{self, Options};
@@ -18,10 +18,10 @@ fn scratch(what: &str) -> PathBuf {
     dir
 }
 
-/// A scratch folder holding a copy of tests/in/mesh/sphere.ply.
+/// A scratch folder holding a copy of compiler/tests/in/mesh/sphere.ply.
 fn with_sphere(what: &str) -> PathBuf {
     let dir = scratch(what);
-    let from = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/in/mesh/sphere.ply");
+    let from = Path::new(env!("CARGO_MANIFEST_DIR")).join("../compiler/tests/in/mesh/sphere.ply");
     std::fs::copy(from, dir.join("sphere.ply")).expect("copy the sphere");
     dir
 }
@@ -91,7 +91,7 @@ fn every_format_sdfc_mesh_writes_reads_back_the_same() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The sphere `sdfc mesh` wrote (tests/in/mesh/sphere.ply, radius 1 at resolution 10) is
+/// The sphere `sdfc mesh` wrote (compiler/tests/in/mesh/sphere.ply, radius 1 at resolution 10) is
 /// within its own error of the unit sphere: at every point the two distances differ by at
 /// most the Hausdorff distance between the mesh and the sphere, bounded by the vertices'
 /// distance from the sphere and the triangles' depth below it.

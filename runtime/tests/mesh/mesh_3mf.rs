@@ -4,9 +4,7 @@
 //! its STL, a colour field's colours per vertex, and z up (`--up`). `python/tests/test_mesh_files.py`
 //! reads the same files with lib3mf and checks them with manifold3d.
 
-mod common;
-#[path = "common/meshes.rs"]
-mod meshes;
+use crate::meshes;
 
 use meshes::*;
 use quick_xml::events::Event;

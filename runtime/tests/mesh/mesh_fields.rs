@@ -4,9 +4,7 @@
 //! solid (the rod's is the same mesh as the primitive's); a field with no bound is named in
 //! the error, whose suggested bounds hold every bounded part.
 
-mod common;
-#[path = "common/meshes.rs"]
-mod meshes;
+use crate::meshes;
 
 use meshes::*;
 use std::path::Path;

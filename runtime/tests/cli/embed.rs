@@ -137,7 +137,7 @@ fn each_language_declares_the_named_functions_and_materials() {
 }
 
 /// The part's function is the renderer kernel's `map`, word for word (the kernel's is
-/// compared with the CPU renderer by tests/render.rs), and its table is the scene's
+/// compared with the CPU renderer by runtime/tests/render/render.rs), and its table is the scene's
 /// materials in order.
 #[test]
 fn the_part_is_the_kernels_own_map() {

@@ -2,7 +2,7 @@
 //! buffers of CPU renders and their sidecar, the reference render, the sweep parser and the
 //! Pareto front of `sdfc pareto`, and its charts (valid SVG and PNG).
 
-mod common;
+use crate::common;
 
 use common::*;
 use sdfc_compiler::{lower, Node, Settings};

@@ -15,12 +15,9 @@
 //! checks, lowers, and its kernel and part validate with naga here; their images are compared
 //! across backends in `image_conformance.rs` and their PTX assembled by `ptxas` in `ptx.rs`.
 
-mod common;
-#[path = "common/evaluators.rs"]
-mod evaluators;
+use crate::common;
 
-use sdfc_compiler::{diagnostics, dump_ast, dump_ir, parse, wgsl, FileId, Lowered, Scene};
-use sdfc_runtime::frontend;
+use sdfc_compiler::{diagnostics, dump_ast, dump_ir, parse, points, wgsl, FileId, Lowered, Scene};
 use std::path::{Path, PathBuf};
 
 /// The most lines of one snapshot.
@@ -216,7 +213,7 @@ fn snapshot(folder: &str, name: &str, text: &str) {
 
 /// A scene file checked without errors.
 fn load(path: &Path) -> Scene {
-    let loaded = frontend::load(path).expect("readable");
+    let loaded = common::load(path).expect("readable");
     let rendered = diagnostics::render(&loaded.diagnostics, &loaded.sources, false);
     loaded
         .scene
@@ -267,7 +264,7 @@ fn error_inputs() {
     );
     let mut codes = std::collections::BTreeSet::new();
     for path in files {
-        let loaded = frontend::load(&path).expect("readable");
+        let loaded = common::load(&path).expect("readable");
         assert!(
             loaded.scene.is_none(),
             "{} compiled without errors",
@@ -284,7 +281,7 @@ fn error_inputs() {
         );
     }
     let mut emitted = std::collections::BTreeSet::new();
-    common::codes_in(Path::new("../compiler/src"), &mut emitted);
+    common::codes_in(Path::new("src"), &mut emitted);
     let missing: Vec<&String> = emitted
         .iter()
         .filter(|c| c.starts_with('E') && !codes.contains(c.as_str()))
@@ -302,7 +299,7 @@ fn warning_inputs() {
     let files = sdf_files("tests/in/warn");
     assert!(files.len() >= 4, "expected warning cases in tests/in/warn");
     for path in files {
-        let loaded = frontend::load(&path).expect("readable");
+        let loaded = common::load(&path).expect("readable");
         let rendered = diagnostics::render(&loaded.diagnostics, &loaded.sources, false);
         assert!(
             loaded.scene.is_some(),
@@ -347,8 +344,11 @@ fn features() {
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         snapshot("part", &name, &part.source);
         if PTX_FEATURES.contains(&name.as_str()) {
-            let m = evaluators::points_module(&scene, &lowered, false);
-            snapshot("ptx", &name, &evaluators::points_ptx(&m, 70));
+            let m = points::points_module(&scene, &lowered, false)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            let ptx =
+                points::points_ptx(&m, 70).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            snapshot("ptx", &name, &ptx);
         }
     }
     for name in PTX_FEATURES {
@@ -412,7 +412,7 @@ fn kernels() {
 fn snapshots_stay_small() {
     let mut total = 0;
     let mut long = Vec::new();
-    for folder in std::fs::read_dir("tests/snapshots").expect("tests/snapshots") {
+    for folder in std::fs::read_dir("tests/compiler/snapshots").expect("tests/compiler/snapshots") {
         let folder = folder.expect("entry").path();
         for file in std::fs::read_dir(&folder).expect("folder") {
             let file = file.expect("entry").path();

@@ -2,7 +2,7 @@
 //! glass, light falloff, bit-identical output whatever the number of threads, and the
 //! explained artefacts of issue 24, item 4.
 
-mod common;
+use crate::common;
 
 use common::*;
 use sdfc_compiler::{Light, Lowered, Method, Node, Pattern, Scene};
@@ -503,10 +503,11 @@ fn a_tiny_step_budget_misses_by_budget() {
     assert_eq!(r.stats.steps_max, 2);
 }
 
-/// The scene of `tests/in/ok/nan_at_run_time.sdf`: NaN at run time in f32, beyond about 1.8
+/// The scene of `compiler/tests/in/ok/nan_at_run_time.sdf`: NaN at run time in f32, beyond about 1.8
 /// from the origin, with finite constants.
 fn nan_scene() -> Scene {
-    let text = std::fs::read_to_string("tests/in/ok/nan_at_run_time.sdf").expect("scene");
+    let text =
+        std::fs::read_to_string("../compiler/tests/in/ok/nan_at_run_time.sdf").expect("scene");
     let (scene, diags, _) = sdfc_compiler::check_str("nan.sdf", &text);
     scene.unwrap_or_else(|| panic!("{diags:?}"))
 }

@@ -4,7 +4,7 @@
 //! combinations that cannot work are refused with a clear error. Without a wgpu adapter the
 //! image tests say they skipped, unless `SDFC_REQUIRE_DEVICES=1`.
 
-mod common;
+use crate::common;
 
 use common::random_scene;
 use sdfc_compiler::{

@@ -4,12 +4,14 @@
 //! a literal list of millions of elements, a mesh file whose triangles are far past the
 //! `triangles` limit), where each of these took gigabytes.
 //!
-//! One test only: the counter sees every thread of the process, so nothing else may run.
+//! The counter sees every thread of the process, so the test measures alone
+//! ([`counting::alone`]).
 
-use sdfc_compiler::{check_str, check_with, has_errors, Diagnostic, Limits, Loader, SourceMap};
+use sdfc_compiler::{
+    check_str, check_with, has_errors, Diagnostic, Limits, LoadError, Loader, SourceMap,
+};
 
-#[path = "common/counting.rs"]
-mod counting;
+use crate::counting;
 use counting::peak_of;
 
 const MB: u64 = 1 << 20;
@@ -18,11 +20,11 @@ const MB: u64 = 1 << 20;
 struct One(Vec<u8>);
 
 impl Loader for One {
-    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), String> {
-        Err(format!("no imports here (`{path}`)"))
+    fn load(&mut self, _from: &str, path: &str) -> Result<(String, String), LoadError> {
+        Err(LoadError::NoImports { path: path.into() })
     }
 
-    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load_bytes(&mut self, _from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         Ok((path.to_string(), self.0.clone()))
     }
 }
@@ -40,6 +42,7 @@ fn check_mesh(name: &str, bytes: Vec<u8>) -> (Vec<Diagnostic>, u64) {
 
 #[test]
 fn hostile_inputs_are_checked_in_memory_proportional_to_them() {
+    let _alone = counting::alone();
     // A list of 20 000 elements passed to a function in a loop: each call's arguments made
     // the key of the memo of calls as text (200 KB a call, 4.46 GB in all); a list of ints
     // passed where floats are expected was copied at every call.

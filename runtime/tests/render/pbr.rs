@@ -2,7 +2,7 @@
 //! backend: the white furnace, a GGX highlight against the f64 formula as the roughness
 //! changes, and Fresnel's brighter reflection at grazing angles.
 
-mod common;
+use crate::common;
 
 use common::render_everywhere;
 use sdfc_compiler::Scene;

@@ -3,7 +3,7 @@
 //! ([`AGREEMENT`]; other scenes within 30 dB and 2 %). On a machine without a wgpu adapter the test says it skipped,
 //! unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe): then it fails.
 
-mod common;
+use crate::common;
 
 use sdfc_compiler::{wgsl, Lowered, Method, Scene};
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
@@ -390,7 +390,7 @@ fn shadows_through_glass_match_without_secondary_rays() {
 #[test]
 fn debug_nan_marks_the_same_pixels_on_wgpu() {
     let Some(gpu) = open_gpu() else { return };
-    let path = PathBuf::from("tests/in/ok/nan_at_run_time.sdf");
+    let path = PathBuf::from("../compiler/tests/in/ok/nan_at_run_time.sdf");
     let scene = frontend::load(&path)
         .expect("readable")
         .scene

@@ -4,15 +4,15 @@
 //! its outputs written, as `sdfc render` does), for several sizes, supersampling and
 //! precisions, on a scene whose glass spawns two rays per hit.
 //!
-//! One test only: the counter sees every thread of the process, so nothing else may run.
+//! The counter sees every thread of the process, so the test measures alone
+//! ([`counting::alone`]).
 
 use sdfc_compiler::{check_str, Lowered, Scene};
 use sdfc_runtime::backend::{Backend, Prepared, Setup};
 use sdfc_runtime::cpu::{self, Options, Precision, Tapes};
 use sdfc_runtime::memory;
 
-#[path = "common/counting.rs"]
-mod counting;
+use crate::counting;
 use counting::peak_of;
 
 const SCENE: &str = "
@@ -64,6 +64,7 @@ fn scene_of(text: &str, width: u32, height: u32, aa: u32) -> Scene {
 
 #[test]
 fn renders_stay_within_the_memory_they_announce() {
+    let _alone = counting::alone();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(3)
         .build()

@@ -642,7 +642,7 @@ fn rules_cited_by_the_parser_and_lexer_exist() {
 #[test]
 fn examples_and_valid_files_are_sentences_of_the_grammar() {
     let mut files = sdf_files(&root().join("examples"));
-    let ok = sdf_files(&root().join("runtime/tests/in/ok"));
+    let ok = sdf_files(&root().join("compiler/tests/in/ok"));
     assert!(!ok.is_empty(), "tests/in/ok has no .sdf files");
     files.extend(ok);
     with_stack(move || {
@@ -700,7 +700,7 @@ fn small_valid_inputs_are_recognised() {
 fn the_grammar_and_the_parser_agree_on_the_error_files() {
     // A file of `tests/in/err` is a sentence of the grammar exactly when the lexer and the
     // parser find nothing wrong with it (its mistake is found by the checker).
-    let files = sdf_files(&root().join("runtime/tests/in/err"));
+    let files = sdf_files(&root().join("compiler/tests/in/err"));
     assert!(!files.is_empty(), "tests/in/err has no .sdf files");
     with_stack(move || {
         let g = grammar();

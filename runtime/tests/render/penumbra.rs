@@ -3,7 +3,7 @@
 //! field's kinks near an occluder leave no ripples or streaks, and every backend draws the
 //! same penumbra.
 
-mod common;
+use crate::common;
 
 use common::*;
 use sdfc_compiler::Scene;

@@ -23,9 +23,9 @@
 //! 127.0.0.1 is reached, and the browser is killed after `deadline` (or when it exits early,
 //! which fails). `SDFC_TINT_PIPELINES=all` makes a pipeline of every kernel (minutes).
 
+use crate::common;
 use rayon::prelude::*;
 use sdfc_compiler::wgsl::{self, Options};
-use sdfc_runtime::frontend;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
@@ -127,7 +127,7 @@ fn example_jobs() -> Vec<Job> {
     let scaling = sdf_files("examples/scaling", |n| {
         n.ends_with("_10") || n.ends_with("_1000")
     });
-    let ok = sdf_files("runtime/tests/in/ok", |_| true);
+    let ok = sdf_files("compiler/tests/in/ok", |_| true);
     let animated = sdf_files("examples/animation", |_| true);
     let all = examples.iter().chain(&scaling).chain(&ok).map(|p| {
         let seed = p
@@ -137,7 +137,7 @@ fn example_jobs() -> Vec<Job> {
     });
     let all = all.chain(animated.iter().map(|p| (p, true, true)));
     all.flat_map(|(path, pipeline, parameters)| {
-        let loaded = frontend::load(path).expect("readable");
+        let loaded = common::load(path).expect("readable");
         let scene = loaded
             .scene
             .unwrap_or_else(|| panic!("{} has errors", path.display()));
@@ -182,7 +182,7 @@ fn interpreted_jobs() -> Vec<Job> {
     // With the scene that imports a triangle mesh, whose kernel calls the mesh walk.
     let mesh = sdf_files("examples/mesh", |n| n == "import");
     for path in sdf_files("examples", |_| true).into_iter().chain(mesh) {
-        let loaded = frontend::load(&path).expect("readable");
+        let loaded = common::load(&path).expect("readable");
         let mut scene = loaded
             .scene
             .unwrap_or_else(|| panic!("{} has errors", path.display()));
@@ -383,8 +383,7 @@ fn features_are_the_templates() {
     // The template is the kernel and its shading part, appended to it.
     let template = ["kernel.wgsl", "shading.wgsl"]
         .map(|f| {
-            std::fs::read_to_string(format!("../compiler/src/back/wgsl/{f}"))
-                .expect("the kernel template")
+            std::fs::read_to_string(format!("src/back/wgsl/{f}")).expect("the kernel template")
         })
         .concat();
     let flags: BTreeSet<&str> = template

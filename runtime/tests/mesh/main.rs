@@ -1,0 +1,17 @@
+//! Meshing and meshes, one test binary: `sdfc mesh` and the files it writes (`mesh`), their
+//! accuracy on printable parts (`mesh_accuracy`), fields meshed without `--bounds`
+//! (`mesh_fields`), 3MF read back by independent readers (`mesh_3mf`), and meshes read into
+//! scenes (`mesh_import`).
+//!
+//! Filter by module: `cargo test --release --test mesh -- mesh_3mf::`.
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../common/meshes.rs"]
+mod meshes;
+
+mod mesh;
+mod mesh_3mf;
+mod mesh_accuracy;
+mod mesh_fields;
+mod mesh_import;

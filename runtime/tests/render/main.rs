@@ -1,0 +1,34 @@
+//! Rendering, one test binary: each module tests one concern of the renderers (CPU, wgpu
+//! through lavapipe, CUDA where there is a device) through the library.
+//!
+//! - `render`: properties of CPU renders (coverage, shadows, mirrors, glass, debug views);
+//! - `look`, `pbr`, `penumbra`: the look (occlusion, fog, tone curves), the physically based
+//!   material and soft shadows on every backend;
+//! - `analytic`: which scenes are traced analytically, and their images;
+//! - `stability`: scenes where sphere tracing is known to struggle;
+//! - `image_conformance`, `distance_conformance`: every backend and evaluator against the
+//!   others;
+//! - `interpreted_kernel`: the interpreted WGSL kernel against the specialised one;
+//! - `optimise`: the optimisation passes and bounding-volume culling;
+//! - `devices`: several devices at once (`--devices`);
+//! - `animation`: the time `t`, sequences and their frames.
+//!
+//! Filter by module: `cargo test --release --test render -- look::`.
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../common/evaluators.rs"]
+mod evaluators;
+
+mod analytic;
+mod animation;
+mod devices;
+mod distance_conformance;
+mod image_conformance;
+mod interpreted_kernel;
+mod look;
+mod optimise;
+mod pbr;
+mod penumbra;
+mod render;
+mod stability;

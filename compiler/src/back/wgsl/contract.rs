@@ -46,6 +46,11 @@ impl Specialisation {
             fog_color: _,
             exposure: _,
             tonemap: _,
+            // Whether it path traces is a feature (`PATH`); its samples and bounces are
+            // read at every render (`depth.y`, `depth.z`).
+            path: _,
+            samples: _,
+            bounces: _,
             // Specialised (and read: ω in `march.z`, max_depth in `depth.x`).
             relaxation,
             max_depth,

@@ -23,6 +23,8 @@ pub struct Specialisation {
     pub relax: bool,
     /// The `max_depth` setting.
     pub max_depth: u32,
+    /// Whether it path traces (`method: "path"`).
+    pub path: bool,
 }
 
 impl Specialisation {
@@ -46,9 +48,9 @@ impl Specialisation {
             fog_color: _,
             exposure: _,
             tonemap: _,
-            // Whether it path traces is a feature (`PATH`); its samples and bounces are
-            // read at every render (`depth.y`, `depth.z`).
-            path: _,
+            // Its samples and bounces are read at every render (`depth.y`, `depth.z`);
+            // whether it path traces is specialised (the feature `PATH`).
+            path,
             samples: _,
             bounces: _,
             // Specialised (and read: ω in `march.z`, max_depth in `depth.x`).
@@ -58,6 +60,7 @@ impl Specialisation {
         } = settings;
         Specialisation {
             method: *method,
+            path: *path,
             relax: *relaxation > 1.0,
             max_depth: *max_depth,
         }
@@ -66,8 +69,9 @@ impl Specialisation {
     /// In words, for errors.
     pub fn describe(&self) -> String {
         format!(
-            "method {}, {}, max_depth {}",
+            "method {}{}, {}, max_depth {}",
             self.method.name(),
+            if self.path { " (path traced)" } else { "" },
             if self.relax {
                 "over-relaxation"
             } else {

@@ -221,10 +221,12 @@ fn draw(m: Material, b: Bsdf, u0: f32, u1: f32, u2: f32) -> Drawn {
     var out = Drawn(vec3<f32>(0.0), vec3<f32>(0.0), 0.0, 0u);
     if u0 < b.p.x {
         var l = to_world(cosine_dir(u1, u2), b.n);
+//#if PBR
         if b.pbr != 0u && u0 / b.p.x < b.q {
             let hv = to_world(ggx_half(u1, u2, m.pbr.y), b.n);
             l = hv * (2.0 * dot(b.v, hv)) - b.v;
         }
+//#endif
         let pdf = bsdf_pdf(m, b, l);
         if pdf <= 0.0 {
             return out;

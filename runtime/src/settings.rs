@@ -284,7 +284,9 @@ mod tests {
         set(&mut s, "method", "march", &limits).expect("march");
         assert!(!s.path && s.method == sdfc_compiler::Method::March);
         assert_eq!(
-            set(&mut s, "samples", "0", &limits).unwrap_err().to_string(),
+            set(&mut s, "samples", "0", &limits)
+                .unwrap_err()
+                .to_string(),
             format!(
                 "samples must be a whole number from 1 to {}, not `0`",
                 limits.get(Limit::Samples)

@@ -145,7 +145,10 @@ fn the_white_furnace_holds_when_path_traced() {
         64,
     );
     for (backend, image) in everywhere("metal furnace", &metal) {
-        let values: Vec<f64> = on.iter().map(|&(x, y)| image.pixel(x, y)[1] as f64).collect();
+        let values: Vec<f64> = on
+            .iter()
+            .map(|&(x, y)| image.pixel(x, y)[1] as f64)
+            .collect();
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let most = values.iter().copied().fold(0.0, f64::max);
         println!("{backend}: rough metal mean {mean:.4}, most {most:.4}");
@@ -181,7 +184,10 @@ scene {
 fn noise_falls_as_one_over_the_root_of_the_samples() {
     let mut scene = checked("ball", BALL);
     assert!(
-        Lowered::new(&scene).traceable.traced(Method::Auto).is_some(),
+        Lowered::new(&scene)
+            .traceable
+            .traced(Method::Auto)
+            .is_some(),
         "the ball is traced analytically"
     );
     scene.settings.samples = 1024;
@@ -258,13 +264,19 @@ fn traced_and_marched_paths_agree() {
         "  sphere(0.6).translate(0, 0.6, 0) @ ball;\n  box((0.4, 0.5, 0.4)).translate(-1.3, 0.5, 0.3) @ glass;\n  sphere(0.3).translate(1.2, 0.3, -0.4) @ gold;",
         );
     let mut scene = checked("ball and glass", &text);
-    assert!(Lowered::new(&scene).traceable.traced(Method::Auto).is_some());
+    assert!(Lowered::new(&scene)
+        .traceable
+        .traced(Method::Auto)
+        .is_some());
     scene.settings.samples = 16;
     let traced = cpu(&scene, Precision::F32);
     scene.settings.method = Method::March;
     assert!(scene.settings.path, "still path traced");
     let marched = cpu(&scene, Precision::F32);
     let d = metrics::compare(&traced, &marched, 0.1).expect("same size");
-    println!("traced against marched: {:.1} dB, {:.4} of pixels", d.psnr, d.differing);
+    println!(
+        "traced against marched: {:.1} dB, {:.4} of pixels",
+        d.psnr, d.differing
+    );
     assert!(d.psnr > 40.0, "traced and marched differ: {d:?}");
 }

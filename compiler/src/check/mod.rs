@@ -776,6 +776,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 path: false,
                 samples: int("samples"),
                 bounces: int("bounces"),
+                first_sample: 0,
             };
             if let Value::Str(name) = &f["method"] {
                 scene.settings.set_method(name);

@@ -929,6 +929,10 @@ pub struct Settings {
     pub samples: u32,
     /// The path tracer's bounces after the camera ray's hit.
     pub bounces: u32,
+    /// The number of the path tracer's first sample in its random stream (not a language
+    /// field: `sdfc view` renders sample `k` of a resting camera as frame `k`, with one
+    /// sample each, so that its frames add up to the picture of `samples` samples).
+    pub first_sample: u32,
 }
 
 /// The intersection method of a render (docs/rendering.md, "Marching" and "Analytic ray tracing").
@@ -1006,6 +1010,7 @@ impl Settings {
         path: false,
         samples: 16,
         bounces: 4,
+        first_sample: 0,
     };
 
     /// The names the `method` setting accepts: [`Method::NAMES`] and `"path"`.

@@ -145,6 +145,8 @@ pub(super) struct Context<T: Float> {
     pub path: bool,
     pub samples: u32,
     pub bounces: u32,
+    /// The number of the first sample in the random stream (`Settings::first_sample`).
+    pub first_sample: u32,
     /// The image's width (the path tracer's pixel numbers are `y·width + x`).
     pub width: u32,
 }
@@ -211,6 +213,7 @@ impl<T: Float> Context<T> {
             path: s.path,
             samples: s.samples.max(1),
             bounces: s.bounces,
+            first_sample: s.first_sample,
             width: s.width,
         }
     }

@@ -30,7 +30,8 @@ pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect
     let mut nan = vec![false; n];
     let mut first = vec![(T::zero(), 0u32); n];
     let mut counters = Counters::default();
-    for sample in 0..ctx.samples {
+    for k in 0..ctx.samples {
+        let sample = ctx.first_sample.wrapping_add(k);
         let mut samples = Samples::new(n, ctx.debug_nan);
         let camera = camera_rays(ctx, rect, sample);
         counters.camera_rays += n as u64;
@@ -58,7 +59,11 @@ pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect
                 return super::NAN_COLOUR;
             }
             let c = super::look::grade(ctx, c * scale);
-            [c.x.to_f64() as f32, c.y.to_f64() as f32, c.z.to_f64() as f32]
+            [
+                c.x.to_f64() as f32,
+                c.y.to_f64() as f32,
+                c.z.to_f64() as f32,
+            ]
         })
         .collect();
     let (distance, coverage) = first
@@ -292,7 +297,12 @@ fn draw<T: Float>(b: &Bsdf<T>, u: [T; 3]) -> Option<(V3<T>, V3<T>, T, Lobe)> {
         ));
     }
     if p_t > T::zero() {
-        return Some((-b.v, b.transmit * (T::one() / p_t), T::zero(), Lobe::Refract));
+        return Some((
+            -b.v,
+            b.transmit * (T::one() / p_t),
+            T::zero(),
+            Lobe::Refract,
+        ));
     }
     None
 }
@@ -376,11 +386,7 @@ fn step<T: Float>(
         if !more {
             continue;
         }
-        let drawn = [
-            u(dim::LOBE),
-            u(dim::DIRECTION[0]),
-            u(dim::DIRECTION[1]),
-        ];
+        let drawn = [u(dim::LOBE), u(dim::DIRECTION[0]), u(dim::DIRECTION[1])];
         let Some((dir, factor, pdf, lobe)) = draw(&b, drawn) else {
             continue;
         };
@@ -393,7 +399,13 @@ fn step<T: Float>(
             Lobe::Scatter | Lobe::Mirror => child(hit.p + off, dir, weight, within, pdf),
             Lobe::Refract => match shade::refract(ray.dir, hit.n, T::one() / m.ior) {
                 Some(t) => child(hit.p - off, t, weight, true, T::zero()),
-                None => child(hit.p + off, ray.dir.reflect(hit.n), weight, within, T::zero()),
+                None => child(
+                    hit.p + off,
+                    ray.dir.reflect(hit.n),
+                    weight,
+                    within,
+                    T::zero(),
+                ),
             },
         };
         next.extend(roulette(ray, u(dim::ROULETTE)));
@@ -406,7 +418,9 @@ fn step<T: Float>(
             *a = *a + contrib;
             continue;
         }
-        let shadowed = shadowed.next().expect("a shadow ray for each decided estimate");
+        let shadowed = shadowed
+            .next()
+            .expect("a shadow ray for each decided estimate");
         *a = *a + contrib * shadowed.light;
         samples.steps[s as usize] += shadowed.steps;
         counters.steps += shadowed.steps as u64;
@@ -425,11 +439,10 @@ fn roulette<T: Float>(mut ray: Ray<T>, u: T) -> Option<Ray<T>> {
         return Some(ray);
     }
     let w = ray.weight;
-    let q = w
-        .x
-        .max(w.y)
-        .max(w.z)
-        .min(T::from_f64(sampling::ROULETTE_MAX));
+    let q =
+        w.x.max(w.y)
+            .max(w.z)
+            .min(T::from_f64(sampling::ROULETTE_MAX));
     if u >= q {
         return None;
     }
@@ -502,7 +515,10 @@ fn estimates<T: Float>(
                 directional += 1;
                 let l = if cos_disc < T::one() {
                     let local = sampling::cone(u(j), u(j + 1), cos_disc);
-                    from(sampling::to_world(local, [to_light.x, to_light.y, to_light.z]))
+                    from(sampling::to_world(
+                        local,
+                        [to_light.x, to_light.y, to_light.z],
+                    ))
                 } else {
                     to_light
                 };
@@ -512,12 +528,7 @@ fn estimates<T: Float>(
         if hit.n.dot(l) <= T::zero() || atten <= T::zero() {
             continue;
         }
-        queue(
-            l,
-            tmax,
-            weight.mul_v(b.lamp(l, il)) * atten,
-            k >= T::zero(),
-        );
+        queue(l, tmax, weight.mul_v(b.lamp(l, il)) * atten, k >= T::zero());
     }
     if ctx.skies.is_empty() {
         return;

@@ -370,12 +370,7 @@ fn solids<T: Float>(
 /// so that a face lying on a checker boundary does not flicker between the two colours, and
 /// its two colours mixed over the sample's footprint ([`look::checker_weight`]); a colour
 /// field is its value at p.
-pub(super) fn colour<T: Float>(
-    ctx: &Context<T>,
-    m: &Mat<T>,
-    hit: &Hit<T>,
-    dir: V3<T>,
-) -> V3<T> {
+pub(super) fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>, dir: V3<T>) -> V3<T> {
     let tint = |t: Tint<T>| match t {
         Tint::Const(c) => c,
         Tint::Field(k) => {

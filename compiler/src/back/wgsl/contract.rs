@@ -48,11 +48,13 @@ impl Specialisation {
             fog_color: _,
             exposure: _,
             tonemap: _,
-            // Its samples and bounces are read at every render (`depth.y`, `depth.z`);
+            // Its samples, bounces and first sample are read at every render (`depth.y`,
+            // `depth.z`, `depth.w`);
             // whether it path traces is specialised (the feature `PATH`).
             path,
             samples: _,
             bounces: _,
+            first_sample: _,
             // Specialised (and read: ω in `march.z`, max_depth in `depth.x`).
             relaxation,
             max_depth,

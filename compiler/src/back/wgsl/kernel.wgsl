@@ -53,7 +53,8 @@ struct Params {
     look: vec4<f32>,       // occlusion radius R, 1/fog distance, 2^exposure, tone curve
     fog: vec4<f32>,        // the fog's colour; w: 0 where it is the background seen along the ray
     counts: vec4<u32>,     // width, height, aa, max_steps
-    depth: vec4<u32>,      // max_depth, the path tracer's samples and bounces
+    //% depth.yzw: the path tracer's samples, bounces and first sample (path.wgsl).
+    depth: vec4<u32>,      // max_depth
 //#if POINT
     points: array<PointLight, {{POINTS}}>,
 //#endif
@@ -680,25 +681,27 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = tile.x + gid.x;
     let y = tile.y + gid.y;
-    var sum = vec3<f32>(0.0);
 //#if PATH
-    // Path traced (path.wgsl): the mean of `samples` paths (depth.y).
+    // Path traced (path.wgsl): the mean of `samples` paths (depth.y), numbered from the first
+    // sample (depth.w).
     let samples = params.depth.y;
+    var sum = vec3<f32>(0.0);
     for (var s = 0u; s < samples; s++) {
-        sum += path_radiance(x, y, s);
+        sum += path_radiance(x, y, params.depth.w + s);
     }
-    let count = f32(samples);
+    let pixel = y * params.counts.x + x;
+    var colour = grade(sum / f32(samples));
 //#else
     let aa = params.counts.z;
+    var sum = vec3<f32>(0.0);
     for (var j = 0u; j < aa; j++) {
         for (var i = 0u; i < aa; i++) {
             sum += radiance(params.eye.xyz, camera_dir(x, y, i, j));
         }
     }
-    let count = f32(aa * aa);
-//#endif
     let pixel = y * params.counts.x + x;
-    var colour = grade(sum / count);
+    var colour = grade(sum / f32(aa * aa));
+//#endif
 //#if DEBUG_NAN
     // --debug-nan: a pixel any of whose rays met a NaN is magenta.
     if counters.nans > 0u {

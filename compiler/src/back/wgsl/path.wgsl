@@ -3,7 +3,6 @@
 //% counter-based random stream, the sampling formulas and the path of one sample, as
 //% docs/rendering.md ("Path tracing") states them. The CPU's copy is runtime/src/cpu/path.rs;
 //% the stream and formulas are compiler/src/scene/sampling.rs, with the same integer arithmetic.
-
 //#if PATH
 const PATH_PI: f32 = {{PI}};
 const PATH_INV_PI: f32 = {{INV_PI}};

@@ -62,7 +62,10 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
     // pixel's (aa counts as 1).
     let aa = if s.path { 1 } else { s.aa.max(1) };
     w.uints("counts", &[s.width, s.height, aa, s.max_steps.max(1)])?;
-    w.uints("depth", &[s.max_depth, s.samples.max(1), s.bounces, 0])?;
+    w.uints(
+        "depth",
+        &[s.max_depth, s.samples.max(1), s.bounces, s.first_sample],
+    )?;
     let (mut points, mut dirs, mut skies) = (0, 0, 0);
     // Whether a sky is the background (`background.w`): rays that hit nothing show the skies
     // that are.

@@ -67,7 +67,7 @@ pub use crate::scene::{
     },
     look,
     params::{Accepts, ParamValue, Parameter},
-    pbr, NodeId, Pbr, Tonemap,
+    pbr, sampling, NodeId, Pbr, Tonemap,
 };
 
 /// The lowering, once per scene: the distance program and what every back end reads of the

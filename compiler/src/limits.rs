@@ -32,6 +32,10 @@ pub enum Limit {
     MaxSteps,
     /// The render setting `max_depth`.
     MaxDepth,
+    /// The path tracer's samples per pixel (the render setting `samples`).
+    Samples,
+    /// The path tracer's bounces (the render setting `bounces`).
+    Bounces,
     /// Operations of the distance program after lowering.
     Program,
     /// Memory a render may allocate, in MiB.
@@ -77,7 +81,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 24] = [
+    pub const ALL: [Limit; 26] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -88,6 +92,8 @@ impl Limit {
         Limit::Aa,
         Limit::MaxSteps,
         Limit::MaxDepth,
+        Limit::Samples,
+        Limit::Bounces,
         Limit::Program,
         Limit::Memory,
         Limit::Expansion,
@@ -152,6 +158,21 @@ impl Limit {
                 "the render setting max_steps",
             ),
             Limit::MaxDepth => s("max_depth", 64, 1_000, "the render setting max_depth"),
+            // A sample is one path a pixel: 65 536 of them at 1920×1080 are 1.4·10¹¹ paths,
+            // hours on any device; the ceiling keeps sample indices within the random
+            // stream's 32 bits.
+            Limit::Samples => s(
+                "samples",
+                65_536,
+                1 << 31,
+                "the path tracer's samples per pixel (render setting samples)",
+            ),
+            Limit::Bounces => s(
+                "bounces",
+                64,
+                1_000,
+                "the path tracer's bounces (render setting bounces)",
+            ),
             Limit::Program => s(
                 "program",
                 4_000_000,
@@ -343,7 +364,7 @@ impl Spelling {
 /// (the viewer's panel), taken only where the scene accepts them.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 24],
+    values: [u64; 26],
     spelling: Spelling,
     params: Vec<(String, String)>,
     offered: Vec<(String, String)>,

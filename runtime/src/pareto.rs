@@ -95,6 +95,8 @@ pub enum Key {
     Relaxation,
     /// Supersampling (every whole number).
     Aa,
+    /// The path tracer's samples a pixel (log-spaced, one value an octave, whole numbers).
+    Samples,
 }
 
 impl Key {
@@ -105,6 +107,7 @@ impl Key {
             Key::MaxSteps => "max_steps",
             Key::Relaxation => "relaxation",
             Key::Aa => "aa",
+            Key::Samples => "samples",
         }
     }
 
@@ -114,6 +117,7 @@ impl Key {
             "max_steps" => Ok(Key::MaxSteps),
             "relaxation" => Ok(Key::Relaxation),
             "aa" => Ok(Key::Aa),
+            "samples" => Ok(Key::Samples),
             _ => Err(Error::Key(s.into())),
         }
     }
@@ -125,6 +129,7 @@ impl Key {
             Key::MaxSteps => s.max_steps as f64,
             Key::Relaxation => s.relaxation,
             Key::Aa => s.aa as f64,
+            Key::Samples => s.samples as f64,
         }
     }
 
@@ -135,7 +140,7 @@ impl Key {
 
     /// Whether the values are whole numbers.
     fn integral(self) -> bool {
-        matches!(self, Key::MaxSteps | Key::Aa)
+        matches!(self, Key::MaxSteps | Key::Aa | Key::Samples)
     }
 }
 
@@ -233,13 +238,13 @@ fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, Erro
         None => (hi, None),
     };
     let (lo, hi) = (number(key, lo)?, number(key, hi)?);
-    let log = matches!(key, Key::Epsilon | Key::MaxSteps);
+    let log = matches!(key, Key::Epsilon | Key::MaxSteps | Key::Samples);
     if log && (lo <= 0.0 || hi <= 0.0) {
         return Err(Error::NotPositive(key.name()));
     }
     let n = count.unwrap_or_else(|| match key {
         Key::Epsilon => (2.0 * (hi / lo).log10().abs()).round() as usize + 1,
-        Key::MaxSteps => (hi / lo).log2().abs().round() as usize + 1,
+        Key::MaxSteps | Key::Samples => (hi / lo).log2().abs().round() as usize + 1,
         Key::Relaxation => ((hi - lo).abs() / 0.2).round() as usize + 1,
         Key::Aa => (hi - lo).abs().round() as usize + 1,
     });
@@ -350,6 +355,8 @@ pub struct Measured {
     pub relaxation: f64,
     /// Supersampling.
     pub aa: u32,
+    /// The path tracer's samples a pixel (0 for a render that is not path traced).
+    pub samples: u32,
     /// Median seconds per frame.
     pub median_s: f64,
     /// Fastest frame, seconds.
@@ -381,6 +388,8 @@ pub struct Measured {
 pub struct ReferenceInfo {
     /// Supersampling of the reference (the largest of the points).
     pub aa: u32,
+    /// The path tracer's samples of the reference (0 where the scene is not path traced).
+    pub samples: u32,
     /// Its convergence check.
     pub convergence: Convergence,
     /// Seconds it took (with the check).
@@ -416,9 +425,15 @@ pub struct Report {
 
 /// Whether two settings agree on the swept keys.
 pub fn same(a: &Settings, b: &Settings) -> bool {
-    [Key::Epsilon, Key::MaxSteps, Key::Relaxation, Key::Aa]
-        .iter()
-        .all(|k| k.get(a) == k.get(b))
+    [
+        Key::Epsilon,
+        Key::MaxSteps,
+        Key::Relaxation,
+        Key::Aa,
+        Key::Samples,
+    ]
+    .iter()
+    .all(|k| k.get(a) == k.get(b))
         && a.footprint == b.footprint
 }
 
@@ -429,8 +444,13 @@ pub fn describe(s: &Settings) -> String {
     } else {
         format!("{:e}", s.epsilon)
     };
+    let samples = if s.path {
+        format!(", {} samples", s.samples)
+    } else {
+        String::new()
+    };
     format!(
-        "ε {epsilon}, {} steps, ω {}, aa {}",
+        "ε {epsilon}, {} steps, ω {}, aa {}{samples}",
         s.max_steps, s.relaxation, s.aa
     )
 }
@@ -464,11 +484,12 @@ pub fn table(r: &Report) -> String {
         }
     );
     out += &format!(
-        "{:>9} {:>9} {:>5} {:>3} {:>10} {:>9} {:>8} {:>7} {:>6} {:>6}\n",
+        "{:>9} {:>9} {:>5} {:>3} {:>7} {:>10} {:>9} {:>8} {:>7} {:>6} {:>6}\n",
         "epsilon",
         "max_steps",
         "ω",
         "aa",
+        "samples",
         "median ms",
         "steps/px",
         "PSNR dB",
@@ -484,11 +505,12 @@ pub fn table(r: &Report) -> String {
             _ => "",
         };
         out += &format!(
-            "{:>9.2e} {:>9} {:>5} {:>3} {:>10.3} {:>9.1} {:>8.2} {:>7.4} {:>6} {:>6}\n",
+            "{:>9.2e} {:>9} {:>5} {:>3} {:>7} {:>10.3} {:>9.1} {:>8.2} {:>7.4} {:>6} {:>6}\n",
             m.epsilon,
             m.max_steps,
             m.relaxation,
             m.aa,
+            m.samples,
             m.median_s * 1e3,
             m.steps_mean,
             m.psnr,
@@ -523,7 +545,7 @@ pub fn chart_of(r: &Report, target: f64) -> Chart {
     Chart {
         title: format!("{name}: speed against accuracy ({} points)", r.points.len()),
         subtitle: format!(
-            "{} on {}, {} {}x{}, median of {} frames; reference: CPU f64, ε {}, {} steps, aa {}; it agrees with ε {}, aa {} to {:.1} dB{}",
+            "{} on {}, {} {}x{}, median of {} frames; reference: CPU f64, ε {}, {} steps, aa {}{}; it agrees with ε {}, aa {}{} to {:.1} dB{}",
             r.backend,
             r.device,
             r.precision,
@@ -533,8 +555,16 @@ pub fn chart_of(r: &Report, target: f64) -> Chart {
             scientific(c.epsilon),
             c.max_steps,
             r.reference.aa,
+            match r.reference.samples {
+                0 => String::new(),
+                n => format!(", {n} samples"),
+            },
             scientific(c.check_epsilon),
             c.check_aa,
+            match r.reference.samples {
+                0 => String::new(),
+                n => format!(" and {n} other samples"),
+            },
             c.difference.psnr,
             if c.converged { "" } else { " (not converged)" }
         ),

@@ -2,7 +2,7 @@
 //! checked against its range and, where one applies, its limit (`render`, `bench`, `pareto`
 //! and `view` share them).
 
-use sdfc_compiler::{Limit, Limits, Method, Settings, Tonemap};
+use sdfc_compiler::{Limit, Limits, Settings, Tonemap};
 
 /// A setting given on the command line that cannot be read or is out of its range: a usage
 /// error.
@@ -52,7 +52,7 @@ pub enum Error {
     #[error("tonemap must be one of {names}, not `{0}`", names = Tonemap::NAMES.join(", "))]
     Tonemap(String),
     /// A `method` that is not one.
-    #[error("method must be one of {names}, not `{0}`", names = Method::NAMES.join(", "))]
+    #[error("method must be one of {names}, not `{0}`", names = Settings::METHODS.join(", "))]
     Method(String),
 }
 
@@ -108,6 +108,8 @@ pub const SETTING_KEYS: &[&str] = &[
     "fog_color",
     "exposure",
     "tonemap",
+    "samples",
+    "bounces",
 ];
 
 /// The help of `--set`: every key of [`SETTING_KEYS`], with the form of the values that are
@@ -117,7 +119,7 @@ pub fn set_help() -> String {
         .iter()
         .map(|&key| match key {
             "background" => "background (as r,g,b)".to_string(),
-            "method" => format!("method ({})", Method::NAMES.join(", ")),
+            "method" => format!("method ({})", Settings::METHODS.join(", ")),
             "fog_color" => "fog_color (as r,g,b)".to_string(),
             "tonemap" => format!("tonemap ({})", Tonemap::NAMES.join(", ")),
             key => key.to_string(),
@@ -143,6 +145,8 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
         "aa" => s.aa = limited(Limit::Aa, 1)?,
         "max_steps" => s.max_steps = limited(Limit::MaxSteps, 1)?,
         "max_depth" => s.max_depth = limited(Limit::MaxDepth, 0)?,
+        "samples" => s.samples = limited(Limit::Samples, 1)?,
+        "bounces" => s.bounces = limited(Limit::Bounces, 0)?,
         "epsilon" => {
             s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?;
             s.footprint = false;
@@ -190,7 +194,9 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
             s.tonemap = Tonemap::from_name(value).ok_or_else(|| Error::Tonemap(value.into()))?
         }
         "method" => {
-            s.method = Method::from_name(value).ok_or_else(|| Error::Method(value.into()))?
+            if !s.set_method(value) {
+                return Err(Error::Method(value.into()));
+            }
         }
         _ => return Err(Error::Unknown(key.into())),
     }
@@ -271,7 +277,21 @@ mod tests {
             let mut s = Settings::default();
             set(&mut s, key, value, &limits).unwrap_or_else(|e| panic!("{key}: {e}"));
         }
-        assert!(help.contains("method (auto, trace, march)"), "{help}");
+        assert!(help.contains("method (auto, trace, march, path)"), "{help}");
+        let mut s = Settings::default();
+        set(&mut s, "method", "path", &limits).expect("path");
+        assert!(s.path && s.method == sdfc_compiler::Method::Auto);
+        set(&mut s, "method", "march", &limits).expect("march");
+        assert!(!s.path && s.method == sdfc_compiler::Method::March);
+        assert_eq!(
+            set(&mut s, "samples", "0", &limits)
+                .unwrap_err()
+                .to_string(),
+            format!(
+                "samples must be a whole number from 1 to {}, not `0`",
+                limits.get(Limit::Samples)
+            )
+        );
         let unknown = set(&mut Settings::default(), "speed", "1", &limits).unwrap_err();
         assert_eq!(unknown, Error::Unknown("speed".into()));
         assert!(
@@ -324,7 +344,7 @@ mod tests {
         );
         assert_eq!(
             refused("method", "fast"),
-            "method must be one of auto, trace, march, not `fast`"
+            "method must be one of auto, trace, march, path, not `fast`"
         );
         assert_eq!(
             parse_size("640by480").unwrap_err().to_string(),

@@ -634,6 +634,96 @@ fn headless_wgpu_screenshot_shows_the_scene() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Headless through wgpu, a path-traced scene accumulates one sample a frame on the device
+/// while the camera rests and stops at its `samples`: the screenshot is `sdfc render`'s
+/// picture of those samples (through wgpu), to within the rounding of summing frames.
+#[test]
+fn headless_wgpu_path_tracing_accumulates_the_scenes_samples() {
+    let dir = temp_dir("headless-path");
+    let scene = SCENE
+        .replace(
+            "aa: 2, max_steps: 128",
+            "method: \"path\", samples: 6, bounces: 2",
+        )
+        .replace(
+            "light point",
+            "light sky { zenith: (0.3, 0.4, 0.7), horizon: (0.8, 0.8, 0.8) }\nlight point",
+        );
+    std::fs::write(dir.join("scene.sdf"), &scene).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&dir)
+        .args(["view", "scene.sdf", "--headless", "--backend", "wgpu"])
+        .args([
+            "--size",
+            "64x48",
+            "--frames",
+            "40",
+            "--screenshot",
+            "shot.png",
+        ])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    if stderr.contains("the Wgpu backend is not available") {
+        assert!(!required(), "{stderr}");
+        eprintln!("SKIPPED: no wgpu adapter\n{stderr}");
+        return;
+    }
+    assert!(out.status.success(), "{stderr}");
+    let rendered = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&dir)
+        .args([
+            "render",
+            "scene.sdf",
+            "--backend",
+            "wgpu",
+            "--size",
+            "64x48",
+        ])
+        .args(["-o", "render.png"])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert!(
+        rendered.status.success(),
+        "{}",
+        String::from_utf8_lossy(&rendered.stderr)
+    );
+    let shot = read_png(&dir.join("shot.png")).unwrap();
+    let render = read_png(&dir.join("render.png")).unwrap();
+    let most = shot
+        .linear
+        .iter()
+        .zip(&render.linear)
+        .flat_map(|(a, b)| (0..3).map(move |i| (a[i] - b[i]).abs()))
+        .fold(0.0f32, f32::max);
+    // One sRGB level of 255 apart at most, where the sums round across a level.
+    assert!(
+        most < 0.02,
+        "the view's six frames against the render: {most}"
+    );
+    // One frame alone is another picture: the frames were six samples, not one six times.
+    let one = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&dir)
+        .args(["view", "scene.sdf", "--headless", "--backend", "wgpu"])
+        .args([
+            "--size",
+            "64x48",
+            "--frames",
+            "1",
+            "--screenshot",
+            "one.png",
+        ])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert!(one.status.success());
+    let one = read_png(&dir.join("one.png")).unwrap();
+    assert_ne!(one.linear, shot.linear);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `sdfc view scene.sdf --headless` (auto) in `dir` for one frame: its status and stderr.
 fn headless_auto(dir: &Path) -> (std::process::ExitStatus, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))

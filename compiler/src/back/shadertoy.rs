@@ -173,6 +173,7 @@ pub fn left_out(scene: &Scene) -> Vec<&'static str> {
             "exposure and the tone curve",
         ),
         (s.aa > 1, "antialiasing"),
+        (s.path, "path tracing (rendered by the Whitted model)"),
     ];
     asked
         .into_iter()

@@ -742,10 +742,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 max_dist: f["max_dist"].num(),
                 relaxation: f["relaxation"].num(),
                 background: f["background"].v3(),
-                method: match &f["method"] {
-                    Value::Str(s) => Method::from_name(s).unwrap_or_default(),
-                    _ => Method::Auto,
-                },
+                method: Method::Auto,
                 occlusion: f["occlusion"].num(),
                 fog: f["fog"].num(),
                 // Left out, the fog takes the background's colour.
@@ -755,7 +752,14 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                     Value::Str(s) => Tonemap::from_name(s).unwrap_or_default(),
                     _ => Tonemap::None,
                 },
+                path: false,
+                samples: int("samples"),
+                bounces: int("bounces"),
+                first_sample: 0,
             };
+            if let Value::Str(name) = &f["method"] {
+                scene.settings.set_method(name);
+            }
             if let (Value::Float(fps), Value::Float(duration)) = (&f["fps"], &f["duration"]) {
                 scene.animation.fps = *fps;
                 scene.animation.duration = *duration;

@@ -26,6 +26,13 @@ pub fn dump(scene: &Scene) -> String {
     if s.method != Method::Auto {
         let _ = writeln!(out, "method {}", s.method.name());
     }
+    if s.path {
+        let _ = writeln!(
+            out,
+            "path traced: samples={} bounces={}",
+            s.samples, s.bounces
+        );
+    }
     // The look, where a setting of it is on.
     if s.occlusion > 0.0 {
         let _ = writeln!(out, "occlusion {}", num(s.occlusion));

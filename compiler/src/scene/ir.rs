@@ -921,6 +921,18 @@ pub struct Settings {
     pub exposure: f64,
     /// The tone curve after the exposure.
     pub tonemap: super::Tonemap,
+    /// Whether pictures are path traced (`method: "path"`; docs/rendering.md, "Path
+    /// tracing"): `samples` paths a pixel of up to `bounces` bounces, intersected as
+    /// `method` says (`auto` for `method: "path"`).
+    pub path: bool,
+    /// The path tracer's samples (paths) per pixel.
+    pub samples: u32,
+    /// The path tracer's bounces after the camera ray's hit.
+    pub bounces: u32,
+    /// The number of the path tracer's first sample in its random stream (not a language
+    /// field: `sdfc view` renders sample `k` of a resting camera as frame `k`, with one
+    /// sample each, so that its frames add up to the picture of `samples` samples).
+    pub first_sample: u32,
 }
 
 /// The intersection method of a render (docs/rendering.md, "Marching" and "Analytic ray tracing").
@@ -995,7 +1007,41 @@ impl Settings {
         fog_color: None,
         exposure: 0.0,
         tonemap: super::Tonemap::None,
+        path: false,
+        samples: 16,
+        bounces: 4,
+        first_sample: 0,
     };
+
+    /// The names the `method` setting accepts: [`Method::NAMES`] and `"path"`.
+    pub const METHODS: &'static [&'static str] = &["auto", "trace", "march", "path"];
+
+    /// Sets the `method` setting by its name: a [`Method`] (the Whitted renderer), or
+    /// `"path"`, the path tracer intersecting as `auto` does. `false` for an unknown name.
+    pub fn set_method(&mut self, name: &str) -> bool {
+        if name == "path" {
+            self.method = Method::Auto;
+            self.path = true;
+            return true;
+        }
+        match Method::from_name(name) {
+            Some(m) => {
+                self.method = m;
+                self.path = false;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The `method` setting's name: `"path"` for the path tracer, else [`Method::name`].
+    pub fn method_name(&self) -> &'static str {
+        if self.path {
+            "path"
+        } else {
+            self.method.name()
+        }
+    }
 }
 
 impl Default for Settings {

@@ -14,6 +14,7 @@ pub mod path;
 pub mod pbr;
 pub mod reach;
 pub mod recentre;
+pub mod sampling;
 
 pub use dump::{dump, num as dump_num};
 pub use ir::*;

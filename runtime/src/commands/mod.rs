@@ -259,6 +259,6 @@ mod tests {
         for key in crate::settings::SETTING_KEYS {
             assert!(help.contains(key), "`--set`'s help lacks {key}:\n{help}");
         }
-        assert!(help.contains("method (auto, trace, march)"), "{help}");
+        assert!(help.contains("method (auto, trace, march, path)"), "{help}");
     }
 }

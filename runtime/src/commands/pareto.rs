@@ -103,7 +103,8 @@ pub fn run(args: ParetoArgs) -> ExitCode {
     };
     // The swept settings are sphere tracing's: a scene that `auto` would trace analytically
     // (no ε, no step budget) is marched, unless `--set method=trace` asks otherwise.
-    if scene.settings.method == Method::Auto {
+    // A path-traced scene keeps finding its surfaces as `auto` does (its sweep is of samples).
+    if scene.settings.method == Method::Auto && !scene.settings.path {
         scene.settings.method = Method::March;
     }
     let mut plan = || -> Result<_, Error> {
@@ -279,10 +280,19 @@ fn reference_setup(
         .map(|s| s.aa)
         .max()
         .unwrap_or(scene.settings.aa);
+    // A path-traced reference has `reference::PATH_FACTOR` times the most samples measured.
+    let most = points
+        .iter()
+        .map(|s| s.samples)
+        .max()
+        .unwrap_or(scene.settings.samples);
+    let samples = most.saturating_mul(reference::PATH_FACTOR);
     let mut reference_scene = scene.clone();
     // The most exact render the scene allows: analytic tracing where it can be traced.
     reference_scene.settings = Settings {
         aa,
+        samples,
+        first_sample: 0,
         method: Method::Auto,
         ..scene.settings.clone()
     };
@@ -331,6 +341,11 @@ fn reference_render(
         frame.render,
         ReferenceInfo {
             aa,
+            samples: if reference_scene.settings.path {
+                reference_scene.settings.samples
+            } else {
+                0
+            },
             convergence,
             seconds,
         },
@@ -368,6 +383,7 @@ fn measure_one(
         max_steps: settings.max_steps,
         relaxation: settings.relaxation,
         aa: settings.aa,
+        samples: if settings.path { settings.samples } else { 0 },
         median_s: times[times.len() / 2],
         min_s: times[0],
         steps_mean: render.stats.steps_mean,

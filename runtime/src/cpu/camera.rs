@@ -65,4 +65,16 @@ impl<T: Float> Pinhole<T> {
         let by = T::one() - two * ay;
         (self.w + self.u * (bx * self.scale.0) + self.v * (by * self.scale.1)).normalize()
     }
+
+    /// The direction through the point `(x + jx, y + jy)` of the image, `jx`, `jy` in [0, 1)
+    /// (the path tracer's jittered samples): `direction`'s formula with `a = ((x + jx)/W,
+    /// (y + jy)/H)`.
+    pub fn jittered(&self, x: u32, y: u32, jx: T, jy: T) -> V3<T> {
+        let ax = (T::from_f64(x as f64) + jx) / self.size.0;
+        let ay = (T::from_f64(y as f64) + jy) / self.size.1;
+        let two = T::from_f64(2.0);
+        let bx = two * ax - T::one();
+        let by = T::one() - two * ay;
+        (self.w + self.u * (bx * self.scale.0) + self.v * (by * self.scale.1)).normalize()
+    }
 }

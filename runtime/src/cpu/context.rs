@@ -77,6 +77,9 @@ pub(super) enum Lamp<T> {
         to_light: V3<T>,
         color: V3<T>,
         sharpness: T,
+        /// The cosine of half its penumbra angle: the path tracer samples it as a disc of
+        /// that angular diameter (a sun's is its `angle`; 1 for none).
+        cos_disc: T,
     },
 }
 
@@ -134,8 +137,18 @@ pub(super) struct Context<T: Float> {
     pub exposure: T,
     pub tonemap: Tonemap,
     /// A sample's pitch at unit distance: 2·tan(fov/2)/(height·aa), the width of its
-    /// footprint on a surface facing it at distance 1 (the filtered checker's).
+    /// footprint on a surface facing it at distance 1 (the filtered checker's; the path
+    /// tracer's samples spread over the whole pixel: aa counts as 1).
     pub pitch: T,
+    /// Whether the render is path traced (`super::path`), with `samples` paths a pixel of
+    /// up to `bounces` bounces.
+    pub path: bool,
+    pub samples: u32,
+    pub bounces: u32,
+    /// The number of the first sample in the random stream (`Settings::first_sample`).
+    pub first_sample: u32,
+    /// The image's width (the path tracer's pixel numbers are `y·width + x`).
+    pub width: u32,
 }
 
 impl<T: Float> Context<T> {
@@ -159,7 +172,10 @@ impl<T: Float> Context<T> {
         if materials.is_empty() {
             materials.push(mat(scene, &Material::default_material(), [None; 2]));
         }
-        let transparent = materials.iter().any(|m| m.transparency > T::zero());
+        // The path tracer's shadow rays are stopped by every surface (light through glass
+        // arrives along the paths that refract), so they look up no material.
+        let transparent = !s.path && materials.iter().any(|m| m.transparency > T::zero());
+        let aa = if s.path { 1 } else { s.aa.max(1) };
         Context {
             camera: Pinhole::new(&scene.camera, s),
             epsilon: T::from_f64(scene.epsilon()),
@@ -193,7 +209,12 @@ impl<T: Float> Context<T> {
             exposure: T::from_f64(s.exposure.exp2()),
             tonemap: s.tonemap,
             pitch: T::from_f64(2.0) * T::from_f64((scene.camera.fov * 0.5).tan())
-                / (T::from_f64(s.height.max(1) as f64) * T::from_f64(s.aa.max(1) as f64)),
+                / (T::from_f64(s.height.max(1) as f64) * T::from_f64(aa as f64)),
+            path: s.path,
+            samples: s.samples.max(1),
+            bounces: s.bounces,
+            first_sample: s.first_sample,
+            width: s.width,
         }
     }
 
@@ -323,17 +344,29 @@ fn lamp<T: Float>(l: &Light) -> Option<Lamp<T>> {
             direction,
             color,
             intensity,
+            penumbra,
             ..
         } => Lamp::Directional {
             to_light: -V3::<T>::from_f64(*direction).normalize(),
             color: V3::from_f64(*color) * T::from_f64(*intensity),
             sharpness: sharpness(l),
+            cos_disc: T::from_f64((penumbra * 0.5).cos()),
         },
         Light::Sky { .. } => return None,
     })
 }
 
 impl<T: Float> Sky<T> {
+    /// Its radiance along `d`: `ground` below the horizon, else `horizon + (zenith −
+    /// horizon)·d.y`.
+    pub fn radiance(&self, d: V3<T>) -> V3<T> {
+        if d.y >= T::zero() {
+            self.horizon + (self.zenith - self.horizon) * d.y
+        } else {
+            self.ground
+        }
+    }
+
     /// Its irradiance over π on a surface whose normal's height is `y`:
     /// `c₀ + c₁·y + c₂·(3y² − 1)` (docs/rendering.md, "Sky light").
     pub fn irradiance_at(&self, y: T) -> V3<T> {
@@ -348,6 +381,14 @@ impl<T: Float> Context<T> {
         self.fog.unwrap_or_else(|| self.background(d))
     }
 
+    /// The radiance of every sky along `d` (the path tracer's light from the skies, whether
+    /// or not they are the background).
+    pub fn sky_radiance(&self, d: V3<T>) -> V3<T> {
+        self.skies
+            .iter()
+            .fold(V3::zero(), |sum, s| sum + s.radiance(d))
+    }
+
     /// What a ray along `d` that hits nothing sees: the skies that are the background, or
     /// the background.
     pub fn background(&self, d: V3<T>) -> V3<T> {
@@ -357,12 +398,6 @@ impl<T: Float> Context<T> {
         self.skies
             .iter()
             .filter(|s| s.background)
-            .fold(V3::zero(), |sum, s| {
-                sum + if d.y >= T::zero() {
-                    s.horizon + (s.zenith - s.horizon) * d.y
-                } else {
-                    s.ground
-                }
-            })
+            .fold(V3::zero(), |sum, s| sum + s.radiance(d))
     }
 }

@@ -31,6 +31,11 @@ pub const AREA_AA: u32 = 8;
 /// be at least ten times (10 dB) more accurate than that.
 pub const CONVERGED_PSNR: f64 = 50.0;
 
+/// A path-traced reference has this many times the samples of the renders it measures (four
+/// octaves: its noise 12 dB below theirs), `sdfc pareto`'s; its check is a render of as many
+/// other samples of the random stream.
+pub const PATH_FACTOR: u32 = 16;
+
 /// Per-channel difference above which a pixel counts as differing in the check.
 pub const THRESHOLD: f64 = 0.1;
 
@@ -70,8 +75,18 @@ pub fn settings_of(scene: &Scene) -> Settings {
 
 /// The settings of the convergence check for reference settings `s`: ε divided by
 /// [`CHECK_FACTOR`], or for an area-averaged reference (ε from the footprint) twice the
-/// samples per axis.
+/// samples per axis; a path-traced one's also other samples of the random stream.
 pub fn check_settings(s: &Settings) -> Settings {
+    // A path-traced reference's own error is mostly its noise: the check draws as many
+    // samples again, the next of the random stream (and ε ten times smaller).
+    let s = &Settings {
+        first_sample: if s.path {
+            s.first_sample.wrapping_add(s.samples)
+        } else {
+            s.first_sample
+        },
+        ..s.clone()
+    };
     if s.footprint {
         Settings {
             aa: s.aa * 2,

@@ -15,23 +15,23 @@ use sdfc_compiler::Float;
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Hit<T> {
     /// Index of the ray in the wave.
-    ray: usize,
-    p: V3<T>,
+    pub ray: usize,
+    pub p: V3<T>,
     /// Unit outward normal (gradient of f).
-    n: V3<T>,
+    pub n: V3<T>,
     /// Path length of the pixel's ray up to `p`.
-    tt: T,
+    pub tt: T,
     /// Normal step h; offsets from the surface are 4h.
-    h: T,
-    mat: u32,
+    pub h: T,
+    pub mat: u32,
     /// A ray inside glass reached an opaque solid within it (not the glass's far side): the
     /// hit is lit and reflects as seen from outside, within the glass.
-    solid: bool,
+    pub solid: bool,
     /// For such a hit, the transparency of the glass around it (sphere tracing only: a traced
     /// shadow ray finds the glass it starts inside of).
-    medium_tau: T,
+    pub medium_tau: T,
     /// What fog left of the ray's segment (1 without fog, and inside solids).
-    fade: T,
+    pub fade: T,
 }
 
 /// Traces `wave`, adds what it sees to its samples, and returns the next wave. On return
@@ -43,6 +43,32 @@ pub(super) fn bounce<T: Float>(
     samples: &mut Samples<T>,
     counters: &mut Counters,
 ) -> Vec<Ray<T>> {
+    // Fog hides what lies beyond every surface: a miss outside solids is its colour.
+    let seen = |ray: &Ray<T>| {
+        if ctx.inv_fog > T::zero() && !ray.inside {
+            ctx.fog_colour(ray.dir)
+        } else {
+            ctx.background(ray.dir)
+        }
+    };
+    let hits = surfaces(ctx, ws, wave, samples, counters, &seen);
+    light(ctx, ws, wave, &hits, samples, counters);
+    let next = spawn(ctx, wave, &hits);
+    counters.secondary_rays += next.len() as u64;
+    next
+}
+
+/// Traces `wave` and finds the surface each ray reached: its point, normal and material
+/// (with the fog over the ray's segment added to its sample). A ray that reached none adds
+/// `seen(ray)` with its weight. On return `ws.traced[i]` holds how ray `i` ended.
+pub(super) fn surfaces<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    wave: &[Ray<T>],
+    samples: &mut Samples<T>,
+    counters: &mut Counters,
+    seen: &dyn Fn(&Ray<T>) -> V3<T>,
+) -> Vec<Hit<T>> {
     trace(ctx, ws, wave, counters);
     let mut hits = Vec::new();
     for (i, (ray, tr)) in wave.iter().zip(&ws.traced).enumerate() {
@@ -81,14 +107,8 @@ pub(super) fn bounce<T: Float>(
             Status::Budget => counters.budget_misses += 1,
             Status::Nan => samples.met_nan(ray.sample),
         }
-        // Fog hides what lies beyond every surface: a miss outside solids is its colour.
-        let seen = if ctx.inv_fog > T::zero() && !ray.inside {
-            ctx.fog_colour(ray.dir)
-        } else {
-            ctx.background(ray.dir)
-        };
         let a = &mut samples.acc[ray.sample as usize];
-        *a = *a + ray.weight.mul_v(seen);
+        *a = *a + ray.weight.mul_v(seen(ray));
     }
     if ctx.analytic.is_some() {
         for hit in &mut hits {
@@ -104,10 +124,7 @@ pub(super) fn bounce<T: Float>(
         materials(ctx, ws, &mut hits);
         solids(ctx, ws, wave, &mut hits);
     }
-    light(ctx, ws, wave, &hits, samples, counters);
-    let next = spawn(ctx, wave, &hits);
-    counters.secondary_rays += next.len() as u64;
-    next
+    hits
 }
 
 /// The evaluators of a workspace that marches: every caller runs where the context has no
@@ -353,7 +370,7 @@ fn solids<T: Float>(
 /// so that a face lying on a checker boundary does not flicker between the two colours, and
 /// its two colours mixed over the sample's footprint ([`look::checker_weight`]); a colour
 /// field is its value at p.
-fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>, dir: V3<T>) -> V3<T> {
+pub(super) fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>, dir: V3<T>) -> V3<T> {
     let tint = |t: Tint<T>| match t {
         Tint::Const(c) => c,
         Tint::Field(k) => {
@@ -584,7 +601,11 @@ fn occlusions<T: Float>(
 }
 
 /// Marches the shadow rays of `ws.launches` into `ws.shadowed`.
-fn shadows<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, counters: &mut Counters) {
+pub(super) fn shadows<T: Float>(
+    ctx: &Context<T>,
+    ws: &mut Workspace<'_, T>,
+    counters: &mut Counters,
+) {
     counters.shadow_rays += ws.launches.len() as u64;
     ws.shadowed.clear();
     if let Some(tracer) = &ctx.analytic {
@@ -593,7 +614,15 @@ fn shadows<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, counters: &mut
                 V3::new(l.origin[0], l.origin[1], l.origin[2]),
                 V3::new(l.dir[0], l.dir[1], l.dir[2]),
             );
-            let light = tracer.transmitted(o, d, l.tmax, |m| ctx.material(m).transparency);
+            // Where shadow rays do not pass transparent surfaces (`Context::transparent`
+            // is off: none is, or the path tracer's are opaque to them), all are opaque.
+            let light = tracer.transmitted(o, d, l.tmax, |m| {
+                if ctx.transparent {
+                    ctx.material(m).transparency
+                } else {
+                    T::zero()
+                }
+            });
             ws.shadowed.push(Shadowed {
                 light,
                 steps: 0,
@@ -620,7 +649,7 @@ fn shadows<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, counters: &mut
 
 /// The transmitted direction through a surface of normal `n` (facing the incoming ray) with
 /// ratio of indices `eta`, or `None` on total internal reflection.
-fn refract<T: Float>(d: V3<T>, n: V3<T>, eta: T) -> Option<V3<T>> {
+pub(super) fn refract<T: Float>(d: V3<T>, n: V3<T>, eta: T) -> Option<V3<T>> {
     let cosi = -d.dot(n);
     let k = T::one() - eta * eta * (T::one() - cosi * cosi);
     if k < T::zero() {
@@ -657,6 +686,8 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
             sample: ray.sample,
             depth: ray.depth + 1,
             inside,
+            pdf: T::zero(),
+            sky_pdf: T::zero(),
         };
         if ray.inside && !hit.solid {
             match refract(ray.dir, -hit.n, m.ior) {

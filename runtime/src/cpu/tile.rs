@@ -43,6 +43,9 @@ pub(super) struct TileOut {
 
 /// Renders one tile.
 pub(super) fn render<T: Float>(ctx: &Context<T>, ws: &mut Workspace<'_, T>, rect: Rect) -> TileOut {
+    if ctx.path {
+        return super::path::render(ctx, ws, rect);
+    }
     let spp = ctx.camera.samples_per_pixel();
     let mut samples = Samples::new((rect.w * rect.h * spp) as usize, ctx.debug_nan);
     let mut counters = Counters::default();
@@ -103,7 +106,7 @@ fn descend<T: Float>(
 /// Per pixel, from the camera rays' results (`spp` consecutive samples per pixel): the mean
 /// distance to the first hit over the rays that hit (NaN where none did) and the fraction of
 /// rays that hit.
-fn first_hits<T: Float>(traced: &[Traced<T>], spp: usize) -> (Vec<f32>, Vec<f32>) {
+pub(super) fn first_hits<T: Float>(traced: &[Traced<T>], spp: usize) -> (Vec<f32>, Vec<f32>) {
     let pixels = traced.len() / spp.max(1);
     let mut distance = Vec::with_capacity(pixels);
     let mut coverage = Vec::with_capacity(pixels);
@@ -138,6 +141,8 @@ fn camera_rays<T: Float>(ctx: &Context<T>, rect: Rect) -> Vec<Ray<T>> {
                     sample: rays.len() as u32,
                     depth: 0,
                     inside: false,
+                    pdf: T::zero(),
+                    sky_pdf: T::zero(),
                 });
             }
         }

@@ -24,6 +24,12 @@ pub(super) struct Ray<T> {
     pub depth: u32,
     /// Whether it travels inside a solid (marching -f).
     pub inside: bool,
+    /// The path tracer's density of the direction as its last bounce drew it, for the
+    /// weight of the sky it may reach (0: a camera ray, a mirror's or a refraction's, whose
+    /// sky is not weighed; always 0 in the Whitted renderer).
+    pub pdf: T,
+    /// The density the sky's next-event estimate at its origin gave the direction (`N·D/π`).
+    pub sky_pdf: T,
 }
 
 /// What the rays of a tile add up to, per sample (index within the tile).

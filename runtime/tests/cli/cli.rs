@@ -687,12 +687,32 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         ("max_steps=2000000", "--limit max_steps=2000000"),
         ("max_depth=100", "--limit max_depth=100"),
         ("width=20000", "--limit edge=20000"),
+        ("samples=70000", "--limit samples=70000"),
+        ("bounces=100", "--limit bounces=100"),
     ] {
         let out = sdfc(&d, &["render", "ball.sdf", "--set", set]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{err}");
         assert!(err.contains(flag), "{set}: {err}");
     }
+    // The path tracer's samples and bounces in the scene: located errors naming the limit
+    // (or, below the least value, the range).
+    for (setting, wanted) in [
+        ("samples: 100000", "--limit samples="),
+        ("bounces: 2000", "--limit bounces="),
+        ("samples: 0", "samples"),
+    ] {
+        let text = format!("render {{ method: \"path\", {setting} }}\nscene {{ sphere(); }}\n");
+        std::fs::write(d.join("path.sdf"), text).expect("write");
+        let out = sdfc(&d, &["check", "path.sdf"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{setting}: {err}");
+        assert!(
+            err.contains("E0400") && err.contains("path.sdf:1:") && err.contains(wanted),
+            "{setting}: {err}"
+        );
+    }
+    std::fs::remove_file(d.join("path.sdf")).expect("remove");
     let out = sdfc(
         &d,
         &[

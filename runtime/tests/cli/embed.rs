@@ -537,6 +537,11 @@ fn the_shadertoy_page_says_what_it_leaves_out() {
         assert!(studio.contains(what), "{what}: {studio}");
     }
     assert!(said(&example("seed3.sdf")).contains("leaves out this scene's reflection"));
+    let path = said(&example("studio_path.sdf"));
+    assert!(
+        path.contains("path tracing (rendered by the Whitted model)"),
+        "{path}"
+    );
     let plain = said(&example("blends.sdf"));
     assert!(!plain.contains("warning"), "{plain}");
 }

@@ -74,6 +74,7 @@ const AGREEMENT: &[(&str, f64, f64)] = &[
     ("spring", 80.0, 0.0005), // 83.7 dB, 0.0000 (0 px), 2026-12-06
     ("star", 105.0, 0.0005),  // 108.9 dB, 0.0000 (0 px), 2026-11-27
     ("studio", 78.0, 0.0005), // 81.5 dB, 0.0000 (0 px), 2026-12-06 (pbr: GGX, metal, glass, emission)
+    ("studio_path", 59.0, 0.0005), // 62.9 dB, 0.0000 (0 px), 2026-12-06 (path traced, 16 samples)
     ("temple", 80.0, 0.0005), // 83.9 dB, 0.0000 (0 px), 2026-12-06 (filtered checker)
     ("vase", 86.0, 0.0005),   // 89.1 dB, 0.0000 (0 px), 2026-11-27
 ];

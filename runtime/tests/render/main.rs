@@ -28,6 +28,7 @@ mod image_conformance;
 mod interpreted_kernel;
 mod look;
 mod optimise;
+mod path;
 mod pbr;
 mod penumbra;
 mod render;

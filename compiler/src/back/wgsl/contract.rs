@@ -23,6 +23,8 @@ pub struct Specialisation {
     pub relax: bool,
     /// The `max_depth` setting.
     pub max_depth: u32,
+    /// Whether it path traces (`method: "path"`).
+    pub path: bool,
 }
 
 impl Specialisation {
@@ -46,6 +48,13 @@ impl Specialisation {
             fog_color: _,
             exposure: _,
             tonemap: _,
+            // Its samples, bounces and first sample are read at every render (`depth.y`,
+            // `depth.z`, `depth.w`);
+            // whether it path traces is specialised (the feature `PATH`).
+            path,
+            samples: _,
+            bounces: _,
+            first_sample: _,
             // Specialised (and read: ω in `march.z`, max_depth in `depth.x`).
             relaxation,
             max_depth,
@@ -53,6 +62,7 @@ impl Specialisation {
         } = settings;
         Specialisation {
             method: *method,
+            path: *path,
             relax: *relaxation > 1.0,
             max_depth: *max_depth,
         }
@@ -61,8 +71,9 @@ impl Specialisation {
     /// In words, for errors.
     pub fn describe(&self) -> String {
         format!(
-            "method {}, {}, max_depth {}",
+            "method {}{}, {}, max_depth {}",
             self.method.name(),
+            if self.path { " (path traced)" } else { "" },
             if self.relax {
                 "over-relaxation"
             } else {

@@ -53,6 +53,7 @@ struct Params {
     look: vec4<f32>,       // occlusion radius R, 1/fog distance, 2^exposure, tone curve
     fog: vec4<f32>,        // the fog's colour; w: 0 where it is the background seen along the ray
     counts: vec4<u32>,     // width, height, aa, max_steps
+    //% depth.yzw: the path tracer's samples, bounces and first sample (path.wgsl).
     depth: vec4<u32>,      // max_depth
 //#if POINT
     points: array<PointLight, {{POINTS}}>,
@@ -164,6 +165,10 @@ fn occlude(through: f32, s: Interval, tmax: f32, tau: f32) -> f32 {
     if !(s.near <= s.far) || s.far <= 0.0 || s.near >= tmax {
         return through;
     }
+//#if PATH
+    // The path tracer's shadow rays are stopped by every surface.
+    return 0.0;
+//#endif
     if tau <= 0.0 {
         return 0.0;
     }
@@ -676,6 +681,17 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = tile.x + gid.x;
     let y = tile.y + gid.y;
+//#if PATH
+    // Path traced (path.wgsl): the mean of `samples` paths (depth.y), numbered from the first
+    // sample (depth.w).
+    let samples = params.depth.y;
+    var sum = vec3<f32>(0.0);
+    for (var s = 0u; s < samples; s++) {
+        sum += path_radiance(x, y, params.depth.w + s);
+    }
+    let pixel = y * params.counts.x + x;
+    var colour = grade(sum / f32(samples));
+//#else
     let aa = params.counts.z;
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < aa; j++) {
@@ -685,6 +701,7 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pixel = y * params.counts.x + x;
     var colour = grade(sum / f32(aa * aa));
+//#endif
 //#if DEBUG_NAN
     // --debug-nan: a pixel any of whose rays met a NaN is magenta.
     if counters.nans > 0u {

@@ -53,7 +53,11 @@ pub const STATS_WORDS: u32 = 9;
 
 /// The kernel template: the renderer (kernel.wgsl) and its shading (shading.wgsl), one
 /// module (WGSL declarations may come in any order).
-const TEMPLATE: &str = concat!(include_str!("kernel.wgsl"), include_str!("shading.wgsl"));
+const TEMPLATE: &str = concat!(
+    include_str!("kernel.wgsl"),
+    include_str!("shading.wgsl"),
+    include_str!("path.wgsl")
+);
 
 /// The most instances (`lower::Lowered::instances`) of a marched scene's root union written as code: beyond,
 /// they are read from `scene_data` and walked nearest first (march.rs). The code grows with
@@ -133,8 +137,11 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
         .iter()
         .any(|l| matches!(l, Light::Directional { .. }));
     let refraction = mats.iter().any(|m| m.transparency > 0.0);
-    let secondary =
-        scene.settings.max_depth > 0 && mats.iter().any(|m| m.reflects() || m.transparency > 0.0);
+    // The path tracer continues every path (and refracts with the secondary rays' code).
+    let path = scene.settings.path;
+    let secondary = path
+        || (scene.settings.max_depth > 0
+            && mats.iter().any(|m| m.reflects() || m.transparency > 0.0));
     vec![
         ("ANALYTIC", traced),
         ("POINT", points),
@@ -146,8 +153,8 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
                 .any(|m| matches!(m.pattern, Pattern::Checker { .. })),
         ),
         // Shadow rays pass through transparent solids even when no refracted ray is traced
-        // (`max_depth: 0`), as on the CPU.
-        ("TRANSPARENT", refraction),
+        // (`max_depth: 0`), as on the CPU; the path tracer's are stopped by every surface.
+        ("TRANSPARENT", refraction && !path),
         ("REFRACTION", refraction && secondary),
         ("SECONDARY", secondary),
         ("MATERIALS", mats.len() > 1),
@@ -551,6 +558,7 @@ fn write_template(
         ("MEDIA", media),
         ("SCENE_DATA", data.is_some()),
         ("INTERPRETED", interprets),
+        ("PATH", scene.settings.path),
     ]);
     on.extend(features[contract::SCENE_FEATURES..].iter().copied());
     let used: Vec<String> = features
@@ -595,6 +603,18 @@ fn write_template(
         values.insert("ENV_C1", v4(pbr::ENV_C1));
         values.insert("ENV_EXP", float(pbr::ENV_EXP));
         values.insert("PI", float(std::f64::consts::PI));
+    }
+    {
+        use crate::scene::sampling::{self, dim};
+        values.insert("INV_PI", float(std::f64::consts::FRAC_1_PI));
+        values.insert("UNIT", float(sampling::UNIT));
+        values.insert("ROULETTE_DEPTH", format!("{}u", sampling::ROULETTE_DEPTH));
+        values.insert("ROULETTE_MAX", float(sampling::ROULETTE_MAX));
+        values.insert("DIM_LOBE", format!("{}u", dim::LOBE));
+        values.insert("DIM_DIRECTION", format!("{}u", dim::DIRECTION[0]));
+        values.insert("DIM_SKY", format!("{}u", dim::SKY[0]));
+        values.insert("DIM_ROULETTE", format!("{}u", dim::ROULETTE));
+        values.insert("DIM_LAMPS", format!("{}u", dim::LAMPS));
     }
     values.insert("ENTRY", ENTRY_POINT.to_string());
     let source = template::expand(template, &on, &values).map_err(|e| Error {

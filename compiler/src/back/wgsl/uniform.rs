@@ -58,11 +58,14 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             if s.fog_color.is_some() { 1.0 } else { 0.0 },
         ),
     )?;
+    // The path tracer's samples spread over the whole pixel: its checker's footprint is the
+    // pixel's (aa counts as 1).
+    let aa = if s.path { 1 } else { s.aa.max(1) };
+    w.uints("counts", &[s.width, s.height, aa, s.max_steps.max(1)])?;
     w.uints(
-        "counts",
-        &[s.width, s.height, s.aa.max(1), s.max_steps.max(1)],
+        "depth",
+        &[s.max_depth, s.samples.max(1), s.bounces, s.first_sample],
     )?;
-    w.uints("depth", &[s.max_depth, 0, 0, 0])?;
     let (mut points, mut dirs, mut skies) = (0, 0, 0);
     // Whether a sky is the background (`background.w`): rays that hit nothing show the skies
     // that are.
@@ -103,10 +106,15 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
                 direction,
                 color,
                 intensity,
+                penumbra,
                 ..
             } => {
                 let to = (-DVec3::from(*direction)).normalize_or_zero().into();
-                w.floats(&format!("dirs[{dirs}].to_light"), &v4(to, 0.0))?;
+                // w: the cosine of half the penumbra angle (the path tracer's disc).
+                w.floats(
+                    &format!("dirs[{dirs}].to_light"),
+                    &v4(to, (penumbra * 0.5).cos()),
+                )?;
                 w.floats(&format!("dirs[{dirs}].color"), &colour(*color, *intensity))?;
                 dirs += 1;
             }

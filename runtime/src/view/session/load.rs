@@ -222,17 +222,26 @@ impl Session {
             }
             _ => None,
         };
-        let method = match prepared.traceable().traced(scene.settings.method) {
-            Some(_) => "trace",
-            None => "march",
+        let traced = prepared.traceable().traced(scene.settings.method).is_some();
+        let method = match (scene.settings.path, traced) {
+            (false, true) => "trace",
+            (false, false) => "march",
+            (true, true) => "path (traced)",
+            (true, false) => "path (marched)",
         };
-        let aa = scene.settings.aa.max(1);
+        // A path-traced picture converges at its `samples`, one a frame.
+        let aa = if scene.settings.path {
+            scene.settings.samples.max(1)
+        } else {
+            let n = scene.settings.aa.max(1);
+            n * n
+        };
         let background = waiting.is_some();
         let good = Good {
             file_camera: scene.camera.clone(),
             scene,
             prepared,
-            aa: aa * aa,
+            aa,
             method,
             load: self.loads - 1,
             waiting,
@@ -331,7 +340,8 @@ impl Session {
             None => scene.camera.clone(),
         };
         let n = scene.settings.aa.max(1);
-        let (dx, dy) = if low {
+        // A path-traced frame jitters within the pixel itself.
+        let (dx, dy) = if low || scene.settings.path {
             (0.0, 0.0)
         } else {
             camera::sample_offset(0, n)
@@ -340,6 +350,7 @@ impl Session {
         first.camera = camera::jittered(&base, dx, dy, w, h);
         let s = &mut first.settings;
         (s.width, s.height, s.aa) = (w, h, 1);
+        (s.samples, s.first_sample) = (1, 0);
         FirstFrame::of((kernel, *lipschitz), &first)
     }
 

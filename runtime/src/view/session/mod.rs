@@ -164,9 +164,10 @@ struct Good {
     prepared: Prepared,
     /// The camera the file gives.
     file_camera: Camera,
-    /// Samples per pixel of a converged image (the scene's `aa`, squared).
+    /// Samples per pixel of a converged image (the scene's `aa`, squared, or its path
+    /// tracer's `samples`).
     aa: u32,
-    /// `trace` or `march`.
+    /// `trace`, `march`, or `path (traced)` or `path (marched)`.
     method: &'static str,
     /// The load it came from.
     load: u32,
@@ -751,8 +752,11 @@ impl Session {
         let Some(good) = self.good.as_mut().filter(|g| g.kernel().is_some()) else {
             return Ok(None);
         };
+        let path = good.scene.settings.path;
         let n = (good.aa as f64).sqrt().round() as u32;
-        let (dx, dy) = if low {
+        // A path-traced frame is one sample, the next of its random stream, jittered within
+        // the pixel by the path tracer itself.
+        let (dx, dy) = if low || path {
             (0.0, 0.0)
         } else {
             camera::sample_offset(a.count, n)
@@ -760,6 +764,7 @@ impl Session {
         good.scene.camera = camera::jittered(&base, dx, dy, w, h);
         let s = &mut good.scene.settings;
         (s.width, s.height, s.aa) = (w, h, 1);
+        (s.samples, s.first_sample) = (1, a.count);
         let start = Instant::now();
         let Some(kernel) = good.kernel() else {
             return Ok(None);
@@ -919,6 +924,13 @@ impl Session {
         }
         if let Some(msg) = &self.broken {
             title.push_str(&format!(" | render error: {msg}"));
+        }
+        // A path-traced picture says how far it has converged: it accumulates while the
+        // camera rests and starts again at any change.
+        if let (Some(good), Some(f)) = (&self.good, &self.last) {
+            if good.scene.settings.path && !stats {
+                title.push_str(&format!(" | {}/{} samples", f.samples, f.target));
+            }
         }
         match self.good.as_ref().and_then(|g| g.waiting.as_ref()) {
             Some(w) if !w.in_grace() && w.interim.as_ref().is_some_and(|i| i.compile.is_none()) => {

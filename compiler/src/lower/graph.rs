@@ -137,8 +137,42 @@ impl<'a> Lowerer<'a> {
             self.zero_set = zero_set;
             f
         };
+        let f = self.raise(id, f, p);
         self.memo.insert(key, f);
         f
+    }
+
+    /// Where the field is read for its zero set alone, an intersection whose planes cut its
+    /// box smaller (`Bounds::raised`) raised to the distance to that box, `max(f, β, β_box)`:
+    /// both are distance bounds, so their maximum is one, with f's solid, and at least the
+    /// distance to the box the unions around it guard it by (`Bounds::zero_set`).
+    fn raise(&mut self, id: NodeId, f: Field, p: P) -> Field {
+        if !self.zero_set || self.b.parametric {
+            return f;
+        }
+        let Some(bound) = self.config.bounds.and_then(|b| b.raised(id)) else {
+            return f;
+        };
+        let text = format!(
+            "node {} intersection: at least the distance to the box its planes cut",
+            self.number(id)
+        );
+        self.b.note(text);
+        let beta = bound_distance(self.b, &bound, p);
+        let (slab, _) = slab_distance(self.b, &bound, None, p);
+        let d = self.b.max(f.d, beta);
+        let d = self.b.max(d, slab);
+        Field { d, m: f.m }
+    }
+
+    /// The bound a union's child is guarded by: where the child's field is read for its zero
+    /// set alone, the one that counts its intersections raised ([`Lowerer::raise`]).
+    fn guard_bound(&self, bounds: &Bounds, c: NodeId) -> Option<Bound> {
+        if self.zero_set && !self.b.parametric {
+            bounds.zero_set(c)
+        } else {
+            bounds.get(c)
+        }
     }
 
     /// The neighbouring cells repetition `id` evaluates, if any.
@@ -733,7 +767,7 @@ impl<'a> Lowerer<'a> {
                 cost: bounds.cost(c),
                 index,
             };
-            match bounds.get(c) {
+            match self.guard_bound(bounds, c) {
                 None => free.push(c),
                 Some(b) if b.finite() => finite.push(item(b)),
                 Some(b) => slabs.push(item(b)),

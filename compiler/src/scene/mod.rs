@@ -5,6 +5,7 @@
 pub mod analysis;
 pub mod analytic;
 pub mod bounds;
+mod clip;
 mod dump;
 pub mod field;
 pub mod ir;

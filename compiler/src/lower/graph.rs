@@ -789,7 +789,12 @@ impl<'a> Lowerer<'a> {
         let split = tree
             .as_ref()
             .is_some_and(|t| matches!(t.kind, Kind::Split(..)));
-        let upper = (self.config.cull && split)
+        // The upper bound costs one child per point (the cheapest of a leaf): not where that
+        // is a child as costly as a Voronoi cell, whose code it would also copy.
+        let cheap = tree
+            .as_ref()
+            .is_some_and(|t| descent_cost(t) <= MAX_DESCENT_COST);
+        let upper = (self.config.cull && split && cheap)
             .then(|| tree.as_ref().map(|t| self.descend(t, p)))
             .flatten()
             .map(|u| {
@@ -823,7 +828,8 @@ impl<'a> Lowerer<'a> {
         })
     }
 
-    /// An upper bound of a hierarchy's union at `p`: the distance of one child of the group
+    /// An upper bound of a hierarchy's union at `p` ([`descent_cost`] at most
+    /// [`MAX_DESCENT_COST`]): the distance of one child of the group
     /// found by descending from the root into the half on the point's side of each splitting
     /// plane. Any child's distance is at least the union's, so the guards may compare with it
     /// before the nearest child is reached.
@@ -1166,6 +1172,17 @@ fn keeps_zero_set(node: &Node) -> bool {
     )
 }
 
+/// The most a union's upper bound ([`Lowerer::descend`]) may cost at a leaf: a few guards.
+const MAX_DESCENT_COST: f64 = 192.0;
+
+/// The most costly child [`Lowerer::descend`] evaluates at a leaf of `t` (the cheapest of
+/// each leaf).
+fn descent_cost(t: &Tree) -> f64 {
+    match &t.kind {
+        Kind::Leaf(items) => items.iter().map(|i| i.cost).fold(f64::INFINITY, f64::min),
+        Kind::Split(a, b, _) => descent_cost(a).max(descent_cost(b)),
+    }
+}
 /// The number of children below a node of a hierarchy.
 fn leaves(t: &Tree) -> usize {
     match &t.kind {

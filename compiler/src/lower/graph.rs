@@ -793,7 +793,7 @@ impl<'a> Lowerer<'a> {
         // is a child as costly as a Voronoi cell, whose code it would also copy.
         let cheap = tree
             .as_ref()
-            .is_some_and(|t| descent_cost(t) <= MAX_DESCENT_COST);
+            .is_some_and(|t| descent_cost(t) <= DESCENT_BUDGET);
         let upper = (self.config.cull && split && cheap)
             .then(|| tree.as_ref().map(|t| self.descend(t, p)))
             .flatten()
@@ -829,7 +829,7 @@ impl<'a> Lowerer<'a> {
     }
 
     /// An upper bound of a hierarchy's union at `p` ([`descent_cost`] at most
-    /// [`MAX_DESCENT_COST`]): the distance of one child of the group
+    /// [`DESCENT_BUDGET`]): the distance of one child of the group
     /// found by descending from the root into the half on the point's side of each splitting
     /// plane. Any child's distance is at least the union's, so the guards may compare with it
     /// before the nearest child is reached.
@@ -1173,7 +1173,7 @@ fn keeps_zero_set(node: &Node) -> bool {
 }
 
 /// The most a union's upper bound ([`Lowerer::descend`]) may cost at a leaf: a few guards.
-const MAX_DESCENT_COST: f64 = 192.0;
+const DESCENT_BUDGET: f64 = 192.0;
 
 /// The most costly child [`Lowerer::descend`] evaluates at a leaf of `t` (the cheapest of
 /// each leaf).

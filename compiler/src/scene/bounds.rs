@@ -10,6 +10,7 @@
 //! bound or an estimate. A box may be infinite along some axes (a slab); a node with no
 //! bound at all (a plane, infinite repetition in every direction) has `None`.
 
+use super::cost::own_cost;
 use super::ir::{mat_vec, Combine, Graph, Node, Smooth, V3};
 use super::NodeId;
 use glam::DVec3;
@@ -250,45 +251,18 @@ fn cut_by_planes(
     node: &Node,
     get: &dyn Fn(&NodeId) -> Option<Bound>,
 ) -> Option<Bound> {
-    let Node::Combine {
-        op: Combine::Intersect,
-        children,
-    } = node
-    else {
-        return None;
+    let boxes = |c: &NodeId| {
+        get(c)
+            .filter(|b| b.finite() && b.scale == 1.0)
+            .map(|b| (b.aabb.c, b.aabb.h))
     };
-    let (mut lo, mut hi) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
-    let mut planes = Vec::new();
-    for c in children {
-        if let Node::Plane { normal, height } = graph.node(*c) {
-            planes.push((*normal, *height));
-        } else if let Some(b) = get(c).filter(|b| b.finite() && b.scale == 1.0) {
-            for k in 0..3 {
-                lo[k] = lo[k].max(b.aabb.c[k] - b.aabb.h[k]);
-                hi[k] = hi[k].min(b.aabb.c[k] + b.aabb.h[k]);
-            }
-        }
-    }
-    if planes.is_empty() || !(0..3).all(|k| lo[k].is_finite() && hi[k].is_finite()) {
-        return None;
-    }
-    if (0..3).any(|k| lo[k] > hi[k]) {
-        return None;
-    }
-    let (lo, hi) = super::clip::clipped(lo, hi, &planes)?;
-    // Grown by a little for the rounding of the cut.
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-    let g = 1e-9 * size.max(1e-9);
-    let h = [0, 1, 2].map(|k| (hi[k] - lo[k]) / 2.0 + g);
+    let (c, h) = super::clip::intersection(graph, node, &boxes)?;
     Some(Bound {
         sphere: Sphere {
-            c: [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
+            c,
             r: DVec3::from(h).length(),
         },
-        aabb: Aabb {
-            c: [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
-            h,
-        },
+        aabb: Aabb { c, h },
         scale: 1.0,
     })
 }
@@ -770,57 +744,6 @@ fn elongate(b: &Bound, h: &V3) -> Bound {
     out.aabb.h = [0, 1, 2].map(|i| b.aabb.h[i] + h[i].abs());
     out.sphere.r += DVec3::from(*h).length();
     out
-}
-
-/// The instructions a node costs per point, roughly, without its children.
-fn own_cost(node: &Node) -> f64 {
-    match node {
-        Node::Sphere { .. } => 8.0,
-        Node::Box { .. } | Node::RoundBox { .. } => 18.0,
-        Node::Plane { .. } => 6.0,
-        Node::Torus { .. } => 12.0,
-        Node::Cylinder { .. } => 17.0,
-        Node::Capsule { .. } => 11.0,
-        Node::Cone { .. } => 35.0,
-        Node::Ellipsoid { .. } => 20.0,
-        Node::Bezier { .. } => 90.0,
-        Node::Rect { .. } => 12.0,
-        Node::Prim { prim, args } => (prim.cost)(args),
-        Node::Polygon { points } => 20.0 * points.len() as f64,
-        // A walk of the hierarchy: a few dozen boxes and triangles of some 40 operations.
-        Node::Mesh { mesh } => 400.0 + 40.0 * (mesh.0.triangles().len() as f64).log2(),
-        // The glyphs near a point: a few glyphs' curves.
-        Node::Text { outline, .. } => {
-            let per_glyph = outline.segments() as f64 / outline.glyphs.len().max(1) as f64;
-            10.0 * outline.glyphs.len() as f64 + 3.0 * 40.0 * per_glyph
-        }
-        Node::Extrude { .. } => 10.0,
-        Node::Revolve { .. } => 5.0,
-        Node::Loft { .. } => 18.0,
-        Node::Screw { .. } => 30.0,
-        Node::Sweep { path, .. } => path.0.cost(),
-        Node::Feature { .. } => 8.0,
-        Node::Combine { children, .. } => 4.0 * children.len() as f64,
-        Node::SmoothCombine { variant, .. } => match variant {
-            Smooth::Stairs(_) | Smooth::Columns(_) => 24.0,
-            _ => 14.0,
-        },
-        Node::Translate { .. } => 3.0,
-        Node::Rotate { .. } => 12.0,
-        Node::Scale { .. } | Node::ScaleXyz { .. } => 5.0,
-        Node::Repeat { .. } => 12.0,
-        Node::Mirror { .. } => 3.0,
-        Node::Twist { .. } | Node::Bend { .. } => 10.0,
-        Node::RepeatPolar { .. } => 30.0,
-        Node::Wrap { .. } => 16.0,
-        Node::Shear { .. } => 12.0,
-        Node::Taper { .. } => 12.0,
-        Node::Morph { .. } => 4.0,
-        Node::Elongate { .. } => 9.0,
-        Node::Round { .. } | Node::Shell { .. } => 2.0,
-        Node::Paint { .. } => 3.0,
-        Node::Field { f, .. } => f.cost(),
-    }
 }
 
 /// The smallest and largest singular values of a 3×3 matrix: the square roots of the

@@ -5,8 +5,50 @@
 //! the polyhedron stays convex and closed, and the box around its vertices holds the
 //! intersection.
 
-use crate::scene::V3;
+use crate::scene::{Combine, Graph, Node, NodeId, V3};
 use glam::DVec3;
+
+/// The box (centre and half-extents) around an intersection `node` of planes and bounded
+/// children, whose boxes (centre and half-extents) `boxes` gives: the children's boxes
+/// intersected, then cut by the planes' half-spaces ([`clipped`]) and grown a little for the
+/// rounding of the cut. `None` for any other node, or one without planes or bounded
+/// children.
+pub(crate) fn intersection(
+    graph: &Graph,
+    node: &Node,
+    boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
+) -> Option<(V3, V3)> {
+    let Node::Combine {
+        op: Combine::Intersect,
+        children,
+    } = node
+    else {
+        return None;
+    };
+    let (mut lo, mut hi) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
+    let mut planes = Vec::new();
+    for c in children {
+        if let Node::Plane { normal, height } = graph.node(*c) {
+            planes.push((*normal, *height));
+        } else if let Some((c, h)) = boxes(c) {
+            for k in 0..3 {
+                lo[k] = lo[k].max(c[k] - h[k]);
+                hi[k] = hi[k].min(c[k] + h[k]);
+            }
+        }
+    }
+    let finite = (0..3).all(|k| lo[k].is_finite() && hi[k].is_finite() && lo[k] <= hi[k]);
+    if planes.is_empty() || !finite {
+        return None;
+    }
+    let (lo, hi) = clipped(lo, hi, &planes)?;
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let g = 1e-9 * size.max(1e-9);
+    Some((
+        [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
+        [0, 1, 2].map(|k| (hi[k] - lo[k]) / 2.0 + g),
+    ))
+}
 
 /// The faces of a convex polyhedron, each a loop of vertices.
 type Faces = Vec<Vec<DVec3>>;

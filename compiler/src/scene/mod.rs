@@ -6,6 +6,7 @@ pub mod analysis;
 pub mod analytic;
 pub mod bounds;
 mod clip;
+mod cost;
 mod dump;
 pub mod field;
 pub mod ir;

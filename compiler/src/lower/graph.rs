@@ -137,8 +137,42 @@ impl<'a> Lowerer<'a> {
             self.zero_set = zero_set;
             f
         };
+        let f = self.raise(id, f, p);
         self.memo.insert(key, f);
         f
+    }
+
+    /// Where the field is read for its zero set alone, an intersection whose planes cut its
+    /// box smaller (`Bounds::raised`) raised to the distance to that box, `max(f, β, β_box)`:
+    /// both are distance bounds, so their maximum is one, with f's solid, and at least the
+    /// distance to the box the unions around it guard it by (`Bounds::zero_set`).
+    fn raise(&mut self, id: NodeId, f: Field, p: P) -> Field {
+        if !self.zero_set || self.b.parametric {
+            return f;
+        }
+        let Some(bound) = self.config.bounds.and_then(|b| b.raised(id)) else {
+            return f;
+        };
+        let text = format!(
+            "node {} intersection: at least the distance to the box its planes cut",
+            self.number(id)
+        );
+        self.b.note(text);
+        let beta = bound_distance(self.b, &bound, p);
+        let (slab, _) = slab_distance(self.b, &bound, None, p);
+        let d = self.b.max(f.d, beta);
+        let d = self.b.max(d, slab);
+        Field { d, m: f.m }
+    }
+
+    /// The bound a union's child is guarded by: where the child's field is read for its zero
+    /// set alone, the one that counts its intersections raised ([`Lowerer::raise`]).
+    fn guard_bound(&self, bounds: &Bounds, c: NodeId) -> Option<Bound> {
+        if self.zero_set && !self.b.parametric {
+            bounds.zero_set(c)
+        } else {
+            bounds.get(c)
+        }
     }
 
     /// The neighbouring cells repetition `id` evaluates, if any.
@@ -742,7 +776,7 @@ impl<'a> Lowerer<'a> {
                 cost: bounds.cost(c),
                 index,
             };
-            match bounds.get(c) {
+            match self.guard_bound(bounds, c) {
                 None => free.push(c),
                 Some(b) if b.finite() => finite.push(item(b)),
                 Some(b) => slabs.push(item(b)),
@@ -764,7 +798,12 @@ impl<'a> Lowerer<'a> {
         let split = tree
             .as_ref()
             .is_some_and(|t| matches!(t.kind, Kind::Split(..)));
-        let upper = (self.config.cull && split)
+        // The upper bound costs one child per point (the cheapest of a leaf): not where that
+        // is a child as costly as a Voronoi cell, whose code it would also copy.
+        let cheap = tree
+            .as_ref()
+            .is_some_and(|t| descent_cost(t) <= DESCENT_BUDGET);
+        let upper = (self.config.cull && split && cheap)
             .then(|| tree.as_ref().map(|t| self.descend(t, p)))
             .flatten()
             .map(|u| {
@@ -798,7 +837,8 @@ impl<'a> Lowerer<'a> {
         })
     }
 
-    /// An upper bound of a hierarchy's union at `p`: the distance of one child of the group
+    /// An upper bound of a hierarchy's union at `p` ([`descent_cost`] at most
+    /// [`DESCENT_BUDGET`]): the distance of one child of the group
     /// found by descending from the root into the half on the point's side of each splitting
     /// plane. Any child's distance is at least the union's, so the guards may compare with it
     /// before the nearest child is reached.
@@ -1141,6 +1181,17 @@ fn keeps_zero_set(node: &Node) -> bool {
     )
 }
 
+/// The most a union's upper bound ([`Lowerer::descend`]) may cost at a leaf: a few guards.
+const DESCENT_BUDGET: f64 = 192.0;
+
+/// The most costly child [`Lowerer::descend`] evaluates at a leaf of `t` (the cheapest of
+/// each leaf).
+fn descent_cost(t: &Tree) -> f64 {
+    match &t.kind {
+        Kind::Leaf(items) => items.iter().map(|i| i.cost).fold(f64::INFINITY, f64::min),
+        Kind::Split(a, b, _) => descent_cost(a).max(descent_cost(b)),
+    }
+}
 /// The number of children below a node of a hierarchy.
 fn leaves(t: &Tree) -> usize {
     match &t.kind {

@@ -10,17 +10,18 @@ use crate::prim::{box_from_q, cylinder, nearer_signed};
 use crate::program::builder::{Builder, Slots, P};
 use crate::scene::{Node, V3};
 
-/// The constants of an exact primitive, four numbers: what its formula below reads as
-/// `s[0..4]` ([`Builder::param`]), and what the GPU's walk over a marched scene's instances
-/// reads from `scene_data` (back/wgsl/march.rs). Derived constants are computed here, in f64,
-/// once: a round box's inner half-extents, a cone's 2h² and 1 / (r² + 4h²). `None` for the
-/// other primitives (a plane, an ellipsoid, a Mandelbulb, which no instance is).
+/// The constants of an exact primitive, four numbers (six for the capped and round cones along
+/// y of the table, `prim::slots`): what its formula below reads as `s[0..8]`
+/// ([`Builder::param`]), and what the GPU's walk over a marched scene's instances reads from
+/// `scene_data` (back/wgsl/march.rs). Derived constants are computed here, in f64, once: a
+/// round box's inner half-extents, a cone's 2h² and 1 / (r² + 4h²). `None` for the other
+/// primitives (a plane, an ellipsoid, a Mandelbulb, which no instance is).
 pub fn slots(node: &Node) -> Option<Slots> {
     Some(match *node {
-        Node::Sphere { radius } => [radius, 0.0, 0.0, 0.0],
-        Node::Box { half } => [half[0], half[1], half[2], 0.0],
-        Node::RoundBox { half, radius: r } => [half[0] - r, half[1] - r, half[2] - r, r],
-        Node::Torus { major, minor } => [major, minor, 0.0, 0.0],
+        Node::Sphere { radius } => four([radius, 0.0, 0.0, 0.0]),
+        Node::Box { half } => four([half[0], half[1], half[2], 0.0]),
+        Node::RoundBox { half, radius: r } => four([half[0] - r, half[1] - r, half[2] - r, r]),
+        Node::Torus { major, minor } => four([major, minor, 0.0, 0.0]),
         Node::Cylinder {
             radius,
             half_height,
@@ -28,13 +29,19 @@ pub fn slots(node: &Node) -> Option<Slots> {
         | Node::Capsule {
             radius,
             half_height,
-        } => [radius, half_height, 0.0, 0.0],
+        } => four([radius, half_height, 0.0, 0.0]),
         Node::Cone {
             radius: r,
             half_height: h,
-        } => [r, h, 2.0 * h * h, 1.0 / (r * r + 4.0 * h * h)],
+        } => four([r, h, 2.0 * h * h, 1.0 / (r * r + 4.0 * h * h)]),
+        Node::Prim { prim, ref args } => return crate::prim::slots(prim, args),
         _ => return None,
     })
+}
+
+/// Four constants as [`Slots`], the rest 0.
+pub(crate) fn four(s: [f64; 4]) -> Slots {
+    [s[0], s[1], s[2], s[3], 0.0, 0.0, 0.0, 0.0]
 }
 
 /// The distance of the exact primitive `node` (one [`slots`] knows) at `p`, its constants
@@ -50,6 +57,7 @@ pub(super) fn exact(b: &mut Builder, p: P, node: &Node, s: &Slots) -> Option<Reg
         Node::Cylinder { .. } => cylinder(b, p, s),
         Node::Capsule { .. } => capsule(b, p, s),
         Node::Cone { .. } => cone(b, p, s),
+        Node::Prim { prim, .. } => return crate::prim::exact(b, p, *prim, s),
         _ => return None,
     })
 }

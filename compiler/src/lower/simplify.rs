@@ -9,7 +9,8 @@
 //!   one of each, in the order translate(rotate(scale(x))); paint moves outside them.
 //! - Primitives absorb what they can exactly: a rotation they are symmetric under (any for
 //!   a sphere, about y for the shapes of revolution, quarter turns for boxes and
-//!   ellipsoids, which permute their extents), a uniform scale (into their sizes), rounding
+//!   ellipsoids, which permute their extents), a uniform scale (into their sizes; a shape
+//!   between two points, into its points and radii), rounding
 //!   (into a sphere's, capsule's or torus's radius), and a plane absorbs any rigid motion.
 //! - Unions flatten: a union inside a union (also through paint, translation, rotation and
 //!   uniform scale, which distribute over a union) gives its children to the outer one;
@@ -501,6 +502,14 @@ impl Simplifier<'_> {
             Node::Plane { normal, height } => Node::Plane {
                 normal: normal.map(|n| n * s.signum()),
                 height: height * a,
+            },
+            // A shape between two points: its points and radii (`prim::scaled`).
+            Node::Prim { prim, ref args } if s > 0.0 => match crate::prim::scaled(prim, args, s) {
+                Some(args) => Node::Prim { prim, args },
+                None => Node::Scale {
+                    factor: s,
+                    child: c,
+                },
             },
             _ => Node::Scale {
                 factor: s,

@@ -4,10 +4,12 @@
 //! to `b` (centred on its midpoint, the segment along y): a rotation and a translation keep
 //! distances, so each is exact as its shape along y is.
 
-use super::solids::{capped_cone, cylinder, round_cone};
+use super::solids::{
+    capped_cone, capped_cone_slots, cylinder, round_cone, round_cone_slots, PRIMS as ALONG_Y,
+};
 use super::Kind::{Float as F, Vec3 as V};
 use super::Range::{Any, NonNeg, Pos};
-use super::{num, param, Args, Def, Extent, Field, Prim};
+use super::{num, param, Args, Def, Extent, Field, Prim, PrimRef};
 use crate::program::builder::{Builder, P};
 use glam::DVec3;
 
@@ -30,7 +32,7 @@ pub(super) static PRIMS: &[Prim] = &[
         cost: |_| 32.0,
         distance: |b, p, args| {
             let (q, h) = frame(b, p, args);
-            cylinder(b, q, &[args.f(2), h, 0.0, 0.0])
+            cylinder(b, q, &[args.f(2), h, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
         },
     },
     Prim {
@@ -50,7 +52,7 @@ pub(super) static PRIMS: &[Prim] = &[
         cost: |_| 55.0,
         distance: |b, p, args| {
             let (q, h) = frame(b, p, args);
-            capped_cone(b, q, h, args.f(2), args.f(3))
+            capped_cone(b, q, &capped_cone_slots(h, args.f(2), args.f(3)))
         },
     },
     Prim {
@@ -89,7 +91,7 @@ pub(super) static PRIMS: &[Prim] = &[
         cost: |_| 42.0,
         distance: |b, p, args| {
             let (q, h) = frame(b, p, args);
-            round_cone(b, q, args.f(2), args.f(3), h)
+            round_cone(b, q, &round_cone_slots(args.f(2), args.f(3), h))
         },
     },
 ];
@@ -135,9 +137,9 @@ fn discs(args: &Args, ra: f64, rb: f64) -> Extent {
     }
 }
 
-/// The point in the frame of the segment from argument `a` to argument `b`: about its
-/// midpoint, turned so that `a` lies at y = -h and `b` at y = +h; and h.
-fn frame(b: &mut Builder, p: P, args: &Args) -> (P, f64) {
+/// The frame of the segment from argument `a` to argument `b`: the rows of the rotation that
+/// turns the segment onto y (`a` below), its midpoint and its half-length.
+fn axes(args: &Args) -> ([V3; 3], V3, f64) {
     let (from, to) = (args.v3(0), args.v3(1));
     let l = length(args);
     let u: V3 = [0, 1, 2].map(|i| (to[i] - from[i]) / l);
@@ -151,11 +153,110 @@ fn frame(b: &mut Builder, p: P, args: &Args) -> (P, f64) {
     let e3 = e1.cross(DVec3::from(u));
     let (e1, e3) = (e1.to_array(), e3.to_array());
     let mid: V3 = [0, 1, 2].map(|i| (from[i] + to[i]) / 2.0);
+    ([e1, u, e3], mid, l / 2.0)
+}
+
+/// The point in the frame of the segment from argument `a` to argument `b`: about its
+/// midpoint, turned so that `a` lies at y = -h and `b` at y = +h; and h.
+fn frame(b: &mut Builder, p: P, args: &Args) -> (P, f64) {
+    let (rows, mid, h) = axes(args);
     let d = b.sub3c(p, mid);
-    let q = [e1, u, e3].map(|row| {
+    let q = rows.map(|row| {
         let terms = [0, 1, 2].map(|j| b.mulc(d[j], row[j]));
         let s = b.add(terms[0], terms[1]);
         b.add(s, terms[2])
     });
-    (q, l / 2.0)
+    (q, h)
+}
+
+/// Whether `prim` is `segment(a, b, radius)`, the capsule between two points (an entry of
+/// solids.rs, whose formula is Quilez's `sdCapsule`: its field is the capsule's along y in
+/// the segment's frame, up to rounding).
+fn is_segment(prim: PrimRef) -> bool {
+    ALONG_Y
+        .iter()
+        .any(|e| std::ptr::eq(e, prim.0) && e.name == "segment")
+}
+
+/// A shape along y that a shape between two points is in its frame.
+#[derive(Debug, Clone)]
+pub enum AlongY {
+    /// A capped cylinder (the scene graph's own node).
+    Cylinder { radius: f64, half_height: f64 },
+    /// A capsule (the scene graph's own node): a segment's.
+    Capsule { radius: f64, half_height: f64 },
+    /// An entry of the table along y (`capped_cone`, `round_cone`) and its arguments.
+    Entry(PrimRef, Args),
+}
+
+/// A shape between two points as its shape along y at `q = rows·(p − mid)`.
+#[derive(Debug, Clone)]
+pub struct Placed {
+    /// The rotation's rows (e1, the unit axis from `a` to `b`, e3).
+    pub rows: [V3; 3],
+    /// The midpoint of the segment.
+    pub mid: V3,
+    pub shape: AlongY,
+}
+
+/// A primitive of this file, or a segment, as its shape along y in its frame, whose distance
+/// there is the primitive's (the same formula and constants; for a segment the capsule's
+/// formula, equal up to rounding); `None` for the other primitives. A marched
+/// scene's instances take shapes between points so (`lower::instances`).
+pub fn placed(prim: PrimRef, args: &Args) -> Option<Placed> {
+    if is_segment(prim) {
+        // A capsule between two points, unless they are one (a ball).
+        if length(args) == 0.0 {
+            return None;
+        }
+        let (rows, mid, h) = axes(args);
+        let shape = AlongY::Capsule {
+            radius: args.f(2),
+            half_height: h,
+        };
+        return Some(Placed { rows, mid, shape });
+    }
+    let index = PRIMS.iter().position(|e| std::ptr::eq(e, prim.0))?;
+    let (rows, mid, h) = axes(args);
+    let entry = |name: &str| {
+        ALONG_Y
+            .iter()
+            .find(|e| e.name == name && e.params[0].kind == F)
+            .map(PrimRef)
+    };
+    let (ra, rb) = (args.f(2), args.f(args.0.len() - 1));
+    let shape = match PRIMS[index].name {
+        "cylinder" => AlongY::Cylinder {
+            radius: ra,
+            half_height: h,
+        },
+        // capped_cone(height, bottom, top) and round_cone(bottom, top, height), the height
+        // 2h: their half-height is h, as here.
+        "cone" => AlongY::Entry(entry("capped_cone")?, Args::numbers(&[2.0 * h, ra, rb])),
+        "round_cone" => AlongY::Entry(entry("round_cone")?, Args::numbers(&[ra, rb, 2.0 * h])),
+        _ => return None,
+    };
+    Some(Placed { rows, mid, shape })
+}
+
+/// The arguments of a primitive of this file or a segment scaled by `s` > 0 (its points and
+/// radii), the
+/// primitive scaled by `s`: a scale above one is absorbed into it (`lower::simplify`).
+pub fn scaled(prim: PrimRef, args: &Args, s: f64) -> Option<Args> {
+    let between = PRIMS.iter().any(|e| std::ptr::eq(e, prim.0)) || is_segment(prim);
+    between.then(|| {
+        Args(
+            args.0
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    if i < 2 {
+                        v.map(|x| x * s)
+                    } else {
+                        [v[0] * s, v[1], v[2]]
+                    }
+                })
+                .collect(),
+        )
+    })
 }

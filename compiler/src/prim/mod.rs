@@ -20,9 +20,10 @@ mod profiles;
 mod solids;
 
 use crate::limits::Limit;
-use crate::program::builder::{Builder, P};
+use crate::program::builder::{Builder, Slots, P};
 use crate::program::Reg;
 
+pub(crate) use between::{placed, scaled, AlongY, Placed};
 pub(crate) use profiles::rect;
 pub(crate) use solids::{box_from_q, cylinder, extrude, nearer_signed};
 
@@ -103,6 +104,11 @@ const fn param(name: &'static str, kind: Kind, def: Def, range: Range) -> Param 
 pub struct Args(pub Vec<[f64; 3]>);
 
 impl Args {
+    /// Arguments that are numbers alone (floats, ints or angles), one each.
+    pub fn numbers(numbers: &[f64]) -> Args {
+        Args(numbers.iter().map(|&x| [x, 0.0, 0.0]).collect())
+    }
+
     /// The arguments `numbers` (one each) with the list `points` as parameter `at`.
     pub fn with_list(numbers: &[f64], at: usize, points: &[[f64; 3]]) -> Args {
         let mut v: Vec<[f64; 3]> = numbers.iter().map(|&x| [x, 0.0, 0.0]).collect();
@@ -232,6 +238,34 @@ pub fn all() -> impl Iterator<Item = &'static Prim> {
 /// The first entry of the primitive `name` (others of that name are its overloads).
 pub fn find(name: &str) -> Option<&'static Prim> {
     all().find(|p| p.name == name)
+}
+
+/// The constants of an entry that a marched scene's instance may be, the capped and round
+/// cones along y (`lower::slots`): what its distance reads through [`Builder::param`].
+pub(crate) fn slots(prim: PrimRef, args: &Args) -> Option<Slots> {
+    match (prim.name, prim.params[0].kind) {
+        ("capped_cone", _) => Some(solids::capped_cone_slots(
+            args.f(0) / 2.0,
+            args.f(1),
+            args.f(2),
+        )),
+        ("round_cone", Kind::Float) => Some(solids::round_cone_slots(
+            args.f(0),
+            args.f(1),
+            args.f(2) / 2.0,
+        )),
+        _ => None,
+    }
+}
+
+/// The distance of an entry [`slots`] knows at `p`, its constants `s` read through
+/// [`Builder::param`]: the entry's own distance with `s` its slots.
+pub(crate) fn exact(b: &mut Builder, p: P, prim: PrimRef, s: &Slots) -> Option<Reg> {
+    match (prim.name, prim.params[0].kind) {
+        ("capped_cone", _) => Some(solids::capped_cone(b, p, s)),
+        ("round_cone", Kind::Float) => Some(solids::round_cone(b, p, s)),
+        _ => None,
+    }
 }
 
 /// No check among the arguments.

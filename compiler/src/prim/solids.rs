@@ -29,7 +29,7 @@ pub(super) static PRIMS: &[Prim] = &[
             Extent::centred([r, h, r], r.hypot(h), [true, false, true])
         },
         cost: |_| 40.0,
-        distance: |b, p, a| capped_cone(b, p, a.f(0) / 2.0, a.f(1), a.f(2)),
+        distance: |b, p, a| capped_cone(b, p, &capped_cone_slots(a.f(0) / 2.0, a.f(1), a.f(2))),
     },
     Prim {
         name: "round_cone",
@@ -64,7 +64,7 @@ pub(super) static PRIMS: &[Prim] = &[
             }
         },
         cost: |_| 30.0,
-        distance: |b, p, a| round_cone(b, p, a.f(0), a.f(1), a.f(2) / 2.0),
+        distance: |b, p, a| round_cone(b, p, &round_cone_slots(a.f(0), a.f(1), a.f(2) / 2.0)),
     },
     Prim {
         name: "segment",
@@ -249,63 +249,96 @@ pub(crate) fn nearer_signed(
     b.mul(s, m)
 }
 
-/// Quilez's exact capped cone (`sdCappedCone`) along y, radius r1 at y = -h and r2 at y = +h:
+/// The constants of [`capped_cone`] of half-height h, radius r1 at y = -h and r2 at y = +h:
+/// (h, r1, r2, k2x, dot(k1, k2), 1 / dot(k2, k2)) with k1 = (r2, h), k2 = (r2 - r1, 2h).
+pub(crate) fn capped_cone_slots(h: f64, r1: f64, r2: f64) -> Slots {
+    let (k2x, k2y) = (r2 - r1, 2.0 * h);
+    let c = r2 * k2x + h * k2y;
+    let inv = 1.0 / (k2x * k2x + k2y * k2y);
+    [h, r1, r2, k2x, c, inv, 0.0, 0.0]
+}
+
+/// Quilez's exact capped cone (`sdCappedCone`) along y, radius r1 at y = -h and r2 at y = +h,
+/// its constants `s` ([`capped_cone_slots`]) read through [`Builder::param`]:
 /// q = (|p.xz|, p.y), k1 = (r2, h), k2 = (r2 - r1, 2h),
 /// ca = (q.x - min(q.x, q.y < 0 ? r1 : r2), |q.y| - h),
 /// cb = q - k1 + k2·clamp(dot(k1 - q, k2) / dot(k2, k2), 0, 1),
 /// d = ±√min(|ca|², |cb|²), negative where cb.x < 0 and ca.y < 0.
-pub(super) fn capped_cone(b: &mut Builder, p: P, h: f64, r1: f64, r2: f64) -> Reg {
+pub(crate) fn capped_cone(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let qx = b.len2(p[0], p[2]);
     let qy = p[1];
     let zero = b.c(0.0);
     let below = b.lt(qy, zero);
-    let (c1, c2) = (b.c(r1), b.c(r2));
+    let (c1, c2) = (b.param(s, 1, 1.0), b.param(s, 2, 1.0));
     let cap = b.select(below, c1, c2);
     let cap = b.min(qx, cap);
     let cax = b.sub(qx, cap);
     let ay = b.abs(qy);
-    let cay = b.subc(ay, h);
-    let (k2x, k2y) = (r2 - r1, 2.0 * h);
-    // dot(k1 - q, k2) = (r2 - qx)·k2x + (h - qy)·k2y
-    let tx = b.mulc(qx, -k2x);
-    let ty = b.mulc(qy, -k2y);
+    let h = b.param(s, 0, 1.0);
+    let cay = b.sub(ay, h);
+    // dot(k1 - q, k2) = (r2 - qx)·k2x + (h - qy)·k2y = -k2x·qx - 2h·qy + dot(k1, k2)
+    let minus_k2x = b.param(s, 3, -1.0);
+    let tx = b.mul(qx, minus_k2x);
+    let minus_k2y = b.param(s, 0, -2.0);
+    let ty = b.mul(qy, minus_k2y);
     let t = b.add(tx, ty);
-    let t = b.addc(t, r2 * k2x + h * k2y);
-    let t = b.mulc(t, 1.0 / (k2x * k2x + k2y * k2y));
+    let c = b.param(s, 4, 1.0);
+    let t = b.add(t, c);
+    let inv = b.param(s, 5, 1.0);
+    let t = b.mul(t, inv);
     let t = b.clampc(t, 0.0, 1.0);
-    let cbx = b.mulc(t, k2x);
+    let k2x = b.param(s, 3, 1.0);
+    let cbx = b.mul(t, k2x);
     let cbx = b.add(qx, cbx);
-    let cbx = b.subc(cbx, r2);
-    let cby = b.mulc(t, k2y);
+    let r2 = b.param(s, 2, 1.0);
+    let cbx = b.sub(cbx, r2);
+    let k2y = b.param(s, 0, 2.0);
+    let cby = b.mul(t, k2y);
     let cby = b.add(qy, cby);
-    let cby = b.subc(cby, h);
+    let h = b.param(s, 0, 1.0);
+    let cby = b.sub(cby, h);
     nearer_signed(b, zero, [cax, cay], [cbx, cby])
 }
 
-/// Quilez's exact round cone (`sdRoundCone`): the hull of spheres of radii r1 at y = -h and
-/// r2 at y = +h. With q = (|p.xz|, p.y + h), s = (r1 - r2) / 2h, c = √(1 - s²) and
-/// k = dot(q, (-s, c)): |q| - r1 where k < 0, |q - (0, 2h)| - r2 where k > 2h·c, else
-/// dot(q, (c, s)) - r1.
-pub(super) fn round_cone(b: &mut Builder, p: P, r1: f64, r2: f64, h: f64) -> Reg {
+/// The constants of [`round_cone`] of radius r1 at y = -h and r2 at y = +h:
+/// (r1, r2, h, s, c, 2h·c) with s = (r1 - r2) / 2h and c = √(1 - s²).
+pub(crate) fn round_cone_slots(r1: f64, r2: f64, h: f64) -> Slots {
     let sn = (r1 - r2) / (2.0 * h);
     let cs = (1.0 - sn * sn).max(0.0).sqrt();
+    [r1, r2, h, sn, cs, 2.0 * h * cs, 0.0, 0.0]
+}
+
+/// Quilez's exact round cone (`sdRoundCone`): the hull of spheres of radii r1 at y = -h and
+/// r2 at y = +h, its constants `s` ([`round_cone_slots`]) read through [`Builder::param`].
+/// With q = (|p.xz|, p.y + h), s = (r1 - r2) / 2h, c = √(1 - s²) and k = dot(q, (-s, c)):
+/// |q| - r1 where k < 0, |q - (0, 2h)| - r2 where k > 2h·c, else dot(q, (c, s)) - r1.
+pub(crate) fn round_cone(b: &mut Builder, p: P, s: &Slots) -> Reg {
     let qx = b.len2(p[0], p[2]);
-    let qy = b.addc(p[1], h);
-    let kx = b.mulc(qx, -sn);
-    let ky = b.mulc(qy, cs);
+    let h = b.param(s, 2, 1.0);
+    let qy = b.add(p[1], h);
+    let minus_sn = b.param(s, 3, -1.0);
+    let kx = b.mul(qx, minus_sn);
+    let cs = b.param(s, 4, 1.0);
+    let ky = b.mul(qy, cs);
     let k = b.add(kx, ky);
     let lower = b.len2(qx, qy);
-    let lower = b.subc(lower, r1);
-    let ty = b.subc(qy, 2.0 * h);
+    let r1 = b.param(s, 0, 1.0);
+    let lower = b.sub(lower, r1);
+    let two_h = b.param(s, 2, 2.0);
+    let ty = b.sub(qy, two_h);
     let upper = b.len2(qx, ty);
-    let upper = b.subc(upper, r2);
-    let sx = b.mulc(qx, cs);
-    let sy = b.mulc(qy, sn);
+    let r2 = b.param(s, 1, 1.0);
+    let upper = b.sub(upper, r2);
+    let cs = b.param(s, 4, 1.0);
+    let sx = b.mul(qx, cs);
+    let sn = b.param(s, 3, 1.0);
+    let sy = b.mul(qy, sn);
     let side = b.add(sx, sy);
-    let side = b.subc(side, r1);
+    let r1 = b.param(s, 0, 1.0);
+    let side = b.sub(side, r1);
     let zero = b.c(0.0);
     let below = b.lt(k, zero);
-    let top = b.c(2.0 * h * cs);
+    let top = b.param(s, 5, 1.0);
     let above = b.lt(top, k);
     let d = b.select(above, upper, side);
     b.select(below, lower, d)
@@ -336,7 +369,7 @@ fn segment(b: &mut Builder, p: P, a: V3, e: V3, r: f64) -> Reg {
 /// A cylinder of radius `r` and half-height `h` with its rims rounded by `e` (Quilez's
 /// `sdRoundedCylinder`): the cylinder of radius r - e and half-height h - e, less e.
 fn rounded_cylinder(b: &mut Builder, p: P, r: f64, e: f64, h: f64) -> Reg {
-    let d = cylinder(b, p, &[r - e, h - e, 0.0, 0.0]);
+    let d = cylinder(b, p, &[r - e, h - e, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
     b.subc(d, e)
 }
 

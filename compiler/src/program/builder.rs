@@ -11,8 +11,8 @@ use std::sync::Arc;
 /// A point or vector: three registers.
 pub(crate) type P = [Reg; 3];
 
-/// The four constants of an exact primitive (`shapes::slots`).
-pub type Slots = [f64; 4];
+/// The constants of an exact primitive (`shapes::slots`): up to eight, unused ones 0.
+pub type Slots = [f64; 8];
 
 /// A constant that is a primitive's constant `slot` times `scale` ([`Builder::param`]).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -10,6 +10,7 @@
 //! bound or an estimate. A box may be infinite along some axes (a slab); a node with no
 //! bound at all (a plane, infinite repetition in every direction) has `None`.
 
+use super::cost::own_cost;
 use super::ir::{mat_vec, Combine, Graph, Node, Smooth, V3};
 use super::NodeId;
 use glam::DVec3;
@@ -171,6 +172,11 @@ fn sphere_hull(a: &Sphere, b: &Sphere) -> Sphere {
 #[derive(Debug, Clone)]
 pub struct Bounds {
     of: Vec<Option<Bound>>,
+    /// Where the node's field is read for its zero set alone ([`Bounds::zero_set`]).
+    zero: Vec<Option<Bound>>,
+    /// The intersections of bounded shapes and planes whose box the planes cut smaller
+    /// ([`Bounds::raised`]).
+    raised: Vec<Option<Bound>>,
     cost: Vec<f64>,
 }
 
@@ -179,16 +185,49 @@ impl Bounds {
     pub fn new(graph: &Graph) -> Bounds {
         let mut out = Bounds {
             of: Vec::with_capacity(graph.len()),
+            zero: Vec::with_capacity(graph.len()),
+            raised: Vec::with_capacity(graph.len()),
             cost: Vec::with_capacity(graph.len()),
         };
         for id in graph.ids() {
             let node = graph.node(id);
-            let b = out.bound(node);
+            let b = bound(node, &|c| out.get(*c)).map(Bound::tight);
             let c = own_cost(node) + node.children().iter().map(|&c| out.cost(c)).sum::<f64>();
-            out.of.push(b.map(Bound::tight));
+            let raised = cut_by_planes(graph, node, &|c| out.zero_set(*c))
+                .filter(|r| b.is_none_or(|b| r.volumes().0 < CUT_SMALLER * b.volumes().0));
+            let zero = match node {
+                _ if raised.is_some() => raised,
+                Node::Paint { .. }
+                | Node::Translate { .. }
+                | Node::Rotate { .. }
+                | Node::Scale { .. }
+                | Node::Combine { .. } => bound(node, &|c| out.zero_set(*c)).map(Bound::tight),
+                _ => b,
+            };
+            out.of.push(b);
+            out.zero.push(zero);
+            out.raised.push(raised);
             out.cost.push(c);
         }
         out
+    }
+
+    /// The bound of a node where its field is read for its zero set alone and the lowering
+    /// raises the intersections [`Bounds::raised`] names to the distance to their boxes
+    /// (local bounds, docs/analysis.md): through paint, rigid and uniformly scaling
+    /// transforms and plain combinations, those intersections' boxes.
+    pub fn zero_set(&self, id: NodeId) -> Option<Bound> {
+        self.zero[id.0 as usize]
+    }
+
+    /// For an intersection of bounded shapes and planes whose planes cut its box to less than
+    /// half its bound's: the box around what is left of its children's boxes on the solid
+    /// side of every plane (`clip.rs`). The intersection's field need not be at least the
+    /// distance to that box (near a sharp edge of half-spaces it is less), so the box is a
+    /// bound only of the field raised to the distance to it, max(f, β), which has the same
+    /// zero set and is a distance bound as both are.
+    pub fn raised(&self, id: NodeId) -> Option<Bound> {
+        self.raised[id.0 as usize]
     }
 
     /// The bound of a node, if it has one.
@@ -200,153 +239,179 @@ impl Bounds {
     pub fn cost(&self, id: NodeId) -> f64 {
         self.cost[id.0 as usize]
     }
+}
 
-    fn bound(&self, node: &Node) -> Option<Bound> {
-        let get = |id: &NodeId| self.get(*id);
-        Some(match node {
-            Node::Sphere { radius } => Bound::of_sphere(*radius),
-            Node::Box { half } => Bound::of_box(*half, DVec3::from(*half).length()),
-            Node::RoundBox { half, radius } => Bound::of_box(
-                *half,
-                DVec3::from(half.map(|h| (h - radius).max(0.0))).length() + radius,
-            ),
-            Node::Plane { .. } | Node::Field { .. } => return None,
-            Node::Torus { major, minor } => {
-                Bound::of_box([major + minor, *minor, major + minor], major + minor)
+/// A raised bound's box must be below this share of the bound's to be kept.
+const CUT_SMALLER: f64 = 0.5;
+
+/// An intersection's children's boxes (their bounds `get`) cut by its planes, as a bound,
+/// when it has planes and bounded children.
+fn cut_by_planes(
+    graph: &Graph,
+    node: &Node,
+    get: &dyn Fn(&NodeId) -> Option<Bound>,
+) -> Option<Bound> {
+    let boxes = |c: &NodeId| {
+        get(c)
+            .filter(|b| b.finite() && b.scale == 1.0)
+            .map(|b| (b.aabb.c, b.aabb.h))
+    };
+    let (c, h) = super::clip::intersection(graph, node, &boxes)?;
+    Some(Bound {
+        sphere: Sphere {
+            c,
+            r: DVec3::from(h).length(),
+        },
+        aabb: Aabb { c, h },
+        scale: 1.0,
+    })
+}
+
+/// The bound of a node from its children's (`get`).
+fn bound(node: &Node, get: &dyn Fn(&NodeId) -> Option<Bound>) -> Option<Bound> {
+    Some(match node {
+        Node::Sphere { radius } => Bound::of_sphere(*radius),
+        Node::Box { half } => Bound::of_box(*half, DVec3::from(*half).length()),
+        Node::RoundBox { half, radius } => Bound::of_box(
+            *half,
+            DVec3::from(half.map(|h| (h - radius).max(0.0))).length() + radius,
+        ),
+        Node::Plane { .. } | Node::Field { .. } => return None,
+        Node::Torus { major, minor } => {
+            Bound::of_box([major + minor, *minor, major + minor], major + minor)
+        }
+        Node::Cylinder {
+            radius,
+            half_height,
+        }
+        | Node::Cone {
+            radius,
+            half_height,
+        } => Bound::of_box([*radius, *half_height, *radius], radius.hypot(*half_height)),
+        Node::Capsule {
+            radius,
+            half_height,
+        } => Bound::of_box(
+            [*radius, half_height + radius, *radius],
+            half_height + radius,
+        ),
+        Node::Ellipsoid { radii } => ellipsoid(*radii),
+        // f ≥ |p| - 2 beyond radius 2, and f ≥ -0.5/e everywhere (see the docs).
+        Node::Mesh { mesh } => {
+            let (lo, hi) = mesh.0.aabb();
+            let c = [0, 1, 2].map(|i| (lo[i] + hi[i]) * 0.5);
+            let h = [0, 1, 2].map(|i| (hi[i] - lo[i]) * 0.5);
+            Bound {
+                sphere: Sphere {
+                    c,
+                    r: (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt(),
+                },
+                aabb: Aabb { c, h },
+                scale: 1.0,
             }
-            Node::Cylinder {
-                radius,
-                half_height,
+        }
+        // A profile read as a field of space is a prism along z.
+        Node::Rect { half } => profile([0.0; 2], *half),
+        Node::Prim { prim, args } => {
+            let e = (prim.extent)(args);
+            let c = [0, 1, 2].map(|i| (e.min[i] + e.max[i]) * 0.5);
+            let h = [0, 1, 2].map(|i| (e.max[i] - e.min[i]) * 0.5);
+            if prim.profile {
+                profile([c[0], c[1]], [h[0], h[1]])
+            } else if h.iter().all(|h| h.is_finite()) {
+                Bound::of_box(h, e.radius).similar(1.0, c)
+            } else {
+                return None;
             }
-            | Node::Cone {
-                radius,
-                half_height,
-            } => Bound::of_box([*radius, *half_height, *radius], radius.hypot(*half_height)),
-            Node::Capsule {
-                radius,
-                half_height,
-            } => Bound::of_box(
-                [*radius, half_height + radius, *radius],
-                half_height + radius,
-            ),
-            Node::Ellipsoid { radii } => ellipsoid(*radii),
-            // f ≥ |p| - 2 beyond radius 2, and f ≥ -0.5/e everywhere (see the docs).
-            Node::Mesh { mesh } => {
-                let (lo, hi) = mesh.0.aabb();
-                let c = [0, 1, 2].map(|i| (lo[i] + hi[i]) * 0.5);
-                let h = [0, 1, 2].map(|i| (hi[i] - lo[i]) * 0.5);
-                Bound {
-                    sphere: Sphere {
-                        c,
-                        r: (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt(),
-                    },
-                    aabb: Aabb { c, h },
-                    scale: 1.0,
-                }
-            }
-            // A profile read as a field of space is a prism along z.
-            Node::Rect { half } => profile([0.0; 2], *half),
-            Node::Prim { prim, args } => {
-                let e = (prim.extent)(args);
-                let c = [0, 1, 2].map(|i| (e.min[i] + e.max[i]) * 0.5);
-                let h = [0, 1, 2].map(|i| (e.max[i] - e.min[i]) * 0.5);
-                if prim.profile {
-                    profile([c[0], c[1]], [h[0], h[1]])
-                } else if h.iter().all(|h| h.is_finite()) {
-                    Bound::of_box(h, e.radius).similar(1.0, c)
-                } else {
-                    return None;
-                }
-            }
-            // A quadratic Bézier curve lies in the triangle of its points.
-            Node::Bezier {
-                a,
-                control,
-                b,
-                radius,
-            } => {
-                let lo = [0, 1].map(|i| a[i].min(control[i]).min(b[i]) - radius);
-                let hi = [0, 1].map(|i| a[i].max(control[i]).max(b[i]) + radius);
-                profile(
-                    [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
-                    [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
-                )
-            }
-            Node::Polygon { points } => {
-                let lo = [0, 1].map(|i| points.iter().fold(f64::INFINITY, |m, q| m.min(q[i])));
-                let hi = [0, 1].map(|i| points.iter().fold(f64::NEG_INFINITY, |m, q| m.max(q[i])));
-                profile(
-                    [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
-                    [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
-                )
-            }
-            Node::Text { outline, .. } => {
-                let (lo, hi) = outline.bounds();
-                profile(
-                    [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
-                    [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
-                )
-            }
-            Node::Extrude {
-                half_height, child, ..
-            } => extrude(&get(child)?, *half_height),
-            Node::Revolve { offset, child } => revolve(&get(child)?, *offset)?,
-            // The loft's field is at least the smaller scale times the distance to the hull
-            // of its profiles' rectangles wherever both are, clamped or not, and is extruded.
-            Node::Loft {
-                half_height,
-                bottom,
-                top,
-                ..
-            } => extrude(&hull(&get(bottom)?, &get(top)?), *half_height),
-            Node::Screw {
-                half_height,
-                floor,
-                child,
-                ..
-            } => screw(&get(child)?, *half_height, *floor)?,
-            Node::Sweep {
-                path,
-                extent,
-                child,
-                ..
-            } => sweep(&path.0, *extent, &get(child)?),
-            Node::Feature { op, a, .. } => get(a)?.grow(op.outset()),
-            Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
-            Node::SmoothCombine {
-                op,
-                k,
-                variant,
-                a,
-                b,
-                ..
-            } => smooth(*op, *k, *variant, get(a), get(b))?,
-            Node::Translate { offset, child } => get(child)?.similar(1.0, *offset),
-            Node::Rotate { matrix, child } => rotate(&get(child)?, matrix),
-            Node::Scale { factor, child } => get(child)?.similar(*factor, [0.0; 3]),
-            Node::ScaleXyz { factors, child } => scale_xyz(&get(child)?, factors),
-            Node::Repeat {
-                period,
-                count,
-                child,
-            } => repeat(&get(child)?, period, count.as_ref())?,
-            Node::Mirror { axes, child } => mirror(&get(child)?, axes),
-            // Every rotation of the child about y; the lowering keeps its field above the
-            // distance to these volumes where it bounds the copies it leaves out.
-            Node::RepeatPolar { child, .. } => about_axis(&get(child)?, 1),
-            Node::Wrap { radius, child } => wrap(&get(child)?, *radius),
-            Node::Shear { matrix, child } => shear(&get(child)?, matrix),
-            // No volume is proven for a taper's field (f(q)·s stretches unevenly).
-            Node::Taper { .. } => return None,
-            Node::Morph { a, b, .. } => hull(&get(a)?, &get(b)?),
-            Node::Twist { child, .. } => about_axis(&get(child)?, 1),
-            Node::Bend { child, .. } => about_axis(&get(child)?, 2),
-            Node::Elongate { half, child } => elongate(&get(child)?, half),
-            Node::Round { radius, child } => get(child)?.grow(*radius),
-            Node::Shell { half, child } => get(child)?.grow(*half),
-            Node::Paint { child, .. } => get(child)?,
-        })
-    }
+        }
+        // A quadratic Bézier curve lies in the triangle of its points.
+        Node::Bezier {
+            a,
+            control,
+            b,
+            radius,
+        } => {
+            let lo = [0, 1].map(|i| a[i].min(control[i]).min(b[i]) - radius);
+            let hi = [0, 1].map(|i| a[i].max(control[i]).max(b[i]) + radius);
+            profile(
+                [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
+                [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
+            )
+        }
+        Node::Polygon { points } => {
+            let lo = [0, 1].map(|i| points.iter().fold(f64::INFINITY, |m, q| m.min(q[i])));
+            let hi = [0, 1].map(|i| points.iter().fold(f64::NEG_INFINITY, |m, q| m.max(q[i])));
+            profile(
+                [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
+                [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
+            )
+        }
+        Node::Text { outline, .. } => {
+            let (lo, hi) = outline.bounds();
+            profile(
+                [0, 1].map(|i| (lo[i] + hi[i]) * 0.5),
+                [0, 1].map(|i| (hi[i] - lo[i]) * 0.5),
+            )
+        }
+        Node::Extrude {
+            half_height, child, ..
+        } => extrude(&get(child)?, *half_height),
+        Node::Revolve { offset, child } => revolve(&get(child)?, *offset)?,
+        // The loft's field is at least the smaller scale times the distance to the hull
+        // of its profiles' rectangles wherever both are, clamped or not, and is extruded.
+        Node::Loft {
+            half_height,
+            bottom,
+            top,
+            ..
+        } => extrude(&hull(&get(bottom)?, &get(top)?), *half_height),
+        Node::Screw {
+            half_height,
+            floor,
+            child,
+            ..
+        } => screw(&get(child)?, *half_height, *floor)?,
+        Node::Sweep {
+            path,
+            extent,
+            child,
+            ..
+        } => sweep(&path.0, *extent, &get(child)?),
+        Node::Feature { op, a, .. } => get(a)?.grow(op.outset()),
+        Node::Combine { op, children } => combine(*op, children.iter().map(get))?,
+        Node::SmoothCombine {
+            op,
+            k,
+            variant,
+            a,
+            b,
+            ..
+        } => smooth(*op, *k, *variant, get(a), get(b))?,
+        Node::Translate { offset, child } => get(child)?.similar(1.0, *offset),
+        Node::Rotate { matrix, child } => rotate(&get(child)?, matrix),
+        Node::Scale { factor, child } => get(child)?.similar(*factor, [0.0; 3]),
+        Node::ScaleXyz { factors, child } => scale_xyz(&get(child)?, factors),
+        Node::Repeat {
+            period,
+            count,
+            child,
+        } => repeat(&get(child)?, period, count.as_ref())?,
+        Node::Mirror { axes, child } => mirror(&get(child)?, axes),
+        // Every rotation of the child about y; the lowering keeps its field above the
+        // distance to these volumes where it bounds the copies it leaves out.
+        Node::RepeatPolar { child, .. } => about_axis(&get(child)?, 1),
+        Node::Wrap { radius, child } => wrap(&get(child)?, *radius),
+        Node::Shear { matrix, child } => shear(&get(child)?, matrix),
+        // No volume is proven for a taper's field (f(q)·s stretches unevenly).
+        Node::Taper { .. } => return None,
+        Node::Morph { a, b, .. } => hull(&get(a)?, &get(b)?),
+        Node::Twist { child, .. } => about_axis(&get(child)?, 1),
+        Node::Bend { child, .. } => about_axis(&get(child)?, 2),
+        Node::Elongate { half, child } => elongate(&get(child)?, half),
+        Node::Round { radius, child } => get(child)?.grow(*radius),
+        Node::Shell { half, child } => get(child)?.grow(*half),
+        Node::Paint { child, .. } => get(child)?,
+    })
 }
 
 /// A profile's bound: the prism along z over the rectangle of centre `c` and half extents
@@ -679,57 +744,6 @@ fn elongate(b: &Bound, h: &V3) -> Bound {
     out.aabb.h = [0, 1, 2].map(|i| b.aabb.h[i] + h[i].abs());
     out.sphere.r += DVec3::from(*h).length();
     out
-}
-
-/// The instructions a node costs per point, roughly, without its children.
-fn own_cost(node: &Node) -> f64 {
-    match node {
-        Node::Sphere { .. } => 8.0,
-        Node::Box { .. } | Node::RoundBox { .. } => 18.0,
-        Node::Plane { .. } => 6.0,
-        Node::Torus { .. } => 12.0,
-        Node::Cylinder { .. } => 17.0,
-        Node::Capsule { .. } => 11.0,
-        Node::Cone { .. } => 35.0,
-        Node::Ellipsoid { .. } => 20.0,
-        Node::Bezier { .. } => 90.0,
-        Node::Rect { .. } => 12.0,
-        Node::Prim { prim, args } => (prim.cost)(args),
-        Node::Polygon { points } => 20.0 * points.len() as f64,
-        // A walk of the hierarchy: a few dozen boxes and triangles of some 40 operations.
-        Node::Mesh { mesh } => 400.0 + 40.0 * (mesh.0.triangles().len() as f64).log2(),
-        // The glyphs near a point: a few glyphs' curves.
-        Node::Text { outline, .. } => {
-            let per_glyph = outline.segments() as f64 / outline.glyphs.len().max(1) as f64;
-            10.0 * outline.glyphs.len() as f64 + 3.0 * 40.0 * per_glyph
-        }
-        Node::Extrude { .. } => 10.0,
-        Node::Revolve { .. } => 5.0,
-        Node::Loft { .. } => 18.0,
-        Node::Screw { .. } => 30.0,
-        Node::Sweep { path, .. } => path.0.cost(),
-        Node::Feature { .. } => 8.0,
-        Node::Combine { children, .. } => 4.0 * children.len() as f64,
-        Node::SmoothCombine { variant, .. } => match variant {
-            Smooth::Stairs(_) | Smooth::Columns(_) => 24.0,
-            _ => 14.0,
-        },
-        Node::Translate { .. } => 3.0,
-        Node::Rotate { .. } => 12.0,
-        Node::Scale { .. } | Node::ScaleXyz { .. } => 5.0,
-        Node::Repeat { .. } => 12.0,
-        Node::Mirror { .. } => 3.0,
-        Node::Twist { .. } | Node::Bend { .. } => 10.0,
-        Node::RepeatPolar { .. } => 30.0,
-        Node::Wrap { .. } => 16.0,
-        Node::Shear { .. } => 12.0,
-        Node::Taper { .. } => 12.0,
-        Node::Morph { .. } => 4.0,
-        Node::Elongate { .. } => 9.0,
-        Node::Round { .. } | Node::Shell { .. } => 2.0,
-        Node::Paint { .. } => 3.0,
-        Node::Field { f, .. } => f.cost(),
-    }
 }
 
 /// The smallest and largest singular values of a 3×3 matrix: the square roots of the

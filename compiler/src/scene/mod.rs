@@ -5,6 +5,8 @@
 pub mod analysis;
 pub mod analytic;
 pub mod bounds;
+mod clip;
+mod cost;
 mod dump;
 pub mod field;
 pub mod ir;

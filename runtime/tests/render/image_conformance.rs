@@ -275,9 +275,10 @@ fn a_marched_scene_read_from_a_buffer_matches_the_cpu() {
 }
 
 /// Large marched scenes walk their instances nearest first and render on wgpu as on the
-/// CPU: examples/scaling/compound_1000.sdf (4 000 instances, beyond the threshold) and the
+/// CPU: examples/scaling/compound_1000.sdf (4 000 instances, beyond the threshold), the
 /// 1 024 spheres of examples/scaling/jittered_1024.sdf marched (`method: "march"`) and
-/// walked (the threshold lowered for the test), at 96×64.
+/// walked (the threshold lowered for the test), and the 1 093 round cones between points and
+/// 729 leaves of examples/scaling/tree.sdf, at 96×64.
 #[test]
 fn many_marched_instances_walked_nearest_first_match_the_cpu() {
     let Some(gpu) = open_gpu() else { return };
@@ -285,7 +286,11 @@ fn many_marched_instances_walked_nearest_first_match_the_cpu() {
         max_instances: 256,
         ..wgsl::Options::default()
     };
-    for (file, instances) in [("compound_1000", 4000), ("jittered_1024", 1024)] {
+    for (file, instances) in [
+        ("compound_1000", 4000),
+        ("jittered_1024", 1024),
+        ("tree", 1822),
+    ] {
         let path = PathBuf::from(format!("../examples/scaling/{file}.sdf"));
         let mut scene = load_small(&path, 96, 64);
         scene.settings.method = sdfc_compiler::Method::March;
@@ -296,6 +301,53 @@ fn many_marched_instances_walked_nearest_first_match_the_cpu() {
         assert!(kernel.data.is_some() && kernel.source.contains("var stack: array<u32,"));
         assert_agree(&gpu, &scene, &lowered, &kernel, file);
     }
+}
+
+/// Cones, round cones, cylinders and segments between two points, bare, painted, and scaled, turned
+/// and moved as a whole, are instances (their shapes along y in the frames of their
+/// segments, two vectors of slots for the cones) and render on wgpu as on the CPU.
+#[test]
+fn shapes_between_points_walked_match_the_cpu() {
+    let mut rng = sdfc_compiler::Rng::new(52);
+    let mut next = move || rng.uniform();
+    let mut text = String::from(
+        "material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\
+         material teal = phong { color: (0.15, 0.6, 0.6), specular: 0.5, shininess: 64 };\n\
+         camera { position: (0, 4, -7), look_at: (0, 1, 3), fov: 60deg }\n\
+         light point { position: (-4, 9, -6), intensity: 1.1, radius: 60 }\n\
+         render { width: 96, height: 64, max_depth: 1 }\n\
+         scene {\n  plane((0, 1, 0), 0);\n",
+    );
+    for i in 0..300 {
+        let a = (16.0 * next() - 8.0, 0.2 + 2.0 * next(), 10.0 * next() - 2.0);
+        let b = (a.0 + next() - 0.5, a.1 + next(), a.2 + next() - 0.5);
+        let (a, b) = (
+            format!("({:.3}, {:.3}, {:.3})", a.0, a.1, a.2),
+            format!("({:.3}, {:.3}, {:.3})", b.0, b.1, b.2),
+        );
+        let shape = match i % 5 {
+            0 => format!("cone({a}, {b}, 0.2, 0.05) @ clay"),
+            1 => format!("round_cone({a}, {b}, 0.15, 0.08)"),
+            2 => format!("cylinder({a}, {b}, 0.1) @ teal"),
+            3 => format!("segment({a}, {b}, 0.08) @ clay"),
+            _ => format!(
+                "cone((0, 0, 0), (0, 1, 0), 0.2, 0.1).scale(0.8).rotate_z({:.1}deg).translate{a}",
+                90.0 * next()
+            ),
+        };
+        text.push_str(&format!("  {shape};\n"));
+    }
+    text.push_str("}\n");
+    let scene = checked("between.sdf", &text);
+    let lowered = Lowered::new(&scene);
+    let split = lowered.instances(wgsl::MAX_INSTANCES).expect("split");
+    assert_eq!(split.instances.len(), 300);
+    let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
+    assert!(kernel
+        .source
+        .contains("fn shape_capped_cone(p: vec3<f32>, s: vec4<f32>, t: vec4<f32>)"));
+    let Some(gpu) = open_gpu() else { return };
+    assert_agree(&gpu, &scene, &lowered, &kernel, "shapes between points");
 }
 
 /// A camera looking straight down (its view parallel to the default `up`) and one rolled by

@@ -77,14 +77,14 @@ fn name(path: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// The examples plus the small scaling scenes.
+/// The examples plus the small scaling scenes (with the Voronoi cells, intersections raised
+/// to the boxes their planes cut, and the small tree of shapes between points).
 fn scenes() -> Vec<(String, Scene)> {
     let mut files = sdf_files("examples");
-    files.extend(
-        sdf_files("examples/scaling")
-            .into_iter()
-            .filter(|p| name(p).ends_with("_10") || name(p).ends_with("_100")),
-    );
+    files.extend(sdf_files("examples/scaling").into_iter().filter(|p| {
+        let n = name(p);
+        n.ends_with("_10") || n.ends_with("_100") || n == "voronoi" || n == "tree_small"
+    }));
     files.iter().map(|p| (name(p), load(p))).collect()
 }
 

@@ -11,7 +11,7 @@
 //!   group      [i]     (centre.xyz, GROUP)
 //!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries,
 //!                      where a ray that does not enter the group's box goes on
-//!   primitive  [i]     (offset.xyz, kind | FRAMED if rotated or scaled | material << 4)
+//!   primitive  [i]     (offset.xyz, kind | FRAMED if rotated or scaled | material << 5)
 //!              [i + 1] the shape: sphere (r², 0, 0, 0), box (half.xyz, 0), cylinder and
 //!                      capsule (r², half height, 0, 0), plane (normal.xyz, height)
 //!              [i + 2 .. i + 5] only when FRAMED: the rows of the world-to-local matrix
@@ -32,14 +32,14 @@ use std::fmt::Write;
 // the material above `MATERIAL_SHIFT`.
 
 /// The tag of a group; the other values of the kind bits are the kinds of leaf of a layout.
-pub(super) const GROUP: u32 = 7;
+pub(super) const GROUP: u32 = 15;
 /// The bits of a tag that hold the kind of entry.
-pub(super) const KIND_BITS: u32 = 7;
+pub(super) const KIND_BITS: u32 = 15;
 /// The tag bit of a leaf with a frame of its own (a primitive with a world-to-local matrix
 /// other than the identity, an instance with a rotation).
-pub(super) const TRANSFORMED: u32 = 8;
+pub(super) const TRANSFORMED: u32 = 16;
 /// Materials are numbered in the tag's bits above these.
-pub(super) const MATERIAL_SHIFT: u32 = 4;
+pub(super) const MATERIAL_SHIFT: u32 = 5;
 
 /// The tag of a leaf of kind `kind` (below [`GROUP`]).
 pub(super) fn tag(kind: u32, transformed: bool, material: u32) -> u32 {

@@ -157,7 +157,7 @@ pub(super) fn write_shape(shape: &crate::lower::ShapeProgram, name: &str) -> Str
     let roots = [program.distance()];
     let mut w = Writer::new(program, &roots, false, name, None);
     for p in &shape.params {
-        let lane = ["s.x", "s.y", "s.z", "s.w"][p.slot];
+        let lane = ["s.x", "s.y", "s.z", "s.w", "t.x", "t.y", "t.z", "t.w"][p.slot];
         w.names.literals[p.reg.0 as usize] = Some(match p.scale {
             1.0 => lane.to_string(),
             -1.0 => format!("(-{lane})"),
@@ -167,7 +167,13 @@ pub(super) fn write_shape(shape: &crate::lower::ShapeProgram, name: &str) -> Str
     let mut body = String::new();
     w.emit(0, w.items.len(), 1, &mut body);
     let d = w.names.get(program.distance(), None);
-    format!("fn {name}(p: vec3<f32>, s: vec4<f32>) -> f32 {{\n{body}    return {d};\n}}\n")
+    // The slots past the fourth are a second vector.
+    let t = if shape.params.iter().any(|p| p.slot >= 4) {
+        ", t: vec4<f32>"
+    } else {
+        ""
+    };
+    format!("fn {name}(p: vec3<f32>, s: vec4<f32>{t}) -> f32 {{\n{body}    return {d};\n}}\n")
 }
 
 /// Writes the statements of a program's live instructions, outlining large blocks.

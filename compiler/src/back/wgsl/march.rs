@@ -15,11 +15,16 @@
 //!              [i + 1] (half-extents.xyz, next): next is the index past the group's entries
 //!              [i + 2 .. next) either two groups (the second at the first's next) or from
 //!                      two to four instances (a leaf)
-//!   instance   [i]     (offset.xyz, kind | ROTATED | material << 4): the point in the
+//!   instance   [i]     (offset.xyz, kind | ROTATED | material << 5): the point in the
 //!                      shape's frame is q = rotate(p) − offset
 //!              [i + 1] the shape: sphere (r, 0, 0, 0), box (half.xyz, 0), round box
 //!                      (half.xyz − r, r), torus (R, r, 0, 0), cylinder and capsule
-//!                      (r, half height, 0, 0), cone (r, h, 2h², 1 / (r² + 4h²))
+//!                      (r, half height, 0, 0), cone (r, h, 2h², 1 / (r² + 4h²)); for the
+//!                      kinds from WIDE on, the first four of their eight slots: capped cone
+//!                      (h, r1, r2, r2 − r1), round cone (r1, r2, h, s)
+//!              [i + 2] only for the kinds from WIDE on, the other four: capped cone
+//!                      (dot(k1, k2), 1 / dot(k2, k2), 0, 0), round cone (c, 2h·c, 0, 0)
+//!                      (prim/solids.rs)
 //!              [+ 3]   only when ROTATED: the columns of the rotation's matrix M, as rows
 //!                      (q_j = Σ_i p_i·M_ij)
 //! ```
@@ -95,6 +100,10 @@ const TORUS: u32 = 3;
 const CYLINDER: u32 = 4;
 const CAPSULE: u32 = 5;
 const CONE: u32 = 6;
+const CAPPED_CONE: u32 = 7;
+const ROUND_CONE: u32 = 8;
+/// The kinds from this one on have eight slots, in two vectors.
+const WIDE: u32 = 7;
 /// The kernel's name of [`TRANSFORMED`] here: an instance with a rotation.
 const ROTATED: u32 = TRANSFORMED;
 
@@ -113,6 +122,8 @@ fn kind(shape: &Node) -> u32 {
         Node::Torus { .. } => TORUS,
         Node::Cylinder { .. } => CYLINDER,
         Node::Capsule { .. } => CAPSULE,
+        Node::Prim { prim, .. } if prim.name == "capped_cone" => CAPPED_CONE,
+        Node::Prim { .. } => ROUND_CONE,
         _ => CONE,
     }
 }
@@ -159,9 +170,14 @@ fn depth(group: &Group) -> usize {
 
 fn instance(out: &mut Vec<[u32; 4]>, i: &Instance) {
     let material = i.material.map_or(0, |m| m.0);
-    let tag = tag(kind(&i.shape), i.rotation.is_some(), material);
+    let kind = kind(&i.shape);
+    let tag = tag(kind, i.rotation.is_some(), material);
     out.push(vec(i.offset, tag));
-    out.push(crate::lower::slots(&i.shape).map_or([0; 4], |s| s.map(bits)));
+    let s = crate::lower::slots(&i.shape).map_or([0; 8], |s| s.map(bits));
+    out.push([s[0], s[1], s[2], s[3]]);
+    if kind >= WIDE {
+        out.push([s[4], s[5], s[6], s[7]]);
+    }
     if let Some(m) = i.rotation {
         out.extend((0..3).map(|j| vec([m[0][j], m[1][j], m[2][j]], 0)));
     }
@@ -172,9 +188,10 @@ fn instance(out: &mut Vec<[u32; 4]>, i: &Instance) {
 /// `instances` are tested for.
 pub fn write(instances: &[Instance], stack: usize) -> String {
     let rotated = instances.iter().any(|i| i.rotation.is_some());
+    let wide = instances.iter().any(|i| kind(&i.shape) >= WIDE);
     let mut out = String::from(
         "// The instances in scene_data (the layout is in compiler/src/back/wgsl/march.rs): the\n\
-         // kind of entry in a tag's low three bits, ROTATED, the material above.\n",
+         // kind of entry in a tag's low four bits, ROTATED, the material above.\n",
     );
     let _ = writeln!(out, "const GROUP: u32 = {GROUP}u;");
     out.push_str(
@@ -194,10 +211,13 @@ pub fn write(instances: &[Instance], stack: usize) -> String {
     if rotated {
         let _ = writeln!(out, "const ROTATED: u32 = {ROTATED}u;");
     }
+    if wide {
+        let _ = writeln!(out, "const WIDE: u32 = {WIDE}u;");
+    }
     out.push('\n');
     helpers(&mut out);
-    shape_distance(&mut out, instances);
-    instance_distance(&mut out, rotated);
+    shape_distance(&mut out, instances, wide);
+    instance_distance(&mut out, rotated, wide);
     walk(&mut out, true, stack);
     walk(&mut out, false, stack);
     out.push_str(
@@ -239,10 +259,12 @@ fn helpers(out: &mut String) {
     );
 }
 
-/// The shape of each kind among `instances` as a function of its own, `fn shape_KIND(p, s)`,
-/// written from the lowering's rules (`lower::shape_program`), then `fn shape_distance`: the
-/// distance of a shape of the tag's kind at q in its own frame, with a branch for each kind.
-fn shape_distance(out: &mut String, instances: &[Instance]) {
+/// The shape of each kind among `instances` as a function of its own, `fn shape_KIND(p, s)`
+/// (`(p, s, t)` for the kinds from [`WIDE`] on, their slots in two vectors), written from the
+/// lowering's rules (`lower::shape_program`), then `fn shape_distance`: the distance of a
+/// shape of the tag's kind at q in its own frame, with a branch for each kind (and `t`, the
+/// second vector of slots, where some kind has one).
+fn shape_distance(out: &mut String, instances: &[Instance], wide: bool) {
     let mut kinds: Vec<(u32, &Node)> = instances
         .iter()
         .map(|i| (kind(&i.shape), &i.shape))
@@ -264,12 +286,17 @@ fn shape_distance(out: &mut String, instances: &[Instance]) {
     }
     out.push_str(
         "// The distance at q of an instance's shape of the tag's kind in its own frame, its\n\
-         // constants s (lower/shapes.rs).\n\
-         fn shape_distance(kind: u32, q: vec3<f32>, s: vec4<f32>) -> f32 {\n",
+         // constants s (lower/shapes.rs).\n",
+    );
+    let t = if wide { ", t: vec4<f32>" } else { "" };
+    let _ = writeln!(
+        out,
+        "fn shape_distance(kind: u32, q: vec3<f32>, s: vec4<f32>{t}) -> f32 {{"
     );
     let call = |k: u32| {
         let name = kinds.iter().find(|c| c.0 == k).map_or("", |c| c.1.kind());
-        format!("return shape_{name}(q, s);")
+        let t = if k >= WIDE { ", t" } else { "" };
+        format!("return shape_{name}(q, s{t});")
     };
     buffer::branches(out, kinds.iter().map(|k| k.0), call, "return 1e30;");
     out.push_str("}\n\n");
@@ -277,7 +304,7 @@ fn shape_distance(out: &mut String, instances: &[Instance]) {
 
 /// `fn instance_distance`: the field of the instance whose entry starts at `i` with `head`,
 /// and `fn instance_size`, its number of vectors.
-fn instance_distance(out: &mut String, rotated: bool) {
+fn instance_distance(out: &mut String, rotated: bool, wide: bool) {
     let _ = write!(
         out,
         "// The distance at p of the instance whose entry starts at scene_data[i] with head.\n\
@@ -286,25 +313,51 @@ fn instance_distance(out: &mut String, rotated: bool) {
          \x20   {} q = p - head.xyz;\n",
         if rotated { "var" } else { "let" }
     );
+    // The vectors of slots: one, or two for the kinds from WIDE on.
+    let slots = if wide {
+        let _ = write!(
+            out,
+            "    let kind = tag & {KIND_BITS}u;\n\
+             \x20   let wide = select(0u, 1u, kind >= WIDE);\n",
+        );
+        ["i + 2u + wide", "i + 3u + wide", "i + 4u + wide"]
+    } else {
+        ["i + 2u", "i + 3u", "i + 4u"]
+    };
     if rotated {
-        out.push_str(
-            "    if (tag & ROTATED) != 0u {\n\
-             \x20       let c0 = scene_data[i + 2u].xyz;\n\
-             \x20       let c1 = scene_data[i + 3u].xyz;\n\
-             \x20       let c2 = scene_data[i + 4u].xyz;\n\
+        let _ = write!(
+            out,
+            "    if (tag & ROTATED) != 0u {{\n\
+             \x20       let c0 = scene_data[{}].xyz;\n\
+             \x20       let c1 = scene_data[{}].xyz;\n\
+             \x20       let c2 = scene_data[{}].xyz;\n\
              \x20       let r = vec3<f32>(\n\
              \x20           (p.x * c0.x + p.y * c0.y) + p.z * c0.z,\n\
              \x20           (p.x * c1.x + p.y * c1.y) + p.z * c1.z,\n\
              \x20           (p.x * c2.x + p.y * c2.y) + p.z * c2.z,\n\
              \x20       );\n\
              \x20       q = r - head.xyz;\n\
-             \x20   }\n",
+             \x20   }}\n",
+            slots[0], slots[1], slots[2]
         );
     }
-    let shape = format!("shape_distance(tag & {KIND_BITS}u, q, scene_data[i + 1u])");
+    let shape = if wide {
+        out.push_str(
+            "    var t = vec4<f32>(0.0);\n\
+             \x20   if wide != 0u {\n\
+             \x20       t = scene_data[i + 2u];\n\
+             \x20   }\n",
+        );
+        "shape_distance(kind, q, scene_data[i + 1u], t)".to_string()
+    } else {
+        format!("shape_distance(tag & {KIND_BITS}u, q, scene_data[i + 1u])")
+    };
     let _ = writeln!(out, "    return {shape};\n}}\n");
     out.push_str("// The number of vectors of the instance whose tag this is.\n");
     out.push_str("fn instance_size(tag: u32) -> u32 {\n    return 2u");
+    if wide {
+        let _ = write!(out, " + select(0u, 1u, (tag & {KIND_BITS}u) >= WIDE)");
+    }
     if rotated {
         out.push_str(" + select(0u, 3u, (tag & ROTATED) != 0u)");
     }

@@ -394,7 +394,8 @@ fn features_are_the_templates() {
     // Not among the combinations: colour fields reach Tint through the examples that use
     // them (rock.sdf), the sky, occlusion, fog and the tone curve (GRADE) through
     // gallery.sdf, which uses all four, the physically based material (PBR, and FRESNEL
-    // with it, whose blocks are all in its kernel) through studio.sdf.
+    // with it, whose blocks are all in its kernel) through studio.sdf, the path tracer
+    // (PATH) through studio_path.sdf.
     let by_examples = [
         "COLOUR_FIELDS",
         "SKY",
@@ -403,6 +404,7 @@ fn features_are_the_templates() {
         "GRADE",
         "FRESNEL",
         "PBR",
+        "PATH",
     ];
     let combined: BTreeSet<&str> = flags
         .iter()

@@ -17,7 +17,7 @@ import numpy as np
 import sdfc
 
 ROOT = Path(__file__).resolve().parents[2]
-ERR = ROOT / "runtime" / "tests" / "in" / "err"
+ERR = ROOT / "compiler" / "tests" / "in" / "err"
 
 SPHERE = """
 camera { position: (0, 0, -4), look_at: (0, 0, 0), fov: 50deg }

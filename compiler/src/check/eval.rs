@@ -70,6 +70,8 @@ pub struct Ctx<'l> {
     /// The resource limits of this compilation: evaluation stays within them on any input.
     pub limits: Limits,
     reported_limit: bool,
+    /// Errors reported so far (evaluation stops at [`MAX_ERRORS`]).
+    errors: usize,
     /// Results of calls of user functions on concrete arguments: functions are pure, so a
     /// call repeated with the same arguments is evaluated once. With each, where its
     /// evaluation read the time `t`, if it did.
@@ -108,10 +110,26 @@ struct PView<'a> {
 }
 
 impl Ctx<'_> {
-    pub fn error(&mut self, d: Diagnostic) {
-        if self.dry == 0 || d.code != "E0401" {
-            self.diags.push(d);
+    /// Records a diagnostic. After [`MAX_ERRORS`] errors evaluation stops: the last one kept
+    /// says so, and no step is taken after it (an input that fails everywhere, such as a
+    /// recursion whose every call overflows, is not evaluated to its end for errors no one
+    /// reads).
+    pub fn error(&mut self, mut d: Diagnostic) {
+        if self.dry > 0 && d.code == "E0401" {
+            return;
         }
+        if d.is_error() {
+            if self.errors >= MAX_ERRORS {
+                return;
+            }
+            self.errors += 1;
+            if self.errors == MAX_ERRORS {
+                d.notes.push(format!(
+                    "checking stopped here, after {MAX_ERRORS} errors: fix these and check again"
+                ));
+            }
+        }
+        self.diags.push(d);
     }
 
     /// Evaluates `e`, within the nesting and fuel limits.
@@ -168,6 +186,9 @@ impl Ctx<'_> {
 
     /// Spends `steps` evaluation steps (elements copied count as one each).
     fn burn_steps(&mut self, steps: u64, span: Span) -> bool {
+        if self.errors >= MAX_ERRORS {
+            return false;
+        }
         self.fuel = self.fuel.saturating_add(steps);
         let max = self.limits.get(Limit::Fuel);
         if self.fuel > max {
@@ -1780,6 +1801,9 @@ impl Ctx<'_> {
 
 /// At most this many call sites are added to a diagnostic inside nested function bodies.
 const MAX_CALL_SITES: usize = 4;
+
+/// The errors after which evaluation stops (the command line shows the first hundred).
+const MAX_ERRORS: usize = 1_000;
 
 /// The span of an argument: `name: value`, or the value alone.
 fn arg_span(a: &Arg) -> Span {

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use sdfc_compiler::{ptx, wgsl};
+use sdfc_compiler::{check_with, ptx, wgsl, Limit, Limits, NoImports, SourceMap};
 
 /// Scenes larger than this (in IR nodes) are skipped: writing and validating the kernel of a
 /// scene of thousands of objects takes seconds under the fuzzer's instrumentation.
@@ -11,7 +11,12 @@ const KERNEL_LIMIT: usize = 2_000;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
-    let (Some(scene), _, _) = sdfc_compiler::check_str("fuzz.sdf", text) else { return };
+    // A million evaluation steps, not the default 50 million: see the front_end target.
+    let mut limits = Limits::default();
+    limits.set(Limit::Fuel, 1_000_000).expect("a valid limit");
+    let mut sources = SourceMap::new();
+    let entry = sources.add("fuzz.sdf", text);
+    let (Some(scene), _) = check_with(&mut sources, entry, &mut NoImports, &limits) else { return };
     if scene.graph.len() > KERNEL_LIMIT {
         return;
     }

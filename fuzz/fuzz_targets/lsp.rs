@@ -94,8 +94,13 @@ fuzz_target!(|data: &[u8]| {
     message(&mut input, None, "exit", Value::Null);
 
     let mut output = Vec::new();
+    // A million evaluation steps, not the default 50 million: see the front_end target.
+    let mut limits = sdfc_compiler::Limits::default();
+    limits
+        .set(sdfc_compiler::Limit::Fuel, 1_000_000)
+        .expect("a valid limit");
     // Serving into memory cannot fail to write.
-    let _ = sdfc_lsp::serve_bytes(&input, &mut output);
+    let _ = sdfc_lsp::serve_bytes(&input, &mut output, limits);
     assert!(
         !output.windows(14).any(|w| w == b"\"code\":-32603,"),
         "an internal error (a panic caught while answering): {}",

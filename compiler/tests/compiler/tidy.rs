@@ -775,6 +775,11 @@ const NOT_LIMITS: &[(&str, &str, &str)] = &[
         "how many calls an error's chain of labels shows; the rest is a note",
     ),
     (
+        "compiler/src/check/eval.rs",
+        "MAX_ERRORS",
+        "errors after which checking stops, saying so: more would be fixed after the first",
+    ),
+    (
         "compiler/src/scene/analysis.rs",
         "MAX_STEP_LIPSCHITZ",
         "the clamp on the step divisor L (docs/analysis.md), a property of the field",

@@ -62,15 +62,18 @@ impl WgpuPrepared {
     /// kernel's frames are 25 to 150 times the specialised kernel's, which its compile never
     /// repays, so `auto` keeps the specialised kernel there, and for the frames of a sequence
     /// (`parameters`), which share one specialised kernel. A CPU adapter's setup is marked
-    /// [`Setup::software`].
+    /// [`Setup::software`], and counts its cut loops whatever [`Setup::image_only`] asks.
     pub(super) fn setup_for(cpu_adapter: bool, setup: &Setup) -> Setup {
         let setup = if cpu_adapter || setup.parameters {
             setup.specialised_for_auto()
         } else {
             *setup
         };
+        // Its frames always count their cut loops (`render` refuses a frame with any), even
+        // where the caller wants the image alone (`sdfc render` without `--stats`).
         Setup {
             software: cpu_adapter,
+            image_only: setup.image_only && !cpu_adapter,
             ..setup
         }
     }

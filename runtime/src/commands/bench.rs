@@ -83,7 +83,9 @@ pub struct Timing {
     /// The GPU kernel: "specialised" (the distance program as code) or "interpreted";
     /// null on the CPU.
     pub kernel: Option<&'static str>,
-    /// The intersection method the scene was rendered with: "trace" (analytic) or "march".
+    /// How the scene was rendered: its surfaces found by "trace" (analytic) or "march"
+    /// (sphere tracing), shaded by Whitted's model; or "path+trace" and "path+march", path
+    /// traced (`method: "path"`) with its surfaces found either way.
     pub method: &'static str,
     /// Instructions of the distance program.
     pub program_len: usize,
@@ -426,7 +428,12 @@ fn time_scene(
         mrays_per_s: c.camera_rays as f64 / median / 1e6,
         total_mrays_per_s: (c.camera_rays + c.secondary_rays + c.shadow_rays) as f64 / median / 1e6,
         kernel: prepared.kernel_kind(),
-        method: if traced { "trace" } else { "march" },
+        method: match (s.path, traced) {
+            (false, true) => "trace",
+            (false, false) => "march",
+            (true, true) => "path+trace",
+            (true, false) => "path+march",
+        },
         program_len: prepared.program_len(),
         ops_per_eval,
         evaluations,
@@ -444,7 +451,7 @@ fn time_scene(
 
 fn header() -> String {
     format!(
-        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>8} {:>9} {:>6} {:>6}",
+        "{:<28} {:>7} {:>10} {:>9} {:>4} {:>7} {:>10} {:>10} {:>8} {:>8} {:>9} {:>6} {:>6}",
         "scene",
         "backend",
         "method",
@@ -466,7 +473,7 @@ fn row(t: &Timing) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned());
     format!(
-        "{:<28} {:>7} {:>6} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>8.2} {:>9.1} {:>6} {:>6}",
+        "{:<28} {:>7} {:>10} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>8.2} {:>9.1} {:>6} {:>6}",
         name.unwrap_or_else(|| t.scene.clone()),
         t.backend,
         t.method,

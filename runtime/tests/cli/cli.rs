@@ -201,6 +201,34 @@ fn bench_prints_a_table_or_json() {
     assert!(runs[0]["median_s"].as_f64().is_some_and(|s| s > 0.0));
     assert_eq!(runs[0]["width"], 16);
     assert!(runs[0]["stats"]["steps_mean"].as_f64().is_some());
+    assert!(["trace", "march"].contains(&runs[0]["method"].as_str().unwrap_or("")));
+    // A path-traced scene says so (it said "march").
+    let out = sdfc(
+        &d,
+        &[
+            "bench",
+            "ball.sdf",
+            "--backend",
+            "cpu",
+            "--size",
+            "16x12",
+            "--frames",
+            "1",
+            "--set",
+            "method=path",
+            "--set",
+            "samples=1",
+            "--json",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let method = v[0]["method"].as_str().unwrap_or("").to_string();
+    assert!(method == "path+trace" || method == "path+march", "{method}");
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -333,15 +333,39 @@ fn a_software_adapter_that_would_cut_loops_refuses_instead_of_a_wrong_picture() 
     let frame = Prepared::new(Backend::Wgpu, &scene, sdfc_runtime::cpu::Precision::F32)
         .expect("prepared")
         .render(&scene, &|_| {});
+    // The command line asks for the image alone (no `--stats`): a software adapter counts
+    // its cut loops all the same (it wrote the streaked picture without a word).
+    let cli = std::process::Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&dir)
+        .args([
+            "render",
+            "shell.sdf",
+            "--backend",
+            "wgpu",
+            "-o",
+            "shell.png",
+        ])
+        .output()
+        .expect("sdfc render runs");
+    let stderr = String::from_utf8_lossy(&cli.stderr);
     if gpu.is_cpu() {
         let Err(e) = frame else {
             panic!("rendered on a software adapter, where it should be refused");
         };
         let e = e.to_string();
         assert!(e.contains("65 535") && e.contains("--backend cpu"), "{e}");
+        assert!(
+            !cli.status.success() && stderr.contains("65 535"),
+            "{stderr}"
+        );
+        assert!(
+            !dir.join("shell.png").exists(),
+            "a refused frame wrote its picture"
+        );
     } else {
         let frame = frame.expect("a GPU renders it");
         assert_eq!(frame.render.stats.counters.cut, 0);
+        assert!(cli.status.success(), "{stderr}");
     }
 }
 

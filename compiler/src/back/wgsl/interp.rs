@@ -620,7 +620,11 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
             "        }\n        if pc == INTERP_DONE {\n            break;\n        }\n        pc = interp_call();\n",
         );
     }
-    out.push_str("    }\n    return interp_result;\n}\n\n");
+    // The loop ends only at `RETURN`: ended elsewhere, a software adapter cut it (the
+    // distance is wrong, and the frame is refused as for a cut marching loop).
+    out.push_str(
+        "    }\n    if pc != INTERP_DONE {\n        counters.cut += 1u;\n    }\n    return interp_result;\n}\n\n",
+    );
     if calls.meshes {
         out.push_str(&super::mesh::write());
         out.push('\n');

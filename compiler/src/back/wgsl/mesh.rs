@@ -149,6 +149,8 @@ pub fn write() -> String {
          \x20           top += 1u;\n\
          \x20       }}\n\
          \x20   }}\n\
+         \x20   // Ended with nodes left: a software adapter cut the walk (see `trace`).\n\
+         \x20   if top > 0u {{ counters.cut += 1u; }}\n\
          \x20   let w = p - mesh_point(p, best_t, best_f);\n\
          \x20   var n = scene_data[best_t + 3u + min(best_f, 5u)].xyz;\n\
          \x20   if best_f == 6u {{\n\

@@ -112,6 +112,21 @@ impl Diagnostic {
     }
 }
 
+/// The start of the note on the last error kept where checking stopped early.
+const STOPPED: &str = "checking stopped here";
+
+/// The note on the last error kept where checking stopped after `errors` errors.
+pub fn stopped_note(errors: usize) -> String {
+    format!("{STOPPED}, after {errors} errors: fix these and check again")
+}
+
+/// Whether checking stopped early at one of `diags` (its note says so).
+pub fn stopped(diags: &[Diagnostic]) -> bool {
+    diags
+        .iter()
+        .any(|d| d.notes.iter().any(|n| n.starts_with(STOPPED)))
+}
+
 /// True when any diagnostic is an error.
 pub fn has_errors(diags: &[Diagnostic]) -> bool {
     diags.iter().any(Diagnostic::is_error)

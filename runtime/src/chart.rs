@@ -1,6 +1,7 @@
-//! Charts of speed against accuracy (`sdfc pareto -o`): two panels, time per frame and
-//! marching steps per pixel (both on log axes) against PSNR, with the Pareto front and the
-//! default settings marked, drawn with plotters as SVG or PNG.
+//! Charts of speed against accuracy (`sdfc pareto -o`): two panels, two costs (time per
+//! frame and marching steps per pixel; for meshes, time and triangles), both on log axes,
+//! against one accuracy (PSNR; for meshes, the distance to the surface on a log axis), with
+//! the Pareto front and the default settings marked, drawn with plotters as SVG or PNG.
 //!
 //! SVG text is left to the viewer's fonts; PNG text is rasterised by ab_glyph from DejaVu
 //! Sans, bundled by the `dejavu` crate, so no system font library is needed.
@@ -13,18 +14,35 @@ use std::sync::Once;
 /// One measured point of a chart.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Point {
-    /// Median time per frame, seconds.
-    pub seconds: f64,
-    /// Mean marching steps per pixel.
-    pub steps: f64,
-    /// PSNR against the reference, dB (may be infinite).
-    pub psnr: f64,
-    /// On the front of time against PSNR.
-    pub front_time: bool,
-    /// On the front of steps against PSNR.
-    pub front_steps: bool,
+    /// Its costs, one a panel (on log axes).
+    pub cost: [f64; 2],
+    /// Its accuracy (may be infinite: drawn at the axis' better end).
+    pub accuracy: f64,
+    /// On the front of each panel's cost against the accuracy.
+    pub front: [bool; 2],
     /// The scene's own settings.
     pub default: bool,
+}
+
+/// One panel: a cost against the accuracy.
+#[derive(Debug, Clone)]
+pub struct Panel {
+    /// The caption above it.
+    pub caption: String,
+    /// The cost axis' description.
+    pub cost: String,
+}
+
+/// The accuracy axis, shared by both panels.
+#[derive(Debug, Clone)]
+pub struct Accuracy {
+    /// Its description.
+    pub label: String,
+    /// Lower values are better (a distance, drawn on a log axis); otherwise higher ones are
+    /// (PSNR, on a linear axis).
+    pub lower_is_better: bool,
+    /// A value drawn as a dashed line (the accuracy target), with its legend, if any.
+    pub target: Option<(f64, String)>,
 }
 
 /// What a chart shows.
@@ -36,8 +54,10 @@ pub struct Chart {
     pub subtitle: String,
     /// The legend entry of the default point.
     pub default_label: String,
-    /// A PSNR drawn as a dashed line (the accuracy target), if any.
-    pub target_psnr: Option<f64>,
+    /// The two panels, left and right.
+    pub panels: [Panel; 2],
+    /// The accuracy axis.
+    pub accuracy: Accuracy,
     /// The points.
     pub points: Vec<Point>,
 }
@@ -112,13 +132,20 @@ fn register_font() {
     });
 }
 
-/// The y range: PSNR from a little below the worst point to a little above the best finite
-/// one (infinite PSNRs are drawn at the top).
-fn psnr_range(chart: &Chart) -> (f64, f64, f64) {
+/// The accuracy axis' range (lo, hi) and where a point of infinite accuracy is drawn: PSNR
+/// from a little below the worst point to a little above the best finite one, infinite ones
+/// at the top; a distance on a log axis around the points, zero at the bottom.
+fn accuracy_range(chart: &Chart) -> (f64, f64, f64) {
+    let a = &chart.accuracy;
+    let target = a.target.as_ref().map(|t| t.0);
+    if a.lower_is_better {
+        let r = log_range(chart.points.iter().map(|p| p.accuracy).chain(target));
+        return (r.start, r.end, r.start);
+    }
     let finite: Vec<f64> = chart
         .points
         .iter()
-        .map(|p| p.psnr)
+        .map(|p| p.accuracy)
         .filter(|v| v.is_finite())
         .collect();
     let lo = finite.iter().copied().fold(f64::INFINITY, f64::min);
@@ -128,7 +155,7 @@ fn psnr_range(chart: &Chart) -> (f64, f64, f64) {
     } else {
         (0.0, 60.0)
     };
-    let (lo, hi) = match chart.target_psnr {
+    let (lo, hi) = match target {
         Some(t) => (lo.min(t), hi.max(t)),
         None => (lo, hi),
     };
@@ -165,63 +192,68 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> Res
     ))
     .map_err(|e| e.to_string())?;
     let (left, right) = body.split_horizontally(SIZE.0 / 2);
-    panel(
-        &left,
-        chart,
-        "Time per frame against accuracy",
-        "median time per frame (ms, log scale)",
-        |p| p.seconds * 1e3,
-        |p| p.front_time,
-    )?;
-    panel(
-        &right,
-        chart,
-        "Marching work against accuracy",
-        "mean marching steps per pixel (log scale)",
-        |p| p.steps,
-        |p| p.front_steps,
-    )
+    if chart.accuracy.lower_is_better {
+        let (lo, hi, _) = accuracy_range(chart);
+        let ys = || (lo..hi).log_scale().with_key_points(log_ticks(lo, hi));
+        panel(&left, chart, 0, ys())?;
+        panel(&right, chart, 1, ys())
+    } else {
+        let (lo, hi, _) = accuracy_range(chart);
+        panel(&left, chart, 0, lo..hi)?;
+        panel(&right, chart, 1, lo..hi)
+    }
 }
 
-/// One panel: `x(point)` on a log axis against PSNR, the front of `on_front` joined by a line.
-fn panel<DB: DrawingBackend>(
+/// Panel `k`: its cost on a log axis against the accuracy on `ys`, the front joined by a
+/// line.
+fn panel<DB: DrawingBackend, Y>(
     area: &DrawingArea<DB, Shift>,
     chart: &Chart,
-    caption: &str,
-    x_label: &str,
-    x: impl Fn(&Point) -> f64,
-    on_front: impl Fn(&Point) -> bool,
-) -> Result<(), String> {
+    k: usize,
+    ys: Y,
+) -> Result<(), String>
+where
+    Y: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
+    Y::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
+{
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-    let (y_lo, y_hi, y_inf) = psnr_range(chart);
-    let y = |p: &Point| if p.psnr.is_finite() { p.psnr } else { y_inf };
-    let xs = log_range(chart.points.iter().map(&x));
+    let (_, _, infinite) = accuracy_range(chart);
+    let y = |p: &Point| {
+        if p.accuracy.is_finite() && !(chart.accuracy.lower_is_better && p.accuracy <= 0.0) {
+            p.accuracy
+        } else {
+            infinite
+        }
+    };
+    let x = |p: &Point| p.cost[k];
+    let xs = log_range(chart.points.iter().map(x));
     let ticks = log_ticks(xs.start, xs.end);
     let mut c = ChartBuilder::on(area)
-        .caption(caption, (FONT, 16))
+        .caption(&chart.panels[k].caption, (FONT, 16))
         .margin(12)
         .x_label_area_size(44)
-        .y_label_area_size(56)
-        .build_cartesian_2d(xs.clone().log_scale().with_key_points(ticks), y_lo..y_hi)
+        .y_label_area_size(66)
+        .build_cartesian_2d(xs.clone().log_scale().with_key_points(ticks), ys)
         .map_err(err)?;
     c.configure_mesh()
-        .x_desc(x_label)
-        .y_desc("PSNR against the reference (dB, higher is better)")
+        .x_desc(&chart.panels[k].cost)
+        .y_desc(&chart.accuracy.label)
         .label_style((FONT, 12))
         .axis_desc_style((FONT, 13))
         .x_label_formatter(&|v| short(*v))
+        .y_label_formatter(&|v| short(*v))
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
         .map_err(err)?;
-    if let Some(t) = chart.target_psnr {
+    if let Some((t, label)) = &chart.accuracy.target {
         c.draw_series(DashedLineSeries::new(
-            [(xs.start, t), (xs.end, t)],
+            [(xs.start, *t), (xs.end, *t)],
             6,
             4,
             BLACK.mix(0.6).stroke_width(1),
         ))
         .map_err(err)?
-        .label(format!("{t} dB target"))
+        .label(label.clone())
         .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK.mix(0.6)));
     }
     c.draw_series(
@@ -236,7 +268,7 @@ fn panel<DB: DrawingBackend>(
     let mut front: Vec<(f64, f64)> = chart
         .points
         .iter()
-        .filter(|p| on_front(p))
+        .filter(|p| p.front[k])
         .map(|p| (x(p), y(p)))
         .collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -260,8 +292,14 @@ fn panel<DB: DrawingBackend>(
     .map_err(err)?
     .label(chart.default_label.clone())
     .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, DEFAULT.filled()));
+    // Better is up for PSNR and down for a distance: the legend goes where the points
+    // are not (the costly and inaccurate corner).
     c.configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
+        .position(if chart.accuracy.lower_is_better {
+            SeriesLabelPosition::UpperRight
+        } else {
+            SeriesLabelPosition::LowerRight
+        })
         .label_font((FONT, 12))
         .background_style(WHITE.mix(0.85))
         .border_style(RGBColor(160, 160, 160))
@@ -294,11 +332,12 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     }
 }
 
-/// A tick label: whole numbers plain, small values with few digits.
+/// A tick label: whole numbers plain, small values with two significant digits.
 fn short(v: f64) -> String {
-    if v >= 1.0 {
+    if v >= 1.0 || v <= 0.0 {
         format!("{}", v.round())
     } else {
-        format!("{v:.2}")
+        let digits = (1 - v.log10().floor() as i32).max(2) as usize;
+        format!("{v:.digits$}")
     }
 }

@@ -235,8 +235,13 @@ fn print_to(diags: &[Diagnostic], sources: &SourceMap, format: DiagnosticFormat,
             let mut text = diagnostics::render(shown, sources, std::io::stderr().is_terminal());
             if let Some(rest) = diags.get(SHOWN..).filter(|r| !r.is_empty()) {
                 let errors = rest.iter().filter(|d| d.is_error()).count();
+                let stopped = if diagnostics::stopped(rest) {
+                    "; checking stopped after these (the last one says where)"
+                } else {
+                    ""
+                };
                 text.push_str(&format!(
-                    "… and {} more diagnostics ({errors} errors) not shown; the first {SHOWN} are above\n",
+                    "… and {} more diagnostics ({errors} errors) not shown; the first {SHOWN} are above{stopped}\n",
                     rest.len()
                 ));
             }

@@ -16,7 +16,7 @@ pub enum Error {
     #[error("--sweep expects KEY=LO..HI or KEY=V1,V2, like epsilon=1e-2..1e-6, not `{0}`")]
     Spec(String),
     /// A setting that is not swept.
-    #[error("cannot sweep `{0}`; the swept settings are epsilon, max_steps, relaxation and aa")]
+    #[error("cannot sweep `{0}`; the swept settings are epsilon, max_steps, relaxation, aa and samples (and resolution with --mesh)")]
     Key(String),
     /// A value that is not a number.
     #[error("{key}: `{value}` is not a number")]
@@ -97,6 +97,9 @@ pub enum Key {
     Aa,
     /// The path tracer's samples a pixel (log-spaced, one value an octave, whole numbers).
     Samples,
+    /// The mesh's cells along the longest side of its bounds (`sdfc pareto --mesh`; not a
+    /// render setting; log-spaced, one value an octave, whole numbers).
+    Resolution,
 }
 
 impl Key {
@@ -108,6 +111,7 @@ impl Key {
             Key::Relaxation => "relaxation",
             Key::Aa => "aa",
             Key::Samples => "samples",
+            Key::Resolution => "resolution",
         }
     }
 
@@ -118,13 +122,15 @@ impl Key {
             "relaxation" => Ok(Key::Relaxation),
             "aa" => Ok(Key::Aa),
             "samples" => Ok(Key::Samples),
+            "resolution" => Ok(Key::Resolution),
             _ => Err(Error::Key(s.into())),
         }
     }
 
-    /// The setting's value in `s`.
+    /// The setting's value in `s` (NaN for [`Key::Resolution`], which is not one).
     pub fn get(self, s: &Settings) -> f64 {
         match self {
+            Key::Resolution => f64::NAN,
             Key::Epsilon => s.epsilon,
             Key::MaxSteps => s.max_steps as f64,
             Key::Relaxation => s.relaxation,
@@ -133,14 +139,26 @@ impl Key {
         }
     }
 
-    /// Sets the value in `s`, checking its range as `--set` does.
+    /// Sets the value in `s`, checking its range as `--set` does (an error for
+    /// [`Key::Resolution`], which is not a render setting).
     pub fn set(self, s: &mut Settings, v: f64, limits: &Limits) -> Result<(), settings::Error> {
         settings::set(s, self.name(), &format!("{v}"), limits)
     }
 
     /// Whether the values are whole numbers.
     fn integral(self) -> bool {
-        matches!(self, Key::MaxSteps | Key::Aa | Key::Samples)
+        matches!(
+            self,
+            Key::MaxSteps | Key::Aa | Key::Samples | Key::Resolution
+        )
+    }
+
+    /// Whether the values are spaced logarithmically in a range.
+    fn logarithmic(self) -> bool {
+        matches!(
+            self,
+            Key::Epsilon | Key::MaxSteps | Key::Samples | Key::Resolution
+        )
     }
 }
 
@@ -198,7 +216,14 @@ pub fn parse_sweep_within(spec: &str, limits: &Limits) -> Result<Sweep, Error> {
     }
     let mut values: Vec<f64> = Vec::new();
     for v in raw.into_iter().map(|v| round(key, v)) {
-        key.set(&mut Settings::default(), v, limits)?;
+        if key == Key::Resolution {
+            // The mesher checks the grid it makes of it.
+            if v < 1.0 {
+                return Err(Error::NotPositive(key.name()));
+            }
+        } else {
+            key.set(&mut Settings::default(), v, limits)?;
+        }
         if !values.contains(&v) {
             values.push(v);
         }
@@ -238,13 +263,15 @@ fn range(key: Key, lo: &str, hi: &str, limits: &Limits) -> Result<Vec<f64>, Erro
         None => (hi, None),
     };
     let (lo, hi) = (number(key, lo)?, number(key, hi)?);
-    let log = matches!(key, Key::Epsilon | Key::MaxSteps | Key::Samples);
+    let log = key.logarithmic();
     if log && (lo <= 0.0 || hi <= 0.0) {
         return Err(Error::NotPositive(key.name()));
     }
     let n = count.unwrap_or_else(|| match key {
         Key::Epsilon => (2.0 * (hi / lo).log10().abs()).round() as usize + 1,
-        Key::MaxSteps | Key::Samples => (hi / lo).log2().abs().round() as usize + 1,
+        Key::MaxSteps | Key::Samples | Key::Resolution => {
+            (hi / lo).log2().abs().round() as usize + 1
+        }
         Key::Relaxation => ((hi - lo).abs() / 0.2).round() as usize + 1,
         Key::Aa => (hi - lo).abs().round() as usize + 1,
     });
@@ -569,16 +596,28 @@ pub fn chart_of(r: &Report, target: f64) -> Chart {
             if c.converged { "" } else { " (not converged)" }
         ),
         default_label,
-        target_psnr: Some(target),
+        panels: [
+            chart::Panel {
+                caption: "Time per frame against accuracy".into(),
+                cost: "median time per frame (ms, log scale)".into(),
+            },
+            chart::Panel {
+                caption: "Marching work against accuracy".into(),
+                cost: "mean marching steps per pixel (log scale)".into(),
+            },
+        ],
+        accuracy: chart::Accuracy {
+            label: "PSNR against the reference (dB, higher is better)".into(),
+            lower_is_better: false,
+            target: Some((target, format!("{target} dB target"))),
+        },
         points: r
             .points
             .iter()
             .map(|m| chart::Point {
-                seconds: m.median_s,
-                steps: m.steps_mean,
-                psnr: m.psnr,
-                front_time: m.front_time,
-                front_steps: m.front_steps,
+                cost: [m.median_s * 1e3, m.steps_mean],
+                accuracy: m.psnr,
+                front: [m.front_time, m.front_steps],
                 default: m.default,
             })
             .collect(),

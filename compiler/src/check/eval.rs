@@ -124,9 +124,7 @@ impl Ctx<'_> {
             }
             self.errors += 1;
             if self.errors == MAX_ERRORS {
-                d.notes.push(format!(
-                    "checking stopped here, after {MAX_ERRORS} errors: fix these and check again"
-                ));
+                d.notes.push(crate::diagnostics::stopped_note(MAX_ERRORS));
             }
         }
         self.diags.push(d);

@@ -549,7 +549,7 @@ fn cause(checked: &frontend::Checked, a: &analysis::Analysis) -> String {
 }
 
 /// The mesh settings of `--set`.
-fn settings(sets: &[String]) -> Result<Settings, String> {
+pub(super) fn settings(sets: &[String]) -> Result<Settings, String> {
     let mut s = Settings::default();
     for item in sets {
         let (key, value) = item

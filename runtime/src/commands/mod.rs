@@ -11,6 +11,7 @@ pub mod fmt;
 pub mod mesh;
 pub mod mesh_region;
 pub mod pareto;
+pub mod pareto_mesh;
 pub mod render;
 pub mod sequence;
 pub mod view;

@@ -32,9 +32,10 @@ pub struct ParetoArgs {
     #[arg(long, value_enum, default_value_t)]
     pub backend: Backend,
     /// A swept setting: `KEY=LO..HI`, `KEY=LO..HI:N` or `KEY=V1,V2,...`, with KEY one of
-    /// epsilon, max_steps (log-spaced ranges), relaxation (linear) or aa (every integer).
-    /// May be repeated; every combination is rendered. Default: epsilon=1e-2..1e-6,
-    /// max_steps=32..1024, relaxation=1..1.8.
+    /// epsilon, max_steps, samples (log-spaced ranges), relaxation (linear) or aa (every
+    /// integer); with --mesh, resolution (log-spaced). May be repeated; every combination is
+    /// rendered. Default: epsilon=1e-2..1e-6, max_steps=32..1024, relaxation=1..1.8; with
+    /// --mesh, resolution=32..256.
     #[arg(long = "sweep", value_name = "KEY=RANGE")]
     pub sweep: Vec<String>,
     /// Frames timed per point (the median is used).
@@ -43,9 +44,17 @@ pub struct ParetoArgs {
     /// Image size, as WIDTHxHEIGHT (default: the scene's own).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Override a render setting (as for `sdfc render`) before sweeping. May be repeated.
+    /// Override a render setting (as for `sdfc render`) before sweeping; with --mesh, a mesh
+    /// setting (as for `sdfc mesh`). May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Measure meshing instead of rendering: `sdfc mesh` at each swept resolution, its time
+    /// and triangles against the largest distance of the mesh from the surface.
+    #[arg(long, conflicts_with_all = ["backend", "precision", "size", "target"])]
+    pub mesh: bool,
+    /// With --mesh, the region to mesh, X0,Y0,Z0,X1,Y1,Z1 (as for `sdfc mesh`).
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = super::mesh::parse_bounds, allow_hyphen_values = true, requires = "mesh")]
+    pub bounds: Option<[[f64; 3]; 2]>,
     /// Float type of the timed renders.
     #[arg(long, value_enum, default_value_t)]
     pub precision: Precision,
@@ -85,6 +94,9 @@ impl ParetoArgs {
 
 /// Runs `sdfc pareto`.
 pub fn run(args: ParetoArgs) -> ExitCode {
+    if args.mesh {
+        return super::pareto_mesh::run(&args);
+    }
     let job = args.job();
     let limits = &job.limits;
     let mut source = match frontend::Source::read_within(&args.file, limits) {
@@ -114,6 +126,14 @@ pub fn run(args: ParetoArgs) -> ExitCode {
             .iter()
             .map(|s| parse_sweep_within(s, limits))
             .collect::<Result<Vec<_>, _>>()?;
+        if sweeps
+            .iter()
+            .any(|s| s.key == crate::pareto::Key::Resolution)
+        {
+            return Err(Error::Usage(
+                "resolution is a mesh's: sweep it with `sdfc pareto --mesh`".into(),
+            ));
+        }
         let points = combinations(&scene.settings, &sweeps, limits)?;
         Ok((points, job.pool()?))
     };
@@ -133,7 +153,7 @@ pub fn run(args: ParetoArgs) -> ExitCode {
 
 /// Refuses a chart name that is neither .svg nor .png, or that cannot be written (a missing
 /// directory), before any work is done.
-fn check_output(out: Option<&std::path::Path>) -> Result<(), String> {
+pub(super) fn check_output(out: Option<&std::path::Path>) -> Result<(), String> {
     let Some(path) = out else { return Ok(()) };
     let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
     match ext {

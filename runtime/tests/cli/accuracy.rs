@@ -6,7 +6,7 @@ use crate::common;
 
 use common::*;
 use sdfc_compiler::{lower, Node, Settings};
-use sdfc_runtime::chart::{self, Chart, Point};
+use sdfc_runtime::chart::{self, Accuracy, Chart, Panel, Point};
 use sdfc_runtime::cpu::{self, reference, Options};
 use sdfc_runtime::depth::{self, Depth};
 use sdfc_runtime::fp32;
@@ -283,23 +283,30 @@ fn the_pareto_front() {
 }
 
 fn sample_chart() -> Chart {
-    let point = |seconds: f64, steps: f64, psnr: f64, front: bool, default: bool| Point {
-        seconds,
-        steps,
-        psnr,
-        front_time: front,
-        front_steps: front,
+    let point = |ms: f64, steps: f64, psnr: f64, front: bool, default: bool| Point {
+        cost: [ms, steps],
+        accuracy: psnr,
+        front: [front, front],
         default,
+    };
+    let panel = |caption: &str, cost: &str| Panel {
+        caption: caption.into(),
+        cost: cost.into(),
     };
     Chart {
         title: "test chart".into(),
         subtitle: "three points".into(),
         default_label: "defaults".into(),
-        target_psnr: Some(40.0),
+        panels: [panel("time", "ms"), panel("work", "steps")],
+        accuracy: Accuracy {
+            label: "PSNR (dB)".into(),
+            lower_is_better: false,
+            target: Some((40.0, "40 dB target".into())),
+        },
         points: vec![
-            point(0.01, 20.0, 25.0, true, false),
-            point(0.02, 40.0, 42.0, true, true),
-            point(0.03, 35.0, f64::INFINITY, true, false),
+            point(10.0, 20.0, 25.0, true, false),
+            point(20.0, 40.0, 42.0, true, true),
+            point(30.0, 35.0, f64::INFINITY, true, false),
         ],
     }
 }
@@ -319,6 +326,22 @@ fn charts_are_valid_svg_and_png() {
     let decoder = png::Decoder::new(std::io::Cursor::new(png));
     let reader = decoder.read_info().expect("a PNG");
     assert_eq!((reader.info().width, reader.info().height), chart::SIZE);
+    // A mesh's chart: a distance on a log axis, lower is better, a zero at the bottom.
+    let mut mesh = sample_chart();
+    mesh.accuracy = Accuracy {
+        label: "largest distance to the surface".into(),
+        lower_is_better: true,
+        target: None,
+    };
+    for (p, d) in mesh.points.iter_mut().zip([1e-2, 1e-3, 0.0]) {
+        p.accuracy = d;
+    }
+    let svg = chart::svg(&mesh).expect("draws");
+    assert!(
+        svg.contains("largest distance") && svg.contains("0.001"),
+        "{svg}"
+    );
+    chart::png(&mesh).expect("draws");
 }
 
 #[test]
@@ -556,6 +579,74 @@ fn pareto_measures_points_and_draws_charts() {
         .output()
         .expect("run sdfc");
     assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `sdfc pareto --mesh`: a part meshed at three resolutions, each with its time, triangles
+/// and largest distance to the surface, which falls as the cells shrink; the chart is drawn;
+/// a render sweep with --mesh, and a resolution without it, are refused.
+#[test]
+fn pareto_mesh_measures_meshing_speed_against_accuracy() {
+    let d = dir("pareto-mesh");
+    std::fs::write(
+        d.join("part.sdf"),
+        "scene { union(box((1, 0.5, 0.7)), sphere(0.6).translate(0.9, 0.4, 0)); }",
+    )
+    .expect("write the part");
+    let out = sdfc(
+        &d,
+        &[
+            "pareto",
+            "part.sdf",
+            "--mesh",
+            "--sweep",
+            "resolution=8..32",
+            "--frames",
+            "1",
+            "--json",
+            "-o",
+            "mesh.svg",
+        ],
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let points = v["points"].as_array().expect("points");
+    let get = |p: &serde_json::Value, k: &str| p[k].as_f64().unwrap_or(f64::NAN);
+    assert_eq!(
+        points
+            .iter()
+            .map(|p| get(p, "resolution"))
+            .collect::<Vec<_>>(),
+        [8.0, 16.0, 32.0],
+        "{v}"
+    );
+    for w in points.windows(2) {
+        assert!(get(&w[1], "triangles") > get(&w[0], "triangles"), "{v}");
+        assert!(get(&w[1], "cell") < get(&w[0], "cell"), "{v}");
+    }
+    let (coarse, fine) = (get(&points[0], "distance"), get(&points[2], "distance"));
+    assert!(fine > 0.0 && fine < coarse, "{v}");
+    assert!(points.iter().all(|p| get(p, "median_s") > 0.0));
+    assert!(points.iter().any(|p| p["front_time"] == true));
+    let svg = std::fs::read_to_string(d.join("mesh.svg")).expect("chart written");
+    assert!(svg.contains("meshing speed against accuracy") && svg.contains("triangles"));
+    let refused = |args: &[&str], says: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&d)
+            .args(args)
+            .output()
+            .expect("run sdfc");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    };
+    refused(
+        &["pareto", "part.sdf", "--mesh", "--sweep", "epsilon=1e-3"],
+        "with --mesh the swept setting is resolution",
+    );
+    refused(
+        &["pareto", "ball.sdf", "--sweep", "resolution=8"],
+        "sdfc pareto --mesh",
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -4,6 +4,7 @@
 
 use super::mesh_region::{frame, short, Frame};
 pub use super::mesh_region::{parse_bounds, BoundsError, Region, Spelling, DEFAULT_RESOLUTION};
+use super::mesh_thin::Thinness;
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
@@ -321,7 +322,7 @@ pub struct Meshed {
 /// or limit that refuses the mesh) and the message (empty when already reported).
 ///
 /// Where the grid misses walls or gaps thinner than a cell ([`crate::mesh::thin`]), the
-/// surface is meshed again on a grid fine enough for them ([`super::mesh_thin`]) when the
+/// surface is meshed again on a grid fine enough for them ([`Thinness`]) when the
 /// limits allow it; what is still thinner than the cells is reported with its place and
 /// the cell that resolves it.
 pub fn surface(
@@ -334,8 +335,23 @@ pub fn surface(
     say: &(dyn Fn(String) + Sync),
 ) -> Result<Meshed, (u8, String)> {
     let coarse = surface_on(checked, region, settings, limits, pool, progress, say)?;
-    let again = |fine: Region| surface_on(checked, fine, settings, limits, pool, progress, say);
-    super::mesh_thin::refine(checked, region, limits, coarse, &again, say)
+    let thin = Thinness::new(checked, region, coarse.grid.voxel);
+    let fits = |bytes: u64| check_memory(bytes, limits, region.spelling).is_ok();
+    let Some(fine) = thin.again(&coarse.grid, &coarse.stats, limits, &fits, say) else {
+        return Ok(coarse);
+    };
+    match surface_on(checked, fine, settings, limits, pool, progress, say) {
+        Ok(mut fine) => {
+            fine.seconds += coarse.seconds;
+            fine.stats.refined_from = Some(coarse.grid.voxel);
+            thin.still(fine.grid.voxel, &fine.stats, say);
+            Ok(fine)
+        }
+        Err((_, why)) => {
+            thin.refused(&coarse.stats, &why, say);
+            Ok(coarse)
+        }
+    }
 }
 
 /// [`surface`] on one grid.
@@ -545,7 +561,7 @@ fn most(fits: impl Fn(u64) -> bool) -> u64 {
     lo
 }
 
-pub(super) fn check_memory(bytes: u64, limits: &Limits, spell: Spelling) -> Result<(), String> {
+fn check_memory(bytes: u64, limits: &Limits, spell: Spelling) -> Result<(), String> {
     if mib(bytes) <= limits.get(Limit::Memory) {
         return Ok(());
     }

@@ -237,8 +237,9 @@ impl Finder<'_> {
     /// not. A wall of even thickness is not followed.
     fn tapers_to_nothing(&self, found: &[(Line, f64)], spans: &[Option<f64>]) -> Vec<bool> {
         let h = self.grid.voxel;
-        let (mut walkers, mut verdict): (Vec<(usize, Line, [f64; 3])>, Vec<bool>) =
-            (Vec::new(), vec![false; found.len()]);
+        // Per feature followed: its index, the line at its place now, and the way it thins.
+        let mut walkers: Vec<(usize, Line, [f64; 3])> = Vec::new();
+        let mut verdict = vec![false; found.len()];
         for (k, (l, t)) in found.iter().enumerate() {
             let s = &spans[4 * k..4 * k + 4];
             let (u, v) = tangents(l.dir);

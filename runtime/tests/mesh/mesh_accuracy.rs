@@ -135,7 +135,7 @@ fn a_sheet_of_a_third_of_a_cell_stays_one_piece() {
     );
     let out = d.join("sheet.stl");
     let err = mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.04"]);
-    assert!(err.contains("meshing again with cells of 0.01 "), "{err}");
+    assert!(err.contains("meshing again with cells of 0.01\n"), "{err}");
     let m = read_stl(&out);
     assert_eq!(manifold(&m, "sheet"), 2);
     assert_eq!(components(&m), 1);

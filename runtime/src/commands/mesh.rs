@@ -4,6 +4,7 @@
 
 use super::mesh_region::{frame, short, Frame};
 pub use super::mesh_region::{parse_bounds, BoundsError, Region, Spelling, DEFAULT_RESOLUTION};
+use super::mesh_thin::Thinness;
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
@@ -319,7 +320,42 @@ pub struct Meshed {
 /// `progress` gets the stage's name and the fraction done of the whole; `say` the
 /// announcements and warnings. `Err` is the exit code (2 for a usage problem, 1 for a scene
 /// or limit that refuses the mesh) and the message (empty when already reported).
+///
+/// Where the grid misses walls or gaps thinner than a cell ([`crate::mesh::thin`]), the
+/// surface is meshed again on a grid fine enough for them ([`Thinness`]) when the
+/// limits allow it; what is still thinner than the cells is reported with its place and
+/// the cell that resolves it.
 pub fn surface(
+    checked: &frontend::Checked,
+    region: Region,
+    settings: &Settings,
+    limits: &Limits,
+    pool: &rayon::ThreadPool,
+    progress: &(dyn Fn(&'static str, f64) + Sync),
+    say: &(dyn Fn(String) + Sync),
+) -> Result<Meshed, (u8, String)> {
+    let coarse = surface_on(checked, region, settings, limits, pool, progress, say)?;
+    let thin = Thinness::new(checked, region, coarse.grid.voxel);
+    let fits = |bytes: u64| check_memory(bytes, limits, region.spelling).is_ok();
+    let Some(fine) = thin.again(&coarse.grid, &coarse.stats, limits, &fits, say) else {
+        return Ok(coarse);
+    };
+    match surface_on(checked, fine, settings, limits, pool, progress, say) {
+        Ok(mut fine) => {
+            fine.seconds += coarse.seconds;
+            fine.stats.refined_from = Some(coarse.grid.voxel);
+            thin.still(fine.grid.voxel, &fine.stats, say);
+            Ok(fine)
+        }
+        Err((_, why)) => {
+            thin.refused(&coarse.stats, &why, say);
+            Ok(coarse)
+        }
+    }
+}
+
+/// [`surface`] on one grid.
+fn surface_on(
     checked: &frontend::Checked,
     region: Region,
     settings: &Settings,
@@ -449,18 +485,25 @@ pub fn surface(
 pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
     let dense = grid.dense_points() as f64;
     format!(
-        "grid            {}x{}x{} cells of {}\n\
+        "grid            {}x{}x{} cells of {}{}\n\
          octree cells    {} evaluated{}\n\
          candidates      {} cells ({} added by crossed edges)\n\
          surface cells   {}\n\
          evaluations     {} points ({:.2} % of the dense grid's {} points)\n\
          sharp patches   {} ({} edges flipped, {} inner vertices projected onto the surface)\n\
-         {}\
+         {}{}\
          time            {:.3} s\n",
         grid.cells[0],
         grid.cells[1],
         grid.cells[2],
         short(grid.voxel),
+        match s.refined_from {
+            Some(v) => format!(
+                " (refined from cells of {}: walls or gaps thinner than a cell)",
+                short(v)
+            ),
+            None => String::new(),
+        },
         s.octree_cells,
         if s.dense {
             " (no proven bound: dense grid)"
@@ -476,6 +519,15 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
         s.features,
         s.flips,
         s.projected,
+        match s.thin {
+            Some(t) => format!(
+                "thin features   {} grid edges cross a wall or gap twice; the thinnest {} ({:.1} % of a cell)\n",
+                t.edges,
+                short(t.thinnest),
+                100.0 * t.thinnest / grid.voxel
+            ),
+            None => String::new(),
+        },
         match s.error {
             Some([v, f]) => format!(
                 "distance        vertices {} ({:.2} % of a cell), triangle centres {} ({:.2} %): the largest |f| (exact fields: the distance to the surface)\n",

@@ -10,6 +10,7 @@ pub mod devices;
 pub mod fmt;
 pub mod mesh;
 pub mod mesh_region;
+pub mod mesh_thin;
 pub mod pareto;
 pub mod pareto_mesh;
 pub mod render;

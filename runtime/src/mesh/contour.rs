@@ -17,6 +17,7 @@ use super::place::{
     GRADIENT_STEP, MARGIN, ON_SURFACE,
 };
 use super::table::{corner, patches, EDGES};
+use super::thin;
 use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
 use rayon::prelude::*;
 
@@ -107,6 +108,10 @@ pub fn contour(
         let d = field.distances(&points);
         for (i, v) in need.into_iter().zip(d) {
             values.set(i, v);
+        }
+        if first {
+            // Walls and gaps between the candidates' corners that no corner sees.
+            stats.thin = thin::missed(field, grid, &values, &pending);
         }
         let mut missing = Vec::new();
         for &c in &pending {

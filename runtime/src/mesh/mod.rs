@@ -2,7 +2,8 @@
 //! by an octree pruned with the distance program's proven Lipschitz bound (`octree`); the
 //! surface patch of each such cell, with edge vertices found on the surface and a vertex
 //! inside the cell placed from the field's gradients, which keeps sharp edges and corners
-//! (`contour`); and the file formats (`write`; 3MF in `threemf`, its archive in `zip`). `docs/mesh.md` describes the method and its
+//! (`contour`), with the walls and gaps thinner than a cell that the grid misses found
+//! (`thin`); and the file formats (`write`; 3MF in `threemf`, its archive in `zip`). `docs/mesh.md` describes the method and its
 //! guarantees.
 
 pub mod contour;
@@ -11,6 +12,7 @@ pub mod parts;
 pub mod place;
 pub mod qef;
 pub mod table;
+pub mod thin;
 pub mod threemf;
 pub mod write;
 pub mod zip;
@@ -315,6 +317,12 @@ pub struct Stats {
     pub projected: u64,
     /// Whether the dense grid was evaluated (no proven bound).
     pub dense: bool,
+    /// Walls and gaps thinner than a cell that the grid missed (grid edges that cross one
+    /// twice, `thin`).
+    pub thin: Option<thin::Thin>,
+    /// The cell of the grid first asked for, where features thinner than it made `sdfc mesh`
+    /// mesh again on a finer grid.
+    pub refined_from: Option<f64>,
     /// The largest |f| at the mesh's vertices and at its triangles' centres (the distance to
     /// the surface where the field is exact), when measured ([`Settings::measure`]).
     pub error: Option<[f64; 2]>,

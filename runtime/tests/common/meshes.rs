@@ -130,3 +130,34 @@ pub fn write_scene(d: &Path, name: &str, body: &str) -> PathBuf {
 pub fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
+/// The connected pieces of a mesh, its vertices joined by position (f32 bits) and edges.
+pub fn components(m: &Read) -> usize {
+    let mut id: HashMap<[u32; 3], usize> = HashMap::new();
+    let same: Vec<usize> = m
+        .positions
+        .iter()
+        .map(|p| {
+            let n = id.len();
+            *id.entry(p.map(f32::to_bits)).or_insert(n)
+        })
+        .collect();
+    let mut parent: Vec<usize> = (0..id.len()).collect();
+    fn find(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for t in &m.triangles {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2])] {
+            let (ra, rb) = (find(&mut parent, same[a]), find(&mut parent, same[b]));
+            parent[ra] = rb;
+        }
+    }
+    let used: std::collections::HashSet<usize> =
+        m.triangles.iter().flatten().map(|&i| same[i]).collect();
+    let roots: std::collections::HashSet<usize> =
+        used.into_iter().map(|v| find(&mut parent, v)).collect();
+    roots.len()
+}

@@ -1,7 +1,9 @@
 //! `sdfc mesh` on printable parts (issue 51): flat faces stay flat (every vertex within 1 % of
 //! a cell of the surface, by the f64 distance program, with corners and edges kept) on a
 //! honeycomb panel, whose hexagonal cells' 120° edges and their corners on the plate's faces
-//! fall anywhere in the grid, and on a box turned off the grid's axes.
+//! fall anywhere in the grid, and on a box turned off the grid's axes; and walls and sheets
+//! thinner than a cell kept (meshed again on a finer grid), where parts that touch a floor
+//! are not taken for thin gaps.
 
 use crate::meshes;
 
@@ -94,4 +96,101 @@ fn a_turned_box_keeps_its_corners_and_flat_faces() {
             .fold(f64::INFINITY, f64::min);
         assert!(near <= 0.12 * voxel, "corner {q:?}: nearest vertex {near}");
     }
+}
+
+/// A Gridfinity-style bin in millimetres, 100 × 40 × 60 outside with walls 0.475 thick and a
+/// divider as thin, slanted to the grid, meshed at resolution 128 (cells of 0.78): the grid
+/// misses the divider between its points, which fell into two pieces before; now the edges
+/// that cross it twice are found and the bin is meshed again on cells of 0.39, one closed
+/// piece of genus 0.
+#[test]
+fn a_bin_with_walls_thinner_than_a_cell_keeps_its_topology() {
+    let d = dir("bin");
+    let scene = write_scene(
+        &d,
+        "bin.sdf",
+        "let outer = box((50, 20, 30));
+let inner = box((49.525, 20, 29.525)).translate(0, 1.2, 0);
+let divider = box((0.2375, 19, 29.6)).rotate_y(3deg).rotate_z(2deg).translate(3.1, 0, 0);
+scene { union(outer.subtract(inner), divider); }
+",
+    );
+    let out = d.join("bin.stl");
+    let err = mesh(&[s(&scene), "-o", s(&out), "--resolution", "128"]);
+    assert!(err.contains("meshing again with cells of 0.3906"), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let m = read_stl(&out);
+    assert_eq!(manifold(&m, "bin"), 2, "genus 0");
+    assert_eq!(components(&m), 1);
+}
+
+/// A sheet 0.3 cells thick, slanted to the grid, stays one piece.
+#[test]
+fn a_sheet_of_a_third_of_a_cell_stays_one_piece() {
+    let d = dir("sheet");
+    let scene = write_scene(
+        &d,
+        "sheet.sdf",
+        "scene { box((0.5, 0.006, 0.4)).rotate_x(11deg).rotate_z(7deg); }\n",
+    );
+    let out = d.join("sheet.stl");
+    let err = mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.04"]);
+    assert!(err.contains("meshing again with cells of 0.01\n"), "{err}");
+    let m = read_stl(&out);
+    assert_eq!(manifold(&m, "sheet"), 2);
+    assert_eq!(components(&m), 1);
+}
+
+/// Where the memory limit leaves no room for the finer grid, the sheet is meshed on the
+/// cells asked for, with a warning that names its place and the cell that resolves it.
+#[test]
+fn a_sheet_too_thin_for_the_memory_limit_is_warned_about() {
+    let d = dir("sheet_limit");
+    let scene = write_scene(
+        &d,
+        "sheet.sdf",
+        "scene { box((0.5, 0.0006, 0.4)).rotate_x(11deg).rotate_z(7deg); }\n",
+    );
+    let out = d.join("sheet.stl");
+    let err = mesh(&[
+        s(&scene),
+        "-o",
+        s(&out),
+        "--voxel",
+        "0.04",
+        "--limit",
+        "memory=64",
+    ]);
+    assert!(
+        err.contains("warning: a wall or gap about 0.0012 thick at (")
+            && err.contains("more than the memory limit of 64 MiB")
+            && err.contains("--voxel 0.0011 resolves it"),
+        "{err}"
+    );
+    assert!(!err.contains("meshing again"), "{err}");
+}
+
+/// A sphere resting on a floor, a cylinder lying on it and a spring's coil lifting off it
+/// leave gaps that close where they touch: no finer grid resolves them, and they are
+/// neither refined nor reported.
+#[test]
+fn parts_touching_a_floor_are_not_thin_gaps() {
+    let d = dir("touching");
+    let scene = write_scene(
+        &d,
+        "touching.sdf",
+        "scene {
+  box((2, 0.1, 2)).translate(0, -0.1, 0);
+  sphere(0.5).translate(-1, 0.5, -1);
+  cylinder(0.3, 0.6).rotate_x(90deg).translate(1, 0.3, 0.5);
+  box((0.4, 0.1, 0.2)).rotate_z(4deg).translate(0, 0.1 + 0.4 * sin(4deg), -0.5);
+}
+",
+    );
+    let out = d.join("touching.stl");
+    let err = mesh(&[s(&scene), "-o", s(&out), "--resolution", "128"]);
+    assert!(
+        !err.contains("meshing again") && !err.contains("warning"),
+        "{err}"
+    );
 }

@@ -152,12 +152,12 @@ fn outlines(out: &mut String, program: &Program, name: &str) {
             text.join(", ")
         );
     }
-    let stack = format!("[0usize; {}]", crate::program::outline::STACK);
+    let stack = format!("[(0usize, zero); {}]", crate::program::outline::STACK);
     let _ = writeln!(
         out,
         "{}",
         OUTLINE_MACRO
-            .replace("[0usize; STACK]", &stack)
+            .replace("[(0usize, zero); STACK]", &stack)
             .replace("NAME", name)
     );
 }
@@ -183,12 +183,14 @@ const OUTLINE_MACRO: &str = r#"macro_rules! NAME_outline_fn {
             };
             let node = |k: usize| 1 + 7 * k;
             // The hierarchy of the glyphs' boxes, the nearer child first.
-            let mut stack = [0usize; STACK];
+            // Each entry: a node and its box's squared distance, tested again when taken off.
+            let mut stack = [(0usize, zero); STACK];
+            stack[0] = (0, gap(node(0)));
             let mut top = 1;
             while top > 0 {
                 top -= 1;
-                let at = node(stack[top]);
-                let g = gap(at);
+                let (k, g) = stack[top];
+                let at = node(k);
                 if g > zero && g >= best {
                     continue;
                 }
@@ -197,11 +199,11 @@ const OUTLINE_MACRO: &str = r#"macro_rules! NAME_outline_fn {
                     let (gl, gr) = (gap(node(l)), gap(node(l + 1)));
                     let (near, far, gn, gf) = if gr < gl { (l + 1, l, gr, gl) } else { (l, l + 1, gl, gr) };
                     if !(gf > zero && gf >= best) {
-                        stack[top] = far;
+                        stack[top] = (far, gf);
                         top += 1;
                     }
                     if !(gn > zero && gn >= best) {
-                        stack[top] = near;
+                        stack[top] = (near, gn);
                         top += 1;
                     }
                     continue;

@@ -313,13 +313,16 @@ pub fn distance_counted<T: Float>(o: &Outline, x: T, y: T, work: &mut Work) -> T
             .max(zero);
         dx * dx + dy * dy
     };
-    let mut stack = [0u32; STACK];
+    // Each entry: a node and its box's squared distance, tested again when it is taken
+    // off (the best may have shrunk since).
+    let mut stack = [(0u32, zero); STACK];
+    stack[0] = (0, gap(&o.nodes[0]));
     let mut top = 1;
     while top > 0 {
         top -= 1;
-        let n = &o.nodes[stack[top] as usize];
+        let (at, g) = stack[top];
+        let n = &o.nodes[at as usize];
         work.nodes += 1;
-        let g = gap(n);
         // Outside the box and no nearer than the best: nothing below counts.
         if g > zero && g >= best {
             continue;
@@ -329,16 +332,16 @@ pub fn distance_counted<T: Float>(o: &Outline, x: T, y: T, work: &mut Work) -> T
             let (l, r) = (n.first, n.first + 1);
             let gl = gap(&o.nodes[l as usize]);
             let gr = gap(&o.nodes[r as usize]);
-            let (near, far, gn, gf) = if gr < gl {
-                (r, l, gr, gl)
+            let (near, far) = if gr < gl {
+                ((r, gr), (l, gl))
             } else {
-                (l, r, gl, gr)
+                ((l, gl), (r, gr))
             };
-            if !(gf > zero && gf >= best) {
+            if !(far.1 > zero && far.1 >= best) {
                 stack[top] = far;
                 top += 1;
             }
-            if !(gn > zero && gn >= best) {
+            if !(near.1 > zero && near.1 >= best) {
                 stack[top] = near;
                 top += 1;
             }

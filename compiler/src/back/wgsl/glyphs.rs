@@ -232,13 +232,16 @@ fn text_gap(bx: vec4<f32>, q: vec2<f32>) -> f32 {
 fn text_outline(base: u32, q: vec2<f32>) -> f32 {
     var best = 3e38;
     var wind = 0i;
+    // Each entry: a node and its box's squared distance, tested again when it is taken off.
     var stack: array<u32, STACKu>;
+    var gaps: array<f32, STACKu>;
     stack[0] = 0u;
+    gaps[0] = text_gap(scene_data[base + 1u], q);
     var top = 1u;
     while top > 0u {
         top -= 1u;
         let n = base + 1u + 2u * stack[top];
-        let gap = text_gap(scene_data[n], q);
+        let gap = gaps[top];
         if gap > 0.0 && gap >= best {
             continue;
         }
@@ -253,10 +256,12 @@ fn text_outline(base: u32, q: vec2<f32>) -> f32 {
             let gf = select(gr, gl, right);
             if !(gf > 0.0 && gf >= best) {
                 stack[top] = select(l + 1u, l, right);
+                gaps[top] = gf;
                 top += 1u;
             }
             if !(gn > 0.0 && gn >= best) {
                 stack[top] = select(l, l + 1u, right);
+                gaps[top] = gn;
                 top += 1u;
             }
             continue;

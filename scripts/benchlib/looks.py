@@ -78,21 +78,25 @@ scene {
 def text(ctx):
     size = ctx.size_list(["1920x1080"])[0][0]
     frames = ctx.n_frames(20)
-    t = ctx.table("A 40-character string and a 1-character one extruded on a plaque: `sdfc "
-                  "bench --size %s --frames %d` median ms (the CPU: 3 frames), and the kernels' "
-                  "sizes (`sdfc compile --emit wgsl|ptx|scene-data`)." % (size, frames),
+    t = ctx.table("examples/plaque.sdf (\"HELLO\"), and a 40-character string and a "
+                  "1-character one extruded on a plaque: `sdfc bench --size %s --frames %d` "
+                  "median ms (the CPU: 3 frames), and the kernels' sizes (`sdfc compile --emit "
+                  "wgsl|ptx|scene-data`)." % (size, frames),
                   ["scene", "build", *["%s ms" % b for b in ctx.backends], "WGSL bytes",
                    "PTX bytes", "scene_data bytes"])
+    scenes = [("plaque", "examples/plaque.sdf")]
     for name, s in (("40 characters", "The quick brown fox jumps over a lazy do"),
                     ("1 character", "T")):
         f = "%s/text%d.sdf" % (IMG, len(s))
         open(f, "w").write(TEXT % s)
+        scenes.append((name, f))
+    for name, f in scenes:
         for x in ctx.builds:
             sizes = []
             for emit in ("wgsl", "ptx"):
                 _, out, _, code = core.run([x.path, "compile", f, "--emit", emit])
                 sizes.append(str(len(out.encode())) if code == 0 else "-")
-            data = f + ".bin"
+            data = "%s/%s-%s.bin" % (IMG, scene_name(f), x.name)
             _, _, _, code = core.run([x.path, "compile", f, "--emit", "scene-data", "-o", data])
             sizes.append(str(os.path.getsize(data)) if code == 0 else "-")
             cells = []
@@ -269,7 +273,8 @@ def view(ctx):
 SUITES = {
     "analytic": (analytic, "seeds 1 and 2 traced against marched at aa 1, 4, 8, and the traced "
                  "examples' agreement; --with aa=1,4,8, max_march_samples=N, check=0"),
-    "text": (text, "a 40-character and a 1-character extruded string: frame ms, kernel sizes"),
+    "text": (text, "examples/plaque.sdf, a 40-character and a 1-character extruded string: "
+                   "frame ms, kernel sizes"),
     "mesh-import": (mesh_import, "a 100 000-triangle mesh(path) scene: load, 1080p frame, "
                     "agreement; --with resolution=104"),
     "view": (view, "sdfc view --headless: edit to pixel of numeric, structural and radius "

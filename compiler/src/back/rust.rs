@@ -112,9 +112,31 @@ fn outlines(out: &mut String, program: &Program, name: &str) {
         return;
     }
     for (k, o) in program.outlines().iter().enumerate() {
-        let mut words: Vec<f64> = vec![o.glyphs.len() as f64];
-        for g in &o.glyphs {
-            words.extend([g.lo[0], g.lo[1], g.hi[0], g.hi[1], g.segments.len() as f64]);
+        // The nodes, seven words each, then the segments, seven words each.
+        let nodes = o.nodes();
+        let mut starts = Vec::new();
+        let mut at = 1 + 7 * nodes.len();
+        for g in o.glyphs() {
+            starts.push(at);
+            at += 7 * g.segments.len();
+        }
+        let mut words: Vec<f64> = vec![nodes.len() as f64];
+        for n in nodes {
+            words.extend([n.lo[0], n.lo[1], n.hi[0], n.hi[1]]);
+            words.extend(match n.glyph {
+                Some(k) => {
+                    let k = k as usize;
+                    let count = o.glyphs().get(k).map_or(0, |g| g.segments.len());
+                    [
+                        starts.get(k).copied().unwrap_or(0) as f64,
+                        count as f64,
+                        1.0,
+                    ]
+                }
+                None => [f64::from(n.first), 0.0, 0.0],
+            });
+        }
+        for g in o.glyphs() {
             for s in &g.segments {
                 let line = if s.line { 1.0 } else { 0.0 };
                 words.extend([s.a[0], s.a[1], s.b[0], s.b[1], s.c[0], s.c[1], line]);
@@ -130,7 +152,14 @@ fn outlines(out: &mut String, program: &Program, name: &str) {
             text.join(", ")
         );
     }
-    let _ = writeln!(out, "{}", OUTLINE_MACRO.replace("NAME", name));
+    let stack = format!("[(0usize, zero); {}]", crate::program::outline::STACK);
+    let _ = writeln!(
+        out,
+        "{}",
+        OUTLINE_MACRO
+            .replace("[(0usize, zero); STACK]", &stack)
+            .replace("NAME", name)
+    );
 }
 
 /// The outline function of the emitted Rust, for f32 and f64: `program/outline.rs`'s
@@ -147,40 +176,40 @@ const OUTLINE_MACRO: &str = r#"macro_rules! NAME_outline_fn {
             let (zero, one, two, three, four): ($t, $t, $t, $t, $t) = (0.0, 1.0, 2.0, 3.0, 4.0);
             let mut best = 3.0e38_f64 as $t;
             let mut wind: i32 = 0;
-            let n = o[0] as usize;
             let gap = |i: usize| {
                 let dx = mx(mx(v(i) - x, x - v(i + 2)), zero);
                 let dy = mx(mx(v(i + 1) - y, y - v(i + 3)), zero);
                 dx * dx + dy * dy
             };
-            let after = |i: usize| i + 5 + 7 * o[i + 4] as usize;
-            // The glyph whose box is nearest first, then the others in order.
-            let (mut first, mut near) = (1, best);
-            let mut i = 1;
-            for _ in 0..n {
-                let d = gap(i);
-                if d < near {
-                    near = d;
-                    first = i;
-                }
-                i = after(i);
-            }
-            let mut i = 1;
-            for k in 0..=n {
-                let mut at = first;
-                if k > 0 {
-                    at = i;
-                    i = after(i);
-                    if at == first {
-                        continue;
-                    }
-                }
-                let next = after(at);
-                let gap = gap(at);
-                if gap > zero && gap >= best {
+            let node = |k: usize| 1 + 7 * k;
+            // The hierarchy of the glyphs' boxes, the nearer child first.
+            // Each entry: a node and its box's squared distance, tested again when taken off.
+            let mut stack = [(0usize, zero); STACK];
+            stack[0] = (0, gap(node(0)));
+            let mut top = 1;
+            while top > 0 {
+                top -= 1;
+                let (k, g) = stack[top];
+                let at = node(k);
+                if g > zero && g >= best {
                     continue;
                 }
-                let mut s = at + 5;
+                if o[at + 6] == 0.0 {
+                    let l = o[at + 4] as usize;
+                    let (gl, gr) = (gap(node(l)), gap(node(l + 1)));
+                    let (near, far, gn, gf) = if gr < gl { (l + 1, l, gr, gl) } else { (l, l + 1, gl, gr) };
+                    if !(gf > zero && gf >= best) {
+                        stack[top] = (far, gf);
+                        top += 1;
+                    }
+                    if !(gn > zero && gn >= best) {
+                        stack[top] = (near, gn);
+                        top += 1;
+                    }
+                    continue;
+                }
+                let mut s = o[at + 4] as usize;
+                let next = s + 7 * o[at + 5] as usize;
                 while s < next {
                     let (a0, a1, b0, b1, c0, c1) = (v(s), v(s + 1), v(s + 2), v(s + 3), v(s + 4), v(s + 5));
                     if o[s + 6] != 0.0 {

@@ -114,7 +114,7 @@ pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, String> {
             *g = glyph(segments);
         }
     }
-    Ok(Outline { glyphs })
+    Ok(Outline::new(glyphs))
 }
 
 /// A glyph of `segments`, with the box of their points.
@@ -269,7 +269,7 @@ mod tests {
                 *wind -= 1;
             }
         };
-        for g in &o.glyphs {
+        for g in o.glyphs() {
             for s in &g.segments {
                 if s.line {
                     seg(s.a, s.c, &mut best, &mut wind);
@@ -390,7 +390,7 @@ mod tests {
         let o = layout(default_font(), "AV", 2048.0).expect("laid out");
         let upem = f64::from(face.units_per_em());
         // Mirrored: a glyph's left edge in the font is its box's high x.
-        let got = (o.glyphs[0].hi[0] - o.glyphs[1].hi[0]) * upem / 2048.0;
+        let got = (o.glyphs()[0].hi[0] - o.glyphs()[1].hi[0]) * upem / 2048.0;
         assert!((got - want).abs() < 1e-9, "{got} against {want}");
     }
 

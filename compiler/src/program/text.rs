@@ -19,9 +19,10 @@ impl Program {
         for (k, o) in self.outlines.iter().enumerate() {
             let _ = writeln!(
                 out,
-                "; outline {k}: {} glyphs, {} segments (data)",
-                o.glyphs.len(),
-                o.segments()
+                "; outline {k}: {} glyphs, {} segments, {} levels of boxes (data)",
+                o.glyphs().len(),
+                o.segments(),
+                o.depth()
             );
         }
         let mut notes = self.notes.iter().peekable();

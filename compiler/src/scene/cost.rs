@@ -20,10 +20,12 @@ pub(super) fn own_cost(node: &Node) -> f64 {
         Node::Polygon { points } => 20.0 * points.len() as f64,
         // A walk of the hierarchy: a few dozen boxes and triangles of some 40 operations.
         Node::Mesh { mesh } => 400.0 + 40.0 * (mesh.0.triangles().len() as f64).log2(),
-        // The glyphs near a point: a few glyphs' curves.
+        // A walk down the glyphs' hierarchy (two boxes a level) to the glyphs near a point:
+        // a few glyphs' curves.
         Node::Text { outline, .. } => {
-            let per_glyph = outline.segments() as f64 / outline.glyphs.len().max(1) as f64;
-            10.0 * outline.glyphs.len() as f64 + 3.0 * 40.0 * per_glyph
+            let glyphs = outline.glyphs().len().max(1) as f64;
+            let per_glyph = outline.segments() as f64 / glyphs;
+            20.0 * (glyphs.log2() + 1.0) + 3.0 * 40.0 * per_glyph
         }
         Node::Extrude { .. } => 10.0,
         Node::Revolve { .. } => 5.0,

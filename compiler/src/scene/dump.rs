@@ -318,7 +318,7 @@ fn node(n: &Node) -> String {
         } => format!(
             "text {text:?} size={} font={font:?} glyphs={} segments={}",
             num(*size),
-            outline.glyphs.len(),
+            outline.glyphs().len(),
             outline.segments()
         ),
         Node::Extrude {

@@ -112,6 +112,7 @@ pub fn rename_calls(map: &str, name: &str) -> String {
 /// [`FUNCTIONS`] with their names prefixed by `prefix` and reading the words from `data`.
 pub(super) fn functions(prefix: &str, data: &str) -> String {
     FUNCTIONS
+        .replace("STACKu", &format!("{}u", crate::program::outline::STACK))
         .replace("text_", &format!("{prefix}text_"))
         .replace("scene_data[", &format!("{data}["))
 }
@@ -217,7 +218,7 @@ fn text_newton(ea: vec2<f32>, eb: vec2<f32>, ec: vec2<f32>, ed: vec2<f32>, t0: f
     return t;
 }
 
-// The squared distance to the box (lo.x, lo.y, hi.x, hi.y) of a glyph, 0 inside it.
+// The squared distance to the box (lo.x, lo.y, hi.x, hi.y) of a node, 0 inside it.
 fn text_gap(bx: vec4<f32>, q: vec2<f32>) -> f32 {
     let dx = max(max(bx.x - q.x, q.x - bx.z), 0.0);
     let dy = max(max(bx.y - q.y, q.y - bx.w), 0.0);
@@ -225,40 +226,49 @@ fn text_gap(bx: vec4<f32>, q: vec2<f32>) -> f32 {
 }
 
 // The signed distance at q to the outline whose words start at scene_data[base]: the
-// nearest of its curves, negative where their winding number is not zero; a glyph whose box
-// is farther than the best so far is skipped.
+// nearest of its curves, negative where their winding number is not zero, found through the
+// hierarchy of its glyphs' boxes, the nearer child first; a node outside whose box the point
+// is, no nearer than the best so far, is skipped.
 fn text_outline(base: u32, q: vec2<f32>) -> f32 {
-    let glyphs = u32(scene_data[base].x);
     var best = 3e38;
     var wind = 0i;
-    // The glyph whose box is nearest first, then the others in order.
-    var first = base + 1u;
-    var near = best;
-    var i = base + 1u;
-    for (var g = 0u; g < glyphs; g++) {
-        let d = text_gap(scene_data[i], q);
-        if d < near {
-            near = d;
-            first = i;
-        }
-        i = i + 2u + 2u * u32(scene_data[i + 1u].x);
-    }
-    i = base + 1u;
-    for (var k = 0u; k <= glyphs; k++) {
-        var at = first;
-        if k > 0u {
-            at = i;
-            i = i + 2u + 2u * u32(scene_data[i + 1u].x);
-            if at == first {
-                continue;
-            }
-        }
-        let next = at + 2u + 2u * u32(scene_data[at + 1u].x);
-        let gap = text_gap(scene_data[at], q);
+    // Each entry: a node and its box's squared distance, tested again when it is taken off.
+    var stack: array<u32, STACKu>;
+    var gaps: array<f32, STACKu>;
+    stack[0] = 0u;
+    gaps[0] = text_gap(scene_data[base + 1u], q);
+    var top = 1u;
+    while top > 0u {
+        top -= 1u;
+        let n = base + 1u + 2u * stack[top];
+        let gap = gaps[top];
         if gap > 0.0 && gap >= best {
             continue;
         }
-        for (var s = at + 2u; s < next; s += 2u) {
+        let link = scene_data[n + 1u];
+        if link.z == 0.0 {
+            // The nearer child on top, so that it is visited first.
+            let l = u32(link.x);
+            let gl = text_gap(scene_data[base + 1u + 2u * l], q);
+            let gr = text_gap(scene_data[base + 3u + 2u * l], q);
+            let right = gr < gl;
+            let gn = select(gl, gr, right);
+            let gf = select(gr, gl, right);
+            if !(gf > 0.0 && gf >= best) {
+                stack[top] = select(l + 1u, l, right);
+                gaps[top] = gf;
+                top += 1u;
+            }
+            if !(gn > 0.0 && gn >= best) {
+                stack[top] = select(l, l + 1u, right);
+                gaps[top] = gn;
+                top += 1u;
+            }
+            continue;
+        }
+        let first = base + u32(link.x);
+        let next = first + 2u * u32(link.y);
+        for (var s = first; s < next; s += 2u) {
             let w0 = scene_data[s];
             let w1 = scene_data[s + 1u];
             let a = w0.xy;

@@ -42,7 +42,9 @@ pub struct MeshArgs {
     pub bounds: Option<[[f64; 3]; 2]>,
     /// Mesh setting: `sharp=on|off` (inner vertices at sharp edges and corners, and edges
     /// flipped along them; off: every inner vertex on the surface near its patch's centre),
-    /// `refine=N` (root-finding rounds per edge vertex, 0 to 50). May be repeated.
+    /// `refine=N` (root-finding rounds per edge vertex, 0 to 50), `thin=on|off` (mesh again
+    /// on finer cells where walls or gaps thinner than a cell were missed; off: only warn).
+    /// May be repeated.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// The file's up axis: y, the scene's up, or z, the build plate's normal that slicers
@@ -202,7 +204,8 @@ struct Meshing<'a> {
 
 /// `sdfc mesh -o FILE.3mf` for a scene of several materials: each part
 /// (`mesh::parts`) meshed on the whole scene's grid, so that where two parts touch their
-/// faces are meshed alike, and written as an object as soon as it is meshed.
+/// faces are meshed alike (and all of them again on one finer grid where one misses walls or
+/// gaps thinner than a cell), then written as an object each.
 fn objects(
     args: &MeshArgs,
     checked: &frontend::Checked,
@@ -218,8 +221,18 @@ fn objects(
     let palette = crate::mesh::write::Palette::new(&checked.scene, &colours);
     let failed = |e: std::io::Error| (1, format!("cannot write `{out}`: {e}"));
     let mut model = crate::mesh::threemf::Model::new(&palette).map_err(failed)?;
-    let (mut objects, mut triangles, mut vertices, mut seconds) = (0, 0, 0, 0.0);
     let n = parts.len();
+    let within = Region {
+        resolution: None,
+        voxel: Some(whole.voxel),
+        bounds: Some(bounds),
+        spelling: region.spelling,
+    };
+    // Every part on the whole scene's grid, so that where two parts touch their faces are
+    // meshed alike; where one misses walls or gaps thinner than a cell, every part again on
+    // the finest grid any asks for (or none, where one cannot be), for the same reason.
+    let mut meshed = Vec::new();
+    let mut fine: Option<Region> = None;
     for (k, part) in parts.into_iter().enumerate() {
         let name = palette
             .materials
@@ -242,15 +255,9 @@ fn objects(
             sources: checked.sources.clone(),
             format: checked.format,
         };
-        let within = Region {
-            resolution: None,
-            voxel: Some(whole.voxel),
-            bounds: Some(bounds),
-            spelling: region.spelling,
-        };
         let progress =
             |stage: &'static str, f: f64| (how.progress)(stage, (k as f64 + f) / n as f64);
-        let meshed = surface(
+        let coarse = surface_on(
             &one,
             within,
             how.settings,
@@ -259,17 +266,72 @@ fn objects(
             &progress,
             how.say,
         )?;
+        let thin = Thinness::new(&one, within, coarse.grid.voxel);
+        let asked = finer(
+            &thin,
+            &coarse,
+            how.settings,
+            how.limits,
+            region.spelling,
+            how.say,
+        );
+        if let Some(r) = asked {
+            if fine.is_none_or(|f| r.voxel < f.voxel) {
+                fine = Some(r);
+            }
+        }
+        meshed.push((name, part.material, one, thin, coarse));
+    }
+    if let Some(fine) = fine {
+        let mut again = Vec::new();
+        for (k, (name, _, one, _, _)) in meshed.iter().enumerate() {
+            (how.say)(format!("mesh: part {} again, material `{name}`", k + 1));
+            let progress = |stage: &'static str, f: f64| {
+                (how.progress)(stage, (k as f64 + f) / meshed.len() as f64)
+            };
+            match surface_on(
+                one,
+                fine,
+                how.settings,
+                how.limits,
+                how.pool,
+                &progress,
+                how.say,
+            ) {
+                Ok(m) => again.push(m),
+                Err((_, why)) => {
+                    for (_, _, _, thin, coarse) in &meshed {
+                        thin.refused(&coarse.stats, &why, how.say);
+                    }
+                    again.clear();
+                    break;
+                }
+            }
+        }
+        if again.len() == meshed.len() {
+            meshed = meshed
+                .into_iter()
+                .zip(again)
+                .map(|((name, material, one, thin, coarse), m)| {
+                    let m = refined(&thin, coarse, m, how.say);
+                    (name, material, one, thin, m)
+                })
+                .collect();
+        }
+    }
+    let (mut objects, mut triangles, mut vertices, mut seconds) = (0, 0, 0, 0.0);
+    for (name, material, _, _, meshed) in meshed {
         if meshed.mesh.triangles.is_empty() {
             (how.say)(format!(
                 "mesh: the part of material `{name}` has no triangles at cells of {}: no object for it",
-                short(whole.voxel)
+                short(meshed.grid.voxel)
             ));
             continue;
         }
         model
             .object(
                 &name,
-                part.material,
+                material,
                 &meshed.mesh,
                 &palette,
                 args.up.unwrap_or(Format::ThreeMf.default_up()),
@@ -336,22 +398,47 @@ pub fn surface(
 ) -> Result<Meshed, (u8, String)> {
     let coarse = surface_on(checked, region, settings, limits, pool, progress, say)?;
     let thin = Thinness::new(checked, region, coarse.grid.voxel);
-    let fits = |bytes: u64| check_memory(bytes, limits, region.spelling).is_ok();
-    let Some(fine) = thin.again(&coarse.grid, &coarse.stats, limits, &fits, say) else {
+    let Some(fine) = finer(&thin, &coarse, settings, limits, region.spelling, say) else {
         return Ok(coarse);
     };
     match surface_on(checked, fine, settings, limits, pool, progress, say) {
-        Ok(mut fine) => {
-            fine.seconds += coarse.seconds;
-            fine.stats.refined_from = Some(coarse.grid.voxel);
-            thin.still(fine.grid.voxel, &fine.stats, say);
-            Ok(fine)
-        }
+        Ok(fine) => Ok(refined(&thin, coarse, fine, say)),
         Err((_, why)) => {
             thin.refused(&coarse.stats, &why, say);
             Ok(coarse)
         }
     }
+}
+
+/// The region to mesh `coarse` again on where it missed walls or gaps thinner than a cell
+/// (`None` with a warning where the limits or `--set thin=off` leave it as it is).
+fn finer(
+    thin: &Thinness,
+    coarse: &Meshed,
+    settings: &Settings,
+    limits: &Limits,
+    spell: Spelling,
+    say: &(dyn Fn(String) + Sync),
+) -> Option<Region> {
+    if !settings.thin {
+        thin.still(coarse.grid.voxel, &coarse.stats, say);
+        return None;
+    }
+    let fits = |bytes: u64| check_memory(bytes, limits, spell).is_ok();
+    thin.again(&coarse.grid, &coarse.stats, limits, &fits, say)
+}
+
+/// `fine`, meshed again after `coarse`: its time the two's, and what it still misses said.
+fn refined(
+    thin: &Thinness,
+    coarse: Meshed,
+    mut fine: Meshed,
+    say: &(dyn Fn(String) + Sync),
+) -> Meshed {
+    fine.seconds += coarse.seconds;
+    fine.stats.refined_from = Some(coarse.grid.voxel);
+    thin.still(fine.grid.voxel, &fine.stats, say);
+    fine
 }
 
 /// [`surface`] on one grid.
@@ -611,6 +698,9 @@ pub(super) fn settings(sets: &[String]) -> Result<Settings, String> {
             ("sharp", "on" | "true") => s.sharp = true,
             ("sharp", "off" | "false") => s.sharp = false,
             ("sharp", v) => return Err(format!("sharp must be on or off, not `{v}`")),
+            ("thin", "on" | "true") => s.thin = true,
+            ("thin", "off" | "false") => s.thin = false,
+            ("thin", v) => return Err(format!("thin must be on or off, not `{v}`")),
             ("refine", v) => {
                 s.refine = v.parse::<u32>().ok().filter(|n| *n <= 50).ok_or_else(|| {
                     format!("refine must be a whole number from 0 to 50, not `{v}`")
@@ -618,7 +708,7 @@ pub(super) fn settings(sets: &[String]) -> Result<Settings, String> {
             }
             (k, _) => {
                 return Err(format!(
-                    "unknown mesh setting `{k}`; the settings are sharp, refine"
+                    "unknown mesh setting `{k}`; the settings are sharp, refine, thin"
                 ))
             }
         }

@@ -340,6 +340,9 @@ pub struct Settings {
     pub materials: bool,
     /// Measure the mesh's distance to the surface ([`Stats::error`]).
     pub measure: bool,
+    /// Mesh again on a finer grid where walls or gaps thinner than a cell were missed
+    /// (`commands::mesh_thin`); off, they are only warned about.
+    pub thin: bool,
 }
 
 impl Default for Settings {
@@ -349,6 +352,7 @@ impl Default for Settings {
             refine: 6,
             materials: true,
             measure: false,
+            thin: true,
         }
     }
 }

@@ -141,6 +141,52 @@ fn a_sheet_of_a_third_of_a_cell_stays_one_piece() {
     assert_eq!(components(&m), 1);
 }
 
+/// A 3MF of two materials, one of them the thin sheet, touching a block: both parts are
+/// meshed again on the one finer grid (each refined on its own left them on different grids,
+/// whose shared faces no longer matched); `--set thin=off` keeps the cells asked for and
+/// warns instead.
+#[test]
+fn every_part_of_a_3mf_is_refined_alike_and_thin_off_only_warns() {
+    let d = dir("parts_thin");
+    let scene = write_scene(
+        &d,
+        "two.sdf",
+        "material a = phong { color: (1, 0, 0) };\nmaterial b = phong { color: (0, 0, 1) };\n\
+         scene { box((0.5, 0.006, 0.4)).rotate_x(11deg).rotate_z(7deg) @ a; box(0.2).translate(0.6, 0, 0) @ b; }\n",
+    );
+    let out = d.join("two.3mf");
+    let stats = sdfc(&[
+        "mesh",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--voxel",
+        "0.04",
+        "--stats",
+    ]);
+    let text = String::from_utf8_lossy(&stats.stdout).into_owned();
+    let err = String::from_utf8_lossy(&stats.stderr).into_owned();
+    assert!(stats.status.success(), "{err}");
+    let grids: Vec<&str> = text.lines().filter(|l| l.starts_with("grid")).collect();
+    assert_eq!(grids.len(), 2, "{text}");
+    assert_eq!(grids[0], grids[1], "{text}");
+    assert!(grids[0].contains("refined from cells of 0.04"), "{text}");
+    let err = mesh(&[
+        s(&scene),
+        "-o",
+        s(&d.join("sheet.stl")),
+        "--voxel",
+        "0.04",
+        "--set",
+        "thin=off",
+    ]);
+    assert!(!err.contains("meshing again"), "{err}");
+    assert!(
+        err.contains("warning: a wall or gap about") && err.contains("--voxel 0.01 resolves it"),
+        "{err}"
+    );
+}
+
 /// Where the memory limit leaves no room for the finer grid, the sheet is meshed on the
 /// cells asked for, with a warning that names its place and the cell that resolves it.
 #[test]

@@ -8,7 +8,7 @@ use super::mesh::{settings, surface, Meshed, Region, Spelling, DEFAULT_RESOLUTIO
 use super::pareto::ParetoArgs;
 use crate::chart::{self, Chart};
 use crate::frontend::{self, DiagnosticFormat};
-use crate::pareto::{front, parse_sweep_within, Key, Sweep, TIME_MARGIN};
+use crate::pareto::{front, parse_sweep_within, Error, Key, Sweep, TIME_MARGIN};
 use sdfc_compiler::analysis;
 use std::process::ExitCode;
 
@@ -75,7 +75,7 @@ pub fn run(args: &ParetoArgs) -> ExitCode {
 }
 
 /// The resolutions of the `--sweep`s (only `resolution` is swept with `--mesh`).
-fn resolutions(args: &ParetoArgs, limits: &sdfc_compiler::Limits) -> Result<Vec<u32>, String> {
+fn resolutions(args: &ParetoArgs, limits: &sdfc_compiler::Limits) -> Result<Vec<u32>, Error> {
     let specs: Vec<&str> = if args.sweep.is_empty() {
         vec![DEFAULT_SWEEP]
     } else {
@@ -83,12 +83,9 @@ fn resolutions(args: &ParetoArgs, limits: &sdfc_compiler::Limits) -> Result<Vec<
     };
     let mut out = Vec::new();
     for spec in specs {
-        let Sweep { key, values } = parse_sweep_within(spec, limits).map_err(|e| e.to_string())?;
+        let Sweep { key, values } = parse_sweep_within(spec, limits)?;
         if key != Key::Resolution {
-            return Err(format!(
-                "with --mesh the swept setting is resolution (like --sweep resolution=32..512), not `{}`",
-                key.name()
-            ));
+            return Err(Error::NotMesh(key.name()));
         }
         for v in values {
             let r = v.min(f64::from(u32::MAX)) as u32;
@@ -105,7 +102,7 @@ fn measure(args: &ParetoArgs) -> Result<MeshReport, (u8, String)> {
     let usage = |msg: String| (2u8, msg);
     super::pareto::check_output(args.output.as_deref()).map_err(usage)?;
     let limits = args.limits.limits();
-    let resolutions = resolutions(args, &limits).map_err(usage)?;
+    let resolutions = resolutions(args, &limits).map_err(|e| usage(e.to_string()))?;
     let mut settings = settings(&args.set).map_err(usage)?;
     let pool = crate::job::thread_pool(args.threads, &limits).map_err(|e| usage(e.to_string()))?;
     let checked = frontend::load_scene_code(&args.file, DiagnosticFormat::Human, &limits)

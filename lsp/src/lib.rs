@@ -123,11 +123,7 @@ pub fn serve_stream<R: std::io::Read + Send + 'static>(
 /// Serves the messages framed in `input`, in order, as if the client paused between each two
 /// long enough for diagnostics to be published, until `exit` or the end of the input, writing
 /// to `output`, within `limits`: the whole server in one thread, deterministic (for fuzzing).
-pub fn serve_bytes(
-    input: &[u8],
-    output: &mut Vec<u8>,
-    limits: Limits,
-) -> Result<Exit, ServeError> {
+pub fn serve_bytes(input: &[u8], output: &mut Vec<u8>, limits: Limits) -> Result<Exit, ServeError> {
     let mut inbox = BytesInbox {
         reader: wire::Reader::with_limit(input, wire::message_limit(&limits)),
     };

@@ -982,7 +982,8 @@ fn serve_bytes_serves_a_stream_in_one_thread() {
     ));
     input.extend(framed_json(json!({ "jsonrpc": "2.0", "method": "exit" })));
     let mut output = Vec::new();
-    let exit = sdfc_runtime::lsp::serve_bytes(&input, &mut output, Default::default()).expect("written");
+    let exit =
+        sdfc_runtime::lsp::serve_bytes(&input, &mut output, Default::default()).expect("written");
     assert_eq!(exit, Exit::Clean);
     let text = String::from_utf8(output).expect("UTF-8");
     let diagnostics = text.find("publishDiagnostics").expect("diagnostics");

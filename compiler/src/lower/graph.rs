@@ -1405,7 +1405,7 @@ fn exp_sum(b: &mut Builder, m: Reg, x: Reg, y: Reg, k: f64) -> Reg {
 }
 
 /// The inverse rotation (transpose of the rows `m`): q_j = Σ_i p_i·m[i][j].
-fn rotate(b: &mut Builder, p: P, m: &[V3; 3]) -> P {
+pub(super) fn rotate(b: &mut Builder, p: P, m: &[V3; 3]) -> P {
     [0, 1, 2].map(|j| {
         let terms: Vec<Reg> = (0..3).map(|i| b.mulc(p[i], m[i][j])).collect();
         let s = b.add(terms[0], terms[1]);
@@ -1415,7 +1415,7 @@ fn rotate(b: &mut Builder, p: P, m: &[V3; 3]) -> P {
 
 /// Domain repetition per axis with period s (0: none). Infinite: p - s·round(p/s). Finite
 /// with n copies: u = p/s + (n-1)/2, id = clamp(round(u), 0, n-1), q = p - s·(id - (n-1)/2).
-fn repeat(b: &mut Builder, p: P, period: V3, count: Option<V3>) -> P {
+pub(super) fn repeat(b: &mut Builder, p: P, period: V3, count: Option<V3>) -> P {
     b.map3(p, |b, x, i| {
         let s = period[i];
         if s == 0.0 {

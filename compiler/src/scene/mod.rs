@@ -9,6 +9,7 @@ mod clip;
 mod cost;
 mod dump;
 pub mod field;
+pub mod frame;
 pub mod ir;
 pub mod look;
 pub mod params;

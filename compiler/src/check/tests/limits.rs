@@ -203,7 +203,9 @@ fn evaluation_stops_after_a_thousand_errors() {
     assert_eq!(errors.len(), 1_000, "{:#?}", &diags[..3]);
     let last = errors.last().expect("errors");
     assert!(
-        last.notes.iter().any(|n| n.contains("checking stopped here, after 1000 errors")),
+        last.notes
+            .iter()
+            .any(|n| n.contains("checking stopped here, after 1000 errors")),
         "{last:#?}"
     );
 }

@@ -366,7 +366,7 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     check_uncalled_functions(cx);
     scene.root = scene_objects(cx, scene_item, entry);
     scene.graph = std::mem::take(&mut cx.graph);
-    crate::scene::frame::place(&mut scene);
+    crate::scene::paint::place(&mut scene);
     crate::scene::recentre::recentre(&mut scene);
     scene
 }

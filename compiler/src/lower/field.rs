@@ -119,17 +119,17 @@ impl Colours {
 }
 
 /// The point `p` and unit normal `n` through one map of a colour's frame: the point as the
-/// distance maps it (`graph.rs`), the normal as the map turns the surface, `(A⁻¹)ᵀn`
+/// distance maps it (`shapes.rs`), the normal as the map turns the surface, `(A⁻¹)ᵀn`
 /// normalised for a linear part `A`, flipped with the coordinates a mirror folds.
 fn place(b: &mut Builder, frame: &Frame, p: P, n: P) -> (P, P) {
     match frame {
         Frame::Affine { matrix, offset } => {
             // rotate(p, M) is Mᵀp: (Aᵀ)ᵀp = Ap, and ((A⁻¹)ᵀ)ᵀ = A⁻¹.
             let t = [0, 1, 2].map(|i| [0, 1, 2].map(|j| matrix[j][i]));
-            let q = super::graph::rotate(b, p, &t);
+            let q = super::shapes::rotate(b, p, &t);
             let q = [0, 1, 2].map(|i| b.addc(q[i], offset[i]));
             let inverse = crate::scene::analysis::invert(matrix).unwrap_or(*matrix);
-            let m = super::graph::rotate(b, n, &inverse);
+            let m = super::shapes::rotate(b, n, &inverse);
             let len = b.len3(m);
             (q, b.map3(m, |b, x, _| b.div(x, len)))
         }
@@ -148,7 +148,7 @@ fn place(b: &mut Builder, frame: &Frame, p: P, n: P) -> (P, P) {
             }
             (q, m)
         }
-        Frame::Repeat { period, count } => (super::graph::repeat(b, p, *period, *count), n),
+        Frame::Repeat { period, count } => (super::shapes::repeat(b, p, *period, *count), n),
     }
 }
 

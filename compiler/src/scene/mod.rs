@@ -12,6 +12,7 @@ pub mod field;
 pub mod frame;
 pub mod ir;
 pub mod look;
+pub mod paint;
 pub mod params;
 pub mod path;
 pub mod pbr;

@@ -1095,14 +1095,15 @@ impl Ctx<'_> {
         } else {
             vec![coord(0), coord(1), coord(2)]
         };
-        self.locals.push(("p".into(), field::point(point)));
         // The surface normal `n`, unless a name of the program hides it (as it hides `t`):
-        // read by a colour field, refused below in a distance's.
+        // read by a colour field, refused below in a distance's. Bound before `p`, so that
+        // `p` is the nearer binding a misspelt name is told of.
         let reads = self.normal_reads.len();
         if !plane && !self.names(NORMAL) {
             let normal = vec![coord(3), coord(4), coord(5)];
             self.locals.push((NORMAL.into(), field::point(normal)));
         }
+        self.locals.push(("p".into(), field::point(point)));
         self.planes.push(plane);
         let v = self.body(body);
         self.planes.pop();

@@ -107,11 +107,10 @@ pub fn arrays(scene: &Scene, ask: Ask) -> Result<Arrays, Failure> {
         .flatten()
         .flat_map(|x| x.to_ne_bytes())
         .collect();
-    let c: Vec<u8> = mesh
-        .positions
-        .iter()
-        .zip(&mesh.vertex_materials)
-        .flat_map(|(q, &id)| palette.colour(id, *q))
+    let c: Vec<u8> = palette
+        .vertex_colours(&mesh, 0)
+        .into_iter()
+        .flatten()
         .flat_map(|x| (x as f32).to_ne_bytes())
         .collect();
     Ok((p, tri, c))

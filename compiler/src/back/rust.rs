@@ -310,6 +310,8 @@ fn expr(op: &Op, ty: &str, name: &str) -> String {
         Op::Input(Axis::X) => "p.x".into(),
         Op::Input(Axis::Y) => "p.y".into(),
         Op::Input(Axis::Z) => "p.z".into(),
+        // Only colour fields read the normal, and `--emit rust` writes the distance alone.
+        Op::Input(Axis::Nx | Axis::Ny | Axis::Nz) => constant(0.0, ty),
         Op::Unary(u, a) => unary(u, &r(a), ty),
         Op::Binary(b, x, y) => binary(b, &r(x), &r(y)),
         Op::Select(c, a, b) => format!("if {} != 0.0 {{ {} }} else {{ {} }}", r(c), r(a), r(b)),

@@ -282,7 +282,7 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
     let mut fields = String::new();
     for (id, slots) in lowered.colours.fields.iter().enumerate() {
         let call = |k: Option<usize>, constant: &str| match k {
-            Some(k) => format!("{NAME}_colour_field({k}u, p)"),
+            Some(k) => format!("{NAME}_colour_field({k}u, p, n)"),
             None => constant.to_string(),
         };
         match slots {

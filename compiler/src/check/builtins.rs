@@ -839,6 +839,10 @@ macro_rules! sigs {
 /// constant, parameter or loop variable of that name hides it.
 pub const TIME: &str = "t";
 
+/// The name of the unit surface normal at the hit that a colour field's body may read beside
+/// its point `p` (docs/language.md, "Colour fields"); a name of the program hides it.
+pub const NORMAL: &str = "n";
+
 /// The built-in constants, read like `t`: a constant, parameter or loop variable of the
 /// same name hides them.
 pub const CONSTANTS: &[(&str, f64)] =

@@ -2,7 +2,7 @@
 //! evaluated at compile time. Function bodies are also checked on their own, with their
 //! parameters `Unknown` values of the declared types ("dry" evaluation: types only, no nodes).
 
-use super::builtins::{self, Build, Def, Range, P};
+use super::builtins::{self, Build, Def, Range, NORMAL, P};
 use super::field;
 use super::ops;
 use super::suggest::{closest, closest_in_order};
@@ -83,6 +83,9 @@ pub struct Ctx<'l> {
     /// For each field being evaluated, innermost last: whether it is a profile's (its point
     /// a vec2).
     planes: Vec<bool>,
+    /// Where the body of a field read `n`, the surface normal (an error unless the field is a
+    /// colour's), innermost field's last.
+    normal_reads: Vec<Span>,
     /// The time `t` the scene is checked at, in seconds.
     pub time: f64,
     /// Reads of `t` so far (dry evaluation not counted): a count, to tell whether evaluating
@@ -633,8 +636,19 @@ impl Ctx<'_> {
         self.last_time_read
     }
 
+    /// Whether the program names `name` where evaluation is: a local, a global constant, or
+    /// one declared further down.
+    fn names(&self, name: &str) -> bool {
+        self.locals.iter().any(|(n, _)| n == name)
+            || self.globals.contains_key(name)
+            || self.declared.contains_key(name)
+    }
+
     fn var(&mut self, id: &Ident) -> Value {
         if let Some((_, v)) = self.locals.iter().rev().find(|(n, _)| *n == id.name) {
+            if id.name == NORMAL && field::is_normal(v) {
+                self.normal_reads.push(id.span);
+            }
             return v.clone();
         }
         if let Some((v, _)) = self.globals.get(&id.name) {
@@ -1079,11 +1093,21 @@ impl Ctx<'_> {
         } else {
             vec![coord(0), coord(1), coord(2)]
         };
+        // The surface normal `n`, unless a name of the program hides it (as it hides `t`):
+        // read by a colour field, refused below in a distance's. Bound before `p`, so that
+        // `p` is the nearer binding a misspelt name is told of.
+        let reads = self.normal_reads.len();
+        if !plane && !self.names(NORMAL) {
+            let normal = vec![coord(3), coord(4), coord(5)];
+            self.locals.push((NORMAL.into(), field::point(normal)));
+        }
         self.locals.push(("p".into(), field::point(point)));
         self.planes.push(plane);
         let v = self.body(body);
         self.planes.pop();
         self.locals.truncate(mark);
+        let normal_read = self.normal_reads.get(reads).copied();
+        self.normal_reads.truncate(reads);
         let distance = if plane { Type::Profile } else { Type::Shape };
         // A float body is a distance (a shape, or a profile), a vec3 body a colour (a colour
         // field; not of the plane).
@@ -1135,6 +1159,21 @@ impl Ctx<'_> {
                 return Value::Error;
             }
         };
+        if let Some(at) = normal_read.filter(|_| !colour && field::reads_normal(&comps)) {
+            self.error(
+                Diagnostic::error(
+                    "E0410",
+                    "`n`, the surface normal, exists only in a colour field",
+                    at,
+                )
+                .with_label("read in a field whose body is a distance")
+                .with_note(
+                    "a distance field defines the surface; its normal is known only where a \
+                     ray hits it, where a material's colour field (a vec3 body) is evaluated",
+                ),
+            );
+            return Value::Error;
+        }
         if colour && lipschitz.is_some() {
             self.error(
                 Diagnostic::error(

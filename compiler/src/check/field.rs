@@ -325,15 +325,32 @@ fn fbm(a: &[Value]) -> Result<Value, String> {
 /// Whether any of the expressions `out` reads a shape's distance (each shared part visited
 /// once).
 pub fn reads_distance(out: &[Rc<Sx>]) -> bool {
+    reads(out, |s| matches!(s, Sx::Distance(..)))
+}
+
+/// Whether the expression `out` reads the surface normal `n` (a colour field's alone).
+pub fn reads_normal(out: &[Rc<Sx>]) -> bool {
+    reads(out, |s| matches!(s, Sx::Coord(a, _) if *a >= 3))
+}
+
+/// Whether the value is the surface normal `n` a field's body is given.
+pub fn is_normal(v: &Value) -> bool {
+    matches!(v, Value::Point(c) if matches!(c.first().map(|s| &**s), Some(Sx::Coord(3, _))))
+}
+
+/// Whether a part of the expression `out` is one that `hit` picks.
+fn reads(out: &[Rc<Sx>], hit: impl Fn(&Sx) -> bool) -> bool {
     let mut seen: std::collections::HashSet<*const Sx> = std::collections::HashSet::new();
     let mut stack: Vec<&Rc<Sx>> = out.iter().collect();
     while let Some(s) = stack.pop() {
         if !seen.insert(Rc::as_ptr(s)) {
             continue;
         }
+        if hit(s) {
+            return true;
+        }
         match &**s {
-            Sx::Distance(..) => return true,
-            Sx::Coord(..) | Sx::Const(_) => {}
+            Sx::Distance(..) | Sx::Coord(..) | Sx::Const(_) => {}
             Sx::Un(_, a) => stack.push(a),
             Sx::Bin(_, a, b) => stack.extend([a, b]),
             Sx::Length(v) | Sx::Noise(v) | Sx::Voronoi(v) | Sx::Hash(v) => stack.extend(v),

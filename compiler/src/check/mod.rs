@@ -366,6 +366,7 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     check_uncalled_functions(cx);
     scene.root = scene_objects(cx, scene_item, entry);
     scene.graph = std::mem::take(&mut cx.graph);
+    crate::scene::paint::place(&mut scene);
     crate::scene::recentre::recentre(&mut scene);
     scene
 }
@@ -645,6 +646,7 @@ fn material(
         ior: f["ior"].num(),
         fresnel: matches!(f["fresnel"], Value::Bool(true)),
         pbr: None,
+        frame: Vec::new(),
     };
 }
 
@@ -677,6 +679,7 @@ fn pbr_material(name: &str, f: &HashMap<&'static str, Value>, base: Colour) -> M
         ior,
         fresnel: true,
         pbr: Some(p),
+        frame: Vec::new(),
     }
 }
 

@@ -590,7 +590,7 @@ fn colour_fields_reach_the_materials() {
     let colours = &lowered.colours;
     assert_eq!(colours.fields[1..], [[Some(0), None], [Some(1), None]]);
     // 0.5 + 0.5 sin(8y) at y = 0.1.
-    let [r, g, _] = colours.programs[0].eval([0.0f64, 0.1, 0.0]);
+    let [r, g, _] = colours.programs[0].eval([0.0f64, 0.1, 0.0], [0.0; 3]);
     assert!((r - (0.5 + 0.5 * 0.8f64.sin())).abs() < 1e-12 && g == 0.2);
     let constant = &colours.programs[1].program;
     assert!(
@@ -600,7 +600,10 @@ fn colour_fields_reach_the_materials() {
         )),
         "{a:?}"
     );
-    assert_eq!(colours.programs[1].eval([5.0f64, -2.0, 1.0]), [0.3; 3]);
+    assert_eq!(
+        colours.programs[1].eval([5.0f64, -2.0, 1.0], [0.0; 3]),
+        [0.3; 3]
+    );
 }
 
 #[test]

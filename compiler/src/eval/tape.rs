@@ -273,6 +273,11 @@ fn axis_index(a: Axis) -> u32 {
         Axis::X => 0,
         Axis::Y => 1,
         Axis::Z => 2,
+        // The tape runs distance programs, which never read the normal (only a colour
+        // field's program does, run by `Program::run_with_normal`): as the point's.
+        Axis::Nx => 0,
+        Axis::Ny => 1,
+        Axis::Nz => 2,
     }
 }
 

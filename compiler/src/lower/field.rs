@@ -10,12 +10,15 @@ use crate::program::{Binary, Float, Program};
 use crate::scene::field::{
     FBin, FOp, FUn, FieldFn, GOLDEN_TURN, NOISE_CELLS, VORONOI_LO, VORONOI_SPAN,
 };
+use crate::scene::frame::Frame;
 use crate::scene::{Colour, Scene, V3};
 use std::f64::consts::TAU;
 
-/// A colour field lowered: a program of the point whose registers `rgb` are the colour's red,
-/// green and blue, each at least 0. Its input is the point in the program's coordinates; the
-/// scene's [`Scene::origin`] is added first, so that the colour keeps its place in the world.
+/// A colour field lowered: a program of the point and the unit surface normal there whose
+/// registers `rgb` are the colour's red, green and blue, each at least 0. Its input is the
+/// point in the program's coordinates; the scene's [`Scene::origin`] is added first, so that
+/// the colour keeps its place in the world, then its material's frames map the point and the
+/// normal to the painted shape's coordinates ([`Material::frame`](crate::scene::Material)).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ColourProgram {
     /// The program (its distance and material registers are red and green; read `rgb`).
@@ -25,14 +28,22 @@ pub struct ColourProgram {
 }
 
 impl ColourProgram {
-    /// Lowers the expression `f` (three values) for a scene moved by `origin`.
-    pub fn new(f: &FieldFn, origin: V3) -> ColourProgram {
+    /// Lowers the expression `f` (three values) for a scene moved by `origin`, in the
+    /// coordinates the maps `frames` lead to from the world's.
+    pub fn new(f: &FieldFn, origin: V3, frames: &[Frame]) -> ColourProgram {
         let mut b = Builder::new(true);
         let q = b.input_point();
-        let p = [0, 1, 2].map(|i| b.addc(q[i], origin[i]));
+        let mut p = [0, 1, 2].map(|i| b.addc(q[i], origin[i]));
+        let mut n = b.input_normal();
+        for frame in frames {
+            (p, n) = place(&mut b, frame, p, n);
+        }
         let mut regs: Vec<Reg> = Vec::with_capacity(f.ops.len());
         for o in &f.ops {
-            let r = op(&mut b, o, p, &regs);
+            let r = match o {
+                FOp::Coord(a @ 3..) => n[*a as usize % 3],
+                o => op(&mut b, o, p, &regs),
+            };
             regs.push(r);
         }
         let rgb = [0, 1, 2].map(|i| {
@@ -46,9 +57,10 @@ impl ColourProgram {
         }
     }
 
-    /// The colour at `p` (the program's reference run, [`Program::run`]).
-    pub fn eval<T: Float>(&self, p: [T; 3]) -> [T; 3] {
-        let regs = self.program.run::<T>(p, |_| {});
+    /// The colour at `p` where the unit surface normal is `n` (the program's reference run,
+    /// [`Program::run_with_normal`]).
+    pub fn eval<T: Float>(&self, p: [T; 3], n: [T; 3]) -> [T; 3] {
+        let regs = self.program.run_with_normal::<T>(p, n, |_| {});
         self.rgb.map(|r| regs[r.0 as usize])
     }
 }
@@ -71,7 +83,7 @@ impl Colours {
         for m in &scene.materials {
             for c in m.pattern.colours() {
                 if let Colour::Field(f) = c {
-                    programs.push(ColourProgram::new(f, scene.origin));
+                    programs.push(ColourProgram::new(f, scene.origin, &m.frame));
                 }
             }
         }
@@ -103,6 +115,40 @@ impl Colours {
     /// Whether no material has a colour field.
     pub fn is_empty(&self) -> bool {
         self.programs.is_empty()
+    }
+}
+
+/// The point `p` and unit normal `n` through one map of a colour's frame: the point as the
+/// distance maps it (`shapes.rs`), the normal as the map turns the surface, `(A⁻¹)ᵀn`
+/// normalised for a linear part `A`, flipped with the coordinates a mirror folds.
+fn place(b: &mut Builder, frame: &Frame, p: P, n: P) -> (P, P) {
+    match frame {
+        Frame::Affine { matrix, offset } => {
+            // rotate(p, M) is Mᵀp: (Aᵀ)ᵀp = Ap, and ((A⁻¹)ᵀ)ᵀ = A⁻¹.
+            let t = [0, 1, 2].map(|i| [0, 1, 2].map(|j| matrix[j][i]));
+            let q = super::shapes::rotate(b, p, &t);
+            let q = [0, 1, 2].map(|i| b.addc(q[i], offset[i]));
+            let inverse = crate::scene::analysis::invert(matrix).unwrap_or(*matrix);
+            let m = super::shapes::rotate(b, n, &inverse);
+            let len = b.len3(m);
+            (q, b.map3(m, |b, x, _| b.div(x, len)))
+        }
+        Frame::Mirror(axes) => {
+            let zero = b.c(0.0);
+            let (minus, plus) = (b.c(-1.0), b.c(1.0));
+            let mut q = p;
+            let mut m = n;
+            for i in 0..3 {
+                if axes[i] {
+                    q[i] = b.abs(p[i]);
+                    let below = b.lt(p[i], zero);
+                    let sign = b.select(below, minus, plus);
+                    m[i] = b.mul(n[i], sign);
+                }
+            }
+            (q, m)
+        }
+        Frame::Repeat { period, count } => (super::shapes::repeat(b, p, *period, *count), n),
     }
 }
 

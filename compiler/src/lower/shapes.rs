@@ -335,3 +335,42 @@ pub(super) fn bezier(b: &mut Builder, p: P, v: [[f64; 2]; 3]) -> Reg {
     let dd = b.select(cubic, three, one);
     b.sqrt(dd)
 }
+
+/// The inverse rotation (transpose of the rows `m`): q_j = Σ_i p_i·m[i][j].
+pub(super) fn rotate(b: &mut Builder, p: P, m: &[V3; 3]) -> P {
+    [0, 1, 2].map(|j| {
+        let terms: Vec<Reg> = (0..3).map(|i| b.mulc(p[i], m[i][j])).collect();
+        let s = b.add(terms[0], terms[1]);
+        b.add(s, terms[2])
+    })
+}
+
+/// Domain repetition per axis with period s (0: none). Infinite: p - s·round(p/s). Finite
+/// with n copies: u = p/s + (n-1)/2, id = clamp(round(u), 0, n-1), q = p - s·(id - (n-1)/2).
+pub(super) fn repeat(b: &mut Builder, p: P, period: V3, count: Option<V3>) -> P {
+    b.map3(p, |b, x, i| {
+        let s = period[i];
+        if s == 0.0 {
+            return x;
+        }
+        let cell = cell_index(b, x, s, count.map(|n| n[i]));
+        let off = b.mulc(cell, s);
+        b.sub(x, off)
+    })
+}
+
+/// The index of the cell holding coordinate `x` along an axis of period `s` ≠ 0, centred on
+/// the middle copy: −(n−1)/2 … (n−1)/2 for `n` copies, any integer for infinitely many.
+pub(super) fn cell_index(b: &mut Builder, x: Reg, s: f64, n: Option<f64>) -> Reg {
+    let u = b.mulc(x, 1.0 / s);
+    match n {
+        None => b.un(Unary::Round, u),
+        Some(n) => {
+            let half = (n - 1.0) * 0.5;
+            let u = b.addc(u, half);
+            let id = b.un(Unary::Round, u);
+            let id = b.clampc(id, 0.0, n - 1.0);
+            b.subc(id, half)
+        }
+    }
+}

@@ -122,6 +122,15 @@ impl Builder {
         ]
     }
 
+    /// The unit surface normal at the input point (a colour field's program reads it).
+    pub fn input_normal(&mut self) -> P {
+        [
+            self.emit(Op::Input(Axis::Nx)),
+            self.emit(Op::Input(Axis::Ny)),
+            self.emit(Op::Input(Axis::Nz)),
+        ]
+    }
+
     /// The constant `x`.
     pub fn c(&mut self, x: f64) -> Reg {
         self.emit(Op::Const(x))

@@ -32,7 +32,9 @@ pub use run::Step;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Reg(pub u32);
 
-/// A coordinate of the input point.
+/// A coordinate of the input point, or of the unit surface normal there: a colour field's
+/// program reads the normal (`n` in its body, docs/language.md "Colour fields"); a distance
+/// program never does (the checker refuses `n` outside a colour field).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Axis {
     /// x
@@ -41,6 +43,19 @@ pub enum Axis {
     Y,
     /// z
     Z,
+    /// The normal's x
+    Nx,
+    /// The normal's y
+    Ny,
+    /// The normal's z
+    Nz,
+}
+
+impl Axis {
+    /// The component of the point (0 to 2) or of the normal (3 to 5) it names.
+    pub fn index(self) -> usize {
+        self as usize
+    }
 }
 
 /// One-operand operations.

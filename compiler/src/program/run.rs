@@ -17,7 +17,18 @@ pub enum Step {
 impl Program {
     /// Runs the program at `p` and returns every register (those of skipped blocks hold
     /// zero); `step` sees each block test and each instruction run, in order.
-    pub fn run<T: Float>(&self, p: [T; 3], mut step: impl FnMut(Step)) -> Vec<T> {
+    pub fn run<T: Float>(&self, p: [T; 3], step: impl FnMut(Step)) -> Vec<T> {
+        self.run_with_normal(p, [T::zero(); 3], step)
+    }
+
+    /// [`Program::run`] at `p` where the surface normal is `n` (a colour field's program
+    /// reads it, [`Axis::Nx`]…).
+    pub fn run_with_normal<T: Float>(
+        &self,
+        p: [T; 3],
+        n: [T; 3],
+        mut step: impl FnMut(Step),
+    ) -> Vec<T> {
         let ops = self.ops();
         let blocks = self.blocks();
         let mut regs: Vec<T> = vec![T::zero(); ops.len()];
@@ -47,6 +58,9 @@ impl Program {
                 Op::Input(Axis::X) => p[0],
                 Op::Input(Axis::Y) => p[1],
                 Op::Input(Axis::Z) => p[2],
+                Op::Input(Axis::Nx) => n[0],
+                Op::Input(Axis::Ny) => n[1],
+                Op::Input(Axis::Nz) => n[2],
                 Op::Unary(u, a) => scalar::unary(u, r(a)),
                 Op::Binary(b, x, y) => scalar::binary(b, r(x), r(y)),
                 Op::Select(c, a, b) => scalar::select(r(c), r(a), r(b)),

@@ -79,6 +79,9 @@ pub fn axis_name(a: Axis) -> &'static str {
         Axis::X => "x",
         Axis::Y => "y",
         Axis::Z => "z",
+        Axis::Nx => "nx",
+        Axis::Ny => "ny",
+        Axis::Nz => "nz",
     }
 }
 

@@ -59,7 +59,8 @@ pub enum FBin {
 /// One operation; operands name earlier operations.
 #[derive(Debug, Clone, PartialEq)]
 pub enum FOp {
-    /// A coordinate of the point (0: x, 1: y, 2: z; a profile's reads x and y only).
+    /// A coordinate of the point (0: x, 1: y, 2: z; a profile's reads x and y only), or of the
+    /// unit surface normal `n` (3, 4, 5: its x, y, z; a colour field's alone).
     Coord(u8),
     /// A constant.
     Const(f64),
@@ -190,7 +191,7 @@ impl FieldFn {
             .enumerate()
             .map(|(i, op)| {
                 let rhs = match op {
-                    FOp::Coord(a) => ["x", "y", "z"][*a as usize % 3].to_string(),
+                    FOp::Coord(a) => ["x", "y", "z", "nx", "ny", "nz"][*a as usize % 6].to_string(),
                     FOp::Const(c) => super::dump_num(*c),
                     FOp::Un(u, a) => format!("{} {}", un_name(*u), s(a)),
                     FOp::Bin(b, x, y) => format!("{} {}, {}", bin_name(*b), s(x), s(y)),

@@ -672,6 +672,9 @@ pub struct Material {
     pub fresnel: bool,
     /// The physically based model's parameters (`pbr { … }`), or `None` for Phong.
     pub pbr: Option<super::Pbr>,
+    /// The maps from the world to the coordinates its colour fields are evaluated in, the
+    /// outermost first (`scene/frame.rs`): none for a material applied in the world's.
+    pub frame: Vec<super::frame::Frame>,
 }
 
 impl Material {
@@ -718,6 +721,7 @@ impl Material {
             ior: Material::IOR,
             fresnel: false,
             pbr: None,
+            frame: Vec::new(),
         }
     }
 }

@@ -369,12 +369,13 @@ fn solids<T: Float>(
 /// ⌊x/s⌋ + ⌊y/s⌋ + ⌊z/s⌋ (even: first colour), sampled at p - 2h·N, just inside the surface,
 /// so that a face lying on a checker boundary does not flicker between the two colours, and
 /// its two colours mixed over the sample's footprint ([`look::checker_weight`]); a colour
-/// field is its value at p.
+/// field is its value at p, where the unit normal is N.
 pub(super) fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>, dir: V3<T>) -> V3<T> {
     let tint = |t: Tint<T>| match t {
         Tint::Const(c) => c,
         Tint::Field(k) => {
-            let [r, g, b] = ctx.colours[k].eval([hit.p.x, hit.p.y, hit.p.z]);
+            let [r, g, b] =
+                ctx.colours[k].eval([hit.p.x, hit.p.y, hit.p.z], [hit.n.x, hit.n.y, hit.n.z]);
             V3::new(r, g, b)
         }
     };

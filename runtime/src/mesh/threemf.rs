@@ -139,9 +139,8 @@ impl Model {
         let (t, materials) = (&mut self.text, self.count);
         if let Some(g) = group {
             writeln!(t, "  <m:colorgroup id=\"{g}\">")?;
-            for (i, p) in mesh.positions.iter().enumerate() {
-                let id = mesh.vertex_materials.get(i).copied().unwrap_or(material);
-                writeln!(t, "   <m:color color=\"{}\"/>", hex(palette.colour(id, *p)))?;
+            for c in palette.vertex_colours(mesh, material) {
+                writeln!(t, "   <m:color color=\"{}\"/>", hex(c))?;
             }
             writeln!(t, "  </m:colorgroup>")?;
         }

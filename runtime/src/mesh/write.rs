@@ -173,14 +173,30 @@ impl<'a> Palette<'a> {
         })
     }
 
-    /// The linear colour of material `id` at `p`, in the axes of [`Palette::up`] (a checker by
-    /// the parity of its cells, a colour field by its value, as the renderer paints them);
-    /// unknown ids get the default grey.
-    pub fn colour(&self, id: u32, p: [f64; 3]) -> [f64; 3] {
+    /// The linear colour of every vertex of `mesh` (in the axes of [`Palette::up`]): of its
+    /// material (`fallback` where the mesh names none), at its position, where the surface's
+    /// normal is the vertex's ([`vertex_normals`]).
+    pub fn vertex_colours(&self, mesh: &Mesh, fallback: u32) -> Vec<[f64; 3]> {
+        let normals = vertex_normals(mesh);
+        mesh.positions
+            .iter()
+            .zip(&normals)
+            .enumerate()
+            .map(|(i, (p, n))| {
+                let id = mesh.vertex_materials.get(i).copied().unwrap_or(fallback);
+                self.colour(id, *p, *n)
+            })
+            .collect()
+    }
+
+    /// The linear colour of material `id` at `p` where the unit surface normal is `n`, both in
+    /// the axes of [`Palette::up`] (a checker by the parity of its cells, a colour field by
+    /// its value, as the renderer paints them); unknown ids get the default grey.
+    pub fn colour(&self, id: u32, p: [f64; 3], n: [f64; 3]) -> [f64; 3] {
         let Some(m) = self.materials.get(id as usize) else {
             return [0.8; 3];
         };
-        let p = self.up.unplace(p);
+        let (p, n) = (self.up.unplace(p), self.up.unplace(n));
         let slot = match &m.pattern {
             Pattern::Solid(_) => 0,
             Pattern::Checker { size, .. } => {
@@ -196,13 +212,32 @@ impl<'a> Palette<'a> {
             (Colour::Field(_), Some(&[a, b])) => match [a, b][slot] {
                 Some(k) => {
                     let q = [0, 1, 2].map(|i| p[i] - self.origin[i]);
-                    self.colours.programs[k].eval(q)
+                    self.colours.programs[k].eval(q, n)
                 }
                 None => [0.8; 3],
             },
             (Colour::Field(_), None) => [0.8; 3],
         }
     }
+}
+
+/// The unit normal at each vertex of `mesh`: the sum of its triangles' area vectors (each
+/// triangle's `(b − a) × (c − a)`, outwards as the mesh is oriented), normalised; (0, 0, 0)
+/// at a vertex of no triangle of area.
+pub fn vertex_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
+    use glam::DVec3;
+    let mut sums = vec![DVec3::ZERO; mesh.positions.len()];
+    let at = |i: u32| DVec3::from(mesh.positions[i as usize]);
+    for t in &mesh.triangles {
+        let (a, b, c) = (at(t[0]), at(t[1]), at(t[2]));
+        let area = (b - a).cross(c - a);
+        for &i in t {
+            sums[i as usize] += area;
+        }
+    }
+    sums.iter()
+        .map(|s| s.try_normalize().unwrap_or(DVec3::ZERO).to_array())
+        .collect()
 }
 
 /// The bytes a mesh file takes at most, for the memory announcement.
@@ -254,13 +289,15 @@ fn obj(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
     if coloured {
         writeln!(out, "# vertex colours: v x y z r g b, sRGB from 0 to 1")?;
     }
+    let colours = if coloured {
+        palette.vertex_colours(mesh, 0)
+    } else {
+        Vec::new()
+    };
     for (i, p) in mesh.positions.iter().enumerate() {
         let [x, y, z] = f32s(*p);
-        if coloured {
-            let id = mesh.vertex_materials.get(i).copied().unwrap_or(0);
-            let [r, g, b] = palette
-                .colour(id, *p)
-                .map(|c| f32::from(srgb_encode(c as f32)) / 255.0);
+        if let Some(c) = colours.get(i) {
+            let [r, g, b] = c.map(|c| f32::from(srgb_encode(c as f32)) / 255.0);
             writeln!(out, "v {x} {y} {z} {r} {g} {b}")?;
         } else {
             writeln!(out, "v {x} {y} {z}")?;
@@ -296,12 +333,11 @@ fn ply(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
         mesh.positions.len(),
         mesh.triangles.len()
     )?;
-    for (i, p) in mesh.positions.iter().enumerate() {
+    let colours = palette.vertex_colours(mesh, 0);
+    for (p, c) in mesh.positions.iter().zip(&colours) {
         for x in f32s(*p) {
             out.write_all(&x.to_le_bytes())?;
         }
-        let id = mesh.vertex_materials.get(i).copied().unwrap_or(0);
-        let c = palette.colour(id, *p);
         out.write_all(&c.map(|x| srgb_encode(x as f32)))?;
     }
     for t in &mesh.triangles {
@@ -338,10 +374,9 @@ fn glb(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
     // The linear colour of every vertex, where a material the mesh uses is a colour field.
     let colours = used.iter().any(|&m| palette.varies(m)).then(|| {
         let start = bin.len();
-        for (i, p) in mesh.positions.iter().enumerate() {
-            let id = mesh.vertex_materials.get(i).copied().unwrap_or(0);
-            for c in palette.colour(id, *p) {
-                bin.extend_from_slice(&(c as f32).to_le_bytes());
+        for c in palette.vertex_colours(mesh, 0) {
+            for x in c {
+                bin.extend_from_slice(&(x as f32).to_le_bytes());
             }
         }
         views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": 34962}));

@@ -1,7 +1,7 @@
 //! Meshing and meshes, one test binary: `sdfc mesh` and the files it writes (`mesh`), their
 //! accuracy on printable parts (`mesh_accuracy`), fields meshed without `--bounds`
-//! (`mesh_fields`), 3MF read back by independent readers (`mesh_3mf`), and meshes read into
-//! scenes (`mesh_import`).
+//! (`mesh_fields`), 3MF read back by independent readers (`mesh_3mf`), meshes read into
+//! scenes (`mesh_import`), and vertex colours of the normal and of moved shapes (`mesh_colour`).
 //!
 //! Filter by module: `cargo test --release --test mesh -- mesh_3mf::`.
 
@@ -13,5 +13,6 @@ mod meshes;
 mod mesh;
 mod mesh_3mf;
 mod mesh_accuracy;
+mod mesh_colour;
 mod mesh_fields;
 mod mesh_import;

@@ -11,7 +11,8 @@
 //! - `interpreted_kernel`: the interpreted WGSL kernel against the specialised one;
 //! - `optimise`: the optimisation passes and bounding-volume culling;
 //! - `devices`: several devices at once (`--devices`);
-//! - `animation`: the time `t`, sequences and their frames.
+//! - `animation`: the time `t`, sequences and their frames;
+//! - `colour`: colour fields of the normal, and of a painted shape moved afterwards.
 //!
 //! Filter by module: `cargo test --release --test render -- look::`.
 
@@ -22,6 +23,7 @@ mod evaluators;
 
 mod analytic;
 mod animation;
+mod colour;
 mod devices;
 mod distance_conformance;
 mod image_conformance;

@@ -67,6 +67,8 @@ const MESH: u32 = 26;
 const OUTLINE: u32 = 27;
 /// The second word of a `MESH`, never run.
 const OPERAND: u32 = 28;
+/// 29, 30, 31: the surface normal's x, y, z (a colour field's program reads it).
+const NORMAL: u32 = 29;
 
 const UNARIES: [Unary; 10] = [
     Unary::Neg,
@@ -134,7 +136,10 @@ fn linear(program: &Program, roots: &[Reg], outlines: &HashMap<String, u32>) -> 
             Item::Op(i) if live[i] && phi_of[i].is_none() => {
                 let (op, args) = match ops[i] {
                     Op::Const(_) => continue,
-                    Op::Input(a) => (INPUT + a as u32, [Arg::None; 3]),
+                    Op::Input(a @ (Axis::X | Axis::Y | Axis::Z)) => {
+                        (INPUT + a as u32, [Arg::None; 3])
+                    }
+                    Op::Input(a) => (NORMAL + (a.index() - 3) as u32, [Arg::None; 3]),
                     Op::Unary(u, a) => (
                         UNARY + UNARIES.iter().position(|&x| x == u).unwrap_or(0) as u32,
                         [arg(a), Arg::None, Arg::None],
@@ -484,6 +489,8 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
         "// The distance programs, interpreted from `scene_data` (compiler/src/back/wgsl/interp.rs):\n\
          // one instruction a word (opcode, operands from registers or immediate, destination).\n\
          var<private> interp_regs: array<f32, {}>;\n\
+         // The surface normal a colour field's program reads (set by `colour_field`).\n\
+         var<private> interp_normal: vec3<f32>;\n\
          // The values of the last program's RETURN.\n\
          var<private> interp_result: vec3<f32>;\n\
          const INTERP_DONE: u32 = 0xffffffffu;\n",
@@ -529,6 +536,9 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
     case(&mut out, INPUT + Axis::X as u32, "v = p.x;");
     case(&mut out, INPUT + Axis::Y as u32, "v = p.y;");
     case(&mut out, INPUT + Axis::Z as u32, "v = p.z;");
+    case(&mut out, NORMAL, "v = interp_normal.x;");
+    case(&mut out, NORMAL + 1, "v = interp_normal.y;");
+    case(&mut out, NORMAL + 2, "v = interp_normal.z;");
     case(&mut out, COPY, "v = a;");
     // The block runs where !(bound >= best), as map.rs's `if`.
     case(
@@ -656,13 +666,15 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
     out
 }
 
-/// The WGSL text of `colour_field(k, p)` in the interpreted kernel: colour field `k`'s
-/// program, found in the table of `scene_data`, run at p. The text does not depend on the
+/// The WGSL text of `colour_field(k, p, n)` in the interpreted kernel: colour field `k`'s
+/// program, found in the table of `scene_data`, run at p where the surface normal is n
+/// (`interp_normal`, which its `NORMAL` instructions read). The text does not depend on the
 /// fields.
 pub(super) fn write_colours() -> String {
-    "// The colour of colour field k at p, interpreted from `scene_data`.\n\
-     fn colour_field(k: u32, p: vec3<f32>) -> vec3<f32> {\n    \
+    "// The colour of colour field k at p, where the normal is n, interpreted from `scene_data`.\n\
+     fn colour_field(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {\n    \
      let at = u32(scene_data[1].y) + k / 4u;\n    \
+     interp_normal = n;\n    \
      return interpret(p, u32(scene_data[at][k % 4u]));\n}"
         .to_string()
 }
@@ -674,15 +686,22 @@ mod tests {
 
     /// Runs the words as the kernel does, on the CPU, in f32.
     fn run(words: &[u32], start: u32, p: [f32; 3], file: usize) -> [f32; 2] {
-        let [a, b, _] = run3(words, start, p, file, &|_, _, _| unreachable!());
+        let [a, b, _] = run3(words, start, [p, [0.0; 3]], file, &|_, _, _| unreachable!());
         [a, b]
     }
 
     /// The value of a call (`MESH`, `OUTLINE`): its opcode, operands and the data's word.
     type Call<'a> = dyn Fn(u32, [f32; 3], u32) -> f32 + 'a;
 
-    /// [`run`], with the third value of `RETURN` (a colour's blue), calls made by `call`.
-    fn run3(words: &[u32], start: u32, p: [f32; 3], file: usize, call: &Call) -> [f32; 3] {
+    /// [`run`] at the point and normal `[p, n]`, with the third value of `RETURN` (a colour's
+    /// blue), calls made by `call`.
+    fn run3(
+        words: &[u32],
+        start: u32,
+        [p, n]: [[f32; 3]; 2],
+        file: usize,
+        call: &Call,
+    ) -> [f32; 3] {
         let mut regs = vec![0f32; file + 1];
         let mut pc = start as usize;
         loop {
@@ -702,6 +721,7 @@ mod tests {
             let v = match op {
                 RETURN => return [a, b, c],
                 1..=3 => p[(op - 1) as usize],
+                NORMAL..=31 => n[(op - NORMAL) as usize],
                 COPY => a,
                 BLOCK => {
                     if a >= b {
@@ -848,13 +868,13 @@ mod tests {
                 regs[program.material().0 as usize],
             ];
             let start = |k: usize| f32::from_bits(words[k]) as u32;
-            let [d, m, _] = run3(&words, start(0), p, file, &call);
+            let [d, m, _] = run3(&words, start(0), [p, [0.0; 3]], file, &call);
             assert_eq!(
                 [d, m].map(f32::to_bits),
                 want.map(f32::to_bits),
                 "map at {p:?}"
             );
-            let [d, _, _] = run3(&words, start(1), p, file, &call);
+            let [d, _, _] = run3(&words, start(1), [p, [0.0; 3]], file, &call);
             assert_eq!(d.to_bits(), want[0].to_bits(), "sdf at {p:?}");
         }
     }
@@ -865,16 +885,22 @@ mod tests {
     fn encoded_colour_fields_run_as_the_reference() {
         let text = "material a = phong { color: field { vec3(0.5 + 0.5 * sin(4 * p.x), 0.3, fbm(p * 2, octaves: 2)) } };\n\
             material b = checker { a: field { vec3(0.2) * p.y }, b: field { vec3(voronoi(p * 3), 0.5, 0.5) } };\n\
-            material c = phong { color: field { (1, 0.5, 0.25) } };\n\
-            scene { sphere(1) @ a; box(0.5).translate(2, 0, 0) @ b; sphere(0.5).translate(0, 2, 0) @ c; }";
+            material c = phong { color: field { vec3(0.5) + 0.5 * n.zxy } };\n\
+            scene { sphere(1) @ a; box(0.5).translate(2, 0, 0) @ b; (sphere(0.5) @ c).rotate_x(30deg).translate(0, 2, 0); }";
         let (scene, diags, _) = crate::front::check_str("t.sdf", text);
         let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
         let lowered = Lowered::new(&scene);
         let colours = &lowered.colours;
-        assert_eq!(colours.programs.len(), 4);
+        // c painted under a rotation and a translation: a copy of c carries them.
+        assert_eq!(colours.programs.len(), 5);
         assert_eq!(
             colours.fields[1..],
-            [[Some(0), None], [Some(1), Some(2)], [Some(3), None]]
+            [
+                [Some(0), None],
+                [Some(1), Some(2)],
+                [Some(3), None],
+                [Some(4), None]
+            ]
         );
         let file = 64;
         let bytes = encode(
@@ -896,10 +922,11 @@ mod tests {
         let mut rng = crate::rng::Rng::new(11);
         for _ in 0..2_000 {
             let p = [0; 3].map(|_| rng.range(-3.0, 3.0) as f32);
+            let n = [0; 3].map(|_| rng.range(-1.0, 1.0) as f32);
             for (k, c) in colours.programs.iter().enumerate() {
                 let start = int(4 * (table + k / 4) + k % 4);
-                let got = run3(&words, start, p, file, &|_, _, _| unreachable!());
-                let want = c.eval::<f32>(p);
+                let got = run3(&words, start, [p, n], file, &|_, _, _| unreachable!());
+                let want = c.eval::<f32>(p, n);
                 assert_eq!(
                     got.map(f32::to_bits),
                     want.map(f32::to_bits),

@@ -112,9 +112,9 @@ pub(super) fn write_sdf_with(program: &Program, name: &str, params: Option<&Para
     out
 }
 
-/// The WGSL functions of the materials' colour fields (`lower::Colours`): `colour_fieldK(p)`
-/// for each, written as `map` is, and `colour_field(k, p)`, field `k`'s colour at p (each
-/// name after `prefix`).
+/// The WGSL functions of the materials' colour fields (`lower::Colours`): `colour_fieldK(p, n)`
+/// for each, written as `map` is, and `colour_field(k, p, n)`, field `k`'s colour at p where
+/// the unit surface normal is n (each name after `prefix`).
 pub(super) fn write_colours(colours: &[crate::lower::ColourProgram], prefix: &str) -> String {
     let mut out = String::new();
     for (k, c) in colours.iter().enumerate() {
@@ -126,7 +126,7 @@ pub(super) fn write_colours(colours: &[crate::lower::ColourProgram], prefix: &st
         out.push_str(&std::mem::take(&mut w.functions));
         let _ = writeln!(
             out,
-            "// Colour field {k}: (red, green, blue) at p.\nfn {name}(p: vec3<f32>) -> vec3<f32> {{"
+            "// Colour field {k}: (red, green, blue) at p, where the normal is n.\nfn {name}(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {{"
         );
         out.push_str(&body);
         let _ = writeln!(
@@ -137,12 +137,12 @@ pub(super) fn write_colours(colours: &[crate::lower::ColourProgram], prefix: &st
     }
     let _ = writeln!(
         out,
-        "// The colour of colour field k at p.\nfn {prefix}colour_field(k: u32, p: vec3<f32>) -> vec3<f32> {{\n    switch k {{"
+        "// The colour of colour field k at p, where the normal is n.\nfn {prefix}colour_field(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {{\n    switch k {{"
     );
     for k in 0..colours.len() {
         let _ = writeln!(
             out,
-            "        case {k}u: {{\n            return {prefix}colour_field{k}(p);\n        }}"
+            "        case {k}u: {{\n            return {prefix}colour_field{k}(p, n);\n        }}"
         );
     }
     out.push_str("        default: {}\n    }\n    return vec3<f32>(0.0);\n}");
@@ -508,6 +508,9 @@ fn expr(program: &Program, op: &Op, names: &Names, params: Option<&Params>) -> S
         Op::Input(Axis::X) => "p.x".into(),
         Op::Input(Axis::Y) => "p.y".into(),
         Op::Input(Axis::Z) => "p.z".into(),
+        Op::Input(Axis::Nx) => "n.x".into(),
+        Op::Input(Axis::Ny) => "n.y".into(),
+        Op::Input(Axis::Nz) => "n.z".into(),
         Op::Unary(u, a) => {
             let a = n(a);
             match u {

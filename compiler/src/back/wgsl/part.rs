@@ -103,7 +103,7 @@ pub(crate) fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String
             .flat_map(|f| f.iter().enumerate())
             .filter_map(|(slot, k)| {
                 let member = ["color", "color_b"][slot];
-                k.map(|k| format!(" ({member}: {name}_colour_field({k}u, p))"))
+                k.map(|k| format!(" ({member}: {name}_colour_field({k}u, p, n))"))
             })
             .collect();
         let _ = writeln!(

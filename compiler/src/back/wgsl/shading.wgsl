@@ -44,13 +44,13 @@ fn checker_weight(q: vec3<f32>, n: vec3<f32>, d: vec3<f32>, s: f32) -> f32 {
 //#endif
 
 // The colour of material m at p (a checker: its two colours mixed over the sample's
-// footprint, sampled just inside; a colour field: its value at p). d: the ray's direction,
-// tt: its path length.
+// footprint, sampled just inside; a colour field: its value at p, where the normal is n). d:
+// the ray's direction, tt: its path length.
 fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32, d: vec3<f32>, tt: f32) -> vec3<f32> {
     var ca = m.color.xyz;
 //#if COLOUR_FIELDS
     if m.optics.w > 0.0 {
-        ca = colour_field(u32(m.optics.w) - 1u, p);
+        ca = colour_field(u32(m.optics.w) - 1u, p, n);
     }
 //#endif
 //#if CHECKER
@@ -62,7 +62,7 @@ fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32, d: vec3<f32>,
         var cb = m.color_b.xyz;
 //#if COLOUR_FIELDS
         if m.shift.w > 0.0 && wb > 0.0 {
-            cb = colour_field(u32(m.shift.w) - 1u, p);
+            cb = colour_field(u32(m.shift.w) - 1u, p, n);
         }
 //#endif
         if wb >= 1.0 {

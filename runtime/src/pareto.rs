@@ -83,7 +83,9 @@ pub enum Error {
     #[error(transparent)]
     Setting(#[from] settings::Error),
     /// A render setting swept with `--mesh`, which sweeps the resolution alone.
-    #[error("with --mesh the swept setting is resolution (like --sweep resolution=32..512), not `{0}`")]
+    #[error(
+        "with --mesh the swept setting is resolution (like --sweep resolution=32..512), not `{0}`"
+    )]
     NotMesh(&'static str),
 }
 

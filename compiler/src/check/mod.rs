@@ -366,7 +366,14 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     check_uncalled_functions(cx);
     scene.root = scene_objects(cx, scene_item, entry);
     scene.graph = std::mem::take(&mut cx.graph);
-    crate::scene::paint::place(&mut scene);
+    let max = cx.limits.count(Limit::Nodes);
+    if let (Err(max), Some(root)) = (crate::scene::paint::place(&mut scene, max), scene.root) {
+        cx.limit(
+            Limit::Nodes,
+            scene.graph.span(root),
+            format!("painting each shape in its own coordinates meets more than {max} shapes under their placements"),
+        );
+    }
     crate::scene::recentre::recentre(&mut scene);
     scene
 }

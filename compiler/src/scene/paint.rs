@@ -47,32 +47,78 @@ fn frame_of(node: &Node) -> Option<Frame> {
 /// ([`Frame`]), a copy of its material that carries them: the root down, each node rebuilt
 /// where a material below it changed. Materials applied in the world's coordinates (at the
 /// top of the scene, or under nothing but combinations) keep theirs: such a scene is unchanged.
-pub fn place(scene: &mut Scene) {
+///
+/// Only the subtrees that paint with a colour field are walked (a shape shared under many
+/// placements is met once per distinct chain of maps above it, and a scene of 2³⁰ leaves as a
+/// tree of shared shapes is 60 nodes). `Err(max)` where that walk would meet more than `max`
+/// nodes under their maps (the scene is then left as it was).
+pub fn place(scene: &mut Scene, max: usize) -> Result<(), usize> {
     let Some(root) = scene.root else {
-        return;
+        return Ok(());
     };
     let mut walk = Walk {
         copies: Vec::new(),
         memo: HashMap::new(),
+        fields: HashMap::new(),
+        max,
     };
-    scene.root = Some(walk.node(scene, root, &[]));
+    let materials = scene.materials.len();
+    match walk.node(scene, root, &[]) {
+        Some(new) => {
+            scene.root = Some(new);
+            Ok(())
+        }
+        None => {
+            // Nothing the walk made is reachable from the root; its materials are dropped.
+            scene.materials.truncate(materials);
+            Err(max)
+        }
+    }
 }
 
-/// The state of [`place`]: the copies of materials made so far, and each node rebuilt under
-/// the frames it was met under.
+/// The state of [`place`]: the copies of materials made so far, each node rebuilt under
+/// the frames it was met under, and which subtrees paint with a colour field.
 struct Walk {
     /// (material, frames, the copy's id).
     copies: Vec<(MaterialId, Vec<Frame>, MaterialId)>,
     memo: HashMap<(NodeId, String), NodeId>,
+    fields: HashMap<NodeId, bool>,
+    /// The most (node, frames) pairs the walk may meet.
+    max: usize,
 }
 
 impl Walk {
+    /// Whether the subtree of `id` paints a shape with a colour field (once per node).
+    fn paints_field(&mut self, scene: &Scene, id: NodeId) -> bool {
+        if let Some(&f) = self.fields.get(&id) {
+            return f;
+        }
+        let node = scene.graph.node(id);
+        let here =
+            matches!(node, Node::Paint { material, .. } if has_field(scene.material(*material)));
+        let f = here
+            || (!matches!(node, Node::Field { .. })
+                && stacker::maybe_grow(64 * 1024, 1024 * 1024, || {
+                    node.children()
+                        .into_iter()
+                        .any(|c| self.paints_field(scene, c))
+                }));
+        self.fields.insert(id, f);
+        f
+    }
+
     /// Node `id` met under `frames` (outermost first), rebuilt where a material below it
-    /// is copied.
-    fn node(&mut self, scene: &mut Scene, id: NodeId, frames: &[Frame]) -> NodeId {
+    /// is copied; `None` once more than [`Walk::max`] nodes were met.
+    fn node(&mut self, scene: &mut Scene, id: NodeId, frames: &[Frame]) -> Option<NodeId> {
+        if !self.paints_field(scene, id) {
+            return Some(id);
+        }
         let key = (id, format!("{frames:?}"));
         if let Some(&m) = self.memo.get(&key) {
-            return m;
+            return Some(m);
+        }
+        if self.memo.len() >= self.max {
+            return None;
         }
         let mut node = scene.graph.node(id).clone();
         let inner = match frame_of(&node) {
@@ -92,7 +138,9 @@ impl Walk {
             let children = node.children();
             let mut new = Vec::with_capacity(children.len());
             for c in &children {
-                new.push(self.node(scene, *c, &inner));
+                let n =
+                    stacker::maybe_grow(64 * 1024, 1024 * 1024, || self.node(scene, *c, &inner))?;
+                new.push(n);
             }
             if new != children {
                 changed = true;
@@ -106,7 +154,7 @@ impl Walk {
             id
         };
         self.memo.insert(key, out);
-        out
+        Some(out)
     }
 
     /// The copy of `material` under `frames`, made once.
@@ -187,6 +235,53 @@ mod tests {
     }
 
     const STRIPES: &str = "material m = phong { color: field { vec3(fract(p.x), fract(2 * p.y), 0.5 + 0.5 * n.z) } };\n";
+
+    /// A chain of shapes each placed twice (2^k placements of the first at level k): without
+    /// paint the walk is skipped (30 levels took minutes and gigabytes: the scene is refused
+    /// by the `expansion` limit, quickly), and with a colour field at the leaves it stops at
+    /// the `nodes` limit with the limit's error.
+    #[test]
+    fn a_shape_placed_exponentially_often_is_bounded() {
+        let chain = |levels: usize, leaf: &str| {
+            let mut text = format!("{STRIPES}fn g0() -> shape {{ {leaf} }}\n");
+            for k in 1..=levels {
+                text += &format!(
+                    "fn g{k}() -> shape {{ smooth_union(0.1, g{}().translate(0.01, 0, 0), g{}().rotate_y(1deg)) }}\n",
+                    k - 1,
+                    k - 1
+                );
+            }
+            text + &format!("scene {{ g{levels}(); }}\n")
+        };
+        let check = |text: String, nodes: u64| {
+            let mut limits = crate::limits::Limits::default();
+            limits
+                .set(crate::limits::Limit::Nodes, nodes)
+                .expect("a valid limit");
+            let mut sources = crate::span::SourceMap::new();
+            let entry = sources.add("t.sdf", text);
+            crate::front::check_with(&mut sources, entry, &mut crate::check::NoImports, &limits)
+        };
+        let started = std::time::Instant::now();
+        let (_, diags) = check(chain(30, "sphere(0.3)"), 1_000_000);
+        assert!(
+            diags
+                .iter()
+                .any(|d| d.message.contains("expand to more than")),
+            "{diags:?}"
+        );
+        assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
+        let (painted, diags) = check(chain(12, "sphere(0.3) @ m"), 1_000);
+        assert!(painted.is_none(), "{diags:?}");
+        assert!(
+            diags.iter().any(|d| d
+                .message
+                .contains("painting each shape in its own coordinates")),
+            "{diags:?}"
+        );
+        let (painted, diags) = check(chain(6, "sphere(0.3) @ m"), 1_000);
+        assert!(painted.is_some(), "{diags:?}");
+    }
 
     #[test]
     fn a_painted_shape_moved_afterwards_takes_its_pattern_along() {

@@ -8,7 +8,7 @@
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Once;
 
 /// One measured point of a chart.
@@ -70,56 +70,78 @@ const GREY: RGBColor = RGBColor(110, 130, 170);
 const FRONT: RGBColor = RGBColor(200, 40, 40);
 const DEFAULT: RGBColor = RGBColor(20, 150, 60);
 
+/// Why a chart could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The file's name says neither SVG nor PNG.
+    #[error("`{}`: the chart must be a .svg or .png file", .0.display())]
+    Extension(PathBuf),
+    /// The file could not be written.
+    #[error("cannot write `{}`: {error}", path.display())]
+    Write {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    /// The plotting library failed to draw.
+    #[error("drawing the chart: {0}")]
+    Draw(Box<dyn std::error::Error + Send + Sync>),
+    /// The PNG encoder failed.
+    #[error("encoding the chart as PNG: {0}")]
+    Png(#[from] ::png::EncodingError),
+}
+
+/// A drawing error of any plotting backend, as an [`Error`].
+fn drawn<E: std::error::Error + Send + Sync + 'static>(e: DrawingAreaErrorKind<E>) -> Error {
+    Error::Draw(Box::new(e))
+}
+
 /// Writes the chart to `path`: SVG for a `.svg` name, PNG for `.png`.
-pub fn write(chart: &Chart, path: &Path) -> Result<(), String> {
+pub fn write(chart: &Chart, path: &Path) -> Result<(), Error> {
     let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
     let bytes = match ext.as_deref() {
         Some("svg") => svg(chart)?.into_bytes(),
         Some("png") => png(chart)?,
-        _ => {
-            return Err(format!(
-                "`{}`: the chart must be a .svg or .png file",
-                path.display()
-            ))
-        }
+        _ => return Err(Error::Extension(path.to_path_buf())),
     };
-    crate::image::write_atomic(path, &bytes)
-        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+    crate::image::write_atomic(path, &bytes).map_err(|error| Error::Write {
+        path: path.to_path_buf(),
+        error,
+    })
 }
 
 /// The chart as SVG text.
-pub fn svg(chart: &Chart) -> Result<String, String> {
+pub fn svg(chart: &Chart) -> Result<String, Error> {
     register_font();
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, SIZE).into_drawing_area();
         draw(&root, chart)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(drawn)?;
     }
     Ok(out)
 }
 
 /// The chart as PNG file bytes.
-pub fn png(chart: &Chart) -> Result<Vec<u8>, String> {
+pub fn png(chart: &Chart) -> Result<Vec<u8>, Error> {
     register_font();
     let (w, h) = SIZE;
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
         draw(&root, chart)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(drawn)?;
     }
     encode_rgb(&rgb, w, h)
 }
 
-fn encode_rgb(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, String> {
+fn encode_rgb(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, Error> {
     let mut bytes = Vec::new();
     let mut encoder = ::png::Encoder::new(&mut bytes, w, h);
     encoder.set_color(::png::ColorType::Rgb);
     encoder.set_depth(::png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    writer.write_image_data(rgb).map_err(|e| e.to_string())?;
-    writer.finish().map_err(|e| e.to_string())?;
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(rgb)?;
+    writer.finish()?;
     Ok(bytes)
 }
 
@@ -176,21 +198,24 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     lo / 1.25..hi * 1.25
 }
 
-fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> Result<(), Error>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(drawn)?;
     let (head, body) = root.split_vertically(64);
     head.draw(&Text::new(
         chart.title.clone(),
         (20, 10),
         (FONT, 22).into_font(),
     ))
-    .map_err(|e| e.to_string())?;
+    .map_err(drawn)?;
     head.draw(&Text::new(
         chart.subtitle.clone(),
         (20, 38),
         (FONT, 14).into_font().color(&RGBColor(80, 80, 80)),
     ))
-    .map_err(|e| e.to_string())?;
+    .map_err(drawn)?;
     let (left, right) = body.split_horizontally(SIZE.0 / 2);
     if chart.accuracy.lower_is_better {
         let (lo, hi, _) = accuracy_range(chart);
@@ -211,12 +236,13 @@ fn panel<DB: DrawingBackend, Y>(
     chart: &Chart,
     k: usize,
     ys: Y,
-) -> Result<(), String>
+) -> Result<(), Error>
 where
+    DB::ErrorType: 'static,
     Y: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
     Y::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let err = drawn::<DB::ErrorType>;
     let (_, _, infinite) = accuracy_range(chart);
     let y = |p: &Point| {
         if p.accuracy.is_finite() && !(chart.accuracy.lower_is_better && p.accuracy <= 0.0) {

@@ -186,23 +186,30 @@ impl Output {
     /// `sync`: [`AtomicFile::create`], else [`AtomicFile::unsynced`]), or to standard output.
     /// Says where the time went (`sdfc render --stats`): (step, time, what) for the
     /// encoding, the write, and for a file its `fsync` and rename.
-    pub fn write(&self, picture: &Picture, sync: bool, png: PngLevel) -> Result<Vec<Step>, String> {
+    pub fn write(
+        &self,
+        picture: &Picture,
+        sync: bool,
+        png: PngLevel,
+    ) -> Result<Vec<Step>, WriteError> {
         let (path, format) = match self {
             Output::Stdout => {
-                let cannot = |e: String| format!("cannot write the image to standard output: {e}");
-                let (bytes, mut steps) =
-                    png_steps(picture, png).map_err(|e| cannot(e.to_string()))?;
+                let (bytes, mut steps) = png_steps(picture, png)
+                    .map_err(|e| WriteError::Stdout(std::io::Error::other(e)))?;
                 let start = Instant::now();
                 let mut out = std::io::stdout().lock();
                 out.write_all(&bytes)
                     .and_then(|()| out.flush())
-                    .map_err(|e| cannot(e.to_string()))?;
+                    .map_err(WriteError::Stdout)?;
                 steps.push(("write", start.elapsed(), "to standard output".to_string()));
                 return Ok(steps);
             }
             Output::File { path, format } => (path, *format),
         };
-        let cannot = |e: std::io::Error| format!("cannot write `{}`: {e}", path.display());
+        let cannot = |error: std::io::Error| WriteError::File {
+            path: path.clone(),
+            error,
+        };
         let mut steps = Vec::new();
         let encoded = if format == Format::Png {
             let (bytes, encoded) =
@@ -276,6 +283,23 @@ pub struct Task {
     pub started: Instant,
 }
 
+/// Why an image could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// Encoding it or writing it to standard output failed.
+    #[error("cannot write the image to standard output: {0}")]
+    Stdout(std::io::Error),
+    /// Encoding it or writing its file failed.
+    #[error("cannot write `{}`: {error}", path.display())]
+    File {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    /// A [`Writers`] pool's threads have ended: it takes no more frames.
+    #[error("the image writers have ended")]
+    Ended,
+}
+
 /// A frame a [`Writers`] pool has written (or failed to write): its number, the error, and
 /// the seconds from the start of its render to its file's rename.
 #[derive(Debug)]
@@ -283,7 +307,7 @@ pub struct Written {
     /// The frame's number.
     pub k: u64,
     /// Why the file could not be written.
-    pub result: Result<(), String>,
+    pub result: Result<(), WriteError>,
     /// Seconds from the start of its render until its file was written.
     pub seconds: f64,
     /// Where the writing went: encoding, write, `fsync` and rename ([`Output::write`]).
@@ -309,10 +333,8 @@ pub struct Submit(std::sync::mpsc::SyncSender<Task>);
 impl Submit {
     /// Hands `task` to the pool, waiting while `depth` frames wait already. `Err` when the
     /// pool has ended.
-    pub fn submit(&self, task: Task) -> Result<(), String> {
-        self.0
-            .send(task)
-            .map_err(|_| "the image writers have ended".to_string())
+    pub fn submit(&self, task: Task) -> Result<(), WriteError> {
+        self.0.send(task).map_err(|_| WriteError::Ended)
     }
 }
 
@@ -374,7 +396,7 @@ impl Writers {
     }
 
     /// Hands `task` to the pool ([`Submit::submit`]).
-    pub fn submit(&self, task: Task) -> Result<(), String> {
+    pub fn submit(&self, task: Task) -> Result<(), WriteError> {
         self.submitter().submit(task)
     }
 

@@ -113,7 +113,7 @@ impl Renderer for SeveralPrepared {
             (faults, statistics, finished),
             &mut |f| progress(f),
         )
-        .map_err(Error::Render)?;
+        .map_err(|e| Error::Render(e.to_string()))?;
         Ok(Frame::of(r))
     }
 

@@ -214,7 +214,7 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
     let picture = frame.take_picture();
     let steps = out
         .write(&picture, false, args.png_level)
-        .map_err(Error::Io)?;
+        .map_err(|e| Error::Io(e.to_string()))?;
     if let (true, Some(path)) = (args.aux, out.path()) {
         write_sidecar(path, frame.render.depth.as_ref(), prepared.name()).map_err(Error::Io)?;
     }

@@ -31,6 +31,23 @@ impl<'a> Device<'a> {
     }
 }
 
+/// Why the CPU device failed.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Its thread pool could not be started.
+    #[error("cannot start the CPU's worker threads: {0}")]
+    Threads(#[from] rayon::ThreadPoolBuildError),
+    /// A tile that is not a band of whole rows (the scheduler gives the CPU bands).
+    #[error("the CPU device renders bands of whole rows")]
+    NotRows,
+    /// Pixels read that no band rendered.
+    #[error("the CPU did not render pixels {0:?}")]
+    NotRendered(Range<usize>),
+    /// A fault injected by `SDFC_FAULT_AFTER_TILES` (tests of the scheduler).
+    #[error("{0}")]
+    Injected(String),
+}
+
 /// The CPU's frame: its thread pool, the bands rendered and not yet read, and the steps and
 /// counters of those read (their statistics, reduced on the host when asked).
 #[derive(Debug)]
@@ -42,17 +59,17 @@ pub struct Frame {
 
 impl launch::Device for Device<'_> {
     type Frame = Frame;
-    type Error = String;
+    type Error = Error;
 
     fn describe(&self) -> String {
         format!("CPU, {} threads", self.threads)
     }
 
-    fn prepare(&self, _job: &Job) -> Result<Frame, String> {
+    fn prepare(&self, _job: &Job) -> Result<Frame, Error> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()
-            .map_err(|e| format!("cannot start the CPU's worker threads: {e}"))?;
+            .map_err(Error::Threads)?;
         Ok(Frame {
             pool,
             rendered: Vec::new(),
@@ -60,11 +77,11 @@ impl launch::Device for Device<'_> {
         })
     }
 
-    fn run(&self, f: &mut Frame, job: &Job, tiles: &[usize]) -> Result<(), String> {
+    fn run(&self, f: &mut Frame, job: &Job, tiles: &[usize]) -> Result<(), Error> {
         for &i in tiles {
             let t = job.tiles[i];
             if t.0 != 0 || t.2 != job.width {
-                return Err("the CPU device renders bands of whole rows".into());
+                return Err(Error::NotRows);
             }
             let rows = t.1..t.1 + t.3;
             let (linear, steps, counters) = f
@@ -78,14 +95,14 @@ impl launch::Device for Device<'_> {
         Ok(())
     }
 
-    fn read(&self, f: &mut Frame, job: &Job, ranges: &[Range<usize>]) -> Result<Pixels, String> {
+    fn read(&self, f: &mut Frame, job: &Job, ranges: &[Range<usize>]) -> Result<Pixels, Error> {
         let mut out = Pixels::default();
         for r in ranges {
             let at = f
                 .rendered
                 .iter()
                 .position(|(have, _)| have == r)
-                .ok_or_else(|| format!("the CPU did not render pixels {r:?}"))?;
+                .ok_or_else(|| Error::NotRendered(r.clone()))?;
             let (_, linear) = f.rendered.swap_remove(at);
             if job.finished {
                 // Finished here as a GPU finishes its pixels: clamped and sRGB-encoded.
@@ -114,7 +131,7 @@ impl launch::Device for Device<'_> {
         _job: &Job,
         ranges: &[Range<usize>],
         ask: Ask,
-    ) -> Result<Answer, String> {
+    ) -> Result<Answer, Error> {
         let mut steps = Vec::new();
         let mut counters = Counters::default();
         for (r, s, c) in f.statistics.iter().filter(|(r, ..)| ranges.contains(r)) {
@@ -125,11 +142,11 @@ impl launch::Device for Device<'_> {
         Ok(Answer::of_steps(&steps, &counters, ask))
     }
 
-    fn finish(&self, _f: Frame, _job: &Job) -> Result<Option<Duration>, String> {
+    fn finish(&self, _f: Frame, _job: &Job) -> Result<Option<Duration>, Error> {
         Ok(None)
     }
 
-    fn fault(&self, message: String) -> String {
-        message
+    fn fault(&self, message: String) -> Error {
+        Error::Injected(message)
     }
 }

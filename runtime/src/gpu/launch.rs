@@ -668,14 +668,13 @@ trait Accept: Device {
         bands: &Bands,
         (band, slot): (usize, usize),
         share: &mut Share,
-    ) -> Result<(), String> {
+    ) -> Result<(), Self::Error> {
         let job = bands.job;
         let read = Instant::now();
         let collected = {
             let mut place = bands.places[band].lock().unwrap_or_else(|e| e.into_inner());
             self.collect_into(frame, job, job.band(band), slot, place.reborrow())
-                .and_then(|c| self.check(frame).map(|()| c))
-                .map_err(|e| e.to_string())?
+                .and_then(|c| self.check(frame).map(|()| c))?
         };
         share.phases.launches += collected.wait;
         share.phases.readback += read
@@ -744,7 +743,7 @@ impl<D: Device> Worker for D {
                     if ran.is_ok() {
                         queue.hand_back(band);
                     }
-                    share.failure = Some(e);
+                    share.failure = Some(e.to_string());
                     break;
                 }
                 rendered.push(job.band(p));
@@ -762,7 +761,7 @@ impl<D: Device> Worker for D {
                 if let Some((p, p_slot)) = pending.take() {
                     if let Err(e) = self.accept(&mut frame, bands, (p, p_slot), &mut share) {
                         queue.hand_back(p);
-                        share.failure = Some(e);
+                        share.failure = Some(e.to_string());
                         break;
                     }
                     rendered.push(job.band(p));
@@ -799,6 +798,35 @@ impl<D: Device> Worker for D {
     }
 }
 
+/// Why a frame on several devices failed: every device did, before the frame's tiles were
+/// all rendered.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeveralError {
+    /// The tiles rendered before the last device failed.
+    pub rendered: usize,
+    /// The frame's tiles.
+    pub tiles: usize,
+    /// Each failed device: its position in the list, its description and why it failed.
+    pub failures: Vec<(usize, String, String)>,
+}
+
+impl std::fmt::Display for SeveralError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "every device failed ({} of {} tiles rendered): ",
+            self.rendered, self.tiles
+        )?;
+        for (k, (i, device, why)) in self.failures.iter().enumerate() {
+            let sep = if k == 0 { "" } else { "; " };
+            write!(f, "{sep}device {i} ({device}): {why}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for SeveralError {}
+
 /// Renders `job` (whose tiles are bands, [`tiling`]) on several devices at once: each
 /// device's worker takes the next band from one queue; the bands are assembled in order. A
 /// device that fails hands its band back; the frame fails only when every device has.
@@ -807,7 +835,7 @@ pub fn render_several(
     job: &Job,
     faults: &Faults,
     progress: &mut dyn FnMut(f64),
-) -> Result<Output, String> {
+) -> Result<Output, SeveralError> {
     let start = Instant::now();
     let (tx, rx) = mpsc::channel();
     let pixels = job.pixels();
@@ -883,21 +911,18 @@ pub fn render_several(
         shares.into_iter().map(|(_, s)| s).collect::<Vec<_>>()
     });
     if done < job.tiles.len() {
-        let why: Vec<String> = shares
-            .iter()
-            .enumerate()
-            .filter_map(|(i, s)| {
-                s.failure
-                    .as_ref()
-                    .map(|f| format!("device {i} ({}): {f}", s.device))
-            })
-            .collect();
-        return Err(format!(
-            "every device failed ({} of {} tiles rendered): {}",
-            done,
-            job.tiles.len(),
-            why.join("; ")
-        ));
+        return Err(SeveralError {
+            rendered: done,
+            tiles: job.tiles.len(),
+            failures: shares
+                .iter()
+                .enumerate()
+                .filter_map(|(i, s)| {
+                    let why = s.failure.clone()?;
+                    Some((i, s.device.clone(), why))
+                })
+                .collect(),
+        });
     }
     let wall = start.elapsed();
     // The workers ran side by side and put the bands in place: the frame's phases are those
@@ -953,6 +978,16 @@ fn places<'a>(job: &Job, rgba: &'a mut [u8], linear: &'a mut [[f32; 3]]) -> Vec<
 mod tests {
     use super::*;
 
+    /// A fake device's failure: what it says.
+    #[derive(Debug)]
+    struct Failed(String);
+
+    impl std::fmt::Display for Failed {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str(&self.0)
+        }
+    }
+
     #[test]
     fn squares_cover_the_image_once() {
         let t = squares(100, 70, 32);
@@ -1004,14 +1039,14 @@ mod tests {
 
     impl Device for Fake<'_> {
         type Frame = usize;
-        type Error = String;
+        type Error = Failed;
         fn describe(&self) -> String {
             "fake".into()
         }
-        fn prepare(&self, _job: &Job) -> Result<usize, String> {
+        fn prepare(&self, _job: &Job) -> Result<usize, Self::Error> {
             Ok(0)
         }
-        fn run(&self, ran: &mut usize, _job: &Job, tiles: &[usize]) -> Result<(), String> {
+        fn run(&self, ran: &mut usize, _job: &Job, tiles: &[usize]) -> Result<(), Self::Error> {
             use std::sync::atomic::Ordering;
             while self.wait && self.failed.load(Ordering::SeqCst) == 0 {
                 std::thread::yield_now();
@@ -1020,12 +1055,17 @@ mod tests {
             match self.fails {
                 Some(n) if *ran > n => {
                     self.failed.fetch_add(1, Ordering::SeqCst);
-                    Err("lost".into())
+                    Err(Failed("lost".into()))
                 }
                 _ => Ok(()),
             }
         }
-        fn read(&self, _: &mut usize, _: &Job, ranges: &[Range<usize>]) -> Result<Pixels, String> {
+        fn read(
+            &self,
+            _: &mut usize,
+            _: &Job,
+            ranges: &[Range<usize>],
+        ) -> Result<Pixels, Self::Error> {
             let mut p = Pixels::default();
             for r in ranges {
                 p.linear.extend(r.clone().map(|i| [i as f32, 0.0, 0.0]));
@@ -1039,7 +1079,7 @@ mod tests {
             _: &Job,
             ranges: &[Range<usize>],
             ask: Ask,
-        ) -> Result<Answer, String> {
+        ) -> Result<Answer, Self::Error> {
             let steps: Vec<u32> = ranges
                 .iter()
                 .flat_map(|r| r.clone())
@@ -1051,11 +1091,11 @@ mod tests {
             };
             Ok(Answer::of_steps(&steps, &counters, ask))
         }
-        fn finish(&self, _: usize, _: &Job) -> Result<Option<Duration>, String> {
+        fn finish(&self, _: usize, _: &Job) -> Result<Option<Duration>, Self::Error> {
             Ok(None)
         }
-        fn fault(&self, message: String) -> String {
-            message
+        fn fault(&self, message: String) -> Failed {
+            Failed(message)
         }
     }
 
@@ -1108,11 +1148,18 @@ mod tests {
         let devices: [&dyn Worker; 2] = [&lost, &lost];
         let err =
             render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect_err("all fail");
-        assert!(err.starts_with("every device failed (2 of "), "{err}");
+        let text = err.to_string();
+        assert!(text.starts_with("every device failed (2 of "), "{text}");
         assert!(
-            err.contains("device 0 (fake): lost; device 1 (fake): lost"),
-            "{err}"
+            text.contains("device 0 (fake): lost; device 1 (fake): lost"),
+            "{text}"
         );
+        let devices: Vec<_> = err
+            .failures
+            .iter()
+            .map(|(i, _, why)| (*i, why.as_str()))
+            .collect();
+        assert_eq!(devices, [(0, "lost"), (1, "lost")]);
     }
 
     /// A device whose reads are started behind its launches and collected later (as the GPU
@@ -1125,17 +1172,22 @@ mod tests {
 
     impl Device for Overlapping<'_> {
         type Frame = [Option<Range<usize>>; 2];
-        type Error = String;
+        type Error = Failed;
         fn describe(&self) -> String {
             "overlapping".into()
         }
-        fn prepare(&self, _job: &Job) -> Result<Self::Frame, String> {
+        fn prepare(&self, _job: &Job) -> Result<Self::Frame, Self::Error> {
             Ok([None, None])
         }
-        fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), String> {
-            Err("run is not called: bands are submitted".into())
+        fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), Self::Error> {
+            Err(Failed("run is not called: bands are submitted".into()))
         }
-        fn submit(&self, _: &mut Self::Frame, job: &Job, tiles: &[usize]) -> Result<(), String> {
+        fn submit(
+            &self,
+            _: &mut Self::Frame,
+            job: &Job,
+            tiles: &[usize],
+        ) -> Result<(), Self::Error> {
             let band = job.band(tiles[0]);
             self.log
                 .lock()
@@ -1149,7 +1201,7 @@ mod tests {
             _: &Job,
             range: Range<usize>,
             slot: usize,
-        ) -> Result<(), String> {
+        ) -> Result<(), Self::Error> {
             // The slot is free: its band was collected before it is used again.
             assert!(slots[slot].is_none(), "slot {slot} still holds a band");
             self.log
@@ -1165,7 +1217,7 @@ mod tests {
             _: &Job,
             range: Range<usize>,
             slot: usize,
-        ) -> Result<Pixels, String> {
+        ) -> Result<Pixels, Self::Error> {
             assert_eq!(slots[slot].take().as_ref(), Some(&range), "slot {slot}");
             self.log
                 .lock()
@@ -1176,8 +1228,13 @@ mod tests {
                 ..Pixels::default()
             })
         }
-        fn read(&self, _: &mut Self::Frame, _: &Job, _: &[Range<usize>]) -> Result<Pixels, String> {
-            Err("read is not called: bands are collected".into())
+        fn read(
+            &self,
+            _: &mut Self::Frame,
+            _: &Job,
+            _: &[Range<usize>],
+        ) -> Result<Pixels, Self::Error> {
+            Err(Failed("read is not called: bands are collected".into()))
         }
         fn reduce(
             &self,
@@ -1185,15 +1242,15 @@ mod tests {
             _: &Job,
             _: &[Range<usize>],
             ask: Ask,
-        ) -> Result<Answer, String> {
+        ) -> Result<Answer, Self::Error> {
             Ok(Answer::empty(ask))
         }
-        fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, String> {
+        fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, Self::Error> {
             assert_eq!(slots, [None, None], "every band collected");
             Ok(None)
         }
-        fn fault(&self, message: String) -> String {
-            message
+        fn fault(&self, message: String) -> Failed {
+            Failed(message)
         }
     }
 
@@ -1286,17 +1343,17 @@ mod tests {
 
     impl Device for Rows {
         type Frame = [Option<Range<usize>>; 2];
-        type Error = String;
+        type Error = Failed;
         fn describe(&self) -> String {
             "rows".into()
         }
-        fn prepare(&self, _job: &Job) -> Result<Self::Frame, String> {
+        fn prepare(&self, _job: &Job) -> Result<Self::Frame, Self::Error> {
             Ok([None, None])
         }
-        fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), String> {
-            Err("run is not called: rows are submitted".into())
+        fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), Self::Error> {
+            Err(Failed("run is not called: rows are submitted".into()))
         }
-        fn submit(&self, _: &mut Self::Frame, _: &Job, tiles: &[usize]) -> Result<(), String> {
+        fn submit(&self, _: &mut Self::Frame, _: &Job, tiles: &[usize]) -> Result<(), Self::Error> {
             let mut log = self.log.lock().expect("log");
             log.extend(tiles.iter().map(|&t| ("submit", t)));
             Ok(())
@@ -1307,7 +1364,7 @@ mod tests {
             _: &Job,
             range: Range<usize>,
             slot: usize,
-        ) -> Result<(), String> {
+        ) -> Result<(), Self::Error> {
             assert!(slots[slot].is_none(), "slot {slot} still holds a row");
             self.log.lock().expect("log").push(("start", range.start));
             slots[slot] = Some(range);
@@ -1319,7 +1376,7 @@ mod tests {
             _: &Job,
             range: Range<usize>,
             slot: usize,
-        ) -> Result<Pixels, String> {
+        ) -> Result<Pixels, Self::Error> {
             assert_eq!(slots[slot].take().as_ref(), Some(&range), "slot {slot}");
             self.log.lock().expect("log").push(("collect", range.start));
             Ok(Pixels {
@@ -1327,8 +1384,13 @@ mod tests {
                 ..Pixels::default()
             })
         }
-        fn read(&self, _: &mut Self::Frame, _: &Job, _: &[Range<usize>]) -> Result<Pixels, String> {
-            Err("read is not called: rows are collected".into())
+        fn read(
+            &self,
+            _: &mut Self::Frame,
+            _: &Job,
+            _: &[Range<usize>],
+        ) -> Result<Pixels, Self::Error> {
+            Err(Failed("read is not called: rows are collected".into()))
         }
         fn reduce(
             &self,
@@ -1336,15 +1398,15 @@ mod tests {
             _: &Job,
             _: &[Range<usize>],
             ask: Ask,
-        ) -> Result<Answer, String> {
+        ) -> Result<Answer, Self::Error> {
             Ok(Answer::empty(ask))
         }
-        fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, String> {
+        fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, Self::Error> {
             assert_eq!(slots, [None, None], "every row collected");
             Ok(None)
         }
-        fn fault(&self, message: String) -> String {
-            message
+        fn fault(&self, message: String) -> Failed {
+            Failed(message)
         }
     }
 
@@ -1396,7 +1458,7 @@ mod tests {
         };
         let faults = Faults::parse("4").expect("parses");
         let err = render_one(&rows, &job, &faults, &mut |_| {}).expect_err("fails");
-        assert!(err.contains("injected at tile 5"), "{err}");
+        assert!(err.0.contains("injected at tile 5"), "{err}");
     }
 
     #[test]

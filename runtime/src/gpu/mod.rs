@@ -201,6 +201,17 @@ fn render_one<D: launch::Device>(
     Ok(finish(out, s))
 }
 
+/// Why a frame on several devices failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SeveralFailed {
+    /// The scene's uniforms do not fit the kernel's layout.
+    #[error(transparent)]
+    Layout(#[from] wgsl::Mismatch),
+    /// Every device failed.
+    #[error(transparent)]
+    Devices(#[from] launch::SeveralError),
+}
+
 /// Renders `scene` on several devices at once ([`launch::render_several`]): the kernel's
 /// uniforms are those of `scene` with the Lipschitz bound `lipschitz`, laid out as `uniform`
 /// (none when every device is the CPU), and `data` its scene data, the same on every GPU
@@ -211,10 +222,10 @@ pub fn render_several(
     (lipschitz, uniform, data): (f64, Option<&wgsl::Uniform>, Option<&[u8]>),
     (faults, statistics, finished): (&launch::Faults, bool, bool),
     progress: &mut dyn FnMut(f64),
-) -> Result<GpuRender, String> {
+) -> Result<GpuRender, SeveralFailed> {
     let s = &scene.settings;
     let uniforms = match uniform {
-        Some(u) => wgsl::uniforms(u, scene, lipschitz).map_err(|e| e.0)?,
+        Some(u) => wgsl::uniforms(u, scene, lipschitz)?,
         None => Vec::new(),
     };
     let tiles = launch::tiling(s.width, s.height, TILE, devices.len());

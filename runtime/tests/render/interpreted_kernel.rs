@@ -45,8 +45,14 @@ fn marched(path: &Path, width: u32, height: u32) -> Scene {
     scene.settings.height = height;
     scene.settings.aa = 1;
     scene.settings.method = Method::March;
+    // A path-traced example (examples/studio_path.sdf: 64 samples) would cost lavapipe a
+    // minute through the interpreted kernel; four samples follow the same paths' code.
+    scene.settings.samples = scene.settings.samples.min(PATH_SAMPLES);
     scene
 }
+
+/// The samples a pixel of a path-traced example compared here.
+const PATH_SAMPLES: u32 = 4;
 
 fn kernel(scene: &Scene, lowered: &Lowered, kernel: KernelChoice) -> wgsl::Kernel {
     kernel_for(scene, lowered, kernel, false)

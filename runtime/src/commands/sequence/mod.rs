@@ -220,7 +220,7 @@ pub fn run(
                                 started: frame_started,
                             };
                             let handing = Instant::now();
-                            w.submit(task).map_err(Error::Encode)?;
+                            w.submit(task).map_err(|e| Error::Encode(e.to_string()))?;
                             tally.since(HERE, "handing to the writers", handing);
                             for done in w.written() {
                                 report(done, checker, &sink)?;
@@ -342,7 +342,7 @@ fn preparing(first: bool) -> &'static str {
 
 /// Logs a frame the writers' pool wrote, or gives its error.
 fn report(done: Written, checker: &Checker, sink: &Sink) -> Result<(), Error> {
-    done.result.map_err(Error::Io)?;
+    done.result.map_err(|e| Error::Io(e.to_string()))?;
     for (step, time, _) in &done.steps {
         checker.tally.add("writers", step, *time);
     }
@@ -617,7 +617,7 @@ impl FramesOn<'_> {
                             };
                             let handing = Instant::now();
                             if let Err(e) = writers.submit(task) {
-                                let _ = tx.send(Report::Unwritten(e));
+                                let _ = tx.send(Report::Unwritten(e.to_string()));
                             }
                             tally.since(&here, "handing to the writers", handing);
                             None

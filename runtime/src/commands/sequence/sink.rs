@@ -115,7 +115,7 @@ impl Sink {
             // Synced: a rerun skips the frames whose files it finds.
             .write(picture, true, PngLevel::Fast)
             .map(|_| ())
-            .map_err(Error::Io),
+            .map_err(|e| Error::Io(e.to_string())),
             Sink::Apng {
                 path,
                 frames,

@@ -6,7 +6,7 @@
 
 use super::render::{self, Backend};
 use crate::backend::{Devices, Prepared, Setup};
-use crate::chart;
+use crate::chart::{self, Chart};
 use crate::cpu::reference;
 use crate::cpu::{Precision, Render};
 use crate::frontend;
@@ -168,6 +168,19 @@ pub(super) fn check_output(out: Option<&std::path::Path>) -> Result<(), String> 
 
 /// Prints the report and draws the chart.
 fn finish(args: &ParetoArgs, report: &Report) -> ExitCode {
+    publish(args, report, &table(report), || {
+        chart_of(report, args.target)
+    })
+}
+
+/// Prints a sweep's `report` (as JSON with `--json`, else its `table`) and draws its chart
+/// into `--output`, if given: the end of `sdfc pareto` for pictures and for meshes.
+pub(super) fn publish<R: serde::Serialize>(
+    args: &ParetoArgs,
+    report: &R,
+    table: &str,
+    chart: impl FnOnce() -> Chart,
+) -> ExitCode {
     if args.json {
         match serde_json::to_string_pretty(report) {
             Ok(s) => println!("{s}"),
@@ -177,10 +190,10 @@ fn finish(args: &ParetoArgs, report: &Report) -> ExitCode {
             }
         }
     } else {
-        print!("{}", table(report));
+        print!("{table}");
     }
     if let Some(out) = &args.output {
-        if let Err(msg) = chart::write(&chart_of(report, args.target), out) {
+        if let Err(msg) = chart::write(&chart(), out) {
             eprintln!("error: {msg}");
             return ExitCode::from(2);
         }

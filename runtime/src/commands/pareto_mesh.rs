@@ -311,23 +311,5 @@ pub fn chart_of(r: &MeshReport) -> Chart {
 
 /// Prints the report and draws the chart.
 fn finish(args: &ParetoArgs, report: &MeshReport) -> ExitCode {
-    if args.json {
-        match serde_json::to_string_pretty(report) {
-            Ok(s) => println!("{s}"),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(2);
-            }
-        }
-    } else {
-        print!("{}", table(report));
-    }
-    if let Some(out) = &args.output {
-        if let Err(msg) = chart::write(&chart_of(report), out) {
-            eprintln!("error: {msg}");
-            return ExitCode::from(2);
-        }
-        eprintln!("wrote {}", out.display());
-    }
-    ExitCode::SUCCESS
+    super::pareto::publish(args, report, &table(report), || chart_of(report))
 }

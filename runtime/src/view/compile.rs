@@ -4,7 +4,7 @@
 //! before on show, and it is told (the [`Waker`]) when the compile has ended. A new pipeline
 //! is dispatched once there, on no pixels, for drivers that compile at the first dispatch.
 
-use super::resident::FirstFrame;
+use super::resident::{self, FirstFrame};
 use crate::backend::Prepared;
 use crate::gpu::wgpu::PipelineTime;
 use sdfc_compiler::wgsl;
@@ -42,7 +42,7 @@ const STACK: usize = 32 << 20;
 /// of its own ([`crate::gpu::Gpu::pipeline_for`], which keeps it for the renders to come).
 #[derive(Debug)]
 pub struct Compile {
-    result: Arc<Mutex<Option<Result<PipelineTime, String>>>>,
+    result: Arc<Mutex<Option<Result<PipelineTime, resident::Error>>>>,
     /// When it started.
     pub started: Instant,
 }
@@ -66,13 +66,13 @@ impl Compile {
             // at the first dispatch (lavapipe) does it here, and its time is the compile's.
             let r = gpu
                 .pipeline_for(&source, Some(&module), wgsl::ENTRY_POINT, data)
-                .map_err(|e| e.to_string())
+                .map_err(resident::Error::from)
                 .and_then(|p| {
                     if p.cached {
                         return Ok(p);
                     }
                     let start = Instant::now();
-                    super::resident::warm(&gpu, &source, data, first.as_ref())?;
+                    resident::warm(&gpu, &source, data, first.as_ref())?;
                     Ok(PipelineTime {
                         time: p.time + start.elapsed(),
                         ..p
@@ -105,11 +105,11 @@ impl Compile {
     }
 
     /// The compile's result once it has ended; `None` before, and after it has been taken.
-    pub fn take(&self) -> Option<Result<PipelineTime, String>> {
+    pub fn take(&self) -> Option<Result<PipelineTime, resident::Error>> {
         self.lock().take()
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, Option<Result<PipelineTime, String>>> {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Option<Result<PipelineTime, resident::Error>>> {
         self.result.lock().unwrap_or_else(|e| e.into_inner())
     }
 }

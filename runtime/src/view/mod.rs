@@ -283,21 +283,44 @@ fn write_image(session: &Session, path: &Path) -> Result<(), String> {
         }
         None => [5, 5, 5, 255].repeat(w as usize * h as usize),
     };
-    write_rgba_png(path, w, h, &bytes)
-        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+    write_rgba_png(path, w, h, &bytes).map_err(|e| e.to_string())?;
     eprintln!("view: wrote {}", path.display());
     Ok(())
 }
 
+/// Why a PNG of the view could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum PngError {
+    /// The encoder failed.
+    #[error("cannot write `{}`: {error}", path.display())]
+    Encode {
+        path: PathBuf,
+        error: png::EncodingError,
+    },
+    /// The file could not be written.
+    #[error("cannot write `{}`: {error}", path.display())]
+    Write {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+}
+
 /// Writes RGBA8 sRGB pixels as a PNG file, atomically.
-pub fn write_rgba_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<(), String> {
+pub fn write_rgba_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<(), PngError> {
+    let encode = |error| PngError::Encode {
+        path: path.to_path_buf(),
+        error,
+    };
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, width, height);
     encoder.set_color(png::ColorType::Rgba);
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    writer.write_image_data(rgba).map_err(|e| e.to_string())?;
-    writer.finish().map_err(|e| e.to_string())?;
-    crate::image::write_atomic(path, &bytes).map_err(|e| e.to_string())
+    let mut writer = encoder.write_header().map_err(encode)?;
+    writer.write_image_data(rgba).map_err(encode)?;
+    writer.finish().map_err(encode)?;
+    crate::image::write_atomic(path, &bytes).map_err(|error| PngError::Write {
+        path: path.to_path_buf(),
+        error,
+    })
 }

@@ -72,7 +72,7 @@ impl Presenter {
         &mut self,
         shots: &[PathBuf],
         overlay: Option<&mut dyn Overlay>,
-    ) -> Result<bool, String> {
+    ) -> Result<bool, Error> {
         match self {
             Presenter::Gpu(p) => p.present(shots, overlay),
             Presenter::Soft(p) => p.present(shots),
@@ -80,12 +80,41 @@ impl Presenter {
     }
 }
 
+/// Why the window could not be drawn into.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// wgpu made no surface for the window.
+    #[error("cannot make a wgpu surface for the window: {0}")]
+    Surface(#[from] wgpu::CreateSurfaceError),
+    /// No adapter presents to the window's surface.
+    #[error("no wgpu adapter can present to the window ({0})")]
+    Adapter(#[from] wgpu::RequestAdapterError),
+    /// The adapter's device could not be opened.
+    #[error(transparent)]
+    Gpu(#[from] crate::gpu::wgpu::Error),
+    /// The surface offers none of the formats the viewer draws.
+    #[error("the window's surface offers no 8-bit RGBA format (it offers {0:?})")]
+    Format(Vec<wgpu::TextureFormat>),
+    /// The surface reported a validation error.
+    #[error("the window's surface reported a validation error")]
+    Validation,
+    /// softbuffer (the window without wgpu) failed to do what is said.
+    #[error("cannot {0}: {1}")]
+    Soft(&'static str, softbuffer::SoftBufferError),
+    /// A screenshot could not be written.
+    #[error(transparent)]
+    Shot(#[from] super::PngError),
+    /// The window's pixels could not be read back for a screenshot.
+    #[error("reading the window back: {0}")]
+    Readback(Box<dyn std::error::Error + Send + Sync>),
+}
+
 /// Opens the wgpu presenter: an instance with the window's display, a surface, and an adapter
 /// that can present to it.
 pub(crate) fn wgpu_presenter(
     event_loop: &ActiveEventLoop,
     window: &Arc<Window>,
-) -> Result<(Arc<Gpu>, GpuPresenter), String> {
+) -> Result<(Arc<Gpu>, GpuPresenter), Error> {
     // One instance for the process, never destroyed (as `runtime/src/gpu/wgpu.rs` keeps its
     // own): the Vulkan driver then stays loaded until the process ends.
     static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
@@ -95,17 +124,14 @@ pub(crate) fn wgpu_presenter(
             display,
         ))
     });
-    let surface = instance
-        .create_surface(window.clone())
-        .map_err(|e| format!("cannot make a wgpu surface for the window: {e}"))?;
+    let surface = instance.create_surface(window.clone())?;
     let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
         power_preference: wgpu::PowerPreference::HighPerformance,
         force_fallback_adapter: false,
         compatible_surface: Some(&surface),
         apply_limit_buckets: false,
-    }))
-    .map_err(|e| format!("no wgpu adapter can present to the window ({e})"))?;
-    let gpu = Arc::new(Gpu::from_adapter(&adapter).map_err(|e| e.to_string())?);
+    }))?;
+    let gpu = Arc::new(Gpu::from_adapter(&adapter)?);
     let size = window.inner_size();
     let presenter = GpuPresenter::new(gpu.clone(), surface, &adapter, size.width, size.height)?;
     Ok((gpu, presenter))
@@ -121,14 +147,10 @@ pub(crate) struct SoftPresenter {
 }
 
 impl SoftPresenter {
-    pub fn new(
-        event_loop: &ActiveEventLoop,
-        window: &Arc<Window>,
-    ) -> Result<SoftPresenter, String> {
-        let context = softbuffer::Context::new(event_loop.owned_display_handle())
-            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
-        let surface = softbuffer::Surface::new(&context, window.clone())
-            .map_err(|e| format!("cannot draw in the window without wgpu either: {e}"))?;
+    pub fn new(event_loop: &ActiveEventLoop, window: &Arc<Window>) -> Result<SoftPresenter, Error> {
+        let soft = |e| Error::Soft("draw in the window without wgpu either", e);
+        let context = softbuffer::Context::new(event_loop.owned_display_handle()).map_err(soft)?;
+        let surface = softbuffer::Surface::new(&context, window.clone()).map_err(soft)?;
         let size = window.inner_size();
         Ok(SoftPresenter {
             surface,
@@ -137,18 +159,18 @@ impl SoftPresenter {
         })
     }
 
-    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, String> {
+    fn present(&mut self, shots: &[PathBuf]) -> Result<bool, Error> {
         let (w, h) = self.size;
         let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
             return Ok(false);
         };
         self.surface
             .resize(nw, nh)
-            .map_err(|e| format!("cannot resize the window's buffer: {e}"))?;
+            .map_err(|e| Error::Soft("resize the window's buffer", e))?;
         let mut buffer = self
             .surface
             .buffer_mut()
-            .map_err(|e| format!("cannot draw in the window: {e}"))?;
+            .map_err(|e| Error::Soft("draw in the window", e))?;
         for y in 0..h {
             for x in 0..w {
                 let px = match &self.image {
@@ -168,13 +190,12 @@ impl SoftPresenter {
                 .flat_map(|&p| [(p >> 16) as u8, (p >> 8) as u8, p as u8, 255])
                 .collect();
             for path in shots {
-                write_rgba_png(path, w, h, &rgba)
-                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+                write_rgba_png(path, w, h, &rgba)?;
             }
         }
         buffer
             .present()
-            .map_err(|e| format!("cannot show the frame: {e}"))?;
+            .map_err(|e| Error::Soft("show the frame", e))?;
         Ok(true)
     }
 }
@@ -243,7 +264,7 @@ impl GpuPresenter {
         adapter: &wgpu::Adapter,
         width: u32,
         height: u32,
-    ) -> Result<GpuPresenter, String> {
+    ) -> Result<GpuPresenter, Error> {
         let caps = surface.get_capabilities(adapter);
         let format = caps
             .formats
@@ -263,12 +284,7 @@ impl GpuPresenter {
                     )
                 })
             })
-            .ok_or_else(|| {
-                format!(
-                    "the window's surface offers no 8-bit RGBA format (it offers {:?})",
-                    caps.formats
-                )
-            })?;
+            .ok_or_else(|| Error::Format(caps.formats.clone()))?;
         let copyable = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
         let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
         if copyable {
@@ -502,7 +518,7 @@ impl GpuPresenter {
         &mut self,
         shots: &[PathBuf],
         mut overlay: Option<&mut dyn Overlay>,
-    ) -> Result<bool, String> {
+    ) -> Result<bool, Error> {
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f) => f,
             wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -513,9 +529,7 @@ impl GpuPresenter {
                 self.surface.configure(self.gpu.device(), &self.config);
                 return Ok(false);
             }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                return Err("the window's surface reported a validation error".into())
-            }
+            wgpu::CurrentSurfaceTexture::Validation => return Err(Error::Validation),
         };
         let device = self.gpu.device();
         let view = frame.texture.create_view(&Default::default());
@@ -551,8 +565,7 @@ impl GpuPresenter {
                 self.read(&texture)?
             };
             for path in shots {
-                write_rgba_png(path, self.config.width, self.config.height, &bytes)
-                    .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+                write_rgba_png(path, self.config.width, self.config.height, &bytes)?;
             }
         }
         self.gpu.queue().present(frame);
@@ -560,7 +573,7 @@ impl GpuPresenter {
     }
 
     /// The pixels of `texture` (of the surface's format) as RGBA8 rows.
-    fn read(&self, texture: &wgpu::Texture) -> Result<Vec<u8>, String> {
+    fn read(&self, texture: &wgpu::Texture) -> Result<Vec<u8>, Error> {
         let device = self.gpu.device();
         let (w, h) = (texture.width(), texture.height());
         let row = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
@@ -592,13 +605,13 @@ impl GpuPresenter {
         });
         device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("reading the window back: {e}"))?;
+            .map_err(|e| Error::Readback(Box::new(e)))?;
         rx.recv()
-            .map_err(|e| e.to_string())?
-            .map_err(|e| format!("reading the window back: {e}"))?;
+            .map_err(|e| Error::Readback(Box::new(e)))?
+            .map_err(|e| Error::Readback(Box::new(e)))?;
         let mapped = slice
             .get_mapped_range()
-            .map_err(|e| format!("reading the window back: {e}"))?;
+            .map_err(|e| Error::Readback(Box::new(e)))?;
         let bgra = matches!(
             self.config.format,
             wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb

@@ -143,9 +143,32 @@ pub struct Rendered {
     pub steps: Option<f64>,
 }
 
+/// Why the viewer's pass on the device failed.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// wgpu refused the viewer's pass (which one) or ran out of memory in it.
+    #[error("the viewer's {0}: {1}")]
+    Pass(&'static str, wgpu::Error),
+    /// The scene's uniforms do not fit the kernel: an internal error.
+    #[error("internal error: the scene uniform does not fit the kernel: {0}")]
+    Layout(#[from] wgsl::Mismatch),
+    /// The device: a pipeline that does not compile, or a wait that failed.
+    #[error(transparent)]
+    Gpu(#[from] crate::gpu::wgpu::Error),
+    /// A frame's buffers were not made.
+    #[error("no frame buffers")]
+    NoBuffers,
+    /// The mapping of a readback never answered.
+    #[error("reading the frame back: {0}")]
+    Unanswered(#[from] std::sync::mpsc::RecvError),
+    /// A readback buffer could not be mapped.
+    #[error("reading the frame back: {0}")]
+    Readback(Box<dyn std::error::Error + Send + Sync>),
+}
+
 impl Resident {
     /// The accumulating pass on `gpu`'s device.
-    pub fn new(gpu: Arc<Gpu>) -> Result<Resident, String> {
+    pub fn new(gpu: Arc<Gpu>) -> Result<Resident, Error> {
         let device = gpu.device();
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -199,7 +222,7 @@ impl Resident {
             cache: None,
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(format!("the viewer's accumulating pass: {e}"));
+            return Err(Error::Pass("accumulating pass", e));
         }
         Ok(Resident {
             gpu,
@@ -224,19 +247,13 @@ impl Resident {
         data_key: (u64, bool),
         first: bool,
         steps: bool,
-    ) -> Result<Rendered, String> {
+    ) -> Result<Rendered, Error> {
         let (width, height) = (scene.settings.width.max(1), scene.settings.height.max(1));
-        let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz).map_err(|e| {
-            format!(
-                "internal error: the scene uniform does not fit the kernel: {}",
-                e.0
-            )
-        })?;
+        let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)?;
         let data = kernel.data.as_deref();
-        let pipeline = self
-            .gpu
-            .compute_pipeline(&kernel.source, wgsl::ENTRY_POINT, data.is_some())
-            .map_err(|e| e.to_string())?;
+        let pipeline =
+            self.gpu
+                .compute_pipeline(&kernel.source, wgsl::ENTRY_POINT, data.is_some())?;
         let device = self.gpu.device().clone();
         let queue = self.gpu.queue().clone();
         let scope = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
@@ -248,7 +265,7 @@ impl Resident {
             data.map(|d| d.len() as u64),
         );
         let Some(t) = self.target.as_mut() else {
-            return Err("no frame buffers".into());
+            return Err(Error::NoBuffers);
         };
         if first {
             t.count = 0;
@@ -293,15 +310,15 @@ impl Resident {
         queue.submit([encoder.finish()]);
         let count = t.count;
         if let Some(e) = pollster::block_on(validation.pop()) {
-            return Err(format!("the viewer's frame: {e}"));
+            return Err(Error::Pass("frame", e));
         }
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(format!("GPU error while rendering: {e}"));
+            return Err(Error::Pass("frame (out of memory)", e));
         }
         let steps = match staging {
             Some(staging) => Some(self.mean_steps(&staging, width, height)?),
             None => {
-                self.gpu.wait().map_err(|e| e.to_string())?;
+                self.gpu.wait()?;
                 None
             }
         };
@@ -310,7 +327,7 @@ impl Resident {
 
     /// The mean marching steps per pixel of the last frame, summed on the device now (the
     /// statistics asked for after it was rendered); `None` before the first frame.
-    pub fn last_steps(&mut self) -> Result<Option<f64>, String> {
+    pub fn last_steps(&mut self) -> Result<Option<f64>, Error> {
         let Some(t) = self.target.as_ref().filter(|t| t.count > 0) else {
             return Ok(None);
         };
@@ -328,14 +345,14 @@ impl Resident {
         let staging = steps_staging(device, &mut encoder, &t.steps);
         queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(validation.pop()) {
-            return Err(format!("the viewer's steps: {e}"));
+            return Err(Error::Pass("steps", e));
         }
         self.mean_steps(&staging, t.width, t.height).map(Some)
     }
 
     /// The steps summed into `staging` (two words, low and high), per pixel of a
     /// `width`×`height` frame.
-    fn mean_steps(&self, staging: &wgpu::Buffer, width: u32, height: u32) -> Result<f64, String> {
+    fn mean_steps(&self, staging: &wgpu::Buffer, width: u32, height: u32) -> Result<f64, Error> {
         let bytes = self.map(staging)?;
         let word =
             |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
@@ -488,7 +505,7 @@ impl Resident {
 
     /// The samples accumulated, read back: their mean as a linear image (the host's own
     /// accumulation's, value for value). `None` before the first frame.
-    pub fn image(&self) -> Result<Option<Image>, String> {
+    pub fn image(&self) -> Result<Option<Image>, Error> {
         let Some(t) = self.target.as_ref().filter(|t| t.count > 0) else {
             return Ok(None);
         };
@@ -518,19 +535,17 @@ impl Resident {
 
     /// The bytes of `staging` (a mappable buffer whose copy was submitted), once the device
     /// has written them.
-    fn map(&self, staging: &wgpu::Buffer) -> Result<Vec<u8>, String> {
+    fn map(&self, staging: &wgpu::Buffer) -> Result<Vec<u8>, Error> {
         let slice = staging.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        self.gpu.wait().map_err(|e| e.to_string())?;
-        rx.recv()
-            .map_err(|e| e.to_string())?
-            .map_err(|e| format!("reading the frame back: {e}"))?;
+        self.gpu.wait()?;
+        rx.recv()?.map_err(|e| Error::Readback(Box::new(e)))?;
         let bytes = slice
             .get_mapped_range()
-            .map_err(|e| format!("reading the frame back: {e}"))?
+            .map_err(|e| Error::Readback(Box::new(e)))?
             .to_vec();
         staging.unmap();
         Ok(bytes)
@@ -629,10 +644,8 @@ pub fn warm(
     wgsl_text: &str,
     data: bool,
     first: Option<&FirstFrame>,
-) -> Result<(), String> {
-    let pipeline = gpu
-        .compute_pipeline(wgsl_text, wgsl::ENTRY_POINT, data)
-        .map_err(|e| e.to_string())?;
+) -> Result<(), Error> {
+    let pipeline = gpu.compute_pipeline(wgsl_text, wgsl::ENTRY_POINT, data)?;
     let device = gpu.device();
     let buffer = |size: u64, usage| {
         device.create_buffer(&wgpu::BufferDescriptor {
@@ -680,9 +693,9 @@ pub fn warm(
     }
     gpu.queue().submit([encoder.finish()]);
     if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(format!("the kernel's first dispatch: {e}"));
+        return Err(Error::Pass("kernel's first dispatch", e));
     }
-    gpu.wait().map_err(|e| e.to_string())
+    Ok(gpu.wait()?)
 }
 
 fn words(w: &[u32]) -> Vec<u8> {

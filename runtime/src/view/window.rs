@@ -136,7 +136,8 @@ impl App {
                 ));
             }
             Err(msg) => {
-                let presenter = SoftPresenter::new(event_loop, &window)?;
+                let presenter =
+                    SoftPresenter::new(event_loop, &window).map_err(|e| e.to_string())?;
                 eprintln!(
                     "view: {msg}; rendering on the CPU ({}) and presenting with softbuffer",
                     Device::Cpu.describe()

@@ -435,7 +435,7 @@ impl Session {
                             shown: false,
                         });
                     }
-                    None => self.broken = Some(msg),
+                    None => self.broken = Some(msg.to_string()),
                 }
             }
         }

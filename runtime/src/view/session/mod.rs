@@ -788,13 +788,17 @@ impl Session {
                     .check_contract(&good.scene)
                     .map_err(|e| e.to_string())
                     .and_then(|()| {
-                        resident?.render(
-                            (kernel, *lipschitz),
-                            &good.scene,
-                            key,
-                            a.count == 0,
-                            self.steps_wanted,
-                        )
+                        resident
+                            .and_then(|r| {
+                                r.render(
+                                    (kernel, *lipschitz),
+                                    &good.scene,
+                                    key,
+                                    a.count == 0,
+                                    self.steps_wanted,
+                                )
+                            })
+                            .map_err(|e| e.to_string())
                     })
                     .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
             }

@@ -770,7 +770,7 @@ const NOT_LIMITS: &[(&str, &str, &str)] = &[
         "how far the viewer lowers the resolution of a frame over its time budget",
     ),
     (
-        "compiler/src/check/eval.rs",
+        "compiler/src/check/eval/call.rs",
         "MAX_CALL_SITES",
         "how many calls an error's chain of labels shows; the rest is a note",
     ),

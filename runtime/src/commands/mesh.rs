@@ -9,6 +9,8 @@ use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::write::{Format, Up};
+use crate::backend::Backend;
+use crate::mesh::device::Gpu;
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{analysis, Limit, Limits, LowerOptions};
@@ -58,6 +60,11 @@ pub struct MeshArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// What evaluates the field's points: the CPU (f64), or a GPU through wgpu or CUDA (f32,
+    /// the scene's points kernel; the mesh agrees with the CPU's within docs/mesh.md's
+    /// tolerance); `auto` picks as `render` does (CUDA, a wgpu GPU, else the CPU).
+    #[arg(long, value_enum, default_value = "cpu")]
+    pub backend: crate::backend::Backend,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -88,6 +95,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         .map_err(|why| usage(format!("cannot write `{}`: {why}", args.output.display())))?;
     let mut settings = settings(&args.set).map_err(usage)?;
     settings.measure = args.stats;
+    settings.backend = crate::mesh::device::resolve(args.backend);
     settings.materials = matches!(format, Format::Ply | Format::Glb | Format::ThreeMf);
     let pool = crate::job::thread_pool(args.threads, &limits).map_err(|e| usage(e.to_string()))?;
     // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
@@ -465,6 +473,14 @@ fn surface_on(
         .lower(&LowerOptions::default(), limits)
         .map_err(|_| (1, String::new()))?;
     let field = Field::new(&lowered.program, proven, clip);
+    let field = match settings.backend {
+        Backend::Cpu | Backend::Auto => field,
+        backend => {
+            let gpu = Gpu::open(backend, &checked.scene, &lowered, &clip).map_err(|m| (1, m))?;
+            say(format!("mesh: evaluating on {}: {}", gpu.name, gpu.device));
+            field.on(gpu)
+        }
+    };
     if !proven {
         say(format!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
@@ -552,8 +568,19 @@ fn surface_on(
         ),
     })?;
     let seconds = started.elapsed().as_secs_f64();
+    if let Some(gpu) = field.gpu() {
+        if let Some(why) = gpu.failure() {
+            return Err((1, format!("--backend {} failed while meshing: {why}", gpu.name)));
+        }
+        stats.backend = gpu.name;
+        stats.launches = gpu.launches();
+    } else {
+        stats.backend = "cpu";
+    }
     if settings.measure {
-        stats.error = Some(pool.install(|| crate::mesh::error(&field, &mesh)));
+        // Measured in f64 by the CPU, whatever evaluated the mesh.
+        let exact = Field::new(&lowered.program, proven, clip);
+        stats.error = Some(pool.install(|| crate::mesh::error(&exact, &mesh)));
     }
     stats.octree_cells = octree_evaluated;
     stats.dense = !proven;
@@ -576,7 +603,7 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
          octree cells    {} evaluated{}\n\
          candidates      {} cells ({} added by crossed edges)\n\
          surface cells   {}\n\
-         evaluations     {} points ({:.2} % of the dense grid's {} points)\n\
+         evaluations     {} points ({:.2} % of the dense grid's {} points) on {}{}\n\
          sharp patches   {} ({} edges flipped, {} inner vertices projected onto the surface)\n\
          {}{}\
          time            {:.3} s\n",
@@ -603,6 +630,11 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
         s.evaluated,
         100.0 * s.evaluated as f64 / dense,
         grid.dense_points(),
+        if s.backend.is_empty() { "cpu" } else { s.backend },
+        match s.launches {
+            0 => String::new(),
+            n => format!(", in {n} launches"),
+        },
         s.features,
         s.flips,
         s.projected,

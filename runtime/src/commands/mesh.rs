@@ -5,12 +5,12 @@
 use super::mesh_region::{frame, short, Frame};
 pub use super::mesh_region::{parse_bounds, BoundsError, Region, Spelling, DEFAULT_RESOLUTION};
 use super::mesh_thin::Thinness;
+use crate::backend::Backend;
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
-use crate::mesh::write::{Format, Up};
-use crate::backend::Backend;
 use crate::mesh::device::Gpu;
+use crate::mesh::write::{Format, Up};
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{analysis, Limit, Limits, LowerOptions};
@@ -445,6 +445,7 @@ fn refined(
 ) -> Meshed {
     fine.seconds += coarse.seconds;
     fine.stats.refined_from = Some(coarse.grid.voxel);
+    fine.stats.before = coarse.stats.before;
     thin.still(fine.grid.voxel, &fine.stats, say);
     fine
 }
@@ -504,6 +505,7 @@ fn surface_on(
     let fits = |n: u64| check_memory(contour::candidate_bytes(&grid, n), limits, spell).is_ok();
     let max_candidates = most(fits);
     let started = Instant::now();
+    let before = super::started().0.elapsed().as_secs_f64();
     let candidates = pool
         .install(|| {
             octree::candidates(
@@ -570,13 +572,17 @@ fn surface_on(
     let seconds = started.elapsed().as_secs_f64();
     if let Some(gpu) = field.gpu() {
         if let Some(why) = gpu.failure() {
-            return Err((1, format!("--backend {} failed while meshing: {why}", gpu.name)));
+            return Err((
+                1,
+                format!("--backend {} failed while meshing: {why}", gpu.name),
+            ));
         }
         stats.backend = gpu.name;
         stats.launches = gpu.launches();
     } else {
         stats.backend = "cpu";
     }
+    stats.before = Some(before);
     if settings.measure {
         // Measured in f64 by the CPU, whatever evaluated the mesh.
         let exact = Field::new(&lowered.program, proven, clip);
@@ -605,7 +611,7 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
          surface cells   {}\n\
          evaluations     {} points ({:.2} % of the dense grid's {} points) on {}{}\n\
          sharp patches   {} ({} edges flipped, {} inner vertices projected onto the surface)\n\
-         {}{}\
+         {}{}{}\
          time            {:.3} s\n",
         grid.cells[0],
         grid.cells[1],
@@ -654,6 +660,17 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
                 100.0 * v / grid.voxel,
                 short(f),
                 100.0 * f / grid.voxel
+            ),
+            None => String::new(),
+        },
+        match s.before {
+            Some(b) => format!(
+                "before meshing  {b:.3} s (reading, checking, lowering{})\n",
+                if s.launches > 0 {
+                    ", the device and its kernel"
+                } else {
+                    ""
+                }
             ),
             None => String::new(),
         },

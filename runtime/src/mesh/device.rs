@@ -30,9 +30,13 @@ const F32_GRADIENT_STEP: f64 = 1.0 / 65_536.0;
 /// mesh made again on finer cells).
 fn wgpu_device() -> Result<&'static Arc<WgpuDevice>, String> {
     static WGPU: OnceLock<Result<Arc<WgpuDevice>, String>> = OnceLock::new();
-    WGPU.get_or_init(|| WgpuDevice::open(false).map(Arc::new).map_err(|e| e.to_string()))
-        .as_ref()
-        .map_err(Clone::clone)
+    WGPU.get_or_init(|| {
+        WgpuDevice::open(false)
+            .map(Arc::new)
+            .map_err(|e| e.to_string())
+    })
+    .as_ref()
+    .map_err(Clone::clone)
 }
 
 fn cuda_device() -> Result<&'static CudaDevice, String> {
@@ -94,17 +98,22 @@ impl Gpu {
         clip: &[[f64; 3]; 2],
     ) -> Result<Gpu, String> {
         let (name, on) = match backend {
-            Backend::Wgpu => ("wgpu", "a wgpu adapter"),
-            Backend::Cuda => ("cuda", "a CUDA device"),
+            Backend::Wgpu => ("wgpu", "wgpu adapter"),
+            Backend::Cuda => ("cuda", "CUDA device"),
             Backend::Cpu | Backend::Auto => {
                 return Err("the CPU evaluates in the field itself, not as a GPU".into())
             }
         };
-        let no = |why: String| format!("--backend {name} cannot mesh here: no {on} ({why}); mesh with --backend cpu");
+        let no = |why: String| {
+            format!(
+                "--backend {name} cannot mesh here: found no {on} ({why}); mesh with --backend cpu"
+            )
+        };
         let cannot = |why: String| {
             format!("--backend {name} cannot mesh this scene: its distance kernel cannot be written ({why}); mesh it with --backend cpu")
         };
-        let module = on_gpu::points_module(scene, lowered, false).map_err(|e| cannot(e.to_string()))?;
+        let module =
+            on_gpu::points_module(scene, lowered, false).map_err(|e| cannot(e.to_string()))?;
         let (kernel, device) = match backend {
             Backend::Cuda => {
                 let (ctx, sm) = cuda_device().map_err(no)?;
@@ -114,7 +123,10 @@ impl Gpu {
             }
             _ => {
                 let gpu = wgpu_device().map_err(no)?;
-                (Kernel::Wgpu(gpu, WgpuPoints::new(gpu, &module)), gpu.describe())
+                (
+                    Kernel::Wgpu(gpu, WgpuPoints::new(gpu, &module)),
+                    gpu.describe(),
+                )
             }
         };
         let scale = clip.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));

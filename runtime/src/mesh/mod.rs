@@ -385,6 +385,9 @@ pub struct Stats {
     pub backend: &'static str,
     /// The GPU's launches (0 on the CPU).
     pub launches: u64,
+    /// Seconds from the command's start to the octree's (reading, checking, lowering; the
+    /// device opened and its kernel compiled), where a command measured it.
+    pub before: Option<f64>,
 }
 
 /// Settings of a mesh.

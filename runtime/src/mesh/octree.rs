@@ -114,7 +114,10 @@ pub fn candidates(
         let rounding = field.rounding();
         let shrunk: Vec<f64>;
         let inside = if rounding > 0.0 {
-            shrunk = d.iter().map(|&v| if v < 0.0 { (v + rounding).min(0.0) } else { v }).collect();
+            shrunk = d
+                .iter()
+                .map(|&v| if v < 0.0 { (v + rounding).min(0.0) } else { v })
+                .collect();
             &shrunk
         } else {
             &d

@@ -19,8 +19,11 @@ use sdfc_runtime::frontend::{self, DiagnosticFormat};
 use sdfc_runtime::mesh::Settings;
 use std::path::{Path, PathBuf};
 
-/// The examples compared: a scene file, the bounds it is meshed in, and the resolution.
-fn cases() -> Vec<(&'static str, PathBuf, Option<[[f64; 3]; 2]>, u32)> {
+/// An example compared: its name, scene file, the bounds it is meshed in, and the resolution.
+type Case = (&'static str, PathBuf, Option<[[f64; 3]; 2]>, u32);
+
+/// The examples compared.
+fn cases() -> Vec<Case> {
     let d = dir("gpu_bin");
     // The bin of `mesh_accuracy`, smaller: its divider is thinner than a cell at 48.
     let bin = write_scene(

@@ -50,16 +50,22 @@ pub enum RunError {
 }
 
 /// The points as the entry point reads them: x, y, z, 0 per point, padded with the origin to
-/// a whole number of workgroups, as bytes.
+/// a whole number of workgroups, as bytes (written on rayon's threads: a batch of the mesher
+/// may hold millions).
 fn point_bytes(points: &[[f64; 3]]) -> Vec<u8> {
+    use rayon::prelude::*;
     let padded = groups(points) as usize * WORKGROUP as usize;
-    let mut bytes = Vec::with_capacity(16 * padded);
-    for p in points {
-        for w in [p[0] as f32, p[1] as f32, p[2] as f32, 0.0] {
-            bytes.extend_from_slice(&w.to_le_bytes());
-        }
-    }
-    bytes.resize(16 * padded, 0);
+    let mut bytes = vec![0u8; 16 * padded];
+    bytes
+        .par_chunks_mut(16 * 4096)
+        .zip(points.par_chunks(4096))
+        .for_each(|(out, ps)| {
+            for (o, p) in out.chunks_exact_mut(16).zip(ps) {
+                for (k, w) in [p[0] as f32, p[1] as f32, p[2] as f32].iter().enumerate() {
+                    o[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
+                }
+            }
+        });
     bytes
 }
 
@@ -77,16 +83,17 @@ fn result_bytes(points: &[[f64; 3]]) -> u64 {
 /// alone.
 pub type Results = (Vec<Value<f32>>, Vec<f32>);
 
-/// Results as the entry point writes them, for the first `n` points.
+/// Results as the entry point writes them, for the first `n` points (read on rayon's
+/// threads).
 fn results(bytes: &[u8], n: usize) -> Results {
-    let words: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    let quads = || words.chunks_exact(4).take(n);
+    use rayon::prelude::*;
+    let word = |c: &[u8], k: usize| {
+        f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])
+    };
+    let quads = || bytes.par_chunks_exact(16).take(n);
     (
-        quads().map(|c| (c[0], c[1] as u32)).collect(),
-        quads().map(|c| c[2]).collect(),
+        quads().map(|c| (word(c, 0), word(c, 1) as u32)).collect(),
+        quads().map(|c| word(c, 2)).collect(),
     )
 }
 

@@ -2,7 +2,8 @@
 # GPU meshing figures for BENCHMARKS.md ("Meshing on a GPU"): `sdfc mesh --backend B` on the
 # bracket (examples/mesh/bracket.sdf) and the knob (examples/knob.sdf above its floor, in
 # -1.1,0.01,-1.1 … 1.1,1.25,1.1) at resolutions 256, 512 and 1024, each backend given. Per
-# run, from `--stats`: the meshing (octree to mesh), what came before it (reading, checking,
+# run, from `--stats`: the meshing (octree to mesh) and the part of it spent evaluating
+# points (on a GPU: launches, transfers, f32 conversions), what came before it (reading, checking,
 # lowering, opening the device and compiling its kernel), their sum (the whole command but
 # the file's write and the distance measured for `--stats`), and the launches. Medians of
 # RUNS runs; the file is written to a temporary folder and not timed.
@@ -28,29 +29,31 @@ LIMITS=(--limit memory=65536 --limit cells=1000000000)
 
 measure() { # name backend resolution file extra-args...
   local name=$1 backend=$2 r=$3 file=$4; shift 4
-  local mesh=() before=() total=() stats
+  local mesh=() before=() total=() evaluating=() stats
   for _ in $(seq "$RUNS"); do
     if ! stats=$("$SDFC" mesh "$file" -o "$OUT/m.ply" --stats --backend "$backend" \
       --resolution "$r" "${LIMITS[@]}" "$@" 2>"$OUT/err"); then
-      printf '| %s | %s | %s | failed: %s | | | | |\n' "$name" "$r" "$backend" "$(tail -1 "$OUT/err")"
+      printf '| %s | %s | %s | failed: %s | | | | | |\n' "$name" "$r" "$backend" "$(tail -1 "$OUT/err")"
       return
     fi
     local m b
     m=$(echo "$stats" | awk '/^time/ {print $2}')
     b=$(echo "$stats" | awk '/^before meshing/ {print $3}')
     mesh+=("$m"); before+=("$b"); total+=("$(echo "$m + $b" | bc -l)")
+    evaluating+=("$(echo "$stats" | awk '/^evaluations/ {print $(NF-1)}')")
   done
   local tris launches
   tris=$(grep -a -m1 'element face' "$OUT/m.ply" | awk '{print $3}')
-  launches=$(echo "$stats" | awk '/^evaluations/ {for (i = 1; i <= NF; i++) if ($i == "launches)" || $i == "launches") print $(i-1)}')
-  printf '| %s | %s | %s | %s | %s | %s | %s | %s |\n' "$name" "$r" "$backend" \
-    "$(printf '%s\n' "${mesh[@]}" | median)" "$(printf '%s\n' "${before[@]}" | median)" \
+  launches=$(echo "$stats" | awk '/^evaluations/ {for (i = 1; i <= NF; i++) if ($i ~ /^launches/) print $(i-1)}')
+  printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' "$name" "$r" "$backend" \
+    "$(printf '%s\n' "${mesh[@]}" | median)" "$(printf '%s\n' "${evaluating[@]}" | median)" \
+    "$(printf '%s\n' "${before[@]}" | median)" \
     "$(printf '%s\n' "${total[@]}" | median | xargs printf '%.3f')" "$tris" "${launches:-0}"
 }
 
 echo
-echo "| scene | resolution | backend | meshing s | before meshing s | sum s | triangles | launches |"
-echo "|---|---:|---|---:|---:|---:|---:|---:|"
+echo "| scene | resolution | backend | meshing s | of which evaluating s | before meshing s | sum s | triangles | launches |"
+echo "|---|---:|---|---:|---:|---:|---:|---:|---:|"
 for r in $RESOLUTIONS; do
   for b in $BACKENDS; do
     measure bracket "$b" "$r" examples/mesh/bracket.sdf

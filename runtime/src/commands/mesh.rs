@@ -446,6 +446,8 @@ fn refined(
     fine.seconds += coarse.seconds;
     fine.stats.refined_from = Some(coarse.grid.voxel);
     fine.stats.before = coarse.stats.before;
+    fine.stats.evaluating += coarse.stats.evaluating;
+    fine.stats.launches += coarse.stats.launches;
     thin.still(fine.grid.voxel, &fine.stats, say);
     fine
 }
@@ -583,6 +585,7 @@ fn surface_on(
         stats.backend = "cpu";
     }
     stats.before = Some(before);
+    stats.evaluating = field.evaluating();
     if settings.measure {
         // Measured in f64 by the CPU, whatever evaluated the mesh.
         let exact = Field::new(&lowered.program, proven, clip);
@@ -609,7 +612,7 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
          octree cells    {} evaluated{}\n\
          candidates      {} cells ({} added by crossed edges)\n\
          surface cells   {}\n\
-         evaluations     {} points ({:.2} % of the dense grid's {} points) on {}{}\n\
+         evaluations     {} points ({:.2} % of the dense grid's {} points) on {}{}, {:.3} s\n\
          sharp patches   {} ({} edges flipped, {} inner vertices projected onto the surface)\n\
          {}{}{}\
          time            {:.3} s\n",
@@ -641,6 +644,7 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
             0 => String::new(),
             n => format!(", in {n} launches"),
         },
+        s.evaluating,
         s.features,
         s.flips,
         s.projected,

@@ -144,6 +144,8 @@ pub struct Field {
     /// Whether that bound is proven; without it the mesher evaluates the dense grid.
     pub proven: bool,
     evaluated: AtomicU64,
+    /// Nanoseconds spent in [`Field::distances`] and [`Field::materials`].
+    nanos: AtomicU64,
 }
 
 /// Points per task of a parallel evaluation.
@@ -161,6 +163,7 @@ impl Field {
             lipschitz: program.lipschitz().max(1.0),
             proven,
             evaluated: AtomicU64::new(0),
+            nanos: AtomicU64::new(0),
         }
     }
 
@@ -187,6 +190,20 @@ impl Field {
         self.evaluated.load(Ordering::Relaxed)
     }
 
+    /// Seconds spent evaluating so far (on the GPU: the launches, the transfers and the
+    /// conversions to and from f32; the clip box included either way).
+    pub fn evaluating(&self) -> f64 {
+        self.nanos.load(Ordering::Relaxed) as f64 * 1e-9
+    }
+
+    fn timed<T>(&self, f: impl FnOnce() -> T) -> T {
+        let t = std::time::Instant::now();
+        let out = f();
+        self.nanos
+            .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        out
+    }
+
     /// The signed distance to the clip box (exact).
     fn clip_distance(&self, p: [f64; 3]) -> f64 {
         let [lo, hi] = self.clip;
@@ -199,6 +216,10 @@ impl Field {
     /// on the GPU, then clipped on the CPU's). A NaN distance counts as outside; after a
     /// GPU's launch has failed, every distance is NaN ([`device::Gpu::failure`]).
     pub fn distances(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        self.timed(|| self.clipped(points))
+    }
+
+    fn clipped(&self, points: &[[f64; 3]]) -> Vec<f64> {
         let mut out = vec![0.0; points.len()];
         self.evaluated
             .fetch_add(points.len() as u64, Ordering::Relaxed);
@@ -241,6 +262,10 @@ impl Field {
 
     /// The material id at every point (0 where a GPU's launch has failed).
     pub fn materials(&self, points: &[[f64; 3]]) -> Vec<u32> {
+        self.timed(|| self.materials_at(points))
+    }
+
+    fn materials_at(&self, points: &[[f64; 3]]) -> Vec<u32> {
         if let Some(gpu) = &self.gpu {
             return match gpu.run(points) {
                 Some(v) => v.into_iter().map(|(_, m)| m).collect(),
@@ -385,6 +410,8 @@ pub struct Stats {
     pub backend: &'static str,
     /// The GPU's launches (0 on the CPU).
     pub launches: u64,
+    /// Seconds of the meshing spent evaluating points ([`Field::evaluating`]).
+    pub evaluating: f64,
     /// Seconds from the command's start to the octree's (reading, checking, lowering; the
     /// device opened and its kernel compiled), where a command measured it.
     pub before: Option<f64>,

@@ -5,9 +5,11 @@
 use super::mesh_region::{frame, short, Frame};
 pub use super::mesh_region::{parse_bounds, BoundsError, Region, Spelling, DEFAULT_RESOLUTION};
 use super::mesh_thin::Thinness;
+use crate::backend::Backend;
 use crate::frontend::{self, DiagnosticFormat};
 use crate::memory::{mib, MIB};
 use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
+use crate::mesh::device::Gpu;
 use crate::mesh::write::{Format, Up};
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -58,6 +60,11 @@ pub struct MeshArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// What evaluates the field's points: the CPU (f64), or a GPU through wgpu or CUDA (f32,
+    /// the scene's points kernel; the mesh agrees with the CPU's within docs/mesh.md's
+    /// tolerance); `auto` picks as `render` does (CUDA, a wgpu GPU, else the CPU).
+    #[arg(long, value_enum, default_value = "cpu")]
+    pub backend: crate::backend::Backend,
     #[command(flatten)]
     pub limits: super::LimitArgs,
 }
@@ -88,6 +95,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
         .map_err(|why| usage(format!("cannot write `{}`: {why}", args.output.display())))?;
     let mut settings = settings(&args.set).map_err(usage)?;
     settings.measure = args.stats;
+    settings.backend = crate::mesh::device::resolve(args.backend);
     settings.materials = matches!(format, Format::Ply | Format::Glb | Format::ThreeMf);
     let pool = crate::job::thread_pool(args.threads, &limits).map_err(|e| usage(e.to_string()))?;
     // 1 for errors in the scene, 2 for a file that cannot be read, as `check` and `render`.
@@ -437,6 +445,9 @@ fn refined(
 ) -> Meshed {
     fine.seconds += coarse.seconds;
     fine.stats.refined_from = Some(coarse.grid.voxel);
+    fine.stats.before = coarse.stats.before;
+    fine.stats.evaluating += coarse.stats.evaluating;
+    fine.stats.launches += coarse.stats.launches;
     thin.still(fine.grid.voxel, &fine.stats, say);
     fine
 }
@@ -465,6 +476,16 @@ fn surface_on(
         .lower(&LowerOptions::default(), limits)
         .map_err(|_| (1, String::new()))?;
     let field = Field::new(&lowered.program, proven, clip);
+    let field = match settings.backend {
+        Backend::Cpu | Backend::Auto => field,
+        backend => {
+            let gpu = Gpu::open(backend, &checked.scene, &lowered, &clip).map_err(|m| (1, m))?;
+            // Once a process: the parts of a 3MF and a finer mesh share the device.
+            static SAID: std::sync::Once = std::sync::Once::new();
+            SAID.call_once(|| say(format!("mesh: evaluating on {}: {}", gpu.name, gpu.device)));
+            field.on(gpu)
+        }
+    };
     if !proven {
         say(format!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
@@ -488,6 +509,7 @@ fn surface_on(
     let fits = |n: u64| check_memory(contour::candidate_bytes(&grid, n), limits, spell).is_ok();
     let max_candidates = most(fits);
     let started = Instant::now();
+    let before = super::started().0.elapsed().as_secs_f64();
     let candidates = pool
         .install(|| {
             octree::candidates(
@@ -552,8 +574,24 @@ fn surface_on(
         ),
     })?;
     let seconds = started.elapsed().as_secs_f64();
+    if let Some(gpu) = field.gpu() {
+        if let Some(why) = gpu.failure() {
+            return Err((
+                1,
+                format!("--backend {} failed while meshing: {why}", gpu.name),
+            ));
+        }
+        stats.backend = gpu.name;
+        stats.launches = gpu.launches();
+    } else {
+        stats.backend = "cpu";
+    }
+    stats.before = Some(before);
+    stats.evaluating = field.evaluating();
     if settings.measure {
-        stats.error = Some(pool.install(|| crate::mesh::error(&field, &mesh)));
+        // Measured in f64 by the CPU, whatever evaluated the mesh.
+        let exact = Field::new(&lowered.program, proven, clip);
+        stats.error = Some(pool.install(|| crate::mesh::error(&exact, &mesh)));
     }
     stats.octree_cells = octree_evaluated;
     stats.dense = !proven;
@@ -576,9 +614,9 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
          octree cells    {} evaluated{}\n\
          candidates      {} cells ({} added by crossed edges)\n\
          surface cells   {}\n\
-         evaluations     {} points ({:.2} % of the dense grid's {} points)\n\
+         evaluations     {} points ({:.2} % of the dense grid's {} points) on {}{}, {:.3} s\n\
          sharp patches   {} ({} edges flipped, {} inner vertices projected onto the surface)\n\
-         {}{}\
+         {}{}{}\
          time            {:.3} s\n",
         grid.cells[0],
         grid.cells[1],
@@ -603,6 +641,12 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
         s.evaluated,
         100.0 * s.evaluated as f64 / dense,
         grid.dense_points(),
+        if s.backend.is_empty() { "cpu" } else { s.backend },
+        match s.launches {
+            0 => String::new(),
+            n => format!(", in {n} launches"),
+        },
+        s.evaluating,
         s.features,
         s.flips,
         s.projected,
@@ -622,6 +666,17 @@ pub fn describe(grid: &Grid, s: &Stats, seconds: f64) -> String {
                 100.0 * v / grid.voxel,
                 short(f),
                 100.0 * f / grid.voxel
+            ),
+            None => String::new(),
+        },
+        match s.before {
+            Some(b) => format!(
+                "before meshing  {b:.3} s (reading, checking, lowering{})\n",
+                if s.launches > 0 {
+                    ", the device and its kernel"
+                } else {
+                    ""
+                }
             ),
             None => String::new(),
         },

@@ -4,6 +4,9 @@
 //! compare every evaluator with it, and the Python package's `Scene.distance(points,
 //! backend=…)` answers with it.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, PoisonError};
+
 pub use sdfc_compiler::points::{
     entry, points_module, points_ptx, walk_module, PointsModule, Value, ENTRY_POINT, WORKGROUP,
 };
@@ -47,15 +50,23 @@ pub enum RunError {
 }
 
 /// The points as the entry point reads them: x, y, z, 0 per point, padded with the origin to
-/// a whole number of workgroups, as bytes.
+/// a whole number of workgroups, as bytes (written on rayon's threads: a batch of the mesher
+/// may hold millions).
 fn point_bytes(points: &[[f64; 3]]) -> Vec<u8> {
+    use rayon::prelude::*;
     let padded = groups(points) as usize * WORKGROUP as usize;
-    let mut words: Vec<f32> = points
-        .iter()
-        .flat_map(|p| [p[0] as f32, p[1] as f32, p[2] as f32, 0.0])
-        .collect();
-    words.resize(4 * padded, 0.0);
-    words.iter().flat_map(|w| w.to_le_bytes()).collect()
+    let mut bytes = vec![0u8; 16 * padded];
+    bytes
+        .par_chunks_mut(16 * 4096)
+        .zip(points.par_chunks(4096))
+        .for_each(|(out, ps)| {
+            for (o, p) in out.chunks_exact_mut(16).zip(ps) {
+                for (k, w) in [p[0] as f32, p[1] as f32, p[2] as f32].iter().enumerate() {
+                    o[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
+                }
+            }
+        });
+    bytes
 }
 
 /// The workgroups that cover `points`.
@@ -72,16 +83,17 @@ fn result_bytes(points: &[[f64; 3]]) -> u64 {
 /// alone.
 pub type Results = (Vec<Value<f32>>, Vec<f32>);
 
-/// Results as the entry point writes them, for the first `n` points.
+/// Results as the entry point writes them, for the first `n` points (read on rayon's
+/// threads).
 fn results(bytes: &[u8], n: usize) -> Results {
-    let words: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    let quads = || words.chunks_exact(4).take(n);
+    use rayon::prelude::*;
+    let word = |c: &[u8], k: usize| {
+        f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])
+    };
+    let quads = || bytes.par_chunks_exact(16).take(n);
     (
-        quads().map(|c| (c[0], c[1] as u32)).collect(),
-        quads().map(|c| c[2]).collect(),
+        quads().map(|c| (word(c, 0), word(c, 1) as u32)).collect(),
+        quads().map(|c| word(c, 2)).collect(),
     )
 }
 
@@ -108,6 +120,22 @@ pub struct WgpuPoints {
     data: Option<wgpu::BindGroup>,
     /// The bind group of the points and results.
     group: u32,
+    /// The points', results' and read-back buffers of the last run, reused by the next
+    /// while they are large enough.
+    kept: Mutex<Option<WgpuBuffers>>,
+    /// Dispatches run so far.
+    launches: AtomicU64,
+}
+
+/// The buffers of one dispatch of [`WgpuPoints`]: `bytes` of points, of results and of
+/// their copy read back (a vec4 each per thread), and the bind group of the first two.
+#[derive(Debug)]
+struct WgpuBuffers {
+    bytes: u64,
+    points: wgpu::Buffer,
+    results: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    bind: wgpu::BindGroup,
 }
 
 impl WgpuPoints {
@@ -147,60 +175,89 @@ impl WgpuPoints {
             pipeline,
             data,
             group: m.group,
+            kept: Mutex::new(None),
+            launches: AtomicU64::new(0),
         }
     }
 
-    /// The pipeline run at every point, [`POINTS_PER_DISPATCH`] at a time, on the `gpu` it
-    /// was compiled on.
-    pub fn run(&self, gpu: &crate::gpu::Gpu, points: &[[f64; 3]]) -> Result<Results, RunError> {
-        let (device, queue) = (gpu.device(), gpu.queue());
+    /// Dispatches run so far (one per [`POINTS_PER_DISPATCH`] points or fewer of a run).
+    pub fn launches(&self) -> u64 {
+        self.launches.load(Ordering::Relaxed)
+    }
+
+    /// Buffers for `bytes` of points and of results on `device`.
+    fn buffers(&self, device: &wgpu::Device, bytes: u64) -> WgpuBuffers {
         use wgpu::BufferUsages as U;
-        let buffer = |size: u64, usage: U| {
+        let buffer = |usage: U| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: None,
-                size,
+                size: bytes,
                 usage,
                 mapped_at_creation: false,
             })
         };
+        let points = buffer(U::STORAGE | U::COPY_DST);
+        let results = buffer(U::STORAGE | U::COPY_SRC);
+        let readback = buffer(U::MAP_READ | U::COPY_DST);
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &self.pipeline.get_bind_group_layout(self.group),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: points.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: results.as_entire_binding(),
+                },
+            ],
+        });
+        WgpuBuffers {
+            bytes,
+            points,
+            results,
+            readback,
+            bind,
+        }
+    }
+
+    /// The pipeline run at every point, [`POINTS_PER_DISPATCH`] at a time, on the `gpu` it
+    /// was compiled on, in the buffers of the run before where they are large enough
+    /// (otherwise in new ones, twice as large or as this run needs, kept for the next).
+    pub fn run(&self, gpu: &crate::gpu::Gpu, points: &[[f64; 3]]) -> Result<Results, RunError> {
+        let (device, queue) = (gpu.device(), gpu.queue());
         let mut out: Results = (
             Vec::with_capacity(points.len()),
             Vec::with_capacity(points.len()),
         );
+        let mut kept = self.kept.lock().unwrap_or_else(PoisonError::into_inner);
         for chunk in points.chunks(POINTS_PER_DISPATCH) {
             let input = point_bytes(chunk);
             let size = result_bytes(chunk);
-            let points_buf = buffer(input.len() as u64, U::STORAGE | U::COPY_DST);
-            queue.write_buffer(&points_buf, 0, &input);
-            let results_buf = buffer(size, U::STORAGE | U::COPY_SRC);
-            let readback = buffer(size, U::MAP_READ | U::COPY_DST);
-            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &self.pipeline.get_bind_group_layout(self.group),
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: points_buf.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: results_buf.as_entire_binding(),
-                    },
-                ],
-            });
+            let b = match kept.take() {
+                Some(b) if b.bytes >= size => b,
+                old => {
+                    let most = result_bytes(&points[..POINTS_PER_DISPATCH.min(points.len())]);
+                    let grown = old.map_or(size, |b| (2 * b.bytes).clamp(size, most.max(size)));
+                    self.buffers(device, grown)
+                }
+            };
+            queue.write_buffer(&b.points, 0, &input);
             let mut enc = device.create_command_encoder(&Default::default());
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
                 pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(self.group, &bind, &[]);
+                pass.set_bind_group(self.group, &b.bind, &[]);
                 if let Some(d) = &self.data {
                     pass.set_bind_group(0, d, &[]);
                 }
                 pass.dispatch_workgroups(groups(chunk), 1, 1);
             }
-            enc.copy_buffer_to_buffer(&results_buf, 0, &readback, 0, size);
+            enc.copy_buffer_to_buffer(&b.results, 0, &b.readback, 0, size);
             queue.submit([enc.finish()]);
-            let slice = readback.slice(..);
+            self.launches.fetch_add(1, Ordering::Relaxed);
+            let slice = b.readback.slice(..size);
             let (tx, rx) = std::sync::mpsc::channel();
             slice.map_async(wgpu::MapMode::Read, move |r| {
                 let _ = tx.send(r);
@@ -209,10 +266,11 @@ impl WgpuPoints {
                 .poll(wgpu::PollType::wait_indefinitely())
                 .map_err(|e| RunError::Wait(e.into()))?;
             rx.recv()??;
-            let bytes = slice.get_mapped_range()?.to_vec();
-            let (v, d) = results(&bytes, chunk.len());
+            let (v, d) = results(&slice.get_mapped_range()?, chunk.len());
+            b.readback.unmap();
             out.0.extend(v);
             out.1.extend(d);
+            *kept = Some(b);
         }
         Ok(out)
     }
@@ -278,6 +336,18 @@ pub struct CudaPoints {
     group: u32,
     /// The bytes of `scene_data`, where the module reads it.
     data: Option<Vec<u8>>,
+    /// The buffers of the last run, reused by the next while they are large enough.
+    kept: Mutex<Option<CudaBuffers>>,
+    /// Launches run so far.
+    launches: AtomicU64,
+}
+
+/// The kernel's buffers of one launch of [`CudaPoints`], in its parameters' order, for
+/// `bytes` of points and of results.
+#[derive(Debug)]
+struct CudaBuffers {
+    bytes: usize,
+    buffers: Vec<cudarc::driver::CudaSlice<u8>>,
 }
 
 impl CudaPoints {
@@ -312,53 +382,96 @@ impl CudaPoints {
             out_at,
             group: m.group,
             data: m.data.clone(),
+            kept: Mutex::new(None),
+            launches: AtomicU64::new(0),
         })
     }
 
-    /// The kernel run at every point, [`POINTS_PER_DISPATCH`] at a time.
+    /// Launches run so far (one per [`POINTS_PER_DISPATCH`] points or fewer of a run).
+    pub fn launches(&self) -> u64 {
+        self.launches.load(Ordering::Relaxed)
+    }
+
+    /// The kernel's buffers for `bytes` of points and of results, `scene_data` written.
+    fn buffers(
+        &self,
+        s: &std::sync::Arc<cudarc::driver::CudaStream>,
+        bytes: usize,
+    ) -> Result<CudaBuffers, RunError> {
+        let cuda = |what| move |error| RunError::Cuda { what, error };
+        let group = self.group;
+        let buffers = self
+            .bindings
+            .iter()
+            .map(|&b| match b {
+                b if b == (group, 0) || b == (group, 1) => {
+                    s.alloc_zeros::<u8>(bytes).map_err(cuda("CUDA"))
+                }
+                (0, 4) => {
+                    let data = self.data.as_ref().ok_or(RunError::NoSceneData)?;
+                    s.clone_htod(data).map_err(cuda("CUDA"))
+                }
+                _ => s.alloc_zeros::<u8>(256).map_err(cuda("CUDA")),
+            })
+            .collect::<Result<Vec<_>, RunError>>()?;
+        Ok(CudaBuffers { bytes, buffers })
+    }
+
+    /// The kernel run at every point, [`POINTS_PER_DISPATCH`] at a time, in the buffers of
+    /// the run before where they are large enough (otherwise in new ones, twice as large or as
+    /// this run needs, kept for the next).
     pub fn run(&self, points: &[[f64; 3]]) -> Result<Results, RunError> {
         use cudarc::driver::{LaunchConfig, PushKernelArg};
         let cuda = |what| move |error| RunError::Cuda { what, error };
         let s = self.ctx.default_stream();
-        let group = self.group;
+        let at_points = self
+            .bindings
+            .iter()
+            .position(|&b| b == (self.group, 0))
+            .ok_or(RunError::NoResults)?;
         let mut out: Results = (
             Vec::with_capacity(points.len()),
             Vec::with_capacity(points.len()),
         );
+        let mut kept = self.kept.lock().unwrap_or_else(PoisonError::into_inner);
         for chunk in points.chunks(POINTS_PER_DISPATCH) {
-            let buffers = self
-                .bindings
-                .iter()
-                .map(|&b| {
-                    let bytes = match b {
-                        b if b == (group, 0) => point_bytes(chunk),
-                        b if b == (group, 1) => vec![0; result_bytes(chunk) as usize],
-                        (0, 4) => self.data.clone().ok_or(RunError::NoSceneData)?,
-                        _ => vec![0; 256],
-                    };
-                    s.clone_htod(&bytes).map_err(cuda("CUDA"))
-                })
-                .collect::<Result<Vec<cudarc::driver::CudaSlice<u8>>, RunError>>()?;
+            let input = point_bytes(chunk);
+            let size = result_bytes(chunk) as usize;
+            let mut b = match kept.take() {
+                Some(b) if b.bytes >= size => b,
+                old => {
+                    let most =
+                        result_bytes(&points[..POINTS_PER_DISPATCH.min(points.len())]) as usize;
+                    let grown = old.map_or(size, |b| (2 * b.bytes).clamp(size, most.max(size)));
+                    self.buffers(&s, grown)?
+                }
+            };
+            s.memcpy_htod(&input, &mut b.buffers[at_points].slice_mut(..input.len()))
+                .map_err(cuda("uploading the points"))?;
             let cfg = LaunchConfig {
                 grid_dim: (groups(chunk), 1, 1),
                 block_dim: (WORKGROUP, 1, 1),
                 shared_mem_bytes: 0,
             };
             let mut launch = s.launch_builder(&self.function);
-            for b in &buffers {
-                launch.arg(b);
+            for buffer in &b.buffers {
+                launch.arg(buffer);
             }
             // SAFETY: the kernel's parameters are the module's buffers in (group, binding)
             // order, as the PTX back end declares them, each passed here; the points and
-            // results hold one element for every thread of the grid, scene_data is the
-            // kernel's own, and the entry point reads nothing of the other buffers.
+            // results hold one element for every thread of the grid (or more), scene_data is
+            // the kernel's own, and the entry point reads nothing of the other buffers.
             #[allow(unsafe_code)]
             unsafe { launch.launch(cfg) }.map_err(cuda("CUDA"))?;
+            self.launches.fetch_add(1, Ordering::Relaxed);
+            let mut bytes = vec![0u8; size];
+            s.memcpy_dtoh(&b.buffers[self.out_at].slice(..size), &mut bytes)
+                .map_err(cuda("reading the distances back"))?;
             s.synchronize().map_err(cuda("CUDA"))?;
-            let out_bytes = s.clone_dtoh(&buffers[self.out_at]).map_err(cuda("CUDA"))?;
-            let (v, d) = results(&out_bytes, chunk.len());
+            let (v, d) = results(&bytes, chunk.len());
             out.0.extend(v);
             out.1.extend(d);
+            *kept = Some(b);
         }
         Ok(out)
     }

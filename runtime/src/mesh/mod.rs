@@ -7,6 +7,7 @@
 //! guarantees.
 
 pub mod contour;
+pub mod device;
 pub mod octree;
 pub mod parts;
 pub mod place;
@@ -129,17 +130,22 @@ pub type KeySet = HashSet<u64, BuildHasherDefault<KeyHasher>>;
 
 /// The scene's distance field as the mesher reads it: the distance program, intersected
 /// with a clip box (so that what reaches out of the meshed region is cut and closed), with
-/// the L that bounds it.
+/// the L that bounds it. Its points are evaluated by the CPU's interpreter (f64), or, given
+/// a [`device::Gpu`], by the scene's points kernel there (f32), a batch at a time either way;
+/// the clip box is applied on the host.
 #[derive(Debug)]
 pub struct Field {
     distance: Tape,
     materials: Tape,
+    gpu: Option<device::Gpu>,
     clip: [[f64; 3]; 2],
     /// `|f(p)| / lipschitz` is at most the distance from `p` to the surface (when `proven`).
     pub lipschitz: f64,
     /// Whether that bound is proven; without it the mesher evaluates the dense grid.
     pub proven: bool,
     evaluated: AtomicU64,
+    /// Nanoseconds spent in [`Field::distances`] and [`Field::materials`].
+    nanos: AtomicU64,
 }
 
 /// Points per task of a parallel evaluation.
@@ -153,15 +159,49 @@ impl Field {
             distance: Tape::new(program, Outputs::Distance),
             materials: Tape::new(program, Outputs::DistanceAndMaterial),
             clip,
+            gpu: None,
             lipschitz: program.lipschitz().max(1.0),
             proven,
             evaluated: AtomicU64::new(0),
+            nanos: AtomicU64::new(0),
         }
+    }
+
+    /// This field evaluated by `gpu` instead of the CPU.
+    pub fn on(mut self, gpu: device::Gpu) -> Field {
+        self.gpu = Some(gpu);
+        self
+    }
+
+    /// The GPU that evaluates the field, if one does.
+    pub fn gpu(&self) -> Option<&device::Gpu> {
+        self.gpu.as_ref()
+    }
+
+    /// How far a distance may be from the f64 one by the rounding of its evaluation, at most:
+    /// 0 on the CPU (whose rounding the callers' relative slack covers), the f32 allowance
+    /// on a GPU ([`device::Gpu::rounding`]).
+    pub fn rounding(&self) -> f64 {
+        self.gpu.as_ref().map_or(0.0, |g| g.rounding())
     }
 
     /// Points evaluated so far.
     pub fn evaluated(&self) -> u64 {
         self.evaluated.load(Ordering::Relaxed)
+    }
+
+    /// Seconds spent evaluating so far (on the GPU: the launches, the transfers and the
+    /// conversions to and from f32; the clip box included either way).
+    pub fn evaluating(&self) -> f64 {
+        self.nanos.load(Ordering::Relaxed) as f64 * 1e-9
+    }
+
+    fn timed<T>(&self, f: impl FnOnce() -> T) -> T {
+        let t = std::time::Instant::now();
+        let out = f();
+        self.nanos
+            .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        out
     }
 
     /// The signed distance to the clip box (exact).
@@ -172,9 +212,41 @@ impl Field {
         outside + q[0].max(q[1]).max(q[2]).min(0.0)
     }
 
-    /// The clipped field at every point, in parallel. A NaN distance counts as outside.
+    /// The clipped field at every point, in parallel (on the CPU's threads, or in one batch
+    /// on the GPU, then clipped on the CPU's). A NaN distance counts as outside; after a
+    /// GPU's launch has failed, every distance is NaN ([`device::Gpu::failure`]).
     pub fn distances(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        self.timed(|| self.clipped(points))
+    }
+
+    fn clipped(&self, points: &[[f64; 3]]) -> Vec<f64> {
         let mut out = vec![0.0; points.len()];
+        self.evaluated
+            .fetch_add(points.len() as u64, Ordering::Relaxed);
+        let clip = |o: &mut [f64], p: &[[f64; 3]]| {
+            for (d, q) in o.iter_mut().zip(p) {
+                let b = self.clip_distance(*q);
+                *d = if *d > b { *d } else { b };
+            }
+        };
+        if let Some(gpu) = &self.gpu {
+            let values = gpu.run(points);
+            out.par_chunks_mut(TASK)
+                .zip(points.par_chunks(TASK))
+                .enumerate()
+                .for_each(|(k, (o, p))| {
+                    match &values {
+                        Some(v) => {
+                            for (d, v) in o.iter_mut().zip(&v[k * TASK..]) {
+                                *d = v.0 as f64;
+                            }
+                        }
+                        None => o.fill(f64::NAN),
+                    }
+                    clip(o, p);
+                });
+            return out;
+        }
         points
             .par_chunks(TASK)
             .zip(out.par_chunks_mut(TASK))
@@ -182,19 +254,24 @@ impl Field {
                 || Scratch::new(&self.distance),
                 |s, (p, o)| {
                     s.run(p, o, None);
-                    for (d, q) in o.iter_mut().zip(p) {
-                        let b = self.clip_distance(*q);
-                        *d = if *d > b { *d } else { b };
-                    }
+                    clip(o, p);
                 },
             );
-        self.evaluated
-            .fetch_add(points.len() as u64, Ordering::Relaxed);
         out
     }
 
-    /// The material id at every point.
+    /// The material id at every point (0 where a GPU's launch has failed).
     pub fn materials(&self, points: &[[f64; 3]]) -> Vec<u32> {
+        self.timed(|| self.materials_at(points))
+    }
+
+    fn materials_at(&self, points: &[[f64; 3]]) -> Vec<u32> {
+        if let Some(gpu) = &self.gpu {
+            return match gpu.run(points) {
+                Some(v) => v.into_iter().map(|(_, m)| m).collect(),
+                None => vec![0; points.len()],
+            };
+        }
         let mut out = vec![0u32; points.len()];
         let mut scratch = vec![0.0; points.len()];
         points
@@ -208,8 +285,11 @@ impl Field {
     }
 
     /// The clipped field and its gradient at every point, from four samples at the corners
-    /// of a tetrahedron of edge `2√2·h` around it (their mean is the value, to O(h²)).
+    /// of a tetrahedron of edge `2√2·h` around it (their mean is the value, to O(h²)), in
+    /// one batch. On a GPU, `h` is at least [`device::Gpu::least_step`], beyond f32's
+    /// rounding.
     pub fn gradients(&self, points: &[[f64; 3]], h: f64) -> (Vec<f64>, Vec<[f64; 3]>) {
+        let h = self.gpu.as_ref().map_or(h, |g| h.max(g.least_step()));
         const K: [[f64; 3]; 4] = [
             [1.0, -1.0, -1.0],
             [-1.0, -1.0, 1.0],
@@ -326,6 +406,15 @@ pub struct Stats {
     /// The largest |f| at the mesh's vertices and at its triangles' centres (the distance to
     /// the surface where the field is exact), when measured ([`Settings::measure`]).
     pub error: Option<[f64; 2]>,
+    /// What evaluated the points, as `--backend` names it (`cpu`, `wgpu`, `cuda`).
+    pub backend: &'static str,
+    /// The GPU's launches (0 on the CPU).
+    pub launches: u64,
+    /// Seconds of the meshing spent evaluating points ([`Field::evaluating`]).
+    pub evaluating: f64,
+    /// Seconds from the command's start to the octree's (reading, checking, lowering; the
+    /// device opened and its kernel compiled), where a command measured it.
+    pub before: Option<f64>,
 }
 
 /// Settings of a mesh.
@@ -343,6 +432,9 @@ pub struct Settings {
     /// Mesh again on a finer grid where walls or gaps thinner than a cell were missed
     /// (`commands::mesh_thin`); off, they are only warned about.
     pub thin: bool,
+    /// What evaluates the field's points (`--backend`): the CPU (f64), or a GPU (f32, the
+    /// scene's points kernel; [`device`]); `auto` is resolved by [`device::resolve`].
+    pub backend: crate::backend::Backend,
 }
 
 impl Default for Settings {
@@ -353,6 +445,7 @@ impl Default for Settings {
             materials: true,
             measure: false,
             thin: true,
+            backend: crate::backend::Backend::Cpu,
         }
     }
 }

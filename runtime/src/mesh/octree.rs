@@ -5,7 +5,8 @@
 //! test keeps. The cells of the last level are not tested by their centres: every child of a
 //! kept two-cell cube is a candidate, and its corners, which contouring evaluates anyway,
 //! decide (a cell whose corners all have one sign holds no patch). A field without a proven
-//! bound gets the dense grid.
+//! bound gets the dense grid. A GPU's f32 distances widen the test by their rounding
+//! ([`Field::rounding`]): a cell more may be kept, never one less.
 //!
 //! A grid too fine for the cells limit, or with more candidates than the memory limit lets
 //! contouring hold, is refused at the first level that proves it ([`candidates_at_least`]),
@@ -109,14 +110,28 @@ pub fn candidates(
         let d = field.distances(&centres);
         // The surface these values prove, before the next level is counted or stored.
         let within = max_cells.saturating_sub(evaluated).min(max_candidates);
-        let surface = candidates_at_least(&frontier, &d, size, grid.voxel, field.lipschitz, within);
+        // The balls inside, shrunk by the rounding of a GPU's f32 distances.
+        let rounding = field.rounding();
+        let shrunk: Vec<f64>;
+        let inside = if rounding > 0.0 {
+            shrunk = d
+                .iter()
+                .map(|&v| if v < 0.0 { (v + rounding).min(0.0) } else { v })
+                .collect();
+            &shrunk
+        } else {
+            &d
+        };
+        let surface =
+            candidates_at_least(&frontier, inside, size, grid.voxel, field.lipschitz, within);
         if evaluated.saturating_add(surface) > max_cells {
             return Err(Refused::Cells(evaluated.saturating_add(surface)));
         }
         if surface > max_candidates {
             return Err(Refused::Candidates(surface));
         }
-        let reach = field.lipschitz * half * 3f64.sqrt() * (1.0 + SLACK) + SLACK * grid.voxel;
+        let reach =
+            field.lipschitz * half * 3f64.sqrt() * (1.0 + SLACK) + SLACK * grid.voxel + rounding;
         let kept = || {
             frontier
                 .iter()

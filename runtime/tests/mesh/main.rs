@@ -1,12 +1,15 @@
 //! Meshing and meshes, one test binary: `sdfc mesh` and the files it writes (`mesh`), their
 //! accuracy on printable parts (`mesh_accuracy`), fields meshed without `--bounds`
 //! (`mesh_fields`), 3MF read back by independent readers (`mesh_3mf`), meshes read into
-//! scenes (`mesh_import`), and vertex colours of the normal and of moved shapes (`mesh_colour`).
+//! scenes (`mesh_import`), vertex colours of the normal and of moved shapes (`mesh_colour`),
+//! and meshes evaluated on a GPU against the CPU's (`mesh_gpu`).
 //!
 //! Filter by module: `cargo test --release --test mesh -- mesh_3mf::`.
 
 #[path = "../common/mod.rs"]
 mod common;
+#[path = "../common/evaluators.rs"]
+mod evaluators;
 #[path = "../common/meshes.rs"]
 mod meshes;
 
@@ -15,4 +18,5 @@ mod mesh_3mf;
 mod mesh_accuracy;
 mod mesh_colour;
 mod mesh_fields;
+mod mesh_gpu;
 mod mesh_import;

@@ -799,6 +799,11 @@ fn smooth_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Va
     Ok(acc)
 }
 
+fn hull(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+    let ids: Vec<NodeId> = a.iter().map(sh).collect();
+    Ok(Value::Shape(super::hull::hull(b.graph, b.span, &ids)?))
+}
+
 fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
     b.node(Node::Combine {
         op,
@@ -1382,6 +1387,14 @@ static FUNCTIONS: &[Builtin] = &[
         name: "round",
         sigs: sigs![
             [shape("shape"), p("radius", F, Req, NonNeg)] -> S => |b, a| b.node(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    // The hull of balls or of parallel cylinders (`hull.rs`); of points, an entry of the table.
+    Builtin {
+        name: "hull",
+        sigs: sigs![
+            [shape("shapes")] rest + -> S => |b, a| hull(b, a);
+            [p("shapes", LS, Req, Any)] -> S => |b, a| hull(b, &shapes(&a[0], "hull")?);
         ],
     },
     // OpenSCAD's `minkowski` with a ball is a rounding: the distance less the radius.

@@ -121,7 +121,7 @@ fn cylinders(graph: &mut Graph, span: Span, pieces: &[Piece]) -> Result<NodeId, 
             continue;
         };
         return Err(format!(
-            "cylinder {} is {why} the first: a `hull` of cylinders is exact where they are parallel and span the same stretch of their axis (then it is the extruded hull of their circles); for others hull balls, e.g. capsules, or hull their rims' points with `hull([points…], radius)`",
+            "cylinder {} is {why} the first: a `hull` of cylinders is exact where they are parallel and span the same stretch of their axis (then it is the extruded hull of their circles); for others hull balls (spheres, capsules) or points with `hull([points…], radius)`",
             k + 1
         ));
     }

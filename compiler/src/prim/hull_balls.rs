@@ -88,7 +88,7 @@ pub(crate) static CIRCLES: Prim = Prim {
         // Each circle's direction from its centre.
         for qi in &q {
             let l = b.len2(qi[0], qi[1]);
-            let u = unit_or(b, qi, l, &[1.0, 0.0]);
+            let (u, ok) = unit(b, qi, l);
             let mut v: Option<Reg> = None;
             for (qk, c) in q.iter().zip(&circles) {
                 let d = b.dot2(qk[0], qk[1], u[0], u[1]);
@@ -96,6 +96,7 @@ pub(crate) static CIRCLES: Prim = Prim {
                 v = Some(v.map_or(d, |x| b.min(x, d)));
             }
             if let Some(v) = v {
+                let v = kept(b, ok, v);
                 keep(b, v);
             }
         }
@@ -175,16 +176,14 @@ pub(crate) fn outermost(balls: &[Ball]) -> Vec<Ball> {
         .collect()
 }
 
-/// The cone tangent to balls `i` and `j`: its axis `a` (from i to j), the part of its normals
-/// along the axis `s` and across it `t` (s² + t² = 1), and a unit vector across the axis (the
-/// side tried where `p` is on the axis).
+/// The cone tangent to balls `i` and `j`: its axis `a` (from i to j), and the part of its
+/// normals along the axis `s` and across it `t` (s² + t² = 1).
 #[derive(Debug, Clone, Copy)]
 struct Cone {
     i: usize,
     a: DVec3,
     s: f64,
     t: f64,
-    across: DVec3,
 }
 
 /// What the hull of balls' field reads besides the point.
@@ -231,19 +230,12 @@ impl Plan {
                 let a = d / l;
                 let s = (balls[i].r - balls[j].r) / l;
                 let t = (1.0 - s * s).max(0.0).sqrt();
-                let across = a.any_orthonormal_vector();
                 // A pair no plane touches is on the hull all round its cone or nowhere: its
                 // part on the hull would end where a third ball touches the cone, at a plane.
-                let u = s * a + t * across;
+                let u = s * a + t * a.any_orthonormal_vector();
                 let on = edge[i][j] || balls[i].c.dot(u) + balls[i].r >= support(u) - eps;
                 if on {
-                    cones.push(Cone {
-                        i,
-                        a,
-                        s,
-                        t,
-                        across,
-                    });
+                    cones.push(Cone { i, a, s, t });
                 }
             }
         }
@@ -275,9 +267,10 @@ impl Plan {
         };
         for qi in &q {
             let l = b.len3(*qi);
-            let u = unit_or(b, qi, l, &[1.0, 0.0, 0.0]);
+            let (u, ok) = unit(b, qi, l);
             let d: Vec<Reg> = q.iter().map(|qk| b.dot3(*qk, [u[0], u[1], u[2]])).collect();
             if let Some(v) = least(b, &d) {
+                let v = kept(b, ok, v);
                 keep(b, v);
             }
         }
@@ -293,7 +286,7 @@ impl Plan {
                 })
                 .collect();
             let rho = b.len3([perp[0], perp[1], perp[2]]);
-            let w = unit_or(b, &perp, rho, &cone.across.to_array());
+            let (w, ok) = unit(b, &perp, rho);
             let w = [w[0], w[1], w[2]];
             let ci = self.balls[cone.i].c;
             // q_k·a = q_i·a + (c_i − c_k)·a, times s.
@@ -314,6 +307,7 @@ impl Plan {
                     })
                     .collect();
                 if let Some(v) = least(b, &d) {
+                    let v = kept(b, ok, v);
                     keep(b, v);
                 }
             }
@@ -331,23 +325,27 @@ impl Plan {
     }
 }
 
-/// The unit vector along `v` of length `l`, or the constant `other` where `l` is too small to
-/// divide by (any unit normal gives a value at most the distance).
-fn unit_or(b: &mut Builder, v: &[Reg], l: Reg, other: &[f64]) -> Vec<Reg> {
+/// The unit vector along `v` of length `l`, and whether `l` is large enough to divide by
+/// (where it is not, the normal is dropped: see [`kept`]).
+fn unit(b: &mut Builder, v: &[Reg], l: Reg) -> (Vec<Reg>, Reg) {
     let tiny = b.c(1e-18);
     let ok = b.lt(tiny, l);
     let safe = b.max(l, tiny);
     let one = b.c(1.0);
     let inv = b.div(one, safe);
-    v.iter()
-        .zip(other)
-        .map(|(&x, &o)| {
-            let y = b.mul(x, inv);
-            let o = b.c(o);
-            b.select(ok, y, o)
-        })
-        .collect()
+    (v.iter().map(|&x| b.mul(x, inv)).collect(), ok)
 }
+
+/// The value `v` of a normal where `ok`, else far below any distance: where the point is a
+/// ball's centre or on a cone's axis its normal has no direction, and any other value of the
+/// maximum is at most the distance still.
+fn kept(b: &mut Builder, ok: Reg, v: Reg) -> Reg {
+    let none = b.c(-FAR);
+    b.select(ok, v, none)
+}
+
+/// Below any distance.
+const FAR: f64 = 1e30;
 
 /// The unit normals u of the planes tangent to three balls with the balls on the side
 /// opposite u (c·u + r equal for the three): none where the centres are on one line.

@@ -801,7 +801,15 @@ fn smooth_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Va
 
 fn hull(b: &mut Build, a: &[Value]) -> Result<Value, String> {
     let ids: Vec<NodeId> = a.iter().map(sh).collect();
-    Ok(Value::Shape(super::hull::hull(b.graph, b.span, &ids)?))
+    let most = b.limits.count(Limit::HullShapes);
+    match super::hull::hull(b.graph, b.span, &ids, most) {
+        Ok(id) => Ok(Value::Shape(id)),
+        Err(super::hull::Refused::Why(why)) => Err(why),
+        Err(super::hull::Refused::Many(n)) => Err(format!(
+            "this `hull` takes {n} balls and cylinders, more than the `hull_shapes` limit of {most}: its cost per point grows as the square of their number (hull fewer, or their centres with `hull([points…], radius)` where the radii are equal; or {})",
+            b.limits.raise_to(Limit::HullShapes, n)
+        )),
+    }
 }
 
 fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {

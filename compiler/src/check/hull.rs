@@ -6,7 +6,7 @@
 //! of their circles (`prim::HULL_CIRCLES`), turned and moved into place. Both are exact; any
 //! other mix is refused with the hulls there are.
 
-use crate::prim::{ball_entries, Args, Ball, Kind, PrimRef, HULL_BALLS, HULL_CIRCLES, HULL_SHAPES};
+use crate::prim::{ball_entries, Args, Ball, Kind, PrimRef, HULL_BALLS, HULL_CIRCLES};
 use crate::scene::{Combine, Graph, Node, NodeId};
 use crate::span::Span;
 use glam::{DMat3, DVec3};
@@ -50,8 +50,68 @@ impl Place {
 /// What `hull` accepts, for its messages.
 const TAKES: &str = "`hull` takes balls (`sphere`, `capsule`, `segment`, `round_cone`, a `hull` of them or of points) or parallel `cylinder`s, moved, turned, scaled, rounded (balls) or united";
 
-/// The node of the hull of `shapes`, added to `graph` at `span`; or why there is none.
-pub(super) fn hull(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<NodeId, String> {
+/// Why `hull` refuses its shapes.
+#[derive(Debug)]
+pub(super) enum Refused {
+    /// What is wrong, with what it takes.
+    Why(String),
+    /// More balls and cylinders (this many, saturating) than the limit.
+    Many(u64),
+}
+
+/// The node of the hull of `shapes`, at most `most` balls and cylinders, added to `graph` at
+/// `span`; or why there is none.
+pub(super) fn hull(
+    graph: &mut Graph,
+    span: Span,
+    shapes: &[NodeId],
+    most: usize,
+) -> Result<NodeId, Refused> {
+    let mut seen = std::collections::HashMap::new();
+    let n = shapes
+        .iter()
+        .fold(0u64, |n, &id| n.saturating_add(count(graph, id, &mut seen)));
+    if n > most as u64 {
+        return Err(Refused::Many(n));
+    }
+    hull_of(graph, span, shapes).map_err(Refused::Why)
+}
+
+/// How many balls and cylinders the shape `id` gives, each shared shape counted once per
+/// use but walked once (`seen`); 0 for one that is refused, as [`collect`] says.
+fn count(graph: &Graph, id: NodeId, seen: &mut std::collections::HashMap<NodeId, u64>) -> u64 {
+    if let Some(&n) = seen.get(&id) {
+        return n;
+    }
+    let n = match graph.node(id) {
+        Node::Sphere { .. } | Node::Cylinder { .. } => 1,
+        Node::Capsule { .. } => 2,
+        Node::Prim { prim, args } => match prim.name {
+            "cylinder" => 1,
+            "segment" | "round_cone" => 2,
+            "hull" if std::ptr::eq(prim.0, &HULL_BALLS) => args.list(0).len() as u64 / 2,
+            "hull" => args.list(0).len() as u64,
+            _ => 0,
+        },
+        Node::Translate { child, .. }
+        | Node::Rotate { child, .. }
+        | Node::Scale { child, .. }
+        | Node::Round { child, .. }
+        | Node::Extrude { child, .. } => count(graph, *child, seen),
+        Node::Combine {
+            op: Combine::Union,
+            children,
+        } => children
+            .iter()
+            .fold(0u64, |n, &c| n.saturating_add(count(graph, c, seen))),
+        _ => 0,
+    };
+    seen.insert(id, n);
+    n
+}
+
+/// The node of the hull of `shapes` (not more than the limit), added to `graph` at `span`.
+fn hull_of(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<NodeId, String> {
     let mut pieces = Vec::new();
     for (k, &id) in shapes.iter().enumerate() {
         let place = Place {
@@ -63,11 +123,6 @@ pub(super) fn hull(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<N
         collect(graph, id, place, &mut pieces).map_err(|why| {
             format!("shape {} of {} is {why}", k + 1, shapes.len())
         })?;
-    }
-    if pieces.len() > HULL_SHAPES {
-        return Err(format!(
-            "this `hull` is of more than {HULL_SHAPES} balls and cylinders: its cost per point grows as the square of their number (hull fewer, or hull their centres with `hull([points…], radius)` where the radii are equal)"
-        ));
     }
     let balls: Vec<Ball> = pieces
         .iter()
@@ -169,10 +224,6 @@ fn cylinders(graph: &mut Graph, span: Span, pieces: &[Piece]) -> Result<NodeId, 
 /// The balls and cylinders the shape `id`, placed at `place`, is made of; or what it is that
 /// `hull` does not take.
 fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Result<(), String> {
-    // Past the most, `hull` refuses them all: stop (a union of itself, repeated, doubles).
-    if out.len() > HULL_SHAPES {
-        return Ok(());
-    }
     let y = |h: f64| DVec3::new(0.0, h, 0.0);
     match graph.node(id) {
         Node::Sphere { radius } => out.push(place.ball(DVec3::ZERO, *radius)),

@@ -19,10 +19,6 @@ use crate::program::builder::{Builder, P};
 use crate::program::Reg;
 use glam::{DVec2, DVec3};
 
-/// The most shapes a `hull` takes: its field costs a pass over the balls per normal tried,
-/// about n² steps per point, and finding the planes n⁴ steps once.
-pub(crate) const MOST_SHAPES: usize = 64;
-
 /// The hull of balls: `balls` holds each ball as two entries, its centre then its radius (the
 /// first number).
 pub(crate) static BALLS: Prim = Prim {

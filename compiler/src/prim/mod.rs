@@ -27,7 +27,7 @@ use crate::program::builder::{Builder, Slots, P};
 use crate::program::Reg;
 
 pub(crate) use between::{placed, scaled, AlongY, Placed};
-pub(crate) use hull_balls::{ball_entries, Ball, BALLS as HULL_BALLS, CIRCLES as HULL_CIRCLES, MOST_SHAPES as HULL_SHAPES};
+pub(crate) use hull_balls::{ball_entries, Ball, BALLS as HULL_BALLS, CIRCLES as HULL_CIRCLES};
 pub(crate) use profiles::rect;
 pub(crate) use solids::{box_from_q, cylinder, extrude, nearer_signed};
 

@@ -120,9 +120,8 @@ fn hull_of(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<NodeId, S
             s: 1.0,
             grow: 0.0,
         };
-        collect(graph, id, place, &mut pieces).map_err(|why| {
-            format!("shape {} of {} is {why}", k + 1, shapes.len())
-        })?;
+        collect(graph, id, place, &mut pieces)
+            .map_err(|why| format!("shape {} of {} is {why}", k + 1, shapes.len()))?;
     }
     let balls: Vec<Ball> = pieces
         .iter()
@@ -245,10 +244,26 @@ fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Res
         }
         Node::Rotate { matrix, child } => {
             let r = DMat3::from_cols_array_2d(matrix).transpose();
-            collect(graph, *child, Place { m: place.m * r, ..place }, out)?;
+            collect(
+                graph,
+                *child,
+                Place {
+                    m: place.m * r,
+                    ..place
+                },
+                out,
+            )?;
         }
         Node::Scale { factor, child } => {
-            collect(graph, *child, Place { s: place.s * factor, ..place }, out)?;
+            collect(
+                graph,
+                *child,
+                Place {
+                    s: place.s * factor,
+                    ..place
+                },
+                out,
+            )?;
         }
         Node::Round { radius, child } => {
             let grow = place.grow + place.s * radius;
@@ -272,7 +287,10 @@ fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Res
         } if *round == 0.0 => match graph.node(*child) {
             Node::Prim { prim, args } if std::ptr::eq(prim.0, &HULL_CIRCLES) => {
                 for c in args.list(0) {
-                    let (x, e) = (DVec3::new(c[0], c[1], 0.0), DVec3::new(0.0, 0.0, *half_height));
+                    let (x, e) = (
+                        DVec3::new(c[0], c[1], 0.0),
+                        DVec3::new(0.0, 0.0, *half_height),
+                    );
                     out.push(cylinder(&place, x - e, x + e, c[2])?);
                 }
             }
@@ -290,7 +308,12 @@ fn not_taken(kind: &str) -> String {
 
 /// The pieces of a primitive of the table: those that are hulls of balls, and the cylinder
 /// between two points.
-fn prim_pieces(prim: PrimRef, args: &Args, place: &Place, out: &mut Vec<Piece>) -> Result<(), String> {
+fn prim_pieces(
+    prim: PrimRef,
+    args: &Args,
+    place: &Place,
+    out: &mut Vec<Piece>,
+) -> Result<(), String> {
     let v = |i: usize| DVec3::from(args.v3(i));
     let y = |h: f64| DVec3::new(0.0, h, 0.0);
     let along_y = prim.params[0].kind == Kind::Float;

@@ -36,7 +36,8 @@ pub(crate) static BALLS: Prim = Prim {
     cost: |args| {
         let plan = Plan::of(&balls(args.list(0)));
         let n = plan.balls.len() as f64;
-        n * (15.0 + 7.0 * n) + plan.cones.len() as f64 * (20.0 + 14.0 * n)
+        n * (15.0 + 7.0 * n)
+            + plan.cones.len() as f64 * (20.0 + 14.0 * n)
             + 6.0 * plan.planes.len() as f64
     },
     distance: |b, p, args| Plan::of(&balls(args.list(0))).distance(b, p),
@@ -163,11 +164,10 @@ fn tolerance(balls: &[Ball]) -> f64 {
 /// The balls no other ball holds (of two that are one, the first).
 pub(crate) fn outermost(balls: &[Ball]) -> Vec<Ball> {
     let eps = tolerance(balls);
-    let holds = |i: usize, j: usize| balls[i].c.distance(balls[j].c) + balls[j].r <= balls[i].r + eps;
+    let holds =
+        |i: usize, j: usize| balls[i].c.distance(balls[j].c) + balls[j].r <= balls[i].r + eps;
     (0..balls.len())
-        .filter(|&j| {
-            !(0..balls.len()).any(|i| i != j && holds(i, j) && !(holds(j, i) && i > j))
-        })
+        .filter(|&j| !(0..balls.len()).any(|i| i != j && holds(i, j) && !(holds(j, i) && i > j)))
         .map(|j| balls[j])
         .collect()
 }
@@ -196,7 +196,12 @@ impl Plan {
         let balls = outermost(given);
         let n = balls.len();
         let eps = tolerance(&balls);
-        let support = |u: DVec3| balls.iter().map(|b| b.c.dot(u) + b.r).fold(f64::NEG_INFINITY, f64::max);
+        let support = |u: DVec3| {
+            balls
+                .iter()
+                .map(|b| b.c.dot(u) + b.r)
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
         let mut planes: Vec<(DVec3, f64)> = Vec::new();
         let mut edge = vec![vec![false; n]; n];
         for i in 0..n {
@@ -204,7 +209,10 @@ impl Plan {
                 for k in j + 1..n {
                     for u in tangent_planes(&balls[i], &balls[j], &balls[k]) {
                         let h = support(u);
-                        if [i, j, k].iter().any(|&m| balls[m].c.dot(u) + balls[m].r < h - eps) {
+                        if [i, j, k]
+                            .iter()
+                            .any(|&m| balls[m].c.dot(u) + balls[m].r < h - eps)
+                        {
                             continue;
                         }
                         (edge[i][j], edge[i][k], edge[j][k]) = (true, true, true);
@@ -244,7 +252,11 @@ impl Plan {
 
     /// max over the normals tried of p·u − h(u).
     fn distance(&self, b: &mut Builder, p: P) -> Reg {
-        let q: Vec<P> = self.balls.iter().map(|x| b.sub3c(p, x.c.to_array())).collect();
+        let q: Vec<P> = self
+            .balls
+            .iter()
+            .map(|x| b.sub3c(p, x.c.to_array()))
+            .collect();
         let mut best: Option<Reg> = None;
         let mut keep = |b: &mut Builder, v: Reg| {
             best = Some(match best {

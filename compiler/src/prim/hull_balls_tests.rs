@@ -102,11 +102,19 @@ fn equal_balls_are_the_hull_of_their_centres_grown_by_the_radius() {
             let at = [0, 1, 2].map(|_| rng.range(-2.0, 2.0));
             let ours = of_balls(&balls, at);
             let theirs = run(&super::super::hull::PRIMS[0], &points, at);
-            assert!((ours - theirs).abs() < 1e-9, "{at:?}: {ours} against {theirs}");
+            assert!(
+                (ours - theirs).abs() < 1e-9,
+                "{at:?}: {ours} against {theirs}"
+            );
         }
     }
     // Four balls in a plane: a rounded plate, its sides cylinders and its faces planes.
-    let corners = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 0.0, 1.0], [0.0, 0.0, 1.0]];
+    let corners = [
+        [0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 0.0, 1.0],
+        [0.0, 0.0, 1.0],
+    ];
     let balls: Vec<Ball> = corners
         .iter()
         .map(|c| Ball {
@@ -119,7 +127,10 @@ fn equal_balls_are_the_hull_of_their_centres_grown_by_the_radius() {
         let at = [0, 1, 2].map(|_| rng.range(-1.0, 3.0));
         let ours = of_balls(&balls, at);
         let theirs = run(&super::super::hull::PRIMS[0], &points, at);
-        assert!((ours - theirs).abs() < 1e-9, "{at:?}: {ours} against {theirs}");
+        assert!(
+            (ours - theirs).abs() < 1e-9,
+            "{at:?}: {ours} against {theirs}"
+        );
     }
 }
 
@@ -145,7 +156,10 @@ fn two_balls_are_the_round_cone_between_them() {
     for _ in 0..1000 {
         let at = [0, 1, 2].map(|_| rng.range(-2.0, 3.0));
         let (ours, theirs) = (of_balls(&balls, at), run(cone, &args, at));
-        assert!((ours - theirs).abs() < 1e-9, "{at:?}: {ours} against {theirs}");
+        assert!(
+            (ours - theirs).abs() < 1e-9,
+            "{at:?}: {ours} against {theirs}"
+        );
     }
 }
 
@@ -181,7 +195,10 @@ fn balls_of_any_radii_match_the_support_function_s_max_found_by_enumeration() {
             let at = b.c.to_array();
             let ours = of_balls(&balls, at);
             let search = reference(&balls, b.c);
-            assert!(ours < 0.0 && (ours - search).abs() < 1e-9, "{ours} {search}");
+            assert!(
+                ours < 0.0 && (ours - search).abs() < 1e-9,
+                "{ours} {search}"
+            );
         }
     }
 }
@@ -191,17 +208,31 @@ fn circles_match_the_support_function_s_max() {
     let mut rng = Rng::new(4);
     for count in 1..7 {
         let list: Vec<[f64; 3]> = (0..count)
-            .map(|_| [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.05, 0.6)])
+            .map(|_| {
+                [
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                    rng.range(0.05, 0.6),
+                ]
+            })
             .collect();
         let args = Args::with_list(&[], 0, &list);
         for _ in 0..60 {
-            let at = [rng.range(-2.5, 2.5), rng.range(-2.5, 2.5), rng.range(-1.0, 1.0)];
+            let at = [
+                rng.range(-2.5, 2.5),
+                rng.range(-2.5, 2.5),
+                rng.range(-1.0, 1.0),
+            ];
             let ours = run(&CIRCLES, &args, at);
             let q: Vec<(DVec2, f64)> = list
                 .iter()
                 .map(|c| (DVec2::new(at[0] - c[0], at[1] - c[1]), c[2]))
                 .collect();
-            let f = |u: DVec2| q.iter().map(|(q, r)| q.dot(u) - r).fold(f64::INFINITY, f64::min);
+            let f = |u: DVec2| {
+                q.iter()
+                    .map(|(q, r)| q.dot(u) - r)
+                    .fold(f64::INFINITY, f64::min)
+            };
             // Where one circle's function is stationary, or two tie.
             let mut exact = f64::NEG_INFINITY;
             for (i, (qi, ri)) in q.iter().enumerate() {
@@ -246,5 +277,52 @@ fn the_extent_holds_every_ball() {
     let centre = DVec3::from(e.min).lerp(DVec3::from(e.max), 0.5);
     for b in &balls {
         assert!(b.c.distance(centre) + b.r <= e.radius + 1e-12);
+    }
+}
+
+#[test]
+fn degenerate_balls_stay_exact() {
+    let ball = |c: [f64; 3], r: f64| Ball {
+        c: DVec3::from(c),
+        r,
+    };
+    let cases = [
+        // On one line; one ball twice; points (radius 0) with a ball; four equal balls on a
+        // circle (every three have the same two planes).
+        vec![
+            ball([0.0, 0.0, 0.0], 0.3),
+            ball([1.0, 0.0, 0.0], 0.2),
+            ball([2.0, 0.0, 0.0], 0.1),
+        ],
+        vec![
+            ball([0.0, 0.0, 0.0], 0.4),
+            ball([0.0, 0.0, 0.0], 0.4),
+            ball([1.0, 0.5, 0.0], 0.2),
+        ],
+        vec![
+            ball([0.0, 0.0, 0.0], 0.0),
+            ball([1.0, 0.0, 0.0], 0.0),
+            ball([0.0, 1.0, 0.0], 0.0),
+            ball([0.0, 0.0, 1.0], 0.0),
+            ball([0.3, 0.3, -1.0], 0.1),
+        ],
+        (0..4)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::FRAC_PI_2;
+                ball([a.cos(), 0.0, a.sin()], 0.2)
+            })
+            .collect(),
+    ];
+    let mut rng = Rng::new(8);
+    for balls in &cases {
+        for _ in 0..200 {
+            let at = rng.point(2.5);
+            let ours = of_balls(balls, at);
+            let exact = reference(balls, DVec3::from(at));
+            assert!(
+                ours.is_finite() && (ours - exact).abs() < 1e-9,
+                "{balls:?} at {at:?}: {ours} against {exact}"
+            );
+        }
     }
 }

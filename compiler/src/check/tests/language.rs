@@ -432,7 +432,10 @@ fn hulls_of_balls_and_of_parallel_cylinders() {
     let got = balls("hull([capsule(0.25, 2).rotate_z(90deg).round(0.25)])");
     assert_eq!(got.len(), 2);
     for (b, x) in got.iter().zip([1.0, -1.0]) {
-        assert!((b[0] - x).abs() < 1e-12 && b[1].abs() < 1e-12 && b[3] == 0.5, "{got:?}");
+        assert!(
+            (b[0] - x).abs() < 1e-12 && b[1].abs() < 1e-12 && b[3] == 0.5,
+            "{got:?}"
+        );
     }
     // A union, a hull of points with a radius and a hull of balls are balls too; a ball
     // inside another stays (the field drops it).
@@ -461,7 +464,10 @@ fn hulls_of_balls_and_of_parallel_cylinders() {
         d.message.clone()
     };
     let m = error("hull(sphere(1), box(0.5))");
-    assert!(m.contains("shape 2 of 2 is a `box`") && m.contains("hull([points"), "{m}");
+    assert!(
+        m.contains("shape 2 of 2 is a `box`") && m.contains("hull([points"),
+        "{m}"
+    );
     let m = error("hull(sphere(1), cylinder(0.5, 1))");
     assert!(m.contains("balls and cylinders together"), "{m}");
     let m = error("hull(cylinder(0.5, 1), cylinder(0.5, 1).rotate_x(10deg))");
@@ -475,9 +481,21 @@ fn hulls_of_balls_and_of_parallel_cylinders() {
     let m = error("hull([for i in 0..0 { sphere(1) }])");
     assert!(m.contains("empty list"), "{m}");
     let m = error("hull([for i in 0..65 { sphere(1).translate(i, 0, 0) }])");
-    assert!(m.contains("takes 65 balls") && m.contains("hull_shapes=65"), "{m}");
+    assert!(
+        m.contains("takes 65 balls") && m.contains("hull_shapes=65"),
+        "{m}"
+    );
     // A union of itself doubling 40 times is counted, not walked, and refused.
-    let shared = format!("let s0 = sphere(1);\n{}", (1..=40).map(|i| format!("let s{i} = union(s{}, s{}.translate(1, 0, 0));\n", i - 1, i - 1)).collect::<String>());
+    let shared = format!(
+        "let s0 = sphere(1);\n{}",
+        (1..=40)
+            .map(|i| format!(
+                "let s{i} = union(s{}, s{}.translate(1, 0, 0));\n",
+                i - 1,
+                i - 1
+            ))
+            .collect::<String>()
+    );
     let (_, diags, _) = check_str("t.sdf", &format!("{light}{shared}scene {{ hull(s40); }}"));
     assert!(
         diags

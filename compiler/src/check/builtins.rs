@@ -1401,7 +1401,7 @@ static FUNCTIONS: &[Builtin] = &[
     Builtin {
         name: "hull",
         sigs: sigs![
-            [shape("shapes")] rest + -> S => |b, a| hull(b, a);
+            [shape("shapes")] rest + -> S => hull;
             [p("shapes", LS, Req, Any)] -> S => |b, a| hull(b, &shapes(&a[0], "hull")?);
         ],
     },

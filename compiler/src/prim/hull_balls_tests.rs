@@ -179,7 +179,7 @@ fn balls_of_any_radii_match_the_support_function_s_max_found_by_enumeration() {
             c: balls[0].c + DVec3::new(0.01, 0.0, 0.0),
             r: balls[0].r * 0.5,
         });
-        assert_eq!(outermost(&balls).len() < balls.len(), true);
+        assert!(outermost(&balls).len() < balls.len());
         for _ in 0..40 {
             let at = rng.point(3.0);
             let ours = of_balls(&balls, at);

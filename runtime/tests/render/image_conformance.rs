@@ -60,6 +60,7 @@ const AGREEMENT: &[(&str, f64, f64)] = &[
     ("lathe", 91.0, 0.0005),   // 94.3 dB, 0.0000 (0 px), 2026-11-27
     ("lattice", 87.0, 0.0005), // 90.1 dB, 0.0000 (0 px)
     ("pawn", 91.0, 0.0005),    // 94.1 dB, 0.0000 (0 px), 2026-11-27
+    ("phone_stand", 65.0, 0.0005), // 68.8 dB, 0.0000 (0 px), 2026-12-07 (hulls of balls and cylinders, in mm)
     ("plaque", 109.0, 0.0005), // 112.0 dB, 0.0000 (0 px), 2026-11-27
     ("polyhedron", 62.0, 0.0005), // 65.3 dB, 0.0000 (0 px), 2026-12-06 (filtered checker)
     ("primitives", 97.0, 0.0005), // 100.8 dB, 0.0000 (0 px), 2026-12-06 (filtered checker)

@@ -799,17 +799,12 @@ fn smooth_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Va
     Ok(acc)
 }
 
-fn hull(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+/// `hull(shapes…)` (`hull.rs`): its node, or why there is none.
+fn hull(b: &mut Build, a: &[Value]) -> Result<Value, super::hull::Refused> {
     let ids: Vec<NodeId> = a.iter().map(sh).collect();
-    let most = b.limits.count(Limit::HullShapes);
-    match super::hull::hull(b.graph, b.span, &ids, most) {
-        Ok(id) => Ok(Value::Shape(id)),
-        Err(super::hull::Refused::Why(why)) => Err(why),
-        Err(super::hull::Refused::Many(n)) => Err(format!(
-            "this `hull` takes {n} balls and cylinders, more than the `hull_shapes` limit of {most}: its cost per point grows as the square of their number (hull fewer, or their centres with `hull([points…], radius)` where the radii are equal; or {})",
-            b.limits.raise_to(Limit::HullShapes, n)
-        )),
-    }
+    let (limits, most) = (b.limits, b.limits.count(Limit::HullShapes));
+    let raise = |n| limits.raise_to(Limit::HullShapes, n);
+    super::hull::hull(b.graph, b.span, &ids, most, raise).map(Value::Shape)
 }
 
 fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
@@ -1401,8 +1396,8 @@ static FUNCTIONS: &[Builtin] = &[
     Builtin {
         name: "hull",
         sigs: sigs![
-            [shape("shapes")] rest + -> S => hull;
-            [p("shapes", LS, Req, Any)] -> S => |b, a| hull(b, &shapes(&a[0], "hull")?);
+            [shape("shapes")] rest + -> S => |b, a| hull(b, a).map_err(|e| e.to_string());
+            [p("shapes", LS, Req, Any)] -> S => |b, a| hull(b, &shapes(&a[0], "hull")?).map_err(|e| e.to_string());
         ],
     },
     // OpenSCAD's `minkowski` with a ball is a rounding: the distance less the radius.

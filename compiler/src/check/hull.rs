@@ -53,28 +53,86 @@ const TAKES: &str = "`hull` takes balls (`sphere`, `capsule`, `segment`, `round_
 /// Why `hull` refuses its shapes.
 #[derive(Debug)]
 pub(super) enum Refused {
-    /// What is wrong, with what it takes.
-    Why(String),
-    /// More balls and cylinders (this many, saturating) than the limit.
-    Many(u64),
+    /// More balls and cylinders (`n`, saturating) than the limit `most`; `raise` says how
+    /// to raise it.
+    Many { n: u64, most: usize, raise: String },
+    /// Shape `at` (from 1) of `of` is not one `hull` takes.
+    Shape { at: usize, of: usize, what: Misfit },
+    /// Balls and cylinders together.
+    Mixed,
+    /// Cylinder `at` (from 1) does not line up with the first.
+    Cylinder { at: usize, how: Apart },
+}
+
+/// What a shape given to `hull` is that it does not take.
+#[derive(Debug)]
+pub(super) enum Misfit {
+    /// A shape of this kind.
+    Kind(&'static str),
+    Painted,
+    RoundedCylinder,
+}
+
+/// How a cylinder differs from the first of a `hull`.
+#[derive(Debug)]
+pub(super) enum Apart {
+    Turned,
+    Height,
+    Moved,
+}
+
+impl std::fmt::Display for Refused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Refused::Many { n, most, raise } => write!(
+                f,
+                "this `hull` takes {n} balls and cylinders, more than the `hull_shapes` limit of {most}: its cost per point grows as the square of their number (hull fewer, or their centres with `hull([points…], radius)` where the radii are equal; or {raise})"
+            ),
+            Refused::Shape { at, of, what } => {
+                write!(f, "shape {at} of {of} is ")?;
+                match what {
+                    Misfit::Kind(kind) => write!(f, "a `{kind}`: {TAKES} (for a polyhedron, hull its corners: `hull([points…], radius)`)"),
+                    Misfit::Painted => write!(f, "painted: paint the hull instead, `hull(…) @ material`"),
+                    Misfit::RoundedCylinder => write!(f, "a rounded cylinder: its hull with others has no exact distance here (hull the rounded cylinder's rims as balls, or round the hull: `hull(…).round(r)`)"),
+                }
+            }
+            Refused::Mixed => write!(
+                f,
+                "a `hull` of balls and cylinders together has no exact distance here: hull balls alone (a cylinder with round ends is a `capsule`) or parallel cylinders alone ({TAKES})"
+            ),
+            Refused::Cylinder { at, how } => {
+                let why = match how {
+                    Apart::Turned => "turned from",
+                    Apart::Height => "of another height than",
+                    Apart::Moved => "moved along its axis from",
+                };
+                write!(f, "cylinder {at} is {why} the first: a `hull` of cylinders is exact where they are parallel and span the same stretch of their axis (then it is the extruded hull of their circles); for others hull balls (spheres, capsules) or points with `hull([points…], radius)`")
+            }
+        }
+    }
 }
 
 /// The node of the hull of `shapes`, at most `most` balls and cylinders, added to `graph` at
-/// `span`; or why there is none.
+/// `span`; or why there is none (`raise`: how to raise the limit to a count).
 pub(super) fn hull(
     graph: &mut Graph,
     span: Span,
     shapes: &[NodeId],
     most: usize,
+    raise: impl Fn(u64) -> String,
 ) -> Result<NodeId, Refused> {
     let mut seen = std::collections::HashMap::new();
     let n = shapes
         .iter()
         .fold(0u64, |n, &id| n.saturating_add(count(graph, id, &mut seen)));
     if n > most as u64 {
-        return Err(Refused::Many(n));
+        return Err(Refused::Many {
+            n,
+            most,
+            raise: raise(n),
+        });
     }
-    hull_of(graph, span, shapes).map_err(Refused::Why)
+    hull_of(graph, span, shapes)
 }
 
 /// How many balls and cylinders the shape `id` gives, each shared shape counted once per
@@ -111,7 +169,7 @@ fn count(graph: &Graph, id: NodeId, seen: &mut std::collections::HashMap<NodeId,
 }
 
 /// The node of the hull of `shapes` (not more than the limit), added to `graph` at `span`.
-fn hull_of(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<NodeId, String> {
+fn hull_of(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<NodeId, Refused> {
     let mut pieces = Vec::new();
     for (k, &id) in shapes.iter().enumerate() {
         let place = Place {
@@ -120,8 +178,11 @@ fn hull_of(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<NodeId, S
             s: 1.0,
             grow: 0.0,
         };
-        collect(graph, id, place, &mut pieces)
-            .map_err(|why| format!("shape {} of {} is {why}", k + 1, shapes.len()))?;
+        collect(graph, id, place, &mut pieces).map_err(|what| Refused::Shape {
+            at: k + 1,
+            of: shapes.len(),
+            what,
+        })?;
     }
     let balls: Vec<Ball> = pieces
         .iter()
@@ -141,16 +202,14 @@ fn hull_of(graph: &mut Graph, span: Span, shapes: &[NodeId]) -> Result<NodeId, S
         ));
     }
     if !balls.is_empty() {
-        return Err(format!(
-            "a `hull` of balls and cylinders together has no exact distance here: hull balls alone (a cylinder with round ends is a `capsule`) or parallel cylinders alone ({TAKES})"
-        ));
+        return Err(Refused::Mixed);
     }
     cylinders(graph, span, &pieces)
 }
 
 /// The hull of parallel cylinders that span one stretch of their axis: the 2D hull of their
 /// circles, extruded, turned so that its z is the axis, and moved to their middle.
-fn cylinders(graph: &mut Graph, span: Span, pieces: &[Piece]) -> Result<NodeId, String> {
+fn cylinders(graph: &mut Graph, span: Span, pieces: &[Piece]) -> Result<NodeId, Refused> {
     let cyls: Vec<(DVec3, DVec3, f64, f64)> = pieces
         .iter()
         .filter_map(|p| match *p {
@@ -165,19 +224,16 @@ fn cylinders(graph: &mut Graph, span: Span, pieces: &[Piece]) -> Result<NodeId, 
         .fold(0.0, f64::max);
     let eps = 1e-9 * size;
     for (k, &(c, b, _, f)) in cyls.iter().enumerate().skip(1) {
-        let why = if b.dot(a).abs() < 1.0 - 1e-9 {
-            "turned from"
+        let how = if b.dot(a).abs() < 1.0 - 1e-9 {
+            Apart::Turned
         } else if (f - e).abs() > eps {
-            "of another height than"
+            Apart::Height
         } else if (c - c0).dot(a).abs() > eps {
-            "moved along its axis from"
+            Apart::Moved
         } else {
             continue;
         };
-        return Err(format!(
-            "cylinder {} is {why} the first: a `hull` of cylinders is exact where they are parallel and span the same stretch of their axis (then it is the extruded hull of their circles); for others hull balls (spheres, capsules) or points with `hull([points…], radius)`",
-            k + 1
-        ));
+        return Err(Refused::Cylinder { at: k + 1, how });
     }
     let middle = cyls.iter().fold(DVec3::ZERO, |m, (c, ..)| m + *c) / cyls.len() as f64;
     let e1 = a.any_orthonormal_vector();
@@ -222,7 +278,7 @@ fn cylinders(graph: &mut Graph, span: Span, pieces: &[Piece]) -> Result<NodeId, 
 
 /// The balls and cylinders the shape `id`, placed at `place`, is made of; or what it is that
 /// `hull` does not take.
-fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Result<(), String> {
+fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Result<(), Misfit> {
     let y = |h: f64| DVec3::new(0.0, h, 0.0);
     match graph.node(id) {
         Node::Sphere { radius } => out.push(place.ball(DVec3::ZERO, *radius)),
@@ -277,9 +333,7 @@ fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Res
                 collect(graph, c, place, out)?;
             }
         }
-        Node::Paint { .. } => {
-            return Err("painted: paint the hull instead, `hull(…) @ material`".to_string())
-        }
+        Node::Paint { .. } => return Err(Misfit::Painted),
         Node::Extrude {
             half_height,
             round,
@@ -294,16 +348,11 @@ fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Res
                     out.push(cylinder(&place, x - e, x + e, c[2])?);
                 }
             }
-            _ => return Err(not_taken("extrude")),
+            _ => return Err(Misfit::Kind("extrude")),
         },
-        node => return Err(not_taken(node.kind())),
+        node => return Err(Misfit::Kind(node.kind())),
     }
     Ok(())
-}
-
-/// Why a shape of this kind is not taken.
-fn not_taken(kind: &str) -> String {
-    format!("a `{kind}`: {TAKES} (for a polyhedron, hull its corners: `hull([points…], radius)`)")
 }
 
 /// The pieces of a primitive of the table: those that are hulls of balls, and the cylinder
@@ -313,7 +362,7 @@ fn prim_pieces(
     args: &Args,
     place: &Place,
     out: &mut Vec<Piece>,
-) -> Result<(), String> {
+) -> Result<(), Misfit> {
     let v = |i: usize| DVec3::from(args.v3(i));
     let y = |h: f64| DVec3::new(0.0, h, 0.0);
     let along_y = prim.params[0].kind == Kind::Float;
@@ -342,15 +391,15 @@ fn prim_pieces(
                 out.push(place.ball(DVec3::from(*q), args.f(1)));
             }
         }
-        name => return Err(not_taken(name)),
+        name => return Err(Misfit::Kind(name)),
     }
     Ok(())
 }
 
 /// The cylinder whose axis runs from `a` to `b` (in the shape's frame) of radius `r`.
-fn cylinder(place: &Place, a: DVec3, b: DVec3, r: f64) -> Result<Piece, String> {
+fn cylinder(place: &Place, a: DVec3, b: DVec3, r: f64) -> Result<Piece, Misfit> {
     if place.grow > 0.0 {
-        return Err("a rounded cylinder: its hull with others has no exact distance here (hull the rounded cylinder's rims as balls, or round the hull: `hull(…).round(r)`)".to_string());
+        return Err(Misfit::RoundedCylinder);
     }
     let (a, b) = (place.at(a), place.at(b));
     Ok(Piece::Cylinder {

@@ -67,6 +67,8 @@ pub enum Limit {
     Threads,
     /// Characters of the text one scene lays out (`text`), in all.
     TextChars,
+    /// Balls and cylinders one `hull(shapes…)` takes.
+    HullShapes,
 }
 
 /// What a limit is: its name, default, accepted values and a one-line description.
@@ -81,7 +83,7 @@ struct Spec {
 
 impl Limit {
     /// Every limit, in the order they are listed.
-    pub const ALL: [Limit; 26] = [
+    pub const ALL: [Limit; 27] = [
         Limit::Nesting,
         Limit::Fuel,
         Limit::CallDepth,
@@ -108,6 +110,7 @@ impl Limit {
         Limit::FileSize,
         Limit::Threads,
         Limit::TextChars,
+        Limit::HullShapes,
     ];
 
     fn spec(self) -> Spec {
@@ -292,6 +295,14 @@ impl Limit {
                 1 << 32,
                 "characters of the text one scene lays out (text), in all",
             ),
+            // Each point tries about 8n normals against all n balls: 64 balls are some
+            // 30 000 operations a point, and finding the planes tangent to three takes n⁴.
+            Limit::HullShapes => s(
+                "hull_shapes",
+                64,
+                4_096,
+                "balls and cylinders one hull(shapes...) takes",
+            ),
         }
     }
 
@@ -364,7 +375,7 @@ impl Spelling {
 /// (the viewer's panel), taken only where the scene accepts them.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Limits {
-    values: [u64; 26],
+    values: [u64; 27],
     spelling: Spelling,
     params: Vec<(String, String)>,
     offered: Vec<(String, String)>,

@@ -799,6 +799,14 @@ fn smooth_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Va
     Ok(acc)
 }
 
+/// `hull(shapes…)` (`hull.rs`): its node, or why there is none.
+fn hull(b: &mut Build, a: &[Value]) -> Result<Value, super::hull::Refused> {
+    let ids: Vec<NodeId> = a.iter().map(sh).collect();
+    let (limits, most) = (b.limits, b.limits.count(Limit::HullShapes));
+    let raise = |n| limits.raise_to(Limit::HullShapes, n);
+    super::hull::hull(b.graph, b.span, &ids, most, raise).map(Value::Shape)
+}
+
 fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
     b.node(Node::Combine {
         op,
@@ -1382,6 +1390,14 @@ static FUNCTIONS: &[Builtin] = &[
         name: "round",
         sigs: sigs![
             [shape("shape"), p("radius", F, Req, NonNeg)] -> S => |b, a| b.node(Node::Round { radius: a[1].num(), child: sh(&a[0]) });
+        ],
+    },
+    // The hull of balls or of parallel cylinders (`hull.rs`); of points, an entry of the table.
+    Builtin {
+        name: "hull",
+        sigs: sigs![
+            [shape("shapes")] rest + -> S => |b, a| hull(b, a).map_err(|e| e.to_string());
+            [p("shapes", LS, Req, Any)] -> S => |b, a| hull(b, &shapes(&a[0], "hull")?).map_err(|e| e.to_string());
         ],
     },
     // OpenSCAD's `minkowski` with a ball is a rounding: the distance less the radius.

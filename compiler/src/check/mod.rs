@@ -11,6 +11,7 @@ pub mod colour;
 mod eval;
 pub mod field;
 pub mod font;
+mod hull;
 mod lights;
 pub mod meshfile;
 mod ops;

@@ -10,10 +10,13 @@
 //! docs/language.md (a test prints the row the table gives), its name in the editor grammar
 //! (a test names what is missing) and a conformance line. The primitives that are also traced
 //! analytically or walked as instances (sphere, box, torus, cylinder, capsule, cone, plane)
-//! and those read from data (polygon, text, mesh) keep their own nodes.
+//! and those read from data (polygon, text, mesh) keep their own nodes. Two entries are out of
+//! the table, since no call names them: the hulls of balls and of circles that the checker
+//! builds for `hull(shapes…)` (`hull_balls.rs`).
 
 mod between;
 mod hull;
+mod hull_balls;
 mod mandelbulb;
 mod polyhedra;
 mod profiles;
@@ -24,6 +27,7 @@ use crate::program::builder::{Builder, Slots, P};
 use crate::program::Reg;
 
 pub(crate) use between::{placed, scaled, AlongY, Placed};
+pub(crate) use hull_balls::{ball_entries, Ball, BALLS as HULL_BALLS, CIRCLES as HULL_CIRCLES};
 pub(crate) use profiles::rect;
 pub(crate) use solids::{box_from_q, cylinder, extrude, nearer_signed};
 

@@ -55,6 +55,9 @@ fn the_exact_primitives_are_exact() {
         "cylinder(0.5, 1)",
         "capsule(0.5, 1)",
         "cone(0.5, 1)",
+        // The hulls of balls and of parallel cylinders (`sdfc check` says exact for them).
+        "hull(sphere(1), sphere(0.5).translate(3, 0, 0), sphere(0.2).translate(1, 2, 0))",
+        "hull(cylinder(0.5, 1), cylinder(0.3, 1).translate(2, 0, 1)).rotate_x(20deg)",
     ] {
         let d = root(p);
         assert_eq!(d.facts.exactness, Exactness::Exact, "{p}");

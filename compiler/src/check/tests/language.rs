@@ -1,5 +1,5 @@
 //! Checker tests of what users of other tools write: division, names that hide built-ins,
-//! web colours, angles, `max_dist`, `len`, recursion and hashes of lattice cells.
+//! web colours, angles, `max_dist`, `len`, recursion, hashes of lattice cells and a number broadcast over a vector.
 
 use super::{check_str, codes, ok};
 use crate::scene::Node;
@@ -526,4 +526,39 @@ fn offered_parameter_values_are_taken_where_accepted_and_passed_over_elsewhere()
         ),
         (ParamValue::Float(60.0), ParamValue::Int(3))
     );
+}
+
+#[test]
+fn a_number_broadcasts_over_a_vector_in_constants_and_fields() {
+    use crate::eval::eval_point;
+    // Constants: `1 + v / 2` is `vec3(1) + v / 2`, and `1 / v` divides per component.
+    let s = ok("let v = (2, 4, 6);\nscene { box(1 + v / 2 - 1 / (1, 2, 4)); }");
+    assert_eq!(
+        s.graph.node(s.root.expect("root")),
+        &Node::Box {
+            half: [1.0, 2.5, 3.75]
+        }
+    );
+    assert_eq!(codes("let v = 1 / (1, 0, 1);\nscene { sphere(); }"), ["E0401"]);
+    // Fields: each form with a number is the same field as with the number made a vector.
+    for (scalar, vector) in [
+        ("length(1 + p) - 1", "length(vec3(1) + p) - 1"),
+        ("length(1 - p) - 1", "length(vec3(1) - p) - 1"),
+        ("length(p.xz + 0.5) - 1", "length(p.xz + vec2(0.5, 0.5)) - 1"),
+        ("length(2 / (p + 3)) - 1", "length(vec3(2) / (p + vec3(3))) - 1"),
+    ] {
+        let a = crate::lower::lower(&ok(&format!("scene {{ field {{ {scalar} }}; }}")));
+        let b = crate::lower::lower(&ok(&format!("scene {{ field {{ {vector} }}; }}")));
+        for at in [[0.3, -0.2, 0.7], [1.5, 2.0, -0.4], [-0.9, 0.1, 0.0]] {
+            assert_eq!(eval_point::<f64>(&a, at).0, eval_point::<f64>(&b, at).0, "{scalar}");
+        }
+    }
+    // A colour field of a number and a vector (GLSL's `0.5 + 0.5 * n`).
+    assert_eq!(
+        codes("material m = phong { color: field { 0.5 + 0.5 * n } };\nlight point { position: (0, 5, 0) }\nscene { sphere(1) @ m; }"),
+        Vec::<&str>::new()
+    );
+    // Vectors of two sizes, and angles with vectors, are still refused.
+    assert_eq!(codes("let v = (1, 2) + (1, 2, 3);\nscene { sphere(); }"), ["E0301"]);
+    assert_eq!(codes("let v = 1deg + (1, 2);\nscene { sphere(); }"), ["E0301"]);
 }

@@ -228,7 +228,11 @@ mod tests {
             Ok(Value::Vec3([2.0, 4.0, 6.0]))
         );
         assert_eq!(
-            binary(BinOp::Add, &Value::Float(0.5), &Value::Vec3([1.0, 2.0, 3.0])),
+            binary(
+                BinOp::Add,
+                &Value::Float(0.5),
+                &Value::Vec3([1.0, 2.0, 3.0])
+            ),
             Ok(Value::Vec3([1.5, 2.5, 3.5]))
         );
         assert_eq!(

@@ -632,6 +632,16 @@ pub enum Pattern {
     Solid(Colour),
     /// A 3D checkerboard of two colours (or colour fields) with cubes of edge `size`.
     Checker { a: Colour, b: Colour, size: f64 },
+    /// A 3D checkerboard of two materials (`checker { a: gold, b: rubber }`), in cubes of edge
+    /// `size` laid out as [`Pattern::Checker`]'s: each cell shades as its material, blended
+    /// over a sample's footprint (docs/rendering.md, "The checker's footprint"). The two are
+    /// opaque, of one model (both Phong or both `pbr`), and neither is such a checker itself
+    /// (the checker refuses the others); the material holding this pattern has no other use.
+    Materials {
+        a: MaterialId,
+        b: MaterialId,
+        size: f64,
+    },
 }
 
 impl Pattern {
@@ -640,6 +650,8 @@ impl Pattern {
         match self {
             Pattern::Solid(c) => vec![c],
             Pattern::Checker { a, b, .. } => vec![a, b],
+            // Its cells' colours are its materials'.
+            Pattern::Materials { .. } => Vec::new(),
         }
     }
 }

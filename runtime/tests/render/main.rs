@@ -12,7 +12,8 @@
 //! - `optimise`: the optimisation passes and bounding-volume culling;
 //! - `devices`: several devices at once (`--devices`);
 //! - `animation`: the time `t`, sequences and their frames;
-//! - `colour`: colour fields of the normal, and of a painted shape moved afterwards.
+//! - `colour`: colour fields of the normal, and of a painted shape moved afterwards;
+//! - `checker_materials`: a checker of two materials, each cell shaded as its material.
 //!
 //! Filter by module: `cargo test --release --test render -- look::`.
 
@@ -23,6 +24,7 @@ mod evaluators;
 
 mod analytic;
 mod animation;
+mod checker_materials;
 mod colour;
 mod devices;
 mod distance_conformance;

@@ -556,8 +556,12 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             if solid.x < h {
                 // An opaque solid inside the glass: lit and reflecting as seen from outside,
                 // within the glass (docs/rendering.md, "Inside glass").
-                let ms = params.materials[u32(solid.y)];
                 let ns = normal_solid(p, h, ray.dir);
+//#if MATERIAL_CHECKER
+                let ms = checkered(params.materials[u32(solid.y)], p, ns, h, ray.dir, tt);
+//#else
+                let ms = params.materials[u32(solid.y)];
+//#endif
                 let ls = lobes(ms, p, ns, ray.dir, tt, h);
                 if ls.local > 0.0 {
                     medium_tau = params.materials[u32(map(p).y)].optics.y;
@@ -575,7 +579,11 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#endif
 //#if ANALYTIC
         let n = hit.normal;
+//#if MATERIAL_CHECKER
+        let m = checkered(params.materials[hit.material], p, n, h, ray.dir, tt);
+//#else
         let m = params.materials[hit.material];
+//#endif
         // Inside glass, an opaque primitive (glass overlaps no other glass in a traced scene):
         // lit and reflecting as seen from outside, within the glass (docs/rendering.md,
         // "Inside glass"); its shadow rays start inside the glass, whose transparency
@@ -584,7 +592,11 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#else
         let n = normal(p, h, ray.dir);
 //#if MATERIALS
+//#if MATERIAL_CHECKER
+        let m = checkered(params.materials[u32(map(p).y)], p, n, h, ray.dir, tt);
+//#else
         let m = params.materials[u32(map(p).y)];
+//#endif
 //#else
         let m = params.materials[0];
 //#endif

@@ -149,8 +149,18 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
         ("SOFT", soft),
         (
             "CHECKER",
+            mats.iter().any(|m| {
+                matches!(
+                    m.pattern,
+                    Pattern::Checker { .. } | Pattern::Materials { .. }
+                )
+            }),
+        ),
+        // A checker of two materials resolves a hit's material (`checkered`).
+        (
+            "MATERIAL_CHECKER",
             mats.iter()
-                .any(|m| matches!(m.pattern, Pattern::Checker { .. })),
+                .any(|m| matches!(m.pattern, Pattern::Materials { .. })),
         ),
         // Shadow rays pass through transparent solids even when no refracted ray is traced
         // (`max_depth: 0`), as on the CPU; the path tracer's are stopped by every surface.

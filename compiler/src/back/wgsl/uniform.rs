@@ -148,6 +148,15 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             Pattern::Checker { a, b, size } => {
                 (v(a), v(b), 1.0, 1.0 / size, scene.checker_shift(*size))
             }
+            // A checker of two materials: their ids in `color`, whose w is 2
+            // (`checkered` in shading.wgsl).
+            Pattern::Materials { a, b, size } => (
+                [a.0 as f64, b.0 as f64, 0.0],
+                [0.0; 3],
+                2.0,
+                1.0 / size,
+                scene.checker_shift(*size),
+            ),
         };
         // The colour fields' numbers, plus 1 (0: none).
         let field = |slot: usize| {

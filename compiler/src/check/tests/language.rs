@@ -1,5 +1,5 @@
 //! Checker tests of what users of other tools write: division, names that hide built-ins,
-//! web colours, angles, `max_dist`, `len`, recursion, hashes of lattice cells and a number broadcast over a vector.
+//! web colours, angles, `max_dist`, `len`, recursion, hashes of lattice cells a number broadcast over a vector and a checker of two materials.
 
 use super::{check_str, codes, ok};
 use crate::scene::Node;
@@ -539,18 +539,31 @@ fn a_number_broadcasts_over_a_vector_in_constants_and_fields() {
             half: [1.0, 2.5, 3.75]
         }
     );
-    assert_eq!(codes("let v = 1 / (1, 0, 1);\nscene { sphere(); }"), ["E0401"]);
+    assert_eq!(
+        codes("let v = 1 / (1, 0, 1);\nscene { sphere(); }"),
+        ["E0401"]
+    );
     // Fields: each form with a number is the same field as with the number made a vector.
     for (scalar, vector) in [
         ("length(1 + p) - 1", "length(vec3(1) + p) - 1"),
         ("length(1 - p) - 1", "length(vec3(1) - p) - 1"),
-        ("length(p.xz + 0.5) - 1", "length(p.xz + vec2(0.5, 0.5)) - 1"),
-        ("length(2 / (p + 3)) - 1", "length(vec3(2) / (p + vec3(3))) - 1"),
+        (
+            "length(p.xz + 0.5) - 1",
+            "length(p.xz + vec2(0.5, 0.5)) - 1",
+        ),
+        (
+            "length(2 / (p + 3)) - 1",
+            "length(vec3(2) / (p + vec3(3))) - 1",
+        ),
     ] {
         let a = crate::lower::lower(&ok(&format!("scene {{ field {{ {scalar} }}; }}")));
         let b = crate::lower::lower(&ok(&format!("scene {{ field {{ {vector} }}; }}")));
         for at in [[0.3, -0.2, 0.7], [1.5, 2.0, -0.4], [-0.9, 0.1, 0.0]] {
-            assert_eq!(eval_point::<f64>(&a, at).0, eval_point::<f64>(&b, at).0, "{scalar}");
+            assert_eq!(
+                eval_point::<f64>(&a, at).0,
+                eval_point::<f64>(&b, at).0,
+                "{scalar}"
+            );
         }
     }
     // A colour field of a number and a vector (GLSL's `0.5 + 0.5 * n`).
@@ -559,6 +572,82 @@ fn a_number_broadcasts_over_a_vector_in_constants_and_fields() {
         Vec::<&str>::new()
     );
     // Vectors of two sizes, and angles with vectors, are still refused.
-    assert_eq!(codes("let v = (1, 2) + (1, 2, 3);\nscene { sphere(); }"), ["E0301"]);
-    assert_eq!(codes("let v = 1deg + (1, 2);\nscene { sphere(); }"), ["E0301"]);
+    assert_eq!(
+        codes("let v = (1, 2) + (1, 2, 3);\nscene { sphere(); }"),
+        ["E0301"]
+    );
+    assert_eq!(
+        codes("let v = 1deg + (1, 2);\nscene { sphere(); }"),
+        ["E0301"]
+    );
+}
+
+#[test]
+fn a_checker_pairs_two_materials_of_one_model() {
+    use crate::scene::{MaterialId, Pattern};
+    let head = "material gold = pbr { base_color: (1, 0.8, 0.3), metallic: 1 };\n\
+                material rubber = pbr { base_color: (0.1, 0.1, 0.1), roughness: 0.9 };\n\
+                material glass = pbr { transmission: 1 };\n\
+                material plastic = phong { color: (1, 0, 0) };\n\
+                light point { position: (0, 5, 0) }\n";
+    let scene = |m: &str| format!("{head}{m}\nscene {{ plane() @ tiles; }}");
+    // Both materials, the second declared below the checker.
+    let s = ok(&format!(
+        "material tiles = checker {{ a: gold, b: later, size: 0.5 }};\n{}\nmaterial later = pbr {{ roughness: 0.3 }};",
+        scene("")
+    ));
+    let tiles = s
+        .materials
+        .iter()
+        .find(|m| m.name == "tiles")
+        .expect("tiles");
+    let id = |name: &str| s.materials.iter().position(|m| m.name == name).expect(name);
+    let (gold, later) = (id("gold"), id("later"));
+    assert_eq!(
+        tiles.pattern,
+        Pattern::Materials {
+            a: MaterialId(gold as u32),
+            b: MaterialId(later as u32),
+            size: 0.5
+        }
+    );
+    // A material and a colour, a transparent material, two models, a checker within a
+    // checker (itself), and a property of its own are refused where they are written.
+    for (tiles, code, at) in [
+        ("checker { a: gold, b: (1, 0, 0) }", "E0300", "(1, 0, 0)"),
+        ("checker { a: (1, 0, 0), b: gold }", "E0300", "(1, 0, 0)"),
+        ("checker { a: gold }", "E0300", "checker"),
+        ("checker { a: gold, b: glass }", "E0400", "glass"),
+        ("checker { a: gold, b: plastic }", "E0400", "plastic"),
+        ("checker { a: tiles, b: gold }", "E0400", "tiles"),
+        (
+            "checker { a: gold, b: rubber, specular: 0.5 }",
+            "E0400",
+            "specular",
+        ),
+    ] {
+        let text = scene(&format!("material tiles = {tiles};"));
+        let (_, diags, _) = check_str("t.sdf", &text);
+        let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
+        assert_eq!(errors.len(), 1, "{tiles}: {errors:#?}");
+        assert_eq!(errors[0].code, code, "{tiles}");
+        let span = errors[0].labels[0].span;
+        let line = text.lines().nth(5).expect("the checker's line");
+        let offset = text.find(line).expect("line");
+        assert_eq!(
+            &text[span.start as usize..span.end as usize],
+            at,
+            "{tiles}: {} at {}",
+            errors[0].message,
+            span.start as usize - offset
+        );
+    }
+    // A constant of a material's name is the constant: a checker of colours.
+    let s = ok("let gold = (1, 0.8, 0.3);\nmaterial gold = phong {};\nmaterial tiles = checker { a: gold, b: (0, 0, 0) };\nlight point { position: (0, 5, 0) }\nscene { plane() @ tiles; }");
+    let tiles = s
+        .materials
+        .iter()
+        .find(|m| m.name == "tiles")
+        .expect("tiles");
+    assert!(matches!(tiles.pattern, Pattern::Checker { .. }));
 }

@@ -623,6 +623,8 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 fog: f["fog"].num(),
                 // Left out, the fog takes the background's colour.
                 fog_color: field_span(&b.fields, "fog_color").map(|_| f["fog_color"].v3()),
+                glow: f["glow"].num(),
+                glow_color: f["glow_color"].v3(),
                 exposure: f["exposure"].num(),
                 tonemap: match &f["tonemap"] {
                     Value::Str(s) => Tonemap::from_name(s).unwrap_or_default(),
@@ -635,6 +637,17 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
             };
             if let Value::Str(name) = &f["method"] {
                 scene.settings.set_method(name);
+            }
+            if let (true, Some(at)) = (
+                scene.settings.path && scene.settings.glow > 0.0,
+                field_span(&b.fields, "glow"),
+            ) {
+                cx.error(
+                    Diagnostic::error("E0400", "the path tracer has no glow of marching steps", at)
+                        .with_label("a glow is asked for here")
+                        .with_note("`glow` adds light along a camera ray's march, which `method: \"path\"` does not take")
+                        .with_help("leave `glow` out, or use `method: \"auto\"`"),
+                );
             }
             if let (Value::Float(fps), Value::Float(duration)) = (&f["fps"], &f["duration"]) {
                 scene.animation.fps = *fps;

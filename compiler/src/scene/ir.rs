@@ -933,6 +933,11 @@ pub struct Settings {
     pub fog: f64,
     /// The fog's colour; `None`: the background.
     pub fog_color: Option<V3>,
+    /// The distance G of the glow of a camera ray's marching steps: each evaluation of its
+    /// march adds `glow_color·e^(−d/G)` (0: none; docs/rendering.md, "The look").
+    pub glow: f64,
+    /// The colour each marching step of a camera ray adds at a distance 0 from a surface.
+    pub glow_color: V3,
     /// Exposure in stops: the pixel's colour is multiplied by 2^exposure.
     pub exposure: f64,
     /// The tone curve after the exposure.
@@ -988,6 +993,12 @@ impl Method {
 }
 
 impl Settings {
+    /// Whether camera rays glow with their marching steps (`glow` > 0, not path traced:
+    /// docs/rendering.md, "The look").
+    pub fn glows(&self) -> bool {
+        self.glow > 0.0 && !self.path
+    }
+
     /// The ε of the hit test for a camera of field of view `fov` (radians): `epsilon`, or
     /// where `footprint`, the angular radius of one pixel, tan(fov/2)/height: the surface as a
     /// cone one pixel wide sees it.
@@ -1021,6 +1032,8 @@ impl Settings {
         occlusion: 0.0,
         fog: 0.0,
         fog_color: None,
+        glow: 0.0,
+        glow_color: [0.02, 0.02, 0.02],
         exposure: 0.0,
         tonemap: super::Tonemap::None,
         path: false,

@@ -169,6 +169,10 @@ pub(super) struct Context<T: Float> {
     pub occlusion: T,
     /// 1/D for fog over a distance D (0: none).
     pub inv_fog: T,
+    /// 1/G for a glow of the camera rays' marching steps over a distance G (0: none).
+    pub inv_glow: T,
+    /// The glow's colour.
+    pub glow: V3<T>,
     /// The fog's colour, where `fog_color` is given (else the background seen along the ray:
     /// [`Context::fog_colour`]).
     pub fog: Option<V3<T>>,
@@ -245,6 +249,8 @@ impl<T: Float> Context<T> {
             colours: colours.to_vec(),
             occlusion: T::from_f64(s.occlusion),
             inv_fog: T::from_f64(if s.fog > 0.0 { 1.0 / s.fog } else { 0.0 }),
+            inv_glow: T::from_f64(if s.glows() { 1.0 / s.glow } else { 0.0 }),
+            glow: V3::from_f64(s.glow_color),
             fog: s.fog_color.map(V3::from_f64),
             graded: s.exposure != 0.0 || s.tonemap != Tonemap::None,
             exposure: T::from_f64(s.exposure.exp2()),

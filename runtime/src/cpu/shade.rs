@@ -86,6 +86,11 @@ pub(super) fn surfaces<T: Float>(
     for (i, (ray, tr)) in wave.iter().zip(&ws.traced).enumerate() {
         samples.steps[ray.sample as usize] += tr.steps;
         counters.steps += tr.steps as u64;
+        // A camera ray glows with its marching steps: glow_color·Σ e^(−|dᵢ|/G).
+        if ray.depth == 0 && ctx.inv_glow > T::zero() {
+            let a = &mut samples.acc[ray.sample as usize];
+            *a = *a + (ray.weight * tr.glow).mul_v(ctx.glow);
+        }
         match tr.status {
             Status::Hit => {
                 counters.hits += 1;
@@ -214,6 +219,7 @@ fn trace<T: Float>(
                         t: s.t,
                         status: Status::Hit,
                         steps: 0,
+                        glow: T::zero(),
                     },
                     (s.normal, s.material),
                 ),
@@ -222,6 +228,7 @@ fn trace<T: Float>(
                         t: ctx.max_dist,
                         status: Status::Miss,
                         steps: 0,
+                        glow: T::zero(),
                     },
                     (V3::zero(), 0),
                 ),

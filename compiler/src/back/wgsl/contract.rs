@@ -46,6 +46,9 @@ impl Specialisation {
             occlusion: _,
             fog: _,
             fog_color: _,
+            // Read at every render (`glow`); whether it is on is a feature (`GLOW`).
+            glow: _,
+            glow_color: _,
             exposure: _,
             tonemap: _,
             // Its samples, bounces and first sample are read at every render (`depth.y`,

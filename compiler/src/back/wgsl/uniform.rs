@@ -66,6 +66,10 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
         "depth",
         &[s.max_depth, s.samples.max(1), s.bounces, s.first_sample],
     )?;
+    // The kernels of the feature GLOW have it: the glow's colour, 1/G.
+    if s.glows() {
+        w.floats("glow", &v4(s.glow_color, 1.0 / s.glow))?;
+    }
     let (mut points, mut dirs, mut skies) = (0, 0, 0);
     // Whether a sky is the background (`background.w`): rays that hit nothing show the skies
     // that are.

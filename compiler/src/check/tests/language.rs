@@ -651,3 +651,20 @@ fn a_checker_pairs_two_materials_of_one_model() {
         .expect("tiles");
     assert!(matches!(tiles.pattern, Pattern::Checker { .. }));
 }
+
+#[test]
+fn a_glow_of_marching_steps_is_marched_and_not_path_traced() {
+    use crate::scene::analytic::{choose, Choice, Reason};
+    let scene = |render: &str| format!("render {{ {render} }}\nscene {{ sphere(1); }}");
+    // A sphere alone is traced analytically; with a glow it is marched, and says why.
+    assert!(matches!(choose(&ok(&scene("width: 64"))), Choice::Trace(_)));
+    let s = ok(&scene("glow: 0.1, glow_color: (0.1, 0.2, 0.3)"));
+    assert_eq!(
+        (s.settings.glow, s.settings.glow_color),
+        (0.1, [0.1, 0.2, 0.3])
+    );
+    assert!(matches!(choose(&s), Choice::March(Reason::Glow)));
+    assert_eq!(codes(&scene("glow: 0.1, method: \"trace\"")), ["E0405"]);
+    assert_eq!(codes(&scene("glow: 0.1, method: \"path\"")), ["E0400"]);
+    assert_eq!(codes(&scene("glow: -1")), ["E0400"]);
+}

@@ -208,7 +208,8 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
             )?
         }
         "tonemap" => {
-            s.tonemap = Tonemap::from_name(value).ok_or_else(|| Error::Tonemap(value.into()))?
+            s.tonemap = Tonemap::from_name(value).ok_or_else(|| Error::Tonemap(value.into()))?;
+            s.tonemap_why = None;
         }
         "method" => {
             if !s.set_method(value) {

@@ -361,6 +361,15 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     materials::declare_materials(cx, &mut scene, items);
     let scene_item = evaluate_items(cx, &mut scene, items);
     materials::check_pairs(cx, &scene, items);
+    // Where `tonemap` is not given, a scene of the newer look is graded by the filmic curve.
+    if !cx.settings_given.iter().any(|(name, _)| name == "tonemap") {
+        use crate::scene::look::{newer_look, OLDER_LOOK};
+        let newer = newer_look(&scene);
+        if newer.is_some() {
+            scene.settings.tonemap = Tonemap::Filmic;
+        }
+        scene.settings.tonemap_why = Some(newer.unwrap_or(OLDER_LOOK));
+    }
     params::unknown(cx, items, entry);
     check_uncalled_functions(cx);
     scene.root = scene_objects(cx, scene_item, entry);
@@ -630,6 +639,7 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                     Value::Str(s) => Tonemap::from_name(s).unwrap_or_default(),
                     _ => Tonemap::None,
                 },
+                tonemap_why: None,
                 path: false,
                 samples: int("samples"),
                 bounces: int("bounces"),

@@ -942,6 +942,10 @@ pub struct Settings {
     pub exposure: f64,
     /// The tone curve after the exposure.
     pub tonemap: super::Tonemap,
+    /// Where `tonemap` was not given, why the tone curve is the default it is: what of the
+    /// newer look the scene uses (`filmic`), or [`super::look::OLDER_LOOK`] (`none`;
+    /// [`super::look::newer_look`]); `None` where it was given.
+    pub tonemap_why: Option<&'static str>,
     /// Whether pictures are path traced (`method: "path"`; docs/rendering.md, "Path
     /// tracing"): `samples` paths a pixel of up to `bounces` bounces, intersected as
     /// `method` says (`auto` for `method: "path"`).
@@ -1036,6 +1040,7 @@ impl Settings {
         glow_color: [0.02, 0.02, 0.02],
         exposure: 0.0,
         tonemap: super::Tonemap::None,
+        tonemap_why: None,
         path: false,
         samples: 16,
         bounces: 4,

@@ -51,6 +51,7 @@ impl Specialisation {
             glow_color: _,
             exposure: _,
             tonemap: _,
+            tonemap_why: _,
             // Its samples, bounces and first sample are read at every render (`depth.y`,
             // `depth.z`, `depth.w`);
             // whether it path traces is specialised (the feature `PATH`).
@@ -105,7 +106,7 @@ pub struct Contract {
 
 /// The features that follow from the scene and its settings alone (the first ones of
 /// [`Contract::features`]): those a render checks.
-pub(super) const SCENE_FEATURES: usize = 17;
+pub(super) const SCENE_FEATURES: usize = 19;
 
 /// A scene that a kernel cannot render, or a uniform that does not fit its layout: what
 /// differs, in words.

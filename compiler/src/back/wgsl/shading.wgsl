@@ -75,8 +75,8 @@ fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32, d: vec3<f32>,
 //#endif
     return ca;
 }
-
 //#if MATERIAL_CHECKER
+
 // A hit on a checker of two materials (color.w = 2, their ids in color.xy) takes the material
 // of the cell its sample sees, or, where the footprint covers both (0 < wb < 1), their blend:
 // every number x·(1 − wb) + y·wb, the colour their colours' blend (runtime/src/cpu/shade.rs,

@@ -668,3 +668,39 @@ fn a_glow_of_marching_steps_is_marched_and_not_path_traced() {
     assert_eq!(codes(&scene("glow: 0.1, method: \"path\"")), ["E0400"]);
     assert_eq!(codes(&scene("glow: -1")), ["E0400"]);
 }
+
+#[test]
+fn a_scene_of_the_newer_look_is_filmic_unless_it_says_otherwise() {
+    use crate::scene::{look, Tonemap};
+    let pbr = "material m = pbr { roughness: 0.4 };\nscene { sphere(1) @ m; }";
+    let s = ok(pbr);
+    assert_eq!(s.settings.tonemap, Tonemap::Filmic);
+    assert_eq!(s.settings.tonemap_why, Some("it has a `pbr` material"));
+    for (text, why) in [
+        (
+            "light sky { }\nscene { sphere(1); }",
+            "it is lit by a `light sky`",
+        ),
+        (
+            "render { method: \"path\" }\nscene { sphere(1); }",
+            "it is path traced (`method: \"path\"`)",
+        ),
+    ] {
+        let s = ok(text);
+        assert_eq!(
+            (s.settings.tonemap, s.settings.tonemap_why),
+            (Tonemap::Filmic, Some(why))
+        );
+    }
+    // A scene of the older look keeps `none`; a given curve is kept, and says so.
+    let s = ok("light point { position: (0, 5, 0) }\nscene { sphere(1); }");
+    assert_eq!(
+        (s.settings.tonemap, s.settings.tonemap_why),
+        (Tonemap::None, Some(look::OLDER_LOOK))
+    );
+    let s = ok(&format!("render {{ tonemap: \"none\" }}\n{pbr}"));
+    assert_eq!(
+        (s.settings.tonemap, s.settings.tonemap_why),
+        (Tonemap::None, None)
+    );
+}

@@ -405,6 +405,20 @@ pub fn method(loaded: &Loaded, scene: &Scene, traceable: &Traceable) -> String {
     }
 }
 
+/// The tone curve the pixels are graded by and why: `tone curve: filmic (the default where
+/// it has a `pbr` material; ...)`, `tone curve: none (the default where it has no ...)` or
+/// `tone curve: reinhard (set by `tonemap`)`.
+pub fn tone_curve(scene: &Scene) -> String {
+    let name = scene.settings.tonemap.name();
+    match scene.settings.tonemap_why {
+        Some(why) if scene.settings.tonemap != sdfc_compiler::Tonemap::None => format!(
+            "tone curve: {name} (the default where {why}; `tonemap: \"none\"` keeps the linear light)"
+        ),
+        Some(why) => format!("tone curve: {name} (the default where {why})"),
+        None => format!("tone curve: {name} (set by `tonemap`)"),
+    }
+}
+
 /// `FILE:LINE:COL` of a span.
 fn at(loaded: &Loaded, span: Span) -> String {
     let (line, col) = loaded.sources.line_col(span);

@@ -48,6 +48,9 @@ pub enum Error {
     /// A `fog_color` that is not a colour.
     #[error("fog_color must be three numbers r,g,b from 0 to 1, like 0.6,0.65,0.7, not `{0}`")]
     FogColour(String),
+    /// A `glow_color` that is not a colour.
+    #[error("glow_color must be three numbers r,g,b from 0 to 1, like 0.02,0.03,0.05, not `{0}`")]
+    GlowColour(String),
     /// A `tonemap` that is not one.
     #[error("tonemap must be one of {names}, not `{0}`", names = Tonemap::NAMES.join(", "))]
     Tonemap(String),
@@ -106,6 +109,8 @@ pub const SETTING_KEYS: &[&str] = &[
     "occlusion",
     "fog",
     "fog_color",
+    "glow",
+    "glow_color",
     "exposure",
     "tonemap",
     "samples",
@@ -121,6 +126,7 @@ pub fn set_help() -> String {
             "background" => "background (as r,g,b)".to_string(),
             "method" => format!("method ({})", Settings::METHODS.join(", ")),
             "fog_color" => "fog_color (as r,g,b)".to_string(),
+            "glow_color" => "glow_color (as r,g,b)".to_string(),
             "tonemap" => format!("tonemap ({})", Tonemap::NAMES.join(", ")),
             key => key.to_string(),
         })
@@ -182,6 +188,17 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
         "fog_color" => {
             s.fog_color = Some(colour(value).ok_or_else(|| Error::FogColour(value.into()))?)
         }
+        "glow" => {
+            s.glow = real(
+                key,
+                value,
+                |v| (0.0..=1e9).contains(&v),
+                "a distance from 0 (none) to 1e9",
+            )?
+        }
+        "glow_color" => {
+            s.glow_color = colour(value).ok_or_else(|| Error::GlowColour(value.into()))?
+        }
         "exposure" => {
             s.exposure = real(
                 key,
@@ -191,7 +208,8 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
             )?
         }
         "tonemap" => {
-            s.tonemap = Tonemap::from_name(value).ok_or_else(|| Error::Tonemap(value.into()))?
+            s.tonemap = Tonemap::from_name(value).ok_or_else(|| Error::Tonemap(value.into()))?;
+            s.tonemap_why = None;
         }
         "method" => {
             if !s.set_method(value) {
@@ -267,7 +285,7 @@ mod tests {
         for key in SETTING_KEYS {
             assert!(help.contains(key), "{key} is missing from `{help}`");
             let value = match *key {
-                "background" | "fog_color" => "0.1,0.2,0.3",
+                "background" | "fog_color" | "glow_color" => "0.1,0.2,0.3",
                 "tonemap" => "filmic",
                 "method" => "march",
                 "epsilon" => "0.001",

@@ -2001,6 +2001,8 @@ pub static RENDER: Record = Record {
         p("occlusion", F, Num(DEFAULT.occlusion), Within(0.0, 1e9)),
         p("fog", F, Num(DEFAULT.fog), Within(0.0, 1e9)),
         p("fog_color", V, V3(DEFAULT.background), NonNeg),
+        p("glow", F, Num(DEFAULT.glow), Within(0.0, 1e9)),
+        p("glow_color", V, V3(DEFAULT.glow_color), NonNeg),
         p("exposure", F, Num(DEFAULT.exposure), Within(-20.0, 20.0)),
         p(
             "tonemap",

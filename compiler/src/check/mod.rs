@@ -13,6 +13,7 @@ pub mod field;
 pub mod font;
 mod hull;
 mod lights;
+mod materials;
 pub mod meshfile;
 mod ops;
 mod params;
@@ -24,10 +25,7 @@ use crate::diagnostics::Diagnostic;
 // The loader is the file system's interface (`files`); the checker reads through it.
 pub use crate::files::{LoadError, Loader, NoImports};
 use crate::limits::{Limit, Limits};
-use crate::scene::{
-    Camera, Colour, Combine, Material, MaterialId, Method, Node, Pattern, Pbr, Scene, Settings,
-    Tonemap,
-};
+use crate::scene::{Camera, Combine, Material, Method, Node, Scene, Settings, Tonemap};
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::{self, ast};
 use eval::{Ctx, FnInfo};
@@ -361,8 +359,18 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
         materials: vec![Material::default_material()],
         ..Scene::default()
     };
-    declare_materials(cx, &mut scene, items);
+    materials::declare_materials(cx, &mut scene, items);
     let scene_item = evaluate_items(cx, &mut scene, items);
+    materials::check_pairs(cx, &scene, items);
+    // Where `tonemap` is not given, a scene of the newer look is graded by the filmic curve.
+    if !cx.settings_given.iter().any(|(name, _)| name == "tonemap") {
+        use crate::scene::look::{newer_look, OLDER_LOOK};
+        let newer = newer_look(&scene);
+        if newer.is_some() {
+            scene.settings.tonemap = Tonemap::Filmic;
+        }
+        scene.settings.tonemap_why = Some(newer.unwrap_or(OLDER_LOOK));
+    }
     params::unknown(cx, items, entry);
     check_uncalled_functions(cx);
     scene.root = scene_objects(cx, scene_item, entry);
@@ -432,7 +440,7 @@ fn evaluate_items<'a>(
             }
             ast::Item::Material {
                 name, kind, fields, ..
-            } => material(cx, scene, name, kind, fields),
+            } => materials::material(cx, scene, name, kind, fields),
             ast::Item::Block(b) => {
                 if first_block(cx, &mut seen_blocks, b) {
                     block(cx, scene, b);
@@ -579,139 +587,6 @@ fn collect_functions(cx: &mut Ctx, items: &[ast::Item]) {
     }
 }
 
-fn material(
-    cx: &mut Ctx,
-    scene: &mut Scene,
-    name: &ast::Ident,
-    kind: &ast::Ident,
-    fields: &[ast::Field],
-) {
-    let rec = builtins::MATERIALS.iter().find(|r| r.name == kind.name);
-    let Some(&(id, first)) = cx.material_ids.get(&name.name) else {
-        return;
-    };
-    if first != name.span {
-        // A second definition, reported by `declare_materials`.
-        return;
-    }
-    let Some(rec) = rec else {
-        let mut d = Diagnostic::error(
-            "E0211",
-            format!("unknown material kind `{}`", kind.name),
-            kind.span,
-        )
-        .with_label("not a material kind")
-        .with_note("the material kinds are phong, checker and pbr");
-        if let Some(s) = suggest::closest(&kind.name, builtins::MATERIALS.iter().map(|r| r.name)) {
-            d = d.with_help(format!("did you mean `{s}`?"));
-        }
-        cx.error(d);
-        return;
-    };
-    let f = eval::record(cx, rec, fields, kind);
-    // A colour field's value, or the constant's.
-    let colour = |v: &Value| match v {
-        Value::Colour(field) => Colour::Field((**field).clone()),
-        other => Colour::Const(other.v3()),
-    };
-    if rec.name == "pbr" {
-        scene.materials[id.0 as usize] = pbr_material(&name.name, &f, colour(&f["base_color"]));
-        return;
-    }
-    let (reflect, transparency) = (f["reflect"].num(), f["transparency"].num());
-    if reflect + transparency > 1.0 + 1e-12 {
-        cx.error(
-            Diagnostic::error(
-                "E0506",
-                "`reflect` and `transparency` add up to more than 1",
-                name.span,
-            )
-            .with_label(format!(
-                "{reflect} + {transparency} = {}",
-                reflect + transparency
-            ))
-            .with_note("the surface's own colour is weighted by 1 − reflect − transparency"),
-        );
-    }
-    let pattern = if rec.name == "checker" {
-        Pattern::Checker {
-            a: colour(&f["a"]),
-            b: colour(&f["b"]),
-            size: f["size"].num(),
-        }
-    } else {
-        Pattern::Solid(colour(&f["color"]))
-    };
-    scene.materials[id.0 as usize] = Material {
-        name: name.name.clone(),
-        pattern,
-        ambient: f["ambient"].num(),
-        diffuse: f["diffuse"].num(),
-        specular: f["specular"].num(),
-        shininess: f["shininess"].num(),
-        reflect,
-        transparency,
-        ior: f["ior"].num(),
-        fresnel: matches!(f["fresnel"], Value::Bool(true)),
-        pbr: None,
-        frame: Vec::new(),
-    };
-}
-
-/// A `pbr` material of base colour `base` from its record's values: its transmission is the
-/// transparency of its dielectric part, `transmission·(1 − metallic)`, and its Phong fields
-/// the nearest Phong material's (no ambient term, the diffuse weight of the dielectric part,
-/// the reflectance at normal incidence as `specular`, the exponent of the same highlight
-/// width), which the material tables of `--part map` and the Shadertoy page show.
-fn pbr_material(name: &str, f: &HashMap<&'static str, Value>, base: Colour) -> Material {
-    let p = Pbr {
-        roughness: f["roughness"].num(),
-        metallic: f["metallic"].num(),
-        emission: f["emission"].v3(),
-        transmission: f["transmission"].num(),
-    };
-    let ior = f["ior"].num();
-    let transparency = p.transmission * (1.0 - p.metallic);
-    let grey = base
-        .constant()
-        .map_or(Material::COLOR[0], |c| (c[0] + c[1] + c[2]) / 3.0);
-    Material {
-        name: name.to_string(),
-        pattern: Pattern::Solid(base),
-        ambient: 0.0,
-        diffuse: 1.0 - p.metallic - transparency,
-        specular: crate::scene::pbr::f0(ior) * (1.0 - p.metallic) + grey * p.metallic,
-        shininess: p.shininess(),
-        reflect: 0.0,
-        transparency,
-        ior,
-        fresnel: true,
-        pbr: Some(p),
-        frame: Vec::new(),
-    }
-}
-
-/// Gives every material its id before any item is evaluated, so that `@ name` finds a
-/// material declared anywhere in the program, above or below its use; a second definition
-/// of a name is E0207. Each material's fields are evaluated later, in source order.
-fn declare_materials(cx: &mut Ctx, scene: &mut Scene, items: &[ast::Item]) {
-    for item in items {
-        let ast::Item::Material { name, .. } = item else {
-            continue;
-        };
-        if let Some(&(_, first)) = cx.material_ids.get(&name.name) {
-            dup(cx, "the material", name, first);
-            continue;
-        }
-        let id = MaterialId(scene.materials.len() as u32);
-        scene.materials.push(Material {
-            name: name.name.clone(),
-            ..Material::default_material()
-        });
-        cx.material_ids.insert(name.name.clone(), (id, name.span));
-    }
-}
-
 fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
     match (b.keyword.name.as_str(), &b.kind) {
         ("camera", _) => {
@@ -758,11 +633,14 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
                 fog: f["fog"].num(),
                 // Left out, the fog takes the background's colour.
                 fog_color: field_span(&b.fields, "fog_color").map(|_| f["fog_color"].v3()),
+                glow: f["glow"].num(),
+                glow_color: f["glow_color"].v3(),
                 exposure: f["exposure"].num(),
                 tonemap: match &f["tonemap"] {
                     Value::Str(s) => Tonemap::from_name(s).unwrap_or_default(),
                     _ => Tonemap::None,
                 },
+                tonemap_why: None,
                 path: false,
                 samples: int("samples"),
                 bounces: int("bounces"),
@@ -770,6 +648,17 @@ fn block(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block) {
             };
             if let Value::Str(name) = &f["method"] {
                 scene.settings.set_method(name);
+            }
+            if let (true, Some(at)) = (
+                scene.settings.path && scene.settings.glow > 0.0,
+                field_span(&b.fields, "glow"),
+            ) {
+                cx.error(
+                    Diagnostic::error("E0400", "the path tracer has no glow of marching steps", at)
+                        .with_label("a glow is asked for here")
+                        .with_note("`glow` adds light along a camera ray's march, which `method: \"path\"` does not take")
+                        .with_help("leave `glow` out, or use `method: \"auto\"`"),
+                );
             }
             if let (Value::Float(fps), Value::Float(duration)) = (&f["fps"], &f["duration"]) {
                 scene.animation.fps = *fps;

@@ -61,10 +61,13 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
         Add if a.elem().is_some() && b.elem().is_some() => {
             [b, a].into_iter().find(|w| a.fits(*w) && b.fits(*w))
         }
+        // A number broadcasts over a vector's components (either order), as in GLSL:
+        // `0.5 + 0.5 * n` is `vec3(0.5) + 0.5 * n`.
         Add | Sub => match (a, b) {
             (Int, Int) => Some(Int),
             _ if num(a) && num(b) => Some(Float),
             (Angle, Angle) => Some(Angle),
+            (v, x) | (x, v) if vec(v) && num(x) => Some(v),
             _ if vec(a) && a == b => Some(a),
             _ => None,
         },
@@ -81,7 +84,7 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
             _ if num(a) && num(b) => Some(Float),
             (Angle, x) if num(x) => Some(Angle),
             (Angle, Angle) => Some(Float),
-            (v, x) if vec(v) && num(x) => Some(v),
+            (v, x) | (x, v) if vec(v) && num(x) => Some(v),
             _ if vec(a) && a == b => Some(a),
             _ => None,
         },
@@ -224,6 +227,34 @@ mod tests {
             ),
             Ok(Value::Vec3([2.0, 4.0, 6.0]))
         );
+        assert_eq!(
+            binary(
+                BinOp::Add,
+                &Value::Float(0.5),
+                &Value::Vec3([1.0, 2.0, 3.0])
+            ),
+            Ok(Value::Vec3([1.5, 2.5, 3.5]))
+        );
+        assert_eq!(
+            binary(BinOp::Sub, &Value::Vec2([1.0, 2.0]), &Value::Int(1)),
+            Ok(Value::Vec2([0.0, 1.0]))
+        );
+        assert_eq!(
+            binary(BinOp::Sub, &Value::Int(1), &Value::Vec2([1.0, 2.0])),
+            Ok(Value::Vec2([0.0, -1.0]))
+        );
+        assert_eq!(
+            binary(BinOp::Div, &Value::Int(1), &Value::Vec3([1.0, 2.0, 4.0])),
+            Ok(Value::Vec3([1.0, 0.5, 0.25]))
+        );
+        assert_eq!(
+            binary(BinOp::Div, &Value::Int(1), &Value::Vec3([1.0, 0.0, 4.0])),
+            Err(OpError::DivZero)
+        );
+        assert!(matches!(
+            binary(BinOp::Add, &Value::Angle(1.0), &Value::Vec2([1.0, 2.0])),
+            Err(OpError::Types(_))
+        ));
         assert_eq!(
             binary(BinOp::Mul, &Value::Angle(1.0), &Value::Int(2)),
             Ok(Value::Angle(2.0))

@@ -59,6 +59,8 @@ pub enum Reason {
     SoftLight { index: usize },
     /// The render asks for ambient occlusion, which samples the distance field.
     Occlusion,
+    /// The render asks for a glow of the marching steps, which it needs.
+    Glow,
     /// Too many primitives for `auto` to trace them from one GPU buffer: more than `limit`,
     /// the `traced` limit.
     Many { count: usize, limit: usize },
@@ -84,6 +86,9 @@ impl Reason {
             }
             Reason::Occlusion => {
                 "the render asks for ambient `occlusion`, which samples a distance field".into()
+            }
+            Reason::Glow => {
+                "the render asks for a `glow` of the marching steps, which a march takes".into()
             }
             Reason::Overlap { .. } => {
                 "a transparent primitive overlaps or touches another transparent one, so rays inside them would need the boundary of their union".into()
@@ -188,6 +193,13 @@ pub fn traceable(scene: &Scene) -> Traceable {
     if scene.settings.occlusion > 0.0 {
         return Traceable {
             primitives: Err(Reason::Occlusion),
+            overlap: None,
+            limit,
+        };
+    }
+    if scene.settings.glow > 0.0 {
+        return Traceable {
+            primitives: Err(Reason::Glow),
             overlap: None,
             limit,
         };

@@ -134,6 +134,15 @@ pub fn dump(scene: &Scene) -> String {
                     num(*size)
                 )
             }
+            Pattern::Materials { a, b, size } => {
+                let name = |m: &MaterialId| {
+                    scene
+                        .materials
+                        .get(m.0 as usize)
+                        .map_or("?", |m| m.name.as_str())
+                };
+                format!("checker a={} b={} size={}", name(a), name(b), num(*size))
+            }
         };
         // A `pbr` material's own parameters, and Phong's Fresnel, only where they are given.
         let extra = match m.pbr {

@@ -632,6 +632,16 @@ pub enum Pattern {
     Solid(Colour),
     /// A 3D checkerboard of two colours (or colour fields) with cubes of edge `size`.
     Checker { a: Colour, b: Colour, size: f64 },
+    /// A 3D checkerboard of two materials (`checker { a: gold, b: rubber }`), in cubes of edge
+    /// `size` laid out as [`Pattern::Checker`]'s: each cell shades as its material, blended
+    /// over a sample's footprint (docs/rendering.md, "The checker's footprint"). The two are
+    /// opaque, of one model (both Phong or both `pbr`), and neither is such a checker itself
+    /// (the checker refuses the others); the material holding this pattern has no other use.
+    Materials {
+        a: MaterialId,
+        b: MaterialId,
+        size: f64,
+    },
 }
 
 impl Pattern {
@@ -640,6 +650,8 @@ impl Pattern {
         match self {
             Pattern::Solid(c) => vec![c],
             Pattern::Checker { a, b, .. } => vec![a, b],
+            // Its cells' colours are its materials'.
+            Pattern::Materials { .. } => Vec::new(),
         }
     }
 }
@@ -921,10 +933,19 @@ pub struct Settings {
     pub fog: f64,
     /// The fog's colour; `None`: the background.
     pub fog_color: Option<V3>,
+    /// The distance G of the glow of a camera ray's marching steps: each evaluation of its
+    /// march adds `glow_color·e^(−d/G)` (0: none; docs/rendering.md, "The look").
+    pub glow: f64,
+    /// The colour each marching step of a camera ray adds at a distance 0 from a surface.
+    pub glow_color: V3,
     /// Exposure in stops: the pixel's colour is multiplied by 2^exposure.
     pub exposure: f64,
     /// The tone curve after the exposure.
     pub tonemap: super::Tonemap,
+    /// Where `tonemap` was not given, why the tone curve is the default it is: what of the
+    /// newer look the scene uses (`filmic`), or [`super::look::OLDER_LOOK`] (`none`;
+    /// [`super::look::newer_look`]); `None` where it was given.
+    pub tonemap_why: Option<&'static str>,
     /// Whether pictures are path traced (`method: "path"`; docs/rendering.md, "Path
     /// tracing"): `samples` paths a pixel of up to `bounces` bounces, intersected as
     /// `method` says (`auto` for `method: "path"`).
@@ -976,6 +997,12 @@ impl Method {
 }
 
 impl Settings {
+    /// Whether camera rays glow with their marching steps (`glow` > 0, not path traced:
+    /// docs/rendering.md, "The look").
+    pub fn glows(&self) -> bool {
+        self.glow > 0.0 && !self.path
+    }
+
     /// The ε of the hit test for a camera of field of view `fov` (radians): `epsilon`, or
     /// where `footprint`, the angular radius of one pixel, tan(fov/2)/height: the surface as a
     /// cone one pixel wide sees it.
@@ -1009,8 +1036,11 @@ impl Settings {
         occlusion: 0.0,
         fog: 0.0,
         fog_color: None,
+        glow: 0.0,
+        glow_color: [0.02, 0.02, 0.02],
         exposure: 0.0,
         tonemap: super::Tonemap::None,
+        tonemap_why: None,
         path: false,
         samples: 16,
         bounces: 4,

@@ -103,6 +103,29 @@ pub fn sky_irradiance(zenith: [f64; 3], horizon: [f64; 3], ground: [f64; 3]) -> 
     ]
 }
 
+/// Why a scene's default tone curve is `"none"`: it has nothing of [`newer_look`].
+pub const OLDER_LOOK: &str = "it has no `pbr` material, `light sky` or `method: \"path\"`";
+
+/// What makes a scene's default tone curve `"filmic"` (docs/rendering.md, "The look"): a
+/// `pbr` material, a `light sky` or `method: "path"`, the look written since the curve came,
+/// whose light runs above 1 (skies, emission, Fresnel's rims); a scene of none of them keeps
+/// `"none"`, the look it was written for. `None` for such a scene.
+pub fn newer_look(scene: &super::Scene) -> Option<&'static str> {
+    if scene.settings.path {
+        Some("it is path traced (`method: \"path\"`)")
+    } else if scene.materials.iter().any(|m| m.pbr.is_some()) {
+        Some("it has a `pbr` material")
+    } else if scene
+        .lights
+        .iter()
+        .any(|l| matches!(l, super::Light::Sky { .. }))
+    {
+        Some("it is lit by a `light sky`")
+    } else {
+        None
+    }
+}
+
 /// `tonemap(2^exposure · c)` for one channel, in f64 (the CPU renderer's own copy, in its
 /// evaluation type, is `runtime/src/cpu/look.rs`; this one states the formula for tests).
 pub fn grade(tonemap: Tonemap, exposure: f64, c: f64) -> f64 {

@@ -395,9 +395,12 @@ fn features_are_the_templates() {
     // them (rock.sdf), the sky, occlusion, fog and the tone curve (GRADE) through
     // gallery.sdf, which uses all four, the physically based material (PBR, and FRESNEL
     // with it, whose blocks are all in its kernel) through studio.sdf, the path tracer
-    // (PATH) through studio_path.sdf.
+    // (PATH) through studio_path.sdf, a checker of two materials (MATERIAL_CHECKER) through
+    // checker_materials.sdf and the glow of the marching steps (GLOW) through glow_blob.sdf.
     let by_examples = [
         "COLOUR_FIELDS",
+        "MATERIAL_CHECKER",
+        "GLOW",
         "SKY",
         "OCCLUSION",
         "FOG",

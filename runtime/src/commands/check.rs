@@ -62,6 +62,7 @@ pub fn run(args: CheckArgs) -> ExitCode {
                             );
                         }
                         if human {
+                            eprintln!("{}: {}", file.display(), frontend::tone_curve(scene));
                             for p in &scene.params {
                                 eprintln!("{}: {}", file.display(), param_line(p));
                             }

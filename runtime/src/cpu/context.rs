@@ -29,6 +29,14 @@ pub(super) enum Paint<T> {
         inv_size: T,
         shift: V3<T>,
     },
+    /// A checker of the two materials of these ids (`Pattern::Materials`): a hit on it takes
+    /// one of them, or their blend (`shade::checkered`).
+    Materials {
+        a: u32,
+        b: u32,
+        inv_size: T,
+        shift: V3<T>,
+    },
 }
 
 /// A material in the evaluation type: Phong, or physically based where `pbr` is given.
@@ -49,6 +57,39 @@ pub(super) struct Mat<T> {
     /// The reflectance at normal incidence of a dielectric of its `ior`.
     pub f0: T,
     pub pbr: Option<PbrMat<T>>,
+}
+
+impl<T: Float> Mat<T> {
+    /// The blend of two materials of one model with the weight `w` of `other` (docs/rendering.md,
+    /// "The checker's footprint"): every number `x·(1 − w) + y·w`, of colour `colour`; Fresnel
+    /// and reflections where either has them.
+    pub fn blend(&self, other: &Mat<T>, w: T, colour: V3<T>) -> Mat<T> {
+        let mix = |x: T, y: T| x * (T::one() - w) + y * w;
+        Mat {
+            paint: Paint::Solid(Tint::Const(colour)),
+            ambient: mix(self.ambient, other.ambient),
+            diffuse: mix(self.diffuse, other.diffuse),
+            specular: mix(self.specular, other.specular),
+            shininess: mix(self.shininess, other.shininess),
+            reflect: mix(self.reflect, other.reflect),
+            transparency: mix(self.transparency, other.transparency),
+            ior: mix(self.ior, other.ior),
+            fresnel: self.fresnel || other.fresnel,
+            reflects: self.reflects || other.reflects,
+            f0: mix(self.f0, other.f0),
+            pbr: match (self.pbr, other.pbr) {
+                (Some(p), Some(q)) => Some(PbrMat {
+                    roughness: mix(p.roughness, q.roughness),
+                    alpha: mix(p.alpha, q.alpha),
+                    metallic: mix(p.metallic, q.metallic),
+                    emission: p.emission * (T::one() - w) + q.emission * w,
+                    mirror: mix(p.mirror, q.mirror),
+                }),
+                // The checker refuses two models.
+                _ => other.pbr,
+            },
+        }
+    }
 }
 
 /// The parameters of a `pbr` material in the evaluation type (`sdfc_compiler::pbr`).
@@ -128,6 +169,10 @@ pub(super) struct Context<T: Float> {
     pub occlusion: T,
     /// 1/D for fog over a distance D (0: none).
     pub inv_fog: T,
+    /// 1/G for a glow of the camera rays' marching steps over a distance G (0: none).
+    pub inv_glow: T,
+    /// The glow's colour.
+    pub glow: V3<T>,
     /// The fog's colour, where `fog_color` is given (else the background seen along the ray:
     /// [`Context::fog_colour`]).
     pub fog: Option<V3<T>>,
@@ -204,6 +249,8 @@ impl<T: Float> Context<T> {
             colours: colours.to_vec(),
             occlusion: T::from_f64(s.occlusion),
             inv_fog: T::from_f64(if s.fog > 0.0 { 1.0 / s.fog } else { 0.0 }),
+            inv_glow: T::from_f64(if s.glows() { 1.0 / s.glow } else { 0.0 }),
+            glow: V3::from_f64(s.glow_color),
             fog: s.fog_color.map(V3::from_f64),
             graded: s.exposure != 0.0 || s.tonemap != Tonemap::None,
             exposure: T::from_f64(s.exposure.exp2()),
@@ -271,6 +318,12 @@ fn mat<T: Float>(scene: &Scene, m: &Material, fields: [Option<usize>; 2]) -> Mat
         Pattern::Checker { a, b, size } => Paint::Checker {
             a: tint(a, 0),
             b: tint(b, 1),
+            inv_size: f(1.0 / size),
+            shift: V3::from_f64(scene.checker_shift(*size)),
+        },
+        Pattern::Materials { a, b, size } => Paint::Materials {
+            a: a.0,
+            b: b.0,
             inv_size: f(1.0 / size),
             shift: V3::from_f64(scene.checker_shift(*size)),
         },

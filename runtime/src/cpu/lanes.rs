@@ -69,6 +69,8 @@ lanes! {
         ox: T, oy: T, oz: T, dx: T, dy: T, dz: T,
         t: T, t0: T, sign: T, tmax: T, k: T,
         omega: T, prev: T, step: T, res: T, through: T,
+        // Camera rays: the glow of the steps so far (`march::Trace`).
+        glow: T,
         // Soft shadow rays: the last two samples (t, d/L, penumbra term) and a search's
         // bracket (docs/rendering.md, "Shadows"; `march::Shadow`).
         ta: T, sa: T, qa: T, tm: T, sm: T, qm: T,
@@ -105,6 +107,7 @@ impl<T: Float> Lanes<T> {
         self.step[k] = T::zero();
         self.res[k] = T::one();
         self.through[k] = l.through;
+        self.glow[k] = T::zero();
         let none = T::from_f64(f64::INFINITY);
         (self.ta[k], self.sa[k], self.qa[k]) = (T::zero(), T::zero(), none);
         (self.tm[k], self.sm[k], self.qm[k]) = (T::zero(), T::zero(), none);

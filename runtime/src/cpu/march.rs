@@ -28,6 +28,9 @@ pub(super) struct Traced<T> {
     pub t: T,
     pub status: Status,
     pub steps: u32,
+    /// Σ e^(−|dᵢ|/G) over the evaluations of its march, where the render has a glow
+    /// (docs/rendering.md, "The look"); else 0.
+    pub glow: T,
 }
 
 /// Sphere tracing with Keinert et al.'s over-relaxation: step ω·d, and when the new
@@ -111,6 +114,13 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             flags[k] = fl;
             any |= fl;
         }
+        // The glow: each evaluation adds e^(−|d|/G) (|d| is `prev` now).
+        if c.inv_glow > zero {
+            let (prev, glow) = (&l.prev[..n], &mut l.glow[..n]);
+            for k in 0..n {
+                glow[k] = glow[k] + (-(prev[k] * c.inv_glow)).exp();
+            }
+        }
         if any == 0 {
             return;
         }
@@ -135,6 +145,7 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
                 t: l.t[k],
                 status,
                 steps: l.steps[k],
+                glow: l.glow[k],
             };
             l.finished.push(k);
         }

@@ -349,7 +349,7 @@ fn step<T: Float>(
         let pixel = pixel_of(rect, ctx.width, ray.sample);
         let u = |d: u32| sampling::uniform::<T>(pixel, sample, ray.depth + 1, d);
         let weight = ray.weight * hit.fade;
-        let m = ctx.material(hit.mat);
+        let m = hit.material(ctx);
         let more = ray.depth < ctx.bounces;
         let off = hit.n * (T::from_f64(4.0) * hit.h);
         let child = |origin: V3<T>, dir: V3<T>, weight: V3<T>, inside: bool, pdf: T| Ray {

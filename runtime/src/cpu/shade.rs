@@ -32,6 +32,18 @@ pub(super) struct Hit<T> {
     pub medium_tau: T,
     /// What fog left of the ray's segment (1 without fog, and inside solids).
     pub fade: T,
+    /// On a checker of two materials whose cells the sample's footprint both covers, their
+    /// blend ([`checkered`]); `mat` is then the checker's.
+    pub blend: Option<Mat<T>>,
+}
+
+impl<T: Float> Hit<T> {
+    /// Its material: the table's, or the blend of a checker's two.
+    pub fn material<'a>(&'a self, ctx: &'a Context<T>) -> &'a Mat<T> {
+        self.blend
+            .as_ref()
+            .unwrap_or_else(|| ctx.material(self.mat))
+    }
 }
 
 /// Traces `wave`, adds what it sees to its samples, and returns the next wave. On return
@@ -74,6 +86,11 @@ pub(super) fn surfaces<T: Float>(
     for (i, (ray, tr)) in wave.iter().zip(&ws.traced).enumerate() {
         samples.steps[ray.sample as usize] += tr.steps;
         counters.steps += tr.steps as u64;
+        // A camera ray glows with its marching steps: glow_color·Σ e^(−|dᵢ|/G).
+        if ray.depth == 0 && ctx.inv_glow > T::zero() {
+            let a = &mut samples.acc[ray.sample as usize];
+            *a = *a + (ray.weight * tr.glow).mul_v(ctx.glow);
+        }
         match tr.status {
             Status::Hit => {
                 counters.hits += 1;
@@ -100,6 +117,7 @@ pub(super) fn surfaces<T: Float>(
                     solid: false,
                     medium_tau: T::zero(),
                     fade,
+                    blend: None,
                 });
                 continue;
             }
@@ -124,7 +142,39 @@ pub(super) fn surfaces<T: Float>(
         materials(ctx, ws, &mut hits);
         solids(ctx, ws, wave, &mut hits);
     }
+    checkered(ctx, wave, &mut hits);
     hits
+}
+
+/// A hit on a checker of two materials takes the material of the cell its sample sees
+/// (the checker's parity at p − 2h·N, as a checker of colours), or, where the sample's
+/// footprint covers both ([`look::checker_weight`] strictly between 0 and 1), their blend
+/// by that weight, whose colour is their colours' blend (docs/rendering.md, "The checker's
+/// footprint").
+fn checkered<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &mut [Hit<T>]) {
+    for hit in hits.iter_mut() {
+        let Paint::Materials {
+            a,
+            b,
+            inv_size,
+            shift,
+        } = ctx.material(hit.mat).paint
+        else {
+            continue;
+        };
+        let dir = wave[hit.ray].dir;
+        let q = (hit.p - hit.n * (T::from_f64(2.0) * hit.h)) * inv_size + shift;
+        let wb = look::checker_weight(q, hit.n, dir, hit.tt * ctx.pitch * inv_size);
+        if wb <= T::zero() {
+            hit.mat = a;
+        } else if wb >= T::one() {
+            hit.mat = b;
+        } else {
+            let (ma, mb) = (ctx.material(a), ctx.material(b));
+            let c = colour(ctx, ma, hit, dir) * (T::one() - wb) + colour(ctx, mb, hit, dir) * wb;
+            hit.blend = Some(ma.blend(mb, wb, c));
+        }
+    }
 }
 
 /// The evaluators of a workspace that marches: every caller runs where the context has no
@@ -169,6 +219,7 @@ fn trace<T: Float>(
                         t: s.t,
                         status: Status::Hit,
                         steps: 0,
+                        glow: T::zero(),
                     },
                     (s.normal, s.material),
                 ),
@@ -177,6 +228,7 @@ fn trace<T: Float>(
                         t: ctx.max_dist,
                         status: Status::Miss,
                         steps: 0,
+                        glow: T::zero(),
                     },
                     (V3::zero(), 0),
                 ),
@@ -397,6 +449,8 @@ pub(super) fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>, dir: 
                 tint(a)
             }
         }
+        // Resolved at the hit ([`checkered`]): never shaded as itself.
+        Paint::Materials { .. } => V3::zero(),
     }
 }
 
@@ -511,13 +565,13 @@ fn light<T: Float>(
     let mut colour_at: Vec<V3<T>> = vec![V3::zero(); hits.len()];
     let mut pending: Vec<(usize, V3<T>)> = Vec::new();
     let lit = |hit: &Hit<T>| {
-        let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
+        let (ray, m) = (&wave[hit.ray], hit.material(ctx));
         (!ray.inside || hit.solid) && has_local(m)
     };
     let ao = occlusions(ctx, ws, hits, &lit);
     ws.launches.clear();
     for (hi, hit) in hits.iter().enumerate() {
-        let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
+        let (ray, m) = (&wave[hit.ray], hit.material(ctx));
         if !lit(hit) {
             continue;
         }
@@ -565,7 +619,7 @@ fn light<T: Float>(
         }
     }
     for (hit, c) in hits.iter().zip(colour_at) {
-        let (ray, m) = (&wave[hit.ray], ctx.material(hit.mat));
+        let (ray, m) = (&wave[hit.ray], hit.material(ctx));
         if lit(hit) {
             let w = pbr::local_weight(m, hit.n, ray.dir);
             let a = &mut samples.acc[ray.sample as usize];
@@ -676,7 +730,7 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
         if ray.depth >= ctx.max_depth {
             continue;
         }
-        let m = ctx.material(hit.mat);
+        let m = hit.material(ctx);
         let off = hit.n * (T::from_f64(4.0) * hit.h);
         let weight = ray.weight * hit.fade;
         let child = |origin: V3<T>, dir: V3<T>, weight: V3<T>, inside: bool| Ray {

@@ -97,7 +97,7 @@ impl Model {
         )?;
         for id in 0..count {
             let (name, colour) = match palette.materials.get(id as usize) {
-                Some(m) => (m.name.clone(), base_colour(m)),
+                Some(m) => (m.name.clone(), base_colour(palette.materials, m)),
                 None => (format!("material {id}"), [0.8; 3]),
             };
             writeln!(

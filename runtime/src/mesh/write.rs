@@ -196,8 +196,19 @@ impl<'a> Palette<'a> {
         let Some(m) = self.materials.get(id as usize) else {
             return [0.8; 3];
         };
+        let (file_p, file_n) = (p, n);
         let (p, n) = (self.up.unplace(p), self.up.unplace(n));
         let slot = match &m.pattern {
+            // A checker of two materials: the colour of the cell's material (the checker
+            // refuses such a checker within another; one is grey here).
+            Pattern::Materials { a, b, size } => {
+                let s: f64 = p.iter().map(|x| (x / size).floor()).sum();
+                let id = if s.rem_euclid(2.0) > 0.5 { b.0 } else { a.0 };
+                return match self.materials.get(id as usize).map(|m| &m.pattern) {
+                    Some(Pattern::Materials { .. }) => [0.8; 3],
+                    _ => self.colour(id, file_p, file_n),
+                };
+            }
             Pattern::Solid(_) => 0,
             Pattern::Checker { size, .. } => {
                 let s: f64 = p.iter().map(|x| (x / size).floor()).sum();
@@ -312,9 +323,21 @@ fn obj(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
 /// The one colour glTF gives a material: its colour, or the mean of a checker's two; white
 /// for a colour field, whose colours are the vertices' (`COLOR_0`, which glTF multiplies by
 /// it).
-pub fn base_colour(m: &Material) -> [f64; 3] {
+pub fn base_colour(materials: &[Material], m: &Material) -> [f64; 3] {
     let c = |c: &Colour| c.constant().unwrap_or([1.0; 3]);
     match &m.pattern {
+        // A checker of two materials: the mean of theirs (one that is such a checker
+        // itself, which the checker refuses, is grey).
+        Pattern::Materials { a, b, .. } => {
+            let one = |id: &sdfc_compiler::MaterialId| match materials.get(id.0 as usize) {
+                Some(m) if !matches!(m.pattern, Pattern::Materials { .. }) => {
+                    base_colour(materials, m)
+                }
+                _ => [0.8; 3],
+            };
+            let (a, b) = (one(a), one(b));
+            [0, 1, 2].map(|i| 0.5 * (a[i] + b[i]))
+        }
         Pattern::Solid(a) => c(a),
         Pattern::Checker { a, b, .. } => {
             let (a, b) = (c(a), c(b));
@@ -410,7 +433,7 @@ fn glb(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {
             "attributes": attributes, "indices": accessors.len() - 1, "material": k, "mode": 4
         }));
         let (name, c) = match materials.get(id as usize) {
-            Some(m) => (m.name.clone(), base_colour(m)),
+            Some(m) => (m.name.clone(), base_colour(materials, m)),
             None => (format!("material {id}"), [0.8; 3]),
         };
         mats.push(json!({

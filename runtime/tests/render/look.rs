@@ -21,7 +21,7 @@ fn checked(name: &str, text: &str) -> Scene {
 const CREASE: &str = "
 material white = phong { color: (1, 1, 1), ambient: 1, diffuse: 0, specular: 0 };
 camera { position: (-1, 10, 0), look_at: (-1, 0, 0), fov: 20deg }
-render { width: 64, height: 64, background: (0, 0, 0) OCCLUSION }
+render { width: 64, height: 64, background: (0, 0, 0), tonemap: \"none\" OCCLUSION }
 scene { plane() @ white; box((1, 1, 3)).translate(1, 1, 0) @ white; }
 ";
 
@@ -245,7 +245,7 @@ fn a_white_sphere_under_a_uniform_sky_is_white() {
 material white = phong { color: (1, 1, 1), ambient: 0, diffuse: 1, specular: 0 };
 camera { position: (0, 2, -4), look_at: (0, 0, 0), fov: 40deg }
 light sky { color: (1, 1, 1), background: false }
-render { width: 48, height: 48, background: (0, 0, 0) }
+render { width: 48, height: 48, background: (0, 0, 0), tonemap: \"none\" }
 scene { sphere(1) @ white; }
 ",
     );
@@ -276,7 +276,7 @@ fn the_background_may_be_the_sky() {
         "
 camera { position: (0, 0, 0), look_at: (0, 0, 1), fov: 90deg }
 light sky { zenith: (0, 0, 1), horizon: (1, 1, 1), ground: (0.2, 0.1, 0) }
-render { width: 9, height: 9 }
+render { width: 9, height: 9, tonemap: \"none\" }
 scene { sphere(0.1).translate(0, 0, -50); }
 ",
     );

@@ -12,7 +12,9 @@
 //! - `optimise`: the optimisation passes and bounding-volume culling;
 //! - `devices`: several devices at once (`--devices`);
 //! - `animation`: the time `t`, sequences and their frames;
-//! - `colour`: colour fields of the normal, and of a painted shape moved afterwards.
+//! - `colour`: colour fields of the normal, and of a painted shape moved afterwards;
+//! - `checker_materials`: a checker of two materials, each cell shaded as its material;
+//! - `glow`: the glow of the marching steps, by its documented sum.
 //!
 //! Filter by module: `cargo test --release --test render -- look::`.
 
@@ -23,9 +25,11 @@ mod evaluators;
 
 mod analytic;
 mod animation;
+mod checker_materials;
 mod colour;
 mod devices;
 mod distance_conformance;
+mod glow;
 mod image_conformance;
 mod interpreted_kernel;
 mod look;

@@ -82,7 +82,7 @@ const FURNACE: &str = "
 material m = MAT;
 camera { position: (0, 2, -4), look_at: (0, 0, 0), fov: 40deg }
 light sky { color: (1, 1, 1) }
-render { width: 32, height: 32, method: \"path\", samples: SAMPLES, bounces: 4 }
+render { width: 32, height: 32, method: \"path\", samples: SAMPLES, bounces: 4, tonemap: \"none\" }
 scene { sphere(1) @ m; }
 ";
 
@@ -168,7 +168,7 @@ material ball = pbr { base_color: (0.8, 0.3, 0.2), roughness: 0.6 };
 camera { position: (0, 1.5, -4), look_at: (0, 0.5, 0), fov: 45deg }
 light sky { zenith: (0.3, 0.45, 0.8), horizon: (0.8, 0.85, 0.9), ground: (0.3, 0.3, 0.3) }
 light point { position: (2, 3, -1), intensity: 0.6 }
-render { width: 48, height: 36, method: \"path\", samples: 4, bounces: 3 }
+render { width: 48, height: 36, method: \"path\", samples: 4, bounces: 3, tonemap: \"none\" }
 scene {
   plane() @ ground;
   sphere(0.6).translate(0, 0.6, 0) @ ball;

@@ -20,7 +20,7 @@ const FURNACE: &str = "
 material m = MAT;
 camera { position: (0, 2, -4), look_at: (0, 0, 0), fov: 40deg }
 light sky { color: (1, 1, 1) }
-render { width: 40, height: 40 }
+render { width: 40, height: 40, tonemap: \"none\" }
 scene { sphere(1) @ m; }
 ";
 
@@ -107,7 +107,7 @@ const FLOOR: &str = "
 material m = pbr { base_color: (0.5, 0.5, 0.5), roughness: ROUGH };
 camera { position: (0, 4, 0), look_at: (0, 0, 0), up: (0, 0, 1), fov: 30deg }
 light directional { direction: (0, -1, 0), shadows: false }
-render { width: 41, height: 41, background: (0, 0, 0) }
+render { width: 41, height: 41, background: (0, 0, 0), tonemap: \"none\" }
 scene { plane() @ m; }
 ";
 
@@ -180,7 +180,7 @@ fn fresnel_brightens_a_pbr_floor_at_grazing_angles() {
 material m = pbr { base_color: (0, 0, 0), roughness: 0 };
 camera { position: (0, 1, -4), look_at: (0, 0, 4), fov: 60deg }
 light sky { color: (1, 1, 1) }
-render { width: 16, height: 64, max_dist: 1000 }
+render { width: 16, height: 64, max_dist: 1000, tonemap: \"none\" }
 scene { plane() @ m; }
 ",
     );
@@ -215,7 +215,7 @@ fn floor_column(name: &str, material: &str) -> Vec<(&'static str, Vec<f32>)> {
 material m = {material};
 camera {{ position: (0, 1, -4), look_at: (0, 0, 4), fov: 60deg }}
 light sky {{ color: (1, 1, 1) }}
-render {{ width: 16, height: 64, max_dist: 1000 }}
+render {{ width: 16, height: 64, max_dist: 1000, tonemap: \"none\" }}
 scene {{ plane() @ m; }}
 "
         ),

@@ -46,8 +46,12 @@ impl Specialisation {
             occlusion: _,
             fog: _,
             fog_color: _,
+            // Read at every render (`glow`); whether it is on is a feature (`GLOW`).
+            glow: _,
+            glow_color: _,
             exposure: _,
             tonemap: _,
+            tonemap_why: _,
             // Its samples, bounces and first sample are read at every render (`depth.y`,
             // `depth.z`, `depth.w`);
             // whether it path traces is specialised (the feature `PATH`).
@@ -102,7 +106,7 @@ pub struct Contract {
 
 /// The features that follow from the scene and its settings alone (the first ones of
 /// [`Contract::features`]): those a render checks.
-pub(super) const SCENE_FEATURES: usize = 17;
+pub(super) const SCENE_FEATURES: usize = 19;
 
 /// A scene that a kernel cannot render, or a uniform that does not fit its layout: what
 /// differs, in words.

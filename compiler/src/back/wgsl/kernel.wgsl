@@ -55,6 +55,9 @@ struct Params {
     counts: vec4<u32>,     // width, height, aa, max_steps
     //% depth.yzw: the path tracer's samples, bounces and first sample (path.wgsl).
     depth: vec4<u32>,      // max_depth
+//#if GLOW
+    glow: vec4<f32>,       // the glow's colour, 1/G
+//#endif
 //#if POINT
     points: array<PointLight, {{POINTS}}>,
 //#endif
@@ -177,8 +180,15 @@ fn occlude(through: f32, s: Interval, tmax: f32, tau: f32) -> f32 {
 
 {{ANALYTIC}}
 //#else
+//#if GLOW
+// The glow of the last march: Σ e^(−|dᵢ|/G) over its evaluations (docs/rendering.md, "The look").
+var<private> glow: f32;
+//#endif
 // Sphere tracing (docs/rendering.md, "Marching"), with over-relaxation when ω > 1.
 fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
+//#if GLOW
+    glow = 0.0;
+//#endif
     let eps = params.march.x;
     let max_dist = params.march.y;
     let inv_l = params.march.w;
@@ -210,6 +220,9 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
         }
         let signed = sign * f * inv_l;
         let r = abs(signed);
+//#if GLOW
+        glow += exp(-r * params.glow.w);
+//#endif
         let tol = tolerance(eps * (t0 + t), p);
         if signed < -tol {
             counters.overshoots += 1u;
@@ -521,6 +534,12 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         let inside = false;
         let hit = trace(ray.origin, ray.dir, ray.t0, 1.0);
 //#endif
+//#if GLOW
+        // A camera ray glows with its marching steps.
+        if ray.depth == 0u {
+            acc += params.glow.xyz * glow;
+        }
+//#endif
         if hit.status != STATUS_HIT {
             if hit.status == STATUS_MISS {
                 counters.misses += 1u;
@@ -556,8 +575,12 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
             if solid.x < h {
                 // An opaque solid inside the glass: lit and reflecting as seen from outside,
                 // within the glass (docs/rendering.md, "Inside glass").
-                let ms = params.materials[u32(solid.y)];
                 let ns = normal_solid(p, h, ray.dir);
+//#if MATERIAL_CHECKER
+                let ms = checkered(params.materials[u32(solid.y)], p, ns, h, ray.dir, tt);
+//#else
+                let ms = params.materials[u32(solid.y)];
+//#endif
                 let ls = lobes(ms, p, ns, ray.dir, tt, h);
                 if ls.local > 0.0 {
                     medium_tau = params.materials[u32(map(p).y)].optics.y;
@@ -575,7 +598,11 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#endif
 //#if ANALYTIC
         let n = hit.normal;
+//#if MATERIAL_CHECKER
+        let m = checkered(params.materials[hit.material], p, n, h, ray.dir, tt);
+//#else
         let m = params.materials[hit.material];
+//#endif
         // Inside glass, an opaque primitive (glass overlaps no other glass in a traced scene):
         // lit and reflecting as seen from outside, within the glass (docs/rendering.md,
         // "Inside glass"); its shadow rays start inside the glass, whose transparency
@@ -584,7 +611,11 @@ fn radiance(eye: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 //#else
         let n = normal(p, h, ray.dir);
 //#if MATERIALS
+//#if MATERIAL_CHECKER
+        let m = checkered(params.materials[u32(map(p).y)], p, n, h, ray.dir, tt);
+//#else
         let m = params.materials[u32(map(p).y)];
+//#endif
 //#else
         let m = params.materials[0];
 //#endif

@@ -149,8 +149,18 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
         ("SOFT", soft),
         (
             "CHECKER",
+            mats.iter().any(|m| {
+                matches!(
+                    m.pattern,
+                    Pattern::Checker { .. } | Pattern::Materials { .. }
+                )
+            }),
+        ),
+        // A checker of two materials resolves a hit's material (`checkered`).
+        (
+            "MATERIAL_CHECKER",
             mats.iter()
-                .any(|m| matches!(m.pattern, Pattern::Checker { .. })),
+                .any(|m| matches!(m.pattern, Pattern::Materials { .. })),
         ),
         // Shadow rays pass through transparent solids even when no refracted ray is traced
         // (`max_depth: 0`), as on the CPU; the path tracer's are stopped by every surface.
@@ -175,6 +185,9 @@ pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)>
             scene.lights.iter().any(|l| matches!(l, Light::Sky { .. })),
         ),
         ("FOG", scene.settings.fog > 0.0),
+        // A glow of the camera rays' marching steps (a marched scene's, never the path
+        // tracer's).
+        ("GLOW", scene.settings.glows()),
         // Schlick's Fresnel term on a material's rays (`fresnel: true`, or `pbr`), and the
         // physically based material (docs/rendering.md, "Physically based materials").
         ("FRESNEL", mats.iter().any(|m| m.fresnel)),

@@ -96,6 +96,19 @@ pub(crate) fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String
         let (a, b, size, shift) = match &m.pattern {
             Pattern::Solid(c) => (v(c), [0.0; 3], 0.0, [0.0; 3]),
             Pattern::Checker { a, b, size } => (v(a), v(b), *size, scene.checker_shift(*size)),
+            // A checker of two materials: a checker of their (first) colours.
+            Pattern::Materials { a, b, size } => {
+                let first = |id: &crate::scene::MaterialId| {
+                    let c = scene.materials[id.0 as usize].pattern.colours();
+                    c.first().map_or([0.0; 3], |c| v(c))
+                };
+                (first(a), first(b), *size, scene.checker_shift(*size))
+            }
+        };
+        // Its Phong parameters are its first material's.
+        let q = match &m.pattern {
+            Pattern::Materials { a, .. } => &scene.materials[a.0 as usize],
+            _ => m,
         };
         let painted: Vec<String> = fields
             .get(id)
@@ -115,13 +128,13 @@ pub(crate) fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String
             v3(b),
             float(size),
             v3(shift),
-            float(m.ambient),
-            float(m.diffuse),
-            float(m.specular),
-            float(m.shininess),
-            float(m.reflect),
-            float(m.transparency),
-            float(m.ior)
+            float(q.ambient),
+            float(q.diffuse),
+            float(q.specular),
+            float(q.shininess),
+            float(q.reflect),
+            float(q.transparency),
+            float(q.ior)
         );
     }
     out.push_str(");\n\n");

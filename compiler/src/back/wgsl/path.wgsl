@@ -393,6 +393,9 @@ fn path_radiance(x: u32, y: u32, sample: u32) -> vec3<f32> {
         }
 //#endif
 //#endif
+//#if MATERIAL_CHECKER
+        m = checkered(m, p, n, h, ray.dir, tt);
+//#endif
         let more = ray.depth < params.depth.z;
         let bounce = ray.depth + 1u;
         let off = n * (4.0 * h);

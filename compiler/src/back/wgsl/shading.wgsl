@@ -75,6 +75,45 @@ fn surface_colour(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32, d: vec3<f32>,
 //#endif
     return ca;
 }
+//#if MATERIAL_CHECKER
+
+// A hit on a checker of two materials (color.w = 2, their ids in color.xy) takes the material
+// of the cell its sample sees, or, where the footprint covers both (0 < wb < 1), their blend:
+// every number x·(1 − wb) + y·wb, the colour their colours' blend (runtime/src/cpu/shade.rs,
+// `checkered`; docs/rendering.md, "The checker's footprint").
+fn checkered(m: Material, p: vec3<f32>, n: vec3<f32>, h: f32, d: vec3<f32>, tt: f32) -> Material {
+    if m.color.w < 2.0 {
+        return m;
+    }
+    let ma = params.materials[u32(m.color.x)];
+    let mb = params.materials[u32(m.color.y)];
+    let q = (p - n * (2.0 * h)) * m.color_b.w + m.shift.xyz;
+    let pitch = 2.0 * params.view.y / (params.view.w * f32(params.counts.z));
+    let wb = checker_weight(q, n, d, tt * pitch * m.color_b.w);
+    if wb <= 0.0 {
+        return ma;
+    }
+    if wb >= 1.0 {
+        return mb;
+    }
+    let wa = 1.0 - wb;
+    let c = surface_colour(ma, p, n, h, d, tt) * wa + surface_colour(mb, p, n, h, d, tt) * wb;
+    return Material(
+        vec4<f32>(c, 0.0),
+        vec4<f32>(0.0),
+        ma.phong * wa + mb.phong * wb,
+        vec4<f32>(ma.optics.xyz * wa + mb.optics.xyz * wb, 0.0),
+        vec4<f32>(0.0),
+//#if FRESNEL
+        ma.fresnel * wa + mb.fresnel * wb,
+//#endif
+//#if PBR
+        ma.pbr * wa + mb.pbr * wb,
+        ma.emission * wa + mb.emission * wb,
+//#endif
+    );
+}
+//#endif
 
 //#if OCCLUSION
 // Ambient occlusion at p on a surface of normal n: with R = look.x and n = OCCLUSION_SAMPLES,

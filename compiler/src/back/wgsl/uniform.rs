@@ -66,6 +66,10 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
         "depth",
         &[s.max_depth, s.samples.max(1), s.bounces, s.first_sample],
     )?;
+    // The kernels of the feature GLOW have it: the glow's colour, 1/G.
+    if s.glows() {
+        w.floats("glow", &v4(s.glow_color, 1.0 / s.glow))?;
+    }
     let (mut points, mut dirs, mut skies) = (0, 0, 0);
     // Whether a sky is the background (`background.w`): rays that hit nothing show the skies
     // that are.
@@ -148,6 +152,15 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             Pattern::Checker { a, b, size } => {
                 (v(a), v(b), 1.0, 1.0 / size, scene.checker_shift(*size))
             }
+            // A checker of two materials: their ids in `color`, whose w is 2
+            // (`checkered` in shading.wgsl).
+            Pattern::Materials { a, b, size } => (
+                [a.0 as f64, b.0 as f64, 0.0],
+                [0.0; 3],
+                2.0,
+                1.0 / size,
+                scene.checker_shift(*size),
+            ),
         };
         // The colour fields' numbers, plus 1 (0: none).
         let field = |slot: usize| {

@@ -42,7 +42,7 @@ pub mod prim;
 /// Sources, spans, resource limits and diagnostics.
 pub use crate::{
     diagnostics::{has_errors, Diagnostic, Severity},
-    limits::{Limit, Limits, Spelling},
+    limits::{Limit, LimitError, Limits, Spelling},
     span::{FileId, SourceMap, Span},
 };
 

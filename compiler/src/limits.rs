@@ -369,6 +369,23 @@ impl Spelling {
     }
 }
 
+/// A limit's setting (`--limit NAME=VALUE`, Python's `limits=`) that cannot be applied.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum LimitError {
+    /// Not of the form `NAME=VALUE`.
+    #[error("--limit expects NAME=VALUE, like fuel=100000000, not `{0}`; {names}", names = Limits::names())]
+    NotASetting(String),
+    /// No limit has this name.
+    #[error("unknown limit `{0}`; {names}", names = Limits::names())]
+    Unknown(String),
+    /// The value is not a whole number within the limit's range.
+    #[error("the limit {} must be a whole number from 1 to {}, not `{value}`", limit.name(), limit.ceiling())]
+    NotANumber { limit: Limit, value: String },
+    /// The value is outside the limit's range.
+    #[error("the limit {} must be a whole number from 1 to {}, not {value}", limit.name(), limit.ceiling())]
+    OutOfRange { limit: Limit, value: u64 },
+}
+
 /// The value of every limit for one run, and how its messages name the option that raises
 /// one ([`Spelling`]); and the values given from outside for the scene's parameters
 /// (`--param name=value`), which a run is checked with beside its limits, and those offered
@@ -438,13 +455,9 @@ impl Limits {
     }
 
     /// Sets `limit` to `value`, which must be from 1 to the limit's ceiling.
-    pub fn set(&mut self, limit: Limit, value: u64) -> Result<(), String> {
+    pub fn set(&mut self, limit: Limit, value: u64) -> Result<(), LimitError> {
         if !(1..=limit.ceiling()).contains(&value) {
-            return Err(format!(
-                "the limit {} must be a whole number from 1 to {}, not {value}",
-                limit.name(),
-                limit.ceiling()
-            ));
+            return Err(LimitError::OutOfRange { limit, value });
         }
         self.values[limit as usize] = value;
         Ok(())
@@ -452,21 +465,15 @@ impl Limits {
 
     /// Parses one `NAME=VALUE` of `--limit` (underscores may group digits). The error names
     /// the valid limits.
-    pub fn parse(setting: &str) -> Result<(Limit, u64), String> {
-        let (name, value) = setting.split_once('=').ok_or_else(|| {
-            format!(
-                "--limit expects NAME=VALUE, like fuel=100000000, not `{setting}`; {}",
-                Self::names()
-            )
-        })?;
+    pub fn parse(setting: &str) -> Result<(Limit, u64), LimitError> {
+        let (name, value) = setting
+            .split_once('=')
+            .ok_or_else(|| LimitError::NotASetting(setting.to_string()))?;
         let (name, value) = (name.trim(), value.trim());
-        let limit = Limit::named(name)
-            .ok_or_else(|| format!("unknown limit `{name}`; {}", Self::names()))?;
-        let bad = || {
-            format!(
-                "the limit {name} must be a whole number from 1 to {}, not `{value}`",
-                limit.ceiling()
-            )
+        let limit = Limit::named(name).ok_or_else(|| LimitError::Unknown(name.to_string()))?;
+        let bad = || LimitError::NotANumber {
+            limit,
+            value: value.to_string(),
         };
         let parsed = value.replace('_', "").parse::<u64>().map_err(|_| bad())?;
         if !(1..=limit.ceiling()).contains(&parsed) {
@@ -476,7 +483,7 @@ impl Limits {
     }
 
     /// Applies one `NAME=VALUE` of `--limit`.
-    pub fn apply(&mut self, setting: &str) -> Result<(), String> {
+    pub fn apply(&mut self, setting: &str) -> Result<(), LimitError> {
         let (limit, value) = Self::parse(setting)?;
         self.set(limit, value)
     }
@@ -539,11 +546,34 @@ mod tests {
         l.apply("fuel=100_000").expect("valid");
         assert_eq!(l.get(Limit::Fuel), 100_000);
         let unknown = l.apply("speed=3").expect_err("unknown");
-        assert!(unknown.contains("unknown limit `speed`") && unknown.contains("max_steps"));
-        assert!(l.apply("aa=0").is_err());
-        assert!(l.apply("aa=257").is_err());
-        assert!(l.apply("aa=x").is_err());
-        assert!(l.apply("aa").expect_err("no =").contains("the limits are"));
+        assert_eq!(unknown, LimitError::Unknown("speed".into()));
+        let text = unknown.to_string();
+        assert!(text.contains("unknown limit `speed`") && text.contains("max_steps"));
+        for bad in ["aa=0", "aa=257", "aa=x"] {
+            let e = l.apply(bad).expect_err(bad);
+            assert!(
+                matches!(
+                    e,
+                    LimitError::NotANumber {
+                        limit: Limit::Aa,
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+        }
+        assert_eq!(
+            l.clone().set(Limit::Aa, 0),
+            Err(LimitError::OutOfRange {
+                limit: Limit::Aa,
+                value: 0
+            })
+        );
+        let no_equals = l.apply("aa").expect_err("no =");
+        assert!(
+            no_equals.to_string().contains("the limits are"),
+            "{no_equals}"
+        );
         assert_eq!(l.raise(Limit::Fuel), "raise it with `--limit fuel=200000`");
         assert_eq!(l.raise(Limit::Aa), "raise it with `--limit aa=32`");
     }

@@ -238,7 +238,8 @@ fn open(source: Option<String>, path: Option<String>) -> Result<Source, Failure>
 fn limits_of(limits: &[String]) -> Result<Limits, Failure> {
     let mut l = Limits::default().spelled(Spelling::Parameters);
     for setting in limits {
-        l.apply(setting).map_err(Failure::Value)?;
+        l.apply(setting)
+            .map_err(|e| Failure::Value(e.to_string()))?;
     }
     Ok(l)
 }

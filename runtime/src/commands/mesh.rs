@@ -479,7 +479,8 @@ fn surface_on(
     let field = match settings.backend {
         Backend::Cpu | Backend::Auto => field,
         backend => {
-            let gpu = Gpu::open(backend, &checked.scene, &lowered, &clip).map_err(|m| (1, m))?;
+            let gpu = Gpu::open(backend, &checked.scene, &lowered, &clip)
+                .map_err(|e| (1, e.to_string()))?;
             // Once a process: the parts of a 3MF and a finer mesh share the device.
             static SAID: std::sync::Once = std::sync::Once::new();
             SAID.call_once(|| say(format!("mesh: evaluating on {}: {}", gpu.name, gpu.device)));

@@ -28,22 +28,35 @@ const F32_GRADIENT_STEP: f64 = 1.0 / 65_536.0;
 
 /// The devices a process opens once, shared by every mesh it makes (the parts of a 3MF, a
 /// mesh made again on finer cells).
-fn wgpu_device() -> Result<&'static Arc<WgpuDevice>, String> {
-    static WGPU: OnceLock<Result<Arc<WgpuDevice>, String>> = OnceLock::new();
-    WGPU.get_or_init(|| {
-        WgpuDevice::open(false)
-            .map(Arc::new)
-            .map_err(|e| e.to_string())
-    })
-    .as_ref()
-    .map_err(Clone::clone)
+fn wgpu_device() -> Result<&'static Arc<WgpuDevice>, &'static crate::gpu::wgpu::Error> {
+    static WGPU: OnceLock<Result<Arc<WgpuDevice>, crate::gpu::wgpu::Error>> = OnceLock::new();
+    WGPU.get_or_init(|| WgpuDevice::open(false).map(Arc::new))
+        .as_ref()
 }
 
-fn cuda_device() -> Result<&'static CudaDevice, String> {
-    static CUDA: OnceLock<Result<CudaDevice, String>> = OnceLock::new();
-    CUDA.get_or_init(|| on_gpu::open_cuda().map_err(|e| e.to_string()))
-        .as_ref()
-        .map_err(Clone::clone)
+fn cuda_device() -> Result<&'static CudaDevice, &'static on_gpu::RunError> {
+    static CUDA: OnceLock<Result<CudaDevice, on_gpu::RunError>> = OnceLock::new();
+    CUDA.get_or_init(on_gpu::open_cuda).as_ref()
+}
+
+/// Why a GPU cannot evaluate a mesher's points.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum OpenError {
+    /// `--backend cpu` or `auto` resolved to the CPU, which evaluates in the field itself.
+    #[error("the CPU evaluates in the field itself, not as a GPU")]
+    NotAGpu,
+    /// The backend found no device: which backend, what it looked for and why.
+    #[error(
+        "--backend {backend} cannot mesh here: found no {device} ({why}); mesh with --backend cpu"
+    )]
+    NoDevice {
+        backend: &'static str,
+        device: &'static str,
+        why: String,
+    },
+    /// The scene's points kernel cannot be written, translated or loaded.
+    #[error("--backend {backend} cannot mesh this scene: its distance kernel cannot be written ({why}); mesh it with --backend cpu")]
+    Kernel { backend: &'static str, why: String },
 }
 
 /// The backend `--backend` names, with `auto` resolved as `render` resolves it for one
@@ -96,33 +109,31 @@ impl Gpu {
         scene: &Scene,
         lowered: &Lowered,
         clip: &[[f64; 3]; 2],
-    ) -> Result<Gpu, String> {
+    ) -> Result<Gpu, OpenError> {
         let (name, on) = match backend {
             Backend::Wgpu => ("wgpu", "wgpu adapter"),
             Backend::Cuda => ("cuda", "CUDA device"),
-            Backend::Cpu | Backend::Auto => {
-                return Err("the CPU evaluates in the field itself, not as a GPU".into())
-            }
+            Backend::Cpu | Backend::Auto => return Err(OpenError::NotAGpu),
         };
-        let no = |why: String| {
-            format!(
-                "--backend {name} cannot mesh here: found no {on} ({why}); mesh with --backend cpu"
-            )
+        let no = |why: &dyn std::fmt::Display| OpenError::NoDevice {
+            backend: name,
+            device: on,
+            why: why.to_string(),
         };
-        let cannot = |why: String| {
-            format!("--backend {name} cannot mesh this scene: its distance kernel cannot be written ({why}); mesh it with --backend cpu")
+        let cannot = |why: &dyn std::fmt::Display| OpenError::Kernel {
+            backend: name,
+            why: why.to_string(),
         };
-        let module =
-            on_gpu::points_module(scene, lowered, false).map_err(|e| cannot(e.to_string()))?;
+        let module = on_gpu::points_module(scene, lowered, false).map_err(|e| cannot(&e))?;
         let (kernel, device) = match backend {
             Backend::Cuda => {
-                let (ctx, sm) = cuda_device().map_err(no)?;
-                let ptx = on_gpu::points_ptx(&module, *sm).map_err(|e| cannot(e.to_string()))?;
-                let k = CudaPoints::new(ctx, &module, &ptx).map_err(|e| cannot(e.to_string()))?;
+                let (ctx, sm) = cuda_device().map_err(|e| no(e))?;
+                let ptx = on_gpu::points_ptx(&module, *sm).map_err(|e| cannot(&e))?;
+                let k = CudaPoints::new(ctx, &module, &ptx).map_err(|e| cannot(&e))?;
                 (Kernel::Cuda(k), format!("CUDA device 0 (sm_{sm})"))
             }
             _ => {
-                let gpu = wgpu_device().map_err(no)?;
+                let gpu = wgpu_device().map_err(|e| no(e))?;
                 (
                     Kernel::Wgpu(gpu, WgpuPoints::new(gpu, &module)),
                     gpu.describe(),

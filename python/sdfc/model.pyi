@@ -132,6 +132,7 @@ class Shape(_Expr):
     def taper(self, rate: float) -> Shape: ...
     def morph(self, b: Shape, t: float) -> Shape: ...
     def round(self, radius: float) -> Shape: ...
+    def hull(self) -> Shape: ...
     def minkowski(self, ball: Shape) -> Shape: ...
     def shell(self, thickness: float) -> Shape: ...
     def elongate(self, half: Vec3) -> Shape: ...
@@ -839,6 +840,34 @@ def round(shape: Shape, radius: float) -> Shape:
     Offsets a shape's surface outwards by `radius`.
     """
     ...
+@overload
+def hull(shapes: Shape, *more: Shape) -> Shape: ...
+@overload
+def hull(shapes: Sequence[Shape]) -> Shape: ...
+@overload
+def hull(points: Sequence[Vec3], radius: float = ...) -> Shape:
+    """```sdf
+    hull(shapes...: shape) -> shape
+    ```
+    Valid: balls, or parallel cylinders of one span (§9d); at most `hull_shapes` (64)
+
+    The convex hull of the shapes. Exact.
+
+    ```sdf
+    hull(shapes: [shape]) -> shape
+    ```
+    Valid: not empty; as above
+
+    The convex hull of a list of shapes: the same as giving them one by one.
+
+    ```sdf
+    hull(points: [vec3], radius: float = 0) -> shape
+    ```
+    Valid: 4 points or more not in one plane, or `radius` > 0
+
+    The convex hull of the points; with a `radius`, the hull of balls of that radius about them. Exact.
+    """
+    ...
 def minkowski(shape: Shape, ball: Shape) -> Shape:
     """```sdf
     minkowski(shape: shape, ball: shape) -> shape
@@ -948,15 +977,6 @@ def slab(thickness: float = ..., normal: Vec3 = ...) -> Shape:
     The space between two parallel planes `thickness` apart, centred on the origin, normal to `normal` (normalised). Exact.
     """
     ...
-def hull(points: Sequence[Vec3], radius: float = ...) -> Shape:
-    """```sdf
-    hull(points: [vec3], radius: float = 0) -> shape
-    ```
-    Valid: 4 points or more not in one plane, or `radius` > 0
-
-    The convex hull of the points; with a `radius`, the hull of balls of that radius about them. Exact.
-    """
-    ...
 def hex_prism(radius: float = ..., height: float = ...) -> Shape:
     """```sdf
     hex_prism(radius: float = 0.5, height: float = 1) -> shape
@@ -1055,6 +1075,6 @@ class Camera(Record):
     def __init__(self, *, position: Vec3 = ..., look_at: Vec3 = ..., up: Vec3 = ..., fov: Angle = ...) -> None: ...
 
 class Render(Record):
-    def __init__(self, *, width: int = ..., height: int = ..., aa: int = ..., max_steps: int = ..., epsilon: float = ..., max_depth: int = ..., max_dist: float = ..., relaxation: float = ..., background: Vec3 = ..., method: str = ..., samples: int = ..., bounces: int = ..., fps: float = ..., duration: float = ..., occlusion: float = ..., fog: float = ..., fog_color: Vec3 = ..., exposure: float = ..., tonemap: str = ...) -> None: ...
+    def __init__(self, *, width: int = ..., height: int = ..., aa: int = ..., max_steps: int = ..., epsilon: float = ..., max_depth: int = ..., max_dist: float = ..., relaxation: float = ..., background: Vec3 = ..., method: str = ..., samples: int = ..., bounces: int = ..., fps: float = ..., duration: float = ..., occlusion: float = ..., fog: float = ..., fog_color: Vec3 = ..., glow: float = ..., glow_color: Vec3 = ..., exposure: float = ..., tonemap: str = ...) -> None: ...
 
-__all__ = ["Angle", "Path", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "sweep", "polyline", "helix", "arc3", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hull", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "Pbr", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]
+__all__ = ["Angle", "Path", "Profile", "Record", "Shape", "deg", "field", "profile", "rad", "show", "sphere", "box", "round_box", "plane", "torus", "cylinder", "capsule", "cone", "ellipsoid", "mesh", "rect", "polygon", "text", "regular_polygon", "star", "ring", "segment2", "extrude", "revolve", "bezier", "sweep", "polyline", "helix", "arc3", "loft", "screw", "offset", "union", "intersect", "subtract", "smooth_union", "smooth_intersect", "smooth_subtract", "engrave", "groove", "tongue", "pipe", "translate", "rotate_x", "rotate_y", "rotate_z", "rotate", "scale", "repeat", "mirror", "reflect", "twist", "bend", "repeat_polar", "wrap", "shear", "taper", "morph", "round", "hull", "minkowski", "shell", "elongate", "mandelbulb", "capped_cone", "round_cone", "segment", "rounded_cylinder", "link", "infinite_cylinder", "slab", "hex_prism", "tri_prism", "octahedron", "pyramid", "box_frame", "circle", "round_rect", "arc", "Phong", "Checker", "Pbr", "PointLight", "DirectionalLight", "SunLight", "SkyLight", "Camera", "Render"]

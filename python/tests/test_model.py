@@ -58,6 +58,8 @@ SPECIAL = {
     "round_cone": {"b": (0, 1, 0)},
     "bezier": {"control": (1, 0.2)},
     "repeat": {"count": (2, 1, 1)},
+    # A hull of shapes takes balls or parallel cylinders (the sample list has a box).
+    "hull": {"shapes": [sdfc.sphere(0.5), sdfc.sphere(0.3).translate(1, 0, 0)]},
 }
 
 

@@ -119,6 +119,14 @@ pub fn distance(p: &Program, q: [f32; 3]) -> f64 {
     eval_point::<f64>(p, q.map(f64::from)).0
 }
 
+/// A Gridfinity-style bin in millimetres, 100 × 40 × 60 outside, walls 0.475 thick and a
+/// divider as thin, slanted to the grid: thinner than a cell at the resolutions the tests use.
+pub const THIN_WALLED_BIN: &str = "let outer = box((50, 20, 30));
+let inner = box((49.525, 20, 29.525)).translate(0, 1.2, 0);
+let divider = box((0.2375, 19, 29.6)).rotate_y(3deg).rotate_z(2deg).translate(3.1, 0, 0);
+scene { union(outer.subtract(inner), divider); }
+";
+
 /// Writes a scene file into `d`.
 pub fn write_scene(d: &Path, name: &str, body: &str) -> PathBuf {
     let p = d.join(name);

@@ -106,15 +106,7 @@ fn a_turned_box_keeps_its_corners_and_flat_faces() {
 #[test]
 fn a_bin_with_walls_thinner_than_a_cell_keeps_its_topology() {
     let d = dir("bin");
-    let scene = write_scene(
-        &d,
-        "bin.sdf",
-        "let outer = box((50, 20, 30));
-let inner = box((49.525, 20, 29.525)).translate(0, 1.2, 0);
-let divider = box((0.2375, 19, 29.6)).rotate_y(3deg).rotate_z(2deg).translate(3.1, 0, 0);
-scene { union(outer.subtract(inner), divider); }
-",
-    );
+    let scene = write_scene(&d, "bin.sdf", meshes::THIN_WALLED_BIN);
     let out = d.join("bin.stl");
     let err = mesh(&[s(&scene), "-o", s(&out), "--resolution", "128"]);
     assert!(err.contains("meshing again with cells of 0.3906"), "{err}");

@@ -11,7 +11,7 @@
 
 use super::common::open_gpu;
 use super::evaluators;
-use super::meshes::{dir, root, s, sdfc, write_scene};
+use super::meshes::{self, dir, root, s, sdfc, write_scene};
 use sdfc_compiler::{Limits, LowerOptions};
 use sdfc_runtime::backend::Backend;
 use sdfc_runtime::commands::mesh::{surface, Meshed, Region, Spelling};
@@ -26,15 +26,7 @@ type Case = (&'static str, PathBuf, Option<[[f64; 3]; 2]>, u32);
 fn cases() -> Vec<Case> {
     let d = dir("gpu_bin");
     // The bin of `mesh_accuracy`, smaller: its divider is thinner than a cell at 48.
-    let bin = write_scene(
-        &d,
-        "bin.sdf",
-        "let outer = box((50, 20, 30));
-let inner = box((49.525, 20, 29.525)).translate(0, 1.2, 0);
-let divider = box((0.2375, 19, 29.6)).rotate_y(3deg).rotate_z(2deg).translate(3.1, 0, 0);
-scene { union(outer.subtract(inner), divider); }
-",
-    );
+    let bin = write_scene(&d, "bin.sdf", meshes::THIN_WALLED_BIN);
     vec![
         (
             "bracket",

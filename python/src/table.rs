@@ -159,7 +159,10 @@ pub fn range_error(
             _ => return Err(PyValueError::new_err("a value of 1, 2 or 3 numbers")),
         }
     };
-    Ok(p.range.check(&value, &Limits::default()).err())
+    Ok(p.range
+        .check(&value, &Limits::default())
+        .err()
+        .map(|e| e.to_string()))
 }
 
 /// `fmt(text)`: the text as `sdfc fmt` writes it, or None where it has syntax errors (the

@@ -227,7 +227,7 @@ impl Ctx<'_> {
                 if field::is_point(&v) {
                     return match field::unary(*op, &v) {
                         Ok(v) => v,
-                        Err(msg) => self.per_point(msg, x.span),
+                        Err(e) => self.per_point(e.to_string(), x.span),
                     };
                 }
                 self.result(ops::unary(*op, &v), e.span)

@@ -96,8 +96,25 @@ pub fn is_point(v: &Value) -> bool {
     matches!(v, Value::Point(_))
 }
 
+/// Why an operator cannot take a per-point value.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum PointError {
+    /// `!` of a per-point value.
+    #[error("`!` needs a bool known at compile time")]
+    Not,
+    /// Operands that are not numbers or vectors.
+    #[error("`{}` cannot be applied to these operands", .op.symbol())]
+    Operands { op: BinOp },
+    /// Vectors of different sizes.
+    #[error("`{}` cannot be applied to vectors of different sizes", .op.symbol())]
+    Sizes { op: BinOp },
+    /// A comparison or logic, which would branch, in a `word` (`field` or `profile`).
+    #[error("`{}` of values that depend on the point `p` is not supported: a {word}'s value cannot branch", .op.symbol())]
+    Branch { op: BinOp, word: &'static str },
+}
+
 /// `op v` for a per-point `v`.
-pub fn unary(op: UnOp, v: &Value) -> Result<Value, String> {
+pub fn unary(op: UnOp, v: &Value) -> Result<Value, PointError> {
     match op {
         UnOp::Neg => Ok(point(
             comps(v)
@@ -106,7 +123,7 @@ pub fn unary(op: UnOp, v: &Value) -> Result<Value, String> {
                 .map(|c| un(FUn::Neg, c))
                 .collect(),
         )),
-        UnOp::Not => Err("`!` needs a bool known at compile time".into()),
+        UnOp::Not => Err(PointError::Not),
     }
 }
 
@@ -125,18 +142,12 @@ fn zip(a: Vec<Rc<Sx>>, b: Vec<Rc<Sx>>, f: impl Fn(Rc<Sx>, Rc<Sx>) -> Rc<Sx>) -> 
 /// `a op b` where either operand is per-point (types already checked by the caller):
 /// arithmetic componentwise; `%` is the floored remainder a − b·⌊a/b⌋. Comparisons and logic
 /// need constants (the message names the value as `word`'s: `field` or `profile`).
-pub fn binary(op: BinOp, a: &Value, b: &Value, word: &str) -> Result<Value, String> {
+pub fn binary(op: BinOp, a: &Value, b: &Value, word: &'static str) -> Result<Value, PointError> {
     let (Some(x), Some(y)) = (comps(a), comps(b)) else {
-        return Err(format!(
-            "`{}` cannot be applied to these operands",
-            op.symbol()
-        ));
+        return Err(PointError::Operands { op });
     };
     if x.len() > 1 && y.len() > 1 && x.len() != y.len() {
-        return Err(format!(
-            "`{}` cannot be applied to vectors of different sizes",
-            op.symbol()
-        ));
+        return Err(PointError::Sizes { op });
     }
     let f: fn(Rc<Sx>, Rc<Sx>) -> Rc<Sx> = match op {
         BinOp::Add => |a, b| bin(FBin::Add, a, b),
@@ -144,12 +155,7 @@ pub fn binary(op: BinOp, a: &Value, b: &Value, word: &str) -> Result<Value, Stri
         BinOp::Mul => |a, b| bin(FBin::Mul, a, b),
         BinOp::Div => |a, b| bin(FBin::Div, a, b),
         BinOp::Rem => modulo,
-        _ => {
-            return Err(format!(
-                "`{}` of values that depend on the point `p` is not supported: a {word}'s value cannot branch",
-                op.symbol()
-            ))
-        }
+        _ => return Err(PointError::Branch { op, word }),
     };
     Ok(point(zip(x, y, f)))
 }
@@ -204,11 +210,11 @@ fn map1(v: &Value, f: impl Fn(Rc<Sx>) -> Rc<Sx>) -> Value {
 
 /// The builtins that accept per-point arguments, applied to `a` (bound to the overload's
 /// parameters, at least one per-point). `None` for a builtin that needs constants.
-pub fn builtin(name: &str, a: &[Value]) -> Option<Result<Value, String>> {
+pub fn builtin(name: &str, a: &[Value]) -> Option<Value> {
     let c = |i: usize| comps(&a[i]).unwrap_or_default();
     let s = |i: usize| c(i)[0].clone();
-    let f1 = |u: FUn| Some(Ok(map1(&a[0], |x| un(u, x))));
-    Some(Ok(match name {
+    let f1 = |u: FUn| Some(map1(&a[0], |x| un(u, x)));
+    Some(match name {
         "sin" => return f1(FUn::Sin),
         "cos" => return f1(FUn::Cos),
         "tan" => return f1(FUn::Tan),
@@ -278,7 +284,7 @@ pub fn builtin(name: &str, a: &[Value]) -> Option<Result<Value, String>> {
         "float" => a[0].clone(),
         "distance" => {
             let (Value::Shape(id) | Value::Profile(id)) = a[0] else {
-                return Some(Ok(Value::Error));
+                return Some(Value::Error);
             };
             // A profile's distance reads x and y: it is read in the plane z = 0.
             let q = c(1);
@@ -293,13 +299,13 @@ pub fn builtin(name: &str, a: &[Value]) -> Option<Result<Value, String>> {
         "hash" => point(vec![Rc::new(Sx::Hash(c(0)))]),
         "fbm" => return Some(fbm(a)),
         _ => return None,
-    }))
+    })
 }
 
 /// Fractal sums of noise: `octaves` noises at frequencies multiplied by `lacunarity` and
 /// amplitudes by `gain`, each octave's point shifted so that the octaves do not share their
 /// lattice's origin.
-fn fbm(a: &[Value]) -> Result<Value, String> {
+fn fbm(a: &[Value]) -> Value {
     let q = comps(&a[0]).unwrap_or_default();
     let octaves = a[1].num() as i64;
     let (lac, gain) = (a[2].num(), a[3].num());
@@ -319,7 +325,7 @@ fn fbm(a: &[Value]) -> Result<Value, String> {
         freq *= lac;
         amp *= gain;
     }
-    Ok(point(vec![sum.unwrap_or_else(|| k(0.0))]))
+    point(vec![sum.unwrap_or_else(|| k(0.0))])
 }
 
 /// Whether any of the expressions `out` reads a shape's distance (each shared part visited

@@ -6,6 +6,21 @@
 
 use crate::program::outline::{Glyph, Outline, Segment};
 
+/// Why a text cannot be laid out in a font.
+#[derive(Debug, thiserror::Error)]
+pub enum FontError {
+    #[error("the file is not a font that can be read ({0})")]
+    NotAFont(ttf_parser::FaceParsingError),
+    #[error("the text is empty")]
+    Empty,
+    #[error("the font has no glyph for {ch:?} (U+{:04X})", u32::from(*ch))]
+    NoGlyph { ch: char },
+    #[error("the font's outlines are cubic curves (a CFF font); only TrueType outlines, of lines and quadratic curves, are read")]
+    Cubic,
+    #[error("the text has no visible glyph (it is all spaces)")]
+    NoInk,
+}
+
 /// The font `text` uses when no `font:` is given: DejaVu Sans.
 pub fn default_font() -> &'static [u8] {
     dejavu::sans::regular()
@@ -21,11 +36,10 @@ const FLAT: f64 = 1e-6;
 /// (so that it reads from left to right looking along +z, as the default camera does); the
 /// first line's capital letters and the last line's baseline centred on y = 0. `Err` says
 /// why not.
-pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, String> {
-    let face = ttf_parser::Face::parse(bytes, 0)
-        .map_err(|e| format!("the file is not a font that can be read ({e})"))?;
+pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, FontError> {
+    let face = ttf_parser::Face::parse(bytes, 0).map_err(FontError::NotAFont)?;
     if text.is_empty() {
-        return Err("the text is empty".into());
+        return Err(FontError::Empty);
     }
     let upem = f64::from(face.units_per_em());
     let scale = size / upem;
@@ -55,7 +69,7 @@ pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, String> {
         let id = face
             .glyph_index(ch)
             .filter(|_| !ch.is_control())
-            .ok_or_else(|| format!("the font has no glyph for {ch:?} (U+{:04X})", u32::from(ch)))?;
+            .ok_or(FontError::NoGlyph { ch })?;
         if let Some(p) = prev {
             let k: f64 = kerning
                 .iter()
@@ -71,11 +85,7 @@ pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, String> {
         };
         face.outline_glyph(id, &mut b);
         if b.cubic {
-            return Err(
-                "the font's outlines are cubic curves (a CFF font); only TrueType outlines, of \
-                 lines and quadratic curves, are read"
-                    .into(),
-            );
+            return Err(FontError::Cubic);
         }
         b.close();
         if !b.segments.is_empty() {
@@ -86,7 +96,7 @@ pub fn layout(bytes: &[u8], text: &str, size: f64) -> Result<Outline, String> {
     }
     lines.push((first, pen));
     if glyphs.is_empty() {
-        return Err("the text has no visible glyph (it is all spaces)".into());
+        return Err(FontError::NoInk);
     }
     let cap = face
         .capital_height()
@@ -396,17 +406,15 @@ mod tests {
 
     #[test]
     fn bad_text_and_fonts_say_why() {
-        assert_eq!(
-            layout(default_font(), "", 1.0).unwrap_err(),
-            "the text is empty"
-        );
-        assert!(layout(default_font(), "   ", 1.0)
-            .unwrap_err()
-            .contains("no visible glyph"));
-        assert!(layout(b"not a font at all", "A", 1.0)
-            .unwrap_err()
-            .starts_with("the file is not a font"));
-        let e = layout(default_font(), "A\u{10FFFD}", 1.0).unwrap_err();
-        assert!(e.contains("U+10FFFD"), "{e}");
+        let fails = |font: &[u8], text| layout(font, text, 1.0).unwrap_err();
+        assert!(matches!(fails(default_font(), ""), FontError::Empty));
+        assert_eq!(fails(default_font(), "").to_string(), "the text is empty");
+        assert!(matches!(fails(default_font(), "   "), FontError::NoInk));
+        let e = fails(b"not a font at all", "A");
+        assert!(matches!(e, FontError::NotAFont(_)));
+        assert!(e.to_string().starts_with("the file is not a font"), "{e}");
+        let e = fails(default_font(), "A\u{10FFFD}");
+        assert!(matches!(e, FontError::NoGlyph { ch: '\u{10FFFD}' }));
+        assert!(e.to_string().contains("U+10FFFD"), "{e}");
     }
 }

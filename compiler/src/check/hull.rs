@@ -52,7 +52,7 @@ const TAKES: &str = "`hull` takes balls (`sphere`, `capsule`, `segment`, `round_
 
 /// Why `hull` refuses its shapes.
 #[derive(Debug)]
-pub(super) enum Refused {
+pub enum Refused {
     /// More balls and cylinders (`n`, saturating) than the limit `most`; `raise` says how
     /// to raise it.
     Many { n: u64, most: usize, raise: String },
@@ -66,7 +66,7 @@ pub(super) enum Refused {
 
 /// What a shape given to `hull` is that it does not take.
 #[derive(Debug)]
-pub(super) enum Misfit {
+pub enum Misfit {
     /// A shape of this kind.
     Kind(&'static str),
     Painted,
@@ -75,7 +75,7 @@ pub(super) enum Misfit {
 
 /// How a cylinder differs from the first of a `hull`.
 #[derive(Debug)]
-pub(super) enum Apart {
+pub enum Apart {
     Turned,
     Height,
     Moved,

@@ -1017,7 +1017,7 @@ fn interpreted_kernels_assemble() {
 /// accepts what the launcher passes and names what differs otherwise.
 #[test]
 fn the_parameters_are_returned_and_launches_checked_against_them() {
-    use ptx::{check_arguments, Argument, Space};
+    use ptx::{check_arguments, Argument, Fault, Mismatch, Space};
     let text = "render { max_depth: 2 }\n\
                 scene {\n  for i in 0..300 { sphere(0.2).translate(i * 0.5, 0, 0); }\n}\n";
     let (scene, diags, _) = sdfc_compiler::check_str("row.sdf", text);
@@ -1077,13 +1077,29 @@ fn the_parameters_are_returned_and_launches_checked_against_them() {
         println!("{what}: {e}");
         e
     };
-    assert!(refused(&args[..5], "no finished pixels").contains("takes 6 buffers"));
+    let fault = |e: Mismatch| match e {
+        Mismatch::Argument { fault, .. } => fault,
+        other => panic!("{other}"),
+    };
+    let e = refused(&args[..5], "no finished pixels");
+    assert!(matches!(e, Mismatch::Count { passed: 5, .. }));
+    assert!(e.to_string().contains("takes 6 buffers"));
     let mut small = args.clone();
     small[0].bytes = uniform - 16;
-    assert!(refused(&small, "a short uniform").contains("needs at least"));
+    let e = fault(refused(&small, "a short uniform"));
+    assert!(matches!(e, Fault::Short { .. }), "{e}");
     let mut swapped = args.clone();
     swapped.swap(2, 3);
-    assert!(refused(&swapped, "image and statistics swapped").contains("binding(3)"));
+    let e = fault(refused(&swapped, "image and statistics swapped"));
+    assert_eq!(
+        e,
+        Fault::Binding {
+            group: 0,
+            binding: 3
+        }
+    );
     args[4].space = rw;
-    assert!(refused(&args, "scene data passed writable").contains("read_write"));
+    let e = fault(refused(&args, "scene data passed writable"));
+    assert_eq!(e, Fault::Space(rw));
+    assert!(e.to_string().contains("read_write"));
 }

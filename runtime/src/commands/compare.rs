@@ -2,7 +2,7 @@
 //! differing pixels) and, when both carry a depth sidecar (`sdfc render --aux`), how their
 //! first hits differ (missed, false and late hits, relative depth error).
 
-use crate::depth::{self, Depth};
+use crate::depth::{self, Depth, DepthError};
 use crate::image::read_png;
 use crate::metrics::{self, DepthDifference, Difference};
 use std::path::{Path, PathBuf};
@@ -58,7 +58,7 @@ pub fn run(args: CompareArgs) -> ExitCode {
     };
     let (depth, depth_note) = match depth_difference(&args) {
         Ok(d) => (Some(d), None),
-        Err(note) => (None, Some(note)),
+        Err(note) => (None, Some(note.to_string())),
     };
     let report = Report {
         colour,
@@ -122,35 +122,40 @@ pub fn text(r: &Report) -> String {
 }
 
 /// The first-hit difference of the two images' sidecars, or why there is none.
-fn depth_difference(args: &CompareArgs) -> Result<DepthDifference, String> {
+fn depth_difference(args: &CompareArgs) -> Result<DepthDifference, NoDepth> {
     let a = sidecar(&args.a)?;
     let b = sidecar(&args.b)?;
-    metrics::compare_depth(&a, &b, args.depth_tolerance).ok_or_else(|| {
-        format!(
-            "the sidecars differ in size: {}x{} and {}x{}",
-            a.width, a.height, b.width, b.height
-        )
+    metrics::compare_depth(&a, &b, args.depth_tolerance).ok_or(NoDepth::Sizes {
+        a: (a.width, a.height),
+        b: (b.width, b.height),
     })
+}
+
+/// Why the images' depths are not compared.
+#[derive(Debug, thiserror::Error)]
+enum NoDepth {
+    #[error("no sidecar `{}` (render with `sdfc render --aux` on the CPU; the GPU backends write none)", .0.display())]
+    Missing(PathBuf),
+    #[error("`{}` is older than its image, from an earlier render", .0.display())]
+    Stale(PathBuf),
+    #[error("cannot read `{}`: {error}", path.display())]
+    Unreadable { path: PathBuf, error: DepthError },
+    #[error("the sidecars differ in size: {}x{} and {}x{}", a.0, a.1, b.0, b.1)]
+    Sizes { a: (u32, u32), b: (u32, u32) },
 }
 
 /// The depth sidecar of an image, if there is a current one: a sidecar older than its image
 /// belongs to an earlier render and is ignored.
-fn sidecar(image: &Path) -> Result<Depth, String> {
+fn sidecar(image: &Path) -> Result<Depth, NoDepth> {
     let path = depth::sidecar_path(image);
     if !path.exists() {
-        return Err(format!(
-            "no sidecar `{}` (render with `sdfc render --aux` on the CPU; the GPU backends write none)",
-            path.display()
-        ));
+        return Err(NoDepth::Missing(path));
     }
     let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
     if let (Some(img), Some(side)) = (modified(image), modified(&path)) {
         if side < img {
-            return Err(format!(
-                "`{}` is older than its image, from an earlier render",
-                path.display()
-            ));
+            return Err(NoDepth::Stale(path));
         }
     }
-    Depth::read(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))
+    Depth::read(&path).map_err(|error| NoDepth::Unreadable { path, error })
 }

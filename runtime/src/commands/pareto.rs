@@ -12,6 +12,7 @@ use crate::cpu::{Precision, Render};
 use crate::frontend;
 use crate::job::{self, Error, FrameScene, Job, Open, Overrides, Ready, Use};
 use crate::metrics;
+use crate::output::CannotWrite;
 use crate::pareto::{
     chart_of, combinations, describe, mark_fronts, parse_sweep_within, same, table, Measured,
     ReferenceInfo, Report, DEFAULT_SWEEPS,
@@ -120,7 +121,7 @@ pub fn run(args: ParetoArgs) -> ExitCode {
         scene.settings.method = Method::March;
     }
     let mut plan = || -> Result<_, Error> {
-        check_output(args.output.as_deref()).map_err(Error::Usage)?;
+        check_output(args.output.as_deref()).map_err(|e| Error::Usage(e.to_string()))?;
         job.settings(&mut scene)?;
         let sweeps = specs
             .iter()
@@ -153,17 +154,27 @@ pub fn run(args: ParetoArgs) -> ExitCode {
 
 /// Refuses a chart name that is neither .svg nor .png, or that cannot be written (a missing
 /// directory), before any work is done.
-pub(super) fn check_output(out: Option<&std::path::Path>) -> Result<(), String> {
+pub(super) fn check_output(out: Option<&std::path::Path>) -> Result<(), ChartRefused> {
     let Some(path) = out else { return Ok(()) };
     let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
     match ext {
-        Some(e) if e == "svg" || e == "png" => crate::output::check_writable(path)
-            .map_err(|why| format!("cannot write `{}`: {why}", path.display())),
-        _ => Err(format!(
-            "`{}`: the chart must be a .svg or .png file",
-            path.display()
-        )),
+        Some(e) if e == "svg" || e == "png" => crate::output::check_writable(path).map_err(|why| {
+            ChartRefused::Unwritable(CannotWrite {
+                path: path.into(),
+                why,
+            })
+        }),
+        _ => Err(ChartRefused::Format(path.into())),
     }
+}
+
+/// Why the chart `--output` names cannot be written.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum ChartRefused {
+    #[error(transparent)]
+    Unwritable(CannotWrite),
+    #[error("`{}`: the chart must be a .svg or .png file", .0.display())]
+    Format(std::path::PathBuf),
 }
 
 /// Prints the report and draws the chart.

@@ -100,7 +100,7 @@ fn resolutions(args: &ParetoArgs, limits: &sdfc_compiler::Limits) -> Result<Vec<
 /// Meshes the scene at every resolution, `args.frames` times each.
 fn measure(args: &ParetoArgs) -> Result<MeshReport, (u8, String)> {
     let usage = |msg: String| (2u8, msg);
-    super::pareto::check_output(args.output.as_deref()).map_err(usage)?;
+    super::pareto::check_output(args.output.as_deref()).map_err(|e| usage(e.to_string()))?;
     let limits = args.limits.limits();
     let resolutions = resolutions(args, &limits).map_err(|e| usage(e.to_string()))?;
     let mut settings = settings(&args.set).map_err(usage)?;

@@ -8,7 +8,7 @@ use super::JobArgs;
 use crate::backend::{self, Devices, Frame, Opening, Prepared, Setup};
 use crate::cpu::reference::{self, Convergence};
 use crate::job::{self, Error, Job};
-use crate::output::Output;
+use crate::output::{CannotWrite, Output};
 use crate::{depth, frontend};
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{LowerOptions, Scene};
@@ -144,7 +144,7 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
     let (backend, _) = mode?;
     job.check_kernel(backend)?;
     // The output is checked before any work, so that a render is never thrown away.
-    let out = output(args).map_err(Error::Usage)?;
+    let out = output(args).map_err(|e| Error::Usage(e.to_string()))?;
     let pool = job.pool()?;
     run.lap("setup", "output checked, thread pool");
     let setup = Setup {
@@ -216,7 +216,8 @@ fn still(args: &RenderArgs, job: &Job) -> Result<Finished, Error> {
         .write(&picture, false, args.png_level)
         .map_err(|e| Error::Io(e.to_string()))?;
     if let (true, Some(path)) = (args.aux, out.path()) {
-        write_sidecar(path, frame.render.depth.as_ref(), prepared.name()).map_err(Error::Io)?;
+        write_sidecar(path, frame.render.depth.as_ref(), prepared.name())
+            .map_err(|e| Error::Io(e.to_string()))?;
     }
     run.split(
         "image",
@@ -375,26 +376,52 @@ pub fn stats(
 
 /// Where the image goes (`-o`, or the scene's name with `.png` in the current directory),
 /// checked: a known format, a writable place; `--aux` needs a file to put its sidecar beside.
-fn output(args: &RenderArgs) -> Result<Output, String> {
+fn output(args: &RenderArgs) -> Result<Output, OutputRefused> {
     let path = args
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.file));
-    let out = Output::new(&path).map_err(|e| e.to_string())?;
+    let out = Output::new(&path)?;
     if out == Output::Stdout && std::io::stdout().is_terminal() {
-        return Err("`-o -` writes the PNG's bytes to standard output, which is a terminal here; redirect it (`-o - > out.png`) or name a file".into());
+        return Err(OutputRefused::Terminal);
     }
     if args.aux && out == Output::Stdout {
-        return Err(
-            "--aux writes the depth sidecar beside the image file; it cannot be used with `-o -`"
-                .into(),
-        );
+        return Err(OutputRefused::AuxToStdout);
     }
     if let (true, Some(p)) = (args.aux, out.path()) {
-        crate::output::check_writable(&depth::sidecar_path(p))
-            .map_err(|why| format!("cannot write `{}`: {why}", depth::sidecar_path(p).display()))?;
+        let path = depth::sidecar_path(p);
+        if let Err(why) = crate::output::check_writable(&path) {
+            return Err(CannotWrite { path, why }.into());
+        }
     }
     Ok(out)
+}
+
+/// Why `sdfc render` refuses its output before any work.
+#[derive(Debug, thiserror::Error)]
+enum OutputRefused {
+    /// The image or its `--aux` sidecar cannot be written.
+    #[error(transparent)]
+    Path(#[from] CannotWrite),
+    #[error("`-o -` writes the PNG's bytes to standard output, which is a terminal here; redirect it (`-o - > out.png`) or name a file")]
+    Terminal,
+    #[error("--aux writes the depth sidecar beside the image file; it cannot be used with `-o -`")]
+    AuxToStdout,
+}
+
+/// Why the depth sidecar was not written, or a stale one not removed.
+#[derive(Debug, thiserror::Error)]
+enum SidecarError {
+    #[error("cannot write `{}`: {error}", path.display())]
+    Write {
+        path: PathBuf,
+        error: depth::DepthError,
+    },
+    #[error("cannot remove the stale sidecar `{}`: {error}", path.display())]
+    Stale {
+        path: PathBuf,
+        error: std::io::Error,
+    },
 }
 
 /// Renders the convergence check of a reference frame (ε divided by ten, or twice the samples
@@ -427,23 +454,22 @@ pub fn not_converged(c: &Convergence) -> String {
 /// Writes the depth sidecar beside `image`. A backend without depth buffers writes none,
 /// and a sidecar left there by an earlier render is removed so that it cannot be mistaken
 /// for this one's.
-fn write_sidecar(image: &Path, depth: Option<&depth::Depth>, backend: &str) -> Result<(), String> {
+fn write_sidecar(
+    image: &Path,
+    depth: Option<&depth::Depth>,
+    backend: &str,
+) -> Result<(), SidecarError> {
     let path = depth::sidecar_path(image);
     match depth {
         Some(d) => d
             .write(&path)
-            .map_err(|e| format!("cannot write `{}`: {e}", path.display())),
+            .map_err(|error| SidecarError::Write { path, error }),
         None => {
             eprintln!("note: the {backend} backend has no depth buffers; no sidecar written");
             match std::fs::remove_file(&path) {
                 Ok(()) => eprintln!("note: removed the stale sidecar `{}`", path.display()),
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(e) => {
-                    return Err(format!(
-                        "cannot remove the stale sidecar `{}`: {e}",
-                        path.display()
-                    ))
-                }
+                Err(error) => return Err(SidecarError::Stale { path, error }),
             }
             Ok(())
         }

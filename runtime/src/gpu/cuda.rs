@@ -45,7 +45,10 @@ pub enum Error {
     /// What a launch would pass differs from the kernel's parameters (a bug of sdfc's):
     /// refused before launching.
     #[error("internal error: the CUDA kernel's parameters do not match the launch: {0}")]
-    Arguments(String),
+    Arguments(#[from] ptx::Mismatch),
+    /// The scene's uniforms do not fit the kernel's layout (a bug of sdfc's).
+    #[error("internal error: the CUDA kernel's parameters do not match the launch: {0}")]
+    Uniforms(#[from] sdfc_compiler::wgsl::Mismatch),
 }
 
 fn driver(during: &'static str) -> impl Fn(cudarc::driver::DriverError) -> Error {

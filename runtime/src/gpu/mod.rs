@@ -162,8 +162,7 @@ pub fn render_cuda(
     (faults, statistics, finished): (&launch::Faults, bool, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, cuda::Error> {
-    let uniforms =
-        wgsl::uniforms(uniform, scene, lipschitz).map_err(|e| cuda::Error::Arguments(e.0))?;
+    let uniforms = wgsl::uniforms(uniform, scene, lipschitz)?;
     let device = cuda.kernel(loaded, wgsl::WORKGROUP);
     render_one(
         &device,

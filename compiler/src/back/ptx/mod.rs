@@ -49,7 +49,7 @@ use std::cell::Cell;
 use std::collections::HashSet;
 use std::fmt;
 
-pub use params::{check_arguments, Argument, Param, Space};
+pub use params::{check_arguments, Argument, Fault, Mismatch, Param, Space};
 
 /// What to write.
 #[derive(Debug, Clone, PartialEq, Eq)]

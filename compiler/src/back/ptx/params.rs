@@ -106,54 +106,85 @@ pub(super) fn params(
         .collect())
 }
 
-/// `Err` saying what differs when `args` are not what `params` declare: as many, each for
-/// the parameter's binding and address space, an argument of the parameter's size, a
-/// buffer at least as large as its type (whole elements of a runtime-sized array).
-pub fn check_arguments(params: &[Param], args: &[Argument]) -> Result<(), String> {
+/// How a launch's arguments differ from the kernel's parameters.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Mismatch {
+    /// Not one argument for each parameter.
+    #[error("the kernel takes {} buffers ({}), the launch passes {passed}", declared.len(), declared.join(", "))]
+    Count {
+        /// The parameters' bindings and variables, `@binding(0) params`.
+        declared: Vec<String>,
+        passed: usize,
+    },
+    /// One parameter (`what` describes it) and how its argument differs.
+    #[error("{what} {fault}")]
+    Argument { what: String, fault: Fault },
+}
+
+/// How one argument differs from its parameter.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Fault {
+    #[error("is passed the buffer of @group({group}) @binding({binding})")]
+    Binding { group: u32, binding: u32 },
+    #[error("is passed a {0} buffer")]
+    Space(Space),
+    #[error("is a .{ty} of {size} bytes, passed an argument of {passed} bytes")]
+    Size {
+        ty: &'static str,
+        size: u32,
+        passed: u32,
+    },
+    #[error("needs at least {least} bytes, passed {passed}")]
+    Short { least: u64, passed: u64 },
+    #[error("holds elements of {stride} bytes, passed {passed} bytes")]
+    Stride { stride: u64, passed: u64 },
+}
+
+/// What differs when `args` are not what `params` declare: as many, each for the
+/// parameter's binding and address space, an argument of the parameter's size, a buffer at
+/// least as large as its type (whole elements of a runtime-sized array).
+pub fn check_arguments(params: &[Param], args: &[Argument]) -> Result<(), Mismatch> {
     if params.len() != args.len() {
-        let list: Vec<String> = params
-            .iter()
-            .map(|p| format!("@binding({}) {}", p.binding, p.var))
-            .collect();
-        return Err(format!(
-            "the kernel takes {} buffers ({}), the launch passes {}",
-            params.len(),
-            list.join(", "),
-            args.len()
-        ));
+        return Err(Mismatch::Count {
+            declared: params
+                .iter()
+                .map(|p| format!("@binding({}) {}", p.binding, p.var))
+                .collect(),
+            passed: args.len(),
+        });
     }
     for (p, a) in params.iter().zip(args) {
+        let fault = if (a.group, a.binding) != (p.group, p.binding) {
+            Fault::Binding {
+                group: a.group,
+                binding: a.binding,
+            }
+        } else if a.space != p.space {
+            Fault::Space(a.space)
+        } else if a.size != p.size {
+            Fault::Size {
+                ty: p.ty,
+                size: p.size,
+                passed: a.size,
+            }
+        } else if a.bytes < p.min_bytes {
+            Fault::Short {
+                least: p.min_bytes,
+                passed: a.bytes,
+            }
+        } else if let Some(stride) = p.stride.filter(|&s| a.bytes % s != 0) {
+            Fault::Stride {
+                stride,
+                passed: a.bytes,
+            }
+        } else {
+            continue;
+        };
         let what = format!(
             "parameter {} (@group({}) @binding({}) var<{}> {})",
             p.name, p.group, p.binding, p.space, p.var
         );
-        if (a.group, a.binding) != (p.group, p.binding) {
-            return Err(format!(
-                "{what} is passed the buffer of @group({}) @binding({})",
-                a.group, a.binding
-            ));
-        }
-        if a.space != p.space {
-            return Err(format!("{what} is passed a {} buffer", a.space));
-        }
-        if a.size != p.size {
-            return Err(format!(
-                "{what} is a .{} of {} bytes, passed an argument of {} bytes",
-                p.ty, p.size, a.size
-            ));
-        }
-        if a.bytes < p.min_bytes {
-            return Err(format!(
-                "{what} needs at least {} bytes, passed {}",
-                p.min_bytes, a.bytes
-            ));
-        }
-        if let Some(s) = p.stride.filter(|&s| a.bytes % s != 0) {
-            return Err(format!(
-                "{what} holds elements of {s} bytes, passed {} bytes",
-                a.bytes
-            ));
-        }
+        return Err(Mismatch::Argument { what, fault });
     }
     Ok(())
 }

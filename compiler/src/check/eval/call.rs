@@ -192,7 +192,7 @@ impl Ctx<'_> {
             return Value::Error;
         }
         if let Some(at) = point_at {
-            return self.point_builtin(b, sig, &vals, at, span);
+            return self.point_builtin(b, sig, &vals, at);
         }
         if abstract_ || self.dry > 0 {
             return if vals.contains(&Value::Error) {
@@ -222,9 +222,9 @@ impl Ctx<'_> {
         }
         match result {
             Ok(v) => self.finite(v, span),
-            Err(msg) => {
+            Err(refusal) => {
                 self.error(
-                    Diagnostic::error("E0400", msg, span)
+                    Diagnostic::error("E0400", refusal.to_string(), span)
                         .with_label(format!("in this call of `{}`", b.name)),
                 );
                 Value::Error

@@ -65,9 +65,9 @@ impl Ctx<'_> {
         }
         match field::binary(op, a.0, b.0, self.word()) {
             Ok(v) => v,
-            Err(msg) => {
+            Err(e) => {
                 let at = if field::is_point(a.0) { a.1 } else { b.1 };
-                let v = self.per_point(msg, at);
+                let v = self.per_point(e.to_string(), at);
                 let word = self.word();
                 if let Some(d) = self.diags.last_mut() {
                     d.help = Some(format!(
@@ -86,7 +86,6 @@ impl Ctx<'_> {
         sig: &builtins::Sig,
         vals: &[Value],
         at: Span,
-        span: Span,
     ) -> Value {
         if vals.iter().any(Value::is_abstract) {
             return if vals.contains(&Value::Error) {
@@ -96,14 +95,7 @@ impl Ctx<'_> {
             };
         }
         match field::builtin(b.name, vals) {
-            Some(Ok(v)) => v,
-            Some(Err(msg)) => {
-                self.error(
-                    Diagnostic::error("E0400", msg, span)
-                        .with_label(format!("in this call of `{}`", b.name)),
-                );
-                Value::Error
-            }
+            Some(v) => v,
             None => self.per_point(
                 format!("`{}` needs values known at compile time", b.name),
                 at,

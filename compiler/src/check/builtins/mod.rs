@@ -1,6 +1,8 @@
 //! The built-in functions and record schemas: signatures (types, defaults, valid ranges) and
 //! their constant evaluation. Shape builtins add nodes to the scene graph.
 
+mod refusal;
+
 use super::types::{Type, Value};
 use super::LoadError;
 use crate::limits::{Limit, Limits};
@@ -11,6 +13,7 @@ use crate::scene::{
     Camera, Combine, Feature, Graph, Material, Node, NodeId, Path, Pbr, Settings, Smooth, V3,
 };
 use crate::span::Span;
+pub use refusal::{Expected, MeshRefusal, OutOfRange, Refusal};
 
 impl Def {
     /// The default as a value; `None` for a required parameter.
@@ -47,47 +50,34 @@ impl Range {
         }
     }
 
-    /// Checks a concrete value; returns what was expected when it is out of range.
-    pub fn check(self, v: &Value, limits: &Limits) -> Result<(), String> {
+    /// Checks a concrete value; says what was expected when it is out of range.
+    pub fn check(self, v: &Value, limits: &Limits) -> Result<(), OutOfRange> {
         let range = self.resolve(limits);
         let c = v.components();
-        let ok = match range {
-            Range::Any => true,
-            Range::Pos => c.iter().all(|&x| x > 0.0),
-            Range::NonNeg => c.iter().all(|&x| x >= 0.0),
-            Range::Unit => c.iter().all(|&x| (0.0..=1.0).contains(&x)),
-            Range::Within(lo, hi) => c.iter().all(|&x| x >= lo && x <= hi),
-            Range::NonZero => c.iter().any(|&x| x != 0.0),
+        let expected = match range {
+            Range::Any | Range::Limited(..) | Range::Chars(_) => return Ok(()),
+            Range::Pos if c.iter().all(|&x| x > 0.0) => return Ok(()),
+            Range::NonNeg if c.iter().all(|&x| x >= 0.0) => return Ok(()),
+            Range::Unit if c.iter().all(|&x| (0.0..=1.0).contains(&x)) => return Ok(()),
+            Range::Within(lo, hi) if c.iter().all(|&x| x >= lo && x <= hi) => return Ok(()),
+            Range::NonZero if c.iter().any(|&x| x != 0.0) => return Ok(()),
             Range::OneOf(opts) => match v {
-                Value::Str(s) => opts.contains(&&**s),
-                _ => true,
+                Value::Str(s) if !opts.contains(&&**s) => Expected::OneOf(opts),
+                _ => return Ok(()),
             },
-            Range::Limited(..) | Range::Chars(_) => true,
+            Range::Pos => Expected::Positive,
+            Range::NonNeg => Expected::NonNegative,
+            Range::Unit => Expected::Unit,
+            Range::Within(lo, hi) => Expected::Within {
+                lo,
+                hi,
+                angle: matches!(v, Value::Angle(_)),
+            },
+            Range::NonZero => Expected::NonZero,
         };
-        if ok {
-            return Ok(());
-        }
-        let vector = matches!(v, Value::Vec2(_) | Value::Vec3(_));
-        let each = if vector { "every component " } else { "" };
-        // Angles are shown in degrees, as they are usually written.
-        let show = |x: f64| match v {
-            Value::Angle(_) => format!("{}deg", crate::scene::dump_num(x.to_degrees())),
-            _ => crate::scene::dump_num(x),
-        };
-        Err(match range {
-            Range::Any | Range::Limited(..) | Range::Chars(_) => String::new(),
-            Range::Pos => format!("{each}must be greater than 0"),
-            Range::NonNeg => format!("{each}must be 0 or more"),
-            Range::Unit => format!("{each}must be between 0 and 1"),
-            Range::Within(lo, hi) => format!("{each}must be between {} and {}", show(lo), show(hi)),
-            Range::NonZero => "must not be the zero vector".to_string(),
-            Range::OneOf(opts) => format!(
-                "must be one of {}",
-                opts.iter()
-                    .map(|o| format!("\"{o}\""))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
+        Err(OutOfRange {
+            expected,
+            vector: matches!(v, Value::Vec2(_) | Value::Vec3(_)),
         })
     }
 }
@@ -118,7 +108,7 @@ const fn shape(name: &'static str) -> P {
 #[derive(Clone, Copy)]
 pub enum Imp {
     /// A function of the arguments.
-    Fn(fn(&mut Build<'_, '_>, &[Value]) -> Result<Value, String>),
+    Fn(fn(&mut Build<'_, '_>, &[Value]) -> Result<Value, Refusal>),
     /// A primitive of the table: its node, once its checks pass.
     Prim(&'static Prim),
 }
@@ -134,7 +124,7 @@ impl std::fmt::Debug for Imp {
 
 impl Imp {
     /// Evaluates the overload on its arguments.
-    pub fn call(self, b: &mut Build<'_, '_>, a: &[Value]) -> Result<Value, String> {
+    pub fn call(self, b: &mut Build<'_, '_>, a: &[Value]) -> Result<Value, Refusal> {
         match self {
             Imp::Fn(f) => f(b, a),
             Imp::Prim(prim) => {
@@ -150,7 +140,7 @@ impl Imp {
                     }
                 }
                 if let Some(why) = (prim.check)(&args) {
-                    return Err(why);
+                    return Err(Refusal::Primitive(why));
                 }
                 let node = Node::Prim {
                     prim: PrimRef(prim),
@@ -216,14 +206,15 @@ impl Build<'_, '_> {
 
     /// The shape of the triangle mesh in the file `path` (relative to the calling file),
     /// scaled by `scale`: read once per file and scale, with a warning where it is open.
-    fn mesh(&mut self, path: &str, scale: f64) -> Result<Value, String> {
+    fn mesh(&mut self, path: &str, scale: f64) -> Result<Value, Refusal> {
         use super::meshfile::{read, Error, Format};
-        use crate::program::mesh::{Invalid, TriMesh};
-        let format = Format::of(path).ok_or_else(|| {
-            format!("`{path}` is not a mesh file: `mesh` reads .stl, .obj, .ply and .glb files")
-        })?;
-        // The builtins' errors are the labels of their diagnostics, as text.
-        let no_files = || LoadError::NoFiles { path: path.into() }.to_string();
+        use crate::program::mesh::TriMesh;
+        let format = Format::of(path).ok_or_else(|| Refusal::NotMeshFile { path: path.into() })?;
+        let refused = |why| Refusal::Mesh {
+            path: path.into(),
+            why,
+        };
+        let no_files = || Refusal::File(LoadError::NoFiles { path: path.into() });
         let files = self.files.as_deref_mut().ok_or_else(no_files)?;
         let from = files
             .names
@@ -231,7 +222,7 @@ impl Build<'_, '_> {
             .cloned()
             .unwrap_or_default();
         let loader = files.loader.as_deref_mut().ok_or_else(no_files)?;
-        let (name, bytes) = loader.load_bytes(&from, path).map_err(|e| e.to_string())?;
+        let (name, bytes) = loader.load_bytes(&from, path)?;
         let key = (name.clone(), scale.to_bits());
         if let Some(m) = files.meshes.get(&key) {
             let node = Node::Mesh {
@@ -241,37 +232,26 @@ impl Build<'_, '_> {
         }
         let max = self.limits.get(Limit::Triangles);
         let used = files.triangles;
-        let read = read(format, &bytes, max.saturating_sub(used)).map_err(|e| match e {
-            // The limit is for all the scene's meshes: the value that would do is this
-            // file's triangles and those read before it.
-            Error::Limit { triangles, at, .. } => {
-                let at = at.map(|p| format!("{p}: ")).unwrap_or_default();
-                let others = if used > 0 {
-                    format!(", and the scene's other meshes {used}")
-                } else {
-                    String::new()
-                };
-                format!(
-                    "cannot read the mesh `{path}`: {at}the file has {triangles} triangles{others}, more than the `triangles` limit of {max}; {}",
-                    self.limits.raise_to(Limit::Triangles, triangles.saturating_add(used))
-                )
-            }
-            e => format!("cannot read the mesh `{path}`: {e}"),
+        let read = read(format, &bytes, max.saturating_sub(used)).map_err(|e| {
+            refused(match e {
+                // The limit is for all the scene's meshes: the value that would do is this
+                // file's triangles and those read before it.
+                Error::Limit { triangles, at, .. } => MeshRefusal::Limit {
+                    at,
+                    triangles,
+                    others: used,
+                    max,
+                    raise: self
+                        .limits
+                        .raise_to(Limit::Triangles, triangles.saturating_add(used)),
+                },
+                e => MeshRefusal::Format(e),
+            })
         })?;
-        let mut mesh = TriMesh::new(path, &read.positions, &read.faces, scale).map_err(|e| {
-            let why = match e {
-                Invalid::NotFinite(i) => format!(
-                    "vertex {i} (counting from 0 in the file's order) has a coordinate that is not a finite number"
-                ),
-                Invalid::Index(t, i) => format!("triangle {t} names vertex {i}, which does not exist"),
-                Invalid::Empty => "every triangle has no area".to_string(),
-            };
-            format!("cannot read the mesh `{path}`: {why}")
-        })?;
+        let mut mesh = TriMesh::new(path, &read.positions, &read.faces, scale)
+            .map_err(|e| refused(MeshRefusal::Invalid(e)))?;
         mesh.id = files.next_id;
-        mesh.base = u32::try_from(files.next_base).map_err(|_| {
-            format!("cannot read the mesh `{path}`: the scene's meshes take more than 2^32 vectors of GPU data")
-        })?;
+        mesh.base = u32::try_from(files.next_base).map_err(|_| refused(MeshRefusal::GpuData))?;
         files.next_id += 1;
         files.next_base += mesh.vectors();
         files.triangles += mesh.triangles().len() as u64;
@@ -306,19 +286,19 @@ impl Build<'_, '_> {
         })
     }
 
-    fn node(&mut self, node: Node) -> Result<Value, String> {
+    fn node(&mut self, node: Node) -> Result<Value, Refusal> {
         Ok(Value::Shape(self.graph.add(node, self.span)))
     }
 
     /// Adds a node of a profile (whose distance reads only x and y).
-    fn profile(&mut self, node: Node) -> Result<Value, String> {
+    fn profile(&mut self, node: Node) -> Result<Value, Refusal> {
         Ok(Value::Profile(self.graph.add(node, self.span)))
     }
 }
 
 /// The result of a builder of shapes as a profile: the 2D operations add the same nodes as
 /// the 3D ones, in the plane z = 0.
-fn flat(v: Result<Value, String>) -> Result<Value, String> {
+fn flat(v: Result<Value, Refusal>) -> Result<Value, Refusal> {
     Ok(match v? {
         Value::Shape(id) => Value::Profile(id),
         other => other,
@@ -369,7 +349,7 @@ const LP: Type = Type::List(&Type::Profile);
 const PR: Type = Type::Profile;
 
 /// `polygon(points)`: three or more points, not all on a line, no two edges crossing.
-fn polygon(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn polygon(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let Value::List(_, items) = &a[0] else {
         return Ok(Value::Error);
     };
@@ -385,7 +365,7 @@ fn polygon(b: &mut Build, a: &[Value]) -> Result<Value, String> {
 
 /// `text(string, size, font)`: the glyphs of `string` in the font (the shipped DejaVu Sans
 /// when `font` is empty), laid out by `check/font.rs`.
-fn text(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn text(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let (Value::Str(string), Value::Str(font)) = (&a[0], &a[2]) else {
         return Ok(Value::Error);
     };
@@ -406,19 +386,22 @@ fn outline_of(
     string: &str,
     size: f64,
     font: &str,
-) -> Result<crate::program::outline::Outline, String> {
+) -> Result<crate::program::outline::Outline, Refusal> {
     if font.is_empty() {
         super::font::layout(super::font::default_font(), string, size)
+            .map_err(|error| Refusal::Font { font: None, error })
     } else {
-        // The label of the call's diagnostic.
-        let bytes = b.read_bytes(font).map_err(|e| e.to_string())?;
-        super::font::layout(&bytes, string, size).map_err(|e| format!("`{font}`: {e}"))
+        let bytes = b.read_bytes(font)?;
+        super::font::layout(&bytes, string, size).map_err(|error| Refusal::Font {
+            font: Some(font.into()),
+            error,
+        })
     }
 }
 
 /// `text_size`: the width and height of the box around the ink of what `text` draws with
 /// the same arguments.
-fn text_size(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn text_size(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let (Value::Str(string), Value::Str(font)) = (&a[0], &a[2]) else {
         return Ok(Value::Error);
     };
@@ -426,12 +409,10 @@ fn text_size(b: &mut Build, a: &[Value]) -> Result<Value, String> {
     Ok(Value::Vec2([hi[0] - lo[0], hi[1] - lo[1]]))
 }
 
-fn polygon_of(b: &mut Build, points: Vec<[f64; 2]>) -> Result<Value, String> {
+fn polygon_of(b: &mut Build, points: Vec<[f64; 2]>) -> Result<Value, Refusal> {
     let n = points.len();
     if n < 3 {
-        return Err(format!(
-            "a polygon needs at least 3 points, and this one has {n}"
-        ));
+        return Err(Refusal::FewPoints { points: n });
     }
     // Every point on the line through the first and some other point.
     let o = points[0];
@@ -441,33 +422,29 @@ fn polygon_of(b: &mut Build, points: Vec<[f64; 2]>) -> Result<Value, String> {
             .all(|q| (e[0] - o[0]) * (q[1] - o[1]) == (e[1] - o[1]) * (q[0] - o[0]))
     });
     if on_line {
-        return Err("the polygon's points lie on one line: it has no area".to_string());
+        return Err(Refusal::Collinear);
     }
     let crossing = super::polygon::crossing(&points, b.fuel_left, &mut b.steps);
     let Ok(crossing) = crossing else {
         // Out of steps: the evaluator reports the `fuel` limit at the call.
         return Ok(Value::Error);
     };
-    if let Some((i, j)) = crossing {
-        return Err(format!(
-            "the polygon crosses itself: its edge from point {i} and its edge from point {j} meet (a polygon's edges may only meet at their shared ends)"
-        ));
+    if let Some((a, b)) = crossing {
+        return Err(Refusal::SelfCrossing { a, b });
     }
     b.profile(Node::Polygon { points })
 }
 
 /// The rectangle of a profile argument and its bound's scale (`scene::bounds::profile_rect`),
 /// or why it has none.
-fn rect_of(b: &Build, v: &Value, what: &str) -> Result<([f64; 2], [f64; 2], f64), String> {
-    crate::scene::bounds::profile_rect(b.graph, sh(v)).ok_or_else(|| {
-        format!("the {what} profile has no finite extent (it reaches infinity), so it cannot be made solid this way")
-    })
+fn rect_of(b: &Build, v: &Value, what: &'static str) -> Result<([f64; 2], [f64; 2], f64), Refusal> {
+    crate::scene::bounds::profile_rect(b.graph, sh(v)).ok_or(Refusal::Unbounded { what })
 }
 
 /// `bezier(a, control, b, radius)`: the curve is a parabola's arc only where the control
 /// point is off the midpoint of `a` and `b` (at the midpoint it is the segment, which
 /// `segment2` draws).
-fn bezier(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn bezier(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let [x, c, y] = [0, 1, 2].map(|i| {
         let v = a[i].components();
         [v[0], v[1]]
@@ -477,10 +454,7 @@ fn bezier(b: &mut Build, a: &[Value]) -> Result<Value, String> {
         .hypot(y[1] - x[1])
         .max((c[0] - x[0]).hypot(c[1] - x[1]));
     if bend[0].hypot(bend[1]) <= 1e-6 * span.max(1e-300) {
-        return Err(
-            "the control point is the midpoint of `a` and `b`, so the curve is the straight segment: draw it with `segment2(a, b, radius)`"
-                .to_string(),
-        );
+        return Err(Refusal::StraightBezier);
     }
     b.profile(Node::Bezier {
         a: x,
@@ -494,7 +468,7 @@ fn bezier(b: &mut Build, a: &[Value]) -> Result<Value, String> {
 /// circles around their rectangles (docs/analysis.md, "Loft").
 /// Where one profile is an `offset` of the other, their fields differ by its amount
 /// everywhere, and that is the spread.
-fn loft(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn loft(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let (ca, ha, _) = rect_of(b, &a[0], "bottom")?;
     let (cb, hb, _) = rect_of(b, &a[1], "top")?;
     let (x, y) = (sh(&a[0]), sh(&a[1]));
@@ -515,25 +489,17 @@ fn loft(b: &mut Build, a: &[Value]) -> Result<Value, String> {
 
 /// `screw(profile, pitch, height)`: the profile, one turn's cross-section, must lie at
 /// x > 0 (x is the distance from the axis) and within one pitch about y = 0.
-fn screw(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn screw(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let (c, h, scale) = rect_of(b, &a[0], "screw's")?;
     let (pitch, height) = (a[1].num(), a[2].num());
     let inner = c[0] - h[0];
     if inner <= 0.0 {
-        return Err(format!(
-            "a screw's profile must lie at x > 0 (x is the distance from the axis), and this one reaches x = {}",
-            crate::scene::dump_num(inner)
-        ));
+        return Err(Refusal::ScrewAxis { x: inner });
     }
     let (lo, hi) = (c[1] - h[1], c[1] + h[1]);
     let half = pitch / 2.0;
     if lo < -half - 1e-9 * pitch || hi > half + 1e-9 * pitch {
-        return Err(format!(
-            "a screw's profile is one turn of the thread: it must lie within y = ±{} (half the pitch), and this one spans y from {} to {}",
-            crate::scene::dump_num(half),
-            crate::scene::dump_num(lo),
-            crate::scene::dump_num(hi)
-        ));
+        return Err(Refusal::ScrewTurn { half, lo, hi });
     }
     let thread = b.node(Node::Screw {
         pitch,
@@ -569,7 +535,7 @@ fn points3(v: &Value) -> Vec<V3> {
 
 /// `sweep(profile, path)`: the profile's reach from its origin against the path's reach; a
 /// profile that reaches past it (but a disc, whose sweep is a union of balls) is W0018.
-fn sweep(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn sweep(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let Value::Path(path) = &a[1] else {
         return Ok(Value::Error);
     };
@@ -641,7 +607,7 @@ fn regular(sides: usize, radius: f64, phase: f64) -> Vec<[f64; 2]> {
 
 /// The number of elements of a list of any type (`len` has a form for each element type but
 /// `int`: a list of ints fits `[float]`).
-fn len(a: &[Value]) -> Result<Value, String> {
+fn len(a: &[Value]) -> Result<Value, Refusal> {
     match &a[0] {
         Value::List(_, items) => Ok(Value::Int(items.len() as i64)),
         _ => Ok(Value::Error),
@@ -652,7 +618,7 @@ const HANDS: &[&str] = &["right", "left"];
 
 const SMOOTH_VARIANTS: &[&str] = &["poly", "exp", "chamfer", "round", "stairs", "columns"];
 
-fn smooth(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
+fn smooth(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, Refusal> {
     let steps = a[4].num() as u32;
     let variant = match &a[3] {
         Value::Str(s) => match &**s {
@@ -674,7 +640,7 @@ fn smooth(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
     })
 }
 
-fn feature(b: &mut Build, a: &[Value], op: Feature) -> Result<Value, String> {
+fn feature(b: &mut Build, a: &[Value], op: Feature) -> Result<Value, Refusal> {
     b.node(Node::Feature {
         op,
         a: sh(&a[0]),
@@ -709,13 +675,11 @@ fn rotation(axis: V3, angle: f64) -> [V3; 3] {
 
 /// `repeat_polar(shape, count, axis, mirror)`: the node about y, between rotations that take
 /// y to `axis` and back for any other axis.
-fn repeat_polar(b: &mut Build, a: &[Value]) -> Result<Value, String> {
+fn repeat_polar(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let count = a[1].num();
     let mirror = a[3] == Value::Bool(true);
     if mirror && count % 2.0 != 0.0 {
-        return Err(format!(
-            "`mirror: true` alternates the copies, so `count` must be even, not {count}"
-        ));
+        return Err(Refusal::OddMirror { count });
     }
     let n = a[2].v3();
     let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
@@ -759,7 +723,7 @@ fn repeat_polar(b: &mut Build, a: &[Value]) -> Result<Value, String> {
     }
 }
 
-fn rotate(b: &mut Build, child: &Value, axis: V3, angle: f64) -> Result<Value, String> {
+fn rotate(b: &mut Build, child: &Value, axis: V3, angle: f64) -> Result<Value, Refusal> {
     b.node(Node::Rotate {
         matrix: rotation(axis, angle),
         child: sh(child),
@@ -767,18 +731,21 @@ fn rotate(b: &mut Build, child: &Value, axis: V3, angle: f64) -> Result<Value, S
 }
 
 /// The shapes of a list argument; an empty list is an error (nothing to combine).
-fn shapes(list: &Value, name: &str) -> Result<Vec<Value>, String> {
+fn shapes(list: &Value, name: &'static str) -> Result<Vec<Value>, Refusal> {
     match list {
-        Value::List(_, items) if items.is_empty() => Err(format!(
-            "`{name}` of an empty list: there is no shape to combine"
-        )),
+        Value::List(_, items) if items.is_empty() => Err(Refusal::EmptyList { name }),
         Value::List(_, items) => Ok(items.to_vec()),
         _ => Ok(Vec::new()),
     }
 }
 
 /// `union(shapes)`, `intersect(shapes)`: the same node as the shapes given one by one.
-fn combine_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Value, String> {
+fn combine_list(
+    b: &mut Build,
+    a: &[Value],
+    op: Combine,
+    name: &'static str,
+) -> Result<Value, Refusal> {
     let items = shapes(&a[0], name)?;
     match items.as_slice() {
         [one] => Ok(one.clone()),
@@ -788,7 +755,12 @@ fn combine_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<V
 
 /// `smooth_union(k, shapes, …)`: the left fold of the binary form,
 /// `smooth_union(k, smooth_union(k, a, b), c)`; its other arguments as the binary form's.
-fn smooth_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Value, String> {
+fn smooth_list(
+    b: &mut Build,
+    a: &[Value],
+    op: Combine,
+    name: &'static str,
+) -> Result<Value, Refusal> {
     let items = shapes(&a[1], name)?;
     let mut acc = items[0].clone();
     for x in &items[1..] {
@@ -800,21 +772,23 @@ fn smooth_list(b: &mut Build, a: &[Value], op: Combine, name: &str) -> Result<Va
 }
 
 /// `hull(shapes…)` (`hull.rs`): its node, or why there is none.
-fn hull(b: &mut Build, a: &[Value]) -> Result<Value, super::hull::Refused> {
+fn hull(b: &mut Build, a: &[Value]) -> Result<Value, Refusal> {
     let ids: Vec<NodeId> = a.iter().map(sh).collect();
     let (limits, most) = (b.limits, b.limits.count(Limit::HullShapes));
     let raise = |n| limits.raise_to(Limit::HullShapes, n);
-    super::hull::hull(b.graph, b.span, &ids, most, raise).map(Value::Shape)
+    super::hull::hull(b.graph, b.span, &ids, most, raise)
+        .map(Value::Shape)
+        .map_err(Refusal::Hull)
 }
 
-fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, String> {
+fn combine(b: &mut Build, a: &[Value], op: Combine) -> Result<Value, Refusal> {
     b.node(Node::Combine {
         op,
         children: a.iter().map(sh).collect(),
     })
 }
 
-fn f1(a: &[Value], f: fn(f64) -> f64) -> Result<Value, String> {
+fn f1(a: &[Value], f: fn(f64) -> f64) -> Result<Value, Refusal> {
     Ok(Value::Float(f(a[0].num())))
 }
 
@@ -860,13 +834,6 @@ pub const CONSTANTS: &[(&str, f64)] =
 pub fn constant(name: &str) -> Option<f64> {
     CONSTANTS.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
 }
-
-/// The error of a builtin built on a primitive the table lacks (a mistake of the compiler's).
-const NO_PRIM: &str = "a primitive this builtin is built on is missing from the table";
-
-/// The error of a per-point builtin called with constants.
-const PER_POINT: &str =
-    "this is evaluated per point: call it inside `field { … }` with an argument that depends on `p`";
 
 /// Every builtin function: those written here and the primitives of the table (`prim/`).
 pub static BUILTINS: std::sync::LazyLock<Vec<Builtin>> = std::sync::LazyLock::new(|| {
@@ -936,7 +903,7 @@ static FUNCTIONS: &[Builtin] = &[
             [p("half", V, Req, Pos), p("radius", F, Num(0.05), NonNeg)] -> S => |b, a| {
                 let (half, radius) = (a[0].v3(), a[1].num());
                 if half.iter().any(|&h| h < radius) {
-                    return Err(format!("the rounding radius {radius} is larger than a half-extent of the box"));
+                    return Err(Refusal::BoxRounding { radius });
                 }
                 b.node(Node::RoundBox { half, radius })
             };
@@ -995,7 +962,7 @@ static FUNCTIONS: &[Builtin] = &[
         sigs: sigs![
             [p("path", Str, Req, Any), p("scale", F, Num(1.0), Pos)] -> S => |b, a| {
                 let Value::Str(path) = &a[0] else {
-                    return Err("`path` must be a string".into());
+                    return Ok(Value::Error);
                 };
                 b.mesh(path, a[1].num())
             };
@@ -1054,7 +1021,7 @@ static FUNCTIONS: &[Builtin] = &[
         name: "ring",
         sigs: sigs![
             [p("radius", F, Num(0.5), Pos), p("thickness", F, Num(0.1), Pos)] -> PR => |b, a| {
-                let circle = Node::prim("circle", &[&[a[0].num()]]).ok_or(NO_PRIM)?;
+                let circle = Node::prim("circle", &[&[a[0].num()]]).ok_or(Refusal::NoPrimitive { name: "circle" })?;
                 let circle = b.graph.add(circle, b.span);
                 b.profile(Node::Shell { half: a[1].num() / 2.0, child: circle })
             };
@@ -1067,7 +1034,7 @@ static FUNCTIONS: &[Builtin] = &[
                 let (x, y) = (a[0].components(), a[1].components());
                 // The capsule of space about the segment, read in its plane z = 0.
                 let segment = Node::prim("segment", &[&[x[0], x[1], 0.0], &[y[0], y[1], 0.0], &[a[2].num()]]);
-                b.profile(segment.ok_or(NO_PRIM)?)
+                b.profile(segment.ok_or(Refusal::NoPrimitive { name: "segment" })?)
             };
         ],
     },
@@ -1077,7 +1044,7 @@ static FUNCTIONS: &[Builtin] = &[
             [prof("profile"), p("height", F, Req, Pos), p("round", F, Num(0.0), NonNeg)] -> S => |b, a| {
                 let (height, round) = (a[1].num(), a[2].num());
                 if 2.0 * round > height {
-                    return Err(format!("the rounding {round} is more than half the height {height}"));
+                    return Err(Refusal::ExtrudeRounding { round, height });
                 }
                 b.node(Node::Extrude { half_height: height / 2.0, round, child: sh(&a[0]) })
             };
@@ -1096,7 +1063,7 @@ static FUNCTIONS: &[Builtin] = &[
         sigs: sigs![
             [p("a", V2, Req, Any), p("control", V2, Req, Any), p("b", V2, Req, Any), p("radius", F, Num(0.05), Pos)] -> PR => bezier;
             [p("points", Type::List(&V), Req, Any)] -> Type::Path => |_, a| {
-                Ok(Value::Path(std::sync::Arc::new(Path::bezier(&points3(&a[0])).map_err(|e| e.to_string())?)))
+                Ok(Value::Path(std::sync::Arc::new(Path::bezier(&points3(&a[0]))?)))
             };
         ],
     },
@@ -1110,7 +1077,7 @@ static FUNCTIONS: &[Builtin] = &[
         name: "polyline",
         sigs: sigs![
             [p("points", Type::List(&V), Req, Any)] -> Type::Path => |_, a| {
-                Ok(Value::Path(std::sync::Arc::new(Path::polyline(&points3(&a[0])).map_err(|e| e.to_string())?)))
+                Ok(Value::Path(std::sync::Arc::new(Path::polyline(&points3(&a[0]))?)))
             };
         ],
     },
@@ -1130,7 +1097,7 @@ static FUNCTIONS: &[Builtin] = &[
                     let c = a[i].components();
                     [c[0], c[1], c[2]]
                 });
-                Ok(Value::Path(std::sync::Arc::new(Path::arc3(x, y, z).map_err(|e| e.to_string())?)))
+                Ok(Value::Path(std::sync::Arc::new(Path::arc3(x, y, z)?)))
             };
         ],
     },
@@ -1301,7 +1268,7 @@ static FUNCTIONS: &[Builtin] = &[
             [shape("shape"), p("period", V, Req, NonNeg), p("count", V, Req, Within(1.0, 1e6))] -> S => |b, a| {
                 let count = a[2].v3();
                 if count.iter().any(|c| c.fract() != 0.0) {
-                    return Err("`count` must be whole numbers of copies".to_string());
+                    return Err(Refusal::FractionalCount);
                 }
                 b.node(Node::Repeat { period: a[1].v3(), count: Some(count), child: sh(&a[0]) })
             };
@@ -1368,7 +1335,7 @@ static FUNCTIONS: &[Builtin] = &[
                 let k = |i: usize| a[i].num();
                 let matrix = [[1.0, k(1), k(2)], [k(3), 1.0, k(4)], [k(5), k(6), 1.0]];
                 if crate::scene::analysis::invert(&matrix).is_none() {
-                    return Err("this shear is singular: it flattens space onto a plane or a line, so the shape has no volume".to_string());
+                    return Err(Refusal::SingularShear);
                 }
                 b.node(Node::Shear { matrix, child: sh(&a[0]) })
             };
@@ -1396,8 +1363,8 @@ static FUNCTIONS: &[Builtin] = &[
     Builtin {
         name: "hull",
         sigs: sigs![
-            [shape("shapes")] rest + -> S => |b, a| hull(b, a).map_err(|e| e.to_string());
-            [p("shapes", LS, Req, Any)] -> S => |b, a| hull(b, &shapes(&a[0], "hull")?).map_err(|e| e.to_string());
+            [shape("shapes")] rest + -> S => hull;
+            [p("shapes", LS, Req, Any)] -> S => |b, a| hull(b, &shapes(&a[0], "hull")?);
         ],
     },
     // OpenSCAD's `minkowski` with a ball is a rounding: the distance less the radius.
@@ -1406,7 +1373,7 @@ static FUNCTIONS: &[Builtin] = &[
         sigs: sigs![
             [shape("shape"), shape("ball")] -> S => |b, a| match *b.graph.node(sh(&a[1])) {
                 Node::Sphere { radius } => b.node(Node::Round { radius, child: sh(&a[0]) }),
-                _ => Err("`minkowski` takes a ball about the origin, `sphere(r)`, as its second shape: it is `shape.round(r)`; the sum with another shape has no exact distance here".to_string()),
+                _ => Err(Refusal::MinkowskiNotBall),
             };
         ],
     },
@@ -1571,7 +1538,7 @@ static FUNCTIONS: &[Builtin] = &[
     Builtin {
         name: "abs",
         sigs: sigs![
-            [p("x", I, Req, Any)] -> I => |_, a| match &a[0] { Value::Int(i) => i.checked_abs().map(Value::Int).ok_or_else(|| "integer overflow".to_string()), _ => Ok(Value::Error) };
+            [p("x", I, Req, Any)] -> I => |_, a| match &a[0] { Value::Int(i) => i.checked_abs().map(Value::Int).ok_or(Refusal::AbsOverflow), _ => Ok(Value::Error) };
             [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::abs);
             [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::abs));
             [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::abs));
@@ -1627,31 +1594,31 @@ static FUNCTIONS: &[Builtin] = &[
     Builtin {
         name: "distance",
         sigs: sigs![
-            [shape("shape"), p("at", V, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
-            [prof("profile"), p("at", V2, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+            [shape("shape"), p("at", V, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
+            [prof("profile"), p("at", V2, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
         ],
     },
     Builtin {
         name: "noise",
         sigs: sigs![
-            [p("at", V, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
-            [p("at", V2, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+            [p("at", V, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
+            [p("at", V2, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
         ],
     },
     Builtin {
         name: "fbm",
         sigs: sigs![
             [p("at", V, Req, Any), p("octaves", I, Int(4), Within(1.0, 12.0)), p("lacunarity", F, Num(2.0), Within(1.0, 8.0)), p("gain", F, Num(0.5), Within(0.0, 1.0))] -> F
-                => |_, _| Err(PER_POINT.to_string());
+                => |_, _| Err(Refusal::PerPoint);
             [p("at", V2, Req, Any), p("octaves", I, Int(4), Within(1.0, 12.0)), p("lacunarity", F, Num(2.0), Within(1.0, 8.0)), p("gain", F, Num(0.5), Within(0.0, 1.0))] -> F
-                => |_, _| Err(PER_POINT.to_string());
+                => |_, _| Err(Refusal::PerPoint);
         ],
     },
     Builtin {
         name: "voronoi",
         sigs: sigs![
-            [p("at", V, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
-            [p("at", V2, Req, Any)] -> F => |_, _| Err(PER_POINT.to_string());
+            [p("at", V, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
+            [p("at", V2, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
         ],
     },
     Builtin {
@@ -1674,7 +1641,7 @@ static FUNCTIONS: &[Builtin] = &[
             [p("x", F, Req, Any), p("lo", F, Req, Any), p("hi", F, Req, Any)] -> F => |_, a| {
                 let (x, lo, hi) = (a[0].num(), a[1].num(), a[2].num());
                 if lo > hi {
-                    return Err(format!("`lo` ({lo}) is greater than `hi` ({hi})"));
+                    return Err(Refusal::ClampOrder { lo, hi });
                 }
                 Ok(Value::Float(x.clamp(lo, hi)))
             };
@@ -1715,10 +1682,10 @@ static FUNCTIONS: &[Builtin] = &[
         name: "div",
         sigs: sigs![
             [p("a", I, Req, Any), p("b", I, Req, Any)] -> I => |_, a| match (&a[0], &a[1]) {
-                (Value::Int(_), Value::Int(0)) => Err("division by zero: `b` is 0".to_string()),
+                (Value::Int(_), Value::Int(0)) => Err(Refusal::DivisionByZero),
                 (Value::Int(x), Value::Int(y)) => floor_div(*x, *y)
                     .map(Value::Int)
-                    .ok_or_else(|| format!("integer overflow in `div({x}, {y})`")),
+                    .ok_or(Refusal::DivOverflow { a: *x, b: *y }),
                 _ => Ok(Value::Error),
             };
         ],

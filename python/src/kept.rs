@@ -50,7 +50,7 @@ pub enum GpuError {
     Run(#[from] RunError),
     /// There is no wgpu device: why, as it was first told.
     #[error("{0}")]
-    NoWgpu(String),
+    NoWgpu(&'static sdfc_runtime::gpu::Error),
 }
 
 impl Kept {

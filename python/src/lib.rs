@@ -19,6 +19,7 @@ use sdfc_runtime::commands::compile::{self, Emit, Part};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::frontend::{self, Source};
 use sdfc_runtime::gpu::points::RunError;
+use sdfc_runtime::gpu::Gpu;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::job::{self, Job, Overrides};
 use std::sync::OnceLock;
@@ -384,7 +385,7 @@ impl Scene {
             (Some(before), _) => job::prepare(pool, on, frame, &setup, job::Open::After(before))?,
             // The process's wgpu device, whose compiled pipelines later renders reuse.
             (None, Backend::Wgpu) => {
-                let gpu = wgpu_device().map_err(|e| Failure::Runtime(e.clone()))?;
+                let gpu = wgpu_device().map_err(|e| Failure::Runtime(e.to_string()))?;
                 let open = job::Open::Gpu(gpu.clone());
                 job::prepare(pool, on, frame, &setup, open)
                     .map_err(|e| Failure::Runtime(format!("the wgpu backend: {e}")))?
@@ -428,15 +429,10 @@ fn cuda_device() -> &'static Result<sdfc_runtime::gpu::points::CudaDevice, RunEr
 
 /// The process's wgpu device, opened on first use: renders and distances share it and the
 /// pipelines compiled on it.
-fn wgpu_device() -> Result<&'static std::sync::Arc<sdfc_runtime::gpu::Gpu>, String> {
-    static WGPU: OnceLock<Result<std::sync::Arc<sdfc_runtime::gpu::Gpu>, String>> = OnceLock::new();
-    WGPU.get_or_init(|| {
-        sdfc_runtime::gpu::Gpu::open(false)
-            .map(std::sync::Arc::new)
-            .map_err(|e| e.to_string())
-    })
-    .as_ref()
-    .map_err(Clone::clone)
+fn wgpu_device() -> Result<&'static std::sync::Arc<Gpu>, &'static sdfc_runtime::gpu::Error> {
+    static WGPU: OnceLock<Result<std::sync::Arc<Gpu>, sdfc_runtime::gpu::Error>> = OnceLock::new();
+    WGPU.get_or_init(|| Gpu::open(false).map(std::sync::Arc::new))
+        .as_ref()
 }
 
 fn backend(name: &str) -> PyResult<Backend> {

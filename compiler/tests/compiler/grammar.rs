@@ -410,13 +410,42 @@ impl<'g> Recogniser<'g> {
     }
 }
 
-/// Recognises `text` from the rule `start`. `Err` says where the input stops fitting.
-fn recognise(g: &Grammar, start: &str, text: &str) -> Result<(), String> {
+/// Why a text is not recognised.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Unrecognised {
+    /// The lexer's messages.
+    Lexical(Vec<String>),
+    /// Not the rule `start`: where the input stops fitting and what would have fitted there.
+    Stuck {
+        start: String,
+        at: String,
+        expected: Vec<String>,
+    },
+}
+
+impl std::fmt::Display for Unrecognised {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Unrecognised::Lexical(messages) => write!(f, "lexical errors: {messages:?}"),
+            Unrecognised::Stuck {
+                start,
+                at,
+                expected,
+            } => write!(
+                f,
+                "not a `{start}`: stuck at {at}; expected one of {}",
+                expected.join(" ")
+            ),
+        }
+    }
+}
+
+/// Recognises `text` from the rule `start`, or says where the input stops fitting.
+fn recognise(g: &Grammar, start: &str, text: &str) -> Result<(), Unrecognised> {
     let (tokens, diags) = lex(FileId(0), text);
     if !diags.is_empty() {
-        return Err(format!(
-            "lexical errors: {:?}",
-            diags.iter().map(|d| &d.message).collect::<Vec<_>>()
+        return Err(Unrecognised::Lexical(
+            diags.iter().map(|d| d.message.clone()).collect(),
         ));
     }
     let input: Vec<Sym> = tokens.iter().map(|(t, _)| terminal(t)).collect();
@@ -432,11 +461,11 @@ fn recognise(g: &Grammar, start: &str, text: &str) -> Result<(), String> {
             format!("{t} on line {line}")
         },
     );
-    let expected: Vec<String> = r.expected.into_iter().collect();
-    Err(format!(
-        "not a `{start}`: stuck at {at}; expected one of {}",
-        expected.join(" ")
-    ))
+    Err(Unrecognised::Stuck {
+        start: start.into(),
+        at,
+        expected: r.expected.into_iter().collect(),
+    })
 }
 
 /// Runs `f` on a thread with a large stack: recognition recurses once per nesting level of

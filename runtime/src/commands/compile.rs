@@ -322,7 +322,7 @@ pub fn emit(
             })
         }
         Emit::Layout => {
-            let value = wgsl::layout::interface(&kernel)?;
+            let value = wgsl::layout::interface(&kernel).map_err(|e| e.to_string())?;
             let mut text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())?;
             text.push('\n');
             return Ok(text.into_bytes());

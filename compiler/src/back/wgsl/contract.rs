@@ -345,7 +345,7 @@ impl UniformWriter<'_> {
 }
 
 /// The offset and shape of the member at `path` among `members`.
-fn resolve<'a>(members: &'a [Field], path: &str) -> Result<(u32, &'a Shape), String> {
+fn resolve<'a>(members: &'a [Field], path: &str) -> Result<(u32, &'a Shape), Unresolved> {
     let (head, rest) = match path.split_once('.') {
         Some((h, r)) => (h, Some(r)),
         None => (path, None),
@@ -355,7 +355,7 @@ fn resolve<'a>(members: &'a [Field], path: &str) -> Result<(u32, &'a Shape), Str
             let i = i
                 .strip_suffix(']')
                 .and_then(|i| i.parse::<u32>().ok())
-                .ok_or_else(|| format!("`{head}` is not an index"))?;
+                .ok_or_else(|| Unresolved::NotIndex(head.into()))?;
             (n, Some(i))
         }
         None => (head, None),
@@ -363,7 +363,7 @@ fn resolve<'a>(members: &'a [Field], path: &str) -> Result<(u32, &'a Shape), Str
     let field = members
         .iter()
         .find(|f| f.name == name)
-        .ok_or_else(|| format!("no `{name}`"))?;
+        .ok_or_else(|| Unresolved::NoMember(name.into()))?;
     let (mut offset, mut shape) = (field.offset, &field.shape);
     if let Some(i) = index {
         match shape {
@@ -376,16 +376,39 @@ fn resolve<'a>(members: &'a [Field], path: &str) -> Result<(u32, &'a Shape), Str
                 shape = element;
             }
             Shape::Array { length, .. } => {
-                return Err(format!("`{name}` holds {length}, not an element {i}"))
+                return Err(Unresolved::Past {
+                    name: name.into(),
+                    length: *length,
+                    index: i,
+                })
             }
-            _ => return Err(format!("`{name}` is not an array")),
+            _ => return Err(Unresolved::NotArray(name.into())),
         }
     }
     match (rest, shape) {
         (None, _) => Ok((offset, shape)),
         (Some(rest), Shape::Struct(inner)) => resolve(inner, rest).map(|(o, s)| (offset + o, s)),
-        (Some(_), _) => Err(format!("`{head}` is not a struct")),
+        (Some(_), _) => Err(Unresolved::NotStruct(head.into())),
     }
+}
+
+/// Why a member's path names nothing in a layout.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+enum Unresolved {
+    #[error("`{0}` is not an index")]
+    NotIndex(String),
+    #[error("no `{0}`")]
+    NoMember(String),
+    #[error("`{name}` holds {length}, not an element {index}")]
+    Past {
+        name: String,
+        length: u32,
+        index: u32,
+    },
+    #[error("`{0}` is not an array")]
+    NotArray(String),
+    #[error("`{0}` is not a struct")]
+    NotStruct(String),
 }
 
 /// Calls `f` with the path and offset of every scalar or vector under `members`.

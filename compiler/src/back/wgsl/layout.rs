@@ -7,19 +7,26 @@ use super::Kernel;
 use naga::{proc::Layouter, Handle, Module, Type, TypeInner};
 use serde_json::{json, Value};
 
+/// Why a kernel's interface cannot be described (a mistake of the compiler's).
+#[derive(Debug, thiserror::Error)]
+pub enum LayoutError {
+    #[error("internal compiler error: laying out the kernel: {0}")]
+    Layout(#[from] naga::proc::LayoutError),
+    #[error("internal compiler error: the kernel has no entry point")]
+    NoEntryPoint,
+}
+
 /// The kernel's interface: `entry_point`, `workgroup_size`, and `bindings`, each with its
 /// group, binding, name, address space, access and type layout.
-pub fn interface(kernel: &Kernel) -> Result<Value, String> {
+pub fn interface(kernel: &Kernel) -> Result<Value, LayoutError> {
     let module = &kernel.module;
     let mut layouter = Layouter::default();
-    layouter
-        .update(module.to_ctx())
-        .map_err(|e| format!("internal compiler error: laying out the kernel: {e}"))?;
+    layouter.update(module.to_ctx())?;
     let entry = module
         .entry_points
         .iter()
         .find(|e| e.name == super::ENTRY_POINT)
-        .ok_or("internal compiler error: the kernel has no entry point")?;
+        .ok_or(LayoutError::NoEntryPoint)?;
     let mut bindings: Vec<(u32, u32, Value)> = module
         .global_variables
         .iter()

@@ -27,7 +27,8 @@ const BISECTIONS: u32 = 24;
 /// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
 /// points asked for, each at most once (a position, its index and its value); and the bricks
 /// of corner values (f64), cell flags and edge indices, at most eight per candidate and at
-/// most the grid's.
+/// most the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one where
+/// the grid's bricks are at most eight per candidate).
 pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
     let points = candidates.saturating_mul(8).min(grid.dense_points());
     let bricks = grid
@@ -35,7 +36,7 @@ pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
         .iter()
         .map(|&n| (n as u64 + 1).div_ceil(8) + 1)
         .product::<u64>();
-    let brick = 512 * (8 + 1 + 12) + 64;
+    let brick = 512 * (8 + 1 + 12) + 64 + 3 * 4;
     candidates
         .saturating_mul(8)
         .saturating_add(points.saturating_mul(24 + 12 + 8))
@@ -80,12 +81,13 @@ pub fn contour(
     };
     // Corner values, and the closure: each crossed edge's four cells. A point whose value
     // was asked for holds -∞ until it comes (the field never gives -∞: see `Field`).
-    let mut values: Bricks<f64> = Bricks::new(f64::NAN);
-    let mut set: Bricks<bool> = Bricks::new(false);
+    let held = candidates.len() as u64;
+    let mut values: Bricks<f64> = Bricks::over(f64::NAN, grid, held);
+    let mut set: Bricks<bool> = Bricks::over(false, grid, held);
     for &c in &candidates {
         set.set(unpack(c), true);
     }
-    let mut held = candidates.len() as u64;
+    let mut held = held;
     let mut pending = candidates;
     let mut surface: Vec<(u64, u8)> = Vec::new();
     let mut first = true;
@@ -149,7 +151,7 @@ pub fn contour(
 
     // Edge vertices: each crossed edge is owned by the cell at its lower end.
     let mut edges: Vec<u64> = Vec::new();
-    let mut index: Bricks<[u32; 3]> = Bricks::new([u32::MAX; 3]);
+    let mut index: Bricks<[u32; 3]> = Bricks::over([u32::MAX; 3], grid, stats.candidates);
     for &(c, config) in &surface {
         let mut ids = [u32::MAX; 3];
         for (axis, id) in ids.iter_mut().enumerate() {

@@ -25,10 +25,10 @@ use rayon::prelude::*;
 const BISECTIONS: u32 = 24;
 
 /// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
-/// points asked for, each at most once (a position, its index and its value); and the bricks
-/// of corner values (f64), cell flags and edge indices, at most eight per candidate and at
-/// most the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one where
-/// the grid's bricks are at most eight per candidate).
+/// points asked for, each at most once (a position, its index, its place and its value); and
+/// the bricks of corner values (f64), cell flags and edge indices, at most eight per candidate
+/// and at most the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one
+/// where the grid's bricks are at most eight per candidate).
 pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
     let points = candidates.saturating_mul(8).min(grid.dense_points());
     let bricks = grid
@@ -39,7 +39,7 @@ pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
     let brick = 512 * (8 + 1 + 12) + 64 + 3 * 4;
     candidates
         .saturating_mul(8)
-        .saturating_add(points.saturating_mul(24 + 12 + 8))
+        .saturating_add(points.saturating_mul(24 + 12 + 8 + 8))
         .saturating_add(
             candidates
                 .saturating_mul(8)
@@ -96,20 +96,22 @@ pub fn contour(
             return Err(Stop::Cells(held));
         }
         let mut need: Vec<[u32; 3]> = Vec::new();
+        let mut places = Vec::new();
         for &c in &pending {
             let i = unpack(c);
             for k in 0..8 {
                 let p = add(i, corner(k));
-                if values.get(p).is_nan() {
-                    values.set(p, f64::NEG_INFINITY);
+                if let Some(at) = values.replace_if(p, f64::is_nan, f64::NEG_INFINITY) {
                     need.push(p);
+                    places.push(at);
                 }
             }
         }
         let points: Vec<[f64; 3]> = need.iter().map(|&i| grid.point(i)).collect();
+        drop(need);
         let d = field.distances(&points);
-        for (i, v) in need.into_iter().zip(d) {
-            values.set(i, v);
+        for (at, v) in places.into_iter().zip(d) {
+            values.put(at, v);
         }
         if first {
             // Walls and gaps between the candidates' corners that no corner sees.
@@ -129,8 +131,7 @@ pub fn contour(
                 }
                 let lower = add(i, corner(a));
                 for n in edge_cells(lower, e / 4) {
-                    if !set.get(n) {
-                        set.set(n, true);
+                    if set.replace_if(n, |held| !held, true).is_some() {
                         held += 1;
                         missing.push(pack(n));
                     }

@@ -472,6 +472,10 @@ enum Directory {
     Hashed(KeyMap<u32>),
 }
 
+/// Where a point's value is in a [`Bricks`] (its brick's slot and its place in the brick).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct At(u32, u32);
+
 /// Points along a brick's edge (a power of two).
 const BRICK: u32 = 8;
 const BRICK_POINTS: usize = (BRICK * BRICK * BRICK) as usize;
@@ -576,6 +580,29 @@ impl<T: Copy + PartialEq> Bricks<T> {
     /// Sets the value at point `i`.
     pub fn set(&mut self, i: [u32; 3], v: T) {
         let (b, o) = Self::split(i);
+        let k = self.slot_or_new(b);
+        self.data[k as usize][o] = v;
+    }
+
+    /// Sets the value at point `i` to `v` where `replace` holds for the value there, saying
+    /// where it is, for [`Bricks::put`] (one lookup for a test and a set).
+    pub fn replace_if(&mut self, i: [u32; 3], replace: impl Fn(T) -> bool, v: T) -> Option<At> {
+        let (b, o) = Self::split(i);
+        let k = self.slot_or_new(b);
+        let at = &mut self.data[k as usize][o];
+        replace(*at).then(|| {
+            *at = v;
+            At(k, o as u32)
+        })
+    }
+
+    /// Sets the value at a place [`Bricks::replace_if`] gave.
+    pub fn put(&mut self, At(k, o): At, v: T) {
+        self.data[k as usize][o as usize] = v;
+    }
+
+    /// The slot of brick `b`, a brick of `empty` values made for it where there was none.
+    fn slot_or_new(&mut self, b: [u32; 3]) -> u32 {
         let next = self.data.len() as u32;
         let k = match &mut self.index {
             Directory::Flat { dims, slots } => {
@@ -583,7 +610,7 @@ impl<T: Copy + PartialEq> Bricks<T> {
                 // [`Bricks::dims`]) moves every brick to a hash map.
                 if b[0] >= dims[0] || b[1] >= dims[1] || b[2] >= dims[2] {
                     self.rehash();
-                    return self.set(i, v);
+                    return self.slot_or_new(b);
                 }
                 let at = b[0] as usize
                     + dims[0] as usize * (b[1] as usize + dims[1] as usize * b[2] as usize);
@@ -597,7 +624,7 @@ impl<T: Copy + PartialEq> Bricks<T> {
         if k == next {
             self.data.push([self.empty; BRICK_POINTS]);
         }
-        self.data[k as usize][o] = v;
+        k
     }
 
     /// The flat directory replaced by a hash map of the same bricks.

@@ -107,7 +107,7 @@ pub fn contour(
                 }
             }
         }
-        let points: Vec<[f64; 3]> = need.iter().map(|&i| grid.point(i)).collect();
+        let points: Vec<[f64; 3]> = need.par_iter().map(|&i| grid.point(i)).collect();
         drop(need);
         let d = field.distances(&points);
         for (at, v) in places.into_iter().zip(d) {
@@ -118,8 +118,11 @@ pub fn contour(
             stats.thin = thin::missed(field, grid, &values, &pending);
         }
         let mut missing = Vec::new();
-        for &c in &pending {
-            let config = configuration(&values, c);
+        let configs: Vec<u8> = pending
+            .par_iter()
+            .map(|&c| configuration(&values, c))
+            .collect();
+        for (&c, &config) in pending.iter().zip(&configs) {
             if config == 0 || config == 255 {
                 continue;
             }
@@ -339,7 +342,7 @@ fn roots(
         t: f64,
     }
     let mut state: Vec<Root> = edges
-        .iter()
+        .par_iter()
         .map(|&e| {
             let axis = (e & 3) as usize;
             let i = unpack(e >> 2);

@@ -25,9 +25,10 @@ use rayon::prelude::*;
 const BISECTIONS: u32 = 24;
 
 /// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
-/// points asked for, each at most once (a position, its index and its value); and the bricks
-/// of corner values (f64), cell flags and edge indices, at most eight per candidate and at
-/// most the grid's.
+/// points asked for, each at most once (a position, its index, its place and its value); and
+/// the bricks of corner values (f64), cell flags and edge indices, at most eight per candidate
+/// and at most the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one
+/// where the grid's bricks are at most eight per candidate).
 pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
     let points = candidates.saturating_mul(8).min(grid.dense_points());
     let bricks = grid
@@ -35,10 +36,10 @@ pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
         .iter()
         .map(|&n| (n as u64 + 1).div_ceil(8) + 1)
         .product::<u64>();
-    let brick = 512 * (8 + 1 + 12) + 64;
+    let brick = 512 * (8 + 1 + 12) + 64 + 3 * 4;
     candidates
         .saturating_mul(8)
-        .saturating_add(points.saturating_mul(24 + 12 + 8))
+        .saturating_add(points.saturating_mul(24 + 12 + 8 + 8))
         .saturating_add(
             candidates
                 .saturating_mul(8)
@@ -80,12 +81,13 @@ pub fn contour(
     };
     // Corner values, and the closure: each crossed edge's four cells. A point whose value
     // was asked for holds -∞ until it comes (the field never gives -∞: see `Field`).
-    let mut values: Bricks<f64> = Bricks::new(f64::NAN);
-    let mut set: Bricks<bool> = Bricks::new(false);
+    let held = candidates.len() as u64;
+    let mut values: Bricks<f64> = Bricks::over(f64::NAN, grid, held);
+    let mut set: Bricks<bool> = Bricks::over(false, grid, held);
     for &c in &candidates {
         set.set(unpack(c), true);
     }
-    let mut held = candidates.len() as u64;
+    let mut held = held;
     let mut pending = candidates;
     let mut surface: Vec<(u64, u8)> = Vec::new();
     let mut first = true;
@@ -94,28 +96,33 @@ pub fn contour(
             return Err(Stop::Cells(held));
         }
         let mut need: Vec<[u32; 3]> = Vec::new();
+        let mut places = Vec::new();
         for &c in &pending {
             let i = unpack(c);
             for k in 0..8 {
                 let p = add(i, corner(k));
-                if values.get(p).is_nan() {
-                    values.set(p, f64::NEG_INFINITY);
+                if let Some(at) = values.replace_if(p, f64::is_nan, f64::NEG_INFINITY) {
                     need.push(p);
+                    places.push(at);
                 }
             }
         }
-        let points: Vec<[f64; 3]> = need.iter().map(|&i| grid.point(i)).collect();
+        let points: Vec<[f64; 3]> = need.par_iter().map(|&i| grid.point(i)).collect();
+        drop(need);
         let d = field.distances(&points);
-        for (i, v) in need.into_iter().zip(d) {
-            values.set(i, v);
+        for (at, v) in places.into_iter().zip(d) {
+            values.put(at, v);
         }
         if first {
             // Walls and gaps between the candidates' corners that no corner sees.
             stats.thin = thin::missed(field, grid, &values, &pending);
         }
         let mut missing = Vec::new();
-        for &c in &pending {
-            let config = configuration(&values, c);
+        let configs: Vec<u8> = pending
+            .par_iter()
+            .map(|&c| configuration(&values, c))
+            .collect();
+        for (&c, &config) in pending.iter().zip(&configs) {
             if config == 0 || config == 255 {
                 continue;
             }
@@ -127,8 +134,7 @@ pub fn contour(
                 }
                 let lower = add(i, corner(a));
                 for n in edge_cells(lower, e / 4) {
-                    if !set.get(n) {
-                        set.set(n, true);
+                    if set.replace_if(n, |held| !held, true).is_some() {
                         held += 1;
                         missing.push(pack(n));
                     }
@@ -149,7 +155,7 @@ pub fn contour(
 
     // Edge vertices: each crossed edge is owned by the cell at its lower end.
     let mut edges: Vec<u64> = Vec::new();
-    let mut index: Bricks<[u32; 3]> = Bricks::new([u32::MAX; 3]);
+    let mut index: Bricks<[u32; 3]> = Bricks::over([u32::MAX; 3], grid, stats.candidates);
     for &(c, config) in &surface {
         let mut ids = [u32::MAX; 3];
         for (axis, id) in ids.iter_mut().enumerate() {
@@ -336,7 +342,7 @@ fn roots(
         t: f64,
     }
     let mut state: Vec<Root> = edges
-        .iter()
+        .par_iter()
         .map(|&e| {
             let axis = (e & 3) as usize;
             let i = unpack(e >> 2);

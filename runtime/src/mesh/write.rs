@@ -60,7 +60,7 @@ impl Format {
     pub fn encode(self, mesh: &Mesh, palette: &Palette, up: Up) -> io::Result<Vec<u8>> {
         let mut out = Vec::new();
         match self {
-            Format::Stl => stl(&up.orient(mesh, palette).0, &mut out)?,
+            Format::Stl => out = stl(&up.orient(mesh, palette).0),
             Format::Obj => {
                 let (mesh, palette) = up.orient(mesh, palette);
                 obj(&mesh, &palette, &mut out)?;
@@ -264,33 +264,45 @@ fn f32s(v: [f64; 3]) -> [f32; 3] {
     v.map(|x| x as f32)
 }
 
-fn stl(mesh: &Mesh, out: &mut Vec<u8>) -> io::Result<()> {
-    let mut header = [b' '; 80];
+/// Bytes of one binary STL triangle: its normal, three corners (f32 each) and two bytes.
+const STL_TRIANGLE: usize = 50;
+
+/// Binary STL, its triangles encoded in parallel straight into the file's buffer (each takes
+/// [`STL_TRIANGLE`] bytes at a place known from its index). The buffer comes zeroed from
+/// the allocator, so that its pages are first touched by the threads that fill them.
+fn stl(mesh: &Mesh) -> Vec<u8> {
+    use rayon::prelude::*;
+    let mut out = vec![0u8; 84 + STL_TRIANGLE * mesh.triangles.len()];
+    out[..80].fill(b' ');
     let text = b"binary STL written by sdfc mesh";
-    header[..text.len()].copy_from_slice(text);
-    out.write_all(&header)?;
-    out.write_all(&(mesh.triangles.len() as u32).to_le_bytes())?;
-    for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let n = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
-        for x in f32s(n.map(|x| x / l))
-            .iter()
-            .chain(&f32s(a))
-            .chain(&f32s(b))
-            .chain(&f32s(c))
-        {
-            out.write_all(&x.to_le_bytes())?;
-        }
-        out.write_all(&[0, 0])?;
-    }
-    Ok(())
+    out[..text.len()].copy_from_slice(text);
+    out[80..84].copy_from_slice(&(mesh.triangles.len() as u32).to_le_bytes());
+    out[84..]
+        .par_chunks_mut(STL_TRIANGLE * 1024)
+        .zip(mesh.triangles.par_chunks(1024))
+        .for_each(|(bytes, triangles)| {
+            for (row, t) in bytes.chunks_exact_mut(STL_TRIANGLE).zip(triangles) {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+                let n = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
+                let values = f32s(n.map(|x| x / l))
+                    .into_iter()
+                    .chain(f32s(a))
+                    .chain(f32s(b))
+                    .chain(f32s(c));
+                for (to, x) in row.chunks_exact_mut(4).zip(values) {
+                    to.copy_from_slice(&x.to_le_bytes());
+                }
+                // The attribute bytes are the zeros the buffer was filled with.
+            }
+        });
+    out
 }
 
 fn obj(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {

@@ -75,10 +75,12 @@ fn mean_of_graded(s: &Session, samples: u32) -> Image {
     let frames: Vec<Image> = (0..samples).map(|k| direct(s, samples, Some(k))).collect();
     let mut mean = frames[0].clone();
     for (i, c) in mean.linear.iter_mut().enumerate() {
-        for ch in 0..3 {
-            let sum: f32 = frames.iter().map(|f| grade.apply(f.linear[i])[ch]).sum();
-            c[ch] = sum / samples as f32;
+        *c = [0.0; 3];
+        for f in &frames {
+            let g = grade.apply(f.linear[i]);
+            *c = std::array::from_fn(|ch| c[ch] + g[ch]);
         }
+        *c = c.map(|x| x / samples as f32);
     }
     mean
 }

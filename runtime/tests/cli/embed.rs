@@ -727,7 +727,7 @@ gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
             &format!("--screenshot={}", shot.display()),
         ])
         .arg(format!("file://{}", page.display()))
-        .env("XDG_RUNTIME_DIR", &dir)
+        .env("XDG_RUNTIME_DIR", dir)
         .output()
         .expect("run chromium");
     assert!(shot.is_file(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -636,7 +636,9 @@ fn headless_wgpu_screenshot_shows_the_scene() {
 
 /// Headless through wgpu, a path-traced scene accumulates one sample a frame on the device
 /// while the camera rests and stops at its `samples`: the screenshot is `sdfc render`'s
-/// picture of those samples (through wgpu), to within the rounding of summing frames.
+/// picture of those samples (through wgpu), to within the rounding of summing frames, under
+/// the scene's default tone curve, filmic (the frames add up in linear light and their mean
+/// is graded: a mean of graded frames was 0.18 apart).
 #[test]
 fn headless_wgpu_path_tracing_accumulates_the_scenes_samples() {
     let dir = temp_dir("headless-path");
@@ -650,6 +652,17 @@ fn headless_wgpu_path_tracing_accumulates_the_scenes_samples() {
             "light sky { zenith: (0.3, 0.4, 0.7), horizon: (0.8, 0.8, 0.8) }\nlight point",
         );
     std::fs::write(dir.join("scene.sdf"), &scene).unwrap();
+    let check = Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(&dir)
+        .args(["check", "scene.sdf"])
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&check.stderr).into_owned()
+        + &String::from_utf8_lossy(&check.stdout);
+    assert!(
+        said.contains("tone curve: filmic (the default where it is path traced"),
+        "{said}"
+    );
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&dir)
         .args(["view", "scene.sdf", "--headless", "--backend", "wgpu"])

@@ -42,6 +42,24 @@ pub fn write_named(program: &Program, name: &str) -> String {
     out
 }
 
+/// The glow of the marching steps of a scene's part named `name` (`--part map`, beside
+/// [`write_named`]): `NAME_LIPSCHITZ` and `NAME_glow(d)`, as the WGSL part declares them.
+pub fn write_glow(glow: &super::wgsl::part::Glow, name: &str) -> String {
+    let f = |x: f64| super::wgsl::float(x);
+    let [r, g, b] = glow.color.map(f);
+    format!(
+        "\n/// The glow of the marching steps (docs/rendering.md, \"The look\"): a renderer adds\n\
+         /// `{name}_glow(d)` to a camera ray's colour at each evaluation of its march, the hit's and\n\
+         /// the last one's included, `d` the distance there divided by `{name}_LIPSCHITZ`.\n\
+         #[allow(non_upper_case_globals)]\n\
+         pub const {name}_LIPSCHITZ: f32 = {};\n\n\
+         /// What one evaluation of a camera ray's march at distance `d` (over L) adds to its colour.\n\
+         pub fn {name}_glow(d: f32) -> [f32; 3] {{\n    let w = (-d.abs() * {}).exp();\n    [{r} * w, {g} * w, {b} * w]\n}}\n",
+        f(glow.lipschitz),
+        f(1.0 / glow.distance),
+    )
+}
+
 /// The function `name` over `vec` and `ty`; `base` names the outline data and functions.
 fn function(out: &mut String, program: &Program, name: &str, base: &str, vec: &str, ty: &str) {
     let _ = writeln!(

@@ -2,9 +2,10 @@
 //! scene's distance function and material table ([`super::wgsl::part`], written by naga as
 //! GLSL ES 3.00) and a `mainImage` that renders it with the scene's camera (its aspect taken
 //! from the canvas), lights and materials: sphere tracing, tetrahedral normals, Phong with
-//! point-light attenuation, hard or soft shadows, checker patterns and colour fields as
-//! docs/rendering.md states them (the checker filtered over the pixel's footprint), for
-//! camera rays only. Reflection, refraction, transparency, over-relaxation, antialiasing, sky
+//! point-light attenuation, hard or soft shadows, checker patterns, colour fields and the
+//! glow of the marching steps as docs/rendering.md states them (the checker filtered over the
+//! pixel's footprint; the march over-relaxed as the renderers' is, so that a glow sums the
+//! same steps), for camera rays only. Reflection, refraction, transparency, antialiasing, sky
 //! lights and the rest of the look (occlusion, fog, exposure and tone curves) are left out, so
 //! a scene using them renders without them ([`left_out`] names those a scene uses, for the
 //! warning `sdfc compile` prints).
@@ -21,16 +22,35 @@ const NAME: &str = "sdfc_map";
 
 /// The renderer, after the constants and the distance function.
 const RENDERER: &str = r#"
-// The distance along the ray to the first hit, or -1 (docs/rendering.md, "Marching").
-float sdfc_march(vec3 o, vec3 d) {
+// The distance along the ray to the first hit, or -1 (docs/rendering.md, "Marching"), with
+// over-relaxation by SDFC_OMEGA; where the scene glows, glow gains e^(-|d|/G) at each
+// evaluation (d = f/L there; docs/rendering.md, "The look"), as the renderers' march does.
+float sdfc_march(vec3 o, vec3 d, inout float glow) {
     float t = 0.0;
+    float omega = SDFC_OMEGA;
+    float prev = 0.0;
+    float stride = 0.0;
     for (int i = 0; i < SDFC_MAX_STEPS; i++) {
         vec3 p = o + d * t;
         float s = sdfc_map_distance(p) * SDFC_INV_L;
+        if (s != s) break;
+        float r = abs(s);
+        if (SDFC_GLOWS) glow += exp(-r * SDFC_INV_GLOW);
         vec3 a = abs(p);
-        if (abs(s) < max(SDFC_EPS * t, 8.0 * 1.1920929e-7 * max(a.x, max(a.y, a.z)))) return t;
-        t += s;
-        if (t > SDFC_MAX_DIST || s != s) break;
+        float tol = max(SDFC_EPS * t, 8.0 * 1.1920929e-7 * max(a.x, max(a.y, a.z)));
+        // A relaxed step whose spheres do not overlap is taken back, and ω drops to 1.
+        bool fail = omega > 1.0 && r + prev < stride;
+        if (fail) {
+            stride = stride - omega * stride;
+            omega = 1.0;
+        } else {
+            stride = s * omega;
+        }
+        prev = r;
+        if (!fail && r < tol) return t;
+        bool gone = !fail && t + s > SDFC_MAX_DIST;
+        t = max(t + stride, 0.0);
+        if (gone) break;
     }
     return -1.0;
 }
@@ -126,7 +146,8 @@ void mainImage(out vec4 fragColor, in vec2 fragCoord) {
     float aspect = iResolution.x / iResolution.y;
     vec3 d = normalize(SDFC_CAM_W + b.x * SDFC_TAN * aspect * SDFC_CAM_U + b.y * SDFC_TAN * SDFC_CAM_V);
     vec3 col = SDFC_BACKGROUND;
-    float t = sdfc_march(SDFC_EYE, d);
+    float glow = 0.0;
+    float t = sdfc_march(SDFC_EYE, d, glow);
     if (t >= 0.0) {
         vec3 p = SDFC_EYE + d * t;
         vec3 a = abs(p);
@@ -142,14 +163,15 @@ void mainImage(out vec4 fragColor, in vec2 fragCoord) {
 SDFC_FIELDS        vec3 v = -d;
         col = m.ambient * c;
 SDFC_LIGHTS    }
+    // The camera ray glows with its marching steps, on a surface or not.
+    col += SDFC_GLOW_COLOR * glow;
     fragColor = vec4(sdfc_srgb(col.x), sdfc_srgb(col.y), sdfc_srgb(col.z), 1.0);
 }
 "#;
 
-/// The page for `scene`, lowered as `lowered`.
 /// What `scene` asks for that the page does not render (the module's list), in words, for the
 /// warning `sdfc compile --emit shadertoy` prints; empty where the page shows what the
-/// renderers show (over-relaxation changes only the speed, so it is not named).
+/// renderers show.
 pub fn left_out(scene: &Scene) -> Vec<&'static str> {
     let (m, s) = (&scene.materials, &scene.settings);
     let asked = [
@@ -182,6 +204,7 @@ pub fn left_out(scene: &Scene) -> Vec<&'static str> {
         .collect()
 }
 
+/// The page for `scene`, lowered as `lowered`.
 pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
     let part = wgsl::part::write(scene, lowered, NAME).map_err(|e| Error(e.to_string()))?;
     let functions = shader::write_part_es(&part)?;
@@ -229,6 +252,24 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
         out,
         "const int SDFC_PENUMBRA_PROBES = {};",
         Light::PENUMBRA_PROBES
+    );
+    let _ = writeln!(
+        out,
+        "const float SDFC_OMEGA = {};",
+        float(s.relaxation.max(1.0))
+    );
+    // The glow of the marching steps (`glow`, `glow_color`); none: no term at all.
+    let glows = s.glows();
+    let _ = writeln!(out, "const bool SDFC_GLOWS = {glows};");
+    let _ = writeln!(
+        out,
+        "const float SDFC_INV_GLOW = {};",
+        float(if glows { 1.0 / s.glow } else { 0.0 })
+    );
+    let _ = writeln!(
+        out,
+        "const vec3 SDFC_GLOW_COLOR = {};",
+        v3(if glows { s.glow_color } else { [0.0; 3] })
     );
     let _ = writeln!(out, "const vec3 SDFC_BACKGROUND = {};\n", v3(s.background));
     out.push_str(&functions);

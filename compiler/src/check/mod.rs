@@ -364,17 +364,12 @@ fn check_items(cx: &mut Ctx, items: &[ast::Item], entry: FileId) -> Scene {
     materials::check_pairs(cx, &scene, items);
     // Where `tonemap` is not given, a scene of the newer look is graded by the filmic curve.
     if !cx.settings_given.iter().any(|(name, _)| name == "tonemap") {
-        use crate::scene::look::{newer_look, OLDER_LOOK, PATH_TRACED};
+        use crate::scene::look::{newer_look, OLDER_LOOK};
         let newer = newer_look(&scene);
         if newer.is_some() {
             scene.settings.tonemap = Tonemap::Filmic;
         }
-        let older = if scene.settings.path {
-            PATH_TRACED
-        } else {
-            OLDER_LOOK
-        };
-        scene.settings.tonemap_why = Some(newer.unwrap_or(older));
+        scene.settings.tonemap_why = Some(newer.unwrap_or(OLDER_LOOK));
     }
     params::unknown(cx, items, entry);
     check_uncalled_functions(cx);

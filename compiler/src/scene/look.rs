@@ -104,21 +104,15 @@ pub fn sky_irradiance(zenith: [f64; 3], horizon: [f64; 3], ground: [f64; 3]) -> 
 }
 
 /// Why a scene's default tone curve is `"none"`: it has nothing of [`newer_look`].
-pub const OLDER_LOOK: &str = "it has no `pbr` material or `light sky`";
-
-/// Why a path-traced scene's default tone curve is `"none"`: `sdfc view` adds up its samples'
-/// frames after they are graded, so a curve by default would show the viewer another picture
-/// than `sdfc render`'s.
-pub const PATH_TRACED: &str =
-    "it is path traced: `sdfc view` adds graded samples, so only a given `tonemap` grades it";
+pub const OLDER_LOOK: &str = "it has no `pbr` material, `light sky` or `method: \"path\"`";
 
 /// What makes a scene's default tone curve `"filmic"` (docs/rendering.md, "The look"): a
-/// `pbr` material or a `light sky`, the look written since the curve came, whose light runs
-/// above 1 (skies, emission, Fresnel's rims); a scene of neither keeps `"none"`, the look it
-/// was written for, and so does a path-traced one ([`PATH_TRACED`]). `None` for such a scene.
+/// `pbr` material, a `light sky` or `method: "path"`, the look written since the curve came,
+/// whose light runs above 1 (skies, emission, Fresnel's rims); a scene of none of them keeps
+/// `"none"`, the look it was written for. `None` for such a scene.
 pub fn newer_look(scene: &super::Scene) -> Option<&'static str> {
     if scene.settings.path {
-        None
+        Some("it is path traced (`method: \"path\"`)")
     } else if scene.materials.iter().any(|m| m.pbr.is_some()) {
         Some("it has a `pbr` material")
     } else if scene

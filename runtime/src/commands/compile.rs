@@ -254,7 +254,13 @@ pub fn emit_map(
         return Err(MESH_DATA.replace("{}", "`--part map`"));
     }
     let lang = match target {
-        Emit::Rust => return Ok(rust::write_named(&lowered.program, name).into_bytes()),
+        Emit::Rust => {
+            let mut text = rust::write_named(&lowered.program, name);
+            if let Some(glow) = wgsl::part::Glow::of(scene, lowered) {
+                text.push_str(&rust::write_glow(&glow, name));
+            }
+            return Ok(text.into_bytes());
+        }
         Emit::Wgsl => None,
         Emit::Glsl => Some(Lang::Glsl),
         Emit::Hlsl => Some(Lang::Hlsl),

@@ -7,6 +7,7 @@
 
 pub mod camera;
 pub mod compile;
+pub mod grade;
 pub mod panel;
 pub mod present;
 pub mod resident;

@@ -1,23 +1,26 @@
 //! Frames that stay on the GPU: on wgpu the viewer dispatches the scene's kernel into buffers
 //! of its own on the device that presents the window; a second pass adds each frame's colours
-//! to the samples accumulated so far and writes their mean, sRGB-encoded, into a storage
+//! (linear light: the scene renders ungraded) to the samples accumulated so far and writes
+//! their mean, graded by the scene's exposure and tone curve and sRGB-encoded, into a storage
 //! texture that the window's render pass samples. Nothing crosses to the host per frame; the
 //! accumulated samples are read back only when asked (a screenshot of the session's image,
 //! and the mean steps per pixel that the statistics in the title show, a sum reduced on the
 //! GPU to two words).
 
+use super::grade::Grade;
 use crate::gpu::wgpu::{Pipeline, TILE_STRIDE};
 use crate::gpu::Gpu;
 use crate::image::Image;
 use sdfc_compiler::{wgsl, Scene};
 use std::sync::Arc;
 
-/// The pass that accumulates a frame: binding 0 the frame's size, sample count and whether to
+/// The pass that accumulates a frame: binding 0 the frame's size, sample count, whether to
 /// sum the steps (1; 2 sums them alone, accumulating nothing: the steps of the frame before,
-/// asked for after it was rendered) (a storage buffer, not a uniform: lavapipe compiles a variant of a shader for
+/// asked for after it was rendered), 2^exposure and the tone curve (`Tonemap::index`) (a
+/// storage buffer, not a uniform: lavapipe compiles a variant of a shader for
 /// each value of a uniform that decides a branch, which the sample count would make one a
-/// frame); 1 the kernel's colours; 2 the sums of the samples so far; 3 the texture on
-/// show (the mean, sRGB bytes); 4 the kernel's per-pixel statistics (`STATS_WORDS` a pixel, the
+/// frame); 1 the kernel's colours (linear light); 2 the sums of the samples so far; 3 the
+/// texture on show (the mean graded, sRGB bytes); 4 the kernel's per-pixel statistics (`STATS_WORDS` a pixel, the
 /// first the marching steps); 5 the steps summed over the frame, as a 64-bit count in two
 /// words (low, high).
 const ACCUMULATE: &str = r#"
@@ -26,6 +29,8 @@ struct Frame {
     height: u32,
     count: u32,
     steps: u32,
+    scale: f32,
+    curve: u32,
 }
 
 @group(0) @binding(0) var<storage, read> frame: Frame;
@@ -51,6 +56,20 @@ fn encode(c: f32) -> f32 {
     return floor(s * 255.0 + 0.5) / 255.0;
 }
 
+// The mean's exposure and tone curve, as the kernel's `grade` (docs/rendering.md, "The look").
+fn grade(c: vec3<f32>) -> vec3<f32> {
+    let x = c * frame.scale;
+    if frame.curve == 1u {
+        let num = x * (FILMIC_A * x + FILMIC_B);
+        let den = x * (FILMIC_C * x + FILMIC_D) + FILMIC_E;
+        return clamp(num / den, vec3<f32>(0.0), vec3<f32>(1.0));
+    }
+    if frame.curve == 2u {
+        return x / (vec3<f32>(1.0) + x);
+    }
+    return x;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn accumulate(
     @builtin(global_invocation_id) gid: vec3<u32>,
@@ -65,7 +84,7 @@ fn accumulate(
             s = sum[p] + image[p];
         }
         sum[p] = s;
-        let mean = s.rgb * (1.0 / f32(frame.count));
+        let mean = grade(s.rgb * (1.0 / f32(frame.count)));
         textureStore(shown, gid.xy, vec4<f32>(encode(mean.r), encode(mean.g), encode(mean.b), 1.0));
     }
     if gid.x < frame.width && gid.y < frame.height && frame.steps >= 1u {
@@ -132,6 +151,24 @@ struct Target {
     bind: wgpu::BindGroup,
     /// Samples accumulated in `sum`.
     count: u32,
+    /// The grade of their mean.
+    grade: Grade,
+}
+
+/// The bytes of the accumulating pass's `Frame`.
+const FRAME_BYTES: u64 = 24;
+
+impl Target {
+    /// The accumulating pass's `Frame`: `steps` 0 (accumulate), 1 (and sum the steps) or 2
+    /// (sum the steps alone).
+    fn frame_words(&self, steps: u32) -> Vec<u8> {
+        let g = &self.grade;
+        let curve = g.tonemap.index();
+        let mut w = words(&[self.width, self.height, self.count, steps]);
+        w.extend(g.scale().to_le_bytes());
+        w.extend(curve.to_le_bytes());
+        w
+    }
 }
 
 /// One frame rendered on the device.
@@ -171,13 +208,16 @@ impl Resident {
     pub fn new(gpu: Arc<Gpu>) -> Result<Resident, Error> {
         let device = gpu.device();
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut source = ACCUMULATE.replace("STATS_WORDS", &wgsl::STATS_WORDS.to_string());
+        for (k, c) in ["FILMIC_A", "FILMIC_B", "FILMIC_C", "FILMIC_D", "FILMIC_E"]
+            .into_iter()
+            .zip(sdfc_compiler::look::FILMIC)
+        {
+            source = source.replace(k, &format!("{c:?}"));
+        }
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("sdfc view accumulate"),
-            source: wgpu::ShaderSource::Wgsl(
-                ACCUMULATE
-                    .replace("STATS_WORDS", &wgsl::STATS_WORDS.to_string())
-                    .into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -234,16 +274,17 @@ impl Resident {
         })
     }
 
-    /// Renders one frame of `scene` (its settings' size, one sample a pixel) with `kernel`
-    /// (compiled on this device: [`Gpu::compute_pipeline`]) and adds it to the samples
-    /// accumulated: the first of them when `first` (or the size changed), else the next.
+    /// Renders one frame of `scene` (its settings' size, one sample a pixel, ungraded: linear
+    /// light) with `kernel` (compiled on this device: [`Gpu::compute_pipeline`]) and adds it
+    /// to the samples accumulated: the first of them when `first` (or the size changed), else
+    /// the next; the texture on show is their mean graded by `grade`.
     /// `data_key` names the kernel's scene data: it is uploaded only when the key changes.
     /// With `steps`, the frame's mean steps per pixel are read back (two words). Returns when
     /// the device has finished the frame.
     pub fn render(
         &mut self,
         (kernel, lipschitz): (&wgsl::Kernel, f64),
-        scene: &Scene,
+        (scene, grade): (&Scene, Grade),
         data_key: (u64, bool),
         first: bool,
         steps: bool,
@@ -278,8 +319,8 @@ impl Resident {
                 self.data_key = Some(data_key);
             }
         }
-        let frame = [width, height, t.count, steps as u32];
-        queue.write_buffer(&t.frame, 0, &words(&frame));
+        t.grade = grade;
+        queue.write_buffer(&t.frame, 0, &t.frame_words(steps as u32));
         let kernel_bind = kernel_bindings(
             &device,
             &pipeline,
@@ -333,7 +374,7 @@ impl Resident {
         };
         let (device, queue) = (self.gpu.device(), self.gpu.queue());
         let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        queue.write_buffer(&t.frame, 0, &words(&[t.width, t.height, t.count, 2]));
+        queue.write_buffer(&t.frame, 0, &t.frame_words(2));
         let mut encoder = device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&t.steps, 0, None);
         {
@@ -410,7 +451,7 @@ impl Resident {
                 usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
                 view_formats: &[wgpu::TextureFormat::Rgba8UnormSrgb],
             });
-            let frame = buffer("sdfc view frame", 16, U::STORAGE | U::COPY_DST);
+            let frame = buffer("sdfc view frame", FRAME_BYTES, U::STORAGE | U::COPY_DST);
             let steps = buffer("sdfc view steps", 8, U::STORAGE | U::COPY_SRC | U::COPY_DST);
             let view = texture.create_view(&wgpu::TextureViewDescriptor {
                 format: Some(wgpu::TextureFormat::Rgba8Unorm),
@@ -478,6 +519,7 @@ impl Resident {
                 number: self.textures,
                 bind,
                 count: 0,
+                grade: Grade::default(),
             });
             self.data_key = None;
         }
@@ -503,8 +545,8 @@ impl Resident {
             .map(|t| (&t.texture, t.number))
     }
 
-    /// The samples accumulated, read back: their mean as a linear image (the host's own
-    /// accumulation's, value for value). `None` before the first frame.
+    /// The samples accumulated, read back: their mean graded ([`Grade::apply`]), as a linear
+    /// image (the host's own accumulation's, value for value). `None` before the first frame.
     pub fn image(&self) -> Result<Option<Image>, Error> {
         let Some(t) = self.target.as_ref().filter(|t| t.count > 0) else {
             return Ok(None);
@@ -528,7 +570,7 @@ impl Resident {
             height: t.height,
             linear: bytes
                 .chunks_exact(16)
-                .map(|c| [f(&c[0..4]), f(&c[4..8]), f(&c[8..12])])
+                .map(|c| t.grade.apply([f(&c[0..4]), f(&c[4..8]), f(&c[8..12])]))
                 .collect(),
         }))
     }

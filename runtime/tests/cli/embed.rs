@@ -136,6 +136,37 @@ fn each_language_declares_the_named_functions_and_materials() {
     assert!(!glsl.contains("local_size_x") && !glsl.contains("void main"));
 }
 
+/// A scene's glow of the marching steps (`render { glow, glow_color }`) comes with its part in
+/// every language: `NAME_LIPSCHITZ` and `NAME_glow(d)`, `glow_color·e^(−|d|/glow)`, for a
+/// user's march to add at each step as the renderers do; a scene without a glow has neither.
+#[test]
+fn the_part_carries_the_glow_of_the_marching_steps() {
+    for (lang, glow) in [
+        ("wgsl", "fn blob_glow(d: f32) -> vec3<f32>"),
+        ("glsl", "vec3 blob_glow(float d)"),
+        ("hlsl", "float3 blob_glow(float d)"),
+        ("msl", "metal::float3 blob_glow("),
+        ("rust", "pub fn blob_glow(d: f32) -> [f32; 3]"),
+    ] {
+        let text = part("glow_blob.sdf", lang, "blob");
+        assert!(text.contains(glow), "{lang}: no `{glow}`\n{text}");
+        assert!(text.contains("blob_LIPSCHITZ"), "{lang}: no L");
+        let plain = part("seed3.sdf", lang, "ball");
+        assert!(
+            !plain.contains("_glow") && !plain.contains("_LIPSCHITZ"),
+            "{lang}"
+        );
+    }
+    // glow: 0.05, glow_color: (0.006, 0.015, 0.04) (examples/glow_blob.sdf).
+    let wgsl = part("glow_blob.sdf", "wgsl", "blob");
+    assert!(
+        wgsl.contains("return vec3<f32>(0.006, 0.015, 0.04) * exp(-abs(d) * 20.0);"),
+        "{wgsl}"
+    );
+    let rust = part("glow_blob.sdf", "rust", "blob");
+    assert!(rust.contains("let w = (-d.abs() * 20.0).exp();"), "{rust}");
+}
+
 /// The part's function is the renderer kernel's `map`, word for word (the kernel's is
 /// compared with the CPU renderer by runtime/tests/render/render.rs), and its table is the scene's
 /// materials in order.
@@ -593,8 +624,77 @@ fn the_shadertoy_page_renders_the_scene_in_webgl() {
     std::fs::create_dir_all(&dir).expect("temp dir");
     let scene = dir.join("small.sdf");
     std::fs::write(&scene, SMALL.replace(", reflect: 0.2", "")).expect("scene");
+    let (mean, far) = webgl_against_cpu(&chromium, &dir, &scene);
+    assert!(
+        mean < MEAN_LIMIT && far * 100 < 192 * 128,
+        "mean {mean}, {far} pixels far off"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The page draws the glow of the marching steps (`render { glow, glow_color }`) as the CPU
+/// renderer does, over the same over-relaxed steps: its WebGL image is the CPU's within the
+/// same bounds, where the CPU's image without the glow is far from it (as the page was
+/// before it drew the glow).
+#[test]
+fn the_shadertoy_page_draws_the_glow_of_the_marching_steps() {
+    let Some(chromium) = on_path("chromium") else {
+        assert!(!required(), "SDFC_REQUIRE_DEVICES=1, but no chromium");
+        println!("embed: SKIPPED: no chromium on PATH");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("sdfc-shadertoy-glow-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = dir.join("glow.sdf");
+    let text = SMALL.replace(", reflect: 0.2", "").replace(
+        "render { width: 48, height: 32 }",
+        "render { width: 48, height: 32, glow: 0.1, glow_color: (0.02, 0.03, 0.05) }",
+    );
+    std::fs::write(&scene, text).expect("scene");
+    let said = sdfc(&[
+        "compile",
+        scene.to_str().expect("utf-8"),
+        "--emit",
+        "shadertoy",
+    ]);
+    assert!(said.status.success());
+    let warned = String::from_utf8_lossy(&said.stderr);
+    assert!(!warned.contains("warning"), "{warned}");
+    let (mean, far) = webgl_against_cpu(&chromium, &dir, &scene);
+    assert!(
+        mean < MEAN_LIMIT && far * 100 < 192 * 128,
+        "mean {mean}, {far} pixels far off"
+    );
     let (w, h) = (192, 128);
-    let frag = serde_json::to_string(&shadertoy_wrapped(&scene)).expect("json");
+    let png = |name: &str, set: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec!["render", scene.to_str().expect("utf-8"), "--backend", "cpu"];
+        args.extend(["--size", "192x128", "-o", out.to_str().expect("utf-8")]);
+        args.extend(set);
+        let o = sdfc(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        sdfc_runtime::image::read_png(&out).expect("png").to_rgba8()
+    };
+    let (glow, none) = (png("a.png", &[]), png("b.png", &["--set", "glow=0"]));
+    let total: u64 = glow
+        .iter()
+        .zip(&none)
+        .map(|(x, y)| x.abs_diff(*y) as u64)
+        .sum();
+    let apart = total as f64 / (w * h * 3) as f64;
+    assert!(
+        apart > 10.0 * MEAN_LIMIT,
+        "the glow is {apart} steps of 255"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The page of `scene` rendered by `chromium` (WebGL 2 through SwiftShader) at 192×128 in
+/// `dir`, against the CPU's image: the mean difference of the sRGB bytes (of 255) and the
+/// pixels off by more than 24 in a channel.
+fn webgl_against_cpu(chromium: &Path, dir: &Path, scene: &Path) -> (f64, usize) {
+    let (w, h) = (192, 128);
+    let frag = serde_json::to_string(&shadertoy_wrapped(scene)).expect("json");
     let html = format!(
         "<!doctype html><html><body style=\"margin:0;overflow:hidden\"><canvas id=\"c\" width=\"{w}\" height=\"{h}\"></canvas><script>
 const gl = document.getElementById('c').getContext('webgl2', {{preserveDrawingBuffer: true}});
@@ -616,7 +716,7 @@ gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
     let page = dir.join("page.html");
     std::fs::write(&page, html).expect("page");
     let shot = dir.join("shot.png");
-    let out = Command::new(&chromium)
+    let out = Command::new(chromium)
         .args([
             "--headless=new",
             "--no-sandbox",
@@ -627,7 +727,7 @@ gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
             &format!("--screenshot={}", shot.display()),
         ])
         .arg(format!("file://{}", page.display()))
-        .env("XDG_RUNTIME_DIR", &dir)
+        .env("XDG_RUNTIME_DIR", dir)
         .output()
         .expect("run chromium");
     assert!(shot.is_file(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -658,9 +758,5 @@ gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
         .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| p.abs_diff(*q) > 24))
         .count();
     println!("shadertoy against cpu: mean |difference| {mean:.3} of 255, {far} pixels off by more than 24");
-    assert!(
-        mean < MEAN_LIMIT && far * 100 < (w * h) as usize,
-        "mean {mean}, {far} pixels far off"
-    );
-    let _ = std::fs::remove_dir_all(&dir);
+    (mean, far)
 }

@@ -1,7 +1,8 @@
 //! The scene's distance function alone, for a user's own shader (`sdfc compile --part map`,
 //! docs/embedding.md): the distance program written as `fn NAME(p) -> vec2<f32>` (distance,
 //! material id) and `fn NAME_distance(p) -> f32`, with their outlined blocks, the scene's
-//! material table as constants, and nothing of the renderer; every name it declares starts
+//! material table as constants and its glow of the marching steps (`NAME_glow`), and nothing
+//! else of the renderer; every name it declares starts
 //! with NAME, so the parts of two scenes live in one module. Parsed and validated by naga.
 
 use super::literal::float;
@@ -138,6 +139,19 @@ pub(crate) fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String
         );
     }
     out.push_str(");\n\n");
+    if let Some(glow) = Glow::of(scene, lowered) {
+        let _ = writeln!(
+            out,
+            "// The glow of the marching steps (docs/rendering.md, \"The look\"; render {{ glow, glow_color }}):\n\
+             // a renderer adds {name}_glow(d) to a camera ray's colour at each evaluation of its march,\n\
+             // the hit's and the last one's included, d = {name}_distance(p) / {name}_LIPSCHITZ there.\n\
+             const {name}_LIPSCHITZ: f32 = {};\n\
+             fn {name}_glow(d: f32) -> vec3<f32> {{\n    return {} * exp(-abs(d) * {});\n}}\n",
+            float(glow.lipschitz),
+            v3(glow.color),
+            float(1.0 / glow.distance),
+        );
+    }
     let glyphs = super::glyphs::part(program, name);
     if !glyphs.is_empty() {
         out.push_str(&glyphs);
@@ -159,6 +173,30 @@ pub(crate) fn write_text(scene: &Scene, lowered: &Lowered, name: &str) -> String
         out.push('\n');
     }
     out
+}
+
+/// A scene's glow of the marching steps, as a part carries it: each evaluation of a camera
+/// ray's march adds `color·e^(−|d|/distance)`, `d` the distance there over `lipschitz`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Glow {
+    /// The L the distance is divided by (the program's, at least 1, as the kernels march).
+    pub lipschitz: f64,
+    /// The glow's distance G (`glow`).
+    pub distance: f64,
+    /// What one step at the surface adds (`glow_color`).
+    pub color: [f64; 3],
+}
+
+impl Glow {
+    /// The glow of `scene` (lowered as `lowered`), if it glows.
+    pub fn of(scene: &Scene, lowered: &Lowered) -> Option<Glow> {
+        let s = &scene.settings;
+        s.glows().then(|| Glow {
+            lipschitz: lowered.program.lipschitz().max(1.0),
+            distance: s.glow,
+            color: s.glow_color,
+        })
+    }
 }
 
 /// Writes and validates the part of `scene` named `name` ([`valid_name`]).

@@ -23,10 +23,20 @@ fn pcg(x: u32) -> u32 {
 }
 
 // The stream's number in [0, 1) for (pixel, sample, bounce, dimension): the top 24 bits of
-// pcg(pcg(pcg(pcg(pixel) + sample) + bounce) + dim) times 2⁻²⁴.
-fn rnd(pixel: u32, sample: u32, bounce: u32, dim: u32) -> f32 {
-    let h = pcg(pcg(pcg(pcg(pixel) + sample) + bounce) + dim);
-    return f32(h >> 8u) * PATH_UNIT;
+// pcg(pcg(pcg(pcg(pixel) + sample) + bounce) + dim) times 2⁻²⁴. The hash is taken in its
+// steps, each once: a sample's key pcg(pcg(pixel) + sample) (`sample_key`), a bounce's
+// pcg(sample key + bounce) (`bounce_key`), then one pcg for each number drawn at that bounce
+// (`rnd`); the numbers are the host's (`sampling::uniform`), bit for bit.
+fn sample_key(pixel: u32, sample: u32) -> u32 {
+    return pcg(pcg(pixel) + sample);
+}
+
+fn bounce_key(sk: u32, bounce: u32) -> u32 {
+    return pcg(sk + bounce);
+}
+
+fn rnd(key: u32, dim: u32) -> f32 {
+    return f32(pcg(key + dim) >> 8u) * PATH_UNIT;
 }
 
 // The direction of local coordinates l about the unit vector n (Duff et al.'s basis).
@@ -245,7 +255,7 @@ fn draw(m: Material, b: Bsdf, u0: f32, u1: f32, u2: f32) -> Drawn {
 // each lamp through a hard shadow ray (a directional light sampled as a disc of its penumbra's
 // diameter, cos of its half angle in to_light.w), and the skies along a cosine-distributed
 // direction, weighed against the BRDF's density where the path goes on.
-fn estimates(m: Material, b: Bsdf, p: vec3<f32>, h: f32, tt: f32, weight: vec3<f32>, more: bool, pixel: u32, sample: u32, bounce: u32) -> vec3<f32> {
+fn estimates(m: Material, b: Bsdf, p: vec3<f32>, h: f32, tt: f32, weight: vec3<f32>, more: bool, key: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let n = b.n;
     let off = 4.0 * h;
@@ -278,8 +288,8 @@ fn estimates(m: Material, b: Bsdf, p: vec3<f32>, h: f32, tt: f32, weight: vec3<f
         var l = light.to_light.xyz;
         if light.to_light.w < 1.0 {
             let k = DIM_LAMPS + 2u * j;
-            let u1 = rnd(pixel, sample, bounce, k);
-            let u2 = rnd(pixel, sample, bounce, k + 1u);
+            let u1 = rnd(key, k);
+            let u2 = rnd(key, k + 1u);
             l = to_world(about(1.0 - u1 * (1.0 - light.to_light.w), u2), light.to_light.xyz);
         }
         if dot(n, l) <= 0.0 {
@@ -293,7 +303,7 @@ fn estimates(m: Material, b: Bsdf, p: vec3<f32>, h: f32, tt: f32, weight: vec3<f
     }
 //#endif
 //#if SKY
-    let l = to_world(cosine_dir(rnd(pixel, sample, bounce, DIM_SKY), rnd(pixel, sample, bounce, DIM_SKY + 1u)), n);
+    let l = to_world(cosine_dir(rnd(key, DIM_SKY), rnd(key, DIM_SKY + 1u)), n);
     let nl = dot(n, l);
     let f = bsdf_eval(m, b, l);
     if nl > 0.0 && max(max(abs(f.x), abs(f.y)), abs(f.z)) > 0.0 {
@@ -322,7 +332,9 @@ fn camera_jittered(x: u32, y: u32, jx: f32, jy: f32) -> vec3<f32> {
 // One sample of pixel (x, y): its path, and what it gathers.
 fn path_radiance(x: u32, y: u32, sample: u32) -> vec3<f32> {
     let pixel = y * params.counts.x + x;
-    let dir0 = camera_jittered(x, y, rnd(pixel, sample, 0u, 0u), rnd(pixel, sample, 0u, 1u));
+    let sk = sample_key(pixel, sample);
+    let first = bounce_key(sk, 0u);
+    let dir0 = camera_jittered(x, y, rnd(first, 0u), rnd(first, 1u));
     var ray = Ray(params.eye.xyz, 0.0, dir0, 0u, vec3<f32>(1.0), 0u);
     var pdf = 0.0;
     var sky_pdf = 0.0;
@@ -399,7 +411,8 @@ fn path_radiance(x: u32, y: u32, sample: u32) -> vec3<f32> {
         let more = ray.depth < params.depth.z;
         let bounce = ray.depth + 1u;
         let off = n * (4.0 * h);
-        let u_roulette = rnd(pixel, sample, bounce, DIM_ROULETTE);
+        let key = bounce_key(sk, bounce);
+        let u_roulette = rnd(key, DIM_ROULETTE);
         var next: Ray;
         if inside && !solid {
             if !more {
@@ -422,12 +435,12 @@ fn path_radiance(x: u32, y: u32, sample: u32) -> vec3<f32> {
             }
 //#endif
             if !solid {
-                acc += estimates(m, b, p, h, tt, weight, more, pixel, sample, bounce);
+                acc += estimates(m, b, p, h, tt, weight, more, key);
             }
             if !more {
                 break;
             }
-            let d = draw(m, b, rnd(pixel, sample, bounce, DIM_LOBE), rnd(pixel, sample, bounce, DIM_DIRECTION), rnd(pixel, sample, bounce, DIM_DIRECTION + 1u));
+            let d = draw(m, b, rnd(key, DIM_LOBE), rnd(key, DIM_DIRECTION), rnd(key, DIM_DIRECTION + 1u));
             if d.lobe == 0u {
                 break;
             }

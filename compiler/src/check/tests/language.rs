@@ -769,19 +769,28 @@ fn a_scene_of_the_newer_look_is_filmic_unless_it_says_otherwise() {
     let s = ok(pbr);
     assert_eq!(s.settings.tonemap, Tonemap::Filmic);
     assert_eq!(s.settings.tonemap_why, Some("it has a `pbr` material"));
-    let s = ok("light sky { }\nscene { sphere(1); }");
-    assert_eq!(
-        (s.settings.tonemap, s.settings.tonemap_why),
-        (Tonemap::Filmic, Some("it is lit by a `light sky`"))
-    );
-    // A path-traced scene keeps `none`, sky or pbr alike: the viewer adds graded samples.
+    for (text, why) in [
+        (
+            "light sky { }\nscene { sphere(1); }",
+            "it is lit by a `light sky`",
+        ),
+        (
+            "render { method: \"path\" }\nscene { sphere(1); }",
+            "it is path traced (`method: \"path\"`)",
+        ),
+    ] {
+        let s = ok(text);
+        assert_eq!(
+            (s.settings.tonemap, s.settings.tonemap_why),
+            (Tonemap::Filmic, Some(why))
+        );
+    }
+    // A path-traced scene of pbr materials under a sky is graded as any other (the viewer
+    // grades the mean of its linear samples, as `sdfc render` does).
     let s = ok(&format!(
         "render {{ method: \"path\" }}\nlight sky {{ }}\n{pbr}"
     ));
-    assert_eq!(
-        (s.settings.tonemap, s.settings.tonemap_why),
-        (Tonemap::None, Some(look::PATH_TRACED))
-    );
+    assert_eq!(s.settings.tonemap, Tonemap::Filmic);
     // A scene of the older look keeps `none`; a given curve is kept, and says so.
     let s = ok("light point { position: (0, 5, 0) }\nscene { sphere(1); }");
     assert_eq!(

@@ -163,6 +163,10 @@ impl Session {
             (None, Device::Cpu) => job::Open::Backend,
             (None, Device::Wgpu(gpu)) => job::Open::Gpu(gpu.clone()),
         };
+        // The frames render linear light, which adds up as samples do; the exposure and tone
+        // curve are applied to their mean, as `sdfc render` grades the mean of its samples.
+        let mut scene = scene;
+        let grade = Grade::take(&mut scene.settings);
         let frame = FrameScene {
             scene,
             lowered,
@@ -240,6 +244,7 @@ impl Session {
         let good = Good {
             file_camera: scene.camera.clone(),
             scene,
+            grade,
             prepared,
             aa,
             method,

@@ -11,6 +11,7 @@
 
 use super::camera::{self, Orbit};
 use super::compile::{Compile, Waker};
+use super::grade::Grade;
 use super::resident::{FirstFrame, Resident};
 use super::watch::Fingerprint;
 use crate::backend::{Devices, Kernel, Prepared, Setup};
@@ -159,8 +160,11 @@ impl Device {
 /// The scene being shown: the last load that compiled.
 #[derive(Debug)]
 struct Good {
-    /// The scene; its camera and size are set for each frame.
+    /// The scene; its camera and size are set for each frame. It is ungraded: its frames are
+    /// linear light, accumulated as such, and `grade` is applied to their mean.
     scene: Scene,
+    /// The scene's exposure and tone curve, taken out of `scene` ([`Grade::take`]).
+    grade: Grade,
     prepared: Prepared,
     /// The camera the file gives.
     file_camera: Camera,
@@ -567,9 +571,12 @@ impl Session {
         let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
             return Ok(());
         };
-        let frame = job
+        let mut frame = job
             .frame(&mut p.source, time, false, &LowerOptions::parametric())
             .map_err(|e| e.to_string())?;
+        // Its frames render linear light; the grade (which may change with `t`) is applied
+        // to their mean.
+        let grade = Grade::take(&mut frame.scene.settings);
         // Each kernel stays the one it is (`Auto`: the one before's).
         let setup = Setup::default();
         if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
@@ -586,6 +593,7 @@ impl Session {
         self.version += 1;
         good.file_camera = scene.camera.clone();
         good.scene = scene;
+        good.grade = grade;
         good.prepared = prepared;
         Ok(())
     }
@@ -792,7 +800,7 @@ impl Session {
                             .and_then(|r| {
                                 r.render(
                                     (kernel, *lipschitz),
-                                    &good.scene,
+                                    (&good.scene, good.grade),
                                     key,
                                     a.count == 0,
                                     self.steps_wanted,
@@ -824,14 +832,16 @@ impl Session {
         let time = start.elapsed();
         a.count = count;
         if !a.sum.is_empty() {
+            // The mean of the linear samples, graded.
             let inv = 1.0 / a.count as f32;
+            let grade = good.grade;
             self.shown = Some(Image {
                 width: w,
                 height: h,
                 linear: a
                     .sum
                     .iter()
-                    .map(|c| [c[0] * inv, c[1] * inv, c[2] * inv])
+                    .map(|c| grade.apply([c[0] * inv, c[1] * inv, c[2] * inv]))
                     .collect(),
             });
         }

@@ -3,6 +3,8 @@
 
 use super::*;
 
+mod path;
+
 const SCENE: &str = "camera { position: (0, 1, -4), look_at: (0, 0.5, 0), fov: 50deg }\n\
     light point { position: (2, 4, -3), intensity: 1 }\n\
     render { width: 32, height: 24, aa: 2 }\n\
@@ -832,69 +834,5 @@ fn a_parameter_of_a_traced_scene_keeps_the_kernel() {
     assert!(fresh.load().ok);
     settle_all(&mut fresh);
     assert_eq!(fresh.image(), Some(changed));
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// A path-traced scene accumulates one sample a frame, the next of its random stream, while
-/// the camera rests, up to its `samples`, saying in the title how many it has; the picture is
-/// then the path tracer's of that many samples; any change starts again.
-#[test]
-fn a_path_traced_picture_accumulates_its_samples_while_the_camera_rests() {
-    let dir = std::env::temp_dir().join(format!("sdfc-path-view-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("s.sdf");
-    // In linear light: the frames are graded before they are averaged, so under a tone curve
-    // (a path-traced scene's default is filmic) their mean is not the graded mean.
-    let text = SCENE.replace(
-        "aa: 2 }",
-        "method: \"path\", samples: 4, bounces: 2, tonemap: \"none\" }",
-    );
-    std::fs::write(&file, &text).unwrap();
-    let mut s = Session::new(file, Options::default(), Device::Cpu);
-    s.set_size(32, 24);
-    assert!(s.load().ok);
-    let info = s.frame().expect("a frame").expect("a frame");
-    assert_eq!((info.samples, info.target), (1, 4));
-    assert!(
-        s.title(false).ends_with(" | 1/4 samples"),
-        "{}",
-        s.title(false)
-    );
-    assert_eq!(settle(&mut s), 3);
-    assert!(
-        s.title(false).ends_with(" | 4/4 samples"),
-        "{}",
-        s.title(false)
-    );
-    let shown = s.image().expect("the image");
-    let good = s.good.as_ref().unwrap();
-    let mut scene = good.scene.clone();
-    scene.camera = camera::jittered(&s.camera().unwrap(), 0.0, 0.0, 32, 24);
-    (scene.settings.samples, scene.settings.first_sample) = (4, 0);
-    let direct = good.prepared.render(&scene, &|_| {}).expect("a render");
-    let most = shown
-        .linear
-        .iter()
-        .zip(&direct.render.image.linear)
-        .flat_map(|(a, b)| (0..3).map(move |i| (a[i] - b[i]).abs()))
-        .fold(0.0f32, f32::max);
-    assert!(
-        most < 1e-5,
-        "the frames add up to the 4-sample picture: {most}"
-    );
-    // A frame of one sample differs from it (the frames were not the same sample).
-    (scene.settings.samples, scene.settings.first_sample) = (1, 3);
-    let one = good.prepared.render(&scene, &|_| {}).expect("a render");
-    assert_ne!(one.render.image.linear, direct.render.image.linear);
-    // Moving the camera starts again.
-    s.rotate(20.0, 0.0);
-    let info = s.frame().expect("a frame").expect("a frame while moving");
-    assert_eq!(info.samples, 1);
-    settle(&mut s);
-    assert!(
-        s.title(false).ends_with(" | 4/4 samples"),
-        "{}",
-        s.title(false)
-    );
     let _ = std::fs::remove_dir_all(&dir);
 }

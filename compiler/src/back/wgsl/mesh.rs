@@ -3,12 +3,17 @@
 //! walk, nearest triangle and pseudo-normal sign as `TriMesh::distance`, in f32.
 //!
 //! Layout, from the mesh's `base` (in `vec4<f32>`, integers as their bits): one header
-//! vector (x: the hierarchy's vectors, twice its nodes); the nodes, two vectors each
+//! vector (x: the hierarchy's vectors, twice its nodes; y: the largest magnitude of a
+//! coordinate of its box, which pads the walk's starting bound); the nodes, two vectors each
 //! (`lo.xyz`, `first`; `hi.xyz`, `count`: a leaf's `count` triangles from `first`, or, when
 //! `count` is 0, the children `first` and `first + 1`); then the triangles, nine vectors each
 //! (the corners a, b, c, then the pseudo-normals of a, b, c and of the edges ab, bc, ca).
 //! The meshes of a scene lie one after the other in the order they were read, each at the
 //! `base` the checker gave it.
+//!
+//! Each invocation keeps, per mesh (four slots by `base`, each naming its mesh), the triangle
+//! nearest to its last query, whose distance bounds the next walk from its start
+//! (`TriMesh::distance_from`: the same result, fewer nodes).
 
 use crate::program::mesh::STACK;
 use crate::program::Program;
@@ -32,7 +37,14 @@ pub fn data<'a>(programs: impl IntoIterator<Item = &'a Program>) -> Vec<u8> {
                 }
             };
             let bits = |u: u32| f32::from_bits(u);
-            put([bits(2 * mesh.nodes().len() as u32), 0.0, 0.0, 0.0]);
+            // The reach rounded up, so that the f32 pad is no smaller than the f64 one.
+            let reach = mesh.reach() as f32;
+            let reach = if f64::from(reach) < mesh.reach() {
+                reach * (1.0 + f32::EPSILON)
+            } else {
+                reach
+            };
+            put([bits(2 * mesh.nodes().len() as u32), reach, 0.0, 0.0]);
             for n in mesh.nodes() {
                 let [x, y, z] = n.lo.map(|v| v as f32);
                 put([x, y, z, bits(n.first)]);
@@ -105,11 +117,21 @@ pub fn write() -> String {
          \x20   let n = cross(scene_data[t + 1u].xyz - a, scene_data[t + 2u].xyz - a);\n\
          \x20   return p - n * (dot(p - a, n) / dot(n, n));\n\
          }}\n\n\
+         // Per slot (base % 4): the base of the mesh it holds and the triangle nearest to its\n\
+         // last query (program/mesh.rs, TriMesh::distance_from).\n\
+         var<private> mesh_hints: array<vec2<u32>, 4>;\n\n\
          // The signed distance at p to the mesh whose data starts at scene_data[base].\n\
          fn mesh_distance(p: vec3<f32>, base: u32) -> f32 {{\n\
          \x20   let nodes = base + 1u;\n\
          \x20   let tris = nodes + bitcast<u32>(scene_data[base].x);\n\
-         \x20   var best = 3.4e38;\n\
+         \x20   // The walk starts bounded by the hinted triangle's distance, padded (bound_pad).\n\
+         \x20   let slot = base & 3u;\n\
+         \x20   let hint = tris + 9u * select(0u, mesh_hints[slot].y, mesh_hints[slot].x == base);\n\
+         \x20   let hw = p - mesh_point(p, hint, mesh_feature(p, hint));\n\
+         \x20   let hd = sqrt(hw.x * hw.x + hw.y * hw.y + hw.z * hw.z);\n\
+         \x20   let ap = abs(p);\n\
+         \x20   let bd = hd + 1e-5 * (scene_data[base].y + max(max(ap.x, ap.y), ap.z) + hd);\n\
+         \x20   var best = select(3.4e38, bd * bd, bd * bd < 3.4e38);\n\
          \x20   var best_t = tris;\n\
          \x20   var best_f = 6u;\n\
          \x20   // Nodes still to visit, the nearer child on top ({STACK} levels hold any mesh).\n\
@@ -157,6 +179,7 @@ pub fn write() -> String {
          \x20       let a = scene_data[best_t].xyz;\n\
          \x20       n = cross(scene_data[best_t + 1u].xyz - a, scene_data[best_t + 2u].xyz - a);\n\
          \x20   }}\n\
+         \x20   mesh_hints[slot] = vec2<u32>(base, (best_t - tris) / 9u);\n\
          \x20   let d = sqrt(best);\n\
          \x20   return select(d, -d, w.x * n.x + w.y * n.y + w.z * n.z < 0.0);\n\
          }}\n"

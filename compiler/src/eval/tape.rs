@@ -699,7 +699,9 @@ impl Inst {
                 // Each lane's walk starts bounded by the triangle nearest to the lane before
                 // (neighbouring lanes are near points: the same results, fewer nodes).
                 let mut hint = 0;
-                map3(d, x, y, z, |x, y, z| mesh.distance_from([x, y, z], &mut hint));
+                map3(d, x, y, z, |x, y, z| {
+                    mesh.distance_from([x, y, z], &mut hint)
+                });
             }
             Code::Outline => {
                 let o = &outlines[self.k as usize];

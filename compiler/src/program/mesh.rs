@@ -155,6 +155,11 @@ fn f32_up(x: f64) -> f64 {
 }
 
 impl TriMesh {
+    /// How far beyond a triangle's edges (in its barycentric coordinates) a traced ray still
+    /// meets it: enough to cover the f32 rounding of the coordinates (a ray through an edge
+    /// meets one of its two triangles, not the crack between), too little to show.
+    pub const EDGE: f64 = 1e-5;
+
     /// Builds a mesh from `positions` (scaled by `scale`, rounded to f32) and `faces`
     /// (indices into them, counter-clockwise seen from outside). Corners at the same place
     /// are one vertex; triangles of no area are dropped; a mesh wound inside out is turned.

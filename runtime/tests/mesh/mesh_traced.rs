@@ -161,3 +161,48 @@ fn a_changed_mesh_or_a_penumbra_is_marched() {
     let soft = setup("traced-mesh-soft", "mesh(\"part.stl\")", ", penumbra: 3deg");
     assert_eq!(choose(&soft), Choice::March(Reason::SoftLight { index: 0 }));
 }
+
+/// Path tracing a traced scene whose mesh and sphere are scaled: the kernel's path tracer and
+/// the intervals of framed primitives each had a `fn to_world`, so such a kernel did not
+/// validate (found with this test's scene); the path-traced picture through wgpu is the CPU's.
+#[test]
+fn a_path_traced_scaled_mesh_has_a_kernel() {
+    let d = dir("traced-mesh-path");
+    let part = d.join("part.stl");
+    let bracket = root().join("examples/mesh/bracket.sdf");
+    super::meshes::mesh(&[s(&bracket), "--resolution", "24", "-o", s(&part)]);
+    let text = "material glass = pbr { base_color: (0.95, 1, 0.97), roughness: 0, transmission: 1, ior: 1.5 };
+material gold = pbr { base_color: (1, 0.78, 0.34), metallic: 1, roughness: 0.25 };
+material floor = pbr { base_color: (0.6, 0.6, 0.6), roughness: 0.8 };
+camera { position: (1.8, 1.5, -2.4), look_at: (0, 0.1, 0), fov: 45deg }
+light sky { zenith: (0.12, 0.28, 0.7), horizon: (0.6, 0.7, 0.85), ground: (0.45, 0.44, 0.42) }
+light directional { direction: (-0.5, -1, 0.8), color: (1, 0.92, 0.8) }
+render { width: 96, height: 64, method: \"path\", samples: 4, bounces: 3 }
+scene {
+  mesh(\"part.stl\") @ gold;
+  mesh(\"part.stl\").scale(0.5).translate(-0.8, -0.2, -0.5) @ glass;
+  sphere(0.3).scale(0.5).translate(0.8, -0.27, -0.5) @ gold;
+  plane((0, 1, 0), -0.42) @ floor;
+}
+";
+    let scene = load(&write_scene(&d, "scene.sdf", text));
+    assert!(matches!(choose(&scene), Choice::Trace(_)));
+    let lowered = Lowered::new(&scene);
+    let kernel = wgsl::write(&scene, &lowered).expect("a valid kernel");
+    let Some(gpu) = open_gpu("path-traced mesh") else {
+        return;
+    };
+    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
+    let on_cpu = cpu_render(&scene);
+    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, 0.1).expect("same size");
+    println!(
+        "path traced, wgpu against cpu: {:.1} dB, {:.4} differing",
+        d.psnr, d.differing
+    );
+    assert!(
+        d.psnr >= 80.0 && d.differing <= 0.0005,
+        "path traced, wgpu against cpu: {:.1} dB, {:.4} differing",
+        d.psnr,
+        d.differing
+    );
+}

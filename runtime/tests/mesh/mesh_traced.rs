@@ -151,6 +151,26 @@ fn which_ptxas() -> Option<std::path::PathBuf> {
     found
 }
 
+/// A traced scene's meshes are held to the `scene_data` limit as a marched scene's are: the
+/// kernel is refused, naming the limit (the traced kernel skipped the check when first
+/// written).
+#[test]
+fn a_traced_mesh_is_held_to_the_scene_data_limit() {
+    let mut scene = setup("traced-mesh-limit", "mesh(\"part.stl\")", "");
+    scene
+        .limits
+        .set(sdfc_compiler::Limit::SceneData, 1)
+        .expect("a limit");
+    let lowered = Lowered::new(&scene);
+    assert!(matches!(choose(&scene), Choice::Trace(_)));
+    let e = wgsl::write(&scene, &lowered).expect_err("above the limit");
+    assert!(
+        e.message.contains("scene_data limit of 1 MiB"),
+        "{}",
+        e.message
+    );
+}
+
 #[test]
 fn a_changed_mesh_or_a_penumbra_is_marched() {
     let rounded = setup("traced-mesh-round", "mesh(\"part.stl\").round(0.02)", "");

@@ -68,6 +68,24 @@ pub fn data_of<'a>(meshes: impl IntoIterator<Item = &'a TriMesh>) -> Vec<u8> {
     out
 }
 
+/// Whether the meshes' bytes of `scene_data`, `data`, are within the `scene_data` limit, or
+/// why not (the marched kernels and a traced scene's read the same bytes).
+pub(super) fn fits(scene: &crate::scene::Scene, data: &[u8]) -> Result<(), String> {
+    let bytes = data.len() as u64;
+    let mib = scene.limits.get(crate::limits::Limit::SceneData);
+    if bytes > mib.saturating_mul(1 << 20) {
+        return Err(format!(
+            "the scene's meshes take {} MiB of scene_data, above the scene_data limit of \
+             {mib} MiB; {}",
+            bytes.div_ceil(1 << 20),
+            scene
+                .limits
+                .raise_to(crate::limits::Limit::SceneData, bytes.div_ceil(1 << 20))
+        ));
+    }
+    Ok(())
+}
+
 /// Whether a program names a mesh.
 pub fn uses_meshes(program: &Program) -> bool {
     program.meshes().next().is_some()

@@ -75,7 +75,7 @@ pub use crate::scene::{
 pub use crate::{
     lower::{lower, lower_scene, lower_with, lower_within, LowerOptions, Lowered},
     lower::{ColourProgram, Colours, Media},
-    program::{Binary, Op, Program, Step, Unary},
+    program::{mesh::TriMesh, Binary, Op, Program, Step, Unary},
 };
 
 /// The batch interpreter of distance programs (f32 or f64), and the bounds it verifies.

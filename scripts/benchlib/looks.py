@@ -109,7 +109,7 @@ def text(ctx):
 MESH_SCENE = """material steel = phong { color: (0.62, 0.64, 0.7), specular: 0.6, shininess: 64 };
 material floor = checker { a: (0.85, 0.85, 0.85), b: (0.55, 0.55, 0.55), size: 0.25 };
 camera { position: (1.8, 1.5, -2.4), look_at: (0, 0.1, 0), fov: 45deg }
-light point { position: (-2, 4, -3), intensity: 1.1, penumbra: 3deg }
+light point { position: (-2, 4, -3), intensity: 1.1%s }
 render { width: 1920, height: 1080, max_depth: 0 }
 scene {
   %s @ steel;
@@ -126,17 +126,23 @@ def mesh_import(ctx):
     if code:
         raise core.Skip("sdfc mesh failed: %s" % core.last_line(err))
     tris = re.search(r"([0-9]+) triangles", out + err)
-    for name, shape in (("scene", 'mesh("big.stl")'), ("box", "box((0.8, 0.3, 0.45))")):
-        open("%s/%s.sdf" % (work, name), "w").write(MESH_SCENE % shape)
+    # The light's penumbra (0: a hard light, which lets the mesh as read be traced), and the
+    # mesh as read or rounded and shelled (shell=1, marched).
+    penumbra = ctx.opt("penumbra", "3deg")
+    light = "" if penumbra in ("0", "0deg") else ", penumbra: " + penumbra
+    big = 'mesh("big.stl")' + (".round(0.02).shell(0.03)" if ctx.opt("shell", False) else "")
+    for name, shape in (("scene", big), ("box", "box((0.8, 0.3, 0.45))")):
+        open("%s/%s.sdf" % (work, name), "w").write(MESH_SCENE % (light, shape))
     scene = work + "/scene.sdf"
     size = ctx.size_list(["1920x1080"])[0][0]
     frames = ctx.n_frames(5)
     t = ctx.table("The bracket meshed by `sdfc mesh --resolution %d` (%s triangles, %d KiB STL) "
-                  "read back with `mesh(...)` beside a floor and a soft-shadowed light: *load*: "
+                  "read back with `mesh(...)`%s beside a floor and a light of penumbra %s: *load*: "
                   "`sdfc check`, best of 3, s (the same scene with a box); *frame*: `sdfc bench "
                   "--size %s --frames %d`, median GPU ms; *agreement*: at 640x480 against the "
                   "CPU." % (res, tris.group(1) if tris else "?", os.path.getsize(
-                      work + "/big.stl") // 1024, size, frames),
+                      work + "/big.stl") // 1024, big[len('mesh("big.stl")'):], penumbra,
+                      size, frames),
                   ["build", "load s", "box s"] + ["%s frame" % b for b in ctx.backends] +
                   ["%s vs cpu" % b for b in ctx.gpu_backends()])
     for x in ctx.builds:
@@ -276,7 +282,7 @@ SUITES = {
     "text": (text, "examples/plaque.sdf, a 40-character and a 1-character extruded string: "
                    "frame ms, kernel sizes"),
     "mesh-import": (mesh_import, "a 100 000-triangle mesh(path) scene: load, 1080p frame, "
-                    "agreement; --with resolution=104"),
+                    "agreement; --with resolution=104, penumbra=3deg (0: hard, traced), shell=0"),
     "view": (view, "sdfc view --headless: edit to pixel of numeric, structural and radius "
              "edits, orbit frames/s; --with kernel=auto, orbit=seed1,..."),
     "pareto": (pareto, "docs/accuracy.md's speed-accuracy charts on the GPU backends; --with "

@@ -696,7 +696,12 @@ impl Inst {
                     sources.get(self.b),
                     sources.get(self.c),
                 );
-                map3(d, x, y, z, |x, y, z| mesh.distance([x, y, z]));
+                // Each lane's walk starts bounded by the triangle nearest to the lane before
+                // (neighbouring lanes are near points: the same results, fewer nodes).
+                let mut hint = 0;
+                map3(d, x, y, z, |x, y, z| {
+                    mesh.distance_from([x, y, z], &mut hint)
+                });
             }
             Code::Outline => {
                 let o = &outlines[self.k as usize];
@@ -757,7 +762,7 @@ fn map1<T: Float>(d: &mut [T], a: &[T], f: impl Fn(T) -> T) {
 }
 
 #[inline(always)]
-fn map3<T: Float>(d: &mut [T], a: &[T], b: &[T], c: &[T], f: impl Fn(T, T, T) -> T) {
+fn map3<T: Float>(d: &mut [T], a: &[T], b: &[T], c: &[T], mut f: impl FnMut(T, T, T) -> T) {
     for (((o, &x), &y), &z) in d.iter_mut().zip(a).zip(b).zip(c) {
         *o = f(x, y, z);
     }

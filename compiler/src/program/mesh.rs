@@ -57,6 +57,8 @@ pub struct TriMesh {
     pub base: u32,
     triangles: Vec<Triangle>,
     nodes: Vec<Node>,
+    /// The largest magnitude of a coordinate of its box ([`bound_pad`]).
+    reach: f64,
     /// What building found: open and non-manifold edges, dropped triangles.
     pub report: Report,
 }
@@ -153,6 +155,11 @@ fn f32_up(x: f64) -> f64 {
 }
 
 impl TriMesh {
+    /// How far beyond a triangle's edges (in its barycentric coordinates) a traced ray still
+    /// meets it: enough to cover the f32 rounding of the coordinates (a ray through an edge
+    /// meets one of its two triangles, not the crack between), too little to show.
+    pub const EDGE: f64 = 1e-5;
+
     /// Builds a mesh from `positions` (scaled by `scale`, rounded to f32) and `faces`
     /// (indices into them, counter-clockwise seen from outside). Corners at the same place
     /// are one vertex; triangles of no area are dropped; a mesh wound inside out is turned.
@@ -257,12 +264,18 @@ impl TriMesh {
             })
             .collect();
         let (triangles, nodes) = hierarchy(triangles);
+        let reach = nodes[0]
+            .lo
+            .iter()
+            .chain(&nodes[0].hi)
+            .fold(0.0f64, |m, x| m.max(x.abs()));
         Ok(TriMesh {
             name: name.to_string(),
             id: 0,
             base: 0,
             triangles,
             nodes,
+            reach,
             report,
         })
     }
@@ -290,6 +303,33 @@ impl TriMesh {
 
     /// The signed distance at `p`: negative inside.
     pub fn distance<T: Float>(&self, p: [T; 3]) -> T {
+        self.walk(p, T::from_f64(f64::INFINITY)).0
+    }
+
+    /// [`TriMesh::distance`], the walk bounded from its start by a triangle near `p`: the
+    /// triangle `hint` names (one of an earlier query, a point near this one, as along a
+    /// ray), which is then set to the nearest triangle at `p`. The distance to any triangle
+    /// bounds the distance to the nearest, so nodes no nearer than that bound (padded by
+    /// [`bound_pad`] for rounding) are skipped from the root down, where the walk from the root
+    /// alone would visit them until it first reaches a leaf. Every node and triangle the
+    /// walk from the root alone would take as nearest is still visited in the same order, so
+    /// the result is the same, bit for bit, whatever the hint (a test holds it to that).
+    pub fn distance_from<T: Float>(&self, p: [T; 3], hint: &mut u32) -> T {
+        let start = (*hint as usize).min(self.triangles.len() - 1);
+        let (d2, _) = nearest(&self.triangles[start], p);
+        let (d, t) = self.walk(p, bound(d2, p, T::from_f64(self.reach)));
+        *hint = t;
+        d
+    }
+
+    /// The largest magnitude of a coordinate of its box ([`bound_pad`]).
+    pub fn reach(&self) -> f64 {
+        self.reach
+    }
+
+    /// The walk over the hierarchy from the root, skipping what is no nearer than `best`
+    /// (squared): the signed distance and the nearest triangle.
+    fn walk<T: Float>(&self, p: [T; 3], mut best: T) -> (T, u32) {
         let f = |x: f64| T::from_f64(x);
         let zero = T::zero();
         let box_d2 = |n: &Node| {
@@ -300,7 +340,6 @@ impl TriMesh {
             }
             s
         };
-        let mut best = T::from_f64(f64::INFINITY);
         let mut sign_of = (zero, 0u32, 0usize);
         let mut stack = [0u32; STACK];
         let mut top = 1;
@@ -355,12 +394,32 @@ impl TriMesh {
         let w = sub3(p, q);
         let s = w[0] * normal[0] + w[1] * normal[1] + w[2] * normal[2];
         let d = d2.sqrt();
-        if s < zero {
-            -d
-        } else {
-            d
-        }
+        (if s < zero { -d } else { d }, t)
     }
+}
+
+/// What [`TriMesh::distance_from`] starts its walk with, given `d2`, the squared distance
+/// from `p` to one triangle: `d2` raised by [`bound_pad`] over its root, so that no node or
+/// triangle nearer than the nearest triangle is skipped for rounding (a box's distance and
+/// a triangle's in it differ by a few ulps of the coordinates); infinity where `d2` or `p` is
+/// not finite, as the walk from the root alone starts.
+fn bound<T: Float>(d2: T, p: [T; 3], reach: T) -> T {
+    let d = d2.sqrt() + bound_pad(p, reach, d2.sqrt());
+    let b = d * d;
+    let inf = T::from_f64(f64::INFINITY);
+    if b < inf {
+        b
+    } else {
+        inf
+    }
+}
+
+/// The margin added to a triangle's distance `d` from `p` before it bounds a walk: 10⁻⁵ of
+/// the sizes in play (the mesh's reach from the origin, `p`'s and `d`), some hundred f32
+/// ulps of them, far above the rounding of a box's or a triangle's distance.
+pub fn bound_pad<T: Float>(p: [T; 3], reach: T, d: T) -> T {
+    let m = p[0].abs().max(p[1].abs()).max(p[2].abs());
+    T::from_f64(1e-5) * (reach + m + d)
 }
 
 /// The feature of the face itself (the corners are 0–2, the edges ab, bc, ca 3–5).
@@ -692,6 +751,33 @@ mod tests {
             if brute > 1e-4 {
                 assert_eq!(d32 < 0.0, inside, "f32 sign at {p:?}: {d32}");
             }
+        }
+    }
+
+    /// A walk bounded from its start by any triangle's distance gives what the walk from the
+    /// root alone gives, bit for bit, in f64 and f32, and names the nearest triangle as the
+    /// next hint.
+    #[test]
+    fn a_hinted_walk_is_the_walk_from_the_root() {
+        let (v, f) = torus(40, 20);
+        let m = TriMesh::new("torus", &v, &f, 1.0).expect("a mesh");
+        let tris: Vec<[[f64; 3]; 3]> = m.triangles().iter().map(|t| [t[0], t[1], t[2]]).collect();
+        let mut rng = crate::rng::Rng::new(42);
+        let n = m.triangles().len();
+        let mut chained = 0u32;
+        for p in probes(&tris, &mut rng) {
+            let (d, d32) = (m.distance(p), m.distance(p.map(|x| x as f32)));
+            for hint in [rng.below(n) as u32, 0, n as u32 + 7] {
+                let mut h = hint;
+                assert_eq!(m.distance_from(p, &mut h).to_bits(), d.to_bits(), "{p:?}");
+                let near = nearest(&m.triangles()[h as usize], p).0.sqrt();
+                assert!((near - d.abs()).abs() <= 1e-12, "{p:?}: hint {h}");
+                let mut h = hint;
+                let q = p.map(|x| x as f32);
+                assert_eq!(m.distance_from(q, &mut h).to_bits(), d32.to_bits(), "{p:?}");
+            }
+            // As along a ray: each query hinted by the one before.
+            assert_eq!(m.distance_from(p, &mut chained).to_bits(), d.to_bits());
         }
     }
 

@@ -1,12 +1,15 @@
 //! Which scenes can be ray traced analytically, and their primitives in world space.
 //!
-//! A scene qualifies when its objects are only spheres, planes, boxes, capped cylinders and
-//! capsules under affine transforms (translate, rotate, uniform and per-axis scale), painted
+//! A scene qualifies when its objects are only spheres, planes, boxes, capped cylinders,
+//! capsules and triangle meshes used as they are read (`mesh(path)`, met through their
+//! hierarchy, triangle by triangle) under affine transforms (translate, rotate, uniform and
+//! per-axis scale), painted
 //! and combined by plain union, no light asks for soft shadows (a penumbra estimate needs a
 //! distance field) and no glass overlaps other glass. Every ray then has closed-form roots: exact hits, exact normals, no step
 //! budget and no ε. The CPU renderer and the WGSL kernel (so also PTX) both trace the list of
 //! [`Primitive`]s this module produces (docs/rendering.md, "Analytic ray tracing").
 
+pub use super::ir::MeshRef;
 use super::ir::{Combine, MaterialId, Method, Node, Scene, V3};
 use super::NodeId;
 use crate::limits::{Limit, Limits};
@@ -25,6 +28,10 @@ pub enum Shape {
     Capsule { radius: f64, half_height: f64 },
     /// Half-space `dot(p, normal) <= height` (unit normal).
     Plane { normal: V3, height: f64 },
+    /// The triangle mesh `Traced::meshes[index]`, whose triangles lie in the box from `lo`
+    /// to `hi`. Not convex: a ray's hit is the nearest triangle it crosses, found through the
+    /// mesh's hierarchy; its normal is the triangle's.
+    Mesh { index: u32, lo: V3, hi: V3 },
 }
 
 /// One primitive of an analytic scene: its shape, the affine map from world to its local
@@ -174,6 +181,8 @@ pub struct Traced {
     pub primitives: Vec<Primitive>,
     /// Their hierarchy (indices into `primitives`).
     pub hierarchy: Vec<Item>,
+    /// The triangle meshes [`Shape::Mesh`] primitives name, by index.
+    pub meshes: Vec<MeshRef>,
 }
 
 /// The primitives of `scene` and what rules tracing out, whatever its `method`.
@@ -205,6 +214,7 @@ pub fn traceable(scene: &Scene) -> Traceable {
         };
     }
     let mut out = Vec::new();
+    let mut meshes = Vec::new();
     if let Some(root) = scene.root {
         let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let frame = Frame {
@@ -212,7 +222,7 @@ pub fn traceable(scene: &Scene) -> Traceable {
             offset: [0.0; 3],
             material: MaterialId(0),
         };
-        if let Err(reason) = collect(scene, root, frame, &mut out) {
+        if let Err(reason) = collect(scene, root, frame, &mut out, &mut meshes) {
             return Traceable {
                 primitives: Err(reason),
                 overlap: None,
@@ -226,6 +236,7 @@ pub fn traceable(scene: &Scene) -> Traceable {
         primitives: Ok(Traced {
             primitives: out,
             hierarchy,
+            meshes,
         }),
         overlap,
         limit,
@@ -374,7 +385,13 @@ fn diagonal(v: V3) -> [V3; 3] {
     [[v[0], 0.0, 0.0], [0.0, v[1], 0.0], [0.0, 0.0, v[2]]]
 }
 
-fn collect(scene: &Scene, id: NodeId, f: Frame, out: &mut Vec<Primitive>) -> Result<(), Reason> {
+fn collect(
+    scene: &Scene,
+    id: NodeId,
+    f: Frame,
+    out: &mut Vec<Primitive>,
+    meshes: &mut Vec<MeshRef>,
+) -> Result<(), Reason> {
     let g = &scene.graph;
     let mut leaf = |shape| {
         out.push(Primitive {
@@ -407,26 +424,49 @@ fn collect(scene: &Scene, id: NodeId, f: Frame, out: &mut Vec<Primitive>) -> Res
             normal: *normal,
             height: *height,
         }),
+        Node::Mesh { mesh } => {
+            let index = match meshes.iter().position(|m| m == mesh) {
+                Some(i) => i,
+                None => {
+                    meshes.push(mesh.clone());
+                    meshes.len() - 1
+                }
+            };
+            let (lo, hi) = mesh.0.aabb();
+            leaf(Shape::Mesh {
+                index: index as u32,
+                lo,
+                hi,
+            })
+        }
         Node::Combine {
             op: Combine::Union,
             children,
-        } => children.iter().try_for_each(|&c| collect(scene, c, f, out)),
+        } => children
+            .iter()
+            .try_for_each(|&c| collect(scene, c, f, out, meshes)),
         Node::Translate { offset, child } => {
             let back = offset.map(|x| -x);
-            collect(scene, *child, f.then(diagonal([1.0; 3]), back), out)
+            collect(scene, *child, f.then(diagonal([1.0; 3]), back), out, meshes)
         }
         // The lowering evaluates a rotated child at Mᵀp.
         Node::Rotate { matrix, child } => {
             let t = [0, 1, 2].map(|i| [0, 1, 2].map(|j| matrix[j][i]));
-            collect(scene, *child, f.then(t, [0.0; 3]), out)
+            collect(scene, *child, f.then(t, [0.0; 3]), out, meshes)
         }
         Node::Scale { factor, child } => {
             let s = 1.0 / factor;
-            collect(scene, *child, f.then(diagonal([s; 3]), [0.0; 3]), out)
+            collect(
+                scene,
+                *child,
+                f.then(diagonal([s; 3]), [0.0; 3]),
+                out,
+                meshes,
+            )
         }
         Node::ScaleXyz { factors, child } => {
             let s = factors.map(|x| 1.0 / x);
-            collect(scene, *child, f.then(diagonal(s), [0.0; 3]), out)
+            collect(scene, *child, f.then(diagonal(s), [0.0; 3]), out, meshes)
         }
         // Inner materials take precedence: the nearest paint above a primitive wins.
         Node::Paint { material, child } => {
@@ -434,7 +474,7 @@ fn collect(scene: &Scene, id: NodeId, f: Frame, out: &mut Vec<Primitive>) -> Res
                 material: *material,
                 ..f
             };
-            collect(scene, *child, inner, out)
+            collect(scene, *child, inner, out, meshes)
         }
         other => Err(Reason::Node {
             what: super::analysis::kind(other),
@@ -562,7 +602,13 @@ fn build(mut items: Vec<(usize, Aabb)>) -> Group {
 /// The world-space box around a primitive (`None` for a plane): the corners of its local box
 /// mapped back to the world.
 pub(crate) fn world_box(p: &Primitive) -> Option<Aabb> {
+    // The local box's centre and half-extents.
+    let mut c = [0.0; 3];
     let h = match p.shape {
+        Shape::Mesh { lo, hi, .. } => {
+            c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+            [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]))
+        }
         Shape::Sphere { radius } => [radius; 3],
         Shape::Box { half } => half,
         Shape::Cylinder {
@@ -581,7 +627,7 @@ pub(crate) fn world_box(p: &Primitive) -> Option<Aabb> {
         // local = M·world + c, so world = M⁻¹·(local − c).
         let local = [0, 1, 2].map(|k| {
             let s = if corner >> k & 1 == 1 { 1.0 } else { -1.0 };
-            s * h[k] - p.offset[k]
+            c[k] + s * h[k] - p.offset[k]
         });
         for k in 0..3 {
             let w: f64 = (0..3).map(|j| inv[k][j] * local[j]).sum();

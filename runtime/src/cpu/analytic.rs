@@ -2,24 +2,43 @@
 //! `sdfc_compiler::analytic` found (spheres, planes, boxes, capped cylinders and
 //! capsules under affine maps), nearest hits with exact normals, and any-hit shadow rays.
 //!
-//! Every primitive is convex (a plane bounds a half-space), so a ray meets it in one interval
-//! [near, far]; the hit is the first end of an interval beyond the ray's origin. Rays start
+//! Every primitive but a mesh is convex (a plane bounds a half-space), so a ray meets it in
+//! one interval [near, far]; the hit is the first end of an interval beyond the ray's origin.
+//! A mesh's hit is its nearest triangle crossing, found through its hierarchy (as the WGSL
+//! kernel's `mesh_interval`, compiler/src/back/wgsl/mesh.rs), an interval of one point. Rays start
 //! on the surface offset along the normal (as in sphere tracing), so t = 0 is the origin.
 
 use super::vec::V3;
 use sdfc_compiler::{
-    analytic::{Item, Primitive, Shape, Traced},
+    analytic::{Item, MeshRef, Primitive, Shape, Traced},
     Float,
 };
 
 /// A primitive in the evaluation type.
 #[derive(Debug, Clone, Copy)]
 enum Kind<T> {
-    Sphere { r2: T },
-    Box { half: V3<T> },
-    Cylinder { r2: T, half_height: T },
-    Capsule { r2: T, half_height: T },
-    Plane { normal: V3<T>, height: T },
+    Sphere {
+        r2: T,
+    },
+    Box {
+        half: V3<T>,
+    },
+    Cylinder {
+        r2: T,
+        half_height: T,
+    },
+    Capsule {
+        r2: T,
+        half_height: T,
+    },
+    Plane {
+        normal: V3<T>,
+        height: T,
+    },
+    /// The mesh of the tracer's `meshes` at this index.
+    Mesh {
+        index: usize,
+    },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -77,6 +96,7 @@ fn node<T: Float>(item: &Item) -> Node<T> {
 pub(super) struct Tracer<T> {
     prims: Vec<Prim<T>>,
     top: Vec<Node<T>>,
+    meshes: Vec<MeshRef>,
 }
 
 /// Whether a ray meets a group's box between 0 and `limit`.
@@ -118,6 +138,9 @@ impl<T: Float> Tracer<T> {
                         normal: V3::from_f64(normal),
                         height: f(height),
                     },
+                    Shape::Mesh { index, .. } => Kind::Mesh {
+                        index: index as usize,
+                    },
                 },
                 rows: p.matrix.map(V3::from_f64),
                 offset: V3::from_f64(p.offset),
@@ -125,7 +148,11 @@ impl<T: Float> Tracer<T> {
             })
             .collect();
         let top = traced.hierarchy.iter().map(node).collect();
-        Tracer { prims, top }
+        Tracer {
+            prims,
+            top,
+            meshes: traced.meshes.clone(),
+        }
     }
 
     /// Visits the primitives of `nodes` whose groups the ray enters before `limit` (which
@@ -169,7 +196,7 @@ impl<T: Float> Tracer<T> {
         let mut best: Option<(T, V3<T>, Prim<T>)> = None;
         let mut limit = tmax;
         self.visit(&self.top, o, d, &mut limit, &mut |p, limit| {
-            let Some(s) = p.interval(o, d) else {
+            let Some(s) = p.interval(o, d, *limit, &self.meshes) else {
                 return true;
             };
             let (t, n) = if s.near > T::zero() {
@@ -200,7 +227,7 @@ impl<T: Float> Tracer<T> {
         let mut through = T::one();
         let mut limit = tmax;
         self.visit(&self.top, o, d, &mut limit, &mut |p, _| {
-            let Some(s) = p.interval(o, d) else {
+            let Some(s) = p.interval(o, d, tmax, &self.meshes) else {
                 return true;
             };
             if !(s.far > T::zero() && s.near < tmax) {
@@ -250,8 +277,9 @@ impl<T: Float> Prim<T> {
         (self.rows[0] * n.x + self.rows[1] * n.y + self.rows[2] * n.z).normalize()
     }
 
-    /// The ray's interval inside the primitive, or `None` when it misses.
-    fn interval(&self, o: V3<T>, d: V3<T>) -> Option<Interval<T>> {
+    /// The ray's interval inside the primitive, or `None` when it misses (a mesh's crossing
+    /// is searched for before `limit` alone).
+    fn interval(&self, o: V3<T>, d: V3<T>, limit: T, meshes: &[MeshRef]) -> Option<Interval<T>> {
         let (o, d) = (self.local(o) + self.offset, self.local(d));
         let s = match self.kind {
             Kind::Sphere { r2 } => sphere(o, d, r2)?,
@@ -259,6 +287,15 @@ impl<T: Float> Prim<T> {
             Kind::Cylinder { r2, half_height } => cylinder(o, d, r2, half_height)?,
             Kind::Capsule { r2, half_height } => capsule(o, d, r2, half_height)?,
             Kind::Plane { normal, height } => plane(o, d, normal, height)?,
+            Kind::Mesh { index } => {
+                let (t, n) = super::mesh_hit::crossing(&meshes[index].0, o, d, limit)?;
+                Interval {
+                    near: t,
+                    far: t,
+                    n_near: n,
+                    n_far: n,
+                }
+            }
         };
         (s.near <= s.far).then_some(s)
     }
@@ -571,6 +608,7 @@ mod tests {
         let brute = Tracer::<f64> {
             prims: tracer.prims.clone(),
             top: (0..tracer.prims.len()).map(Node::Prim).collect(),
+            meshes: tracer.meshes.clone(),
         };
         let tau = |m: u32| if m == 1 { 0.5 } else { 0.0 };
         let mut hits = 0;

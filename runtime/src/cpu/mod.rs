@@ -14,6 +14,7 @@ mod lanes;
 mod look;
 mod march;
 mod memory;
+mod mesh_hit;
 mod path;
 mod pbr;
 pub mod reference;

@@ -2,7 +2,8 @@
 //! accuracy on printable parts (`mesh_accuracy`), fields meshed without `--bounds`
 //! (`mesh_fields`), 3MF read back by independent readers (`mesh_3mf`), meshes read into
 //! scenes (`mesh_import`), vertex colours of the normal and of moved shapes (`mesh_colour`),
-//! and meshes evaluated on a GPU against the CPU's (`mesh_gpu`).
+//! meshes evaluated on a GPU against the CPU's (`mesh_gpu`), and meshes traced
+//! analytically (`mesh_traced`).
 //!
 //! Filter by module: `cargo test --release --test mesh -- mesh_3mf::`.
 
@@ -20,3 +21,4 @@ mod mesh_colour;
 mod mesh_fields;
 mod mesh_gpu;
 mod mesh_import;
+mod mesh_traced;

@@ -2,7 +2,9 @@
 //! primitives use, `fn trace` (nearest hit, its normal and material) and `fn shadow` (any-hit
 //! shadow rays) on top of the kernel template's `ANALYTIC` block. Up to [`MAX_UNROLLED`]
 //! primitives, both are unrolled over the primitives and their hierarchy; beyond, they walk
-//! the primitives and hierarchy stored in the `scene_data` buffer (buffer.rs).
+//! the primitives and hierarchy stored in the `scene_data` buffer (buffer.rs). A scene with
+//! a triangle mesh is unrolled, its triangles and their hierarchy in `scene_data` (mesh.rs's
+//! layout), met by `fn mesh_interval`.
 
 use super::buffer::{self, identity, trace_start};
 use super::literal::float;
@@ -65,6 +67,12 @@ pub fn write(
     let (primitives, top) = (&traced.primitives[..], &traced.hierarchy[..]);
     let mut out = sections(primitives, top);
     let glass = primitives.iter().any(|p| clear(p.material));
+    let bases: Vec<u32> = traced.meshes.iter().map(|m| m.0.base).collect();
+    let meshes = (!bases.is_empty()).then(|| {
+        out.push_str(&super::mesh::write_hit());
+        out.push('\n');
+        super::mesh::data_of(traced.meshes.iter().map(|m| &*m.0))
+    });
     if primitives.len() > max_unrolled && buffer::fits(primitives) {
         out.push_str(&buffer::write(primitives, top, glass));
         return (out, Some(buffer::data(primitives, top)));
@@ -91,7 +99,7 @@ pub fn write(
     let nearest = |i: usize, p: &Primitive| {
         format!(
             "best = nearest(best, {}, {}u, {});",
-            interval(i, p),
+            interval(i, p, "best.limit", &bases),
             p.material.0,
             if clear(p.material) { "slack" } else { "0.0" }
         )
@@ -107,13 +115,13 @@ pub fn write(
     let occlude = |i: usize, p: &Primitive| {
         format!(
             "through = occlude(through, {}, tmax, params.materials[{}u].optics.y);",
-            interval(i, p),
+            interval(i, p, "tmax", &bases),
             p.material.0
         )
     };
     items(&mut out, primitives, top, 1, "tmax", &occlude);
     out.push_str("    return through;\n}\n");
-    (out, None)
+    (out, meshes)
 }
 
 /// Writes the statements of `items` at `depth`: one `test` per primitive, each group's items
@@ -155,6 +163,7 @@ fn name(s: &Shape) -> &'static str {
         Shape::Cylinder { .. } => "cylinder",
         Shape::Capsule { .. } => "capsule",
         Shape::Plane { .. } => "plane",
+        Shape::Mesh { .. } => "mesh",
     }
 }
 
@@ -167,8 +176,9 @@ fn vec3(v: V3) -> String {
     )
 }
 
-/// The expression of primitive `i`'s interval along the ray (o, d), normals in world space.
-fn interval(i: usize, p: &Primitive) -> String {
+/// The expression of primitive `i`'s interval along the ray (o, d), normals in world space;
+/// a mesh's (whose data starts at its entry of `bases`) is searched before `limit` alone.
+fn interval(i: usize, p: &Primitive, limit: &str, bases: &[u32]) -> String {
     let plain = identity(&p.matrix);
     let rows = format!("P{i}_R0, P{i}_R1, P{i}_R2");
     let moved = |v: &str| {
@@ -212,6 +222,10 @@ fn interval(i: usize, p: &Primitive) -> String {
             "plane_interval({origin}, {dir}, {}, {})",
             vec3(normal),
             float(height)
+        ),
+        Shape::Mesh { index, .. } => format!(
+            "mesh_interval({origin}, {dir}, {}u, {limit})",
+            bases[index as usize]
         ),
     };
     if plain {

@@ -52,13 +52,19 @@ const BOX: u32 = 1;
 const CYLINDER: u32 = 2;
 const CAPSULE: u32 = 3;
 const PLANE: u32 = 4;
+/// A mesh's kind, never written: [`fits`] keeps meshes out of this layout.
+const MESH: u32 = 5;
 /// The kernel's name of [`TRANSFORMED`] here: a primitive with a world-to-local matrix other
 /// than the identity.
 const FRAMED: u32 = TRANSFORMED;
 
 /// Whether every material of `primitives` fits in a tag.
 pub fn fits(primitives: &[Primitive]) -> bool {
-    primitives.iter().all(|p| tag_holds(p.material.0))
+    // A mesh's triangles are data of their own (mesh.rs's layout), which this layout does
+    // not hold beside the primitives: a scene with a mesh is unrolled.
+    primitives
+        .iter()
+        .all(|p| tag_holds(p.material.0) && !matches!(p.shape, Shape::Mesh { .. }))
 }
 
 /// Whether a material id fits in a tag's bits above [`MATERIAL_SHIFT`] (shared with the
@@ -74,6 +80,7 @@ fn kind(s: &Shape) -> u32 {
         Shape::Cylinder { .. } => CYLINDER,
         Shape::Capsule { .. } => CAPSULE,
         Shape::Plane { .. } => PLANE,
+        Shape::Mesh { .. } => MESH,
     }
 }
 
@@ -137,6 +144,8 @@ fn primitive(out: &mut Vec<[u32; 4]>, p: &Primitive) {
             half_height,
         } => [bits(radius * radius), bits(half_height), 0, 0],
         Shape::Plane { normal, height } => vec(normal, bits(height)),
+        // Never written ([`fits`]): the box, for completeness.
+        Shape::Mesh { lo, hi, .. } => vec([0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k])), 0),
     });
     if framed {
         out.extend(p.matrix.iter().map(|row| vec(*row, 0)));

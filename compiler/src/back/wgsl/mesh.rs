@@ -3,22 +3,33 @@
 //! walk, nearest triangle and pseudo-normal sign as `TriMesh::distance`, in f32.
 //!
 //! Layout, from the mesh's `base` (in `vec4<f32>`, integers as their bits): one header
-//! vector (x: the hierarchy's vectors, twice its nodes); the nodes, two vectors each
+//! vector (x: the hierarchy's vectors, twice its nodes; y: the largest magnitude of a
+//! coordinate of its box, which pads the walk's starting bound); the nodes, two vectors each
 //! (`lo.xyz`, `first`; `hi.xyz`, `count`: a leaf's `count` triangles from `first`, or, when
 //! `count` is 0, the children `first` and `first + 1`); then the triangles, nine vectors each
 //! (the corners a, b, c, then the pseudo-normals of a, b, c and of the edges ab, bc, ca).
 //! The meshes of a scene lie one after the other in the order they were read, each at the
 //! `base` the checker gave it.
+//!
+//! Each invocation keeps, per mesh (four slots by `base`, each naming its mesh), the triangle
+//! nearest to its last query, whose distance bounds the next walk from its start
+//! (`TriMesh::distance_from`: the same result, fewer nodes).
 
-use crate::program::mesh::STACK;
+use crate::program::mesh::{TriMesh, STACK};
 use crate::program::Program;
 
 /// The bytes of `scene_data` holding every mesh `programs` name, each at its base (a mesh of
 /// the scene that none names leaves zeros).
 pub fn data<'a>(programs: impl IntoIterator<Item = &'a Program>) -> Vec<u8> {
+    data_of(programs.into_iter().flat_map(|p| p.meshes()))
+}
+
+/// The bytes of `scene_data` holding `meshes`, each at its base (a mesh of the scene not
+/// among them leaves zeros).
+pub fn data_of<'a>(meshes: impl IntoIterator<Item = &'a TriMesh>) -> Vec<u8> {
     let mut out: Vec<u8> = Vec::new();
-    for program in programs {
-        for mesh in program.meshes() {
+    {
+        for mesh in meshes {
             let start = mesh.base as usize * 16;
             let end = start + mesh.vectors() as usize * 16;
             if out.len() < end {
@@ -32,7 +43,14 @@ pub fn data<'a>(programs: impl IntoIterator<Item = &'a Program>) -> Vec<u8> {
                 }
             };
             let bits = |u: u32| f32::from_bits(u);
-            put([bits(2 * mesh.nodes().len() as u32), 0.0, 0.0, 0.0]);
+            // The reach rounded up, so that the f32 pad is no smaller than the f64 one.
+            let reach = mesh.reach() as f32;
+            let reach = if f64::from(reach) < mesh.reach() {
+                reach * (1.0 + f32::EPSILON)
+            } else {
+                reach
+            };
+            put([bits(2 * mesh.nodes().len() as u32), reach, 0.0, 0.0]);
             for n in mesh.nodes() {
                 let [x, y, z] = n.lo.map(|v| v as f32);
                 put([x, y, z, bits(n.first)]);
@@ -50,9 +68,110 @@ pub fn data<'a>(programs: impl IntoIterator<Item = &'a Program>) -> Vec<u8> {
     out
 }
 
+/// Whether the meshes' bytes of `scene_data`, `data`, are within the `scene_data` limit, or
+/// why not (the marched kernels and a traced scene's read the same bytes).
+pub(super) fn fits(scene: &crate::scene::Scene, data: &[u8]) -> Result<(), String> {
+    let bytes = data.len() as u64;
+    let mib = scene.limits.get(crate::limits::Limit::SceneData);
+    if bytes > mib.saturating_mul(1 << 20) {
+        return Err(format!(
+            "the scene's meshes take {} MiB of scene_data, above the scene_data limit of \
+             {mib} MiB; {}",
+            bytes.div_ceil(1 << 20),
+            scene
+                .limits
+                .raise_to(crate::limits::Limit::SceneData, bytes.div_ceil(1 << 20))
+        ));
+    }
+    Ok(())
+}
+
 /// Whether a program names a mesh.
 pub fn uses_meshes(program: &Program) -> bool {
     program.meshes().next().is_some()
+}
+
+/// `fn mesh_interval`, the ray's nearest crossing of a mesh's triangles, for an analytically
+/// traced scene (the kernel's `Interval`, `missed` and `BIG`, analytic.rs): the hierarchy
+/// walked nearer box first, each box entered before the best crossing so far (slab test),
+/// each triangle by Möller and Trumbore's test ("Fast, minimum storage ray/triangle
+/// intersection", Journal of Graphics Tools, 1997). The CPU's runtime/src/cpu/analytic.rs
+/// walks it the same way.
+pub fn write_hit() -> String {
+    format!(
+        "// Where o + t·d enters the box of the node at n (t >= 0), or BIG when it misses it.\n\
+         fn mesh_enter(o: vec3<f32>, inv: vec3<f32>, n: u32) -> f32 {{\n\
+         \x20   let t1 = (scene_data[n].xyz - o) * inv;\n\
+         \x20   let t2 = (scene_data[n + 1u].xyz - o) * inv;\n\
+         \x20   let lo = min(t1, t2);\n\
+         \x20   let hi = max(t1, t2);\n\
+         \x20   let near = max(max(lo.x, lo.y), max(lo.z, 0.0));\n\
+         \x20   let far = min(min(hi.x, hi.y), hi.z);\n\
+         \x20   return select(BIG, near, near <= far);\n\
+         }}\n\n\
+         // The nearest crossing of o + t·d, 0 < t < limit, with the triangles of the mesh at\n\
+         // scene_data[base] (layout in compiler/src/back/wgsl/mesh.rs): one point, with the\n\
+         // triangle's outward normal.\n\
+         fn mesh_interval(o: vec3<f32>, d: vec3<f32>, base: u32, limit: f32) -> Interval {{\n\
+         \x20   let nodes = base + 1u;\n\
+         \x20   let tris = nodes + bitcast<u32>(scene_data[base].x);\n\
+         \x20   // A zero component of d as a tiny one, so that no slab computes 0 · inf.\n\
+         \x20   let inv = 1.0 / select(d, vec3<f32>(1e-30), abs(d) < vec3<f32>(1e-30));\n\
+         \x20   var best = limit;\n\
+         \x20   var hit = 0u;\n\
+         \x20   var stack: array<u32, {STACK}>;\n\
+         \x20   var top = 1u;\n\
+         \x20   stack[0] = 0u;\n\
+         \x20   loop {{\n\
+         \x20       if top == 0u {{ break; }}\n\
+         \x20       top -= 1u;\n\
+         \x20       let n = nodes + 2u * stack[top];\n\
+         \x20       if mesh_enter(o, inv, n) >= best {{ continue; }}\n\
+         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
+         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
+         \x20       if count > 0u {{\n\
+         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
+         \x20               let t = tris + 9u * (first + k);\n\
+         \x20               let a = scene_data[t].xyz;\n\
+         \x20               let e1 = scene_data[t + 1u].xyz - a;\n\
+         \x20               let e2 = scene_data[t + 2u].xyz - a;\n\
+         \x20               let q = cross(d, e2);\n\
+         \x20               let det = dot(e1, q);\n\
+         \x20               if det == 0.0 {{ continue; }}\n\
+         \x20               let f = 1.0 / det;\n\
+         \x20               let s = o - a;\n\
+         \x20               let u = f * dot(s, q);\n\
+         \x20               let r = cross(s, e1);\n\
+         \x20               let v = f * dot(d, r);\n\
+         \x20               let h = f * dot(e2, r);\n\
+         \x20               if u >= -{edge} && v >= -{edge} && u + v <= 1.0 + {edge} && h > 0.0 && h < best {{\n\
+         \x20                   best = h;\n\
+         \x20                   hit = t + 1u;\n\
+         \x20               }}\n\
+         \x20           }}\n\
+         \x20           continue;\n\
+         \x20       }}\n\
+         \x20       let tl = mesh_enter(o, inv, nodes + 2u * first);\n\
+         \x20       let tr = mesh_enter(o, inv, nodes + 2u * first + 2u);\n\
+         \x20       let right = tr < tl;\n\
+         \x20       if max(tl, tr) < best {{\n\
+         \x20           stack[top] = select(first + 1u, first, right);\n\
+         \x20           top += 1u;\n\
+         \x20       }}\n\
+         \x20       if min(tl, tr) < best {{\n\
+         \x20           stack[top] = select(first, first + 1u, right);\n\
+         \x20           top += 1u;\n\
+         \x20       }}\n\
+         \x20   }}\n\
+         \x20   // Ended with nodes left: a software adapter cut the walk (see `trace`).\n\
+         \x20   if top > 0u {{ counters.cut += 1u; }}\n\
+         \x20   if hit == 0u {{ return missed(); }}\n\
+         \x20   let a = scene_data[hit - 1u].xyz;\n\
+         \x20   let n = cross(scene_data[hit].xyz - a, scene_data[hit + 1u].xyz - a);\n\
+         \x20   return Interval(best, best, n, n);\n\
+         }}\n",
+        edge = super::literal::float(TriMesh::EDGE)
+    )
 }
 
 /// The WGSL functions of the mesh walk.
@@ -105,11 +224,21 @@ pub fn write() -> String {
          \x20   let n = cross(scene_data[t + 1u].xyz - a, scene_data[t + 2u].xyz - a);\n\
          \x20   return p - n * (dot(p - a, n) / dot(n, n));\n\
          }}\n\n\
+         // Per slot (base % 4): the base of the mesh it holds and the triangle nearest to its\n\
+         // last query (program/mesh.rs, TriMesh::distance_from).\n\
+         var<private> mesh_hints: array<vec2<u32>, 4>;\n\n\
          // The signed distance at p to the mesh whose data starts at scene_data[base].\n\
          fn mesh_distance(p: vec3<f32>, base: u32) -> f32 {{\n\
          \x20   let nodes = base + 1u;\n\
          \x20   let tris = nodes + bitcast<u32>(scene_data[base].x);\n\
-         \x20   var best = 3.4e38;\n\
+         \x20   // The walk starts bounded by the hinted triangle's distance, padded (bound_pad).\n\
+         \x20   let slot = base & 3u;\n\
+         \x20   let hint = tris + 9u * select(0u, mesh_hints[slot].y, mesh_hints[slot].x == base);\n\
+         \x20   let hw = p - mesh_point(p, hint, mesh_feature(p, hint));\n\
+         \x20   let hd = sqrt(hw.x * hw.x + hw.y * hw.y + hw.z * hw.z);\n\
+         \x20   let ap = abs(p);\n\
+         \x20   let bd = hd + 1e-5 * (scene_data[base].y + max(max(ap.x, ap.y), ap.z) + hd);\n\
+         \x20   var best = select(3.4e38, bd * bd, bd * bd < 3.4e38);\n\
          \x20   var best_t = tris;\n\
          \x20   var best_f = 6u;\n\
          \x20   // Nodes still to visit, the nearer child on top ({STACK} levels hold any mesh).\n\
@@ -157,6 +286,7 @@ pub fn write() -> String {
          \x20       let a = scene_data[best_t].xyz;\n\
          \x20       n = cross(scene_data[best_t + 1u].xyz - a, scene_data[best_t + 2u].xyz - a);\n\
          \x20   }}\n\
+         \x20   mesh_hints[slot] = vec2<u32>(base, (best_t - tris) / 9u);\n\
          \x20   let d = sqrt(best);\n\
          \x20   return select(d, -d, w.x * n.x + w.y * n.y + w.z * n.z < 0.0);\n\
          }}\n"

@@ -289,18 +289,7 @@ pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Ker
     let traced = lowered.traceable.traced(scene.settings.method).is_some();
     if let Some(data) = meshes_of(scene, lowered).filter(|_| !traced) {
         // The meshes' triangles are read from `scene_data`, by either kernel.
-        let bytes = data.len() as u64;
-        let mib = scene.limits.get(crate::limits::Limit::SceneData);
-        if bytes > mib.saturating_mul(1 << 20) {
-            return Err(format!(
-                "the scene's meshes take {} MiB of scene_data, above the scene_data limit of \
-                 {mib} MiB; {}",
-                bytes.div_ceil(1 << 20),
-                scene
-                    .limits
-                    .raise_to(crate::limits::Limit::SceneData, bytes.div_ceil(1 << 20))
-            ));
-        }
+        mesh::fits(scene, &data)?;
     }
     match options.kernel {
         KernelChoice::Specialised => Ok(KernelKind::Specialised),
@@ -478,6 +467,14 @@ fn write_template(
                 false => options.max_unrolled,
             };
             let (text, bytes) = analytic::write(traced, &clear, unrolled);
+            // A mesh's triangles, read from `scene_data` as a marched scene's are.
+            if let Some(bytes) = bytes.as_ref().filter(|_| !traced.meshes.is_empty()) {
+                mesh::fits(scene, bytes).map_err(|message| Error {
+                    message,
+                    line: None,
+                    node_span: None,
+                })?;
+            }
             values.insert("MAP", String::new());
             values.insert("ANALYTIC", text);
             bytes

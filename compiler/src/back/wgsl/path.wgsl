@@ -40,7 +40,7 @@ fn rnd(key: u32, dim: u32) -> f32 {
 }
 
 // The direction of local coordinates l about the unit vector n (Duff et al.'s basis).
-fn to_world(l: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+fn from_tangent(l: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let s = select(-1.0, 1.0, n.z >= 0.0);
     let a = -1.0 / (s + n.z);
     let b = n.x * n.y * a;
@@ -229,10 +229,10 @@ struct Drawn {
 fn draw(m: Material, b: Bsdf, u0: f32, u1: f32, u2: f32) -> Drawn {
     var out = Drawn(vec3<f32>(0.0), vec3<f32>(0.0), 0.0, 0u);
     if u0 < b.p.x {
-        var l = to_world(cosine_dir(u1, u2), b.n);
+        var l = from_tangent(cosine_dir(u1, u2), b.n);
 //#if PBR
         if b.pbr != 0u && u0 / b.p.x < b.q {
-            let hv = to_world(ggx_half(u1, u2, m.pbr.y), b.n);
+            let hv = from_tangent(ggx_half(u1, u2, m.pbr.y), b.n);
             l = hv * (2.0 * dot(b.v, hv)) - b.v;
         }
 //#endif
@@ -290,7 +290,7 @@ fn estimates(m: Material, b: Bsdf, p: vec3<f32>, h: f32, tt: f32, weight: vec3<f
             let k = DIM_LAMPS + 2u * j;
             let u1 = rnd(key, k);
             let u2 = rnd(key, k + 1u);
-            l = to_world(about(1.0 - u1 * (1.0 - light.to_light.w), u2), light.to_light.xyz);
+            l = from_tangent(about(1.0 - u1 * (1.0 - light.to_light.w), u2), light.to_light.xyz);
         }
         if dot(n, l) <= 0.0 {
             continue;
@@ -303,7 +303,7 @@ fn estimates(m: Material, b: Bsdf, p: vec3<f32>, h: f32, tt: f32, weight: vec3<f
     }
 //#endif
 //#if SKY
-    let l = to_world(cosine_dir(rnd(key, DIM_SKY), rnd(key, DIM_SKY + 1u)), n);
+    let l = from_tangent(cosine_dir(rnd(key, DIM_SKY), rnd(key, DIM_SKY + 1u)), n);
     let nl = dot(n, l);
     let f = bsdf_eval(m, b, l);
     if nl > 0.0 && max(max(abs(f.x), abs(f.y)), abs(f.z)) > 0.0 {

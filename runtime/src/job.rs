@@ -465,7 +465,7 @@ pub fn prepare_here(
             kernel: setup.kernel,
             ..Default::default()
         };
-        wgsl::choose(&scene, &lowered, &options).map_err(backend::Error::Unsupported)?;
+        wgsl::choose(&scene, &lowered, &options).map_err(backend::Error::Refused)?;
     }
     let unavailable = |source| Error::unavailable(backend, source);
     let (prepared, built) = match open {

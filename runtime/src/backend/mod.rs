@@ -36,6 +36,9 @@ pub enum Error {
     /// was not specialised for, GPUs of the CPU backend.
     #[error("{0}")]
     Unsupported(String),
+    /// The kernel asked for cannot render the scene (`wgsl::choose`).
+    #[error(transparent)]
+    Refused(#[from] wgsl::Refused),
     /// A device could not be opened: no driver, no adapter, no such index.
     #[error("{0}")]
     Device(String),
@@ -550,7 +553,7 @@ fn gpu_kind(backend: Backend) -> Result<Backend, Usage> {
 /// The kernel for `scene`, chosen (`wgsl::choose`), written and validated.
 fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, Error> {
     let options = kernel_options(setup);
-    wgsl::choose(scene, lowered, &options).map_err(Error::Unsupported)?;
+    wgsl::choose(scene, lowered, &options)?;
     wgsl::write_with(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
 }
 
@@ -572,7 +575,7 @@ fn kernel_options(setup: &Setup) -> wgsl::Options {
 /// held).
 fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, Error> {
     let options = kernel_options(setup);
-    wgsl::choose(scene, lowered, &options).map_err(Error::Unsupported)?;
+    wgsl::choose(scene, lowered, &options)?;
     wgsl::write_text(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
 }
 

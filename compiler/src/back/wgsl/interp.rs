@@ -293,7 +293,7 @@ const DEST_SHIFT: u32 = 11;
 
 /// What keeps a scene from the interpreted kernel.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) enum Unfit {
+pub enum Unfit {
     /// Its programs need more registers than the file has: (needed, the file's size).
     Registers(usize, usize),
     /// Its programs' words exceed the `scene_data` limit: (bytes, the limit in MiB).

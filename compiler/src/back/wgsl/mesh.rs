@@ -70,18 +70,14 @@ pub fn data_of<'a>(meshes: impl IntoIterator<Item = &'a TriMesh>) -> Vec<u8> {
 
 /// Whether the meshes' bytes of `scene_data`, `data`, are within the `scene_data` limit, or
 /// why not (the marched kernels and a traced scene's read the same bytes).
-pub(super) fn fits(scene: &crate::scene::Scene, data: &[u8]) -> Result<(), String> {
+pub(super) fn fits(scene: &crate::scene::Scene, data: &[u8]) -> Result<(), super::Refused> {
+    use crate::limits::Limit;
     let bytes = data.len() as u64;
-    let mib = scene.limits.get(crate::limits::Limit::SceneData);
-    if bytes > mib.saturating_mul(1 << 20) {
-        return Err(format!(
-            "the scene's meshes take {} MiB of scene_data, above the scene_data limit of \
-             {mib} MiB; {}",
-            bytes.div_ceil(1 << 20),
-            scene
-                .limits
-                .raise_to(crate::limits::Limit::SceneData, bytes.div_ceil(1 << 20))
-        ));
+    let limit = scene.limits.get(Limit::SceneData);
+    if bytes > limit.saturating_mul(1 << 20) {
+        let mib = bytes.div_ceil(1 << 20);
+        let raise = scene.limits.raise_to(Limit::SceneData, mib);
+        return Err(super::Refused::MeshData { mib, limit, raise });
     }
     Ok(())
 }

@@ -24,6 +24,7 @@ mod march;
 mod mesh;
 pub mod part;
 pub mod reduce;
+mod refused;
 pub mod srgb;
 mod template;
 mod uniform;
@@ -32,6 +33,7 @@ pub use analytic::MAX_UNROLLED;
 pub use contract::{Contract, Field, Mismatch, Shape, Specialisation, Uniform, UniformWriter};
 pub(crate) use literal::float;
 pub use map::{write_map, write_sdf};
+pub use refused::Refused;
 pub use uniform::uniforms;
 
 use crate::lower::Lowered;
@@ -285,7 +287,7 @@ pub enum KernelKind {
 
 /// The kernel `options.kernel` gives `scene`, lowered as `lowered`, or why the interpreted
 /// kernel that it asks for cannot render it.
-pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<KernelKind, String> {
+pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<KernelKind, Refused> {
     let traced = lowered.traceable.traced(scene.settings.method).is_some();
     if let Some(data) = meshes_of(scene, lowered).filter(|_| !traced) {
         // The meshes' triangles are read from `scene_data`, by either kernel.
@@ -293,12 +295,7 @@ pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Ker
     }
     match options.kernel {
         KernelChoice::Specialised => Ok(KernelKind::Specialised),
-        KernelChoice::Interpreted if traced => Err(
-            "the interpreted kernel runs a distance program, and this scene is traced \
-             analytically, with no distance program in its kernel; march it with \
-             `--set method=march`, or use `--kernel specialised` or `--kernel auto`"
-                .into(),
-        ),
+        KernelChoice::Interpreted if traced => Err(Refused::InterpretedTraced),
         KernelChoice::Interpreted => interpreted(scene, lowered).map(|_| KernelKind::Interpreted),
         KernelChoice::Auto if traced => Ok(KernelKind::Specialised),
         KernelChoice::Auto => {
@@ -354,7 +351,7 @@ fn meshes_of(scene: &Scene, lowered: &Lowered) -> Option<Vec<u8>> {
 
 /// The `scene_data` of the interpreted kernel for a marched scene, or why it cannot hold its
 /// programs.
-fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, String> {
+fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, Refused> {
     use crate::limits::Limit;
     let media = media_of(scene, lowered);
     let programs = interp::Programs {
@@ -364,25 +361,19 @@ fn interpreted(scene: &Scene, lowered: &Lowered) -> Result<Vec<u8>, String> {
     };
     let file = scene.limits.count(Limit::Registers);
     let mib = scene.limits.get(Limit::SceneData);
-    interp::encode(&programs, file, mib).map_err(|unfit| match unfit {
-        interp::Unfit::Registers(needed, file) => format!(
-            "the interpreted kernel cannot run this scene: its distance program needs {needed} \
-             registers and the kernel has {file}; {} (or use `--kernel specialised`)",
-            scene.limits.raise_to(Limit::Registers, needed as u64)
-        ),
-        interp::Unfit::Words(words) => format!(
-            "the interpreted kernel cannot run this scene: its distance programs take {words} \
-             instructions, more than the 2^24 it can address; use `--kernel specialised`"
-        ),
-        interp::Unfit::Bytes(bytes, mib) => format!(
-            "the interpreted kernel cannot run this scene: its distance program takes {} MiB \
-             of scene_data, above the scene_data limit of {mib} MiB; {} (or use \
-             `--kernel specialised`)",
-            bytes.div_ceil(1 << 20),
-            scene
-                .limits
-                .raise_to(Limit::SceneData, bytes.div_ceil(1 << 20) as u64)
-        ),
+    interp::encode(&programs, file, mib).map_err(|unfit| {
+        let raise = match unfit {
+            interp::Unfit::Registers(needed, _) => {
+                Some(scene.limits.raise_to(Limit::Registers, needed as u64))
+            }
+            interp::Unfit::Bytes(bytes, _) => Some(
+                scene
+                    .limits
+                    .raise_to(Limit::SceneData, bytes.div_ceil(1 << 20) as u64),
+            ),
+            interp::Unfit::Words(_) => None,
+        };
+        Refused::Interpreted { unfit, raise }
     })
 }
 
@@ -469,8 +460,8 @@ fn write_template(
             let (text, bytes) = analytic::write(traced, &clear, unrolled);
             // A mesh's triangles, read from `scene_data` as a marched scene's are.
             if let Some(bytes) = bytes.as_ref().filter(|_| !traced.meshes.is_empty()) {
-                mesh::fits(scene, bytes).map_err(|message| Error {
-                    message,
+                mesh::fits(scene, bytes).map_err(|refused| Error {
+                    message: refused.to_string(),
                     line: None,
                     node_span: None,
                 })?;
@@ -479,16 +470,16 @@ fn write_template(
             values.insert("ANALYTIC", text);
             bytes
         }
-        None if choose(scene, lowered, options).map_err(|message| Error {
-            message,
+        None if choose(scene, lowered, options).map_err(|refused| Error {
+            message: refused.to_string(),
             line: None,
             node_span: None,
         })? == KernelKind::Interpreted =>
         {
             // The distance programs interpreted from `scene_data`: the text depends only on
             // the features and the register file's size.
-            let bytes = interpreted(scene, lowered).map_err(|message| Error {
-                message,
+            let bytes = interpreted(scene, lowered).map_err(|refused| Error {
+                message: refused.to_string(),
                 line: None,
                 node_span: None,
             })?;

@@ -33,7 +33,22 @@ pub(crate) enum Tok {
 /// The identifiers and punctuation of Rust source, without comments, strings, characters
 /// and lifetimes.
 pub(crate) fn tokens(src: &str) -> Vec<Tok> {
+    located_tokens(src).into_iter().map(|(t, _)| t).collect()
+}
+
+/// [`tokens`], each with the 1-based line it starts on.
+pub(crate) fn located_tokens(src: &str) -> Vec<(Tok, usize)> {
     let s: Vec<char> = src.chars().collect();
+    // The index of the first character of each line.
+    let starts: Vec<usize> = std::iter::once(0)
+        .chain(
+            s.iter()
+                .enumerate()
+                .filter(|(_, &c)| c == '\n')
+                .map(|(i, _)| i + 1),
+        )
+        .collect();
+    let line = |i: usize| starts.partition_point(|&start| start <= i);
     let mut out = Vec::new();
     let mut i = 0;
     while i < s.len() {
@@ -92,13 +107,13 @@ pub(crate) fn tokens(src: &str) -> Vec<Tok> {
             while i < s.len() && (s[i].is_alphanumeric() || s[i] == '_') {
                 i += 1;
             }
-            out.push(Tok::Ident(s[start..i].iter().collect()));
+            out.push((Tok::Ident(s[start..i].iter().collect()), line(start)));
         } else if c == ':' && next == Some(':') {
-            out.push(Tok::Path);
+            out.push((Tok::Path, line(i)));
             i += 2;
         } else {
             if !c.is_whitespace() {
-                out.push(Tok::Punct(c));
+                out.push((Tok::Punct(c), line(i)));
             }
             i += 1;
         }

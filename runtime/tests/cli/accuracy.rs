@@ -368,7 +368,7 @@ fn distance_ops_count_transcendentals() {
 /// issue 16, item 4: `fp32_fraction` is never above 1. The guarded blocks of culling run
 /// only where their bounds are near, which the statistics do not count: 1 000 spheres lower
 /// to a program whose blocks hold nearly all of it, and a frame that evaluated the distance
-/// as often as the H100 run of `compound_1000.sdf` (5.63 of the peak when every block was
+/// as often as a GPU's run of `compound_1000.sdf` (5.63 of the peak when every block was
 /// counted) gets no fraction. A program without blocks runs all of it at every evaluation:
 /// its fraction is exact.
 #[test]

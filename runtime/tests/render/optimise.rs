@@ -2,7 +2,7 @@
 //! for bit on the CPU), the passes keep the distance field (to rounding) at random points,
 //! the batch interpreter runs guarded blocks exactly as the reference path, and instruction
 //! counts drop. `cargo test --release --test render -- optimise:: --ignored --nocapture` prints the
-//! tables of BENCHMARKS.md ("Distance program size, passes off and on").
+//! tables of instruction counts and frame times with the passes off and on.
 
 use crate::common;
 
@@ -371,7 +371,7 @@ fn time_frames(scene: &Scene, lowered: &Lowered, frames: usize) -> f64 {
     times[times.len() / 2]
 }
 
-/// The tables of BENCHMARKS.md: instruction counts (static, WGSL, executed per evaluation
+/// The passes' tables: instruction counts (static, WGSL, executed per evaluation
 /// along camera rays) and CPU frame times with the passes off and on.
 #[test]
 #[ignore]

@@ -67,7 +67,7 @@ fn a_thin_vases_penumbra_has_no_ripples_on_any_backend() {
     }
 }
 
-/// Every backend draws the vase as the CPU does (issue 47: wgpu on an H100 was 30.1 dB from
+/// Every backend draws the vase as the CPU does (issue 47: wgpu on a GPU was 30.1 dB from
 /// the CPU on the trial's vase, CUDA 45.0 dB, where other scenes are 57 dB and more).
 #[test]
 fn the_backends_draw_the_vase_alike() {

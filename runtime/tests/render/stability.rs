@@ -5,18 +5,17 @@
 //! f64 reference (ε = 1e-6, a budget of 100 000 steps, no over-relaxation; steps four times
 //! shorter where the analysis proves no bound).
 //!
-//! Every scene file names its sweep in a comment, `// sweep NAME: v1, v2, …`, and defines
-//! `let NAME = …;`: each value replaces that definition. The printed table (recorded in
-//! BENCHMARKS.md, "Stability") has, per scene and value, the percentage of pixels the render
-//! missed, hit falsely and hit behind the reference's surface, the percentage of rays that ran
-//! out of steps, the PSNR against the reference, the mean steps per pixel, and, where L > 1,
-//! the steps per pixel of the field as written stepped with the scene's L everywhere (no local
-//! bounds) and what stepping it with L = 1 instead would have missed and hit behind. A file
-//! may name the value of its parameter at which the scene is an exact field of the same layout
-//! (`// exact layout: VALUE`); the table then gives the steps per pixel relative to that render.
-//! It may also name the least PSNR against the reference that every render must reach
-//! (`// min psnr: DB`).
-//! With `SDFC_STABILITY_IMAGES=DIR` set, both images of every render are written to `DIR`.
+//! Every scene file names its sweep in a comment, `// sweep NAME: v1, v2, …`, and defines `let NAME
+//! = …;`: each value replaces that definition. The printed table has, per scene and value, the
+//! percentage of pixels the render missed, hit falsely and hit behind the reference's surface, the
+//! percentage of rays that ran out of steps, the PSNR against the reference, the mean steps per
+//! pixel, and, where L > 1, the steps per pixel of the field as written stepped with the scene's L
+//! everywhere (no local bounds) and what stepping it with L = 1 instead would have missed and hit
+//! behind. A file may name the value of its parameter at which the scene is an exact field of the
+//! same layout (`// exact layout: VALUE`); the table then gives the steps per pixel relative to
+//! that render. It may also name the least PSNR against the reference that every render must reach
+//! (`// min psnr: DB`). With `SDFC_STABILITY_IMAGES=DIR` set, both images of every render are
+//! written to `DIR`.
 //!
 //! Scenes that `method: auto` (the default) traces analytically are also rendered so and
 //! must then miss nothing and hit nothing behind.

@@ -5,7 +5,7 @@
 //! (figures belong to the benchmarks page, with their machine). Each figure is the count today;
 //! lower it when a change removes some.
 
-use crate::tidy::{located_tokens, root, tokens, workspace_rust_files, Tok};
+use crate::scan::{located_tokens, root, tokens, workspace_rust_files, Tok};
 use std::path::PathBuf;
 
 /// The most `Result<_, String>` types the workspace may write (comments and strings aside).
@@ -83,7 +83,7 @@ fn string_errors_do_not_grow() {
 }
 
 /// The most Rust files over [`FILE_LINES`] lines the workspace may hold.
-const LONG_FILES: usize = 27;
+const LONG_FILES: usize = 24;
 /// A file's length past which it should be split by responsibility.
 const FILE_LINES: usize = 800;
 /// The most functions over [`FUNCTION_LINES`] lines the workspace may hold.

@@ -9,6 +9,26 @@ use std::fmt::Write;
 /// as `%n = op(args)`, children before parents.
 pub fn dump(scene: &Scene) -> String {
     let mut out = String::new();
+    settings(&mut out, scene);
+    lights(&mut out, scene);
+    materials(&mut out, scene);
+    match scene.root {
+        None => out.push_str("root none\n"),
+        Some(root) => {
+            let mut order = Vec::new();
+            let mut seen = vec![false; scene.graph.len()];
+            postorder(&scene.graph, root, &mut seen, &mut order);
+            for id in order {
+                let _ = writeln!(out, "%{} = {}", id.0, node(scene.graph.node(id)));
+            }
+            let _ = writeln!(out, "root %{}", root.0);
+        }
+    }
+    out
+}
+
+/// The render settings, the look, the origin and the camera.
+fn settings(out: &mut String, scene: &Scene) {
     let s = &scene.settings;
     let _ = writeln!(
         out,
@@ -69,6 +89,10 @@ pub fn dump(scene: &Scene) -> String {
         v3(c.look_at),
         num(c.fov.to_degrees())
     );
+}
+
+/// One line for each light.
+fn lights(out: &mut String, scene: &Scene) {
     for l in &scene.lights {
         let shadows = if l.shadows() { "" } else { " shadows=false" };
         let _ = match l {
@@ -119,6 +143,10 @@ pub fn dump(scene: &Scene) -> String {
             ),
         };
     }
+}
+
+/// One line for each material.
+fn materials(out: &mut String, scene: &Scene) {
     for (i, m) in scene.materials.iter().enumerate() {
         let colour = |c: &Colour| match c {
             Colour::Const(c) => v3(*c),
@@ -163,19 +191,6 @@ pub fn dump(scene: &Scene) -> String {
             num(m.transparency), num(m.ior)
         );
     }
-    match scene.root {
-        None => out.push_str("root none\n"),
-        Some(root) => {
-            let mut order = Vec::new();
-            let mut seen = vec![false; scene.graph.len()];
-            postorder(&scene.graph, root, &mut seen, &mut order);
-            for id in order {
-                let _ = writeln!(out, "%{} = {}", id.0, node(scene.graph.node(id)));
-            }
-            let _ = writeln!(out, "root %{}", root.0);
-        }
-    }
-    out
 }
 
 fn postorder(g: &Graph, id: NodeId, seen: &mut [bool], order: &mut Vec<NodeId>) {
@@ -236,6 +251,113 @@ fn ids(ids: &[NodeId]) -> String {
 }
 
 fn node(n: &Node) -> String {
+    match n {
+        Node::Sphere { .. }
+        | Node::Box { .. }
+        | Node::RoundBox { .. }
+        | Node::Plane { .. }
+        | Node::Torus { .. }
+        | Node::Cylinder { .. }
+        | Node::Capsule { .. }
+        | Node::Cone { .. }
+        | Node::Ellipsoid { .. }
+        | Node::Rect { .. }
+        | Node::Mesh { .. }
+        | Node::Bezier { .. }
+        | Node::Prim { .. }
+        | Node::Polygon { .. }
+        | Node::Text { .. } => shape(n),
+        Node::Extrude { .. }
+        | Node::Revolve { .. }
+        | Node::Loft { .. }
+        | Node::Sweep { .. }
+        | Node::Screw { .. }
+        | Node::Feature { .. } => from_profiles(n),
+        Node::Combine { op, children } => format!("{} {}", combine(*op), ids(children)),
+        Node::SmoothCombine {
+            op,
+            k,
+            variant,
+            a,
+            b,
+        } => {
+            let v = match variant.steps() {
+                Some(n) => format!("{} steps={n}", variant.name()),
+                None => variant.name().to_string(),
+            };
+            format!(
+                "smooth_{} k={} {v} %{}, %{}",
+                combine(*op),
+                num(*k),
+                a.0,
+                b.0
+            )
+        }
+        Node::Translate { offset, child } => format!("translate {} %{}", v3(*offset), child.0),
+        Node::Rotate { matrix, child } => format!(
+            "rotate [{}, {}, {}] %{}",
+            v3(matrix[0]),
+            v3(matrix[1]),
+            v3(matrix[2]),
+            child.0
+        ),
+        Node::Scale { factor, child } => format!("scale {} %{}", num(*factor), child.0),
+        Node::ScaleXyz { factors, child } => format!("scale_xyz {} %{}", v3(*factors), child.0),
+        Node::Repeat {
+            period,
+            count,
+            child,
+        } => match count {
+            Some(c) => format!(
+                "repeat period={} count={} %{}",
+                v3(*period),
+                v3(*c),
+                child.0
+            ),
+            None => format!("repeat period={} %{}", v3(*period), child.0),
+        },
+        Node::Mirror { axes, child } => {
+            let a: String = ["x", "y", "z"]
+                .iter()
+                .zip(axes)
+                .filter(|(_, on)| **on)
+                .map(|(n, _)| *n)
+                .collect();
+            format!("mirror {a} %{}", child.0)
+        }
+        Node::RepeatPolar {
+            count,
+            mirror,
+            child,
+        } => {
+            let m = if *mirror { " mirror" } else { "" };
+            format!("repeat_polar count={count}{m} %{}", child.0)
+        }
+        Node::Wrap { radius, child } => format!("wrap {} %{}", num(*radius), child.0),
+        Node::Shear { matrix, child } => format!(
+            "shear [{}, {}, {}] %{}",
+            v3(matrix[0]),
+            v3(matrix[1]),
+            v3(matrix[2]),
+            child.0
+        ),
+        Node::Taper { rate, child } => format!("taper {} %{}", num(*rate), child.0),
+        Node::Morph { t, a, b } => format!("morph t={} %{}, %{}", num(*t), a.0, b.0),
+        Node::Twist { rate, child } => format!("twist {} %{}", num(*rate), child.0),
+        Node::Bend { rate, child } => format!("bend {} %{}", num(*rate), child.0),
+        Node::Round { radius, child } => format!("round {} %{}", num(*radius), child.0),
+        Node::Shell { half, child } => format!("shell half={} %{}", num(*half), child.0),
+        Node::Elongate { half, child } => format!("elongate {} %{}", v3(*half), child.0),
+        Node::Paint { material, child } => format!("paint #{} %{}", material.0, child.0),
+        Node::Field { f, lipschitz, .. } => match lipschitz {
+            Some(l) => format!("{} lipschitz={} {{ {} }}", n.kind(), num(*l), f.text()),
+            None => format!("{} {{ {} }}", n.kind(), f.text()),
+        },
+    }
+}
+
+/// A shape's line: a primitive of the table or one of the graph's own.
+fn shape(n: &Node) -> String {
     match n {
         Node::Sphere { radius } => format!("sphere radius={}", num(*radius)),
         Node::Box { half } => format!("box half={}", v3(*half)),
@@ -330,6 +452,14 @@ fn node(n: &Node) -> String {
             outline.glyphs().len(),
             outline.segments()
         ),
+        _ => unreachable!("{} is not a shape", n.kind()),
+    }
+}
+
+/// The line of a shape made from profiles or other shapes: an extrusion, revolution, loft,
+/// sweep or screw, or a feature between two shapes.
+fn from_profiles(n: &Node) -> String {
+    match n {
         Node::Extrude {
             half_height,
             round,
@@ -396,86 +526,7 @@ fn node(n: &Node) -> String {
             };
             format!("{} {size} %{}, %{}", op.name(), a.0, b.0)
         }
-        Node::Combine { op, children } => format!("{} {}", combine(*op), ids(children)),
-        Node::SmoothCombine {
-            op,
-            k,
-            variant,
-            a,
-            b,
-        } => {
-            let v = match variant.steps() {
-                Some(n) => format!("{} steps={n}", variant.name()),
-                None => variant.name().to_string(),
-            };
-            format!(
-                "smooth_{} k={} {v} %{}, %{}",
-                combine(*op),
-                num(*k),
-                a.0,
-                b.0
-            )
-        }
-        Node::Translate { offset, child } => format!("translate {} %{}", v3(*offset), child.0),
-        Node::Rotate { matrix, child } => format!(
-            "rotate [{}, {}, {}] %{}",
-            v3(matrix[0]),
-            v3(matrix[1]),
-            v3(matrix[2]),
-            child.0
-        ),
-        Node::Scale { factor, child } => format!("scale {} %{}", num(*factor), child.0),
-        Node::ScaleXyz { factors, child } => format!("scale_xyz {} %{}", v3(*factors), child.0),
-        Node::Repeat {
-            period,
-            count,
-            child,
-        } => match count {
-            Some(c) => format!(
-                "repeat period={} count={} %{}",
-                v3(*period),
-                v3(*c),
-                child.0
-            ),
-            None => format!("repeat period={} %{}", v3(*period), child.0),
-        },
-        Node::Mirror { axes, child } => {
-            let a: String = ["x", "y", "z"]
-                .iter()
-                .zip(axes)
-                .filter(|(_, on)| **on)
-                .map(|(n, _)| *n)
-                .collect();
-            format!("mirror {a} %{}", child.0)
-        }
-        Node::RepeatPolar {
-            count,
-            mirror,
-            child,
-        } => {
-            let m = if *mirror { " mirror" } else { "" };
-            format!("repeat_polar count={count}{m} %{}", child.0)
-        }
-        Node::Wrap { radius, child } => format!("wrap {} %{}", num(*radius), child.0),
-        Node::Shear { matrix, child } => format!(
-            "shear [{}, {}, {}] %{}",
-            v3(matrix[0]),
-            v3(matrix[1]),
-            v3(matrix[2]),
-            child.0
-        ),
-        Node::Taper { rate, child } => format!("taper {} %{}", num(*rate), child.0),
-        Node::Morph { t, a, b } => format!("morph t={} %{}, %{}", num(*t), a.0, b.0),
-        Node::Twist { rate, child } => format!("twist {} %{}", num(*rate), child.0),
-        Node::Bend { rate, child } => format!("bend {} %{}", num(*rate), child.0),
-        Node::Round { radius, child } => format!("round {} %{}", num(*radius), child.0),
-        Node::Shell { half, child } => format!("shell half={} %{}", num(*half), child.0),
-        Node::Elongate { half, child } => format!("elongate {} %{}", v3(*half), child.0),
-        Node::Paint { material, child } => format!("paint #{} %{}", material.0, child.0),
-        Node::Field { f, lipschitz, .. } => match lipschitz {
-            Some(l) => format!("{} lipschitz={} {{ {} }}", n.kind(), num(*l), f.text()),
-            None => format!("{} {{ {} }}", n.kind(), f.text()),
-        },
+        _ => unreachable!("{} is not made from profiles", n.kind()),
     }
 }
 

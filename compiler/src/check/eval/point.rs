@@ -114,92 +114,13 @@ impl Ctx<'_> {
         span: Span,
     ) -> Value {
         let word = if plane { "profile" } else { "field" };
-        let mut lipschitz = None;
-        for (i, a) in args.iter().enumerate() {
-            let named = a.name.as_ref().map(|n| n.name.as_str());
-            // The label is on the argument at fault: a name other than `lipschitz`, or any
-            // argument after the first (whose own name, if any, was checked first).
-            let fault = match named {
-                Some(name) if name != "lipschitz" => Some((
-                    "E0202",
-                    format!("`{word}` has no parameter `{name}`"),
-                    "not `lipschitz`",
-                )),
-                Some(_) if i > 0 => Some((
-                    "E0203",
-                    "argument `lipschitz` is given twice".to_string(),
-                    "a second `lipschitz`",
-                )),
-                None if i > 0 => Some((
-                    "E0205",
-                    format!("too many arguments to `{word}`"),
-                    "a second argument",
-                )),
-                _ => None,
-            };
-            if let Some((code, msg, label)) = fault {
-                self.error(
-                    Diagnostic::error(code, msg, arg_span(a))
-                        .with_label(label)
-                        .with_note(format!("`{word}` takes one argument, `lipschitz`"))
-                        .with_help(format!(
-                            "declare a bound of the gradient: `{word}(lipschitz: 2) {{ … }}`"
-                        )),
-                );
-                return Value::Error;
-            }
-            match self.expr(&a.value).coerce(Type::Float) {
-                Some(Value::Float(l)) if l > 0.0 && l.is_finite() => lipschitz = Some(l),
-                Some(Value::Error) => return Value::Error,
-                Some(Value::Unknown(_)) => {}
-                Some(v @ Value::Float(_)) => {
-                    self.error(
-                        Diagnostic::error(
-                            "E0400",
-                            format!("`lipschitz` of `{word}` must be greater than 0"),
-                            a.value.span,
-                        )
-                        .with_label(format!("this is {v}")),
-                    );
-                    return Value::Error;
-                }
-                other => {
-                    let v = other.unwrap_or(Value::Error);
-                    if field::is_point(&v) {
-                        return self.per_point(
-                            format!("`lipschitz` of `{word}` must be a constant"),
-                            a.value.span,
-                        );
-                    }
-                    self.error(type_mismatch("lipschitz", Type::Float, &v, a.value.span));
-                    return Value::Error;
-                }
-            }
-        }
+        let lipschitz = match self.field_lipschitz(args, word) {
+            Ok(l) => l,
+            Err(v) => return v,
+        };
         self.fields += 1;
         let owner = self.fields;
-        let coord = |i: u8| std::rc::Rc::new(crate::check::types::Sx::Coord(i, owner));
-        let mark = self.locals.len();
-        let point = if plane {
-            vec![coord(0), coord(1)]
-        } else {
-            vec![coord(0), coord(1), coord(2)]
-        };
-        // The surface normal `n`, unless a name of the program hides it (as it hides `t`):
-        // read by a colour field, refused below in a distance's. Bound before `p`, so that
-        // `p` is the nearer binding a misspelt name is told of.
-        let reads = self.normal_reads.len();
-        if !plane && !self.names(NORMAL) {
-            let normal = vec![coord(3), coord(4), coord(5)];
-            self.locals.push((NORMAL.into(), field::point(normal)));
-        }
-        self.locals.push(("p".into(), field::point(point)));
-        self.planes.push(plane);
-        let v = self.body(body);
-        self.planes.pop();
-        self.locals.truncate(mark);
-        let normal_read = self.normal_reads.get(reads).copied();
-        self.normal_reads.truncate(reads);
+        let (v, normal_read) = self.field_body(body, plane, owner);
         let distance = if plane { Type::Profile } else { Type::Shape };
         // A float body is a distance (a shape, or a profile), a vec3 body a colour (a colour
         // field; not of the plane).
@@ -314,5 +235,101 @@ impl Ctx<'_> {
                 body.value.span,
             ),
         }
+    }
+
+    /// The `lipschitz` argument of a `field` or `profile` (`word`), if given: a constant
+    /// greater than 0; the value to return where it is refused.
+    fn field_lipschitz(&mut self, args: &[Arg], word: &str) -> Result<Option<f64>, Value> {
+        let mut lipschitz = None;
+        for (i, a) in args.iter().enumerate() {
+            let named = a.name.as_ref().map(|n| n.name.as_str());
+            // The label is on the argument at fault: a name other than `lipschitz`, or any
+            // argument after the first (whose own name, if any, was checked first).
+            let fault = match named {
+                Some(name) if name != "lipschitz" => Some((
+                    "E0202",
+                    format!("`{word}` has no parameter `{name}`"),
+                    "not `lipschitz`",
+                )),
+                Some(_) if i > 0 => Some((
+                    "E0203",
+                    "argument `lipschitz` is given twice".to_string(),
+                    "a second `lipschitz`",
+                )),
+                None if i > 0 => Some((
+                    "E0205",
+                    format!("too many arguments to `{word}`"),
+                    "a second argument",
+                )),
+                _ => None,
+            };
+            if let Some((code, msg, label)) = fault {
+                self.error(
+                    Diagnostic::error(code, msg, arg_span(a))
+                        .with_label(label)
+                        .with_note(format!("`{word}` takes one argument, `lipschitz`"))
+                        .with_help(format!(
+                            "declare a bound of the gradient: `{word}(lipschitz: 2) {{ … }}`"
+                        )),
+                );
+                return Err(Value::Error);
+            }
+            match self.expr(&a.value).coerce(Type::Float) {
+                Some(Value::Float(l)) if l > 0.0 && l.is_finite() => lipschitz = Some(l),
+                Some(Value::Error) => return Err(Value::Error),
+                Some(Value::Unknown(_)) => {}
+                Some(v @ Value::Float(_)) => {
+                    self.error(
+                        Diagnostic::error(
+                            "E0400",
+                            format!("`lipschitz` of `{word}` must be greater than 0"),
+                            a.value.span,
+                        )
+                        .with_label(format!("this is {v}")),
+                    );
+                    return Err(Value::Error);
+                }
+                other => {
+                    let v = other.unwrap_or(Value::Error);
+                    if field::is_point(&v) {
+                        return Err(self.per_point(
+                            format!("`lipschitz` of `{word}` must be a constant"),
+                            a.value.span,
+                        ));
+                    }
+                    self.error(type_mismatch("lipschitz", Type::Float, &v, a.value.span));
+                    return Err(Value::Error);
+                }
+            }
+        }
+        Ok(lipschitz)
+    }
+
+    /// A field's body evaluated with `p` its point (of the plane where `plane`) and, in space,
+    /// `n` the surface normal: its value, and where it first read `n`.
+    fn field_body(&mut self, body: &Body, plane: bool, owner: u32) -> (Value, Option<Span>) {
+        let coord = |i: u8| std::rc::Rc::new(crate::check::types::Sx::Coord(i, owner));
+        let mark = self.locals.len();
+        let point = if plane {
+            vec![coord(0), coord(1)]
+        } else {
+            vec![coord(0), coord(1), coord(2)]
+        };
+        // The surface normal `n`, unless a name of the program hides it (as it hides `t`):
+        // read by a colour field, refused in a distance's (`field_block`). Bound before `p`,
+        // so that `p` is the nearer binding a misspelt name is told of.
+        let reads = self.normal_reads.len();
+        if !plane && !self.names(NORMAL) {
+            let normal = vec![coord(3), coord(4), coord(5)];
+            self.locals.push((NORMAL.into(), field::point(normal)));
+        }
+        self.locals.push(("p".into(), field::point(point)));
+        self.planes.push(plane);
+        let v = self.body(body);
+        self.planes.pop();
+        self.locals.truncate(mark);
+        let normal_read = self.normal_reads.get(reads).copied();
+        self.normal_reads.truncate(reads);
+        (v, normal_read)
     }
 }

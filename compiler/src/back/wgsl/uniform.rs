@@ -3,7 +3,7 @@
 //! camera, settings, the look, lights (skies' irradiance coefficients computed here once, in
 //! f64), materials and the sRGB thresholds.
 
-use super::contract::{Mismatch, Uniform};
+use super::contract::{Mismatch, Uniform, UniformWriter};
 use super::srgb;
 use crate::scene::{Colour, Light, Pattern, Scene};
 use glam::DVec3;
@@ -16,13 +16,28 @@ use glam::DVec3;
 /// lags the template).
 pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u8>, Mismatch> {
     let mut w = layout.writer();
-    let colours = crate::lower::Colours::numbers(scene);
+    view(&mut w, scene, lipschitz)?;
+    lights(&mut w, scene)?;
+    materials(&mut w, scene)?;
+    for (k, t) in srgb::thresholds().chunks_exact(4).enumerate() {
+        let t: Vec<f64> = t.iter().map(|&x| f64::from(x)).collect();
+        w.floats(&format!("srgb[{k}]"), &t)?;
+    }
+    w.finish()
+}
+
+/// A vec3 and a w.
+fn v4(v: [f64; 3], w: f64) -> [f64; 4] {
+    [v[0], v[1], v[2], w]
+}
+
+/// The camera, the march, the look, the counts, the glow and the background.
+fn view(w: &mut UniformWriter, scene: &Scene, lipschitz: f64) -> Result<(), Mismatch> {
     let cam = &scene.camera;
     let s = &scene.settings;
     let (fwd, u, v) = cam.basis();
     let tan = (cam.fov * 0.5).tan();
     let aspect = s.width.max(1) as f64 / s.height.max(1) as f64;
-    let v4 = |v: [f64; 3], w: f64| [v[0], v[1], v[2], w];
     w.floats("eye", &v4(cam.position, 0.0))?;
     w.floats("cam_w", &v4(fwd, 0.0))?;
     w.floats("cam_u", &v4(u, 0.0))?;
@@ -70,7 +85,6 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
     if s.glows() {
         w.floats("glow", &v4(s.glow_color, 1.0 / s.glow))?;
     }
-    let (mut points, mut dirs, mut skies) = (0, 0, 0);
     // Whether a sky is the background (`background.w`): rays that hit nothing show the skies
     // that are.
     let sky_background = scene.lights.iter().any(|l| {
@@ -85,7 +99,12 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
     w.floats(
         "background",
         &v4(s.background, if sky_background { 1.0 } else { 0.0 }),
-    )?;
+    )
+}
+
+/// The lights: point, directional and sky lights in their arrays, in the scene's order.
+fn lights(w: &mut UniformWriter, scene: &Scene) -> Result<(), Mismatch> {
+    let (mut points, mut dirs, mut skies) = (0, 0, 0);
     for l in &scene.lights {
         // w: the shadows' sharpness k (0: hard), or −1 for a light without shadows.
         let k = if l.shadows() { l.sharpness() } else { -1.0 };
@@ -144,6 +163,13 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             }
         }
     }
+    Ok(())
+}
+
+/// The materials: colours or checkers, Phong's terms, optics, colour fields, and the Fresnel
+/// and physically based members of the kernels that have them.
+fn materials(w: &mut UniformWriter, scene: &Scene) -> Result<(), Mismatch> {
+    let colours = crate::lower::Colours::numbers(scene);
     for (k, m) in scene.materials.iter().enumerate() {
         // A colour field's colour is its program's (the constant is unused).
         let v = |c: &Colour| c.constant().unwrap_or([0.0; 3]);
@@ -208,9 +234,5 @@ pub fn uniforms(layout: &Uniform, scene: &Scene, lipschitz: f64) -> Result<Vec<u
             w.floats(&at("emission"), &v4(p.emission, 0.0))?;
         }
     }
-    for (k, t) in srgb::thresholds().chunks_exact(4).enumerate() {
-        let t: Vec<f64> = t.iter().map(|&x| f64::from(x)).collect();
-        w.floats(&format!("srgb[{k}]"), &t)?;
-    }
-    w.finish()
+    Ok(())
 }

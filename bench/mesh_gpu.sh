@@ -39,7 +39,7 @@ measure() { # name backend resolution file extra-args...
     local m b
     m=$(echo "$stats" | awk '/^time/ {print $2}')
     b=$(echo "$stats" | awk '/^before meshing/ {print $3}')
-    mesh+=("$m"); before+=("$b"); total+=("$(echo "$m + $b" | bc -l)")
+    mesh+=("$m"); before+=("$b"); total+=("$(awk -v m="$m" -v b="$b" 'BEGIN { printf "%.4f", m + b }')")
     evaluating+=("$(echo "$stats" | awk '/^evaluations/ {print $(NF-1)}')")
   done
   local tris launches

@@ -53,6 +53,14 @@ fn json<T: serde::Serialize>(value: T) -> Answer {
         .map_err(|e| (lsp_server::ErrorCode::InternalError as i32, e.to_string()))
 }
 
+/// The answer to a request about a document that is not open.
+fn not_open() -> Answer {
+    Err((
+        lsp_server::ErrorCode::InvalidRequest as i32,
+        "the document is not open".to_string(),
+    ))
+}
+
 /// The path a document's URI names (a `file:` URI's path; another scheme's URI as it is).
 fn path_of(uri: &lsp::Uri) -> PathBuf {
     text::uri_to_path(uri).unwrap_or_else(|| PathBuf::from(uri.as_str()))
@@ -201,18 +209,12 @@ impl Server {
     }
 
     fn request(&mut self, req: Request) -> Answer {
-        let unknown = || {
-            Err((
-                lsp_server::ErrorCode::InvalidRequest as i32,
-                "the document is not open".to_string(),
-            ))
-        };
         match req.method.as_str() {
             "textDocument/hover" => {
                 let p: lsp::HoverParams = params(req)?;
                 let uri = p.text_document_position_params.text_document.uri;
                 let Some(a) = self.analysed(&uri) else {
-                    return unknown();
+                    return not_open();
                 };
                 let c = &a.checked;
                 let t = c.sources.text(c.entry);
@@ -229,7 +231,7 @@ impl Server {
                 let p: lsp::GotoDefinitionParams = params(req)?;
                 let uri = p.text_document_position_params.text_document.uri;
                 let Some(a) = self.analysed(&uri) else {
-                    return unknown();
+                    return not_open();
                 };
                 let (decl, _) = match self.decl_at(&a, p.text_document_position_params.position) {
                     Some(d) => d,
@@ -240,60 +242,13 @@ impl Server {
                         .map(lsp::GotoDefinitionResponse::Scalar),
                 )
             }
-            "textDocument/references" => {
-                let p: lsp::ReferenceParams = params(req)?;
-                let uri = p.text_document_position.text_document.uri;
-                let Some(a) = self.analysed(&uri) else {
-                    return unknown();
-                };
-                let Some((decl, _)) = self.decl_at(&a, p.text_document_position.position) else {
-                    return json(serde_json::Value::Null);
-                };
-                let locations: Vec<lsp::Location> = a
-                    .index
-                    .references(&decl)
-                    .filter(|s| p.context.include_declaration || *s != decl.at)
-                    .filter_map(|s| self.location(&a, &uri, s))
-                    .collect();
-                json(locations)
-            }
-            "textDocument/rename" => {
-                let p: lsp::RenameParams = params(req)?;
-                let uri = p.text_document_position.text_document.uri;
-                let Some(a) = self.analysed(&uri) else {
-                    return unknown();
-                };
-                let new = p.new_name;
-                if let Some(why) = navigate::not_a_new_name(&new) {
-                    return Err((lsp_server::ErrorCode::InvalidParams as i32, why));
-                }
-                let Some((decl, _)) = self.decl_at(&a, p.text_document_position.position) else {
-                    return Err((
-                        lsp_server::ErrorCode::InvalidParams as i32,
-                        "no declaration of this file or its imports is here".into(),
-                    ));
-                };
-                // `Uri` hashes by its text, which nothing here mutates.
-                #[allow(clippy::mutable_key_type)]
-                let mut changes: HashMap<lsp::Uri, Vec<lsp::TextEdit>> = HashMap::new();
-                for s in a.index.references(&decl) {
-                    if let Some(l) = self.location(&a, &uri, s) {
-                        changes
-                            .entry(l.uri)
-                            .or_default()
-                            .push(lsp::TextEdit::new(l.range, new.clone()));
-                    }
-                }
-                json(lsp::WorkspaceEdit {
-                    changes: Some(changes),
-                    ..Default::default()
-                })
-            }
+            "textDocument/references" => self.references(params(req)?),
+            "textDocument/rename" => self.rename(params(req)?),
             "textDocument/codeAction" => {
                 let p: lsp::CodeActionParams = params(req)?;
                 let uri = p.text_document.uri;
                 let Some(a) = self.analysed(&uri) else {
-                    return unknown();
+                    return not_open();
                 };
                 let c = &a.checked;
                 json(diagnostics::quick_fixes(
@@ -308,7 +263,7 @@ impl Server {
                 let p: lsp::CompletionParams = params(req)?;
                 let uri = p.text_document_position.text_document.uri;
                 let Some(a) = self.analysed(&uri) else {
-                    return unknown();
+                    return not_open();
                 };
                 let c = &a.checked;
                 let t = c.sources.text(c.entry);
@@ -321,7 +276,7 @@ impl Server {
                 let p: lsp::SignatureHelpParams = params(req)?;
                 let uri = p.text_document_position_params.text_document.uri;
                 let Some(a) = self.analysed(&uri) else {
-                    return unknown();
+                    return not_open();
                 };
                 let c = &a.checked;
                 let at = text::offset(
@@ -334,14 +289,14 @@ impl Server {
                 let p: lsp::DocumentFormattingParams = params(req)?;
                 let path = path_of(&p.text_document.uri);
                 let Some(t) = self.docs.get(&path) else {
-                    return unknown();
+                    return not_open();
                 };
                 json(formatting(t))
             }
             "textDocument/documentSymbol" => {
                 let p: lsp::DocumentSymbolParams = params(req)?;
                 let Some(a) = self.analysed(&p.text_document.uri) else {
-                    return unknown();
+                    return not_open();
                 };
                 json(lsp::DocumentSymbolResponse::Nested(symbols(&a)))
             }
@@ -350,6 +305,58 @@ impl Server {
                 format!("`{}` is not supported", req.method),
             )),
         }
+    }
+
+    /// `textDocument/references`: every use of the declaration at the position.
+    fn references(&mut self, p: lsp::ReferenceParams) -> Answer {
+        let uri = p.text_document_position.text_document.uri;
+        let Some(a) = self.analysed(&uri) else {
+            return not_open();
+        };
+        let Some((decl, _)) = self.decl_at(&a, p.text_document_position.position) else {
+            return json(serde_json::Value::Null);
+        };
+        let locations: Vec<lsp::Location> = a
+            .index
+            .references(&decl)
+            .filter(|s| p.context.include_declaration || *s != decl.at)
+            .filter_map(|s| self.location(&a, &uri, s))
+            .collect();
+        json(locations)
+    }
+
+    /// `textDocument/rename`: every use of the declaration at the position renamed, in every
+    /// document of the workspace that has one.
+    fn rename(&mut self, p: lsp::RenameParams) -> Answer {
+        let uri = p.text_document_position.text_document.uri;
+        let Some(a) = self.analysed(&uri) else {
+            return not_open();
+        };
+        let new = p.new_name;
+        if let Some(why) = navigate::not_a_new_name(&new) {
+            return Err((lsp_server::ErrorCode::InvalidParams as i32, why));
+        }
+        let Some((decl, _)) = self.decl_at(&a, p.text_document_position.position) else {
+            return Err((
+                lsp_server::ErrorCode::InvalidParams as i32,
+                "no declaration of this file or its imports is here".into(),
+            ));
+        };
+        // `Uri` hashes by its text, which nothing here mutates.
+        #[allow(clippy::mutable_key_type)]
+        let mut changes: HashMap<lsp::Uri, Vec<lsp::TextEdit>> = HashMap::new();
+        for s in a.index.references(&decl) {
+            if let Some(l) = self.location(&a, &uri, s) {
+                changes
+                    .entry(l.uri)
+                    .or_default()
+                    .push(lsp::TextEdit::new(l.range, new.clone()));
+            }
+        }
+        json(lsp::WorkspaceEdit {
+            changes: Some(changes),
+            ..Default::default()
+        })
     }
 
     /// The declaration of the name at `pos` of the entry document (or the declaration written

@@ -87,7 +87,7 @@ const LONG_FILES: usize = 24;
 /// A file's length past which it should be split by responsibility.
 const FILE_LINES: usize = 800;
 /// The most functions over [`FUNCTION_LINES`] lines the workspace may hold.
-const LONG_FUNCTIONS: usize = 20;
+const LONG_FUNCTIONS: usize = 19;
 /// A function's length past which it should be split.
 const FUNCTION_LINES: usize = 150;
 

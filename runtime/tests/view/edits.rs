@@ -2,7 +2,6 @@
 //! error that leaves the last good image on show): in a window on wgpu, on the CPU, and headless.
 
 use crate::{changed, display, exited, mean, temp_dir, wait_for, Display, CENTRE, LEFT, SCENE};
-use std::io::BufRead;
 use std::process::{Command, Stdio};
 
 /// Opens the viewer with `args` (besides the file and the screenshot folder), edits the file

@@ -3,7 +3,6 @@
 
 use crate::{changed, display, exited, mean, temp_dir, wait_for, Display, CENTRE, LEFT, SCENE};
 use sdfc_runtime::image::{read_png, Image};
-use std::io::BufRead;
 use std::path::Path;
 use std::process::{Command, Stdio};
 

@@ -3,12 +3,15 @@
 //! times; what a render allocates is known before it starts ([`Prepared::memory`]). Each
 //! backend implements [`Renderer`] in a module of its own (`cpu.rs`, `wgpu.rs`, `cuda.rs`,
 //! and `several.rs` for several devices at once); [`Prepared`] holds one, and the
-//! preparations that choose it are here (`opening.rs` the one that joins a device opened
-//! beside the front end). What fails is an [`Error`].
+//! preparations that choose it are `prepare.rs`'s (`opening.rs` the one that joins a device
+//! opened beside the front end), the devices `--devices` asks for `devices.rs`'s. What fails is
+//! an [`Error`].
 
 mod cpu;
 mod cuda;
+mod devices;
 mod opening;
+mod prepare;
 mod several;
 mod wgpu;
 
@@ -17,15 +20,14 @@ pub use self::cuda::CudaPrepared;
 pub use self::opening::{see_only, Opening};
 pub use self::several::SeveralPrepared;
 pub use self::wgpu::WgpuPrepared;
+pub use devices::{Device, Devices};
+pub use prepare::method_allowed;
 
 use crate::cpu::{Precision, Render};
-use crate::gpu::{self, cuda::Cuda, Gpu};
+use crate::gpu::{self};
 use crate::memory::{self, Memory};
-use sdfc_compiler::{
-    analytic::{Choice, Traceable},
-    lower_scene, wgsl, LowerOptions, Lowered, Method, Scene, Settings,
-};
-use std::sync::Arc;
+use prepare::{kernel, kernel_text};
+use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
 use std::time::Duration;
 
 /// What fails preparing a scene on a backend or rendering it there.
@@ -208,92 +210,9 @@ impl Setup {
     }
 }
 
-/// Which devices a render uses (`--devices`).
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub enum Devices {
-    /// The one device `--backend` picks.
-    #[default]
-    Auto,
-    /// Every GPU of the backend: every CUDA device, or every wgpu adapter (the CPU is not
-    /// one of them).
-    All,
-    /// These, in order: GPUs by index (CUDA devices, or wgpu adapters, as `sdfc devices`
-    /// lists them), and `cpu`. An index given twice opens the device twice: two logical
-    /// devices that share it.
-    List(Vec<Device>),
-}
-
-/// One entry of `--devices`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Device {
-    /// The CPU renderer.
-    Cpu,
-    /// A GPU by index.
-    Gpu(usize),
-}
-
-impl Devices {
-    /// Reads `--devices`: `auto`, `all`, or a comma-separated list of indices and `cpu`.
-    pub fn parse(text: &str) -> Result<Devices, Usage> {
-        match text.trim() {
-            "auto" => return Ok(Devices::Auto),
-            "all" => return Ok(Devices::All),
-            _ => {}
-        }
-        text.split(',')
-            .map(|entry| match entry.trim() {
-                "cpu" => Ok(Device::Cpu),
-                e => e
-                    .parse()
-                    .map(Device::Gpu)
-                    .map_err(|_| Usage::DevicesEntry(e.into())),
-            })
-            .collect::<Result<Vec<_>, _>>()
-            .map(Devices::List)
-    }
-
-    /// The devices of `backend` these name; `None` for `auto` (the one device the backend
-    /// picks). Every caller reports a failure as `job::Error::unavailable` does: GPUs asked of
-    /// the CPU backend are a usage error, `all` finding none a device error.
-    pub fn resolve(&self, backend: Backend) -> Result<Option<Vec<Device>>, Resolve> {
-        let list: Vec<Device> = match self {
-            Devices::Auto => return Ok(None),
-            Devices::All => match gpu_kind(backend)? {
-                Backend::Cuda => (0..Cuda::count()).map(Device::Gpu).collect(),
-                _ => (0..gpu::wgpu::adapters().len()).map(Device::Gpu).collect(),
-            },
-            Devices::List(list) => list.clone(),
-        };
-        if list.is_empty() {
-            return Err(Resolve::NoDevice(match gpu_kind(backend)? {
-                Backend::Cuda => "cuda",
-                _ => "wgpu",
-            }));
-        }
-        Ok(Some(list))
-    }
-
-    /// `Err` naming the first entry `backend` cannot render on (a GPU with `--backend cpu`).
-    pub fn check(&self, backend: Backend) -> Result<(), Usage> {
-        match self {
-            Devices::List(list) if backend == Backend::Cpu => {
-                match list.iter().find_map(|d| match d {
-                    Device::Gpu(i) => Some(*i),
-                    Device::Cpu => None,
-                }) {
-                    Some(i) => Err(Usage::GpuOnCpu(i)),
-                    None => Ok(()),
-                }
-            }
-            Devices::All if backend == Backend::Cpu => Err(Usage::AllOnCpu),
-            _ => Ok(()),
-        }
-    }
-}
-
 /// Where the first preparation of a scene for a GPU went (`sdfc render --stats`): the
 /// device opened and the kernel written; the driver's compile is the wgpu pipeline's
-/// (`pipeline`) or the CUDA module's load (`cuda.rs`).
+/// (`pipeline`) or the CUDA module's load (`gpu/cuda/jit.rs`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Preparation {
     /// Opening the device: wgpu's adapters enumerated and a device opened, or the CUDA
@@ -388,21 +307,6 @@ impl Frame {
             })
             .collect()
     }
-}
-
-/// `Err` when the scene's settings ask for analytic tracing (`method=trace`) of a scene that
-/// does not allow it, saying why, from the primitives the lowering found (`traceable`):
-/// `sdfc render` refuses such settings before preparing a backend.
-pub fn method_allowed(scene: &Scene, traceable: &Traceable) -> Result<(), Error> {
-    if scene.settings.method == Method::Trace {
-        if let Choice::March(reason) = traceable.choose(scene.settings.method) {
-            return Err(Error::Unsupported(format!(
-                "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
-                reason.describe()
-            )));
-        }
-    }
-    Ok(())
 }
 
 impl Frame {
@@ -539,176 +443,7 @@ impl std::fmt::Debug for Part<'_> {
 #[derive(Debug)]
 pub struct Prepared(Box<dyn Renderer>);
 
-/// Whose GPUs `--devices` indexes: CUDA's or wgpu's (for `auto`, CUDA's where a driver has
-/// devices).
-fn gpu_kind(backend: Backend) -> Result<Backend, Usage> {
-    match backend {
-        Backend::Cuda | Backend::Wgpu => Ok(backend),
-        Backend::Auto if Cuda::count() > 0 => Ok(Backend::Cuda),
-        Backend::Auto => Ok(Backend::Wgpu),
-        Backend::Cpu => Err(Usage::GpusOnCpu),
-    }
-}
-
-/// The kernel for `scene`, chosen (`wgsl::choose`), written and validated.
-fn kernel(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Kernel, Error> {
-    let options = kernel_options(setup);
-    wgsl::choose(scene, lowered, &options)?;
-    wgsl::write_with(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
-}
-
-fn kernel_options(setup: &Setup) -> wgsl::Options {
-    wgsl::Options {
-        debug_nan: setup.debug_nan,
-        parameters: setup.parameters,
-        kernel: setup.kernel,
-        interp_unroll: if setup.software {
-            wgsl::interp::UNROLL_SOFTWARE
-        } else {
-            wgsl::interp::UNROLL
-        },
-        ..wgsl::Options::default()
-    }
-}
-
-/// The text and data of the kernel for `scene`, not validated (to compare with a kernel
-/// held).
-fn kernel_text(scene: &Scene, lowered: &Lowered, setup: &Setup) -> Result<wgsl::Text, Error> {
-    let options = kernel_options(setup);
-    wgsl::choose(scene, lowered, &options)?;
-    wgsl::write_text(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
-}
-
 impl Prepared {
-    /// `backend` prepared.
-    fn of(backend: impl Renderer + 'static) -> Prepared {
-        Prepared(Box::new(backend))
-    }
-
-    /// Prepares `scene` for `backend`. `Err` says why the backend cannot be used.
-    pub fn new(backend: Backend, scene: &Scene, precision: Precision) -> Result<Prepared, Error> {
-        let setup = Setup {
-            precision,
-            ..Setup::default()
-        };
-        let lowered = lower_scene(scene, &LowerOptions::default());
-        Self::from_program(backend, scene, lowered, &setup)
-    }
-
-    /// Prepares `scene`, lowered as `lowered` (its program and what else the backends
-    /// read), for `backend`.
-    pub fn from_program(
-        backend: Backend,
-        scene: &Scene,
-        lowered: Lowered,
-        setup: &Setup,
-    ) -> Result<Prepared, Error> {
-        method_allowed(scene, &lowered.traceable)?;
-        let cpu = |lowered| Prepared::of(CpuPrepared::new(scene, lowered, setup));
-        let wgpu =
-            |hardware| WgpuPrepared::open(scene, &lowered, setup, hardware).map(Prepared::of);
-        let cuda = || CudaPrepared::open(scene, &lowered, setup, Cuda::open).map(Prepared::of);
-        match backend {
-            Backend::Cpu => Ok(cpu(lowered)),
-            Backend::Wgpu => wgpu(false),
-            Backend::Cuda => cuda(),
-            Backend::Auto if setup.precision == Precision::F64 => Ok(cpu(lowered)),
-            Backend::Auto => match cuda().or_else(|_| wgpu(true)) {
-                Ok(p) => Ok(p),
-                Err(_) => Ok(cpu(lowered)),
-            },
-        }
-    }
-
-    /// Prepares `scene`, lowered as `lowered`, for `backend` on `devices`: the device the
-    /// backend picks ([`Devices::Auto`]), or several that render each frame together.
-    pub fn on_devices(
-        backend: Backend,
-        devices: &Devices,
-        scene: &Scene,
-        lowered: Lowered,
-        setup: &Setup,
-    ) -> Result<Prepared, Error> {
-        let Some(list) = devices.resolve(backend)? else {
-            return Self::from_program(backend, scene, lowered, setup);
-        };
-        method_allowed(scene, &lowered.traceable)?;
-        let mut parts = Vec::with_capacity(list.len());
-        for d in &list {
-            let part = match *d {
-                Device::Cpu => Prepared::of(CpuPrepared::new(scene, lowered.clone(), setup)),
-                Device::Gpu(i) => match gpu_kind(backend)? {
-                    // On a stream of its own: the same index twice is two logical devices on
-                    // one GPU, running side by side.
-                    Backend::Cuda => {
-                        Prepared::of(CudaPrepared::open(scene, &lowered, setup, || {
-                            Cuda::open_device(i, true)
-                        })?)
-                    }
-                    _ => {
-                        let gpu = Gpu::open_index(i).map_err(|e| Error::Device(e.to_string()))?;
-                        Self::on_gpu(Arc::new(gpu), scene, &lowered, setup)?
-                    }
-                },
-            };
-            parts.push(part);
-        }
-        Ok(match parts.len() {
-            1 => parts.remove(0),
-            _ => Prepared::of(SeveralPrepared { parts }),
-        })
-    }
-
-    /// Prepares `scene`, lowered as `lowered`, for wgpu on an already opened device:
-    /// generates and validates the kernel (its pipeline is compiled, or found in the
-    /// device's cache, at the first render or by [`Gpu::pipeline_for`]).
-    pub fn on_gpu(
-        gpu: Arc<Gpu>,
-        scene: &Scene,
-        lowered: &Lowered,
-        setup: &Setup,
-    ) -> Result<Prepared, Error> {
-        WgpuPrepared::on_gpu_after(gpu, scene, lowered, setup, None).map(|(p, _)| Prepared::of(p))
-    }
-
-    /// Prepares `scene`, lowered as `lowered`, for the CPU renderer.
-    pub fn on_cpu(scene: &Scene, lowered: Lowered, setup: &Setup) -> Result<Prepared, Error> {
-        method_allowed(scene, &lowered.traceable)?;
-        Ok(Prepared::of(CpuPrepared::new(scene, lowered, setup)))
-    }
-
-    /// `scene`, lowered as `lowered`, prepared as this is (the same backend, device and
-    /// setup), leaving this as it is: a wgpu kernel whose text is unchanged is reused (with
-    /// [`Setup::parameters`], a program that differs only in numbers: only its `scene_data`
-    /// is new); the CPU's tapes are made again. Also says whether a kernel (or the tapes) was
-    /// built. The viewer keeps its last good scene until the new one is ready; a sequence
-    /// replaces its scene with [`Prepared::update`]. CUDA and several devices are prepared
-    /// again with `update` alone.
-    pub fn next(&self, scene: &Scene, lowered: Lowered) -> Result<(Prepared, bool), Error> {
-        self.0.next(scene, lowered, None)
-    }
-
-    /// [`Prepared::next`] with the wgpu kernel `kernel` instead of this one's choice (the
-    /// viewer shows a scene through the interpreted kernel while its specialised kernel
-    /// compiles); the same as `next` for the CPU.
-    pub fn next_with(
-        &self,
-        scene: &Scene,
-        lowered: Lowered,
-        kernel: wgsl::KernelChoice,
-    ) -> Result<(Prepared, bool), Error> {
-        self.0.next(scene, lowered, Some(kernel))
-    }
-
-    /// Prepares `scene`, lowered as `lowered`, in place of the scene this was prepared for,
-    /// keeping the device: a GPU kernel whose text is unchanged (with [`Setup::parameters`], a
-    /// program that differs only in numbers) is kept and given the new `scene_data`; another
-    /// is compiled. Returns whether a kernel (or the CPU's tapes) was built.
-    pub fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
-        method_allowed(scene, &lowered.traceable)?;
-        self.0.update(scene, lowered)
-    }
-
     /// The contract of the GPU kernel: what it was specialised for and what it reads
     /// (`None` on the CPU, which reads every setting at every render).
     pub fn contract(&self) -> Option<&wgsl::Contract> {
@@ -720,34 +455,6 @@ impl Prepared {
     /// count nothing but the camera rays.
     pub fn reduce_statistics(&mut self, on: bool) {
         self.0.reduce_statistics(on)
-    }
-
-    /// Specialises the GPU kernel again when `scene` needs other features than it has
-    /// (another method, over-relaxation on or off, another `max_depth`, soft shadows where
-    /// the kernel has hard ones, ...: [`wgsl::Contract::check`]): a sweep of ω from 1 up must
-    /// turn `RELAX` on. Keeps the device; nothing to do on the CPU. Says whether a kernel was
-    /// written.
-    pub fn specialise(&mut self, scene: &Scene) -> Result<bool, Error> {
-        if self.check_contract(scene).is_ok() {
-            return Ok(false);
-        }
-        self.0.specialise(scene)
-    }
-
-    /// `Err` when `scene` needs a kernel specialised otherwise than this one
-    /// ([`wgsl::Contract::check`]; [`Prepared::specialise`] writes it again): a render never
-    /// silently ignores a setting or a feature of the scene.
-    pub fn check_contract(&self, scene: &Scene) -> Result<(), Error> {
-        let Some(contract) = self.contract() else {
-            return Ok(());
-        };
-        let traced = self.traceable().traced(scene.settings.method).is_some();
-        contract.check(scene, traced).map_err(|m| {
-            Error::Unsupported(format!(
-                "the {} kernel cannot render this scene: {m}; specialise it again",
-                self.name()
-            ))
-        })
     }
 
     /// The backend's name, as in `--backend`.

@@ -115,7 +115,7 @@ pub(crate) fn wgpu_presenter(
     event_loop: &ActiveEventLoop,
     window: &Arc<Window>,
 ) -> Result<(Arc<Gpu>, GpuPresenter), Error> {
-    // One instance for the process, never destroyed (as `runtime/src/gpu/wgpu.rs` keeps its
+    // One instance for the process, never destroyed (as `runtime/src/gpu/wgpu/mod.rs` keeps its
     // own): the Vulkan driver then stays loaded until the process ends.
     static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
     let instance = INSTANCE.get_or_init(|| {

@@ -1,7 +1,8 @@
 //! Rendering, one test binary: each module tests one concern of the renderers (CPU, wgpu
 //! through lavapipe, CUDA where there is a device) through the library.
 //!
-//! - `render`: properties of CPU renders (coverage, shadows, mirrors, glass, debug views);
+//! - `render`, `shading`, `regressions`: properties of CPU renders (coverage, threads, debug
+//!   views; shadows, mirrors, glass; renders that once went wrong);
 //! - `look`, `pbr`, `penumbra`: the look (occlusion, fog, tone curves), the physically based
 //!   material and soft shadows on every backend;
 //! - `analytic`: which scenes are traced analytically, and their images;
@@ -11,7 +12,8 @@
 //! - `interpreted_kernel`: the interpreted WGSL kernel against the specialised one;
 //! - `optimise`: the optimisation passes and bounding-volume culling;
 //! - `devices`: several devices at once (`--devices`);
-//! - `animation`: the time `t`, sequences and their frames;
+//! - `animation`, `sequence`, `animation_kernels`: the time `t`, sequences and their frames,
+//!   one kernel per sequence;
 //! - `colour`: colour fields of the normal, and of a painted shape moved afterwards;
 //! - `checker_materials`: a checker of two materials, each cell shaded as its material;
 //! - `glow`: the glow of the marching steps, by its documented sum.
@@ -25,6 +27,7 @@ mod evaluators;
 
 mod analytic;
 mod animation;
+mod animation_kernels;
 mod checker_materials;
 mod colour;
 mod devices;
@@ -37,5 +40,8 @@ mod optimise;
 mod path;
 mod pbr;
 mod penumbra;
+mod regressions;
 mod render;
+mod sequence;
+mod shading;
 mod stability;

@@ -6,7 +6,8 @@
 //! (each frame's scene checked at its time, its kernel kept while only numbers change). On wgpu,
 //! a scene whose specialised kernel is not compiled yet waits a short grace period ([`GRACE`])
 //! for it to compile on another thread ([`super::compile`]), and is shown through the
-//! interpreted kernel from then until it is ready. A load is `load.rs`'s; the tests are
+//! interpreted kernel from then until it is ready. A load is `load.rs`'s, a frame `frame.rs`'s,
+//! the camera's moves `navigate.rs`'s, an animation's time `playback.rs`'s; the tests are
 //! `tests.rs`.
 
 use super::camera::{self, Orbit};
@@ -14,38 +15,45 @@ use super::compile::{Compile, Waker};
 use super::grade::Grade;
 use super::resident::{FirstFrame, Resident};
 use super::watch::Fingerprint;
-use crate::backend::{Devices, Kernel, Prepared, Setup};
-use crate::frontend::{self, Loaded};
+use crate::backend::{Kernel, Prepared, Setup};
+use crate::frontend::{self};
 use crate::gpu::wgpu::PipelineTime;
 use crate::gpu::Gpu;
 use crate::image::Image;
-use crate::job::{self, Error, Job};
+use crate::job::{Error, Job};
 use sdfc_compiler::{wgsl, Animation, Camera, LowerOptions, Lowered, Scene};
-use sdfc_compiler::{FileId, Limit, SourceMap};
+use sdfc_compiler::{FileId, SourceMap};
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant, SystemTime};
-
-mod load;
-mod params;
-mod timings;
-
 use timings::Timings;
+
+mod frame;
+mod load;
+mod navigate;
+mod params;
+mod playback;
+mod timings;
 
 /// The time a frame may take while the camera moves; a slower one lowers the resolution.
 pub const FRAME_BUDGET: Duration = Duration::from_millis(33);
+
 /// How long after the last camera motion the camera counts as still (and samples accumulate).
 pub const SETTLE: Duration = Duration::from_millis(120);
+
 /// How many times a load reads files that keep changing under it before it goes on with
 /// what it read.
 const STABLE_READS: usize = 4;
+
 /// How long a load waits for an empty scene file to be written: an editor saving in place
 /// truncates the file, then writes it, and a busy machine can run the load in between. No
 /// one saves a scene empty on purpose; one that stays empty this long is loaded (and reported
 /// as it is).
 const EMPTY_PATIENCE: Duration = Duration::from_millis(500);
+
 /// The largest divisor of the resolution while moving.
 pub const MAX_SCALE: u32 = 8;
+
 /// How long a load whose specialised pipeline compiles on another thread (`--kernel auto` on a
 /// GPU) waits for it before showing the scene through the interpreted kernel. A driver that
 /// compiles a kernel in a few milliseconds then shows the specialised kernel's frame at once,
@@ -109,25 +117,6 @@ struct Playback {
     paused: Option<f64>,
     /// The animation frame on show.
     shown: Option<u64>,
-}
-
-impl Playback {
-    /// The clock, in seconds (within `duration`, when the scene states one).
-    fn clock(&self) -> f64 {
-        let age = self
-            .paused
-            .unwrap_or_else(|| self.origin.elapsed().as_secs_f64());
-        if self.animation.duration > 0.0 {
-            age.rem_euclid(self.animation.duration)
-        } else {
-            age
-        }
-    }
-
-    /// The animation frame the clock is in.
-    fn frame(&self) -> u64 {
-        (self.clock() * self.animation.fps).floor() as u64
-    }
 }
 
 /// Where frames are rendered.
@@ -446,25 +435,6 @@ impl Session {
         self.good.as_ref().is_some_and(|g| g.waiting.is_some())
     }
 
-    /// The size a view of `file` starts at: `size`, or the scene's (640×480 when the file does
-    /// not compile yet). Nothing is printed.
-    pub fn initial_size(file: &Path, options: &Options) -> (u32, u32) {
-        let job = &options.job;
-        if let Some(size) = job.overrides.size {
-            return size;
-        }
-        match frontend::load_with(file, &job.limits) {
-            Ok(Loaded {
-                scene: Some(mut scene),
-                ..
-            }) => match job.settings(&mut scene) {
-                Ok(()) => (scene.settings.width, scene.settings.height),
-                Err(_) => (640, 480),
-            },
-            _ => (640, 480),
-        }
-    }
-
     /// The device frames are rendered on.
     pub fn device(&self) -> &Device {
         &self.device
@@ -486,443 +456,6 @@ impl Session {
                 && paths.iter().any(|p| {
                     p.extension().is_some_and(|e| e == "sdf") && !read.contains(&absolute(p))
                 }))
-    }
-
-    /// The playback of a newly loaded scene: `None` for a still; for an animated scene the
-    /// clock of the last playback goes on (paused or not), or starts (paused at `--time`, if
-    /// given). The files are read again for the frames to come; if they cannot be, the scene
-    /// stays at the time it was loaded at.
-    fn playback_of(&mut self, scene: &Scene) -> Option<Playback> {
-        if !scene.animation.animated() {
-            return None;
-        }
-        let source = match frontend::Source::read(&self.file) {
-            Ok(s) => s,
-            Err(msg) => {
-                eprintln!("view: the animation stays at t = 0: {msg}");
-                return None;
-            }
-        };
-        let (origin, paused) = match &self.playback {
-            Some(p) => (p.origin, p.paused),
-            None => (Instant::now(), self.options.time),
-        };
-        Some(Playback {
-            source,
-            animation: scene.animation,
-            origin,
-            paused,
-            // The load checked the scene at t = 0.
-            shown: Some(0),
-        })
-    }
-
-    /// Whether an animated scene's time is playing.
-    pub fn playing(&self) -> bool {
-        self.playback.as_ref().is_some_and(|p| p.paused.is_none()) && self.broken.is_none()
-    }
-
-    /// Pauses a playing animation at its clock, or plays a paused one on from there.
-    pub fn toggle_pause(&mut self) {
-        if let Some(p) = self.playback.as_mut() {
-            match p.paused.take() {
-                Some(at) => p.origin = Instant::now() - Duration::from_secs_f64(at),
-                None => p.paused = Some(p.clock()),
-            }
-            self.accumulation = Accumulation::default();
-        }
-    }
-
-    /// The animation time on show, for the title; `None` for a still.
-    pub fn time(&self) -> Option<f64> {
-        let p = self.playback.as_ref()?;
-        Some(Animation::time_of(p.animation.fps, p.shown.unwrap_or(0)))
-    }
-
-    /// Brings the scene to the animation frame the clock is in: the scene checked at that
-    /// frame's time, lowered and prepared (the kernel kept when only numbers change). A frame
-    /// that fails stops the clock there, with its problem in the title.
-    fn advance(&mut self) {
-        let Some(p) = self.playback.as_mut() else {
-            return;
-        };
-        let k = p.frame();
-        if p.shown == Some(k) {
-            return;
-        }
-        p.shown = Some(k);
-        let time = Animation::time_of(p.animation.fps, k);
-        if let Err(msg) = self.scene_at(time) {
-            eprintln!("view: t = {time} s: {msg}");
-            self.status = Some(format!("t = {time} s: {msg}"));
-            if let Some(p) = self.playback.as_mut() {
-                p.paused = Some(time);
-            }
-        }
-    }
-
-    /// Replaces the scene on show with the scene checked at `time`, through the job's path:
-    /// checked, its settings applied and lowered (keeping its program's structure:
-    /// [`LowerOptions::parametric`]), then prepared as the scene before was, with the kernel
-    /// it had ([`job::Open::After`]), and the interpreted kernel shown meanwhile too.
-    fn scene_at(&mut self, time: f64) -> Result<(), String> {
-        let job = &self.job();
-        let on = (self.backend(), &Devices::Auto);
-        let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
-            return Ok(());
-        };
-        let mut frame = job
-            .frame(&mut p.source, time, false, &LowerOptions::parametric())
-            .map_err(|e| e.to_string())?;
-        // Its frames render linear light; the grade (which may change with `t`) is applied
-        // to their mean.
-        let grade = Grade::take(&mut frame.scene.settings);
-        // Each kernel stays the one it is (`Auto`: the one before's).
-        let setup = Setup::default();
-        if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
-            let frame = frame.clone();
-            let open = job::Open::After(&i.prepared);
-            i.prepared = job::prepare_here(on, frame, &setup, open)
-                .map_err(|e| e.to_string())?
-                .prepared;
-        }
-        let open = job::Open::After(&good.prepared);
-        let job::Ready {
-            scene, prepared, ..
-        } = job::prepare_here(on, frame, &setup, open).map_err(|e| e.to_string())?;
-        self.version += 1;
-        good.file_camera = scene.camera.clone();
-        good.scene = scene;
-        good.grade = grade;
-        good.prepared = prepared;
-        Ok(())
-    }
-
-    /// The divisor of the resolution of a new scene's first frame: enough to bring the last
-    /// full frame's time within the budget (1 before the first frame).
-    fn preview_scale(&self) -> u32 {
-        let ratio = self
-            .last_full
-            .map_or(0.0, |t| t.as_secs_f64() / FRAME_BUDGET.as_secs_f64());
-        (ratio.sqrt().ceil() as u32).clamp(1, MAX_SCALE)
-    }
-
-    /// Sets the view's size (the window's), clamped to the `edge` limit.
-    pub fn set_size(&mut self, width: u32, height: u32) {
-        let edge = self
-            .options
-            .job
-            .limits
-            .get(Limit::Edge)
-            .min(u32::MAX as u64) as u32;
-        let size = (width.clamp(1, edge), height.clamp(1, edge));
-        if size != self.size {
-            self.size = size;
-            self.accumulation = Accumulation::default();
-        }
-    }
-
-    /// The view's size.
-    pub fn size(&self) -> (u32, u32) {
-        self.size
-    }
-
-    /// The camera frames are rendered from.
-    fn camera(&self) -> Option<Camera> {
-        match (&self.user_camera, &self.good) {
-            (Some(orbit), _) => Some(orbit.camera()),
-            (None, Some(good)) => Some(good.file_camera.clone()),
-            (None, None) => None,
-        }
-    }
-
-    /// The orbit to move (starting from the file's camera), marking the camera as moving.
-    fn orbit(&mut self) -> Option<&mut Orbit> {
-        let camera = self.camera()?;
-        self.moving_until = Some(Instant::now() + SETTLE);
-        self.broken = None;
-        Some(
-            self.user_camera
-                .get_or_insert_with(|| Orbit::from_camera(&camera)),
-        )
-    }
-
-    /// Orbits by a drag of (`dx`, `dy`) pixels.
-    pub fn rotate(&mut self, dx: f64, dy: f64) {
-        if let Some(o) = self.orbit() {
-            o.orbit(dx, dy);
-        }
-    }
-
-    /// Pans by a drag of (`dx`, `dy`) pixels.
-    pub fn pan(&mut self, dx: f64, dy: f64) {
-        let height = self.size.1;
-        if let Some(o) = self.orbit() {
-            o.pan(dx, dy, height);
-        }
-    }
-
-    /// Zooms by `lines` wheel lines (positive: closer).
-    pub fn zoom(&mut self, lines: f64) {
-        if let Some(o) = self.orbit() {
-            o.zoom(lines);
-        }
-    }
-
-    /// Returns to the file's camera.
-    pub fn reset_camera(&mut self) {
-        if self.user_camera.take().is_some() {
-            self.accumulation = Accumulation::default();
-            self.broken = None;
-        }
-    }
-
-    /// Whether the user has moved the camera away from the file's.
-    pub fn camera_moved(&self) -> bool {
-        self.user_camera.is_some()
-    }
-
-    fn moving(&self) -> bool {
-        self.moving_until.is_some_and(|t| Instant::now() < t)
-    }
-
-    /// Whether there is a frame to render: a scene is loaded and the camera moves or the image
-    /// has fewer samples than the scene's `aa` asks for.
-    /// While the scene's kernel compiles on another thread, only its end calls for a frame
-    /// (before, the interpreted kernel's image converges, or there is nothing to render: in
-    /// the grace period, the end of the period calls for one, at [`Session::grace_deadline`]).
-    pub fn wants_frame(&self) -> bool {
-        let Some(good) = &self.good else {
-            return false;
-        };
-        if good
-            .waiting
-            .as_ref()
-            .is_some_and(|w| w.finished(self.held(w.load)))
-        {
-            return true;
-        }
-        if self.broken.is_some() || good.kernel().is_none() {
-            return false;
-        }
-        let a = &self.accumulation;
-        self.moving()
-            || self.playing()
-            || !a.still
-            || a.count < good.aa
-            || (a.width, a.height) != self.size
-    }
-
-    /// Whether the image on show is final until something changes (converged, or nothing to
-    /// render, and no kernel compiling to replace the one that rendered it).
-    pub fn settled(&self) -> bool {
-        !self.wants_frame() && !self.compiling()
-    }
-
-    /// Renders the next frame into the image on show. `Ok(None)` when there is nothing to
-    /// render; `Err` is a render error (rendering stops until the next load or camera move).
-    pub fn frame(&mut self) -> Result<Option<FrameInfo>, String> {
-        self.poll();
-        if !self.wants_frame() {
-            return Ok(None);
-        }
-        self.advance();
-        // A playing animation renders as a moving camera does: one sample a frame.
-        let moving = self.moving() || self.playing();
-        let Some(base) = self.camera() else {
-            return Ok(None);
-        };
-        let scale = if moving {
-            self.scale
-        } else if self.preview {
-            self.preview_scale()
-        } else {
-            1
-        };
-        // A frame below full resolution is a single sample, replaced by the next frame.
-        let low = scale > 1 || moving;
-        self.preview = false;
-        let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
-        let a = &mut self.accumulation;
-        if low || !a.still || (a.width, a.height) != (w, h) {
-            let on_cpu = matches!(self.device, Device::Cpu);
-            *a = Accumulation {
-                width: w,
-                height: h,
-                sum: match on_cpu {
-                    true => vec![[0.0; 3]; w as usize * h as usize],
-                    false => Vec::new(),
-                },
-                count: 0,
-                still: !low,
-            };
-        }
-        let Some(good) = self.good.as_mut().filter(|g| g.kernel().is_some()) else {
-            return Ok(None);
-        };
-        let path = good.scene.settings.path;
-        let n = (good.aa as f64).sqrt().round() as u32;
-        // A path-traced frame is one sample, the next of its random stream, jittered within
-        // the pixel by the path tracer itself.
-        let (dx, dy) = if low || path {
-            (0.0, 0.0)
-        } else {
-            camera::sample_offset(a.count, n)
-        };
-        good.scene.camera = camera::jittered(&base, dx, dy, w, h);
-        let s = &mut good.scene.settings;
-        (s.width, s.height, s.aa) = (w, h, 1);
-        (s.samples, s.first_sample) = (1, a.count);
-        let start = Instant::now();
-        let Some(kernel) = good.kernel() else {
-            return Ok(None);
-        };
-        let kind = kernel.kernel_kind();
-        let prepared = kernel;
-        let rendered = match prepared.as_wgpu() {
-            // On wgpu the frame stays on the device: rendered, accumulated and shown there.
-            Some(crate::backend::WgpuPrepared {
-                gpu,
-                kernel,
-                lipschitz,
-                ..
-            }) => {
-                let key = (self.version, kernel.interpreted());
-                let resident = match self.resident.as_mut() {
-                    Some(r) => Ok(r),
-                    None => Resident::new(gpu.clone()).map(|r| self.resident.insert(r)),
-                };
-                prepared
-                    .check_contract(&good.scene)
-                    .map_err(|e| e.to_string())
-                    .and_then(|()| {
-                        resident
-                            .and_then(|r| {
-                                r.render(
-                                    (kernel, *lipschitz),
-                                    (&good.scene, good.grade),
-                                    key,
-                                    a.count == 0,
-                                    self.steps_wanted,
-                                )
-                            })
-                            .map_err(|e| e.to_string())
-                    })
-                    .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
-            }
-            None => prepared
-                .render(&good.scene, &|_| {})
-                .map_err(|e| e.to_string())
-                .map(|frame| {
-                    for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
-                        for i in 0..3 {
-                            sum[i] += c[i];
-                        }
-                    }
-                    (a.count + 1, frame.render.stats.steps_mean)
-                }),
-        };
-        let (count, steps) = match rendered {
-            Ok(r) => r,
-            Err(msg) => {
-                self.broken = Some(msg.clone());
-                return Err(msg);
-            }
-        };
-        let time = start.elapsed();
-        a.count = count;
-        if !a.sum.is_empty() {
-            // The mean of the linear samples, graded.
-            let inv = 1.0 / a.count as f32;
-            let grade = good.grade;
-            self.shown = Some(Image {
-                width: w,
-                height: h,
-                linear: a
-                    .sum
-                    .iter()
-                    .map(|c| grade.apply([c[0] * inv, c[1] * inv, c[2] * inv]))
-                    .collect(),
-            });
-        }
-        if scale == 1 {
-            self.last_full = Some(time);
-        }
-        if moving {
-            if time > FRAME_BUDGET && self.scale < MAX_SCALE {
-                self.scale += 1;
-            } else if time * 3 < FRAME_BUDGET && self.scale > 1 {
-                self.scale -= 1;
-            }
-        }
-        let info = FrameInfo {
-            width: w,
-            height: h,
-            samples: a.count,
-            target: good.aa,
-            time,
-            steps,
-            moving,
-            kernel: kind,
-        };
-        let interim = match good.waiting.as_mut() {
-            Some(w) => {
-                w.shown = true;
-                w.interim.as_ref().and_then(|i| i.pipeline)
-            }
-            None => None,
-        };
-        if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
-            t.first_frame = Some((time, w, h));
-            t.first_kernel = kind;
-            t.interim_pipeline = interim;
-        }
-        self.last = Some(info);
-        Ok(Some(info))
-    }
-
-    /// The image on show: the mean of the samples accumulated (at the size of the last frame),
-    /// or `None` before the first good frame. On wgpu it is read back from the device (for a
-    /// screenshot or a test: frames themselves never are); a failed read is printed, and is
-    /// `None`.
-    pub fn image(&self) -> Option<Image> {
-        match &self.resident {
-            Some(r) => r.image().unwrap_or_else(|msg| {
-                eprintln!("error: {msg}");
-                None
-            }),
-            None => self.shown.clone(),
-        }
-    }
-
-    /// The image on show as the host holds it: the CPU renderer's (a window uploads it to show
-    /// it). `None` on wgpu, whose image stays on the device ([`Session::texture`]).
-    pub fn host_image(&self) -> Option<&Image> {
-        self.shown.as_ref()
-    }
-
-    /// On wgpu, the texture on show (sRGB bytes in an `Rgba8Unorm` texture, which may be
-    /// viewed as `Rgba8UnormSrgb`), on the device that renders the frames, and its number,
-    /// which changes when the texture does; `None` before the first frame and on the CPU.
-    pub fn texture(&self) -> Option<(&wgpu::Texture, u64)> {
-        self.resident.as_ref().and_then(Resident::texture)
-    }
-
-    /// Whether each frame's mean steps per pixel are wanted (the statistics in the title); on
-    /// wgpu, where frames stay on the device, a frame then reads back their sum (two words).
-    pub fn want_steps(&mut self, wanted: bool) {
-        self.steps_wanted = wanted;
-        // The frame on show was rendered without them: they are summed on the device now.
-        let Some(last) = self.last.as_mut().filter(|l| wanted && l.steps.is_nan()) else {
-            return;
-        };
-        if let Some(resident) = self.resident.as_mut() {
-            match resident.last_steps() {
-                Ok(Some(steps)) => last.steps = steps,
-                Ok(None) => {}
-                Err(msg) => eprintln!("error: {msg}"),
-            }
-        }
     }
 
     /// The window title: the file, the problem with the last load if it failed, a render

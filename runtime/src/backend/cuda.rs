@@ -85,9 +85,13 @@ impl CudaModule {
         let ptx = ptx::write(&kernel.module, &kernel.info, &options)
             .map_err(|e| Error::Kernel(e.to_string()))?;
         let ptx_time = start.elapsed();
-        let marched = !kernel.contract.has("ANALYTIC");
+        let tracing = match (kernel.contract.has("ANALYTIC"), kernel.contract.has("PATH")) {
+            (true, _) => gpu::cuda::Tracing::Analytic,
+            (false, true) => gpu::cuda::Tracing::MarchedPaths,
+            (false, false) => gpu::cuda::Tracing::Marched,
+        };
         let loaded = cuda
-            .load(&ptx, wgsl::ENTRY_POINT, gpu::cuda::register_cap(marched))
+            .load(&ptx, wgsl::ENTRY_POINT, gpu::cuda::register_cap(tracing))
             .map_err(|e| Error::Kernel(e.to_string()))?;
         Ok(CudaModule {
             interpreted: kernel.interpreted(),

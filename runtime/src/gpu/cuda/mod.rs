@@ -287,13 +287,32 @@ impl Cuda {
 /// own count does not say which kernels gain, so the cap is one constant.
 pub const MARCHED_REGISTERS: u32 = 72;
 
-/// The register cap for the JIT of a kernel that sphere traces (`marched`) or traces
-/// analytically: `$SDFC_CUDA_MAX_REGISTERS` when set (0: the JIT's choice), else
-/// [`MARCHED_REGISTERS`] for a marched kernel and the JIT's choice for the other.
-pub fn register_cap(marched: bool) -> Option<u32> {
+/// The register cap of a path-traced kernel that sphere traces: its bounces' loop keeps
+/// little alive across the march, and of the caps tried on it 56 was the fastest.
+pub const PATH_REGISTERS: u32 = 56;
+
+/// How a kernel finds its surfaces, as far as its register cap goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tracing {
+    /// Sphere traced, Whitted shading.
+    Marched,
+    /// Sphere traced, path traced.
+    MarchedPaths,
+    /// Traced analytically.
+    Analytic,
+}
+
+/// The register cap for the JIT of a kernel traced as `tracing`:
+/// `$SDFC_CUDA_MAX_REGISTERS` when set (0: the JIT's choice), else [`MARCHED_REGISTERS`] or
+/// [`PATH_REGISTERS`] for a marched kernel and the JIT's choice for the other.
+pub fn register_cap(tracing: Tracing) -> Option<u32> {
     match std::env::var("SDFC_CUDA_MAX_REGISTERS") {
         Ok(v) => v.trim().parse().ok().filter(|&n| n > 0),
-        Err(_) => marched.then_some(MARCHED_REGISTERS),
+        Err(_) => match tracing {
+            Tracing::Marched => Some(MARCHED_REGISTERS),
+            Tracing::MarchedPaths => Some(PATH_REGISTERS),
+            Tracing::Analytic => None,
+        },
     }
 }
 

@@ -712,6 +712,9 @@ fn a_profile_is_called_a_profile() {
     );
 }
 
+mod hulls;
 mod language;
 mod limits;
+mod looks;
+mod params;
 mod sweeps;

@@ -9,6 +9,7 @@ use crate::front::check_str;
 use crate::lower::{lower, lower_with, LowerOptions};
 use crate::program::Program;
 use crate::rng::Rng;
+use crate::scene::V3;
 
 fn scene(objects: &str) -> (Scene, Vec<Diagnostic>) {
     let text = format!("scene {{ {objects}; }}");

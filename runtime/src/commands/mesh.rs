@@ -484,18 +484,7 @@ fn surface_on(
     let lowered = checked
         .lower(&LowerOptions::default(), limits)
         .map_err(|_| (1, String::new()))?;
-    let field = Field::new(&lowered.program, proven, clip);
-    let field = match settings.backend {
-        Backend::Cpu | Backend::Auto => field,
-        backend => {
-            let gpu = Gpu::open(backend, &checked.scene, &lowered, &clip)
-                .map_err(|e| (1, e.to_string()))?;
-            // Once a process: the parts of a 3MF and a finer mesh share the device.
-            static SAID: std::sync::Once = std::sync::Once::new();
-            SAID.call_once(|| say(format!("mesh: evaluating on {}: {}", gpu.name, gpu.device)));
-            field.on(gpu)
-        }
-    };
+    let field = field_on(checked, &lowered, (proven, clip), settings, say)?;
     if !proven {
         say(format!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
@@ -613,6 +602,28 @@ fn surface_on(
         stats,
         grid,
         seconds,
+    })
+}
+
+/// The field of `lowered` over `clip`, evaluated by the CPU or the GPU `settings` name.
+fn field_on(
+    checked: &frontend::Checked,
+    lowered: &sdfc_compiler::Lowered,
+    (proven, clip): (bool, [[f64; 3]; 2]),
+    settings: &Settings,
+    say: &(dyn Fn(String) + Sync),
+) -> Result<Field, (u8, String)> {
+    let field = Field::new(&lowered.program, proven, clip);
+    Ok(match settings.backend {
+        Backend::Cpu | Backend::Auto => field,
+        backend => {
+            let gpu = Gpu::open(backend, &checked.scene, lowered, &clip)
+                .map_err(|e| (1, e.to_string()))?;
+            // Once a process: the parts of a 3MF and a finer mesh share the device.
+            static SAID: std::sync::Once = std::sync::Once::new();
+            SAID.call_once(|| say(format!("mesh: evaluating on {}: {}", gpu.name, gpu.device)));
+            field.on(gpu)
+        }
     })
 }
 

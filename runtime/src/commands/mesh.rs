@@ -265,15 +265,7 @@ fn objects(
         };
         let progress =
             |stage: &'static str, f: f64| (how.progress)(stage, (k as f64 + f) / n as f64);
-        let coarse = surface_on(
-            &one,
-            within,
-            how.settings,
-            how.limits,
-            how.pool,
-            &progress,
-            how.say,
-        )?;
+        let coarse = how.surface_on(&one, within, &progress)?;
         let thin = Thinness::new(&one, within, coarse.grid.voxel);
         let asked = finer(
             &thin,
@@ -291,41 +283,7 @@ fn objects(
         meshed.push((name, part.material, one, thin, coarse));
     }
     if let Some(fine) = fine {
-        let mut again = Vec::new();
-        for (k, (name, _, one, _, _)) in meshed.iter().enumerate() {
-            (how.say)(format!("mesh: part {} again, material `{name}`", k + 1));
-            let progress = |stage: &'static str, f: f64| {
-                (how.progress)(stage, (k as f64 + f) / meshed.len() as f64)
-            };
-            match surface_on(
-                one,
-                fine,
-                how.settings,
-                how.limits,
-                how.pool,
-                &progress,
-                how.say,
-            ) {
-                Ok(m) => again.push(m),
-                Err((_, why)) => {
-                    for (_, _, _, thin, coarse) in &meshed {
-                        thin.refused(&coarse.stats, &why, how.say);
-                    }
-                    again.clear();
-                    break;
-                }
-            }
-        }
-        if again.len() == meshed.len() {
-            meshed = meshed
-                .into_iter()
-                .zip(again)
-                .map(|((name, material, one, thin, coarse), m)| {
-                    let m = refined(&thin, coarse, m, how.say);
-                    (name, material, one, thin, m)
-                })
-                .collect();
-        }
+        meshed = again(meshed, fine, how);
     }
     let (mut objects, mut triangles, mut vertices, mut seconds) = (0, 0, 0, 0.0);
     for (name, material, _, _, meshed) in meshed {
@@ -369,6 +327,57 @@ fn objects(
         "wrote {out} ({objects} objects, {triangles} triangles, {vertices} vertices, {seconds:.3} s)"
     );
     Ok(())
+}
+
+/// A part of a 3MF meshed: its material's name and id, scene, thinness and mesh.
+type Part = (String, u32, frontend::Checked, Thinness, Meshed);
+
+impl Meshing<'_> {
+    /// [`surface_on`] of `checked` over `region`, its progress told to `progress`.
+    fn surface_on(
+        &self,
+        checked: &frontend::Checked,
+        region: Region,
+        progress: &(dyn Fn(&'static str, f64) + Sync),
+    ) -> Result<Meshed, (u8, String)> {
+        surface_on(
+            checked,
+            region,
+            self.settings,
+            self.limits,
+            self.pool,
+            progress,
+            self.say,
+        )
+    }
+}
+
+/// The parts meshed again on `fine`; where one cannot be, every part as it was, saying why.
+fn again(meshed: Vec<Part>, fine: Region, how: &Meshing) -> Vec<Part> {
+    let mut again = Vec::new();
+    for (k, (name, _, one, _, _)) in meshed.iter().enumerate() {
+        (how.say)(format!("mesh: part {} again, material `{name}`", k + 1));
+        let progress = |stage: &'static str, f: f64| {
+            (how.progress)(stage, (k as f64 + f) / meshed.len() as f64)
+        };
+        match how.surface_on(one, fine, &progress) {
+            Ok(m) => again.push(m),
+            Err((_, why)) => {
+                for (_, _, _, thin, coarse) in &meshed {
+                    thin.refused(&coarse.stats, &why, how.say);
+                }
+                return meshed;
+            }
+        }
+    }
+    meshed
+        .into_iter()
+        .zip(again)
+        .map(|((name, material, one, thin, coarse), m)| {
+            let m = refined(&thin, coarse, m, how.say);
+            (name, material, one, thin, m)
+        })
+        .collect()
 }
 
 /// A surface meshed by [`surface`]: the mesh in the scene's coordinates, its grid, what
@@ -475,18 +484,7 @@ fn surface_on(
     let lowered = checked
         .lower(&LowerOptions::default(), limits)
         .map_err(|_| (1, String::new()))?;
-    let field = Field::new(&lowered.program, proven, clip);
-    let field = match settings.backend {
-        Backend::Cpu | Backend::Auto => field,
-        backend => {
-            let gpu = Gpu::open(backend, &checked.scene, &lowered, &clip)
-                .map_err(|e| (1, e.to_string()))?;
-            // Once a process: the parts of a 3MF and a finer mesh share the device.
-            static SAID: std::sync::Once = std::sync::Once::new();
-            SAID.call_once(|| say(format!("mesh: evaluating on {}: {}", gpu.name, gpu.device)));
-            field.on(gpu)
-        }
-    };
+    let field = field_on(checked, &lowered, (proven, clip), settings, say)?;
     if !proven {
         say(format!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
@@ -604,6 +602,28 @@ fn surface_on(
         stats,
         grid,
         seconds,
+    })
+}
+
+/// The field of `lowered` over `clip`, evaluated by the CPU or the GPU `settings` name.
+fn field_on(
+    checked: &frontend::Checked,
+    lowered: &sdfc_compiler::Lowered,
+    (proven, clip): (bool, [[f64; 3]; 2]),
+    settings: &Settings,
+    say: &(dyn Fn(String) + Sync),
+) -> Result<Field, (u8, String)> {
+    let field = Field::new(&lowered.program, proven, clip);
+    Ok(match settings.backend {
+        Backend::Cpu | Backend::Auto => field,
+        backend => {
+            let gpu = Gpu::open(backend, &checked.scene, lowered, &clip)
+                .map_err(|e| (1, e.to_string()))?;
+            // Once a process: the parts of a 3MF and a finer mesh share the device.
+            static SAID: std::sync::Once = std::sync::Once::new();
+            SAID.call_once(|| say(format!("mesh: evaluating on {}: {}", gpu.name, gpu.device)));
+            field.on(gpu)
+        }
     })
 }
 

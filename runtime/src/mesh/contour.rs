@@ -79,94 +79,18 @@ pub fn contour(
         candidates: candidates.len() as u64,
         ..Stats::default()
     };
-    // Corner values, and the closure: each crossed edge's four cells. A point whose value
-    // was asked for holds -∞ until it comes (the field never gives -∞: see `Field`).
-    let held = candidates.len() as u64;
-    let mut values: Bricks<f64> = Bricks::over(f64::NAN, grid, held);
-    let mut set: Bricks<bool> = Bricks::over(false, grid, held);
-    for &c in &candidates {
-        set.set(unpack(c), true);
-    }
-    let mut held = held;
-    let mut pending = candidates;
-    let mut surface: Vec<(u64, u8)> = Vec::new();
-    let mut first = true;
-    while !pending.is_empty() {
-        if held > max_cells {
-            return Err(Stop::Cells(held));
-        }
-        let mut need: Vec<[u32; 3]> = Vec::new();
-        let mut places = Vec::new();
-        for &c in &pending {
-            let i = unpack(c);
-            for k in 0..8 {
-                let p = add(i, corner(k));
-                if let Some(at) = values.replace_if(p, f64::is_nan, f64::NEG_INFINITY) {
-                    need.push(p);
-                    places.push(at);
-                }
-            }
-        }
-        let points: Vec<[f64; 3]> = need.par_iter().map(|&i| grid.point(i)).collect();
-        drop(need);
-        let d = field.distances(&points);
-        for (at, v) in places.into_iter().zip(d) {
-            values.put(at, v);
-        }
-        if first {
-            // Walls and gaps between the candidates' corners that no corner sees.
-            stats.thin = thin::missed(field, grid, &values, &pending);
-        }
-        let mut missing = Vec::new();
-        let configs: Vec<u8> = pending
-            .par_iter()
-            .map(|&c| configuration(&values, c))
-            .collect();
-        for (&c, &config) in pending.iter().zip(&configs) {
-            if config == 0 || config == 255 {
-                continue;
-            }
-            surface.push((c, config));
-            let i = unpack(c);
-            for (e, &(a, b)) in EDGES.iter().enumerate() {
-                if (config >> a & 1) == (config >> b & 1) {
-                    continue;
-                }
-                let lower = add(i, corner(a));
-                for n in edge_cells(lower, e / 4) {
-                    if set.replace_if(n, |held| !held, true).is_some() {
-                        held += 1;
-                        missing.push(pack(n));
-                    }
-                }
-            }
-        }
-        if !first {
-            stats.added += pending.len() as u64;
-        }
-        first = false;
-        pending = missing;
-    }
-    drop(set);
+    let Closure {
+        values,
+        mut surface,
+        ..
+    } = closure(field, grid, candidates, max_cells, &mut stats)?;
     progress(0.2);
     surface.par_sort_unstable();
     stats.surface_cells = surface.len() as u64;
     surface_cells(stats.surface_cells).map_err(Stop::Refused)?;
 
     // Edge vertices: each crossed edge is owned by the cell at its lower end.
-    let mut edges: Vec<u64> = Vec::new();
-    let mut index: Bricks<[u32; 3]> = Bricks::over([u32::MAX; 3], grid, stats.candidates);
-    for &(c, config) in &surface {
-        let mut ids = [u32::MAX; 3];
-        for (axis, id) in ids.iter_mut().enumerate() {
-            let (a, b) = EDGES[axis * 4];
-            if (config >> a & 1) != (config >> b & 1) {
-                *id = edges.len() as u32;
-                edges.push(c << 2 | axis as u64);
-            }
-        }
-        index.set(unpack(c), ids);
-    }
+    let (index, edges) = edge_index(grid, &surface, stats.candidates);
     let crossings = roots(field, grid, &values, &edges, settings.refine);
     progress(0.5);
     let h = GRADIENT_STEP * grid.voxel;
@@ -174,86 +98,16 @@ pub fn contour(
     let normals: Vec<[f64; 3]> = gradients.iter().map(|g| normalise(*g)).collect();
     progress(0.6);
 
-    // Patches: (cell, first index into `ring`, length).
-    let mut patch_cells = Vec::new();
-    let mut ring: Vec<u32> = Vec::new();
-    let mut starts = vec![0usize];
-    for &(c, config) in &surface {
-        let i = unpack(c);
-        for cycle in patches(config) {
-            for &e in cycle {
-                let (a, _) = EDGES[e as usize];
-                let id = index.get(add(i, corner(a)))[e as usize / 4];
-                ring.push(if id == u32::MAX { 0 } else { id });
-            }
-            patch_cells.push(i);
-            starts.push(ring.len());
-        }
-    }
-    let patch_count = patch_cells.len();
-    let inner: Vec<Placed> = (0..patch_count)
-        .into_par_iter()
-        .map(|p| {
-            let ids = &ring[starts[p]..starts[p + 1]];
-            let mut pts = [[0.0; 3]; 12];
-            let mut nrm = [[0.0; 3]; 12];
-            let n = ids.len().min(12);
-            for (k, &v) in ids.iter().take(n).enumerate() {
-                pts[k] = crossings[v as usize];
-                nrm[k] = normals[v as usize];
-            }
-            let lo = grid.point(patch_cells[p]).map(|x| x + MARGIN * grid.voxel);
-            let hi = lo.map(|x| x + (1.0 - 2.0 * MARGIN) * grid.voxel);
-            place(&pts[..n], &nrm[..n], settings.sharp, [lo, hi])
-        })
-        .collect();
-    let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.point).collect();
-    let smooth: Vec<bool> = inner.iter().map(|c| c.smooth).collect();
-    choose(field, grid.voxel, &inner, &mut centres);
-    stats.features = smooth.iter().filter(|s| !**s).count() as u64;
-    // Smooth patches: the centroid moved along the patch's mean normal to where the field
-    // is zero (Newton's steps for a field of unit gradient along the normal).
-    let round: Vec<usize> = (0..patch_count).filter(|&p| smooth[p]).collect();
-    let mean: Vec<[f64; 3]> = round
-        .iter()
-        .map(|&p| {
-            let ids = &ring[starts[p]..starts[p + 1]];
-            normalise([0, 1, 2].map(|i| ids.iter().map(|&v| normals[v as usize][i]).sum::<f64>()))
-        })
-        .collect();
-    for _ in 0..2 {
-        let pts: Vec<[f64; 3]> = round.iter().map(|&p| centres[p]).collect();
-        let d = field.distances(&pts);
-        for (k, &p) in round.iter().enumerate() {
-            if d[k].is_finite() && d[k].abs() < grid.voxel {
-                centres[p] = [0, 1, 2].map(|i| centres[p][i] - d[k] * mean[k][i]);
-            }
-        }
-    }
-    for p in 0..patch_count {
-        centres[p] = inside_cell(grid, patch_cells[p], centres[p]);
-    }
-    let patches = Patches {
-        cells: &patch_cells,
-        ring: &ring,
-        starts: &starts,
+    let rings = Rings::new(&surface, &index);
+    let edge = Edges {
         crossings: &crossings,
+        normals: &normals,
     };
-    stats.projected = onto_surface(field, grid, &patches, &mut centres);
-    separate(grid, &patch_cells, &mut centres, &ring, &starts, &crossings);
+    let (centres, smooth) = inner_vertices(field, grid, settings, &rings, edge, &mut stats);
     progress(0.75);
 
-    // Fans.
     let base = crossings.len() as u32;
-    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(ring.len());
-    let mut owner: Vec<u32> = Vec::with_capacity(ring.len());
-    for p in 0..patch_count {
-        let ids = &ring[starts[p]..starts[p + 1]];
-        for k in 0..ids.len() {
-            triangles.push([base + p as u32, ids[k], ids[(k + 1) % ids.len()]]);
-            owner.push(p as u32);
-        }
-    }
+    let (mut triangles, owner) = rings.fans(base);
     let mut positions = crossings;
     positions.extend_from_slice(&centres);
     if settings.sharp {
@@ -287,6 +141,279 @@ pub fn contour(
         },
         stats,
     ))
+}
+
+/// The cells contouring holds while it closes over the crossed edges: their corner values,
+/// which of them are held, how many, and those the surface crosses.
+struct Closure {
+    /// Corner values. A point whose value was asked for holds -∞ until it comes (the field
+    /// never gives -∞: see `Field`).
+    values: Bricks<f64>,
+    /// Whether a cell is held.
+    set: Bricks<bool>,
+    /// The cells held.
+    held: u64,
+    /// The surface cells and their configurations, in the order found.
+    surface: Vec<(u64, u8)>,
+}
+
+/// The corner values of `candidates` and the closure (each crossed edge's four cells), and
+/// the surface cells among them; `Stop::Cells` once more than `max_cells` are held.
+fn closure(
+    field: &Field,
+    grid: &Grid,
+    candidates: Vec<u64>,
+    max_cells: u64,
+    stats: &mut Stats,
+) -> Result<Closure, Stop> {
+    let held = candidates.len() as u64;
+    let mut closure = Closure {
+        values: Bricks::over(f64::NAN, grid, held),
+        set: Bricks::over(false, grid, held),
+        held,
+        surface: Vec::new(),
+    };
+    for &c in &candidates {
+        closure.set.set(unpack(c), true);
+    }
+    let mut pending = candidates;
+    let mut first = true;
+    while !pending.is_empty() {
+        if closure.held > max_cells {
+            return Err(Stop::Cells(closure.held));
+        }
+        closure.evaluate(field, grid, &pending);
+        if first {
+            // Walls and gaps between the candidates' corners that no corner sees.
+            stats.thin = thin::missed(field, grid, &closure.values, &pending);
+        }
+        let missing = closure.cross(&pending);
+        if !first {
+            stats.added += pending.len() as u64;
+        }
+        first = false;
+        pending = missing;
+    }
+    Ok(closure)
+}
+
+impl Closure {
+    /// The values at the corners of `pending` not asked for yet.
+    fn evaluate(&mut self, field: &Field, grid: &Grid, pending: &[u64]) {
+        let mut need: Vec<[u32; 3]> = Vec::new();
+        let mut places = Vec::new();
+        for &c in pending {
+            let i = unpack(c);
+            for k in 0..8 {
+                let p = add(i, corner(k));
+                if let Some(at) = self.values.replace_if(p, f64::is_nan, f64::NEG_INFINITY) {
+                    need.push(p);
+                    places.push(at);
+                }
+            }
+        }
+        let points: Vec<[f64; 3]> = need.par_iter().map(|&i| grid.point(i)).collect();
+        drop(need);
+        let d = field.distances(&points);
+        for (at, v) in places.into_iter().zip(d) {
+            self.values.put(at, v);
+        }
+    }
+
+    /// The surface cells of `pending` kept; returns the cells around their crossed edges
+    /// not held yet, now held.
+    fn cross(&mut self, pending: &[u64]) -> Vec<u64> {
+        let mut missing = Vec::new();
+        let configs: Vec<u8> = pending
+            .par_iter()
+            .map(|&c| configuration(&self.values, c))
+            .collect();
+        for (&c, &config) in pending.iter().zip(&configs) {
+            if config == 0 || config == 255 {
+                continue;
+            }
+            self.surface.push((c, config));
+            let i = unpack(c);
+            for (e, &(a, b)) in EDGES.iter().enumerate() {
+                if (config >> a & 1) == (config >> b & 1) {
+                    continue;
+                }
+                let lower = add(i, corner(a));
+                for n in edge_cells(lower, e / 4) {
+                    if self.set.replace_if(n, |held| !held, true).is_some() {
+                        self.held += 1;
+                        missing.push(pack(n));
+                    }
+                }
+            }
+        }
+        missing
+    }
+}
+
+/// The crossed edges each surface cell owns (those from its lower corner): for each cell, its
+/// edges' indices by axis (`u32::MAX` where not crossed), and each edge's key (the cell's key
+/// and the axis); `held` sizes the bricks.
+fn edge_index(grid: &Grid, surface: &[(u64, u8)], held: u64) -> (Bricks<[u32; 3]>, Vec<u64>) {
+    let mut edges: Vec<u64> = Vec::new();
+    let mut index: Bricks<[u32; 3]> = Bricks::over([u32::MAX; 3], grid, held);
+    for &(c, config) in surface {
+        let mut ids = [u32::MAX; 3];
+        for (axis, id) in ids.iter_mut().enumerate() {
+            let (a, b) = EDGES[axis * 4];
+            if (config >> a & 1) != (config >> b & 1) {
+                *id = edges.len() as u32;
+                edges.push(c << 2 | axis as u64);
+            }
+        }
+        index.set(unpack(c), ids);
+    }
+    (index, edges)
+}
+
+/// The edge vertices: their positions and unit normals.
+#[derive(Clone, Copy)]
+struct Edges<'a> {
+    crossings: &'a [[f64; 3]],
+    normals: &'a [[f64; 3]],
+}
+
+/// The patches: each one's cell and its ring of edge vertices.
+struct Rings {
+    /// Each patch's cell.
+    cells: Vec<[u32; 3]>,
+    /// The edge vertices of the patches' rings, one after another.
+    ring: Vec<u32>,
+    /// Where each patch's ring starts in `ring` (and, last, its end).
+    starts: Vec<usize>,
+}
+
+impl Rings {
+    /// The patches of the `surface` cells (`table`), their edge vertices found in `index`.
+    fn new(surface: &[(u64, u8)], index: &Bricks<[u32; 3]>) -> Rings {
+        let mut cells = Vec::new();
+        let mut ring: Vec<u32> = Vec::new();
+        let mut starts = vec![0usize];
+        for &(c, config) in surface {
+            let i = unpack(c);
+            for cycle in patches(config) {
+                for &e in cycle {
+                    let (a, _) = EDGES[e as usize];
+                    let id = index.get(add(i, corner(a)))[e as usize / 4];
+                    ring.push(if id == u32::MAX { 0 } else { id });
+                }
+                cells.push(i);
+                starts.push(ring.len());
+            }
+        }
+        Rings {
+            cells,
+            ring,
+            starts,
+        }
+    }
+
+    /// Patch `p`'s ring.
+    fn of(&self, p: usize) -> &[u32] {
+        &self.ring[self.starts[p]..self.starts[p + 1]]
+    }
+
+    /// Each patch fanned around its inner vertex (vertex `base + p` for patch `p`): the
+    /// triangles and each one's patch.
+    fn fans(&self, base: u32) -> (Vec<[u32; 3]>, Vec<u32>) {
+        let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(self.ring.len());
+        let mut owner: Vec<u32> = Vec::with_capacity(self.ring.len());
+        for p in 0..self.cells.len() {
+            let ids = self.of(p);
+            for k in 0..ids.len() {
+                triangles.push([base + p as u32, ids[k], ids[(k + 1) % ids.len()]]);
+                owner.push(p as u32);
+            }
+        }
+        (triangles, owner)
+    }
+}
+
+/// Each patch's inner vertex (`place`, `choose`; smooth ones moved onto the surface; all kept
+/// inside their cell, projected and separated), and whether its patch is smooth.
+fn inner_vertices(
+    field: &Field,
+    grid: &Grid,
+    settings: &Settings,
+    rings: &Rings,
+    edge: Edges,
+    stats: &mut Stats,
+) -> (Vec<[f64; 3]>, Vec<bool>) {
+    let patch_count = rings.cells.len();
+    let inner: Vec<Placed> = (0..patch_count)
+        .into_par_iter()
+        .map(|p| {
+            let ids = rings.of(p);
+            let mut pts = [[0.0; 3]; 12];
+            let mut nrm = [[0.0; 3]; 12];
+            let n = ids.len().min(12);
+            for (k, &v) in ids.iter().take(n).enumerate() {
+                pts[k] = edge.crossings[v as usize];
+                nrm[k] = edge.normals[v as usize];
+            }
+            let lo = grid.point(rings.cells[p]).map(|x| x + MARGIN * grid.voxel);
+            let hi = lo.map(|x| x + (1.0 - 2.0 * MARGIN) * grid.voxel);
+            place(&pts[..n], &nrm[..n], settings.sharp, [lo, hi])
+        })
+        .collect();
+    let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.point).collect();
+    let smooth: Vec<bool> = inner.iter().map(|c| c.smooth).collect();
+    choose(field, grid.voxel, &inner, &mut centres);
+    stats.features = smooth.iter().filter(|s| !**s).count() as u64;
+    onto_zero(field, grid, rings, edge.normals, &smooth, &mut centres);
+    for (centre, &cell) in centres.iter_mut().zip(&rings.cells) {
+        *centre = inside_cell(grid, cell, *centre);
+    }
+    let patches = Patches {
+        cells: &rings.cells,
+        ring: &rings.ring,
+        starts: &rings.starts,
+        crossings: edge.crossings,
+    };
+    stats.projected = onto_surface(field, grid, &patches, &mut centres);
+    separate(
+        grid,
+        &rings.cells,
+        &mut centres,
+        &rings.ring,
+        &rings.starts,
+        edge.crossings,
+    );
+    (centres, smooth)
+}
+
+/// Smooth patches: the centroid moved along the patch's mean normal to where the field is
+/// zero (Newton's steps for a field of unit gradient along the normal).
+fn onto_zero(
+    field: &Field,
+    grid: &Grid,
+    rings: &Rings,
+    normals: &[[f64; 3]],
+    smooth: &[bool],
+    centres: &mut [[f64; 3]],
+) {
+    let round: Vec<usize> = (0..rings.cells.len()).filter(|&p| smooth[p]).collect();
+    let mean: Vec<[f64; 3]> = round
+        .iter()
+        .map(|&p| {
+            let ids = rings.of(p);
+            normalise([0, 1, 2].map(|i| ids.iter().map(|&v| normals[v as usize][i]).sum::<f64>()))
+        })
+        .collect();
+    for _ in 0..2 {
+        let pts: Vec<[f64; 3]> = round.iter().map(|&p| centres[p]).collect();
+        let d = field.distances(&pts);
+        for (k, &p) in round.iter().enumerate() {
+            if d[k].is_finite() && d[k].abs() < grid.voxel {
+                centres[p] = [0, 1, 2].map(|i| centres[p][i] - d[k] * mean[k][i]);
+            }
+        }
+    }
 }
 
 fn add(a: [u32; 3], b: [u32; 3]) -> [u32; 3] {

@@ -285,11 +285,7 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
         let o = sdfc(&["compile", file, "--emit", emit, "-o", &at(out)]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
-    let wgsl = std::fs::read_to_string(dir.join("k.wgsl")).expect("kernel");
-    let params = std::fs::read(dir.join("params.bin")).expect("params");
-    let layout: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("layout.json")).expect("layout"))
-            .expect("json");
+    let (wgsl, params, layout) = emitted(&dir);
     let bindings = layout["bindings"].as_array().expect("bindings");
     let p = &bindings[0];
     assert_eq!(
@@ -323,100 +319,18 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
                 return;
             }
         };
-    let (device, queue) =
-        pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
-            .expect("device");
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("sdfc kernel"),
-        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: None,
-        layout: None,
-        module: &module,
+    let kernel = Kernel {
+        wgsl,
         entry_point: layout["entry_point"].as_str(),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    use wgpu::BufferUsages as U;
-    let buffer = |size: u64, usage: U| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size,
-            usage,
-            mapped_at_creation: false,
-        })
+        params: &params,
+        size: (width, height),
+        group,
     };
-    let pixels = (width * height) as u64;
-    let params_buf = buffer(params.len() as u64, U::UNIFORM | U::COPY_DST);
-    queue.write_buffer(&params_buf, 0, &params);
-    let tile: Vec<u8> = [0, 0, width, height]
-        .iter()
-        .flat_map(|w: &u32| w.to_le_bytes())
-        .collect();
-    let tile_buf = buffer(16, U::UNIFORM | U::COPY_DST);
-    queue.write_buffer(&tile_buf, 0, &tile);
-    let image = buffer(pixels * 16, U::STORAGE | U::COPY_SRC);
-    let stats = buffer(pixels * 4 * 8, U::STORAGE);
-    let finished = buffer(pixels * 4, U::STORAGE | U::COPY_SRC);
-    let readback = buffer(pixels * 16, U::MAP_READ | U::COPY_DST);
-    let readback8 = buffer(pixels * 4, U::MAP_READ | U::COPY_DST);
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params_buf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: tile_buf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: image.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: stats.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 5,
-                resource: finished.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(width.div_ceil(group), height.div_ceil(group), 1);
-    }
-    enc.copy_buffer_to_buffer(&image, 0, &readback, 0, pixels * 16);
-    enc.copy_buffer_to_buffer(&finished, 0, &readback8, 0, pixels * 4);
-    queue.submit([enc.finish()]);
-    let slice = readback.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
-    let slice8 = readback8.slice(..);
-    slice8.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .expect("poll");
-    let bytes = slice.get_mapped_range().expect("mapped").to_vec();
-    let rgba8 = slice8.get_mapped_range().expect("mapped").to_vec();
-    let linear: Vec<[f32; 3]> = bytes
-        .chunks_exact(16)
-        .map(|c| {
-            let f = |k: usize| f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().expect("4"));
-            [f(0), f(1), f(2)]
-        })
-        .collect();
+    let (bytes, rgba8) = kernel.dispatch(&adapter);
     let ours = sdfc_runtime::image::Image {
         width,
         height,
-        linear,
+        linear: linear(&bytes),
     };
 
     let o = sdfc(&["render", file, "--backend", "wgpu", "-o", &at("ref.png")]);
@@ -435,6 +349,130 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
     let distinct: std::collections::BTreeSet<&[u8]> = a.chunks(4).collect();
     assert!(distinct.len() > 20, "{} colours", distinct.len());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The kernel's text, the parameters' bytes and the layout `--emit` wrote into `dir`.
+fn emitted(dir: &Path) -> (String, Vec<u8>, serde_json::Value) {
+    let wgsl = std::fs::read_to_string(dir.join("k.wgsl")).expect("kernel");
+    let params = std::fs::read(dir.join("params.bin")).expect("params");
+    let layout: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("layout.json")).expect("layout"))
+            .expect("json");
+    (wgsl, params, layout)
+}
+
+/// The kernel as a user's program holds it: text, entry point, params, image and workgroup.
+struct Kernel<'a> {
+    wgsl: String,
+    entry_point: Option<&'a str>,
+    params: &'a [u8],
+    size: (u32, u32),
+    group: u32,
+}
+
+impl Kernel<'_> {
+    /// The kernel dispatched once over the image on `adapter`'s device, bound as the layout
+    /// says: the image read back (four f32 a pixel) and the finished pixels (RGBA8).
+    fn dispatch(self, adapter: &wgpu::Adapter) -> (Vec<u8>, Vec<u8>) {
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
+                .expect("device");
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("sdfc kernel"),
+            source: wgpu::ShaderSource::Wgsl(self.wgsl.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: None,
+            layout: None,
+            module: &module,
+            entry_point: self.entry_point,
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        use wgpu::BufferUsages as U;
+        let buffer = |size: u64, usage: U| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let (width, height) = self.size;
+        let pixels = (width * height) as u64;
+        let params_buf = buffer(self.params.len() as u64, U::UNIFORM | U::COPY_DST);
+        queue.write_buffer(&params_buf, 0, self.params);
+        let tile: Vec<u8> = [0, 0, width, height]
+            .iter()
+            .flat_map(|w: &u32| w.to_le_bytes())
+            .collect();
+        let tile_buf = buffer(16, U::UNIFORM | U::COPY_DST);
+        queue.write_buffer(&tile_buf, 0, &tile);
+        let image = buffer(pixels * 16, U::STORAGE | U::COPY_SRC);
+        let stats = buffer(pixels * 4 * 8, U::STORAGE);
+        let finished = buffer(pixels * 4, U::STORAGE | U::COPY_SRC);
+        let readback = buffer(pixels * 16, U::MAP_READ | U::COPY_DST);
+        let readback8 = buffer(pixels * 4, U::MAP_READ | U::COPY_DST);
+        let bound = [&params_buf, &tile_buf, &image, &stats, &finished];
+        let bind = bind_group(&device, &pipeline, bound);
+        let mut enc = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            let group = self.group;
+            pass.dispatch_workgroups(width.div_ceil(group), height.div_ceil(group), 1);
+        }
+        enc.copy_buffer_to_buffer(&image, 0, &readback, 0, pixels * 16);
+        enc.copy_buffer_to_buffer(&finished, 0, &readback8, 0, pixels * 4);
+        queue.submit([enc.finish()]);
+        let slice = readback.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
+        let slice8 = readback8.slice(..);
+        slice8.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+        let bytes = slice.get_mapped_range().expect("mapped").to_vec();
+        let rgba8 = slice8.get_mapped_range().expect("mapped").to_vec();
+        (bytes, rgba8)
+    }
+}
+
+/// Group 0's bindings 0, 1, 2, 3, 5: params, tile, image, stats and finished pixels.
+fn bind_group(
+    device: &wgpu::Device,
+    pipeline: &wgpu::ComputePipeline,
+    [params, tile, image, stats, finished]: [&wgpu::Buffer; 5],
+) -> wgpu::BindGroup {
+    fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+        wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        }
+    }
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            entry(0, params),
+            entry(1, tile),
+            entry(2, image),
+            entry(3, stats),
+            entry(5, finished),
+        ],
+    })
+}
+
+/// The image's linear colours from the kernel's bytes (four f32 a pixel, the fourth unused).
+fn linear(bytes: &[u8]) -> Vec<[f32; 3]> {
+    bytes
+        .chunks_exact(16)
+        .map(|c| {
+            let f = |k: usize| f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().expect("4"));
+            [f(0), f(1), f(2)]
+        })
+        .collect()
 }
 
 /// `--emit scene-data` writes the storage buffer the kernel of a large scene reads, the bytes

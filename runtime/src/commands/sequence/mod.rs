@@ -5,13 +5,13 @@
 //! the previous frame's; camera, lights, materials and settings are read at every render.
 //! Where the frames go is `sink.rs`'s.
 
-use crate::backend::Setup;
+use crate::backend::{Backend, Device, Devices, Setup};
 use crate::frontend::Source;
 use crate::gpu::launch::{Faults, Queue};
 use crate::image::{Picture, PngLevel};
 use crate::job::{self, Error, FrameScene, Job, Kernels};
 use crate::output::{Output, Submit, Task, Writers, Written};
-use crate::sequence::{Frames, Target};
+use crate::sequence::{Frames, Shard, Target};
 use crate::tally::Tally;
 use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{Animation, LowerOptions};
@@ -61,27 +61,12 @@ pub fn run(
     let lowering = LowerOptions::parametric();
     let first = job.frame(&mut source, 0.0, true, &lowering)?;
     let animation = first.scene.animation;
-    let fps = match args.fps {
-        Some(f) if f.is_finite() && (0.01..=1000.0).contains(&f) => f,
-        Some(f) => {
-            return Err(Error::Usage(format!(
-                "--fps must be a number from 0.01 to 1000, not {f}"
-            )))
-        }
-        None => animation.fps,
-    };
+    let animated = animation.animated();
+    let fps = fps(args, &animation)?;
     let frames = frame_range(args, &animation, limits)?;
     let shard = args.shard.unwrap_or_default();
     let path = output.map_or_else(|| default_pattern(file), Path::to_path_buf);
-    let target = Target::new(&path)?;
-    if shard.count > 1 && !matches!(target, Target::Numbered(..)) {
-        return Err(Error::Usage(
-            "--shard renders part of a sequence: its frames must go to numbered files (`-o out/frame_####.png`), not one animated PNG or video".into(),
-        ));
-    }
-    if let Target::Numbered(pattern, _) = &target {
-        create_directory(&pattern.path(frames.start))?;
-    }
+    let target = target(&path, shard, frames)?;
     let mut sink = Sink::open(&target, frames, fps)?;
     let (backend, _) = job.mode()?;
     job.check_kernel(backend)?;
@@ -93,28 +78,10 @@ pub fn run(
         finished: !matches!(&target, Target::Numbered(_, format) if format.linear()),
         ..job.setup()
     };
-    let mine: Vec<u64> = shard.frames(frames).collect();
-    let todo: Vec<u64> = mine
-        .iter()
-        .copied()
-        .filter(|&k| args.force || !sink.exists(k))
-        .collect();
-    let skipped = mine.len() - todo.len();
-    if !animation.animated() {
-        eprintln!("note: the scene does not read `t`: every frame is the same");
-    }
-    eprintln!(
-        "render: frames {}..{} at {fps} fps{}: {} to render, {skipped} already written",
-        frames.start,
-        frames.end,
-        if shard.count > 1 {
-            format!(", shard {}/{}", shard.index, shard.count)
-        } else {
-            String::new()
-        },
-        todo.len()
-    );
-    let bar = progress(mine.len() as u64, skipped as u64);
+    let (mine, todo) = todo(args, shard.frames(frames), &sink);
+    let skipped = mine - todo.len();
+    announce(animated, (frames, fps, shard), todo.len(), skipped);
+    let bar = progress(mine as u64, skipped as u64);
     let mut first = Some(first);
     let tally = Tally::default();
     let mut checker = Checker {
@@ -127,25 +94,9 @@ pub fn run(
         place: "main thread",
     };
     let started = Instant::now();
-    // Numbered files are encoded and written on a pool of threads while the next frames
-    // render; at most a gigabyte of frames waits for them.
-    let writers = match &sink {
-        Sink::Numbered(..) => {
-            let threads = Writers::cores();
-            let s = &first.as_ref().expect("the first frame").scene.settings;
-            let frame = (12 * s.width as u64 * s.height as u64).max(1);
-            let depth = (2 * threads as u64).min((1 << 30) / frame).max(1);
-            Some(Writers::new(threads, depth as usize, png_level))
-        }
-        _ => None,
-    };
-    // Several devices take whole frames from one queue; a scene that does not read `t` is
-    // rendered once, its one frame split among them.
-    let resolved = job.devices.resolve(backend);
-    let workers = match resolved.map_err(|e| Error::unavailable(backend, e.into()))? {
-        Some(list) if list.len() > 1 && animation.animated() => Some(list),
-        _ => None,
-    };
+    let writers = writers(&sink, &first, png_level);
+    let workers = workers(job, backend, animated)?;
+    let out = (&mut checker, &mut sink, writers.as_ref());
     let (count, device) = match workers {
         Some(list) => {
             let frames = FramesOn {
@@ -156,105 +107,21 @@ pub fn run(
                 limits,
                 tally: &tally,
             };
-            let writers = writers.as_ref();
-            frames.render(&list, &todo, &mut first, (&mut checker, &mut sink, writers))?
+            frames.render(&list, &todo, &mut first, out)?
         }
         None => {
-            let mut kernels = Kernels::new(&pool, (backend, job.devices.clone()), setup);
-            // The picture of a scene that does not read `t`, rendered once.
-            let mut still: Option<Picture> = None;
-            const HERE: &str = "device";
-            // The frames are checked on a thread of their own, a frame or two ahead of the
-            // device, which renders one while the next is checked.
-            checker.place = "checking thread";
-            let checker = &checker;
-            let first = &mut first;
-            std::thread::scope(|scope| -> Result<(), Error> {
-                let (tx, checked) = std::sync::mpsc::sync_channel(2);
-                let todo = &todo;
-                scope.spawn(move || {
-                    for &k in todo {
-                        let frame = checker.frame(k, first);
-                        let failed = frame.is_err();
-                        // The receiver is gone after an error of its own.
-                        if tx.send((k, frame)).is_err() || failed {
-                            return;
-                        }
-                    }
-                });
-                for (n, (k, frame)) in checked.iter().enumerate() {
-                    let frame = frame?;
-                    let frame_started = Instant::now();
-                    let picture = match &still {
-                        Some(picture) => picture.clone(),
-                        None => {
-                            let (scene, prepared) = kernels.prepare(frame)?;
-                            let memory = job::Use::IMAGE;
-                            job::check_memory(&pool, prepared, &scene, memory, limits, n == 0)?;
-                            tally.since(HERE, preparing(n == 0), frame_started);
-                            let rendered = Instant::now();
-                            let mut frame = pool.install(|| prepared.render(&scene, &|_| {}))?;
-                            match &frame.phases {
-                                Some(p) => tally.phases(HERE, p),
-                                None => tally.since(HERE, "render", rendered),
-                            }
-                            for w in frame.warnings() {
-                                eprintln!("warning: frame {k}: {w}");
-                            }
-                            let picture = frame.take_picture();
-                            if !animation.animated() {
-                                still = Some(picture.clone());
-                            }
-                            picture
-                        }
-                    };
-                    match (&writers, &sink) {
-                        (Some(w), Sink::Numbered(pattern, format)) => {
-                            let task = Task {
-                                k,
-                                output: Output::File {
-                                    path: pattern.path(k),
-                                    format: *format,
-                                },
-                                picture,
-                                started: frame_started,
-                            };
-                            let handing = Instant::now();
-                            w.submit(task).map_err(|e| Error::Encode(e.to_string()))?;
-                            tally.since(HERE, "handing to the writers", handing);
-                            for done in w.written() {
-                                report(done, checker, &sink)?;
-                            }
-                        }
-                        _ => {
-                            let writing = Instant::now();
-                            sink.write(k, &picture)?;
-                            // Its buffer takes the next frame's pixels.
-                            if let Picture::Finished(f) = picture {
-                                f.recycle();
-                            }
-                            tally.since(HERE, "writing", writing);
-                            checker.written(k, &sink, frame_started.elapsed().as_secs_f64());
-                        }
-                    }
-                }
-                Ok(())
-            })?;
-            let device = kernels
-                .last()
-                .map(|p| format!("{} on {}", p.name(), p.device()));
-            (kernels.count, device)
+            let frames = FramesHere {
+                pool: &pool,
+                kernels: (backend, job.devices.clone()),
+                setup,
+                limits,
+                tally: &tally,
+                animated,
+            };
+            frames.render(&todo, &mut first, out)?
         }
     };
-    if let Some(w) = writers {
-        for done in w.finish() {
-            report(done, &checker, &sink)?;
-        }
-    }
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
-    sink.finish()?;
+    checker.finish(writers, sink)?;
     let seconds = started.elapsed().as_secs_f64();
     if stats {
         eprintln!(
@@ -263,12 +130,90 @@ pub fn run(
             tally.report()
         );
     }
+    summary(todo.len(), &path, seconds, (count, device));
+    Ok(())
+}
+
+/// The frames per second: `--fps` (from 0.01 to 1000), or the scene's.
+fn fps(args: &SequenceArgs, animation: &Animation) -> Result<f64, Error> {
+    match args.fps {
+        Some(f) if f.is_finite() && (0.01..=1000.0).contains(&f) => Ok(f),
+        Some(f) => Err(Error::Usage(format!(
+            "--fps must be a number from 0.01 to 1000, not {f}"
+        ))),
+        None => Ok(animation.fps),
+    }
+}
+
+/// Where the frames go (numbered files for a shard), the directory of numbered files made.
+fn target(path: &Path, shard: Shard, frames: Frames) -> Result<Target, Error> {
+    let target = Target::new(path)?;
+    if shard.count > 1 && !matches!(target, Target::Numbered(..)) {
+        return Err(Error::Usage(
+            "--shard renders part of a sequence: its frames must go to numbered files (`-o out/frame_####.png`), not one animated PNG or video".into(),
+        ));
+    }
+    if let Target::Numbered(pattern, _) = &target {
+        create_directory(&pattern.path(frames.start))?;
+    }
+    Ok(target)
+}
+
+/// How many frames the shard has (`mine`), and those to render (all with `--force`).
+fn todo(args: &SequenceArgs, mine: impl Iterator<Item = u64>, sink: &Sink) -> (usize, Vec<u64>) {
+    let mine: Vec<u64> = mine.collect();
+    let todo = mine.iter().filter(|&&k| args.force || !sink.exists(k));
+    (mine.len(), todo.copied().collect())
+}
+
+/// Says which frames the sequence renders: `n` of them, `skipped` already written.
+fn announce(animated: bool, (frames, fps, shard): (Frames, f64, Shard), n: usize, skipped: usize) {
+    if !animated {
+        eprintln!("note: the scene does not read `t`: every frame is the same");
+    }
+    eprintln!(
+        "render: frames {}..{} at {fps} fps{}: {} to render, {skipped} already written",
+        frames.start,
+        frames.end,
+        if shard.count > 1 {
+            format!(", shard {}/{}", shard.index, shard.count)
+        } else {
+            String::new()
+        },
+        n
+    );
+}
+
+/// The threads that write numbered files while the next frames render (at most a gigabyte
+/// of frames waits for them).
+fn writers(sink: &Sink, first: &Option<FrameScene>, png_level: PngLevel) -> Option<Writers> {
+    match sink {
+        Sink::Numbered(..) => {
+            let threads = Writers::cores();
+            let s = &first.as_ref().expect("the first frame").scene.settings;
+            let frame = (12 * s.width as u64 * s.height as u64).max(1);
+            let depth = (2 * threads as u64).min((1 << 30) / frame).max(1);
+            Some(Writers::new(threads, depth as usize, png_level))
+        }
+        _ => None,
+    }
+}
+
+/// The devices that take whole frames from one queue: several, for a scene that reads `t`.
+fn workers(job: &Job, backend: Backend, animated: bool) -> Result<Option<Vec<Device>>, Error> {
+    let resolved = job.devices.resolve(backend);
+    let list = resolved.map_err(|e| Error::unavailable(backend, e.into()))?;
+    Ok(list.filter(|list| list.len() > 1 && animated))
+}
+
+/// The last line: `written` frames to `path` in `seconds`, `count` kernels on `device`.
+fn summary(written: usize, path: &Path, seconds: f64, (count, device): (usize, Option<String>)) {
     eprintln!(
         "wrote {} frame{} to {} in {seconds:.3} s ({:.2} frames/s); {} kernel{} prepared{}",
-        todo.len(),
-        if todo.len() == 1 { "" } else { "s" },
+        written,
+        if written == 1 { "" } else { "s" },
         path.display(),
-        todo.len() as f64 / seconds.max(1e-9),
+        written as f64 / seconds.max(1e-9),
         count,
         if count == 1 { "" } else { "s" },
         match device {
@@ -276,7 +221,130 @@ pub fn run(
             None => String::new(),
         }
     );
-    Ok(())
+}
+
+/// The tally's name of the device that renders the frames of [`FramesHere`].
+const HERE: &str = "device";
+
+/// The frames of a sequence on one device (or on devices splitting each frame), checked on
+/// a thread of their own a frame or two ahead; a scene that does not read `t` rendered once.
+struct FramesHere<'a> {
+    pool: &'a rayon::ThreadPool,
+    kernels: (Backend, Devices),
+    setup: Setup,
+    limits: &'a Limits,
+    tally: &'a Tally,
+    animated: bool,
+}
+
+impl FramesHere<'_> {
+    /// Renders `todo`; returns the kernels prepared and the device, for the log.
+    fn render(
+        &self,
+        todo: &[u64],
+        first: &mut Option<FrameScene>,
+        (checker, sink, writers): (&mut Checker, &mut Sink, Option<&Writers>),
+    ) -> Result<(usize, Option<String>), Error> {
+        let mut kernels = Kernels::new(self.pool, self.kernels.clone(), self.setup);
+        // The picture of a scene that does not read `t`, rendered once.
+        let mut still: Option<Picture> = None;
+        checker.place = "checking thread";
+        let checker = &*checker;
+        std::thread::scope(|scope| -> Result<(), Error> {
+            let (tx, checked) = std::sync::mpsc::sync_channel(2);
+            scope.spawn(move || {
+                for &k in todo {
+                    let frame = checker.frame(k, first);
+                    let failed = frame.is_err();
+                    // The receiver is gone after an error of its own.
+                    if tx.send((k, frame)).is_err() || failed {
+                        return;
+                    }
+                }
+            });
+            for (n, (k, frame)) in checked.iter().enumerate() {
+                let frame = frame?;
+                let started = Instant::now();
+                let picture = match &still {
+                    Some(picture) => picture.clone(),
+                    None => {
+                        let picture = self.picture(&mut kernels, (n, k), (frame, started))?;
+                        if !self.animated {
+                            still = Some(picture.clone());
+                        }
+                        picture
+                    }
+                };
+                self.deliver((k, picture, started), (checker, &mut *sink, writers))?;
+            }
+            Ok(())
+        })?;
+        let device = kernels
+            .last()
+            .map(|p| format!("{} on {}", p.name(), p.device()));
+        Ok((kernels.count, device))
+    }
+
+    /// Frame `k`, the `n`th here, prepared (its memory checked), rendered and its warnings said.
+    fn picture(
+        &self,
+        kernels: &mut Kernels,
+        (n, k): (usize, u64),
+        (frame, started): (FrameScene, Instant),
+    ) -> Result<Picture, Error> {
+        let (scene, prepared) = kernels.prepare(frame)?;
+        let memory = job::Use::IMAGE;
+        job::check_memory(self.pool, prepared, &scene, memory, self.limits, n == 0)?;
+        self.tally.since(HERE, preparing(n == 0), started);
+        let rendered = Instant::now();
+        let mut frame = self.pool.install(|| prepared.render(&scene, &|_| {}))?;
+        match &frame.phases {
+            Some(p) => self.tally.phases(HERE, p),
+            None => self.tally.since(HERE, "render", rendered),
+        }
+        for w in frame.warnings() {
+            eprintln!("warning: frame {k}: {w}");
+        }
+        Ok(frame.take_picture())
+    }
+
+    /// Frame `k`'s picture handed to the writers (numbered files) or written to the sink.
+    fn deliver(
+        &self,
+        (k, picture, started): (u64, Picture, Instant),
+        (checker, sink, writers): (&Checker, &mut Sink, Option<&Writers>),
+    ) -> Result<(), Error> {
+        match (writers, &*sink) {
+            (Some(w), Sink::Numbered(pattern, format)) => {
+                let task = Task {
+                    k,
+                    output: Output::File {
+                        path: pattern.path(k),
+                        format: *format,
+                    },
+                    picture,
+                    started,
+                };
+                let handing = Instant::now();
+                w.submit(task).map_err(|e| Error::Encode(e.to_string()))?;
+                self.tally.since(HERE, "handing to the writers", handing);
+                for done in w.written() {
+                    report(done, checker, sink)?;
+                }
+            }
+            _ => {
+                let writing = Instant::now();
+                sink.write(k, &picture)?;
+                // Its buffer takes the next frame's pixels.
+                if let Picture::Finished(f) = picture {
+                    f.recycle();
+                }
+                self.tally.since(HERE, "writing", writing);
+                checker.written(k, sink, started.elapsed().as_secs_f64());
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Checks the frames of a sequence one after the other (the source is read once and checked
@@ -315,6 +383,19 @@ impl Checker<'_> {
             }
             e
         })
+    }
+
+    /// The frames the writers still hold written and logged, the bar cleared, the sink finished.
+    fn finish(&self, writers: Option<Writers>, sink: Sink) -> Result<(), Error> {
+        if let Some(w) = writers {
+            for done in w.finish() {
+                report(done, self, &sink)?;
+            }
+        }
+        if let Some(b) = self.bar {
+            b.finish_and_clear();
+        }
+        sink.finish()
     }
 
     /// Frame `k` was written in `seconds`.

@@ -82,12 +82,12 @@ fn string_errors_do_not_grow() {
     );
 }
 
-/// The most Rust files over [`FILE_LINES`] lines the workspace may hold.
-const LONG_FILES: usize = 24;
+/// The most Rust files over [`FILE_LINES`] lines the workspace may hold: none.
+const LONG_FILES: usize = 0;
 /// A file's length past which it should be split by responsibility.
 const FILE_LINES: usize = 800;
 /// The most functions over [`FUNCTION_LINES`] lines the workspace may hold.
-const LONG_FUNCTIONS: usize = 19;
+const LONG_FUNCTIONS: usize = 14;
 /// A function's length past which it should be split.
 const FUNCTION_LINES: usize = 150;
 

@@ -504,8 +504,6 @@ const NOT_LIMITS: &[(&str, &str, &str)] = &[
     ),
 ];
 
-/// The `.rs` files under `dir` (relative to the workspace root), build output left out.
-
 /// issue 16, item 2: every resource limit lives in `Limits` (compiler/src/limits.rs), with
 /// its `--limit` name; a `const MAX_…` anywhere else is a limit that `--limit` cannot raise,
 /// unless it is one of [`NOT_LIMITS`].

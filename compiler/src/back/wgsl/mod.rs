@@ -126,10 +126,13 @@ impl std::error::Error for Error {}
 /// ray traced analytically.
 pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
     let mats = &scene.materials;
-    let soft = scene
-        .lights
-        .iter()
-        .any(|l| l.penumbra() > 0.0 && l.shadows());
+    // The path tracer's shadow rays are hard (it samples a light's disc instead), so its
+    // kernel leaves the penumbra search out.
+    let soft = !scene.settings.path
+        && scene
+            .lights
+            .iter()
+            .any(|l| l.penumbra() > 0.0 && l.shadows());
     let points = scene
         .lights
         .iter()

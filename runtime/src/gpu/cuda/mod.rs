@@ -288,8 +288,8 @@ impl Cuda {
 pub const MARCHED_REGISTERS: u32 = 72;
 
 /// The register cap of a path-traced kernel that sphere traces: its bounces' loop keeps
-/// little alive across the march, and of the caps tried on it 56 was the fastest.
-pub const PATH_REGISTERS: u32 = 56;
+/// little alive across the march, and of the caps tried on it (48 to 80) 64 was the fastest.
+pub const PATH_REGISTERS: u32 = 64;
 
 /// How a kernel finds its surfaces, as far as its register cap goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

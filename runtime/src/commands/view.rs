@@ -54,7 +54,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub headless: bool,
     /// With --headless: once the first image has settled, orbit the camera for N frames and
-    /// print the frame rate, then the time to converge after the camera stops.
+    /// print the frame rate, then the time to converge after the camera stops; then exit.
     #[arg(long, value_name = "N", requires = "headless", value_parser = clap::value_parser!(u32).range(1..))]
     pub orbit_frames: Option<u32>,
     /// Stop after N frames have been presented.

@@ -41,7 +41,8 @@ pub struct Control {
     /// Start with the statistics shown in the title.
     pub stats: bool,
     /// Headless: once the first image has settled, orbit the camera for this many frames,
-    /// print the frame rate, then the time to the converged image after the camera stops.
+    /// print the frame rate, then the time to the converged image after the camera stops;
+    /// the run ends once that image (and every `--change`'s) has settled.
     pub orbit_frames: Option<u32>,
     /// `--change NAME=VALUE`: once the image of the last load has settled (and its screenshot
     /// is written), give the parameter NAME the value VALUE as its control in the panel would
@@ -111,6 +112,7 @@ pub fn headless(run: Run) -> ExitCode {
     let mut shot_for = Some(session.load().number);
     let mut frames = 0u64;
     let mut orbit = control.orbit_frames;
+    let mut measured = false;
     let mut changes: std::collections::VecDeque<_> = control.changes.iter().collect();
     loop {
         if let Some(w) = watch.as_mut() {
@@ -163,6 +165,7 @@ pub fn headless(run: Run) -> ExitCode {
         }
         if let Some(n) = orbit.take() {
             measure_orbit(&mut session, n);
+            measured = true;
         }
         if let (Some(k), Some(dir)) = (shot_for.take(), &control.screenshot_dir) {
             let path = dir.join(format!("reload-{k}.png"));
@@ -184,6 +187,11 @@ pub fn headless(run: Run) -> ExitCode {
                 }
             }
             continue;
+        }
+        // An orbit's measurement ends the run once its changes are made (unless frames are
+        // counted, which end it themselves).
+        if measured && control.frames.is_none() {
+            return ExitCode::SUCCESS;
         }
         // Wait for a change that calls for a reload; while frames are counted, only look for
         // one, and present the settled image again (a display's next refresh).

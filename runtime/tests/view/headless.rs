@@ -1,5 +1,6 @@
 //! The viewer without a window (`--headless`): screenshots on wgpu, path tracing's samples
-//! accumulated, frames that stop once the image settles, and a scene that never loads.
+//! accumulated, frames that stop once the image settles, a scene that never loads, and an
+//! orbit measured.
 
 use crate::{headless_run, mean, required, temp_dir, CENTRE, SCENE};
 use sdfc_runtime::image::read_png;
@@ -226,5 +227,21 @@ fn headless_screenshot_of_a_scene_that_never_loads_fails() {
             "{file}: a screenshot was written"
         );
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--orbit-frames` is a measurement: it prints the orbit's frame rate and the time to
+/// converge once the camera stops, then the run ends (it waited for file changes before).
+#[test]
+fn headless_orbit_prints_its_figures_and_exits() {
+    let dir = temp_dir("headless-orbit");
+    std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
+    let (status, stderr) = headless_run(
+        &dir,
+        &["scene.sdf", "--size", "32x24", "--orbit-frames", "3"],
+    );
+    assert!(status.success(), "{stderr}");
+    assert!(stderr.contains("view: orbit: 3 frames in"), "{stderr}");
+    assert!(stderr.contains("after the camera stopped"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -21,6 +21,7 @@
 //! triangles and boxes.
 
 use super::Float;
+use glam::DVec3;
 use std::collections::HashMap;
 use triangle::{bound, nearest, point_of, sub3, FACE};
 
@@ -90,34 +91,14 @@ pub enum Invalid {
     Empty,
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let l = dot(a, a).sqrt();
+/// `a / |a|`, or `a` itself where it has no length (divided, not multiplied by the
+/// reciprocal, so that the normals are those the mesh has always had).
+fn unit(a: DVec3) -> DVec3 {
+    let l = a.length();
     if l > 0.0 {
-        a.map(|x| x / l)
+        a / l
     } else {
         a
-    }
-}
-
-fn add_to(acc: &mut [f64; 3], v: [f64; 3], w: f64) {
-    for i in 0..3 {
-        acc[i] += v[i] * w;
     }
 }
 
@@ -196,9 +177,9 @@ impl TriMesh {
             for k in 0..3 {
                 g[k] = *remap.get(f[k] as usize).ok_or(Invalid::Index(t, f[k]))?;
             }
-            let [a, b, c] = g.map(|i| verts[i as usize]);
-            let n = cross(sub(b, a), sub(c, a));
-            if g[0] == g[1] || g[1] == g[2] || g[2] == g[0] || dot(n, n) == 0.0 {
+            let [a, b, c] = g.map(|i| DVec3::from(verts[i as usize]));
+            let n = (b - a).cross(c - a);
+            if g[0] == g[1] || g[1] == g[2] || g[2] == g[0] || n.length_squared() == 0.0 {
                 report.degenerate += 1;
                 continue;
             }
@@ -211,8 +192,8 @@ impl TriMesh {
         let volume: f64 = tris
             .iter()
             .map(|t| {
-                let [a, b, c] = t.map(|i| verts[i as usize]);
-                dot(a, cross(b, c))
+                let [a, b, c] = t.map(|i| DVec3::from(verts[i as usize]));
+                a.dot(b.cross(c))
             })
             .sum();
         if volume < 0.0 {
@@ -223,19 +204,21 @@ impl TriMesh {
         }
         // Pseudo-normals: per vertex the angle-weighted sum of its faces' unit normals, per
         // edge the sum of its faces' (Bærentzen and Aanæs 2005).
-        let mut vn = vec![[0.0; 3]; verts.len()];
-        let mut edges: HashMap<(u32, u32), ([f64; 3], u32)> = HashMap::new();
+        let mut vn = vec![DVec3::ZERO; verts.len()];
+        let mut edges: HashMap<(u32, u32), (DVec3, u32)> = HashMap::new();
         for t in &tris {
-            let p = t.map(|i| verts[i as usize]);
-            let n = unit(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+            let p = t.map(|i| DVec3::from(verts[i as usize]));
+            let n = unit((p[1] - p[0]).cross(p[2] - p[0]));
             for k in 0..3 {
                 let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
-                let (u, v) = (unit(sub(b, a)), unit(sub(c, a)));
-                let angle = dot(u, v).clamp(-1.0, 1.0).acos();
-                add_to(&mut vn[t[k] as usize], n, angle);
+                let (u, v) = (unit(b - a), unit(c - a));
+                let angle = u.dot(v).clamp(-1.0, 1.0).acos();
+                vn[t[k] as usize] += n * angle;
                 let (i, j) = (t[k], t[(k + 1) % 3]);
-                let e = edges.entry((i.min(j), i.max(j))).or_insert(([0.0; 3], 0));
-                add_to(&mut e.0, n, 1.0);
+                let e = edges
+                    .entry((i.min(j), i.max(j)))
+                    .or_insert((DVec3::ZERO, 0));
+                e.0 += n;
                 e.1 += 1;
             }
         }
@@ -251,15 +234,15 @@ impl TriMesh {
             .map(|t| {
                 let en = |k: usize| {
                     let (i, j) = (t[k], t[(k + 1) % 3]);
-                    unit(edges[&(i.min(j), i.max(j))].0)
+                    unit(edges[&(i.min(j), i.max(j))].0).to_array()
                 };
                 [
                     verts[t[0] as usize],
                     verts[t[1] as usize],
                     verts[t[2] as usize],
-                    unit(vn[t[0] as usize]),
-                    unit(vn[t[1] as usize]),
-                    unit(vn[t[2] as usize]),
+                    unit(vn[t[0] as usize]).to_array(),
+                    unit(vn[t[1] as usize]).to_array(),
+                    unit(vn[t[2] as usize]).to_array(),
                     en(0),
                     en(1),
                     en(2),

@@ -13,12 +13,13 @@
 //! flip replaces two triangles by two that share a new edge, which is made only once.
 
 use super::place::{
-    choose, dot, inside_cell, normalise, onto_surface, place, separate, sub, Patches, Placed,
-    GRADIENT_STEP, MARGIN, ON_SURFACE,
+    choose, inside_cell, normalise, onto_surface, place, separate, Patches, Placed, GRADIENT_STEP,
+    MARGIN, ON_SURFACE,
 };
 use super::table::{corner, patches, EDGES};
 use super::thin;
 use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
+use glam::DVec3;
 use rayon::prelude::*;
 
 /// Bisections after the root finding's rounds for an edge vertex still off the surface.
@@ -555,17 +556,9 @@ fn roots(
         .collect()
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
-    let [a, b, c] = t.map(|i| p[i as usize]);
-    cross(sub(b, a), sub(c, a))
+fn normal(p: &[[f64; 3]], t: [u32; 3]) -> DVec3 {
+    let [a, b, c] = t.map(|i| DVec3::from(p[i as usize]));
+    (b - a).cross(c - a)
 }
 
 /// Flips the patch edge between two sharp patches' fans to join their inner vertices, where
@@ -628,14 +621,16 @@ fn flip(
                 normal(positions, triangles[t]),
                 normal(positions, triangles[u]),
             );
-            [n1[0] + n2[0], n1[1] + n2[1], n1[2] + n2[2]]
+            n1 + n2
         };
         let (s, r) = ([c1, a, c2], [c2, b, c1]);
         let (ns, nr) = (normal(positions, s), normal(positions, r));
         // Well above what the files' f32 coordinates can round to zero.
         let tiny = 1e-6 * voxel * voxel;
-        let area = |n: [f64; 3]| dot(n, n).sqrt();
-        if area(ns) <= tiny || area(nr) <= tiny || dot(ns, before) <= 0.0 || dot(nr, before) <= 0.0
+        if ns.length() <= tiny
+            || nr.length() <= tiny
+            || ns.dot(before) <= 0.0
+            || nr.dot(before) <= 0.0
         {
             continue;
         }

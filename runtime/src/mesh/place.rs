@@ -6,6 +6,7 @@
 
 use super::qef;
 use super::{Field, Grid};
+use glam::DVec3;
 
 /// Edge vertices stay this fraction of a voxel inside their edge, and inner vertices inside
 /// their cell, so that no two vertices coincide.
@@ -27,13 +28,16 @@ pub const ON_SURFACE: f64 = 1e-3;
 /// Rounds of that projection: a Newton step along the gradient, then the clamp into the cell.
 const PROJECT_ROUNDS: usize = 4;
 
+/// `g / |g|` (divided, not multiplied by the reciprocal), or zero where `g` has no finite,
+/// non-zero length.
 pub fn normalise(g: [f64; 3]) -> [f64; 3] {
-    let l = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-    if l > 0.0 && l.is_finite() {
-        g.map(|x| x / l)
-    } else {
-        [0.0; 3]
-    }
+    unit(g.into()).map_or([0.0; 3], |u| u.to_array())
+}
+
+/// `a / |a|` where `a` has a finite, non-zero length.
+pub fn unit(a: DVec3) -> Option<DVec3> {
+    let l = a.length();
+    (l > 0.0 && l.is_finite()).then(|| a / l)
 }
 
 /// A patch's inner vertex as [`place`] puts it.
@@ -105,7 +109,7 @@ pub fn choose(field: &Field, voxel: f64, placed: &[Placed], centres: &mut [[f64;
         }
         let values = &d[at..at + options.len()];
         at += options.len();
-        let far = |y: &[f64; 3]| dot(sub(*y, *fit), sub(*y, *fit));
+        let far = |y: &[f64; 3]| DVec3::from(*y).distance_squared(DVec3::from(*fit));
         let on = options
             .iter()
             .zip(values)
@@ -180,7 +184,7 @@ pub fn onto_surface(
         let mut next = Vec::with_capacity(off.len());
         for (k, &p) in off.iter().enumerate() {
             let (v, g) = (values[k], gradients[k]);
-            let g2 = dot(g, g);
+            let g2 = DVec3::from(g).length_squared();
             if v.abs() <= tolerance {
                 continue;
             }
@@ -238,7 +242,7 @@ pub fn onto_surface(
         let mut best: Option<(f64, Bracket)> = None;
         let mut nearest = (a, f64::INFINITY);
         for (n, b) in ends(p).into_iter().enumerate() {
-            let length = dot(sub(b, a), sub(b, a)).sqrt();
+            let length = DVec3::from(b).distance(DVec3::from(a));
             if n < ring_len(p) && length < nearest.1 {
                 nearest = (b, length);
             }
@@ -307,14 +311,4 @@ pub fn separate(
         }
         p = q;
     }
-}
-
-/// `a − b`.
-pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// `a · b`.
-pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

@@ -14,7 +14,9 @@
 //! and a box's corner 90°, and neither is reported. The feature's thickness is its extent
 //! along the edge projected onto the mean of the two normals, the thickness across it.
 
+use super::place::unit;
 use super::{unpack, Bricks, Field, Grid};
+use glam::DVec3;
 
 /// The normals at a feature's two roots are at least this far apart (`cos` below its
 /// negative): 155°, walls whose faces are within 25° of parallel.
@@ -171,19 +173,22 @@ impl Finder<'_> {
         // Opposite faces: the feature's thickness across it, its mid-point and normal.
         let mut found: Vec<(Line, f64)> = Vec::new();
         for (k, (l, o)) in lines.iter().zip(&offsets).enumerate() {
-            let (Some(g0), Some(g1)) = (unit(gradients[2 * k]), unit(gradients[2 * k + 1])) else {
+            let (Some(g0), Some(g1)) = (
+                unit(gradients[2 * k].into()),
+                unit(gradients[2 * k + 1].into()),
+            ) else {
                 continue;
             };
-            if dot(g0, g1) > -OPPOSITE {
+            if g0.dot(g1) > -OPPOSITE {
                 continue;
             }
-            let normal = unit([0, 1, 2].map(|i| g0[i] - g1[i])).unwrap_or(g0);
-            let thickness = (o[1] - o[0]).abs() * dot(normal, l.dir).abs();
+            let normal = unit(g0 - g1).unwrap_or(g0);
+            let thickness = (o[1] - o[0]).abs() * normal.dot(l.dir.into()).abs();
             let centre = l.at(0.5 * (o[0] + o[1]));
             found.push((
                 Line {
                     centre,
-                    dir: normal,
+                    dir: normal.to_array(),
                     ends: [-h, h],
                     inside: l.inside,
                 },
@@ -252,10 +257,10 @@ impl Finder<'_> {
                 continue;
             }
             // Down the slope of the thickness.
-            let Some(d) = unit([0, 1, 2].map(|i| -(gu * u[i] + gv * v[i]))) else {
+            let Some(d) = unit(-(DVec3::from(u) * gu + DVec3::from(v) * gv)) else {
                 continue;
             };
-            walkers.push((k, *l, d));
+            walkers.push((k, *l, d.to_array()));
         }
         for _ in 0..WALK {
             if walkers.is_empty() {
@@ -423,10 +428,6 @@ fn bin_low(k: usize) -> f64 {
     (-((k + 1) as f64) / BINS_PER_OCTAVE as f64).exp2()
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// Whether the feature of thickness `t`, `spans` thick a cell `h` away along ±u and ±v,
 /// closes nearby: the quadric through the five thicknesses, along each line that bends up
 /// (by more than the bisections' error) with its lowest point within [`CLOSES_WITHIN`]
@@ -459,23 +460,9 @@ fn tangents(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     let k = (0..3)
         .min_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
         .unwrap_or(0);
-    let mut e = [0.0; 3];
-    e[k] = 1.0;
-    let u = unit(cross(n, e)).unwrap_or([1.0, 0.0, 0.0]);
-    (u, cross(n, u))
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
-    let n = dot(a, a).sqrt();
-    (n > 0.0 && n.is_finite()).then(|| a.map(|x| x / n))
+    let n = DVec3::from(n);
+    let u = unit(n.cross(DVec3::AXES[k])).unwrap_or(DVec3::X);
+    (u.to_array(), n.cross(u).to_array())
 }
 
 #[cfg(test)]

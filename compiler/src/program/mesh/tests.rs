@@ -92,21 +92,21 @@ pub(crate) fn torus(n: usize, m: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 /// The distance from `p` to a triangle, computed another way than Ericson's regions: the
 /// projection onto the plane where it falls inside, else the nearest of the three edges.
 fn brute_triangle(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
-    let seg = |a: [f64; 3], b: [f64; 3]| {
-        let d = sub(b, a);
-        let s = (dot(sub(p, a), d) / dot(d, d)).clamp(0.0, 1.0);
-        let q = [a[0] + d[0] * s, a[1] + d[1] * s, a[2] + d[2] * s];
-        dot(sub(p, q), sub(p, q)).sqrt()
+    let p = DVec3::from(p);
+    let t = t.map(DVec3::from);
+    let seg = |a: DVec3, b: DVec3| {
+        let d = b - a;
+        let s = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+        p.distance(a + d * s)
     };
-    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
-    let h = dot(sub(p, t[0]), n) / dot(n, n);
-    let q = [p[0] - n[0] * h, p[1] - n[1] * h, p[2] - n[2] * h];
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    let q = p - n * ((p - t[0]).dot(n) / n.length_squared());
     let inside = (0..3).all(|k| {
         let (a, b) = (t[k], t[(k + 1) % 3]);
-        dot(cross(sub(b, a), sub(q, a)), n) >= 0.0
+        (b - a).cross(q - a).dot(n) >= 0.0
     });
     if inside {
-        dot(sub(p, q), sub(p, q)).sqrt()
+        p.distance(q)
     } else {
         seg(t[0], t[1]).min(seg(t[1], t[2])).min(seg(t[2], t[0]))
     }
@@ -118,10 +118,10 @@ fn brute_triangle(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
 fn winding(p: [f64; 3], tris: &[[[f64; 3]; 3]]) -> f64 {
     let mut sum = 0.0;
     for t in tris {
-        let [a, b, c] = t.map(|v| sub(v, p));
-        let (la, lb, lc) = (dot(a, a).sqrt(), dot(b, b).sqrt(), dot(c, c).sqrt());
-        let det = dot(a, cross(b, c));
-        let div = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+        let [a, b, c] = t.map(|v| DVec3::from(v) - DVec3::from(p));
+        let (la, lb, lc) = (a.length(), b.length(), c.length());
+        let det = a.dot(b.cross(c));
+        let div = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
         sum += 2.0 * det.atan2(div);
     }
     sum / (4.0 * std::f64::consts::PI)
@@ -238,8 +238,9 @@ fn a_hole_leaves_the_sign_right_away_from_it() {
     let mut checked = 0;
     for p in probes(&closed_tris, &mut rng) {
         // Away from the hole, whose rim lies within 0.55 of (1.4, 0, 0).
-        let far = sub(p, [1.4, 0.0, 0.0]);
-        if dot(far, far).sqrt() < 1.2 || closed.distance(p).abs() < 1e-9 {
+        if DVec3::from(p).distance(DVec3::new(1.4, 0.0, 0.0)) < 1.2
+            || closed.distance(p).abs() < 1e-9
+        {
             continue;
         }
         let inside = winding(p, &closed_tris) > 0.5;

@@ -7,6 +7,7 @@
 use crate::common;
 
 use common::*;
+use glam::DVec3;
 use sdfc_compiler::{
     eval_point, lower_scene, lower_with, rust, wgsl, Evaluator, Float, LowerOptions, Lowered,
     Method, Op, Outputs, Program, Rng, Scene, Step, Tape,
@@ -257,9 +258,9 @@ fn executed(program: &Program, p: [f32; 3]) -> usize {
 fn ray_points(scene: &Scene, program: &Program, w: u32, h: u32) -> Vec<[f32; 3]> {
     let cam = &scene.camera;
     let eye = cam.position;
-    let f = normalize(sub3(cam.look_at, eye));
-    let u = normalize(cross(f, [0.0, 1.0, 0.0]));
-    let v = cross(u, f);
+    let f = (DVec3::from(cam.look_at) - DVec3::from(eye)).normalize();
+    let u = f.cross(DVec3::Y).normalize();
+    let v = u.cross(f);
     let tan = (cam.fov * 0.5).tan();
     let aspect = scene.settings.width as f64 / scene.settings.height as f64;
     let mut out = Vec::new();
@@ -267,7 +268,7 @@ fn ray_points(scene: &Scene, program: &Program, w: u32, h: u32) -> Vec<[f32; 3]>
         for i in 0..w {
             let sx = ((i as f64 + 0.5) / w as f64 * 2.0 - 1.0) * tan * aspect;
             let sy = (1.0 - (j as f64 + 0.5) / h as f64 * 2.0) * tan;
-            let d = normalize([0, 1, 2].map(|k| f[k] + sx * u[k] + sy * v[k]));
+            let d = (f + u * sx + v * sy).normalize();
             let mut t = 0.0;
             for _ in 0..scene.settings.max_steps {
                 let p = [0, 1, 2].map(|k| (eye[k] + t * d[k]) as f32);
@@ -283,19 +284,6 @@ fn ray_points(scene: &Scene, program: &Program, w: u32, h: u32) -> Vec<[f32; 3]>
         }
     }
     out
-}
-
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let l = len3(a);
-    a.map(|x| x / l)
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// Mean operations executed per evaluation along camera rays.

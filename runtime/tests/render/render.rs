@@ -4,6 +4,7 @@
 
 use crate::common;
 use common::*;
+use glam::DVec3;
 use sdfc_compiler::{Light, Lowered, Method, Node, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision, Render};
 
@@ -33,38 +34,21 @@ fn render_with(scene: &Scene, options: &Options, threads: usize) -> Render {
 
 /// The camera of docs/rendering.md, "Camera", written again for a camera whose `up` is not
 /// parallel to the view: (eye, u, v, w, tan(fov/2)).
-fn basis(scene: &Scene) -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3], f64) {
+fn basis(scene: &Scene) -> (DVec3, DVec3, DVec3, DVec3, f64) {
     let c = &scene.camera;
-    let w = normalize(sub3(c.look_at, c.position));
-    let u = normalize(cross(w, c.up));
-    let v = cross(u, w);
-    (c.position, u, v, w, (c.fov / 2.0).tan())
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let l = len3(a);
-    a.map(|x| x / l)
+    let w = (DVec3::from(c.look_at) - DVec3::from(c.position)).normalize();
+    let u = w.cross(c.up.into()).normalize();
+    let v = u.cross(w);
+    (c.position.into(), u, v, w, (c.fov / 2.0).tan())
 }
 
 /// The pixel whose centre ray passes through the world point `x`.
 pub(crate) fn project(scene: &Scene, x: [f64; 3]) -> (u32, u32) {
     let (eye, u, v, w, tan) = basis(scene);
     let (wd, ht) = (scene.settings.width as f64, scene.settings.height as f64);
-    let d = sub3(x, eye);
-    let bx = dot(d, u) / dot(d, w) / (tan * wd / ht);
-    let by = dot(d, v) / dot(d, w) / tan;
+    let d = DVec3::from(x) - eye;
+    let bx = d.dot(u) / d.dot(w) / (tan * wd / ht);
+    let by = d.dot(v) / d.dot(w) / tan;
     let (ax, ay) = ((bx + 1.0) / 2.0, (1.0 - by) / 2.0);
     (
         (ax * wd - 0.5).round() as u32,
@@ -99,10 +83,8 @@ fn a_sphere_seen_head_on_covers_the_predicted_pixels() {
             for x in 0..96 {
                 let bx = 2.0 * (x as f64 + 0.5) / wd - 1.0;
                 let by = 1.0 - 2.0 * (y as f64 + 0.5) / ht;
-                let dir = normalize(
-                    [0, 1, 2].map(|i| w[i] + bx * tan * wd / ht * u[i] + by * tan * v[i]),
-                );
-                predicted += (len3(cross(eye, dir)) < 1.0) as i64;
+                let dir = (w + u * (bx * tan * wd / ht) + v * (by * tan)).normalize();
+                predicted += (eye.cross(dir).length() < 1.0) as i64;
             }
         }
         assert!(predicted > 300, "{predicted}");

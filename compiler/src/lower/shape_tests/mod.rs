@@ -11,6 +11,7 @@ use crate::eval::eval_point;
 use crate::program::Program;
 use crate::rng::Rng;
 use crate::scene::analysis::analyse;
+use glam::DVec3;
 
 mod blends;
 mod fields;
@@ -37,12 +38,8 @@ fn point(rng: &mut Rng, r: f64) -> [f64; 3] {
     [0; 3].map(|_| rng.range(-r, r))
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 fn len(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+    DVec3::from(a).length()
 }
 
 /// The largest |f(p) - f(q)| / |p - q| over random pairs, near (q within 0.05 of p) and far.
@@ -56,7 +53,7 @@ fn slope(p: &Program, rng: &mut Rng, r: f64) -> f64 {
         } else {
             point(rng, r)
         };
-        let d = len(sub(a, b));
+        let d = DVec3::from(a).distance(DVec3::from(b));
         if d > 1e-9 {
             worst = worst.max((f(p, a) - f(p, b)).abs() / d);
         }

@@ -2,7 +2,8 @@
 //! frames and links are exact and equal the shapes they generalise; `reflect`; the shapes
 //! between two points.
 
-use super::{exact, f, len, program, same, sub};
+use super::{exact, f, len, program, same};
+use glam::DVec3;
 
 const S3: f64 = 1.732_050_807_568_877_2;
 
@@ -51,12 +52,10 @@ fn segment_is_a_capsule_between_two_points() {
         "sphere(0.5).translate(0.3, 0, 0)",
     );
     exact("segment((-0.5, -0.3, 0.2), (0.6, 0.4, -0.1), 0.3)", |p| {
-        let (a, b) = ([-0.5, -0.3, 0.2], [0.6, 0.4, -0.1]);
-        let ba = sub(b, a);
-        let pa = sub(p, a);
-        let t =
-            ((pa[0] * ba[0] + pa[1] * ba[1] + pa[2] * ba[2]) / (len(ba) * len(ba))).clamp(0.0, 1.0);
-        len(sub(pa, ba.map(|x| x * t))) < 0.3
+        let (a, b) = (DVec3::new(-0.5, -0.3, 0.2), DVec3::new(0.6, 0.4, -0.1));
+        let (ba, pa) = (b - a, DVec3::from(p) - a);
+        let t = (pa.dot(ba) / ba.length_squared()).clamp(0.0, 1.0);
+        (pa - ba * t).length() < 0.3
     });
 }
 

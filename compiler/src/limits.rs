@@ -73,6 +73,8 @@ pub enum Limit {
 
 /// What a limit is: its name, default, accepted values and a one-line description.
 struct Spec {
+    /// The limit the row is of.
+    limit: Limit,
     name: &'static str,
     default: u64,
     /// The largest value `--limit` accepts (beyond it the implementation's own bounds, such
@@ -80,6 +82,251 @@ struct Spec {
     ceiling: u64,
     what: &'static str,
 }
+
+/// Every limit's [`Spec`], in the order of [`Limit::ALL`] (checked when compiled, below).
+const SPECS: [Spec; 27] = [
+    Spec {
+        limit: Limit::Nesting,
+        name: "nesting",
+        default: 1_000,
+        ceiling: 100_000,
+        what: "levels of expression nesting",
+    },
+    Spec {
+        limit: Limit::Fuel,
+        name: "fuel",
+        default: 50_000_000,
+        ceiling: 1 << 50,
+        what: "evaluation steps (expressions and loop iterations) of one compilation",
+    },
+    Spec {
+        limit: Limit::CallDepth,
+        name: "call_depth",
+        default: 256,
+        ceiling: 1_000_000,
+        what: "depth of nested calls of functions",
+    },
+    Spec {
+        limit: Limit::Nodes,
+        name: "nodes",
+        default: 1_000_000,
+        ceiling: u32::MAX as u64 - 1,
+        what: "shape nodes a scene builds",
+    },
+    Spec {
+        limit: Limit::Objects,
+        name: "objects",
+        default: 100_000,
+        ceiling: u32::MAX as u64 - 1,
+        what: "objects in a scene, and iterations of one loop",
+    },
+    Spec {
+        limit: Limit::Files,
+        name: "files",
+        default: 256,
+        ceiling: 1_000_000,
+        what: "files imported by one compilation",
+    },
+    Spec {
+        limit: Limit::Edge,
+        name: "edge",
+        default: 16_384,
+        ceiling: 65_535,
+        what: "width and height of an image, in pixels",
+    },
+    Spec {
+        limit: Limit::Aa,
+        name: "aa",
+        default: 16,
+        ceiling: 256,
+        what: "supersampling (samples per pixel edge)",
+    },
+    Spec {
+        limit: Limit::MaxSteps,
+        name: "max_steps",
+        default: 1_000_000,
+        ceiling: u32::MAX as u64 - 1,
+        what: "the render setting max_steps",
+    },
+    Spec {
+        limit: Limit::MaxDepth,
+        name: "max_depth",
+        default: 64,
+        ceiling: 1_000,
+        what: "the render setting max_depth",
+    },
+    // A sample is one path a pixel: 65 536 of them at 1920×1080 are 1.4·10¹¹ paths,
+    // hours on any device; the ceiling keeps sample indices within the random
+    // stream's 32 bits.
+    Spec {
+        limit: Limit::Samples,
+        name: "samples",
+        default: 65_536,
+        ceiling: 1 << 31,
+        what: "the path tracer's samples per pixel (render setting samples)",
+    },
+    Spec {
+        limit: Limit::Bounces,
+        name: "bounces",
+        default: 64,
+        ceiling: 1_000,
+        what: "the path tracer's bounces (render setting bounces)",
+    },
+    Spec {
+        limit: Limit::Program,
+        name: "program",
+        default: 4_000_000,
+        ceiling: u32::MAX as u64 - 1,
+        what: "operations of the distance program after lowering",
+    },
+    Spec {
+        limit: Limit::Memory,
+        name: "memory",
+        default: 4_096,
+        ceiling: 1 << 30,
+        what: "memory a render may allocate, in MiB (host and device together)",
+    },
+    // 4 000 000 holds 2¹⁹ spheres built by sharing, two translated copies per level
+    // (2²¹ − 3 nodes as a tree, checked in about a second);
+    // every example is far below it (the largest, examples/scaling/compound_10000.sdf,
+    // expands to 120 003).
+    Spec {
+        limit: Limit::Expansion,
+        name: "expansion",
+        default: 4_000_000,
+        ceiling: 1 << 40,
+        what: "shape nodes counted as a tree (a shared shape once per use)",
+    },
+    // Rays visit the primitives through a bounding-volume hierarchy, in O(log n) per
+    // ray, so tracing beats sphere tracing at any size. The default
+    // keeps the GPU buffer of a large traced scene (at most 112 bytes a primitive:
+    // 80 for a rotated one, 32 for a group, of which there are fewer than primitives)
+    // under the 128 MiB that wgpu's default limits let a storage buffer bind; the
+    // default `objects` limit stays below it. `method: "trace"` has no limit.
+    Spec {
+        limit: Limit::Traced,
+        name: "traced",
+        default: 1_000_000,
+        ceiling: u32::MAX as u64 - 1,
+        what: "primitives method \"auto\" traces analytically (beyond, it sphere traces)",
+    },
+    // What wgpu's default limits let a storage buffer bind (128 MiB: over a million
+    // instances, ten times the default `objects` limit).
+    Spec {
+        limit: Limit::SceneData,
+        name: "scene_data",
+        default: 128,
+        ceiling: 4_095,
+        what: "MiB of a marched scene's instances in one GPU buffer (beyond, they are code)",
+    },
+    Spec {
+        limit: Limit::SweepValues,
+        name: "sweep_values",
+        default: 1_000,
+        ceiling: 1_000_000,
+        what: "values of one sdfc pareto --sweep",
+    },
+    Spec {
+        limit: Limit::SweepPoints,
+        name: "sweep_points",
+        default: 1_000,
+        ceiling: 1_000_000,
+        what: "settings sdfc pareto measures (the product of its sweeps' values)",
+    },
+    // An hour at 30 frames per second is 108 000 frames: ten hours fit.
+    Spec {
+        limit: Limit::Frames,
+        name: "frames",
+        default: 1_000_000,
+        ceiling: 1 << 40,
+        what: "frames of one animated sequence",
+    },
+    // A dense grid of 512³ cells is 134 million; the octree of a scene at that
+    // resolution evaluates a few percent of it.
+    Spec {
+        limit: Limit::Cells,
+        name: "cells",
+        default: 50_000_000,
+        ceiling: 1 << 40,
+        what: "cells sdfc mesh evaluates (octree cells and candidates, or the dense grid)",
+    },
+    // The interpreted kernel's file is an array of this many f32 per GPU thread
+    // (compiler/src/back/wgsl/interp.rs), in the GPU's local memory: its size is part
+    // of the kernel's text, so every scene that fits shares one kernel. The examples
+    // need 5 (seed1) to 40 (lattice), examples/scaling/compound_1000.sdf 54 (linear
+    // scan over the program's liveness); 64 holds them all in 256 bytes a thread. A
+    // register's number is 13 bits of an instruction word.
+    Spec {
+        limit: Limit::Registers,
+        name: "registers",
+        default: 64,
+        ceiling: 8_190,
+        what: "registers of the interpreted GPU kernel (programs that need more cannot use it)",
+    },
+    // A triangle takes 144 bytes of the GPU's `scene_data` (its corners and
+    // pseudo-normals) and its hierarchy some 16 more: 800 000 fit the 128 MiB that wgpu's
+    // default limits let a storage buffer bind, and load in about a second.
+    Spec {
+        limit: Limit::Triangles,
+        name: "triangles",
+        default: 800_000,
+        ceiling: 1 << 28,
+        what: "triangles of the meshes one scene reads",
+    },
+    // Files are read whole: a mesh of the default `triangles` limit is about 40 MB as
+    // binary STL and several times that as text; a scene is far smaller.
+    Spec {
+        limit: Limit::FileSize,
+        name: "file_size",
+        default: 256,
+        ceiling: 1 << 20,
+        what: "MiB of one file read (a scene, an import, a mesh, a font)",
+    },
+    // Each worker is a thread of the operating system with its own stack and, on the
+    // CPU renderer, its evaluators' slots: far more workers than cores only costs
+    // (`--threads 100000` started threads until the system refused them). 1 024 is
+    // beyond any machine the project meets; the ceiling is where Linux's default
+    // limit of threads a process may start lies.
+    Spec {
+        limit: Limit::Threads,
+        name: "threads",
+        default: 1_024,
+        ceiling: 32_768,
+        what: "worker threads --threads may start",
+    },
+    // A glyph of DejaVu Sans holds some 30 lines and curves, about 2 KB as they are
+    // laid out and lowered, and every point walks the glyphs near it: 10 000
+    // characters (a few pages, far beyond any plaque or label) check in a tenth of a
+    // second within some 40 MB. `text` of a million characters took 1.9 GB.
+    Spec {
+        limit: Limit::TextChars,
+        name: "text_chars",
+        default: 10_000,
+        ceiling: 1 << 32,
+        what: "characters of the text one scene lays out (text), in all",
+    },
+    // Each point tries about 8n normals against all n balls: 64 balls are some
+    // 30 000 operations a point, and finding the planes tangent to three takes n⁴.
+    Spec {
+        limit: Limit::HullShapes,
+        name: "hull_shapes",
+        default: 64,
+        ceiling: 4_096,
+        what: "balls and cylinders one hull(shapes...) takes",
+    },
+];
+
+// Each limit's row stands at its place in the enum: [`Limit::spec`] reads it by position.
+const _: () = {
+    let mut i = 0;
+    while i < SPECS.len() {
+        assert!(
+            SPECS[i].limit as usize == i,
+            "SPECS is in declaration order"
+        );
+        i += 1;
+    }
+};
 
 impl Limit {
     /// Every limit, in the order they are listed.
@@ -113,197 +360,9 @@ impl Limit {
         Limit::HullShapes,
     ];
 
-    fn spec(self) -> Spec {
-        let s = |name, default, ceiling, what| Spec {
-            name,
-            default,
-            ceiling,
-            what,
-        };
-        match self {
-            Limit::Nesting => s("nesting", 1_000, 100_000, "levels of expression nesting"),
-            Limit::Fuel => s(
-                "fuel",
-                50_000_000,
-                1 << 50,
-                "evaluation steps (expressions and loop iterations) of one compilation",
-            ),
-            Limit::CallDepth => s(
-                "call_depth",
-                256,
-                1_000_000,
-                "depth of nested calls of functions",
-            ),
-            Limit::Nodes => s(
-                "nodes",
-                1_000_000,
-                u32::MAX as u64 - 1,
-                "shape nodes a scene builds",
-            ),
-            Limit::Objects => s(
-                "objects",
-                100_000,
-                u32::MAX as u64 - 1,
-                "objects in a scene, and iterations of one loop",
-            ),
-            Limit::Files => s("files", 256, 1_000_000, "files imported by one compilation"),
-            Limit::Edge => s(
-                "edge",
-                16_384,
-                65_535,
-                "width and height of an image, in pixels",
-            ),
-            Limit::Aa => s("aa", 16, 256, "supersampling (samples per pixel edge)"),
-            Limit::MaxSteps => s(
-                "max_steps",
-                1_000_000,
-                u32::MAX as u64 - 1,
-                "the render setting max_steps",
-            ),
-            Limit::MaxDepth => s("max_depth", 64, 1_000, "the render setting max_depth"),
-            // A sample is one path a pixel: 65 536 of them at 1920×1080 are 1.4·10¹¹ paths,
-            // hours on any device; the ceiling keeps sample indices within the random
-            // stream's 32 bits.
-            Limit::Samples => s(
-                "samples",
-                65_536,
-                1 << 31,
-                "the path tracer's samples per pixel (render setting samples)",
-            ),
-            Limit::Bounces => s(
-                "bounces",
-                64,
-                1_000,
-                "the path tracer's bounces (render setting bounces)",
-            ),
-            Limit::Program => s(
-                "program",
-                4_000_000,
-                u32::MAX as u64 - 1,
-                "operations of the distance program after lowering",
-            ),
-            Limit::Memory => s(
-                "memory",
-                4_096,
-                1 << 30,
-                "memory a render may allocate, in MiB (host and device together)",
-            ),
-            // 4 000 000 holds 2¹⁹ spheres built by sharing, two translated copies per level
-            // (2²¹ − 3 nodes as a tree, checked in about a second);
-            // every example is far below it (the largest, examples/scaling/compound_10000.sdf,
-            // expands to 120 003).
-            Limit::Expansion => s(
-                "expansion",
-                4_000_000,
-                1 << 40,
-                "shape nodes counted as a tree (a shared shape once per use)",
-            ),
-            // Rays visit the primitives through a bounding-volume hierarchy, in O(log n) per
-            // ray, so tracing beats sphere tracing at any size. The default
-            // keeps the GPU buffer of a large traced scene (at most 112 bytes a primitive:
-            // 80 for a rotated one, 32 for a group, of which there are fewer than primitives)
-            // under the 128 MiB that wgpu's default limits let a storage buffer bind; the
-            // default `objects` limit stays below it. `method: "trace"` has no limit.
-            Limit::Traced => s(
-                "traced",
-                1_000_000,
-                u32::MAX as u64 - 1,
-                "primitives method \"auto\" traces analytically (beyond, it sphere traces)",
-            ),
-            // What wgpu's default limits let a storage buffer bind (128 MiB: over a million
-            // instances, ten times the default `objects` limit).
-            Limit::SceneData => s(
-                "scene_data",
-                128,
-                4_095,
-                "MiB of a marched scene's instances in one GPU buffer (beyond, they are code)",
-            ),
-            Limit::SweepValues => s(
-                "sweep_values",
-                1_000,
-                1_000_000,
-                "values of one sdfc pareto --sweep",
-            ),
-            Limit::SweepPoints => s(
-                "sweep_points",
-                1_000,
-                1_000_000,
-                "settings sdfc pareto measures (the product of its sweeps' values)",
-            ),
-            // An hour at 30 frames per second is 108 000 frames: ten hours fit.
-            Limit::Frames => s(
-                "frames",
-                1_000_000,
-                1 << 40,
-                "frames of one animated sequence",
-            ),
-            // A dense grid of 512³ cells is 134 million; the octree of a scene at that
-            // resolution evaluates a few percent of it.
-            Limit::Cells => s(
-                "cells",
-                50_000_000,
-                1 << 40,
-                "cells sdfc mesh evaluates (octree cells and candidates, or the dense grid)",
-            ),
-            // The interpreted kernel's file is an array of this many f32 per GPU thread
-            // (compiler/src/back/wgsl/interp.rs), in the GPU's local memory: its size is part
-            // of the kernel's text, so every scene that fits shares one kernel. The examples
-            // need 5 (seed1) to 40 (lattice), examples/scaling/compound_1000.sdf 54 (linear
-            // scan over the program's liveness); 64 holds them all in 256 bytes a thread. A
-            // register's number is 13 bits of an instruction word.
-            Limit::Registers => s(
-                "registers",
-                64,
-                8_190,
-                "registers of the interpreted GPU kernel (programs that need more cannot use it)",
-            ),
-            // A triangle takes 144 bytes of the GPU's `scene_data` (its corners and
-            // pseudo-normals) and its hierarchy some 16 more: 800 000 fit the 128 MiB that wgpu's
-            // default limits let a storage buffer bind, and load in about a second.
-            Limit::Triangles => s(
-                "triangles",
-                800_000,
-                1 << 28,
-                "triangles of the meshes one scene reads",
-            ),
-            // Files are read whole: a mesh of the default `triangles` limit is about 40 MB as
-            // binary STL and several times that as text; a scene is far smaller.
-            Limit::FileSize => s(
-                "file_size",
-                256,
-                1 << 20,
-                "MiB of one file read (a scene, an import, a mesh, a font)",
-            ),
-            // Each worker is a thread of the operating system with its own stack and, on the
-            // CPU renderer, its evaluators' slots: far more workers than cores only costs
-            // (`--threads 100000` started threads until the system refused them). 1 024 is
-            // beyond any machine the project meets; the ceiling is where Linux's default
-            // limit of threads a process may start lies.
-            Limit::Threads => s(
-                "threads",
-                1_024,
-                32_768,
-                "worker threads --threads may start",
-            ),
-            // A glyph of DejaVu Sans holds some 30 lines and curves, about 2 KB as they are
-            // laid out and lowered, and every point walks the glyphs near it: 10 000
-            // characters (a few pages, far beyond any plaque or label) check in a tenth of a
-            // second within some 40 MB. `text` of a million characters took 1.9 GB.
-            Limit::TextChars => s(
-                "text_chars",
-                10_000,
-                1 << 32,
-                "characters of the text one scene lays out (text), in all",
-            ),
-            // Each point tries about 8n normals against all n balls: 64 balls are some
-            // 30 000 operations a point, and finding the planes tangent to three takes n⁴.
-            Limit::HullShapes => s(
-                "hull_shapes",
-                64,
-                4_096,
-                "balls and cylinders one hull(shapes...) takes",
-            ),
-        }
+    /// The limit's row of [`SPECS`].
+    fn spec(self) -> &'static Spec {
+        &SPECS[self as usize]
     }
 
     /// The name `--limit NAME=VALUE` uses.

@@ -31,16 +31,19 @@ fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
     ]
 }
 
-/// A graph holding one of every kind of node, alone and nested.
+/// A primitive of the table (`prim/`).
 fn prim(name: &str, args: &[&[f64]]) -> Node {
     Node::prim(name, args).expect("a primitive of the table")
 }
 
-fn zoo() -> (Graph, Vec<NodeId>) {
-    let mut g = Graph::default();
-    let add = |g: &mut Graph, n: Node| g.add(n, Span::new(FileId(0), 0..0));
-    let mut ids = Vec::new();
-    let prims = [
+/// Adds `n` to `g`, spanning nothing.
+fn add(g: &mut Graph, n: Node) -> NodeId {
+    g.add(n, Span::new(FileId(0), 0..0))
+}
+
+/// One of every primitive: those with nodes of their own, then the table's.
+fn primitives() -> Vec<Node> {
+    vec![
         Node::Sphere { radius: 0.7 },
         Node::Box {
             half: [0.5, 0.2, 0.9],
@@ -82,25 +85,18 @@ fn zoo() -> (Graph, Vec<NodeId>) {
         prim("link", &[&[0.6], &[0.4], &[0.1]]),
         prim("infinite_cylinder", &[&[0.3], &[0.0, 0.0, 1.0]]),
         prim("slab", &[&[0.4], &[0.0, 1.0, 0.0]]),
-    ];
-    let prims: Vec<NodeId> = prims.into_iter().map(|n| add(&mut g, n)).collect();
-    ids.extend(&prims);
-    let (a, b) = (prims[1], prims[7]);
-    let moved = add(
-        &mut g,
-        Node::Translate {
-            offset: [0.6, -0.2, 0.3],
-            child: b,
-        },
-    );
+    ]
+}
+
+/// Every combination of `a` and `b`: plain and smooth (of every variant) unions,
+/// intersections and subtractions, morphs and features.
+fn combinations(a: NodeId, b: NodeId) -> Vec<Node> {
+    let mut nodes = Vec::new();
     for op in [Combine::Union, Combine::Intersect, Combine::Subtract] {
-        ids.push(add(
-            &mut g,
-            Node::Combine {
-                op,
-                children: vec![a, moved],
-            },
-        ));
+        nodes.push(Node::Combine {
+            op,
+            children: vec![a, b],
+        });
         for variant in [
             Smooth::Poly,
             Smooth::Exp,
@@ -109,20 +105,17 @@ fn zoo() -> (Graph, Vec<NodeId>) {
             Smooth::Stairs(3),
             Smooth::Columns(2),
         ] {
-            ids.push(add(
-                &mut g,
-                Node::SmoothCombine {
-                    op,
-                    k: 0.5,
-                    variant,
-                    a,
-                    b: moved,
-                },
-            ));
+            nodes.push(Node::SmoothCombine {
+                op,
+                k: 0.5,
+                variant,
+                a,
+                b,
+            });
         }
     }
     for t in [0.3, 0.8] {
-        ids.push(add(&mut g, Node::Morph { t, a, b: moved }));
+        nodes.push(Node::Morph { t, a, b });
     }
     for op in [
         Feature::Engrave { depth: 0.2 },
@@ -136,88 +129,111 @@ fn zoo() -> (Graph, Vec<NodeId>) {
         },
         Feature::Pipe { radius: 0.1 },
     ] {
-        ids.push(add(&mut g, Node::Feature { op, a, b: moved }));
+        nodes.push(Node::Feature { op, a, b });
     }
-    let wrappers = |c: NodeId| {
-        vec![
-            Node::Translate {
-                offset: [1.5, -0.5, 2.0],
-                child: c,
-            },
-            Node::Rotate {
-                matrix: rotation([1.0, 2.0, 0.5], 0.9),
-                child: c,
-            },
-            Node::Scale {
-                factor: 2.5,
-                child: c,
-            },
-            Node::Scale {
-                factor: 0.4,
-                child: c,
-            },
-            Node::ScaleXyz {
-                factors: [0.5, 2.0, 1.0],
-                child: c,
-            },
-            Node::Repeat {
-                period: [1.5, 0.0, 2.0],
-                count: Some([3.0, 1.0, 2.0]),
-                child: c,
-            },
-            Node::Repeat {
-                period: [2.5, 0.0, 0.0],
-                count: None,
-                child: c,
-            },
-            Node::Mirror {
-                axes: [true, false, true],
-                child: c,
-            },
-            Node::Twist {
-                rate: 1.3,
-                child: c,
-            },
-            Node::RepeatPolar {
-                count: 5,
-                mirror: false,
-                child: c,
-            },
-            Node::RepeatPolar {
-                count: 6,
-                mirror: true,
-                child: c,
-            },
-            Node::Wrap {
-                radius: 2.0,
-                child: c,
-            },
-            Node::Shear {
-                matrix: [[1.0, 0.5, 0.0], [0.0, 1.0, 0.3], [0.2, 0.0, 1.0]],
-                child: c,
-            },
-            Node::Bend {
-                rate: 0.7,
-                child: c,
-            },
-            Node::Elongate {
-                half: [0.3, 0.0, 0.5],
-                child: c,
-            },
-            Node::Round {
-                radius: 0.2,
-                child: c,
-            },
-            Node::Shell {
-                half: 0.1,
-                child: c,
-            },
-            Node::Paint {
-                material: MaterialId(1),
-                child: c,
-            },
-        ]
-    };
+    nodes
+}
+
+/// Every transform, paint and offset of `c`.
+fn wrappers(c: NodeId) -> Vec<Node> {
+    vec![
+        Node::Translate {
+            offset: [1.5, -0.5, 2.0],
+            child: c,
+        },
+        Node::Rotate {
+            matrix: rotation([1.0, 2.0, 0.5], 0.9),
+            child: c,
+        },
+        Node::Scale {
+            factor: 2.5,
+            child: c,
+        },
+        Node::Scale {
+            factor: 0.4,
+            child: c,
+        },
+        Node::ScaleXyz {
+            factors: [0.5, 2.0, 1.0],
+            child: c,
+        },
+        Node::Repeat {
+            period: [1.5, 0.0, 2.0],
+            count: Some([3.0, 1.0, 2.0]),
+            child: c,
+        },
+        Node::Repeat {
+            period: [2.5, 0.0, 0.0],
+            count: None,
+            child: c,
+        },
+        Node::Mirror {
+            axes: [true, false, true],
+            child: c,
+        },
+        Node::Twist {
+            rate: 1.3,
+            child: c,
+        },
+        Node::RepeatPolar {
+            count: 5,
+            mirror: false,
+            child: c,
+        },
+        Node::RepeatPolar {
+            count: 6,
+            mirror: true,
+            child: c,
+        },
+        Node::Wrap {
+            radius: 2.0,
+            child: c,
+        },
+        Node::Shear {
+            matrix: [[1.0, 0.5, 0.0], [0.0, 1.0, 0.3], [0.2, 0.0, 1.0]],
+            child: c,
+        },
+        Node::Bend {
+            rate: 0.7,
+            child: c,
+        },
+        Node::Elongate {
+            half: [0.3, 0.0, 0.5],
+            child: c,
+        },
+        Node::Round {
+            radius: 0.2,
+            child: c,
+        },
+        Node::Shell {
+            half: 0.1,
+            child: c,
+        },
+        Node::Paint {
+            material: MaterialId(1),
+            child: c,
+        },
+    ]
+}
+
+/// A graph holding one of every kind of node, alone and nested: the primitives, their
+/// combinations, each of those wrapped once (translated first), and a few shapes wrapped
+/// twice.
+fn zoo() -> (Graph, Vec<NodeId>) {
+    let mut g = Graph::default();
+    let prims: Vec<NodeId> = primitives().into_iter().map(|n| add(&mut g, n)).collect();
+    let mut ids = prims.clone();
+    let (a, b) = (prims[1], prims[7]);
+    let moved = add(
+        &mut g,
+        Node::Translate {
+            offset: [0.6, -0.2, 0.3],
+            child: b,
+        },
+    );
+    for n in combinations(a, moved) {
+        ids.push(add(&mut g, n));
+    }
     let bases: Vec<NodeId> = ids.clone();
     for &c in &bases {
         let shifted = add(

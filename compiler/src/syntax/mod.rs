@@ -2,6 +2,7 @@
 
 pub mod ast;
 mod dump;
+mod errors;
 pub mod format;
 pub mod lexer;
 pub mod parser;

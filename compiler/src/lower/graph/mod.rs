@@ -183,14 +183,7 @@ impl<'a> Lowerer<'a> {
                 b,
             } => self.smooth(id, *op, *k, *variant, [*a, *b], p),
             Node::Feature { op, a, b } => self.feature(id, *op, [*a, *b], p),
-            Node::Paint { material, child } => {
-                let f = self.node(*child, p);
-                self.resume(id, node);
-                Field {
-                    d: f.d,
-                    m: self.b.paint(f.m, material.0 as f64),
-                }
-            }
+            Node::Paint { material, child } => self.paint(id, material.0 as f64, *child, p),
             Node::Round { radius, child } => self.post(id, *child, p, |b, d| b.subc(d, *radius)),
             Node::Shell { half, child } => self.post(id, *child, p, |b, d| {
                 let a = b.abs(d);
@@ -213,88 +206,22 @@ impl<'a> Lowerer<'a> {
                 mirror,
                 child,
             } => self.polar(id, *count, *mirror, *child, p),
-            Node::Shear { matrix, child } => {
-                // f(S⁻¹p)·σmin(S): a bound with the child's L (docs/analysis.md).
-                let inverse = analysis::invert(matrix).unwrap_or(IDENTITY);
-                let (smin, _) = crate::scene::bounds::singular_range(matrix);
-                let transposed = [0, 1, 2].map(|i| [0, 1, 2].map(|j| inverse[j][i]));
-                let q = rotate(self.b, p, &transposed);
-                self.post(id, *child, q, |b, d| b.mulc(d, smin))
-            }
-            Node::Taper { rate, child } => {
-                // f(x/s, y, z/s)·s with s = 1 + rate·y, clamped above 0 where the taper folds.
-                let b = &mut *self.b;
-                let s = b.mulc(p[1], *rate);
-                let s = b.addc(s, 1.0);
-                let s = b.maxc(s, analysis::TAPER_FLOOR);
-                let q = [b.div(p[0], s), p[1], b.div(p[2], s)];
-                self.post(id, *child, q, |b, d| b.mul(d, s))
-            }
-            Node::Morph { t, a, b } => {
-                let (fa, fb) = (self.node(*a, p), self.node(*b, p));
-                self.resume(id, node);
-                let wa = self.b.mulc(fa.d, 1.0 - t);
-                let wb = self.b.mulc(fb.d, *t);
-                Field {
-                    d: self.b.add(wa, wb),
-                    m: self.material(Combine::Union, fa, fb),
-                }
-            }
+            Node::Shear { matrix, child } => self.shear(id, matrix, *child, p),
+            Node::Taper { rate, child } => self.taper(id, *rate, *child, p),
+            Node::Morph { t, a, b } => self.morph(id, *t, [*a, *b], p),
             Node::Field { f, .. } => self.field(id, f, p),
             Node::Extrude {
                 half_height,
                 round,
                 child,
-            } => {
-                // The profile is read in the plane z = 0.
-                let (h, r) = (*half_height, *round);
-                let q = [p[0], p[1], self.b.c(0.0)];
-                self.post(id, *child, q, |b, d| {
-                    if r > 0.0 {
-                        let d = b.addc(d, r);
-                        let e = crate::prim::extrude(b, d, p[2], h - r);
-                        b.subc(e, r)
-                    } else {
-                        crate::prim::extrude(b, d, p[2], h)
-                    }
-                })
-            }
-            Node::Revolve { offset, child } => {
-                let b = &mut *self.b;
-                let r = b.len2(p[0], p[2]);
-                let x = b.subc(r, *offset);
-                let q = [x, p[1], b.c(0.0)];
-                let f = self.node(*child, q);
-                Field { d: f.d, m: f.m }
-            }
+            } => self.extrude(id, *half_height, *round, *child, p),
+            Node::Revolve { offset, child } => self.revolve(*offset, *child, p),
             Node::Loft {
                 half_height,
                 spread,
                 bottom,
                 top,
-            } => {
-                // Both profiles in the plane z = 0, mixed by the height's fraction t, the
-                // difference clamped to ±spread (docs/analysis.md, "Loft"), then extruded.
-                let (h, s) = (*half_height, *spread);
-                let q = [p[0], p[1], self.b.c(0.0)];
-                let (fa, fb) = (self.node(*bottom, q), self.node(*top, q));
-                self.resume(id, node);
-                let b = &mut *self.b;
-                let t = b.mulc(p[2], 0.5 / h);
-                let t = b.addc(t, 0.5);
-                let t = b.clampc(t, 0.0, 1.0);
-                let diff = b.sub(fb.d, fa.d);
-                let diff = b.clampc(diff, -s, s);
-                let step = b.mul(t, diff);
-                let d = b.add(fa.d, step);
-                let d = crate::prim::extrude(b, d, p[2], h);
-                let upper = b.c(0.5);
-                let upper = b.lt(upper, t);
-                Field {
-                    d,
-                    m: b.select(upper, fb.m, fa.m),
-                }
-            }
+            } => self.loft(id, [*half_height, *spread], [*bottom, *top], p),
             Node::Screw {
                 pitch,
                 half_height,
@@ -308,15 +235,7 @@ impl<'a> Lowerer<'a> {
                 extent,
                 child,
                 ..
-            } => {
-                // The profile read in its plane z = 0 at the point's place about the path.
-                let hit = super::sweep::locate(self.b, p, &path.0);
-                let q = [hit.u, hit.v, self.b.c(0.0)];
-                let f = self.node(*child, q);
-                self.resume(id, node);
-                let d = super::sweep::finish(self.b, f.d, &hit, *inner, *extent);
-                Field { d, m: f.m }
-            }
+            } => self.sweep(id, &path.0, [*inner, *extent], *child, p),
             Node::ScaleXyz { factors, child } => {
                 let q = self.b.map3(p, |b, x, i| b.mulc(x, 1.0 / factors[i]));
                 let s = factors.iter().fold(f64::INFINITY, |m, f| m.min(f.abs()));
@@ -327,6 +246,115 @@ impl<'a> Lowerer<'a> {
                 None => self.primitive(node, p),
             },
         }
+    }
+
+    /// Paint: the child's field, its material register painted `material`.
+    fn paint(&mut self, id: NodeId, material: f64, child: NodeId, p: P) -> Field {
+        let f = self.node(child, p);
+        self.resume(id, self.graph.node(id));
+        Field {
+            d: f.d,
+            m: self.b.paint(f.m, material),
+        }
+    }
+
+    /// A shear S: f(S⁻¹p)·σmin(S), a bound with the child's L (docs/analysis.md).
+    fn shear(&mut self, id: NodeId, matrix: &[V3; 3], child: NodeId, p: P) -> Field {
+        let inverse = analysis::invert(matrix).unwrap_or(IDENTITY);
+        let (smin, _) = crate::scene::bounds::singular_range(matrix);
+        let transposed = [0, 1, 2].map(|i| [0, 1, 2].map(|j| inverse[j][i]));
+        let q = rotate(self.b, p, &transposed);
+        self.post(id, child, q, |b, d| b.mulc(d, smin))
+    }
+
+    /// A taper: f(x/s, y, z/s)·s with s = 1 + rate·y, clamped above 0 where the taper folds.
+    fn taper(&mut self, id: NodeId, rate: f64, child: NodeId, p: P) -> Field {
+        let b = &mut *self.b;
+        let s = b.mulc(p[1], rate);
+        let s = b.addc(s, 1.0);
+        let s = b.maxc(s, analysis::TAPER_FLOOR);
+        let q = [b.div(p[0], s), p[1], b.div(p[2], s)];
+        self.post(id, child, q, |b, d| b.mul(d, s))
+    }
+
+    /// A morph: the mix (1 - t)·a + t·b of the two fields, the nearer's material.
+    fn morph(&mut self, id: NodeId, t: f64, [a, b]: [NodeId; 2], p: P) -> Field {
+        let (fa, fb) = (self.node(a, p), self.node(b, p));
+        self.resume(id, self.graph.node(id));
+        let wa = self.b.mulc(fa.d, 1.0 - t);
+        let wb = self.b.mulc(fb.d, t);
+        Field {
+            d: self.b.add(wa, wb),
+            m: self.material(Combine::Union, fa, fb),
+        }
+    }
+
+    /// An extrusion of `half_height`, its edges rounded by `round`: the profile is read in
+    /// the plane z = 0.
+    fn extrude(&mut self, id: NodeId, half_height: f64, round: f64, child: NodeId, p: P) -> Field {
+        let (h, r) = (half_height, round);
+        let q = [p[0], p[1], self.b.c(0.0)];
+        self.post(id, child, q, |b, d| {
+            if r > 0.0 {
+                let d = b.addc(d, r);
+                let e = crate::prim::extrude(b, d, p[2], h - r);
+                b.subc(e, r)
+            } else {
+                crate::prim::extrude(b, d, p[2], h)
+            }
+        })
+    }
+
+    /// A revolution about the y axis: the profile read at (r - offset, y) in the plane z = 0,
+    /// r the distance from the axis.
+    fn revolve(&mut self, offset: f64, child: NodeId, p: P) -> Field {
+        let b = &mut *self.b;
+        let r = b.len2(p[0], p[2]);
+        let x = b.subc(r, offset);
+        let q = [x, p[1], b.c(0.0)];
+        let f = self.node(child, q);
+        Field { d: f.d, m: f.m }
+    }
+
+    /// A loft: both profiles in the plane z = 0, mixed by the height's fraction t, the
+    /// difference clamped to ±spread (docs/analysis.md, "Loft"), then extruded.
+    fn loft(&mut self, id: NodeId, [h, s]: [f64; 2], [bottom, top]: [NodeId; 2], p: P) -> Field {
+        let q = [p[0], p[1], self.b.c(0.0)];
+        let (fa, fb) = (self.node(bottom, q), self.node(top, q));
+        self.resume(id, self.graph.node(id));
+        let b = &mut *self.b;
+        let t = b.mulc(p[2], 0.5 / h);
+        let t = b.addc(t, 0.5);
+        let t = b.clampc(t, 0.0, 1.0);
+        let diff = b.sub(fb.d, fa.d);
+        let diff = b.clampc(diff, -s, s);
+        let step = b.mul(t, diff);
+        let d = b.add(fa.d, step);
+        let d = crate::prim::extrude(b, d, p[2], h);
+        let upper = b.c(0.5);
+        let upper = b.lt(upper, t);
+        Field {
+            d,
+            m: b.select(upper, fb.m, fa.m),
+        }
+    }
+
+    /// A sweep along `path`: the profile read in its plane z = 0 at the point's place about
+    /// the path, then cut to the sweep's `inner` and `extent`.
+    fn sweep(
+        &mut self,
+        id: NodeId,
+        path: &crate::scene::path::Path,
+        [inner, extent]: [f64; 2],
+        child: NodeId,
+        p: P,
+    ) -> Field {
+        let hit = super::sweep::locate(self.b, p, path);
+        let q = [hit.u, hit.v, self.b.c(0.0)];
+        let f = self.node(child, q);
+        self.resume(id, self.graph.node(id));
+        let d = super::sweep::finish(self.b, f.d, &hit, inner, extent);
+        Field { d, m: f.m }
     }
 
     /// A screw (docs/analysis.md, "Screw"): the profile read at (r, w), r the distance from
@@ -534,10 +562,6 @@ pub(super) fn field_and_bound(
     Some(b.finish(f.d, beta))
 }
 
-/// Whether only the zero set of a node's children matters when only its own does: true for
-/// plain combinations (a minimum or maximum of bounds is a bound), paint, translation,
-/// rotation and uniform scale; false where the children's values are read (offsets, smooth
-/// combinations) or the point map stretches (repetition, twist, bend, per-axis scale).
 /// For each node of `graph`, whether its L may exceed 1 for some values of its numbers (and of
 /// its descendants'): the maps that stretch distances by an amount their numbers set (twist,
 /// bend, taper, shear, wrap, a scale per axis, a screw, a loft) and user fields do; shapes,
@@ -568,6 +592,10 @@ fn steepening(graph: &Graph) -> Vec<bool> {
     out
 }
 
+/// Whether only the zero set of a node's children matters when only its own does: true for
+/// plain combinations (a minimum or maximum of bounds is a bound), paint, translation,
+/// rotation and uniform scale; false where the children's values are read (offsets, smooth
+/// combinations) or the point map stretches (repetition, twist, bend, per-axis scale).
 fn keeps_zero_set(node: &Node) -> bool {
     matches!(
         node,

@@ -358,147 +358,9 @@ fn bezier(
     let k = (pts.len() - 1) / 3;
     let mut best = None;
     for c in 0..k {
-        let q = &pts[3 * c..3 * c + 4];
-        // The chords.
-        let mut near: Option<(Reg, Reg)> = None;
-        for j in 0..pieces {
-            let (t0, t1) = (j as f64 / pieces as f64, (j + 1) as f64 / pieces as f64);
-            let (a, e) = (cubic(q, t0), cubic(q, t1) - cubic(q, t0));
-            let r = b.sub3c(p, a.to_array());
-            let s = dot(b, r, e / e.length_squared().max(1e-300));
-            let s = b.clampc(s, 0.0, 1.0);
-            let off = b.map3(r, |b, x, i| {
-                let m = b.mulc(s, e[i]);
-                b.sub(x, m)
-            });
-            let d2 = b.dot3(off, off);
-            let t = b.mulc(s, t1 - t0);
-            let t = b.addc(t, t0);
-            near = Some(match near {
-                None => (d2, t),
-                Some((bd, bt)) => {
-                    let cnd = b.lt(d2, bd);
-                    (b.select(cnd, d2, bd), b.select(cnd, t, bt))
-                }
-            });
-        }
-        let (_, mut t) = near.expect("pieces");
-        let co = coefficients(q);
-        let curve = |b: &mut Builder, t: Reg| -> (P, P, P) {
-            let pos = b.map3(p, |b, _, i| {
-                let x = b.mulc(t, co[3][i]);
-                let x = b.addc(x, co[2][i]);
-                let x = b.mul(x, t);
-                let x = b.addc(x, co[1][i]);
-                let x = b.mul(x, t);
-                b.addc(x, co[0][i])
-            });
-            let d1 = b.map3(p, |b, _, i| {
-                let x = b.mulc(t, 3.0 * co[3][i]);
-                let x = b.addc(x, 2.0 * co[2][i]);
-                let x = b.mul(x, t);
-                b.addc(x, co[1][i])
-            });
-            let d2 = b.map3(p, |b, _, i| {
-                let x = b.mulc(t, 6.0 * co[3][i]);
-                b.addc(x, 2.0 * co[2][i])
-            });
-            (pos, d1, d2)
-        };
-        for _ in 0..3 {
-            let (pos, d1, d2) = curve(b, t);
-            let d = b.map3(pos, |b, x, i| b.sub(x, p[i]));
-            let f1 = b.dot3(d, d1);
-            let g = b.dot3(d1, d1);
-            let h = b.dot3(d, d2);
-            // Newton's step where the squared distance curves up enough, at most a piece's
-            // span (near the centre of curvature it is flat, and beyond it curves down).
-            let f2 = b.add(g, h);
-            let floor = b.mulc(g, 0.02);
-            let f2 = b.max(f2, floor);
-            let f2 = b.maxc(f2, 1e-12);
-            let step = b.div(f1, f2);
-            let span = 1.0 / pieces as f64;
-            let step = b.clampc(step, -span, span);
-            let next = b.sub(t, step);
-            t = b.clampc(next, 0.0, 1.0);
-        }
-        let (pos, d1, _) = curve(b, t);
-        let qv = b.map3(p, |b, x, i| b.sub(x, pos[i]));
-        let d2 = b.dot3(qv, qv);
-        let l = b.len3(d1);
-        let tan = b.map3(d1, |b, x, _| b.div(x, l));
-        // N between the cuts: Σ N_j·max(0, 1 − |m·t − j|).
-        let mt = b.mulc(t, pieces as f64);
-        let mut nv: Option<P> = None;
-        for j in 0..=pieces {
-            let nj = normals[c * (pieces + 1) + j];
-            let x = b.subc(mt, j as f64);
-            let x = b.abs(x);
-            let x = b.neg(x);
-            let hat = b.addc(x, 1.0);
-            let hat = b.maxc(hat, 0.0);
-            nv = Some(match nv {
-                None => b.map3(p, |b, _, i| b.mulc(hat, nj[i])),
-                Some(acc) => b.map3(acc, |b, a, i| {
-                    let m = b.mulc(hat, nj[i]);
-                    b.add(a, m)
-                }),
-            });
-        }
-        let nv = nv.expect("cuts");
-        let along = b.dot3(nv, tan);
-        let nv = b.map3(nv, |b, x, i| {
-            let m = b.mul(along, tan[i]);
-            b.sub(x, m)
-        });
-        let nl = b.len3(nv);
-        let nn = b.map3(nv, |b, x, _| b.div(x, nl));
-        let bb = cross(b, tan, nn);
-        let u = b.dot3(qv, nn);
-        let v = b.dot3(qv, bb);
-        // Beyond an end at a corner the corner's wedge holds the nearest point.
-        let along = b.dot3(qv, tan);
-        let mut d2 = d2;
-        let (starts, ends) = (joint(&pts, c, closed), joint(&pts, c + 1, closed));
-        if starts.is_some() {
-            let (lim, zero) = (b.c(1e-6), b.c(0.0));
-            let at = b.lt(t, lim);
-            let back = b.lt(along, zero);
-            let out = b.mul(at, back);
-            let far = b.c(FAR);
-            d2 = b.select(out, far, d2);
-        }
-        if ends.is_some() {
-            let (lim, zero) = (b.c(1.0 - 1e-6), b.c(0.0));
-            let at = b.lt(lim, t);
-            let ahead = b.lt(zero, along);
-            let out = b.mul(at, ahead);
-            let far = b.c(FAR);
-            d2 = b.select(out, far, d2);
-        }
-        let mut w = b.c(-FAR);
-        if !closed && c == 0 {
-            let t0 = tangent(q, 0.0).normalize();
-            let r = b.sub3c(p, q[0].to_array());
-            let plane = dot(b, r, -t0);
-            let lim = b.c(0.25);
-            let near = b.lt(t, lim);
-            let far = b.c(-FAR);
-            let plane = b.select(near, plane, far);
-            w = b.max(w, plane);
-        }
-        if !closed && c + 1 == k {
-            let t1 = tangent(q, 1.0).normalize();
-            let r = b.sub3c(p, q[3].to_array());
-            let plane = dot(b, r, t1);
-            let lim = b.c(0.75);
-            let near = b.lt(lim, t);
-            let far = b.c(-FAR);
-            let plane = b.select(near, plane, far);
-            w = b.max(w, plane);
-        }
-        best = Some(nearer(b, best, Hit { d2, u, v, w }));
+        let cuts = &normals[c * (pieces + 1)..(c + 1) * (pieces + 1)];
+        let h = bezier_curve(b, p, &pts, c, cuts, closed);
+        best = Some(nearer(b, best, h));
     }
     for c in 0..k {
         if let Some((x, t0, t1)) = joint(&pts, c, closed) {
@@ -511,6 +373,198 @@ fn bezier(
         }
     }
     best.expect("a Bézier path has a curve")
+}
+
+/// Where `p` lies about curve `c` of the chain `pts`, whose frame's N at its cuts is `cuts`
+/// (one more than its pieces): its nearest point, the frame there, and the ends' and
+/// corners' limits.
+fn bezier_curve(
+    b: &mut Builder,
+    p: P,
+    pts: &[DVec3],
+    c: usize,
+    cuts: &[[f64; 3]],
+    closed: bool,
+) -> Hit {
+    let k = (pts.len() - 1) / 3;
+    let pieces = cuts.len() - 1;
+    let q = &pts[3 * c..3 * c + 4];
+    let t = nearest_chord(b, p, q, pieces);
+    let co = coefficients(q);
+    let t = newton(b, p, &co, t, pieces);
+    let (pos, d1, _) = curve_at(b, p, &co, t);
+    let qv = b.map3(p, |b, x, i| b.sub(x, pos[i]));
+    let d2 = b.dot3(qv, qv);
+    let l = b.len3(d1);
+    let tan = b.map3(d1, |b, x, _| b.div(x, l));
+    let nn = frame_normal(b, p, cuts, t, tan);
+    let bb = cross(b, tan, nn);
+    let u = b.dot3(qv, nn);
+    let v = b.dot3(qv, bb);
+    // Beyond an end at a corner the corner's wedge holds the nearest point.
+    let along = b.dot3(qv, tan);
+    let mut d2 = d2;
+    if joint(pts, c, closed).is_some() {
+        d2 = past_end(b, d2, t, along, true);
+    }
+    if joint(pts, c + 1, closed).is_some() {
+        d2 = past_end(b, d2, t, along, false);
+    }
+    let mut w = b.c(-FAR);
+    if !closed && c == 0 {
+        let plane = end_plane(b, p, q, t, true);
+        w = b.max(w, plane);
+    }
+    if !closed && c + 1 == k {
+        let plane = end_plane(b, p, q, t, false);
+        w = b.max(w, plane);
+    }
+    Hit { d2, u, v, w }
+}
+
+/// The parameter of the nearest point to `p` on the chords of the curve `q`'s `pieces`
+/// pieces.
+fn nearest_chord(b: &mut Builder, p: P, q: &[DVec3], pieces: usize) -> Reg {
+    let mut near: Option<(Reg, Reg)> = None;
+    for j in 0..pieces {
+        let (t0, t1) = (j as f64 / pieces as f64, (j + 1) as f64 / pieces as f64);
+        let (a, e) = (cubic(q, t0), cubic(q, t1) - cubic(q, t0));
+        let r = b.sub3c(p, a.to_array());
+        let s = dot(b, r, e / e.length_squared().max(1e-300));
+        let s = b.clampc(s, 0.0, 1.0);
+        let off = b.map3(r, |b, x, i| {
+            let m = b.mulc(s, e[i]);
+            b.sub(x, m)
+        });
+        let d2 = b.dot3(off, off);
+        let t = b.mulc(s, t1 - t0);
+        let t = b.addc(t, t0);
+        near = Some(match near {
+            None => (d2, t),
+            Some((bd, bt)) => {
+                let cnd = b.lt(d2, bd);
+                (b.select(cnd, d2, bd), b.select(cnd, t, bt))
+            }
+        });
+    }
+    near.expect("pieces").1
+}
+
+/// The curve of coefficients `co` at `t`: its point and its first and second derivatives.
+fn curve_at(b: &mut Builder, p: P, co: &[DVec3; 4], t: Reg) -> (P, P, P) {
+    let pos = b.map3(p, |b, _, i| {
+        let x = b.mulc(t, co[3][i]);
+        let x = b.addc(x, co[2][i]);
+        let x = b.mul(x, t);
+        let x = b.addc(x, co[1][i]);
+        let x = b.mul(x, t);
+        b.addc(x, co[0][i])
+    });
+    let d1 = b.map3(p, |b, _, i| {
+        let x = b.mulc(t, 3.0 * co[3][i]);
+        let x = b.addc(x, 2.0 * co[2][i]);
+        let x = b.mul(x, t);
+        b.addc(x, co[1][i])
+    });
+    let d2 = b.map3(p, |b, _, i| {
+        let x = b.mulc(t, 6.0 * co[3][i]);
+        b.addc(x, 2.0 * co[2][i])
+    });
+    (pos, d1, d2)
+}
+
+/// Three steps of Newton's method from `t` towards the parameter of the curve's point
+/// nearest `p`, each at most a piece's span.
+fn newton(b: &mut Builder, p: P, co: &[DVec3; 4], mut t: Reg, pieces: usize) -> Reg {
+    for _ in 0..3 {
+        let (pos, d1, d2) = curve_at(b, p, co, t);
+        let d = b.map3(pos, |b, x, i| b.sub(x, p[i]));
+        let f1 = b.dot3(d, d1);
+        let g = b.dot3(d1, d1);
+        let h = b.dot3(d, d2);
+        // Newton's step where the squared distance curves up enough, at most a piece's
+        // span (near the centre of curvature it is flat, and beyond it curves down).
+        let f2 = b.add(g, h);
+        let floor = b.mulc(g, 0.02);
+        let f2 = b.max(f2, floor);
+        let f2 = b.maxc(f2, 1e-12);
+        let step = b.div(f1, f2);
+        let span = 1.0 / pieces as f64;
+        let step = b.clampc(step, -span, span);
+        let next = b.sub(t, step);
+        t = b.clampc(next, 0.0, 1.0);
+    }
+    t
+}
+
+/// The frame's unit N at `t` on a curve whose N at its cuts is `cuts`: interpolated between
+/// the cuts, then made normal to the unit direction `tan`.
+fn frame_normal(b: &mut Builder, p: P, cuts: &[[f64; 3]], t: Reg, tan: P) -> P {
+    let pieces = cuts.len() - 1;
+    // N between the cuts: Σ N_j·max(0, 1 − |m·t − j|).
+    let mt = b.mulc(t, pieces as f64);
+    let mut nv: Option<P> = None;
+    for (j, nj) in cuts.iter().enumerate() {
+        let x = b.subc(mt, j as f64);
+        let x = b.abs(x);
+        let x = b.neg(x);
+        let hat = b.addc(x, 1.0);
+        let hat = b.maxc(hat, 0.0);
+        nv = Some(match nv {
+            None => b.map3(p, |b, _, i| b.mulc(hat, nj[i])),
+            Some(acc) => b.map3(acc, |b, a, i| {
+                let m = b.mulc(hat, nj[i]);
+                b.add(a, m)
+            }),
+        });
+    }
+    let nv = nv.expect("cuts");
+    let along = b.dot3(nv, tan);
+    let nv = b.map3(nv, |b, x, i| {
+        let m = b.mul(along, tan[i]);
+        b.sub(x, m)
+    });
+    let nl = b.len3(nv);
+    b.map3(nv, |b, x, _| b.div(x, nl))
+}
+
+/// `d2`, or FAR where the point lies past the curve's `start` (or its end) along the curve's
+/// direction there (`along`), as it does beyond a corner.
+fn past_end(b: &mut Builder, d2: Reg, t: Reg, along: Reg, start: bool) -> Reg {
+    let out = if start {
+        let (lim, zero) = (b.c(1e-6), b.c(0.0));
+        let at = b.lt(t, lim);
+        let back = b.lt(along, zero);
+        b.mul(at, back)
+    } else {
+        let (lim, zero) = (b.c(1.0 - 1e-6), b.c(0.0));
+        let at = b.lt(lim, t);
+        let ahead = b.lt(zero, along);
+        b.mul(at, ahead)
+    };
+    let far = b.c(FAR);
+    b.select(out, far, d2)
+}
+
+/// How far beyond the plane of the open path's `start` (or its end) on the curve `q` the point
+/// lies, where its nearest point is in the curve's first (last) quarter; −FAR elsewhere.
+fn end_plane(b: &mut Builder, p: P, q: &[DVec3], t: Reg, start: bool) -> Reg {
+    let near = if start {
+        let t0 = tangent(q, 0.0).normalize();
+        let r = b.sub3c(p, q[0].to_array());
+        let plane = dot(b, r, -t0);
+        let lim = b.c(0.25);
+        (b.lt(t, lim), plane)
+    } else {
+        let t1 = tangent(q, 1.0).normalize();
+        let r = b.sub3c(p, q[3].to_array());
+        let plane = dot(b, r, t1);
+        let lim = b.c(0.75);
+        (b.lt(lim, t), plane)
+    };
+    let (near, plane) = near;
+    let far = b.c(-FAR);
+    b.select(near, plane, far)
 }
 
 /// The corner where curve `c` starts, if the curve before it (the last, on a closed path)

@@ -484,6 +484,28 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
     let called = calls.meshes || calls.outlines;
     let last = file; // the scratch register
     let mut out = String::new();
+    write_globals(&mut out, file, called);
+    write_step(&mut out, last, called);
+    if called {
+        write_call(&mut out, last, calls);
+    }
+    write_interpret(&mut out, unroll, called);
+    if calls.meshes {
+        out.push_str(&super::mesh::write());
+        out.push('\n');
+    }
+    if calls.outlines {
+        out.push_str(&super::glyphs::functions("", "scene_data"));
+        out.push('\n');
+    }
+    write_entries(&mut out, media);
+    out
+}
+
+/// The interpreter's globals: its register file of `file` registers and one scratch, the
+/// normal and result it shares with its callers, and, when the programs `called` the data's
+/// functions, the operands of a pending call.
+fn write_globals(out: &mut String, file: usize, called: bool) {
     let _ = writeln!(
         out,
         "// The distance programs, interpreted from `scene_data` (compiler/src/back/wgsl/interp.rs):\n\
@@ -496,14 +518,6 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
          const INTERP_DONE: u32 = 0xffffffffu;\n",
         file + 1
     );
-    let call = if called {
-        format!(
-            "if op == {MESH}u || op == {OUTLINE}u {{\n        interp_args = vec3<f32>(a, b, c);\n        \
-             interp_pc = pc;\n        return INTERP_CALL;\n    }}\n    "
-        )
-    } else {
-        String::new()
-    };
     if called {
         out.push_str(
             "// A call of the data's functions (MESH, OUTLINE): its operands and its word, run by\n\
@@ -513,6 +527,20 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
              const INTERP_CALL: u32 = 0xfffffffeu;\n\n",
         );
     }
+}
+
+/// `interp_step`, which runs one instruction: its operands read, then a `case` per opcode
+/// ([`write_cases`]) that writes register `last` at most; with `called`, a call of the data's
+/// functions returns to the interpreter's loop.
+fn write_step(out: &mut String, last: usize, called: bool) {
+    let call = if called {
+        format!(
+            "if op == {MESH}u || op == {OUTLINE}u {{\n        interp_args = vec3<f32>(a, b, c);\n        \
+             interp_pc = pc;\n        return INTERP_CALL;\n    }}\n    "
+        )
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         out,
         "// Runs the instruction at pc; returns the next one's index, or INTERP_DONE after RETURN.\n\
@@ -527,22 +555,32 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
          {call}\
          var v = 0.0;\n    var next = pc + 1u;\n    switch op {{"
     );
+    write_cases(out);
+    let _ = writeln!(
+        out,
+        "        default: {{}}\n    }}\n    interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = v;\n    return next;\n}}\n"
+    );
+}
+
+/// The cases of `interp_step`'s switch: the inputs, the copy and the block's jump, then one
+/// per unary and binary operation, and the select.
+fn write_cases(out: &mut String) {
     let case = |out: &mut String, op: u32, body: &str| {
         let _ = writeln!(
             out,
             "        case {op}u: {{\n            {body}\n        }}"
         );
     };
-    case(&mut out, INPUT + Axis::X as u32, "v = p.x;");
-    case(&mut out, INPUT + Axis::Y as u32, "v = p.y;");
-    case(&mut out, INPUT + Axis::Z as u32, "v = p.z;");
-    case(&mut out, NORMAL, "v = interp_normal.x;");
-    case(&mut out, NORMAL + 1, "v = interp_normal.y;");
-    case(&mut out, NORMAL + 2, "v = interp_normal.z;");
-    case(&mut out, COPY, "v = a;");
+    case(out, INPUT + Axis::X as u32, "v = p.x;");
+    case(out, INPUT + Axis::Y as u32, "v = p.y;");
+    case(out, INPUT + Axis::Z as u32, "v = p.z;");
+    case(out, NORMAL, "v = interp_normal.x;");
+    case(out, NORMAL + 1, "v = interp_normal.y;");
+    case(out, NORMAL + 2, "v = interp_normal.z;");
+    case(out, COPY, "v = a;");
     // The block runs where !(bound >= best), as map.rs's `if`.
     case(
-        &mut out,
+        out,
         BLOCK,
         "if a >= b {\n                next = u32(w.w);\n            }",
     );
@@ -560,7 +598,7 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
             // ⌊a + 0.5⌋, as map.rs writes it.
             Unary::Round => "floor(a + 0.5)",
         };
-        case(&mut out, UNARY + k as u32, &format!("v = {e};"));
+        case(out, UNARY + k as u32, &format!("v = {e};"));
     }
     for (k, bin) in BINARIES.iter().enumerate() {
         let e = match bin {
@@ -574,39 +612,43 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
             Binary::Atan2 => "atan2(a, b)",
             Binary::Lt => "select(0.0, 1.0, a < b)",
         };
-        case(&mut out, BINARY + k as u32, &format!("v = {e};"));
+        case(out, BINARY + k as u32, &format!("v = {e};"));
     }
-    case(&mut out, SELECT, "v = select(c, b, a != 0.0);");
-    let _ = writeln!(
-        out,
-        "        default: {{}}\n    }}\n    interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = v;\n    return next;\n}}\n"
-    );
-    if called {
-        let mut body = String::new();
-        if calls.meshes {
-            let _ = write!(
-                body,
-                "if (h & 0xffu) == {MESH}u {{\n        \
-                 let base = u32(scene_data[interp_pc + 1u].y);\n        \
-                 interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = mesh_distance(interp_args, base);\n        \
-                 return interp_pc + 2u;\n    }}\n    "
-            );
-        }
-        if calls.outlines {
-            let _ = write!(
-                body,
-                "if (h & 0xffu) == {OUTLINE}u {{\n        \
-                 let q = interp_args.xy;\n        \
-                 interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = text_outline(u32(interp_args.z), q);\n    }}\n    "
-            );
-        }
-        let _ = writeln!(
-            out,
-            "// Runs the call at interp_pc; returns the next instruction's index.\n\
-             fn interp_call() -> u32 {{\n    let h = u32(scene_data[interp_pc].x);\n    \
-             {body}return interp_pc + 1u;\n}}\n"
+    case(out, SELECT, "v = select(c, b, a != 0.0);");
+}
+
+/// `interp_call`, which runs the call of the data's functions (a mesh's distance, a text's
+/// outline) that `interp_step` left pending, writing register `last` at most.
+fn write_call(out: &mut String, last: usize, calls: Calls) {
+    let mut body = String::new();
+    if calls.meshes {
+        let _ = write!(
+            body,
+            "if (h & 0xffu) == {MESH}u {{\n        \
+             let base = u32(scene_data[interp_pc + 1u].y);\n        \
+             interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = mesh_distance(interp_args, base);\n        \
+             return interp_pc + 2u;\n    }}\n    "
         );
     }
+    if calls.outlines {
+        let _ = write!(
+            body,
+            "if (h & 0xffu) == {OUTLINE}u {{\n        \
+             let q = interp_args.xy;\n        \
+             interp_regs[min(h >> {DEST_SHIFT}u, {last}u)] = text_outline(u32(interp_args.z), q);\n    }}\n    "
+        );
+    }
+    let _ = writeln!(
+        out,
+        "// Runs the call at interp_pc; returns the next instruction's index.\n\
+         fn interp_call() -> u32 {{\n    let h = u32(scene_data[interp_pc].x);\n    \
+         {body}return interp_pc + 1u;\n}}\n"
+    );
+}
+
+/// `interpret`, which runs a program from its start to its `RETURN`: `unroll` steps an
+/// iteration of its loop, the pending calls between (with `called`).
+fn write_interpret(out: &mut String, unroll: usize, called: bool) {
     let _ = writeln!(
         out,
         "// Runs the program that starts at `start` at p: (distance, material id, 0), or a colour.\n\
@@ -635,14 +677,11 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
     out.push_str(
         "    }\n    if pc != INTERP_DONE {\n        counters.cut += 1u;\n    }\n    return interp_result;\n}\n\n",
     );
-    if calls.meshes {
-        out.push_str(&super::mesh::write());
-        out.push('\n');
-    }
-    if calls.outlines {
-        out.push_str(&super::glyphs::functions("", "scene_data"));
-        out.push('\n');
-    }
+}
+
+/// The distance functions the kernel calls (`map`, `sdf`, and with `media` those of glass
+/// over solids), each the interpreter run from its program's start in `scene_data`.
+fn write_entries(out: &mut String, media: bool) {
     let entry = |out: &mut String, name: &str, slot: &str, material: bool| {
         let (ty, tail) = if material {
             ("vec2<f32>", ".xy")
@@ -655,15 +694,14 @@ pub(super) fn write(file: usize, media: bool, unroll: usize, calls: Calls) -> St
         );
     };
     out.push_str("// The scene's distance field: (signed distance, material id) at p.\n");
-    entry(&mut out, "map", "[0].x", true);
+    entry(out, "map", "[0].x", true);
     out.push_str("// The distance alone, for marching and normals.\n");
-    entry(&mut out, "sdf", "[0].y", false);
+    entry(out, "sdf", "[0].y", false);
     if media {
-        entry(&mut out, "sdf_medium", "[0].z", false);
-        entry(&mut out, "map_solid", "[0].w", true);
-        entry(&mut out, "sdf_solid", "[1].x", false);
+        entry(out, "sdf_medium", "[0].z", false);
+        entry(out, "map_solid", "[0].w", true);
+        entry(out, "sdf_solid", "[1].x", false);
     }
-    out
 }
 
 /// The WGSL text of `colour_field(k, p, n)` in the interpreted kernel: colour field `k`'s

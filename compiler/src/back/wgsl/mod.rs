@@ -122,6 +122,17 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+impl Error {
+    /// A kernel refused before it is written: the reason, with no line.
+    fn refused(reason: impl fmt::Display) -> Error {
+        Error {
+            message: reason.to_string(),
+            line: None,
+            node_span: None,
+        }
+    }
+}
+
 /// What the scene uses, deciding which parts of the kernel are emitted; `traced` when it is
 /// ray traced analytically.
 pub(crate) fn features(scene: &Scene, traced: bool) -> Vec<(&'static str, bool)> {
@@ -446,108 +457,23 @@ fn write_template(
     debug_assert_eq!(features.len(), contract::SCENE_FEATURES);
     let mut on: HashMap<&str, bool> = features.iter().copied().collect();
     let mut values: HashMap<&str, String> = HashMap::new();
-    let mut params = false;
-    let mut media = false;
-    let mut interprets = false;
-    let data = match traced {
+    let code = match traced {
         // An analytically traced scene needs no distance field.
-        Some(traced) => {
-            let clear = |m| scene.material(m).transparency > 0.0;
-            // A scene with parameters, asked for a kernel whose text does not depend on its
-            // numbers (the viewer's panel), walks its primitives in `scene_data`: a changed
-            // size or place is new data for the same kernel, not a new kernel.
-            let unrolled = match options.parameters && !scene.params.is_empty() {
-                true => 0,
-                false => options.max_unrolled,
-            };
-            let (text, bytes) = analytic::write(traced, &clear, unrolled);
-            // A mesh's triangles, read from `scene_data` as a marched scene's are.
-            if let Some(bytes) = bytes.as_ref().filter(|_| !traced.meshes.is_empty()) {
-                mesh::fits(scene, bytes).map_err(|refused| Error {
-                    message: refused.to_string(),
-                    line: None,
-                    node_span: None,
-                })?;
-            }
-            values.insert("MAP", String::new());
-            values.insert("ANALYTIC", text);
-            bytes
-        }
-        None if choose(scene, lowered, options).map_err(|refused| Error {
-            message: refused.to_string(),
-            line: None,
-            node_span: None,
-        })? == KernelKind::Interpreted =>
+        Some(traced) => analytic_map(scene, traced, options)?,
+        None if choose(scene, lowered, options).map_err(Error::refused)?
+            == KernelKind::Interpreted =>
         {
-            // The distance programs interpreted from `scene_data`: the text depends only on
-            // the features and the register file's size.
-            let bytes = interpreted(scene, lowered).map_err(|refused| Error {
-                message: refused.to_string(),
-                line: None,
-                node_span: None,
-            })?;
-            media = media_of(scene, lowered).is_some();
-            interprets = true;
-            let file = scene.limits.count(crate::limits::Limit::Registers);
-            let m = media_of(scene, lowered);
-            let calls = interp::Programs {
-                main: &lowered.program,
-                media: m.map(|m| (&m.medium, &m.solid)),
-                colours: &lowered.colours.programs,
-            }
-            .calls();
-            values.insert(
-                "MAP",
-                interp::write(file, media, options.interp_unroll, calls),
-            );
-            Some(bytes)
+            interpreted_map(scene, lowered, options)?
         }
-        None => {
-            let meshes = meshes_of(scene, lowered);
-            let (mut text, bytes, read) = match meshes {
-                // The program as code, its constants as literals, the meshes' walk after it.
-                Some(data) => (
-                    format!(
-                        "{}\n{}\n{}",
-                        write_map(&lowered.program),
-                        write_sdf(&lowered.program),
-                        mesh::write()
-                    ),
-                    Some(data),
-                    false,
-                ),
-                None => marched(scene, lowered, options),
-            };
-            params = read;
-            // Rays inside glass that may overlap a solid march the scene's media.
-            let m = lowered.media.as_ref().filter(|_| on["REFRACTION"]);
-            media = m.is_some();
-            if let Some(m) = m {
-                text.push('\n');
-                text.push_str(&map::write_sdf_named(&m.medium, "sdf_medium"));
-                text.push('\n');
-                text.push_str(&map::write_map_named(&m.solid, "map_solid"));
-                text.push('\n');
-                text.push_str(&map::write_sdf_named(&m.solid, "sdf_solid"));
-            }
-            // Text: its outlines after the rest of scene_data.
-            let mut bytes = bytes;
-            let mut programs = vec![&lowered.program];
-            if let Some(m) = m {
-                programs.extend([&m.medium, &m.solid]);
-            }
-            let glyphs = glyphs::append(&programs, &mut bytes);
-            if !glyphs.is_empty() {
-                text.push('\n');
-                text.push_str(&glyphs);
-            }
-            values.insert("MAP", text);
-            bytes
-        }
+        None => marched_map(scene, lowered, options, on["REFRACTION"]),
     };
+    values.insert("MAP", code.text);
+    if let Some(text) = code.analytic {
+        values.insert("ANALYTIC", text);
+    }
     if on["COLOUR_FIELDS"] {
         let colours = &lowered.colours.programs;
-        let text = if interprets {
+        let text = if code.interprets {
             interp::write_colours()
         } else {
             map::write_colours(colours, "")
@@ -558,26 +484,164 @@ fn write_template(
     // that the kernels without them do not change.
     features.extend([
         ("DEBUG_NAN", options.debug_nan),
-        ("PARAMS", params),
-        ("MEDIA", media),
-        ("SCENE_DATA", data.is_some()),
-        ("INTERPRETED", interprets),
+        ("PARAMS", code.params),
+        ("MEDIA", code.media),
+        ("SCENE_DATA", code.data.is_some()),
+        ("INTERPRETED", code.interprets),
         ("PATH", scene.settings.path),
     ]);
     on.extend(features[contract::SCENE_FEATURES..].iter().copied());
+    values.insert("HEADER", header(&features));
+    insert_constants(&mut values, scene);
+    let source = template::expand(template, &on, &values).map_err(|e| Error {
+        message: format!("kernel template: {e}"),
+        line: None,
+        node_span: None,
+    })?;
+    Ok(Text {
+        source,
+        features,
+        data: code.data,
+    })
+}
+
+/// The scene's distance code of a kernel (its `MAP`), with the bytes of its `scene_data` and
+/// the kernel's features it decides.
+struct MapText {
+    text: String,
+    /// The closed-form trace of an analytically traced scene (`ANALYTIC`).
+    analytic: Option<String>,
+    data: Option<Vec<u8>>,
+    /// Whether the program reads its constants from `scene_data` (`PARAMS`).
+    params: bool,
+    /// Whether rays inside glass march the scene's media (`MEDIA`).
+    media: bool,
+    /// Whether the distance programs are interpreted (`INTERPRETED`).
+    interprets: bool,
+}
+
+/// The `MAP` of an analytically traced scene: no distance field, the primitives traced in
+/// closed form (from `scene_data` past the unrolled ones, or all of them for a scene whose
+/// parameters the kernel reads).
+fn analytic_map(
+    scene: &Scene,
+    traced: &crate::scene::analytic::Traced,
+    options: &Options,
+) -> Result<MapText, Error> {
+    let clear = |m| scene.material(m).transparency > 0.0;
+    // A scene with parameters, asked for a kernel whose text does not depend on its
+    // numbers (the viewer's panel), walks its primitives in `scene_data`: a changed
+    // size or place is new data for the same kernel, not a new kernel.
+    let unrolled = match options.parameters && !scene.params.is_empty() {
+        true => 0,
+        false => options.max_unrolled,
+    };
+    let (text, bytes) = analytic::write(traced, &clear, unrolled);
+    // A mesh's triangles, read from `scene_data` as a marched scene's are.
+    if let Some(bytes) = bytes.as_ref().filter(|_| !traced.meshes.is_empty()) {
+        mesh::fits(scene, bytes).map_err(Error::refused)?;
+    }
+    Ok(MapText {
+        text: String::new(),
+        analytic: Some(text),
+        data: bytes,
+        params: false,
+        media: false,
+        interprets: false,
+    })
+}
+
+/// The `MAP` of a scene whose distance programs the kernel interprets from `scene_data`: the
+/// text depends only on the features and the register file's size.
+fn interpreted_map(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<MapText, Error> {
+    let bytes = interpreted(scene, lowered).map_err(Error::refused)?;
+    let media = media_of(scene, lowered).is_some();
+    let file = scene.limits.count(crate::limits::Limit::Registers);
+    let m = media_of(scene, lowered);
+    let calls = interp::Programs {
+        main: &lowered.program,
+        media: m.map(|m| (&m.medium, &m.solid)),
+        colours: &lowered.colours.programs,
+    }
+    .calls();
+    Ok(MapText {
+        text: interp::write(file, media, options.interp_unroll, calls),
+        analytic: None,
+        data: Some(bytes),
+        params: false,
+        media,
+        interprets: true,
+    })
+}
+
+/// The `MAP` of a marched scene: its program as code (with the meshes' walk, or its
+/// instances or constants in `scene_data`: [`marched`]), then, with `refraction`, the
+/// media's programs, then the text's outlines.
+fn marched_map(scene: &Scene, lowered: &Lowered, options: &Options, refraction: bool) -> MapText {
+    let meshes = meshes_of(scene, lowered);
+    let (mut text, bytes, params) = match meshes {
+        // The program as code, its constants as literals, the meshes' walk after it.
+        Some(data) => (
+            format!(
+                "{}\n{}\n{}",
+                write_map(&lowered.program),
+                write_sdf(&lowered.program),
+                mesh::write()
+            ),
+            Some(data),
+            false,
+        ),
+        None => marched(scene, lowered, options),
+    };
+    // Rays inside glass that may overlap a solid march the scene's media.
+    let m = lowered.media.as_ref().filter(|_| refraction);
+    if let Some(m) = m {
+        text.push('\n');
+        text.push_str(&map::write_sdf_named(&m.medium, "sdf_medium"));
+        text.push('\n');
+        text.push_str(&map::write_map_named(&m.solid, "map_solid"));
+        text.push('\n');
+        text.push_str(&map::write_sdf_named(&m.solid, "sdf_solid"));
+    }
+    // Text: its outlines after the rest of scene_data.
+    let mut bytes = bytes;
+    let mut programs = vec![&lowered.program];
+    if let Some(m) = m {
+        programs.extend([&m.medium, &m.solid]);
+    }
+    let glyphs = glyphs::append(&programs, &mut bytes);
+    if !glyphs.is_empty() {
+        text.push('\n');
+        text.push_str(&glyphs);
+    }
+    MapText {
+        text,
+        analytic: None,
+        data: bytes,
+        params,
+        media: m.is_some(),
+        interprets: false,
+    }
+}
+
+/// The kernel's first lines: what generated it, and its features (the scene's, on or off,
+/// then the kernel's own that are on).
+fn header(features: &[(&str, bool)]) -> String {
     let used: Vec<String> = features
         .iter()
         .enumerate()
         .filter(|&(k, &(_, on))| k < contract::SCENE_FEATURES || on)
         .map(|(_, (n, on))| format!("{}{n}", if *on { "+" } else { "-" }))
         .collect();
-    values.insert(
-        "HEADER",
-        format!(
-            "// Generated by sdfc: the renderer kernel of docs/rendering.md specialised for one scene.\n// Features: {}.",
-            used.join(" ")
-        ),
-    );
+    format!(
+        "// Generated by sdfc: the renderer kernel of docs/rendering.md specialised for one scene.\n// Features: {}.",
+        used.join(" ")
+    )
+}
+
+/// The template's numbers: the scene's counts, and the constants of the look, the
+/// physically based materials and the path tracer's sampling, as WGSL literals.
+fn insert_constants(values: &mut HashMap<&str, String>, scene: &Scene) {
     values.insert("POINTS", count(scene, 0).to_string());
     values.insert("DIRS", count(scene, 1).to_string());
     values.insert("SKIES", count(scene, 2).to_string());
@@ -621,16 +685,6 @@ fn write_template(
         values.insert("DIM_LAMPS", format!("{}u", dim::LAMPS));
     }
     values.insert("ENTRY", ENTRY_POINT.to_string());
-    let source = template::expand(template, &on, &values).map_err(|e| Error {
-        message: format!("kernel template: {e}"),
-        line: None,
-        node_span: None,
-    })?;
-    Ok(Text {
-        source,
-        features,
-        data,
-    })
 }
 
 /// `fn map` and `fn sdf` of a marched scene: the program as code, or, when its root union has

@@ -172,6 +172,38 @@ fn accessor<'a>(doc: &Json, bin: &'a [u8], a: u64, from: String) -> Result<Acces
 /// space. Every accessor is checked and the triangles of every placed primitive counted
 /// against the limit before any is read; the positions read are those the triangles use.
 pub(super) fn glb(b: &[u8], max: u64) -> Result<Read, Error> {
+    let b = header(b)?;
+    let (doc, bin) = chunks(b)?;
+    let meshes = array(&doc, "meshes", "")?;
+    let primitives = meshes
+        .iter()
+        .enumerate()
+        .map(|(m, mesh)| triangle_primitives(&doc, bin, mesh, m))
+        .collect::<Result<Vec<_>, _>>()?;
+    let placements = placed(&doc, meshes.len())?;
+    let mut triangles: u64 = 0;
+    for (mesh, _) in &placements {
+        for t in &primitives[*mesh] {
+            triangles = triangles.saturating_add(t.corners() as u64 / 3);
+        }
+    }
+    if triangles > max {
+        return Err(Error::Limit {
+            triangles,
+            max,
+            at: Some(Place::Json("meshes".into())),
+        });
+    }
+    let mut read = Read::default();
+    for (mesh, transform) in &placements {
+        read_placed(&mut read, &primitives[*mesh], transform)?;
+    }
+    Ok(read)
+}
+
+/// The bytes of a binary glTF file that its 12-byte header declares, checked: its magic,
+/// version 2, and a length within the file.
+fn header(b: &[u8]) -> Result<&[u8], Error> {
     if b.len() < 12 || &b[..4] != b"glTF" {
         return Err(bad_file(
             "a binary glTF file starts with `glTF` and a 12-byte header",
@@ -194,7 +226,12 @@ pub(super) fn glb(b: &[u8], max: u64) -> Result<Read, Error> {
             ),
         ));
     }
-    let b = &b[..total];
+    Ok(&b[..total])
+}
+
+/// The file's chunks after its header: the JSON document (an object), and the BIN chunk's
+/// bytes (none without one); buffer 0 must be the BIN chunk, not a file of its own.
+fn chunks(b: &[u8]) -> Result<(Json, &[u8]), Error> {
     if b.len() < 20 || &b[16..20] != b"JSON" {
         return Err(bad(
             Place::Byte(12),
@@ -245,119 +282,134 @@ pub(super) fn glb(b: &[u8], max: u64) -> Result<Read, Error> {
             ),
         ));
     }
-    // The triangle primitives: where each is, its positions and its indices.
-    let array = |v: &Json, key: &str, path: &str| -> Result<Vec<Json>, Error> {
-        match v.get(key) {
-            None => Ok(Vec::new()),
-            Some(Json::Array(items)) => Ok(items.clone()),
-            Some(_) => Err(bad(
-                Place::Json(format!("{path}.{key}")),
-                "it is not an array",
-            )),
-        }
-    };
-    // The triangle primitives of each mesh.
-    let meshes = array(&doc, "meshes", "")?;
-    let mut primitives = Vec::with_capacity(meshes.len());
-    for (m, mesh) in meshes.iter().enumerate() {
-        let mpath = format!("meshes[{m}]");
-        let mut list = Vec::new();
-        for (p, prim) in array(mesh, "primitives", &mpath)?.iter().enumerate() {
-            let path = format!("{mpath}.primitives[{p}]");
-            if uint(prim, &path, "mode")?.unwrap_or(4) != 4 {
-                continue;
-            }
-            let apath = format!("{path}.attributes");
-            let attributes = prim
-                .get("attributes")
-                .ok_or_else(|| bad(Place::Json(path.clone()), "it has no `attributes`"))?;
-            let pos = need(attributes, &apath, "POSITION")?;
-            let positions = accessor(&doc, bin, pos, format!("{apath}.POSITION"))?;
-            if positions.component != 5126 || positions.components != 3 {
-                return Err(bad(
-                    Place::Json(format!("accessors[{pos}]")),
-                    "a POSITION accessor is of f32 VEC3",
-                ));
-            }
-            let indices = match uint(prim, &path, "indices")? {
-                Some(ix) => {
-                    let indices = accessor(&doc, bin, ix, format!("{path}.indices"))?;
-                    if indices.component == 5126 || indices.components != 1 {
-                        return Err(bad(
-                            Place::Json(format!("accessors[{ix}]")),
-                            "indices are an accessor of unsigned byte, short or int SCALAR",
-                        ));
-                    }
-                    Some(indices)
-                }
-                None => None,
-            };
-            let corners = indices.as_ref().map_or(positions.count, |i| i.count);
-            if corners % 3 != 0 {
-                return Err(bad(
-                    Place::Json(path),
-                    format!("{corners} corners of triangles, not a multiple of 3"),
-                ));
-            }
-            list.push((pos, positions, indices));
-        }
-        primitives.push(list);
+    Ok((doc, bin))
+}
+
+/// The member `key` of `v` (at `path`): absent, an empty list; else an array.
+fn array(v: &Json, key: &str, path: &str) -> Result<Vec<Json>, Error> {
+    match v.get(key) {
+        None => Ok(Vec::new()),
+        Some(Json::Array(items)) => Ok(items.clone()),
+        Some(_) => Err(bad(
+            Place::Json(format!("{path}.{key}")),
+            "it is not an array",
+        )),
     }
-    let placements = placed(&doc, meshes.len())?;
-    let mut triangles: u64 = 0;
-    for (mesh, _) in &placements {
-        for (_, positions, indices) in &primitives[*mesh] {
-            let corners = indices.as_ref().map_or(positions.count, |i| i.count);
-            triangles = triangles.saturating_add(corners as u64 / 3);
+}
+
+/// A triangle primitive of a mesh, checked: its `POSITION` accessor (numbered `pos`) and its
+/// indices, if any.
+struct Triangles<'a> {
+    pos: u64,
+    positions: Accessor<'a>,
+    indices: Option<Accessor<'a>>,
+}
+
+impl Triangles<'_> {
+    /// The corners of its triangles: one per index, or per position without indices.
+    fn corners(&self) -> usize {
+        self.indices
+            .as_ref()
+            .map_or(self.positions.count, |i| i.count)
+    }
+}
+
+/// The triangle primitives (mode 4) of mesh `m`, `mesh`, their accessors checked over `bin`.
+fn triangle_primitives<'a>(
+    doc: &Json,
+    bin: &'a [u8],
+    mesh: &Json,
+    m: usize,
+) -> Result<Vec<Triangles<'a>>, Error> {
+    let mpath = format!("meshes[{m}]");
+    let mut list = Vec::new();
+    for (p, prim) in array(mesh, "primitives", &mpath)?.iter().enumerate() {
+        let path = format!("{mpath}.primitives[{p}]");
+        if uint(prim, &path, "mode")?.unwrap_or(4) != 4 {
+            continue;
         }
-    }
-    if triangles > max {
-        return Err(Error::Limit {
-            triangles,
-            max,
-            at: Some(Place::Json("meshes".into())),
-        });
-    }
-    let mut read = Read::default();
-    for (mesh, transform) in &placements {
-        // A transform that mirrors turns the triangles inside out: their corners are
-        // taken in the other order, so that they stay counter-clockwise seen from outside.
-        let mirrored = transform.determinant() < 0.0;
-        // The positions read for this placement: (accessor, element) to the index in
-        // `read.positions`.
-        let mut used: HashMap<(u64, usize), u32> = HashMap::new();
-        for (pos, positions, indices) in &primitives[*mesh] {
-            let corners = indices.as_ref().map_or(positions.count, |i| i.count);
-            let mut face = [0u32; 3];
-            for c in 0..corners {
-                let i = match indices {
-                    Some(ix) => ix.get(c, 0) as usize,
-                    None => c,
-                };
-                if i >= positions.count {
+        let apath = format!("{path}.attributes");
+        let attributes = prim
+            .get("attributes")
+            .ok_or_else(|| bad(Place::Json(path.clone()), "it has no `attributes`"))?;
+        let pos = need(attributes, &apath, "POSITION")?;
+        let positions = accessor(doc, bin, pos, format!("{apath}.POSITION"))?;
+        if positions.component != 5126 || positions.components != 3 {
+            return Err(bad(
+                Place::Json(format!("accessors[{pos}]")),
+                "a POSITION accessor is of f32 VEC3",
+            ));
+        }
+        let indices = match uint(prim, &path, "indices")? {
+            Some(ix) => {
+                let indices = accessor(doc, bin, ix, format!("{path}.indices"))?;
+                if indices.component == 5126 || indices.components != 1 {
                     return Err(bad(
-                        Place::Json(format!("accessors[{pos}]")),
-                        format!("index {i} is past its {} positions", positions.count),
+                        Place::Json(format!("accessors[{ix}]")),
+                        "indices are an accessor of unsigned byte, short or int SCALAR",
                     ));
                 }
-                let next = read.positions.len() as u32;
-                let v = *used.entry((*pos, i)).or_insert_with(|| {
-                    let local = DVec3::from_array([0, 1, 2].map(|k| positions.get(i, k)));
-                    read.positions
-                        .push(transform.transform_point3(local).to_array());
-                    next
-                });
-                face[c % 3] = v;
-                if c % 3 == 2 {
-                    if mirrored {
-                        face.swap(1, 2);
-                    }
-                    read.faces.push(face);
+                Some(indices)
+            }
+            None => None,
+        };
+        let t = Triangles {
+            pos,
+            positions,
+            indices,
+        };
+        let corners = t.corners();
+        if corners % 3 != 0 {
+            return Err(bad(
+                Place::Json(path),
+                format!("{corners} corners of triangles, not a multiple of 3"),
+            ));
+        }
+        list.push(t);
+    }
+    Ok(list)
+}
+
+/// The triangles of one placement of a mesh, its `primitives` through `transform`, added to
+/// `read`: the positions their indices use (each once), and their faces.
+fn read_placed(read: &mut Read, primitives: &[Triangles], transform: &DMat4) -> Result<(), Error> {
+    // A transform that mirrors turns the triangles inside out: their corners are
+    // taken in the other order, so that they stay counter-clockwise seen from outside.
+    let mirrored = transform.determinant() < 0.0;
+    // The positions read for this placement: (accessor, element) to the index in
+    // `read.positions`.
+    let mut used: HashMap<(u64, usize), u32> = HashMap::new();
+    for t in primitives {
+        let (pos, positions) = (t.pos, &t.positions);
+        let mut face = [0u32; 3];
+        for c in 0..t.corners() {
+            let i = match &t.indices {
+                Some(ix) => ix.get(c, 0) as usize,
+                None => c,
+            };
+            if i >= positions.count {
+                return Err(bad(
+                    Place::Json(format!("accessors[{pos}]")),
+                    format!("index {i} is past its {} positions", positions.count),
+                ));
+            }
+            let next = read.positions.len() as u32;
+            let v = *used.entry((pos, i)).or_insert_with(|| {
+                let local = DVec3::from_array([0, 1, 2].map(|k| positions.get(i, k)));
+                read.positions
+                    .push(transform.transform_point3(local).to_array());
+                next
+            });
+            face[c % 3] = v;
+            if c % 3 == 2 {
+                if mirrored {
+                    face.swap(1, 2);
                 }
+                read.faces.push(face);
             }
         }
     }
-    Ok(read)
+    Ok(())
 }
 
 /// The meshes the file's scene places, each with its world transform: the nodes of the scene

@@ -524,6 +524,45 @@ struct Element {
 /// `y`, `z` and the `face` element's list `vertex_indices` (or `vertex_index`) are read,
 /// faces of more than three corners fanned.
 fn ply(b: &[u8], max: u64) -> Result<Read, Error> {
+    let (header, body) = ply_header(b)?;
+    let (big, elements) = ply_elements(header)?;
+    ply_counts(&elements, (b.len() - body) as u64, body, max)?;
+    let mut values = Values { b, at: body, big };
+    let mut positions = Vec::new();
+    let mut faces = Faces::new(max);
+    for e in &elements {
+        for _ in 0..e.count {
+            let mut p = [0.0; 3];
+            for prop in &e.properties {
+                match prop.list {
+                    None => {
+                        let v = values.next(prop.ty)?;
+                        if e.name == "vertex" {
+                            match prop.name.as_str() {
+                                "x" => p[0] = v,
+                                "y" => p[1] = v,
+                                "z" => p[2] = v,
+                                _ => {}
+                            }
+                        }
+                    }
+                    Some(c) => ply_list(&mut values, e, prop, c, &mut faces)?,
+                }
+            }
+            if e.name == "vertex" {
+                positions.push(p);
+            }
+        }
+    }
+    Ok(Read {
+        faces: faces.done()?,
+        positions,
+    })
+}
+
+/// A PLY file's header, as text, and where its body starts (past `end_header`, the rest of
+/// its line and its line break).
+fn ply_header(b: &[u8]) -> Result<(&str, usize), Error> {
     const END: &[u8] = b"end_header";
     let end = b
         .windows(END.len())
@@ -542,6 +581,12 @@ fn ply(b: &[u8], max: u64) -> Result<Read, Error> {
             "the PLY header must be text, and this byte is not UTF-8",
         )
     })?;
+    Ok((header, body))
+}
+
+/// What a PLY header declares: the body's format (`None` for ASCII, else whether
+/// big-endian) and its elements with their properties, in order.
+fn ply_elements(header: &str) -> Result<(Option<bool>, Vec<Element>), Error> {
     let mut lines = header.lines();
     if lines.next().map(str::trim) != Some("ply") {
         return Err(bad(Place::Line(1), "a PLY file starts with the line `ply`"));
@@ -595,11 +640,16 @@ fn ply(b: &[u8], max: u64) -> Result<Read, Error> {
         Some("binary_big_endian") => Some(true),
         _ => return Err(bad_file("the PLY header has no known `format` line")),
     };
+    Ok((big, elements))
+}
+
+/// The element counts a PLY header declares, checked before its body (of `rest` bytes from
+/// byte `body`) is read: within what the body can hold, and no more faces than `max`.
+fn ply_counts(elements: &[Element], rest: u64, body: usize, max: u64) -> Result<(), Error> {
     // Every element takes at least a byte (or a character) per property: a count beyond
     // the bytes left is a truncated or lying file, refused before anything is allocated,
     // and before the limit (whose error would suggest a count the file does not hold).
-    let rest = (b.len() - body) as u64;
-    for e in &elements {
+    for e in elements {
         if e.count.saturating_mul(e.properties.len().max(1) as u64) > rest {
             return Err(bad(
                 Place::Byte(body as u64),
@@ -621,81 +671,62 @@ fn ply(b: &[u8], max: u64) -> Result<Read, Error> {
             });
         }
     }
-    let mut values = Values { b, at: body, big };
-    let mut positions = Vec::new();
-    let mut faces = Faces::new(max);
-    for e in &elements {
-        for _ in 0..e.count {
-            let mut p = [0.0; 3];
-            for prop in &e.properties {
-                match prop.list {
-                    None => {
-                        let v = values.next(prop.ty)?;
-                        if e.name == "vertex" {
-                            match prop.name.as_str() {
-                                "x" => p[0] = v,
-                                "y" => p[1] = v,
-                                "z" => p[2] = v,
-                                _ => {}
-                            }
-                        }
-                    }
-                    Some(c) => {
-                        let at = values.at;
-                        let n = values.next(c)?;
-                        if !(0.0..=1024.0).contains(&n) {
-                            return Err(bad(
-                                Place::Byte(at as u64),
-                                format!("a list of {n} items is not a face"),
-                            ));
-                        }
-                        let indices = prop.name == "vertex_indices" || prop.name == "vertex_index";
-                        let face = e.name == "face" && indices;
-                        if face && n < 3.0 {
-                            return Err(bad(Place::Byte(at as u64), "a face needs three corners"));
-                        }
-                        // The fan's first corner and the last one read.
-                        let (mut first, mut previous) = (0, 0);
-                        for k in 0..n as usize {
-                            let c = values.next(prop.ty)?;
-                            if !face {
-                                continue;
-                            }
-                            if faces.over() {
-                                // Past the limit the triangles are only counted.
-                                if k >= 2 {
-                                    faces.skip(1);
-                                }
-                                continue;
-                            }
-                            // A negative or fractional index names no vertex: u32::MAX is
-                            // refused as such when the mesh is built.
-                            let ix = if c >= 0.0 && c.fract() == 0.0 {
-                                c as u32
-                            } else {
-                                u32::MAX
-                            };
-                            match k {
-                                0 => first = ix,
-                                1 => previous = ix,
-                                _ => {
-                                    faces.push([first, previous, ix]);
-                                    previous = ix;
-                                }
-                            }
-                        }
-                    }
-                }
+    Ok(())
+}
+
+/// One list property `prop` of element `e`, its length of type `count`: read past, or, for a
+/// face's corner indices, its triangles (a fan from its first corner) added to `faces`.
+fn ply_list(
+    values: &mut Values,
+    e: &Element,
+    prop: &Property,
+    count: Scalar,
+    faces: &mut Faces,
+) -> Result<(), Error> {
+    let at = values.at;
+    let n = values.next(count)?;
+    if !(0.0..=1024.0).contains(&n) {
+        return Err(bad(
+            Place::Byte(at as u64),
+            format!("a list of {n} items is not a face"),
+        ));
+    }
+    let indices = prop.name == "vertex_indices" || prop.name == "vertex_index";
+    let face = e.name == "face" && indices;
+    if face && n < 3.0 {
+        return Err(bad(Place::Byte(at as u64), "a face needs three corners"));
+    }
+    // The fan's first corner and the last one read.
+    let (mut first, mut previous) = (0, 0);
+    for k in 0..n as usize {
+        let c = values.next(prop.ty)?;
+        if !face {
+            continue;
+        }
+        if faces.over() {
+            // Past the limit the triangles are only counted.
+            if k >= 2 {
+                faces.skip(1);
             }
-            if e.name == "vertex" {
-                positions.push(p);
+            continue;
+        }
+        // A negative or fractional index names no vertex: u32::MAX is
+        // refused as such when the mesh is built.
+        let ix = if c >= 0.0 && c.fract() == 0.0 {
+            c as u32
+        } else {
+            u32::MAX
+        };
+        match k {
+            0 => first = ix,
+            1 => previous = ix,
+            _ => {
+                faces.push([first, previous, ix]);
+                previous = ix;
             }
         }
     }
-    Ok(Read {
-        faces: faces.done()?,
-        positions,
-    })
+    Ok(())
 }
 
 /// The values of a PLY body, read one by one.

@@ -6,7 +6,7 @@ use super::{
     at_most_bound, blend_reach, blend_steepness, classify, exact, feature_steepness,
     profile_bounds, unproven, Aabb, Derived, Pass,
 };
-use crate::prim::Field as PrimField;
+use crate::prim::{Args, Field as PrimField, PrimRef};
 use crate::scene::field::FieldFn;
 use crate::scene::ir::{Combine, Exactness, Feature, Node, Smooth, V3};
 use crate::scene::NodeId;
@@ -50,21 +50,7 @@ impl Pass<'_> {
             ),
             Node::Ellipsoid { radii } => ellipsoid(*radii),
             Node::Rect { half } => exact(profile_bounds(*half), [true; 3]),
-            Node::Prim { prim, args } => {
-                let e = (prim.extent)(args);
-                let mut bounds = Aabb {
-                    min: e.min,
-                    max: e.max,
-                };
-                if prim.profile {
-                    (bounds.min[2], bounds.max[2]) = (f64::NEG_INFINITY, f64::INFINITY);
-                }
-                let d = exact(bounds, e.symmetric);
-                match prim.field {
-                    PrimField::Exact => d,
-                    PrimField::Unproven => unproven(d, id),
-                }
-            }
+            Node::Prim { prim, args } => table_prim(id, prim, args),
             Node::Mesh { mesh } => {
                 let (min, max) = mesh.0.aabb();
                 exact(Aabb { min, max }, [false; 3])
@@ -74,72 +60,18 @@ impl Pass<'_> {
                 control,
                 b,
                 radius,
-            } => {
-                let lo = [0, 1].map(|i| a[i].min(control[i]).min(b[i]) - radius);
-                let hi = [0, 1].map(|i| a[i].max(control[i]).max(b[i]) + radius);
-                let bounds = Aabb {
-                    min: [lo[0], lo[1], f64::NEG_INFINITY],
-                    max: [hi[0], hi[1], f64::INFINITY],
-                };
-                exact(bounds, [false, false, true])
-            }
-            Node::Polygon { points } => {
-                let mut b = Aabb::EMPTY;
-                for q in points {
-                    b = b.union(Aabb {
-                        min: [q[0], q[1], f64::NEG_INFINITY],
-                        max: [q[0], q[1], f64::INFINITY],
-                    });
-                }
-                exact(b, [false, false, true])
-            }
+            } => bezier(*a, *control, *b, *radius),
+            Node::Polygon { points } => polygon(points),
             Node::Text { outline, .. } => {
                 let (lo, hi) = outline.bounds();
-                let b = Aabb {
-                    min: [lo[0], lo[1], f64::NEG_INFINITY],
-                    max: [hi[0], hi[1], f64::INFINITY],
-                };
-                exact(b, [false, false, true])
+                plane_profile(lo, hi)
             }
             Node::Extrude {
                 half_height,
                 round,
                 child,
-            } => {
-                let mut d = self.get(*child);
-                if *round > 0.0 {
-                    // The profile shrunk by `round` is a bound outside its solid.
-                    d = at_most_bound(d);
-                }
-                // |(a, b)| of a field a of the plane and b = |z| - h: as steep as the steeper.
-                d.facts.lipschitz = d.facts.lipschitz.max(1.0);
-                d.gradient = d.gradient.max(1.0);
-                d.bounds.min[2] = -half_height;
-                d.bounds.max[2] = *half_height;
-                d.symmetric[2] = true;
-                d
-            }
-            Node::Revolve { offset, child } => {
-                let mut d = self.get(*child);
-                let c = d.bounds;
-                // The profile is read at x = r - offset for r ≥ 0; a part of it at smaller x
-                // is never read, but may be nearer than the part that is: then a bound.
-                let read_only = c.min[0] >= -offset || (d.symmetric[0] && *offset == 0.0);
-                if !read_only {
-                    d = at_most_bound(d);
-                }
-                let r = (c.max[0] + offset).max(0.0);
-                d.bounds = if c.max[0] + offset < 0.0 || c.is_empty() {
-                    Aabb::EMPTY
-                } else {
-                    Aabb {
-                        min: [-r, c.min[1], -r],
-                        max: [r, c.max[1], r],
-                    }
-                };
-                d.symmetric = [true, d.symmetric[1], true];
-                d
-            }
+            } => self.extrude(*half_height, *round, *child),
+            Node::Revolve { offset, child } => self.revolve(*offset, *child),
             Node::Loft {
                 half_height,
                 spread,
@@ -169,12 +101,8 @@ impl Pass<'_> {
                 a,
                 b,
             } => self.smooth(id, *op, *k, *variant, *a, *b),
-            Node::Translate { offset, child } => {
-                let mut d = self.get(*child);
-                d.bounds = d.bounds.translate(*offset);
-                d.symmetric = [0, 1, 2].map(|i| d.symmetric[i] && offset[i] == 0.0);
-                d
-            }
+            Node::Morph { a, b, .. } => self.morph(id, *a, *b),
+            Node::Translate { offset, child } => self.translate(*offset, *child),
             Node::Rotate { matrix, child } => self.rotate(matrix, *child),
             Node::Scale { factor, child } => {
                 let mut d = self.get(*child);
@@ -192,21 +120,6 @@ impl Pass<'_> {
             Node::Wrap { radius, child } => self.wrap(id, *radius, *child),
             Node::Shear { matrix, child } => self.shear(id, matrix, *child),
             Node::Taper { rate, child } => self.taper(id, *rate, *child),
-            Node::Morph { a, b, .. } => {
-                // A convex combination of L-Lipschitz fields is L-Lipschitz, so f / L is a
-                // bound of its own zero set; the solid lies where either operand's does.
-                let (da, db) = (self.get(*a), self.get(*b));
-                let mut d = merge(&[da, db]);
-                d.facts.exactness = Exactness::Approximate;
-                if d.gradient.is_finite() {
-                    d.facts.lipschitz = d.facts.lipschitz.max(d.gradient);
-                    d.facts.exactness = classify(d.facts.lipschitz, d.proven);
-                } else if d.proven {
-                    d = unproven(d, id);
-                }
-                d.bounds = da.bounds.union(db.bounds);
-                d
-            }
             Node::Twist { rate, child } => self.distort(id, *rate, *child, 1),
             Node::Bend { rate, child } => self.distort(id, *rate, *child, 2),
             Node::Round { radius, child } => self.offset(id, *child, *radius),
@@ -219,6 +132,74 @@ impl Pass<'_> {
             Node::Paint { child, .. } => self.get(*child),
             Node::Field { f, lipschitz, .. } => self.field(id, f, *lipschitz),
         }
+    }
+
+    /// A profile extruded along z: the profile's facts, at most a bound when its edges are
+    /// rounded, at least as steep as 1, its box cut at the half-height.
+    fn extrude(&self, half_height: f64, round: f64, child: NodeId) -> Derived {
+        let mut d = self.get(child);
+        if round > 0.0 {
+            // The profile shrunk by `round` is a bound outside its solid.
+            d = at_most_bound(d);
+        }
+        // |(a, b)| of a field a of the plane and b = |z| - h: as steep as the steeper.
+        d.facts.lipschitz = d.facts.lipschitz.max(1.0);
+        d.gradient = d.gradient.max(1.0);
+        d.bounds.min[2] = -half_height;
+        d.bounds.max[2] = half_height;
+        d.symmetric[2] = true;
+        d
+    }
+
+    /// A profile revolved about the y axis at `offset`: a bound where a part of the profile
+    /// is never read; the box of the swept profile, symmetric in x and z.
+    fn revolve(&self, offset: f64, child: NodeId) -> Derived {
+        let mut d = self.get(child);
+        let c = d.bounds;
+        // The profile is read at x = r - offset for r ≥ 0; a part of it at smaller x
+        // is never read, but may be nearer than the part that is: then a bound.
+        let read_only = c.min[0] >= -offset || (d.symmetric[0] && offset == 0.0);
+        if !read_only {
+            d = at_most_bound(d);
+        }
+        let r = (c.max[0] + offset).max(0.0);
+        d.bounds = if c.max[0] + offset < 0.0 || c.is_empty() {
+            Aabb::EMPTY
+        } else {
+            Aabb {
+                min: [-r, c.min[1], -r],
+                max: [r, c.max[1], r],
+            }
+        };
+        d.symmetric = [true, d.symmetric[1], true];
+        d
+    }
+
+    /// A morph between `a` and `b`: approximate, as steep as the steeper operand, its solid
+    /// within the union of theirs.
+    fn morph(&self, id: NodeId, a: NodeId, b: NodeId) -> Derived {
+        // A convex combination of L-Lipschitz fields is L-Lipschitz, so f / L is a
+        // bound of its own zero set; the solid lies where either operand's does.
+        let (da, db) = (self.get(a), self.get(b));
+        let mut d = merge(&[da, db]);
+        d.facts.exactness = Exactness::Approximate;
+        if d.gradient.is_finite() {
+            d.facts.lipschitz = d.facts.lipschitz.max(d.gradient);
+            d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+        } else if d.proven {
+            d = unproven(d, id);
+        }
+        d.bounds = da.bounds.union(db.bounds);
+        d
+    }
+
+    /// A translation: the child's facts, its box moved, symmetric only across the planes
+    /// the offset keeps.
+    fn translate(&self, offset: V3, child: NodeId) -> Derived {
+        let mut d = self.get(child);
+        d.bounds = d.bounds.translate(offset);
+        d.symmetric = [0, 1, 2].map(|i| d.symmetric[i] && offset[i] == 0.0);
+        d
     }
 
     /// A user field: its declared L, or the one derived from its expression (the shapes it
@@ -382,6 +363,54 @@ pub(super) fn merge(ds: &[Derived]) -> Derived {
     }
     d.cause = worst.and_then(|w| w.cause);
     d
+}
+
+/// A primitive of the table: exact unless its field is unproven, within its extent
+/// (unbounded along z for a profile).
+fn table_prim(id: NodeId, prim: &PrimRef, args: &Args) -> Derived {
+    let e = (prim.extent)(args);
+    let mut bounds = Aabb {
+        min: e.min,
+        max: e.max,
+    };
+    if prim.profile {
+        (bounds.min[2], bounds.max[2]) = (f64::NEG_INFINITY, f64::INFINITY);
+    }
+    let d = exact(bounds, e.symmetric);
+    match prim.field {
+        PrimField::Exact => d,
+        PrimField::Unproven => unproven(d, id),
+    }
+}
+
+/// A profile's facts from its box in the plane, `lo` to `hi`: exact, unbounded along z
+/// (and symmetric across z = 0).
+fn plane_profile(lo: [f64; 2], hi: [f64; 2]) -> Derived {
+    let bounds = Aabb {
+        min: [lo[0], lo[1], f64::NEG_INFINITY],
+        max: [hi[0], hi[1], f64::INFINITY],
+    };
+    exact(bounds, [false, false, true])
+}
+
+/// The quadratic Bézier profile from `a` to `b` through `control`, thickened by `radius`:
+/// within the box of its three points, grown by the radius.
+fn bezier(a: [f64; 2], control: [f64; 2], b: [f64; 2], radius: f64) -> Derived {
+    let lo = [0, 1].map(|i| a[i].min(control[i]).min(b[i]) - radius);
+    let hi = [0, 1].map(|i| a[i].max(control[i]).max(b[i]) + radius);
+    plane_profile(lo, hi)
+}
+
+/// A polygon profile: within the box of its points, unbounded along z.
+fn polygon(points: &[[f64; 2]]) -> Derived {
+    let mut b = Aabb::EMPTY;
+    for q in points {
+        b = b.union(Aabb {
+            min: [q[0], q[1], f64::NEG_INFINITY],
+            max: [q[0], q[1], f64::INFINITY],
+        });
+    }
+    exact(b, [false, false, true])
 }
 
 /// The half-space `dot(p, n) ≤ h`: bounded on one side when `n` is an axis.

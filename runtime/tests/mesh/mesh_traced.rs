@@ -152,8 +152,9 @@ fn which_ptxas() -> Option<std::path::PathBuf> {
 }
 
 /// A traced scene's meshes are held to the `scene_data` limit as a marched scene's are: the
-/// kernel is refused, naming the limit (the traced kernel skipped the check when first
-/// written).
+/// kernel is refused before it is written, naming the limit (the traced kernel skipped the
+/// check when first written, then was refused as an invalid kernel, "internal compiler
+/// error", by `sdfc compile` and `sdfc render`).
 #[test]
 fn a_traced_mesh_is_held_to_the_scene_data_limit() {
     let mut scene = setup("traced-mesh-limit", "mesh(\"part.stl\")", "");
@@ -163,6 +164,37 @@ fn a_traced_mesh_is_held_to_the_scene_data_limit() {
         .expect("a limit");
     let lowered = Lowered::new(&scene);
     assert!(matches!(choose(&scene), Choice::Trace(_)));
+    let refused = wgsl::choose(&scene, &lowered, &wgsl::Options::default())
+        .expect_err("refused before the kernel is written");
+    assert!(
+        matches!(refused, wgsl::Refused::MeshData { limit: 1, .. }),
+        "{refused}"
+    );
+    // The file `setup` wrote (`dir` would empty its directory).
+    let scene_file = std::env::temp_dir()
+        .join(format!(
+            "sdfc-mesh-traced-mesh-limit-{}",
+            std::process::id()
+        ))
+        .join("scene.sdf");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .args([
+            "compile",
+            "--emit",
+            "wgsl",
+            "--limit",
+            "scene_data=1",
+            s(&scene_file),
+        ])
+        .output()
+        .expect("sdfc runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("above the scene_data limit of 1 MiB"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("internal compiler error"), "{stderr}");
     let e = wgsl::write(&scene, &lowered).expect_err("above the limit");
     assert!(
         e.message.contains("scene_data limit of 1 MiB"),

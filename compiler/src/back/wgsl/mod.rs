@@ -299,13 +299,23 @@ pub enum KernelKind {
     Interpreted,
 }
 
-/// The kernel `options.kernel` gives `scene`, lowered as `lowered`, or why the interpreted
-/// kernel that it asks for cannot render it.
+/// The kernel `options.kernel` gives `scene`, lowered as `lowered`, or why it cannot render
+/// it: the interpreted kernel asked for and unable to, or meshes over the `scene_data` limit.
 pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<KernelKind, Refused> {
-    let traced = lowered.traceable.traced(scene.settings.method).is_some();
-    if let Some(data) = meshes_of(scene, lowered).filter(|_| !traced) {
-        // The meshes' triangles are read from `scene_data`, by either kernel.
-        mesh::fits(scene, &data)?;
+    let primitives = lowered.traceable.traced(scene.settings.method);
+    let traced = primitives.is_some();
+    // The meshes' triangles are read from `scene_data`: a traced scene's own meshes
+    // (analytic.rs), else those the programs name, by either kernel.
+    match primitives {
+        Some(t) if !t.meshes.is_empty() => {
+            mesh::fits(scene, &mesh::data_of(t.meshes.iter().map(|m| &*m.0)))?
+        }
+        Some(_) => {}
+        None => {
+            if let Some(data) = meshes_of(scene, lowered) {
+                mesh::fits(scene, &data)?;
+            }
+        }
     }
     match options.kernel {
         KernelChoice::Specialised => Ok(KernelKind::Specialised),

@@ -84,7 +84,8 @@ impl Session {
         };
         let kind = prepared.kernel_kind();
         let on = (&mut self.resident, (self.version, self.steps_wanted));
-        let (count, steps) = match render_sample(prepared, (&good.scene, good.grade), on, a) {
+        let rendered = render_sample(prepared, (&good.scene, good.grade), on, a);
+        let (count, steps) = match rendered.map_err(|e| e.to_string()) {
             Ok(r) => r,
             Err(msg) => {
                 self.broken = Some(msg.clone());
@@ -252,6 +253,16 @@ impl Accumulation {
     }
 }
 
+/// Why a frame was not rendered: the scene does not fit its kernel or the CPU's render failed
+/// (the backend's error), or the viewer's pass on the device failed.
+#[derive(Debug, thiserror::Error)]
+enum FrameError {
+    #[error(transparent)]
+    Backend(#[from] crate::backend::Error),
+    #[error(transparent)]
+    Pass(#[from] crate::view::resident::Error),
+}
+
 /// Renders a sample of `scene` through `prepared`: on wgpu the frame stays on the device,
 /// rendered, accumulated and shown there (in `resident`, made on the first frame; the scene
 /// data uploaded again when `version` changes; the steps summed when `steps_wanted`); on the
@@ -262,47 +273,36 @@ fn render_sample(
     (scene, grade): (&Scene, Grade),
     (resident, (version, steps_wanted)): (&mut Option<Resident>, (u64, bool)),
     a: &mut Accumulation,
-) -> Result<(u32, f64), String> {
-    match prepared.as_wgpu() {
-        Some(crate::backend::WgpuPrepared {
-            gpu,
-            kernel,
-            lipschitz,
-            ..
-        }) => {
-            let key = (version, kernel.interpreted());
-            let resident = match resident.as_mut() {
-                Some(r) => Ok(r),
-                None => Resident::new(gpu.clone()).map(|r| resident.insert(r)),
-            };
-            prepared
-                .check_contract(scene)
-                .map_err(|e| e.to_string())
-                .and_then(|()| {
-                    resident
-                        .and_then(|r| {
-                            r.render(
-                                (kernel, *lipschitz),
-                                (scene, grade),
-                                key,
-                                a.count == 0,
-                                steps_wanted,
-                            )
-                        })
-                        .map_err(|e| e.to_string())
-                })
-                .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
+) -> Result<(u32, f64), FrameError> {
+    let Some(crate::backend::WgpuPrepared {
+        gpu,
+        kernel,
+        lipschitz,
+        ..
+    }) = prepared.as_wgpu()
+    else {
+        let frame = prepared.render(scene, &|_| {})?;
+        for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
+            for i in 0..3 {
+                sum[i] += c[i];
+            }
         }
-        None => prepared
-            .render(scene, &|_| {})
-            .map_err(|e| e.to_string())
-            .map(|frame| {
-                for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
-                    for i in 0..3 {
-                        sum[i] += c[i];
-                    }
-                }
-                (a.count + 1, frame.render.stats.steps_mean)
-            }),
-    }
+        return Ok((a.count + 1, frame.render.stats.steps_mean));
+    };
+    let key = (version, kernel.interpreted());
+    // Made (and kept) before the scene is checked against its kernel.
+    let resident = match resident.as_mut() {
+        Some(r) => Ok(r),
+        None => Resident::new(gpu.clone()).map(|r| resident.insert(r)),
+    };
+    prepared.check_contract(scene)?;
+    let first = a.count == 0;
+    let r = resident?.render(
+        (kernel, *lipschitz),
+        (scene, grade),
+        key,
+        first,
+        steps_wanted,
+    )?;
+    Ok((r.count, r.steps.unwrap_or(f64::NAN)))
 }

@@ -84,7 +84,11 @@ impl Session {
     fn compile(&mut self) -> Result<(Good, Timings), String> {
         let job = self.job();
         let start = Instant::now();
-        let mut loaded = self.read(&job.limits)?;
+        let mut loaded = self.read(&job.limits).map_err(|e| {
+            let msg = e.to_string();
+            eprintln!("error: {msg}");
+            msg
+        })?;
         let scene = job.scene(&mut loaded, true).map_err(summary)?;
         let check_time = start.elapsed();
         let start = Instant::now();
@@ -99,7 +103,8 @@ impl Session {
             frontend::method(&loaded, &scene, &lowered.traceable)
         );
         let start = Instant::now();
-        let (ready, grade, interim_lowered) = self.prepare(&job, scene, lowered)?;
+        let (ready, grade, interim_lowered) =
+            self.prepare(&job, scene, lowered).map_err(summary)?;
         let prepare_time = start.elapsed();
         let job::Ready {
             scene,
@@ -109,7 +114,10 @@ impl Session {
         // Its frames are the view's size, whatever the scene's settings say.
         job::check_memory_here(&prepared, &scene, self.shown(), &job.limits, false)
             .map_err(summary)?;
-        let pipeline = self.pipeline(&prepared, &scene, interim_lowered)?;
+        let pipeline = self
+            .pipeline(&prepared, &scene, interim_lowered)
+            .map_err(|e| e.to_string())
+            .inspect_err(|msg| eprintln!("error: {msg}"))?;
         let background = pipeline.waiting.is_some();
         let good = Good {
             file_camera: scene.camera.clone(),
@@ -145,8 +153,8 @@ impl Session {
 
     /// Reads and checks the scene file (once it is not empty, or has stayed empty for
     /// [`EMPTY_PATIENCE`]), again while its files change under the read, and notes the files
-    /// read and their fingerprint; `Err` (printed) when the file cannot be read.
-    fn read(&mut self, limits: &Limits) -> Result<frontend::Loaded, String> {
+    /// read and their fingerprint; `Err` when the file cannot be read.
+    fn read(&mut self, limits: &Limits) -> Result<frontend::Loaded, frontend::ReadError> {
         let start = Instant::now();
         let empty = || std::fs::metadata(&self.file).is_ok_and(|m| m.len() == 0);
         while empty() && start.elapsed() < EMPTY_PATIENCE {
@@ -155,11 +163,9 @@ impl Session {
         let mut loaded = match frontend::load_with(&self.file, limits) {
             Ok(l) => l,
             Err(e) => {
-                let msg = e.to_string();
-                eprintln!("error: {msg}");
                 self.files = vec![self.file.clone()];
                 self.fingerprint = Fingerprint::of(&self.files);
-                return Err(msg);
+                return Err(e);
             }
         };
         // Files that changed while they were read (an editor saving in place truncates, then
@@ -201,7 +207,7 @@ impl Session {
         job: &Job,
         mut scene: Scene,
         lowered: Lowered,
-    ) -> Result<(job::Ready, Grade, Option<Lowered>), String> {
+    ) -> Result<(job::Ready, Grade, Option<Lowered>), Error> {
         // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
         // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.
         // The kernel kept is the specialised one unless `--kernel interpreted`; with `auto`
@@ -238,8 +244,7 @@ impl Session {
             lowered,
             phases: Vec::new(),
         };
-        let ready = job::prepare_here((self.backend(), &Devices::Auto), frame, &setup, open)
-            .map_err(summary)?;
+        let ready = job::prepare_here((self.backend(), &Devices::Auto), frame, &setup, open)?;
         Ok((ready, grade, interim_lowered))
     }
 
@@ -254,7 +259,7 @@ impl Session {
         prepared: &Prepared,
         scene: &Scene,
         interim_lowered: Option<Lowered>,
-    ) -> Result<PipelineState, String> {
+    ) -> Result<PipelineState, crate::gpu::wgpu::Error> {
         let mut pipeline = PipelineState {
             ready: None,
             waiting: None,
@@ -266,11 +271,8 @@ impl Session {
         };
         let data = kernel.data.is_some();
         if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
-            pipeline.ready = Some(
-                gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data)
-                    .map_err(|e| e.to_string())
-                    .inspect_err(|msg| eprintln!("error: {msg}"))?,
-            );
+            pipeline.ready =
+                Some(gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data)?);
             return Ok(pipeline);
         }
         let start = Instant::now();

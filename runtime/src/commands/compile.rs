@@ -1,5 +1,6 @@
 //! `sdfc compile`: write a scene as one of the textual targets.
 
+use crate::backend::Backend;
 use crate::frontend::{self, DiagnosticFormat};
 use clap::ValueEnum;
 use sdfc_compiler::{
@@ -149,14 +150,11 @@ pub fn run(args: CompileArgs) -> ExitCode {
             let Some(mut scene) = loaded.scene.take() else {
                 return ExitCode::from(1);
             };
-            let job = crate::job::Job {
-                overrides: crate::job::Overrides {
-                    set: args.set.clone(),
-                    ..Default::default()
-                },
-                limits: limits.clone(),
+            let overrides = crate::job::Overrides {
+                set: args.set.clone(),
                 ..Default::default()
             };
+            let job = crate::job::Job::new(Backend::Auto, overrides, limits.clone());
             if let Err(e) = job.settings(&mut scene) {
                 return e.exit();
             }

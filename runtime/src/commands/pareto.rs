@@ -78,17 +78,15 @@ pub struct ParetoArgs {
 impl ParetoArgs {
     /// The job these arguments describe: the timed renders'.
     pub fn job(&self) -> Job {
+        let overrides = Overrides {
+            size: self.size,
+            set: self.set.clone(),
+            ..Overrides::default()
+        };
         Job {
-            backend: self.backend,
             precision: self.precision,
-            overrides: Overrides {
-                size: self.size,
-                set: self.set.clone(),
-                ..Overrides::default()
-            },
-            limits: self.limits.limits(),
             threads: self.threads,
-            ..Job::default()
+            ..Job::new(self.backend, overrides, self.limits.limits())
         }
     }
 }

@@ -91,16 +91,12 @@ pub fn run(args: ViewArgs) -> ExitCode {
         ViewBackend::Wgpu => Backend::Wgpu,
         ViewBackend::Cpu => Backend::Cpu,
     };
-    let job = Job {
-        backend,
-        overrides: Overrides {
-            size: args.size,
-            set: args.set,
-            ..Overrides::default()
-        },
-        limits: args.limits.limits(),
-        ..Job::default()
+    let overrides = Overrides {
+        size: args.size,
+        set: args.set,
+        ..Overrides::default()
     };
+    let job = Job::new(backend, overrides, args.limits.limits());
     // The --set values are checked once here, so that a mistake in them stops at once rather
     // than failing every reload.
     let mut probe = sdfc_compiler::Settings::default();

@@ -2,7 +2,7 @@
 //! take bands of an image beside GPU devices (`--devices cpu,0`): it renders each band it
 //! takes with [`crate::cpu::render_rows`] in a thread pool of its own.
 
-use super::launch::{self, Job, Pixels};
+use super::launch::{self, Pixels, Work};
 use super::reduce::{Answer, Ask};
 use crate::cpu::{self, Counters, Options, Tapes};
 use sdfc_compiler::Scene;
@@ -65,7 +65,7 @@ impl launch::Device for Device<'_> {
         format!("CPU, {} threads", self.threads)
     }
 
-    fn prepare(&self, _job: &Job) -> Result<Frame, Error> {
+    fn prepare(&self, _work: &Work) -> Result<Frame, Error> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()
@@ -77,17 +77,17 @@ impl launch::Device for Device<'_> {
         })
     }
 
-    fn run(&self, f: &mut Frame, job: &Job, tiles: &[usize]) -> Result<(), Error> {
+    fn run(&self, f: &mut Frame, work: &Work, tiles: &[usize]) -> Result<(), Error> {
         for &i in tiles {
-            let t = job.tiles[i];
-            if t.0 != 0 || t.2 != job.width {
+            let t = work.tiles[i];
+            if t.0 != 0 || t.2 != work.width {
                 return Err(Error::NotRows);
             }
             let rows = t.1..t.1 + t.3;
             let (linear, steps, counters) = f
                 .pool
                 .install(|| cpu::render_rows(self.scene, self.tapes, self.options, rows));
-            let w = job.width as usize;
+            let w = work.width as usize;
             let range = t.1 as usize * w..(t.1 + t.3) as usize * w;
             f.rendered.push((range.clone(), linear));
             f.statistics.push((range, steps, counters));
@@ -95,7 +95,7 @@ impl launch::Device for Device<'_> {
         Ok(())
     }
 
-    fn read(&self, f: &mut Frame, job: &Job, ranges: &[Range<usize>]) -> Result<Pixels, Error> {
+    fn read(&self, f: &mut Frame, work: &Work, ranges: &[Range<usize>]) -> Result<Pixels, Error> {
         let mut out = Pixels::default();
         for r in ranges {
             let at = f
@@ -104,7 +104,7 @@ impl launch::Device for Device<'_> {
                 .position(|(have, _)| have == r)
                 .ok_or_else(|| Error::NotRendered(r.clone()))?;
             let (_, linear) = f.rendered.swap_remove(at);
-            if job.finished {
+            if work.finished {
                 // Finished here as a GPU finishes its pixels: clamped and sRGB-encoded.
                 let start = std::time::Instant::now();
                 let table = crate::image::SrgbTable::get();
@@ -128,7 +128,7 @@ impl launch::Device for Device<'_> {
     fn reduce(
         &self,
         f: &mut Frame,
-        _job: &Job,
+        _work: &Work,
         ranges: &[Range<usize>],
         ask: Ask,
     ) -> Result<Answer, Error> {
@@ -142,7 +142,7 @@ impl launch::Device for Device<'_> {
         Ok(Answer::of_steps(&steps, &counters, ask))
     }
 
-    fn finish(&self, _f: Frame, _job: &Job) -> Result<Option<Duration>, Error> {
+    fn finish(&self, _f: Frame, _work: &Work) -> Result<Option<Duration>, Error> {
         Ok(None)
     }
 

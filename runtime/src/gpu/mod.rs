@@ -59,7 +59,7 @@ pub struct GpuRender {
     /// Image and statistics (the image empty when the frame was finished on the device).
     pub render: Render,
     /// The pixels finished on the device (clamped, sRGB-encoded RGBA8), when they were read
-    /// back instead of the linear colours ([`launch::Job::finished`]).
+    /// back instead of the linear colours ([`launch::Work::finished`]).
     pub finished: Option<Rgba8>,
     /// Where the frame's wall time went on the host.
     pub phases: Phases,
@@ -127,8 +127,8 @@ pub fn render(
 }
 
 /// [`render`] with the faults `faults` injected, reducing the per-pixel statistics on the
-/// device only when `statistics` ([`launch::Job::statistics`]), and the finished pixels instead of the
-/// linear colours when `finished` ([`launch::Job::finished`]).
+/// device only when `statistics` ([`launch::Work::statistics`]), and the finished pixels instead of the
+/// linear colours when `finished` ([`launch::Work::finished`]).
 pub fn render_faults(
     gpu: &Gpu,
     scene: &Scene,
@@ -186,7 +186,7 @@ fn render_one<D: launch::Device>(
 ) -> Result<GpuRender, D::Error> {
     let s = &scene.settings;
     let tiles = launch::tiling(s.width, s.height, TILE, 1);
-    let job = launch::Job {
+    let work = launch::Work {
         uniforms,
         data,
         width: s.width,
@@ -196,7 +196,7 @@ fn render_one<D: launch::Device>(
         statistics,
         finished,
     };
-    let out = launch::render_one(device, &job, faults, progress)?;
+    let out = launch::render_one(device, &work, faults, progress)?;
     Ok(finish(out, s))
 }
 
@@ -228,7 +228,7 @@ pub fn render_several(
         None => Vec::new(),
     };
     let tiles = launch::tiling(s.width, s.height, TILE, devices.len());
-    let job = launch::Job {
+    let work = launch::Work {
         uniforms: &uniforms,
         data,
         width: s.width,
@@ -238,7 +238,7 @@ pub fn render_several(
         statistics,
         finished,
     };
-    let out = launch::render_several(devices, &job, faults, progress)?;
+    let out = launch::render_several(devices, &work, faults, progress)?;
     Ok(finish(out, s))
 }
 

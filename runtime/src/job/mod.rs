@@ -244,6 +244,17 @@ pub struct FrameScene {
 }
 
 impl Job {
+    /// A job on `backend`, the settings overridden as `overrides`, within `limits`; the rest
+    /// as by default (`--devices auto`, f32, no `--kernel`, one worker thread per core).
+    pub fn new(backend: Backend, overrides: Overrides, limits: Limits) -> Job {
+        Job {
+            backend,
+            overrides,
+            limits,
+            ..Job::default()
+        }
+    }
+
     /// The backend and float type the job renders with: `--reference` means the CPU in f64.
     pub fn mode(&self) -> Result<(Backend, Precision), Error> {
         self.devices.check(self.backend)?;

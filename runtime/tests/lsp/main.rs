@@ -96,6 +96,26 @@ impl Client {
         }
     }
 
+    /// Opens the document `uri` with `text` (version 1).
+    fn open(&self, uri: &str, text: &str) {
+        self.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": uri, "languageId": "sdf", "version": 1, "text": text } }),
+        );
+    }
+
+    /// The markdown of a hover at `position` (request parameters).
+    fn hover(&mut self, position: Value) -> String {
+        let h = self.request("textDocument/hover", position);
+        h["contents"]["value"].as_str().unwrap().to_string()
+    }
+
+    /// The workspace edit of renaming the name at `position` (request parameters) to `new`.
+    fn rename(&mut self, mut position: Value, new: &str) -> Value {
+        position["newName"] = json!(new);
+        self.request("textDocument/rename", position)
+    }
+
     /// Waits for diagnostics of `uri` to be published.
     fn diagnostics(&mut self, uri: &str) -> Value {
         self.published.remove(uri);

@@ -67,10 +67,7 @@ fn never_crashes_on_mutated_text() {
     ];
     for round in 0..12 {
         let mut text = corpus[rng.below(corpus.len())].clone();
-        c.notify(
-            "textDocument/didOpen",
-            json!({ "textDocument": { "uri": doc, "languageId": "sdf", "version": 1, "text": text } }),
-        );
+        c.open(&doc, &text);
         for step in 0..25 {
             // A change at a random line and character, possibly past the end of either.
             let lines = text.matches('\n').count() + 2;
@@ -150,10 +147,7 @@ fn request_latency_on_every_example() {
         let text = std::fs::read_to_string(&path).expect("read");
         let doc = uri(&path);
         let t0 = std::time::Instant::now();
-        c.notify(
-            "textDocument/didOpen",
-            json!({ "textDocument": { "uri": doc, "languageId": "sdf", "version": 1, "text": text } }),
-        );
+        c.open(&doc, &text);
         c.diagnostics(&doc);
         // Less the debounce, which the client waits on purpose.
         let publish = t0.elapsed().saturating_sub(sdfc_runtime::lsp::DEBOUNCE);

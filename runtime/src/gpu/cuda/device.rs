@@ -3,7 +3,7 @@
 
 #![allow(unsafe_code)] // The driver API is C: its calls are wrapped here, each with its reason.
 
-use super::super::launch::{self, Job, Pixels};
+use super::super::launch::{self, Pixels, Work};
 use super::super::reduce::{self, Answer, Ask};
 use super::{driver, Error, FrameBuffers, Kernel, Loaded};
 use cudarc::driver::{sys, LaunchConfig, PushKernelArg};
@@ -46,11 +46,11 @@ impl launch::Device for Kernel<'_> {
         self.cuda.describe()
     }
 
-    fn prepare(&self, job: &Job) -> Result<FrameBuffers, Error> {
+    fn prepare(&self, work: &Work) -> Result<FrameBuffers, Error> {
         let s = &self.cuda.stream;
-        let pixels = job.width as usize * job.height as usize;
-        check_launch(self.loaded, job.uniforms, pixels, STATS_WORDS, job.data)?;
-        let table: Vec<u32> = job
+        let pixels = work.width as usize * work.height as usize;
+        check_launch(self.loaded, work.uniforms, pixels, STATS_WORDS, work.data)?;
+        let table: Vec<u32> = work
             .tiles
             .iter()
             .flat_map(|t| [t.0, t.1, t.2, t.3])
@@ -58,17 +58,17 @@ impl launch::Device for Kernel<'_> {
         let kept = self.cuda.spare.lock().ok().and_then(|mut k| k.take());
         let fits = |f: &FrameBuffers| {
             f.image.len() == pixels * 4
-                && f.uniforms.len() == job.uniforms.len()
+                && f.uniforms.len() == work.uniforms.len()
                 && f.tiles.len() == table.len()
-                && f.data.as_ref().map(|d| d.len()) == job.data.map(|d| d.len())
+                && f.data.as_ref().map(|d| d.len()) == work.data.map(|d| d.len())
         };
         if let Some(mut f) = kept.filter(fits) {
             // Every pixel of the tiles is written by the kernel: the buffers need no clearing.
-            s.memcpy_htod(job.uniforms, &mut f.uniforms)
+            s.memcpy_htod(work.uniforms, &mut f.uniforms)
                 .map_err(driver("uploading the scene"))?;
             s.memcpy_htod(&table, &mut f.tiles)
                 .map_err(driver("uploading the tiles"))?;
-            if let (Some(d), Some(bytes)) = (&mut f.data, job.data) {
+            if let (Some(d), Some(bytes)) = (&mut f.data, work.data) {
                 s.memcpy_htod(bytes, d)
                     .map_err(driver("uploading the scene data"))?;
             }
@@ -77,7 +77,7 @@ impl launch::Device for Kernel<'_> {
             return Ok(f);
         }
         let uniforms = s
-            .clone_htod(job.uniforms)
+            .clone_htod(work.uniforms)
             .map_err(driver("uploading the scene"))?;
         let tiles = s
             .clone_htod(&table)
@@ -91,7 +91,7 @@ impl launch::Device for Kernel<'_> {
         let finished = s
             .alloc_zeros::<u8>(pixels * 4)
             .map_err(driver("allocating the pixels"))?;
-        let data = match job.data {
+        let data = match work.data {
             Some(bytes) => Some(
                 s.clone_htod(bytes)
                     .map_err(driver("uploading the scene data"))?,
@@ -106,29 +106,29 @@ impl launch::Device for Kernel<'_> {
             stats,
             data,
             pixels: finished,
-            events: Vec::with_capacity(job.tiles.len()),
+            events: Vec::with_capacity(work.tiles.len()),
             reduction: None,
             readback: [(None, None), (None, None)],
         })
     }
 
-    fn run(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
-        self.submit(f, job, tiles)?;
+    fn run(&self, f: &mut FrameBuffers, work: &Work, tiles: &[usize]) -> Result<(), Error> {
+        self.submit(f, work, tiles)?;
         self.cuda
             .stream
             .synchronize()
             .map_err(driver("running the kernel"))
     }
 
-    fn submit(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
+    fn submit(&self, f: &mut FrameBuffers, work: &Work, tiles: &[usize]) -> Result<(), Error> {
         let s = &self.cuda.stream;
         let workgroup = self.workgroup;
         // Each launch is timed by its own pair of events, and the times are summed: the
         // same measure as the wgpu path's per-pass timestamps (gaps between launches excluded).
         let flags = Some(sys::CUevent_flags::CU_EVENT_DEFAULT);
         for &i in tiles {
-            let t = job.tiles[i];
-            let timed = if job.timed {
+            let t = work.tiles[i];
+            let timed = if work.timed {
                 let start = self
                     .cuda
                     .ctx
@@ -181,11 +181,11 @@ impl launch::Device for Kernel<'_> {
     fn start_read(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<(), Error> {
-        if !job.finished {
+        if !work.finished {
             return Ok(());
         }
         let bytes = 4 * range.len();
@@ -221,14 +221,14 @@ impl launch::Device for Kernel<'_> {
     fn collect(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<Pixels, Error> {
         let (kept, at) = &mut f.readback[slot];
         let copied = at.take().filter(|(r, _)| *r == range);
         let (Some(pinned), Some((_, copied))) = (kept.as_ref(), copied) else {
-            return self.read(f, job, std::slice::from_ref(&range));
+            return self.read(f, work, std::slice::from_ref(&range));
         };
         // Waits for the copy alone: the launches queued after it may still run.
         copied.synchronize().map_err(driver("reading the pixels"))?;
@@ -246,7 +246,7 @@ impl launch::Device for Kernel<'_> {
     fn collect_into(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         slot: usize,
         place: launch::Place<'_>,
@@ -269,7 +269,7 @@ impl launch::Device for Kernel<'_> {
             (_, copied, place) => {
                 // A read started for this band, collected through `collect`.
                 f.readback[slot].1 = copied;
-                launch::collect_copied(self, f, job, (range, slot), place)
+                launch::collect_copied(self, f, work, (range, slot), place)
             }
         }
     }
@@ -277,16 +277,16 @@ impl launch::Device for Kernel<'_> {
     fn read(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Error> {
         let s = &self.cuda.stream;
         let n: usize = ranges.iter().map(|r| r.end - r.start).sum();
         // The finished pixels (4 bytes each) or the linear colours (4 floats).
-        let paged = job.finished && ranges.len() != 1;
+        let paged = work.finished && ranges.len() != 1;
         let mut rgba = vec![0u8; if paged { 4 * n } else { 0 }];
-        let mut image = vec![0f32; if job.finished { 0 } else { 4 * n }];
-        if job.finished && ranges.len() == 1 {
+        let mut image = vec![0f32; if work.finished { 0 } else { 4 * n }];
+        if work.finished && ranges.len() == 1 {
             // Through the kept page-locked buffer, then copied out.
             let r = &ranges[0];
             rgba = self.read_pinned(&f.pixels.slice(4 * r.start..4 * r.end))?;
@@ -294,9 +294,9 @@ impl launch::Device for Kernel<'_> {
         let mut at = 0;
         for r in ranges {
             let len = r.end - r.start;
-            if job.finished && ranges.len() == 1 {
+            if work.finished && ranges.len() == 1 {
                 // Read above.
-            } else if job.finished {
+            } else if work.finished {
                 s.memcpy_dtoh(
                     &f.pixels.slice(4 * r.start..4 * r.end),
                     &mut rgba[4 * at..4 * (at + len)],
@@ -331,17 +331,17 @@ impl launch::Device for Kernel<'_> {
     fn reduce(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         ranges: &[Range<usize>],
         ask: Ask,
     ) -> Result<Answer, Error> {
-        let queries = reduce::queries(job.pixels(), ranges, ask);
+        let queries = reduce::queries(work.pixels(), ranges, ask);
         if queries.is_empty() {
             return Ok(Answer::empty(ask));
         }
         let reducer = self.cuda.reducer()?;
         let s = &self.cuda.stream;
-        let (first, second) = reduce::threads(job.pixels());
+        let (first, second) = reduce::threads(work.pixels());
         let record = reduction::RECORD as usize;
         if f.reduction.is_none() {
             let partial = s
@@ -387,9 +387,9 @@ impl launch::Device for Kernel<'_> {
         Ok(Answer::of_totals(&totals, ask))
     }
 
-    fn finish(&self, f: FrameBuffers, job: &Job) -> Result<Option<Duration>, Error> {
+    fn finish(&self, f: FrameBuffers, work: &Work) -> Result<Option<Duration>, Error> {
         let mut time = None;
-        if job.timed {
+        if work.timed {
             let mut ms = 0.0f64;
             for (start, end) in &f.events {
                 ms += start.elapsed_ms(end).map_err(driver("reading the timer"))? as f64;

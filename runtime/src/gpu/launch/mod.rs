@@ -25,9 +25,11 @@ pub type Tile = (u32, u32, u32, u32);
 /// (progress, and a bound on how much work is queued at once).
 const TILES_PER_SUBMIT: usize = 8;
 
-/// What every device renders of a frame: the kernel's inputs, the image size and the tiles.
+/// What every device renders of a frame: the kernel's inputs (uniforms and scene data), the
+/// image size and the tiles, and whether to time them, reduce the statistics and read back
+/// finished pixels. (A render request as a whole is a [`crate::job::Job`].)
 #[derive(Debug, Clone, Copy)]
-pub struct Job<'a> {
+pub struct Work<'a> {
     /// Bytes of the scene uniform (binding 0).
     pub uniforms: &'a [u8],
     /// Bytes of the read-only `scene_data` (binding 4), when the kernel declares it.
@@ -51,7 +53,7 @@ pub struct Job<'a> {
     pub finished: bool,
 }
 
-impl Job<'_> {
+impl Work<'_> {
     /// The image's pixels.
     pub fn pixels(&self) -> usize {
         self.width as usize * self.height as usize
@@ -67,7 +69,7 @@ impl Job<'_> {
 }
 
 /// Pixels read back from a device, in the order of the ranges asked for: linear colours (or,
-/// for a job that asks for them, finished RGBA8 bytes), and how long converting them from the
+/// where the work asks for them, finished RGBA8 bytes), and how long converting them from the
 /// device's layout took.
 #[derive(Debug, Default)]
 pub struct Pixels {
@@ -85,14 +87,15 @@ pub trait Device: Sync {
     /// The device, for messages.
     fn describe(&self) -> String;
     /// Allocates a frame's buffers and uploads the uniforms, the scene data and the tile table.
-    fn prepare(&self, job: &Job) -> Result<Self::Frame, Self::Error>;
-    /// Runs the tiles `tiles` (indices into the job's table) and waits until they are done.
-    fn run(&self, frame: &mut Self::Frame, job: &Job, tiles: &[usize]) -> Result<(), Self::Error>;
+    fn prepare(&self, work: &Work) -> Result<Self::Frame, Self::Error>;
+    /// Runs the tiles `tiles` (indices into the work's table) and waits until they are done.
+    fn run(&self, frame: &mut Self::Frame, work: &Work, tiles: &[usize])
+        -> Result<(), Self::Error>;
     /// Reads back the pixels of `ranges` (row-major pixel indices), one after the other.
     fn read(
         &self,
         frame: &mut Self::Frame,
-        job: &Job,
+        work: &Work,
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Self::Error>;
     /// Starts the tiles `tiles` without waiting for them: several devices overlap a band's
@@ -101,10 +104,10 @@ pub trait Device: Sync {
     fn submit(
         &self,
         frame: &mut Self::Frame,
-        job: &Job,
+        work: &Work,
         tiles: &[usize],
     ) -> Result<(), Self::Error> {
-        self.run(frame, job, tiles)
+        self.run(frame, work, tiles)
     }
     /// Starts reading back the pixels of `range` once the work submitted so far is done, into
     /// readback buffer `slot` (0 or 1: a band's pixels are collected from one while the next
@@ -112,7 +115,7 @@ pub trait Device: Sync {
     fn start_read(
         &self,
         _frame: &mut Self::Frame,
-        _job: &Job,
+        _work: &Work,
         _range: Range<usize>,
         _slot: usize,
     ) -> Result<(), Self::Error> {
@@ -123,11 +126,11 @@ pub trait Device: Sync {
     fn collect(
         &self,
         frame: &mut Self::Frame,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         _slot: usize,
     ) -> Result<Pixels, Self::Error> {
-        self.read(frame, job, std::slice::from_ref(&range))
+        self.read(frame, work, std::slice::from_ref(&range))
     }
     /// [`Device::collect`] straight into `place`, the band's place in the image: the pixels
     /// cross the host's memory once, on the worker's thread. Says how long it waited for the
@@ -136,19 +139,19 @@ pub trait Device: Sync {
     fn collect_into(
         &self,
         frame: &mut Self::Frame,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         slot: usize,
         place: Place<'_>,
     ) -> Result<Collected, Self::Error> {
-        collect_copied(self, frame, job, (range, slot), place)
+        collect_copied(self, frame, work, (range, slot), place)
     }
     /// The statistics of the pixels of `ranges` (rendered in `frame`) reduced as `ask` asks,
     /// on the device ([`super::reduce`]).
     fn reduce(
         &self,
         frame: &mut Self::Frame,
-        job: &Job,
+        work: &Work,
         ranges: &[Range<usize>],
         ask: Ask,
     ) -> Result<Answer, Self::Error>;
@@ -157,9 +160,9 @@ pub trait Device: Sync {
     fn check(&self, _frame: &mut Self::Frame) -> Result<(), Self::Error> {
         Ok(())
     }
-    /// Ends the frame: errors the device held back, and the time of its tiles when the job
+    /// Ends the frame: errors the device held back, and the time of its tiles when the work
     /// is timed and the device can time them.
-    fn finish(&self, frame: Self::Frame, job: &Job) -> Result<Option<Duration>, Self::Error>;
+    fn finish(&self, frame: Self::Frame, work: &Work) -> Result<Option<Duration>, Self::Error>;
     /// The error a device fault of the testing aid is reported as (the path a real device
     /// error takes).
     fn fault(&self, message: String) -> Self::Error;
@@ -182,7 +185,7 @@ impl Place<'_> {
         }
     }
 
-    /// `pixels` copied in (those the job asked for).
+    /// `pixels` copied in (those the work asked for).
     fn fill(self, pixels: &Pixels) {
         match self {
             Place::Rgba(p) => {
@@ -209,11 +212,11 @@ pub struct Collected {
 pub fn collect_copied<D: Device + ?Sized>(
     device: &D,
     frame: &mut D::Frame,
-    job: &Job,
+    work: &Work,
     (range, slot): (Range<usize>, usize),
     place: Place<'_>,
 ) -> Result<Collected, D::Error> {
-    let pixels = device.collect(frame, job, range, slot)?;
+    let pixels = device.collect(frame, work, range, slot)?;
     place.fill(&pixels);
     Ok(Collected {
         wait: Duration::ZERO,
@@ -222,12 +225,12 @@ pub fn collect_copied<D: Device + ?Sized>(
 }
 
 /// A frame rendered by the scheduler: its linear colours, or its finished RGBA8 bytes when
-/// the job asked for them ([`Job::finished`]).
+/// the work asked for them ([`Work::finished`]).
 #[derive(Debug)]
 pub struct Output {
     pub linear: Vec<[f32; 3]>,
     pub rgba: Vec<u8>,
-    /// The statistics reduced on the devices (empty unless the job asked for them).
+    /// The statistics reduced on the devices (empty unless the work asked for them).
     pub summary: Summary,
     pub phases: Phases,
     /// The tiles' time on the device, where measured.
@@ -353,25 +356,25 @@ pub fn squares(width: u32, height: u32, edge: u32) -> Vec<Tile> {
     out
 }
 
-/// Renders `job` on one device. Finished pixels ([`Job::finished`]): a row of tiles at a
+/// Renders `work` on one device. Finished pixels ([`Work::finished`]): a row of tiles at a
 /// time, each row's readback queued behind its launches and the row before collected while
 /// it renders, straight into the frame's buffer (one of [`crate::image::pixel_buffer`]'s).
 /// Linear colours: the tiles in batches, waiting after each (progress, the injected fault),
 /// then the image read back whole.
 pub fn render_one<D: Device>(
     device: &D,
-    job: &Job,
+    work: &Work,
     faults: &Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Output, D::Error> {
     let setup = Instant::now();
-    let mut frame = device.prepare(job)?;
+    let mut frame = device.prepare(work)?;
     let setup = setup.elapsed();
     let start = Instant::now();
-    let whole = 0..job.pixels();
-    let (pixels, wall, readback) = match job.finished {
+    let whole = 0..work.pixels();
+    let (pixels, wall, readback) = match work.finished {
         true => {
-            let (rgba, collecting) = overlapped(device, &mut frame, job, faults, progress)?;
+            let (rgba, collecting) = overlapped(device, &mut frame, work, faults, progress)?;
             let pixels = Pixels {
                 rgba,
                 ..Pixels::default()
@@ -383,9 +386,9 @@ pub fn render_one<D: Device>(
             )
         }
         false => {
-            let all: Vec<usize> = (0..job.tiles.len()).collect();
+            let all: Vec<usize> = (0..work.tiles.len()).collect();
             for batch in all.chunks(TILES_PER_SUBMIT) {
-                device.run(&mut frame, job, batch)?;
+                device.run(&mut frame, work, batch)?;
                 if let Some(msg) = batch.iter().find_map(|&i| faults.injected(0, i)) {
                     return Err(device.fault(msg));
                 }
@@ -394,23 +397,23 @@ pub fn render_one<D: Device>(
             }
             let wall = start.elapsed();
             let readback = Instant::now();
-            let pixels = device.read(&mut frame, job, std::slice::from_ref(&whole))?;
+            let pixels = device.read(&mut frame, work, std::slice::from_ref(&whole))?;
             let readback = readback.elapsed().saturating_sub(pixels.convert);
             (pixels, wall, readback)
         }
     };
     let reducing = Instant::now();
     let mut summary = Summary::default();
-    if job.statistics {
-        let mut selection = Selection::new(job.pixels() as u64);
+    if work.statistics {
+        let mut selection = Selection::new(work.pixels() as u64);
         while let Some(ask) = selection.ask() {
-            let answer = device.reduce(&mut frame, job, std::slice::from_ref(&whole), ask)?;
+            let answer = device.reduce(&mut frame, work, std::slice::from_ref(&whole), ask)?;
             selection.answer(answer);
         }
         summary = selection.summary();
     }
     let readback = readback + reducing.elapsed();
-    let device_time = device.finish(frame, job)?;
+    let device_time = device.finish(frame, work)?;
     Ok(Output {
         linear: pixels.linear,
         rgba: pixels.rgba,
@@ -427,7 +430,7 @@ pub fn render_one<D: Device>(
     })
 }
 
-/// The finished pixels of `job`'s tiles on one device, a row of tiles at a time ([`rows`]):
+/// The finished pixels of `work`'s tiles on one device, a row of tiles at a time ([`rows`]):
 /// each row's launches submitted with its readback queued behind them, the row before
 /// collected into the frame's buffer while it renders. Returns the pixels and the time spent
 /// reading them back (starting the copies, and copying into the frame's buffer; the waits for
@@ -435,34 +438,34 @@ pub fn render_one<D: Device>(
 fn overlapped<D: Device>(
     device: &D,
     frame: &mut D::Frame,
-    job: &Job,
+    work: &Work,
     faults: &Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<(Vec<u8>, Duration), D::Error> {
-    let mut rgba = crate::image::pixel_buffer(4 * job.pixels());
+    let mut rgba = crate::image::pixel_buffer(4 * work.pixels());
     let mut reading = Duration::ZERO;
-    let rows = rows(job.tiles);
-    let w = job.width as usize;
+    let rows = rows(work.tiles);
+    let w = work.width as usize;
     let pixels = |r: &Range<u32>| r.start as usize * w..r.end as usize * w;
     // Collects the pixels of `range` from readback buffer `slot`: the time spent copying.
     let collect = |frame: &mut D::Frame, range: Range<usize>, slot, rgba: &mut [u8]| {
         let t = Instant::now();
         let place = Place::Rgba(&mut rgba[4 * range.start..4 * range.end]);
-        let collected = device.collect_into(frame, job, range, slot, place)?;
+        let collected = device.collect_into(frame, work, range, slot, place)?;
         Ok(t.elapsed().saturating_sub(collected.wait))
     };
     for (i, (tiles, lines)) in rows.iter().enumerate() {
         let tiles: Vec<usize> = tiles.clone().collect();
-        device.submit(frame, job, &tiles)?;
+        device.submit(frame, work, &tiles)?;
         if let Some(msg) = tiles.iter().find_map(|&t| faults.injected(0, t)) {
             return Err(device.fault(msg));
         }
         let t = Instant::now();
-        device.start_read(frame, job, pixels(lines), i % 2)?;
+        device.start_read(frame, work, pixels(lines), i % 2)?;
         reading += t.elapsed();
         if i > 0 {
             reading += collect(frame, pixels(&rows[i - 1].1), (i - 1) % 2, &mut rgba)?;
-            progress(tiles[0] as f64 / job.tiles.len().max(1) as f64);
+            progress(tiles[0] as f64 / work.tiles.len().max(1) as f64);
         }
     }
     if let Some((_, lines)) = rows.last() {

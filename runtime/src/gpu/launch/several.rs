@@ -2,7 +2,7 @@
 //! from one [`Queue`], reads it back into its place in the image, and hands it back when its
 //! device fails, so that the others finish the frame ([`render_several`]).
 
-use super::{Device, Faults, Job, Output, Place, Share};
+use super::{Device, Faults, Output, Place, Share, Work};
 use crate::gpu::reduce::{Rounds, Summary};
 use crate::gpu::Phases;
 use std::collections::VecDeque;
@@ -149,12 +149,12 @@ impl<T> Queue<T> {
     }
 }
 
-/// The bands of a frame on several devices: the job, the queue of band indices, each band's
+/// The bands of a frame on several devices: the work, the queue of band indices, each band's
 /// place in the image, where finished bands are told, the faults to inject, and the rounds of
-/// the statistics' reduction when the job asks for them.
+/// the statistics' reduction when the work asks for them.
 #[derive(Debug)]
 pub struct Bands<'a> {
-    job: &'a Job<'a>,
+    work: &'a Work<'a>,
     faults: &'a Faults,
     queue: Queue<usize>,
     /// Each band's place in the image, written by the worker that collects it (again by
@@ -187,11 +187,11 @@ trait Accept: Device {
         (band, slot): (usize, usize),
         share: &mut Share,
     ) -> Result<(), Self::Error> {
-        let job = bands.job;
+        let work = bands.work;
         let read = Instant::now();
         let collected = {
             let mut place = bands.places[band].lock().unwrap_or_else(|e| e.into_inner());
-            self.collect_into(frame, job, job.band(band), slot, place.reborrow())
+            self.collect_into(frame, work, work.band(band), slot, place.reborrow())
                 .and_then(|c| self.check(frame).map(|()| c))?
         };
         share.phases.launches += collected.wait;
@@ -214,7 +214,7 @@ impl<D: Device> Worker for D {
     }
 
     fn work(&self, bands: &Bands, position: usize) -> Share {
-        let job = bands.job;
+        let work = bands.work;
         let queue = &bands.queue;
         let mut share = Share {
             device: self.describe(),
@@ -229,7 +229,7 @@ impl<D: Device> Worker for D {
                 r.leave(lost)
             }
         };
-        let mut frame = match self.prepare(job) {
+        let mut frame = match self.prepare(work) {
             Ok(f) => f,
             Err(e) => {
                 leave(false);
@@ -250,8 +250,8 @@ impl<D: Device> Worker for D {
             let ran = match bands.faults.injected(position, started) {
                 Some(msg) => Err(self.fault(msg)),
                 None => self
-                    .submit(&mut frame, job, &[band])
-                    .and_then(|()| self.start_read(&mut frame, job, job.band(band), slot)),
+                    .submit(&mut frame, work, &[band])
+                    .and_then(|()| self.start_read(&mut frame, work, work.band(band), slot)),
             };
             started += 1;
             share.phases.launches += launch.elapsed();
@@ -264,7 +264,7 @@ impl<D: Device> Worker for D {
                     share.failure = Some(e.to_string());
                     break;
                 }
-                rendered.push(job.band(p));
+                rendered.push(work.band(p));
             }
             if let Err(e) = ran {
                 queue.hand_back(band);
@@ -282,7 +282,7 @@ impl<D: Device> Worker for D {
                         share.failure = Some(e.to_string());
                         break;
                     }
-                    rendered.push(job.band(p));
+                    rendered.push(work.band(p));
                 }
                 next = queue.take();
             }
@@ -294,7 +294,7 @@ impl<D: Device> Worker for D {
             let read = Instant::now();
             let mut round = 0;
             while let Some(ask) = rounds.ask(round) {
-                match self.reduce(&mut frame, job, &rendered, ask) {
+                match self.reduce(&mut frame, work, &rendered, ask) {
                     Ok(answer) => rounds.answer(answer),
                     Err(e) => {
                         rounds.leave(!rendered.is_empty());
@@ -309,7 +309,7 @@ impl<D: Device> Worker for D {
         if share.failure.is_some() {
             return share;
         }
-        if let Err(e) = self.finish(frame, job) {
+        if let Err(e) = self.finish(frame, work) {
             share.failure = Some(e.to_string());
         }
         share
@@ -345,33 +345,33 @@ impl std::fmt::Display for SeveralError {
 
 impl std::error::Error for SeveralError {}
 
-/// Renders `job` (whose tiles are bands, [`tiling`]) on several devices at once: each
+/// Renders `work` (whose tiles are bands, [`tiling`]) on several devices at once: each
 /// device's worker takes the next band from one queue; the bands are assembled in order. A
 /// device that fails hands its band back; the frame fails only when every device has.
 pub fn render_several(
     devices: &[&dyn Worker],
-    job: &Job,
+    work: &Work,
     faults: &Faults,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Output, SeveralError> {
     let start = Instant::now();
     let (tx, rx) = mpsc::channel();
-    let pixels = job.pixels();
+    let pixels = work.pixels();
     // The finished pixels go into a buffer an earlier frame handed back when there is one
     // (every band overwrites its place), its pages in memory already.
-    let (mut linear, mut rgba) = match job.finished {
+    let (mut linear, mut rgba) = match work.finished {
         true => (Vec::new(), crate::image::pixel_buffer(4 * pixels)),
         false => (crate::image::zeroed(pixels), Vec::new()),
     };
     let bands = Bands {
-        job,
+        work,
         faults,
-        queue: Queue::new(0..job.tiles.len(), false),
-        places: places(job, &mut rgba, &mut linear),
+        queue: Queue::new(0..work.tiles.len(), false),
+        places: places(work, &mut rgba, &mut linear),
         events: tx,
-        rounds: job
+        rounds: work
             .statistics
-            .then(|| Rounds::new(job.pixels() as u64, devices.len())),
+            .then(|| Rounds::new(work.pixels() as u64, devices.len())),
     };
     let mut done = 0usize;
     let shares = std::thread::scope(|scope| {
@@ -409,7 +409,7 @@ pub fn render_several(
             match rx.recv() {
                 Ok(Event::Band) => {
                     done += 1;
-                    progress(done as f64 / job.tiles.len().max(1) as f64);
+                    progress(done as f64 / work.tiles.len().max(1) as f64);
                 }
                 Ok(Event::Ended) => ended += 1,
                 Err(_) => break,
@@ -428,10 +428,10 @@ pub fn render_several(
         shares.sort_by_key(|(i, _)| *i);
         shares.into_iter().map(|(_, s)| s).collect::<Vec<_>>()
     });
-    if done < job.tiles.len() {
+    if done < work.tiles.len() {
         return Err(SeveralError {
             rendered: done,
-            tiles: job.tiles.len(),
+            tiles: work.tiles.len(),
             failures: shares
                 .iter()
                 .enumerate()
@@ -463,19 +463,23 @@ pub fn render_several(
     })
 }
 
-/// Each band's place in the image (`rgba` for a job of finished pixels, else `linear`), in
-/// the order of the job's bands, which follow each other from the first row.
-fn places<'a>(job: &Job, rgba: &'a mut [u8], linear: &'a mut [[f32; 3]]) -> Vec<Mutex<Place<'a>>> {
-    let mut places = Vec::with_capacity(job.tiles.len());
+/// Each band's place in the image (`rgba` where the work asks for finished pixels, else
+/// `linear`), in the order of the work's bands, which follow each other from the first row.
+fn places<'a>(
+    work: &Work,
+    rgba: &'a mut [u8],
+    linear: &'a mut [[f32; 3]],
+) -> Vec<Mutex<Place<'a>>> {
+    let mut places = Vec::with_capacity(work.tiles.len());
     let (mut rgba, mut linear) = (rgba, linear);
-    for i in 0..job.tiles.len() {
-        let band = job.band(i);
+    for i in 0..work.tiles.len() {
+        let band = work.band(i);
         debug_assert_eq!(
             band.start,
-            job.band(i.saturating_sub(1)).end * usize::from(i > 0),
+            work.band(i.saturating_sub(1)).end * usize::from(i > 0),
             "bands follow each other"
         );
-        let place = match job.finished {
+        let place = match work.finished {
             true => {
                 let (here, rest) = std::mem::take(&mut rgba).split_at_mut(4 * band.len());
                 rgba = rest;

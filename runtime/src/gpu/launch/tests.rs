@@ -69,10 +69,10 @@ impl Device for Fake<'_> {
     fn describe(&self) -> String {
         "fake".into()
     }
-    fn prepare(&self, _job: &Job) -> Result<usize, Self::Error> {
+    fn prepare(&self, _work: &Work) -> Result<usize, Self::Error> {
         Ok(0)
     }
-    fn run(&self, ran: &mut usize, _job: &Job, tiles: &[usize]) -> Result<(), Self::Error> {
+    fn run(&self, ran: &mut usize, _work: &Work, tiles: &[usize]) -> Result<(), Self::Error> {
         use std::sync::atomic::Ordering;
         while self.wait && self.failed.load(Ordering::SeqCst) == 0 {
             std::thread::yield_now();
@@ -86,7 +86,12 @@ impl Device for Fake<'_> {
             _ => Ok(()),
         }
     }
-    fn read(&self, _: &mut usize, _: &Job, ranges: &[Range<usize>]) -> Result<Pixels, Self::Error> {
+    fn read(
+        &self,
+        _: &mut usize,
+        _: &Work,
+        ranges: &[Range<usize>],
+    ) -> Result<Pixels, Self::Error> {
         let mut p = Pixels::default();
         for r in ranges {
             p.linear.extend(r.clone().map(|i| [i as f32, 0.0, 0.0]));
@@ -97,7 +102,7 @@ impl Device for Fake<'_> {
     fn reduce(
         &self,
         _: &mut usize,
-        _: &Job,
+        _: &Work,
         ranges: &[Range<usize>],
         ask: Ask,
     ) -> Result<Answer, Self::Error> {
@@ -112,7 +117,7 @@ impl Device for Fake<'_> {
         };
         Ok(Answer::of_steps(&steps, &counters, ask))
     }
-    fn finish(&self, _: usize, _: &Job) -> Result<Option<Duration>, Self::Error> {
+    fn finish(&self, _: usize, _: &Work) -> Result<Option<Duration>, Self::Error> {
         Ok(None)
     }
     fn fault(&self, message: String) -> Failed {
@@ -123,7 +128,7 @@ impl Device for Fake<'_> {
 #[test]
 fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
     let tiles = tiling(37, 29, 512, 3);
-    let job = Job {
+    let work = Work {
         uniforms: &[],
         data: None,
         width: 37,
@@ -146,7 +151,7 @@ fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
     };
     let devices: [&dyn Worker; 3] = [&lost, &good, &lost];
     let out =
-        render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect("one survives");
+        render_several(&devices, &work, &Faults::default(), &mut |_| {}).expect("one survives");
     let n = 37 * 29;
     assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
     // The statistics of the bands every device rendered, reduced a round at a time: those
@@ -168,7 +173,7 @@ fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
     // Every device fails: an error naming each.
     let devices: [&dyn Worker; 2] = [&lost, &lost];
     let err =
-        render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect_err("all fail");
+        render_several(&devices, &work, &Faults::default(), &mut |_| {}).expect_err("all fail");
     let text = err.to_string();
     assert!(text.starts_with("every device failed (2 of "), "{text}");
     assert!(
@@ -197,14 +202,14 @@ impl Device for Overlapping<'_> {
     fn describe(&self) -> String {
         "overlapping".into()
     }
-    fn prepare(&self, _job: &Job) -> Result<Self::Frame, Self::Error> {
+    fn prepare(&self, _work: &Work) -> Result<Self::Frame, Self::Error> {
         Ok([None, None])
     }
-    fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), Self::Error> {
+    fn run(&self, _: &mut Self::Frame, _: &Work, _: &[usize]) -> Result<(), Self::Error> {
         Err(Failed("run is not called: bands are submitted".into()))
     }
-    fn submit(&self, _: &mut Self::Frame, job: &Job, tiles: &[usize]) -> Result<(), Self::Error> {
-        let band = job.band(tiles[0]);
+    fn submit(&self, _: &mut Self::Frame, work: &Work, tiles: &[usize]) -> Result<(), Self::Error> {
+        let band = work.band(tiles[0]);
         self.log
             .lock()
             .expect("log")
@@ -214,7 +219,7 @@ impl Device for Overlapping<'_> {
     fn start_read(
         &self,
         slots: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<(), Self::Error> {
@@ -230,7 +235,7 @@ impl Device for Overlapping<'_> {
     fn collect(
         &self,
         slots: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<Pixels, Self::Error> {
@@ -247,7 +252,7 @@ impl Device for Overlapping<'_> {
     fn read(
         &self,
         _: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         _: &[Range<usize>],
     ) -> Result<Pixels, Self::Error> {
         Err(Failed("read is not called: bands are collected".into()))
@@ -255,13 +260,13 @@ impl Device for Overlapping<'_> {
     fn reduce(
         &self,
         _: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         _: &[Range<usize>],
         ask: Ask,
     ) -> Result<Answer, Self::Error> {
         Ok(Answer::empty(ask))
     }
-    fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, Self::Error> {
+    fn finish(&self, slots: Self::Frame, _: &Work) -> Result<Option<Duration>, Self::Error> {
         assert_eq!(slots, [None, None], "every band collected");
         Ok(None)
     }
@@ -273,7 +278,7 @@ impl Device for Overlapping<'_> {
 #[test]
 fn a_band_is_collected_while_the_next_one_renders() {
     let tiles = tiling(16, 64, 512, 2);
-    let job = Job {
+    let work = Work {
         uniforms: &[],
         data: None,
         width: 16,
@@ -289,7 +294,7 @@ fn a_band_is_collected_while_the_next_one_renders() {
         Overlapping { log: &log, id: 1 },
     );
     let devices: [&dyn Worker; 2] = [&a, &b];
-    let out = render_several(&devices, &job, &Faults::default(), &mut |_| {}).expect("renders");
+    let out = render_several(&devices, &work, &Faults::default(), &mut |_| {}).expect("renders");
     assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
     let log = log.into_inner().expect("log");
     for band in tiles.iter().map(|t| t.1 as usize * 16) {
@@ -363,13 +368,13 @@ impl Device for Rows {
     fn describe(&self) -> String {
         "rows".into()
     }
-    fn prepare(&self, _job: &Job) -> Result<Self::Frame, Self::Error> {
+    fn prepare(&self, _work: &Work) -> Result<Self::Frame, Self::Error> {
         Ok([None, None])
     }
-    fn run(&self, _: &mut Self::Frame, _: &Job, _: &[usize]) -> Result<(), Self::Error> {
+    fn run(&self, _: &mut Self::Frame, _: &Work, _: &[usize]) -> Result<(), Self::Error> {
         Err(Failed("run is not called: rows are submitted".into()))
     }
-    fn submit(&self, _: &mut Self::Frame, _: &Job, tiles: &[usize]) -> Result<(), Self::Error> {
+    fn submit(&self, _: &mut Self::Frame, _: &Work, tiles: &[usize]) -> Result<(), Self::Error> {
         let mut log = self.log.lock().expect("log");
         log.extend(tiles.iter().map(|&t| ("submit", t)));
         Ok(())
@@ -377,7 +382,7 @@ impl Device for Rows {
     fn start_read(
         &self,
         slots: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<(), Self::Error> {
@@ -389,7 +394,7 @@ impl Device for Rows {
     fn collect(
         &self,
         slots: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<Pixels, Self::Error> {
@@ -403,7 +408,7 @@ impl Device for Rows {
     fn read(
         &self,
         _: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         _: &[Range<usize>],
     ) -> Result<Pixels, Self::Error> {
         Err(Failed("read is not called: rows are collected".into()))
@@ -411,13 +416,13 @@ impl Device for Rows {
     fn reduce(
         &self,
         _: &mut Self::Frame,
-        _: &Job,
+        _: &Work,
         _: &[Range<usize>],
         ask: Ask,
     ) -> Result<Answer, Self::Error> {
         Ok(Answer::empty(ask))
     }
-    fn finish(&self, slots: Self::Frame, _: &Job) -> Result<Option<Duration>, Self::Error> {
+    fn finish(&self, slots: Self::Frame, _: &Work) -> Result<Option<Duration>, Self::Error> {
         assert_eq!(slots, [None, None], "every row collected");
         Ok(None)
     }
@@ -430,7 +435,7 @@ impl Device for Rows {
 fn one_device_collects_a_row_of_tiles_while_the_next_renders() {
     // Squares of 8 pixels over 20×20: three rows of three tiles (8, 8 and 4 pixels high).
     let tiles = squares(20, 20, 8);
-    let job = Job {
+    let work = Work {
         uniforms: &[],
         data: None,
         width: 20,
@@ -443,7 +448,7 @@ fn one_device_collects_a_row_of_tiles_while_the_next_renders() {
     let rows = Rows {
         log: Mutex::new(Vec::new()),
     };
-    let out = render_one(&rows, &job, &Faults::default(), &mut |_| {}).expect("renders");
+    let out = render_one(&rows, &work, &Faults::default(), &mut |_| {}).expect("renders");
     let expected: Vec<u8> = (0..400).flat_map(|i| [i as u8; 4]).collect();
     assert_eq!(out.rgba, expected);
     let log = rows.log.lock().expect("log").clone();
@@ -473,7 +478,7 @@ fn one_device_collects_a_row_of_tiles_while_the_next_renders() {
         log: Mutex::new(Vec::new()),
     };
     let faults = Faults::parse("4").expect("parses");
-    let err = render_one(&rows, &job, &faults, &mut |_| {}).expect_err("fails");
+    let err = render_one(&rows, &work, &faults, &mut |_| {}).expect_err("fails");
     assert!(err.0.contains("injected at tile 5"), "{err}");
 }
 

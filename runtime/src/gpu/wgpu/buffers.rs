@@ -2,7 +2,7 @@
 //! sizes; waiting on the device, the statistics' reduction, and reading results back.
 
 use super::{Buffers, Error, Gpu, Pipeline, SPIN, TILE_STRIDE};
-use crate::gpu::launch::Job;
+use crate::gpu::launch::Work;
 use sdfc_compiler::wgsl::{reduce as reduction, STATS_WORDS};
 use std::ops::Range;
 use std::sync::Arc;
@@ -14,9 +14,9 @@ pub(super) fn padded(n: u64) -> u64 {
 }
 
 impl Gpu {
-    /// The buffers of a frame with the job's uniforms and scene data written (queued): the
+    /// The buffers of a frame with the work's uniforms and scene data written (queued): the
     /// spare ones when their sizes fit, else new ones.
-    pub(super) fn buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {
+    pub(super) fn buffers(&self, l: &Work, pixels: u64, tiles: u64) -> Buffers {
         let fits = |b: &Buffers| {
             b.uniforms.size() == padded(l.uniforms.len() as u64)
                 && b.data.as_ref().map(|d| d.size()) == l.data.map(|d| padded(d.len() as u64))
@@ -34,7 +34,7 @@ impl Gpu {
         b
     }
 
-    fn new_buffers(&self, l: &Job, pixels: u64, tiles: u64) -> Buffers {
+    fn new_buffers(&self, l: &Work, pixels: u64, tiles: u64) -> Buffers {
         use wgpu::BufferUsages as U;
         let make = |label, size: u64, usage| {
             self.device.create_buffer(&wgpu::BufferDescriptor {

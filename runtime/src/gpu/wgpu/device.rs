@@ -3,7 +3,7 @@
 
 use super::buffers::{padded, words};
 use super::{Error, FrameBuffers, Kernel, TILE_STRIDE};
-use crate::gpu::launch::{self, Job, Pixels};
+use crate::gpu::launch::{self, Pixels, Work};
 use crate::gpu::reduce::{self, Answer, Ask};
 use sdfc_compiler::wgsl::{reduce as reduction, STATS_WORDS};
 use std::ops::Range;
@@ -17,31 +17,31 @@ impl launch::Device for Kernel<'_> {
         self.gpu.describe()
     }
 
-    fn prepare(&self, job: &Job) -> Result<FrameBuffers, Error> {
+    fn prepare(&self, work: &Work) -> Result<FrameBuffers, Error> {
         let gpu = self.gpu;
         let limits = gpu.device.limits();
         let limit = limits.max_storage_buffer_binding_size;
-        if let Some(data) = job.data.filter(|d| d.len() as u64 > limit) {
+        if let Some(data) = work.data.filter(|d| d.len() as u64 > limit) {
             return Err(Error::Render(format!(
                 "the scene's primitives take {} bytes, more than the {limit} bytes a storage buffer of this adapter may bind",
                 data.len()
             )));
         }
         // The image (16 bytes a pixel) and the statistics are storage buffers bound whole.
-        let largest = job.width as u64 * job.height as u64 * 4 * STATS_WORDS.max(4) as u64;
+        let largest = work.width as u64 * work.height as u64 * 4 * STATS_WORDS.max(4) as u64;
         let most = limit.min(limits.max_buffer_size);
         if largest > most {
             return Err(Error::Render(format!(
                 "a {}x{} frame needs buffers of {largest} bytes, more than the {most} bytes this adapter allows; render it smaller or with --backend cuda",
-                job.width, job.height
+                work.width, work.height
             )));
         }
-        let (pipeline, _) = gpu.cached_pipeline(self.wgsl, self.entry, job.data.is_some())?;
-        let pixels = job.width as u64 * job.height as u64;
-        let tiles = job.tiles.len() as u64;
-        let buffers = gpu.buffers(job, pixels, tiles);
+        let (pipeline, _) = gpu.cached_pipeline(self.wgsl, self.entry, work.data.is_some())?;
+        let pixels = work.width as u64 * work.height as u64;
+        let tiles = work.tiles.len() as u64;
+        let buffers = gpu.buffers(work, pixels, tiles);
         let bind = gpu.bind_group(&pipeline.1, &buffers);
-        let queries = (gpu.timestamps && job.timed).then(|| {
+        let queries = (gpu.timestamps && work.timed).then(|| {
             gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("sdfc timestamps"),
                 ty: wgpu::QueryType::Timestamp,
@@ -49,7 +49,7 @@ impl launch::Device for Kernel<'_> {
             })
         });
         let memory = Some(gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory));
-        let table: Vec<u8> = job
+        let table: Vec<u8> = work
             .tiles
             .iter()
             .flat_map(|t| {
@@ -73,17 +73,17 @@ impl launch::Device for Kernel<'_> {
         })
     }
 
-    fn run(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
-        self.submit(f, job, tiles)?;
+    fn run(&self, f: &mut FrameBuffers, work: &Work, tiles: &[usize]) -> Result<(), Error> {
+        self.submit(f, work, tiles)?;
         self.gpu.wait()
     }
 
-    fn submit(&self, f: &mut FrameBuffers, job: &Job, tiles: &[usize]) -> Result<(), Error> {
+    fn submit(&self, f: &mut FrameBuffers, work: &Work, tiles: &[usize]) -> Result<(), Error> {
         let gpu = self.gpu;
         // Each tile is its own dispatch, in one submission.
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for &i in tiles {
-            let t = job.tiles[i];
+            let t = work.tiles[i];
             let i = i as u32;
             let writes = f
                 .queries
@@ -115,11 +115,11 @@ impl launch::Device for Kernel<'_> {
     fn start_read(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<(), Error> {
-        if !job.finished {
+        if !work.finished {
             return Ok(());
         }
         let gpu = self.gpu;
@@ -150,13 +150,13 @@ impl launch::Device for Kernel<'_> {
     fn collect(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         slot: usize,
     ) -> Result<Pixels, Error> {
         let reading = f.reading[slot].take();
         let (Some((at, index, mapped)), Some(buffer)) = (reading, &f.buffers.readback[slot]) else {
-            return self.read(f, job, std::slice::from_ref(&range));
+            return self.read(f, work, std::slice::from_ref(&range));
         };
         debug_assert_eq!(at, range, "the band read into this slot");
         // Waits for the copy alone: the launches submitted after it may still run.
@@ -182,7 +182,7 @@ impl launch::Device for Kernel<'_> {
     fn collect_into(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         range: Range<usize>,
         slot: usize,
         place: launch::Place<'_>,
@@ -212,14 +212,14 @@ impl launch::Device for Kernel<'_> {
                     convert: Duration::ZERO,
                 })
             }
-            (_, place) => launch::collect_copied(self, f, job, (range, slot), place),
+            (_, place) => launch::collect_copied(self, f, work, (range, slot), place),
         }
     }
 
     fn read(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         ranges: &[Range<usize>],
     ) -> Result<Pixels, Error> {
         let bytes = |per: u64| -> Vec<Range<u64>> {
@@ -232,7 +232,7 @@ impl launch::Device for Kernel<'_> {
         use rayon::prelude::*;
         let mut convert = Duration::ZERO;
         let f32_at = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-        let (linear, rgba) = if job.finished {
+        let (linear, rgba) = if work.finished {
             // The finished pixels are the bytes to write: copied out as they are.
             let rgba = self.gpu.read_with(&f.buffers.pixels, &bytes(4), |b| {
                 // Copied out by every core, as the linear colours are converted.
@@ -261,17 +261,17 @@ impl launch::Device for Kernel<'_> {
     fn reduce(
         &self,
         f: &mut FrameBuffers,
-        job: &Job,
+        work: &Work,
         ranges: &[Range<usize>],
         ask: Ask,
     ) -> Result<Answer, Error> {
-        let queries = reduce::queries(job.pixels(), ranges, ask);
+        let queries = reduce::queries(work.pixels(), ranges, ask);
         if queries.is_empty() {
             return Ok(Answer::empty(ask));
         }
         let gpu = self.gpu;
         let pipeline = gpu.reducer()?;
-        let (first, second) = reduce::threads(job.pixels());
+        let (first, second) = reduce::threads(work.pixels());
         let record = 4 * reduction::RECORD as u64;
         let (partial, total) = f.buffers.reduction.get_or_insert_with(|| {
             use wgpu::BufferUsages as U;
@@ -357,14 +357,14 @@ impl launch::Device for Kernel<'_> {
         Ok(())
     }
 
-    fn finish(&self, mut f: FrameBuffers, job: &Job) -> Result<Option<Duration>, Error> {
+    fn finish(&self, mut f: FrameBuffers, work: &Work) -> Result<Option<Duration>, Error> {
         if let Some(scope) = f.memory.take() {
             if let Some(e) = pollster::block_on(scope.pop()) {
                 return Err(Error::Render(e.to_string()));
             }
         }
         let time = match &f.queries {
-            Some(q) => Some(self.gpu.gpu_time(q, job.tiles.len() as u32)?),
+            Some(q) => Some(self.gpu.gpu_time(q, work.tiles.len() as u32)?),
             None => None,
         };
         if let Ok(mut spare) = self.gpu.spare.lock() {

@@ -2,11 +2,14 @@
 //! frame exceeds its budget or the camera moves, jittered samples accumulated up to the
 //! scene's `aa` while it is still), and the image or texture it leaves.
 
-use super::{Accumulation, Device, FrameInfo, Session, FRAME_BUDGET, MAX_SCALE};
+use super::{Accumulation, Device, FrameInfo, Good, Session, FRAME_BUDGET, MAX_SCALE};
+use crate::backend::Prepared;
 use crate::image::Image;
 use crate::view::camera::{self};
+use crate::view::grade::Grade;
 use crate::view::resident::Resident;
-use std::time::Instant;
+use sdfc_compiler::{Camera, Scene};
+use std::time::{Duration, Instant};
 
 impl Session {
     /// The divisor of the resolution of a new scene's first frame: enough to bring the last
@@ -64,97 +67,25 @@ impl Session {
         let Some(base) = self.camera() else {
             return Ok(None);
         };
-        let scale = if moving {
-            self.scale
-        } else if self.preview {
-            self.preview_scale()
-        } else {
-            1
-        };
+        let scale = self.frame_scale(moving);
         // A frame below full resolution is a single sample, replaced by the next frame.
         let low = scale > 1 || moving;
         self.preview = false;
         let (w, h) = (self.size.0.div_ceil(scale), self.size.1.div_ceil(scale));
+        self.accumulate_at(low, w, h);
         let a = &mut self.accumulation;
-        if low || !a.still || (a.width, a.height) != (w, h) {
-            let on_cpu = matches!(self.device, Device::Cpu);
-            *a = Accumulation {
-                width: w,
-                height: h,
-                sum: match on_cpu {
-                    true => vec![[0.0; 3]; w as usize * h as usize],
-                    false => Vec::new(),
-                },
-                count: 0,
-                still: !low,
-            };
-        }
         let Some(good) = self.good.as_mut().filter(|g| g.kernel().is_some()) else {
             return Ok(None);
         };
-        let path = good.scene.settings.path;
-        let n = (good.aa as f64).sqrt().round() as u32;
-        // A path-traced frame is one sample, the next of its random stream, jittered within
-        // the pixel by the path tracer itself.
-        let (dx, dy) = if low || path {
-            (0.0, 0.0)
-        } else {
-            camera::sample_offset(a.count, n)
-        };
-        good.scene.camera = camera::jittered(&base, dx, dy, w, h);
-        let s = &mut good.scene.settings;
-        (s.width, s.height, s.aa) = (w, h, 1);
-        (s.samples, s.first_sample) = (1, a.count);
+        good.aim(&base, low, a.count, (w, h));
         let start = Instant::now();
-        let Some(kernel) = good.kernel() else {
+        let Some(prepared) = good.kernel() else {
             return Ok(None);
         };
-        let kind = kernel.kernel_kind();
-        let prepared = kernel;
-        let rendered = match prepared.as_wgpu() {
-            // On wgpu the frame stays on the device: rendered, accumulated and shown there.
-            Some(crate::backend::WgpuPrepared {
-                gpu,
-                kernel,
-                lipschitz,
-                ..
-            }) => {
-                let key = (self.version, kernel.interpreted());
-                let resident = match self.resident.as_mut() {
-                    Some(r) => Ok(r),
-                    None => Resident::new(gpu.clone()).map(|r| self.resident.insert(r)),
-                };
-                prepared
-                    .check_contract(&good.scene)
-                    .map_err(|e| e.to_string())
-                    .and_then(|()| {
-                        resident
-                            .and_then(|r| {
-                                r.render(
-                                    (kernel, *lipschitz),
-                                    (&good.scene, good.grade),
-                                    key,
-                                    a.count == 0,
-                                    self.steps_wanted,
-                                )
-                            })
-                            .map_err(|e| e.to_string())
-                    })
-                    .map(|r| (r.count, r.steps.unwrap_or(f64::NAN)))
-            }
-            None => prepared
-                .render(&good.scene, &|_| {})
-                .map_err(|e| e.to_string())
-                .map(|frame| {
-                    for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
-                        for i in 0..3 {
-                            sum[i] += c[i];
-                        }
-                    }
-                    (a.count + 1, frame.render.stats.steps_mean)
-                }),
-        };
-        let (count, steps) = match rendered {
+        let kind = prepared.kernel_kind();
+        let on = (&mut self.resident, (self.version, self.steps_wanted));
+        let rendered = render_sample(prepared, (&good.scene, good.grade), on, a);
+        let (count, steps) = match rendered.map_err(|e| e.to_string()) {
             Ok(r) => r,
             Err(msg) => {
                 self.broken = Some(msg.clone());
@@ -164,28 +95,7 @@ impl Session {
         let time = start.elapsed();
         a.count = count;
         if !a.sum.is_empty() {
-            // The mean of the linear samples, graded.
-            let inv = 1.0 / a.count as f32;
-            let grade = good.grade;
-            self.shown = Some(Image {
-                width: w,
-                height: h,
-                linear: a
-                    .sum
-                    .iter()
-                    .map(|c| grade.apply([c[0] * inv, c[1] * inv, c[2] * inv]))
-                    .collect(),
-            });
-        }
-        if scale == 1 {
-            self.last_full = Some(time);
-        }
-        if moving {
-            if time > FRAME_BUDGET && self.scale < MAX_SCALE {
-                self.scale += 1;
-            } else if time * 3 < FRAME_BUDGET && self.scale > 1 {
-                self.scale -= 1;
-            }
+            self.shown = Some(a.mean(good.grade));
         }
         let info = FrameInfo {
             width: w,
@@ -204,6 +114,7 @@ impl Session {
             }
             None => None,
         };
+        self.pace(scale, moving, time);
         if let Some(t) = self.timings.as_mut().filter(|t| t.first_frame.is_none()) {
             t.first_frame = Some((time, w, h));
             t.first_kernel = kind;
@@ -211,6 +122,54 @@ impl Session {
         }
         self.last = Some(info);
         Ok(Some(info))
+    }
+
+    /// The divisor of the resolution of the next frame: the moving camera's, a new scene's
+    /// first frame's ([`Session::preview_scale`]), else 1.
+    fn frame_scale(&self, moving: bool) -> u32 {
+        if moving {
+            self.scale
+        } else if self.preview {
+            self.preview_scale()
+        } else {
+            1
+        }
+    }
+
+    /// Starts the accumulation again, empty, for a frame of `w` × `h` pixels unless it goes
+    /// on: a `low` frame (below full resolution, or of a moving camera) starts it again, as do
+    /// a change of size and the end of a low frame.
+    fn accumulate_at(&mut self, low: bool, w: u32, h: u32) {
+        let a = &mut self.accumulation;
+        if low || !a.still || (a.width, a.height) != (w, h) {
+            let on_cpu = matches!(self.device, Device::Cpu);
+            *a = Accumulation {
+                width: w,
+                height: h,
+                sum: match on_cpu {
+                    true => vec![[0.0; 3]; w as usize * h as usize],
+                    false => Vec::new(),
+                },
+                count: 0,
+                still: !low,
+            };
+        }
+    }
+
+    /// Notes the time of a frame: a full-resolution frame's sets the next scene's preview
+    /// scale; while moving, a frame over its budget lowers the resolution and one well
+    /// within it raises it.
+    fn pace(&mut self, scale: u32, moving: bool, time: Duration) {
+        if scale == 1 {
+            self.last_full = Some(time);
+        }
+        if moving {
+            if time > FRAME_BUDGET && self.scale < MAX_SCALE {
+                self.scale += 1;
+            } else if time * 3 < FRAME_BUDGET && self.scale > 1 {
+                self.scale -= 1;
+            }
+        }
     }
 
     /// The image on show: the mean of the samples accumulated (at the size of the last frame),
@@ -256,4 +215,94 @@ impl Session {
             }
         }
     }
+}
+
+impl Good {
+    /// Sets the scene for the next sample, `count`, of a `w` × `h` frame seen from `base`: the
+    /// camera jittered within the pixel (not for a `low` frame), one sample.
+    fn aim(&mut self, base: &Camera, low: bool, count: u32, (w, h): (u32, u32)) {
+        let path = self.scene.settings.path;
+        let n = (self.aa as f64).sqrt().round() as u32;
+        // A path-traced frame is one sample, the next of its random stream, jittered within
+        // the pixel by the path tracer itself.
+        let (dx, dy) = if low || path {
+            (0.0, 0.0)
+        } else {
+            camera::sample_offset(count, n)
+        };
+        self.scene.camera = camera::jittered(base, dx, dy, w, h);
+        let s = &mut self.scene.settings;
+        (s.width, s.height, s.aa) = (w, h, 1);
+        (s.samples, s.first_sample) = (1, count);
+    }
+}
+
+impl Accumulation {
+    /// The mean of the linear samples summed on the CPU, graded.
+    fn mean(&self, grade: Grade) -> Image {
+        let inv = 1.0 / self.count as f32;
+        Image {
+            width: self.width,
+            height: self.height,
+            linear: self
+                .sum
+                .iter()
+                .map(|c| grade.apply([c[0] * inv, c[1] * inv, c[2] * inv]))
+                .collect(),
+        }
+    }
+}
+
+/// Why a frame was not rendered: the scene does not fit its kernel or the CPU's render failed
+/// (the backend's error), or the viewer's pass on the device failed.
+#[derive(Debug, thiserror::Error)]
+enum FrameError {
+    #[error(transparent)]
+    Backend(#[from] crate::backend::Error),
+    #[error(transparent)]
+    Pass(#[from] crate::view::resident::Error),
+}
+
+/// Renders a sample of `scene` through `prepared`: on wgpu the frame stays on the device,
+/// rendered, accumulated and shown there (in `resident`, made on the first frame; the scene
+/// data uploaded again when `version` changes; the steps summed when `steps_wanted`); on the
+/// CPU it is added to `a`'s sums. The number of samples accumulated, and the frame's mean
+/// steps (NaN where not summed).
+fn render_sample(
+    prepared: &Prepared,
+    (scene, grade): (&Scene, Grade),
+    (resident, (version, steps_wanted)): (&mut Option<Resident>, (u64, bool)),
+    a: &mut Accumulation,
+) -> Result<(u32, f64), FrameError> {
+    let Some(crate::backend::WgpuPrepared {
+        gpu,
+        kernel,
+        lipschitz,
+        ..
+    }) = prepared.as_wgpu()
+    else {
+        let frame = prepared.render(scene, &|_| {})?;
+        for (sum, c) in a.sum.iter_mut().zip(&frame.render.image.linear) {
+            for i in 0..3 {
+                sum[i] += c[i];
+            }
+        }
+        return Ok((a.count + 1, frame.render.stats.steps_mean));
+    };
+    let key = (version, kernel.interpreted());
+    // Made (and kept) before the scene is checked against its kernel.
+    let resident = match resident.as_mut() {
+        Some(r) => Ok(r),
+        None => Resident::new(gpu.clone()).map(|r| resident.insert(r)),
+    };
+    prepared.check_contract(scene)?;
+    let first = a.count == 0;
+    let r = resident?.render(
+        (kernel, *lipschitz),
+        (scene, grade),
+        key,
+        first,
+        steps_wanted,
+    )?;
+    Ok((r.count, r.steps.unwrap_or(f64::NAN)))
 }

@@ -7,6 +7,7 @@
 use super::*;
 use crate::backend::{Backend, Devices};
 use crate::job::{self, FrameScene};
+use sdfc_compiler::{Limits, Settings};
 
 impl Session {
     /// Loads the scene file again (or for the first time): on success the new scene replaces
@@ -82,45 +83,12 @@ impl Session {
     /// `Err` is the one-line summary of the first problem.
     fn compile(&mut self) -> Result<(Good, Timings), String> {
         let job = self.job();
-        let limits = &job.limits;
         let start = Instant::now();
-        let empty = || std::fs::metadata(&self.file).is_ok_and(|m| m.len() == 0);
-        while empty() && start.elapsed() < EMPTY_PATIENCE {
-            std::thread::sleep(Duration::from_millis(5));
-        }
-        let mut loaded = match frontend::load_with(&self.file, limits) {
-            Ok(l) => l,
-            Err(e) => {
-                let msg = e.to_string();
-                eprintln!("error: {msg}");
-                self.files = vec![self.file.clone()];
-                self.fingerprint = Fingerprint::of(&self.files);
-                return Err(msg);
-            }
-        };
-        // Files that changed while they were read (an editor saving in place truncates, then
-        // writes) are read again: a load stands on contents still there after it was read.
-        for _ in 0..STABLE_READS {
-            // The scene's files and the others it read (meshes, fonts), as the load read them.
-            let sources = files_of(&loaded.sources)
-                .into_iter()
-                .zip(0..)
-                .map(|(f, i)| (f, loaded.sources.text(FileId(i)).as_bytes()));
-            let data = loaded
-                .data
-                .iter()
-                .map(|(name, bytes)| (PathBuf::from(name), bytes.as_slice()));
-            let read: Vec<(PathBuf, &[u8])> = sources.chain(data).collect();
-            self.files = read.iter().map(|(f, _)| f.clone()).collect();
-            self.fingerprint = Fingerprint::from_sources(read.into_iter());
-            if !self.fingerprint.changed() {
-                break;
-            }
-            match frontend::load_with(&self.file, limits) {
-                Ok(again) => loaded = again,
-                Err(_) => break,
-            }
-        }
+        let mut loaded = self.read(&job.limits).map_err(|e| {
+            let msg = e.to_string();
+            eprintln!("error: {msg}");
+            msg
+        })?;
         let scene = job.scene(&mut loaded, true).map_err(summary)?;
         let check_time = start.elapsed();
         let start = Instant::now();
@@ -135,6 +103,111 @@ impl Session {
             frontend::method(&loaded, &scene, &lowered.traceable)
         );
         let start = Instant::now();
+        let (ready, grade, interim_lowered) =
+            self.prepare(&job, scene, lowered).map_err(summary)?;
+        let prepare_time = start.elapsed();
+        let job::Ready {
+            scene,
+            prepared,
+            built,
+        } = ready;
+        // Its frames are the view's size, whatever the scene's settings say.
+        job::check_memory_here(&prepared, &scene, self.shown(), &job.limits, false)
+            .map_err(summary)?;
+        let pipeline = self
+            .pipeline(&prepared, &scene, interim_lowered)
+            .map_err(|e| e.to_string())
+            .inspect_err(|msg| eprintln!("error: {msg}"))?;
+        let background = pipeline.waiting.is_some();
+        let good = Good {
+            file_camera: scene.camera.clone(),
+            method: method(&prepared, &scene),
+            aa: samples_wanted(&scene.settings),
+            scene,
+            grade,
+            prepared,
+            load: self.loads - 1,
+            waiting: pipeline.waiting,
+        };
+        let timings = Timings {
+            number: 0,
+            cause: None,
+            check: check_time,
+            lower: lower_time,
+            prepare: prepare_time,
+            built,
+            pipeline: pipeline.ready,
+            background,
+            interim: pipeline.interim_possible,
+            first_kernel: None,
+            interim_prepare: pipeline.interim_prepare,
+            interim_pipeline: None,
+            ready: None,
+            modified: None,
+            began: SystemTime::now(),
+            first_frame: None,
+            printed: false,
+        };
+        Ok((good, timings))
+    }
+
+    /// Reads and checks the scene file (once it is not empty, or has stayed empty for
+    /// [`EMPTY_PATIENCE`]), again while its files change under the read, and notes the files
+    /// read and their fingerprint; `Err` when the file cannot be read.
+    fn read(&mut self, limits: &Limits) -> Result<frontend::Loaded, frontend::ReadError> {
+        let start = Instant::now();
+        let empty = || std::fs::metadata(&self.file).is_ok_and(|m| m.len() == 0);
+        while empty() && start.elapsed() < EMPTY_PATIENCE {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        let mut loaded = match frontend::load_with(&self.file, limits) {
+            Ok(l) => l,
+            Err(e) => {
+                self.files = vec![self.file.clone()];
+                self.fingerprint = Fingerprint::of(&self.files);
+                return Err(e);
+            }
+        };
+        // Files that changed while they were read (an editor saving in place truncates, then
+        // writes) are read again: a load stands on contents still there after it was read.
+        for _ in 0..STABLE_READS {
+            self.note_read(&loaded);
+            if !self.fingerprint.changed() {
+                break;
+            }
+            match frontend::load_with(&self.file, limits) {
+                Ok(again) => loaded = again,
+                Err(_) => break,
+            }
+        }
+        Ok(loaded)
+    }
+
+    /// Notes the files `loaded` read and the fingerprint of their contents as it read them.
+    fn note_read(&mut self, loaded: &frontend::Loaded) {
+        // The scene's files and the others it read (meshes, fonts), as the load read them.
+        let sources = files_of(&loaded.sources)
+            .into_iter()
+            .zip(0..)
+            .map(|(f, i)| (f, loaded.sources.text(FileId(i)).as_bytes()));
+        let data = loaded
+            .data
+            .iter()
+            .map(|(name, bytes)| (PathBuf::from(name), bytes.as_slice()));
+        let read: Vec<(PathBuf, &[u8])> = sources.chain(data).collect();
+        self.files = read.iter().map(|(f, _)| f.clone()).collect();
+        self.fingerprint = Fingerprint::from_sources(read.into_iter());
+    }
+
+    /// Prepares the checked and lowered scene through the job's path, its grade taken out;
+    /// with the lowering kept for the interpreted kernel where it may show the scene while
+    /// the specialised one compiles.
+    fn prepare(
+        &self,
+        job: &Job,
+        mut scene: Scene,
+        lowered: Lowered,
+    ) -> Result<(job::Ready, Grade, Option<Lowered>), Error> {
         // The GPU kernel reads the distance program's constants from `scene_data`, so an edit
         // of numbers only keeps the kernel (and its pipeline) and uploads the new numbers.
         // The kernel kept is the specialised one unless `--kernel interpreted`; with `auto`
@@ -165,112 +238,64 @@ impl Session {
         };
         // The frames render linear light, which adds up as samples do; the exposure and tone
         // curve are applied to their mean, as `sdfc render` grades the mean of its samples.
-        let mut scene = scene;
         let grade = Grade::take(&mut scene.settings);
         let frame = FrameScene {
             scene,
             lowered,
             phases: Vec::new(),
         };
-        let job::Ready {
-            scene,
-            prepared,
-            built,
-        } = job::prepare_here((self.backend(), &Devices::Auto), frame, &setup, open)
-            .map_err(summary)?;
-        let prepare_time = start.elapsed();
-        // Its frames are the view's size, whatever the scene's settings say.
-        job::check_memory_here(&prepared, &scene, self.shown(), limits, false).map_err(summary)?;
-        // A pipeline not compiled yet compiles on another thread (the driver may take
-        // seconds; lavapipe tens of them), never on the caller's: a window's event loop goes on
-        // answering meanwhile. With `--kernel auto` the interpreted kernel shows the scene
-        // from the end of the grace period where it can; otherwise the image before stays on
-        // show until the pipeline is ready.
-        let mut waiting = None;
-        let mut interim_prepare = Duration::ZERO;
-        let mut interim_possible = false;
-        let pipeline = match prepared.as_wgpu() {
-            Some(crate::backend::WgpuPrepared { gpu, kernel, .. }) => {
-                let data = kernel.data.is_some();
-                if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
-                    Some(
-                        gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data)
-                            .map_err(|e| e.to_string())
-                            .inspect_err(|msg| eprintln!("error: {msg}"))?,
-                    )
-                } else {
-                    let start = Instant::now();
-                    let interim = match interim_lowered {
-                        Some(lowered) => self.interim(gpu, &scene, lowered),
-                        None => None,
-                    };
-                    interim_prepare = start.elapsed();
-                    interim_possible = interim.is_some();
-                    let grace = match interim {
-                        Some(_) => self.options.grace,
-                        None => Duration::ZERO,
-                    };
-                    let first = self.first_frame(&prepared, &scene);
-                    waiting =
-                        Compile::start(&prepared, first, self.compile_waker()).map(|compile| {
-                            Waiting {
-                                load: self.loads - 1,
-                                grace_until: compile.started + grace,
-                                compile,
-                                interim,
-                                shown: false,
-                            }
-                        });
-                    None
-                }
-            }
-            _ => None,
-        };
-        let traced = prepared.traceable().traced(scene.settings.method).is_some();
-        let method = match (scene.settings.path, traced) {
-            (false, true) => "trace",
-            (false, false) => "march",
-            (true, true) => "path (traced)",
-            (true, false) => "path (marched)",
-        };
-        // A path-traced picture converges at its `samples`, one a frame.
-        let aa = if scene.settings.path {
-            scene.settings.samples.max(1)
-        } else {
-            let n = scene.settings.aa.max(1);
-            n * n
-        };
-        let background = waiting.is_some();
-        let good = Good {
-            file_camera: scene.camera.clone(),
-            scene,
-            grade,
-            prepared,
-            aa,
-            method,
-            load: self.loads - 1,
-            waiting,
-        };
-        let timings = Timings {
-            number: 0,
-            cause: None,
-            check: check_time,
-            lower: lower_time,
-            prepare: prepare_time,
-            built,
-            pipeline,
-            background,
-            interim: interim_possible,
-            first_kernel: None,
-            interim_prepare,
-            interim_pipeline: None,
+        let ready = job::prepare_here((self.backend(), &Devices::Auto), frame, &setup, open)?;
+        Ok((ready, grade, interim_lowered))
+    }
+
+    /// The pipeline of `prepared`'s kernel: had at once where it was compiled before;
+    /// otherwise compiling on another thread (the driver may take seconds; lavapipe tens of
+    /// them), never on the caller's: a window's event loop goes on answering meanwhile. With
+    /// `--kernel auto` the interpreted kernel (of `interim_lowered`) shows the scene from the
+    /// end of the grace period where it can; otherwise the image before stays on show until
+    /// the pipeline is ready. Nothing on the CPU.
+    fn pipeline(
+        &self,
+        prepared: &Prepared,
+        scene: &Scene,
+        interim_lowered: Option<Lowered>,
+    ) -> Result<PipelineState, crate::gpu::wgpu::Error> {
+        let mut pipeline = PipelineState {
             ready: None,
-            modified: None,
-            began: SystemTime::now(),
-            first_frame: None,
-            printed: false,
+            waiting: None,
+            interim_prepare: Duration::ZERO,
+            interim_possible: false,
         };
-        Ok((good, timings))
+        let Some(crate::backend::WgpuPrepared { gpu, kernel, .. }) = prepared.as_wgpu() else {
+            return Ok(pipeline);
+        };
+        let data = kernel.data.is_some();
+        if gpu.has_pipeline(&kernel.source, wgsl::ENTRY_POINT, data) {
+            pipeline.ready =
+                Some(gpu.pipeline_for(&kernel.source, None, wgsl::ENTRY_POINT, data)?);
+            return Ok(pipeline);
+        }
+        let start = Instant::now();
+        let interim = match interim_lowered {
+            Some(lowered) => self.interim(gpu, scene, lowered),
+            None => None,
+        };
+        pipeline.interim_prepare = start.elapsed();
+        pipeline.interim_possible = interim.is_some();
+        let grace = match interim {
+            Some(_) => self.options.grace,
+            None => Duration::ZERO,
+        };
+        let first = self.first_frame(prepared, scene);
+        pipeline.waiting =
+            Compile::start(prepared, first, self.compile_waker()).map(|compile| Waiting {
+                load: self.loads - 1,
+                grace_until: compile.started + grace,
+                compile,
+                interim,
+                shown: false,
+            });
+        Ok(pipeline)
     }
 
     /// The interpreted kernel of `scene`, lowered as `lowered`, to show it while its specialised
@@ -469,5 +494,37 @@ impl Session {
         self.broken = None;
         self.preview = true;
         self.accumulation = Accumulation::default();
+    }
+}
+
+/// A loaded kernel's pipeline: had at once, or compiling on another thread (and whether the
+/// interpreted kernel could show the scene meanwhile, and the time to prepare it).
+struct PipelineState {
+    ready: Option<PipelineTime>,
+    waiting: Option<Waiting>,
+    interim_prepare: Duration,
+    interim_possible: bool,
+}
+
+/// How `scene` is rendered through `prepared`, for the title: `trace`, `march`, or
+/// `path (traced)` or `path (marched)`.
+fn method(prepared: &Prepared, scene: &Scene) -> &'static str {
+    let traced = prepared.traceable().traced(scene.settings.method).is_some();
+    match (scene.settings.path, traced) {
+        (false, true) => "trace",
+        (false, false) => "march",
+        (true, true) => "path (traced)",
+        (true, false) => "path (marched)",
+    }
+}
+
+/// Samples per pixel of a converged image: the scene's `aa`, squared; a path-traced picture
+/// converges at its `samples`, one a frame.
+fn samples_wanted(settings: &Settings) -> u32 {
+    if settings.path {
+        settings.samples.max(1)
+    } else {
+        let n = settings.aa.max(1);
+        n * n
     }
 }

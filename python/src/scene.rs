@@ -32,17 +32,15 @@ impl Scene {
     /// The job of a call: the scene's settings and `size` and `aa` overridden, its limits,
     /// `backend`; its diagnostics come back in its errors, unprinted.
     fn job(&self, size: Option<(u32, u32)>, aa: Option<u32>, backend: Backend) -> Job {
+        let overrides = Overrides {
+            size,
+            aa,
+            set: self.set.clone(),
+            ..Overrides::default()
+        };
         Job {
-            backend,
-            overrides: Overrides {
-                size,
-                aa,
-                set: self.set.clone(),
-                ..Overrides::default()
-            },
-            limits: self.limits.clone(),
             quiet: true,
-            ..Job::default()
+            ..Job::new(backend, overrides, self.limits.clone())
         }
     }
 

@@ -1,7 +1,7 @@
 //! Checker tests of inputs built to reach the limits early: chains of functions, cycles,
 //! literal lists, text, polygons.
 
-use super::{check_str, ok};
+use super::{check_str, ok, root};
 use crate::scene::Node;
 
 /// A chain of functions each calling the next, deeper than `call_depth`.
@@ -39,10 +39,7 @@ fn a_chain_of_functions_stops_at_the_call_depth() {
         crate::front::check_with(&mut sources, entry, &mut crate::check::NoImports, &limits);
     assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
     let scene = scene.expect("a scene");
-    assert_eq!(
-        scene.graph.node(scene.root.expect("root")),
-        &Node::Sphere { radius: 0.5 }
-    );
+    assert_eq!(root(&scene), &Node::Sphere { radius: 0.5 });
 }
 
 /// A cycle through 100 000 functions is evaluated until it meets `call_depth`: one E0507,
@@ -80,10 +77,7 @@ fn a_literal_list_past_the_objects_limit_is_refused_before_parsing() {
     let items = vec!["[1, 2][0]"; 100_000].join(", ");
     let src = format!("let xs = [{items},];\nscene {{ sphere(len(xs)); }}\n");
     let s = ok(&src);
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 100_000.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 100_000.0 });
     // A loop past the limit suggests its count too.
     let (_, diags, _) = check_str("t.sdf", "scene { for i in 0..250000 { sphere(1); } }");
     assert!(

@@ -115,19 +115,7 @@ pub fn write_hit() -> String {
          \x20   let inv = 1.0 / select(d, vec3<f32>(1e-30), abs(d) < vec3<f32>(1e-30));\n\
          \x20   var best = limit;\n\
          \x20   var hit = 0u;\n\
-         \x20   var stack: array<u32, {STACK}>;\n\
-         \x20   var top = 1u;\n\
-         \x20   stack[0] = 0u;\n\
-         \x20   loop {{\n\
-         \x20       if top == 0u {{ break; }}\n\
-         \x20       top -= 1u;\n\
-         \x20       let n = nodes + 2u * stack[top];\n\
-         \x20       if mesh_enter(o, inv, n) >= best {{ continue; }}\n\
-         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
-         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
-         \x20       if count > 0u {{\n\
-         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
-         \x20               let t = tris + 9u * (first + k);\n\
+         {walk}\
          \x20               let a = scene_data[t].xyz;\n\
          \x20               let e1 = scene_data[t + 1u].xyz - a;\n\
          \x20               let e2 = scene_data[t + 2u].xyz - a;\n\
@@ -156,6 +144,7 @@ pub fn write_hit() -> String {
          \x20   return Interval(best, best, n, n);\n\
          }}\n",
         edge = super::literal::float(TriMesh::EDGE),
+        walk = walk_start("mesh_enter(o, inv, n)"),
         push = push_children("tl", "tr"),
     )
 }
@@ -228,19 +217,7 @@ pub fn write() -> String {
          \x20   var best_t = tris;\n\
          \x20   var best_f = 6u;\n\
          \x20   // Nodes still to visit, the nearer child on top ({STACK} levels hold any mesh).\n\
-         \x20   var stack: array<u32, {STACK}>;\n\
-         \x20   var top = 1u;\n\
-         \x20   stack[0] = 0u;\n\
-         \x20   loop {{\n\
-         \x20       if top == 0u {{ break; }}\n\
-         \x20       top -= 1u;\n\
-         \x20       let n = nodes + 2u * stack[top];\n\
-         \x20       if mesh_box(p, n) >= best {{ continue; }}\n\
-         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
-         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
-         \x20       if count > 0u {{\n\
-         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
-         \x20               let t = tris + 9u * (first + k);\n\
+         {walk}\
          \x20               let f = mesh_feature(p, t);\n\
          \x20               let w = p - mesh_point(p, t, f);\n\
          \x20               let d2 = w.x * w.x + w.y * w.y + w.z * w.z;\n\
@@ -265,7 +242,29 @@ pub fn write() -> String {
          \x20   let d = sqrt(best);\n\
          \x20   return select(d, -d, w.x * n.x + w.y * n.y + w.z * n.z < 0.0);\n\
          }}\n",
+        walk = walk_start("mesh_box(p, n)"),
         push = push_children("dl", "dr"),
+    )
+}
+
+/// The start of a walk over the tree: the stack of nodes to visit, a node skipped where `enter`
+/// (of its index `n`) is no nearer than `best`, and a leaf's loop over its triangles, `t` the
+/// data of each.
+fn walk_start(enter: &str) -> String {
+    format!(
+        "\x20   var stack: array<u32, {STACK}>;\n\
+         \x20   var top = 1u;\n\
+         \x20   stack[0] = 0u;\n\
+         \x20   loop {{\n\
+         \x20       if top == 0u {{ break; }}\n\
+         \x20       top -= 1u;\n\
+         \x20       let n = nodes + 2u * stack[top];\n\
+         \x20       if {enter} >= best {{ continue; }}\n\
+         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
+         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
+         \x20       if count > 0u {{\n\
+         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
+         \x20               let t = tris + 9u * (first + k);\n"
     )
 }
 

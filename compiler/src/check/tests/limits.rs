@@ -15,16 +15,21 @@ fn chain(n: usize, last: &str) -> String {
     src
 }
 
+/// Checks that `src` has one error, E0507 at the default `call_depth`.
+fn stops_at_the_call_depth(src: &str) {
+    let (_, diags, _) = check_str("t.sdf", src);
+    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
+    assert_eq!(errors.len(), 1, "{errors:#?}");
+    assert_eq!(errors[0].code, "E0507");
+    assert_eq!(errors[0].message, "calls nest deeper than 256");
+}
+
 /// A chain of 1 000 functions stops at `call_depth`: the body of each is checked at its own
 /// first call, not from within its caller's (which nested as deep as the chain, and reported
 /// the `nesting` limit after seconds).
 #[test]
 fn a_chain_of_functions_stops_at_the_call_depth() {
-    let (_, diags, _) = check_str("t.sdf", &chain(1000, "1.0"));
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert_eq!(errors.len(), 1, "{diags:#?}");
-    assert_eq!(errors[0].code, "E0507");
-    assert_eq!(errors[0].message, "calls nest deeper than 256");
+    stops_at_the_call_depth(&chain(1000, "1.0"));
     // Within the limits (each call nests its body's expressions) the chain evaluates.
     let mut limits = crate::limits::Limits::default();
     for (limit, value) in [
@@ -46,11 +51,7 @@ fn a_chain_of_functions_stops_at_the_call_depth() {
 /// soon, with no stack of the chain's depth.
 #[test]
 fn a_cycle_through_a_hundred_thousand_functions_stops_at_the_call_depth() {
-    let (_, diags, _) = check_str("t.sdf", &chain(100_000, "f0()"));
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert_eq!(errors.len(), 1, "{errors:#?}");
-    assert_eq!(errors[0].code, "E0507");
-    assert_eq!(errors[0].message, "calls nest deeper than 256");
+    stops_at_the_call_depth(&chain(100_000, "f0()"));
 }
 
 /// A literal list longer than the `objects` limit is refused at its `[` before the file is

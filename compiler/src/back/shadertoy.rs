@@ -219,59 +219,41 @@ pub fn write(scene: &Scene, lowered: &Lowered) -> Result<String, Error> {
          // Camera rays only: reflection, refraction, transparency and antialiasing are left out\n\
          // (docs/embedding.md). The canvas's aspect replaces the scene's image size.\n\n",
     );
-    let _ = writeln!(out, "const vec3 SDFC_EYE = {};", v3(cam.position));
-    let _ = writeln!(out, "const vec3 SDFC_CAM_W = {};", v3(w));
-    let _ = writeln!(out, "const vec3 SDFC_CAM_U = {};", v3(u));
-    let _ = writeln!(out, "const vec3 SDFC_CAM_V = {};", v3(v));
-    let _ = writeln!(
-        out,
-        "const float SDFC_TAN = {};",
-        float((cam.fov * 0.5).tan())
-    );
-    let _ = writeln!(out, "const float SDFC_EPS = {};", float(scene.epsilon()));
-    let _ = writeln!(
-        out,
-        "const float SDFC_FOOTPRINT_MIN = {};",
-        float(look::FOOTPRINT_MIN)
-    );
-    let _ = writeln!(
-        out,
-        "const float SDFC_FOOTPRINT_COS = {};",
-        float(look::FOOTPRINT_COS)
-    );
-    let _ = writeln!(out, "const float SDFC_MAX_DIST = {};", float(s.max_dist));
-    let _ = writeln!(out, "const int SDFC_MAX_STEPS = {};", s.max_steps.max(1));
-    let _ = writeln!(out, "const float SDFC_L = {};", float(l));
-    let _ = writeln!(out, "const float SDFC_INV_L = {};", float(1.0 / l));
-    let _ = writeln!(
-        out,
-        "const float SDFC_PENUMBRA_BRACKET = {};",
-        float(Light::PENUMBRA_BRACKET)
-    );
-    let _ = writeln!(
-        out,
-        "const int SDFC_PENUMBRA_PROBES = {};",
-        Light::PENUMBRA_PROBES
-    );
-    let _ = writeln!(
-        out,
-        "const float SDFC_OMEGA = {};",
-        float(s.relaxation.max(1.0))
-    );
     // The glow of the marching steps (`glow`, `glow_color`); none: no term at all.
     let glows = s.glows();
-    let _ = writeln!(out, "const bool SDFC_GLOWS = {glows};");
-    let _ = writeln!(
-        out,
-        "const float SDFC_INV_GLOW = {};",
-        float(if glows { 1.0 / s.glow } else { 0.0 })
-    );
-    let _ = writeln!(
-        out,
-        "const vec3 SDFC_GLOW_COLOR = {};",
-        v3(if glows { s.glow_color } else { [0.0; 3] })
-    );
-    let _ = writeln!(out, "const vec3 SDFC_BACKGROUND = {};\n", v3(s.background));
+    let consts = [
+        ("vec3", "EYE", v3(cam.position)),
+        ("vec3", "CAM_W", v3(w)),
+        ("vec3", "CAM_U", v3(u)),
+        ("vec3", "CAM_V", v3(v)),
+        ("float", "TAN", float((cam.fov * 0.5).tan())),
+        ("float", "EPS", float(scene.epsilon())),
+        ("float", "FOOTPRINT_MIN", float(look::FOOTPRINT_MIN)),
+        ("float", "FOOTPRINT_COS", float(look::FOOTPRINT_COS)),
+        ("float", "MAX_DIST", float(s.max_dist)),
+        ("int", "MAX_STEPS", s.max_steps.max(1).to_string()),
+        ("float", "L", float(l)),
+        ("float", "INV_L", float(1.0 / l)),
+        ("float", "PENUMBRA_BRACKET", float(Light::PENUMBRA_BRACKET)),
+        ("int", "PENUMBRA_PROBES", Light::PENUMBRA_PROBES.to_string()),
+        ("float", "OMEGA", float(s.relaxation.max(1.0))),
+        ("bool", "GLOWS", glows.to_string()),
+        (
+            "float",
+            "INV_GLOW",
+            float(if glows { 1.0 / s.glow } else { 0.0 }),
+        ),
+        (
+            "vec3",
+            "GLOW_COLOR",
+            v3(if glows { s.glow_color } else { [0.0; 3] }),
+        ),
+        ("vec3", "BACKGROUND", v3(s.background)),
+    ];
+    for (ty, name, value) in consts {
+        let _ = writeln!(out, "const {ty} SDFC_{name} = {value};");
+    }
+    out.push('\n');
     out.push_str(&functions);
     let mut lights = String::new();
     for light in &scene.lights {

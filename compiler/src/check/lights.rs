@@ -3,7 +3,7 @@
 
 use super::eval::{self, Ctx};
 use super::types::Value;
-use super::{builtins, field_span, suggest};
+use super::{builtins, field_span, unknown_kind};
 use crate::diagnostics::Diagnostic;
 use crate::scene::{Light, Scene};
 use crate::syntax::ast;
@@ -12,18 +12,8 @@ use std::collections::HashMap;
 /// Adds the light of the block `b` of kind `kind` to the scene.
 pub(super) fn light(cx: &mut Ctx, scene: &mut Scene, b: &ast::Block, kind: &ast::Ident) {
     let Some(rec) = builtins::LIGHTS.iter().find(|r| r.name == kind.name) else {
-        let mut d = Diagnostic::error(
-            "E0211",
-            format!("unknown light kind `{}`", kind.name),
-            kind.span,
-        )
-        .with_label("not a light kind")
-        .with_note("the light kinds are point, directional, sun and sky");
-        if let Some(s) = suggest::closest(&kind.name, builtins::LIGHTS.iter().map(|r| r.name)) {
-            d = d.with_help(format!("did you mean `{s}`?"));
-        }
-        cx.error(d);
-        return;
+        let note = "the light kinds are point, directional, sun and sky";
+        return unknown_kind(cx, "light", kind, builtins::LIGHTS, note);
     };
     let f = eval::record(cx, rec, &b.fields, kind);
     let (color, intensity) = (f["color"].v3(), f["intensity"].num());

@@ -4,7 +4,7 @@
 
 use super::eval::{self, Ctx};
 use super::types::Value;
-use super::{builtins, dup, field_span, suggest};
+use super::{builtins, dup, field_span, unknown_kind};
 use crate::diagnostics::Diagnostic;
 use crate::scene::{Colour, Material, MaterialId, Pattern, Pbr, Scene};
 use crate::span::Span;
@@ -27,18 +27,8 @@ pub(super) fn material(
         return;
     }
     let Some(rec) = rec else {
-        let mut d = Diagnostic::error(
-            "E0211",
-            format!("unknown material kind `{}`", kind.name),
-            kind.span,
-        )
-        .with_label("not a material kind")
-        .with_note("the material kinds are phong, checker and pbr");
-        if let Some(s) = suggest::closest(&kind.name, builtins::MATERIALS.iter().map(|r| r.name)) {
-            d = d.with_help(format!("did you mean `{s}`?"));
-        }
-        cx.error(d);
-        return;
+        let note = "the material kinds are phong, checker and pbr";
+        return unknown_kind(cx, "material", kind, builtins::MATERIALS, note);
     };
     if rec.name == "checker" && pair(cx, scene, id, name, kind, fields) {
         return;

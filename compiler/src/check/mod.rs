@@ -246,6 +246,28 @@ fn dup(cx: &mut Ctx, what: &str, name: &ast::Ident, first: Span) {
     );
 }
 
+/// E0211: `kind` names none of `records`, the kinds of `what` (light, material) that `note`
+/// lists; the nearest name as help.
+fn unknown_kind(
+    cx: &mut Ctx,
+    what: &str,
+    kind: &ast::Ident,
+    records: &[builtins::Record],
+    note: &str,
+) {
+    let mut d = Diagnostic::error(
+        "E0211",
+        format!("unknown {what} kind `{}`", kind.name),
+        kind.span,
+    )
+    .with_label(format!("not a {what} kind"))
+    .with_note(note);
+    if let Some(s) = suggest::closest(&kind.name, records.iter().map(|r| r.name)) {
+        d = d.with_help(format!("did you mean `{s}`?"));
+    }
+    cx.error(d);
+}
+
 /// The span of the value of the field `name` of a block, when it is given.
 pub(super) fn field_span(fields: &[ast::Field], name: &str) -> Option<Span> {
     fields

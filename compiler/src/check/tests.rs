@@ -12,6 +12,20 @@ fn ok(src: &str) -> crate::scene::Scene {
     scene.expect("scene")
 }
 
+/// The root node of a scene.
+fn root(s: &crate::scene::Scene) -> &Node {
+    s.graph.node(s.root.expect("root"))
+}
+
+/// The help of the first diagnostic `code` of `src`, if any.
+fn help_of(src: &str, code: &str) -> Option<String> {
+    let (_, diags, _) = check_str("t.sdf", src);
+    diags
+        .iter()
+        .find(|d| d.code == code)
+        .and_then(|d| d.help.clone())
+}
+
 fn codes(src: &str) -> Vec<&'static str> {
     let (_, diags, _) = check_str("t.sdf", src);
     diags.iter().map(|d| d.code).collect()
@@ -44,7 +58,7 @@ fn angles_and_vectors() {
 #[test]
 fn loops_if_and_hash() {
     let s = ok("scene { for i in 0..4 { sphere(if i % 2 == 0 { 0.5 } else { 0.25 }).translate(i, 0, 0); } }");
-    let Node::Combine { children, .. } = s.graph.node(s.root.expect("root")) else {
+    let Node::Combine { children, .. } = root(&s) else {
         panic!()
     };
     assert_eq!(children.len(), 4);
@@ -219,7 +233,7 @@ fn a_material_can_be_used_above_its_declaration() {
         s.materials[1].pattern,
         crate::scene::Pattern::Solid([0.0, 0.0, 1.0].into())
     );
-    let Node::Paint { material, .. } = s.graph.node(s.root.expect("root")) else {
+    let Node::Paint { material, .. } = root(&s) else {
         panic!("not painted")
     };
     assert_eq!(material.0, 1);
@@ -231,13 +245,7 @@ fn a_material_can_be_used_above_its_declaration() {
 
 #[test]
 fn suggestions_skip_the_parameters_already_given() {
-    let help = |src: &str| {
-        let (_, diags, _) = check_str("t.sdf", src);
-        diags
-            .iter()
-            .find(|d| d.code == "E0202")
-            .and_then(|d| d.help.clone())
-    };
+    let help = |src: &str| help_of(src, "E0202");
     let f = "fn f(a: float, b: float = 1, c: float = 2) -> shape { sphere(a + b + c) }\n";
     // `d` is one edit from a, b and c; a and c are given.
     assert_eq!(
@@ -259,10 +267,7 @@ fn suggestions_skip_the_parameters_already_given() {
 fn function_bodies_see_the_global_constants() {
     // docs/language.md §5: a body sees its parameters, its `let`s and the global constants.
     let s = ok("let k = 2;\nfn ball() -> shape { sphere(k) }\nscene { ball(); }");
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 2.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 2.0 });
     // ... and a call from a constant above the one the body uses is E0208.
     assert_eq!(
         codes("let b = ball();\nlet k = 2;\nfn ball() -> shape { sphere(k) }\nscene { b; }"),
@@ -328,7 +333,7 @@ fn a_list_union_is_the_union_of_its_shapes() {
 #[test]
 fn comprehensions_in_function_bodies() {
     let s = ok("fn hoop(n: int, r: float) -> shape {\n  union([for i in 0..n { sphere(0.1).translate(r, 0, 0).rotate_y(360deg * i / n) }])\n}\nscene { hoop(6, 2); }");
-    let Node::Combine { children, .. } = s.graph.node(s.root.expect("root")) else {
+    let Node::Combine { children, .. } = root(&s) else {
         panic!("not a union")
     };
     assert_eq!(children.len(), 6);
@@ -340,16 +345,10 @@ fn comprehensions_in_function_bodies() {
 #[test]
 fn list_values_len_and_index() {
     let s = ok("let xs = [1, 2.5, 3];\nlet n = len(xs);\nlet sq: [float] = [for i in 0..n { xs[i] * xs[i] }];\nscene { sphere(sq[1] + n); }");
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 9.25 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 9.25 });
     // A list parameter, with a comprehension over its length.
     let s = ok("fn sum(xs: [float], i: int = 0) -> float { if i >= len(xs) { 0 } else { xs[i] + sum2(xs, i + 1) } }\nfn sum2(xs: [float], i: int) -> float { if i >= len(xs) { 0 } else { xs[i] } }\nscene { sphere(sum([1, 2])); }");
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 3.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 3.0 });
 }
 
 #[test]
@@ -421,25 +420,16 @@ fn smooth_lists_fold_from_the_left() {
     };
     assert_eq!(program(&listed), program(&nested));
     let one = ok("scene { smooth_intersect(0.2, [sphere(1)]); }");
-    assert_eq!(
-        one.graph.node(one.root.expect("root")),
-        &Node::Sphere { radius: 1.0 }
-    );
+    assert_eq!(root(&one), &Node::Sphere { radius: 1.0 });
 }
 
 #[test]
 fn pi_and_tau_are_constants_a_name_of_the_file_hides() {
     let s = ok("scene { sphere(pi / 4 + tau); }");
     let want = std::f64::consts::PI / 4.0 + std::f64::consts::TAU;
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: want }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: want });
     let s = ok("let pi = 3;\nfn r(tau: float) -> float { tau }\nscene { sphere(pi + r(1)); }");
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 4.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 4.0 });
 }
 
 #[test]
@@ -608,13 +598,7 @@ fn colour_fields_reach_the_materials() {
 
 #[test]
 fn an_unknown_name_in_a_field_suggests_the_nearest_binding() {
-    let help = |src: &str| {
-        let (_, diags, _) = check_str("t.sdf", src);
-        diags
-            .iter()
-            .find(|d| d.code == "E0200")
-            .and_then(|d| d.help.clone())
-    };
+    let help = |src: &str| help_of(src, "E0200");
     // `q` is one edit from both `a` and `p`: the field's point is the nearer binding.
     assert_eq!(
         help("let a = 1;\nscene { field { length(q) - a }; }").as_deref(),

@@ -31,35 +31,32 @@ pub(super) fn combine(
             let ny = b.neg(y);
             round_intersect(b, x, ny, r)
         }
-        (Smooth::Stairs(n), Combine::Union) => stairs_union(b, x, y, r, n),
-        (Smooth::Stairs(n), Combine::Intersect) => {
-            // -union(-a, -b)
-            let (nx, ny) = (b.neg(x), b.neg(y));
-            let u = stairs_union(b, nx, ny, r, n);
-            b.neg(u)
-        }
-        (Smooth::Stairs(n), Combine::Subtract) => {
-            // -union(-a, b)
-            let nx = b.neg(x);
-            let u = stairs_union(b, nx, y, r, n);
-            b.neg(u)
-        }
-        (Smooth::Columns(n), Combine::Union) => columns_union(b, x, y, r, n),
+        (Smooth::Stairs(n), _) => by_union(b, op, x, y, |b, x, y| stairs_union(b, x, y, r, n)),
         // hg_sdf's `fOpDifferenceColumns` is evaluated only near the edge and jumps at the
         // border of that region; the union of the complements, as for the stairs, is
         // continuous and cuts the same columns as grooves.
-        (Smooth::Columns(n), Combine::Intersect) => {
-            let (nx, ny) = (b.neg(x), b.neg(y));
-            let u = columns_union(b, nx, ny, r, n);
-            b.neg(u)
-        }
-        (Smooth::Columns(n), Combine::Subtract) => {
-            let nx = b.neg(x);
-            let u = columns_union(b, nx, y, r, n);
-            b.neg(u)
-        }
+        (Smooth::Columns(n), _) => by_union(b, op, x, y, |b, x, y| columns_union(b, x, y, r, n)),
         (Smooth::Poly | Smooth::Exp, _) => return None,
     })
+}
+
+/// `op` of `x` and `y` through a blended `union`: the union itself, else the complement of
+/// the union of complements, -union(-a, -b) for the intersection and -union(-a, b) for the
+/// difference.
+fn by_union(
+    b: &mut Builder,
+    op: Combine,
+    x: Reg,
+    y: Reg,
+    union: impl FnOnce(&mut Builder, Reg, Reg) -> Reg,
+) -> Reg {
+    let (nx, ny) = match op {
+        Combine::Union => return union(b, x, y),
+        Combine::Intersect => (b.neg(x), b.neg(y)),
+        Combine::Subtract => (b.neg(x), y),
+    };
+    let u = union(b, nx, ny);
+    b.neg(u)
 }
 
 /// `fOpUnionChamfer`: min(min(a, b), (a + b - r)·√½).

@@ -40,6 +40,20 @@ fn f(p: &Program, x: DVec3) -> f64 {
     eval_point(p, x.to_array()).0
 }
 
+/// Checks that `p` is within `tol` of the field of `shape` at 3000 random points (of the
+/// generator seeded `seed`) in the cube of half-side `r`.
+fn close_to(p: &Program, shape: &str, seed: u64, r: f64, tol: f64) {
+    let src = format!("scene {{ {shape}; }}");
+    let (scene, _, _) = crate::front::check_str("c.sdf", &src);
+    let q = super::lower(&scene.expect("scene"));
+    let mut rng = Rng::new(seed);
+    for _ in 0..3000 {
+        let x = DVec3::from([0; 3].map(|_| rng.range(-r, r)));
+        let (a, b) = (f(p, x), f(&q, x));
+        assert!((a - b).abs() < tol, "{x}: {a} against {shape}'s {b}");
+    }
+}
+
 /// The distance from `x` to the polyline through `pts`.
 fn to_polyline(pts: &[DVec3], x: DVec3) -> f64 {
     pts.windows(2)
@@ -54,18 +68,8 @@ fn to_polyline(pts: &[DVec3], x: DVec3) -> f64 {
 #[test]
 fn a_disc_swept_along_a_straight_polyline_is_the_cylinder() {
     let (p, exactness, l, _) = program("sweep(circle(0.3), polyline([(0, -1, 0), (0, 1, 0)]))");
-    let (cyl, ..) = {
-        let src = "scene { cylinder(0.3, 2); }";
-        let (scene, _, _) = crate::front::check_str("c.sdf", src);
-        (super::lower(&scene.expect("scene")), 0)
-    };
     assert_eq!((exactness, l), (Exactness::Exact, 1.0));
-    let mut rng = Rng::new(5);
-    for _ in 0..3000 {
-        let x = DVec3::from([0; 3].map(|_| rng.range(-1.6, 1.6)));
-        let (a, b) = (f(&p, x), f(&cyl, x));
-        assert!((a - b).abs() < 1e-9, "{x}: {a} against the cylinder's {b}");
-    }
+    close_to(&p, "cylinder(0.3, 2)", 5, 1.6, 1e-9);
 }
 
 #[test]
@@ -78,14 +82,7 @@ fn a_disc_swept_round_a_closed_chain_of_quarter_circles_is_the_torus() {
     let (p, exactness, _, path) = program(&shape);
     assert!(path.closed && path.twist.abs() < 1e-12, "{path:?}");
     assert_eq!(exactness, Exactness::Exact);
-    let (scene, _, _) = crate::front::check_str("c.sdf", "scene { torus(1, 0.15); }");
-    let torus = super::lower(&scene.expect("scene"));
-    let mut rng = Rng::new(8);
-    for _ in 0..3000 {
-        let x = DVec3::from([0; 3].map(|_| rng.range(-1.5, 1.5)));
-        let (a, b) = (f(&p, x), f(&torus, x));
-        assert!((a - b).abs() < 3e-4, "{x}: {a} against the torus's {b}");
-    }
+    close_to(&p, "torus(1, 0.15)", 8, 1.5, 3e-4);
 }
 
 #[test]

@@ -218,19 +218,11 @@ impl Fw<'_, '_> {
             out.push(self.setp("ne.u16", Op::Reg(b), Op::U32(0)));
             return;
         }
-        let regs: Vec<Reg> = (0..c.n).map(|_| self.fresh(c.sc)).collect();
+        let regs: Vec<Op> = (0..c.n).map(|_| Op::Reg(self.fresh(c.sc))).collect();
         let mem = c.sc.mem();
-        if c.n == 1 {
-            ins!(self.out, "ld.{sp}.{mem} {}, {addr};", regs[0]);
-        } else {
-            ins!(
-                self.out,
-                "ld.{sp}.v{}.{mem} {{{}}}, {addr};",
-                c.n,
-                join(regs.iter().map(|r| Op::Reg(*r)))
-            );
-        }
-        out.extend(regs.into_iter().map(Op::Reg));
+        let (v, dst) = vector(&regs);
+        ins!(self.out, "ld.{sp}{v}.{mem} {dst}, {addr};");
+        out.extend(regs);
     }
 
     fn store_mem(
@@ -270,16 +262,20 @@ impl Fw<'_, '_> {
             return;
         }
         let mem = c.sc.mem();
-        if c.n == 1 {
-            ins!(self.out, "st.{sp}.{mem} {addr}, {};", vals[0]);
-        } else {
-            ins!(
-                self.out,
-                "st.{sp}.v{}.{mem} {addr}, {{{}}};",
-                c.n,
-                join(vals.iter().copied())
-            );
-        }
+        let (v, src) = vector(vals);
+        ins!(self.out, "st.{sp}{v}.{mem} {addr}, {src};");
+    }
+}
+
+/// The width suffix and the operand of a memory access to `ops`: no suffix and the one
+/// operand, or `.vN` and the N operands in braces.
+fn vector(ops: &[Op]) -> (String, String) {
+    match ops {
+        [one] => (String::new(), one.to_string()),
+        _ => (
+            format!(".v{}", ops.len()),
+            format!("{{{}}}", join(ops.iter().copied())),
+        ),
     }
 }
 

@@ -115,19 +115,7 @@ pub fn write_hit() -> String {
          \x20   let inv = 1.0 / select(d, vec3<f32>(1e-30), abs(d) < vec3<f32>(1e-30));\n\
          \x20   var best = limit;\n\
          \x20   var hit = 0u;\n\
-         \x20   var stack: array<u32, {STACK}>;\n\
-         \x20   var top = 1u;\n\
-         \x20   stack[0] = 0u;\n\
-         \x20   loop {{\n\
-         \x20       if top == 0u {{ break; }}\n\
-         \x20       top -= 1u;\n\
-         \x20       let n = nodes + 2u * stack[top];\n\
-         \x20       if mesh_enter(o, inv, n) >= best {{ continue; }}\n\
-         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
-         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
-         \x20       if count > 0u {{\n\
-         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
-         \x20               let t = tris + 9u * (first + k);\n\
+         {walk}\
          \x20               let a = scene_data[t].xyz;\n\
          \x20               let e1 = scene_data[t + 1u].xyz - a;\n\
          \x20               let e2 = scene_data[t + 2u].xyz - a;\n\
@@ -149,24 +137,15 @@ pub fn write_hit() -> String {
          \x20       }}\n\
          \x20       let tl = mesh_enter(o, inv, nodes + 2u * first);\n\
          \x20       let tr = mesh_enter(o, inv, nodes + 2u * first + 2u);\n\
-         \x20       let right = tr < tl;\n\
-         \x20       if max(tl, tr) < best {{\n\
-         \x20           stack[top] = select(first + 1u, first, right);\n\
-         \x20           top += 1u;\n\
-         \x20       }}\n\
-         \x20       if min(tl, tr) < best {{\n\
-         \x20           stack[top] = select(first, first + 1u, right);\n\
-         \x20           top += 1u;\n\
-         \x20       }}\n\
-         \x20   }}\n\
-         \x20   // Ended with nodes left: a software adapter cut the walk (see `trace`).\n\
-         \x20   if top > 0u {{ counters.cut += 1u; }}\n\
+         {push}\
          \x20   if hit == 0u {{ return missed(); }}\n\
          \x20   let a = scene_data[hit - 1u].xyz;\n\
          \x20   let n = cross(scene_data[hit].xyz - a, scene_data[hit + 1u].xyz - a);\n\
          \x20   return Interval(best, best, n, n);\n\
          }}\n",
-        edge = super::literal::float(TriMesh::EDGE)
+        edge = super::literal::float(TriMesh::EDGE),
+        walk = walk_start("mesh_enter(o, inv, n)"),
+        push = push_children("tl", "tr"),
     )
 }
 
@@ -238,19 +217,7 @@ pub fn write() -> String {
          \x20   var best_t = tris;\n\
          \x20   var best_f = 6u;\n\
          \x20   // Nodes still to visit, the nearer child on top ({STACK} levels hold any mesh).\n\
-         \x20   var stack: array<u32, {STACK}>;\n\
-         \x20   var top = 1u;\n\
-         \x20   stack[0] = 0u;\n\
-         \x20   loop {{\n\
-         \x20       if top == 0u {{ break; }}\n\
-         \x20       top -= 1u;\n\
-         \x20       let n = nodes + 2u * stack[top];\n\
-         \x20       if mesh_box(p, n) >= best {{ continue; }}\n\
-         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
-         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
-         \x20       if count > 0u {{\n\
-         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
-         \x20               let t = tris + 9u * (first + k);\n\
+         {walk}\
          \x20               let f = mesh_feature(p, t);\n\
          \x20               let w = p - mesh_point(p, t, f);\n\
          \x20               let d2 = w.x * w.x + w.y * w.y + w.z * w.z;\n\
@@ -264,18 +231,7 @@ pub fn write() -> String {
          \x20       }}\n\
          \x20       let dl = mesh_box(p, nodes + 2u * first);\n\
          \x20       let dr = mesh_box(p, nodes + 2u * first + 2u);\n\
-         \x20       let right = dr < dl;\n\
-         \x20       if max(dl, dr) < best {{\n\
-         \x20           stack[top] = select(first + 1u, first, right);\n\
-         \x20           top += 1u;\n\
-         \x20       }}\n\
-         \x20       if min(dl, dr) < best {{\n\
-         \x20           stack[top] = select(first, first + 1u, right);\n\
-         \x20           top += 1u;\n\
-         \x20       }}\n\
-         \x20   }}\n\
-         \x20   // Ended with nodes left: a software adapter cut the walk (see `trace`).\n\
-         \x20   if top > 0u {{ counters.cut += 1u; }}\n\
+         {push}\
          \x20   let w = p - mesh_point(p, best_t, best_f);\n\
          \x20   var n = scene_data[best_t + 3u + min(best_f, 5u)].xyz;\n\
          \x20   if best_f == 6u {{\n\
@@ -285,6 +241,49 @@ pub fn write() -> String {
          \x20   mesh_hints[slot] = vec2<u32>(base, (best_t - tris) / 9u);\n\
          \x20   let d = sqrt(best);\n\
          \x20   return select(d, -d, w.x * n.x + w.y * n.y + w.z * n.z < 0.0);\n\
-         }}\n"
+         }}\n",
+        walk = walk_start("mesh_box(p, n)"),
+        push = push_children("dl", "dr"),
+    )
+}
+
+/// The start of a walk over the tree: the stack of nodes to visit, a node skipped where `enter`
+/// (of its index `n`) is no nearer than `best`, and a leaf's loop over its triangles, `t` the
+/// data of each.
+fn walk_start(enter: &str) -> String {
+    format!(
+        "\x20   var stack: array<u32, {STACK}>;\n\
+         \x20   var top = 1u;\n\
+         \x20   stack[0] = 0u;\n\
+         \x20   loop {{\n\
+         \x20       if top == 0u {{ break; }}\n\
+         \x20       top -= 1u;\n\
+         \x20       let n = nodes + 2u * stack[top];\n\
+         \x20       if {enter} >= best {{ continue; }}\n\
+         \x20       let first = bitcast<u32>(scene_data[n].w);\n\
+         \x20       let count = bitcast<u32>(scene_data[n + 1u].w);\n\
+         \x20       if count > 0u {{\n\
+         \x20           for (var k = 0u; k < count; k += 1u) {{\n\
+         \x20               let t = tris + 9u * (first + k);\n"
+    )
+}
+
+/// The end of a walk's loop over the tree, once the entries `l` and `r` of the node's two
+/// children are known: each child that may hold something nearer than `best` is pushed, the
+/// nearer on top; a walk that ended with nodes left is counted.
+fn push_children(l: &str, r: &str) -> String {
+    format!(
+        "\x20       let right = {r} < {l};\n\
+         \x20       if max({l}, {r}) < best {{\n\
+         \x20           stack[top] = select(first + 1u, first, right);\n\
+         \x20           top += 1u;\n\
+         \x20       }}\n\
+         \x20       if min({l}, {r}) < best {{\n\
+         \x20           stack[top] = select(first, first + 1u, right);\n\
+         \x20           top += 1u;\n\
+         \x20       }}\n\
+         \x20   }}\n\
+         \x20   // Ended with nodes left: a software adapter cut the walk (see `trace`).\n\
+         \x20   if top > 0u {{ counters.cut += 1u; }}\n"
     )
 }

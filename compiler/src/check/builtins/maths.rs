@@ -3,6 +3,22 @@
 
 use super::*;
 
+/// The built-in `name` of `f` over a number and over each component of a 2- or 3-vector;
+/// `int`, where given, its evaluation over an integer (the first overload).
+macro_rules! componentwise {
+    ($name:literal, $f:expr $(, int: $int:expr)?) => {
+        Builtin {
+            name: $name,
+            sigs: sigs![
+                $([p("x", I, Req, Any)] -> I => $int;)?
+                [p("x", F, Req, Any)] -> F => |_, a| f1(a, $f);
+                [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], $f));
+                [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], $f));
+            ],
+        }
+    };
+}
+
 /// The built-ins of lists, vectors, scalar maths and per-point functions.
 pub(super) static MATHS: &[Builtin] = &[
     // Lists.
@@ -151,39 +167,13 @@ pub(super) static MATHS: &[Builtin] = &[
             [p("base", F, Req, Any), p("exponent", F, Req, Any)] -> F => |_, a| Ok(Value::Float(a[0].num().powf(a[1].num())));
         ],
     },
-    Builtin {
-        name: "abs",
-        sigs: sigs![
-            [p("x", I, Req, Any)] -> I => |_, a| match &a[0] { Value::Int(i) => i.checked_abs().map(Value::Int).ok_or(Refusal::AbsOverflow), _ => Ok(Value::Error) };
-            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::abs);
-            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::abs));
-            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::abs));
-        ],
-    },
-    Builtin {
-        name: "floor",
-        sigs: sigs![
-            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::floor);
-            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::floor));
-            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::floor));
-        ],
-    },
-    Builtin {
-        name: "ceil",
-        sigs: sigs![
-            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::ceil);
-            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], f64::ceil));
-            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], f64::ceil));
-        ],
-    },
-    Builtin {
-        name: "fract",
-        sigs: sigs![
-            [p("x", F, Req, Any)] -> F => |_, a| f1(a, |x| x - x.floor());
-            [p("x", V2, Req, Any)] -> V2 => |_, a| Ok(vmap(&a[0], |x| x - x.floor()));
-            [p("x", V, Req, Any)] -> V => |_, a| Ok(vmap(&a[0], |x| x - x.floor()));
-        ],
-    },
+    componentwise!("abs", f64::abs, int: |_, a| match &a[0] {
+        Value::Int(i) => i.checked_abs().map(Value::Int).ok_or(Refusal::AbsOverflow),
+        _ => Ok(Value::Error),
+    }),
+    componentwise!("floor", f64::floor),
+    componentwise!("ceil", f64::ceil),
+    componentwise!("fract", |x| x - x.floor()),
     Builtin {
         name: "mod",
         sigs: sigs![

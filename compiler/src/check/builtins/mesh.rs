@@ -14,15 +14,9 @@ impl Build<'_, '_> {
             path: path.into(),
             why,
         };
+        let (name, bytes) = self.read_bytes(path)?;
         let no_files = || Refusal::File(LoadError::NoFiles { path: path.into() });
         let files = self.files.as_deref_mut().ok_or_else(no_files)?;
-        let from = files
-            .names
-            .get(self.span.file.0 as usize)
-            .cloned()
-            .unwrap_or_default();
-        let loader = files.loader.as_deref_mut().ok_or_else(no_files)?;
-        let (name, bytes) = loader.load_bytes(&from, path)?;
         let key = (name.clone(), scale.to_bits());
         if let Some(m) = files.meshes.get(&key) {
             let node = Node::Mesh {

@@ -204,9 +204,9 @@ pub struct Build<'a, 'l> {
 }
 
 impl Build<'_, '_> {
-    /// The bytes of the file `path` (relative to the calling file), read through the
-    /// caller's loader.
-    fn read_bytes(&mut self, path: &str) -> Result<Vec<u8>, LoadError> {
+    /// The name and the bytes of the file `path` (relative to the calling file), read through
+    /// the caller's loader.
+    fn read_bytes(&mut self, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         let no_files = || LoadError::NoFiles { path: path.into() };
         let files = self.files.as_deref_mut().ok_or_else(no_files)?;
         let from = files
@@ -215,7 +215,7 @@ impl Build<'_, '_> {
             .cloned()
             .unwrap_or_default();
         let loader = files.loader.as_deref_mut().ok_or_else(no_files)?;
-        loader.load_bytes(&from, path).map(|(_, bytes)| bytes)
+        loader.load_bytes(&from, path)
     }
 
     fn node(&mut self, node: Node) -> Result<Value, Refusal> {

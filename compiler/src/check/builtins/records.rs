@@ -204,6 +204,11 @@ pub static CAMERA: Record = Record {
 /// The defaults of `render`'s fields.
 const DEFAULT: Settings = Settings::DEFAULT;
 
+/// An integer setting of default `def`, from `lo` up to the limit `limit`.
+const fn limited(name: &'static str, def: i64, lo: f64, limit: Limit) -> P {
+    p(name, I, Int(def), Limited(lo, limit))
+}
+
 /// `render { ... }`; the same keys are accepted by `sdfc render --set`.
 pub static RENDER: Record = Record {
     name: "render",
@@ -212,32 +217,12 @@ pub static RENDER: Record = Record {
     painted: &[],
     help: &[],
     fields: &[
-        p(
-            "width",
-            I,
-            Int(DEFAULT.width as i64),
-            Limited(1.0, Limit::Edge),
-        ),
-        p(
-            "height",
-            I,
-            Int(DEFAULT.height as i64),
-            Limited(1.0, Limit::Edge),
-        ),
-        p("aa", I, Int(DEFAULT.aa as i64), Limited(1.0, Limit::Aa)),
-        p(
-            "max_steps",
-            I,
-            Int(DEFAULT.max_steps as i64),
-            Limited(1.0, Limit::MaxSteps),
-        ),
+        limited("width", DEFAULT.width as i64, 1.0, Limit::Edge),
+        limited("height", DEFAULT.height as i64, 1.0, Limit::Edge),
+        limited("aa", DEFAULT.aa as i64, 1.0, Limit::Aa),
+        limited("max_steps", DEFAULT.max_steps as i64, 1.0, Limit::MaxSteps),
         p("epsilon", F, Num(DEFAULT.epsilon), Within(1e-9, 0.5)),
-        p(
-            "max_depth",
-            I,
-            Int(DEFAULT.max_depth as i64),
-            Limited(0.0, Limit::MaxDepth),
-        ),
+        limited("max_depth", DEFAULT.max_depth as i64, 0.0, Limit::MaxDepth),
         p("max_dist", F, Num(DEFAULT.max_dist), Within(1e-6, 1e9)),
         p("relaxation", F, Num(DEFAULT.relaxation), Within(1.0, 1.99)),
         p("background", V, V3(DEFAULT.background), NonNeg),
@@ -247,18 +232,8 @@ pub static RENDER: Record = Record {
             Text(DEFAULT.method.name()),
             OneOf(Settings::METHODS),
         ),
-        p(
-            "samples",
-            I,
-            Int(DEFAULT.samples as i64),
-            Limited(1.0, Limit::Samples),
-        ),
-        p(
-            "bounces",
-            I,
-            Int(DEFAULT.bounces as i64),
-            Limited(0.0, Limit::Bounces),
-        ),
+        limited("samples", DEFAULT.samples as i64, 1.0, Limit::Samples),
+        limited("bounces", DEFAULT.bounces as i64, 0.0, Limit::Bounces),
         p("fps", F, Num(30.0), Within(0.01, 1000.0)),
         p("duration", F, Num(0.0), Within(0.0, 1e7)),
         p("occlusion", F, Num(DEFAULT.occlusion), Within(0.0, 1e9)),

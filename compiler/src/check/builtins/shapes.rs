@@ -47,7 +47,7 @@ pub(super) fn outline_of(
         crate::check::font::layout(crate::check::font::default_font(), string, size)
             .map_err(|error| Refusal::Font { font: None, error })
     } else {
-        let bytes = b.read_bytes(font)?;
+        let (_, bytes) = b.read_bytes(font)?;
         crate::check::font::layout(&bytes, string, size).map_err(|error| Refusal::Font {
             font: Some(font.into()),
             error,

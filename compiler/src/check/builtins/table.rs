@@ -4,6 +4,34 @@
 use super::shapes::*;
 use super::*;
 
+/// The parameters of every smooth combination but the shapes: the radius `k`, the `variant`
+/// and the `steps` of the stairs variants.
+const SMOOTH_K: P = p("k", F, Req, NonNeg);
+const SMOOTH_VARIANT: P = p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS));
+const SMOOTH_STEPS: P = p("steps", I, Int(4), Within(1.0, 64.0));
+
+/// The built-in of a smooth combination `op` named `name`: of two shapes or two profiles, and
+/// where `fold` is given (`smooth_list`), of a list of profiles or of shapes folded by it.
+macro_rules! smooth_builtin {
+    ($name:literal, $op:expr $(, $fold:ident)?) => {
+        Builtin {
+            name: $name,
+            sigs: sigs![
+                [SMOOTH_K, shape("a"), shape("b"), SMOOTH_VARIANT, SMOOTH_STEPS] -> S
+                    => |b, a| smooth(b, a, $op);
+                [SMOOTH_K, prof("a"), prof("b"), SMOOTH_VARIANT, SMOOTH_STEPS] -> PR
+                    => |b, a| flat(smooth(b, a, $op));
+                $(
+                    [SMOOTH_K, p("profiles", LP, Req, Any), SMOOTH_VARIANT, SMOOTH_STEPS] -> PR
+                        => |b, a| flat($fold(b, a, $op, $name));
+                    [SMOOTH_K, p("shapes", LS, Req, Any), SMOOTH_VARIANT, SMOOTH_STEPS] -> S
+                        => |b, a| $fold(b, a, $op, $name);
+                )?
+            ],
+        }
+    };
+}
+
 /// The built-ins of shapes, profiles and their operations.
 pub(super) static SHAPES: &[Builtin] = &[
     // Primitives.
@@ -268,41 +296,9 @@ pub(super) static SHAPES: &[Builtin] = &[
             [prof("a"), prof("b")] -> PR => |b, a| flat(combine(b, a, Combine::Subtract));
         ],
     },
-    Builtin {
-        name: "smooth_union",
-        sigs: sigs![
-            [p("k", F, Req, NonNeg), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
-                => |b, a| smooth(b, a, Combine::Union);
-            [p("k", F, Req, NonNeg), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
-                => |b, a| flat(smooth(b, a, Combine::Union));
-            [p("k", F, Req, NonNeg), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
-                => |b, a| flat(smooth_list(b, a, Combine::Union, "smooth_union"));
-            [p("k", F, Req, NonNeg), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
-                => |b, a| smooth_list(b, a, Combine::Union, "smooth_union");
-        ],
-    },
-    Builtin {
-        name: "smooth_intersect",
-        sigs: sigs![
-            [p("k", F, Req, NonNeg), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
-                => |b, a| smooth(b, a, Combine::Intersect);
-            [p("k", F, Req, NonNeg), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
-                => |b, a| flat(smooth(b, a, Combine::Intersect));
-            [p("k", F, Req, NonNeg), p("profiles", LP, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
-                => |b, a| flat(smooth_list(b, a, Combine::Intersect, "smooth_intersect"));
-            [p("k", F, Req, NonNeg), p("shapes", LS, Req, Any), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
-                => |b, a| smooth_list(b, a, Combine::Intersect, "smooth_intersect");
-        ],
-    },
-    Builtin {
-        name: "smooth_subtract",
-        sigs: sigs![
-            [p("k", F, Req, NonNeg), shape("a"), shape("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> S
-                => |b, a| smooth(b, a, Combine::Subtract);
-            [p("k", F, Req, NonNeg), prof("a"), prof("b"), p("variant", Str, Text("poly"), OneOf(SMOOTH_VARIANTS)), p("steps", I, Int(4), Within(1.0, 64.0))] -> PR
-                => |b, a| flat(smooth(b, a, Combine::Subtract));
-        ],
-    },
+    smooth_builtin!("smooth_union", Combine::Union, smooth_list),
+    smooth_builtin!("smooth_intersect", Combine::Intersect, smooth_list),
+    smooth_builtin!("smooth_subtract", Combine::Subtract),
     Builtin {
         name: "engrave",
         sigs: sigs![

@@ -1,7 +1,7 @@
 //! Checker tests of hulls: `hull` of points, Minkowski sums with a ball, and the hulls of
 //! balls and of parallel cylinders.
 
-use super::{check_str, codes, ok};
+use super::{check_str, codes, ok, root};
 use crate::scene::Node;
 
 #[test]
@@ -10,7 +10,7 @@ fn hulls_of_points_and_minkowski_with_a_ball() {
     let s = ok(&format!(
         "{light}scene {{ hull([for i in 0..8 {{ (hash(i), hash(i + 8), hash(i + 16)) }}]); }}"
     ));
-    let Node::Prim { prim, args } = s.graph.node(s.root.expect("root")) else {
+    let Node::Prim { prim, args } = root(&s) else {
         panic!("not a primitive")
     };
     assert_eq!((prim.name, args.list(0).len(), args.f(1)), ("hull", 8, 0.0));
@@ -35,7 +35,7 @@ fn hulls_of_points_and_minkowski_with_a_ball() {
         "{light}scene {{ minkowski(box((1, 1, 1)), sphere(0.2)); }}"
     ));
     assert!(matches!(
-        s.graph.node(s.root.expect("root")),
+        root(&s),
         Node::Round { radius, .. } if *radius == 0.2
     ));
     let (_, diags, _) = check_str(
@@ -55,7 +55,7 @@ fn hulls_of_balls_and_of_parallel_cylinders() {
     let light = "light point { position: (0, 5, 0) }\n";
     let balls = |src: &str| {
         let s = ok(&format!("{light}scene {{ {src}; }}"));
-        let Node::Prim { prim, args } = s.graph.node(s.root.expect("root")) else {
+        let Node::Prim { prim, args } = root(&s) else {
             panic!("{src}: not a primitive")
         };
         assert_eq!(prim.params[0].name, "balls", "{src}");
@@ -85,7 +85,7 @@ fn hulls_of_balls_and_of_parallel_cylinders() {
     let s = ok(&format!(
         "{light}scene {{ hull([for i in 0..3 {{ cylinder(0.2 + 0.1 * i, 1).translate(i, 0, i * i) }}]); }}"
     ));
-    let Node::Translate { child, .. } = s.graph.node(s.root.expect("root")) else {
+    let Node::Translate { child, .. } = root(&s) else {
         panic!("not moved")
     };
     let Node::Rotate { child, .. } = s.graph.node(*child) else {

@@ -3,7 +3,7 @@
 //! lattice cells, lists joined with `+` and a number broadcast over a vector (hulls,
 //! parameters and the look in `hulls.rs`, `params.rs`, `looks.rs`).
 
-use super::{check_str, codes, ok};
+use super::{check_str, codes, ok, root};
 use crate::scene::Node;
 
 #[test]
@@ -11,7 +11,7 @@ fn division_gives_what_users_of_other_tools_expect() {
     // `5 / 2` is 2.5: a box 5 wide, not 4.
     let s = ok("let w = 5;\nscene { box((w / 2, 0.5, 0.5)); }");
     assert_eq!(
-        s.graph.node(s.root.expect("root")),
+        root(&s),
         &Node::Box {
             half: [2.5, 0.5, 0.5]
         }
@@ -19,7 +19,7 @@ fn division_gives_what_users_of_other_tools_expect() {
     // Whole numbers divide with `div`, rounded down as Python's `//`.
     let s =
         ok("scene { for i in 0..1 { sphere(1).translate(div(7, 2), div(-7, 2), div(7, -2)); } }");
-    let Node::Translate { offset, .. } = s.graph.node(s.root.expect("root")) else {
+    let Node::Translate { offset, .. } = root(&s) else {
         panic!("not a translation")
     };
     assert_eq!(offset, &[3.0, -4.0, -4.0]);
@@ -62,7 +62,7 @@ fn a_function_named_like_a_built_in_hides_it_with_a_warning() {
     );
     // The calls are the user's: a torus moved up, not a profile.
     let s = scene.expect("scene");
-    let Node::Translate { offset, child } = s.graph.node(s.root.expect("root")) else {
+    let Node::Translate { offset, child } = root(&s) else {
         panic!("not a translation")
     };
     assert_eq!(offset, &[0.0, 2.0, 0.0]);
@@ -107,7 +107,7 @@ fn radians_is_refused_with_the_spelling_that_works_and_degrees_reads_both_ways()
     let s = ok(
         "let a = degrees(90);\nlet n = degrees(a) + degrees(0.5rad);\nscene { sphere(n / 100); }",
     );
-    let Node::Sphere { radius } = s.graph.node(s.root.expect("root")) else {
+    let Node::Sphere { radius } = root(&s) else {
         panic!("not a sphere")
     };
     assert!((radius - (90.0 + 0.5f64.to_degrees()) / 100.0).abs() < 1e-12);
@@ -144,10 +144,7 @@ fn max_dist_covers_the_bounded_parts_unless_set_and_then_says_what_it_cuts() {
 #[test]
 fn len_takes_a_list_of_profiles() {
     let s = ok("let n = len([circle(1), rect(1)]);\nlight point { position: (0, 5, 0) }\nscene { sphere(n); }");
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 2.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 2.0 });
 }
 
 /// `text_size` is the size of the box around the ink `text` draws: a plate fits the text
@@ -158,7 +155,7 @@ fn text_size_measures_the_ink_of_text() {
         .expect("laid out");
     let (lo, hi) = outline.bounds();
     let s = ok("let s = text_size(\"HELLO\", 2);\nscene { box((s.x, s.y, 1)); }");
-    let Node::Box { half } = s.graph.node(s.root.expect("root")) else {
+    let Node::Box { half } = root(&s) else {
         panic!("not a box")
     };
     assert_eq!(half[0], hi[0] - lo[0]);
@@ -166,7 +163,7 @@ fn text_size_measures_the_ink_of_text() {
     assert!(half[0] > 4.0 * half[1], "HELLO is wide: {half:?}");
     // Twice the size, twice the box; the text's mistakes are text's.
     let t = ok("let s = text_size(\"HELLO\", 4);\nscene { box((s.x, s.y, 1)); }");
-    let Node::Box { half: twice } = t.graph.node(t.root.expect("root")) else {
+    let Node::Box { half: twice } = root(&t) else {
         panic!("not a box")
     };
     assert!((twice[0] - 2.0 * half[0]).abs() < 1e-9 * half[0]);
@@ -236,10 +233,7 @@ scene { branch(4, 1); }";
 fn odd(n: int) -> bool { if n == 0 { false } else { even(n - 1) } }
 scene { sphere(if even(10) { 1 } else { 2 }); }",
     );
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 1.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 1.0 });
     // Without a stopping case: E0507 at `call_depth`, naming the function.
     let (_, diags, _) = check_str(
         "t.sdf",
@@ -264,14 +258,11 @@ fn comprehensions_keep_what_their_condition_allows() {
         "let xs = [for i in 0..10 if i % 3 == 0 { i * 2 }];\nscene { sphere(len(xs) + xs[3]); }",
     );
     // 0, 3, 6, 9 kept: four elements, the last 18.
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 22.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 22.0 });
     // Inside a function, with a hash choosing what stays.
     let s = ok("fn some(n: int) -> shape { union([for i in 0..n if hash(i) < 2 { sphere(0.1).translate(i, 0, 0) }]) }\nscene { some(3); }");
     assert!(matches!(
-        s.graph.node(s.root.expect("root")),
+        root(&s),
         Node::Combine { children, .. } if children.len() == 3
     ));
     assert_eq!(
@@ -295,7 +286,7 @@ fn hashes_of_lattice_cells_agree_in_the_checker_and_in_fields_of_either_precisio
                 "let h = hash(vec2({}, {}));\nscene {{ sphere(h); }}",
                 at[0], at[1]
             ));
-            let Node::Sphere { radius } = constant.graph.node(constant.root.expect("root")) else {
+            let Node::Sphere { radius } = root(&constant) else {
                 panic!("not a sphere")
             };
             assert!(*radius > 0.0 && *radius < 1.0, "{radius}");
@@ -374,7 +365,7 @@ fn a_number_broadcasts_over_a_vector_in_constants_and_fields() {
     // Constants: `1 + v / 2` is `vec3(1) + v / 2`, and `1 / v` divides per component.
     let s = ok("let v = (2, 4, 6);\nscene { box(1 + v / 2 - 1 / (1, 2, 4)); }");
     assert_eq!(
-        s.graph.node(s.root.expect("root")),
+        root(&s),
         &Node::Box {
             half: [1.0, 2.5, 3.75]
         }

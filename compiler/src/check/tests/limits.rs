@@ -1,7 +1,7 @@
 //! Checker tests of inputs built to reach the limits early: chains of functions, cycles,
 //! literal lists, text, polygons.
 
-use super::{check_str, ok};
+use super::{check_str, ok, root};
 use crate::scene::Node;
 
 /// A chain of functions each calling the next, deeper than `call_depth`.
@@ -15,16 +15,21 @@ fn chain(n: usize, last: &str) -> String {
     src
 }
 
+/// Checks that `src` has one error, E0507 at the default `call_depth`.
+fn stops_at_the_call_depth(src: &str) {
+    let (_, diags, _) = check_str("t.sdf", src);
+    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
+    assert_eq!(errors.len(), 1, "{errors:#?}");
+    assert_eq!(errors[0].code, "E0507");
+    assert_eq!(errors[0].message, "calls nest deeper than 256");
+}
+
 /// A chain of 1 000 functions stops at `call_depth`: the body of each is checked at its own
 /// first call, not from within its caller's (which nested as deep as the chain, and reported
 /// the `nesting` limit after seconds).
 #[test]
 fn a_chain_of_functions_stops_at_the_call_depth() {
-    let (_, diags, _) = check_str("t.sdf", &chain(1000, "1.0"));
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert_eq!(errors.len(), 1, "{diags:#?}");
-    assert_eq!(errors[0].code, "E0507");
-    assert_eq!(errors[0].message, "calls nest deeper than 256");
+    stops_at_the_call_depth(&chain(1000, "1.0"));
     // Within the limits (each call nests its body's expressions) the chain evaluates.
     let mut limits = crate::limits::Limits::default();
     for (limit, value) in [
@@ -39,21 +44,14 @@ fn a_chain_of_functions_stops_at_the_call_depth() {
         crate::front::check_with(&mut sources, entry, &mut crate::check::NoImports, &limits);
     assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
     let scene = scene.expect("a scene");
-    assert_eq!(
-        scene.graph.node(scene.root.expect("root")),
-        &Node::Sphere { radius: 0.5 }
-    );
+    assert_eq!(root(&scene), &Node::Sphere { radius: 0.5 });
 }
 
 /// A cycle through 100 000 functions is evaluated until it meets `call_depth`: one E0507,
 /// soon, with no stack of the chain's depth.
 #[test]
 fn a_cycle_through_a_hundred_thousand_functions_stops_at_the_call_depth() {
-    let (_, diags, _) = check_str("t.sdf", &chain(100_000, "f0()"));
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert_eq!(errors.len(), 1, "{errors:#?}");
-    assert_eq!(errors[0].code, "E0507");
-    assert_eq!(errors[0].message, "calls nest deeper than 256");
+    stops_at_the_call_depth(&chain(100_000, "f0()"));
 }
 
 /// A literal list longer than the `objects` limit is refused at its `[` before the file is
@@ -80,10 +78,7 @@ fn a_literal_list_past_the_objects_limit_is_refused_before_parsing() {
     let items = vec!["[1, 2][0]"; 100_000].join(", ");
     let src = format!("let xs = [{items},];\nscene {{ sphere(len(xs)); }}\n");
     let s = ok(&src);
-    assert_eq!(
-        s.graph.node(s.root.expect("root")),
-        &Node::Sphere { radius: 100_000.0 }
-    );
+    assert_eq!(root(&s), &Node::Sphere { radius: 100_000.0 });
     // A loop past the limit suggests its count too.
     let (_, diags, _) = check_str("t.sdf", "scene { for i in 0..250000 { sphere(1); } }");
     assert!(

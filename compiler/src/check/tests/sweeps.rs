@@ -1,7 +1,7 @@
 //! Checker tests of `sweep` and its paths: what each path accepts, the located error of each
 //! bad one with what to write instead, and W0018 where the profile reaches past the path.
 
-use super::{check_str, ok};
+use super::{check_str, ok, root};
 use crate::diagnostics::Diagnostic;
 use crate::scene::Node;
 
@@ -38,10 +38,7 @@ fn every_path_makes_a_sweep_node() {
     ] {
         let s = ok(&format!("{LIGHT}scene {{ sweep(circle(0.05), {path}); }}"));
         assert!(
-            matches!(
-                s.graph.node(s.root.expect("root")),
-                Node::Sweep { folds: false, .. }
-            ),
+            matches!(root(&s), Node::Sweep { folds: false, .. }),
             "{path}"
         );
     }
@@ -54,9 +51,7 @@ fn every_path_makes_a_sweep_node() {
     let s = ok(&format!(
         "{LIGHT}let ps: [path] = [helix(0.5, 0.2, 3), arc3((0, 0, 0), (1, 1, 0), (2, 0, 0))];\nscene {{ union([for i in 0..len(ps) {{ sweep(circle(0.05), ps[i]) }}]); }}"
     ));
-    assert!(
-        matches!(s.graph.node(s.root.expect("root")), Node::Combine { children, .. } if children.len() == 2)
-    );
+    assert!(matches!(root(&s), Node::Combine { children, .. } if children.len() == 2));
 }
 
 #[test]

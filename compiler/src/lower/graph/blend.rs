@@ -32,11 +32,11 @@ impl Lowerer<'_> {
         };
         let d = match (blend, op) {
             (Some(d), _) => d,
-            (None, Combine::Union) => smin(b, fa.d, fb.d, kb, v),
-            (None, Combine::Intersect) => smax(b, fa.d, fb.d, kb, v),
+            (None, Combine::Union) => smooth_extreme(b, fa.d, fb.d, kb, v, false),
+            (None, Combine::Intersect) => smooth_extreme(b, fa.d, fb.d, kb, v, true),
             (None, Combine::Subtract) => {
                 let nb = b.neg(fb.d);
-                smax(b, fa.d, nb, kb, v)
+                smooth_extreme(b, fa.d, nb, kb, v, true)
             }
         };
         let d = if b.parametric {
@@ -76,44 +76,24 @@ impl Lowerer<'_> {
 /// k and its values finite: its reciprocal is far inside f32's range.
 const LEAST_BLEND: f64 = 1e-12;
 
-/// The smooth minimum. Poly: h = max(k - |a - b|, 0) / k, min(a, b) - h²·k/4 (Quilez's
-/// quadratic). Exp: -k·ln(e^(-a/k) + e^(-b/k)), computed as m - k·ln(e^((m-a)/k) + e^((m-b)/k))
-/// with m = min(a, b) so that it cannot overflow. k ≤ 0 is the plain minimum. (hg_sdf's
-/// variants are `blends::combine`'s: they never come here with k > 0.)
-fn smin(b: &mut Builder, x: Reg, y: Reg, k: f64, v: Smooth) -> Reg {
-    if k <= 0.0 {
-        return b.min(x, y);
-    }
-    let m = b.min(x, y);
-    match v {
-        Smooth::Poly => {
-            let h = poly_h(b, x, y, k);
-            b.sub(m, h)
-        }
-        Smooth::Exp => {
-            let s = exp_sum(b, m, x, y, k);
-            b.sub(m, s)
-        }
-        _ => m,
-    }
-}
-
-/// The smooth maximum, -smin(-a, -b): max(a, b) + h²·k/4, or M + k·ln(e^((a-M)/k) + e^((b-M)/k)).
-fn smax(b: &mut Builder, x: Reg, y: Reg, k: f64, v: Smooth) -> Reg {
-    if k <= 0.0 {
-        return b.max(x, y);
-    }
-    let m = b.max(x, y);
-    match v {
-        Smooth::Poly => {
-            let h = poly_h(b, x, y, k);
-            b.add(m, h)
-        }
-        Smooth::Exp => {
-            let s = exp_sum(b, m, x, y, k);
-            b.add(m, s)
-        }
-        _ => m,
+/// The smooth minimum, or with `max` the smooth maximum -smin(-a, -b). Poly: h = max(k - |a -
+/// b|, 0) / k, min(a, b) - h²·k/4 (Quilez's quadratic), or max(a, b) + h²·k/4. Exp:
+/// -k·ln(e^(-a/k) + e^(-b/k)), computed as m - k·ln(e^((m-a)/k) + e^((m-b)/k)) with m = min(a,
+/// b) so that it cannot overflow, or M + k·ln(e^((a-M)/k) + e^((b-M)/k)) with M = max(a, b).
+/// k ≤ 0 is the plain minimum or maximum. (hg_sdf's variants are `blends::combine`'s: they
+/// never come here with k > 0.)
+fn smooth_extreme(b: &mut Builder, x: Reg, y: Reg, k: f64, v: Smooth, max: bool) -> Reg {
+    let m = if max { b.max(x, y) } else { b.min(x, y) };
+    let s = match v {
+        _ if k <= 0.0 => return m,
+        Smooth::Poly => poly_h(b, x, y, k),
+        Smooth::Exp => exp_sum(b, m, x, y, k),
+        _ => return m,
+    };
+    if max {
+        b.add(m, s)
+    } else {
+        b.sub(m, s)
     }
 }
 

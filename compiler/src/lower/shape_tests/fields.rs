@@ -2,7 +2,7 @@
 //! within their recorded bound, random formulas included; misuse as located errors; a warp
 //! written as a field keeps its materials.
 
-use super::{f, point, program, same, slope, within_l};
+use super::{f, located_error, point, program, same, slope, within_l};
 use crate::eval::eval_point;
 use crate::lower::{lower, lower_with, LowerOptions};
 use crate::program::Program;
@@ -118,16 +118,7 @@ fn profile_fields_misused_are_located_errors() {
             "screw",
         ),
     ] {
-        let text = format!("scene {{ {src}; }}");
-        let (_, diags, _) = crate::front::check_str("t.sdf", &text);
-        let error = diags
-            .iter()
-            .find(|d| d.is_error())
-            .unwrap_or_else(|| panic!("{src}: no error"));
-        let all = format!("{error:?}");
-        assert!(all.contains(says), "{src}: {all}");
-        let start = text.find(at).expect("in the text") as u32;
-        assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
+        located_error(src, says, at);
     }
 }
 

@@ -1,7 +1,7 @@
 //! Lofts and screws: sections kept, helices followed, bounds held, bad ones as located errors;
 //! a chamfered plate under culling; a left-handed screw.
 
-use super::{f, point, program, same, within_l};
+use super::{f, located_error, point, program, same, within_l};
 use crate::lower::{lower, lower_with, LowerOptions};
 use crate::rng::Rng;
 
@@ -128,16 +128,7 @@ fn bad_lofts_and_screws_are_located_errors() {
             "screw",
         ),
     ] {
-        let text = format!("scene {{ {src}; }}");
-        let (_, diags, _) = crate::front::check_str("t.sdf", &text);
-        let error = diags
-            .iter()
-            .find(|d| d.is_error())
-            .unwrap_or_else(|| panic!("{src}: no error"));
-        let all = format!("{error:?}");
-        assert!(all.contains(says), "{src}: {all}");
-        let start = text.find(at).expect("in the text") as u32;
-        assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
+        located_error(src, says, at);
     }
 }
 

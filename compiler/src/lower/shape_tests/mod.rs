@@ -38,6 +38,17 @@ fn point(rng: &mut Rng, r: f64) -> [f64; 3] {
     [0; 3].map(|_| rng.range(-r, r))
 }
 
+/// The gradient of `p` at `x` by central differences.
+fn gradient(p: &Program, x: [f64; 3]) -> [f64; 3] {
+    let h = 1e-6;
+    [0, 1, 2].map(|i| {
+        let (mut a, mut b) = (x, x);
+        a[i] += h;
+        b[i] -= h;
+        (f(p, a) - f(p, b)) / (2.0 * h)
+    })
+}
+
 fn len(a: [f64; 3]) -> f64 {
     DVec3::from(a).length()
 }
@@ -78,13 +89,7 @@ fn exact(shape: &str, inside: impl Fn([f64; 3]) -> bool) {
             assert_eq!(d < 0.0, inside(x), "{shape}: sign at {x:?} ({d})");
             signs += 1;
         }
-        let h = 1e-6;
-        let g = [0, 1, 2].map(|i| {
-            let (mut a, mut b) = (x, x);
-            a[i] += h;
-            b[i] -= h;
-            (f(&p, a) - f(&p, b)) / (2.0 * h)
-        });
+        let g = gradient(&p, x);
         if (len(g) - 1.0).abs() > 1e-4 {
             continue;
         }
@@ -100,6 +105,21 @@ fn exact(shape: &str, inside: impl Fn([f64; 3]) -> bool) {
         signs > 2500 && projected > 2000,
         "{shape}: {signs} signs, {projected} projections"
     );
+}
+
+/// Checks that `src`, the scene's one statement, is an error whose message holds `says`,
+/// its first label starting at the first `at` of the scene's text.
+fn located_error(src: &str, says: &str, at: &str) {
+    let text = format!("scene {{ {src}; }}");
+    let (_, diags, _) = crate::front::check_str("t.sdf", &text);
+    let error = diags
+        .iter()
+        .find(|d| d.is_error())
+        .unwrap_or_else(|| panic!("{src}: no error"));
+    let all = format!("{error:?}");
+    assert!(all.contains(says), "{src}: {all}");
+    let start = text.find(at).expect("in the text") as u32;
+    assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
 }
 
 /// Checks that two shapes have the same field near the origin.
@@ -133,13 +153,7 @@ fn within_l(shape: &str, r: f64) -> (f64, f64) {
     let mut s = slope(&p, &mut rng, r);
     for _ in 0..4000 {
         let x = point(&mut rng, r);
-        let h = 1e-6;
-        let g = [0, 1, 2].map(|i| {
-            let (mut a, mut b) = (x, x);
-            a[i] += h;
-            b[i] -= h;
-            (f(&p, a) - f(&p, b)) / (2.0 * h)
-        });
+        let g = gradient(&p, x);
         s = s.max(len(g));
     }
     assert!(s <= l * (1.0 + 1e-6), "{shape}: slope {s} above L = {l}");

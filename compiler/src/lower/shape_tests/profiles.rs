@@ -2,7 +2,7 @@
 //! and revolutions, polygons, arcs and Bézier strokes against brute force; bad profiles as
 //! located errors; insets.
 
-use super::{exact, f, point, program, same};
+use super::{exact, f, located_error, point, program, same};
 use crate::rng::Rng;
 use crate::scene::analysis::analyse;
 
@@ -170,16 +170,7 @@ fn bad_profiles_are_located_errors() {
         ),
         ("circle(1)", "make it a shape with `extrude", "circle"),
     ] {
-        let text = format!("scene {{ {src}; }}");
-        let (_, diags, _) = crate::front::check_str("t.sdf", &text);
-        let error = diags
-            .iter()
-            .find(|d| d.is_error())
-            .unwrap_or_else(|| panic!("{src}: no error"));
-        let all = format!("{error:?}");
-        assert!(all.contains(says), "{src}: {all}");
-        let start = text.find(at).expect("in the text") as u32;
-        assert_eq!(error.labels[0].span.start, start, "{src}: {all}");
+        located_error(src, says, at);
     }
 }
 

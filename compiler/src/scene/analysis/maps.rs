@@ -145,13 +145,7 @@ impl Pass<'_> {
             .bounds
             .map(|j, lo, hi| if j == keep { (lo, hi) } else { (-rb, rb) });
         d.symmetric = [false, false, keep == 2 && c.symmetric[2]];
-        d.growth *= sigma;
-        d.facts.lipschitz *= sigma;
-        d.gradient *= sigma;
-        d.facts.exactness = classify(d.facts.lipschitz, d.proven);
-        if sigma > 1.0 && d.proven {
-            d.cause = Some(id);
-        }
+        stretch(&mut d, sigma, id);
         let what = if keep == 1 { "twist" } else { "bend" };
         if !extent.radius(a, b).is_finite() {
             self.warn_unbounded(id, what, sigma, rho);
@@ -237,13 +231,7 @@ impl Pass<'_> {
             return unproven(d, id);
         }
         let sigma = (radius / inner).max(1.0);
-        d.growth *= sigma;
-        d.facts.lipschitz *= sigma;
-        d.gradient *= sigma;
-        d.facts.exactness = classify(d.facts.lipschitz, d.proven);
-        if sigma > 1.0 && d.proven {
-            d.cause = Some(id);
-        }
+        stretch(&mut d, sigma, id);
         d
     }
 
@@ -455,5 +443,17 @@ impl Pass<'_> {
         } else {
             d
         }
+    }
+}
+
+/// The child's facts `d` under a map `id` that stretches distances up to `sigma`-fold (≥ 1):
+/// its growth, L and gradient times `sigma`, the node the cause of an L above the child's.
+fn stretch(d: &mut Derived, sigma: f64, id: NodeId) {
+    d.growth *= sigma;
+    d.facts.lipschitz *= sigma;
+    d.gradient *= sigma;
+    d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+    if sigma > 1.0 && d.proven {
+        d.cause = Some(id);
     }
 }

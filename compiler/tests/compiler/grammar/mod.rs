@@ -34,31 +34,43 @@ fn grammar() -> Grammar {
     read_grammar(&grammar_text())
 }
 
-fn refs(e: &Ebnf, out: &mut Vec<String>) {
+/// The leaves of `e` that `pick` takes (rule names, literals or token classes), in order.
+fn leaves(e: &Ebnf, pick: fn(&Ebnf) -> Option<&String>, out: &mut Vec<String>) {
     match e {
-        Ebnf::Rule(n) => out.push(n.clone()),
-        Ebnf::Lit(_) | Ebnf::Class(_) => {}
-        Ebnf::Seq(xs) | Ebnf::Alt(xs) => xs.iter().for_each(|x| refs(x, out)),
-        Ebnf::Rep(x) | Ebnf::Opt(x) => refs(x, out),
+        Ebnf::Seq(xs) | Ebnf::Alt(xs) => xs.iter().for_each(|x| leaves(x, pick, out)),
+        Ebnf::Rep(x) | Ebnf::Opt(x) => leaves(x, pick, out),
+        leaf => out.extend(pick(leaf).cloned()),
     }
+}
+
+fn refs(e: &Ebnf, out: &mut Vec<String>) {
+    leaves(
+        e,
+        |e| if let Ebnf::Rule(n) = e { Some(n) } else { None },
+        out,
+    );
 }
 
 fn lits(e: &Ebnf, out: &mut Vec<String>) {
-    match e {
-        Ebnf::Lit(s) => out.push(s.clone()),
-        Ebnf::Rule(_) | Ebnf::Class(_) => {}
-        Ebnf::Seq(xs) | Ebnf::Alt(xs) => xs.iter().for_each(|x| lits(x, out)),
-        Ebnf::Rep(x) | Ebnf::Opt(x) => lits(x, out),
-    }
+    leaves(
+        e,
+        |e| if let Ebnf::Lit(s) = e { Some(s) } else { None },
+        out,
+    );
 }
 
 fn classes(e: &Ebnf, out: &mut Vec<String>) {
-    match e {
-        Ebnf::Class(c) => out.push(c.clone()),
-        Ebnf::Rule(_) | Ebnf::Lit(_) => {}
-        Ebnf::Seq(xs) | Ebnf::Alt(xs) => xs.iter().for_each(|x| classes(x, out)),
-        Ebnf::Rep(x) | Ebnf::Opt(x) => classes(x, out),
-    }
+    leaves(
+        e,
+        |e| {
+            if let Ebnf::Class(c) = e {
+                Some(c)
+            } else {
+                None
+            }
+        },
+        out,
+    );
 }
 
 /// The backticked snippets of the comments of a Rust source file, with the comment line

@@ -4,6 +4,17 @@
 
 use super::*;
 
+/// The `.sdf` files of `dir`, sorted.
+fn sdf_files(dir: &Path) -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
+        .collect();
+    paths.sort();
+    paths
+}
+
 /// A `map` of a few thousand expressions, like a large scene's.
 fn big_kernel(n: usize) -> String {
     let mut s =
@@ -60,12 +71,7 @@ fn a_large_kernel_translates_with_map_as_one_function() {
 #[test]
 fn example_scenes_assemble() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
-        .collect();
-    paths.sort();
+    let paths = sdf_files(&dir);
     assert!(
         paths.len() >= 6,
         "the report's six scenes at least: {paths:?}"
@@ -127,12 +133,7 @@ fn example_scenes_assemble() {
 fn every_renderer_feature_kernel_assembles() {
     use sdfc_compiler::wgsl;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/in/kernel");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
-        .collect();
-    paths.sort();
+    let paths = sdf_files(&dir);
     assert!(paths.len() >= 10, "{paths:?}");
     let variants = [
         ("plain", wgsl::Options::default()),
@@ -314,12 +315,7 @@ fn kernels_reading_the_scene_from_a_buffer_assemble() {
 fn interpreted_kernels_assemble() {
     use sdfc_compiler::wgsl;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
-        .collect();
-    paths.sort();
+    let mut paths = sdf_files(&dir);
     // A scene that imports a triangle mesh, whose kernel calls the mesh walk.
     paths.push(dir.join("mesh/import.sdf"));
     let ptxas = ptxas();

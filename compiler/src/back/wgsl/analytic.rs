@@ -73,6 +73,8 @@ pub fn write(
         out.push('\n');
         super::mesh::data_of(traced.meshes.iter().map(|m| &*m.0))
     });
+    // The buffer's layout holds no mesh (`buffer::fits` keeps a scene with one unrolled), so
+    // the meshes' bytes are never dropped here.
     if primitives.len() > max_unrolled && buffer::fits(primitives) {
         out.push_str(&buffer::write(primitives, top, glass));
         return (out, Some(buffer::data(primitives, top)));

@@ -68,11 +68,19 @@ pub fn data_of<'a>(meshes: impl IntoIterator<Item = &'a TriMesh>) -> Vec<u8> {
     out
 }
 
-/// Whether the meshes' bytes of `scene_data`, `data`, are within the `scene_data` limit, or
-/// why not (the marched kernels and a traced scene's read the same bytes).
-pub(super) fn fits(scene: &crate::scene::Scene, data: &[u8]) -> Result<(), super::Refused> {
+/// The length of [`data_of`]'s bytes for `meshes`, without writing them.
+pub fn data_len<'a>(meshes: impl IntoIterator<Item = &'a TriMesh>) -> u64 {
+    meshes
+        .into_iter()
+        .map(|mesh| (u64::from(mesh.base) + mesh.vectors()) * 16)
+        .max()
+        .unwrap_or(0)
+}
+
+/// Whether `bytes` of meshes in `scene_data` are within the `scene_data` limit, or why not
+/// (the marched kernels and a traced scene's read the same bytes).
+pub(super) fn fits(scene: &crate::scene::Scene, bytes: u64) -> Result<(), super::Refused> {
     use crate::limits::Limit;
-    let bytes = data.len() as u64;
     let limit = scene.limits.get(Limit::SceneData);
     if bytes > limit.saturating_mul(1 << 20) {
         let mib = bytes.div_ceil(1 << 20);

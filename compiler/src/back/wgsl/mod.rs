@@ -306,17 +306,11 @@ pub fn choose(scene: &Scene, lowered: &Lowered, options: &Options) -> Result<Ker
     let traced = primitives.is_some();
     // The meshes' triangles are read from `scene_data`: a traced scene's own meshes
     // (analytic.rs), else those the programs name, by either kernel.
-    match primitives {
-        Some(t) if !t.meshes.is_empty() => {
-            mesh::fits(scene, &mesh::data_of(t.meshes.iter().map(|m| &*m.0)))?
-        }
-        Some(_) => {}
-        None => {
-            if let Some(data) = meshes_of(scene, lowered) {
-                mesh::fits(scene, &data)?;
-            }
-        }
-    }
+    let bytes = match primitives {
+        Some(t) => mesh::data_len(t.meshes.iter().map(|m| &*m.0)),
+        None => mesh::data_len(mesh_programs(scene, lowered).flat_map(|p| p.meshes())),
+    };
+    mesh::fits(scene, bytes)?;
     match options.kernel {
         KernelChoice::Specialised => Ok(KernelKind::Specialised),
         KernelChoice::Interpreted if traced => Err(Refused::InterpretedTraced),
@@ -360,17 +354,24 @@ fn media_of<'a>(scene: &Scene, lowered: &'a Lowered) -> Option<&'a crate::lower:
     lowered.media.as_ref().filter(|_| refraction)
 }
 
-/// The `scene_data` of the meshes a marched scene's programs name (its media's too), when
-/// they name any (mesh.rs).
+/// The `scene_data` of the meshes a marched scene's [`mesh_programs`] name, if any (mesh.rs).
 fn meshes_of(scene: &Scene, lowered: &Lowered) -> Option<Vec<u8>> {
-    let media = media_of(scene, lowered);
-    let programs = std::iter::once(&lowered.program)
-        .chain(media.map(|m| &m.medium))
-        .chain(media.map(|m| &m.solid));
+    let programs = mesh_programs(scene, lowered);
     if !programs.clone().any(mesh::uses_meshes) {
         return None;
     }
     Some(mesh::data(programs))
+}
+
+/// The programs whose meshes a marched scene's kernel reads: the scene's and its media's.
+fn mesh_programs<'a>(
+    scene: &Scene,
+    lowered: &'a Lowered,
+) -> impl Iterator<Item = &'a crate::program::Program> + Clone {
+    let media = media_of(scene, lowered);
+    std::iter::once(&lowered.program)
+        .chain(media.map(|m| &m.medium))
+        .chain(media.map(|m| &m.solid))
 }
 
 /// The `scene_data` of the interpreted kernel for a marched scene, or why it cannot hold its
@@ -549,7 +550,7 @@ fn analytic_map(
     let (text, bytes) = analytic::write(traced, &clear, unrolled);
     // A mesh's triangles, read from `scene_data` as a marched scene's are.
     if let Some(bytes) = bytes.as_ref().filter(|_| !traced.meshes.is_empty()) {
-        mesh::fits(scene, bytes).map_err(Error::refused)?;
+        mesh::fits(scene, bytes.len() as u64).map_err(Error::refused)?;
     }
     Ok(MapText {
         text: String::new(),

@@ -106,15 +106,13 @@ impl Session {
     /// checked, its settings applied and lowered (keeping its program's structure:
     /// [`LowerOptions::parametric`]), then prepared as the scene before was, with the kernel
     /// it had ([`job::Open::After`]), and the interpreted kernel shown meanwhile too.
-    fn scene_at(&mut self, time: f64) -> Result<(), String> {
+    fn scene_at(&mut self, time: f64) -> Result<(), job::Error> {
         let job = &self.job();
         let on = (self.backend(), &Devices::Auto);
         let (Some(p), Some(good)) = (self.playback.as_mut(), self.good.as_mut()) else {
             return Ok(());
         };
-        let mut frame = job
-            .frame(&mut p.source, time, false, &LowerOptions::parametric())
-            .map_err(|e| e.to_string())?;
+        let mut frame = job.frame(&mut p.source, time, false, &LowerOptions::parametric())?;
         // Its frames render linear light; the grade (which may change with `t`) is applied
         // to their mean.
         let grade = Grade::take(&mut frame.scene.settings);
@@ -123,14 +121,12 @@ impl Session {
         if let Some(i) = good.waiting.as_mut().and_then(|w| w.interim.as_mut()) {
             let frame = frame.clone();
             let open = job::Open::After(&i.prepared);
-            i.prepared = job::prepare_here(on, frame, &setup, open)
-                .map_err(|e| e.to_string())?
-                .prepared;
+            i.prepared = job::prepare_here(on, frame, &setup, open)?.prepared;
         }
         let open = job::Open::After(&good.prepared);
         let job::Ready {
             scene, prepared, ..
-        } = job::prepare_here(on, frame, &setup, open).map_err(|e| e.to_string())?;
+        } = job::prepare_here(on, frame, &setup, open)?;
         self.version += 1;
         good.file_camera = scene.camera.clone();
         good.scene = scene;

@@ -576,3 +576,21 @@ fn the_exponential_smooth_union_of_a_list_is_independent_of_its_order() {
         "the polynomial blend of three should depend on the order"
     );
 }
+
+/// Where only its solid is read, an intersection leaves out the planes that cut nothing of
+/// it (a box cut by one plane has the same program with two more that miss it); where its
+/// field is read off the surface too (rounded), it keeps them.
+#[test]
+fn planes_that_cut_nothing_are_left_out_where_only_the_solid_counts() {
+    let ops = |planes: &str, post: &str| {
+        let src = format!(
+            "scene {{ intersect([box((1, 1, 1)), plane((1, 0, 0), 0.5){planes}]){post}; }}"
+        );
+        let (scene, diags, _) = crate::front::check_str("t.sdf", &src);
+        assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
+        super::lower(&scene.expect("a scene")).ops.len()
+    };
+    let far = ", plane((0, 1, 0), 1.5), plane((0, 0, -1), 2)";
+    assert_eq!(ops(far, ""), ops("", ""));
+    assert!(ops(far, ".round(0.2)") > ops("", ".round(0.2)"));
+}

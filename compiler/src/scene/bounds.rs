@@ -192,7 +192,13 @@ impl Bounds {
         for id in graph.ids() {
             let node = graph.node(id);
             let b = bound(node, &|c| out.get(*c)).map(Bound::tight);
-            let c = own_cost(node) + node.children().iter().map(|&c| out.cost(c)).sum::<f64>();
+            // Less the planes the lowering leaves out where they cut nothing.
+            let uncut = super::clip::uncut(graph, node, &|c| box_of(out.zero_set(*c)));
+            let c = own_cost(node)
+                + (node.children().iter())
+                    .filter(|c| !uncut.contains(c))
+                    .map(|&c| out.cost(c))
+                    .sum::<f64>();
             let raised = cut_by_planes(graph, node, &|c| out.zero_set(*c))
                 .filter(|r| b.is_none_or(|b| r.volumes().0 < CUT_SMALLER * b.volumes().0));
             let zero = match node {
@@ -244,6 +250,12 @@ impl Bounds {
 /// A raised bound's box must be below this share of the bound's to be kept.
 const CUT_SMALLER: f64 = 0.5;
 
+/// The box (centre and half-extents) of a finite, unscaled bound, as `clip.rs` reads it.
+pub(crate) fn box_of(b: Option<Bound>) -> Option<(V3, V3)> {
+    b.filter(|b| b.finite() && b.scale == 1.0)
+        .map(|b| (b.aabb.c, b.aabb.h))
+}
+
 /// An intersection's children's boxes (their bounds `get`) cut by its planes, as a bound,
 /// when it has planes and bounded children.
 fn cut_by_planes(
@@ -251,12 +263,7 @@ fn cut_by_planes(
     node: &Node,
     get: &dyn Fn(&NodeId) -> Option<Bound>,
 ) -> Option<Bound> {
-    let boxes = |c: &NodeId| {
-        get(c)
-            .filter(|b| b.finite() && b.scale == 1.0)
-            .map(|b| (b.aabb.c, b.aabb.h))
-    };
-    let (c, h) = super::clip::intersection(graph, node, &boxes)?;
+    let (c, h) = super::clip::intersection(graph, node, &|c| box_of(get(c)))?;
     Some(Bound {
         sphere: Sphere {
             c,

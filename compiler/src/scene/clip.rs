@@ -18,6 +18,68 @@ pub(crate) fn intersection(
     node: &Node,
     boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
 ) -> Option<(V3, V3)> {
+    let (lo, hi, planes) = parts(graph, node, boxes)?;
+    let planes: Vec<(V3, f64)> = planes.iter().map(|&(_, n, h)| (n, h)).collect();
+    let (lo, hi) = clipped(lo, hi, &planes)?;
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let g = 1e-9 * size.max(1e-9);
+    Some((
+        [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
+        [0, 1, 2].map(|k| (hi[k] - lo[k]) / 2.0 + g),
+    ))
+}
+
+/// The plane children of an intersection `node` (as [`intersection`] reads it) that cut
+/// nothing: the solid lies strictly inside each one's half-space, because the polyhedron of
+/// its bounded children's boxes cut by every plane does. Without them the intersection has
+/// the same solid, and its field, a maximum of fewer distance bounds, is still one (lower
+/// only away from the solid). Empty for any other node.
+pub(crate) fn uncut(
+    graph: &Graph,
+    node: &Node,
+    boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
+) -> Vec<NodeId> {
+    let Some((lo, hi, planes)) = parts(graph, node, boxes) else {
+        return Vec::new();
+    };
+    let mut faces = cube(DVec3::from(lo), DVec3::from(hi));
+    let unit = |n: V3, h: f64| {
+        let n = DVec3::from(n);
+        let len = n.length();
+        (len > 0.0 && h.is_finite()).then(|| (n / len, h / len))
+    };
+    for &(_, n, h) in &planes {
+        if let Some((n, h)) = unit(n, h) {
+            faces = cut(&faces, n, h);
+        }
+    }
+    let vertices: Vec<DVec3> = faces.into_iter().flatten().collect();
+    let size = vertices
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(DVec3::from(hi).abs().max_element(), f64::max);
+    // Far enough inside that the rounding of the cut points cannot be what separates them.
+    let margin = 1e-9 * size.max(1e-9);
+    if vertices.is_empty() {
+        return Vec::new();
+    }
+    planes
+        .iter()
+        .filter(|&&(_, n, h)| {
+            unit(n, h).is_some_and(|(n, h)| vertices.iter().all(|v| n.dot(*v) - h < -margin))
+        })
+        .map(|&(id, ..)| id)
+        .collect()
+}
+
+/// An intersection's children's boxes intersected (low and high corners) and its planes
+/// (child, normal, height): `None` for any other node, or one without planes or bounded
+/// children.
+fn parts(
+    graph: &Graph,
+    node: &Node,
+    boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
+) -> Option<(V3, V3, Vec<(NodeId, V3, f64)>)> {
     let Node::Combine {
         op: Combine::Intersect,
         children,
@@ -29,7 +91,7 @@ pub(crate) fn intersection(
     let mut planes = Vec::new();
     for c in children {
         if let Node::Plane { normal, height } = graph.node(*c) {
-            planes.push((*normal, *height));
+            planes.push((*c, *normal, *height));
         } else if let Some((c, h)) = boxes(c) {
             for k in 0..3 {
                 lo[k] = lo[k].max(c[k] - h[k]);
@@ -38,16 +100,7 @@ pub(crate) fn intersection(
         }
     }
     let finite = (0..3).all(|k| lo[k].is_finite() && hi[k].is_finite() && lo[k] <= hi[k]);
-    if planes.is_empty() || !finite {
-        return None;
-    }
-    let (lo, hi) = clipped(lo, hi, &planes)?;
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-    let g = 1e-9 * size.max(1e-9);
-    Some((
-        [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
-        [0, 1, 2].map(|k| (hi[k] - lo[k]) / 2.0 + g),
-    ))
+    (!planes.is_empty() && finite).then_some((lo, hi, planes))
 }
 
 /// The faces of a convex polyhedron, each a loop of vertices.
@@ -173,6 +226,26 @@ mod tests {
         assert!(clipped([-1.0; 3], [1.0; 3], &gone).is_none());
         let same = clipped([-1.0; 3], [1.0; 3], &[([0.0, 1.0, 0.0], 3.0)]).expect("the box");
         assert_eq!(same, ([-1.0; 3], [1.0; 3]));
+    }
+
+    /// Of a box's planes, those that cut a corner off or touch it are kept and those the box
+    /// lies inside are left out.
+    #[test]
+    fn planes_the_solid_lies_inside_cut_nothing() {
+        let mut graph = Graph::default();
+        let span = crate::Span::new(crate::FileId(0), 0..0);
+        let cube = graph.add(Node::Box { half: [1.0; 3] }, span);
+        let mut plane = |normal: V3, height: f64| graph.add(Node::Plane { normal, height }, span);
+        let corner = plane([1.0, 1.0, 1.0], 2.5);
+        let touching = plane([0.0, 1.0, 0.0], 1.0);
+        let far = plane([0.0, 0.0, -2.0], 2.5);
+        let beyond = plane([1.0, 1.0, 1.0], 3.5);
+        let node = Node::Combine {
+            op: Combine::Intersect,
+            children: vec![cube, corner, touching, far, beyond],
+        };
+        let boxes = |c: &NodeId| (*c == cube).then_some(([0.0; 3], [1.0; 3]));
+        assert_eq!(uncut(&graph, &node, &boxes), vec![far, beyond]);
     }
 
     /// Cells of a sphere cut by the planes halfway between seeds: every point of a cell

@@ -5,7 +5,7 @@
 pub mod analysis;
 pub mod analytic;
 pub mod bounds;
-mod clip;
+pub(crate) mod clip;
 mod cost;
 mod dump;
 pub mod field;

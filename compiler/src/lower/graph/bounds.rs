@@ -5,8 +5,8 @@
 use super::{Field, Lowerer, SHRINK};
 use crate::lower::Reg;
 use crate::program::builder::{Builder, P};
-use crate::scene::bounds::{Aabb, Bound, Bounds};
-use crate::scene::NodeId;
+use crate::scene::bounds::{box_of, Aabb, Bound, Bounds};
+use crate::scene::{clip, NodeId};
 use glam::DVec3;
 
 impl Lowerer<'_> {
@@ -31,6 +31,29 @@ impl Lowerer<'_> {
         let d = self.b.max(f.d, beta);
         let d = self.b.max(d, slab);
         Field { d, m: f.m }
+    }
+
+    /// Where the field is read for its zero set alone, the plane children of intersection
+    /// `id` that cut nothing of its solid (`clip::uncut`), which it leaves out: the solid is
+    /// the same, and so are its surface's field and material.
+    pub(super) fn uncut(&mut self, id: NodeId) -> Vec<NodeId> {
+        if !self.zero_set || self.b.parametric || !self.config.optimise {
+            return Vec::new();
+        }
+        let Some(bounds) = self.config.bounds else {
+            return Vec::new();
+        };
+        let boxes = |c: &NodeId| box_of(bounds.zero_set(*c));
+        let uncut = clip::uncut(self.graph, self.graph.node(id), &boxes);
+        if !uncut.is_empty() {
+            let text = format!(
+                "node {} intersection: {} planes that cut nothing left out",
+                self.number(id),
+                uncut.len()
+            );
+            self.b.note(text);
+        }
+        uncut
     }
 
     /// The bound a union's child is guarded by: where the child's field is read for its zero

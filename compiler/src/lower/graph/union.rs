@@ -14,7 +14,15 @@ use std::collections::HashMap;
 impl Lowerer<'_> {
     /// Union, intersection or subtraction of any number of children, left to right.
     pub(super) fn combine(&mut self, id: NodeId, op: Combine, children: &[NodeId], p: P) -> Field {
-        let fields: Vec<Field> = children.iter().map(|&c| self.node(c, p)).collect();
+        let uncut = match op {
+            Combine::Intersect => self.uncut(id),
+            _ => Vec::new(),
+        };
+        let fields: Vec<Field> = children
+            .iter()
+            .filter(|c| !uncut.contains(c))
+            .map(|&c| self.node(c, p))
+            .collect();
         self.resume(id, self.graph.node(id));
         let Some((&first, rest)) = fields.split_first() else {
             return Field {

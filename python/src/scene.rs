@@ -82,7 +82,9 @@ impl Scene {
             .map_err(|e| match e {
                 // Settings the scene cannot be rendered with (`method=trace` of a scene that
                 // cannot be traced): a bad argument.
-                job::Error::Backend(e) => Failure::Value(e.to_string()),
+                job::Error::Backend(e @ sdfc_runtime::backend::Error::NotTraceable(_)) => {
+                    Failure::Value(e.to_string())
+                }
                 e => e.into(),
             })?;
         let pool = pool()?;

@@ -41,7 +41,7 @@ impl CudaPrepared {
         open: impl FnOnce() -> Result<Cuda, gpu::cuda::Error>,
     ) -> Result<CudaPrepared, Error> {
         let start = Instant::now();
-        let cuda = open().map_err(|e| Error::Device(e.to_string()))?;
+        let cuda = open()?;
         let device = start.elapsed();
         let start = Instant::now();
         let kernel = kernel(scene, lowered, &setup.on_cuda())?;
@@ -82,17 +82,14 @@ impl CudaModule {
             sm: cuda.sm,
             entry_point: wgsl::ENTRY_POINT.to_string(),
         };
-        let ptx = ptx::write(&kernel.module, &kernel.info, &options)
-            .map_err(|e| Error::Kernel(e.to_string()))?;
+        let ptx = ptx::write(&kernel.module, &kernel.info, &options)?;
         let ptx_time = start.elapsed();
         let tracing = match (kernel.contract.has("ANALYTIC"), kernel.contract.has("PATH")) {
             (true, _) => gpu::cuda::Tracing::Analytic,
             (false, true) => gpu::cuda::Tracing::MarchedPaths,
             (false, false) => gpu::cuda::Tracing::Marched,
         };
-        let loaded = cuda
-            .load(&ptx, wgsl::ENTRY_POINT, gpu::cuda::register_cap(tracing))
-            .map_err(|e| Error::Kernel(e.to_string()))?;
+        let loaded = cuda.load(&ptx, wgsl::ENTRY_POINT, gpu::cuda::register_cap(tracing))?;
         Ok(CudaModule {
             interpreted: kernel.interpreted(),
             loaded,
@@ -197,8 +194,7 @@ impl Renderer for CudaPrepared {
             self.lipschitz,
             (faults, !self.setup.image_only, self.setup.finished),
             &mut |f| progress(f),
-        )
-        .map_err(|e| Error::Render(e.to_string()))?;
+        )?;
         Ok(Frame::of(r))
     }
 
@@ -220,9 +216,7 @@ impl Renderer for CudaPrepared {
         _: Lowered,
         _: Option<wgsl::KernelChoice>,
     ) -> Result<(Prepared, bool), Error> {
-        Err(Error::Misuse(
-            "CUDA kernels and several devices are prepared again with Prepared::update".into(),
-        ))
+        Err(Error::NotNext)
     }
 
     fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {

@@ -27,33 +27,72 @@ use crate::cpu::{Precision, Render};
 use crate::gpu::{self};
 use crate::memory::{self, Memory};
 use prepare::{kernel, kernel_text};
-use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
+use sdfc_compiler::{
+    analytic::{self, Traceable},
+    ptx, wgsl, Lowered, Scene, Settings,
+};
 use std::time::Duration;
 
 /// What fails preparing a scene on a backend or rendering it there.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// The scene asks for what the backend or its kernel cannot do: analytic tracing of a
-    /// scene that does not allow it, a GPU kernel that cannot render it, settings its kernel
-    /// was not specialised for, GPUs of the CPU backend.
-    #[error("{0}")]
-    Unsupported(String),
+    /// `method=trace` asked of a scene that cannot be traced analytically, for this reason.
+    #[error(
+        "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
+        .0.describe()
+    )]
+    NotTraceable(analytic::Reason),
+    /// A kernel specialised for other settings than the scene's (a frame of an animation
+    /// whose settings changed): the kernel's name and what differs.
+    #[error("the {kernel} kernel cannot render this scene: {mismatch}; specialise it again")]
+    Stale {
+        kernel: &'static str,
+        mismatch: wgsl::Mismatch,
+    },
     /// The kernel asked for cannot render the scene (`wgsl::choose`).
     #[error(transparent)]
     Refused(#[from] wgsl::Refused),
-    /// A device could not be opened: no driver, no adapter, no such index.
-    #[error("{0}")]
-    Device(String),
-    /// The kernel could not be written, translated to PTX, loaded, or compiled into a
-    /// pipeline.
-    #[error("{0}")]
-    Kernel(String),
-    /// A render failed on its device (or on every device of several).
-    #[error("{0}")]
-    Render(String),
-    /// Asked of a preparation that does not do it (a CUDA preparation's `next`).
-    #[error("{0}")]
-    Misuse(String),
+    /// The kernel could not be written (naga rejected the WGSL: a compiler bug).
+    #[error(transparent)]
+    Write(#[from] wgsl::Error),
+    /// The kernel could not be translated to PTX.
+    #[error(transparent)]
+    Ptx(#[from] ptx::Error),
+    /// The wgpu path failed: no adapter or device, a pipeline refused, a render's error.
+    #[error(transparent)]
+    Wgpu(#[from] gpu::wgpu::Error),
+    /// The CUDA path failed: no driver or device, the JIT, a driver call.
+    #[error(transparent)]
+    Cuda(#[from] gpu::cuda::Error),
+    /// Every device of several failed a frame.
+    #[error(transparent)]
+    Several(#[from] gpu::SeveralFailed),
+    /// A software adapter ended `cut` marching loops of a frame early: its picture would be
+    /// wrong.
+    #[error(
+        "the adapter {adapter} ended {cut} marching loops before they returned: a software \
+         adapter (Mesa's llvmpipe, as lavapipe) stops every loop of a shader once they have \
+         run 65 535 iterations together, and this scene's distance walks need more, so the \
+         picture would be wrong; render it with `--backend cpu`, or on a GPU"
+    )]
+    Cut { adapter: String, cut: u64 },
+    /// `--devices all` found no GPU of the backend (`cuda` or `wgpu`).
+    #[error("--devices all found no {0} device")]
+    NoDevice(&'static str),
+    /// The device opened beside the front end was not of the backend (`CUDA` or `wgpu`)
+    /// that the scene asks for.
+    #[error("no {0} device was opened")]
+    NotOpened(&'static str),
+    /// The thread opening the device beside the front end panicked.
+    #[error("the thread opening the device panicked")]
+    OpeningPanicked,
+    /// Several devices asked to hold several devices (a bug of sdfc's).
+    #[error("several devices cannot hold several devices")]
+    Nested,
+    /// A CUDA preparation's or several devices' `next` (a bug of sdfc's): they are prepared
+    /// again with `Prepared::update`.
+    #[error("CUDA kernels and several devices are prepared again with Prepared::update")]
+    NotNext,
     /// Arguments the backend cannot take: a usage error wherever it is found.
     #[error(transparent)]
     Usage(#[from] Usage),
@@ -99,7 +138,7 @@ impl From<Resolve> for Error {
     fn from(e: Resolve) -> Error {
         match e {
             Resolve::Usage(u) => Error::Usage(u),
-            Resolve::NoDevice(_) => Error::Device(e.to_string()),
+            Resolve::NoDevice(backend) => Error::NoDevice(backend),
         }
     }
 }

@@ -106,10 +106,7 @@ impl Opening {
     /// Waits for the thread: what it opened, and how long this waited.
     fn join(self) -> Result<(Opened, Duration), Error> {
         let start = Instant::now();
-        let opened = self
-            .thread
-            .join()
-            .map_err(|_| Error::Device("the thread opening the device panicked".into()))?;
+        let opened = self.thread.join().map_err(|_| Error::OpeningPanicked)?;
         Ok((opened, start.elapsed()))
     }
 }
@@ -152,19 +149,15 @@ impl Prepared {
             Backend::Cuda => {
                 let kernel = timed(&setup.on_cuda());
                 let (opened, waited) = opening.join()?;
-                let cuda = opened
-                    .cuda
-                    .ok_or_else(|| Error::Device("no CUDA device was opened".into()))?;
-                let cuda = cuda.map_err(|e| Error::Device(e.to_string()))?;
+                let cuda = opened.cuda.ok_or(Error::NotOpened("CUDA"))?;
+                let cuda = cuda?;
                 on_cuda(cuda, kernel, waited, opened.took)
             }
             Backend::Wgpu => {
                 let kernel = timed(&hardware);
                 let (opened, waited) = opening.join()?;
-                let gpu = opened
-                    .wgpu
-                    .ok_or_else(|| Error::Device("no wgpu device was opened".into()))?;
-                let gpu = gpu.map_err(|e| Error::Device(e.to_string()))?;
+                let gpu = opened.wgpu.ok_or(Error::NotOpened("wgpu"))?;
+                let gpu = gpu?;
                 on_wgpu(gpu, kernel, waited, opened.took)
             }
             _ => {
@@ -175,11 +168,11 @@ impl Prepared {
                     (Some(Ok(cuda)), None) => {
                         CudaPrepared::open(scene, &lowered, setup, || Ok(cuda)).map(Prepared::of)
                     }
-                    _ => Err(Error::Device("no CUDA device".into())),
+                    _ => Err(Error::NotOpened("CUDA")),
                 };
                 cuda.or_else(|_| match opened.wgpu {
                     Some(Ok(gpu)) => on_wgpu(gpu, timed(&hardware), waited, opened.took),
-                    Some(Err(e)) => Err(Error::Device(e.to_string())),
+                    Some(Err(e)) => Err(Error::Wgpu(e)),
                     // CUDA opened, and its kernel failed: a GPU adapter, as `from_program`.
                     None => WgpuPrepared::open(scene, &lowered, setup, true).map(Prepared::of),
                 })

@@ -22,10 +22,7 @@ use std::sync::Arc;
 pub fn method_allowed(scene: &Scene, traceable: &Traceable) -> Result<(), Error> {
     if scene.settings.method == Method::Trace {
         if let Choice::March(reason) = traceable.choose(scene.settings.method) {
-            return Err(Error::Unsupported(format!(
-                "this scene cannot be ray traced analytically: {}; use method=auto or method=march",
-                reason.describe()
-            )));
+            return Err(Error::NotTraceable(reason));
         }
     }
     Ok(())
@@ -39,7 +36,7 @@ pub(super) fn kernel(
 ) -> Result<wgsl::Kernel, Error> {
     let options = kernel_options(setup);
     wgsl::choose(scene, lowered, &options)?;
-    wgsl::write_with(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
+    Ok(wgsl::write_with(scene, lowered, &options)?)
 }
 
 fn kernel_options(setup: &Setup) -> wgsl::Options {
@@ -65,7 +62,7 @@ pub(super) fn kernel_text(
 ) -> Result<wgsl::Text, Error> {
     let options = kernel_options(setup);
     wgsl::choose(scene, lowered, &options)?;
-    wgsl::write_text(scene, lowered, &options).map_err(|e| Error::Kernel(e.to_string()))
+    Ok(wgsl::write_text(scene, lowered, &options)?)
 }
 
 impl Prepared {
@@ -135,7 +132,7 @@ impl Prepared {
                         })?)
                     }
                     _ => {
-                        let gpu = Gpu::open_index(i).map_err(|e| Error::Device(e.to_string()))?;
+                        let gpu = Gpu::open_index(i)?;
                         Self::on_gpu(Arc::new(gpu), scene, &lowered, setup)?
                     }
                 },
@@ -218,11 +215,11 @@ impl Prepared {
             return Ok(());
         };
         let traced = self.traceable().traced(scene.settings.method).is_some();
-        contract.check(scene, traced).map_err(|m| {
-            Error::Unsupported(format!(
-                "the {} kernel cannot render this scene: {m}; specialise it again",
-                self.name()
-            ))
-        })
+        contract
+            .check(scene, traced)
+            .map_err(|mismatch| Error::Stale {
+                kernel: self.name(),
+                mismatch,
+            })
     }
 }

@@ -112,15 +112,12 @@ impl Renderer for SeveralPrepared {
             (lipschitz, uniform, data),
             (faults, statistics, finished),
             &mut |f| progress(f),
-        )
-        .map_err(|e| Error::Render(e.to_string()))?;
+        )?;
         Ok(Frame::of(r))
     }
 
     fn part<'a>(&'a self, _: &'a Scene) -> Result<Part<'a>, Error> {
-        Err(Error::Misuse(
-            "several devices cannot hold several devices".into(),
-        ))
+        Err(Error::Nested)
     }
 
     fn next(
@@ -129,9 +126,7 @@ impl Renderer for SeveralPrepared {
         _: Lowered,
         _: Option<wgsl::KernelChoice>,
     ) -> Result<(Prepared, bool), Error> {
-        Err(Error::Misuse(
-            "CUDA kernels and several devices are prepared again with Prepared::update".into(),
-        ))
+        Err(Error::NotNext)
     }
 
     fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {

@@ -33,7 +33,7 @@ impl WgpuPrepared {
         require_hardware: bool,
     ) -> Result<WgpuPrepared, Error> {
         let start = Instant::now();
-        let gpu = Gpu::open(require_hardware).map_err(|e| Error::Device(e.to_string()))?;
+        let gpu = Gpu::open(require_hardware)?;
         let device = start.elapsed();
         let (prepared, _) = Self::on_gpu_after(Arc::new(gpu), scene, lowered, setup, None)?;
         prepared.with_pipeline(device, None)
@@ -52,7 +52,7 @@ impl WgpuPrepared {
         let pipeline = self
             .gpu
             .pipeline_for(&self.kernel.source, module, wgsl::ENTRY_POINT, data);
-        self.timing.pipeline = Some(pipeline.map_err(|e| Error::Kernel(e.to_string()))?);
+        self.timing.pipeline = Some(pipeline?);
         self.timing.device = device;
         self.timing.overlapped = overlapped;
         Ok(self)
@@ -251,17 +251,13 @@ impl Renderer for WgpuPrepared {
             self.lipschitz,
             (faults, !self.setup.image_only, self.setup.finished),
             &mut |f| progress(f),
-        )
-        .map_err(|e| Error::Render(e.to_string()))?;
+        )?;
         let cut = r.render.stats.counters.cut;
         if cut > 0 {
-            return Err(Error::Render(format!(
-                "the adapter {} ended {cut} marching loops before they returned: a software adapter \
-                 (Mesa's llvmpipe, as lavapipe) stops every loop of a shader once they have run \
-                 65 535 iterations together, and this scene's distance walks need more, so the \
-                 picture would be wrong; render it with `--backend cpu`, or on a GPU",
-                self.gpu.describe()
-            )));
+            return Err(Error::Cut {
+                adapter: self.gpu.describe(),
+                cut,
+            });
         }
         Ok(Frame::of(r))
     }

@@ -412,10 +412,10 @@ fn measure_one(
         times.push(frame.time.as_secs_f64());
         last = Some(frame.render);
     }
-    let render = last.ok_or_else(|| Error::Render("no frame rendered".into()))?;
+    let render = last.ok_or(Error::NoFrame)?;
     times.sort_by(f64::total_cmp);
     let d = metrics::compare(&reference.image, &render.image, reference::THRESHOLD)
-        .ok_or_else(|| Error::Render("the reference and the render differ in size".into()))?;
+        .ok_or(Error::SizeDiffers)?;
     let depth = match (&reference.depth, &render.depth) {
         (Some(r), Some(t)) => metrics::compare_depth(r, t, reference::DEPTH_TOLERANCE),
         _ => None,

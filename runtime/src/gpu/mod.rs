@@ -137,8 +137,8 @@ pub fn render_faults(
     (faults, statistics, finished): (&launch::Faults, bool, bool),
     progress: &mut dyn FnMut(f64),
 ) -> Result<GpuRender, Error> {
-    let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)
-        .map_err(|e| Error::Uniform(e.0))?;
+    let uniforms =
+        wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz).map_err(Error::Uniform)?;
     let device = gpu.kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
     render_one(
         &device,

@@ -111,13 +111,41 @@ pub enum Error {
     /// What the render would allocate is above the `memory` limit.
     #[error(transparent)]
     Memory(#[from] memory::Exceeded),
-    /// A render failed otherwise: every device of a sequence, or a result that cannot be
-    /// used.
+    /// Every device of a sequence failed before its frames were all written: how many were
+    /// written of how many, and each device's position and why it failed.
+    #[error(
+        "every device failed ({written} of {frames} frames written): {}",
+        failures_in_words(.failures)
+    )]
+    DevicesFailed {
+        written: usize,
+        frames: usize,
+        failures: Vec<(usize, String)>,
+    },
+    /// A sequence ended with `frames - rendered` of its frames not rendered.
+    #[error("{} of {frames} frames were not rendered", .frames - .rendered)]
+    Unrendered { rendered: usize, frames: usize },
+    /// A fault injected by `SDFC_FAULT_AFTER_TILES` into a frame of a sequence: its message.
     #[error("{0}")]
-    Render(String),
+    Injected(String),
+    /// A sweep of `sdfc pareto` rendered no frame.
+    #[error("no frame rendered")]
+    NoFrame,
+    /// The reference and a render compared with it differ in size.
+    #[error("the reference and the render differ in size")]
+    SizeDiffers,
     /// An encoder the frames are handed to (`ffmpeg`) failed.
     #[error("{0}")]
     Encode(String),
+}
+
+/// Each device's failure, as `device P: why`, joined by `; `.
+fn failures_in_words(failures: &[(usize, String)]) -> String {
+    let words: Vec<String> = failures
+        .iter()
+        .map(|(position, why)| format!("device {position}: {why}"))
+        .collect();
+    words.join("; ")
 }
 
 impl From<backend::Error> for Error {

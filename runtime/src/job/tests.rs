@@ -4,7 +4,7 @@
 use super::*;
 use crate::backend::Device;
 use crate::gpu::Gpu;
-use sdfc_compiler::{wgsl, Limit};
+use sdfc_compiler::{analytic::Reason, wgsl, Limit};
 use std::sync::Arc;
 
 #[test]
@@ -54,18 +54,21 @@ fn usage_and_io_exit_with_2_and_the_rest_with_1() {
     };
     assert_eq!(Error::Memory(exceeded).code(), one);
     assert_eq!(Error::Encode("ffmpeg".into()).code(), one);
-    let failed = backend::Error::Device("no adapter".into());
+    let failed = backend::Error::NoDevice("wgpu");
     let unavailable = Error::Unavailable {
         backend: Backend::Wgpu,
         source: failed,
     };
     assert_eq!(
         unavailable.to_string(),
-        "the Wgpu backend is not available: no adapter"
+        "the Wgpu backend is not available: --devices all found no wgpu device"
     );
     assert_eq!(unavailable.code(), one);
-    let unsupported = Error::from(backend::Error::Unsupported("not traced".into()));
-    assert_eq!(unsupported.to_string(), "not traced");
+    let unsupported = Error::from(backend::Error::NotTraceable(Reason::Occlusion));
+    assert_eq!(
+        unsupported.to_string(),
+        "this scene cannot be ray traced analytically: the render asks for ambient `occlusion`, which samples a distance field; use method=auto or method=march"
+    );
     assert_eq!(unsupported.code(), one);
 }
 

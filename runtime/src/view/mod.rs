@@ -85,7 +85,7 @@ pub fn headless(run: Run) -> ExitCode {
                 Device::Cpu
             }
             Err(e) => {
-                let source = crate::backend::Error::Device(e.to_string());
+                let source = crate::backend::Error::Wgpu(e);
                 return crate::job::Error::unavailable(Backend::Wgpu, source).exit();
             }
         },

@@ -532,7 +532,7 @@ impl FramesOn<'_> {
                                 "no device is left"
                             }
                         );
-                        failures.push(format!("device {position}: {message}"));
+                        failures.push((position, message));
                     }
                     Report::Ended { kernels: n, device } => {
                         kernels += n;
@@ -550,11 +550,11 @@ impl FramesOn<'_> {
                     report(done, checker, sink)?;
                 }
                 if alive == 0 && next < todo.len() {
-                    return Err(Error::Render(format!(
-                        "every device failed ({next} of {} frames written): {}",
-                        todo.len(),
-                        failures.join("; ")
-                    )));
+                    return Err(Error::DevicesFailed {
+                        written: next,
+                        frames: todo.len(),
+                        failures: std::mem::take(&mut failures),
+                    });
                 }
                 Ok(())
             };
@@ -587,11 +587,10 @@ impl FramesOn<'_> {
             queue.abandon();
             result?;
             if next < todo.len() {
-                return Err(Error::Render(format!(
-                    "{} of {} frames were not rendered",
-                    todo.len() - next,
-                    todo.len()
-                )));
+                return Err(Error::Unrendered {
+                    rendered: next,
+                    frames: todo.len(),
+                });
             }
             names.sort();
             names.dedup();
@@ -666,7 +665,7 @@ impl FramesOn<'_> {
                 let s = &scene.settings;
                 let n = crate::gpu::launch::tiling(s.width, s.height, crate::gpu::TILE, 1).len();
                 if let Some(message) = faults.injected_within(position, tiles..tiles + n) {
-                    return Err(Error::Render(message));
+                    return Err(Error::Injected(message));
                 }
                 tiles += n;
                 tally.since(&here, preparing(false), started);

@@ -403,10 +403,7 @@ impl launch::Device for Kernel<'_> {
     }
 
     fn fault(&self, message: String) -> Error {
-        Error::Driver {
-            during: "running the kernel",
-            message,
-        }
+        Error::Injected(message)
     }
 }
 

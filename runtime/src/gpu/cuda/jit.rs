@@ -77,8 +77,12 @@ impl Cuda {
                 return Ok(());
             }
             let end = log.iter().position(|&b| b == 0).unwrap_or(log.len());
-            let msg = String::from_utf8_lossy(&log[..end]).into_owned();
-            Err(Error::Jit(format!("{during}: {r:?} {msg}")))
+            let log = String::from_utf8_lossy(&log[..end]).into_owned();
+            Err(Error::Jit {
+                during,
+                result: r,
+                log,
+            })
         };
         // SAFETY: the option arrays outlive the link state, which is destroyed below; the
         // PTX buffer is NUL-terminated and outlives cuLinkAddData; the cubin returned by
@@ -124,8 +128,7 @@ impl Cuda {
         if let Some(k) = kept.as_ref() {
             return Ok(k.clone());
         }
-        let ptx = reduction::ptx(self.sm)
-            .map_err(|e| Error::Jit(format!("the statistics' reduction: {e}")))?;
+        let ptx = reduction::ptx(self.sm).map_err(Error::Reduction)?;
         let loaded = Arc::new(self.load(&ptx, reduction::ENTRY_POINT, None)?);
         *kept = Some(loaded.clone());
         Ok(loaded)

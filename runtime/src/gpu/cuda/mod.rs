@@ -31,14 +31,43 @@ pub enum Error {
     #[error("the CUDA driver found no device")]
     NoDevice,
     /// A driver call failed.
-    #[error("CUDA driver error during {during}: {message}")]
+    #[error("CUDA driver error during {during}: {source}")]
     Driver {
         during: &'static str,
-        message: String,
+        source: cudarc::driver::DriverError,
     },
-    /// The JIT refused the PTX (a compiler bug: the PTX is checked by ptxas in CI).
-    #[error("the CUDA JIT rejected the PTX: {0}")]
-    Jit(String),
+    /// Device `index` is not among those the driver was restricted to ([`only_devices`]).
+    #[error(
+        "CUDA driver error during opening the device: CUDA device {index} was not among those \
+         named before the driver started"
+    )]
+    NotVisible { index: usize },
+    /// There is no device `index`: the driver found `count` (of those named, when
+    /// `restricted`).
+    #[error(
+        "CUDA driver error during opening the device: there is no CUDA device {index} (the \
+         driver found {count}{}; `sdfc devices` lists them)",
+        if *.restricted { " of those named" } else { "" }
+    )]
+    NoSuchDevice {
+        index: usize,
+        count: i32,
+        restricted: bool,
+    },
+    /// A fault injected by `SDFC_FAULT_AFTER_TILES` (tests of the scheduler): its message.
+    #[error("CUDA driver error during running the kernel: {0}")]
+    Injected(String),
+    /// The JIT refused the PTX (a compiler bug: the PTX is checked by ptxas in CI): the
+    /// step, the driver's result and the JIT's log.
+    #[error("the CUDA JIT rejected the PTX: {during}: {result:?} {log}")]
+    Jit {
+        during: &'static str,
+        result: sys::CUresult,
+        log: String,
+    },
+    /// The statistics' reduction could not be written as PTX (a compiler bug).
+    #[error("the CUDA JIT rejected the PTX: the statistics' reduction: {0}")]
+    Reduction(#[source] ptx::Error),
     /// What a launch would pass differs from the kernel's parameters (a bug of sdfc's):
     /// refused before launching.
     #[error("internal error: the CUDA kernel's parameters do not match the launch: {0}")]
@@ -49,10 +78,7 @@ pub enum Error {
 }
 
 fn driver(during: &'static str) -> impl Fn(cudarc::driver::DriverError) -> Error {
-    move |e| Error::Driver {
-        during,
-        message: e.to_string(),
-    }
+    move |source| Error::Driver { during, source }
 }
 
 /// An opened CUDA device.
@@ -209,12 +235,7 @@ impl Cuda {
     pub fn open_device(index: usize, own_stream: bool) -> Result<Cuda, Error> {
         match ordinal_of(VISIBLE.get().map(Vec::as_slice), index) {
             Some(ordinal) => Self::open_ordinal((ordinal, index), own_stream),
-            None => Err(Error::Driver {
-                during: "opening the device",
-                message: format!(
-                    "CUDA device {index} was not among those named before the driver started"
-                ),
-            }),
+            None => Err(Error::NotVisible { index }),
         }
     }
 
@@ -231,15 +252,10 @@ impl Cuda {
         }
         if ordinal >= count as usize {
             // Restricted to the devices named, the driver finds only those that exist.
-            let found = match restricted {
-                true => format!("the driver found {count} of those named"),
-                false => format!("the driver found {count}"),
-            };
-            return Err(Error::Driver {
-                during: "opening the device",
-                message: format!(
-                    "there is no CUDA device {index} ({found}; `sdfc devices` lists them)"
-                ),
+            return Err(Error::NoSuchDevice {
+                index,
+                count,
+                restricted,
             });
         }
         let ctx = CudaContext::new(ordinal).map_err(driver("creating a context"))?;

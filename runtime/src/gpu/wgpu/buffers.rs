@@ -126,14 +126,13 @@ impl Gpu {
     /// wait blocks, its latency small beside the frame. A software adapter (lavapipe)
     /// renders on the host's cores, which polling would take from it: it blocks at once.
     pub fn wait(&self) -> Result<(), Error> {
-        let error = |e: wgpu::PollError| Error::Render(e.to_string());
         if !self.is_cpu() {
             let start = Instant::now();
             while start.elapsed() < SPIN {
                 if self
                     .device
                     .poll(wgpu::PollType::Poll)
-                    .map_err(error)?
+                    .map_err(Error::Poll)?
                     .is_queue_empty()
                 {
                     return Ok(());
@@ -144,7 +143,7 @@ impl Gpu {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(error)
+            .map_err(Error::Poll)
     }
 
     /// The statistics' reduction pipeline (`sdfc_compiler::wgsl::reduce`): binding 0
@@ -198,7 +197,7 @@ impl Gpu {
             &module,
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::Pipeline(e.to_string()));
+            return Err(Error::Pipeline(e));
         }
         let p = Arc::new((pipeline, layout));
         *kept = Some(p.clone());
@@ -234,13 +233,13 @@ impl Gpu {
         index: wgpu::SubmissionIndex,
         mapped: &std::sync::mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>,
     ) -> Result<(), Error> {
-        let error = |e: wgpu::PollError| Error::Render(e.to_string());
-        let done =
-            |r: Result<(), wgpu::BufferAsyncError>| r.map_err(|e| Error::Render(e.to_string()));
+        let done = |r: Result<(), wgpu::BufferAsyncError>| r.map_err(Error::Map);
         if !self.is_cpu() {
             let start = Instant::now();
             while start.elapsed() < SPIN {
-                self.device.poll(wgpu::PollType::Poll).map_err(error)?;
+                self.device
+                    .poll(wgpu::PollType::Poll)
+                    .map_err(Error::Poll)?;
                 if let Ok(r) = mapped.try_recv() {
                     return done(r);
                 }
@@ -252,8 +251,8 @@ impl Gpu {
                 submission_index: Some(index),
                 timeout: None,
             })
-            .map_err(error)?;
-        done(mapped.recv().map_err(|e| Error::Render(e.to_string()))?)
+            .map_err(Error::Poll)?;
+        done(mapped.recv()?)
     }
 
     pub(super) fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, Error> {
@@ -300,12 +299,8 @@ impl Gpu {
             let _ = tx.send(r);
         });
         self.wait()?;
-        rx.recv()
-            .map_err(|e| Error::Render(e.to_string()))?
-            .map_err(|e| Error::Render(e.to_string()))?;
-        let out = f(&slice
-            .get_mapped_range()
-            .map_err(|e| Error::Render(e.to_string()))?);
+        rx.recv()??;
+        let out = f(&slice.get_mapped_range()?);
         staging.unmap();
         if let Ok(mut kept) = self.staging.lock() {
             // The few sizes a frame reads back (image or pixels, statistics, timestamps).

@@ -22,19 +22,21 @@ impl launch::Device for Kernel<'_> {
         let limits = gpu.device.limits();
         let limit = limits.max_storage_buffer_binding_size;
         if let Some(data) = work.data.filter(|d| d.len() as u64 > limit) {
-            return Err(Error::Render(format!(
-                "the scene's primitives take {} bytes, more than the {limit} bytes a storage buffer of this adapter may bind",
-                data.len()
-            )));
+            return Err(Error::StorageBuffer {
+                bytes: data.len(),
+                limit,
+            });
         }
         // The image (16 bytes a pixel) and the statistics are storage buffers bound whole.
         let largest = work.width as u64 * work.height as u64 * 4 * STATS_WORDS.max(4) as u64;
         let most = limit.min(limits.max_buffer_size);
         if largest > most {
-            return Err(Error::Render(format!(
-                "a {}x{} frame needs buffers of {largest} bytes, more than the {most} bytes this adapter allows; render it smaller or with --backend cuda",
-                work.width, work.height
-            )));
+            return Err(Error::FrameTooLarge {
+                width: work.width,
+                height: work.height,
+                largest,
+                most,
+            });
         }
         let (pipeline, _) = gpu.cached_pipeline(self.wgsl, self.entry, work.data.is_some())?;
         let pixels = work.width as u64 * work.height as u64;
@@ -163,10 +165,7 @@ impl launch::Device for Kernel<'_> {
         self.gpu.wait_for(index, &mapped)?;
         let size = 4 * range.len() as u64;
         let rgba = {
-            let view = buffer
-                .slice(..size)
-                .get_mapped_range()
-                .map_err(|e| Error::Render(e.to_string()))?;
+            let view = buffer.slice(..size).get_mapped_range()?;
             crate::gpu::to_vec_parallel(&view)
         };
         buffer.unmap();
@@ -192,7 +191,7 @@ impl launch::Device for Kernel<'_> {
         match (buffer, place) {
             (Some(buffer), launch::Place::Rgba(out)) => {
                 let Some((_, index, mapped)) = f.reading[slot].take() else {
-                    return Err(Error::Render("no band was read into this slot".into()));
+                    return Err(Error::NotRead { slot });
                 };
                 let waiting = Instant::now();
                 // Waits for the copy alone: the launches submitted after it may still run.
@@ -200,10 +199,7 @@ impl launch::Device for Kernel<'_> {
                 let wait = waiting.elapsed();
                 let size = 4 * range.len() as u64;
                 {
-                    let view = buffer
-                        .slice(..size)
-                        .get_mapped_range()
-                        .map_err(|e| Error::Render(e.to_string()))?;
+                    let view = buffer.slice(..size).get_mapped_range()?;
                     crate::gpu::copy_parallel(out, &view);
                 }
                 buffer.unmap();
@@ -351,7 +347,7 @@ impl launch::Device for Kernel<'_> {
                     .push_error_scope(wgpu::ErrorFilter::OutOfMemory),
             );
             if let Some(e) = error {
-                return Err(Error::Render(e.to_string()));
+                return Err(Error::Render(e));
             }
         }
         Ok(())
@@ -360,7 +356,7 @@ impl launch::Device for Kernel<'_> {
     fn finish(&self, mut f: FrameBuffers, work: &Work) -> Result<Option<Duration>, Error> {
         if let Some(scope) = f.memory.take() {
             if let Some(e) = pollster::block_on(scope.pop()) {
-                return Err(Error::Render(e.to_string()));
+                return Err(Error::Render(e));
             }
         }
         let time = match &f.queries {
@@ -374,6 +370,6 @@ impl launch::Device for Kernel<'_> {
     }
 
     fn fault(&self, message: String) -> Error {
-        Error::Render(message)
+        Error::Injected(message)
     }
 }

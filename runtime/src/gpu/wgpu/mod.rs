@@ -25,18 +25,51 @@ pub enum Error {
     #[error("there is no wgpu adapter {index} (wgpu found {count}; `sdfc devices` lists them)")]
     NoSuchAdapter { index: usize, count: usize },
     /// The adapter refused the device request.
-    #[error("the adapter `{adapter}` refused to open a device: {message}")]
-    Device { adapter: String, message: String },
+    #[error("the adapter `{adapter}` refused to open a device: {source}")]
+    Device {
+        adapter: String,
+        source: wgpu::RequestDeviceError,
+    },
     /// wgpu rejected the shader or pipeline (a compiler bug: the kernel was validated by naga).
     #[error("wgpu rejected the kernel: {0}")]
-    Pipeline(String),
+    Pipeline(#[source] wgpu::Error),
     /// The device reported an error while rendering (out of memory, device lost, …).
     #[error("GPU error while rendering: {0}")]
-    Render(String),
+    Render(#[source] wgpu::Error),
+    /// Waiting for the device failed (a lost device, a timeout).
+    #[error("GPU error while rendering: {0}")]
+    Poll(#[from] wgpu::PollError),
+    /// A buffer could not be mapped to be read back.
+    #[error("GPU error while rendering: {0}")]
+    Map(#[from] wgpu::BufferAsyncError),
+    /// A mapped buffer's range could not be viewed.
+    #[error("GPU error while rendering: {0}")]
+    MapRange(#[from] wgpu::MapRangeError),
+    /// The mapping's callback was dropped before it reported.
+    #[error("GPU error while rendering: {0}")]
+    Mapped(#[from] std::sync::mpsc::RecvError),
+    /// The scene's data (`bytes`) is larger than a storage buffer of the adapter may bind.
+    #[error("GPU error while rendering: the scene's primitives take {bytes} bytes, more than the {limit} bytes a storage buffer of this adapter may bind")]
+    StorageBuffer { bytes: usize, limit: u64 },
+    /// A frame whose largest buffer (`largest` bytes) is above what the adapter allows
+    /// (`most`).
+    #[error("GPU error while rendering: a {width}x{height} frame needs buffers of {largest} bytes, more than the {most} bytes this adapter allows; render it smaller or with --backend cuda")]
+    FrameTooLarge {
+        width: u32,
+        height: u32,
+        largest: u64,
+        most: u64,
+    },
+    /// A band collected from a readback slot no band was read into (a bug of sdfc's).
+    #[error("GPU error while rendering: no band was read into this slot")]
+    NotRead { slot: usize },
+    /// A fault injected by `SDFC_FAULT_AFTER_TILES` (tests of the scheduler): its message.
+    #[error("GPU error while rendering: {0}")]
+    Injected(String),
     /// The scene uniform does not fit the kernel's layout (`wgsl::uniforms`; a bug of
     /// sdfc's, or a kernel written for another scene): refused before anything is uploaded.
     #[error("internal error: the scene uniform does not fit the kernel: {0}")]
-    Uniform(String),
+    Uniform(#[source] sdfc_compiler::wgsl::Mismatch),
 }
 
 /// Bytes between tile entries in the tile table (the largest uniform offset alignment).
@@ -243,7 +276,7 @@ impl Gpu {
         let (device, queue) =
             pollster::block_on(adapter.request_device(&desc)).map_err(|e| Error::Device {
                 adapter: info.name.clone(),
-                message: e.to_string(),
+                source: e,
             })?;
         Ok(Gpu {
             device,

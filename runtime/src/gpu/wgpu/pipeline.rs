@@ -57,7 +57,7 @@ impl Gpu {
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let (pipeline, layout, driver) = self.pipeline(wgsl, module, entry, data);
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::Pipeline(e.to_string()));
+            return Err(Error::Pipeline(e));
         }
         let pipeline = Arc::new((pipeline, layout));
         let mut cache = self.lock_pipelines();

@@ -42,6 +42,9 @@ pub enum Error {
         .0.describe()
     )]
     NotTraceable(analytic::Reason),
+    /// The kernel asked for cannot render the scene (`wgsl::choose`).
+    #[error(transparent)]
+    Refused(#[from] wgsl::Refused),
     /// A kernel specialised for other settings than the scene's (a frame of an animation
     /// whose settings changed): the kernel's name and what differs.
     #[error("the {kernel} kernel cannot render this scene: {mismatch}; specialise it again")]
@@ -49,24 +52,15 @@ pub enum Error {
         kernel: &'static str,
         mismatch: wgsl::Mismatch,
     },
-    /// The kernel asked for cannot render the scene (`wgsl::choose`).
+    /// Arguments the backend cannot take: a usage error wherever it is found.
     #[error(transparent)]
-    Refused(#[from] wgsl::Refused),
-    /// The kernel could not be written (naga rejected the WGSL: a compiler bug).
-    #[error(transparent)]
-    Write(#[from] wgsl::Error),
-    /// The kernel could not be translated to PTX.
-    #[error(transparent)]
-    Ptx(#[from] ptx::Error),
+    Usage(#[from] Usage),
+    /// `--devices all` found no GPU of the backend (`cuda` or `wgpu`).
+    #[error("--devices all found no {0} device")]
+    NoDevice(&'static str),
     /// The wgpu path failed: no adapter or device, a pipeline refused, a render's error.
     #[error(transparent)]
     Wgpu(#[from] gpu::wgpu::Error),
-    /// The CUDA path failed: no driver or device, the JIT, a driver call.
-    #[error(transparent)]
-    Cuda(#[from] gpu::cuda::Error),
-    /// Every device of several failed a frame.
-    #[error(transparent)]
-    Several(#[from] gpu::SeveralFailed),
     /// A software adapter ended `cut` marching loops of a frame early: its picture would be
     /// wrong.
     #[error(
@@ -76,26 +70,32 @@ pub enum Error {
          picture would be wrong; render it with `--backend cpu`, or on a GPU"
     )]
     Cut { adapter: String, cut: u64 },
-    /// `--devices all` found no GPU of the backend (`cuda` or `wgpu`).
-    #[error("--devices all found no {0} device")]
-    NoDevice(&'static str),
+    /// The CUDA path failed: no driver or device, the JIT, a driver call.
+    #[error(transparent)]
+    Cuda(#[from] gpu::cuda::Error),
     /// The device opened beside the front end was not of the backend (`CUDA` or `wgpu`)
     /// that the scene asks for.
     #[error("no {0} device was opened")]
     NotOpened(&'static str),
+    /// The kernel could not be written (naga rejected the WGSL: a compiler bug).
+    #[error(transparent)]
+    Write(#[from] wgsl::Error),
     /// The thread opening the device beside the front end panicked.
     #[error("the thread opening the device panicked")]
     OpeningPanicked,
+    /// The kernel could not be translated to PTX.
+    #[error(transparent)]
+    Ptx(#[from] ptx::Error),
     /// Several devices asked to hold several devices (a bug of sdfc's).
     #[error("several devices cannot hold several devices")]
     Nested,
+    /// Every device of several failed a frame.
+    #[error(transparent)]
+    Several(#[from] gpu::SeveralFailed),
     /// A CUDA preparation's or several devices' `next` (a bug of sdfc's): they are prepared
     /// again with `Prepared::update`.
     #[error("CUDA kernels and several devices are prepared again with Prepared::update")]
     NotNext,
-    /// Arguments the backend cannot take: a usage error wherever it is found.
-    #[error(transparent)]
-    Usage(#[from] Usage),
 }
 
 /// A `--kernel` or `--devices` that cannot be read or that the backend cannot take: a usage

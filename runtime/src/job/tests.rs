@@ -299,3 +299,74 @@ fn the_jobs_settings_are_applied_in_order_within_the_limits() {
         "{refused:?}"
     );
 }
+
+#[test]
+fn typed_failures_keep_their_messages_word_for_word() {
+    use crate::gpu::{cuda, wgpu};
+    let said = |e: backend::Error| Error::from(e).to_string();
+    assert_eq!(
+        said(
+            wgpu::Error::StorageBuffer {
+                bytes: 300,
+                limit: 256
+            }
+            .into()
+        ),
+        "GPU error while rendering: the scene's primitives take 300 bytes, more than the 256 \
+         bytes a storage buffer of this adapter may bind"
+    );
+    let large = wgpu::Error::FrameTooLarge {
+        width: 100,
+        height: 50,
+        largest: 320_000,
+        most: 1000,
+    };
+    assert_eq!(
+        said(large.into()),
+        "GPU error while rendering: a 100x50 frame needs buffers of 320000 bytes, more than the \
+         1000 bytes this adapter allows; render it smaller or with --backend cuda"
+    );
+    let cut = backend::Error::Cut {
+        adapter: "llvmpipe".into(),
+        cut: 7,
+    };
+    assert!(said(cut).starts_with(
+        "the adapter llvmpipe ended 7 marching loops before they returned: a software adapter \
+         (Mesa's llvmpipe, as lavapipe) stops every loop of a shader once they have run 65 535 \
+         iterations together"
+    ));
+    let missing = |restricted| cuda::Error::NoSuchDevice {
+        index: 3,
+        count: 2,
+        restricted,
+    };
+    assert_eq!(
+        said(missing(true).into()),
+        "CUDA driver error during opening the device: there is no CUDA device 3 (the driver \
+         found 2 of those named; `sdfc devices` lists them)"
+    );
+    assert_eq!(
+        said(missing(false).into()),
+        "CUDA driver error during opening the device: there is no CUDA device 3 (the driver \
+         found 2; `sdfc devices` lists them)"
+    );
+    let failed = Error::DevicesFailed {
+        written: 3,
+        frames: 10,
+        failures: vec![(0, "lost".into()), (1, "out of memory".into())],
+    };
+    assert_eq!(
+        failed.to_string(),
+        "every device failed (3 of 10 frames written): device 0: lost; device 1: out of memory"
+    );
+    let unrendered = Error::Unrendered {
+        rendered: 3,
+        frames: 10,
+    };
+    assert_eq!(unrendered.to_string(), "7 of 10 frames were not rendered");
+    // A caller tells the failures apart by their variants.
+    assert!(matches!(
+        Error::from(backend::Error::NotTraceable(Reason::Glow)),
+        Error::Backend(backend::Error::NotTraceable(Reason::Glow))
+    ));
+}

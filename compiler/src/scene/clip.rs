@@ -72,14 +72,16 @@ pub(crate) fn uncut(
         .collect()
 }
 
-/// An intersection's children's boxes intersected (low and high corners) and its planes
-/// (child, normal, height): `None` for any other node, or one without planes or bounded
-/// children.
+/// A plane child of an intersection: the child, its normal and its height.
+type Cut = (NodeId, V3, f64);
+
+/// An intersection's children's boxes intersected (low and high corners) and its planes:
+/// `None` for any other node, or one without planes or bounded children.
 fn parts(
     graph: &Graph,
     node: &Node,
     boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
-) -> Option<(V3, V3, Vec<(NodeId, V3, f64)>)> {
+) -> Option<(V3, V3, Vec<Cut>)> {
     let Node::Combine {
         op: Combine::Intersect,
         children,

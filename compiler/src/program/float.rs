@@ -110,9 +110,32 @@ pub trait Float:
 }
 
 macro_rules! impl_float {
-    ($t:ty, $i:ty, $big:expr, { $($trig:item)* }) => {
+    ($t:ty, $i:ty, $big:expr, [$sin:ident, $cos:ident, $reduced:ident, $sin_r:ident, $cos_r:ident, $atan2:ident]) => {
         impl Float for $t {
-            $($trig)*
+            #[inline(always)]
+            fn sin(self) -> Self {
+                trig::$sin(self)
+            }
+            #[inline(always)]
+            fn cos(self) -> Self {
+                trig::$cos(self)
+            }
+            #[inline(always)]
+            fn reduced(self) -> bool {
+                trig::$reduced(self)
+            }
+            #[inline(always)]
+            fn sin_reduced(self) -> Self {
+                trig::$sin_r(self)
+            }
+            #[inline(always)]
+            fn cos_reduced(self) -> Self {
+                trig::$cos_r(self)
+            }
+            #[inline(always)]
+            fn atan2(self, x: Self) -> Self {
+                trig::$atan2(self, x)
+            }
             const EPSILON: Self = <$t>::EPSILON;
             const NAME: &'static str = stringify!($t);
             #[inline(always)]
@@ -169,58 +192,18 @@ macro_rules! impl_float {
     };
 }
 
-impl_float!(f32, i32, 8_388_608.0, {
-    #[inline(always)]
-    fn sin(self) -> Self {
-        trig::sinf(self)
-    }
-    #[inline(always)]
-    fn cos(self) -> Self {
-        trig::cosf(self)
-    }
-    #[inline(always)]
-    fn reduced(self) -> bool {
-        trig::reducedf(self)
-    }
-    #[inline(always)]
-    fn sin_reduced(self) -> Self {
-        trig::sinf_reduced(self)
-    }
-    #[inline(always)]
-    fn cos_reduced(self) -> Self {
-        trig::cosf_reduced(self)
-    }
-    #[inline(always)]
-    fn atan2(self, x: Self) -> Self {
-        trig::atan2f(self, x)
-    }
-});
-impl_float!(f64, i64, 4_503_599_627_370_496.0, {
-    #[inline(always)]
-    fn sin(self) -> Self {
-        trig::sin(self)
-    }
-    #[inline(always)]
-    fn cos(self) -> Self {
-        trig::cos(self)
-    }
-    #[inline(always)]
-    fn reduced(self) -> bool {
-        trig::reduced(self)
-    }
-    #[inline(always)]
-    fn sin_reduced(self) -> Self {
-        trig::sin_reduced(self)
-    }
-    #[inline(always)]
-    fn cos_reduced(self) -> Self {
-        trig::cos_reduced(self)
-    }
-    #[inline(always)]
-    fn atan2(self, x: Self) -> Self {
-        trig::atan2(self, x)
-    }
-});
+impl_float!(
+    f32,
+    i32,
+    8_388_608.0,
+    [sinf, cosf, reducedf, sinf_reduced, cosf_reduced, atan2f]
+);
+impl_float!(
+    f64,
+    i64,
+    4_503_599_627_370_496.0,
+    [sin, cos, reduced, sin_reduced, cos_reduced, atan2]
+);
 
 #[cfg(test)]
 mod tests {

@@ -210,13 +210,12 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
 #[inline(always)]
 fn quadrant(x: f64, shift: u64) -> f64 {
     const ROUND: f64 = 6_755_399_441_055_744.0;
-    // 2/π, and π/2 = P1 + P2 + P3 + P4, the first three of 33 bits (fdlibm's).
-    const INV_PIO2: f64 = 6.366_197_723_675_813_8e-1;
+    // π/2 = P1 + P2 + P3 + P4, the first three of 33 bits (fdlibm's).
     const P1: f64 = 1.570_796_326_734_125_6;
     const P2: f64 = 6.077_100_506_303_966e-11;
     const P3: f64 = 2.022_266_248_711_166_5e-21;
     const P4: f64 = 8.478_427_660_368_9e-32;
-    let s = x * INV_PIO2 + ROUND;
+    let s = x * core::f64::consts::FRAC_2_PI + ROUND;
     let q = s.to_bits().wrapping_add(shift);
     let k = s - ROUND;
     let a = x - k * P1;
@@ -257,11 +256,11 @@ fn kernel_sin(x: f64, y: f64) -> f64 {
 /// cos(x + y) for |x| ≤ π/4, |y| below half an ulp of x (fdlibm's `__kernel_cos`).
 #[inline(always)]
 fn kernel_cos(x: f64, y: f64) -> f64 {
-    const C1: f64 = 4.166_666_666_666_660_2e-2;
+    const C1: f64 = 0.0416666666666666;
     const C2: f64 = -1.388_888_888_887_411e-3;
     const C3: f64 = 2.480_158_728_947_673e-5;
     const C4: f64 = -2.755_731_435_139_066_3e-7;
-    const C5: f64 = 2.087_572_321_298_174_8e-9;
+    const C5: f64 = 2.087572321298175e-09;
     const C6: f64 = -1.135_964_755_778_819_5e-11;
     let z = x * x;
     let w = z * z;
@@ -278,11 +277,11 @@ pub(crate) fn atan2(y: f64, x: f64) -> f64 {
     // atan ½ and atan 1, and π/2 and π, as sums of two f64 (fdlibm's).
     const HALF_HI: f64 = 4.636_476_090_008_061e-1;
     const HALF_LO: f64 = 2.269_877_745_296_168_7e-17;
-    const ONE_HI: f64 = 7.853_981_633_974_483e-1;
+    const ONE_HI: f64 = core::f64::consts::FRAC_PI_4;
     const ONE_LO: f64 = 3.061_616_997_868_383e-17;
-    const PIO2_HI: f64 = 1.570_796_326_794_896_6;
+    const PIO2_HI: f64 = core::f64::consts::FRAC_PI_2;
     const PIO2_LO: f64 = 6.123_233_995_736_766e-17;
-    const PI_HI: f64 = 3.141_592_653_589_793;
+    const PI_HI: f64 = core::f64::consts::PI;
     const PI_LO: f64 = 1.224_646_799_147_353_2e-16;
     const AT: [f64; 11] = [
         3.333_333_333_333_293e-1,

@@ -2,7 +2,8 @@
 //! self-contained functions over glam, `map` in f32 and `map_f64` in f64, one statement per
 //! instruction, with the meaning of every operation as in [`crate::program::scalar`]. A guarded
 //! block is an `if`/`else`; each of its results is declared before it and assigned in both
-//! branches.
+//! branches. A program with sines, cosines or arc tangents carries `program/trig.rs`, the
+//! interpreter's functions, as a module `{name}_trig` that `map` and `map_f64` call.
 
 use crate::program::{results, Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::fmt::Write;
@@ -29,6 +30,7 @@ pub fn write_named(program: &Program, name: &str) -> String {
         "// lt gives 1.0 or 0.0, and select picks its second operand where the first is not 0.\n\n",
     );
     outlines(&mut out, program, name);
+    trig(&mut out, program, name);
     function(&mut out, program, name, name, "glam::Vec3", "f32");
     out.push('\n');
     function(
@@ -40,6 +42,25 @@ pub fn write_named(program: &Program, name: &str) -> String {
         "f64",
     );
     out
+}
+
+/// The module `{name}_trig` (`program/trig.rs`) where `program` reads a sine, a cosine or an
+/// arc tangent: the functions of the interpreter, so that `map` and `map_f64` give its values
+/// bit for bit.
+fn trig(out: &mut String, program: &Program, name: &str) {
+    let uses = program.ops().iter().any(|op| {
+        matches!(
+            op,
+            Op::Unary(Unary::Sin | Unary::Cos, _) | Op::Binary(Binary::Atan2, ..)
+        )
+    });
+    if uses {
+        let source = include_str!("../program/trig.rs");
+        let _ = writeln!(
+            out,
+            "#[allow(dead_code, clippy::all)]\nmod {name}_trig {{\n{source}}}\n"
+        );
+    }
 }
 
 /// The glow of the marching steps of a scene's part named `name` (`--part map`, beside
@@ -330,8 +351,8 @@ fn expr(op: &Op, ty: &str, name: &str) -> String {
         Op::Input(Axis::Z) => "p.z".into(),
         // Only colour fields read the normal, and `--emit rust` writes the distance alone.
         Op::Input(Axis::Nx | Axis::Ny | Axis::Nz) => constant(0.0, ty),
-        Op::Unary(u, a) => unary(u, &r(a), ty),
-        Op::Binary(b, x, y) => binary(b, &r(x), &r(y)),
+        Op::Unary(u, a) => unary(u, &r(a), ty, name),
+        Op::Binary(b, x, y) => binary(b, &r(x), &r(y), ty, name),
         Op::Select(c, a, b) => format!("if {} != 0.0 {{ {} }} else {{ {} }}", r(c), r(a), r(b)),
         Op::Phi(a, _) => r(a),
         // `sdfc compile` refuses such a program before writing it; written anyway, the Rust
@@ -363,13 +384,15 @@ fn constant(c: f64, ty: &str) -> String {
     }
 }
 
-fn unary(u: Unary, a: &str, ty: &str) -> String {
+fn unary(u: Unary, a: &str, ty: &str, name: &str) -> String {
     match u {
         Unary::Neg => format!("-{a}"),
         Unary::Abs => format!("{a}.abs()"),
         Unary::Sqrt => format!("{a}.sqrt()"),
-        Unary::Sin => format!("{a}.sin()"),
-        Unary::Cos => format!("{a}.cos()"),
+        Unary::Sin if ty == "f32" => format!("{name}_trig::sinf({a})"),
+        Unary::Cos if ty == "f32" => format!("{name}_trig::cosf({a})"),
+        Unary::Sin => format!("{name}_trig::sin({a})"),
+        Unary::Cos => format!("{name}_trig::cos({a})"),
         Unary::Acos => format!("{a}.acos()"),
         Unary::Exp => format!("{a}.exp()"),
         Unary::Log => format!("{a}.ln()"),
@@ -378,7 +401,7 @@ fn unary(u: Unary, a: &str, ty: &str) -> String {
     }
 }
 
-fn binary(b: Binary, x: &str, y: &str) -> String {
+fn binary(b: Binary, x: &str, y: &str, ty: &str, name: &str) -> String {
     match b {
         Binary::Add => format!("{x} + {y}"),
         Binary::Sub => format!("{x} - {y}"),
@@ -387,7 +410,8 @@ fn binary(b: Binary, x: &str, y: &str) -> String {
         Binary::Min => format!("if {x} < {y} {{ {x} }} else {{ {y} }}"),
         Binary::Max => format!("if {x} > {y} {{ {x} }} else {{ {y} }}"),
         Binary::Pow => format!("{x}.powf({y})"),
-        Binary::Atan2 => format!("{x}.atan2({y})"),
+        Binary::Atan2 if ty == "f32" => format!("{name}_trig::atan2f({x}, {y})"),
+        Binary::Atan2 => format!("{name}_trig::atan2({x}, {y})"),
         Binary::Lt => format!("if {x} < {y} {{ 1.0 }} else {{ 0.0 }}"),
     }
 }

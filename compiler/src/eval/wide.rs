@@ -9,7 +9,10 @@
 //! whole inlined loop nest, too large for LLVM to inline on its own (without the attribute
 //! the interpreter's loops ran as a separate, baseline-compiled closure). Results do not change: rustc never lets LLVM contract
 //! or reorder floating-point operations, so the vector code performs the same IEEE operations
-//! in the same order, and the transcendental functions are the same library calls either way.
+//! in the same order. That holds for f32 sine, cosine and arc tangent too, polynomials of
+//! plain operations (`program/trig.rs`) that vectorise like the rest; the other
+//! transcendental functions (and sine and cosine of arguments beyond 2²⁰) are the same library
+//! calls either way.
 
 /// Runs `f`, compiled for AVX2 where the processor has it.
 #[inline(always)]

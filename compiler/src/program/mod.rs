@@ -1,6 +1,6 @@
 //! The distance program, the IR between the lowering and every back end: one flat scalar SSA
 //! program that maps a point (x, y, z) to (distance, material id), with the meaning of each
-//! operation (`scalar.rs`, over the evaluation types of `float.rs`), the reference run of a
+//! operation (`scalar.rs`, over the evaluation types of `float.rs`; their f32 sine, cosine and arc tangent in `trig.rs`), the reference run of a
 //! whole program at one point (`run.rs`), liveness (`live.rs`) and its text form (`text.rs`). The lowering builds programs; the interpreter, the placement
 //! warnings and the Rust and WGSL writers read them.
 //!
@@ -23,6 +23,9 @@ pub mod outline;
 mod run;
 pub mod scalar;
 mod text;
+mod trig;
+#[cfg(test)]
+mod trig_tests;
 
 pub use float::Float;
 pub use live::results;

@@ -160,17 +160,34 @@ fn map2<T: Float>(d: &mut [T], a: &[T], b: &[T], f: impl Fn(T, T) -> T) {
     }
 }
 
-/// One loop per operation, each specialised by `scalar::unary` with a constant operation.
+/// One loop per operation, each specialised by `scalar::unary` with a constant operation;
+/// sine and cosine as [`reduced_loop`]s.
 #[inline(always)]
 fn unary_loop<T: Float>(u: Unary, d: &mut [T], a: &[T]) {
     macro_rules! arms {
         ($($v:ident),*) => {
             match u {
+                Unary::Sin => reduced_loop(d, a, T::sin_reduced, T::sin),
+                Unary::Cos => reduced_loop(d, a, T::cos_reduced, T::cos),
                 $(Unary::$v => map1(d, a, |x| scalar::unary(Unary::$v, x)),)*
             }
         };
     }
-    arms!(Neg, Abs, Sqrt, Sin, Cos, Acos, Exp, Log, Floor, Round)
+    arms!(Neg, Abs, Sqrt, Acos, Exp, Log, Floor, Round)
+}
+
+/// `f` over every lane (branch-free, so the loop vectorises), then, where some lane is not
+/// [`Float::reduced`], `whole` over those lanes: `whole` at every lane.
+#[inline(always)]
+fn reduced_loop<T: Float>(d: &mut [T], a: &[T], f: impl Fn(T) -> T, whole: impl Fn(T) -> T) {
+    map1(d, a, f);
+    if a.iter().fold(false, |any, x| any | !x.reduced()) {
+        for (o, &x) in d.iter_mut().zip(a) {
+            if !x.reduced() {
+                *o = whole(x);
+            }
+        }
+    }
 }
 
 /// One loop per operation, each specialised by `scalar::binary` with a constant operation.

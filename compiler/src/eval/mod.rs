@@ -64,8 +64,9 @@ pub struct Evaluator<'t, T: Float> {
     slots: Vec<T>,
     chunk: usize,
     /// Per open guarded block: the points (of the enclosing block's packing) where it runs,
-    /// and how many points the enclosing block had.
-    frames: Vec<(Vec<u32>, usize)>,
+    /// how many points the enclosing block had, and whether the block runs on all of them
+    /// ([`DENSE`]).
+    frames: Vec<(Vec<u32>, usize, bool)>,
 }
 
 impl<'t, T: Float> Evaluator<'t, T> {
@@ -77,7 +78,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
             slots[(slot - INPUTS) as usize * chunk..][..chunk].fill(T::from_f64(c));
         }
         let frames = (0..tape.depth())
-            .map(|_| (Vec::with_capacity(chunk), 0))
+            .map(|_| (Vec::with_capacity(chunk), 0, false))
             .collect();
         Evaluator {
             tape,
@@ -91,7 +92,8 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// the point lists of its guarded blocks); evaluating allocates nothing more.
     pub fn heap_bytes(tape: &Tape, chunk: usize) -> usize {
         let chunk = chunk.max(1);
-        let frame = chunk * std::mem::size_of::<u32>() + std::mem::size_of::<(Vec<u32>, usize)>();
+        let frame =
+            chunk * std::mem::size_of::<u32>() + std::mem::size_of::<(Vec<u32>, usize, bool)>();
         chunk * tape.slot_count() * std::mem::size_of::<T>() + tape.depth() * frame
     }
 
@@ -217,7 +219,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
     #[inline(always)]
     fn enter(&mut self, inputs: [&[T]; 3], guard: &Guard, depth: usize, n: usize) -> Option<usize> {
         let c = self.chunk;
-        let (mut idx, _) = std::mem::take(&mut self.frames[depth]);
+        let (mut idx, _, _) = std::mem::take(&mut self.frames[depth]);
         idx.resize(n, 0);
         let m = {
             let bound = self.view(inputs, guard.bound, n);
@@ -225,11 +227,12 @@ impl<'t, T: Float> Evaluator<'t, T> {
             compact(bound, best, &mut idx)
         };
         idx.truncate(m);
+        let dense = m < n && m * DENSE.1 >= n * DENSE.0;
         if m == 0 {
             for &(dst, _, other) in &guard.phis {
                 self.copy(inputs, other, dst, n);
             }
-        } else if m == n {
+        } else if m == n || dense {
             for &(from, to) in &guard.gathers {
                 self.copy(inputs, from, to, n);
             }
@@ -249,8 +252,8 @@ impl<'t, T: Float> Evaluator<'t, T> {
                 }
             }
         }
-        self.frames[depth] = (idx, n);
-        (m > 0).then_some(m)
+        self.frames[depth] = (idx, n, dense);
+        (m > 0).then_some(if dense { n } else { m })
     }
 
     /// Ends a guarded block that ran on `m` points: scatters its results into the enclosing
@@ -258,9 +261,16 @@ impl<'t, T: Float> Evaluator<'t, T> {
     #[inline(always)]
     fn leave(&mut self, inputs: [&[T]; 3], guard: &Guard, depth: usize, m: usize) -> usize {
         let c = self.chunk;
-        let (idx, n) = std::mem::take(&mut self.frames[depth]);
+        let (idx, n, dense) = std::mem::take(&mut self.frames[depth]);
         for &(dst, then, other) in &guard.phis {
-            if m == n {
+            if dense {
+                self.copy(inputs, other, dst, n);
+                let (then, dst) = ((then - INPUTS) as usize * c, (dst - INPUTS) as usize * c);
+                let (dst, src) = two(&mut self.slots, dst, n, then, n);
+                for &i in &idx {
+                    dst[i as usize] = src[i as usize];
+                }
+            } else if m == n {
                 self.copy(inputs, then, dst, n);
             } else {
                 self.copy(inputs, other, dst, n);
@@ -271,10 +281,16 @@ impl<'t, T: Float> Evaluator<'t, T> {
                 }
             }
         }
-        self.frames[depth] = (idx, n);
+        self.frames[depth] = (idx, n, dense);
         n
     }
 }
+
+/// A guarded block that runs on at least `DENSE.0 / DENSE.1` of its enclosing block's points
+/// runs on all of them, its results kept where it runs: its values from outside are copied
+/// whole instead of gathered point by point, for the little more work of the points where it
+/// does not (whose guards inside it, testing boxes within its own, mostly fail too).
+const DENSE: (usize, usize) = (3, 4);
 
 /// Lists in `idx` the points where a guarded block runs, `!(bound >= best)`, and returns how
 /// many there are; eight points are compared at a time, and a group where the block runs

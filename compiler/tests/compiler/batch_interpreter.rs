@@ -145,6 +145,58 @@ fn batch_matches_the_reference_path_bit_for_bit() {
     batch_matches_reference::<f64>();
 }
 
+/// A row of spheres, each painted, as one union: a hierarchy of guarded groups.
+fn row_scene() -> Scene {
+    let mut b = Build::new();
+    let ms = [
+        b.material([1.0, 0.2, 0.2], 0.0, 0.0),
+        b.material([0.2, 0.2, 1.0], 0.0, 0.0),
+    ];
+    let children = (0..24)
+        .map(|i| {
+            let s = b.add(Node::Sphere { radius: 0.3 });
+            let s = b.at(s, [2.0 * i as f64, 0.0, 0.0]);
+            b.paint(s, ms[i % 2])
+        })
+        .collect();
+    let root = b.add(Node::Combine {
+        op: Combine::Union,
+        children,
+    });
+    b.finish(root)
+}
+
+/// Batches where most points are near one end of the row and a few near the other, so that
+/// guarded blocks run on all, most (the interpreter then runs them on every point and keeps
+/// the results where they run) and few of a batch's points: bit for bit the reference.
+fn dense_and_sparse_blocks<T: Float>() {
+    let program = lower(&row_scene());
+    let mut rng = Rng::new(7);
+    let pts: Vec<[f64; 3]> = (0..256)
+        .map(|i| {
+            let x = if i % 8 == 7 { 46.0 } else { 0.0 };
+            let q = rng.point(1.5);
+            [x + q[0], q[1], q[2]]
+        })
+        .collect();
+    for chunk in [8, 16, 64, 256] {
+        let (d, m) = run::<T>(&program, Outputs::DistanceAndMaterial, chunk, &pts);
+        for (i, p) in pts.iter().enumerate() {
+            let (rd, rm) = eval_point::<T>(&program, p.map(T::from_f64));
+            assert!(
+                rd.to_f64().to_bits() == d[i].to_f64().to_bits() && rm == m[i],
+                "chunk {chunk}, point {i}"
+            );
+        }
+    }
+}
+
+#[test]
+fn blocks_run_on_most_or_few_points_as_the_reference() {
+    dense_and_sparse_blocks::<f32>();
+    dense_and_sparse_blocks::<f64>();
+}
+
 #[test]
 fn distance_tape_drops_material_code() {
     let program = lower(&busy_scene());

@@ -8,7 +8,9 @@
 //! results to their values from before and jumps past `Leave`. Otherwise it gathers the
 //! values the block reads from outside into slots of its own, packed for the running points
 //! only, so that the block's steps run over those points alone; `Leave` scatters the
-//! results back. Blocks nest, each packing relative to the one around it.
+//! results back. Blocks nest, each packing relative to the one around it. A block that runs on
+//! most of the points around it copies its values whole instead and runs on all of them,
+//! `Leave` keeping its results where it runs (the evaluator's `DENSE`).
 
 use super::fuse::{Finish, Kind};
 use crate::program::mesh::TriMesh;

@@ -126,16 +126,21 @@ fn batch_matches_reference<T: Float>() {
     let pts = points(300);
     for chunk in [1, 7, 64] {
         for n in [0, 1, 63, 64, 65, 128, 300] {
-            let (d, m) = run::<T>(&program, Outputs::DistanceAndMaterial, chunk, &pts[..n]);
-            for i in 0..n {
-                let p = pts[i].map(T::from_f64);
-                let (rd, rm) = eval_point::<T>(&program, p);
-                assert!(
-                    rd.to_f64().to_bits() == d[i].to_f64().to_bits() && rm == m[i],
-                    "chunk {chunk}, n {n}, point {i}"
-                );
-            }
+            as_reference::<T>(&program, &pts[..n], chunk, &format!("n {n}"));
         }
+    }
+}
+
+/// Asserts that a batch run of `program` at `chunk` points per pass gives the reference
+/// path's distances and materials, bit for bit.
+fn as_reference<T: Float>(program: &Program, pts: &[[f64; 3]], chunk: usize, what: &str) {
+    let (d, m) = run::<T>(program, Outputs::DistanceAndMaterial, chunk, pts);
+    for (i, p) in pts.iter().enumerate() {
+        let (rd, rm) = eval_point::<T>(program, p.map(T::from_f64));
+        assert!(
+            rd.to_f64().to_bits() == d[i].to_f64().to_bits() && rm == m[i],
+            "{what}, chunk {chunk}, point {i}"
+        );
     }
 }
 
@@ -180,14 +185,7 @@ fn dense_and_sparse_blocks<T: Float>() {
         })
         .collect();
     for chunk in [8, 16, 64, 256] {
-        let (d, m) = run::<T>(&program, Outputs::DistanceAndMaterial, chunk, &pts);
-        for (i, p) in pts.iter().enumerate() {
-            let (rd, rm) = eval_point::<T>(&program, p.map(T::from_f64));
-            assert!(
-                rd.to_f64().to_bits() == d[i].to_f64().to_bits() && rm == m[i],
-                "chunk {chunk}, point {i}"
-            );
-        }
+        as_reference::<T>(&program, &pts, chunk, "a row of spheres");
     }
 }
 

@@ -64,8 +64,9 @@ pub struct Evaluator<'t, T: Float> {
     slots: Vec<T>,
     chunk: usize,
     /// Per open guarded block: the points (of the enclosing block's packing) where it runs,
-    /// and how many points the enclosing block had.
-    frames: Vec<(Vec<u32>, usize)>,
+    /// how many points the enclosing block had, and whether the block runs on all of them
+    /// ([`DENSE`]).
+    frames: Vec<(Vec<u32>, usize, bool)>,
 }
 
 impl<'t, T: Float> Evaluator<'t, T> {
@@ -77,7 +78,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
             slots[(slot - INPUTS) as usize * chunk..][..chunk].fill(T::from_f64(c));
         }
         let frames = (0..tape.depth())
-            .map(|_| (Vec::with_capacity(chunk), 0))
+            .map(|_| (Vec::with_capacity(chunk), 0, false))
             .collect();
         Evaluator {
             tape,
@@ -91,7 +92,8 @@ impl<'t, T: Float> Evaluator<'t, T> {
     /// the point lists of its guarded blocks); evaluating allocates nothing more.
     pub fn heap_bytes(tape: &Tape, chunk: usize) -> usize {
         let chunk = chunk.max(1);
-        let frame = chunk * std::mem::size_of::<u32>() + std::mem::size_of::<(Vec<u32>, usize)>();
+        let frame =
+            chunk * std::mem::size_of::<u32>() + std::mem::size_of::<(Vec<u32>, usize, bool)>();
         chunk * tape.slot_count() * std::mem::size_of::<T>() + tape.depth() * frame
     }
 
@@ -172,6 +174,7 @@ impl<'t, T: Float> Evaluator<'t, T> {
         let tape = self.tape;
         let steps = tape.steps();
         let direct = tape.direct().then(|| steps.len() - 1);
+        let data = (tape.meshes(), tape.outlines());
         let mut out = Some(out);
         let mut depth = 0;
         let mut s = 0;
@@ -186,7 +189,6 @@ impl<'t, T: Float> Evaluator<'t, T> {
                         0 => n,
                         _ => n.next_multiple_of(BLOCK_LANES).min(chunk),
                     };
-                    let data = (tape.meshes(), tape.outlines());
                     inst.apply(data, &mut self.slots, out, inputs, chunk, width);
                 }
                 Step::Enter(g) => {
@@ -217,25 +219,20 @@ impl<'t, T: Float> Evaluator<'t, T> {
     #[inline(always)]
     fn enter(&mut self, inputs: [&[T]; 3], guard: &Guard, depth: usize, n: usize) -> Option<usize> {
         let c = self.chunk;
-        let (mut idx, _) = std::mem::take(&mut self.frames[depth]);
+        let (mut idx, _, _) = std::mem::take(&mut self.frames[depth]);
         idx.resize(n, 0);
-        let mut m = 0;
-        {
-            // Branch-free compaction: every index is written, the count advances where the
-            // block runs (whether it does varies from point to point).
+        let m = {
             let bound = self.view(inputs, guard.bound, n);
             let best = self.view(inputs, guard.best, n);
-            for (i, (b, d)) in bound.iter().zip(best).enumerate() {
-                idx[m] = i as u32;
-                m += usize::from(!(*b >= *d));
-            }
-        }
+            compact(bound, best, &mut idx)
+        };
         idx.truncate(m);
+        let dense = m < n && m * DENSE.1 >= n * DENSE.0;
         if m == 0 {
             for &(dst, _, other) in &guard.phis {
                 self.copy(inputs, other, dst, n);
             }
-        } else if m == n {
+        } else if m == n || dense {
             for &(from, to) in &guard.gathers {
                 self.copy(inputs, from, to, n);
             }
@@ -244,22 +241,19 @@ impl<'t, T: Float> Evaluator<'t, T> {
                 let to = (to - INPUTS) as usize * c;
                 match from.checked_sub(INPUTS) {
                     None => {
-                        let from = inputs[from as usize];
-                        for (j, &i) in idx.iter().enumerate() {
-                            self.slots[to + j] = from[i as usize];
-                        }
+                        let from = &inputs[from as usize][..n];
+                        gather(&mut self.slots[to..][..m], from, &idx);
                     }
                     Some(from) => {
                         let from = from as usize * c;
-                        for (j, &i) in idx.iter().enumerate() {
-                            self.slots[to + j] = self.slots[from + i as usize];
-                        }
+                        let (dst, src) = two(&mut self.slots, to, m, from, n);
+                        gather(dst, src, &idx);
                     }
                 }
             }
         }
-        self.frames[depth] = (idx, n);
-        (m > 0).then_some(m)
+        self.frames[depth] = (idx, n, dense);
+        (m > 0).then_some(if dense { n } else { m })
     }
 
     /// Ends a guarded block that ran on `m` points: scatters its results into the enclosing
@@ -267,19 +261,92 @@ impl<'t, T: Float> Evaluator<'t, T> {
     #[inline(always)]
     fn leave(&mut self, inputs: [&[T]; 3], guard: &Guard, depth: usize, m: usize) -> usize {
         let c = self.chunk;
-        let (idx, n) = std::mem::take(&mut self.frames[depth]);
+        let (idx, n, dense) = std::mem::take(&mut self.frames[depth]);
         for &(dst, then, other) in &guard.phis {
-            if m == n {
+            if dense {
+                self.copy(inputs, other, dst, n);
+                let (then, dst) = ((then - INPUTS) as usize * c, (dst - INPUTS) as usize * c);
+                let (dst, src) = two(&mut self.slots, dst, n, then, n);
+                for &i in &idx {
+                    dst[i as usize] = src[i as usize];
+                }
+            } else if m == n {
                 self.copy(inputs, then, dst, n);
             } else {
                 self.copy(inputs, other, dst, n);
                 let (then, dst) = ((then - INPUTS) as usize * c, (dst - INPUTS) as usize * c);
-                for (j, &i) in idx.iter().enumerate() {
-                    self.slots[dst + i as usize] = self.slots[then + j];
+                let (dst, src) = two(&mut self.slots, dst, n, then, m);
+                for (&i, &v) in idx.iter().zip(src) {
+                    dst[i as usize] = v;
                 }
             }
         }
-        self.frames[depth] = (idx, n);
+        self.frames[depth] = (idx, n, dense);
         n
+    }
+}
+
+/// A guarded block that runs on at least `DENSE.0 / DENSE.1` of its enclosing block's points
+/// runs on all of them, its results kept where it runs: its values from outside are copied
+/// whole instead of gathered point by point, for the little more work of the points where it
+/// does not (whose guards inside it, testing boxes within its own, mostly fail too).
+const DENSE: (usize, usize) = (3, 4);
+
+/// Lists in `idx` the points where a guarded block runs, `!(bound >= best)`, and returns how
+/// many there are; eight points are compared at a time, and a group where the block runs
+/// everywhere or nowhere is written at once.
+#[inline(always)]
+fn compact<T: Float>(bound: &[T], best: &[T], idx: &mut [u32]) -> usize {
+    let mut m = 0;
+    let (whole, rest) = (bound.len() / 8 * 8, bound.len() % 8);
+    for (g, (b, d)) in bound.chunks_exact(8).zip(best.chunks_exact(8)).enumerate() {
+        let mut mask = 0u32;
+        for (j, (b, d)) in b.iter().zip(d).enumerate() {
+            mask |= u32::from(!(*b >= *d)) << j;
+        }
+        let base = (g * 8) as u32;
+        if mask == 0xff {
+            for (j, i) in idx[m..m + 8].iter_mut().enumerate() {
+                *i = base + j as u32;
+            }
+            m += 8;
+            continue;
+        }
+        while mask != 0 {
+            idx[m] = base + mask.trailing_zeros();
+            m += 1;
+            mask &= mask - 1;
+        }
+    }
+    for (j, (b, d)) in bound[whole..]
+        .iter()
+        .zip(&best[whole..])
+        .enumerate()
+        .take(rest)
+    {
+        idx[m] = (whole + j) as u32;
+        m += usize::from(!(*b >= *d));
+    }
+    m
+}
+
+/// `dst[j] = src[idx[j]]` for every listed point.
+#[inline(always)]
+fn gather<T: Float>(dst: &mut [T], src: &[T], idx: &[u32]) {
+    for (d, &i) in dst.iter_mut().zip(idx) {
+        *d = src[i as usize];
+    }
+}
+
+/// The `a_len` values from `a` (written) and the `b_len` values from `b` (read) of `slots`,
+/// two ranges that do not overlap.
+#[inline(always)]
+fn two<T>(slots: &mut [T], a: usize, a_len: usize, b: usize, b_len: usize) -> (&mut [T], &[T]) {
+    if a < b {
+        let (lo, hi) = slots.split_at_mut(b);
+        (&mut lo[a..][..a_len], &hi[..b_len])
+    } else {
+        let (lo, hi) = slots.split_at_mut(a);
+        (&mut hi[..a_len], &lo[b..][..b_len])
     }
 }

@@ -126,16 +126,21 @@ fn batch_matches_reference<T: Float>() {
     let pts = points(300);
     for chunk in [1, 7, 64] {
         for n in [0, 1, 63, 64, 65, 128, 300] {
-            let (d, m) = run::<T>(&program, Outputs::DistanceAndMaterial, chunk, &pts[..n]);
-            for i in 0..n {
-                let p = pts[i].map(T::from_f64);
-                let (rd, rm) = eval_point::<T>(&program, p);
-                assert!(
-                    rd.to_f64().to_bits() == d[i].to_f64().to_bits() && rm == m[i],
-                    "chunk {chunk}, n {n}, point {i}"
-                );
-            }
+            as_reference::<T>(&program, &pts[..n], chunk, &format!("n {n}"));
         }
+    }
+}
+
+/// Asserts that a batch run of `program` at `chunk` points per pass gives the reference
+/// path's distances and materials, bit for bit.
+fn as_reference<T: Float>(program: &Program, pts: &[[f64; 3]], chunk: usize, what: &str) {
+    let (d, m) = run::<T>(program, Outputs::DistanceAndMaterial, chunk, pts);
+    for (i, p) in pts.iter().enumerate() {
+        let (rd, rm) = eval_point::<T>(program, p.map(T::from_f64));
+        assert!(
+            rd.to_f64().to_bits() == d[i].to_f64().to_bits() && rm == m[i],
+            "{what}, chunk {chunk}, point {i}"
+        );
     }
 }
 
@@ -143,6 +148,51 @@ fn batch_matches_reference<T: Float>() {
 fn batch_matches_the_reference_path_bit_for_bit() {
     batch_matches_reference::<f32>();
     batch_matches_reference::<f64>();
+}
+
+/// A row of spheres, each painted, as one union: a hierarchy of guarded groups.
+fn row_scene() -> Scene {
+    let mut b = Build::new();
+    let ms = [
+        b.material([1.0, 0.2, 0.2], 0.0, 0.0),
+        b.material([0.2, 0.2, 1.0], 0.0, 0.0),
+    ];
+    let children = (0..24)
+        .map(|i| {
+            let s = b.add(Node::Sphere { radius: 0.3 });
+            let s = b.at(s, [2.0 * i as f64, 0.0, 0.0]);
+            b.paint(s, ms[i % 2])
+        })
+        .collect();
+    let root = b.add(Node::Combine {
+        op: Combine::Union,
+        children,
+    });
+    b.finish(root)
+}
+
+/// Batches where most points are near one end of the row and a few near the other, so that
+/// guarded blocks run on all, most (the interpreter then runs them on every point and keeps
+/// the results where they run) and few of a batch's points: bit for bit the reference.
+fn dense_and_sparse_blocks<T: Float>() {
+    let program = lower(&row_scene());
+    let mut rng = Rng::new(7);
+    let pts: Vec<[f64; 3]> = (0..256)
+        .map(|i| {
+            let x = if i % 8 == 7 { 46.0 } else { 0.0 };
+            let q = rng.point(1.5);
+            [x + q[0], q[1], q[2]]
+        })
+        .collect();
+    for chunk in [8, 16, 64, 256] {
+        as_reference::<T>(&program, &pts, chunk, "a row of spheres");
+    }
+}
+
+#[test]
+fn blocks_run_on_most_or_few_points_as_the_reference() {
+    dense_and_sparse_blocks::<f32>();
+    dense_and_sparse_blocks::<f64>();
 }
 
 #[test]

@@ -209,12 +209,19 @@ impl Compiler<'_> {
                 need[block.best.0 as usize] = true;
             }
         }
+        // One slot per value: a large program repeats its constants (materials, radii,
+        // the infinity of an empty union) many times, and each slot is a chunk of memory
+        // the evaluator keeps filled.
+        let mut by_value: HashMap<u64, u32> = HashMap::new();
         for (i, op) in ops.iter().enumerate() {
             match *op {
                 Op::Const(c) if need[i] && self.live[i] => {
-                    let s = self.alloc.fresh();
+                    let s = *by_value.entry(c.to_bits()).or_insert_with(|| {
+                        let s = self.alloc.fresh();
+                        self.tape.constants.push((s, c));
+                        s
+                    });
                     self.slot_of[i] = Some(s);
-                    self.tape.constants.push((s, c));
                 }
                 Op::Input(a) if self.live[i] => self.slot_of[i] = Some(axis_index(a)),
                 _ => {}

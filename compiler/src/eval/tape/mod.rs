@@ -8,7 +8,9 @@
 //! results to their values from before and jumps past `Leave`. Otherwise it gathers the
 //! values the block reads from outside into slots of its own, packed for the running points
 //! only, so that the block's steps run over those points alone; `Leave` scatters the
-//! results back. Blocks nest, each packing relative to the one around it.
+//! results back. Blocks nest, each packing relative to the one around it. A block that runs on
+//! most of the points around it copies its values whole instead and runs on all of them,
+//! `Leave` keeping its results where it runs (the evaluator's `DENSE`).
 
 use super::fuse::{Finish, Kind};
 use crate::program::mesh::TriMesh;
@@ -115,56 +117,68 @@ pub struct Tape {
 
 impl Tape {
     /// The meshes its steps read, by id.
+    #[inline]
     pub(super) fn meshes(&self) -> &[Option<std::sync::Arc<TriMesh>>] {
         &self.meshes
     }
 
     /// Number of instructions run per point (when every guarded block runs).
+    #[inline]
     pub fn len(&self) -> usize {
         self.instructions
     }
 
     /// True when the tape runs no instruction (the result is a constant or an input).
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.instructions == 0
     }
 
     /// Number of scratch slots (of one chunk each) an evaluator needs (inputs not counted).
+    #[inline]
     pub fn slot_count(&self) -> usize {
         self.slots
     }
 
     /// The deepest nesting of guarded blocks.
+    #[inline]
     pub fn depth(&self) -> usize {
         self.depth
     }
 
+    #[inline]
     pub(super) fn outlines(&self) -> &[Arc<Outline>] {
         &self.outlines
     }
 
+    #[inline]
     pub(super) fn steps(&self) -> &[Step] {
         &self.steps
     }
 
+    #[inline]
     pub(super) fn guard(&self, g: u32) -> &Guard {
         &self.guards[g as usize]
     }
 
+    #[inline]
     pub(super) fn constants(&self) -> &[(u32, f64)] {
         &self.constants
     }
 
+    #[inline]
     pub(super) fn distance_slot(&self) -> u32 {
         self.distance
     }
 
+    #[inline]
     pub(super) fn material_slot(&self) -> Option<u32> {
         self.material
     }
 
     /// Whether the last step computes the distance at the top level, and so can write it
     /// straight into the caller's output instead of its slot.
+    #[inline]
     pub(super) fn direct(&self) -> bool {
         self.direct
     }

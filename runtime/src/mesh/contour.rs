@@ -18,7 +18,7 @@ use super::place::{
 };
 use super::table::{corner, patches, EDGES};
 use super::thin;
-use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
+use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats, KEY_BITS};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -183,7 +183,11 @@ fn closure(
         if closure.held > max_cells {
             return Err(Stop::Cells(closure.held));
         }
-        closure.evaluate(field, grid, &pending);
+        if first {
+            closure.evaluate_first(field, grid, &pending);
+        } else {
+            closure.evaluate(field, grid, &pending);
+        }
         if first {
             // Walls and gaps between the candidates' corners that no corner sees.
             stats.thin = thin::missed(field, grid, &closure.values, &pending);
@@ -199,6 +203,18 @@ fn closure(
 }
 
 impl Closure {
+    /// The values at the corners of `candidates` (sorted keys), when none has been asked
+    /// for yet: the corners found as one sorted list ([`corners`]), not cell by cell.
+    fn evaluate_first(&mut self, field: &Field, grid: &Grid, candidates: &[u64]) {
+        let keys = corners(candidates);
+        let points: Vec<[f64; 3]> = keys.par_iter().map(|&k| grid.point(unpack(k))).collect();
+        let d = field.distances(&points);
+        drop(points);
+        for (&k, v) in keys.iter().zip(d) {
+            self.values.set(unpack(k), v);
+        }
+    }
+
     /// The values at the corners of `pending` not asked for yet.
     fn evaluate(&mut self, field: &Field, grid: &Grid, pending: &[u64]) {
         let mut need: Vec<[u32; 3]> = Vec::new();
@@ -224,22 +240,34 @@ impl Closure {
     /// The surface cells of `pending` kept; returns the cells around their crossed edges
     /// not held yet, now held.
     fn cross(&mut self, pending: &[u64]) -> Vec<u64> {
-        let mut missing = Vec::new();
-        let configs: Vec<u8> = pending
+        // The surface cells, and whether any cell around a crossed edge of each was not held
+        // before (read in parallel; only those cells are visited again below, in order).
+        let set = &self.set;
+        let found: Vec<(u64, u8, bool)> = pending
             .par_iter()
-            .map(|&c| configuration(&self.values, c))
+            .filter_map(|&c| {
+                let config = configuration(&self.values, c);
+                if config == 0 || config == 255 {
+                    return None;
+                }
+                let i = unpack(c);
+                let lacks = crossed(config).any(|e| {
+                    let lower = add(i, corner(EDGES[e].0));
+                    edge_cells(lower, e / 4).any(|n| !set.get(n))
+                });
+                Some((c, config, lacks))
+            })
             .collect();
-        for (&c, &config) in pending.iter().zip(&configs) {
-            if config == 0 || config == 255 {
+        let mut missing = Vec::new();
+        self.surface.reserve(found.len());
+        for &(c, config, lacks) in &found {
+            self.surface.push((c, config));
+            if !lacks {
                 continue;
             }
-            self.surface.push((c, config));
             let i = unpack(c);
-            for (e, &(a, b)) in EDGES.iter().enumerate() {
-                if (config >> a & 1) == (config >> b & 1) {
-                    continue;
-                }
-                let lower = add(i, corner(a));
+            for e in crossed(config) {
+                let lower = add(i, corner(EDGES[e].0));
                 for n in edge_cells(lower, e / 4) {
                     if self.set.replace_if(n, |held| !held, true).is_some() {
                         self.held += 1;
@@ -250,6 +278,37 @@ impl Closure {
         }
         missing
     }
+}
+
+/// The corners of `cells` (sorted keys), sorted, each once: the cells grown by one point
+/// along x, then y, then z, each a merge of two sorted lists (a key plus one along an axis
+/// keeps its order: no index reaches the next axis's bits, see [`super::AXIS_CELLS`]).
+fn corners(cells: &[u64]) -> Vec<u64> {
+    let mut keys = grown(cells, 1);
+    for axis in 1..3 {
+        keys = grown(&keys, 1 << (axis * KEY_BITS));
+    }
+    keys
+}
+
+/// The union of the sorted keys `a` and `a + step`, sorted, each once.
+fn grown(a: &[u64], step: u64) -> Vec<u64> {
+    let mut out = Vec::with_capacity(2 * a.len());
+    let (mut i, mut j) = (0, 0);
+    while j < a.len() {
+        let shifted = a[j] + step;
+        if i < a.len() && a[i] <= shifted {
+            if a[i] == shifted {
+                j += 1;
+            }
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(shifted);
+            j += 1;
+        }
+    }
+    out
 }
 
 /// The crossed edges each surface cell owns (those from its lower corner): for each cell, its
@@ -430,6 +489,15 @@ fn configuration(values: &Bricks<f64>, c: u64) -> u8 {
         }
     }
     config
+}
+
+/// The edges of a cell of configuration `config` that the surface crosses (their ends'
+/// signs differ).
+fn crossed(config: u8) -> impl Iterator<Item = usize> {
+    (0..12).filter(move |&e| {
+        let (a, b) = EDGES[e];
+        (config >> a & 1) != (config >> b & 1)
+    })
 }
 
 /// The four cells around the grid edge from `lower` along `axis` (those inside the grid's
@@ -640,4 +708,34 @@ fn flip(
         flips += 1;
     }
     flips
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The corners found as one sorted list are those found cell by cell.
+    #[test]
+    fn corners_are_each_cells_eight_corners_once() {
+        let mut cells: Vec<u64> = Vec::new();
+        for z in 0..7u32 {
+            for y in 0..6u32 {
+                for x in 0..9u32 {
+                    if (x * 7 + y * 3 + z * 5) % 4 != 1 || (x + y + z) % 3 == 0 {
+                        cells.push(pack([x, y, z]));
+                    }
+                }
+            }
+        }
+        cells.push(pack([super::super::AXIS_CELLS - 1, 3, 2]));
+        cells.sort_unstable();
+        let mut expected: Vec<u64> = cells
+            .iter()
+            .flat_map(|&c| (0..8).map(move |k| pack(add(unpack(c), corner(k)))))
+            .collect();
+        expected.sort_unstable();
+        expected.dedup();
+        assert_eq!(corners(&cells), expected);
+        assert!(corners(&[]).is_empty());
+    }
 }

@@ -251,10 +251,17 @@ impl Closure {
                     return None;
                 }
                 let i = unpack(c);
-                let lacks = crossed(config).any(|e| {
-                    let lower = add(i, corner(EDGES[e].0));
-                    edge_cells(lower, e / 4).any(|n| !set.get(n))
-                });
+                let mut around = around_crossed(config);
+                let mut lacks = false;
+                while around != 0 && !lacks {
+                    let o = around.trailing_zeros();
+                    around &= around - 1;
+                    let d = [o % 3, o / 3 % 3, o / 9];
+                    // Offsets of -1 below the grid's first cell name no cell.
+                    if (0..3).all(|a| i[a] + d[a] >= 1) {
+                        lacks = !set.get([0, 1, 2].map(|a| i[a] + d[a] - 1));
+                    }
+                }
                 Some((c, config, lacks))
             })
             .collect();
@@ -284,7 +291,14 @@ impl Closure {
 /// along x, then y, then z, each a merge of two sorted lists (a key plus one along an axis
 /// keeps its order: no index reaches the next axis's bits, see [`super::AXIS_CELLS`]).
 fn corners(cells: &[u64]) -> Vec<u64> {
-    let mut keys = grown(cells, 1);
+    // Along x in one pass: each key, and the next point where it is not the next key.
+    let mut keys = Vec::with_capacity(2 * cells.len());
+    for (k, &c) in cells.iter().enumerate() {
+        keys.push(c);
+        if cells.get(k + 1) != Some(&(c + 1)) {
+            keys.push(c + 1);
+        }
+    }
     for axis in 1..3 {
         keys = grown(&keys, 1 << (axis * KEY_BITS));
     }
@@ -500,6 +514,29 @@ fn crossed(config: u8) -> impl Iterator<Item = usize> {
     })
 }
 
+/// The cells around the crossed edges of a cell of configuration `config`, other than the
+/// cell itself, as bits of its 3×3×3 neighbourhood (bit `dx + 3·dy + 9·dz` for the offset
+/// `(dx, dy, dz) − 1`): the cells [`edge_cells`] gives for each crossed edge, each once.
+fn around_crossed(config: u8) -> u32 {
+    let mut bits = 0u32;
+    for e in crossed(config) {
+        let lower = corner(EDGES[e].0);
+        let axis = e / 4;
+        for k in 0..4u32 {
+            let mut d = lower.map(|x| x + 1);
+            let (u, v) = match axis {
+                0 => (1, 2),
+                1 => (0, 2),
+                _ => (0, 1),
+            };
+            d[u] -= k & 1;
+            d[v] -= k >> 1 & 1;
+            bits |= 1 << (d[0] + 3 * d[1] + 9 * d[2]);
+        }
+    }
+    bits & !(1 << 13)
+}
+
 /// The four cells around the grid edge from `lower` along `axis` (those inside the grid's
 /// index range).
 fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = [u32; 3]> {
@@ -519,6 +556,51 @@ fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = [u32; 3]> {
     })
 }
 
+/// Edges updated by one task of [`roots`].
+const ROOT_TASK: usize = 1 << 12;
+
+/// An edge's root being found: its lower end, axis, bracket (t, f) on each side, which side
+/// moved last, and the next point to evaluate.
+struct Root {
+    p: [f64; 3],
+    axis: usize,
+    lo: (f64, f64),
+    hi: (f64, f64),
+    side: i8,
+    t: f64,
+}
+
+/// One round of [`roots`] for an edge whose field at its point `r.t` is `f`: nothing where
+/// `f` is within `tolerance` (or not finite); else the bracket narrowed (Illinois) and the
+/// next point, regula falsi's or, when `bisect` (or where that falls outside the bracket),
+/// the bracket's middle. Whether the edge goes on.
+fn step(r: &mut Root, f: f64, tolerance: f64, bisect: bool) -> bool {
+    if !f.is_finite() || f.abs() <= tolerance {
+        return false;
+    }
+    if (f < 0.0) == (r.lo.1 < 0.0) {
+        r.lo = (r.t, f);
+        if r.side == -1 {
+            r.hi.1 /= 2.0;
+        }
+        r.side = -1;
+    } else {
+        r.hi = (r.t, f);
+        if r.side == 1 {
+            r.lo.1 /= 2.0;
+        }
+        r.side = 1;
+    }
+    let (a, b) = (r.lo, r.hi);
+    let t = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
+    r.t = if !bisect && t.is_finite() && t > a.0.min(b.0) && t < a.0.max(b.0) {
+        t
+    } else {
+        0.5 * (a.0 + b.0)
+    };
+    (b.0 - a.0).abs() > 1e-12
+}
+
 /// The surface point on each edge: regula falsi (Illinois) from the corner values,
 /// `iterations` rounds, kept [`MARGIN`] inside the edge.
 fn roots(
@@ -528,15 +610,6 @@ fn roots(
     edges: &[u64],
     iterations: u32,
 ) -> Vec<[f64; 3]> {
-    // Per edge: its lower end, axis, bracket (t, f) on each side, and which side moved last.
-    struct Root {
-        p: [f64; 3],
-        axis: usize,
-        lo: (f64, f64),
-        hi: (f64, f64),
-        side: i8,
-        t: f64,
-    }
     let mut state: Vec<Root> = edges
         .par_iter()
         .map(|&e| {
@@ -578,45 +651,40 @@ fn roots(
         if active.is_empty() {
             break;
         }
-        let pts: Vec<[f64; 3]> = active.iter().map(|&k| at(&state[k], state[k].t)).collect();
+        let pts: Vec<[f64; 3]> = active
+            .par_iter()
+            .map(|&k| at(&state[k], state[k].t))
+            .collect();
         let d = field.distances(&pts);
         let tolerance = if round + 1 < iterations {
             1e-12 * grid.voxel.max(1e-300)
         } else {
             0.25 * ON_SURFACE * grid.voxel
         };
-        let mut next = Vec::with_capacity(active.len());
-        for (&k, &f) in active.iter().zip(&d) {
-            let r = &mut state[k];
-            if !f.is_finite() || f.abs() <= tolerance {
-                continue;
-            }
-            if (f < 0.0) == (r.lo.1 < 0.0) {
-                r.lo = (r.t, f);
-                if r.side == -1 {
-                    r.hi.1 /= 2.0;
-                }
-                r.side = -1;
-            } else {
-                r.hi = (r.t, f);
-                if r.side == 1 {
-                    r.lo.1 /= 2.0;
-                }
-                r.side = 1;
-            }
-            let (a, b) = (r.lo, r.hi);
-            let t = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
-            r.t = if round + 1 < iterations && t.is_finite() && t > a.0.min(b.0) && t < a.0.max(b.0)
-            {
-                t
-            } else {
-                0.5 * (a.0 + b.0)
-            };
-            if (b.0 - a.0).abs() > 1e-12 {
-                next.push(k);
-            }
+        let bisect = round + 1 >= iterations;
+        // The active edges in runs of [`ROOT_TASK`], each with the part of `state` its
+        // edges lie in (`active` is increasing), updated in parallel.
+        let mut parts = Vec::with_capacity(active.len().div_ceil(ROOT_TASK));
+        let (mut rest, mut base) = (&mut state[..], 0);
+        for (ks, ds) in active.chunks(ROOT_TASK).zip(d.chunks(ROOT_TASK)) {
+            let end = ks[ks.len() - 1] + 1;
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(end - base);
+            parts.push((part, base, ks, ds));
+            (rest, base) = (tail, end);
         }
-        active = next;
+        let next: Vec<Vec<usize>> = parts
+            .into_par_iter()
+            .map(|(part, base, ks, ds)| {
+                let mut next = Vec::with_capacity(ks.len());
+                for (&k, &f) in ks.iter().zip(ds) {
+                    if step(&mut part[k - base], f, tolerance, bisect) {
+                        next.push(k);
+                    }
+                }
+                next
+            })
+            .collect();
+        active = next.concat();
     }
     state
         .iter()
@@ -736,6 +804,25 @@ mod tests {
         expected.sort_unstable();
         expected.dedup();
         assert_eq!(corners(&cells), expected);
+        // The neighbourhood of each configuration holds the cells around its crossed edges.
+        let i = [5u32, 5, 5];
+        for config in 0..=255u8 {
+            let mut cells: Vec<[u32; 3]> = crossed(config)
+                .flat_map(|e| edge_cells(add(i, corner(EDGES[e].0)), e / 4))
+                .filter(|&n| n != i)
+                .collect();
+            cells.sort_unstable();
+            cells.dedup();
+            let mut bits = around_crossed(config);
+            let mut from_bits = Vec::new();
+            while bits != 0 {
+                let o = bits.trailing_zeros();
+                bits &= bits - 1;
+                from_bits.push([o % 3 + 4, o / 3 % 3 + 4, o / 9 + 4]);
+            }
+            from_bits.sort_unstable();
+            assert_eq!(from_bits, cells, "{config}");
+        }
         assert!(corners(&[]).is_empty());
     }
 }

@@ -12,13 +12,13 @@
 //! inner vertex off the face its other two vertices lie on, so none has zero area; and a
 //! flip replaces two triangles by two that share a new edge, which is made only once.
 
+use super::closure::{add, closure, Closure};
 use super::place::{
     choose, inside_cell, normalise, onto_surface, place, separate, Patches, Placed, GRADIENT_STEP,
     MARGIN, ON_SURFACE,
 };
 use super::table::{corner, patches, EDGES};
-use super::thin;
-use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
+use super::{unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -84,9 +84,12 @@ pub fn contour(
         values,
         mut surface,
         ..
-    } = closure(field, grid, candidates, max_cells, &mut stats)?;
+    } = closure(field, grid, candidates, max_cells, &mut stats).map_err(Stop::Cells)?;
     progress(0.2);
-    surface.par_sort_unstable();
+    // Found in the candidates' order, sorted unless cells were added.
+    if !surface.is_sorted() {
+        surface.par_sort_unstable();
+    }
     stats.surface_cells = surface.len() as u64;
     surface_cells(stats.surface_cells).map_err(Stop::Refused)?;
 
@@ -142,114 +145,6 @@ pub fn contour(
         },
         stats,
     ))
-}
-
-/// The cells contouring holds while it closes over the crossed edges: their corner values,
-/// which of them are held, how many, and those the surface crosses.
-struct Closure {
-    /// Corner values. A point whose value was asked for holds -∞ until it comes (the field
-    /// never gives -∞: see `Field`).
-    values: Bricks<f64>,
-    /// Whether a cell is held.
-    set: Bricks<bool>,
-    /// The cells held.
-    held: u64,
-    /// The surface cells and their configurations, in the order found.
-    surface: Vec<(u64, u8)>,
-}
-
-/// The corner values of `candidates` and the closure (each crossed edge's four cells), and
-/// the surface cells among them; `Stop::Cells` once more than `max_cells` are held.
-fn closure(
-    field: &Field,
-    grid: &Grid,
-    candidates: Vec<u64>,
-    max_cells: u64,
-    stats: &mut Stats,
-) -> Result<Closure, Stop> {
-    let held = candidates.len() as u64;
-    let mut closure = Closure {
-        values: Bricks::over(f64::NAN, grid, held),
-        set: Bricks::over(false, grid, held),
-        held,
-        surface: Vec::new(),
-    };
-    for &c in &candidates {
-        closure.set.set(unpack(c), true);
-    }
-    let mut pending = candidates;
-    let mut first = true;
-    while !pending.is_empty() {
-        if closure.held > max_cells {
-            return Err(Stop::Cells(closure.held));
-        }
-        closure.evaluate(field, grid, &pending);
-        if first {
-            // Walls and gaps between the candidates' corners that no corner sees.
-            stats.thin = thin::missed(field, grid, &closure.values, &pending);
-        }
-        let missing = closure.cross(&pending);
-        if !first {
-            stats.added += pending.len() as u64;
-        }
-        first = false;
-        pending = missing;
-    }
-    Ok(closure)
-}
-
-impl Closure {
-    /// The values at the corners of `pending` not asked for yet.
-    fn evaluate(&mut self, field: &Field, grid: &Grid, pending: &[u64]) {
-        let mut need: Vec<[u32; 3]> = Vec::new();
-        let mut places = Vec::new();
-        for &c in pending {
-            let i = unpack(c);
-            for k in 0..8 {
-                let p = add(i, corner(k));
-                if let Some(at) = self.values.replace_if(p, f64::is_nan, f64::NEG_INFINITY) {
-                    need.push(p);
-                    places.push(at);
-                }
-            }
-        }
-        let points: Vec<[f64; 3]> = need.par_iter().map(|&i| grid.point(i)).collect();
-        drop(need);
-        let d = field.distances(&points);
-        for (at, v) in places.into_iter().zip(d) {
-            self.values.put(at, v);
-        }
-    }
-
-    /// The surface cells of `pending` kept; returns the cells around their crossed edges
-    /// not held yet, now held.
-    fn cross(&mut self, pending: &[u64]) -> Vec<u64> {
-        let mut missing = Vec::new();
-        let configs: Vec<u8> = pending
-            .par_iter()
-            .map(|&c| configuration(&self.values, c))
-            .collect();
-        for (&c, &config) in pending.iter().zip(&configs) {
-            if config == 0 || config == 255 {
-                continue;
-            }
-            self.surface.push((c, config));
-            let i = unpack(c);
-            for (e, &(a, b)) in EDGES.iter().enumerate() {
-                if (config >> a & 1) == (config >> b & 1) {
-                    continue;
-                }
-                let lower = add(i, corner(a));
-                for n in edge_cells(lower, e / 4) {
-                    if self.set.replace_if(n, |held| !held, true).is_some() {
-                        self.held += 1;
-                        missing.push(pack(n));
-                    }
-                }
-            }
-        }
-        missing
-    }
 }
 
 /// The crossed edges each surface cell owns (those from its lower corner): for each cell, its
@@ -417,38 +312,49 @@ fn onto_zero(
     }
 }
 
-fn add(a: [u32; 3], b: [u32; 3]) -> [u32; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+/// Edges updated by one task of [`roots`].
+const ROOT_TASK: usize = 1 << 12;
+
+/// An edge's root being found: its lower end, axis, bracket (t, f) on each side, which side
+/// moved last, and the next point to evaluate.
+struct Root {
+    p: [f64; 3],
+    axis: usize,
+    lo: (f64, f64),
+    hi: (f64, f64),
+    side: i8,
+    t: f64,
 }
 
-/// Which corners of cell `c` are inside (bit set: negative distance).
-fn configuration(values: &Bricks<f64>, c: u64) -> u8 {
-    let mut config = 0u8;
-    for (k, d) in values.cube(unpack(c)).into_iter().enumerate() {
-        if d < 0.0 {
-            config |= 1 << k;
-        }
+/// One round of [`roots`] for an edge whose field at its point `r.t` is `f`: nothing where
+/// `f` is within `tolerance` (or not finite); else the bracket narrowed (Illinois) and the
+/// next point, regula falsi's or, when `bisect` (or where that falls outside the bracket),
+/// the bracket's middle. Whether the edge goes on.
+fn step(r: &mut Root, f: f64, tolerance: f64, bisect: bool) -> bool {
+    if !f.is_finite() || f.abs() <= tolerance {
+        return false;
     }
-    config
-}
-
-/// The four cells around the grid edge from `lower` along `axis` (those inside the grid's
-/// index range).
-fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = [u32; 3]> {
-    let (u, v) = match axis {
-        0 => (1, 2),
-        1 => (0, 2),
-        _ => (0, 1),
-    };
-    (0..4u32).filter_map(move |k| {
-        let mut c = lower;
-        for (bit, a) in [(k & 1, u), (k >> 1 & 1, v)] {
-            if bit == 1 {
-                c[a] = c[a].checked_sub(1)?;
-            }
+    if (f < 0.0) == (r.lo.1 < 0.0) {
+        r.lo = (r.t, f);
+        if r.side == -1 {
+            r.hi.1 /= 2.0;
         }
-        Some(c)
-    })
+        r.side = -1;
+    } else {
+        r.hi = (r.t, f);
+        if r.side == 1 {
+            r.lo.1 /= 2.0;
+        }
+        r.side = 1;
+    }
+    let (a, b) = (r.lo, r.hi);
+    let t = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
+    r.t = if !bisect && t.is_finite() && t > a.0.min(b.0) && t < a.0.max(b.0) {
+        t
+    } else {
+        0.5 * (a.0 + b.0)
+    };
+    (b.0 - a.0).abs() > 1e-12
 }
 
 /// The surface point on each edge: regula falsi (Illinois) from the corner values,
@@ -460,15 +366,6 @@ fn roots(
     edges: &[u64],
     iterations: u32,
 ) -> Vec<[f64; 3]> {
-    // Per edge: its lower end, axis, bracket (t, f) on each side, and which side moved last.
-    struct Root {
-        p: [f64; 3],
-        axis: usize,
-        lo: (f64, f64),
-        hi: (f64, f64),
-        side: i8,
-        t: f64,
-    }
     let mut state: Vec<Root> = edges
         .par_iter()
         .map(|&e| {
@@ -510,45 +407,40 @@ fn roots(
         if active.is_empty() {
             break;
         }
-        let pts: Vec<[f64; 3]> = active.iter().map(|&k| at(&state[k], state[k].t)).collect();
+        let pts: Vec<[f64; 3]> = active
+            .par_iter()
+            .map(|&k| at(&state[k], state[k].t))
+            .collect();
         let d = field.distances(&pts);
         let tolerance = if round + 1 < iterations {
             1e-12 * grid.voxel.max(1e-300)
         } else {
             0.25 * ON_SURFACE * grid.voxel
         };
-        let mut next = Vec::with_capacity(active.len());
-        for (&k, &f) in active.iter().zip(&d) {
-            let r = &mut state[k];
-            if !f.is_finite() || f.abs() <= tolerance {
-                continue;
-            }
-            if (f < 0.0) == (r.lo.1 < 0.0) {
-                r.lo = (r.t, f);
-                if r.side == -1 {
-                    r.hi.1 /= 2.0;
-                }
-                r.side = -1;
-            } else {
-                r.hi = (r.t, f);
-                if r.side == 1 {
-                    r.lo.1 /= 2.0;
-                }
-                r.side = 1;
-            }
-            let (a, b) = (r.lo, r.hi);
-            let t = a.0 - a.1 * (b.0 - a.0) / (b.1 - a.1);
-            r.t = if round + 1 < iterations && t.is_finite() && t > a.0.min(b.0) && t < a.0.max(b.0)
-            {
-                t
-            } else {
-                0.5 * (a.0 + b.0)
-            };
-            if (b.0 - a.0).abs() > 1e-12 {
-                next.push(k);
-            }
+        let bisect = round + 1 >= iterations;
+        // The active edges in runs of [`ROOT_TASK`], each with the part of `state` its
+        // edges lie in (`active` is increasing), updated in parallel.
+        let mut parts = Vec::with_capacity(active.len().div_ceil(ROOT_TASK));
+        let (mut rest, mut base) = (&mut state[..], 0);
+        for (ks, ds) in active.chunks(ROOT_TASK).zip(d.chunks(ROOT_TASK)) {
+            let end = ks[ks.len() - 1] + 1;
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(end - base);
+            parts.push((part, base, ks, ds));
+            (rest, base) = (tail, end);
         }
-        active = next;
+        let next: Vec<Vec<usize>> = parts
+            .into_par_iter()
+            .map(|(part, base, ks, ds)| {
+                let mut next = Vec::with_capacity(ks.len());
+                for (&k, &f) in ks.iter().zip(ds) {
+                    if step(&mut part[k - base], f, tolerance, bisect) {
+                        next.push(k);
+                    }
+                }
+                next
+            })
+            .collect();
+        active = next.concat();
     }
     state
         .iter()

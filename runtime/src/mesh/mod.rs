@@ -6,6 +6,7 @@
 //! (`thin`); and the file formats (`write`; 3MF in `threemf`, its archive in `zip`). `docs/mesh.md` describes the method and its
 //! guarantees.
 
+mod closure;
 pub mod contour;
 pub mod device;
 pub mod octree;

@@ -16,6 +16,7 @@
 //! is bounded), in cells that the octree keeps.
 
 use super::{pack, Field, Grid};
+use rayon::prelude::*;
 
 /// Relative slack of the test, for the rounding of the distance program.
 const SLACK: f64 = 1e-6;
@@ -156,7 +157,7 @@ pub fn candidates(
         next.extend(kept().flat_map(children));
         if level + 1 == levels {
             let mut cells: Vec<u64> = next.into_iter().map(pack).collect();
-            cells.sort_unstable();
+            cells.par_sort_unstable();
             return Ok(Candidates { cells, evaluated });
         }
         frontier = next;

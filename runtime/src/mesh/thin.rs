@@ -17,6 +17,7 @@
 use super::place::unit;
 use super::{unpack, Bricks, Field, Grid};
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// The normals at a feature's two roots are at least this far apart (`cos` below its
 /// negative): 155°, walls whose faces are within 25° of parallel.
@@ -69,9 +70,8 @@ pub struct Thin {
 struct Finder<'a> {
     field: &'a Field,
     grid: &'a Grid,
-    /// Per probe: its edge's lower end (a point), axis, the probe's offset along it and
-    /// whether the ends are inside.
-    probes: Vec<([f64; 3], usize, f64, bool)>,
+    /// The probes pending.
+    probes: Vec<Probe>,
     /// Per thickness bin: features found, and a point in one of them.
     bins: Vec<(u64, [f64; 3])>,
     thinnest: f64,
@@ -89,40 +89,21 @@ pub fn missed(field: &Field, grid: &Grid, values: &Bricks<f64>, cells: &[u64]) -
         bins: vec![(0, [0.0; 3]); BINS],
         thinnest: f64::INFINITY,
     };
-    for &c in cells {
-        let i = unpack(c);
-        let cube = values.cube(i);
-        for axis in 0..3 {
-            let (a, b) = (cube[0], cube[1 << axis]);
-            if !(a.is_finite() && b.is_finite()) || (a < 0.0) != (b < 0.0) {
-                continue;
-            }
-            let (ra, rb) = (a.abs() / l, b.abs() / l);
-            if ra + rb >= h {
-                continue;
-            }
-            // Beyond the ends: a point not evaluated counts as growing.
-            let grows = |k: [u32; 3], v: f64| {
-                let w = values.get(k);
-                !w.is_finite() || w.abs() > v.abs()
-            };
-            let mut before = i;
-            let mut after = i;
-            after[axis] += 2;
-            let before_grows = match i[axis].checked_sub(1) {
-                Some(x) => {
-                    before[axis] = x;
-                    grows(before, a)
+    // The cells are scanned in parallel, a window at a time; their probes are then run in
+    // the cells' order, in batches of [`BATCH`].
+    for window in cells.chunks(SCAN) {
+        let found: Vec<Vec<Probe>> = window
+            .par_chunks(SCAN_TASK)
+            .map(|part| {
+                let mut probes = Vec::new();
+                for &c in part {
+                    probe(grid, values, l, c, &mut probes);
                 }
-                None => true,
-            };
-            if !(before_grows && grows(after, b)) {
-                continue;
-            }
-            let t = 0.5 * (h + ra - rb);
-            finder
-                .probes
-                .push((grid.point(i), axis, t.clamp(0.0, h), a < 0.0));
+                probes
+            })
+            .collect();
+        for p in found.into_iter().flatten() {
+            finder.probes.push(p);
             if finder.probes.len() == BATCH {
                 finder.run();
             }
@@ -130,6 +111,53 @@ pub fn missed(field: &Field, grid: &Grid, values: &Bricks<f64>, cells: &[u64]) -
     }
     finder.run();
     finder.result(h)
+}
+
+/// A probe: its edge's lower end (a point), axis, the probe's offset along it and whether the
+/// ends are inside.
+type Probe = ([f64; 3], usize, f64, bool);
+
+/// Cells scanned together for probes, and by one task.
+const SCAN: usize = 1 << 16;
+const SCAN_TASK: usize = 1 << 11;
+
+/// The probes of cell `c`'s three edges from its lowest corner (bound `l`): where both ends
+/// have one sign, their balls leave room for the surface, and the values beyond both ends
+/// grow away from the edge, the point where the two balls meet.
+fn probe(grid: &Grid, values: &Bricks<f64>, l: f64, c: u64, probes: &mut Vec<Probe>) {
+    let h = grid.voxel;
+    let i = unpack(c);
+    let cube = values.cube(i);
+    for axis in 0..3 {
+        let (a, b) = (cube[0], cube[1 << axis]);
+        if !(a.is_finite() && b.is_finite()) || (a < 0.0) != (b < 0.0) {
+            continue;
+        }
+        let (ra, rb) = (a.abs() / l, b.abs() / l);
+        if ra + rb >= h {
+            continue;
+        }
+        // Beyond the ends: a point not evaluated counts as growing.
+        let grows = |k: [u32; 3], v: f64| {
+            let w = values.get(k);
+            !w.is_finite() || w.abs() > v.abs()
+        };
+        let mut before = i;
+        let mut after = i;
+        after[axis] += 2;
+        let before_grows = match i[axis].checked_sub(1) {
+            Some(x) => {
+                before[axis] = x;
+                grows(before, a)
+            }
+            None => true,
+        };
+        if !(before_grows && grows(after, b)) {
+            continue;
+        }
+        let t = 0.5 * (h + ra - rb);
+        probes.push((grid.point(i), axis, t.clamp(0.0, h), a < 0.0));
+    }
 }
 
 impl Finder<'_> {

@@ -1,0 +1,314 @@
+//! The cells contouring holds (`contour`'s first step): the candidates' corner values, found
+//! as one sorted list of grid points and evaluated in one batch, and the closure over the
+//! crossed edges (each crossed edge's four cells held, their corners evaluated in turn),
+//! with the surface cells and their configurations; the walls and gaps thinner than a cell
+//! that the candidates' corners miss are looked for on the way (`thin`).
+
+use super::table::{corner, EDGES};
+use super::thin;
+use super::{pack, unpack, Bricks, Field, Grid, Stats, KEY_BITS};
+use rayon::prelude::*;
+use std::sync::OnceLock;
+
+/// The cells contouring holds while it closes over the crossed edges: their corner values,
+/// which of them are held, how many, and those the surface crosses.
+pub(super) struct Closure {
+    /// Corner values. A point whose value was asked for holds -∞ until it comes (the field
+    /// never gives -∞: see `Field`).
+    pub(super) values: Bricks<f64>,
+    /// Whether a cell is held.
+    set: Bricks<bool>,
+    /// The cells held.
+    held: u64,
+    /// The surface cells and their configurations, in the order found.
+    pub(super) surface: Vec<(u64, u8)>,
+}
+
+/// The corner values of `candidates` and the closure (each crossed edge's four cells), and
+/// the surface cells among them; `Err` with the cells held once more than `max_cells` are.
+pub(super) fn closure(
+    field: &Field,
+    grid: &Grid,
+    candidates: Vec<u64>,
+    max_cells: u64,
+    stats: &mut Stats,
+) -> Result<Closure, u64> {
+    let held = candidates.len() as u64;
+    let mut closure = Closure {
+        values: Bricks::over(f64::NAN, grid, held),
+        set: Bricks::over(false, grid, held),
+        held,
+        surface: Vec::new(),
+    };
+    for &c in &candidates {
+        closure.set.set(unpack(c), true);
+    }
+    let mut pending = candidates;
+    let mut first = true;
+    while !pending.is_empty() {
+        if closure.held > max_cells {
+            return Err(closure.held);
+        }
+        if first {
+            closure.evaluate_first(field, grid, &pending);
+        } else {
+            closure.evaluate(field, grid, &pending);
+        }
+        if first {
+            // Walls and gaps between the candidates' corners that no corner sees.
+            stats.thin = thin::missed(field, grid, &closure.values, &pending);
+        }
+        let missing = closure.cross(&pending);
+        if !first {
+            stats.added += pending.len() as u64;
+        }
+        first = false;
+        pending = missing;
+    }
+    Ok(closure)
+}
+
+impl Closure {
+    /// The values at the corners of `candidates` (sorted keys), when none has been asked
+    /// for yet: the corners found as one sorted list ([`corners`]), not cell by cell.
+    fn evaluate_first(&mut self, field: &Field, grid: &Grid, candidates: &[u64]) {
+        let keys = corners(candidates);
+        let points: Vec<[f64; 3]> = keys.par_iter().map(|&k| grid.point(unpack(k))).collect();
+        let d = field.distances(&points);
+        drop(points);
+        for (&k, v) in keys.iter().zip(d) {
+            self.values.set(unpack(k), v);
+        }
+    }
+
+    /// The values at the corners of `pending` not asked for yet.
+    fn evaluate(&mut self, field: &Field, grid: &Grid, pending: &[u64]) {
+        let mut need: Vec<[u32; 3]> = Vec::new();
+        let mut places = Vec::new();
+        for &c in pending {
+            let i = unpack(c);
+            for k in 0..8 {
+                let p = add(i, corner(k));
+                if let Some(at) = self.values.replace_if(p, f64::is_nan, f64::NEG_INFINITY) {
+                    need.push(p);
+                    places.push(at);
+                }
+            }
+        }
+        let points: Vec<[f64; 3]> = need.par_iter().map(|&i| grid.point(i)).collect();
+        drop(need);
+        let d = field.distances(&points);
+        for (at, v) in places.into_iter().zip(d) {
+            self.values.put(at, v);
+        }
+    }
+
+    /// The surface cells of `pending` kept; returns the cells around their crossed edges
+    /// not held yet, now held.
+    fn cross(&mut self, pending: &[u64]) -> Vec<u64> {
+        // The surface cells, and whether any cell around a crossed edge of each was not held
+        // before (read in parallel; only those cells are visited again below, in order).
+        let set = &self.set;
+        let found: Vec<(u64, u8, bool)> = pending
+            .par_iter()
+            .filter_map(|&c| {
+                let config = configuration(&self.values, c);
+                if config == 0 || config == 255 {
+                    return None;
+                }
+                let i = unpack(c);
+                let mut around = around_crossed(config);
+                let mut lacks = false;
+                while around != 0 && !lacks {
+                    let o = around.trailing_zeros();
+                    around &= around - 1;
+                    let d = [o % 3, o / 3 % 3, o / 9];
+                    // Offsets of -1 below the grid's first cell name no cell.
+                    if (0..3).all(|a| i[a] + d[a] >= 1) {
+                        lacks = !set.get([0, 1, 2].map(|a| i[a] + d[a] - 1));
+                    }
+                }
+                Some((c, config, lacks))
+            })
+            .collect();
+        let mut missing = Vec::new();
+        self.surface.reserve(found.len());
+        for &(c, config, lacks) in &found {
+            self.surface.push((c, config));
+            if !lacks {
+                continue;
+            }
+            let i = unpack(c);
+            for e in crossed(config) {
+                let lower = add(i, corner(EDGES[e].0));
+                for n in edge_cells(lower, e / 4) {
+                    if self.set.replace_if(n, |held| !held, true).is_some() {
+                        self.held += 1;
+                        missing.push(pack(n));
+                    }
+                }
+            }
+        }
+        missing
+    }
+}
+
+/// The corners of `cells` (sorted keys), sorted, each once: the cells grown by one point
+/// along x, then y, then z, each a merge of two sorted lists (a key plus one along an axis
+/// keeps its order: no index reaches the next axis's bits, see [`super::AXIS_CELLS`]).
+fn corners(cells: &[u64]) -> Vec<u64> {
+    // Along x in one pass: each key, and the next point where it is not the next key.
+    let mut keys = Vec::with_capacity(2 * cells.len());
+    for (k, &c) in cells.iter().enumerate() {
+        keys.push(c);
+        if cells.get(k + 1) != Some(&(c + 1)) {
+            keys.push(c + 1);
+        }
+    }
+    for axis in 1..3 {
+        keys = grown(&keys, 1 << (axis * KEY_BITS));
+    }
+    keys
+}
+
+/// The union of the sorted keys `a` and `a + step`, sorted, each once.
+fn grown(a: &[u64], step: u64) -> Vec<u64> {
+    let mut out = Vec::with_capacity(2 * a.len());
+    let (mut i, mut j) = (0, 0);
+    while j < a.len() {
+        let shifted = a[j] + step;
+        if i < a.len() && a[i] <= shifted {
+            if a[i] == shifted {
+                j += 1;
+            }
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(shifted);
+            j += 1;
+        }
+    }
+    out
+}
+
+/// `a + b`, by components.
+pub(super) fn add(a: [u32; 3], b: [u32; 3]) -> [u32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Which corners of cell `c` are inside (bit set: negative distance).
+fn configuration(values: &Bricks<f64>, c: u64) -> u8 {
+    let mut config = 0u8;
+    for (k, d) in values.cube(unpack(c)).into_iter().enumerate() {
+        if d < 0.0 {
+            config |= 1 << k;
+        }
+    }
+    config
+}
+
+/// The edges of a cell of configuration `config` that the surface crosses (their ends'
+/// signs differ).
+fn crossed(config: u8) -> impl Iterator<Item = usize> {
+    (0..12).filter(move |&e| {
+        let (a, b) = EDGES[e];
+        (config >> a & 1) != (config >> b & 1)
+    })
+}
+
+/// The cells around the crossed edges of a cell of configuration `config`, other than the
+/// cell itself, as bits of its 3×3×3 neighbourhood (bit `dx + 3·dy + 9·dz` for the offset
+/// `(dx, dy, dz) − 1`): the cells [`edge_cells`] gives for each crossed edge, each once.
+fn around_crossed(config: u8) -> u32 {
+    static TABLE: OnceLock<[u32; 256]> = OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|c| around(c as u8)))[config as usize]
+}
+
+/// [`around_crossed`], computed.
+fn around(config: u8) -> u32 {
+    let mut bits = 0u32;
+    for e in crossed(config) {
+        let lower = corner(EDGES[e].0);
+        let axis = e / 4;
+        for k in 0..4u32 {
+            let mut d = lower.map(|x| x + 1);
+            let (u, v) = match axis {
+                0 => (1, 2),
+                1 => (0, 2),
+                _ => (0, 1),
+            };
+            d[u] -= k & 1;
+            d[v] -= k >> 1 & 1;
+            bits |= 1 << (d[0] + 3 * d[1] + 9 * d[2]);
+        }
+    }
+    bits & !(1 << 13)
+}
+
+/// The four cells around the grid edge from `lower` along `axis` (those inside the grid's
+/// index range).
+fn edge_cells(lower: [u32; 3], axis: usize) -> impl Iterator<Item = [u32; 3]> {
+    let (u, v) = match axis {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    (0..4u32).filter_map(move |k| {
+        let mut c = lower;
+        for (bit, a) in [(k & 1, u), (k >> 1 & 1, v)] {
+            if bit == 1 {
+                c[a] = c[a].checked_sub(1)?;
+            }
+        }
+        Some(c)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The corners found as one sorted list are those found cell by cell.
+    #[test]
+    fn corners_are_each_cells_eight_corners_once() {
+        let mut cells: Vec<u64> = Vec::new();
+        for z in 0..7u32 {
+            for y in 0..6u32 {
+                for x in 0..9u32 {
+                    if (x * 7 + y * 3 + z * 5) % 4 != 1 || (x + y + z) % 3 == 0 {
+                        cells.push(pack([x, y, z]));
+                    }
+                }
+            }
+        }
+        cells.push(pack([super::super::AXIS_CELLS - 1, 3, 2]));
+        cells.sort_unstable();
+        let mut expected: Vec<u64> = cells
+            .iter()
+            .flat_map(|&c| (0..8).map(move |k| pack(add(unpack(c), corner(k)))))
+            .collect();
+        expected.sort_unstable();
+        expected.dedup();
+        assert_eq!(corners(&cells), expected);
+        // The neighbourhood of each configuration holds the cells around its crossed edges.
+        let i = [5u32, 5, 5];
+        for config in 0..=255u8 {
+            let mut cells: Vec<[u32; 3]> = crossed(config)
+                .flat_map(|e| edge_cells(add(i, corner(EDGES[e].0)), e / 4))
+                .filter(|&n| n != i)
+                .collect();
+            cells.sort_unstable();
+            cells.dedup();
+            let mut bits = around_crossed(config);
+            let mut from_bits = Vec::new();
+            while bits != 0 {
+                let o = bits.trailing_zeros();
+                bits &= bits - 1;
+                from_bits.push([o % 3 + 4, o / 3 % 3 + 4, o / 9 + 4]);
+            }
+            from_bits.sort_unstable();
+            assert_eq!(from_bits, cells, "{config}");
+        }
+        assert!(corners(&[]).is_empty());
+    }
+}

@@ -178,6 +178,8 @@ pub struct Bounds {
     /// ([`Bounds::raised`]).
     raised: Vec<Option<Bound>>,
     cost: Vec<f64>,
+    /// The plane children of each intersection that cut nothing ([`Bounds::uncut`]).
+    uncut: Vec<Vec<NodeId>>,
 }
 
 impl Bounds {
@@ -188,18 +190,25 @@ impl Bounds {
             zero: Vec::with_capacity(graph.len()),
             raised: Vec::with_capacity(graph.len()),
             cost: Vec::with_capacity(graph.len()),
+            uncut: Vec::with_capacity(graph.len()),
         };
         for id in graph.ids() {
             let node = graph.node(id);
             let b = bound(node, &|c| out.get(*c)).map(Bound::tight);
-            // Less the planes the lowering leaves out where they cut nothing.
-            let uncut = super::clip::uncut(graph, node, &|c| box_of(out.zero_set(*c)));
+            let boxes = |c: &NodeId| {
+                (out.zero_set(*c).filter(|b| b.finite() && b.scale == 1.0))
+                    .map(|b| (b.aabb.c, b.aabb.h))
+            };
+            let cuts = super::clip::intersection(graph, node, &boxes);
+            // The cost leaves out the planes that cut nothing, as the lowering does.
+            let (cut, uncut) = cuts.map_or((None, Vec::new()), |c| (c.bound, c.uncut));
             let c = own_cost(node)
                 + (node.children().iter())
                     .filter(|c| !uncut.contains(c))
                     .map(|&c| out.cost(c))
                     .sum::<f64>();
-            let raised = cut_by_planes(graph, node, &|c| out.zero_set(*c))
+            let raised = cut
+                .map(|(c, h)| Bound::of_box(h, DVec3::from(h).length()).similar(1.0, c))
                 .filter(|r| b.is_none_or(|b| r.volumes().0 < CUT_SMALLER * b.volumes().0));
             let zero = match node {
                 _ if raised.is_some() => raised,
@@ -214,6 +223,7 @@ impl Bounds {
             out.zero.push(zero);
             out.raised.push(raised);
             out.cost.push(c);
+            out.uncut.push(uncut);
         }
         out
     }
@@ -241,6 +251,12 @@ impl Bounds {
         self.of[id.0 as usize]
     }
 
+    /// The plane children of an intersection that cut nothing (`clip::Cuts::uncut`, of its
+    /// children's zero-set boxes): where only its zero set is read, the lowering drops them.
+    pub fn uncut(&self, id: NodeId) -> &[NodeId] {
+        &self.uncut[id.0 as usize]
+    }
+
     /// The estimated number of instructions a node costs per point.
     pub fn cost(&self, id: NodeId) -> f64 {
         self.cost[id.0 as usize]
@@ -249,30 +265,6 @@ impl Bounds {
 
 /// A raised bound's box must be below this share of the bound's to be kept.
 const CUT_SMALLER: f64 = 0.5;
-
-/// The box (centre and half-extents) of a finite, unscaled bound, as `clip.rs` reads it.
-pub(crate) fn box_of(b: Option<Bound>) -> Option<(V3, V3)> {
-    b.filter(|b| b.finite() && b.scale == 1.0)
-        .map(|b| (b.aabb.c, b.aabb.h))
-}
-
-/// An intersection's children's boxes (their bounds `get`) cut by its planes, as a bound,
-/// when it has planes and bounded children.
-fn cut_by_planes(
-    graph: &Graph,
-    node: &Node,
-    get: &dyn Fn(&NodeId) -> Option<Bound>,
-) -> Option<Bound> {
-    let (c, h) = super::clip::intersection(graph, node, &|c| box_of(get(c)))?;
-    Some(Bound {
-        sphere: Sphere {
-            c,
-            r: DVec3::from(h).length(),
-        },
-        aabb: Aabb { c, h },
-        scale: 1.0,
-    })
-}
 
 /// The bound of a node from its children's (`get`).
 fn bound(node: &Node, get: &dyn Fn(&NodeId) -> Option<Bound>) -> Option<Bound> {

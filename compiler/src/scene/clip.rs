@@ -1,5 +1,6 @@
-//! The box around a box cut by half-spaces: the bounds of an intersection of bounded shapes
-//! and planes (`bounds.rs`, a Voronoi cell cut from a sphere). The box is a convex polyhedron
+//! The box around a box cut by half-spaces, and the half-spaces that cut nothing of it: the
+//! bounds of an intersection of bounded shapes and planes and the planes it can do without
+//! (`bounds.rs`, a Voronoi cell cut from a sphere). The box is a convex polyhedron
 //! held as the vertex loops of its faces; each half-space clips every face (Sutherland and
 //! Hodgman's polygon clipping) and closes the cut with a face of the points on its plane, so
 //! the polyhedron stays convex and closed, and the box around its vertices holds the
@@ -8,72 +9,57 @@
 use crate::scene::{Combine, Graph, Node, NodeId, V3};
 use glam::DVec3;
 
-/// The box (centre and half-extents) around an intersection `node` of planes and bounded
-/// children, whose boxes (centre and half-extents) `boxes` gives: the children's boxes
-/// intersected, then cut by the planes' half-spaces ([`clipped`]) and grown a little for the
-/// rounding of the cut. `None` for any other node, or one without planes or bounded
-/// children.
+/// What the planes of an intersection of planes and bounded children do to the children's
+/// boxes (centre and half-extents, as `boxes` gives them), intersected.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Cuts {
+    /// The box (centre and half-extents) around what the planes' half-spaces leave of them,
+    /// grown a little for the rounding of the cut; `None` when they leave nothing.
+    pub bound: Option<(V3, V3)>,
+    /// The plane children that cut nothing: the polyhedron lies strictly inside each one's
+    /// half-space, and so does the solid. Without them the intersection has the same solid,
+    /// and its field, a maximum of fewer distance bounds, is still one (lower only away from
+    /// the solid).
+    pub uncut: Vec<NodeId>,
+}
+
+/// [`Cuts`] of an intersection `node`; `None` for any other node, or one without planes or
+/// bounded children.
 pub(crate) fn intersection(
     graph: &Graph,
     node: &Node,
     boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
-) -> Option<(V3, V3)> {
+) -> Option<Cuts> {
     let (lo, hi, planes) = parts(graph, node, boxes)?;
-    let planes: Vec<(V3, f64)> = planes.iter().map(|&(_, n, h)| (n, h)).collect();
-    let (lo, hi) = clipped(lo, hi, &planes)?;
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let units: Vec<_> = planes.iter().map(|&(_, n, h)| unit(n, h)).collect();
+    let vertices = polyhedron(lo, hi, units.iter().flatten().copied());
+    let Some((vlo, vhi)) = extent(&vertices) else {
+        return Some(Cuts {
+            bound: None,
+            uncut: Vec::new(),
+        });
+    };
+    let size = (0..3).map(|k| vhi[k] - vlo[k]).fold(0.0, f64::max);
     let g = 1e-9 * size.max(1e-9);
-    Some((
-        [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
-        [0, 1, 2].map(|k| (hi[k] - lo[k]) / 2.0 + g),
-    ))
-}
-
-/// The plane children of an intersection `node` (as [`intersection`] reads it) that cut
-/// nothing: the solid lies strictly inside each one's half-space, because the polyhedron of
-/// its bounded children's boxes cut by every plane does. Without them the intersection has
-/// the same solid, and its field, a maximum of fewer distance bounds, is still one (lower
-/// only away from the solid). Empty for any other node.
-pub(crate) fn uncut(
-    graph: &Graph,
-    node: &Node,
-    boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
-) -> Vec<NodeId> {
-    let Some((lo, hi, planes)) = parts(graph, node, boxes) else {
-        return Vec::new();
-    };
-    let mut faces = cube(DVec3::from(lo), DVec3::from(hi));
-    let unit = |n: V3, h: f64| {
-        let n = DVec3::from(n);
-        let len = n.length();
-        (len > 0.0 && h.is_finite()).then(|| (n / len, h / len))
-    };
-    for &(_, n, h) in &planes {
-        if let Some((n, h)) = unit(n, h) {
-            faces = cut(&faces, n, h);
-        }
-    }
-    let vertices: Vec<DVec3> = faces.into_iter().flatten().collect();
-    let size = vertices
+    let bound = Some((
+        [0, 1, 2].map(|k| (vlo[k] + vhi[k]) / 2.0),
+        [0, 1, 2].map(|k| (vhi[k] - vlo[k]) / 2.0 + g),
+    ));
+    let reach = vertices
         .iter()
         .map(|v| v.abs().max_element())
         .fold(DVec3::from(hi).abs().max_element(), f64::max);
     // Far enough inside that the rounding of the cut points cannot be what separates them.
-    let margin = 1e-9 * size.max(1e-9);
-    if vertices.is_empty() {
-        return Vec::new();
-    }
-    planes
-        .iter()
-        .filter(|&&(_, n, h)| {
-            unit(n, h).is_some_and(|(n, h)| vertices.iter().all(|v| n.dot(*v) - h < -margin))
-        })
-        .map(|&(id, ..)| id)
-        .collect()
+    let margin = 1e-9 * reach.max(1e-9);
+    let uncut = (planes.iter().zip(&units))
+        .filter(|(_, u)| u.is_some_and(|(n, h)| vertices.iter().all(|v| n.dot(*v) - h < -margin)))
+        .map(|(&(id, ..), _)| id)
+        .collect();
+    Some(Cuts { bound, uncut })
 }
 
 /// A plane child of an intersection: the child, its normal and its height.
-type Cut = (NodeId, V3, f64);
+type PlaneChild = (NodeId, V3, f64);
 
 /// An intersection's children's boxes intersected (low and high corners) and its planes:
 /// `None` for any other node, or one without planes or bounded children.
@@ -81,7 +67,7 @@ fn parts(
     graph: &Graph,
     node: &Node,
     boxes: &dyn Fn(&NodeId) -> Option<(V3, V3)>,
-) -> Option<(V3, V3, Vec<Cut>)> {
+) -> Option<(V3, V3, Vec<PlaneChild>)> {
     let Node::Combine {
         op: Combine::Intersect,
         children,
@@ -108,27 +94,31 @@ fn parts(
 /// The faces of a convex polyhedron, each a loop of vertices.
 type Faces = Vec<Vec<DVec3>>;
 
-/// The box (low and high corners) around the part of the box `lo..hi` where
-/// `dot(p, n) ≤ h` for every `(n, h)` of `planes`; `None` when nothing is left.
-pub(crate) fn clipped(lo: V3, hi: V3, planes: &[(V3, f64)]) -> Option<(V3, V3)> {
+/// The half-space `dot(p, n) ≤ h` with a normal of length 1; `None` for a normal of length 0
+/// or a height that is not finite (such a plane is passed over).
+fn unit(n: V3, h: f64) -> Option<(DVec3, f64)> {
+    let n = DVec3::from(n);
+    let len = n.length();
+    (len > 0.0 && h.is_finite()).then(|| (n / len, h / len))
+}
+
+/// The vertices of the box `lo..hi` cut by the half-spaces `planes` (normals of length 1);
+/// none when nothing is left.
+fn polyhedron(lo: V3, hi: V3, planes: impl Iterator<Item = (DVec3, f64)>) -> Vec<DVec3> {
     let mut faces = cube(DVec3::from(lo), DVec3::from(hi));
-    for &(n, h) in planes {
-        let n = DVec3::from(n);
-        let len = n.length();
-        if !(len > 0.0) || !h.is_finite() {
-            continue;
-        }
-        faces = cut(&faces, n / len, h / len);
+    for (n, h) in planes {
+        faces = cut(&faces, n, h);
         if faces.is_empty() {
-            return None;
+            break;
         }
     }
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for v in faces.iter().flatten() {
-        lo = lo.min(*v);
-        hi = hi.max(*v);
-    }
+    faces.into_iter().flatten().collect()
+}
+
+/// The low and high corners of the box around `vertices`; `None` for none.
+fn extent(vertices: &[DVec3]) -> Option<(V3, V3)> {
+    let lo = vertices.iter().copied().reduce(DVec3::min)?;
+    let hi = vertices.iter().copied().reduce(DVec3::max)?;
     Some((lo.to_array(), hi.to_array()))
 }
 
@@ -202,6 +192,13 @@ fn around(points: Vec<DVec3>, n: DVec3) -> Vec<DVec3> {
 mod tests {
     use super::*;
 
+    /// The box (low and high corners) around the part of the box `lo..hi` where
+    /// `dot(p, n) ≤ h` for every `(n, h)` of `planes`; `None` when nothing is left.
+    fn clipped(lo: V3, hi: V3, planes: &[(V3, f64)]) -> Option<(V3, V3)> {
+        let vertices = polyhedron(lo, hi, planes.iter().filter_map(|&(n, h)| unit(n, h)));
+        extent(&vertices)
+    }
+
     /// A cube cut by the planes of an octahedron's faces keeps the octahedron's box; a
     /// corner cut off by x + y + z ≤ −2.5 leaves the box of that corner; half-spaces that
     /// leave nothing give `None`; a plane the box lies inside changes nothing.
@@ -247,7 +244,8 @@ mod tests {
             children: vec![cube, corner, touching, far, beyond],
         };
         let boxes = |c: &NodeId| (*c == cube).then_some(([0.0; 3], [1.0; 3]));
-        assert_eq!(uncut(&graph, &node, &boxes), vec![far, beyond]);
+        let cuts = intersection(&graph, &node, &boxes).expect("an intersection");
+        assert_eq!(cuts.uncut, vec![far, beyond]);
     }
 
     /// Cells of a sphere cut by the planes halfway between seeds: every point of a cell

@@ -5,7 +5,7 @@
 pub mod analysis;
 pub mod analytic;
 pub mod bounds;
-pub(crate) mod clip;
+mod clip;
 mod cost;
 mod dump;
 pub mod field;

@@ -5,8 +5,8 @@
 use super::{Field, Lowerer, SHRINK};
 use crate::lower::Reg;
 use crate::program::builder::{Builder, P};
-use crate::scene::bounds::{box_of, Aabb, Bound, Bounds};
-use crate::scene::{clip, NodeId};
+use crate::scene::bounds::{Aabb, Bound, Bounds};
+use crate::scene::NodeId;
 use glam::DVec3;
 
 impl Lowerer<'_> {
@@ -34,17 +34,15 @@ impl Lowerer<'_> {
     }
 
     /// Where the field is read for its zero set alone, the plane children of intersection
-    /// `id` that cut nothing of its solid (`clip::uncut`), which it leaves out: the solid is
+    /// `id` that cut nothing of its solid ([`Bounds::uncut`]), which it leaves out: the solid is
     /// the same, and so are its surface's field and material.
     pub(super) fn uncut(&mut self, id: NodeId) -> Vec<NodeId> {
-        if !self.zero_set || self.b.parametric || !self.config.optimise {
-            return Vec::new();
-        }
-        let Some(bounds) = self.config.bounds else {
-            return Vec::new();
+        let uncut = match self.config.bounds {
+            Some(bounds) if self.zero_set && !self.b.parametric && self.config.optimise => {
+                bounds.uncut(id).to_vec()
+            }
+            _ => return Vec::new(),
         };
-        let boxes = |c: &NodeId| box_of(bounds.zero_set(*c));
-        let uncut = clip::uncut(self.graph, self.graph.node(id), &boxes);
         if !uncut.is_empty() {
             let text = format!(
                 "node {} intersection: {} planes that cut nothing left out",

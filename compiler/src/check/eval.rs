@@ -315,7 +315,7 @@ impl Ctx<'_> {
                         "the condition of a comprehension's `if` must be a bool",
                         cond.span,
                     )
-                    .with_label(format!("this is `{}`", type_name(&other))),
+                    .with_label(format!("this is `{}`", other.type_name())),
                 );
                 None
             }
@@ -332,10 +332,7 @@ impl Ctx<'_> {
                 failed = true;
                 self.error(
                     Diagnostic::error("E0303", "the condition of `if` must be a bool", cond.span)
-                        .with_label(format!(
-                            "this is `{}`",
-                            other.ty().map_or("?".into(), |t| t.to_string())
-                        )),
+                        .with_label(format!("this is `{}`", other.type_name())),
                 );
                 None
             }
@@ -409,9 +406,4 @@ pub(super) fn arg_span(a: &Arg) -> Span {
     a.name
         .as_ref()
         .map_or(a.value.span, |n| n.span.join(a.value.span))
-}
-
-/// The name of a value's type for messages (`?` for an error value).
-pub fn type_name(v: &Value) -> String {
-    v.ty().map_or("?".into(), |t| t.to_string())
 }

@@ -12,9 +12,7 @@ use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::device::Gpu;
 use crate::mesh::write::{Format, Up};
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats};
-use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{analysis, Limit, Limits, LowerOptions};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -109,15 +107,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             .any(|c| matches!(c, sdfc_compiler::Colour::Field(_)))
     });
     settings.materials |= format == Format::Obj && colour_fields;
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = ProgressBar::new(1000);
-        if let Ok(style) =
-            ProgressStyle::with_template("{msg:>9} {bar:40} {percent:>3}% {elapsed_precise}")
-        {
-            bar.set_style(style);
-        }
-        bar
-    });
+    let bar = super::progress_bar(1000, "{msg:>9} {bar:40} {percent:>3}% {elapsed_precise}");
     let progress = |name: &'static str, f: f64| {
         if let Some(b) = &bar {
             b.set_message(name);

@@ -55,6 +55,99 @@ pub fn render_everywhere(
     out
 }
 
+/// A scene file loaded and made small: `width`×`height`, one sample per pixel.
+#[track_caller]
+pub fn load_small(path: &std::path::Path, width: u32, height: u32) -> sdfc_compiler::Scene {
+    let mut scene = sdfc_runtime::frontend::load(path)
+        .expect("readable")
+        .scene
+        .unwrap_or_else(|| panic!("{} is a valid scene", path.display()));
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene.settings.aa = 1;
+    scene
+}
+
+/// The kernels a scene renders through on a GPU: traced (where it allows it) and marched by
+/// the specialised kernel, and marched by the interpreted one.
+pub const KERNELS: [(sdfc_compiler::Method, sdfc_compiler::wgsl::KernelChoice); 3] = [
+    (
+        sdfc_compiler::Method::Auto,
+        sdfc_compiler::wgsl::KernelChoice::Specialised,
+    ),
+    (
+        sdfc_compiler::Method::March,
+        sdfc_compiler::wgsl::KernelChoice::Specialised,
+    ),
+    (
+        sdfc_compiler::Method::March,
+        sdfc_compiler::wgsl::KernelChoice::Interpreted,
+    ),
+];
+
+/// The kernel `kernel` of `scene` for a software adapter (`software`: lavapipe, whose loops
+/// share a budget of iterations) or a GPU, as the runtime writes it (`Setup::software`).
+#[track_caller]
+pub fn kernel_for(
+    scene: &sdfc_compiler::Scene,
+    lowered: &sdfc_compiler::Lowered,
+    kernel: sdfc_compiler::wgsl::KernelChoice,
+    software: bool,
+) -> sdfc_compiler::wgsl::Kernel {
+    use sdfc_compiler::wgsl;
+    let options = wgsl::Options {
+        kernel,
+        interp_unroll: if software {
+            wgsl::interp::UNROLL_SOFTWARE
+        } else {
+            wgsl::interp::UNROLL
+        },
+        ..wgsl::Options::default()
+    };
+    wgsl::write_with(scene, lowered, &options).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// `scene` rendered by the CPU renderer with the default options.
+pub fn cpu_render(scene: &sdfc_compiler::Scene) -> sdfc_runtime::cpu::Render {
+    sdfc_runtime::cpu::render(
+        scene,
+        &sdfc_compiler::Lowered::new(scene),
+        &sdfc_runtime::cpu::Options::default(),
+        &|| {},
+    )
+}
+
+/// The words of `line`, split at white space: a command's arguments written as one line.
+pub fn words(line: &str) -> Vec<&str> {
+    line.split_whitespace().collect()
+}
+
+/// The scene of the source text `text` (the file `name`), which must check without errors.
+#[track_caller]
+pub fn checked(name: &str, text: &str) -> sdfc_compiler::Scene {
+    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
+    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
+    assert!(errors.is_empty(), "{name}: {errors:?}");
+    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
+}
+
+/// The output of `command`, run to its end, which must have succeeded: else the test fails,
+/// saying `what` and what the command printed.
+#[track_caller]
+pub fn run_ok(command: &mut std::process::Command, what: &str) -> std::process::Output {
+    let out = command
+        .output()
+        .unwrap_or_else(|e| panic!("{what}: cannot run it: {e}"));
+    assert!(
+        out.status.success(),
+        "{what}: {}\n{}{}",
+        out.status,
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn env_is(name: &str) -> bool {
     std::env::var(name).as_deref() == Ok("1")
 }

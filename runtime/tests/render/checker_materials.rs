@@ -4,16 +4,8 @@
 
 use crate::common;
 
-use common::render_everywhere;
-use sdfc_compiler::Scene;
+use common::{checked, render_everywhere};
 use sdfc_runtime::image::Image;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
 
 /// A floor of FLOOR under a lamp, with a red ball the floor may reflect.
 const TILES: &str = "
@@ -89,13 +81,7 @@ scene { plane() @ floor; }
 ";
     let one = checked("one sample", &text.replace("AA", ""));
     let many = checked("12×12 samples", &text.replace("AA", ", aa: 12"));
-    let truth = sdfc_runtime::cpu::render(
-        &many,
-        &sdfc_compiler::Lowered::new(&many),
-        &sdfc_runtime::cpu::Options::default(),
-        &|| {},
-    )
-    .image;
+    let truth = common::cpu_render(&many).image;
     let horizon = (0..one.settings.height)
         .find(|&y| truth.pixel(80, y)[0] != 0.5)
         .expect("the floor");

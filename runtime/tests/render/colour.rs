@@ -159,24 +159,11 @@ fn colour_from_the_surface_matches_the_cpu_on_wgpu() {
     };
     let normals = lit_by_its_colours(CAMERA, "field { vec3(0.5) + 0.5 * n }", "sphere(1) @ m;");
     for scene in [normals, moved()] {
-        for (method, choice) in [
-            (Method::Auto, wgsl::KernelChoice::Specialised),
-            (Method::March, wgsl::KernelChoice::Specialised),
-            (Method::March, wgsl::KernelChoice::Interpreted),
-        ] {
+        for (method, choice) in common::KERNELS {
             let mut scene = scene.clone();
             scene.settings.method = method;
             let lowered = Lowered::new(&scene);
-            let options = wgsl::Options {
-                kernel: choice,
-                interp_unroll: if gpu.is_cpu() {
-                    wgsl::interp::UNROLL_SOFTWARE
-                } else {
-                    wgsl::interp::UNROLL
-                },
-                ..wgsl::Options::default()
-            };
-            let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
+            let kernel = common::kernel_for(&scene, &lowered, choice, gpu.is_cpu());
             let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
             let on_cpu = cpu_render(&scene, method, Precision::F32);
             agree(

@@ -4,16 +4,9 @@
 
 use crate::common;
 
-use common::render_everywhere;
+use common::{checked, render_everywhere};
 use sdfc_compiler::{look, Scene, Tonemap};
 use sdfc_runtime::image::Image;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
 
 /// A white floor and a wall standing on it along x = 0 (the box spans x from 0 to 2), lit by
 /// the ambient term alone (ambient 1, no lights: a pixel is its occlusion), seen straight
@@ -201,13 +194,7 @@ scene { plane() @ floor; }
 ";
     let one = checked("one sample", &text.replace("AA", ""));
     let many = checked("12×12 samples", &text.replace("AA", ", aa: 12"));
-    let truth = sdfc_runtime::cpu::render(
-        &many,
-        &sdfc_compiler::Lowered::new(&many),
-        &sdfc_runtime::cpu::Options::default(),
-        &|| {},
-    )
-    .image;
+    let truth = common::cpu_render(&many).image;
     // The rows just below the horizon (row 50 is the horizon's neighbourhood at this tilt).
     let horizon = (0..one.settings.height)
         .find(|&y| truth.pixel(80, y)[0] != 0.5)

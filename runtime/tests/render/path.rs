@@ -5,20 +5,15 @@
 //! giving the same picture.
 
 use crate::common;
+use crate::evaluators;
 
-use common::render_everywhere;
+use common::{checked, render_everywhere};
 use sdfc_compiler::{Lowered, Method, Scene};
 use sdfc_runtime::backend::{Backend, Prepared};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::metrics;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
+use std::path::Path;
 
 /// `scene` rendered on the CPU in `precision`.
 fn cpu(scene: &Scene, precision: Precision) -> Image {
@@ -48,12 +43,7 @@ fn assembles(what: &str, scene: &Scene) {
     let text = sdfc_compiler::ptx::write(&kernel.module, &kernel.info, &options)
         .unwrap_or_else(|e| panic!("{what}: {e}"))
         .text;
-    let found = std::env::var_os("PATH").and_then(|p| {
-        std::env::split_paths(&p)
-            .map(|d| d.join("ptxas"))
-            .find(|p| p.is_file())
-    });
-    let Some(ptxas) = found else {
+    let Some(ptxas) = evaluators::ptxas() else {
         assert!(
             std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
             "SDFC_REQUIRE_DEVICES=1 but no ptxas on PATH"
@@ -63,17 +53,8 @@ fn assembles(what: &str, scene: &Scene) {
     };
     let path = std::env::temp_dir().join(format!("sdfc_path_{what}_{}.ptx", std::process::id()));
     std::fs::write(&path, &text).unwrap();
-    let out = std::process::Command::new(ptxas)
-        .args(["-arch=sm_80", "-o", "/dev/null"])
-        .arg(&path)
-        .output()
-        .expect("ptxas runs");
+    evaluators::assemble(&ptxas, &path, Path::new("/dev/null"), what);
     let _ = std::fs::remove_file(&path);
-    assert!(
-        out.status.success(),
-        "ptxas rejected {what}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 /// A sphere of the material `MAT` under a sky of radiance 1 all round, which is also the

@@ -4,15 +4,8 @@
 
 use crate::common;
 
-use common::render_everywhere;
+use common::{checked, render_everywhere};
 use sdfc_compiler::Scene;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
 
 /// A sphere of the material `MAT` under a sky of radiance 1 all round, which is also the
 /// background (so that the rays the sphere reflects see it), without occlusion.

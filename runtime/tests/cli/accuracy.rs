@@ -414,17 +414,8 @@ fn dir(name: &str) -> PathBuf {
 }
 
 fn sdfc(cwd: &Path, args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(cwd)
-        .args(args)
-        .output()
-        .expect("run sdfc");
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+    let mut command = Command::new(env!("CARGO_BIN_EXE_sdfc"));
+    run_ok(command.current_dir(cwd).args(args), &format!("{args:?}"))
 }
 
 #[test]

@@ -117,6 +117,81 @@ pub fn cpu_render(scene: &sdfc_compiler::Scene) -> sdfc_runtime::cpu::Render {
     )
 }
 
+/// `a` compared with `b` (a pixel differs where a channel is more than `threshold` apart),
+/// printed under `label`: the test fails below `min_psnr` dB or where more than
+/// `max_differing` of the pixels differ.
+#[track_caller]
+pub fn assert_agree(
+    label: &str,
+    (a, b): (&sdfc_runtime::image::Image, &sdfc_runtime::image::Image),
+    threshold: f64,
+    (min_psnr, max_differing): (f64, f64),
+) {
+    let d = sdfc_runtime::metrics::compare(a, b, threshold).expect("same size");
+    println!(
+        "{label}: psnr {:.1} dB, differing {:.4}",
+        d.psnr, d.differing
+    );
+    assert!(
+        d.psnr >= min_psnr && d.differing <= max_differing,
+        "{label}: psnr {:.1} dB, differing {:.4}",
+        d.psnr,
+        d.differing
+    );
+}
+
+/// A plane of the material `floor` (which `materials` declares) seen towards the horizon, on a
+/// grey background: the scene with one sample a pixel, the CPU's picture of it with 12×12
+/// samples a pixel, and the picture's first row of the floor (down column 80).
+pub fn floor_to_the_horizon(
+    materials: &str,
+) -> (sdfc_compiler::Scene, sdfc_runtime::image::Image, u32) {
+    let text = format!(
+        "{materials}
+camera {{ position: (0, 1, -4), look_at: (0, 0.6, 4), fov: 40deg }}
+render {{ width: 160, height: 100, max_dist: 300, background: (0.5, 0.5, 0.5) AA }}
+scene {{ plane() @ floor; }}
+"
+    );
+    let one = checked("one sample", &text.replace("AA", ""));
+    let many = checked("12×12 samples", &text.replace("AA", ", aa: 12"));
+    let truth = cpu_render(&many).image;
+    let horizon = (0..one.settings.height)
+        .find(|&y| truth.pixel(80, y)[0] != 0.5)
+        .expect("the floor");
+    (one, truth, horizon)
+}
+
+/// `scene` rendered by the CPU backend in `precision`: its image.
+pub fn cpu_image(
+    scene: &sdfc_compiler::Scene,
+    precision: sdfc_runtime::cpu::Precision,
+) -> sdfc_runtime::image::Image {
+    use sdfc_runtime::backend::{Backend, Prepared};
+    let prepared = Prepared::new(Backend::Cpu, scene, precision).expect("the CPU backend");
+    prepared
+        .render(scene, &|_| {})
+        .expect("a CPU render")
+        .render
+        .image
+}
+
+/// Fails, saying `what`, unless every channel of every pixel of `image` in its top-left
+/// `size`×`size` square is within `tolerance` of 1 (a white furnace's picture).
+#[track_caller]
+pub fn assert_white(image: &sdfc_runtime::image::Image, size: u32, tolerance: f32, what: &str) {
+    for y in 0..size {
+        for x in 0..size {
+            for v in image.pixel(x, y) {
+                assert!(
+                    (v - 1.0).abs() < tolerance,
+                    "{what}: ({x}, {y}) is {v}, not 1"
+                );
+            }
+        }
+    }
+}
+
 /// The words of `line`, split at white space: a command's arguments written as one line.
 pub fn words(line: &str) -> Vec<&str> {
     line.split_whitespace().collect()

@@ -62,17 +62,8 @@ fn traced_images_agree_with_marched_ones() {
         assert_eq!(traced.stats.counters.steps, 0, "{name}: traced with steps");
         assert!(marched.stats.counters.steps > 0);
         assert!(traced.stats.counters.hits > 0);
-        let d = metrics::compare(&traced.image, &marched.image, THRESHOLD).expect("same size");
-        println!(
-            "{name}: psnr {:.1} dB, differing {:.4}",
-            d.psnr, d.differing
-        );
-        assert!(
-            d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
-            "{name}: psnr {:.1} dB, differing {:.4}",
-            d.psnr,
-            d.differing
-        );
+        let pair = (&traced.image, &marched.image);
+        common::assert_agree(name, pair, THRESHOLD, (MIN_PSNR, MAX_DIFFERING));
     }
 }
 

@@ -136,17 +136,8 @@ fn assert_agree(
 ) {
     let on_gpu = gpu::render(gpu, scene, kernel, 1.0, &mut |_| {}).expect("gpu render");
     let on_cpu = cpu::render(scene, lowered, &cpu::Options::default(), &|| {});
-    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
-    println!(
-        "{label}: psnr {:.1} dB, differing {:.4}",
-        d.psnr, d.differing
-    );
-    assert!(
-        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
-        "{label}: psnr {:.1} dB, differing {:.4}",
-        d.psnr,
-        d.differing
-    );
+    let pair = (&on_gpu.render.image, &on_cpu.image);
+    common::assert_agree(label, pair, THRESHOLD, (MIN_PSNR, MAX_DIFFERING));
 }
 
 /// A distance program large enough that `map` and `sdf` are cut into functions

@@ -7,23 +7,12 @@
 use crate::common;
 use crate::evaluators;
 
-use common::{checked, render_everywhere};
+use common::{checked, cpu_image, render_everywhere};
 use sdfc_compiler::{Lowered, Method, Scene};
-use sdfc_runtime::backend::{Backend, Prepared};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::metrics;
 use std::path::Path;
-
-/// `scene` rendered on the CPU in `precision`.
-fn cpu(scene: &Scene, precision: Precision) -> Image {
-    let prepared = Prepared::new(Backend::Cpu, scene, precision).expect("the CPU");
-    prepared
-        .render(scene, &|_| {})
-        .expect("renders")
-        .render
-        .image
-}
 
 /// The PSNR of `a` against `b`.
 fn psnr(a: &Image, b: &Image) -> f64 {
@@ -79,7 +68,7 @@ fn furnace(mat: &str, samples: u32) -> Scene {
 /// Every image of `scene`: the backends of [`render_everywhere`] and the f64 reference.
 fn everywhere(what: &str, scene: &Scene) -> Vec<(&'static str, Image)> {
     let mut out = render_everywhere(what, scene);
-    out.push(("f64", cpu(scene, Precision::F64)));
+    out.push(("f64", cpu_image(scene, Precision::F64)));
     out
 }
 
@@ -89,7 +78,7 @@ fn sphere_pixels() -> Vec<(u32, u32)> {
         "phong { color: (0.5, 0.5, 0.5), ambient: 0, diffuse: 1, specular: 0 }",
         4,
     );
-    let image = cpu(&grey, Precision::F32);
+    let image = cpu_image(&grey, Precision::F32);
     let on: Vec<(u32, u32)> = (0..32)
         .flat_map(|y| (0..32).map(move |x| (x, y)))
         .filter(|&(x, y)| image.pixel(x, y)[0] < 0.9)
@@ -110,16 +99,7 @@ fn the_white_furnace_holds_when_path_traced() {
         4,
     );
     for (backend, image) in everywhere("white furnace", &white) {
-        for y in 0..32 {
-            for x in 0..32 {
-                for v in image.pixel(x, y) {
-                    assert!(
-                        (v - 1.0).abs() < 1e-4,
-                        "{backend}: ({x}, {y}) is {v}, not 1"
-                    );
-                }
-            }
-        }
+        common::assert_white(&image, 32, 1e-4, backend);
     }
     let metal = furnace(
         "pbr { base_color: (1, 1, 1), metallic: 1, roughness: 0.6 }",
@@ -172,12 +152,12 @@ fn noise_falls_as_one_over_the_root_of_the_samples() {
         "the ball is traced analytically"
     );
     scene.settings.samples = 1024;
-    let reference = cpu(&scene, Precision::F64);
+    let reference = cpu_image(&scene, Precision::F64);
     let mut last = None;
     let mut first = None;
     for samples in [4, 8, 16, 32, 64] {
         scene.settings.samples = samples;
-        let db = psnr(&cpu(&scene, Precision::F32), &reference);
+        let db = psnr(&cpu_image(&scene, Precision::F32), &reference);
         println!("{samples} samples: {db:.2} dB");
         if let Some(before) = last {
             let gain: f64 = db - before;
@@ -250,10 +230,10 @@ fn traced_and_marched_paths_agree() {
         .traced(Method::Auto)
         .is_some());
     scene.settings.samples = 16;
-    let traced = cpu(&scene, Precision::F32);
+    let traced = cpu_image(&scene, Precision::F32);
     scene.settings.method = Method::March;
     assert!(scene.settings.path, "still path traced");
-    let marched = cpu(&scene, Precision::F32);
+    let marched = cpu_image(&scene, Precision::F32);
     let d = metrics::compare(&traced, &marched, 0.1).expect("same size");
     println!(
         "traced against marched: {:.1} dB, {:.4} of pixels",

@@ -50,16 +50,8 @@ fn the_white_furnace_holds_for_pbr() {
             ),
         );
         for (backend, image) in render_everywhere("white furnace", &white) {
-            for y in 0..40 {
-                for x in 0..40 {
-                    for v in image.pixel(x, y) {
-                        assert!(
-                            (v - 1.0).abs() < 2e-4,
-                            "{backend}: roughness {roughness}: ({x}, {y}) is {v}"
-                        );
-                    }
-                }
-            }
+            let what = format!("{backend}: roughness {roughness}");
+            common::assert_white(&image, 40, 2e-4, &what);
         }
     }
     for (roughness, least) in [(0.0, 0.999), (0.5, 0.6), (1.0, 0.35)] {

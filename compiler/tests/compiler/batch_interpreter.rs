@@ -4,8 +4,8 @@
 
 use crate::common::*;
 use sdfc_compiler::{
-    eval_point, lower, lower_with, Combine, Evaluator, Float, LowerOptions, Node, Outputs, Program,
-    Rng, Scene, Smooth, Tape,
+    eval_point, lower, lower_with, Combine, Float, LowerOptions, Node, Outputs, Program, Rng,
+    Scene, Smooth, Tape,
 };
 
 /// A scene that uses most operations: smooth blends, repetition, twist, bend, rotation,
@@ -79,21 +79,6 @@ fn busy_scene() -> Scene {
     b.finish(root)
 }
 
-fn run<T: Float>(
-    program: &Program,
-    outputs: Outputs,
-    chunk: usize,
-    pts: &[[f64; 3]],
-) -> (Vec<T>, Vec<u32>) {
-    let tape = Tape::new(program, outputs);
-    let mut ev = Evaluator::<T>::new(&tape, chunk);
-    let c = |i: usize| pts.iter().map(|p| T::from_f64(p[i])).collect::<Vec<T>>();
-    let mut d = vec![T::zero(); pts.len()];
-    let mut m = vec![0u32; pts.len()];
-    ev.eval(&c(0), &c(1), &c(2), &mut d, Some(&mut m));
-    (d, m)
-}
-
 fn points(n: usize) -> Vec<[f64; 3]> {
     let mut rng = Rng::new(42);
     (0..n).map(|_| rng.point(4.0)).collect()
@@ -103,8 +88,8 @@ fn points(n: usize) -> Vec<[f64; 3]> {
 fn f32_agrees_with_f64() {
     let program = lower(&busy_scene());
     let pts = points(2000);
-    let (d32, m32) = run::<f32>(&program, Outputs::DistanceAndMaterial, 256, &pts);
-    let (d64, m64) = run::<f64>(&program, Outputs::DistanceAndMaterial, 256, &pts);
+    let (d32, m32) = run_batch::<f32>(&program, Outputs::DistanceAndMaterial, 256, &pts);
+    let (d64, m64) = run_batch::<f64>(&program, Outputs::DistanceAndMaterial, 256, &pts);
     let mut material_mismatch = 0;
     for i in 0..pts.len() {
         let tol = 2e-5 * (1.0 + d64[i].abs() + len3(pts[i]));
@@ -134,7 +119,7 @@ fn batch_matches_reference<T: Float>() {
 /// Asserts that a batch run of `program` at `chunk` points per pass gives the reference
 /// path's distances and materials, bit for bit.
 fn as_reference<T: Float>(program: &Program, pts: &[[f64; 3]], chunk: usize, what: &str) {
-    let (d, m) = run::<T>(program, Outputs::DistanceAndMaterial, chunk, pts);
+    let (d, m) = run_batch::<T>(program, Outputs::DistanceAndMaterial, chunk, pts);
     for (i, p) in pts.iter().enumerate() {
         let (rd, rm) = eval_point::<T>(program, p.map(T::from_f64));
         assert!(
@@ -202,8 +187,8 @@ fn distance_tape_drops_material_code() {
     let dist = Tape::new(&program, Outputs::Distance);
     assert!(dist.len() < full.len(), "{} vs {}", dist.len(), full.len());
     let pts = points(100);
-    let (a, _) = run::<f32>(&program, Outputs::Distance, 32, &pts);
-    let (b, _) = run::<f32>(&program, Outputs::DistanceAndMaterial, 32, &pts);
+    let (a, _) = run_batch::<f32>(&program, Outputs::Distance, 32, &pts);
+    let (b, _) = run_batch::<f32>(&program, Outputs::DistanceAndMaterial, 32, &pts);
     assert_eq!(a, b);
 }
 
@@ -347,7 +332,7 @@ fn same_bits<T: Float>(a: T, b: T) -> bool {
 fn fused_matches_reference<T: Float>(program: &Program, pts: &[[f64; 3]], what: &str) {
     for outputs in [Outputs::Distance, Outputs::DistanceAndMaterial] {
         for chunk in [1, 64, 256] {
-            let (d, m) = run::<T>(program, outputs, chunk, pts);
+            let (d, m) = run_batch::<T>(program, outputs, chunk, pts);
             for (i, p) in pts.iter().enumerate() {
                 let (rd, rm) = eval_point::<T>(program, p.map(T::from_f64));
                 assert!(

@@ -275,3 +275,31 @@ pub fn load(path: &std::path::Path) -> std::io::Result<Loaded> {
         sources,
     })
 }
+
+/// The `.sdf` files directly inside `dir`, sorted.
+pub fn sdf_files_in(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
+        .collect();
+    files.sort();
+    files
+}
+
+/// `program` run by the batch interpreter over `pts` in chunks of `chunk`: the distances (or
+/// what `outputs` asks for) and the materials.
+pub fn run_batch<T: sdfc_compiler::Float>(
+    program: &sdfc_compiler::Program,
+    outputs: sdfc_compiler::Outputs,
+    chunk: usize,
+    pts: &[[f64; 3]],
+) -> (Vec<T>, Vec<u32>) {
+    let tape = sdfc_compiler::Tape::new(program, outputs);
+    let mut ev = sdfc_compiler::Evaluator::<T>::new(&tape, chunk);
+    let c = |i: usize| pts.iter().map(|p| T::from_f64(p[i])).collect::<Vec<T>>();
+    let mut d = vec![T::zero(); pts.len()];
+    let mut m = vec![0u32; pts.len()];
+    ev.eval(&c(0), &c(1), &c(2), &mut d, Some(&mut m));
+    (d, m)
+}

@@ -5,19 +5,13 @@
 
 use crate::common::*;
 use sdfc_compiler::{
-    eval_point, lower, lower_with, Combine, Evaluator, Float, LowerOptions, Node, Outputs, Program,
-    Rng, Scene, Smooth, Tape,
+    eval_point, lower, lower_with, Combine, Float, LowerOptions, Node, Outputs, Program, Rng,
+    Scene, Smooth,
 };
 
 /// Distance (and material) of a program at many points, in f32 through the batch path.
 fn batch<T: Float>(program: &Program, points: &[[f64; 3]]) -> (Vec<f64>, Vec<u32>) {
-    let tape = Tape::new(program, Outputs::DistanceAndMaterial);
-    let mut ev = Evaluator::<T>::new(&tape, 64);
-    let coord = |i: usize| points.iter().map(|p| T::from_f64(p[i])).collect::<Vec<T>>();
-    let (x, y, z) = (coord(0), coord(1), coord(2));
-    let mut d = vec![T::zero(); points.len()];
-    let mut m = vec![0u32; points.len()];
-    ev.eval(&x, &y, &z, &mut d, Some(&mut m));
+    let (d, m) = run_batch::<T>(program, Outputs::DistanceAndMaterial, 64, points);
     (d.iter().map(|v| v.to_f64()).collect(), m)
 }
 

@@ -187,13 +187,7 @@ impl Options {
 
 /// The `.sdf` files directly inside `dir` (relative to this crate), sorted.
 fn sdf_files(dir: &str) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("cannot list {dir}: {e}"))
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
-        .collect();
-    files.sort();
-    files
+    common::sdf_files_in(Path::new(dir))
 }
 
 fn stem(p: &Path) -> String {

@@ -3,11 +3,12 @@
 //! Pareto front of `sdfc pareto`, and its charts (valid SVG and PNG).
 
 use crate::common;
+use crate::common::words;
 
 use common::*;
 use sdfc_compiler::{lower, Node, Settings};
 use sdfc_runtime::chart::{self, Accuracy, Chart, Panel, Point};
-use sdfc_runtime::cpu::{self, reference, Options};
+use sdfc_runtime::cpu::{self, reference};
 use sdfc_runtime::depth::{self, Depth};
 use sdfc_runtime::fp32;
 use sdfc_runtime::image::Image;
@@ -96,12 +97,7 @@ fn sphere_scene(w: u32, h: u32) -> sdfc_compiler::Scene {
 #[test]
 fn cpu_renders_carry_first_hit_depths() {
     let scene = sphere_scene(33, 33);
-    let r = cpu::render(
-        &scene,
-        &sdfc_compiler::Lowered::new(&scene),
-        &Options::default(),
-        &|| {},
-    );
+    let r = cpu_render(&scene);
     let d = r.depth.expect("the CPU renderer fills in depth");
     assert_eq!((d.width, d.height, d.samples), (33, 33, 1));
     // The centre ray meets the sphere 4 units from the eye, within the hit tolerance ε·t.
@@ -118,12 +114,7 @@ fn cpu_renders_carry_first_hit_depths() {
     // are a quarter pixel off centre, where the sphere is a little farther).
     let mut aa = scene.clone();
     aa.settings.aa = 2;
-    let r2 = cpu::render(
-        &aa,
-        &sdfc_compiler::Lowered::new(&aa),
-        &Options::default(),
-        &|| {},
-    );
+    let r2 = cpu_render(&aa);
     let d2 = r2.depth.expect("depth");
     assert_eq!(d2.samples, 4);
     assert!(d2
@@ -149,14 +140,7 @@ fn depth_buffers_are_identical_whatever_the_number_of_threads() {
             .num_threads(threads)
             .build()
             .expect("pool");
-        pool.install(|| {
-            cpu::render(
-                &scene,
-                &sdfc_compiler::Lowered::new(&scene),
-                &Options::default(),
-                &|| {},
-            )
-        })
+        pool.install(|| cpu_render(&scene))
     };
     let (a, b) = (render(1), render(3));
     let (da, db) = (a.depth.expect("depth"), b.depth.expect("depth"));
@@ -430,17 +414,8 @@ fn dir(name: &str) -> PathBuf {
 }
 
 fn sdfc(cwd: &Path, args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(cwd)
-        .args(args)
-        .output()
-        .expect("run sdfc");
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+    let mut command = Command::new(env!("CARGO_BIN_EXE_sdfc"));
+    run_ok(command.current_dir(cwd).args(args), &format!("{args:?}"))
 }
 
 #[test]
@@ -448,15 +423,7 @@ fn reference_renders_with_sidecars_compare_by_depth() {
     let d = dir("compare");
     let out = sdfc(
         &d,
-        &[
-            "render",
-            "ball.sdf",
-            "--reference",
-            "--aux",
-            "--stats",
-            "-o",
-            "ref.png",
-        ],
+        &words("render ball.sdf --reference --aux --stats -o ref.png"),
     );
     let stats = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -468,17 +435,7 @@ fn reference_renders_with_sidecars_compare_by_depth() {
     assert_eq!((reference.width, reference.height), (24, 16));
     sdfc(
         &d,
-        &[
-            "render",
-            "ball.sdf",
-            "--backend",
-            "cpu",
-            "--set",
-            "epsilon=1e-2",
-            "--aux",
-            "-o",
-            "coarse.png",
-        ],
+        &words("render ball.sdf --backend cpu --set epsilon=1e-2 --aux -o coarse.png"),
     );
     let out = sdfc(&d, &["compare", "ref.png", "coarse.png", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
@@ -595,18 +552,7 @@ fn pareto_mesh_measures_meshing_speed_against_accuracy() {
     .expect("write the part");
     let out = sdfc(
         &d,
-        &[
-            "pareto",
-            "part.sdf",
-            "--mesh",
-            "--sweep",
-            "resolution=8..32",
-            "--frames",
-            "1",
-            "--json",
-            "-o",
-            "mesh.svg",
-        ],
+        &words("pareto part.sdf --mesh --sweep resolution=8..32 --frames 1 --json -o mesh.svg"),
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     let points = v["points"].as_array().expect("points");

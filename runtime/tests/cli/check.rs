@@ -1,7 +1,8 @@
 //! `sdfc check`: diagnostics as text and JSON, imports, the intersection method it reports,
 //! `--verify-bounds`, and scenes built to exhaust the checker and the lowering within their limits.
 
-use crate::cli::{dir, entries, scene_file, sdfc, SCENE};
+use crate::cli::{dir, entries, exits, ok, scene_file, sdfc, SCENE};
+use crate::common::words;
 
 #[test]
 fn json_diagnostics_and_io_errors_go_to_stdout() {
@@ -58,9 +59,7 @@ fn a_library_imported_through_a_symbolic_link_is_read_once() {
         "import \"lib/shapes.sdf\";\nimport \"alias.sdf\";\nimport \"linked/shapes.sdf\";\nscene { sphere(r); }\n",
     )
     .expect("write");
-    let out = sdfc(&d, &["check", "main.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
+    let err = exits(&d, &["check", "main.sdf"], 0);
     assert!(!err.contains("E0207"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -116,9 +115,7 @@ fn the_method_setting_and_what_check_says_about_it() {
         err.contains("method: march (light 1 casts soft shadows"),
         "{err}"
     );
-    let out = sdfc(&d, &["render", "ball.sdf", "--set", "method=trace"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let err = exits(&d, &["render", "ball.sdf", "--set", "method=trace"], 1);
     assert!(err.contains("cannot be ray traced analytically"), "{err}");
     let out = sdfc(&d, &["render", "ball.sdf", "--set", "method=fast"]);
     assert_eq!(out.status.code(), Some(2));
@@ -175,12 +172,7 @@ fn exponential_expansion_is_a_located_limit_error_in_well_under_a_second() {
     assert!(took.as_secs_f64() < 1.0, "took {took:?}");
     // Raised, the same limit lets a smaller tree through; lowered, it stops a small one.
     std::fs::write(d.join("small.sdf"), exponential(8)).expect("write");
-    let ok = sdfc(&d, &["check", "small.sdf"]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    ok(&d, &["check", "small.sdf"]);
     let low = sdfc(&d, &["check", "small.sdf", "--limit", "expansion=100"]);
     assert_eq!(low.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&low.stderr).contains("--limit expansion="));
@@ -202,21 +194,11 @@ fn the_program_limit_stops_lowering_at_the_limit() {
     text.push_str("scene { f14(); }\n");
     let d = dir("program-limit");
     std::fs::write(d.join("big.sdf"), text).expect("write");
-    let out = sdfc(
+    let err = exits(
         &d,
-        &[
-            "compile",
-            "big.sdf",
-            "--emit",
-            "program",
-            "--limit",
-            "program=1000",
-            "-o",
-            "p.txt",
-        ],
+        &words("compile big.sdf --emit program --limit program=1000 -o p.txt"),
+        1,
     );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains("E0507")
             && err.contains("more than 1000 operations")
@@ -224,14 +206,9 @@ fn the_program_limit_stops_lowering_at_the_limit() {
         "{err}"
     );
     assert!(!d.join("p.txt").exists());
-    let out = sdfc(
+    ok(
         &d,
         &["compile", "big.sdf", "--emit", "program", "-o", "p.txt"],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
 }
 
@@ -250,16 +227,12 @@ fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
         "scene {\n  field { 2 * (length(p) - 1) };\n  field(lipschitz: 3) { 3 * (length(p) - 1) }.translate(3, 0, 0);\n}\n",
     )
     .expect("write");
-    let out = sdfc(&d, &["check", "--verify-bounds", "steep.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let err = exits(&d, &["check", "--verify-bounds", "steep.sdf"], 1);
     assert!(
         err.contains("steep.sdf:2:3: this field has a slope of") && err.contains("above its L = 1"),
         "{err}"
     );
-    let out = sdfc(&d, &["check", "--verify-bounds", "fine.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
+    let err = exits(&d, &["check", "--verify-bounds", "fine.sdf"], 0);
     assert!(
         err.contains("bounds sampled, not proven: 2 field(s), none steeper than its L"),
         "{err}"
@@ -271,9 +244,7 @@ fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
         "scene {\n  revolve(profile(lipschitz: 0.1) { length(p) - 0.5 });\n}\n",
     )
     .expect("write");
-    let out = sdfc(&d, &["check", "--verify-bounds", "flat.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let err = exits(&d, &["check", "--verify-bounds", "flat.sdf"], 1);
     assert!(
         err.contains("flat.sdf:2:11: this profile has a slope of"),
         "{err}"
@@ -292,9 +263,7 @@ fn check_verify_bounds_samples_the_scene_and_says_where() {
         "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nscene {\n  intersect(field(lipschitz: 1) { length(p) - 1 + 0.5 * max(p.x - 6, 0) }, box(9));\n}\n",
     )
     .expect("write");
-    let out = sdfc(&d, &["check", "--verify-bounds", "far.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let err = exits(&d, &["check", "--verify-bounds", "far.sdf"], 1);
     assert!(
         err.contains("far.sdf:3:13: this field has a slope of") && err.contains("above its L = 1"),
         "{err}"
@@ -312,9 +281,7 @@ fn check_verify_bounds_samples_the_scene_and_says_where() {
         "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nrender { max_dist: 50 }\nscene {\n  field { length(p) - 1 };\n  field { p.x * p.y };\n}\n",
     )
     .expect("write");
-    let out = sdfc(&d, &["check", "--verify-bounds", "open.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
+    let err = exits(&d, &["check", "--verify-bounds", "open.sdf"], 0);
     assert!(
         err.contains("open.sdf:4:3: this field: no slope above its L = 1 in 20000 pairs of points over the scene's box [(-50, -50, -55), (50, 50, 45)]"),
         "{err}"
@@ -342,13 +309,9 @@ fn ten_thousand_nested_unions_check_with_the_limit_raised() {
         ")".repeat(n)
     );
     std::fs::write(d.join("deep.sdf"), text).expect("write");
-    let out = sdfc(&d, &["check", "deep.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let err = exits(&d, &["check", "deep.sdf"], 1);
     assert!(err.contains("`--limit nesting=2000`"), "{err}");
-    let out = sdfc(&d, &["check", "deep.sdf", "--limit", "nesting=20000"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
+    let err = exits(&d, &["check", "deep.sdf", "--limit", "nesting=20000"], 0);
     assert!(err.contains("deep.sdf: ok"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -2,6 +2,7 @@
 //! problems), settings refused, limits set and named, help and completions, a closed standard
 //! output; and the helpers of the binary's modules (a test's folder, `sdfc` run in it, a scene).
 
+use crate::common::words;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -29,6 +30,27 @@ pub(crate) fn sdfc(cwd: &Path, args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("run sdfc")
+}
+
+/// `sdfc` run in `cwd` with `args`, which must exit with `code`: its standard error.
+#[track_caller]
+pub(crate) fn exits(cwd: &Path, args: &[&str], code: i32) -> String {
+    let out = sdfc(cwd, args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(code), "sdfc {args:?}: {err}");
+    err
+}
+
+/// `sdfc` run in `cwd` with `args`, which must succeed: its output.
+#[track_caller]
+pub(crate) fn ok(cwd: &Path, args: &[&str]) -> Output {
+    let out = sdfc(cwd, args);
+    assert!(
+        out.status.success(),
+        "sdfc {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
 
 pub(crate) fn scene_file(d: &Path) -> PathBuf {
@@ -85,13 +107,7 @@ fn scene_errors_exit_1_and_io_errors_exit_2() {
     assert_eq!(sdfc(&d, &["render", "broken.sdf"]).status.code(), Some(1));
     assert_eq!(sdfc(&d, &["render", "missing.sdf"]).status.code(), Some(2));
     scene_file(&d);
-    let out = sdfc(&d, &["render", "ball.sdf", "-o", "no/such/dir/x.png"]);
-    assert_eq!(
-        out.status.code(),
-        Some(2),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    exits(&d, &["render", "ball.sdf", "-o", "no/such/dir/x.png"], 2);
     assert_eq!(entries(&d), ["ball.sdf", "broken.sdf"]);
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -100,9 +116,7 @@ fn scene_errors_exit_1_and_io_errors_exit_2() {
 fn limits_are_set_by_name_and_named_when_exceeded() {
     let d = dir("limits");
     scene_file(&d);
-    let out = sdfc(&d, &["render", "ball.sdf", "--limit", "speed=3"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let err = exits(&d, &["render", "ball.sdf", "--limit", "speed=3"], 2);
     assert!(
         err.contains("unknown limit `speed`") && err.contains("fuel"),
         "{err}"
@@ -115,9 +129,7 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
     // (the loop's count, not twice the limit), and the flag raises it.
     let many = "scene { for i in 0..50 { sphere(0.1).translate(i, 0, 0); } }\n";
     std::fs::write(d.join("many.sdf"), many).expect("write");
-    let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=20"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let err = exits(&d, &["check", "many.sdf", "--limit", "objects=20"], 1);
     assert!(
         err.contains("E0507") && err.contains("--limit objects=50"),
         "{err}"
@@ -125,9 +137,7 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
     let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=50"]);
     assert!(out.status.success());
     // The render settings' limits: in the scene (E0400) and on the command line (exit 2).
-    let out = sdfc(&d, &["render", "ball.sdf", "--aa", "20"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let err = exits(&d, &["render", "ball.sdf", "--aa", "20"], 2);
     assert!(err.contains("--limit aa=20"), "{err}");
     for (set, flag) in [
         ("max_steps=2000000", "--limit max_steps=2000000"),
@@ -136,9 +146,7 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         ("samples=70000", "--limit samples=70000"),
         ("bounces=100", "--limit bounces=100"),
     ] {
-        let out = sdfc(&d, &["render", "ball.sdf", "--set", set]);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{err}");
+        let err = exits(&d, &["render", "ball.sdf", "--set", set], 2);
         assert!(err.contains(flag), "{set}: {err}");
     }
     // The path tracer's samples and bounces in the scene: located errors naming the limit
@@ -159,29 +167,15 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         );
     }
     std::fs::remove_file(d.join("path.sdf")).expect("remove");
-    let out = sdfc(
+    ok(
         &d,
         &[
             "render", "ball.sdf", "--aa", "20", "--limit", "aa=20", "--size", "4x4",
         ],
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     // The program limit, after lowering and before any output.
     for args in [
-        &[
-            "compile",
-            "ball.sdf",
-            "--emit",
-            "wgsl",
-            "--limit",
-            "program=10",
-            "-o",
-            "k.wgsl",
-        ][..],
+        &words("compile ball.sdf --emit wgsl --limit program=10 -o k.wgsl")[..],
         &["render", "ball.sdf", "--limit", "program=10", "-o", "p.png"],
     ] {
         let out = sdfc(&d, args);
@@ -195,9 +189,7 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         );
     }
     // `check` passes the scene and warns, located, that a render will refuse it (issue 37).
-    let out = sdfc(&d, &["check", "many.sdf", "--limit", "program=100"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
+    let err = exits(&d, &["check", "many.sdf", "--limit", "program=100"], 0);
     assert!(
         err.contains("[E0507] Warning")
             && err.contains("will refuse this scene")
@@ -217,16 +209,7 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
 pub(crate) fn wgpu_available(d: &Path) -> bool {
     let out = sdfc(
         d,
-        &[
-            "render",
-            "ball.sdf",
-            "--backend",
-            "wgpu",
-            "--size",
-            "8x8",
-            "-o",
-            "probe.png",
-        ],
+        &words("render ball.sdf --backend wgpu --size 8x8 -o probe.png"),
     );
     let _ = std::fs::remove_file(d.join("probe.png"));
     if out.status.success() {

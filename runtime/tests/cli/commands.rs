@@ -1,7 +1,8 @@
 //! The smaller commands: `sdfc bench`, `pareto`'s limits, `compile` (binary output, `--set`),
 //! `fmt`, and a scene's parameters (`--param`) as `check` lists them and `render` refuses them.
 
-use crate::cli::{dir, entries, png_size, scene_file, sdfc};
+use crate::cli::{dir, entries, exits, ok, png_size, scene_file, sdfc};
+use crate::common::words;
 use std::path::Path;
 use std::process::Command;
 
@@ -9,23 +10,9 @@ use std::process::Command;
 fn bench_prints_a_table_or_json() {
     let d = dir("bench");
     scene_file(&d);
-    let out = sdfc(
+    let out = ok(
         &d,
-        &[
-            "bench",
-            "ball.sdf",
-            "--backend",
-            "cpu",
-            "--size",
-            "16x12",
-            "--frames",
-            "2",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &words("bench ball.sdf --backend cpu --size 16x12 --frames 2"),
     );
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -47,28 +34,9 @@ fn bench_prints_a_table_or_json() {
     assert!(runs[0]["stats"]["steps_mean"].as_f64().is_some());
     assert!(["trace", "march"].contains(&runs[0]["method"].as_str().unwrap_or("")));
     // A path-traced scene says so (it said "march").
-    let out = sdfc(
+    let out = ok(
         &d,
-        &[
-            "bench",
-            "ball.sdf",
-            "--backend",
-            "cpu",
-            "--size",
-            "16x12",
-            "--frames",
-            "1",
-            "--set",
-            "method=path",
-            "--set",
-            "samples=1",
-            "--json",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &words("bench ball.sdf --backend cpu --size 16x12 --frames 1 --set method=path --set samples=1 --json"),
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     let method = v[0]["method"].as_str().unwrap_or("").to_string();
@@ -82,29 +50,17 @@ fn bench_prints_a_table_or_json() {
 fn pareto_sweeps_are_bounded_by_limits() {
     let d = dir("pareto-limits");
     scene_file(&d);
-    let out = sdfc(
+    let err = exits(
         &d,
-        &[
-            "pareto",
-            "ball.sdf",
-            "--sweep",
-            "epsilon=1e-2..1e-6:100",
-            "--sweep",
-            "max_steps=32..1024:100",
-            "--sweep",
-            "relaxation=1..1.8:100",
-        ],
+        &words("pareto ball.sdf --sweep epsilon=1e-2..1e-6:100 --sweep max_steps=32..1024:100 --sweep relaxation=1..1.8:100"),
+        2,
     );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
         err.contains("combinations of settings, more than 1000")
             && err.contains("--limit sweep_points="),
         "{err}"
     );
-    let out = sdfc(&d, &["pareto", "ball.sdf", "--sweep", "aa=1..2000"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let err = exits(&d, &["pareto", "ball.sdf", "--sweep", "aa=1..2000"], 2);
     assert!(err.contains("--limit sweep_values="), "{err}");
 }
 
@@ -152,12 +108,7 @@ fn compile_applies_set_before_specialising_the_kernel() {
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed1.sdf");
     let example = example.to_str().expect("utf-8 path");
     let features = |args: &[&str]| {
-        let out = sdfc(&d, args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = ok(&d, args);
         let text = String::from_utf8_lossy(&out.stdout).into_owned();
         text.lines().nth(1).expect("features line").to_string()
     };
@@ -210,13 +161,7 @@ fn fmt_rewrites_checks_and_filters() {
         messy
     );
 
-    let out = sdfc(&d, &["fmt", "a.sdf", "more"]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    exits(&d, &["fmt", "a.sdf", "more"], 0);
     for f in ["a.sdf", "more/b.sdf", "more/c.sdf"] {
         assert_eq!(
             std::fs::read_to_string(d.join(f)).expect("read"),
@@ -327,19 +272,11 @@ fn parameters_are_listed_set_and_refused_before_any_work() {
         "{json}"
     );
     // Out of range: refused at the declaration, nothing written.
-    let out = sdfc(
+    let err = exits(
         &d,
-        &[
-            "render",
-            "part.sdf",
-            "-o",
-            "part.png",
-            "--param",
-            "width=500",
-        ],
+        &words("render part.sdf -o part.png --param width=500"),
+        1,
     );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains("`--param width=500` is outside") && err.contains("part.sdf:1:7"),
         "{err}"
@@ -355,16 +292,11 @@ fn parameters_are_listed_set_and_refused_before_any_work() {
     let out = sdfc(&d, &["check", "part.sdf", "--param", "width"]);
     assert_eq!(out.status.code(), Some(2));
     // Given: the render is of the part that wide.
-    let out = sdfc(
+    ok(
         &d,
         &[
             "render", "part.sdf", "-o", "part.png", "--param", "width=80", "--size", "32x24",
         ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     assert_eq!(png_size(&d.join("part.png")), (32, 24));
 }

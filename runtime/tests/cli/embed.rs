@@ -7,6 +7,7 @@
 //! render`'s image byte for byte; `--emit scene-data|params` the bytes the renderer binds; and the
 //! Shadertoy page compiled as Shadertoy wraps it and rendered through WebGL.
 
+use crate::common::run_ok;
 use sdfc_compiler::{
     shader::{self, Lang},
     wgsl,
@@ -27,10 +28,16 @@ fn sdfc(args: &[&str]) -> Output {
         .expect("run sdfc")
 }
 
+/// `sdfc` run with `args`, which must succeed: its output.
+#[track_caller]
+fn ok(args: &[&str]) -> Output {
+    run_ok(Command::new(env!("CARGO_BIN_EXE_sdfc")).args(args), "sdfc")
+}
+
 /// `sdfc compile FILE --emit LANG --part map --name NAME`, which must succeed.
 fn part(file: &str, lang: &str, name: &str) -> String {
     let path = example(file);
-    let out = sdfc(&[
+    let out = ok(&[
         "compile",
         path.to_str().expect("utf-8 path"),
         "--emit",
@@ -40,11 +47,6 @@ fn part(file: &str, lang: &str, name: &str) -> String {
         "--name",
         name,
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     String::from_utf8(out.stdout).expect("text")
 }
 
@@ -282,8 +284,7 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
         ("params", "params.bin"),
         ("layout", "layout.json"),
     ] {
-        let o = sdfc(&["compile", file, "--emit", emit, "-o", &at(out)]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        ok(&["compile", file, "--emit", emit, "-o", &at(out)]);
     }
     let (wgsl, params, layout) = emitted(&dir);
     let bindings = layout["bindings"].as_array().expect("bindings");
@@ -333,8 +334,7 @@ fn the_kernel_runs_from_its_files_in_a_plain_wgpu_program() {
         linear: linear(&bytes),
     };
 
-    let o = sdfc(&["render", file, "--backend", "wgpu", "-o", &at("ref.png")]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ok(&["render", file, "--backend", "wgpu", "-o", &at("ref.png")]);
     let reference = sdfc_runtime::image::read_png(&dir.join("ref.png")).expect("png");
     assert_eq!((reference.width, reference.height), (width, height));
     let (a, b) = (ours.to_rgba8(), reference.to_rgba8());
@@ -565,17 +565,12 @@ void main() {
 
 /// The page of `file` wrapped the way Shadertoy wraps it.
 fn shadertoy_wrapped(file: &Path) -> String {
-    let out = sdfc(&[
+    let out = ok(&[
         "compile",
         file.to_str().expect("utf-8"),
         "--emit",
         "shadertoy",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let page = String::from_utf8(out.stdout).expect("text");
     assert!(page.contains("void mainImage(out vec4 fragColor, in vec2 fragCoord)"));
     assert!(!page.contains("#version") && !page.contains("precision "));
@@ -636,15 +631,8 @@ fn the_shadertoy_page_compiles_as_shadertoy_wraps_it() {
             shadertoy_wrapped(&example(&format!("seed{seed}.sdf"))),
         )
         .expect("write");
-        let out = Command::new(&glslang)
-            .arg(&frag)
-            .output()
-            .expect("glslangValidator");
-        assert!(
-            out.status.success(),
-            "seed{seed}: {}",
-            String::from_utf8_lossy(&out.stdout)
-        );
+        let what = format!("glslangValidator on seed{seed}");
+        run_ok(Command::new(&glslang).arg(&frag), &what);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -709,8 +697,7 @@ fn the_shadertoy_page_draws_the_glow_of_the_marching_steps() {
         let mut args = vec!["render", scene.to_str().expect("utf-8"), "--backend", "cpu"];
         args.extend(["--size", "192x128", "-o", out.to_str().expect("utf-8")]);
         args.extend(set);
-        let o = sdfc(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        ok(&args);
         sdfc_runtime::image::read_png(&out).expect("png").to_rgba8()
     };
     let (glow, none) = (png("a.png", &[]), png("b.png", &["--set", "glow=0"]));
@@ -772,7 +759,7 @@ gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
     let cpu = dir.join("cpu.png");
     let file = scene.to_str().expect("utf-8");
     let size = format!("{w}x{h}");
-    let o = sdfc(&[
+    ok(&[
         "render",
         file,
         "--backend",
@@ -782,7 +769,6 @@ gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
         "-o",
         cpu.to_str().expect("utf-8"),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let a = sdfc_runtime::image::read_png(&shot)
         .expect("screenshot")
         .to_rgba8();

@@ -2,6 +2,7 @@
 //! in a scratch crate that depends on the glam version its header names, giving the
 //! interpreter's results bit for bit.
 
+use crate::common::run_ok;
 use sdfc_compiler::{eval_point, rust, Rng};
 use std::fmt::Write;
 use std::process::Command;
@@ -14,15 +15,11 @@ fn emitted_rust_builds_in_a_scratch_crate_with_glam() {
     let scene_path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/seed1.sdf");
     let root = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("emit-rust-crate");
     std::fs::create_dir_all(root.join("src")).expect("scratch crate");
-    let emitted = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .args(["compile", scene_path, "--emit", "rust", "-o"])
-        .arg(root.join("src/scene.rs"))
-        .output()
-        .expect("run sdfc");
-    assert!(
-        emitted.status.success(),
-        "{}",
-        String::from_utf8_lossy(&emitted.stderr)
+    run_ok(
+        Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .args(["compile", scene_path, "--emit", "rust", "-o"])
+            .arg(root.join("src/scene.rs")),
+        "run sdfc",
     );
     std::fs::write(
         root.join("Cargo.toml"),
@@ -50,16 +47,12 @@ fn emitted_rust_builds_in_a_scratch_crate_with_glam() {
     main.push_str("}\n");
     std::fs::write(root.join("src/main.rs"), main).expect("main");
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let run = Command::new(cargo)
-        .current_dir(&root)
-        .args(["run", "--quiet", "--offline"])
-        .env_remove("RUSTFLAGS")
-        .output()
-        .expect("run cargo");
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    let run = run_ok(
+        Command::new(cargo)
+            .current_dir(&root)
+            .args(["run", "--quiet", "--offline"])
+            .env_remove("RUSTFLAGS"),
+        "run cargo",
     );
     let text = std::fs::read_to_string(scene_path).expect("scene");
     let (checked, diags, _) = sdfc_compiler::check_str("seed1.sdf", &text);

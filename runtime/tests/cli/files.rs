@@ -2,7 +2,8 @@
 //! `file_size` limit, outputs that cannot be written (a missing folder, a read-only file, a full
 //! device), and a byte-order mark. Failure paths: docs/failures.md lists each with its test.
 
-use crate::cli::{dir, entries, scene_file, sdfc};
+use crate::cli::{dir, entries, exits, scene_file, sdfc};
+use crate::common::words;
 use std::path::Path;
 use std::process::Command;
 
@@ -40,17 +41,7 @@ fn a_missing_or_invalid_output_directory_leaves_nothing() {
             "{target}"
         );
     }
-    let out = sdfc(
-        &d,
-        &[
-            "compile",
-            "ball.sdf",
-            "--emit",
-            "wgsl",
-            "-o",
-            "missing/k.wgsl",
-        ],
-    );
+    let out = sdfc(&d, &words("compile ball.sdf --emit wgsl -o missing/k.wgsl"));
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(entries(&d), ["ball.sdf", "plain-file"]);
 }
@@ -62,16 +53,7 @@ fn an_unwritable_output_is_refused_before_the_render() {
     // A render that would take long: refused before it is lowered or announced.
     let out = sdfc(
         &d,
-        &[
-            "render",
-            "ball.sdf",
-            "--size",
-            "4000x4000",
-            "--aa",
-            "4",
-            "-o",
-            "/nonexistent/x.png",
-        ],
+        &words("render ball.sdf --size 4000x4000 --aa 4 -o /nonexistent/x.png"),
     );
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
@@ -83,14 +65,7 @@ fn an_unwritable_output_is_refused_before_the_render() {
     // `pareto` checks its chart's place before its sweeps.
     let out = sdfc(
         &d,
-        &[
-            "pareto",
-            "ball.sdf",
-            "--frames",
-            "1",
-            "-o",
-            "missing/chart.svg",
-        ],
+        &words("pareto ball.sdf --frames 1 -o missing/chart.svg"),
     );
     assert_eq!(out.status.code(), Some(2));
     assert!(out.stdout.is_empty(), "the sweeps ran");
@@ -230,9 +205,7 @@ fn special_files_are_refused_and_files_are_read_within_the_file_size_limit() {
         format!("// {}\nscene {{\n  sphere(1);\n}}\n", "x".repeat(3 << 20)),
     )
     .expect("write");
-    let out = sdfc(&d, &["check", "--limit", "file_size=2", "big.sdf"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let err = exits(&d, &["check", "--limit", "file_size=2", "big.sdf"], 2);
     assert!(
         err.contains("over the file_size limit of 2 MiB; raise it with `--limit file_size=4`"),
         "{err}"
@@ -289,13 +262,7 @@ fn output_that_cannot_be_written_is_an_error_and_fmt_keeps_permissions() {
         eprintln!("/dev/full checks SKIPPED: there is no /dev/full");
     }
     std::fs::set_permissions(&messy, std::fs::Permissions::from_mode(0o600)).expect("chmod");
-    let out = sdfc(&d, &["fmt", "messy.sdf"]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    exits(&d, &["fmt", "messy.sdf"], 0);
     assert_eq!(
         std::fs::read_to_string(&messy).expect("read"),
         "scene {\n  sphere(1);\n}\n"
@@ -325,27 +292,9 @@ fn a_byte_order_mark_is_skipped() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(!stdout.contains("E0001"), "{stdout}");
     assert!(stdout.contains("E0201"), "the misspelt sphere: {stdout}");
-    let out = sdfc(&d, &["check", "ok.sdf"]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = sdfc(&d, &["compile", "ok.sdf", "--emit", "ir"]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = sdfc(&d, &["fmt", "ok.sdf"]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    exits(&d, &["check", "ok.sdf"], 0);
+    exits(&d, &["compile", "ok.sdf", "--emit", "ir"], 0);
+    exits(&d, &["fmt", "ok.sdf"], 0);
     assert_eq!(
         std::fs::read_to_string(d.join("ok.sdf")).expect("read"),
         "import \"lib.sdf\";\nscene {\n  ball;\n}\n"

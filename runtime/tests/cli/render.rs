@@ -2,19 +2,15 @@
 //! interrupt, the devices it renders on (no adapter or driver, a device error mid-render, the
 //! pipeline cache, a device opening beside the front end) and the breakdown of `--stats`.
 
-use crate::cli::{dir, entries, png_size, scene_file, sdfc, wgpu_available};
+use crate::cli::{dir, entries, exits, ok, png_size, scene_file, sdfc, wgpu_available};
+use crate::common::words;
 use std::process::{Command, Output};
 
 #[test]
 fn render_writes_the_default_output_in_the_current_directory() {
     let d = dir("default");
     scene_file(&d);
-    let out = sdfc(&d, &["render", "ball.sdf", "--stats"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = ok(&d, &["render", "ball.sdf", "--stats"]);
     assert_eq!(png_size(&d.join("ball.png")), (40, 30));
     assert_eq!(
         entries(&d),
@@ -33,31 +29,9 @@ fn render_writes_the_default_output_in_the_current_directory() {
 fn size_aa_set_and_output_options() {
     let d = dir("options");
     scene_file(&d);
-    let out = sdfc(
+    ok(
         &d,
-        &[
-            "render",
-            "ball.sdf",
-            "--size",
-            "24x16",
-            "--aa",
-            "2",
-            "--set",
-            "max_steps=64",
-            "--set",
-            "epsilon=1e-3",
-            "-o",
-            "x.png",
-            "--precision",
-            "f64",
-            "--threads",
-            "1",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &words("render ball.sdf --size 24x16 --aa 2 --set max_steps=64 --set epsilon=1e-3 -o x.png --precision f64 --threads 1"),
     );
     assert_eq!(png_size(&d.join("x.png")), (24, 16));
     let out = sdfc(
@@ -94,24 +68,14 @@ fn outputs_are_written_in_the_format_their_extension_names() {
     let d = dir("formats");
     scene_file(&d);
     for name in ["out.jpg", "out.JPEG"] {
-        let out = sdfc(&d, &["render", "ball.sdf", "-o", name]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        ok(&d, &["render", "ball.sdf", "-o", name]);
         let bytes = std::fs::read(d.join(name)).expect("jpeg");
         assert_eq!(&bytes[..3], &[0xFF, 0xD8, 0xFF], "{name} is not a JPEG");
         assert_eq!(&bytes[bytes.len() - 2..], &[0xFF, 0xD9]);
     }
     // OpenEXR: magic number, version 2 (single-part scanline), a header of 305 bytes, the
     // offset table and 30 rows of 40 float RGB pixels (runtime/src/output.rs).
-    let out = sdfc(&d, &["render", "ball.sdf", "-o", "out.exr"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&d, &["render", "ball.sdf", "-o", "out.exr"]);
     let exr = std::fs::read(d.join("out.exr")).expect("exr");
     assert_eq!(&exr[..8], &[0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0]);
     assert!(String::from_utf8_lossy(&exr[..100]).contains("channels\0chlist"));
@@ -125,12 +89,7 @@ fn outputs_are_written_in_the_format_their_extension_names() {
         assert!(!err.contains("allocating"), "{err}");
     }
     // `-o -`: the PNG on standard output (statistics on standard error), no file named `-`.
-    let out = sdfc(&d, &["render", "ball.sdf", "-o", "-", "--stats"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = ok(&d, &["render", "ball.sdf", "-o", "-", "--stats"]);
     assert_eq!(&out.stdout[..8], b"\x89PNG\r\n\x1a\n");
     assert_eq!(
         &out.stdout[out.stdout.len() - 8..out.stdout.len() - 4],
@@ -189,18 +148,9 @@ fn an_interrupt_stops_a_render_and_leaves_no_file() {
     scene_file(&d);
     let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&d)
-        .args([
-            "render",
-            "ball.sdf",
-            "--backend",
-            "cpu",
-            "--size",
-            "4000x3000",
-            "--aa",
-            "4",
-            "-o",
-            "big.png",
-        ])
+        .args(words(
+            "render ball.sdf --backend cpu --size 4000x3000 --aa 4 -o big.png",
+        ))
         .spawn()
         .expect("spawn");
     std::thread::sleep(std::time::Duration::from_millis(500));
@@ -228,23 +178,11 @@ fn a_render_announces_its_memory_and_stops_above_the_memory_limit() {
         err.contains("render: 40x30, aa 1, cpu: allocating at most ") && err.contains(" MiB"),
         "{err}"
     );
-    let out = sdfc(
+    let err = exits(
         &d,
-        &[
-            "render",
-            "ball.sdf",
-            "--backend",
-            "cpu",
-            "--limit",
-            "memory=1",
-            "--size",
-            "2000x2000",
-            "-o",
-            "b.png",
-        ],
+        &words("render ball.sdf --backend cpu --limit memory=1 --size 2000x2000 -o b.png"),
+        1,
     );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains("more than the memory limit of 1 MiB") && err.contains("--limit memory="),
         "{err}"
@@ -269,12 +207,7 @@ fn debug_nan_paints_nan_pixels_magenta_in_the_written_image() {
     for (flag, png) in [(None, "plain.png"), (Some("--debug-nan"), "debug.png")] {
         let mut args = vec!["render", &scene, "--backend", "cpu", "-o", png];
         args.extend(flag);
-        let out = sdfc(&d, &args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        ok(&d, &args);
     }
     assert_eq!(magenta("plain.png"), 0);
     assert!(magenta("debug.png") > 100);
@@ -290,14 +223,7 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
     // 4100x16 is three tiles of 2048 pixels: the second fails after the first rendered.
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&d)
-        .args([
-            "render",
-            "ball.sdf",
-            "--backend",
-            "wgpu",
-            "--size",
-            "4100x16",
-        ])
+        .args(words("render ball.sdf --backend wgpu --size 4100x16"))
         .args(["-o", "fault.png"])
         .env("SDFC_FAULT_AFTER_TILES", "1")
         // Mesa's window-system code complains on stderr without it.
@@ -426,26 +352,18 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
     );
     diagnostics(&both);
     scene_file(&d);
-    let usage = sdfc(
+    let err = exits(
         &d,
         &["render", "ball.sdf", "--reference", "--backend", "wgpu"],
+        2,
     );
-    let err = String::from_utf8_lossy(&usage.stderr);
-    assert_eq!(usage.status.code(), Some(2), "{err}");
     assert!(
         err.contains("--reference renders on the CPU in f64"),
         "{err}"
     );
     let kernel = sdfc(
         &d,
-        &[
-            "render",
-            "broken.sdf",
-            "--backend",
-            "cpu",
-            "--kernel",
-            "interpreted",
-        ],
+        &words("render broken.sdf --backend cpu --kernel interpreted"),
     );
     diagnostics(&kernel);
     assert_eq!(

@@ -126,15 +126,7 @@ pub fn emitted_rust(
         "the emitted Rust does not compile:\n{}",
         String::from_utf8_lossy(&compiled.stderr)
     );
-    let run = Command::new(&exe)
-        .arg(&input)
-        .output()
-        .expect("run the emitted Rust");
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let run = crate::common::run_ok(Command::new(&exe).arg(&input), "the emitted Rust");
     let text = String::from_utf8_lossy(&run.stdout);
     let mut rows = text.lines().map(|line| {
         let w: Vec<&str> = line.split(' ').collect();
@@ -168,6 +160,14 @@ pub fn ptxas() -> Option<PathBuf> {
     std::env::split_paths(&path)
         .map(|d| d.join("ptxas"))
         .find(|p| p.is_file())
+}
+
+/// The PTX file `ptx` assembled by `ptxas` for sm_80 into `cubin`, which must succeed
+/// (`what` names the PTX in the failure).
+pub fn assemble(ptxas: &Path, ptx: &Path, cubin: &Path, what: &str) {
+    let mut command = Command::new(ptxas);
+    command.args(["-arch=sm_80", "-o"]).arg(cubin).arg(ptx);
+    crate::common::run_ok(&mut command, &format!("ptxas on {what}"));
 }
 
 /// Whether the environment asks for every device of its kind: then a missing one fails.

@@ -59,11 +59,9 @@ pub fn read_stl(path: &Path) -> Read {
     }
 }
 
-/// Checks a closed, oriented 2-manifold by positions (vertices with the same f32 coordinates
-/// are one vertex): every directed edge once and its reverse once (so each undirected edge
-/// in exactly two triangles), no triangle of zero area. Returns the Euler characteristic.
-pub fn manifold(m: &Read, what: &str) -> i64 {
-    assert!(!m.triangles.is_empty(), "{what}: no triangles");
+/// Each vertex of `m` as the index of its position among the distinct positions (by their f32
+/// bits), and how many distinct positions there are.
+fn by_position(m: &Read) -> (Vec<usize>, usize) {
     let mut id: HashMap<[u32; 3], usize> = HashMap::new();
     let same: Vec<usize> = m
         .positions
@@ -73,6 +71,15 @@ pub fn manifold(m: &Read, what: &str) -> i64 {
             *id.entry(p.map(f32::to_bits)).or_insert(n)
         })
         .collect();
+    (same, id.len())
+}
+
+/// Checks a closed, oriented 2-manifold by positions (vertices with the same f32 coordinates
+/// are one vertex): every directed edge once and its reverse once (so each undirected edge
+/// in exactly two triangles), no triangle of zero area. Returns the Euler characteristic.
+pub fn manifold(m: &Read, what: &str) -> i64 {
+    assert!(!m.triangles.is_empty(), "{what}: no triangles");
+    let (same, _) = by_position(m);
     let mut directed: HashMap<(usize, usize), u32> = HashMap::new();
     for (k, t) in m.triangles.iter().enumerate() {
         let v = t.map(|i| same[i]);
@@ -134,22 +141,56 @@ pub fn write_scene(d: &Path, name: &str, body: &str) -> PathBuf {
     p
 }
 
+/// A fresh directory `test` holding the scene `file` written with `body`, and the path in it
+/// that the mesh goes to, `out`: the directory, the scene's path and the output's.
+pub fn scene_in(test: &str, file: &str, body: &str, out: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let d = dir(test);
+    let scene = write_scene(&d, file, body);
+    let out = d.join(out);
+    (d, scene, out)
+}
+
+/// Runs `sdfc` with `args` and insists that it exited with `code`: its standard error.
+#[track_caller]
+pub fn exits(args: &[&str], code: i32) -> String {
+    let out = sdfc(args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(code), "sdfc {args:?}: {err}");
+    err
+}
+
+/// The positions, the linear `COLOR_0` colours and the material's base colour of the one
+/// primitive of a `.glb`.
+pub fn glb_colours(path: &Path) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, [f32; 4]) {
+    let bytes = std::fs::read(path).expect("read glb");
+    let gltf = gltf::Gltf::from_slice(&bytes).expect("gltf reads it");
+    let blob = gltf.blob.clone();
+    let prim = gltf
+        .meshes()
+        .next()
+        .expect("a mesh")
+        .primitives()
+        .next()
+        .expect("one");
+    let reader = prim.reader(|_| blob.as_deref());
+    let positions: Vec<[f32; 3]> = reader.read_positions().expect("positions").collect();
+    let colours: Vec<[f32; 3]> = reader
+        .read_colors(0)
+        .expect("COLOR_0")
+        .into_rgb_f32()
+        .collect();
+    let base = prim.material().pbr_metallic_roughness().base_color_factor();
+    (positions, colours, base)
+}
+
 /// A path as a command-line argument.
 pub fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
 /// The connected pieces of a mesh, its vertices joined by position (f32 bits) and edges.
 pub fn components(m: &Read) -> usize {
-    let mut id: HashMap<[u32; 3], usize> = HashMap::new();
-    let same: Vec<usize> = m
-        .positions
-        .iter()
-        .map(|p| {
-            let n = id.len();
-            *id.entry(p.map(f32::to_bits)).or_insert(n)
-        })
-        .collect();
-    let mut parent: Vec<usize> = (0..id.len()).collect();
+    let (same, count) = by_position(m);
+    let mut parent: Vec<usize> = (0..count).collect();
     fn find(parent: &mut [usize], mut x: usize) -> usize {
         while parent[x] != x {
             parent[x] = parent[parent[x]];

@@ -235,13 +235,8 @@ fn the_bracket_has_genus_three() {
 /// manifold of genus one (χ = 0), with no seam where the bar's ends meet.
 #[test]
 fn a_wrapped_bar_meshes_to_a_ring_of_genus_one() {
-    let d = dir("wrap");
-    let scene = write_scene(
-        &d,
-        "ring.sdf",
-        "scene { wrap(box((4.71238898038469, 0.2, 0.25)), 1.5); }\n",
-    );
-    let out = d.join("ring.stl");
+    let body = "scene { wrap(box((4.71238898038469, 0.2, 0.25)), 1.5); }\n";
+    let (_, scene, out) = scene_in("wrap", "ring.sdf", body, "ring.stl");
     mesh(&[s(&scene), "-o", s(&out), "--resolution", "64"]);
     assert_eq!(manifold(&read_stl(&out), "wrapped bar"), 0);
 }
@@ -331,9 +326,8 @@ pub(crate) fn hausdorff(m: &Read, p: &Program, voxel: f64, centre: [f64; 3], rad
 /// naming the node, and still closed.
 #[test]
 fn an_unproven_field_falls_back_to_the_dense_grid() {
-    let d = dir("fractal");
-    let scene = write_scene(&d, "bulb.sdf", "scene { mandelbulb(8, 6); }\n");
-    let out = d.join("bulb.stl");
+    let body = "scene { mandelbulb(8, 6); }\n";
+    let (_, scene, out) = scene_in("fractal", "bulb.sdf", body, "bulb.stl");
     let err = mesh(&[s(&scene), "-o", s(&out), "--resolution", "32", "--stats"]);
     assert!(
         err.contains("no proven bound (the mandelbulb at") && err.contains("dense grid"),
@@ -348,11 +342,8 @@ fn an_unproven_field_falls_back_to_the_dense_grid() {
 #[test]
 fn faces_on_grid_planes_still_give_a_closed_manifold() {
     let d = dir("aligned");
-    let scene = write_scene(
-        &d,
-        "cube.sdf",
-        "scene { box(0.5); sphere(0.3).translate(0.5, 0.5, 0); }\n",
-    );
+    let body = "scene { box(0.5); sphere(0.3).translate(0.5, 0.5, 0); }\n";
+    let scene = write_scene(&d, "cube.sdf", body);
     // The grid starts 1.381966… cells below the bounds: here at -0.7, so that the planes
     // x, y, z = ±0.5 hold grid points.
     let lo = -0.7 + 1.381_966_011_250_105 * 0.1;
@@ -368,12 +359,10 @@ fn faces_on_grid_planes_still_give_a_closed_manifold() {
 #[test]
 fn vertex_colours_follow_a_colour_field() {
     let d = dir("colour-field");
-    let scene = write_scene(
-        &d,
-        "gradient.sdf",
+    let body =
         "material g = phong { color: field { vec3(0.5 + 0.5 * p.y, 0.25, 0.5 - 0.5 * p.y) } };\n\
-         scene { sphere(1) @ g; }\n",
-    );
+         scene { sphere(1) @ g; }\n";
+    let scene = write_scene(&d, "gradient.sdf", body);
     // The field's colour at a vertex, linear.
     let field = |p: [f32; 3]| {
         let y = f64::from(p[1]);
@@ -394,23 +383,7 @@ fn vertex_colours_follow_a_colour_field() {
     }
     let glb = d.join("g.glb");
     mesh(&[s(&scene), "-o", s(&glb), "--resolution", "16"]);
-    let bytes = std::fs::read(&glb).expect("read glb");
-    let gltf = gltf::Gltf::from_slice(&bytes).expect("gltf reads it");
-    let blob = gltf.blob.clone();
-    let prim = gltf
-        .meshes()
-        .next()
-        .expect("a mesh")
-        .primitives()
-        .next()
-        .expect("one");
-    let reader = prim.reader(|_| blob.as_deref());
-    let positions: Vec<[f32; 3]> = reader.read_positions().expect("positions").collect();
-    let colours: Vec<[f32; 3]> = reader
-        .read_colors(0)
-        .expect("COLOR_0")
-        .into_rgb_f32()
-        .collect();
+    let (positions, colours, base) = glb_colours(&glb);
     assert_eq!(positions.len(), colours.len());
     for (p, c) in positions.iter().zip(&colours) {
         let want = field(*p);
@@ -421,7 +394,6 @@ fn vertex_colours_follow_a_colour_field() {
             );
         }
     }
-    let base = prim.material().pbr_metallic_roughness().base_color_factor();
     assert_eq!(base, [1.0; 4], "the vertex colours are the colour");
     let obj = d.join("g.obj");
     mesh(&[s(&scene), "-o", s(&obj), "--resolution", "16"]);

@@ -210,15 +210,11 @@ fn a_one_material_part_is_its_stl_mesh() {
 /// (the Materials extension, declared required), the field's colour at the vertex.
 #[test]
 fn a_colour_field_is_a_colour_per_vertex() {
-    let d = dir("3mf-field");
-    let scene = write_scene(
-        &d,
-        "two.sdf",
+    let body =
         "material g = phong { color: field { vec3(0.5 + 0.5 * p.y, 0.25, 0.5 - 0.5 * p.y) } };\n\
          material red = phong { color: (0.9, 0.1, 0.1) };\n\
-         scene { sphere(1) @ g; box(0.5).translate(2, 0, 0) @ red; }\n",
-    );
-    let out = d.join("two.3mf");
+         scene { sphere(1) @ g; box(0.5).translate(2, 0, 0) @ red; }\n";
+    let (_, scene, out) = scene_in("3mf-field", "two.sdf", body, "two.3mf");
     mesh(&[s(&scene), "-o", s(&out), "--resolution", "32"]);
     let p = read_3mf(&out);
     assert_eq!(p.model["requiredextensions"], "m");
@@ -314,11 +310,8 @@ fn extent(m: &Read) -> [[f32; 2]; 3] {
 fn a_3mf_has_z_up_and_up_turns_any_format() {
     let d = dir("3mf-up");
     // 1 wide (x), 3 tall (y, from 0 to 3), half deep (z, towards -z from 0).
-    let scene = write_scene(
-        &d,
-        "post.sdf",
-        "scene { box((0.5, 1.5, 0.25)).translate(0, 1.5, -0.25); }\n",
-    );
+    let body = "scene { box((0.5, 1.5, 0.25)).translate(0, 1.5, -0.25); }\n";
+    let scene = write_scene(&d, "post.sdf", body);
     let near = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 0.05 && (a[1] - b[1]).abs() < 0.05;
     let file = |name: &str, up: Option<&str>| {
         let out = d.join(name);

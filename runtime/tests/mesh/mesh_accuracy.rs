@@ -32,9 +32,7 @@ fn worst_vertex(scene: &std::path::Path, m: &Read, voxel: f64) -> f64 {
 /// cell and 120° edges were taken for features, vertices were up to 22 % of a cell off.
 #[test]
 fn honeycomb_vertices_lie_on_its_faces() {
-    let d = dir("honeycomb");
-    let scene = write_scene(&d, "honeycomb.sdf", HONEYCOMB);
-    let out = d.join("honeycomb.stl");
+    let (_, scene, out) = scene_in("honeycomb", "honeycomb.sdf", HONEYCOMB, "honeycomb.stl");
     mesh(&[s(&scene), "-o", s(&out), "--resolution", "128"]);
     let m = read_stl(&out);
     // 45 + 32 holes through it: genus 77.
@@ -55,13 +53,8 @@ fn honeycomb_vertices_lie_on_its_faces() {
 /// the nearest point of an edge in the neighbouring cell, 7 to 10 % of a cell away here.
 #[test]
 fn a_turned_box_keeps_its_corners_and_flat_faces() {
-    let d = dir("turned-box");
-    let scene = write_scene(
-        &d,
-        "box.sdf",
-        "scene { box((0.5, 0.3, 0.4)).rotate_y(23deg).rotate_x(17deg); }\n",
-    );
-    let out = d.join("box.stl");
+    let body = "scene { box((0.5, 0.3, 0.4)).rotate_y(23deg).rotate_x(17deg); }\n";
+    let (_, scene, out) = scene_in("turned-box", "box.sdf", body, "box.stl");
     let voxel = 0.021;
     mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.021"]);
     let m = read_stl(&out);
@@ -105,9 +98,7 @@ fn a_turned_box_keeps_its_corners_and_flat_faces() {
 /// piece of genus 0.
 #[test]
 fn a_bin_with_walls_thinner_than_a_cell_keeps_its_topology() {
-    let d = dir("bin");
-    let scene = write_scene(&d, "bin.sdf", meshes::THIN_WALLED_BIN);
-    let out = d.join("bin.stl");
+    let (_, scene, out) = scene_in("bin", "bin.sdf", meshes::THIN_WALLED_BIN, "bin.stl");
     let err = mesh(&[s(&scene), "-o", s(&out), "--resolution", "128"]);
     assert!(err.contains("meshing again with cells of 0.3906"), "{err}");
     assert!(!err.contains("warning"), "{err}");
@@ -119,13 +110,8 @@ fn a_bin_with_walls_thinner_than_a_cell_keeps_its_topology() {
 /// A sheet 0.3 cells thick, slanted to the grid, stays one piece.
 #[test]
 fn a_sheet_of_a_third_of_a_cell_stays_one_piece() {
-    let d = dir("sheet");
-    let scene = write_scene(
-        &d,
-        "sheet.sdf",
-        "scene { box((0.5, 0.006, 0.4)).rotate_x(11deg).rotate_z(7deg); }\n",
-    );
-    let out = d.join("sheet.stl");
+    let body = "scene { box((0.5, 0.006, 0.4)).rotate_x(11deg).rotate_z(7deg); }\n";
+    let (_, scene, out) = scene_in("sheet", "sheet.sdf", body, "sheet.stl");
     let err = mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.04"]);
     assert!(err.contains("meshing again with cells of 0.01\n"), "{err}");
     let m = read_stl(&out);
@@ -139,14 +125,9 @@ fn a_sheet_of_a_third_of_a_cell_stays_one_piece() {
 /// warns instead.
 #[test]
 fn every_part_of_a_3mf_is_refined_alike_and_thin_off_only_warns() {
-    let d = dir("parts_thin");
-    let scene = write_scene(
-        &d,
-        "two.sdf",
-        "material a = phong { color: (1, 0, 0) };\nmaterial b = phong { color: (0, 0, 1) };\n\
-         scene { box((0.5, 0.006, 0.4)).rotate_x(11deg).rotate_z(7deg) @ a; box(0.2).translate(0.6, 0, 0) @ b; }\n",
-    );
-    let out = d.join("two.3mf");
+    let body = "material a = phong { color: (1, 0, 0) };\nmaterial b = phong { color: (0, 0, 1) };\n\
+         scene { box((0.5, 0.006, 0.4)).rotate_x(11deg).rotate_z(7deg) @ a; box(0.2).translate(0.6, 0, 0) @ b; }\n";
+    let (d, scene, out) = scene_in("parts_thin", "two.sdf", body, "two.3mf");
     let stats = sdfc(&[
         "mesh",
         s(&scene),
@@ -183,13 +164,8 @@ fn every_part_of_a_3mf_is_refined_alike_and_thin_off_only_warns() {
 /// cells asked for, with a warning that names its place and the cell that resolves it.
 #[test]
 fn a_sheet_too_thin_for_the_memory_limit_is_warned_about() {
-    let d = dir("sheet_limit");
-    let scene = write_scene(
-        &d,
-        "sheet.sdf",
-        "scene { box((0.5, 0.0006, 0.4)).rotate_x(11deg).rotate_z(7deg); }\n",
-    );
-    let out = d.join("sheet.stl");
+    let body = "scene { box((0.5, 0.0006, 0.4)).rotate_x(11deg).rotate_z(7deg); }\n";
+    let (_, scene, out) = scene_in("sheet_limit", "sheet.sdf", body, "sheet.stl");
     let err = mesh(&[
         s(&scene),
         "-o",
@@ -213,19 +189,14 @@ fn a_sheet_too_thin_for_the_memory_limit_is_warned_about() {
 /// neither refined nor reported.
 #[test]
 fn parts_touching_a_floor_are_not_thin_gaps() {
-    let d = dir("touching");
-    let scene = write_scene(
-        &d,
-        "touching.sdf",
-        "scene {
+    let body = "scene {
   box((2, 0.1, 2)).translate(0, -0.1, 0);
   sphere(0.5).translate(-1, 0.5, -1);
   cylinder(0.3, 0.6).rotate_x(90deg).translate(1, 0.3, 0.5);
   box((0.4, 0.1, 0.2)).rotate_z(4deg).translate(0, 0.1 + 0.4 * sin(4deg), -0.5);
 }
-",
-    );
-    let out = d.join("touching.stl");
+";
+    let (_, scene, out) = scene_in("touching", "touching.sdf", body, "touching.stl");
     let err = mesh(&[s(&scene), "-o", s(&out), "--resolution", "128"]);
     assert!(
         !err.contains("meshing again") && !err.contains("warning"),

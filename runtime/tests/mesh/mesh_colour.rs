@@ -8,23 +8,7 @@ use meshes::*;
 
 /// The positions and linear `COLOR_0` colours of the one primitive of a `.glb`.
 fn coloured(path: &std::path::Path) -> Vec<([f32; 3], [f32; 3])> {
-    let bytes = std::fs::read(path).expect("read glb");
-    let gltf = gltf::Gltf::from_slice(&bytes).expect("gltf reads it");
-    let blob = gltf.blob.clone();
-    let prim = gltf
-        .meshes()
-        .next()
-        .expect("a mesh")
-        .primitives()
-        .next()
-        .expect("one");
-    let reader = prim.reader(|_| blob.as_deref());
-    let positions: Vec<[f32; 3]> = reader.read_positions().expect("positions").collect();
-    let colours: Vec<[f32; 3]> = reader
-        .read_colors(0)
-        .expect("COLOR_0")
-        .into_rgb_f32()
-        .collect();
+    let (positions, colours, _) = glb_colours(path);
     positions.into_iter().zip(colours).collect()
 }
 
@@ -34,12 +18,9 @@ fn coloured(path: &std::path::Path) -> Vec<([f32; 3], [f32; 3])> {
 #[test]
 fn vertex_colours_take_the_normal_and_move_with_the_painted_shape() {
     let d = dir("colour-normal");
-    let scene = write_scene(
-        &d,
-        "normals.sdf",
-        "material m = phong { color: field { vec3(0.5 + 0.5 * n.x, 0.5 + 0.5 * n.y, 0.5 + 0.4 * p.y) } };\n\
-         scene { (sphere(1) @ m).translate(2, 1, 0); }\n",
-    );
+    let body = "material m = phong { color: field { vec3(0.5 + 0.5 * n.x, 0.5 + 0.5 * n.y, 0.5 + 0.4 * p.y) } };\n\
+         scene { (sphere(1) @ m).translate(2, 1, 0); }\n";
+    let scene = write_scene(&d, "normals.sdf", body);
     let glb = d.join("n.glb");
     mesh(&[s(&scene), "-o", s(&glb), "--resolution", "24"]);
     let vertices = coloured(&glb);

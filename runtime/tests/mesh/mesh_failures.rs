@@ -9,13 +9,8 @@ use std::process::Command;
 /// box and the cut closed.
 #[test]
 fn an_unbounded_scene_needs_bounds_and_is_closed_at_them() {
-    let d = dir("unbounded");
-    let scene = write_scene(
-        &d,
-        "floor.sdf",
-        "scene { plane(); sphere(0.5).translate(0, 0.4, 0); }\n",
-    );
-    let out = d.join("floor.stl");
+    let body = "scene { plane(); sphere(0.5).translate(0, 0.4, 0); }\n";
+    let (_, scene, out) = scene_in("unbounded", "floor.sdf", body, "floor.stl");
     let o = sdfc(&["mesh", s(&scene), "-o", s(&out)]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -143,9 +138,7 @@ fn a_read_only_output_is_refused_and_left_unchanged() {
     std::fs::write(&out, b"keep me").expect("old file");
     std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o444)).expect("chmod");
     let scene = root().join("examples/mesh/parts.sdf");
-    let o = sdfc(&["mesh", s(&scene), "--resolution", "16", "-o", s(&out)]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = exits(&["mesh", s(&scene), "--resolution", "16", "-o", s(&out)], 2);
     assert!(err.contains("read-only"), "{err}");
     assert_eq!(std::fs::read(&out).expect("kept"), b"keep me");
 }
@@ -155,31 +148,31 @@ fn a_read_only_output_is_refused_and_left_unchanged() {
 /// nothing written; a tiny cell is named in scientific notation, not as `0`.
 #[test]
 fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
-    let d = dir("empty");
-    let scene = write_scene(&d, "ball.sdf", "scene { sphere(0.5); }\n");
-    let out = d.join("ball.stl");
+    let (d, scene, out) = scene_in("empty", "ball.sdf", "scene { sphere(0.5); }\n", "ball.stl");
     let o = sdfc(&["mesh", s(&d.join("nope.sdf")), "-o", s(&out)]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read"));
     // Bounds away from the shape's box say where it is; bounds in its box's corner, that they
     // hold none of the surface.
-    let o = sdfc(&["mesh", s(&scene), "-o", s(&out), "--bounds=2,2,2,3,3,3"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
+    let err = exits(
+        &["mesh", s(&scene), "-o", s(&out), "--bounds=2,2,2,3,3,3"],
+        1,
+    );
     assert!(
         err.contains("--bounds does not reach the scene's solid, which lies within `--bounds=-0.5,-0.5,-0.5,0.5,0.5,0.5`"),
         "{err}"
     );
     assert!(!out.exists());
-    let o = sdfc(&[
-        "mesh",
-        s(&scene),
-        "-o",
-        s(&out),
-        "--bounds=0.4,0.4,0.4,0.5,0.5,0.5",
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
+    let err = exits(
+        &[
+            "mesh",
+            s(&scene),
+            "-o",
+            s(&out),
+            "--bounds=0.4,0.4,0.4,0.5,0.5,0.5",
+        ],
+        1,
+    );
     assert!(
         err.contains("no triangles") && err.contains("--bounds"),
         "{err}"

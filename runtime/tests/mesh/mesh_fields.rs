@@ -45,18 +45,11 @@ fn meshed(d: &Path, name: &str, body: &str, resolution: &str) -> Read {
 #[test]
 fn a_rod_built_as_a_field_meshes_as_the_primitive_does() {
     let d = dir("field-rod");
-    let field = meshed(
-        &d,
-        "field",
-        "scene { field { max(length(p.xz) - 0.2, abs(p.y) - 1) }.translate(0.5, 0, 0); }\n",
-        "64",
-    );
-    let prim = meshed(
-        &d,
-        "prim",
-        "scene { cylinder(0.2, 2).translate(0.5, 0, 0); }\n",
-        "64",
-    );
+    let field_text =
+        "scene { field { max(length(p.xz) - 0.2, abs(p.y) - 1) }.translate(0.5, 0, 0); }\n";
+    let field = meshed(&d, "field", field_text, "64");
+    let prim_text = "scene { cylinder(0.2, 2).translate(0.5, 0, 0); }\n";
+    let prim = meshed(&d, "prim", prim_text, "64");
     assert_eq!(manifold(&field, "field rod"), 2);
     assert_eq!(field.triangles.len(), prim.triangles.len());
     // The whole rod: from y = −1 to 1, x from 0.3 to 0.7 (within a hundredth).
@@ -79,17 +72,13 @@ fn a_rod_built_as_a_field_meshes_as_the_primitive_does() {
 #[test]
 fn a_blob_and_a_bumpy_sphere_mesh_without_bounds() {
     let d = dir("field-blob");
-    let blob = meshed(
-        &d,
-        "blob",
-        "scene { field {\n\
+    let blob_text = "scene { field {\n\
            let a = length(p - vec3(-0.4, 0, 0)) - 0.5;\n\
            let b = length(p - vec3(0.4, 0.2, 0)) - 0.4;\n\
            let h = max(0.3 - abs(a - b), 0) / 0.3;\n\
            min(a, b) - h * h * 0.3 / 4\n\
-         }; }\n",
-        "64",
-    );
+         }; }\n";
+    let blob = meshed(&d, "blob", blob_text, "64");
     assert_eq!(manifold(&blob, "blob"), 2);
     // The spheres' far sides: x from −0.9 to 0.8, y from −0.5 to 0.6, z ±0.5; the blend
     // only adds material between them.
@@ -99,12 +88,9 @@ fn a_blob_and_a_bumpy_sphere_mesh_without_bounds() {
         0.02,
         "blob",
     );
-    let bumpy = meshed(
-        &d,
-        "bumpy",
-        "scene { field { distance(sphere(1), p) + 0.1 * noise(p * 4) }.translate(0, 2, 0); }\n",
-        "48",
-    );
+    let bumpy_text =
+        "scene { field { distance(sphere(1), p) + 0.1 * noise(p * 4) }.translate(0, 2, 0); }\n";
+    let bumpy = meshed(&d, "bumpy", bumpy_text, "48");
     assert_eq!(manifold(&bumpy, "bumpy sphere"), 2);
     // Within the sphere of radius 1 ± 0.087 (the noise's range times 0.1) around (0, 2, 0).
     let [lo, hi] = extent(&bumpy);
@@ -119,12 +105,9 @@ fn a_blob_and_a_bumpy_sphere_mesh_without_bounds() {
 #[test]
 fn a_repeated_field_is_bounded_by_its_count() {
     let d = dir("field-repeat");
-    let rods = meshed(
-        &d,
-        "rods",
-        "scene { field { max(length(p.xz) - 0.2, abs(p.y) - 1) }.repeat((1, 0, 0), (3, 1, 1)); }\n",
-        "64",
-    );
+    let rods_text =
+        "scene { field { max(length(p.xz) - 0.2, abs(p.y) - 1) }.repeat((1, 0, 0), (3, 1, 1)); }\n";
+    let rods = meshed(&d, "rods", rods_text, "64");
     // Three closed rods: χ = 6.
     assert_eq!(manifold(&rods, "rods"), 6);
     close(
@@ -140,12 +123,9 @@ fn a_repeated_field_is_bounded_by_its_count() {
 #[test]
 fn an_unbounded_field_is_named_and_the_hint_holds_the_bounded_fields() {
     let d = dir("field-unbounded");
-    let scene = write_scene(
-        &d,
-        "gyroid.sdf",
-        "scene {\n  field { abs(sin(p.x) * cos(p.y) + sin(p.y) * cos(p.z) + sin(p.z) * cos(p.x)) - 0.2 };\n  \
-         field { max(length(p.xz) - 0.2, abs(p.y) - 3) }.translate(4, 0, 0);\n  sphere(1);\n}\n",
-    );
+    let body = "scene {\n  field { abs(sin(p.x) * cos(p.y) + sin(p.y) * cos(p.z) + sin(p.z) * cos(p.x)) - 0.2 };\n  \
+         field { max(length(p.xz) - 0.2, abs(p.y) - 3) }.translate(4, 0, 0);\n  sphere(1);\n}\n";
+    let scene = write_scene(&d, "gyroid.sdf", body);
     let out = sdfc(&["mesh", s(&scene), "-o", s(&d.join("g.stl"))]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr).replace(s(&d), "DIR");

@@ -11,7 +11,7 @@
 
 use super::common::open_gpu;
 use super::evaluators;
-use super::meshes::{self, dir, root, s, sdfc, write_scene};
+use super::meshes::{self, dir, exits, root, s, scene_in, sdfc, write_scene};
 use sdfc_compiler::{Limits, LowerOptions};
 use sdfc_runtime::backend::Backend;
 use sdfc_runtime::commands::mesh::{surface, Meshed, Region, Spelling};
@@ -152,17 +152,8 @@ fn cuda_meshes_the_examples_as_the_cpu_does() {
             let m = evaluators::points_module(&checked.scene, &lowered, false);
             let ptx = d.join("mesh.ptx");
             std::fs::write(&ptx, evaluators::points_ptx(&m, 80)).expect("PTX written");
-            let out = std::process::Command::new(&ptxas)
-                .args(["-arch=sm_80", "-o"])
-                .arg(d.join("mesh.cubin"))
-                .arg(&ptx)
-                .output()
-                .expect("run ptxas");
-            assert!(
-                out.status.success(),
-                "{what}: ptxas refused the mesher's PTX:\n{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
+            let cubin = d.join("mesh.cubin");
+            evaluators::assemble(&ptxas, &ptx, &cubin, &format!("{what}: the mesher's PTX"));
         }
     } else {
         println!("SKIPPED: ptxas: not on the PATH");
@@ -187,13 +178,10 @@ fn cuda_meshes_the_examples_as_the_cpu_does() {
 /// made on the CPU instead; `--stats` names what evaluated the points.
 #[test]
 fn a_missing_device_is_an_error_and_stats_name_the_backend() {
-    let d = dir("gpu_cli");
-    let scene = write_scene(&d, "ball.sdf", "scene { sphere(0.5); }\n");
-    let out = d.join("ball.stl");
+    let body = "scene { sphere(0.5); }\n";
+    let (_, scene, out) = scene_in("gpu_cli", "ball.sdf", body, "ball.stl");
     if evaluators::open_cuda().is_err() {
-        let r = sdfc(&["mesh", s(&scene), "-o", s(&out), "--backend", "cuda"]);
-        let err = String::from_utf8_lossy(&r.stderr);
-        assert_eq!(r.status.code(), Some(1), "{err}");
+        let err = exits(&["mesh", s(&scene), "-o", s(&out), "--backend", "cuda"], 1);
         assert!(
             err.contains("error: --backend cuda cannot mesh here: found no CUDA device ("),
             "{err}"

@@ -5,6 +5,8 @@
 //! that read them, naming where in the file, and never a crash.
 
 use crate::common;
+use crate::common::words;
+use common::run_ok;
 
 use sdfc_compiler::{Lowered, Rng, Scene};
 use sdfc_runtime::cpu::{self, Options};
@@ -65,16 +67,12 @@ fn every_format_sdfc_mesh_writes_reads_back_the_same() {
     let pts = points(200, 1.5);
     let mut first: Option<Vec<f64>> = None;
     for ext in ["stl", "obj", "ply", "glb"] {
-        let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-            .args(["mesh", "part.sdf", "--resolution", "12", "-o"])
-            .arg(format!("part.{ext}"))
-            .current_dir(&dir)
-            .output()
-            .expect("run sdfc mesh");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        run_ok(
+            Command::new(env!("CARGO_BIN_EXE_sdfc"))
+                .args(["mesh", "part.sdf", "--resolution", "12", "-o"])
+                .arg(format!("part.{ext}"))
+                .current_dir(&dir),
+            "run sdfc mesh",
         );
         let scene = check(
             &dir,
@@ -163,15 +161,11 @@ fn a_mesh_composes_and_remeshes() {
         format!("{LIGHTS}scene {{ mesh(\"sphere.ply\").round(0.1); }}"),
     )
     .expect("write");
-    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .args(["mesh", "round.sdf", "--resolution", "16", "-o", "round.stl"])
-        .current_dir(&dir)
-        .output()
-        .expect("run sdfc mesh");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    run_ok(
+        Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .args(["mesh", "round.sdf", "--resolution", "16", "-o", "round.stl"])
+            .current_dir(&dir),
+        "run sdfc mesh",
     );
     // The remeshed, rounded sphere has radius 1.1: its vertices lie near that.
     let remeshed = check(
@@ -311,15 +305,11 @@ fn a_software_adapter_that_would_cut_loops_refuses_instead_of_a_wrong_picture() 
     };
     let dir = scratch("software_cut");
     std::fs::write(dir.join("ball.sdf"), "scene { sphere(1); }").expect("write");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&dir)
-        .args(["mesh", "ball.sdf", "-o", "ball.stl", "--resolution", "96"])
-        .output()
-        .expect("sdfc mesh runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    run_ok(
+        std::process::Command::new(env!("CARGO_BIN_EXE_sdfc"))
+            .current_dir(&dir)
+            .args(["mesh", "ball.sdf", "-o", "ball.stl", "--resolution", "96"]),
+        "sdfc mesh runs",
     );
     let scene = check(
         &dir,
@@ -337,14 +327,7 @@ fn a_software_adapter_that_would_cut_loops_refuses_instead_of_a_wrong_picture() 
     // its cut loops all the same (it wrote the streaked picture without a word).
     let cli = std::process::Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&dir)
-        .args([
-            "render",
-            "shell.sdf",
-            "--backend",
-            "wgpu",
-            "-o",
-            "shell.png",
-        ])
+        .args(words("render shell.sdf --backend wgpu -o shell.png"))
         .output()
         .expect("sdfc render runs");
     let stderr = String::from_utf8_lossy(&cli.stderr);

@@ -9,13 +9,8 @@ use meshes::*;
 /// and the mesh is within half a voxel of the surface both ways.
 #[test]
 fn sphere_vertices_lie_on_the_surface() {
-    let d = dir("sphere");
-    let scene = write_scene(
-        &d,
-        "ball.sdf",
-        "scene { sphere(0.5).translate(0.1, -0.2, 0.3); }\n",
-    );
-    let out = d.join("ball.obj");
+    let body = "scene { sphere(0.5).translate(0.1, -0.2, 0.3); }\n";
+    let (_, scene, out) = scene_in("sphere", "ball.sdf", body, "ball.obj");
     let voxel = 0.03;
     mesh(&[s(&scene), "-o", s(&out), "--voxel", "0.03"]);
     let m = read_obj(&out);

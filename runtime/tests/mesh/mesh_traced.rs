@@ -4,7 +4,7 @@
 //! CPU (f32 and the f64 reference) and through wgpu, and PTX assembles where `ptxas` is on the
 //! PATH. A mesh that is rounded, or a light with a penumbra, keeps the scene marched.
 
-use super::common::open_gpu;
+use super::common::{cpu_render, open_gpu, run_ok};
 use super::meshes::{dir, root, s, write_scene};
 use sdfc_compiler::{
     analytic::{choose, Choice, Reason},
@@ -50,15 +50,6 @@ fn setup(name: &str, shape: &str, penumbra: &str) -> Scene {
         super::meshes::mesh(&[s(&bracket), "--resolution", "40", "-o", s(&part)]);
     }
     load(&write_scene(&d, "scene.sdf", &scene_text(shape, penumbra)))
-}
-
-fn cpu_render(scene: &Scene) -> cpu::Render {
-    cpu::render(
-        scene,
-        &Lowered::new(scene),
-        &cpu::Options::default(),
-        &|| {},
-    )
 }
 
 #[test]
@@ -109,14 +100,14 @@ fn wgpu_traces_a_mesh_as_the_cpu_does() {
         let d = dir("traced-mesh-ptx");
         let file = d.join("k.ptx");
         std::fs::write(&file, ptx.text).expect("write");
-        let out = std::process::Command::new(ptxas)
-            .args(["-arch=sm_90", s(&file), "-o", s(&d.join("k.cubin"))])
-            .output()
-            .expect("ptxas runs");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        run_ok(
+            std::process::Command::new(ptxas).args([
+                "-arch=sm_90",
+                s(&file),
+                "-o",
+                s(&d.join("k.cubin")),
+            ]),
+            "ptxas runs",
         );
     }
     let Some(gpu) = open_gpu("traced mesh") else {

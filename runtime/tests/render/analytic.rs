@@ -1,11 +1,12 @@
 //! Analytic ray tracing (issue 9): which scenes the compiler traces analytically and why,
 //! traced images against sphere-traced ones of the same file, and the kernel it emits.
 
+use crate::common;
 use sdfc_compiler::{
     analytic::{choose, Choice, Reason},
     wgsl, Method, Scene,
 };
-use sdfc_runtime::{cpu, frontend, metrics};
+use sdfc_runtime::{frontend, metrics};
 use std::path::Path;
 
 /// The conformance tolerance of image_conformance.rs: PSNR, differing fraction, threshold.
@@ -54,31 +55,15 @@ fn traced_images_agree_with_marched_ones() {
         let mut scene = load(name);
         scene.settings.width = 256;
         scene.settings.height = 160;
-        let render = |scene: &Scene| {
-            cpu::render(
-                scene,
-                &sdfc_compiler::Lowered::new(scene),
-                &cpu::Options::default(),
-                &|| {},
-            )
-        };
+        let render = common::cpu_render;
         let traced = render(&scene);
         scene.settings.method = Method::March;
         let marched = render(&scene);
         assert_eq!(traced.stats.counters.steps, 0, "{name}: traced with steps");
         assert!(marched.stats.counters.steps > 0);
         assert!(traced.stats.counters.hits > 0);
-        let d = metrics::compare(&traced.image, &marched.image, THRESHOLD).expect("same size");
-        println!(
-            "{name}: psnr {:.1} dB, differing {:.4}",
-            d.psnr, d.differing
-        );
-        assert!(
-            d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
-            "{name}: psnr {:.1} dB, differing {:.4}",
-            d.psnr,
-            d.differing
-        );
+        let pair = (&traced.image, &marched.image);
+        common::assert_agree(name, pair, THRESHOLD, (MIN_PSNR, MAX_DIFFERING));
     }
 }
 
@@ -106,14 +91,7 @@ fn glass_on_the_floor_is_traced_as_it_is_marched() {
     let (scene, diags, _) = sdfc_compiler::check_str("sunk.sdf", text);
     let mut scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
     assert!(matches!(choose(&scene), Choice::Trace(_)));
-    let render = |scene: &Scene| {
-        cpu::render(
-            scene,
-            &sdfc_compiler::Lowered::new(scene),
-            &cpu::Options::default(),
-            &|| {},
-        )
-    };
+    let render = common::cpu_render;
     let traced = render(&scene);
     scene.settings.method = Method::March;
     let marched = render(&scene);

@@ -4,16 +4,8 @@
 
 use crate::common;
 
-use common::render_everywhere;
-use sdfc_compiler::Scene;
+use common::{checked, render_everywhere};
 use sdfc_runtime::image::Image;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
 
 /// A floor of FLOOR under a lamp, with a red ball the floor may reflect.
 const TILES: &str = "
@@ -83,22 +75,8 @@ fn two_materials_blend_over_the_pixels_footprint() {
 material bright = phong { color: (1, 1, 1), ambient: 1, diffuse: 0, specular: 0 };
 material dark = phong { color: (1, 1, 1), ambient: 0, diffuse: 0, specular: 0 };
 material floor = checker { a: bright, b: dark, size: 0.5 };
-camera { position: (0, 1, -4), look_at: (0, 0.6, 4), fov: 40deg }
-render { width: 160, height: 100, max_dist: 300, background: (0.5, 0.5, 0.5) AA }
-scene { plane() @ floor; }
 ";
-    let one = checked("one sample", &text.replace("AA", ""));
-    let many = checked("12×12 samples", &text.replace("AA", ", aa: 12"));
-    let truth = sdfc_runtime::cpu::render(
-        &many,
-        &sdfc_compiler::Lowered::new(&many),
-        &sdfc_runtime::cpu::Options::default(),
-        &|| {},
-    )
-    .image;
-    let horizon = (0..one.settings.height)
-        .find(|&y| truth.pixel(80, y)[0] != 0.5)
-        .expect("the floor");
+    let (one, truth, horizon) = common::floor_to_the_horizon(text);
     for (backend, image) in render_everywhere("one sample", &one) {
         let mut sum = 0.0;
         for y in horizon + 1..horizon + 12 {

@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use sdfc_compiler::{wgsl, Lowered, Method, Scene};
+use sdfc_compiler::{Lowered, Method, Scene};
 use sdfc_runtime::cpu::{self, Options, Precision};
 use sdfc_runtime::{gpu, metrics};
 
@@ -62,17 +62,18 @@ const CAMERA: &str = "position: (0, 0.6, -4), look_at: (0, 0, 0)";
 fn a_field_of_the_normal_paints_a_sphere_with_its_normals() {
     let normals = lit_by_its_colours(CAMERA, "field { vec3(0.5) + 0.5 * n }", "sphere(1) @ m;");
     let points = lit_by_its_colours(CAMERA, "field { vec3(0.5) + 0.5 * p }", "sphere(1) @ m;");
+    agree_on_the_cpu(&normals, &points, (45.0, 0.0), "n and p");
+}
+
+/// `a` and `b` rendered on the CPU, marched and as they allow, in f32 and in f64: each pair of
+/// pictures agrees as [`agree`] asks (`psnr` and `differing`), said under `what`.
+fn agree_on_the_cpu(a: &Scene, b: &Scene, (psnr, differing): (f64, f64), what: &str) {
     for precision in [Precision::F32, Precision::F64] {
         for method in [Method::March, Method::Auto] {
-            let a = cpu_render(&normals, method, precision);
-            let b = cpu_render(&points, method, precision);
-            agree(
-                &a,
-                &b,
-                45.0,
-                0.0,
-                &format!("n and p, {method:?}, {precision:?}"),
-            );
+            let x = cpu_render(a, method, precision);
+            let y = cpu_render(b, method, precision);
+            let label = format!("{what}, {method:?}, {precision:?}");
+            agree(&x, &y, psnr, differing, &label);
         }
     }
 }
@@ -123,19 +124,7 @@ fn unmoved() -> Scene {
 #[test]
 fn a_pattern_moves_with_its_shape() {
     let (moved, unmoved) = (moved(), unmoved());
-    for precision in [Precision::F32, Precision::F64] {
-        for method in [Method::March, Method::Auto] {
-            let a = cpu_render(&moved, method, precision);
-            let b = cpu_render(&unmoved, method, precision);
-            agree(
-                &a,
-                &b,
-                40.0,
-                0.002,
-                &format!("moved and unmoved, {method:?}, {precision:?}"),
-            );
-        }
-    }
+    agree_on_the_cpu(&moved, &unmoved, (40.0, 0.002), "moved and unmoved");
     // Painted after the transforms, the same sphere keeps the world's coordinates: the
     // pattern does not move, and the pictures differ.
     let [x, y, z] = OFFSET;
@@ -159,24 +148,11 @@ fn colour_from_the_surface_matches_the_cpu_on_wgpu() {
     };
     let normals = lit_by_its_colours(CAMERA, "field { vec3(0.5) + 0.5 * n }", "sphere(1) @ m;");
     for scene in [normals, moved()] {
-        for (method, choice) in [
-            (Method::Auto, wgsl::KernelChoice::Specialised),
-            (Method::March, wgsl::KernelChoice::Specialised),
-            (Method::March, wgsl::KernelChoice::Interpreted),
-        ] {
+        for (method, choice) in common::KERNELS {
             let mut scene = scene.clone();
             scene.settings.method = method;
             let lowered = Lowered::new(&scene);
-            let options = wgsl::Options {
-                kernel: choice,
-                interp_unroll: if gpu.is_cpu() {
-                    wgsl::interp::UNROLL_SOFTWARE
-                } else {
-                    wgsl::interp::UNROLL
-                },
-                ..wgsl::Options::default()
-            };
-            let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
+            let kernel = common::kernel_for(&scene, &lowered, choice, gpu.is_cpu());
             let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
             let on_cpu = cpu_render(&scene, method, Precision::F32);
             agree(

@@ -8,26 +8,16 @@
 //! skipped, unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe).
 
 use crate::common;
+use common::load_small;
 
-use sdfc_compiler::{wgsl, Lowered, Scene};
+use sdfc_compiler::{wgsl, Lowered};
 use sdfc_runtime::gpu::launch::Worker;
-use sdfc_runtime::{cpu, frontend, gpu, metrics};
+use sdfc_runtime::{cpu, gpu, metrics};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn open_gpu() -> Option<gpu::Gpu> {
     common::open_gpu("several devices")
-}
-
-fn load(path: &Path, width: u32, height: u32) -> Scene {
-    let mut scene = frontend::load(path)
-        .expect("readable")
-        .scene
-        .unwrap_or_else(|| panic!("{} is a valid scene", path.display()));
-    scene.settings.width = width;
-    scene.settings.height = height;
-    scene.settings.aa = 1;
-    scene
 }
 
 fn bits(image: &sdfc_runtime::image::Image) -> Vec<u32> {
@@ -45,7 +35,7 @@ fn two_logical_devices_render_every_example_bit_for_bit_as_one() {
     };
     // An odd size: bands of unequal height, the last one short.
     for path in common::examples() {
-        let scene = load(&path, 131, 97);
+        let scene = load_small(&path, 131, 97);
         let lowered = Lowered::new(&scene);
         let l = lowered.program.lipschitz();
         let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
@@ -106,7 +96,7 @@ fn statistics_reduced_on_the_device_are_the_hosts_sums() {
     let Some(a) = open_gpu() else { return };
     for (name, aa) in [("seed3", 2), ("seed6", 1), ("glass", 1)] {
         let path = PathBuf::from(format!("../examples/{name}.sdf"));
-        let mut scene = load(&path, 131, 97);
+        let mut scene = load_small(&path, 131, 97);
         scene.settings.aa = aa;
         let lowered = Lowered::new(&scene);
         let l = lowered.program.lipschitz();
@@ -135,7 +125,7 @@ fn the_cpu_beside_lavapipe_agrees_with_lavapipe_alone() {
     // lavapipe (image_conformance.rs) less a margin.
     for (name, min_psnr) in [("seed3", 45.0), ("seed6", 90.0), ("glass", 38.0)] {
         let path = PathBuf::from(format!("../examples/{name}.sdf"));
-        let scene = load(&path, 96, 64);
+        let scene = load_small(&path, 96, 64);
         let lowered = Lowered::new(&scene);
         let l = lowered.program.lipschitz();
         let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
@@ -210,11 +200,23 @@ fn sdfc(cwd: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     c.output().expect("run sdfc")
 }
 
-fn seed3() -> String {
-    std::fs::canonicalize("../examples/seed3.sdf")
-        .expect("examples/seed3.sdf")
+/// `sdfc COMMAND FILE` followed by the words of `rest`, run in `d` with `env`.
+fn sdfc_on(d: &Path, command: &str, file: &str, rest: &str, env: &[(&str, &str)]) -> Output {
+    let mut args = vec![command, file];
+    args.extend(common::words(rest));
+    sdfc(d, &args, env)
+}
+
+/// The absolute path of the example `name`.
+fn example(name: &str) -> String {
+    std::fs::canonicalize(Path::new("../examples").join(name))
+        .unwrap_or_else(|e| panic!("examples/{name}: {e}"))
         .display()
         .to_string()
+}
+
+fn seed3() -> String {
+    example("seed3.sdf")
 }
 
 fn wgpu_here() -> bool {
@@ -222,20 +224,8 @@ fn wgpu_here() -> bool {
 }
 
 fn render(d: &Path, devices: &str, out: &str, env: &[(&str, &str)]) -> Output {
-    let scene = seed3();
-    let args = [
-        "render",
-        &scene,
-        "--backend",
-        "wgpu",
-        "--devices",
-        devices,
-        "--size",
-        "160x120",
-        "-o",
-        out,
-    ];
-    sdfc(d, &args, env)
+    let rest = format!("--backend wgpu --devices {devices} --size 160x120 -o {out}");
+    sdfc_on(d, "render", &seed3(), &rest, env)
 }
 
 #[test]
@@ -291,21 +281,8 @@ fn the_cpu_and_lavapipe_render_together_from_the_command_line() {
     let d = dir("mixed");
     let one = render(&d, "0", "one.png", &[]);
     assert!(one.status.success(), "{one:?}");
-    let scene = seed3();
-    let args = [
-        "render",
-        &scene,
-        "--backend",
-        "wgpu",
-        "--devices",
-        "cpu,0",
-        "--size",
-        "160x120",
-        "--stats",
-        "-o",
-        "mixed.png",
-    ];
-    let out = sdfc(&d, &args, &[]);
+    let rest = "--backend wgpu --devices cpu,0 --size 160x120 --stats -o mixed.png";
+    let out = sdfc_on(&d, "render", &seed3(), rest, &[]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{out:?}");
     assert!(
@@ -322,25 +299,9 @@ fn the_cpu_and_lavapipe_render_together_from_the_command_line() {
 }
 
 fn sequence(d: &Path, devices: &str, pattern: &str, env: &[(&str, &str)]) -> Output {
-    let orbit = std::fs::canonicalize("../examples/animation/orbit.sdf")
-        .expect("orbit")
-        .display()
-        .to_string();
-    let args = [
-        "render",
-        &orbit,
-        "--backend",
-        "wgpu",
-        "--devices",
-        devices,
-        "--size",
-        "96x64",
-        "--frames",
-        "0..6",
-        "-o",
-        pattern,
-    ];
-    sdfc(d, &args, env)
+    let rest =
+        format!("--backend wgpu --devices {devices} --size 96x64 --frames 0..6 -o {pattern}");
+    sdfc_on(d, "render", &example("animation/orbit.sdf"), &rest, env)
 }
 
 #[test]
@@ -365,23 +326,15 @@ fn the_frames_of_a_sequence_go_to_the_devices_and_survive_one_failing() {
     same("two");
     // The second device fails on its first frame (it opens its device after taking one,
     // while the first is still opening its own); the first renders every frame.
-    let out = sequence(
-        &d,
-        "0,0",
-        "back/f_##.png",
-        &[("SDFC_FAULT_AFTER_TILES", "1:0")],
-    );
+    let fault = [("SDFC_FAULT_AFTER_TILES", "1:0")];
+    let out = sequence(&d, "0,0", "back/f_##.png", &fault);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("warning: device 1 failed: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=1:0 (a testing aid); the other devices render its frame"), "{err}");
     same("back");
     // Every device fails at its second frame: two frames are written, then the error.
-    let out = sequence(
-        &d,
-        "0,0",
-        "none/f_##.png",
-        &[("SDFC_FAULT_AFTER_TILES", "1")],
-    );
+    let fault = [("SDFC_FAULT_AFTER_TILES", "1")];
+    let out = sequence(&d, "0,0", "none/f_##.png", &fault);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
@@ -396,27 +349,12 @@ fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
         return;
     }
     let d = dir("sequence");
-    let orbit = std::fs::canonicalize("../examples/animation/orbit.sdf")
-        .expect("orbit")
-        .display()
-        .to_string();
+    let orbit = example("animation/orbit.sdf");
     for (devices, pattern) in [("0", "one/f_##.png"), ("0,0", "two/f_##.png")] {
-        let args = [
-            "render",
-            &orbit,
-            "--backend",
-            "wgpu",
-            "--devices",
-            devices,
-            "--size",
-            "96x64",
-            "--frames",
-            "0..3",
-            "--stats",
-            "-o",
-            pattern,
-        ];
-        let out = sdfc(&d, &args, &[]);
+        let rest = format!(
+            "--backend wgpu --devices {devices} --size 96x64 --frames 0..3 --stats -o {pattern}"
+        );
+        let out = sdfc_on(&d, "render", &orbit, &rest, &[]);
         assert!(out.status.success(), "{out:?}");
         // `--stats` says where the time went: each device's steps and the writers'.
         let err = String::from_utf8_lossy(&out.stderr);
@@ -437,23 +375,8 @@ fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
         let b = std::fs::read(d.join(format!("two/f_{k:02}.png"))).expect("frame");
         assert!(a == b, "frame {k} differs");
     }
-    let bench = sdfc(
-        &d,
-        &[
-            "bench",
-            &orbit,
-            "--backend",
-            "wgpu",
-            "--devices",
-            "0,0",
-            "--size",
-            "64x48",
-            "--frames",
-            "1",
-            "--json",
-        ],
-        &[],
-    );
+    let rest = "--backend wgpu --devices 0,0 --size 64x48 --frames 1 --json";
+    let bench = sdfc_on(&d, "bench", &orbit, rest, &[]);
     let json = String::from_utf8_lossy(&bench.stdout);
     assert!(bench.status.success(), "{bench:?}");
     assert!(json.contains("2 devices: "), "{json}");
@@ -500,38 +423,18 @@ fn bad_devices_are_named_in_the_error() {
         ),
         ("0,99", "wgpu", 1, "there is no wgpu adapter 99"),
     ] {
-        let out = sdfc(
-            &d,
-            &[
-                "render",
-                &scene,
-                "--backend",
-                backend,
-                "--devices",
-                devices,
-                "--size",
-                "8x8",
-                "-o",
-                "x.png",
-            ],
-            &[],
-        );
+        let rest = format!("--backend {backend} --devices {devices} --size 8x8 -o x.png");
+        let out = sdfc_on(&d, "render", &scene, &rest, &[]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(code), "{devices}: {err}");
         assert!(err.contains(expected), "{devices}: {err}");
         assert!(!d.join("x.png").exists());
     }
-    let out = sdfc(
+    let out = sdfc_on(
         &d,
-        &[
-            "render",
-            &scene,
-            "--reference",
-            "--devices",
-            "0,0",
-            "-o",
-            "x.png",
-        ],
+        "render",
+        &scene,
+        "--reference --devices 0,0 -o x.png",
         &[],
     );
     let err = String::from_utf8_lossy(&out.stderr);
@@ -549,10 +452,7 @@ fn a_still_and_a_sequence_report_bad_devices_alike() {
     let no_cuda = String::from_utf8_lossy(&listed.stdout)
         .lines()
         .any(|l| l.starts_with("cuda: none"));
-    let orbit = std::fs::canonicalize("../examples/animation/orbit.sdf")
-        .expect("orbit")
-        .display()
-        .to_string();
+    let orbit = example("animation/orbit.sdf");
     let mut cases = vec![
         (
             "cpu,0",
@@ -599,7 +499,7 @@ fn a_frame_without_statistics_is_the_same_image() {
     let Some(gpu) = open_gpu() else { return };
     let gpu = std::sync::Arc::new(gpu);
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed3.sdf");
-    let scene = load(&path, 96, 64);
+    let scene = load_small(&path, 96, 64);
     let lowered = Lowered::new(&scene);
     let frame = |setup: &Setup| {
         Prepared::on_gpu(gpu.clone(), &scene, &lowered, setup)

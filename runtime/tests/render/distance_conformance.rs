@@ -99,7 +99,7 @@ const FEATURES: &str = "../compiler/tests/in/feature";
 
 /// The scenes of the folder `dir` (relative to the runtime crate), lowered.
 fn scenes(dir: &str) -> Vec<Case> {
-    sdf_files(dir)
+    common::sdf_files_in(std::path::Path::new(dir))
         .into_iter()
         .map(|path| {
             let scene = sdfc_runtime::frontend::load(&path)
@@ -136,17 +136,6 @@ fn cases() -> Vec<Case> {
         });
     }
     cases
-}
-
-/// The `.sdf` files in `dir`, sorted.
-fn sdf_files(dir: &str) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{dir}: {e}"))
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
-        .collect();
-    files.sort();
-    files
 }
 
 /// The points: 512 uniform in [-3, 3]³ (where the scenes are) and 64 in [-12, 12]³.
@@ -542,19 +531,9 @@ fn the_ptx_assembles_and_cuda_agrees_with_the_interpreter_in_ulps() {
                     let Some(m) = m else { continue };
                     let file = dir.join(format!("case{i}_{what}.ptx"));
                     std::fs::write(&file, evaluators::points_ptx(&m, 70)).expect("PTX");
-                    let out = std::process::Command::new(&ptxas)
-                        .args(["-arch=sm_80", "-o"])
-                        .arg(dir.join(format!("case{i}_{what}.cubin")))
-                        .arg(&file)
-                        .output()
-                        .expect("run ptxas");
-                    assert!(
-                        out.status.success(),
-                        "{} ({what}): ptxas refused {}:\n{}",
-                        case.name,
-                        file.display(),
-                        String::from_utf8_lossy(&out.stderr)
-                    );
+                    let cubin = dir.join(format!("case{i}_{what}.cubin"));
+                    let named = format!("{} ({what}): {}", case.name, file.display());
+                    evaluators::assemble(&ptxas, &file, &cubin, &named);
                 }
             }
             let _ = std::fs::remove_dir_all(&dir);

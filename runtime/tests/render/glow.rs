@@ -3,15 +3,8 @@
 
 use crate::common;
 
-use common::render_everywhere;
+use common::{checked, render_everywhere};
 use sdfc_compiler::Scene;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
 
 /// A unit sphere seen from (0, 0, −5) on black, no lights, no relaxation (a step is the
 /// distance): the glow of G and colour (0.01, 0.02, 0.04).

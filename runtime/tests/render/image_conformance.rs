@@ -4,10 +4,11 @@
 //! unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe): then it fails.
 
 use crate::common;
+use common::load_small;
 
 use sdfc_compiler::{wgsl, Lowered, Method, Scene};
 use sdfc_runtime::{cpu, frontend, gpu, metrics};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Minimum PSNR (dB) between the wgpu and CPU renders of an example.
 const MIN_PSNR: f64 = 30.0;
@@ -24,18 +25,6 @@ fn open_gpu() -> Option<gpu::Gpu> {
 fn checked(name: &str, text: &str) -> Scene {
     let (scene, diags, _) = sdfc_compiler::check_str(name, text);
     scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
-
-/// A scene file loaded and made small: `width`×`height`, one sample per pixel.
-fn load_small(path: &Path, width: u32, height: u32) -> Scene {
-    let mut scene = frontend::load(path)
-        .expect("readable")
-        .scene
-        .unwrap_or_else(|| panic!("{} is a valid scene", path.display()));
-    scene.settings.width = width;
-    scene.settings.height = height;
-    scene.settings.aa = 1;
-    scene
 }
 
 /// Per example: the least PSNR (dB) and the largest fraction of pixels differing by more
@@ -147,17 +136,8 @@ fn assert_agree(
 ) {
     let on_gpu = gpu::render(gpu, scene, kernel, 1.0, &mut |_| {}).expect("gpu render");
     let on_cpu = cpu::render(scene, lowered, &cpu::Options::default(), &|| {});
-    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
-    println!(
-        "{label}: psnr {:.1} dB, differing {:.4}",
-        d.psnr, d.differing
-    );
-    assert!(
-        d.psnr >= MIN_PSNR && d.differing <= MAX_DIFFERING,
-        "{label}: psnr {:.1} dB, differing {:.4}",
-        d.psnr,
-        d.differing
-    );
+    let pair = (&on_gpu.render.image, &on_cpu.image);
+    common::assert_agree(label, pair, THRESHOLD, (MIN_PSNR, MAX_DIFFERING));
 }
 
 /// A distance program large enough that `map` and `sdf` are cut into functions
@@ -668,16 +648,12 @@ fn a_field_of_two_noises_through_the_interpreted_kernel_matches_the_cpu() {
     let scene = checked("two_noises.sdf", TWO_NOISES);
     let lowered = Lowered::new(&scene);
     let Some(gpu) = open_gpu() else { return };
-    let options = wgsl::Options {
-        kernel: wgsl::KernelChoice::Interpreted,
-        interp_unroll: if gpu.is_cpu() {
-            wgsl::interp::UNROLL_SOFTWARE
-        } else {
-            wgsl::interp::UNROLL
-        },
-        ..wgsl::Options::default()
-    };
-    let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
+    let kernel = common::kernel_for(
+        &scene,
+        &lowered,
+        wgsl::KernelChoice::Interpreted,
+        gpu.is_cpu(),
+    );
     assert!(kernel.interpreted());
     let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
     let on_cpu = cpu::render(&scene, &lowered, &cpu::Options::default(), &|| {});
@@ -709,24 +685,11 @@ fn colour_fields_match_the_cpu_on_every_kernel() {
                   0.5 + 0.5 * sin(6 * p.x + 4 * fbm(p * 1.5, octaves: 2))) }";
     let scene = checked("colours.sdf", &text(marble));
     let Some(gpu) = open_gpu() else { return };
-    for (method, choice) in [
-        (Method::Auto, wgsl::KernelChoice::Specialised),
-        (Method::March, wgsl::KernelChoice::Specialised),
-        (Method::March, wgsl::KernelChoice::Interpreted),
-    ] {
+    for (method, choice) in common::KERNELS {
         let mut scene = scene.clone();
         scene.settings.method = method;
         let lowered = Lowered::new(&scene);
-        let options = wgsl::Options {
-            kernel: choice,
-            interp_unroll: if gpu.is_cpu() {
-                wgsl::interp::UNROLL_SOFTWARE
-            } else {
-                wgsl::interp::UNROLL
-            },
-            ..wgsl::Options::default()
-        };
-        let kernel = wgsl::write_with(&scene, &lowered, &options).expect("valid kernel");
+        let kernel = common::kernel_for(&scene, &lowered, choice, gpu.is_cpu());
         assert!(kernel.contract.has("COLOUR_FIELDS"));
         assert_eq!(
             kernel.interpreted(),

@@ -5,8 +5,9 @@
 //! image tests say they skipped, unless `SDFC_REQUIRE_DEVICES=1`.
 
 use crate::common;
+use crate::common::words;
 
-use common::random_scene;
+use common::{kernel_for, random_scene};
 use sdfc_compiler::{
     wgsl::{self, KernelChoice, Options},
     Lowered, Method, Rng, Scene,
@@ -37,13 +38,7 @@ fn open_gpu() -> Option<gpu::Gpu> {
 /// An example, marched (an analytically traced scene has no distance program in its
 /// kernel), at `width`×`height` with one sample per pixel.
 fn marched(path: &Path, width: u32, height: u32) -> Scene {
-    let mut scene = frontend::load(path)
-        .expect("readable")
-        .scene
-        .unwrap_or_else(|| panic!("{} is a valid scene", path.display()));
-    scene.settings.width = width;
-    scene.settings.height = height;
-    scene.settings.aa = 1;
+    let mut scene = common::load_small(path, width, height);
     scene.settings.method = Method::March;
     // A path-traced example (examples/studio_path.sdf: 64 samples) would cost lavapipe a
     // minute through the interpreted kernel; four samples follow the same paths' code.
@@ -56,26 +51,6 @@ const PATH_SAMPLES: u32 = 4;
 
 fn kernel(scene: &Scene, lowered: &Lowered, kernel: KernelChoice) -> wgsl::Kernel {
     kernel_for(scene, lowered, kernel, false)
-}
-
-/// [`kernel`] for a software adapter (`software`: lavapipe, whose loops share a budget of
-/// iterations) or a GPU, as the runtime writes it (`Setup::software`).
-fn kernel_for(
-    scene: &Scene,
-    lowered: &Lowered,
-    kernel: KernelChoice,
-    software: bool,
-) -> wgsl::Kernel {
-    let options = Options {
-        kernel,
-        interp_unroll: if software {
-            wgsl::interp::UNROLL_SOFTWARE
-        } else {
-            wgsl::interp::UNROLL
-        },
-        ..Options::default()
-    };
-    wgsl::write_with(scene, lowered, &options).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The examples, and the one that imports a triangle mesh (examples/mesh/import.sdf).
@@ -328,14 +303,9 @@ fn bad_combinations_are_refused() {
         );
     }
     // A traced scene has no distance program to interpret.
-    let (code, err) = sdfc(&[
-        "compile",
-        "../examples/seed2.sdf",
-        "--emit",
-        "wgsl",
-        "--kernel",
-        "interpreted",
-    ]);
+    let (code, err) = sdfc(&words(
+        "compile ../examples/seed2.sdf --emit wgsl --kernel interpreted",
+    ));
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("traced analytically") && err.contains("--set method=march"),
@@ -358,30 +328,18 @@ fn bad_combinations_are_refused() {
         assert!(!Path::new(out).exists());
     }
     // Too few registers: the error names the limit that raises it.
-    let (code, err) = sdfc(&[
-        "compile",
-        "../examples/seed3.sdf",
-        "--emit",
-        "wgsl",
-        "--kernel",
-        "interpreted",
-        "--limit",
-        "registers=2",
-    ]);
+    let (code, err) = sdfc(&words(
+        "compile ../examples/seed3.sdf --emit wgsl --kernel interpreted --limit registers=2",
+    ));
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("registers and the kernel has 2") && err.contains("--limit registers="),
         "{err}"
     );
     // `--kernel` goes with the kernel's targets only.
-    let (code, err) = sdfc(&[
-        "compile",
-        "../examples/seed3.sdf",
-        "--emit",
-        "program",
-        "--kernel",
-        "interpreted",
-    ]);
+    let (code, err) = sdfc(&words(
+        "compile ../examples/seed3.sdf --emit program --kernel interpreted",
+    ));
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("`--kernel` chooses the renderer kernel"),

@@ -4,16 +4,9 @@
 
 use crate::common;
 
-use common::render_everywhere;
+use common::{checked, render_everywhere};
 use sdfc_compiler::{look, Scene, Tonemap};
 use sdfc_runtime::image::Image;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
 
 /// A white floor and a wall standing on it along x = 0 (the box spans x from 0 to 2), lit by
 /// the ambient term alone (ambient 1, no lights: a pixel is its occlusion), seen straight
@@ -195,23 +188,9 @@ fn band_error(a: &Image, b: &Image, rows: std::ops::Range<u32>) -> f64 {
 fn a_checker_is_filtered_over_the_pixels_footprint() {
     let text = "
 material floor = checker { a: (1, 1, 1), b: (0, 0, 0), size: 0.5, ambient: 1, diffuse: 0, specular: 0 };
-camera { position: (0, 1, -4), look_at: (0, 0.6, 4), fov: 40deg }
-render { width: 160, height: 100, max_dist: 300, background: (0.5, 0.5, 0.5) AA }
-scene { plane() @ floor; }
 ";
-    let one = checked("one sample", &text.replace("AA", ""));
-    let many = checked("12×12 samples", &text.replace("AA", ", aa: 12"));
-    let truth = sdfc_runtime::cpu::render(
-        &many,
-        &sdfc_compiler::Lowered::new(&many),
-        &sdfc_runtime::cpu::Options::default(),
-        &|| {},
-    )
-    .image;
     // The rows just below the horizon (row 50 is the horizon's neighbourhood at this tilt).
-    let horizon = (0..one.settings.height)
-        .find(|&y| truth.pixel(80, y)[0] != 0.5)
-        .expect("the floor");
+    let (one, truth, horizon) = common::floor_to_the_horizon(text);
     let far = horizon + 1..horizon + 12;
     for (backend, image) in render_everywhere("one sample", &one) {
         let error = band_error(&image, &truth, far.clone());

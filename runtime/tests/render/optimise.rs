@@ -9,8 +9,8 @@ use crate::common;
 use common::*;
 use glam::DVec3;
 use sdfc_compiler::{
-    eval_point, lower_scene, lower_with, rust, wgsl, Evaluator, Float, LowerOptions, Lowered,
-    Method, Op, Outputs, Program, Rng, Scene, Step, Tape,
+    eval_point, lower_scene, lower_with, rust, wgsl, Evaluator, LowerOptions, Lowered, Method, Op,
+    Outputs, Program, Rng, Scene, Step, Tape,
 };
 use sdfc_runtime::cpu::{self, Options, Precision};
 use sdfc_runtime::frontend;
@@ -52,13 +52,7 @@ const LITERAL: LowerOptions = LowerOptions {
 
 /// The `.sdf` files directly inside `dir` (relative to the workspace root), sorted.
 fn sdf_files(dir: &str) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(Path::new("..").join(dir))
-        .unwrap_or_else(|e| panic!("cannot list {dir}: {e}"))
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "sdf"))
-        .collect();
-    files.sort();
-    files
+    sdf_files_in(&Path::new("..").join(dir))
 }
 
 /// A scene, sphere traced (`method: "march"`) whatever it allows: these tests are about the
@@ -99,16 +93,6 @@ fn points(scene: &Scene, seed: u64, n: usize) -> Vec<[f64; 3]> {
             [c[0] + q[0], c[1] + q[1], c[2] + q[2]]
         })
         .collect()
-}
-
-fn batch<T: Float>(program: &Program, pts: &[[f64; 3]], chunk: usize) -> (Vec<T>, Vec<u32>) {
-    let tape = Tape::new(program, Outputs::DistanceAndMaterial);
-    let mut ev = Evaluator::<T>::new(&tape, chunk);
-    let c = |i: usize| pts.iter().map(|p| T::from_f64(p[i])).collect::<Vec<T>>();
-    let mut d = vec![T::zero(); pts.len()];
-    let mut m = vec![0u32; pts.len()];
-    ev.eval(&c(0), &c(1), &c(2), &mut d, Some(&mut m));
-    (d, m)
 }
 
 #[test]
@@ -166,7 +150,7 @@ fn the_batch_interpreter_runs_blocks_like_the_reference_path() {
         let program = lower_with(&scene, &CULL);
         let pts = points(&scene, 5, 700);
         for chunk in [1, 7, 64, 256] {
-            let (d, m) = batch::<f32>(&program, &pts, chunk);
+            let (d, m) = run_batch::<f32>(&program, Outputs::DistanceAndMaterial, chunk, &pts);
             for (i, p) in pts.iter().enumerate() {
                 let (rd, rm) = eval_point::<f32>(&program, p.map(|v| v as f32));
                 assert!(
@@ -217,8 +201,8 @@ fn the_passes_keep_the_distance_field() {
         }
         // Materials can differ only where two children are exactly as near (none here).
         assert_eq!(materials, 0, "{name}");
-        let (d1, _) = batch::<f32>(&opt, &pts, 256);
-        let (d0, _) = batch::<f32>(&literal, &pts, 256);
+        let (d1, _) = run_batch::<f32>(&opt, Outputs::DistanceAndMaterial, 256, &pts);
+        let (d0, _) = run_batch::<f32>(&literal, Outputs::DistanceAndMaterial, 256, &pts);
         for (i, p) in pts.iter().enumerate() {
             let scale = 1.0 + len3(*p) + (d0[i] as f64).abs();
             let diff = (d1[i] as f64 - d0[i] as f64).abs();

@@ -5,30 +5,14 @@
 //! giving the same picture.
 
 use crate::common;
+use crate::evaluators;
 
-use common::render_everywhere;
+use common::{checked, cpu_image, render_everywhere};
 use sdfc_compiler::{Lowered, Method, Scene};
-use sdfc_runtime::backend::{Backend, Prepared};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::metrics;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
-
-/// `scene` rendered on the CPU in `precision`.
-fn cpu(scene: &Scene, precision: Precision) -> Image {
-    let prepared = Prepared::new(Backend::Cpu, scene, precision).expect("the CPU");
-    prepared
-        .render(scene, &|_| {})
-        .expect("renders")
-        .render
-        .image
-}
+use std::path::Path;
 
 /// The PSNR of `a` against `b`.
 fn psnr(a: &Image, b: &Image) -> f64 {
@@ -48,12 +32,7 @@ fn assembles(what: &str, scene: &Scene) {
     let text = sdfc_compiler::ptx::write(&kernel.module, &kernel.info, &options)
         .unwrap_or_else(|e| panic!("{what}: {e}"))
         .text;
-    let found = std::env::var_os("PATH").and_then(|p| {
-        std::env::split_paths(&p)
-            .map(|d| d.join("ptxas"))
-            .find(|p| p.is_file())
-    });
-    let Some(ptxas) = found else {
+    let Some(ptxas) = evaluators::ptxas() else {
         assert!(
             std::env::var("SDFC_REQUIRE_DEVICES").as_deref() != Ok("1"),
             "SDFC_REQUIRE_DEVICES=1 but no ptxas on PATH"
@@ -63,17 +42,8 @@ fn assembles(what: &str, scene: &Scene) {
     };
     let path = std::env::temp_dir().join(format!("sdfc_path_{what}_{}.ptx", std::process::id()));
     std::fs::write(&path, &text).unwrap();
-    let out = std::process::Command::new(ptxas)
-        .args(["-arch=sm_80", "-o", "/dev/null"])
-        .arg(&path)
-        .output()
-        .expect("ptxas runs");
+    evaluators::assemble(&ptxas, &path, Path::new("/dev/null"), what);
     let _ = std::fs::remove_file(&path);
-    assert!(
-        out.status.success(),
-        "ptxas rejected {what}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 /// A sphere of the material `MAT` under a sky of radiance 1 all round, which is also the
@@ -98,7 +68,7 @@ fn furnace(mat: &str, samples: u32) -> Scene {
 /// Every image of `scene`: the backends of [`render_everywhere`] and the f64 reference.
 fn everywhere(what: &str, scene: &Scene) -> Vec<(&'static str, Image)> {
     let mut out = render_everywhere(what, scene);
-    out.push(("f64", cpu(scene, Precision::F64)));
+    out.push(("f64", cpu_image(scene, Precision::F64)));
     out
 }
 
@@ -108,7 +78,7 @@ fn sphere_pixels() -> Vec<(u32, u32)> {
         "phong { color: (0.5, 0.5, 0.5), ambient: 0, diffuse: 1, specular: 0 }",
         4,
     );
-    let image = cpu(&grey, Precision::F32);
+    let image = cpu_image(&grey, Precision::F32);
     let on: Vec<(u32, u32)> = (0..32)
         .flat_map(|y| (0..32).map(move |x| (x, y)))
         .filter(|&(x, y)| image.pixel(x, y)[0] < 0.9)
@@ -129,16 +99,7 @@ fn the_white_furnace_holds_when_path_traced() {
         4,
     );
     for (backend, image) in everywhere("white furnace", &white) {
-        for y in 0..32 {
-            for x in 0..32 {
-                for v in image.pixel(x, y) {
-                    assert!(
-                        (v - 1.0).abs() < 1e-4,
-                        "{backend}: ({x}, {y}) is {v}, not 1"
-                    );
-                }
-            }
-        }
+        common::assert_white(&image, 32, 1e-4, backend);
     }
     let metal = furnace(
         "pbr { base_color: (1, 1, 1), metallic: 1, roughness: 0.6 }",
@@ -191,12 +152,12 @@ fn noise_falls_as_one_over_the_root_of_the_samples() {
         "the ball is traced analytically"
     );
     scene.settings.samples = 1024;
-    let reference = cpu(&scene, Precision::F64);
+    let reference = cpu_image(&scene, Precision::F64);
     let mut last = None;
     let mut first = None;
     for samples in [4, 8, 16, 32, 64] {
         scene.settings.samples = samples;
-        let db = psnr(&cpu(&scene, Precision::F32), &reference);
+        let db = psnr(&cpu_image(&scene, Precision::F32), &reference);
         println!("{samples} samples: {db:.2} dB");
         if let Some(before) = last {
             let gain: f64 = db - before;
@@ -269,10 +230,10 @@ fn traced_and_marched_paths_agree() {
         .traced(Method::Auto)
         .is_some());
     scene.settings.samples = 16;
-    let traced = cpu(&scene, Precision::F32);
+    let traced = cpu_image(&scene, Precision::F32);
     scene.settings.method = Method::March;
     assert!(scene.settings.path, "still path traced");
-    let marched = cpu(&scene, Precision::F32);
+    let marched = cpu_image(&scene, Precision::F32);
     let d = metrics::compare(&traced, &marched, 0.1).expect("same size");
     println!(
         "traced against marched: {:.1} dB, {:.4} of pixels",

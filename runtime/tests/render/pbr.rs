@@ -4,15 +4,8 @@
 
 use crate::common;
 
-use common::render_everywhere;
+use common::{checked, render_everywhere};
 use sdfc_compiler::Scene;
-
-fn checked(name: &str, text: &str) -> Scene {
-    let (scene, diags, _) = sdfc_compiler::check_str(name, text);
-    let errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:?}");
-    scene.unwrap_or_else(|| panic!("{name}: {diags:?}"))
-}
 
 /// A sphere of the material `MAT` under a sky of radiance 1 all round, which is also the
 /// background (so that the rays the sphere reflects see it), without occlusion.
@@ -57,16 +50,8 @@ fn the_white_furnace_holds_for_pbr() {
             ),
         );
         for (backend, image) in render_everywhere("white furnace", &white) {
-            for y in 0..40 {
-                for x in 0..40 {
-                    for v in image.pixel(x, y) {
-                        assert!(
-                            (v - 1.0).abs() < 2e-4,
-                            "{backend}: roughness {roughness}: ({x}, {y}) is {v}"
-                        );
-                    }
-                }
-            }
+            let what = format!("{backend}: roughness {roughness}");
+            common::assert_white(&image, 40, 2e-4, &what);
         }
     }
     for (roughness, least) in [(0.0, 0.999), (0.5, 0.6), (1.0, 0.35)] {

@@ -7,7 +7,6 @@ use crate::common;
 
 use common::*;
 use sdfc_compiler::Scene;
-use sdfc_runtime::backend::{Backend, Prepared};
 use sdfc_runtime::cpu::Precision;
 use sdfc_runtime::image::Image;
 
@@ -34,15 +33,6 @@ const FLOOR: (u32, u32, u32, u32) = (222, 78, 246, 104);
 fn checked(name: &str, text: &str) -> Scene {
     let (scene, diags, _) = sdfc_compiler::check_str(name, text);
     scene.unwrap_or_else(|| panic!("{diags:?}"))
-}
-
-fn render_cpu(scene: &Scene, precision: Precision) -> Image {
-    let prepared = Prepared::new(Backend::Cpu, scene, precision).expect("the CPU backend");
-    prepared
-        .render(scene, &|_| {})
-        .expect("a CPU render")
-        .render
-        .image
 }
 
 /// The vase's penumbrae are smooth on every backend. The rim's field `max(wall, cap)` has a
@@ -100,7 +90,7 @@ fn the_dark_pixels_at_the_vases_rim_ends_are_its_wall_in_its_own_shade() {
         linear: vec![[0.08, 0.05, 0.03]],
     })[0];
     for precision in [Precision::F32, Precision::F64] {
-        let g = grey(&render_cpu(&scene, precision));
+        let g = grey(&cpu_image(&scene, precision));
         let at = |x: u32, y: u32| g[(y * 320 + x) as usize];
         let column: Vec<f64> = (78..88).map(|y| at(219, y)).collect();
         println!("{precision:?}: x = 219, y = 78 to 87: {column:.2?}");
@@ -134,7 +124,7 @@ fn the_cut_shells_penumbra_has_no_streaks() {
                  }";
     let region = (215, 120, 280, 170);
     let scene = checked("shell.sdf", shell);
-    let soft = roughness(&grey(&render_cpu(&scene, Precision::F32)), 400, region);
+    let soft = roughness(&grey(&cpu_image(&scene, Precision::F32)), 400, region);
     println!("roughness: {soft:.5}");
     assert!(soft < 0.003, "the penumbra streaks: roughness {soft:.5}");
     assert!(soft > 0.001, "the penumbra is gone: roughness {soft:.5}");

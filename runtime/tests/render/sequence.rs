@@ -5,6 +5,7 @@
 //! of their ecosystems.
 
 use crate::animation::BASE;
+use crate::common::words;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -21,6 +22,21 @@ pub(crate) fn dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).expect("temp dir");
     d
+}
+
+/// A fresh directory `name` holding `moving.sdf`.
+fn moving(name: &str) -> PathBuf {
+    let d = dir(name);
+    std::fs::write(d.join("moving.sdf"), MOVING).unwrap();
+    d
+}
+
+/// `sdfc` run in `cwd` with the words of `line`, which must succeed: its output.
+#[track_caller]
+fn ok(cwd: &Path, line: &str) -> Output {
+    let o = sdfc(cwd, &words(line));
+    assert!(o.status.success(), "{}", text(&o));
+    o
 }
 
 pub(crate) fn sdfc(cwd: &Path, args: &[&str]) -> Output {
@@ -58,22 +74,11 @@ fn files(d: &Path) -> Vec<String> {
 
 #[test]
 fn frames_are_numbered_by_the_pattern_in_a_new_directory() {
-    let d = dir("numbered");
-    std::fs::write(d.join("moving.sdf"), MOVING).unwrap();
-    let o = sdfc(
+    let d = moving("numbered");
+    ok(
         &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--backend",
-            "cpu",
-            "--frames",
-            "8..11",
-            "-o",
-            "out/sub/f_###.png",
-        ],
+        "render moving.sdf --backend cpu --frames 8..11 -o out/sub/f_###.png",
     );
-    assert!(o.status.success(), "{}", text(&o));
     assert_eq!(
         files(&d.join("out/sub")),
         ["f_008.png", "f_009.png", "f_010.png"]
@@ -84,18 +89,7 @@ fn frames_are_numbered_by_the_pattern_in_a_new_directory() {
     assert_ne!(a, b);
     // Without --frames, the pattern renders the scene's fps × duration; numbers wider than
     // the run are written in full.
-    let o = sdfc(
-        &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--backend",
-            "cpu",
-            "-o",
-            "all/#.png",
-        ],
-    );
-    assert!(o.status.success(), "{}", text(&o));
+    ok(&d, "render moving.sdf --backend cpu -o all/#.png");
     let want: Vec<String> = (0..10).map(|k| format!("{k}.png")).collect::<Vec<_>>();
     let mut want = want;
     want.sort();
@@ -113,8 +107,7 @@ fn frames_are_numbered_by_the_pattern_in_a_new_directory() {
 
 #[test]
 fn shards_render_every_frame_exactly_once() {
-    let d = dir("shards");
-    std::fs::write(d.join("moving.sdf"), MOVING).unwrap();
+    let d = moving("shards");
     let n = 3;
     for i in 0..n {
         let o = sdfc(
@@ -147,57 +140,27 @@ fn shards_render_every_frame_exactly_once() {
     // A shard's frames are the frames its index picks out, whatever the others did.
     let o = sdfc(
         &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--frames",
-            "0..4",
-            "--shard",
-            "3/3",
-            "-o",
-            "x_#.png",
-        ],
+        &words("render moving.sdf --frames 0..4 --shard 3/3 -o x_#.png"),
     );
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     // An animated PNG cannot be sharded.
     let o = sdfc(
         &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--frames",
-            "0..4",
-            "--shard",
-            "0/2",
-            "-o",
-            "a.png",
-        ],
+        &words("render moving.sdf --frames 0..4 --shard 0/2 -o a.png"),
     );
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
 }
 
 #[test]
 fn a_killed_render_resumes_where_it_stopped() {
-    let d = dir("resume");
-    std::fs::write(d.join("moving.sdf"), MOVING).unwrap();
+    let d = moving("resume");
     let out = d.join("out");
     // Slow frames (big, supersampled) so that the kill lands mid-sequence.
     let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&d)
-        .args([
-            "render",
-            "moving.sdf",
-            "--backend",
-            "cpu",
-            "--frames",
-            "0..40",
-            "--size",
-            "320x240",
-            "--aa",
-            "3",
-            "-o",
-            "out/f_##.png",
-        ])
+        .args(words(
+            "render moving.sdf --backend cpu --frames 0..40 --size 320x240 --aa 3 -o out/f_##.png",
+        ))
         .stderr(std::process::Stdio::null())
         .spawn()
         .expect("spawn");
@@ -230,20 +193,9 @@ fn a_killed_render_resumes_where_it_stopped() {
         .collect();
     let o = sdfc(
         &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--backend",
-            "cpu",
-            "--frames",
-            "0..40",
-            "--size",
-            "320x240",
-            "--aa",
-            "3",
-            "-o",
-            "out/f_##.png",
-        ],
+        &words(
+            "render moving.sdf --backend cpu --frames 0..40 --size 320x240 --aa 3 -o out/f_##.png",
+        ),
     );
     assert!(o.status.success(), "{}", text(&o));
     let log = text(&o);
@@ -270,17 +222,7 @@ fn a_killed_render_resumes_where_it_stopped() {
     }
     let o = sdfc(
         &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--backend",
-            "cpu",
-            "--frames",
-            "0..3",
-            "-o",
-            "out/f_##.png",
-            "--force",
-        ],
+        &words("render moving.sdf --backend cpu --frames 0..3 -o out/f_##.png --force"),
     );
     assert!(
         text(&o).contains("3 to render, 0 already written"),
@@ -291,22 +233,11 @@ fn a_killed_render_resumes_where_it_stopped() {
 
 #[test]
 fn an_animated_png_holds_every_frame() {
-    let d = dir("apng");
-    std::fs::write(d.join("moving.sdf"), MOVING).unwrap();
-    let o = sdfc(
+    let d = moving("apng");
+    ok(
         &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--backend",
-            "cpu",
-            "--frames",
-            "0..6",
-            "-o",
-            "loop.png",
-        ],
+        "render moving.sdf --backend cpu --frames 0..6 -o loop.png",
     );
-    assert!(o.status.success(), "{}", text(&o));
     let decoder = png::Decoder::new(std::io::BufReader::new(
         std::fs::File::open(d.join("loop.png")).unwrap(),
     ));
@@ -329,8 +260,7 @@ fn an_animated_png_holds_every_frame() {
 
 #[test]
 fn a_video_needs_ffmpeg_on_path() {
-    let d = dir("video");
-    std::fs::write(d.join("moving.sdf"), MOVING).unwrap();
+    let d = moving("video");
     let empty = d.join("empty");
     std::fs::create_dir_all(&empty).unwrap();
     let o = sdfc_env(
@@ -354,16 +284,7 @@ fn a_video_needs_ffmpeg_on_path() {
     std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
     let o = sdfc_env(
         &d,
-        &[
-            "render",
-            "moving.sdf",
-            "--backend",
-            "cpu",
-            "--frames",
-            "0..3",
-            "-o",
-            "clip.mp4",
-        ],
+        &words("render moving.sdf --backend cpu --frames 0..3 -o clip.mp4"),
         &[("PATH", bin.to_str().unwrap())],
     );
     assert!(o.status.success(), "{}", text(&o));
@@ -487,22 +408,7 @@ fn job_array_files_parse() {
 #[test]
 fn bench_times_a_sequence_and_counts_its_kernels() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let o = sdfc(
-        &root,
-        &[
-            "bench",
-            "--frames-per-second",
-            "--backend",
-            "cpu",
-            "--size",
-            "64x48",
-            "--sequence",
-            "0..5",
-            "--json",
-            "examples/animation/orbit.sdf",
-        ],
-    );
-    assert!(o.status.success(), "{}", text(&o));
+    let o = ok(&root, "bench --frames-per-second --backend cpu --size 64x48 --sequence 0..5 --json examples/animation/orbit.sdf");
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
     let t = &v[0];
     assert_eq!(t["timed"], 4);

@@ -142,18 +142,21 @@ fn glass_scene(ball: Option<(f64, f64)>) -> Scene {
     scene
 }
 
+/// How many pixels of `a` and `b` differ by more than 0.02 in red.
+fn red_differs(a: &sdfc_runtime::image::Image, b: &sdfc_runtime::image::Image) -> usize {
+    a.linear
+        .iter()
+        .zip(&b.linear)
+        .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
+        .count()
+}
+
 #[test]
 fn clear_glass_of_index_one_is_invisible() {
     for method in METHODS {
         let bare = render_as(method, &glass_scene(None));
         let clear = render_as(method, &glass_scene(Some((1.0, 1.0))));
-        let differ = bare
-            .image
-            .linear
-            .iter()
-            .zip(&clear.image.linear)
-            .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
-            .count();
+        let differ = red_differs(&bare.image, &clear.image);
         assert!(
             differ * 50 < bare.image.linear.len(),
             "{differ} pixels differ"
@@ -161,13 +164,7 @@ fn clear_glass_of_index_one_is_invisible() {
         assert!(clear.stats.counters.secondary_rays > 0);
         // Real glass bends the checkerboard: many pixels change, none is NaN.
         let glass = render_as(method, &glass_scene(Some((0.9, 1.5))));
-        let changed = bare
-            .image
-            .linear
-            .iter()
-            .zip(&glass.image.linear)
-            .filter(|(a, b)| (a[0] - b[0]).abs() > 0.02)
-            .count();
+        let changed = red_differs(&bare.image, &glass.image);
         assert!(changed > 300, "{changed}");
         assert!(glass
             .image

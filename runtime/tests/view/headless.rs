@@ -2,10 +2,11 @@
 //! accumulated, frames that stop once the image settles, a scene that never loads, and an
 //! orbit measured.
 
+use crate::words;
 use crate::{headless_run, mean, required, temp_dir, CENTRE, SCENE};
 use sdfc_runtime::image::read_png;
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Output};
 
 /// Headless through wgpu (lavapipe without a GPU), the frames stay on the device and the
 /// screenshot is read back from it: the scene's picture, after its kernel compiled on another
@@ -14,25 +15,9 @@ use std::process::Command;
 fn headless_wgpu_screenshot_shows_the_scene() {
     let dir = temp_dir("headless-wgpu");
     std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&dir)
-        .args(["view", "scene.sdf", "--headless", "--backend", "wgpu"])
-        .args([
-            "--size",
-            "64x48",
-            "--frames",
-            "3",
-            "--screenshot",
-            "shot.png",
-        ])
-        .args(["--timings"])
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    if stderr.contains("the Wgpu backend is not available") {
-        assert!(!required(), "{stderr}");
-        eprintln!("SKIPPED: no wgpu adapter\n{stderr}");
+    let args = "view scene.sdf --headless --backend wgpu --size 64x48 --frames 3 --screenshot shot.png --timings";
+    let (out, stderr) = sdfc_in(&dir, &words(args));
+    if no_wgpu(&stderr) {
         return;
     }
     assert!(out.status.success(), "{stderr}");
@@ -77,57 +62,22 @@ fn headless_wgpu_path_tracing_accumulates_the_scenes_samples() {
             "light sky { zenith: (0.3, 0.4, 0.7), horizon: (0.8, 0.8, 0.8) }\nlight point",
         );
     std::fs::write(dir.join("scene.sdf"), &scene).unwrap();
-    let check = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&dir)
-        .args(["check", "scene.sdf"])
-        .output()
-        .unwrap();
-    let said = String::from_utf8_lossy(&check.stderr).into_owned()
-        + &String::from_utf8_lossy(&check.stdout);
+    let (check, said) = sdfc_in(&dir, &["check", "scene.sdf"]);
+    let said = said + &String::from_utf8_lossy(&check.stdout);
     assert!(
         said.contains("tone curve: filmic (the default where it is path traced"),
         "{said}"
     );
-    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&dir)
-        .args(["view", "scene.sdf", "--headless", "--backend", "wgpu"])
-        .args([
-            "--size",
-            "64x48",
-            "--frames",
-            "40",
-            "--screenshot",
-            "shot.png",
-        ])
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    if stderr.contains("the Wgpu backend is not available") {
-        assert!(!required(), "{stderr}");
-        eprintln!("SKIPPED: no wgpu adapter\n{stderr}");
+    let args =
+        "view scene.sdf --headless --backend wgpu --size 64x48 --frames 40 --screenshot shot.png";
+    let (out, stderr) = sdfc_in(&dir, &words(args));
+    if no_wgpu(&stderr) {
         return;
     }
     assert!(out.status.success(), "{stderr}");
-    let rendered = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&dir)
-        .args([
-            "render",
-            "scene.sdf",
-            "--backend",
-            "wgpu",
-            "--size",
-            "64x48",
-        ])
-        .args(["-o", "render.png"])
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
-    assert!(
-        rendered.status.success(),
-        "{}",
-        String::from_utf8_lossy(&rendered.stderr)
-    );
+    let args = "render scene.sdf --backend wgpu --size 64x48 -o render.png";
+    let (rendered, stderr) = sdfc_in(&dir, &words(args));
+    assert!(rendered.status.success(), "{stderr}");
     let shot = read_png(&dir.join("shot.png")).unwrap();
     let render = read_png(&dir.join("render.png")).unwrap();
     let most = shot
@@ -142,20 +92,9 @@ fn headless_wgpu_path_tracing_accumulates_the_scenes_samples() {
         "the view's six frames against the render: {most}"
     );
     // One frame alone is another picture: the frames were six samples, not one six times.
-    let one = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&dir)
-        .args(["view", "scene.sdf", "--headless", "--backend", "wgpu"])
-        .args([
-            "--size",
-            "64x48",
-            "--frames",
-            "1",
-            "--screenshot",
-            "one.png",
-        ])
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
+    let args =
+        "view scene.sdf --headless --backend wgpu --size 64x48 --frames 1 --screenshot one.png";
+    let (one, _) = sdfc_in(&dir, &words(args));
     assert!(one.status.success());
     let one = read_png(&dir.join("one.png")).unwrap();
     assert_ne!(one.linear, shot.linear);
@@ -164,17 +103,33 @@ fn headless_wgpu_path_tracing_accumulates_the_scenes_samples() {
 
 /// `sdfc view scene.sdf --headless` (auto) in `dir` for one frame: its status and stderr.
 fn headless_auto(dir: &Path) -> (std::process::ExitStatus, String) {
+    let args = "view scene.sdf --headless --size 32x24 --frames 1 --screenshot auto.png";
+    let (out, stderr) = sdfc_in(dir, &words(args));
+    (out.status, stderr)
+}
+
+/// `sdfc` run in `dir` with `args`, wgpu's runtime folder set: its output and its standard
+/// error.
+fn sdfc_in(dir: &Path, args: &[&str]) -> (Output, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(dir)
-        .args(["view", "scene.sdf", "--headless", "--size", "32x24"])
-        .args(["--frames", "1", "--screenshot", "auto.png"])
+        .args(args)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .output()
         .unwrap();
-    (
-        out.status,
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    (out, stderr)
+}
+
+/// Whether wgpu found no adapter, as `stderr` says: then the test skips (or, under
+/// `SDFC_REQUIRE_DEVICES=1`, fails).
+fn no_wgpu(stderr: &str) -> bool {
+    let missing = stderr.contains("the Wgpu backend is not available");
+    if missing {
+        assert!(!required(), "{stderr}");
+        eprintln!("SKIPPED: no wgpu adapter\n{stderr}");
+    }
+    missing
 }
 
 /// Headless with `--frames`, the settled image counts as frames: a scene that converges in
@@ -183,18 +138,8 @@ fn headless_auto(dir: &Path) -> (std::process::ExitStatus, String) {
 fn headless_frames_stop_after_the_image_settles() {
     let dir = temp_dir("headless-frames");
     std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
-    let (status, stderr) = headless_run(
-        &dir,
-        &[
-            "scene.sdf",
-            "--size",
-            "64x48",
-            "--frames",
-            "40",
-            "--screenshot",
-            "shot.png",
-        ],
-    );
+    let args = "scene.sdf --size 64x48 --frames 40 --screenshot shot.png";
+    let (status, stderr) = headless_run(&dir, &words(args));
     assert!(status.success(), "{stderr}");
     let shot = read_png(&dir.join("shot.png")).unwrap();
     assert_eq!((shot.width, shot.height), (64, 48));
@@ -208,18 +153,8 @@ fn headless_screenshot_of_a_scene_that_never_loads_fails() {
     let dir = temp_dir("headless-broken");
     std::fs::write(dir.join("broken.sdf"), "scene { sphre(1); }").unwrap();
     for file in ["broken.sdf", "missing.sdf"] {
-        let (status, stderr) = headless_run(
-            &dir,
-            &[
-                file,
-                "--size",
-                "32x24",
-                "--frames",
-                "3",
-                "--screenshot",
-                "shot.png",
-            ],
-        );
+        let args = format!("{file} --size 32x24 --frames 3 --screenshot shot.png");
+        let (status, stderr) = headless_run(&dir, &words(&args));
         assert!(!status.success(), "{file}: {stderr}");
         assert!(stderr.contains("no screenshot written"), "{file}: {stderr}");
         assert!(

@@ -40,6 +40,11 @@ scene {
 /// How long one reload may take to reach its screenshot (lavapipe on a busy 2-core machine).
 const PATIENCE: Duration = Duration::from_secs(180);
 
+/// The words of `line`, split at white space: a command's arguments written as one line.
+fn words(line: &str) -> Vec<&str> {
+    line.split_whitespace().collect()
+}
+
 fn required() -> bool {
     std::env::var("SDFC_REQUIRE_DEVICES").as_deref() == Ok("1")
 }
@@ -84,15 +89,7 @@ fn display() -> Option<Display> {
     // Xvfb picks a free display number itself (so tests running at once do not collide) and
     // writes it to the descriptor given once it accepts connections.
     let child = Command::new("Xvfb")
-        .args([
-            "-displayfd",
-            "1",
-            "-screen",
-            "0",
-            "1024x768x24",
-            "-nolisten",
-            "tcp",
-        ])
+        .args(words("-displayfd 1 -screen 0 1024x768x24 -nolisten tcp"))
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn();

@@ -1,6 +1,7 @@
 //! The window's screenshots: the scene after some frames, CPU frames without an adapter, an
 //! animated scene at a time, and new kernels shown interpreted while they compile.
 
+use crate::words;
 use crate::{changed, display, exited, mean, temp_dir, wait_for, Display, CENTRE, LEFT, SCENE};
 use sdfc_runtime::image::{read_png, Image};
 use std::path::Path;
@@ -16,16 +17,9 @@ fn screenshot_after_frames(name: &str, env: &[(&str, &str)]) -> String {
     std::fs::create_dir_all(dir.join("xdg")).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&dir)
-        .args([
-            "view",
-            "scene.sdf",
-            "--size",
-            "200x100",
-            "--frames",
-            "6",
-            "--screenshot",
-            "shot.png",
-        ])
+        .args(words(
+            "view scene.sdf --size 200x100 --frames 6 --screenshot shot.png",
+        ))
         .env("DISPLAY", &display.name)
         .env("XDG_RUNTIME_DIR", dir.join("xdg"))
         .env_remove("WAYLAND_DISPLAY")

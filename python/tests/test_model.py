@@ -370,10 +370,10 @@ class Outputs(unittest.TestCase):
 class Stubs(unittest.TestCase):
     def test_stubs_are_current(self):
         path = Path(model.__file__).with_name("model.pyi")
-        self.assertEqual(path.read_text(), stubs.generate(), "python -m sdfc.stubs > python/sdfc/model.pyi")
+        self.assertEqual(path.read_text(), stubs.generate(), "python -m sdfc.stubs python/sdfc/model.pyi")
         source = ROOT / "python" / "sdfc" / "model.pyi"
         if source.exists():
-            self.assertEqual(source.read_text(), stubs.generate(), "python -m sdfc.stubs > python/sdfc/model.pyi")
+            self.assertEqual(source.read_text(), stubs.generate(), "python -m sdfc.stubs python/sdfc/model.pyi")
 
     def test_stubs_name_every_public_method(self):
         tree = ast.parse(stubs.generate())

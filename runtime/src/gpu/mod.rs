@@ -194,7 +194,7 @@ fn render_one<D: launch::Device>(
         tiles: &tiles,
         timed: true,
         statistics,
-        finished,
+        target: launch::Target::read_back(finished),
     };
     let out = launch::render_one(device, &work, faults, progress)?;
     Ok(finish(out, s))
@@ -236,7 +236,7 @@ pub fn render_several(
         tiles: &tiles,
         timed: false,
         statistics,
-        finished,
+        target: launch::Target::read_back(finished),
     };
     let out = launch::render_several(devices, &work, faults, progress)?;
     Ok(finish(out, s))

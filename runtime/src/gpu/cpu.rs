@@ -104,7 +104,7 @@ impl launch::Device for Device<'_> {
                 .position(|(have, _)| have == r)
                 .ok_or_else(|| Error::NotRendered(r.clone()))?;
             let (_, linear) = f.rendered.swap_remove(at);
-            if work.finished {
+            if work.finished() {
                 // Finished here as a GPU finishes its pixels: clamped and sRGB-encoded.
                 let start = std::time::Instant::now();
                 let table = crate::image::SrgbTable::get();

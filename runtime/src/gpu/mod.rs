@@ -192,7 +192,7 @@ fn work<'a>(
         tiles,
         timed,
         statistics,
-        finished,
+        target: launch::Target::read_back(finished),
     }
 }
 

@@ -52,7 +52,7 @@ impl Compile {
     /// has ended. `None` for a scene prepared for anything but wgpu (nothing to compile).
     /// Where no thread can be started, the pipeline is compiled before this returns.
     /// `first` is what the scene's first frame will read, for the kernel's first dispatch
-    /// ([`super::resident::warm`]).
+    /// ([`crate::gpu::Gpu::warm`]).
     pub fn start(prepared: &Prepared, first: Option<FirstFrame>, done: Waker) -> Option<Compile> {
         let wgpu = prepared.as_wgpu()?;
         let (gpu, kernel) = (&wgpu.gpu, &wgpu.kernel);
@@ -72,7 +72,8 @@ impl Compile {
                         return Ok(p);
                     }
                     let start = Instant::now();
-                    resident::warm(&gpu, &source, data, first.as_ref())?;
+                    let first = first.as_ref().map(|f| (&f.uniforms[..], f.tile));
+                    gpu.warm((&source, wgsl::ENTRY_POINT, data), first)?;
                     Ok(PipelineTime {
                         time: p.time + start.elapsed(),
                         ..p

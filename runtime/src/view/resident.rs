@@ -1,5 +1,6 @@
-//! Frames that stay on the GPU: on wgpu the viewer dispatches the scene's kernel into buffers
-//! of its own on the device that presents the window; a second pass adds each frame's colours
+//! Frames that stay on the GPU: on wgpu the viewer launches the scene's kernel through
+//! `gpu::launch` into a frame kept on the device that presents the window
+//! (`gpu::wgpu::ResidentFrame`, the launch's target); a second pass, the viewer's, adds each frame's colours
 //! (linear light: the scene renders ungraded) to the samples accumulated so far and writes
 //! their mean, graded by the scene's exposure and tone curve and sRGB-encoded, into a storage
 //! texture that the window's render pass samples. Nothing crosses to the host per frame; the
@@ -8,7 +9,8 @@
 //! GPU to two words).
 
 use super::grade::Grade;
-use crate::gpu::wgpu::{Pipeline, TILE_STRIDE};
+use crate::gpu::launch::{self, Work};
+use crate::gpu::wgpu::ResidentFrame;
 use crate::gpu::Gpu;
 use crate::image::Image;
 use sdfc_compiler::{wgsl, Scene};
@@ -104,15 +106,15 @@ fn accumulate(
 /// The side of the accumulating pass's workgroups.
 const GROUP: u32 = 8;
 
-/// The viewer's frames on a wgpu device: the accumulating pass and the buffers of the frames
-/// at the current size.
+/// The viewer's frames on a wgpu device: the frame the kernel renders into, kept on the
+/// device, and the accumulating pass with its buffers at the current size.
 pub struct Resident {
     gpu: Arc<Gpu>,
     accumulate: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    /// The launches' target: the kernel's buffers, kept on the device.
+    frame: ResidentFrame,
     target: Option<Target>,
-    /// What the scene-data buffer holds: the key its writer gave ([`Resident::render`]).
-    data_key: Option<(u64, bool)>,
     /// Textures made so far (a new texture's number tells a presenter to bind it).
     textures: u64,
 }
@@ -125,22 +127,13 @@ impl std::fmt::Debug for Resident {
     }
 }
 
-/// The buffers of frames of one size (the pixel buffers may be larger, from a larger size).
+/// The accumulating pass's buffers for frames of one size (the sums may be larger, from a
+/// larger size).
 struct Target {
     width: u32,
     height: u32,
-    /// Pixels the image, statistics and sums buffers hold.
+    /// Pixels the sums buffer holds.
     capacity: u64,
-    uniforms: wgpu::Buffer,
-    data: Option<wgpu::Buffer>,
-    /// The tiles (one dispatch each) and their table, an entry every [`TILE_STRIDE`] bytes.
-    tiles: Vec<crate::gpu::launch::Tile>,
-    tile_table: wgpu::Buffer,
-    image: wgpu::Buffer,
-    stats: wgpu::Buffer,
-    /// The kernel's finished pixels (binding 5), which the viewer does not read: it
-    /// accumulates the linear image.
-    pixels: wgpu::Buffer,
     sum: wgpu::Buffer,
     frame: wgpu::Buffer,
     steps: wgpu::Buffer,
@@ -268,43 +261,57 @@ impl Resident {
             gpu,
             accumulate,
             layout,
+            frame: ResidentFrame::default(),
             target: None,
-            data_key: None,
             textures: 0,
         })
     }
 
     /// Renders one frame of `scene` (its settings' size, one sample a pixel, ungraded: linear
-    /// light) with `kernel` (compiled on this device: [`Gpu::compute_pipeline`]) and adds it
-    /// to the samples accumulated: the first of them when `first` (or the size changed), else
-    /// the next; the texture on show is their mean graded by `grade`.
-    /// `data_key` names the kernel's scene data: it is uploaded only when the key changes.
-    /// With `steps`, the frame's mean steps per pixel are read back (two words). Returns when
-    /// the device has finished the frame.
+    /// light) with `kernel` through `gpu::launch`, into the frame kept on the device, and adds
+    /// it to the samples accumulated: the first of them when `first` (or the size changed),
+    /// else the next; the texture on show is their mean graded by `grade`. `data_key` names
+    /// the kernel's scene data: it is uploaded only when the key changes. With `steps`, the
+    /// frame's mean steps per pixel are read back (two words). Returns when the device has
+    /// finished the frame.
     pub fn render(
         &mut self,
         (kernel, lipschitz): (&wgsl::Kernel, f64),
         (scene, grade): (&Scene, Grade),
-        data_key: (u64, bool),
+        data_key: u64,
         first: bool,
         steps: bool,
     ) -> Result<Rendered, Error> {
         let (width, height) = (scene.settings.width.max(1), scene.settings.height.max(1));
         let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz)?;
-        let data = kernel.data.as_deref();
-        let pipeline =
-            self.gpu
-                .compute_pipeline(&kernel.source, wgsl::ENTRY_POINT, data.is_some())?;
+        let tiles = launch::tiling(width, height, crate::gpu::TILE, 1);
+        let work = Work {
+            uniforms: &uniforms,
+            data: kernel.data.as_deref(),
+            width,
+            height,
+            tiles: &tiles,
+            timed: false,
+            statistics: false,
+            target: launch::Target::Resident,
+        };
         let device = self.gpu.device().clone();
         let queue = self.gpu.queue().clone();
         let scope = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        self.fit(
-            width,
-            height,
-            uniforms.len() as u64,
-            data.map(|d| d.len() as u64),
-        );
+        if self.frame.fit(&self.gpu, &work, data_key) || self.target.is_none() {
+            self.target = Some(self.target_for(width, height)?);
+        }
+        let kernel = self
+            .gpu
+            .kernel(&kernel.source, wgsl::ENTRY_POINT, wgsl::WORKGROUP);
+        let faults = launch::Faults::default();
+        launch::render_one(
+            &kernel.into_resident(&self.frame),
+            &work,
+            &faults,
+            &mut |_| {},
+        )?;
         let Some(t) = self.target.as_mut() else {
             return Err(Error::NoBuffers);
         };
@@ -312,34 +319,11 @@ impl Resident {
             t.count = 0;
         }
         t.count += 1;
-        queue.write_buffer(&t.uniforms, 0, &uniforms);
-        if let (Some(buffer), Some(bytes)) = (&t.data, data) {
-            if self.data_key != Some(data_key) {
-                queue.write_buffer(buffer, 0, bytes);
-                self.data_key = Some(data_key);
-            }
-        }
         t.grade = grade;
         queue.write_buffer(&t.frame, 0, &t.frame_words(steps as u32));
-        let kernel_bind = kernel_bindings(
-            &device,
-            &pipeline,
-            [&t.uniforms, &t.tile_table, &t.image, &t.stats, &t.pixels],
-            t.data.as_ref(),
-        );
         let mut encoder = device.create_command_encoder(&Default::default());
         if steps {
             encoder.clear_buffer(&t.steps, 0, None);
-        }
-        for (i, tile) in (0..).zip(&t.tiles) {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline.0);
-            pass.set_bind_group(0, &kernel_bind, &[i * TILE_STRIDE]);
-            pass.dispatch_workgroups(
-                tile.2.div_ceil(wgsl::WORKGROUP),
-                tile.3.div_ceil(wgsl::WORKGROUP),
-                1,
-            );
         }
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -401,12 +385,16 @@ impl Resident {
         Ok(sum as f64 / (width as f64 * height as f64))
     }
 
-    /// Makes the buffers and texture fit frames of `width`×`height` with a uniform of
-    /// `uniform` bytes and scene data of `data` bytes; a new size starts the samples again.
-    fn fit(&mut self, width: u32, height: u32, uniform: u64, data: Option<u64>) {
+    /// The accumulating pass's buffers and texture for frames of `width`×`height`, bound to
+    /// the kernel's colours and statistics in the frame kept on the device (fitted to that
+    /// size); the sums of the target before are kept when they are large enough. Its samples
+    /// start again.
+    fn target_for(&mut self, width: u32, height: u32) -> Result<Target, Error> {
+        let (Some(image), Some(stats)) = (self.frame.image(), self.frame.stats()) else {
+            return Err(Error::NoBuffers);
+        };
         let device = self.gpu.device();
         let pixels = width as u64 * height as u64;
-        let tiles = crate::gpu::launch::tiling(width, height, crate::gpu::TILE, 1);
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -416,123 +404,59 @@ impl Resident {
             })
         };
         use wgpu::BufferUsages as U;
-        let same_size = self
-            .target
-            .as_ref()
-            .is_some_and(|t| (t.width, t.height) == (width, height));
-        if !same_size {
-            let old = self.target.take();
-            let capacity = old.as_ref().map_or(0, |t| t.capacity).max(pixels);
-            let (image, stats, finished, sum) = match old {
-                Some(t) if t.capacity >= pixels => (t.image, t.stats, t.pixels, t.sum),
-                _ => (
-                    buffer("sdfc view image", capacity * 16, U::STORAGE),
-                    buffer(
-                        "sdfc view stats",
-                        capacity * 4 * wgsl::STATS_WORDS as u64,
-                        U::STORAGE,
-                    ),
-                    buffer("sdfc view pixels", capacity * 4, U::STORAGE),
-                    buffer("sdfc view sums", capacity * 16, U::STORAGE | U::COPY_SRC),
-                ),
-            };
-            self.textures += 1;
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("sdfc view shown"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8Unorm,
-                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[wgpu::TextureFormat::Rgba8UnormSrgb],
-            });
-            let frame = buffer("sdfc view frame", FRAME_BYTES, U::STORAGE | U::COPY_DST);
-            let steps = buffer("sdfc view steps", 8, U::STORAGE | U::COPY_SRC | U::COPY_DST);
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                format: Some(wgpu::TextureFormat::Rgba8Unorm),
-                ..Default::default()
-            });
-            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("sdfc view accumulate"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: frame.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: image.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: sum.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: stats.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: steps.as_entire_binding(),
-                    },
-                ],
-            });
-            let table: Vec<u8> = tiles
-                .iter()
-                .flat_map(|t| {
-                    let mut entry = words(&[t.0, t.1, t.2, t.3]);
-                    entry.resize(TILE_STRIDE as usize, 0);
-                    entry
-                })
-                .collect();
-            let tile_table = buffer(
-                "sdfc view tiles",
-                table.len() as u64,
-                U::UNIFORM | U::COPY_DST,
-            );
-            self.gpu.queue().write_buffer(&tile_table, 0, &table);
-            self.target = Some(Target {
+        let old = self.target.take().map(|t| (t.sum, t.capacity));
+        let capacity = old.as_ref().map_or(0, |(_, c)| *c).max(pixels);
+        let sum = match old {
+            Some((sum, c)) if c >= pixels => sum,
+            _ => buffer("sdfc view sums", capacity * 16, U::STORAGE | U::COPY_SRC),
+        };
+        self.textures += 1;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("sdfc view shown"),
+            size: wgpu::Extent3d {
                 width,
                 height,
-                capacity,
-                uniforms: buffer("sdfc view scene", uniform, U::UNIFORM | U::COPY_DST),
-                data: data.map(|n| buffer("sdfc view scene data", n, U::STORAGE | U::COPY_DST)),
-                tiles,
-                tile_table,
-                image,
-                stats,
-                pixels: finished,
-                sum,
-                frame,
-                steps,
-                texture,
-                number: self.textures,
-                bind,
-                count: 0,
-                grade: Grade::default(),
-            });
-            self.data_key = None;
-        }
-        let Some(t) = self.target.as_mut() else {
-            return;
-        };
-        if t.uniforms.size() != uniform.max(16) {
-            t.uniforms = buffer("sdfc view scene", uniform, U::UNIFORM | U::COPY_DST);
-        }
-        if t.data.as_ref().map(|b| b.size()) != data.map(|n| n.max(16)) {
-            t.data = data.map(|n| buffer("sdfc view scene data", n, U::STORAGE | U::COPY_DST));
-            self.data_key = None;
-        }
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[wgpu::TextureFormat::Rgba8UnormSrgb],
+        });
+        let frame = buffer("sdfc view frame", FRAME_BYTES, U::STORAGE | U::COPY_DST);
+        let steps = buffer("sdfc view steps", 8, U::STORAGE | U::COPY_SRC | U::COPY_DST);
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(wgpu::TextureFormat::Rgba8Unorm),
+            ..Default::default()
+        });
+        let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sdfc view accumulate"),
+            layout: &self.layout,
+            entries: &[
+                entry(0, frame.as_entire_binding()),
+                entry(1, image.as_entire_binding()),
+                entry(2, sum.as_entire_binding()),
+                entry(3, wgpu::BindingResource::TextureView(&view)),
+                entry(4, stats.as_entire_binding()),
+                entry(5, steps.as_entire_binding()),
+            ],
+        });
+        Ok(Target {
+            width,
+            height,
+            capacity,
+            sum,
+            frame,
+            steps,
+            texture,
+            number: self.textures,
+            bind,
+            count: 0,
+            grade: Grade::default(),
+        })
     }
 
     /// The texture on show (the mean of the samples, sRGB bytes; an `Rgba8Unorm` texture
@@ -594,54 +518,6 @@ impl Resident {
     }
 }
 
-/// The bindings of the scene's kernel ([`Gpu::compute_pipeline`]'s layout): the scene
-/// uniform, the tile table (16 bytes at a dynamic offset), the image, the statistics and the
-/// finished pixels, and the scene data when the kernel reads it.
-fn kernel_bindings(
-    device: &wgpu::Device,
-    pipeline: &Pipeline,
-    [uniforms, tiles, image, stats, pixels]: [&wgpu::Buffer; 5],
-    data: Option<&wgpu::Buffer>,
-) -> wgpu::BindGroup {
-    let mut entries = vec![
-        wgpu::BindGroupEntry {
-            binding: 0,
-            resource: uniforms.as_entire_binding(),
-        },
-        wgpu::BindGroupEntry {
-            binding: 1,
-            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: tiles,
-                offset: 0,
-                size: std::num::NonZeroU64::new(16),
-            }),
-        },
-        wgpu::BindGroupEntry {
-            binding: 2,
-            resource: image.as_entire_binding(),
-        },
-        wgpu::BindGroupEntry {
-            binding: 3,
-            resource: stats.as_entire_binding(),
-        },
-        wgpu::BindGroupEntry {
-            binding: 5,
-            resource: pixels.as_entire_binding(),
-        },
-    ];
-    if let Some(data) = data {
-        entries.push(wgpu::BindGroupEntry {
-            binding: 4,
-            resource: data.as_entire_binding(),
-        });
-    }
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("sdfc view kernel"),
-        layout: &pipeline.1,
-        entries: &entries,
-    })
-}
-
 /// A mappable copy of the steps' two words, its copy recorded in `encoder`.
 fn steps_staging(
     device: &wgpu::Device,
@@ -673,71 +549,6 @@ impl FirstFrame {
         let uniforms = wgsl::uniforms(&kernel.contract.uniform, scene, lipschitz).ok()?;
         Some(FirstFrame { uniforms, tile })
     }
-}
-
-/// Runs a compiled kernel once, on one workgroup of the first tile of the frame `first` (or
-/// of no pixels: a tile of size 0, every thread returning at once), so that a driver that
-/// compiles a pipeline only at its first dispatch does so here, on the thread that compiles
-/// it, and not in the first frame on the window's thread. Lavapipe compiles then, and again
-/// for each new value of a uniform that decides a loop or a branch: the first frame's
-/// uniforms make its variant the one compiled.
-pub fn warm(
-    gpu: &Gpu,
-    wgsl_text: &str,
-    data: bool,
-    first: Option<&FirstFrame>,
-) -> Result<(), Error> {
-    let pipeline = gpu.compute_pipeline(wgsl_text, wgsl::ENTRY_POINT, data)?;
-    let device = gpu.device();
-    let buffer = |size: u64, usage| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sdfc view warm"),
-            size,
-            usage,
-            mapped_at_creation: false,
-        })
-    };
-    use wgpu::BufferUsages as U;
-    // A uniform as large as one may be bound (the kernel's is at most that), zeros: a frame
-    // of 0×0 pixels and no samples.
-    let limit = device.limits().max_uniform_buffer_binding_size.min(1 << 16);
-    let uniforms = buffer(limit, U::UNIFORM | U::COPY_DST);
-    let tiles = buffer(TILE_STRIDE as u64, U::UNIFORM | U::COPY_DST);
-    // The pixels of one workgroup: the first rows of the frame.
-    let width = first.map_or(1, |f| f.tile.2.max(1)) as u64;
-    let pixels = width * wgsl::WORKGROUP as u64;
-    let (image, stats, finished) = (
-        buffer(pixels * 16, U::STORAGE),
-        buffer(pixels * 4 * wgsl::STATS_WORDS as u64, U::STORAGE),
-        buffer(pixels * 4, U::STORAGE),
-    );
-    if let Some(f) = first {
-        let n = (f.uniforms.len() as u64).min(limit) as usize;
-        gpu.queue().write_buffer(&uniforms, 0, &f.uniforms[..n]);
-        let t = f.tile;
-        gpu.queue()
-            .write_buffer(&tiles, 0, &words(&[t.0, t.1, t.2, t.3]));
-    }
-    let scene_data = data.then(|| buffer(16, U::STORAGE));
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let bind = kernel_bindings(
-        device,
-        &pipeline,
-        [&uniforms, &tiles, &image, &stats, &finished],
-        scene_data.as_ref(),
-    );
-    let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline.0);
-        pass.set_bind_group(0, &bind, &[0]);
-        pass.dispatch_workgroups(1, 1, 1);
-    }
-    gpu.queue().submit([encoder.finish()]);
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(Error::Pass("kernel's first dispatch", e));
-    }
-    Ok(gpu.wait()?)
 }
 
 fn words(w: &[u32]) -> Vec<u8> {

@@ -192,7 +192,7 @@ impl launch::Device for Kernel<'_> {
         range: Range<usize>,
         slot: usize,
     ) -> Result<(), Error> {
-        if !work.finished {
+        if !work.finished() {
             return Ok(());
         }
         let bytes = 4 * range.len();
@@ -290,10 +290,10 @@ impl launch::Device for Kernel<'_> {
         let s = &self.cuda.stream;
         let n: usize = ranges.iter().map(|r| r.end - r.start).sum();
         // The finished pixels (4 bytes each) or the linear colours (4 floats).
-        let paged = work.finished && ranges.len() != 1;
+        let paged = work.finished() && ranges.len() != 1;
         let mut rgba = vec![0u8; if paged { 4 * n } else { 0 }];
-        let mut image = vec![0f32; if work.finished { 0 } else { 4 * n }];
-        if work.finished && ranges.len() == 1 {
+        let mut image = vec![0f32; if work.finished() { 0 } else { 4 * n }];
+        if work.finished() && ranges.len() == 1 {
             // Through the kept page-locked buffer, then copied out.
             let r = &ranges[0];
             rgba = self.read_pinned(&f.pixels.slice(4 * r.start..4 * r.end))?;
@@ -301,9 +301,9 @@ impl launch::Device for Kernel<'_> {
         let mut at = 0;
         for r in ranges {
             let len = r.end - r.start;
-            if work.finished && ranges.len() == 1 {
+            if work.finished() && ranges.len() == 1 {
                 // Read above.
-            } else if work.finished {
+            } else if work.finished() {
                 s.memcpy_dtoh(
                     &f.pixels.slice(4 * r.start..4 * r.end),
                     &mut rgba[4 * at..4 * (at + len)],

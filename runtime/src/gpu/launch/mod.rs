@@ -26,8 +26,8 @@ pub type Tile = (u32, u32, u32, u32);
 const TILES_PER_SUBMIT: usize = 8;
 
 /// What every device renders of a frame: the kernel's inputs (uniforms and scene data), the
-/// image size and the tiles, and whether to time them, reduce the statistics and read back
-/// finished pixels. (A render request as a whole is a [`crate::job::Job`].)
+/// image size and the tiles, whether to time them and reduce the statistics, and where the
+/// pixels go ([`Target`]). (A render request as a whole is a [`crate::job::Job`].)
 #[derive(Debug, Clone, Copy)]
 pub struct Work<'a> {
     /// Bytes of the scene uniform (binding 0).
@@ -47,13 +47,43 @@ pub struct Work<'a> {
     /// statistics themselves are 66 MB at 1920×1080. Without them the frame's steps are zero
     /// and its counters empty (the kernel still writes them on the device).
     pub statistics: bool,
-    /// Whether to read back the finished pixels (RGBA8, sRGB-encoded on the device: 4 bytes
-    /// a pixel) instead of the linear colours (16 bytes a pixel on the device, 12 on the
-    /// host): the frame then has no linear image.
-    pub finished: bool,
+    /// Where the frame's pixels go: read back as linear colours or finished pixels, or kept
+    /// on the device.
+    pub target: Target,
+}
+
+/// Where a frame's pixels go once its tiles have rendered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    /// Read back as linear colours (16 bytes a pixel on the device, 12 on the host).
+    Linear,
+    /// Read back as finished pixels (RGBA8, sRGB-encoded on the device: 4 bytes a pixel):
+    /// the frame then has no linear image.
+    Finished,
+    /// Kept on the device, nothing read back (but the statistics, when asked for): the tiles
+    /// are submitted without waiting for them, for a caller that goes on with the pixels there
+    /// (the viewer accumulates them: a wgpu `Kernel` given the buffers it renders into,
+    /// `wgpu::ResidentFrame`). Several devices read their bands back, as linear colours: a
+    /// frame kept on the device is one device's.
+    Resident,
+}
+
+impl Target {
+    /// [`Target::Finished`] when `finished`, else [`Target::Linear`].
+    pub fn read_back(finished: bool) -> Target {
+        match finished {
+            true => Target::Finished,
+            false => Target::Linear,
+        }
+    }
 }
 
 impl Work<'_> {
+    /// Whether the finished pixels are read back ([`Target::Finished`]).
+    pub fn finished(&self) -> bool {
+        self.target == Target::Finished
+    }
+
     /// The image's pixels.
     pub fn pixels(&self) -> usize {
         self.width as usize * self.height as usize
@@ -356,11 +386,12 @@ pub fn squares(width: u32, height: u32, edge: u32) -> Vec<Tile> {
     out
 }
 
-/// Renders `work` on one device. Finished pixels ([`Work::finished`]): a row of tiles at a
+/// Renders `work` on one device. Finished pixels ([`Target::Finished`]): a row of tiles at a
 /// time, each row's readback queued behind its launches and the row before collected while
 /// it renders, straight into the frame's buffer (one of [`crate::image::pixel_buffer`]'s).
 /// Linear colours: the tiles in batches, waiting after each (progress, the injected fault),
-/// then the image read back whole.
+/// then the image read back whole. Kept on the device ([`Target::Resident`]): the tiles
+/// submitted in batches without waiting, nothing read back.
 pub fn render_one<D: Device>(
     device: &D,
     work: &Work,
@@ -372,8 +403,8 @@ pub fn render_one<D: Device>(
     let setup = setup.elapsed();
     let start = Instant::now();
     let whole = 0..work.pixels();
-    let (pixels, wall, readback) = match work.finished {
-        true => {
+    let (pixels, wall, readback) = match work.target {
+        Target::Finished => {
             let (rgba, collecting) = overlapped(device, &mut frame, work, faults, progress)?;
             let pixels = Pixels {
                 rgba,
@@ -385,21 +416,17 @@ pub fn render_one<D: Device>(
                 collecting,
             )
         }
-        false => {
-            let all: Vec<usize> = (0..work.tiles.len()).collect();
-            for batch in all.chunks(TILES_PER_SUBMIT) {
-                device.run(&mut frame, work, batch)?;
-                if let Some(msg) = batch.iter().find_map(|&i| faults.injected(0, i)) {
-                    return Err(device.fault(msg));
-                }
-                let done = batch.last().map_or(0, |&i| i + 1);
-                progress((done as f64 / all.len().max(1) as f64).min(1.0));
-            }
+        Target::Linear => {
+            batches((device, &mut frame), (work, true), faults, progress)?;
             let wall = start.elapsed();
             let readback = Instant::now();
             let pixels = device.read(&mut frame, work, std::slice::from_ref(&whole))?;
             let readback = readback.elapsed().saturating_sub(pixels.convert);
             (pixels, wall, readback)
+        }
+        Target::Resident => {
+            batches((device, &mut frame), (work, false), faults, progress)?;
+            (Pixels::default(), start.elapsed(), Duration::ZERO)
         }
     };
     let reducing = Instant::now();
@@ -428,6 +455,30 @@ pub fn render_one<D: Device>(
         wall,
         shares: Vec::new(),
     })
+}
+
+/// Runs `work`'s tiles on one device in batches of [`TILES_PER_SUBMIT`], waiting after each
+/// when `wait` (progress, and a bound on the work queued at once), else submitting them all
+/// without waiting (a frame kept on the device: the caller's next pass is queued behind them).
+fn batches<D: Device>(
+    (device, frame): (&D, &mut D::Frame),
+    (work, wait): (&Work, bool),
+    faults: &Faults,
+    progress: &mut dyn FnMut(f64),
+) -> Result<(), D::Error> {
+    let all: Vec<usize> = (0..work.tiles.len()).collect();
+    for batch in all.chunks(TILES_PER_SUBMIT) {
+        match wait {
+            true => device.run(frame, work, batch)?,
+            false => device.submit(frame, work, batch)?,
+        }
+        if let Some(msg) = batch.iter().find_map(|&i| faults.injected(0, i)) {
+            return Err(device.fault(msg));
+        }
+        let done = batch.last().map_or(0, |&i| i + 1);
+        progress((done as f64 / all.len().max(1) as f64).min(1.0));
+    }
+    Ok(())
 }
 
 /// The finished pixels of `work`'s tiles on one device, a row of tiles at a time ([`rows`]):

@@ -359,7 +359,7 @@ pub fn render_several(
     let pixels = work.pixels();
     // The finished pixels go into a buffer an earlier frame handed back when there is one
     // (every band overwrites its place), its pages in memory already.
-    let (mut linear, mut rgba) = match work.finished {
+    let (mut linear, mut rgba) = match work.finished() {
         true => (Vec::new(), crate::image::pixel_buffer(4 * pixels)),
         false => (crate::image::zeroed(pixels), Vec::new()),
     };
@@ -479,7 +479,7 @@ fn places<'a>(
             work.band(i.saturating_sub(1)).end * usize::from(i > 0),
             "bands follow each other"
         );
-        let place = match work.finished {
+        let place = match work.finished() {
             true => {
                 let (here, rest) = std::mem::take(&mut rgba).split_at_mut(4 * band.len());
                 rgba = rest;

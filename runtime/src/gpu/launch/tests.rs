@@ -4,6 +4,21 @@
 use super::*;
 use std::sync::Mutex;
 
+/// The work of `tiles` over a `width`×`height` image, untimed and without statistics, its
+/// pixels going to `target`.
+fn plain(tiles: &[Tile], (width, height): (u32, u32), target: Target) -> Work<'_> {
+    Work {
+        uniforms: &[],
+        data: None,
+        width,
+        height,
+        tiles,
+        timed: false,
+        statistics: false,
+        target,
+    }
+}
+
 /// A fake device's failure: what it says.
 #[derive(Debug)]
 struct Failed(String);
@@ -136,7 +151,7 @@ fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
         tiles: &tiles,
         timed: false,
         statistics: true,
-        finished: false,
+        target: Target::Linear,
     };
     let failed = std::sync::atomic::AtomicUsize::new(0);
     let good = Fake {
@@ -278,16 +293,7 @@ impl Device for Overlapping<'_> {
 #[test]
 fn a_band_is_collected_while_the_next_one_renders() {
     let tiles = tiling(16, 64, 512, 2);
-    let work = Work {
-        uniforms: &[],
-        data: None,
-        width: 16,
-        height: 64,
-        tiles: &tiles,
-        timed: false,
-        statistics: false,
-        finished: false,
-    };
+    let work = plain(&tiles, (16, 64), Target::Linear);
     let log = Mutex::new(Vec::new());
     let (a, b) = (
         Overlapping { log: &log, id: 0 },
@@ -435,16 +441,7 @@ impl Device for Rows {
 fn one_device_collects_a_row_of_tiles_while_the_next_renders() {
     // Squares of 8 pixels over 20×20: three rows of three tiles (8, 8 and 4 pixels high).
     let tiles = squares(20, 20, 8);
-    let work = Work {
-        uniforms: &[],
-        data: None,
-        width: 20,
-        height: 20,
-        tiles: &tiles,
-        timed: false,
-        statistics: false,
-        finished: true,
-    };
+    let work = plain(&tiles, (20, 20), Target::Finished);
     let rows = Rows {
         log: Mutex::new(Vec::new()),
     };
@@ -494,4 +491,68 @@ fn faults_parse_per_device() {
         one.injected(0, 1).as_deref(),
         Some("device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1 (a testing aid)")
     );
+}
+
+/// A device that logs the steps the scheduler asks of it.
+#[derive(Default)]
+struct Logged(Mutex<Vec<&'static str>>);
+
+impl Logged {
+    fn log(&self, step: &'static str) {
+        self.0.lock().expect("the log").push(step);
+    }
+}
+
+impl Device for Logged {
+    type Frame = ();
+    type Error = Failed;
+    fn describe(&self) -> String {
+        "logged".into()
+    }
+    fn prepare(&self, _: &Work) -> Result<(), Failed> {
+        self.log("prepare");
+        Ok(())
+    }
+    fn run(&self, _: &mut (), _: &Work, _: &[usize]) -> Result<(), Failed> {
+        self.log("run");
+        Ok(())
+    }
+    fn submit(&self, _: &mut (), _: &Work, _: &[usize]) -> Result<(), Failed> {
+        self.log("submit");
+        Ok(())
+    }
+    fn read(&self, _: &mut (), _: &Work, _: &[Range<usize>]) -> Result<Pixels, Failed> {
+        self.log("read");
+        Ok(Pixels::default())
+    }
+    fn reduce(&self, _: &mut (), _: &Work, _: &[Range<usize>], a: Ask) -> Result<Answer, Failed> {
+        self.log("reduce");
+        Ok(Answer::empty(a))
+    }
+    fn finish(&self, _: (), _: &Work) -> Result<Option<Duration>, Failed> {
+        self.log("finish");
+        Ok(None)
+    }
+    fn fault(&self, message: String) -> Failed {
+        Failed(message)
+    }
+}
+
+#[test]
+fn a_frame_kept_on_the_device_is_submitted_without_waiting_and_never_read_back() {
+    // 20 tiles: three batches.
+    let tiles = squares(80, 64, 16);
+    let mut work = plain(&tiles, (80, 64), Target::Resident);
+    let device = Logged::default();
+    let mut done = Vec::new();
+    let out = render_one(&device, &work, &Faults::default(), &mut |p| done.push(p)).expect("kept");
+    assert!(out.linear.is_empty() && out.rgba.is_empty());
+    let log = std::mem::take(&mut *device.0.lock().expect("the log"));
+    assert_eq!(log, ["prepare", "submit", "submit", "submit", "finish"]);
+    assert_eq!(done.last(), Some(&1.0));
+    // Read back as linear colours, the same tiles are waited for and read.
+    work.target = Target::Linear;
+    render_one(&device, &work, &Faults::default(), &mut |_| {}).expect("read back");
+    let log = std::mem::take(&mut *device.0.lock().expect("the log"));
+    assert_eq!(log, ["prepare", "run", "run", "run", "read", "finish"]);
 }

@@ -34,16 +34,19 @@ impl Gpu {
         b
     }
 
+    /// A buffer of `size` bytes ([`padded`]) for `usage`, not mapped.
+    pub(super) fn buffer(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: padded(size),
+            usage,
+            mapped_at_creation: false,
+        })
+    }
+
     fn new_buffers(&self, l: &Work, pixels: u64, tiles: u64) -> Buffers {
         use wgpu::BufferUsages as U;
-        let make = |label, size: u64, usage| {
-            self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: padded(size),
-                usage,
-                mapped_at_creation: false,
-            })
-        };
+        let make = |label, size, usage| self.buffer(label, size, usage);
         Buffers {
             uniforms: make(
                 "sdfc scene",
@@ -325,6 +328,18 @@ impl Gpu {
             .sum();
         Ok(Duration::from_nanos((total as f64 * period) as u64))
     }
+}
+
+/// The tile table of `work`: an entry (x, y, width, height) every [`TILE_STRIDE`] bytes.
+pub(super) fn tile_table(work: &Work) -> Vec<u8> {
+    work.tiles
+        .iter()
+        .flat_map(|t| {
+            let mut entry = words(&[t.0, t.1, t.2, t.3]);
+            entry.resize(TILE_STRIDE as usize, 0);
+            entry
+        })
+        .collect()
 }
 
 pub(super) fn words(w: &[u32]) -> Vec<u8> {

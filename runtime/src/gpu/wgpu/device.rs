@@ -1,7 +1,7 @@
 //! A [`Kernel`] as the tile launcher's device (`launch::Device`): a frame's buffers prepared,
 //! tiles dispatched and submitted, pixels and statistics read back, faults reported.
 
-use super::buffers::{padded, words};
+use super::buffers::{padded, tile_table, words};
 use super::{Error, FrameBuffers, Kernel, TILE_STRIDE};
 use crate::gpu::launch::{self, Pixels, Work};
 use crate::gpu::reduce::{self, Answer, Ask};
@@ -39,9 +39,21 @@ impl launch::Device for Kernel<'_> {
             });
         }
         let (pipeline, _) = gpu.cached_pipeline(self.wgsl, self.entry, work.data.is_some())?;
-        let pixels = work.width as u64 * work.height as u64;
         let tiles = work.tiles.len() as u64;
-        let buffers = gpu.buffers(work, pixels, tiles);
+        // Buffers kept on the device by their owner, or the spare ones (returned to the
+        // spare when the frame finishes).
+        let (buffers, spare) = match self.resident {
+            Some(resident) => match resident.buffers(gpu, work) {
+                Some(b) => (b, false),
+                None => return Err(Error::NotFitted),
+            },
+            None => {
+                let pixels = work.width as u64 * work.height as u64;
+                let b = gpu.buffers(work, pixels, tiles);
+                gpu.queue.write_buffer(&b.tile, 0, &tile_table(work));
+                (b, true)
+            }
+        };
         let bind = gpu.bind_group(&pipeline.1, &buffers);
         let queries = (gpu.timestamps && work.timed).then(|| {
             gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -51,20 +63,13 @@ impl launch::Device for Kernel<'_> {
             })
         });
         let memory = Some(gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory));
-        let table: Vec<u8> = work
-            .tiles
-            .iter()
-            .flat_map(|t| {
-                let mut entry = words(&[t.0, t.1, t.2, t.3]);
-                entry.resize(TILE_STRIDE as usize, 0);
-                entry
-            })
-            .collect();
-        gpu.queue.write_buffer(&buffers.tile, 0, &table);
         // wgpu queues its writes until the next submission: submitted now, the uploads are
-        // part of the frame's setup, as CUDA's are, not of its first launch.
-        gpu.queue.submit([]);
-        gpu.wait()?;
+        // part of the frame's setup, as CUDA's are, not of its first launch. A frame kept on
+        // the device is not waited for: its writes go with its tiles.
+        if work.target != launch::Target::Resident {
+            gpu.queue.submit([]);
+            gpu.wait()?;
+        }
         Ok(FrameBuffers {
             pipeline,
             buffers,
@@ -72,6 +77,7 @@ impl launch::Device for Kernel<'_> {
             queries,
             memory,
             reading: [None, None],
+            spare,
         })
     }
 
@@ -121,7 +127,7 @@ impl launch::Device for Kernel<'_> {
         range: Range<usize>,
         slot: usize,
     ) -> Result<(), Error> {
-        if !work.finished {
+        if !work.finished() {
             return Ok(());
         }
         let gpu = self.gpu;
@@ -228,7 +234,7 @@ impl launch::Device for Kernel<'_> {
         use rayon::prelude::*;
         let mut convert = Duration::ZERO;
         let f32_at = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-        let (linear, rgba) = if work.finished {
+        let (linear, rgba) = if work.finished() {
             // The finished pixels are the bytes to write: copied out as they are.
             let rgba = self.gpu.read_with(&f.buffers.pixels, &bytes(4), |b| {
                 // Copied out by every core, as the linear colours are converted.
@@ -363,8 +369,10 @@ impl launch::Device for Kernel<'_> {
             Some(q) => Some(self.gpu.gpu_time(q, work.tiles.len() as u32)?),
             None => None,
         };
-        if let Ok(mut spare) = self.gpu.spare.lock() {
-            *spare = Some(f.buffers);
+        if f.spare {
+            if let Ok(mut spare) = self.gpu.spare.lock() {
+                *spare = Some(f.buffers);
+            }
         }
         Ok(time)
     }

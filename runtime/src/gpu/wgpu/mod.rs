@@ -6,6 +6,9 @@
 mod buffers;
 mod device;
 mod pipeline;
+mod resident;
+
+pub use resident::ResidentFrame;
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -60,6 +63,9 @@ pub enum Error {
         largest: u64,
         most: u64,
     },
+    /// A launch into a [`ResidentFrame`] not fitted to its work (a bug of sdfc's).
+    #[error("internal error: the frame kept on the device does not fit the launch")]
+    NotFitted,
     /// A band collected from a readback slot no band was read into (a bug of sdfc's).
     #[error("GPU error while rendering: no band was read into this slot")]
     NotRead { slot: usize },
@@ -137,13 +143,26 @@ pub enum DriverCache {
     Read(u64),
 }
 
-/// A kernel on a [`Gpu`], ready to render tiles ([`Gpu::kernel`]).
+/// A kernel on a [`Gpu`], ready to render tiles ([`Gpu::kernel`]), into a frame's buffers of
+/// its own or into those of a [`ResidentFrame`] ([`Kernel::into_resident`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Kernel<'a> {
     gpu: &'a Gpu,
     wgsl: &'a str,
     entry: &'a str,
     workgroup: u32,
+    resident: Option<&'a ResidentFrame>,
+}
+
+impl<'a> Kernel<'a> {
+    /// The kernel rendering into `frame`'s buffers, which stay on the device (a launch of
+    /// [`crate::gpu::launch::Target::Resident`] work fitted to it: [`ResidentFrame::fit`]).
+    pub fn into_resident(self, frame: &'a ResidentFrame) -> Kernel<'a> {
+        Kernel {
+            resident: Some(frame),
+            ..self
+        }
+    }
 }
 
 /// A frame's buffers on the device: the pipeline and its bindings, the timestamp queries and
@@ -157,6 +176,9 @@ pub struct FrameBuffers {
     /// The reads started into each of [`Buffers::readback`]: the pixels, the copy's
     /// submission, and the mapping's outcome to come.
     reading: [Option<Reading>; 2],
+    /// Whether the buffers go back to [`Gpu`]'s spare when the frame finishes (not those of
+    /// a [`ResidentFrame`], which its owner keeps).
+    spare: bool,
 }
 
 /// A read started into a readback buffer ([`launch::Device::start_read`]).
@@ -315,7 +337,7 @@ impl Gpu {
     }
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Buffers {
     uniforms: wgpu::Buffer,
     data: Option<wgpu::Buffer>,

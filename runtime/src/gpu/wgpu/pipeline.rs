@@ -1,7 +1,12 @@
 //! The kernels' compute pipelines on a [`Gpu`]: compiled once per kernel text and kept, the
 //! driver's pipeline cache stored on disk between processes, and a [`Kernel`] ready to render.
 
-use super::{DriverCache, Error, Gpu, Kernel, Pipeline, PipelineTime, PIPELINES_KEPT};
+use super::buffers::words;
+use super::{
+    Buffers, DriverCache, Error, Gpu, Kernel, Pipeline, PipelineTime, PIPELINES_KEPT, TILE_STRIDE,
+};
+use crate::gpu::launch;
+use sdfc_compiler::wgsl::STATS_WORDS;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
@@ -68,12 +73,62 @@ impl Gpu {
         Ok((pipeline, driver))
     }
 
-    /// The pipeline of `wgsl` (entry point `entry`, with the scene-data binding when `data`)
-    /// and its bind group layout (the bindings of [`Gpu::kernel`]'s frames), compiled now or
-    /// found among those compiled: for a caller that dispatches the kernel into buffers of its
-    /// own (the viewer's frames, which stay on the device).
-    pub fn compute_pipeline(&self, wgsl: &str, entry: &str, data: bool) -> Result<Pipeline, Error> {
-        self.cached_pipeline(wgsl, entry, data).map(|(p, _)| p)
+    /// Runs the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
+    /// `data`; compiled now or found among those compiled) once, on one workgroup of a tile
+    /// (of no pixels: a tile of size 0, every thread returning at once, unless `first` gives
+    /// the uniforms and first tile of the frame to come), so that a driver that compiles a
+    /// pipeline only at its first dispatch does so here, on the thread that compiles it, and
+    /// not in the first frame. Lavapipe compiles then, and again for each new value of a
+    /// uniform that decides a loop or a branch: the first frame's uniforms make its variant
+    /// the one compiled. No frame is rendered: the buffers hold one workgroup's pixels.
+    pub fn warm(
+        &self,
+        (wgsl, entry, data): (&str, &str, bool),
+        first: Option<(&[u8], launch::Tile)>,
+    ) -> Result<(), Error> {
+        let (pipeline, _) = self.cached_pipeline(wgsl, entry, data)?;
+        let buffer = |size, usage| self.buffer("sdfc warm", size, usage);
+        use wgpu::BufferUsages as U;
+        // A uniform as large as one may be bound (the kernel's is at most that), zeros: a
+        // frame of 0×0 pixels and no samples.
+        let limit = self
+            .device
+            .limits()
+            .max_uniform_buffer_binding_size
+            .min(1 << 16);
+        // The pixels of one workgroup: the first rows of the frame.
+        let width = first.map_or(1, |(_, t)| t.2.max(1)) as u64;
+        let pixels = width * sdfc_compiler::wgsl::WORKGROUP as u64;
+        let b = Buffers {
+            uniforms: buffer(limit, U::UNIFORM | U::COPY_DST),
+            data: data.then(|| buffer(16, U::STORAGE)),
+            tile: buffer(TILE_STRIDE as u64, U::UNIFORM | U::COPY_DST),
+            image: buffer(pixels * 16, U::STORAGE),
+            pixels: buffer(pixels * 4, U::STORAGE),
+            stats: buffer(pixels * 4 * STATS_WORDS as u64, U::STORAGE),
+            reduction: None,
+            readback: [None, None],
+        };
+        if let Some((uniforms, t)) = first {
+            let n = (uniforms.len() as u64).min(limit) as usize;
+            self.queue.write_buffer(&b.uniforms, 0, &uniforms[..n]);
+            self.queue
+                .write_buffer(&b.tile, 0, &words(&[t.0, t.1, t.2, t.3]));
+        }
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let bind = self.bind_group(&pipeline.1, &b);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline.0);
+            pass.set_bind_group(0, &bind, &[0]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        self.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Pipeline(e));
+        }
+        self.wait()
     }
 
     /// Whether the pipeline of `wgsl` (entry point `entry`, with the scene-data binding when
@@ -116,6 +171,7 @@ impl Gpu {
             wgsl,
             entry,
             workgroup,
+            resident: None,
         }
     }
 

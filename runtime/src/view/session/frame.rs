@@ -289,7 +289,7 @@ fn render_sample(
         }
         return Ok((a.count + 1, frame.render.stats.steps_mean));
     };
-    let key = (version, kernel.interpreted());
+    let key = version << 1 | kernel.interpreted() as u64;
     // Made (and kept) before the scene is checked against its kernel.
     let resident = match resident.as_mut() {
         Some(r) => Ok(r),

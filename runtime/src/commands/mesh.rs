@@ -555,7 +555,7 @@ fn surface_on(
         contour::contour(
             &field,
             &grid,
-            candidates.cells,
+            candidates,
             settings,
             memory_cells,
             &surface_check,

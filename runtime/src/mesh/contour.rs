@@ -13,6 +13,7 @@
 //! flip replaces two triangles by two that share a new edge, which is made only once.
 
 use super::closure::{add, closure, Closure};
+use super::octree::Candidates;
 use super::place::{
     choose, inside_cell, normalise, onto_surface, place, separate, Patches, Placed, GRADIENT_STEP,
     MARGIN, ON_SURFACE,
@@ -64,18 +65,23 @@ pub enum Stop {
     Refused(String),
 }
 
-/// Contours the surface in `candidates` (sorted cell keys), holding at most `max_cells`
-/// cells; `surface` is told the number of surface cells before they are contoured, and may
-/// refuse.
+/// Contours the surface in `candidates` (sorted cell keys, and the corners whose values the
+/// octree knows), holding at most `max_cells` cells; `surface` is told the number of surface
+/// cells before they are contoured, and may refuse.
 pub fn contour(
     field: &Field,
     grid: &Grid,
-    candidates: Vec<u64>,
+    candidates: impl Into<Candidates>,
     settings: &Settings,
     max_cells: u64,
     surface_cells: &dyn Fn(u64) -> Result<(), String>,
     progress: &dyn Fn(f64),
 ) -> Result<(Mesh, Stats), Stop> {
+    let Candidates {
+        cells: candidates,
+        centres: known,
+        ..
+    } = candidates.into();
     let mut stats = Stats {
         candidates: candidates.len() as u64,
         ..Stats::default()
@@ -84,7 +90,7 @@ pub fn contour(
         values,
         mut surface,
         ..
-    } = closure(field, grid, candidates, max_cells, &mut stats).map_err(Stop::Cells)?;
+    } = closure(field, grid, candidates, known, max_cells, &mut stats).map_err(Stop::Cells)?;
     progress(0.2);
     // Found in the candidates' order, sorted unless cells were added.
     if !surface.is_sorted() {

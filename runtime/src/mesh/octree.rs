@@ -24,7 +24,8 @@ const SLACK: f64 = 1e-6;
 /// Bytes per octree cell at most, counting every cell the octree may evaluate and the
 /// candidates: while a level is evaluated it holds its cells' indices, centres and values (44
 /// bytes each), and the indices of the next level's cells in a vector that may double (24
-/// bytes each) and, at the last level, their keys (8 bytes each).
+/// bytes each) and, at the last level, their keys (8 bytes each) and the kept cells' centres
+/// as keys and values (16 bytes each, once the 24 of the centres are freed).
 const BYTES_PER_OCTREE_CELL: u64 = 44 + 24;
 
 /// The most [`candidates`] allocates for `grid`: every octree cell it may evaluate and every
@@ -41,12 +42,27 @@ pub fn bytes(grid: &Grid, proven: bool, max_cells: u64) -> u64 {
 }
 
 /// The cells that may hold surface, sorted by key, and the cells evaluated to find them.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Candidates {
     /// Packed keys of the cells (their lowest corner).
     pub cells: Vec<u64>,
     /// Octree cells whose centre was evaluated (0 for the dense grid).
     pub evaluated: u64,
+    /// The centres of the last level's cells kept, which are corners of the candidates
+    /// (the corner every child of one shares), with their values: packed keys, in no order.
+    /// Contouring reads them instead of evaluating those corners again.
+    pub centres: Vec<(u64, f64)>,
+}
+
+impl From<Vec<u64>> for Candidates {
+    /// Candidates found otherwise: sorted cell keys, none of whose corners is known.
+    fn from(cells: Vec<u64>) -> Self {
+        Candidates {
+            cells,
+            evaluated: 0,
+            centres: Vec::new(),
+        }
+    }
 }
 
 /// Why [`candidates`] stopped early.
@@ -90,6 +106,7 @@ pub fn candidates(
         return Ok(Candidates {
             cells,
             evaluated: 0,
+            centres: Vec::new(),
         });
     }
     let largest = grid.cells.iter().copied().max().unwrap_or(1).max(1);
@@ -104,11 +121,14 @@ pub fn candidates(
             return Err(Refused::Cells(evaluated));
         }
         let half = 0.5 * size as f64 * grid.voxel;
+        // The centres are grid points, placed as the grid places them, so that the last
+        // level's are the corners contouring would evaluate, to the bit ([`Candidates::centres`]).
         let centres: Vec<[f64; 3]> = frontier
             .iter()
-            .map(|c| [0, 1, 2].map(|a| grid.origin[a] + c[a] as f64 * 2.0 * half + half))
+            .map(|c| grid.point(c.map(|x| x * size + size / 2)))
             .collect();
         let d = field.distances(&centres);
+        drop(centres);
         // The surface these values prove, before the next level is counted or stored.
         let within = max_cells.saturating_sub(evaluated).min(max_candidates);
         // The balls inside, shrunk by the rounding of a GPU's f32 distances.
@@ -158,13 +178,24 @@ pub fn candidates(
         if level + 1 == levels {
             let mut cells: Vec<u64> = next.into_iter().map(pack).collect();
             cells.par_sort_unstable();
-            return Ok(Candidates { cells, evaluated });
+            let centres = frontier
+                .iter()
+                .zip(&d)
+                .filter(|(_, d)| !(d.abs() > reach))
+                .map(|(c, &d)| (pack(c.map(|x| 2 * x + 1)), d))
+                .collect();
+            return Ok(Candidates {
+                cells,
+                evaluated,
+                centres,
+            });
         }
         frontier = next;
     }
     Ok(Candidates {
         cells: Vec::new(),
         evaluated,
+        centres: Vec::new(),
     })
 }
 

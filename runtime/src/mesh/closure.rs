@@ -38,13 +38,10 @@ pub(super) fn closure(
     let held = candidates.len() as u64;
     let mut closure = Closure {
         values: Bricks::over(f64::NAN, grid, held),
-        set: Bricks::over(false, grid, held),
+        set: Bricks::from_sorted(false, grid, held, &candidates, |_| true),
         held,
         surface: Vec::new(),
     };
-    for &c in &candidates {
-        closure.set.set(unpack(c), true);
-    }
     let mut pending = candidates;
     let mut first = true;
     let mut known = Some(known);
@@ -87,9 +84,7 @@ impl Closure {
         let points: Vec<[f64; 3]> = keys.par_iter().map(|&k| grid.point(unpack(k))).collect();
         let d = field.distances(&points);
         drop(points);
-        for (&k, v) in keys.iter().zip(d) {
-            self.values.set(unpack(k), v);
-        }
+        self.values = Bricks::from_sorted(f64::NAN, grid, self.held, &keys, |n| d[n]);
         for (k, v) in known {
             self.values.set(unpack(k), v);
         }

@@ -2,14 +2,17 @@
 built-ins and records (the same table `model.py` builds the functions from): one function
 (with an overload per form) for each built-in that makes a shape or a profile, a method of
 `Shape` or `Profile` where its first parameter takes one, and a keyword class for each
-material, light, camera and render record. A test keeps python/sdfc/model.pyi equal to
-`generate()`; `python -m sdfc.stubs > python/sdfc/model.pyi` writes it again.
+material, light, camera and render record; model.pyi's head and the shape's own methods are
+written by hand there, and kept. A test keeps python/sdfc/model.pyi equal to `generate()`;
+`python -m sdfc.stubs python/sdfc/model.pyi` writes it again.
 """
 
 from __future__ import annotations
 
+import sys
 import textwrap
-from typing import List
+from pathlib import Path
+from typing import List, Optional, Tuple
 
 from . import model
 
@@ -33,88 +36,21 @@ def _type(ty: str) -> str:
     return _TYPES[ty]
 
 
-# The shape's own API (model.py, class Shape), beside the methods of the table.
-_SHAPE_OWN = '''
-    def __matmul__(self, material: Record) -> Shape: ...
-    def source(self, camera: Optional[Camera] = ..., lights: Optional[Sequence[Record]] = ..., render: Optional[Render] = ...) -> str: ...
-    def scene(
-        self,
-        camera: Optional[Camera] = ...,
-        lights: Optional[Sequence[Record]] = ...,
-        render: Optional[Render] = ...,
-        set: Optional[Dict[str, Any]] = ...,
-        limits: Optional[Dict[str, int]] = ...,
-    ) -> Scene: ...
-    def mesh(
-        self,
-        resolution: Optional[int] = ...,
-        bounds: Optional[Sequence[Sequence[float]]] = ...,
-        voxel: Optional[float] = ...,
-        sharp: bool = ...,
-        limits: Optional[Dict[str, int]] = ...,
-    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]: ...
-    def save(
-        self,
-        path: Any,
-        resolution: Optional[int] = ...,
-        bounds: Optional[Sequence[Sequence[float]]] = ...,
-        voxel: Optional[float] = ...,
-        sharp: bool = ...,
-        limits: Optional[Dict[str, int]] = ...,
-        up: Optional[str] = ...,
-    ) -> Tuple[int, int]: ...
-    def distance(self, points: Any, backend: str = ...) -> np.ndarray: ...
-    def facts(self) -> Facts: ...
-    def render(
-        self,
-        size: Optional[Tuple[int, int]] = ...,
-        backend: str = ...,
-        aa: Optional[int] = ...,
-        camera: Optional[Camera] = ...,
-        lights: Optional[Sequence[Record]] = ...,
-        render: Optional[Render] = ...,
-        dtype: Any = ...,
-    ) -> np.ndarray: ...
-    def png(self, size: Optional[Tuple[int, int]] = ..., backend: str = ..., **scene: Any) -> bytes: ...
-    def _repr_png_(self) -> bytes: ...
-    def show(self, **scene: Any) -> subprocess.Popen[bytes]: ...
-'''
+# model.pyi's parts written by hand, kept as they are there: its head (to the first class of
+# the table, `Path`) and the shape's own API (model.py, class Shape) before the methods of the
+# table, which start at `_OWN_END`.
+_HEAD_END = "class Path(_Expr): ..."
+_SHAPE = "class Shape(_Expr):"
+_OWN_END = "    # The methods of the table of built-ins:"
 
-_HEAD = '''# The modelling API's types, generated from the checker's table of built-ins and records by
-# python/sdfc/stubs.py (`python -m sdfc.stubs > python/sdfc/model.pyi`); a test keeps it current.
-import subprocess
-from typing import Any, Dict, List, Optional, Sequence, Tuple, TypeVar, Union, overload
 
-import numpy as np
-
-from . import Facts, Scene
-
-Vec2 = Union[Tuple[float, float], Sequence[float], np.ndarray]
-Vec3 = Union[Tuple[float, float, float], Sequence[float], np.ndarray]
-_E = TypeVar("_E", bound="_Expr")
-
-class Angle:
-    value: float
-    unit: str
-    def __init__(self, value: float, unit: str = ...) -> None: ...
-    @property
-    def radians(self) -> float: ...
-
-def deg(x: float) -> Angle: ...
-def rad(x: float) -> Angle: ...
-
-class _Expr:
-    def __or__(self: _E, other: _E) -> _E: ...
-    def __and__(self: _E, other: _E) -> _E: ...
-    def __sub__(self: _E, other: _E) -> _E: ...
-    def source(self) -> str: ...
-
-class Record: ...
-
-def field(formula: str, lipschitz: Optional[float] = ..., **values: Any) -> Shape: ...
-def profile(formula: str, lipschitz: Optional[float] = ..., **values: Any) -> Profile: ...
-def show(shape: Shape, **scene: Any) -> subprocess.Popen[bytes]: ...
-'''
+def _written_by_hand(text: str) -> Tuple[str, str]:
+    """The head and the shape's own methods of `text`, a model.pyi."""
+    head, found, rest = text.partition(_HEAD_END + "\n")
+    own = rest.partition("\n" + _SHAPE + "\n")[2].partition("\n" + _OWN_END + "\n")[0]
+    if not found or not own:
+        raise ValueError("model.pyi has lost its parts written by hand (its head, the shape's own methods): git checkout python/sdfc/model.pyi")
+    return head, own
 
 
 def _params(sig: "model._Sig", skip: int) -> str:
@@ -163,16 +99,17 @@ def _docstring(doc: str, indent: str) -> List[str]:
     return [f'{indent}    """{body}', f'{indent}    """', f"{indent}    ..."]
 
 
-def generate() -> str:
-    """The text of model.pyi."""
-    out = [_HEAD]
+def generate(pyi: Optional[Path] = None) -> str:
+    """The text of model.pyi, its parts written by hand read from `pyi` (this package's)."""
+    head, own = _written_by_hand((pyi or Path(__file__).with_name("model.pyi")).read_text())
+    out = [head.removesuffix("\n")]
     shaped = {n: [s for s in model.BUILTINS[n].sigs if s.ret in model._MADE] for n in model.SHAPE_BUILTINS}
     out.append("class Path(_Expr): ...")
     out.append("")
     for cls, ty in (("Profile", "profile"), ("Shape", "shape")):
         out.append(f"class {cls}(_Expr):")
         if cls == "Shape":
-            out.append(_SHAPE_OWN.strip("\n"))
+            out += [own, _OWN_END]
         for name, sigs in shaped.items():
             # The methods model.py made from the table (not the shape's own of that name).
             if not getattr(getattr(getattr(model, cls), name, None), "_table", False):
@@ -197,4 +134,10 @@ def generate() -> str:
 
 
 if __name__ == "__main__":
-    print(generate(), end="")
+    # `python -m sdfc.stubs FILE` writes FILE (python/sdfc/model.pyi) again, keeping its parts
+    # written by hand; without FILE, the text is printed, those parts taken from this package's.
+    if len(sys.argv) > 1:
+        target = Path(sys.argv[1])
+        target.write_text(generate(target))
+    else:
+        print(generate(), end="")

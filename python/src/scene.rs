@@ -99,13 +99,15 @@ impl Scene {
             software: false,
         };
         let on = (ask.backend, &Devices::Auto);
-        // The render prepared last for the same backend and outputs is prepared again as the
-        // viewer's later loads are: its kernel kept where its text is unchanged.
+        // The render prepared last for the same backend and outputs is taken over: its
+        // device kept, and its kernel where the text is unchanged.
         let before = self.kept.take_render(ask.backend, image_only);
         let job::Ready {
             scene, prepared, ..
-        } = match (&before, ask.backend) {
-            (Some(before), _) => job::prepare(pool, on, frame, &setup, job::Open::After(before))?,
+        } = match (before, ask.backend) {
+            (Some(before), _) => {
+                job::prepare(pool, on, frame, &setup, job::Open::Replacing(before))?
+            }
             // The process's wgpu device, whose compiled pipelines later renders reuse.
             (None, Backend::Wgpu) => {
                 let gpu = wgpu_device().map_err(|e| Failure::Runtime(e.to_string()))?;
@@ -122,7 +124,6 @@ impl Scene {
                 job::prepare(pool, on, frame, &setup, job::Open::Backend)?
             }
         };
-        drop(before);
         job::check_memory(
             pool,
             &prepared,

@@ -396,26 +396,51 @@ class Kept(unittest.TestCase):
         "scene { sphere(0.5).translate(t * 2, 0, 0); box((0.3, 0.3, 0.3)).translate(-1, 0, 0); }"
     )
 
+    def renders_again_as_a_new_scene_would(self, backend):
+        s = sdfc.Scene(self.ANIMATED)
+        asks = [dict(t=0.0), dict(t=0.25), dict(t=0.25, size=(40, 30)), dict(t=0.0), dict(t=0.0, aa=2)]
+        for ask in asks:
+            kept = s.render(backend=backend, **ask)
+            fresh = sdfc.Scene(self.ANIMATED).render(backend=backend, **ask)
+            np.testing.assert_array_equal(kept, fresh, err_msg=str(ask))
+        self.assertFalse(np.array_equal(s.render(backend=backend, t=0.0), s.render(backend=backend, t=0.25)))
+
     def test_renders_again_as_a_new_scene_would(self):
         for backend in ("cpu", "wgpu"):
             with self.subTest(backend=backend):
-                s = sdfc.Scene(self.ANIMATED)
-                asks = [dict(t=0.0), dict(t=0.25), dict(t=0.25, size=(40, 30)), dict(t=0.0), dict(t=0.0, aa=2)]
-                for ask in asks:
-                    kept = s.render(backend=backend, **ask)
-                    fresh = sdfc.Scene(self.ANIMATED).render(backend=backend, **ask)
-                    np.testing.assert_array_equal(kept, fresh, err_msg=str(ask))
-                self.assertFalse(np.array_equal(s.render(backend=backend, t=0.0), s.render(backend=backend, t=0.25)))
+                self.renders_again_as_a_new_scene_would(backend)
 
-    def test_distances_again_as_a_new_scene_would(self):
+    def test_renders_again_through_cuda_as_a_new_scene_would(self):
+        # CUDA's preparation is taken over, not copied: once, a second render raised.
+        try:
+            sdfc.Scene(self.ANIMATED).render(backend="cuda")
+        except RuntimeError as e:
+            if os.environ.get("SDFC_REQUIRE_CUDA") == "1":
+                raise
+            self.skipTest(f"no CUDA device ({e}); SDFC_REQUIRE_CUDA=1 requires one")
+        self.renders_again_as_a_new_scene_would("cuda")
+
+    def distances_again_as_a_new_scene_would(self, backend):
         rng = np.random.default_rng(5)
         s = sdfc.Scene(self.ANIMATED)
         for t in (0.0, 0.5, 0.0):
             points = rng.uniform(-2, 2, size=(300, 3))
-            d, m = s.distance(points, t=t, backend="wgpu")
-            d_new, m_new = sdfc.Scene(self.ANIMATED).distance(points, t=t, backend="wgpu")
+            d, m = s.distance(points, t=t, backend=backend)
+            d_new, m_new = sdfc.Scene(self.ANIMATED).distance(points, t=t, backend=backend)
             np.testing.assert_array_equal(d, d_new)
             np.testing.assert_array_equal(m, m_new)
+
+    def test_distances_again_as_a_new_scene_would(self):
+        self.distances_again_as_a_new_scene_would("wgpu")
+
+    def test_distances_again_through_cuda_as_a_new_scene_would(self):
+        try:
+            sdfc.Scene(self.ANIMATED).distance(np.zeros((1, 3)), backend="cuda")
+        except RuntimeError as e:
+            if os.environ.get("SDFC_REQUIRE_CUDA") == "1":
+                raise
+            self.skipTest(f"no CUDA device ({e}); SDFC_REQUIRE_CUDA=1 requires one")
+        self.distances_again_as_a_new_scene_would("cuda")
 
 
 class Docs(unittest.TestCase):

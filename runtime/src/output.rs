@@ -283,6 +283,18 @@ pub struct Task {
     pub started: Instant,
 }
 
+impl Task {
+    /// Frame `k`'s `picture`, its render started at `started`, for the file `path`.
+    pub fn file(k: u64, path: PathBuf, format: Format, picture: Picture, started: Instant) -> Task {
+        Task {
+            k,
+            output: Output::File { path, format },
+            picture,
+            started,
+        }
+    }
+}
+
 /// Why an image could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {

@@ -455,6 +455,17 @@ pub struct Report {
     pub points: Vec<Measured>,
 }
 
+/// A table's word for the fronts a point is on: that of time, the other (`other`, with its
+/// word), both or neither.
+pub fn front_word(time: bool, (other, word): (bool, &'static str)) -> &'static str {
+    match (time, other) {
+        (true, true) => "both",
+        (true, false) => "time",
+        (false, true) => word,
+        _ => "",
+    }
+}
+
 /// Whether two settings agree on the swept keys.
 pub fn same(a: &Settings, b: &Settings) -> bool {
     [
@@ -530,12 +541,7 @@ pub fn table(r: &Report) -> String {
         "default"
     );
     for m in &r.points {
-        let front = match (m.front_time, m.front_steps) {
-            (true, true) => "both",
-            (true, false) => "time",
-            (false, true) => "steps",
-            _ => "",
-        };
+        let front = front_word(m.front_time, (m.front_steps, "steps"));
         out += &format!(
             "{:>9.2e} {:>9} {:>5} {:>3} {:>7} {:>10.3} {:>9.1} {:>8.2} {:>7.4} {:>6} {:>6}\n",
             m.epsilon,

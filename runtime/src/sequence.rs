@@ -55,13 +55,16 @@ pub struct Frames {
     pub end: u64,
 }
 
+/// The two whole numbers of `s`, written either side of `between`.
+fn two_numbers(s: &str, between: &str) -> Option<(u64, u64)> {
+    let (a, b) = s.split_once(between)?;
+    Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
+}
+
 impl Frames {
     /// Parses `A..B` (frames A up to B − 1).
     pub fn parse(s: &str) -> Result<Frames, Error> {
-        let err = || Error::Frames(s.into());
-        let (a, b) = s.split_once("..").ok_or_else(err)?;
-        let start = a.trim().parse::<u64>().map_err(|_| err())?;
-        let end = b.trim().parse::<u64>().map_err(|_| err())?;
+        let (start, end) = two_numbers(s, "..").ok_or_else(|| Error::Frames(s.into()))?;
         if end <= start {
             return Err(Error::NoFrames(s.into()));
         }
@@ -97,10 +100,7 @@ impl Default for Shard {
 impl Shard {
     /// Parses `I/N` with 0 ≤ I < N.
     pub fn parse(s: &str) -> Result<Shard, Error> {
-        let err = || Error::Shard(s.into());
-        let (i, n) = s.split_once('/').ok_or_else(err)?;
-        let index = i.trim().parse::<u64>().map_err(|_| err())?;
-        let count = n.trim().parse::<u64>().map_err(|_| err())?;
+        let (index, count) = two_numbers(s, "/").ok_or_else(|| Error::Shard(s.into()))?;
         if count == 0 || index >= count {
             return Err(Error::NoShard(s.into()));
         }

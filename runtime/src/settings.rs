@@ -145,6 +145,14 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
         let hi = limits.get(limit).min(u32::MAX as u64) as u32;
         int(key, value, lo, hi, Some((limits, limit)))
     };
+    // A number `ok` accepts (`what` says which); a distance, where 0 is none.
+    let within = |ok: fn(f64) -> bool, what| real(key, value, ok, what);
+    let distance = || {
+        within(
+            |v| (0.0..=1e9).contains(&v),
+            "a distance from 0 (none) to 1e9",
+        )
+    };
     match key {
         "width" => s.width = limited(Limit::Edge, 1)?,
         "height" => s.height = limited(Limit::Edge, 1)?,
@@ -154,55 +162,25 @@ pub fn set(s: &mut Settings, key: &str, value: &str, limits: &Limits) -> Result<
         "samples" => s.samples = limited(Limit::Samples, 1)?,
         "bounces" => s.bounces = limited(Limit::Bounces, 0)?,
         "epsilon" => {
-            s.epsilon = real(key, value, |v| v > 0.0 && v < 1.0, "a number in (0, 1)")?;
+            s.epsilon = within(|v| v > 0.0 && v < 1.0, "a number in (0, 1)")?;
             s.footprint = false;
         }
-        "max_dist" => s.max_dist = real(key, value, |v| v > 0.0, "a positive number")?,
-        "relaxation" => {
-            s.relaxation = real(
-                key,
-                value,
-                |v| (1.0..2.0).contains(&v),
-                "a number in [1, 2)",
-            )?
-        }
+        "max_dist" => s.max_dist = within(|v| v > 0.0, "a positive number")?,
+        "relaxation" => s.relaxation = within(|v| (1.0..2.0).contains(&v), "a number in [1, 2)")?,
         "background" => {
             s.background = colour(value).ok_or_else(|| Error::Background(value.into()))?
         }
-        "occlusion" => {
-            s.occlusion = real(
-                key,
-                value,
-                |v| (0.0..=1e9).contains(&v),
-                "a distance from 0 (none) to 1e9",
-            )?
-        }
-        "fog" => {
-            s.fog = real(
-                key,
-                value,
-                |v| (0.0..=1e9).contains(&v),
-                "a distance from 0 (none) to 1e9",
-            )?
-        }
+        "occlusion" => s.occlusion = distance()?,
+        "fog" => s.fog = distance()?,
         "fog_color" => {
             s.fog_color = Some(colour(value).ok_or_else(|| Error::FogColour(value.into()))?)
         }
-        "glow" => {
-            s.glow = real(
-                key,
-                value,
-                |v| (0.0..=1e9).contains(&v),
-                "a distance from 0 (none) to 1e9",
-            )?
-        }
+        "glow" => s.glow = distance()?,
         "glow_color" => {
             s.glow_color = colour(value).ok_or_else(|| Error::GlowColour(value.into()))?
         }
         "exposure" => {
-            s.exposure = real(
-                key,
-                value,
+            s.exposure = within(
                 |v| (-20.0..=20.0).contains(&v),
                 "a number of stops from -20 to 20",
             )?

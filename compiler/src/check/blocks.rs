@@ -170,10 +170,7 @@ fn stmts_into(cx: &mut Ctx, stmts: &[ast::Stmt], out: &mut Vec<crate::scene::Nod
                 other => {
                     let mut d =
                         Diagnostic::error("E0300", "a scene statement must be a shape", e.span)
-                            .with_label(format!(
-                                "this is `{}`",
-                                other.ty().map_or("?".into(), |t| t.to_string())
-                            ));
+                            .with_label(format!("this is `{}`", other.type_name()));
                     if other.ty().and_then(Type::elem) == Some(Type::Shape) {
                         d = d.with_help("combine the list's shapes into one: `union(...)`");
                     }
@@ -209,12 +206,8 @@ fn for_loop(
         Value::Int(i) => Some(i),
         Value::Error => None,
         other => {
-            let mut d = Diagnostic::error("E0300", "loop bounds must be `int`", e.span).with_label(
-                format!(
-                    "this is `{}`",
-                    other.ty().map_or("?".into(), |t| t.to_string())
-                ),
-            );
+            let mut d = Diagnostic::error("E0300", "loop bounds must be `int`", e.span)
+                .with_label(format!("this is `{}`", other.type_name()));
             if other.ty() == Some(Type::Float) {
                 d = d.with_help(eval::WHOLE_NUMBER_HELP);
             }

@@ -127,12 +127,10 @@ impl Ctx<'_> {
     pub fn expr(&mut self, e: &Expr) -> Value {
         let max = self.limits.count(Limit::Nesting);
         if self.nesting >= max {
-            self.limit(
-                Limit::Nesting,
+            return self.too_deep(
                 e.span,
                 format!("expressions nest more than {max} levels deep"),
             );
-            return Value::Error;
         }
         if !self.burn(e.span) {
             return Value::Error;
@@ -142,6 +140,12 @@ impl Ctx<'_> {
         let v = stacker::maybe_grow(64 * 1024, 1024 * 1024, || self.expr_kind(e));
         self.nesting -= 1;
         v
+    }
+
+    /// The error value, the nesting limit reported at `span` as `message`.
+    fn too_deep(&mut self, span: Span, message: String) -> Value {
+        self.limit(Limit::Nesting, span, message);
+        Value::Error
     }
 
     /// Evaluates the left operand of a binary operator, the receiver of a method, field or
@@ -155,12 +159,7 @@ impl Ctx<'_> {
             .count(Limit::Nesting)
             .saturating_mul(CHAIN_FACTOR);
         if self.chain >= max {
-            self.limit(
-                Limit::Nesting,
-                e.span,
-                format!("a chain of operators or method calls is longer than {max} links (ten times the nesting limit)"),
-            );
-            return Value::Error;
+            return self.too_deep(e.span, format!("a chain of operators or method calls is longer than {max} links (ten times the nesting limit)"));
         }
         self.nesting -= 1;
         self.chain += 1;
@@ -315,7 +314,7 @@ impl Ctx<'_> {
                         "the condition of a comprehension's `if` must be a bool",
                         cond.span,
                     )
-                    .with_label(format!("this is `{}`", type_name(&other))),
+                    .with_label(format!("this is `{}`", other.type_name())),
                 );
                 None
             }
@@ -332,10 +331,7 @@ impl Ctx<'_> {
                 failed = true;
                 self.error(
                     Diagnostic::error("E0303", "the condition of `if` must be a bool", cond.span)
-                        .with_label(format!(
-                            "this is `{}`",
-                            other.ty().map_or("?".into(), |t| t.to_string())
-                        )),
+                        .with_label(format!("this is `{}`", other.type_name())),
                 );
                 None
             }
@@ -409,9 +405,4 @@ pub(super) fn arg_span(a: &Arg) -> Span {
     a.name
         .as_ref()
         .map_or(a.value.span, |n| n.span.join(a.value.span))
-}
-
-/// The name of a value's type for messages (`?` for an error value).
-pub fn type_name(v: &Value) -> String {
-    v.ty().map_or("?".into(), |t| t.to_string())
 }

@@ -299,27 +299,12 @@ fn collect(graph: &Graph, id: NodeId, place: Place, out: &mut Vec<Piece>) -> Res
             collect(graph, *child, Place { t, ..place }, out)?;
         }
         Node::Rotate { matrix, child } => {
-            let r = DMat3::from_cols_array_2d(matrix).transpose();
-            collect(
-                graph,
-                *child,
-                Place {
-                    m: place.m * r,
-                    ..place
-                },
-                out,
-            )?;
+            let m = place.m * DMat3::from_cols_array_2d(matrix).transpose();
+            collect(graph, *child, Place { m, ..place }, out)?;
         }
         Node::Scale { factor, child } => {
-            collect(
-                graph,
-                *child,
-                Place {
-                    s: place.s * factor,
-                    ..place
-                },
-                out,
-            )?;
+            let s = place.s * factor;
+            collect(graph, *child, Place { s, ..place }, out)?;
         }
         Node::Round { radius, child } => {
             let grow = place.grow + place.s * radius;

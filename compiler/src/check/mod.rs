@@ -135,7 +135,7 @@ fn check_loaded(
             Some(Constant {
                 at: *at,
                 value: v.show()?,
-                ty: eval::type_name(v),
+                ty: v.type_name(),
             })
         })
         .collect();

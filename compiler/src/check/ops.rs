@@ -14,10 +14,6 @@ pub enum OpError {
     Overflow,
 }
 
-fn tname(v: &Value) -> String {
-    v.ty().map_or("?".into(), |t| t.to_string())
-}
-
 /// Applies a unary operator.
 pub fn unary(op: UnOp, v: &Value) -> Result<Value, OpError> {
     Ok(match (op, v) {
@@ -34,12 +30,15 @@ pub fn unary(op: UnOp, v: &Value) -> Result<Value, OpError> {
         (UnOp::Not, Value::Bool(b)) => Value::Bool(!b),
         (UnOp::Not, Value::Unknown(Type::Bool)) => Value::Unknown(Type::Bool),
         (UnOp::Neg, other) => {
-            return Err(OpError::Types(format!("cannot negate `{}`", tname(other))))
+            return Err(OpError::Types(format!(
+                "cannot negate `{}`",
+                other.type_name()
+            )))
         }
         (UnOp::Not, other) => {
             return Err(OpError::Types(format!(
                 "`!` needs a bool, found `{}`",
-                tname(other)
+                other.type_name()
             )))
         }
     })

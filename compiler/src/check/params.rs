@@ -31,10 +31,7 @@ pub fn declare(
                     "a parameter is a number, an int, a bool or a string",
                     l.value.span,
                 )
-                .with_label(format!(
-                    "this is `{}`",
-                    default.ty().map_or("?".into(), |t| t.to_string())
-                ))
+                .with_label(format!("this is `{}`", default.type_name()))
                 .with_help("make it a `let` constant, or give it a number, a bool or a string"),
             );
         }
@@ -51,10 +48,7 @@ pub fn declare(
             other => {
                 cx.error(
                     Diagnostic::error("E0300", "a parameter's description is a string", e.span)
-                        .with_label(format!(
-                            "this is `{}`",
-                            other.ty().map_or("?".into(), |t| t.to_string())
-                        )),
+                        .with_label(format!("this is `{}`", other.type_name())),
                 );
                 return Value::Error;
             }
@@ -189,10 +183,7 @@ fn accepts(cx: &mut Ctx, spec: &ParamSpec, def: &ParamValue, l: &Let) -> Option<
             other => {
                 cx.error(
                     Diagnostic::error("E0300", format!("a parameter's {what} is a number"), e.span)
-                        .with_label(format!(
-                            "this is `{}`",
-                            other.ty().map_or("?".into(), |t| t.to_string())
-                        )),
+                        .with_label(format!("this is `{}`", other.type_name())),
                 );
                 None
             }
@@ -252,7 +243,7 @@ fn accepts(cx: &mut Ctx, spec: &ParamSpec, def: &ParamValue, l: &Let) -> Option<
             other => {
                 cx.error(
                     Diagnostic::error("E0300", "a parameter's choices are a list of strings, and its default one of them", list.span)
-                        .with_label(format!("this is `{}`", other.ty().map_or("?".into(), |t| t.to_string())))
+                        .with_label(format!("this is `{}`", other.type_name()))
                         .with_secondary(l.value.span, format!("the default is a {}", def.type_name()))
                         .with_help("write `param style = \"round\" in [\"round\", \"square\"];`, or `in lo..hi` for a number"),
                 );

@@ -153,6 +153,11 @@ pub enum Value {
 }
 
 impl Value {
+    /// The name of the value's type for messages (`?` for an error value).
+    pub fn type_name(&self) -> String {
+        self.ty().map_or("?".into(), |t| t.to_string())
+    }
+
     /// The value's type; `None` for `Error`.
     pub fn ty(&self) -> Option<Type> {
         Some(match self {

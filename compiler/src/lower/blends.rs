@@ -19,11 +19,11 @@ pub(super) fn combine(
     v: Smooth,
 ) -> Option<Reg> {
     Some(match (v, op) {
-        (Smooth::Chamfer, Combine::Union) => chamfer_union(b, x, y, r),
-        (Smooth::Chamfer, Combine::Intersect) => chamfer_intersect(b, x, y, r),
+        (Smooth::Chamfer, Combine::Union) => chamfer(b, x, y, r, true),
+        (Smooth::Chamfer, Combine::Intersect) => chamfer(b, x, y, r, false),
         (Smooth::Chamfer, Combine::Subtract) => {
             let ny = b.neg(y);
-            chamfer_intersect(b, x, ny, r)
+            chamfer(b, x, ny, r, false)
         }
         (Smooth::Round, Combine::Union) => round_union(b, x, y, r),
         (Smooth::Round, Combine::Intersect) => round_intersect(b, x, y, r),
@@ -59,22 +59,24 @@ fn by_union(
     b.neg(u)
 }
 
-/// `fOpUnionChamfer`: min(min(a, b), (a + b - r)·√½).
-fn chamfer_union(b: &mut Builder, x: Reg, y: Reg, r: f64) -> Reg {
-    let m = b.min(x, y);
+/// `fOpUnionChamfer`: min(min(a, b), (a + b - r)·√½); with `union` false,
+/// `fOpIntersectionChamfer`: max(max(a, b), (a + b + r)·√½).
+fn chamfer(b: &mut Builder, x: Reg, y: Reg, r: f64, union: bool) -> Reg {
+    let pick = if union { Builder::min } else { Builder::max };
+    let m = pick(b, x, y);
     let s = b.add(x, y);
-    let s = b.subc(s, r);
+    let s = if union { b.subc(s, r) } else { b.addc(s, r) };
     let s = b.mulc(s, FRAC_1_SQRT_2);
-    b.min(m, s)
+    pick(b, m, s)
 }
 
-/// `fOpIntersectionChamfer`: max(max(a, b), (a + b + r)·√½).
-fn chamfer_intersect(b: &mut Builder, x: Reg, y: Reg, r: f64) -> Reg {
-    let m = b.max(x, y);
-    let s = b.add(x, y);
-    let s = b.addc(s, r);
-    let s = b.mulc(s, FRAC_1_SQRT_2);
-    b.max(m, s)
+/// |max((u(a), u(b)), 0)|.
+fn positive_len(b: &mut Builder, x: Reg, y: Reg, u: impl Fn(&mut Builder, Reg) -> Reg) -> Reg {
+    let ux = u(b, x);
+    let ux = b.maxc(ux, 0.0);
+    let uy = u(b, y);
+    let uy = b.maxc(uy, 0.0);
+    b.len2(ux, uy)
 }
 
 /// `fOpUnionRound`: max(r, min(a, b)) - |max((r - a, r - b), 0)|.
@@ -82,11 +84,7 @@ fn round_union(b: &mut Builder, x: Reg, y: Reg, r: f64) -> Reg {
     let m = b.min(x, y);
     let m = b.maxc(m, r);
     let rc = b.c(r);
-    let ux = b.sub(rc, x);
-    let ux = b.maxc(ux, 0.0);
-    let uy = b.sub(rc, y);
-    let uy = b.maxc(uy, 0.0);
-    let l = b.len2(ux, uy);
+    let l = positive_len(b, x, y, |b, v| b.sub(rc, v));
     b.sub(m, l)
 }
 
@@ -94,11 +92,7 @@ fn round_union(b: &mut Builder, x: Reg, y: Reg, r: f64) -> Reg {
 fn round_intersect(b: &mut Builder, x: Reg, y: Reg, r: f64) -> Reg {
     let m = b.max(x, y);
     let m = b.minc(m, -r);
-    let ux = b.addc(x, r);
-    let ux = b.maxc(ux, 0.0);
-    let uy = b.addc(y, r);
-    let uy = b.maxc(uy, 0.0);
-    let l = b.len2(ux, uy);
+    let l = positive_len(b, x, y, |b, v| b.addc(v, r));
     b.add(m, l)
 }
 

@@ -354,20 +354,30 @@ pub(crate) fn hash_of(cell: &[f64]) -> f64 {
     program.run::<f64>(at, |_| {})[roots[0].0 as usize]
 }
 
+/// The lattice cell of `q`, axis by axis: the fractional coordinates, and what `cell` makes of
+/// the integer part (mod 289).
+fn lattice<T>(
+    b: &mut Builder,
+    q: &[Reg],
+    mut cell: impl FnMut(&mut Builder, Reg) -> T,
+) -> (Vec<Reg>, Vec<T>) {
+    let mut f = Vec::with_capacity(q.len());
+    let mut a = Vec::with_capacity(q.len());
+    for &x in q {
+        let i = b.un(Unary::Floor, x);
+        f.push(b.sub(x, i));
+        let r = mod289(b, i);
+        a.push(cell(b, r));
+    }
+    (f, a)
+}
+
 /// Gradient noise at `q` (2 or 3 coordinates): the lattice cell's corners each contribute
 /// the dot product of their gradient with the offset from the corner, blended by the quintic
 /// fade of the fractional coordinates (Perlin 2002).
 pub(super) fn noise(b: &mut Builder, q: &[Reg]) -> Reg {
     let dims = q.len();
-    let mut f = Vec::with_capacity(dims);
-    let mut a = Vec::with_capacity(dims);
-    for &x in q {
-        let i = b.un(Unary::Floor, x);
-        f.push(b.sub(x, i));
-        let r = mod289(b, i);
-        let r1 = b.addc(r, 1.0);
-        a.push([r, r1]);
-    }
+    let (f, a) = lattice(b, q, |b, r| [r, b.addc(r, 1.0)]);
     let s: Vec<Reg> = f.iter().map(|&t| fade(b, t)).collect();
     // Each corner's contribution, corners numbered with bit k for axis k.
     let corners = 1usize << dims;
@@ -412,13 +422,7 @@ pub(super) fn voronoi(b: &mut Builder, q: &[Reg]) -> Reg {
         1.732_050_807_568_877_2 - 1.0,
     ];
     let dims = q.len();
-    let mut f = Vec::with_capacity(dims);
-    let mut a = Vec::with_capacity(dims);
-    for &x in q {
-        let i = b.un(Unary::Floor, x);
-        f.push(b.sub(x, i));
-        a.push(mod289(b, i));
-    }
+    let (f, a) = lattice(b, q, |_, r| r);
     let cells = 3usize.pow(dims as u32);
     let mut best: Option<Reg> = None;
     for c in 0..cells {

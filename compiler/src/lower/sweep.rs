@@ -268,17 +268,23 @@ fn helix(b: &mut Builder, p: P, radius: f64, pitch: f64, turns: f64) -> Hit {
     let at = b.mulc(next, TAU);
     let second = b.add(phi0, at);
     let (start, end) = (b.c(0.0), b.c(total));
+    // At the angle φ: p's offsets sideways and towards the axis in the plane turned by φ, and
+    // its height above the helix there.
+    let at_angle = |b: &mut Builder, phi: Reg| {
+        let (s, c) = (b.un(Unary::Sin, phi), b.un(Unary::Cos, phi));
+        let (xs, zc) = (b.mul(p[0], s), b.mul(p[2], c));
+        let side = b.add(xs, zc);
+        let (xc, zs) = (b.mul(p[0], c), b.mul(p[2], s));
+        let radial = b.sub(xc, zs);
+        let kp = b.mulc(phi, k);
+        let h = b.sub(py, kp);
+        (side, radial, h)
+    };
     let mut best = None;
     for (from, newton) in [(first, true), (second, true), (start, false), (end, false)] {
         let mut phi = b.clampc(from, 0.0, total);
         for _ in 0..if newton { 3 } else { 0 } {
-            let (s, c) = (b.un(Unary::Sin, phi), b.un(Unary::Cos, phi));
-            let (xs, zc) = (b.mul(p[0], s), b.mul(p[2], c));
-            let side = b.add(xs, zc);
-            let (xc, zs) = (b.mul(p[0], c), b.mul(p[2], s));
-            let radial = b.sub(xc, zs);
-            let kp = b.mulc(phi, k);
-            let h = b.sub(py, kp);
+            let (side, radial, h) = at_angle(b, phi);
             let f1a = b.mulc(side, radius);
             let f1b = b.mulc(h, k);
             let f1 = b.sub(f1a, f1b);
@@ -290,13 +296,7 @@ fn helix(b: &mut Builder, p: P, radius: f64, pitch: f64, turns: f64) -> Hit {
             let next = b.sub(phi, dphi);
             phi = b.clampc(next, 0.0, total);
         }
-        let (s, c) = (b.un(Unary::Sin, phi), b.un(Unary::Cos, phi));
-        let (xs, zc) = (b.mul(p[0], s), b.mul(p[2], c));
-        let side = b.add(xs, zc);
-        let (xc, zs) = (b.mul(p[0], c), b.mul(p[2], s));
-        let radial = b.sub(xc, zs);
-        let kp = b.mulc(phi, k);
-        let h = b.sub(py, kp);
+        let (side, radial, h) = at_angle(b, phi);
         // q·E1 (E1 towards the axis), q·E2 (E2 = T × E1), q·T.
         let e1 = b.neg(radial);
         let e1 = b.addc(e1, radius);

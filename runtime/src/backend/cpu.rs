@@ -1,9 +1,9 @@
 //! The CPU renderer behind [`Renderer`]: the distance program's tapes, prepared once, and the
 //! render options.
 
-use super::{Error, Frame, Part, Prepared, Renderer, Setup};
+use super::{Error, Frame, Part, Prepared, Progress, Renderer, Setup};
 use crate::cpu::{self, Options, Tapes};
-use crate::gpu;
+use crate::gpu::{self, launch::Faults};
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
 use std::time::{Duration, Instant};
@@ -44,11 +44,7 @@ impl CpuPrepared {
         Setup {
             precision: self.options.precision,
             debug_nan: self.options.debug_nan,
-            parameters: false,
-            kernel: wgsl::KernelChoice::default(),
-            image_only: false,
-            finished: false,
-            software: false,
+            ..Setup::default()
         }
     }
 }
@@ -101,12 +97,7 @@ impl Renderer for CpuPrepared {
         self.tapes.traceable()
     }
 
-    fn render(
-        &self,
-        scene: &Scene,
-        progress: &(dyn Fn(f64) + Sync),
-        _: &gpu::launch::Faults,
-    ) -> Result<Frame, Error> {
+    fn render(&self, scene: &Scene, progress: Progress, _: &Faults) -> Result<Frame, Error> {
         let tiles = cpu::tile_count(&scene.settings, &self.options).max(1) as f64;
         let done = std::sync::atomic::AtomicU64::new(0);
         let start = Instant::now();

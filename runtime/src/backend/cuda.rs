@@ -1,8 +1,10 @@
 //! CUDA behind [`Renderer`]: the device, the kernel translated to PTX and loaded as a module,
 //! and what it takes to write the kernel again.
 
-use super::{kernel, kernel_text, Error, Frame, Part, Preparation, Prepared, Renderer, Setup};
-use crate::gpu::{self, cuda::Cuda};
+use super::{
+    kernel, written, Error, Frame, Part, Preparation, Prepared, Progress, Renderer, Setup,
+};
+use crate::gpu::{self, cuda::Cuda, launch::Faults};
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, ptx, wgsl, Lowered, Scene, Settings};
 use std::time::{Duration, Instant};
@@ -152,10 +154,6 @@ impl Renderer for CudaPrepared {
         )
     }
 
-    fn retained(&self, settings: &Settings) -> u64 {
-        gpu::retained(settings)
-    }
-
     fn program_len(&self) -> usize {
         self.lowered.program.len()
     }
@@ -176,12 +174,7 @@ impl Renderer for CudaPrepared {
         self.setup.image_only = !on;
     }
 
-    fn render(
-        &self,
-        scene: &Scene,
-        progress: &(dyn Fn(f64) + Sync),
-        faults: &gpu::launch::Faults,
-    ) -> Result<Frame, Error> {
+    fn render(&self, scene: &Scene, progress: Progress, faults: &Faults) -> Result<Frame, Error> {
         let module = &self.module;
         let r = gpu::render_cuda(
             &self.cuda,
@@ -220,7 +213,7 @@ impl Renderer for CudaPrepared {
     }
 
     fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
-        let text = kernel_text(scene, &lowered, &self.setup)?;
+        let text = written(scene, &lowered, &self.setup, wgsl::write_text)?;
         let built = text.source != self.module.source;
         if built {
             let kernel = kernel(scene, &lowered, &self.setup.on_cuda())?;

@@ -24,9 +24,9 @@ pub use devices::{Device, Devices};
 pub use prepare::method_allowed;
 
 use crate::cpu::{Precision, Render};
-use crate::gpu::{self};
+use crate::gpu::{self, launch::Faults};
 use crate::memory::{self, Memory};
-use prepare::{kernel, kernel_text};
+use prepare::{kernel, written};
 use sdfc_compiler::{
     analytic::{self, Traceable},
     ptx, wgsl, Lowered, Scene, Settings,
@@ -376,6 +376,9 @@ fn kind(interpreted: bool) -> &'static str {
     }
 }
 
+/// What a render tells of how far it has come: the fraction done.
+pub type Progress<'a> = &'a (dyn Fn(f64) + Sync);
+
 /// A scene prepared for one backend, or for several devices: what every backend answers.
 /// [`Prepared`] holds one and does what is the same for all (the kernel's contract checked
 /// before a render, the method checked before a preparation).
@@ -401,7 +404,9 @@ pub trait Renderer: std::fmt::Debug + Send + Sync {
     fn memory(&self, scene: &Scene, settings: &Settings) -> Memory;
 
     /// The bytes a finished frame holds (its image and, on the CPU, its depth buffers).
-    fn retained(&self, settings: &Settings) -> u64;
+    fn retained(&self, settings: &Settings) -> u64 {
+        gpu::retained(settings)
+    }
 
     /// Instructions of the distance program (CPU) or of the kernel's `map` (GPU).
     fn program_len(&self) -> usize;
@@ -421,12 +426,7 @@ pub trait Renderer: std::fmt::Debug + Send + Sync {
     }
 
     /// Renders one frame, its contract checked; `progress` gets the fraction done.
-    fn render(
-        &self,
-        scene: &Scene,
-        progress: &(dyn Fn(f64) + Sync),
-        faults: &gpu::launch::Faults,
-    ) -> Result<Frame, Error>;
+    fn render(&self, scene: &Scene, progress: Progress, faults: &Faults) -> Result<Frame, Error>;
 
     /// Whether GPU frames reduce the per-pixel statistics on the device (the opposite of
     /// [`Setup::image_only`]): `sdfc bench` reduces them for its warm-up frame alone. Nothing
@@ -547,16 +547,16 @@ impl Prepared {
 
     /// Renders one frame; `progress` gets the fraction done. The faults of the testing aid
     /// `SDFC_FAULT_AFTER_TILES` are injected.
-    pub fn render(&self, scene: &Scene, progress: &(dyn Fn(f64) + Sync)) -> Result<Frame, Error> {
-        self.render_faults(scene, progress, &gpu::launch::Faults::from_env())
+    pub fn render(&self, scene: &Scene, progress: Progress) -> Result<Frame, Error> {
+        self.render_faults(scene, progress, &Faults::from_env())
     }
 
     /// [`Prepared::render`] with the faults `faults` injected.
     pub fn render_faults(
         &self,
         scene: &Scene,
-        progress: &(dyn Fn(f64) + Sync),
-        faults: &gpu::launch::Faults,
+        progress: Progress,
+        faults: &Faults,
     ) -> Result<Frame, Error> {
         self.check_contract(scene)?;
         self.0.render(scene, progress, faults)

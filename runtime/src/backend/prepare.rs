@@ -34,9 +34,21 @@ pub(super) fn kernel(
     lowered: &Lowered,
     setup: &Setup,
 ) -> Result<wgsl::Kernel, Error> {
+    written(scene, lowered, setup, wgsl::write_with)
+}
+
+/// What `write` makes of the kernel for `scene` once it is chosen (`wgsl::choose`):
+/// `wgsl::write_with`, the kernel validated, or `wgsl::write_text`, its text and data alone
+/// (to compare with a kernel held).
+pub(super) fn written<T>(
+    scene: &Scene,
+    lowered: &Lowered,
+    setup: &Setup,
+    write: fn(&Scene, &Lowered, &wgsl::Options) -> Result<T, wgsl::Error>,
+) -> Result<T, Error> {
     let options = kernel_options(setup);
     wgsl::choose(scene, lowered, &options)?;
-    Ok(wgsl::write_with(scene, lowered, &options)?)
+    Ok(write(scene, lowered, &options)?)
 }
 
 fn kernel_options(setup: &Setup) -> wgsl::Options {
@@ -51,18 +63,6 @@ fn kernel_options(setup: &Setup) -> wgsl::Options {
         },
         ..wgsl::Options::default()
     }
-}
-
-/// The text and data of the kernel for `scene`, not validated (to compare with a kernel
-/// held).
-pub(super) fn kernel_text(
-    scene: &Scene,
-    lowered: &Lowered,
-    setup: &Setup,
-) -> Result<wgsl::Text, Error> {
-    let options = kernel_options(setup);
-    wgsl::choose(scene, lowered, &options)?;
-    Ok(wgsl::write_text(scene, lowered, &options)?)
 }
 
 impl Prepared {

@@ -1,8 +1,8 @@
 //! Several devices behind [`Renderer`] (`--devices`): each prepared as one device is, rendering
 //! each frame together through the one tile scheduler ([`gpu::render_several`]).
 
-use super::{Error, Frame, Part, Prepared, Renderer, Setup};
-use crate::gpu;
+use super::{Error, Frame, Part, Prepared, Progress, Renderer, Setup};
+use crate::gpu::{self, launch::Faults};
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
 use std::time::Duration;
@@ -88,12 +88,7 @@ impl Renderer for SeveralPrepared {
         self.parts.iter().find_map(|p| p.0.setup())
     }
 
-    fn render(
-        &self,
-        scene: &Scene,
-        progress: &(dyn Fn(f64) + Sync),
-        faults: &gpu::launch::Faults,
-    ) -> Result<Frame, Error> {
+    fn render(&self, scene: &Scene, progress: Progress, faults: &Faults) -> Result<Frame, Error> {
         let statistics = !self.setup().is_some_and(|s| s.image_only);
         let finished = self.setup().is_some_and(|s| s.finished);
         let mut workers = Vec::with_capacity(self.parts.len());

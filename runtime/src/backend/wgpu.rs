@@ -1,8 +1,10 @@
 //! wgpu behind [`Renderer`]: the device (which may be shared, as the viewer shares its
 //! window's), the validated kernel, and what it takes to write the kernel again.
 
-use super::{kernel, kernel_text, Error, Frame, Part, Preparation, Prepared, Renderer, Setup};
-use crate::gpu::{self, Gpu};
+use super::{
+    kernel, written, Error, Frame, Part, Preparation, Prepared, Progress, Renderer, Setup,
+};
+use crate::gpu::{self, launch::Faults, Gpu};
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, wgsl, Lowered, Scene, Settings};
 use std::sync::Arc;
@@ -132,7 +134,7 @@ impl WgpuPrepared {
         let start = Instant::now();
         let (kernel, built) = match held {
             Some(held) => {
-                let text = kernel_text(scene, lowered, setup)?;
+                let text = written(scene, lowered, setup, wgsl::write_text)?;
                 if text.source == held.source {
                     let mut kernel = held.clone();
                     kernel.data = text.data;
@@ -213,10 +215,6 @@ impl Renderer for WgpuPrepared {
         )
     }
 
-    fn retained(&self, settings: &Settings) -> u64 {
-        gpu::retained(settings)
-    }
-
     fn program_len(&self) -> usize {
         self.lowered.program.len()
     }
@@ -238,12 +236,7 @@ impl Renderer for WgpuPrepared {
         self.setup.image_only = !on && !self.setup.software;
     }
 
-    fn render(
-        &self,
-        scene: &Scene,
-        progress: &(dyn Fn(f64) + Sync),
-        faults: &gpu::launch::Faults,
-    ) -> Result<Frame, Error> {
+    fn render(&self, scene: &Scene, progress: Progress, faults: &Faults) -> Result<Frame, Error> {
         let r = gpu::render_faults(
             &self.gpu,
             scene,

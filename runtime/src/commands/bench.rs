@@ -251,12 +251,8 @@ pub fn run(args: BenchArgs) -> ExitCode {
             Err(e) => return e.exit(),
         };
         if args.json {
-            match serde_json::to_string_pretty(&timings) {
-                Ok(s) => println!("{s}"),
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    return ExitCode::from(2);
-                }
+            if let Err(code) = super::print_json(&timings, true) {
+                return code;
             }
         } else {
             println!(
@@ -316,12 +312,8 @@ pub fn run(args: BenchArgs) -> ExitCode {
         timings.push(t);
     }
     if args.json {
-        match serde_json::to_string_pretty(&timings) {
-            Ok(s) => println!("{s}"),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(2);
-            }
+        if let Err(code) = super::print_json(&timings, true) {
+            return code;
         }
     }
     ExitCode::SUCCESS

@@ -66,12 +66,8 @@ pub fn run(args: CompareArgs) -> ExitCode {
         depth_note,
     };
     if args.json {
-        match serde_json::to_string(&report) {
-            Ok(s) => println!("{s}"),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(2);
-            }
+        if let Err(code) = super::print_json(&report, false) {
+            return code;
         }
     } else {
         print!("{}", text(&report));

@@ -12,9 +12,7 @@ use crate::mesh::contour::{self, Stop, BYTES_PER_SURFACE_CELL};
 use crate::mesh::device::Gpu;
 use crate::mesh::write::{Format, Up};
 use crate::mesh::{octree, Field, Grid, Mesh, Settings, Stats};
-use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{analysis, Limit, Limits, LowerOptions};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -109,15 +107,7 @@ fn mesh(args: &MeshArgs) -> Result<(), (u8, String)> {
             .any(|c| matches!(c, sdfc_compiler::Colour::Field(_)))
     });
     settings.materials |= format == Format::Obj && colour_fields;
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = ProgressBar::new(1000);
-        if let Ok(style) =
-            ProgressStyle::with_template("{msg:>9} {bar:40} {percent:>3}% {elapsed_precise}")
-        {
-            bar.set_style(style);
-        }
-        bar
-    });
+    let bar = super::progress_bar(1000, "{msg:>9} {bar:40} {percent:>3}% {elapsed_precise}");
     let progress = |name: &'static str, f: f64| {
         if let Some(b) = &bar {
             b.set_message(name);
@@ -332,26 +322,6 @@ fn objects(
 /// A part of a 3MF meshed: its material's name and id, scene, thinness and mesh.
 type Part = (String, u32, frontend::Checked, Thinness, Meshed);
 
-impl Meshing<'_> {
-    /// [`surface_on`] of `checked` over `region`, its progress told to `progress`.
-    fn surface_on(
-        &self,
-        checked: &frontend::Checked,
-        region: Region,
-        progress: &(dyn Fn(&'static str, f64) + Sync),
-    ) -> Result<Meshed, (u8, String)> {
-        surface_on(
-            checked,
-            region,
-            self.settings,
-            self.limits,
-            self.pool,
-            progress,
-            self.say,
-        )
-    }
-}
-
 /// The parts meshed again on `fine`; where one cannot be, every part as it was, saying why.
 fn again(meshed: Vec<Part>, fine: Region, how: &Meshing) -> Vec<Part> {
     let mut again = Vec::new();
@@ -413,12 +383,19 @@ pub fn surface(
     progress: &(dyn Fn(&'static str, f64) + Sync),
     say: &(dyn Fn(String) + Sync),
 ) -> Result<Meshed, (u8, String)> {
-    let coarse = surface_on(checked, region, settings, limits, pool, progress, say)?;
+    let how = Meshing {
+        settings,
+        limits,
+        pool,
+        progress,
+        say,
+    };
+    let coarse = how.surface_on(checked, region, progress)?;
     let thin = Thinness::new(checked, region, coarse.grid.voxel);
     let Some(fine) = finer(&thin, &coarse, settings, limits, region.spelling, say) else {
         return Ok(coarse);
     };
-    match surface_on(checked, fine, settings, limits, pool, progress, say) {
+    match how.surface_on(checked, fine, progress) {
         Ok(fine) => Ok(refined(&thin, coarse, fine, say)),
         Err((_, why)) => {
             thin.refused(&coarse.stats, &why, say);
@@ -461,55 +438,61 @@ fn refined(
     fine
 }
 
-/// [`surface`] on one grid.
-fn surface_on(
-    checked: &frontend::Checked,
-    region: Region,
-    settings: &Settings,
-    limits: &Limits,
-    pool: &rayon::ThreadPool,
-    progress: &(dyn Fn(&'static str, f64) + Sync),
-    say: &(dyn Fn(String) + Sync),
-) -> Result<Meshed, (u8, String)> {
-    let analysis = analysis::analyse(&checked.scene);
-    let Frame {
-        clip,
-        voxel,
-        proven,
-    } = frame(checked, &analysis, region, say)?;
-    let spell = region.spelling;
-    let resolution_opt = spell.option("resolution");
-    let origin = checked.scene.origin;
-    let grid = Grid::over(&clip, voxel);
-    let lowered = checked
-        .lower(&LowerOptions::default(), limits)
-        .map_err(|_| (1, String::new()))?;
-    let field = field_on(checked, &lowered, (proven, clip), settings, say)?;
-    if !proven {
-        say(format!(
+impl Meshing<'_> {
+    /// [`surface`] of `checked` over `region` on one grid, its progress told to `progress`.
+    fn surface_on(
+        &self,
+        checked: &frontend::Checked,
+        region: Region,
+        progress: &(dyn Fn(&'static str, f64) + Sync),
+    ) -> Result<Meshed, (u8, String)> {
+        let Meshing {
+            settings,
+            limits,
+            pool,
+            say,
+            ..
+        } = *self;
+        let analysis = analysis::analyse(&checked.scene);
+        let Frame {
+            clip,
+            voxel,
+            proven,
+        } = frame(checked, &analysis, region, say)?;
+        let spell = region.spelling;
+        let resolution_opt = spell.option("resolution");
+        let origin = checked.scene.origin;
+        let grid = Grid::over(&clip, voxel);
+        let lowered = checked
+            .lower(&LowerOptions::default(), limits)
+            .map_err(|_| (1, String::new()))?;
+        let field = field_on(checked, &lowered, (proven, clip), settings, say)?;
+        if !proven {
+            say(format!(
             "warning: the scene's distance field has no proven bound{}, so no cell can be ruled out; meshing the dense grid of {} cells",
             cause(checked, &analysis),
             grid.dense_cells()
         ));
-    }
-    let max_cells = limits.get(Limit::Cells);
-    let octree_bytes = octree::bytes(&grid, proven, max_cells);
-    let [nx, ny, nz] = grid.cells;
-    say(format!(
-        "mesh: {nx}x{ny}x{nz} cells of {}: allocating at most {} MiB to find the surface",
-        short(voxel),
-        mib(octree_bytes)
-    ));
-    check_memory(octree_bytes, limits, spell).map_err(|m| (1, m))?;
-    let stage =
-        |name: &'static str, base: f64, share: f64| move |f: f64| progress(name, base + share * f);
-    // The most candidates whose corners the memory limit lets contouring hold: the octree
-    // stops at the first level that proves more, with the message the check after it gives.
-    let fits = |n: u64| check_memory(contour::candidate_bytes(&grid, n), limits, spell).is_ok();
-    let max_candidates = most(fits);
-    let started = Instant::now();
-    let before = super::started().0.elapsed().as_secs_f64();
-    let candidates = pool
+        }
+        let max_cells = limits.get(Limit::Cells);
+        let octree_bytes = octree::bytes(&grid, proven, max_cells);
+        let [nx, ny, nz] = grid.cells;
+        say(format!(
+            "mesh: {nx}x{ny}x{nz} cells of {}: allocating at most {} MiB to find the surface",
+            short(voxel),
+            mib(octree_bytes)
+        ));
+        check_memory(octree_bytes, limits, spell).map_err(|m| (1, m))?;
+        let stage = |name: &'static str, base: f64, share: f64| {
+            move |f: f64| progress(name, base + share * f)
+        };
+        // The most candidates whose corners the memory limit lets contouring hold: the octree
+        // stops at the first level that proves more, with the message the check after it gives.
+        let fits = |n: u64| check_memory(contour::candidate_bytes(&grid, n), limits, spell).is_ok();
+        let max_candidates = most(fits);
+        let started = Instant::now();
+        let before = super::started().0.elapsed().as_secs_f64();
+        let candidates = pool
         .install(|| {
             octree::candidates(
                 &field,
@@ -532,37 +515,37 @@ fn surface_on(
                 refuse_memory(contour::candidate_bytes(&grid, n), true, limits, spell),
             ),
         })?;
-    let n = candidates.cells.len() as u64;
-    let bound = contour::candidate_bytes(&grid, n);
-    say(format!(
-        "mesh: {n} cells may hold surface: allocating at most {} MiB for their corners",
-        mib(bound)
-    ));
-    check_memory(bound, limits, spell).map_err(|m| (1, m))?;
-    let surface_check = |cells: u64| {
-        let total = bound.saturating_add(cells.saturating_mul(BYTES_PER_SURFACE_CELL));
+        let n = candidates.cells.len() as u64;
+        let bound = contour::candidate_bytes(&grid, n);
         say(format!(
-            "mesh: {cells} cells hold surface: allocating at most {} MiB in all",
-            mib(total)
+            "mesh: {n} cells may hold surface: allocating at most {} MiB for their corners",
+            mib(bound)
         ));
-        check_memory(total, limits, spell)
-    };
-    // The cells the closure may hold: as many as the memory limit allows at 52 bytes each
-    // (a key and a point), within the cells limit.
-    let memory_cells = (limits.get(Limit::Memory).saturating_mul(MIB) / 52).min(max_cells);
-    let octree_evaluated = candidates.evaluated;
-    let result = pool.install(|| {
-        contour::contour(
-            &field,
-            &grid,
-            candidates,
-            settings,
-            memory_cells,
-            &surface_check,
-            &stage("contour", 0.3, 0.7),
-        )
-    });
-    let (mut mesh, mut stats): (Mesh, Stats) = result.map_err(|stop| match stop {
+        check_memory(bound, limits, spell).map_err(|m| (1, m))?;
+        let surface_check = |cells: u64| {
+            let total = bound.saturating_add(cells.saturating_mul(BYTES_PER_SURFACE_CELL));
+            say(format!(
+                "mesh: {cells} cells hold surface: allocating at most {} MiB in all",
+                mib(total)
+            ));
+            check_memory(total, limits, spell)
+        };
+        // The cells the closure may hold: as many as the memory limit allows at 52 bytes each
+        // (a key and a point), within the cells limit.
+        let memory_cells = (limits.get(Limit::Memory).saturating_mul(MIB) / 52).min(max_cells);
+        let octree_evaluated = candidates.evaluated;
+        let result = pool.install(|| {
+            contour::contour(
+                &field,
+                &grid,
+                candidates,
+                settings,
+                memory_cells,
+                &surface_check,
+                &stage("contour", 0.3, 0.7),
+            )
+        });
+        let (mut mesh, mut stats): (Mesh, Stats) = result.map_err(|stop| match stop {
         Stop::Refused(msg) => (1, msg),
         Stop::Cells(cells) => (
             1,
@@ -572,37 +555,38 @@ fn surface_on(
             ),
         ),
     })?;
-    let seconds = started.elapsed().as_secs_f64();
-    if let Some(gpu) = field.gpu() {
-        if let Some(why) = gpu.failure() {
-            return Err((
-                1,
-                format!("--backend {} failed while meshing: {why}", gpu.name),
-            ));
+        let seconds = started.elapsed().as_secs_f64();
+        if let Some(gpu) = field.gpu() {
+            if let Some(why) = gpu.failure() {
+                return Err((
+                    1,
+                    format!("--backend {} failed while meshing: {why}", gpu.name),
+                ));
+            }
+            stats.backend = gpu.name;
+            stats.launches = gpu.launches();
+        } else {
+            stats.backend = "cpu";
         }
-        stats.backend = gpu.name;
-        stats.launches = gpu.launches();
-    } else {
-        stats.backend = "cpu";
+        stats.before = Some(before);
+        stats.evaluating = field.evaluating();
+        if settings.measure {
+            // Measured in f64 by the CPU, whatever evaluated the mesh.
+            let exact = Field::new(&lowered.program, proven, clip);
+            stats.error = Some(pool.install(|| crate::mesh::error(&exact, &mesh)));
+        }
+        stats.octree_cells = octree_evaluated;
+        stats.dense = !proven;
+        for p in &mut mesh.positions {
+            *p = [0, 1, 2].map(|i| p[i] + origin[i]);
+        }
+        Ok(Meshed {
+            mesh,
+            stats,
+            grid,
+            seconds,
+        })
     }
-    stats.before = Some(before);
-    stats.evaluating = field.evaluating();
-    if settings.measure {
-        // Measured in f64 by the CPU, whatever evaluated the mesh.
-        let exact = Field::new(&lowered.program, proven, clip);
-        stats.error = Some(pool.install(|| crate::mesh::error(&exact, &mesh)));
-    }
-    stats.octree_cells = octree_evaluated;
-    stats.dense = !proven;
-    for p in &mut mesh.positions {
-        *p = [0, 1, 2].map(|i| p[i] + origin[i]);
-    }
-    Ok(Meshed {
-        mesh,
-        stats,
-        grid,
-        seconds,
-    })
 }
 
 /// The field of `lowered` over `clip`, evaluated by the CPU or the GPU `settings` name.

@@ -161,6 +161,47 @@ pub fn write_stdout(bytes: &[u8]) -> Result<(), std::process::ExitCode> {
         })
 }
 
+/// Prints `value` as JSON on a line (indented over many with `pretty`); a value that cannot
+/// be written is reported, `error: …`, and is exit code 2.
+pub(crate) fn print_json(
+    value: &impl serde::Serialize,
+    pretty: bool,
+) -> Result<(), std::process::ExitCode> {
+    let text = if pretty {
+        serde_json::to_string_pretty(value)
+    } else {
+        serde_json::to_string(value)
+    };
+    match text {
+        Ok(s) => {
+            println!("{s}");
+            Ok(())
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            Err(std::process::ExitCode::from(2))
+        }
+    }
+}
+
+/// A progress bar of `len` steps on stderr, drawn with `template`, when stderr is a terminal.
+pub(crate) fn progress_bar(len: u64, template: &str) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(len);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
+            bar.set_style(style);
+        }
+        bar
+    })
+}
+
+/// The stem of `file`'s name (`scene` of `scene.sdf`), else `or`: the default output's.
+pub(crate) fn stem_or(file: &std::path::Path, or: &str) -> String {
+    file.file_stem()
+        .map_or_else(|| or.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
 /// `--limit NAME=VALUE`: the resource limits of a run.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct LimitArgs {

@@ -191,12 +191,8 @@ pub(super) fn publish<R: serde::Serialize>(
     chart: impl FnOnce() -> Chart,
 ) -> ExitCode {
     if args.json {
-        match serde_json::to_string_pretty(report) {
-            Ok(s) => println!("{s}"),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(2);
-            }
+        if let Err(code) = super::print_json(report, true) {
+            return code;
         }
     } else {
         print!("{table}");
@@ -226,12 +222,7 @@ fn measure(
     }
     let setup = Setup {
         precision: args.precision,
-        debug_nan: false,
-        parameters: false,
-        kernel: Default::default(),
-        image_only: false,
-        finished: false,
-        software: false,
+        ..Setup::default()
     };
     // Through the job's path, on the pool this runs in.
     let frame = FrameScene {
@@ -346,12 +337,7 @@ fn reference_setup(
     };
     let setup = Setup {
         precision: Precision::F64,
-        debug_nan: false,
-        parameters: false,
-        kernel: Default::default(),
-        image_only: false,
-        finished: false,
-        software: false,
+        ..Setup::default()
     };
     let on = (Backend::Cpu, &Devices::Auto);
     let Ready {

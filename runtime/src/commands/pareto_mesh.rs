@@ -235,12 +235,7 @@ pub fn table(r: &MeshReport) -> String {
         "default"
     );
     for m in &r.points {
-        let front = match (m.front_time, m.front_triangles) {
-            (true, true) => "both",
-            (true, false) => "time",
-            (false, true) => "tris",
-            _ => "",
-        };
+        let front = crate::pareto::front_word(m.front_time, (m.front_triangles, "tris"));
         out += &format!(
             "{:>10} {:>10.4} {:>10} {:>10} {:>10.1} {:>12.3e} {:>12.3e} {:>8.2} {:>6} {:>7}\n",
             m.resolution,

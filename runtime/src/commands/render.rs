@@ -10,7 +10,6 @@ use crate::cpu::reference::{self, Convergence};
 use crate::job::{self, Error, Job};
 use crate::output::{CannotWrite, Output};
 use crate::{depth, frontend};
-use indicatif::{ProgressBar, ProgressStyle};
 use sdfc_compiler::{LowerOptions, Scene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -478,15 +477,7 @@ fn write_sidecar(
 
 /// Renders with a progress bar on stderr when stderr is a terminal.
 pub fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame, backend::Error> {
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = ProgressBar::new(1000);
-        if let Ok(style) =
-            ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}")
-        {
-            bar.set_style(style);
-        }
-        bar
-    });
+    let bar = super::progress_bar(1000, "{bar:40} {percent:>3}% {elapsed_precise} eta {eta}");
     let frame = prepared.render(scene, &|f| {
         if let Some(b) = &bar {
             b.set_position((f * 1000.0) as u64);
@@ -500,9 +491,5 @@ pub fn render_with_progress(prepared: &Prepared, scene: &Scene) -> Result<Frame,
 
 /// `scene.sdf` → `./scene.png`.
 fn default_output(file: &Path) -> PathBuf {
-    let stem = file
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "render".into());
-    PathBuf::from(format!("{stem}.png"))
+    PathBuf::from(format!("{}.png", super::stem_or(file, "render")))
 }

@@ -266,6 +266,17 @@ pub fn render_tapes(
     }
 }
 
+/// What every ray of `scene` rendered with `tapes` and `options` reads, in the float type `T`.
+fn context<T: Float>(scene: &Scene, tapes: &Tapes, options: &Options) -> Context<T> {
+    Context::new(
+        scene,
+        &tapes.traceable,
+        &tapes.colours,
+        options.lipschitz,
+        options.debug_nan,
+    )
+}
+
 /// [`render_tapes`] in the float type `T`.
 pub fn render_in<T: Float>(
     scene: &Scene,
@@ -273,13 +284,7 @@ pub fn render_in<T: Float>(
     options: &Options,
     progress: &(dyn Fn() + Sync),
 ) -> Render {
-    let ctx = Context::<T>::new(
-        scene,
-        &tapes.traceable,
-        &tapes.colours,
-        options.lipschitz,
-        options.debug_nan,
-    );
+    let ctx = context::<T>(scene, tapes, options);
     let rects = tiles(&scene.settings, options.tile);
     let outs: Vec<tile::TileOut> = rects
         .par_iter()
@@ -317,13 +322,7 @@ fn rows_in<T: Float>(
     options: &Options,
     rows: std::ops::Range<u32>,
 ) -> (Vec<[f32; 3]>, Vec<u32>, Counters) {
-    let ctx = Context::<T>::new(
-        scene,
-        &tapes.traceable,
-        &tapes.colours,
-        options.lipschitz,
-        options.debug_nan,
-    );
+    let ctx = context::<T>(scene, tapes, options);
     let s = &scene.settings;
     let edge = options.tile.max(1);
     let rects: Vec<Rect> = tiles(s, edge)

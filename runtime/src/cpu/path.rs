@@ -353,15 +353,9 @@ fn step<T: Float>(
         let more = ray.depth < ctx.bounces;
         let off = hit.n * (T::from_f64(4.0) * hit.h);
         let child = |origin: V3<T>, dir: V3<T>, weight: V3<T>, inside: bool, pdf: T| Ray {
-            origin,
-            dir,
-            t0: hit.tt,
-            weight,
-            sample: ray.sample,
-            depth: ray.depth + 1,
-            inside,
             pdf,
             sky_pdf: hit.n.dot(dir).max(T::zero()) / T::from_f64(PI),
+            ..ray.child(hit.tt, origin, dir, weight, inside)
         };
         if ray.inside && !hit.solid {
             // Leaving the solid: refract out, or reflect back in on total internal reflection.
@@ -489,21 +483,10 @@ fn estimates<T: Float>(
     for lamp in &ctx.lamps {
         let (l, tmax, atten, il, k) = match *lamp {
             Lamp::Point {
-                position,
-                color,
-                radius,
-                sharpness,
+                color, sharpness, ..
             } => {
-                let v = position - hit.p;
-                let d = v.length();
-                let atten = if radius > T::zero() {
-                    let x = d / radius;
-                    let f = (T::one() - x * x).clamp(T::zero(), T::one());
-                    f * f
-                } else {
-                    T::one()
-                };
-                (v * (T::one() / d), d - off, atten, color, sharpness)
+                let (l, d, atten) = shade::towards(ctx, lamp, hit.p);
+                (l, d - off, atten, color, sharpness)
             }
             Lamp::Directional {
                 to_light,

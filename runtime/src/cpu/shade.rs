@@ -457,7 +457,7 @@ pub(super) fn colour<T: Float>(ctx: &Context<T>, m: &Mat<T>, hit: &Hit<T>, dir: 
 /// Direction to the light, its distance (max_dist for a directional light) and its
 /// attenuation. Point lights fall off as (1 - (d/r)²)² clamped to [0, 1], reaching 0 at the
 /// radius r (a radius ≤ 0 or infinite means no falloff).
-fn towards<T: Float>(ctx: &Context<T>, lamp: &Lamp<T>, p: V3<T>) -> (V3<T>, T, T) {
+pub(super) fn towards<T: Float>(ctx: &Context<T>, lamp: &Lamp<T>, p: V3<T>) -> (V3<T>, T, T) {
     match *lamp {
         Lamp::Point {
             position, radius, ..
@@ -733,17 +733,7 @@ fn spawn<T: Float>(ctx: &Context<T>, wave: &[Ray<T>], hits: &[Hit<T>]) -> Vec<Ra
         let m = hit.material(ctx);
         let off = hit.n * (T::from_f64(4.0) * hit.h);
         let weight = ray.weight * hit.fade;
-        let child = |origin: V3<T>, dir: V3<T>, weight: V3<T>, inside: bool| Ray {
-            origin,
-            dir,
-            t0: hit.tt,
-            weight,
-            sample: ray.sample,
-            depth: ray.depth + 1,
-            inside,
-            pdf: T::zero(),
-            sky_pdf: T::zero(),
-        };
+        let child = |origin, dir, weight, inside| ray.child(hit.tt, origin, dir, weight, inside);
         if ray.inside && !hit.solid {
             match refract(ray.dir, -hit.n, m.ior) {
                 Some(t) => next.push(child(hit.p + off, t, weight, false)),

@@ -32,6 +32,24 @@ pub(super) struct Ray<T> {
     pub sky_pdf: T,
 }
 
+impl<T: Float> Ray<T> {
+    /// The ray this one's hit at path length `t0` sends on from `origin` along `dir` (one
+    /// bounce deeper, of the same sample), with no densities.
+    pub fn child(&self, t0: T, origin: V3<T>, dir: V3<T>, weight: V3<T>, inside: bool) -> Ray<T> {
+        Ray {
+            origin,
+            dir,
+            t0,
+            weight,
+            sample: self.sample,
+            depth: self.depth + 1,
+            inside,
+            pdf: T::zero(),
+            sky_pdf: T::zero(),
+        }
+    }
+}
+
 /// What the rays of a tile add up to, per sample (index within the tile).
 #[derive(Debug)]
 pub(super) struct Samples<T> {

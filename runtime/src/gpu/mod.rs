@@ -174,6 +174,28 @@ pub fn render_cuda(
     )
 }
 
+/// The work of a frame of the settings `s` in the tiles `tiles`: the kernel's uniforms and
+/// scene data, whether launches are timed, whether statistics are reduced and whether pixels
+/// are finished on the device.
+fn work<'a>(
+    s: &Settings,
+    (uniforms, data): (&'a [u8], Option<&'a [u8]>),
+    tiles: &'a [launch::Tile],
+    timed: bool,
+    (statistics, finished): (bool, bool),
+) -> launch::Work<'a> {
+    launch::Work {
+        uniforms,
+        data,
+        width: s.width,
+        height: s.height,
+        tiles,
+        timed,
+        statistics,
+        finished,
+    }
+}
+
 /// Renders `scene` on one device, in squares of [`TILE`] pixels (finished pixels read back a
 /// row of squares at a time, each while the next renders: [`launch::render_one`]).
 fn render_one<D: launch::Device>(
@@ -186,16 +208,7 @@ fn render_one<D: launch::Device>(
 ) -> Result<GpuRender, D::Error> {
     let s = &scene.settings;
     let tiles = launch::tiling(s.width, s.height, TILE, 1);
-    let work = launch::Work {
-        uniforms,
-        data,
-        width: s.width,
-        height: s.height,
-        tiles: &tiles,
-        timed: true,
-        statistics,
-        finished,
-    };
+    let work = work(s, (uniforms, data), &tiles, true, (statistics, finished));
     let out = launch::render_one(device, &work, faults, progress)?;
     Ok(finish(out, s))
 }
@@ -228,16 +241,7 @@ pub fn render_several(
         None => Vec::new(),
     };
     let tiles = launch::tiling(s.width, s.height, TILE, devices.len());
-    let work = launch::Work {
-        uniforms: &uniforms,
-        data,
-        width: s.width,
-        height: s.height,
-        tiles: &tiles,
-        timed: false,
-        statistics,
-        finished,
-    };
+    let work = work(s, (&uniforms, data), &tiles, false, (statistics, finished));
     let out = launch::render_several(devices, &work, faults, progress)?;
     Ok(finish(out, s))
 }

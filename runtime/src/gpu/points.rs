@@ -83,6 +83,11 @@ fn result_bytes(points: &[[f64; 3]]) -> u64 {
 /// alone.
 pub type Results = (Vec<Value<f32>>, Vec<f32>);
 
+/// Room for the results of `n` points.
+fn results_for(n: usize) -> Results {
+    (Vec::with_capacity(n), Vec::with_capacity(n))
+}
+
 /// Results as the entry point writes them, for the first `n` points (read on rayon's
 /// threads).
 fn results(bytes: &[u8], n: usize) -> Results {
@@ -227,10 +232,7 @@ impl WgpuPoints {
     /// (otherwise in new ones, twice as large or as this run needs, kept for the next).
     pub fn run(&self, gpu: &crate::gpu::Gpu, points: &[[f64; 3]]) -> Result<Results, RunError> {
         let (device, queue) = (gpu.device(), gpu.queue());
-        let mut out: Results = (
-            Vec::with_capacity(points.len()),
-            Vec::with_capacity(points.len()),
-        );
+        let mut out = results_for(points.len());
         let mut kept = self.kept.lock().unwrap_or_else(PoisonError::into_inner);
         for chunk in points.chunks(POINTS_PER_DISPATCH) {
             let input = point_bytes(chunk);
@@ -429,10 +431,7 @@ impl CudaPoints {
             .iter()
             .position(|&b| b == (self.group, 0))
             .ok_or(RunError::NoResults)?;
-        let mut out: Results = (
-            Vec::with_capacity(points.len()),
-            Vec::with_capacity(points.len()),
-        );
+        let mut out = results_for(points.len());
         let mut kept = self.kept.lock().unwrap_or_else(PoisonError::into_inner);
         for chunk in points.chunks(POINTS_PER_DISPATCH) {
             let input = point_bytes(chunk);

@@ -28,6 +28,12 @@ pub enum Open<'a> {
     /// and given the new `scene_data` ([`Prepared::next`]). The backend and devices asked are
     /// the ones before's.
     After(&'a Prepared),
+    /// Where a scene before was prepared, taken over: its backend, device and setup, its GPU
+    /// kernel kept where the new kernel's text is the same and given the new `scene_data`
+    /// ([`Prepared::update`]): for a caller that has no more use for the scene before (the
+    /// Python module's renders). Unlike [`Open::After`], every backend and set of devices
+    /// can be taken over.
+    Replacing(Prepared),
 }
 
 /// A frame's scene prepared on its backend ([`prepare`]).
@@ -37,8 +43,8 @@ pub struct Ready {
     pub scene: Scene,
     /// The backend prepared for it.
     pub prepared: Prepared,
-    /// Whether a kernel (or the CPU's tapes) was built: `false` where [`Open::After`] kept
-    /// the kernel before.
+    /// Whether a kernel (or the CPU's tapes) was built: `false` where [`Open::After`] or
+    /// [`Open::Replacing`] kept the kernel before.
     pub built: bool,
 }
 
@@ -82,6 +88,10 @@ pub fn prepare_here(
             wgsl::KernelChoice::Auto => before.next(&scene, lowered)?,
             kernel => before.next_with(&scene, lowered, kernel)?,
         },
+        Open::Replacing(mut before) => {
+            let built = before.update(&scene, lowered)?;
+            (before, built)
+        }
         Open::Beside(o) if o.backend() == backend && *devices == Devices::Auto => (
             Prepared::opened(o, &scene, lowered, setup).map_err(unavailable)?,
             true,

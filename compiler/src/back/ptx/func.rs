@@ -22,6 +22,17 @@ fn read_only(g: &GlobalVariable) -> bool {
     }
 }
 
+/// Global `g`'s buffer, at the address in `base`, for the function `fw` writes: read through
+/// the read-only path where the kernel never stores to it.
+fn bind_buffer(fw: &mut Fw, g: Handle<GlobalVariable>, base: Reg) {
+    let space = if read_only(&fw.cx.module.global_variables[g]) {
+        Space::GlobalRo
+    } else {
+        Space::Global
+    };
+    fw.globals[g.index()] = Some(Store::Mem(space, base));
+}
+
 /// The PTX type of one leaf in a parameter (booleans travel as `b32`).
 fn param_ty(sc: Sc) -> &'static str {
     if sc == Sc::F32 {
@@ -348,12 +359,7 @@ pub(super) fn write_func(cx: &Cx, h: Handle<Function>) -> Result<String, Error> 
         let p = format!("{name}_param_{}", params.len());
         let base = fw.out.reg(Class::B64);
         ins!(fw.out, "ld.param.b64 {base}, [{p}];");
-        let space = if read_only(&cx.module.global_variables[g]) {
-            Space::GlobalRo
-        } else {
-            Space::Global
-        };
-        fw.globals[g.index()] = Some(Store::Mem(space, base));
+        bind_buffer(&mut fw, g, base);
         params.push(format!(".param .b64 {p}"));
     }
     let mut args = Vec::with_capacity(func.arguments.len());
@@ -418,12 +424,7 @@ pub(super) fn write_kernel(cx: &Cx, ep: &EntryPoint, index: usize) -> Result<Str
         let base = fw.out.reg(Class::B64);
         ins!(fw.out, "ld.param.u64 {raw}, [{p}];");
         ins!(fw.out, "cvta.to.global.u64 {base}, {raw};");
-        let space = if read_only(&cx.module.global_variables[g]) {
-            Space::GlobalRo
-        } else {
-            Space::Global
-        };
-        fw.globals[g.index()] = Some(Store::Mem(space, base));
+        bind_buffer(&mut fw, g, base);
     }
     fw.privates(info)?;
     let mut args = Vec::with_capacity(ep.function.arguments.len());

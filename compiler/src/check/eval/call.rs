@@ -3,7 +3,6 @@
 //! error inside a body shows.
 
 use super::bind::{bind, Bound};
-use super::type_name;
 use super::{ArgVal, Ctx, PView};
 use crate::check::builtins::{self, Build, Range, P};
 use crate::check::field;
@@ -423,7 +422,7 @@ impl Ctx<'_> {
                                 format!("the default of `{}` is not a `{t}`", p.name.name),
                                 d.span,
                             )
-                            .with_label(format!("this is `{}`", type_name(&v))),
+                            .with_label(format!("this is `{}`", v.type_name())),
                         );
                     }
                 }

@@ -2,7 +2,6 @@
 //! indexing, each list's length held to its limit.
 
 use super::bind::WHOLE_NUMBER_HELP;
-use super::type_name;
 use super::Ctx;
 use crate::check::field;
 use crate::check::types::{Type, Value};
@@ -123,7 +122,7 @@ impl Ctx<'_> {
             other => {
                 let mut d =
                     Diagnostic::error("E0300", "the bounds of a range must be `int`", e.span)
-                        .with_label(format!("this is `{}`", type_name(&other)));
+                        .with_label(format!("this is `{}`", other.type_name()));
                 if other.ty() == Some(Type::Float) {
                     d = d.with_help(WHOLE_NUMBER_HELP);
                 }

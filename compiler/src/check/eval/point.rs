@@ -2,7 +2,6 @@
 //! built-ins per-point values allow, and `field { … }` blocks lowered to field shapes.
 
 use super::bind::type_mismatch;
-use super::type_name;
 use super::{arg_span, Ctx};
 use crate::check::builtins::{self, NORMAL};
 use crate::check::field;
@@ -125,7 +124,7 @@ impl Ctx<'_> {
         // A float body is a distance (a shape, or a profile), a vec3 body a colour (a colour
         // field; not of the plane).
         if plane && v.ty().is_some_and(|t| !t.fits(Type::Float)) {
-            let ty = type_name(&v);
+            let ty = v.type_name();
             let mut d = Diagnostic::error(
                 "E0300",
                 format!("the body of `profile` is a `{ty}`, not a float"),
@@ -159,11 +158,11 @@ impl Ctx<'_> {
                         "E0300",
                         format!(
                             "the body of `field` is a `{}`, not a float or a vec3",
-                            type_name(other)
+                            other.type_name()
                         ),
                         body.value.span,
                     )
-                    .with_label(format!("this is `{}`", type_name(other)))
+                    .with_label(format!("this is `{}`", other.type_name()))
                     .with_note(
                         "a field's body is its distance at the point `p` (a float), or, for a \
                          material's colour, its colour there (a vec3)",

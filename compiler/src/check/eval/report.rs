@@ -68,20 +68,8 @@ impl Ctx<'_> {
             ops::OpError::DivZero => "division by zero".into(),
         };
         let mut d = Diagnostic::error("E0301", msg, span)
-            .with_secondary(
-                a.1,
-                format!(
-                    "this is `{}`",
-                    a.0.ty().map_or("?".into(), |t| t.to_string())
-                ),
-            )
-            .with_secondary(
-                b.1,
-                format!(
-                    "this is `{}`",
-                    b.0.ty().map_or("?".into(), |t| t.to_string())
-                ),
-            );
+            .with_secondary(a.1, format!("this is `{}`", a.0.type_name()))
+            .with_secondary(b.1, format!("this is `{}`", b.0.type_name()));
         let tys = (a.0.ty(), b.0.ty());
         if [tys.0, tys.1]
             .iter()

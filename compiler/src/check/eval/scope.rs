@@ -1,7 +1,7 @@
 //! Names during evaluation: variables and their suggestions, `let` bindings and the stack of
 //! locals, type names.
 
-use super::{type_name, with_type_help, Ctx};
+use super::{with_type_help, Ctx};
 use crate::check::builtins::{self, NORMAL};
 use crate::check::field;
 use crate::check::suggest::{closest, closest_in_order};
@@ -105,10 +105,10 @@ impl Ctx<'_> {
             None => {
                 let d = Diagnostic::error(
                     "E0300",
-                    format!("expected `{want}`, found `{}`", type_name(&v)),
+                    format!("expected `{want}`, found `{}`", v.type_name()),
                     l.value.span,
                 )
-                .with_label(format!("this is `{}`", type_name(&v)))
+                .with_label(format!("this is `{}`", v.type_name()))
                 .with_secondary(ty.span, "declared type");
                 self.error(with_type_help(d, want, v.ty()));
                 Value::Error

@@ -33,10 +33,7 @@ impl Ctx<'_> {
                 None => {
                     self.error(
                         Diagnostic::error("E0300", "vector components must be numbers", item.span)
-                            .with_label(format!(
-                                "this is `{}`",
-                                v.ty().map_or("?".into(), |t| t.to_string())
-                            )),
+                            .with_label(format!("this is `{}`", v.type_name())),
                     );
                     return Value::Error;
                 }
@@ -163,10 +160,7 @@ impl Ctx<'_> {
             (other, _) => {
                 self.error(
                     Diagnostic::error("E0300", "only shapes can be given a material", vspan)
-                        .with_label(format!(
-                            "this is `{}`",
-                            other.ty().map_or("?".into(), |t| t.to_string())
-                        )),
+                        .with_label(format!("this is `{}`", other.type_name())),
                 );
                 Value::Error
             }

@@ -118,6 +118,11 @@ fn bad(at: Place, what: impl Into<String>) -> Error {
     }
 }
 
+/// `b` as text, or `message` at its first byte that is not UTF-8.
+fn as_text<'a>(b: &'a [u8], message: &'static str) -> Result<&'a str, Error> {
+    std::str::from_utf8(b).map_err(|e| bad(Place::Byte(e.valid_up_to() as u64), message))
+}
+
 /// A malformed file, as a whole.
 fn bad_file(what: impl Into<String>) -> Error {
     Error::Malformed {
@@ -185,6 +190,43 @@ impl Faces {
             });
         }
         Ok(self.kept)
+    }
+}
+
+/// A polygon fanned into triangles as its corners are read: the fan's first corner and the
+/// last one read.
+#[derive(Default)]
+struct Fan {
+    first: u32,
+    previous: u32,
+}
+
+impl Fan {
+    /// Corner `k` (from 0), its index found by `index`: from the third on, each closes a
+    /// triangle with the first and the one before. Past the limit the triangles are only
+    /// counted, and the index is not read.
+    fn corner(
+        &mut self,
+        k: u64,
+        index: impl FnOnce() -> Result<u32, Error>,
+        faces: &mut Faces,
+    ) -> Result<(), Error> {
+        if faces.over() {
+            if k >= 2 {
+                faces.skip(1);
+            }
+            return Ok(());
+        }
+        let index = index()?;
+        match k {
+            0 => self.first = index,
+            1 => self.previous = index,
+            _ => {
+                faces.push([self.first, self.previous, index]);
+                self.previous = index;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -287,12 +329,10 @@ enum StlState {
 /// `vertex` lines, `endloop` and `endfacet` for each triangle, and `endsolid`. A file cut
 /// anywhere, even mid-word, is an error at the line where it breaks off.
 fn stl_ascii(b: &[u8], max: u64) -> Result<Read, Error> {
-    let text = std::str::from_utf8(b).map_err(|e| {
-        bad(
-            Place::Byte(e.valid_up_to() as u64),
-            "an ASCII STL file must be text, and this byte is not UTF-8",
-        )
-    })?;
+    let text = as_text(
+        b,
+        "an ASCII STL file must be text, and this byte is not UTF-8",
+    )?;
     let mut weld = Weld::default();
     let mut faces = Faces::new(max);
     let mut corners = [0u32; 3];
@@ -371,12 +411,7 @@ fn numbers<'a>(words: &mut impl Iterator<Item = &'a str>, line: usize) -> Result
 /// `i//n`, 1-based or negative, relative to the end), fanned into triangles as the corners
 /// are read.
 fn obj(b: &[u8], max: u64) -> Result<Read, Error> {
-    let text = std::str::from_utf8(b).map_err(|e| {
-        bad(
-            Place::Byte(e.valid_up_to() as u64),
-            "an OBJ file must be text, and this byte is not UTF-8",
-        )
-    })?;
+    let text = as_text(b, "an OBJ file must be text, and this byte is not UTF-8")?;
     let mut positions = Vec::new();
     let mut faces = Faces::new(max);
     for (n, line) in text.lines().enumerate() {
@@ -385,27 +420,12 @@ fn obj(b: &[u8], max: u64) -> Result<Read, Error> {
         match words.next() {
             Some("v") => positions.push(numbers(&mut words, line_no)?),
             Some("f") => {
-                // The fan's first corner and the last one read.
-                let (mut first, mut previous) = (0, 0);
+                let mut fan = Fan::default();
                 let mut corners = 0u64;
                 for w in words {
+                    let index = || obj_index(w, positions.len(), line_no);
+                    fan.corner(corners, index, &mut faces)?;
                     corners += 1;
-                    if faces.over() {
-                        // Past the limit the triangles are only counted.
-                        if corners >= 3 {
-                            faces.skip(1);
-                        }
-                        continue;
-                    }
-                    let index = obj_index(w, positions.len(), line_no)?;
-                    match corners {
-                        1 => first = index,
-                        2 => previous = index,
-                        _ => {
-                            faces.push([first, previous, index]);
-                            previous = index;
-                        }
-                    }
                 }
                 if corners < 3 {
                     return Err(bad(Place::Line(line_no), "a face needs three corners"));
@@ -575,13 +595,22 @@ fn ply_header(b: &[u8]) -> Result<(&str, usize), Error> {
     if body < b.len() && b[body] == b'\n' {
         body += 1;
     }
-    let header = std::str::from_utf8(&b[..end]).map_err(|e| {
-        bad(
-            Place::Byte(e.valid_up_to() as u64),
-            "the PLY header must be text, and this byte is not UTF-8",
-        )
-    })?;
+    let header = as_text(
+        &b[..end],
+        "the PLY header must be text, and this byte is not UTF-8",
+    )?;
     Ok((header, body))
+}
+
+/// The error of a PLY property declared before any element.
+const NO_ELEMENT: &str = "a property before any element";
+
+/// The property `name` added to the last of `elements`; `None` where there is none.
+fn property(elements: &mut [Element], name: &str, ty: Scalar, list: Option<Scalar>) -> Option<()> {
+    let name = name.to_string();
+    elements
+        .last_mut()
+        .map(|e| e.properties.push(Property { name, ty, list }))
 }
 
 /// What a PLY header declares: the body's format (`None` for ASCII, else whether
@@ -610,26 +639,12 @@ fn ply_elements(header: &str) -> Result<(Option<bool>, Vec<Element>), Error> {
                 let (Some(c), Some(t)) = (Scalar::named(c), Scalar::named(t)) else {
                     return Err(bad(at(), "unknown property type"));
                 };
-                let e = elements
-                    .last_mut()
-                    .ok_or_else(|| bad(at(), "a property before any element"))?;
-                e.properties.push(Property {
-                    name: name.to_string(),
-                    ty: t,
-                    list: Some(c),
-                });
+                property(&mut elements, name, t, Some(c)).ok_or_else(|| bad(at(), NO_ELEMENT))?;
             }
             ["property", t, name] => {
                 let t = Scalar::named(t)
                     .ok_or_else(|| bad(at(), format!("unknown property type `{t}`")))?;
-                let e = elements
-                    .last_mut()
-                    .ok_or_else(|| bad(at(), "a property before any element"))?;
-                e.properties.push(Property {
-                    name: name.to_string(),
-                    ty: t,
-                    list: None,
-                });
+                property(&mut elements, name, t, None).ok_or_else(|| bad(at(), NO_ELEMENT))?;
             }
             _ => {}
         }
@@ -696,35 +711,22 @@ fn ply_list(
     if face && n < 3.0 {
         return Err(bad(Place::Byte(at as u64), "a face needs three corners"));
     }
-    // The fan's first corner and the last one read.
-    let (mut first, mut previous) = (0, 0);
-    for k in 0..n as usize {
+    let mut fan = Fan::default();
+    for k in 0..n as u64 {
         let c = values.next(prop.ty)?;
         if !face {
             continue;
         }
-        if faces.over() {
-            // Past the limit the triangles are only counted.
-            if k >= 2 {
-                faces.skip(1);
-            }
-            continue;
-        }
-        // A negative or fractional index names no vertex: u32::MAX is
-        // refused as such when the mesh is built.
-        let ix = if c >= 0.0 && c.fract() == 0.0 {
-            c as u32
-        } else {
-            u32::MAX
+        // A negative or fractional index names no vertex: u32::MAX is refused as such when
+        // the mesh is built.
+        let index = || {
+            Ok(if c >= 0.0 && c.fract() == 0.0 {
+                c as u32
+            } else {
+                u32::MAX
+            })
         };
-        match k {
-            0 => first = ix,
-            1 => previous = ix,
-            _ => {
-                faces.push([first, previous, ix]);
-                previous = ix;
-            }
-        }
+        fan.corner(k, index, faces)?;
     }
     Ok(())
 }

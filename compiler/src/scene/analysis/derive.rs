@@ -292,17 +292,8 @@ impl Pass<'_> {
             return self.combine(op, &[a, b]);
         }
         let (da, db) = (self.get(a), self.get(b));
-        let mut d = merge(&[da, db]);
-        d.facts.exactness = Exactness::Approximate;
         let reach = blend_reach(k, v);
-        if d.gradient.is_finite() {
-            let steep = blend_steepness(v);
-            d.gradient *= steep;
-            d.facts.lipschitz = (d.facts.lipschitz * steep).max(d.gradient);
-            d.facts.exactness = classify(d.facts.lipschitz, d.proven);
-        } else if d.proven {
-            d = unproven(d, id);
-        }
+        let mut d = steeper(da, db, blend_steepness(v), id);
         d.bounds = match op {
             Combine::Union => da
                 .bounds
@@ -322,19 +313,26 @@ impl Pass<'_> {
     /// feature's steepness; the solid lies within `a`'s, grown by what stands out of it.
     fn feature(&mut self, id: NodeId, f: Feature, a: NodeId, b: NodeId) -> Derived {
         let (da, db) = (self.get(a), self.get(b));
-        let mut d = merge(&[da, db]);
-        d.facts.exactness = Exactness::Approximate;
-        if d.gradient.is_finite() {
-            let steep = feature_steepness(f);
-            d.gradient *= steep;
-            d.facts.lipschitz = (d.facts.lipschitz * steep).max(d.gradient);
-            d.facts.exactness = classify(d.facts.lipschitz, d.proven);
-        } else if d.proven {
-            d = unproven(d, id);
-        }
+        let mut d = steeper(da, db, feature_steepness(f), id);
         d.bounds = da.bounds.grow(da.growth * f.outset());
         d
     }
+}
+
+/// The facts of `da` and `db` blended (or one along the other's surface, a feature, of node
+/// `id`) by a rule `steep` times as steep as theirs: approximate, or a bound where its L,
+/// their L times `steep`, proves one.
+fn steeper(da: Derived, db: Derived, steep: f64, id: NodeId) -> Derived {
+    let mut d = merge(&[da, db]);
+    d.facts.exactness = Exactness::Approximate;
+    if d.gradient.is_finite() {
+        d.gradient *= steep;
+        d.facts.lipschitz = (d.facts.lipschitz * steep).max(d.gradient);
+        d.facts.exactness = classify(d.facts.lipschitz, d.proven);
+    } else if d.proven {
+        d = unproven(d, id);
+    }
+    d
 }
 
 /// The facts of a combination of several fields (before its own rule): the largest L and

@@ -10,13 +10,12 @@ use crate::frontend::Source;
 use crate::gpu::launch::{Faults, Queue};
 use crate::image::{Picture, PngLevel};
 use crate::job::{self, Error, FrameScene, Job, Kernels};
-use crate::output::{Output, Submit, Task, Writers, Written};
+use crate::output::{Submit, Task, Writers, Written};
 use crate::sequence::{Frames, Shard, Target};
 use crate::tally::Tally;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use sdfc_compiler::{Animation, LowerOptions};
 use sdfc_compiler::{Limit, Limits};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -316,15 +315,7 @@ impl FramesHere<'_> {
     ) -> Result<(), Error> {
         match (writers, &*sink) {
             (Some(w), Sink::Numbered(pattern, format)) => {
-                let task = Task {
-                    k,
-                    output: Output::File {
-                        path: pattern.path(k),
-                        format: *format,
-                    },
-                    picture,
-                    started,
-                };
+                let task = Task::file(k, pattern.path(k), *format, picture, started);
                 let handing = Instant::now();
                 w.submit(task).map_err(|e| Error::Encode(e.to_string()))?;
                 self.tally.since(HERE, "handing to the writers", handing);
@@ -686,15 +677,7 @@ impl FramesOn<'_> {
                     checked = true;
                     let picture = match &numbered {
                         Some((writers, pattern, format)) => {
-                            let task = Task {
-                                k,
-                                output: Output::File {
-                                    path: pattern.path(k),
-                                    format: *format,
-                                },
-                                picture,
-                                started,
-                            };
+                            let task = Task::file(k, pattern.path(k), *format, picture, started);
                             let handing = Instant::now();
                             if let Err(e) = writers.submit(task) {
                                 let _ = tx.send(Report::Unwritten(e.to_string()));
@@ -766,11 +749,7 @@ fn frame_range(
 
 /// `scene.sdf` → `./scene_####.png`.
 fn default_pattern(file: &Path) -> PathBuf {
-    let stem = file
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "frame".into());
-    PathBuf::from(format!("{stem}_####.png"))
+    PathBuf::from(format!("{}_####.png", super::stem_or(file, "frame")))
 }
 
 /// Creates the directory of `file` when it is missing.
@@ -785,14 +764,10 @@ fn create_directory(file: &Path) -> Result<(), Error> {
 /// A progress bar over the shard's frames on a terminal (frames already written count as
 /// done); `None` elsewhere, where each frame prints a line.
 fn progress(len: u64, done: u64) -> Option<ProgressBar> {
-    std::io::stderr().is_terminal().then(|| {
-        let bar = ProgressBar::new(len);
-        if let Ok(style) = ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} frames {elapsed_precise} eta {eta} ({per_sec})",
-        ) {
-            bar.set_style(style);
-        }
+    let template = "{bar:40} {pos}/{len} frames {elapsed_precise} eta {eta} ({per_sec})";
+    let bar = super::progress_bar(len, template);
+    if let Some(bar) = &bar {
         bar.set_position(done);
-        bar
-    })
+    }
+    bar
 }

@@ -55,6 +55,13 @@ impl launch::Device for Kernel<'_> {
             .iter()
             .flat_map(|t| [t.0, t.1, t.2, t.3])
             .collect();
+        // Kept buffers of another size are freed below through the context current on this
+        // thread, which a pool thread may not have yet: the driver would refuse the free, and
+        // the next call report it (a render at another size once failed so).
+        self.cuda
+            .ctx
+            .bind_to_thread()
+            .map_err(driver("making the context current"))?;
         let kept = self.cuda.spare.lock().ok().and_then(|mut k| k.take());
         let fits = |f: &FrameBuffers| {
             f.image.len() == pixels * 4

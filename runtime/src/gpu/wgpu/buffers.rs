@@ -171,24 +171,14 @@ impl Gpu {
             },
             count: None,
         };
-        let layout = self
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("sdfc reduction"),
-                entries: &[
-                    entry(0, true, true),
-                    entry(1, true, false),
-                    entry(2, false, false),
-                    entry(3, false, false),
-                ],
-            });
-        let pipeline_layout = self
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("sdfc reduction"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
+        let entries = [
+            entry(0, true, true),
+            entry(1, true, false),
+            entry(2, false, false),
+            entry(3, false, false),
+        ];
+        let (layout, pipeline_layout) =
+            self.layouts(("sdfc reduction", "sdfc reduction"), &entries);
         // The driver's compiled code kept between processes, as a kernel's is.
         let (pipeline, _) = self.cached_compute(
             (reduction::SOURCE, reduction::ENTRY_POINT, false),

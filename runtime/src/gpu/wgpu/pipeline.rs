@@ -185,19 +185,7 @@ impl Gpu {
         if data {
             entries.push(entry(4, storage(true)));
         }
-        let layout = self
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("sdfc bindings"),
-                entries: &entries,
-            });
-        let pipeline_layout = self
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("sdfc layout"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
+        let (layout, pipeline_layout) = self.layouts(("sdfc bindings", "sdfc layout"), &entries);
         let (pipeline, driver) = self.cached_compute(
             (wgsl, entry_point, data),
             "sdfc render",
@@ -205,6 +193,29 @@ impl Gpu {
             &module,
         );
         (pipeline, layout, driver)
+    }
+
+    /// A bind group layout of `entries` and the layout of a pipeline of that one group, with
+    /// the labels `labels`.
+    pub(super) fn layouts(
+        &self,
+        (group, pipeline): (&str, &str),
+        entries: &[wgpu::BindGroupLayoutEntry],
+    ) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {
+        let layout = self
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(group),
+                entries,
+            });
+        let pipeline_layout = self
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(pipeline),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        (layout, pipeline_layout)
     }
 
     /// The compute pipeline of `module`'s entry point `entry` (of the text `wgsl`, with the

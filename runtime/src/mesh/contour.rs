@@ -180,6 +180,9 @@ struct Edges<'a> {
     normals: &'a [[f64; 3]],
 }
 
+/// Surface cells per task of [`Rings::new`].
+const RING_TASK: usize = 1 << 14;
+
 /// The patches: each one's cell and its ring of edge vertices.
 struct Rings {
     /// Each patch's cell.
@@ -191,28 +194,46 @@ struct Rings {
 }
 
 impl Rings {
-    /// The patches of the `surface` cells (`table`), their edge vertices found in `index`.
+    /// The patches of the `surface` cells (`table`), their edge vertices found in `index`:
+    /// those of a run of cells per task, joined in order.
     fn new(surface: &[(u64, u8)], index: &Bricks<[u32; 3]>) -> Rings {
-        let mut cells = Vec::new();
-        let mut ring: Vec<u32> = Vec::new();
-        let mut starts = vec![0usize];
-        for &(c, config) in surface {
-            let i = unpack(c);
-            for cycle in patches(config) {
-                for &e in cycle {
-                    let (a, _) = EDGES[e as usize];
-                    let id = index.get(add(i, corner(a)))[e as usize / 4];
-                    ring.push(if id == u32::MAX { 0 } else { id });
+        let parts: Vec<Rings> = surface
+            .par_chunks(RING_TASK)
+            .map(|part| {
+                let mut rings = Rings {
+                    cells: Vec::with_capacity(part.len()),
+                    ring: Vec::with_capacity(4 * part.len()),
+                    starts: Vec::with_capacity(part.len()),
+                };
+                for &(c, config) in part {
+                    let i = unpack(c);
+                    for cycle in patches(config) {
+                        for &e in cycle {
+                            let (a, _) = EDGES[e as usize];
+                            let id = index.get(add(i, corner(a)))[e as usize / 4];
+                            rings.ring.push(if id == u32::MAX { 0 } else { id });
+                        }
+                        rings.cells.push(i);
+                        rings.starts.push(rings.ring.len());
+                    }
                 }
-                cells.push(i);
-                starts.push(ring.len());
-            }
+                rings
+            })
+            .collect();
+        let patches = parts.iter().map(|p| p.cells.len()).sum::<usize>();
+        let mut rings = Rings {
+            cells: Vec::with_capacity(patches),
+            ring: Vec::with_capacity(parts.iter().map(|p| p.ring.len()).sum()),
+            starts: Vec::with_capacity(patches + 1),
+        };
+        rings.starts.push(0);
+        for part in parts {
+            let base = rings.ring.len();
+            rings.cells.extend_from_slice(&part.cells);
+            rings.ring.extend_from_slice(&part.ring);
+            rings.starts.extend(part.starts.iter().map(|s| base + s));
         }
-        Rings {
-            cells,
-            ring,
-            starts,
-        }
+        rings
     }
 
     /// Patch `p`'s ring.

@@ -221,7 +221,6 @@ impl<T: Copy + PartialEq + Send + Sync> Bricks<T> {
         keys: &[u64],
         value: impl Fn(usize) -> T + Sync,
     ) -> Self {
-        debug_assert!(keys.windows(2).all(|w| w[0] < w[1]));
         let mut bricks = Self::over(empty, grid, held);
         if let Some(layers) = bricks.layers(keys) {
             bricks.fill_layers(keys, &layers, value);

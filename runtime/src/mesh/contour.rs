@@ -158,23 +158,18 @@ pub fn contour(
 /// and the axis); `held` sizes the bricks.
 fn edge_index(grid: &Grid, surface: &[(u64, u8)], held: u64) -> (Bricks<[u32; 3]>, Vec<u64>) {
     let mut edges: Vec<u64> = Vec::new();
-    let ids: Vec<[u32; 3]> = surface
-        .iter()
-        .map(|&(c, config)| {
-            let mut ids = [u32::MAX; 3];
-            for (axis, id) in ids.iter_mut().enumerate() {
-                let (a, b) = EDGES[axis * 4];
-                if (config >> a & 1) != (config >> b & 1) {
-                    *id = edges.len() as u32;
-                    edges.push(c << 2 | axis as u64);
-                }
+    let mut index: Bricks<[u32; 3]> = Bricks::over([u32::MAX; 3], grid, held);
+    for &(c, config) in surface {
+        let mut ids = [u32::MAX; 3];
+        for (axis, id) in ids.iter_mut().enumerate() {
+            let (a, b) = EDGES[axis * 4];
+            if (config >> a & 1) != (config >> b & 1) {
+                *id = edges.len() as u32;
+                edges.push(c << 2 | axis as u64);
             }
-            ids
-        })
-        .collect();
-    // The surface cells are sorted, each once: their bricks are filled in parallel.
-    let keys: Vec<u64> = surface.iter().map(|&(c, _)| c).collect();
-    let index = Bricks::from_sorted([u32::MAX; 3], grid, held, &keys, |n| ids[n]);
+        }
+        index.set(unpack(c), ids);
+    }
     (index, edges)
 }
 

@@ -538,7 +538,7 @@ impl Meshing<'_> {
             contour::contour(
                 &field,
                 &grid,
-                candidates.cells,
+                candidates,
                 settings,
                 memory_cells,
                 &surface_check,

@@ -24,33 +24,33 @@ pub(super) struct Closure {
     pub(super) surface: Vec<(u64, u8)>,
 }
 
-/// The corner values of `candidates` and the closure (each crossed edge's four cells), and
-/// the surface cells among them; `Err` with the cells held once more than `max_cells` are.
+/// The corner values of `candidates` (those of `known`, corners with their values, read
+/// instead of evaluated) and the closure (each crossed edge's four cells), and the surface
+/// cells among them; `Err` with the cells held once more than `max_cells` are.
 pub(super) fn closure(
     field: &Field,
     grid: &Grid,
     candidates: Vec<u64>,
+    known: Vec<(u64, f64)>,
     max_cells: u64,
     stats: &mut Stats,
 ) -> Result<Closure, u64> {
     let held = candidates.len() as u64;
     let mut closure = Closure {
         values: Bricks::over(f64::NAN, grid, held),
-        set: Bricks::over(false, grid, held),
+        set: Bricks::from_sorted(false, grid, held, &candidates, |_| true),
         held,
         surface: Vec::new(),
     };
-    for &c in &candidates {
-        closure.set.set(unpack(c), true);
-    }
     let mut pending = candidates;
     let mut first = true;
+    let mut known = Some(known);
     while !pending.is_empty() {
         if closure.held > max_cells {
             return Err(closure.held);
         }
-        if first {
-            closure.evaluate_first(field, grid, &pending);
+        if let Some(known) = known.take() {
+            closure.evaluate_first(field, grid, &pending, known);
         } else {
             closure.evaluate(field, grid, &pending);
         }
@@ -70,13 +70,22 @@ pub(super) fn closure(
 
 impl Closure {
     /// The values at the corners of `candidates` (sorted keys), when none has been asked
-    /// for yet: the corners found as one sorted list ([`corners`]), not cell by cell.
-    fn evaluate_first(&mut self, field: &Field, grid: &Grid, candidates: &[u64]) {
-        let keys = corners(candidates);
+    /// for yet: the corners found as one sorted list ([`corners`]), not cell by cell, those
+    /// of `known` (corners of them) read, the others evaluated.
+    fn evaluate_first(
+        &mut self,
+        field: &Field,
+        grid: &Grid,
+        candidates: &[u64],
+        mut known: Vec<(u64, f64)>,
+    ) {
+        known.par_sort_unstable_by_key(|&(k, _)| k);
+        let keys = unknown(corners(candidates), &known);
         let points: Vec<[f64; 3]> = keys.par_iter().map(|&k| grid.point(unpack(k))).collect();
         let d = field.distances(&points);
         drop(points);
-        for (&k, v) in keys.iter().zip(d) {
+        self.values = Bricks::from_sorted(f64::NAN, grid, self.held, &keys, |n| d[n]);
+        for (k, v) in known {
             self.values.set(unpack(k), v);
         }
     }
@@ -168,6 +177,16 @@ fn corners(cells: &[u64]) -> Vec<u64> {
     for axis in 1..3 {
         keys = grown(&keys, 1 << (axis * KEY_BITS));
     }
+    keys
+}
+
+/// The sorted keys `keys` less those of `known` (sorted by key), in place.
+fn unknown(mut keys: Vec<u64>, known: &[(u64, f64)]) -> Vec<u64> {
+    let mut known = known.iter().map(|&(k, _)| k).peekable();
+    keys.retain(|&k| {
+        while known.next_if(|&j| j < k).is_some() {}
+        known.next_if_eq(&k).is_none()
+    });
     keys
 }
 
@@ -310,5 +329,12 @@ mod tests {
             assert_eq!(from_bits, cells, "{config}");
         }
         assert!(corners(&[]).is_empty());
+        // Known corners are left out, each once; keys not among them are ignored.
+        let known = [(2, 0.5), (5, -1.0), (6, 1.0), (11, 2.0)];
+        assert_eq!(
+            unknown(vec![1, 2, 3, 5, 7, 9, 10], &known),
+            [1, 3, 7, 9, 10]
+        );
+        assert_eq!(unknown(vec![], &known), Vec::<u64>::new());
     }
 }

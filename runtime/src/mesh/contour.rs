@@ -13,6 +13,7 @@
 //! flip replaces two triangles by two that share a new edge, which is made only once.
 
 use super::closure::{add, closure, Closure};
+use super::octree::Candidates;
 use super::place::{
     choose, inside_cell, normalise, onto_surface, place, separate, Patches, Placed, GRADIENT_STEP,
     MARGIN, ON_SURFACE,
@@ -64,18 +65,23 @@ pub enum Stop {
     Refused(String),
 }
 
-/// Contours the surface in `candidates` (sorted cell keys), holding at most `max_cells`
-/// cells; `surface` is told the number of surface cells before they are contoured, and may
-/// refuse.
+/// Contours the surface in `candidates` (sorted cell keys, and the corners whose values the
+/// octree knows), holding at most `max_cells` cells; `surface` is told the number of surface
+/// cells before they are contoured, and may refuse.
 pub fn contour(
     field: &Field,
     grid: &Grid,
-    candidates: Vec<u64>,
+    candidates: impl Into<Candidates>,
     settings: &Settings,
     max_cells: u64,
     surface_cells: &dyn Fn(u64) -> Result<(), String>,
     progress: &dyn Fn(f64),
 ) -> Result<(Mesh, Stats), Stop> {
+    let Candidates {
+        cells: candidates,
+        centres: known,
+        ..
+    } = candidates.into();
     let mut stats = Stats {
         candidates: candidates.len() as u64,
         ..Stats::default()
@@ -84,7 +90,7 @@ pub fn contour(
         values,
         mut surface,
         ..
-    } = closure(field, grid, candidates, max_cells, &mut stats).map_err(Stop::Cells)?;
+    } = closure(field, grid, candidates, known, max_cells, &mut stats).map_err(Stop::Cells)?;
     progress(0.2);
     // Found in the candidates' order, sorted unless cells were added.
     if !surface.is_sorted() {
@@ -174,6 +180,9 @@ struct Edges<'a> {
     normals: &'a [[f64; 3]],
 }
 
+/// Surface cells per task of [`Rings::new`].
+const RING_TASK: usize = 1 << 14;
+
 /// The patches: each one's cell and its ring of edge vertices.
 struct Rings {
     /// Each patch's cell.
@@ -185,28 +194,46 @@ struct Rings {
 }
 
 impl Rings {
-    /// The patches of the `surface` cells (`table`), their edge vertices found in `index`.
+    /// The patches of the `surface` cells (`table`), their edge vertices found in `index`:
+    /// those of a run of cells per task, joined in order.
     fn new(surface: &[(u64, u8)], index: &Bricks<[u32; 3]>) -> Rings {
-        let mut cells = Vec::new();
-        let mut ring: Vec<u32> = Vec::new();
-        let mut starts = vec![0usize];
-        for &(c, config) in surface {
-            let i = unpack(c);
-            for cycle in patches(config) {
-                for &e in cycle {
-                    let (a, _) = EDGES[e as usize];
-                    let id = index.get(add(i, corner(a)))[e as usize / 4];
-                    ring.push(if id == u32::MAX { 0 } else { id });
+        let parts: Vec<Rings> = surface
+            .par_chunks(RING_TASK)
+            .map(|part| {
+                let mut rings = Rings {
+                    cells: Vec::with_capacity(part.len()),
+                    ring: Vec::with_capacity(4 * part.len()),
+                    starts: Vec::with_capacity(part.len()),
+                };
+                for &(c, config) in part {
+                    let i = unpack(c);
+                    for cycle in patches(config) {
+                        for &e in cycle {
+                            let (a, _) = EDGES[e as usize];
+                            let id = index.get(add(i, corner(a)))[e as usize / 4];
+                            rings.ring.push(if id == u32::MAX { 0 } else { id });
+                        }
+                        rings.cells.push(i);
+                        rings.starts.push(rings.ring.len());
+                    }
                 }
-                cells.push(i);
-                starts.push(ring.len());
-            }
+                rings
+            })
+            .collect();
+        let patches = parts.iter().map(|p| p.cells.len()).sum::<usize>();
+        let mut rings = Rings {
+            cells: Vec::with_capacity(patches),
+            ring: Vec::with_capacity(parts.iter().map(|p| p.ring.len()).sum()),
+            starts: Vec::with_capacity(patches + 1),
+        };
+        rings.starts.push(0);
+        for part in parts {
+            let base = rings.ring.len();
+            rings.cells.extend_from_slice(&part.cells);
+            rings.ring.extend_from_slice(&part.ring);
+            rings.starts.extend(part.starts.iter().map(|s| base + s));
         }
-        Rings {
-            cells,
-            ring,
-            starts,
-        }
+        rings
     }
 
     /// Patch `p`'s ring.

@@ -6,6 +6,7 @@
 //! (`thin`); and the file formats (`write`; 3MF in `threemf`, its archive in `zip`). `docs/mesh.md` describes the method and its
 //! guarantees.
 
+mod bricks;
 mod closure;
 pub mod contour;
 pub mod device;
@@ -19,6 +20,7 @@ pub mod threemf;
 pub mod write;
 pub mod zip;
 
+pub use bricks::{At, Bricks};
 use rayon::prelude::*;
 use sdfc_compiler::{Evaluator, Outputs, Program, Tape, DEFAULT_CHUNK};
 use std::collections::{HashMap, HashSet};
@@ -220,16 +222,19 @@ impl Field {
         self.timed(|| self.clipped(points))
     }
 
+    /// `d` at the points `p` intersected with the clip box.
+    fn clip(&self, d: &mut [f64], p: &[[f64; 3]]) {
+        for (d, q) in d.iter_mut().zip(p) {
+            let b = self.clip_distance(*q);
+            *d = if *d > b { *d } else { b };
+        }
+    }
+
     fn clipped(&self, points: &[[f64; 3]]) -> Vec<f64> {
         let mut out = vec![0.0; points.len()];
         self.evaluated
             .fetch_add(points.len() as u64, Ordering::Relaxed);
-        let clip = |o: &mut [f64], p: &[[f64; 3]]| {
-            for (d, q) in o.iter_mut().zip(p) {
-                let b = self.clip_distance(*q);
-                *d = if *d > b { *d } else { b };
-            }
-        };
+        let clip = |o: &mut [f64], p: &[[f64; 3]]| self.clip(o, p);
         if let Some(gpu) = &self.gpu {
             let values = gpu.run(points);
             out.par_chunks_mut(TASK)
@@ -291,29 +296,60 @@ impl Field {
     /// rounding.
     pub fn gradients(&self, points: &[[f64; 3]], h: f64) -> (Vec<f64>, Vec<[f64; 3]>) {
         let h = self.gpu.as_ref().map_or(h, |g| h.max(g.least_step()));
-        const K: [[f64; 3]; 4] = [
-            [1.0, -1.0, -1.0],
-            [-1.0, -1.0, 1.0],
-            [-1.0, 1.0, -1.0],
-            [1.0, 1.0, 1.0],
-        ];
-        let samples: Vec<[f64; 3]> = points
-            .iter()
-            .flat_map(|p| K.map(|k| [0, 1, 2].map(|i| p[i] + h * k[i])))
-            .collect();
-        let d = self.distances(&samples);
-        d.chunks_exact(4)
-            .map(|s| {
-                let mut g = [0.0; 3];
-                for (k, v) in K.iter().zip(s) {
-                    for i in 0..3 {
-                        g[i] += k[i] * v / (4.0 * h);
-                    }
-                }
-                (s.iter().sum::<f64>() / 4.0, g)
-            })
-            .unzip()
+        let samples = |p: &[[f64; 3]]| -> Vec<[f64; 3]> {
+            p.iter()
+                .flat_map(|p| TETRAHEDRON.map(|k| [0, 1, 2].map(|i| p[i] + h * k[i])))
+                .collect()
+        };
+        if self.gpu.is_some() {
+            let d = self.distances(&samples(points));
+            return d.chunks_exact(4).map(|s| gradient(s, h)).unzip();
+        }
+        // On the CPU, each task makes its points' samples and reduces their values: the
+        // samples of every point are never held at once.
+        let mut values = vec![0.0; points.len()];
+        let mut gradients = vec![[0.0; 3]; points.len()];
+        self.evaluated
+            .fetch_add(4 * points.len() as u64, Ordering::Relaxed);
+        self.timed(|| {
+            points
+                .par_chunks(TASK / 4)
+                .zip(values.par_chunks_mut(TASK / 4))
+                .zip(gradients.par_chunks_mut(TASK / 4))
+                .for_each_init(
+                    || (Scratch::new(&self.distance), Vec::new()),
+                    |(s, d), ((p, v), g)| {
+                        let q = samples(p);
+                        d.resize(q.len(), 0.0);
+                        s.run(&q, d, None);
+                        self.clip(d, &q);
+                        for ((s, v), g) in d.chunks_exact(4).zip(v).zip(g) {
+                            (*v, *g) = gradient(s, h);
+                        }
+                    },
+                )
+        });
+        (values, gradients)
     }
+}
+
+/// The offsets of [`Field::gradients`]' samples about a point (in units of `h`).
+const TETRAHEDRON: [[f64; 3]; 4] = [
+    [1.0, -1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [-1.0, 1.0, -1.0],
+    [1.0, 1.0, 1.0],
+];
+
+/// The value and gradient at a point from its four samples' values `s` ([`TETRAHEDRON`]).
+fn gradient(s: &[f64], h: f64) -> (f64, [f64; 3]) {
+    let mut g = [0.0; 3];
+    for (k, v) in TETRAHEDRON.iter().zip(s) {
+        for i in 0..3 {
+            g[i] += k[i] * v / (4.0 * h);
+        }
+    }
+    (s.iter().sum::<f64>() / 4.0, g)
 }
 
 /// The largest |f| of `field` at the vertices of `mesh` and at its triangles' centres.
@@ -448,266 +484,5 @@ impl Default for Settings {
             thin: true,
             backend: crate::backend::Backend::Cpu,
         }
-    }
-}
-
-/// Values on grid points, stored sparsely in bricks of 8×8×8 points found through a
-/// directory: the points a cell reads lie in one or a few bricks, so a walk over cells in key
-/// order touches memory mostly in sequence. The directory is a flat array over the grid's
-/// bricks where it takes no more than the bricks the cells held may fill ([`Bricks::over`]),
-/// a hash map otherwise (a grid far larger than the surface in it).
-#[derive(Debug, Clone)]
-pub struct Bricks<T: Copy> {
-    index: Directory,
-    data: Vec<[T; BRICK_POINTS]>,
-    empty: T,
-}
-
-/// Where each brick's values are in [`Bricks::data`].
-#[derive(Debug, Clone)]
-enum Directory {
-    /// Slots for the bricks of the points `0..dims·BRICK` along each axis, x fastest
-    /// (`u32::MAX` for a brick not held).
-    Flat { dims: [u32; 3], slots: Vec<u32> },
-    /// By packed brick index.
-    Hashed(KeyMap<u32>),
-}
-
-/// Where a point's value is in a [`Bricks`] (its brick's slot and its place in the brick).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct At(u32, u32);
-
-/// Points along a brick's edge (a power of two).
-const BRICK: u32 = 8;
-const BRICK_POINTS: usize = (BRICK * BRICK * BRICK) as usize;
-
-/// Bytes of one slot of a flat directory.
-const SLOT: u64 = 4;
-
-impl<T: Copy + PartialEq> Bricks<T> {
-    /// No values; `empty` is what an unset point reads.
-    pub fn new(empty: T) -> Self {
-        Bricks {
-            index: Directory::Hashed(KeyMap::default()),
-            data: Vec::new(),
-            empty,
-        }
-    }
-
-    /// No values on the points of `grid` (and those a cell beyond its last cells reaches),
-    /// for `held` cells: a flat directory where the grid has at most [`Bricks::flat_bricks`]
-    /// of them, a hash map otherwise.
-    pub fn over(empty: T, grid: &Grid, held: u64) -> Self {
-        let dims = Self::dims(grid);
-        let count = dims.iter().map(|&n| n as u64).product::<u64>();
-        let index = if count <= Self::flat_bricks(held) {
-            Directory::Flat {
-                dims,
-                slots: vec![u32::MAX; count as usize],
-            }
-        } else {
-            Directory::Hashed(KeyMap::default())
-        };
-        Bricks {
-            index,
-            data: Vec::new(),
-            empty,
-        }
-    }
-
-    /// Bricks along each axis of a flat directory over `grid`: its points, and the points
-    /// one cell beyond them, which the corners of a cell at the grid's far side reach.
-    fn dims(grid: &Grid) -> [u32; 3] {
-        grid.cells.map(|n| (n + 2) / BRICK + 1)
-    }
-
-    /// The most bricks a flat directory may have for `held` cells (those bricks' values could
-    /// fill, each cell touching at most eight).
-    pub fn flat_bricks(held: u64) -> u64 {
-        held.saturating_mul(8)
-    }
-
-    fn split(i: [u32; 3]) -> ([u32; 3], usize) {
-        let b = i.map(|x| x / BRICK);
-        let o = i.map(|x| (x % BRICK) as usize);
-        (b, o[0] + BRICK as usize * (o[1] + BRICK as usize * o[2]))
-    }
-
-    /// The slot of brick `b`, where it is held.
-    fn slot(&self, b: [u32; 3]) -> Option<u32> {
-        match &self.index {
-            Directory::Flat { dims, slots } => {
-                if b[0] >= dims[0] || b[1] >= dims[1] || b[2] >= dims[2] {
-                    return None;
-                }
-                let at = b[0] as usize
-                    + dims[0] as usize * (b[1] as usize + dims[1] as usize * b[2] as usize);
-                let k = slots[at];
-                (k != u32::MAX).then_some(k)
-            }
-            Directory::Hashed(map) => map.get(&pack(b)).copied(),
-        }
-    }
-
-    /// The value at point `i` (`empty` where none was set).
-    pub fn get(&self, i: [u32; 3]) -> T {
-        let (b, o) = Self::split(i);
-        match self.slot(b) {
-            Some(k) => self.data[k as usize][o],
-            None => self.empty,
-        }
-    }
-
-    /// The values at the eight corners of the cell whose lowest corner is `i`, in the order
-    /// of [`table::corner`] (one brick lookup when the cell lies in one brick).
-    pub fn cube(&self, i: [u32; 3]) -> [T; 8] {
-        if i.iter().all(|&x| x % BRICK < BRICK - 1) {
-            let (b, o) = Self::split(i);
-            let Some(k) = self.slot(b) else {
-                return [self.empty; 8];
-            };
-            let brick = &self.data[k as usize];
-            let (sy, sz) = (BRICK as usize, (BRICK * BRICK) as usize);
-            return std::array::from_fn(|c| {
-                brick[o + (c & 1) + (c >> 1 & 1) * sy + (c >> 2 & 1) * sz]
-            });
-        }
-        std::array::from_fn(|c| {
-            let d = table::corner(c);
-            self.get([i[0] + d[0], i[1] + d[1], i[2] + d[2]])
-        })
-    }
-
-    /// Sets the value at point `i`.
-    pub fn set(&mut self, i: [u32; 3], v: T) {
-        let (b, o) = Self::split(i);
-        let k = self.slot_or_new(b);
-        self.data[k as usize][o] = v;
-    }
-
-    /// Sets the value at point `i` to `v` where `replace` holds for the value there, saying
-    /// where it is, for [`Bricks::put`] (one lookup for a test and a set).
-    pub fn replace_if(&mut self, i: [u32; 3], replace: impl Fn(T) -> bool, v: T) -> Option<At> {
-        let (b, o) = Self::split(i);
-        let k = self.slot_or_new(b);
-        let at = &mut self.data[k as usize][o];
-        replace(*at).then(|| {
-            *at = v;
-            At(k, o as u32)
-        })
-    }
-
-    /// Sets the value at a place [`Bricks::replace_if`] gave.
-    pub fn put(&mut self, At(k, o): At, v: T) {
-        self.data[k as usize][o as usize] = v;
-    }
-
-    /// The slot of brick `b`, a brick of `empty` values made for it where there was none.
-    fn slot_or_new(&mut self, b: [u32; 3]) -> u32 {
-        let next = self.data.len() as u32;
-        let k = match &mut self.index {
-            Directory::Flat { dims, slots } => {
-                // A point beyond the flat directory's bricks (none that contouring sets: see
-                // [`Bricks::dims`]) moves every brick to a hash map.
-                if b[0] >= dims[0] || b[1] >= dims[1] || b[2] >= dims[2] {
-                    self.rehash();
-                    return self.slot_or_new(b);
-                }
-                let at = b[0] as usize
-                    + dims[0] as usize * (b[1] as usize + dims[1] as usize * b[2] as usize);
-                if slots[at] == u32::MAX {
-                    slots[at] = next;
-                }
-                slots[at]
-            }
-            Directory::Hashed(map) => *map.entry(pack(b)).or_insert(next),
-        };
-        if k == next {
-            self.data.push([self.empty; BRICK_POINTS]);
-        }
-        k
-    }
-
-    /// The flat directory replaced by a hash map of the same bricks.
-    fn rehash(&mut self) {
-        if let Directory::Flat { dims, slots } = &self.index {
-            let mut map = KeyMap::default();
-            for (at, &k) in slots.iter().enumerate() {
-                if k != u32::MAX {
-                    let (at, nx, ny) = (at as u64, dims[0] as u64, dims[1] as u64);
-                    let b = [at % nx, at / nx % ny, at / (nx * ny)].map(|x| x as u32);
-                    map.insert(pack(b), k);
-                }
-            }
-            self.index = Directory::Hashed(map);
-        }
-    }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        let index = match &self.index {
-            Directory::Flat { slots, .. } => slots.len() * SLOT as usize,
-            Directory::Hashed(map) => map.len() * 24,
-        };
-        self.data.len() * std::mem::size_of::<[T; BRICK_POINTS]>() + index
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A flat directory reads as the hash map does: values set at the grid's points, the
-    /// corners of a cell across bricks, points never set; and a point beyond its bricks moves
-    /// them to a hash map with every value kept.
-    #[test]
-    fn a_flat_directory_reads_as_a_hashed_one() {
-        let grid = Grid {
-            origin: [0.0; 3],
-            voxel: 1.0,
-            cells: [20, 9, 13],
-        };
-        let mut flat = Bricks::over(-1i64, &grid, 1000);
-        assert!(matches!(flat.index, Directory::Flat { .. }));
-        let mut hashed = Bricks::new(-1i64);
-        let value = |i: [u32; 3]| (i[0] * 10_000 + i[1] * 100 + i[2]) as i64;
-        let mut points = Vec::new();
-        for z in (0..=14).step_by(3) {
-            for y in 0..=10 {
-                for x in (0..=21).step_by(2) {
-                    points.push([x, y, z]);
-                }
-            }
-        }
-        for &i in &points {
-            flat.set(i, value(i));
-            hashed.set(i, value(i));
-        }
-        let same = |flat: &Bricks<i64>, hashed: &Bricks<i64>| {
-            for z in 0..16 {
-                for y in 0..12 {
-                    for x in 0..23 {
-                        assert_eq!(flat.get([x, y, z]), hashed.get([x, y, z]), "{x} {y} {z}");
-                        assert_eq!(flat.cube([x, y, z]), hashed.cube([x, y, z]), "{x} {y} {z}");
-                    }
-                }
-            }
-        };
-        same(&flat, &hashed);
-        assert_eq!(flat.get([900, 3, 4]), -1);
-        flat.set([900, 3, 4], 7);
-        hashed.set([900, 3, 4], 7);
-        assert!(matches!(flat.index, Directory::Hashed(_)));
-        assert_eq!(flat.get([900, 3, 4]), 7);
-        same(&flat, &hashed);
-        // A grid far larger than the cells held gets a hash map from the start.
-        let wide = Grid {
-            cells: [4000, 4000, 4000],
-            ..grid
-        };
-        assert!(matches!(
-            Bricks::over(0u8, &wide, 1000).index,
-            Directory::Hashed(_)
-        ));
     }
 }

@@ -15,8 +15,7 @@
 //! and every line through the ball meets the surface on both sides of it (the clipped solid
 //! is bounded), in cells that the octree keeps.
 
-use super::{pack, Field, Grid};
-use rayon::prelude::*;
+use super::{pack, Field, Grid, KEY_BITS};
 
 /// Relative slack of the test, for the rounding of the distance program.
 const SLACK: f64 = 1e-6;
@@ -24,7 +23,8 @@ const SLACK: f64 = 1e-6;
 /// Bytes per octree cell at most, counting every cell the octree may evaluate and the
 /// candidates: while a level is evaluated it holds its cells' indices, centres and values (44
 /// bytes each), and the indices of the next level's cells in a vector that may double (24
-/// bytes each) and, at the last level, their keys (8 bytes each).
+/// bytes each) and, at the last level, their keys (8 bytes each) and the kept cells' centres
+/// as keys and values (16 bytes each, once the 24 of the centres are freed).
 const BYTES_PER_OCTREE_CELL: u64 = 44 + 24;
 
 /// The most [`candidates`] allocates for `grid`: every octree cell it may evaluate and every
@@ -41,12 +41,27 @@ pub fn bytes(grid: &Grid, proven: bool, max_cells: u64) -> u64 {
 }
 
 /// The cells that may hold surface, sorted by key, and the cells evaluated to find them.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Candidates {
     /// Packed keys of the cells (their lowest corner).
     pub cells: Vec<u64>,
     /// Octree cells whose centre was evaluated (0 for the dense grid).
     pub evaluated: u64,
+    /// The centres of the last level's cells kept, which are corners of the candidates
+    /// (the corner every child of one shares), with their values: packed keys, in no order.
+    /// Contouring reads them instead of evaluating those corners again.
+    pub centres: Vec<(u64, f64)>,
+}
+
+impl From<Vec<u64>> for Candidates {
+    /// Candidates found otherwise: sorted cell keys, none of whose corners is known.
+    fn from(cells: Vec<u64>) -> Self {
+        Candidates {
+            cells,
+            evaluated: 0,
+            centres: Vec::new(),
+        }
+    }
 }
 
 /// Why [`candidates`] stopped early.
@@ -90,6 +105,7 @@ pub fn candidates(
         return Ok(Candidates {
             cells,
             evaluated: 0,
+            centres: Vec::new(),
         });
     }
     let largest = grid.cells.iter().copied().max().unwrap_or(1).max(1);
@@ -104,11 +120,14 @@ pub fn candidates(
             return Err(Refused::Cells(evaluated));
         }
         let half = 0.5 * size as f64 * grid.voxel;
+        // The centres are grid points, placed as the grid places them, so that the last
+        // level's are the corners contouring would evaluate, to the bit ([`Candidates::centres`]).
         let centres: Vec<[f64; 3]> = frontier
             .iter()
-            .map(|c| [0, 1, 2].map(|a| grid.origin[a] + c[a] as f64 * 2.0 * half + half))
+            .map(|c| grid.point(c.map(|x| x * size + size / 2)))
             .collect();
         let d = field.distances(&centres);
+        drop(centres);
         // The surface these values prove, before the next level is counted or stored.
         let within = max_cells.saturating_sub(evaluated).min(max_candidates);
         // The balls inside, shrunk by the rounding of a GPU's f32 distances.
@@ -157,15 +176,60 @@ pub fn candidates(
         next.extend(kept().flat_map(children));
         if level + 1 == levels {
             let mut cells: Vec<u64> = next.into_iter().map(pack).collect();
-            cells.par_sort_unstable();
-            return Ok(Candidates { cells, evaluated });
+            sort_keys(&mut cells, grid.cells);
+            let centres = frontier
+                .iter()
+                .zip(&d)
+                .filter(|(_, d)| !(d.abs() > reach))
+                .map(|(c, &d)| (pack(c.map(|x| 2 * x + 1)), d))
+                .collect();
+            return Ok(Candidates {
+                cells,
+                evaluated,
+                centres,
+            });
         }
         frontier = next;
     }
     Ok(Candidates {
         cells: Vec::new(),
         evaluated,
+        centres: Vec::new(),
     })
+}
+
+/// Bits of a radix pass of [`sort_keys`].
+const DIGIT: u32 = 11;
+
+/// Packed keys of cells of a grid of `cells` sorted: a least-significant-digit radix sort
+/// over the bits the cells' indices use (a pass per [`DIGIT`] bits, three for a grid of up to
+/// 2048 cells along each axis), where a comparison sort's work grows as n log n.
+fn sort_keys(keys: &mut Vec<u64>, cells: [u32; 3]) {
+    let mut other = vec![0u64; keys.len()];
+    for (axis, &n) in cells.iter().enumerate() {
+        let used = u32::BITS - n.saturating_sub(1).leading_zeros();
+        let mut low = 0;
+        while low < used {
+            let bits = (used - low).min(DIGIT);
+            let shift = axis as u32 * KEY_BITS + low;
+            let digit = |k: u64| (k >> shift & ((1 << bits) - 1)) as usize;
+            let mut starts = vec![0usize; 1 << bits];
+            for &k in keys.iter() {
+                starts[digit(k)] += 1;
+            }
+            let mut sum = 0;
+            for s in &mut starts {
+                (*s, sum) = (sum, sum + *s);
+            }
+            for &k in keys.iter() {
+                let d = digit(k);
+                other[starts[d]] = k;
+                starts[d] += 1;
+            }
+            std::mem::swap(keys, &mut other);
+            low += bits;
+        }
+    }
 }
 
 /// Relative slack of the radii in [`candidates_at_least`], for the rounding of the distances.
@@ -268,4 +332,41 @@ pub fn candidates_at_least(
         best = best.max(sum);
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::unpack;
+
+    /// The radix sort sorts as a comparison sort does, over grids whose axes need one pass
+    /// or several.
+    #[test]
+    fn keys_sort_as_numbers_do() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for cells in [
+            [1, 1, 1],
+            [259, 147, 259],
+            [5000, 3, 2100],
+            [1 << 19, 7, 70],
+        ] {
+            let mut keys: Vec<u64> = (0..20_000)
+                .map(|_| {
+                    pack(cells.map(|n| {
+                        state = state
+                            .wrapping_mul(6_364_136_223_846_793_005)
+                            .wrapping_add(1);
+                        (state >> 33) as u32 % n
+                    }))
+                })
+                .collect();
+            let mut expected = keys.clone();
+            expected.sort_unstable();
+            sort_keys(&mut keys, cells);
+            assert_eq!(keys, expected, "{cells:?}");
+            assert!(keys
+                .iter()
+                .all(|&k| (0..3).all(|a| unpack(k)[a] < cells[a])));
+        }
+    }
 }

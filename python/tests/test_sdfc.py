@@ -410,14 +410,19 @@ class Kept(unittest.TestCase):
             with self.subTest(backend=backend):
                 self.renders_again_as_a_new_scene_would(backend)
 
-    def test_renders_again_through_cuda_as_a_new_scene_would(self):
-        # CUDA's preparation is taken over, not copied: once, a second render raised.
+    def require_cuda(self, probe):
+        """Skips, saying why, where `probe` cannot reach a CUDA device (unless
+        SDFC_REQUIRE_CUDA=1, which makes that a failure)."""
         try:
-            sdfc.Scene(self.ANIMATED).render(backend="cuda")
+            probe()
         except RuntimeError as e:
             if os.environ.get("SDFC_REQUIRE_CUDA") == "1":
                 raise
             self.skipTest(f"no CUDA device ({e}); SDFC_REQUIRE_CUDA=1 requires one")
+
+    def test_renders_again_through_cuda_as_a_new_scene_would(self):
+        # CUDA's preparation is taken over, not copied: once, a second render raised.
+        self.require_cuda(lambda: sdfc.Scene(self.ANIMATED).render(backend="cuda"))
         self.renders_again_as_a_new_scene_would("cuda")
 
     def distances_again_as_a_new_scene_would(self, backend):
@@ -434,12 +439,7 @@ class Kept(unittest.TestCase):
         self.distances_again_as_a_new_scene_would("wgpu")
 
     def test_distances_again_through_cuda_as_a_new_scene_would(self):
-        try:
-            sdfc.Scene(self.ANIMATED).distance(np.zeros((1, 3)), backend="cuda")
-        except RuntimeError as e:
-            if os.environ.get("SDFC_REQUIRE_CUDA") == "1":
-                raise
-            self.skipTest(f"no CUDA device ({e}); SDFC_REQUIRE_CUDA=1 requires one")
+        self.require_cuda(lambda: sdfc.Scene(self.ANIMATED).distance(np.zeros((1, 3)), backend="cuda"))
         self.distances_again_as_a_new_scene_would("cuda")
 
 

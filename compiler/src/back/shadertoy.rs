@@ -66,7 +66,7 @@ float sdfc_shadow(vec3 o, vec3 d, float tt, float tmax, float k) {
     for (int i = 0; i < SDFC_MAX_STEPS; i++) {
         if (probes == 0 && t >= tmax) break;
         float s = sdfc_map_distance(o + d * t) * SDFC_INV_L;
-        if (abs(s) < SDFC_EPS * (tt + t)) return 0.0;
+        if (s < SDFC_EPS * (tt + t)) return 0.0;
         float q = (k > 0.0 && t > 0.0) ? k * s / t : 3.4e38;
         res = min(res, q);
         float next = t + s;

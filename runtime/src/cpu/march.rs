@@ -290,7 +290,8 @@ impl<T: Float> Shadow<'_, T> {
             let tol = c.tolerance(eps * (t0[k] + t[k]), px[k], py[k], pz[k]);
             let q = penumbra(kk[k], s, t[k]);
             res[k] = res[k].min(q);
-            let blocked = s.abs() < tol;
+            // Below −tol: inside the solid (a start lifted into a neighbouring one), blocked.
+            let blocked = s < tol;
             // A search goes on, or starts: the scan below moves such a lane
             // ([`Shadow::search`], whose test this repeats); the others step on here and
             // shift their sample into their last two.
@@ -374,7 +375,7 @@ impl<T: Float> Shadow<'_, T> {
             T::from_f64(f64::INFINITY)
         };
         l.res[k] = l.res[k].min(q);
-        let reached = signed.abs() < tol;
+        let reached = signed < tol;
         if reached && tau <= T::zero() {
             return self.finish(l, k, T::zero());
         }

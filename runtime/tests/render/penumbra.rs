@@ -129,3 +129,43 @@ fn the_cut_shells_penumbra_has_no_streaks() {
     assert!(soft < 0.003, "the penumbra streaks: roughness {soft:.5}");
     assert!(soft > 0.001, "the penumbra is gone: roughness {soft:.5}");
 }
+
+/// A shadow ray leaves its surface lifted by 4h along the normal; near where a sphere rests on
+/// a floor that start lies inside the sphere (at ε 10⁻³, h is large). The sphere blocks it at
+/// once on every backend. Before, the ray stepped back by −d from t = 0, stayed in place
+/// until its step budget ran out and counted as lit: lit floor pixels in the sphere's shade,
+/// each as slow as `max_steps` steps (steps_max was the budget and some 40 000 overshoots).
+#[test]
+fn a_shadow_ray_that_starts_inside_a_solid_is_blocked_at_once() {
+    let resting = "material floor = phong { color: (0.7, 0.7, 0.7) };\n\
+                   material red = phong { color: (0.8, 0.25, 0.2) };\n\
+                   camera { position: (0.6, 0.5, -2.5), look_at: (0, 0.3, 0), fov: 40deg }\n\
+                   light directional { direction: (-0.5, -1, 0.4) }\n\
+                   render { width: 320, height: 240, max_steps: 2000, method: \"march\", epsilon: 1e-3 }\n\
+                   scene {\n\
+                     plane((0, 1, 0), 0) @ floor;\n\
+                     sphere(0.7).translate(0, 0.7, 0) @ red;\n\
+                   }";
+    let scene = checked("resting.sdf", resting);
+    let r = cpu_render(&scene);
+    println!(
+        "steps per pixel: max {}, p99 {}; overshoots {}",
+        r.stats.steps_max, r.stats.steps_p99, r.stats.counters.overshoots
+    );
+    assert!(
+        r.stats.steps_max < 500,
+        "a ray ran {} steps of its budget of 2000",
+        r.stats.steps_max
+    );
+    // The other backends draw the same shade (a stuck ray there lit its pixel too).
+    let images = render_everywhere("resting", &scene);
+    let (_, cpu) = &images[0];
+    for (backend, image) in &images[1..] {
+        let d = sdfc_runtime::metrics::compare(cpu, image, 0.1).expect("images of one size");
+        assert!(
+            d.differing < 1e-4,
+            "{backend}: {:.4} % of pixels off the CPU's",
+            100.0 * d.differing
+        );
+    }
+}

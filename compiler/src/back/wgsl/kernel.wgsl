@@ -397,7 +397,8 @@ fn shadow(o: vec3<f32>, d: vec3<f32>, t0: f32, tmax: f32, k: f32) -> f32 {
         }
 //#endif
         var next = t + signed;
-        let reached = abs(signed) < tol;
+        // Below −tol: inside a solid (a start lifted into a neighbour), as if reached.
+        let reached = signed < tol;
         if reached && tau <= 0.0 {
             return 0.0;
         }

@@ -1,11 +1,16 @@
-//! A hand-written CUDA sphere tracer of bench/handwritten/scene.sdf, the yardstick for sdfc's
-//! own kernels (BENCHMARKS.md, "Beside a hand-written tracer"): the same primitives, camera,
-//! light and settings, written as one would by hand — the field as inline functions, a camera
-//! ray marched to d < ε·t (a negative distance counts as a hit, and in a shadow ray as blocked), the normal from four taps, one soft-shadow ray (res = min(res,
-//! k·d/t)), Phong shading — and the whole image in one launch.
+//! A hand-written CUDA sphere tracer of three scenes, the yardstick for sdfc's own kernels
+//! (BENCHMARKS.md, "Beside a hand-written tracer"): `spheres` (bench/handwritten/scene.sdf),
+//! `bulb` (bulb.sdf, a Mandelbulb over a floor) and `lattice` (lattice.sdf, a repeated strut
+//! lattice cut by a box), each with the same primitives, camera, light and settings as its
+//! `.sdf` file, written as one would by hand — the field as inline functions (the Mandelbulb
+//! in spherical coordinates with acos, atan2 and pow, leaving its loop once it escapes; the
+//! lattice by folding the point into one cell), a camera ray marched to d < ε·t (a negative
+//! distance counts as a hit, and in a shadow ray as blocked), the normal from four taps, one
+//! shadow ray (soft: res = min(res, k·d/t); hard: blocked or not), Phong shading — and the
+//! whole image in one launch.
 //!
 //! Build: nvcc -O3 -arch=sm_90 -o tracer tracer.cu
-//! Run:   ./tracer EPSILON [MAX_STEPS] [WIDTH HEIGHT] [FRAMES] [out.ppm]
+//! Run:   ./tracer SCENE soft|hard EPSILON [MAX_STEPS] [WIDTH HEIGHT] [FRAMES] [out.ppm]
 //! Prints the median frame time (CUDA events) and the mean steps per pixel (camera and
 //! shadow rays) as one line of JSON.
 
@@ -13,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <vector>
 
 struct V { float x, y, z; };
@@ -48,8 +54,10 @@ __device__ inline float torus(V p, V c, float R, float r) {
   return sqrtf(a * a + q.y * q.y) - r;
 }
 
-// The field and the material index of the nearest surface (0 floor, 1 red, 2 blue).
-__device__ inline float map(V p, int *m) {
+enum Scene { SPHERES, BULB, LATTICE };
+
+// The fields and the material index of the nearest surface (0 floor, 1 red, 2 blue).
+__device__ inline float spheres(V p, int *m) {
   float d = p.y;
   int mat = 0;
   float e;
@@ -63,13 +71,65 @@ __device__ inline float map(V p, int *m) {
   *m = mat;
   return d;
 }
-__device__ inline float sdf(V p) { int m; return map(p, &m); }
+
+// mandelbulb(8, 8): z <- z^8 + p in spherical coordinates (y up), bailout 2, the estimate
+// 0.5 ln(r) r / dr, and |p| - 2 beyond |p| > 4.
+__device__ inline float mandelbulb(V p) {
+  float r0 = len(p);
+  if (r0 > 4.0f) return r0 - 2.0f;
+  V z = p;
+  float dr = 1.0f;
+  for (int i = 0; i < 8; i++) {
+    float r = len(z);
+    if (r > 2.0f) break;
+    float theta = acosf(fminf(fmaxf(z.y / fmaxf(r, 1e-30f), -1.0f), 1.0f)) * 8.0f;
+    float phi = atan2f(z.z, z.x) * 8.0f;
+    dr = 8.0f * powf(r, 7.0f) * dr + 1.0f;
+    float rn = powf(r, 8.0f);
+    float st = sinf(theta);
+    z = v(st * cosf(phi), cosf(theta), st * sinf(phi)) * rn + p;
+  }
+  float r = fmaxf(len(z), 1e-30f);
+  return 0.5f * logf(r) * r / dr;
+}
+
+__device__ inline float bulb(V p, int *m) {
+  float d = p.y + 1.3f;
+  int mat = 0;
+  float e = mandelbulb(p);
+  if (e < d) { d = e; mat = 1; }
+  *m = mat;
+  return d;
+}
+
+// Square struts 0.1 thick along x, y and z every 0.5 (the point folded into its cell, the
+// three struts through its centre), cut to the box of half-extents (1.5, 1, 1.5) about
+// (0, 1.1, 0).
+__device__ inline float lattice(V p, int *m) {
+  float d = p.y;
+  int mat = 0;
+  V q = v(p.x - 0.5f * roundf(p.x * 2.0f), p.y - 0.5f * roundf(p.y * 2.0f),
+          p.z - 0.5f * roundf(p.z * 2.0f));
+  V o = v(0, 0, 0);
+  float s = fminf(box(q, o, v(0.25f, 0.05f, 0.05f), 0.0f),
+                  fminf(box(q, o, v(0.05f, 0.25f, 0.05f), 0.0f), box(q, o, v(0.05f, 0.05f, 0.25f), 0.0f)));
+  float e = fmaxf(s, box(p, v(0, 1.1f, 0), v(1.5f, 1, 1.5f), 0.0f));
+  if (e < d) { d = e; mat = 2; }
+  *m = mat;
+  return d;
+}
+
+template <int S> __device__ inline float map(V p, int *m) {
+  return S == SPHERES ? spheres(p, m) : S == BULB ? bulb(p, m) : lattice(p, m);
+}
+template <int S> __device__ inline float sdf(V p) { int m; return map<S>(p, &m); }
 
 __device__ inline float tol(float eps, float t, V p) {
   V a = vabs(p);
   return fmaxf(eps * t, 8.0f * 1.1920929e-7f * fmaxf(a.x, fmaxf(a.y, a.z)));
 }
 
+template <int S, bool SOFT>
 __global__ void render(Params P, float4 *image, unsigned *steps_out) {
   int x = blockIdx.x * blockDim.x + threadIdx.x;
   int y = blockIdx.y * blockDim.y + threadIdx.y;
@@ -82,7 +142,7 @@ __global__ void render(Params P, float4 *image, unsigned *steps_out) {
   bool hit = false;
   for (int i = 0; i < P.max_steps; i++) {
     V p = P.eye + d * t;
-    float f = sdf(p);
+    float f = sdf<S>(p);
     steps++;
     if (f < tol(P.eps, t, p)) { hit = true; break; }
     t += f;
@@ -92,22 +152,23 @@ __global__ void render(Params P, float4 *image, unsigned *steps_out) {
   if (hit) {
     V p = P.eye + d * t;
     int m;
-    map(p, &m);
+    map<S>(p, &m);
     V a = vabs(p);
     float h = fmaxf(P.eps * t, 64.0f * 1.1920929e-7f * (1.0f + fmaxf(a.x, fmaxf(a.y, a.z))));
     V k0 = v(1, -1, -1), k1 = v(-1, -1, 1), k2 = v(-1, 1, -1), k3 = v(1, 1, 1);
-    V g = k0 * sdf(p + k0 * h) + k1 * sdf(p + k1 * h) + k2 * sdf(p + k2 * h) + k3 * sdf(p + k3 * h);
+    V g = k0 * sdf<S>(p + k0 * h) + k1 * sdf<S>(p + k1 * h) + k2 * sdf<S>(p + k2 * h) +
+            k3 * sdf<S>(p + k3 * h);
     V n = norm(g);
     V c = m == 0 ? v(0.6f, 0.6f, 0.6f) : m == 1 ? v(0.8f, 0.25f, 0.2f) : v(0.2f, 0.35f, 0.8f);
     float ks = m == 0 ? 0.0f : 0.4f;
-    // The soft shadow towards the directional light.
+    // The shadow towards the directional light.
     V o = p + n * (4.0f * h);
     float res = 1.0f, s = 0.0f;
     for (int i = 0; i < P.max_steps; i++) {
       V q = o + P.light * s;
-      float f = sdf(q);
+      float f = sdf<S>(q);
       steps++;
-      if (s > 0.0f) res = fminf(res, P.k * f / s);
+      if (SOFT && s > 0.0f) res = fminf(res, P.k * f / s);
       if (f < tol(P.eps, t + s, q)) { res = 0.0f; break; }
       s += f;
       if (s >= P.max_dist) break;
@@ -122,20 +183,46 @@ __global__ void render(Params P, float4 *image, unsigned *steps_out) {
   steps_out[y * P.width + x] = steps;
 }
 
+// The launch of one scene and shadow kind.
+typedef void (*Kernel)(Params, float4 *, unsigned *);
+static Kernel kernel(int scene, bool soft) {
+  static const Kernel k[3][2] = {{render<SPHERES, false>, render<SPHERES, true>},
+                                 {render<BULB, false>, render<BULB, true>},
+                                 {render<LATTICE, false>, render<LATTICE, true>}};
+  return k[scene][soft];
+}
+
 int main(int argc, char **argv) {
-  float eps = argc > 1 ? atof(argv[1]) : 1e-5f;
-  int max_steps = argc > 2 ? atoi(argv[2]) : 512;
-  int width = argc > 4 ? atoi(argv[3]) : 1920, height = argc > 4 ? atoi(argv[4]) : 1080;
-  int frames = argc > 5 ? atoi(argv[5]) : 21;
-  const char *ppm = argc > 6 ? argv[6] : nullptr;
+  if (argc < 4) {
+    fprintf(stderr, "usage: tracer spheres|bulb|lattice soft|hard EPSILON [MAX_STEPS] [WIDTH HEIGHT] [FRAMES] [out.ppm]\n");
+    return 2;
+  }
+  const char *names[3] = {"spheres", "bulb", "lattice"};
+  int scene = -1;
+  for (int i = 0; i < 3; i++) if (!strcmp(argv[1], names[i])) scene = i;
+  bool soft = !strcmp(argv[2], "soft");
+  if (scene < 0 || (!soft && strcmp(argv[2], "hard"))) {
+    fprintf(stderr, "tracer: unknown scene or shadow kind: %s %s\n", argv[1], argv[2]);
+    return 2;
+  }
+  float eps = atof(argv[3]);
+  int max_steps = argc > 4 ? atoi(argv[4]) : 512;
+  int width = argc > 6 ? atoi(argv[5]) : 1920, height = argc > 6 ? atoi(argv[6]) : 1080;
+  int frames = argc > 7 ? atoi(argv[7]) : 21;
+  const char *ppm = argc > 8 ? argv[8] : nullptr;
+  // Each scene's camera, as its .sdf file places it (fov is vertical).
+  const V eyes[3] = {v(0, 2.5f, -7), v(0, 1.2f, -3.4f), v(0, 3.5f, -6)};
+  const V looks[3] = {v(0, 0.7f, 0), v(0, -0.1f, 0), v(0, 1, 0)};
+  const float fovs[3] = {50, 45, 50};
+  Kernel render_one = kernel(scene, soft);
   Params P;
-  P.eye = v(0, 2.5f, -7);
-  V look = v(0, 0.7f, 0);
+  P.eye = eyes[scene];
+  V look = looks[scene];
   P.fwd = norm(look - P.eye);
   // Right-handed, +y up: u points to the picture's right (-x when looking along +z).
   P.u = norm(cross(P.fwd, v(0, 1, 0)));
   P.v = cross(P.u, P.fwd);
-  float tan = tanf(50.0f * 3.14159265f / 360.0f);
+  float tan = tanf(fovs[scene] * 3.14159265f / 360.0f);
   P.tan_y = tan;
   P.tan_x = tan * width / height;
   P.width = width; P.height = height; P.max_steps = max_steps;
@@ -151,7 +238,7 @@ int main(int argc, char **argv) {
   // Warm-up: half a second of frames, so that the clocks have risen before timing.
   cudaEventRecord(a);
   for (float ms = 0.0f; ms < 500.0f;) {
-    render<<<grid, block>>>(P, image, steps);
+    render_one<<<grid, block>>>(P, image, steps);
     cudaEventRecord(b);
     cudaEventSynchronize(b);
     cudaEventElapsedTime(&ms, a, b);
@@ -159,7 +246,7 @@ int main(int argc, char **argv) {
   std::vector<float> times;
   for (int f = 0; f < frames; f++) {
     cudaEventRecord(a);
-    render<<<grid, block>>>(P, image, steps);
+    render_one<<<grid, block>>>(P, image, steps);
     cudaEventRecord(b);
     cudaEventSynchronize(b);
     float ms; cudaEventElapsedTime(&ms, a, b);
@@ -184,7 +271,7 @@ int main(int argc, char **argv) {
     }
     fclose(f);
   }
-  printf("{\"eps\": %g, \"max_steps\": %d, \"median_ms\": %.4f, \"min_ms\": %.4f, \"steps_per_pixel\": %.2f}\n",
-         eps, max_steps, times[times.size() / 2], times[0], sum / n);
+  printf("{\"scene\": \"%s\", \"shadow\": \"%s\", \"eps\": %g, \"max_steps\": %d, \"median_ms\": %.4f, \"min_ms\": %.4f, \"steps_per_pixel\": %.2f}\n",
+         argv[1], argv[2], eps, max_steps, times[times.size() / 2], times[0], sum / n);
   return 0;
 }

@@ -12,6 +12,27 @@ from . import core
 from .core import bench, fmt, ms, ratio, scene_name
 
 
+# The hand-written tracer's scenes (`tracer SCENE`) and the .sdf files that say the same.
+PEER_SCENES = {"spheres": "bench/handwritten/scene.sdf", "bulb": "bench/handwritten/bulb.sdf",
+               "lattice": "bench/handwritten/lattice.sdf"}
+
+
+def _ppm_to_png(ppm, png):
+    """The tracer's binary PPM as an 8-bit RGB PNG (for `sdfc compare`), stdlib only."""
+    import struct
+    import zlib
+    data = open(ppm, "rb").read()
+    head = data.split(b"\n", 3)
+    w, h = (int(v) for v in head[1].split())
+    pixels = head[3]
+    rows = b"".join(b"\0" + pixels[y * 3 * w:(y + 1) * 3 * w] for y in range(h))
+    chunk = lambda kind, body: (struct.pack(">I", len(body)) + kind + body
+                                + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF))
+    with open(png, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(rows, 6)) + chunk(b"IEND", b""))
+
+
 def peer(ctx):
     if "cuda" not in ctx.backends:
         raise core.Skip("the peer is a CUDA program: --backends cuda[,wgpu]")
@@ -23,29 +44,45 @@ def peer(ctx):
     size = ctx.size_list(["1920x1080"])[0][0]
     w, h = size.split("x")
     frames = ctx.n_frames(21)
-    scene = "bench/handwritten/scene.sdf"
-    head = ["ε, steps", "hand-written"]
+    head = ["scene, shadows", "ε, steps", "hand-written"]
     for b in ctx.backends:
         head += ["sdfc %s %s" % (b, x.name) for x in ctx.builds]
-    head.append("cuda / hand")
-    t = ctx.table("bench/handwritten/tracer.cu (`nvcc -O3`) and `sdfc bench %s --size %s "
-                  "--frames %d --set epsilon=E --set max_steps=S`: median GPU ms." % (
-                      scene, size, frames), head)
-    for e in ctx.opt("epsilons", ["1e-3", "1e-4", "1e-5"]):
-        for s in ctx.opt("steps", ["512", "1024"]):
-            _, out, err, code = core.run([tracer, e, s, w, h, frames])
-            hand = json.loads(out)["median_ms"] if code == 0 else None
-            cells, cuda = [], None
-            for b in ctx.backends:
-                for x in ctx.builds:
-                    got = bench(x, [scene], b, size, None, frames, ["--set", "epsilon=" + e,
-                                                                    "--set", "max_steps=" + s],
-                                ctx.fails)
-                    v = ms(got[0]) if got else None
-                    cells.append(fmt(v, 3))
-                    if b == "cuda" and x.name == "new":
-                        cuda = v
-            t.add("%s, %s" % (e, s), fmt(hand, 3), *cells, ratio(cuda, hand))
+    head += ["cuda / hand", "pictures (CUDA against hand-written)"]
+    t = ctx.table("bench/handwritten/tracer.cu (`nvcc -O3`, `tracer SCENE soft|hard E S`) and "
+                  "`sdfc bench FILE --size %s --frames %d --set epsilon=E --set max_steps=S` of "
+                  "its scenes (scene.sdf, bulb.sdf, lattice.sdf; hard: the light's penumbra "
+                  "removed): median GPU ms; the pictures at the row's settings compared by "
+                  "`sdfc compare` (PSNR, pixels over 0.1 apart)." % (size, frames), head)
+    tmp = tempfile.mkdtemp(prefix="sdfc-peer-")
+    for name in ctx.opt("scene", ["spheres", "bulb", "lattice"]):
+        for shadow in ctx.opt("shadows", ["soft", "hard"]):
+            scene = PEER_SCENES[name]
+            if shadow == "hard":
+                text = open(scene).read().replace(", penumbra: 4deg", "")
+                scene = os.path.join(tmp, "%s_hard.sdf" % name)
+                open(scene, "w").write(text)
+            for e in ctx.opt("epsilons", ["1e-3", "1e-4", "1e-5"]):
+                for s in ctx.opt("steps", ["512", "1024"]):
+                    ppm = os.path.join(tmp, "hand.ppm")
+                    _, out, err, code = core.run([tracer, name, shadow, e, s, w, h, frames, ppm])
+                    hand = json.loads(out)["median_ms"] if code == 0 else None
+                    settings = ["--set", "epsilon=" + e, "--set", "max_steps=" + s]
+                    cells, cuda = [], None
+                    for b in ctx.backends:
+                        for x in ctx.builds:
+                            got = bench(x, [scene], b, size, None, frames, settings, ctx.fails)
+                            v = ms(got[0]) if got else None
+                            cells.append(fmt(v, 3))
+                            if b == "cuda" and x.name == "new":
+                                cuda = v
+                    pictures = "-"
+                    if code == 0:
+                        ours = os.path.join(tmp, "sdfc.png")
+                        _ppm_to_png(ppm, os.path.join(tmp, "hand.png"))
+                        core.render(ctx.new, scene, "cuda", ours, size, None, settings)
+                        pictures = core.agreement(core.compare(ctx.new, os.path.join(tmp, "hand.png"), ours))
+                    t.add("%s, %s" % (name, shadow), "%s, %s" % (e, s), fmt(hand, 3), *cells,
+                          ratio(cuda, hand), pictures)
 
 
 # The phases of `sdfc render --stats` a Python render does not do: the process's start, its
@@ -147,8 +184,10 @@ def cpu_ab(ctx):
 
 
 SUITES = {
-    "peer": (peer, "beside bench/handwritten's CUDA tracer (nvcc) at ε 1e-3..1e-5, 512 and "
-             "1 024 steps; --with arch=sm_90"),
+    "peer": (peer, "beside bench/handwritten's CUDA tracer (nvcc): spheres, a Mandelbulb and a "
+             "lattice, soft and hard shadows, at ε 1e-3..1e-5, 512 and 1 024 steps, and the "
+             "pictures compared; --with arch=sm_90, scene=spheres,bulb,lattice, shadows=soft,hard, "
+             "epsilons=..., steps=..."),
     "python": (python, "import sdfc: Scene.render against the CLI's phases, Scene.distance "
                "throughput (the package importable)"),
     "cpu": (cpu_ab, "the CPU renderer: the report scenes at 640x480 and 1080p, median ms, the "

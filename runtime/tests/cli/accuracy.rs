@@ -2,7 +2,9 @@
 //! buffers of CPU renders and their sidecar, the reference render, the sweep parser and the
 //! Pareto front of `sdfc pareto`, and its charts (valid SVG and PNG).
 
+use crate::cli::put;
 use crate::common;
+use crate::common::assert_has;
 use crate::common::words;
 
 use common::*;
@@ -321,10 +323,7 @@ fn charts_are_valid_svg_and_png() {
         p.accuracy = d;
     }
     let svg = chart::svg(&mesh).expect("draws");
-    assert!(
-        svg.contains("largest distance") && svg.contains("0.001"),
-        "{svg}"
-    );
+    assert_has(&svg, &["largest distance", "0.001"]);
     chart::png(&mesh).expect("draws");
 }
 
@@ -409,7 +408,7 @@ fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("sdfc-accuracy-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).expect("temp dir");
-    std::fs::write(d.join("ball.sdf"), SCENE).expect("write scene");
+    put(&d, "ball.sdf", SCENE);
     d
 }
 
@@ -426,10 +425,7 @@ fn reference_renders_with_sidecars_compare_by_depth() {
         &words("render ball.sdf --reference --aux --stats -o ref.png"),
     );
     let stats = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        stats.contains("against ε 1e-7") && stats.contains("converged"),
-        "{stats}"
-    );
+    assert_has(&stats, &["against ε 1e-7", "converged"]);
     assert!(d.join("ref.aux").exists());
     let reference = Depth::read(&d.join("ref.aux")).expect("a sidecar");
     assert_eq!((reference.width, reference.height), (24, 16));
@@ -545,11 +541,11 @@ fn pareto_measures_points_and_draws_charts() {
 #[test]
 fn pareto_mesh_measures_meshing_speed_against_accuracy() {
     let d = dir("pareto-mesh");
-    std::fs::write(
-        d.join("part.sdf"),
+    put(
+        &d,
+        "part.sdf",
         "scene { union(box((1, 0.5, 0.7)), sphere(0.6).translate(0.9, 0.4, 0)); }",
-    )
-    .expect("write the part");
+    );
     let out = sdfc(
         &d,
         &words("pareto part.sdf --mesh --sweep resolution=8..32 --frames 1 --json -o mesh.svg"),
@@ -661,10 +657,7 @@ fn the_area_averaged_reference_of_a_fractal_converges() {
         text.contains("aa 8,"),
         "the reference averages 8×8 samples: {text}"
     );
-    assert!(
-        text.contains("against ε") && text.contains("aa 16"),
-        "{text}"
-    );
-    assert!(text.contains("converged       yes"), "{text}");
+    assert_has(&text, &["against ε", "aa 16"]);
+    assert_has(&text, &["converged       yes"]);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -2,6 +2,7 @@
 //! problems), settings refused, limits set and named, help and completions, a closed standard
 //! output; and the helpers of the binary's modules (a test's folder, `sdfc` run in it, a scene).
 
+use crate::common::assert_has;
 use crate::common::words;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -53,6 +54,19 @@ pub(crate) fn ok(cwd: &Path, args: &[&str]) -> Output {
     out
 }
 
+/// A fresh directory for one test, holding the scene `ball.sdf` (`SCENE`).
+pub(crate) fn scene_dir(name: &str) -> PathBuf {
+    let d = dir(name);
+    scene_file(&d);
+    d
+}
+
+/// Writes `text` to the file `name` of the directory `d`.
+#[track_caller]
+pub(crate) fn put(d: &Path, name: &str, text: impl AsRef<[u8]>) {
+    std::fs::write(d.join(name), text).unwrap_or_else(|e| panic!("write {name}: {e}"));
+}
+
 pub(crate) fn scene_file(d: &Path) -> PathBuf {
     let p = d.join("ball.sdf");
     std::fs::write(&p, SCENE).expect("write scene");
@@ -78,8 +92,7 @@ pub(crate) fn png_size(p: &Path) -> (u32, u32) {
 
 #[test]
 fn bad_settings_are_usage_errors() {
-    let d = dir("bad-set");
-    scene_file(&d);
+    let d = scene_dir("bad-set");
     for (args, needle) in [
         (vec!["--set", "colour=1"], "unknown render setting `colour`"),
         (vec!["--set", "max_steps=-3"], "max_steps must be"),
@@ -103,7 +116,7 @@ fn bad_settings_are_usage_errors() {
 #[test]
 fn scene_errors_exit_1_and_io_errors_exit_2() {
     let d = dir("errors");
-    std::fs::write(d.join("broken.sdf"), "scene { sphere(; }").expect("write");
+    put(&d, "broken.sdf", "scene { sphere(; }");
     assert_eq!(sdfc(&d, &["render", "broken.sdf"]).status.code(), Some(1));
     assert_eq!(sdfc(&d, &["render", "missing.sdf"]).status.code(), Some(2));
     scene_file(&d);
@@ -114,13 +127,9 @@ fn scene_errors_exit_1_and_io_errors_exit_2() {
 
 #[test]
 fn limits_are_set_by_name_and_named_when_exceeded() {
-    let d = dir("limits");
-    scene_file(&d);
+    let d = scene_dir("limits");
     let err = exits(&d, &["render", "ball.sdf", "--limit", "speed=3"], 2);
-    assert!(
-        err.contains("unknown limit `speed`") && err.contains("fuel"),
-        "{err}"
-    );
+    assert_has(&err, &["unknown limit `speed`", "fuel"]);
     for bad in ["aa=0", "aa=x", "aa"] {
         let out = sdfc(&d, &["check", "ball.sdf", "--limit", bad]);
         assert_eq!(out.status.code(), Some(2), "{bad}");
@@ -128,17 +137,14 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
     // A loop over the objects limit: E0507 naming the flag with the value that would do
     // (the loop's count, not twice the limit), and the flag raises it.
     let many = "scene { for i in 0..50 { sphere(0.1).translate(i, 0, 0); } }\n";
-    std::fs::write(d.join("many.sdf"), many).expect("write");
+    put(&d, "many.sdf", many);
     let err = exits(&d, &["check", "many.sdf", "--limit", "objects=20"], 1);
-    assert!(
-        err.contains("E0507") && err.contains("--limit objects=50"),
-        "{err}"
-    );
+    assert_has(&err, &["E0507", "--limit objects=50"]);
     let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=50"]);
     assert!(out.status.success());
     // The render settings' limits: in the scene (E0400) and on the command line (exit 2).
     let err = exits(&d, &["render", "ball.sdf", "--aa", "20"], 2);
-    assert!(err.contains("--limit aa=20"), "{err}");
+    assert_has(&err, &["--limit aa=20"]);
     for (set, flag) in [
         ("max_steps=2000000", "--limit max_steps=2000000"),
         ("max_depth=100", "--limit max_depth=100"),
@@ -157,7 +163,7 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         ("samples: 0", "samples"),
     ] {
         let text = format!("render {{ method: \"path\", {setting} }}\nscene {{ sphere(); }}\n");
-        std::fs::write(d.join("path.sdf"), text).expect("write");
+        put(&d, "path.sdf", text);
         let out = sdfc(&d, &["check", "path.sdf"]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{setting}: {err}");
@@ -181,22 +187,19 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         let out = sdfc(&d, args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-        assert!(
-            err.contains("E0507")
-                && err.contains("distance program has")
-                && err.contains("--limit program="),
-            "{err}"
-        );
+        assert_has(&err, &["E0507", "distance program has", "--limit program="]);
     }
     // `check` passes the scene and warns, located, that a render will refuse it (issue 37).
     let err = exits(&d, &["check", "many.sdf", "--limit", "program=100"], 0);
-    assert!(
-        err.contains("[E0507] Warning")
-            && err.contains("will refuse this scene")
-            && err.contains("many.sdf:1:1")
-            && err.contains("--limit program=")
-            && err.contains("many.sdf: ok"),
-        "{err}"
+    assert_has(
+        &err,
+        &[
+            "[E0507] Warning",
+            "will refuse this scene",
+            "many.sdf:1:1",
+            "--limit program=",
+            "many.sdf: ok",
+        ],
     );
     let out = sdfc(&d, &["check", "many.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);

@@ -5,6 +5,7 @@
 //! that read them, naming where in the file, and never a crash.
 
 use crate::common;
+use crate::common::assert_has;
 use crate::common::words;
 use common::run_ok;
 
@@ -336,7 +337,7 @@ fn a_software_adapter_that_would_cut_loops_refuses_instead_of_a_wrong_picture() 
             panic!("rendered on a software adapter, where it should be refused");
         };
         let e = e.to_string();
-        assert!(e.contains("65 535") && e.contains("--backend cpu"), "{e}");
+        assert_has(&e, &["65 535", "--backend cpu"]);
         assert!(
             !cli.status.success() && stderr.contains("65 535"),
             "{stderr}"

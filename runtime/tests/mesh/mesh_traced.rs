@@ -6,6 +6,7 @@
 
 use super::common::{cpu_render, open_gpu, run_ok};
 use super::meshes::{dir, root, s, write_scene};
+use crate::common::assert_has;
 use sdfc_compiler::{
     analytic::{choose, Choice, Reason},
     wgsl, Lowered, Method, Scene,
@@ -181,10 +182,7 @@ fn a_traced_mesh_is_held_to_the_scene_data_limit() {
         .expect("sdfc runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("above the scene_data limit of 1 MiB"),
-        "{stderr}"
-    );
+    assert_has(&stderr, &["above the scene_data limit of 1 MiB"]);
     assert!(!stderr.contains("internal compiler error"), "{stderr}");
     let e = wgsl::write(&scene, &lowered).expect_err("above the limit");
     assert!(

@@ -8,6 +8,7 @@
 //! skipped, unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe).
 
 use crate::common;
+use crate::common::assert_has;
 use common::load_small;
 
 use sdfc_compiler::{wgsl, Lowered};
@@ -270,7 +271,7 @@ fn a_failing_device_hands_its_tile_back_and_the_others_finish() {
     let out = render(&d, "0", "alone.png", &[("SDFC_FAULT_AFTER_TILES", "0:0")]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("error: GPU error while rendering: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=0:0 (a testing aid)"), "{err}");
+    assert_has(&err, &["error: GPU error while rendering: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=0:0 (a testing aid)"]);
 }
 
 #[test]
@@ -285,12 +286,9 @@ fn the_cpu_and_lavapipe_render_together_from_the_command_line() {
     let out = sdfc_on(&d, "render", &seed3(), rest, &[]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{out:?}");
-    assert!(
-        text.contains("backend         mixed (2 devices: CPU, "),
-        "{text}"
-    );
-    assert!(text.contains("device 0        CPU, "), "{text}");
-    assert!(text.contains("device 1        "), "{text}");
+    assert_has(&text, &["backend         mixed (2 devices: CPU, "]);
+    assert_has(&text, &["device 0        CPU, "]);
+    assert_has(&text, &["device 1        "]);
     let compare = sdfc(&d, &["compare", "one.png", "mixed.png", "--json"], &[]);
     let json = String::from_utf8_lossy(&compare.stdout);
     let v: serde_json::Value = serde_json::from_str(&json).expect("json");
@@ -322,7 +320,7 @@ fn the_frames_of_a_sequence_go_to_the_devices_and_survive_one_failing() {
     let two = sequence(&d, "0,0", "two/f_##.png", &[]);
     let err = String::from_utf8_lossy(&two.stderr);
     assert!(two.status.success(), "{err}");
-    assert!(err.contains("(2 devices: wgpu on "), "{err}");
+    assert_has(&err, &["(2 devices: wgpu on "]);
     same("two");
     // The second device fails on its first frame (it opens its device after taking one,
     // while the first is still opening its own); the first renders every frame.
@@ -330,16 +328,16 @@ fn the_frames_of_a_sequence_go_to_the_devices_and_survive_one_failing() {
     let out = sequence(&d, "0,0", "back/f_##.png", &fault);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
-    assert!(err.contains("warning: device 1 failed: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=1:0 (a testing aid); the other devices render its frame"), "{err}");
+    assert_has(&err, &["warning: device 1 failed: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=1:0 (a testing aid); the other devices render its frame"]);
     same("back");
     // Every device fails at its second frame: two frames are written, then the error.
     let fault = [("SDFC_FAULT_AFTER_TILES", "1")];
     let out = sequence(&d, "0,0", "none/f_##.png", &fault);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("error: every device failed (2 of 6 frames written): device "),
-        "{err}"
+    assert_has(
+        &err,
+        &["error: every device failed (2 of 6 frames written): device "],
     );
 }
 
@@ -358,17 +356,14 @@ fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
         assert!(out.status.success(), "{out:?}");
         // `--stats` says where the time went: each device's steps and the writers'.
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains("where the sequence's time went"), "{err}");
+        assert_has(&err, &["where the sequence's time went"]);
         let place = if devices == "0" { "device" } else { "device 1" };
         assert!(
             err.contains(&format!("\n  {place}: "))
                 && err.contains("opening and first preparation"),
             "{err}"
         );
-        assert!(
-            err.contains("\n  writers: ") && err.contains(" fsync "),
-            "{err}"
-        );
+        assert_has(&err, &["\n  writers: ", " fsync "]);
     }
     for k in 0..3 {
         let a = std::fs::read(d.join(format!("one/f_{k:02}.png"))).expect("frame");
@@ -379,7 +374,7 @@ fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
     let bench = sdfc_on(&d, "bench", &orbit, rest, &[]);
     let json = String::from_utf8_lossy(&bench.stdout);
     assert!(bench.status.success(), "{bench:?}");
-    assert!(json.contains("2 devices: "), "{json}");
+    assert_has(&json, &["2 devices: "]);
 }
 
 #[test]
@@ -439,7 +434,7 @@ fn bad_devices_are_named_in_the_error() {
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("it cannot use --devices"), "{err}");
+    assert_has(&err, &["it cannot use --devices"]);
 }
 
 /// A still and a sequence report `--devices` alike: a list the backend cannot take is a usage

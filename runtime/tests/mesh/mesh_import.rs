@@ -7,6 +7,7 @@
 use crate::common;
 use crate::common::assert_has;
 use crate::common::words;
+use crate::glb::glb;
 use common::run_ok;
 
 use sdfc_compiler::{Lowered, Rng, Scene};
@@ -181,24 +182,6 @@ fn a_mesh_composes_and_remeshes() {
         "{d:?}"
     );
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// A binary glTF file of `json` and `bin`.
-fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
-    let mut json = json.as_bytes().to_vec();
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
-    let mut b = b"glTF".to_vec();
-    for n in [2, 20 + json.len() + 8 + bin.len(), json.len()] {
-        b.extend_from_slice(&(n as u32).to_le_bytes());
-    }
-    b.extend_from_slice(b"JSON");
-    b.extend_from_slice(&json);
-    b.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    b.extend_from_slice(b"BIN\0");
-    b.extend_from_slice(bin);
-    b
 }
 
 /// Bad files: an error E0400 at the `mesh` call whose message says what and where.

@@ -214,6 +214,13 @@ fn stale_compile(gpu: &Arc<Gpu>, name: &str, options: Options) -> (Session, Path
     (s, dir, newer)
 }
 
+/// Loads the edit of [`settled_on_marched`]'s scene in `dir` that adds a box, its compile held
+/// back.
+fn add_the_box(s: &mut Session, dir: &Path) {
+    let [_, boxed, _] = marched();
+    load_held(s, &dir.join("k.sdf"), &boxed, 1);
+}
+
 /// A marched scene (the interpreted kernel renders marched scenes alone), and two
 /// structural edits of it (new kernels).
 fn marched() -> [String; 3] {

@@ -8,8 +8,6 @@ use super::*;
 fn a_new_kernel_is_shown_interpreted_until_the_specialised_one_is_ready() {
     let Some(gpu) = wgpu() else { return };
     let (mut s, dir) = settled_on_marched(&gpu, "interim", interim());
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
     assert_eq!(s.last.unwrap().kernel, Some("specialised"));
     s.rotate(20.0, 5.0);
     let camera = s.camera();
@@ -18,7 +16,7 @@ fn a_new_kernel_is_shown_interpreted_until_the_specialised_one_is_ready() {
 
     // A structural edit needs a new specialised kernel, which compiles on another thread
     // (held back here until the interpreted kernel's image has converged).
-    load_held(&mut s, &file, &boxed, 1);
+    add_the_box(&mut s, &dir);
     assert!(s.compiling() && !s.settled());
     let info = next_frame(&mut s);
     assert_eq!(
@@ -60,11 +58,9 @@ fn a_kernel_ready_within_the_grace_period_is_shown_with_no_interpreted_frame() {
     // machine.
     let Some(gpu) = wgpu() else { return };
     let (mut s, dir) = settled_on_marched(&gpu, "grace-in", an_hours_grace());
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
     let before = s.image().unwrap();
 
-    load_held(&mut s, &file, &boxed, 1);
+    add_the_box(&mut s, &dir);
     assert!(s.compiling() && s.grace_deadline().is_some());
     // Nothing is rendered in the grace period, not even once the interpreted kernel's
     // pipeline is ready: the image before stays on show.
@@ -109,10 +105,8 @@ fn a_kernel_not_ready_within_the_grace_period_is_shown_interpreted_first() {
         ..interim()
     };
     let (mut s, dir) = settled_on_marched(&gpu, "grace-out", options);
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
 
-    load_held(&mut s, &file, &boxed, 1);
+    add_the_box(&mut s, &dir);
     let w = waiting(&s);
     let end = w.grace_until;
     assert_eq!(end, w.compile.started + GRACE);
@@ -150,11 +144,9 @@ fn a_new_kernel_compiles_off_the_callers_thread_and_the_image_before_stays() {
     let Some(gpu) = wgpu() else { return };
     let options = specialised();
     let (mut s, dir) = settled_on_marched(&gpu, "off-thread", options);
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
     let before = s.image().unwrap();
 
-    load_held(&mut s, &file, &boxed, 1);
+    add_the_box(&mut s, &dir);
     assert!(s.compiling() && !s.wants_frame() && !s.settled());
     assert!(
         s.grace_deadline().is_none(),

@@ -2,7 +2,7 @@
 //! buffers of CPU renders and their sidecar, the reference render, the sweep parser and the
 //! Pareto front of `sdfc pareto`, and its charts (valid SVG and PNG).
 
-use crate::cli::put;
+use crate::cli::{put, TestDir};
 use crate::common;
 use crate::common::assert_has;
 use crate::common::words;
@@ -404,10 +404,9 @@ scene {
 }
 ";
 
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sdfc-accuracy-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
+fn dir(name: &str) -> TestDir {
+    let path = std::env::temp_dir().join(format!("sdfc-accuracy-{name}-{}", std::process::id()));
+    let d = TestDir::fresh(path);
     put(&d, "ball.sdf", SCENE);
     d
 }
@@ -465,7 +464,6 @@ fn reference_renders_with_sidecars_compare_by_depth() {
     let out = sdfc(&d, &["compare", "ref.png", "plain.png", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert!(v["depth"].is_null() && v["depth_note"].is_string(), "{v}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -478,7 +476,6 @@ fn reference_needs_the_cpu() {
         .expect("run sdfc");
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--reference renders on the CPU"));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -532,7 +529,6 @@ fn pareto_measures_points_and_draws_charts() {
         .output()
         .expect("run sdfc");
     assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// `sdfc pareto --mesh`: a part meshed at three resolutions, each with its time, triangles
@@ -589,7 +585,6 @@ fn pareto_mesh_measures_meshing_speed_against_accuracy() {
         &["pareto", "ball.sdf", "--sweep", "resolution=8"],
         "sdfc pareto --mesh",
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// The scene of a file of `examples/`, checked.

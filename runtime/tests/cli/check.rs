@@ -42,7 +42,6 @@ fn json_diagnostics_and_io_errors_go_to_stdout() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A library imported by its path and through a symbolic link to it is read once (no
@@ -58,7 +57,6 @@ fn a_library_imported_through_a_symbolic_link_is_read_once() {
     put(&d, "main.sdf", "import \"lib/shapes.sdf\";\nimport \"alias.sdf\";\nimport \"linked/shapes.sdf\";\nscene { sphere(r); }\n");
     let err = exits(&d, &["check", "main.sdf"], 0);
     assert!(!err.contains("E0207"), "{err}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A one-line file with 20 000 duplicate definitions: the human form shows the first 100
@@ -79,7 +77,6 @@ fn twenty_thousand_errors_on_one_line_are_capped() {
         "{}",
         &err[err.len().saturating_sub(400)..]
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -125,7 +122,6 @@ fn the_method_setting_and_what_check_says_about_it() {
     );
     assert_eq!(out.status.code(), Some(0));
     assert!(d.join("hard.png").exists());
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// The 42-line file of issue 16, item 1: forty functions, each using the one below twice,
@@ -261,7 +257,6 @@ fn check_verify_bounds_samples_the_scene_and_says_where() {
         &["open.sdf:5:3: this field has no declared or proven L: nothing to sample"],
     );
     assert_has(&err, &["the scene is unbounded along x, y, z, sampled within max_dist = 50 of the camera there, and not beyond"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// 10 000 nested `union(…)` with the `nesting` limit raised, as the error suggests, check
@@ -280,5 +275,4 @@ fn ten_thousand_nested_unions_check_with_the_limit_raised() {
     assert_has(&err, &["`--limit nesting=2000`"]);
     let err = exits(&d, &["check", "deep.sdf", "--limit", "nesting=20000"], 0);
     assert_has(&err, &["deep.sdf: ok"]);
-    let _ = std::fs::remove_dir_all(&d);
 }

@@ -17,12 +17,42 @@ scene {
 }
 ";
 
+/// A test's directory, removed when the test ends well (kept to look at when it fails).
+pub(crate) struct TestDir(PathBuf);
+
+impl TestDir {
+    /// The directory `path`, made fresh.
+    pub(crate) fn fresh(path: PathBuf) -> TestDir {
+        let _ = std::fs::remove_dir_all(&path);
+        std::fs::create_dir_all(&path).expect("temp dir");
+        TestDir(path)
+    }
+}
+
+impl std::ops::Deref for TestDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for TestDir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TestDir {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
 /// A fresh directory for one test.
-pub(crate) fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sdfc-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
+pub(crate) fn dir(name: &str) -> TestDir {
+    TestDir::fresh(std::env::temp_dir().join(format!("sdfc-cli-{name}-{}", std::process::id())))
 }
 
 pub(crate) fn sdfc(cwd: &Path, args: &[&str]) -> Output {
@@ -55,7 +85,7 @@ pub(crate) fn ok(cwd: &Path, args: &[&str]) -> Output {
 }
 
 /// A fresh directory for one test, holding the scene `ball.sdf` (`SCENE`).
-pub(crate) fn scene_dir(name: &str) -> PathBuf {
+pub(crate) fn scene_dir(name: &str) -> TestDir {
     let d = dir(name);
     scene_file(&d);
     d
@@ -110,7 +140,6 @@ fn bad_settings_are_usage_errors() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
     assert_eq!(entries(&d), ["ball.sdf"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -122,7 +151,6 @@ fn scene_errors_exit_1_and_io_errors_exit_2() {
     scene_file(&d);
     exits(&d, &["render", "ball.sdf", "-o", "no/such/dir/x.png"], 2);
     assert_eq!(entries(&d), ["ball.sdf", "broken.sdf"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -340,7 +368,6 @@ fn help_and_completions() {
         "{top_lines:?}"
     );
     assert!(help(&["mesh", "--help"]).contains("importers load as separate parts"));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A standard output closed before the command is done (`sdfc completions bash | head -1`)
@@ -386,5 +413,4 @@ fn a_closed_standard_output_ends_a_command_quietly() {
             out.status
         );
     }
-    let _ = std::fs::remove_dir_all(&d);
 }

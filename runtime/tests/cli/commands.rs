@@ -38,7 +38,6 @@ fn bench_prints_a_table_or_json() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     let method = v[0]["method"].as_str().unwrap_or("").to_string();
     assert!(method == "path+trace" || method == "path+march", "{method}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// issue 16, item 2: `sdfc pareto` counts the combinations of its sweeps before building
@@ -93,7 +92,6 @@ fn spirv_is_not_written_to_a_terminal() {
         !text.contains('\u{0}'),
         "binary reached the terminal: {text:?}"
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// `compile --set` specialises the kernel as `render --set` would: the method, here marching a
@@ -239,7 +237,6 @@ fn fmt_rewrites_checks_and_filters() {
         (Some(1), "<stdin>\n")
     );
     assert_eq!(run(&["fmt", "--check"], tidy).status.code(), Some(0));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]

@@ -70,7 +70,6 @@ fn an_unwritable_output_is_refused_before_the_render() {
     assert!(out.stdout.is_empty(), "the sweeps ran");
     assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
     assert_eq!(entries(&d), ["ball.sdf"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A read-only output file is refused (exit 2, saying so) and left as it was, by `render`
@@ -102,7 +101,6 @@ fn a_read_only_output_is_refused_and_left_unchanged() {
         );
         assert_eq!(std::fs::read(&out).expect("kept"), b"keep me", "{name}");
     }
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Runs sdfc in `cwd` with standard input from `stdin` and standard output to `stdout` (files
@@ -225,7 +223,6 @@ fn special_files_are_refused_and_files_are_read_within_the_file_size_limit() {
         &err,
         &["standard input: it is over the file_size limit of 1 MiB"],
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Output that cannot be written (`> /dev/full`) is an error, not a silent success:
@@ -270,7 +267,6 @@ fn output_that_cannot_be_written_is_an_error_and_fmt_keeps_permissions() {
         .permissions()
         .mode();
     assert_eq!(mode & 0o777, 0o600, "{mode:o}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A UTF-8 byte-order mark at the start of a file (some editors write one) is skipped: the
@@ -301,5 +297,4 @@ fn a_byte_order_mark_is_skipped() {
     let out = sdfc(&d, &["check", "first.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_has(&err, &["first.sdf:1:9"]);
-    let _ = std::fs::remove_dir_all(&d);
 }

@@ -7,6 +7,7 @@ use crate::cli::{
 };
 use crate::common::assert_has;
 use crate::common::words;
+use std::path::Path;
 use std::process::{Command, Output};
 
 #[test]
@@ -21,7 +22,6 @@ fn render_writes_the_default_output_in_the_current_directory() {
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_has(&stdout, &["steps/pixel", "overshoots"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -40,7 +40,6 @@ fn size_aa_set_and_output_options() {
     );
     assert!(out.status.success());
     assert_eq!(png_size(&d.join("y.png")), (8, 6));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -55,7 +54,6 @@ fn render_prints_the_warnings_of_check() {
     assert!(out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert_has(&err, &["[W0008]", "no lights"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -97,20 +95,24 @@ fn outputs_are_written_in_the_format_their_extension_names() {
         ["ball.sdf", "out.JPEG", "out.exr", "out.jpg"],
         "no other file, no temporary file left"
     );
-    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `sdfc render FILE --backend wgpu` run in `d` where Vulkan finds no driver.
+fn on_wgpu_without_adapters(d: &Path, file: &str) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(d)
+        .args(["render", file, "--backend", "wgpu"])
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .output()
+        .expect("run sdfc")
 }
 
 #[test]
 fn no_gpu_adapter_is_a_clear_error() {
     let d = scene_dir("adapter");
-    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&d)
-        .args(["render", "ball.sdf", "--backend", "wgpu"])
-        .env("WGPU_BACKEND", "vulkan")
-        .env("VK_ICD_FILENAMES", "/nonexistent.json")
-        .env("VK_DRIVER_FILES", "/nonexistent.json")
-        .output()
-        .expect("run sdfc");
+    let out = on_wgpu_without_adapters(&d, "ball.sdf");
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_has(&err, &["no wgpu adapter found", "mesa-vulkan-drivers"]);
@@ -303,14 +305,7 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
         err
     };
     // No wgpu adapter at all.
-    let no_adapter = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&d)
-        .args(["render", "broken.sdf", "--backend", "wgpu"])
-        .env("WGPU_BACKEND", "vulkan")
-        .env("VK_ICD_FILENAMES", "/nonexistent.json")
-        .env("VK_DRIVER_FILES", "/nonexistent.json")
-        .output()
-        .expect("run sdfc");
+    let no_adapter = on_wgpu_without_adapters(&d, "broken.sdf");
     diagnostics(&no_adapter);
     // Whatever this machine has: a device opening (lavapipe, a GPU) or none.
     for backend in ["wgpu", "cuda", "auto"] {
@@ -349,7 +344,6 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
         ["ball.sdf", "broken.sdf"],
         "no image, no temporary file"
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// `--stats`'s breakdown of the whole run: its phases add up to its total, a device opened
@@ -422,5 +416,4 @@ fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
         }
         assert_eq!(png_size(&d.join("out.png")), (40, 30));
     }
-    let _ = std::fs::remove_dir_all(&d);
 }

@@ -54,45 +54,95 @@ const PTX_FEATURES: &[&str] = &[
 /// A kernel snapshot: the input file of `tests/in/kernel` and the writer's options.
 type Written = (&'static str, Options);
 
-/// The kernel of the input `file` written with the default options.
-const fn plain(file: &'static str) -> Written {
-    (file, Options::Default)
-}
-
-/// The kernel of the input `file` written with the default options, to compare with.
-const fn beside(file: &'static str) -> Option<Written> {
-    Some(plain(file))
-}
-
 /// Each kernel snapshot: its name, the kernel, and the kernel it is compared with (one
 /// feature less), or none where it is snapshotted whole.
 const KERNELS: &[(&str, Written, Option<Written>)] = &[
-    ("base", plain("base"), None),
-    ("relax", plain("relax"), beside("base")),
-    ("point", plain("point"), beside("base")),
-    ("directional", plain("directional"), beside("base")),
-    ("soft", plain("soft"), beside("point")),
-    ("materials", plain("materials"), beside("base")),
-    ("look", plain("look"), beside("base")),
-    ("sky", plain("sky"), beside("base")),
-    ("pbr", plain("pbr"), beside("sky")),
-    ("checker", plain("checker"), beside("materials")),
-    ("reflect", plain("reflect"), beside("materials")),
-    ("transparent", plain("transparent"), beside("point")),
-    ("refraction", plain("refraction"), beside("materials")),
-    ("media", plain("media"), beside("refraction")),
-    ("debug_nan", ("base", Options::DebugNan), beside("base")),
-    ("params", ("base", Options::Parameters), beside("base")),
-    ("analytic", plain("analytic"), None),
+    ("base", ("base", Options::Default), None),
+    (
+        "relax",
+        ("relax", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "point",
+        ("point", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "directional",
+        ("directional", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "soft",
+        ("soft", Options::Default),
+        Some(("point", Options::Default)),
+    ),
+    (
+        "materials",
+        ("materials", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "look",
+        ("look", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "sky",
+        ("sky", Options::Default),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "pbr",
+        ("pbr", Options::Default),
+        Some(("sky", Options::Default)),
+    ),
+    (
+        "checker",
+        ("checker", Options::Default),
+        Some(("materials", Options::Default)),
+    ),
+    (
+        "reflect",
+        ("reflect", Options::Default),
+        Some(("materials", Options::Default)),
+    ),
+    (
+        "transparent",
+        ("transparent", Options::Default),
+        Some(("point", Options::Default)),
+    ),
+    (
+        "refraction",
+        ("refraction", Options::Default),
+        Some(("materials", Options::Default)),
+    ),
+    (
+        "media",
+        ("media", Options::Default),
+        Some(("refraction", Options::Default)),
+    ),
+    (
+        "debug_nan",
+        ("base", Options::DebugNan),
+        Some(("base", Options::Default)),
+    ),
+    (
+        "params",
+        ("base", Options::Parameters),
+        Some(("base", Options::Default)),
+    ),
+    ("analytic", ("analytic", Options::Default), None),
     (
         "analytic_data",
         ("analytic", Options::OneUnrolled),
-        beside("analytic"),
+        Some(("analytic", Options::Default)),
     ),
     (
         "instances_data",
         ("instances", Options::OneInstance),
-        beside("instances"),
+        Some(("instances", Options::Default)),
     ),
 ];
 

@@ -16,7 +16,7 @@ use sdfc_runtime::fp32;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::metrics::{compare, compare_depth};
 use sdfc_runtime::pareto::{self, front, parse_sweep, Key};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn image(pixels: &[[f32; 3]]) -> Image {

@@ -670,7 +670,7 @@ fn a_field_of_two_noises_through_the_interpreted_kernel_matches_the_cpu() {
         gpu.is_cpu(),
     );
     assert!(kernel.interpreted());
-    let (on_gpu, on_cpu, d) = side_by_side(&gpu, &scene, &lowered, &kernel);
+    let (_, _, d) = side_by_side(&gpu, &scene, &lowered, &kernel);
     println!(
         "two noises, interpreted: psnr {:.1} dB, differing {:.4}",
         d.psnr, d.differing
@@ -708,7 +708,7 @@ fn colour_fields_match_the_cpu_on_every_kernel() {
             kernel.interpreted(),
             choice == wgsl::KernelChoice::Interpreted
         );
-        let (on_gpu, on_cpu, d) = side_by_side(&gpu, &scene, &lowered, &kernel);
+        let (_, _, d) = side_by_side(&gpu, &scene, &lowered, &kernel);
         println!(
             "colour fields, {method:?}, {choice:?}: psnr {:.1} dB, differing {:.4}",
             d.psnr, d.differing

@@ -75,19 +75,21 @@ fn shared_shapes_are_one_node() {
     assert_eq!(spheres, 1);
 }
 
+/// A white directional light of intensity 1 shining straight down.
+fn downwards(penumbra: f64, shadows: bool) -> Light {
+    Light::Directional {
+        direction: [0.0, -1.0, 0.0],
+        color: [1.0; 3],
+        intensity: 1.0,
+        penumbra,
+        shadows,
+    }
+}
+
 #[test]
 fn lights_are_normalised() {
     let s = ok("light directional { direction: (0, -2, 0) }\nscene { sphere(); }");
-    assert_eq!(
-        s.lights[0],
-        Light::Directional {
-            direction: [0.0, -1.0, 0.0],
-            color: [1.0; 3],
-            intensity: 1.0,
-            penumbra: 0.0,
-            shadows: true,
-        }
-    );
+    assert_eq!(s.lights[0], downwards(0.0, true));
 }
 
 /// `sun` is a directional light whose penumbra is its angle (the real sun's by default);
@@ -97,16 +99,7 @@ fn suns_and_skies() {
     let s = ok("light sun { direction: (0, -2, 0), shadows: false }\n\
                 light sky { color: (0.5, 0.5, 0.5), ground: (0.1, 0.1, 0.1), background: false }\n\
                 scene { sphere(); }");
-    assert_eq!(
-        s.lights[0],
-        Light::Directional {
-            direction: [0.0, -1.0, 0.0],
-            color: [1.0; 3],
-            intensity: 1.0,
-            penumbra: 0.53f64.to_radians(),
-            shadows: false,
-        }
-    );
+    assert_eq!(s.lights[0], downwards(0.53f64.to_radians(), false));
     assert_eq!(
         s.lights[1],
         Light::Sky {

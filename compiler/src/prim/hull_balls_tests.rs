@@ -85,28 +85,53 @@ fn grid(balls: &[Ball], p: DVec3) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
+/// A ball of radius `r` centred at `c`.
+fn ball(c: [f64; 3], r: f64) -> Ball {
+    Ball {
+        c: DVec3::from(c),
+        r,
+    }
+}
+
+/// The hull of `balls` against `prim` of `args` at `n` random points of the cube [lo, hi]³:
+/// the same distance.
+fn agree(
+    rng: &mut Rng,
+    balls: &[Ball],
+    (prim, args): (&Prim, &Args),
+    n: usize,
+    (lo, hi): (f64, f64),
+) {
+    for _ in 0..n {
+        let at = [0, 1, 2].map(|_| rng.range(lo, hi));
+        let (ours, theirs) = (of_balls(balls, at), run(prim, args, at));
+        assert!(
+            (ours - theirs).abs() < 1e-9,
+            "{at:?}: {ours} against {theirs}"
+        );
+    }
+}
+
+/// Balls of radius `r` at `centres` against the hull of the points `centres` grown by `r`, at
+/// 300 random points of the cube [lo, hi]³.
+fn agree_with_the_grown_hull(rng: &mut Rng, centres: &[[f64; 3]], r: f64, box_: (f64, f64)) {
+    let balls: Vec<Ball> = centres.iter().map(|c| ball(*c, r)).collect();
+    let points = Args::with_list(&[r], 0, centres);
+    agree(
+        rng,
+        &balls,
+        (&super::super::hull::PRIMS[0], &points),
+        300,
+        box_,
+    );
+}
+
 #[test]
 fn equal_balls_are_the_hull_of_their_centres_grown_by_the_radius() {
     let mut rng = Rng::new(3);
     for (count, r) in [(8, 0.3), (4, 0.5), (12, 0.1)] {
         let centres: Vec<[f64; 3]> = (0..count).map(|_| rng.point(1.0)).collect();
-        let balls: Vec<Ball> = centres
-            .iter()
-            .map(|c| Ball {
-                c: DVec3::from(*c),
-                r,
-            })
-            .collect();
-        let points = Args::with_list(&[r], 0, &centres);
-        for _ in 0..300 {
-            let at = [0, 1, 2].map(|_| rng.range(-2.0, 2.0));
-            let ours = of_balls(&balls, at);
-            let theirs = run(&super::super::hull::PRIMS[0], &points, at);
-            assert!(
-                (ours - theirs).abs() < 1e-9,
-                "{at:?}: {ours} against {theirs}"
-            );
-        }
+        agree_with_the_grown_hull(&mut rng, &centres, r, (-2.0, 2.0));
     }
     // Four balls in a plane: a rounded plate, its sides cylinders and its faces planes.
     let corners = [
@@ -115,23 +140,7 @@ fn equal_balls_are_the_hull_of_their_centres_grown_by_the_radius() {
         [2.0, 0.0, 1.0],
         [0.0, 0.0, 1.0],
     ];
-    let balls: Vec<Ball> = corners
-        .iter()
-        .map(|c| Ball {
-            c: DVec3::from(*c),
-            r: 0.25,
-        })
-        .collect();
-    let points = Args::with_list(&[0.25], 0, &corners);
-    for _ in 0..300 {
-        let at = [0, 1, 2].map(|_| rng.range(-1.0, 3.0));
-        let ours = of_balls(&balls, at);
-        let theirs = run(&super::super::hull::PRIMS[0], &points, at);
-        assert!(
-            (ours - theirs).abs() < 1e-9,
-            "{at:?}: {ours} against {theirs}"
-        );
-    }
+    agree_with_the_grown_hull(&mut rng, &corners, 0.25, (-1.0, 3.0));
 }
 
 #[test]
@@ -141,26 +150,9 @@ fn two_balls_are_the_round_cone_between_them() {
         .find(|p| p.name == "round_cone")
         .expect("round_cone");
     let (a, b, ra, rb) = ([0.3, -0.2, 0.1], [1.5, 0.9, -0.4], 0.6, 0.2);
-    let balls = [
-        Ball {
-            c: DVec3::from(a),
-            r: ra,
-        },
-        Ball {
-            c: DVec3::from(b),
-            r: rb,
-        },
-    ];
+    let balls = [ball(a, ra), ball(b, rb)];
     let args = Args(vec![a, b, [ra, 0.0, 0.0], [rb, 0.0, 0.0]]);
-    let mut rng = Rng::new(9);
-    for _ in 0..1000 {
-        let at = [0, 1, 2].map(|_| rng.range(-2.0, 3.0));
-        let (ours, theirs) = (of_balls(&balls, at), run(cone, &args, at));
-        assert!(
-            (ours - theirs).abs() < 1e-9,
-            "{at:?}: {ours} against {theirs}"
-        );
-    }
+    agree(&mut Rng::new(9), &balls, (cone, &args), 1000, (-2.0, 3.0));
 }
 
 #[test]

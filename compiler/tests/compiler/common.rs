@@ -13,6 +13,14 @@ pub fn span() -> Span {
     Span::new(FileId(0), 0..0)
 }
 
+/// Fails, showing `text`, unless it contains every one of `needles`.
+#[track_caller]
+pub fn assert_has(text: &str, needles: &[&str]) {
+    for needle in needles {
+        assert!(text.contains(needle), "no `{needle}` in:\n{text}");
+    }
+}
+
 /// A scene under construction.
 #[derive(Debug, Default)]
 pub struct Build {

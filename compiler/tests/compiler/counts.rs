@@ -9,7 +9,7 @@ use crate::scan::{located_tokens, root, tokens, workspace_rust_files, Tok};
 use std::path::PathBuf;
 
 /// The most `Result<_, String>` types the workspace may write (comments and strings aside).
-const STRING_ERRORS: usize = 14;
+const STRING_ERRORS: usize = 8;
 
 /// How many `Result<…, String>` types the tokens hold: a `Result` whose last top-level
 /// argument is the identifier `String` alone.
@@ -170,24 +170,30 @@ fn the_scanner_measures_functions() {
 }
 
 /// issue 48, step 5: no Rust file is over [`FILE_LINES`] lines.
+/// Fails, saying `what` and naming them longest first, unless there are no `long` places.
+#[track_caller]
+fn assert_none(mut long: Vec<(usize, String)>, what: &str) {
+    long.sort_by(|a, b| b.cmp(a));
+    assert!(long.is_empty(), "{what}. They are: {long:?}");
+}
+
 #[test]
 fn no_file_is_long() {
-    let mut long: Vec<(usize, String)> = workspace_sources()
+    let long: Vec<(usize, String)> = workspace_sources()
         .into_iter()
         .map(|(path, text)| (text.lines().count(), path))
         .filter(|(n, _)| *n > FILE_LINES)
         .collect();
-    long.sort_by(|a, b| b.cmp(a));
-    assert!(
-        long.is_empty(),
-        "Rust files over {FILE_LINES} lines: split them by responsibility. They are: {long:?}"
+    assert_none(
+        long,
+        &format!("Rust files over {FILE_LINES} lines: split them by responsibility"),
     );
 }
 
 /// issue 48, step 5: no function is over [`FUNCTION_LINES`] lines.
 #[test]
 fn no_function_is_long() {
-    let mut long: Vec<(usize, String)> = workspace_sources()
+    let long: Vec<(usize, String)> = workspace_sources()
         .into_iter()
         .flat_map(|(path, text)| {
             functions(&located_tokens(&text))
@@ -196,10 +202,9 @@ fn no_function_is_long() {
                 .map(move |(name, line, n)| (n, format!("{path}:{line} {name}")))
         })
         .collect();
-    long.sort_by(|a, b| b.cmp(a));
-    assert!(
-        long.is_empty(),
-        "functions over {FUNCTION_LINES} lines: split them into steps. They are: {long:?}"
+    assert_none(
+        long,
+        &format!("functions over {FUNCTION_LINES} lines: split them into steps"),
     );
 }
 

@@ -679,7 +679,7 @@ fn dump_is_stable_and_one_instruction_per_line() {
         .iter()
         .enumerate()
         .all(|(i, l)| l.starts_with(&format!("%{i} = "))));
-    assert!(d.contains("; node ") && d.contains("smooth_union"), "{d}");
+    assert_has(&d, &["; node ", "smooth_union"]);
     assert!(d
         .lines()
         .last()

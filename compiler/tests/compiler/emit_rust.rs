@@ -42,14 +42,8 @@ fn scene() -> Scene {
 fn text_has_both_functions_with_one_statement_per_instruction() {
     let program = lower(&scene());
     let text = rust::write(&program);
-    assert!(
-        text.contains("pub fn map(p: glam::Vec3) -> (f32, u32) {"),
-        "{text}"
-    );
-    assert!(
-        text.contains("pub fn map_f64(p: glam::DVec3) -> (f64, u32) {"),
-        "{text}"
-    );
+    assert_has(&text, &["pub fn map(p: glam::Vec3) -> (f32, u32) {"]);
+    assert_has(&text, &["pub fn map_f64(p: glam::DVec3) -> (f64, u32) {"]);
     assert_eq!(text.matches("    let r").count(), 2 * program.len());
     assert!(text.contains(": f32 = p.x;") && text.contains(": f64 = p.z;"));
     assert_eq!(rust::write(&program), text, "output must be stable");

@@ -280,19 +280,19 @@ fn no_gpu(e: &crate::gpu::wgpu::Error) -> String {
 }
 
 /// Writes the session's image (the background grey when there is none yet).
-fn write_image(session: &Session, path: &Path) -> Result<(), String> {
+fn write_image(session: &Session, path: &Path) -> Result<(), PngError> {
     let (w, h) = session.size();
     let bytes = match session.image() {
         Some(image) => {
             if (image.width, image.height) != (w, h) {
                 // Only a frame rendered while moving is smaller, and headless nothing moves.
-                return Err("the image on show is not at the view's size".into());
+                return Err(PngError::Size);
             }
             image.to_rgba8()
         }
         None => [5, 5, 5, 255].repeat(w as usize * h as usize),
     };
-    write_rgba_png(path, w, h, &bytes).map_err(|e| e.to_string())?;
+    write_rgba_png(path, w, h, &bytes)?;
     eprintln!("view: wrote {}", path.display());
     Ok(())
 }
@@ -312,6 +312,9 @@ pub enum PngError {
         path: PathBuf,
         error: std::io::Error,
     },
+    /// The image on show is smaller than the view (a frame rendered while moving).
+    #[error("the image on show is not at the view's size")]
+    Size,
 }
 
 /// Writes RGBA8 sRGB pixels as a PNG file, atomically.

@@ -17,6 +17,11 @@ use std::time::{Duration, Instant, SystemTime};
 /// another load when the contents differ from the ones loaded.
 pub const DEBOUNCE: Duration = Duration::from_millis(15);
 
+/// Why no files can be watched: the watcher could not be made.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot watch files: {0}")]
+pub struct WatchError(notify_debouncer_full::notify::Error);
+
 /// Watches directories and calls back with the paths of each debounced batch of events.
 pub struct Watch {
     debouncer: Debouncer<RecommendedWatcher, RecommendedCache>,
@@ -35,7 +40,7 @@ impl Watch {
     /// watcher reported an error (so that the files are looked at again).
     pub fn new(
         changed: impl Fn(Vec<PathBuf>, SystemTime) + Send + 'static,
-    ) -> Result<Watch, String> {
+    ) -> Result<Watch, WatchError> {
         let debouncer =
             new_debouncer(
                 DEBOUNCE,
@@ -54,7 +59,7 @@ impl Watch {
                     Err(_) => changed(Vec::new(), SystemTime::now()),
                 },
             )
-            .map_err(|e| format!("cannot watch files: {e}"))?;
+            .map_err(WatchError)?;
         Ok(Watch {
             debouncer,
             dirs: BTreeSet::new(),

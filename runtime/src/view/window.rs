@@ -7,7 +7,7 @@
 
 use super::compile::Waker;
 use super::panel::Panel;
-use super::present::{wgpu_presenter, Overlay, Presenter, SoftPresenter};
+use super::present::{self, wgpu_presenter, Overlay, Presenter, SoftPresenter};
 use super::session::{Device, Outcome, Session};
 use super::watch::Watch;
 use super::{widgets, Run};
@@ -102,8 +102,22 @@ struct State {
     changes: VecDeque<(String, String)>,
 }
 
+/// Why the window did not start.
+#[derive(Debug, thiserror::Error)]
+enum StartError {
+    /// No window could be opened.
+    #[error("cannot open a window: {0}")]
+    Window(winit::error::OsError),
+    /// `--backend wgpu`, and wgpu cannot present to the window.
+    #[error("{0}: install a Vulkan driver (on Linux without a GPU, Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`), or use --backend cpu")]
+    Wgpu(present::Error),
+    /// Neither wgpu nor softbuffer can draw in the window.
+    #[error(transparent)]
+    Soft(present::Error),
+}
+
 impl App {
-    fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<State, String> {
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<State, StartError> {
         let (w, h) = Session::initial_size(&self.run.file, &self.run.options);
         let attributes = Window::default_attributes()
             .with_title(format!("sdfc view: {}", self.run.file.display()))
@@ -111,7 +125,7 @@ impl App {
         let window = Arc::new(
             event_loop
                 .create_window(attributes)
-                .map_err(|e| format!("cannot open a window: {e}"))?,
+                .map_err(StartError::Window)?,
         );
         let (device, presenter) = match wgpu_presenter(event_loop, &window) {
             Ok((gpu, presenter)) => {
@@ -130,14 +144,12 @@ impl App {
                 );
                 (device, Presenter::Gpu(Box::new(presenter)))
             }
-            Err(msg) if self.run.options.job.backend == Backend::Wgpu => {
-                return Err(format!(
-                    "{msg}: install a Vulkan driver (on Linux without a GPU, Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`), or use --backend cpu"
-                ));
+            Err(e) if self.run.options.job.backend == Backend::Wgpu => {
+                return Err(StartError::Wgpu(e));
             }
             Err(msg) => {
                 let presenter =
-                    SoftPresenter::new(event_loop, &window).map_err(|e| e.to_string())?;
+                    SoftPresenter::new(event_loop, &window).map_err(StartError::Soft)?;
                 eprintln!(
                     "view: {msg}; rendering on the CPU ({}) and presenting with softbuffer",
                     Device::Cpu.describe()

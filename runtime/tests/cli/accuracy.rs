@@ -2,7 +2,9 @@
 //! buffers of CPU renders and their sidecar, the reference render, the sweep parser and the
 //! Pareto front of `sdfc pareto`, and its charts (valid SVG and PNG).
 
+use crate::cli::{put, TestDir};
 use crate::common;
+use crate::common::assert_has;
 use crate::common::words;
 
 use common::*;
@@ -14,7 +16,7 @@ use sdfc_runtime::fp32;
 use sdfc_runtime::image::Image;
 use sdfc_runtime::metrics::{compare, compare_depth};
 use sdfc_runtime::pareto::{self, front, parse_sweep, Key};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn image(pixels: &[[f32; 3]]) -> Image {
@@ -321,10 +323,7 @@ fn charts_are_valid_svg_and_png() {
         p.accuracy = d;
     }
     let svg = chart::svg(&mesh).expect("draws");
-    assert!(
-        svg.contains("largest distance") && svg.contains("0.001"),
-        "{svg}"
-    );
+    assert_has(&svg, &["largest distance", "0.001"]);
     chart::png(&mesh).expect("draws");
 }
 
@@ -405,11 +404,10 @@ scene {
 }
 ";
 
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sdfc-accuracy-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    std::fs::write(d.join("ball.sdf"), SCENE).expect("write scene");
+fn dir(name: &str) -> TestDir {
+    let path = std::env::temp_dir().join(format!("sdfc-accuracy-{name}-{}", std::process::id()));
+    let d = TestDir::fresh(path);
+    put(&d, "ball.sdf", SCENE);
     d
 }
 
@@ -426,10 +424,7 @@ fn reference_renders_with_sidecars_compare_by_depth() {
         &words("render ball.sdf --reference --aux --stats -o ref.png"),
     );
     let stats = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        stats.contains("against ε 1e-7") && stats.contains("converged"),
-        "{stats}"
-    );
+    assert_has(&stats, &["against ε 1e-7", "converged"]);
     assert!(d.join("ref.aux").exists());
     let reference = Depth::read(&d.join("ref.aux")).expect("a sidecar");
     assert_eq!((reference.width, reference.height), (24, 16));
@@ -469,7 +464,6 @@ fn reference_renders_with_sidecars_compare_by_depth() {
     let out = sdfc(&d, &["compare", "ref.png", "plain.png", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert!(v["depth"].is_null() && v["depth_note"].is_string(), "{v}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -482,7 +476,6 @@ fn reference_needs_the_cpu() {
         .expect("run sdfc");
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--reference renders on the CPU"));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -536,7 +529,6 @@ fn pareto_measures_points_and_draws_charts() {
         .output()
         .expect("run sdfc");
     assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// `sdfc pareto --mesh`: a part meshed at three resolutions, each with its time, triangles
@@ -545,11 +537,11 @@ fn pareto_measures_points_and_draws_charts() {
 #[test]
 fn pareto_mesh_measures_meshing_speed_against_accuracy() {
     let d = dir("pareto-mesh");
-    std::fs::write(
-        d.join("part.sdf"),
+    put(
+        &d,
+        "part.sdf",
         "scene { union(box((1, 0.5, 0.7)), sphere(0.6).translate(0.9, 0.4, 0)); }",
-    )
-    .expect("write the part");
+    );
     let out = sdfc(
         &d,
         &words("pareto part.sdf --mesh --sweep resolution=8..32 --frames 1 --json -o mesh.svg"),
@@ -593,7 +585,6 @@ fn pareto_mesh_measures_meshing_speed_against_accuracy() {
         &["pareto", "ball.sdf", "--sweep", "resolution=8"],
         "sdfc pareto --mesh",
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// The scene of a file of `examples/`, checked.
@@ -661,10 +652,7 @@ fn the_area_averaged_reference_of_a_fractal_converges() {
         text.contains("aa 8,"),
         "the reference averages 8×8 samples: {text}"
     );
-    assert!(
-        text.contains("against ε") && text.contains("aa 16"),
-        "{text}"
-    );
-    assert!(text.contains("converged       yes"), "{text}");
+    assert_has(&text, &["against ε", "aa 16"]);
+    assert_has(&text, &["converged       yes"]);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,13 +1,14 @@
 //! `sdfc check`: diagnostics as text and JSON, imports, the intersection method it reports,
 //! `--verify-bounds`, and scenes built to exhaust the checker and the lowering within their limits.
 
-use crate::cli::{dir, entries, exits, ok, scene_file, sdfc, SCENE};
+use crate::cli::{dir, entries, exits, ok, put, scene_dir, sdfc, SCENE};
+use crate::common::assert_has;
 use crate::common::words;
 
 #[test]
 fn json_diagnostics_and_io_errors_go_to_stdout() {
     let d = dir("json");
-    std::fs::write(d.join("bad.sdf"), "scene { sphre(1); }\n").expect("write");
+    put(&d, "bad.sdf", "scene { sphre(1); }\n");
     let out = sdfc(
         &d,
         &["check", "--diagnostics", "json", "bad.sdf", "nope.sdf"],
@@ -41,7 +42,6 @@ fn json_diagnostics_and_io_errors_go_to_stdout() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A library imported by its path and through a symbolic link to it is read once (no
@@ -51,17 +51,12 @@ fn json_diagnostics_and_io_errors_go_to_stdout() {
 fn a_library_imported_through_a_symbolic_link_is_read_once() {
     let d = dir("symlink");
     std::fs::create_dir(d.join("lib")).expect("dir");
-    std::fs::write(d.join("lib/shapes.sdf"), "let r = 1;\n").expect("write");
+    put(&d, "lib/shapes.sdf", "let r = 1;\n");
     std::os::unix::fs::symlink("lib/shapes.sdf", d.join("alias.sdf")).expect("link");
     std::os::unix::fs::symlink("lib", d.join("linked")).expect("link");
-    std::fs::write(
-        d.join("main.sdf"),
-        "import \"lib/shapes.sdf\";\nimport \"alias.sdf\";\nimport \"linked/shapes.sdf\";\nscene { sphere(r); }\n",
-    )
-    .expect("write");
+    put(&d, "main.sdf", "import \"lib/shapes.sdf\";\nimport \"alias.sdf\";\nimport \"linked/shapes.sdf\";\nscene { sphere(r); }\n");
     let err = exits(&d, &["check", "main.sdf"], 0);
     assert!(!err.contains("E0207"), "{err}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A one-line file with 20 000 duplicate definitions: the human form shows the first 100
@@ -71,7 +66,7 @@ fn a_library_imported_through_a_symbolic_link_is_read_once() {
 fn twenty_thousand_errors_on_one_line_are_capped() {
     let d = dir("many");
     let text = format!("{}scene {{ sphere(a); }}", "let a = 1; ".repeat(20_000));
-    std::fs::write(d.join("many.sdf"), text).expect("write");
+    put(&d, "many.sdf", text);
     let out = sdfc(&d, &["check", "many.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1));
@@ -82,60 +77,51 @@ fn twenty_thousand_errors_on_one_line_are_capped() {
         "{}",
         &err[err.len().saturating_sub(400)..]
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
 fn an_unreadable_import_is_a_diagnostic() {
     let d = dir("import");
-    std::fs::write(d.join("lib.sdf"), b"let r = 1; // caf\xe9\n").expect("write");
-    std::fs::write(
-        d.join("main.sdf"),
+    put(&d, "lib.sdf", b"let r = 1; // caf\xe9\n");
+    put(
+        &d,
+        "main.sdf",
         "import \"lib.sdf\";\nscene { sphere(r); }\n",
-    )
-    .expect("write");
+    );
     let out = sdfc(&d, &["check", "main.sdf"]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("E0501") && err.contains("not valid UTF-8"),
-        "{err}"
-    );
+    assert_has(&err, &["E0501", "not valid UTF-8"]);
 }
 
 /// `sdfc check` says which intersection method a scene gets and why; `--set method=trace`
 /// on a scene that does not allow it is an error that writes nothing.
 #[test]
 fn the_method_setting_and_what_check_says_about_it() {
-    let d = dir("method");
-    scene_file(&d);
+    let d = scene_dir("method");
     let out = sdfc(&d, &["check", "ball.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("method: march (light 1 casts soft shadows"),
-        "{err}"
-    );
+    assert_has(&err, &["method: march (light 1 casts soft shadows"]);
     let err = exits(&d, &["render", "ball.sdf", "--set", "method=trace"], 1);
-    assert!(err.contains("cannot be ray traced analytically"), "{err}");
+    assert_has(&err, &["cannot be ray traced analytically"]);
     let out = sdfc(&d, &["render", "ball.sdf", "--set", "method=fast"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("method must be one of"));
     assert_eq!(entries(&d), ["ball.sdf"]);
-    std::fs::write(
-        d.join("hard.sdf"),
+    put(
+        &d,
+        "hard.sdf",
         SCENE.replace("penumbra: 7.125deg", "penumbra: 0deg"),
-    )
-    .expect("write");
+    );
     let out = sdfc(&d, &["check", "hard.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("method: trace (2 primitives"), "{err}");
+    assert_has(&err, &["method: trace (2 primitives"]);
     let out = sdfc(
         &d,
         &["render", "hard.sdf", "--set", "method=trace", "--stats"],
     );
     assert_eq!(out.status.code(), Some(0));
     assert!(d.join("hard.png").exists());
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// The 42-line file of issue 16, item 1: forty functions, each using the one below twice,
@@ -157,7 +143,7 @@ fn exponential(levels: usize) -> String {
 #[test]
 fn exponential_expansion_is_a_located_limit_error_in_well_under_a_second() {
     let d = dir("expansion");
-    std::fs::write(d.join("exp.sdf"), exponential(40)).expect("write");
+    put(&d, "exp.sdf", exponential(40));
     assert_eq!(exponential(40).lines().count(), 42);
     let start = std::time::Instant::now();
     let out = sdfc(&d, &["check", "exp.sdf"]);
@@ -165,13 +151,10 @@ fn exponential_expansion_is_a_located_limit_error_in_well_under_a_second() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     // At the union of f20, the first level whose tree (2²² − 3 nodes) is over 4 000 000.
-    assert!(
-        err.contains("E0507") && err.contains("exp.sdf:21:") && err.contains("--limit expansion="),
-        "{err}"
-    );
+    assert_has(&err, &["E0507", "exp.sdf:21:", "--limit expansion="]);
     assert!(took.as_secs_f64() < 1.0, "took {took:?}");
     // Raised, the same limit lets a smaller tree through; lowered, it stops a small one.
-    std::fs::write(d.join("small.sdf"), exponential(8)).expect("write");
+    put(&d, "small.sdf", exponential(8));
     ok(&d, &["check", "small.sdf"]);
     let low = sdfc(&d, &["check", "small.sdf", "--limit", "expansion=100"]);
     assert_eq!(low.status.code(), Some(1));
@@ -193,17 +176,15 @@ fn the_program_limit_stops_lowering_at_the_limit() {
     }
     text.push_str("scene { f14(); }\n");
     let d = dir("program-limit");
-    std::fs::write(d.join("big.sdf"), text).expect("write");
+    put(&d, "big.sdf", text);
     let err = exits(
         &d,
         &words("compile big.sdf --emit program --limit program=1000 -o p.txt"),
         1,
     );
-    assert!(
-        err.contains("E0507")
-            && err.contains("more than 1000 operations")
-            && err.contains("--limit program=2000"),
-        "{err}"
+    assert_has(
+        &err,
+        &["E0507", "more than 1000 operations", "--limit program=2000"],
     );
     assert!(!d.join("p.txt").exists());
     ok(
@@ -217,38 +198,34 @@ fn the_program_limit_stops_lowering_at_the_limit() {
 #[test]
 fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
     let d = dir("verify-bounds");
-    std::fs::write(
-        d.join("steep.sdf"),
+    put(
+        &d,
+        "steep.sdf",
         "scene {\n  field(lipschitz: 1) { 3 * (length(p) - 1) };\n}\n",
-    )
-    .expect("write");
-    std::fs::write(
-        d.join("fine.sdf"),
-        "scene {\n  field { 2 * (length(p) - 1) };\n  field(lipschitz: 3) { 3 * (length(p) - 1) }.translate(3, 0, 0);\n}\n",
-    )
-    .expect("write");
+    );
+    put(&d, "fine.sdf", "scene {\n  field { 2 * (length(p) - 1) };\n  field(lipschitz: 3) { 3 * (length(p) - 1) }.translate(3, 0, 0);\n}\n");
     let err = exits(&d, &["check", "--verify-bounds", "steep.sdf"], 1);
-    assert!(
-        err.contains("steep.sdf:2:3: this field has a slope of") && err.contains("above its L = 1"),
-        "{err}"
+    assert_has(
+        &err,
+        &[
+            "steep.sdf:2:3: this field has a slope of",
+            "above its L = 1",
+        ],
     );
     let err = exits(&d, &["check", "--verify-bounds", "fine.sdf"], 0);
-    assert!(
-        err.contains("bounds sampled, not proven: 2 field(s), none steeper than its L"),
-        "{err}"
+    assert_has(
+        &err,
+        &["bounds sampled, not proven: 2 field(s), none steeper than its L"],
     );
     assert!(!err.contains("verified"), "{err}");
     // A profile is named as one.
-    std::fs::write(
-        d.join("flat.sdf"),
+    put(
+        &d,
+        "flat.sdf",
         "scene {\n  revolve(profile(lipschitz: 0.1) { length(p) - 0.5 });\n}\n",
-    )
-    .expect("write");
-    let err = exits(&d, &["check", "--verify-bounds", "flat.sdf"], 1);
-    assert!(
-        err.contains("flat.sdf:2:11: this profile has a slope of"),
-        "{err}"
     );
+    let err = exits(&d, &["check", "--verify-bounds", "flat.sdf"], 1);
+    assert_has(&err, &["flat.sdf:2:11: this profile has a slope of"]);
 }
 
 /// `--verify-bounds` samples the whole of the scene's bounded region, in each field's own
@@ -258,15 +235,11 @@ fn check_verify_bounds_reports_a_field_steeper_than_its_bound() {
 #[test]
 fn check_verify_bounds_samples_the_scene_and_says_where() {
     let d = dir("verify-bounds-far");
-    std::fs::write(
-        d.join("far.sdf"),
-        "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nscene {\n  intersect(field(lipschitz: 1) { length(p) - 1 + 0.5 * max(p.x - 6, 0) }, box(9));\n}\n",
-    )
-    .expect("write");
+    put(&d, "far.sdf", "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nscene {\n  intersect(field(lipschitz: 1) { length(p) - 1 + 0.5 * max(p.x - 6, 0) }, box(9));\n}\n");
     let err = exits(&d, &["check", "--verify-bounds", "far.sdf"], 1);
-    assert!(
-        err.contains("far.sdf:3:13: this field has a slope of") && err.contains("above its L = 1"),
-        "{err}"
+    assert_has(
+        &err,
+        &["far.sdf:3:13: this field has a slope of", "above its L = 1"],
     );
     assert!(
         err.contains(
@@ -276,25 +249,14 @@ fn check_verify_bounds_samples_the_scene_and_says_where() {
     );
     assert!(!err.contains("verified"), "{err}");
     // A scene unbounded along every axis: sampled within max_dist of the camera, and said so.
-    std::fs::write(
-        d.join("open.sdf"),
-        "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nrender { max_dist: 50 }\nscene {\n  field { length(p) - 1 };\n  field { p.x * p.y };\n}\n",
-    )
-    .expect("write");
+    put(&d, "open.sdf", "camera { position: (0, 0, -5), look_at: (0, 0, 0) }\nrender { max_dist: 50 }\nscene {\n  field { length(p) - 1 };\n  field { p.x * p.y };\n}\n");
     let err = exits(&d, &["check", "--verify-bounds", "open.sdf"], 0);
-    assert!(
-        err.contains("open.sdf:4:3: this field: no slope above its L = 1 in 20000 pairs of points over the scene's box [(-50, -50, -55), (50, 50, 45)]"),
-        "{err}"
+    assert_has(&err, &["open.sdf:4:3: this field: no slope above its L = 1 in 20000 pairs of points over the scene's box [(-50, -50, -55), (50, 50, 45)]"]);
+    assert_has(
+        &err,
+        &["open.sdf:5:3: this field has no declared or proven L: nothing to sample"],
     );
-    assert!(
-        err.contains("open.sdf:5:3: this field has no declared or proven L: nothing to sample"),
-        "{err}"
-    );
-    assert!(
-        err.contains("the scene is unbounded along x, y, z, sampled within max_dist = 50 of the camera there, and not beyond"),
-        "{err}"
-    );
-    let _ = std::fs::remove_dir_all(&d);
+    assert_has(&err, &["the scene is unbounded along x, y, z, sampled within max_dist = 50 of the camera there, and not beyond"]);
 }
 
 /// 10 000 nested `union(…)` with the `nesting` limit raised, as the error suggests, check
@@ -308,10 +270,9 @@ fn ten_thousand_nested_unions_check_with_the_limit_raised() {
         "union(sphere(1), ".repeat(n),
         ")".repeat(n)
     );
-    std::fs::write(d.join("deep.sdf"), text).expect("write");
+    put(&d, "deep.sdf", text);
     let err = exits(&d, &["check", "deep.sdf"], 1);
-    assert!(err.contains("`--limit nesting=2000`"), "{err}");
+    assert_has(&err, &["`--limit nesting=2000`"]);
     let err = exits(&d, &["check", "deep.sdf", "--limit", "nesting=20000"], 0);
-    assert!(err.contains("deep.sdf: ok"), "{err}");
-    let _ = std::fs::remove_dir_all(&d);
+    assert_has(&err, &["deep.sdf: ok"]);
 }

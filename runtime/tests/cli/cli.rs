@@ -2,6 +2,7 @@
 //! problems), settings refused, limits set and named, help and completions, a closed standard
 //! output; and the helpers of the binary's modules (a test's folder, `sdfc` run in it, a scene).
 
+use crate::common::assert_has;
 use crate::common::words;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -16,12 +17,48 @@ scene {
 }
 ";
 
+/// A test's directory, removed when the test ends well (kept to look at when it fails).
+pub(crate) struct TestDir(PathBuf);
+
+impl TestDir {
+    /// The directory `path`, made fresh.
+    pub(crate) fn fresh(path: PathBuf) -> TestDir {
+        let _ = std::fs::remove_dir_all(&path);
+        std::fs::create_dir_all(&path).expect("temp dir");
+        TestDir(path)
+    }
+}
+
+impl std::ops::Deref for TestDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for TestDir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for TestDir {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+impl Drop for TestDir {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
 /// A fresh directory for one test.
-pub(crate) fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sdfc-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
+pub(crate) fn dir(name: &str) -> TestDir {
+    TestDir::fresh(std::env::temp_dir().join(format!("sdfc-cli-{name}-{}", std::process::id())))
 }
 
 pub(crate) fn sdfc(cwd: &Path, args: &[&str]) -> Output {
@@ -53,6 +90,19 @@ pub(crate) fn ok(cwd: &Path, args: &[&str]) -> Output {
     out
 }
 
+/// A fresh directory for one test, holding the scene `ball.sdf` (`SCENE`).
+pub(crate) fn scene_dir(name: &str) -> TestDir {
+    let d = dir(name);
+    scene_file(&d);
+    d
+}
+
+/// Writes `text` to the file `name` of the directory `d`.
+#[track_caller]
+pub(crate) fn put(d: &Path, name: &str, text: impl AsRef<[u8]>) {
+    std::fs::write(d.join(name), text).unwrap_or_else(|e| panic!("write {name}: {e}"));
+}
+
 pub(crate) fn scene_file(d: &Path) -> PathBuf {
     let p = d.join("ball.sdf");
     std::fs::write(&p, SCENE).expect("write scene");
@@ -78,8 +128,7 @@ pub(crate) fn png_size(p: &Path) -> (u32, u32) {
 
 #[test]
 fn bad_settings_are_usage_errors() {
-    let d = dir("bad-set");
-    scene_file(&d);
+    let d = scene_dir("bad-set");
     for (args, needle) in [
         (vec!["--set", "colour=1"], "unknown render setting `colour`"),
         (vec!["--set", "max_steps=-3"], "max_steps must be"),
@@ -97,30 +146,24 @@ fn bad_settings_are_usage_errors() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
     assert_eq!(entries(&d), ["ball.sdf"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
 fn scene_errors_exit_1_and_io_errors_exit_2() {
     let d = dir("errors");
-    std::fs::write(d.join("broken.sdf"), "scene { sphere(; }").expect("write");
+    put(&d, "broken.sdf", "scene { sphere(; }");
     assert_eq!(sdfc(&d, &["render", "broken.sdf"]).status.code(), Some(1));
     assert_eq!(sdfc(&d, &["render", "missing.sdf"]).status.code(), Some(2));
     scene_file(&d);
     exits(&d, &["render", "ball.sdf", "-o", "no/such/dir/x.png"], 2);
     assert_eq!(entries(&d), ["ball.sdf", "broken.sdf"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
 fn limits_are_set_by_name_and_named_when_exceeded() {
-    let d = dir("limits");
-    scene_file(&d);
+    let d = scene_dir("limits");
     let err = exits(&d, &["render", "ball.sdf", "--limit", "speed=3"], 2);
-    assert!(
-        err.contains("unknown limit `speed`") && err.contains("fuel"),
-        "{err}"
-    );
+    assert_has(&err, &["unknown limit `speed`", "fuel"]);
     for bad in ["aa=0", "aa=x", "aa"] {
         let out = sdfc(&d, &["check", "ball.sdf", "--limit", bad]);
         assert_eq!(out.status.code(), Some(2), "{bad}");
@@ -128,17 +171,14 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
     // A loop over the objects limit: E0507 naming the flag with the value that would do
     // (the loop's count, not twice the limit), and the flag raises it.
     let many = "scene { for i in 0..50 { sphere(0.1).translate(i, 0, 0); } }\n";
-    std::fs::write(d.join("many.sdf"), many).expect("write");
+    put(&d, "many.sdf", many);
     let err = exits(&d, &["check", "many.sdf", "--limit", "objects=20"], 1);
-    assert!(
-        err.contains("E0507") && err.contains("--limit objects=50"),
-        "{err}"
-    );
+    assert_has(&err, &["E0507", "--limit objects=50"]);
     let out = sdfc(&d, &["check", "many.sdf", "--limit", "objects=50"]);
     assert!(out.status.success());
     // The render settings' limits: in the scene (E0400) and on the command line (exit 2).
     let err = exits(&d, &["render", "ball.sdf", "--aa", "20"], 2);
-    assert!(err.contains("--limit aa=20"), "{err}");
+    assert_has(&err, &["--limit aa=20"]);
     for (set, flag) in [
         ("max_steps=2000000", "--limit max_steps=2000000"),
         ("max_depth=100", "--limit max_depth=100"),
@@ -157,7 +197,7 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         ("samples: 0", "samples"),
     ] {
         let text = format!("render {{ method: \"path\", {setting} }}\nscene {{ sphere(); }}\n");
-        std::fs::write(d.join("path.sdf"), text).expect("write");
+        put(&d, "path.sdf", text);
         let out = sdfc(&d, &["check", "path.sdf"]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{setting}: {err}");
@@ -181,22 +221,19 @@ fn limits_are_set_by_name_and_named_when_exceeded() {
         let out = sdfc(&d, args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-        assert!(
-            err.contains("E0507")
-                && err.contains("distance program has")
-                && err.contains("--limit program="),
-            "{err}"
-        );
+        assert_has(&err, &["E0507", "distance program has", "--limit program="]);
     }
     // `check` passes the scene and warns, located, that a render will refuse it (issue 37).
     let err = exits(&d, &["check", "many.sdf", "--limit", "program=100"], 0);
-    assert!(
-        err.contains("[E0507] Warning")
-            && err.contains("will refuse this scene")
-            && err.contains("many.sdf:1:1")
-            && err.contains("--limit program=")
-            && err.contains("many.sdf: ok"),
-        "{err}"
+    assert_has(
+        &err,
+        &[
+            "[E0507] Warning",
+            "will refuse this scene",
+            "many.sdf:1:1",
+            "--limit program=",
+            "many.sdf: ok",
+        ],
     );
     let out = sdfc(&d, &["check", "many.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
@@ -337,7 +374,6 @@ fn help_and_completions() {
         "{top_lines:?}"
     );
     assert!(help(&["mesh", "--help"]).contains("importers load as separate parts"));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A standard output closed before the command is done (`sdfc completions bash | head -1`)
@@ -383,5 +419,4 @@ fn a_closed_standard_output_ends_a_command_quietly() {
             out.status
         );
     }
-    let _ = std::fs::remove_dir_all(&d);
 }

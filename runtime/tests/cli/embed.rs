@@ -7,6 +7,7 @@
 //! render`'s image byte for byte; `--emit scene-data|params` the bytes the renderer binds; and the
 //! Shadertoy page compiled as Shadertoy wraps it and rendered through WebGL.
 
+use crate::common::assert_has;
 use crate::common::run_ok;
 use sdfc_compiler::{
     shader::{self, Lang},
@@ -161,12 +162,12 @@ fn the_part_carries_the_glow_of_the_marching_steps() {
     }
     // glow: 0.05, glow_color: (0.006, 0.015, 0.04) (examples/glow_blob.sdf).
     let wgsl = part("glow_blob.sdf", "wgsl", "blob");
-    assert!(
-        wgsl.contains("return vec3<f32>(0.006, 0.015, 0.04) * exp(-abs(d) * 20.0);"),
-        "{wgsl}"
+    assert_has(
+        &wgsl,
+        &["return vec3<f32>(0.006, 0.015, 0.04) * exp(-abs(d) * 20.0);"],
     );
     let rust = part("glow_blob.sdf", "rust", "blob");
-    assert!(rust.contains("let w = (-d.abs() * 20.0).exp();"), "{rust}");
+    assert_has(&rust, &["let w = (-d.abs() * 20.0).exp();"]);
 }
 
 /// The part's function is the renderer kernel's `map`, word for word (the kernel's is
@@ -602,10 +603,7 @@ fn the_shadertoy_page_says_what_it_leaves_out() {
     }
     assert!(said(&example("seed3.sdf")).contains("leaves out this scene's reflection"));
     let path = said(&example("studio_path.sdf"));
-    assert!(
-        path.contains("path tracing (rendered by the Whitted model)"),
-        "{path}"
-    );
+    assert_has(&path, &["path tracing (rendered by the Whitted model)"]);
     let plain = said(&example("blends.sdf"));
     assert!(!plain.contains("warning"), "{plain}");
 }

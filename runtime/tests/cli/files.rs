@@ -2,7 +2,8 @@
 //! `file_size` limit, outputs that cannot be written (a missing folder, a read-only file, a full
 //! device), and a byte-order mark. Failure paths: docs/failures.md lists each with its test.
 
-use crate::cli::{dir, entries, exits, scene_file, sdfc};
+use crate::cli::{dir, entries, exits, put, scene_dir, scene_file, sdfc};
+use crate::common::assert_has;
 use crate::common::words;
 use std::path::Path;
 use std::process::Command;
@@ -21,7 +22,7 @@ fn missing_unreadable_and_non_utf8_inputs_exit_2() {
     }
     std::fs::create_dir(d.join("folder.sdf")).expect("dir");
     assert_eq!(sdfc(&d, &["check", "folder.sdf"]).status.code(), Some(2));
-    std::fs::write(d.join("latin1.sdf"), b"scene { sphere(); } // caf\xe9\n").expect("write");
+    put(&d, "latin1.sdf", b"scene { sphere(); } // caf\xe9\n");
     let out = sdfc(&d, &["render", "latin1.sdf"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("not valid UTF-8"));
@@ -30,9 +31,8 @@ fn missing_unreadable_and_non_utf8_inputs_exit_2() {
 
 #[test]
 fn a_missing_or_invalid_output_directory_leaves_nothing() {
-    let d = dir("outputs");
-    scene_file(&d);
-    std::fs::write(d.join("plain-file"), "x").expect("write");
+    let d = scene_dir("outputs");
+    put(&d, "plain-file", "x");
     for target in ["missing/out.png", "plain-file/out.png"] {
         let out = sdfc(&d, &["render", "ball.sdf", "-o", target]);
         assert_eq!(out.status.code(), Some(2), "{target}");
@@ -48,8 +48,7 @@ fn a_missing_or_invalid_output_directory_leaves_nothing() {
 
 #[test]
 fn an_unwritable_output_is_refused_before_the_render() {
-    let d = dir("early");
-    scene_file(&d);
+    let d = scene_dir("early");
     // A render that would take long: refused before it is lowered or announced.
     let out = sdfc(
         &d,
@@ -57,9 +56,9 @@ fn an_unwritable_output_is_refused_before_the_render() {
     );
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("cannot write `/nonexistent/x.png`") && err.contains("does not exist"),
-        "{err}"
+    assert_has(
+        &err,
+        &["cannot write `/nonexistent/x.png`", "does not exist"],
     );
     assert!(!err.contains("allocating"), "the render started: {err}");
     // `pareto` checks its chart's place before its sweeps.
@@ -71,7 +70,6 @@ fn an_unwritable_output_is_refused_before_the_render() {
     assert!(out.stdout.is_empty(), "the sweeps ran");
     assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
     assert_eq!(entries(&d), ["ball.sdf"]);
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A read-only output file is refused (exit 2, saying so) and left as it was, by `render`
@@ -79,8 +77,7 @@ fn an_unwritable_output_is_refused_before_the_render() {
 #[test]
 fn a_read_only_output_is_refused_and_left_unchanged() {
     use std::os::unix::fs::PermissionsExt;
-    let d = dir("read-only");
-    scene_file(&d);
+    let d = scene_dir("read-only");
     for (name, args) in [
         (
             "x.png",
@@ -104,7 +101,6 @@ fn a_read_only_output_is_refused_and_left_unchanged() {
         );
         assert_eq!(std::fs::read(&out).expect("kept"), b"keep me", "{name}");
     }
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Runs sdfc in `cwd` with standard input from `stdin` and standard output to `stdout` (files
@@ -154,7 +150,7 @@ fn special_files_are_refused_and_files_are_read_within_the_file_size_limit() {
     fifo("pipe.stl");
     std::fs::create_dir(d.join("tree")).expect("dir");
     fifo("tree/x.sdf");
-    std::fs::write(d.join("tree/ok.sdf"), "scene {\n  sphere(1);\n}\n").expect("write");
+    put(&d, "tree/ok.sdf", "scene {\n  sphere(1);\n}\n");
     for (args, what) in [
         (
             &["check", "pipe.sdf"][..],
@@ -183,12 +179,12 @@ fn special_files_are_refused_and_files_are_read_within_the_file_size_limit() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(what), "{args:?}: {err}");
     }
-    std::fs::write(
-        d.join("imports.sdf"),
+    put(
+        &d,
+        "imports.sdf",
         "import \"pipe.sdf\";\nscene {\n  sphere(1);\n}\n",
-    )
-    .expect("write");
-    std::fs::write(d.join("meshes.sdf"), "scene {\n  mesh(\"pipe.stl\");\n}\n").expect("write");
+    );
+    put(&d, "meshes.sdf", "scene {\n  mesh(\"pipe.stl\");\n}\n");
     for (file, code) in [("imports.sdf", "E0501"), ("meshes.sdf", "E0400")] {
         let out = sdfc(&d, &["check", file]);
         let err = String::from_utf8_lossy(&out.stderr);
@@ -200,15 +196,15 @@ fn special_files_are_refused_and_files_are_read_within_the_file_size_limit() {
     }
     // Over the limit: a file by its size, standard input by what was read (at most the limit
     // and a byte: /dev/zero ends there).
-    std::fs::write(
-        d.join("big.sdf"),
+    put(
+        &d,
+        "big.sdf",
         format!("// {}\nscene {{\n  sphere(1);\n}}\n", "x".repeat(3 << 20)),
-    )
-    .expect("write");
+    );
     let err = exits(&d, &["check", "--limit", "file_size=2", "big.sdf"], 2);
-    assert!(
-        err.contains("over the file_size limit of 2 MiB; raise it with `--limit file_size=4`"),
-        "{err}"
+    assert_has(
+        &err,
+        &["over the file_size limit of 2 MiB; raise it with `--limit file_size=4`"],
     );
     assert_eq!(
         sdfc(&d, &["check", "--limit", "file_size=4", "big.sdf"])
@@ -223,11 +219,10 @@ fn special_files_are_refused_and_files_are_read_within_the_file_size_limit() {
         Path::new("/dev/null"),
     );
     assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("standard input: it is over the file_size limit of 1 MiB"),
-        "{err}"
+    assert_has(
+        &err,
+        &["standard input: it is over the file_size limit of 1 MiB"],
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Output that cannot be written (`> /dev/full`) is an error, not a silent success:
@@ -242,7 +237,7 @@ fn output_that_cannot_be_written_is_an_error_and_fmt_keeps_permissions() {
     std::fs::write(&messy, "scene{sphere(1);}\n").expect("write");
     scene_file(&d);
     if Path::new("/dev/full").exists() {
-        std::fs::write(d.join("bad.sdf"), "scene { sphre(1); }\n").expect("write");
+        put(&d, "bad.sdf", "scene { sphre(1); }\n");
         for (args, input) in [
             (&["fmt"][..], &messy),
             (&["compile", "ball.sdf", "--emit", "wgsl"], &messy),
@@ -272,7 +267,6 @@ fn output_that_cannot_be_written_is_an_error_and_fmt_keeps_permissions() {
         .permissions()
         .mode();
     assert_eq!(mode & 0o777, 0o600, "{mode:o}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A UTF-8 byte-order mark at the start of a file (some editors write one) is skipped: the
@@ -281,13 +275,13 @@ fn output_that_cannot_be_written_is_an_error_and_fmt_keeps_permissions() {
 #[test]
 fn a_byte_order_mark_is_skipped() {
     let d = dir("bom");
-    std::fs::write(d.join("bom.sdf"), "\u{feff}scene {\n  sphre(1);\n}\n").expect("write");
-    std::fs::write(
-        d.join("ok.sdf"),
+    put(&d, "bom.sdf", "\u{feff}scene {\n  sphre(1);\n}\n");
+    put(
+        &d,
+        "ok.sdf",
         "\u{feff}import \"lib.sdf\";\nscene {\n  ball;\n}\n",
-    )
-    .expect("write");
-    std::fs::write(d.join("lib.sdf"), "\u{feff}let ball = sphere(1);\n").expect("write");
+    );
+    put(&d, "lib.sdf", "\u{feff}let ball = sphere(1);\n");
     let out = sdfc(&d, &["check", "--diagnostics", "json", "bom.sdf"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(!stdout.contains("E0001"), "{stdout}");
@@ -299,9 +293,8 @@ fn a_byte_order_mark_is_skipped() {
         std::fs::read_to_string(d.join("ok.sdf")).expect("read"),
         "import \"lib.sdf\";\nscene {\n  ball;\n}\n"
     );
-    std::fs::write(d.join("first.sdf"), "\u{feff}scene { sphre(1); }\n").expect("write");
+    put(&d, "first.sdf", "\u{feff}scene { sphre(1); }\n");
     let out = sdfc(&d, &["check", "first.sdf"]);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("first.sdf:1:9"), "{err}");
-    let _ = std::fs::remove_dir_all(&d);
+    assert_has(&err, &["first.sdf:1:9"]);
 }

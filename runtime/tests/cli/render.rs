@@ -2,14 +2,17 @@
 //! interrupt, the devices it renders on (no adapter or driver, a device error mid-render, the
 //! pipeline cache, a device opening beside the front end) and the breakdown of `--stats`.
 
-use crate::cli::{dir, entries, exits, ok, png_size, scene_file, sdfc, wgpu_available};
+use crate::cli::{
+    dir, entries, exits, ok, png_size, put, scene_dir, scene_file, sdfc, wgpu_available,
+};
+use crate::common::assert_has;
 use crate::common::words;
+use std::path::Path;
 use std::process::{Command, Output};
 
 #[test]
 fn render_writes_the_default_output_in_the_current_directory() {
-    let d = dir("default");
-    scene_file(&d);
+    let d = scene_dir("default");
     let out = ok(&d, &["render", "ball.sdf", "--stats"]);
     assert_eq!(png_size(&d.join("ball.png")), (40, 30));
     assert_eq!(
@@ -18,17 +21,12 @@ fn render_writes_the_default_output_in_the_current_directory() {
         "no temporary file left"
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        stdout.contains("steps/pixel") && stdout.contains("overshoots"),
-        "{stdout}"
-    );
-    let _ = std::fs::remove_dir_all(&d);
+    assert_has(&stdout, &["steps/pixel", "overshoots"]);
 }
 
 #[test]
 fn size_aa_set_and_output_options() {
-    let d = dir("options");
-    scene_file(&d);
+    let d = scene_dir("options");
     ok(
         &d,
         &words("render ball.sdf --size 24x16 --aa 2 --set max_steps=64 --set epsilon=1e-3 -o x.png --precision f64 --threads 1"),
@@ -42,31 +40,25 @@ fn size_aa_set_and_output_options() {
     );
     assert!(out.status.success());
     assert_eq!(png_size(&d.join("y.png")), (8, 6));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
 fn render_prints_the_warnings_of_check() {
     let d = dir("warnings");
-    std::fs::write(
-        d.join("dark.sdf"),
+    put(
+        &d,
+        "dark.sdf",
         "render { width: 8, height: 6 }\nscene { sphere(1); }\n",
-    )
-    .expect("write scene");
+    );
     let out = sdfc(&d, &["render", "dark.sdf"]);
     assert!(out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("[W0008]") && err.contains("no lights"),
-        "{err}"
-    );
-    let _ = std::fs::remove_dir_all(&d);
+    assert_has(&err, &["[W0008]", "no lights"]);
 }
 
 #[test]
 fn outputs_are_written_in_the_format_their_extension_names() {
-    let d = dir("formats");
-    scene_file(&d);
+    let d = scene_dir("formats");
     for name in ["out.jpg", "out.JPEG"] {
         ok(&d, &["render", "ball.sdf", "-o", name]);
         let bytes = std::fs::read(d.join(name)).expect("jpeg");
@@ -85,7 +77,7 @@ fn outputs_are_written_in_the_format_their_extension_names() {
         let out = sdfc(&d, &["render", "ball.sdf", "-o", name]);
         assert_eq!(out.status.code(), Some(2), "{name}");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains(".png`, `.jpg`"), "{err}");
+        assert_has(&err, &[".png`, `.jpg`"]);
         assert!(!err.contains("allocating"), "{err}");
     }
     // `-o -`: the PNG on standard output (statistics on standard error), no file named `-`.
@@ -103,34 +95,33 @@ fn outputs_are_written_in_the_format_their_extension_names() {
         ["ball.sdf", "out.JPEG", "out.exr", "out.jpg"],
         "no other file, no temporary file left"
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
-#[test]
-fn no_gpu_adapter_is_a_clear_error() {
-    let d = dir("adapter");
-    scene_file(&d);
-    let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&d)
-        .args(["render", "ball.sdf", "--backend", "wgpu"])
+/// `sdfc render FILE --backend wgpu` run in `d` where Vulkan finds no driver.
+fn on_wgpu_without_adapters(d: &Path, file: &str) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sdfc"))
+        .current_dir(d)
+        .args(["render", file, "--backend", "wgpu"])
         .env("WGPU_BACKEND", "vulkan")
         .env("VK_ICD_FILENAMES", "/nonexistent.json")
         .env("VK_DRIVER_FILES", "/nonexistent.json")
         .output()
-        .expect("run sdfc");
+        .expect("run sdfc")
+}
+
+#[test]
+fn no_gpu_adapter_is_a_clear_error() {
+    let d = scene_dir("adapter");
+    let out = on_wgpu_without_adapters(&d, "ball.sdf");
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("no wgpu adapter found") && err.contains("mesa-vulkan-drivers"),
-        "{err}"
-    );
+    assert_has(&err, &["no wgpu adapter found", "mesa-vulkan-drivers"]);
     assert_eq!(entries(&d), ["ball.sdf"]);
 }
 
 #[test]
 fn no_cuda_driver_is_a_clear_error() {
-    let d = dir("cuda");
-    scene_file(&d);
+    let d = scene_dir("cuda");
     let out = sdfc(&d, &["render", "ball.sdf", "--backend", "cuda"]);
     if out.status.success() {
         println!("SKIPPED: a CUDA driver and device are present here");
@@ -138,14 +129,13 @@ fn no_cuda_driver_is_a_clear_error() {
     }
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("CUDA"), "{err}");
+    assert_has(&err, &["CUDA"]);
     assert_eq!(entries(&d), ["ball.sdf"]);
 }
 
 #[test]
 fn an_interrupt_stops_a_render_and_leaves_no_file() {
-    let d = dir("interrupt");
-    scene_file(&d);
+    let d = scene_dir("interrupt");
     let mut child = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&d)
         .args(words(
@@ -166,26 +156,25 @@ fn an_interrupt_stops_a_render_and_leaves_no_file() {
 
 #[test]
 fn a_render_announces_its_memory_and_stops_above_the_memory_limit() {
-    let d = dir("memory");
-    scene_file(&d);
+    let d = scene_dir("memory");
     let out = sdfc(
         &d,
         &["render", "ball.sdf", "--backend", "cpu", "-o", "a.png"],
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
-    assert!(
-        err.contains("render: 40x30, aa 1, cpu: allocating at most ") && err.contains(" MiB"),
-        "{err}"
+    assert_has(
+        &err,
+        &["render: 40x30, aa 1, cpu: allocating at most ", " MiB"],
     );
     let err = exits(
         &d,
         &words("render ball.sdf --backend cpu --limit memory=1 --size 2000x2000 -o b.png"),
         1,
     );
-    assert!(
-        err.contains("more than the memory limit of 1 MiB") && err.contains("--limit memory="),
-        "{err}"
+    assert_has(
+        &err,
+        &["more than the memory limit of 1 MiB", "--limit memory="],
     );
     assert_eq!(entries(&d), ["a.png", "ball.sdf"], "no file written");
 }
@@ -215,8 +204,7 @@ fn debug_nan_paints_nan_pixels_magenta_in_the_written_image() {
 
 #[test]
 fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
-    let d = dir("gpu-fault");
-    scene_file(&d);
+    let d = scene_dir("gpu-fault");
     if !wgpu_available(&d) {
         return;
     }
@@ -251,8 +239,7 @@ fn a_gpu_error_mid_render_is_one_message_and_leaves_no_file() {
 /// device, whose pipeline keeps a file of its own, the same for every scene.
 #[test]
 fn a_second_process_finds_the_wgpu_pipeline_cache() {
-    let d = dir("pipeline-cache");
-    scene_file(&d);
+    let d = scene_dir("pipeline-cache");
     if !wgpu_available(&d) {
         return;
     }
@@ -280,10 +267,7 @@ fn a_second_process_finds_the_wgpu_pipeline_cache() {
         (line, entries(&cache))
     };
     let (first, files) = render("16x16");
-    assert!(
-        first.contains("bytes of driver cache data stored"),
-        "{first}"
-    );
+    assert_has(&first, &["bytes of driver cache data stored"]);
     assert_eq!(
         files.len(),
         2,
@@ -291,18 +275,17 @@ fn a_second_process_finds_the_wgpu_pipeline_cache() {
     );
     assert!(files.iter().all(|f| f.ends_with(".pipeline")), "{files:?}");
     let (second, again) = render("24x16");
-    assert!(
-        second.contains("pipeline created from")
-            && second.contains("bytes of stored driver cache data"),
-        "{second}"
+    assert_has(
+        &second,
+        &["pipeline created from", "bytes of stored driver cache data"],
     );
     assert_eq!(again, files, "the same kernel, the same file");
     // Another kernel (a box in place of the sphere) gets a file of its own.
     let scene = std::fs::read_to_string(d.join("ball.sdf")).expect("scene");
     let boxed = scene.replace("sphere(1)", "box((0.5, 0.5, 0.5))");
-    std::fs::write(d.join("ball.sdf"), boxed).expect("write");
+    put(&d, "ball.sdf", boxed);
     let (third, more) = render("16x16");
-    assert!(third.contains("stored"), "{third}");
+    assert_has(&third, &["stored"]);
     assert_eq!(more.len(), 3, "{more:?}");
 }
 
@@ -313,23 +296,16 @@ fn a_second_process_finds_the_wgpu_pipeline_cache() {
 #[test]
 fn a_scene_with_errors_exits_1_whatever_the_device_does() {
     let d = dir("errors-device");
-    std::fs::write(d.join("broken.sdf"), "scene { sphere(; }").expect("write");
+    put(&d, "broken.sdf", "scene { sphere(; }");
     let diagnostics = |out: &Output| {
         let err = String::from_utf8_lossy(&out.stderr).into_owned();
         assert_eq!(out.status.code(), Some(1), "{err}");
-        assert!(err.contains("broken.sdf") && err.contains("E0101"), "{err}");
+        assert_has(&err, &["broken.sdf", "E0101"]);
         assert!(!err.contains("adapter") && !err.contains("CUDA"), "{err}");
         err
     };
     // No wgpu adapter at all.
-    let no_adapter = Command::new(env!("CARGO_BIN_EXE_sdfc"))
-        .current_dir(&d)
-        .args(["render", "broken.sdf", "--backend", "wgpu"])
-        .env("WGPU_BACKEND", "vulkan")
-        .env("VK_ICD_FILENAMES", "/nonexistent.json")
-        .env("VK_DRIVER_FILES", "/nonexistent.json")
-        .output()
-        .expect("run sdfc");
+    let no_adapter = on_wgpu_without_adapters(&d, "broken.sdf");
     diagnostics(&no_adapter);
     // Whatever this machine has: a device opening (lavapipe, a GPU) or none.
     for backend in ["wgpu", "cuda", "auto"] {
@@ -357,10 +333,7 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
         &["render", "ball.sdf", "--reference", "--backend", "wgpu"],
         2,
     );
-    assert!(
-        err.contains("--reference renders on the CPU in f64"),
-        "{err}"
-    );
+    assert_has(&err, &["--reference renders on the CPU in f64"]);
     let kernel = sdfc(
         &d,
         &words("render broken.sdf --backend cpu --kernel interpreted"),
@@ -371,7 +344,6 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
         ["ball.sdf", "broken.sdf"],
         "no image, no temporary file"
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// `--stats`'s breakdown of the whole run: its phases add up to its total, a device opened
@@ -379,8 +351,7 @@ fn a_scene_with_errors_exits_1_whatever_the_device_does() {
 /// rename; a still is not synced to the disk) are listed; the device is left to the operating system at the end.
 #[test]
 fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
-    let d = dir("breakdown");
-    scene_file(&d);
+    let d = scene_dir("breakdown");
     let backends: &[&str] = if wgpu_available(&d) {
         &["cpu", "wgpu"]
     } else {
@@ -445,5 +416,4 @@ fn the_run_breakdown_adds_up_and_names_the_overlapped_device() {
         }
         assert_eq!(png_size(&d.join("out.png")), (40, 30));
     }
-    let _ = std::fs::remove_dir_all(&d);
 }

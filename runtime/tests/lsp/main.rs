@@ -125,6 +125,12 @@ impl Client {
         self.published[uri].clone()
     }
 
+    /// Stops the server, then removes the test's directory `dir`.
+    fn finish(self, dir: &Path) {
+        self.stop();
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
     fn stop(mut self) {
         self.request("shutdown", Value::Null);
         self.notify("exit", Value::Null);
@@ -143,6 +149,16 @@ fn temp_dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
     dir
+}
+
+/// A client of a fresh server with `text` open as the file `file` of a fresh directory for
+/// the test `name`: the directory, the document's URI and the client.
+fn opened(name: &str, file: &str, text: &str) -> (PathBuf, String, Client) {
+    let dir = temp_dir(name);
+    let doc = uri(&dir.join(file));
+    let c = Client::start();
+    c.open(&doc, text);
+    (dir, doc, c)
 }
 
 fn uri(p: &Path) -> String {

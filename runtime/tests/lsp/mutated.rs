@@ -121,8 +121,7 @@ fn never_crashes_on_mutated_text() {
             json!({ "textDocument": { "uri": doc } }),
         );
     }
-    c.stop();
-    let _ = std::fs::remove_dir_all(&dir);
+    c.finish(&dir);
 }
 
 /// The time each request takes on every example, printed (run with `--nocapture`; nothing

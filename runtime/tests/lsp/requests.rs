@@ -1,7 +1,7 @@
 //! Each request on a document with an import and a mistake, formatting, rename, hover on a
 //! parameter, and a byte-order mark, over the in-memory connection.
 
-use crate::{at, temp_dir, uri, Client, LIB, MAIN};
+use crate::{at, opened, temp_dir, uri, Client, LIB, MAIN};
 use serde_json::{json, Value};
 
 #[test]
@@ -25,8 +25,7 @@ fn every_request_on_a_document_with_an_import_and_a_mistake() {
         at(&uri(&dir.join("other.sdf")), "x", "x", 0),
     );
     assert!(r.response_result.is_err());
-    c.stop();
-    let _ = std::fs::remove_dir_all(&dir);
+    c.finish(&dir);
 }
 
 /// The mistake of [`MAIN`], at its place, with its code linked and a quick fix; fixed
@@ -209,12 +208,8 @@ fn strings<'a>(items: &'a Value, key: &str) -> Vec<&'a str> {
 /// (on the unsaved text), none for formatted text or text that does not parse.
 #[test]
 fn formatting_replaces_the_text_with_the_formatters() {
-    let dir = temp_dir("fmt");
-    let path = dir.join("messy.sdf");
-    let doc = uri(&path);
     let text = "let r=2*3; // six\nscene { sphere( r ) ; }";
-    let mut c = Client::start();
-    c.open(&doc, text);
+    let (dir, doc, mut c) = opened("fmt", "messy.sdf", text);
     let opts = json!({ "textDocument": { "uri": doc }, "options": { "tabSize": 4, "insertSpaces": true } });
     let edits = c.request("textDocument/formatting", opts.clone());
     let formatted = "let r = 2 * 3; // six\nscene {\n  sphere(r);\n}\n";
@@ -233,20 +228,15 @@ fn formatting_replaces_the_text_with_the_formatters() {
             "{t}"
         );
     }
-    c.stop();
-    let _ = std::fs::remove_dir_all(&dir);
+    c.finish(&dir);
 }
 
 /// Rename refuses a new name that is a keyword or would hide a built-in (the file's uses of
 /// it would then mean the renamed declaration), and one that is not a name at all.
 #[test]
 fn rename_refuses_keywords_and_built_in_names() {
-    let dir = temp_dir("rename");
-    let main = dir.join("main.sdf");
-    let main_uri = uri(&main);
     let text = "let r = 1;\nscene {\n    sphere(r * pi);\n}\n";
-    let mut c = Client::start();
-    c.open(&main_uri, text);
+    let (dir, main_uri, mut c) = opened("rename", "main.sdf", text);
     for (new, why) in [
         ("let", "keyword"),
         ("scene", "keyword"),
@@ -274,19 +264,15 @@ fn rename_refuses_keywords_and_built_in_names() {
         Some(2),
         "{edit}"
     );
-    c.stop();
-    let _ = std::fs::remove_dir_all(&dir);
+    c.finish(&dir);
 }
 
 /// A byte-order mark at the start of a document is skipped: no diagnostic about it, and the
 /// positions of the first line count it as the client does (one UTF-16 unit).
 #[test]
 fn a_byte_order_mark_is_skipped_by_the_language_server() {
-    let dir = temp_dir("bom");
-    let main_uri = uri(&dir.join("main.sdf"));
     let text = "\u{feff}let r = 1;\nscene {\n    sphere(r);\n}\n";
-    let mut c = Client::start();
-    c.open(&main_uri, text);
+    let (dir, main_uri, mut c) = opened("bom", "main.sdf", text);
     let diags = c.diagnostics(&main_uri);
     assert!(
         diags
@@ -302,20 +288,15 @@ fn a_byte_order_mark_is_skipped_by_the_language_server() {
         json!({ "line": 0, "character": 5 }),
         "{def}"
     );
-    c.stop();
-    let _ = std::fs::remove_dir_all(&dir);
+    c.finish(&dir);
 }
 
 #[test]
 fn a_parameters_hover_shows_its_range_description_and_value() {
-    let dir = temp_dir("param-hover");
-    let main = dir.join("part.sdf");
-    let main_uri = uri(&main);
     let text = "param width = 40.0 in 10..100 step 1 \"Box width (mm)\";\n\
                 light directional { direction: (-1, -1, 1) }\n\
                 scene { box((width / 100, 0.5, 0.5)); }\n";
-    let mut c = Client::start();
-    c.open(&main_uri, text);
+    let (_dir, main_uri, mut c) = opened("param-hover", "part.sdf", text);
     let md = c.hover(at(&main_uri, text, "width /", 0));
     assert!(
         md.contains("param width = 40.0 in 10..100 step 1 \"Box width (mm)\";")

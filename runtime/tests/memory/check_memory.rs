@@ -40,6 +40,20 @@ fn check_mesh(name: &str, bytes: Vec<u8>) -> (Vec<Diagnostic>, u64) {
     (diags, peak)
 }
 
+/// [`check_mesh`] of `bytes`, whose error must say that the file has `triangles` triangles:
+/// the file's size and the peak.
+#[track_caller]
+fn refused_mesh(name: &str, bytes: Vec<u8>, triangles: u64) -> (u64, u64) {
+    let input = bytes.len() as u64;
+    let (diags, peak) = check_mesh(name, bytes);
+    let says = format!("the file has {triangles} triangles");
+    assert!(
+        diags.iter().any(|d| d.message.contains(&says)),
+        "{diags:#?}"
+    );
+    (input, peak)
+}
+
 #[test]
 fn hostile_inputs_are_checked_in_memory_proportional_to_them() {
     let _alone = counting::alone();
@@ -84,14 +98,7 @@ fn hostile_inputs_are_checked_in_memory_proportional_to_them() {
     for k in 0..5_000_000 {
         obj.push_str([" 1", " 2", " 3"][k % 3]);
     }
-    let input = obj.len() as u64;
-    let (diags, peak) = check_mesh("face.obj", obj.into_bytes());
-    assert!(
-        diags
-            .iter()
-            .any(|d| d.message.contains("the file has 4999998 triangles")),
-        "{diags:#?}"
-    );
+    let (input, peak) = refused_mesh("face.obj", obj.into_bytes(), 4999998);
     // The file's copy from the loader, and the triangles kept up to the limit (800 000 of
     // 12 bytes) with their vector's growth.
     assert!(
@@ -108,28 +115,8 @@ fn hostile_inputs_are_checked_in_memory_proportional_to_them() {
         r#"{{"asset":{{"version":"2.0"}},"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"bufferViews":[{{"buffer":0,"byteLength":{}}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":{count},"type":"VEC3"}}]}}"#,
         12 * count
     );
-    let mut json = json.into_bytes();
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
-    let bin = vec![0u8; 12 * count];
-    let mut glb = b"glTF".to_vec();
-    for n in [2, 20 + json.len() + 8 + bin.len(), json.len()] {
-        glb.extend_from_slice(&(n as u32).to_le_bytes());
-    }
-    glb.extend_from_slice(b"JSON");
-    glb.extend_from_slice(&json);
-    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    glb.extend_from_slice(b"BIN\0");
-    glb.extend_from_slice(&bin);
-    let input = glb.len() as u64;
-    let (diags, peak) = check_mesh("big.glb", glb);
-    assert!(
-        diags
-            .iter()
-            .any(|d| d.message.contains("the file has 900000 triangles")),
-        "{diags:#?}"
-    );
+    let glb = crate::glb::glb(&json, &vec![0u8; 12 * count]);
+    let (input, peak) = refused_mesh("big.glb", glb, 900000);
     assert!(
         peak < input + 8 * MB,
         "a peak of {} MB for {} MB of glTF",

@@ -6,6 +6,8 @@
 
 #[path = "../common/counting.rs"]
 mod counting;
+#[path = "../common/glb.rs"]
+mod glb;
 
 mod check_memory;
 mod memory;

@@ -12,6 +12,8 @@
 mod common;
 #[path = "../common/evaluators.rs"]
 mod evaluators;
+#[path = "../common/glb.rs"]
+mod glb;
 #[path = "../common/meshes.rs"]
 mod meshes;
 

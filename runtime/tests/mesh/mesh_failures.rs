@@ -1,6 +1,7 @@
 //! `sdfc mesh`'s failure paths (docs/failures.md): unbounded scenes, limits and bad arguments,
 //! a killed mesh, a read-only output, missing files, empty meshes and tiny cells, a grid too fine.
 
+use crate::common::assert_has;
 use crate::meshes;
 use meshes::*;
 use std::process::Command;
@@ -14,10 +15,7 @@ fn an_unbounded_scene_needs_bounds_and_is_closed_at_them() {
     let o = sdfc(&["mesh", s(&scene), "-o", s(&out)]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("unbounded") && err.contains("`--bounds X0,Y0,Z0,X1,Y1,Z1`"),
-        "{err}"
-    );
+    assert_has(&err, &["unbounded", "`--bounds X0,Y0,Z0,X1,Y1,Z1`"]);
     assert!(!out.exists());
     mesh(&[
         s(&scene),
@@ -49,30 +47,21 @@ fn limits_and_bad_arguments_are_reported() {
     };
     let (code, err) = run(&["--limit", "cells=1000"]);
     assert_eq!(code, Some(1), "{err}");
-    assert!(
-        err.contains("cells limit of 1000") && err.contains("--limit cells="),
-        "{err}"
-    );
+    assert_has(&err, &["cells limit of 1000", "--limit cells="]);
     let (code, err) = run(&["--limit", "memory=1", "--resolution", "200"]);
     assert_eq!(code, Some(1), "{err}");
-    assert!(
-        err.contains("allocating at most") && err.contains("--limit memory="),
-        "{err}"
-    );
+    assert_has(&err, &["allocating at most", "--limit memory="]);
     let (code, err) = run(&["--set", "sharp=maybe"]);
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("sharp must be on or off"), "{err}");
+    assert_has(&err, &["sharp must be on or off"]);
     let (code, err) = run(&["--bounds=1,0,0,0,1,1"]);
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("X0 < X1"), "{err}");
+    assert_has(&err, &["X0 < X1"]);
     // More workers than the `threads` limit (10 000 never finished): refused, naming the
     // range and the value that would do.
     let (code, err) = run(&["--threads", "10000"]);
     assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("from 1 to 1024") && err.contains("`--limit threads=10000`"),
-        "{err}"
-    );
+    assert_has(&err, &["from 1 to 1024", "`--limit threads=10000`"]);
     assert!(!out.exists());
     let o = sdfc(&["mesh", s(&scene), "-o", s(&d.join("p.xyz"))]);
     assert_eq!(o.status.code(), Some(2));
@@ -139,7 +128,7 @@ fn a_read_only_output_is_refused_and_left_unchanged() {
     std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o444)).expect("chmod");
     let scene = root().join("examples/mesh/parts.sdf");
     let err = exits(&["mesh", s(&scene), "--resolution", "16", "-o", s(&out)], 2);
-    assert!(err.contains("read-only"), "{err}");
+    assert_has(&err, &["read-only"]);
     assert_eq!(std::fs::read(&out).expect("kept"), b"keep me");
 }
 
@@ -158,10 +147,7 @@ fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
         &["mesh", s(&scene), "-o", s(&out), "--bounds=2,2,2,3,3,3"],
         1,
     );
-    assert!(
-        err.contains("--bounds does not reach the scene's solid, which lies within `--bounds=-0.5,-0.5,-0.5,0.5,0.5,0.5`"),
-        "{err}"
-    );
+    assert_has(&err, &["--bounds does not reach the scene's solid, which lies within `--bounds=-0.5,-0.5,-0.5,0.5,0.5,0.5`"]);
     assert!(!out.exists());
     let err = exits(
         &[
@@ -173,10 +159,7 @@ fn missing_files_empty_meshes_and_tiny_cells_are_reported() {
         ],
         1,
     );
-    assert!(
-        err.contains("no triangles") && err.contains("--bounds"),
-        "{err}"
-    );
+    assert_has(&err, &["no triangles", "--bounds"]);
     assert!(!out.exists());
     // A solid known to be empty says so, with no advice on cells or bounds (it was told to
     // raise the resolution, or that it was unbounded).

@@ -33,6 +33,12 @@ fn close(a: [[f32; 3]; 2], b: [[f32; 3]; 2], tolerance: f32, what: &str) {
     }
 }
 
+/// Fails unless the extent of `m` is `b` within `tolerance`, saying `what`.
+#[track_caller]
+fn spans(m: &Read, b: [[f32; 3]; 2], tolerance: f32, what: &str) {
+    close(extent(m), b, tolerance, what);
+}
+
 fn meshed(d: &Path, name: &str, body: &str, resolution: &str) -> Read {
     let scene = write_scene(d, &format!("{name}.sdf"), body);
     let out = d.join(format!("{name}.stl"));
@@ -53,12 +59,7 @@ fn a_rod_built_as_a_field_meshes_as_the_primitive_does() {
     assert_eq!(manifold(&field, "field rod"), 2);
     assert_eq!(field.triangles.len(), prim.triangles.len());
     // The whole rod: from y = −1 to 1, x from 0.3 to 0.7 (within a hundredth).
-    close(
-        extent(&field),
-        [[0.3, -1.0, -0.2], [0.7, 1.0, 0.2]],
-        0.01,
-        "rod",
-    );
+    spans(&field, [[0.3, -1.0, -0.2], [0.7, 1.0, 0.2]], 0.01, "rod");
     close(
         extent(&field),
         extent(&prim),
@@ -82,12 +83,7 @@ fn a_blob_and_a_bumpy_sphere_mesh_without_bounds() {
     assert_eq!(manifold(&blob, "blob"), 2);
     // The spheres' far sides: x from −0.9 to 0.8, y from −0.5 to 0.6, z ±0.5; the blend
     // only adds material between them.
-    close(
-        extent(&blob),
-        [[-0.9, -0.5, -0.5], [0.8, 0.6, 0.5]],
-        0.02,
-        "blob",
-    );
+    spans(&blob, [[-0.9, -0.5, -0.5], [0.8, 0.6, 0.5]], 0.02, "blob");
     let bumpy_text =
         "scene { field { distance(sphere(1), p) + 0.1 * noise(p * 4) }.translate(0, 2, 0); }\n";
     let bumpy = meshed(&d, "bumpy", bumpy_text, "48");
@@ -110,12 +106,7 @@ fn a_repeated_field_is_bounded_by_its_count() {
     let rods = meshed(&d, "rods", rods_text, "64");
     // Three closed rods: χ = 6.
     assert_eq!(manifold(&rods, "rods"), 6);
-    close(
-        extent(&rods),
-        [[-1.2, -1.0, -0.2], [1.2, 1.0, 0.2]],
-        0.02,
-        "rods",
-    );
+    spans(&rods, [[-1.2, -1.0, -0.2], [1.2, 1.0, 0.2]], 0.02, "rods");
 }
 
 /// A field with no bound (a gyroid sheet fills space) is named, with its location, in the

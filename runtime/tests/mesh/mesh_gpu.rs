@@ -12,6 +12,7 @@
 use super::common::open_gpu;
 use super::evaluators;
 use super::meshes::{self, dir, exits, root, s, scene_in, sdfc, write_scene};
+use crate::common::assert_has;
 use sdfc_compiler::{Limits, LowerOptions};
 use sdfc_runtime::backend::Backend;
 use sdfc_runtime::commands::mesh::{surface, Meshed, Region, Spelling};
@@ -182,11 +183,11 @@ fn a_missing_device_is_an_error_and_stats_name_the_backend() {
     let (_, scene, out) = scene_in("gpu_cli", "ball.sdf", body, "ball.stl");
     if evaluators::open_cuda().is_err() {
         let err = exits(&["mesh", s(&scene), "-o", s(&out), "--backend", "cuda"], 1);
-        assert!(
-            err.contains("error: --backend cuda cannot mesh here: found no CUDA device ("),
-            "{err}"
+        assert_has(
+            &err,
+            &["error: --backend cuda cannot mesh here: found no CUDA device ("],
         );
-        assert!(err.contains("--backend cpu"), "{err}");
+        assert_has(&err, &["--backend cpu"]);
         assert!(!out.exists(), "no mesh is written");
     }
     let r = sdfc(&[
@@ -200,10 +201,7 @@ fn a_missing_device_is_an_error_and_stats_name_the_backend() {
     ]);
     let stats = String::from_utf8_lossy(&r.stdout);
     assert!(r.status.success());
-    assert!(
-        stats.contains("points") && stats.contains(" on cpu, "),
-        "{stats}"
-    );
+    assert_has(&stats, &["points", " on cpu, "]);
     let r = sdfc(&["mesh", s(&scene), "-o", s(&out), "--backend", "metal"]);
     assert_eq!(
         r.status.code(),

@@ -5,7 +5,9 @@
 //! that read them, naming where in the file, and never a crash.
 
 use crate::common;
+use crate::common::assert_has;
 use crate::common::words;
+use crate::glb::glb;
 use common::run_ok;
 
 use sdfc_compiler::{Lowered, Rng, Scene};
@@ -182,24 +184,6 @@ fn a_mesh_composes_and_remeshes() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A binary glTF file of `json` and `bin`.
-fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
-    let mut json = json.as_bytes().to_vec();
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
-    let mut b = b"glTF".to_vec();
-    for n in [2, 20 + json.len() + 8 + bin.len(), json.len()] {
-        b.extend_from_slice(&(n as u32).to_le_bytes());
-    }
-    b.extend_from_slice(b"JSON");
-    b.extend_from_slice(&json);
-    b.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    b.extend_from_slice(b"BIN\0");
-    b.extend_from_slice(bin);
-    b
-}
-
 /// Bad files: an error E0400 at the `mesh` call whose message says what and where.
 #[test]
 fn bad_mesh_files_are_located_errors() {
@@ -336,7 +320,7 @@ fn a_software_adapter_that_would_cut_loops_refuses_instead_of_a_wrong_picture() 
             panic!("rendered on a software adapter, where it should be refused");
         };
         let e = e.to_string();
-        assert!(e.contains("65 535") && e.contains("--backend cpu"), "{e}");
+        assert_has(&e, &["65 535", "--backend cpu"]);
         assert!(
             !cli.status.success() && stderr.contains("65 535"),
             "{stderr}"

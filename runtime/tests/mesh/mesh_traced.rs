@@ -4,8 +4,9 @@
 //! CPU (f32 and the f64 reference) and through wgpu, and PTX assembles where `ptxas` is on the
 //! PATH. A mesh that is rounded, or a light with a penumbra, keeps the scene marched.
 
-use super::common::{cpu_render, open_gpu, run_ok};
+use super::common::{assert_agree, cpu_render, open_gpu, run_ok};
 use super::meshes::{dir, root, s, write_scene};
+use crate::common::assert_has;
 use sdfc_compiler::{
     analytic::{choose, Choice, Reason},
     wgsl, Lowered, Method, Scene,
@@ -110,21 +111,11 @@ fn wgpu_traces_a_mesh_as_the_cpu_does() {
             "ptxas runs",
         );
     }
-    let Some(gpu) = open_gpu("traced mesh") else {
-        return;
-    };
-    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-    let on_cpu = cpu_render(&scene);
-    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, 0.1).expect("same size");
-    println!(
-        "wgpu against cpu: {:.1} dB, {:.4} differing",
-        d.psnr, d.differing
-    );
-    assert!(
-        d.psnr >= 95.0 && d.differing <= 0.0005,
-        "wgpu against cpu: {:.1} dB, {:.4} differing",
-        d.psnr,
-        d.differing
+    wgpu_agrees_with_cpu(
+        "traced mesh",
+        (&scene, &kernel),
+        "wgpu against cpu",
+        (95.0, 0.0005),
     );
 }
 
@@ -181,10 +172,7 @@ fn a_traced_mesh_is_held_to_the_scene_data_limit() {
         .expect("sdfc runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("above the scene_data limit of 1 MiB"),
-        "{stderr}"
-    );
+    assert_has(&stderr, &["above the scene_data limit of 1 MiB"]);
     assert!(!stderr.contains("internal compiler error"), "{stderr}");
     let e = wgsl::write(&scene, &lowered).expect_err("above the limit");
     assert!(
@@ -232,20 +220,27 @@ scene {
     assert!(matches!(choose(&scene), Choice::Trace(_)));
     let lowered = Lowered::new(&scene);
     let kernel = wgsl::write(&scene, &lowered).expect("a valid kernel");
-    let Some(gpu) = open_gpu("path-traced mesh") else {
+    wgpu_agrees_with_cpu(
+        "path-traced mesh",
+        (&scene, &kernel),
+        "path traced, wgpu against cpu",
+        (80.0, 0.0005),
+    );
+}
+
+/// `scene` rendered through `kernel` by wgpu (where there is an adapter, else the test `what`
+/// skips) against the CPU's render: `label`, and at least `bounds` (PSNR, most pixels
+/// differing by 0.1) alike.
+fn wgpu_agrees_with_cpu(
+    what: &str,
+    (scene, kernel): (&Scene, &wgsl::Kernel),
+    label: &str,
+    bounds: (f64, f64),
+) {
+    let Some(gpu) = open_gpu(what) else {
         return;
     };
-    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-    let on_cpu = cpu_render(&scene);
-    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, 0.1).expect("same size");
-    println!(
-        "path traced, wgpu against cpu: {:.1} dB, {:.4} differing",
-        d.psnr, d.differing
-    );
-    assert!(
-        d.psnr >= 80.0 && d.differing <= 0.0005,
-        "path traced, wgpu against cpu: {:.1} dB, {:.4} differing",
-        d.psnr,
-        d.differing
-    );
+    let on_gpu = gpu::render(&gpu, scene, kernel, 1.0, &mut |_| {}).expect("gpu render");
+    let on_cpu = cpu_render(scene);
+    assert_agree(label, (&on_gpu.render.image, &on_cpu.image), 0.1, bounds);
 }

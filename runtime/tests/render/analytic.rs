@@ -2,6 +2,7 @@
 //! traced images against sphere-traced ones of the same file, and the kernel it emits.
 
 use crate::common;
+use crate::common::assert_has;
 use sdfc_compiler::{
     analytic::{choose, Choice, Reason},
     wgsl, Method, Scene,
@@ -276,9 +277,9 @@ fn glass_overlap_is_found_through_the_hierarchy_and_traced_is_a_limit() {
             },
         ) => {
             let plain = r.describe();
-            assert!(plain.contains("`traced` limit of 1000"), "{plain}");
+            assert_has(&plain, &["`traced` limit of 1000"]);
             let spelled = r.describe_in(&limited.limits);
-            assert!(spelled.contains("--limit traced=40000"), "{spelled}");
+            assert_has(&spelled, &["--limit traced=40000"]);
         }
         other => panic!("{other:?}"),
     }

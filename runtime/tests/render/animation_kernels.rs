@@ -3,6 +3,7 @@
 //! one does.
 
 use crate::animation::{scene, BASE};
+use crate::common::assert_has;
 use crate::sequence::{dir, sdfc, sdfc_env, text};
 use sdfc_compiler::{Limits, Scene};
 use std::path::Path;
@@ -39,9 +40,9 @@ fn a_sequence_that_moves_only_numbers_keeps_one_structure_and_one_kernel() {
     let o = sdfc(&d, &["check", "moving.sdf"]);
     let out = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
-    assert!(
-        out.contains("moving.sdf: animated, numbers only") && out.contains("36 frames at 12 fps"),
-        "{out}"
+    assert_has(
+        &out,
+        &["moving.sdf: animated, numbers only", "36 frames at 12 fps"],
     );
     // The kernels of frames at the rotation's 0 and quarter turn, the twist's 0 and between.
     let texts: Vec<String> = [0u64, 1, 12, 24, 35]

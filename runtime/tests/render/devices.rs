@@ -8,6 +8,7 @@
 //! skipped, unless `SDFC_REQUIRE_DEVICES=1` (set by CI, which installs lavapipe).
 
 use crate::common;
+use crate::common::assert_has;
 use common::load_small;
 
 use sdfc_compiler::{wgsl, Lowered};
@@ -219,8 +220,25 @@ fn seed3() -> String {
     example("seed3.sdf")
 }
 
-fn wgpu_here() -> bool {
-    open_gpu().is_some()
+/// The standard error of `out`, which must have exited with `code`.
+#[track_caller]
+fn exited(out: &Output, code: i32) -> String {
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(code), "{err}");
+    err
+}
+
+/// The one line of `err` that starts with `kind`.
+#[track_caller]
+fn only_line<'a>(err: &'a str, kind: &str) -> &'a str {
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with(kind)).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    lines[0]
+}
+
+/// Where there is a wgpu adapter, a fresh directory for the test `name`.
+fn wgpu_dir(name: &str) -> Option<PathBuf> {
+    open_gpu().map(|_| dir(name))
 }
 
 fn render(d: &Path, devices: &str, out: &str, env: &[(&str, &str)]) -> Output {
@@ -228,23 +246,27 @@ fn render(d: &Path, devices: &str, out: &str, env: &[(&str, &str)]) -> Output {
     sdfc_on(d, "render", &seed3(), &rest, env)
 }
 
-#[test]
-fn a_failing_device_hands_its_tile_back_and_the_others_finish() {
-    if !wgpu_here() {
-        return;
-    }
-    let d = dir("fault");
+/// Where there is a wgpu adapter, a fresh directory for the test `name` holding `one.png`,
+/// the image [`render`] makes on device 0 alone.
+fn one_device_image(name: &str) -> Option<PathBuf> {
+    let d = wgpu_dir(name)?;
     let one = render(&d, "0", "one.png", &[]);
     assert!(one.status.success(), "{one:?}");
+    Some(d)
+}
+
+#[test]
+fn a_failing_device_hands_its_tile_back_and_the_others_finish() {
+    let Some(d) = one_device_image("fault") else {
+        return;
+    };
     // The second device fails at its second band; the first renders the rest.
     let out = render(&d, "0,0", "two.png", &[("SDFC_FAULT_AFTER_TILES", "1:1")]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning")).collect();
-    assert_eq!(warnings.len(), 1, "{err}");
+    let err = exited(&out, 0);
+    let warning = only_line(&err, "warning");
     assert!(
-        warnings[0].starts_with("warning: device 1 (")
-            && warnings[0].contains("failed after 1 tile: GPU error while rendering: device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1:1 (a testing aid); the other devices rendered its tiles"),
+        warning.starts_with("warning: device 1 (")
+            && warning.contains("failed after 1 tile: GPU error while rendering: device error injected at tile 2 by SDFC_FAULT_AFTER_TILES=1:1 (a testing aid); the other devices rendered its tiles"),
         "{err}"
     );
     let a = std::fs::read(d.join("one.png")).expect("one.png");
@@ -253,44 +275,35 @@ fn a_failing_device_hands_its_tile_back_and_the_others_finish() {
 
     // Both fail: one error naming each device's, and no image.
     let out = render(&d, "0,0", "none.png", &[("SDFC_FAULT_AFTER_TILES", "2")]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
-    assert_eq!(errors.len(), 1, "{err}");
+    let err = exited(&out, 1);
+    let error = only_line(&err, "error");
     assert!(
-        errors[0].starts_with("error: every device failed (4 of ")
-            && errors[0].contains("device 0 (")
-            && errors[0].contains("device 1 (")
-            && errors[0].matches("device error injected at tile 3").count() == 2,
+        error.starts_with("error: every device failed (4 of ")
+            && error.contains("device 0 (")
+            && error.contains("device 1 (")
+            && error.matches("device error injected at tile 3").count() == 2,
         "{err}"
     );
     assert!(!d.join("none.png").exists());
 
     // One device alone: the fault is the render's error, as before.
     let out = render(&d, "0", "alone.png", &[("SDFC_FAULT_AFTER_TILES", "0:0")]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("error: GPU error while rendering: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=0:0 (a testing aid)"), "{err}");
+    let err = exited(&out, 1);
+    assert_has(&err, &["error: GPU error while rendering: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=0:0 (a testing aid)"]);
 }
 
 #[test]
 fn the_cpu_and_lavapipe_render_together_from_the_command_line() {
-    if !wgpu_here() {
+    let Some(d) = one_device_image("mixed") else {
         return;
-    }
-    let d = dir("mixed");
-    let one = render(&d, "0", "one.png", &[]);
-    assert!(one.status.success(), "{one:?}");
+    };
     let rest = "--backend wgpu --devices cpu,0 --size 160x120 --stats -o mixed.png";
     let out = sdfc_on(&d, "render", &seed3(), rest, &[]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{out:?}");
-    assert!(
-        text.contains("backend         mixed (2 devices: CPU, "),
-        "{text}"
-    );
-    assert!(text.contains("device 0        CPU, "), "{text}");
-    assert!(text.contains("device 1        "), "{text}");
+    assert_has(&text, &["backend         mixed (2 devices: CPU, "]);
+    assert_has(&text, &["device 0        CPU, "]);
+    assert_has(&text, &["device 1        "]);
     let compare = sdfc(&d, &["compare", "one.png", "mixed.png", "--json"], &[]);
     let json = String::from_utf8_lossy(&compare.stdout);
     let v: serde_json::Value = serde_json::from_str(&json).expect("json");
@@ -306,10 +319,9 @@ fn sequence(d: &Path, devices: &str, pattern: &str, env: &[(&str, &str)]) -> Out
 
 #[test]
 fn the_frames_of_a_sequence_go_to_the_devices_and_survive_one_failing() {
-    if !wgpu_here() {
+    let Some(d) = wgpu_dir("frames") else {
         return;
-    }
-    let d = dir("frames");
+    };
     let one = sequence(&d, "0", "one/f_##.png", &[]);
     assert!(one.status.success(), "{one:?}");
     let same = |dir: &str| {
@@ -320,35 +332,31 @@ fn the_frames_of_a_sequence_go_to_the_devices_and_survive_one_failing() {
         }
     };
     let two = sequence(&d, "0,0", "two/f_##.png", &[]);
-    let err = String::from_utf8_lossy(&two.stderr);
-    assert!(two.status.success(), "{err}");
-    assert!(err.contains("(2 devices: wgpu on "), "{err}");
+    let err = exited(&two, 0);
+    assert_has(&err, &["(2 devices: wgpu on "]);
     same("two");
     // The second device fails on its first frame (it opens its device after taking one,
     // while the first is still opening its own); the first renders every frame.
     let fault = [("SDFC_FAULT_AFTER_TILES", "1:0")];
     let out = sequence(&d, "0,0", "back/f_##.png", &fault);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    assert!(err.contains("warning: device 1 failed: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=1:0 (a testing aid); the other devices render its frame"), "{err}");
+    let err = exited(&out, 0);
+    assert_has(&err, &["warning: device 1 failed: device error injected at tile 1 by SDFC_FAULT_AFTER_TILES=1:0 (a testing aid); the other devices render its frame"]);
     same("back");
     // Every device fails at its second frame: two frames are written, then the error.
     let fault = [("SDFC_FAULT_AFTER_TILES", "1")];
     let out = sequence(&d, "0,0", "none/f_##.png", &fault);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("error: every device failed (2 of 6 frames written): device "),
-        "{err}"
+    let err = exited(&out, 1);
+    assert_has(
+        &err,
+        &["error: every device failed (2 of 6 frames written): device "],
     );
 }
 
 #[test]
 fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
-    if !wgpu_here() {
+    let Some(d) = wgpu_dir("sequence") else {
         return;
-    }
-    let d = dir("sequence");
+    };
     let orbit = example("animation/orbit.sdf");
     for (devices, pattern) in [("0", "one/f_##.png"), ("0,0", "two/f_##.png")] {
         let rest = format!(
@@ -358,17 +366,14 @@ fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
         assert!(out.status.success(), "{out:?}");
         // `--stats` says where the time went: each device's steps and the writers'.
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains("where the sequence's time went"), "{err}");
+        assert_has(&err, &["where the sequence's time went"]);
         let place = if devices == "0" { "device" } else { "device 1" };
         assert!(
             err.contains(&format!("\n  {place}: "))
                 && err.contains("opening and first preparation"),
             "{err}"
         );
-        assert!(
-            err.contains("\n  writers: ") && err.contains(" fsync "),
-            "{err}"
-        );
+        assert_has(&err, &["\n  writers: ", " fsync "]);
     }
     for k in 0..3 {
         let a = std::fs::read(d.join(format!("one/f_{k:02}.png"))).expect("frame");
@@ -379,15 +384,14 @@ fn a_sequence_on_two_logical_devices_is_the_sequence_on_one() {
     let bench = sdfc_on(&d, "bench", &orbit, rest, &[]);
     let json = String::from_utf8_lossy(&bench.stdout);
     assert!(bench.status.success(), "{bench:?}");
-    assert!(json.contains("2 devices: "), "{json}");
+    assert_has(&json, &["2 devices: "]);
 }
 
 #[test]
 fn devices_lists_the_adapters_and_the_cpu() {
-    if !wgpu_here() {
+    let Some(d) = wgpu_dir("list") else {
         return;
-    }
-    let d = dir("list");
+    };
     let out = sdfc(&d, &["devices"], &[]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{out:?}");
@@ -437,9 +441,8 @@ fn bad_devices_are_named_in_the_error() {
         "--reference --devices 0,0 -o x.png",
         &[],
     );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("it cannot use --devices"), "{err}");
+    let err = exited(&out, 2);
+    assert_has(&err, &["it cannot use --devices"]);
 }
 
 /// A still and a sequence report `--devices` alike: a list the backend cannot take is a usage

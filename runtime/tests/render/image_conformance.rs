@@ -81,10 +81,7 @@ fn wgpu_matches_cpu_on_every_example() {
         let scene = load_small(&path, 96, 64);
         let lowered = Lowered::new(&scene);
         let kernel = wgsl::write(&scene, &lowered).expect("valid kernel");
-        let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-        let on_cpu = cpu::render(&scene, &lowered, &cpu::Options::default(), &|| {});
-        let d =
-            metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+        let (on_gpu, on_cpu, d) = side_by_side(&gpu, &scene, &lowered, &kernel);
         println!(
             "{:<14} psnr {:6.1} dB  differing {:.4}  steps/px gpu {:.1} cpu {:.1}",
             path.file_stem().unwrap_or_default().to_string_lossy(),
@@ -140,6 +137,20 @@ fn assert_agree(
     common::assert_agree(label, pair, THRESHOLD, (MIN_PSNR, MAX_DIFFERING));
 }
 
+/// `scene` rendered through `kernel` on `gpu` and by the CPU with the default options, and
+/// how far the GPU's image is from the CPU's.
+fn side_by_side(
+    gpu: &gpu::Gpu,
+    scene: &sdfc_compiler::Scene,
+    lowered: &Lowered,
+    kernel: &wgsl::Kernel,
+) -> (gpu::GpuRender, cpu::Render, metrics::Difference) {
+    let on_gpu = gpu::render(gpu, scene, kernel, 1.0, &mut |_| {}).expect("gpu render");
+    let on_cpu = cpu::render(scene, lowered, &cpu::Options::default(), &|| {});
+    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+    (on_gpu, on_cpu, d)
+}
+
 /// A distance program large enough that `map` and `sdf` are cut into functions
 /// (examples/scaling/compound_100.sdf, about 15 000 instructions, its instances written as
 /// code) renders on wgpu as on the CPU.
@@ -164,24 +175,18 @@ fn a_kernel_with_outlined_blocks_matches_the_cpu() {
 /// with shapes that must stay in the rest of the program: a twisted box and ellipsoids (a
 /// bound, not an exact distance).
 fn marched_scene(n: usize) -> String {
-    let mut rng = sdfc_compiler::Rng::new(0x9e37_79b9_u64);
-    let mut next = move || rng.uniform();
-    let mut text = String::from(
-        "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75 };\n\
+    let header = "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75 };\n\
          material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\
          material mirror = phong { color: (0.9, 0.9, 0.95), diffuse: 0.2, specular: 1, shininess: 200, reflect: 0.5 };\n\
          material teal = phong { color: (0.15, 0.6, 0.6), specular: 0.5, shininess: 64 };\n\
          camera { position: (0, 4, -7), look_at: (0, 1, 3), fov: 60deg }\n\
          light point { position: (-4, 9, -6), intensity: 1.1, radius: 60, penumbra: 84.2894deg }\n\
          render { width: 96, height: 64, max_depth: 2, method: \"march\" }\n\
-         scene {\n  plane() @ floor;\n  box((0.3, 1, 0.3)).twist(1.5).translate(0, 1, -3) @ teal;\n",
-    );
-    for i in 0..n {
-        let (x, y, z) = (16.0 * next() - 8.0, 0.4 + 2.0 * next(), 10.0 * next() - 2.0);
-        let (a, b) = (360.0 * next(), 360.0 * next());
+         scene {\n  plane() @ floor;\n  box((0.3, 1, 0.3)).twist(1.5).translate(0, 1, -3) @ teal;\n";
+    scattered((0x9e37_79b9_u64, n), header, |i, (a, b), rng| {
         let turn = format!("rotate_y({a:.1}deg).rotate_x({b:.1}deg)");
         let shape = match i % 9 {
-            0 => format!("sphere({:.3})", 0.2 + 0.1 * next()),
+            0 => format!("sphere({:.3})", 0.2 + 0.1 * rng.uniform()),
             1 => format!("box((0.2, 0.15, 0.25)).{turn}"),
             2 => format!("round_box((0.2, 0.15, 0.25), 0.05).{turn}.scale(1.2)"),
             3 => format!("torus(0.25, 0.06).{turn}"),
@@ -197,8 +202,28 @@ fn marched_scene(n: usize) -> String {
         } else {
             format!(" @ {material}")
         };
+        (format!("{shape}.scale(2)"), paint)
+    })
+}
+
+/// The text of a scene: `header`, which opens the scene block, then `n` shapes at random
+/// places (the stream seeded by `seed`), each as `place` writes it from its index, two random
+/// angles in degrees and the stream: what comes before its translation and what after; the
+/// block closed.
+fn scattered(
+    (seed, n): (u64, usize),
+    header: &str,
+    mut place: impl FnMut(usize, (f64, f64), &mut sdfc_compiler::Rng) -> (String, String),
+) -> String {
+    let mut rng = sdfc_compiler::Rng::new(seed);
+    let mut text = String::from(header);
+    for i in 0..n {
+        let mut next = || rng.uniform();
+        let (x, y, z) = (16.0 * next() - 8.0, 0.4 + 2.0 * next(), 10.0 * next() - 2.0);
+        let (a, b) = (360.0 * next(), 360.0 * next());
+        let (before, after) = place(i, (a, b), &mut rng);
         text.push_str(&format!(
-            "  {shape}.scale(2).translate({x:.3}, {y:.3}, {z:.3}){paint};\n"
+            "  {before}.translate({x:.3}, {y:.3}, {z:.3}){after};\n"
         ));
     }
     text.push_str("}\n");
@@ -469,10 +494,7 @@ fn debug_nan_marks_the_same_pixels_on_wgpu() {
 /// capsules turned and scaled at pseudo-random places on a checkered, reflective floor, with
 /// mirrors and a floating glass ball that touches nothing (so `auto` traces it).
 fn mixed_scene(n: usize) -> String {
-    let mut rng = sdfc_compiler::Rng::new(0x2545_f491_u64);
-    let mut next = move || rng.uniform();
-    let mut text = String::from(
-        "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75, reflect: 0.1 };\n\
+    let header = "material floor = checker { a: (0.9, 0.9, 0.88), b: (0.2, 0.22, 0.25), size: 0.75, reflect: 0.1 };\n\
          material clay = phong { color: (0.85, 0.45, 0.25), specular: 0.3, shininess: 24 };\n\
          material mirror = phong { color: (0.9, 0.9, 0.95), diffuse: 0.2, specular: 1, shininess: 200, reflect: 0.6 };\n\
          material teal = phong { color: (0.15, 0.6, 0.6), specular: 0.5, shininess: 64 };\n\
@@ -481,31 +503,24 @@ fn mixed_scene(n: usize) -> String {
          light point { position: (-4, 9, -6), intensity: 1.1, radius: 60 }\n\
          light directional { direction: (1, -1, 0.6), color: (0.35, 0.35, 0.4) }\n\
          render { width: 96, height: 64, max_depth: 3 }\n\
-         scene {\n  plane() @ floor;\n  sphere(0.9).translate(0, 5, -5) @ glass;\n",
-    );
-    for i in 0..n {
-        let (x, y, z) = (16.0 * next() - 8.0, 0.4 + 2.0 * next(), 10.0 * next() - 2.0);
-        let (a, b) = (360.0 * next(), 360.0 * next());
+         scene {\n  plane() @ floor;\n  sphere(0.9).translate(0, 5, -5) @ glass;\n";
+    scattered((0x2545_f491_u64, n), header, |i, (a, b), rng| {
         let shape = match i % 4 {
             0 => format!(
                 "sphere({:.3}).scale(({:.3}, 1, 1))",
-                0.2 + 0.1 * next(),
-                0.6 + next()
+                0.2 + 0.1 * rng.uniform(),
+                0.6 + rng.uniform()
             ),
             1 => format!("box((0.2, 0.15, 0.25)).rotate_y({a:.1}deg).rotate_x({b:.1}deg)"),
             2 => format!(
                 "cylinder(0.15, 0.3).rotate_z({a:.1}deg).scale({:.3})",
-                0.8 + 0.4 * next()
+                0.8 + 0.4 * rng.uniform()
             ),
             _ => format!("capsule(0.1, 0.25).rotate_x({a:.1}deg).rotate_y({b:.1}deg)"),
         };
         let material = ["clay", "mirror", "teal"][i % 3];
-        text.push_str(&format!(
-            "  {shape}.translate({x:.3}, {y:.3}, {z:.3}) @ {material};\n"
-        ));
-    }
-    text.push_str("}\n");
-    text
+        (shape, format!(" @ {material}"))
+    })
 }
 
 /// A traced scene of more primitives than the kernel unrolls reads them and their hierarchy
@@ -655,9 +670,7 @@ fn a_field_of_two_noises_through_the_interpreted_kernel_matches_the_cpu() {
         gpu.is_cpu(),
     );
     assert!(kernel.interpreted());
-    let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-    let on_cpu = cpu::render(&scene, &lowered, &cpu::Options::default(), &|| {});
-    let d = metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+    let (_, _, d) = side_by_side(&gpu, &scene, &lowered, &kernel);
     println!(
         "two noises, interpreted: psnr {:.1} dB, differing {:.4}",
         d.psnr, d.differing
@@ -695,10 +708,7 @@ fn colour_fields_match_the_cpu_on_every_kernel() {
             kernel.interpreted(),
             choice == wgsl::KernelChoice::Interpreted
         );
-        let on_gpu = gpu::render(&gpu, &scene, &kernel, 1.0, &mut |_| {}).expect("gpu render");
-        let on_cpu = cpu::render(&scene, &lowered, &cpu::Options::default(), &|| {});
-        let d =
-            metrics::compare(&on_gpu.render.image, &on_cpu.image, THRESHOLD).expect("same size");
+        let (_, _, d) = side_by_side(&gpu, &scene, &lowered, &kernel);
         println!(
             "colour fields, {method:?}, {choice:?}: psnr {:.1} dB, differing {:.4}",
             d.psnr, d.differing

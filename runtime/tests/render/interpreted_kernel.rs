@@ -5,6 +5,7 @@
 //! image tests say they skipped, unless `SDFC_REQUIRE_DEVICES=1`.
 
 use crate::common;
+use crate::common::assert_has;
 use crate::common::words;
 
 use common::{kernel_for, random_scene};
@@ -297,20 +298,14 @@ fn bad_combinations_are_refused() {
         }
         let (code, err) = sdfc(&args);
         assert_eq!(code, 2, "{args:?}: {err}");
-        assert!(
-            err.contains("--kernel interpreted chooses a GPU kernel"),
-            "{err}"
-        );
+        assert_has(&err, &["--kernel interpreted chooses a GPU kernel"]);
     }
     // A traced scene has no distance program to interpret.
     let (code, err) = sdfc(&words(
         "compile ../examples/seed2.sdf --emit wgsl --kernel interpreted",
     ));
     assert_eq!(code, 1, "{err}");
-    assert!(
-        err.contains("traced analytically") && err.contains("--set method=march"),
-        "{err}"
-    );
+    assert_has(&err, &["traced analytically", "--set method=march"]);
     // Through `render` too, whatever the backend, and never by falling back to the CPU.
     for backend in ["auto", "wgpu"] {
         let (code, err) = sdfc(&[
@@ -324,7 +319,7 @@ fn bad_combinations_are_refused() {
             out,
         ]);
         assert_eq!(code, 1, "{err}");
-        assert!(err.contains("traced analytically"), "{err}");
+        assert_has(&err, &["traced analytically"]);
         assert!(!Path::new(out).exists());
     }
     // Too few registers: the error names the limit that raises it.
@@ -332,19 +327,16 @@ fn bad_combinations_are_refused() {
         "compile ../examples/seed3.sdf --emit wgsl --kernel interpreted --limit registers=2",
     ));
     assert_eq!(code, 1, "{err}");
-    assert!(
-        err.contains("registers and the kernel has 2") && err.contains("--limit registers="),
-        "{err}"
+    assert_has(
+        &err,
+        &["registers and the kernel has 2", "--limit registers="],
     );
     // `--kernel` goes with the kernel's targets only.
     let (code, err) = sdfc(&words(
         "compile ../examples/seed3.sdf --emit program --kernel interpreted",
     ));
     assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("`--kernel` chooses the renderer kernel"),
-        "{err}"
-    );
+    assert_has(&err, &["`--kernel` chooses the renderer kernel"]);
     // The interpreted kernel's scene data is the program's words.
     let (code, err) = sdfc(&[
         "compile",

@@ -17,38 +17,23 @@ use sdfc_runtime::frontend;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-const CULL: LowerOptions = LowerOptions {
-    level: 1,
-    cull: true,
-    local: true,
-    parametric: false,
-};
-const NO_CULL: LowerOptions = LowerOptions {
-    level: 1,
-    cull: false,
-    local: true,
-    parametric: false,
-};
+/// The lowering at `level`, culling or not, with local bounds or not, not parametric.
+const fn lowering(level: u8, cull: bool, local: bool) -> LowerOptions {
+    LowerOptions {
+        level,
+        cull,
+        local,
+        parametric: false,
+    }
+}
+
+const CULL: LowerOptions = lowering(1, true, true);
+const NO_CULL: LowerOptions = lowering(1, false, true);
 /// Every pass, without local bounds: the field as written, for comparing values.
-const WRITTEN: LowerOptions = LowerOptions {
-    level: 1,
-    cull: true,
-    local: false,
-    parametric: false,
-};
+const WRITTEN: LowerOptions = lowering(1, true, false);
 /// The passes alone: no culling and no local bounds, which add instructions on purpose.
-const PASSES: LowerOptions = LowerOptions {
-    level: 1,
-    cull: false,
-    local: false,
-    parametric: false,
-};
-const LITERAL: LowerOptions = LowerOptions {
-    level: 0,
-    cull: false,
-    local: false,
-    parametric: false,
-};
+const PASSES: LowerOptions = lowering(1, false, false);
+const LITERAL: LowerOptions = lowering(0, false, false);
 
 /// The `.sdf` files directly inside `dir` (relative to the workspace root), sorted.
 fn sdf_files(dir: &str) -> Vec<PathBuf> {

@@ -180,12 +180,8 @@ fn noise_falls_as_one_over_the_root_of_the_samples() {
 /// sky and a sun (a disc: sphere traced), path traced.
 fn studio() -> Scene {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/studio_path.sdf");
-    let mut scene = sdfc_runtime::frontend::load(&path)
-        .expect("readable")
-        .scene
-        .expect("checks");
-    scene.settings.width = 64;
-    scene.settings.height = 36;
+    // One sample a pixel (the file sets no `aa`), four paths each.
+    let mut scene = common::load_small(&path, 64, 36);
     scene.settings.samples = 4;
     scene
 }

@@ -22,12 +22,14 @@ scene { sphere(1) @ m; }
 /// reflects, its diffuse part does not); a rough white metal is not above 1 and loses some
 /// (the single-scattering lobe's energy), a mirror metal none. A grey sphere shows where the
 /// sphere is.
+/// The scene [`FURNACE`] with the material `material`, checked (the file `name`).
+fn furnace(name: &str, material: &str) -> sdfc_compiler::Scene {
+    checked(name, &FURNACE.replace("MAT", material))
+}
+
 #[test]
 fn the_white_furnace_holds_for_pbr() {
-    let grey = checked(
-        "grey",
-        &FURNACE.replace("MAT", "pbr { base_color: (0.5, 0.5, 0.5) }"),
-    );
+    let grey = furnace("grey", "pbr { base_color: (0.5, 0.5, 0.5) }");
     let mut on_sphere = Vec::new();
     for (backend, image) in render_everywhere("grey", &grey) {
         let dark: Vec<(u32, u32)> = (0..40)
@@ -42,12 +44,9 @@ fn the_white_furnace_holds_for_pbr() {
         on_sphere = dark;
     }
     for roughness in [0.0, 0.3, 0.5, 1.0] {
-        let white = checked(
+        let white = furnace(
             "white",
-            &FURNACE.replace(
-                "MAT",
-                &format!("pbr {{ base_color: (1, 1, 1), roughness: {roughness} }}"),
-            ),
+            &format!("pbr {{ base_color: (1, 1, 1), roughness: {roughness} }}"),
         );
         for (backend, image) in render_everywhere("white furnace", &white) {
             let what = format!("{backend}: roughness {roughness}");
@@ -55,12 +54,9 @@ fn the_white_furnace_holds_for_pbr() {
         }
     }
     for (roughness, least) in [(0.0, 0.999), (0.5, 0.6), (1.0, 0.35)] {
-        let metal = checked(
+        let metal = furnace(
             "metal",
-            &FURNACE.replace(
-                "MAT",
-                &format!("pbr {{ base_color: (1, 1, 1), metallic: 1, roughness: {roughness} }}"),
-            ),
+            &format!("pbr {{ base_color: (1, 1, 1), metallic: 1, roughness: {roughness} }}"),
         );
         for (backend, image) in render_everywhere("metal furnace", &metal) {
             let mut sum = 0.0;
@@ -175,19 +171,32 @@ scene { plane() @ m; }
         assert!(floor.len() > 30, "{backend}: {column:?}");
         // From the nearest row (the last) up towards the horizon: brighter and brighter.
         let near = *column.last().unwrap();
-        assert!(
-            near > 0.035 && near < 0.08,
-            "{backend}: the nearest row is {near}"
-        );
-        for w in floor.windows(2) {
-            assert!(w[0] >= w[1] - 1e-6, "{backend}: {column:?}");
-        }
-        assert!(
-            floor[0] > 0.3,
-            "{backend}: towards the horizon {}",
-            floor[0]
-        );
+        brightens_towards_the_horizon(backend, (&floor, near), (0.035, 0.08), 0.3);
     }
+}
+
+/// Fails unless the `floor` rows of a column (from the horizon down) brighten towards the
+/// horizon on `backend`: the nearest row's value `near` within `nearest` (open), every row at
+/// least the one below it, and the row at the horizon above `horizon`.
+#[track_caller]
+fn brightens_towards_the_horizon(
+    backend: &str,
+    (floor, near): (&[f32], f32),
+    nearest: (f32, f32),
+    horizon: f32,
+) {
+    assert!(
+        near > nearest.0 && near < nearest.1,
+        "{backend}: the nearest row is {near}"
+    );
+    for w in floor.windows(2) {
+        assert!(w[0] >= w[1] - 1e-6, "{backend}: {floor:?}");
+    }
+    assert!(
+        floor[0] > horizon,
+        "{backend}: towards the horizon {}",
+        floor[0]
+    );
 }
 
 /// A black floor of `MAT` under a uniform sky of 1 that is also the background, seen from a
@@ -235,17 +244,6 @@ fn fresnel_on_phong_brightens_grazing_angles_and_is_off_by_default() {
         assert!(column.len() > 30, "{backend}: {column:?}");
         let near = *column.last().unwrap();
         // The nearest row: N·V ≈ sin 37°, s = (1 − 0.6)⁵ ≈ 0.01.
-        assert!(
-            near > 0.1 && near < 0.13,
-            "{backend}: the nearest row is {near}"
-        );
-        for w in column.windows(2) {
-            assert!(w[0] >= w[1] - 1e-6, "{backend}: {column:?}");
-        }
-        assert!(
-            column[0] > 0.5,
-            "{backend}: towards the horizon {}",
-            column[0]
-        );
+        brightens_towards_the_horizon(backend, (&column, near), (0.1, 0.13), 0.5);
     }
 }

@@ -66,13 +66,22 @@ pub(crate) fn small(scene: &mut Scene, w: u32, h: u32) {
     scene.settings.background = [0.0, 0.0, 0.0];
 }
 
+/// `scene` seen from `position` towards `look_at`, [`small`].
+pub(crate) fn seen_from(
+    scene: &mut Scene,
+    (position, look_at): ([f64; 3], [f64; 3]),
+    (w, h): (u32, u32),
+) {
+    scene.camera.position = position;
+    scene.camera.look_at = look_at;
+    small(scene, w, h);
+}
+
 #[test]
 fn a_sphere_seen_head_on_covers_the_predicted_pixels() {
     for method in METHODS {
         let mut scene = single(Node::Sphere { radius: 1.0 });
-        scene.camera.position = [0.0, 0.0, -5.0];
-        scene.camera.look_at = [0.0, 0.0, 0.0];
-        small(&mut scene, 96, 72);
+        seen_from(&mut scene, ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), (96, 72));
         let r = render_as(method, &scene);
         let covered = r.image.linear.iter().filter(|c| c[0] > 0.0).count() as i64;
         // A pixel is covered when its centre ray passes within the radius of the centre.
@@ -112,9 +121,7 @@ fn a_camera_looking_straight_down_sees_the_scene_and_up_rolls_it() {
     });
     b.point_light([0.0, 10.0, 0.0], 0.0);
     let mut scene = b.finish(root);
-    scene.camera.position = [0.0, 6.0, 0.0];
-    scene.camera.look_at = [0.0, 0.0, 0.0];
-    small(&mut scene, 64, 64);
+    seen_from(&mut scene, ([0.0, 6.0, 0.0], [0.0, 0.0, 0.0]), (64, 64));
     // Where the marker must appear: with up = +z (the stand-in), and rolled with up = +x.
     let mut facing = scene.clone();
     facing.camera.up = [0.0, 0.0, 1.0];
@@ -165,9 +172,7 @@ pub(crate) fn shadow_scene(penumbra: f64) -> Scene {
     });
     b.point_light([2.0, 5.0, 0.0], penumbra);
     let mut scene = b.finish(root);
-    scene.camera.position = [0.0, 4.0, -6.0];
-    scene.camera.look_at = [0.0, 0.0, 0.0];
-    small(&mut scene, 160, 120);
+    seen_from(&mut scene, ([0.0, 4.0, -6.0], [0.0, 0.0, 0.0]), (160, 120));
     scene
 }
 
@@ -189,9 +194,7 @@ pub(crate) fn mirror_scene(reflect: f64) -> Scene {
     });
     b.point_light([0.0, 5.0, -2.0], 0.0);
     let mut scene = b.finish(root);
-    scene.camera.position = [0.0, 1.0, -4.0];
-    scene.camera.look_at = [0.0, 0.0, 2.0];
-    small(&mut scene, 120, 90);
+    seen_from(&mut scene, ([0.0, 1.0, -4.0], [0.0, 0.0, 2.0]), (120, 90));
     scene
 }
 

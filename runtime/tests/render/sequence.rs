@@ -5,6 +5,7 @@
 //! of their ecosystems.
 
 use crate::animation::BASE;
+use crate::common::assert_has;
 use crate::common::words;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -293,10 +294,7 @@ fn a_video_needs_ffmpeg_on_path() {
         3 * 32 * 24 * 3
     );
     let args = std::fs::read_to_string(d.join("args.txt")).unwrap();
-    assert!(
-        args.contains("-s 32x24") && args.contains("-framerate 10"),
-        "{args}"
-    );
+    assert_has(&args, &["-s 32x24", "-framerate 10"]);
 }
 
 #[test]
@@ -324,16 +322,16 @@ fn check_says_still_numbers_or_structure() {
     };
     let (code, out) = line("still.sdf");
     assert_eq!(code, Some(0));
-    assert!(out.contains("still.sdf: still"), "{out}");
+    assert_has(&out, &["still.sdf: still"]);
     let (code, out) = line("numbers.sdf");
     assert_eq!(code, Some(0));
-    assert!(out.contains("animated, numbers only"), "{out}");
-    assert!(out.contains("8 frames at 4 fps"), "{out}");
+    assert_has(&out, &["animated, numbers only"]);
+    assert_has(&out, &["8 frames at 4 fps"]);
     let (code, out) = line("structure.sdf");
     assert_eq!(code, Some(0));
-    assert!(
-        out.contains("structure varies: 4 structures, changing at frames 2, 4, 6"),
-        "{out}"
+    assert_has(
+        &out,
+        &["structure varies: 4 structures, changing at frames 2, 4, 6"],
     );
     // Each change is said where it happens in the source, and how.
     for said in [
@@ -348,7 +346,7 @@ fn check_says_still_numbers_or_structure() {
     // A frame whose scene does not check is reported with its time.
     let (code, out) = line("broken.sdf");
     assert_eq!(code, Some(1));
-    assert!(out.contains("frame 6 (t = 1.5 s) has errors"), "{out}");
+    assert_has(&out, &["frame 6 (t = 1.5 s) has errors"]);
 }
 
 /// The job-array files of the README: the Slurm script parses with `bash -n`, the

@@ -3,7 +3,7 @@
 
 use crate::common;
 use crate::render::{
-    luminance, mirror_scene, project, render, render_as, shadow_scene, small, METHODS,
+    luminance, mirror_scene, project, render, render_as, seen_from, shadow_scene, METHODS,
 };
 use common::*;
 use sdfc_compiler::{Light, Node, Pattern, Scene};
@@ -136,9 +136,7 @@ fn glass_scene(ball: Option<(f64, f64)>) -> Scene {
     };
     b.point_light([0.0, 0.0, -6.0], 4.0);
     let mut scene = b.finish(root);
-    scene.camera.position = [0.0, 0.0, -5.0];
-    scene.camera.look_at = [0.0, 0.0, 0.0];
-    small(&mut scene, 96, 72);
+    seen_from(&mut scene, ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), (96, 72));
     scene
 }
 

@@ -1,15 +1,13 @@
 //! The viewer follows edits of its scene file (a colour, a new shape saved by renaming, an
 //! error that leaves the last good image on show): in a window on wgpu, on the CPU, and headless.
 
-use crate::{changed, display, exited, mean, temp_dir, wait_for, Display, CENTRE, LEFT, SCENE};
+use crate::{changed, display, exited, mean, scene_dir, wait_for, Display, CENTRE, LEFT, SCENE};
 use std::process::{Command, Stdio};
 
 /// Opens the viewer with `args` (besides the file and the screenshot folder), edits the file
 /// three times, and checks each reload's screenshot.
 fn follows_edits(name: &str, display: Option<&Display>, args: &[&str]) {
-    let dir = temp_dir(name);
-    let scene = dir.join("scene.sdf");
-    std::fs::write(&scene, SCENE).unwrap();
+    let (dir, scene) = scene_dir(name, SCENE);
     let shots = dir.join("shots");
     let log = dir.join("viewer.log");
     let runtime = dir.join("xdg");

@@ -3,7 +3,7 @@
 //! orbit measured.
 
 use crate::words;
-use crate::{headless_run, mean, required, temp_dir, CENTRE, SCENE};
+use crate::{headless_run, mean, required, scene_dir, temp_dir, CENTRE, SCENE};
 use sdfc_runtime::image::read_png;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -13,8 +13,7 @@ use std::process::{Command, Output};
 /// thread; and `--backend auto` says what it found.
 #[test]
 fn headless_wgpu_screenshot_shows_the_scene() {
-    let dir = temp_dir("headless-wgpu");
-    std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
+    let (dir, _) = scene_dir("headless-wgpu", SCENE);
     let args = "view scene.sdf --headless --backend wgpu --size 64x48 --frames 3 --screenshot shot.png --timings";
     let (out, stderr) = sdfc_in(&dir, &words(args));
     if no_wgpu(&stderr) {
@@ -136,8 +135,7 @@ fn no_wgpu(stderr: &str) -> bool {
 /// fewer frames than asked for (`aa: 2`) stops and writes its screenshot.
 #[test]
 fn headless_frames_stop_after_the_image_settles() {
-    let dir = temp_dir("headless-frames");
-    std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
+    let (dir, _) = scene_dir("headless-frames", SCENE);
     let args = "scene.sdf --size 64x48 --frames 40 --screenshot shot.png";
     let (status, stderr) = headless_run(&dir, &words(args));
     assert!(status.success(), "{stderr}");
@@ -169,8 +167,7 @@ fn headless_screenshot_of_a_scene_that_never_loads_fails() {
 /// converge once the camera stops, then the run ends (it waited for file changes before).
 #[test]
 fn headless_orbit_prints_its_figures_and_exits() {
-    let dir = temp_dir("headless-orbit");
-    std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
+    let (dir, _) = scene_dir("headless-orbit", SCENE);
     let (status, stderr) = headless_run(
         &dir,
         &["scene.sdf", "--size", "32x24", "--orbit-frames", "3"],

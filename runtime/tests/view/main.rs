@@ -23,19 +23,31 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// A plane and a red sphere in the middle of the picture, lit from the viewer's right (world
-/// −x), so that the shadows of shapes added on the left (world +x) stay on the left.
-const SCENE: &str = r#"
-material grey = phong { color: (0.6, 0.6, 0.6) };
+/// The materials, camera and light of the tests' scenes: a grey floor and a red ball, seen
+/// from the front, lit from the viewer's right (world −x).
+macro_rules! studio {
+    () => {
+        r#"material grey = phong { color: (0.6, 0.6, 0.6) };
 material ball = phong { color: (0.9, 0.1, 0.1) };
 camera { position: (0, 1.5, -5), look_at: (0, 0.6, 0), fov: 50deg }
 light point { position: (-3, 5, -4), intensity: 1 }
-render { width: 160, height: 120, aa: 2, max_steps: 128 }
+"#
+    };
+}
+use studio;
+
+/// A plane and a red sphere in the middle of the picture, lit from the viewer's right (world
+/// −x), so that the shadows of shapes added on the left (world +x) stay on the left.
+const SCENE: &str = concat!(
+    "\n",
+    studio!(),
+    r#"render { width: 160, height: 120, aa: 2, max_steps: 128 }
 scene {
   plane((0, 1, 0), 0) @ grey;
   sphere(0.8).translate(0, 0.8, 0) @ ball;
 }
-"#;
+"#
+);
 
 /// How long one reload may take to reach its screenshot (lavapipe on a busy 2-core machine).
 const PATIENCE: Duration = Duration::from_secs(180);
@@ -123,6 +135,15 @@ fn temp_dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// A fresh directory for the test `name` holding `text` as `scene.sdf`: the directory and the
+/// scene's path.
+fn scene_dir(name: &str, text: &str) -> (PathBuf, PathBuf) {
+    let dir = temp_dir(name);
+    let scene = dir.join("scene.sdf");
+    std::fs::write(&scene, text).unwrap();
+    (dir, scene)
 }
 
 /// Waits for `path` to exist, while `child` runs.

@@ -8,19 +8,19 @@
 use super::*;
 
 /// A ball on a floor, with a radius, a floor that can be switched off, and a colour.
-const PARAMETRIC: &str = r#"
+const PARAMETRIC: &str = concat!(
+    r#"
 param radius = 0.5 in 0.2..1.0 step 0.1 "Ball radius";
 param floor = true "A floor under the ball";
-material grey = phong { color: (0.6, 0.6, 0.6) };
-material ball = phong { color: (0.9, 0.1, 0.1) };
-camera { position: (0, 1.5, -5), look_at: (0, 0.6, 0), fov: 50deg }
-light point { position: (-3, 5, -4), intensity: 1 }
-render { width: 200, height: 200, aa: 2, max_steps: 128 }
+"#,
+    studio!(),
+    r#"render { width: 200, height: 200, aa: 2, max_steps: 128 }
 scene {
   union([for i in 0..1 if floor { plane((0, 1, 0), 0) @ grey }]
     + [sphere(radius).translate(0, radius, 0) @ ball]);
 }
-"#;
+"#
+);
 
 /// The scene's image in the screenshot: its `render` size, on the left.
 const IMAGE: (u32, u32) = (200, 200);
@@ -47,9 +47,7 @@ fn bright(shot: &Image, x0: u32, x1: u32) -> f64 {
 #[test]
 fn the_panel_shows_parameters_and_a_change_rerenders_the_scene() {
     let Some(display) = display() else { return };
-    let dir = temp_dir("panel");
-    let scene = dir.join("scene.sdf");
-    std::fs::write(&scene, PARAMETRIC).unwrap();
+    let (dir, scene) = scene_dir("panel", PARAMETRIC);
     let shots = dir.join("shots");
     let log = dir.join("viewer.log");
     let runtime = dir.join("xdg");
@@ -179,8 +177,7 @@ fn the_panel_shows_parameters_and_a_change_rerenders_the_scene() {
 
 #[test]
 fn headless_changes_take_the_controls_values_and_refuse_others() {
-    let dir = temp_dir("panel-headless");
-    std::fs::write(dir.join("scene.sdf"), PARAMETRIC).unwrap();
+    let (dir, _) = scene_dir("panel-headless", PARAMETRIC);
     let base = [
         "scene.sdf",
         "--size",

@@ -2,7 +2,9 @@
 //! animated scene at a time, and new kernels shown interpreted while they compile.
 
 use crate::words;
-use crate::{changed, display, exited, mean, temp_dir, wait_for, Display, CENTRE, LEFT, SCENE};
+use crate::{
+    changed, display, exited, mean, scene_dir, temp_dir, wait_for, Display, CENTRE, LEFT, SCENE,
+};
 use sdfc_runtime::image::{read_png, Image};
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -12,8 +14,7 @@ fn screenshot_after_frames(name: &str, env: &[(&str, &str)]) -> String {
     let Some(display) = display() else {
         return String::new();
     };
-    let dir = temp_dir(name);
-    std::fs::write(dir.join("scene.sdf"), SCENE).unwrap();
+    let (dir, _) = scene_dir(name, SCENE);
     std::fs::create_dir_all(dir.join("xdg")).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_sdfc"))
         .current_dir(&dir)
@@ -147,9 +148,7 @@ fn the_window_shows_new_kernels_interpreted_while_they_compile() {
     // The image each load settles on is the specialised kernel's, as `--kernel specialised`
     // shows it, and the interpreted kernel's image agrees with it.
     let Some(display) = display() else { return };
-    let dir = temp_dir("interim");
-    let scene = dir.join("scene.sdf");
-    std::fs::write(&scene, SCENE).unwrap();
+    let (dir, scene) = scene_dir("interim", SCENE);
     std::fs::create_dir_all(dir.join("xdg")).unwrap();
     let shots = dir.join("shots");
     let log = dir.join("viewer.log");

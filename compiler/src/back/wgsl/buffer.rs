@@ -338,7 +338,7 @@ pub(super) fn identity(m: &[V3; 3]) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::scene::analytic::hierarchy;
     use crate::scene::{MaterialId, NodeId};
@@ -354,7 +354,8 @@ mod tests {
         }
     }
 
-    fn words(bytes: &[u8]) -> Vec<[u32; 4]> {
+    /// The entries of `bytes`, four words each.
+    pub(in super::super) fn words(bytes: &[u8]) -> Vec<[u32; 4]> {
         let w: Vec<u32> = bytes
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -362,6 +363,32 @@ mod tests {
         w.chunks_exact(4)
             .map(|c| [c[0], c[1], c[2], c[3]])
             .collect()
+    }
+
+    /// Walks the entries `e` of the data (`e[0][0]` its end) as the kernel does: checks that
+    /// every group's `next` lies past its own entries and within the data, gives every
+    /// other entry's index and tag to `entry`, which checks it and says how many entries it
+    /// takes, and checks that the walk ends exactly at the end; returns the number of groups.
+    pub(in super::super) fn walk(
+        e: &[[u32; 4]],
+        mut entry: impl FnMut(usize, u32) -> usize,
+    ) -> usize {
+        let end = e[0][0] as usize;
+        assert_eq!(end, e.len());
+        let (mut i, mut groups) = (1, 0);
+        while i < end {
+            let tag = e[i][3];
+            if tag == GROUP {
+                let next = e[i + 1][3] as usize;
+                assert!(next > i + 2 && next <= end, "group at {i}: next {next}");
+                groups += 1;
+                i += 2;
+            } else {
+                i += entry(i, tag);
+            }
+        }
+        assert_eq!(i, end);
+        groups
     }
 
     /// Every primitive is written once, in the order of the hierarchy, and every group's
@@ -372,26 +399,16 @@ mod tests {
         prims[5].matrix = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
         let top = hierarchy(&prims);
         let e = words(&data(&prims, &top));
-        let end = e[0][0] as usize;
-        assert_eq!(end, e.len());
-        let (mut i, mut seen, mut groups, mut framed) = (1, Vec::new(), 0, Vec::new());
-        while i < end {
-            let tag = e[i][3];
-            if tag == GROUP {
-                let next = e[i + 1][3] as usize;
-                assert!(next > i + 2 && next <= end, "group at {i}: next {next}");
-                groups += 1;
-                i += 2;
-            } else {
-                seen.push((f32::from_bits(e[i][0]), tag >> MATERIAL_SHIFT));
-                assert_eq!(tag & KIND_BITS, SPHERE);
-                if tag & FRAMED != 0 {
-                    framed.push(seen.len() - 1);
-                }
-                i += if tag & FRAMED != 0 { 5 } else { 2 };
+        let (mut seen, mut framed) = (Vec::new(), Vec::new());
+        let groups = walk(&e, |i, tag| {
+            seen.push((f32::from_bits(e[i][0]), tag >> MATERIAL_SHIFT));
+            assert_eq!(tag & KIND_BITS, SPHERE);
+            if tag & FRAMED == 0 {
+                return 2;
             }
-        }
-        assert_eq!(i, end);
+            framed.push(seen.len() - 1);
+            5
+        });
         assert!(groups >= 9, "{groups} groups");
         let mut order = Vec::new();
         fn flatten(items: &[Item], out: &mut Vec<usize>) {

@@ -101,28 +101,42 @@ fn hulls_of_balls_and_of_parallel_cylinders() {
         let d = diags.iter().find(|d| d.is_error()).expect("an error");
         d.message.clone()
     };
-    let m = error("hull(sphere(1), box(0.5))");
-    assert!(
-        m.contains("shape 2 of 2 is a `box`") && m.contains("hull([points"),
-        "{m}"
-    );
-    let m = error("hull(sphere(1), cylinder(0.5, 1))");
-    assert!(m.contains("balls and cylinders together"), "{m}");
-    let m = error("hull(cylinder(0.5, 1), cylinder(0.5, 1).rotate_x(10deg))");
-    assert!(m.contains("cylinder 2 is turned"), "{m}");
-    let m = error("hull(cylinder(0.5, 1), cylinder(0.5, 1).translate(1, 0.5, 0))");
-    assert!(m.contains("moved along its axis"), "{m}");
-    let m = error("hull(cylinder(0.5, 1), cylinder(0.5, 2).translate(1, 0, 0))");
-    assert!(m.contains("another height"), "{m}");
-    let m = error("hull(cylinder(0.5, 1).round(0.1), sphere(1))");
-    assert!(m.contains("rounded cylinder"), "{m}");
-    let m = error("hull([for i in 0..0 { sphere(1) }])");
-    assert!(m.contains("empty list"), "{m}");
-    let m = error("hull([for i in 0..65 { sphere(1).translate(i, 0, 0) }])");
-    assert!(
-        m.contains("takes 65 balls") && m.contains("hull_shapes=65"),
-        "{m}"
-    );
+    for (src, says) in [
+        (
+            "hull(sphere(1), box(0.5))",
+            &["shape 2 of 2 is a `box`", "hull([points"][..],
+        ),
+        (
+            "hull(sphere(1), cylinder(0.5, 1))",
+            &["balls and cylinders together"],
+        ),
+        (
+            "hull(cylinder(0.5, 1), cylinder(0.5, 1).rotate_x(10deg))",
+            &["cylinder 2 is turned"],
+        ),
+        (
+            "hull(cylinder(0.5, 1), cylinder(0.5, 1).translate(1, 0.5, 0))",
+            &["moved along its axis"],
+        ),
+        (
+            "hull(cylinder(0.5, 1), cylinder(0.5, 2).translate(1, 0, 0))",
+            &["another height"],
+        ),
+        (
+            "hull(cylinder(0.5, 1).round(0.1), sphere(1))",
+            &["rounded cylinder"],
+        ),
+        ("hull([for i in 0..0 { sphere(1) }])", &["empty list"]),
+        (
+            "hull([for i in 0..65 { sphere(1).translate(i, 0, 0) }])",
+            &["takes 65 balls", "hull_shapes=65"],
+        ),
+    ] {
+        let m = error(src);
+        for s in says {
+            assert!(m.contains(s), "{src}: {m}");
+        }
+    }
     // A union of itself doubling 40 times is counted, not walked, and refused.
     let shared = format!(
         "let s0 = sphere(1);\n{}",

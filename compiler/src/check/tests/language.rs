@@ -4,18 +4,19 @@
 //! parameters and the look in `hulls.rs`, `params.rs`, `looks.rs`).
 
 use super::{check_str, codes, ok, root};
-use crate::scene::Node;
+use crate::scene::{Node, Scene};
+
+/// Fails unless the root of `s` is a box of half-size `half`.
+#[track_caller]
+fn assert_box(s: &Scene, half: [f64; 3]) {
+    assert_eq!(root(s), &Node::Box { half });
+}
 
 #[test]
 fn division_gives_what_users_of_other_tools_expect() {
     // `5 / 2` is 2.5: a box 5 wide, not 4.
     let s = ok("let w = 5;\nscene { box((w / 2, 0.5, 0.5)); }");
-    assert_eq!(
-        root(&s),
-        &Node::Box {
-            half: [2.5, 0.5, 0.5]
-        }
-    );
+    assert_box(&s, [2.5, 0.5, 0.5]);
     // Whole numbers divide with `div`, rounded down as Python's `//`.
     let s =
         ok("scene { for i in 0..1 { sphere(1).translate(div(7, 2), div(-7, 2), div(7, -2)); } }");
@@ -364,12 +365,7 @@ fn a_number_broadcasts_over_a_vector_in_constants_and_fields() {
     use crate::eval::eval_point;
     // Constants: `1 + v / 2` is `vec3(1) + v / 2`, and `1 / v` divides per component.
     let s = ok("let v = (2, 4, 6);\nscene { box(1 + v / 2 - 1 / (1, 2, 4)); }");
-    assert_eq!(
-        root(&s),
-        &Node::Box {
-            half: [1.0, 2.5, 3.75]
-        }
-    );
+    assert_box(&s, [1.0, 2.5, 3.75]);
     assert_eq!(
         codes("let v = 1 / (1, 0, 1);\nscene { sphere(); }"),
         ["E0401"]

@@ -56,65 +56,73 @@ fn every_path_makes_a_sweep_node() {
 
 #[test]
 fn bad_paths_are_located_errors_that_say_what_to_write() {
-    let d = error(
-        "sweep(circle(0.1), polyline([(0, 0, 0)]))",
-        "polyline([(0, 0, 0)])",
-    );
-    assert!(d.message.contains("at least 2 points"), "{d:#?}");
-    let d = error(
-        "sweep(circle(0.1), polyline([(0, 0, 0), (1, 0, 0), (1, 0, 0)]))",
-        "polyline(",
-    );
-    assert!(d.message.contains("points 1 and 2"), "{d:#?}");
-    let d = error(
-        "sweep(circle(0.1), polyline([(0, 0, 0), (1, 0, 0), (0.5, 0, 0)]))",
-        "polyline(",
-    );
-    assert!(
-        d.message.contains("turns straight back at point 1"),
-        "{d:#?}"
-    );
-    // A Bézier path says how many control points it needs, near the count given.
-    let d = error(
-        "sweep(circle(0.1), bezier([(0, 0, 0), (1, 0, 0), (1, 1, 0), (2, 1, 0), (3, 1, 0)]))",
-        "bezier(",
-    );
-    assert!(
-        d.message.contains("3k + 1")
-            && d.message.contains("has 5")
-            && d.message.contains("give 4 or 7"),
-        "{d:#?}"
-    );
-    let d = error(
-        "sweep(circle(0.1), bezier([(0, 0, 0), (1, 0, 0)]))",
-        "bezier(",
-    );
-    assert!(d.message.contains("give 4"), "{d:#?}");
-    let d = error(
-        "sweep(circle(0.1), bezier([(0, 0, 0), (0, 0, 0), (1, 1, 0), (2, 1, 0)]))",
-        "bezier(",
-    );
-    assert!(d.message.contains("control point 1"), "{d:#?}");
-    // A degenerate helix: each number out of range is refused at its argument.
-    for (shape, at) in [
-        ("sweep(circle(0.1), helix(0, 0.2, 3))", "0, 0.2"),
-        ("sweep(circle(0.1), helix(0.5, 0, 3))", "0, 3"),
-        ("sweep(circle(0.1), helix(0.5, 0.2, -1))", "-1"),
-    ] {
+    // Each shape, where its error is, and what the message says.
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            "sweep(circle(0.1), polyline([(0, 0, 0)]))",
+            "polyline([(0, 0, 0)])",
+            &["at least 2 points"],
+        ),
+        (
+            "sweep(circle(0.1), polyline([(0, 0, 0), (1, 0, 0), (1, 0, 0)]))",
+            "polyline(",
+            &["points 1 and 2"],
+        ),
+        (
+            "sweep(circle(0.1), polyline([(0, 0, 0), (1, 0, 0), (0.5, 0, 0)]))",
+            "polyline(",
+            &["turns straight back at point 1"],
+        ),
+        // A Bézier path says how many control points it needs, near the count given.
+        (
+            "sweep(circle(0.1), bezier([(0, 0, 0), (1, 0, 0), (1, 1, 0), (2, 1, 0), (3, 1, 0)]))",
+            "bezier(",
+            &["3k + 1", "has 5", "give 4 or 7"],
+        ),
+        (
+            "sweep(circle(0.1), bezier([(0, 0, 0), (1, 0, 0)]))",
+            "bezier(",
+            &["give 4"],
+        ),
+        (
+            "sweep(circle(0.1), bezier([(0, 0, 0), (0, 0, 0), (1, 1, 0), (2, 1, 0)]))",
+            "bezier(",
+            &["control point 1"],
+        ),
+        // A degenerate helix: each number out of range is refused at its argument.
+        (
+            "sweep(circle(0.1), helix(0, 0.2, 3))",
+            "0, 0.2",
+            &["greater than 0"],
+        ),
+        (
+            "sweep(circle(0.1), helix(0.5, 0, 3))",
+            "0, 3",
+            &["greater than 0"],
+        ),
+        (
+            "sweep(circle(0.1), helix(0.5, 0.2, -1))",
+            "-1",
+            &["greater than 0"],
+        ),
+        (
+            "sweep(circle(0.1), arc3((0, 0, 0), (1, 1, 1), (2, 2, 2)))",
+            "arc3(",
+            &["one line", "polyline"],
+        ),
+        // A profile with no finite extent cannot be swept.
+        (
+            "sweep(profile { p.x }, helix(0.5, 0.2, 3))",
+            "sweep(",
+            &["no finite extent"],
+        ),
+    ];
+    for (shape, at, says) in cases {
         let d = error(shape, at);
-        assert!(d.message.contains("greater than 0"), "{d:#?}");
+        for s in *says {
+            assert!(d.message.contains(s), "{s}: {d:#?}");
+        }
     }
-    let d = error(
-        "sweep(circle(0.1), arc3((0, 0, 0), (1, 1, 1), (2, 2, 2)))",
-        "arc3(",
-    );
-    assert!(
-        d.message.contains("one line") && d.message.contains("polyline"),
-        "{d:#?}"
-    );
-    // A profile with no finite extent cannot be swept.
-    let d = error("sweep(profile { p.x }, helix(0.5, 0.2, 3))", "sweep(");
-    assert!(d.message.contains("no finite extent"), "{d:#?}");
 }
 
 #[test]

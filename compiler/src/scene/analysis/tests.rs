@@ -76,43 +76,33 @@ fn rigid_motions_and_uniform_scale_keep_exactness() {
 
 #[test]
 fn bounds_and_approximations() {
+    // What each is, and whether that is proven.
+    const BOUND: (Exactness, bool) = (Exactness::Bound, true);
+    const APPROXIMATE: (Exactness, bool) = (Exactness::Approximate, true);
+    const UNPROVEN: (Exactness, bool) = (Exactness::Approximate, false);
     let cases = [
-        ("ellipsoid((1, 2, 3))", Exactness::Bound, true),
-        ("sphere(1).scale((1, 2, 1))", Exactness::Bound, true),
-        (
-            "union(sphere(1), box(1).translate(3, 0, 0))",
-            Exactness::Bound,
-            true,
-        ),
-        ("subtract(box(1), sphere(1.2))", Exactness::Bound, true),
+        ("ellipsoid((1, 2, 3))", BOUND),
+        ("sphere(1).scale((1, 2, 1))", BOUND),
+        ("union(sphere(1), box(1).translate(3, 0, 0))", BOUND),
+        ("subtract(box(1), sphere(1.2))", BOUND),
         (
             "smooth_union(0.5, sphere(1), box(1).translate(1, 0, 0))",
-            Exactness::Bound,
-            true,
+            BOUND,
         ),
         (
             "smooth_union(2, sphere(1), box(1), variant: \"exp\")",
-            Exactness::Bound,
-            true,
+            BOUND,
         ),
-        ("sphere(1).round(0.2)", Exactness::Bound, true),
-        ("sphere(1).shell(0.1)", Exactness::Bound, true),
-        ("capsule().elongate((1, 0, 0))", Exactness::Bound, true),
-        (
-            "sphere(0.5).translate(0.2, 0, 0).mirror()",
-            Exactness::Bound,
-            true,
-        ),
-        ("mandelbulb()", Exactness::Approximate, false),
-        (
-            "ellipsoid((1, 2, 3)).round(0.1)",
-            Exactness::Approximate,
-            false,
-        ),
-        ("box((1, 2, 1)).twist(1)", Exactness::Approximate, true),
-        ("box((2, 0.2, 0.5)).bend(0.5)", Exactness::Approximate, true),
+        ("sphere(1).round(0.2)", BOUND),
+        ("sphere(1).shell(0.1)", BOUND),
+        ("capsule().elongate((1, 0, 0))", BOUND),
+        ("sphere(0.5).translate(0.2, 0, 0).mirror()", BOUND),
+        ("mandelbulb()", UNPROVEN),
+        ("ellipsoid((1, 2, 3)).round(0.1)", UNPROVEN),
+        ("box((1, 2, 1)).twist(1)", APPROXIMATE),
+        ("box((2, 0.2, 0.5)).bend(0.5)", APPROXIMATE),
     ];
-    for (p, e, proven) in cases {
+    for (p, (e, proven)) in cases {
         let d = root(p);
         assert_eq!((d.facts.exactness, d.proven), (e, proven), "{p}: {d:?}");
     }
@@ -166,53 +156,46 @@ fn twist_and_bend_lipschitz_bounds() {
 
 #[test]
 fn warnings_name_the_unreliable_constructs() {
-    assert_eq!(codes("sphere(1)"), Vec::<&str>::new());
-    assert_eq!(
-        codes("smooth_union(2, sphere(0.5), box(0.4).translate(1, 0, 0), variant: \"exp\")"),
-        ["W0002"]
-    );
-    assert_eq!(
-        codes("smooth_union(0.1, sphere(0.5), box(0.4).translate(1, 0, 0), variant: \"exp\")"),
-        Vec::<&str>::new()
-    );
-    assert_eq!(codes("box((0.5, 1, 0.5)).twist(4)"), ["W0003"]);
-    assert_eq!(codes("box((0.5, 1, 0.5)).twist(0.5)"), Vec::<&str>::new());
-    assert_eq!(codes("plane((0, 1, 0), 0).twist(0.1)"), ["W0004"]);
-    // Copies reaching one cell out are evaluated with their neighbours; three cells out on
-    // every axis would need 343 cells.
-    assert_eq!(codes("sphere(0.6).repeat((1, 0, 1))"), Vec::<&str>::new());
-    assert_eq!(codes("sphere(2.5).repeat((1, 1, 1))"), ["W0005"]);
-    // The repeated field is the exact distance to every copy, so offsetting it is safe.
-    assert_eq!(
-        codes("sphere(0.4).repeat((1, 0, 1)).round(0.2)"),
-        Vec::<&str>::new()
-    );
-    assert_eq!(codes("sphere(0.4).repeat((1, 0, 1))"), Vec::<&str>::new());
-    assert_eq!(
-        codes("sphere(0.2).translate(0.2, 0, 0).repeat((1, 0, 1))"),
-        Vec::<&str>::new()
-    );
+    const NONE: &[&str] = &[];
     // Windows nested in windows multiply (9 × 9 cells): the outer one keeps its own cell.
     let inner = "sphere(0.6).repeat((1, 0, 1), (3, 1, 3))";
-    assert_eq!(
-        codes(&format!("{inner}.repeat((5, 0, 5))")),
-        Vec::<&str>::new()
-    );
-    assert_eq!(
-        codes(&format!("{inner}.translate(0.2, 0, 0.2).repeat((4, 0, 4))")),
-        ["W0006"]
-    );
-    // Rounded by 2, the copies must be bounded 2 units out: 125 cells.
-    assert_eq!(
-        codes("sphere(0.2).translate(0.2, 0.2, 0.2).repeat((1, 1, 1)).round(2)"),
-        ["W0006"]
-    );
-    assert_eq!(
-        codes("sphere(0.2).translate(0, 0.2, 0).repeat((1, 0, 1))"),
-        Vec::<&str>::new()
-    );
-    assert_eq!(codes("sphere(1).scale((1, 1, 12))"), ["W0007"]);
-    assert_eq!(codes("sphere(1).scale((1, 1, 2))"), Vec::<&str>::new());
+    let nested = format!("{inner}.repeat((5, 0, 5))");
+    let nested_off = format!("{inner}.translate(0.2, 0, 0.2).repeat((4, 0, 4))");
+    let cases: [(&str, &[&str]); 17] = [
+        ("sphere(1)", NONE),
+        (
+            "smooth_union(2, sphere(0.5), box(0.4).translate(1, 0, 0), variant: \"exp\")",
+            &["W0002"],
+        ),
+        (
+            "smooth_union(0.1, sphere(0.5), box(0.4).translate(1, 0, 0), variant: \"exp\")",
+            NONE,
+        ),
+        ("box((0.5, 1, 0.5)).twist(4)", &["W0003"]),
+        ("box((0.5, 1, 0.5)).twist(0.5)", NONE),
+        ("plane((0, 1, 0), 0).twist(0.1)", &["W0004"]),
+        // Copies reaching one cell out are evaluated with their neighbours; three cells out
+        // on every axis would need 343 cells.
+        ("sphere(0.6).repeat((1, 0, 1))", NONE),
+        ("sphere(2.5).repeat((1, 1, 1))", &["W0005"]),
+        // The repeated field is the exact distance to every copy, so offsetting it is safe.
+        ("sphere(0.4).repeat((1, 0, 1)).round(0.2)", NONE),
+        ("sphere(0.4).repeat((1, 0, 1))", NONE),
+        ("sphere(0.2).translate(0.2, 0, 0).repeat((1, 0, 1))", NONE),
+        (&nested, NONE),
+        (&nested_off, &["W0006"]),
+        // Rounded by 2, the copies must be bounded 2 units out: 125 cells.
+        (
+            "sphere(0.2).translate(0.2, 0.2, 0.2).repeat((1, 1, 1)).round(2)",
+            &["W0006"],
+        ),
+        ("sphere(0.2).translate(0, 0.2, 0).repeat((1, 0, 1))", NONE),
+        ("sphere(1).scale((1, 1, 12))", &["W0007"]),
+        ("sphere(1).scale((1, 1, 2))", NONE),
+    ];
+    for (src, want) in cases {
+        assert_eq!(codes(src), want, "{src}");
+    }
 }
 
 #[test]

@@ -156,8 +156,7 @@ fn every_renderer_feature_kernel_assembles() {
     ];
     let ptxas = ptxas();
     for path in paths {
-        let scene = crate::common::load(&path).unwrap().scene.unwrap();
-        let lowered = sdfc_compiler::Lowered::new(&scene);
+        let (scene, lowered) = load_lowered(&path);
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         for (variant, opts) in &variants {
             let kernel = wgsl::write_with(&scene, &lowered, opts)
@@ -172,12 +171,18 @@ fn every_renderer_feature_kernel_assembles() {
     }
 }
 
+/// The scene of the file `path` (relative to the compiler's folder), checked and lowered.
+fn load_lowered(path: impl AsRef<Path>) -> (sdfc_compiler::Scene, sdfc_compiler::Lowered) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let scene = crate::common::load(&path).unwrap().scene.unwrap();
+    let lowered = sdfc_compiler::Lowered::new(&scene);
+    (scene, lowered)
+}
+
 /// `--debug-nan` reaches CUDA through the same kernel: its `DEBUG_NAN` feature translates.
 #[test]
 fn the_debug_nan_kernel_assembles() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/in/ok/nan_at_run_time.sdf");
-    let scene = crate::common::load(&path).unwrap().scene.unwrap();
-    let lowered = sdfc_compiler::Lowered::new(&scene);
+    let (scene, lowered) = load_lowered("tests/in/ok/nan_at_run_time.sdf");
     let debug = sdfc_compiler::wgsl::Options {
         debug_nan: true,
         ..Default::default()
@@ -200,9 +205,7 @@ fn the_debug_nan_kernel_assembles() {
 /// blocks outlined) translates, and assembles.
 #[test]
 fn a_kernel_with_outlined_blocks_assembles() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scaling/compound_100.sdf");
-    let scene = crate::common::load(&path).unwrap().scene.unwrap();
-    let lowered = sdfc_compiler::Lowered::new(&scene);
+    let (scene, lowered) = load_lowered("../examples/scaling/compound_100.sdf");
     // Its 400 instances written as code, not read from `scene_data`.
     let code = sdfc_compiler::wgsl::Options {
         max_instances: usize::MAX,
@@ -234,10 +237,7 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
     let ptxas = ptxas();
     for n in [1000, 10000] {
         let name = format!("compound_{n}");
-        let path =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../examples/scaling/{name}.sdf"));
-        let scene = crate::common::load(&path).unwrap().scene.unwrap();
-        let lowered = sdfc_compiler::Lowered::new(&scene);
+        let (scene, lowered) = load_lowered(&format!("../examples/scaling/{name}.sdf"));
         let kernel = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());

@@ -144,14 +144,8 @@ impl Device for Fake<'_> {
 fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
     let tiles = tiling(37, 29, 512, 3);
     let work = Work {
-        uniforms: &[],
-        data: None,
-        width: 37,
-        height: 29,
-        tiles: &tiles,
-        timed: false,
         statistics: true,
-        target: Target::Linear,
+        ..plain(&tiles, (37, 29), Target::Linear)
     };
     let failed = std::sync::atomic::AtomicUsize::new(0);
     let good = Fake {
@@ -204,31 +198,50 @@ fn several_devices_assemble_the_bands_in_order_and_survive_a_failing_one() {
 }
 
 /// A device whose reads are started behind its launches and collected later (as the GPU
-/// devices' are): a band's pixels are its indices, copied at `start_read` into one of two
-/// slots; what it did is logged.
-struct Overlapping<'a> {
+/// devices' are), copied at `start_read` into one of two slots; what it did is logged as
+/// (device, step, first pixel or tile). Of `bands`, a band's pixels are its indices and a
+/// submission is logged by its band's first pixel; else (rows of tiles, finished pixels) a
+/// pixel's bytes are its index's and every tile submitted is logged.
+struct Slotted<'a> {
     log: &'a Mutex<Vec<(usize, &'static str, usize)>>,
     id: usize,
+    bands: bool,
 }
 
-impl Device for Overlapping<'_> {
+impl Slotted<'_> {
+    /// What the device reads back at once: a band or a row of tiles.
+    fn unit(&self) -> &'static str {
+        if self.bands {
+            "band"
+        } else {
+            "row"
+        }
+    }
+
+    fn log(&self, step: &'static str, at: usize) {
+        self.log.lock().expect("log").push((self.id, step, at));
+    }
+}
+
+impl Device for Slotted<'_> {
     type Frame = [Option<Range<usize>>; 2];
     type Error = Failed;
     fn describe(&self) -> String {
-        "overlapping".into()
+        if self.bands { "overlapping" } else { "rows" }.into()
     }
     fn prepare(&self, _work: &Work) -> Result<Self::Frame, Self::Error> {
         Ok([None, None])
     }
     fn run(&self, _: &mut Self::Frame, _: &Work, _: &[usize]) -> Result<(), Self::Error> {
-        Err(Failed("run is not called: bands are submitted".into()))
+        let unit = self.unit();
+        Err(Failed(format!("run is not called: {unit}s are submitted")))
     }
     fn submit(&self, _: &mut Self::Frame, work: &Work, tiles: &[usize]) -> Result<(), Self::Error> {
-        let band = work.band(tiles[0]);
-        self.log
-            .lock()
-            .expect("log")
-            .push((self.id, "submit", band.start));
+        if self.bands {
+            self.log("submit", work.band(tiles[0]).start);
+        } else {
+            tiles.iter().for_each(|&t| self.log("submit", t));
+        }
         Ok(())
     }
     fn start_read(
@@ -239,11 +252,9 @@ impl Device for Overlapping<'_> {
         slot: usize,
     ) -> Result<(), Self::Error> {
         // The slot is free: its band was collected before it is used again.
-        assert!(slots[slot].is_none(), "slot {slot} still holds a band");
-        self.log
-            .lock()
-            .expect("log")
-            .push((self.id, "start", range.start));
+        let unit = self.unit();
+        assert!(slots[slot].is_none(), "slot {slot} still holds a {unit}");
+        self.log("start", range.start);
         slots[slot] = Some(range);
         Ok(())
     }
@@ -255,13 +266,17 @@ impl Device for Overlapping<'_> {
         slot: usize,
     ) -> Result<Pixels, Self::Error> {
         assert_eq!(slots[slot].take().as_ref(), Some(&range), "slot {slot}");
-        self.log
-            .lock()
-            .expect("log")
-            .push((self.id, "collect", range.start));
-        Ok(Pixels {
-            linear: range.map(|i| [i as f32, 0.0, 0.0]).collect(),
-            ..Pixels::default()
+        self.log("collect", range.start);
+        Ok(if self.bands {
+            Pixels {
+                linear: range.map(|i| [i as f32, 0.0, 0.0]).collect(),
+                ..Pixels::default()
+            }
+        } else {
+            Pixels {
+                rgba: range.flat_map(|i| [i as u8; 4]).collect(),
+                ..Pixels::default()
+            }
         })
     }
     fn read(
@@ -270,7 +285,8 @@ impl Device for Overlapping<'_> {
         _: &Work,
         _: &[Range<usize>],
     ) -> Result<Pixels, Self::Error> {
-        Err(Failed("read is not called: bands are collected".into()))
+        let unit = self.unit();
+        Err(Failed(format!("read is not called: {unit}s are collected")))
     }
     fn reduce(
         &self,
@@ -282,7 +298,8 @@ impl Device for Overlapping<'_> {
         Ok(Answer::empty(ask))
     }
     fn finish(&self, slots: Self::Frame, _: &Work) -> Result<Option<Duration>, Self::Error> {
-        assert_eq!(slots, [None, None], "every band collected");
+        let unit = self.unit();
+        assert_eq!(slots, [None, None], "every {unit} collected");
         Ok(None)
     }
     fn fault(&self, message: String) -> Failed {
@@ -295,10 +312,12 @@ fn a_band_is_collected_while_the_next_one_renders() {
     let tiles = tiling(16, 64, 512, 2);
     let work = plain(&tiles, (16, 64), Target::Linear);
     let log = Mutex::new(Vec::new());
-    let (a, b) = (
-        Overlapping { log: &log, id: 0 },
-        Overlapping { log: &log, id: 1 },
-    );
+    let band = |id| Slotted {
+        log: &log,
+        id,
+        bands: true,
+    };
+    let (a, b) = (band(0), band(1));
     let devices: [&dyn Worker; 2] = [&a, &b];
     let out = render_several(&devices, &work, &Faults::default(), &mut |_| {}).expect("renders");
     assert!(out.linear.iter().enumerate().all(|(i, p)| p[0] == i as f32));
@@ -362,93 +381,22 @@ fn the_first_item_is_seen_without_taking_it() {
     assert_eq!(q.first(|&k| k), None);
 }
 
-/// One device whose finished pixels are read back into two slots, started behind the
-/// launches and collected later: a pixel's bytes are its index's; what it did is logged.
-struct Rows {
-    log: Mutex<Vec<(&'static str, usize)>>,
-}
-
-impl Device for Rows {
-    type Frame = [Option<Range<usize>>; 2];
-    type Error = Failed;
-    fn describe(&self) -> String {
-        "rows".into()
-    }
-    fn prepare(&self, _work: &Work) -> Result<Self::Frame, Self::Error> {
-        Ok([None, None])
-    }
-    fn run(&self, _: &mut Self::Frame, _: &Work, _: &[usize]) -> Result<(), Self::Error> {
-        Err(Failed("run is not called: rows are submitted".into()))
-    }
-    fn submit(&self, _: &mut Self::Frame, _: &Work, tiles: &[usize]) -> Result<(), Self::Error> {
-        let mut log = self.log.lock().expect("log");
-        log.extend(tiles.iter().map(|&t| ("submit", t)));
-        Ok(())
-    }
-    fn start_read(
-        &self,
-        slots: &mut Self::Frame,
-        _: &Work,
-        range: Range<usize>,
-        slot: usize,
-    ) -> Result<(), Self::Error> {
-        assert!(slots[slot].is_none(), "slot {slot} still holds a row");
-        self.log.lock().expect("log").push(("start", range.start));
-        slots[slot] = Some(range);
-        Ok(())
-    }
-    fn collect(
-        &self,
-        slots: &mut Self::Frame,
-        _: &Work,
-        range: Range<usize>,
-        slot: usize,
-    ) -> Result<Pixels, Self::Error> {
-        assert_eq!(slots[slot].take().as_ref(), Some(&range), "slot {slot}");
-        self.log.lock().expect("log").push(("collect", range.start));
-        Ok(Pixels {
-            rgba: range.flat_map(|i| [i as u8; 4]).collect(),
-            ..Pixels::default()
-        })
-    }
-    fn read(
-        &self,
-        _: &mut Self::Frame,
-        _: &Work,
-        _: &[Range<usize>],
-    ) -> Result<Pixels, Self::Error> {
-        Err(Failed("read is not called: rows are collected".into()))
-    }
-    fn reduce(
-        &self,
-        _: &mut Self::Frame,
-        _: &Work,
-        _: &[Range<usize>],
-        ask: Ask,
-    ) -> Result<Answer, Self::Error> {
-        Ok(Answer::empty(ask))
-    }
-    fn finish(&self, slots: Self::Frame, _: &Work) -> Result<Option<Duration>, Self::Error> {
-        assert_eq!(slots, [None, None], "every row collected");
-        Ok(None)
-    }
-    fn fault(&self, message: String) -> Failed {
-        Failed(message)
-    }
-}
-
 #[test]
 fn one_device_collects_a_row_of_tiles_while_the_next_renders() {
     // Squares of 8 pixels over 20×20: three rows of three tiles (8, 8 and 4 pixels high).
     let tiles = squares(20, 20, 8);
     let work = plain(&tiles, (20, 20), Target::Finished);
-    let rows = Rows {
-        log: Mutex::new(Vec::new()),
+    let log = Mutex::new(Vec::new());
+    let rows = Slotted {
+        log: &log,
+        id: 0,
+        bands: false,
     };
     let out = render_one(&rows, &work, &Faults::default(), &mut |_| {}).expect("renders");
     let expected: Vec<u8> = (0..400).flat_map(|i| [i as u8; 4]).collect();
     assert_eq!(out.rgba, expected);
-    let log = rows.log.lock().expect("log").clone();
+    let log: Vec<_> = log.into_inner().expect("log");
+    let log: Vec<_> = log.into_iter().map(|(_, step, at)| (step, at)).collect();
     let s = |t| ("submit", t);
     assert_eq!(
         log,
@@ -471,8 +419,11 @@ fn one_device_collects_a_row_of_tiles_while_the_next_renders() {
         ]
     );
     // A fault at the fifth tile ends the frame after its row was submitted.
-    let rows = Rows {
-        log: Mutex::new(Vec::new()),
+    let log = Mutex::new(Vec::new());
+    let rows = Slotted {
+        log: &log,
+        id: 0,
+        bands: false,
     };
     let faults = Faults::parse("4").expect("parses");
     let err = render_one(&rows, &work, &faults, &mut |_| {}).expect_err("fails");

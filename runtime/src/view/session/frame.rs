@@ -56,7 +56,7 @@ impl Session {
 
     /// Renders the next frame into the image on show. `Ok(None)` when there is nothing to
     /// render; `Err` is a render error (rendering stops until the next load or camera move).
-    pub fn frame(&mut self) -> Result<Option<FrameInfo>, String> {
+    pub fn frame(&mut self) -> Result<Option<FrameInfo>, FrameError> {
         self.poll();
         if !self.wants_frame() {
             return Ok(None);
@@ -85,11 +85,11 @@ impl Session {
         let kind = prepared.kernel_kind();
         let on = (&mut self.resident, (self.version, self.steps_wanted));
         let rendered = render_sample(prepared, (&good.scene, good.grade), on, a);
-        let (count, steps) = match rendered.map_err(|e| e.to_string()) {
+        let (count, steps) = match rendered {
             Ok(r) => r,
-            Err(msg) => {
-                self.broken = Some(msg.clone());
-                return Err(msg);
+            Err(e) => {
+                self.broken = Some(e.to_string());
+                return Err(e);
             }
         };
         let time = start.elapsed();
@@ -256,7 +256,7 @@ impl Accumulation {
 /// Why a frame was not rendered: the scene does not fit its kernel or the CPU's render failed
 /// (the backend's error), or the viewer's pass on the device failed.
 #[derive(Debug, thiserror::Error)]
-enum FrameError {
+pub enum FrameError {
     #[error(transparent)]
     Backend(#[from] crate::backend::Error),
     #[error(transparent)]

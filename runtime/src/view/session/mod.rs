@@ -35,6 +35,8 @@ mod params;
 mod playback;
 mod timings;
 
+pub use frame::FrameError;
+
 /// The time a frame may take while the camera moves; a slower one lowers the resolution.
 pub const FRAME_BUDGET: Duration = Duration::from_millis(33);
 

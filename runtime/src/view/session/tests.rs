@@ -22,6 +22,59 @@ fn settle(s: &mut Session) -> u32 {
     frames
 }
 
+/// A fresh directory `sdfc-{name}-{process}` of the temporary directory.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sdfc-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// [`temp_dir`] and the path of its file `file`.
+fn temp_file(name: &str, file: &str) -> (PathBuf, PathBuf) {
+    let dir = temp_dir(name);
+    let file = dir.join(file);
+    (dir, file)
+}
+
+/// A session of `file` with `options` on `device`, 32×24, loaded without errors.
+#[track_caller]
+fn loaded(file: PathBuf, options: Options, device: Device) -> Session {
+    let mut s = Session::new(file, options, device);
+    s.set_size(32, 24);
+    assert!(s.load().ok);
+    s
+}
+
+/// The options of a session that shows the specialised kernel alone.
+fn specialised() -> Options {
+    Options {
+        kernel: Kernel::Specialised,
+        ..Options::default()
+    }
+}
+
+/// Writes `text` to `file` and loads it, the compile of load `held` held back.
+#[track_caller]
+fn load_held(s: &mut Session, file: &Path, text: &str, held: u32) {
+    std::fs::write(file, text).unwrap();
+    s.held = Some(held);
+    assert!(s.load().ok);
+}
+
+/// Fails unless the session's title ends with `tail`.
+#[track_caller]
+fn assert_title_ends(s: &Session, tail: &str) {
+    let title = s.title(false);
+    assert!(title.ends_with(tail), "{title}");
+}
+
+/// Fails unless `after` differs from `before` (the box that an edit added appeared).
+#[track_caller]
+fn assert_appeared(before: &Image, after: &Image) {
+    let changed = crate::metrics::compare(before, after, 0.1).unwrap();
+    assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+}
+
 /// The longest a test waits for lavapipe to compile a kernel on a busy 2-core machine.
 const PATIENCE: Duration = Duration::from_secs(300);
 
@@ -48,6 +101,14 @@ fn interim() -> Options {
         interim_on_cpu: true,
         grace: Duration::ZERO,
         ..Options::default()
+    }
+}
+
+/// [`interim`]'s options with a grace period of an hour: one within which any compile ends.
+fn an_hours_grace() -> Options {
+    Options {
+        grace: Duration::from_secs(3600),
+        ..interim()
     }
 }
 
@@ -124,13 +185,9 @@ fn kernel_text(s: &Session) -> String {
 /// A session with `options` on the first of [`marched`]'s scenes, in `k.sdf` of a fresh
 /// directory named after `name`, loaded and settled: the session and the directory.
 fn settled_on_marched(gpu: &Arc<Gpu>, name: &str, options: Options) -> (Session, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("sdfc-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("k.sdf");
+    let (dir, file) = temp_file(name, "k.sdf");
     std::fs::write(&file, &marched()[0]).unwrap();
-    let mut s = Session::new(file, options, Device::Wgpu(gpu.clone()));
-    s.set_size(32, 24);
-    assert!(s.load().ok);
+    let mut s = loaded(file, options, Device::Wgpu(gpu.clone()));
     settle_all(&mut s);
     (s, dir)
 }
@@ -146,9 +203,7 @@ fn stale_compile(gpu: &Arc<Gpu>, name: &str, options: Options) -> (Session, Path
     std::fs::write(&file, &boxed).unwrap();
     assert!(s.load().ok);
     let stale = kernel_text(&s);
-    std::fs::write(&file, &torus).unwrap();
-    s.held = Some(2);
-    assert!(s.load().ok);
+    load_held(&mut s, &file, &torus, 2);
     let newer = kernel_text(&s);
     assert_ne!(stale, newer);
     let start = Instant::now();
@@ -157,6 +212,13 @@ fn stale_compile(gpu: &Arc<Gpu>, name: &str, options: Options) -> (Session, Path
         std::thread::sleep(Duration::from_millis(10));
     }
     (s, dir, newer)
+}
+
+/// Loads the edit of [`settled_on_marched`]'s scene in `dir` that adds a box, its compile held
+/// back.
+fn add_the_box(s: &mut Session, dir: &Path) {
+    let [_, boxed, _] = marched();
+    load_held(s, &dir.join("k.sdf"), &boxed, 1);
 }
 
 /// A marched scene (the interpreted kernel renders marched scenes alone), and two
@@ -183,17 +245,9 @@ fn frames_on_the_device_accumulate_the_kernels_renders() {
     // jittered cameras, value for value; the window is given a texture, and the host holds
     // no image.
     let Some(gpu) = wgpu() else { return };
-    let dir = std::env::temp_dir().join(format!("sdfc-resident-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("s.sdf");
+    let (dir, file) = temp_file("resident", "s.sdf");
     std::fs::write(&file, &marched()[0]).unwrap();
-    let options = Options {
-        kernel: Kernel::Specialised,
-        ..Options::default()
-    };
-    let mut s = Session::new(file, options, Device::Wgpu(gpu));
-    s.set_size(32, 24);
-    assert!(s.load().ok);
+    let mut s = loaded(file, specialised(), Device::Wgpu(gpu));
     settle_all(&mut s);
     assert_eq!(s.last.unwrap().samples, 4);
     assert!(s.texture().is_some(), "a texture on show");
@@ -243,9 +297,7 @@ fn frames_on_the_device_accumulate_the_kernels_renders() {
 
 #[test]
 fn an_animated_scene_plays_and_pauses() {
-    let dir = std::env::temp_dir().join(format!("sdfc-play-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("a.sdf");
+    let (dir, file) = temp_file("play", "a.sdf");
     let animated = SCENE
         .replace("aa: 2 }", "aa: 2, fps: 200, duration: 10 }")
         .replace(
@@ -253,9 +305,7 @@ fn an_animated_scene_plays_and_pauses() {
             "sphere(0.5).translate(0, 0.5 + t, 0)",
         );
     std::fs::write(&file, animated).unwrap();
-    let mut s = Session::new(file, Options::default(), Device::Cpu);
-    s.set_size(32, 24);
-    assert!(s.load().ok);
+    let mut s = loaded(file, Options::default(), Device::Cpu);
     assert!(s.playing(), "a window plays the animation");
     assert!(
         s.wants_frame(),

@@ -4,6 +4,21 @@
 use super::*;
 use crate::lower::Lowered;
 
+/// The checked scene of `text`, lowered.
+fn lowered(text: &str) -> Lowered {
+    let (scene, diags, _) = crate::front::check_str("t.sdf", text);
+    Lowered::new(&scene.unwrap_or_else(|| panic!("{diags:?}")))
+}
+
+/// The words of `programs` encoded with a register file of `file`.
+fn encoded(programs: &Programs, file: usize) -> Vec<u32> {
+    encode(programs, file, 128)
+        .expect("fits")
+        .chunks(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
 /// Runs the words as the kernel does, on the CPU, in f32.
 fn run(words: &[u32], start: u32, p: [f32; 3], file: usize) -> [f32; 2] {
     let [a, b, _] = run3(words, start, [p, [0.0; 3]], file, &|_, _, _| unreachable!());
@@ -74,26 +89,18 @@ fn encoded_programs_run_as_the_reference() {
 }
 
 fn agrees(text: &str, extent: [f64; 3]) {
-    let (scene, diags, _) = crate::front::check_str("t.sdf", text);
-    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
-    let lowered = Lowered::new(&scene);
+    let lowered = lowered(text);
     let program = &lowered.program;
     assert!(!program.blocks().is_empty(), "the scene has guarded blocks");
     let file = 64;
-    let bytes = encode(
+    let words = encoded(
         &Programs {
             main: program,
             media: None,
             colours: &[],
         },
         file,
-        128,
-    )
-    .expect("fits");
-    let words: Vec<u32> = bytes
-        .chunks(4)
-        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+    );
     let needed = registers(program);
     assert!(
         needed < program.len() / 2,
@@ -136,9 +143,7 @@ fn agrees(text: &str, extent: [f64; 3]) {
 fn encoded_outlines_run_as_the_reference() {
     let text = "scene { extrude(text(\"HELLO\", 0.7), 0.2, 0.01).translate(0, 0.3, -0.1);\n\
         box((1.45, 0.5, 0.1)).translate(0, 0.3, 0.05); extrude(text(\"ok\", 0.5), 0.1).translate(0, -1, 0); }";
-    let (scene, diags, _) = crate::front::check_str("t.sdf", text);
-    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
-    let lowered = Lowered::new(&scene);
+    let lowered = lowered(text);
     let program = &lowered.program;
     assert_eq!(program.outlines().len(), 2);
     let file = 64;
@@ -154,11 +159,7 @@ fn encoded_outlines_run_as_the_reference() {
             outlines: true
         }
     );
-    let bytes = encode(&programs, file, 128).expect("fits");
-    let words: Vec<u32> = bytes
-        .chunks(4)
-        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+    let words = encoded(&programs, file);
     // The outline whose words start at the call's word.
     let call = |op: u32, [x, y, _]: [f32; 3], at: u32| {
         assert_eq!(op, OUTLINE);
@@ -201,9 +202,7 @@ fn encoded_colour_fields_run_as_the_reference() {
         material b = checker { a: field { vec3(0.2) * p.y }, b: field { vec3(voronoi(p * 3), 0.5, 0.5) } };\n\
         material c = phong { color: field { vec3(0.5) + 0.5 * n.zxy } };\n\
         scene { sphere(1) @ a; box(0.5).translate(2, 0, 0) @ b; (sphere(0.5) @ c).rotate_x(30deg).translate(0, 2, 0); }";
-    let (scene, diags, _) = crate::front::check_str("t.sdf", text);
-    let scene = scene.unwrap_or_else(|| panic!("{diags:?}"));
-    let lowered = Lowered::new(&scene);
+    let lowered = lowered(text);
     let colours = &lowered.colours;
     // c painted under a rotation and a translation: a copy of c carries them.
     assert_eq!(colours.programs.len(), 5);
@@ -217,20 +216,14 @@ fn encoded_colour_fields_run_as_the_reference() {
         ]
     );
     let file = 64;
-    let bytes = encode(
+    let words = encoded(
         &Programs {
             main: &lowered.program,
             media: None,
             colours: &colours.programs,
         },
         file,
-        128,
-    )
-    .expect("fits");
-    let words: Vec<u32> = bytes
-        .chunks(4)
-        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+    );
     let int = |k: usize| f32::from_bits(words[k]) as u32;
     let table = int(5) as usize;
     let mut rng = crate::rng::Rng::new(11);

@@ -3,6 +3,7 @@
 //! minimum in few steps.
 
 use super::*;
+use crate::back::wgsl::buffer::tests::{walk, words};
 use crate::scene::MaterialId;
 
 fn sphere(x: f64, k: usize) -> Instance {
@@ -22,24 +23,9 @@ fn sphere(x: f64, k: usize) -> Instance {
 #[test]
 fn entries_cover_every_instance_and_groups_skip_forward() {
     let instances: Vec<Instance> = (0..41).map(|k| sphere(k as f64 * 1.5, k)).collect();
-    let bytes = data(&instances).bytes;
-    let w: Vec<u32> = bytes
-        .chunks_exact(4)
-        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    let e: Vec<&[u32]> = w.chunks_exact(4).collect();
-    let end = e[0][0] as usize;
-    assert_eq!(end, e.len());
-    let (mut i, mut seen, mut groups) = (1, Vec::new(), 0);
-    while i < end {
-        let tag = e[i][3];
-        if tag == GROUP {
-            let next = e[i + 1][3] as usize;
-            assert!(next > i + 2 && next <= end, "group at {i}: next {next}");
-            groups += 1;
-            i += 2;
-            continue;
-        }
+    let e = words(&data(&instances).bytes);
+    let mut seen = Vec::new();
+    let groups = walk(&e, |i, tag| {
         let x = f32::from_bits(e[i][0]);
         let k = (x / 1.5).round() as usize;
         assert_eq!(tag & KIND_BITS, SPHERE);
@@ -47,9 +33,8 @@ fn entries_cover_every_instance_and_groups_skip_forward() {
         let material = if k % 2 == 0 { k as u32 } else { 0 };
         assert_eq!(tag >> MATERIAL_SHIFT, material);
         seen.push(k);
-        i += 2 + 3 * usize::from(tag & ROTATED != 0);
-    }
-    assert_eq!(i, end);
+        2 + 3 * usize::from(tag & ROTATED != 0)
+    });
     assert!(groups >= 9, "{groups} groups");
     seen.sort_unstable();
     assert_eq!(seen, (0..41).collect::<Vec<_>>());
@@ -200,13 +185,9 @@ fn model_sdf(
 
 /// The vectors of `scene_data` as floats.
 fn vectors(d: &Data) -> Vec<[f32; 4]> {
-    let w: Vec<f32> = d
-        .bytes
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    w.chunks_exact(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
+    words(&d.bytes)
+        .into_iter()
+        .map(|v| v.map(f32::from_bits))
         .collect()
 }
 

@@ -8,8 +8,6 @@ use super::*;
 fn a_new_kernel_is_shown_interpreted_until_the_specialised_one_is_ready() {
     let Some(gpu) = wgpu() else { return };
     let (mut s, dir) = settled_on_marched(&gpu, "interim", interim());
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
     assert_eq!(s.last.unwrap().kernel, Some("specialised"));
     s.rotate(20.0, 5.0);
     let camera = s.camera();
@@ -18,9 +16,7 @@ fn a_new_kernel_is_shown_interpreted_until_the_specialised_one_is_ready() {
 
     // A structural edit needs a new specialised kernel, which compiles on another thread
     // (held back here until the interpreted kernel's image has converged).
-    std::fs::write(&file, &boxed).unwrap();
-    s.held = Some(1);
-    assert!(s.load().ok);
+    add_the_box(&mut s, &dir);
     assert!(s.compiling() && !s.settled());
     let info = next_frame(&mut s);
     assert_eq!(
@@ -51,8 +47,7 @@ fn a_new_kernel_is_shown_interpreted_until_the_specialised_one_is_ready() {
     let specialised = s.image().unwrap();
     let same = crate::metrics::compare(&interpreted, &specialised, 0.1).unwrap();
     assert!(same.psnr >= 40.0, "the two kernels agree: {same:?}");
-    let changed = crate::metrics::compare(&before, &specialised, 0.1).unwrap();
-    assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+    assert_appeared(&before, &specialised);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -62,18 +57,10 @@ fn a_kernel_ready_within_the_grace_period_is_shown_with_no_interpreted_frame() {
     // held back until the interpreted kernel is ready too, ends within it however busy the
     // machine.
     let Some(gpu) = wgpu() else { return };
-    let options = Options {
-        grace: Duration::from_secs(3600),
-        ..interim()
-    };
-    let (mut s, dir) = settled_on_marched(&gpu, "grace-in", options);
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
+    let (mut s, dir) = settled_on_marched(&gpu, "grace-in", an_hours_grace());
     let before = s.image().unwrap();
 
-    std::fs::write(&file, &boxed).unwrap();
-    s.held = Some(1);
-    assert!(s.load().ok);
+    add_the_box(&mut s, &dir);
     assert!(s.compiling() && s.grace_deadline().is_some());
     // Nothing is rendered in the grace period, not even once the interpreted kernel's
     // pipeline is ready: the image before stays on show.
@@ -104,8 +91,7 @@ fn a_kernel_ready_within_the_grace_period_is_shown_with_no_interpreted_frame() {
     );
     settle_all(&mut s);
     assert_eq!(s.last.unwrap().kernel, Some("specialised"));
-    let changed = crate::metrics::compare(&before, &s.image().unwrap(), 0.1).unwrap();
-    assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+    assert_appeared(&before, &s.image().unwrap());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -119,12 +105,8 @@ fn a_kernel_not_ready_within_the_grace_period_is_shown_interpreted_first() {
         ..interim()
     };
     let (mut s, dir) = settled_on_marched(&gpu, "grace-out", options);
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
 
-    std::fs::write(&file, &boxed).unwrap();
-    s.held = Some(1);
-    assert!(s.load().ok);
+    add_the_box(&mut s, &dir);
     let w = waiting(&s);
     let end = w.grace_until;
     assert_eq!(end, w.compile.started + GRACE);
@@ -160,18 +142,11 @@ fn a_new_kernel_compiles_off_the_callers_thread_and_the_image_before_stays() {
     // that a window's event loop goes on answering: nothing is rendered, the image before
     // stays, the title says the kernel compiles, and the new kernel is shown once ready.
     let Some(gpu) = wgpu() else { return };
-    let options = Options {
-        kernel: Kernel::Specialised,
-        ..Options::default()
-    };
+    let options = specialised();
     let (mut s, dir) = settled_on_marched(&gpu, "off-thread", options);
-    let file = dir.join("k.sdf");
-    let [_, boxed, _] = marched();
     let before = s.image().unwrap();
 
-    std::fs::write(&file, &boxed).unwrap();
-    s.held = Some(1);
-    assert!(s.load().ok);
+    add_the_box(&mut s, &dir);
     assert!(s.compiling() && !s.wants_frame() && !s.settled());
     assert!(
         s.grace_deadline().is_none(),
@@ -193,8 +168,7 @@ fn a_new_kernel_compiles_off_the_callers_thread_and_the_image_before_stays() {
         "{words}"
     );
     settle_all(&mut s);
-    let changed = crate::metrics::compare(&before, &s.image().unwrap(), 0.1).unwrap();
-    assert!(changed.differing > 0.01, "the box appeared: {changed:?}");
+    assert_appeared(&before, &s.image().unwrap());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -204,11 +178,7 @@ fn a_stale_compile_does_not_end_a_newer_loads_grace_period() {
     // own, held back: nothing is rendered until load 2's compile has ended, and then its
     // specialised kernel is shown first.
     let Some(gpu) = wgpu() else { return };
-    let options = Options {
-        grace: Duration::from_secs(3600),
-        ..interim()
-    };
-    let (mut s, dir, newer) = stale_compile(&gpu, "grace-stale", options);
+    let (mut s, dir, newer) = stale_compile(&gpu, "grace-stale", an_hours_grace());
     nothing_in_the_grace_period(&mut s);
     assert_eq!(s.good.as_ref().unwrap().load, 2);
     assert!(s.compiling() && s.grace_deadline().is_some());
@@ -236,13 +206,8 @@ fn a_stale_compile_does_not_replace_a_newer_edit() {
     assert_eq!(kernel_text(&s), newer);
     // What is shown is load 2's scene: the image of a session that compiled it at once.
     let shown = s.image().unwrap();
-    let options = Options {
-        kernel: Kernel::Specialised,
-        ..Options::default()
-    };
-    let mut reference = Session::new(dir.join("k.sdf"), options, Device::Wgpu(gpu));
-    reference.set_size(32, 24);
-    assert!(reference.load().ok);
+    let options = specialised();
+    let mut reference = loaded(dir.join("k.sdf"), options, Device::Wgpu(gpu));
     assert!(
         !reference.compiling(),
         "`--kernel specialised` finds the kernel compiled for the session before"
@@ -259,9 +224,7 @@ fn the_specialised_kernel_takes_over_at_the_animation_time_on_show() {
     // the specialised kernel that replaces it: the image of a session that compiled it at
     // once.
     let Some(gpu) = wgpu() else { return };
-    let dir = std::env::temp_dir().join(format!("sdfc-interim-t-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("a.sdf");
+    let (dir, file) = temp_file("interim-t", "a.sdf");
     let animated = marched()[0]
         .replace(
             "method: \"march\" }",
@@ -291,13 +254,8 @@ fn the_specialised_kernel_takes_over_at_the_animation_time_on_show() {
     settle_all(&mut s);
     assert_eq!(s.last.unwrap().kernel, Some("specialised"));
     assert_eq!(s.time(), Some(0.5), "the time on show stayed");
-    let options = Options {
-        kernel: Kernel::Specialised,
-        ..Options::default()
-    };
-    let mut reference = Session::new(file.clone(), paused(options), Device::Wgpu(gpu));
-    reference.set_size(32, 24);
-    assert!(reference.load().ok);
+    let options = specialised();
+    let mut reference = loaded(file.clone(), paused(options), Device::Wgpu(gpu));
     settle_all(&mut reference);
     assert_eq!(reference.time(), Some(0.5));
     assert_eq!(s.image(), reference.image());
@@ -315,9 +273,7 @@ fn the_specialised_kernel_takes_over_at_the_animation_time_on_show() {
 #[test]
 fn a_parameter_of_a_traced_scene_keeps_the_kernel() {
     let Some(gpu) = wgpu() else { return };
-    let dir = std::env::temp_dir().join(format!("sdfc-traced-param-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("ball.sdf");
+    let (dir, file) = temp_file("traced-param", "ball.sdf");
     std::fs::write(
         &file,
         format!(
@@ -329,9 +285,7 @@ fn a_parameter_of_a_traced_scene_keeps_the_kernel() {
         ),
     )
     .unwrap();
-    let mut s = Session::new(file.clone(), Options::default(), Device::Wgpu(gpu.clone()));
-    s.set_size(32, 24);
-    assert!(s.load().ok);
+    let mut s = loaded(file.clone(), Options::default(), Device::Wgpu(gpu.clone()));
     settle_all(&mut s);
     let kernel = kernel_text(&s);
     assert!(
@@ -347,9 +301,7 @@ fn a_parameter_of_a_traced_scene_keeps_the_kernel() {
     assert_ne!(changed, before);
     let mut options = Options::default();
     options.job.limits.set_param("r", "0.8");
-    let mut fresh = Session::new(file, options, Device::Wgpu(gpu));
-    fresh.set_size(32, 24);
-    assert!(fresh.load().ok);
+    let mut fresh = loaded(file, options, Device::Wgpu(gpu));
     settle_all(&mut fresh);
     assert_eq!(fresh.image(), Some(changed));
     let _ = std::fs::remove_dir_all(&dir);

@@ -22,9 +22,7 @@ fn a_file_saved_in_place_is_read_once_written() {
     // An editor saving in place truncates the file, then writes it: a load that runs in
     // between waits for the contents instead of reporting an empty scene; a file that
     // stays empty is loaded as it is (and fails: no `scene` block).
-    let dir = std::env::temp_dir().join(format!("sdfc-in-place-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("a.sdf");
+    let (dir, file) = temp_file("in-place", "a.sdf");
     std::fs::write(&file, "").unwrap();
     let writer = {
         let file = file.clone();
@@ -50,13 +48,9 @@ fn a_file_saved_in_place_is_read_once_written() {
 
 #[test]
 fn reloads_keep_the_moved_camera_and_errors_keep_the_image() {
-    let dir = std::env::temp_dir().join(format!("sdfc-session-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("s.sdf");
+    let (dir, file) = temp_file("session", "s.sdf");
     std::fs::write(&file, SCENE).unwrap();
-    let mut s = Session::new(file.clone(), Options::default(), Device::Cpu);
-    s.set_size(32, 24);
-    assert!(s.load().ok);
+    let mut s = loaded(file.clone(), Options::default(), Device::Cpu);
     // aa 2: four jittered samples, then nothing more to render.
     assert_eq!(settle(&mut s), 4);
     assert!(s.settled());
@@ -128,8 +122,7 @@ fn tetrahedron_stl(size: f64) -> String {
 /// change of the mesh file calls for a reload, and the reload shows the new mesh.
 #[test]
 fn a_changed_mesh_file_reloads() {
-    let dir = std::env::temp_dir().join(format!("sdfc-session-mesh-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("session-mesh");
     let (file, mesh) = (dir.join("s.sdf"), dir.join("part.stl"));
     std::fs::write(&mesh, tetrahedron_stl(1.0)).unwrap();
     std::fs::write(
@@ -140,9 +133,7 @@ fn a_changed_mesh_file_reloads() {
         ),
     )
     .unwrap();
-    let mut s = Session::new(file.clone(), Options::default(), Device::Cpu);
-    s.set_size(32, 24);
-    assert!(s.load().ok);
+    let mut s = loaded(file.clone(), Options::default(), Device::Cpu);
     assert!(
         s.files().iter().any(|f| f.ends_with("part.stl")),
         "{:?}",
@@ -167,9 +158,7 @@ fn a_changed_mesh_file_reloads() {
 /// before staying on show.
 #[test]
 fn every_load_is_held_to_the_memory_limit_at_the_views_size() {
-    let dir = std::env::temp_dir().join(format!("sdfc-session-memory-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("m.sdf");
+    let (dir, file) = temp_file("session-memory", "m.sdf");
     // 8000x6000 pixels: a render of the scene's size is far above 32 MiB.
     let huge = SCENE.replace("width: 32, height: 24", "width: 8000, height: 6000");
     std::fs::write(&file, &huge).unwrap();

@@ -92,28 +92,16 @@ fn mean_of_graded(s: &Session, samples: u32) -> Image {
 /// change starts again.
 #[test]
 fn a_path_traced_picture_accumulates_its_samples_while_the_camera_rests() {
-    let dir = std::env::temp_dir().join(format!("sdfc-path-view-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("s.sdf");
+    let (dir, file) = temp_file("path-view", "s.sdf");
     for (look, curve) in LOOKS {
         std::fs::write(&file, path_scene(look)).unwrap();
-        let mut s = Session::new(file.clone(), Options::default(), Device::Cpu);
-        s.set_size(32, 24);
-        assert!(s.load().ok);
+        let mut s = loaded(file.clone(), Options::default(), Device::Cpu);
         assert_eq!(s.good.as_ref().unwrap().grade.tonemap, curve, "{look}");
         let info = s.frame().expect("a frame").expect("a frame");
         assert_eq!((info.samples, info.target), (1, 4));
-        assert!(
-            s.title(false).ends_with(" | 1/4 samples"),
-            "{}",
-            s.title(false)
-        );
+        assert_title_ends(&s, " | 1/4 samples");
         assert_eq!(settle(&mut s), 3);
-        assert!(
-            s.title(false).ends_with(" | 4/4 samples"),
-            "{}",
-            s.title(false)
-        );
+        assert_title_ends(&s, " | 4/4 samples");
         let shown = s.image().expect("the image");
         let render = direct(&s, 4, None);
         let apart = most(&shown, &render);
@@ -134,11 +122,7 @@ fn a_path_traced_picture_accumulates_its_samples_while_the_camera_rests() {
         let info = s.frame().expect("a frame").expect("a frame while moving");
         assert_eq!(info.samples, 1);
         settle(&mut s);
-        assert!(
-            s.title(false).ends_with(" | 4/4 samples"),
-            "{}",
-            s.title(false)
-        );
+        assert_title_ends(&s, " | 4/4 samples");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -150,26 +134,15 @@ fn a_path_traced_picture_accumulates_its_samples_while_the_camera_rests() {
 #[test]
 fn on_the_device_a_path_traced_picture_is_graded_from_its_linear_mean() {
     let Some(gpu) = wgpu() else { return };
-    let dir = std::env::temp_dir().join(format!("sdfc-path-resident-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("s.sdf");
-    let options = Options {
-        kernel: Kernel::Specialised,
-        ..Options::default()
-    };
+    let (dir, file) = temp_file("path-resident", "s.sdf");
+    let options = specialised();
     for (look, curve) in &LOOKS[..2] {
         std::fs::write(&file, path_scene(look)).unwrap();
-        let mut s = Session::new(file.clone(), options.clone(), Device::Wgpu(gpu.clone()));
-        s.set_size(32, 24);
-        assert!(s.load().ok);
+        let mut s = loaded(file.clone(), options.clone(), Device::Wgpu(gpu.clone()));
         settle_all(&mut s);
         assert_eq!(s.good.as_ref().unwrap().grade.tonemap, *curve);
         assert!(s.host_image().is_none(), "no frame crossed to the host");
-        assert!(
-            s.title(false).ends_with(" | 4/4 samples"),
-            "{}",
-            s.title(false)
-        );
+        assert_title_ends(&s, " | 4/4 samples");
         let shown = s.image().expect("the image, read back");
         let render = direct(&s, 4, None);
         let apart = most(&shown, &render);

@@ -112,8 +112,8 @@ impl Kept {
             source: module.source,
             kernel,
         });
-        let d = values.iter().flat_map(|(d, _)| d.to_ne_bytes()).collect();
-        let m = values.iter().flat_map(|(_, m)| m.to_ne_bytes()).collect();
+        let d = super::bytes(values.iter().map(|&(d, _)| d));
+        let m = super::bytes(values.iter().map(|&(_, m)| m));
         Ok((d, m))
     }
 }

@@ -249,6 +249,32 @@ fn limits_of(limits: &[String]) -> Result<Limits, Failure> {
 }
 
 /// The worker threads every call shares (one per core).
+/// A number that crosses to Python as its native-endian bytes.
+trait NativeBytes: Copy {
+    /// The bytes, as `to_ne_bytes` gives them.
+    fn extend(self, out: &mut Vec<u8>);
+}
+
+macro_rules! native_bytes {
+    ($($t:ty),*) => {
+        $(impl NativeBytes for $t {
+            fn extend(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_ne_bytes());
+            }
+        })*
+    };
+}
+native_bytes!(f32, f64, u32);
+
+/// Numbers as one array of native-endian bytes, the form arrays cross to Python in.
+fn bytes<T: NativeBytes>(values: impl IntoIterator<Item = T>) -> Vec<u8> {
+    let mut out = Vec::new();
+    for x in values {
+        x.extend(&mut out);
+    }
+    out
+}
+
 fn pool() -> Result<&'static rayon::ThreadPool, Failure> {
     static POOL: OnceLock<Result<rayon::ThreadPool, job::Threads>> = OnceLock::new();
     POOL.get_or_init(|| job::thread_pool(None, &sdfc_compiler::Limits::default()))

@@ -2,7 +2,7 @@
 //! meshes it (`commands::mesh::surface`), as arrays or written to a mesh file in the format
 //! its extension names, by the writers `sdfc mesh -o` uses.
 
-use super::{pool, Failure, Scene};
+use super::{bytes, pool, Failure, Scene};
 use pyo3::exceptions::PyValueError;
 use pyo3::PyResult;
 use sdfc_runtime::commands::mesh as mesher;
@@ -95,24 +95,15 @@ pub fn arrays(scene: &Scene, ask: Ask) -> Result<Arrays, Failure> {
     let (mesh, checked) = surface(scene, ask)?;
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = Palette::new(&checked.scene, &colours);
-    let p: Vec<u8> = mesh
-        .positions
-        .iter()
-        .flatten()
-        .flat_map(|x| x.to_ne_bytes())
-        .collect();
-    let tri: Vec<u8> = mesh
-        .triangles
-        .iter()
-        .flatten()
-        .flat_map(|x| x.to_ne_bytes())
-        .collect();
-    let c: Vec<u8> = palette
-        .vertex_colours(&mesh, 0)
-        .into_iter()
-        .flatten()
-        .flat_map(|x| (x as f32).to_ne_bytes())
-        .collect();
+    let p = bytes(mesh.positions.iter().flatten().copied());
+    let tri = bytes(mesh.triangles.iter().flatten().copied());
+    let c = bytes(
+        palette
+            .vertex_colours(&mesh, 0)
+            .into_iter()
+            .flatten()
+            .map(|x| x as f32),
+    );
     Ok((p, tri, c))
 }
 

@@ -249,12 +249,7 @@ impl Scene {
         let (w, h, bytes) = interruptible(py, move || {
             let image = scene.get().image(ask)?;
             let bytes = match encoding.as_str() {
-                "linear" => image
-                    .linear
-                    .iter()
-                    .flatten()
-                    .flat_map(|x| x.to_ne_bytes())
-                    .collect(),
+                "linear" => super::bytes(image.linear.iter().flatten().copied()),
                 "srgb" => image
                     .to_rgba8()
                     .chunks_exact(4)
@@ -297,16 +292,8 @@ impl Scene {
                     "the {name} backend keeps no depth buffers; depth() needs backend=\"cpu\""
                 )));
             };
-            let d: Vec<u8> = depth
-                .distance
-                .iter()
-                .flat_map(|x| x.to_ne_bytes())
-                .collect();
-            let c: Vec<u8> = depth
-                .coverage
-                .iter()
-                .flat_map(|x| x.to_ne_bytes())
-                .collect();
+            let d = super::bytes(depth.distance.iter().copied());
+            let c = super::bytes(depth.coverage.iter().copied());
             Ok((depth.width, depth.height, d, c))
         })?;
         Ok((w, h, PyBytes::new(py, &d), PyBytes::new(py, &c)))
@@ -382,8 +369,10 @@ impl Scene {
                         },
                     )
             });
-            let d: Vec<u8> = d.iter().flat_map(|x| x.to_ne_bytes()).collect();
-            let m: Vec<u8> = m.iter().flat_map(|x| x.to_ne_bytes()).collect();
+            let (d, m) = (
+                super::bytes(d.iter().copied()),
+                super::bytes(m.iter().copied()),
+            );
             (d, m)
         });
         Ok((PyBytes::new(py, &d), PyBytes::new(py, &m)))

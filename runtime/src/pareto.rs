@@ -3,6 +3,7 @@
 //! sweep, the Pareto front, the measured points and their report, as a table and as a chart
 //! (`crate::chart`).
 
+use crate::backend::Ran;
 use crate::chart::{self, Chart};
 use crate::cpu::reference::Convergence;
 use crate::metrics::DepthDifference;
@@ -431,18 +432,10 @@ pub struct ReferenceInfo {
 /// The report of `sdfc pareto --json`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Report {
-    /// Scene file.
-    pub scene: String,
-    /// Backend timed.
-    pub backend: &'static str,
-    /// Its device.
-    pub device: String,
-    /// Float type of the timed renders.
-    pub precision: &'static str,
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
+    /// The scene, the backend timed, its device, the float type of the timed renders and
+    /// the size.
+    #[serde(flatten)]
+    pub ran: Ran,
     /// Frames timed per point.
     pub frames: u32,
     /// The reference.
@@ -513,11 +506,11 @@ pub fn mark_fronts(points: &mut [Measured]) {
 pub fn table(r: &Report) -> String {
     let mut out = format!(
         "{} on {} ({}), {}x{}; reference aa {}, agreement with its check {:.2} dB{}\n",
-        r.scene,
-        r.backend,
-        r.device,
-        r.width,
-        r.height,
+        r.ran.scene,
+        r.ran.backend,
+        r.ran.device,
+        r.ran.width,
+        r.ran.height,
         r.reference.aa,
         r.reference.convergence.difference.psnr,
         if r.reference.convergence.converged {
@@ -562,10 +555,10 @@ pub fn table(r: &Report) -> String {
 
 /// The chart of a report.
 pub fn chart_of(r: &Report, target: f64) -> Chart {
-    let name = std::path::Path::new(&r.scene)
+    let name = std::path::Path::new(&r.ran.scene)
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| r.scene.clone());
+        .unwrap_or_else(|| r.ran.scene.clone());
     let c = &r.reference.convergence;
     let default_label = r
         .points
@@ -584,11 +577,11 @@ pub fn chart_of(r: &Report, target: f64) -> Chart {
         title: format!("{name}: speed against accuracy ({} points)", r.points.len()),
         subtitle: format!(
             "{} on {}, {} {}x{}, median of {} frames; reference: CPU f64, ε {}, {} steps, aa {}{}; it agrees with ε {}, aa {}{} to {:.1} dB{}",
-            r.backend,
-            r.device,
-            r.precision,
-            r.width,
-            r.height,
+            r.ran.backend,
+            r.ran.device,
+            r.ran.precision,
+            r.ran.width,
+            r.ran.height,
             r.frames,
             scientific(c.epsilon),
             c.max_steps,

@@ -50,6 +50,20 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
     use Type::*;
     let num = |t: Type| matches!(t, Int | Float);
     let vec = |t: Type| matches!(t, Vec2 | Vec3);
+    // Arithmetic of two numbers: an int where both are.
+    let numbers = |a: Type, b: Type| match (a, b) {
+        (Int, Int) => Some(Int),
+        _ if num(a) && num(b) => Some(Float),
+        _ => None,
+    };
+    // Arithmetic of vectors of one size, componentwise, or of a vector and a number, which
+    // broadcasts over its components (either order), as in GLSL: `0.5 + 0.5 * n` is
+    // `vec3(0.5) + 0.5 * n`.
+    let vectors = |a: Type, b: Type| match (a, b) {
+        (v, x) | (x, v) if vec(v) && num(x) => Some(v),
+        _ if vec(a) && a == b => Some(a),
+        _ => None,
+    };
     match op {
         Or | And => (a == Bool && b == Bool).then_some(Bool),
         Eq | Ne => (a == b || (num(a) && num(b)))
@@ -60,38 +74,22 @@ pub fn binary_type(op: BinOp, a: Type, b: Type) -> Option<Type> {
         Add if a.elem().is_some() && b.elem().is_some() => {
             [b, a].into_iter().find(|w| a.fits(*w) && b.fits(*w))
         }
-        // A number broadcasts over a vector's components (either order), as in GLSL:
-        // `0.5 + 0.5 * n` is `vec3(0.5) + 0.5 * n`.
         Add | Sub => match (a, b) {
-            (Int, Int) => Some(Int),
-            _ if num(a) && num(b) => Some(Float),
             (Angle, Angle) => Some(Angle),
-            (v, x) | (x, v) if vec(v) && num(x) => Some(v),
-            _ if vec(a) && a == b => Some(a),
-            _ => None,
+            _ => numbers(a, b).or_else(|| vectors(a, b)),
         },
         Mul => match (a, b) {
-            (Int, Int) => Some(Int),
-            _ if num(a) && num(b) => Some(Float),
             (Angle, x) | (x, Angle) if num(x) => Some(Angle),
-            (v, x) | (x, v) if vec(v) && num(x) => Some(v),
-            _ if vec(a) && a == b => Some(a),
-            _ => None,
+            _ => numbers(a, b).or_else(|| vectors(a, b)),
         },
         // `5 / 2` is 2.5: whole numbers divide with `div(a, b)`.
         Div => match (a, b) {
             _ if num(a) && num(b) => Some(Float),
             (Angle, x) if num(x) => Some(Angle),
             (Angle, Angle) => Some(Float),
-            (v, x) | (x, v) if vec(v) && num(x) => Some(v),
-            _ if vec(a) && a == b => Some(a),
-            _ => None,
+            _ => vectors(a, b),
         },
-        Rem => match (a, b) {
-            (Int, Int) => Some(Int),
-            _ if num(a) && num(b) => Some(Float),
-            _ => None,
-        },
+        Rem => numbers(a, b),
     }
 }
 

@@ -283,6 +283,17 @@ fn unit(v: [f64; 3]) -> [f64; 3] {
     v.map(|x| x / l)
 }
 
+/// The refusal of a `what` of size `x` larger than one of the half-extents `half` of the
+/// `shape`; none where it fits within each.
+fn within_halves(half: &[f64], x: f64, what: &str, shape: &str) -> Option<String> {
+    half.iter().any(|&h| h < x).then(|| {
+        format!(
+            "the {what} {} is larger than a half-extent of the {shape}",
+            num(x)
+        )
+    })
+}
+
 /// A number for a message.
 fn num(x: f64) -> String {
     crate::diagnostics::number(x, 6)

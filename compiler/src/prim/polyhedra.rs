@@ -5,7 +5,7 @@
 use super::solids::{box_from_q, extrude, sign};
 use super::Kind::{Float as F, Vec3 as V};
 use super::Range::Pos;
-use super::{any, num, param, Def, Extent, Field, Prim};
+use super::{any, param, within_halves, Def, Extent, Field, Prim};
 use crate::program::builder::{Builder, P};
 use crate::program::Reg;
 
@@ -95,15 +95,7 @@ pub(super) static PRIMS: &[Prim] = &[
         ],
         accepts: "`half` > 0; `edge` > 0, at most every half-extent",
         doc: "The twelve edges of the box of half-extents `half`, as square bars `2·edge` thick inside it.",
-        check: |a| {
-            let (half, edge) = (a.v3(0), a.f(1));
-            half.iter().any(|&h| h < edge).then(|| {
-                format!(
-                    "the edge {} is larger than a half-extent of the frame",
-                    num(edge)
-                )
-            })
-        },
+        check: |a| within_halves(&a.v3(0), a.f(1), "edge", "frame"),
         field: Field::Exact,
         extent: |a| {
             let h = a.v3(0);

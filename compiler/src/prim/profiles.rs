@@ -4,7 +4,7 @@
 
 use super::Kind::{Angle as A, Float as F, Vec2 as V2};
 use super::Range::{NonNeg, Pos, Within};
-use super::{any, num, param, Def, Extent, Field, Prim};
+use super::{any, param, within_halves, Def, Extent, Field, Prim};
 use crate::program::builder::{Builder, P};
 use crate::program::Reg;
 
@@ -33,15 +33,7 @@ pub(super) static PRIMS: &[Prim] = &[
         ],
         accepts: "`half` > 0; `radius` ≥ 0 and at most each half-extent",
         doc: "A rectangle with its corners rounded by `radius`, inside the extents.",
-        check: |a| {
-            let (half, radius) = (a.v2(0), a.f(1));
-            half.iter().any(|&h| h < radius).then(|| {
-                format!(
-                    "the rounding radius {} is larger than a half-extent of the rectangle",
-                    num(radius)
-                )
-            })
-        },
+        check: |a| within_halves(&a.v2(0), a.f(1), "rounding radius", "rectangle"),
         field: Field::Exact,
         extent: |a| {
             let h = a.v2(0);

@@ -447,6 +447,30 @@ fn renumber(op: &Op, new_index: &[Reg]) -> Op {
     }
 }
 
+/// Methods `name(x, y)`: the operation `Binary::$op` of two registers.
+macro_rules! binary {
+    ($($name:ident => $op:ident,)*) => {
+        $(
+            pub fn $name(&mut self, x: Reg, y: Reg) -> Reg {
+                self.bin(Binary::$op, x, y)
+            }
+        )*
+    };
+}
+
+/// Methods `name(x, k)`: the operation `op` of `x` and the constant `k`.
+macro_rules! with_constant {
+    ($($(#[$doc:meta])* $name:ident => $op:ident;)*) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(&mut self, x: Reg, k: f64) -> Reg {
+                let k = self.c(k);
+                self.$op(x, k)
+            }
+        )*
+    };
+}
+
 /// Scalar helpers, one per instruction.
 impl Builder {
     /// The signed distance to a triangle mesh at `p`.
@@ -465,17 +489,14 @@ impl Builder {
     pub fn bin(&mut self, b: Binary, x: Reg, y: Reg) -> Reg {
         self.emit(Op::Binary(b, x, y))
     }
-    pub fn add(&mut self, x: Reg, y: Reg) -> Reg {
-        self.bin(Binary::Add, x, y)
-    }
-    pub fn sub(&mut self, x: Reg, y: Reg) -> Reg {
-        self.bin(Binary::Sub, x, y)
-    }
-    pub fn mul(&mut self, x: Reg, y: Reg) -> Reg {
-        self.bin(Binary::Mul, x, y)
-    }
-    pub fn div(&mut self, x: Reg, y: Reg) -> Reg {
-        self.bin(Binary::Div, x, y)
+    binary! {
+        add => Add,
+        sub => Sub,
+        mul => Mul,
+        div => Div,
+        min => Min,
+        max => Max,
+        lt => Lt,
     }
     /// The signed distance at (x, y) to `outline` ([`Op::Outline`]), the outline shared by
     /// every instruction that reads it.
@@ -489,15 +510,6 @@ impl Builder {
         };
         self.emit(Op::Outline(k as u32, x, y))
     }
-    pub fn min(&mut self, x: Reg, y: Reg) -> Reg {
-        self.bin(Binary::Min, x, y)
-    }
-    pub fn max(&mut self, x: Reg, y: Reg) -> Reg {
-        self.bin(Binary::Max, x, y)
-    }
-    pub fn lt(&mut self, x: Reg, y: Reg) -> Reg {
-        self.bin(Binary::Lt, x, y)
-    }
     pub fn select(&mut self, c: Reg, a: Reg, b: Reg) -> Reg {
         self.emit(Op::Select(c, a, b))
     }
@@ -510,30 +522,17 @@ impl Builder {
     pub fn sqrt(&mut self, a: Reg) -> Reg {
         self.un(Unary::Sqrt, a)
     }
-    /// x + k for a constant k.
-    pub fn addc(&mut self, x: Reg, k: f64) -> Reg {
-        let k = self.c(k);
-        self.add(x, k)
-    }
-    /// x - k for a constant k.
-    pub fn subc(&mut self, x: Reg, k: f64) -> Reg {
-        let k = self.c(k);
-        self.sub(x, k)
-    }
-    /// x * k for a constant k.
-    pub fn mulc(&mut self, x: Reg, k: f64) -> Reg {
-        let k = self.c(k);
-        self.mul(x, k)
-    }
-    /// max(x, k) for a constant k.
-    pub fn maxc(&mut self, x: Reg, k: f64) -> Reg {
-        let k = self.c(k);
-        self.max(x, k)
-    }
-    /// min(x, k) for a constant k.
-    pub fn minc(&mut self, x: Reg, k: f64) -> Reg {
-        let k = self.c(k);
-        self.min(x, k)
+    with_constant! {
+        /// x + k for a constant k.
+        addc => add;
+        /// x - k for a constant k.
+        subc => sub;
+        /// x * k for a constant k.
+        mulc => mul;
+        /// max(x, k) for a constant k.
+        maxc => max;
+        /// min(x, k) for a constant k.
+        minc => min;
     }
     /// x limited to the constant range [lo, hi].
     pub fn clampc(&mut self, x: Reg, lo: f64, hi: f64) -> Reg {

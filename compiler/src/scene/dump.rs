@@ -243,6 +243,11 @@ fn v3(v: V3) -> String {
     format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]))
 }
 
+/// A 3×3 matrix as its rows: `[(…), (…), (…)]`.
+fn m3(m: &[V3; 3]) -> String {
+    format!("[{}, {}, {}]", v3(m[0]), v3(m[1]), v3(m[2]))
+}
+
 fn ids(ids: &[NodeId]) -> String {
     ids.iter()
         .map(|i| format!("%{}", i.0))
@@ -294,13 +299,7 @@ fn node(n: &Node) -> String {
             )
         }
         Node::Translate { offset, child } => format!("translate {} %{}", v3(*offset), child.0),
-        Node::Rotate { matrix, child } => format!(
-            "rotate [{}, {}, {}] %{}",
-            v3(matrix[0]),
-            v3(matrix[1]),
-            v3(matrix[2]),
-            child.0
-        ),
+        Node::Rotate { matrix, child } => format!("rotate {} %{}", m3(matrix), child.0),
         Node::Scale { factor, child } => format!("scale {} %{}", num(*factor), child.0),
         Node::ScaleXyz { factors, child } => format!("scale_xyz {} %{}", v3(*factors), child.0),
         Node::Repeat {
@@ -334,13 +333,7 @@ fn node(n: &Node) -> String {
             format!("repeat_polar count={count}{m} %{}", child.0)
         }
         Node::Wrap { radius, child } => format!("wrap {} %{}", num(*radius), child.0),
-        Node::Shear { matrix, child } => format!(
-            "shear [{}, {}, {}] %{}",
-            v3(matrix[0]),
-            v3(matrix[1]),
-            v3(matrix[2]),
-            child.0
-        ),
+        Node::Shear { matrix, child } => format!("shear {} %{}", m3(matrix), child.0),
         Node::Taper { rate, child } => format!("taper {} %{}", num(*rate), child.0),
         Node::Morph { t, a, b } => format!("morph t={} %{}, %{}", num(*t), a.0, b.0),
         Node::Twist { rate, child } => format!("twist {} %{}", num(*rate), child.0),

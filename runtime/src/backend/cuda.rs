@@ -1,9 +1,7 @@
 //! CUDA behind [`Renderer`]: the device, the kernel translated to PTX and loaded as a module,
 //! and what it takes to write the kernel again.
 
-use super::{
-    kernel, written, Error, Frame, Part, Preparation, Prepared, Progress, Renderer, Setup,
-};
+use super::{kernel, written, Error, Frame, Part, Preparation, Progress, Renderer, Setup};
 use crate::gpu::{self, cuda::Cuda, launch::Faults};
 use crate::memory::Memory;
 use sdfc_compiler::{analytic::Traceable, ptx, wgsl, Lowered, Scene, Settings};
@@ -201,15 +199,6 @@ impl Renderer for CudaPrepared {
                 module.data.as_deref(),
             )),
         })
-    }
-
-    fn next(
-        &self,
-        _: &Scene,
-        _: Lowered,
-        _: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), Error> {
-        Err(Error::NotNext)
     }
 
     fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {

@@ -437,13 +437,17 @@ pub trait Renderer: std::fmt::Debug + Send + Sync {
     fn part<'a>(&'a self, scene: &'a Scene) -> Result<Part<'a>, Error>;
 
     /// `scene`, lowered as `lowered`, prepared as this is (see [`Prepared::next`]), with the
-    /// wgpu kernel `kernel` instead of this one's choice when given.
+    /// wgpu kernel `kernel` instead of this one's choice when given. A CUDA preparation and
+    /// several devices keep the default, [`Error::NotNext`]: they are prepared again with
+    /// [`Prepared::update`].
     fn next(
         &self,
-        scene: &Scene,
-        lowered: Lowered,
-        kernel: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), Error>;
+        _scene: &Scene,
+        _lowered: Lowered,
+        _kernel: Option<wgsl::KernelChoice>,
+    ) -> Result<(Prepared, bool), Error> {
+        Err(Error::NotNext)
+    }
 
     /// Prepares `scene`, lowered as `lowered`, in place of this one's scene (see
     /// [`Prepared::update`]).
@@ -475,6 +479,46 @@ impl std::fmt::Debug for Part<'_> {
         f.debug_struct("Part")
             .field("worker", &self.worker.name())
             .finish_non_exhaustive()
+    }
+}
+
+/// What a timed render ran, the head of `sdfc bench`'s and `sdfc pareto`'s reports: the scene
+/// file, the backend and its device, the float type and the image size.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Ran {
+    /// The scene file.
+    pub scene: String,
+    /// Backend used.
+    pub backend: &'static str,
+    /// The device it ran on.
+    pub device: String,
+    /// Float type.
+    pub precision: &'static str,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+}
+
+impl Ran {
+    /// `scene` rendered on `prepared` in `precision` at the size of `settings`.
+    pub fn new(
+        scene: String,
+        prepared: &Prepared,
+        precision: Precision,
+        settings: &Settings,
+    ) -> Ran {
+        Ran {
+            scene,
+            backend: prepared.name(),
+            device: prepared.device(),
+            precision: match precision {
+                Precision::F32 => "f32",
+                Precision::F64 => "f64",
+            },
+            width: settings.width,
+            height: settings.height,
+        }
     }
 }
 

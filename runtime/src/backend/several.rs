@@ -115,15 +115,6 @@ impl Renderer for SeveralPrepared {
         Err(Error::Nested)
     }
 
-    fn next(
-        &self,
-        _: &Scene,
-        _: Lowered,
-        _: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), Error> {
-        Err(Error::NotNext)
-    }
-
     fn update(&mut self, scene: &Scene, lowered: Lowered) -> Result<bool, Error> {
         let mut built = false;
         for p in &mut self.parts {

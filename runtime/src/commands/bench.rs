@@ -2,8 +2,8 @@
 //! for GPU targets the achieved fraction of the FP32 floor).
 
 use super::JobArgs;
-use crate::backend::Setup;
-use crate::cpu::{Precision, Stats};
+use crate::backend::{Ran, Setup};
+use crate::cpu::Stats;
 use crate::fp32;
 use crate::frontend;
 use crate::job::{self, Error, FrameScene, Job, Kernels, Open, Ready, Use};
@@ -46,18 +46,9 @@ pub struct BenchArgs {
 /// The timing of one scene.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Timing {
-    /// The scene file.
-    pub scene: String,
-    /// Backend used.
-    pub backend: &'static str,
-    /// The device it ran on.
-    pub device: String,
-    /// Float type.
-    pub precision: &'static str,
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
+    /// The scene, backend, device, float type and size.
+    #[serde(flatten)]
+    pub ran: Ran,
     /// Samples per pixel edge.
     pub aa: u32,
     /// Worker threads.
@@ -395,15 +386,7 @@ fn time_scene(
         _ => None,
     };
     Ok(Timing {
-        scene: name,
-        backend: prepared.name(),
-        device: prepared.device(),
-        precision: match job.precision {
-            Precision::F32 => "f32",
-            Precision::F64 => "f64",
-        },
-        width: s.width,
-        height: s.height,
+        ran: Ran::new(name, &prepared, job.precision, s),
         aa: s.aa,
         threads: rayon::current_num_threads(),
         frames: args.frames,
@@ -461,15 +444,15 @@ fn header() -> String {
 }
 
 fn row(t: &Timing) -> String {
-    let name = std::path::Path::new(&t.scene)
+    let name = std::path::Path::new(&t.ran.scene)
         .file_name()
         .map(|n| n.to_string_lossy().into_owned());
     format!(
         "{:<28} {:>7} {:>10} {:>9} {:>4} {:>7} {:>10.2} {:>10.2} {:>8.2} {:>8.2} {:>9.1} {:>6} {:>6}",
-        name.unwrap_or_else(|| t.scene.clone()),
-        t.backend,
+        name.unwrap_or_else(|| t.ran.scene.clone()),
+        t.ran.backend,
         t.method,
-        format!("{}x{}", t.width, t.height),
+        format!("{}x{}", t.ran.width, t.ran.height),
         t.aa,
         t.threads,
         t.median_s * 1e3,

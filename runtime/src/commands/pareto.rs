@@ -5,7 +5,7 @@
 //! `crate::pareto`'s.
 
 use super::render::{self, Backend};
-use crate::backend::{Devices, Prepared, Setup};
+use crate::backend::{Devices, Prepared, Ran, Setup};
 use crate::chart::{self, Chart};
 use crate::cpu::reference;
 use crate::cpu::{Precision, Render};
@@ -284,15 +284,12 @@ fn measure(
     let d = measured.iter().find(|m| m.default);
     let s = &scene.settings;
     Ok(Report {
-        scene: args.file.display().to_string(),
-        backend: prepared.name(),
-        device: prepared.device(),
-        precision: match args.precision {
-            Precision::F32 => "f32",
-            Precision::F64 => "f64",
-        },
-        width: s.width,
-        height: s.height,
+        ran: Ran::new(
+            args.file.display().to_string(),
+            &prepared,
+            args.precision,
+            s,
+        ),
         frames: args.frames,
         reference: info,
         default_on_front_time: d.is_some_and(|m| m.front_time),

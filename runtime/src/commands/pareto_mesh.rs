@@ -207,19 +207,22 @@ fn mark_fronts(points: &mut [MeshPoint]) {
     }
 }
 
+/// What the distances measured in a field of `exactness` are, and the caution a table adds
+/// where they are |f| (which may understate them).
+fn distances(exactness: &str) -> (&'static str, &'static str) {
+    if exactness == "exact" {
+        ("distances to the surface", "")
+    } else {
+        ("distances are |f|", ", which may understate them")
+    }
+}
+
 /// The points as a text table.
 pub fn table(r: &MeshReport) -> String {
+    let (what, caution) = distances(&r.exactness);
     let mut out = format!(
-        "{}: meshed on {} threads, median of {} runs; the field is {}{}\n",
-        r.scene,
-        r.threads,
-        r.runs,
-        r.exactness,
-        if r.exactness == "exact" {
-            " (distances to the surface)"
-        } else {
-            " (distances are |f|, which may understate them)"
-        }
+        "{}: meshed on {} threads, median of {} runs; the field is {} ({what}{caution})\n",
+        r.scene, r.threads, r.runs, r.exactness,
     );
     out += &format!(
         "{:>10} {:>10} {:>10} {:>10} {:>10} {:>12} {:>12} {:>8} {:>6} {:>7}\n",
@@ -269,11 +272,7 @@ pub fn chart_of(r: &MeshReport) -> Chart {
             r.threads,
             r.runs,
             r.exactness,
-            if r.exactness == "exact" {
-                "distances to the surface"
-            } else {
-                "distances are |f|"
-            }
+            distances(&r.exactness).0,
         ),
         default_label: format!("sdfc mesh's default, resolution {DEFAULT_RESOLUTION}"),
         panels: [

@@ -314,9 +314,9 @@ impl GpuPresenter {
             label: Some("sdfc view blit"),
             source: wgpu::ShaderSource::Wgsl(BLIT.into()),
         });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sdfc view blit"),
-            entries: &[
+        let (layout, pipeline_layout) = gpu.layouts(
+            ("sdfc view blit", "sdfc view blit"),
+            &[
                 wgpu::BindGroupLayoutEntry {
                     binding: 0,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -334,12 +334,7 @@ impl GpuPresenter {
                     count: None,
                 },
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sdfc view blit"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        );
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("sdfc view blit"),
             layout: Some(&pipeline_layout),

@@ -10,7 +10,7 @@
 
 use super::grade::Grade;
 use crate::gpu::launch::{self, Work};
-use crate::gpu::wgpu::ResidentFrame;
+use crate::gpu::wgpu::{compute_entry, storage, ResidentFrame};
 use crate::gpu::Gpu;
 use crate::image::Image;
 use sdfc_compiler::{wgsl, Scene};
@@ -212,24 +212,13 @@ impl Resident {
             label: Some("sdfc view accumulate"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
-            count: None,
-        };
-        let storage = |read_only| wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sdfc view accumulate"),
-            entries: &[
-                entry(0, storage(true)),
-                entry(1, storage(true)),
-                entry(2, storage(false)),
-                entry(
+        let (layout, pipeline_layout) = gpu.layouts(
+            ("sdfc view accumulate", "sdfc view accumulate"),
+            &[
+                compute_entry(0, storage(true, false)),
+                compute_entry(1, storage(true, false)),
+                compute_entry(2, storage(false, false)),
+                compute_entry(
                     3,
                     wgpu::BindingType::StorageTexture {
                         access: wgpu::StorageTextureAccess::WriteOnly,
@@ -237,15 +226,10 @@ impl Resident {
                         view_dimension: wgpu::TextureViewDimension::D2,
                     },
                 ),
-                entry(4, storage(true)),
-                entry(5, storage(false)),
+                compute_entry(4, storage(true, false)),
+                compute_entry(5, storage(false, false)),
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sdfc view accumulate"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        );
         let accumulate = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("sdfc view accumulate"),
             layout: Some(&pipeline_layout),

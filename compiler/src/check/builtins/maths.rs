@@ -19,6 +19,33 @@ macro_rules! componentwise {
     };
 }
 
+/// The built-in `name` of `f` over an angle or a plain number (read as radians).
+macro_rules! trig {
+    ($name:literal, $f:expr) => {
+        Builtin {
+            name: $name,
+            sigs: sigs![
+                [p("x", A, Req, Any)] -> F => |_, a| f1(a, $f);
+                [p("x", F, Req, Any)] -> F => |_, a| f1(a, $f);
+            ],
+        }
+    };
+}
+
+/// The per-point function `name` of a point in space or in the plane (`at`): refused with
+/// constants, evaluated at each point inside `field { … }`.
+macro_rules! at_point {
+    ($name:literal) => {
+        Builtin {
+            name: $name,
+            sigs: sigs![
+                [p("at", V, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
+                [p("at", V2, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
+            ],
+        }
+    };
+}
+
 /// The built-ins of lists, vectors, scalar maths and per-point functions.
 pub(super) static MATHS: &[Builtin] = &[
     // Lists.
@@ -98,27 +125,9 @@ pub(super) static MATHS: &[Builtin] = &[
         ],
     },
     // Scalar maths.
-    Builtin {
-        name: "sin",
-        sigs: sigs![
-            [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::sin);
-            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::sin);
-        ],
-    },
-    Builtin {
-        name: "cos",
-        sigs: sigs![
-            [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::cos);
-            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::cos);
-        ],
-    },
-    Builtin {
-        name: "tan",
-        sigs: sigs![
-            [p("x", A, Req, Any)] -> F => |_, a| f1(a, f64::tan);
-            [p("x", F, Req, Any)] -> F => |_, a| f1(a, f64::tan);
-        ],
-    },
+    trig!("sin", f64::sin),
+    trig!("cos", f64::cos),
+    trig!("tan", f64::tan),
     Builtin {
         name: "asin",
         sigs: sigs![
@@ -204,13 +213,7 @@ pub(super) static MATHS: &[Builtin] = &[
             [prof("profile"), p("at", V2, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
         ],
     },
-    Builtin {
-        name: "noise",
-        sigs: sigs![
-            [p("at", V, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
-            [p("at", V2, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
-        ],
-    },
+    at_point!("noise"),
     Builtin {
         name: "fbm",
         sigs: sigs![
@@ -220,13 +223,7 @@ pub(super) static MATHS: &[Builtin] = &[
                 => |_, _| Err(Refusal::PerPoint);
         ],
     },
-    Builtin {
-        name: "voronoi",
-        sigs: sigs![
-            [p("at", V, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
-            [p("at", V2, Req, Any)] -> F => |_, _| Err(Refusal::PerPoint);
-        ],
-    },
+    at_point!("voronoi"),
     Builtin {
         name: "min",
         sigs: sigs![

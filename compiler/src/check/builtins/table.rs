@@ -32,6 +32,22 @@ macro_rules! smooth_builtin {
     };
 }
 
+/// The built-in `name` combining two or more shapes or profiles by `op`, or a list of them
+/// (`union`, `intersect`).
+macro_rules! combine_builtin {
+    ($name:literal, $op:expr) => {
+        Builtin {
+            name: $name,
+            sigs: sigs![
+                [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, $op);
+                [p("shapes", LS, Req, Any)] -> S => |b, a| combine_list(b, a, $op, $name);
+                [prof("a"), prof("b")] rest + -> PR => |b, a| flat(combine(b, a, $op));
+                [p("profiles", LP, Req, Any)] -> PR => |b, a| flat(combine_list(b, a, $op, $name));
+            ],
+        }
+    };
+}
+
 /// The built-ins of shapes, profiles and their operations.
 pub(super) static SHAPES: &[Builtin] = &[
     // Primitives.
@@ -271,24 +287,8 @@ pub(super) static SHAPES: &[Builtin] = &[
         ],
     },
     // Combinators.
-    Builtin {
-        name: "union",
-        sigs: sigs![
-            [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Union);
-            [p("shapes", LS, Req, Any)] -> S => |b, a| combine_list(b, a, Combine::Union, "union");
-            [prof("a"), prof("b")] rest + -> PR => |b, a| flat(combine(b, a, Combine::Union));
-            [p("profiles", LP, Req, Any)] -> PR => |b, a| flat(combine_list(b, a, Combine::Union, "union"));
-        ],
-    },
-    Builtin {
-        name: "intersect",
-        sigs: sigs![
-            [shape("a"), shape("b")] rest + -> S => |b, a| combine(b, a, Combine::Intersect);
-            [p("shapes", LS, Req, Any)] -> S => |b, a| combine_list(b, a, Combine::Intersect, "intersect");
-            [prof("a"), prof("b")] rest + -> PR => |b, a| flat(combine(b, a, Combine::Intersect));
-            [p("profiles", LP, Req, Any)] -> PR => |b, a| flat(combine_list(b, a, Combine::Intersect, "intersect"));
-        ],
-    },
+    combine_builtin!("union", Combine::Union),
+    combine_builtin!("intersect", Combine::Intersect),
     Builtin {
         name: "subtract",
         sigs: sigs![

@@ -190,43 +190,38 @@ fn reduced_loop<T: Float>(d: &mut [T], a: &[T], f: impl Fn(T) -> T, whole: impl 
     }
 }
 
+/// `$body` in one arm per binary operation, `$op` there a constant naming the arm's operation:
+/// the loops of [`binary_loop`] and its kin, each specialised by its constant.
+macro_rules! each_binary {
+    ($b:expr, $op:ident => $body:expr) => {
+        each_binary!(@arms $b, $op => $body; Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+    };
+    (@arms $b:expr, $op:ident => $body:expr; $($v:ident),*) => {
+        match $b {
+            $(Binary::$v => {
+                const $op: Binary = Binary::$v;
+                $body
+            })*
+        }
+    };
+}
+
 /// One loop per operation, each specialised by `scalar::binary` with a constant operation.
 #[inline(always)]
 fn binary_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], y: &[T]) {
-    macro_rules! arms {
-        ($($v:ident),*) => {
-            match b {
-                $(Binary::$v => map2(d, x, y, |p, q| scalar::binary(Binary::$v, p, q)),)*
-            }
-        };
-    }
-    arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+    each_binary!(b, OP => map2(d, x, y, |p, q| scalar::binary(OP, p, q)))
 }
 
 /// `op(x, k)` for an immediate `k`.
 #[inline(always)]
 fn binary_k_loop<T: Float>(b: Binary, d: &mut [T], x: &[T], k: T) {
-    macro_rules! arms {
-        ($($v:ident),*) => {
-            match b {
-                $(Binary::$v => map1(d, x, |p| scalar::binary(Binary::$v, p, k)),)*
-            }
-        };
-    }
-    arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+    each_binary!(b, OP => map1(d, x, |p| scalar::binary(OP, p, k)))
 }
 
 /// `op(k, y)` for an immediate `k`.
 #[inline(always)]
 fn k_binary_loop<T: Float>(b: Binary, d: &mut [T], k: T, y: &[T]) {
-    macro_rules! arms {
-        ($($v:ident),*) => {
-            match b {
-                $(Binary::$v => map1(d, y, |q| scalar::binary(Binary::$v, k, q)),)*
-            }
-        };
-    }
-    arms!(Add, Sub, Mul, Div, Min, Max, Pow, Atan2, Lt)
+    each_binary!(b, OP => map1(d, y, |q| scalar::binary(OP, k, q)))
 }
 
 /// A fused step: `finish(Σ term(xᵢ, kᵢ))` over `terms` operands, summed left to right, the

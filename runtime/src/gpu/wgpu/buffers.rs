@@ -8,6 +8,25 @@ use std::ops::Range;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+/// The binding `binding` of a compute pass, of type `ty`.
+pub(crate) fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
+}
+
+/// A storage buffer, `read_only` or not, bound at a dynamic offset when `dynamic`.
+pub(crate) fn storage(read_only: bool, dynamic: bool) -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only },
+        has_dynamic_offset: dynamic,
+        min_binding_size: None,
+    }
+}
+
 /// The size of a buffer for `n` bytes: at least 16, so that one for no bytes can be bound.
 pub(super) fn padded(n: u64) -> u64 {
     n.max(16)
@@ -164,16 +183,8 @@ impl Gpu {
                 label: Some("sdfc reduction"),
                 source: wgpu::ShaderSource::Wgsl(reduction::SOURCE.into()),
             });
-        let entry = |binding, read_only, dynamic| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: dynamic,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let entry =
+            |binding, read_only, dynamic| compute_entry(binding, storage(read_only, dynamic));
         let entries = [
             entry(0, true, true),
             entry(1, true, false),

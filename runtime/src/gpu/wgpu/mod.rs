@@ -8,6 +8,7 @@ mod device;
 mod pipeline;
 mod resident;
 
+pub(crate) use buffers::{compute_entry, storage};
 pub use resident::ResidentFrame;
 
 use std::collections::HashMap;

@@ -1,7 +1,7 @@
 //! The kernels' compute pipelines on a [`Gpu`]: compiled once per kernel text and kept, the
 //! driver's pipeline cache stored on disk between processes, and a [`Kernel`] ready to render.
 
-use super::buffers::words;
+use super::buffers::{compute_entry, storage, words};
 use super::{
     Buffers, DriverCache, Error, Gpu, Kernel, Pipeline, PipelineTime, PIPELINES_KEPT, TILE_STRIDE,
 };
@@ -215,31 +215,20 @@ impl Gpu {
                 checks,
             )
         };
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
-            count: None,
-        };
         let uniform = |dynamic| wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Uniform,
             has_dynamic_offset: dynamic,
             min_binding_size: None,
         };
-        let storage = |read_only| wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        };
         let mut entries = vec![
-            entry(0, uniform(false)),
-            entry(1, uniform(true)),
-            entry(2, storage(false)),
-            entry(3, storage(false)),
-            entry(5, storage(false)),
+            compute_entry(0, uniform(false)),
+            compute_entry(1, uniform(true)),
+            compute_entry(2, storage(false, false)),
+            compute_entry(3, storage(false, false)),
+            compute_entry(5, storage(false, false)),
         ];
         if data {
-            entries.push(entry(4, storage(true)));
+            entries.push(compute_entry(4, storage(true, false)));
         }
         let (layout, pipeline_layout) = self.layouts(("sdfc bindings", "sdfc layout"), &entries);
         let (pipeline, driver) = self.cached_compute(
@@ -253,7 +242,7 @@ impl Gpu {
 
     /// A bind group layout of `entries` and the layout of a pipeline of that one group, with
     /// the labels `labels`.
-    pub(super) fn layouts(
+    pub(crate) fn layouts(
         &self,
         (group, pipeline): (&str, &str),
         entries: &[wgpu::BindGroupLayoutEntry],

@@ -329,8 +329,7 @@ fn onto_zero(
         })
         .collect();
     for _ in 0..2 {
-        let pts: Vec<[f64; 3]> = round.iter().map(|&p| centres[p]).collect();
-        let d = field.distances(&pts);
+        let d = field.distances_of(round.len(), |k| centres[round[k]]);
         for (k, &p) in round.iter().enumerate() {
             if d[k].is_finite() && d[k].abs() < grid.voxel {
                 centres[p] = [0, 1, 2].map(|i| centres[p][i] - d[k] * mean[k][i]);
@@ -434,11 +433,10 @@ fn roots(
         if active.is_empty() {
             break;
         }
-        let pts: Vec<[f64; 3]> = active
-            .par_iter()
-            .map(|&k| at(&state[k], state[k].t))
-            .collect();
-        let d = field.distances(&pts);
+        let d = field.distances_of(active.len(), |n| {
+            let r = &state[active[n]];
+            at(r, r.t)
+        });
         let tolerance = if round + 1 < iterations {
             1e-12 * grid.voxel.max(1e-300)
         } else {

@@ -7,7 +7,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::PyResult;
 use sdfc_runtime::commands::mesh as mesher;
 use sdfc_runtime::frontend::Checked;
-use sdfc_runtime::mesh::write::{Format, Palette, Up};
+use sdfc_runtime::mesh::write::{Format, Palette, Unsaved, Up};
 use sdfc_runtime::mesh::Mesh;
 use std::path::Path;
 
@@ -52,8 +52,10 @@ impl Ask {
     }
 }
 
-/// The scene's surface, and the checked scene it came from.
-fn surface(scene: &Scene, ask: Ask) -> Result<(Mesh, Checked), Failure> {
+/// The scene's surface, and the checked scene it came from; the materials found where
+/// the mesh goes to a file of `format` that carries them ([`Format::carries_materials`]),
+/// or, without one, everywhere (the arrays' colours).
+fn surface(scene: &Scene, ask: Ask, format: Option<Format>) -> Result<(Mesh, Checked), Failure> {
     let checked = scene.checked(ask.t, None, None)?;
     let region = mesher::Region {
         resolution: ask.resolution,
@@ -63,6 +65,7 @@ fn surface(scene: &Scene, ask: Ask) -> Result<(Mesh, Checked), Failure> {
     };
     let settings = sdfc_runtime::mesh::Settings {
         sharp: ask.sharp,
+        materials: format.is_none_or(|f| f.carries_materials(&checked.scene)),
         ..Default::default()
     };
     let say = |text: String| {
@@ -92,7 +95,7 @@ pub type Arrays = (Vec<u8>, Vec<u8>, Vec<u8>);
 
 /// The mesh as [`Arrays`].
 pub fn arrays(scene: &Scene, ask: Ask) -> Result<Arrays, Failure> {
-    let (mesh, checked) = surface(scene, ask)?;
+    let (mesh, checked) = surface(scene, ask, None)?;
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = Palette::new(&checked.scene, &colours);
     let p = bytes(mesh.positions.iter().flatten().copied());
@@ -136,7 +139,7 @@ pub fn save(
     })?;
     sdfc_runtime::output::check_writable(path)
         .map_err(|why| Failure::Value(format!("cannot write `{}`: {why}", path.display())))?;
-    let (mesh, checked) = surface(scene, ask)?;
+    let (mesh, checked) = surface(scene, ask, Some(format))?;
     if mesh.triangles.is_empty() {
         return Err(Failure::Runtime(format!(
             "the mesh has no triangles: no surface crosses the grid (a higher resolution, or bounds that hold the surface); `{}` is not written",
@@ -145,10 +148,10 @@ pub fn save(
     }
     let colours = sdfc_compiler::Colours::new(&checked.scene);
     let palette = Palette::new(&checked.scene, &colours);
-    let bytes = format
-        .encode(&mesh, &palette, up.unwrap_or(format.default_up()))
-        .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;
-    sdfc_runtime::image::write_atomic(path, &bytes)
-        .map_err(|e| Failure::Value(format!("cannot write `{}`: {e}", path.display())))?;
+    let up = up.unwrap_or(format.default_up());
+    sdfc_runtime::mesh::write::save(format, &mesh, &palette, up, path).map_err(|e| {
+        let (Unsaved::Encode(e) | Unsaved::Write(e)) = e;
+        Failure::Value(format!("cannot write `{}`: {e}", path.display()))
+    })?;
     Ok((mesh.triangles.len(), mesh.positions.len()))
 }

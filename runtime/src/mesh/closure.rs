@@ -81,9 +81,7 @@ impl Closure {
     ) {
         known.par_sort_unstable_by_key(|&(k, _)| k);
         let keys = unknown(corners(candidates), &known);
-        let points: Vec<[f64; 3]> = keys.par_iter().map(|&k| grid.point(unpack(k))).collect();
-        let d = field.distances(&points);
-        drop(points);
+        let d = field.distances_of(keys.len(), |n| grid.point(unpack(keys[n])));
         self.values = Bricks::from_sorted(f64::NAN, grid, self.held, &keys, |n| d[n]);
         for (k, v) in known {
             self.values.set(unpack(k), v);
@@ -104,9 +102,8 @@ impl Closure {
                 }
             }
         }
-        let points: Vec<[f64; 3]> = need.par_iter().map(|&i| grid.point(i)).collect();
+        let d = field.distances_of(need.len(), |n| grid.point(need[n]));
         drop(need);
-        let d = field.distances(&points);
         for (at, v) in places.into_iter().zip(d) {
             self.values.put(at, v);
         }

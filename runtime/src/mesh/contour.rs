@@ -244,15 +244,20 @@ impl Rings {
     /// Each patch fanned around its inner vertex (vertex `base + p` for patch `p`): the
     /// triangles and each one's patch.
     fn fans(&self, base: u32) -> (Vec<[u32; 3]>, Vec<u32>) {
-        let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(self.ring.len());
-        let mut owner: Vec<u32> = Vec::with_capacity(self.ring.len());
-        for p in 0..self.cells.len() {
-            let ids = self.of(p);
-            for k in 0..ids.len() {
-                triangles.push([base + p as u32, ids[k], ids[(k + 1) % ids.len()]]);
-                owner.push(p as u32);
-            }
-        }
+        // The triangles of patch `p` are `starts[p]..starts[p + 1]`, made in parallel.
+        let owner: Vec<u32> = (0..self.cells.len() as u32)
+            .into_par_iter()
+            .flat_map_iter(|p| std::iter::repeat_n(p, self.of(p as usize).len()))
+            .collect();
+        let triangles = owner
+            .par_iter()
+            .enumerate()
+            .map(|(t, &p)| {
+                let (start, end) = (self.starts[p as usize], self.starts[p as usize + 1]);
+                let next = if t + 1 == end { start } else { t + 1 };
+                [base + p, self.ring[t], self.ring[next]]
+            })
+            .collect();
         (triangles, owner)
     }
 }
@@ -322,15 +327,14 @@ fn onto_zero(
 ) {
     let round: Vec<usize> = (0..rings.cells.len()).filter(|&p| smooth[p]).collect();
     let mean: Vec<[f64; 3]> = round
-        .iter()
+        .par_iter()
         .map(|&p| {
             let ids = rings.of(p);
             normalise([0, 1, 2].map(|i| ids.iter().map(|&v| normals[v as usize][i]).sum::<f64>()))
         })
         .collect();
     for _ in 0..2 {
-        let pts: Vec<[f64; 3]> = round.iter().map(|&p| centres[p]).collect();
-        let d = field.distances(&pts);
+        let d = field.distances_of(round.len(), |k| centres[round[k]]);
         for (k, &p) in round.iter().enumerate() {
             if d[k].is_finite() && d[k].abs() < grid.voxel {
                 centres[p] = [0, 1, 2].map(|i| centres[p][i] - d[k] * mean[k][i]);
@@ -434,11 +438,10 @@ fn roots(
         if active.is_empty() {
             break;
         }
-        let pts: Vec<[f64; 3]> = active
-            .par_iter()
-            .map(|&k| at(&state[k], state[k].t))
-            .collect();
-        let d = field.distances(&pts);
+        let d = field.distances_of(active.len(), |n| {
+            let r = &state[active[n]];
+            at(r, r.t)
+        });
         let tolerance = if round + 1 < iterations {
             1e-12 * grid.voxel.max(1e-300)
         } else {
@@ -470,7 +473,7 @@ fn roots(
         active = next.concat();
     }
     state
-        .iter()
+        .par_iter()
         .map(|r| at(r, r.t.clamp(MARGIN, 1.0 - MARGIN)))
         .collect()
 }

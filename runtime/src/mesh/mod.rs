@@ -222,6 +222,37 @@ impl Field {
         self.timed(|| self.clipped(points))
     }
 
+    /// The clipped field at `count` points, the `n`th at `point(n)`, as [`Field::distances`]
+    /// gives it, to the bit: on the CPU each task writes its points straight into the
+    /// evaluator's columns, so that no array of the points is made (on a GPU, one is).
+    pub fn distances_of(
+        &self,
+        count: usize,
+        point: impl Fn(usize) -> [f64; 3] + Sync + Send,
+    ) -> Vec<f64> {
+        if self.gpu.is_some() {
+            let points: Vec<[f64; 3]> = (0..count).into_par_iter().map(point).collect();
+            return self.distances(&points);
+        }
+        self.timed(|| {
+            let mut out = vec![0.0; count];
+            self.evaluated.fetch_add(count as u64, Ordering::Relaxed);
+            out.par_chunks_mut(TASK).enumerate().for_each_init(
+                || Scratch::new(&self.distance),
+                |s, (k, o)| {
+                    s.fill((k * TASK..k * TASK + o.len()).map(&point));
+                    s.eval_filled(o, None);
+                    let [x, y, z] = &s.xyz;
+                    for (i, d) in o.iter_mut().enumerate() {
+                        let b = self.clip_distance([x[i], y[i], z[i]]);
+                        *d = if *d > b { *d } else { b };
+                    }
+                },
+            );
+            out
+        })
+    }
+
     /// `d` at the points `p` intersected with the clip box.
     fn clip(&self, d: &mut [f64], p: &[[f64; 3]]) {
         for (d, q) in d.iter_mut().zip(p) {
@@ -392,6 +423,23 @@ impl<'t> Scratch<'t> {
             col.clear();
             col.extend(points.iter().map(|p| p[i]));
         }
+        self.eval_filled(d, m);
+    }
+
+    /// The columns set to `points`.
+    fn fill(&mut self, points: impl Iterator<Item = [f64; 3]>) {
+        for col in &mut self.xyz {
+            col.clear();
+        }
+        for p in points {
+            for (col, x) in self.xyz.iter_mut().zip(p) {
+                col.push(x);
+            }
+        }
+    }
+
+    /// The field at the points of the columns.
+    fn eval_filled(&mut self, d: &mut [f64], m: Option<&mut [u32]>) {
         let [x, y, z] = &self.xyz;
         self.eval.eval(x, y, z, d, m);
     }

@@ -122,12 +122,9 @@ pub fn candidates(
         let half = 0.5 * size as f64 * grid.voxel;
         // The centres are grid points, placed as the grid places them, so that the last
         // level's are the corners contouring would evaluate, to the bit ([`Candidates::centres`]).
-        let centres: Vec<[f64; 3]> = frontier
-            .iter()
-            .map(|c| grid.point(c.map(|x| x * size + size / 2)))
-            .collect();
-        let d = field.distances(&centres);
-        drop(centres);
+        let d = field.distances_of(frontier.len(), |n| {
+            grid.point(frontier[n].map(|x| x * size + size / 2))
+        });
         // The surface these values prove, before the next level is counted or stored.
         let within = max_cells.saturating_sub(evaluated).min(max_candidates);
         // The balls inside, shrunk by the rounding of a GPU's f32 distances.

@@ -44,6 +44,22 @@ impl Format {
         }
     }
 
+    /// Whether a file of this format of `scene` carries materials, so that meshing finds
+    /// them: PLY, glTF and 3MF always (colours, objects), OBJ where a material's colour is a
+    /// colour field (its vertices' colours), STL never.
+    pub fn carries_materials(self, scene: &Scene) -> bool {
+        match self {
+            Format::Ply | Format::Glb | Format::ThreeMf => true,
+            Format::Stl => false,
+            Format::Obj => scene.materials.iter().any(|m| {
+                m.pattern
+                    .colours()
+                    .iter()
+                    .any(|c| matches!(c, Colour::Field(_)))
+            }),
+        }
+    }
+
     /// The axis a file of this format has up unless asked otherwise: z for 3MF, whose build
     /// plate is the xy plane; the scene's y for the others (glTF's up is y; STL, OBJ and PLY
     /// say nothing, and slicers reading STL take z: `sdfc mesh --up z`).
@@ -267,19 +283,29 @@ fn f32s(v: [f64; 3]) -> [f32; 3] {
 /// Bytes of one binary STL triangle: its normal, three corners (f32 each) and two bytes.
 const STL_TRIANGLE: usize = 50;
 
-/// Binary STL, its triangles encoded in parallel straight into the file's buffer (each takes
-/// [`STL_TRIANGLE`] bytes at a place known from its index). The buffer comes zeroed from
-/// the allocator, so that its pages are first touched by the threads that fill them.
+/// Binary STL, its triangles encoded in parallel ([`stl_rows`]).
 fn stl(mesh: &Mesh) -> Vec<u8> {
-    use rayon::prelude::*;
     let mut out = vec![0u8; 84 + STL_TRIANGLE * mesh.triangles.len()];
-    out[..80].fill(b' ');
+    out[..84].copy_from_slice(&stl_header(mesh.triangles.len()));
+    stl_rows(mesh, &mesh.triangles, &mut out[84..]);
+    out
+}
+
+/// The 84 bytes before a binary STL's triangles: its text and the triangles' count.
+fn stl_header(triangles: usize) -> [u8; 84] {
+    let mut out = [b' '; 84];
     let text = b"binary STL written by sdfc mesh";
     out[..text.len()].copy_from_slice(text);
-    out[80..84].copy_from_slice(&(mesh.triangles.len() as u32).to_le_bytes());
-    out[84..]
-        .par_chunks_mut(STL_TRIANGLE * 1024)
-        .zip(mesh.triangles.par_chunks(1024))
+    out[80..84].copy_from_slice(&(triangles as u32).to_le_bytes());
+    out
+}
+
+/// The rows of `triangles` (of `mesh`) in `out`, [`STL_TRIANGLE`] bytes each, encoded in
+/// parallel (each at a place known from its index); the attribute bytes zero.
+fn stl_rows(mesh: &Mesh, triangles: &[[u32; 3]], out: &mut [u8]) {
+    use rayon::prelude::*;
+    out.par_chunks_mut(STL_TRIANGLE * 1024)
+        .zip(triangles.par_chunks(1024))
         .for_each(|(bytes, triangles)| {
             for (row, t) in bytes.chunks_exact_mut(STL_TRIANGLE).zip(triangles) {
                 let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
@@ -299,10 +325,62 @@ fn stl(mesh: &Mesh) -> Vec<u8> {
                 for (to, x) in row.chunks_exact_mut(4).zip(values) {
                     to.copy_from_slice(&x.to_le_bytes());
                 }
-                // The attribute bytes are the zeros the buffer was filled with.
+                row[48..].fill(0);
             }
         });
-    out
+}
+
+/// Triangles of a binary STL encoded at a time by [`save`] (2.5 MB).
+const STL_BLOCK: usize = 1 << 16;
+
+/// Why [`save`] wrote no file.
+#[derive(Debug)]
+pub enum Unsaved {
+    /// The mesh cannot be encoded in the format ([`Format::encode`]'s error).
+    Encode(io::Error),
+    /// The file cannot be written.
+    Write(io::Error),
+}
+
+/// Writes `mesh` to `path` in `format` ([`Format::encode`]'s bytes), atomically but not
+/// synced to the disk, as a compiler writes its output (`image::AtomicFile::unsynced`: the
+/// file is complete or untouched whatever happens to the process, and a mesh is made again
+/// by running the command again). A binary STL is encoded a block of triangles at a time
+/// into one buffer, never held whole.
+pub fn save(
+    format: Format,
+    mesh: &Mesh,
+    palette: &Palette,
+    up: Up,
+    path: &Path,
+) -> Result<(), Unsaved> {
+    let encoded = match format {
+        Format::Stl => None,
+        _ => Some(format.encode(mesh, palette, up).map_err(Unsaved::Encode)?),
+    };
+    let write = || -> io::Result<()> {
+        if let Some(bytes) = &encoded {
+            return save_bytes(path, bytes);
+        }
+        let mut file = crate::image::AtomicFile::unsynced(path)?;
+        let mesh = up.orient(mesh, palette).0;
+        file.write_all(&stl_header(mesh.triangles.len()))?;
+        let mut block = vec![0u8; STL_TRIANGLE * STL_BLOCK.min(mesh.triangles.len())];
+        for triangles in mesh.triangles.chunks(STL_BLOCK) {
+            let bytes = &mut block[..STL_TRIANGLE * triangles.len()];
+            stl_rows(&mesh, triangles, bytes);
+            file.write_all(bytes)?;
+        }
+        file.finish()
+    };
+    write().map_err(Unsaved::Write)
+}
+
+/// A mesh file's bytes written to `path` as [`save`] writes them (atomically, unsynced).
+pub fn save_bytes(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut file = crate::image::AtomicFile::unsynced(path)?;
+    file.write_all(bytes)?;
+    file.finish()
 }
 
 fn obj(mesh: &Mesh, palette: &Palette, out: &mut Vec<u8>) -> io::Result<()> {

@@ -237,7 +237,7 @@ fn marched_kernels_reading_instances_from_a_buffer_are_small_and_assemble() {
     let ptxas = ptxas();
     for n in [1000, 10000] {
         let name = format!("compound_{n}");
-        let (scene, lowered) = load_lowered(&format!("../examples/scaling/{name}.sdf"));
+        let (scene, lowered) = load_lowered(format!("../examples/scaling/{name}.sdf"));
         let kernel = sdfc_compiler::wgsl::write(&scene, &lowered).unwrap();
         let data = kernel.data.as_ref().expect("instances read from a buffer");
         keep(&format!("{name}.wgsl"), kernel.source.as_bytes());

@@ -47,7 +47,8 @@ float sdfc_march(vec3 o, vec3 d, inout float glow) {
             stride = s * omega;
         }
         prev = r;
-        if (!fail && r < tol) return t;
+        // A ray that starts inside a solid (or is stepped back to its start) has reached it.
+        if (!fail && (r < tol || (t == 0.0 && s < -tol))) return t;
         bool gone = !fail && t + s > SDFC_MAX_DIST;
         t = max(t + stride, 0.0);
         if (gone) break;

@@ -97,7 +97,9 @@ impl<T: Float> Rule<T> for Trace<'_, T> {
             step[k] = st;
             omega[k] = if fail { one } else { om };
             prev[k] = r;
-            let hit = !fail & (r < tol);
+            // A ray that starts inside a solid, or is stepped back to its start, has
+            // reached it there (as the kernel's `trace`).
+            let hit = !fail & ((r < tol) | ((t[k] == zero) & (s < -tol)));
             // A miss needs the verified reach t + f/L past max_dist, not a relaxed step's.
             let gone = !fail & (t[k] + s > max_dist);
             let count = steps[k] + 1;

@@ -169,3 +169,43 @@ fn a_shadow_ray_that_starts_inside_a_solid_is_blocked_at_once() {
         );
     }
 }
+
+/// The same start for a reflection: lifted by 4h off a mirror-like floor near where a sphere
+/// rests on it, it starts inside the sphere, and has reached the sphere there on every
+/// backend. Before, the march stepped back in place until its budget ran out (a miss by the
+/// step budget, drawn as the background, at the foot of every resting sphere).
+#[test]
+fn a_reflection_that_starts_inside_a_solid_reaches_it_at_once() {
+    let resting = "material floor = phong { color: (0.7, 0.7, 0.7), reflect: 0.5 };\n\
+                   material red = phong { color: (0.8, 0.25, 0.2) };\n\
+                   camera { position: (0.6, 0.5, -2.5), look_at: (0, 0.3, 0), fov: 40deg }\n\
+                   light directional { direction: (-0.5, -1, 0.4) }\n\
+                   render { width: 320, height: 240, max_steps: 2000, max_depth: 1, method: \"march\", epsilon: 1e-3 }\n\
+                   scene {\n\
+                     plane((0, 1, 0), 0) @ floor;\n\
+                     sphere(0.7).translate(0, 0.7, 0) @ red;\n\
+                   }";
+    let scene = checked("mirror.sdf", resting);
+    let r = cpu_render(&scene);
+    let c = &r.stats.counters;
+    println!(
+        "steps per pixel: max {}; misses by the budget {}; overshoots {}",
+        r.stats.steps_max, c.budget_misses, c.overshoots
+    );
+    assert_eq!(c.budget_misses, 0, "rays ran out of steps");
+    assert!(
+        r.stats.steps_max < 1000,
+        "a ray ran {} steps",
+        r.stats.steps_max
+    );
+    let images = render_everywhere("mirror", &scene);
+    let (_, cpu) = &images[0];
+    for (backend, image) in &images[1..] {
+        let d = sdfc_runtime::metrics::compare(cpu, image, 0.1).expect("images of one size");
+        assert!(
+            d.differing < 1e-4,
+            "{backend}: {:.4} % of pixels off the CPU's",
+            100.0 * d.differing
+        );
+    }
+}

@@ -236,7 +236,9 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
             step = signed * omega;
         }
         prev = r;
-        if !fail && r < tol {
+        // A ray that starts inside a solid (a reflection lifted into a neighbour it touches,
+        // a camera in a wall), or is stepped back to its start, has reached it there.
+        if !fail && (r < tol || (t == 0.0 && signed < -tol)) {
             return Traced(t, STATUS_HIT);
         }
         let next = max(t + step, 0.0);
@@ -244,7 +246,7 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
         // max_dist: a relaxed step that crosses it is checked at the next point first.
         let gone = !fail && t + signed > max_dist;
 //#else
-        if r < tol {
+        if r < tol || (t == 0.0 && signed < -tol) {
             return Traced(t, STATUS_HIT);
         }
         let next = max(t + signed, 0.0);

@@ -39,4 +39,22 @@ impl Rng {
     pub fn point(&mut self, s: f64) -> [f64; 3] {
         [self.range(-s, s), self.range(-s, s), self.range(-s, s)]
     }
+
+    /// A random formula `depth` operations deep (for the tests of the bound analysis): a leaf
+    /// is one of `leaves` or a number in [-2, 2); an operation one of `forms`, its operands
+    /// `{a}` and `{b}` formulas one level less deep.
+    #[cfg(test)]
+    pub(crate) fn formula(&mut self, depth: u32, leaves: &[&str], forms: &[&str]) -> String {
+        if depth == 0 {
+            return match leaves.get(self.below(leaves.len() + 1)) {
+                Some(leaf) => leaf.to_string(),
+                None => format!("{:.2}", self.range(-2.0, 2.0)),
+            };
+        }
+        let a = self.formula(depth - 1, leaves, forms);
+        let b = self.formula(depth - 1, leaves, forms);
+        forms[self.below(forms.len())]
+            .replace("{a}", &a)
+            .replace("{b}", &b)
+    }
 }

@@ -1,5 +1,5 @@
 //! A small deterministic generator of pseudo-random numbers (xorshift64*), the one the tests
-//! draw their points, rays and mutations from, so that every failure reproduces. The
+//! draw their points, rays, mutations and formulas from, so that every failure reproduces. The
 //! language's `hash` builtin is a hash of its argument, not a generator (check/builtins.rs).
 
 /// A xorshift64* generator.

@@ -1,5 +1,5 @@
 //! A small deterministic generator of pseudo-random numbers (xorshift64*), the one the tests
-//! draw their points, rays and mutations from, so that every failure reproduces. The
+//! draw their points, rays, mutations and formulas from, so that every failure reproduces. The
 //! language's `hash` builtin is a hash of its argument, not a generator (check/builtins.rs).
 
 /// A xorshift64* generator.
@@ -38,5 +38,23 @@ impl Rng {
     /// A point uniform in the cube [-s, s]³.
     pub fn point(&mut self, s: f64) -> [f64; 3] {
         [self.range(-s, s), self.range(-s, s), self.range(-s, s)]
+    }
+
+    /// A random formula `depth` operations deep (for the tests of the bound analysis): a leaf
+    /// is one of `leaves` or a number in [-2, 2); an operation one of `forms`, its operands
+    /// `{a}` and `{b}` formulas one level less deep.
+    #[cfg(test)]
+    pub(crate) fn formula(&mut self, depth: u32, leaves: &[&str], forms: &[&str]) -> String {
+        if depth == 0 {
+            return match leaves.get(self.below(leaves.len() + 1)) {
+                Some(leaf) => leaf.to_string(),
+                None => format!("{:.2}", self.range(-2.0, 2.0)),
+            };
+        }
+        let a = self.formula(depth - 1, leaves, forms);
+        let b = self.formula(depth - 1, leaves, forms);
+        forms[self.below(forms.len())]
+            .replace("{a}", &a)
+            .replace("{b}", &b)
     }
 }

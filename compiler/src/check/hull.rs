@@ -350,7 +350,7 @@ fn prim_pieces(
 ) -> Result<(), Misfit> {
     let v = |i: usize| DVec3::from(args.v3(i));
     let y = |h: f64| DVec3::new(0.0, h, 0.0);
-    let along_y = prim.params[0].kind == Kind::Float;
+    let along_y = prim.params[0].ty == Kind::Float;
     match prim.name {
         "segment" => {
             out.push(place.ball(v(0), args.f(2)));
@@ -371,7 +371,7 @@ fn prim_pieces(
                 out.push(place.ball(DVec3::from(e[0]), e[1][0]));
             }
         }
-        "hull" if prim.params[0].kind == Kind::Points && prim.params.len() == 2 => {
+        "hull" if prim.params[0].ty == Kind::Points && prim.params.len() == 2 => {
             for q in args.list(0) {
                 out.push(place.ball(DVec3::from(*q), args.f(1)));
             }

@@ -314,34 +314,24 @@ mod tests {
 
     /// A random field expression of the point, from the operations the bound analysis rules.
     fn random_expr(rng: &mut Rng, depth: u32) -> String {
-        let leaf = |rng: &mut Rng| match rng.below(5) {
-            0 => "p.x".to_string(),
-            1 => "p.y".to_string(),
-            2 => "p.z".to_string(),
-            3 => "length(p)".to_string(),
-            _ => format!("{:.2}", rng.range(-2.0, 2.0)),
-        };
-        if depth == 0 {
-            return leaf(rng);
-        }
-        let mut e = || random_expr(rng, depth - 1);
-        let (a, b) = (e(), e());
-        match rng.below(14) {
-            0 => format!("({a} + {b})"),
-            1 => format!("({a} - {b})"),
-            2 => format!("({a} * 0.7)"),
-            3 => format!("sin({a})"),
-            4 => format!("cos({a} * 2)"),
-            5 => format!("abs({a})"),
-            6 => format!("min({a}, {b})"),
-            7 => format!("max({a}, {b})"),
-            8 => format!("sqrt({a} * {a} + 1)"),
-            9 => format!("smoothstep(-1, 1, {a})"),
-            10 => format!("noise(vec3({a}, {b}, p.z))"),
-            11 => format!("(sin({a}) * cos({b}))"),
-            12 => format!("exp(-abs({a}))"),
-            _ => format!("distance(torus(1, 0.3), vec3({a}, p.y, {b}))"),
-        }
+        let leaves = ["p.x", "p.y", "p.z", "length(p)"];
+        let forms = [
+            "({a} + {b})",
+            "({a} - {b})",
+            "({a} * 0.7)",
+            "sin({a})",
+            "cos({a} * 2)",
+            "abs({a})",
+            "min({a}, {b})",
+            "max({a}, {b})",
+            "sqrt({a} * {a} + 1)",
+            "smoothstep(-1, 1, {a})",
+            "noise(vec3({a}, {b}, p.z))",
+            "(sin({a}) * cos({b}))",
+            "exp(-abs({a}))",
+            "distance(torus(1, 0.3), vec3({a}, p.y, {b}))",
+        ];
+        rng.formula(depth, &leaves, &forms)
     }
 
     #[test]

@@ -331,17 +331,6 @@ fn lowering_stops_at_the_program_limit() {
     assert_eq!(lowered, Ok(whole));
 }
 
-/// The entry of the table along y (its first parameter a float) named `name`, with `args`.
-fn along_y(name: &str, args: &[f64]) -> Node {
-    let prim = crate::prim::all()
-        .find(|p| p.name == name && p.params[0].kind == crate::prim::Kind::Float)
-        .expect("an entry along y");
-    Node::Prim {
-        prim: crate::prim::PrimRef(prim),
-        args: crate::prim::Args::numbers(args),
-    }
-}
-
 /// The GPU walk's shape functions are the lowering's own rules: for every kind of instance,
 /// the program `shape_program` returns (the one the WGSL writer writes, each recorded
 /// parameter read as `scale · s[slot]`) has the instructions of the primitive lowered with
@@ -352,34 +341,12 @@ fn the_walks_shape_programs_are_the_lowerings_rules() {
     use super::{shape_program, shapes};
     use crate::program::builder::Builder;
     use crate::program::Op;
-    let shapes_of = [
-        Node::Sphere { radius: 0.7 },
-        Node::Box {
-            half: [0.3, 0.2, 0.9],
-        },
-        Node::RoundBox {
-            half: [0.3, 0.2, 0.9],
-            radius: 0.05,
-        },
-        Node::Torus {
-            major: 0.8,
-            minor: 0.15,
-        },
-        Node::Cylinder {
-            radius: 0.3,
-            half_height: 0.55,
-        },
-        Node::Capsule {
-            radius: 0.3,
-            half_height: 0.55,
-        },
-        Node::Cone {
-            radius: 0.3,
-            half_height: 0.55,
-        },
-        along_y("capped_cone", &[1.1, 0.3, 0.1]),
-        along_y("round_cone", &[0.3, 0.1, 1.1]),
-    ];
+    // Every kind of instance among the primitives.
+    let shapes_of: Vec<Node> = primitives()
+        .into_iter()
+        .filter(|n| shapes::slots(n).is_some())
+        .collect();
+    assert_eq!(shapes_of.len(), 9);
     for node in &shapes_of {
         let slots = shapes::slots(node).expect("an instance kind");
         let shape = shape_program(node).expect("a shape program");

@@ -221,7 +221,7 @@ pub fn placed(prim: PrimRef, args: &Args) -> Option<Placed> {
     let entry = |name: &str| {
         ALONG_Y
             .iter()
-            .find(|e| e.name == name && e.params[0].kind == F)
+            .find(|e| e.name == name && e.params[0].ty == F)
             .map(PrimRef)
     };
     let (ra, rb) = (args.f(2), args.f(args.0.len() - 1));

@@ -83,19 +83,21 @@ pub enum Kind {
     Points,
 }
 
-/// One parameter of a primitive.
+/// One parameter of a primitive (`ty` its [`Kind`]), or of a built-in of the checker (its
+/// type of value).
 #[derive(Debug, Clone, Copy)]
-pub struct Param {
+pub struct Param<K = Kind> {
     pub name: &'static str,
-    pub kind: Kind,
+    /// What it holds.
+    pub ty: K,
     pub def: Def,
     pub range: Range,
 }
 
-const fn param(name: &'static str, kind: Kind, def: Def, range: Range) -> Param {
+pub(crate) const fn param<K>(name: &'static str, ty: K, def: Def, range: Range) -> Param<K> {
     Param {
         name,
-        kind,
+        ty,
         def,
         range,
     }
@@ -247,7 +249,7 @@ pub fn find(name: &str) -> Option<&'static Prim> {
 /// The constants of an entry that a marched scene's instance may be, the capped and round
 /// cones along y (`lower::slots`): what its distance reads through [`Builder::param`].
 pub(crate) fn slots(prim: PrimRef, args: &Args) -> Option<Slots> {
-    match (prim.name, prim.params[0].kind) {
+    match (prim.name, prim.params[0].ty) {
         ("capped_cone", _) => Some(solids::capped_cone_slots(
             args.f(0) / 2.0,
             args.f(1),
@@ -265,7 +267,7 @@ pub(crate) fn slots(prim: PrimRef, args: &Args) -> Option<Slots> {
 /// The distance of an entry [`slots`] knows at `p`, its constants `s` read through
 /// [`Builder::param`]: the entry's own distance with `s` its slots.
 pub(crate) fn exact(b: &mut Builder, p: P, prim: PrimRef, s: &Slots) -> Option<Reg> {
-    match (prim.name, prim.params[0].kind) {
+    match (prim.name, prim.params[0].ty) {
         ("capped_cone", _) => Some(solids::capped_cone(b, p, s)),
         ("round_cone", Kind::Float) => Some(solids::round_cone(b, p, s)),
         _ => None,

@@ -4,20 +4,27 @@
 //! the library's.
 
 use super::trig::{self, atan2f, cosf, reducedf, sinf, REDUCED};
+use super::Float;
 use crate::rng::Rng;
 
 /// The bound of the module doc, in ulps of the exact value.
 const BOUND: f64 = 0.501;
 
+/// The distance in ulps where a value is NaN: none between two NaN, infinite between NaN and a
+/// number; `None` between two numbers.
+fn nan_ulps(a: f64, b: f64) -> Option<f64> {
+    match (a.is_nan(), b.is_nan()) {
+        (false, false) => None,
+        (true, true) => Some(0.0),
+        _ => Some(f64::INFINITY),
+    }
+}
+
 /// How far `got` is from `exact`, in ulps of f32 at `exact` (subnormal spacing below the
 /// normal range).
 fn ulps(got: f32, exact: f64) -> f64 {
-    if got.is_nan() || exact.is_nan() {
-        return if got.is_nan() && exact.is_nan() {
-            0.0
-        } else {
-            f64::INFINITY
-        };
+    if let Some(e) = nan_ulps(got as f64, exact) {
+        return e;
     }
     let e = if exact == 0.0 {
         -126
@@ -25,6 +32,37 @@ fn ulps(got: f32, exact: f64) -> f64 {
         (((exact.to_bits() >> 52) & 0x7ff) as i32 - 1023).max(-126)
     };
     (got as f64 - exact).abs() / 2f64.powi(e - 23)
+}
+
+/// The values nearest kπ/2 (where reduction is hardest) for k up to just beyond [`REDUCED`],
+/// each as `near` gives it with its neighbours, and their negatives.
+fn near_quarters<T: Float>(near: impl Fn(f64) -> [T; 3]) -> Vec<T> {
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let mut xs = Vec::new();
+    let mut k = 1.0;
+    while k * quarter <= REDUCED as f64 * 1.01 {
+        for x in near(k * quarter) {
+            xs.extend([x, -x]);
+        }
+        k = (k * 1.0007f64).ceil();
+    }
+    xs
+}
+
+/// Pairs (y, x) for the arc tangent of every kind: random bits with random bits, angles with
+/// angles, and each argument against a nearby magnitude (ratios near 1, the octants' seam),
+/// each in the four orders and signs that reach every octant: `f` is called with each.
+fn atan2_pairs<T: Float>(xs: &[T], rng: &mut Rng, mut f: impl FnMut(T, T)) {
+    for (i, &y) in xs.iter().enumerate() {
+        let x = match i % 3 {
+            0 => xs[rng.below(xs.len())],
+            1 => T::from_f64(rng.range(-10.0, 10.0)),
+            _ => y * T::from_f64(rng.range(0.5, 2.0)),
+        };
+        for (y, x) in [(y, x), (x, y), (-y, x), (y, -x)] {
+            f(y, x);
+        }
+    }
 }
 
 /// Arguments over the whole f32 range and where reduction is hardest: random bits, uniform
@@ -37,19 +75,14 @@ fn arguments() -> Vec<f32> {
         xs.push(rng.range(-10.0, 10.0) as f32);
         xs.push(rng.range(-2e4, 2e4) as f32);
     }
-    let quarter = std::f64::consts::FRAC_PI_2;
-    let mut k = 1.0;
-    while k * quarter <= REDUCED as f64 * 1.01 {
-        let v = (k * quarter) as f32;
-        for x in [
+    xs.extend(near_quarters(|v| {
+        let v = v as f32;
+        [
             v,
             f32::from_bits(v.to_bits() + 1),
             f32::from_bits(v.to_bits() - 1),
-        ] {
-            xs.extend([x, -x]);
-        }
-        k = (k * 1.0007f64).ceil();
-    }
+        ]
+    }));
     xs.extend([
         0.0,
         -0.0,
@@ -110,21 +143,12 @@ fn the_arc_tangent_is_within_the_bound() {
     let xs = arguments();
     let mut rng = Rng::new(7);
     let mut worst = 0.0f64;
-    for (i, &y) in xs.iter().enumerate() {
-        // Pairs of every kind: random bits with random bits, angles with angles, and each
-        // argument against a nearby magnitude (ratios near 1, the octants' seam).
-        let x = match i % 3 {
-            0 => xs[rng.below(xs.len())],
-            1 => rng.range(-10.0, 10.0) as f32,
-            _ => y * rng.range(0.5, 2.0) as f32,
-        };
-        for (y, x) in [(y, x), (x, y), (-y, x), (y, -x)] {
-            let a = atan2f(y, x);
-            let e = ulps(a, (y as f64).atan2(x as f64));
-            assert!(e <= BOUND, "atan2({y:e}, {x:e}): {a:e}, {e} ulps");
-            worst = worst.max(e);
-        }
-    }
+    atan2_pairs(&xs, &mut rng, |y, x| {
+        let a = atan2f(y, x);
+        let e = ulps(a, (y as f64).atan2(x as f64));
+        assert!(e <= BOUND, "atan2({y:e}, {x:e}): {a:e}, {e} ulps");
+        worst = worst.max(e);
+    });
     assert!(worst > 0.49, "{worst}");
 }
 
@@ -157,12 +181,8 @@ fn the_arc_tangent_has_the_library_special_cases() {
 
 /// How far apart two f64 are, in ulps of `b` (the spacing above |b|).
 fn ulps64(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        return if a.is_nan() && b.is_nan() {
-            0.0
-        } else {
-            f64::INFINITY
-        };
+    if let Some(e) = nan_ulps(a, b) {
+        return e;
     }
     let m = b.abs();
     (a - b).abs() / (f64::from_bits(m.to_bits() + 1) - m)
@@ -180,20 +200,14 @@ fn arguments64() -> Vec<f64> {
         let e = 2f64.powi(rng.below(82) as i32 - 60);
         xs.push(rng.range(-1.0, 1.0) * e);
     }
-    let quarter = std::f64::consts::FRAC_PI_2;
-    let mut k = 1.0;
-    let limit = REDUCED as f64;
-    while k * quarter <= limit * 1.01 {
-        let v = k * quarter;
-        for x in [
+    xs.extend(near_quarters(|v| {
+        [
             v,
             f64::from_bits(v.to_bits() + 1),
             f64::from_bits(v.to_bits() - 1),
-        ] {
-            xs.extend([x, -x]);
-        }
-        k = (k * 1.0007f64).ceil();
-    }
+        ]
+    }));
+    let limit = REDUCED as f64;
     xs.extend([
         0.0,
         -0.0,
@@ -259,20 +273,13 @@ fn the_f64_arc_tangent_is_within_two_ulps_of_the_library() {
     let xs = arguments64();
     let mut rng = Rng::new(8);
     let (mut same, mut count) = (0usize, 0usize);
-    for (i, &y) in xs.iter().enumerate() {
-        let x = match i % 3 {
-            0 => xs[rng.below(xs.len())],
-            1 => rng.range(-10.0, 10.0),
-            _ => y * rng.range(0.5, 2.0),
-        };
-        for (y, x) in [(y, x), (x, y), (-y, x), (y, -x)] {
-            let (a, b) = (trig::atan2(y, x), y.atan2(x));
-            let e = ulps64(a, b);
-            assert!(e <= 2.0, "atan2({y:e}, {x:e}): {a:e}, the library {b:e}");
-            same += usize::from(a.to_bits() == b.to_bits());
-            count += 1;
-        }
-    }
+    atan2_pairs(&xs, &mut rng, |y, x| {
+        let (a, b) = (trig::atan2(y, x), y.atan2(x));
+        let e = ulps64(a, b);
+        assert!(e <= 2.0, "atan2({y:e}, {x:e}): {a:e}, the library {b:e}");
+        same += usize::from(a.to_bits() == b.to_bits());
+        count += 1;
+    });
     // Most (79 %) are the library's bit for bit.
     assert!(same as f64 > 0.75 * count as f64, "{same} of {count}");
     let special = [0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN];

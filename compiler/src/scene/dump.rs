@@ -417,7 +417,7 @@ fn shape(n: &Node) -> String {
         Node::Prim { prim, args } => {
             let mut out = prim.name.to_string();
             for (i, p) in prim.params.iter().enumerate() {
-                let v = match p.kind {
+                let v = match p.ty {
                     Kind::Vec2 => v2(args.v2(i)),
                     Kind::Vec3 => v3(args.v3(i)),
                     Kind::Points => {

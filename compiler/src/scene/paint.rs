@@ -223,8 +223,10 @@ mod tests {
     use crate::lower::Lowered;
     use crate::scene::Scene;
 
-    fn scene(text: &str) -> Scene {
-        let (scene, diags, _) = check_str("t.sdf", text);
+    /// The scene of the one object `object`, which may paint with the material `m` of
+    /// [`STRIPES`].
+    fn striped(object: &str) -> Scene {
+        let (scene, diags, _) = check_str("t.sdf", &format!("{STRIPES}scene {{ {object}; }}"));
         scene.unwrap_or_else(|| panic!("{diags:?}"))
     }
 
@@ -285,9 +287,7 @@ mod tests {
 
     #[test]
     fn a_painted_shape_moved_afterwards_takes_its_pattern_along() {
-        let s = scene(&format!(
-            "{STRIPES}scene {{ (sphere(1) @ m).rotate_y(90deg).translate(3, 0.25, 0); }}"
-        ));
+        let s = striped("(sphere(1) @ m).rotate_y(90deg).translate(3, 0.25, 0)");
         // The copy of m, carrying the rotation and the translation.
         assert_eq!(s.materials.len(), 3);
         let lowered = Lowered::new(&s);
@@ -309,18 +309,14 @@ mod tests {
     #[test]
     fn a_material_applied_in_the_world_keeps_the_world_coordinates() {
         // Painted outside its transforms, at the top of the scene: the scene is as it was.
-        let s = scene(&format!(
-            "{STRIPES}scene {{ sphere(1).rotate_y(90deg).translate(3, 0.25, 0) @ m; }}"
-        ));
+        let s = striped("sphere(1).rotate_y(90deg).translate(3, 0.25, 0) @ m");
         assert_eq!(s.materials.len(), 2);
         assert!(s.materials[1].frame.is_empty());
     }
 
     #[test]
     fn the_normal_turns_with_the_shape_under_a_scale_per_axis_and_a_mirror() {
-        let s = scene(&format!(
-            "{STRIPES}scene {{ (sphere(1) @ m).scale((2, 1, 1)).mirror(x: true); }}"
-        ));
+        let s = striped("(sphere(1) @ m).scale((2, 1, 1)).mirror(x: true)");
         let lowered = Lowered::new(&s);
         // At world x < 0 the mirror folds x; the scale halves it. A world normal (a, b, c)
         // becomes (−2a, b, c)/|…| in the sphere's coordinates, its z read as 0.5 + 0.5 n.z.
@@ -333,9 +329,7 @@ mod tests {
 
     #[test]
     fn copies_of_a_repeated_painted_shape_each_show_the_pattern_of_their_own() {
-        let s = scene(&format!(
-            "{STRIPES}scene {{ (sphere(0.4) @ m).repeat((2, 0, 0)); }}"
-        ));
+        let s = striped("(sphere(0.4) @ m).repeat((2, 0, 0))");
         let lowered = Lowered::new(&s);
         let n = [0.0, 1.0, 0.0];
         let a = colour(&lowered, 2, [0.25, 0.2, 0.0], n);

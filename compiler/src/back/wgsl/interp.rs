@@ -40,6 +40,7 @@
 //! (map.rs) writes for it, so the two kernels compute the same values, unless a driver
 //! contracts the code's products and sums into fused multiply-adds.
 
+use super::map;
 use crate::program::{results, Axis, Binary, Item, Op, Program, Reg, Unary};
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -584,35 +585,20 @@ fn write_cases(out: &mut String) {
         BLOCK,
         "if a >= b {\n                next = u32(w.w);\n            }",
     );
-    for (k, u) in UNARIES.iter().enumerate() {
-        let e = match u {
-            Unary::Neg => "-a",
-            Unary::Abs => "abs(a)",
-            Unary::Sqrt => "sqrt(a)",
-            Unary::Sin => "sin(a)",
-            Unary::Cos => "cos(a)",
-            Unary::Acos => "acos(a)",
-            Unary::Exp => "exp(a)",
-            Unary::Log => "log(a)",
-            Unary::Floor => "floor(a)",
-            // ⌊a + 0.5⌋, as map.rs writes it.
-            Unary::Round => "floor(a + 0.5)",
-        };
-        case(out, UNARY + k as u32, &format!("v = {e};"));
+    // Each operation as map.rs writes it, on the registers `a` and `b`.
+    for (k, &u) in UNARIES.iter().enumerate() {
+        case(
+            out,
+            UNARY + k as u32,
+            &format!("v = {};", map::unary(u, "a")),
+        );
     }
-    for (k, bin) in BINARIES.iter().enumerate() {
-        let e = match bin {
-            Binary::Add => "a + b",
-            Binary::Sub => "a - b",
-            Binary::Mul => "a * b",
-            Binary::Div => "a / b",
-            Binary::Min => "min(a, b)",
-            Binary::Max => "max(a, b)",
-            Binary::Pow => "pow(a, b)",
-            Binary::Atan2 => "atan2(a, b)",
-            Binary::Lt => "select(0.0, 1.0, a < b)",
-        };
-        case(out, BINARY + k as u32, &format!("v = {e};"));
+    for (k, &bin) in BINARIES.iter().enumerate() {
+        case(
+            out,
+            BINARY + k as u32,
+            &format!("v = {};", map::binary(bin, "a", "b")),
+        );
     }
     case(out, SELECT, "v = select(c, b, a != 0.0);");
 }

@@ -501,6 +501,39 @@ impl Names {
     }
 }
 
+/// The WGSL of a one-operand operation on the expression `a` (also the interpreted kernel's).
+pub(super) fn unary(u: Unary, a: &str) -> String {
+    match u {
+        Unary::Neg => format!("-{a}"),
+        Unary::Abs => format!("abs({a})"),
+        Unary::Sqrt => format!("sqrt({a})"),
+        Unary::Sin => format!("sin({a})"),
+        Unary::Cos => format!("cos({a})"),
+        Unary::Acos => format!("acos({a})"),
+        Unary::Exp => format!("exp({a})"),
+        Unary::Log => format!("log({a})"),
+        Unary::Floor => format!("floor({a})"),
+        // ⌊a + 0.5⌋, as on the CPU (WGSL's round() rounds halves to even).
+        Unary::Round => format!("floor({a} + 0.5)"),
+    }
+}
+
+/// The WGSL of a two-operand operation on the expressions `x` and `y` (also the interpreted
+/// kernel's).
+pub(super) fn binary(b: Binary, x: &str, y: &str) -> String {
+    match b {
+        Binary::Add => format!("{x} + {y}"),
+        Binary::Sub => format!("{x} - {y}"),
+        Binary::Mul => format!("{x} * {y}"),
+        Binary::Div => format!("{x} / {y}"),
+        Binary::Min => format!("min({x}, {y})"),
+        Binary::Max => format!("max({x}, {y})"),
+        Binary::Pow => format!("pow({x}, {y})"),
+        Binary::Atan2 => format!("atan2({x}, {y})"),
+        Binary::Lt => format!("select(0.0, 1.0, {x} < {y})"),
+    }
+}
+
 fn expr(program: &Program, op: &Op, names: &Names, params: Option<&Params>) -> String {
     let n = |r: Reg| names.get(r, params);
     match *op {
@@ -511,36 +544,8 @@ fn expr(program: &Program, op: &Op, names: &Names, params: Option<&Params>) -> S
         Op::Input(Axis::Nx) => "n.x".into(),
         Op::Input(Axis::Ny) => "n.y".into(),
         Op::Input(Axis::Nz) => "n.z".into(),
-        Op::Unary(u, a) => {
-            let a = n(a);
-            match u {
-                Unary::Neg => format!("-{a}"),
-                Unary::Abs => format!("abs({a})"),
-                Unary::Sqrt => format!("sqrt({a})"),
-                Unary::Sin => format!("sin({a})"),
-                Unary::Cos => format!("cos({a})"),
-                Unary::Acos => format!("acos({a})"),
-                Unary::Exp => format!("exp({a})"),
-                Unary::Log => format!("log({a})"),
-                Unary::Floor => format!("floor({a})"),
-                // ⌊a + 0.5⌋, as on the CPU (WGSL's round() rounds halves to even).
-                Unary::Round => format!("floor({a} + 0.5)"),
-            }
-        }
-        Op::Binary(b, x, y) => {
-            let (x, y) = (n(x), n(y));
-            match b {
-                Binary::Add => format!("{x} + {y}"),
-                Binary::Sub => format!("{x} - {y}"),
-                Binary::Mul => format!("{x} * {y}"),
-                Binary::Div => format!("{x} / {y}"),
-                Binary::Min => format!("min({x}, {y})"),
-                Binary::Max => format!("max({x}, {y})"),
-                Binary::Pow => format!("pow({x}, {y})"),
-                Binary::Atan2 => format!("atan2({x}, {y})"),
-                Binary::Lt => format!("select(0.0, 1.0, {x} < {y})"),
-            }
-        }
+        Op::Unary(u, a) => unary(u, &n(a)),
+        Op::Binary(b, x, y) => binary(b, &n(x), &n(y)),
         Op::Select(c, a, b) => format!("select({}, {}, {} != 0.0)", n(b), n(a), n(c)),
         Op::Phi(a, _) => n(a),
         // The walk over the mesh's hierarchy in `scene_data` (mesh.rs).

@@ -97,21 +97,10 @@ impl Range {
 }
 
 /// One parameter of a builtin or record.
-#[derive(Debug, Clone, Copy)]
-pub struct P {
-    pub name: &'static str,
-    pub ty: Type,
-    pub def: Def,
-    pub range: Range,
-}
+pub type P = crate::prim::Param<Type>;
 
 const fn p(name: &'static str, ty: Type, def: Def, range: Range) -> P {
-    P {
-        name,
-        ty,
-        def,
-        range,
-    }
+    crate::prim::param(name, ty, def, range)
 }
 
 const fn shape(name: &'static str) -> P {
@@ -304,7 +293,7 @@ pub static BUILTINS: std::sync::LazyLock<Vec<Builtin>> = std::sync::LazyLock::ne
         let params: Vec<P> = prim
             .params
             .iter()
-            .map(|q| p(q.name, kind_type(q.kind), q.def, q.range))
+            .map(|q| p(q.name, kind_type(q.ty), q.def, q.range))
             .collect();
         let sig = Sig {
             params: Vec::leak(params),

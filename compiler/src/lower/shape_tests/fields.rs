@@ -124,31 +124,22 @@ fn profile_fields_misused_are_located_errors() {
 
 /// A random formula of the plane's point, from the operations the bound analysis rules.
 fn random_plane_expr(rng: &mut Rng, depth: u32) -> String {
-    let leaf = |rng: &mut Rng| match rng.below(4) {
-        0 => "p.x".to_string(),
-        1 => "p.y".to_string(),
-        2 => "length(p)".to_string(),
-        _ => format!("{:.2}", rng.range(-2.0, 2.0)),
-    };
-    if depth == 0 {
-        return leaf(rng);
-    }
-    let mut e = || random_plane_expr(rng, depth - 1);
-    let (a, b) = (e(), e());
-    match rng.below(12) {
-        0 => format!("({a} + {b})"),
-        1 => format!("({a} - {b})"),
-        2 => format!("({a} * 1.3)"),
-        3 => format!("sin({a})"),
-        4 => format!("abs({a})"),
-        5 => format!("min({a}, {b})"),
-        6 => format!("max({a}, {b})"),
-        7 => format!("sqrt({a} * {a} + 1)"),
-        8 => format!("noise(vec2({a}, {b}))"),
-        9 => format!("(sin({a}) * cos({b}))"),
-        10 => format!("voronoi(vec2({a}, p.y))"),
-        _ => format!("distance(star(5, 0.8, 0.4), vec2({a}, {b}))"),
-    }
+    let leaves = ["p.x", "p.y", "length(p)"];
+    let forms = [
+        "({a} + {b})",
+        "({a} - {b})",
+        "({a} * 1.3)",
+        "sin({a})",
+        "abs({a})",
+        "min({a}, {b})",
+        "max({a}, {b})",
+        "sqrt({a} * {a} + 1)",
+        "noise(vec2({a}, {b}))",
+        "(sin({a}) * cos({b}))",
+        "voronoi(vec2({a}, p.y))",
+        "distance(star(5, 0.8, 0.4), vec2({a}, {b}))",
+    ];
+    rng.formula(depth, &leaves, &forms)
 }
 
 /// Random formulas of the plane, extruded and revolved: wherever the analysis proves a

@@ -368,25 +368,18 @@ impl Pass<'_> {
         child: NodeId,
     ) -> Derived {
         let c = self.get(child);
-        let mut d = c;
         let r = c.bounds.max[0].max(0.0);
-        d.bounds = Aabb {
+        let bounds = Aabb {
             min: [-r, -half_height, -r],
             max: [r, half_height, r],
         };
-        d.symmetric = [false; 3];
-        d.growth = c.growth.max(1.0 / floor);
+        let d = carried(c, bounds, 1.0 / floor);
         if c.facts.exactness != Exactness::Exact {
             return unproven(d, id);
         }
         let k = pitch / std::f64::consts::TAU;
         let stretch = (k / (0.5 * inner)).hypot(1.0);
-        let g = (c.gradient * stretch).max(1.0);
-        d.gradient = g;
-        d.facts.lipschitz = g;
-        d.facts.exactness = classify(g, d.proven);
-        d.cause = Some(id);
-        d
+        of_gradient(d, (c.gradient * stretch).max(1.0), id)
     }
 
     /// A sweep (docs/analysis.md, "Sweep"): a disc about the origin swept is the distance to
@@ -405,14 +398,12 @@ impl Pass<'_> {
         child: NodeId,
     ) -> Derived {
         let c = self.get(child);
-        let mut d = c;
         let (lo, hi) = path.aabb();
-        d.bounds = Aabb {
+        let bounds = Aabb {
             min: lo.map(|x| x - extent),
             max: hi.map(|x| x + extent),
         };
-        d.symmetric = [false; 3];
-        d.growth = c.growth.max(1.0);
+        let mut d = carried(c, bounds, 1.0);
         if crate::scene::path::round_profile(&self.scene.graph, child) {
             d.gradient = 1.0;
             d.facts.lipschitz = 1.0;
@@ -421,12 +412,11 @@ impl Pass<'_> {
         if !c.proven || folds || c.facts.exactness == Exactness::Approximate {
             return unproven(d, id);
         }
-        let g = (c.gradient * (path.twist * extent).hypot(1.0)).max(1.0);
-        d.gradient = g;
-        d.facts.lipschitz = g;
-        d.facts.exactness = classify(g, d.proven);
-        d.cause = Some(id);
-        d
+        of_gradient(
+            d,
+            (c.gradient * (path.twist * extent).hypot(1.0)).max(1.0),
+            id,
+        )
     }
 
     pub(super) fn offset(&self, id: NodeId, child: NodeId, by: f64) -> Derived {
@@ -444,6 +434,26 @@ impl Pass<'_> {
             d
         }
     }
+}
+
+/// The child's facts `c` carried round an axis or along a path (a screw, a sweep): within
+/// `bounds`, symmetric across no plane, growing at least `growth`-fold.
+fn carried(c: Derived, bounds: Aabb, growth: f64) -> Derived {
+    Derived {
+        bounds,
+        symmetric: [false; 3],
+        growth: c.growth.max(growth),
+        ..c
+    }
+}
+
+/// `d` with the gradient bound and L `g`, classified, the node `id` its cause.
+fn of_gradient(mut d: Derived, g: f64, id: NodeId) -> Derived {
+    d.gradient = g;
+    d.facts.lipschitz = g;
+    d.facts.exactness = classify(g, d.proven);
+    d.cause = Some(id);
+    d
 }
 
 /// The child's facts `d` under a map `id` that stretches distances up to `sigma`-fold (≥ 1):

@@ -238,15 +238,34 @@ fn assert_same(gpu: &gpu::Gpu, scene: &Scene, label: &str) -> f64 {
     d.psnr
 }
 
-#[test]
-fn every_example_renders_as_with_the_specialised_kernel() {
+/// Every `SHARDS`th example from `shard` on: most of the time is the software adapter's
+/// compiling of each example's specialised kernel, so the examples are split over tests that
+/// the harness runs side by side.
+fn examples_render_as_with_the_specialised_kernel(shard: usize) {
     let Some(gpu) = open_gpu() else { return };
     println!("adapter: {}", gpu.describe());
-    for path in examples() {
+    for path in examples().into_iter().skip(shard).step_by(SHARDS) {
         let scene = marched(&path, 48, 32);
         let name = path.file_stem().unwrap_or_default().to_string_lossy();
         assert_same(&gpu, &scene, &name);
     }
+}
+
+const SHARDS: usize = 3;
+
+#[test]
+fn every_example_renders_as_with_the_specialised_kernel_0() {
+    examples_render_as_with_the_specialised_kernel(0);
+}
+
+#[test]
+fn every_example_renders_as_with_the_specialised_kernel_1() {
+    examples_render_as_with_the_specialised_kernel(1);
+}
+
+#[test]
+fn every_example_renders_as_with_the_specialised_kernel_2() {
+    examples_render_as_with_the_specialised_kernel(2);
 }
 
 #[test]

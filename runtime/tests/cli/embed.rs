@@ -563,15 +563,22 @@ void main() {
 }
 ";
 
-/// The page of `file` wrapped the way Shadertoy wraps it.
-fn shadertoy_wrapped(file: &Path) -> String {
+/// `sdfc compile FILE --emit shadertoy`, which must succeed: the page (standard output) and
+/// what it says of the scene (standard error).
+fn shadertoy(file: &Path) -> (String, String) {
     let out = ok(&[
         "compile",
         file.to_str().expect("utf-8"),
         "--emit",
         "shadertoy",
     ]);
-    let page = String::from_utf8(out.stdout).expect("text");
+    let said = String::from_utf8_lossy(&out.stderr).into_owned();
+    (String::from_utf8(out.stdout).expect("text"), said)
+}
+
+/// The page of `file` wrapped the way Shadertoy wraps it.
+fn shadertoy_wrapped(file: &Path) -> String {
+    let (page, _) = shadertoy(file);
     assert!(page.contains("void mainImage(out vec4 fragColor, in vec2 fragCoord)"));
     assert!(!page.contains("#version") && !page.contains("precision "));
     format!("{SHADERTOY_HEAD}{page}{SHADERTOY_TAIL}")
@@ -581,16 +588,7 @@ fn shadertoy_wrapped(file: &Path) -> String {
 /// leaves out, on standard error, and says nothing for a scene it shows whole.
 #[test]
 fn the_shadertoy_page_says_what_it_leaves_out() {
-    let said = |file: &Path| {
-        let out = sdfc(&[
-            "compile",
-            file.to_str().expect("utf-8"),
-            "--emit",
-            "shadertoy",
-        ]);
-        assert!(out.status.success());
-        String::from_utf8_lossy(&out.stderr).into_owned()
-    };
+    let said = |file: &Path| shadertoy(file).1;
     let studio = said(&example("studio.sdf"));
     for what in [
         "warning: the Shadertoy page",
@@ -654,14 +652,7 @@ fn the_shadertoy_page_draws_the_glow_of_the_marching_steps() {
         "render { width: 48, height: 32, glow: 0.1, glow_color: (0.02, 0.03, 0.05) }",
     );
     std::fs::write(&scene, text).expect("scene");
-    let said = sdfc(&[
-        "compile",
-        scene.to_str().expect("utf-8"),
-        "--emit",
-        "shadertoy",
-    ]);
-    assert!(said.status.success());
-    let warned = String::from_utf8_lossy(&said.stderr);
+    let (_, warned) = shadertoy(&scene);
     assert!(!warned.contains("warning"), "{warned}");
     assert_webgl_like_cpu(&chromium, &dir, &scene);
     let (w, h) = (192, 128);

@@ -36,6 +36,7 @@ pub mod wire;
 use lsp_server::{Connection, Message, RequestId, Response};
 use lsp_types as lsp;
 use sdfc_compiler::Limits;
+use serde_json::value::RawValue;
 use server::Server;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -198,12 +199,7 @@ trait Outbox {
     /// Sends a message.
     fn send(&mut self, message: Message) -> std::io::Result<()>;
     /// Answers what is not a message the server can handle with an error (to `id`, any JSON).
-    fn refuse(
-        &mut self,
-        id: &serde_json::value::RawValue,
-        code: i32,
-        message: &str,
-    ) -> std::io::Result<()>;
+    fn refuse(&mut self, id: &RawValue, code: i32, message: &str) -> std::io::Result<()>;
 }
 
 struct WriteOutbox<W>(W);
@@ -213,12 +209,7 @@ impl<W: std::io::Write> Outbox for WriteOutbox<W> {
         wire::write(&mut self.0, &message)
     }
 
-    fn refuse(
-        &mut self,
-        id: &serde_json::value::RawValue,
-        code: i32,
-        message: &str,
-    ) -> std::io::Result<()> {
+    fn refuse(&mut self, id: &RawValue, code: i32, message: &str) -> std::io::Result<()> {
         wire::write_error(&mut self.0, id, code, message)
     }
 }
@@ -233,12 +224,7 @@ impl Outbox for ConnectionOutbox<'_> {
             .map_err(|_| std::io::Error::from(std::io::ErrorKind::BrokenPipe))
     }
 
-    fn refuse(
-        &mut self,
-        id: &serde_json::value::RawValue,
-        code: i32,
-        message: &str,
-    ) -> std::io::Result<()> {
+    fn refuse(&mut self, id: &RawValue, code: i32, message: &str) -> std::io::Result<()> {
         // A connection of typed messages carries only ids that are ids: nothing is refused
         // for its id there.
         let id = serde_json::from_str::<RequestId>(id.get()).ok();

@@ -53,12 +53,12 @@ fn json<T: serde::Serialize>(value: T) -> Answer {
         .map_err(|e| (lsp_server::ErrorCode::InternalError as i32, e.to_string()))
 }
 
-/// The answer to a request about a document that is not open.
-fn not_open() -> Answer {
-    Err((
+/// The error answered to a request about a document that is not open.
+fn not_open() -> (i32, String) {
+    (
         lsp_server::ErrorCode::InvalidRequest as i32,
         "the document is not open".to_string(),
-    ))
+    )
 }
 
 /// The path a document's URI names (a `file:` URI's path; another scheme's URI as it is).
@@ -184,6 +184,23 @@ impl Server {
         Some(a)
     }
 
+    /// [`Server::analysed`] for a request, which refuses a document that is not open.
+    fn open(&mut self, uri: &lsp::Uri) -> Result<Rc<Analysed>, (i32, String)> {
+        self.analysed(uri).ok_or_else(not_open)
+    }
+
+    /// The document a request points into, opened, and the byte offset of the point in its
+    /// text.
+    fn open_at(
+        &mut self,
+        p: &lsp::TextDocumentPositionParams,
+    ) -> Result<(Rc<Analysed>, usize), (i32, String)> {
+        let a = self.open(&p.text_document.uri)?;
+        let c = &a.checked;
+        let at = text::offset(c.sources.text(c.entry), p.position);
+        Ok((a, at))
+    }
+
     /// The location of `span`: the entry document's own URI, or an imported file's path.
     fn location(&self, a: &Analysed, uri: &lsp::Uri, span: Span) -> Option<lsp::Location> {
         let c = &a.checked;
@@ -212,13 +229,9 @@ impl Server {
         match req.method.as_str() {
             "textDocument/hover" => {
                 let p: lsp::HoverParams = params(req)?;
-                let uri = p.text_document_position_params.text_document.uri;
-                let Some(a) = self.analysed(&uri) else {
-                    return not_open();
-                };
+                let (a, at) = self.open_at(&p.text_document_position_params)?;
                 let c = &a.checked;
                 let t = c.sources.text(c.entry);
-                let at = text::offset(t, p.text_document_position_params.position);
                 json(hover::hover(c, &a.index, at).map(|(md, span)| lsp::Hover {
                     contents: lsp::HoverContents::Markup(lsp::MarkupContent {
                         kind: lsp::MarkupKind::Markdown,
@@ -229,16 +242,13 @@ impl Server {
             }
             "textDocument/definition" => {
                 let p: lsp::GotoDefinitionParams = params(req)?;
-                let uri = p.text_document_position_params.text_document.uri;
-                let Some(a) = self.analysed(&uri) else {
-                    return not_open();
+                let (a, at) = self.open_at(&p.text_document_position_params)?;
+                let Some((decl, _)) = self.decl_at(&a, at) else {
+                    return json(serde_json::Value::Null);
                 };
-                let (decl, _) = match self.decl_at(&a, p.text_document_position_params.position) {
-                    Some(d) => d,
-                    None => return json(serde_json::Value::Null),
-                };
+                let uri = &p.text_document_position_params.text_document.uri;
                 json(
-                    self.location(&a, &uri, decl.at)
+                    self.location(&a, uri, decl.at)
                         .map(lsp::GotoDefinitionResponse::Scalar),
                 )
             }
@@ -247,9 +257,7 @@ impl Server {
             "textDocument/codeAction" => {
                 let p: lsp::CodeActionParams = params(req)?;
                 let uri = p.text_document.uri;
-                let Some(a) = self.analysed(&uri) else {
-                    return not_open();
-                };
+                let a = self.open(&uri)?;
                 let c = &a.checked;
                 json(diagnostics::quick_fixes(
                     &c.diagnostics,
@@ -261,43 +269,28 @@ impl Server {
             }
             "textDocument/completion" => {
                 let p: lsp::CompletionParams = params(req)?;
-                let uri = p.text_document_position.text_document.uri;
-                let Some(a) = self.analysed(&uri) else {
-                    return not_open();
-                };
+                let (a, at) = self.open_at(&p.text_document_position)?;
                 let c = &a.checked;
                 let t = c.sources.text(c.entry);
-                let at = text::offset(t, p.text_document_position.position);
                 json(lsp::CompletionResponse::Array(complete::complete(
                     &a.index, c.entry, t, at,
                 )))
             }
             "textDocument/signatureHelp" => {
                 let p: lsp::SignatureHelpParams = params(req)?;
-                let uri = p.text_document_position_params.text_document.uri;
-                let Some(a) = self.analysed(&uri) else {
-                    return not_open();
-                };
+                let (a, at) = self.open_at(&p.text_document_position_params)?;
                 let c = &a.checked;
-                let at = text::offset(
-                    c.sources.text(c.entry),
-                    p.text_document_position_params.position,
-                );
                 json(complete::signature_help(&a.index, &c.sources, c.entry, at))
             }
             "textDocument/formatting" => {
                 let p: lsp::DocumentFormattingParams = params(req)?;
                 let path = path_of(&p.text_document.uri);
-                let Some(t) = self.docs.get(&path) else {
-                    return not_open();
-                };
+                let t = self.docs.get(&path).ok_or_else(not_open)?;
                 json(formatting(t))
             }
             "textDocument/documentSymbol" => {
                 let p: lsp::DocumentSymbolParams = params(req)?;
-                let Some(a) = self.analysed(&p.text_document.uri) else {
-                    return not_open();
-                };
+                let a = self.open(&p.text_document.uri)?;
                 json(lsp::DocumentSymbolResponse::Nested(symbols(&a)))
             }
             _ => Err((
@@ -309,18 +302,16 @@ impl Server {
 
     /// `textDocument/references`: every use of the declaration at the position.
     fn references(&mut self, p: lsp::ReferenceParams) -> Answer {
-        let uri = p.text_document_position.text_document.uri;
-        let Some(a) = self.analysed(&uri) else {
-            return not_open();
-        };
-        let Some((decl, _)) = self.decl_at(&a, p.text_document_position.position) else {
+        let (a, at) = self.open_at(&p.text_document_position)?;
+        let uri = &p.text_document_position.text_document.uri;
+        let Some((decl, _)) = self.decl_at(&a, at) else {
             return json(serde_json::Value::Null);
         };
         let locations: Vec<lsp::Location> = a
             .index
             .references(&decl)
             .filter(|s| p.context.include_declaration || *s != decl.at)
-            .filter_map(|s| self.location(&a, &uri, s))
+            .filter_map(|s| self.location(&a, uri, s))
             .collect();
         json(locations)
     }
@@ -328,15 +319,13 @@ impl Server {
     /// `textDocument/rename`: every use of the declaration at the position renamed, in every
     /// document of the workspace that has one.
     fn rename(&mut self, p: lsp::RenameParams) -> Answer {
-        let uri = p.text_document_position.text_document.uri;
-        let Some(a) = self.analysed(&uri) else {
-            return not_open();
-        };
+        let (a, at) = self.open_at(&p.text_document_position)?;
+        let uri = &p.text_document_position.text_document.uri;
         let new = p.new_name;
         if let Some(why) = navigate::not_a_new_name(&new) {
             return Err((lsp_server::ErrorCode::InvalidParams as i32, why));
         }
-        let Some((decl, _)) = self.decl_at(&a, p.text_document_position.position) else {
+        let Some((decl, _)) = self.decl_at(&a, at) else {
             return Err((
                 lsp_server::ErrorCode::InvalidParams as i32,
                 "no declaration of this file or its imports is here".into(),
@@ -346,7 +335,7 @@ impl Server {
         #[allow(clippy::mutable_key_type)]
         let mut changes: HashMap<lsp::Uri, Vec<lsp::TextEdit>> = HashMap::new();
         for s in a.index.references(&decl) {
-            if let Some(l) = self.location(&a, &uri, s) {
+            if let Some(l) = self.location(&a, uri, s) {
                 changes
                     .entry(l.uri)
                     .or_default()
@@ -359,11 +348,10 @@ impl Server {
         })
     }
 
-    /// The declaration of the name at `pos` of the entry document (or the declaration written
-    /// there).
-    fn decl_at(&self, a: &Analysed, pos: lsp::Position) -> Option<(navigate::Decl, Span)> {
+    /// The declaration of the name at byte `at` of the entry document (or the declaration
+    /// written there).
+    fn decl_at(&self, a: &Analysed, at: usize) -> Option<(navigate::Decl, Span)> {
         let c = &a.checked;
-        let at = text::offset(c.sources.text(c.entry), pos);
         let (name, span) = a.index.use_at(c.entry, at)?;
         Some((a.index.resolve(name, *span)?.clone(), *span))
     }
@@ -391,6 +379,9 @@ fn symbols(a: &Analysed) -> Vec<lsp::DocumentSymbol> {
         selection_range: r(at),
         children: (!children.is_empty()).then_some(children),
     };
+    // A symbol without children, selected at its name.
+    let named =
+        |name: &ast::Ident, kind, span| sym(name.name.clone(), kind, span, name.span, vec![]);
     let Some(file) = a.index.files.get(c.entry.0 as usize) else {
         return Vec::new();
     };
@@ -398,26 +389,12 @@ fn symbols(a: &Analysed) -> Vec<lsp::DocumentSymbol> {
     let mut out = Vec::new();
     for item in &file.items {
         match item {
-            ast::Item::Let(l) => out.push(sym(
-                l.name.name.clone(),
-                lsp::SymbolKind::CONSTANT,
-                l.span,
-                l.name.span,
-                vec![],
-            )),
+            ast::Item::Let(l) => out.push(named(&l.name, lsp::SymbolKind::CONSTANT, l.span)),
             ast::Item::Fn(f) => {
                 let params = f
                     .params
                     .iter()
-                    .map(|p| {
-                        sym(
-                            p.name.name.clone(),
-                            lsp::SymbolKind::VARIABLE,
-                            p.name.span,
-                            p.name.span,
-                            vec![],
-                        )
-                    })
+                    .map(|p| named(&p.name, lsp::SymbolKind::VARIABLE, p.name.span))
                     .collect();
                 out.push(sym(
                     f.name.name.clone(),
@@ -427,13 +404,9 @@ fn symbols(a: &Analysed) -> Vec<lsp::DocumentSymbol> {
                     params,
                 ));
             }
-            ast::Item::Material { name, span, .. } => out.push(sym(
-                name.name.clone(),
-                lsp::SymbolKind::STRUCT,
-                *span,
-                name.span,
-                vec![],
-            )),
+            ast::Item::Material { name, span, .. } => {
+                out.push(named(name, lsp::SymbolKind::STRUCT, *span))
+            }
             ast::Item::Block(b) => {
                 let name = match &b.kind {
                     Some(k) => format!("{} {}", b.keyword.name, k.name),
@@ -451,13 +424,9 @@ fn symbols(a: &Analysed) -> Vec<lsp::DocumentSymbol> {
                 let children = stmts
                     .iter()
                     .filter_map(|s| match s {
-                        ast::Stmt::Let(l) => Some(sym(
-                            l.name.name.clone(),
-                            lsp::SymbolKind::VARIABLE,
-                            l.span,
-                            l.name.span,
-                            vec![],
-                        )),
+                        ast::Stmt::Let(l) => {
+                            Some(named(&l.name, lsp::SymbolKind::VARIABLE, l.span))
+                        }
                         ast::Stmt::Object(e) => {
                             let first = t
                                 .get(e.span.range())

@@ -498,6 +498,18 @@ mod tests {
         format!("Content-Length: {}\r\n\r\n{body}", body.len())
     }
 
+    /// `bad` followed by a good message reads as the frame refused with `error`, then the
+    /// message.
+    #[track_caller]
+    fn assert_bad_then_good(bad: &str, error: FrameError) {
+        let input = format!("{bad}{}", msg("{}"));
+        assert_eq!(
+            frames(input.as_bytes(), 100),
+            vec![Frame::Bad(error), Frame::Body(b"{}".to_vec())],
+            "{bad:?}"
+        );
+    }
+
     #[test]
     fn frames_with_crlf_or_lf_and_any_case() {
         let input = format!(
@@ -517,7 +529,6 @@ mod tests {
 
     #[test]
     fn malformed_headers_are_reported_and_skipped_to_the_next_message() {
-        let good = msg("{}");
         let cases: &[(&str, FrameError)] = &[
             (
                 "Content-Length: -5\r\n\r\n{}",
@@ -544,39 +555,26 @@ mod tests {
             ),
         ];
         for (bad, error) in cases {
-            let input = format!("{bad}{good}");
-            assert_eq!(
-                frames(input.as_bytes(), 100),
-                vec![Frame::Bad(error.clone()), Frame::Body(b"{}".to_vec())],
-                "{bad:?}"
-            );
+            assert_bad_then_good(bad, error.clone());
         }
     }
 
     #[test]
     fn a_long_length_stops_at_the_next_header_and_a_huge_one_is_not_kept() {
         let good = msg("{}");
-        let input = format!("Content-Length: 50\r\n\r\n{{\"a\":\n{good}");
-        assert_eq!(
-            frames(input.as_bytes(), 100),
-            vec![
-                Frame::Bad(FrameError::Short {
-                    length: 50,
-                    found: 6
-                }),
-                Frame::Body(b"{}".to_vec())
-            ]
+        assert_bad_then_good(
+            "Content-Length: 50\r\n\r\n{\"a\":\n",
+            FrameError::Short {
+                length: 50,
+                found: 6,
+            },
         );
-        let input = format!("Content-Length: 1000000000000\r\n\r\n{good}");
-        assert_eq!(
-            frames(input.as_bytes(), 100),
-            vec![
-                Frame::Bad(FrameError::TooLong {
-                    length: 1_000_000_000_000,
-                    limit: 100
-                }),
-                Frame::Body(b"{}".to_vec())
-            ]
+        assert_bad_then_good(
+            "Content-Length: 1000000000000\r\n\r\n",
+            FrameError::TooLong {
+                length: 1_000_000_000_000,
+                limit: 100,
+            },
         );
         // A short length leaves the rest of the body, which is skipped as a bad header.
         let input = format!("Content-Length: 1\r\n\r\n{{\"a\":1}}\r\n{good}");

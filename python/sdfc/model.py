@@ -92,24 +92,30 @@ def rad(x: float) -> Angle:
     return Angle(x, "rad")
 
 
-_TYPE_WORDS = {
-    "float": "a number",
-    "int": "an int",
-    "bool": "a bool",
-    "vec2": "2 numbers",
-    "vec3": "3 numbers",
-    "angle": "an angle, sdfc.deg(x) or sdfc.rad(x)",
-    "string": "a str",
-    "shape": "a shape",
-    "profile": "a profile",
-    "path": "a path (sdfc.polyline, sdfc.helix, sdfc.bezier or sdfc.arc3)",
+# The language's types of value: the annotation of each in model.pyi (stubs.py), and the
+# words an error names it with.
+_TYPES = {
+    "float": ("float", "a number"),
+    "int": ("int", "an int"),
+    "bool": ("bool", "a bool"),
+    "vec2": ("Vec2", "2 numbers"),
+    "vec3": ("Vec3", "3 numbers"),
+    "angle": ("Angle", "an angle, sdfc.deg(x) or sdfc.rad(x)"),
+    "string": ("str", "a str"),
+    "shape": ("Shape", "a shape"),
+    "profile": ("Profile", "a profile"),
+    "path": ("Path", "a path (sdfc.polyline, sdfc.helix, sdfc.bezier or sdfc.arc3)"),
 }
+
+
+def _words(ty: str) -> str:
+    return _TYPES[ty][1] if ty in _TYPES else ty
 
 
 def _type_words(ty: str) -> str:
     if ty.startswith("["):
-        return f"a list of {_TYPE_WORDS.get(ty[1:-1], ty[1:-1]).replace('a ', '', 1)}s"
-    return _TYPE_WORDS.get(ty, ty)
+        return f"a list of {_words(ty[1:-1]).replace('a ', '', 1)}s"
+    return _words(ty)
 
 
 class _Bad(Exception):

@@ -16,24 +16,11 @@ from typing import List, Optional, Tuple
 
 from . import model
 
-_TYPES = {
-    "float": "float",
-    "int": "int",
-    "bool": "bool",
-    "vec2": "Vec2",
-    "vec3": "Vec3",
-    "angle": "Angle",
-    "string": "str",
-    "shape": "Shape",
-    "profile": "Profile",
-    "path": "Path",
-}
-
 
 def _type(ty: str) -> str:
     if ty.startswith("["):
         return f"Sequence[{_type(ty[1:-1])}]"
-    return _TYPES[ty]
+    return model._TYPES[ty][0]
 
 
 # model.pyi's parts written by hand, kept as they are there: its head (to the first class of

@@ -1,7 +1,7 @@
 //! The CPU renderer behind [`Renderer`]: the distance program's tapes, prepared once, and the
 //! render options.
 
-use super::{Error, Frame, Part, Prepared, Progress, Renderer, Setup};
+use super::{Error, Frame, Next, Part, Prepared, Progress, Renderer, Setup};
 use crate::cpu::{self, Options, Tapes};
 use crate::gpu::{self, launch::Faults};
 use crate::memory::Memory;
@@ -123,12 +123,7 @@ impl Renderer for CpuPrepared {
         })
     }
 
-    fn next(
-        &self,
-        scene: &Scene,
-        lowered: Lowered,
-        _: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), Error> {
+    fn next(&self, scene: &Scene, lowered: Lowered, _: Option<wgsl::KernelChoice>) -> Next {
         Ok((Prepared::on_cpu(scene, lowered, &self.setup())?, true))
     }
 

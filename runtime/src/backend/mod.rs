@@ -376,6 +376,10 @@ fn kind(interpreted: bool) -> &'static str {
     }
 }
 
+/// A scene prepared after another ([`Prepared::next`]), and whether a kernel (or the CPU's
+/// tapes) was built for it.
+pub(crate) type Next = Result<(Prepared, bool), Error>;
+
 /// What a render tells of how far it has come: the fraction done.
 pub type Progress<'a> = &'a (dyn Fn(f64) + Sync);
 
@@ -440,12 +444,7 @@ pub trait Renderer: std::fmt::Debug + Send + Sync {
     /// wgpu kernel `kernel` instead of this one's choice when given. A CUDA preparation and
     /// several devices keep the default, [`Error::NotNext`]: they are prepared again with
     /// [`Prepared::update`].
-    fn next(
-        &self,
-        _scene: &Scene,
-        _lowered: Lowered,
-        _kernel: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), Error> {
+    fn next(&self, _scene: &Scene, _lowered: Lowered, _kernel: Option<wgsl::KernelChoice>) -> Next {
         Err(Error::NotNext)
     }
 

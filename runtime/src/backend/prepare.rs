@@ -7,7 +7,7 @@ use super::cuda::CudaPrepared;
 use super::devices::{gpu_kind, Device, Devices};
 use super::several::SeveralPrepared;
 use super::wgpu::WgpuPrepared;
-use super::{Backend, Error, Prepared, Renderer, Setup};
+use super::{Backend, Error, Next, Prepared, Renderer, Setup};
 use crate::cpu::Precision;
 use crate::gpu::{cuda::Cuda, Gpu};
 use sdfc_compiler::{
@@ -170,19 +170,14 @@ impl Prepared {
     /// built. The viewer keeps its last good scene until the new one is ready; a sequence
     /// replaces its scene with [`Prepared::update`]. CUDA and several devices are prepared
     /// again with `update` alone.
-    pub fn next(&self, scene: &Scene, lowered: Lowered) -> Result<(Prepared, bool), Error> {
+    pub fn next(&self, scene: &Scene, lowered: Lowered) -> Next {
         self.0.next(scene, lowered, None)
     }
 
     /// [`Prepared::next`] with the wgpu kernel `kernel` instead of this one's choice (the
     /// viewer shows a scene through the interpreted kernel while its specialised kernel
     /// compiles); the same as `next` for the CPU.
-    pub fn next_with(
-        &self,
-        scene: &Scene,
-        lowered: Lowered,
-        kernel: wgsl::KernelChoice,
-    ) -> Result<(Prepared, bool), Error> {
+    pub fn next_with(&self, scene: &Scene, lowered: Lowered, kernel: wgsl::KernelChoice) -> Next {
         self.0.next(scene, lowered, Some(kernel))
     }
 

@@ -2,7 +2,7 @@
 //! window's), the validated kernel, and what it takes to write the kernel again.
 
 use super::{
-    kernel, written, Error, Frame, Part, Preparation, Prepared, Progress, Renderer, Setup,
+    kernel, written, Error, Frame, Next, Part, Preparation, Prepared, Progress, Renderer, Setup,
 };
 use crate::gpu::{self, launch::Faults, Gpu};
 use crate::memory::Memory;
@@ -270,12 +270,7 @@ impl Renderer for WgpuPrepared {
         })
     }
 
-    fn next(
-        &self,
-        scene: &Scene,
-        lowered: Lowered,
-        kernel: Option<wgsl::KernelChoice>,
-    ) -> Result<(Prepared, bool), Error> {
+    fn next(&self, scene: &Scene, lowered: Lowered, kernel: Option<wgsl::KernelChoice>) -> Next {
         let setup = Setup {
             kernel: kernel.unwrap_or(self.setup.kernel),
             ..self.setup

@@ -7,8 +7,9 @@
 //! render`'s image byte for byte; `--emit scene-data|params` the bytes the renderer binds; and the
 //! Shadertoy page compiled as Shadertoy wraps it and rendered through WebGL.
 
+use crate::cli::TestDir;
 use crate::common::assert_has;
-use crate::common::run_ok;
+use crate::common::{run_ok, words};
 use sdfc_compiler::{
     shader::{self, Lang},
     wgsl,
@@ -199,35 +200,20 @@ fn the_part_is_the_kernels_own_map() {
 fn the_command_line_refuses_what_has_no_part() {
     let path = example("seed1.sdf");
     let file = path.to_str().expect("utf-8 path");
-    let cases: [(&[&str], &str); 6] = [
+    let cases = [
+        ("--emit wgsl --part map --name loop", "not a name"),
+        ("--emit rust --part map --name min", "not a name"),
+        ("--emit ptx --part map", "`--part map` is written as"),
+        ("--emit spirv --part map -o /dev/null", "not `spirv`"),
+        ("--emit wgsl --part map --name 2d", "not a name"),
         (
-            &["--emit", "wgsl", "--part", "map", "--name", "loop"],
-            "not a name",
-        ),
-        (
-            &["--emit", "rust", "--part", "map", "--name", "min"],
-            "not a name",
-        ),
-        (
-            &["--emit", "ptx", "--part", "map"],
-            "`--part map` is written as",
-        ),
-        (
-            &["--emit", "spirv", "--part", "map", "-o", "/dev/null"],
-            "not `spirv`",
-        ),
-        (
-            &["--emit", "wgsl", "--part", "map", "--name", "2d"],
-            "not a name",
-        ),
-        (
-            &["--emit", "wgsl", "--name", "x"],
+            "--emit wgsl --name x",
             "`--name` names the distance function",
         ),
     ];
     for (args, wanted) in cases {
         let mut all = vec!["compile", file];
-        all.extend_from_slice(args);
+        all.extend(words(args));
         let out = sdfc(&all);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
@@ -521,6 +507,19 @@ fn scene_data_and_params_are_the_bytes_the_renderer_binds() {
     assert!(String::from_utf8_lossy(&none.stderr).contains("reads no `scene_data`"));
 }
 
+/// The program `name` on PATH ([`on_path`]) and a fresh temporary directory
+/// `sdfc-{dir}-PID` for a test that runs it; without the program, `None`: the test is skipped
+/// (which, where every device is required, fails, naming `what` is missing).
+fn tool_and_dir(name: &str, what: &str, dir: &str) -> Option<(PathBuf, TestDir)> {
+    let Some(tool) = on_path(name) else {
+        assert!(!required(), "SDFC_REQUIRE_DEVICES=1, but no {what}");
+        println!("embed: SKIPPED: no {name} on PATH");
+        return None;
+    };
+    let dir = std::env::temp_dir().join(format!("sdfc-{dir}-{}", std::process::id()));
+    Some((tool, TestDir::fresh(dir)))
+}
+
 /// A program on PATH (or at `$SDFC_CHROMIUM` for chromium), if there is one.
 fn on_path(name: &str) -> Option<PathBuf> {
     if name == "chromium" {
@@ -564,15 +563,22 @@ void main() {
 }
 ";
 
-/// The page of `file` wrapped the way Shadertoy wraps it.
-fn shadertoy_wrapped(file: &Path) -> String {
+/// `sdfc compile FILE --emit shadertoy`, which must succeed: the page (standard output) and
+/// what it says of the scene (standard error).
+fn shadertoy(file: &Path) -> (String, String) {
     let out = ok(&[
         "compile",
         file.to_str().expect("utf-8"),
         "--emit",
         "shadertoy",
     ]);
-    let page = String::from_utf8(out.stdout).expect("text");
+    let said = String::from_utf8_lossy(&out.stderr).into_owned();
+    (String::from_utf8(out.stdout).expect("text"), said)
+}
+
+/// The page of `file` wrapped the way Shadertoy wraps it.
+fn shadertoy_wrapped(file: &Path) -> String {
+    let (page, _) = shadertoy(file);
     assert!(page.contains("void mainImage(out vec4 fragColor, in vec2 fragCoord)"));
     assert!(!page.contains("#version") && !page.contains("precision "));
     format!("{SHADERTOY_HEAD}{page}{SHADERTOY_TAIL}")
@@ -582,16 +588,7 @@ fn shadertoy_wrapped(file: &Path) -> String {
 /// leaves out, on standard error, and says nothing for a scene it shows whole.
 #[test]
 fn the_shadertoy_page_says_what_it_leaves_out() {
-    let said = |file: &Path| {
-        let out = sdfc(&[
-            "compile",
-            file.to_str().expect("utf-8"),
-            "--emit",
-            "shadertoy",
-        ]);
-        assert!(out.status.success());
-        String::from_utf8_lossy(&out.stderr).into_owned()
-    };
+    let said = |file: &Path| shadertoy(file).1;
     let studio = said(&example("studio.sdf"));
     for what in [
         "warning: the Shadertoy page",
@@ -612,16 +609,10 @@ fn the_shadertoy_page_says_what_it_leaves_out() {
 /// glslangValidator (Debian's `glslang-tools`) as a GLSL ES 3.00 fragment shader.
 #[test]
 fn the_shadertoy_page_compiles_as_shadertoy_wraps_it() {
-    let Some(glslang) = on_path("glslangValidator") else {
-        assert!(
-            !required(),
-            "SDFC_REQUIRE_DEVICES=1, but no glslangValidator (glslang-tools)"
-        );
-        println!("embed: SKIPPED: no glslangValidator on PATH");
+    let glslang = "glslangValidator (glslang-tools)";
+    let Some((glslang, dir)) = tool_and_dir("glslangValidator", glslang, "shadertoy") else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("sdfc-shadertoy-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
     for seed in 1..=6 {
         let frag = dir.join(format!("seed{seed}.frag"));
         std::fs::write(
@@ -632,28 +623,18 @@ fn the_shadertoy_page_compiles_as_shadertoy_wraps_it() {
         let what = format!("glslangValidator on seed{seed}");
         run_ok(Command::new(&glslang).arg(&frag), &what);
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The page rendered by headless Chromium through WebGL 2 (SwiftShader) looks like the CPU
 /// image of a scene without reflections: the mean difference of the sRGB bytes is small.
 #[test]
 fn the_shadertoy_page_renders_the_scene_in_webgl() {
-    let Some(chromium) = on_path("chromium") else {
-        assert!(!required(), "SDFC_REQUIRE_DEVICES=1, but no chromium");
-        println!("embed: SKIPPED: no chromium on PATH");
+    let Some((chromium, dir)) = tool_and_dir("chromium", "chromium", "shadertoy-gl") else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("sdfc-shadertoy-gl-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
     let scene = dir.join("small.sdf");
     std::fs::write(&scene, SMALL.replace(", reflect: 0.2", "")).expect("scene");
-    let (mean, far) = webgl_against_cpu(&chromium, &dir, &scene);
-    assert!(
-        mean < MEAN_LIMIT && far * 100 < 192 * 128,
-        "mean {mean}, {far} pixels far off"
-    );
-    let _ = std::fs::remove_dir_all(&dir);
+    assert_webgl_like_cpu(&chromium, &dir, &scene);
 }
 
 /// The page draws the glow of the marching steps (`render { glow, glow_color }`) as the CPU
@@ -662,33 +643,18 @@ fn the_shadertoy_page_renders_the_scene_in_webgl() {
 /// before it drew the glow).
 #[test]
 fn the_shadertoy_page_draws_the_glow_of_the_marching_steps() {
-    let Some(chromium) = on_path("chromium") else {
-        assert!(!required(), "SDFC_REQUIRE_DEVICES=1, but no chromium");
-        println!("embed: SKIPPED: no chromium on PATH");
+    let Some((chromium, dir)) = tool_and_dir("chromium", "chromium", "shadertoy-glow") else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("sdfc-shadertoy-glow-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
     let scene = dir.join("glow.sdf");
     let text = SMALL.replace(", reflect: 0.2", "").replace(
         "render { width: 48, height: 32 }",
         "render { width: 48, height: 32, glow: 0.1, glow_color: (0.02, 0.03, 0.05) }",
     );
     std::fs::write(&scene, text).expect("scene");
-    let said = sdfc(&[
-        "compile",
-        scene.to_str().expect("utf-8"),
-        "--emit",
-        "shadertoy",
-    ]);
-    assert!(said.status.success());
-    let warned = String::from_utf8_lossy(&said.stderr);
+    let (_, warned) = shadertoy(&scene);
     assert!(!warned.contains("warning"), "{warned}");
-    let (mean, far) = webgl_against_cpu(&chromium, &dir, &scene);
-    assert!(
-        mean < MEAN_LIMIT && far * 100 < 192 * 128,
-        "mean {mean}, {far} pixels far off"
-    );
+    assert_webgl_like_cpu(&chromium, &dir, &scene);
     let (w, h) = (192, 128);
     let png = |name: &str, set: &[&str]| {
         let out = dir.join(name);
@@ -709,13 +675,12 @@ fn the_shadertoy_page_draws_the_glow_of_the_marching_steps() {
         apart > 10.0 * MEAN_LIMIT,
         "the glow is {apart} steps of 255"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The page of `scene` rendered by `chromium` (WebGL 2 through SwiftShader) at 192×128 in
-/// `dir`, against the CPU's image: the mean difference of the sRGB bytes (of 255) and the
-/// pixels off by more than 24 in a channel.
-fn webgl_against_cpu(chromium: &Path, dir: &Path, scene: &Path) -> (f64, usize) {
+/// `dir` looks like the CPU's image: the mean difference of the sRGB bytes (of 255) is under
+/// `MEAN_LIMIT`, and under 1 % of the pixels are off by more than 24 in a channel.
+fn assert_webgl_like_cpu(chromium: &Path, dir: &Path, scene: &Path) {
     let (w, h) = (192, 128);
     let frag = serde_json::to_string(&shadertoy_wrapped(scene)).expect("json");
     let html = format!(
@@ -780,5 +745,8 @@ gl.viewport(0, 0, {w}, {h}); gl.drawArrays(gl.TRIANGLES, 0, 3);
         .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| p.abs_diff(*q) > 24))
         .count();
     println!("shadertoy against cpu: mean |difference| {mean:.3} of 255, {far} pixels off by more than 24");
-    (mean, far)
+    assert!(
+        mean < MEAN_LIMIT && far * 100 < 192 * 128,
+        "mean {mean}, {far} pixels far off"
+    );
 }

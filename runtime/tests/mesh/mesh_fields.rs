@@ -39,6 +39,9 @@ fn spans(m: &Read, b: [[f32; 3]; 2], tolerance: f32, what: &str) {
     close(extent(m), b, tolerance, what);
 }
 
+/// A rod of radius 0.2 along y, 2 long (`cylinder(0.2, 2)`), written as a field.
+const ROD: &str = "field { max(length(p.xz) - 0.2, abs(p.y) - 1) }";
+
 fn meshed(d: &Path, name: &str, body: &str, resolution: &str) -> Read {
     let scene = write_scene(d, &format!("{name}.sdf"), body);
     let out = d.join(format!("{name}.stl"));
@@ -51,9 +54,8 @@ fn meshed(d: &Path, name: &str, body: &str, resolution: &str) -> Read {
 #[test]
 fn a_rod_built_as_a_field_meshes_as_the_primitive_does() {
     let d = dir("field-rod");
-    let field_text =
-        "scene { field { max(length(p.xz) - 0.2, abs(p.y) - 1) }.translate(0.5, 0, 0); }\n";
-    let field = meshed(&d, "field", field_text, "64");
+    let field_text = format!("scene {{ {ROD}.translate(0.5, 0, 0); }}\n");
+    let field = meshed(&d, "field", &field_text, "64");
     let prim_text = "scene { cylinder(0.2, 2).translate(0.5, 0, 0); }\n";
     let prim = meshed(&d, "prim", prim_text, "64");
     assert_eq!(manifold(&field, "field rod"), 2);
@@ -101,9 +103,8 @@ fn a_blob_and_a_bumpy_sphere_mesh_without_bounds() {
 #[test]
 fn a_repeated_field_is_bounded_by_its_count() {
     let d = dir("field-repeat");
-    let rods_text =
-        "scene { field { max(length(p.xz) - 0.2, abs(p.y) - 1) }.repeat((1, 0, 0), (3, 1, 1)); }\n";
-    let rods = meshed(&d, "rods", rods_text, "64");
+    let rods_text = format!("scene {{ {ROD}.repeat((1, 0, 0), (3, 1, 1)); }}\n");
+    let rods = meshed(&d, "rods", &rods_text, "64");
     // Three closed rods: χ = 6.
     assert_eq!(manifold(&rods, "rods"), 6);
     spans(&rods, [[-1.2, -1.0, -0.2], [1.2, 1.0, 0.2]], 0.02, "rods");

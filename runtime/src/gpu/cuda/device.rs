@@ -225,60 +225,26 @@ impl launch::Device for Kernel<'_> {
         Ok(())
     }
 
-    fn collect(
+    /// A band's finished pixels, from the page-locked buffer once its copy is done.
+    fn copied(
         &self,
         f: &mut FrameBuffers,
-        work: &Work,
-        range: Range<usize>,
+        range: &Range<usize>,
         slot: usize,
-    ) -> Result<Pixels, Error> {
+        take: &mut dyn FnMut(&[u8]),
+    ) -> Result<Option<Duration>, Error> {
         let (kept, at) = &mut f.readback[slot];
-        let copied = at.take().filter(|(r, _)| *r == range);
+        let copied = at.take().filter(|(r, _)| r == range);
         let (Some(pinned), Some((_, copied))) = (kept.as_ref(), copied) else {
-            return self.read(f, work, std::slice::from_ref(&range));
+            return Ok(None);
         };
+        let waiting = Instant::now();
         // Waits for the copy alone: the launches queued after it may still run.
         copied.synchronize().map_err(driver("reading the pixels"))?;
+        let wait = waiting.elapsed();
         let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
-        let rgba = super::super::to_vec_parallel(&bytes[..4 * range.len()]);
-        Ok(Pixels {
-            linear: Vec::new(),
-            rgba,
-            convert: Duration::ZERO,
-        })
-    }
-
-    /// A band's finished pixels copied from the page-locked buffer straight into their
-    /// place, the wait for the copy timed apart.
-    fn collect_into(
-        &self,
-        f: &mut FrameBuffers,
-        work: &Work,
-        range: Range<usize>,
-        slot: usize,
-        place: launch::Place<'_>,
-    ) -> Result<launch::Collected, Error> {
-        let (kept, at) = &mut f.readback[slot];
-        let started = at.as_ref().is_some_and(|(r, _)| *r == range);
-        match (kept.as_ref(), at.take().filter(|_| started), place) {
-            (Some(pinned), Some((_, copied)), launch::Place::Rgba(out)) => {
-                let waiting = Instant::now();
-                // Waits for the copy alone: the launches queued after it may still run.
-                copied.synchronize().map_err(driver("reading the pixels"))?;
-                let wait = waiting.elapsed();
-                let bytes = pinned.as_slice().map_err(driver("reading the pixels"))?;
-                super::super::copy_parallel(out, &bytes[..4 * range.len()]);
-                Ok(launch::Collected {
-                    wait,
-                    convert: Duration::ZERO,
-                })
-            }
-            (_, copied, place) => {
-                // A read started for this band, collected through `collect`.
-                f.readback[slot].1 = copied;
-                launch::collect_copied(self, f, work, (range, slot), place)
-            }
-        }
+        take(&bytes[..4 * range.len()]);
+        Ok(Some(wait))
     }
 
     fn read(

@@ -151,21 +151,45 @@ pub trait Device: Sync {
     ) -> Result<(), Self::Error> {
         Ok(())
     }
-    /// The pixels of `range` whose read was started into `slot`, once they are copied (the
-    /// work submitted after them may still be running). By default [`Device::read`].
+    /// The finished pixels of `range` whose read was started into `slot`, handed to `take`
+    /// once they are copied (the work submitted after them may still be running): how long
+    /// the copy was waited for, or `None` where no read of `range` was started into `slot`.
+    /// By default `None`: [`Device::collect`] reads.
+    fn copied(
+        &self,
+        _frame: &mut Self::Frame,
+        _range: &Range<usize>,
+        _slot: usize,
+        _take: &mut dyn FnMut(&[u8]),
+    ) -> Result<Option<Duration>, Self::Error> {
+        Ok(None)
+    }
+    /// The pixels of `range` whose read was started into `slot`, once they are copied
+    /// ([`Device::copied`]); where none was started, [`Device::read`].
     fn collect(
         &self,
         frame: &mut Self::Frame,
         work: &Work,
         range: Range<usize>,
-        _slot: usize,
+        slot: usize,
     ) -> Result<Pixels, Self::Error> {
-        self.read(frame, work, std::slice::from_ref(&range))
+        let mut rgba = Vec::new();
+        let copied = self.copied(frame, &range, slot, &mut |b| {
+            rgba = super::to_vec_parallel(b)
+        })?;
+        match copied {
+            Some(_) => Ok(Pixels {
+                rgba,
+                ..Pixels::default()
+            }),
+            None => self.read(frame, work, std::slice::from_ref(&range)),
+        }
     }
     /// [`Device::collect`] straight into `place`, the band's place in the image: the pixels
     /// cross the host's memory once, on the worker's thread. Says how long it waited for the
-    /// device (the band's launches and its copy across the bus) and converted. By default
-    /// `collect`, copied ([`collect_copied`]).
+    /// device (the band's launches and its copy across the bus) and converted. Finished pixels
+    /// whose read was started are copied from the device's buffer into their place, the wait
+    /// for the copy timed apart; others are collected, then copied ([`collect_copied`]).
     fn collect_into(
         &self,
         frame: &mut Self::Frame,
@@ -174,6 +198,19 @@ pub trait Device: Sync {
         slot: usize,
         place: Place<'_>,
     ) -> Result<Collected, Self::Error> {
+        let place = match place {
+            Place::Rgba(out) => {
+                let copy = &mut |b: &[u8]| super::copy_parallel(&mut *out, b);
+                if let Some(wait) = self.copied(frame, &range, slot, copy)? {
+                    return Ok(Collected {
+                        wait,
+                        convert: Duration::ZERO,
+                    });
+                }
+                Place::Rgba(out)
+            }
+            place => place,
+        };
         collect_copied(self, frame, work, (range, slot), place)
     }
     /// The statistics of the pixels of `ranges` (rendered in `frame`) reduced as `ask` asks,

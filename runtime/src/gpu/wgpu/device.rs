@@ -155,67 +155,27 @@ impl launch::Device for Kernel<'_> {
         Ok(())
     }
 
-    fn collect(
+    /// A band's finished pixels, from the mapped buffer once its copy is done.
+    fn copied(
         &self,
         f: &mut FrameBuffers,
-        work: &Work,
-        range: Range<usize>,
+        range: &Range<usize>,
         slot: usize,
-    ) -> Result<Pixels, Error> {
+        take: &mut dyn FnMut(&[u8]),
+    ) -> Result<Option<Duration>, Error> {
         let reading = f.reading[slot].take();
         let (Some((at, index, mapped)), Some(buffer)) = (reading, &f.buffers.readback[slot]) else {
-            return self.read(f, work, std::slice::from_ref(&range));
+            return Ok(None);
         };
-        debug_assert_eq!(at, range, "the band read into this slot");
+        debug_assert_eq!(&at, range, "the band read into this slot");
+        let waiting = Instant::now();
         // Waits for the copy alone: the launches submitted after it may still run.
         self.gpu.wait_for(index, &mapped)?;
+        let wait = waiting.elapsed();
         let size = 4 * range.len() as u64;
-        let rgba = {
-            let view = buffer.slice(..size).get_mapped_range()?;
-            crate::gpu::to_vec_parallel(&view)
-        };
+        take(&buffer.slice(..size).get_mapped_range()?);
         buffer.unmap();
-        Ok(Pixels {
-            linear: Vec::new(),
-            rgba,
-            convert: Duration::ZERO,
-        })
-    }
-
-    /// A band's finished pixels copied from the mapped buffer straight into their place,
-    /// the wait for the copy timed apart.
-    fn collect_into(
-        &self,
-        f: &mut FrameBuffers,
-        work: &Work,
-        range: Range<usize>,
-        slot: usize,
-        place: launch::Place<'_>,
-    ) -> Result<launch::Collected, Error> {
-        let started = matches!(&f.reading[slot], Some((at, ..)) if *at == range);
-        let buffer = f.buffers.readback[slot].as_ref().filter(|_| started);
-        match (buffer, place) {
-            (Some(buffer), launch::Place::Rgba(out)) => {
-                let Some((_, index, mapped)) = f.reading[slot].take() else {
-                    return Err(Error::NotRead { slot });
-                };
-                let waiting = Instant::now();
-                // Waits for the copy alone: the launches submitted after it may still run.
-                self.gpu.wait_for(index, &mapped)?;
-                let wait = waiting.elapsed();
-                let size = 4 * range.len() as u64;
-                {
-                    let view = buffer.slice(..size).get_mapped_range()?;
-                    crate::gpu::copy_parallel(out, &view);
-                }
-                buffer.unmap();
-                Ok(launch::Collected {
-                    wait,
-                    convert: Duration::ZERO,
-                })
-            }
-            (_, place) => launch::collect_copied(self, f, work, (range, slot), place),
-        }
+        Ok(Some(wait))
     }
 
     fn read(

@@ -67,9 +67,6 @@ pub enum Error {
     /// A launch into a [`ResidentFrame`] not fitted to its work (a bug of sdfc's).
     #[error("internal error: the frame kept on the device does not fit the launch")]
     NotFitted,
-    /// A band collected from a readback slot no band was read into (a bug of sdfc's).
-    #[error("GPU error while rendering: no band was read into this slot")]
-    NotRead { slot: usize },
     /// A fault injected by `SDFC_FAULT_AFTER_TILES` (tests of the scheduler): its message.
     #[error("GPU error while rendering: {0}")]
     Injected(String),

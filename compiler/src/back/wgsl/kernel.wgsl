@@ -236,8 +236,7 @@ fn trace(o: vec3<f32>, d: vec3<f32>, t0: f32, sign: f32) -> Traced {
             step = signed * omega;
         }
         prev = r;
-        // A ray that starts inside a solid (a reflection lifted into a neighbour it touches,
-        // a camera in a wall), or is stepped back to its start, has reached it there.
+        // Inside a solid at t = 0: reached there (docs/rendering.md, "Marching").
         if !fail && (r < tol || (t == 0.0 && signed < -tol)) {
             return Traced(t, STATUS_HIT);
         }

@@ -38,8 +38,9 @@ const WALK: usize = 8;
 /// Bisection rounds towards each root (the thickness to 2⁻¹⁶ of a cell).
 const BISECTIONS: u32 = 16;
 
-/// Edges probed together (the memory this holds is a few MiB, whatever the grid).
-const BATCH: usize = 1 << 12;
+/// Edges probed together, enough that their evaluations are shared among the threads (the
+/// memory this holds is a few MiB, whatever the grid).
+const BATCH: usize = 1 << 15;
 
 /// Which share of the features found, thinnest first, the reported thickness leaves below
 /// it: a tenth, so that the refined grid resolves nine features in ten, and a few edges that

@@ -124,18 +124,8 @@ impl Closure {
                 if config == 0 || config == 255 {
                     return None;
                 }
-                let i = unpack(c);
-                let mut around = around_crossed(config);
-                let mut lacks = false;
-                while around != 0 && !lacks {
-                    let o = around.trailing_zeros();
-                    around &= around - 1;
-                    let d = [o % 3, o / 3 % 3, o / 9];
-                    // Offsets of -1 below the grid's first cell name no cell.
-                    if (0..3).all(|a| i[a] + d[a] >= 1) {
-                        lacks = !set.get([0, 1, 2].map(|a| i[a] + d[a] - 1));
-                    }
-                }
+                // Offsets of -1 below the grid's first cell name no cell.
+                let lacks = !set.all_around(unpack(c), around_crossed(config), |held| held);
                 Some((c, config, lacks))
             })
             .collect();

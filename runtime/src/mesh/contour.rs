@@ -361,14 +361,15 @@ fn inner_vertices(
             place(&pts[..n], &nrm[..n], settings.sharp, [lo, hi])
         })
         .collect();
-    let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.point).collect();
-    let smooth: Vec<bool> = inner.iter().map(|c| c.smooth).collect();
+    let mut centres: Vec<[f64; 3]> = inner.par_iter().map(|c| c.point).collect();
+    let smooth: Vec<bool> = inner.par_iter().map(|c| c.smooth).collect();
     choose(field, grid.voxel, &inner, &mut centres);
     stats.features = smooth.iter().filter(|s| !**s).count() as u64;
     onto_zero(field, grid, rings, edge.normals, &smooth, &mut centres);
-    for (centre, &cell) in centres.iter_mut().zip(&rings.cells) {
-        *centre = inside_cell(grid, cell, *centre);
-    }
+    centres
+        .par_iter_mut()
+        .zip(&rings.cells)
+        .for_each(|(centre, &cell)| *centre = inside_cell(grid, cell, *centre));
     let patches = Patches {
         cells: &rings.cells,
         ring: &rings.ring,
@@ -567,17 +568,22 @@ fn flip(
     smooth: &[bool],
     voxel: f64,
 ) -> u64 {
+    // The sharp patches' triangles, in order (found in parallel).
+    let sharp: Vec<usize> = (0..triangles.len())
+        .into_par_iter()
+        .filter(|&t| !smooth[owner[t] as usize])
+        .collect();
     // Each fan triangle [centre, a, b] has one patch edge, a → b.
     let mut by_edge: KeyMap<u32> = KeyMap::default();
-    for (t, tri) in triangles.iter().enumerate() {
-        if !smooth[owner[t] as usize] {
-            by_edge.insert((tri[1] as u64) << 32 | tri[2] as u64, t as u32);
-        }
+    by_edge.reserve(sharp.len());
+    for &t in &sharp {
+        let tri = triangles[t];
+        by_edge.insert((tri[1] as u64) << 32 | tri[2] as u64, t as u32);
     }
     let mut pairs = Vec::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        let (a, b) = (tri[1], tri[2]);
-        if a > b || smooth[owner[t] as usize] {
+    for &t in &sharp {
+        let (a, b) = (triangles[t][1], triangles[t][2]);
+        if a > b {
             continue;
         }
         if let Some(&u) = by_edge.get(&((b as u64) << 32 | a as u64)) {

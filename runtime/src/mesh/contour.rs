@@ -28,9 +28,9 @@ const BISECTIONS: u32 = 24;
 
 /// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
 /// points asked for, each at most once (a position, its index, its place and its value); and
-/// the bricks of corner values (f64), cell flags and edge indices, at most eight per candidate
-/// and at most the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one
-/// where the grid's bricks are at most eight per candidate).
+/// the bricks of corner values (f64) and cell flags, at most eight per candidate and at most
+/// the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one where the
+/// grid's bricks are at most eight per candidate), with 12 bytes a point to spare.
 pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
     let points = candidates.saturating_mul(8).min(grid.dense_points());
     let bricks = grid

@@ -1,5 +1,5 @@
 //! Values on grid points, stored sparsely in bricks of 8×8×8 points (`Bricks`): the corner
-//! values, cell flags and edge indices contouring holds.
+//! values and cell flags contouring holds.
 
 use super::{pack, table, unpack, Grid, KeyMap};
 use rayon::prelude::*;
@@ -126,10 +126,48 @@ impl<T: Copy + PartialEq> Bricks<T> {
                 brick[o + (c & 1) + (c >> 1 & 1) * sy + (c >> 2 & 1) * sz]
             });
         }
+        // Across bricks: each brick the corners reach looked up once.
+        let b = i.map(|x| x / BRICK);
+        let mut slots = [None; 8];
         std::array::from_fn(|c| {
             let d = table::corner(c);
-            self.get([i[0] + d[0], i[1] + d[1], i[2] + d[2]])
+            let (mut beyond, mut at) = (0, 0);
+            for a in (0..3).rev() {
+                let x = i[a] % BRICK + d[a];
+                beyond |= usize::from(x == BRICK) << a;
+                at = at * BRICK as usize + (x % BRICK) as usize;
+            }
+            let slot = *slots[beyond].get_or_insert_with(|| {
+                self.slot([0, 1, 2].map(|a| b[a] + (beyond >> a & 1) as u32))
+            });
+            slot.map_or(self.empty, |k| self.data[k as usize][at])
         })
+    }
+
+    /// Whether `test` holds for the value at every point `i + d − 1` for the offsets `d` in
+    /// `{0, 1, 2}³` whose bit `d[0] + 3·d[1] + 9·d[2]` is set in `around` (those below the
+    /// grid's first point left out), each brick they reach looked up once.
+    pub fn all_around(&self, i: [u32; 3], mut around: u32, test: impl Fn(T) -> bool) -> bool {
+        let mut slots = [None; 27];
+        while around != 0 {
+            let o = around.trailing_zeros();
+            around &= around - 1;
+            let d = [o % 3, o / 3 % 3, o / 9];
+            if (0..3).any(|a| i[a] + d[a] < 1) {
+                continue;
+            }
+            let p = [0, 1, 2].map(|a| i[a] + d[a] - 1);
+            let (b, at) = Self::split(p);
+            // The brick's place among the 3×3×3 about `i`'s brick.
+            let near = (0..3)
+                .rev()
+                .fold(0, |n, a| n * 3 + (b[a] + 1 - i[a] / BRICK) as usize);
+            let slot = *slots[near].get_or_insert_with(|| self.slot(b));
+            if !test(slot.map_or(self.empty, |k| self.data[k as usize][at])) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Sets the value at point `i`.
@@ -355,6 +393,27 @@ mod tests {
             }
         };
         same(&flat, &hashed);
+        // Every neighbourhood read at once is the points read one by one.
+        for z in 0..15 {
+            for y in 0..11 {
+                for x in 0..22 {
+                    for around in [
+                        0,
+                        1,
+                        1 << 13,
+                        (1 << 27) - 1,
+                        0b101_0000_0110_0010_0011_0100_0101,
+                    ] {
+                        let one_by_one = (0..27).filter(|o| around >> o & 1 == 1).all(|o| {
+                            let d = [o % 3, o / 3 % 3, o / 9];
+                            (0..3).any(|a| [x, y, z][a] + d[a] < 1)
+                                || flat.get([0, 1, 2].map(|a| [x, y, z][a] + d[a] - 1)) != -1
+                        });
+                        assert_eq!(flat.all_around([x, y, z], around, |v| v != -1), one_by_one);
+                    }
+                }
+            }
+        }
         // Filled from sorted keys in one go, flat or hashed, the same values.
         let mut keys: Vec<u64> = points.iter().map(|&i| pack(i)).collect();
         keys.sort_unstable();

@@ -79,8 +79,10 @@ impl Closure {
         candidates: &[u64],
         mut known: Vec<(u64, f64)>,
     ) {
-        known.par_sort_unstable_by_key(|&(k, _)| k);
-        let keys = unknown(corners(candidates), &known);
+        if !known.is_sorted_by_key(|&(k, _)| k) {
+            known.par_sort_unstable_by_key(|&(k, _)| k);
+        }
+        let keys = corners_unknown(candidates, &known);
         let d = field.distances_of(keys.len(), |n| grid.point(unpack(keys[n])));
         self.values = Bricks::from_sorted(f64::NAN, grid, self.held, &keys, |n| d[n]);
         for (k, v) in known {
@@ -122,18 +124,8 @@ impl Closure {
                 if config == 0 || config == 255 {
                     return None;
                 }
-                let i = unpack(c);
-                let mut around = around_crossed(config);
-                let mut lacks = false;
-                while around != 0 && !lacks {
-                    let o = around.trailing_zeros();
-                    around &= around - 1;
-                    let d = [o % 3, o / 3 % 3, o / 9];
-                    // Offsets of -1 below the grid's first cell name no cell.
-                    if (0..3).all(|a| i[a] + d[a] >= 1) {
-                        lacks = !set.get([0, 1, 2].map(|a| i[a] + d[a] - 1));
-                    }
-                }
+                // Offsets of -1 below the grid's first cell name no cell.
+                let lacks = !set.all_around(unpack(c), around_crossed(config), |held| held);
                 Some((c, config, lacks))
             })
             .collect();
@@ -159,10 +151,67 @@ impl Closure {
     }
 }
 
-/// The corners of `cells` (sorted keys), sorted, each once: the cells grown by one point
-/// along x, then y, then z, each a merge of two sorted lists (a key plus one along an axis
-/// keeps its order: no index reaches the next axis's bits, see [`super::AXIS_CELLS`]).
-fn corners(cells: &[u64]) -> Vec<u64> {
+/// The corners of `cells` (sorted keys), sorted, each once, less those of `known` (sorted by
+/// key): a layer along z at a time, in parallel. The corners of one layer of cells along x
+/// and y ([`corners`]) are their corners in two layers of points, so each layer of points is
+/// a merge of those of the two layers of cells beside it.
+fn corners_unknown(cells: &[u64], known: &[(u64, f64)]) -> Vec<u64> {
+    let z_of = |k: u64| k >> (2 * KEY_BITS);
+    if cells.is_empty() {
+        return Vec::new();
+    }
+    let mut starts: Vec<usize> = vec![0];
+    starts.extend((1..cells.len()).filter(|&n| z_of(cells[n]) != z_of(cells[n - 1])));
+    starts.push(cells.len());
+    // Each layer of cells' corners in its own layer of points.
+    let flat: Vec<(u64, Vec<u64>)> = starts
+        .par_windows(2)
+        .map(|w| (z_of(cells[w[0]]), corners(&cells[w[0]..w[1]], 2)))
+        .collect();
+    let mut layers: Vec<u64> = flat.iter().flat_map(|&(z, _)| [z, z + 1]).collect();
+    layers.dedup();
+    let step = 1 << (2 * KEY_BITS);
+    let parts: Vec<Vec<u64>> = layers
+        .par_iter()
+        .map(|&z| {
+            let find = |z: u64| {
+                flat.binary_search_by_key(&z, |l| l.0)
+                    .ok()
+                    .map(|k| &flat[k].1[..])
+            };
+            let below = z.checked_sub(1).and_then(find).unwrap_or(&[]);
+            let here = find(z).unwrap_or(&[]);
+            let keys = union(here, below, step);
+            let from = known.partition_point(|&(k, _)| z_of(k) < z);
+            let to = known.partition_point(|&(k, _)| z_of(k) <= z);
+            unknown(keys, &known[from..to])
+        })
+        .collect();
+    concat(parts)
+}
+
+/// `parts` one after another, copied in parallel.
+fn concat<T: Copy + Default + Send + Sync>(parts: Vec<Vec<T>>) -> Vec<T> {
+    let mut out = vec![T::default(); parts.iter().map(Vec::len).sum()];
+    let mut slices = Vec::with_capacity(parts.len());
+    let mut rest = &mut out[..];
+    for part in &parts {
+        let (slice, tail) = std::mem::take(&mut rest).split_at_mut(part.len());
+        slices.push(slice);
+        rest = tail;
+    }
+    slices
+        .into_par_iter()
+        .zip(&parts)
+        .for_each(|(slice, part)| slice.copy_from_slice(part));
+    out
+}
+
+/// The corners of `cells` (sorted keys), sorted, each once, along the first `axes` axes:
+/// the cells grown by one point along x, then y, then z, each a merge of two sorted lists (a
+/// key plus one along an axis keeps its order: no index reaches the next axis's bits, see
+/// [`super::AXIS_CELLS`]).
+fn corners(cells: &[u64], axes: u32) -> Vec<u64> {
     // Along x in one pass: each key, and the next point where it is not the next key.
     let mut keys = Vec::with_capacity(2 * cells.len());
     for (k, &c) in cells.iter().enumerate() {
@@ -171,7 +220,7 @@ fn corners(cells: &[u64]) -> Vec<u64> {
             keys.push(c + 1);
         }
     }
-    for axis in 1..3 {
+    for axis in 1..axes {
         keys = grown(&keys, 1 << (axis * KEY_BITS));
     }
     keys
@@ -189,10 +238,15 @@ fn unknown(mut keys: Vec<u64>, known: &[(u64, f64)]) -> Vec<u64> {
 
 /// The union of the sorted keys `a` and `a + step`, sorted, each once.
 fn grown(a: &[u64], step: u64) -> Vec<u64> {
-    let mut out = Vec::with_capacity(2 * a.len());
+    union(a, a, step)
+}
+
+/// The union of the sorted keys `a` and `b + step`, sorted, each once.
+fn union(a: &[u64], b: &[u64], step: u64) -> Vec<u64> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
     let (mut i, mut j) = (0, 0);
-    while j < a.len() {
-        let shifted = a[j] + step;
+    while j < b.len() {
+        let shifted = b[j] + step;
         if i < a.len() && a[i] <= shifted {
             if a[i] == shifted {
                 j += 1;
@@ -204,6 +258,7 @@ fn grown(a: &[u64], step: u64) -> Vec<u64> {
             j += 1;
         }
     }
+    out.extend_from_slice(&a[i..]);
     out
 }
 
@@ -305,7 +360,16 @@ mod tests {
             .collect();
         expected.sort_unstable();
         expected.dedup();
-        assert_eq!(corners(&cells), expected);
+        assert_eq!(corners(&cells, 3), expected);
+        assert_eq!(corners_unknown(&cells, &[]), expected);
+        let known: Vec<(u64, f64)> = expected.iter().step_by(3).map(|&k| (k, 0.0)).collect();
+        let rest: Vec<u64> = expected
+            .iter()
+            .enumerate()
+            .filter(|(n, _)| n % 3 != 0)
+            .map(|(_, &k)| k)
+            .collect();
+        assert_eq!(corners_unknown(&cells, &known), rest);
         // The neighbourhood of each configuration holds the cells around its crossed edges.
         let i = [5u32, 5, 5];
         for config in 0..=255u8 {
@@ -325,7 +389,8 @@ mod tests {
             from_bits.sort_unstable();
             assert_eq!(from_bits, cells, "{config}");
         }
-        assert!(corners(&[]).is_empty());
+        assert!(corners(&[], 3).is_empty());
+        assert!(corners_unknown(&[], &[]).is_empty());
         // Known corners are left out, each once; keys not among them are ignored.
         let known = [(2, 0.5), (5, -1.0), (6, 1.0), (11, 2.0)];
         assert_eq!(

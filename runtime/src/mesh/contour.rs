@@ -12,14 +12,14 @@
 //! inner vertex off the face its other two vertices lie on, so none has zero area; and a
 //! flip replaces two triangles by two that share a new edge, which is made only once.
 
-use super::closure::{add, closure, Closure};
+use super::closure::{closure, Closure};
 use super::octree::Candidates;
 use super::place::{
     choose, inside_cell, normalise, onto_surface, place, separate, Patches, Placed, GRADIENT_STEP,
     MARGIN, ON_SURFACE,
 };
 use super::table::{corner, patches, EDGES};
-use super::{unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
+use super::{pack, unpack, Bricks, Field, Grid, KeyMap, KeySet, Mesh, Settings, Stats};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -28,9 +28,9 @@ const BISECTIONS: u32 = 24;
 
 /// Bytes held at most for `candidates` cells of `grid` before contouring: their keys; the
 /// points asked for, each at most once (a position, its index, its place and its value); and
-/// the bricks of corner values (f64), cell flags and edge indices, at most eight per candidate
-/// and at most the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one
-/// where the grid's bricks are at most eight per candidate).
+/// the bricks of corner values (f64) and cell flags, at most eight per candidate and at most
+/// the grid's, with a slot of each one's flat directory ([`Bricks::over`]: one where the
+/// grid's bricks are at most eight per candidate), with 12 bytes a point to spare.
 pub fn candidate_bytes(grid: &Grid, candidates: u64) -> u64 {
     let points = candidates.saturating_mul(8).min(grid.dense_points());
     let bricks = grid
@@ -100,7 +100,8 @@ pub fn contour(
     surface_cells(stats.surface_cells).map_err(Stop::Refused)?;
 
     // Edge vertices: each crossed edge is owned by the cell at its lower end.
-    let (index, edges) = edge_index(grid, &surface, stats.candidates);
+    let owned = Owned::new(&surface);
+    let edges = owned.keys(&surface);
     let crossings = roots(field, grid, &values, &edges, settings.refine);
     progress(0.5);
     let h = GRADIENT_STEP * grid.voxel;
@@ -108,7 +109,7 @@ pub fn contour(
     let normals: Vec<[f64; 3]> = gradients.iter().map(|g| normalise(*g)).collect();
     progress(0.6);
 
-    let rings = Rings::new(&surface, &index);
+    let rings = Rings::new(&surface, &owned);
     let edge = Edges {
         crossings: &crossings,
         normals: &normals,
@@ -153,24 +154,67 @@ pub fn contour(
     ))
 }
 
-/// The crossed edges each surface cell owns (those from its lower corner): for each cell, its
-/// edges' indices by axis (`u32::MAX` where not crossed), and each edge's key (the cell's key
-/// and the axis); `held` sizes the bricks.
-fn edge_index(grid: &Grid, surface: &[(u64, u8)], held: u64) -> (Bricks<[u32; 3]>, Vec<u64>) {
-    let mut edges: Vec<u64> = Vec::new();
-    let mut index: Bricks<[u32; 3]> = Bricks::over([u32::MAX; 3], grid, held);
-    for &(c, config) in surface {
-        let mut ids = [u32::MAX; 3];
-        for (axis, id) in ids.iter_mut().enumerate() {
-            let (a, b) = EDGES[axis * 4];
-            if (config >> a & 1) != (config >> b & 1) {
-                *id = edges.len() as u32;
-                edges.push(c << 2 | axis as u64);
-            }
+/// The crossed edges each surface cell owns (those from its lower corner), numbered cell
+/// after cell in the surface cells' order: which axes each cell's are along, as bits, and
+/// the number of the first.
+struct Owned {
+    bits: Vec<u8>,
+    first: Vec<u32>,
+}
+
+impl Owned {
+    /// The edges of `surface` (sorted cells and their configurations).
+    fn new(surface: &[(u64, u8)]) -> Owned {
+        let bits: Vec<u8> = surface
+            .par_iter()
+            .map(|&(_, config)| {
+                (0..3).fold(0u8, |bits, axis| {
+                    let (a, b) = EDGES[axis * 4];
+                    bits | u8::from((config >> a & 1) != (config >> b & 1)) << axis
+                })
+            })
+            .collect();
+        let mut first = Vec::with_capacity(surface.len() + 1);
+        let mut count = 0u32;
+        for &b in &bits {
+            first.push(count);
+            count += b.count_ones();
         }
-        index.set(unpack(c), ids);
+        first.push(count);
+        Owned { bits, first }
     }
-    (index, edges)
+
+    /// The number of the edge along `axis` that surface cell `n` owns, if it owns one.
+    fn id(&self, n: usize, axis: usize) -> Option<u32> {
+        let bits = self.bits[n];
+        (bits >> axis & 1 == 1).then(|| self.first[n] + (bits & ((1 << axis) - 1)).count_ones())
+    }
+
+    /// Each edge's key (its cell's key and its axis), made in parallel.
+    fn keys(&self, surface: &[(u64, u8)]) -> Vec<u64> {
+        let mut edges = vec![0u64; self.first[surface.len()] as usize];
+        let mut parts = Vec::with_capacity(surface.len().div_ceil(RING_TASK));
+        let mut rest = &mut edges[..];
+        for (k, cells) in surface.chunks(RING_TASK).enumerate() {
+            let start = k * RING_TASK;
+            let n = self.first[start + cells.len()] - self.first[start];
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(n as usize);
+            parts.push((start, cells, part));
+            rest = tail;
+        }
+        parts.into_par_iter().for_each(|(start, cells, part)| {
+            let mut at = 0;
+            for (n, &(c, _)) in cells.iter().enumerate() {
+                for axis in 0..3 {
+                    if self.bits[start + n] >> axis & 1 == 1 {
+                        part[at] = c << 2 | axis as u64;
+                        at += 1;
+                    }
+                }
+            }
+        });
+        edges
+    }
 }
 
 /// The edge vertices: their positions and unit normals.
@@ -194,24 +238,42 @@ struct Rings {
 }
 
 impl Rings {
-    /// The patches of the `surface` cells (`table`), their edge vertices found in `index`:
-    /// those of a run of cells per task, joined in order.
-    fn new(surface: &[(u64, u8)], index: &Bricks<[u32; 3]>) -> Rings {
-        let parts: Vec<Rings> = surface
-            .par_chunks(RING_TASK)
-            .map(|part| {
+    /// The patches of the `surface` cells (`table`), with the numbers of their edge
+    /// vertices (`owned`): those of a run of cells per task, joined in order. An edge is
+    /// owned by the cell at its lower end, one of the eight at the corners of the cell from
+    /// its lowest; the cells are sorted, so the cell at each corner is found by a cursor
+    /// that only moves forward.
+    fn new(surface: &[(u64, u8)], owned: &Owned) -> Rings {
+        let parts: Vec<Rings> = (0..surface.len())
+            .step_by(RING_TASK)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|start| {
+                let part = &surface[start..(start + RING_TASK).min(surface.len())];
                 let mut rings = Rings {
                     cells: Vec::with_capacity(part.len()),
                     ring: Vec::with_capacity(4 * part.len()),
                     starts: Vec::with_capacity(part.len()),
                 };
+                let offset = |a: usize| pack(corner(a));
+                let mut cursors: [usize; 8] = std::array::from_fn(|a| {
+                    let target = part.first().map_or(0, |&(c, _)| c + offset(a));
+                    surface.partition_point(|&(k, _)| k < target)
+                });
                 for &(c, config) in part {
                     let i = unpack(c);
                     for cycle in patches(config) {
                         for &e in cycle {
                             let (a, _) = EDGES[e as usize];
-                            let id = index.get(add(i, corner(a)))[e as usize / 4];
-                            rings.ring.push(if id == u32::MAX { 0 } else { id });
+                            let target = c + offset(a);
+                            let m = &mut cursors[a];
+                            while *m < surface.len() && surface[*m].0 < target {
+                                *m += 1;
+                            }
+                            let id = (*m < surface.len() && surface[*m].0 == target)
+                                .then(|| owned.id(*m, e as usize / 4))
+                                .flatten();
+                            rings.ring.push(id.unwrap_or(0));
                         }
                         rings.cells.push(i);
                         rings.starts.push(rings.ring.len());
@@ -242,22 +304,32 @@ impl Rings {
     }
 
     /// Each patch fanned around its inner vertex (vertex `base + p` for patch `p`): the
-    /// triangles and each one's patch.
+    /// triangles and each one's patch, a run of patches per task.
     fn fans(&self, base: u32) -> (Vec<[u32; 3]>, Vec<u32>) {
-        // The triangles of patch `p` are `starts[p]..starts[p + 1]`, made in parallel.
-        let owner: Vec<u32> = (0..self.cells.len() as u32)
-            .into_par_iter()
-            .flat_map_iter(|p| std::iter::repeat_n(p, self.of(p as usize).len()))
-            .collect();
-        let triangles = owner
-            .par_iter()
-            .enumerate()
-            .map(|(t, &p)| {
-                let (start, end) = (self.starts[p as usize], self.starts[p as usize + 1]);
-                let next = if t + 1 == end { start } else { t + 1 };
-                [base + p, self.ring[t], self.ring[next]]
-            })
-            .collect();
+        // The triangles of patch `p` are `starts[p]..starts[p + 1]`.
+        let count = self.ring.len();
+        let (mut triangles, mut owner) = (vec![[0u32; 3]; count], vec![0u32; count]);
+        let mut parts = Vec::with_capacity(self.cells.len().div_ceil(RING_TASK));
+        let (mut rest_t, mut rest_o) = (&mut triangles[..], &mut owner[..]);
+        for first in (0..self.cells.len()).step_by(RING_TASK) {
+            let last = (first + RING_TASK).min(self.cells.len());
+            let n = self.starts[last] - self.starts[first];
+            let (t, tail_t) = std::mem::take(&mut rest_t).split_at_mut(n);
+            let (o, tail_o) = std::mem::take(&mut rest_o).split_at_mut(n);
+            parts.push((first..last, t, o));
+            (rest_t, rest_o) = (tail_t, tail_o);
+        }
+        parts.into_par_iter().for_each(|(patches, t, o)| {
+            let offset = self.starts[patches.start];
+            for p in patches {
+                let (start, end) = (self.starts[p], self.starts[p + 1]);
+                for k in start..end {
+                    let next = if k + 1 == end { start } else { k + 1 };
+                    t[k - offset] = [base + p as u32, self.ring[k], self.ring[next]];
+                    o[k - offset] = p as u32;
+                }
+            }
+        });
         (triangles, owner)
     }
 }
@@ -289,14 +361,15 @@ fn inner_vertices(
             place(&pts[..n], &nrm[..n], settings.sharp, [lo, hi])
         })
         .collect();
-    let mut centres: Vec<[f64; 3]> = inner.iter().map(|c| c.point).collect();
-    let smooth: Vec<bool> = inner.iter().map(|c| c.smooth).collect();
+    let mut centres: Vec<[f64; 3]> = inner.par_iter().map(|c| c.point).collect();
+    let smooth: Vec<bool> = inner.par_iter().map(|c| c.smooth).collect();
     choose(field, grid.voxel, &inner, &mut centres);
     stats.features = smooth.iter().filter(|s| !**s).count() as u64;
     onto_zero(field, grid, rings, edge.normals, &smooth, &mut centres);
-    for (centre, &cell) in centres.iter_mut().zip(&rings.cells) {
-        *centre = inside_cell(grid, cell, *centre);
-    }
+    centres
+        .par_iter_mut()
+        .zip(&rings.cells)
+        .for_each(|(centre, &cell)| *centre = inside_cell(grid, cell, *centre));
     let patches = Patches {
         cells: &rings.cells,
         ring: &rings.ring,
@@ -495,17 +568,22 @@ fn flip(
     smooth: &[bool],
     voxel: f64,
 ) -> u64 {
+    // The sharp patches' triangles, in order (found in parallel).
+    let sharp: Vec<usize> = (0..triangles.len())
+        .into_par_iter()
+        .filter(|&t| !smooth[owner[t] as usize])
+        .collect();
     // Each fan triangle [centre, a, b] has one patch edge, a → b.
     let mut by_edge: KeyMap<u32> = KeyMap::default();
-    for (t, tri) in triangles.iter().enumerate() {
-        if !smooth[owner[t] as usize] {
-            by_edge.insert((tri[1] as u64) << 32 | tri[2] as u64, t as u32);
-        }
+    by_edge.reserve(sharp.len());
+    for &t in &sharp {
+        let tri = triangles[t];
+        by_edge.insert((tri[1] as u64) << 32 | tri[2] as u64, t as u32);
     }
     let mut pairs = Vec::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        let (a, b) = (tri[1], tri[2]);
-        if a > b || smooth[owner[t] as usize] {
+    for &t in &sharp {
+        let (a, b) = (triangles[t][1], triangles[t][2]);
+        if a > b {
             continue;
         }
         if let Some(&u) = by_edge.get(&((b as u64) << 32 | a as u64)) {

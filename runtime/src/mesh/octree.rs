@@ -15,7 +15,8 @@
 //! and every line through the ball meets the surface on both sides of it (the clipped solid
 //! is bounded), in cells that the octree keeps.
 
-use super::{pack, Field, Grid, KEY_BITS};
+use super::{pack, Field, Grid};
+use rayon::prelude::*;
 
 /// Relative slack of the test, for the rounding of the distance program.
 const SLACK: f64 = 1e-6;
@@ -48,7 +49,7 @@ pub struct Candidates {
     /// Octree cells whose centre was evaluated (0 for the dense grid).
     pub evaluated: u64,
     /// The centres of the last level's cells kept, which are corners of the candidates
-    /// (the corner every child of one shares), with their values: packed keys, in no order.
+    /// (the corner every child of one shares), with their values: packed keys, sorted.
     /// Contouring reads them instead of evaluating those corners again.
     pub centres: Vec<(u64, f64)>,
 }
@@ -149,36 +150,23 @@ pub fn candidates(
         }
         let reach =
             field.lipschitz * half * 3f64.sqrt() * (1.0 + SLACK) + SLACK * grid.voxel + rounding;
-        let kept = || {
-            frontier
-                .iter()
-                .zip(&d)
-                .filter(|(_, d)| !(d.abs() > reach))
-                .map(|(c, _)| *c)
-        };
+        let keep: Vec<bool> = d.par_iter().map(|d| !(d.abs() > reach)).collect();
         progress((level + 1) as f64 / levels.max(1) as f64);
-        let child = size / 2;
-        let children = |c: [u32; 3]| {
-            (0..8u32)
-                .map(move |o| [0, 1, 2].map(|a| 2 * c[a] + (o >> a & 1)))
-                .filter(move |ch| (0..3).all(|a| ch[a] * child < grid.cells[a]))
-        };
+        let runs = Runs::new(&frontier, &keep, size / 2, grid.cells);
         // The next level's cells are counted before they are stored, so that a grid too fine
         // for the cells limit is refused without allocating them.
-        let count: u64 = kept().map(|c| children(c).count() as u64).sum();
+        let count = runs.count();
         if evaluated + count > max_cells {
             return Err(Refused::Cells(evaluated + count));
         }
-        let mut next = Vec::with_capacity(count as usize);
-        next.extend(kept().flat_map(children));
         if level + 1 == levels {
-            let mut cells: Vec<u64> = next.into_iter().map(pack).collect();
-            sort_keys(&mut cells, grid.cells);
+            let cells = runs.children(pack);
             let centres = frontier
-                .iter()
+                .par_iter()
                 .zip(&d)
-                .filter(|(_, d)| !(d.abs() > reach))
-                .map(|(c, &d)| (pack(c.map(|x| 2 * x + 1)), d))
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .map(|((c, &d), _)| (pack(c.map(|x| 2 * x + 1)), d))
                 .collect();
             return Ok(Candidates {
                 cells,
@@ -186,6 +174,7 @@ pub fn candidates(
                 centres,
             });
         }
+        let next = runs.children(|c| c);
         frontier = next;
     }
     Ok(Candidates {
@@ -195,37 +184,108 @@ pub fn candidates(
     })
 }
 
-/// Bits of a radix pass of [`sort_keys`].
-const DIGIT: u32 = 11;
+/// A level's cells (sorted by key: z, then y, then x) in runs of one layer along z, with
+/// which of them are kept, from which the next level's cells (`child` grid cells along an
+/// edge, those that begin inside a grid of `cells`) are made sorted by key, a layer at a
+/// time in parallel: the children of one layer along z of the parents lie in two layers of
+/// their own, each row of parents giving two rows in turn, where a parent's children along
+/// x follow its neighbour's. No sort is needed, and the next level is sorted in turn.
+struct Runs<'a> {
+    cells: &'a [[u32; 3]],
+    keep: &'a [bool],
+    child: u32,
+    grid: [u32; 3],
+    /// The start of each layer's run in `cells` (and, last, their end).
+    starts: Vec<usize>,
+    /// Children of each layer's kept cells.
+    counts: Vec<u64>,
+}
 
-/// Packed keys of cells of a grid of `cells` sorted: a least-significant-digit radix sort
-/// over the bits the cells' indices use (a pass per [`DIGIT`] bits, three for a grid of up to
-/// 2048 cells along each axis), where a comparison sort's work grows as n log n.
-fn sort_keys(keys: &mut Vec<u64>, cells: [u32; 3]) {
-    let mut other = vec![0u64; keys.len()];
-    for (axis, &n) in cells.iter().enumerate() {
-        let used = u32::BITS - n.saturating_sub(1).leading_zeros();
-        let mut low = 0;
-        while low < used {
-            let bits = (used - low).min(DIGIT);
-            let shift = axis as u32 * KEY_BITS + low;
-            let digit = |k: u64| (k >> shift & ((1 << bits) - 1)) as usize;
-            let mut starts = vec![0usize; 1 << bits];
-            for &k in keys.iter() {
-                starts[digit(k)] += 1;
-            }
-            let mut sum = 0;
-            for s in &mut starts {
-                (*s, sum) = (sum, sum + *s);
-            }
-            for &k in keys.iter() {
-                let d = digit(k);
-                other[starts[d]] = k;
-                starts[d] += 1;
-            }
-            std::mem::swap(keys, &mut other);
-            low += bits;
+impl<'a> Runs<'a> {
+    fn new(cells: &'a [[u32; 3]], keep: &'a [bool], child: u32, grid: [u32; 3]) -> Self {
+        let mut starts = vec![0];
+        if !cells.is_empty() {
+            starts.extend((1..cells.len()).filter(|&n| cells[n][2] != cells[n - 1][2]));
+            starts.push(cells.len());
         }
+        let mut runs = Runs {
+            cells,
+            keep,
+            child,
+            grid,
+            starts,
+            counts: Vec::new(),
+        };
+        runs.counts = (0..runs.starts.len() - 1)
+            .into_par_iter()
+            .map(|r| runs.layer(r, &mut |_| ()))
+            .collect();
+        runs
+    }
+
+    /// The next level's cells.
+    fn count(&self) -> u64 {
+        self.counts.iter().sum()
+    }
+
+    /// Whether a child's index `x` along `axis` begins inside the grid.
+    fn inside(&self, x: u32, axis: usize) -> bool {
+        x * self.child < self.grid[axis]
+    }
+
+    /// The children of layer `r`'s kept cells, in key order, each given to `emit`; their
+    /// number.
+    fn layer(&self, r: usize, emit: &mut impl FnMut([u32; 3])) -> u64 {
+        let run = &self.cells[self.starts[r]..self.starts[r + 1]];
+        let keep = &self.keep[self.starts[r]..self.starts[r + 1]];
+        let mut n = 0;
+        for dz in 0..2 {
+            let z = 2 * run[0][2] + dz;
+            if !self.inside(z, 2) {
+                continue;
+            }
+            let mut row = 0;
+            while row < run.len() {
+                let end = row + run[row..].partition_point(|c| c[1] == run[row][1]);
+                for dy in 0..2 {
+                    let y = 2 * run[row][1] + dy;
+                    if !self.inside(y, 1) {
+                        continue;
+                    }
+                    for (c, _) in run[row..end].iter().zip(&keep[row..end]).filter(|p| *p.1) {
+                        for dx in 0..2 {
+                            let x = 2 * c[0] + dx;
+                            if self.inside(x, 0) {
+                                emit([x, y, z]);
+                                n += 1;
+                            }
+                        }
+                    }
+                }
+                row = end;
+            }
+        }
+        n
+    }
+
+    /// The children of the kept cells, sorted by key, each made by `make`.
+    fn children<T: Send + Copy + Default>(&self, make: impl Fn([u32; 3]) -> T + Sync) -> Vec<T> {
+        let mut out = vec![T::default(); self.count() as usize];
+        let mut parts = Vec::with_capacity(self.counts.len());
+        let mut rest = &mut out[..];
+        for (r, &n) in self.counts.iter().enumerate() {
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(n as usize);
+            parts.push((r, part));
+            rest = tail;
+        }
+        parts.into_par_iter().for_each(|(r, part)| {
+            let mut k = 0;
+            self.layer(r, &mut |c| {
+                part[k] = make(c);
+                k += 1;
+            });
+        });
+        out
     }
 }
 
@@ -336,34 +396,53 @@ mod tests {
     use super::*;
     use crate::mesh::unpack;
 
-    /// The radix sort sorts as a comparison sort does, over grids whose axes need one pass
-    /// or several.
+    /// The children made layer by layer are sorted, each once, and are those of the kept
+    /// cells that begin inside the grid, over grids whose sides are odd or even.
     #[test]
-    fn keys_sort_as_numbers_do() {
+    fn children_are_made_sorted() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        for cells in [
-            [1, 1, 1],
-            [259, 147, 259],
-            [5000, 3, 2100],
-            [1 << 19, 7, 70],
-        ] {
-            let mut keys: Vec<u64> = (0..20_000)
+        for (grid, child) in [([1, 1, 1], 1), ([259, 147, 259], 4), ([37, 3, 20], 1)] {
+            let parents = grid.map(|n: u32| n.div_ceil(2 * child));
+            let mut cells = Vec::new();
+            for z in 0..parents[2] {
+                for y in 0..parents[1] {
+                    for x in 0..parents[0] {
+                        cells.push([x, y, z]);
+                    }
+                }
+            }
+            let keep: Vec<bool> = cells
+                .iter()
                 .map(|_| {
-                    pack(cells.map(|n| {
-                        state = state
-                            .wrapping_mul(6_364_136_223_846_793_005)
-                            .wrapping_add(1);
-                        (state >> 33) as u32 % n
-                    }))
+                    state = state
+                        .wrapping_mul(6_364_136_223_846_793_005)
+                        .wrapping_add(1);
+                    state >> 62 != 0
                 })
                 .collect();
-            let mut expected = keys.clone();
-            expected.sort_unstable();
-            sort_keys(&mut keys, cells);
-            assert_eq!(keys, expected, "{cells:?}");
-            assert!(keys
+            let runs = Runs::new(&cells, &keep, child, grid);
+            let made = runs.children(pack);
+            let mut expected: Vec<u64> = cells
                 .iter()
-                .all(|&k| (0..3).all(|a| unpack(k)[a] < cells[a])));
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .flat_map(|(c, _)| {
+                    (0..8u32).map(move |o| [0, 1, 2].map(|a| 2 * c[a] + (o >> a & 1)))
+                })
+                .filter(|ch| (0..3).all(|a| ch[a] * child < grid[a]))
+                .map(pack)
+                .collect();
+            expected.sort_unstable();
+            assert_eq!(made, expected, "{grid:?}");
+            assert_eq!(runs.count(), made.len() as u64);
+            assert!(made
+                .iter()
+                .all(|&k| (0..3).all(|a| unpack(k)[a] * child < grid[a])));
+            let unpacked = runs.children(|c| c);
+            assert_eq!(unpacked.iter().map(|&c| pack(c)).collect::<Vec<_>>(), made);
         }
+        let none = Runs::new(&[], &[], 1, [4, 4, 4]);
+        assert_eq!(none.count(), 0);
+        assert!(none.children(pack).is_empty());
     }
 }

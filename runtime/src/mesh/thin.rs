@@ -38,8 +38,9 @@ const WALK: usize = 8;
 /// Bisection rounds towards each root (the thickness to 2⁻¹⁶ of a cell).
 const BISECTIONS: u32 = 16;
 
-/// Edges probed together (the memory this holds is a few MiB, whatever the grid).
-const BATCH: usize = 1 << 12;
+/// Edges probed together, enough that their evaluations are shared among the threads (the
+/// memory this holds is a few MiB, whatever the grid).
+const BATCH: usize = 1 << 15;
 
 /// Which share of the features found, thinnest first, the reported thickness leaves below
 /// it: a tenth, so that the refined grid resolves nine features in ten, and a few edges that
@@ -126,11 +127,16 @@ const SCAN_TASK: usize = 1 << 11;
 /// grow away from the edge, the point where the two balls meet.
 fn probe(grid: &Grid, values: &Bricks<f64>, l: f64, c: u64, probes: &mut Vec<Probe>) {
     let h = grid.voxel;
+    let far = 2.0 * l * h;
     let i = unpack(c);
     let cube = values.cube(i);
     for axis in 0..3 {
         let (a, b) = (cube[0], cube[1 << axis]);
         if !(a.is_finite() && b.is_finite()) || (a < 0.0) != (b < 0.0) {
+            continue;
+        }
+        // Balls far wider than the edge, without dividing (the test below decides the rest).
+        if a.abs() + b.abs() > far {
             continue;
         }
         let (ra, rb) = (a.abs() / l, b.abs() / l);

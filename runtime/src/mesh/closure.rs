@@ -6,7 +6,7 @@
 
 use super::table::{corner, EDGES};
 use super::thin;
-use super::{pack, unpack, Bricks, Field, Grid, Stats, KEY_BITS};
+use super::{filled_in_parts, pack, unpack, Bricks, Field, Grid, Stats, KEY_BITS};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -187,24 +187,8 @@ fn corners_unknown(cells: &[u64], known: &[(u64, f64)]) -> Vec<u64> {
             unknown(keys, &known[from..to])
         })
         .collect();
-    concat(parts)
-}
-
-/// `parts` one after another, copied in parallel.
-fn concat<T: Copy + Default + Send + Sync>(parts: Vec<Vec<T>>) -> Vec<T> {
-    let mut out = vec![T::default(); parts.iter().map(Vec::len).sum()];
-    let mut slices = Vec::with_capacity(parts.len());
-    let mut rest = &mut out[..];
-    for part in &parts {
-        let (slice, tail) = std::mem::take(&mut rest).split_at_mut(part.len());
-        slices.push(slice);
-        rest = tail;
-    }
-    slices
-        .into_par_iter()
-        .zip(&parts)
-        .for_each(|(slice, part)| slice.copy_from_slice(part));
-    out
+    let lengths: Vec<usize> = parts.iter().map(Vec::len).collect();
+    filled_in_parts(&lengths, |r, out| out.copy_from_slice(&parts[r]))
 }
 
 /// The corners of `cells` (sorted keys), sorted, each once, along the first `axes` axes:

@@ -106,6 +106,27 @@ pub fn unpack(k: u64) -> [u32; 3] {
     ]
 }
 
+/// A vector of `lengths`' sum, its consecutive parts of those lengths filled in parallel by
+/// `fill(part's index, part)`.
+pub(crate) fn filled_in_parts<T: Copy + Default + Send>(
+    lengths: &[usize],
+    fill: impl Fn(usize, &mut [T]) + Sync,
+) -> Vec<T> {
+    let mut out = vec![T::default(); lengths.iter().sum()];
+    let mut parts = Vec::with_capacity(lengths.len());
+    let mut rest = &mut out[..];
+    for &n in lengths {
+        let (part, tail) = std::mem::take(&mut rest).split_at_mut(n);
+        parts.push(part);
+        rest = tail;
+    }
+    parts
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(r, part)| fill(r, part));
+    out
+}
+
 /// A hasher for packed keys: one multiplication, its high bits folded down.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct KeyHasher(u64);

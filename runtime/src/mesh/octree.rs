@@ -15,7 +15,7 @@
 //! and every line through the ball meets the surface on both sides of it (the clipped solid
 //! is bounded), in cells that the octree keeps.
 
-use super::{pack, Field, Grid};
+use super::{filled_in_parts, pack, Field, Grid};
 use rayon::prelude::*;
 
 /// Relative slack of the test, for the rounding of the distance program.
@@ -270,22 +270,14 @@ impl<'a> Runs<'a> {
 
     /// The children of the kept cells, sorted by key, each made by `make`.
     fn children<T: Send + Copy + Default>(&self, make: impl Fn([u32; 3]) -> T + Sync) -> Vec<T> {
-        let mut out = vec![T::default(); self.count() as usize];
-        let mut parts = Vec::with_capacity(self.counts.len());
-        let mut rest = &mut out[..];
-        for (r, &n) in self.counts.iter().enumerate() {
-            let (part, tail) = std::mem::take(&mut rest).split_at_mut(n as usize);
-            parts.push((r, part));
-            rest = tail;
-        }
-        parts.into_par_iter().for_each(|(r, part)| {
+        let lengths: Vec<usize> = self.counts.iter().map(|&n| n as usize).collect();
+        filled_in_parts(&lengths, |r, part| {
             let mut k = 0;
             self.layer(r, &mut |c| {
                 part[k] = make(c);
                 k += 1;
             });
-        });
-        out
+        })
     }
 }
 
